@@ -1,0 +1,1 @@
+//! Kinematics: spline routes and wave perturbations (see submodules).

@@ -1,0 +1,27 @@
+//! # mmusv-core
+//!
+//! The plain-Rust heart of mmusv, a headless maritime simulator for multi-USV cooperative perception.
+//! It has no Python in it: the `mmusv-py` crate wraps it for Python, and `cargo test -p mmusv-core`
+//! runs on its own.
+//!
+//! Modules, one job each:
+//! - [`error`]: the one error enum every fallible call returns.
+//! - [`geometry`]: rigid poses, rays and the ray–triangle test.
+//! - [`mesh`]: triangle meshes with per-face semantic classes and a parry bottom-level BVH built once.
+//! - [`scene`]: meshes placed as instances, a top-level BVH over them, and batch ray casting over rayon.
+//! - [`export`]: the world triangles at the current poses as PLY or OBJ.
+//! - [`kinematics`]: spline routes at nominal speed with wave-driven heave, roll and pitch.
+//!
+//! Conventions: metres, seconds, radians; world frame right-handed, x east, y north, z up, water at z = 0.
+
+pub mod error;
+pub mod export;
+pub mod geometry;
+pub mod kinematics;
+pub mod mesh;
+pub mod scene;
+
+pub use error::{MmusvError, Result};
+pub use geometry::RigidPose;
+pub use mesh::Mesh;
+pub use scene::{RayHits, Scene};
