@@ -69,7 +69,8 @@ pub struct RayHits {
     /// Triangle index within that instance's mesh, or [`NO_HIT`].
     pub triangle: Vec<i32>,
     /// Unit geometric normal in the world frame, following the triangle winding; zero for a miss.
-    pub normal: Vec<[f32; 3]>,
+    /// Flat `(N, 3)` row-major: ray `i` owns `normal[3i..3i+3]`.
+    pub normal: Vec<f32>,
     /// Semantic class of the triangle hit, or [`CLASS_NONE`].
     pub class: Vec<u16>,
     /// Whether the ray hit the back side of the triangle (`normal · dir > 0`).
@@ -82,7 +83,7 @@ impl RayHits {
             distance: vec![f32::INFINITY; n],
             instance: vec![NO_HIT; n],
             triangle: vec![NO_HIT; n],
-            normal: vec![[0.0; 3]; n],
+            normal: vec![0.0; 3 * n],
             class: vec![CLASS_NONE; n],
             backface: vec![false; n],
         }
@@ -248,7 +249,7 @@ impl Scene {
             out.distance.par_chunks_mut(CHUNK),
             out.instance.par_chunks_mut(CHUNK),
             out.triangle.par_chunks_mut(CHUNK),
-            out.normal.par_chunks_mut(CHUNK),
+            out.normal.par_chunks_mut(3 * CHUNK),
             out.class.par_chunks_mut(CHUNK),
             out.backface.par_chunks_mut(CHUNK),
             origins.par_chunks(CHUNK),
@@ -263,7 +264,7 @@ impl Scene {
                         dist[i] = hit.distance;
                         inst[i] = hit.instance as i32;
                         tri[i] = hit.triangle as i32;
-                        nrm[i] = n.to_array();
+                        nrm[3 * i..3 * i + 3].copy_from_slice(&n.to_array());
                         cls[i] = c;
                         back[i] = n.dot(dir) > 0.0;
                     }
@@ -362,7 +363,7 @@ mod tests {
         assert_eq!(hits.instance[0], id as i32);
         assert_eq!(hits.class[0], 9);
         assert!(!hits.backface[0]);
-        assert!((hits.normal[0][0] + 1.0).abs() < 1e-6, "outward normal of the -x face");
+        assert!((hits.normal[0] + 1.0).abs() < 1e-6, "outward normal of the -x face");
         // From inside the box the ray leaves through the +x face's back side.
         assert!((hits.distance[1] - 2.0).abs() < 1e-5);
         assert!(hits.backface[1]);
@@ -393,7 +394,7 @@ mod tests {
                 hits += 1;
                 assert!((ha.distance[i] - hb.distance[i]).abs() <= 1e-4 * hb.distance[i]);
                 for k in 0..3 {
-                    assert!((ha.normal[i][k] - hb.normal[i][k]).abs() < 1e-4);
+                    assert!((ha.normal[3 * i + k] - hb.normal[3 * i + k]).abs() < 1e-4);
                 }
             }
         }

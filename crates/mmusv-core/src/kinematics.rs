@@ -1,1 +1,0 @@
-//! Kinematics: spline routes and wave perturbations (see submodules).

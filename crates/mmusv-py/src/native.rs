@@ -1,0 +1,48 @@
+//! The one wrapper for every long native call, and array helpers.
+
+use crate::errors::{to_py, InputError, InternalError};
+use numpy::{PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+/// Runs `f` with the GIL released; a core error becomes its Python exception, a panic an `InternalError`.
+pub fn detached<T, F>(py: Python<'_>, f: F) -> PyResult<T>
+where
+    F: FnOnce() -> mmusv_core::Result<T> + Send,
+    T: Send,
+{
+    let outcome = py.detach(|| catch_unwind(AssertUnwindSafe(f)));
+    match outcome {
+        Ok(result) => result.map_err(to_py),
+        Err(payload) => {
+            let what = payload
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown panic".to_string());
+            Err(InternalError::new_err(format!(
+                "internal error in mmusv (please report it with the input that caused it): {what}"
+            )))
+        }
+    }
+}
+
+/// Borrows a C-contiguous `(N, K)` array as rows of `K`; `name` is used in the error.
+pub fn rows<'a, T: numpy::Element, const K: usize>(arr: &'a PyReadonlyArray2<'_, T>, name: &str) -> PyResult<&'a [[T; K]]> {
+    let shape = arr.shape();
+    if shape[1] != K {
+        return Err(InputError::new_err(format!("{name} must have shape (N, {K}), got {shape:?}")));
+    }
+    let flat = arr
+        .as_slice()
+        .map_err(|_| InputError::new_err(format!("{name} must be C-contiguous (use numpy.ascontiguousarray)")))?;
+    let (chunks, rest) = flat.as_chunks::<K>();
+    debug_assert!(rest.is_empty());
+    Ok(chunks)
+}
+
+/// Borrows a C-contiguous 1-D array; `name` is used in the error.
+pub fn flat<'a, T: numpy::Element>(arr: &'a PyReadonlyArray1<'_, T>, name: &str) -> PyResult<&'a [T]> {
+    arr.as_slice()
+        .map_err(|_| InputError::new_err(format!("{name} must be C-contiguous (use numpy.ascontiguousarray)")))
+}

@@ -1,0 +1,228 @@
+//! Bindings for `mmusv_core::scene`, `mesh` and `export`: build a scene from numpy arrays, place and move
+//! instances, cast rays, export the world triangles.
+
+use crate::errors::InputError;
+use crate::native::{detached, flat, rows};
+use mmusv_core::export::{write_world_mesh, MeshFormat};
+use mmusv_core::{Mesh, RigidPose, Scene as CoreScene};
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use std::path::PathBuf;
+use std::sync::RwLock;
+
+/// Tuple of arrays returned by `Scene.cast_rays` (see the `.pyi` for shapes and dtypes).
+type RayHitArrays<'py> = (
+    Bound<'py, PyArray1<f32>>,
+    Bound<'py, PyArray1<i32>>,
+    Bound<'py, PyArray1<i32>>,
+    Bound<'py, PyArray2<f32>>,
+    Bound<'py, PyArray1<u16>>,
+    Bound<'py, PyArray1<bool>>,
+);
+
+/// Tuple of arrays returned by `Scene.world_mesh`.
+type WorldMeshArrays<'py> = (
+    Bound<'py, PyArray2<f32>>,
+    Bound<'py, PyArray2<u32>>,
+    Bound<'py, PyArray1<u16>>,
+    Bound<'py, PyArray1<u32>>,
+    Bound<'py, PyArray1<u32>>,
+);
+
+/// A ray-casting scene: meshes (each with a BVH built once) placed as instances.
+#[pyclass(frozen, module = "mmusv._core")]
+pub struct Scene {
+    inner: RwLock<CoreScene>,
+}
+
+fn poisoned() -> PyErr {
+    crate::errors::InternalError::new_err("scene lock poisoned by an earlier internal error; rebuild the scene")
+}
+
+fn pose_from(arr: &[f64], field: &str) -> PyResult<RigidPose> {
+    let m: [f64; 16] = arr.try_into().map_err(|_| InputError::new_err(format!("{field} must be a 4x4 matrix")))?;
+    RigidPose::from_matrix_row_major(&m, field).map_err(crate::errors::to_py)
+}
+
+impl Scene {
+    /// Runs `f` on the scene under the read lock.
+    pub fn read<T>(&self, f: impl FnOnce(&CoreScene) -> PyResult<T>) -> PyResult<T> {
+        let guard = self.inner.read().map_err(|_| poisoned())?;
+        f(&guard)
+    }
+}
+
+#[pymethods]
+impl Scene {
+    #[new]
+    fn new() -> Self {
+        Self { inner: RwLock::new(CoreScene::new()) }
+    }
+
+    /// Adds a mesh; builds its BVH with the GIL released. Returns the mesh id.
+    #[pyo3(signature = (vertices, faces, classes, name))]
+    fn add_mesh(
+        &self,
+        py: Python<'_>,
+        vertices: PyReadonlyArray2<'_, f32>,
+        faces: PyReadonlyArray2<'_, i64>,
+        classes: PyReadonlyArray1<'_, u16>,
+        name: &str,
+    ) -> PyResult<u32> {
+        let v = rows::<f32, 3>(&vertices, "vertices")?;
+        let f = rows::<i64, 3>(&faces, "faces")?;
+        let c = flat(&classes, "classes")?;
+        let mesh = detached(py, || Mesh::new(name, v, f, c))?;
+        let mut guard = self.inner.write().map_err(|_| poisoned())?;
+        Ok(guard.add_mesh(mesh))
+    }
+
+    /// Places mesh `mesh_id` at `pose` (4x4 float64); returns the instance id.
+    #[pyo3(signature = (mesh_id, pose, class_override=None))]
+    fn add_instance(&self, mesh_id: u32, pose: PyReadonlyArray2<'_, f64>, class_override: Option<u16>) -> PyResult<u32> {
+        if pose.shape() != [4, 4] {
+            return Err(InputError::new_err(format!("pose must have shape (4, 4), got {:?}", pose.shape())));
+        }
+        let p = pose_from(flat_2d(&pose)?, "pose")?;
+        let mut guard = self.inner.write().map_err(|_| poisoned())?;
+        guard.add_instance(mesh_id, p, class_override).map_err(crate::errors::to_py)
+    }
+
+    /// Moves instances `ids` (K,) to `poses` (K, 4, 4); rebuilds only the top-level BVH.
+    fn set_poses(&self, ids: PyReadonlyArray1<'_, u32>, poses: PyReadonlyArray3<'_, f64>) -> PyResult<()> {
+        let ids = flat(&ids, "instance_ids")?;
+        let shape = poses.shape();
+        if shape[1] != 4 || shape[2] != 4 || shape[0] != ids.len() {
+            return Err(InputError::new_err(format!(
+                "poses must have shape ({}, 4, 4) for {} ids, got {shape:?}",
+                ids.len(),
+                ids.len()
+            )));
+        }
+        let data = poses.as_slice().map_err(|_| InputError::new_err("poses must be C-contiguous"))?;
+        let parsed = data
+            .chunks_exact(16)
+            .enumerate()
+            .map(|(i, m)| pose_from(m, &format!("poses[{i}]")))
+            .collect::<PyResult<Vec<_>>>()?;
+        let mut guard = self.inner.write().map_err(|_| poisoned())?;
+        guard.set_poses(ids, &parsed).map_err(crate::errors::to_py)
+    }
+
+    /// Casts rays (GIL released, all cores). Returns
+    /// `(distance, instance_id, triangle_id, normal, semantic_class, backface)`.
+    #[pyo3(signature = (origins, directions, max_range))]
+    fn cast_rays<'py>(
+        &self,
+        py: Python<'py>,
+        origins: PyReadonlyArray2<'py, f32>,
+        directions: PyReadonlyArray2<'py, f32>,
+        max_range: f32,
+    ) -> PyResult<RayHitArrays<'py>> {
+        let o = rows::<f32, 3>(&origins, "origins")?;
+        let d = rows::<f32, 3>(&directions, "directions")?;
+        let hits = self.read(|s| detached(py, || s.cast_rays(o, d, max_range)))?;
+        let n = hits.len();
+        let normal = Array2::from_shape_vec((n, 3), hits.normal)
+            .map_err(|e| crate::errors::InternalError::new_err(e.to_string()))?;
+        Ok((
+            hits.distance.into_pyarray(py),
+            hits.instance.into_pyarray(py),
+            hits.triangle.into_pyarray(py),
+            normal.into_pyarray(py),
+            hits.class.into_pyarray(py),
+            hits.backface.into_pyarray(py),
+        ))
+    }
+
+    /// The world triangles at the current poses:
+    /// `(vertices (V,3) f32, faces (F,3) u32, classes (F,) u16, instance_ids (F,) u32, triangle_ids (F,) u32)`.
+    fn world_mesh<'py>(&self, py: Python<'py>) -> PyResult<WorldMeshArrays<'py>> {
+        let w = self.read(|s| detached(py, || Ok(s.world_mesh())))?;
+        let nv = w.vertices.len();
+        let nf = w.faces.len();
+        let v = Array2::from_shape_vec((nv, 3), w.vertices.into_iter().flatten().collect())
+            .map_err(|e| crate::errors::InternalError::new_err(e.to_string()))?;
+        let f = Array2::from_shape_vec((nf, 3), w.faces.into_iter().flatten().collect())
+            .map_err(|e| crate::errors::InternalError::new_err(e.to_string()))?;
+        Ok((v.into_pyarray(py), f.into_pyarray(py), w.classes.into_pyarray(py), w.instances.into_pyarray(py), w.triangles.into_pyarray(py)))
+    }
+
+    /// Writes the world triangles at the current poses to `path` (`.ply` or `.obj`).
+    fn export(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        self.read(|s| {
+            detached(py, || {
+                let format = MeshFormat::from_path(&path)?;
+                write_world_mesh(&s.world_mesh(), &path, format)
+            })
+        })
+    }
+
+    /// World-space AABB of an instance at its current pose, `(2, 3)` float32: min row, max row.
+    fn instance_aabb<'py>(&self, py: Python<'py>, instance_id: u32) -> PyResult<Bound<'py, PyArray2<f32>>> {
+        let aabb = self.read(|s| s.instance_aabb(instance_id).map_err(crate::errors::to_py))?;
+        let arr = Array2::from_shape_vec((2, 3), [aabb.mins.to_array(), aabb.maxs.to_array()].concat())
+            .map_err(|e| crate::errors::InternalError::new_err(e.to_string()))?;
+        Ok(arr.into_pyarray(py))
+    }
+
+    /// The current pose of an instance as a 4x4 float64 matrix.
+    fn instance_pose<'py>(&self, py: Python<'py>, instance_id: u32) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let m = self.read(|s| {
+            let inst = s.instances().get(instance_id as usize).ok_or_else(|| {
+                crate::errors::NotFoundError::new_err(format!(
+                    "unknown instance id {instance_id}: the scene has {} instances",
+                    s.instances().len()
+                ))
+            })?;
+            Ok(inst.pose().to_matrix_row_major())
+        })?;
+        let arr = Array2::from_shape_vec((4, 4), m.to_vec())
+            .map_err(|e| crate::errors::InternalError::new_err(e.to_string()))?;
+        Ok(arr.into_pyarray(py))
+    }
+
+    /// Mesh id placed by each instance, `(K,)` uint32.
+    fn instance_meshes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<u32>>> {
+        let v = self.read(|s| Ok(s.instances().iter().map(|i| i.mesh()).collect::<Vec<u32>>()))?;
+        Ok(v.into_pyarray(py))
+    }
+
+    /// Number of meshes.
+    #[getter]
+    fn num_meshes(&self) -> PyResult<usize> {
+        self.read(|s| Ok(s.meshes().len()))
+    }
+
+    /// Number of instances.
+    #[getter]
+    fn num_instances(&self) -> PyResult<usize> {
+        self.read(|s| Ok(s.instances().len()))
+    }
+
+    /// Number of triangles placed in the world.
+    #[getter]
+    fn num_world_triangles(&self) -> PyResult<usize> {
+        self.read(|s| Ok(s.num_world_triangles()))
+    }
+
+    fn __repr__(&self) -> PyResult<String> {
+        self.read(|s| {
+            Ok(format!(
+                "Scene(meshes={}, instances={}, world_triangles={})",
+                s.meshes().len(),
+                s.instances().len(),
+                s.num_world_triangles()
+            ))
+        })
+    }
+}
+
+fn flat_2d<'a>(arr: &'a PyReadonlyArray2<'_, f64>) -> PyResult<&'a [f64]> {
+    arr.as_slice().map_err(|_| InputError::new_err("pose must be C-contiguous"))
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Scene>()
+}

@@ -1,0 +1,60 @@
+"""Semantic classes shared by every mesh, sensor and annotation, with a fixed colour palette.
+
+Class ids are ``uint16`` in Rust and numpy. ``0`` means "nothing hit" (sky, no return). The palette is the
+one quick-look images and semantic camera PNGs use: ``PALETTE[class_id]`` is an ``(R, G, B)`` uint8 triple.
+"""
+
+from __future__ import annotations
+
+from enum import IntEnum
+
+import numpy as np
+
+__all__ = ["SemanticClass", "PALETTE", "palette_array", "class_name"]
+
+
+class SemanticClass(IntEnum):
+    """Semantic class ids (stable: they are written into recordings)."""
+
+    NONE = 0
+    WATER = 1
+    TERRAIN = 2
+    VEGETATION = 3
+    PORT_STRUCTURE = 4
+    CONTAINER = 5
+    CRANE = 6
+    BUOY = 7
+    BUILDING = 8
+    VESSEL = 10
+    USV = 11
+
+
+PALETTE: dict[int, tuple[int, int, int]] = {
+    SemanticClass.NONE: (0, 0, 0),
+    SemanticClass.WATER: (30, 90, 160),
+    SemanticClass.TERRAIN: (150, 120, 80),
+    SemanticClass.VEGETATION: (60, 140, 60),
+    SemanticClass.PORT_STRUCTURE: (170, 170, 170),
+    SemanticClass.CONTAINER: (200, 80, 40),
+    SemanticClass.CRANE: (230, 200, 40),
+    SemanticClass.BUOY: (255, 100, 180),
+    SemanticClass.BUILDING: (120, 100, 140),
+    SemanticClass.VESSEL: (240, 240, 240),
+    SemanticClass.USV: (40, 220, 220),
+}
+
+
+def palette_array() -> np.ndarray:
+    """The palette as a ``(256, 3)`` uint8 lookup table indexed by class id (unknown ids are magenta)."""
+    lut = np.full((256, 3), (255, 0, 255), dtype=np.uint8)
+    for k, rgb in PALETTE.items():
+        lut[int(k)] = rgb
+    return lut
+
+
+def class_name(class_id: int) -> str:
+    """Lower-case name of a class id, e.g. ``class_name(10) == "vessel"``; ``"unknown_<id>"`` otherwise."""
+    try:
+        return SemanticClass(class_id).name.lower()
+    except ValueError:
+        return f"unknown_{class_id}"

@@ -1,0 +1,205 @@
+"""The low-level ray-casting scene: build it from numpy arrays, place instances, cast rays.
+
+Frames and units: world frame right-handed (x east, y north, z up), metres. A pose is a ``(4, 4)`` homogeneous
+rigid transform (body → world). Distances are metres along the normalised ray direction.
+
+Example::
+
+    scene = Scene()
+    mesh = scene.add_mesh(vertices, faces, classes=10)
+    boat = scene.add_instance(mesh, pose=np.eye(4))
+    hits = scene.cast_rays(origins, directions, max_range=200.0)
+    hits.distance  # (N,) float32, inf where nothing was hit
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from mmusv._native import core
+from mmusv.errors import GeometryError, InputError
+
+__all__ = ["Scene", "RayHits", "NO_HIT"]
+
+NO_HIT = -1
+"""Value of ``RayHits.instance_id`` and ``triangle_id`` where the ray hit nothing."""
+
+
+@dataclass(frozen=True)
+class RayHits:
+    """Per-ray results of :meth:`Scene.cast_rays` (N rays); arrays are owned, not copies of Rust memory views.
+
+    Attributes:
+        distance: ``(N,)`` float32, metres along the unit direction; ``inf`` for a miss.
+        instance_id: ``(N,)`` int32, instance hit or ``-1``.
+        triangle_id: ``(N,)`` int32, triangle index within that instance's mesh, or ``-1``.
+        normal: ``(N, 3)`` float32, unit geometric normal (world frame, triangle winding); zeros for a miss.
+        semantic_class: ``(N,)`` uint16, class of the triangle hit (see :mod:`mmusv.classes`); 0 for a miss.
+        backface: ``(N,)`` bool, the ray hit the triangle's back side (``normal · direction > 0``).
+    """
+
+    distance: npt.NDArray[np.float32]
+    instance_id: npt.NDArray[np.int32]
+    triangle_id: npt.NDArray[np.int32]
+    normal: npt.NDArray[np.float32]
+    semantic_class: npt.NDArray[np.uint16]
+    backface: npt.NDArray[np.bool_]
+
+    @property
+    def hit(self) -> npt.NDArray[np.bool_]:
+        """``(N,)`` bool, True where the ray hit something within range."""
+        return self.instance_id >= 0
+
+    def points(self, origins: npt.ArrayLike, directions: npt.ArrayLike) -> npt.NDArray[np.float32]:
+        """``(N, 3)`` float32 world hit points (``nan`` rows for misses)."""
+        o = np.asarray(origins, dtype=np.float32)
+        d = np.asarray(directions, dtype=np.float32)
+        d = d / np.linalg.norm(d, axis=1, keepdims=True)
+        with np.errstate(invalid="ignore"):
+            p = o + d * self.distance[:, None]
+        p[~self.hit] = np.nan
+        return p.astype(np.float32, copy=False)
+
+
+def _array(value: Any, *, name: str, dtype: Any, shape_tail: tuple[int, ...]) -> np.ndarray:
+    """Coerces ``value`` to a C-contiguous array of ``dtype`` with trailing shape ``shape_tail``."""
+    try:
+        arr = np.asarray(value)
+    except Exception as exc:  # noqa: BLE001 - any conversion failure is the caller's input
+        raise InputError(f"{name} could not be converted to an array: {exc}") from None
+    if arr.dtype == object or not (np.issubdtype(arr.dtype, np.number) or arr.dtype == np.bool_):
+        raise InputError(f"{name} must be numeric, got dtype {arr.dtype}")
+    want_ndim = 1 + len(shape_tail)
+    if arr.ndim != want_ndim or tuple(arr.shape[1:]) != shape_tail:
+        tail = ", ".join(str(s) for s in shape_tail)
+        raise InputError(f"{name} must have shape (N, {tail}), got {arr.shape}")
+    if np.issubdtype(dtype, np.integer) and not np.issubdtype(arr.dtype, np.integer):
+        raise InputError(f"{name} must be an integer array, got dtype {arr.dtype}")
+    return np.ascontiguousarray(arr, dtype=dtype)
+
+
+def _pose(pose: Any, *, name: str) -> np.ndarray:
+    arr = np.asarray(pose, dtype=np.float64)
+    if arr.shape != (4, 4):
+        raise InputError(f"{name} must be a (4, 4) homogeneous matrix, got shape {arr.shape}")
+    return np.ascontiguousarray(arr)
+
+
+class Scene:
+    """Meshes (each with a bottom-level BVH built once) placed as instances under a top-level BVH.
+
+    Moving instances with :meth:`set_poses` only rebuilds the top level. All ray casting releases the GIL
+    and uses every core.
+    """
+
+    def __init__(self) -> None:
+        self._native = core.Scene()
+
+    @property
+    def native(self) -> Any:
+        """The underlying ``mmusv._core.Scene``."""
+        return self._native
+
+    def add_mesh(
+        self,
+        vertices: npt.ArrayLike,
+        faces: npt.ArrayLike,
+        *,
+        classes: int | npt.ArrayLike = 0,
+        name: str = "",
+    ) -> int:
+        """Adds a triangle mesh and returns its mesh id.
+
+        Args:
+            vertices: ``(V, 3)`` float32/float64 positions, metres, in the mesh's own frame.
+            faces: ``(F, 3)`` integer vertex indices in ``0..V``.
+            classes: one semantic class id for the whole mesh, or ``(F,)`` ids, one per face (0..65535).
+            name: free text, shown in errors and exports.
+        """
+        v = _array(vertices, name="vertices", dtype=np.float32, shape_tail=(3,))
+        f = _array(faces, name="faces", dtype=np.int64, shape_tail=(3,))
+        c = np.atleast_1d(np.asarray(classes))
+        if c.ndim != 1 or not np.issubdtype(c.dtype, np.integer):
+            raise InputError(f"classes must be an int or a 1-D integer array, got {c.dtype} with shape {c.shape}")
+        if c.size and (c.min() < 0 or c.max() > 65535):
+            raise InputError("classes must be in 0..65535")
+        if v.shape[0] and not np.isfinite(np.asarray(vertices, dtype=np.float64)).all():
+            bad = int(np.argwhere(~np.isfinite(np.asarray(vertices, dtype=np.float64)).all(axis=1))[0, 0])
+            raise GeometryError(f"invalid geometry in vertices[{bad}]: vertex is not finite; remove NaN/inf vertices")
+        return int(self._native.add_mesh(v, f, np.ascontiguousarray(c, dtype=np.uint16), name))
+
+    def add_instance(self, mesh_id: int, *, pose: npt.ArrayLike | None = None, class_override: int | None = None) -> int:
+        """Places mesh ``mesh_id`` at ``pose`` (``(4, 4)`` body → world, default identity); returns the instance id.
+
+        ``class_override`` replaces the mesh's per-face classes for this instance (e.g. a vessel asset placed
+        as a USV).
+        """
+        p = _pose(np.eye(4) if pose is None else pose, name="pose")
+        return int(self._native.add_instance(int(mesh_id), p, class_override))
+
+    def set_poses(self, instance_ids: npt.ArrayLike, poses: npt.ArrayLike) -> None:
+        """Moves instances: ``instance_ids`` ``(K,)`` ints, ``poses`` ``(K, 4, 4)`` float. Only the top level is rebuilt."""
+        ids = np.atleast_1d(np.asarray(instance_ids))
+        if ids.ndim != 1 or not np.issubdtype(ids.dtype, np.integer):
+            raise InputError(f"instance_ids must be a 1-D integer array, got {ids.dtype} with shape {ids.shape}")
+        if ids.size and ids.min() < 0:
+            raise InputError(f"instance_ids must be >= 0, got {int(ids.min())}")
+        p = np.asarray(poses, dtype=np.float64)
+        if p.ndim == 2:
+            p = p[None]
+        self._native.set_poses(np.ascontiguousarray(ids, dtype=np.uint32), np.ascontiguousarray(p))
+
+    def cast_rays(self, origins: npt.ArrayLike, directions: npt.ArrayLike, *, max_range: float = float("inf")) -> RayHits:
+        """Casts ``N`` rays and returns the closest hit of each.
+
+        Args:
+            origins: ``(N, 3)`` float, world frame, metres.
+            directions: ``(N, 3)`` float, world frame; any non-zero length (normalised internally).
+            max_range: metres; hits farther than this are misses.
+        """
+        o = _array(origins, name="origins", dtype=np.float32, shape_tail=(3,))
+        d = _array(directions, name="directions", dtype=np.float32, shape_tail=(3,))
+        dist, inst, tri, normal, cls, back = self._native.cast_rays(o, d, float(max_range))
+        return RayHits(dist, inst, tri, normal, cls, back)
+
+    def world_mesh(self) -> dict[str, np.ndarray]:
+        """The world triangles at the current poses: ``vertices`` (V,3) f32, ``faces`` (F,3) u32, ``classes``,
+        ``instance_ids`` and ``triangle_ids`` (F,)."""
+        v, f, c, i, t = self._native.world_mesh()
+        return {"vertices": v, "faces": f, "classes": c, "instance_ids": i, "triangle_ids": t}
+
+    def export(self, path: str | os.PathLike[str]) -> None:
+        """Writes the world triangles at the current poses to ``path`` (``.ply`` with per-face class and
+        instance, or ``.obj``); written atomically."""
+        self._native.export(os.fspath(path))
+
+    def instance_aabb(self, instance_id: int) -> np.ndarray:
+        """``(2, 3)`` float32 world AABB (min row, max row) of an instance at its current pose."""
+        return np.asarray(self._native.instance_aabb(int(instance_id)))
+
+    def instance_pose(self, instance_id: int) -> np.ndarray:
+        """``(4, 4)`` float64 current pose of an instance."""
+        return np.asarray(self._native.instance_pose(int(instance_id)))
+
+    @property
+    def num_instances(self) -> int:
+        """Number of instances."""
+        return int(self._native.num_instances)
+
+    @property
+    def num_meshes(self) -> int:
+        """Number of meshes."""
+        return int(self._native.num_meshes)
+
+    @property
+    def num_world_triangles(self) -> int:
+        """Number of triangles placed in the world."""
+        return int(self._native.num_world_triangles)
+
+    def __repr__(self) -> str:
+        return repr(self._native)
