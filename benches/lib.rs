@@ -1,1 +1,28 @@
-//! bench helpers
+//! Shared fixtures for the mmusv criterion benchmarks: the synthetic maritime scene and the ray sets
+//! (one 64×2048 LiDAR sweep; four 640×480 surround cameras) cast from an ego USV at the origin.
+
+use mmusv_core::demo::{lidar_rays, maritime_demo, surround_camera_rays, DemoParams, DemoScene};
+use mmusv_core::Result;
+
+/// LiDAR mount height above the waterline, metres.
+pub const LIDAR_HEIGHT: f32 = 2.5;
+/// Camera mount height above the waterline, metres.
+pub const CAMERA_HEIGHT: f32 = 2.0;
+
+/// Rays as parallel origin / direction arrays.
+pub type Rays = (Vec<[f32; 3]>, Vec<[f32; 3]>);
+
+/// The benchmark scene (defaults of [`DemoParams`]: ≈0.75 M triangles, 48 vessel instances).
+pub fn scene() -> Result<DemoScene> {
+    maritime_demo(DemoParams::default())
+}
+
+/// One 64-channel × 2048-azimuth LiDAR sweep.
+pub fn lidar() -> Result<Rays> {
+    lidar_rays([0.0, 0.0, LIDAR_HEIGHT], 64, 2048)
+}
+
+/// Four 640×480 pinhole cameras with 90° horizontal FOV looking forward, left, back, right.
+pub fn cameras() -> Result<Rays> {
+    surround_camera_rays([0.0, 0.0, CAMERA_HEIGHT], 4, 640, 480, std::f64::consts::FRAC_PI_2)
+}

@@ -1,1 +1,51 @@
-fn main(){}
+//! `cargo bench`: ray-casting throughput (rays/s) on the synthetic maritime scene, and the cost of moving
+//! vessel instances (top-level rebuild only).
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use mmusv_core::RigidPose;
+use std::hint::black_box;
+use std::time::Duration;
+
+fn bench_raycast(c: &mut Criterion) {
+    let (demo, lidar, cams) = match (mmusv_benches::scene(), mmusv_benches::lidar(), mmusv_benches::cameras()) {
+        (Ok(s), Ok(l), Ok(c)) => (s, l, c),
+        _ => {
+            eprintln!("could not build the benchmark scene");
+            return;
+        }
+    };
+    eprintln!(
+        "scene: {} world triangles, {} instances; lidar rays {}, camera rays {}",
+        demo.scene.num_world_triangles(),
+        demo.scene.instances().len(),
+        lidar.0.len(),
+        cams.0.len()
+    );
+    let mut g = c.benchmark_group("raycast");
+    g.sample_size(10).measurement_time(Duration::from_secs(6)).warm_up_time(Duration::from_secs(1));
+    g.throughput(Throughput::Elements(lidar.0.len() as u64));
+    g.bench_function("lidar_64x2048", |b| b.iter(|| black_box(demo.scene.cast_rays(&lidar.0, &lidar.1, 2000.0))));
+    g.throughput(Throughput::Elements(cams.0.len() as u64));
+    g.bench_function("cameras_4x640x480", |b| b.iter(|| black_box(demo.scene.cast_rays(&cams.0, &cams.1, 2000.0))));
+    g.finish();
+
+    let mut scene = demo.scene.clone();
+    let ids: Vec<u32> = demo.vessel_instances.iter().copied().take(50).collect();
+    let mut g = c.benchmark_group("pose_update");
+    g.sample_size(50).measurement_time(Duration::from_secs(2));
+    let mut k = 0.0f64;
+    g.bench_function(format!("move_{}_instances", ids.len()), |b| {
+        b.iter(|| {
+            k += 1.0;
+            let poses: Vec<RigidPose> = ids
+                .iter()
+                .map(|&i| RigidPose::from_xyz_rpy([i as f64 * 10.0 + k * 0.01, 0.0, 0.0], [0.0, 0.0, k * 0.001]))
+                .collect();
+            black_box(scene.set_poses(&ids, &poses))
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench_raycast);
+criterion_main!(benches);

@@ -10,16 +10,20 @@
 //! - [`mesh`]: triangle meshes with per-face semantic classes and a parry bottom-level BVH built once.
 //! - [`scene`]: meshes placed as instances, a top-level BVH over them, and batch ray casting over rayon.
 //! - [`export`]: the world triangles at the current poses as PLY or OBJ.
+//! - [`sensors`]: sensor ray patterns (LiDAR sweeps, pinhole cameras).
+//! - [`demo`]: a synthetic maritime scene for benchmarks and comparisons.
 //! - [`kinematics`]: spline routes at nominal speed with wave-driven heave, roll and pitch.
 //!
 //! Conventions: metres, seconds, radians; world frame right-handed, x east, y north, z up, water at z = 0.
 
+pub mod demo;
 pub mod error;
 pub mod export;
 pub mod geometry;
 pub mod kinematics;
 pub mod mesh;
 pub mod scene;
+pub mod sensors;
 
 pub use error::{MmusvError, Result};
 pub use geometry::RigidPose;

@@ -27,9 +27,15 @@ pub const SUBDIVISIONS: usize = 32;
 pub const MIN_WAYPOINT_SPACING_M: f64 = 1e-6;
 
 /// 5-point Gauss–Legendre nodes and weights on `[-1, 1]`.
-const GL_NODES: [f64; 5] = [0.0, -0.538_469_310_105_683_1, 0.538_469_310_105_683_1, -0.906_179_845_938_664, 0.906_179_845_938_664];
-const GL_WEIGHTS: [f64; 5] =
-    [0.568_888_888_888_888_9, 0.478_628_670_499_366_5, 0.478_628_670_499_366_5, 0.236_926_885_056_189_1, 0.236_926_885_056_189_1];
+const GL_NODES: [f64; 5] =
+    [0.0, -0.538_469_310_105_683_1, 0.538_469_310_105_683_1, -0.906_179_845_938_664, 0.906_179_845_938_664];
+const GL_WEIGHTS: [f64; 5] = [
+    0.568_888_888_888_888_9,
+    0.478_628_670_499_366_5,
+    0.478_628_670_499_366_5,
+    0.236_926_885_056_189_1,
+    0.236_926_885_056_189_1,
+];
 
 /// What a vessel does once it has travelled the whole route.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -50,7 +56,11 @@ impl EndBehaviour {
             "stop" => Ok(Self::Stop),
             "loop" => Ok(Self::Loop),
             "ping_pong" | "pingpong" | "ping-pong" => Ok(Self::PingPong),
-            _ => Err(MmusvError::config("end_behaviour", format!("{name:?}"), "allowed values are stop, loop, ping_pong")),
+            _ => Err(MmusvError::config(
+                "end_behaviour",
+                format!("{name:?}"),
+                "allowed values are stop, loop, ping_pong",
+            )),
         }
     }
 }
@@ -132,7 +142,11 @@ impl Route {
     /// repeating the first is dropped. Errors are [`MmusvError::Config`] naming `route` or `route[i]`.
     pub fn new(waypoints: &[[f64; 2]], end: EndBehaviour) -> Result<Self> {
         if let Some(i) = waypoints.iter().position(|p| !(p[0].is_finite() && p[1].is_finite())) {
-            return Err(MmusvError::config(format!("route[{i}]"), format!("{:?}", waypoints[i]), "waypoints must be finite [x, y] in metres"));
+            return Err(MmusvError::config(
+                format!("route[{i}]"),
+                format!("{:?}", waypoints[i]),
+                "waypoints must be finite [x, y] in metres",
+            ));
         }
         let mut pts = waypoints.to_vec();
         if end == EndBehaviour::Loop && pts.len() > 2 {
@@ -144,7 +158,11 @@ impl Route {
         }
         let need = if end == EndBehaviour::Loop { 3 } else { 2 };
         if pts.len() < need {
-            let what = if end == EndBehaviour::Loop { "a looped route needs at least 3 distinct waypoints" } else { "a route needs at least 2 waypoints" };
+            let what = if end == EndBehaviour::Loop {
+                "a looped route needs at least 3 distinct waypoints"
+            } else {
+                "a route needs at least 2 waypoints"
+            };
             return Err(MmusvError::config("route", format!("{} waypoint(s)", waypoints.len()), what));
         }
         let n = pts.len();
@@ -155,7 +173,11 @@ impl Route {
                 return Err(MmusvError::config(
                     format!("route[{}]", i % n),
                     format!("{q:?}"),
-                    format!("consecutive waypoints must be at least {MIN_WAYPOINT_SPACING_M} m apart (it repeats route[{}])", i - 1),
+                    format!(
+                        "consecutive waypoints must be at least {MIN_WAYPOINT_SPACING_M} m apart \
+                         (it repeats route[{}])",
+                        i - 1
+                    ),
                 ));
             }
         }

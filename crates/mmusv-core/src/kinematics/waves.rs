@@ -146,7 +146,9 @@ impl VesselDims {
 
     /// Checks that every dimension is finite and > 0; errors name `dims.<field>`.
     pub fn validate(&self) -> Result<()> {
-        for (name, v) in [("dims.length_m", self.length_m), ("dims.beam_m", self.beam_m), ("dims.height_m", self.height_m)] {
+        for (name, v) in
+            [("dims.length_m", self.length_m), ("dims.beam_m", self.beam_m), ("dims.height_m", self.height_m)]
+        {
             if !v.is_finite() || v <= 0.0 {
                 return Err(MmusvError::config(name, v, "must be a finite length > 0 m"));
             }
@@ -185,9 +187,11 @@ pub struct BaseAmplitudes {
 impl BaseAmplitudes {
     /// Checks that every amplitude is finite and ≥ 0; errors name `amplitudes.<field>`.
     pub fn validate(&self) -> Result<()> {
-        for (name, v) in
-            [("amplitudes.heave_m", self.heave_m), ("amplitudes.roll_rad", self.roll_rad), ("amplitudes.pitch_rad", self.pitch_rad)]
-        {
+        for (name, v) in [
+            ("amplitudes.heave_m", self.heave_m),
+            ("amplitudes.roll_rad", self.roll_rad),
+            ("amplitudes.pitch_rad", self.pitch_rad),
+        ] {
             if !v.is_finite() || v < 0.0 {
                 return Err(MmusvError::config(name, v, "must be a finite amplitude >= 0"));
             }

@@ -1,0 +1,434 @@
+//! Vessel motion (paper eq. 1–4): spline routes travelled at a nominal speed, with wave-driven heave, roll
+//! and pitch superimposed.
+//!
+//! For vessel `v` at time `t ≥ 0` (seconds), with travelled distance `d = offset + u·t` mapped to an arc
+//! length `s` and direction `σ ∈ {+1, −1, 0}` by [`Route::distance_to_arc`]:
+//!
+//! ```text
+//! η_v(t) = [x, y, z_base + Δz, Δφ, Δθ, θ]
+//! [x, y] = c(s),   θ = atan2(c'(s)) (+ π when σ = −1),   [Δz, Δφ, Δθ] from the wave model (see waves)
+//! ```
+//!
+//! Angles are roll about x, pitch about y, yaw about z (R = Rz·Ry·Rx), radians; positions are metres in the
+//! world frame (x east, y north, z up). The state is a pure function of the configuration, the seed and `t`.
+//!
+//! - [`spline`]: [`Route`] and [`EndBehaviour`].
+//! - [`waves`]: [`WaveSetting`], size factor, base amplitudes and the seeded periodic functions `g(t)`.
+
+pub mod spline;
+pub mod waves;
+
+pub use spline::{wrap_angle, EndBehaviour, Route};
+pub use waves::{mix_seed, BaseAmplitudes, PeriodicSignal, VesselDims, WaveSetting, WaveSignals};
+
+use crate::error::{MmusvError, Result};
+use rayon::prelude::*;
+use std::f64::consts::PI;
+
+/// Checks that a simulation time is finite and ≥ 0; `field` names it in the [`MmusvError::InvalidInput`].
+pub fn check_time(t: f64, field: &str) -> Result<()> {
+    if t.is_finite() && t >= 0.0 {
+        Ok(())
+    } else {
+        Err(MmusvError::input(field, format!("time must be finite and >= 0 s, got {t}")))
+    }
+}
+
+/// Per-vessel motion settings other than the route and the wave signals.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VesselParams {
+    /// Nominal speed `u` along the route in m/s (finite, ≥ 0).
+    pub speed_mps: f64,
+    /// Distance along the route at `t = 0` in metres (finite, ≥ 0; at most the route length for `Stop`).
+    pub start_offset_m: f64,
+    /// Height of the vessel origin above the water surface at rest, `z_base`, in metres.
+    pub z_base_m: f64,
+    /// Bounding box used for the size factor `α_v`.
+    pub dims: VesselDims,
+    /// Base amplitudes `r_z`, `r_φ`, `r_θ`.
+    pub amplitudes: BaseAmplitudes,
+}
+
+impl Default for VesselParams {
+    /// At rest at the route start, `z_base = 0`, reference USV size and amplitudes.
+    fn default() -> Self {
+        Self {
+            speed_mps: 0.0,
+            start_offset_m: 0.0,
+            z_base_m: 0.0,
+            dims: VesselDims::REFERENCE,
+            amplitudes: BaseAmplitudes::default(),
+        }
+    }
+}
+
+/// The motion of one vessel: its route, speed, start offset, base height, size and wave signals.
+#[derive(Debug, Clone)]
+pub struct VesselMotion {
+    route: Route,
+    params: VesselParams,
+    signals: WaveSignals,
+    alpha: f64,
+}
+
+impl VesselMotion {
+    /// Builds a vessel motion; errors are [`MmusvError::Config`] naming `speed_mps`, `start_offset_m`,
+    /// `z_base_m`, `dims.*` or `amplitudes.*`.
+    pub fn new(route: Route, params: VesselParams, signals: WaveSignals) -> Result<Self> {
+        let p = &params;
+        if !p.speed_mps.is_finite() || p.speed_mps < 0.0 {
+            return Err(MmusvError::config("speed_mps", p.speed_mps, "must be a finite speed >= 0 m/s"));
+        }
+        if !p.start_offset_m.is_finite() || p.start_offset_m < 0.0 {
+            return Err(MmusvError::config("start_offset_m", p.start_offset_m, "must be a finite distance >= 0 m"));
+        }
+        if route.end_behaviour() == EndBehaviour::Stop && p.start_offset_m > route.length() {
+            return Err(MmusvError::config(
+                "start_offset_m",
+                p.start_offset_m,
+                format!("must not exceed the route length {:.3} m when the vessel stops at the end", route.length()),
+            ));
+        }
+        if !p.z_base_m.is_finite() {
+            return Err(MmusvError::config("z_base_m", p.z_base_m, "must be a finite height in metres"));
+        }
+        p.dims.validate()?;
+        p.amplitudes.validate()?;
+        let alpha = p.dims.alpha();
+        Ok(Self { route, params, signals, alpha })
+    }
+
+    /// The route.
+    pub fn route(&self) -> &Route {
+        &self.route
+    }
+
+    /// The motion settings.
+    pub fn params(&self) -> &VesselParams {
+        &self.params
+    }
+
+    /// The seeded periodic functions `g_z`, `g_φ`, `g_θ`.
+    pub fn signals(&self) -> &WaveSignals {
+        &self.signals
+    }
+
+    /// The size factor `α_v` of this vessel.
+    pub fn alpha(&self) -> f64 {
+        self.alpha
+    }
+
+    /// Travelled distance `d = offset + u·t` in metres (before end handling).
+    pub fn travelled_m(&self, t: f64) -> f64 {
+        self.params.start_offset_m + self.params.speed_mps * t
+    }
+
+    /// `[Δz (m), Δφ (rad), Δθ (rad)] = S_wave · α_v · [r_z g_z(t), r_φ g_φ(t), r_θ g_θ(t)]` (eq. 3).
+    pub fn perturbation_at(&self, t: f64, wave: &WaveSetting) -> [f64; 3] {
+        let k = wave.scale() * self.alpha;
+        let (a, g) = (&self.params.amplitudes, &self.signals);
+        [k * a.heave_m * g.heave.value(t), k * a.roll_rad * g.roll.value(t), k * a.pitch_rad * g.pitch.value(t)]
+    }
+
+    /// The pose `η = [x, y, z_base + Δz, Δφ, Δθ, θ]` at time `t` (eq. 4); `t` must be finite and ≥ 0.
+    /// Yaw `θ` is in `[-π, π]`; travelling backwards on a ping-pong route it is the route heading + π.
+    pub fn pose_at(&self, t: f64, wave: &WaveSetting) -> Result<[f64; 6]> {
+        check_time(t, "t")?;
+        Ok(self.pose_unchecked(t, wave))
+    }
+
+    /// World-frame linear velocity `[vx, vy, vz]` in m/s at time `t`: `u·σ·tangent(s)` horizontally (zero at
+    /// rest at the end of a `Stop` route) and `dΔz/dt` vertically.
+    pub fn velocity_at(&self, t: f64, wave: &WaveSetting) -> Result<[f64; 3]> {
+        check_time(t, "t")?;
+        Ok(self.velocity_unchecked(t, wave))
+    }
+
+    fn pose_unchecked(&self, t: f64, wave: &WaveSetting) -> [f64; 6] {
+        let (s, sign) = self.route.distance_to_arc(self.travelled_m(t));
+        let [x, y] = self.route.position(s);
+        let mut yaw = self.route.yaw(s);
+        if sign < 0.0 {
+            yaw = wrap_angle(yaw + PI);
+        }
+        let [dz, roll, pitch] = self.perturbation_at(t, wave);
+        [x, y, self.params.z_base_m + dz, roll, pitch, yaw]
+    }
+
+    fn velocity_unchecked(&self, t: f64, wave: &WaveSetting) -> [f64; 3] {
+        let (s, sign) = self.route.distance_to_arc(self.travelled_m(t));
+        let v = self.params.speed_mps * sign;
+        let [tx, ty] = if v == 0.0 { [0.0, 0.0] } else { self.route.tangent(s) };
+        let vz = wave.scale() * self.alpha * self.params.amplitudes.heave_m * self.signals.heave.derivative(t);
+        [v * tx, v * ty, vz]
+    }
+}
+
+/// All vessels of a scenario under one wave setting.
+#[derive(Debug, Clone)]
+pub struct Fleet {
+    vessels: Vec<VesselMotion>,
+    wave: WaveSetting,
+}
+
+impl Fleet {
+    /// A fleet of `vessels` (index order is kept in every output) under `wave`.
+    pub fn new(vessels: Vec<VesselMotion>, wave: WaveSetting) -> Self {
+        Self { vessels, wave }
+    }
+
+    /// The vessels, in order.
+    pub fn vessels(&self) -> &[VesselMotion] {
+        &self.vessels
+    }
+
+    /// Number of vessels.
+    pub fn len(&self) -> usize {
+        self.vessels.len()
+    }
+
+    /// Whether the fleet has no vessel.
+    pub fn is_empty(&self) -> bool {
+        self.vessels.is_empty()
+    }
+
+    /// The scene wave setting.
+    pub fn wave(&self) -> WaveSetting {
+        self.wave
+    }
+
+    /// Changes the scene wave setting.
+    pub fn set_wave(&mut self, wave: WaveSetting) {
+        self.wave = wave;
+    }
+
+    /// Poses `η = [x, y, z, roll, pitch, yaw]` of every vessel at time `t` (finite, ≥ 0), in vessel order.
+    pub fn poses_at(&self, t: f64) -> Result<Vec<[f64; 6]>> {
+        check_time(t, "t")?;
+        Ok(self.vessels.iter().map(|v| v.pose_unchecked(t, &self.wave)).collect())
+    }
+
+    /// World-frame linear velocities `[vx, vy, vz]` (m/s) of every vessel at time `t`, in vessel order.
+    pub fn velocities_at(&self, t: f64) -> Result<Vec<[f64; 3]>> {
+        check_time(t, "t")?;
+        Ok(self.vessels.iter().map(|v| v.velocity_unchecked(t, &self.wave)).collect())
+    }
+
+    /// Poses at many times, flattened time-major: entry `k · len() + v` is vessel `v` at `times[k]`
+    /// (a T×V×6 array). Every time must be finite and ≥ 0 (errors name `times[k]`). Runs over rayon.
+    pub fn poses_at_times(&self, times: &[f64]) -> Result<Vec<[f64; 6]>> {
+        for (k, &t) in times.iter().enumerate() {
+            check_time(t, &format!("times[{k}]"))?;
+        }
+        let nv = self.vessels.len();
+        let mut out = vec![[0.0; 6]; times.len() * nv];
+        if nv == 0 {
+            return Ok(out);
+        }
+        out.par_chunks_mut(nv).zip(times.par_iter()).for_each(|(row, &t)| {
+            for (slot, v) in row.iter_mut().zip(&self.vessels) {
+                *slot = v.pose_unchecked(t, &self.wave);
+            }
+        });
+        Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const CURVY: [[f64; 2]; 5] = [[0.0, 0.0], [60.0, 20.0], [80.0, 90.0], [10.0, 120.0], [-50.0, 60.0]];
+
+    fn ok<T>(r: Result<T>) -> T {
+        r.unwrap_or_else(|e| unreachable!("{e}"))
+    }
+
+    fn vessel(end: EndBehaviour, speed: f64, dims: VesselDims, seed: u64, idx: u64) -> VesselMotion {
+        let route = ok(Route::new(&CURVY, end));
+        let params = VesselParams { speed_mps: speed, dims, z_base_m: 0.4, ..VesselParams::default() };
+        ok(VesselMotion::new(route, params, WaveSignals::from_seed(seed, idx)))
+    }
+
+    fn hyp(a: [f64; 6], b: [f64; 6]) -> f64 {
+        (b[0] - a[0]).hypot(b[1] - a[1])
+    }
+
+    #[test]
+    fn travelled_distance_is_speed_times_time() {
+        for end in [EndBehaviour::Stop, EndBehaviour::Loop, EndBehaviour::PingPong] {
+            let v = vessel(end, 4.0, VesselDims::REFERENCE, 1, 0);
+            let len = v.route().length();
+            let t_end = if end == EndBehaviour::Stop { 0.9 * len / 4.0 } else { 2.6 * len / 4.0 };
+            let n = 100_000;
+            let mut prev = ok(v.pose_at(0.0, &WaveSetting::W2));
+            let mut acc = 0.0;
+            for k in 1..=n {
+                let p = ok(v.pose_at(t_end * k as f64 / n as f64, &WaveSetting::W2));
+                acc += hyp(prev, p);
+                prev = p;
+            }
+            let want = 4.0 * t_end;
+            assert!(((acc - want) / want).abs() < 0.005, "{end:?}: {acc} vs {want}");
+        }
+    }
+
+    #[test]
+    fn yaw_and_velocity_follow_the_motion() {
+        for end in [EndBehaviour::Loop, EndBehaviour::PingPong] {
+            let v = vessel(end, 3.0, VesselDims::REFERENCE, 2, 1);
+            let w = WaveSetting::W1;
+            let h = 1e-4;
+            for k in 0..300 {
+                let t = 0.7 + k as f64 * 0.77;
+                let (a, b) = (ok(v.pose_at(t - h, &w)), ok(v.pose_at(t + h, &w)));
+                if hyp(a, b) < 2.0 * h * 3.0 * 0.99 {
+                    continue; // straddles a ping-pong reversal
+                }
+                let yaw = ok(v.pose_at(t, &w))[5];
+                let fd = (b[1] - a[1]).atan2(b[0] - a[0]);
+                assert!(wrap_angle(fd - yaw).abs() < 1e-4, "{end:?} t={t}");
+                let vel = ok(v.velocity_at(t, &w));
+                for (i, want) in [(b[0] - a[0]) / (2.0 * h), (b[1] - a[1]) / (2.0 * h), (b[2] - a[2]) / (2.0 * h)]
+                    .into_iter()
+                    .enumerate()
+                {
+                    assert!((vel[i] - want).abs() < 1e-4, "{end:?} t={t} axis {i}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn stop_rests_at_the_end_and_ping_pong_turns_round() {
+        let w = WaveSetting::W0;
+        let stop = vessel(EndBehaviour::Stop, 5.0, VesselDims::REFERENCE, 3, 0);
+        let len = stop.route().length();
+        let t_after = len / 5.0 + 10.0;
+        let (p, q) = (ok(stop.pose_at(t_after, &w)), ok(stop.pose_at(t_after + 50.0, &w)));
+        assert!(hyp(p, CURVY.map(|c| [c[0], c[1], 0.0, 0.0, 0.0, 0.0])[4]) < 1e-9);
+        assert_eq!((p[0], p[1], p[5]), (q[0], q[1], q[5]));
+        let vel = ok(stop.velocity_at(t_after, &w));
+        assert_eq!((vel[0], vel[1]), (0.0, 0.0));
+
+        let pp = vessel(EndBehaviour::PingPong, 5.0, VesselDims::REFERENCE, 3, 0);
+        let s = 30.0;
+        let (fwd, back) = (ok(pp.pose_at(s / 5.0, &w)), ok(pp.pose_at((2.0 * len - s) / 5.0, &w)));
+        assert!(hyp(fwd, back) < 1e-6);
+        assert!((wrap_angle(back[5] - fwd[5]).abs() - PI).abs() < 1e-9);
+        let lp = vessel(EndBehaviour::Loop, 5.0, VesselDims::REFERENCE, 3, 0);
+        let period = lp.route().length() / 5.0;
+        let (a, b) = (ok(lp.pose_at(7.0, &w)), ok(lp.pose_at(7.0 + period, &w)));
+        assert!(hyp(a, b) < 1e-6 && wrap_angle(a[5] - b[5]).abs() < 1e-9);
+    }
+
+    /// RMS of heave (mean removed per vessel), roll and pitch (degrees) over all vessels and frames.
+    fn rms(fleet: &Fleet, frames: usize, dt: f64) -> [f64; 3] {
+        let times: Vec<f64> = (0..frames).map(|k| k as f64 * dt).collect();
+        let poses = ok(fleet.poses_at_times(&times));
+        let nv = fleet.len();
+        let mut sums = [0.0; 3];
+        for v in 0..nv {
+            let mean_z = (0..frames).map(|k| poses[k * nv + v][2]).sum::<f64>() / frames as f64;
+            for k in 0..frames {
+                let p = poses[k * nv + v];
+                sums[0] += (p[2] - mean_z).powi(2);
+                sums[1] += p[3].to_degrees().powi(2);
+                sums[2] += p[4].to_degrees().powi(2);
+            }
+        }
+        sums.map(|s| (s / (frames * nv) as f64).sqrt())
+    }
+
+    fn fleet(dims: VesselDims, wave: WaveSetting, seed: u64) -> Fleet {
+        Fleet::new((0..4).map(|i| vessel(EndBehaviour::Loop, 3.0, dims, seed, i)).collect(), wave)
+    }
+
+    #[test]
+    fn wave_rms_is_monotonic_linear_and_matches_table_one() {
+        let table =
+            [[0.0274, 0.2054, 0.0684], [0.0818, 0.6134, 0.2062], [0.1379, 1.0345, 0.3395], [0.1923, 1.4421, 0.4774]];
+        let mut got = Vec::new();
+        for (w, want) in WaveSetting::PRESETS.iter().zip(table) {
+            let r = rms(&fleet(VesselDims::REFERENCE, *w, 7), 36_000, 0.1);
+            eprintln!("{w}: heave {:.4} m, roll {:.4} deg, pitch {:.4} deg", r[0], r[1], r[2]);
+            for axis in 0..3 {
+                assert!((r[axis] / want[axis] - 1.0).abs() < 0.05, "{w} axis {axis}: {} vs {}", r[axis], want[axis]);
+            }
+            got.push(r);
+        }
+        let heights: Vec<f64> = WaveSetting::PRESETS.iter().map(WaveSetting::height_m).collect();
+        for axis in 0..3 {
+            let y: Vec<f64> = got.iter().map(|r| r[axis]).collect();
+            assert!(y.windows(2).all(|p| p[1] > p[0]), "axis {axis} not monotonic: {y:?}");
+            let n = y.len() as f64;
+            let (mx, my) = (heights.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+            let sxy: f64 = heights.iter().zip(&y).map(|(x, y)| (x - mx) * (y - my)).sum();
+            let sxx: f64 = heights.iter().map(|x| (x - mx).powi(2)).sum();
+            let slope = sxy / sxx;
+            let ss_res: f64 = heights.iter().zip(&y).map(|(x, y)| (y - my - slope * (x - mx)).powi(2)).sum();
+            let ss_tot: f64 = y.iter().map(|y| (y - my).powi(2)).sum();
+            assert!(1.0 - ss_res / ss_tot >= 0.99, "axis {axis}: R² too low");
+        }
+        // A free height in between behaves like the presets.
+        let free = rms(&fleet(VesselDims::REFERENCE, ok(WaveSetting::from_height(2.0)), 7), 36_000, 0.1);
+        assert!(free[0] > got[1][0] && free[0] < got[2][0]);
+        let flat = rms(&fleet(VesselDims::REFERENCE, ok(WaveSetting::from_height(0.0)), 7), 100, 0.1);
+        assert!(flat.iter().all(|r| *r < 1e-12), "{flat:?}");
+    }
+
+    #[test]
+    fn small_vessels_move_more_than_large_ships() {
+        let small = VesselDims { length_m: 3.0, beam_m: 1.2, height_m: 1.0 };
+        let ship = VesselDims { length_m: 300.0, beam_m: 48.0, height_m: 60.0 };
+        let a = rms(&fleet(small, WaveSetting::W2, 5), 12_000, 0.1);
+        let b = rms(&fleet(ship, WaveSetting::W2, 5), 12_000, 0.1);
+        for axis in 0..3 {
+            assert!(a[axis] > 10.0 * b[axis], "axis {axis}: {} vs {}", a[axis], b[axis]);
+        }
+    }
+
+    #[test]
+    fn same_seed_same_poses_other_seed_other_phases() {
+        let times: Vec<f64> = (0..500).map(|k| k as f64 * 0.2).collect();
+        let a = ok(fleet(VesselDims::REFERENCE, WaveSetting::W3, 42).poses_at_times(&times));
+        let b = ok(fleet(VesselDims::REFERENCE, WaveSetting::W3, 42).poses_at_times(&times));
+        let bits = |p: &[[f64; 6]]| p.iter().flatten().map(|x| x.to_bits()).collect::<Vec<u64>>();
+        assert_eq!(bits(&a), bits(&b));
+        let c = ok(fleet(VesselDims::REFERENCE, WaveSetting::W3, 43).poses_at_times(&times));
+        assert_ne!(bits(&a), bits(&c));
+        // Same layout as calling poses_at at each time; vessels of one fleet differ from each other.
+        let f = fleet(VesselDims::REFERENCE, WaveSetting::W3, 42);
+        assert_eq!(ok(f.poses_at(times[17])), a[17 * 4..18 * 4].to_vec());
+        assert_ne!(f.vessels()[0].signals(), f.vessels()[1].signals());
+    }
+
+    #[test]
+    fn bad_inputs_are_errors_not_panics() {
+        let route = || ok(Route::new(&CURVY, EndBehaviour::Stop));
+        let sig = WaveSignals::from_seed(0, 0);
+        let field_of = |p: VesselParams| match VesselMotion::new(route(), p, sig) {
+            Err(MmusvError::Config { field, .. }) => field,
+            other => unreachable!("expected a config error, got {other:?}"),
+        };
+        assert_eq!(field_of(VesselParams { speed_mps: -1.0, ..VesselParams::default() }), "speed_mps");
+        assert_eq!(field_of(VesselParams { speed_mps: f64::NAN, ..VesselParams::default() }), "speed_mps");
+        assert_eq!(field_of(VesselParams { start_offset_m: 1e6, ..VesselParams::default() }), "start_offset_m");
+        assert_eq!(field_of(VesselParams { z_base_m: f64::INFINITY, ..VesselParams::default() }), "z_base_m");
+        assert!(matches!(Route::new(&[[0.0, 0.0]], EndBehaviour::Stop), Err(MmusvError::Config { .. })));
+        assert!(matches!(
+            Route::new(&[[0.0, 0.0], [f64::NAN, 0.0]], EndBehaviour::Stop),
+            Err(MmusvError::Config { .. })
+        ));
+        assert!(matches!("W9".parse::<WaveSetting>(), Err(MmusvError::Config { .. })));
+        assert!(matches!(WaveSetting::from_height(-1.0), Err(MmusvError::Config { .. })));
+        let f = fleet(VesselDims::REFERENCE, WaveSetting::W1, 1);
+        for t in [-1.0, f64::NAN, f64::INFINITY] {
+            assert!(matches!(f.poses_at(t), Err(MmusvError::InvalidInput { ref field, .. }) if field == "t"));
+            assert!(matches!(f.velocities_at(t), Err(MmusvError::InvalidInput { .. })));
+        }
+        let err = f.poses_at_times(&[0.0, 1.0, -2.0]);
+        assert!(matches!(err, Err(MmusvError::InvalidInput { ref field, .. }) if field == "times[2]"));
+        assert_eq!(Fleet::new(Vec::new(), WaveSetting::W0).poses_at_times(&[1.0]).map(|v| v.len()), Ok(0));
+    }
+}

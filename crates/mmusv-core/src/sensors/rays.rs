@@ -1,0 +1,114 @@
+//! Ray patterns of the sensors, as unit direction vectors in the sensor's body frame (x forward, y left,
+//! z up) or, for cameras, rows of pixels.
+//!
+//! * Spinning LiDAR: `channels × azimuth_steps` rays, ordered azimuth-major (all channels of one column
+//!   are consecutive, as a spinning head fires them), azimuth from 0 (forward) counter-clockwise.
+//! * Pinhole camera: one ray per pixel centre, row-major from the top-left pixel, for the optical frame
+//!   (x right, y down, z forward) mapped to the body frame (optical z = body x, optical x = −body y,
+//!   optical y = −body z).
+
+use crate::error::{MmusvError, Result};
+
+/// Pinhole intrinsics from an image size and horizontal field of view: `fx = fy = W / (2 tan(hfov/2))`,
+/// principal point at the image centre `(W/2, H/2)`. Returns `[fx, fy, cx, cy]` in pixels.
+pub fn pinhole_intrinsics(width: u32, height: u32, hfov: f64) -> Result<[f64; 4]> {
+    if width == 0 || height == 0 {
+        return Err(MmusvError::config("resolution", format!("[{width}, {height}]"), "width and height must be >= 1"));
+    }
+    if !(hfov > 0.0 && hfov < std::f64::consts::PI) {
+        return Err(MmusvError::config("hfov", hfov, "horizontal field of view must be in (0, 180) degrees"));
+    }
+    let f = width as f64 / (2.0 * (hfov / 2.0).tan());
+    Ok([f, f, width as f64 / 2.0, height as f64 / 2.0])
+}
+
+/// Unit ray directions through every pixel centre of a pinhole camera, in the camera BODY frame
+/// (x forward, y left, z up). Row-major, `width × height` rows of `[x, y, z]`.
+pub fn pinhole_directions(width: u32, height: u32, hfov: f64) -> Result<Vec<[f32; 3]>> {
+    let [fx, fy, cx, cy] = pinhole_intrinsics(width, height, hfov)?;
+    let mut out = Vec::with_capacity(width as usize * height as usize);
+    for v in 0..height {
+        for u in 0..width {
+            // Optical frame: x right, y down, z forward.
+            let ox = (u as f64 + 0.5 - cx) / fx;
+            let oy = (v as f64 + 0.5 - cy) / fy;
+            let n = (ox * ox + oy * oy + 1.0).sqrt();
+            out.push([(1.0 / n) as f32, (-ox / n) as f32, (-oy / n) as f32]);
+        }
+    }
+    Ok(out)
+}
+
+/// Elevation angles (radians) of `channels` beams spread uniformly over `[lower, upper]` radians,
+/// lowest first.
+pub fn uniform_elevations(channels: u32, lower: f64, upper: f64) -> Result<Vec<f64>> {
+    if channels == 0 {
+        return Err(MmusvError::config("channels", channels, "a LiDAR needs at least one channel"));
+    }
+    if !(lower.is_finite() && upper.is_finite() && lower <= upper && lower > -std::f64::consts::FRAC_PI_2 && upper < std::f64::consts::FRAC_PI_2) {
+        return Err(MmusvError::config(
+            "vertical_fov",
+            format!("[{lower}, {upper}] rad"),
+            "need lower <= upper, both strictly between -90 and 90 degrees",
+        ));
+    }
+    if channels == 1 {
+        return Ok(vec![(lower + upper) / 2.0]);
+    }
+    let step = (upper - lower) / (channels - 1) as f64;
+    Ok((0..channels).map(|i| lower + step * i as f64).collect())
+}
+
+/// Unit directions of one full LiDAR sweep in the LiDAR frame: `azimuth_steps` columns starting at azimuth 0
+/// (forward, +x) and turning counter-clockwise (towards +y), each column holding every elevation in order.
+pub fn lidar_directions(elevations: &[f64], azimuth_steps: u32) -> Result<Vec<[f32; 3]>> {
+    if azimuth_steps == 0 {
+        return Err(MmusvError::config("azimuth_steps", azimuth_steps, "need at least one azimuth step per sweep"));
+    }
+    let mut out = Vec::with_capacity(elevations.len() * azimuth_steps as usize);
+    for a in 0..azimuth_steps {
+        let az = std::f64::consts::TAU * a as f64 / azimuth_steps as f64;
+        let (sa, ca) = az.sin_cos();
+        for &el in elevations {
+            let (se, ce) = el.sin_cos();
+            out.push([(ce * ca) as f32, (ce * sa) as f32, se as f32]);
+        }
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pinhole_centre_ray_is_forward_and_corners_match_fov() {
+        let d = pinhole_directions(4, 2, std::f64::consts::FRAC_PI_2).unwrap_or_default();
+        assert_eq!(d.len(), 8);
+        // Pixel (0, 0) is top-left: looks left (+y) and up (+z).
+        assert!(d[0][1] > 0.0 && d[0][2] > 0.0);
+        // Horizontal angle of the left edge of the image is hfov/2 = 45°.
+        let [fx, _, cx, _] = pinhole_intrinsics(4, 2, std::f64::consts::FRAC_PI_2).unwrap_or([0.0; 4]);
+        assert!(((cx / fx).atan() - std::f64::consts::FRAC_PI_4).abs() < 1e-12);
+        for r in &d {
+            let n = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
+            assert!((n - 1.0).abs() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn lidar_pattern_order_and_angles() {
+        let el = uniform_elevations(64, (-25f64).to_radians(), 15f64.to_radians()).unwrap_or_default();
+        assert_eq!(el.len(), 64);
+        assert!((el[63] - 15f64.to_radians()).abs() < 1e-12);
+        let d = lidar_directions(&el, 2048).unwrap_or_default();
+        assert_eq!(d.len(), 64 * 2048);
+        // Column 512 is azimuth 90°: +y.
+        let r = d[512 * 64 + 20];
+        assert!(r[0].abs() < 1e-6 && r[1] > 0.0);
+        assert!((r[2] as f64 - el[20].sin()).abs() < 1e-6);
+        assert!(uniform_elevations(0, 0.0, 0.1).is_err());
+        assert!(lidar_directions(&el, 0).is_err());
+        assert!(pinhole_intrinsics(0, 10, 1.0).is_err());
+    }
+}
