@@ -24,7 +24,7 @@ import numpy.typing as npt
 from mmusv._native import core
 from mmusv.errors import GeometryError, InputError
 
-__all__ = ["Scene", "RayHits", "NO_HIT"]
+__all__ = ["Scene", "RayHits", "NO_HIT", "demo_scene"]
 
 NO_HIT = -1
 """Value of ``RayHits.instance_id`` and ``triangle_id`` where the ray hit nothing."""
@@ -99,6 +99,12 @@ class Scene:
 
     def __init__(self) -> None:
         self._native = core.Scene()
+
+    @classmethod
+    def _from_native(cls, native: Any) -> Scene:
+        obj = cls.__new__(cls)
+        obj._native = native
+        return obj
 
     @property
     def native(self) -> Any:
@@ -203,3 +209,13 @@ class Scene:
 
     def __repr__(self) -> str:
         return repr(self._native)
+
+
+def demo_scene(*, seed: int = 1, extent: float = 2000.0, terrain_cells: int = 512, vessels: int = 48) -> tuple[Scene, list[int]]:
+    """The synthetic maritime benchmark scene: seabed/islands heightfield (``2·terrain_cells²`` triangles,
+    instance 0), water plane at z = 0 (instance 1) and ``vessels`` hull instances around the origin.
+
+    Returns ``(scene, vessel_instance_ids)``. Deterministic from ``seed``.
+    """
+    native, ids = core.demo_scene(seed=seed, extent=extent, terrain_cells=terrain_cells, vessels=vessels)
+    return Scene._from_native(native), [int(i) for i in ids]

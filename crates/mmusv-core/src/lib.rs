@@ -7,6 +7,8 @@
 //! Modules, one job each:
 //! - [`error`]: the one error enum every fallible call returns.
 //! - [`geometry`]: rigid poses, rays and the ray–triangle test.
+//! - [`bvh`]: the 4-wide traversal layout flattened from parry's BVH.
+//! - [`packet`]: coherent rays traced together.
 //! - [`mesh`]: triangle meshes with per-face semantic classes and a parry bottom-level BVH built once.
 //! - [`scene`]: meshes placed as instances, a top-level BVH over them, and batch ray casting over rayon.
 //! - [`export`]: the world triangles at the current poses as PLY or OBJ.
@@ -16,12 +18,14 @@
 //!
 //! Conventions: metres, seconds, radians; world frame right-handed, x east, y north, z up, water at z = 0.
 
+pub mod bvh;
 pub mod demo;
 pub mod error;
 pub mod export;
 pub mod geometry;
 pub mod kinematics;
 pub mod mesh;
+pub mod packet;
 pub mod scene;
 pub mod sensors;
 

@@ -4,8 +4,10 @@
 //! then shared, read-only, by every instance that places it in a [`crate::Scene`]. Moving an instance never
 //! touches its mesh.
 
+use crate::bvh::{Bvh4, RayInv};
 use crate::error::{MmusvError, Result};
 use crate::geometry::PreparedTriangle;
+use crate::packet::{Packet, PACKET};
 use parry3d::bounding_volume::Aabb;
 use parry3d::math::Vec3;
 use parry3d::partitioning::{Bvh, BvhBuildStrategy};
@@ -20,6 +22,8 @@ pub struct Mesh {
     classes: Vec<u16>,
     triangles: Vec<PreparedTriangle>,
     bvh: Bvh,
+    /// The flattened 4-wide copy of `bvh` used for traversal, with triangles in its leaf order.
+    fast: Option<(Bvh4, Vec<PreparedTriangle>)>,
     aabb: Aabb,
 }
 
@@ -90,7 +94,11 @@ impl Mesh {
             }),
         );
         let aabb = Aabb::from_points(verts.iter().copied());
-        Ok(Self { name, vertices: verts, faces: checked, classes, triangles, bvh, aabb })
+        let fast = Bvh4::from_parry(&bvh, triangles.len()).map(|b4| {
+            let ordered = b4.order().iter().map(|&i| triangles[i as usize]).collect();
+            (b4, ordered)
+        });
+        Ok(Self { name, vertices: verts, faces: checked, classes, triangles, bvh, fast, aabb })
     }
 
     /// The mesh's name (free text, used in exports and errors).
@@ -125,6 +133,50 @@ impl Mesh {
     /// Closest hit of the ray `origin + t·dir`, `0 < t < t_max`, in the local frame.
     #[inline]
     pub fn cast_local(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<LocalHit> {
+        self.cast_local_with(origin, dir, t_max, &mut Vec::new())
+    }
+
+    /// [`Mesh::cast_local`] with caller-owned traversal scratch space (reuse it across rays).
+    #[inline]
+    pub fn cast_local_with(&self, origin: Vec3, dir: Vec3, t_max: f32, stack: &mut Vec<(u32, f32)>) -> Option<LocalHit> {
+        match &self.fast {
+            Some((b4, tris)) => b4
+                .closest(&RayInv::new(origin, dir), t_max, stack, |k, best| tris[k as usize].intersect(origin, dir, best))
+                .map(|(k, t)| LocalHit { t, triangle: b4.order()[k as usize] }),
+            None => self.cast_local_parry(origin, dir, t_max),
+        }
+    }
+
+    /// Traces a packet (in this mesh's local frame). Rays that hit closer than their current best get the
+    /// new distance and, in `prim`, the index of the triangle hit; other rays are left unchanged.
+    #[inline]
+    pub fn cast_packet_local(&self, p: &mut Packet, stack: &mut Vec<(u32, f32)>) {
+        match &self.fast {
+            Some((b4, tris)) => {
+                p.prim = [u32::MAX; PACKET];
+                b4.closest_packet(p, stack, |k, p| p.intersect_triangle(&tris[k as usize], k));
+                for prim in p.prim.iter_mut().filter(|k| **k != u32::MAX) {
+                    *prim = b4.order()[*prim as usize];
+                }
+            }
+            None => {
+                for r in 0..PACKET {
+                    p.prim[r] = u32::MAX;
+                    let o = Vec3::new(p.o[0][r], p.o[1][r], p.o[2][r]);
+                    let d = Vec3::new(p.d[0][r], p.d[1][r], p.d[2][r]);
+                    if p.best[r] > 0.0 {
+                        if let Some(h) = self.cast_local_parry(o, d, p.best[r]) {
+                            p.best[r] = h.t;
+                            p.prim[r] = h.triangle;
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Closest hit using parry's own best-first BVH query (the fallback of [`Mesh::cast_local`]).
+    pub fn cast_local_parry(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<LocalHit> {
         let ray = Ray::new(origin, dir);
         let tris = &self.triangles;
         self.bvh
@@ -181,6 +233,8 @@ pub(crate) mod tests {
                 .normalize();
             let a = mesh.cast_local(o, d, 1e3);
             let b = mesh.cast_local_brute_force(o, d, 1e3);
+            let c = mesh.cast_local_parry(o, d, 1e3);
+            assert_eq!(a.map(|h| h.triangle), c.map(|h| h.triangle));
             match (a, b) {
                 (Some(a), Some(b)) => {
                     hits += 1;
@@ -191,6 +245,25 @@ pub(crate) mod tests {
             }
         }
         assert!(hits > 300, "too few hits to be a meaningful test: {hits}");
+    }
+
+    #[test]
+    fn fast_bvh_is_built_for_small_and_large_meshes() {
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        for n in [1usize, 2, 3, 5, 17, 1000] {
+            let (v, f) = random_soup(&mut rng, n);
+            let mesh = Mesh::new("soup", &v, &f, &[1]).unwrap_or_else(|e| unreachable!("{e}"));
+            assert!(mesh.fast.is_some(), "flattening failed for {n} triangles");
+            let o = Vec3::new(0.0, 0.0, 50.0);
+            for (i, t) in mesh.triangles.iter().enumerate() {
+                // Aim at each triangle's centroid: the hit must be found, at or before the centroid.
+                let c = t.v0 + (t.e1 + t.e2) / 3.0;
+                let d = (c - o).normalize();
+                let brute = mesh.cast_local_brute_force(o, d, 1e3);
+                let fast = mesh.cast_local(o, d, 1e3);
+                assert_eq!(brute.map(|h| h.triangle), fast.map(|h| h.triangle), "triangle {i} of {n}");
+            }
+        }
     }
 
     #[test]

@@ -7,9 +7,11 @@
 //!
 //! Rays are cast in parallel over rayon. Distances are metres along the normalised direction.
 
+use crate::bvh::{Bvh4, RayInv};
 use crate::error::{MmusvError, Result};
 use crate::geometry::RigidPose;
 use crate::mesh::Mesh;
+use crate::packet::{Packet, PACKET};
 use parry3d::bounding_volume::Aabb;
 use parry3d::math::Vec3;
 use parry3d::partitioning::{Bvh, BvhBuildStrategy};
@@ -22,8 +24,12 @@ use std::sync::Arc;
 pub const NO_HIT: i32 = -1;
 /// Semantic class reported for a ray that hit nothing (sky / no return).
 pub const CLASS_NONE: u16 = 0;
-/// Rays per rayon task: large enough to amortise scheduling, small enough to balance.
+/// Rays per rayon task: large enough to amortise scheduling, small enough to balance (a multiple of [`PACKET`]).
 const CHUNK: usize = 512;
+/// Rays whose directions lie within ≈8° of each other and whose origins lie within 1 m are traced as a packet.
+const COHERENT_COS: f32 = 0.990;
+/// See [`COHERENT_COS`].
+const COHERENT_RADIUS: f32 = 1.0;
 
 /// One placed copy of a mesh.
 #[derive(Debug, Clone)]
@@ -98,6 +104,13 @@ impl RayHits {
     }
 }
 
+/// Per-thread traversal stacks, reused across rays.
+#[derive(Debug, Default)]
+pub struct Scratch {
+    top: Vec<(u32, f32)>,
+    bottom: Vec<(u32, f32)>,
+}
+
 /// Meshes, instances and the top-level BVH.
 #[derive(Debug, Clone, Default)]
 pub struct Scene {
@@ -105,6 +118,8 @@ pub struct Scene {
     instances: Vec<Instance>,
     world_aabbs: Vec<Aabb>,
     tlas: Bvh,
+    /// Flattened copy of `tlas` used for traversal (`None` only if flattening failed or the scene is empty).
+    tlas4: Option<Bvh4>,
 }
 
 impl Scene {
@@ -164,6 +179,10 @@ impl Scene {
             self.world_aabbs[id as usize] = Aabb::new(c - he, c + he);
         }
         self.tlas = Bvh::from_iter(BvhBuildStrategy::Binned, self.world_aabbs.iter().copied().enumerate());
+        let (instances, meshes) = (&self.instances, &self.meshes);
+        self.tlas4 = Bvh4::from_parry_with_cost(&self.tlas, instances.len(), |i| {
+            meshes[instances[i as usize].mesh as usize].num_triangles() as f32
+        });
     }
 
     fn check_mesh(&self, mesh: u32) -> Result<()> {
@@ -211,18 +230,80 @@ impl Scene {
     /// Closest hit of one ray. `dir` must be unit length; `max_range` in metres.
     #[inline]
     pub fn cast_ray(&self, origin: Vec3, dir: Vec3, max_range: f32) -> Option<Hit> {
+        self.cast_ray_with(origin, dir, max_range, &mut Scratch::default())
+    }
+
+    /// [`Scene::cast_ray`] with caller-owned traversal scratch space (reuse one per thread).
+    #[inline]
+    pub fn cast_ray_with(&self, origin: Vec3, dir: Vec3, max_range: f32, scratch: &mut Scratch) -> Option<Hit> {
         let best_tri = Cell::new(u32::MAX);
-        let ray = Ray::new(origin, dir);
-        let (instance, distance) = self.tlas.cast_ray(&ray, max_range, |leaf, best| {
+        let Scratch { top, bottom } = scratch;
+        let mut cast_instance = |leaf: u32, best: f32| {
             let inst = &self.instances[leaf as usize];
             let mesh = &self.meshes[inst.mesh as usize];
             let o = inst.pose.inverse_transform_point(origin);
             let d = inst.pose.inverse_transform_vector(dir);
-            let hit = mesh.cast_local(o, d, best)?;
+            let hit = mesh.cast_local_with(o, d, best, bottom)?;
             best_tri.set(hit.triangle);
             Some(hit.t)
-        })?;
+        };
+        let (instance, distance) = match &self.tlas4 {
+            Some(t4) => {
+                let (k, t) = t4.closest(&RayInv::new(origin, dir), max_range, top, |k, best| {
+                    cast_instance(t4.order()[k as usize], best)
+                })?;
+                (t4.order()[k as usize], t)
+            }
+            None => {
+                let cell = std::cell::RefCell::new(cast_instance);
+                self.tlas.cast_ray(&Ray::new(origin, dir), max_range, |leaf, best| (cell.borrow_mut())(leaf, best))?
+            }
+        };
         Some(Hit { distance, instance, triangle: best_tri.get() })
+    }
+
+    /// Closest hits of up to [`PACKET`] coherent rays traced together (`dirs` unit length). Results are the
+    /// same as [`Scene::cast_ray_with`] per ray.
+    pub fn cast_packet_with(&self, origins: &[[f32; 3]], dirs: &[[f32; 3]], max_range: f32, scratch: &mut Scratch) -> [Option<Hit>; PACKET] {
+        let mut out = [None; PACKET];
+        let Some(t4) = &self.tlas4 else {
+            for (r, (o, d)) in origins.iter().zip(dirs).take(PACKET).enumerate() {
+                out[r] = self.cast_ray_with(Vec3::from_array(*o), Vec3::from_array(*d), max_range, scratch);
+            }
+            return out;
+        };
+        let mut p = Packet::new(origins, dirs, max_range);
+        let mut tri = [u32::MAX; PACKET];
+        let Scratch { top, bottom } = scratch;
+        t4.closest_packet(&mut p, top, |k, p| {
+            let id = t4.order()[k as usize];
+            let inst = &self.instances[id as usize];
+            let mut local = *p;
+            let rt = inst.pose.rotation.transpose();
+            for r in 0..PACKET {
+                let o = rt * (Vec3::new(p.o[0][r], p.o[1][r], p.o[2][r]) - inst.pose.translation);
+                let d = rt * Vec3::new(p.d[0][r], p.d[1][r], p.d[2][r]);
+                for a in 0..3 {
+                    local.o[a][r] = o[a];
+                    local.d[a][r] = d[a];
+                }
+            }
+            local.refresh_inverse();
+            self.meshes[inst.mesh as usize].cast_packet_local(&mut local, bottom);
+            for r in 0..PACKET {
+                if local.prim[r] != u32::MAX {
+                    p.best[r] = local.best[r];
+                    p.prim[r] = id;
+                    tri[r] = local.prim[r];
+                }
+            }
+        });
+        for r in 0..origins.len().min(PACKET) {
+            if p.prim[r] != u32::MAX {
+                out[r] = Some(Hit { distance: p.best[r], instance: p.prim[r], triangle: tri[r] });
+            }
+        }
+        out
     }
 
     /// Unit world normal (triangle winding) and semantic class of a hit.
@@ -257,9 +338,9 @@ impl Scene {
         )
             .into_par_iter()
             .for_each(|(dist, inst, tri, nrm, cls, back, o, d)| {
-                for i in 0..o.len() {
-                    let dir = Vec3::from_array(d[i]).normalize();
-                    if let Some(hit) = self.cast_ray(Vec3::from_array(o[i]), dir, limit) {
+                let mut scratch = Scratch::default();
+                let mut store = |i: usize, dir: Vec3, hit: Option<Hit>| {
+                    if let Some(hit) = hit {
                         let (n, c) = self.hit_normal_class(&hit);
                         dist[i] = hit.distance;
                         inst[i] = hit.instance as i32;
@@ -267,6 +348,26 @@ impl Scene {
                         nrm[3 * i..3 * i + 3].copy_from_slice(&n.to_array());
                         cls[i] = c;
                         back[i] = n.dot(dir) > 0.0;
+                    }
+                };
+                for start in (0..o.len()).step_by(PACKET) {
+                    let end = (start + PACKET).min(o.len());
+                    let mut unit = [[0.0f32; 3]; PACKET];
+                    for (u, src) in unit.iter_mut().zip(&d[start..end]) {
+                        *u = Vec3::from_array(*src).normalize().to_array();
+                    }
+                    let unit = &unit[..end - start];
+                    if end - start > 1 && Packet::is_coherent(&o[start..end], unit, COHERENT_COS, COHERENT_RADIUS) {
+                        let hits = self.cast_packet_with(&o[start..end], unit, limit, &mut scratch);
+                        for (r, hit) in hits.into_iter().take(end - start).enumerate() {
+                            store(start + r, Vec3::from_array(unit[r]), hit);
+                        }
+                    } else {
+                        for (r, u) in unit.iter().enumerate() {
+                            let dir = Vec3::from_array(*u);
+                            let hit = self.cast_ray_with(Vec3::from_array(o[start + r]), dir, limit, &mut scratch);
+                            store(start + r, dir, hit);
+                        }
                     }
                 }
             });
@@ -414,6 +515,56 @@ mod tests {
         // Empty scene / empty batch: misses, not errors.
         assert!(Scene::new().cast_rays(&[[0.0; 3]], &[[1.0, 0.0, 0.0]], 10.0).is_ok_and(|h| h.instance[0] == NO_HIT));
         assert!(s.cast_rays(&[], &[], 10.0).is_ok_and(|h| h.is_empty()));
+    }
+
+    #[test]
+    fn coherent_packets_match_single_rays_and_brute_force() {
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let (v, f) = crate::mesh::tests::random_soup(&mut rng, 300);
+        let mut s = Scene::new();
+        let soup = s.add_mesh(Mesh::new("soup", &v, &f, &[2]).unwrap_or_else(|e| unreachable!("{e}")));
+        let boxm = s.add_mesh(box_mesh([1.5, 0.7, 0.5]));
+        let _ = s.add_instance(soup, RigidPose::from_xyz_rpy([0.0, 0.0, -3.0], [0.1, 0.0, 0.4]), None);
+        for k in 0..12 {
+            let a = k as f64 * 0.5;
+            let _ = s.add_instance(boxm, RigidPose::from_xyz_rpy([8.0 * a.cos(), 8.0 * a.sin(), 0.0], [0.0, 0.0, a]), None);
+        }
+        // A 96x64 pinhole image from above: rows of 8 neighbouring pixels form coherent packets.
+        let body = crate::sensors::rays::pinhole_directions(96, 64, 1.6).unwrap_or_default();
+        let cam = RigidPose::from_xyz_rpy([0.0, 0.0, 25.0], [0.0, 1.3, 0.2]);
+        let dirs: Vec<[f32; 3]> = body.iter().map(|d| cam.transform_vector(Vec3::from_array(*d)).to_array()).collect();
+        let origins = vec![cam.translation.to_array(); dirs.len()];
+        let batch = s.cast_rays(&origins, &dirs, 100.0).unwrap_or_default();
+        let world = s.world_mesh();
+        let tris: Vec<crate::geometry::PreparedTriangle> = world
+            .faces
+            .iter()
+            .map(|f| {
+                let p = |i: u32| Vec3::from_array(world.vertices[i as usize]);
+                crate::geometry::PreparedTriangle::new(p(f[0]), p(f[1]), p(f[2]))
+            })
+            .collect();
+        let mut hits = 0;
+        for i in 0..dirs.len() {
+            let d = Vec3::from_array(dirs[i]).normalize();
+            let single = s.cast_ray(Vec3::from_array(origins[i]), d, 100.0);
+            assert_eq!(single.map(|h| h.instance as i32).unwrap_or(NO_HIT), batch.instance[i], "ray {i}");
+            let brute = tris
+                .iter()
+                .enumerate()
+                .filter_map(|(k, t)| t.intersect(Vec3::from_array(origins[i]), d, 100.0).map(|t| (t, k)))
+                .min_by(|a, b| a.0.total_cmp(&b.0));
+            match brute {
+                Some((t, k)) => {
+                    hits += 1;
+                    assert!((batch.distance[i] - t).abs() <= 1e-4 * t.max(1.0), "ray {i}: {} vs {t}", batch.distance[i]);
+                    assert_eq!(world.instances[k] as i32, batch.instance[i]);
+                    assert_eq!(world.triangles[k] as i32, batch.triangle[i]);
+                }
+                None => assert_eq!(batch.instance[i], NO_HIT),
+            }
+        }
+        assert!(hits > 400, "{hits}");
     }
 
     #[test]

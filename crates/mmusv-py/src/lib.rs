@@ -6,10 +6,12 @@
 
 use pyo3::prelude::*;
 
+mod demo;
 mod errors;
 mod kinematics;
 mod native;
 mod scene;
+mod sensors;
 
 /// The compiled core of mmusv. Use the `mmusv` package rather than this module directly.
 #[pymodule]
@@ -18,5 +20,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     errors::register(m)?;
     scene::register(m)?;
     kinematics::register(m)?;
+    sensors::register(m)?;
+    demo::register(m)?;
     Ok(())
 }

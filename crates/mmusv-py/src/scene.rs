@@ -46,6 +46,11 @@ fn pose_from(arr: &[f64], field: &str) -> PyResult<RigidPose> {
 }
 
 impl Scene {
+    /// Wraps a core scene built in Rust.
+    pub fn from_core(scene: CoreScene) -> Self {
+        Self { inner: RwLock::new(scene) }
+    }
+
     /// Runs `f` on the scene under the read lock.
     pub fn read<T>(&self, f: impl FnOnce(&CoreScene) -> PyResult<T>) -> PyResult<T> {
         let guard = self.inner.read().map_err(|_| poisoned())?;

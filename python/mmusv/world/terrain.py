@@ -21,6 +21,7 @@ from mmusv.world.primitives import TriMesh
 
 __all__ = [
     "ValueNoise",
+    "FractalNoise",
     "fbm",
     "Heightfield",
     "IslandSpec",
@@ -63,22 +64,32 @@ class ValueNoise:
         return out
 
 
+class FractalNoise:
+    """Fractal sum of ``octaves`` :class:`ValueNoise` layers (cell halves, amplitude halves per octave),
+    normalised by the amplitude sum so values stay in [-1, 1]. Draws its lattices from ``rng`` when built."""
+
+    def __init__(self, *, rng: np.random.Generator, half_extent_m: float, cell_m: float, octaves: int = 4) -> None:
+        self.layers = [
+            ValueNoise(rng=rng, half_extent_m=half_extent_m, cell_m=cell_m * 0.5**k) for k in range(int(octaves))
+        ]
+
+    def __call__(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Noise at world ``x``, ``y`` (same-shape float arrays, metres); same shape, values in [-1, 1]."""
+        total = np.zeros(np.shape(x), dtype=np.float64)
+        amp, norm = 1.0, 0.0
+        for layer in self.layers:
+            total += amp * layer(x, y)
+            norm += amp
+            amp *= 0.5
+        out: np.ndarray = total / norm
+        return out
+
+
 def fbm(
     *, rng: np.random.Generator, x: np.ndarray, y: np.ndarray, half_extent_m: float, cell_m: float, octaves: int = 4
 ) -> np.ndarray:
-    """Fractal sum of ``octaves`` value-noise layers (cell halves, amplitude halves per octave).
-
-    Returns an array shaped like ``x`` with values in [-1, 1] (normalised by the amplitude sum).
-    """
-    total = np.zeros(np.shape(x), dtype=np.float64)
-    amp, norm, cell = 1.0, 0.0, float(cell_m)
-    for _ in range(octaves):
-        total += amp * ValueNoise(rng=rng, half_extent_m=half_extent_m, cell_m=cell)(x, y)
-        norm += amp
-        amp *= 0.5
-        cell *= 0.5
-    out: np.ndarray = total / norm
-    return out
+    """One-shot :class:`FractalNoise` evaluated at ``x``, ``y``: an array shaped like ``x``, values in [-1, 1]."""
+    return FractalNoise(rng=rng, half_extent_m=half_extent_m, cell_m=cell_m, octaves=octaves)(x, y)
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,54 @@
+//! Bindings for `mmusv_core::sensors`: the sensor ray patterns.
+
+use crate::native::detached;
+use mmusv_core::sensors::rays;
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2};
+use pyo3::prelude::*;
+
+fn to_array<'py>(py: Python<'py>, v: Vec<[f32; 3]>) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let n = v.len();
+    Array2::from_shape_vec((n, 3), v.into_iter().flatten().collect())
+        .map(|a| a.into_pyarray(py))
+        .map_err(|e| crate::errors::InternalError::new_err(e.to_string()))
+}
+
+/// `[fx, fy, cx, cy]` (pixels) of a pinhole camera of `width × height` and horizontal FOV `hfov` (radians).
+#[pyfunction]
+#[pyo3(signature = (*, width, height, hfov))]
+fn pinhole_intrinsics<'py>(py: Python<'py>, width: u32, height: u32, hfov: f64) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let k = rays::pinhole_intrinsics(width, height, hfov).map_err(crate::errors::to_py)?;
+    Ok(k.to_vec().into_pyarray(py))
+}
+
+/// `(width·height, 3)` float32 unit ray directions through pixel centres, camera body frame, row-major.
+#[pyfunction]
+#[pyo3(signature = (*, width, height, hfov))]
+fn pinhole_directions<'py>(py: Python<'py>, width: u32, height: u32, hfov: f64) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let d = detached(py, || rays::pinhole_directions(width, height, hfov))?;
+    to_array(py, d)
+}
+
+/// `(azimuth_steps·len(elevations), 3)` float32 unit directions of one sweep, LiDAR frame, azimuth-major.
+#[pyfunction]
+#[pyo3(signature = (*, elevations, azimuth_steps))]
+fn lidar_directions<'py>(py: Python<'py>, elevations: Vec<f64>, azimuth_steps: u32) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let d = detached(py, || rays::lidar_directions(&elevations, azimuth_steps))?;
+    to_array(py, d)
+}
+
+/// Elevation angles (radians), lowest first, of `channels` beams spread uniformly over `[lower, upper]`.
+#[pyfunction]
+#[pyo3(signature = (*, channels, lower, upper))]
+fn uniform_elevations<'py>(py: Python<'py>, channels: u32, lower: f64, upper: f64) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let e = rays::uniform_elevations(channels, lower, upper).map_err(crate::errors::to_py)?;
+    Ok(e.into_pyarray(py))
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(pinhole_intrinsics, m)?)?;
+    m.add_function(wrap_pyfunction!(pinhole_directions, m)?)?;
+    m.add_function(wrap_pyfunction!(lidar_directions, m)?)?;
+    m.add_function(wrap_pyfunction!(uniform_elevations, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,487 @@
+"""The vessel asset library: procedural vessels from 3 m to 330 m, instrumented USVs, and user assets.
+
+Every asset is a :class:`VesselAsset`: a closed, outward-facing triangle mesh in the vessel **body frame**
+(x forward with the bow at +x, y left, z up; origin at the waterline centre of the bounding box in x/y; z = 0 is
+the waterline, so the hull reaches down to ``z = -draft``) plus its dimensions, which are always the mesh's
+bounding box: ``length`` = x extent, ``beam`` = y extent, ``height`` = z extent (keel to top), ``draft`` =
+``-min z``. All in metres.
+
+Built-in assets are described in ``vessel_catalog.yaml`` (hull + parts vocabulary of
+:mod:`mmusv.world.vessel_shapes`) and built on first use, then cached. Users add their own with
+:func:`load_asset_file` (a mesh file, OBJ/STL/PLY/GLB via trimesh, or a procedural hull/parts entry) and
+:func:`register_asset`::
+
+    from mmusv.world.vessels import get_asset, library
+    ship = get_asset("container_ship_300m")
+    ship.length, ship.mesh.vertices.shape        # 300.0, (V, 3)
+    [a.name for a in library(category="tug")]
+"""
+
+from __future__ import annotations
+
+import difflib
+import os
+import re
+import threading
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any, NamedTuple
+
+import numpy as np
+import yaml
+
+from mmusv.classes import SemanticClass
+from mmusv.world.primitives import TriMesh
+from mmusv.world.vessel_shapes import AssetSpecError, Fields, build_procedural
+
+__all__ = [
+    "AssetSpecError",
+    "MountPoint",
+    "UnknownAssetError",
+    "VesselAsset",
+    "asset_names",
+    "categories",
+    "get_asset",
+    "library",
+    "load_asset_catalog",
+    "load_asset_file",
+    "register_asset",
+    "unregister_asset",
+]
+
+_NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.\-]*$")
+_ALLOWED_CLASSES = (SemanticClass.VESSEL, SemanticClass.USV)
+_YamlLoader: Any = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
+class MountPoint(NamedTuple):
+    """A sensor mount in the vessel body frame: ``xyz`` metres, ``rpy_deg`` roll/pitch/yaw degrees (R = Rz·Ry·Rx).
+
+    The sensor's own body frame (x forward, y left, z up) is rotated by ``rpy_deg``: yaw 90 looks to port,
+    pitch 90 looks straight down.
+    """
+
+    xyz: tuple[float, float, float]
+    rpy_deg: tuple[float, float, float]
+
+
+def _as_mount(m: object, where: str) -> MountPoint:
+    try:
+        pair: Sequence[Any] = m  # type: ignore[assignment]
+        xyz, rpy = pair
+        a = tuple(float(x) for x in xyz)
+        b = tuple(float(x) for x in rpy)
+    except (TypeError, ValueError) as exc:
+        raise AssetSpecError(where, f"must be (xyz, rpy_deg), two triples of numbers; got {m!r}") from exc
+    if len(a) != 3 or len(b) != 3 or not all(np.isfinite(a + b)):
+        raise AssetSpecError(where, f"must be (xyz, rpy_deg), two finite triples; got {m!r}")
+    return MountPoint((a[0], a[1], a[2]), (b[0], b[1], b[2]))
+
+
+class UnknownAssetError(KeyError):
+    """No asset has this name. ``suggestions`` holds close matches; ``str()`` is a readable message."""
+
+    def __init__(self, name: str, known: Sequence[str]) -> None:
+        self.name = name
+        self.suggestions = _suggest(name, known)
+        hint = (f"did you mean {', '.join(repr(s) for s in self.suggestions)}?" if self.suggestions
+                else "no close match")
+        self.message = (f"unknown vessel asset {name!r}; {hint} "
+                        f"(mmusv.world.vessels.asset_names() lists all {len(known)} assets)")
+        super().__init__(self.message)
+
+    def __str__(self) -> str:
+        return self.message
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (_unknown_asset_error, (self.name, tuple(self.suggestions), self.message))
+
+
+def _unknown_asset_error(name: str, suggestions: tuple[str, ...], message: str) -> UnknownAssetError:
+    err = UnknownAssetError.__new__(UnknownAssetError)
+    KeyError.__init__(err, message)
+    err.name, err.suggestions, err.message = name, list(suggestions), message
+    return err
+
+
+def _suggest(name: str, known: Sequence[str]) -> list[str]:
+    key = str(name).lower()
+    out = difflib.get_close_matches(key, list(known), n=5, cutoff=0.5)
+    for k in known:
+        if len(out) >= 5:
+            break
+        if key and key in k.lower() and k not in out:
+            out.append(k)
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class VesselAsset:
+    """One vessel asset: a labelled body-frame mesh, its bounding-box dimensions and sensor mounts.
+
+    Constructed from ``name``, ``category``, ``semantic_class`` (VESSEL or USV), ``mesh`` and optionally
+    ``mounts``/``description``/``source``; ``length``, ``beam``, ``height``, ``draft`` (metres, floats) and
+    ``bbox`` (``(2, 3)`` float64, min/max corner, metres, body frame) are computed from the mesh. The mesh
+    arrays are copied and made read-only. The mesh must be centred in x/y (|centre| <= 1e-6 of its size)
+    and must cross the waterline (``min z < 0 < max z``); otherwise ``ValueError``.
+    """
+
+    name: str
+    category: str
+    semantic_class: SemanticClass
+    mesh: TriMesh = field(repr=False)
+    mounts: Mapping[str, MountPoint] = field(default_factory=dict, repr=False)
+    description: str = field(default="", repr=False)
+    source: str = "builtin"
+    length: float = field(init=False)
+    beam: float = field(init=False)
+    height: float = field(init=False)
+    draft: float = field(init=False)
+    bbox: np.ndarray = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not _NAME_RE.match(self.name):
+            raise AssetSpecError("name", f"must be letters, digits, '_', '-' or '.', got {self.name!r}")
+        cls = SemanticClass(self.semantic_class)
+        if cls not in _ALLOWED_CLASSES:
+            raise AssetSpecError(f"{self.name}.semantic_class", f"must be vessel or usv, got {cls.name.lower()}")
+        object.__setattr__(self, "semantic_class", cls)
+        v = np.array(self.mesh.vertices, dtype=np.float64)
+        fc = np.array(self.mesh.faces, dtype=np.int64)
+        c = np.array(self.mesh.classes, dtype=np.uint16)
+        if fc.shape[0] == 0 or v.shape[0] == 0:
+            raise AssetSpecError(f"{self.name}.mesh", "mesh has no triangles")
+        if not np.all(np.isfinite(v)):
+            raise AssetSpecError(f"{self.name}.mesh", "mesh has non-finite vertices")
+        if fc.min() < 0 or fc.max() >= v.shape[0]:
+            raise AssetSpecError(f"{self.name}.mesh", "face indices out of range")
+        for a in (v, fc, c):
+            a.setflags(write=False)
+        mesh = TriMesh(v, fc, c)
+        lo, hi = v[fc.reshape(-1)].min(axis=0), v[fc.reshape(-1)].max(axis=0)
+        ext = hi - lo
+        centre = (lo[:2] + hi[:2]) / 2.0
+        if np.any(np.abs(centre) > 1e-6 * max(1.0, float(ext.max()))):
+            raise AssetSpecError(f"{self.name}.mesh", f"x/y bounding box centre is {centre.tolist()}, not the origin")
+        if not lo[2] < 0.0 < hi[2]:
+            raise AssetSpecError(f"{self.name}.mesh",
+                                 f"mesh spans z [{lo[2]:g}, {hi[2]:g}] m; it must cross the waterline z = 0")
+        bbox = np.stack([lo, hi])
+        bbox.setflags(write=False)
+        mounts = {str(k): _as_mount(m, f"{self.name}.mounts.{k}") for k, m in dict(self.mounts).items()}
+        object.__setattr__(self, "mesh", mesh)
+        object.__setattr__(self, "mounts", MappingProxyType(mounts))
+        object.__setattr__(self, "bbox", bbox)
+        object.__setattr__(self, "length", float(ext[0]))
+        object.__setattr__(self, "beam", float(ext[1]))
+        object.__setattr__(self, "height", float(ext[2]))
+        object.__setattr__(self, "draft", float(-lo[2]))
+
+    @property
+    def air_draft(self) -> float:
+        """Height of the highest point above the waterline, metres (``height - draft``)."""
+        return float(self.bbox[1, 2])
+
+    @property
+    def num_triangles(self) -> int:
+        """Number of mesh triangles."""
+        return self.mesh.num_triangles
+
+    @property
+    def is_usv(self) -> bool:
+        """Whether this is an (instrumentable) USV asset."""
+        return self.semantic_class == SemanticClass.USV
+
+
+# ------------------------------------------------------------------------------------------------- library
+
+_lock = threading.RLock()
+_entries: dict[str, Mapping[str, Any]] | None = None
+_built: dict[str, VesselAsset] = {}
+_user: dict[str, VesselAsset] = {}
+
+
+def _builtin_entries() -> dict[str, Mapping[str, Any]]:
+    global _entries
+    with _lock:
+        if _entries is None:
+            text = resources.files("mmusv.world").joinpath("vessel_catalog.yaml").read_text(encoding="utf-8")
+            _entries = _index_entries(yaml.load(text, Loader=_YamlLoader), source="vessel_catalog.yaml")
+        return _entries
+
+
+def _index_entries(data: object, *, source: str) -> dict[str, Mapping[str, Any]]:
+    items = data.get("vessels") if isinstance(data, Mapping) else data
+    if not isinstance(items, list):
+        raise AssetSpecError("vessels", f"{source} must hold a list of entries (or a 'vessels:' list)")
+    out: dict[str, Mapping[str, Any]] = {}
+    for i, item in enumerate(items):
+        if not isinstance(item, Mapping):
+            raise AssetSpecError(f"vessels[{i}]", "must be a mapping")
+        name = item.get("name")
+        if not isinstance(name, str):
+            raise AssetSpecError(f"vessels[{i}].name", "is required (a string)")
+        if name in out:
+            raise AssetSpecError(f"vessels[{i}].name", f"duplicate asset name {name!r} in {source}")
+        out[name] = item
+    return out
+
+
+def asset_names() -> list[str]:
+    """Names of all assets (built-in and registered), sorted. Builds nothing."""
+    with _lock:
+        return sorted(set(_builtin_entries()) | set(_user))
+
+
+def get_asset(name: str) -> VesselAsset:
+    """The asset called ``name`` (built on first use, then cached).
+
+    Raises :class:`UnknownAssetError` (a ``KeyError``) listing close matches when no asset has that name.
+    """
+    if not isinstance(name, str):
+        raise TypeError(f"asset name must be a string, got {type(name).__name__}")
+    with _lock:
+        if name in _user:
+            return _user[name]
+        if name in _built:
+            return _built[name]
+        entries = _builtin_entries()
+        if name in entries:
+            asset = _build_entry(entries[name], base_dir=None, source="builtin", builtin=True)
+            _built[name] = asset
+            return asset
+    raise UnknownAssetError(name, asset_names())
+
+
+def library(*, category: str | None = None, semantic_class: SemanticClass | int | None = None) -> list[VesselAsset]:
+    """All assets sorted by name, optionally only one ``category`` and/or ``semantic_class``. Builds them all."""
+    assets = [get_asset(n) for n in asset_names()]
+    if category is not None:
+        assets = [a for a in assets if a.category == category]
+    if semantic_class is not None:
+        assets = [a for a in assets if a.semantic_class == SemanticClass(semantic_class)]
+    return assets
+
+
+def categories() -> list[str]:
+    """Sorted distinct categories of all assets."""
+    with _lock:
+        cats = {str(e.get("category", "")) for e in _builtin_entries().values()} | {a.category for a in _user.values()}
+    return sorted(cats)
+
+
+def register_asset(asset: VesselAsset) -> VesselAsset:
+    """Adds ``asset`` to this process's library and returns it; a name already taken raises :class:`AssetSpecError`."""
+    if not isinstance(asset, VesselAsset):
+        raise TypeError(f"register_asset() takes a VesselAsset, got {type(asset).__name__}")
+    with _lock:
+        if asset.name in _builtin_entries():
+            raise AssetSpecError("name", f"{asset.name!r} is a built-in asset; choose another name")
+        if asset.name in _user:
+            raise AssetSpecError("name", f"an asset named {asset.name!r} is already registered")
+        _user[asset.name] = asset
+    return asset
+
+
+def unregister_asset(name: str) -> None:
+    """Removes a registered user asset (built-ins cannot be removed)."""
+    with _lock:
+        if name in _user:
+            del _user[name]
+            return
+        if name in _builtin_entries():
+            raise AssetSpecError("name", f"{name!r} is a built-in asset and cannot be unregistered")
+    raise UnknownAssetError(name, asset_names())
+
+
+# ------------------------------------------------------------------------------------------- user assets
+
+_AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
+
+
+def _axis(f: Fields, key: str, default: str) -> np.ndarray:
+    s = f.text(key, default).strip().lower()
+    sign = -1.0 if s.startswith("-") else 1.0
+    letter = s.lstrip("+-")
+    if letter not in _AXES or len(s) - len(letter) > 1:
+        raise AssetSpecError(f.at(key), f"must be one of x, y, z, -x, -y, -z; got {s!r}")
+    return sign * np.array(_AXES[letter])
+
+
+def _load_mesh_file(path: Path, where: str) -> tuple[np.ndarray, np.ndarray]:
+    if not path.is_file():
+        raise AssetSpecError(where, f"mesh file {str(path)!r} does not exist")
+    try:
+        import trimesh
+    except ImportError as exc:  # pragma: no cover - depends on the install
+        raise AssetSpecError(where, "loading mesh files needs the 'trimesh' package (pip install trimesh)") from exc
+    try:
+        loaded = trimesh.load(str(path), force="mesh")
+    except Exception as exc:  # trimesh raises many types for unreadable files
+        raise AssetSpecError(where, f"cannot read {str(path)!r}: {exc}") from exc
+    if not isinstance(loaded, trimesh.Trimesh):
+        raise AssetSpecError(where, f"{str(path)!r} does not hold a triangle mesh")
+    v = np.asarray(loaded.vertices, dtype=np.float64).reshape(-1, 3)
+    fc = np.asarray(loaded.faces, dtype=np.int64).reshape(-1, 3)
+    if fc.shape[0] == 0:
+        raise AssetSpecError(where, f"{str(path)!r} holds no triangles")
+    used, inverse = np.unique(fc.reshape(-1), return_inverse=True)
+    v, fc = v[used], inverse.reshape(-1, 3).astype(np.int64)
+    if not np.all(np.isfinite(v)):
+        raise AssetSpecError(where, f"{str(path)!r} has non-finite vertices")
+    return v, fc
+
+
+def _semantic_class(f: Fields) -> SemanticClass:
+    v = f.raw("semantic_class")
+    if v is None:
+        return SemanticClass.VESSEL
+    cls: SemanticClass | None = None
+    try:
+        if isinstance(v, str):
+            cls = SemanticClass[v.upper()]
+        elif isinstance(v, int) and not isinstance(v, bool):
+            cls = SemanticClass(v)
+    except (KeyError, ValueError):
+        cls = None
+    if cls not in _ALLOWED_CLASSES:
+        raise AssetSpecError(f.at("semantic_class"), f"must be 'vessel' or 'usv', got {v!r}")
+    assert cls is not None
+    return cls
+
+
+def _mounts(f: Fields) -> dict[str, MountPoint]:
+    raw = f.raw("mounts")
+    if raw is None:
+        return {}
+    mf = Fields(raw, f.at("mounts"))
+    out = {}
+    for key in mf.keys():
+        m = Fields(mf.raw(key), mf.at(key))
+        xyz = m.vec("xyz", 3)
+        rpy = m.vec("rpy_deg", 3, (0.0, 0.0, 0.0))
+        m.finish()
+        out[str(key)] = MountPoint((xyz[0], xyz[1], xyz[2]), (rpy[0], rpy[1], rpy[2]))
+    return out
+
+
+def _build_entry(entry: object, *, base_dir: Path | None, source: str, builtin: bool = False) -> VesselAsset:
+    name_guess = entry.get("name") if isinstance(entry, Mapping) else None
+    f = Fields(entry, name_guess if isinstance(name_guess, str) and _NAME_RE.match(name_guess) else "")
+    name = f.text("name")
+    if not _NAME_RE.match(name):
+        raise AssetSpecError(f.at("name"), f"must be letters, digits, '_', '-' or '.', got {name!r}")
+    category = f.text("category", "custom")
+    description = str(f.raw("description") or "")
+    cls = _semantic_class(f)
+    mounts = _mounts(f)
+    has_mesh, has_hull = f.has("mesh"), f.has("hull")
+    if has_mesh == has_hull:
+        raise AssetSpecError(f.at("mesh"), "give exactly one of 'mesh' (a mesh file) or 'hull' (procedural)")
+    if has_hull:
+        mesh = build_procedural(hull=f.raw("hull"), parts=f.raw("parts"), path=f.path, cls=int(cls))
+        f.finish()
+    else:
+        if builtin:
+            raise AssetSpecError(f.at("mesh"), "built-in assets are procedural")
+        mesh = _mesh_entry(f, base_dir=base_dir, cls=int(cls))
+    b = mesh.bounds
+    shift = np.array([(b[0, 0] + b[1, 0]) / 2.0, (b[0, 1] + b[1, 1]) / 2.0, 0.0])
+    if np.any(np.abs(shift) > 1e-9 * max(1.0, float((b[1] - b[0]).max()))):
+        mesh = TriMesh(mesh.vertices - shift, mesh.faces, mesh.classes)
+        if has_hull:
+            mounts = {k: MountPoint((m.xyz[0] - shift[0], m.xyz[1] - shift[1], m.xyz[2]), m.rpy_deg)
+                      for k, m in mounts.items()}
+    return VesselAsset(name=name, category=category, semantic_class=cls, mesh=mesh, mounts=mounts,
+                       description=description, source=source)
+
+
+def _mesh_entry(f: Fields, *, base_dir: Path | None, cls: int) -> TriMesh:
+    mesh_path = Path(os.fspath(f.text("mesh"))).expanduser()
+    if not mesh_path.is_absolute():
+        mesh_path = (base_dir or Path.cwd()) / mesh_path
+    scale = f.num("scale", 1.0, minimum=0.0, exclusive=True)
+    up = _axis(f, "up_axis", "z")
+    fwd = _axis(f, "forward_axis", "x")
+    if abs(float(up @ fwd)) > 0.5:
+        raise AssetSpecError(f.at("forward_axis"), "must be perpendicular to up_axis")
+    waterline = f.opt_num("waterline_z")
+    draft = f.opt_num("draft", minimum=0.0, exclusive=True)
+    if waterline is not None and draft is not None:
+        raise AssetSpecError(f.at("draft"), "give either waterline_z or draft, not both")
+    f.finish()
+    v, fc = _load_mesh_file(mesh_path, f.at("mesh"))
+    rot = np.stack([fwd, np.cross(up, fwd), up])          # rows: body x, y, z in file coordinates
+    body = (v @ rot.T) * scale
+    zmin, zmax = float(body[:, 2].min()), float(body[:, 2].max())
+    if draft is not None:
+        if draft >= zmax - zmin:
+            raise AssetSpecError(f.at("draft"), f"{draft:g} m is not less than the mesh height {zmax - zmin:g} m")
+        body[:, 2] -= zmin + draft
+    else:
+        wl = (waterline or 0.0) * scale
+        if not zmin < wl < zmax:
+            raise AssetSpecError(
+                f.at("waterline_z"),
+                f"waterline {wl:g} m must lie inside the mesh's vertical extent [{zmin:g}, {zmax:g}] m "
+                "(after scaling; check up_axis and scale)")
+        body[:, 2] -= wl
+    return TriMesh(body, fc, np.array([cls]))
+
+
+def load_asset_file(entry: Mapping[str, Any] | str | os.PathLike[str], *,
+                    base_dir: str | os.PathLike[str] | None = None, register: bool = False) -> VesselAsset:
+    """Builds one user asset from a mapping or a YAML file holding one mapping.
+
+    Mesh entry keys: ``name`` (required), ``category`` ("custom"), ``description``, ``semantic_class``
+    (``vessel`` | ``usv``), ``mesh`` (path, OBJ/STL/PLY/GLB/... read with ``trimesh.load(force="mesh")``;
+    relative to the YAML file's folder, or ``base_dir``/cwd for a mapping), ``scale`` (file units -> metres, 1.0),
+    ``up_axis`` (``z``; ``y`` for glTF-style files; any of ±x/±y/±z), ``forward_axis`` (bow direction in the file,
+    ``x``; any of ±x/±y/±z perpendicular to up), ``waterline_z`` (waterline height along ``up_axis`` in file units,
+    0.0) or ``draft`` (metres above the lowest point), ``mounts`` (``{name: {xyz, rpy_deg}}`` in the asset frame).
+    A procedural entry gives ``hull`` and ``parts`` instead of ``mesh`` (see :mod:`mmusv.world.vessel_shapes`).
+
+    The mesh is rotated to the body frame, scaled, shifted so the waterline is z = 0 and re-centred in x/y;
+    dimensions come from its bounding box. Raises :class:`AssetSpecError` (a ``ValueError``) naming the field.
+    ``register=True`` also adds it with :func:`register_asset`.
+    """
+    if isinstance(entry, Mapping):
+        data: object = entry
+        base = Path(base_dir) if base_dir is not None else None
+        source = "<mapping>"
+    else:
+        path = Path(os.fspath(entry)).expanduser()
+        data = _read_yaml(path)
+        if not isinstance(data, Mapping) or "vessels" in data:
+            raise AssetSpecError("file", f"{str(path)!r} must hold one asset mapping; use load_asset_catalog() "
+                                         "for a list of assets")
+        base = Path(base_dir) if base_dir is not None else path.parent
+        source = str(path)
+    asset = _build_entry(data, base_dir=base, source=source)
+    return register_asset(asset) if register else asset
+
+
+def load_asset_catalog(path: str | os.PathLike[str], *, register: bool = False) -> list[VesselAsset]:
+    """Builds every asset of a YAML file holding a list of entries (or ``{vessels: [...]}``), in file order.
+
+    Entries are those of :func:`load_asset_file`; relative mesh paths are relative to the file's folder.
+    """
+    p = Path(os.fspath(path)).expanduser()
+    entries = _index_entries(_read_yaml(p), source=str(p))
+    assets = [_build_entry(e, base_dir=p.parent, source=str(p)) for e in entries.values()]
+    if register:
+        for a in assets:
+            register_asset(a)
+    return assets
+
+
+def _read_yaml(path: Path) -> object:
+    if not path.is_file():
+        raise AssetSpecError("file", f"asset file {str(path)!r} does not exist")
+    try:
+        return yaml.load(path.read_text(encoding="utf-8"), Loader=_YamlLoader)
+    except yaml.YAMLError as exc:
+        raise AssetSpecError("file", f"{str(path)!r} is not valid YAML: {exc}") from exc
