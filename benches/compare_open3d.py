@@ -4,7 +4,8 @@ Both use every core of this machine, in one process, one after the other, best o
 The scene is mmusv's synthetic maritime benchmark scene (≈0.75 M triangles: islands heightfield, water plane,
 48 vessel instances); Open3D gets the same world triangles flattened into one mesh, which is the best case
 for Embree (a single BVH, no instancing). Ray sets: one 64×2048 LiDAR sweep and four 640×480 surround
-pinhole cameras, exactly the sets `cargo bench` uses.
+pinhole cameras, exactly the sets `cargo bench` uses (the LiDAR rays in the sensor's trace order: blocks of 8
+neighbouring columns).
 
 Run: ``python benches/compare_open3d.py`` (needs ``pip install open3d-cpu``).
 """
@@ -29,6 +30,7 @@ def ray_sets() -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """The LiDAR and camera ray sets: name -> (origins (N,3) f32, directions (N,3) f32), world frame."""
     el = core.uniform_elevations(channels=64, lower=np.deg2rad(-25.0), upper=np.deg2rad(15.0))
     lidar = np.asarray(core.lidar_directions(elevations=list(el), azimuth_steps=2048))
+    lidar = lidar[np.asarray(core.lidar_trace_order(channels=64, azimuth_steps=2048))]  # the sensor's trace order
     body = np.asarray(core.pinhole_directions(width=640, height=480, hfov=np.pi / 2))
     cams = []
     for k in range(4):

@@ -186,12 +186,15 @@ pub fn maritime_demo(p: DemoParams) -> Result<DemoScene> {
     Ok(DemoScene { scene, vessel_instances })
 }
 
-/// Origins and unit directions of one 64-channel sweep (−25°…+15°, `azimuth_steps` columns) from a LiDAR
-/// at `position` with the body axes aligned to the world.
+/// Origins and unit directions of one sweep (`channels` beams over −25°…+15°, `azimuth_steps` columns) from a
+/// LiDAR at `position` with the body axes aligned to the world, in [`rays::lidar_trace_order`] (blocks of 8
+/// columns), the order the LiDAR sensor traces them in.
 pub fn lidar_rays(position: [f32; 3], channels: u32, azimuth_steps: u32) -> Result<(Vec<[f32; 3]>, Vec<[f32; 3]>)> {
     let el = rays::uniform_elevations(channels, (-25f64).to_radians(), 15f64.to_radians())?;
     let dirs = rays::lidar_directions(&el, azimuth_steps)?;
-    Ok((vec![position; dirs.len()], dirs))
+    let order = rays::lidar_trace_order(channels, azimuth_steps, crate::packet::PACKET as u32);
+    let traced: Vec<[f32; 3]> = order.iter().map(|&i| dirs[i as usize]).collect();
+    Ok((vec![position; traced.len()], traced))
 }
 
 /// Origins and unit world directions of `count` surround pinhole cameras (yaw 0, 360/count, ...) at `position`.

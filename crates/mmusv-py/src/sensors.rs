@@ -45,10 +45,19 @@ fn uniform_elevations<'py>(py: Python<'py>, channels: u32, lower: f64, upper: f6
     Ok(e.into_pyarray(py))
 }
 
+/// `(channels·azimuth_steps,)` uint32: the packet-friendly trace order of a sweep (indices into the
+/// azimuth-major order of `lidar_directions`), blocks of `block` neighbouring columns.
+#[pyfunction]
+#[pyo3(signature = (*, channels, azimuth_steps, block=8))]
+fn lidar_trace_order<'py>(py: Python<'py>, channels: u32, azimuth_steps: u32, block: u32) -> Bound<'py, PyArray1<u32>> {
+    rays::lidar_trace_order(channels, azimuth_steps, block).into_pyarray(py)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(pinhole_intrinsics, m)?)?;
     m.add_function(wrap_pyfunction!(pinhole_directions, m)?)?;
     m.add_function(wrap_pyfunction!(lidar_directions, m)?)?;
     m.add_function(wrap_pyfunction!(uniform_elevations, m)?)?;
+    m.add_function(wrap_pyfunction!(lidar_trace_order, m)?)?;
     Ok(())
 }

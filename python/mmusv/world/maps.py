@@ -56,7 +56,7 @@ DEFAULT_MOORED_ASSETS: tuple[tuple[str, float, float], ...] = (
 )
 
 
-class MapConfigError(ConfigError, ValueError):  # type: ignore[misc]
+class MapConfigError(ConfigError, ValueError):  # type: ignore[misc,unused-ignore]
     """A map parameter is invalid. ``field`` names it, ``allowed`` says what is accepted."""
 
     def __init__(self, field: str, value: object, allowed: str) -> None:

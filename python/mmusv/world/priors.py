@@ -17,6 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 import shapely
 from scipy.ndimage import distance_transform_edt
 from shapely.geometry import Polygon
@@ -77,7 +78,7 @@ class MapPriors:
         """``(H, W)`` raster shape."""
         return (int(self.water_mask.shape[0]), int(self.water_mask.shape[1]))
 
-    def world_to_cell(self, xy: np.ndarray) -> np.ndarray:
+    def world_to_cell(self, xy: npt.ArrayLike) -> np.ndarray:
         """Cells containing points ``xy`` ``(N, 2)`` metres -> ``(N, 2)`` int64 ``(row, col)``; may be out of
         range (see :meth:`in_bounds`)."""
         p = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
@@ -85,35 +86,35 @@ class MapPriors:
         row = np.floor((p[:, 1] - self.origin[1]) / self.resolution)
         return np.column_stack([row, col]).astype(np.int64)
 
-    def cell_to_world(self, rc: np.ndarray) -> np.ndarray:
+    def cell_to_world(self, rc: npt.ArrayLike) -> np.ndarray:
         """Centres of cells ``rc`` ``(N, 2)`` ``(row, col)`` -> ``(N, 2)`` float64 world ``(x, y)`` metres."""
         c = np.asarray(rc, dtype=np.float64).reshape(-1, 2)
         return np.column_stack(
             [self.origin[0] + (c[:, 1] + 0.5) * self.resolution, self.origin[1] + (c[:, 0] + 0.5) * self.resolution]
         )
 
-    def in_bounds(self, rc: np.ndarray) -> np.ndarray:
+    def in_bounds(self, rc: npt.ArrayLike) -> np.ndarray:
         """``(N,)`` bool: cells ``rc`` ``(N, 2)`` lie inside the raster."""
         c = np.asarray(rc).reshape(-1, 2)
         h, w = self.shape
         return (c[:, 0] >= 0) & (c[:, 0] < h) & (c[:, 1] >= 0) & (c[:, 1] < w)
 
-    def _lookup(self, raster: np.ndarray, xy: np.ndarray, outside: float | bool) -> np.ndarray:
+    def _lookup(self, raster: np.ndarray, xy: npt.ArrayLike, outside: float | bool) -> np.ndarray:
         rc = self.world_to_cell(xy)
         ok = self.in_bounds(rc)
         out = np.full(rc.shape[0], outside, dtype=raster.dtype)
         out[ok] = raster[rc[ok, 0], rc[ok, 1]]
         return out
 
-    def is_water(self, xy: np.ndarray) -> np.ndarray:
+    def is_water(self, xy: npt.ArrayLike) -> np.ndarray:
         """``(N,)`` bool: points ``xy`` ``(N, 2)`` (world, metres) lie in navigable water; False outside the map."""
         return self._lookup(self.water_mask, xy, False)
 
-    def is_valid(self, xy: np.ndarray) -> np.ndarray:
+    def is_valid(self, xy: npt.ArrayLike) -> np.ndarray:
         """``(N,)`` bool: points ``xy`` ``(N, 2)`` lie in :attr:`valid_zones`; False outside the map."""
         return self._lookup(self.valid_zones, xy, False)
 
-    def shore_distance_at(self, xy: np.ndarray) -> np.ndarray:
+    def shore_distance_at(self, xy: npt.ArrayLike) -> np.ndarray:
         """``(N,)`` float64 shore distance (metres) of the cells holding points ``xy`` ``(N, 2)``; 0 outside."""
         return self._lookup(self.shore_distance, xy, 0.0).astype(np.float64)
 
@@ -138,7 +139,7 @@ class MapPriors:
              self.origin[1] + (rc[:, 0] + jitter[:, 1]) * self.resolution]
         )
 
-    def line_of_sight(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    def line_of_sight(self, a: npt.ArrayLike, b: npt.ArrayLike) -> np.ndarray:
         """``(N,)`` bool: the segments ``a[i] -> b[i]`` (each ``(N, 2)``, metres) cross no occlusion region."""
         pa = np.asarray(a, dtype=np.float64).reshape(-1, 2)
         pb = np.asarray(b, dtype=np.float64).reshape(-1, 2)
@@ -147,7 +148,8 @@ class MapPriors:
         occ = shapely.union_all(list(self.occlusion_regions))
         shapely.prepare(occ)
         segs = shapely.linestrings(np.stack([pa, pb], axis=1))
-        return ~shapely.intersects(occ, segs)
+        blocked = np.asarray(shapely.intersects(occ, segs), dtype=bool)
+        return ~blocked
 
 
 def _rasterize(geom: BaseGeometry, *, origin: tuple[float, float], res: float, shape: tuple[int, int]) -> np.ndarray:

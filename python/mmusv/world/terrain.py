@@ -12,6 +12,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 import shapely
 from shapely.geometry import MultiPolygon, Polygon
 from shapely.geometry.base import BaseGeometry
@@ -183,7 +184,7 @@ class Heightfield:
         ny, nx = self.shape
         return (self.x0, self.y0, self.x0 + (nx - 1) * self.spacing, self.y0 + (ny - 1) * self.spacing)
 
-    def sample(self, xy: np.ndarray) -> np.ndarray:
+    def sample(self, xy: npt.ArrayLike) -> np.ndarray:
         """Mesh height at points ``xy`` ``(N, 2)`` (metres, world frame) -> ``(N,)`` float64; NaN outside."""
         p = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
         ny, nx = self.shape
@@ -198,7 +199,7 @@ class Heightfield:
         z00, z10, z01, z11 = z[i, j], z[i, j + 1], z[i + 1, j], z[i + 1, j + 1]
         lower = z00 + fu * (z10 - z00) + fv * (z11 - z10)
         upper = z00 + fv * (z01 - z00) + fu * (z11 - z01)
-        out = np.where(fu >= fv, lower, upper)
+        out: np.ndarray = np.where(fu >= fv, lower, upper)
         out[~inside] = np.nan
         return out
 

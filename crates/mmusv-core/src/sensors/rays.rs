@@ -77,6 +77,25 @@ pub fn lidar_directions(elevations: &[f64], azimuth_steps: u32) -> Result<Vec<[f
     Ok(out)
 }
 
+/// The order in which a sweep is best traced: blocks of `block` neighbouring columns, and within a block each
+/// channel's `block` rays consecutively, so consecutive rays are nearly parallel and form coherent packets.
+/// Entry `i` is the index, in [`lidar_directions`]'s azimuth-major order, of the `i`-th ray to trace.
+pub fn lidar_trace_order(channels: u32, azimuth_steps: u32, block: u32) -> Vec<u32> {
+    let block = block.max(1);
+    let mut order = Vec::with_capacity(channels as usize * azimuth_steps as usize);
+    let mut first = 0;
+    while first < azimuth_steps {
+        let last = (first + block).min(azimuth_steps);
+        for ch in 0..channels {
+            for col in first..last {
+                order.push(col * channels + ch);
+            }
+        }
+        first = last;
+    }
+    order
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -107,6 +126,11 @@ mod tests {
         let r = d[512 * 64 + 20];
         assert!(r[0].abs() < 1e-6 && r[1] > 0.0);
         assert!((r[2] as f64 - el[20].sin()).abs() < 1e-6);
+        let order = lidar_trace_order(64, 2048, 8);
+        let mut sorted = order.clone();
+        sorted.sort_unstable();
+        assert_eq!(sorted, (0..64 * 2048).collect::<Vec<u32>>(), "a permutation");
+        assert_eq!(&order[..3], &[0, 64, 128]);
         assert!(uniform_elevations(0, 0.0, 0.1).is_err());
         assert!(lidar_directions(&el, 0).is_err());
         assert!(pinhole_intrinsics(0, 10, 1.0).is_err());
