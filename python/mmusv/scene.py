@@ -61,7 +61,7 @@ class RayHits:
         d = np.asarray(directions, dtype=np.float32)
         d = d / np.linalg.norm(d, axis=1, keepdims=True)
         with np.errstate(invalid="ignore"):
-            p = o + d * self.distance[:, None]
+            p: npt.NDArray[np.float32] = o + d * self.distance[:, None]
         p[~self.hit] = np.nan
         return p.astype(np.float32, copy=False)
 

@@ -28,9 +28,19 @@ SMALL: dict[str, dict[str, Any]] = {
     "island": dict(extent_m=400.0, n_islands=2, island_radius_m=(30.0, 60.0), min_gap_m=30.0, clearance_m=15.0),
     "open_sea": dict(extent_m=400.0, islet_probability=1.0, islet_radius_m=(15.0, 25.0), n_buoys=2, clearance_m=15.0),
     "port": dict(
-        extent_m=800.0, coast_offset_m=120.0, harbour_width_m=420.0, harbour_depth_m=230.0, entrance_width_m=90.0,
-        n_piers=1, pier_length_m=(60.0, 110.0), n_cranes=2, n_buildings=3, n_channel_buoy_pairs=1, n_moored=2,
-        n_buoys=1, hill_height_m=20.0,
+        extent_m=800.0,
+        coast_offset_m=120.0,
+        harbour_width_m=420.0,
+        harbour_depth_m=230.0,
+        entrance_width_m=90.0,
+        n_piers=1,
+        pier_length_m=(60.0, 110.0),
+        n_cranes=2,
+        n_buildings=3,
+        n_channel_buoy_pairs=1,
+        n_moored=2,
+        n_buoys=1,
+        hill_height_m=20.0,
     ),
 }
 
@@ -144,8 +154,15 @@ def test_each_kind_generates(kind: str) -> None:
     expected = {
         "island": {SemanticClass.WATER, SemanticClass.TERRAIN, SemanticClass.BUOY},
         "open_sea": {SemanticClass.WATER, SemanticClass.TERRAIN, SemanticClass.BUOY},
-        "port": {SemanticClass.WATER, SemanticClass.TERRAIN, SemanticClass.PORT_STRUCTURE, SemanticClass.CONTAINER,
-                 SemanticClass.CRANE, SemanticClass.BUILDING, SemanticClass.BUOY},
+        "port": {
+            SemanticClass.WATER,
+            SemanticClass.TERRAIN,
+            SemanticClass.PORT_STRUCTURE,
+            SemanticClass.CONTAINER,
+            SemanticClass.CRANE,
+            SemanticClass.BUILDING,
+            SemanticClass.BUOY,
+        },
     }[kind]
     assert {int(c) for c in expected} <= classes
     pr = w.priors
@@ -159,7 +176,9 @@ def test_each_kind_generates(kind: str) -> None:
         for name, (x, y, yaw) in w.moored:
             assert isinstance(name, str) and -np.pi <= yaw <= np.pi
             assert w.heightfield.sample(np.array([[x, y]]))[0] < -w.params.draft_margin_m
-        assert not shapely.union_all(list(pr.moored_footprints)).intersects(shapely.union_all(list(pr.structure_boundaries)))
+        assert not shapely.union_all(list(pr.moored_footprints)).intersects(
+            shapely.union_all(list(pr.structure_boundaries))
+        )
 
 
 def test_open_sea_can_be_water_only() -> None:
@@ -198,14 +217,16 @@ def _fingerprint(w: MapWorld) -> list[Any]:
         out += [name, m.vertices, m.faces, m.classes]
     pr = w.priors
     out += [pr.water_mask, pr.shore_distance, pr.valid_zones, pr.buoys, w.heightfield.z, *pr.shoreline]
-    out += [shapely.to_wkb(g) for g in (*pr.land, *pr.structure_boundaries, *pr.occlusion_regions, *pr.moored_footprints)]
+    out += [
+        shapely.to_wkb(g) for g in (*pr.land, *pr.structure_boundaries, *pr.occlusion_regions, *pr.moored_footprints)
+    ]
     return out
 
 
 def _same(a: list[Any], b: list[Any]) -> bool:
     if len(a) != len(b):
         return False
-    for x, y in zip(a, b):
+    for x, y in zip(a, b, strict=True):
         if isinstance(x, np.ndarray):
             if not (isinstance(y, np.ndarray) and x.dtype == y.dtype and np.array_equal(x, y)):
                 return False
@@ -231,8 +252,13 @@ def test_different_seed_gives_a_different_map(kind: str) -> None:
 
 @pytest.mark.parametrize(
     ("kind", "extra"),
-    [("island", {}), ("island", {"grid_m": 8.0, "prior_resolution_m": 5.0}), ("open_sea", {}), ("port", {}),
-     ("port", {"coast_side": "west", "grid_m": 4.0, "prior_resolution_m": 6.0})],
+    [
+        ("island", {}),
+        ("island", {"grid_m": 8.0, "prior_resolution_m": 5.0}),
+        ("open_sea", {}),
+        ("port", {}),
+        ("port", {"coast_side": "west", "grid_m": 4.0, "prior_resolution_m": 6.0}),
+    ],
 )
 def test_priors_agree_with_the_meshes(kind: str, extra: dict[str, Any]) -> None:
     w = small(kind, seed=2, **extra)
@@ -251,8 +277,12 @@ def test_priors_agree_with_the_meshes(kind: str, extra: dict[str, Any]) -> None:
     edge_cells = np.argwhere(water & near)
     other = np.argwhere(water & ~near)
     cells = np.vstack([edge_cells[rng.permutation(len(edge_cells))[:600]], other[rng.permutation(len(other))[:200]]])
-    pts = np.vstack([cells_sample(w, cells, 3, rng).reshape(-1, 2),
-                     pr.cell_to_world(cells) + rng.uniform(-0.5, 0.5, size=(len(cells), 2)) * pr.resolution])
+    pts = np.vstack(
+        [
+            cells_sample(w, cells, 3, rng).reshape(-1, 2),
+            pr.cell_to_world(cells) + rng.uniform(-0.5, 0.5, size=(len(cells), 2)) * pr.resolution,
+        ]
+    )
     assert pr.is_water(pts[len(cells) * 9 :]).all()
     top_cls, obstacle = caster.cast(pts)
     assert np.all(top_cls == WATER), "a point of a water cell hits something above the water surface"

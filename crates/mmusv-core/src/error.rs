@@ -64,6 +64,16 @@ impl MmusvError {
     pub fn geometry(field: impl Into<String>, reason: impl Into<String>) -> Self {
         Self::Geometry { field: field.into(), reason: reason.into() }
     }
+    /// The same error with `prefix.` put in front of its field name, e.g. `vessels[2].` + `speed_mps`.
+    pub fn within(self, prefix: &str) -> Self {
+        match self {
+            Self::InvalidInput { field, reason } => Self::InvalidInput { field: format!("{prefix}.{field}"), reason },
+            Self::Geometry { field, reason } => Self::Geometry { field: format!("{prefix}.{field}"), reason },
+            Self::Config { field, value, reason } => Self::Config { field: format!("{prefix}.{field}"), value, reason },
+            other @ (Self::UnknownId { .. } | Self::Io { .. }) => other,
+        }
+    }
+
     /// Shorthand for [`MmusvError::Config`].
     pub fn config(field: impl Into<String>, value: impl ToString, reason: impl Into<String>) -> Self {
         Self::Config { field: field.into(), value: value.to_string(), reason: reason.into() }

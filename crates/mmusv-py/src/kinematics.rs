@@ -1,7 +1,165 @@
-//! Bindings for `mmusv_core::kinematics` (filled in once the core module lands).
+//! Bindings for `mmusv_core::kinematics`: a fleet of vessels on spline routes with wave perturbations.
 
+use crate::errors::{to_py, InputError};
+use crate::native::{detached, flat, rows};
+use mmusv_core::kinematics::{
+    BaseAmplitudes, EndBehaviour, Fleet as CoreFleet, Route, VesselDims, VesselMotion, VesselParams, WaveSetting,
+    WaveSignals,
+};
+use mmusv_core::MmusvError;
+use numpy::ndarray::{Array2, Array3};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
-pub fn register(_m: &Bound<'_, PyModule>) -> PyResult<()> {
+/// Parses a wave setting: a preset name `"W0".."W3"` or a significant wave height in metres.
+fn wave_from(obj: &Bound<'_, PyAny>) -> PyResult<WaveSetting> {
+    if let Ok(name) = obj.extract::<String>() {
+        return name.parse::<WaveSetting>().map_err(to_py);
+    }
+    let h: f64 = obj
+        .extract()
+        .map_err(|_| InputError::new_err("wave must be a preset name 'W0'..'W3' or a wave height in metres"))?;
+    WaveSetting::from_height(h).map_err(to_py)
+}
+
+/// The vessels of a scenario moving along their routes (equations 1–4 of the MMUSV-Sim paper).
+#[pyclass(frozen, module = "mmusv._core")]
+pub struct Fleet {
+    inner: CoreFleet,
+}
+
+#[pymethods]
+impl Fleet {
+    /// Builds a fleet. Per vessel `i`: `routes[i]` (K,2) waypoints in metres, `end_behaviours[i]` in
+    /// {"stop", "loop", "ping_pong"}, `speeds[i]` m/s, `start_offsets[i]` m along the route, `z_base[i]` m,
+    /// `dims[i]` = (length, beam, height) m, `amplitudes[i]` = (heave m, roll rad, pitch rad).
+    #[new]
+    #[pyo3(signature = (*, routes, end_behaviours, speeds, start_offsets, z_base, dims, amplitudes, seed, wave))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        routes: Vec<PyReadonlyArray2<'_, f64>>,
+        end_behaviours: Vec<String>,
+        speeds: PyReadonlyArray1<'_, f64>,
+        start_offsets: PyReadonlyArray1<'_, f64>,
+        z_base: PyReadonlyArray1<'_, f64>,
+        dims: PyReadonlyArray2<'_, f64>,
+        amplitudes: PyReadonlyArray2<'_, f64>,
+        seed: u64,
+        wave: &Bound<'_, PyAny>,
+    ) -> PyResult<Self> {
+        let n = routes.len();
+        let speeds = flat(&speeds, "speeds")?;
+        let offsets = flat(&start_offsets, "start_offsets")?;
+        let z = flat(&z_base, "z_base")?;
+        let dims = rows::<f64, 3>(&dims, "dims")?;
+        let amps = rows::<f64, 3>(&amplitudes, "amplitudes")?;
+        for (name, len) in [
+            ("end_behaviours", end_behaviours.len()),
+            ("speeds", speeds.len()),
+            ("start_offsets", offsets.len()),
+            ("z_base", z.len()),
+            ("dims", dims.len()),
+            ("amplitudes", amps.len()),
+        ] {
+            if len != n {
+                return Err(InputError::new_err(format!("{name} has {len} entries for {n} routes; give one per vessel")));
+            }
+        }
+        let wave = wave_from(wave)?;
+        let mut vessels = Vec::with_capacity(n);
+        for i in 0..n {
+            let prefix = format!("vessels[{i}]");
+            let build = || -> Result<VesselMotion, MmusvError> {
+                let end = EndBehaviour::parse(&end_behaviours[i])?;
+                let pts = routes[i]
+                    .as_slice()
+                    .map_err(|_| MmusvError::input("route", "must be a C-contiguous (K, 2) float64 array"))?;
+                if pts.len() % 2 != 0 {
+                    return Err(MmusvError::input("route", "must have shape (K, 2)"));
+                }
+                let (wps, _) = pts.as_chunks::<2>();
+                let route = Route::new(wps, end)?;
+                let params = VesselParams {
+                    speed_mps: speeds[i],
+                    start_offset_m: offsets[i],
+                    z_base_m: z[i],
+                    dims: VesselDims { length_m: dims[i][0], beam_m: dims[i][1], height_m: dims[i][2] },
+                    amplitudes: BaseAmplitudes { heave_m: amps[i][0], roll_rad: amps[i][1], pitch_rad: amps[i][2] },
+                };
+                VesselMotion::new(route, params, WaveSignals::from_seed(seed, i as u64))
+            };
+            vessels.push(build().map_err(|e| to_py(e.within(&prefix)))?);
+        }
+        Ok(Self { inner: CoreFleet::new(vessels, wave) })
+    }
+
+    /// Number of vessels.
+    fn __len__(&self) -> usize {
+        self.inner.len()
+    }
+
+    /// Wave height H in metres of the fleet's wave setting.
+    #[getter]
+    fn wave_height_m(&self) -> f64 {
+        self.inner.wave().height_m()
+    }
+
+    /// `(V,)` route lengths in metres.
+    fn route_lengths<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.inner.vessels().iter().map(|v| v.route().length()).collect::<Vec<_>>().into_pyarray(py)
+    }
+
+    /// `(V,)` size factors α_v.
+    fn alphas<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.inner.vessels().iter().map(|v| v.alpha()).collect::<Vec<_>>().into_pyarray(py)
+    }
+
+    /// `(V, 6)` float64 poses η = [x, y, z, roll, pitch, yaw] (world frame, metres, radians) at time `t` s.
+    fn poses_at<'py>(&self, py: Python<'py>, t: f64) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let poses = self.inner.poses_at(t).map_err(to_py)?;
+        let n = poses.len();
+        Array2::from_shape_vec((n, 6), poses.into_iter().flatten().collect())
+            .map(|a| a.into_pyarray(py))
+            .map_err(|e| crate::errors::InternalError::new_err(e.to_string()))
+    }
+
+    /// `(V, 3)` float64 world-frame linear velocities (m/s) at time `t` s.
+    fn velocities_at<'py>(&self, py: Python<'py>, t: f64) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let v = self.inner.velocities_at(t).map_err(to_py)?;
+        let n = v.len();
+        Array2::from_shape_vec((n, 3), v.into_iter().flatten().collect())
+            .map(|a| a.into_pyarray(py))
+            .map_err(|e| crate::errors::InternalError::new_err(e.to_string()))
+    }
+
+    /// `(T, V, 6)` float64 poses at every time in `times` (s), computed in parallel with the GIL released.
+    fn poses_at_times<'py>(&self, py: Python<'py>, times: PyReadonlyArray1<'py, f64>) -> PyResult<Bound<'py, PyArray3<f64>>> {
+        let ts = flat(&times, "times")?;
+        let poses = detached(py, || self.inner.poses_at_times(ts))?;
+        let v = self.inner.len();
+        Array3::from_shape_vec((ts.len(), v, 6), poses.into_iter().flatten().collect())
+            .map(|a| a.into_pyarray(py))
+            .map_err(|e| crate::errors::InternalError::new_err(e.to_string()))
+    }
+}
+
+/// `(heave_m, roll_rad, pitch_rad)`: the default base amplitudes r of a vessel (calibrated so that the
+/// reference 5 m USV reproduces Table I of the paper).
+#[pyfunction]
+fn default_amplitudes() -> (f64, f64, f64) {
+    let a = BaseAmplitudes::default();
+    (a.heave_m, a.roll_rad, a.pitch_rad)
+}
+
+/// Wave height H (m) of a preset name `"W0".."W3"` or a height given in metres (validated).
+#[pyfunction]
+fn wave_height(wave: &Bound<'_, PyAny>) -> PyResult<f64> {
+    Ok(wave_from(wave)?.height_m())
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Fleet>()?;
+    m.add_function(wrap_pyfunction!(default_amplitudes, m)?)?;
+    m.add_function(wrap_pyfunction!(wave_height, m)?)?;
     Ok(())
 }

@@ -14,22 +14,32 @@ kind, seed and parameters give bitwise-identical arrays.
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
-from typing import Any, Union
+from typing import Any
 
 import numpy as np
 import shapely
+from shapely.geometry import Polygon
+from shapely.geometry.base import BaseGeometry
 
 from mmusv.classes import SemanticClass
-from mmusv.errors import ConfigError
+from mmusv.world.map_params import (
+    MAP_KINDS,
+    IslandParams,
+    MapConfigError,
+    MapParams,
+    OpenSeaParams,
+    PortParams,
+    make_params,
+)
 from mmusv.world.port import buoy_mesh, plan_port, port_structures, port_terrain
 from mmusv.world.primitives import TriMesh, merge, transformed
 from mmusv.world.priors import MapPriors, build_priors
-from mmusv.world.terrain import FractalNoise, Heightfield, IslandSpec, fbm, island_heights
+from mmusv.world.terrain import FaceClassifier, FractalNoise, Heightfield, IslandSpec, fbm, island_heights
 
 __all__ = [
     "MAP_KINDS",
+    "TERRAIN_MESH_MIN_Z",
     "MapConfigError",
     "IslandParams",
     "OpenSeaParams",
@@ -44,254 +54,8 @@ __all__ = [
     "generate_port",
 ]
 
-MAP_KINDS = ("island", "open_sea", "port")
 TERRAIN_MESH_MIN_Z = -2.0
 """Terrain cells whose four vertices are all at or below this height (m) are left out of the terrain mesh."""
-DEFAULT_MOORED_ASSETS: tuple[tuple[str, float, float], ...] = (
-    ("container_ship_300m", 300.0, 48.0),
-    ("cargo_ship_120m", 120.0, 20.0),
-    ("ferry_90m", 90.0, 18.0),
-    ("tugboat_30m", 30.0, 10.0),
-    ("fishing_boat_20m", 20.0, 6.0),
-)
-
-
-class MapConfigError(ConfigError, ValueError):  # type: ignore[misc,unused-ignore]
-    """A map parameter is invalid. ``field`` names it, ``allowed`` says what is accepted."""
-
-    def __init__(self, field: str, value: object, allowed: str) -> None:
-        super().__init__(f"map parameter {field}={value!r} is invalid; allowed: {allowed}")
-        self.field = field
-        self.allowed = allowed
-
-
-# ---------------------------------------------------------------------------------------------- parameters
-
-
-def _num(obj: object, name: str, lo: float, hi: float, *, integer: bool = False) -> None:
-    v = getattr(obj, name)
-    kind = "an integer" if integer else "a number"
-    ok_type = isinstance(v, (int, np.integer)) if integer else isinstance(v, (int, float, np.integer, np.floating))
-    if isinstance(v, bool) or not ok_type or not np.isfinite(v) or not lo <= v <= hi:
-        raise MapConfigError(name, v, f"{kind} in [{lo:g}, {hi:g}]")
-    object.__setattr__(obj, name, int(v) if integer else float(v))
-
-
-def _pair(obj: object, name: str, lo: float, hi: float) -> None:
-    v = getattr(obj, name)
-    allowed = f"two numbers [a, b] with {lo:g} <= a <= b <= {hi:g}"
-    try:
-        a, b = (float(x) for x in v)
-    except (TypeError, ValueError):
-        raise MapConfigError(name, v, allowed) from None
-    if any(isinstance(x, bool) for x in v) or not (np.isfinite(a) and np.isfinite(b) and lo <= a <= b <= hi):
-        raise MapConfigError(name, v, allowed)
-    object.__setattr__(obj, name, (a, b))
-
-
-def _resolved(value: float | None) -> float:
-    if value is None:  # pragma: no cover - callers resolve first
-        raise RuntimeError("unresolved map parameter")
-    return float(value)
-
-
-@dataclass(frozen=True)
-class _CommonParams:
-    """Parameters shared by every map kind (metres)."""
-
-    extent_m: float = 2000.0
-    """Side of the square map."""
-    grid_m: float = 5.0
-    """Terrain heightfield spacing (effective value: ``extent_m / round(extent_m / grid_m)``)."""
-    prior_resolution_m: float = 5.0
-    """Prior raster cell size (effective value: ``extent_m / round(extent_m / prior_resolution_m)``)."""
-    draft_margin_m: float = 2.0
-    """Terrain shallower than this below the surface is not navigable."""
-    clearance_m: float = 30.0
-    """Shore / structure / map-edge clearance of the valid sampling zones."""
-    occlusion_height_m: float = 3.0
-    """Terrain and structures higher than this block line of sight in the priors."""
-    n_buoys: int = 0
-    """Extra free-standing buoys placed at random in open water (at most this many)."""
-
-    def _validate(self) -> None:
-        _num(self, "extent_m", 200.0, 20000.0)
-        _num(self, "grid_m", 1.0, 20.0)
-        if (self.extent_m / self.grid_m) ** 2 > 4.0e6:
-            raise MapConfigError("grid_m", self.grid_m, f">= extent_m / 2000 = {self.extent_m / 2000.0:g}")
-        _num(self, "prior_resolution_m", 0.5, 50.0)
-        if self.extent_m / self.prior_resolution_m > 8000.0:
-            raise MapConfigError("prior_resolution_m", self.prior_resolution_m, f">= extent_m / 8000 = {self.extent_m / 8000.0:g}")
-        _num(self, "draft_margin_m", 0.0, 20.0)
-        _num(self, "clearance_m", 0.0, self.extent_m / 4.0)
-        _num(self, "occlusion_height_m", 0.5, 100.0)
-        _num(self, "n_buoys", 0, 500, integer=True)
-
-
-@dataclass(frozen=True)
-class IslandParams(_CommonParams):
-    """``island`` map: several islands of varied size on open water."""
-
-    n_islands: int = 5
-    island_radius_m: tuple[float, float] = (60.0, 280.0)
-    """Range of mean coast radii."""
-    island_height_m: tuple[float, float] = (15.0, 80.0)
-    """Range of peak heights (capped at 0.35 x radius)."""
-    min_gap_m: float = 120.0
-    """Minimum open-water gap between two islands' coasts."""
-    coast_roughness: float = 0.25
-    """Relative coastline irregularity (0 = round)."""
-    vegetation: bool = True
-    """Label gentle terrain above ~4 m as VEGETATION."""
-    n_buoys: int = 2
-
-    def __post_init__(self) -> None:
-        self._validate()
-        _num(self, "n_islands", 0, 50, integer=True)
-        _pair(self, "island_radius_m", 15.0, self.extent_m / 2.0)
-        _pair(self, "island_height_m", 1.0, 500.0)
-        _num(self, "min_gap_m", 0.0, self.extent_m / 2.0)
-        _num(self, "coast_roughness", 0.0, 0.5)
-        if not isinstance(self.vegetation, bool):
-            raise MapConfigError("vegetation", self.vegetation, "true or false")
-
-
-@dataclass(frozen=True)
-class OpenSeaParams(_CommonParams):
-    """``open_sea`` map: open water, a few buoys and maybe one distant small islet."""
-
-    extent_m: float = 4000.0
-    islet_probability: float = 0.5
-    islet_radius_m: tuple[float, float] = (25.0, 70.0)
-    islet_height_m: tuple[float, float] = (5.0, 20.0)
-    vegetation: bool = True
-    n_buoys: int = 4
-
-    def __post_init__(self) -> None:
-        self._validate()
-        _num(self, "islet_probability", 0.0, 1.0)
-        _pair(self, "islet_radius_m", 10.0, self.extent_m / 4.0)
-        _pair(self, "islet_height_m", 1.0, 200.0)
-        if not isinstance(self.vegetation, bool):
-            raise MapConfigError("vegetation", self.vegetation, "true or false")
-
-
-COAST_SIDES = ("north", "south", "east", "west")
-
-
-@dataclass(frozen=True)
-class PortParams(_CommonParams):
-    """``port`` map: land on one side with quay, piers, breakwaters and a harbour entrance, container yard,
-    gantry cranes, buildings, channel buoys and moored ships. Layout distances are metres from the quay line.
-
-    Layout knobs left at ``None`` scale with ``extent_m`` (values in brackets are those for 2000 m) and are
-    replaced by the resolved numbers, so ``MapWorld.params`` always records what was built.
-    """
-
-    coast_side: str = "north"
-    """Side of the map the land is on: north, south, east or west."""
-    coast_offset_m: float | None = None
-    """Distance from the map centre to the quay line, towards the land [0.125 extent: 250]."""
-    harbour_width_m: float | None = None
-    """Length of the harbour front between the two breakwater roots [0.5 extent: 1000]."""
-    harbour_depth_m: float | None = None
-    """Distance from the quay line out to the outer breakwater arms [0.21 extent: 420]."""
-    entrance_width_m: float | None = None
-    """Gap between the breakwater heads, at their toes [0.1 extent within 60..250: 200]."""
-    quay_height_m: float = 2.5
-    basin_depth_m: float = 14.0
-    n_piers: int | None = None
-    """Piers in the eastern 40 % of the harbour front [2, or as many as fit]."""
-    pier_length_m: tuple[float, float] | None = None
-    """Range of pier lengths [(0.07, 0.13) extent: (140, 260), at most harbour_depth_m - 100]."""
-    pier_width_m: float = 24.0
-    n_cranes: int | None = None
-    """Gantry cranes along the container-terminal quay [4, or as many as fit]."""
-    container_fill: float = 0.8
-    """Probability that a container-stack slot in the yard is occupied."""
-    max_container_tiers: int = 5
-    n_buildings: int = 8
-    n_channel_buoy_pairs: int = 3
-    n_moored: int = 4
-    moored_assets: tuple[tuple[str, float, float], ...] = DEFAULT_MOORED_ASSETS
-    """Candidate moored ships: ``(asset_name, length_m, beam_m)``."""
-    hill_height_m: float = 35.0
-    vegetation: bool = True
-
-    def _auto(self, name: str, value: object) -> None:
-        if getattr(self, name) is None:
-            object.__setattr__(self, name, value)
-
-    def __post_init__(self) -> None:
-        self._validate()
-        e = self.extent_m
-        if e < 600.0:
-            raise MapConfigError("extent_m", e, "a number in [600, 20000] for a port map")
-        half = e / 2.0
-        if self.coast_side not in COAST_SIDES:
-            raise MapConfigError("coast_side", self.coast_side, " | ".join(COAST_SIDES))
-        self._auto("coast_offset_m", 0.125 * e)
-        _num(self, "coast_offset_m", -half + 300.0, half - 150.0)
-        self._auto("harbour_width_m", 0.5 * e)
-        _num(self, "harbour_width_m", 200.0, e - 300.0)
-        q, hw = _resolved(self.coast_offset_m), _resolved(self.harbour_width_m)
-        self._auto("harbour_depth_m", float(np.clip(0.21 * e, 120.0, q + half - 100.0)))
-        _num(self, "harbour_depth_m", 120.0, q + half - 100.0)
-        hd = _resolved(self.harbour_depth_m)
-        self._auto("entrance_width_m", float(np.clip(0.1 * e, 60.0, min(250.0, hw - 140.0))))
-        _num(self, "entrance_width_m", 60.0, hw - 140.0)
-        _num(self, "quay_height_m", 1.0, 6.0)
-        _num(self, "basin_depth_m", self.draft_margin_m + 3.0, 40.0)
-        _num(self, "pier_width_m", 8.0, 60.0)
-        piers_max = max(int((0.4 * hw - 60.0) // (self.pier_width_m + 80.0)), 0)
-        self._auto("n_piers", min(2, piers_max))
-        _num(self, "n_piers", 0, piers_max, integer=True)
-        longest = max(hd - 100.0, 30.0)
-        self._auto("pier_length_m", (min(max(round(0.07 * e, 1), 30.0), longest), min(max(round(0.13 * e, 1), 30.0), longest)))
-        _pair(self, "pier_length_m", 30.0, longest)
-        terminal = (0.6 if self.n_piers else 1.0) * hw - 60.0
-        cranes_max = max(int(terminal // 35.0), 0)
-        self._auto("n_cranes", min(4, cranes_max))
-        _num(self, "n_cranes", 0, cranes_max, integer=True)
-        _num(self, "container_fill", 0.0, 1.0)
-        _num(self, "max_container_tiers", 1, 8, integer=True)
-        _num(self, "n_buildings", 0, 200, integer=True)
-        _num(self, "n_channel_buoy_pairs", 0, 50, integer=True)
-        _num(self, "n_moored", 0, 50, integer=True)
-        _num(self, "hill_height_m", 0.0, 200.0)
-        if not isinstance(self.vegetation, bool):
-            raise MapConfigError("vegetation", self.vegetation, "true or false")
-        allowed = "a list of [asset_name, length_m > 0, beam_m > 0] (non-empty when n_moored > 0)"
-        try:
-            assets = tuple((str(a), float(length), float(beam)) for a, length, beam in self.moored_assets)
-        except (TypeError, ValueError):
-            raise MapConfigError("moored_assets", self.moored_assets, allowed) from None
-        if any(not a or length <= 0.0 or beam <= 0.0 for a, length, beam in assets) or (self.n_moored and not assets):
-            raise MapConfigError("moored_assets", self.moored_assets, allowed)
-        object.__setattr__(self, "moored_assets", assets)
-
-
-MapParams = Union[IslandParams, OpenSeaParams, PortParams]
-_PARAM_TYPES: dict[str, type[IslandParams] | type[OpenSeaParams] | type[PortParams]] = {
-    "island": IslandParams,
-    "open_sea": OpenSeaParams,
-    "port": PortParams,
-}
-
-
-def make_params(kind: str, **params: Any) -> MapParams:
-    """Validated parameters of map ``kind`` from keyword values (lists are accepted for pairs).
-
-    Raises :class:`MapConfigError` naming ``kind`` or the first unknown/invalid field and the allowed values.
-    """
-    if kind not in _PARAM_TYPES:
-        raise MapConfigError("kind", kind, " | ".join(MAP_KINDS))
-    cls = _PARAM_TYPES[kind]
-    names = sorted(f.name for f in dataclasses.fields(cls))
-    for key in params:
-        if key not in names:
-            raise MapConfigError(key, params[key], f"a parameter of the {kind} map: {', '.join(names)}")
-    return cls(**params)
 
 
 # ---------------------------------------------------------------------------------------------- the world
@@ -343,11 +107,14 @@ def _water(extent: float, tiles: int = 4) -> TriMesh:
     v = np.column_stack([gx.ravel(), gy.ravel(), np.zeros(gx.size)])
     i, j = np.meshgrid(np.arange(tiles), np.arange(tiles), indexing="ij")
     v00 = (i * (tiles + 1) + j).ravel()
-    f = np.concatenate([np.column_stack([v00, v00 + 1, v00 + tiles + 2]), np.column_stack([v00, v00 + tiles + 2, v00 + tiles + 1])])
+    f = np.concatenate(
+        [np.column_stack([v00, v00 + 1, v00 + tiles + 2]), np.column_stack([v00, v00 + tiles + 2, v00 + tiles + 1])]
+    )
     return TriMesh(v, f, np.array([int(SemanticClass.WATER)]))
 
 
-def _vegetation(rng: np.random.Generator, extent: float, enabled: bool, min_z: float) -> Any:
+def _vegetation(rng: np.random.Generator, extent: float, enabled: bool, min_z: float) -> FaceClassifier:
+    """Face classifier: VEGETATION on gentle slopes above ``min_z`` in noise patches, TERRAIN elsewhere."""
     patches = FractalNoise(rng=rng, half_extent_m=extent / 2.0, cell_m=90.0, octaves=3)
 
     def classify(c: np.ndarray, n: np.ndarray) -> np.ndarray:
@@ -361,11 +128,14 @@ def _vegetation(rng: np.random.Generator, extent: float, enabled: bool, min_z: f
 
 
 def _harmonics(rng: np.random.Generator, roughness: float) -> tuple[tuple[float, float, float], ...]:
-    return tuple((float(k), float(rng.uniform(0.0, roughness * 0.6) / (k - 1)), float(rng.uniform(0, 2 * np.pi))) for k in range(2, 6))
+    return tuple(
+        (float(k), float(rng.uniform(0.0, roughness * 0.6) / (k - 1)), float(rng.uniform(0, 2 * np.pi)))
+        for k in range(2, 6)
+    )
 
 
 def _free_buoys(
-    n: int, *, rng: np.random.Generator, hf: Heightfield, reach: float, avoid: Any, depth: float
+    n: int, *, rng: np.random.Generator, hf: Heightfield, reach: float, avoid: BaseGeometry | None, depth: float
 ) -> list[np.ndarray]:
     """Up to ``n`` buoy positions in open water within ``[-reach, reach]^2``: terrain below ``-depth`` within
     25 m, 60 m from ``avoid`` (shapely geometry or None) and 80 m from each other."""
@@ -388,8 +158,16 @@ def _free_buoys(
 
 
 def _assemble(
-    kind: str, seed: int, params: MapParams, *, hf: Heightfield, classify: Any, structures: list[TriMesh],
-    buoys: list[np.ndarray], moored: list[tuple[str, tuple[float, float, float]]], moored_fp: list[Any],
+    kind: str,
+    seed: int,
+    params: MapParams,
+    *,
+    hf: Heightfield,
+    classify: FaceClassifier,
+    structures: list[TriMesh],
+    buoys: list[np.ndarray],
+    moored: list[tuple[str, tuple[float, float, float]]],
+    moored_fp: list[Polygon],
 ) -> MapWorld:
     buoy_meshes = [buoy_mesh(float(p[0]), float(p[1])) for p in buoys]
     meshes: dict[str, TriMesh] = {}
@@ -402,12 +180,25 @@ def _assemble(
         meshes["terrain"] = terrain
     meshes["water"] = _water(params.extent_m)
     priors = build_priors(
-        heightfield=hf, structures=structures + buoy_meshes, buoys=np.array(buoys).reshape(-1, 2),
-        moored_footprints=moored_fp, extent_m=params.extent_m, resolution_m=params.prior_resolution_m,
-        draft_margin_m=params.draft_margin_m, clearance_m=params.clearance_m, occlusion_height_m=params.occlusion_height_m,
+        heightfield=hf,
+        structures=structures + buoy_meshes,
+        buoys=np.array(buoys).reshape(-1, 2),
+        moored_footprints=moored_fp,
+        extent_m=params.extent_m,
+        resolution_m=params.prior_resolution_m,
+        draft_margin_m=params.draft_margin_m,
+        clearance_m=params.clearance_m,
+        occlusion_height_m=params.occlusion_height_m,
     )
-    return MapWorld(kind=kind, seed=seed, params=params, static_meshes=dict(sorted(meshes.items())), moored=moored,
-                    priors=priors, heightfield=hf)
+    return MapWorld(
+        kind=kind,
+        seed=seed,
+        params=params,
+        static_meshes=dict(sorted(meshes.items())),
+        moored=moored,
+        priors=priors,
+        heightfield=hf,
+    )
 
 
 def _check_seed(seed: object) -> int:
@@ -436,7 +227,9 @@ def _place_islands(p: IslandParams, rng: np.random.Generator) -> list[IslandSpec
             if all(np.hypot(*(c - c2)) >= (r + r2) * grow + p.min_gap_m for c2, r2 in placed):
                 break
         else:
-            raise MapConfigError("n_islands", p.n_islands, "fewer or smaller islands (they do not fit in extent_m with min_gap_m)")
+            raise MapConfigError(
+                "n_islands", p.n_islands, "fewer or smaller islands (they do not fit in extent_m with min_gap_m)"
+            )
         placed.append((c, r))
         peak = min(float(rng.uniform(*p.island_height_m)), 0.35 * r)
         # A main dome and 0-3 lower lobes inside the island's radius make irregular, multi-peaked islands.
@@ -448,8 +241,14 @@ def _place_islands(p: IslandParams, rng: np.random.Generator) -> list[IslandSpec
             lr = float(rng.uniform(0.3, 0.45)) * r
             off = r - lr
             lc = (float(c[0] + off * np.cos(ang)), float(c[1] + off * np.sin(ang)))
-            specs.append(IslandSpec(center=lc, radius_m=lr, peak_m=peak * float(rng.uniform(0.3, 0.8)),
-                                    harmonics=_harmonics(rng, p.coast_roughness)))
+            specs.append(
+                IslandSpec(
+                    center=lc,
+                    radius_m=lr,
+                    peak_m=peak * float(rng.uniform(0.3, 0.8)),
+                    harmonics=_harmonics(rng, p.coast_roughness),
+                )
+            )
     return specs
 
 
@@ -460,7 +259,9 @@ def _island_terrain(
     half = extent / 2.0
     warp = roughness * fbm(rng=rng, x=gx, y=gy, half_extent_m=half, cell_m=220.0, octaves=4)
     detail = fbm(rng=rng, x=gx, y=gy, half_extent_m=half, cell_m=120.0, octaves=4)
-    z = island_heights(gx, gy, islands=islands, floor_z=-25.0, shelf_slope=0.08, warp=warp, detail=detail, detail_frac=0.35)
+    z = island_heights(
+        gx, gy, islands=islands, floor_z=-25.0, shelf_slope=0.08, warp=warp, detail=detail, detail_frac=0.35
+    )
     return Heightfield(x0=float(xs[0]), y0=float(xs[0]), spacing=spacing, z=z)
 
 
@@ -473,7 +274,9 @@ def generate_island(*, seed: int, params: IslandParams | None = None) -> MapWorl
     islands = _place_islands(p, rng)
     hf = _island_terrain(rng, xs, spacing, islands, p.coast_roughness, p.extent_m)
     classify = _vegetation(rng, p.extent_m, p.vegetation, 4.0)
-    buoys = _free_buoys(p.n_buoys, rng=rng, hf=hf, reach=p.extent_m / 2.0 - 100.0, avoid=None, depth=p.draft_margin_m + 3.0)
+    buoys = _free_buoys(
+        p.n_buoys, rng=rng, hf=hf, reach=p.extent_m / 2.0 - 100.0, avoid=None, depth=p.draft_margin_m + 3.0
+    )
     return _assemble("island", seed, p, hf=hf, classify=classify, structures=[], buoys=buoys, moored=[], moored_fp=[])
 
 
@@ -491,8 +294,14 @@ def generate_open_sea(*, seed: int, params: OpenSeaParams | None = None) -> MapW
         dist, ang = rng.uniform(0.55, 0.8) * half, rng.uniform(0.0, 2.0 * np.pi)
         dist = min(float(dist), half - 2.0 * r - 60.0)
         peak = min(float(rng.uniform(*p.islet_height_m)), 0.4 * r)
-        islands.append(IslandSpec(center=(dist * float(np.cos(ang)), dist * float(np.sin(ang))), radius_m=r, peak_m=peak,
-                                  harmonics=_harmonics(rng, 0.2)))
+        islands.append(
+            IslandSpec(
+                center=(dist * float(np.cos(ang)), dist * float(np.sin(ang))),
+                radius_m=r,
+                peak_m=peak,
+                harmonics=_harmonics(rng, 0.2),
+            )
+        )
     hf = _island_terrain(rng, xs, spacing, islands, 0.2, p.extent_m)
     classify = _vegetation(rng, p.extent_m, p.vegetation, 3.0)
     buoys = _free_buoys(p.n_buoys, rng=rng, hf=hf, reach=0.75 * half, avoid=None, depth=p.draft_margin_m + 3.0)
@@ -541,18 +350,28 @@ def generate_port(*, seed: int, params: PortParams | None = None) -> MapWorld:
     structures = [transformed(s, rotation=rot3) for s in built.parts]
     buoys = [np.asarray(b, dtype=np.float64) @ m.T for b in built.buoys]
     moored: list[tuple[str, tuple[float, float, float]]] = []
-    moored_fp = []
+    moored_fp: list[Polygon] = []
     for b in built.berths:
         x, y = np.array(b.pose[:2]) @ m.T
         moored.append((b.asset, (float(x), float(y), _wrap(b.pose[2] + dyaw))))
-        moored_fp.append(shapely.Polygon(np.asarray(b.footprint().exterior.coords) @ m.T))
+        moored_fp.append(Polygon(np.asarray(b.footprint().exterior.coords) @ m.T))
     avoid = shapely.union_all(
         [shapely.convex_hull(shapely.multipoints(s.vertices[:, :2])) for s in structures]
-        + moored_fp + [shapely.Point(b) for b in buoys]
+        + moored_fp
+        + [shapely.Point(b) for b in buoys]
     )
     buoys += _free_buoys(p.n_buoys, rng=rng, hf=hf, reach=half - 100.0, avoid=avoid, depth=p.draft_margin_m + 3.0)
-    return _assemble("port", seed, p, hf=hf, classify=classify, structures=structures, buoys=buoys, moored=moored,
-                     moored_fp=moored_fp)
+    return _assemble(
+        "port",
+        seed,
+        p,
+        hf=hf,
+        classify=classify,
+        structures=structures,
+        buoys=buoys,
+        moored=moored,
+        moored_fp=moored_fp,
+    )
 
 
 def generate_map(kind: str, *, seed: int, **params: Any) -> MapWorld:

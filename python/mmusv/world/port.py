@@ -20,7 +20,7 @@ from mmusv.classes import SemanticClass
 from mmusv.world.primitives import TriMesh, box, cylinder, merge, transformed
 
 if TYPE_CHECKING:
-    from mmusv.world.maps import PortParams
+    from mmusv.world.map_params import PortParams
 
 __all__ = ["PortPlan", "Berth", "plan_port", "port_terrain", "port_structures", "buoy_mesh", "tapered_wall"]
 
@@ -108,9 +108,19 @@ def plan_port(p: PortParams, *, grid: float, rng: np.random.Generator) -> PortPl
             length = float(rng.uniform(*_set(p.pier_length_m)))
             piers.append((a + (k + 0.5) * pitch, min(length, hd - 100.0)))
     return PortPlan(
-        half=half, quay_y=q, quay_face=quay_face, hw=hw, hd=hd, entrance_x=entrance_x, entrance_w=ew,
-        terminal_x1=terminal_x1, yard=(-hw / 2.0 + 30.0, yard_y0, terminal_x1 - 20.0, yard_y1),
-        land_h=p.quay_height_m - 0.3, quay_h=p.quay_height_m, basin=p.basin_depth_m, piers=tuple(piers),
+        half=half,
+        quay_y=q,
+        quay_face=quay_face,
+        hw=hw,
+        hd=hd,
+        entrance_x=entrance_x,
+        entrance_w=ew,
+        terminal_x1=terminal_x1,
+        yard=(-hw / 2.0 + 30.0, yard_y0, terminal_x1 - 20.0, yard_y1),
+        land_h=p.quay_height_m - 0.3,
+        quay_h=p.quay_height_m,
+        basin=p.basin_depth_m,
+        piers=tuple(piers),
         hills_from=max(yard_y1 - q, 260.0) + 60.0,
     )
 
@@ -137,8 +147,15 @@ def port_terrain(
 
 
 def tapered_wall(
-    p0: tuple[float, float], p1: tuple[float, float], *, bottom_w: float, top_w: float, z0: float, z1: float,
-    extend: float, cls: int,
+    p0: tuple[float, float],
+    p1: tuple[float, float],
+    *,
+    bottom_w: float,
+    top_w: float,
+    z0: float,
+    z1: float,
+    extend: float,
+    cls: int,
 ) -> TriMesh:
     """A wall along segment ``p0 -> p1`` (extended by ``extend`` at both ends) with a trapezoidal section."""
     a, b = np.asarray(p0, dtype=np.float64), np.asarray(p1, dtype=np.float64)
@@ -149,7 +166,9 @@ def tapered_wall(
     top = v[:, 2] > 0.0
     v[top, 1] *= top_w / bottom_w
     mid = (a + b) / 2.0
-    return transformed(TriMesh(v, base.faces, base.classes), rotation=_rz(yaw), translation=(mid[0], mid[1], (z0 + z1) / 2.0))
+    return transformed(
+        TriMesh(v, base.faces, base.classes), rotation=_rz(yaw), translation=(mid[0], mid[1], (z0 + z1) / 2.0)
+    )
 
 
 def _rz(yaw: float) -> np.ndarray:
@@ -193,7 +212,9 @@ def _sts_crane(x: float, face: float, base: float) -> TriMesh:
     return merge(parts)
 
 
-def _container_block(x0: float, y0: float, base: float, *, rng: np.random.Generator, fill: float, tiers: int) -> TriMesh | None:
+def _container_block(
+    x0: float, y0: float, base: float, *, rng: np.random.Generator, fill: float, tiers: int
+) -> TriMesh | None:
     """5 bays x 6 rows of container stacks (class CONTAINER) with random heights; ``None`` when empty."""
     parts = []
     for row in range(6):
@@ -204,7 +225,13 @@ def _container_block(x0: float, y0: float, base: float, *, rng: np.random.Genera
             cx = x0 + bay * (CONTAINER_L + 0.6) + CONTAINER_L / 2.0
             cy = y0 + row * (CONTAINER_W + 0.4) + CONTAINER_W / 2.0
             h = n * CONTAINER_H
-            parts.append(box(center=(cx, cy, base + h / 2.0), size=(CONTAINER_L, CONTAINER_W, h), cls=int(SemanticClass.CONTAINER)))
+            parts.append(
+                box(
+                    center=(cx, cy, base + h / 2.0),
+                    size=(CONTAINER_L, CONTAINER_W, h),
+                    cls=int(SemanticClass.CONTAINER),
+                )
+            )
     return merge(parts) if parts else None
 
 
@@ -225,11 +252,22 @@ def port_structures(p: PortParams, plan: PortPlan, *, ground: Ground, rng: np.ra
     q, face, hw, hd = plan.quay_y, plan.quay_face, plan.hw, plan.hd
     parts: list[TriMesh] = []
     # Quay apron along the whole harbour front, hiding the land/basin step of the terrain.
-    parts.append(box(center=(0.0, (face + q + 30.0) / 2.0, (plan.quay_h - plan.basin) / 2.0),
-                     size=(hw, q + 30.0 - face, plan.quay_h + plan.basin), cls=ps))
+    parts.append(
+        box(
+            center=(0.0, (face + q + 30.0) / 2.0, (plan.quay_h - plan.basin) / 2.0),
+            size=(hw, q + 30.0 - face, plan.quay_h + plan.basin),
+            cls=ps,
+        )
+    )
     pier_w = p.pier_width_m
     for px, plen in plan.piers:
-        parts.append(box(center=(px, face - plen / 2.0 + 0.5, (plan.quay_h - 3.0) / 2.0), size=(pier_w, plen + 1.0, plan.quay_h + 3.0), cls=ps))
+        parts.append(
+            box(
+                center=(px, face - plen / 2.0 + 0.5, (plan.quay_h - 3.0) / 2.0),
+                size=(pier_w, plen + 1.0, plan.quay_h + 3.0),
+                cls=ps,
+            )
+        )
     # Breakwaters: west and east arms, each a root leg and a head leg, leaving the entrance between heads.
     y_out = q - hd
     z0 = -plan.basin - 1.0
@@ -237,12 +275,29 @@ def port_structures(p: PortParams, plan: PortPlan, *, ground: Ground, rng: np.ra
     heads = []
     for root_x, head_x in ((-hw / 2.0, ex0 + BREAKWATER_BOTTOM_W / 2.0), (hw / 2.0, ex1 - BREAKWATER_BOTTOM_W / 2.0)):
         for a, b in (((root_x, q + 10.0), (root_x, y_out)), ((root_x, y_out), (head_x, y_out))):
-            parts.append(tapered_wall(a, b, bottom_w=BREAKWATER_BOTTOM_W, top_w=BREAKWATER_TOP_W, z0=z0,
-                                      z1=BREAKWATER_CREST, extend=BREAKWATER_TOP_W / 2.0, cls=ps))
+            parts.append(
+                tapered_wall(
+                    a,
+                    b,
+                    bottom_w=BREAKWATER_BOTTOM_W,
+                    top_w=BREAKWATER_TOP_W,
+                    z0=z0,
+                    z1=BREAKWATER_CREST,
+                    extend=BREAKWATER_TOP_W / 2.0,
+                    cls=ps,
+                )
+            )
         heads.append(head_x)
     for hx in heads:
-        parts.append(cylinder(center=(hx, y_out, BREAKWATER_CREST - 0.5), radius=2.5, height=11.0,
-                              cls=int(SemanticClass.BUILDING), segments=10))
+        parts.append(
+            cylinder(
+                center=(hx, y_out, BREAKWATER_CREST - 0.5),
+                radius=2.5,
+                height=11.0,
+                cls=int(SemanticClass.BUILDING),
+                segments=10,
+            )
+        )
     # Gantry cranes along the terminal quay.
     t0, t1 = -hw / 2.0 + 40.0, plan.terminal_x1 - 20.0
     n_cranes = _set(p.n_cranes)
@@ -255,16 +310,26 @@ def port_structures(p: PortParams, plan: PortPlan, *, ground: Ground, rng: np.ra
     yx0, yy0, yx1, yy1 = plan.yard
     bl, bw = 5 * CONTAINER_L + 4 * 0.6, 6 * CONTAINER_W + 5 * 0.4
     nx_b, ny_b = int((yx1 - yx0 + 15.0) // (bl + 15.0)), int((yy1 - yy0 + 12.0) // (bw + 12.0))
-    occupied = [shapely.box(yx0 - 5.0, yy0 - 5.0, yx0 + nx_b * (bl + 15.0), yy0 + ny_b * (bw + 12.0))] if nx_b * ny_b else []
+    occupied = (
+        [shapely.box(yx0 - 5.0, yy0 - 5.0, yx0 + nx_b * (bl + 15.0), yy0 + ny_b * (bw + 12.0))] if nx_b * ny_b else []
+    )
     for i in range(ny_b):
         for j in range(nx_b):
-            blk = _container_block(yx0 + j * (bl + 15.0), yy0 + i * (bw + 12.0), plan.land_h - 0.1, rng=rng,
-                                   fill=p.container_fill, tiers=p.max_container_tiers)
+            blk = _container_block(
+                yx0 + j * (bl + 15.0),
+                yy0 + i * (bw + 12.0),
+                plan.land_h - 0.1,
+                rng=rng,
+                fill=p.container_fill,
+                tiers=p.max_container_tiers,
+            )
             if blk is not None:
                 parts.append(blk)
     # Buildings: warehouses and offices behind the pier section and behind the yard, on land.
-    zones = [(plan.terminal_x1 + 10.0, q + 45.0, hw / 2.0 + 40.0, q + 280.0),
-             (-hw / 2.0, yy1 + 25.0, plan.terminal_x1, min(yy1 + 220.0, plan.half - 40.0))]
+    zones = [
+        (plan.terminal_x1 + 10.0, q + 45.0, hw / 2.0 + 40.0, q + 280.0),
+        (-hw / 2.0, yy1 + 25.0, plan.terminal_x1, min(yy1 + 220.0, plan.half - 40.0)),
+    ]
     zones = [z for z in zones if z[2] - z[0] > 40.0 and z[3] - z[1] > 40.0]
     placed = 0
     for _ in range(40 * p.n_buildings):

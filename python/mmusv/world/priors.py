@@ -30,9 +30,15 @@ __all__ = ["MapPriors", "build_priors", "footprint"]
 
 
 def footprint(mesh: TriMesh) -> Polygon:
-    """Convex hull of a mesh's vertices projected on the xy plane (shapely Polygon, metres)."""
+    """Convex hull of a mesh's vertices projected on the xy plane (shapely Polygon, metres).
+
+    A mesh with no area seen from above (a vertical plate) gets its hull grown by a millimetre.
+    """
     hull = shapely.convex_hull(shapely.multipoints(mesh.vertices[:, :2]))
-    return hull if isinstance(hull, Polygon) else Polygon(hull.buffer(1e-3).exterior)
+    if not isinstance(hull, Polygon):
+        hull = shapely.buffer(hull, 1e-3)
+    assert isinstance(hull, Polygon)
+    return hull
 
 
 @dataclass(frozen=True, eq=False)
@@ -118,7 +124,9 @@ class MapPriors:
         """``(N,)`` float64 shore distance (metres) of the cells holding points ``xy`` ``(N, 2)``; 0 outside."""
         return self._lookup(self.shore_distance, xy, 0.0).astype(np.float64)
 
-    def sample_water_points(self, n: int, *, rng: np.random.Generator, min_clearance: float | None = None) -> np.ndarray:
+    def sample_water_points(
+        self, n: int, *, rng: np.random.Generator, min_clearance: float | None = None
+    ) -> np.ndarray:
         """``n`` points ``(n, 2)`` float64 (world, metres), uniform over the eligible area.
 
         Eligible cells are :attr:`valid_zones` when ``min_clearance`` is None, otherwise water cells with
@@ -130,13 +138,17 @@ class MapPriors:
             ok = self.water_mask & (self.shore_distance >= min_clearance)
         flat = np.flatnonzero(ok)
         if flat.size == 0:
-            raise ValueError(f"no water cell with clearance >= {self.clearance if min_clearance is None else min_clearance} m")
+            raise ValueError(
+                f"no water cell with clearance >= {self.clearance if min_clearance is None else min_clearance} m"
+            )
         pick = flat[rng.integers(0, flat.size, size=int(n))]
         rc = np.column_stack(np.unravel_index(pick, ok.shape)).astype(np.float64)
         jitter = rng.uniform(0.0, 1.0, size=(int(n), 2))
         return np.column_stack(
-            [self.origin[0] + (rc[:, 1] + jitter[:, 0]) * self.resolution,
-             self.origin[1] + (rc[:, 0] + jitter[:, 1]) * self.resolution]
+            [
+                self.origin[0] + (rc[:, 1] + jitter[:, 0]) * self.resolution,
+                self.origin[1] + (rc[:, 0] + jitter[:, 1]) * self.resolution,
+            ]
         )
 
     def line_of_sight(self, a: npt.ArrayLike, b: npt.ArrayLike) -> np.ndarray:
@@ -215,7 +227,7 @@ def build_priors(
         zone = shapely.union_all(moored_footprints).buffer(clearance_m)
         cx, cy = np.meshgrid(centres, centres)
         valid &= ~shapely.contains_xy(zone, cx, cy)
-    tall = [h for h, m in zip(hulls, structures) if float(m.vertices[:, 2].max()) > occlusion_height_m]
+    tall = [h for h, m in zip(hulls, structures, strict=True) if float(m.vertices[:, 2].max()) > occlusion_height_m]
     occl = shapely.union_all([heightfield.region_above(occlusion_height_m), *tall])
     return MapPriors(
         resolution=float(res),

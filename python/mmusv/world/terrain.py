@@ -21,6 +21,7 @@ from mmusv.classes import SemanticClass
 from mmusv.world.primitives import TriMesh
 
 __all__ = [
+    "FaceClassifier",
     "ValueNoise",
     "FractalNoise",
     "fbm",
@@ -208,8 +209,9 @@ class Heightfield:
 
         The raster has ``shape`` ``(H, W)`` cells of ``resolution`` metres, cell ``(r, c)`` covering
         ``[ox + c res, ox + (c+1) res] x [oy + r res, oy + (r+1) res]``. Returns ``(H, W)`` float64: the largest
-        vertex height of every grid cell touching the raster cell, which bounds the mesh from above there.
-        Raster cells outside the grid get ``-inf`` contributions only from the grid part they touch.
+        vertex height of every grid cell touching the raster cell, which bounds the mesh from above there
+        (exactly its maximum when ``resolution`` is a whole multiple of ``spacing`` and the grids line up).
+        Vertex indices are clamped to the grid, so raster cells beyond it see the nearest border vertices.
         """
         ny, nx = self.shape
 

@@ -1,0 +1,157 @@
+"""Type stubs for the compiled extension ``mmusv._core`` (pyo3 bindings over the Rust crate ``mmusv-core``).
+
+Arrays going in must already have the exact dtype and be C-contiguous (the :mod:`mmusv` package coerces before
+calling); a wrong dtype raises ``TypeError``. Arrays coming out are freshly allocated, owned, C-contiguous and
+writeable. World frame: right-handed, x east, y north, z up, metres. Sensor body frames: x forward, y left, z up.
+"""
+
+import os
+from collections.abc import Sequence
+from typing import final
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = [
+    "__version__",
+    "MmusvError",
+    "InputError",
+    "GeometryError",
+    "ConfigError",
+    "NotFoundError",
+    "IoError",
+    "InternalError",
+    "Scene",
+    "pinhole_intrinsics",
+    "pinhole_directions",
+    "lidar_directions",
+    "uniform_elevations",
+    "lidar_trace_order",
+    "demo_scene",
+]
+
+__version__: str
+"""Version of the compiled core (the Cargo package version)."""
+
+# --- errors ---
+
+class MmusvError(Exception):
+    """Base class of every mmusv error."""
+
+class InputError(MmusvError):
+    """An argument has the wrong shape, dtype or value."""
+
+class GeometryError(MmusvError):
+    """Mesh data that cannot be used (empty, NaN, bad indices)."""
+
+class ConfigError(MmusvError):
+    """A configuration value outside what is allowed."""
+
+class NotFoundError(MmusvError):
+    """An id, asset or name that does not exist."""
+
+class IoError(MmusvError):
+    """A file could not be read or written."""
+
+class InternalError(MmusvError):
+    """A bug in mmusv (an internal panic was caught)."""
+
+# --- scene ---
+
+@final
+class Scene:
+    """A ray-casting scene: meshes (each with a BVH built once) placed as instances under a top-level BVH."""
+
+    def __init__(self) -> None:
+        """An empty scene."""
+
+    def add_mesh(
+        self,
+        vertices: npt.NDArray[np.float32],
+        faces: npt.NDArray[np.int64],
+        classes: npt.NDArray[np.uint16],
+        name: str,
+    ) -> int:
+        """Adds a mesh: ``vertices`` (V, 3) float32 metres (mesh frame), ``faces`` (F, 3) int64 in ``0..V``, ``classes`` (1,) or (F,) uint16; returns the mesh id."""
+
+    def add_instance(self, mesh_id: int, pose: npt.NDArray[np.float64], class_override: int | None = None) -> int:
+        """Places mesh ``mesh_id`` at ``pose`` ((4, 4) float64 rigid body → world); ``class_override`` uint16 or None; returns the instance id."""
+
+    def set_poses(self, ids: npt.NDArray[np.uint32], poses: npt.NDArray[np.float64]) -> None:
+        """Moves instances ``ids`` (K,) uint32 to ``poses`` (K, 4, 4) float64 rigid body → world; rebuilds only the top-level BVH."""
+
+    def cast_rays(
+        self,
+        origins: npt.NDArray[np.float32],
+        directions: npt.NDArray[np.float32],
+        max_range: float,
+    ) -> tuple[
+        npt.NDArray[np.float32],
+        npt.NDArray[np.int32],
+        npt.NDArray[np.int32],
+        npt.NDArray[np.float32],
+        npt.NDArray[np.uint16],
+        npt.NDArray[np.bool_],
+    ]:
+        """Casts N rays (``origins``, ``directions`` (N, 3) float32 world frame, ``max_range`` metres > 0); returns ``(distance (N,) f32 m / inf, instance_id (N,) i32 / -1, triangle_id (N,) i32 / -1, normal (N, 3) f32 unit world, semantic_class (N,) u16 / 0, backface (N,) bool)``."""
+
+    def world_mesh(
+        self,
+    ) -> tuple[
+        npt.NDArray[np.float32],
+        npt.NDArray[np.uint32],
+        npt.NDArray[np.uint16],
+        npt.NDArray[np.uint32],
+        npt.NDArray[np.uint32],
+    ]:
+        """World triangles at the current poses: ``(vertices (V, 3) f32 world m, faces (F, 3) u32, classes (F,) u16, instance_ids (F,) u32, triangle_ids (F,) u32)``."""
+
+    def export(self, path: str | os.PathLike[str]) -> None:
+        """Writes the world triangles at the current poses to ``path`` (``.ply`` or ``.obj``, world frame, metres), atomically."""
+
+    def instance_aabb(self, instance_id: int) -> npt.NDArray[np.float32]:
+        """(2, 3) float32 world-frame AABB in metres of an instance at its current pose: min row, max row."""
+
+    def instance_pose(self, instance_id: int) -> npt.NDArray[np.float64]:
+        """(4, 4) float64 current body → world pose of an instance."""
+
+    def instance_meshes(self) -> npt.NDArray[np.uint32]:
+        """(K,) uint32 mesh id placed by each instance, indexed by instance id."""
+
+    @property
+    def num_meshes(self) -> int:
+        """Number of meshes."""
+
+    @property
+    def num_instances(self) -> int:
+        """Number of instances."""
+
+    @property
+    def num_world_triangles(self) -> int:
+        """Number of triangles placed in the world (sum over instances of their mesh's triangles)."""
+
+# --- sensors ---
+
+def pinhole_intrinsics(*, width: int, height: int, hfov: float) -> npt.NDArray[np.float64]:
+    """(4,) float64 ``[fx, fy, cx, cy]`` in pixels of a ``width × height`` pinhole camera with horizontal FOV ``hfov`` radians."""
+
+def pinhole_directions(*, width: int, height: int, hfov: float) -> npt.NDArray[np.float32]:
+    """(width·height, 3) float32 unit ray directions through pixel centres, camera body frame, row-major from top-left."""
+
+def lidar_directions(*, elevations: Sequence[float], azimuth_steps: int) -> npt.NDArray[np.float32]:
+    """(azimuth_steps·len(elevations), 3) float32 unit directions of one sweep (elevations in radians), LiDAR frame, azimuth-major."""
+
+def uniform_elevations(*, channels: int, lower: float, upper: float) -> npt.NDArray[np.float64]:
+    """(channels,) float64 elevation angles in radians, lowest first, spread uniformly over ``[lower, upper]``."""
+
+def lidar_trace_order(*, channels: int, azimuth_steps: int, block: int = 8) -> npt.NDArray[np.uint32]:
+    """(channels·azimuth_steps,) uint32 packet-friendly trace order: indices into ``lidar_directions``' azimuth-major order."""
+
+# --- demo ---
+
+def demo_scene(
+    *, seed: int = 1, extent: float = 2000.0, terrain_cells: int = 512, vessels: int = 48
+) -> tuple[Scene, list[int]]:
+    """The synthetic maritime scene (terrain instance 0, water plane instance 1, vessels; ``extent`` metres); returns ``(scene, vessel_instance_ids)``."""
+
+# --- kinematics ---

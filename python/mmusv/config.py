@@ -1,0 +1,207 @@
+"""The scenario file: a YAML schema validated into typed, frozen objects.
+
+Every error is a :class:`mmusv.ConfigError` whose message names the field (``vessels[2].speed_mps``), the value
+given and what is allowed. Everything a newcomer should not have to write has a default. Example::
+
+    name: port_crossing
+    seed: 7
+    map: {type: port, seed: 3}
+    environment: {time_of_day: "16:30", weather: fog, visibility_m: 800, wave: W2}
+    acquisition: {frequency_hz: 5, frames: 100}
+    vessels:
+      - {id: usv_1, role: usv, asset: usv_wamv, speed_mps: 3.0, route: [[0, 0], [150, 40]]}
+      - {id: target_1, role: target, asset: container_ship_300m, speed_mps: 6.0, route: [[-800, 300], [900, 200]]}
+
+Units: metres, seconds, metres per second; angles in degrees only in keys ending in ``_deg``.
+"""
+
+from __future__ import annotations
+
+import difflib
+import hashlib
+import json
+import math
+import os
+from pathlib import Path
+from typing import Any, Literal
+
+import yaml
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+
+from mmusv.errors import ConfigError
+from mmusv.world.environment import Environment, wave_height_m
+from mmusv.world.vessels import asset_names
+
+__all__ = [
+    "MapConfig",
+    "EnvironmentConfig",
+    "AcquisitionConfig",
+    "VesselConfig",
+    "Scenario",
+    "load_scenario",
+    "scenario_hash",
+]
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True, str_strip_whitespace=True)
+
+
+class MapConfig(_Model):
+    """Which map to generate: ``type`` in {island, open_sea, port}, its ``seed`` and optional parameters
+    (``extent_m`` and the per-type knobs of :mod:`mmusv.world.maps`)."""
+
+    type: Literal["island", "open_sea", "port"] = "island"
+    seed: int = Field(default=0, ge=0)
+    params: dict[str, Any] = Field(default_factory=dict)
+
+
+class EnvironmentConfig(_Model):
+    """Time of day (``"HH:MM"``), weather, visibility, rain and the wave setting (``W0``..``W3`` or metres)."""
+
+    time_of_day: str = "12:00"
+    weather: Literal["clear", "overcast", "fog", "rain"] = "clear"
+    visibility_m: float | None = Field(default=None, gt=0)
+    rain_mm_per_h: float | None = Field(default=None, ge=0)
+    wave: str | float = "W0"
+    latitude_deg: float = Field(default=45.0, ge=-90, le=90)
+    day_of_year: int = Field(default=172, ge=1, le=366)
+
+    @field_validator("wave")
+    @classmethod
+    def _wave(cls, v: str | float) -> str | float:
+        wave_height_m(v)
+        return v.strip().upper() if isinstance(v, str) else float(v)
+
+    def resolve(self) -> Environment:
+        """The resolved :class:`~mmusv.world.environment.Environment` (sun, weather, wave height)."""
+        return Environment.make(**self.model_dump())
+
+
+class AcquisitionConfig(_Model):
+    """Acquisition: ``frequency_hz`` (Δt = 1/f) and the number of ``frames`` (indices 0..frames-1)."""
+
+    frequency_hz: float = Field(default=5.0, gt=0, le=1000)
+    frames: int = Field(default=100, ge=1, le=10_000_000)
+
+    def times(self) -> list[float]:
+        """Acquisition times t_k = k / f in seconds."""
+        return [k / self.frequency_hz for k in range(self.frames)]
+
+
+class VesselConfig(_Model):
+    """One vessel: a USV (instrumented, carries ``rig``) or a target, on a spline ``route`` through waypoints
+    (metres, world frame) at ``speed_mps``; ``end`` says what happens at the route end."""
+
+    id: str = Field(pattern=r"^[A-Za-z0-9_\-]+$", min_length=1, max_length=64)
+    role: Literal["usv", "target"] = "target"
+    asset: str
+    rig: str | None = None
+    speed_mps: float = Field(default=0.0, ge=0, allow_inf_nan=False)
+    route: list[tuple[float, float]] = Field(min_length=2)
+    end: Literal["stop", "loop", "ping_pong"] = "stop"
+    start_offset_m: float = Field(default=0.0, ge=0, allow_inf_nan=False)
+    z_base_m: float = Field(default=0.0, allow_inf_nan=False)
+
+    @field_validator("asset")
+    @classmethod
+    def _asset(cls, v: str) -> str:
+        names = asset_names()
+        if v not in names:
+            close = difflib.get_close_matches(v, names, n=3, cutoff=0.5)
+            hint = f"; did you mean {', '.join(close)}?" if close else ""
+            raise ValueError(f"unknown asset{hint} (`mmusv assets` lists all {len(names)})")
+        return v
+
+    @field_validator("route")
+    @classmethod
+    def _route(cls, v: list[tuple[float, float]]) -> list[tuple[float, float]]:
+        for i, (x, y) in enumerate(v):
+            if not (math.isfinite(x) and math.isfinite(y)):
+                raise ValueError(f"waypoint {i} is not finite")
+        return v
+
+
+class Scenario(_Model):
+    """A whole scenario: map, environment, acquisition, sensor rigs and vessels."""
+
+    name: str = Field(default="scenario", pattern=r"^[A-Za-z0-9_\-.]+$")
+    seed: int = Field(default=0, ge=0, lt=2**63)
+    map: MapConfig = Field(default_factory=MapConfig)
+    environment: EnvironmentConfig = Field(default_factory=EnvironmentConfig)
+    acquisition: AcquisitionConfig = Field(default_factory=AcquisitionConfig)
+    rigs: dict[str, dict[str, Any]] = Field(default_factory=dict)
+    vessels: list[VesselConfig] = Field(min_length=1)
+
+    @model_validator(mode="after")
+    def _cross_checks(self) -> Scenario:
+        seen: set[str] = set()
+        for v in self.vessels:
+            if v.id in seen:
+                raise ValueError(f"vessel id {v.id!r} is used twice; ids must be unique")
+            seen.add(v.id)
+            if v.rig is not None and v.rig not in self.rigs:
+                raise ValueError(f"vessel {v.id!r} names rig {v.rig!r}, which is not defined under rigs: ({sorted(self.rigs)})")
+        return self
+
+    @property
+    def usvs(self) -> list[VesselConfig]:
+        """The instrumented vessels, in file order."""
+        return [v for v in self.vessels if v.role == "usv"]
+
+    def with_wave(self, wave: str | float) -> Scenario:
+        """A copy with another wave setting (everything else unchanged)."""
+        env = self.environment.model_copy(update={"wave": EnvironmentConfig._wave(wave)})
+        return self.model_copy(update={"environment": env})
+
+
+def _field_path(loc: tuple[int | str, ...]) -> str:
+    out = ""
+    for part in loc:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        else:
+            out += ("." if out else "") + str(part)
+    return out or "scenario"
+
+
+def _config_error(err: ValidationError, source: str) -> ConfigError:
+    lines = []
+    for e in err.errors():
+        # Pydantic adds the union member or validator name to `loc`; drop the non-field parts.
+        loc = tuple(p for p in e["loc"] if not (isinstance(p, str) and ("[" in p or p in {"str", "float", "function-after"})))
+        value = e.get("input")
+        shown = repr(value) if not isinstance(value, (dict, list)) or len(repr(value)) < 80 else f"<{type(value).__name__}>"
+        msg = str(e["msg"]).removeprefix("Value error, ")
+        lines.append(f"invalid config {_field_path(loc)} = {shown}: {msg}")
+    return ConfigError(f"{source}: " + "; ".join(lines))
+
+
+def load_scenario(source: str | os.PathLike[str] | dict[str, Any] | Scenario) -> Scenario:
+    """Validates a scenario given as a YAML path, a dict, or a :class:`Scenario` (returned as is)."""
+    if isinstance(source, Scenario):
+        return source
+    if isinstance(source, dict):
+        data: Any = source
+        where = "scenario"
+    else:
+        path = Path(source)
+        if not path.is_file():
+            raise ConfigError(f"scenario file {str(path)!r} does not exist")
+        try:
+            data = yaml.safe_load(path.read_text(encoding="utf-8"))
+        except yaml.YAMLError as exc:
+            raise ConfigError(f"{path}: not valid YAML: {exc}") from None
+        where = str(path)
+    if not isinstance(data, dict):
+        raise ConfigError(f"{where}: a scenario must be a YAML mapping with at least `vessels:`")
+    try:
+        return Scenario.model_validate(data)
+    except ValidationError as exc:
+        raise _config_error(exc, where) from None
+
+
+def scenario_hash(scenario: Scenario) -> str:
+    """SHA-256 (hex) of the resolved scenario's canonical JSON: the config hash written into manifests."""
+    text = json.dumps(scenario.model_dump(mode="json"), sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()

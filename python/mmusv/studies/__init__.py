@@ -1,0 +1,1 @@
+"""The paper's experiments, reproduced on mmusv output (wave study, Table I; more to come)."""

@@ -1,0 +1,165 @@
+"""Environment settings: time of day (sun), weather, and the wave setting.
+
+They parameterise the motion model (wave height H scales heave, roll and pitch) and, later, the sensors
+(camera shading and fog, LiDAR/radar attenuation and sea clutter).
+
+* Time of day ``"HH:MM"`` → sun direction from a simple solar model (declination from ``day_of_year``,
+  hour angle from local solar time, latitude ``latitude_deg``), sun colour warming near the horizon, and an
+  ambient level; below the horizon the sun is off.
+* Weather: ``clear``, ``overcast``, ``fog`` (with ``visibility_m``), ``rain`` (with ``rain_mm_per_h``).
+* Waves: presets ``W0``..``W3`` (H = 0.5, 1.5, 2.5, 3.5 m; amplitude A = H/2) or a free height in metres.
+
+Frames: the sun direction is a unit vector in the world frame (x east, y north, z up) pointing *towards* the
+sun.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+from typing import Literal
+
+from mmusv.errors import ConfigError
+
+__all__ = ["WAVE_PRESETS", "Sun", "Weather", "Environment", "wave_height_m", "sun_at"]
+
+WAVE_PRESETS: dict[str, float] = {"W0": 0.5, "W1": 1.5, "W2": 2.5, "W3": 3.5}
+"""Significant wave height H in metres of each preset (paper, Table I)."""
+
+WeatherKind = Literal["clear", "overcast", "fog", "rain"]
+_WEATHER: tuple[str, ...] = ("clear", "overcast", "fog", "rain")
+_TIME_RE = re.compile(r"^(\d{1,2}):(\d{2})$")
+
+
+def wave_height_m(wave: str | float) -> float:
+    """Wave height H (m) of a preset name (``"W0"``..``"W3"``, any case) or a height in metres (≥ 0)."""
+    if isinstance(wave, str):
+        key = wave.strip().upper()
+        if key not in WAVE_PRESETS:
+            raise ConfigError(
+                f"invalid config environment.wave = {wave!r}: allowed presets are "
+                f"{', '.join(WAVE_PRESETS)} or a wave height in metres (>= 0)"
+            )
+        return WAVE_PRESETS[key]
+    h = float(wave)
+    if not math.isfinite(h) or h < 0:
+        raise ConfigError(f"invalid config environment.wave = {wave!r}: a wave height must be finite and >= 0 metres")
+    return h
+
+
+@dataclass(frozen=True)
+class Sun:
+    """Sun state. ``direction``: unit vector towards the sun (world frame); ``elevation_deg``/``azimuth_deg``
+    (azimuth clockwise from north); ``color``: linear RGB in [0, 1]; ``intensity``: 0 at night, 1 at zenith
+    in clear sky; ``ambient``: sky light level in [0, 1]."""
+
+    direction: tuple[float, float, float]
+    elevation_deg: float
+    azimuth_deg: float
+    color: tuple[float, float, float]
+    intensity: float
+    ambient: float
+
+
+def _parse_time(text: str) -> float:
+    m = _TIME_RE.match(text.strip())
+    if not m or int(m.group(1)) > 23 or int(m.group(2)) > 59:
+        raise ConfigError(f"invalid config environment.time_of_day = {text!r}: use 24-hour \"HH:MM\", e.g. \"16:30\"")
+    return int(m.group(1)) + int(m.group(2)) / 60.0
+
+
+def sun_at(time_of_day: str, *, latitude_deg: float = 45.0, day_of_year: int = 172) -> Sun:
+    """Sun direction, colour and light level at local solar time ``time_of_day`` (``"HH:MM"``)."""
+    if not -90.0 <= latitude_deg <= 90.0:
+        raise ConfigError(f"invalid config environment.latitude_deg = {latitude_deg}: must be in [-90, 90]")
+    if not 1 <= day_of_year <= 366:
+        raise ConfigError(f"invalid config environment.day_of_year = {day_of_year}: must be in 1..366")
+    hours = _parse_time(time_of_day)
+    decl = math.radians(23.44) * math.sin(2 * math.pi * (284 + day_of_year) / 365.0)
+    hour_angle = math.radians(15.0 * (hours - 12.0))
+    lat = math.radians(latitude_deg)
+    sin_el = math.sin(lat) * math.sin(decl) + math.cos(lat) * math.cos(decl) * math.cos(hour_angle)
+    el = math.asin(max(-1.0, min(1.0, sin_el)))
+    # Azimuth clockwise from north.
+    az = math.atan2(
+        -math.sin(hour_angle) * math.cos(decl),
+        math.cos(lat) * math.sin(decl) - math.sin(lat) * math.cos(decl) * math.cos(hour_angle),
+    ) % (2 * math.pi)
+    direction = (math.cos(el) * math.sin(az), math.cos(el) * math.cos(az), math.sin(el))
+    up = max(0.0, math.sin(el))
+    warm = 1.0 - min(1.0, up / 0.35)  # 1 at the horizon, 0 above ~20°
+    color = (1.0, 1.0 - 0.35 * warm, 1.0 - 0.65 * warm)
+    intensity = up ** 0.6 if el > 0 else 0.0
+    ambient = 0.08 + 0.5 * (max(0.0, sin_el + 0.1) / 1.1) ** 0.5
+    return Sun(direction, math.degrees(el), math.degrees(az), color, intensity, min(1.0, ambient))
+
+
+@dataclass(frozen=True)
+class Weather:
+    """Weather: ``kind`` in {clear, overcast, fog, rain}; ``visibility_m`` (meteorological visibility, the
+    distance at which contrast falls to 5 %); ``rain_mm_per_h``; ``cloud_cover`` in [0, 1]."""
+
+    kind: WeatherKind
+    visibility_m: float
+    rain_mm_per_h: float
+    cloud_cover: float
+
+    @property
+    def extinction_per_m(self) -> float:
+        """Atmospheric extinction coefficient σ (1/m) from visibility by Koschmieder's law, σ = 3.0 / V."""
+        return 3.0 / self.visibility_m
+
+    @classmethod
+    def make(cls, kind: str = "clear", *, visibility_m: float | None = None, rain_mm_per_h: float | None = None) -> Weather:
+        """Weather of ``kind`` with sensible defaults (clear 20 km visibility, overcast 10 km, fog 500 m,
+        rain 4 mm/h with 5 km)."""
+        if kind not in _WEATHER:
+            raise ConfigError(f"invalid config environment.weather = {kind!r}: allowed values are {', '.join(_WEATHER)}")
+        defaults = {"clear": (20000.0, 0.0, 0.1), "overcast": (10000.0, 0.0, 0.9), "fog": (500.0, 0.0, 1.0), "rain": (5000.0, 4.0, 1.0)}
+        vis, rain, cloud = defaults[kind]
+        vis = vis if visibility_m is None else float(visibility_m)
+        rain = rain if rain_mm_per_h is None else float(rain_mm_per_h)
+        if not (math.isfinite(vis) and vis > 0):
+            raise ConfigError(f"invalid config environment.visibility_m = {visibility_m}: must be > 0 metres")
+        if not (math.isfinite(rain) and rain >= 0):
+            raise ConfigError(f"invalid config environment.rain_mm_per_h = {rain_mm_per_h}: must be >= 0")
+        return cls(kind, vis, rain, cloud)  # type: ignore[arg-type]
+
+
+@dataclass(frozen=True)
+class Environment:
+    """Resolved environment: sun, weather, wave height H (m) and, when a preset was named, its name."""
+
+    time_of_day: str
+    sun: Sun
+    weather: Weather
+    wave_height_m: float
+    wave_preset: str | None
+
+    @property
+    def wave_amplitude_m(self) -> float:
+        """Wave amplitude A = H / 2 in metres."""
+        return self.wave_height_m / 2.0
+
+    @classmethod
+    def make(
+        cls,
+        *,
+        time_of_day: str = "12:00",
+        weather: str = "clear",
+        visibility_m: float | None = None,
+        rain_mm_per_h: float | None = None,
+        wave: str | float = "W0",
+        latitude_deg: float = 45.0,
+        day_of_year: int = 172,
+    ) -> Environment:
+        """Resolves and validates an environment (errors name the ``environment.*`` field)."""
+        preset = wave.strip().upper() if isinstance(wave, str) else None
+        return cls(
+            time_of_day=time_of_day,
+            sun=sun_at(time_of_day, latitude_deg=latitude_deg, day_of_year=day_of_year),
+            weather=Weather.make(weather, visibility_m=visibility_m, rain_mm_per_h=rain_mm_per_h),
+            wave_height_m=wave_height_m(wave),
+            wave_preset=preset,
+        )
