@@ -9,14 +9,24 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from rich.console import Console
 
 from mmusv.errors import MmusvError
 
 BUNDLED_WAVE_SCENARIO = "scenarios/island_port_waves.yaml"
 
 
-def _cmd_assets(args: argparse.Namespace) -> int:
+def _console() -> Console:
+    """A rich console; wide when not writing to a terminal so piped tables are not wrapped."""
     from rich.console import Console
+
+    return Console(width=None if sys.stdout.isatty() else 160)
+
+
+def _cmd_assets(args: argparse.Namespace) -> int:
     from rich.table import Table
 
     from mmusv.world.vessels import library
@@ -26,12 +36,11 @@ def _cmd_assets(args: argparse.Namespace) -> int:
         table.add_column(col, justify="right" if col.endswith(("m", "triangles")) else "left")
     for a in library():
         table.add_row(a.name, a.category, a.semantic_class.name.lower(), f"{a.length:.1f}", f"{a.beam:.1f}", f"{a.height:.1f}", f"{a.draft:.1f}", str(a.num_triangles))
-    Console().print(table)
+    _console().print(table)
     return 0
 
 
 def _cmd_study_waves(args: argparse.Namespace) -> int:
-    from rich.console import Console
     from rich.table import Table
 
     from mmusv.config import load_scenario
@@ -48,7 +57,7 @@ def _cmd_study_waves(args: argparse.Namespace) -> int:
         table.add_column(col, justify="right")
     for r in study.table.iter_rows(named=True):
         table.add_row(str(r["wave"]), f"{r['H_m']:.1f}", f"{r['heave_rms_m']:.4f}", f"{r['roll_rms_deg']:.4f}", f"{r['pitch_rms_deg']:.4f}")
-    console = Console()
+    console = _console()
     console.print(table)
     console.print("R² of a linear fit in H: " + ", ".join(f"{k} {v:.4f}" for k, v in study.r2.items()))
     paths = study.write(Path(args.output))

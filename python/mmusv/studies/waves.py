@@ -44,8 +44,11 @@ def _rms_stats(poses: np.ndarray) -> tuple[float, float, float]:
     heave = z - z.mean(axis=0, keepdims=True)
     roll = np.degrees(poses[:, :, 3])
     pitch = np.degrees(poses[:, :, 4])
-    rms = lambda a: float(np.sqrt(np.mean(np.square(a))))  # noqa: E731
-    return rms(heave), rms(roll), rms(pitch)
+    return _rms(heave), _rms(roll), _rms(pitch)
+
+
+def _rms(a: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(np.square(a))))
 
 
 def _r2(x: np.ndarray, y: np.ndarray) -> float:

@@ -1,0 +1,33 @@
+.PHONY: help install dev test test-rust test-py fmt lint bench bench-peers
+
+help: ## list the targets
+	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  %-12s %s\n", $$1, $$2}'
+
+install: ## install mmusv (release build of the extension)
+	python3 -m pip install .
+
+dev: ## editable install with test extras
+	python3 -m pip install -e ".[test]"
+
+test: ## everything CI runs (installs what it needs)
+	bash scripts/test.sh
+
+test-rust: ## Rust unit tests of the core (no Python)
+	cargo test -p mmusv-core --release
+
+test-py: ## pytest only (after `make dev`)
+	python3 -m pytest -q -p no:dash tests
+
+fmt: ## format Rust and check Python style
+	cargo fmt --all
+
+lint: ## clippy + mypy + stubtest
+	cargo clippy --workspace --all-targets
+	python3 -m mypy
+	python3 -m mypy.stubtest mmusv._core
+
+bench: ## criterion ray-casting benchmarks (rays/s)
+	cargo bench -p mmusv-benches
+
+bench-peers: ## mmusv vs Open3D/Embree on the same scene and rays
+	python3 benches/compare_open3d.py

@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Installs everything the tests need on a fresh machine and runs them all:
+# Rust unit tests (mmusv-core alone, no Python), benches compile check, the Python package with its test
+# extras, the type-stub check, and pytest. Exits non-zero on any failure (pytest's "no tests" included).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+echo "== system libraries (Open3D, the peer used in tests and benches, needs libusb and libgomp)"
+if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = "0" ]; then
+    if ! ldconfig -p | grep -q libusb-1.0.so.0 || ! ldconfig -p | grep -q libgomp.so.1; then
+        apt-get update -qq
+        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libusb-1.0-0 libgomp1 >/dev/null
+    fi
+fi
+
+echo "== toolchains"
+command -v cargo >/dev/null || { echo "cargo not found: install a Rust toolchain (rustup) first" >&2; exit 1; }
+cargo --version
+python3 --version
+
+echo "== cargo test (mmusv-core alone, no Python)"
+cargo test -p mmusv-core --release --quiet
+
+echo "== cargo bench --no-run (benches keep compiling)"
+cargo bench --no-run --quiet
+
+echo "== pip install the package with test extras (builds the extension in release)"
+python3 -m pip install --quiet --disable-pip-version-check -e ".[test]"
+
+echo "== type stubs match the compiled module (mypy stubtest) and the package type-checks"
+python3 -m mypy.stubtest mmusv._core
+python3 -m mypy
+
+echo "== pytest"
+set +e
+python3 -m pytest -q -p no:dash -p no:cacheprovider tests
+rc=$?
+set -e
+if [ "$rc" = "5" ]; then
+    echo "pytest collected no tests: that is a failure" >&2
+    exit 1
+fi
+exit "$rc"

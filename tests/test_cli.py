@@ -1,0 +1,33 @@
+"""The command line: subcommands work, bad input is one clear line and exit status 2."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def run(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "mmusv.cli", *args], capture_output=True, text=True, cwd=ROOT, timeout=120)
+
+
+def test_version_and_assets() -> None:
+    assert run("version").stdout.startswith("mmusv ")
+    out = run("assets").stdout
+    assert "container_ship_300m" in out and "usv_wamv" in out
+
+
+def test_wave_study_command(tmp_path: Path) -> None:
+    r = run("study", "waves", "--frames", "100", "-o", str(tmp_path))
+    assert r.returncode == 0, r.stderr
+    assert "W3" in r.stdout and (tmp_path / "wave_study.csv").is_file()
+
+
+def test_bad_scenario_is_one_line_not_a_traceback(tmp_path: Path) -> None:
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("vessels:\n  - {id: a, asset: nothing, route: [[0, 0], [1, 1]]}\n")
+    r = run("study", "waves", "--scenario", str(bad), "-o", str(tmp_path))
+    assert r.returncode == 2
+    assert "Traceback" not in r.stderr and "vessels[0].asset" in r.stderr

@@ -1,0 +1,78 @@
+"""Scenario schema: defaults, validation errors that name the field, and the bundled scenarios."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import mmusv
+from mmusv.config import load_scenario, scenario_hash
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def minimal(**vessel: object) -> dict[str, object]:
+    v: dict[str, object] = {"id": "usv_1", "role": "usv", "asset": "usv_wamv", "speed_mps": 2.0, "route": [[0, 0], [100, 0]]}
+    v.update(vessel)
+    return {"vessels": [v]}
+
+
+def test_defaults_fill_everything_a_newcomer_omits() -> None:
+    s = load_scenario(minimal())
+    assert s.acquisition.frequency_hz == 5.0 and s.acquisition.frames == 100
+    assert s.environment.wave == "W0" and s.map.type == "island"
+    assert s.usvs[0].id == "usv_1"
+
+
+@pytest.mark.parametrize(
+    ("vessel", "field", "fragment"),
+    [
+        ({"asset": "container_ship_3000m"}, "vessels[0].asset", "did you mean"),
+        ({"route": [[0, 0]]}, "vessels[0].route", "at least 2"),
+        ({"speed_mps": -1.0}, "vessels[0].speed_mps", "greater than or equal to 0"),
+        ({"end": "bounce"}, "vessels[0].end", "'stop', 'loop' or 'ping_pong'"),
+        ({"colour": "red"}, "vessels[0].colour", "Extra inputs"),
+    ],
+)
+def test_bad_vessel_fields_are_named(vessel: dict[str, object], field: str, fragment: str) -> None:
+    with pytest.raises(mmusv.ConfigError) as info:
+        load_scenario(minimal(**vessel))
+    assert field in str(info.value)
+    assert fragment in str(info.value)
+
+
+def test_unknown_wave_setting_is_rejected_with_allowed_values() -> None:
+    data = minimal()
+    data["environment"] = {"wave": "W7"}
+    with pytest.raises(mmusv.ConfigError) as info:
+        load_scenario(data)
+    assert "environment.wave" in str(info.value) and "W0, W1, W2, W3" in str(info.value)
+
+
+def test_duplicate_ids_and_missing_rig() -> None:
+    data = minimal()
+    data["vessels"] = [data["vessels"][0], data["vessels"][0]]  # type: ignore[index]
+    with pytest.raises(mmusv.ConfigError, match="used twice"):
+        load_scenario(data)
+    with pytest.raises(mmusv.ConfigError, match="rig 'nope'"):
+        load_scenario(minimal(rig="nope"))
+
+
+def test_missing_file_and_bad_yaml(tmp_path: Path) -> None:
+    with pytest.raises(mmusv.ConfigError, match="does not exist"):
+        load_scenario(tmp_path / "nope.yaml")
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("vessels: [\n")
+    with pytest.raises(mmusv.ConfigError, match="not valid YAML"):
+        load_scenario(bad)
+
+
+def test_bundled_scenarios_validate_and_hash_is_stable() -> None:
+    files = sorted((ROOT / "scenarios").glob("*.yaml"))
+    assert files
+    for f in files:
+        s = load_scenario(f)
+        assert scenario_hash(s) == scenario_hash(load_scenario(f))
+    a = load_scenario(files[0])
+    assert scenario_hash(a) != scenario_hash(a.with_wave("W3"))
