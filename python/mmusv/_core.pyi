@@ -7,7 +7,7 @@ writeable. World frame: right-handed, x east, y north, z up, metres. Sensor body
 
 import os
 from collections.abc import Sequence
-from typing import final
+from typing import Any, final
 
 import numpy as np
 import numpy.typing as npt
@@ -28,6 +28,9 @@ __all__ = [
     "uniform_elevations",
     "lidar_trace_order",
     "demo_scene",
+    "Fleet",
+    "default_amplitudes",
+    "wave_height",
 ]
 
 __version__: str
@@ -138,7 +141,9 @@ def pinhole_intrinsics(*, width: int, height: int, hfov: float) -> npt.NDArray[n
 def pinhole_directions(*, width: int, height: int, hfov: float) -> npt.NDArray[np.float32]:
     """(width·height, 3) float32 unit ray directions through pixel centres, camera body frame, row-major from top-left."""
 
-def lidar_directions(*, elevations: Sequence[float], azimuth_steps: int) -> npt.NDArray[np.float32]:
+def lidar_directions(
+    *, elevations: Sequence[float] | npt.NDArray[np.floating[Any]], azimuth_steps: int
+) -> npt.NDArray[np.float32]:
     """(azimuth_steps·len(elevations), 3) float32 unit directions of one sweep (elevations in radians), LiDAR frame, azimuth-major."""
 
 def uniform_elevations(*, channels: int, lower: float, upper: float) -> npt.NDArray[np.float64]:
@@ -155,3 +160,45 @@ def demo_scene(
     """The synthetic maritime scene (terrain instance 0, water plane instance 1, vessels; ``extent`` metres); returns ``(scene, vessel_instance_ids)``."""
 
 # --- kinematics ---
+
+@final
+class Fleet:
+    """Vessels on arc-length spline routes with wave heave/roll/pitch (paper eq. 1–4). Poses are
+    ``[x, y, z, roll, pitch, yaw]`` in the world frame (metres, radians)."""
+
+    def __new__(
+        cls,
+        *,
+        routes: Sequence[npt.NDArray[np.float64]],
+        end_behaviours: Sequence[str],
+        speeds: npt.NDArray[np.float64],
+        start_offsets: npt.NDArray[np.float64],
+        z_base: npt.NDArray[np.float64],
+        dims: npt.NDArray[np.float64],
+        amplitudes: npt.NDArray[np.float64],
+        seed: int,
+        wave: str | float,
+    ) -> Fleet:
+        """Per vessel i: routes[i] (K,2) m, end_behaviours[i] in {stop, loop, ping_pong}, speeds (V,) m/s,
+        start_offsets (V,) m, z_base (V,) m, dims (V,3) length/beam/height m, amplitudes (V,3) heave m/roll rad/pitch rad."""
+    def __len__(self) -> int:
+        """Number of vessels."""
+    @property
+    def wave_height_m(self) -> float:
+        """Wave height H in metres."""
+    def route_lengths(self) -> npt.NDArray[np.float64]:
+        """(V,) float64 route lengths in metres."""
+    def alphas(self) -> npt.NDArray[np.float64]:
+        """(V,) float64 size factors α_v."""
+    def poses_at(self, t: float) -> npt.NDArray[np.float64]:
+        """(V, 6) float64 poses at time t seconds."""
+    def velocities_at(self, t: float) -> npt.NDArray[np.float64]:
+        """(V, 3) float64 world-frame velocities (m/s) at time t seconds."""
+    def poses_at_times(self, times: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+        """(T, V, 6) float64 poses at each time (seconds); GIL released."""
+
+def default_amplitudes() -> tuple[float, float, float]:
+    """Default base amplitudes (heave m, roll rad, pitch rad), calibrated on the reference 5 m USV."""
+
+def wave_height(wave: str | float) -> float:
+    """Wave height H in metres of a preset "W0".."W3" or a height in metres (validated)."""

@@ -22,7 +22,7 @@ import numpy as np
 import numpy.typing as npt
 
 from mmusv._native import core
-from mmusv.errors import GeometryError, InputError
+from mmusv.errors import GeometryError, InputError, NotFoundError
 
 __all__ = ["Scene", "RayHits", "NO_HIT", "demo_scene"]
 
@@ -74,6 +74,8 @@ def _array(value: Any, *, name: str, dtype: Any, shape_tail: tuple[int, ...]) ->
         raise InputError(f"{name} could not be converted to an array: {exc}") from None
     if arr.dtype == object or not (np.issubdtype(arr.dtype, np.number) or arr.dtype == np.bool_):
         raise InputError(f"{name} must be numeric, got dtype {arr.dtype}")
+    if np.iscomplexobj(arr):
+        raise InputError(f"{name} must be real, got complex dtype {arr.dtype}")
     want_ndim = 1 + len(shape_tail)
     if arr.ndim != want_ndim or tuple(arr.shape[1:]) != shape_tail:
         tail = ", ".join(str(s) for s in shape_tail)
@@ -83,8 +85,27 @@ def _array(value: Any, *, name: str, dtype: Any, shape_tail: tuple[int, ...]) ->
     return np.ascontiguousarray(arr, dtype=dtype)
 
 
+def _floats(value: Any, *, name: str) -> np.ndarray:
+    """``value`` as a float64 array, or an :class:`InputError` naming ``name``."""
+    try:
+        arr = np.asarray(value)
+        if np.iscomplexobj(arr):
+            raise TypeError("complex values")
+        return np.asarray(arr, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name} must be a real numeric array: {exc}") from None
+
+
+def _id(value: Any, *, name: str, kind: str) -> int:
+    """A non-negative id that fits in uint32, else :class:`NotFoundError`."""
+    i = int(value)
+    if not 0 <= i < 2**32:
+        raise NotFoundError(f"unknown {kind} id {i}: {name} must be a non-negative id returned by the scene")
+    return i
+
+
 def _pose(pose: Any, *, name: str) -> np.ndarray:
-    arr = np.asarray(pose, dtype=np.float64)
+    arr = _floats(pose, name=name)
     if arr.shape != (4, 4):
         raise InputError(f"{name} must be a (4, 4) homogeneous matrix, got shape {arr.shape}")
     return np.ascontiguousarray(arr)
@@ -146,18 +167,26 @@ class Scene:
         as a USV).
         """
         p = _pose(np.eye(4) if pose is None else pose, name="pose")
-        return int(self._native.add_instance(int(mesh_id), p, class_override))
+        if class_override is not None and not 0 <= int(class_override) <= 65535:
+            raise InputError(f"class_override must be in 0..65535, got {class_override}")
+        cls = None if class_override is None else int(class_override)
+        return int(self._native.add_instance(_id(mesh_id, name="mesh_id", kind="mesh"), p, cls))
 
     def set_poses(self, instance_ids: npt.ArrayLike, poses: npt.ArrayLike) -> None:
         """Moves instances: ``instance_ids`` ``(K,)`` ints, ``poses`` ``(K, 4, 4)`` float. Only the top level is rebuilt."""
         ids = np.atleast_1d(np.asarray(instance_ids))
+        p = _floats(poses, name="poses")
+        if ids.size == 0 and p.size == 0:
+            return
         if ids.ndim != 1 or not np.issubdtype(ids.dtype, np.integer):
             raise InputError(f"instance_ids must be a 1-D integer array, got {ids.dtype} with shape {ids.shape}")
-        if ids.size and ids.min() < 0:
-            raise InputError(f"instance_ids must be >= 0, got {int(ids.min())}")
-        p = np.asarray(poses, dtype=np.float64)
+        if ids.min() < 0 or ids.max() >= 2**32:
+            bad = int(ids.min()) if ids.min() < 0 else int(ids.max())
+            raise NotFoundError(f"unknown instance id {bad}: instance ids are the non-negative ids add_instance returned")
         if p.ndim == 2:
             p = p[None]
+        if p.ndim != 3 or p.shape[1:] != (4, 4):
+            raise InputError(f"poses must have shape (K, 4, 4) (or (4, 4) for one id), got {np.shape(poses)}")
         self._native.set_poses(np.ascontiguousarray(ids, dtype=np.uint32), np.ascontiguousarray(p))
 
     def cast_rays(self, origins: npt.ArrayLike, directions: npt.ArrayLike, *, max_range: float = float("inf")) -> RayHits:
@@ -186,11 +215,11 @@ class Scene:
 
     def instance_aabb(self, instance_id: int) -> np.ndarray:
         """``(2, 3)`` float32 world AABB (min row, max row) of an instance at its current pose."""
-        return np.asarray(self._native.instance_aabb(int(instance_id)))
+        return np.asarray(self._native.instance_aabb(_id(instance_id, name="instance_id", kind="instance")))
 
     def instance_pose(self, instance_id: int) -> np.ndarray:
         """``(4, 4)`` float64 current pose of an instance."""
-        return np.asarray(self._native.instance_pose(int(instance_id)))
+        return np.asarray(self._native.instance_pose(_id(instance_id, name="instance_id", kind="instance")))
 
     @property
     def num_instances(self) -> int:

@@ -113,8 +113,11 @@ pub fn hull_mesh(name: &str, length: f32, beam: f32, draft: f32, freeboard: f32,
 
 /// Builds the demo scene.
 pub fn maritime_demo(p: DemoParams) -> Result<DemoScene> {
-    if p.terrain_cells == 0 || !(p.extent > 0.0) {
-        return Err(MmusvError::input("terrain_cells/extent", "need terrain_cells >= 1 and extent > 0"));
+    if p.terrain_cells == 0 {
+        return Err(MmusvError::input("terrain_cells", "need at least 1 terrain cell per side"));
+    }
+    if !(p.extent >= 100.0 && p.extent.is_finite()) {
+        return Err(MmusvError::input("extent", format!("{} m is too small; the demo scene needs extent >= 100 m", p.extent)));
     }
     let mut rng = ChaCha8Rng::seed_from_u64(p.seed);
     let islands: Vec<Island> = (0..7)

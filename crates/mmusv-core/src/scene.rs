@@ -354,7 +354,7 @@ impl Scene {
                     let end = (start + PACKET).min(o.len());
                     let mut unit = [[0.0f32; 3]; PACKET];
                     for (u, src) in unit.iter_mut().zip(&d[start..end]) {
-                        *u = Vec3::from_array(*src).normalize().to_array();
+                        *u = unit_direction(src);
                     }
                     let unit = &unit[..end - start];
                     if end - start > 1 && Packet::is_coherent(&o[start..end], unit, COHERENT_COS, COHERENT_RADIUS) {
@@ -408,6 +408,15 @@ pub struct WorldMesh {
     pub triangles: Vec<u32>,
 }
 
+/// `d / |d|` computed in `f64`, so any finite non-zero `f32` direction (even 1e-30 or 1e30 long) normalises
+/// exactly instead of under- or overflowing in `f32`.
+#[inline]
+fn unit_direction(d: &[f32; 3]) -> [f32; 3] {
+    let (x, y, z) = (d[0] as f64, d[1] as f64, d[2] as f64);
+    let n = (x * x + y * y + z * z).sqrt();
+    [(x / n) as f32, (y / n) as f32, (z / n) as f32]
+}
+
 fn validate_rays(origins: &[[f32; 3]], dirs: &[[f32; 3]], max_range: f32) -> Result<()> {
     if origins.len() != dirs.len() {
         return Err(MmusvError::input(
@@ -421,10 +430,7 @@ fn validate_rays(origins: &[[f32; 3]], dirs: &[[f32; 3]], max_range: f32) -> Res
     if let Some(i) = origins.par_iter().position_first(|o| o.iter().any(|c| !c.is_finite())) {
         return Err(MmusvError::input(format!("origins[{i}]"), format!("{:?} is not finite", origins[i])));
     }
-    if let Some(i) = dirs.par_iter().position_first(|d| {
-        let n2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-        !n2.is_finite() || n2 == 0.0 || d.iter().any(|c| !c.is_finite())
-    }) {
+    if let Some(i) = dirs.par_iter().position_first(|d| d.iter().any(|c| !c.is_finite()) || d.iter().all(|&c| c == 0.0)) {
         return Err(MmusvError::input(
             format!("directions[{i}]"),
             format!("{:?} is zero-length or not finite; directions must be finite and non-zero", dirs[i]),

@@ -9,7 +9,7 @@ use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use std::path::PathBuf;
-use std::sync::RwLock;
+use std::sync::{Arc, RwLock};
 
 /// Tuple of arrays returned by `Scene.cast_rays` (see the `.pyi` for shapes and dtypes).
 type RayHitArrays<'py> = (
@@ -31,9 +31,14 @@ type WorldMeshArrays<'py> = (
 );
 
 /// A ray-casting scene: meshes (each with a BVH built once) placed as instances.
+///
+/// Concurrency: the lock guards only an `Arc` to the current scene and is held for a pointer copy (readers) or
+/// a short in-place update (writers), never while the GIL is released or re-acquired, so a long cast in one
+/// thread and a pose update in another cannot deadlock. A writer that finds a cast still using the old scene
+/// copies it first (cheap: meshes are shared `Arc`s); the running cast finishes on the state it started with.
 #[pyclass(frozen, module = "mmusv._core")]
 pub struct Scene {
-    inner: RwLock<CoreScene>,
+    inner: RwLock<Arc<CoreScene>>,
 }
 
 fn poisoned() -> PyErr {
@@ -48,13 +53,19 @@ fn pose_from(arr: &[f64], field: &str) -> PyResult<RigidPose> {
 impl Scene {
     /// Wraps a core scene built in Rust.
     pub fn from_core(scene: CoreScene) -> Self {
-        Self { inner: RwLock::new(scene) }
+        Self { inner: RwLock::new(Arc::new(scene)) }
     }
 
-    /// Runs `f` on the scene under the read lock.
+    /// Runs `f` on a snapshot of the scene (the lock is released before `f` runs).
     pub fn read<T>(&self, f: impl FnOnce(&CoreScene) -> PyResult<T>) -> PyResult<T> {
-        let guard = self.inner.read().map_err(|_| poisoned())?;
-        f(&guard)
+        let snapshot = Arc::clone(&*self.inner.read().map_err(|_| poisoned())?);
+        f(&snapshot)
+    }
+
+    /// Applies `f` to the scene under the write lock (held only for `f`, which must not touch the GIL).
+    fn write<T>(&self, f: impl FnOnce(&mut CoreScene) -> T) -> PyResult<T> {
+        let mut guard = self.inner.write().map_err(|_| poisoned())?;
+        Ok(f(Arc::make_mut(&mut guard)))
     }
 }
 
@@ -62,7 +73,7 @@ impl Scene {
 impl Scene {
     #[new]
     fn new() -> Self {
-        Self { inner: RwLock::new(CoreScene::new()) }
+        Self::from_core(CoreScene::new())
     }
 
     /// Adds a mesh; builds its BVH with the GIL released. Returns the mesh id.
@@ -79,8 +90,7 @@ impl Scene {
         let f = rows::<i64, 3>(&faces, "faces")?;
         let c = flat(&classes, "classes")?;
         let mesh = detached(py, || Mesh::new(name, v, f, c))?;
-        let mut guard = self.inner.write().map_err(|_| poisoned())?;
-        Ok(guard.add_mesh(mesh))
+        self.write(|s| s.add_mesh(mesh))
     }
 
     /// Places mesh `mesh_id` at `pose` (4x4 float64); returns the instance id.
@@ -90,8 +100,7 @@ impl Scene {
             return Err(InputError::new_err(format!("pose must have shape (4, 4), got {:?}", pose.shape())));
         }
         let p = pose_from(flat_2d(&pose)?, "pose")?;
-        let mut guard = self.inner.write().map_err(|_| poisoned())?;
-        guard.add_instance(mesh_id, p, class_override).map_err(crate::errors::to_py)
+        self.write(|s| s.add_instance(mesh_id, p, class_override))?.map_err(crate::errors::to_py)
     }
 
     /// Moves instances `ids` (K,) to `poses` (K, 4, 4); rebuilds only the top-level BVH.
@@ -111,8 +120,7 @@ impl Scene {
             .enumerate()
             .map(|(i, m)| pose_from(m, &format!("poses[{i}]")))
             .collect::<PyResult<Vec<_>>>()?;
-        let mut guard = self.inner.write().map_err(|_| poisoned())?;
-        guard.set_poses(ids, &parsed).map_err(crate::errors::to_py)
+        self.write(|s| s.set_poses(ids, &parsed))?.map_err(crate::errors::to_py)
     }
 
     /// Casts rays (GIL released, all cores). Returns
