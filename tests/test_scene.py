@@ -5,7 +5,7 @@ against Open3D's ``RaycastingScene``. Rays whose answer is numerically ambiguous
 passing within a hair of an edge, two triangles at the same distance, a hit at the range limit) are excluded
 from the exact comparison by the brute force itself; every test asserts that such rays are rare, so the
 comparison stays meaningful. Tests known to fail because of a bug are marked ``xfail(strict=True)`` with the
-bug described in ``reason``.
+bug described in ``reason``: remove the mark with the fix.
 """
 
 from __future__ import annotations
@@ -742,6 +742,11 @@ BAD_CALLS: list[tuple[str, Callable[[Scene], object], type[MmusvError], str]] = 
     ("classes_float", lambda s: s.add_mesh(TRI_V, TRI_F, classes=1.5), InputError, r"classes must be an int"),
     # add_instance / set_poses
     ("instance_of_unknown_mesh", lambda s: s.add_instance(99), NotFoundError, r"unknown mesh id 99"),
+    ("instance_of_negative_mesh", lambda s: s.add_instance(-1), NotFoundError, r"unknown mesh id -1"),
+    ("class_override_negative", lambda s: s.add_instance(0, class_override=-1), InputError, r"class_override must be in 0\.\.65535"),
+    ("class_override_too_big", lambda s: s.add_instance(0, class_override=70000), InputError, r"class_override must be in 0\.\.65535"),
+    ("pose_string", lambda s: s.add_instance(0, pose="identity"), InputError, r"pose must be a real numeric array"),
+    ("pose_complex", lambda s: s.add_instance(0, pose=np.eye(4) * 1j), InputError, r"pose must be a real numeric array"),
     ("pose_3x3", lambda s: s.add_instance(0, pose=np.eye(3)), InputError, r"pose must be a \(4, 4\)"),
     ("pose_scaled", lambda s: s.add_instance(0, pose=np.diag([2.0, 1.0, 1.0, 1.0])), InputError, r"pose.*not orthonormal"),
     ("pose_sheared", lambda s: s.add_instance(0, pose=np.array([[1, 0.3, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])), InputError, r"pose.*not orthonormal"),
@@ -749,13 +754,22 @@ BAD_CALLS: list[tuple[str, Callable[[Scene], object], type[MmusvError], str]] = 
     ("pose_nan", lambda s: s.add_instance(0, pose=np.where(np.eye(4) > 0, np.nan, 0.0)), InputError, r"pose.*NaN"),
     ("pose_bad_last_row", lambda s: s.add_instance(0, pose=np.array([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [1, 0, 0, 1.0]])), InputError, r"pose.*last row"),
     ("set_poses_unknown_instance", lambda s: s.set_poses([5], np.eye(4)), NotFoundError, r"unknown instance id 5"),
-    ("set_poses_negative_id", lambda s: s.set_poses([-1], np.eye(4)), InputError, r"instance_ids must be >= 0"),
+    ("set_poses_negative_id", lambda s: s.set_poses([-1], np.eye(4)), NotFoundError, r"unknown instance id -1"),
+    ("set_poses_id_2**32", lambda s: s.set_poses(np.array([2**32]), np.eye(4)), NotFoundError, r"unknown instance id 4294967296"),
+    ("set_poses_id_2**40", lambda s: s.set_poses([2**40], np.eye(4)), NotFoundError, r"unknown instance id 1099511627776"),
+    ("set_poses_flat_16", lambda s: s.set_poses([0], np.eye(4).ravel()), InputError, r"poses must have shape \(K, 4, 4\)"),
+    ("set_poses_4d", lambda s: s.set_poses([0], np.eye(4)[None, None]), InputError, r"poses must have shape \(K, 4, 4\)"),
+    ("set_poses_string", lambda s: s.set_poses([0], "identity"), InputError, r"poses must be a real numeric array"),
+    ("set_poses_complex", lambda s: s.set_poses([0], np.eye(4) + 0j), InputError, r"poses must be a real numeric array"),
+    ("set_poses_bool_ids", lambda s: s.set_poses([True], np.eye(4)), InputError, r"instance_ids must be a 1-D integer array"),
     ("set_poses_float_ids", lambda s: s.set_poses([0.5], np.eye(4)), InputError, r"instance_ids must be a 1-D integer array"),
     ("set_poses_count_mismatch", lambda s: s.set_poses([0, 0], np.eye(4)), InputError, r"poses must have shape \(2, 4, 4\)"),
-    ("set_poses_3x3", lambda s: s.set_poses([0], np.eye(3)), InputError, r"poses must have shape \(1, 4, 4\)"),
+    ("set_poses_3x3", lambda s: s.set_poses([0], np.eye(3)), InputError, r"poses must have shape \(K, 4, 4\).*got \(3, 3\)"),
     ("set_poses_non_rigid", lambda s: s.set_poses([0], np.diag([1.0, 3.0, 1.0, 1.0])), InputError, r"poses\[0\].*not orthonormal"),
     ("set_poses_second_bad", lambda s: s.set_poses([0, 0], np.stack([np.eye(4), np.diag([1.0, 1.0, -1.0, 1.0])])), InputError, r"poses\[1\]"),
     ("aabb_unknown_instance", lambda s: s.instance_aabb(9), NotFoundError, r"unknown instance id 9"),
+    ("aabb_negative_instance", lambda s: s.instance_aabb(-1), NotFoundError, r"unknown instance id -1"),
+    ("pose_of_negative_instance", lambda s: s.instance_pose(-1), NotFoundError, r"unknown instance id -1"),
     ("pose_of_unknown_instance", lambda s: s.instance_pose(9), NotFoundError, r"unknown instance id 9"),
     # cast_rays
     ("zero_direction", lambda s: s.cast_rays(np.zeros((2, 3)), [[0, 0, 1], [0, 0, 0]]), InputError, r"directions\[1\].*zero-length"),
@@ -767,6 +781,8 @@ BAD_CALLS: list[tuple[str, Callable[[Scene], object], type[MmusvError], str]] = 
     ("directions_1d", lambda s: s.cast_rays(GOOD_O, GOOD_D.ravel()), InputError, r"directions must have shape"),
     ("origins_strings", lambda s: s.cast_rays([["a", "b", "c"]], GOOD_D), InputError, r"origins must be numeric"),
     ("directions_object", lambda s: s.cast_rays(GOOD_O, np.array([[0, 0, None]], dtype=object)), InputError, r"directions must be numeric"),
+    ("directions_complex", lambda s: s.cast_rays(GOOD_O, GOOD_D + 1j), InputError, r"directions must be real"),
+    ("vertices_complex", lambda s: s.add_mesh(TRI_V + 0j, TRI_F), InputError, r"vertices must be real"),
     ("max_range_zero", lambda s: s.cast_rays(GOOD_O, GOOD_D, max_range=0.0), InputError, r"max_range"),
     ("max_range_negative", lambda s: s.cast_rays(GOOD_O, GOOD_D, max_range=-1.0), InputError, r"max_range"),
     ("max_range_nan", lambda s: s.cast_rays(GOOD_O, GOOD_D, max_range=float("nan")), InputError, r"max_range"),
@@ -796,52 +812,29 @@ def test_bad_export_leaves_no_file(tri_scene: Scene, tmp_path: Path) -> None:
     assert list(tmp_path.iterdir()) == []
 
 
-# Known bugs: bad input that escapes as a builtin exception (or none). Each asserts the documented behaviour.
-
-
-@pytest.mark.xfail(strict=True, raises=OverflowError, reason="BUG: negative mesh/instance ids raise builtin OverflowError from the u32 conversion, not an mmusv error")
-@pytest.mark.parametrize("call", [lambda s: s.add_instance(-1), lambda s: s.instance_aabb(-1), lambda s: s.instance_pose(-1)], ids=["add_instance", "instance_aabb", "instance_pose"])
-def test_negative_ids_raise_mmusv_error(tri_scene: Scene, call: Callable[[Scene], object]) -> None:
-    with pytest.raises((InputError, NotFoundError), match="-1"):
-        call(tri_scene)
-
-
-@pytest.mark.xfail(strict=True, raises=OverflowError, reason="BUG: class_override outside 0..65535 raises builtin OverflowError (u16 conversion), not InputError")
-@pytest.mark.parametrize("value", [-1, 70000])
-def test_class_override_out_of_range(tri_scene: Scene, value: int) -> None:
-    with pytest.raises(InputError, match="class_override"):
-        tri_scene.add_instance(0, class_override=value)
-
-
-@pytest.mark.xfail(strict=True, reason="BUG: instance ids >= 2**32 are wrapped to uint32 by Scene.set_poses (2**32 moves instance 0)")
-@pytest.mark.parametrize("bad_id", [2**32, 2**40])
-def test_set_poses_huge_id_is_not_wrapped(tri_scene: Scene, bad_id: int) -> None:
-    with pytest.raises(NotFoundError):
-        tri_scene.set_poses(np.array([bad_id], dtype=np.int64), pose(translation=(1.0, 0.0, 0.0)))
-
-
-@pytest.mark.xfail(strict=True, raises=TypeError, reason="BUG: poses of 1 or 4 dimensions reach the binding and raise numpy's TypeError 'dimensionality mismatch', not InputError")
-@pytest.mark.parametrize("poses", [np.eye(4).ravel(), np.eye(4)[None, None]], ids=["flat16", "4d"])
-def test_set_poses_wrong_ndim(tri_scene: Scene, poses: F64) -> None:
-    with pytest.raises(InputError, match="poses"):
-        tri_scene.set_poses([0], poses)
-
-
-@pytest.mark.xfail(strict=True, raises=ValueError, reason="BUG: a string pose raises builtin ValueError from np.asarray(dtype=float64), not InputError")
-def test_string_pose(tri_scene: Scene) -> None:
-    with pytest.raises(InputError, match="pose"):
-        tri_scene.add_instance(0, pose="identity")
-
-
-@pytest.mark.xfail(strict=True, reason="BUG: complex arrays pass the numeric check and are cast to float32, silently dropping the imaginary part")
-def test_complex_arrays_rejected(tri_scene: Scene) -> None:
-    with pytest.raises(InputError, match="directions"):
-        tri_scene.cast_rays(GOOD_O, GOOD_D.astype(np.complex128) + 1j)
-
-
-@pytest.mark.xfail(strict=True, reason="BUG: an empty update set_poses([], zeros((0, 4, 4))) raises InputError (empty list has dtype float64) instead of doing nothing")
 def test_set_poses_empty_is_a_no_op(tri_scene: Scene) -> None:
     tri_scene.set_poses([], np.zeros((0, 4, 4)))
+    np.testing.assert_array_equal(tri_scene.instance_pose(0), np.eye(4))
+    assert_still_usable(tri_scene)
+
+
+# Bad input that once escaped as a builtin exception, or was silently coerced. Each asserts the wanted behaviour.
+
+
+@pytest.mark.parametrize("value", ["far", None])
+def test_non_numeric_max_range(tri_scene: Scene, value: Any) -> None:
+    with pytest.raises(InputError, match="max_range"):
+        tri_scene.cast_rays(GOOD_O, GOOD_D, max_range=value)
+
+
+@pytest.mark.parametrize(
+    "call",
+    [lambda s: s.add_instance(0.7), lambda s: s.add_instance("0"), lambda s: s.instance_pose(0.9), lambda s: s.add_instance(0, class_override=2.5)],
+    ids=["mesh_id_float", "mesh_id_str", "instance_id_float", "class_override_float"],
+)
+def test_non_integer_ids_rejected(tri_scene: Scene, call: Callable[[Scene], object]) -> None:
+    with pytest.raises(InputError):
+        call(tri_scene)
 
 
 @pytest.mark.parametrize("scale", [1e-22, 1e-30, 1e20, 1e30])
@@ -994,27 +987,25 @@ def work():
 worker = threading.Thread(target=work)
 worker.start()
 started.wait()
-time.sleep(0.1)  # the worker is now inside the native cast, GIL released, scene read-locked
-s.{call}
+time.sleep(0.1)  # the worker is now inside the native cast, GIL released
+s.set_poses(vessels[:1], np.eye(4))
+s.add_instance(2)
+s.add_mesh(np.eye(3), [[0, 1, 2]])
 worker.join()
 print("ok")
 """
 
 
-@pytest.mark.xfail(
-    strict=False,  # timing-based: on a machine where the cast ends within 0.1 s the bug cannot show
-    reason="BUG: deadlock. Scene.cast_rays holds the scene's read lock while py.detach re-acquires the GIL, and "
-    "set_poses / add_instance / add_mesh wait for the write lock while holding the GIL: calling one of them from "
-    "another thread during a cast hangs the interpreter for ever",
-)
 def test_mutating_the_scene_during_a_cast_in_another_thread_does_not_deadlock() -> None:
-    """Run in a subprocess: a deadlock would otherwise hang the whole test run."""
-    call = "set_poses(vessels[:1], np.eye(4))"  # add_instance and add_mesh take the write lock the same way
-    script = _DEADLOCK_SCRIPT.replace("{call}", call)
+    """(Was: cast_rays held the scene's read lock while re-acquiring the GIL, set_poses/add_instance/add_mesh waited
+    for the write lock holding the GIL: a cast in one thread and an update in another hung the interpreter.)
+
+    Run in a subprocess, because a deadlock would hang the whole test run.
+    """
     try:
-        out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=3.0)
+        out = subprocess.run([sys.executable, "-c", _DEADLOCK_SCRIPT], check=False, capture_output=True, text=True, timeout=30.0)
     except subprocess.TimeoutExpired:
-        pytest.fail(f"deadlock: scene.{call} during a cast_rays in another thread never returned")
+        pytest.fail("deadlock: set_poses / add_instance / add_mesh during a cast_rays in another thread never returned")
     assert out.returncode == 0 and out.stdout.strip() == "ok", out.stderr
 
 

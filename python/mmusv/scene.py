@@ -97,7 +97,9 @@ def _floats(value: Any, *, name: str) -> np.ndarray:
 
 
 def _id(value: Any, *, name: str, kind: str) -> int:
-    """A non-negative id that fits in uint32, else :class:`NotFoundError`."""
+    """A non-negative integer id that fits in uint32, else :class:`InputError` / :class:`NotFoundError`."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise InputError(f"{name} must be an integer id, got {value!r}")
     i = int(value)
     if not 0 <= i < 2**32:
         raise NotFoundError(f"unknown {kind} id {i}: {name} must be a non-negative id returned by the scene")
@@ -167,6 +169,10 @@ class Scene:
         as a USV).
         """
         p = _pose(np.eye(4) if pose is None else pose, name="pose")
+        if class_override is not None and (
+            isinstance(class_override, bool) or not isinstance(class_override, (int, np.integer))
+        ):
+            raise InputError(f"class_override must be an integer class id in 0..65535, got {class_override!r}")
         if class_override is not None and not 0 <= int(class_override) <= 65535:
             raise InputError(f"class_override must be in 0..65535, got {class_override}")
         cls = None if class_override is None else int(class_override)
@@ -199,7 +205,11 @@ class Scene:
         """
         o = _array(origins, name="origins", dtype=np.float32, shape_tail=(3,))
         d = _array(directions, name="directions", dtype=np.float32, shape_tail=(3,))
-        dist, inst, tri, normal, cls, back = self._native.cast_rays(o, d, float(max_range))
+        try:
+            limit = float(max_range)
+        except (TypeError, ValueError):
+            raise InputError(f"max_range must be a number of metres > 0, got {max_range!r}") from None
+        dist, inst, tri, normal, cls, back = self._native.cast_rays(o, d, limit)
         return RayHits(dist, inst, tri, normal, cls, back)
 
     def world_mesh(self) -> dict[str, np.ndarray]:

@@ -49,8 +49,9 @@ fn uniform_elevations<'py>(py: Python<'py>, channels: u32, lower: f64, upper: f6
 /// azimuth-major order of `lidar_directions`), blocks of `block` neighbouring columns.
 #[pyfunction]
 #[pyo3(signature = (*, channels, azimuth_steps, block=8))]
-fn lidar_trace_order<'py>(py: Python<'py>, channels: u32, azimuth_steps: u32, block: u32) -> Bound<'py, PyArray1<u32>> {
-    rays::lidar_trace_order(channels, azimuth_steps, block).into_pyarray(py)
+fn lidar_trace_order<'py>(py: Python<'py>, channels: u32, azimuth_steps: u32, block: u32) -> PyResult<Bound<'py, PyArray1<u32>>> {
+    let order = detached(py, || rays::lidar_trace_order(channels, azimuth_steps, block))?;
+    Ok(order.into_pyarray(py))
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

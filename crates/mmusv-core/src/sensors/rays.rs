@@ -9,6 +9,11 @@
 
 use crate::error::{MmusvError, Result};
 
+/// Most LiDAR channels a sweep may have.
+pub const MAX_CHANNELS: u32 = 1024;
+/// Most azimuth steps a sweep may have.
+pub const MAX_AZIMUTH_STEPS: u32 = 1 << 16;
+
 /// Pinhole intrinsics from an image size and horizontal field of view: `fx = fy = W / (2 tan(hfov/2))`,
 /// principal point at the image centre `(W/2, H/2)`. Returns `[fx, fy, cx, cy]` in pixels.
 pub fn pinhole_intrinsics(width: u32, height: u32, hfov: f64) -> Result<[f64; 4]> {
@@ -62,8 +67,14 @@ pub fn uniform_elevations(channels: u32, lower: f64, upper: f64) -> Result<Vec<f
 /// Unit directions of one full LiDAR sweep in the LiDAR frame: `azimuth_steps` columns starting at azimuth 0
 /// (forward, +x) and turning counter-clockwise (towards +y), each column holding every elevation in order.
 pub fn lidar_directions(elevations: &[f64], azimuth_steps: u32) -> Result<Vec<[f32; 3]>> {
-    if azimuth_steps == 0 {
-        return Err(MmusvError::config("azimuth_steps", azimuth_steps, "need at least one azimuth step per sweep"));
+    if azimuth_steps == 0 || azimuth_steps > MAX_AZIMUTH_STEPS {
+        return Err(MmusvError::config("azimuth_steps", azimuth_steps, format!("must be in 1..={MAX_AZIMUTH_STEPS}")));
+    }
+    if elevations.len() > MAX_CHANNELS as usize {
+        return Err(MmusvError::config("channels", elevations.len(), format!("at most {MAX_CHANNELS} channels")));
+    }
+    if let Some(i) = elevations.iter().position(|e| !(e.is_finite() && e.abs() < std::f64::consts::FRAC_PI_2)) {
+        return Err(MmusvError::config(format!("elevations[{i}]"), elevations[i], "must be finite, strictly between -90 and 90 degrees"));
     }
     let mut out = Vec::with_capacity(elevations.len() * azimuth_steps as usize);
     for a in 0..azimuth_steps {
@@ -80,7 +91,13 @@ pub fn lidar_directions(elevations: &[f64], azimuth_steps: u32) -> Result<Vec<[f
 /// The order in which a sweep is best traced: blocks of `block` neighbouring columns, and within a block each
 /// channel's `block` rays consecutively, so consecutive rays are nearly parallel and form coherent packets.
 /// Entry `i` is the index, in [`lidar_directions`]'s azimuth-major order, of the `i`-th ray to trace.
-pub fn lidar_trace_order(channels: u32, azimuth_steps: u32, block: u32) -> Vec<u32> {
+pub fn lidar_trace_order(channels: u32, azimuth_steps: u32, block: u32) -> Result<Vec<u32>> {
+    if channels == 0 || channels > MAX_CHANNELS {
+        return Err(MmusvError::config("channels", channels, format!("must be in 1..={MAX_CHANNELS}")));
+    }
+    if azimuth_steps == 0 || azimuth_steps > MAX_AZIMUTH_STEPS {
+        return Err(MmusvError::config("azimuth_steps", azimuth_steps, format!("must be in 1..={MAX_AZIMUTH_STEPS}")));
+    }
     let block = block.max(1);
     let mut order = Vec::with_capacity(channels as usize * azimuth_steps as usize);
     let mut first = 0;
@@ -93,7 +110,7 @@ pub fn lidar_trace_order(channels: u32, azimuth_steps: u32, block: u32) -> Vec<u
         }
         first = last;
     }
-    order
+    Ok(order)
 }
 
 #[cfg(test)]
@@ -126,12 +143,14 @@ mod tests {
         let r = d[512 * 64 + 20];
         assert!(r[0].abs() < 1e-6 && r[1] > 0.0);
         assert!((r[2] as f64 - el[20].sin()).abs() < 1e-6);
-        let order = lidar_trace_order(64, 2048, 8);
+        let order = lidar_trace_order(64, 2048, 8).unwrap_or_default();
         let mut sorted = order.clone();
         sorted.sort_unstable();
         assert_eq!(sorted, (0..64 * 2048).collect::<Vec<u32>>(), "a permutation");
         assert_eq!(&order[..3], &[0, 64, 128]);
         assert!(uniform_elevations(0, 0.0, 0.1).is_err());
+        assert!(lidar_trace_order(u32::MAX, u32::MAX, 8).is_err());
+        assert!(lidar_directions(&[f64::NAN], 16).is_err());
         assert!(lidar_directions(&el, 0).is_err());
         assert!(pinhole_intrinsics(0, 10, 1.0).is_err());
     }
