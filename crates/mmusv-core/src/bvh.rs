@@ -235,13 +235,7 @@ impl Bvh4 {
                     let mut nh = 0;
                     for (lane, &t) in tn.iter().enumerate() {
                         if t < f32::INFINITY {
-                            let mut j = nh;
-                            while j > 0 && hits[j - 1].1 > t {
-                                hits[j] = hits[j - 1];
-                                j -= 1;
-                            }
-                            hits[j] = (node.child[lane], t);
-                            nh += 1;
+                            insert_nearest_first(&mut hits, &mut nh, (node.child[lane], t));
                         }
                     }
                     if nh > 0 {
@@ -291,13 +285,7 @@ impl Bvh4 {
                         }
                         let t = p.entry([b[0][lane], b[1][lane], b[2][lane]], [b[3][lane], b[4][lane], b[5][lane]]);
                         if t < f32::INFINITY {
-                            let mut j = nh;
-                            while j > 0 && hits[j - 1].1 > t {
-                                hits[j] = hits[j - 1];
-                                j -= 1;
-                            }
-                            hits[j] = (node.child[lane], t);
-                            nh += 1;
+                            insert_nearest_first(&mut hits, &mut nh, (node.child[lane], t));
                         }
                     }
                     if nh > 0 {
@@ -334,6 +322,18 @@ fn slab4(node: &Node4, ray: &RayInv, t_max: f32) -> [f32; 4] {
         out[l] = if t0 <= t1 { t0 } else { f32::INFINITY };
     }
     out
+}
+
+/// Inserts `entry` into the first `*len` slots of `hits`, kept sorted by entry distance (nearest first).
+#[inline(always)]
+fn insert_nearest_first(hits: &mut [(u32, f32); 4], len: &mut usize, entry: (u32, f32)) {
+    let mut j = *len;
+    while j > 0 && hits[j - 1].1 > entry.1 {
+        hits[j] = hits[j - 1];
+        j -= 1;
+    }
+    hits[j] = entry;
+    *len += 1;
 }
 
 /// `max` without NaN handling, so it compiles to a single `maxps` lane (no NaN reaches here: see [`RayInv`]).

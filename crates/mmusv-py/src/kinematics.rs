@@ -1,13 +1,13 @@
 //! Bindings for `mmusv_core::kinematics`: a fleet of vessels on spline routes with wave perturbations.
 
 use crate::errors::{to_py, InputError};
-use crate::native::{detached, flat, rows};
+use crate::native::{detached, flat, rows, rows_to_array};
 use mmusv_core::kinematics::{
     BaseAmplitudes, EndBehaviour, Fleet as CoreFleet, Route, VesselDims, VesselMotion, VesselParams, WaveSetting,
     WaveSignals,
 };
 use mmusv_core::MmusvError;
-use numpy::ndarray::{Array2, Array3};
+use numpy::ndarray::Array3;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
@@ -116,20 +116,12 @@ impl Fleet {
 
     /// `(V, 6)` float64 poses η = [x, y, z, roll, pitch, yaw] (world frame, metres, radians) at time `t` s.
     fn poses_at<'py>(&self, py: Python<'py>, t: f64) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let poses = self.inner.poses_at(t).map_err(to_py)?;
-        let n = poses.len();
-        Array2::from_shape_vec((n, 6), poses.into_iter().flatten().collect())
-            .map(|a| a.into_pyarray(py))
-            .map_err(|e| crate::errors::InternalError::new_err(e.to_string()))
+        rows_to_array(py, self.inner.poses_at(t).map_err(to_py)?)
     }
 
     /// `(V, 3)` float64 world-frame linear velocities (m/s) at time `t` s.
     fn velocities_at<'py>(&self, py: Python<'py>, t: f64) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let v = self.inner.velocities_at(t).map_err(to_py)?;
-        let n = v.len();
-        Array2::from_shape_vec((n, 3), v.into_iter().flatten().collect())
-            .map(|a| a.into_pyarray(py))
-            .map_err(|e| crate::errors::InternalError::new_err(e.to_string()))
+        rows_to_array(py, self.inner.velocities_at(t).map_err(to_py)?)
     }
 
     /// `(T, V, 6)` float64 poses at every time in `times` (s), computed in parallel with the GIL released.

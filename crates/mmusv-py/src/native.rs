@@ -1,7 +1,8 @@
 //! The one wrapper for every long native call, and array helpers.
 
 use crate::errors::{to_py, InputError, InternalError};
-use numpy::{PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
@@ -45,4 +46,12 @@ pub fn rows<'a, T: numpy::Element, const K: usize>(arr: &'a PyReadonlyArray2<'_,
 pub fn flat<'a, T: numpy::Element>(arr: &'a PyReadonlyArray1<'_, T>, name: &str) -> PyResult<&'a [T]> {
     arr.as_slice()
         .map_err(|_| InputError::new_err(format!("{name} must be C-contiguous (use numpy.ascontiguousarray)")))
+}
+
+/// Moves rows of `K` into a new owned `(N, K)` numpy array.
+pub fn rows_to_array<'py, T: numpy::Element, const K: usize>(py: Python<'py>, rows: Vec<[T; K]>) -> PyResult<Bound<'py, PyArray2<T>>> {
+    let n = rows.len();
+    Array2::from_shape_vec((n, K), rows.into_iter().flatten().collect())
+        .map(|a| a.into_pyarray(py))
+        .map_err(|e| InternalError::new_err(e.to_string()))
 }

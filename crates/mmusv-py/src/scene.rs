@@ -2,7 +2,7 @@
 //! instances, cast rays, export the world triangles.
 
 use crate::errors::InputError;
-use crate::native::{detached, flat, rows};
+use crate::native::{detached, flat, rows, rows_to_array};
 use mmusv_core::export::{write_world_mesh, MeshFormat};
 use mmusv_core::{Mesh, RigidPose, Scene as CoreScene};
 use numpy::ndarray::Array2;
@@ -153,13 +153,13 @@ impl Scene {
     /// `(vertices (V,3) f32, faces (F,3) u32, classes (F,) u16, instance_ids (F,) u32, triangle_ids (F,) u32)`.
     fn world_mesh<'py>(&self, py: Python<'py>) -> PyResult<WorldMeshArrays<'py>> {
         let w = self.read(|s| detached(py, || Ok(s.world_mesh())))?;
-        let nv = w.vertices.len();
-        let nf = w.faces.len();
-        let v = Array2::from_shape_vec((nv, 3), w.vertices.into_iter().flatten().collect())
-            .map_err(|e| crate::errors::InternalError::new_err(e.to_string()))?;
-        let f = Array2::from_shape_vec((nf, 3), w.faces.into_iter().flatten().collect())
-            .map_err(|e| crate::errors::InternalError::new_err(e.to_string()))?;
-        Ok((v.into_pyarray(py), f.into_pyarray(py), w.classes.into_pyarray(py), w.instances.into_pyarray(py), w.triangles.into_pyarray(py)))
+        Ok((
+            rows_to_array(py, w.vertices)?,
+            rows_to_array(py, w.faces)?,
+            w.classes.into_pyarray(py),
+            w.instances.into_pyarray(py),
+            w.triangles.into_pyarray(py),
+        ))
     }
 
     /// Writes the world triangles at the current poses to `path` (`.ply` or `.obj`).
@@ -175,9 +175,7 @@ impl Scene {
     /// World-space AABB of an instance at its current pose, `(2, 3)` float32: min row, max row.
     fn instance_aabb<'py>(&self, py: Python<'py>, instance_id: u32) -> PyResult<Bound<'py, PyArray2<f32>>> {
         let aabb = self.read(|s| s.instance_aabb(instance_id).map_err(crate::errors::to_py))?;
-        let arr = Array2::from_shape_vec((2, 3), [aabb.mins.to_array(), aabb.maxs.to_array()].concat())
-            .map_err(|e| crate::errors::InternalError::new_err(e.to_string()))?;
-        Ok(arr.into_pyarray(py))
+        rows_to_array(py, vec![aabb.mins.to_array(), aabb.maxs.to_array()])
     }
 
     /// The current pose of an instance as a 4x4 float64 matrix.
@@ -191,9 +189,7 @@ impl Scene {
             })?;
             Ok(inst.pose().to_matrix_row_major())
         })?;
-        let arr = Array2::from_shape_vec((4, 4), m.to_vec())
-            .map_err(|e| crate::errors::InternalError::new_err(e.to_string()))?;
-        Ok(arr.into_pyarray(py))
+        rows_to_array(py, m.as_chunks::<4>().0.to_vec())
     }
 
     /// Mesh id placed by each instance, `(K,)` uint32.

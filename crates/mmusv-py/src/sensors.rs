@@ -1,17 +1,9 @@
 //! Bindings for `mmusv_core::sensors`: the sensor ray patterns.
 
-use crate::native::detached;
+use crate::native::{detached, rows_to_array};
 use mmusv_core::sensors::rays;
-use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
-
-fn to_array<'py>(py: Python<'py>, v: Vec<[f32; 3]>) -> PyResult<Bound<'py, PyArray2<f32>>> {
-    let n = v.len();
-    Array2::from_shape_vec((n, 3), v.into_iter().flatten().collect())
-        .map(|a| a.into_pyarray(py))
-        .map_err(|e| crate::errors::InternalError::new_err(e.to_string()))
-}
 
 /// `[fx, fy, cx, cy]` (pixels) of a pinhole camera of `width × height` and horizontal FOV `hfov` (radians).
 #[pyfunction]
@@ -26,7 +18,7 @@ fn pinhole_intrinsics<'py>(py: Python<'py>, width: u32, height: u32, hfov: f64) 
 #[pyo3(signature = (*, width, height, hfov))]
 fn pinhole_directions<'py>(py: Python<'py>, width: u32, height: u32, hfov: f64) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let d = detached(py, || rays::pinhole_directions(width, height, hfov))?;
-    to_array(py, d)
+    rows_to_array(py, d)
 }
 
 /// `(azimuth_steps·len(elevations), 3)` float32 unit directions of one sweep, LiDAR frame, azimuth-major.
@@ -34,7 +26,7 @@ fn pinhole_directions<'py>(py: Python<'py>, width: u32, height: u32, hfov: f64) 
 #[pyo3(signature = (*, elevations, azimuth_steps))]
 fn lidar_directions<'py>(py: Python<'py>, elevations: Vec<f64>, azimuth_steps: u32) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let d = detached(py, || rays::lidar_directions(&elevations, azimuth_steps))?;
-    to_array(py, d)
+    rows_to_array(py, d)
 }
 
 /// Elevation angles (radians), lowest first, of `channels` beams spread uniformly over `[lower, upper]`.
