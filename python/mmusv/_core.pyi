@@ -152,6 +152,77 @@ def uniform_elevations(*, channels: int, lower: float, upper: float) -> npt.NDAr
 def lidar_trace_order(*, channels: int, azimuth_steps: int, block: int = 8) -> npt.NDArray[np.uint32]:
     """(channels·azimuth_steps,) uint32 packet-friendly trace order: indices into ``lidar_directions``' azimuth-major order."""
 
+@final
+class Lidar:
+    """A spinning multi-channel LiDAR with its ray pattern computed once."""
+
+    def __new__(
+        cls,
+        *,
+        elevations: Sequence[float],
+        azimuth_steps: int,
+        range_min: float,
+        range_max: float,
+        range_noise_std: float,
+        dropout: float,
+        water_probability: float,
+        water_probability_per_wave_m: float,
+        water_range_m: float,
+        water_range_per_wave_m: float,
+    ) -> Lidar: ...
+    @property
+    def num_rays(self) -> int:
+        """Rays per sweep (channels × azimuth steps)."""
+    def pattern(self) -> npt.NDArray[np.float32]:
+        """(channels·azimuth_steps, 3) float32 unit directions, LiDAR frame, azimuth-major."""
+    def scan(
+        self,
+        scene: Scene,
+        *,
+        pose: npt.NDArray[np.float64],
+        fog_extinction_per_m: float,
+        rain_mm_per_h: float,
+        wave_height_m: float,
+        seed: int,
+    ) -> dict[str, npt.NDArray[Any]]:
+        """One sweep: xyz (N,3) f32 LiDAR frame, range, intensity, ring, azimuth, class, instance, ray_index."""
+
+@final
+class Camera:
+    """A pinhole (``hfov``) or orthographic (``metres_per_pixel``) camera with its rays computed once."""
+
+    def __new__(
+        cls, *, width: int, height: int, hfov: float | None = None, metres_per_pixel: float | None = None, range_max: float = ...
+    ) -> Camera: ...
+    @property
+    def intrinsics(self) -> tuple[float, float, float, float] | None:
+        """[fx, fy, cx, cy] pixels (pinhole) or None (orthographic)."""
+    @property
+    def resolution(self) -> tuple[int, int]:
+        """(width, height) pixels."""
+    def world_rays(self, pose: npt.NDArray[np.float64]) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
+        """World ray origins and unit directions (H·W, 3) float32, row-major."""
+    def render(
+        self,
+        scene: Scene,
+        *,
+        pose: npt.NDArray[np.float64],
+        rgb: bool,
+        seed: int,
+        sun_direction: Sequence[float],
+        sun_color: Sequence[float],
+        sun_intensity: float,
+        ambient: float,
+        sky_zenith: Sequence[float],
+        sky_horizon: Sequence[float],
+        fog_extinction_per_m: float,
+        fog_color: Sequence[float],
+        rain_mm_per_h: float,
+        wave_height_m: float,
+        shadows: bool = True,
+    ) -> dict[str, npt.NDArray[Any]]:
+        """depth (H,W) f32, semantic (H,W) u16, instance (H,W) i32 and, if rgb, rgb (H,W,3) u8."""
+
 # --- demo ---
 
 def demo_scene(

@@ -29,6 +29,7 @@ import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from mmusv.errors import ConfigError
+from mmusv.sensors.config import RigConfig
 from mmusv.world.environment import Environment, wave_height_m
 from mmusv.world.vessels import asset_names
 
@@ -130,7 +131,7 @@ class Scenario(_Model):
     map: MapConfig = Field(default_factory=MapConfig)
     environment: EnvironmentConfig = Field(default_factory=EnvironmentConfig)
     acquisition: AcquisitionConfig = Field(default_factory=AcquisitionConfig)
-    rigs: dict[str, dict[str, Any]] = Field(default_factory=dict)
+    rigs: dict[str, RigConfig] = Field(default_factory=dict)
     vessels: list[VesselConfig] = Field(min_length=1)
 
     @model_validator(mode="after")

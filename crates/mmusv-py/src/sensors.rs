@@ -1,9 +1,13 @@
-//! Bindings for `mmusv_core::sensors`: the sensor ray patterns.
+//! Bindings for `mmusv_core::sensors`: ray patterns, the spinning LiDAR and the cameras.
 
-use crate::native::{detached, rows_to_array};
-use mmusv_core::sensors::rays;
-use numpy::{IntoPyArray, PyArray1, PyArray2};
+use crate::native::{detached, rows, rows_to_array};
+use mmusv_core::sensors::shade::ShadeEnv;
+use mmusv_core::sensors::{camera, lidar, rays};
+use mmusv_core::RigidPose;
+use numpy::ndarray::{Array2, Array3};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 
 /// `[fx, fy, cx, cy]` (pixels) of a pinhole camera of `width × height` and horizontal FOV `hfov` (radians).
 #[pyfunction]
@@ -24,7 +28,11 @@ fn pinhole_directions<'py>(py: Python<'py>, width: u32, height: u32, hfov: f64) 
 /// `(azimuth_steps·len(elevations), 3)` float32 unit directions of one sweep, LiDAR frame, azimuth-major.
 #[pyfunction]
 #[pyo3(signature = (*, elevations, azimuth_steps))]
-fn lidar_directions<'py>(py: Python<'py>, elevations: Vec<f64>, azimuth_steps: u32) -> PyResult<Bound<'py, PyArray2<f32>>> {
+fn lidar_directions<'py>(
+    py: Python<'py>,
+    elevations: Vec<f64>,
+    azimuth_steps: u32,
+) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let d = detached(py, || rays::lidar_directions(&elevations, azimuth_steps))?;
     rows_to_array(py, d)
 }
@@ -32,7 +40,12 @@ fn lidar_directions<'py>(py: Python<'py>, elevations: Vec<f64>, azimuth_steps: u
 /// Elevation angles (radians), lowest first, of `channels` beams spread uniformly over `[lower, upper]`.
 #[pyfunction]
 #[pyo3(signature = (*, channels, lower, upper))]
-fn uniform_elevations<'py>(py: Python<'py>, channels: u32, lower: f64, upper: f64) -> PyResult<Bound<'py, PyArray1<f64>>> {
+fn uniform_elevations<'py>(
+    py: Python<'py>,
+    channels: u32,
+    lower: f64,
+    upper: f64,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let e = rays::uniform_elevations(channels, lower, upper).map_err(crate::errors::to_py)?;
     Ok(e.into_pyarray(py))
 }
@@ -41,7 +54,12 @@ fn uniform_elevations<'py>(py: Python<'py>, channels: u32, lower: f64, upper: f6
 /// azimuth-major order of `lidar_directions`), blocks of `block` neighbouring columns.
 #[pyfunction]
 #[pyo3(signature = (*, channels, azimuth_steps, block=8))]
-fn lidar_trace_order<'py>(py: Python<'py>, channels: u32, azimuth_steps: u32, block: u32) -> PyResult<Bound<'py, PyArray1<u32>>> {
+fn lidar_trace_order<'py>(
+    py: Python<'py>,
+    channels: u32,
+    azimuth_steps: u32,
+    block: u32,
+) -> PyResult<Bound<'py, PyArray1<u32>>> {
     let order = detached(py, || rays::lidar_trace_order(channels, azimuth_steps, block))?;
     Ok(order.into_pyarray(py))
 }
@@ -52,5 +70,211 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(lidar_directions, m)?)?;
     m.add_function(wrap_pyfunction!(uniform_elevations, m)?)?;
     m.add_function(wrap_pyfunction!(lidar_trace_order, m)?)?;
+    m.add_class::<Lidar>()?;
+    m.add_class::<Camera>()?;
     Ok(())
+}
+
+fn pose_arg(pose: &PyReadonlyArray2<'_, f64>, field: &str) -> PyResult<RigidPose> {
+    let rows4 = rows::<f64, 4>(pose, field)?;
+    if rows4.len() != 4 {
+        return Err(crate::errors::InputError::new_err(format!("{field} must be a (4, 4) matrix")));
+    }
+    let mut m = [0.0; 16];
+    for (k, v) in rows4.iter().flatten().enumerate() {
+        m[k] = *v;
+    }
+    RigidPose::from_matrix_row_major(&m, field).map_err(crate::errors::to_py)
+}
+
+/// A spinning multi-channel LiDAR with its ray pattern computed once (see `mmusv_core::sensors::lidar`).
+#[pyclass(frozen, module = "mmusv._core")]
+pub struct Lidar {
+    inner: lidar::Lidar,
+}
+
+#[pymethods]
+impl Lidar {
+    #[new]
+    #[pyo3(signature = (*, elevations, azimuth_steps, range_min, range_max, range_noise_std, dropout,
+        water_probability, water_probability_per_wave_m, water_range_m, water_range_per_wave_m))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        elevations: Vec<f64>,
+        azimuth_steps: u32,
+        range_min: f32,
+        range_max: f32,
+        range_noise_std: f32,
+        dropout: f32,
+        water_probability: f32,
+        water_probability_per_wave_m: f32,
+        water_range_m: f32,
+        water_range_per_wave_m: f32,
+    ) -> PyResult<Self> {
+        let cfg = lidar::LidarConfig {
+            elevations,
+            azimuth_steps,
+            range_min,
+            range_max,
+            range_noise_std,
+            dropout,
+            water_probability,
+            water_probability_per_wave_m,
+            water_range_m,
+            water_range_per_wave_m,
+        };
+        Ok(Self { inner: lidar::Lidar::new(cfg).map_err(crate::errors::to_py)? })
+    }
+
+    /// Number of rays in one sweep (channels × azimuth steps).
+    #[getter]
+    fn num_rays(&self) -> usize {
+        self.inner.pattern().len()
+    }
+
+    /// `(channels·azimuth_steps, 3)` float32 unit directions of the pattern, LiDAR frame, azimuth-major.
+    fn pattern<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f32>>> {
+        rows_to_array(py, self.inner.pattern().to_vec())
+    }
+
+    /// One sweep on the current state of `scene` from the LiDAR at `pose` (4×4 LiDAR → world). Returns a dict
+    /// of equal-length columns: xyz (N,3) f32 LiDAR frame, range, intensity (f32), ring (u16), azimuth (f32
+    /// rad), class (u16), instance (i32), ray_index (u32).
+    #[pyo3(signature = (scene, *, pose, fog_extinction_per_m, rain_mm_per_h, wave_height_m, seed))]
+    #[allow(clippy::too_many_arguments)]
+    fn scan<'py>(
+        &self,
+        py: Python<'py>,
+        scene: &crate::scene::Scene,
+        pose: PyReadonlyArray2<'py, f64>,
+        fog_extinction_per_m: f32,
+        rain_mm_per_h: f32,
+        wave_height_m: f32,
+        seed: u64,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let pose = pose_arg(&pose, "pose")?;
+        let env = lidar::LidarEnv { fog_extinction_per_m, rain_mm_per_h, wave_height_m };
+        let s = scene.read(|s| detached(py, || self.inner.scan(s, &pose, &env, seed)))?;
+        let d = PyDict::new(py);
+        d.set_item("xyz", rows_to_array(py, s.xyz)?)?;
+        d.set_item("range", s.range.into_pyarray(py))?;
+        d.set_item("intensity", s.intensity.into_pyarray(py))?;
+        d.set_item("ring", s.ring.into_pyarray(py))?;
+        d.set_item("azimuth", s.azimuth.into_pyarray(py))?;
+        d.set_item("class", s.class.into_pyarray(py))?;
+        d.set_item("instance", s.instance.into_pyarray(py))?;
+        d.set_item("ray_index", s.ray_index.into_pyarray(py))?;
+        Ok(d)
+    }
+}
+
+/// A pinhole or orthographic camera with its rays computed once (see `mmusv_core::sensors::camera`).
+#[pyclass(frozen, module = "mmusv._core")]
+pub struct Camera {
+    inner: camera::Camera,
+}
+
+fn triple(v: Vec<f32>, field: &str) -> PyResult<[f32; 3]> {
+    v.try_into().map_err(|_| crate::errors::InputError::new_err(format!("{field} must have 3 components")))
+}
+
+#[pymethods]
+impl Camera {
+    #[new]
+    #[pyo3(signature = (*, width, height, hfov=None, metres_per_pixel=None, range_max=f32::INFINITY))]
+    fn new(
+        width: u32,
+        height: u32,
+        hfov: Option<f64>,
+        metres_per_pixel: Option<f64>,
+        range_max: f32,
+    ) -> PyResult<Self> {
+        let projection = match (hfov, metres_per_pixel) {
+            (Some(hfov), None) => camera::Projection::Pinhole { hfov },
+            (None, Some(m)) => camera::Projection::Orthographic { metres_per_pixel: m },
+            _ => {
+                return Err(crate::errors::ConfigError::new_err(
+                    "give exactly one of hfov (pinhole camera) or metres_per_pixel (orthographic camera)",
+                ))
+            }
+        };
+        let cfg = camera::CameraConfig { width, height, projection, range_max };
+        Ok(Self { inner: camera::Camera::new(cfg).map_err(crate::errors::to_py)? })
+    }
+
+    /// `[fx, fy, cx, cy]` in pixels for a pinhole camera, `None` for an orthographic one.
+    #[getter]
+    fn intrinsics(&self) -> Option<[f64; 4]> {
+        self.inner.intrinsics()
+    }
+
+    /// `(width, height)` in pixels.
+    #[getter]
+    fn resolution(&self) -> (u32, u32) {
+        (self.inner.config().width, self.inner.config().height)
+    }
+
+    /// World ray origins and unit directions `(H·W, 3)` float32 for the camera at `pose`, row-major.
+    fn world_rays<'py>(
+        &self,
+        py: Python<'py>,
+        pose: PyReadonlyArray2<'py, f64>,
+    ) -> PyResult<(Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>)> {
+        let pose = pose_arg(&pose, "pose")?;
+        let (o, d) = self.inner.world_rays(&pose);
+        Ok((rows_to_array(py, o)?, rows_to_array(py, d)?))
+    }
+
+    /// Renders the current state of `scene` from `pose` (4×4 camera body → world). Returns a dict: depth
+    /// (H,W) f32 metres along the axis (inf = sky), semantic (H,W) u16, instance (H,W) i32 (−1 = sky) and, if
+    /// `rgb`, rgb (H,W,3) u8 sRGB. Lighting keywords are the fields of `ShadeEnv` (linear colours, world-frame
+    /// sun direction).
+    #[pyo3(signature = (scene, *, pose, rgb, seed, sun_direction, sun_color, sun_intensity, ambient, sky_zenith,
+        sky_horizon, fog_extinction_per_m, fog_color, rain_mm_per_h, wave_height_m, shadows=true))]
+    #[allow(clippy::too_many_arguments)]
+    fn render<'py>(
+        &self,
+        py: Python<'py>,
+        scene: &crate::scene::Scene,
+        pose: PyReadonlyArray2<'py, f64>,
+        rgb: bool,
+        seed: u64,
+        sun_direction: Vec<f32>,
+        sun_color: Vec<f32>,
+        sun_intensity: f32,
+        ambient: f32,
+        sky_zenith: Vec<f32>,
+        sky_horizon: Vec<f32>,
+        fog_extinction_per_m: f32,
+        fog_color: Vec<f32>,
+        rain_mm_per_h: f32,
+        wave_height_m: f32,
+        shadows: bool,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let pose = pose_arg(&pose, "pose")?;
+        let env = ShadeEnv {
+            sun_direction: triple(sun_direction, "sun_direction")?,
+            sun_color: triple(sun_color, "sun_color")?,
+            sun_intensity,
+            ambient,
+            sky_zenith: triple(sky_zenith, "sky_zenith")?,
+            sky_horizon: triple(sky_horizon, "sky_horizon")?,
+            fog_extinction_per_m,
+            fog_color: triple(fog_color, "fog_color")?,
+            rain_mm_per_h,
+            wave_height_m,
+            shadows,
+        };
+        let f = scene.read(|s| detached(py, || self.inner.render(s, &pose, &env, rgb, seed)))?;
+        let (w, h) = (f.width as usize, f.height as usize);
+        let shape_err = |e: numpy::ndarray::ShapeError| crate::errors::InternalError::new_err(e.to_string());
+        let d = PyDict::new(py);
+        d.set_item("depth", Array2::from_shape_vec((h, w), f.depth).map_err(shape_err)?.into_pyarray(py))?;
+        d.set_item("semantic", Array2::from_shape_vec((h, w), f.semantic).map_err(shape_err)?.into_pyarray(py))?;
+        d.set_item("instance", Array2::from_shape_vec((h, w), f.instance).map_err(shape_err)?.into_pyarray(py))?;
+        if rgb {
+            d.set_item("rgb", Array3::from_shape_vec((h, w, 3), f.rgb).map_err(shape_err)?.into_pyarray(py))?;
+        }
+        Ok(d)
+    }
 }

@@ -1,3 +1,12 @@
-//! Sensors. [`rays`] generates the ray patterns (spinning LiDAR, pinhole camera) every sensor casts.
+//! Sensors, all sampling one frozen [`crate::Scene`] state:
+//! - [`rays`]: ray patterns (spinning LiDAR sweeps, pinhole cameras);
+//! - [`lidar`]: the spinning multi-channel LiDAR with noise, dropout, water returns and weather;
+//! - [`camera`]: pinhole and orthographic (top-view) cameras giving depth, semantic, instance and RGB;
+//! - [`shade`]: the RGB shading model (sun, sky, water, shadows, fog, rain);
+//! - [`noise`]: counter-based random draws, so results never depend on thread scheduling.
 
+pub mod camera;
+pub mod lidar;
+pub mod noise;
 pub mod rays;
+pub mod shade;

@@ -50,7 +50,12 @@ pub fn uniform_elevations(channels: u32, lower: f64, upper: f64) -> Result<Vec<f
     if channels == 0 {
         return Err(MmusvError::config("channels", channels, "a LiDAR needs at least one channel"));
     }
-    if !(lower.is_finite() && upper.is_finite() && lower <= upper && lower > -std::f64::consts::FRAC_PI_2 && upper < std::f64::consts::FRAC_PI_2) {
+    if !(lower.is_finite()
+        && upper.is_finite()
+        && lower <= upper
+        && lower > -std::f64::consts::FRAC_PI_2
+        && upper < std::f64::consts::FRAC_PI_2)
+    {
         return Err(MmusvError::config(
             "vertical_fov",
             format!("[{lower}, {upper}] rad"),
@@ -74,7 +79,11 @@ pub fn lidar_directions(elevations: &[f64], azimuth_steps: u32) -> Result<Vec<[f
         return Err(MmusvError::config("channels", elevations.len(), format!("at most {MAX_CHANNELS} channels")));
     }
     if let Some(i) = elevations.iter().position(|e| !(e.is_finite() && e.abs() < std::f64::consts::FRAC_PI_2)) {
-        return Err(MmusvError::config(format!("elevations[{i}]"), elevations[i], "must be finite, strictly between -90 and 90 degrees"));
+        return Err(MmusvError::config(
+            format!("elevations[{i}]"),
+            elevations[i],
+            "must be finite, strictly between -90 and 90 degrees",
+        ));
     }
     let mut out = Vec::with_capacity(elevations.len() * azimuth_steps as usize);
     for a in 0..azimuth_steps {

@@ -1,0 +1,325 @@
+//! Cameras: pinhole (surround views) and orthographic (the top-view camera for BEV renderings).
+//!
+//! Body frame of a camera: x forward (the optical axis), y left, z up. Image `u` grows to the right (−y),
+//! `v` downwards (−z); pixel `(u, v)` covers `[u, u+1) × [v, v+1)` and its ray goes through the pixel centre.
+//! * Pinhole: intrinsics `fx = fy = W / (2 tan(hfov/2))`, `c = (W/2, H/2)` ([`rays::pinhole_intrinsics`]); depth
+//!   is the distance along the optical axis (`t · d_x`).
+//! * Orthographic: parallel rays along +x from an image plane of `W · m × H · m` metres (`m` metres per pixel)
+//!   centred on the camera; depth is the distance along the axis. Mounted with pitch +90° it looks straight
+//!   down with the vessel's forward direction at the top of the image.
+//!
+//! One render casts every pixel's primary ray at once on the frozen scene and, for RGB, one shadow ray per lit
+//! surface pixel towards the sun. Outputs per pixel: depth (float32 metres, +inf for sky), semantic class
+//! (uint16, 0 for sky), instance id (int32, −1 for sky) and optionally sRGB (uint8 × 3).
+
+use super::rays;
+use super::shade::{self, ShadeEnv, SurfaceHit};
+use crate::error::{MmusvError, Result};
+use crate::geometry::RigidPose;
+use crate::scene::Scene;
+use parry3d::math::Vec3;
+use rayon::prelude::*;
+
+/// Largest image side, pixels.
+pub const MAX_SIDE: u32 = 16_384;
+
+/// How pixels map to rays.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Projection {
+    /// Pinhole with horizontal field of view (radians, in (0, π)).
+    Pinhole {
+        /// Horizontal field of view, radians.
+        hfov: f64,
+    },
+    /// Parallel rays, `metres_per_pixel` apart.
+    Orthographic {
+        /// Ground sampling distance, metres per pixel (> 0).
+        metres_per_pixel: f64,
+    },
+}
+
+/// Configuration of a camera.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CameraConfig {
+    /// Image width, pixels.
+    pub width: u32,
+    /// Image height, pixels.
+    pub height: u32,
+    /// Projection.
+    pub projection: Projection,
+    /// Farthest surface rendered (metres, > 0; may be infinite).
+    pub range_max: f32,
+}
+
+/// One rendered image set. Arrays are row-major, `width · height` long (`× 3` for RGB).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct CameraFrame {
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Depth along the optical axis, metres; `+inf` where nothing was hit.
+    pub depth: Vec<f32>,
+    /// Semantic class per pixel, 0 where nothing was hit.
+    pub semantic: Vec<u16>,
+    /// Scene instance id per pixel, −1 where nothing was hit.
+    pub instance: Vec<i32>,
+    /// sRGB, 3 bytes per pixel; empty unless RGB was requested.
+    pub rgb: Vec<u8>,
+}
+
+/// A camera with its ray pattern computed once.
+#[derive(Debug, Clone)]
+pub struct Camera {
+    cfg: CameraConfig,
+    /// Body-frame ray direction of each pixel (pinhole) or the common direction (orthographic).
+    dirs: Vec<[f32; 3]>,
+    /// Body-frame ray origin of each pixel (orthographic only).
+    origins: Vec<[f32; 3]>,
+}
+
+impl Camera {
+    /// Validates `cfg` and precomputes the rays. Errors name the field (`camera.resolution`, `camera.hfov_deg`,
+    /// `camera.metres_per_pixel`, `camera.range_m`).
+    pub fn new(cfg: CameraConfig) -> Result<Self> {
+        if cfg.width == 0 || cfg.height == 0 || cfg.width > MAX_SIDE || cfg.height > MAX_SIDE {
+            return Err(MmusvError::config(
+                "camera.resolution",
+                format!("[{}, {}]", cfg.width, cfg.height),
+                format!("width and height must be in 1..={MAX_SIDE}"),
+            ));
+        }
+        if !(cfg.range_max > 0.0) {
+            return Err(MmusvError::config("camera.range_m", cfg.range_max, "must be > 0 metres"));
+        }
+        let (w, h) = (cfg.width, cfg.height);
+        let (dirs, origins) = match cfg.projection {
+            Projection::Pinhole { hfov } => {
+                if !(hfov > 0.0 && hfov < std::f64::consts::PI) {
+                    return Err(MmusvError::config(
+                        "camera.hfov_deg",
+                        hfov.to_degrees(),
+                        "a pinhole camera needs a horizontal field of view strictly between 0 and 180 degrees; \
+                         use several cameras for a wider view",
+                    ));
+                }
+                (rays::pinhole_directions(w, h, hfov)?, Vec::new())
+            }
+            Projection::Orthographic { metres_per_pixel: m } => {
+                if !(m.is_finite() && m > 0.0) {
+                    return Err(MmusvError::config("camera.metres_per_pixel", m, "must be a finite distance > 0"));
+                }
+                let mut origins = Vec::with_capacity(w as usize * h as usize);
+                for v in 0..h {
+                    for u in 0..w {
+                        let y = (w as f64 / 2.0 - (u as f64 + 0.5)) * m;
+                        let z = (h as f64 / 2.0 - (v as f64 + 0.5)) * m;
+                        origins.push([0.0, y as f32, z as f32]);
+                    }
+                }
+                (vec![[1.0, 0.0, 0.0]], origins)
+            }
+        };
+        Ok(Self { cfg, dirs, origins })
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &CameraConfig {
+        &self.cfg
+    }
+
+    /// Pinhole intrinsics `[fx, fy, cx, cy]` (pixels); `None` for an orthographic camera.
+    pub fn intrinsics(&self) -> Option<[f64; 4]> {
+        match self.cfg.projection {
+            Projection::Pinhole { hfov } => rays::pinhole_intrinsics(self.cfg.width, self.cfg.height, hfov).ok(),
+            Projection::Orthographic { .. } => None,
+        }
+    }
+
+    /// World-frame ray origins and unit directions of every pixel, row-major.
+    pub fn world_rays(&self, pose: &RigidPose) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
+        let n = self.cfg.width as usize * self.cfg.height as usize;
+        if self.origins.is_empty() {
+            let o = pose.translation.to_array();
+            let d = self.dirs.iter().map(|d| pose.transform_vector(Vec3::from_array(*d)).to_array()).collect();
+            (vec![o; n], d)
+        } else {
+            let d = pose.transform_vector(Vec3::from_array(self.dirs[0])).to_array();
+            let o = self.origins.iter().map(|o| pose.transform_point(Vec3::from_array(*o)).to_array()).collect();
+            (o, vec![d; n])
+        }
+    }
+
+    /// Renders the frozen `scene` from `pose` (camera body → world). `rgb` asks for the shaded image (one more
+    /// ray per sunlit surface pixel); `seed` drives the water ripples and rain streaks.
+    pub fn render(&self, scene: &Scene, pose: &RigidPose, env: &ShadeEnv, rgb: bool, seed: u64) -> Result<CameraFrame> {
+        let (origins, dirs) = self.world_rays(pose);
+        let hits = scene.cast_rays(&origins, &dirs, self.cfg.range_max)?;
+        let n = origins.len();
+        let axis = pose.transform_vector(Vec3::X);
+        let mut frame = CameraFrame {
+            width: self.cfg.width,
+            height: self.cfg.height,
+            depth: vec![f32::INFINITY; n],
+            semantic: hits.class.clone(),
+            instance: hits.instance.clone(),
+            rgb: Vec::new(),
+        };
+        frame.depth.par_iter_mut().zip(hits.distance.par_iter()).zip(dirs.par_iter()).for_each(|((out, &t), d)| {
+            if t.is_finite() {
+                *out = t * Vec3::from_array(*d).dot(axis);
+            }
+        });
+        if !rgb {
+            return Ok(frame);
+        }
+        let surface = |i: usize| -> Option<SurfaceHit> {
+            let t = hits.distance[i];
+            if !t.is_finite() {
+                return None;
+            }
+            let d = Vec3::from_array(dirs[i]);
+            let mut normal = Vec3::new(hits.normal[3 * i], hits.normal[3 * i + 1], hits.normal[3 * i + 2]);
+            if normal.dot(d) > 0.0 {
+                normal = -normal;
+            }
+            let point = Vec3::from_array(origins[i]) + d * t;
+            Some(SurfaceHit { t, point, normal, class: hits.class[i], instance: hits.instance[i] })
+        };
+        // Shadow rays from every surface point facing the sun.
+        let sun = Vec3::from_array(env.sun_direction).normalize_or_zero();
+        let mut lit = vec![false; n];
+        if env.sun_intensity > 0.0 && sun.z > 0.0 {
+            let facing: Vec<(usize, [f32; 3])> = (0..n)
+                .into_par_iter()
+                .filter_map(|i| {
+                    surface(i).filter(|h| h.normal.dot(sun) > 0.0 || h.class == 1).map(|h| {
+                        let eps = 0.02 + 1e-4 * h.t;
+                        (i, (h.point + h.normal * eps).to_array())
+                    })
+                })
+                .collect();
+            if env.shadows {
+                let so: Vec<[f32; 3]> = facing.iter().map(|(_, o)| *o).collect();
+                let sd = vec![sun.to_array(); so.len()];
+                let blocked = scene.cast_rays(&so, &sd, 5_000.0)?;
+                for (k, (i, _)) in facing.iter().enumerate() {
+                    lit[*i] = !blocked.distance[k].is_finite();
+                }
+            } else {
+                for (i, _) in &facing {
+                    lit[*i] = true;
+                }
+            }
+        }
+        let w = self.cfg.width;
+        let mut out = vec![0u8; 3 * n];
+        out.par_chunks_mut(3).enumerate().for_each(|(i, px)| {
+            let d = Vec3::from_array(dirs[i]);
+            let h = surface(i);
+            let c = shade::shade(env, d, h.as_ref(), lit[i], seed);
+            let c = shade::rain(env, c, i as u32 % w, i as u32 / w, seed);
+            px.copy_from_slice(&shade::to_srgb8(c));
+        });
+        frame.rgb = out;
+        Ok(frame)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::Mesh;
+
+    fn ground_with_box() -> Scene {
+        let mut s = Scene::new();
+        let g = [[-500.0, -500.0, 0.0], [500.0, -500.0, 0.0], [500.0, 500.0, 0.0], [-500.0, 500.0, 0.0]];
+        let gf = [[0i64, 1, 2], [0, 2, 3]];
+        if let Ok(m) = Mesh::new("ground", &g, &gf, &[1, 1]) {
+            let id = s.add_mesh(m);
+            let _ = s.add_instance(id, RigidPose::IDENTITY, None);
+        }
+        // A 4 m cube centred at (20, 0, 2).
+        let mut v = Vec::new();
+        for i in 0..8 {
+            v.push([18.0 + 4.0 * (i & 1) as f32, -2.0 + 4.0 * ((i >> 1) & 1) as f32, 4.0 * ((i >> 2) & 1) as f32]);
+        }
+        let f: Vec<[i64; 3]> = vec![
+            [0, 2, 1],
+            [1, 2, 3],
+            [4, 5, 6],
+            [5, 7, 6],
+            [0, 1, 4],
+            [1, 5, 4],
+            [2, 6, 3],
+            [3, 6, 7],
+            [0, 4, 2],
+            [2, 4, 6],
+            [1, 3, 5],
+            [3, 7, 5],
+        ];
+        if let Ok(m) = Mesh::new("cube", &v, &f, &[10; 12]) {
+            let id = s.add_mesh(m);
+            let _ = s.add_instance(id, RigidPose::IDENTITY, None);
+        }
+        s
+    }
+
+    #[test]
+    fn pinhole_depth_is_along_the_axis() {
+        let cam = Camera::new(CameraConfig {
+            width: 64,
+            height: 48,
+            projection: Projection::Pinhole { hfov: 1.5 },
+            range_max: 1e4,
+        });
+        let Ok(cam) = cam else { return };
+        let pose = RigidPose::from_xyz_rpy([0.0, 0.0, 2.0], [0.0, 0.0, 0.0]);
+        let f = cam.render(&ground_with_box(), &pose, &ShadeEnv::default(), true, 1).unwrap_or_default();
+        assert_eq!(f.rgb.len(), 64 * 48 * 3);
+        // Centre pixel looks at the cube's face at x = 18: depth 18 m along the axis.
+        let c = 24 * 64 + 32;
+        assert!((f.depth[c] - 18.0).abs() < 1e-3, "depth {}", f.depth[c]);
+        assert_eq!(f.semantic[c], 10);
+        assert_eq!(f.instance[c], 1);
+        // Top row sees the sky.
+        assert_eq!(f.instance[0], -1);
+        assert!(f.depth[0].is_infinite());
+    }
+
+    #[test]
+    fn orthographic_top_view_sees_the_cube_at_its_place() {
+        let m = 0.5;
+        let cam = Camera::new(CameraConfig {
+            width: 200,
+            height: 200,
+            projection: Projection::Orthographic { metres_per_pixel: m },
+            range_max: 1e4,
+        });
+        let Ok(cam) = cam else { return };
+        // 100 m up, looking down (pitch +90°), forward = +x at the top of the image.
+        let pose = RigidPose::from_xyz_rpy([0.0, 0.0, 100.0], [0.0, std::f64::consts::FRAC_PI_2, 0.0]);
+        let f = cam.render(&ground_with_box(), &pose, &ShadeEnv::default(), false, 1).unwrap_or_default();
+        // World (20, 0) is 20 m ahead: row 100 - 40 = 60 (centre 59.5..60.5), column 100 (y = 0).
+        let px = |u: usize, v: usize| v * 200 + u;
+        assert_eq!(f.instance[px(100, 60)], 1);
+        assert!((f.depth[px(100, 60)] - 96.0).abs() < 1e-3);
+        // 4 m wide: 8 pixels; just outside is ground.
+        assert_eq!(f.instance[px(100, 55)], 0);
+        assert_eq!(f.instance[px(100, 65)], 0);
+        assert_eq!(f.instance[px(105, 60)], 0);
+        assert!(f.rgb.is_empty());
+    }
+
+    #[test]
+    fn bad_configs_name_the_field() {
+        let bad = |c: CameraConfig| Camera::new(c).err().map(|e| e.to_string()).unwrap_or_default();
+        let ok = CameraConfig { width: 8, height: 8, projection: Projection::Pinhole { hfov: 1.0 }, range_max: 10.0 };
+        assert!(bad(CameraConfig { projection: Projection::Pinhole { hfov: std::f64::consts::PI }, ..ok })
+            .contains("camera.hfov_deg"));
+        assert!(bad(CameraConfig { width: 0, ..ok }).contains("camera.resolution"));
+        assert!(bad(CameraConfig { range_max: -1.0, ..ok }).contains("camera.range_m"));
+        assert!(bad(CameraConfig { projection: Projection::Orthographic { metres_per_pixel: 0.0 }, ..ok })
+            .contains("metres_per_pixel"));
+    }
+}

@@ -1,0 +1,235 @@
+"""Per-agent annotations derived from the world state and the agent's own captures.
+
+For every agent (USV) and frame, for every other vessel (the agent's own hull is never a target):
+* a 3D box in the agent's LiDAR frame (centre, size = length/beam/height, rotation quaternion xyzw, yaw) with the
+  number of LiDAR points on the vessel (exact: points carry instance ids) and its range;
+* an ego-centric BEV box: the 3D box's footprint in the LiDAR frame's xy plane (x, y, length, width, yaw);
+* per pinhole camera, a 2D box: the projected 3D-box corners (edges clipped at the near plane), clipped to the
+  image, with ``truncation`` = 1 − clipped area / unclipped area, ``visible_pixels`` (pixels whose instance is
+  the vessel), ``box_pixels`` (the clipped box area) and ``occlusion`` = 1 − visible / silhouette, where the
+  silhouette is the vessel's pixels with everything else removed (its rays cast against the vessel alone).
+
+Frames: LiDAR frame x forward, y left, z up; image u right, v down, pixel centres at +0.5.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from mmusv.scene import Scene
+from mmusv.sensors.camera import BODY_TO_OPTICAL
+from mmusv.world.vessels import get_asset
+
+__all__ = ["Annotations", "annotate_agent", "box_corners", "SilhouetteCache"]
+
+# Corner order of a box: bit 0 → +x, bit 1 → +y, bit 2 → +z.
+_SIGNS = np.array([[(i & 1) * 2 - 1, ((i >> 1) & 1) * 2 - 1, ((i >> 2) & 1) * 2 - 1] for i in range(8)], dtype=np.float64)
+_EDGES = [(a, b) for a in range(8) for b in range(a + 1, 8) if bin(a ^ b).count("1") == 1]
+NEAR_M = 0.05
+
+
+def box_corners(matrix: np.ndarray, size: np.ndarray) -> np.ndarray:
+    """``(8, 3)`` corners of a box with pose ``matrix`` (``(4, 4)`` box → frame, centred) and full ``size``."""
+    local = _SIGNS * (np.asarray(size, dtype=np.float64) / 2.0)
+    out: np.ndarray = local @ matrix[:3, :3].T + matrix[:3, 3]
+    return out
+
+
+def _translate(v: np.ndarray) -> np.ndarray:
+    m = np.eye(4)
+    m[:3, 3] = v
+    return m
+
+
+@dataclass
+class Annotations:
+    """Columns of one agent's annotations at one frame (see the module docstring). Lengths: ``n3d`` for
+    ``lidar_*``/``bev_*``, ``n2d`` for ``cam_*``."""
+
+    agent: str
+    frame: int
+    time_s: float
+    lidar_ids: list[str] = field(default_factory=list)
+    lidar_instance: list[int] = field(default_factory=list)
+    lidar_class: list[int] = field(default_factory=list)
+    lidar_center: list[np.ndarray] = field(default_factory=list)
+    lidar_size: list[np.ndarray] = field(default_factory=list)
+    lidar_rotation: list[np.ndarray] = field(default_factory=list)
+    lidar_yaw: list[float] = field(default_factory=list)
+    lidar_points: list[int] = field(default_factory=list)
+    lidar_range: list[float] = field(default_factory=list)
+    cam_ids: list[str] = field(default_factory=list)
+    cam_camera: list[str] = field(default_factory=list)
+    cam_box: list[np.ndarray] = field(default_factory=list)
+    cam_truncation: list[float] = field(default_factory=list)
+    cam_visible: list[int] = field(default_factory=list)
+    cam_box_pixels: list[int] = field(default_factory=list)
+    cam_occlusion: list[float] = field(default_factory=list)
+
+    def columns(self) -> dict[str, Any]:
+        """Numpy columns: ``lidar`` and ``bev`` and ``camera`` dicts of arrays (shapes in the docstrings above)."""
+        n = len(self.lidar_ids)
+        centre = np.array(self.lidar_center, dtype=np.float64).reshape(n, 3)
+        size = np.array(self.lidar_size, dtype=np.float64).reshape(n, 3)
+        lidar = {
+            "target_id": list(self.lidar_ids),
+            "instance_id": np.array(self.lidar_instance, dtype=np.uint32),
+            "semantic_class": np.array(self.lidar_class, dtype=np.uint32),
+            "center": centre,
+            "size": size,
+            "rotation": np.array(self.lidar_rotation, dtype=np.float64).reshape(n, 4),
+            "yaw": np.array(self.lidar_yaw, dtype=np.float64),
+            "lidar_points": np.array(self.lidar_points, dtype=np.uint32),
+            "range_m": np.array(self.lidar_range, dtype=np.float64),
+        }
+        bev = {
+            "target_id": list(self.lidar_ids),
+            "x": centre[:, 0].copy(),
+            "y": centre[:, 1].copy(),
+            "length": size[:, 0].copy(),
+            "width": size[:, 1].copy(),
+            "yaw": np.array(self.lidar_yaw, dtype=np.float64),
+        }
+        m = len(self.cam_ids)
+        box = np.array(self.cam_box, dtype=np.float64).reshape(m, 4)
+        camera = {
+            "target_id": list(self.cam_ids),
+            "camera": list(self.cam_camera),
+            "x_min": box[:, 0].copy(),
+            "y_min": box[:, 1].copy(),
+            "x_max": box[:, 2].copy(),
+            "y_max": box[:, 3].copy(),
+            "truncation": np.array(self.cam_truncation, dtype=np.float64),
+            "visible_pixels": np.array(self.cam_visible, dtype=np.uint32),
+            "box_pixels": np.array(self.cam_box_pixels, dtype=np.uint32),
+            "occlusion": np.array(self.cam_occlusion, dtype=np.float64),
+        }
+        return {"lidar": lidar, "bev": bev, "camera": camera}
+
+
+class SilhouetteCache:
+    """One single-instance scene per vessel asset, to render a vessel with nothing else in the way."""
+
+    def __init__(self) -> None:
+        self._scenes: dict[str, tuple[Scene, int]] = {}
+
+    def hits(self, asset: str, pose: np.ndarray, origins: np.ndarray, directions: np.ndarray) -> np.ndarray:
+        """``(N,)`` bool: which rays hit the vessel ``asset`` at ``pose`` (body → world), alone in the world."""
+        if asset not in self._scenes:
+            a = get_asset(asset)
+            s = Scene()
+            mid = s.add_mesh(a.mesh.vertices, a.mesh.faces, classes=a.mesh.classes, name=asset)
+            self._scenes[asset] = (s, s.add_instance(mid))
+        scene, inst = self._scenes[asset]
+        scene.set_poses([inst], pose[None])
+        if origins.shape[0] == 0:
+            return np.zeros(0, dtype=bool)
+        return scene.cast_rays(origins, directions).hit
+
+
+def _project_box(corners_opt: np.ndarray, k: tuple[float, float, float, float]) -> np.ndarray | None:
+    """Pixel bounding box ``[x0, y0, x1, y1]`` of a box given by its corners in the optical frame, with edges
+    clipped at the near plane; ``None`` when the box is entirely behind the camera."""
+    fx, fy, cx, cy = k
+    pts = [c for c in corners_opt if c[2] >= NEAR_M]
+    for a, b in _EDGES:
+        za, zb = corners_opt[a, 2], corners_opt[b, 2]
+        if (za - NEAR_M) * (zb - NEAR_M) < 0:
+            t = (NEAR_M - za) / (zb - za)
+            pts.append(corners_opt[a] + t * (corners_opt[b] - corners_opt[a]))
+    if not pts:
+        return None
+    p = np.array(pts)
+    u = fx * p[:, 0] / p[:, 2] + cx
+    v = fy * p[:, 1] / p[:, 2] + cy
+    return np.array([u.min(), v.min(), u.max(), v.max()])
+
+
+def annotate_agent(
+    *,
+    agent_id: str,
+    agent_index: int,
+    frame: int,
+    time_s: float,
+    vessels: list[Any],
+    state: Any,
+    lidar_pose: np.ndarray | None,
+    lidar_instances: np.ndarray | None,
+    cameras: dict[str, tuple[Any, np.ndarray, np.ndarray]],
+    silhouettes: SilhouetteCache,
+    max_range_m: float,
+) -> Annotations:
+    """Annotations of one agent (see the module docstring).
+
+    Args:
+        vessels: ``VesselInfo`` of every vessel of the world state (same order as ``state``).
+        state: the ``WorldState`` of the frame.
+        lidar_pose: ``(4, 4)`` LiDAR → world (boxes are expressed in this frame; the vessel body if ``None``).
+        lidar_instances: ``(N,)`` instance id of each LiDAR point (for the point counts).
+        cameras: name -> (native camera, ``(4, 4)`` camera body → world, ``(H, W)`` instance image).
+        max_range_m: vessels farther than this from the LiDAR get no 3D/BEV box.
+    """
+    ann = Annotations(agent=agent_id, frame=frame, time_s=time_s)
+    ref = lidar_pose if lidar_pose is not None else state.matrices[agent_index]
+    ref_inv = np.linalg.inv(ref)
+    counts: dict[int, int] = {}
+    if lidar_instances is not None and lidar_instances.size:
+        ids, cnt = np.unique(lidar_instances, return_counts=True)
+        counts = {int(i): int(c) for i, c in zip(ids, cnt, strict=True)}
+    rays: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+    for vi, info in enumerate(vessels):
+        if vi == agent_index:
+            continue
+        box_world = state.matrices[vi] @ _translate(info.box_center_body)
+        box_ref = ref_inv @ box_world
+        rng = float(np.linalg.norm(box_ref[:3, 3]))
+        if rng <= max_range_m:
+            ann.lidar_ids.append(info.id)
+            ann.lidar_instance.append(info.instance_id)
+            ann.lidar_class.append(info.semantic_class)
+            ann.lidar_center.append(box_ref[:3, 3].copy())
+            ann.lidar_size.append(np.asarray(info.box_size, dtype=np.float64))
+            ann.lidar_rotation.append(Rotation.from_matrix(box_ref[:3, :3]).as_quat())
+            ann.lidar_yaw.append(float(np.arctan2(box_ref[1, 0], box_ref[0, 0])))
+            ann.lidar_points.append(counts.get(info.instance_id, 0))
+            ann.lidar_range.append(rng)
+        corners_world = box_corners(box_world, info.box_size)
+        for name, (cam, pose, inst_img) in cameras.items():
+            k = cam.intrinsics
+            if k is None:
+                continue
+            h, w = inst_img.shape
+            inv = np.linalg.inv(pose)
+            body = corners_world @ inv[:3, :3].T + inv[:3, 3]
+            box = _project_box(body @ BODY_TO_OPTICAL.T, k)
+            if box is None:
+                continue
+            area = max(box[2] - box[0], 0.0) * max(box[3] - box[1], 0.0)
+            clipped = np.array([max(box[0], 0.0), max(box[1], 0.0), min(box[2], float(w)), min(box[3], float(h))])
+            if clipped[2] <= clipped[0] or clipped[3] <= clipped[1] or area <= 0:
+                continue
+            carea = (clipped[2] - clipped[0]) * (clipped[3] - clipped[1])
+            u0, v0 = int(np.floor(clipped[0])), int(np.floor(clipped[1]))
+            u1, v1 = int(np.ceil(clipped[2])), int(np.ceil(clipped[3]))
+            window = inst_img[v0:v1, u0:u1]
+            visible = int(np.count_nonzero(window == info.instance_id))
+            vv, uu = np.mgrid[v0:v1, u0:u1]
+            pix = (vv * w + uu).reshape(-1)
+            if name not in rays:
+                rays[name] = cam.world_rays(np.ascontiguousarray(pose))
+            o, d = rays[name]
+            sil = int(np.count_nonzero(silhouettes.hits(info.asset, state.matrices[vi], o[pix], d[pix])))
+            if sil == 0 and visible == 0:
+                continue
+            ann.cam_ids.append(info.id)
+            ann.cam_camera.append(name)
+            ann.cam_box.append(clipped)
+            ann.cam_truncation.append(float(1.0 - carea / area))
+            ann.cam_visible.append(visible)
+            ann.cam_box_pixels.append(int((u1 - u0) * (v1 - v0)))
+            ann.cam_occlusion.append(float(1.0 - visible / sil) if sil else 0.0)
+    return ann

@@ -1,0 +1,203 @@
+"""Sensor rig configuration: what every instrumented USV carries, validated into frozen pydantic models.
+
+A rig (``rigs:`` in a scenario) has a LiDAR, a radar, any number of pinhole cameras and a top-view camera;
+every part has defaults (the paper's suite: a 64-channel LiDAR at 131,072 points/s and 5 Hz, a marine radar,
+four 640×480 surround cameras with a 90° field of view, a top-view camera 120 m up), so ``usv_standard: {}``
+is a complete rig. ``null`` switches a sensor off (``radar: null``); ``cameras: []`` removes the cameras.
+
+Mounts: ``point`` names a mount point of the vessel asset (``lidar``, ``radar``, ``camera_front``, ...; see
+``mmusv assets``); ``xyz`` (metres) and ``rpy_deg`` (degrees) are then relative to that point, in the vessel
+body frame (x forward, y left, z up). Without ``point``, they are relative to the vessel origin (midship, at
+the waterline). Assets without the named point fall back to the top of the hull's bounding box.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+
+__all__ = [
+    "Mount",
+    "LidarConfig",
+    "RadarConfig",
+    "CameraConfig",
+    "TopViewConfig",
+    "RigConfig",
+    "default_cameras",
+]
+
+CameraOutput = Literal["rgb", "depth", "semantic", "instance"]
+_ALL_OUTPUTS: tuple[CameraOutput, ...] = ("rgb", "depth", "semantic", "instance")
+_TOP_OUTPUTS: tuple[CameraOutput, ...] = ("rgb", "semantic", "instance")
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True, str_strip_whitespace=True)
+
+
+class Mount(_Model):
+    """Where a sensor sits on its vessel (see the module docstring)."""
+
+    point: str | None = None
+    xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rpy_deg: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    @field_validator("xyz", "rpy_deg")
+    @classmethod
+    def _finite(cls, v: tuple[float, float, float]) -> tuple[float, float, float]:
+        if not all(math.isfinite(x) for x in v):
+            raise ValueError("must be three finite numbers")
+        return v
+
+
+class LidarConfig(_Model):
+    """Spinning LiDAR. Columns per sweep = ``points_per_second / (rotation_hz · channels)`` (rounded).
+
+    ``elevations_deg`` (one per channel, any order) replaces the uniform ``vertical_fov_deg`` pattern.
+    Water returns: probability ``water_probability + water_probability_per_wave_m · H`` within
+    ``water_range_m + water_range_per_wave_m · H`` metres (H the wave height).
+    """
+
+    channels: int = Field(default=64, ge=1, le=1024)
+    vertical_fov_deg: tuple[float, float] = (-25.0, 15.0)
+    elevations_deg: list[float] | None = None
+    points_per_second: float = Field(default=131_072.0, gt=0)
+    rotation_hz: float = Field(default=5.0, gt=0)
+    range_m: float = Field(default=200.0, gt=0)
+    range_min_m: float = Field(default=0.5, ge=0)
+    range_noise_std_m: float = Field(default=0.02, ge=0)
+    dropout: float = Field(default=0.0, ge=0, le=1)
+    water_probability: float = Field(default=0.05, ge=0, le=1)
+    water_probability_per_wave_m: float = Field(default=0.1, ge=0)
+    water_range_m: float = Field(default=20.0, ge=0)
+    water_range_per_wave_m: float = Field(default=10.0, ge=0)
+    mount: Mount = Mount(point="lidar")
+
+    @field_validator("vertical_fov_deg")
+    @classmethod
+    def _fov(cls, v: tuple[float, float]) -> tuple[float, float]:
+        lo, hi = v
+        if not (-90 < lo <= hi < 90):
+            raise ValueError("need -90 < lower <= upper < 90 degrees")
+        return v
+
+    @model_validator(mode="after")
+    def _check(self) -> LidarConfig:
+        if self.elevations_deg is not None:
+            if len(self.elevations_deg) != self.channels:
+                raise ValueError(f"elevations_deg has {len(self.elevations_deg)} entries for {self.channels} channels")
+            if not all(-90 < e < 90 for e in self.elevations_deg):
+                raise ValueError("every elevation must be strictly between -90 and 90 degrees")
+        if self.range_min_m >= self.range_m:
+            raise ValueError(f"range_min_m ({self.range_min_m}) must be below range_m ({self.range_m})")
+        if not 1 <= self.azimuth_steps <= 65536:
+            raise ValueError(
+                f"points_per_second / (rotation_hz * channels) = {self.azimuth_steps} columns per sweep; must be 1..65536"
+            )
+        return self
+
+    @property
+    def azimuth_steps(self) -> int:
+        """Columns per sweep."""
+        return max(1, round(self.points_per_second / (self.rotation_hz * self.channels)))
+
+    def elevations_rad(self) -> list[float]:
+        """Elevation of each ring, radians (ring ``i`` = entry ``i``)."""
+        if self.elevations_deg is not None:
+            return [math.radians(e) for e in self.elevations_deg]
+        lo, hi = self.vertical_fov_deg
+        if self.channels == 1:
+            return [math.radians((lo + hi) / 2)]
+        step = (hi - lo) / (self.channels - 1)
+        return [math.radians(lo + i * step) for i in range(self.channels)]
+
+
+class RadarConfig(_Model):
+    """Rotating marine radar (ray cast) and its PPI image at a fixed metres-per-pixel scale."""
+
+    range_m: float = Field(default=3000.0, gt=0)
+    range_min_m: float = Field(default=5.0, ge=0)
+    range_resolution_m: float = Field(default=3.0, gt=0)
+    azimuth_bins: int = Field(default=2048, ge=1, le=65536)
+    beamwidth_deg: float = Field(default=1.2, gt=0, lt=90)
+    elevation_fan_deg: tuple[float, float] = (-10.0, 10.0)
+    rays_az: int = Field(default=3, ge=1, le=64)
+    rays_el: int = Field(default=16, ge=1, le=256)
+    ppi_size_px: int = Field(default=512, ge=16, le=8192)
+    ppi_metres_per_pixel: float = Field(default=10.0, gt=0)
+    ppi_orientation: Literal["north_up", "head_up"] = "north_up"
+    mount: Mount = Mount(point="radar")
+
+    @model_validator(mode="after")
+    def _check(self) -> RadarConfig:
+        lo, hi = self.elevation_fan_deg
+        if not (-90 < lo <= hi < 90):
+            raise ValueError("elevation_fan_deg needs -90 < lower <= upper < 90 degrees")
+        if self.range_min_m >= self.range_m:
+            raise ValueError(f"range_min_m ({self.range_min_m}) must be below range_m ({self.range_m})")
+        return self
+
+
+class CameraConfig(_Model):
+    """A pinhole camera: ``resolution`` ``[width, height]`` pixels, horizontal field of view ``hfov_deg`` (< 180),
+    the images to produce, and its mount (optical axis = the mount's x axis)."""
+
+    name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$")
+    resolution: tuple[int, int] = (640, 480)
+    hfov_deg: float = Field(default=90.0, gt=0, lt=180)
+    outputs: list[CameraOutput] = Field(default_factory=lambda: list(_ALL_OUTPUTS))
+    range_m: float = Field(default=5000.0, gt=0)
+    mount: Mount = Mount()
+
+    @field_validator("resolution")
+    @classmethod
+    def _res(cls, v: tuple[int, int]) -> tuple[int, int]:
+        if not (1 <= v[0] <= 16384 and 1 <= v[1] <= 16384):
+            raise ValueError("width and height must be in 1..16384 pixels")
+        return v
+
+
+class TopViewConfig(_Model):
+    """A level orthographic camera ``altitude_m`` above the water over the USV, looking straight down:
+    ``resolution`` pixels at ``metres_per_pixel``; ``heading_up`` puts the USV's bow at the top of the image,
+    ``north_up`` puts north there."""
+
+    altitude_m: float = Field(default=120.0, gt=0)
+    resolution: tuple[int, int] = (512, 512)
+    metres_per_pixel: float = Field(default=0.5, gt=0)
+    orientation: Literal["heading_up", "north_up"] = "heading_up"
+    outputs: list[CameraOutput] = Field(default_factory=lambda: list(_TOP_OUTPUTS))
+
+    @field_validator("resolution")
+    @classmethod
+    def _res(cls, v: tuple[int, int]) -> tuple[int, int]:
+        if not (1 <= v[0] <= 16384 and 1 <= v[1] <= 16384):
+            raise ValueError("width and height must be in 1..16384 pixels")
+        return v
+
+
+def default_cameras(resolution: tuple[int, int] = (640, 480)) -> list[CameraConfig]:
+    """The surround rig: front, left, rear, right, 90° each, on the asset's ``camera_*`` mount points."""
+    return [
+        CameraConfig(name=n, resolution=resolution, mount=Mount(point=f"camera_{n}"))
+        for n in ("front", "left", "rear", "right")
+    ]
+
+
+class RigConfig(_Model):
+    """The sensors of one instrumented USV; every part defaults to the paper's suite."""
+
+    lidar: LidarConfig | None = Field(default_factory=LidarConfig)
+    radar: RadarConfig | None = Field(default_factory=RadarConfig)
+    cameras: list[CameraConfig] = Field(default_factory=default_cameras)
+    top_view: TopViewConfig | None = Field(default_factory=TopViewConfig)
+
+    @model_validator(mode="after")
+    def _unique(self) -> RigConfig:
+        names = [c.name for c in self.cameras]
+        dup = sorted({n for n in names if names.count(n) > 1})
+        if dup:
+            raise ValueError(f"camera names must be unique; repeated: {', '.join(dup)}")
+        return self

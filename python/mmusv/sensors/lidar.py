@@ -1,0 +1,91 @@
+"""The spinning LiDAR from Python: build it from a :class:`~mmusv.sensors.config.LidarConfig`, scan a scene.
+
+Points are in the LiDAR frame (x forward, y left, z up, metres), in pattern order (azimuth column, then ring),
+rays without a return left out. See ``mmusv_core::sensors::lidar`` for the return, noise, water and weather
+model.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from mmusv._native import core
+from mmusv.scene import Scene
+from mmusv.sensors.config import LidarConfig
+
+__all__ = ["LidarPoints", "lidar_from_config", "scan"]
+
+
+@dataclass(frozen=True)
+class LidarPoints:
+    """One sweep. All arrays have length N (points).
+
+    Attributes:
+        xyz: ``(N, 3)`` float32, metres, LiDAR frame.
+        range: ``(N,)`` float32, measured range in metres (noise included).
+        intensity: ``(N,)`` float32 in [0, 1].
+        ring: ``(N,)`` uint16 channel index.
+        azimuth: ``(N,)`` float32 radians in [0, 2π), counter-clockwise from +x.
+        semantic_class: ``(N,)`` uint16 class of the surface hit (:mod:`mmusv.classes`).
+        instance: ``(N,)`` int32 scene instance id of the surface hit.
+        ray_index: ``(N,)`` uint32 index of the ray in the full pattern (``column · channels + ring``).
+    """
+
+    xyz: npt.NDArray[np.float32]
+    range: npt.NDArray[np.float32]
+    intensity: npt.NDArray[np.float32]
+    ring: npt.NDArray[np.uint16]
+    azimuth: npt.NDArray[np.float32]
+    semantic_class: npt.NDArray[np.uint16]
+    instance: npt.NDArray[np.int32]
+    ray_index: npt.NDArray[np.uint32]
+
+    def __len__(self) -> int:
+        return int(self.xyz.shape[0])
+
+
+def lidar_from_config(cfg: LidarConfig) -> Any:
+    """The native LiDAR (pattern computed once) for ``cfg``."""
+    return core.Lidar(
+        elevations=cfg.elevations_rad(),
+        azimuth_steps=cfg.azimuth_steps,
+        range_min=cfg.range_min_m,
+        range_max=cfg.range_m,
+        range_noise_std=cfg.range_noise_std_m,
+        dropout=cfg.dropout,
+        water_probability=cfg.water_probability,
+        water_probability_per_wave_m=cfg.water_probability_per_wave_m,
+        water_range_m=cfg.water_range_m,
+        water_range_per_wave_m=cfg.water_range_per_wave_m,
+    )
+
+
+def scan(
+    lidar: Any,
+    scene: Scene,
+    *,
+    pose: npt.ArrayLike,
+    seed: int,
+    fog_extinction_per_m: float = 0.0,
+    rain_mm_per_h: float = 0.0,
+    wave_height_m: float = 0.0,
+) -> LidarPoints:
+    """One sweep of ``lidar`` (from :func:`lidar_from_config`) at ``pose`` (``(4, 4)`` LiDAR → world) on the
+    current state of ``scene``. ``seed`` drives noise, dropout and water returns."""
+    p = np.ascontiguousarray(pose, dtype=np.float64).reshape(4, 4)
+    d = lidar.scan(
+        scene.native,
+        pose=p,
+        fog_extinction_per_m=float(fog_extinction_per_m),
+        rain_mm_per_h=float(rain_mm_per_h),
+        wave_height_m=float(wave_height_m),
+        seed=int(seed),
+    )
+    return LidarPoints(
+        xyz=d["xyz"], range=d["range"], intensity=d["intensity"], ring=d["ring"], azimuth=d["azimuth"],
+        semantic_class=d["class"], instance=d["instance"], ray_index=d["ray_index"],
+    )

@@ -1,0 +1,350 @@
+"""A scenario made runnable: map, vessels, motion and every USV's sensors, captured on one frozen state per frame.
+
+``Simulation(cfg)`` builds the world once (map meshes, one mesh per vessel asset, the fleet's routes and waves,
+the native sensors with their ray patterns). ``capture(frame)`` sets every vessel's pose at ``t_k = k / f``
+(only the scene's top level is rebuilt) and then runs every sensor of every USV on that one state, so there is
+no skew between sensors or agents. The state at frame ``k`` is a pure function of (scenario, seed, k).
+
+Frames: world x east, y north, z up (metres); vessel/sensor body frames x forward, y left, z up. Sensor poses
+are ``(4, 4)`` float64 sensor → world matrices.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from dataclasses import dataclass, field
+from collections.abc import Collection
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from mmusv.config import Scenario, VesselConfig, load_scenario
+from mmusv.errors import ConfigError
+from mmusv.motion import build_fleet
+from mmusv.sensors.camera import CameraImages, camera_from_config, render, shading_kwargs, top_view_from_config
+from mmusv.sensors.config import CameraConfig, Mount, RigConfig
+from mmusv.sensors.lidar import LidarPoints, lidar_from_config, scan
+from mmusv.world.build import WorldScene, build_world_scene, pose_matrices
+from mmusv.world.environment import Environment
+from mmusv.world.maps import MapWorld, generate_map
+from mmusv.world.vessels import VesselAsset, get_asset
+
+__all__ = ["Simulation", "Agent", "VesselInfo", "WorldState", "AgentCapture", "FrameCapture", "sensor_seed"]
+
+SENSOR_KINDS = ("lidar", "cameras", "top_view", "radar")
+_SENSOR_CODES = {"lidar": 1, "radar": 2, "camera": 3, "top_view": 4}
+
+
+def sensor_seed(scenario_seed: int, frame: int, agent: int, sensor: str, index: int = 0) -> int:
+    """The 64-bit seed of one sensor capture: a hash of (scenario seed, frame, agent index, sensor, index)."""
+    key = f"{scenario_seed}/{frame}/{agent}/{_SENSOR_CODES.get(sensor, 9)}/{index}".encode()
+    return int.from_bytes(hashlib.blake2b(key, digest_size=8).digest(), "little")
+
+
+def _rpy_matrix(xyz: tuple[float, float, float], rpy_deg: tuple[float, float, float]) -> np.ndarray:
+    r, p, y = (math.radians(a) for a in rpy_deg)
+    return pose_matrices(np.array([*xyz, r, p, y], dtype=np.float64))
+
+
+def mount_matrix(asset: VesselAsset, mount: Mount, *, where: str) -> np.ndarray:
+    """``(4, 4)`` sensor → vessel body transform of ``mount`` on ``asset`` (see :class:`~mmusv.sensors.config.Mount`)."""
+    base = np.eye(4)
+    if mount.point is not None:
+        if mount.point in asset.mounts:
+            mp = asset.mounts[mount.point]
+            base = _rpy_matrix(mp.xyz, mp.rpy_deg)
+        else:
+            # Fall back to the top of the hull: above the deck, looking where the mount name says.
+            yaw = {"camera_left": 90.0, "camera_rear": 180.0, "camera_right": -90.0}.get(mount.point, 0.0)
+            top = float(asset.bbox[1, 2]) + 0.5
+            base = _rpy_matrix((0.0, 0.0, top), (0.0, 0.0, yaw))
+    m: np.ndarray = base @ _rpy_matrix(mount.xyz, mount.rpy_deg)
+    if not np.all(np.isfinite(m)):
+        raise ConfigError(f"invalid config {where}: the mount is not a finite pose")
+    return m
+
+
+@dataclass(frozen=True)
+class VesselInfo:
+    """A vessel of the world state: scenario vessels first (file order), then moored ships (port maps)."""
+
+    id: str
+    asset: str
+    role: str  # "usv", "target" or "moored"
+    semantic_class: int
+    instance_id: int
+    box_center_body: np.ndarray  # (3,) box centre in the vessel body frame, metres
+    box_size: np.ndarray  # (3,) length, beam, height, metres
+
+
+@dataclass(frozen=True)
+class WorldState:
+    """Every vessel at one frame: ``poses`` ``(V, 6)`` [x, y, z, roll, pitch, yaw] (m, rad, world),
+    ``velocities`` ``(V, 3)`` m/s world, ``box_centers`` ``(V, 3)`` world, ``matrices`` ``(V, 4, 4)`` body → world."""
+
+    frame: int
+    time_s: float
+    poses: np.ndarray
+    velocities: np.ndarray
+    box_centers: np.ndarray
+    matrices: np.ndarray
+
+
+@dataclass
+class Agent:
+    """An instrumented USV and its native sensors."""
+
+    index: int  # position in Simulation.vessels
+    vessel: VesselConfig
+    asset: VesselAsset
+    rig: RigConfig
+    lidar: Any | None
+    lidar_mount: np.ndarray | None
+    radar_mount: np.ndarray | None
+    cameras: dict[str, tuple[Any, CameraConfig, np.ndarray]] = field(default_factory=dict)
+    top_view: Any | None = None
+
+    @property
+    def id(self) -> str:
+        """The vessel id."""
+        return self.vessel.id
+
+
+@dataclass
+class AgentCapture:
+    """Everything one USV's sensors produced at one frame, with the sensor poses (sensor → world)."""
+
+    agent: str
+    lidar: LidarPoints | None
+    lidar_pose: np.ndarray | None
+    cameras: dict[str, CameraImages]
+    camera_poses: dict[str, np.ndarray]
+    top_view: CameraImages | None
+    top_view_pose: np.ndarray | None
+    radar: Any | None = None
+    radar_ppi: np.ndarray | None = None
+    radar_pose: np.ndarray | None = None
+
+
+@dataclass
+class FrameCapture:
+    """One acquisition index: the world state and every agent's capture."""
+
+    frame: int
+    time_s: float
+    world: WorldState
+    agents: dict[str, AgentCapture]
+
+
+class Simulation:
+    """A runnable scenario (see the module docstring). ``source``: a path, a dict or a :class:`Scenario`."""
+
+    def __init__(self, source: Any, *, world: MapWorld | None = None) -> None:
+        self.scenario: Scenario = load_scenario(source)
+        sc = self.scenario
+        self.environment: Environment = sc.environment.resolve()
+        self.world: MapWorld = world if world is not None else generate_map(sc.map.type, seed=sc.map.seed, **sc.map.params)
+        self.fleet = build_fleet(sc)
+        self.lighting = shading_kwargs(self.environment)
+        poses0 = np.asarray(self.fleet.poses_at_times(np.zeros(1)))[0]
+        self.ws: WorldScene = build_world_scene(self.world, [(v.asset, v.role) for v in sc.vessels], poses0)
+        self.vessels: list[VesselInfo] = []
+        for v, inst in zip(sc.vessels, self.ws.vessel_instances, strict=True):
+            self.vessels.append(self._info(v.id, v.asset, v.role, int(inst)))
+        self._moored_mats = []
+        for k, ((asset_name, (x, y, yaw)), inst) in enumerate(zip(self.world.moored, self.ws.moored_instances, strict=True)):
+            self.vessels.append(self._info(f"moored_{k:02d}", asset_name, "moored", inst))
+            self._moored_mats.append(pose_matrices(np.array([x, y, 0.0, 0.0, 0.0, yaw])))
+        self._moored_eta = np.array([[x, y, 0.0, 0.0, 0.0, yaw] for _, (x, y, yaw) in self.world.moored]).reshape(-1, 6)
+        self.agents: list[Agent] = [self._agent(i, v) for i, v in enumerate(sc.vessels) if v.role == "usv"]
+        self._frame: int | None = None
+
+    # ------------------------------------------------------------------------------------------ building
+
+    @staticmethod
+    def _info(vid: str, asset_name: str, role: str, instance: int) -> VesselInfo:
+        a = get_asset(asset_name)
+        lo, hi = a.bbox[0], a.bbox[1]
+        cls = 11 if role == "usv" else int(a.semantic_class)
+        return VesselInfo(vid, asset_name, role, cls, instance, (lo + hi) / 2.0, hi - lo)
+
+    def _agent(self, index: int, v: VesselConfig) -> Agent:
+        rig = self.scenario.rigs[v.rig] if v.rig is not None else RigConfig()
+        where = f"rigs.{v.rig or '<default>'}"
+        asset = get_asset(v.asset)
+        agent = Agent(index=index, vessel=v, asset=asset, rig=rig, lidar=None, lidar_mount=None, radar_mount=None)
+        if rig.lidar is not None:
+            agent.lidar = lidar_from_config(rig.lidar)
+            agent.lidar_mount = mount_matrix(asset, rig.lidar.mount, where=f"{where}.lidar.mount")
+        if rig.radar is not None:
+            agent.radar_mount = mount_matrix(asset, rig.radar.mount, where=f"{where}.radar.mount")
+        for c in rig.cameras:
+            m = mount_matrix(asset, c.mount, where=f"{where}.cameras[{c.name}].mount")
+            agent.cameras[c.name] = (camera_from_config(c), c, m)
+        if rig.top_view is not None:
+            agent.top_view = top_view_from_config(rig.top_view)
+        self._check_mounts(agent, where)
+        return agent
+
+    def _check_mounts(self, agent: Agent, where: str) -> None:
+        """A sensor whose origin lies inside its own hull would see only the hull's inside: refuse it."""
+        dirs = _sphere_directions(48)
+        mounts: list[tuple[str, np.ndarray]] = []
+        if agent.lidar_mount is not None:
+            mounts.append((f"{where}.lidar.mount", agent.lidar_mount))
+        if agent.radar_mount is not None:
+            mounts.append((f"{where}.radar.mount", agent.radar_mount))
+        mounts += [(f"{where}.cameras[{n}].mount", m) for n, (_, _, m) in agent.cameras.items()]
+        inst = int(self.ws.vessel_instances[agent.index])
+        body = self.ws.scene.instance_pose(inst)
+        for name, m in mounts:
+            origin = (body @ m)[:3, 3]
+            hits = self.ws.scene.cast_rays(np.tile(origin, (len(dirs), 1)), dirs, max_range=2.0 * float(agent.asset.length) + 10)
+            own_back = (hits.instance_id == inst) & hits.backface
+            if own_back.mean() > 0.9:
+                xyz = np.round(m[:3, 3], 3).tolist()
+                raise ConfigError(
+                    f"invalid config {name} = {xyz}: the sensor sits inside the hull of vessel {agent.id!r} "
+                    f"({agent.asset.name}, deck/top at z = {agent.asset.bbox[1, 2]:.2f} m); move it above the hull"
+                )
+
+    # ------------------------------------------------------------------------------------------ state
+
+    @property
+    def frames(self) -> int:
+        """Number of acquisition indices."""
+        return self.scenario.acquisition.frames
+
+    def time_of(self, frame: int) -> float:
+        """``t_k = k / f`` in seconds."""
+        return frame / self.scenario.acquisition.frequency_hz
+
+    def world_state(self, frame: int) -> WorldState:
+        """Poses, velocities and boxes of every vessel at ``frame`` (does not move the scene)."""
+        t = self.time_of(frame)
+        eta = np.asarray(self.fleet.poses_at_times(np.array([t])))[0]
+        vel = np.asarray(self.fleet.velocities_at(t))
+        n_moored = self._moored_eta.shape[0]
+        eta_all = np.concatenate([eta, self._moored_eta]) if n_moored else eta
+        vel_all = np.concatenate([vel, np.zeros((n_moored, 3))]) if n_moored else vel
+        mats = pose_matrices(eta_all)
+        centres_body = np.array([v.box_center_body for v in self.vessels]).reshape(-1, 3)
+        centres = np.einsum("vij,vj->vi", mats[:, :3, :3], centres_body) + mats[:, :3, 3]
+        return WorldState(frame, t, eta_all, vel_all, centres, mats)
+
+    def set_frame(self, frame: int) -> WorldState:
+        """Moves every vessel to its pose at ``frame`` and returns the world state."""
+        if not 0 <= frame < self.frames:
+            raise ConfigError(f"frame {frame} is outside the acquisition (0..{self.frames - 1})")
+        state = self.world_state(frame)
+        n = len(self.scenario.vessels)
+        self.ws.scene.set_poses(self.ws.vessel_instances, state.matrices[:n])
+        self._frame = frame
+        return state
+
+    def agent(self, agent_id: str) -> Agent:
+        """The agent (USV) named ``agent_id``."""
+        for a in self.agents:
+            if a.id == agent_id:
+                return a
+        raise ConfigError(f"no USV named {agent_id!r}; the USVs are {[a.id for a in self.agents]}")
+
+    def sensor_poses(self, agent: Agent, state: WorldState) -> dict[str, np.ndarray]:
+        """Sensor → world matrices of every sensor of ``agent`` in ``state``: keys ``lidar``, ``radar``,
+        ``camera/<name>``, ``top_view``."""
+        body = state.matrices[agent.index]
+        out: dict[str, np.ndarray] = {}
+        if agent.lidar_mount is not None:
+            out["lidar"] = body @ agent.lidar_mount
+        if agent.radar_mount is not None:
+            out["radar"] = body @ agent.radar_mount
+        for name, (_, _, m) in agent.cameras.items():
+            out[f"camera/{name}"] = body @ m
+        if agent.top_view is not None and agent.rig.top_view is not None:
+            tv = agent.rig.top_view
+            x, y, _, _, _, yaw = state.poses[agent.index]
+            heading = yaw if tv.orientation == "heading_up" else math.pi / 2
+            out["top_view"] = pose_matrices(np.array([x, y, tv.altitude_m, 0.0, 0.0, heading])) @ _rpy_matrix(
+                (0.0, 0.0, 0.0), (0.0, 90.0, 0.0)
+            )
+        return out
+
+    # ------------------------------------------------------------------------------------------ capture
+
+    def capture(
+        self,
+        frame: int,
+        *,
+        agents: Collection[str] | None = None,
+        sensors: Collection[str] | None = None,
+        radar: bool = True,
+    ) -> FrameCapture:
+        """Moves the world to ``frame`` and runs every sensor of every USV on that state.
+
+        ``agents`` limits the USVs (ids), ``sensors`` the sensor kinds (``lidar``, ``cameras``, ``top_view``,
+        ``radar``); ``None`` means all. ``radar=False`` leaves the radar out whatever ``sensors`` says.
+        """
+        kinds = set(SENSOR_KINDS if sensors is None else sensors)
+        if not radar:
+            kinds.discard("radar")
+        if kinds - set(SENSOR_KINDS):
+            raise ConfigError(f"unknown sensor kind(s) {sorted(kinds - set(SENSOR_KINDS))}; allowed: {', '.join(SENSOR_KINDS)}")
+        state = self.set_frame(frame)
+        env = self.environment
+        sc = self.scenario
+        out: dict[str, AgentCapture] = {}
+        for agent in self.agents:
+            if agents is not None and agent.id not in agents:
+                continue
+            poses = self.sensor_poses(agent, state)
+            cap = AgentCapture(agent.id, None, None, {}, {}, None, None)
+            if agent.lidar is not None and "lidar" in kinds:
+                cap.lidar_pose = poses["lidar"]
+                cap.lidar = scan(
+                    agent.lidar, self.ws.scene, pose=cap.lidar_pose,
+                    seed=sensor_seed(sc.seed, frame, agent.index, "lidar"),
+                    fog_extinction_per_m=env.weather.extinction_per_m, rain_mm_per_h=env.weather.rain_mm_per_h,
+                    wave_height_m=env.wave_height_m,
+                )
+            for k, (name, (cam, cfg, _)) in enumerate(agent.cameras.items()):
+                if "cameras" not in kinds:
+                    break
+                p = poses[f"camera/{name}"]
+                cap.camera_poses[name] = p
+                cap.cameras[name] = render(
+                    cam, self.ws.scene, pose=p, seed=sensor_seed(sc.seed, frame, agent.index, "camera", k),
+                    rgb="rgb" in cfg.outputs, lighting=self.lighting,
+                )
+            if agent.top_view is not None and agent.rig.top_view is not None and "top_view" in kinds:
+                cap.top_view_pose = poses["top_view"]
+                cap.top_view = render(
+                    agent.top_view, self.ws.scene, pose=cap.top_view_pose,
+                    seed=sensor_seed(sc.seed, frame, agent.index, "top_view"),
+                    rgb="rgb" in agent.rig.top_view.outputs, lighting=self.lighting,
+                )
+            if "radar" in kinds and agent.rig.radar is not None and "radar" in poses:
+                cap.radar_pose = poses["radar"]
+                self._radar(agent, cap, state, frame)
+            out[agent.id] = cap
+        return FrameCapture(frame, state.time_s, state, out)
+
+    def _radar(self, agent: Agent, cap: AgentCapture, state: WorldState, frame: int) -> None:
+        from mmusv.sensors import radar as radar_mod  # the radar sensor lives in its own module
+
+        cfg = agent.rig.radar
+        assert cfg is not None and cap.radar_pose is not None
+        cap.radar, cap.radar_ppi = radar_mod.capture(
+            self.ws.scene, pose=cap.radar_pose, config=cfg, environment=self.environment,
+            seed=sensor_seed(self.scenario.seed, frame, agent.index, "radar"),
+        )
+
+
+def _sphere_directions(n: int) -> npt.NDArray[np.float64]:
+    """``n`` unit vectors spread over the sphere (Fibonacci lattice)."""
+    i = np.arange(n) + 0.5
+    z = 1 - 2 * i / n
+    r = np.sqrt(1 - z * z)
+    phi = i * math.pi * (3 - math.sqrt(5))
+    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)

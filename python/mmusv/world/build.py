@@ -1,0 +1,113 @@
+"""Turning a generated map and a scenario's vessels into a ray-castable :class:`mmusv.Scene`.
+
+Static map meshes become one instance each at the identity pose (instance ids ``0..S-1`` in the key order of
+``MapWorld.static_meshes``); every vessel asset is added once as a mesh and instanced per vessel, so moving
+vessels only rebuilds the scene's top level. Moored ships of a port map are static instances of their assets.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from mmusv.classes import SemanticClass
+from mmusv.scene import Scene
+from mmusv.world.maps import MapWorld
+from mmusv.world.primitives import TriMesh
+from mmusv.world.vessels import get_asset
+
+__all__ = ["WorldScene", "build_static_scene", "build_world_scene", "pose_matrices"]
+
+
+@dataclass
+class WorldScene:
+    """A scene plus the bookkeeping that maps scenario objects to instance ids.
+
+    Attributes:
+        scene: the ray-castable scene.
+        static_instances: map mesh name -> instance id.
+        vessel_instances: ``(V,)`` int64 instance id of scenario vessel ``i``.
+        moored_instances: instance ids of moored ships (port maps), in ``MapWorld.moored`` order.
+        asset_meshes: asset name -> mesh id.
+    """
+
+    scene: Scene
+    static_instances: dict[str, int]
+    vessel_instances: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    moored_instances: list[int] = field(default_factory=list)
+    asset_meshes: dict[str, int] = field(default_factory=dict)
+
+
+def _add(scene: Scene, mesh: TriMesh, name: str) -> int:
+    return scene.add_mesh(mesh.vertices, mesh.faces, classes=mesh.classes, name=name)
+
+
+def pose_matrices(eta: np.ndarray) -> np.ndarray:
+    """``(..., 4, 4)`` float64 body -> world matrices from poses ``η = [x, y, z, roll, pitch, yaw]`` ``(..., 6)``
+    (metres, radians, R = Rz(yaw)·Ry(pitch)·Rx(roll))."""
+    eta = np.asarray(eta, dtype=np.float64)
+    cr, sr = np.cos(eta[..., 3]), np.sin(eta[..., 3])
+    cp, sp = np.cos(eta[..., 4]), np.sin(eta[..., 4])
+    cy, sy = np.cos(eta[..., 5]), np.sin(eta[..., 5])
+    m = np.zeros(eta.shape[:-1] + (4, 4), dtype=np.float64)
+    m[..., 0, 0] = cy * cp
+    m[..., 0, 1] = cy * sp * sr - sy * cr
+    m[..., 0, 2] = cy * sp * cr + sy * sr
+    m[..., 1, 0] = sy * cp
+    m[..., 1, 1] = sy * sp * sr + cy * cr
+    m[..., 1, 2] = sy * sp * cr - cy * sr
+    m[..., 2, 0] = -sp
+    m[..., 2, 1] = cp * sr
+    m[..., 2, 2] = cp * cr
+    m[..., :3, 3] = eta[..., :3]
+    m[..., 3, 3] = 1.0
+    return m
+
+
+def build_static_scene(world: MapWorld, *, include_water: bool = True, include_moored: bool = True) -> WorldScene:
+    """A scene holding the map's static meshes (and its moored ships), no scenario vessels.
+
+    ``include_water=False`` leaves the water plane out (useful for line-of-sight checks above the surface).
+    """
+    scene = Scene()
+    static: dict[str, int] = {}
+    for name, mesh in world.static_meshes.items():
+        if name == "water" and not include_water:
+            continue
+        if mesh.num_triangles == 0:
+            continue
+        static[name] = scene.add_instance(_add(scene, mesh, name))
+    out = WorldScene(scene=scene, static_instances=static)
+    if include_moored:
+        for asset_name, (x, y, yaw) in world.moored:
+            mid = _mesh_for(out, asset_name)
+            pose = pose_matrices(np.array([x, y, 0.0, 0.0, 0.0, yaw]))
+            out.moored_instances.append(scene.add_instance(mid, pose=pose))
+    return out
+
+
+def _mesh_for(ws: WorldScene, asset_name: str) -> int:
+    if asset_name not in ws.asset_meshes:
+        asset = get_asset(asset_name)
+        ws.asset_meshes[asset_name] = _add(ws.scene, asset.mesh, asset_name)
+    return ws.asset_meshes[asset_name]
+
+
+def build_world_scene(world: MapWorld, vessels: list[tuple[str, str]], initial_poses: np.ndarray) -> WorldScene:
+    """The full scene: static map, moored ships, and one instance per scenario vessel.
+
+    Args:
+        world: the generated map.
+        vessels: ``(asset_name, role)`` per scenario vessel, role ``"usv"`` or ``"target"``; a USV's faces are
+            labelled :data:`SemanticClass.USV` whatever the asset says.
+        initial_poses: ``(V, 6)`` float64 poses η of the vessels at the first frame.
+    """
+    ws = build_static_scene(world)
+    mats = pose_matrices(np.asarray(initial_poses, dtype=np.float64).reshape(-1, 6))
+    ids = []
+    for (asset_name, role), m in zip(vessels, mats, strict=True):
+        override = int(SemanticClass.USV) if role == "usv" else None
+        ids.append(ws.scene.add_instance(_mesh_for(ws, asset_name), pose=m, class_override=override))
+    ws.vessel_instances = np.asarray(ids, dtype=np.int64)
+    return ws
