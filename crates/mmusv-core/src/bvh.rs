@@ -58,11 +58,8 @@ impl RayInv {
     pub fn new(origin: Vec3, dir: Vec3) -> Self {
         let f = |d: f32| if d.abs() < 1e-20 { 1e20f32.copysign(d) } else { 1.0 / d };
         let inv = [f(dir.x), f(dir.y), f(dir.z)];
-        let near = [
-            if inv[0] < 0.0 { 3 } else { 0 },
-            if inv[1] < 0.0 { 4 } else { 1 },
-            if inv[2] < 0.0 { 5 } else { 2 },
-        ];
+        let near =
+            [if inv[0] < 0.0 { 3 } else { 0 }, if inv[1] < 0.0 { 4 } else { 1 }, if inv[2] < 0.0 { 5 } else { 2 }];
         Self { origin: origin.to_array(), inv, near }
     }
 }
@@ -179,13 +176,25 @@ impl Bvh4 {
             kids.push(r);
         }
         let me = self.nodes.len();
-        self.nodes.push(Node4 { bounds: [[f32::INFINITY; 4], [f32::INFINITY; 4], [f32::INFINITY; 4], [f32::NEG_INFINITY; 4], [f32::NEG_INFINITY; 4], [f32::NEG_INFINITY; 4]], child: [EMPTY; 4] });
+        self.nodes.push(Node4 {
+            bounds: [
+                [f32::INFINITY; 4],
+                [f32::INFINITY; 4],
+                [f32::INFINITY; 4],
+                [f32::NEG_INFINITY; 4],
+                [f32::NEG_INFINITY; 4],
+                [f32::NEG_INFINITY; 4],
+            ],
+            child: [EMPTY; 4],
+        });
         for (slot, &k) in kids.iter().enumerate() {
             let child = self.flatten(b, k, cost)?;
             let a = b[k].aabb;
             let node = &mut self.nodes[me];
             node.child[slot] = child;
-            for (axis, (lo, hi)) in [(a.mins.x, a.maxs.x), (a.mins.y, a.maxs.y), (a.mins.z, a.maxs.z)].into_iter().enumerate() {
+            for (axis, (lo, hi)) in
+                [(a.mins.x, a.maxs.x), (a.mins.y, a.maxs.y), (a.mins.z, a.maxs.z)].into_iter().enumerate()
+            {
                 node.bounds[axis][slot] = lo;
                 node.bounds[axis + 3][slot] = hi;
             }
@@ -339,13 +348,21 @@ fn insert_nearest_first(hits: &mut [(u32, f32); 4], len: &mut usize, entry: (u32
 /// `max` without NaN handling, so it compiles to a single `maxps` lane (no NaN reaches here: see [`RayInv`]).
 #[inline(always)]
 fn fmax(a: f32, b: f32) -> f32 {
-    if a > b { a } else { b }
+    if a > b {
+        a
+    } else {
+        b
+    }
 }
 
 /// `min` without NaN handling, so it compiles to a single `minps` lane.
 #[inline(always)]
 fn fmin(a: f32, b: f32) -> f32 {
-    if a < b { a } else { b }
+    if a < b {
+        a
+    } else {
+        b
+    }
 }
 
 fn area(a: &Aabb) -> f32 {

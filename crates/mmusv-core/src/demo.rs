@@ -64,7 +64,15 @@ fn height(islands: &[Island], x: f32, y: f32) -> f32 {
 
 /// A closed, tessellated hull: `stations` rings of `ring` points along x, superelliptic sections,
 /// tapering to a bow at +x. Length `length`, beam `beam`, from z = -draft to z = freeboard.
-pub fn hull_mesh(name: &str, length: f32, beam: f32, draft: f32, freeboard: f32, stations: u32, ring: u32) -> Result<Mesh> {
+pub fn hull_mesh(
+    name: &str,
+    length: f32,
+    beam: f32,
+    draft: f32,
+    freeboard: f32,
+    stations: u32,
+    ring: u32,
+) -> Result<Mesh> {
     if stations < 2 || ring < 3 {
         return Err(MmusvError::input("stations/ring", "need at least 2 stations and 3 points per ring"));
     }
@@ -117,14 +125,22 @@ pub fn maritime_demo(p: DemoParams) -> Result<DemoScene> {
         return Err(MmusvError::input("terrain_cells", "need at least 1 terrain cell per side"));
     }
     if !(p.extent >= 100.0 && p.extent.is_finite()) {
-        return Err(MmusvError::input("extent", format!("{} m is too small; the demo scene needs extent >= 100 m", p.extent)));
+        return Err(MmusvError::input(
+            "extent",
+            format!("{} m is too small; the demo scene needs extent >= 100 m", p.extent),
+        ));
     }
     let mut rng = ChaCha8Rng::seed_from_u64(p.seed);
     let islands: Vec<Island> = (0..7)
         .map(|_| {
             let a = rng.random_range(0.0..std::f32::consts::TAU);
             let r = rng.random_range(0.2..0.45) * p.extent;
-            Island { x: r * a.cos(), y: r * a.sin(), height: rng.random_range(45.0..95.0), sigma: rng.random_range(0.03..0.07) * p.extent }
+            Island {
+                x: r * a.cos(),
+                y: r * a.sin(),
+                height: rng.random_range(45.0..95.0),
+                sigma: rng.random_range(0.03..0.07) * p.extent,
+            }
         })
         .collect();
     let n = p.terrain_cells as usize;
@@ -174,7 +190,13 @@ pub fn maritime_demo(p: DemoParams) -> Result<DemoScene> {
     let mut attempts = 0;
     while placed < p.vessels && attempts < 100_000 {
         attempts += 1;
-        let kind = if placed % 6 == 5 { 2 } else if placed % 3 == 1 { 1 } else { 0 };
+        let kind = if placed % 6 == 5 {
+            2
+        } else if placed % 3 == 1 {
+            1
+        } else {
+            0
+        };
         let r = rng.random_range(25.0..(0.4 * p.extent));
         let a = rng.random_range(0.0..std::f32::consts::TAU);
         let (x, y) = (r * a.cos(), r * a.sin());
@@ -201,7 +223,13 @@ pub fn lidar_rays(position: [f32; 3], channels: u32, azimuth_steps: u32) -> Resu
 }
 
 /// Origins and unit world directions of `count` surround pinhole cameras (yaw 0, 360/count, ...) at `position`.
-pub fn surround_camera_rays(position: [f32; 3], count: u32, width: u32, height: u32, hfov: f64) -> Result<(Vec<[f32; 3]>, Vec<[f32; 3]>)> {
+pub fn surround_camera_rays(
+    position: [f32; 3],
+    count: u32,
+    width: u32,
+    height: u32,
+    hfov: f64,
+) -> Result<(Vec<[f32; 3]>, Vec<[f32; 3]>)> {
     let body = rays::pinhole_directions(width, height, hfov)?;
     let mut dirs = Vec::with_capacity(body.len() * count as usize);
     for c in 0..count {

@@ -24,10 +24,7 @@ impl MeshFormat {
         match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
             Some("ply") => Ok(Self::Ply),
             Some("obj") => Ok(Self::Obj),
-            other => Err(MmusvError::input(
-                "path",
-                format!("extension {other:?} is not supported; use .ply or .obj"),
-            )),
+            other => Err(MmusvError::input("path", format!("extension {other:?} is not supported; use .ply or .obj"))),
         }
     }
 }
@@ -36,10 +33,7 @@ impl MeshFormat {
 /// failure never leaves a half-written file under `path`.
 pub fn write_world_mesh(mesh: &WorldMesh, path: &Path, format: MeshFormat) -> Result<()> {
     let io = |e: std::io::Error| MmusvError::Io { path: path.display().to_string(), reason: e.to_string() };
-    let tmp = path.with_extension(format!(
-        "{}.partial",
-        path.extension().and_then(|e| e.to_str()).unwrap_or("mesh")
-    ));
+    let tmp = path.with_extension(format!("{}.partial", path.extension().and_then(|e| e.to_str()).unwrap_or("mesh")));
     let file = std::fs::File::create(&tmp).map_err(io)?;
     let mut w = BufWriter::new(file);
     let result = match format {

@@ -38,10 +38,7 @@ impl RigidPose {
         }
         let last = [m[12], m[13], m[14], m[15]];
         if (last[0].abs() + last[1].abs() + last[2].abs() + (last[3] - 1.0).abs()) > 1e-9 {
-            return Err(MmusvError::input(
-                field,
-                format!("last row of a pose must be [0, 0, 0, 1], got {last:?}"),
-            ));
+            return Err(MmusvError::input(field, format!("last row of a pose must be [0, 0, 0, 1], got {last:?}")));
         }
         let r = |i: usize, j: usize| m[i * 4 + j];
         // Orthonormality: columns unit length and mutually orthogonal, det = +1.
@@ -61,7 +58,10 @@ impl RigidPose {
         let det = r(0, 0) * (r(1, 1) * r(2, 2) - r(1, 2) * r(2, 1)) - r(0, 1) * (r(1, 0) * r(2, 2) - r(1, 2) * r(2, 0))
             + r(0, 2) * (r(1, 0) * r(2, 1) - r(1, 1) * r(2, 0));
         if det < 0.0 {
-            return Err(MmusvError::input(field, "the rotation block has determinant -1 (a reflection); give a proper rotation"));
+            return Err(MmusvError::input(
+                field,
+                "the rotation block has determinant -1 (a reflection); give a proper rotation",
+            ));
         }
         let col = |j: usize| Vec3::new(r(0, j) as f32, r(1, j) as f32, r(2, j) as f32);
         Ok(Self {
@@ -92,10 +92,22 @@ impl RigidPose {
         let r = self.rotation;
         let t = self.translation;
         [
-            r.x_axis.x as f64, r.y_axis.x as f64, r.z_axis.x as f64, t.x as f64,
-            r.x_axis.y as f64, r.y_axis.y as f64, r.z_axis.y as f64, t.y as f64,
-            r.x_axis.z as f64, r.y_axis.z as f64, r.z_axis.z as f64, t.z as f64,
-            0.0, 0.0, 0.0, 1.0,
+            r.x_axis.x as f64,
+            r.y_axis.x as f64,
+            r.z_axis.x as f64,
+            t.x as f64,
+            r.x_axis.y as f64,
+            r.y_axis.y as f64,
+            r.z_axis.y as f64,
+            t.y as f64,
+            r.x_axis.z as f64,
+            r.y_axis.z as f64,
+            r.z_axis.z as f64,
+            t.z as f64,
+            0.0,
+            0.0,
+            0.0,
+            1.0,
         ]
     }
 

@@ -138,10 +138,18 @@ impl Mesh {
 
     /// [`Mesh::cast_local`] with caller-owned traversal scratch space (reuse it across rays).
     #[inline]
-    pub fn cast_local_with(&self, origin: Vec3, dir: Vec3, t_max: f32, stack: &mut Vec<(u32, f32)>) -> Option<LocalHit> {
+    pub fn cast_local_with(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+        stack: &mut Vec<(u32, f32)>,
+    ) -> Option<LocalHit> {
         match &self.fast {
             Some((b4, tris)) => b4
-                .closest(&RayInv::new(origin, dir), t_max, stack, |k, best| tris[k as usize].intersect(origin, dir, best))
+                .closest(&RayInv::new(origin, dir), t_max, stack, |k, best| {
+                    tris[k as usize].intersect(origin, dir, best)
+                })
                 .map(|(k, t)| LocalHit { t, triangle: b4.order()[k as usize] }),
             None => self.cast_local_parry(origin, dir, t_max),
         }
@@ -228,7 +236,8 @@ pub(crate) mod tests {
         let mesh = Mesh::new("soup", &v, &f, &[3]).unwrap_or_else(|e| unreachable!("{e}"));
         let mut hits = 0;
         for _ in 0..3000 {
-            let o = Vec3::new(rng.random_range(-15.0..15.0), rng.random_range(-15.0..15.0), rng.random_range(-15.0..15.0));
+            let o =
+                Vec3::new(rng.random_range(-15.0..15.0), rng.random_range(-15.0..15.0), rng.random_range(-15.0..15.0));
             let d = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0))
                 .normalize();
             let a = mesh.cast_local(o, d, 1e3);

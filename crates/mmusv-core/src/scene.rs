@@ -264,7 +264,13 @@ impl Scene {
 
     /// Closest hits of up to [`PACKET`] coherent rays traced together (`dirs` unit length). Results are the
     /// same as [`Scene::cast_ray_with`] per ray.
-    pub fn cast_packet_with(&self, origins: &[[f32; 3]], dirs: &[[f32; 3]], max_range: f32, scratch: &mut Scratch) -> [Option<Hit>; PACKET] {
+    pub fn cast_packet_with(
+        &self,
+        origins: &[[f32; 3]],
+        dirs: &[[f32; 3]],
+        max_range: f32,
+        scratch: &mut Scratch,
+    ) -> [Option<Hit>; PACKET] {
         let mut out = [None; PACKET];
         let Some(t4) = &self.tlas4 else {
             for (r, (o, d)) in origins.iter().zip(dirs).take(PACKET).enumerate() {
@@ -430,7 +436,8 @@ fn validate_rays(origins: &[[f32; 3]], dirs: &[[f32; 3]], max_range: f32) -> Res
     if let Some(i) = origins.par_iter().position_first(|o| o.iter().any(|c| !c.is_finite())) {
         return Err(MmusvError::input(format!("origins[{i}]"), format!("{:?} is not finite", origins[i])));
     }
-    if let Some(i) = dirs.par_iter().position_first(|d| d.iter().any(|c| !c.is_finite()) || d.iter().all(|&c| c == 0.0)) {
+    if let Some(i) = dirs.par_iter().position_first(|d| d.iter().any(|c| !c.is_finite()) || d.iter().all(|&c| c == 0.0))
+    {
         return Err(MmusvError::input(
             format!("directions[{i}]"),
             format!("{:?} is zero-length or not finite; directions must be finite and non-zero", dirs[i]),
@@ -447,13 +454,20 @@ mod tests {
 
     fn box_mesh(half: [f32; 3]) -> Mesh {
         let [a, b, c] = half;
-        let v = [
-            [-a, -b, -c], [a, -b, -c], [a, b, -c], [-a, b, -c],
-            [-a, -b, c], [a, -b, c], [a, b, c], [-a, b, c],
-        ];
+        let v = [[-a, -b, -c], [a, -b, -c], [a, b, -c], [-a, b, -c], [-a, -b, c], [a, -b, c], [a, b, c], [-a, b, c]];
         let f = [
-            [0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4],
-            [1, 2, 6], [1, 6, 5], [2, 3, 7], [2, 7, 6], [3, 0, 4], [3, 4, 7],
+            [0, 2, 1],
+            [0, 3, 2],
+            [4, 5, 6],
+            [4, 6, 7],
+            [0, 1, 5],
+            [0, 5, 4],
+            [1, 2, 6],
+            [1, 6, 5],
+            [2, 3, 7],
+            [2, 7, 6],
+            [3, 0, 4],
+            [3, 4, 7],
         ];
         Mesh::new("box", &v, &f, &[9]).unwrap_or_else(|e| unreachable!("{e}"))
     }
@@ -490,8 +504,10 @@ mod tests {
         let mb = b.add_mesh(Mesh::new("b", &moved, &f, &[1]).unwrap_or_else(|e| unreachable!("{e}")));
         let _ = b.add_instance(mb, RigidPose::IDENTITY, None);
         let n = 4000;
-        let origins: Vec<[f32; 3]> = (0..n).map(|_| [rng.random_range(-20.0..20.0), rng.random_range(-20.0..20.0), 30.0]).collect();
-        let dirs: Vec<[f32; 3]> = (0..n).map(|_| [rng.random_range(-0.5..0.5), rng.random_range(-0.5..0.5), -1.0]).collect();
+        let origins: Vec<[f32; 3]> =
+            (0..n).map(|_| [rng.random_range(-20.0..20.0), rng.random_range(-20.0..20.0), 30.0]).collect();
+        let dirs: Vec<[f32; 3]> =
+            (0..n).map(|_| [rng.random_range(-0.5..0.5), rng.random_range(-0.5..0.5), -1.0]).collect();
         let ha = a.cast_rays(&origins, &dirs, 1e3).unwrap_or_default();
         let hb = b.cast_rays(&origins, &dirs, 1e3).unwrap_or_default();
         let mut hits = 0;
@@ -533,7 +549,8 @@ mod tests {
         let _ = s.add_instance(soup, RigidPose::from_xyz_rpy([0.0, 0.0, -3.0], [0.1, 0.0, 0.4]), None);
         for k in 0..12 {
             let a = k as f64 * 0.5;
-            let _ = s.add_instance(boxm, RigidPose::from_xyz_rpy([8.0 * a.cos(), 8.0 * a.sin(), 0.0], [0.0, 0.0, a]), None);
+            let _ =
+                s.add_instance(boxm, RigidPose::from_xyz_rpy([8.0 * a.cos(), 8.0 * a.sin(), 0.0], [0.0, 0.0, a]), None);
         }
         // A 96x64 pinhole image from above: rows of 8 neighbouring pixels form coherent packets.
         let body = crate::sensors::rays::pinhole_directions(96, 64, 1.6).unwrap_or_default();
@@ -563,7 +580,11 @@ mod tests {
             match brute {
                 Some((t, k)) => {
                     hits += 1;
-                    assert!((batch.distance[i] - t).abs() <= 1e-4 * t.max(1.0), "ray {i}: {} vs {t}", batch.distance[i]);
+                    assert!(
+                        (batch.distance[i] - t).abs() <= 1e-4 * t.max(1.0),
+                        "ray {i}: {} vs {t}",
+                        batch.distance[i]
+                    );
                     assert_eq!(world.instances[k] as i32, batch.instance[i]);
                     assert_eq!(world.triangles[k] as i32, batch.triangle[i]);
                 }

@@ -62,7 +62,9 @@ impl Fleet {
             ("amplitudes", amps.len()),
         ] {
             if len != n {
-                return Err(InputError::new_err(format!("{name} has {len} entries for {n} routes; give one per vessel")));
+                return Err(InputError::new_err(format!(
+                    "{name} has {len} entries for {n} routes; give one per vessel"
+                )));
             }
         }
         let wave = wave_from(wave)?;
@@ -125,7 +127,11 @@ impl Fleet {
     }
 
     /// `(T, V, 6)` float64 poses at every time in `times` (s), computed in parallel with the GIL released.
-    fn poses_at_times<'py>(&self, py: Python<'py>, times: PyReadonlyArray1<'py, f64>) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    fn poses_at_times<'py>(
+        &self,
+        py: Python<'py>,
+        times: PyReadonlyArray1<'py, f64>,
+    ) -> PyResult<Bound<'py, PyArray3<f64>>> {
         let ts = flat(&times, "times")?;
         let poses = detached(py, || self.inner.poses_at_times(ts))?;
         let v = self.inner.len();

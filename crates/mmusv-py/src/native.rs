@@ -29,7 +29,10 @@ where
 }
 
 /// Borrows a C-contiguous `(N, K)` array as rows of `K`; `name` is used in the error.
-pub fn rows<'a, T: numpy::Element, const K: usize>(arr: &'a PyReadonlyArray2<'_, T>, name: &str) -> PyResult<&'a [[T; K]]> {
+pub fn rows<'a, T: numpy::Element, const K: usize>(
+    arr: &'a PyReadonlyArray2<'_, T>,
+    name: &str,
+) -> PyResult<&'a [[T; K]]> {
     let shape = arr.shape();
     if shape[1] != K {
         return Err(InputError::new_err(format!("{name} must have shape (N, {K}), got {shape:?}")));
@@ -49,7 +52,10 @@ pub fn flat<'a, T: numpy::Element>(arr: &'a PyReadonlyArray1<'_, T>, name: &str)
 }
 
 /// Moves rows of `K` into a new owned `(N, K)` numpy array.
-pub fn rows_to_array<'py, T: numpy::Element, const K: usize>(py: Python<'py>, rows: Vec<[T; K]>) -> PyResult<Bound<'py, PyArray2<T>>> {
+pub fn rows_to_array<'py, T: numpy::Element, const K: usize>(
+    py: Python<'py>,
+    rows: Vec<[T; K]>,
+) -> PyResult<Bound<'py, PyArray2<T>>> {
     let n = rows.len();
     Array2::from_shape_vec((n, K), rows.into_iter().flatten().collect())
         .map(|a| a.into_pyarray(py))

@@ -6,7 +6,9 @@ use crate::native::{detached, flat, rows, rows_to_array};
 use mmusv_core::export::{write_world_mesh, MeshFormat};
 use mmusv_core::{Mesh, RigidPose, Scene as CoreScene};
 use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
+use numpy::{
+    IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods,
+};
 use pyo3::prelude::*;
 use std::path::PathBuf;
 use std::sync::{Arc, RwLock};
@@ -95,7 +97,12 @@ impl Scene {
 
     /// Places mesh `mesh_id` at `pose` (4x4 float64); returns the instance id.
     #[pyo3(signature = (mesh_id, pose, class_override=None))]
-    fn add_instance(&self, mesh_id: u32, pose: PyReadonlyArray2<'_, f64>, class_override: Option<u16>) -> PyResult<u32> {
+    fn add_instance(
+        &self,
+        mesh_id: u32,
+        pose: PyReadonlyArray2<'_, f64>,
+        class_override: Option<u16>,
+    ) -> PyResult<u32> {
         if pose.shape() != [4, 4] {
             return Err(InputError::new_err(format!("pose must have shape (4, 4), got {:?}", pose.shape())));
         }
