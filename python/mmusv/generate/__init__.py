@@ -1,0 +1,21 @@
+"""Batch scenario generation under constraints (issue #7): ``mmusv generate SPEC.yaml -o DIR``.
+
+A generation spec (:mod:`.spec`) names a map, scenario families (:mod:`.families`), roles and difficulty levels,
+role combinations with quotas, and constraint thresholds. The sampler (:mod:`.sampler`) draws candidates from
+the spec's seed; the named constraints (:mod:`.checks`) accept or reject them, vectorised over dense route and
+time samples evaluated in the Rust core; the loop (:mod:`.runner`) resamples up to a cap and writes one scenario
+YAML per accepted candidate plus ``report.json`` (:mod:`.report`). Python API::
+
+    from mmusv.generate import generate
+    report = generate("scenarios/specs/island_demo.yaml", "scenarios/generated/island_demo")
+    report.accepted, report.attempts, report.rejected
+"""
+
+from __future__ import annotations
+
+from mmusv.generate.families import FAMILIES
+from mmusv.generate.report import ComboReport, RunReport
+from mmusv.generate.runner import generate
+from mmusv.generate.spec import GenerationSpec, load_spec
+
+__all__ = ["FAMILIES", "ComboReport", "GenerationSpec", "RunReport", "generate", "load_spec"]

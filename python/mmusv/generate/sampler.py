@@ -1,0 +1,226 @@
+"""The sampler: one candidate scenario per (spec, combination, attempt), deterministically.
+
+The random generator of an attempt is ``numpy.random.default_rng(SeedSequence([spec.seed, combination index,
+attempt]))``, so a candidate does not depend on what other combinations or attempts drew. The sampler draws the
+environment choices, the assets and nominal speeds of every role, an encounter centre in open water (map priors),
+lets the family template lay out the routes, scatters the difficulty's distractor targets around the centre and
+assembles a scenario dict with every number rounded (metres and m/s to 0.01) in a fixed key order, validated
+with :func:`mmusv.config.load_scenario`. Units: metres, seconds, m/s; world frame.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from mmusv.config import Scenario, load_scenario
+from mmusv.generate.families import FAMILIES
+from mmusv.generate.layout import FamilyInput, Layout, Role, SamplingError, Track, pick_best, straight_track
+from mmusv.generate.hulls import capsule
+from mmusv.generate.mapctx import MapContext
+from mmusv.generate.spec import Combination, GenerationSpec, class_assets
+from mmusv.world.vessels import get_asset
+
+__all__ = ["Candidate", "CandidateMeta", "sample_candidate", "attempt_rng", "scenario_seed", "hull_radius"]
+
+
+@dataclass(frozen=True)
+class CandidateMeta:
+    """The roles of a candidate's vessels (ids) and what its checks need beyond the scenario itself.
+
+    ``occlusion_share`` is the share of frames the primary target must be hidden from the ego (None: no
+    occlusion requirement); ``range_m`` the difficulty's closest-approach range for the ``ranged`` targets.
+    """
+
+    combination: str
+    family: str
+    difficulty: str
+    attempt: int
+    ego: str
+    cooperating: tuple[str, ...]
+    targets: tuple[str, ...]
+    primary: str
+    ranged: tuple[str, ...]
+    distractors: tuple[str, ...]
+    range_m: tuple[float, float]
+    occlusion_share: float | None
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready roles (for the report)."""
+        return {
+            "ego": self.ego,
+            "cooperating": list(self.cooperating),
+            "targets": list(self.targets),
+            "primary": self.primary,
+            "ranged": list(self.ranged),
+            "distractors": list(self.distractors),
+            "range_m": list(self.range_m),
+            "occlusion_share": self.occlusion_share,
+        }
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """A sampled scenario: the rounded ``data`` dict (what gets written), its validated ``scenario`` and roles."""
+
+    data: dict[str, Any]
+    scenario: Scenario
+    meta: CandidateMeta
+
+
+def attempt_rng(seed: int, combo_index: int, attempt: int) -> np.random.Generator:
+    """The random generator of one attempt (see module docstring)."""
+    return np.random.default_rng(np.random.SeedSequence([int(seed), int(combo_index), int(attempt)]))
+
+
+def scenario_seed(seed: int, combo_index: int, attempt: int) -> int:
+    """The ``seed`` written into a scenario (wave phases etc.), in ``[0, 2**63)``, from the same triple."""
+    hi, lo = np.random.SeedSequence([int(seed), int(combo_index), int(attempt), 1]).generate_state(2, np.uint32)
+    return ((int(hi) << 32) | int(lo)) >> 1
+
+
+def hull_radius(asset: str) -> float:
+    """Radius (metres) of the bounding circle of an asset's hull footprint: half its length-beam diagonal."""
+    a = get_asset(asset)
+    return 0.5 * math.hypot(a.length, a.beam)
+
+
+def _r(x: float) -> float:
+    """Rounded to 0.01 with -0.0 normalised (byte-stable YAML)."""
+    return round(float(x), 2) + 0.0
+
+
+def _route(points: np.ndarray) -> list[list[float]]:
+    out: list[list[float]] = []
+    for x, y in np.asarray(points, dtype=np.float64):
+        p = [_r(x), _r(y)]
+        if not out or math.hypot(p[0] - out[-1][0], p[1] - out[-1][1]) >= 0.01:
+            out.append(p)
+    if len(out) < 2:
+        out.append([_r(out[0][0] + 1.0), out[0][1]])
+    return out
+
+
+def _choice(rng: np.random.Generator, items: list[str]) -> str:
+    return items[int(rng.integers(len(items)))]
+
+
+def _environment(spec: GenerationSpec, rng: np.random.Generator) -> dict[str, Any]:
+    env: dict[str, Any] = {}
+    for key in sorted(spec.environment):
+        value = spec.environment[key]
+        env[key] = value[int(rng.integers(len(value)))] if isinstance(value, list) else value
+    return env
+
+
+def _vessel(t: Track, rig: str) -> dict[str, Any]:
+    r = t.role
+    out: dict[str, Any] = {"id": r.id, "role": r.role, "asset": r.asset}
+    if r.role == "usv":
+        out["rig"] = rig
+    out["speed_mps"] = _r(t.speed)
+    out["end"] = "stop"
+    out["start_offset_m"] = _r(t.start_offset)
+    out["route"] = _route(t.route)
+    return out
+
+
+def sample_candidate(spec: GenerationSpec, combo_index: int, attempt: int, ctx: MapContext, name: str) -> Candidate:
+    """Draws candidate ``attempt`` of combination ``combo_index``, named ``name``; raises :class:`SamplingError`
+    when the template cannot place the vessels."""
+    combo: Combination = spec.combinations[combo_index]
+    fam = FAMILIES[combo.family]
+    diff = spec.difficulties[combo.difficulty]
+    rng = attempt_rng(spec.seed, combo_index, attempt)
+    acq = spec.acquisition
+    duration = max((acq.frames - 1) / acq.frequency_hz, 1.0 / acq.frequency_hz)
+    cons = spec.constraints
+    env = _environment(spec, rng)
+    usv_lo, usv_hi = spec.usv.speed_mps
+
+    def usv(role_id: str, asset: str) -> Role:
+        return Role(role_id, "usv", asset, float(rng.uniform(usv_lo, usv_hi)), hull_radius(asset), capsule(asset)[1])
+
+    def target(role_id: str, cls: str) -> Role:
+        sc = spec.size_classes[cls]
+        asset = _choice(rng, class_assets(sc))
+        return Role(role_id, "target", asset, float(rng.uniform(*sc.speed_mps)), hull_radius(asset), capsule(asset)[1])
+
+    ego = usv("usv_ego", combo.ego or spec.usv.assets[0])
+    coops = [usv(f"usv_coop_{k + 1}", _choice(rng, spec.usv.assets)) for k in range(combo.cooperating)]
+    targets = [target(f"target_{k + 1}", cls) for k, cls in enumerate(combo.targets)]
+    shore = cons.shore_clearance.min_m if cons.shore_clearance.enabled else 0.0
+    struct = cons.structure_clearance.min_m if cons.structure_clearance.enabled else 0.0
+    inp = FamilyInput(
+        ctx=ctx,
+        rng=rng,
+        duration=duration,
+        ego=ego,
+        coops=coops,
+        targets=targets,
+        range_m=diff.range_m,
+        coop_m=(cons.cooperation.min_m, cons.cooperation.max_m),
+        usv_speed=spec.usv.speed_mps,
+        separation_m=cons.separation.min_m if cons.separation.enabled else 0.0,
+        clearance_m=max(shore, struct),
+        encounter_clearance=spec.encounter_clearance_m,
+        proposals=spec.proposals,
+    )
+    try:
+        layout: Layout = fam.build(inp)
+    except ValueError as exc:  # no valid water cell at all
+        raise SamplingError(str(exc)) from None
+    # distractors: extra targets around the encounter centre on random straight tracks
+    n_extra = int(rng.integers(diff.extra_targets[0], diff.extra_targets[1] + 1))
+    classes = diff.extra_classes or list(spec.size_classes)
+    reach = max(diff.range_m[1], 150.0)
+    distractors = []
+    for k in range(n_extra):
+        role = target(f"distractor_{k + 1}", _choice(rng, classes))
+
+        def make(role: Role = role) -> list[Track]:
+            dist = reach * math.sqrt(float(rng.uniform()))
+            bearing = float(rng.uniform(0.0, 2.0 * math.pi))
+            at = layout.centre + dist * np.array([math.cos(bearing), math.sin(bearing)])
+            psi = float(rng.uniform(0.0, 2.0 * math.pi))
+            vel = role.speed * np.array([math.cos(psi), math.sin(psi)])
+            return [straight_track(role, at, vel, float(rng.uniform(0.0, duration)), duration, rng)]
+
+        distractors += pick_best(inp, make)
+    tracks = layout.tracks + distractors
+    order = {"usv": 0, "target": 1}
+    tracks.sort(key=lambda t: (order[t.role.role], 0 if t.role.id == "usv_ego" else 1))
+    data: dict[str, Any] = {
+        "name": name,
+        "seed": scenario_seed(spec.seed, combo_index, attempt),
+        "map": {"type": spec.map.type, "seed": spec.map.seed, "params": dict(sorted(spec.map.params.items()))},
+        "environment": env,
+        "acquisition": {"frequency_hz": acq.frequency_hz, "frames": acq.frames},
+        "rigs": {spec.rig: dict(spec.rigs[spec.rig])},
+        "vessels": [_vessel(t, spec.rig) for t in tracks],
+    }
+    if not data["map"]["params"]:
+        del data["map"]["params"]
+    if not env:
+        del data["environment"]
+    occl: float | None = None
+    if cons.occlusion.enabled and (fam.occlusion or diff.occluded_share is not None):
+        occl = diff.occluded_share if diff.occluded_share is not None else cons.occlusion.min_occluded_share
+    meta = CandidateMeta(
+        combination=combo.label(),
+        family=combo.family,
+        difficulty=combo.difficulty,
+        attempt=attempt,
+        ego=ego.id,
+        cooperating=tuple(c.id for c in coops),
+        targets=tuple(t.id for t in targets),
+        primary=targets[0].id,
+        ranged=tuple(layout.ranged),
+        distractors=tuple(t.role.id for t in distractors),
+        range_m=diff.range_m,
+        occlusion_share=occl,
+    )
+    return Candidate(data=data, scenario=load_scenario(data), meta=meta)

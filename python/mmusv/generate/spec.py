@@ -1,0 +1,393 @@
+"""The generation spec: a YAML file describing a batch of scenarios to generate under constraints.
+
+Units: metres, seconds, metres per second; shares are fractions of the frames in [0, 1]. Top-level keys:
+
+- ``name``, ``seed`` (every random draw derives from it), ``map`` (``type``/``seed``/``params`` as in a scenario);
+- ``acquisition`` (``frequency_hz``, ``frames``: the window every scenario covers) and ``environment`` (scenario
+  environment keys; a list means one value drawn per scenario);
+- ``rig``/``rigs``: the sensor rig every USV carries (``{usv_standard: {}}`` = the default rig);
+- ``usv``: USV ``assets`` and ``speed_mps``; ``size_classes``: target classes by hull ``length_m`` (default
+  small < 15 m <= medium < 80 m <= large) with their ``speed_mps``;
+- ``difficulties``: ``range_m`` (ego to target closest approach), ``extra_targets`` (distractors, n or
+  [lo, hi]) from ``extra_classes``, ``occluded_share`` (ask for occlusion of the primary target);
+- ``combinations``: ``family`` (:data:`mmusv.generate.families.FAMILIES`), ``difficulty``, ``ego`` asset,
+  ``cooperating`` USVs, ``targets`` (one size class per role target, the first is primary), ``quota``,
+  optional ``max_attempts`` (default ``quota x max_attempts_per_scenario``) and ``name``;
+- ``constraints``: the named checks and thresholds (:mod:`mmusv.generate.spec_constraints`);
+- tuning: ``check_step_m`` (sample spacing of the checks), ``sensor_height_m``, ``encounter_clearance_m``,
+  ``proposals`` (prior-guided proposals per placed vessel).
+
+Example (``scenarios/specs/island_demo.yaml`` is a commented one)::
+
+    name: island_demo
+    seed: 42
+    map: {type: island, seed: 4}
+    acquisition: {frequency_hz: 2, frames: 60}
+    environment: {weather: [clear, fog], wave: [W0, W1]}
+    combinations:
+      - {family: crossing, difficulty: easy, cooperating: 1, targets: [small], quota: 3}
+      - {family: occluded_by_island, difficulty: medium, cooperating: 1, targets: [medium], quota: 2}
+    constraints:
+      separation: {min_m: 20}
+      occlusion: {min_occluded_share: 0.3}
+
+Every error is a :class:`mmusv.ConfigError` whose message names the field (``combinations[1].difficulty``),
+the value given and what is allowed, in the style of :func:`mmusv.config.load_scenario`.
+"""
+
+from __future__ import annotations
+
+import difflib
+import os
+from functools import lru_cache
+from pathlib import Path
+from typing import Any
+
+import yaml
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+
+from mmusv.config import AcquisitionConfig, EnvironmentConfig, MapConfig, load_scenario
+from mmusv.errors import ConfigError
+from mmusv.generate.families import FAMILIES
+from mmusv.generate.spec_constraints import (
+    Constraints,
+    CooperationCheck,
+    InWaterCheck,
+    LineOfSightCheck,
+    OcclusionCheck,
+    RouteSeparationCheck,
+    SensingRangeCheck,
+    SeparationCheck,
+    ShoreClearanceCheck,
+    StructureClearanceCheck,
+    TargetRangeCheck,
+)
+from mmusv.world.vessels import asset_names, get_asset
+
+__all__ = [
+    "CooperationCheck",
+    "InWaterCheck",
+    "LineOfSightCheck",
+    "OcclusionCheck",
+    "RouteSeparationCheck",
+    "SensingRangeCheck",
+    "SeparationCheck",
+    "ShoreClearanceCheck",
+    "StructureClearanceCheck",
+    "TargetRangeCheck",
+    "SizeClass",
+    "UsvRoles",
+    "Difficulty",
+    "Combination",
+    "Constraints",
+    "GenerationSpec",
+    "load_spec",
+    "class_assets",
+]
+
+Pair = tuple[float, float]
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True, str_strip_whitespace=True)
+
+
+def _ordered(v: Pair, what: str) -> Pair:
+    if not v[0] <= v[1]:
+        raise ValueError(f"{what} must be [low, high] with low <= high")
+    return v
+
+
+def _known_asset(v: str) -> str:
+    names = asset_names()
+    if v not in names:
+        close = difflib.get_close_matches(v, names, n=3, cutoff=0.5)
+        hint = f"; did you mean {', '.join(close)}?" if close else ""
+        raise ValueError(f"unknown asset{hint} (`mmusv assets` lists all {len(names)})")
+    return v
+
+
+class SizeClass(_Model):
+    """A target size class: assets whose length lies in ``length_m`` (or the explicit ``assets`` list), moving
+    at a speed drawn uniformly from ``speed_mps``."""
+
+    length_m: Pair = (0.0, 1000.0)
+    speed_mps: Pair = (2.0, 8.0)
+    assets: list[str] | None = None
+
+    @field_validator("length_m", "speed_mps")
+    @classmethod
+    def _pairs(cls, v: Pair) -> Pair:
+        if v[0] < 0:
+            raise ValueError("must be >= 0")
+        return _ordered(v, "range")
+
+    @field_validator("assets")
+    @classmethod
+    def _assets(cls, v: list[str] | None) -> list[str] | None:
+        if v is not None:
+            for name in v:
+                _known_asset(name)
+                if get_asset(name).is_usv:
+                    raise ValueError(f"{name} is a USV; targets must be other vessels")
+        return v
+
+
+def class_assets(c: SizeClass) -> list[str]:
+    """Target asset names of a size class (non-USV assets with ``length_m[0] <= length < length_m[1]``, or the
+    explicit list), sorted."""
+    if c.assets is not None:
+        return sorted(c.assets)
+    return list(_by_length(c.length_m, tuple(asset_names())))
+
+
+@lru_cache(maxsize=64)
+def _by_length(length_m: Pair, names: tuple[str, ...]) -> tuple[str, ...]:
+    lo, hi = length_m
+    return tuple(sorted(n for n in names if not get_asset(n).is_usv and lo <= get_asset(n).length < hi))
+
+
+DEFAULT_SIZE_CLASSES: dict[str, SizeClass] = {
+    "small": SizeClass(length_m=(0.0, 15.0), speed_mps=(3.0, 10.0)),
+    "medium": SizeClass(length_m=(15.0, 80.0), speed_mps=(3.0, 8.0)),
+    "large": SizeClass(length_m=(80.0, 1000.0), speed_mps=(3.0, 7.0)),
+}
+
+
+class UsvRoles(_Model):
+    """The instrumented vessels: assets the cooperating USVs are drawn from (the ego's default is the first)
+    and their speed range."""
+
+    assets: list[str] = Field(default_factory=lambda: ["usv_wamv"], min_length=1)
+    speed_mps: Pair = (1.5, 3.5)
+
+    @field_validator("assets")
+    @classmethod
+    def _assets(cls, v: list[str]) -> list[str]:
+        for name in v:
+            _known_asset(name)
+            if not get_asset(name).is_usv:
+                raise ValueError(f"{name} is not a USV asset (USVs: {', '.join(_usv_names())})")
+        return v
+
+    @field_validator("speed_mps")
+    @classmethod
+    def _speed(cls, v: Pair) -> Pair:
+        if v[0] <= 0:
+            raise ValueError("USV speeds must be > 0")
+        return _ordered(v, "speed_mps")
+
+
+def _usv_names() -> list[str]:
+    return [n for n in asset_names() if get_asset(n).is_usv]
+
+
+class Difficulty(_Model):
+    """A difficulty level: the closest-approach range between the ego and each ranged target, the number of
+    extra (distractor) targets, drawn from ``extra_classes`` (default: every size class), and an optional
+    occlusion requirement (share of frames the primary target is hidden from the ego by the static map)."""
+
+    range_m: Pair = (100.0, 400.0)
+    extra_targets: tuple[int, int] = (0, 0)
+    extra_classes: list[str] | None = None
+    occluded_share: float | None = Field(default=None, gt=0.0, le=1.0)
+
+    @field_validator("range_m")
+    @classmethod
+    def _range(cls, v: Pair) -> Pair:
+        if v[0] < 0:
+            raise ValueError("must be >= 0")
+        return _ordered(v, "range_m")
+
+    @field_validator("extra_targets", mode="before")
+    @classmethod
+    def _extra(cls, v: Any) -> Any:
+        return (v, v) if isinstance(v, int) and not isinstance(v, bool) else v
+
+    @field_validator("extra_targets")
+    @classmethod
+    def _extra_range(cls, v: tuple[int, int]) -> tuple[int, int]:
+        if v[0] < 0 or v[1] > 16 or v[0] > v[1]:
+            raise ValueError("must be n or [low, high] with 0 <= low <= high <= 16")
+        return v
+
+
+DEFAULT_DIFFICULTIES: dict[str, Difficulty] = {
+    "easy": Difficulty(range_m=(80.0, 250.0), extra_targets=(0, 0)),
+    "medium": Difficulty(range_m=(150.0, 500.0), extra_targets=(0, 1)),
+    "hard": Difficulty(range_m=(300.0, 900.0), extra_targets=(1, 3)),
+}
+
+
+class Combination(_Model):
+    """One role combination with its quota: a family template, a difficulty, the ego USV asset, the number of
+    cooperating USVs and the size class of each role target (the first is the primary target)."""
+
+    name: str | None = Field(default=None, pattern=r"^[A-Za-z0-9_\-]+$", max_length=80)
+    family: str
+    difficulty: str = "easy"
+    ego: str | None = None
+    cooperating: int = Field(default=0, ge=0, le=8)
+    targets: list[str] = Field(default_factory=lambda: ["small"], min_length=1, max_length=8)
+    quota: int = Field(default=1, ge=1, le=100_000)
+    max_attempts: int | None = Field(default=None, ge=1, le=10_000_000)
+
+    @field_validator("family")
+    @classmethod
+    def _family(cls, v: str) -> str:
+        if v not in FAMILIES:
+            close = difflib.get_close_matches(v, list(FAMILIES), n=2, cutoff=0.5)
+            hint = f"did you mean {', '.join(close)}? " if close else ""
+            raise ValueError(f"unknown family; {hint}(families: {', '.join(FAMILIES)})")
+        return v
+
+    @field_validator("ego")
+    @classmethod
+    def _ego(cls, v: str | None) -> str | None:
+        if v is not None:
+            _known_asset(v)
+            if not get_asset(v).is_usv:
+                raise ValueError(f"the ego must be a USV asset ({', '.join(_usv_names())})")
+        return v
+
+    def label(self) -> str:
+        """The combination's name: ``name`` or ``<family>_<difficulty>_<1+cooperating>usv_<classes>``."""
+        if self.name is not None:
+            return self.name
+        return f"{self.family}_{self.difficulty}_{1 + self.cooperating}usv_{'-'.join(self.targets)}"
+
+
+# ---------------------------------------------------------------------------------------------------- the spec
+
+
+def _default_rigs() -> dict[str, dict[str, Any]]:
+    return {"usv_standard": {}}
+
+
+class GenerationSpec(_Model):
+    """A whole generation spec (see the module docstring)."""
+
+    name: str = Field(default="generated", pattern=r"^[A-Za-z0-9_\-.]+$")
+    seed: int = Field(default=0, ge=0, lt=2**63)
+    map: MapConfig = Field(default_factory=MapConfig)
+    environment: dict[str, Any] = Field(default_factory=dict)
+    acquisition: AcquisitionConfig = Field(default_factory=AcquisitionConfig)
+    rig: str = Field(default="usv_standard", pattern=r"^[A-Za-z0-9_\-]+$")
+    rigs: dict[str, dict[str, Any]] = Field(default_factory=_default_rigs)
+    usv: UsvRoles = Field(default_factory=UsvRoles)
+    size_classes: dict[str, SizeClass] = Field(default_factory=lambda: dict(DEFAULT_SIZE_CLASSES))
+    difficulties: dict[str, Difficulty] = Field(default_factory=lambda: dict(DEFAULT_DIFFICULTIES))
+    combinations: list[Combination] = Field(min_length=1)
+    constraints: Constraints = Field(default_factory=Constraints)
+    max_attempts_per_scenario: int = Field(default=40, ge=1, le=100_000)
+    check_step_m: float = Field(default=2.0, gt=0.0, le=50.0)
+    sensor_height_m: float = Field(default=2.5, gt=0.0, le=100.0)
+    encounter_clearance_m: float = Field(default=100.0, ge=0.0)
+    proposals: int = Field(default=6, ge=1, le=100)
+
+    @field_validator("environment")
+    @classmethod
+    def _environment(cls, v: dict[str, Any]) -> dict[str, Any]:
+        fields = EnvironmentConfig.model_fields
+        for key, value in v.items():
+            if key not in fields:
+                raise ValueError(f"unknown environment key {key!r} (allowed: {', '.join(fields)})")
+            choices = value if isinstance(value, list) else [value]
+            if not choices:
+                raise ValueError(f"environment.{key}: an empty list has nothing to choose from")
+            for c in choices:
+                try:
+                    EnvironmentConfig.model_validate({key: c})
+                except ValidationError as exc:
+                    msg = str(exc.errors()[0]["msg"]).removeprefix("Value error, ")
+                    raise ValueError(f"environment.{key} = {c!r}: {msg}") from None
+        return v
+
+    def max_attempts(self, combo: Combination) -> int:
+        """The attempt cap of a combination: its own ``max_attempts`` or ``quota x max_attempts_per_scenario``."""
+        return combo.max_attempts if combo.max_attempts is not None else combo.quota * self.max_attempts_per_scenario
+
+
+def _field_path(loc: tuple[int | str, ...]) -> str:
+    out = ""
+    for part in loc:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        else:
+            out += ("." if out else "") + str(part)
+    return out or "spec"
+
+
+def _spec_error(err: ValidationError, source: str) -> ConfigError:
+    lines = []
+    for e in err.errors():
+        loc = tuple(p for p in e["loc"] if not (isinstance(p, str) and ("[" in p or p in {"str", "float", "function-after"})))
+        value = e.get("input")
+        shown = repr(value) if not isinstance(value, (dict, list)) or len(repr(value)) < 80 else f"<{type(value).__name__}>"
+        msg = str(e["msg"]).removeprefix("Value error, ")
+        lines.append(f"invalid spec {_field_path(loc)} = {shown}: {msg}")
+    return ConfigError(f"{source}: " + "; ".join(lines))
+
+
+def _cross_checks(spec: GenerationSpec, source: str) -> None:
+    """Checks that need several fields; raises ConfigError naming the field at fault."""
+
+    def fail(path: str, value: object, msg: str) -> None:
+        raise ConfigError(f"{source}: invalid spec {path} = {value!r}: {msg}")
+
+    if spec.rig not in spec.rigs:
+        fail("rig", spec.rig, f"not defined under rigs: ({', '.join(sorted(spec.rigs))})")
+    try:  # the rig must be valid in a scenario: validate it in a one-vessel scenario
+        load_scenario({"rigs": {spec.rig: spec.rigs[spec.rig]}, "vessels": [{"id": "probe", "asset": "usv_wamv", "route": [[0, 0], [1, 0]]}]})
+    except ConfigError as exc:
+        fail(f"rigs.{spec.rig}", spec.rigs[spec.rig], str(exc).removeprefix("scenario: "))
+    for name, sc in spec.size_classes.items():
+        if not class_assets(sc):
+            fail(f"size_classes.{name}.length_m", list(sc.length_m), "no target asset has a length in this range")
+    for name, d in spec.difficulties.items():
+        for c in d.extra_classes or []:
+            if c not in spec.size_classes:
+                fail(f"difficulties.{name}.extra_classes", c, f"not a size class ({', '.join(spec.size_classes)})")
+    labels: set[str] = set()
+    for i, combo in enumerate(spec.combinations):
+        where = f"combinations[{i}]"
+        if combo.difficulty not in spec.difficulties:
+            fail(f"{where}.difficulty", combo.difficulty, f"not defined under difficulties: ({', '.join(spec.difficulties)})")
+        for j, t in enumerate(combo.targets):
+            if t not in spec.size_classes:
+                fail(f"{where}.targets[{j}]", t, f"not a size class ({', '.join(spec.size_classes)})")
+        fam = FAMILIES[combo.family]
+        if fam.map_types and spec.map.type not in fam.map_types:
+            fail(f"{where}.family", combo.family, f"needs a map of type {' or '.join(fam.map_types)} (map.type is {spec.map.type})")
+        if combo.cooperating < fam.min_cooperating:
+            fail(f"{where}.cooperating", combo.cooperating, f"family {combo.family} needs at least {fam.min_cooperating}")
+        label = combo.label()
+        if label in labels:
+            fail(f"{where}.name", label, "two combinations have this name; give them distinct `name:`s")
+        labels.add(label)
+
+
+def load_spec(source: str | os.PathLike[str] | dict[str, Any] | GenerationSpec) -> GenerationSpec:
+    """Validates a generation spec given as a YAML path, a dict or a :class:`GenerationSpec` (returned as is)."""
+    if isinstance(source, GenerationSpec):
+        return source
+    if isinstance(source, dict):
+        data: Any = source
+        where = "spec"
+    else:
+        path = Path(source)
+        if not path.is_file():
+            raise ConfigError(f"spec file {str(path)!r} does not exist")
+        try:
+            data = yaml.safe_load(path.read_text(encoding="utf-8"))
+        except yaml.YAMLError as exc:
+            raise ConfigError(f"{path}: not valid YAML: {exc}") from None
+        where = str(path)
+    if not isinstance(data, dict):
+        raise ConfigError(f"{where}: a generation spec must be a YAML mapping with at least `combinations:`")
+    try:
+        spec = GenerationSpec.model_validate(data)
+    except ValidationError as exc:
+        raise _spec_error(exc, where) from None
+    _cross_checks(spec, where)
+    return spec

@@ -1,0 +1,125 @@
+"""The constraint block of a generation spec: one model per named constraint, with its thresholds.
+
+Units: metres; shares are fractions of the acquisition frames in [0, 1]. Every constraint has ``enabled``;
+:func:`mmusv.generate.checks.build_constraints` turns the enabled ones into checks, in the order of
+:class:`Constraints` (cheap first).
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+__all__ = [
+    "Constraints",
+    "CooperationCheck",
+    "InWaterCheck",
+    "LineOfSightCheck",
+    "OcclusionCheck",
+    "PairKind",
+    "RouteSeparationCheck",
+    "SensingRangeCheck",
+    "SeparationCheck",
+    "ShoreClearanceCheck",
+    "StructureClearanceCheck",
+    "TargetRangeCheck",
+]
+
+PairKind = Literal["usv-usv", "usv-target", "target-target"]
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class _Check(_Model):
+    enabled: bool = True
+
+
+class InWaterCheck(_Check):
+    """Every route sample and every vessel position (centre) in navigable water."""
+
+
+class ShoreClearanceCheck(_Check):
+    """Hull (bounding circle) at least ``min_m`` from non-navigable cells (land, shallows, structures, map edge)."""
+
+    min_m: float = Field(default=10.0, ge=0.0)
+
+
+class StructureClearanceCheck(_Check):
+    """Hull at least ``min_m`` from port structures, buoys and moored ships."""
+
+    min_m: float = Field(default=15.0, ge=0.0)
+
+
+class SeparationCheck(_Check):
+    """Hull-to-hull distance (bounding circles) at least ``min_m`` between every two vessels at every time."""
+
+    min_m: float = Field(default=15.0, ge=0.0)
+
+
+class RouteSeparationCheck(_Check):
+    """Route centre lines of the vessel pairs of kinds ``pairs`` at least ``min_m`` apart everywhere."""
+
+    min_m: float = Field(default=20.0, ge=0.0)
+    pairs: list[PairKind] = Field(default_factory=lambda: list[PairKind](["usv-usv"]))
+
+
+class TargetRangeCheck(_Check):
+    """Closest approach (over frames) of the ego to each ranged target within the difficulty's ``range_m``."""
+
+
+class SensingRangeCheck(_Check):
+    """Each target within ``range_m`` of at least one USV for at least ``min_share`` of the frames."""
+
+    range_m: float = Field(default=1000.0, gt=0.0)
+    min_share: float = Field(default=0.8, ge=0.0, le=1.0)
+    targets: Literal["all", "role"] = "all"
+
+
+class CooperationCheck(_Check):
+    """Each USV's nearest other USV between ``min_m`` and ``max_m`` for at least ``min_share`` of the frames
+    (vacuous with one USV)."""
+
+    min_m: float = Field(default=20.0, ge=0.0)
+    max_m: float = Field(default=800.0, gt=0.0)
+    min_share: float = Field(default=1.0, ge=0.0, le=1.0)
+
+    @model_validator(mode="after")
+    def _bounds(self) -> CooperationCheck:
+        if self.min_m > self.max_m:
+            raise ValueError(f"min_m ({self.min_m}) must not exceed max_m ({self.max_m})")
+        return self
+
+
+class LineOfSightCheck(_Check):
+    """Each role target seen (ray cast against the static map, within sensing range) by at least one USV for
+    at least ``min_share`` of the frames."""
+
+    enabled: bool = False
+    min_share: float = Field(default=0.5, ge=0.0, le=1.0)
+
+
+class OcclusionCheck(_Check):
+    """For combinations that ask for occlusion: the primary target hidden from the ego by the static map for at
+    least ``min_occluded_share`` of the frames (a difficulty's ``occluded_share`` overrides it), and during at
+    least ``min_visible_other_share`` of those frames seen by another USV (line of sight and sensing range)."""
+
+    min_occluded_share: float = Field(default=0.3, gt=0.0, le=1.0)
+    min_visible_other_share: float = Field(default=0.5, ge=0.0, le=1.0)
+
+
+class Constraints(_Model):
+    """The named constraints, in evaluation order (cheap first); the first that fails rejects an attempt."""
+
+    in_water: InWaterCheck = Field(default_factory=InWaterCheck)
+    shore_clearance: ShoreClearanceCheck = Field(default_factory=ShoreClearanceCheck)
+    structure_clearance: StructureClearanceCheck = Field(default_factory=StructureClearanceCheck)
+    separation: SeparationCheck = Field(default_factory=SeparationCheck)
+    route_separation: RouteSeparationCheck = Field(default_factory=RouteSeparationCheck)
+    target_range: TargetRangeCheck = Field(default_factory=TargetRangeCheck)
+    sensing_range: SensingRangeCheck = Field(default_factory=SensingRangeCheck)
+    cooperation: CooperationCheck = Field(default_factory=CooperationCheck)
+    line_of_sight: LineOfSightCheck = Field(default_factory=LineOfSightCheck)
+    occlusion: OcclusionCheck = Field(default_factory=OcclusionCheck)
