@@ -190,24 +190,19 @@ class Simulation:
 
     def _check_mounts(self, agent: Agent, where: str) -> None:
         """A sensor whose origin lies inside its own hull would see only the hull's inside: refuse it."""
-        dirs = _sphere_directions(48)
         mounts: list[tuple[str, np.ndarray]] = []
         if agent.lidar_mount is not None:
             mounts.append((f"{where}.lidar.mount", agent.lidar_mount))
         if agent.radar_mount is not None:
             mounts.append((f"{where}.radar.mount", agent.radar_mount))
         mounts += [(f"{where}.cameras[{n}].mount", m) for n, (_, _, m) in agent.cameras.items()]
-        inst = int(self.ws.vessel_instances[agent.index])
-        body = self.ws.scene.instance_pose(inst)
         for name, m in mounts:
-            origin = (body @ m)[:3, 3]
-            hits = self.ws.scene.cast_rays(np.tile(origin, (len(dirs), 1)), dirs, max_range=2.0 * float(agent.asset.length) + 10)
-            own_back = (hits.instance_id == inst) & hits.backface
-            if own_back.mean() > 0.9:
+            if inside_mesh(agent.asset.mesh.vertices, agent.asset.mesh.faces, m[:3, 3]):
                 xyz = np.round(m[:3, 3], 3).tolist()
                 raise ConfigError(
                     f"invalid config {name} = {xyz}: the sensor sits inside the hull of vessel {agent.id!r} "
-                    f"({agent.asset.name}, deck/top at z = {agent.asset.bbox[1, 2]:.2f} m); move it above the hull"
+                    f"({agent.asset.name}, top at z = {agent.asset.bbox[1, 2]:.2f} m); move it outside the hull, "
+                    "e.g. onto a mount point (`mmusv assets` lists them) or above the deck"
                 )
 
     # ------------------------------------------------------------------------------------------ state
@@ -286,6 +281,10 @@ class Simulation:
         ``agents`` limits the USVs (ids), ``sensors`` the sensor kinds (``lidar``, ``cameras``, ``top_view``,
         ``radar``); ``None`` means all. ``radar=False`` leaves the radar out whatever ``sensors`` says.
         """
+        if agents is not None:
+            unknown = sorted(set(agents) - {a.id for a in self.agents})
+            if unknown:
+                raise ConfigError(f"no USV named {', '.join(map(repr, unknown))}; the USVs are {[a.id for a in self.agents]}")
         kinds = set(SENSOR_KINDS if sensors is None else sensors)
         if not radar:
             kinds.discard("radar")
@@ -339,6 +338,33 @@ class Simulation:
             self.ws.scene, pose=cap.radar_pose, config=cfg, environment=self.environment,
             seed=sensor_seed(self.scenario.seed, frame, agent.index, "radar"),
         )
+
+
+def inside_mesh(vertices: np.ndarray, faces: np.ndarray, point: np.ndarray, *, rays: int = 9) -> bool:
+    """Whether ``point`` lies inside the closed (union of) mesh(es) ``vertices``/``faces`` (same frame).
+
+    Along each of ``rays`` directions every crossing is found by re-casting past the previous hit; the winding
+    number is (back-face exits − front-face entries). The point is inside when most rays give a positive one.
+    """
+    from mmusv.scene import Scene
+
+    scene = Scene()
+    scene.add_instance(scene.add_mesh(vertices, faces, classes=0))
+    dirs = _sphere_directions(rays)
+    origin = np.tile(np.asarray(point, dtype=np.float64), (rays, 1))
+    winding = np.zeros(rays, dtype=np.int64)
+    active = np.ones(rays, dtype=bool)
+    for _ in range(64):
+        if not active.any():
+            break
+        hits = scene.cast_rays(origin[active], dirs[active])
+        idx = np.nonzero(active)[0]
+        hit = hits.hit
+        winding[idx[hit]] += np.where(hits.backface[hit], 1, -1)
+        active[idx[~hit]] = False
+        step = hits.distance[hit].astype(np.float64) + 1e-4
+        origin[idx[hit]] += dirs[idx[hit]] * step[:, None]
+    return bool(np.count_nonzero(winding > 0) * 2 > rays)
 
 
 def _sphere_directions(n: int) -> npt.NDArray[np.float64]:

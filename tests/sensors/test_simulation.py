@@ -1,0 +1,477 @@
+"""Capturing frames with :class:`mmusv.simulation.Simulation`: determinism, one shared state per frame,
+sensor poses from the mounts, and configuration errors that name the field.
+
+The bundled scenario (``scenarios/island_port_waves.yaml``) is used with a shrunk rig (one 160×120 camera, a
+128×128 top view, no radar); the other tests use the small scenario of ``conftest.py``.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import mmusv
+import numpy as np
+import pytest
+import yaml
+from mmusv._native import core
+from mmusv.sensors import CameraImages, LidarPoints
+from mmusv.sensors.camera import BODY_TO_OPTICAL
+from mmusv.simulation import FrameCapture, Simulation, WorldState, sensor_seed
+from mmusv.world.build import pose_matrices
+from mmusv.world.vessels import get_asset
+
+BUNDLED = Path(__file__).resolve().parents[2] / "scenarios" / "island_port_waves.yaml"
+SMALL_RIG = {
+    "cameras": [{"name": "front", "resolution": [160, 120], "mount": {"point": "camera_front"}}],
+    "top_view": {"resolution": [128, 128]},
+    "radar": None,
+}
+LIDAR_FIELDS = ("xyz", "range", "intensity", "ring", "azimuth", "semantic_class", "instance", "ray_index")
+
+
+def bundled(**rig: Any) -> dict[str, Any]:
+    """The bundled scenario as a dict with the small rig (plus ``rig`` overrides) for every USV."""
+    d: dict[str, Any] = yaml.safe_load(BUNDLED.read_text(encoding="utf-8"))
+    d["rigs"] = {"usv_standard": {**SMALL_RIG, **rig}}
+    return d
+
+
+def assert_same_capture(a: FrameCapture, b: FrameCapture) -> None:
+    assert a.frame == b.frame and a.time_s == b.time_s
+    for name in ("poses", "velocities", "box_centers", "matrices"):
+        assert np.array_equal(getattr(a.world, name), getattr(b.world, name)), name
+    assert a.agents.keys() == b.agents.keys()
+    for aid, ca in a.agents.items():
+        cb = b.agents[aid]
+        assert isinstance(ca.lidar, LidarPoints) and isinstance(cb.lidar, LidarPoints)
+        for f in LIDAR_FIELDS:
+            assert np.array_equal(getattr(ca.lidar, f), getattr(cb.lidar, f)), f"{aid}.lidar.{f}"
+        assert ca.lidar_pose is not None and cb.lidar_pose is not None
+        assert np.array_equal(ca.lidar_pose, cb.lidar_pose)
+        assert ca.cameras.keys() == cb.cameras.keys()
+        pairs: list[tuple[str, CameraImages | None, CameraImages | None]] = [
+            (f"camera/{n}", ca.cameras[n], cb.cameras[n]) for n in ca.cameras
+        ]
+        pairs.append(("top_view", ca.top_view, cb.top_view))
+        for name, ia, ib in pairs:
+            assert ia is not None and ib is not None
+            for f in ("depth", "semantic", "instance"):
+                assert np.array_equal(getattr(ia, f), getattr(ib, f)), f"{aid}.{name}.{f}"
+            assert (ia.rgb is None) == (ib.rgb is None)
+            if ia.rgb is not None:
+                assert np.array_equal(ia.rgb, ib.rgb), f"{aid}.{name}.rgb"
+        for n in ca.camera_poses:
+            assert np.array_equal(ca.camera_poses[n], cb.camera_poses[n])
+
+
+# ------------------------------------------------------------------------------------------ determinism
+
+
+@pytest.fixture(scope="module")
+def bundled_pair() -> tuple[Simulation, Simulation]:
+    return Simulation(bundled()), Simulation(bundled())
+
+
+def test_bundled_scenario_capture_is_deterministic(bundled_pair: tuple[Simulation, Simulation]) -> None:
+    s1, s2 = bundled_pair
+    a = s1.capture(3, radar=False)
+    b = s2.capture(3, radar=False)
+    assert set(a.agents) == {"usv_1", "usv_2", "usv_3", "usv_4"}
+    assert_same_capture(a, b)
+    for cap in a.agents.values():
+        assert cap.lidar is not None and len(cap.lidar) > 100
+        assert cap.cameras["front"].depth.shape == (120, 160)
+        assert cap.top_view is not None and cap.top_view.depth.shape == (128, 128)
+        assert cap.radar is None
+    # Another frame is another state.
+    c = s1.capture(4, radar=False)
+    assert not np.array_equal(c.world.poses, a.world.poses)
+    assert not np.array_equal(c.agents["usv_1"].cameras["front"].depth, a.agents["usv_1"].cameras["front"].depth)
+
+
+def test_capture_does_not_depend_on_history(bundled_pair: tuple[Simulation, Simulation]) -> None:
+    """The state of frame k is a pure function of (scenario, seed, k): visiting other frames first changes nothing."""
+    s1, s2 = bundled_pair
+    s1.capture(11, radar=False)
+    s1.capture(0, radar=False)
+    a = s1.capture(5, radar=False)
+    b = Simulation(bundled()).capture(5, radar=False)
+    assert_same_capture(a, b)
+    s2.capture(5, agents=["usv_2"], radar=False)
+    only = s2.capture(5, agents=["usv_2"], radar=False)
+    assert set(only.agents) == {"usv_2"}
+    lp_a, lp_o = a.agents["usv_2"].lidar, only.agents["usv_2"].lidar
+    assert lp_a is not None and lp_o is not None
+    for f in LIDAR_FIELDS:
+        assert np.array_equal(getattr(lp_a, f), getattr(lp_o, f)), f
+
+
+def test_scenario_seed_drives_the_noise() -> None:
+    d = bundled()
+    d["seed"] = 12
+    other = Simulation(d).capture(3, agents=["usv_1"], radar=False)
+    base = Simulation(bundled()).capture(3, agents=["usv_1"], radar=False)
+    la, lb = base.agents["usv_1"].lidar, other.agents["usv_1"].lidar
+    assert la is not None and lb is not None
+    assert not (len(la) == len(lb) and np.array_equal(la.range, lb.range)), "another seed, other noise"
+    assert sensor_seed(11, 3, 0, "lidar") != sensor_seed(12, 3, 0, "lidar")
+    assert sensor_seed(11, 3, 0, "lidar") != sensor_seed(11, 4, 0, "lidar")
+    assert sensor_seed(11, 3, 0, "camera", 0) != sensor_seed(11, 3, 0, "camera", 1)
+
+
+_HASH_SCRIPT = """
+import hashlib, json, sys
+import numpy as np
+from mmusv.simulation import Simulation
+
+def capture_digest(sim, frame):
+    cap = sim.capture(frame, radar=False)
+    h = hashlib.sha256()
+    for aid, a in sorted(cap.agents.items()):
+        for f in ("xyz", "range", "intensity", "ring", "azimuth", "semantic_class", "instance", "ray_index"):
+            h.update(np.ascontiguousarray(getattr(a.lidar, f)).tobytes())
+        images = [c for _, c in sorted(a.cameras.items())] + [a.top_view]
+        for img in images:
+            for f in ("depth", "semantic", "instance", "rgb"):
+                v = getattr(img, f)
+                h.update(b"-" if v is None else np.ascontiguousarray(v).tobytes())
+    return h.hexdigest()
+
+if __name__ == "__main__":
+    print(capture_digest(Simulation(json.loads(sys.stdin.read())), int(sys.argv[1])))
+"""
+
+
+def test_capture_is_independent_of_the_thread_count(make_scenario: Any, sim: Simulation, tmp_path: Path) -> None:
+    """Counter-based noise and per-ray results: one worker thread gives bit-identical frames."""
+    import json
+    import os
+    import runpy
+    import subprocess
+    import sys
+
+    script = tmp_path / "digest.py"
+    script.write_text(_HASH_SCRIPT, encoding="utf-8")
+    here = runpy.run_path(str(script))["capture_digest"](sim, 5)
+    env = {**os.environ, "RAYON_NUM_THREADS": "1"}
+    out = subprocess.run(
+        [sys.executable, str(script), "5"], input=json.dumps(make_scenario()), env=env,
+        capture_output=True, text=True, timeout=120, check=True,
+    )
+    assert out.stdout.strip() == here
+
+
+@pytest.mark.parametrize("agent_id", ["usv_a", "usv_b"])
+def test_capture_applies_the_water_model_with_the_scenario_waves(sim: Simulation, agent_id: str) -> None:
+    """Water returns in a capture follow the rig's water model at the environment's wave height (W1: 1.5 m)."""
+    cap = sim.capture(2, agents=[agent_id], radar=False)
+    ac = cap.agents[agent_id]
+    agent = sim.agent(agent_id)
+    cfg = agent.rig.lidar
+    assert cfg is not None and ac.lidar is not None and ac.lidar_pose is not None
+    wave = sim.environment.wave_height_m
+    assert wave == pytest.approx(1.5)
+    p = min(1.0, cfg.water_probability + cfg.water_probability_per_wave_m * wave)
+    reach = cfg.water_range_m + cfg.water_range_per_wave_m * wave
+    # Re-cast the pattern with the scene to know which rays reach open water, and how far.
+    dirs = np.asarray(agent.lidar.pattern(), dtype=np.float64) @ ac.lidar_pose[:3, :3].T
+    hits = sim.ws.scene.cast_rays(np.broadcast_to(ac.lidar_pose[:3, 3], dirs.shape), dirs, max_range=cfg.range_m)
+    water_ray = (hits.semantic_class == 1) & (hits.distance >= cfg.range_min_m)
+    eligible = water_ray & (hits.distance <= reach)
+    got = ac.lidar.semantic_class == 1
+    assert np.all(eligible[ac.lidar.ray_index[got]]), "water returns only within the water range"
+    n, k = int(eligible.sum()), int(got.sum())
+    assert n > 500 and abs(k - n * p) < 4.5 * math.sqrt(n * p * (1 - p)), f"{k} water returns of {n} rays, p = {p}"
+    # Other surfaces return unless the (clear, 20 km visibility) air loses them: probability exp(−2σr).
+    solid = (hits.semantic_class != 1) & np.isfinite(hits.distance) & (hits.distance >= cfg.range_min_m)
+    sigma = sim.environment.weather.extinction_per_m + 1e-5 * sim.environment.weather.rain_mm_per_h**0.6
+    tau = np.exp(-2 * sigma * hits.distance[solid].astype(np.float64))
+    kept = np.isin(np.flatnonzero(solid), ac.lidar.ray_index)
+    assert abs(kept.sum() - tau.sum()) <= 4.5 * math.sqrt(np.sum(tau * (1 - tau))) + 1
+    assert np.isin(ac.lidar.ray_index[~got], np.flatnonzero(solid)).all()
+
+
+def test_fallback_mounts_on_assets_without_mount_points(make_scenario: Any) -> None:
+    """A USV on an asset without mount points gets its sensors 0.5 m above the hull's top, pointing where the
+    mount name says (camera_left: +90°)."""
+    sc = make_scenario()
+    sc["vessels"][2]["asset"] = "fishing_boat_12m"
+    s = Simulation(sc)
+    asset = get_asset("fishing_boat_12m")
+    assert not asset.mounts
+    agent = s.agent("usv_b")
+    top = float(asset.bbox[1, 2]) + 0.5
+    assert agent.lidar_mount is not None
+    np.testing.assert_allclose(agent.lidar_mount, pose_matrices(np.array([0, 0, top, 0, 0, 0])), atol=1e-12)
+    np.testing.assert_allclose(agent.cameras["aux"][2], pose_matrices(np.array([0, 0, top, 0, 0, math.pi / 2])), atol=1e-12)
+    cap = s.capture(0, agents=["usv_b"], radar=False)
+    lidar = cap.agents["usv_b"].lidar
+    assert lidar is not None and not np.any(lidar.instance == s.vessels[2].instance_id), "no returns from its own hull"
+
+
+# ------------------------------------------------------------------------------------------ one state per frame
+
+
+def in_body_box(points_world: np.ndarray, state: WorldState, vessel: int, centre: np.ndarray, size: np.ndarray, margin: float) -> np.ndarray:
+    """``(N,)`` bool: world points inside vessel ``vessel``'s box (body frame, ±``margin`` metres) in ``state``."""
+    m = state.matrices[vessel]
+    body = (points_world - m[:3, 3]) @ m[:3, :3]
+    inside: np.ndarray = np.all(np.abs(body - centre) <= size / 2 + margin, axis=1)
+    return inside
+
+
+class SurfaceDistance:
+    """Distance from world points to a vessel's mesh placed at its pose in a world state (Open3D)."""
+
+    def __init__(self, asset_name: str) -> None:
+        o3d = pytest.importorskip("open3d")
+        mesh = get_asset(asset_name).mesh
+        self._scene = o3d.t.geometry.RaycastingScene()
+        self._scene.add_triangles(
+            o3d.core.Tensor(np.asarray(mesh.vertices, dtype=np.float32)), o3d.core.Tensor(np.asarray(mesh.faces, dtype=np.uint32))
+        )
+        self._o3d = o3d
+
+    def __call__(self, points_world: np.ndarray, state: WorldState, vessel: int) -> np.ndarray:
+        m = state.matrices[vessel]
+        body = ((points_world - m[:3, 3]) @ m[:3, :3]).astype(np.float32)
+        d: np.ndarray = self._scene.compute_distance(self._o3d.core.Tensor(body)).numpy().astype(np.float64)
+        return d
+
+
+@pytest.mark.parametrize("frame", [3, 12])
+def test_all_sensors_see_the_frame_state(sim: Simulation, frame: int) -> None:
+    """Every sensor of every USV sees the tug on its mesh at this frame's world-state pose (and not at the pose
+    of three frames earlier, 1.8 m back): LiDAR points, camera pixels back-projected with their depth, top-view
+    pixels at (pixel centre, altitude − depth)."""
+    cap = sim.capture(frame, radar=False)
+    state = cap.world
+    assert state.frame == frame and state.time_s == pytest.approx(frame / 5.0)
+    earlier = sim.world_state(frame - 3)
+    tgt_index = 1
+    tgt = sim.vessels[tgt_index]
+    assert tgt.id == "tgt" and tgt.role == "target"
+    box = (tgt.box_center_body, tgt.box_size)
+    dist = SurfaceDistance(tgt.asset)
+    # The scene holds exactly the world-state poses.
+    for i, v in enumerate(sim.vessels[: len(sim.scenario.vessels)]):
+        np.testing.assert_allclose(sim.ws.scene.instance_pose(v.instance_id), state.matrices[i], atol=1e-9)
+    # The world-state box centre is the body box centre moved by the pose.
+    m = state.matrices[tgt_index]
+    np.testing.assert_allclose(state.box_centers[tgt_index], m[:3, :3] @ tgt.box_center_body + m[:3, 3], atol=1e-9)
+
+    def check(world: np.ndarray, tol: float | np.ndarray, what: str) -> None:
+        assert in_body_box(world, state, tgt_index, *box, margin=0.02).all(), what
+        d_now = dist(world, state, tgt_index)
+        assert np.all(d_now <= tol), f"{what}: up to {d_now.max():.3f} m off the tug's surface"
+        assert np.quantile(dist(world, earlier, tgt_index), 0.9) > 0.2, f"{what}: the check tells frames apart"
+
+    seen = []
+    for aid, ac in cap.agents.items():
+        # LiDAR (no range noise in this rig).
+        assert ac.lidar is not None and ac.lidar_pose is not None
+        on = ac.lidar.instance == tgt.instance_id
+        assert np.all(ac.lidar.semantic_class[on] == tgt.semantic_class)
+        if on.sum() >= 20:
+            pw = ac.lidar.xyz[on].astype(np.float64) @ ac.lidar_pose[:3, :3].T + ac.lidar_pose[:3, 3]
+            check(pw, 0.01, f"{aid}/lidar")
+            seen.append(f"{aid}/lidar")
+        # Cameras: pixel-centre ray scaled to the depth (optical z = depth).
+        for name, img in ac.cameras.items():
+            cam, _, _ = sim.agent(aid).cameras[name]
+            mask = img.instance == tgt.instance_id
+            assert np.all(img.semantic[mask] == tgt.semantic_class)
+            if mask.sum() < 20:
+                continue
+            cp = ac.camera_poses[name]
+            fx, fy, cx, cy = cam.intrinsics
+            vv, uu = np.nonzero(mask)
+            opt = np.stack([(uu + 0.5 - cx) / fx, (vv + 0.5 - cy) / fy, np.ones(len(uu))], axis=1)
+            depth = img.depth[vv, uu].astype(np.float64)
+            world = (opt * depth[:, None]) @ BODY_TO_OPTICAL @ cp[:3, :3].T + cp[:3, 3]
+            check(world, 0.01 + 1e-4 * depth, f"{aid}/{name}")
+            seen.append(f"{aid}/{name}")
+        # Top view: camera body (depth, left, up) = (depth, (W/2 − u)·m, (H/2 − v)·m).
+        tv, tvc = ac.top_view, sim.agent(aid).rig.top_view
+        assert tv is not None and tvc is not None and ac.top_view_pose is not None
+        mask = tv.instance == tgt.instance_id
+        if mask.sum() >= 20:
+            w, h = tvc.resolution
+            mpp = tvc.metres_per_pixel
+            vv, uu = np.nonzero(mask)
+            local = np.stack([tv.depth[vv, uu].astype(np.float64), (w / 2 - (uu + 0.5)) * mpp, (h / 2 - (vv + 0.5)) * mpp], axis=1)
+            world = local @ ac.top_view_pose[:3, :3].T + ac.top_view_pose[:3, 3]
+            check(world, 0.02, f"{aid}/top_view")
+            seen.append(f"{aid}/top_view")
+    assert len(seen) >= 5, f"the tug is seen by (nearly) every sensor: {seen}"
+
+
+def test_sensor_poses_follow_mounts(sim: Simulation) -> None:
+    cap = sim.capture(6, radar=False)
+    state = cap.world
+    for agent in sim.agents:
+        ac = cap.agents[agent.id]
+        asset = get_asset(agent.vessel.asset)
+        body = state.matrices[agent.index]
+        mp = asset.mounts["lidar"]
+        assert ac.lidar_pose is not None
+        np.testing.assert_allclose(ac.lidar_pose[:3, 3], body[:3, :3] @ np.array(mp.xyz) + body[:3, 3], atol=1e-9)
+        np.testing.assert_allclose(ac.lidar_pose[:3, :3], body[:3, :3], atol=1e-12)  # LiDAR mount not rotated
+        fp = asset.mounts["camera_front"]
+        np.testing.assert_allclose(ac.camera_poses["front"][:3, 3], body[:3, :3] @ np.array(fp.xyz) + body[:3, 3], atol=1e-9)
+        if "aux" in ac.camera_poses:  # on the camera_left point: looks 90° to port
+            np.testing.assert_allclose(ac.camera_poses["aux"][:3, 0], body[:3, 1], atol=1e-9)
+        # Top view: level, altitude above the USV's (x, y), looking straight down.
+        tv = agent.rig.top_view
+        assert tv is not None and ac.top_view_pose is not None
+        x, y, _, _, _, yaw = state.poses[agent.index]
+        np.testing.assert_allclose(ac.top_view_pose[:3, 3], [x, y, tv.altitude_m], atol=1e-9)
+        np.testing.assert_allclose(ac.top_view_pose[:3, 0], [0.0, 0.0, -1.0], atol=1e-12)
+        up_in_image = ac.top_view_pose[:3, 2]  # camera body +z = image up (−v)
+        heading = yaw if tv.orientation == "heading_up" else math.pi / 2
+        np.testing.assert_allclose(up_in_image, [math.cos(heading), math.sin(heading), 0.0], atol=1e-12)
+
+
+# ------------------------------------------------------------------------------------------ misconfiguration
+
+
+def winding_number(vertices: np.ndarray, faces: np.ndarray, p: np.ndarray) -> float:
+    """Generalised winding number of a closed mesh around ``p`` (1 inside, 0 outside; Van Oosterom–Strackee)."""
+    a, b, c = (vertices[faces[:, k]].astype(np.float64) - p for k in range(3))
+    la, lb, lc = (np.linalg.norm(x, axis=1) for x in (a, b, c))
+    num = np.einsum("ij,ij->i", a, np.cross(b, c))
+    den = la * lb * lc + np.einsum("ij,ij->i", a, b) * lc + np.einsum("ij,ij->i", b, c) * la + np.einsum("ij,ij->i", c, a) * lb
+    return float(2 * np.arctan2(num, den).sum() / (4 * np.pi))
+
+
+def test_mount_inside_hull_is_refused(make_scenario: Any) -> None:
+    """A camera at 1 m above the WAM-V origin is inside its hull (winding number 1): refused, naming the mount."""
+    asset = get_asset("usv_wamv")
+    assert winding_number(asset.mesh.vertices, asset.mesh.faces, np.array([0.0, 0.0, 1.0])) == pytest.approx(1.0, abs=1e-6)
+    sc = make_scenario()
+    sc["rigs"]["rn"]["cameras"][0]["mount"] = {"xyz": [0.0, 0.0, 1.0]}
+    with pytest.raises(mmusv.ConfigError, match=r"rigs\.rn\.cameras\[front\]\.mount"):
+        Simulation(sc)
+    sc = make_scenario()
+    sc["rigs"]["rn"]["lidar"]["mount"] = {"xyz": [0.0, 0.0, 1.0]}
+    with pytest.raises(mmusv.ConfigError, match=r"rigs\.rn\.lidar\.mount"):
+        Simulation(sc)
+
+
+@pytest.mark.parametrize("z", [0.0, 1.0, 2.0])
+def test_mount_inside_monohull_is_refused(make_scenario: Any, z: float) -> None:
+    """``{xyz: [0, 0, z]}`` without a point is relative to the vessel origin (midship, waterline): inside the
+    patrol boat's hull for these z (winding number 1), so the Simulation must refuse it, naming the mount."""
+    asset = get_asset("usv_patrol_12m")
+    assert winding_number(asset.mesh.vertices, asset.mesh.faces, np.array([0.0, 0.0, z])) == pytest.approx(1.0, abs=1e-6)
+    sc = make_scenario()
+    assert sc["vessels"][0]["asset"] == "usv_patrol_12m" and sc["vessels"][0]["rig"] == "r"
+    sc["rigs"]["r"]["cameras"][0]["mount"] = {"xyz": [0.0, 0.0, z]}
+    with pytest.raises(mmusv.ConfigError, match=r"rigs\.r\.cameras\[front\]\.mount"):
+        Simulation(sc)
+
+
+def test_mount_outside_hull_is_accepted(make_scenario: Any) -> None:
+    """Between the WAM-V's pontoons at the waterline is outside the hull (winding number 0)."""
+    asset = get_asset("usv_wamv")
+    assert winding_number(asset.mesh.vertices, asset.mesh.faces, np.array([0.0, 0.0, 0.0])) == pytest.approx(0.0, abs=1e-6)
+    sc = make_scenario()
+    sc["rigs"]["rn"]["cameras"][0]["mount"] = {"xyz": [0.0, 0.0, 3.0]}
+    Simulation(sc)
+
+
+@pytest.mark.parametrize(
+    "lidar,pattern",
+    [
+        ({"channels": 0}, r"rigs\.r\.lidar\.channels"),
+        ({"range_m": -10}, r"rigs\.r\.lidar\.range_m"),
+        ({"range_m": 0}, r"rigs\.r\.lidar\.range_m"),
+        ({"range_min_m": 250}, r"rigs\.r\.lidar\b.*range_min_m"),
+        ({"range_min_m": 200}, r"rigs\.r\.lidar\b.*range_min_m"),
+        ({"range_min_m": -1}, r"rigs\.r\.lidar\.range_min_m"),
+        ({"dropout": 1.5}, r"rigs\.r\.lidar\.dropout"),
+        ({"vertical_fov_deg": [-95, 10]}, r"rigs\.r\.lidar\.vertical_fov_deg"),
+        ({"elevations_deg": [1.0, 2.0]}, r"rigs\.r\.lidar\b.*elevations_deg"),
+        ({"points_per_second": 0}, r"rigs\.r\.lidar\.points_per_second"),
+        ({"channel": 16}, r"rigs\.r\.lidar\.channel\b"),
+        ({"mount": {"point": "lidar", "xyz": [0, 0, float("nan")]}}, r"rigs\.r\.lidar\.mount\.xyz"),
+    ],
+)
+def test_lidar_misconfig_names_the_field(make_scenario: Any, lidar: dict[str, Any], pattern: str) -> None:
+    sc = make_scenario()
+    sc["rigs"]["r"]["lidar"].update(lidar)
+    with pytest.raises(mmusv.ConfigError, match=pattern):
+        Simulation(sc)
+
+
+@pytest.mark.parametrize(
+    "rig,pattern",
+    [
+        ({"lidars": {}}, r"rigs\.r\.lidars"),
+        ({"sonar": None}, r"rigs\.r\.sonar"),
+        ({"cameras": [{"name": "a"}, {"name": "a"}]}, r"rigs\.r\b.*repeated: a"),
+        ({"cameras": [{"name": "bad name!"}]}, r"rigs\.r\.cameras\[0\]\.name"),
+        ({"top_view": {"orientation": "south_up"}}, r"rigs\.r\.top_view\.orientation"),
+    ],
+)
+def test_rig_misconfig_names_the_field(make_scenario: Any, rig: dict[str, Any], pattern: str) -> None:
+    sc = make_scenario()
+    sc["rigs"]["r"].update(rig)
+    with pytest.raises(mmusv.ConfigError, match=pattern):
+        Simulation(sc)
+
+
+def test_unknown_rig_name_is_an_error(make_scenario: Any) -> None:
+    sc = make_scenario()
+    sc["vessels"][0]["rig"] = "nope"
+    with pytest.raises(mmusv.ConfigError, match="nope"):
+        Simulation(sc)
+
+
+def test_native_lidar_misconfig_names_the_field() -> None:
+    ok: dict[str, Any] = {
+        "elevations": [0.0, 0.1],
+        "azimuth_steps": 16,
+        "range_min": 0.5,
+        "range_max": 100.0,
+        "range_noise_std": 0.0,
+        "dropout": 0.0,
+        "water_probability": 0.1,
+        "water_probability_per_wave_m": 0.1,
+        "water_range_m": 20.0,
+        "water_range_per_wave_m": 10.0,
+    }
+    core.Lidar(**ok)
+    for change, field in [
+        ({"elevations": []}, "lidar.channels"),
+        ({"range_max": -1.0}, "lidar.range_m"),
+        ({"range_min": 200.0}, "lidar.range_m"),
+        ({"range_min": -1.0}, "lidar.range_min_m"),
+        ({"dropout": 2.0}, "lidar.dropout"),
+        ({"water_probability": -0.1}, "lidar.water_probability"),
+        ({"range_noise_std": float("nan")}, "lidar.range_noise_std_m"),
+        ({"azimuth_steps": 0}, "lidar.azimuth_steps"),
+        ({"elevations": [0.0, math.pi / 2]}, "elevations"),
+    ]:
+        with pytest.raises(mmusv.errors.ConfigError, match=field.replace(".", r"\.")):
+            core.Lidar(**{**ok, **change})
+
+
+def test_frame_outside_acquisition(sim: Simulation) -> None:
+    with pytest.raises(mmusv.ConfigError, match="frame"):
+        sim.capture(sim.frames)
+    with pytest.raises(mmusv.ConfigError, match="frame"):
+        sim.capture(-1)
+    with pytest.raises(mmusv.ConfigError, match="no USV named"):
+        sim.agent("tgt")
+
+
+def test_pose_matrices_convention() -> None:
+    """R = Rz(yaw)·Ry(pitch)·Rx(roll): positive pitch points the nose (x) down, positive yaw turns x to +y."""
+    m = pose_matrices(np.array([0, 0, 0, 0.0, math.radians(30), 0.0]))
+    np.testing.assert_allclose(m[:3, 0], [math.cos(math.radians(30)), 0, -0.5], atol=1e-12)
+    m = pose_matrices(np.array([1, 2, 3, 0.0, 0.0, math.pi / 2]))
+    np.testing.assert_allclose(m[:3, 0], [0, 1, 0], atol=1e-12)
+    np.testing.assert_allclose(m[:3, 3], [1, 2, 3])
