@@ -8,6 +8,8 @@ use mmusv_core::Result;
 pub const LIDAR_HEIGHT: f32 = 2.5;
 /// Camera mount height above the waterline, metres.
 pub const CAMERA_HEIGHT: f32 = 2.0;
+/// Radar antenna height above the waterline, metres.
+pub const RADAR_HEIGHT: f32 = 3.0;
 
 /// Rays as parallel origin / direction arrays.
 pub type Rays = (Vec<[f32; 3]>, Vec<[f32; 3]>);

@@ -5,7 +5,9 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let which = args.get(1).map_or("lidar", String::as_str);
     let reps: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(3);
-    let (Ok(demo), Ok(rays)) = (mmusv_benches::scene(), if which == "lidar" { mmusv_benches::lidar() } else { mmusv_benches::cameras() }) else {
+    let (Ok(demo), Ok(rays)) =
+        (mmusv_benches::scene(), if which == "lidar" { mmusv_benches::lidar() } else { mmusv_benches::cameras() })
+    else {
         eprintln!("could not build the scene");
         return;
     };
@@ -17,5 +19,9 @@ fn main() {
         }
     }
     let dt = t0.elapsed().as_secs_f64();
-    println!("{which}: {} rays x {reps} in {dt:.3} s = {:.2} Mrays/s (hits {hits})", rays.0.len(), (rays.0.len() * reps) as f64 / dt / 1e6);
+    println!(
+        "{which}: {} rays x {reps} in {dt:.3} s = {:.2} Mrays/s (hits {hits})",
+        rays.0.len(),
+        (rays.0.len() * reps) as f64 / dt / 1e6
+    );
 }

@@ -48,7 +48,9 @@ fn bench_sensors(c: &mut Criterion) {
     g.bench_function("camera_640x480_depth_semantic", |b| {
         b.iter(|| black_box(cam.render(scene, &cam_pose, &env, false, 1)))
     });
-    g.bench_function("camera_640x480_rgb_shaded", |b| b.iter(|| black_box(cam.render(scene, &cam_pose, &env, true, 1))));
+    g.bench_function("camera_640x480_rgb_shaded", |b| {
+        b.iter(|| black_box(cam.render(scene, &cam_pose, &env, true, 1)))
+    });
     g.throughput(Throughput::Elements(512 * 512));
     g.bench_function("top_view_512x512_rgb", |b| b.iter(|| black_box(top.render(scene, &top_pose, &env, true, 1))));
     g.finish();

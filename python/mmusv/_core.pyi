@@ -27,6 +27,10 @@ __all__ = [
     "lidar_directions",
     "uniform_elevations",
     "lidar_trace_order",
+    "radar_sweep",
+    "ppi_image",
+    "Lidar",
+    "Camera",
     "demo_scene",
     "Fleet",
     "default_amplitudes",
@@ -222,6 +226,54 @@ class Camera:
         shadows: bool = True,
     ) -> dict[str, npt.NDArray[Any]]:
         """depth (H,W) f32, semantic (H,W) u16, instance (H,W) i32 and, if rgb, rgb (H,W,3) u8."""
+
+# --- radar ---
+
+def radar_sweep(
+    scene: Scene,
+    *,
+    pose: npt.NDArray[np.float64],
+    range_min_m: float,
+    range_max_m: float,
+    range_resolution_m: float,
+    azimuth_bins: int,
+    beamwidth_az_rad: float,
+    elevation_fan_rad: tuple[float, float],
+    rays_az: int,
+    rays_el: int,
+    horizon_fraction: float,
+    horizon_band_rad: float,
+    detection_threshold: float,
+    range_noise_std_m: float,
+    sea_sigma0_at_1m: float,
+    critical_range_per_m: float,
+    sea_max_range_m: float,
+    rain_eta_at_1mm_h: float,
+    wave_height_m: float,
+    rain_mm_per_h: float,
+    seed: int,
+) -> dict[str, npt.NDArray[Any]]:
+    """One radar revolution from ``pose`` ((4, 4) float64 sensor → world); GIL released. Returns equal-length
+    arrays sorted by (azimuth bin, range bin): ``range`` (N,) f32 m, ``azimuth`` (N,) f32 rad sensor frame in
+    [0, 2π), ``elevation`` (N,) f32 rad, ``intensity`` (N,) f32 (1.0 = a 1 m² target at 1 km), ``instance``
+    (N,) i32 (-1 = clutter), ``class`` (N,) u16. Bad values raise ``ConfigError`` naming ``radar.<field>``."""
+
+def ppi_image(
+    *,
+    range: npt.NDArray[np.float32],
+    azimuth: npt.NDArray[np.float32],
+    intensity: npt.NDArray[np.float32],
+    size_px: int,
+    metres_per_pixel: float,
+    orientation: str,
+    sensor_yaw: float,
+    range_resolution_m: float,
+    azimuth_bins: int,
+) -> npt.NDArray[np.float32]:
+    """(size_px, size_px) float32 PPI of returns (``range`` m, ``azimuth`` rad sensor frame, ``intensity``; (N,)
+    float32 each): ego at pixel (size_px // 2, size_px // 2), row 0 at the top, a return at range R exactly
+    R / metres_per_pixel px from it; ``orientation`` "north_up" (rotated by ``sensor_yaw`` rad) or "head_up"."""
+
 
 # --- demo ---
 

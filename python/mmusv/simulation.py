@@ -26,6 +26,7 @@ from mmusv.motion import build_fleet
 from mmusv.sensors.camera import CameraImages, camera_from_config, render, shading_kwargs, top_view_from_config
 from mmusv.sensors.config import CameraConfig, Mount, RigConfig
 from mmusv.sensors.lidar import LidarPoints, lidar_from_config, scan
+from mmusv.sensors.radar import RadarReturns, RadarSettings, ppi_image, radar_sweep
 from mmusv.world.build import WorldScene, build_world_scene, pose_matrices
 from mmusv.world.environment import Environment
 from mmusv.world.maps import MapWorld, generate_map
@@ -105,6 +106,7 @@ class Agent:
     radar_mount: np.ndarray | None
     cameras: dict[str, tuple[Any, CameraConfig, np.ndarray]] = field(default_factory=dict)
     top_view: Any | None = None
+    radar_settings: RadarSettings | None = None
 
     @property
     def id(self) -> str:
@@ -123,7 +125,7 @@ class AgentCapture:
     camera_poses: dict[str, np.ndarray]
     top_view: CameraImages | None
     top_view_pose: np.ndarray | None
-    radar: Any | None = None
+    radar: RadarReturns | None = None
     radar_ppi: np.ndarray | None = None
     radar_pose: np.ndarray | None = None
 
@@ -180,6 +182,10 @@ class Simulation:
             agent.lidar_mount = mount_matrix(asset, rig.lidar.mount, where=f"{where}.lidar.mount")
         if rig.radar is not None:
             agent.radar_mount = mount_matrix(asset, rig.radar.mount, where=f"{where}.radar.mount")
+            try:
+                agent.radar_settings = RadarSettings(**rig.radar.sensor_fields())  # type: ignore[arg-type]
+            except ConfigError as exc:
+                raise ConfigError(f"{where}.{exc}") from None
         for c in rig.cameras:
             m = mount_matrix(asset, c.mount, where=f"{where}.cameras[{c.name}].mount")
             agent.cameras[c.name] = (camera_from_config(c), c, m)
@@ -330,13 +336,15 @@ class Simulation:
         return FrameCapture(frame, state.time_s, state, out)
 
     def _radar(self, agent: Agent, cap: AgentCapture, state: WorldState, frame: int) -> None:
-        from mmusv.sensors import radar as radar_mod  # the radar sensor lives in its own module
-
         cfg = agent.rig.radar
-        assert cfg is not None and cap.radar_pose is not None
-        cap.radar, cap.radar_ppi = radar_mod.capture(
-            self.ws.scene, pose=cap.radar_pose, config=cfg, environment=self.environment,
-            seed=sensor_seed(self.scenario.seed, frame, agent.index, "radar"),
+        assert cfg is not None and cap.radar_pose is not None and agent.radar_settings is not None
+        cap.radar = radar_sweep(
+            self.ws.scene, pose=cap.radar_pose, settings=agent.radar_settings, wave_height_m=self.environment.wave_height_m,
+            rain_mm_per_h=self.environment.weather.rain_mm_per_h, seed=sensor_seed(self.scenario.seed, frame, agent.index, "radar"),
+        )
+        cap.radar_ppi = ppi_image(
+            cap.radar, size_px=cfg.ppi_size_px, metres_per_pixel=cfg.ppi_metres_per_pixel, orientation=cfg.ppi_orientation,
+            settings=agent.radar_settings,
         )
 
 

@@ -12,7 +12,7 @@
 //! - [`mesh`]: triangle meshes with per-face semantic classes and a parry bottom-level BVH built once.
 //! - [`scene`]: meshes placed as instances, a top-level BVH over them, and batch ray casting over rayon.
 //! - [`export`]: the world triangles at the current poses as PLY or OBJ.
-//! - [`sensors`]: sensor ray patterns (LiDAR sweeps, pinhole cameras).
+//! - [`sensors`]: sensor ray patterns (LiDAR sweeps, pinhole cameras), the marine radar and its PPI image.
 //! - [`demo`]: a synthetic maritime scene for benchmarks and comparisons.
 //! - [`kinematics`]: spline routes at nominal speed with wave-driven heave, roll and pitch.
 //!

@@ -10,6 +10,7 @@ mod demo;
 mod errors;
 mod kinematics;
 mod native;
+mod radar;
 mod scene;
 mod sensors;
 
@@ -21,6 +22,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     scene::register(m)?;
     kinematics::register(m)?;
     sensors::register(m)?;
+    radar::register(m)?;
     demo::register(m)?;
     Ok(())
 }

@@ -115,18 +115,28 @@ class LidarConfig(_Model):
 
 
 class RadarConfig(_Model):
-    """Rotating marine radar (ray cast) and its PPI image at a fixed metres-per-pixel scale."""
+    """Rotating marine radar (ray cast) and its PPI image at a fixed metres-per-pixel scale. The sensor fields
+    mirror :class:`mmusv.sensors.radar.RadarSettings` (see it for the model); ``ppi_*`` set the image:
+    ``ppi_metres_per_pixel`` defaults to ``range_m / (ppi_size_px / 2)``."""
 
-    range_m: float = Field(default=3000.0, gt=0)
-    range_min_m: float = Field(default=5.0, ge=0)
+    range_m: float = Field(default=3000.0, gt=0, le=100_000)
+    min_range_m: float = Field(default=10.0, ge=0)
     range_resolution_m: float = Field(default=3.0, gt=0)
     azimuth_bins: int = Field(default=2048, ge=1, le=65536)
-    beamwidth_deg: float = Field(default=1.2, gt=0, lt=90)
+    beamwidth_deg: float = Field(default=1.2, gt=0, le=90)
     elevation_fan_deg: tuple[float, float] = (-10.0, 10.0)
     rays_az: int = Field(default=3, ge=1, le=64)
     rays_el: int = Field(default=16, ge=1, le=256)
+    horizon_fraction: float = Field(default=0.75, ge=0, le=1)
+    horizon_band_deg: float = Field(default=1.0, ge=0, le=45)
+    detection_threshold: float = Field(default=0.3, ge=0)
+    range_noise_std_m: float = Field(default=0.0, ge=0)
+    sea_clutter_sigma0: float = Field(default=4.0e-7, ge=0)
+    clutter_critical_range_per_m: float = Field(default=300.0, ge=0)
+    sea_clutter_max_range_m: float = Field(default=2500.0, ge=0)
+    rain_clutter_eta: float = Field(default=5.0e-9, ge=0)
     ppi_size_px: int = Field(default=512, ge=16, le=8192)
-    ppi_metres_per_pixel: float = Field(default=10.0, gt=0)
+    ppi_metres_per_pixel: float | None = Field(default=None, gt=0)
     ppi_orientation: Literal["north_up", "head_up"] = "north_up"
     mount: Mount = Mount(point="radar")
 
@@ -135,9 +145,13 @@ class RadarConfig(_Model):
         lo, hi = self.elevation_fan_deg
         if not (-90 < lo <= hi < 90):
             raise ValueError("elevation_fan_deg needs -90 < lower <= upper < 90 degrees")
-        if self.range_min_m >= self.range_m:
-            raise ValueError(f"range_min_m ({self.range_min_m}) must be below range_m ({self.range_m})")
+        if self.min_range_m >= self.range_m:
+            raise ValueError(f"min_range_m ({self.min_range_m}) must be below range_m ({self.range_m})")
         return self
+
+    def sensor_fields(self) -> dict[str, object]:
+        """The keyword arguments of :class:`mmusv.sensors.radar.RadarSettings`."""
+        return self.model_dump(exclude={"ppi_size_px", "ppi_metres_per_pixel", "ppi_orientation", "mount"})
 
 
 class CameraConfig(_Model):

@@ -2,11 +2,16 @@
 //! - [`rays`]: ray patterns (spinning LiDAR sweeps, pinhole cameras);
 //! - [`lidar`]: the spinning multi-channel LiDAR with noise, dropout, water returns and weather;
 //! - [`camera`]: pinhole and orthographic (top-view) cameras giving depth, semantic, instance and RGB;
+//! - [`radar`]: the rotating ray-cast marine radar ([`radar_model`]: its intensity, rain and clutter
+//!   formulas) and [`ppi`]: the PPI image at a fixed metres-per-pixel scale;
 //! - [`shade`]: the RGB shading model (sun, sky, water, shadows, fog, rain);
 //! - [`noise`]: counter-based random draws, so results never depend on thread scheduling.
 
 pub mod camera;
 pub mod lidar;
 pub mod noise;
+pub mod ppi;
+pub mod radar;
+pub mod radar_model;
 pub mod rays;
 pub mod shade;

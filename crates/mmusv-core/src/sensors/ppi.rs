@@ -1,0 +1,311 @@
+//! The plan-position indicator (PPI): radar returns rasterised into an ego-centred square image at a fixed
+//! scale.
+//!
+//! Pixel `(row, col)` has its centre at `(row, col)` in pixel units; the sensor sits at the centre of pixel
+//! `(S/2, S/2)` (integer division) of an `S × S` image, row 0 at the top. A point at range `r` (metres) and
+//! screen angle `θ` (counter-clockwise from screen right) is at `col = S/2 + (r/m) cos θ`,
+//! `row = S/2 − (r/m) sin θ` with `m` metres per pixel: **a target at range `R` is `R / m` pixels from the
+//! centre in every frame**, whatever else is in view (the scale never adapts to the content).
+//!
+//! * North-up: up is world north (+y), right is east (+x): `θ = azimuth + sensor_yaw`.
+//! * Head-up: up is the sensor's forward (+x), left its +y: `θ = azimuth + π/2`.
+//!
+//! Each return is painted as its polar cell, range `[r − Δr/2, r + Δr/2)` × azimuth `[a − π/N, a + π/N)`
+//! (`N` azimuth bins): every pixel whose centre lies in the cell takes the return's intensity, with max
+//! compositing, so neighbouring cells tile the image without gaps and far cells are arcs. The pixel nearest
+//! the cell centre is always painted too, so a cell thinner than a pixel never vanishes.
+
+use crate::error::{MmusvError, Result};
+use crate::sensors::radar::{validate_azimuth_bins, validate_resolution, RadarConfig, RadarReturns};
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
+
+/// Largest PPI side, pixels.
+pub const MAX_PPI_SIZE: u32 = 8192;
+
+/// Which way is up in the PPI.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum PpiOrientation {
+    /// Up is world north (+y).
+    #[default]
+    NorthUp,
+    /// Up is the sensor's forward axis (+x).
+    HeadUp,
+}
+
+impl PpiOrientation {
+    /// Parses `"north_up"` or `"head_up"`; the error names `ppi.orientation`.
+    pub fn parse(name: &str) -> Result<Self> {
+        match name {
+            "north_up" => Ok(Self::NorthUp),
+            "head_up" => Ok(Self::HeadUp),
+            other => Err(MmusvError::config("ppi.orientation", other, "must be \"north_up\" or \"head_up\"")),
+        }
+    }
+}
+
+/// Size, scale and orientation of a PPI image.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PpiConfig {
+    /// Image side, pixels (`1..=8192`); the image is `size_px × size_px`.
+    pub size_px: u32,
+    /// Scale, metres per pixel (`> 0`).
+    pub metres_per_pixel: f32,
+    /// North-up or head-up.
+    pub orientation: PpiOrientation,
+}
+
+impl Default for PpiConfig {
+    /// 512 px at 12 m/px: a 3 km radar fills the image.
+    fn default() -> Self {
+        Self { size_px: 512, metres_per_pixel: 12.0, orientation: PpiOrientation::NorthUp }
+    }
+}
+
+impl PpiConfig {
+    /// Checks the size and scale; errors name `ppi.size_px` / `ppi.metres_per_pixel`.
+    pub fn validate(&self) -> Result<()> {
+        if !(1..=MAX_PPI_SIZE).contains(&self.size_px) {
+            return Err(MmusvError::config("ppi.size_px", self.size_px, format!("must be in 1..={MAX_PPI_SIZE}")));
+        }
+        let m = self.metres_per_pixel;
+        if !(m.is_finite() && m > 0.0) {
+            return Err(MmusvError::config("ppi.metres_per_pixel", m, "must be a finite number of metres > 0"));
+        }
+        Ok(())
+    }
+
+    /// Screen angle (radians, counter-clockwise from screen right) of sensor azimuth `azimuth`.
+    pub fn screen_angle(&self, azimuth: f64, sensor_yaw: f64) -> f64 {
+        match self.orientation {
+            PpiOrientation::NorthUp => azimuth + sensor_yaw,
+            PpiOrientation::HeadUp => azimuth + FRAC_PI_2,
+        }
+    }
+
+    /// Continuous `(row, col)` pixel coordinates of the point at `range` metres and sensor `azimuth`.
+    pub fn pixel(&self, range: f64, azimuth: f64, sensor_yaw: f64) -> (f64, f64) {
+        let c = (self.size_px / 2) as f64;
+        let rho = range / self.metres_per_pixel as f64;
+        let (s, co) = self.screen_angle(azimuth, sensor_yaw).sin_cos();
+        (c - rho * s, c + rho * co)
+    }
+}
+
+/// Wraps an angle into `[−π, π)`.
+fn wrap(a: f64) -> f64 {
+    (a + PI).rem_euclid(TAU) - PI
+}
+
+/// The `size × size` float32 PPI (row-major, row 0 at the top) of `returns` from a sensor with world yaw
+/// `sensor_yaw` (radians; used by north-up only). `cfg_radar` gives the cell size (`range_resolution_m`,
+/// `azimuth_bins`); only `range`, `azimuth` and `intensity` of the returns are read. Pixels without a return
+/// are 0.
+pub fn ppi_image(
+    returns: &RadarReturns,
+    cfg: &PpiConfig,
+    sensor_yaw: f32,
+    cfg_radar: &RadarConfig,
+) -> Result<Vec<f32>> {
+    cfg.validate()?;
+    validate_resolution(cfg_radar.range_resolution_m)?;
+    validate_azimuth_bins(cfg_radar.azimuth_bins)?;
+    let n = returns.range.len();
+    if returns.azimuth.len() != n || returns.intensity.len() != n {
+        return Err(MmusvError::input(
+            "returns",
+            format!(
+                "range, azimuth and intensity must have the same length, got {}, {} and {}",
+                n,
+                returns.azimuth.len(),
+                returns.intensity.len()
+            ),
+        ));
+    }
+    if !sensor_yaw.is_finite() {
+        return Err(MmusvError::input("sensor_yaw", format!("{sensor_yaw} is not a finite angle in radians")));
+    }
+    let bad = |v: &[f32], ok: fn(f32) -> bool| v.iter().position(|&x| !ok(x));
+    if let Some(i) = bad(&returns.range, |r| r.is_finite() && r >= 0.0) {
+        return Err(MmusvError::input(
+            format!("range[{i}]"),
+            format!("{} must be finite metres >= 0", returns.range[i]),
+        ));
+    }
+    if let Some(i) = bad(&returns.azimuth, f32::is_finite) {
+        return Err(MmusvError::input(format!("azimuth[{i}]"), "must be a finite angle in radians"));
+    }
+    if let Some(i) = bad(&returns.intensity, f32::is_finite) {
+        return Err(MmusvError::input(format!("intensity[{i}]"), "must be finite"));
+    }
+    let size = cfg.size_px as usize;
+    let mut img = vec![0.0f32; size * size];
+    let mpp = cfg.metres_per_pixel as f64;
+    let half_range = cfg_radar.range_resolution_m / 2.0;
+    let half_az = PI / cfg_radar.azimuth_bins as f64;
+    let c = (cfg.size_px / 2) as f64;
+    let yaw = sensor_yaw as f64;
+    for i in 0..n {
+        let (r, v) = (returns.range[i] as f64, returns.intensity[i]);
+        let theta = cfg.screen_angle(returns.azimuth[i] as f64, yaw);
+        let (rho0, rho1) = (((r - half_range) / mpp).max(0.0), (r + half_range) / mpp);
+        let mut paint = |row: i64, col: i64| {
+            if (0..size as i64).contains(&row) && (0..size as i64).contains(&col) {
+                let p = &mut img[row as usize * size + col as usize];
+                *p = p.max(v);
+            }
+        };
+        // Bounding box of the annular sector: its corners plus the axis directions it spans.
+        let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+        let mut add = |rho: f64, a: f64| {
+            let (s, co) = a.sin_cos();
+            x0 = x0.min(rho * co);
+            x1 = x1.max(rho * co);
+            y0 = y0.min(rho * s);
+            y1 = y1.max(rho * s);
+        };
+        for a in [theta - half_az, theta + half_az] {
+            add(rho0, a);
+            add(rho1, a);
+        }
+        for axis in [0.0, FRAC_PI_2, PI, -FRAC_PI_2] {
+            if wrap(axis - theta).abs() <= half_az {
+                add(rho1, axis);
+            }
+        }
+        let (col0, col1) = ((c + x0).floor() as i64, (c + x1).ceil() as i64);
+        let (row0, row1) = ((c - y1).floor() as i64, (c - y0).ceil() as i64);
+        for row in row0.max(0)..=row1.min(size as i64 - 1) {
+            let dy = c - row as f64;
+            for col in col0.max(0)..=col1.min(size as i64 - 1) {
+                let dx = col as f64 - c;
+                let rho = (dx * dx + dy * dy).sqrt();
+                if rho < rho0 || rho >= rho1 {
+                    continue;
+                }
+                let d = wrap(dy.atan2(dx) - theta);
+                if d >= -half_az && d < half_az {
+                    paint(row, col);
+                }
+            }
+        }
+        let rho = r / mpp;
+        paint((c - rho * theta.sin()).round() as i64, (c + rho * theta.cos()).round() as i64);
+    }
+    Ok(img)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn one(range: f32, azimuth: f32, intensity: f32) -> RadarReturns {
+        RadarReturns {
+            range: vec![range],
+            azimuth: vec![azimuth],
+            elevation: vec![0.0],
+            intensity: vec![intensity],
+            instance: vec![1],
+            class: vec![10],
+        }
+    }
+
+    fn painted(img: &[f32], size: usize) -> Vec<(usize, usize)> {
+        (0..img.len()).filter(|&i| img[i] > 0.0).map(|i| (i / size, i % size)).collect()
+    }
+
+    #[test]
+    fn target_at_range_r_is_r_over_mpp_pixels_from_centre() {
+        let radar = RadarConfig::default();
+        for orientation in [PpiOrientation::NorthUp, PpiOrientation::HeadUp] {
+            let cfg = PpiConfig { size_px: 401, metres_per_pixel: 7.5, orientation };
+            let c = 200i64;
+            // Exact: R / mpp an integer, on the four screen axes.
+            for (k, r_px) in [(0u32, 10i64), (1, 57), (2, 133), (3, 199)] {
+                let want_theta = k as f64 * FRAC_PI_2;
+                let yaw = 0.3f32;
+                let az = match orientation {
+                    PpiOrientation::NorthUp => want_theta - yaw as f64,
+                    PpiOrientation::HeadUp => want_theta - FRAC_PI_2,
+                };
+                let az = az.rem_euclid(TAU) as f32;
+                let img = ppi_image(&one(r_px as f32 * 7.5, az, 2.0), &cfg, yaw, &radar).unwrap_or_default();
+                let (dr, dc) = [(0, 1), (-1, 0), (0, -1), (1, 0)][k as usize];
+                let (row, col) = (c + dr * r_px, c + dc * r_px);
+                assert_eq!(img[(row * 401 + col) as usize], 2.0, "{orientation:?} k={k} r={r_px}");
+                for (pr, pc) in painted(&img, 401) {
+                    let d = (((pr as i64 - c).pow(2) + (pc as i64 - c).pow(2)) as f64).sqrt();
+                    assert!((d - r_px as f64).abs() <= 1.5 / 7.5 + 0.5, "pixel at {d} for {r_px}");
+                }
+            }
+            // Anywhere: every painted pixel lies within the cell's range ± half a pixel diagonal.
+            for i in 0..200 {
+                let r = 20.0 + 7.31 * i as f64;
+                let az = (i as f64 * 0.731).rem_euclid(TAU);
+                let img = ppi_image(&one(r as f32, az as f32, 1.0), &cfg, 1.1, &radar).unwrap_or_default();
+                let px = painted(&img, 401);
+                assert!(!px.is_empty());
+                for (pr, pc) in px {
+                    let d = (((pr as i64 - c).pow(2) + (pc as i64 - c).pow(2)) as f64).sqrt();
+                    assert!((d - r / 7.5).abs() <= 1.5 / 7.5 + 0.75, "pixel at {d} px for {} px", r / 7.5);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn orientation_and_arcs() {
+        let radar = RadarConfig { azimuth_bins: 64, range_resolution_m: 10.0, ..RadarConfig::default() };
+        // Forward (azimuth 0) with the sensor facing east (yaw 0): right in north-up, up in head-up.
+        let ret = one(500.0, 0.0, 1.0);
+        let north = PpiConfig { size_px: 256, metres_per_pixel: 5.0, orientation: PpiOrientation::NorthUp };
+        let img = ppi_image(&ret, &north, 0.0, &radar).unwrap_or_default();
+        assert_eq!(img[128 * 256 + 228], 1.0);
+        let head = PpiConfig { orientation: PpiOrientation::HeadUp, ..north };
+        let img = ppi_image(&ret, &head, 0.0, &radar).unwrap_or_default();
+        assert_eq!(img[28 * 256 + 128], 1.0);
+        // A 64-bin beam at 100 px spans 2π/64 · 100 ≈ 9.8 px of arc: an arc, not a dot.
+        assert!(painted(&img, 256).len() >= 15, "{}", painted(&img, 256).len());
+        // Sensor yawed 90° (facing north): forward is up in north-up too.
+        let img = ppi_image(&ret, &north, std::f32::consts::FRAC_PI_2, &radar).unwrap_or_default();
+        assert_eq!(img[28 * 256 + 128], 1.0);
+        // Max compositing; cells of a full ring tile without gaps.
+        let ring = RadarReturns {
+            range: vec![300.0; 64],
+            azimuth: (0..64).map(|b| (TAU * b as f64 / 64.0) as f32).collect(),
+            intensity: (0..64).map(|b| b as f32 + 1.0).collect(),
+            ..RadarReturns::default()
+        };
+        let img = ppi_image(&ring, &north, 0.0, &radar).unwrap_or_default();
+        for k in 0..720 {
+            let a = TAU * k as f64 / 720.0;
+            let (row, col) = north.pixel(300.0, a, 0.0);
+            assert!(img[row.round() as usize * 256 + col.round() as usize] > 0.0, "gap at {a}");
+        }
+    }
+
+    #[test]
+    fn bad_inputs_are_errors() {
+        let r = RadarConfig::default();
+        let ok = one(100.0, 0.0, 1.0);
+        let field = |res: Result<Vec<f32>>| match res {
+            Err(MmusvError::Config { field, .. } | MmusvError::InvalidInput { field, .. }) => field,
+            other => format!("{:?}", other.map(|v| v.len())),
+        };
+        let p = PpiConfig::default();
+        assert_eq!(field(ppi_image(&ok, &PpiConfig { size_px: 0, ..p }, 0.0, &r)), "ppi.size_px");
+        assert_eq!(field(ppi_image(&ok, &PpiConfig { metres_per_pixel: -1.0, ..p }, 0.0, &r)), "ppi.metres_per_pixel");
+        let bins = RadarConfig { azimuth_bins: 0, ..r };
+        assert_eq!(field(ppi_image(&ok, &p, 0.0, &bins)), "radar.azimuth_bins");
+        let short = RadarReturns { intensity: vec![], ..ok.clone() };
+        assert_eq!(field(ppi_image(&short, &p, 0.0, &r)), "returns");
+        let neg = one(-3.0, 0.0, 1.0);
+        assert_eq!(field(ppi_image(&neg, &p, 0.0, &r)), "range[0]");
+        assert_eq!(field(ppi_image(&ok, &p, f32::NAN, &r)), "sensor_yaw");
+        assert_eq!(PpiOrientation::parse("head_up"), Ok(PpiOrientation::HeadUp));
+        assert!(
+            matches!(PpiOrientation::parse("up"), Err(MmusvError::Config { field, .. }) if field == "ppi.orientation")
+        );
+        // Returns outside the image are clipped, not errors.
+        assert!(ppi_image(&one(1e5, 1.0, 1.0), &p, 0.0, &r).is_ok_and(|v| v.iter().all(|&x| x == 0.0)));
+    }
+}

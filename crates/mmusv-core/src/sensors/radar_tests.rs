@@ -1,0 +1,234 @@
+//! Unit tests of the radar sweep (`radar.rs`): binning, determinism, clutter, validation.
+
+use super::*;
+use crate::mesh::Mesh;
+
+fn box_mesh(half: [f32; 3], class: u16) -> Mesh {
+    let [a, b, c] = half;
+    let v = [[-a, -b, -c], [a, -b, -c], [a, b, -c], [-a, b, -c], [-a, -b, c], [a, -b, c], [a, b, c], [-a, b, c]];
+    let f = [
+        [0, 2, 1],
+        [0, 3, 2],
+        [4, 5, 6],
+        [4, 6, 7],
+        [0, 1, 5],
+        [0, 5, 4],
+        [1, 2, 6],
+        [1, 6, 5],
+        [2, 3, 7],
+        [2, 7, 6],
+        [3, 0, 4],
+        [3, 4, 7],
+    ];
+    Mesh::new("box", &v, &f, &[class]).unwrap_or_else(|e| unreachable!("{e}"))
+}
+
+/// A sea plane (instance 0) and a 10 m cube (instance 1) whose near face is at `range` and `bearing`
+/// (world frame, from the origin), standing on the water.
+fn sea_with_box(range: f64, bearing: f64) -> Scene {
+    let mut s = Scene::new();
+    let h = 20_000.0f32;
+    let sea =
+        Mesh::new("sea", &[[-h, -h, 0.0], [h, -h, 0.0], [h, h, 0.0], [-h, h, 0.0]], &[[0, 1, 2], [0, 2, 3]], &[1]);
+    let sea = s.add_mesh(sea.unwrap_or_else(|e| unreachable!("{e}")));
+    let _ = s.add_instance(sea, RigidPose::IDENTITY, None);
+    let cube = s.add_mesh(box_mesh([5.0, 5.0, 5.0], 10));
+    let c = range + 5.0;
+    let pose = RigidPose::from_xyz_rpy([c * bearing.cos(), c * bearing.sin(), 3.0], [0.0, 0.0, bearing]);
+    let _ = s.add_instance(cube, pose, None);
+    s
+}
+
+fn small_cfg() -> RadarConfig {
+    RadarConfig { azimuth_bins: 512, range_max_m: 1500.0, rays_el: 32, ..RadarConfig::default() }
+}
+
+const MAST: RigidPose = RigidPose { rotation: parry3d::math::Mat3::IDENTITY, translation: Vec3::new(0.0, 0.0, 3.0) };
+
+fn sweep(s: &Scene, cfg: &RadarConfig, waves: f32, seed: u64) -> RadarReturns {
+    radar_sweep(s, &MAST, cfg, &RadarEnv { wave_height_m: waves, rain_mm_per_h: 0.0 }, seed)
+        .unwrap_or_else(|e| unreachable!("{e}"))
+}
+
+#[test]
+fn trace_order_is_a_permutation() {
+    for (samples, rows) in [(24, 5), (13, 3), (1, 1), (8, 16)] {
+        let mut seen = vec![false; samples * rows];
+        for g in 0..samples {
+            for k in 0..rows {
+                let i = trace_index(g, k, samples, rows);
+                assert!(!seen[i], "duplicate index {i}");
+                seen[i] = true;
+            }
+        }
+        assert!(seen.iter().all(|&x| x));
+    }
+}
+
+#[test]
+fn ray_pattern_spans_beam_and_fan() {
+    let uniform = RadarConfig { horizon_fraction: 0.0, ..RadarConfig::default() };
+    let [lo, hi] = uniform.elevation_fan_rad;
+    let rows = uniform.rays_el as usize;
+    let mut column = vec![(0.0, 0.0); rows];
+    for cfg in [uniform, RadarConfig::default()] {
+        let (mut min_el, mut max_el) = (f64::MAX, f64::MIN);
+        for g in 0..cfg.rays_az * 64 {
+            let b = g / cfg.rays_az;
+            let az = cfg.sample_azimuth(g);
+            assert!((az - cfg.beam_azimuth(b)).abs() < cfg.beamwidth_az_rad / 2.0);
+            cfg.sample_elevations(g, Some(0.0), &mut column);
+            let total: f64 = column.iter().map(|c| c.1).sum();
+            assert!((total - (hi - lo)).abs() < 1e-9, "weights sum to the fan height");
+            for &(el, _) in &column {
+                assert!(el >= lo && el < hi);
+                min_el = min_el.min(el);
+                max_el = max_el.max(el);
+            }
+        }
+        // Over a few beams the staggered rows cover the fan to within a small fraction of a row spacing.
+        let row = (hi - lo) / rows as f64;
+        assert!(min_el - lo < 0.05 * row && hi - max_el < 0.05 * row, "{min_el} {max_el}");
+    }
+    // Default: three quarters of the rays within ±1° of the horizon, which follows the sensor's roll.
+    let cfg = RadarConfig::default();
+    let rolled = RigidPose::from_xyz_rpy([0.0, 0.0, 3.0], [0.1, 0.0, 0.0]);
+    let left = horizon_elevation(&rolled, std::f64::consts::FRAC_PI_2).unwrap_or(f64::NAN);
+    assert!((left + 0.1).abs() < 1e-6, "rolled right-side-down by 0.1 rad: the horizon on the left is 0.1 rad low");
+    cfg.sample_elevations(7, Some(left), &mut column);
+    let near = column.iter().filter(|c| (c.0 - left).abs() <= cfg.horizon_band_rad).count();
+    assert_eq!(near, rows * 3 / 4);
+    assert_eq!(horizon_elevation(&RigidPose::from_xyz_rpy([0.0; 3], [0.0, 0.0, 2.0]), 1.0), Some(0.0));
+    // A flat fan: every ray at the one elevation, weights still positive.
+    let flat = RadarConfig { elevation_fan_rad: [0.0, 0.0], ..cfg };
+    flat.sample_elevations(3, Some(0.0), &mut column);
+    assert!(column.iter().all(|&(el, w)| el == 0.0 && w > 0.0));
+}
+
+#[test]
+fn target_lands_in_its_range_and_azimuth_bin() {
+    let cfg = small_cfg();
+    for (range, bearing_deg) in [(400.0, 0.0), (730.0, 37.0), (1210.0, 200.0), (95.0, 301.5)] {
+        let bearing = f64::to_radians(bearing_deg);
+        let s = sea_with_box(range, bearing);
+        let ret = sweep(&s, &cfg, 0.0, 1);
+        assert!(ret.instance.iter().all(|&i| i == 1), "only the cube, no clutter without waves");
+        assert!(!ret.is_empty(), "cube at {range} m not seen");
+        let nearest = ret.range.iter().fold(f32::MAX, |m, &r| m.min(r)) as f64;
+        assert!((nearest - range).abs() <= cfg.range_resolution_m, "range {nearest} vs {range}");
+        let k = (0..ret.len()).max_by(|&a, &b| ret.intensity[a].total_cmp(&ret.intensity[b])).unwrap_or(0);
+        let mut diff = (ret.azimuth[k] as f64 - bearing).rem_euclid(std::f64::consts::TAU);
+        if diff > std::f64::consts::PI {
+            diff -= std::f64::consts::TAU;
+        }
+        // Within half a beam (plus half a bin) of some point of the 10 m wide face.
+        let tol = cfg.beamwidth_az_rad / 2.0 + std::f64::consts::PI / cfg.azimuth_bins as f64 + (5.0 / range).atan();
+        assert!(diff.abs() <= tol, "azimuth {} vs {bearing}", ret.azimuth[k]);
+        // Sorted by (azimuth bin, range bin); azimuths are bin centres in [0, 2π).
+        let bin_of = |a: f32| (a as f64 / std::f64::consts::TAU * cfg.azimuth_bins as f64).round() as u32;
+        for w in 0..ret.len().saturating_sub(1) {
+            let key = |i: usize| (bin_of(ret.azimuth[i]), ret.range[i].to_bits());
+            assert!(key(w) < key(w + 1));
+        }
+        assert!(ret.azimuth.iter().all(|&a| (0.0..std::f32::consts::TAU).contains(&a)));
+    }
+}
+
+#[test]
+fn bigger_and_nearer_targets_are_brighter_rain_attenuates() {
+    let cfg = small_cfg();
+    let total = |r: &RadarReturns| r.intensity.iter().map(|&x| x as f64).sum::<f64>();
+    let near = sweep(&sea_with_box(300.0, 0.5), &cfg, 0.0, 1);
+    let far = sweep(&sea_with_box(900.0, 0.5), &cfg, 0.0, 1);
+    assert!(total(&near) > 3.0 * total(&far), "{} vs {}", total(&near), total(&far));
+    let s = sea_with_box(900.0, 0.5);
+    let wet_cfg = RadarConfig { clutter: ClutterModel { rain_eta_at_1mm_h: 0.0, ..ClutterModel::default() }, ..cfg };
+    let wet = radar_sweep(&s, &MAST, &wet_cfg, &RadarEnv { wave_height_m: 0.0, rain_mm_per_h: 30.0 }, 1);
+    let wet = wet.unwrap_or_default();
+    assert!(!wet.is_empty() && total(&wet) < 0.97 * total(&far));
+}
+
+#[test]
+fn same_seed_same_bytes_other_seed_other_clutter() {
+    let cfg = RadarConfig { range_noise_std_m: 0.5, ..small_cfg() };
+    let s = sea_with_box(500.0, 1.0);
+    let a = sweep(&s, &cfg, 2.0, 7);
+    let b = sweep(&s, &cfg, 2.0, 7);
+    assert_eq!(a, b);
+    let c = sweep(&s, &cfg, 2.0, 8);
+    assert_ne!(a.range, c.range);
+    // Thread count does not matter.
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build();
+    let one = pool.map(|p| p.install(|| sweep(&s, &cfg, 2.0, 7))).unwrap_or_default();
+    assert_eq!(a, one);
+}
+
+#[test]
+fn clutter_grows_with_waves_and_stops_at_range() {
+    let cfg = small_cfg();
+    let s = sea_with_box(1400.0, 0.0);
+    let clutter = |h: f32| {
+        let r = sweep(&s, &cfg, h, 3);
+        let keep: Vec<(u32, u32)> = (0..r.len())
+            .filter(|&i| r.instance[i] == NO_HIT)
+            .map(|i| (r.azimuth[i].to_bits(), r.range[i].to_bits()))
+            .collect();
+        assert!((0..r.len()).filter(|&i| r.instance[i] == NO_HIT).all(|i| r.class[i] == CLASS_WATER));
+        let far = (0..r.len()).filter(|&i| r.instance[i] == NO_HIT).map(|i| r.range[i]).fold(0.0f32, f32::max);
+        (keep, far)
+    };
+    let (w0, far0) = clutter(0.5);
+    let (w3, far3) = clutter(3.5);
+    assert!(w0.len() > 50, "{}", w0.len());
+    assert!(w3.len() > 3 * w0.len(), "{} vs {}", w3.len(), w0.len());
+    eprintln!("clutter cells W0 {} (to {far0} m), W3 {} (to {far3} m)", w0.len(), w3.len());
+    assert!(far3 > 2.0 * far0 && far0 > 0.0, "{far0} {far3}");
+    // Same seed: the calm-sea clutter cells are a subset of the rough-sea ones.
+    let rough: std::collections::HashSet<(u32, u32)> = w3.into_iter().collect();
+    assert!(w0.iter().all(|c| rough.contains(c)));
+    assert!(clutter(0.0).0.is_empty());
+    // Nothing beyond the sea clutter limit.
+    let limited = RadarConfig { clutter: ClutterModel { sea_max_range_m: 150.0, ..ClutterModel::default() }, ..cfg };
+    let r = sweep(&s, &limited, 3.5, 3);
+    assert!((0..r.len()).filter(|&i| r.instance[i] == NO_HIT).all(|i| r.range[i] <= 150.0));
+}
+
+#[test]
+fn misconfiguration_names_the_field() {
+    let s = Scene::new();
+    let field_of = |cfg: RadarConfig, env: RadarEnv| match radar_sweep(&s, &MAST, &cfg, &env, 0) {
+        Err(MmusvError::Config { field, .. }) => field,
+        other => format!("no config error: {other:?}"),
+    };
+    let d = RadarConfig::default();
+    let e = RadarEnv::default();
+    let cases = [
+        (RadarConfig { azimuth_bins: 0, ..d }, "radar.azimuth_bins"),
+        (RadarConfig { range_max_m: -5.0, ..d }, "radar.range_max_m"),
+        (RadarConfig { range_min_m: -1.0, ..d }, "radar.range_min_m"),
+        (RadarConfig { range_min_m: 4000.0, ..d }, "radar.range_min_m"),
+        (RadarConfig { range_resolution_m: 0.0, ..d }, "radar.range_resolution_m"),
+        (RadarConfig { range_resolution_m: 1e-4, ..d }, "radar.range_resolution_m"),
+        (RadarConfig { beamwidth_az_rad: 0.0, ..d }, "radar.beamwidth_az_rad"),
+        (RadarConfig { beamwidth_az_rad: -0.1, ..d }, "radar.beamwidth_az_rad"),
+        (RadarConfig { elevation_fan_rad: [0.2, -0.2], ..d }, "radar.elevation_fan_rad"),
+        (RadarConfig { rays_az: 0, ..d }, "radar.rays_az"),
+        (RadarConfig { rays_el: 0, ..d }, "radar.rays_el"),
+        (RadarConfig { rays_el: 100_000, ..d }, "radar.rays_el"),
+        (RadarConfig { detection_threshold: f64::NAN, ..d }, "radar.detection_threshold"),
+        (RadarConfig { horizon_fraction: 1.5, ..d }, "radar.horizon_fraction"),
+        (RadarConfig { horizon_band_rad: -0.1, ..d }, "radar.horizon_band_rad"),
+        (RadarConfig { range_noise_std_m: -1.0, ..d }, "radar.range_noise_std_m"),
+        (
+            RadarConfig { clutter: ClutterModel { sea_sigma0_at_1m: -1.0, ..ClutterModel::default() }, ..d },
+            "radar.clutter.sea_sigma0_at_1m",
+        ),
+    ];
+    for (cfg, field) in cases {
+        assert_eq!(field_of(cfg, e), field);
+    }
+    assert_eq!(field_of(d, RadarEnv { wave_height_m: -1.0, ..e }), "radar.wave_height_m");
+    assert_eq!(field_of(d, RadarEnv { rain_mm_per_h: f32::INFINITY, ..e }), "radar.rain_mm_per_h");
+    // An empty scene is not an error: no targets, no clutter without waves.
+    assert!(radar_sweep(&s, &MAST, &d, &e, 0).is_ok_and(|r| r.is_empty()));
+}
