@@ -6,7 +6,7 @@ writeable. World frame: right-handed, x east, y north, z up, metres. Sensor body
 """
 
 import os
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any, final
 
 import numpy as np
@@ -35,6 +35,7 @@ __all__ = [
     "Fleet",
     "default_amplitudes",
     "wave_height",
+    "Recorder",
 ]
 
 __version__: str
@@ -325,3 +326,127 @@ def default_amplitudes() -> tuple[float, float, float]:
 
 def wave_height(wave: str | float) -> float:
     """Wave height H in metres of a preset "W0".."W3" or a height in metres (validated)."""
+
+# --- record ---
+
+@final
+class Recorder:
+    """Streams messages into one MCAP file (zstd chunks, deterministic bytes), written as ``<path>.partial`` and
+    renamed to ``path`` by :meth:`finish`. Times are simulation times in integer nanoseconds (log = publish time).
+    Every method releases the GIL while it encodes and writes. Use :class:`mmusv.record.Recording` instead."""
+
+    def __new__(cls, path: str | os.PathLike[str], *, overwrite: bool = False) -> Recorder:
+        """Starts a recording; an existing ``path`` raises ``IoError`` unless ``overwrite`` (replaced only on finish)."""
+
+    @property
+    def path(self) -> str:
+        """The final file name."""
+
+    @property
+    def partial_path(self) -> str:
+        """``<path>.partial``, written to until :meth:`finish`."""
+
+    @property
+    def closed(self) -> bool:
+        """True once :meth:`finish` or :meth:`abandon` ran."""
+
+    def point_cloud(
+        self,
+        topic: str,
+        *,
+        log_time_ns: int,
+        frame_id: str,
+        names: Sequence[str],
+        columns: Sequence[npt.NDArray[Any]],
+        pose: Sequence[float] | None = None,
+    ) -> None:
+        """``foxglove.PointCloud``: ``columns[i]`` is a C-contiguous 1-D array (one value per point) of uint8, int8, uint16, int16, uint32, int32, float32 or float64 named ``names[i]``, packed row-interleaved little-endian in the order given; ``pose`` = ``(x, y, z, qx, qy, qz, qw)`` of the cloud origin in ``frame_id`` or None (identity)."""
+
+    def raw_image(self, topic: str, *, log_time_ns: int, frame_id: str, image: npt.NDArray[Any]) -> None:
+        """``foxglove.RawImage``: (H, W) uint8 → mono8, (H, W, 3) uint8 → rgb8, (H, W) uint16 → 16UC1, (H, W) float32 → 32FC1; C-contiguous."""
+
+    def png_image(self, topic: str, *, log_time_ns: int, frame_id: str, image: npt.NDArray[Any]) -> None:
+        """``foxglove.CompressedImage`` format png of a C-contiguous (H, W) uint8, (H, W, 3) uint8 or (H, W) uint16 image."""
+
+    def frame_transforms(
+        self,
+        topic: str,
+        *,
+        log_time_ns: int,
+        parents: Sequence[str],
+        children: Sequence[str],
+        translations: npt.NDArray[np.float64],
+        rotations: npt.NDArray[np.float64],
+    ) -> None:
+        """``foxglove.FrameTransforms``: pose of ``children[i]`` in ``parents[i]``, ``translations`` (N, 3) float64 metres, ``rotations`` (N, 4) float64 unit quaternions x, y, z, w."""
+
+    def boxes(
+        self,
+        topic: str,
+        *,
+        log_time_ns: int,
+        frame_id: str,
+        entity_id: str,
+        ids: Sequence[str],
+        centers: npt.NDArray[np.float64],
+        quaternions: npt.NDArray[np.float64],
+        sizes: npt.NDArray[np.float64],
+        colors: npt.NDArray[np.float32],
+        labels: Sequence[str],
+    ) -> None:
+        """``foxglove.SceneUpdate`` with one frame-locked entity ``entity_id`` in ``frame_id``: one cube per box (``centers`` (N, 3) m, ``quaternions`` (N, 4) x, y, z, w, ``sizes`` (N, 3) m, ``colors`` (N, 4) float32 RGBA 0..1) and a text per non-empty label; ``ids`` unique."""
+
+    def world_state(
+        self,
+        topic: str,
+        *,
+        log_time_ns: int,
+        frame: int,
+        time_s: float,
+        ids: Sequence[str],
+        assets: Sequence[str],
+        roles: Sequence[str],
+        classes: npt.NDArray[np.uint32],
+        instance_ids: npt.NDArray[np.uint32],
+        poses: npt.NDArray[np.float64],
+        velocities: npt.NDArray[np.float64],
+        box_centers: npt.NDArray[np.float64],
+        box_sizes: npt.NDArray[np.float64],
+    ) -> None:
+        """``mmusv.WorldState``, one vessel per row: ``classes``/``instance_ids`` (N,) uint32, ``poses`` (N, 6) x, y, z, roll, pitch, yaw (world, m, rad), ``velocities`` (N, 3) m/s, ``box_centers`` (N, 3) m, ``box_sizes`` (N, 3) length, beam, height m."""
+
+    def annotations(
+        self,
+        topic: str,
+        *,
+        log_time_ns: int,
+        frame: int,
+        time_s: float,
+        agent_id: str,
+        lidar_ids: Sequence[str],
+        lidar_ints: npt.NDArray[np.uint32],
+        lidar_values: npt.NDArray[np.float64],
+        bev_ids: Sequence[str],
+        bev_values: npt.NDArray[np.float64],
+        camera_ids: Sequence[str],
+        camera_names: Sequence[str],
+        camera_ints: npt.NDArray[np.uint32],
+        camera_values: npt.NDArray[np.float64],
+    ) -> None:
+        """``mmusv.AgentAnnotations`` from packed columns: ``lidar_ints`` (N, 3) [instance_id, semantic_class, lidar_points], ``lidar_values`` (N, 12) [center xyz, size lwh, rotation xyzw, yaw, range_m]; ``bev_values`` (M, 5) [x, y, length, width, yaw]; ``camera_ints`` (K, 2) [visible_pixels, box_pixels], ``camera_values`` (K, 6) [x_min, y_min, x_max, y_max, truncation, occlusion]."""
+
+    def metadata(self, name: str, mapping: Mapping[str, str]) -> None:
+        """An MCAP metadata record ``name`` holding ``mapping``."""
+
+    def attachment(self, name: str, *, media_type: str, data: bytes, log_time_ns: int = 0) -> None:
+        """An MCAP attachment (log and create time ``log_time_ns``)."""
+
+    def finish(self) -> dict[str, Any]:
+        """Completes the file and renames it to ``path``; returns ``{"path", "messages", "channels", "bytes"}``."""
+
+    def abandon(self) -> str:
+        """Completes the file but keeps the ``.partial`` name; returns that path (no-op once closed)."""
+
+    def __enter__(self) -> Recorder: ...
+    def __exit__(self, exc_type: object = None, exc_value: object = None, traceback: object = None) -> bool:
+        """Finishes on a clean exit; after an exception completes the file under ``.partial`` and re-raises."""

@@ -1,6 +1,8 @@
 """The ``mmusv`` command line.
 
-Subcommands: ``assets`` (list the vessel library), ``study waves`` (Table I of the paper), ``version``.
+Subcommands: ``run`` (a scenario or a folder of them into MCAP + Parquet), ``info`` and ``preview`` (inspect a
+recording), ``generate`` (batch scenario generation), ``assets`` (the vessel library), ``study waves`` (Table I)
+and ``study agreement`` (Table II), ``version``.
 Errors in the input end with a one-line message naming the problem and exit status 2, never a traceback.
 """
 
@@ -65,6 +67,107 @@ def _cmd_study_waves(args: argparse.Namespace) -> int:
     return 0
 
 
+def _run_one(path: str, out: str, overwrite: bool, frames: int | None, show_progress: bool) -> str:
+    """Runs one scenario; returns a one-line report. Used directly and in worker processes."""
+    from mmusv.acquire import run
+    from mmusv.config import load_scenario
+
+    scenario = load_scenario(path)
+    if show_progress:
+        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+        with Progress(TextColumn(f"[bold]{scenario.name}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn()) as bar:
+            task = bar.add_task("frames", total=frames or scenario.acquisition.frames)
+            try:
+                res = run(scenario, out_dir=out, overwrite=overwrite, frames=frames,
+                          progress=lambda done, total: bar.update(task, completed=done))
+            except KeyboardInterrupt:
+                from mmusv.acquire import recording_path
+
+                rec = recording_path(Path(out), scenario)
+                print(f"mmusv: interrupted; {rec} is a valid recording holding every completed frame", file=sys.stderr)
+                raise
+    else:
+        res = run(scenario, out_dir=out, overwrite=overwrite, frames=frames)
+    fps = res.frames_written / res.seconds if res.seconds > 0 else float("nan")
+    return (f"{scenario.name}: {res.frames_written} frames in {res.seconds:.1f} s ({fps:.2f} frames/s), "
+            f"{res.messages} messages, {res.bytes / 1e6:.1f} MB -> {res.recording}")
+
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    src = Path(args.scenario)
+    if src.is_dir():
+        files = sorted(p for p in src.glob("*.yaml") if p.name != "report.yaml")
+        if not files:
+            raise MmusvError(f"{src} holds no *.yaml scenarios")
+        jobs = max(1, int(args.jobs))
+        outs = [str(Path(args.output) / f.stem) for f in files]
+        if jobs == 1:
+            for f, o in zip(files, outs, strict=True):
+                print(_run_one(str(f), o, args.overwrite, args.frames, sys.stdout.isatty()))
+        else:
+            from concurrent.futures import ProcessPoolExecutor
+
+            with ProcessPoolExecutor(max_workers=jobs) as pool:
+                futures = [pool.submit(_run_one, str(f), o, args.overwrite, args.frames, False) for f, o in zip(files, outs, strict=True)]
+                for fut in futures:
+                    print(fut.result())
+        return 0
+    print(_run_one(str(src), args.output, args.overwrite, args.frames, True))
+    return 0
+
+
+def _cmd_info(args: argparse.Namespace) -> int:
+    from rich.table import Table
+
+    from mmusv.record import summary
+
+    info = summary(args.recording)
+    console = _console()
+    meta = info.get("metadata", {})
+    run_meta = meta.get("run", {})
+    if not info.get("complete", True):
+        console.print("[yellow]incomplete recording (.partial or no summary): counts come from scanning the messages[/yellow]")
+    console.print(f"[bold]{args.recording}[/bold]: scenario {run_meta.get('scenario', '?')}, status {run_meta.get('status', '?')}, "
+                  f"{run_meta.get('frames_written', '?')} frames, agents {run_meta.get('agents', '?')}")
+    start, end = info.get("start_ns", 0), info.get("end_ns", 0)
+    console.print(f"time {start / 1e9:.3f} .. {end / 1e9:.3f} s (duration {(end - start) / 1e9:.3f} s), {info.get('messages', 0)} messages")
+    table = Table(title="topics")
+    for col in ("topic", "schema", "messages"):
+        table.add_column(col)
+    for topic, t in sorted(info.get("topics", {}).items()):
+        table.add_row(topic, t["schema"], str(t["messages"]))
+    console.print(table)
+    return 0
+
+
+def _cmd_preview(args: argparse.Namespace) -> int:
+    from mmusv.preview import write_preview
+
+    out = write_preview(args.recording, frame=args.frame, agent=args.agent, output=args.output)
+    print(f"wrote {out}")
+    return 0
+
+
+def _cmd_study_agreement(args: argparse.Namespace) -> int:
+    from rich.table import Table
+
+    from mmusv.studies.agreement import BUNDLED_SCENARIOS, run_agreement_study
+
+    study = run_agreement_study(args.scenarios or BUNDLED_SCENARIOS, frames=args.frames)
+    table = Table(title="Annotation vs top-view rendering (Table II)")
+    for col in ("map", "valid samples", "median centre error (px)", "median centroid error (px)", "mean containment", "mean hull occupancy"):
+        table.add_column(col, justify="right")
+    for r in study.summary.iter_rows(named=True):
+        table.add_row(str(r["map"]), str(r["valid_samples"]), f"{r['median_centre_error_px']:.3f}", f"{r['median_centroid_error_px']:.3f}",
+                      f"{r['mean_containment']:.4f}", f"{r['mean_hull_occupancy']:.3f}")
+    console = _console()
+    console.print(table)
+    paths = study.write(Path(args.output))
+    console.print(f"wrote {paths['samples']} and {paths['summary']}")
+    return 0
+
+
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="mmusv", description="Headless maritime multi-USV simulator and dataset generator.")
     sub = p.add_subparsers(dest="command", required=True)
@@ -76,6 +179,26 @@ def _parser() -> argparse.ArgumentParser:
     waves.add_argument("--scenario", default=BUNDLED_WAVE_SCENARIO, help=f"scenario YAML (default {BUNDLED_WAVE_SCENARIO})")
     waves.add_argument("-o", "--output", default="out/wave_study", help="output folder for CSV and plot")
     waves.add_argument("--frames", type=int, default=None, help="override the scenario's frame count")
+    agree = studies.add_parser("agreement", help="Table II: 3D-box annotations vs top-view semantic rendering")
+    agree.add_argument("scenarios", nargs="*", help="scenario YAMLs (default: the three bundled map scenarios)")
+    agree.add_argument("-o", "--output", default="out/agreement_study", help="output folder")
+    agree.add_argument("--frames", type=int, default=None, help="frames per scenario (default: all)")
+    run = sub.add_parser("run", help="run a scenario (or a folder of them) into an MCAP recording + Parquet tables")
+    run.add_argument("scenario", help="scenario YAML, or a folder of scenario YAMLs")
+    run.add_argument("-o", "--output", default="out", help="output folder (default out/)")
+    run.add_argument("--overwrite", action="store_true", help="replace an existing recording")
+    run.add_argument("--frames", type=int, default=None, help="run only the first N frames")
+    run.add_argument("--jobs", type=int, default=1, help="for a folder: scenarios run in parallel processes (default 1)")
+    info = sub.add_parser("info", help="agents, topics, frames and duration of a recording")
+    info.add_argument("recording", help="an .mcap written by mmusv run")
+    prev = sub.add_parser("preview", help="one picture of a recorded frame (surround RGB, depth, semantic, PPI, BEV)")
+    prev.add_argument("recording", help="an .mcap written by mmusv run")
+    prev.add_argument("--frame", type=int, default=0, help="acquisition index (default 0)")
+    prev.add_argument("--agent", default=None, help="USV id (default: the first)")
+    prev.add_argument("-o", "--output", default=None, help="PNG path (default: next to the recording)")
+    from mmusv.generate.cli import add_parser as add_generate_parser
+
+    add_generate_parser(sub)
     return p
 
 
@@ -92,6 +215,18 @@ def main(argv: list[str] | None = None) -> int:
             return _cmd_assets(args)
         if args.command == "study" and args.study == "waves":
             return _cmd_study_waves(args)
+        if args.command == "study" and args.study == "agreement":
+            return _cmd_study_agreement(args)
+        if args.command == "run":
+            return _cmd_run(args)
+        if args.command == "info":
+            return _cmd_info(args)
+        if args.command == "preview":
+            return _cmd_preview(args)
+        if args.command == "generate":
+            from mmusv.generate.cli import run as _run_generate
+
+            return _run_generate(args)
     except MmusvError as exc:
         print(f"mmusv: error: {exc}", file=sys.stderr)
         return 2

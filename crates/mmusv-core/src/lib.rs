@@ -13,6 +13,7 @@
 //! - [`scene`]: meshes placed as instances, a top-level BVH over them, and batch ray casting over rayon.
 //! - [`export`]: the world triangles at the current poses as PLY or OBJ.
 //! - [`sensors`]: sensor ray patterns (LiDAR sweeps, pinhole cameras), the marine radar and its PPI image.
+//! - [`record`]: the MCAP recorder (Foxglove schemas plus the project's own world state and annotations).
 //! - [`demo`]: a synthetic maritime scene for benchmarks and comparisons.
 //! - [`kinematics`]: spline routes at nominal speed with wave-driven heave, roll and pitch.
 //!
@@ -26,6 +27,7 @@ pub mod geometry;
 pub mod kinematics;
 pub mod mesh;
 pub mod packet;
+pub mod record;
 pub mod scene;
 pub mod sensors;
 

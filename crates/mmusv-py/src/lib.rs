@@ -11,6 +11,7 @@ mod errors;
 mod kinematics;
 mod native;
 mod radar;
+mod record;
 mod scene;
 mod sensors;
 
@@ -23,6 +24,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     kinematics::register(m)?;
     sensors::register(m)?;
     radar::register(m)?;
+    record::register(m)?;
     demo::register(m)?;
     Ok(())
 }

@@ -1,0 +1,299 @@
+//! One [`Recorder`] method per message kind: Foxglove's well-known schemas (point cloud, raw and PNG image,
+//! transforms, 3-D boxes) and the project's own world state and annotations.
+
+use super::image::{encode_png, raw_bytes_per_pixel, Pixels};
+use super::own_schema::{AgentAnnotations, WorldState};
+use super::points::{packed_offsets, PackedType};
+use super::writer::Recorder;
+use crate::error::{MmusvError, Result};
+use foxglove::messages::{
+    Color, CompressedImage, CubePrimitive, Duration, FrameTransform, FrameTransforms, KeyValuePair, PackedElementField,
+    PointCloud, Pose, Quaternion, RawImage, SceneEntity, SceneUpdate, TextPrimitive, Timestamp, Vector3,
+};
+use prost::bytes::Bytes;
+
+/// One transform for [`Recorder::frame_transforms`]: the pose of `child` in `parent`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Transform {
+    /// Parent frame id, e.g. `world`.
+    pub parent: String,
+    /// Child frame id, e.g. `usv0/base_link`.
+    pub child: String,
+    /// Origin of the child frame in the parent frame, metres.
+    pub translation: [f64; 3],
+    /// Orientation of the child frame in the parent frame, quaternion `x, y, z, w` (unit).
+    pub rotation: [f64; 4],
+}
+
+/// One 3-D box for [`Recorder::boxes`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct BoxMarker {
+    /// Box id (e.g. the target id), unique within one message; stored in the entity metadata as `id → label`.
+    pub id: String,
+    /// Box centre in the message frame, metres.
+    pub center: [f64; 3],
+    /// Box orientation, quaternion `x, y, z, w` (unit).
+    pub quaternion: [f64; 4],
+    /// Edge lengths along the box's x, y, z axes, metres.
+    pub size: [f64; 3],
+    /// RGBA, each 0..1.
+    pub color: [f32; 4],
+    /// Text drawn above the box; empty for none.
+    pub label: String,
+}
+
+/// Height of a box label above the box top, metres.
+const LABEL_LIFT_M: f64 = 0.5;
+/// Label font size, screen pixels.
+const LABEL_FONT_PX: f64 = 14.0;
+
+/// Simulation time in nanoseconds as a Foxglove timestamp.
+pub fn timestamp(log_time_ns: u64) -> Result<Timestamp> {
+    let sec = u32::try_from(log_time_ns / 1_000_000_000).map_err(|_| {
+        MmusvError::input("log_time_ns", format!("{log_time_ns} ns is past the 32-bit seconds range of timestamps"))
+    })?;
+    Ok(Timestamp::new(sec, (log_time_ns % 1_000_000_000) as u32))
+}
+
+fn finite(values: &[f64], field: &str) -> Result<()> {
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(MmusvError::input(field, format!("contains NaN or infinity: {values:?}")))
+    }
+}
+
+/// Checks a quaternion `x, y, z, w` is finite and of unit length (within 1e-3).
+fn unit_quaternion(q: &[f64; 4], field: &str) -> Result<Quaternion> {
+    finite(q, field)?;
+    let norm = q.iter().map(|v| v * v).sum::<f64>().sqrt();
+    if (norm - 1.0).abs() > 1e-3 {
+        return Err(MmusvError::input(field, format!("quaternion x, y, z, w must have unit length, got norm {norm}")));
+    }
+    Ok(Quaternion { x: q[0], y: q[1], z: q[2], w: q[3] })
+}
+
+fn vec3(v: &[f64; 3]) -> Vector3 {
+    Vector3 { x: v[0], y: v[1], z: v[2] }
+}
+
+fn pose(position: &[f64; 3], q: &[f64; 4], field: &str) -> Result<Pose> {
+    finite(position, field)?;
+    Ok(Pose { position: Some(vec3(position)), orientation: Some(unit_quaternion(q, field)?) })
+}
+
+impl Recorder {
+    /// Writes a `foxglove.PointCloud`: `fields` packed back to back in each `point_stride`-byte point of
+    /// `data` (little-endian; `point_stride` may exceed the fields' total to leave padding). `pose_of_frame`
+    /// is the cloud origin in `frame_id` as `x, y, z, qx, qy, qz, qw` (None: identity).
+    #[allow(clippy::too_many_arguments)]
+    pub fn point_cloud(
+        &mut self,
+        topic: &str,
+        log_time_ns: u64,
+        frame_id: &str,
+        pose_of_frame: Option<[f64; 7]>,
+        fields: &[(&str, PackedType)],
+        point_stride: u32,
+        data: &[u8],
+    ) -> Result<()> {
+        let (offsets, packed) = packed_offsets(fields);
+        if fields.is_empty() || point_stride < packed {
+            return Err(MmusvError::input(
+                "point_stride",
+                format!("{point_stride} bytes cannot hold the {} field(s) of {packed} bytes", fields.len()),
+            ));
+        }
+        if !data.len().is_multiple_of(point_stride as usize) {
+            return Err(MmusvError::input(
+                "data",
+                format!("{} bytes is not a whole number of {point_stride}-byte points", data.len()),
+            ));
+        }
+        let pose = match pose_of_frame {
+            Some(p) => Some(pose(&[p[0], p[1], p[2]], &[p[3], p[4], p[5], p[6]], "pose")?),
+            None => None,
+        };
+        let message = PointCloud {
+            timestamp: Some(timestamp(log_time_ns)?),
+            frame_id: frame_id.to_string(),
+            pose,
+            point_stride,
+            fields: fields
+                .iter()
+                .zip(offsets)
+                .map(|((name, t), offset)| PackedElementField {
+                    name: (*name).to_string(),
+                    offset,
+                    r#type: t.numeric_type() as i32,
+                })
+                .collect(),
+            data: Bytes::copy_from_slice(data),
+        };
+        self.write(topic, log_time_ns, &message)
+    }
+
+    /// Writes a `foxglove.RawImage`; `encoding` is one of `rgb8`, `rgba8`, `bgr8`, `bgra8`, `mono8`, `8UC1`,
+    /// `8UC3`, `mono16`, `16UC1`, `32FC1`; `data` is `height` rows of `step` bytes, multi-byte values
+    /// little-endian.
+    #[allow(clippy::too_many_arguments)]
+    pub fn raw_image(
+        &mut self,
+        topic: &str,
+        log_time_ns: u64,
+        frame_id: &str,
+        width: u32,
+        height: u32,
+        encoding: &str,
+        step: u32,
+        data: &[u8],
+    ) -> Result<()> {
+        let bpp = raw_bytes_per_pixel(encoding)?;
+        if (step as u64) < width as u64 * bpp as u64 || data.len() as u64 != step as u64 * height as u64 {
+            return Err(MmusvError::input(
+                "image",
+                format!(
+                    "{} bytes do not make {height} rows of step {step} for width {width} {encoding} \
+                     (step >= {} and data = step * height)",
+                    data.len(),
+                    width as u64 * bpp as u64
+                ),
+            ));
+        }
+        let message = RawImage {
+            timestamp: Some(timestamp(log_time_ns)?),
+            frame_id: frame_id.to_string(),
+            width,
+            height,
+            encoding: encoding.to_string(),
+            step,
+            data: Bytes::copy_from_slice(data),
+        };
+        self.write(topic, log_time_ns, &message)
+    }
+
+    /// Writes `pixels` as a `foxglove.RawImage` (encoding from the pixel kind, rows unpadded).
+    pub fn pixels(
+        &mut self,
+        topic: &str,
+        log_time_ns: u64,
+        frame_id: &str,
+        width: u32,
+        height: u32,
+        pixels: &Pixels<'_>,
+    ) -> Result<()> {
+        pixels.check(width, height)?;
+        let step = width * pixels.bytes_per_pixel();
+        self.raw_image(topic, log_time_ns, frame_id, width, height, pixels.encoding(), step, &pixels.le_bytes())
+    }
+
+    /// Encodes `pixels` as PNG (8-bit gray, 8-bit RGB or 16-bit gray) and writes a `foxglove.CompressedImage`
+    /// with format `png`.
+    pub fn png_image(
+        &mut self,
+        topic: &str,
+        log_time_ns: u64,
+        frame_id: &str,
+        width: u32,
+        height: u32,
+        pixels: &Pixels<'_>,
+    ) -> Result<()> {
+        let png = encode_png(width, height, pixels)?;
+        let message = CompressedImage {
+            timestamp: Some(timestamp(log_time_ns)?),
+            frame_id: frame_id.to_string(),
+            data: Bytes::from(png),
+            format: "png".to_string(),
+        };
+        self.write(topic, log_time_ns, &message)
+    }
+
+    /// Writes a `foxglove.FrameTransforms` holding every transform, all stamped `log_time_ns`.
+    pub fn frame_transforms(&mut self, topic: &str, log_time_ns: u64, transforms: &[Transform]) -> Result<()> {
+        let stamp = timestamp(log_time_ns)?;
+        let transforms = transforms
+            .iter()
+            .enumerate()
+            .map(|(i, t)| {
+                let field = format!("transforms[{i}]");
+                finite(&t.translation, &field)?;
+                Ok(FrameTransform {
+                    timestamp: Some(stamp),
+                    parent_frame_id: t.parent.clone(),
+                    child_frame_id: t.child.clone(),
+                    translation: Some(vec3(&t.translation)),
+                    rotation: Some(unit_quaternion(&t.rotation, &field)?),
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        self.write(topic, log_time_ns, &FrameTransforms { transforms })
+    }
+
+    /// Writes a `foxglove.SceneUpdate` with one entity `entity_id` in `frame_id` (frame-locked, no lifetime)
+    /// holding one cube per box and one billboard text per non-empty label; it replaces the previous entity
+    /// with the same id on the topic.
+    pub fn boxes(
+        &mut self,
+        topic: &str,
+        log_time_ns: u64,
+        frame_id: &str,
+        entity_id: &str,
+        boxes: &[BoxMarker],
+    ) -> Result<()> {
+        let stamp = timestamp(log_time_ns)?;
+        let mut cubes = Vec::with_capacity(boxes.len());
+        let mut texts = Vec::new();
+        let mut metadata = Vec::with_capacity(boxes.len());
+        for (i, b) in boxes.iter().enumerate() {
+            let field = format!("boxes[{i}]");
+            if b.id.is_empty() || metadata.iter().any(|kv: &KeyValuePair| kv.key == b.id) {
+                return Err(MmusvError::input(
+                    field,
+                    format!("id {:?} is empty or repeated; ids must be unique", b.id),
+                ));
+            }
+            finite(&b.size, &field)?;
+            let color =
+                Color { r: b.color[0] as f64, g: b.color[1] as f64, b: b.color[2] as f64, a: b.color[3] as f64 };
+            cubes.push(CubePrimitive {
+                pose: Some(pose(&b.center, &b.quaternion, &field)?),
+                size: Some(vec3(&b.size)),
+                color: Some(color),
+            });
+            if !b.label.is_empty() {
+                let above = [b.center[0], b.center[1], b.center[2] + 0.5 * b.size[2] + LABEL_LIFT_M];
+                texts.push(TextPrimitive {
+                    pose: Some(pose(&above, &[0.0, 0.0, 0.0, 1.0], &field)?),
+                    billboard: true,
+                    font_size: LABEL_FONT_PX,
+                    scale_invariant: true,
+                    color: Some(Color { a: 1.0, ..color }),
+                    text: b.label.clone(),
+                });
+            }
+            metadata.push(KeyValuePair { key: b.id.clone(), value: b.label.clone() });
+        }
+        let entity = SceneEntity {
+            timestamp: Some(stamp),
+            frame_id: frame_id.to_string(),
+            id: entity_id.to_string(),
+            lifetime: Some(Duration::new(0, 0)),
+            frame_locked: true,
+            metadata,
+            cubes,
+            texts,
+            ..Default::default()
+        };
+        self.write(topic, log_time_ns, &SceneUpdate { deletions: Vec::new(), entities: vec![entity] })
+    }
+
+    /// Writes the project's own `mmusv.WorldState`.
+    pub fn world_state(&mut self, topic: &str, log_time_ns: u64, state: &WorldState) -> Result<()> {
+        self.write(topic, log_time_ns, state)
+    }
+
+    /// Writes the project's own `mmusv.AgentAnnotations`.
+    pub fn annotations(&mut self, topic: &str, log_time_ns: u64, annotations: &AgentAnnotations) -> Result<()> {
+        self.write(topic, log_time_ns, annotations)
+    }
+}

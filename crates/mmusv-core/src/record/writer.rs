@@ -1,0 +1,249 @@
+//! The MCAP file itself: creation under a `.partial` name, lazily created channels, per-channel sequence
+//! numbers, metadata and attachments, and the rename into place on [`Recorder::finish`].
+//!
+//! Deterministic: no wall clock is read; log and publish times are the simulation times the caller gives;
+//! zstd runs single-threaded with a fixed level, so the same calls give the same bytes.
+
+use crate::error::{MmusvError, Result};
+use foxglove::Encode;
+use mcap::records::{MessageHeader, Metadata};
+use mcap::{Attachment, WriteOptions, Writer};
+use std::borrow::Cow;
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+/// Target uncompressed size of one zstd chunk.
+const CHUNK_BYTES: u64 = 4 << 20;
+
+/// What [`Recorder::finish`] reports.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RecordSummary {
+    /// Where the finished file now lies.
+    pub path: PathBuf,
+    /// Messages written, all channels.
+    pub messages: u64,
+    /// Channels (topics) created.
+    pub channels: u32,
+    /// Size of the finished file, bytes.
+    pub bytes: u64,
+}
+
+/// A channel created on first use of its topic.
+struct Slot {
+    id: u16,
+    schema: String,
+    next_sequence: u32,
+}
+
+/// Streams messages into one MCAP file. Write under `<path>.partial`; [`finish`](Self::finish) completes the
+/// file and renames it to `path`. Dropped without `finish`, it still completes the MCAP (readable, with
+/// everything written) but leaves it under the `.partial` name, so an interrupted run never looks complete.
+pub struct Recorder {
+    writer: Option<Writer<BufWriter<File>>>,
+    path: PathBuf,
+    partial: PathBuf,
+    channels: BTreeMap<String, Slot>,
+    messages: u64,
+}
+
+impl std::fmt::Debug for Recorder {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Recorder")
+            .field("path", &self.path)
+            .field("channels", &self.channels.len())
+            .field("messages", &self.messages)
+            .finish_non_exhaustive()
+    }
+}
+
+/// `<path>.partial`.
+pub fn partial_path(path: &Path) -> PathBuf {
+    let mut s = path.as_os_str().to_owned();
+    s.push(".partial");
+    PathBuf::from(s)
+}
+
+fn io_err(path: &Path) -> impl Fn(std::io::Error) -> MmusvError + '_ {
+    move |e| MmusvError::Io { path: path.display().to_string(), reason: e.to_string() }
+}
+
+fn mcap_err(path: &Path) -> impl Fn(mcap::McapError) -> MmusvError + '_ {
+    move |e| MmusvError::Io { path: path.display().to_string(), reason: format!("MCAP write failed: {e}") }
+}
+
+/// Completes the MCAP (summary, footer), flushes and syncs the file.
+fn close(mut writer: Writer<BufWriter<File>>, partial: &Path) -> Result<()> {
+    writer.finish().map_err(mcap_err(partial))?;
+    let file = writer.into_inner().into_inner().map_err(|e| io_err(partial)(e.into_error()))?;
+    file.sync_all().map_err(io_err(partial))
+}
+
+impl Recorder {
+    /// Starts a recording that will be named `path`. An existing `path` is refused unless `overwrite`; it is
+    /// then replaced only when [`finish`](Self::finish) succeeds. A stale `<path>.partial` is truncated.
+    pub fn create(path: &Path, overwrite: bool) -> Result<Self> {
+        if path.is_dir() {
+            return Err(MmusvError::Io { path: path.display().to_string(), reason: "is a directory".into() });
+        }
+        if path.exists() && !overwrite {
+            return Err(MmusvError::Io {
+                path: path.display().to_string(),
+                reason: "the file already exists; pass overwrite=True (Python) or --overwrite (CLI) to replace it"
+                    .into(),
+            });
+        }
+        let partial = partial_path(path);
+        let file = File::create(&partial).map_err(io_err(&partial))?;
+        let options = WriteOptions::new()
+            .compression(Some(mcap::Compression::Zstd))
+            .compression_level(3)
+            .compression_threads(0)
+            .chunk_size(Some(CHUNK_BYTES))
+            .profile("")
+            .library(format!("mmusv {}", env!("CARGO_PKG_VERSION")));
+        let writer = options.create(BufWriter::with_capacity(1 << 20, file)).map_err(mcap_err(&partial))?;
+        Ok(Self { writer: Some(writer), path: path.to_path_buf(), partial, channels: BTreeMap::new(), messages: 0 })
+    }
+
+    /// The final name of the recording.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The name written to until [`finish`](Self::finish).
+    pub fn partial_path(&self) -> &Path {
+        &self.partial
+    }
+
+    /// Messages written so far.
+    pub fn messages(&self) -> u64 {
+        self.messages
+    }
+
+    fn writer(&mut self) -> Result<&mut Writer<BufWriter<File>>> {
+        let partial = &self.partial;
+        self.writer.as_mut().ok_or_else(|| MmusvError::Io {
+            path: partial.display().to_string(),
+            reason: "the recording is already closed".into(),
+        })
+    }
+
+    /// Encodes `message` and writes it on `topic` at simulation time `log_time_ns` (also the publish time).
+    /// The channel and its schema are created on the first message of a topic; a topic keeps one schema.
+    pub fn write<M: Encode>(&mut self, topic: &str, log_time_ns: u64, message: &M) -> Result<()> {
+        let mut buf = Vec::with_capacity(message.encoded_len().unwrap_or(1024));
+        message
+            .encode(&mut buf)
+            .map_err(|e| MmusvError::input(topic.to_string(), format!("message could not be encoded: {e}")))?;
+        let Some(schema) = M::get_schema() else {
+            return Err(MmusvError::input(topic.to_string(), "message type has no schema"));
+        };
+        self.write_encoded(topic, log_time_ns, &schema, &M::get_message_encoding(), &buf)
+    }
+
+    /// Writes already-encoded bytes with the given schema (used by [`write`](Self::write)).
+    pub fn write_encoded(
+        &mut self,
+        topic: &str,
+        log_time_ns: u64,
+        schema: &foxglove::Schema,
+        message_encoding: &str,
+        data: &[u8],
+    ) -> Result<()> {
+        if topic.is_empty() {
+            return Err(MmusvError::input("topic", "must not be empty (e.g. /usv0/lidar)"));
+        }
+        let partial = self.partial.clone();
+        let slot = match self.channels.get_mut(topic) {
+            Some(slot) => {
+                if slot.schema != schema.name {
+                    return Err(MmusvError::input(
+                        "topic",
+                        format!("{topic} already carries {}, cannot write {} on it", slot.schema, schema.name),
+                    ));
+                }
+                slot
+            }
+            None => {
+                let w = self.writer()?;
+                let schema_id =
+                    w.add_schema(&schema.name, &schema.encoding, &schema.data).map_err(mcap_err(&partial))?;
+                let id =
+                    w.add_channel(schema_id, topic, message_encoding, &BTreeMap::new()).map_err(mcap_err(&partial))?;
+                self.channels.entry(topic.to_string()).or_insert(Slot {
+                    id,
+                    schema: schema.name.clone(),
+                    next_sequence: 0,
+                })
+            }
+        };
+        let header = MessageHeader {
+            channel_id: slot.id,
+            sequence: slot.next_sequence,
+            log_time: log_time_ns,
+            publish_time: log_time_ns,
+        };
+        slot.next_sequence = slot.next_sequence.wrapping_add(1);
+        self.writer()?.write_to_known_channel(&header, data).map_err(mcap_err(&partial))?;
+        self.messages += 1;
+        Ok(())
+    }
+
+    /// Writes an MCAP metadata record `name` holding `map` (e.g. scenario name, seed, mmusv version).
+    pub fn metadata(&mut self, name: &str, map: &BTreeMap<String, String>) -> Result<()> {
+        let partial = self.partial.clone();
+        let record = Metadata { name: name.to_string(), metadata: map.clone() };
+        self.writer()?.write_metadata(&record).map_err(mcap_err(&partial))
+    }
+
+    /// Writes an attachment (e.g. the scenario YAML); `log_time_ns` is also used as its create time.
+    pub fn attachment(&mut self, name: &str, media_type: &str, log_time_ns: u64, data: &[u8]) -> Result<()> {
+        let partial = self.partial.clone();
+        let a = Attachment {
+            log_time: log_time_ns,
+            create_time: log_time_ns,
+            name: name.to_string(),
+            media_type: media_type.to_string(),
+            data: Cow::Borrowed(data),
+        };
+        self.writer()?.attach(&a).map_err(mcap_err(&partial))
+    }
+
+    /// Completes the file and renames it from `<path>.partial` to `path` (replacing `path` if it exists).
+    pub fn finish(mut self) -> Result<RecordSummary> {
+        let Some(writer) = self.writer.take() else {
+            return Err(MmusvError::Io {
+                path: self.partial.display().to_string(),
+                reason: "the recording is already closed".into(),
+            });
+        };
+        close(writer, &self.partial)?;
+        std::fs::rename(&self.partial, &self.path).map_err(io_err(&self.path))?;
+        let bytes = std::fs::metadata(&self.path).map_err(io_err(&self.path))?.len();
+        Ok(RecordSummary {
+            path: self.path.clone(),
+            messages: self.messages,
+            channels: self.channels.len() as u32,
+            bytes,
+        })
+    }
+
+    /// Completes the MCAP (valid, with everything written so far) but keeps it under `<path>.partial`, for a
+    /// run that stopped early. Returns the `.partial` path.
+    pub fn abandon(mut self) -> Result<PathBuf> {
+        if let Some(writer) = self.writer.take() {
+            close(writer, &self.partial)?;
+        }
+        Ok(self.partial.clone())
+    }
+}
+
+impl Drop for Recorder {
+    fn drop(&mut self) {
+        if let Some(writer) = self.writer.take() {
+            let _ = close(writer, &self.partial);
+        }
+    }
+}

@@ -1,0 +1,225 @@
+"""The main job: run a scenario and stream every frame into one MCAP recording plus Parquet tables.
+
+``run(cfg, out_dir=...)`` (also ``mmusv.run`` and ``mmusv run FILE -o DIR``) validates the scenario before
+anything is written, builds the :class:`~mmusv.simulation.Simulation`, then for every acquisition index k
+captures every sensor of every USV on the frozen state of t_k = k / f, derives the annotations and writes them
+(Algorithm 1 of the paper). Frames are written as they are produced, so memory stays flat however long the
+run; tables are flushed to Parquet parts every ``TABLE_PART_FRAMES`` frames.
+
+Output in ``out_dir``: ``<name>.mcap`` (see ``docs/recording.md``), ``tables/{world_state,boxes_3d,boxes_2d}/
+part-NNNNN.parquet`` (polars), ``scenario.yaml`` (the resolved scenario) and ``manifest.json``. A run stopped by
+Ctrl-C or an error still finishes the MCAP (every completed frame is in it, its ``run`` metadata says
+``status: interrupted`` or ``failed``) and the tables of the completed frames.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import polars as pl
+import yaml
+
+from mmusv.annotate import Annotations, SilhouetteCache, annotate_agent
+from mmusv.config import Scenario, load_scenario, scenario_hash
+from mmusv.errors import ConfigError, IoError
+from mmusv.simulation import FrameCapture, Simulation
+
+__all__ = ["RunResult", "run", "TABLE_PART_FRAMES", "recording_path"]
+
+TABLE_PART_FRAMES = 200
+
+
+@dataclass
+class RunResult:
+    """What a run wrote and how it ended: ``status`` is ``complete``, ``interrupted`` or ``failed``."""
+
+    recording: Path
+    tables: Path
+    frames_written: int
+    status: str
+    seconds: float
+    messages: int = 0
+    bytes: int = 0
+    error: str | None = None
+    frame_seconds: list[float] = field(default_factory=list)
+
+
+def recording_path(out_dir: Path, scenario: Scenario) -> Path:
+    """Where the MCAP of ``scenario`` goes in ``out_dir``."""
+    return out_dir / f"{scenario.name}.mcap"
+
+
+class _Tables:
+    """Buffers table rows and flushes them as numbered Parquet parts."""
+
+    def __init__(self, root: Path) -> None:
+        self.root = root
+        self.rows: dict[str, list[dict[str, Any]]] = {"world_state": [], "boxes_3d": [], "boxes_2d": []}
+        self.part = 0
+
+    def add_world(self, sim: Simulation, cap: FrameCapture) -> None:
+        st = cap.world
+        for i, v in enumerate(sim.vessels):
+            x, y, z, r, p, yaw = (float(a) for a in st.poses[i])
+            self.rows["world_state"].append({
+                "frame": cap.frame, "time_s": cap.time_s, "vessel_id": v.id, "asset": v.asset, "role": v.role,
+                "semantic_class": v.semantic_class, "instance_id": v.instance_id, "x": x, "y": y, "z": z,
+                "roll": r, "pitch": p, "yaw": yaw, "vx": float(st.velocities[i, 0]), "vy": float(st.velocities[i, 1]),
+                "vz": float(st.velocities[i, 2]), "box_cx": float(st.box_centers[i, 0]), "box_cy": float(st.box_centers[i, 1]),
+                "box_cz": float(st.box_centers[i, 2]), "length": float(v.box_size[0]), "beam": float(v.box_size[1]),
+                "height": float(v.box_size[2]),
+            })
+
+    def add_annotations(self, ann: Annotations) -> None:
+        cols = ann.columns()
+        lid = cols["lidar"]
+        for j, tid in enumerate(lid["target_id"]):
+            c, s, q = lid["center"][j], lid["size"][j], lid["rotation"][j]
+            self.rows["boxes_3d"].append({
+                "frame": ann.frame, "time_s": ann.time_s, "agent": ann.agent, "target_id": tid,
+                "instance_id": int(lid["instance_id"][j]), "semantic_class": int(lid["semantic_class"][j]),
+                "x": float(c[0]), "y": float(c[1]), "z": float(c[2]), "length": float(s[0]), "beam": float(s[1]),
+                "height": float(s[2]), "qx": float(q[0]), "qy": float(q[1]), "qz": float(q[2]), "qw": float(q[3]),
+                "yaw": float(lid["yaw"][j]), "lidar_points": int(lid["lidar_points"][j]), "range_m": float(lid["range_m"][j]),
+            })
+        cam = cols["camera"]
+        for j, tid in enumerate(cam["target_id"]):
+            self.rows["boxes_2d"].append({
+                "frame": ann.frame, "time_s": ann.time_s, "agent": ann.agent, "camera": cam["camera"][j], "target_id": tid,
+                "x_min": float(cam["x_min"][j]), "y_min": float(cam["y_min"][j]), "x_max": float(cam["x_max"][j]),
+                "y_max": float(cam["y_max"][j]), "truncation": float(cam["truncation"][j]),
+                "visible_pixels": int(cam["visible_pixels"][j]), "box_pixels": int(cam["box_pixels"][j]),
+                "occlusion": float(cam["occlusion"][j]),
+            })
+
+    def flush(self) -> None:
+        for name, rows in self.rows.items():
+            if not rows:
+                continue
+            d = self.root / name
+            d.mkdir(parents=True, exist_ok=True)
+            pl.DataFrame(rows).write_parquet(d / f"part-{self.part:05d}.parquet")
+            rows.clear()
+        self.part += 1
+
+
+def annotations_for(sim: Simulation, cap: FrameCapture, silhouettes: SilhouetteCache) -> dict[str, Annotations]:
+    """Every agent's annotations of one captured frame."""
+    out: dict[str, Annotations] = {}
+    for agent in sim.agents:
+        ac = cap.agents.get(agent.id)
+        if ac is None:
+            continue
+        cams = {
+            name: (agent.cameras[name][0], ac.camera_poses[name], img.instance) for name, img in ac.cameras.items()
+        }
+        rng = agent.rig.lidar.range_m if agent.rig.lidar is not None else 200.0
+        out[agent.id] = annotate_agent(
+            agent_id=agent.id, agent_index=agent.index, frame=cap.frame, time_s=cap.time_s, vessels=sim.vessels,
+            state=cap.world, lidar_pose=ac.lidar_pose,
+            lidar_instances=ac.lidar.instance if ac.lidar is not None else None,
+            cameras=cams, silhouettes=silhouettes, max_range_m=rng,
+        )
+    return out
+
+
+def run(
+    cfg: Any,
+    *,
+    out_dir: str | Path = "out",
+    overwrite: bool = False,
+    frames: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> RunResult:
+    """Runs a scenario (a YAML path, a dict or a :class:`~mmusv.config.Scenario`) into ``out_dir``.
+
+    Args:
+        out_dir: output folder (created).
+        overwrite: replace an existing recording of the same scenario name; otherwise that is an error.
+        frames: run only the first ``frames`` indices (default: the scenario's ``acquisition.frames``).
+        progress: called with (frames done, frames total) after every frame.
+
+    Raises:
+        ConfigError: the scenario is invalid (nothing is written).
+        IoError: the output exists and ``overwrite`` is false, or cannot be written.
+        KeyboardInterrupt: re-raised after the recording was finished with every completed frame.
+    """
+    from mmusv.record_frames import FrameRecorder  # the MCAP side, kept apart from the loop
+
+    scenario = load_scenario(cfg)
+    total = scenario.acquisition.frames if frames is None else int(frames)
+    if not 1 <= total <= scenario.acquisition.frames:
+        raise ConfigError(f"frames = {frames}: must be in 1..{scenario.acquisition.frames} (acquisition.frames)")
+    out = Path(out_dir)
+    rec_path = recording_path(out, scenario)
+    if rec_path.exists() and not overwrite:
+        raise IoError(f"{rec_path} already exists; pass overwrite=True (mmusv run --overwrite) to replace it")
+    sim = Simulation(scenario)  # builds the world: any remaining config problem surfaces here, before writing
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise IoError(f"cannot create output folder {out}: {exc.strerror}") from None
+    tables_dir = out / "tables"
+    if tables_dir.exists() and overwrite:
+        for old in sorted(tables_dir.glob("*/part-*.parquet")):
+            old.unlink()
+    tables = _Tables(tables_dir)
+    silhouettes = SilhouetteCache()
+    (out / "scenario.yaml").write_text(yaml.safe_dump(scenario.model_dump(mode="json"), sort_keys=False), encoding="utf-8")
+    result = RunResult(recording=rec_path, tables=tables_dir, frames_written=0, status="complete", seconds=0.0)
+    t0 = time.perf_counter()
+    recorder = FrameRecorder(rec_path, sim, overwrite=overwrite)
+    try:
+        for k in range(total):
+            tf = time.perf_counter()
+            cap = sim.capture(k)
+            anns = annotations_for(sim, cap, silhouettes)
+            recorder.write_frame(cap, anns)
+            tables.add_world(sim, cap)
+            for a in anns.values():
+                tables.add_annotations(a)
+            del cap
+            result.frames_written = k + 1
+            result.frame_seconds.append(time.perf_counter() - tf)
+            if (k + 1) % TABLE_PART_FRAMES == 0:
+                tables.flush()
+            if progress is not None:
+                progress(k + 1, total)
+    except KeyboardInterrupt:
+        result.status = "interrupted"
+        raise
+    except Exception as exc:
+        result.status = "failed"
+        result.error = f"{type(exc).__name__}: {exc}"
+        raise
+    finally:
+        summary = recorder.finish(status=result.status, frames=result.frames_written, error=result.error)
+        result.messages, result.bytes = summary.get("messages", 0), summary.get("bytes", 0)
+        tables.flush()
+        result.seconds = time.perf_counter() - t0
+        manifest = {
+            "mmusv_version": _version(),
+            "scenario": scenario.name,
+            "seed": scenario.seed,
+            "config_hash": scenario_hash(scenario),
+            "status": result.status,
+            "frames_written": result.frames_written,
+            "frames_requested": total,
+            "frequency_hz": scenario.acquisition.frequency_hz,
+            "agents": [a.id for a in sim.agents],
+            "recording": rec_path.name,
+            "tables": sorted(p.name for p in tables_dir.iterdir()) if tables_dir.exists() else [],
+        }
+        (out / "manifest.json").write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")
+    return result
+
+
+def _version() -> str:
+    from mmusv import __version__
+
+    return __version__

@@ -1,0 +1,174 @@
+"""Writing captured frames into the MCAP recording: which topic gets what (the layout of ``docs/recording.md``).
+
+Per frame k (log time = t_k in ns, the same for every message of the frame):
+
+* ``/tf`` — ``foxglove.FrameTransforms``: ``world → <vessel>`` for every vessel, and for every agent
+  ``<agent> → <agent>/lidar``, ``<agent>/radar``, ``<agent>/camera/<name>`` (optical frame: x right, y down,
+  z forward), ``world → <agent>/top_view`` (optical frame of the top-view camera);
+* ``/world/state`` — ``mmusv.WorldState``;
+* per agent: ``/<agent>/lidar`` (``foxglove.PointCloud``: x, y, z, intensity float32, ring uint16, azimuth
+  float32, class uint16, instance int32; LiDAR frame), ``/<agent>/camera/<name>/rgb`` (PNG),
+  ``.../depth`` (RawImage 32FC1, metres along the optical axis, +inf = sky), ``.../semantic`` (PNG uint16 class
+  ids), ``.../instance`` (PNG uint16 instance ids, 65535 = sky), ``/<agent>/top_view/{rgb,semantic,instance}``,
+  ``/<agent>/radar/returns`` (PointCloud: x, y, z, range, azimuth, elevation, intensity float32, instance int32;
+  radar frame), ``/<agent>/radar/ppi`` (PNG, colour-mapped PPI), ``/<agent>/boxes`` (``foxglove.SceneUpdate`` in
+  the LiDAR frame) and ``/<agent>/annotations`` (``mmusv.AgentAnnotations``).
+
+Metadata records: ``scenario`` (the resolved YAML), ``manifest`` (mmusv version, seed, config hash), ``sensors``
+(JSON: per agent, mounts and camera intrinsics), ``run`` (status, frames written, frequency, agents; written last).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+from scipy.spatial.transform import Rotation
+
+from mmusv.annotate import Annotations
+from mmusv.config import scenario_hash
+from mmusv.record import Recording
+from mmusv.sensors.camera import BODY_TO_OPTICAL, CameraImages
+from mmusv.simulation import FrameCapture, Simulation
+
+__all__ = ["FrameRecorder", "OPTICAL_IN_BODY", "pose7"]
+
+OPTICAL_IN_BODY = np.eye(4)
+OPTICAL_IN_BODY[:3, :3] = BODY_TO_OPTICAL.T
+"""``(4, 4)`` optical frame → camera body frame."""
+
+_ROLE_COLOURS = {"usv": (0.2, 0.9, 0.9, 0.5), "target": (1.0, 0.3, 0.2, 0.5), "moored": (1.0, 0.8, 0.2, 0.5)}
+
+
+def pose7(m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Translation ``(3,)`` and quaternion ``(4,)`` (x, y, z, w) of a ``(4, 4)`` rigid transform."""
+    return m[:3, 3].copy(), Rotation.from_matrix(m[:3, :3]).as_quat()
+
+
+class FrameRecorder:
+    """Streams :class:`~mmusv.simulation.FrameCapture` frames of ``sim`` into ``path``."""
+
+    def __init__(self, path: Path, sim: Simulation, *, overwrite: bool = False) -> None:
+        self.sim = sim
+        self.rec = Recording(path, overwrite=overwrite)
+        sc = sim.scenario
+        self.rec.metadata("scenario", {"name": sc.name, "yaml": yaml.safe_dump(sc.model_dump(mode="json"), sort_keys=False)})
+        from mmusv import __version__
+
+        self.rec.metadata("manifest", {"mmusv_version": __version__, "seed": sc.seed, "config_hash": scenario_hash(sc)})
+        sensors: dict[str, Any] = {}
+        for a in sim.agents:
+            cams = {}
+            for name, (cam, cfg, mount) in a.cameras.items():
+                cams[name] = {"resolution": list(cfg.resolution), "hfov_deg": cfg.hfov_deg, "intrinsics": list(cam.intrinsics),
+                              "mount_in_body": np.round(mount, 9).tolist(), "outputs": list(cfg.outputs)}
+            sensors[a.id] = {
+                "asset": a.asset.name,
+                "lidar_mount_in_body": None if a.lidar_mount is None else np.round(a.lidar_mount, 9).tolist(),
+                "radar_mount_in_body": None if a.radar_mount is None else np.round(a.radar_mount, 9).tolist(),
+                "cameras": cams,
+                "rig": a.rig.model_dump(mode="json"),
+            }
+        self.rec.metadata("sensors", {"json": json.dumps(sensors, sort_keys=True)})
+
+    # ------------------------------------------------------------------------------------------ per frame
+
+    def write_frame(self, cap: FrameCapture, annotations: dict[str, Annotations]) -> None:
+        """Writes every message of one frame."""
+        t = round(cap.time_s * 1e9)
+        sim, st, rec = self.sim, cap.world, self.rec
+        tfs: list[tuple[str, str, np.ndarray, np.ndarray]] = []
+        for i, v in enumerate(sim.vessels):
+            tfs.append(("world", v.id, *pose7(st.matrices[i])))
+        for a in sim.agents:
+            ac = cap.agents.get(a.id)
+            if ac is None:
+                continue
+            body_inv = np.linalg.inv(st.matrices[a.index])
+            if ac.lidar_pose is not None:
+                tfs.append((a.id, f"{a.id}/lidar", *pose7(body_inv @ ac.lidar_pose)))
+            if ac.radar_pose is not None:
+                tfs.append((a.id, f"{a.id}/radar", *pose7(body_inv @ ac.radar_pose)))
+            for name, p in ac.camera_poses.items():
+                tfs.append((a.id, f"{a.id}/camera/{name}", *pose7(body_inv @ p @ OPTICAL_IN_BODY)))
+            if ac.top_view_pose is not None:
+                tfs.append(("world", f"{a.id}/top_view", *pose7(ac.top_view_pose @ OPTICAL_IN_BODY)))
+        rec.frame_transforms("/tf", log_time_ns=t, transforms=tfs)
+        rec.world_state(
+            "/world/state", log_time_ns=t, frame=cap.frame, time_s=cap.time_s,
+            ids=[v.id for v in sim.vessels], assets=[v.asset for v in sim.vessels], roles=[v.role for v in sim.vessels],
+            classes=[v.semantic_class for v in sim.vessels], instance_ids=[v.instance_id for v in sim.vessels],
+            poses=st.poses, velocities=st.velocities, box_centers=st.box_centers,
+            box_sizes=np.array([v.box_size for v in sim.vessels]).reshape(-1, 3),
+        )
+        for a in sim.agents:
+            ac = cap.agents.get(a.id)
+            if ac is None:
+                continue
+            if ac.lidar is not None:
+                pts = ac.lidar
+                rec.point_cloud(
+                    f"/{a.id}/lidar", log_time_ns=t, frame_id=f"{a.id}/lidar",
+                    columns={"x": pts.xyz[:, 0], "y": pts.xyz[:, 1], "z": pts.xyz[:, 2], "intensity": pts.intensity,
+                             "ring": pts.ring, "azimuth": pts.azimuth, "class": pts.semantic_class, "instance": pts.instance},
+                )
+            for name, img in ac.cameras.items():
+                self._images(f"/{a.id}/camera/{name}", f"{a.id}/camera/{name}", t, img, list(a.cameras[name][1].outputs))
+            if ac.top_view is not None and a.rig.top_view is not None:
+                self._images(f"/{a.id}/top_view", f"{a.id}/top_view", t, ac.top_view, list(a.rig.top_view.outputs))
+            if ac.radar is not None:
+                self._radar(a.id, t, ac.radar, ac.radar_ppi)
+            ann = annotations.get(a.id)
+            if ann is not None:
+                cols = ann.columns()
+                rec.annotations(f"/{a.id}/annotations", log_time_ns=t, frame=cap.frame, time_s=cap.time_s, agent_id=a.id,
+                                lidar=cols["lidar"], bev=cols["bev"], camera=cols["camera"])
+                lid = cols["lidar"]
+                roles = {v.id: v.role for v in sim.vessels}
+                colours = np.array([_ROLE_COLOURS.get(roles.get(i, "target"), (1, 1, 1, 0.5)) for i in lid["target_id"]]).reshape(-1, 4)
+                rec.boxes(f"/{a.id}/boxes", log_time_ns=t, frame_id=f"{a.id}/lidar", entity_id=f"{a.id}/targets",
+                          ids=lid["target_id"], centers=lid["center"], quaternions=lid["rotation"], sizes=lid["size"],
+                          colors=colours)
+
+    def _images(self, topic: str, frame_id: str, t: int, img: CameraImages, outputs: list[str]) -> None:
+        rec = self.rec
+        if img.rgb is not None and "rgb" in outputs:
+            rec.png_image(f"{topic}/rgb", log_time_ns=t, frame_id=frame_id, image=img.rgb)
+        if "depth" in outputs:
+            rec.raw_image(f"{topic}/depth", log_time_ns=t, frame_id=frame_id, image=np.ascontiguousarray(img.depth, dtype=np.float32))
+        if "semantic" in outputs:
+            rec.png_image(f"{topic}/semantic", log_time_ns=t, frame_id=frame_id, image=img.semantic)
+        if "instance" in outputs:
+            inst = np.where(img.instance < 0, 65535, img.instance).astype(np.uint16)
+            rec.png_image(f"{topic}/instance", log_time_ns=t, frame_id=frame_id, image=inst)
+
+    def _radar(self, agent: str, t: int, returns: Any, ppi: np.ndarray | None) -> None:
+        from mmusv.sensors.radar import ppi_colormap
+
+        r, az, el = returns.range, returns.azimuth, returns.elevation
+        ce = np.cos(el)
+        self.rec.point_cloud(
+            f"/{agent}/radar/returns", log_time_ns=t, frame_id=f"{agent}/radar",
+            columns={"x": (r * ce * np.cos(az)).astype(np.float32), "y": (r * ce * np.sin(az)).astype(np.float32),
+                     "z": (r * np.sin(el)).astype(np.float32), "range": r, "azimuth": az, "elevation": el,
+                     "intensity": returns.intensity, "instance": returns.instance_id},
+        )
+        if ppi is not None:
+            self.rec.png_image(f"/{agent}/radar/ppi", log_time_ns=t, frame_id=f"{agent}/radar", image=ppi_colormap(ppi))
+
+    # ------------------------------------------------------------------------------------------ end
+
+    def finish(self, *, status: str, frames: int, error: str | None = None) -> dict[str, Any]:
+        """Writes the ``run`` metadata and completes the file (also after an interruption: the file then holds
+        every completed frame and says ``status: interrupted``)."""
+        sc = self.sim.scenario
+        meta = {"scenario": sc.name, "status": status, "frames_written": frames, "frames_configured": sc.acquisition.frames,
+                "frequency_hz": sc.acquisition.frequency_hz, "agents": ",".join(a.id for a in self.sim.agents)}
+        if error:
+            meta["error"] = error
+        self.rec.metadata("run", meta)
+        summary: dict[str, Any] = self.rec.finish()
+        return summary
