@@ -1,7 +1,8 @@
 """mmusv: a headless, deterministic maritime multi-USV simulator and dataset generator.
 
-Start with :mod:`mmusv.scene` for ray casting on your own meshes, :mod:`mmusv.world` for maps, vessels and
-environments.
+The main job is ``mmusv.run(cfg, out_dir=...)`` (a scenario YAML path, dict or :class:`mmusv.config.Scenario`)
+into an MCAP recording plus Parquet tables; :class:`mmusv.Simulation` captures single frames as numpy arrays;
+:mod:`mmusv.scene` casts rays on your own meshes; :mod:`mmusv.world` has maps, vessels and environments.
 """
 
 from __future__ import annotations
@@ -17,6 +18,9 @@ from mmusv.errors import (
     NotFoundError,
 )
 from mmusv.scene import RayHits, Scene
+from mmusv import config
+from mmusv.acquire import RunResult, run
+from mmusv.simulation import Simulation
 
 __version__: str = _core_module.__version__
 
@@ -24,6 +28,10 @@ __all__ = [
     "__version__",
     "Scene",
     "RayHits",
+    "Simulation",
+    "run",
+    "RunResult",
+    "config",
     "MmusvError",
     "InputError",
     "GeometryError",

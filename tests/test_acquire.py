@@ -1,0 +1,173 @@
+"""The main job end to end: `mmusv.run` / `mmusv run` into MCAP + Parquet, read back with the official readers."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import polars as pl
+import pytest
+import yaml
+from mcap.reader import make_reader
+from mcap_protobuf.decoder import DecoderFactory
+
+import mmusv
+from mmusv.acquire import run
+from mmusv.cli import main
+from mmusv.preview import decode_image, decode_point_cloud
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def small_scenario(frames: int = 3) -> dict[str, Any]:
+    """The bundled port scenario shrunk for tests: 2 USVs, small images, short radar."""
+    sc = yaml.safe_load((ROOT / "scenarios/port_entry.yaml").read_text())
+    sc["acquisition"]["frames"] = frames
+    sc["vessels"] = [v for v in sc["vessels"] if v["id"] != "usv_3"]
+    sc["rigs"] = {
+        "usv_standard": {
+            "lidar": {"channels": 16, "points_per_second": 16 * 360 * 5},
+            "radar": {"range_m": 1000, "azimuth_bins": 256, "rays_el": 8, "ppi_size_px": 64},
+            "cameras": [
+                {"name": "front", "resolution": [64, 48], "mount": {"point": "camera_front"}},
+                {"name": "rear", "resolution": [64, 48], "mount": {"point": "camera_rear"}, "outputs": ["rgb", "semantic"]},
+            ],
+            "top_view": {"resolution": [64, 64], "metres_per_pixel": 1.0},
+        }
+    }
+    return sc
+
+
+@pytest.fixture(scope="module")
+def recorded(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Any]:
+    out = tmp_path_factory.mktemp("run")
+    res = run(small_scenario(), out_dir=out)
+    return out, res
+
+
+def _messages(path: Path) -> list[tuple[str, int, Any, Any]]:
+    with path.open("rb") as f:
+        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        return [(c.topic, m.log_time, m, d) for _s, c, m, d in reader.iter_decoded_messages()]
+
+
+def test_every_channel_decodes_and_frames_and_times_are_right(recorded: tuple[Path, Any]) -> None:
+    out, res = recorded
+    assert res.status == "complete" and res.frames_written == 3
+    msgs = _messages(res.recording)
+    topics = {t for t, *_ in msgs}
+    for agent in ("usv_1", "usv_2"):
+        for suffix in ("lidar", "radar/returns", "radar/ppi", "camera/front/rgb", "camera/front/depth", "camera/front/semantic",
+                       "camera/front/instance", "camera/rear/rgb", "camera/rear/semantic", "top_view/rgb", "top_view/semantic",
+                       "boxes", "annotations"):
+            assert f"/{agent}/{suffix}" in topics
+        assert f"/{agent}/camera/rear/depth" not in topics  # not among that camera's outputs
+    assert {"/tf", "/world/state"} <= topics
+    # One message per topic per frame, at t_k = k / f.
+    per_topic: dict[str, list[int]] = {}
+    for t, lt, _m, _d in msgs:
+        per_topic.setdefault(t, []).append(lt)
+    for t, times in per_topic.items():
+        assert sorted(times) == [0, 200_000_000, 400_000_000], t
+    states = [d for t, _lt, _m, d in msgs if t == "/world/state"]
+    assert [s.frame for s in states] == [0, 1, 2]
+    assert [len(s.vessels) for s in states] == [6 + 4] * 3  # 6 scenario vessels + 4 moored ships
+
+
+def test_recorded_sensors_match_a_direct_capture(recorded: tuple[Path, Any]) -> None:
+    out, res = recorded
+    sim = mmusv.Simulation(small_scenario())
+    cap = sim.capture(1)
+    msgs = {t: d for t, lt, _m, d in _messages(res.recording) if lt == 200_000_000}
+    pts = decode_point_cloud(msgs["/usv_1/lidar"])
+    direct = cap.agents["usv_1"].lidar
+    assert direct is not None
+    np.testing.assert_array_equal(pts["x"], direct.xyz[:, 0])
+    np.testing.assert_array_equal(pts["ring"], direct.ring)
+    np.testing.assert_array_equal(pts["instance"], direct.instance)
+    img = cap.agents["usv_1"].cameras["front"]
+    np.testing.assert_array_equal(decode_image(msgs["/usv_1/camera/front/depth"]), img.depth)
+    np.testing.assert_array_equal(decode_image(msgs["/usv_1/camera/front/semantic"]), img.semantic)
+    assert img.rgb is not None
+    np.testing.assert_array_equal(decode_image(msgs["/usv_1/camera/front/rgb"]), img.rgb)
+    ann = msgs["/usv_1/annotations"]
+    ids = [b.target_id for b in ann.boxes_lidar]
+    assert "usv_1" not in ids, "the agent's own hull is never its target"
+    assert "usv_2" in ids or all(b.range_m > 200 for b in ann.boxes_lidar)
+    for b in ann.boxes_lidar:
+        n = int(np.count_nonzero(pts["instance"] == b.instance_id))
+        assert b.lidar_points == n
+
+
+def test_tables_and_manifest(recorded: tuple[Path, Any]) -> None:
+    out, res = recorded
+    ws = pl.read_parquet(out / "tables/world_state/*.parquet")
+    assert ws.height == 3 * 10 and set(ws["frame"].unique()) == {0, 1, 2}
+    b3 = pl.read_parquet(out / "tables/boxes_3d/*.parquet")
+    assert (b3["agent"] != b3["target_id"]).all()
+    man = json.loads((out / "manifest.json").read_text())
+    assert man["status"] == "complete" and man["frames_written"] == 3 and man["agents"] == ["usv_1", "usv_2"]
+    assert man["config_hash"] == mmusv.config.scenario_hash(mmusv.config.load_scenario(small_scenario()))
+
+
+def test_same_scenario_and_seed_give_identical_bytes(recorded: tuple[Path, Any], tmp_path: Path) -> None:
+    _out, res = recorded
+    again = run(small_scenario(), out_dir=tmp_path)
+    digest = lambda p: hashlib.sha256(Path(p).read_bytes()).hexdigest()  # noqa: E731
+    assert digest(again.recording) == digest(res.recording)
+    changed = small_scenario()
+    changed["seed"] = 8
+    other = run(changed, out_dir=tmp_path / "other")
+    assert digest(other.recording) != digest(res.recording)
+
+
+def test_existing_output_is_not_overwritten_unless_asked(recorded: tuple[Path, Any]) -> None:
+    out, res = recorded
+    before = res.recording.read_bytes()
+    with pytest.raises(mmusv.IoError, match="overwrite"):
+        run(small_scenario(), out_dir=out)
+    assert res.recording.read_bytes() == before
+
+
+def test_malformed_scenario_fails_before_anything_is_written(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    bad = small_scenario()
+    bad["rigs"]["usv_standard"]["lidar"]["channels"] = 0
+    path = tmp_path / "bad.yaml"
+    path.write_text(yaml.safe_dump(bad))
+    assert main(["run", str(path), "-o", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert "rigs.usv_standard.lidar.channels" in err and "Traceback" not in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_interrupted_run_leaves_a_readable_recording(tmp_path: Path) -> None:
+    def stop(done: int, total: int) -> None:
+        if done == 2:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run(small_scenario(frames=5), out_dir=tmp_path, progress=stop)
+    rec = tmp_path / "port_entry.mcap"
+    msgs = _messages(rec)
+    assert sorted({lt for _t, lt, _m, _d in msgs}) == [0, 200_000_000]
+    with rec.open("rb") as f:
+        meta = {m.name: dict(m.metadata) for m in make_reader(f).iter_metadata()}
+    assert meta["run"]["status"] == "interrupted" and meta["run"]["frames_written"] == "2"
+    assert json.loads((tmp_path / "manifest.json").read_text())["status"] == "interrupted"
+    assert pl.read_parquet(tmp_path / "tables/world_state/*.parquet")["frame"].max() == 1
+
+
+def test_info_and_preview_commands(recorded: tuple[Path, Any], tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    _out, res = recorded
+    assert main(["info", str(res.recording)]) == 0
+    text = capsys.readouterr().out
+    assert "/usv_1/lidar" in text and "complete" in text and "3 frames" in text
+    png = tmp_path / "p.png"
+    assert main(["preview", str(res.recording), "--frame", "2", "--agent", "usv_2", "-o", str(png)]) == 0
+    from PIL import Image
+
+    assert Image.open(png).size[0] > 100
+    assert main(["preview", str(res.recording), "--frame", "9"]) == 2
