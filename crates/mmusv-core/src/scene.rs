@@ -26,10 +26,11 @@ pub const NO_HIT: i32 = -1;
 pub const CLASS_NONE: u16 = 0;
 /// Rays per rayon task: large enough to amortise scheduling, small enough to balance (a multiple of [`PACKET`]).
 const CHUNK: usize = 512;
-/// Rays whose directions lie within ≈8° of each other and whose origins lie within 1 m are traced as a packet.
+/// Rays whose directions lie within ≈8° of each other and whose origins lie within 4 m are traced as a packet
+/// (camera pixels share an origin; the parallel rays of 8 neighbouring top-view pixels span ≈ 4 m).
 const COHERENT_COS: f32 = 0.990;
 /// See [`COHERENT_COS`].
-const COHERENT_RADIUS: f32 = 1.0;
+const COHERENT_RADIUS: f32 = 4.0;
 
 /// One placed copy of a mesh.
 #[derive(Debug, Clone)]
