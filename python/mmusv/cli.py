@@ -1,7 +1,7 @@
 """The ``mmusv`` command line.
 
 Subcommands: ``run`` (a scenario or a folder of them into MCAP + Parquet), ``info`` and ``preview`` (inspect a
-recording), ``generate`` (batch scenario generation), ``assets`` (the vessel library), ``study waves`` (Table I)
+recording), ``convert`` (to OPV2V or KITTI), ``generate`` (batch scenario generation), ``assets`` (the vessel library), ``study waves`` (Table I)
 and ``study agreement`` (Table II), ``version``.
 Errors in the input end with a one-line message naming the problem and exit status 2, never a traceback.
 """
@@ -196,9 +196,11 @@ def _parser() -> argparse.ArgumentParser:
     prev.add_argument("--frame", type=int, default=0, help="acquisition index (default 0)")
     prev.add_argument("--agent", default=None, help="USV id (default: the first)")
     prev.add_argument("-o", "--output", default=None, help="PNG path (default: next to the recording)")
+    from mmusv.export.cli import add_parser as add_convert_parser
     from mmusv.generate.cli import add_parser as add_generate_parser
 
     add_generate_parser(sub)
+    add_convert_parser(sub)
     return p
 
 
@@ -223,6 +225,10 @@ def main(argv: list[str] | None = None) -> int:
             return _cmd_info(args)
         if args.command == "preview":
             return _cmd_preview(args)
+        if args.command == "convert":
+            from mmusv.export.cli import run as _run_convert
+
+            return _run_convert(args)
         if args.command == "generate":
             from mmusv.generate.cli import run as _run_generate
 

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mmusv.classes import SemanticClass
+from mmusv.frames import pose_matrices  # re-exported: the pose convention lives in mmusv.frames
 from mmusv.scene import Scene
 from mmusv.world.maps import MapWorld
 from mmusv.world.primitives import TriMesh
@@ -41,28 +42,6 @@ class WorldScene:
 
 def _add(scene: Scene, mesh: TriMesh, name: str) -> int:
     return scene.add_mesh(mesh.vertices, mesh.faces, classes=mesh.classes, name=name)
-
-
-def pose_matrices(eta: np.ndarray) -> np.ndarray:
-    """``(..., 4, 4)`` float64 body -> world matrices from poses ``η = [x, y, z, roll, pitch, yaw]`` ``(..., 6)``
-    (metres, radians, R = Rz(yaw)·Ry(pitch)·Rx(roll))."""
-    eta = np.asarray(eta, dtype=np.float64)
-    cr, sr = np.cos(eta[..., 3]), np.sin(eta[..., 3])
-    cp, sp = np.cos(eta[..., 4]), np.sin(eta[..., 4])
-    cy, sy = np.cos(eta[..., 5]), np.sin(eta[..., 5])
-    m = np.zeros(eta.shape[:-1] + (4, 4), dtype=np.float64)
-    m[..., 0, 0] = cy * cp
-    m[..., 0, 1] = cy * sp * sr - sy * cr
-    m[..., 0, 2] = cy * sp * cr + sy * sr
-    m[..., 1, 0] = sy * cp
-    m[..., 1, 1] = sy * sp * sr + cy * cr
-    m[..., 1, 2] = sy * sp * cr - cy * sr
-    m[..., 2, 0] = -sp
-    m[..., 2, 1] = cp * sr
-    m[..., 2, 2] = cp * cr
-    m[..., :3, 3] = eta[..., :3]
-    m[..., 3, 3] = 1.0
-    return m
 
 
 def build_static_scene(world: MapWorld, *, include_water: bool = True, include_moored: bool = True) -> WorldScene:

@@ -1,0 +1,129 @@
+"""What the dataset writers share: options, topic names, id scheme, image helpers and a byte-counting sink."""
+
+from __future__ import annotations
+
+import builtins
+import io
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from mmusv.errors import ConfigError
+
+__all__ = [
+    "TARGETS",
+    "EXTRAS",
+    "DEFAULT_EXTRAS",
+    "CAV_ID_BASE",
+    "DEPTH_UNIT_M",
+    "Options",
+    "Sink",
+    "cav_id",
+    "parse_extras",
+    "png_bytes",
+    "depth_png",
+    "dump_yaml",
+    "rounded",
+]
+
+TARGETS = ("opv2v", "kitti")
+EXTRAS = ("depth", "semantic", "instance", "radar", "top_view")
+DEFAULT_EXTRAS = ("depth", "semantic", "radar", "top_view")
+CAV_ID_BASE = 1000
+DEPTH_UNIT_M = 0.01
+"""Depth PNGs are uint16 centimetres along the optical axis: 0 = no hit (sky), 65535 = 655.35 m or farther."""
+
+
+def cav_id(index: int) -> int:
+    """Dataset id of the vessel in world-state row ``index`` (agents and targets alike): ``1000 + index``, so
+    string order = numeric order = scenario order (for fewer than 9000 vessels)."""
+    return CAV_ID_BASE + int(index)
+
+
+def parse_extras(extras: Iterable[str] | str | None) -> tuple[str, ...]:
+    """Validated extras (order of :data:`EXTRAS`) from a sequence or a comma-separated string."""
+    if extras is None:
+        return ()
+    items = [e.strip() for e in extras.split(",")] if isinstance(extras, str) else [str(e).strip() for e in extras]
+    items = [e for e in items if e]
+    bad = sorted(set(items) - set(EXTRAS))
+    if bad:
+        raise ConfigError(f"unknown extra(s) {', '.join(map(repr, bad))}; allowed: {', '.join(EXTRAS)}")
+    return tuple(e for e in EXTRAS if e in items)
+
+
+@dataclass(frozen=True)
+class Options:
+    """Conversion options (see :func:`mmusv.export.convert`)."""
+
+    to: str = "opv2v"
+    eval_range_m: float = 200.0
+    include_usvs: bool = False
+    extras: tuple[str, ...] = DEFAULT_EXTRAS
+
+
+@dataclass
+class Sink:
+    """Writes files and counts them."""
+
+    files: int = 0
+    bytes: int = 0
+    created: list[Path] = field(default_factory=list)
+
+    def write(self, path: Path, data: builtins.bytes) -> None:
+        path.write_bytes(data)
+        self.files += 1
+        self.bytes += len(data)
+
+    def mkdir(self, path: Path) -> Path:
+        if not path.exists():
+            path.mkdir(parents=True)
+            self.created.append(path)
+        return path
+
+
+def png_bytes(msg: Any) -> bytes:
+    """The PNG bytes of an image message: a ``foxglove.CompressedImage`` in PNG is copied as is, anything else
+    is decoded and encoded (fixed settings, so the bytes are deterministic)."""
+    if hasattr(msg, "format") and str(msg.format).lower() == "png":
+        return bytes(msg.data)
+    from mmusv.preview import decode_image
+
+    return encode_png(decode_image(msg))
+
+
+def encode_png(img: np.ndarray, *, compress_level: int = 6) -> bytes:
+    """PNG of an ``(H, W)`` uint8/uint16 or ``(H, W, 3)`` uint8 image."""
+    from PIL import Image
+
+    buf = io.BytesIO()
+    Image.fromarray(np.ascontiguousarray(img)).save(buf, format="PNG", compress_level=compress_level)
+    return buf.getvalue()
+
+
+def depth_png(msg: Any) -> bytes:
+    """A depth image message (metres, float; +inf or 0 = no hit) as a uint16 PNG in units of
+    :data:`DEPTH_UNIT_M` (0 = no hit, 65535 = saturated)."""
+    from mmusv.preview import decode_image
+
+    d = np.asarray(decode_image(msg), dtype=np.float64)
+    units = np.where(np.isfinite(d) & (d > 0), np.clip(np.rint(d / DEPTH_UNIT_M), 1, 65535), 0).astype(np.uint16)
+    return encode_png(units, compress_level=1)
+
+
+def rounded(values: Iterable[float], nd: int = 6) -> list[float]:
+    """Python floats rounded to ``nd`` decimals, with ``-0.0`` written as ``0.0``."""
+    return [round(float(v), nd) + 0.0 for v in values]
+
+
+_Dumper: Any = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
+
+
+def dump_yaml(data: Any) -> bytes:
+    """YAML bytes with sorted keys, block style (as OpenCDA writes its files)."""
+    text: str = yaml.dump(data, Dumper=_Dumper, default_flow_style=False, sort_keys=True, allow_unicode=False)
+    return text.encode("utf-8")

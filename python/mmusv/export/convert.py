@@ -1,0 +1,262 @@
+"""``convert``: recordings → an OPV2V (or KITTI-style) dataset folder, optionally split by sequence.
+
+Output root ``out_dir``: ``{train,validate,test}/<scenario>/...`` (or ``<scenario>/...`` with ``splits=None``)
+plus ``conversion.yaml`` (options, sources, split of every recording, frames converted and skipped; no times
+or absolute paths, so two conversions of the same input are byte-identical). ``conversion.yaml`` is written
+first with ``status: in_progress`` and rewritten at the end; an existing ``out_dir`` is replaced only with
+``overwrite`` and only when it is empty or holds a previous conversion (its ``conversion.yaml``).
+"""
+
+from __future__ import annotations
+
+import math
+import shutil
+import time
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from mmusv.errors import ConfigError, IoError
+from mmusv.export.common import DEFAULT_EXTRAS, TARGETS, Options, Sink, dump_yaml, parse_extras
+from mmusv.export.kitti import KittiWriter
+from mmusv.export.opv2v import Opv2vWriter
+from mmusv.export.reader import FrameStream, RecordingInfo, read_info
+from mmusv.export.splits import SPLIT_NAMES, assign_splits, parse_ratios
+from mmusv.export.writer import DatasetWriter
+
+__all__ = ["ConvertReport", "RecordingReport", "convert", "REPORT_NAME"]
+
+REPORT_NAME = "conversion.yaml"
+
+
+@dataclass
+class RecordingReport:
+    """One recording's conversion: where it went and which frames were converted or skipped (``skipped``:
+    ``{"frames": [first, last], "reason": ...}`` ranges)."""
+
+    path: Path
+    scenario: str
+    folder: str
+    split: str | None
+    frames_converted: int = 0
+    first_frame: int | None = None
+    last_frame: int | None = None
+    skipped: list[dict[str, Any]] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    status: str = ""
+
+    def as_dict(self) -> dict[str, Any]:
+        """The recording's entry of ``conversion.yaml``."""
+        return {"source": self.path.name, "scenario": self.scenario, "folder": self.folder, "split": self.split,
+                "run_status": self.status, "frames_converted": self.frames_converted,
+                "frames": None if self.first_frame is None else [self.first_frame, self.last_frame],
+                "skipped": self.skipped, "notes": self.notes}
+
+
+@dataclass
+class ConvertReport:
+    """What a conversion wrote: per recording, totals, seconds (wall) and bytes on disk."""
+
+    out_dir: Path
+    target: str
+    recordings: list[RecordingReport]
+    agent_frames: int = 0
+    files: int = 0
+    bytes: int = 0
+    seconds: float = 0.0
+
+    @property
+    def frames(self) -> int:
+        """Frames converted (each one for every agent of its recording)."""
+        return sum(r.frames_converted for r in self.recordings)
+
+    @property
+    def skipped(self) -> list[dict[str, Any]]:
+        """Every skipped range, with its recording's file name."""
+        return [{"recording": r.path.name, **s} for r in self.recordings for s in r.skipped]
+
+    def lines(self) -> list[str]:
+        """A human summary, one line per recording and a total."""
+        out = []
+        for r in self.recordings:
+            where = f"{r.split}/{r.folder}" if r.split else r.folder
+            out.append(f"{r.path.name} -> {where}: {r.frames_converted} frames")
+            out += [f"  skipped frames {s['frames'][0]}..{s['frames'][1]}: {s['reason']}" for s in r.skipped]
+            out += [f"  note: {n}" for n in r.notes]
+        out.append(f"{self.frames} frames ({self.agent_frames} agent-frames), {self.files} files, {self.bytes / 1e6:.1f} MB "
+                   f"in {self.seconds:.1f} s -> {self.out_dir}")
+        return out
+
+
+def _as_list(recordings: str | Path | Iterable[str | Path]) -> list[Path]:
+    if isinstance(recordings, (str, Path)):
+        return [Path(recordings)]
+    out = [Path(r) for r in recordings]
+    if not out:
+        raise ConfigError("no recordings given")
+    return out
+
+
+def _prepare_out(out: Path, overwrite: bool) -> None:
+    if out.exists() and not out.is_dir():
+        raise IoError(f"output {out} exists and is not a folder")
+    if out.exists() and any(out.iterdir()):
+        if not overwrite:
+            raise IoError(f"output folder {out} already exists and is not empty; pass overwrite=True (--overwrite) to replace it")
+        if not (out / REPORT_NAME).is_file():
+            raise IoError(f"output folder {out} is not empty and holds no {REPORT_NAME} from a previous conversion; "
+                          "refusing to delete it, choose another folder")
+        shutil.rmtree(out)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise IoError(f"cannot create output folder {out}: {exc.strerror}") from None
+
+
+def _ranges(frames: list[int]) -> list[tuple[int, int]]:
+    out: list[tuple[int, int]] = []
+    for k in sorted(frames):
+        if out and k == out[-1][1] + 1:
+            out[-1] = (out[-1][0], k)
+        else:
+            out.append((k, k))
+    return out
+
+
+def _folders(infos: list[RecordingInfo]) -> list[str]:
+    """Scenario folder names: the scenario name, or ``<name>_<hash8>`` when names repeat."""
+    names = [i.scenario_name for i in infos]
+    keys = [f"{i.scenario_name}_{i.config_hash[:8]}" for i in infos]
+    dup = {k for k in keys if keys.count(k) > 1}
+    if dup:
+        a = [str(i.path) for i, k in zip(infos, keys, strict=True) if k in dup]
+        raise ConfigError(f"recordings {', '.join(a)} are runs of the same scenario configuration; give each only once")
+    return [n if names.count(n) == 1 else k for n, k in zip(names, keys, strict=True)]
+
+
+def convert(
+    recordings: str | Path | Iterable[str | Path],
+    *,
+    to: str = "opv2v",
+    out_dir: str | Path,
+    splits: Sequence[float] | str | None = (0.7, 0.15, 0.15),
+    seed: int = 0,
+    eval_range_m: float = 200.0,
+    include_usvs: bool = False,
+    extras: Iterable[str] | str | None = DEFAULT_EXTRAS,
+    overwrite: bool = False,
+    progress: Callable[[int, int], None] | None = None,
+) -> ConvertReport:
+    """Converts one or many recordings into a dataset folder (see the module docstring).
+
+    Args:
+        recordings: ``.mcap`` files written by ``mmusv run`` (also ``.mcap.partial`` or truncated ones: their
+            complete frames are converted, the rest reported as skipped).
+        to: ``"opv2v"`` or ``"kitti"``.
+        splits: ``(train, validate, test)`` fractions (split per recording, shuffled with ``seed``) or ``None``
+            for one folder of scenarios.
+        eval_range_m: targets are vessels whose box centre lies within ±``eval_range_m`` (x and y) of the agent's
+            LiDAR.
+        include_usvs: list the other USVs as targets too (default: only non-instrumented vessels).
+        extras: any of ``depth``, ``semantic``, ``instance``, ``radar``, ``top_view`` (extra files stock loaders
+            skip).
+        overwrite: replace a previous conversion in ``out_dir``.
+        progress: called with (frames done, frames expected) after every frame.
+
+    Raises:
+        ConfigError: bad options. IoError: missing, unreadable or non-MCAP recordings; an existing output.
+    """
+    t0 = time.perf_counter()
+    if to not in TARGETS:
+        raise ConfigError(f"unknown target {to!r}; allowed: {', '.join(TARGETS)}")
+    try:
+        rng = float(eval_range_m)
+    except (TypeError, ValueError):
+        raise ConfigError(f"eval_range_m = {eval_range_m!r}: must be a number of metres") from None
+    if not math.isfinite(rng) or rng <= 0:
+        raise ConfigError(f"eval_range_m = {eval_range_m!r}: must be a positive, finite number of metres")
+    ratios = None if splits is None else parse_ratios(splits)
+    options = Options(to=to, eval_range_m=rng, include_usvs=bool(include_usvs), extras=parse_extras(extras))
+    paths = _as_list(recordings)
+    infos = [read_info(p) for p in paths]  # validates every input before anything is written
+    folders = _folders(infos)
+    split_of: dict[str, str | None] = {f: None for f in folders}
+    if ratios is not None:
+        split_of = dict(assign_splits(folders, ratios, seed))
+    out = Path(out_dir)
+    _prepare_out(out, overwrite)
+    reports = [RecordingReport(path=i.path, scenario=i.scenario_name, folder=f, split=split_of[f]) for i, f in zip(infos, folders, strict=True)]
+    header = {"format": to, "options": {"eval_range_m": rng, "include_usvs": options.include_usvs, "extras": list(options.extras),
+              "splits": None if ratios is None else dict(zip(SPLIT_NAMES, [round(r, 9) for r in ratios], strict=True)), "seed": seed}}
+    (out / REPORT_NAME).write_bytes(dump_yaml({**header, "status": "in_progress"}))
+    sink = Sink()
+    report = ConvertReport(out_dir=out, target=to, recordings=reports)
+    expected = sum(int(i.run.get("frames_written", i.frames_configured) or 0) for i in infos)
+    done = 0
+    order = sorted(range(len(infos)), key=lambda j: (SPLIT_NAMES.index(reports[j].split) if reports[j].split else 0, folders[j]))
+    for j in order:
+        info, rep = infos[j], reports[j]
+        folder = out / rep.split / rep.folder if rep.split else out / rep.folder
+        sink.mkdir(folder)
+        cls: type[DatasetWriter] = Opv2vWriter if to == "opv2v" else KittiWriter
+        writer = cls(info, folder, options, sink)
+        wanted = writer.topic_filter()
+        stream = FrameStream(info, wanted.__contains__)
+        converted: list[int] = []
+        incomplete: list[tuple[int, str]] = []
+        for fr in stream:
+            missing = writer.missing(fr)
+            if fr.world is None or missing or not writer.agents:
+                why = "no agent with a LiDAR" if not writer.agents else f"incomplete: missing {', '.join(missing[:4])}" + (
+                    f" and {len(missing) - 4} more" if len(missing) > 4 else "")
+                incomplete.append((fr.index, why))
+            else:
+                writer.write_frame(fr)
+                converted.append(fr.index)
+                report.agent_frames += len(writer.agents)
+            done += 1
+            if progress is not None:
+                progress(done, max(expected, done))
+        rep.status = stream.run.get("status", "unfinished (no run metadata)")
+        for k, why in incomplete:
+            rep.skipped.append({"frames": [k, k], "reason": why})
+        seen = set(converted) | {k for k, _ in incomplete}
+        configured = int(stream.run.get("frames_configured", info.frames_configured) or 0)
+        absent = [k for k in range(configured) if k not in seen]
+        if absent:
+            written = stream.run.get("frames_written")
+            why = (f"not in the recording (run {rep.status}: {written} of {configured} frames written)" if written is not None
+                   else f"not in the recording (the run did not finish; {configured} frames configured)")
+            if stream.truncated:
+                why += "; " + stream.truncated
+            rep.skipped += [{"frames": [a, b], "reason": why} for a, b in _ranges(absent)]
+        elif stream.truncated:
+            rep.notes.append(stream.truncated)
+        if stream.out_of_order:
+            rep.notes.append(f"frames {sorted(set(stream.out_of_order))} appear more than once; the last copy was kept")
+        rep.skipped.sort(key=lambda s: s["frames"][0])
+        writer.finish(sorted(converted), rep.skipped)
+        rep.notes += writer.notes
+        rep.frames_converted = len(converted)
+        if converted:
+            rep.first_frame, rep.last_frame = min(converted), max(converted)
+        else:
+            rep.notes.append("no complete frame: nothing written for this recording")
+            shutil.rmtree(folder, ignore_errors=True)
+    doc = {**header, "status": "complete", "frames_converted": report.frames, "agent_frames": report.agent_frames,
+           "recordings": [r.as_dict() for r in sorted(reports, key=lambda r: (r.split or "", r.folder))]}
+    data = dump_yaml(doc)
+    (out / REPORT_NAME).write_bytes(data)
+    report.files = sink.files + 1
+    report.bytes = sink.bytes + len(data)
+    report.seconds = time.perf_counter() - t0
+    return report
+
+
+def load_report(out_dir: str | Path) -> dict[str, Any]:
+    """The ``conversion.yaml`` of a converted folder."""
+    doc: dict[str, Any] = yaml.safe_load((Path(out_dir) / REPORT_NAME).read_text(encoding="utf-8"))
+    return doc

@@ -1,0 +1,79 @@
+"""Per frame and agent: where the agent's sensors are and which vessels are its targets (mmusv frames).
+
+Everything here stays in mmusv's right-handed frames; the dataset writers change frames only through
+:mod:`mmusv.frames`. Sensor poses follow the recorder: sensor → world = vessel body → world (from the world
+state pose) · sensor mount in body.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from mmusv.export.reader import AgentInfo, WorldFrame
+from mmusv.frames import invert, pose_matrices
+
+__all__ = ["AgentView", "Target", "agent_view", "targets_of"]
+
+
+@dataclass(frozen=True)
+class AgentView:
+    """An agent at one frame: ``body``, ``lidar`` and ``cameras[name]`` are ``(4, 4)`` → world matrices."""
+
+    agent: AgentInfo
+    body: np.ndarray
+    lidar: np.ndarray | None
+    cameras: dict[str, np.ndarray]
+    speed_mps: float
+
+
+@dataclass(frozen=True)
+class Target:
+    """A vessel seen as a target by one agent: ``index`` its world-state row, ``body`` ``(4, 4)`` body → world,
+    ``box`` ``(4, 4)`` box → world (body rotation, box centre), ``box_in_lidar`` ``(4, 4)`` box → agent LiDAR,
+    ``size`` (length, beam, height)."""
+
+    index: int
+    id: str
+    asset: str
+    role: str
+    semantic_class: int
+    instance_id: int
+    body: np.ndarray
+    box: np.ndarray
+    box_in_lidar: np.ndarray
+    size: np.ndarray
+    speed_mps: float
+
+
+def agent_view(agent: AgentInfo, world: WorldFrame) -> AgentView:
+    """The sensor poses of ``agent`` in ``world``."""
+    body = pose_matrices(world.poses[agent.index])
+    lidar = None if agent.lidar_mount is None else body @ agent.lidar_mount
+    cams = {name: body @ c.mount for name, c in agent.cameras.items()}
+    return AgentView(agent, body, lidar, cams, float(np.linalg.norm(world.velocities[agent.index])))
+
+
+def targets_of(view: AgentView, world: WorldFrame, *, eval_range_m: float, include_usvs: bool) -> list[Target]:
+    """The targets of ``view``'s agent, in world-state order: every vessel but the agent itself (and other USVs
+    unless ``include_usvs``) whose box centre lies within ``|x|, |y| <= eval_range_m`` in the agent's LiDAR frame
+    (its body frame when it has no LiDAR)."""
+    ref = view.lidar if view.lidar is not None else view.body
+    ref_inv = invert(ref)
+    out: list[Target] = []
+    mats = pose_matrices(world.poses)
+    for i, vid in enumerate(world.ids):
+        if i == view.agent.index or (world.roles[i] == "usv" and not include_usvs):
+            continue
+        box = mats[i].copy()
+        box[:3, 3] = world.box_centers[i]
+        in_lidar = ref_inv @ box
+        if abs(in_lidar[0, 3]) > eval_range_m or abs(in_lidar[1, 3]) > eval_range_m:
+            continue
+        out.append(Target(
+            index=i, id=vid, asset=world.assets[i], role=world.roles[i], semantic_class=int(world.classes[i]),
+            instance_id=int(world.instance_ids[i]), body=mats[i], box=box, box_in_lidar=in_lidar,
+            size=world.box_sizes[i].copy(), speed_mps=float(np.linalg.norm(world.velocities[i])),
+        ))
+    return out

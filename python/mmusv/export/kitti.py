@@ -1,0 +1,132 @@
+"""KITTI-style per-agent folders: the same scenario/agent/timestamp structure as the OPV2V writer, KITTI files.
+
+``<scenario>/<cav_id>/velodyne/<ts>.bin`` (float32 x, y, z, intensity in the LiDAR frame, x forward, y left,
+z up — KITTI's Velodyne axes, so no mirror), ``image_2/<ts>.png`` (front camera), ``calib/<ts>.txt`` (``P0..P3``
+= the front camera's ``K·[I|0]``, ``R0_rect`` = I, ``Tr_velo_to_cam`` LiDAR → front optical frame,
+``Tr_imu_to_velo`` vessel body → LiDAR), ``label_2/<ts>.txt`` and ``pose/<ts>.txt`` (LiDAR → mmusv world,
+3×4 row-major, for cooperative use). Labels, one line per target within the evaluation range (same filter as
+OPV2V): ``type truncated occluded alpha x1 y1 x2 y2 h w l x y z rotation_y`` in the front camera frame
+(location = bottom centre of the box); the 2D box, truncation and occlusion come from the recording's camera
+annotations (occluded 0: < 25 % hidden, 1: < 60 %, 2: more, 3: not in the front image, with box ``0 0 0 0``).
+Extras: ``depth_2`` (uint16 cm), ``semantic_2``, ``instance_2``, ``radar_ppi``, ``top_view_rgb``,
+``top_view_semantic``.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from mmusv.classes import class_name
+from mmusv.export.common import cav_id, depth_png, dump_yaml, png_bytes
+from mmusv.export.geometry import AgentView, Target
+from mmusv.export.reader import AgentInfo, Frame, WorldFrame
+from mmusv.export.writer import DatasetWriter
+from mmusv.frames import BODY_TO_OPTICAL, invert, transform_points, wrap_rad
+
+__all__ = ["KittiWriter", "kitti_label", "occlusion_level"]
+
+
+def occlusion_level(occlusion: float | None) -> int:
+    """KITTI's occluded flag from the fraction of the target hidden (``None``: not in the image → 3)."""
+    if occlusion is None:
+        return 3
+    return 0 if occlusion < 0.25 else 1 if occlusion < 0.6 else 2
+
+
+def _fmt(values: Any) -> str:
+    return " ".join(f"{float(v) + 0.0:.6e}" for v in np.asarray(values, dtype=np.float64).reshape(-1))
+
+
+def kitti_label(target: Target, velo_to_cam: np.ndarray, box2d: Any | None) -> str:
+    """One ``label_2`` line of ``target`` (box in the LiDAR frame) for the camera ``velo_to_cam`` (4×4)."""
+    length, beam, height = (float(x) for x in target.size)
+    box_cam = velo_to_cam @ target.box_in_lidar
+    bottom = transform_points(box_cam, np.array([[0.0, 0.0, -height / 2.0]]))[0]
+    d = box_cam[:3, 0]
+    ry = float(wrap_rad(math.atan2(-d[2], d[0])))
+    centre = box_cam[:3, 3]
+    alpha = float(wrap_rad(ry - math.atan2(centre[0], centre[2])))
+    if box2d is None:
+        trunc, occ, bb = 0.0, 3, (0.0, 0.0, 0.0, 0.0)
+    else:
+        trunc, occ = float(box2d.truncation), occlusion_level(float(box2d.occlusion))
+        bb = (box2d.x_min, box2d.y_min, box2d.x_max, box2d.y_max)
+    name = class_name(target.semantic_class).capitalize()
+    vals = [trunc, occ, alpha, *bb, height, beam, length, *bottom, ry]
+    return f"{name} {vals[0]:.2f} {int(vals[1])} " + " ".join(f"{round(float(v), 2) + 0.0:.2f}" for v in vals[2:])
+
+
+class KittiWriter(DatasetWriter):
+    """Writes one recording as KITTI-style per-agent folders (see the module docstring)."""
+
+    cameras = {"front": 2}
+
+    def optional_topics(self) -> list[str]:
+        return super().optional_topics() + [f"/{a.id}/annotations" for a in self.agents]
+
+    def _dir(self, agent: AgentInfo, sub: str) -> Path:
+        return self.sink.mkdir(self.folder / str(cav_id(agent.index)) / sub)
+
+    def write_agent(self, frame: Frame, world: WorldFrame, view: AgentView, targets: list[Target]) -> None:
+        from mmusv.preview import decode_point_cloud
+
+        a = view.agent
+        assert view.lidar is not None and a.lidar_mount is not None
+        ts = f"{frame.index:06d}"
+        msgs = frame.messages
+        cloud = decode_point_cloud(msgs[f"/{a.id}/lidar"])
+        n = len(cloud["x"])
+        pts = np.column_stack([cloud["x"], cloud["y"], cloud["z"], cloud.get("intensity", np.zeros(n))]).astype("<f4")
+        self.put(self._dir(a, "velodyne") / f"{ts}.bin", pts.tobytes())
+        self.put(self._dir(a, "pose") / f"{ts}.txt", (_fmt(view.lidar[:3, :]) + "\n").encode())
+        cam = a.cameras.get("front")
+        velo_to_cam = np.eye(4)
+        k = np.zeros((3, 4))
+        if cam is not None:
+            opt = np.eye(4)
+            opt[:3, :3] = BODY_TO_OPTICAL
+            velo_to_cam = opt @ invert(view.cameras["front"]) @ view.lidar
+            fx, fy, cx, cy = cam.intrinsics
+            k = np.array([[fx, 0.0, cx, 0.0], [0.0, fy, cy, 0.0], [0.0, 0.0, 1.0, 0.0]])
+        calib = [f"P{i}: {_fmt(k)}" for i in range(4)]
+        calib += [f"R0_rect: {_fmt(np.eye(3))}", f"Tr_velo_to_cam: {_fmt(velo_to_cam[:3, :])}",
+                  f"Tr_imu_to_velo: {_fmt(invert(a.lidar_mount)[:3, :])}"]
+        self.put(self._dir(a, "calib") / f"{ts}.txt", ("\n".join(calib) + "\n").encode())
+        boxes: dict[str, Any] = {}
+        ann = msgs.get(f"/{a.id}/annotations")
+        if ann is not None:
+            boxes = {b.target_id: b for b in ann.boxes_camera if b.camera == "front"}
+        lines = [kitti_label(t, velo_to_cam, boxes.get(t.id)) if cam is not None else kitti_label(t, velo_to_cam, None) for t in targets]
+        self.put(self._dir(a, "label_2") / f"{ts}.txt", "".join(line + "\n" for line in lines).encode())
+        if cam is not None:
+            base = f"/{a.id}/camera/front/"
+            if base + "rgb" in msgs:
+                self.put(self._dir(a, "image_2") / f"{ts}.png", png_bytes(msgs[base + "rgb"]))
+            if "depth" in self.options.extras and base + "depth" in msgs:
+                self.put(self._dir(a, "depth_2") / f"{ts}.png", depth_png(msgs[base + "depth"]), "depth")
+            for kind in ("semantic", "instance"):
+                if kind in self.options.extras and base + kind in msgs:
+                    self.put(self._dir(a, f"{kind}_2") / f"{ts}.png", png_bytes(msgs[base + kind]), kind)
+        if "radar" in self.options.extras and f"/{a.id}/radar/ppi" in msgs:
+            self.put(self._dir(a, "radar_ppi") / f"{ts}.png", png_bytes(msgs[f"/{a.id}/radar/ppi"]), "radar")
+        if "top_view" in self.options.extras:
+            for kind in ("rgb", "semantic"):
+                m = msgs.get(f"/{a.id}/top_view/{kind}")
+                if m is not None:
+                    self.put(self._dir(a, f"top_view_{kind}") / f"{ts}.png", png_bytes(m), "top_view")
+
+    def finish(self, frames: list[int], skipped: list[dict[str, Any]]) -> None:
+        super().finish(frames, skipped)
+        if not frames:
+            return
+        o = self.options
+        self.put(self.folder / "mmusv_kitti.yaml", dump_yaml({
+            "source": self.info.path.name, "scenario": self.info.scenario_name, "config_hash": self.info.config_hash,
+            "agents": {cav_id(a.index): a.id for a in self.agents}, "eval_range_m": o.eval_range_m,
+            "include_usvs": o.include_usvs, "extras": list(o.extras), "frames_converted": len(frames),
+            "frames_skipped": skipped,
+        }))

@@ -1,0 +1,200 @@
+"""The OPV2V layout: one scenario folder per recording, one integer folder per agent.
+
+``<scenario>/<cav_id>/<ts>.yaml``, ``<ts>.pcd``, ``<ts>_camera0..3.png`` (+ ``<scenario>/data_protocol.yaml``);
+``<ts>`` is the 6-digit acquisition index, the same for every agent; ``cav_id`` = 1000 + the vessel's index in
+the scenario (:func:`~mmusv.export.common.cav_id`), also the key of ``vehicles``. Everything is in the CARLA
+frame (left-handed, x forward, y right, z up, metres, degrees, poses ``[x, y, z, roll, yaw, pitch]``), obtained
+from mmusv's frames only through :mod:`mmusv.frames` (a mirror of y).
+
+Per-frame yaml (keys sorted, as OpenCDA writes them): ``camera0..3`` (``cords`` world pose, ``intrinsic``,
+``extrinsic`` LiDAR → camera), ``ego_speed`` (km/h), ``lidar_pose``, ``plan_trajectory`` (the scenario route:
+``[x, y, speed km/h]``), ``predicted_ego_pos`` = ``true_ego_pos`` (the vessel pose), ``vehicles``
+(``{id: {angle: [roll, yaw, pitch], center, extent (half sizes), location, speed km/h}}``, box centre =
+location + center component-wise). Camera order: 0 front, 1 right, 2 left, 3 rear.
+
+Files beyond stock OPV2V, which stock loaders skip: ``<ts>_additional.yaml`` (our names, classes and LiDAR point
+counts of the listed vehicles), ``<ts>_depth{i}.png`` (uint16 cm), ``<ts>_semantic{i}.png``,
+``<ts>_instance{i}.png`` (uint16 ids), ``<ts>_radar_ppi.png``, ``<ts>_topview_{rgb,semantic}.png``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from mmusv.classes import class_name
+from mmusv.export.common import DEPTH_UNIT_M, cav_id, depth_png, dump_yaml, png_bytes, rounded
+from mmusv.export.geometry import AgentView, Target
+from mmusv.export.pcd import pcd_bytes
+from mmusv.export.reader import Frame, WorldFrame
+from mmusv.export.writer import DatasetWriter
+from mmusv.frames import carla_matrix, carla_pose, invert, mirror_points
+
+__all__ = ["Opv2vWriter", "OPV2V_CAMERAS", "timestamp"]
+
+OPV2V_CAMERAS = {"front": 0, "right": 1, "left": 2, "rear": 3, "back": 3}
+"""Our camera name → OPV2V camera index."""
+
+
+def timestamp(frame: int) -> str:
+    """The OPV2V timestamp of acquisition index ``frame`` (6 digits, zero-padded)."""
+    return f"{frame:06d}"
+
+
+def _matrix_list(m: np.ndarray) -> list[list[float]]:
+    return [rounded(row, 9) for row in np.asarray(m)]
+
+
+class Opv2vWriter(DatasetWriter):
+    """Writes one recording as one OPV2V scenario folder (see the module docstring)."""
+
+    cameras = {k: v for k, v in OPV2V_CAMERAS.items() if k != "back"}
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        speeds = {str(v["id"]): float(v.get("speed_mps", 0.0)) * 3.6 for v in self.info.scenario.get("vessels", [])}
+        self.plans: dict[str, list[list[float]]] = {}
+        for v in self.info.scenario.get("vessels", []):
+            route = np.asarray(v.get("route", []), dtype=np.float64).reshape(-1, 2)
+            self.plans[str(v["id"])] = [rounded([x, -y, speeds[str(v["id"])]]) for x, y in route]
+        for a in self.agents:
+            names = [n for n, _ in self.agent_cameras(a)]
+            if len(names) < 4:
+                self.notes.append(f"agent {a.id}: cameras {names} cover {len(names)} of the 4 OPV2V cameras (front, right, left, rear)")
+            other = sorted(set(a.cameras) - set(self.cameras))
+            if other:
+                self.notes.append(f"agent {a.id}: cameras {other} have no OPV2V slot and are left out")
+
+    def agent_dir(self, view: AgentView) -> Path:
+        return self.sink.mkdir(self.folder / str(cav_id(view.agent.index)))
+
+    def write_agent(self, frame: Frame, world: WorldFrame, view: AgentView, targets: list[Target]) -> None:
+        from mmusv.preview import decode_point_cloud
+
+        a = view.agent
+        assert view.lidar is not None
+        d = self.agent_dir(view)
+        ts = timestamp(frame.index)
+        msgs = frame.messages
+        cloud = decode_point_cloud(msgs[f"/{a.id}/lidar"])
+        xyz = np.column_stack([cloud["x"], cloud["y"], cloud["z"]]).astype(np.float64)
+        self.put(d / f"{ts}.pcd", pcd_bytes(mirror_points(xyz), cloud.get("intensity", np.zeros(len(xyz)))))
+        lidar_pose = rounded(carla_pose(view.lidar))
+        lidar_m = carla_matrix(np.array(lidar_pose))
+        ego = rounded(carla_pose(view.body))
+        doc: dict[str, Any] = {
+            "lidar_pose": lidar_pose,
+            "true_ego_pos": ego,
+            "predicted_ego_pos": list(ego),
+            "ego_speed": round(view.speed_mps * 3.6, 6),
+            "plan_trajectory": self.plans.get(a.id, []),
+            "vehicles": {cav_id(t.index): self._vehicle(t) for t in targets},
+        }
+        for name, idx in self.agent_cameras(a):
+            cam = a.cameras[name]
+            cords = rounded(carla_pose(view.cameras[name]))
+            fx, fy, cx, cy = cam.intrinsics
+            doc[f"camera{idx}"] = {
+                "cords": cords,
+                "intrinsic": _matrix_list(np.array([[fx, 0.0, cx], [0.0, fy, cy], [0.0, 0.0, 1.0]])),
+                "extrinsic": _matrix_list(invert(carla_matrix(np.array(cords))) @ lidar_m),
+            }
+            rgb = msgs.get(f"/{a.id}/camera/{name}/rgb")
+            if rgb is not None:
+                self.put(d / f"{ts}_camera{idx}.png", png_bytes(rgb))
+            base = f"/{a.id}/camera/{name}/"
+            if "depth" in self.options.extras and base + "depth" in msgs:
+                self.put(d / f"{ts}_depth{idx}.png", depth_png(msgs[base + "depth"]), "depth")
+            for kind in ("semantic", "instance"):
+                if kind in self.options.extras and base + kind in msgs:
+                    self.put(d / f"{ts}_{kind}{idx}.png", png_bytes(msgs[base + kind]), kind)
+        self.put(d / f"{ts}.yaml", dump_yaml(doc))
+        self.put(d / f"{ts}_additional.yaml", dump_yaml(self._additional(frame, world, view, targets, cloud)))
+        if "radar" in self.options.extras and f"/{a.id}/radar/ppi" in msgs:
+            self.put(d / f"{ts}_radar_ppi.png", png_bytes(msgs[f"/{a.id}/radar/ppi"]), "radar")
+        if "top_view" in self.options.extras:
+            for kind in ("rgb", "semantic"):
+                m = msgs.get(f"/{a.id}/top_view/{kind}")
+                if m is not None:
+                    self.put(d / f"{ts}_topview_{kind}.png", png_bytes(m), "top_view")
+
+    @staticmethod
+    def _vehicle(t: Target) -> dict[str, Any]:
+        loc = mirror_points(t.body[:3, 3])[0]
+        centre = mirror_points(t.box[:3, 3])[0] - loc
+        pose = carla_pose(t.body)
+        return {
+            "location": rounded(loc),
+            "center": rounded(centre),
+            "extent": rounded(np.asarray(t.size) / 2.0),
+            "angle": rounded(pose[3:6]),
+            "speed": round(t.speed_mps * 3.6, 6),
+        }
+
+    def _additional(self, frame: Frame, world: WorldFrame, view: AgentView, targets: list[Target], cloud: dict[str, np.ndarray]) -> dict[str, Any]:
+        counts: dict[int, int] = {}
+        inst = cloud.get("instance")
+        if inst is not None and inst.size:
+            ids, n = np.unique(inst, return_counts=True)
+            counts = {int(i): int(c) for i, c in zip(ids, n, strict=True)}
+        return {
+            "mmusv": {
+                "agent": view.agent.id,
+                "frame": frame.index,
+                "time_s": round(world.time_s, 9),
+                "vehicles": {
+                    cav_id(t.index): {"name": t.id, "asset": t.asset, "role": t.role, "semantic_class": t.semantic_class,
+                                      "class_name": class_name(t.semantic_class), "instance_id": t.instance_id,
+                                      "lidar_points": counts.get(t.instance_id, 0)}
+                    for t in targets
+                },
+            }
+        }
+
+    def finish(self, frames: list[int], skipped: list[dict[str, Any]]) -> None:
+        super().finish(frames, skipped)
+        if not frames:
+            return
+        info, o = self.info, self.options
+        lidar = next((a.rig.get("lidar") for a in self.agents if a.rig.get("lidar")), None) or {}
+        acq = info.scenario.get("acquisition", {})
+        protocol: dict[str, Any] = {
+            "description": f"mmusv scenario {info.scenario_name} converted to the OPV2V layout",
+            "world": {
+                "sync_mode": True,
+                "fixed_delta_seconds": round(1.0 / float(acq.get("frequency_hz", 1.0)), 9),
+                "seed": info.seed,
+                "environment": info.scenario.get("environment", {}),
+                "map": info.scenario.get("map", {}),
+            },
+            "vehicle_base": {"sensing": {"perception": {
+                "lidar": {
+                    "channels": lidar.get("channels"), "range": lidar.get("range_m"),
+                    "points_per_second": lidar.get("points_per_second"), "rotation_frequency": lidar.get("rotation_hz"),
+                    "upper_fov": (lidar.get("vertical_fov_deg") or [None, None])[1],
+                    "lower_fov": (lidar.get("vertical_fov_deg") or [None, None])[0],
+                    "noise_stddev": lidar.get("range_noise_std_m"), "dropoff_general_rate": lidar.get("dropout"),
+                },
+                "camera": {"num": 4, "order": ["front", "right", "left", "rear"]},
+            }}},
+            "mmusv": {
+                "source": info.path.name,
+                "scenario": info.scenario_name,
+                "config_hash": info.config_hash,
+                "mmusv_version": info.mmusv_version,
+                "frame": "CARLA/UE world, left-handed: x forward, y right, z up; metres; degrees; poses [x, y, z, roll, yaw, pitch]; "
+                         "mmusv's right-handed frames (world x east, y north, z up; body x forward, y left, z up) with y mirrored",
+                "cavs": {cav_id(a.index): a.id for a in self.agents},
+                "eval_range_m": o.eval_range_m,
+                "gt_filter": "vehicles: every vessel whose box centre has |x| <= eval_range_m and |y| <= eval_range_m "
+                             "in the agent's LiDAR frame; the agent itself never, other USVs only if include_usvs",
+                "include_usvs": o.include_usvs,
+                "extras": list(o.extras),
+                "depth_png": {"unit_m": DEPTH_UNIT_M, "no_hit": 0, "saturated": 65535, "along": "optical axis"},
+                "frames_converted": len(frames),
+                "frames_skipped": skipped,
+            },
+        }
+        self.put(self.folder / "data_protocol.yaml", dump_yaml(protocol))

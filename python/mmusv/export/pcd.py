@@ -1,0 +1,57 @@
+"""ASCII PCD files the way Open3D writes them: ``FIELDS x y z rgb`` with the LiDAR intensity in the red byte.
+
+OPV2V loaders read a cloud with ``open3d.io.read_point_cloud`` and take ``colors[:, 0]`` as the intensity, so
+the intensity (in [0, 1]) is stored as ``round(255·i) << 16`` in an unsigned ``rgb`` field (Open3D's own ASCII
+layout, ``TYPE F F F U``); it reads back to within 1/510. A ``FIELDS x y z intensity`` file would make those
+loaders fail.
+"""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = ["pcd_bytes", "write_pcd", "read_pcd"]
+
+_HEADER = (
+    "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F U\n"
+    "COUNT 1 1 1 1\nWIDTH {n}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {n}\nDATA ascii\n"
+)
+
+
+def pcd_bytes(xyz: npt.ArrayLike, intensity: npt.ArrayLike, *, decimals: int = 4) -> bytes:
+    """The PCD file of ``(N, 3)`` points and ``(N,)`` intensities in [0, 1] (clipped), coordinates rounded to
+    ``decimals`` places (0.1 mm by default)."""
+    xyz = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
+    n = xyz.shape[0]
+    red = np.rint(np.clip(np.nan_to_num(np.asarray(intensity, dtype=np.float64).reshape(n), nan=0.0), 0.0, 1.0) * 255.0)
+    rgb = red.astype(np.int64) << 16
+    buf = io.StringIO()
+    buf.write(_HEADER.format(n=n))
+    if n:
+        # Rounded first, "-0" normalised to "0" (+ 0.0), so equal clouds give equal bytes.
+        q = (np.round(xyz, decimals) + 0.0).tolist()
+        f = f"{{:.{decimals}f}} {{:.{decimals}f}} {{:.{decimals}f}} {{}}\n".format
+        buf.write("".join([f(a, b, c, e) for (a, b, c), e in zip(q, rgb.tolist(), strict=True)]))
+    return buf.getvalue().encode("ascii")
+
+
+def write_pcd(path: Path, xyz: npt.ArrayLike, intensity: npt.ArrayLike) -> int:
+    """Writes :func:`pcd_bytes` to ``path``; returns the number of bytes."""
+    data = pcd_bytes(xyz, intensity)
+    path.write_bytes(data)
+    return len(data)
+
+
+def read_pcd(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """``(N, 3)`` points and ``(N,)`` intensities (red byte / 255) of a file written by :func:`write_pcd`."""
+    text = path.read_text(encoding="ascii")
+    head, _, body = text.partition("DATA ascii\n")
+    if "FIELDS x y z rgb" not in head:
+        raise ValueError(f"{path} is not an x y z rgb PCD")
+    arr = np.loadtxt(io.StringIO(body), dtype=np.float64, ndmin=2).reshape(-1, 4)
+    rgb = arr[:, 3].astype(np.int64)
+    return arr[:, :3], ((rgb >> 16) & 0xFF) / 255.0

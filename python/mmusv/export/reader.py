@@ -1,0 +1,298 @@
+"""Reading an ``mmusv run`` recording frame by frame, for conversion (also a truncated or ``.partial`` file).
+
+:func:`read_info` reads the metadata (``scenario``, ``manifest``, ``sensors``, ``run``) without decoding any
+message: from the summary section when the file has one, otherwise from the records before the first chunk.
+:class:`FrameStream` then walks the file once, front to back, with the streaming MCAP reader, decodes only the
+topics asked for and yields one :class:`Frame` per log time (every message of a frame shares its log time). A
+file that ends in the middle of a record (a killed writer) yields every frame read so far and says where it
+stopped in :attr:`FrameStream.truncated`; the ``run`` metadata, written last, is picked up when present.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import IO, Any
+
+import numpy as np
+import yaml
+
+from mmusv.errors import IoError
+
+__all__ = ["MCAP_MAGIC", "CameraInfo", "AgentInfo", "RecordingInfo", "WorldFrame", "Frame", "FrameStream", "read_info", "check_mcap"]
+
+MCAP_MAGIC = b"\x89MCAP0\r\n"
+
+
+@dataclass(frozen=True)
+class CameraInfo:
+    """A pinhole camera of an agent: image size, intrinsics ``(fx, fy, cx, cy)`` pixels, ``mount``
+    ``(4, 4)`` camera body (x forward = optical axis, y left, z up) → vessel body, recorded outputs."""
+
+    name: str
+    width: int
+    height: int
+    hfov_deg: float
+    intrinsics: tuple[float, float, float, float]
+    mount: np.ndarray
+    outputs: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class AgentInfo:
+    """An instrumented USV: ``index`` in the scenario's vessel list (= its row in the world state), mounts
+    ``(4, 4)`` sensor → vessel body, its cameras and the rig as recorded."""
+
+    id: str
+    index: int
+    asset: str
+    lidar_mount: np.ndarray | None
+    radar_mount: np.ndarray | None
+    cameras: dict[str, CameraInfo]
+    rig: dict[str, Any]
+
+
+@dataclass
+class RecordingInfo:
+    """What a recording says about itself (metadata only)."""
+
+    path: Path
+    scenario_name: str
+    scenario: dict[str, Any]
+    config_hash: str
+    seed: int | None
+    mmusv_version: str
+    frequency_hz: float
+    frames_configured: int
+    agents: list[AgentInfo]
+    run: dict[str, str]
+    has_summary: bool
+
+    @property
+    def vessel_ids(self) -> list[str]:
+        """Scenario vessel ids in file order (rows ``0..n-1`` of every world state)."""
+        return [str(v["id"]) for v in self.scenario.get("vessels", [])]
+
+
+@dataclass(frozen=True)
+class WorldFrame:
+    """One ``/world/state``: per vessel (scenario vessels in file order, then moored ships) its id, asset,
+    role, class, instance, pose ``(V, 6)`` [x, y, z, roll, pitch, yaw], velocity ``(V, 3)``, box centre
+    ``(V, 3)`` (world) and box size ``(V, 3)`` (length, beam, height)."""
+
+    frame: int
+    time_s: float
+    ids: list[str]
+    assets: list[str]
+    roles: list[str]
+    classes: np.ndarray
+    instance_ids: np.ndarray
+    poses: np.ndarray
+    velocities: np.ndarray
+    box_centers: np.ndarray
+    box_sizes: np.ndarray
+
+    @staticmethod
+    def from_message(msg: Any) -> WorldFrame:
+        """From a decoded ``mmusv.WorldState``."""
+        vs = list(msg.vessels)
+
+        def rows(attr: str, k: int) -> np.ndarray:
+            return np.array([list(getattr(v, attr)) for v in vs], dtype=np.float64).reshape(len(vs), k)
+
+        return WorldFrame(
+            frame=int(msg.frame), time_s=float(msg.time_s), ids=[v.id for v in vs], assets=[v.asset for v in vs],
+            roles=[v.role for v in vs], classes=np.array([v.semantic_class for v in vs], dtype=np.int64),
+            instance_ids=np.array([v.instance_id for v in vs], dtype=np.int64), poses=rows("pose", 6),
+            velocities=rows("velocity", 3), box_centers=rows("box_center", 3), box_sizes=rows("box_size", 3),
+        )
+
+
+@dataclass
+class Frame:
+    """Every decoded message of one acquisition index: ``messages`` by topic."""
+
+    index: int
+    log_time_ns: int
+    world: WorldFrame | None
+    messages: dict[str, Any] = field(default_factory=dict)
+
+
+def check_mcap(path: str | Path) -> Path:
+    """``path`` as a Path after checking it is an existing file that starts with the MCAP magic."""
+    p = Path(path)
+    if not p.exists():
+        raise IoError(f"recording {p} does not exist")
+    if not p.is_file():
+        raise IoError(f"recording {p} is not a file")
+    with p.open("rb") as f:
+        head = f.read(len(MCAP_MAGIC))
+    if head != MCAP_MAGIC:
+        raise IoError(f"{p} is not an MCAP file (it does not start with the MCAP magic bytes)")
+    return p
+
+
+def _metadata_from_summary(f: IO[bytes]) -> dict[str, dict[str, str]] | None:
+    from mcap.reader import make_reader
+
+    try:
+        reader = make_reader(f)
+        summary = reader.get_summary()
+        if summary is None:
+            return None
+        return {m.name: dict(m.metadata) for m in reader.iter_metadata()}
+    except Exception:  # a truncated file has no usable summary: fall back to streaming
+        return None
+
+
+def _metadata_from_head(f: IO[bytes]) -> dict[str, dict[str, str]]:
+    from mcap.records import Chunk, DataEnd, Message, Metadata
+    from mcap.stream_reader import StreamReader
+
+    out: dict[str, dict[str, str]] = {}
+    f.seek(0)
+    try:
+        for rec in StreamReader(f, emit_chunks=True).records:
+            if isinstance(rec, Metadata):
+                out[rec.name] = dict(rec.metadata)
+            elif isinstance(rec, (Chunk, Message, DataEnd)):
+                break
+    except Exception:
+        pass
+    return out
+
+
+def _mat(v: Any) -> np.ndarray | None:
+    if v is None:
+        return None
+    return np.asarray(v, dtype=np.float64).reshape(4, 4)
+
+
+def read_info(path: str | Path) -> RecordingInfo:
+    """The metadata of the recording at ``path`` (see the module docstring)."""
+    p = check_mcap(path)
+    with p.open("rb") as f:
+        meta = _metadata_from_summary(f)
+        has_summary = meta is not None
+        if meta is None:
+            meta = _metadata_from_head(f)
+    if "sensors" not in meta or "scenario" not in meta:
+        raise IoError(f"{p} has no scenario/sensors metadata; was it written by mmusv run?")
+    try:
+        sensors = json.loads(meta["sensors"]["json"])
+        scenario = yaml.safe_load(meta["scenario"]["yaml"])
+    except (KeyError, ValueError, yaml.YAMLError) as exc:
+        raise IoError(f"{p}: unreadable scenario/sensors metadata ({exc})") from None
+    manifest = meta.get("manifest", {})
+    run = meta.get("run", {})
+    ids = [str(v["id"]) for v in scenario.get("vessels", [])]
+    acq = scenario.get("acquisition", {})
+    agents: list[AgentInfo] = []
+    for aid, s in sensors.items():
+        if aid not in ids:
+            raise IoError(f"{p}: sensors metadata names agent {aid!r}, which is not a scenario vessel")
+        cams = {
+            name: CameraInfo(
+                name=name, width=int(c["resolution"][0]), height=int(c["resolution"][1]), hfov_deg=float(c["hfov_deg"]),
+                intrinsics=(float(c["intrinsics"][0]), float(c["intrinsics"][1]), float(c["intrinsics"][2]), float(c["intrinsics"][3])),
+                mount=np.asarray(c["mount_in_body"], dtype=np.float64).reshape(4, 4), outputs=tuple(c.get("outputs", ())),
+            )
+            for name, c in s.get("cameras", {}).items()
+        }
+        agents.append(AgentInfo(id=aid, index=ids.index(aid), asset=str(s.get("asset", "")), lidar_mount=_mat(s.get("lidar_mount_in_body")),
+                                radar_mount=_mat(s.get("radar_mount_in_body")), cameras=cams, rig=dict(s.get("rig", {}))))
+    agents.sort(key=lambda a: a.index)
+    seed = manifest.get("seed", scenario.get("seed"))
+    return RecordingInfo(
+        path=p, scenario_name=str(meta["scenario"].get("name", scenario.get("name", p.stem))), scenario=scenario,
+        config_hash=str(manifest.get("config_hash", "")), seed=None if seed in (None, "None") else int(seed),
+        mmusv_version=str(manifest.get("mmusv_version", "")),
+        frequency_hz=float(run.get("frequency_hz", acq.get("frequency_hz", 0.0)) or acq.get("frequency_hz", 0.0)),
+        frames_configured=int(run.get("frames_configured", acq.get("frames", 0)) or 0), agents=agents, run=dict(run),
+        has_summary=has_summary,
+    )
+
+
+class FrameStream:
+    """Iterates the frames of a recording once (see the module docstring).
+
+    Args:
+        info: from :func:`read_info`.
+        want: which topics to decode (``/world/state`` always is); others are skipped undecoded.
+    """
+
+    def __init__(self, info: RecordingInfo, want: Callable[[str], bool]) -> None:
+        self.info = info
+        self.want = want
+        self.truncated: str | None = None
+        self.run: dict[str, str] = dict(info.run)
+        self.out_of_order: list[int] = []
+
+    def _index(self, log_time_ns: int, world: WorldFrame | None) -> int:
+        if world is not None:
+            return world.frame
+        return round(log_time_ns * self.info.frequency_hz / 1e9)
+
+    def __iter__(self) -> Iterator[Frame]:
+        from mcap.records import Channel, Message, Metadata, Schema
+        from mcap.stream_reader import StreamReader
+        from mcap_protobuf.decoder import DecoderFactory
+
+        factory = DecoderFactory()
+        schemas: dict[int, Schema] = {}
+        channels: dict[int, Channel] = {}
+        decoders: dict[int, Callable[[bytes], Any] | None] = {}
+        current: Frame | None = None
+        seen: set[int] = set()
+        with self.info.path.open("rb") as f:
+            size = self.info.path.stat().st_size
+            records = StreamReader(f, emit_chunks=False).records
+            good = 0
+            while True:
+                try:
+                    rec = next(records)
+                except StopIteration:
+                    break
+                except Exception as exc:  # ends mid-record: keep what was read
+                    self.truncated = (f"the file is truncated: it ends inside a record ({type(exc).__name__}) at byte {size}; "
+                                      f"the last complete record ends at byte {good}")
+                    break
+                good = f.tell()
+                if isinstance(rec, Schema):
+                    schemas[rec.id] = rec
+                elif isinstance(rec, Channel):
+                    channels[rec.id] = rec
+                elif isinstance(rec, Metadata):
+                    if rec.name == "run":
+                        self.run = dict(rec.metadata)
+                elif isinstance(rec, Message):
+                    ch = channels.get(rec.channel_id)
+                    if ch is None:
+                        continue
+                    topic = ch.topic
+                    if topic != "/world/state" and not self.want(topic):
+                        continue
+                    if rec.channel_id not in decoders:
+                        decoders[rec.channel_id] = factory.decoder_for(ch.message_encoding, schemas.get(ch.schema_id))
+                    dec = decoders[rec.channel_id]
+                    if dec is None:
+                        continue
+                    if current is None or rec.log_time != current.log_time_ns:
+                        if current is not None:
+                            yield self._close(current, seen)
+                        current = Frame(index=-1, log_time_ns=rec.log_time, world=None)
+                    msg = dec(rec.data)
+                    if topic == "/world/state":
+                        current.world = WorldFrame.from_message(msg)
+                    current.messages[topic] = msg
+        if current is not None:
+            yield self._close(current, seen)
+
+    def _close(self, fr: Frame, seen: set[int]) -> Frame:
+        fr.index = self._index(fr.log_time_ns, fr.world)
+        if fr.index in seen:
+            self.out_of_order.append(fr.index)
+        seen.add(fr.index)
+        return fr

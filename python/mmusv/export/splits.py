@@ -1,0 +1,71 @@
+"""Splitting recordings (sequences) into ``train`` / ``validate`` / ``test`` with a fixed seed.
+
+The split is made per recording, before any agent-as-ego expansion a loader may do, so no scene ends up in two
+splits. Recordings are ordered by a stable key (not by the order they were given), shuffled with
+``random.Random(seed)``, and cut by largest-remainder counts; every split with a non-zero ratio gets at least one
+recording when there are enough recordings for that.
+"""
+
+from __future__ import annotations
+
+import math
+import random
+from collections.abc import Sequence
+
+from mmusv.errors import ConfigError
+
+__all__ = ["SPLIT_NAMES", "split_counts", "assign_splits", "parse_ratios"]
+
+SPLIT_NAMES = ("train", "validate", "test")
+
+
+def parse_ratios(ratios: Sequence[float] | str) -> tuple[float, float, float]:
+    """Validated ``(train, validate, test)`` fractions from a sequence or a ``"0.7,0.15,0.15"`` string; they
+    are normalised to sum to 1."""
+    if isinstance(ratios, str):
+        try:
+            vals = [float(x) for x in ratios.split(",")]
+        except ValueError:
+            raise ConfigError(f"split {ratios!r}: expected three comma-separated fractions, e.g. 0.7,0.15,0.15") from None
+    else:
+        vals = [float(x) for x in ratios]
+    if len(vals) != 3:
+        raise ConfigError(f"split {list(ratios) if not isinstance(ratios, str) else ratios!r}: expected three fractions (train, validate, test)")
+    if not all(math.isfinite(v) and v >= 0 for v in vals) or sum(vals) <= 0:
+        raise ConfigError(f"split {vals}: fractions must be finite, non-negative and not all zero")
+    total = sum(vals)
+    return (vals[0] / total, vals[1] / total, vals[2] / total)
+
+
+def split_counts(n: int, ratios: Sequence[float]) -> list[int]:
+    """How many of ``n`` recordings go to each split (largest remainder; ties to the earlier split)."""
+    raw = [r * n for r in ratios]
+    counts = [math.floor(x) for x in raw]
+    order = sorted(range(len(raw)), key=lambda i: (-(raw[i] - counts[i]), i))
+    for i in order[: n - sum(counts)]:
+        counts[i] += 1
+    wanted = [i for i, r in enumerate(ratios) if r > 0]
+    if n >= len(wanted):
+        for i in wanted:
+            if counts[i] == 0:
+                donor = max(range(len(counts)), key=lambda j: (counts[j], -j))
+                counts[donor] -= 1
+                counts[i] += 1
+    return counts
+
+
+def assign_splits(keys: Sequence[str], ratios: Sequence[float], seed: int) -> dict[str, str]:
+    """Split name of every key (unique strings, e.g. recording paths): deterministic in (set of keys, ratios,
+    seed), independent of the order of ``keys``."""
+    if len(set(keys)) != len(keys):
+        raise ConfigError("the same recording is given twice")
+    ordered = sorted(keys)
+    random.Random(seed).shuffle(ordered)
+    counts = split_counts(len(ordered), ratios)
+    out: dict[str, str] = {}
+    start = 0
+    for name, c in zip(SPLIT_NAMES, counts, strict=True):
+        for k in ordered[start : start + c]:
+            out[k] = name
+        start += c
+    return out

@@ -1,0 +1,181 @@
+"""Frames and poses in one place: every change of frame mmusv makes goes through these functions.
+
+mmusv's own frames are right-handed: world x east, y north, z up; vessel and sensor body frames x forward, y left,
+z up; poses ``η = [x, y, z, roll, pitch, yaw]`` (metres, radians) with ``R = Rz(yaw)·Ry(pitch)·Rx(roll)``. Camera
+optical frames (OpenCV) are x right, y down, z forward.
+
+The CARLA / Unreal frame that OPV2V uses is left-handed: x forward, y right, z up, metres, angles in degrees,
+poses ``[x, y, z, roll, yaw, pitch]``. Going from ours to CARLA mirrors the y axis of *both* the world and the
+body frames: a point becomes ``S·p`` and a transform ``S·T·S`` with ``S = diag(1, -1, 1)``. Since
+``S·Rz(a)·S = Rz(-a)``, ``S·Rx(a)·S = Rx(-a)`` and ``S·Ry(a)·S = Ry(a)``, and the CARLA loader rotation is
+``Rz(yaw)·Ry(-pitch)·Rx(-roll)`` in right-handed terms, a pose ``[x, y, z, φ, θ, ψ]`` of ours is the CARLA pose
+
+    ``[x, -y, z, roll = deg(φ), yaw = -deg(ψ), pitch = -deg(θ)]``
+
+(:func:`carla_pose_from_eta`); for an arbitrary rotation :func:`carla_pose` reads the angles off ``S·R·S``.
+Mirroring is its own inverse, so the same functions take CARLA data back.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = [
+    "MIRROR_Y",
+    "BODY_TO_OPTICAL",
+    "pose_matrices",
+    "matrix_to_pose",
+    "invert",
+    "transform_points",
+    "mirror_points",
+    "mirror_transform",
+    "carla_rotation",
+    "carla_matrix",
+    "carla_pose",
+    "carla_pose_from_eta",
+    "x1_to_x2",
+    "wrap_deg",
+    "wrap_rad",
+]
+
+MIRROR_Y = np.diag([1.0, -1.0, 1.0, 1.0])
+"""``(4, 4)`` the y mirror ``S`` between mmusv's right-handed frames and CARLA's left-handed ones."""
+
+BODY_TO_OPTICAL = np.array([[0.0, -1.0, 0.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0]])
+"""``(3, 3)`` camera body (x forward, y left, z up) → optical (x right, y down, z forward)."""
+
+
+def pose_matrices(eta: npt.ArrayLike) -> np.ndarray:
+    """``(..., 4, 4)`` float64 body -> world matrices from poses ``η = [x, y, z, roll, pitch, yaw]`` ``(..., 6)``
+    (metres, radians, R = Rz(yaw)·Ry(pitch)·Rx(roll))."""
+    eta = np.asarray(eta, dtype=np.float64)
+    cr, sr = np.cos(eta[..., 3]), np.sin(eta[..., 3])
+    cp, sp = np.cos(eta[..., 4]), np.sin(eta[..., 4])
+    cy, sy = np.cos(eta[..., 5]), np.sin(eta[..., 5])
+    m = np.zeros(eta.shape[:-1] + (4, 4), dtype=np.float64)
+    m[..., 0, 0] = cy * cp
+    m[..., 0, 1] = cy * sp * sr - sy * cr
+    m[..., 0, 2] = cy * sp * cr + sy * sr
+    m[..., 1, 0] = sy * cp
+    m[..., 1, 1] = sy * sp * sr + cy * cr
+    m[..., 1, 2] = sy * sp * cr - cy * sr
+    m[..., 2, 0] = -sp
+    m[..., 2, 1] = cp * sr
+    m[..., 2, 2] = cp * cr
+    m[..., :3, 3] = eta[..., :3]
+    m[..., 3, 3] = 1.0
+    return m
+
+
+def matrix_to_pose(m: npt.ArrayLike) -> np.ndarray:
+    """``(..., 6)`` poses ``[x, y, z, roll, pitch, yaw]`` of ``(..., 4, 4)`` rigid transforms (the inverse of
+    :func:`pose_matrices`; pitch in [-π/2, π/2], roll = 0 at gimbal lock)."""
+    m = np.asarray(m, dtype=np.float64)
+    r = m[..., :3, :3]
+    pitch = np.arcsin(np.clip(-r[..., 2, 0], -1.0, 1.0))
+    lock = np.hypot(r[..., 0, 0], r[..., 1, 0]) < 1e-9
+    yaw = np.where(lock, np.arctan2(-r[..., 0, 1], r[..., 1, 1]), np.arctan2(r[..., 1, 0], r[..., 0, 0]))
+    roll = np.where(lock, 0.0, np.arctan2(r[..., 2, 1], r[..., 2, 2]))
+    out: np.ndarray = np.concatenate([m[..., :3, 3], np.stack([roll, pitch, yaw], axis=-1)], axis=-1)
+    return out
+
+
+def invert(m: npt.ArrayLike) -> np.ndarray:
+    """The inverse of ``(..., 4, 4)`` rigid transforms (Rᵀ, −Rᵀt)."""
+    m = np.asarray(m, dtype=np.float64)
+    out = np.zeros_like(m)
+    rt = np.swapaxes(m[..., :3, :3], -1, -2)
+    out[..., :3, :3] = rt
+    out[..., :3, 3] = -np.einsum("...ij,...j->...i", rt, m[..., :3, 3])
+    out[..., 3, 3] = 1.0
+    return out
+
+
+def transform_points(m: np.ndarray, points: npt.ArrayLike) -> np.ndarray:
+    """``(N, 3)`` points moved by the ``(4, 4)`` transform ``m``."""
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    out: np.ndarray = p @ m[:3, :3].T + m[:3, 3]
+    return out
+
+
+def mirror_points(points: npt.ArrayLike) -> np.ndarray:
+    """``(N, 3)`` points with y negated: mmusv frame ↔ CARLA frame (the same for world and body frames)."""
+    p = np.array(points, dtype=np.float64).reshape(-1, 3)
+    p[:, 1] *= -1.0
+    return p
+
+
+def mirror_transform(m: npt.ArrayLike) -> np.ndarray:
+    """``S·m·S`` for ``(..., 4, 4)`` transforms: a right-handed body → world transform as the left-handed one
+    (and back)."""
+    out: np.ndarray = MIRROR_Y @ np.asarray(m, dtype=np.float64) @ MIRROR_Y
+    return out
+
+
+def carla_rotation(roll_deg: npt.ArrayLike, yaw_deg: npt.ArrayLike, pitch_deg: npt.ArrayLike) -> np.ndarray:
+    """``(..., 3, 3)`` the rotation CARLA/OpenCOOD loaders build from ``[roll, yaw, pitch]`` degrees."""
+    r, y, p = (np.radians(np.asarray(a, dtype=np.float64)) for a in (roll_deg, yaw_deg, pitch_deg))
+    cr, sr, cy, sy, cp, sp = np.cos(r), np.sin(r), np.cos(y), np.sin(y), np.cos(p), np.sin(p)
+    rows = [
+        [cp * cy, cy * sp * sr - sy * cr, -cy * sp * cr - sy * sr],
+        [sy * cp, sy * sp * sr + cy * cr, -sy * sp * cr + cy * sr],
+        [sp, -cp * sr, cp * cr],
+    ]
+    out: np.ndarray = np.stack([np.stack(np.broadcast_arrays(*row), axis=-1) for row in rows], axis=-2)
+    return out
+
+
+def carla_matrix(pose: npt.ArrayLike) -> np.ndarray:
+    """``(..., 4, 4)`` the CARLA transform of ``[x, y, z, roll, yaw, pitch]`` poses ``(..., 6)`` (left-handed)."""
+    pose = np.asarray(pose, dtype=np.float64)
+    m = np.zeros(pose.shape[:-1] + (4, 4), dtype=np.float64)
+    m[..., :3, :3] = carla_rotation(pose[..., 3], pose[..., 4], pose[..., 5])
+    m[..., :3, 3] = pose[..., :3]
+    m[..., 3, 3] = 1.0
+    return m
+
+
+def carla_pose(m: npt.ArrayLike) -> np.ndarray:
+    """``(..., 6)`` CARLA pose ``[x, y, z, roll, yaw, pitch]`` (metres, degrees) of a right-handed body → world
+    transform ``m`` ``(..., 4, 4)`` in mmusv frames: the mirrored transform ``S·m·S`` read with the loader's
+    rotation convention, so that ``carla_matrix(carla_pose(m)) == S·m·S``."""
+    c = mirror_transform(m)
+    r = c[..., :3, :3]
+    pitch = np.arcsin(np.clip(r[..., 2, 0], -1.0, 1.0))
+    lock = np.hypot(r[..., 0, 0], r[..., 1, 0]) < 1e-9
+    yaw = np.where(lock, np.arctan2(-r[..., 0, 1], r[..., 1, 1]), np.arctan2(r[..., 1, 0], r[..., 0, 0]))
+    roll = np.where(lock, 0.0, np.arctan2(-r[..., 2, 1], r[..., 2, 2]))
+    out: np.ndarray = np.concatenate([c[..., :3, 3], np.degrees(np.stack([roll, yaw, pitch], axis=-1))], axis=-1)
+    return out
+
+
+def carla_pose_from_eta(eta: npt.ArrayLike) -> np.ndarray:
+    """``(..., 6)`` CARLA pose of mmusv poses ``[x, y, z, roll, pitch, yaw]``: ``[x, -y, z, deg(roll),
+    -deg(yaw), -deg(pitch)]`` (closed form of :func:`carla_pose` for Euler poses)."""
+    eta = np.asarray(eta, dtype=np.float64)
+    out: np.ndarray = np.stack(
+        [eta[..., 0], -eta[..., 1], eta[..., 2], np.degrees(eta[..., 3]), -np.degrees(eta[..., 5]), -np.degrees(eta[..., 4])],
+        axis=-1,
+    )
+    return out
+
+
+def x1_to_x2(pose1: npt.ArrayLike, pose2: npt.ArrayLike) -> np.ndarray:
+    """``(4, 4)`` transform from the frame of CARLA pose ``pose1`` to that of ``pose2`` (``inv(T2)·T1``)."""
+    out: np.ndarray = invert(carla_matrix(pose2)) @ carla_matrix(pose1)
+    return out
+
+
+def wrap_deg(a: npt.ArrayLike) -> np.ndarray:
+    """Angles in degrees wrapped to (-180, 180]."""
+    w: np.ndarray = 180.0 - np.mod(180.0 - np.asarray(a, dtype=np.float64), 360.0)
+    return w
+
+
+def wrap_rad(a: npt.ArrayLike) -> np.ndarray:
+    """Angles in radians wrapped to (-π, π]."""
+    w: np.ndarray = math.pi - np.mod(math.pi - np.asarray(a, dtype=np.float64), 2 * math.pi)
+    return w

@@ -1,0 +1,221 @@
+"""The conversion job: bad input, overwrite, determinism, truncated recordings, splits and the command line."""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
+
+from mmusv.errors import ConfigError, IoError, MmusvError
+from mmusv.export import convert
+from mmusv.export import cli as export_cli
+
+
+def tree(root: Path) -> dict[str, str]:
+    return {str(p.relative_to(root)): hashlib.sha256(p.read_bytes()).hexdigest() for p in sorted(root.rglob("*")) if p.is_file()}
+
+
+def parse(argv: list[str]) -> argparse.Namespace:
+    p = argparse.ArgumentParser(prog="mmusv")
+    export_cli.add_parser(p.add_subparsers(dest="command"))
+    return p.parse_args(["convert", *argv])
+
+
+# ---------------------------------------------------------------------------------------------- bad input
+
+
+def test_missing_and_non_mcap_inputs(tmp_path: Path) -> None:
+    with pytest.raises(IoError, match="does not exist"):
+        convert(tmp_path / "nope.mcap", out_dir=tmp_path / "o")
+    junk = tmp_path / "junk.mcap"
+    junk.write_text("not an mcap\n")
+    with pytest.raises(IoError, match="not an MCAP file"):
+        convert(junk, out_dir=tmp_path / "o")
+    with pytest.raises(IoError, match="not a file"):
+        convert(tmp_path, out_dir=tmp_path / "o")
+    assert not (tmp_path / "o").exists()  # nothing written on bad input
+
+
+def test_bad_options(coop_rec: Path, tmp_path: Path) -> None:
+    with pytest.raises(ConfigError, match="unknown target 'coco'"):
+        convert(coop_rec, to="coco", out_dir=tmp_path / "o")
+    with pytest.raises(ConfigError, match="unknown extra"):
+        convert(coop_rec, out_dir=tmp_path / "o", extras=("depth", "lidar2"))
+    with pytest.raises(ConfigError, match="eval_range_m"):
+        convert(coop_rec, out_dir=tmp_path / "o", eval_range_m=-5)
+    with pytest.raises(ConfigError, match="split"):
+        convert(coop_rec, out_dir=tmp_path / "o", splits=(0.5, 0.5))
+    with pytest.raises(ConfigError, match="same scenario configuration"):
+        convert([coop_rec, coop_rec], out_dir=tmp_path / "o")
+    assert not (tmp_path / "o").exists()
+
+
+def test_cli_errors_are_one_line(coop_rec: Path, tmp_path: Path) -> None:
+    for argv, kind in (([str(coop_rec), "--to", "coco", "-o", str(tmp_path / "o")], ConfigError),
+                       ([str(tmp_path / "missing.mcap"), "-o", str(tmp_path / "o")], IoError),
+                       ([str(coop_rec), "-o", str(tmp_path / "o"), "--extras", "depth,nope"], ConfigError),
+                       ([str(coop_rec), "-o", str(tmp_path / "o"), "--split", "1,2"], ConfigError)):
+        with pytest.raises(kind) as exc:
+            export_cli.run(parse(argv + ["--no-progress"]))
+        assert isinstance(exc.value, MmusvError) and "\n" not in str(exc.value)
+
+
+def test_cli_converts(coop_rec: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "o"
+    assert export_cli.run(parse([str(coop_rec), "-o", str(out), "--no-split", "--range", "150", "--extras", ""])) == 0
+    text = capsys.readouterr().out
+    assert "export_coop.mcap -> export_coop: 3 frames" in text
+    doc = yaml.safe_load((out / "conversion.yaml").read_text())
+    assert doc["status"] == "complete" and doc["options"]["eval_range_m"] == 150.0 and doc["options"]["extras"] == []
+    assert sorted(p.name for p in (out / "export_coop").iterdir()) == ["1000", "1002", "data_protocol.yaml"]
+
+
+# ---------------------------------------------------------------------------------------------- overwrite, determinism
+
+
+def test_existing_output_refused_without_overwrite(coop_rec: Path, tmp_path: Path) -> None:
+    out = tmp_path / "o"
+    convert(coop_rec, out_dir=out, splits=None, extras=())
+    with pytest.raises(IoError, match="already exists"):
+        convert(coop_rec, out_dir=out, splits=None, extras=())
+    (out / "stale.txt").write_text("x")
+    rep = convert(coop_rec, out_dir=out, splits=None, extras=(), overwrite=True)
+    assert rep.frames == 3 and not (out / "stale.txt").exists()
+    foreign = tmp_path / "foreign"
+    foreign.mkdir()
+    (foreign / "precious.txt").write_text("keep me")
+    with pytest.raises(IoError, match="refusing to delete"):
+        convert(coop_rec, out_dir=foreign, overwrite=True)
+    assert (foreign / "precious.txt").read_text() == "keep me"
+
+
+@pytest.mark.parametrize("to", ["opv2v", "kitti"])
+def test_deterministic(coop_rec: Path, tmp_path: Path, to: str) -> None:
+    a = convert(coop_rec, to=to, out_dir=tmp_path / "a", splits=None)
+    b = convert(coop_rec, to=to, out_dir=tmp_path / "b", splits=None)
+    ta, tb = tree(tmp_path / "a"), tree(tmp_path / "b")
+    assert ta == tb and len(ta) > 50
+    assert a.bytes == b.bytes == sum((tmp_path / "a" / f).stat().st_size for f in ta)
+    assert a.files == len(ta)
+
+
+# ---------------------------------------------------------------------------------------------- truncated recordings
+
+
+def test_stopped_run_converts_written_frames_and_says_so(short_rec: Path, tmp_path: Path) -> None:
+    rep = convert(short_rec, out_dir=tmp_path / "o", splits=None, extras=())
+    assert rep.frames == 2
+    assert rep.skipped == [{"recording": short_rec.name, "frames": [2, 2],
+                            "reason": "not in the recording (run complete: 2 of 3 frames written)"}]
+    assert sorted(p.stem for p in (tmp_path / "o" / "export_short" / "1000").glob("*.pcd")) == ["000000", "000001"]
+    assert "skipped frames 2..2" in "\n".join(rep.lines())
+    doc = yaml.safe_load((tmp_path / "o" / "conversion.yaml").read_text())
+    assert doc["recordings"][0]["skipped"] == [{"frames": [2, 2], "reason": "not in the recording (run complete: 2 of 3 frames written)"}]
+
+
+def test_interrupted_run(tmp_path: Path, make_coop: Callable[..., dict[str, Any]]) -> None:
+    from mmusv.acquire import recording_path, run
+
+    def stop(done: int, total: int) -> None:
+        if done == 2:
+            raise KeyboardInterrupt
+
+    cfg = make_coop(name="export_interrupted")
+    with pytest.raises(KeyboardInterrupt):
+        run(cfg, out_dir=tmp_path / "in", progress=stop)
+    from mmusv.config import load_scenario
+
+    rec = recording_path(tmp_path / "in", load_scenario(cfg))
+    if not rec.exists():
+        rec = rec.with_name(rec.name + ".partial")
+    rep = convert(rec, out_dir=tmp_path / "o", splits=None, extras=())
+    assert rep.frames == 2
+    assert rep.skipped[0]["frames"] == [2, 2] and "interrupted" in rep.skipped[0]["reason"]
+
+
+def rechunk(src: Path, dst: Path, chunk_size: int) -> None:
+    """Copies a recording record by record into small chunks (a real run's chunks are ~4 MiB)."""
+    from mcap.records import Channel, Message, Metadata, Schema
+    from mcap.stream_reader import StreamReader
+    from mcap.writer import CompressionType, Writer
+
+    with src.open("rb") as f, dst.open("wb") as g:
+        w = Writer(g, chunk_size=chunk_size, compression=CompressionType.ZSTD)
+        w.start(profile="", library="test")
+        schemas: dict[int, int] = {}
+        channels: dict[int, int] = {}
+        for rec in StreamReader(f).records:
+            if isinstance(rec, Schema):
+                schemas[rec.id] = w.register_schema(rec.name, rec.encoding, rec.data)
+            elif isinstance(rec, Channel):
+                channels[rec.id] = w.register_channel(rec.topic, rec.message_encoding, schemas.get(rec.schema_id, 0), rec.metadata)
+            elif isinstance(rec, Message):
+                w.add_message(channels[rec.channel_id], rec.log_time, rec.data, rec.publish_time, rec.sequence)
+            elif isinstance(rec, Metadata):
+                w.add_metadata(rec.name, rec.metadata)
+        w.finish()  # type: ignore[no-untyped-call]
+
+
+def test_truncated_partial_file(coop_rec: Path, tmp_path: Path) -> None:
+    small = tmp_path / "export_coop.mcap"
+    rechunk(coop_rec, small, 64 * 1024)
+    full = convert(small, out_dir=tmp_path / "full", splits=None)
+    ref = convert(coop_rec, out_dir=tmp_path / "ref", splits=None)
+    assert tree(tmp_path / "full") == tree(tmp_path / "ref") and full.frames == ref.frames == 3
+    data = small.read_bytes()
+    cut = tmp_path / "export_coop.mcap.partial"
+    cut.write_bytes(data[: int(len(data) * 0.55)])  # a killed writer: no summary, last chunk cut in the middle
+    rep = convert(cut, out_dir=tmp_path / "cut", splits=None)
+    assert 1 <= rep.frames < 3
+    done = rep.recordings[0]
+    skipped = {k for s in done.skipped for k in range(s["frames"][0], s["frames"][1] + 1)}
+    assert skipped == set(range(rep.frames, 3))
+    reasons = " ".join(s["reason"] for s in done.skipped)
+    assert "the file is truncated" in reasons
+    assert "incomplete: missing" in reasons or "not in the recording" in reasons
+    # the converted frames are byte-identical to those of the complete recording
+    t_cut, t_ref = tree(tmp_path / "cut"), tree(tmp_path / "ref")
+    for name, digest in t_cut.items():
+        if name.endswith((".pcd", ".png")) or (name.endswith(".yaml") and "/100" in name):
+            assert t_ref[name] == digest, name
+    stamps = {c: sorted(p.stem for p in (tmp_path / "cut" / "export_coop" / c).glob("*.pcd")) for c in ("1000", "1002")}
+    assert stamps["1000"] == stamps["1002"] == [f"{k:06d}" for k in range(rep.frames)]
+
+
+def test_cut_before_any_frame(coop_rec: Path, tmp_path: Path) -> None:
+    from mcap.records import Chunk
+    from mcap.stream_reader import StreamReader
+
+    with coop_rec.open("rb") as f:  # the end of the first chunk: metadata read, no message complete
+        end = next(f.tell() for rec in StreamReader(f, emit_chunks=True).records if isinstance(rec, Chunk))
+    cut = tmp_path / "x.mcap.partial"
+    cut.write_bytes(coop_rec.read_bytes()[: end - 10])
+    rep = convert(cut, out_dir=tmp_path / "o", splits=None)
+    assert rep.frames == 0 and rep.skipped and "nothing written" in " ".join(rep.recordings[0].notes)
+    assert not (tmp_path / "o" / "export_coop").exists()
+    assert export_cli.run(parse([str(cut), "-o", str(tmp_path / "o2"), "--no-progress"])) == 1
+
+
+# ---------------------------------------------------------------------------------------------- splits
+
+
+def test_splits_by_sequence(many_recs: list[Path], tmp_path: Path) -> None:
+    rep = convert(many_recs, out_dir=tmp_path / "a", splits=(0.6, 0.2, 0.2), seed=3, extras=())
+    where = {r.folder: r.split or "" for r in rep.recordings}
+    assert sorted(where.values()) == ["test", "train", "train", "train", "validate"]
+    for name, split in where.items():
+        assert (tmp_path / "a" / split / name / "1000").is_dir()
+        assert [s for s in ("train", "validate", "test") if (tmp_path / "a" / s / name).exists()] == [split]
+    again = convert(list(reversed(many_recs)), out_dir=tmp_path / "b", splits=(0.6, 0.2, 0.2), seed=3, extras=())
+    assert {r.folder: r.split or "" for r in again.recordings} == where
+    assert tree(tmp_path / "a") == tree(tmp_path / "b")
+    other = convert(many_recs, out_dir=tmp_path / "c", splits="0.6,0.2,0.2", seed=4, extras=())
+    assert sorted(r.split or "" for r in other.recordings) == sorted(where.values())
+    doc = yaml.safe_load((tmp_path / "a" / "conversion.yaml").read_text())
+    assert {r["folder"]: r["split"] for r in doc["recordings"]} == where
+    assert doc["options"]["seed"] == 3

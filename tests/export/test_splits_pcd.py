@@ -1,0 +1,72 @@
+"""Sequence splits (deterministic, order-independent, no empty split when avoidable) and the ASCII PCD format."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mmusv.errors import ConfigError
+from mmusv.export.pcd import pcd_bytes, read_pcd, write_pcd
+from mmusv.export.splits import assign_splits, parse_ratios, split_counts
+
+
+def test_split_counts() -> None:
+    r = parse_ratios((0.7, 0.15, 0.15))
+    assert split_counts(1, r) == [1, 0, 0]
+    assert split_counts(3, r) == [1, 1, 1]
+    assert split_counts(10, r) == [7, 2, 1] or split_counts(10, r) == [7, 1, 2]
+    assert sum(split_counts(10, r)) == 10
+    assert split_counts(20, r) == [14, 3, 3]
+    assert split_counts(5, parse_ratios("1,0,0")) == [5, 0, 0]
+    for n in range(0, 40):
+        c = split_counts(n, r)
+        assert sum(c) == n and min(c) >= 0
+        if n >= 3:
+            assert min(c) >= 1
+
+
+def test_assign_splits_deterministic_and_order_independent() -> None:
+    keys = [f"scenario_{i:02d}" for i in range(20)]
+    a = assign_splits(keys, parse_ratios((0.7, 0.15, 0.15)), seed=0)
+    b = assign_splits(list(reversed(keys)), parse_ratios((0.7, 0.15, 0.15)), seed=0)
+    assert a == b
+    assert sorted(a.values()).count("train") == 14
+    c = assign_splits(keys, parse_ratios((0.7, 0.15, 0.15)), seed=1)
+    assert c != a
+    with pytest.raises(ConfigError):
+        assign_splits(["x", "x"], (1.0, 0.0, 0.0), seed=0)
+
+
+@pytest.mark.parametrize("bad", ["0.7,0.3", "a,b,c", "-1,1,1", "0,0,0", (0.5, float("nan"), 0.5)])
+def test_parse_ratios_rejects(bad: object) -> None:
+    with pytest.raises(ConfigError):
+        parse_ratios(bad)  # type: ignore[arg-type]
+
+
+def test_pcd_open3d_reads_points_and_intensity(tmp_path: Path) -> None:
+    o3d = pytest.importorskip("open3d")
+    rng = np.random.default_rng(0)
+    xyz = rng.normal(size=(500, 3)) * 80
+    inten = rng.uniform(size=500)
+    inten[:3] = [0.0, 1.0, 1.7]  # out-of-range values are clipped
+    p = tmp_path / "a.pcd"
+    write_pcd(p, xyz, inten)
+    text = p.read_text()
+    assert "FIELDS x y z rgb\n" in text and "DATA ascii\n" in text
+    pc = o3d.io.read_point_cloud(str(p))
+    pts, cols = np.asarray(pc.points), np.asarray(pc.colors)
+    np.testing.assert_allclose(pts, xyz, atol=6e-5)
+    np.testing.assert_allclose(cols[:, 0], np.clip(inten, 0, 1), atol=0.5 / 255 + 1e-9)
+    assert np.all(cols[:, 1:] == 0)
+    back_xyz, back_i = read_pcd(p)
+    np.testing.assert_allclose(back_xyz, xyz, atol=6e-5)
+    np.testing.assert_allclose(back_i, cols[:, 0], atol=1e-12)
+
+
+def test_pcd_deterministic_and_empty() -> None:
+    xyz = np.array([[-1e-9, 0.0, 1.0]])
+    assert pcd_bytes(xyz, [0.5]) == pcd_bytes(xyz.copy(), [0.5])
+    assert b"\n0.0000 0.0000 1.0000 8388608\n" in pcd_bytes(xyz, [0.5])
+    assert b"POINTS 0\n" in pcd_bytes(np.zeros((0, 3)), np.zeros(0))
