@@ -1,6 +1,7 @@
 //! The one wrapper for every long native call, and array helpers.
 
 use crate::errors::{to_py, InputError, InternalError};
+use mmusv_core::RigidPose;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
@@ -49,6 +50,23 @@ pub fn rows<'a, T: numpy::Element, const K: usize>(
 pub fn flat<'a, T: numpy::Element>(arr: &'a PyReadonlyArray1<'_, T>, name: &str) -> PyResult<&'a [T]> {
     arr.as_slice()
         .map_err(|_| InputError::new_err(format!("{name} must be C-contiguous (use numpy.ascontiguousarray)")))
+}
+
+/// A rigid pose from 16 row-major numbers of a 4×4 matrix; `field` names the argument in errors.
+pub fn pose_from(m: &[f64], field: &str) -> PyResult<RigidPose> {
+    let m: [f64; 16] = m.try_into().map_err(|_| InputError::new_err(format!("{field} must be a 4x4 matrix")))?;
+    RigidPose::from_matrix_row_major(&m, field).map_err(to_py)
+}
+
+/// A rigid pose from a C-contiguous `(4, 4)` float64 array (body → world); `field` names the argument in errors.
+pub fn pose_arg(pose: &PyReadonlyArray2<'_, f64>, field: &str) -> PyResult<RigidPose> {
+    if pose.shape() != [4, 4] {
+        return Err(InputError::new_err(format!("{field} must have shape (4, 4), got {:?}", pose.shape())));
+    }
+    let m = pose
+        .as_slice()
+        .map_err(|_| InputError::new_err(format!("{field} must be a C-contiguous (4, 4) float64 array")))?;
+    pose_from(m, field)
 }
 
 /// Moves rows of `K` into a new owned `(N, K)` numpy array.

@@ -1,29 +1,15 @@
 //! Bindings for `mmusv_core::sensors::radar` and `ppi`: one radar sweep as a dict of arrays, and its PPI.
 
-use crate::errors::{to_py, InputError};
-use crate::native::{detached, flat};
+use crate::errors::to_py;
+use crate::native::{detached, flat, pose_arg};
 use crate::scene::Scene;
 use mmusv_core::sensors::ppi::{self, PpiConfig, PpiOrientation};
 use mmusv_core::sensors::radar::{self, RadarConfig, RadarEnv, RadarReturns};
 use mmusv_core::sensors::radar_model::ClutterModel;
-use mmusv_core::RigidPose;
 use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-
-/// A (4, 4) float64 sensor-to-world pose.
-fn pose_from(pose: &PyReadonlyArray2<'_, f64>) -> PyResult<RigidPose> {
-    if pose.shape() != [4, 4] {
-        return Err(InputError::new_err(format!("pose must have shape (4, 4), got {:?}", pose.shape())));
-    }
-    let m: [f64; 16] = pose
-        .as_slice()
-        .ok()
-        .and_then(|s| s.try_into().ok())
-        .ok_or_else(|| InputError::new_err("pose must be a C-contiguous (4, 4) float64 array"))?;
-    RigidPose::from_matrix_row_major(&m, "pose").map_err(to_py)
-}
 
 /// One radar revolution of `scene` from `pose`. Returns a dict of equal-length 1-D arrays sorted by
 /// (azimuth bin, range bin): `range` f32 m, `azimuth` f32 rad (sensor frame, [0, 2π)), `elevation` f32 rad,
@@ -60,7 +46,7 @@ fn radar_sweep<'py>(
     rain_mm_per_h: f32,
     seed: u64,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let pose = pose_from(&pose)?;
+    let pose = pose_arg(&pose, "pose")?;
     let cfg = RadarConfig {
         range_min_m,
         range_max_m,

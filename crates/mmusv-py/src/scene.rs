@@ -2,9 +2,9 @@
 //! instances, cast rays, export the world triangles.
 
 use crate::errors::InputError;
-use crate::native::{detached, flat, rows, rows_to_array};
+use crate::native::{detached, flat, pose_from, rows, rows_to_array};
 use mmusv_core::export::{write_world_mesh, MeshFormat};
-use mmusv_core::{Mesh, RigidPose, Scene as CoreScene};
+use mmusv_core::{Mesh, Scene as CoreScene};
 use numpy::ndarray::Array2;
 use numpy::{
     IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods,
@@ -45,11 +45,6 @@ pub struct Scene {
 
 fn poisoned() -> PyErr {
     crate::errors::InternalError::new_err("scene lock poisoned by an earlier internal error; rebuild the scene")
-}
-
-fn pose_from(arr: &[f64], field: &str) -> PyResult<RigidPose> {
-    let m: [f64; 16] = arr.try_into().map_err(|_| InputError::new_err(format!("{field} must be a 4x4 matrix")))?;
-    RigidPose::from_matrix_row_major(&m, field).map_err(crate::errors::to_py)
 }
 
 impl Scene {

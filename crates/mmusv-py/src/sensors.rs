@@ -1,9 +1,8 @@
 //! Bindings for `mmusv_core::sensors`: ray patterns, the spinning LiDAR and the cameras.
 
-use crate::native::{detached, rows, rows_to_array};
+use crate::native::{detached, pose_arg, rows_to_array};
 use mmusv_core::sensors::shade::ShadeEnv;
 use mmusv_core::sensors::{camera, lidar, rays};
-use mmusv_core::RigidPose;
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -73,18 +72,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Lidar>()?;
     m.add_class::<Camera>()?;
     Ok(())
-}
-
-fn pose_arg(pose: &PyReadonlyArray2<'_, f64>, field: &str) -> PyResult<RigidPose> {
-    let rows4 = rows::<f64, 4>(pose, field)?;
-    if rows4.len() != 4 {
-        return Err(crate::errors::InputError::new_err(format!("{field} must be a (4, 4) matrix")));
-    }
-    let mut m = [0.0; 16];
-    for (k, v) in rows4.iter().flatten().enumerate() {
-        m[k] = *v;
-    }
-    RigidPose::from_matrix_row_major(&m, field).map_err(crate::errors::to_py)
 }
 
 /// A spinning multi-channel LiDAR with its ray pattern computed once (see `mmusv_core::sensors::lidar`).
