@@ -75,8 +75,8 @@ class _Tables:
                 "height": float(v.box_size[2]),
             })
 
-    def add_annotations(self, ann: Annotations) -> None:
-        cols = ann.columns()
+    def add_annotations(self, ann: Annotations, cols: dict[str, Any]) -> None:
+        """Rows of one agent's annotations; ``cols`` is ``ann.columns()``."""
         lid = cols["lidar"]
         for j, tid in enumerate(lid["target_id"]):
             c, s, q = lid["center"][j], lid["size"][j], lid["rotation"][j]
@@ -179,10 +179,11 @@ def run(
             tf = time.perf_counter()
             cap = sim.capture(k)
             anns = annotations_for(sim, cap, silhouettes)
-            recorder.write_frame(cap, anns)
+            cols = {agent: a.columns() for agent, a in anns.items()}
+            recorder.write_frame(cap, cols)
             tables.add_world(sim, cap)
-            for a in anns.values():
-                tables.add_annotations(a)
+            for agent, a in anns.items():
+                tables.add_annotations(a, cols[agent])
             del cap
             result.frames_written = k + 1
             result.frame_seconds.append(time.perf_counter() - tf)

@@ -20,8 +20,8 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from mmusv.frames import BODY_TO_OPTICAL, translation
 from mmusv.scene import Scene
-from mmusv.sensors.camera import BODY_TO_OPTICAL
 from mmusv.world.vessels import get_asset
 
 __all__ = ["Annotations", "annotate_agent", "box_corners", "SilhouetteCache"]
@@ -37,12 +37,6 @@ def box_corners(matrix: np.ndarray, size: np.ndarray) -> np.ndarray:
     local = _SIGNS * (np.asarray(size, dtype=np.float64) / 2.0)
     out: np.ndarray = local @ matrix[:3, :3].T + matrix[:3, 3]
     return out
-
-
-def _translate(v: np.ndarray) -> np.ndarray:
-    m = np.eye(4)
-    m[:3, 3] = v
-    return m
 
 
 @dataclass
@@ -181,10 +175,16 @@ def annotate_agent(
         ids, cnt = np.unique(lidar_instances, return_counts=True)
         counts = {int(i): int(c) for i, c in zip(ids, cnt, strict=True)}
     rays: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+    # Per pinhole camera, once: intrinsics and the world → camera-body transform.
+    views = {
+        name: (cam, cam.intrinsics, np.linalg.inv(pose), pose, inst_img)
+        for name, (cam, pose, inst_img) in cameras.items()
+        if cam.intrinsics is not None
+    }
     for vi, info in enumerate(vessels):
         if vi == agent_index:
             continue
-        box_world = state.matrices[vi] @ _translate(info.box_center_body)
+        box_world = state.matrices[vi] @ translation(info.box_center_body)
         box_ref = ref_inv @ box_world
         rng = float(np.linalg.norm(box_ref[:3, 3]))
         if rng <= max_range_m:
@@ -198,12 +198,8 @@ def annotate_agent(
             ann.lidar_points.append(counts.get(info.instance_id, 0))
             ann.lidar_range.append(rng)
         corners_world = box_corners(box_world, info.box_size)
-        for name, (cam, pose, inst_img) in cameras.items():
-            k = cam.intrinsics
-            if k is None:
-                continue
+        for name, (cam, k, inv, pose, inst_img) in views.items():
             h, w = inst_img.shape
-            inv = np.linalg.inv(pose)
             body = corners_world @ inv[:3, :3].T + inv[:3, 3]
             box = _project_box(body @ BODY_TO_OPTICAL.T, k)
             if box is None:

@@ -41,6 +41,7 @@ __all__ = [
     "Scenario",
     "load_scenario",
     "scenario_hash",
+    "validation_error",
 ]
 
 
@@ -156,17 +157,19 @@ class Scenario(_Model):
         return self.model_copy(update={"environment": env})
 
 
-def _field_path(loc: tuple[int | str, ...]) -> str:
+def _field_path(loc: tuple[int | str, ...], root: str) -> str:
     out = ""
     for part in loc:
         if isinstance(part, int):
             out += f"[{part}]"
         else:
             out += ("." if out else "") + str(part)
-    return out or "scenario"
+    return out or root
 
 
-def _config_error(err: ValidationError, source: str) -> ConfigError:
+def validation_error(err: ValidationError, source: str, *, noun: str = "config", root: str = "scenario") -> ConfigError:
+    """A pydantic ``ValidationError`` as one :class:`ConfigError` line per problem: ``invalid <noun> <field
+    path> = <value>: <what is allowed>``; ``root`` names the whole document when the problem has no field."""
     lines = []
     for e in err.errors():
         # Pydantic adds the union member or validator name to `loc`; drop the non-field parts.
@@ -174,7 +177,7 @@ def _config_error(err: ValidationError, source: str) -> ConfigError:
         value = e.get("input")
         shown = repr(value) if not isinstance(value, (dict, list)) or len(repr(value)) < 80 else f"<{type(value).__name__}>"
         msg = str(e["msg"]).removeprefix("Value error, ")
-        lines.append(f"invalid config {_field_path(loc)} = {shown}: {msg}")
+        lines.append(f"invalid {noun} {_field_path(loc, root)} = {shown}: {msg}")
     return ConfigError(f"{source}: " + "; ".join(lines))
 
 
@@ -199,7 +202,7 @@ def load_scenario(source: str | os.PathLike[str] | dict[str, Any] | Scenario) ->
     try:
         return Scenario.model_validate(data)
     except ValidationError as exc:
-        raise _config_error(exc, where) from None
+        raise validation_error(exc, where) from None
 
 
 def scenario_hash(scenario: Scenario) -> str:

@@ -27,6 +27,7 @@ __all__ = [
     "MIRROR_Y",
     "BODY_TO_OPTICAL",
     "pose_matrices",
+    "translation",
     "matrix_to_pose",
     "invert",
     "transform_points",
@@ -67,6 +68,13 @@ def pose_matrices(eta: npt.ArrayLike) -> np.ndarray:
     m[..., 2, 2] = cp * cr
     m[..., :3, 3] = eta[..., :3]
     m[..., 3, 3] = 1.0
+    return m
+
+
+def translation(v: npt.ArrayLike) -> np.ndarray:
+    """``(4, 4)`` float64 pure translation by ``v`` ``(3,)`` metres."""
+    m = np.eye(4)
+    m[:3, 3] = np.asarray(v, dtype=np.float64).reshape(3)
     return m
 
 

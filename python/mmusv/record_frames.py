@@ -28,10 +28,10 @@ import numpy as np
 import yaml
 from scipy.spatial.transform import Rotation
 
-from mmusv.annotate import Annotations
 from mmusv.config import scenario_hash
 from mmusv.record import Recording
-from mmusv.sensors.camera import BODY_TO_OPTICAL, CameraImages
+from mmusv.frames import BODY_TO_OPTICAL
+from mmusv.sensors.camera import CameraImages
 from mmusv.simulation import FrameCapture, Simulation
 
 __all__ = ["FrameRecorder", "OPTICAL_IN_BODY", "pose7"]
@@ -53,6 +53,7 @@ class FrameRecorder:
 
     def __init__(self, path: Path, sim: Simulation, *, overwrite: bool = False) -> None:
         self.sim = sim
+        self.roles = {v.id: v.role for v in sim.vessels}
         self.rec = Recording(path, overwrite=overwrite)
         sc = sim.scenario
         self.rec.metadata("scenario", {"name": sc.name, "yaml": yaml.safe_dump(sc.model_dump(mode="json"), sort_keys=False)})
@@ -76,8 +77,8 @@ class FrameRecorder:
 
     # ------------------------------------------------------------------------------------------ per frame
 
-    def write_frame(self, cap: FrameCapture, annotations: dict[str, Annotations]) -> None:
-        """Writes every message of one frame."""
+    def write_frame(self, cap: FrameCapture, annotations: dict[str, dict[str, Any]]) -> None:
+        """Writes every message of one frame; ``annotations`` maps an agent to its ``Annotations.columns()``."""
         t = round(cap.time_s * 1e9)
         sim, st, rec = self.sim, cap.world, self.rec
         tfs: list[tuple[str, str, np.ndarray, np.ndarray]] = []
@@ -121,14 +122,12 @@ class FrameRecorder:
                 self._images(f"/{a.id}/top_view", f"{a.id}/top_view", t, ac.top_view, list(a.rig.top_view.outputs))
             if ac.radar is not None:
                 self._radar(a.id, t, ac.radar, ac.radar_ppi)
-            ann = annotations.get(a.id)
-            if ann is not None:
-                cols = ann.columns()
+            cols = annotations.get(a.id)
+            if cols is not None:
                 rec.annotations(f"/{a.id}/annotations", log_time_ns=t, frame=cap.frame, time_s=cap.time_s, agent_id=a.id,
                                 lidar=cols["lidar"], bev=cols["bev"], camera=cols["camera"])
                 lid = cols["lidar"]
-                roles = {v.id: v.role for v in sim.vessels}
-                colours = np.array([_ROLE_COLOURS.get(roles.get(i, "target"), (1, 1, 1, 0.5)) for i in lid["target_id"]]).reshape(-1, 4)
+                colours = np.array([_ROLE_COLOURS.get(self.roles.get(i, "target"), (1, 1, 1, 0.5)) for i in lid["target_id"]]).reshape(-1, 4)
                 rec.boxes(f"/{a.id}/boxes", log_time_ns=t, frame_id=f"{a.id}/lidar", entity_id=f"{a.id}/targets",
                           ids=lid["target_id"], centers=lid["center"], quaternions=lid["rotation"], sizes=lid["size"],
                           colors=colours)

@@ -46,7 +46,7 @@ from typing import Any
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
-from mmusv.config import AcquisitionConfig, EnvironmentConfig, MapConfig, load_scenario
+from mmusv.config import AcquisitionConfig, EnvironmentConfig, MapConfig, load_scenario, validation_error
 from mmusv.errors import ConfigError
 from mmusv.generate.families import FAMILIES
 from mmusv.generate.spec_constraints import (
@@ -308,27 +308,6 @@ class GenerationSpec(_Model):
         return combo.max_attempts if combo.max_attempts is not None else combo.quota * self.max_attempts_per_scenario
 
 
-def _field_path(loc: tuple[int | str, ...]) -> str:
-    out = ""
-    for part in loc:
-        if isinstance(part, int):
-            out += f"[{part}]"
-        else:
-            out += ("." if out else "") + str(part)
-    return out or "spec"
-
-
-def _spec_error(err: ValidationError, source: str) -> ConfigError:
-    lines = []
-    for e in err.errors():
-        loc = tuple(p for p in e["loc"] if not (isinstance(p, str) and ("[" in p or p in {"str", "float", "function-after"})))
-        value = e.get("input")
-        shown = repr(value) if not isinstance(value, (dict, list)) or len(repr(value)) < 80 else f"<{type(value).__name__}>"
-        msg = str(e["msg"]).removeprefix("Value error, ")
-        lines.append(f"invalid spec {_field_path(loc)} = {shown}: {msg}")
-    return ConfigError(f"{source}: " + "; ".join(lines))
-
-
 def _cross_checks(spec: GenerationSpec, source: str) -> None:
     """Checks that need several fields; raises ConfigError naming the field at fault."""
 
@@ -388,6 +367,6 @@ def load_spec(source: str | os.PathLike[str] | dict[str, Any] | GenerationSpec) 
     try:
         spec = GenerationSpec.model_validate(data)
     except ValidationError as exc:
-        raise _spec_error(exc, where) from None
+        raise validation_error(exc, where, noun="spec", root="spec") from None
     _cross_checks(spec, where)
     return spec

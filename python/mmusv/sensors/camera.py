@@ -16,14 +16,12 @@ import numpy as np
 import numpy.typing as npt
 
 from mmusv._native import core
+from mmusv.frames import BODY_TO_OPTICAL
 from mmusv.scene import Scene
 from mmusv.sensors.config import CameraConfig, TopViewConfig
 from mmusv.world.environment import Environment
 
 __all__ = ["CameraImages", "camera_from_config", "top_view_from_config", "shading_kwargs", "render", "BODY_TO_OPTICAL"]
-
-BODY_TO_OPTICAL = np.array([[0.0, -1.0, 0.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0]])
-"""Rotation taking camera-body coordinates (x fwd, y left, z up) to optical ones (x right, y down, z fwd)."""
 
 
 @dataclass(frozen=True)

@@ -37,6 +37,13 @@ class _Model(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, str_strip_whitespace=True)
 
 
+def _check_resolution(v: tuple[int, int]) -> tuple[int, int]:
+    """An image ``[width, height]``: both in 1..16384 pixels."""
+    if not (1 <= v[0] <= 16384 and 1 <= v[1] <= 16384):
+        raise ValueError("width and height must be in 1..16384 pixels")
+    return v
+
+
 class Mount(_Model):
     """Where a sensor sits on its vessel (see the module docstring)."""
 
@@ -165,12 +172,7 @@ class CameraConfig(_Model):
     range_m: float = Field(default=5000.0, gt=0)
     mount: Mount = Mount()
 
-    @field_validator("resolution")
-    @classmethod
-    def _res(cls, v: tuple[int, int]) -> tuple[int, int]:
-        if not (1 <= v[0] <= 16384 and 1 <= v[1] <= 16384):
-            raise ValueError("width and height must be in 1..16384 pixels")
-        return v
+    _res = field_validator("resolution")(_check_resolution)
 
 
 class TopViewConfig(_Model):
@@ -184,12 +186,7 @@ class TopViewConfig(_Model):
     orientation: Literal["heading_up", "north_up"] = "heading_up"
     outputs: list[CameraOutput] = Field(default_factory=lambda: list(_TOP_OUTPUTS))
 
-    @field_validator("resolution")
-    @classmethod
-    def _res(cls, v: tuple[int, int]) -> tuple[int, int]:
-        if not (1 <= v[0] <= 16384 and 1 <= v[1] <= 16384):
-            raise ValueError("width and height must be in 1..16384 pixels")
-        return v
+    _res = field_validator("resolution")(_check_resolution)
 
 
 def default_cameras(resolution: tuple[int, int] = (640, 480)) -> list[CameraConfig]:

@@ -30,18 +30,13 @@ from scipy import ndimage
 
 from mmusv.annotate import box_corners
 from mmusv.config import load_scenario
+from mmusv.frames import translation
 from mmusv.simulation import Simulation
 
 __all__ = ["AgreementStudy", "run_agreement_study", "sample_agreement", "BUNDLED_SCENARIOS"]
 
 BUNDLED_SCENARIOS = ("scenarios/island_occlusion.yaml", "scenarios/open_sea_convoy.yaml", "scenarios/port_entry.yaml")
 _VESSEL_CLASSES = (10, 11)
-
-
-def _translate(v: np.ndarray) -> np.ndarray:
-    m = np.eye(4)
-    m[:3, 3] = v
-    return m
 
 
 def sample_agreement(
@@ -143,7 +138,7 @@ def run_agreement_study(scenarios: list[str] | tuple[str, ...] = BUNDLED_SCENARI
                 for vi, info in enumerate(sim.vessels):
                     if vi == agent.index:
                         continue
-                    box = state.matrices[vi] @ _translate(info.box_center_body)
+                    box = state.matrices[vi] @ translation(info.box_center_body)
                     r = sample_agreement(
                         semantic=ac.top_view.semantic, instance=ac.top_view.instance, camera_pose=ac.top_view_pose,
                         metres_per_pixel=tv.metres_per_pixel, box_matrix=box, box_size=info.box_size,
