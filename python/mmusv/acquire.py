@@ -15,6 +15,7 @@ Ctrl-C or an error still finishes the MCAP (every completed frame is in it, its 
 from __future__ import annotations
 
 import json
+import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -26,7 +27,8 @@ import yaml
 
 from mmusv.annotate import Annotations, SilhouetteCache, annotate_agent
 from mmusv.config import Scenario, load_scenario, scenario_hash
-from mmusv.errors import ConfigError, IoError
+from mmusv.errors import ConfigError, IoError, MmusvError
+from mmusv.scenario_checks import check_mounts, check_routes
 from mmusv.simulation import FrameCapture, Simulation
 
 __all__ = ["RunResult", "run", "TABLE_PART_FRAMES", "recording_path"]
@@ -137,6 +139,7 @@ def run(
     overwrite: bool = False,
     frames: int | None = None,
     progress: Callable[[int, int], None] | None = None,
+    checks: bool = True,
 ) -> RunResult:
     """Runs a scenario (a YAML path, a dict or a :class:`~mmusv.config.Scenario`) into ``out_dir``.
 
@@ -145,6 +148,8 @@ def run(
         overwrite: replace an existing recording of the same scenario name; otherwise that is an error.
         frames: run only the first ``frames`` indices (default: the scenario's ``acquisition.frames``).
         progress: called with (frames done, frames total) after every frame.
+        checks: run the generator's route checks on the map (:mod:`mmusv.scenario_checks`): a route over land
+            is an error, clearance and separation problems and far-away mounts are warnings.
 
     Raises:
         ConfigError: the scenario is invalid (nothing is written).
@@ -153,6 +158,11 @@ def run(
     """
     from mmusv.record_frames import FrameRecorder  # the MCAP side, kept apart from the loop
 
+    if isinstance(cfg, (str, os.PathLike)) and Path(cfg).is_dir():
+        raise ConfigError(
+            f"{cfg} is a directory; mmusv.run takes one scenario file (run a folder with `mmusv run {cfg} -o OUT`)"
+        )
+    source = str(cfg) if isinstance(cfg, (str, os.PathLike)) else "scenario"
     scenario = load_scenario(cfg)
     total = scenario.acquisition.frames if frames is None else int(frames)
     if not 1 <= total <= scenario.acquisition.frames:
@@ -161,7 +171,13 @@ def run(
     rec_path = recording_path(out, scenario)
     if rec_path.exists() and not overwrite:
         raise IoError(f"{rec_path} already exists; pass overwrite=True (mmusv run --overwrite) to replace it")
-    sim = Simulation(scenario)  # builds the world: any remaining config problem surfaces here, before writing
+    try:  # builds the world: any remaining config problem surfaces here, before writing
+        sim = Simulation(scenario)
+    except MmusvError as exc:
+        raise type(exc)(f"{source}: {exc}" if not str(exc).startswith(source) else str(exc)) from None
+    if checks:
+        check_mounts(scenario, source=source)
+        check_routes(scenario, sim.world, source=source)
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:

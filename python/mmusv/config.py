@@ -22,16 +22,22 @@ import hashlib
 import json
 import math
 import os
-from pathlib import Path
 from typing import Any, Literal
 
-import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
 
 from mmusv.errors import ConfigError
 from mmusv.sensors.config import RigConfig
 from mmusv.world.environment import Environment, wave_height_m
-from mmusv.world.vessels import asset_names
+from mmusv.world.vessels import asset_names, get_asset
+from mmusv.yamlio import mapping_source
 
 __all__ = [
     "MapConfig",
@@ -46,7 +52,7 @@ __all__ = [
 
 
 class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, str_strip_whitespace=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, str_strip_whitespace=True, allow_inf_nan=False)
 
 
 class MapConfig(_Model):
@@ -150,6 +156,14 @@ class Scenario(_Model):
             seen.add(v.id)
             if v.rig is not None and v.rig not in self.rigs:
                 raise ValueError(f"vessel {v.id!r} names rig {v.rig!r}, which is not defined under rigs: ({sorted(self.rigs)})")
+        for i, v in enumerate(self.vessels):
+            if v.rig is not None and v.role != "usv":
+                raise ValueError(
+                    f"vessels[{i}].rig = {v.rig!r}: only instrumented vessels (role: usv) carry a rig; "
+                    f"vessel {v.id!r} has role {v.role!r} (add `role: usv` or remove `rig`)"
+                )
+            if v.role == "usv" and v.rig is not None:
+                _check_mount_points(v, i, v.rig, self.rigs[v.rig])
         return self
 
     @property
@@ -161,6 +175,25 @@ class Scenario(_Model):
         """A copy with another wave setting (everything else unchanged)."""
         env = self.environment.model_copy(update={"wave": EnvironmentConfig._wave(wave)})
         return self.model_copy(update={"environment": env})
+
+
+def _check_mount_points(v: VesselConfig, index: int, rig_name: str, rig: RigConfig) -> None:
+    """Every mount ``point`` of ``rig`` must be one of the asset's mount points (assets without any fall back to
+    the top of the hull, as documented in :mod:`mmusv.sensors.config`)."""
+    points = sorted(get_asset(v.asset).mounts)
+    if not points:
+        return
+    mounts = [("lidar.mount", rig.lidar.mount if rig.lidar else None),
+              ("radar.mount", rig.radar.mount if rig.radar else None)]
+    mounts += [(f"cameras[{i}].mount", c.mount) for i, c in enumerate(rig.cameras)]
+    for where, m in mounts:
+        if m is not None and m.point is not None and m.point not in points:
+            close = difflib.get_close_matches(m.point, points, n=1, cutoff=0.5)
+            hint = f"did you mean {close[0]!r}? " if close else ""
+            raise ValueError(
+                f"rigs.{rig_name}.{where}.point = {m.point!r}: asset {v.asset} (vessels[{index}], {v.id}) has no such "
+                f"mount point; {hint}its points: {', '.join(points)}"
+            )
 
 
 def _field_path(loc: tuple[int | str, ...], root: str) -> str:
@@ -183,6 +216,9 @@ def validation_error(err: ValidationError, source: str, *, noun: str = "config",
         value = e.get("input")
         shown = repr(value) if not isinstance(value, (dict, list)) or len(repr(value)) < 80 else f"<{type(value).__name__}>"
         msg = str(e["msg"]).removeprefix("Value error, ")
+        if not loc and isinstance(value, dict):  # a check across fields: its message names the fields itself
+            lines.append(f"invalid {noun}: {msg}")
+            continue
         lines.append(f"invalid {noun} {_field_path(loc, root)} = {shown}: {msg}")
     return ConfigError(f"{source}: " + "; ".join(lines))
 
@@ -191,20 +227,7 @@ def load_scenario(source: str | os.PathLike[str] | dict[str, Any] | Scenario) ->
     """Validates a scenario given as a YAML path, a dict, or a :class:`Scenario` (returned as is)."""
     if isinstance(source, Scenario):
         return source
-    if isinstance(source, dict):
-        data: Any = source
-        where = "scenario"
-    else:
-        path = Path(source)
-        if not path.is_file():
-            raise ConfigError(f"scenario file {str(path)!r} does not exist")
-        try:
-            data = yaml.safe_load(path.read_text(encoding="utf-8"))
-        except yaml.YAMLError as exc:
-            raise ConfigError(f"{path}: not valid YAML: {exc}") from None
-        where = str(path)
-    if not isinstance(data, dict):
-        raise ConfigError(f"{where}: a scenario must be a YAML mapping with at least `vessels:`")
+    data, where = mapping_source(source, kind="scenario", root_hint="at least `vessels:`")
     try:
         return Scenario.model_validate(data)
     except ValidationError as exc:

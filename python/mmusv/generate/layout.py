@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mmusv.errors import MmusvError
 from mmusv.generate.mapctx import MapContext
 
 __all__ = [
@@ -28,7 +29,7 @@ __all__ = [
 ]
 
 
-class SamplingError(Exception):
+class SamplingError(MmusvError):
     """A template could not place its vessels (the message says why)."""
 
 

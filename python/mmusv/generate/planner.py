@@ -18,12 +18,13 @@ import shapely
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
+from mmusv.errors import MmusvError
 from mmusv.generate.mapctx import MapContext
 
 __all__ = ["HarbourPlanner", "PlannerError", "harbour_planner"]
 
 
-class PlannerError(Exception):
+class PlannerError(MmusvError):
     """No route exists (the message says why)."""
 
 

@@ -41,13 +41,17 @@ from __future__ import annotations
 import difflib
 import os
 from functools import lru_cache
-from pathlib import Path
 from typing import Any
 
-import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
-from mmusv.config import AcquisitionConfig, EnvironmentConfig, MapConfig, load_scenario, validation_error
+from mmusv.config import (
+    AcquisitionConfig,
+    EnvironmentConfig,
+    MapConfig,
+    load_scenario,
+    validation_error,
+)
 from mmusv.errors import ConfigError
 from mmusv.generate.families import FAMILIES
 from mmusv.generate.spec_constraints import (
@@ -64,6 +68,7 @@ from mmusv.generate.spec_constraints import (
     TargetRangeCheck,
 )
 from mmusv.world.vessels import asset_names, get_asset
+from mmusv.yamlio import mapping_source
 
 __all__ = [
     "CooperationCheck",
@@ -90,7 +95,7 @@ Pair = tuple[float, float]
 
 
 class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, str_strip_whitespace=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, str_strip_whitespace=True, allow_inf_nan=False)
 
 
 def _ordered(v: Pair, what: str) -> Pair:
@@ -282,7 +287,7 @@ class GenerationSpec(_Model):
     combinations: list[Combination] = Field(min_length=1)
     constraints: Constraints = Field(default_factory=Constraints)
     max_attempts_per_scenario: int = Field(default=40, ge=1, le=100_000)
-    check_step_m: float = Field(default=2.0, gt=0.0, le=50.0)
+    check_step_m: float = Field(default=2.0, ge=0.25, le=50.0)
     sensor_height_m: float = Field(default=2.5, gt=0.0, le=100.0)
     encounter_clearance_m: float = Field(default=100.0, ge=0.0)
     proposals: int = Field(default=6, ge=1, le=100)
@@ -357,20 +362,7 @@ def load_spec(source: str | os.PathLike[str] | dict[str, Any] | GenerationSpec) 
     """Validates a generation spec given as a YAML path, a dict or a :class:`GenerationSpec` (returned as is)."""
     if isinstance(source, GenerationSpec):
         return source
-    if isinstance(source, dict):
-        data: Any = source
-        where = "spec"
-    else:
-        path = Path(source)
-        if not path.is_file():
-            raise ConfigError(f"spec file {str(path)!r} does not exist")
-        try:
-            data = yaml.safe_load(path.read_text(encoding="utf-8"))
-        except yaml.YAMLError as exc:
-            raise ConfigError(f"{path}: not valid YAML: {exc}") from None
-        where = str(path)
-    if not isinstance(data, dict):
-        raise ConfigError(f"{where}: a generation spec must be a YAML mapping with at least `combinations:`")
+    data, where = mapping_source(source, kind="spec", root_hint="at least `combinations:`")
     try:
         spec = GenerationSpec.model_validate(data)
     except ValidationError as exc:

@@ -30,7 +30,7 @@ PairKind = Literal["usv-usv", "usv-target", "target-target"]
 
 
 class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 class _Check(_Model):

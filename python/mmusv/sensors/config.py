@@ -44,13 +44,26 @@ _TOP_OUTPUTS: tuple[CameraOutput, ...] = ("rgb", "semantic", "instance")
 
 
 class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, str_strip_whitespace=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, str_strip_whitespace=True, allow_inf_nan=False)
+
+
+MAX_IMAGE_PIXELS = 4096 * 4096
+"""Largest image of any camera: about 16.8 M pixels (a 4096 x 4096 frame takes ~0.6 GB of buffers per frame)."""
+MAX_LIDAR_RAYS = 1 << 22
+"""Most LiDAR rays per sweep (4.2 M: ~0.3 GB of points per sweep)."""
+MAX_RADAR_RAYS = 1 << 23
+"""Most radar rays per sweep: azimuth_bins x rays_az x rays_el (8.4 M)."""
 
 
 def _check_resolution(v: tuple[int, int]) -> tuple[int, int]:
-    """An image ``[width, height]``: both in 1..16384 pixels."""
+    """An image ``[width, height]``: both in 1..16384 pixels, at most :data:`MAX_IMAGE_PIXELS` in all."""
     if not (1 <= v[0] <= 16384 and 1 <= v[1] <= 16384):
         raise ValueError("width and height must be in 1..16384 pixels")
+    if v[0] * v[1] > MAX_IMAGE_PIXELS:
+        raise ValueError(
+            f"{v[0]} x {v[1]} = {v[0] * v[1]:,} pixels would take about {v[0] * v[1] * 36 / 1e9:.1f} GB per frame; "
+            f"at most {MAX_IMAGE_PIXELS:,} pixels are allowed"
+        )
     return v
 
 
@@ -113,6 +126,12 @@ class LidarConfig(_Model):
             raise ValueError(
                 f"points_per_second / (rotation_hz * channels) = {self.azimuth_steps} columns per sweep; must be 1..65536"
             )
+        rays = self.azimuth_steps * self.channels
+        if rays > MAX_LIDAR_RAYS:
+            raise ValueError(
+                f"{self.channels} channels x {self.azimuth_steps} columns = {rays:,} rays per sweep would take about "
+                f"{rays * 64 / 1e9:.1f} GB per sweep; at most {MAX_LIDAR_RAYS:,} are allowed"
+            )
         return self
 
     @property
@@ -164,6 +183,12 @@ class RadarConfig(_Model):
             raise ValueError("elevation_fan_deg needs -90 < lower <= upper < 90 degrees")
         if self.min_range_m >= self.range_m:
             raise ValueError(f"min_range_m ({self.min_range_m}) must be below range_m ({self.range_m})")
+        rays = self.azimuth_bins * self.rays_az * self.rays_el
+        if rays > MAX_RADAR_RAYS:
+            raise ValueError(
+                f"azimuth_bins x rays_az x rays_el = {rays:,} rays per sweep would take about {rays * 48 / 1e9:.1f} GB; "
+                f"at most {MAX_RADAR_RAYS:,} are allowed"
+            )
         return self
 
     def sensor_fields(self) -> dict[str, object]:

@@ -50,13 +50,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mmusv.errors import ConfigError
 from mmusv.world.primitives import TriMesh, box, merge, prism, transformed
 
 __all__ = ["AssetSpecError", "Fields", "HullSpec", "build_procedural", "parse_hull", "PART_TYPES"]
 
 
-class AssetSpecError(ValueError):
-    """A vessel asset entry is invalid; ``field`` is the dotted path of the offending key (``tug_32m.hull.beam``)."""
+class AssetSpecError(ConfigError, ValueError):
+    """A vessel asset entry is invalid (a :class:`mmusv.ConfigError`, and a ``ValueError`` as before); ``field`` is the dotted path of the offending key (``tug_32m.hull.beam``)."""
 
     def __init__(self, field: str, message: str) -> None:
         super().__init__(f"{field}: {message}")

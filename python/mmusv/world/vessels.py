@@ -34,8 +34,10 @@ import numpy as np
 import yaml
 
 from mmusv.classes import SemanticClass
+from mmusv.errors import ConfigError, NotFoundError
 from mmusv.world.primitives import TriMesh
 from mmusv.world.vessel_shapes import AssetSpecError, Fields, build_procedural
+from mmusv.yamlio import parse_yaml, read_yaml
 
 __all__ = [
     "AssetSpecError",
@@ -81,8 +83,8 @@ def _as_mount(m: object, where: str) -> MountPoint:
     return MountPoint((a[0], a[1], a[2]), (b[0], b[1], b[2]))
 
 
-class UnknownAssetError(KeyError):
-    """No asset has this name. ``suggestions`` holds close matches; ``str()`` is a readable message."""
+class UnknownAssetError(NotFoundError, KeyError):
+    """No asset has this name (a :class:`mmusv.NotFoundError`, and a ``KeyError`` as before). ``suggestions`` holds close matches; ``str()`` is a readable message."""
 
     def __init__(self, name: str, known: Sequence[str]) -> None:
         self.name = name
@@ -102,7 +104,7 @@ class UnknownAssetError(KeyError):
 
 def _unknown_asset_error(name: str, suggestions: tuple[str, ...], message: str) -> UnknownAssetError:
     err = UnknownAssetError.__new__(UnknownAssetError)
-    KeyError.__init__(err, message)
+    NotFoundError.__init__(err, message)
     err.name, err.suggestions, err.message = name, list(suggestions), message
     return err
 
@@ -209,7 +211,7 @@ def _builtin_entries() -> dict[str, Mapping[str, Any]]:
     with _lock:
         if _entries is None:
             text = resources.files("mmusv.world").joinpath("vessel_catalog.yaml").read_text(encoding="utf-8")
-            _entries = _index_entries(yaml.load(text, Loader=_YamlLoader), source="vessel_catalog.yaml")
+            _entries = _index_entries(parse_yaml(text, "vessel_catalog.yaml"), source="vessel_catalog.yaml")
         return _entries
 
 
@@ -482,6 +484,6 @@ def _read_yaml(path: Path) -> object:
     if not path.is_file():
         raise AssetSpecError("file", f"asset file {str(path)!r} does not exist")
     try:
-        return yaml.load(path.read_text(encoding="utf-8"), Loader=_YamlLoader)
-    except yaml.YAMLError as exc:
-        raise AssetSpecError("file", f"{str(path)!r} is not valid YAML: {exc}") from exc
+        return read_yaml(path, kind="asset")
+    except ConfigError as exc:
+        raise AssetSpecError("file", str(exc)) from None

@@ -1,0 +1,99 @@
+"""Checks of a hand-written scenario against its map, with the generator's own named checks.
+
+:func:`check_routes` runs, on the scenario's routes and motion, the checks ``mmusv generate`` applies to every
+scenario it writes (:mod:`mmusv.generate.checks`): ``in_water`` (every vessel's centre on navigable water,
+along the whole route and at every sampled time) is an error, since a vessel sailing over land makes every
+label wrong; ``shore_clearance``, ``structure_clearance`` and ``separation`` are warnings (a close pass can be
+what a user wants). ``mmusv run --no-checks`` and ``mmusv.run(..., checks=False)`` skip them.
+
+:func:`check_mounts` warns about sensor mounts far from their hull (a units mistake: millimetres for metres).
+Warnings are :class:`MmusvWarning` through :mod:`warnings`; the CLI prints each as one line.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from mmusv.config import Scenario
+from mmusv.errors import ConfigError
+
+if TYPE_CHECKING:
+    from mmusv.world.maps import MapWorld
+
+__all__ = ["MmusvWarning", "check_routes", "check_mounts", "MOUNT_WARN_FACTOR"]
+
+MOUNT_WARN_FACTOR = 2.0
+"""A mount farther than this many hull lengths (at least 10 m) from the hull's box gets a warning."""
+
+
+class MmusvWarning(UserWarning):
+    """A scenario that runs but is probably not what was meant (a close pass, a far-away mount)."""
+
+
+def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[str]:
+    """Runs the generator's ``in_water`` check (an error) and clearance/separation checks (warnings, also
+    returned) on ``scenario`` sailing on ``world``; ``source`` names the file in messages."""
+    from mmusv.generate.checks import InWater, Separation, ShoreClearance, StructureClearance, take_samples
+    from mmusv.generate.mapctx import MapContext
+    from mmusv.generate.sampler import CandidateMeta
+    from mmusv.generate.spec import GenerationSpec
+
+    usvs = [v.id for v in scenario.vessels if v.role == "usv"]
+    targets = tuple(v.id for v in scenario.vessels if v.role != "usv")
+    ego = usvs[0] if usvs else scenario.vessels[0].id
+    meta = CandidateMeta(
+        combination="scenario", family="scenario", difficulty="scenario", attempt=0, ego=ego,
+        cooperating=tuple(usvs[1:]), targets=targets, primary=targets[0] if targets else ego, ranged=(),
+        distractors=(), range_m=(0.0, math.inf), occlusion_share=None,
+    )
+    spec = GenerationSpec.model_validate({"combinations": [{"family": "crossing"}]})
+    samples = take_samples(scenario, meta, MapContext(world), spec)
+    cons = spec.constraints
+    fail = InWater().check(samples)
+    if fail is not None:
+        raise ConfigError(f"{source}: in_water: {fail}; routes must stay on navigable water (--no-checks skips this)")
+    found: list[str] = []
+    for check in (ShoreClearance(cons.shore_clearance), StructureClearance(cons.structure_clearance),
+                  Separation(cons.separation)):
+        msg = check.check(samples)
+        if msg is not None:
+            found.append(f"{source}: {check.name}: {msg}")
+    for w in found:
+        warnings.warn(w, MmusvWarning, stacklevel=2)
+    return found
+
+
+def check_mounts(scenario: Scenario, *, source: str) -> list[str]:
+    """Warns (and returns the warnings) for every sensor mount farther than :data:`MOUNT_WARN_FACTOR` hull
+    lengths (at least 10 m) from its vessel's box."""
+    from mmusv.world.vessels import get_asset
+
+    found: list[str] = []
+    for v in scenario.vessels:
+        if v.role != "usv" or v.rig is None:
+            continue
+        rig = scenario.rigs[v.rig]
+        asset = get_asset(v.asset)
+        lo, hi = np.asarray(asset.bbox[0], dtype=float), np.asarray(asset.bbox[1], dtype=float)
+        limit = max(MOUNT_WARN_FACTOR * asset.length, 10.0)
+        mounts = [(f"rigs.{v.rig}.lidar.mount", rig.lidar.mount if rig.lidar else None),
+                  (f"rigs.{v.rig}.radar.mount", rig.radar.mount if rig.radar else None)]
+        mounts += [(f"rigs.{v.rig}.cameras[{i}].mount", c.mount) for i, c in enumerate(rig.cameras)]
+        for where, m in mounts:
+            if m is None:
+                continue
+            base = np.zeros(3)
+            if m.point is not None and m.point in asset.mounts:
+                base = np.asarray(asset.mounts[m.point].xyz, dtype=float)
+            p = base + np.asarray(m.xyz, dtype=float)
+            dist = float(np.linalg.norm(np.maximum(np.maximum(lo - p, p - hi), 0.0)))
+            if dist > limit:
+                found.append(f"{source}: {where} (vessel {v.id}) is {dist:.0f} m from the {asset.name} hull; "
+                             f"xyz is in metres")
+    for w in found:
+        warnings.warn(w, MmusvWarning, stacklevel=2)
+    return found

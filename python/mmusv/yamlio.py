@@ -1,0 +1,133 @@
+"""The one reader of every YAML input mmusv takes: scenarios, generation specs, rigs, asset catalogues.
+
+:func:`read_yaml` turns a file into plain Python data, or raises :class:`mmusv.ConfigError` naming the file and
+what is wrong, never a ``UnicodeDecodeError`` or a bare parser error:
+
+* bytes are decoded as UTF-8 (a UTF-8 byte-order mark is accepted); UTF-16/32 files (as some Windows editors
+  save them), Latin-1 text and binary files are refused with the byte offset of the first bad byte;
+* duplicate keys in a mapping are refused, naming the key and both lines (the YAML spec forbids them, and
+  PyYAML would silently keep the last one: two ``vessels:`` blocks would drop the first fleet);
+* syntax errors name the line and column.
+
+:func:`mapping_source` accepts a path, a dict or an already validated model, which is how ``load_scenario``
+and ``load_spec`` take their input.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from mmusv.errors import ConfigError
+
+__all__ = ["read_yaml", "parse_yaml", "mapping_source", "MAX_YAML_BYTES"]
+
+MAX_YAML_BYTES = 64 * 1024 * 1024
+"""Largest YAML input read (64 MiB): larger files are refused before they are read."""
+
+_BOMS = {
+    b"\xff\xfe\x00\x00": "UTF-32 (little-endian)",
+    b"\x00\x00\xfe\xff": "UTF-32 (big-endian)",
+    b"\xff\xfe": "UTF-16 (little-endian)",
+    b"\xfe\xff": "UTF-16 (big-endian)",
+}
+
+
+class _UniqueKeyLoader(yaml.SafeLoader):
+    """PyYAML's safe loader, refusing duplicate keys in any mapping."""
+
+
+def _construct_mapping(loader: _UniqueKeyLoader, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
+    loader.flatten_mapping(node)
+    seen: dict[Any, int] = {}
+    for key_node, _ in node.value:
+        key = loader.construct_object(key_node, deep=True)
+        try:
+            hash(key)
+        except TypeError:
+            raise yaml.constructor.ConstructorError(
+                "while constructing a mapping", node.start_mark, "found an unhashable key", key_node.start_mark
+            ) from None
+        line = key_node.start_mark.line + 1
+        if key in seen:
+            raise _DuplicateKey(f"duplicate key {key!r} at line {line} (first at line {seen[key]})")
+        seen[key] = line
+    return loader.construct_mapping(node, deep=deep)
+
+
+class _DuplicateKey(Exception):
+    pass
+
+
+_UniqueKeyLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
+
+
+def _decode(raw: bytes, where: str) -> str:
+    for bom, name in _BOMS.items():
+        if raw.startswith(bom):
+            raise ConfigError(f"{where}: the file is encoded as {name}; save it as UTF-8")
+    if raw.startswith(b"\xef\xbb\xbf"):
+        raw = raw[3:]
+    nul = raw.find(b"\x00")
+    if nul >= 0:
+        raise ConfigError(f"{where}: not a text file (a NUL byte at offset {nul}); expected UTF-8 YAML")
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        bad = raw[exc.start : exc.start + 1].hex()
+        raise ConfigError(
+            f"{where}: not UTF-8 text (byte 0x{bad} at offset {exc.start}); save the file as UTF-8"
+        ) from None
+
+
+def parse_yaml(text: str, where: str) -> Any:
+    """Parses YAML ``text`` (``where`` names it in errors), refusing duplicate keys."""
+    try:
+        return yaml.load(text, Loader=_UniqueKeyLoader)  # noqa: S506 - a SafeLoader subclass
+    except _DuplicateKey as exc:
+        raise ConfigError(f"{where}: {exc}; each key may appear once") from None
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        at = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
+        problem = exc.problem or exc.context or "unreadable"
+        raise ConfigError(f"{where}: not valid YAML{at}: {problem}") from None
+    except yaml.YAMLError as exc:
+        raise ConfigError(f"{where}: not valid YAML: {exc}") from None
+    except RecursionError:
+        raise ConfigError(f"{where}: not valid YAML: nested too deeply") from None
+
+
+def read_yaml(path: str | os.PathLike[str], *, kind: str = "YAML") -> Any:
+    """Reads and parses the YAML file ``path`` (``kind`` names it in errors: "scenario", "spec", ...)."""
+    p = Path(os.fspath(path))
+    if p.is_dir():
+        raise ConfigError(f"{kind} {str(p)!r} is a directory, not a file")
+    if not p.is_file():
+        raise ConfigError(f"{kind} file {str(p)!r} does not exist")
+    try:
+        size = p.stat().st_size
+        if size > MAX_YAML_BYTES:
+            raise ConfigError(f"{p}: {size} bytes; a {kind} file may be at most {MAX_YAML_BYTES} bytes")
+        raw = p.read_bytes()
+    except OSError as exc:
+        raise ConfigError(f"{kind} file {str(p)!r} cannot be read: {exc.strerror or exc}") from None
+    return parse_yaml(_decode(raw, str(p)), str(p))
+
+
+def mapping_source(source: Any, *, kind: str, root_hint: str) -> tuple[dict[str, Any], str]:
+    """``(data, where)`` for a path or a dict: the mapping to validate and how errors name it. ``root_hint``
+    says what the mapping needs (``"at least `vessels:`"``)."""
+    if isinstance(source, dict):
+        data: Any = source
+        where = kind
+    elif isinstance(source, (str, os.PathLike)):
+        data = read_yaml(source, kind=kind)
+        where = str(Path(os.fspath(source)))
+    else:
+        raise ConfigError(f"a {kind} is a YAML path, a dict or a validated model, not {type(source).__name__}")
+    if not isinstance(data, dict):
+        raise ConfigError(f"{where}: a {kind} must be a YAML mapping with {root_hint}")
+    return data, where
