@@ -27,7 +27,7 @@ import yaml
 
 from mmusv.annotate import Annotations, SilhouetteCache, annotate_agent
 from mmusv.config import Scenario, load_scenario, scenario_hash
-from mmusv.errors import ConfigError, IoError, MmusvError
+from mmusv.errors import ConfigError, IoError, MmusvError, located
 from mmusv.scenario_checks import check_mounts, check_routes
 from mmusv.simulation import FrameCapture, Simulation
 
@@ -174,7 +174,7 @@ def run(
     try:  # builds the world: any remaining config problem surfaces here, before writing
         sim = Simulation(scenario)
     except MmusvError as exc:
-        raise type(exc)(f"{source}: {exc}" if not str(exc).startswith(source) else str(exc)) from None
+        raise located(exc, source) from None
     if checks:
         check_mounts(scenario, source=source)
         check_routes(scenario, sim.world, source=source)
@@ -217,7 +217,7 @@ def run(
         result.error = f"{type(exc).__name__}: {exc}"
         raise
     finally:
-        summary = recorder.finish(status=result.status, frames=result.frames_written, error=result.error)
+        summary = recorder.finish(status=result.status, frames=result.frames_written, error=result.error, requested=total)
         result.messages, result.bytes = summary.get("messages", 0), summary.get("bytes", 0)
         tables.flush()
         result.seconds = time.perf_counter() - t0

@@ -67,7 +67,7 @@ def _cmd_study_waves(args: argparse.Namespace) -> int:
     return 0
 
 
-def _run_one(path: str, out: str, overwrite: bool, frames: int | None, show_progress: bool) -> str:
+def _run_one(path: str, out: str, overwrite: bool, frames: int | None, show_progress: bool, checks: bool = True) -> str:
     """Runs one scenario; returns a one-line report. Used directly and in worker processes."""
     from mmusv.acquire import run
     from mmusv.config import load_scenario
@@ -79,7 +79,7 @@ def _run_one(path: str, out: str, overwrite: bool, frames: int | None, show_prog
         with Progress(TextColumn(f"[bold]{scenario.name}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn()) as bar:
             task = bar.add_task("frames", total=frames or scenario.acquisition.frames)
             try:
-                res = run(scenario, out_dir=out, overwrite=overwrite, frames=frames,
+                res = run(path, out_dir=out, overwrite=overwrite, frames=frames, checks=checks,
                           progress=lambda done, total: bar.update(task, completed=done))
             except KeyboardInterrupt:
                 from mmusv.acquire import recording_path
@@ -88,33 +88,75 @@ def _run_one(path: str, out: str, overwrite: bool, frames: int | None, show_prog
                 print(f"mmusv: interrupted; {rec} is a valid recording holding every completed frame", file=sys.stderr)
                 raise
     else:
-        res = run(scenario, out_dir=out, overwrite=overwrite, frames=frames)
+        res = run(path, out_dir=out, overwrite=overwrite, frames=frames, checks=checks)
     fps = res.frames_written / res.seconds if res.seconds > 0 else float("nan")
     return (f"{scenario.name}: {res.frames_written} frames in {res.seconds:.1f} s ({fps:.2f} frames/s), "
             f"{res.messages} messages, {res.bytes / 1e6:.1f} MB -> {res.recording}")
 
 
+def _run_one_safe(path: str, out: str, overwrite: bool, frames: int | None, checks: bool) -> tuple[str, str]:
+    """``(status, message)`` of one scenario of a folder run: never raises, so nothing has to be pickled back
+    from a worker but two strings. ``status``: ``done`` or ``failed``; a failure names its file."""
+    import warnings
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return "done", _run_one(path, out, overwrite, frames, False, checks)
+    except MmusvError as exc:
+        msg = str(exc)
+        return "failed", msg if path in msg else f"{path}: {msg}"
+    except Exception as exc:  # a bug, not bad input: still reported per file, with its type
+        return "failed", f"{path}: internal error {type(exc).__name__}: {exc}"
+
+
 def _cmd_run(args: argparse.Namespace) -> int:
     src = Path(args.scenario)
+    checks = not args.no_checks
     if src.is_dir():
         files = sorted(p for p in src.glob("*.yaml") if p.name != "report.yaml")
         if not files:
             raise MmusvError(f"{src} holds no *.yaml scenarios")
         jobs = max(1, int(args.jobs))
         outs = [str(Path(args.output) / f.stem) for f in files]
+        results: list[tuple[str, str]] = []
         if jobs == 1:
             for f, o in zip(files, outs, strict=True):
-                print(_run_one(str(f), o, args.overwrite, args.frames, sys.stdout.isatty()))
+                results.append(_run_one_safe(str(f), o, args.overwrite, args.frames, checks))
+                print(results[-1][1])
         else:
+            import multiprocessing
             from concurrent.futures import ProcessPoolExecutor
 
-            with ProcessPoolExecutor(max_workers=jobs) as pool:
-                futures = [pool.submit(_run_one, str(f), o, args.overwrite, args.frames, False) for f, o in zip(files, outs, strict=True)]
+            # spawn, not fork: the parent already runs the core's thread pool, and a forked copy of a process with
+            # threads can deadlock on a lock another thread held
+            ctx = multiprocessing.get_context("spawn")
+            with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
+                futures = [pool.submit(_run_one_safe, str(f), o, args.overwrite, args.frames, checks)
+                           for f, o in zip(files, outs, strict=True)]
                 for fut in futures:
-                    print(fut.result())
-        return 0
-    print(_run_one(str(src), args.output, args.overwrite, args.frames, True))
+                    results.append(fut.result())
+                    print(results[-1][1])
+        return _report_folder(files, results)
+    print(_run_one(str(src), args.output, args.overwrite, args.frames, sys.stdout.isatty(), checks))
     return 0
+
+
+def _report_folder(files: list[Path], results: list[tuple[str, str]]) -> int:
+    """Prints the table of a folder run (file, status, message); returns 1 if any scenario failed."""
+    from rich.table import Table
+
+    table = Table(title="mmusv run: folder")
+    for col in ("scenario", "status", "result"):
+        table.add_column(col, overflow="fold")
+    for f, (status, msg) in zip(files, results, strict=True):
+        colour = "green" if status == "done" else "red"
+        table.add_row(f.name, f"[{colour}]{status}[/{colour}]", msg)
+    console = _console()
+    console.print(table)
+    failed = sum(1 for st, _ in results if st != "done")
+    console.print(f"{len(results) - failed} done, {failed} failed")
+    return 1 if failed else 0
 
 
 def _cmd_info(args: argparse.Namespace) -> int:
@@ -189,6 +231,8 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--overwrite", action="store_true", help="replace an existing recording")
     run.add_argument("--frames", type=int, default=None, help="run only the first N frames")
     run.add_argument("--jobs", type=int, default=1, help="for a folder: scenarios run in parallel processes (default 1)")
+    run.add_argument("--no-checks", action="store_true",
+                     help="skip the route checks on the map (in water: an error; clearances, separation: warnings)")
     info = sub.add_parser("info", help="agents, topics, frames and duration of a recording")
     info.add_argument("recording", help="an .mcap written by mmusv run")
     prev = sub.add_parser("preview", help="one picture of a recorded frame (surround RGB, depth, semantic, PPI, BEV)")
@@ -207,6 +251,15 @@ def _parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``mmusv`` command; returns the exit status."""
     args = _parser().parse_args(sys.argv[1:] if argv is None else argv)
+    import warnings
+
+    from mmusv.scenario_checks import MmusvWarning
+
+    def _show(message: Warning | str, category: type[Warning], *rest: object, **kw: object) -> None:
+        prefix = "mmusv: warning: " if issubclass(category, MmusvWarning) else f"{category.__name__}: "
+        print(prefix + str(message), file=sys.stderr)
+
+    warnings.showwarning = _show  # one line per warning, never a source excerpt
     try:
         if args.command == "version":
             from mmusv import __version__

@@ -75,6 +75,17 @@ class EnvironmentConfig(_Model):
     latitude_deg: float = Field(default=45.0, ge=-90, le=90)
     day_of_year: int = Field(default=172, ge=1, le=366)
 
+    @field_validator("time_of_day")
+    @classmethod
+    def _time(cls, v: str) -> str:
+        from mmusv.world.environment import _parse_time
+
+        try:
+            _parse_time(v)
+        except ConfigError:
+            raise ValueError('use 24-hour "HH:MM", e.g. "16:30"') from None
+        return v
+
     @field_validator("wave")
     @classmethod
     def _wave(cls, v: str | float) -> str | float:

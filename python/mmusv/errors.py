@@ -25,3 +25,14 @@ __all__ = [
     "IoError",
     "InternalError",
 ]
+
+
+def located(exc: MmusvError, source: str) -> MmusvError:
+    """``exc`` with ``source`` (a file name) in front of its message, as the nearest class of the core tree
+    (``ConfigError``, ``InputError``, ...), so subclasses whose constructors take other arguments work too.
+    Returned unchanged when the message already names ``source``."""
+    msg = str(exc)
+    if source in msg:
+        return exc
+    base = next(c for c in type(exc).__mro__ if c.__module__ == core.__name__)
+    return base(f"{source}: {msg}")  # type: ignore[no-any-return]

@@ -160,12 +160,14 @@ class FrameRecorder:
 
     # ------------------------------------------------------------------------------------------ end
 
-    def finish(self, *, status: str, frames: int, error: str | None = None) -> dict[str, Any]:
+    def finish(self, *, status: str, frames: int, error: str | None = None, requested: int | None = None) -> dict[str, Any]:
         """Writes the ``run`` metadata and completes the file (also after an interruption: the file then holds
         every completed frame and says ``status: interrupted``)."""
         sc = self.sim.scenario
         meta = {"scenario": sc.name, "status": status, "frames_written": frames, "frames_configured": sc.acquisition.frames,
                 "frequency_hz": sc.acquisition.frequency_hz, "agents": ",".join(a.id for a in self.sim.agents)}
+        if requested is not None:  # a run limited to its first N frames (--frames N)
+            meta["frames_requested"] = requested
         if error:
             meta["error"] = error
         self.rec.metadata("run", meta)

@@ -224,7 +224,8 @@ def convert(
         for k, why in incomplete:
             rep.skipped.append({"frames": [k, k], "reason": why})
         seen = set(converted) | {k for k, _ in incomplete}
-        configured = int(stream.run.get("frames_configured", info.frames_configured) or 0)
+        # the frames the run set out to write: --frames N cuts a run short on purpose, those after N are not missing
+        configured = int(stream.run.get("frames_requested", stream.run.get("frames_configured", info.frames_configured)) or 0)
         absent = [k for k in range(configured) if k not in seen]
         if absent:
             written = stream.run.get("frames_written")

@@ -1,0 +1,242 @@
+"""Every class of malformed input of issue #14 gets a clear MmusvError naming file and field, nothing written,
+and the CLI prints one line and exits 2 (or, for a folder run, reports each file and keeps going)."""
+
+from __future__ import annotations
+
+import pickle
+import warnings
+from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
+
+import mmusv
+from mmusv.cli import main
+from mmusv.config import load_scenario
+from mmusv.errors import ConfigError, MmusvError
+from mmusv.generate.layout import SamplingError
+from mmusv.generate.planner import PlannerError
+from mmusv.generate.spec import load_spec
+from mmusv.scenario_checks import MmusvWarning
+from mmusv.world.vessel_shapes import AssetSpecError
+from mmusv.world.vessels import UnknownAssetError, get_asset
+
+ROOT = Path(__file__).resolve().parents[2]
+PORT = ROOT / "scenarios/port_entry.yaml"
+SPEC = ROOT / "scenarios/specs/island_demo.yaml"
+
+
+def tiny(**changes: Any) -> dict[str, Any]:
+    """A fast open-sea scenario (LiDAR only, 2 frames); keyword arguments replace top-level keys."""
+    d: dict[str, Any] = {
+        "name": "tiny", "seed": 1, "map": {"type": "open_sea", "seed": 0}, "acquisition": {"frames": 2},
+        "rigs": {"r": {"preset": "lidar_only", "lidar": {"channels": 8, "points_per_second": 8 * 64 * 5}}},
+        "vessels": [
+            {"id": "u", "role": "usv", "asset": "usv_wamv", "rig": "r", "speed_mps": 2, "route": [[0, 0], [50, 0]]},
+            {"id": "t", "asset": "fishing_boat_12m", "speed_mps": 3, "route": [[0, 60], [60, 60]]},
+        ],
+    }
+    d.update(changes)
+    return d
+
+
+def write(path: Path, data: dict[str, Any]) -> Path:
+    path.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+    return path
+
+
+def cli_error(capsys: pytest.CaptureFixture[str], argv: list[str]) -> str:
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("mmusv: error: ") and "\n" not in err and "Traceback" not in err, err
+    return err
+
+
+# ---------------------------------------------------------------------------------------------- encodings
+
+
+@pytest.mark.parametrize(
+    ("encode", "expect"),
+    [
+        (lambda t: t.encode("latin-1"), "not UTF-8 text (byte 0xe9"),
+        (lambda t: t.encode("utf-16"), "UTF-16"),
+        (lambda t: b"\x89PNG\r\n\x1a\n\x00\x00\x00" + bytes(range(256)), "not a text file"),
+    ],
+    ids=["latin1", "utf16", "binary"],
+)
+def test_bad_encodings_are_config_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str], encode: Any, expect: str) -> None:
+    text = PORT.read_text(encoding="utf-8").replace("# Port map", "# Port map, café")
+    f = tmp_path / "bad.yaml"
+    f.write_bytes(encode(text))
+    with pytest.raises(ConfigError, match="bad.yaml") as exc:
+        load_scenario(f)
+    assert expect in str(exc.value)
+    with pytest.raises(ConfigError, match="bad.yaml"):
+        load_spec(f)
+    err = cli_error(capsys, ["run", str(f), "-o", str(tmp_path / "out")])
+    assert "bad.yaml" in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_utf8_bom_is_accepted(tmp_path: Path) -> None:
+    f = tmp_path / "bom.yaml"
+    f.write_bytes(b"\xef\xbb\xbf" + PORT.read_bytes())
+    assert load_scenario(f) == load_scenario(PORT)
+
+
+def test_duplicate_keys_are_refused(tmp_path: Path) -> None:
+    text = PORT.read_text(encoding="utf-8") + "vessels:\n  - {id: x, asset: tug_32m, route: [[0, 0], [1, 0]]}\n"
+    f = tmp_path / "dup.yaml"
+    f.write_text(text, encoding="utf-8")
+    with pytest.raises(ConfigError, match=r"dup.yaml: duplicate key 'vessels' at line \d+ \(first at line \d+\)"):
+        load_scenario(f)
+
+
+def test_yaml_syntax_errors_name_line_and_column(tmp_path: Path) -> None:
+    f = tmp_path / "syntax.yaml"
+    f.write_text("name: x\nvessels: [{id: a,\n", encoding="utf-8")
+    with pytest.raises(ConfigError, match=r"syntax.yaml: not valid YAML at line \d+, column \d+"):
+        load_scenario(f)
+
+
+# ---------------------------------------------------------------------------------------------- numbers
+
+
+@pytest.mark.parametrize("value", [float("inf"), float("-inf"), float("nan")])
+def test_non_finite_numbers_are_refused_with_the_field(value: float) -> None:
+    d = tiny()
+    d["rigs"]["r"]["lidar"]["points_per_second"] = value
+    with pytest.raises(ConfigError, match=r"rigs\.r\.lidar\.points_per_second = .*finite number"):
+        load_scenario(d)
+    d = tiny(environment={"visibility_m": value})
+    with pytest.raises(ConfigError, match=r"environment\.visibility_m = .*finite"):
+        load_scenario(d)
+
+
+def test_spec_ranges_with_infinite_bounds_are_refused() -> None:
+    d = yaml.safe_load(SPEC.read_text(encoding="utf-8"))
+    d["usv"]["speed_mps"] = [1.0, float("inf")]
+    with pytest.raises(ConfigError, match=r"usv\.speed_mps.*finite"):
+        load_spec(d)
+
+
+@pytest.mark.parametrize(
+    ("rig", "field"),
+    [
+        ({"cameras": [{"name": "c", "resolution": [16384, 16384]}]}, r"cameras\.0\.resolution|cameras\[0\]\.resolution"),
+        ({"lidar": {"channels": 1024, "points_per_second": 1024 * 65536 * 5.0}}, r"lidar"),
+        ({"radar": {"azimuth_bins": 65536, "rays_az": 64, "rays_el": 256}}, r"radar"),
+        ({"top_view": {"resolution": [16000, 16000]}}, r"top_view\.resolution"),
+    ],
+)
+def test_allocation_sizes_are_bounded_by_their_cost(rig: dict[str, Any], field: str) -> None:
+    with pytest.raises(ConfigError, match=field) as exc:
+        load_scenario(tiny(rigs={"r": rig}))
+    assert "GB" in str(exc.value)
+
+
+def test_tiny_check_step_is_refused_before_allocating() -> None:
+    d = yaml.safe_load(SPEC.read_text(encoding="utf-8"))
+    d["check_step_m"] = 0.001
+    with pytest.raises(ConfigError, match=r"check_step_m = 0\.001"):
+        load_spec(d)
+
+
+# ---------------------------------------------------------------------------------------------- semantics
+
+
+def test_a_rig_on_a_vessel_that_is_not_a_usv_is_an_error() -> None:
+    d = tiny()
+    d["vessels"][1]["rig"] = "r"
+    with pytest.raises(ConfigError, match=r"vessels\[1\]\.rig = 'r': only instrumented vessels \(role: usv\)"):
+        load_scenario(d)
+
+
+def test_an_unknown_mount_point_lists_the_assets_points() -> None:
+    d = tiny()
+    d["rigs"]["r"]["lidar"]["mount"] = {"point": "lidr"}
+    with pytest.raises(ConfigError, match=r"rigs\.r\.lidar\.mount\.point = 'lidr'.*did you mean 'lidar'.*its points: camera_front"):
+        load_scenario(d)
+
+
+def test_a_mount_kilometres_away_is_a_warning_naming_it(tmp_path: Path) -> None:
+    d = tiny()
+    d["rigs"]["r"]["lidar"]["mount"] = {"xyz": [0.0, 0.0, 2300.0]}  # millimetres typed as metres
+    with pytest.warns(MmusvWarning, match=r"rigs\.r\.lidar\.mount \(vessel u\) is \d+ m from the usv_wamv hull"):
+        mmusv.run(d, out_dir=tmp_path / "o")
+
+
+def test_a_route_over_land_is_an_error_unless_checks_are_off(tmp_path: Path) -> None:
+    d = tiny(map={"type": "island", "seed": 4})
+    d["vessels"][0]["route"] = [[460, -330], [500, -200]]  # across the islet of island map 4
+    with pytest.raises(ConfigError, match=r"in_water: u leaves navigable water"):
+        mmusv.run(d, out_dir=tmp_path / "o")
+    assert not (tmp_path / "o").exists()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = mmusv.run(d, out_dir=tmp_path / "o2", checks=False)
+    assert res.frames_written == 2
+
+
+def test_close_passes_are_warnings(tmp_path: Path) -> None:
+    d = tiny()
+    d["vessels"][1]["route"] = [[0, 8], [60, 8]]  # 8 m abeam of the USV
+    with pytest.warns(MmusvWarning, match="separation"):
+        mmusv.run(d, out_dir=tmp_path / "o")
+
+
+def test_generation_spec_shares_the_scenario_field_types() -> None:
+    d = yaml.safe_load(SPEC.read_text(encoding="utf-8"))
+    d["environment"]["time_of_day"] = ["7:30 pm"]
+    with pytest.raises(ConfigError, match=r"environment\.time_of_day = '7:30 pm': use 24-hour"):
+        load_spec(d)
+    with pytest.raises(ConfigError, match=r"environment\.time_of_day"):
+        load_scenario(tiny(environment={"time_of_day": "7:30 pm"}))
+
+
+# ---------------------------------------------------------------------------------------------- where
+
+
+def test_world_build_errors_name_the_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    f = write(tmp_path / "bad_map.yaml", tiny(map={"type": "port", "seed": 3, "params": {"n_moored": 999}}))
+    err = cli_error(capsys, ["run", str(f), "-o", str(tmp_path / "out")])
+    assert "bad_map.yaml" in err and "n_moored" in err
+
+
+def test_run_of_a_directory_says_so(tmp_path: Path) -> None:
+    with pytest.raises(ConfigError, match="is a directory; mmusv.run takes one scenario file"):
+        mmusv.run(tmp_path, out_dir=tmp_path / "o")
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_folder_runs_report_each_file_and_keep_going(tmp_path: Path, capsys: pytest.CaptureFixture[str], jobs: int) -> None:
+    src = tmp_path / "src"
+    src.mkdir()
+    write(src / "a_good.yaml", tiny(name="a_good"))
+    write(src / "b_bad.yaml", tiny(name="b_bad", map={"type": "port", "seed": 3, "params": {"n_moored": 999}}))
+    (src / "c_broken.yaml").write_bytes("name: c\nvessels: ]\n".encode())
+    write(src / "d_good.yaml", tiny(name="d_good"))
+    assert main(["run", str(src), "-o", str(tmp_path / "out"), "--jobs", str(jobs)]) == 1
+    out = capsys.readouterr().out
+    assert "Traceback" not in out and "BrokenProcessPool" not in out
+    assert "b_bad.yaml" in out and "c_broken.yaml" in out and "2 done, 2 failed" in out
+    assert (tmp_path / "out/a_good/a_good.mcap").is_file() and (tmp_path / "out/d_good/d_good.mcap").is_file()
+    assert not (tmp_path / "out/b_bad").exists() and not (tmp_path / "out/c_broken").exists()
+
+
+def test_every_error_class_is_an_mmusv_error_and_pickles() -> None:
+    errors: list[Exception] = [
+        ConfigError("f.yaml: invalid config x = 1: y"),
+        AssetSpecError("tug.hull.beam", "must be positive"),
+        SamplingError("no water"),
+        PlannerError("no route"),
+    ]
+    with pytest.raises(UnknownAssetError) as exc:
+        get_asset("tugg_32m")
+    errors.append(exc.value)
+    for e in errors:
+        assert isinstance(e, MmusvError), type(e)
+        back = pickle.loads(pickle.dumps(e))
+        assert type(back) is type(e) and str(back) == str(e)
+    assert isinstance(exc.value, KeyError)  # still what callers caught before
