@@ -111,7 +111,7 @@ def fit_box(xy: np.ndarray, *, z_low: float, z_high: float, min_width_m: float =
     else:  # a segment or a point
         c = np.asarray(rect.coords) if rect.geom_type == "LineString" else pts[:1]
         e1 = c[-1] - c[0] if len(c) > 1 else np.array([0.0, 0.0])
-        e2 = np.array([-e1[1], e1[0]])
+        e2 = np.zeros(2)  # no extent across
         centre = c.mean(axis=0)
     if np.hypot(*e2) > np.hypot(*e1):
         e1, e2 = e2, e1
