@@ -6,9 +6,14 @@ import math
 
 import numpy as np
 import pytest
-
 from mmusv.studies.detection.evaluate import (
-    FrameMatch, average_precision, bev_iou, match_frame, range_bin, summarize, voc_ap,
+    FrameMatch,
+    average_precision,
+    bev_iou,
+    match_frame,
+    range_bin,
+    summarize,
+    voc_ap,
 )
 
 
@@ -150,10 +155,11 @@ def _clip(subject: list[tuple[float, float]], clipper: list[tuple[float, float]]
     for i in range(len(clipper)):
         a, b = clipper[i], clipper[(i + 1) % len(clipper)]
 
-        def inside(p: tuple[float, float]) -> bool:
+        def inside(p: tuple[float, float], a: tuple[float, float] = a, b: tuple[float, float] = b) -> bool:
             return (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]) >= 0
 
-        def cut(p: tuple[float, float], q: tuple[float, float]) -> tuple[float, float]:
+        def cut(p: tuple[float, float], q: tuple[float, float], a: tuple[float, float] = a,
+                b: tuple[float, float] = b) -> tuple[float, float]:
             d1 = (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
             d2 = (b[0] - a[0]) * (q[1] - a[1]) - (b[1] - a[1]) * (q[0] - a[0])
             t = d1 / (d1 - d2)

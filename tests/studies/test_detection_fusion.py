@@ -2,17 +2,36 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 import pytest
-
 from mmusv.errors import InputError
 from mmusv.frames import invert, pose_matrices, transform_points
-from mmusv.studies.detection.data import AgentFrame, SceneFrame, SequenceData, boxes_in_frame, gt_in_ego
-from mmusv.studies.detection.detector import BaselineParams, baseline_detect, fit_box, load_detector, water_plane
+from mmusv.studies.detection.data import (
+    AgentFrame,
+    SceneFrame,
+    SequenceData,
+    boxes_in_frame,
+    gt_in_ego,
+)
+from mmusv.studies.detection.detector import (
+    BaselineParams,
+    baseline_detect,
+    fit_box,
+    load_detector,
+    water_plane,
+)
 from mmusv.studies.detection.evaluate import bev_iou
-from mmusv.studies.detection.fusion import early_points, fuse, parse_modes, relative, rotated_nms, transform_boxes
+from mmusv.studies.detection.fusion import (
+    early_points,
+    fuse,
+    parse_modes,
+    relative,
+    rotated_nms,
+    transform_boxes,
+)
 from mmusv.studies.detection.robustness import Setting, neighbours_for, parse_settings
 
 MOUNT = pose_matrices([0.45, 0.0, 2.3, 0.0, 0.0, 0.0])
@@ -128,7 +147,7 @@ def test_late_and_early_fusion_find_what_only_the_neighbour_sees() -> None:
     none = fuse("none", ego, [nb], detector=baseline_detect)
     assert len(none[0]) == 0  # the ego sees only water
     for mode in ("late", "early"):
-        boxes, scores = fuse(mode, ego, [nb], detector=baseline_detect)
+        boxes, _ = fuse(mode, ego, [nb], detector=baseline_detect)
         assert len(boxes) == 1, mode
         assert bev_iou(boxes, gt)[0, 0] > 0.7, mode
     pts = early_points(ego, [nb], crop_m=1000.0)
@@ -145,7 +164,8 @@ def test_late_fusion_merges_duplicates_with_rotated_nms() -> None:
         return answers[id(points)]
 
     boxes, scores = fuse("late", ego, [nb], detector=stub)
-    assert len(boxes) == 1 and scores[0] == 0.9
+    assert len(boxes) == 1
+    assert scores[0] == 0.9
     assert np.allclose(boxes[0, :3], gt[0, :3], atol=1e-9)
 
 
@@ -215,5 +235,5 @@ def test_parse_settings() -> None:
 
 
 def test_baseline_params_are_frozen() -> None:
-    with pytest.raises(Exception):
+    with pytest.raises(dataclasses.FrozenInstanceError):
         BaselineParams().gap_m = 3.0  # type: ignore[misc]

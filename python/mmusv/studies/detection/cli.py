@@ -58,7 +58,6 @@ def add_parsers(studies: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     """Runs ``mmusv study detection|robustness``; returns the exit status."""
     from rich.console import Console
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
     from mmusv.errors import InputError
     from mmusv.export.splits import parse_ratios
@@ -131,7 +130,14 @@ class _bar:
     def __enter__(self) -> tuple[Any, Any]:
         if self.off:
             return None, None
-        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+        from rich.progress import (
+            BarColumn,
+            MofNCompleteColumn,
+            Progress,
+            TextColumn,
+            TimeElapsedColumn,
+            TimeRemainingColumn,
+        )
 
         self.progress = Progress(TextColumn(f"[bold]{self.title}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
                                  TimeRemainingColumn(), console=self.console, transient=True)

@@ -23,8 +23,19 @@ import yaml
 from mmusv.errors import InputError, IoError
 from mmusv.frames import carla_matrix, invert, mirror_transform, pose_matrices
 
-__all__ = ["AgentFrame", "SceneFrame", "SequenceData", "read_recording", "read_opv2v", "opv2v_scenarios",
-           "split_sequences", "gt_in_ego", "usv_boxes_in_ego", "boxes_in_frame", "OPV2V_USV_RADIUS_M"]
+__all__ = [
+    "OPV2V_USV_RADIUS_M",
+    "AgentFrame",
+    "SceneFrame",
+    "SequenceData",
+    "boxes_in_frame",
+    "gt_in_ego",
+    "opv2v_scenarios",
+    "read_opv2v",
+    "read_recording",
+    "split_sequences",
+    "usv_boxes_in_ego",
+]
 
 OPV2V_USV_RADIUS_M = 8.0
 """An OPV2V folder gives no hull size for its CAVs: their platform is taken as a disc of this radius."""
@@ -107,7 +118,10 @@ def _box_mats(poses: np.ndarray, centres: np.ndarray) -> np.ndarray:
 def read_recording(path: str | Path) -> SequenceData:
     """A recording (``mmusv run`` MCAP) as a sequence: every frame with the LiDAR of every instrumented USV that
     has one. Raises :class:`~mmusv.IoError` for a file that is not a readable recording."""
-    from mmusv.export.reader import FrameStream, read_info  # the recording reader (moving to mmusv.recording)
+    from mmusv.export.reader import (  # the recording reader (moving to mmusv.recording)
+        FrameStream,
+        read_info,
+    )
     from mmusv.preview import decode_point_cloud
 
     info = read_info(path)

@@ -42,8 +42,15 @@ from scipy.spatial import cKDTree
 
 from mmusv.errors import ConfigError
 
-__all__ = ["Detector", "BaselineParams", "baseline_detect", "water_plane", "fit_box", "load_detector",
-           "BASELINE_NOTE"]
+__all__ = [
+    "BASELINE_NOTE",
+    "BaselineParams",
+    "Detector",
+    "baseline_detect",
+    "fit_box",
+    "load_detector",
+    "water_plane",
+]
 
 Detector = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
 """``(points (N, 4) float32 ego LiDAR frame) -> (boxes (M, 7), scores (M,))``."""
@@ -126,8 +133,7 @@ def fit_box(xy: np.ndarray, *, z_low: float, z_high: float, min_width_m: float =
     if width < min_width_m:
         centre = centre + v * out_dir * (min_width_m - width) / 2.0
         width = min_width_m
-    if length < min_length_m:
-        length = min_length_m
+    length = max(length, min_length_m)
     yaw = float(np.arctan2(u[1], u[0]))
     if yaw <= -np.pi / 2:
         yaw += np.pi

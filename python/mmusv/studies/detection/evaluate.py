@@ -26,8 +26,18 @@ import shapely
 from shapely.geometry import Polygon
 
 __all__ = [
-    "IOU_THRESHOLDS", "RANGE_BINS", "BOX_COLUMNS", "FrameMatch", "box_polygons", "bev_iou", "match_frame",
-    "voc_ap", "average_precision", "range_bin", "bin_label", "summarize",
+    "BOX_COLUMNS",
+    "IOU_THRESHOLDS",
+    "RANGE_BINS",
+    "FrameMatch",
+    "average_precision",
+    "bev_iou",
+    "bin_label",
+    "box_polygons",
+    "match_frame",
+    "range_bin",
+    "summarize",
+    "voc_ap",
 ]
 
 IOU_THRESHOLDS = (0.3, 0.5, 0.7)

@@ -22,7 +22,7 @@ from mmusv.studies.detection.data import AgentFrame
 from mmusv.studies.detection.detector import Detector
 from mmusv.studies.detection.evaluate import bev_iou
 
-__all__ = ["MODES", "NMS_IOU", "relative", "transform_boxes", "rotated_nms", "fuse", "parse_modes"]
+__all__ = ["MODES", "NMS_IOU", "fuse", "parse_modes", "relative", "rotated_nms", "transform_boxes"]
 
 MODES = ("none", "late", "early")
 NMS_IOU = 0.10
@@ -49,10 +49,10 @@ def relative(ego: AgentFrame, other: AgentFrame) -> np.ndarray:
 def transform_boxes(m: np.ndarray, boxes: np.ndarray) -> np.ndarray:
     """``(M, 7)`` boxes moved by the rigid ``(4, 4)`` transform ``m``: centres transformed, yaw = heading of the
     transformed box x axis in the target xy plane; sizes unchanged."""
-    b = np.asarray(boxes, dtype=np.float64).reshape(-1, 7)
+    b: np.ndarray = np.asarray(boxes, dtype=np.float64).reshape(-1, 7)
+    out: np.ndarray = b.copy()
     if b.shape[0] == 0:
-        return b.copy()
-    out = b.copy()
+        return out
     out[:, :3] = transform_points(m, b[:, :3])
     heading = np.column_stack([np.cos(b[:, 6]), np.sin(b[:, 6]), np.zeros(len(b))]) @ m[:3, :3].T
     out[:, 6] = np.arctan2(heading[:, 1], heading[:, 0])

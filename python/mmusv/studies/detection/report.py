@@ -11,7 +11,7 @@ from mmusv.studies.detection.detector import BASELINE_NOTE
 from mmusv.studies.detection.evaluate import RANGE_BINS, bin_label
 from mmusv.studies.detection.study import StudyResult
 
-__all__ = ["detection_table", "robustness_table", "write_detection", "write_robustness", "fmt"]
+__all__ = ["detection_table", "fmt", "robustness_table", "write_detection", "write_robustness"]
 
 BINS = [bin_label(k) for k in range(len(RANGE_BINS))]
 

@@ -20,7 +20,7 @@ from mmusv.errors import InputError
 from mmusv.frames import matrix_to_pose, pose_matrices
 from mmusv.studies.detection.data import AgentFrame, SequenceData
 
-__all__ = ["Setting", "DEFAULT_SETTINGS", "parse_settings", "neighbours_for"]
+__all__ = ["DEFAULT_SETTINGS", "Setting", "neighbours_for", "parse_settings"]
 
 
 @dataclass(frozen=True)

@@ -16,9 +16,15 @@ from typing import Any
 import yaml
 
 from mmusv.errors import InputError, IoError
-from mmusv.studies.detection.data import SequenceData, opv2v_scenarios, read_opv2v, read_recording, split_sequences
+from mmusv.studies.detection.data import (
+    SequenceData,
+    opv2v_scenarios,
+    read_opv2v,
+    read_recording,
+    split_sequences,
+)
 
-__all__ = ["BUNDLED_SPEC", "Dataset", "resolve_dataset", "generate_dataset", "lidar_only"]
+__all__ = ["BUNDLED_SPEC", "Dataset", "generate_dataset", "lidar_only", "resolve_dataset"]
 
 BUNDLED_SPEC = "scenarios/specs/coop_detection.yaml"
 """The bundled detection dataset spec (run from the repository root)."""

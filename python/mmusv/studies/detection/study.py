@@ -31,15 +31,27 @@ import polars as pl
 import shapely
 
 from mmusv.errors import InputError
-from mmusv.studies.detection.data import AgentFrame, SceneFrame, SequenceData, gt_in_ego, usv_boxes_in_ego
+from mmusv.studies.detection.data import (
+    AgentFrame,
+    SceneFrame,
+    SequenceData,
+    gt_in_ego,
+    usv_boxes_in_ego,
+)
 from mmusv.studies.detection.detector import Detector
 from mmusv.studies.detection.evaluate import (
-    BOX_COLUMNS, RANGE_BINS, FrameMatch, bin_label, box_polygons, range_bin, summarize,
+    BOX_COLUMNS,
+    RANGE_BINS,
+    FrameMatch,
+    bin_label,
+    box_polygons,
+    range_bin,
+    summarize,
 )
 from mmusv.studies.detection.fusion import MODES, _as_boxes, fuse
 from mmusv.studies.detection.robustness import Setting, neighbours_for
 
-__all__ = ["StudyOptions", "StudyResult", "run_study", "load_predictions", "gt_visibility"]
+__all__ = ["StudyOptions", "StudyResult", "gt_visibility", "load_predictions", "run_study"]
 
 Key = tuple[str, str]  # (setting name, mode)
 
@@ -120,7 +132,7 @@ def load_predictions(path: str | Path) -> dict[tuple[str, int, str, str, str], t
         raise InputError(f"--predictions {p}: no such file")
     try:
         df = pl.read_parquet(p)
-    except Exception as exc:  # polars raises several kinds for a file that is not Parquet
+    except (OSError, pl.exceptions.PolarsError) as exc:
         raise InputError(f"--predictions {p}: not a readable Parquet file ({type(exc).__name__})") from None
     need = ["sequence", "frame", "ego", "mode", *BOX_COLUMNS, "score"]
     missing = [c for c in need if c not in df.columns]
@@ -188,15 +200,7 @@ def run_study(
             raise InputError(f"sequence {seq.name}: {len(seq.agent_ids)} instrumented USV(s) with a LiDAR; "
                              f"{'/'.join(fusion)} fusion needs at least 2 (use --modes none)")
         res.sequences.append(seq.name)
-        cache: dict[tuple[str, int], tuple[np.ndarray, np.ndarray]] = {}
-
-        def own(a: AgentFrame) -> tuple[np.ndarray, np.ndarray]:
-            key = (a.id, id(a.points))
-            if key not in cache:
-                assert o.detector is not None
-                cache[key] = _as_boxes(o.detector(a.points))
-            return cache[key]
-
+        own = _OwnDetections(o.detector)
         for t in range(start, len(seq.frames)):
             frame = seq.frames[t]
             res.frames += 1
@@ -209,6 +213,23 @@ def run_study(
         raise InputError("--predictions: no row matches any (sequence, frame, ego, mode) evaluated; check the "
                          f"sequence names ({', '.join(res.sequences[:3])}, ...) and the ego ids")
     return res
+
+
+class _OwnDetections:
+    """The detector's output on an agent's own cloud, computed once per cloud (a neighbour's cloud serves every
+    ego, delay and noise setting: noise changes only its pose)."""
+
+    def __init__(self, detector: Detector | None) -> None:
+        self.detector = detector
+        self.cache: dict[tuple[str, int], tuple[np.ndarray, np.ndarray]] = {}
+
+    def __call__(self, a: AgentFrame) -> tuple[np.ndarray, np.ndarray]:
+        key = (a.id, id(a.points))
+        if key not in self.cache:
+            if self.detector is None:
+                raise InputError("no detector given")
+            self.cache[key] = _as_boxes(self.detector(a.points))
+        return self.cache[key]
 
 
 def _score_ego(res: StudyResult, seq: SequenceData, t: int, frame: SceneFrame, ego: AgentFrame,
