@@ -100,7 +100,7 @@ def test_water_plane_follows_tilt() -> None:
 
 def test_edge_on_face_is_widened_away_from_the_sensor() -> None:
     xy = np.column_stack([np.linspace(-4, 4, 30), np.full(30, 20.0)])  # near side of a boat abeam, at y = 20
-    b = fit_box(xy, z_low=-2.0, z_high=1.0, min_width_m=3.0)
+    b = fit_box(xy, z_low=-2.0, z_high=1.0, min_width_m=3.0, beam_ratio=0.25)  # 3 > 0.25 · 8
     assert b[3] == pytest.approx(8.0, abs=1e-6) and b[4] == pytest.approx(3.0)
     assert b[1] == pytest.approx(21.5, abs=1e-6)  # pushed 1.5 m away from the sensor
     assert yaw_diff(b[6], 0.0) < 1e-9

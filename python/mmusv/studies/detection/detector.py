@@ -22,7 +22,8 @@ model of the paper (a PointPillars-style network), so its absolute numbers are n
 3. the kept points are binned into 0.5 m BEV cells and the cells are clustered by single linkage with a
    range-adaptive gap (``max(gap_m, gap_per_m · range)``: the LiDAR's point spacing grows with range);
 4. each cluster gets the minimum-area rectangle of its points (shapely), with length along the longer side;
-   a side seen edge-on is widened to ``min_width_m`` away from the sensor (the visible face is the near one);
+   a side seen edge-on is widened to ``max(min_width_m, beam_ratio · length)`` (a usual beam-to-length ratio)
+   away from the sensor (the visible face is the near one);
    z spans the water plane to the highest point;
 5. the score is the point support ``n / (n + 20)``; clusters with fewer than ``min_points`` points, or larger
    than any vessel (``max_length_m``, ``max_width_m``: land) are dropped.
@@ -64,16 +65,17 @@ class BaselineParams:
     """Tuning of :func:`baseline_detect` (metres unless said otherwise)."""
 
     plane_cell_m: float = 10.0
-    min_height_m: float = 0.7
+    min_height_m: float = 0.5
     self_radius_m: float = 2.0
     cell_m: float = 0.5
     gap_m: float = 1.5
     gap_per_m: float = 0.05
     min_points: int = 3
-    min_width_m: float = 2.0
+    min_width_m: float = 0.8
+    beam_ratio: float = 0.25
     min_length_m: float = 3.0
-    max_length_m: float = 140.0
-    max_width_m: float = 40.0
+    max_length_m: float = 320.0
+    max_width_m: float = 50.0
     support_half: float = 20.0
 
 
@@ -104,11 +106,11 @@ def water_plane(points: np.ndarray, *, cell_m: float = 10.0, rounds: int = 3, to
     return np.asarray(coef, dtype=np.float64)
 
 
-def fit_box(xy: np.ndarray, *, z_low: float, z_high: float, min_width_m: float = 2.0,
+def fit_box(xy: np.ndarray, *, z_low: float, z_high: float, min_width_m: float = 0.8, beam_ratio: float = 0.25,
             min_length_m: float = 3.0) -> np.ndarray:
     """``(7,)`` box ``x, y, z, l, w, h, yaw`` of the BEV points ``xy`` ``(K, 2)`` (K ≥ 1): minimum-area
-    rectangle, length along the longer side, yaw in (-π/2, π/2]; a side shorter than its minimum is widened away
-    from the origin (the sensor)."""
+    rectangle, length along the longer side, yaw in (-π/2, π/2]; a width under ``max(min_width_m, beam_ratio ·
+    length)`` is widened to it away from the origin (the sensor); a length under ``min_length_m`` is raised."""
     pts = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
     rect = shapely.minimum_rotated_rectangle(shapely.multipoints(pts))
     if rect.geom_type == "Polygon":
@@ -130,10 +132,11 @@ def fit_box(xy: np.ndarray, *, z_low: float, z_high: float, min_width_m: float =
         u = np.array([-centre[1], centre[0]]) / r if r > 1e-9 else np.array([1.0, 0.0])
     v = np.array([-u[1], u[0]])
     out_dir = 1.0 if float(np.dot(v, centre)) >= 0 else -1.0  # across the box, away from the sensor
-    if width < min_width_m:
-        centre = centre + v * out_dir * (min_width_m - width) / 2.0
-        width = min_width_m
     length = max(length, min_length_m)
+    wmin = max(min_width_m, beam_ratio * length)
+    if width < wmin:
+        centre = centre + v * out_dir * (wmin - width) / 2.0
+        width = wmin
     yaw = float(np.arctan2(u[1], u[0]))
     if yaw <= -np.pi / 2:
         yaw += np.pi
@@ -182,7 +185,7 @@ def baseline_detect(points: np.ndarray, params: BaselineParams | None = None) ->
         pts = q[m]
         z_low = float(np.mean(a * pts[:, 0] + b * pts[:, 1] + c))
         box = fit_box(pts[:, :2], z_low=z_low, z_high=float(pts[:, 2].max()), min_width_m=prm.min_width_m,
-                      min_length_m=prm.min_length_m)
+                      beam_ratio=prm.beam_ratio, min_length_m=prm.min_length_m)
         if box[3] > prm.max_length_m or box[4] > prm.max_width_m:
             continue
         boxes.append(box)
