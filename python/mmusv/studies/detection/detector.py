@@ -177,12 +177,13 @@ def baseline_detect(points: np.ndarray, params: BaselineParams | None = None) ->
     label = cell_label[inv]
     boxes: list[np.ndarray] = []
     scores: list[float] = []
-    for k in np.unique(label):
-        m = label == k
-        npts = int(m.sum())
+    order = np.argsort(label, kind="stable")
+    starts = np.flatnonzero(np.r_[True, label[order][1:] != label[order][:-1]])
+    for group in np.split(order, starts[1:]):
+        npts = len(group)
         if npts < prm.min_points:
             continue
-        pts = q[m]
+        pts = q[group]
         z_low = float(np.mean(a * pts[:, 0] + b * pts[:, 1] + c))
         box = fit_box(pts[:, :2], z_low=z_low, z_high=float(pts[:, 2].max()), min_width_m=prm.min_width_m,
                       beam_ratio=prm.beam_ratio, min_length_m=prm.min_length_m)
@@ -194,8 +195,8 @@ def baseline_detect(points: np.ndarray, params: BaselineParams | None = None) ->
         return np.zeros((0, 7)), np.zeros(0)
     bx = np.array(boxes)
     sc = np.array(scores)
-    order = np.lexsort((bx[:, 1], bx[:, 0], -sc))
-    return bx[order], sc[order]
+    rank = np.lexsort((bx[:, 1], bx[:, 0], -sc))
+    return bx[rank], sc[rank]
 
 
 def load_detector(spec: str) -> Detector:
