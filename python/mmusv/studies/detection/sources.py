@@ -72,6 +72,21 @@ def _recordings(inputs: Sequence[str | Path]) -> list[Path]:
     return out
 
 
+def _sequence_names(recs: Sequence[Path]) -> dict[str, Path]:
+    """Sequence name → recording: the file stem, or, when two recordings share a stem, the path below the
+    inputs' common folder without the suffix (``island/recordings/x/x``)."""
+    import os
+
+    uniq = sorted({r.resolve() for r in recs})
+    if len(uniq) != len(recs):
+        raise InputError("the same recording is given twice")
+    stems = [r.stem for r in uniq]
+    if len(set(stems)) == len(stems):
+        return dict(zip(stems, uniq, strict=True))
+    root = Path(os.path.commonpath([str(r.parent) for r in uniq]))
+    return {str(r.relative_to(root).with_suffix("")): r for r in uniq}
+
+
 def resolve_dataset(
     inputs: Sequence[str | Path], *, opv2v: str | Path | None, split: str, ratios: Sequence[float] = (0.7, 0.15, 0.15),
     seed: int = 0,
@@ -96,11 +111,7 @@ def resolve_dataset(
         if not recs:
             raise InputError("empty dataset: give recordings (.mcap or folders of them), --opv2v DIR or --generate")
         kind = "recording"
-        by_name: dict[str, Path] = {}
-        for r in recs:
-            if r.stem in by_name:
-                raise InputError(f"two recordings named {r.stem}: {by_name[r.stem]} and {r}")
-            by_name[r.stem] = r
+        by_name = _sequence_names(recs)
         chosen = {n: by_name[n] for n in split_sequences(list(by_name), split=split, ratios=ratios, seed=seed)}
     if not chosen:
         where = opv2v if opv2v is not None else ", ".join(str(x) for x in inputs)
