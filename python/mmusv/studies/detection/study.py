@@ -76,7 +76,7 @@ class StudyResult:
 
     options: StudyOptions
     matches: dict[Key, list[FrameMatch]] = field(default_factory=dict)
-    visibility: dict[Key, list[tuple[np.ndarray, np.ndarray]]] = field(default_factory=dict)
+    visibility: dict[Key, list[tuple[np.ndarray, np.ndarray, np.ndarray]]] = field(default_factory=dict)
     rows: dict[str, list[Any]] = field(default_factory=dict)
     sequences: list[str] = field(default_factory=list)
     frames: int = 0
@@ -85,15 +85,18 @@ class StudyResult:
     predictions_used: int = 0
 
     def metrics(self, key: Key) -> dict[str, float]:
-        """:func:`~mmusv.studies.detection.evaluate.summarize` of ``key`` plus ``recall50_hidden`` and
-        ``recall50_visible`` and their ground-truth counts ``gt_hidden``, ``gt_visible``."""
+        """:func:`~mmusv.studies.detection.evaluate.summarize` of ``key`` plus the recall at IoU 0.5 and 0.3
+        of the ground truths hidden from the ego and visible to it (``recall50_hidden``, ``recall30_hidden``, ...)
+        and their counts ``gt_hidden``, ``gt_visible``."""
         out = summarize(self.matches.get(key, []))
         vis = self.visibility.get(key, [])
         pts = np.concatenate([v[0] for v in vis]) if vis else np.zeros(0)
-        hit = np.concatenate([v[1] for v in vis]) if vis else np.zeros(0, dtype=bool)
+        hit50 = np.concatenate([v[1] for v in vis]) if vis else np.zeros(0, dtype=bool)
+        hit30 = np.concatenate([v[2] for v in vis]) if vis else np.zeros(0, dtype=bool)
         for name, sel in (("hidden", pts == 0), ("visible", pts > 0)):
             n = int(sel.sum())
-            out[f"recall50_{name}"] = float(hit[sel].sum()) / n if n else math.nan
+            out[f"recall50_{name}"] = float(hit50[sel].sum()) / n if n else math.nan
+            out[f"recall30_{name}"] = float(hit30[sel].sum()) / n if n else math.nan
             out[f"gt_{name}"] = float(n)
         return out
 
@@ -260,7 +263,7 @@ def _score_ego(res: StudyResult, seq: SequenceData, t: int, frame: SceneFrame, e
             key = (s.name, mode)
             res.matches.setdefault(key, []).append(fm)
             gm = fm.gt_matched(0.5)
-            res.visibility.setdefault(key, []).append((vis, gm))
+            res.visibility.setdefault(key, []).append((vis, gm, fm.gt_matched(0.3)))
             _add_rows(res, seq.name, frame.frame, ego.id, s.name, mode, fm, gm, gbin, vis)
 
 
