@@ -237,3 +237,13 @@ def test_parse_settings() -> None:
 def test_baseline_params_are_frozen() -> None:
     with pytest.raises(dataclasses.FrozenInstanceError):
         BaselineParams().gap_m = 3.0  # type: ignore[misc]
+
+
+def test_gt_visibility_counts_points_inside_the_box() -> None:
+    from mmusv.studies.detection.study import gt_visibility
+
+    gt = np.array([[10.0, 0.0, 0.0, 4.0, 2.0, 2.0, math.pi / 2], [50.0, 50.0, 0.0, 4.0, 2.0, 2.0, 0.0]])
+    pts = np.array([[10.0, 1.9, 0.0], [10.9, -1.5, 0.5], [10.0, 2.1, 0.0],   # inside, inside, beyond the long side
+                    [10.0, 0.0, 1.6], [10.0, 0.0, 3.0], [50.0, 50.0, -2.0]])  # z within h/2 + 0.5, too high, too low
+    assert gt_visibility(gt, pts).tolist() == [3, 0]
+    assert gt_visibility(gt, np.zeros((0, 3))).tolist() == [0, 0]

@@ -50,8 +50,9 @@ def test_detection_study_end_to_end(two_usv: Path, tmp_path: Path, capsys: pytes
     assert table["mode"].to_list() == ["none", "late", "early"]
     assert table["det"].sum() > 0 and table["gt"][0] > 0
     boxes = pl.read_parquet(out / "detection_boxes.parquet")
-    assert boxes.columns[:16] == ["sequence", "frame", "ego", "mode", "kind", "x", "y", "z", "l", "w", "h", "yaw",
-                                  "score", "range_bin", "matched", "ego_points"]
+    assert boxes.columns == ["sequence", "frame", "ego", "mode", "kind", "x", "y", "z", "l", "w", "h", "yaw",
+                             "score", "range_bin", "matched", "ego_points", "neighbour_points"]
+    assert table["gt_visible"][0] + table["gt_hidden"][0] + table["gt_unseen"][0] == table["gt"][0]
     gt = boxes.filter(pl.col("kind") == "gt")
     assert len(gt) == 3 * int(table["gt"][0])  # the same ground truth under each mode
     assert set(gt["range_bin"].to_list()) <= {"0-50", "50-100", "100-150", "150-200"}

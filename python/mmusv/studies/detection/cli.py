@@ -17,8 +17,8 @@ from typing import Any
 __all__ = ["add_parsers", "run"]
 
 _BOXES_HELP = ("Parquet columns: sequence, frame, ego, [setting], mode, kind (det|gt), x, y, z, l, w, h, yaw "
-               "(ego LiDAR frame, m, rad), score, range_bin, matched (at IoU 0.5), ego_points (gt: ego LiDAR "
-               "points inside)")
+               "(ego LiDAR frame, m, rad), score, range_bin, matched (at IoU 0.5), ego_points, neighbour_points (gt: "
+               "LiDAR points inside from the ego / the other USVs)")
 
 
 def _common(p: argparse.ArgumentParser, default_out: str) -> None:
@@ -157,17 +157,18 @@ def _print_detection(console: Any, res: Any) -> None:
     t = detection_table(res)
     table = Table(title="Cooperative detection (Table III)")
     heads = ["mode", "AP@0.3", "AP@0.5", "AP@0.7", "P@0.5", "R@0.5", *[f"AP@0.5 {b} m" for b in BINS],
-             "R@0.5 hidden", "R@0.5 visible", "R@0.3 hidden"]
+             "R@0.5 visible", "R@0.5 hidden", "R@0.3 hidden"]
     for h in heads:
         table.add_column(h, justify="right")
     for r in t.iter_rows(named=True):
         table.add_row(r["mode"], *[fmt(r[k]) for k in ("ap30", "ap50", "ap70", "precision50", "recall50",
-                                                       *[f"ap50_{b}" for b in BINS], "recall50_hidden",
-                                                       "recall50_visible", "recall30_hidden")])
+                                                       *[f"ap50_{b}" for b in BINS], "recall50_visible",
+                                                       "recall50_hidden", "recall30_hidden")])
     console.print(table)
     r0 = t.row(0, named=True)
-    console.print(f"ground truth: {int(r0['gt'])} boxes ({int(r0['gt_hidden'])} hidden from the ego: no ego LiDAR "
-                  f"point inside)", highlight=False)
+    console.print(f"ground truth: {int(r0['gt'])} boxes: {int(r0['gt_visible'])} visible to the ego, "
+                  f"{int(r0['gt_hidden'])} hidden from it but seen by a neighbour, {int(r0['gt_unseen'])} seen by no "
+                  "USV (no LiDAR point inside)", highlight=False)
 
 
 def _print_robustness(console: Any, res: Any) -> None:

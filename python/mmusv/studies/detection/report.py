@@ -25,8 +25,8 @@ def detection_table(res: StudyResult) -> pl.DataFrame:
     """Table III: one row per fusion mode (clean setting)."""
     t = res.table().filter(pl.col("setting") == "clean")
     cols = ["mode", "ap30", "ap50", "ap70", "precision50", "recall50", *[f"ap50_{b}" for b in BINS],
-            "recall50_hidden", "recall50_visible", "recall30_hidden", "recall30_visible", "gt_hidden", "gt_visible",
-            "gt", "det", "frames"]
+            "recall50_visible", "recall50_hidden", "recall50_unseen", "recall30_visible", "recall30_hidden",
+            "recall30_unseen", "gt_visible", "gt_hidden", "gt_unseen", "gt", "det", "frames"]
     return t.select(cols)
 
 

@@ -7,8 +7,10 @@ USVs are not targets), are dropped; the rest are matched against the ground trut
 (:func:`~mmusv.studies.detection.data.gt_in_ego`) by :mod:`~mmusv.studies.detection.evaluate`.
 
 Every ground truth also records ``ego_points``, the number of the ego's own LiDAR points inside it (BEV rectangle,
-height within ±0.5 m): 0 means the ego cannot see it (behind an island or another vessel, or too sparse far out).
-Recall@0.5 is reported separately for hidden and visible targets.
+height within ±0.5 m), and ``neighbour_points``, the same for the other USVs' current clouds. A target is
+*visible* (ego_points > 0), *hidden* (none from the ego but some from a neighbour: behind an island or another
+hull, or out of the ego's beams, but seen by a cooperating USV: the case cooperation exists for) or *unseen* (no
+USV has a point on it). Recall at IoU 0.5 and 0.3 is reported for each class.
 
 **Predictions file** (``--predictions``, instead of a detector): a Parquet file with one row per detection and
 columns ``sequence`` (recording stem or OPV2V scenario folder name), ``frame`` (acquisition index), ``ego``
@@ -31,6 +33,7 @@ import polars as pl
 import shapely
 
 from mmusv.errors import InputError
+from mmusv.frames import transform_points
 from mmusv.studies.detection.data import (
     AgentFrame,
     SceneFrame,
@@ -48,7 +51,7 @@ from mmusv.studies.detection.evaluate import (
     range_bin,
     summarize,
 )
-from mmusv.studies.detection.fusion import MODES, _as_boxes, fuse
+from mmusv.studies.detection.fusion import MODES, _as_boxes, fuse, relative
 from mmusv.studies.detection.robustness import Setting, neighbours_for
 
 __all__ = ["StudyOptions", "StudyResult", "gt_visibility", "load_predictions", "run_study"]
@@ -77,6 +80,8 @@ class StudyResult:
     options: StudyOptions
     matches: dict[Key, list[FrameMatch]] = field(default_factory=dict)
     visibility: dict[Key, list[tuple[np.ndarray, np.ndarray, np.ndarray]]] = field(default_factory=dict)
+    """Per key and ego-frame: visibility class of each ground truth (0 visible, 1 hidden, 2 unseen), matched at
+    0.5, matched at 0.3."""
     rows: dict[str, list[Any]] = field(default_factory=dict)
     sequences: list[str] = field(default_factory=list)
     frames: int = 0
@@ -86,14 +91,14 @@ class StudyResult:
 
     def metrics(self, key: Key) -> dict[str, float]:
         """:func:`~mmusv.studies.detection.evaluate.summarize` of ``key`` plus the recall at IoU 0.5 and 0.3
-        of the ground truths hidden from the ego and visible to it (``recall50_hidden``, ``recall30_hidden``, ...)
-        and their counts ``gt_hidden``, ``gt_visible``."""
+        of the visible, hidden and unseen ground truths (``recall50_hidden``, ``recall30_hidden``, ...; module
+        docstring) and their counts ``gt_visible``, ``gt_hidden``, ``gt_unseen``."""
         out = summarize(self.matches.get(key, []))
         vis = self.visibility.get(key, [])
-        pts = np.concatenate([v[0] for v in vis]) if vis else np.zeros(0)
+        cls = np.concatenate([v[0] for v in vis]) if vis else np.zeros(0)
         hit50 = np.concatenate([v[1] for v in vis]) if vis else np.zeros(0, dtype=bool)
         hit30 = np.concatenate([v[2] for v in vis]) if vis else np.zeros(0, dtype=bool)
-        for name, sel in (("hidden", pts == 0), ("visible", pts > 0)):
+        for name, sel in (("visible", cls == 0), ("hidden", cls == 1), ("unseen", cls == 2)):
             n = int(sel.sum())
             out[f"recall50_{name}"] = float(hit50[sel].sum()) / n if n else math.nan
             out[f"recall30_{name}"] = float(hit30[sel].sum()) / n if n else math.nan
@@ -123,7 +128,7 @@ class StudyResult:
 _ROW_SCHEMA: dict[str, Any] = {
     "sequence": pl.Utf8, "frame": pl.Int64, "ego": pl.Utf8, "setting": pl.Utf8, "mode": pl.Utf8, "kind": pl.Utf8,
     **{c: pl.Float64 for c in BOX_COLUMNS}, "score": pl.Float64, "range_bin": pl.Utf8, "matched": pl.Boolean,
-    "ego_points": pl.Int64,
+    "ego_points": pl.Int64, "neighbour_points": pl.Int64,
 }
 
 
@@ -191,7 +196,7 @@ def run_study(
         raise InputError("no detector and no predictions given")
     res = StudyResult(options=o)
     for k in ("sequence", "frame", "ego", "setting", "mode", "kind", *BOX_COLUMNS, "score", "range_bin", "matched",
-              "ego_points"):
+              "ego_points", "neighbour_points"):
         res.rows[k] = []
     start = max(s.delay_frames for s in o.settings)
     fusion = [m for m in o.modes if m != "none"]
@@ -243,6 +248,11 @@ def _score_ego(res: StudyResult, seq: SequenceData, t: int, frame: SceneFrame, e
     res.gt_boxes += len(gt)
     usv = usv_boxes_in_ego(frame, ego)
     vis = gt_visibility(gt, ego.points)
+    nb_vis = np.zeros(len(gt), dtype=np.int64)
+    for nb in frame.agents:
+        if nb.id != ego.id and len(gt):
+            nb_vis += gt_visibility(gt, transform_points(relative(ego, nb), nb.points[:, :3]))
+    cls = np.where(vis > 0, 0, np.where(nb_vis > 0, 1, 2))
     gbin = range_bin(gt[:, :2])
     for s in o.settings:
         nbs = neighbours_for(seq, t, ego.id, s, seed=o.seed)
@@ -263,18 +273,19 @@ def _score_ego(res: StudyResult, seq: SequenceData, t: int, frame: SceneFrame, e
             key = (s.name, mode)
             res.matches.setdefault(key, []).append(fm)
             gm = fm.gt_matched(0.5)
-            res.visibility.setdefault(key, []).append((vis, gm, fm.gt_matched(0.3)))
-            _add_rows(res, seq.name, frame.frame, ego.id, s.name, mode, fm, gm, gbin, vis)
+            res.visibility.setdefault(key, []).append((cls, gm, fm.gt_matched(0.3)))
+            _add_rows(res, seq.name, frame.frame, ego.id, s.name, mode, fm, gm, gbin, vis, nb_vis)
 
 
 def _add_rows(res: StudyResult, seq: str, frame: int, ego: str, setting: str, mode: str, fm: FrameMatch,
-              gm: np.ndarray, gbin: np.ndarray, vis: np.ndarray) -> None:
+              gm: np.ndarray, gbin: np.ndarray, vis: np.ndarray, nb_vis: np.ndarray) -> None:
     r = res.rows
     dbin = fm.det_bins(0.5)
     tp = fm.matches[0.5] >= 0
-    for kind, boxes, scores, bins, matched, pts in (
-        ("det", fm.det_boxes, fm.det_scores, dbin, tp, [None] * len(fm.det_boxes)),
-        ("gt", fm.gt_boxes, [math.nan] * len(fm.gt_boxes), gbin, gm, vis.tolist()),
+    none: list[int | None] = [None] * len(fm.det_boxes)
+    for kind, boxes, scores, bins, matched, pts, nb_pts in (
+        ("det", fm.det_boxes, fm.det_scores, dbin, tp, none, none),
+        ("gt", fm.gt_boxes, [math.nan] * len(fm.gt_boxes), gbin, gm, vis.tolist(), nb_vis.tolist()),
     ):
         n = len(boxes)
         r["sequence"] += [seq] * n
@@ -289,6 +300,7 @@ def _add_rows(res: StudyResult, seq: str, frame: int, ego: str, setting: str, mo
         r["range_bin"] += [bin_label(int(b)) for b in bins]
         r["matched"] += [bool(v) for v in matched]
         r["ego_points"] += list(pts)
+        r["neighbour_points"] += list(nb_pts)
 
 
 def range_bin_labels() -> list[str]:
