@@ -244,6 +244,6 @@ def test_gt_visibility_counts_points_inside_the_box() -> None:
 
     gt = np.array([[10.0, 0.0, 0.0, 4.0, 2.0, 2.0, math.pi / 2], [50.0, 50.0, 0.0, 4.0, 2.0, 2.0, 0.0]])
     pts = np.array([[10.0, 1.9, 0.0], [10.9, -1.5, 0.5], [10.0, 2.1, 0.0],   # inside, inside, beyond the long side
-                    [10.0, 0.0, 1.6], [10.0, 0.0, 3.0], [50.0, 50.0, -2.0]])  # z within h/2 + 0.5, too high, too low
+                    [10.0, 0.0, 1.4], [10.0, 0.0, 1.6], [50.0, 50.0, -2.0]])  # z within h/2 + 0.5, too high, too low
     assert gt_visibility(gt, pts).tolist() == [3, 0]
     assert gt_visibility(gt, np.zeros((0, 3))).tolist() == [0, 0]
