@@ -119,3 +119,16 @@ def test_bad_input_errors(two_usv: Path, tmp_path: Path, capsys: pytest.CaptureF
     assert "not an MCAP file" in err(["study", "detection", str(notmcap)])
     assert "--detector" in err(["study", "detection", str(two_usv), "--detector", "nowhere:fn"])
     assert "--predictions" in err(["study", "detection", str(two_usv), "--predictions", str(notmcap)])
+
+
+def test_rescore_of_the_boxes_parquet_gives_the_table(two_usv: Path, tmp_path: Path) -> None:
+    from mmusv.studies.detection.report import rescore
+
+    out = tmp_path / "det"
+    assert main(["study", "detection", str(two_usv), "-o", str(out), "--no-progress"]) == 0
+    table = pl.read_csv(out / "detection_table.csv")
+    boxes = pl.read_parquet(out / "detection_boxes.parquet")
+    for row in table.iter_rows(named=True):
+        got = rescore(boxes.filter(pl.col("mode") == row["mode"]))
+        for k in ("ap30", "ap50", "ap70", "gt", "det"):
+            assert (math.isnan(got[k]) and math.isnan(row[k])) or got[k] == pytest.approx(row[k]), k

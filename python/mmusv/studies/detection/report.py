@@ -139,3 +139,17 @@ def _plot_robustness(res: StudyResult, path: Path) -> None:
     fig.tight_layout()
     fig.savefig(path, dpi=100, metadata={"Software": None})
     plt.close(fig)
+
+
+def rescore(boxes: pl.DataFrame) -> dict[str, float]:
+    """:func:`~mmusv.studies.detection.evaluate.summarize` of the rows of a boxes Parquet (one mode and setting,
+    e.g. after filtering by sequence): every (sequence, frame, ego) is matched again from its det and gt rows."""
+    from mmusv.studies.detection.evaluate import BOX_COLUMNS, FrameMatch, summarize
+
+    frames = []
+    for _, g in boxes.group_by(["sequence", "frame", "ego"], maintain_order=True):
+        d = g.filter(pl.col("kind") == "det")
+        t = g.filter(pl.col("kind") == "gt")
+        frames.append(FrameMatch.evaluate(d.select(list(BOX_COLUMNS)).to_numpy(), d["score"].to_numpy(),
+                                          t.select(list(BOX_COLUMNS)).to_numpy()))
+    return summarize(frames)
