@@ -167,8 +167,8 @@ def _print_detection(console: Any, res: Any) -> None:
     console.print(table)
     r0 = t.row(0, named=True)
     console.print(f"ground truth: {int(r0['gt'])} boxes: {int(r0['gt_visible'])} visible to the ego, "
-                  f"{int(r0['gt_hidden'])} hidden from it but seen by a neighbour, {int(r0['gt_unseen'])} seen by no "
-                  "USV (no LiDAR point inside)", highlight=False)
+                  f"{int(r0['gt_hidden'])} hidden from it but seen by neighbours, {int(r0['gt_unseen'])} seen by "
+                  "neither (seen = at least 5 LiDAR points inside)", highlight=False)
 
 
 def _print_robustness(console: Any, res: Any) -> None:

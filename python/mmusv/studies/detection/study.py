@@ -7,10 +7,11 @@ USVs are not targets), are dropped; the rest are matched against the ground trut
 (:func:`~mmusv.studies.detection.data.gt_in_ego`) by :mod:`~mmusv.studies.detection.evaluate`.
 
 Every ground truth also records ``ego_points``, the number of the ego's own LiDAR points inside it (BEV rectangle,
-height within ±0.5 m), and ``neighbour_points``, the same for the other USVs' current clouds. A target is
-*visible* (ego_points > 0), *hidden* (none from the ego but some from a neighbour: behind an island or another
-hull, or out of the ego's beams, but seen by a cooperating USV: the case cooperation exists for) or *unseen* (no
-USV has a point on it). Recall at IoU 0.5 and 0.3 is reported for each class.
+height within ±0.5 m), and ``neighbour_points``, the same summed over the other USVs' current clouds. With
+``SEEN_POINTS`` = 5 (about the fewest points a box can be put on), a target is *visible* (ego_points ≥ 5),
+*hidden* (fewer from the ego but ≥ 5 from the neighbours: behind an island or another hull, or too small for the
+ego's beams at that range, but seen by cooperating USVs: the case cooperation exists for) or *unseen* (neither).
+Recall at IoU 0.5 and 0.3 is reported for each class.
 
 **Predictions file** (``--predictions``, instead of a detector): a Parquet file with one row per detection and
 columns ``sequence`` (recording stem or OPV2V scenario folder name), ``frame`` (acquisition index), ``ego``
@@ -57,6 +58,8 @@ from mmusv.studies.detection.robustness import Setting, neighbours_for
 __all__ = ["StudyOptions", "StudyResult", "gt_visibility", "load_predictions", "run_study"]
 
 Key = tuple[str, str]  # (setting name, mode)
+SEEN_POINTS = 5
+"""LiDAR points inside a target for it to count as seen by a USV (module docstring)."""
 
 
 @dataclass(frozen=True)
@@ -252,7 +255,7 @@ def _score_ego(res: StudyResult, seq: SequenceData, t: int, frame: SceneFrame, e
     for nb in frame.agents:
         if nb.id != ego.id and len(gt):
             nb_vis += gt_visibility(gt, transform_points(relative(ego, nb), nb.points[:, :3]))
-    cls = np.where(vis > 0, 0, np.where(nb_vis > 0, 1, 2))
+    cls = np.where(vis >= SEEN_POINTS, 0, np.where(nb_vis >= SEEN_POINTS, 1, 2))
     gbin = range_bin(gt[:, :2])
     for s in o.settings:
         nbs = neighbours_for(seq, t, ego.id, s, seed=o.seed)
