@@ -16,6 +16,7 @@ from __future__ import annotations
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from types import ModuleType
 
 import numpy as np
 import yaml
@@ -115,20 +116,41 @@ def _box_mats(poses: np.ndarray, centres: np.ndarray) -> np.ndarray:
     return m
 
 
+def _reader() -> ModuleType:
+    """The project's recording reader: the one place this package imports it (it is moving from
+    ``mmusv.export.reader`` to ``mmusv.recording``; re-point this import then)."""
+    from mmusv.export import reader
+
+    return reader
+
+
+@dataclass(frozen=True)
+class RecordingSummary:
+    """What a recording says about itself without reading its frames."""
+
+    frames_configured: int
+    config_hash: str
+    complete: bool
+
+
+def recording_summary(path: str | Path) -> RecordingSummary:
+    """The frame count, config hash and completeness (summary section present) of a recording; raises
+    :class:`~mmusv.IoError` for a file that is not one."""
+    info = _reader().read_info(path)
+    return RecordingSummary(int(info.frames_configured), str(info.config_hash), bool(info.has_summary))
+
+
 def read_recording(path: str | Path) -> SequenceData:
     """A recording (``mmusv run`` MCAP) as a sequence: every frame with the LiDAR of every instrumented USV that
     has one. Raises :class:`~mmusv.IoError` for a file that is not a readable recording."""
-    from mmusv.export.reader import (  # the recording reader (moving to mmusv.recording)
-        FrameStream,
-        read_info,
-    )
     from mmusv.preview import decode_point_cloud
 
-    info = read_info(path)
+    reader = _reader()
+    info = reader.read_info(path)
     agents = [a for a in info.agents if a.lidar_mount is not None]
     topics = {f"/{a.id}/lidar" for a in agents}
     frames: list[SceneFrame] = []
-    for fr in FrameStream(info, want=topics.__contains__):
+    for fr in reader.FrameStream(info, want=topics.__contains__):
         w = fr.world
         if w is None or not all(t in fr.messages for t in topics):
             continue

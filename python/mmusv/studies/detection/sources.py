@@ -21,6 +21,7 @@ from mmusv.studies.detection.data import (
     opv2v_scenarios,
     read_opv2v,
     read_recording,
+    recording_summary,
     split_sequences,
 )
 
@@ -49,9 +50,7 @@ class Dataset:
     def count_frames(self) -> int:
         """Frames over all sequences (cheap for recordings: from their metadata)."""
         if self.kind == "recording":
-            from mmusv.export.reader import read_info
-
-            return sum(read_info(p).frames_configured for p in self.sources.values())
+            return sum(recording_summary(p).frames_configured for p in self.sources.values())
         return sum(len({f.stem for c in p.iterdir() if c.is_dir() for f in c.glob("*.pcd")})
                    for p in self.sources.values())
 
@@ -164,10 +163,8 @@ def generate_dataset(
 def _same_scenario(path: Path, scenario: Any) -> bool:
     """Whether the complete recording at ``path`` was made from ``scenario`` (same config hash)."""
     from mmusv.config import scenario_hash
-    from mmusv.export.reader import read_info
-
     try:
-        info = read_info(path)
+        info = recording_summary(path)
     except IoError:
         return False
-    return info.has_summary and info.config_hash == scenario_hash(scenario)
+    return info.complete and info.config_hash == scenario_hash(scenario)
