@@ -77,6 +77,12 @@ def test_robustness_study_end_to_end(two_usv: Path, tmp_path: Path) -> None:
     boxes = pl.read_parquet(out / "robustness_boxes.parquet")
     assert "setting" in boxes.columns
     assert boxes["frame"].min() == 1  # frames before the largest delay are skipped for every setting
+    # Same inputs and seed, same bytes (the pose noise is seeded).
+    again = tmp_path / "rob2"
+    assert main(["study", "robustness", str(two_usv), "--settings", "delay:1,noise:1/1", "-o", str(again),
+                 "--no-progress"]) == 0
+    for name in ("robustness_table.csv", "robustness_boxes.parquet"):
+        assert (out / name).read_bytes() == (again / name).read_bytes()
 
 
 def test_opv2v_input_gives_the_same_ground_truth(two_usv: Path, tmp_path: Path) -> None:
