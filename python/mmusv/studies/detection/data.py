@@ -39,7 +39,8 @@ __all__ = [
 ]
 
 OPV2V_USV_RADIUS_M = 8.0
-"""An OPV2V folder gives no hull size for its CAVs: their platform is taken as a disc of this radius."""
+"""An OPV2V folder gives no hull size for its CAVs: their platform is taken as a square of twice this half-size
+about the body origin."""
 
 
 @dataclass(frozen=True)
@@ -196,7 +197,7 @@ def opv2v_scenarios(root: str | Path) -> list[Path]:
 def read_opv2v(folder: str | Path) -> SequenceData:
     """One OPV2V scenario folder (as ``mmusv convert --to opv2v`` writes it) as a sequence, converted back from
     the CARLA frame (y mirrored, degrees) to mmusv frames. Targets are the union of the CAVs' ``vehicles``;
-    the CAVs' platforms are discs of :data:`OPV2V_USV_RADIUS_M`."""
+    the CAVs' platforms are squares of half-size :data:`OPV2V_USV_RADIUS_M` about their body origin."""
     from mmusv.export.pcd import read_pcd
 
     d = Path(folder)
