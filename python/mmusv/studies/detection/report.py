@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import polars as pl
 
@@ -95,16 +96,21 @@ def _plot_detection(table: pl.DataFrame, path: Path) -> None:
         r = table.filter(pl.col("mode") == m).row(0, named=True)
         ax[0].plot([0.3, 0.5, 0.7], [r["ap30"], r["ap50"], r["ap70"]], marker="o", label=m)
         ax[1].plot(range(len(BINS)), [r[f"ap50_{b}"] for b in BINS], marker="o", label=m)
-    ax[0].set_xlabel("IoU threshold")
-    ax[0].set_ylabel("AP")
     ax[1].set_xticks(range(len(BINS)), BINS)
-    ax[1].set_xlabel("range bin (m)")
-    ax[1].set_ylabel("AP@0.5")
-    for a in ax:
+    _finish(fig, ax, [("IoU threshold", "AP"), ("range bin (m)", "AP@0.5")], "Cooperative detection (Table III)", path)
+
+
+def _finish(fig: Any, ax: Any, labels: list[tuple[str, str]], title: str, path: Path) -> None:
+    """Axis labels, limits, grid and legends of the two panels; saves ``fig`` (no timestamp) and closes it."""
+    import matplotlib.pyplot as plt
+
+    for a, (xl, yl) in zip(ax, labels, strict=True):
+        a.set_xlabel(xl)
+        a.set_ylabel(yl)
         a.set_ylim(0, 1)
         a.grid(alpha=0.3)
         a.legend()
-    fig.suptitle("Cooperative detection (Table III)")
+    fig.suptitle(title)
     fig.tight_layout()
     fig.savefig(path, dpi=100, metadata={"Software": None})
     plt.close(fig)
@@ -119,8 +125,7 @@ def _plot_robustness(res: StudyResult, path: Path) -> None:
     t = res.table()
     fig, ax = plt.subplots(1, 2, figsize=(10, 4))
     clean = {r["mode"]: r["ap50"] for r in t.filter(pl.col("setting") == "clean").iter_rows(named=True)}
-    for a, kind, xcol, label in ((ax[0], "delay", "delay_frames", "delay (frames)"),
-                                 (ax[1], "noise", "sigma_xyz_m", "pose noise σ_xyz (m) = σ_rpy (°)")):
+    for a, kind, xcol in ((ax[0], "delay", "delay_frames"), (ax[1], "noise", "sigma_xyz_m")):
         for m in res.options.modes:
             if m == "none":
                 if "none" in clean:
@@ -130,15 +135,8 @@ def _plot_robustness(res: StudyResult, path: Path) -> None:
             xs = [0.0, *sub[xcol].cast(pl.Float64).to_list()]
             ys = [clean.get(m, math.nan), *sub["ap50"].to_list()]
             a.plot(xs, ys, marker="o", label=m)
-        a.set_xlabel(label)
-        a.set_ylabel("AP@0.5")
-        a.set_ylim(0, 1)
-        a.grid(alpha=0.3)
-        a.legend()
-    fig.suptitle("Robustness (Table IV)")
-    fig.tight_layout()
-    fig.savefig(path, dpi=100, metadata={"Software": None})
-    plt.close(fig)
+    _finish(fig, ax, [("delay (frames)", "AP@0.5"), ("pose noise σ_xyz (m) = σ_rpy (°)", "AP@0.5")],
+            "Robustness (Table IV)", path)
 
 
 def rescore(boxes: pl.DataFrame) -> dict[str, float]:
