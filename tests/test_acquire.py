@@ -74,7 +74,7 @@ def test_every_channel_decodes_and_frames_and_times_are_right(recorded: tuple[Pa
         assert sorted(times) == [0, 200_000_000, 400_000_000], t
     states = [d for t, _lt, _m, d in msgs if t == "/world/state"]
     assert [s.frame for s in states] == [0, 1, 2]
-    assert [len(s.vessels) for s in states] == [6 + 4] * 3  # 6 scenario vessels + 4 moored ships
+    assert [len(s.vessels) for s in states] == [7 + 4] * 3  # 7 scenario vessels (usv_3 removed) + 4 moored ships
 
 
 def test_recorded_sensors_match_a_direct_capture(recorded: tuple[Path, Any]) -> None:
@@ -96,7 +96,8 @@ def test_recorded_sensors_match_a_direct_capture(recorded: tuple[Path, Any]) -> 
     ann = msgs["/usv_1/annotations"]
     ids = [b.target_id for b in ann.boxes_lidar]
     assert "usv_1" not in ids, "the agent's own hull is never its target"
-    assert "usv_2" in ids or all(b.range_m > 200 for b in ann.boxes_lidar)
+    assert all(b.range_m <= 200 for b in ann.boxes_lidar)  # the LiDAR's range
+    assert {"ferry", "tug"} <= set(ids)  # both within 200 m of usv_1 in port_entry
     for b in ann.boxes_lidar:
         n = int(np.count_nonzero(pts["instance"] == b.instance_id))
         assert b.lidar_points == n
@@ -105,7 +106,7 @@ def test_recorded_sensors_match_a_direct_capture(recorded: tuple[Path, Any]) -> 
 def test_tables_and_manifest(recorded: tuple[Path, Any]) -> None:
     out, res = recorded
     ws = pl.read_parquet(out / "tables/world_state/*.parquet")
-    assert ws.height == 3 * 10 and set(ws["frame"].unique()) == {0, 1, 2}
+    assert ws.height == 3 * 11 and set(ws["frame"].unique()) == {0, 1, 2}
     b3 = pl.read_parquet(out / "tables/boxes_3d/*.parquet")
     assert (b3["agent"] != b3["target_id"]).all()
     man = json.loads((out / "manifest.json").read_text())

@@ -68,6 +68,7 @@ class _Tables:
             x, y, z, r, p, yaw = (float(a) for a in st.poses[i])
             self.rows["world_state"].append({
                 "frame": cap.frame, "time_s": cap.time_s, "vessel_id": v.id, "asset": v.asset, "role": v.role,
+                "static": v.static,
                 "semantic_class": v.semantic_class, "instance_id": v.instance_id, "x": x, "y": y, "z": z,
                 "roll": r, "pitch": p, "yaw": yaw, "vx": float(st.velocities[i, 0]), "vy": float(st.velocities[i, 1]),
                 "vz": float(st.velocities[i, 2]), "box_cx": float(st.box_centers[i, 0]), "box_cy": float(st.box_centers[i, 1]),
@@ -86,6 +87,7 @@ class _Tables:
                 "x": float(c[0]), "y": float(c[1]), "z": float(c[2]), "length": float(s[0]), "beam": float(s[1]),
                 "height": float(s[2]), "qx": float(q[0]), "qy": float(q[1]), "qz": float(q[2]), "qw": float(q[3]),
                 "yaw": float(lid["yaw"][j]), "lidar_points": int(lid["lidar_points"][j]), "range_m": float(lid["range_m"][j]),
+                "role": lid["role"][j], "static": bool(lid["static"][j]),
             })
         cam = cols["camera"]
         for j, tid in enumerate(cam["target_id"]):
@@ -94,7 +96,7 @@ class _Tables:
                 "x_min": float(cam["x_min"][j]), "y_min": float(cam["y_min"][j]), "x_max": float(cam["x_max"][j]),
                 "y_max": float(cam["y_max"][j]), "truncation": float(cam["truncation"][j]),
                 "visible_pixels": int(cam["visible_pixels"][j]), "box_pixels": int(cam["box_pixels"][j]),
-                "occlusion": float(cam["occlusion"][j]),
+                "occlusion": float(cam["occlusion"][j]), "role": cam["role"][j], "static": bool(cam["static"][j]),
             })
 
     def flush(self) -> None:

@@ -3,6 +3,8 @@
 For every agent (USV) and frame, for every other vessel (the agent's own hull is never a target):
 * a 3D box in the agent's LiDAR frame (centre, size = length/beam/height, rotation quaternion xyzw, yaw) with the
   number of LiDAR points on the vessel (exact: points carry instance ids) and its range;
+* the vessel's ``role`` (``target``, ``usv`` — another instrumented USV, never a detection target — or
+  ``moored``) and ``static`` flag (moored ships, and scenario vessels that never move), so users can filter;
 * an ego-centric BEV box: the 3D box's footprint in the LiDAR frame's xy plane (x, y, length, width, yaw);
 * per pinhole camera, a 2D box: the projected 3D-box corners (edges clipped at the near plane), clipped to the
   image, with ``truncation`` = 1 − clipped area / unclipped area, ``visible_pixels`` (pixels whose instance is
@@ -56,6 +58,8 @@ class Annotations:
     lidar_yaw: list[float] = field(default_factory=list)
     lidar_points: list[int] = field(default_factory=list)
     lidar_range: list[float] = field(default_factory=list)
+    lidar_role: list[str] = field(default_factory=list)
+    lidar_static: list[bool] = field(default_factory=list)
     cam_ids: list[str] = field(default_factory=list)
     cam_camera: list[str] = field(default_factory=list)
     cam_box: list[np.ndarray] = field(default_factory=list)
@@ -63,6 +67,8 @@ class Annotations:
     cam_visible: list[int] = field(default_factory=list)
     cam_box_pixels: list[int] = field(default_factory=list)
     cam_occlusion: list[float] = field(default_factory=list)
+    cam_role: list[str] = field(default_factory=list)
+    cam_static: list[bool] = field(default_factory=list)
 
     def columns(self) -> dict[str, Any]:
         """Numpy columns: ``lidar`` and ``bev`` and ``camera`` dicts of arrays (shapes in the docstrings above)."""
@@ -79,6 +85,8 @@ class Annotations:
             "yaw": np.array(self.lidar_yaw, dtype=np.float64),
             "lidar_points": np.array(self.lidar_points, dtype=np.uint32),
             "range_m": np.array(self.lidar_range, dtype=np.float64),
+            "role": list(self.lidar_role),
+            "static": np.array(self.lidar_static, dtype=bool),
         }
         bev = {
             "target_id": list(self.lidar_ids),
@@ -101,6 +109,8 @@ class Annotations:
             "visible_pixels": np.array(self.cam_visible, dtype=np.uint32),
             "box_pixels": np.array(self.cam_box_pixels, dtype=np.uint32),
             "occlusion": np.array(self.cam_occlusion, dtype=np.float64),
+            "role": list(self.cam_role),
+            "static": np.array(self.cam_static, dtype=bool),
         }
         return {"lidar": lidar, "bev": bev, "camera": camera}
 
@@ -197,6 +207,8 @@ def annotate_agent(
             ann.lidar_yaw.append(float(np.arctan2(box_ref[1, 0], box_ref[0, 0])))
             ann.lidar_points.append(counts.get(info.instance_id, 0))
             ann.lidar_range.append(rng)
+            ann.lidar_role.append(info.role)
+            ann.lidar_static.append(bool(getattr(info, "static", False)))
         corners_world = box_corners(box_world, info.box_size)
         for name, (cam, k, inv, pose, inst_img) in views.items():
             h, w = inst_img.shape
@@ -228,4 +240,6 @@ def annotate_agent(
             ann.cam_visible.append(visible)
             ann.cam_box_pixels.append(int((u1 - u0) * (v1 - v0)))
             ann.cam_occlusion.append(float(1.0 - visible / sil) if sil else 0.0)
+            ann.cam_role.append(info.role)
+            ann.cam_static.append(bool(getattr(info, "static", False)))
     return ann

@@ -115,6 +115,12 @@ class VesselConfig(_Model):
             raise ValueError(f"unknown asset{hint} (`mmusv assets` lists all {len(names)})")
         return v
 
+    @property
+    def static(self) -> bool:
+        """Whether the vessel never moves (``speed_mps`` 0). Moored ships of port maps are static too; boxes,
+        tables and exports carry this flag so users can filter static vessels."""
+        return self.speed_mps == 0.0
+
     @field_validator("route")
     @classmethod
     def _route(cls, v: list[tuple[float, float]]) -> list[tuple[float, float]]:

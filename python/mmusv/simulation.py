@@ -78,6 +78,7 @@ class VesselInfo:
     instance_id: int
     box_center_body: np.ndarray  # (3,) box centre in the vessel body frame, metres
     box_size: np.ndarray  # (3,) length, beam, height, metres
+    static: bool = False  # never moves: moored ships, and scenario vessels at speed 0 (VesselConfig.static)
 
 
 @dataclass(frozen=True)
@@ -154,10 +155,10 @@ class Simulation:
         self.ws: WorldScene = build_world_scene(self.world, [(v.asset, v.role) for v in sc.vessels], poses0)
         self.vessels: list[VesselInfo] = []
         for v, inst in zip(sc.vessels, self.ws.vessel_instances, strict=True):
-            self.vessels.append(self._info(v.id, v.asset, v.role, int(inst)))
+            self.vessels.append(self._info(v.id, v.asset, v.role, int(inst), static=v.static))
         self._moored_mats = []
         for k, ((asset_name, (x, y, yaw)), inst) in enumerate(zip(self.world.moored, self.ws.moored_instances, strict=True)):
-            self.vessels.append(self._info(f"moored_{k:02d}", asset_name, "moored", inst))
+            self.vessels.append(self._info(f"moored_{k:02d}", asset_name, "moored", inst, static=True))
             self._moored_mats.append(pose_matrices(np.array([x, y, 0.0, 0.0, 0.0, yaw])))
         self._moored_eta = np.array([[x, y, 0.0, 0.0, 0.0, yaw] for _, (x, y, yaw) in self.world.moored]).reshape(-1, 6)
         self.agents: list[Agent] = [self._agent(i, v) for i, v in enumerate(sc.vessels) if v.role == "usv"]
@@ -166,11 +167,11 @@ class Simulation:
     # ------------------------------------------------------------------------------------------ building
 
     @staticmethod
-    def _info(vid: str, asset_name: str, role: str, instance: int) -> VesselInfo:
+    def _info(vid: str, asset_name: str, role: str, instance: int, *, static: bool) -> VesselInfo:
         a = get_asset(asset_name)
         lo, hi = a.bbox[0], a.bbox[1]
         cls = 11 if role == "usv" else int(a.semantic_class)
-        return VesselInfo(vid, asset_name, role, cls, instance, (lo + hi) / 2.0, hi - lo)
+        return VesselInfo(vid, asset_name, role, cls, instance, (lo + hi) / 2.0, hi - lo, static)
 
     def _agent(self, index: int, v: VesselConfig) -> Agent:
         rig = self.scenario.rigs[v.rig] if v.rig is not None else RigConfig()

@@ -303,3 +303,36 @@ def test_round_trip_port(port_rec: Path, tmp_path: Path) -> None:
     assert sorted(p.name for p in out.iterdir() if p.is_dir()) == ["1000", "1001", "1002"]
     n = check_round_trip(out, recorded(port_rec), {"1000": "usv_1", "1001": "usv_2", "1002": "usv_3"})
     assert n["own"] > 100, n
+
+
+def test_moored_ships_are_labelled_static_with_boxes_that_hold_their_points(port_rec: Path, tmp_path: Path) -> None:
+    """Moored ships are vessels like any other: in the annotations, the tables and the OPV2V export, flagged
+    ``static`` with role ``moored``; their boxes hold their LiDAR points, seen by the ego in port_entry."""
+    import polars as pl
+
+    convert(port_rec, to="opv2v", out_dir=tmp_path, splits=None, extras=())
+    out = tmp_path / "port_entry"
+    rec = recorded(port_rec)
+    moored_pts = 0
+    for ts in frames_of(out / "1001"):
+        k = int(ts)
+        inst = _instance_rows(rec[k]["world"])
+        doc = load(out / "1001" / f"{ts}.yaml")
+        extra = load(out / "1001" / f"{ts}_additional.yaml")["mmusv"]["vehicles"]
+        pts_all = read_pcd_o3d(out / "1001" / f"{ts}.pcd")[0]
+        ids = rec[k]["/usv_2/lidar"]["instance"]
+        for vid, meta in extra.items():
+            assert meta["static"] == (meta["role"] == "moored"), meta  # the scenario's other vessels all move
+            if meta["role"] != "moored":
+                continue
+            pts = pts_all[ids == inst[vid]]
+            ok = inside(pts, doc["vehicles"][vid], doc["lidar_pose"], TOL_M)
+            assert ok.all()
+            moored_pts += len(pts)
+    assert moored_pts > 100, "usv_2 waits beside the quays: it must see a moored ship"
+    boxes = pl.read_parquet(port_rec.parent / "tables" / "boxes_3d")
+    moored = boxes.filter(pl.col("role") == "moored")
+    assert moored.height > 0 and moored["static"].all() and moored["lidar_points"].sum() > 0
+    assert not boxes.filter(pl.col("role") != "moored")["static"].any()
+    world = pl.read_parquet(port_rec.parent / "tables" / "world_state")
+    assert world.filter(pl.col("role") == "moored")["static"].all()

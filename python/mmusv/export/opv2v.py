@@ -145,13 +145,21 @@ class Opv2vWriter(DatasetWriter):
                 "frame": frame.index,
                 "time_s": round(world.time_s, 9),
                 "vehicles": {
-                    cav_id(t.index): {"name": t.id, "asset": t.asset, "role": t.role, "semantic_class": t.semantic_class,
+                    cav_id(t.index): {"name": t.id, "asset": t.asset, "role": t.role, "static": self._static(t),
+                                      "semantic_class": t.semantic_class,
                                       "class_name": class_name(t.semantic_class), "instance_id": t.instance_id,
                                       "lidar_points": counts.get(t.instance_id, 0)}
                     for t in targets
                 },
             }
         }
+
+    def _static(self, t: Target) -> bool:
+        """The vessel never moves: a moored ship, or a scenario vessel at speed 0 (``VesselConfig.static``)."""
+        if t.role == "moored":
+            return True
+        speeds = {str(v.get("id")): float(v.get("speed_mps", 0.0)) for v in self.info.scenario.get("vessels", [])}
+        return speeds.get(t.id, 0.0) == 0.0
 
     def finish(self, frames: list[int], skipped: list[dict[str, Any]]) -> None:
         super().finish(frames, skipped)

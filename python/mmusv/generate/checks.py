@@ -43,6 +43,7 @@ from mmusv.generate.spec import (
     ShoreClearanceCheck,
     StructureClearanceCheck,
 )
+from mmusv.generate.spec_constraints import TargetDensityCheck
 from mmusv.motion import build_fleet
 from mmusv.world.vessels import get_asset
 
@@ -308,6 +309,26 @@ class SensingRange:
         return None
 
 
+class TargetDensity:
+    name = "target_density"
+
+    def __init__(self, cfg: TargetDensityCheck) -> None:
+        self.range_m, self.min_targets, self.share = cfg.range_m, cfg.min_targets, cfg.min_share
+
+    def check(self, s: Samples) -> str | None:
+        u = np.asarray(s.usvs)
+        t = np.array([i for i in range(len(s.ids)) if not s.is_usv[i]], dtype=np.int64)
+        if t.size == 0:
+            return f"no targets: each USV needs {self.min_targets} within {self.range_m:g} m"
+        d = np.linalg.norm(s.frames[:, u, None, :] - s.frames[:, None, t, :], axis=-1)  # (frames, usvs, targets)
+        share = np.mean((d <= self.range_m).sum(axis=2) >= self.min_targets, axis=0)  # per USV
+        worst = int(np.argmin(share))
+        if share[worst] < self.share:
+            return (f"{s.ids[int(u[worst])]} has {self.min_targets}+ targets within {self.range_m:g} m in "
+                    f"{share[worst]:.0%} of frames; need {self.share:.0%}")
+        return None
+
+
 class Cooperation:
     name = "cooperation"
 
@@ -390,6 +411,8 @@ def build_constraints(spec: GenerationSpec) -> list[Constraint]:
         out.append(TargetRange())
     if c.sensing_range.enabled:
         out.append(SensingRange(c.sensing_range))
+    if c.target_density.enabled:
+        out.append(TargetDensity(c.target_density))
     if c.cooperation.enabled:
         out.append(Cooperation(c.cooperation))
     if c.line_of_sight.enabled:

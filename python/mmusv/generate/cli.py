@@ -46,8 +46,10 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.output) if args.output else Path("scenarios/generated") / spec.name
     total = sum(c.quota for c in spec.combinations)
     t0 = time.perf_counter()
-    with console.status(f"building map {spec.map.type} seed {spec.map.seed}", spinner="dots"):
-        map_context(spec.map.type, spec.map.seed, dict(spec.map.params)).scene
+    maps = {(m.type, m.seed): m for m in (spec.map_of(c) for c in spec.combinations)}
+    for (kind, seed), m in sorted(maps.items()):
+        with console.status(f"building map {kind} seed {seed}", spinner="dots"):
+            map_context(m.type, m.seed, dict(m.params)).scene
     t_map = time.perf_counter() - t0
     t0 = time.perf_counter()
     if args.no_progress:

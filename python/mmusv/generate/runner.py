@@ -129,7 +129,7 @@ def generate(
     unless ``force``) and writes ``report.json`` there; returns the report."""
     spec = load_spec(spec_source)
     out = Path(out_dir)
-    ctx = map_context(spec.map.type, spec.map.seed, dict(spec.map.params))
+    contexts = [map_context(m.type, m.seed, dict(m.params)) for m in (spec.map_of(c) for c in spec.combinations)]
     constraints = build_constraints(spec)
     _prepare_dir(out, force)
     report = RunReport(
@@ -140,6 +140,7 @@ def generate(
     )
     total_attempts = 0
     for i, combo in enumerate(spec.combinations):
+        ctx = contexts[i]
         rep = ComboReport(combo.label(), combo.family, combo.difficulty, combo.quota, spec.max_attempts(combo))
         rep.infeasible = _infeasible(spec, ctx, i)
         report.combos.append(rep)
@@ -168,6 +169,7 @@ def generate(
                     report.scenarios.append(
                         {"file": path.name, "combination": rep.name, "family": combo.family,
                          "difficulty": combo.difficulty, "attempt": attempt, "seed": cand.data["seed"],
+                         "map": cand.data["map"]["type"],
                          "roles": cand.meta.as_dict()}
                     )
             if progress is not None:

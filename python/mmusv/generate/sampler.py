@@ -191,12 +191,13 @@ def sample_candidate(spec: GenerationSpec, combo_index: int, attempt: int, ctx: 
 
         distractors += pick_best(inp, make)
     tracks = layout.tracks + distractors
+    map_cfg = spec.map_of(combo)
     order = {"usv": 0, "target": 1}
     tracks.sort(key=lambda t: (order[t.role.role], 0 if t.role.id == "usv_ego" else 1))
     data: dict[str, Any] = {
         "name": name,
         "seed": scenario_seed(spec.seed, combo_index, attempt),
-        "map": {"type": spec.map.type, "seed": spec.map.seed, "params": dict(sorted(spec.map.params.items()))},
+        "map": {"type": map_cfg.type, "seed": map_cfg.seed, "params": dict(sorted(map_cfg.params.items()))},
         "environment": env,
         "acquisition": {"frequency_hz": acq.frequency_hz, "frames": acq.frames},
         "rigs": {spec.rig: dict(spec.rigs[spec.rig])},

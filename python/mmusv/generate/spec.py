@@ -12,7 +12,8 @@ Units: metres, seconds, metres per second; shares are fractions of the frames in
   [lo, hi]) from ``extra_classes``, ``occluded_share`` (ask for occlusion of the primary target);
 - ``combinations``: ``family`` (:data:`mmusv.generate.families.FAMILIES`), ``difficulty``, ``ego`` asset,
   ``cooperating`` USVs, ``targets`` (one size class per role target, the first is primary), ``quota``,
-  optional ``max_attempts`` (default ``quota x max_attempts_per_scenario``) and ``name``;
+  optional ``max_attempts`` (default ``quota x max_attempts_per_scenario``), ``name`` and ``map`` (this
+  combination's own map instead of the spec's, so one spec can cover several maps);
 - ``constraints``: the named checks and thresholds (:mod:`mmusv.generate.spec_constraints`);
 - tuning: ``check_step_m`` (sample spacing of the checks), ``sensor_height_m``, ``encounter_clearance_m``,
   ``proposals`` (prior-guided proposals per placed vessel).
@@ -231,6 +232,7 @@ class Combination(_Model):
     targets: list[str] = Field(default_factory=lambda: ["small"], min_length=1, max_length=8)
     quota: int = Field(default=1, ge=1, le=100_000)
     max_attempts: int | None = Field(default=None, ge=1, le=10_000_000)
+    map: MapConfig | None = None
 
     @field_validator("family")
     @classmethod
@@ -303,6 +305,10 @@ class GenerationSpec(_Model):
                     raise ValueError(f"environment.{key} = {c!r}: {msg}") from None
         return v
 
+    def map_of(self, combo: Combination) -> MapConfig:
+        """The map a combination's scenarios use: its own ``map`` or the spec's (one spec can cover several maps)."""
+        return combo.map if combo.map is not None else self.map
+
     def max_attempts(self, combo: Combination) -> int:
         """The attempt cap of a combination: its own ``max_attempts`` or ``quota x max_attempts_per_scenario``."""
         return combo.max_attempts if combo.max_attempts is not None else combo.quota * self.max_attempts_per_scenario
@@ -336,8 +342,9 @@ def _cross_checks(spec: GenerationSpec, source: str) -> None:
             if t not in spec.size_classes:
                 fail(f"{where}.targets[{j}]", t, f"not a size class ({', '.join(spec.size_classes)})")
         fam = FAMILIES[combo.family]
-        if fam.map_types and spec.map.type not in fam.map_types:
-            fail(f"{where}.family", combo.family, f"needs a map of type {' or '.join(fam.map_types)} (map.type is {spec.map.type})")
+        map_type = spec.map_of(combo).type
+        if fam.map_types and map_type not in fam.map_types:
+            fail(f"{where}.family", combo.family, f"needs a map of type {' or '.join(fam.map_types)} (map.type is {map_type})")
         if combo.cooperating < fam.min_cooperating:
             fail(f"{where}.cooperating", combo.cooperating, f"family {combo.family} needs at least {fam.min_cooperating}")
         label = combo.label()

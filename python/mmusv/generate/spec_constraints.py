@@ -78,6 +78,17 @@ class SensingRangeCheck(_Check):
     targets: Literal["all", "role"] = "all"
 
 
+class TargetDensityCheck(_Check):
+    """Each USV has at least ``min_targets`` targets (role targets and distractors; other USVs do not count)
+    within ``range_m`` (centre to centre, BEV) for at least ``min_share`` of the frames: datasets dense enough
+    to learn detection from. Off unless a spec sets it."""
+
+    enabled: bool = False
+    range_m: float = Field(default=200.0, gt=0.0, le=100_000.0)
+    min_targets: int = Field(default=1, ge=1, le=64)
+    min_share: float = Field(default=0.8, ge=0.0, le=1.0)
+
+
 class CooperationCheck(_Check):
     """Each USV's nearest other USV between ``min_m`` and ``max_m`` for at least ``min_share`` of the frames
     (vacuous with one USV)."""
@@ -120,6 +131,7 @@ class Constraints(_Model):
     route_separation: RouteSeparationCheck = Field(default_factory=RouteSeparationCheck)
     target_range: TargetRangeCheck = Field(default_factory=TargetRangeCheck)
     sensing_range: SensingRangeCheck = Field(default_factory=SensingRangeCheck)
+    target_density: TargetDensityCheck = Field(default_factory=TargetDensityCheck)
     cooperation: CooperationCheck = Field(default_factory=CooperationCheck)
     line_of_sight: LineOfSightCheck = Field(default_factory=LineOfSightCheck)
     occlusion: OcclusionCheck = Field(default_factory=OcclusionCheck)

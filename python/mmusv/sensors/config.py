@@ -4,6 +4,8 @@ A rig (``rigs:`` in a scenario) has a LiDAR, a radar, any number of pinhole came
 every part has defaults (the paper's suite: a 64-channel LiDAR at 131,072 points/s and 5 Hz, a marine radar,
 four 640×480 surround cameras with a 90° field of view, a top-view camera 120 m up), so ``usv_standard: {}``
 is a complete rig. ``null`` switches a sensor off (``radar: null``); ``cameras: []`` removes the cameras.
+``preset: lidar_only`` starts from the LiDAR alone (no radar, cameras or top view; any of them can still be
+added explicitly): the rig for detection datasets, where cameras would cost most of the time.
 
 Mounts: ``point`` names a mount point of the vessel asset (``lidar``, ``radar``, ``camera_front``, ...; see
 ``mmusv assets``); ``xyz`` (metres) and ``rpy_deg`` (degrees) are then relative to that point, in the vessel
@@ -25,8 +27,16 @@ __all__ = [
     "CameraConfig",
     "TopViewConfig",
     "RigConfig",
+    "RIG_PRESETS",
     "default_cameras",
 ]
+
+RigPreset = Literal["full", "lidar_only"]
+RIG_PRESETS: dict[str, dict[str, object]] = {
+    "full": {},
+    "lidar_only": {"radar": None, "cameras": [], "top_view": None},
+}
+"""Defaults each preset puts in place of the paper's full suite (keys given explicitly in the rig win)."""
 
 CameraOutput = Literal["rgb", "depth", "semantic", "instance"]
 _ALL_OUTPUTS: tuple[CameraOutput, ...] = ("rgb", "depth", "semantic", "instance")
@@ -198,12 +208,23 @@ def default_cameras(resolution: tuple[int, int] = (640, 480)) -> list[CameraConf
 
 
 class RigConfig(_Model):
-    """The sensors of one instrumented USV; every part defaults to the paper's suite."""
+    """The sensors of one instrumented USV; every part defaults to the paper's suite, or to ``preset``'s
+    (:data:`RIG_PRESETS`): ``full`` (the default) or ``lidar_only``."""
 
+    preset: RigPreset = "full"
     lidar: LidarConfig | None = Field(default_factory=LidarConfig)
     radar: RadarConfig | None = Field(default_factory=RadarConfig)
     cameras: list[CameraConfig] = Field(default_factory=default_cameras)
     top_view: TopViewConfig | None = Field(default_factory=TopViewConfig)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _apply_preset(cls, data: object) -> object:
+        if isinstance(data, dict):
+            preset = data.get("preset", "full")
+            if isinstance(preset, str) and preset in RIG_PRESETS:
+                return {**RIG_PRESETS[preset], **data}
+        return data
 
     @model_validator(mode="after")
     def _unique(self) -> RigConfig:

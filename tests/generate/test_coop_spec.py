@@ -1,0 +1,68 @@
+"""The bundled cooperative-detection spec: all three maps, 2-4 USVs on the LiDAR-only rig, and the target
+density it asks for, checked independently on the generated scenarios from the simulator's world state."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mmusv.config import load_scenario
+from mmusv.generate.runner import generate
+from mmusv.generate.spec import load_spec
+from mmusv.simulation import Simulation
+
+ROOT = Path(__file__).resolve().parents[2]
+SPEC = ROOT / "scenarios/specs/coop_detection.yaml"
+
+
+def test_spec_covers_every_map_on_the_lidar_only_rig() -> None:
+    spec = load_spec(SPEC)
+    assert {spec.map_of(c).type for c in spec.combinations} == {"island", "open_sea", "port"}
+    assert spec.rigs[spec.rig] == {"preset": "lidar_only"}
+    assert all(1 <= c.cooperating <= 3 for c in spec.combinations)
+    d = spec.constraints.target_density
+    assert d.enabled and d.range_m == 200 and d.min_targets >= 2
+
+
+@pytest.fixture(scope="module")
+def generated(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    spec = load_spec(SPEC).model_dump()
+    # one scenario per map keeps the test short: the island occlusion, open-sea convoy and harbour combinations
+    keep = {"island_occluded", "sea_convoy", "port_traffic"}
+    spec["combinations"] = [dict(c, quota=1, max_attempts=3000) for c in spec["combinations"] if c["name"] in keep]
+    out = tmp_path_factory.mktemp("coop_gen")
+    report = generate(spec, out)
+    assert report.accepted == 3
+    return out
+
+
+def test_generated_scenarios_have_the_density_they_promise(generated: Path) -> None:
+    files = sorted(generated.glob("*.yaml"))
+    assert {load_scenario(f).map.type for f in files} == {"island", "open_sea", "port"}
+    for f in files:
+        sc = load_scenario(f)
+        assert 2 <= len(sc.usvs) <= 4
+        assert all(sc.rigs[v.rig or ""].radar is None and not sc.rigs[v.rig or ""].cameras for v in sc.usvs)
+        sim = Simulation(sc)
+        ok = {a.vessel.id: 0 for a in sim.agents}
+        for k in range(sim.frames):
+            st = sim.world_state(k)
+            for a in sim.agents:
+                d = np.hypot(*(st.poses[:, :2] - st.poses[a.index, :2]).T)
+                n = sum(1 for i, v in enumerate(sim.vessels) if v.role == "target" and d[i] <= 200.0)
+                ok[a.vessel.id] += n >= 2
+        for usv, n in ok.items():
+            assert n / sim.frames >= 0.6, f"{f.name}: {usv} has 2+ targets within 200 m in {n}/{sim.frames} frames"
+
+
+def test_target_density_rejects_a_lonely_usv(tmp_path: Path) -> None:
+    """The same combination with distractors removed and density asking for 3 targets can never pass."""
+    spec = load_spec(SPEC).model_dump()
+    spec["combinations"] = [dict(c, quota=1, max_attempts=20) for c in spec["combinations"] if c["name"] == "sea_crossing"]
+    spec["difficulties"]["mid"]["extra_targets"] = 0
+    spec["constraints"]["target_density"]["min_targets"] = 3
+    report = generate(spec, tmp_path)
+    assert report.accepted == 0
+    assert report.combos[0].rejected.get("target_density", 0) > 0
