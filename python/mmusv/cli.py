@@ -2,7 +2,7 @@
 
 Subcommands: ``run`` (a scenario or a folder of them into MCAP + Parquet), ``info`` and ``preview`` (inspect a
 recording), ``convert`` (to OPV2V or KITTI), ``generate`` (batch scenario generation), ``assets`` (the vessel library), ``study waves`` (Table I)
-and ``study agreement`` (Table II), ``version``.
+and ``study agreement`` (Table II), ``study detection`` / ``study robustness`` (Tables III, IV), ``version``.
 Errors in the input end with a one-line message naming the problem and exit status 2, never a traceback.
 """
 
@@ -225,6 +225,9 @@ def _parser() -> argparse.ArgumentParser:
     agree.add_argument("scenarios", nargs="*", help="scenario YAMLs (default: the three bundled map scenarios)")
     agree.add_argument("-o", "--output", default="out/agreement_study", help="output folder")
     agree.add_argument("--frames", type=int, default=None, help="frames per scenario (default: all)")
+    from mmusv.studies.detection.cli import add_parsers as add_detection_parsers
+
+    add_detection_parsers(studies)
     run = sub.add_parser("run", help="run a scenario (or a folder of them) into an MCAP recording + Parquet tables")
     run.add_argument("scenario", help="scenario YAML, or a folder of scenario YAMLs")
     run.add_argument("-o", "--output", default="out", help="output folder (default out/)")
@@ -272,6 +275,10 @@ def main(argv: list[str] | None = None) -> int:
             return _cmd_study_waves(args)
         if args.command == "study" and args.study == "agreement":
             return _cmd_study_agreement(args)
+        if args.command == "study" and args.study in ("detection", "robustness"):
+            from mmusv.studies.detection.cli import run as _run_detection
+
+            return _run_detection(args)
         if args.command == "run":
             return _cmd_run(args)
         if args.command == "info":

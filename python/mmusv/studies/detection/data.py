@@ -1,0 +1,258 @@
+"""The detection dataset: sequences of frames, each with every instrumented USV's LiDAR cloud and pose and the
+clean world-frame boxes of the targets (mmusv frames: world x east, y north, z up).
+
+Sources: ``mmusv run`` recordings (one sequence each, read through :func:`read_recording`, the one place that
+touches the recording reader) and OPV2V folders written by ``mmusv convert --to opv2v`` (one sequence per
+scenario folder). Sequences are split (train / validate / test) by a seeded shuffle of their names *before*
+agent-as-ego expansion (:func:`split_sequences`), so no scene is in two splits.
+
+Ground truth for an ego (:func:`gt_in_ego`): every target box (USVs excluded) moved into the ego LiDAR frame and
+kept when its BEV centre is within ``range_m`` (200 m) of the sensor. USV platforms (:func:`usv_boxes_in_ego`)
+are returned separately: detections centred on them are ignored in evaluation.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from types import ModuleType
+
+import numpy as np
+import yaml
+
+from mmusv.errors import InputError, IoError
+from mmusv.frames import carla_matrix, invert, mirror_transform, pose_matrices
+
+__all__ = [
+    "OPV2V_USV_RADIUS_M",
+    "AgentFrame",
+    "SceneFrame",
+    "SequenceData",
+    "boxes_in_frame",
+    "gt_in_ego",
+    "opv2v_scenarios",
+    "read_opv2v",
+    "read_recording",
+    "split_sequences",
+    "usv_boxes_in_ego",
+]
+
+OPV2V_USV_RADIUS_M = 8.0
+"""An OPV2V folder gives no hull size for its CAVs: their platform is taken as a square of twice this half-size
+about the body origin."""
+
+
+@dataclass(frozen=True)
+class AgentFrame:
+    """One instrumented USV at one frame: ``points`` ``(N, 4)`` float32 ``x, y, z, intensity`` in its LiDAR
+    frame, ``body`` ``(4, 4)`` body → world and ``mount`` ``(4, 4)`` LiDAR → body."""
+
+    id: str
+    points: np.ndarray
+    body: np.ndarray
+    mount: np.ndarray
+
+    @property
+    def lidar(self) -> np.ndarray:
+        """``(4, 4)`` LiDAR → world."""
+        out: np.ndarray = self.body @ self.mount
+        return out
+
+
+@dataclass(frozen=True)
+class SceneFrame:
+    """One acquisition index of a sequence: the USVs (``agents``, scenario order) and the world-frame boxes of
+    the targets (``targets`` ``(K, 4, 4)`` box → world, ``target_sizes`` ``(K, 3)`` l, w, h) and of the USV
+    platforms (``usv_boxes``, ``usv_sizes``)."""
+
+    frame: int
+    agents: tuple[AgentFrame, ...]
+    target_ids: tuple[str, ...]
+    targets: np.ndarray
+    target_sizes: np.ndarray
+    usv_boxes: np.ndarray
+    usv_sizes: np.ndarray
+
+
+@dataclass(frozen=True)
+class SequenceData:
+    """A whole sequence (one recording or one OPV2V scenario folder)."""
+
+    name: str
+    frames: tuple[SceneFrame, ...]
+
+    @property
+    def agent_ids(self) -> tuple[str, ...]:
+        """The instrumented USVs (those present in the first frame)."""
+        return tuple(a.id for a in self.frames[0].agents) if self.frames else ()
+
+
+def boxes_in_frame(to_frame: np.ndarray, boxes: np.ndarray, sizes: np.ndarray) -> np.ndarray:
+    """``(K, 7)`` ``x, y, z, l, w, h, yaw`` of box → world transforms ``boxes`` ``(K, 4, 4)`` with ``sizes``
+    ``(K, 3)`` seen from the frame whose world → frame transform is ``to_frame`` (yaw of the box x axis
+    projected on the frame's xy plane)."""
+    if len(boxes) == 0:
+        return np.zeros((0, 7))
+    m = np.einsum("ij,kjl->kil", to_frame, boxes)
+    yaw = np.arctan2(m[:, 1, 0], m[:, 0, 0])
+    return np.column_stack([m[:, :3, 3], sizes, yaw])
+
+
+def gt_in_ego(frame: SceneFrame, ego: AgentFrame, *, range_m: float = 200.0) -> np.ndarray:
+    """``(G, 7)`` ground-truth target boxes in ``ego``'s LiDAR frame within ``range_m`` (BEV distance)."""
+    b = boxes_in_frame(invert(ego.lidar), frame.targets, frame.target_sizes)
+    out: np.ndarray = b[np.hypot(b[:, 0], b[:, 1]) < range_m] if len(b) else b
+    return out
+
+
+def usv_boxes_in_ego(frame: SceneFrame, ego: AgentFrame) -> np.ndarray:
+    """``(U, 7)`` every USV platform (the ego's included) in ``ego``'s LiDAR frame."""
+    return boxes_in_frame(invert(ego.lidar), frame.usv_boxes, frame.usv_sizes)
+
+
+def _box_mats(poses: np.ndarray, centres: np.ndarray) -> np.ndarray:
+    m = pose_matrices(poses).reshape(-1, 4, 4)
+    m[:, :3, 3] = centres
+    return m
+
+
+def _reader() -> ModuleType:
+    """The project's recording reader: the one place this package imports it (it is moving from
+    ``mmusv.export.reader`` to ``mmusv.recording``; re-point this import then)."""
+    from mmusv.export import reader
+
+    return reader
+
+
+@dataclass(frozen=True)
+class RecordingSummary:
+    """What a recording says about itself without reading its frames."""
+
+    frames_configured: int
+    config_hash: str
+    complete: bool
+
+
+def recording_summary(path: str | Path) -> RecordingSummary:
+    """The frame count, config hash and completeness (summary section present) of a recording; raises
+    :class:`~mmusv.IoError` for a file that is not one."""
+    info = _reader().read_info(path)
+    return RecordingSummary(int(info.frames_configured), str(info.config_hash), bool(info.has_summary))
+
+
+def read_recording(path: str | Path) -> SequenceData:
+    """A recording (``mmusv run`` MCAP) as a sequence: every frame with the LiDAR of every instrumented USV that
+    has one. Raises :class:`~mmusv.IoError` for a file that is not a readable recording."""
+    from mmusv.preview import decode_point_cloud
+
+    reader = _reader()
+    info = reader.read_info(path)
+    agents = [a for a in info.agents if a.lidar_mount is not None]
+    topics = {f"/{a.id}/lidar" for a in agents}
+    frames: list[SceneFrame] = []
+    for fr in reader.FrameStream(info, want=topics.__contains__):
+        w = fr.world
+        if w is None or not all(t in fr.messages for t in topics):
+            continue
+        afs = []
+        for a in agents:
+            c = decode_point_cloud(fr.messages[f"/{a.id}/lidar"])
+            pts = np.column_stack([c["x"], c["y"], c["z"], c.get("intensity", np.zeros(len(c["x"])))])
+            assert a.lidar_mount is not None
+            afs.append(AgentFrame(a.id, pts.astype(np.float32), pose_matrices(w.poses[a.index]), a.lidar_mount))
+        is_usv = np.array([r == "usv" for r in w.roles], dtype=bool)
+        boxes = _box_mats(w.poses, w.box_centers)
+        frames.append(SceneFrame(
+            frame=fr.index, agents=tuple(afs),
+            target_ids=tuple(i for i, u in zip(w.ids, is_usv, strict=True) if not u),
+            targets=boxes[~is_usv], target_sizes=w.box_sizes[~is_usv], usv_boxes=boxes[is_usv],
+            usv_sizes=w.box_sizes[is_usv],
+        ))
+    frames.sort(key=lambda f: f.frame)
+    return SequenceData(info.path.stem, tuple(frames))
+
+
+def opv2v_scenarios(root: str | Path) -> list[Path]:
+    """The scenario folders of an OPV2V tree: ``root`` itself when it holds CAV folders, else its
+    sub-folders (one level, or split folders ``train``/``validate``/``test`` below them) that do. Raises
+    :class:`~mmusv.IoError` when there is none."""
+    r = Path(root)
+    if not r.is_dir():
+        raise IoError(f"--opv2v {r}: not a folder")
+
+    def is_scenario(d: Path) -> bool:
+        return any(c.is_dir() and c.name.isdigit() and any(c.glob("*.pcd")) for c in d.iterdir())
+
+    if is_scenario(r):
+        return [r]
+    found = sorted(d for d in r.iterdir() if d.is_dir() and is_scenario(d))
+    if not found:
+        found = sorted(s for d in r.iterdir() if d.is_dir() for s in d.iterdir() if s.is_dir() and is_scenario(s))
+    if not found:
+        raise IoError(f"--opv2v {r}: not an OPV2V folder (no <scenario>/<cav_id>/<timestamp>.pcd + .yaml found)")
+    return found
+
+
+def read_opv2v(folder: str | Path) -> SequenceData:
+    """One OPV2V scenario folder (as ``mmusv convert --to opv2v`` writes it) as a sequence, converted back from
+    the CARLA frame (y mirrored, degrees) to mmusv frames. Targets are the union of the CAVs' ``vehicles``;
+    the CAVs' platforms are squares of half-size :data:`OPV2V_USV_RADIUS_M` about their body origin."""
+    from mmusv.export.pcd import read_pcd
+
+    d = Path(folder)
+    cavs = sorted((c for c in d.iterdir() if c.is_dir() and c.name.isdigit()), key=lambda c: int(c.name))
+    stamps = sorted({p.stem for c in cavs for p in c.glob("*.pcd")})
+    frames: list[SceneFrame] = []
+    for ts in stamps:
+        afs: list[AgentFrame] = []
+        vehicles: dict[str, np.ndarray] = {}
+        sizes: dict[str, np.ndarray] = {}
+        for c in cavs:
+            y_path, p_path = c / f"{ts}.yaml", c / f"{ts}.pcd"
+            if not (y_path.is_file() and p_path.is_file()):
+                continue
+            try:
+                doc = yaml.safe_load(y_path.read_text(encoding="utf-8"))
+                xyz, inten = read_pcd(p_path)
+                lidar = mirror_transform(carla_matrix(np.asarray(doc["lidar_pose"], dtype=np.float64)))
+                body = mirror_transform(carla_matrix(np.asarray(doc["true_ego_pos"], dtype=np.float64)))
+            except (OSError, ValueError, KeyError, TypeError, yaml.YAMLError) as exc:
+                raise IoError(f"{y_path}: not a readable OPV2V frame ({type(exc).__name__}: {exc})") from None
+            pts = np.column_stack([xyz[:, 0], -xyz[:, 1], xyz[:, 2], inten]).astype(np.float32)
+            afs.append(AgentFrame(c.name, pts, body, invert(body) @ lidar))
+            for vid, v in (doc.get("vehicles") or {}).items():
+                loc = np.asarray(v["location"], dtype=np.float64) + np.asarray(v["center"], dtype=np.float64)
+                roll, yaw, pitch = (float(x) for x in v["angle"])
+                box = mirror_transform(carla_matrix(np.array([loc[0], loc[1], loc[2], roll, yaw, pitch])))
+                vehicles[str(vid)] = box
+                sizes[str(vid)] = 2.0 * np.asarray(v["extent"], dtype=np.float64)
+        if not afs:
+            continue
+        ids = sorted(k for k in vehicles if k not in {a.id for a in afs})
+        usv = np.stack([a.body for a in afs])
+        frames.append(SceneFrame(
+            frame=int(ts), agents=tuple(afs), target_ids=tuple(ids),
+            targets=np.stack([vehicles[k] for k in ids]) if ids else np.zeros((0, 4, 4)),
+            target_sizes=np.stack([sizes[k] for k in ids]) if ids else np.zeros((0, 3)),
+            usv_boxes=usv, usv_sizes=np.tile([2 * OPV2V_USV_RADIUS_M, 2 * OPV2V_USV_RADIUS_M, 5.0], (len(afs), 1)),
+        ))
+    return SequenceData(d.name, tuple(frames))
+
+
+def split_sequences(names: Sequence[str], *, split: str, ratios: Sequence[float], seed: int) -> list[str]:
+    """The names in ``split`` (``train``, ``validate``, ``test`` or ``all``), split by sequence with the seeded
+    shuffle of :func:`mmusv.export.splits.assign_splits`, in sorted order."""
+    from mmusv.export.splits import SPLIT_NAMES, assign_splits
+
+    if split == "all":
+        return sorted(names)
+    if split not in SPLIT_NAMES:
+        raise InputError(f"--split {split!r}: expected one of {', '.join((*SPLIT_NAMES, 'all'))}")
+    sp = assign_splits(list(names), ratios, seed)
+    return sorted(n for n in names if sp[n] == split)
+
+
+def iter_frames(seq: SequenceData) -> Iterator[SceneFrame]:
+    """The frames of ``seq`` in order."""
+    yield from seq.frames

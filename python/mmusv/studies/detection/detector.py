@@ -1,0 +1,217 @@
+"""Detectors: the interface a user's model plugs into, and the training-free baseline.
+
+**Interface.** A detector is any Python callable ``detect(points) -> (boxes, scores)``:
+
+- ``points``: ``(N, 4)`` float32 ``x, y, z, intensity`` in the ego LiDAR frame (metres; x forward, y left,
+  z up; intensity in [0, 1]). For early fusion it is the aggregate of the ego's and its neighbours' points.
+- ``boxes``: ``(M, 7)`` float ``x, y, z, l, w, h, yaw`` in the same frame (box centre, length along the
+  heading, beam, height, heading in radians); ``scores``: ``(M,)`` float, higher is more confident.
+
+It is selected on the command line as ``--detector package.module:function`` (:func:`load_detector`). A model
+that cannot run in-process can instead hand over its predictions as a Parquet file (``--predictions``, see
+:mod:`mmusv.studies.detection.study`).
+
+**Baseline** (:func:`baseline_detect`, the default). Deterministic, no training, no GPU. It is *not* the learned
+model of the paper (a PointPillars-style network), so its absolute numbers are not the paper's:
+
+1. the water surface is fitted as a plane ``z = a·x + b·y + c`` to the lowest point of every occupied 10 m BEV
+   cell (least squares, trimmed to the cells within 1 m of the plane, three rounds): this follows the ego's roll,
+   pitch and heave without knowing its pose;
+2. points more than ``min_height_m`` above that plane are kept; points within ``self_radius_m`` of the sensor
+   (the own platform) are dropped;
+3. the kept points are binned into 0.5 m BEV cells and the cells are clustered by single linkage with a
+   range-adaptive gap (``max(gap_m, gap_per_m · range)``: the LiDAR's point spacing grows with range);
+4. each cluster gets the minimum-area rectangle of its points (shapely), with length along the longer side;
+   a side seen edge-on is widened to ``max(min_width_m, beam_ratio · length)`` (a usual beam-to-length ratio)
+   away from the sensor (the visible face is the near one);
+   z spans the water plane to the highest point;
+5. the score is the point support ``n / (n + 20)``; clusters with fewer than ``min_points`` points, or larger
+   than any vessel (``max_length_m``, ``max_width_m``: land) are dropped.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import shapely
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+from scipy.spatial import cKDTree
+
+from mmusv.errors import ConfigError
+
+__all__ = [
+    "BASELINE_NOTE",
+    "BaselineParams",
+    "Detector",
+    "baseline_detect",
+    "fit_box",
+    "load_detector",
+    "water_plane",
+]
+
+Detector = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
+"""``(points (N, 4) float32 ego LiDAR frame) -> (boxes (M, 7), scores (M,))``."""
+
+BASELINE_NOTE = ("baseline detector: training-free BEV clustering with oriented box fitting, NOT the paper's "
+                 "learned model; absolute AP values are not comparable with the paper's")
+
+
+@dataclass(frozen=True)
+class BaselineParams:
+    """Tuning of :func:`baseline_detect` (metres unless said otherwise)."""
+
+    plane_cell_m: float = 10.0
+    min_height_m: float = 0.5
+    self_radius_m: float = 2.0
+    cell_m: float = 0.5
+    gap_m: float = 1.5
+    gap_per_m: float = 0.05
+    min_points: int = 3
+    min_width_m: float = 0.8
+    beam_ratio: float = 0.25
+    min_length_m: float = 3.0
+    max_length_m: float = 320.0
+    max_width_m: float = 50.0
+    support_half: float = 20.0
+
+
+def water_plane(points: np.ndarray, *, cell_m: float = 10.0, rounds: int = 3, tol_m: float = 1.0) -> np.ndarray:
+    """``(3,)`` plane ``(a, b, c)``, ``z = a·x + b·y + c``, fitted to the lowest point of each ``cell_m`` BEV
+    cell of ``points`` ``(N, ≥3)`` (see the module docstring). Fewer than 3 cells: a level plane at the lowest
+    point (or 0 without points)."""
+    p = np.asarray(points, dtype=np.float64)
+    if p.shape[0] == 0:
+        return np.zeros(3)
+    keys = np.floor(p[:, :2] / cell_m).astype(np.int64)
+    order = np.lexsort((p[:, 2], keys[:, 1], keys[:, 0]))
+    k = keys[order]
+    first = np.ones(len(order), dtype=bool)
+    first[1:] = np.any(k[1:] != k[:-1], axis=1)
+    low = p[order[first], :3]
+    if low.shape[0] < 3:
+        return np.array([0.0, 0.0, float(low[:, 2].min())])
+    sel = low[:, 2] <= np.quantile(low[:, 2], 0.5)
+    coef = np.array([0.0, 0.0, float(np.median(low[:, 2]))])
+    for _ in range(rounds):
+        if sel.sum() < 3:
+            break
+        a = np.column_stack([low[sel, 0], low[sel, 1], np.ones(int(sel.sum()))])
+        coef = np.linalg.lstsq(a, low[sel, 2], rcond=None)[0]
+        resid = low[:, 2] - (low[:, 0] * coef[0] + low[:, 1] * coef[1] + coef[2])
+        sel = np.abs(resid) <= tol_m
+    return np.asarray(coef, dtype=np.float64)
+
+
+def fit_box(xy: np.ndarray, *, z_low: float, z_high: float, min_width_m: float = 0.8, beam_ratio: float = 0.25,
+            min_length_m: float = 3.0) -> np.ndarray:
+    """``(7,)`` box ``x, y, z, l, w, h, yaw`` of the BEV points ``xy`` ``(K, 2)`` (K ≥ 1): minimum-area
+    rectangle, length along the longer side, yaw in (-π/2, π/2]; a width under ``max(min_width_m, beam_ratio ·
+    length)`` is widened to it away from the origin (the sensor); a length under ``min_length_m`` is raised."""
+    pts = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+    rect = shapely.minimum_rotated_rectangle(shapely.multipoints(pts))
+    if rect.geom_type == "Polygon":
+        c = np.asarray(rect.exterior.coords)[:4]
+        e1, e2 = c[1] - c[0], c[2] - c[1]
+        centre = c.mean(axis=0)
+    else:  # a segment or a point
+        c = np.asarray(rect.coords) if rect.geom_type == "LineString" else pts[:1]
+        e1 = c[-1] - c[0] if len(c) > 1 else np.array([0.0, 0.0])
+        e2 = np.zeros(2)  # no extent across
+        centre = c.mean(axis=0)
+    if np.hypot(*e2) > np.hypot(*e1):
+        e1, e2 = e2, e1
+    length, width = float(np.hypot(*e1)), float(np.hypot(*e2))
+    if length > 1e-9:
+        u = e1 / length
+    else:
+        r = np.hypot(*centre)
+        u = np.array([-centre[1], centre[0]]) / r if r > 1e-9 else np.array([1.0, 0.0])
+    v = np.array([-u[1], u[0]])
+    out_dir = 1.0 if float(np.dot(v, centre)) >= 0 else -1.0  # across the box, away from the sensor
+    length = max(length, min_length_m)
+    wmin = max(min_width_m, beam_ratio * length)
+    if width < wmin:
+        centre = centre + v * out_dir * (wmin - width) / 2.0
+        width = wmin
+    yaw = float(np.arctan2(u[1], u[0]))
+    if yaw <= -np.pi / 2:
+        yaw += np.pi
+    elif yaw > np.pi / 2:
+        yaw -= np.pi
+    h = max(z_high - z_low, 0.1)
+    return np.array([centre[0], centre[1], (z_low + z_high) / 2.0, length, width, h, yaw])
+
+
+def baseline_detect(points: np.ndarray, params: BaselineParams | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The baseline detector (see the module docstring): ``points`` ``(N, 4)`` float32 in the ego LiDAR frame →
+    boxes ``(M, 7)`` float64 and scores ``(M,)`` float64, sorted by descending score then position."""
+    prm = params or BaselineParams()
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 4) if np.size(points) else np.zeros((0, 4))
+    if p.shape[0] == 0:
+        return np.zeros((0, 7)), np.zeros(0)
+    a, b, c = water_plane(p, cell_m=prm.plane_cell_m)
+    height = p[:, 2] - (a * p[:, 0] + b * p[:, 1] + c)
+    keep = (height > prm.min_height_m) & (np.hypot(p[:, 0], p[:, 1]) > prm.self_radius_m)
+    q = p[keep]
+    if q.shape[0] < prm.min_points:
+        return np.zeros((0, 7)), np.zeros(0)
+    cell = np.floor(q[:, :2] / prm.cell_m).astype(np.int64)
+    uniq, inv = np.unique(cell, axis=0, return_inverse=True)
+    inv = inv.reshape(-1)
+    centres = (uniq + 0.5) * prm.cell_m
+    rng = np.hypot(centres[:, 0], centres[:, 1])
+    gap = np.maximum(prm.gap_m, prm.gap_per_m * rng)
+    pairs = cKDTree(centres).query_pairs(r=float(gap.max()), output_type="ndarray")
+    if pairs.size:
+        d = np.hypot(*(centres[pairs[:, 0]] - centres[pairs[:, 1]]).T)
+        ok = d <= np.minimum(gap[pairs[:, 0]], gap[pairs[:, 1]])
+        pairs = pairs[ok]
+    n = uniq.shape[0]
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])) if len(pairs) else ([], ([], [])),
+                       shape=(n, n))
+    _, cell_label = connected_components(graph, directed=False)
+    label = cell_label[inv]
+    boxes: list[np.ndarray] = []
+    scores: list[float] = []
+    order = np.argsort(label, kind="stable")
+    starts = np.flatnonzero(np.r_[True, label[order][1:] != label[order][:-1]])
+    for group in np.split(order, starts[1:]):
+        npts = len(group)
+        if npts < prm.min_points:
+            continue
+        pts = q[group]
+        z_low = float(np.mean(a * pts[:, 0] + b * pts[:, 1] + c))
+        box = fit_box(pts[:, :2], z_low=z_low, z_high=float(pts[:, 2].max()), min_width_m=prm.min_width_m,
+                      beam_ratio=prm.beam_ratio, min_length_m=prm.min_length_m)
+        if box[3] > prm.max_length_m or box[4] > prm.max_width_m:
+            continue
+        boxes.append(box)
+        scores.append(npts / (npts + prm.support_half))
+    if not boxes:
+        return np.zeros((0, 7)), np.zeros(0)
+    bx = np.array(boxes)
+    sc = np.array(scores)
+    rank = np.lexsort((bx[:, 1], bx[:, 0], -sc))
+    return bx[rank], sc[rank]
+
+
+def load_detector(spec: str) -> Detector:
+    """The callable named by ``spec`` = ``"package.module:function"`` (``"baseline"`` is
+    :func:`baseline_detect`)."""
+    if spec == "baseline":
+        return baseline_detect
+    mod_name, sep, attr = spec.partition(":")
+    if not sep or not mod_name or not attr:
+        raise ConfigError(f"--detector {spec!r}: expected 'baseline' or 'package.module:function'")
+    try:
+        mod = importlib.import_module(mod_name)
+    except ImportError as exc:
+        raise ConfigError(f"--detector {spec!r}: cannot import module {mod_name!r} ({exc})") from None
+    fn = getattr(mod, attr, None)
+    if not callable(fn):
+        raise ConfigError(f"--detector {spec!r}: module {mod_name!r} has no callable {attr!r}")
+    return fn  # type: ignore[no-any-return]

@@ -1,0 +1,153 @@
+"""Presenting a detection study: rich tables, CSV, a plot (matplotlib) and the Parquet of every scored box."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import polars as pl
+
+from mmusv.studies.detection.detector import BASELINE_NOTE
+from mmusv.studies.detection.evaluate import RANGE_BINS, bin_label
+from mmusv.studies.detection.study import StudyResult
+
+__all__ = ["detection_table", "fmt", "robustness_table", "write_detection", "write_robustness"]
+
+BINS = [bin_label(k) for k in range(len(RANGE_BINS))]
+
+
+def fmt(v: float) -> str:
+    """Three decimals, ``-`` for NaN."""
+    return "-" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:.3f}"
+
+
+def detection_table(res: StudyResult) -> pl.DataFrame:
+    """Table III: one row per fusion mode (clean setting)."""
+    t = res.table().filter(pl.col("setting") == "clean")
+    cols = ["mode", "ap30", "ap50", "ap70", "precision50", "recall50", *[f"ap50_{b}" for b in BINS],
+            "recall50_visible", "recall50_hidden", "recall50_unseen", "recall30_visible", "recall30_hidden",
+            "recall30_unseen", "gt_visible", "gt_hidden", "gt_unseen", "gt", "det", "frames"]
+    return t.select(cols)
+
+
+def robustness_table(res: StudyResult) -> pl.DataFrame:
+    """Table IV: AP@0.5 per setting (rows) and mode (columns); no fusion only under ``clean``."""
+    t = res.table()
+    wide = t.pivot(on="mode", index=["setting", "kind", "delay_frames", "sigma_xyz_m", "sigma_rpy_deg"], values="ap50")
+    order = {s.name: i for i, s in enumerate(res.options.settings)}
+    wide = wide.with_columns(pl.col("setting").replace_strict(order, return_dtype=pl.Int64).alias("_o")).sort("_o")
+    return wide.drop("_o")
+
+
+def _detector_name(res: StudyResult, detector: str) -> str:
+    return "predictions file" if res.options.predictions is not None else detector
+
+
+def write_detection(res: StudyResult, out: Path, *, detector: str) -> dict[str, Path]:
+    """Writes ``detection_table.csv``, ``detection_boxes.parquet``, ``detection_ap.png`` and
+    ``detection_note.txt`` into ``out``; returns the paths."""
+    out.mkdir(parents=True, exist_ok=True)
+    table = detection_table(res)
+    paths = {"csv": out / "detection_table.csv", "parquet": out / "detection_boxes.parquet",
+             "png": out / "detection_ap.png", "note": out / "detection_note.txt"}
+    table.write_csv(paths["csv"])
+    res.boxes_frame(with_setting=False).write_parquet(paths["parquet"])
+    _plot_detection(table, paths["png"])
+    paths["note"].write_text(_note(res, detector), encoding="utf-8")
+    return paths
+
+
+def write_robustness(res: StudyResult, out: Path, *, detector: str) -> dict[str, Path]:
+    """Writes ``robustness_table.csv`` (AP@0.5 per setting and mode), ``robustness_metrics.csv`` (every metric),
+    ``robustness_boxes.parquet``, ``robustness_ap.png`` and ``robustness_note.txt`` into ``out``."""
+    out.mkdir(parents=True, exist_ok=True)
+    paths = {"csv": out / "robustness_table.csv", "metrics": out / "robustness_metrics.csv",
+             "parquet": out / "robustness_boxes.parquet", "png": out / "robustness_ap.png",
+             "note": out / "robustness_note.txt"}
+    wide = robustness_table(res)
+    wide.write_csv(paths["csv"])
+    res.table().write_csv(paths["metrics"])
+    res.boxes_frame(with_setting=True).write_parquet(paths["parquet"])
+    _plot_robustness(res, paths["png"])
+    paths["note"].write_text(_note(res, detector), encoding="utf-8")
+    return paths
+
+
+def _note(res: StudyResult, detector: str) -> str:
+    lines = [f"detector: {_detector_name(res, detector)}"]
+    if detector == "baseline" and res.options.predictions is None:
+        lines.append(BASELINE_NOTE)
+    lines += [f"sequences: {len(res.sequences)} ({', '.join(res.sequences)})", f"frames: {res.frames}",
+              f"ego-frames: {res.ego_frames}", f"ground-truth boxes: {res.gt_boxes}",
+              f"range: {res.options.range_m:g} m; seed: {res.options.seed}"]
+    return "\n".join(lines) + "\n"
+
+
+def _plot_detection(table: pl.DataFrame, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(1, 2, figsize=(10, 4))
+    modes = table["mode"].to_list()
+    for m in modes:
+        r = table.filter(pl.col("mode") == m).row(0, named=True)
+        ax[0].plot([0.3, 0.5, 0.7], [r["ap30"], r["ap50"], r["ap70"]], marker="o", label=m)
+        ax[1].plot(range(len(BINS)), [r[f"ap50_{b}"] for b in BINS], marker="o", label=m)
+    ax[1].set_xticks(range(len(BINS)), BINS)
+    _finish(fig, ax, [("IoU threshold", "AP"), ("range bin (m)", "AP@0.5")], "Cooperative detection (Table III)", path)
+
+
+def _finish(fig: Any, ax: Any, labels: list[tuple[str, str]], title: str, path: Path) -> None:
+    """Axis labels, limits, grid and legends of the two panels; saves ``fig`` (no timestamp) and closes it."""
+    import matplotlib.pyplot as plt
+
+    for a, (xl, yl) in zip(ax, labels, strict=True):
+        a.set_xlabel(xl)
+        a.set_ylabel(yl)
+        a.set_ylim(0, 1)
+        a.grid(alpha=0.3)
+        a.legend()
+    fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100, metadata={"Software": None})
+    plt.close(fig)
+
+
+def _plot_robustness(res: StudyResult, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    t = res.table()
+    fig, ax = plt.subplots(1, 2, figsize=(10, 4))
+    clean = {r["mode"]: r["ap50"] for r in t.filter(pl.col("setting") == "clean").iter_rows(named=True)}
+    for a, kind, xcol in ((ax[0], "delay", "delay_frames"), (ax[1], "noise", "sigma_xyz_m")):
+        for m in res.options.modes:
+            if m == "none":
+                if "none" in clean:
+                    a.axhline(clean["none"], color="grey", ls="--", label="none")
+                continue
+            sub = t.filter((pl.col("mode") == m) & (pl.col("kind") == kind)).sort(xcol)
+            xs = [0.0, *sub[xcol].cast(pl.Float64).to_list()]
+            ys = [clean.get(m, math.nan), *sub["ap50"].to_list()]
+            a.plot(xs, ys, marker="o", label=m)
+    _finish(fig, ax, [("delay (frames)", "AP@0.5"), ("pose noise σ_xyz (m) = σ_rpy (°)", "AP@0.5")],
+            "Robustness (Table IV)", path)
+
+
+def rescore(boxes: pl.DataFrame) -> dict[str, float]:
+    """:func:`~mmusv.studies.detection.evaluate.summarize` of the rows of a boxes Parquet (one mode and setting,
+    e.g. after filtering by sequence): every (sequence, frame, ego) is matched again from its det and gt rows."""
+    from mmusv.studies.detection.evaluate import BOX_COLUMNS, FrameMatch, summarize
+
+    frames = []
+    for _, g in boxes.group_by(["sequence", "frame", "ego"], maintain_order=True):
+        d = g.filter(pl.col("kind") == "det")
+        t = g.filter(pl.col("kind") == "gt")
+        frames.append(FrameMatch.evaluate(d.select(list(BOX_COLUMNS)).to_numpy(), d["score"].to_numpy(),
+                                          t.select(list(BOX_COLUMNS)).to_numpy()))
+    return summarize(frames)

@@ -1,0 +1,170 @@
+"""Where the sequences of a detection study come from: recordings given on the command line (files, or folders
+searched for ``*.mcap``), an OPV2V folder, or the bundled detection spec generated and recorded LiDAR-only.
+
+Sequences are split by sequence before any agent-as-ego expansion: recordings and OPV2V scenario folders without
+split folders by :func:`~mmusv.studies.detection.data.split_sequences`; an OPV2V tree that already has
+``train``/``validate``/``test`` folders by those folders.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from mmusv.errors import InputError, IoError
+from mmusv.studies.detection.data import (
+    SequenceData,
+    opv2v_scenarios,
+    read_opv2v,
+    read_recording,
+    recording_summary,
+    split_sequences,
+)
+
+__all__ = ["BUNDLED_SPEC", "Dataset", "generate_dataset", "lidar_only", "resolve_dataset"]
+
+BUNDLED_SPEC = "scenarios/specs/coop_detection.yaml"
+"""The bundled detection dataset spec (run from the repository root)."""
+
+
+@dataclass(frozen=True)
+class Dataset:
+    """The sequences chosen for a study: ``sources`` (recording files or OPV2V scenario folders, by name) and
+    the split they came from; :meth:`sequences` loads them one at a time."""
+
+    sources: dict[str, Path]
+    kind: str
+    split: str
+
+    def sequences(self) -> Iterator[SequenceData]:
+        """Each chosen sequence, loaded when reached (sorted by name)."""
+        for name in sorted(self.sources):
+            p = self.sources[name]
+            seq = read_recording(p) if self.kind == "recording" else read_opv2v(p)
+            yield SequenceData(name, seq.frames)
+
+    def count_frames(self) -> int:
+        """Frames over all sequences (cheap for recordings: from their metadata)."""
+        if self.kind == "recording":
+            return sum(recording_summary(p).frames_configured for p in self.sources.values())
+        return sum(len({f.stem for c in p.iterdir() if c.is_dir() for f in c.glob("*.pcd")})
+                   for p in self.sources.values())
+
+
+def _recordings(inputs: Sequence[str | Path]) -> list[Path]:
+    out: list[Path] = []
+    for x in inputs:
+        p = Path(x)
+        if p.is_dir():
+            found = sorted(p.rglob("*.mcap"))
+            if not found:
+                raise InputError(f"{p}: folder holds no .mcap recording")
+            out.extend(found)
+        elif p.is_file():
+            out.append(p)
+        else:
+            raise IoError(f"{p}: no such recording or folder")
+    return out
+
+
+def _sequence_names(recs: Sequence[Path]) -> dict[str, Path]:
+    """Sequence name → recording: the file stem, or, when two recordings share a stem, the path below the
+    inputs' common folder without the suffix (``island/recordings/x/x``)."""
+    import os
+
+    uniq = sorted({r.resolve() for r in recs})
+    if len(uniq) != len(recs):
+        raise InputError("the same recording is given twice")
+    stems = [r.stem for r in uniq]
+    if len(set(stems)) == len(stems):
+        return dict(zip(stems, uniq, strict=True))
+    root = Path(os.path.commonpath([str(r.parent) for r in uniq]))
+    return {str(r.relative_to(root).with_suffix("")): r for r in uniq}
+
+
+def resolve_dataset(
+    inputs: Sequence[str | Path], *, opv2v: str | Path | None, split: str, ratios: Sequence[float] = (0.7, 0.15, 0.15),
+    seed: int = 0,
+) -> Dataset:
+    """The sequences of ``split`` from recordings ``inputs`` or the OPV2V folder ``opv2v`` (not both). Raises
+    :class:`~mmusv.InputError` when nothing is given or the split is empty."""
+    if inputs and opv2v is not None:
+        raise InputError("give recordings or --opv2v DIR, not both")
+    if opv2v is not None:
+        folders = opv2v_scenarios(opv2v)
+        kind = "opv2v"
+        names = {f.name if f.parent.name not in ("train", "validate", "test") else f"{f.parent.name}/{f.name}": f
+                 for f in folders}
+        presplit = all(f.parent.name in ("train", "validate", "test") for f in folders)
+        if presplit and split != "all":
+            chosen = {n: f for n, f in names.items() if f.parent.name == split}
+        else:
+            chosen = {n: names[n] for n in split_sequences(list(names), split=split, ratios=ratios, seed=seed)}
+        chosen = {n.split("/")[-1]: f for n, f in chosen.items()}
+    else:
+        recs = _recordings(inputs)
+        if not recs:
+            raise InputError("empty dataset: give recordings (.mcap or folders of them), --opv2v DIR or --generate")
+        kind = "recording"
+        by_name = _sequence_names(recs)
+        chosen = {n: by_name[n] for n in split_sequences(list(by_name), split=split, ratios=ratios, seed=seed)}
+    if not chosen:
+        where = opv2v if opv2v is not None else ", ".join(str(x) for x in inputs)
+        raise InputError(f"empty dataset: split {split!r} of {where} holds no sequence (try --split all)")
+    return Dataset(chosen, kind, split)
+
+
+def lidar_only(data: dict[str, Any]) -> dict[str, Any]:
+    """A scenario dict whose rigs keep only their LiDAR (no cameras, radar or top view)."""
+    out = dict(data)
+    rigs = out.get("rigs") or {}
+    out["rigs"] = {name: {**(r or {}), "cameras": [], "radar": None, "top_view": None} if isinstance(r, dict) or r is None
+                   else r for name, r in rigs.items()}
+    return out
+
+
+def generate_dataset(
+    out_dir: str | Path, *, spec: str | Path = BUNDLED_SPEC, progress: Callable[[str, int, int], None] | None = None,
+) -> list[Path]:
+    """Generates ``spec`` into ``out_dir/scenarios`` and records every scenario LiDAR-only into
+    ``out_dir/recordings/<name>/``; returns the recordings. An existing recording of the same scenario is kept
+    (delete ``out_dir`` to redo it)."""
+    from mmusv.acquire import recording_path, run
+    from mmusv.config import load_scenario
+    from mmusv.generate.runner import generate
+
+    sp = Path(spec)
+    if not sp.is_file():
+        raise IoError(f"--generate: spec {sp} not found (run from the repository root, or pass a spec path)")
+    out = Path(out_dir)
+    scen_dir = out / "scenarios"
+    generate(sp, scen_dir, force=True)
+    files = sorted(scen_dir.glob("*.yaml"))
+    if not files:
+        raise InputError(f"--generate: spec {sp} produced no scenario (see {scen_dir / 'report.json'})")
+    recs: list[Path] = []
+    for i, f in enumerate(files):
+        data = lidar_only(yaml.safe_load(f.read_text(encoding="utf-8")))
+        rec_dir = out / "recordings" / f.stem
+        scenario = load_scenario(data)
+        path = recording_path(rec_dir, scenario)
+        if not (path.exists() and _same_scenario(path, scenario)):
+            run(scenario, out_dir=rec_dir, overwrite=True)
+        recs.append(path)
+        if progress is not None:
+            progress(f.stem, i + 1, len(files))
+    return recs
+
+
+def _same_scenario(path: Path, scenario: Any) -> bool:
+    """Whether the complete recording at ``path`` was made from ``scenario`` (same config hash)."""
+    from mmusv.config import scenario_hash
+    try:
+        info = recording_summary(path)
+    except IoError:
+        return False
+    return info.complete and info.config_hash == scenario_hash(scenario)

@@ -1,0 +1,316 @@
+"""The detection study (Table III) and the robustness study (Table IV) over a set of sequences.
+
+For every sequence of the chosen split, every frame and every instrumented USV as the ego in turn, each fusion
+mode (and, for Table IV, each robustness setting) yields boxes in the ego LiDAR frame. Detections farther than
+``range_m`` from the ego, or centred within ``platform_margin_m`` of a USV's platform (the ego's or a neighbour's:
+USVs are not targets), are dropped; the rest are matched against the ground truth
+(:func:`~mmusv.studies.detection.data.gt_in_ego`) by :mod:`~mmusv.studies.detection.evaluate`.
+
+Every ground truth also records ``ego_points``, the number of the ego's own LiDAR points inside it (BEV rectangle,
+height within ±0.5 m), and ``neighbour_points``, the same summed over the other USVs' current clouds. With
+``SEEN_POINTS`` = 5 (about the fewest points a box can be put on), a target is *visible* (ego_points ≥ 5),
+*hidden* (fewer from the ego but ≥ 5 from the neighbours: behind an island or another hull, or too small for the
+ego's beams at that range, but seen by cooperating USVs: the case cooperation exists for) or *unseen* (neither).
+Recall at IoU 0.5 and 0.3 is reported for each class.
+
+**Predictions file** (``--predictions``, instead of a detector): a Parquet file with one row per detection and
+columns ``sequence`` (recording stem or OPV2V scenario folder name), ``frame`` (acquisition index), ``ego``
+(USV id, or CAV id for OPV2V), ``mode`` (``none``/``late``/``early``), ``x, y, z, l, w, h, yaw`` (ego LiDAR
+frame, mmusv axes: x forward, y left, z up; metres, radians), ``score``; optionally ``setting`` (robustness
+study, e.g. ``delay:2``; missing = ``clean``) and ``kind`` (rows with ``kind != "det"`` are skipped). A frame with
+no row has no detection. The Parquet this study writes has that layout, so its output can be re-scored.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import polars as pl
+import shapely
+
+from mmusv.errors import InputError
+from mmusv.frames import transform_points
+from mmusv.studies.detection.data import (
+    AgentFrame,
+    SceneFrame,
+    SequenceData,
+    gt_in_ego,
+    usv_boxes_in_ego,
+)
+from mmusv.studies.detection.detector import Detector
+from mmusv.studies.detection.evaluate import (
+    BOX_COLUMNS,
+    RANGE_BINS,
+    FrameMatch,
+    bin_label,
+    box_polygons,
+    range_bin,
+    summarize,
+)
+from mmusv.studies.detection.fusion import MODES, _as_boxes, fuse, relative
+from mmusv.studies.detection.robustness import Setting, neighbours_for
+
+__all__ = ["StudyOptions", "StudyResult", "gt_visibility", "load_predictions", "run_study"]
+
+Key = tuple[str, str]  # (setting name, mode)
+SEEN_POINTS = 5
+"""LiDAR points inside a target for it to count as seen by a USV (module docstring)."""
+
+
+@dataclass(frozen=True)
+class StudyOptions:
+    """What to evaluate: ``modes``, ``settings`` (``(Setting(),)`` for Table III), range, seed of the pose
+    noise, and either a ``detector`` or ``predictions`` (from :func:`load_predictions`)."""
+
+    modes: tuple[str, ...] = MODES
+    settings: tuple[Setting, ...] = (Setting(),)
+    detector: Detector | None = None
+    predictions: dict[tuple[str, int, str, str, str], tuple[np.ndarray, np.ndarray]] | None = None
+    range_m: float = 200.0
+    platform_margin_m: float = 2.0
+    seed: int = 0
+
+
+@dataclass
+class StudyResult:
+    """Matches per (setting, mode), the rows of every scored box, and what was evaluated."""
+
+    options: StudyOptions
+    matches: dict[Key, list[FrameMatch]] = field(default_factory=dict)
+    visibility: dict[Key, list[tuple[np.ndarray, np.ndarray, np.ndarray]]] = field(default_factory=dict)
+    """Per key and ego-frame: visibility class of each ground truth (0 visible, 1 hidden, 2 unseen), matched at
+    0.5, matched at 0.3."""
+    rows: dict[str, list[Any]] = field(default_factory=dict)
+    sequences: list[str] = field(default_factory=list)
+    frames: int = 0
+    ego_frames: int = 0
+    gt_boxes: int = 0
+    predictions_used: int = 0
+
+    def metrics(self, key: Key) -> dict[str, float]:
+        """:func:`~mmusv.studies.detection.evaluate.summarize` of ``key`` plus the recall at IoU 0.5 and 0.3
+        of the visible, hidden and unseen ground truths (``recall50_hidden``, ``recall30_hidden``, ...; module
+        docstring) and their counts ``gt_visible``, ``gt_hidden``, ``gt_unseen``."""
+        out = summarize(self.matches.get(key, []))
+        vis = self.visibility.get(key, [])
+        cls = np.concatenate([v[0] for v in vis]) if vis else np.zeros(0)
+        hit50 = np.concatenate([v[1] for v in vis]) if vis else np.zeros(0, dtype=bool)
+        hit30 = np.concatenate([v[2] for v in vis]) if vis else np.zeros(0, dtype=bool)
+        for name, sel in (("visible", cls == 0), ("hidden", cls == 1), ("unseen", cls == 2)):
+            n = int(sel.sum())
+            out[f"recall50_{name}"] = float(hit50[sel].sum()) / n if n else math.nan
+            out[f"recall30_{name}"] = float(hit30[sel].sum()) / n if n else math.nan
+            out[f"gt_{name}"] = float(n)
+        return out
+
+    def table(self) -> pl.DataFrame:
+        """One row per (setting, mode) evaluated, with every metric of :meth:`metrics`."""
+        recs = []
+        for s in self.options.settings:
+            for m in self.options.modes:
+                if (s.name, m) in self.matches:
+                    recs.append({"setting": s.name, "kind": s.kind, "delay_frames": s.delay_frames,
+                                 "sigma_xyz_m": s.sigma_xyz_m, "sigma_rpy_deg": s.sigma_rpy_deg, "mode": m,
+                                 **self.metrics((s.name, m))})
+        return pl.DataFrame(recs)
+
+    def boxes_frame(self, *, with_setting: bool) -> pl.DataFrame:
+        """Every scored detection and ground-truth box (see the CLI help for the columns)."""
+        df = pl.DataFrame(self.rows, schema=_ROW_SCHEMA)
+        if not with_setting:
+            df = df.drop("setting")
+        keys = ["sequence", "frame", "ego", *(["setting"] if with_setting else []), "mode", "kind", "x", "y"]
+        return df.sort(keys, maintain_order=True)
+
+
+_ROW_SCHEMA: dict[str, Any] = {
+    "sequence": pl.Utf8, "frame": pl.Int64, "ego": pl.Utf8, "setting": pl.Utf8, "mode": pl.Utf8, "kind": pl.Utf8,
+    **{c: pl.Float64 for c in BOX_COLUMNS}, "score": pl.Float64, "range_bin": pl.Utf8, "matched": pl.Boolean,
+    "ego_points": pl.Int64, "neighbour_points": pl.Int64,
+}
+
+
+def load_predictions(path: str | Path) -> dict[tuple[str, int, str, str, str], tuple[np.ndarray, np.ndarray]]:
+    """The detections of a predictions Parquet (module docstring) keyed by (sequence, frame, ego, mode,
+    setting)."""
+    p = Path(path)
+    if not p.is_file():
+        raise InputError(f"--predictions {p}: no such file")
+    try:
+        df = pl.read_parquet(p)
+    except (OSError, pl.exceptions.PolarsError) as exc:
+        raise InputError(f"--predictions {p}: not a readable Parquet file ({type(exc).__name__})") from None
+    need = ["sequence", "frame", "ego", "mode", *BOX_COLUMNS, "score"]
+    missing = [c for c in need if c not in df.columns]
+    if missing:
+        raise InputError(f"--predictions {p}: missing column(s) {missing}; required: {need}")
+    if "kind" in df.columns:
+        df = df.filter(pl.col("kind") == "det")
+    if "setting" not in df.columns:
+        df = df.with_columns(pl.lit("clean").alias("setting"))
+    bad = sorted(set(df["mode"].to_list()) - set(MODES))
+    if bad:
+        raise InputError(f"--predictions {p}: column mode has unknown value(s) {bad}; allowed: {', '.join(MODES)}")
+    out: dict[tuple[str, int, str, str, str], tuple[np.ndarray, np.ndarray]] = {}
+    df = df.with_columns(pl.col("frame").cast(pl.Int64), pl.col("ego").cast(pl.Utf8), pl.col("sequence").cast(pl.Utf8))
+    for key, g in df.group_by(["sequence", "frame", "ego", "mode", "setting"], maintain_order=True):
+        k = (str(key[0]), int(key[1]), str(key[2]), str(key[3]), str(key[4]))
+        out[k] = (g.select(list(BOX_COLUMNS)).to_numpy().astype(np.float64), g["score"].to_numpy().astype(np.float64))
+    return out
+
+
+def gt_visibility(gt: np.ndarray, points: np.ndarray, *, z_margin_m: float = 0.5) -> np.ndarray:
+    """``(G,)`` int64 number of ``points`` ``(N, ≥3)`` inside each box of ``gt`` ``(G, 7)`` (same frame): BEV
+    rectangle and height within ``z ± (h/2 + z_margin_m)``."""
+    out = np.zeros(len(gt), dtype=np.int64)
+    if len(gt) == 0 or len(points) == 0:
+        return out
+    p = np.asarray(points, dtype=np.float64)
+    for i, (poly, b) in enumerate(zip(box_polygons(gt), gt, strict=True)):
+        near = np.abs(p[:, 2] - b[2]) <= b[5] / 2 + z_margin_m
+        q = p[near]
+        if len(q):
+            out[i] = int(shapely.contains_xy(poly, q[:, 0], q[:, 1]).sum())
+    return out
+
+
+def _keep(boxes: np.ndarray, scores: np.ndarray, usv: np.ndarray, *, range_m: float,
+          margin: float) -> tuple[np.ndarray, np.ndarray]:
+    sel = np.hypot(boxes[:, 0], boxes[:, 1]) < range_m
+    if len(usv) and len(boxes):
+        plat = shapely.union_all(shapely.buffer(box_polygons(usv), margin))
+        sel &= ~shapely.contains_xy(plat, boxes[:, 0], boxes[:, 1])
+    return boxes[sel], scores[sel]
+
+
+def run_study(
+    sequences: Iterable[SequenceData], *, options: StudyOptions, total_frames: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> StudyResult:
+    """Evaluates ``sequences`` (see the module docstring). With delays, the first ``max delay`` frames of every
+    sequence are skipped for every setting, so all settings are scored on the same frames."""
+    o = options
+    if o.detector is None and o.predictions is None:
+        raise InputError("no detector and no predictions given")
+    res = StudyResult(options=o)
+    for k in ("sequence", "frame", "ego", "setting", "mode", "kind", *BOX_COLUMNS, "score", "range_bin", "matched",
+              "ego_points", "neighbour_points"):
+        res.rows[k] = []
+    start = max(s.delay_frames for s in o.settings)
+    fusion = [m for m in o.modes if m != "none"]
+    done = 0
+    for seq in sequences:
+        if not seq.frames:
+            continue
+        if fusion and len(seq.agent_ids) < 2:
+            raise InputError(f"sequence {seq.name}: {len(seq.agent_ids)} instrumented USV(s) with a LiDAR; "
+                             f"{'/'.join(fusion)} fusion needs at least 2 (use --modes none)")
+        res.sequences.append(seq.name)
+        own = _OwnDetections(o.detector)
+        for t in range(start, len(seq.frames)):
+            frame = seq.frames[t]
+            res.frames += 1
+            for ego in frame.agents:
+                _score_ego(res, seq, t, frame, ego, own)
+            done += 1
+            if progress is not None:
+                progress(done, total_frames or done)
+    if o.predictions is not None and res.predictions_used == 0 and res.ego_frames:
+        raise InputError("--predictions: no row matches any (sequence, frame, ego, mode) evaluated; check the "
+                         f"sequence names ({', '.join(res.sequences[:3])}, ...) and the ego ids")
+    return res
+
+
+class _OwnDetections:
+    """The detector's output on an agent's own cloud, computed once per cloud (a neighbour's cloud serves every
+    ego, delay and noise setting: noise changes only its pose)."""
+
+    def __init__(self, detector: Detector | None) -> None:
+        self.detector = detector
+        self.cache: dict[tuple[str, int], tuple[np.ndarray, np.ndarray]] = {}
+
+    def __call__(self, a: AgentFrame) -> tuple[np.ndarray, np.ndarray]:
+        key = (a.id, id(a.points))
+        if key not in self.cache:
+            if self.detector is None:
+                raise InputError("no detector given")
+            self.cache[key] = _as_boxes(self.detector(a.points))
+        return self.cache[key]
+
+
+def _score_ego(res: StudyResult, seq: SequenceData, t: int, frame: SceneFrame, ego: AgentFrame,
+               own: Callable[[AgentFrame], tuple[np.ndarray, np.ndarray]]) -> None:
+    o = res.options
+    res.ego_frames += 1
+    gt = gt_in_ego(frame, ego, range_m=o.range_m)
+    res.gt_boxes += len(gt)
+    usv = usv_boxes_in_ego(frame, ego)
+    vis = gt_visibility(gt, ego.points)
+    nb_vis = np.zeros(len(gt), dtype=np.int64)
+    for nb in frame.agents:
+        if nb.id != ego.id and len(gt):
+            nb_vis += gt_visibility(gt, transform_points(relative(ego, nb), nb.points[:, :3]))
+    cls = np.where(vis >= SEEN_POINTS, 0, np.where(nb_vis >= SEEN_POINTS, 1, 2))
+    gbin = range_bin(gt[:, :2])
+    for s in o.settings:
+        nbs = neighbours_for(seq, t, ego.id, s, seed=o.seed)
+        for mode in o.modes:
+            if mode == "none" and s.name != "clean":
+                continue  # no fusion does not depend on the neighbours
+            if o.predictions is not None:
+                got = o.predictions.get((seq.name, frame.frame, ego.id, mode, s.name))
+                if got is not None:
+                    res.predictions_used += 1
+                boxes, scores = got if got is not None else (np.zeros((0, 7)), np.zeros(0))
+            else:
+                assert o.detector is not None
+                boxes, scores = fuse(mode, ego, nbs, detector=o.detector, own_detections=own,
+                                     crop_m=o.range_m + 20.0)
+            boxes, scores = _keep(boxes, scores, usv, range_m=o.range_m, margin=o.platform_margin_m)
+            fm = FrameMatch.evaluate(boxes, scores, gt)
+            key = (s.name, mode)
+            res.matches.setdefault(key, []).append(fm)
+            gm = fm.gt_matched(0.5)
+            res.visibility.setdefault(key, []).append((cls, gm, fm.gt_matched(0.3)))
+            _add_rows(res, seq.name, frame.frame, ego.id, s.name, mode, fm, gm, gbin, vis, nb_vis)
+
+
+def _add_rows(res: StudyResult, seq: str, frame: int, ego: str, setting: str, mode: str, fm: FrameMatch,
+              gm: np.ndarray, gbin: np.ndarray, vis: np.ndarray, nb_vis: np.ndarray) -> None:
+    r = res.rows
+    dbin = fm.det_bins(0.5)
+    tp = fm.matches[0.5] >= 0
+    none: list[int | None] = [None] * len(fm.det_boxes)
+    for kind, boxes, scores, bins, matched, pts, nb_pts in (
+        ("det", fm.det_boxes, fm.det_scores, dbin, tp, none, none),
+        ("gt", fm.gt_boxes, [math.nan] * len(fm.gt_boxes), gbin, gm, vis.tolist(), nb_vis.tolist()),
+    ):
+        n = len(boxes)
+        r["sequence"] += [seq] * n
+        r["frame"] += [frame] * n
+        r["ego"] += [ego] * n
+        r["setting"] += [setting] * n
+        r["mode"] += [mode] * n
+        r["kind"] += [kind] * n
+        for j, c in enumerate(BOX_COLUMNS):
+            r[c] += [float(v) for v in np.asarray(boxes)[:, j]] if n else []
+        r["score"] += [float(v) for v in scores]
+        r["range_bin"] += [bin_label(int(b)) for b in bins]
+        r["matched"] += [bool(v) for v in matched]
+        r["ego_points"] += list(pts)
+        r["neighbour_points"] += list(nb_pts)
+
+
+def range_bin_labels() -> list[str]:
+    """``["0-50", "50-100", ...]``."""
+    return [bin_label(k) for k in range(len(RANGE_BINS))]
+
+
+def sequence_list(seqs: Sequence[SequenceData]) -> list[str]:
+    """Names of ``seqs``."""
+    return [s.name for s in seqs]

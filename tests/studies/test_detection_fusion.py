@@ -1,0 +1,249 @@
+"""Fusion transforms, the baseline detector, and the robustness settings."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+from mmusv.errors import InputError
+from mmusv.frames import invert, pose_matrices, transform_points
+from mmusv.studies.detection.data import (
+    AgentFrame,
+    SceneFrame,
+    SequenceData,
+    boxes_in_frame,
+    gt_in_ego,
+)
+from mmusv.studies.detection.detector import (
+    BaselineParams,
+    baseline_detect,
+    fit_box,
+    load_detector,
+    water_plane,
+)
+from mmusv.studies.detection.evaluate import bev_iou
+from mmusv.studies.detection.fusion import (
+    early_points,
+    fuse,
+    parse_modes,
+    relative,
+    rotated_nms,
+    transform_boxes,
+)
+from mmusv.studies.detection.robustness import Setting, neighbours_for, parse_settings
+
+MOUNT = pose_matrices([0.45, 0.0, 2.3, 0.0, 0.0, 0.0])
+
+
+def water(rng: np.random.Generator, *, z: float = -2.3, n: int = 3000, r: float = 60.0) -> np.ndarray:
+    xy = rng.uniform(-r, r, (n, 2))
+    return np.column_stack([xy, z + rng.normal(0, 0.05, n), np.full(n, 0.1)])
+
+
+def box_surface(b: np.ndarray, rng: np.random.Generator, *, n: int = 1500) -> np.ndarray:
+    """Points on the four sides and the top of box ``b`` (x, y, z, l, w, h, yaw)."""
+    u = rng.uniform(-0.5, 0.5, (n, 3))
+    face = rng.integers(0, 5, n)
+    u[face == 0, 0] = 0.5
+    u[face == 1, 0] = -0.5
+    u[face == 2, 1] = 0.5
+    u[face == 3, 1] = -0.5
+    u[face == 4, 2] = 0.5
+    local = u * b[3:6]
+    c, s = math.cos(b[6]), math.sin(b[6])
+    x = b[0] + c * local[:, 0] - s * local[:, 1]
+    y = b[1] + s * local[:, 0] + c * local[:, 1]
+    return np.column_stack([x, y, b[2] + local[:, 2], np.full(n, 0.5)])
+
+
+def yaw_diff(a: float, b: float) -> float:
+    return abs((a - b + math.pi / 2) % math.pi - math.pi / 2)
+
+
+# ---- detector ----------------------------------------------------------------------------------------------------
+
+def test_detector_finds_an_isolated_box_with_size_and_yaw() -> None:
+    rng = np.random.default_rng(0)
+    target = np.array([40.0, 10.0, -0.8, 10.0, 4.0, 3.0, math.radians(30)])
+    pts = np.concatenate([water(rng), box_surface(target, rng)]).astype(np.float32)
+    boxes, scores = baseline_detect(pts)
+    assert len(boxes) == 1 and 0 < scores[0] < 1
+    b = boxes[0]
+    assert np.hypot(b[0] - 40, b[1] - 10) < 0.3
+    assert b[3] == pytest.approx(10.0, abs=0.4) and b[4] == pytest.approx(4.0, abs=0.4)
+    assert yaw_diff(b[6], target[6]) < math.radians(3)
+    assert bev_iou(boxes, target[None])[0, 0] > 0.8
+
+
+def test_detector_ignores_water_own_platform_and_is_deterministic() -> None:
+    rng = np.random.default_rng(1)
+    w = water(rng)
+    own = np.column_stack([rng.uniform(-1, 1, (200, 2)), rng.uniform(-1.5, 0.5, 200), np.zeros(200)])
+    pts = np.concatenate([w, own]).astype(np.float32)
+    assert len(baseline_detect(pts)[0]) == 0
+    assert len(baseline_detect(np.zeros((0, 4), np.float32))[0]) == 0
+    t = np.array([-30.0, 25.0, -1.0, 6.0, 2.5, 2.0, 1.0])
+    pts2 = np.concatenate([pts, box_surface(t, rng, n=400)]).astype(np.float32)
+    a, b = baseline_detect(pts2), baseline_detect(pts2.copy())
+    assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
+
+
+def test_water_plane_follows_tilt() -> None:
+    rng = np.random.default_rng(2)
+    xy = rng.uniform(-80, 80, (4000, 2))
+    z = 0.03 * xy[:, 0] - 0.02 * xy[:, 1] - 2.0
+    pts = np.column_stack([xy, z, np.zeros(len(z))])
+    assert np.allclose(water_plane(pts), [0.03, -0.02, -2.0], atol=1e-3)
+
+
+def test_edge_on_face_is_widened_away_from_the_sensor() -> None:
+    xy = np.column_stack([np.linspace(-4, 4, 30), np.full(30, 20.0)])  # near side of a boat abeam, at y = 20
+    b = fit_box(xy, z_low=-2.0, z_high=1.0, min_width_m=3.0, beam_ratio=0.25)  # 3 > 0.25 · 8
+    assert b[3] == pytest.approx(8.0, abs=1e-6) and b[4] == pytest.approx(3.0)
+    assert b[1] == pytest.approx(21.5, abs=1e-6)  # pushed 1.5 m away from the sensor
+    assert yaw_diff(b[6], 0.0) < 1e-9
+
+
+def test_load_detector() -> None:
+    assert load_detector("baseline") is baseline_detect
+    assert load_detector("mmusv.studies.detection.detector:baseline_detect") is baseline_detect
+    for bad in ("nope", "no.such.module:f", "mmusv.studies.detection.detector:missing"):
+        with pytest.raises(Exception, match="--detector"):
+            load_detector(bad)
+
+
+# ---- fusion ------------------------------------------------------------------------------------------------------
+
+def scene(rng: np.random.Generator) -> tuple[SceneFrame, AgentFrame, AgentFrame, np.ndarray]:
+    ego_body = pose_matrices([100.0, -50.0, 0.2, 0.0, 0.0, math.radians(35)])
+    nb_body = pose_matrices([180.0, 40.0, -0.1, 0.0, 0.0, math.radians(-120)])
+    target = pose_matrices([150.0, 20.0, 0.0, 0.0, 0.0, math.radians(75)])
+    target[:3, 3] = [150.0, 20.0, 1.0]
+    sizes = np.array([[12.0, 4.0, 3.0]])
+    ego = AgentFrame("usv_1", water(rng), ego_body, MOUNT)
+    nb_box = boxes_in_frame(invert(nb_body @ MOUNT), target[None], sizes)[0]
+    nb = AgentFrame("usv_2", np.concatenate([water(rng), box_surface(nb_box, rng)]).astype(np.float32), nb_body, MOUNT)
+    usv = np.stack([ego_body, nb_body])
+    frame = SceneFrame(0, (ego, nb), ("t",), target[None], sizes, usv, np.tile([5.0, 2.4, 2.5], (2, 1)))
+    return frame, ego, nb, nb_box
+
+
+def test_box_seen_by_a_neighbour_lands_on_the_ego_ground_truth() -> None:
+    frame, ego, nb, nb_box = scene(np.random.default_rng(3))
+    gt = gt_in_ego(frame, ego)
+    assert len(gt) == 1
+    moved = transform_boxes(relative(ego, nb), nb_box[None])[0]
+    assert np.allclose(moved[:6], gt[0, :6], atol=1e-9) and yaw_diff(moved[6], gt[0, 6]) < 1e-9
+    # the same through a hand-made world round trip: neighbour LiDAR -> world -> ego LiDAR
+    centre_world = transform_points(nb.lidar, nb_box[None, :3])
+    assert np.allclose(transform_points(invert(ego.lidar), centre_world), gt[:, :3], atol=1e-9)
+
+
+def test_late_and_early_fusion_find_what_only_the_neighbour_sees() -> None:
+    frame, ego, nb, _ = scene(np.random.default_rng(4))
+    gt = gt_in_ego(frame, ego)
+    none = fuse("none", ego, [nb], detector=baseline_detect)
+    assert len(none[0]) == 0  # the ego sees only water
+    for mode in ("late", "early"):
+        boxes, _ = fuse(mode, ego, [nb], detector=baseline_detect)
+        assert len(boxes) == 1, mode
+        assert bev_iou(boxes, gt)[0, 0] > 0.7, mode
+    pts = early_points(ego, [nb], crop_m=1000.0)
+    assert pts.dtype == np.float32 and len(pts) == len(ego.points) + len(nb.points)
+
+
+def test_late_fusion_merges_duplicates_with_rotated_nms() -> None:
+    frame, ego, nb, nb_box = scene(np.random.default_rng(5))
+    gt = gt_in_ego(frame, ego)
+    answers = {id(ego.points): (gt + [0.3, 0, 0, 0, 0, 0, 0.05], np.array([0.6])),
+               id(nb.points): (nb_box[None], np.array([0.9]))}
+
+    def stub(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return answers[id(points)]
+
+    boxes, scores = fuse("late", ego, [nb], detector=stub)
+    assert len(boxes) == 1
+    assert scores[0] == 0.9
+    assert np.allclose(boxes[0, :3], gt[0, :3], atol=1e-9)
+
+
+def test_rotated_nms_threshold() -> None:
+    a = np.array([[0, 0, 0, 4, 2, 1, 0]], float)
+    near = np.array([[1.0, 0, 0, 4, 2, 1, 0]])      # IoU 0.6: suppressed
+    far = np.array([[3.8, 0, 0, 4, 2, 1, 0]])       # IoU 0.2/7.8 ≈ 0.026: kept
+    boxes = np.concatenate([a, near, far])
+    keep = rotated_nms(boxes, np.array([0.9, 0.8, 0.7]))
+    assert keep.tolist() == [0, 2]
+    assert rotated_nms(np.zeros((0, 7)), np.zeros(0)).tolist() == []
+
+
+def test_parse_modes() -> None:
+    assert parse_modes("early,none") == ("none", "early")
+    with pytest.raises(InputError, match="unknown mode"):
+        parse_modes("none,middle")
+
+
+# ---- robustness --------------------------------------------------------------------------------------------------
+
+def sequence(n: int = 6) -> SequenceData:
+    frames = []
+    for t in range(n):
+        agents = tuple(AgentFrame(f"usv_{k}", np.full((3, 4), t * 10 + k, np.float32),
+                                  pose_matrices([t * 1.0, 10.0 * k, 0, 0, 0, 0.1 * k]), MOUNT) for k in range(3))
+        frames.append(SceneFrame(t, agents, (), np.zeros((0, 4, 4)), np.zeros((0, 3)), np.zeros((0, 4, 4)),
+                                 np.zeros((0, 3))))
+    return SequenceData("seq", tuple(frames))
+
+
+def test_delay_takes_points_and_pose_from_earlier_frames() -> None:
+    seq = sequence()
+    nbs = neighbours_for(seq, 4, "usv_0", Setting(delay_frames=2), seed=0)
+    assert [a.id for a in nbs] == ["usv_1", "usv_2"]
+    for a in nbs:
+        old = next(x for x in seq.frames[2].agents if x.id == a.id)
+        assert a.points is old.points and np.array_equal(a.body, old.body)
+    with pytest.raises(InputError):
+        neighbours_for(seq, 1, "usv_0", Setting(delay_frames=2), seed=0)
+
+
+def test_pose_noise_is_seeded_shared_and_zero_mean() -> None:
+    seq = sequence()
+    s = Setting(sigma_xyz_m=1.0, sigma_rpy_deg=1.0)
+    a = neighbours_for(seq, 3, "usv_0", s, seed=7)
+    b = neighbours_for(seq, 3, "usv_0", s, seed=7)
+    assert all(np.array_equal(x.body, y.body) for x, y in zip(a, b, strict=True))  # same draws for late and early
+    c = neighbours_for(seq, 3, "usv_0", s, seed=8)
+    assert not np.array_equal(a[0].body, c[0].body)
+    clean = neighbours_for(seq, 3, "usv_0", Setting(), seed=7)
+    assert np.array_equal(clean[0].body, seq.frames[3].agents[1].body)
+    from mmusv.frames import matrix_to_pose
+    draws = np.array([matrix_to_pose(neighbours_for(seq, 3, "usv_0", s, seed=k)[0].body)
+                      - matrix_to_pose(seq.frames[3].agents[1].body) for k in range(400)])
+    assert np.all(np.abs(draws[:, :3].mean(axis=0)) < 0.2)
+    assert np.allclose(draws[:, :3].std(axis=0), 1.0, atol=0.15)
+    assert np.allclose(np.degrees(draws[:, 3:].std(axis=0)), 1.0, atol=0.15)
+
+
+def test_parse_settings() -> None:
+    got = parse_settings("delay:1,noise:0.5/0.5,delay:3")
+    assert [s.name for s in got] == ["clean", "delay:1", "noise:0.5/0.5", "delay:3"]
+    for bad in ("delay:0", "delay:x", "noise:-1/1", "noise:0/0", "jitter:1"):
+        with pytest.raises(InputError, match="--settings"):
+            parse_settings(bad)
+
+
+def test_baseline_params_are_frozen() -> None:
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        BaselineParams().gap_m = 3.0  # type: ignore[misc]
+
+
+def test_gt_visibility_counts_points_inside_the_box() -> None:
+    from mmusv.studies.detection.study import gt_visibility
+
+    gt = np.array([[10.0, 0.0, 0.0, 4.0, 2.0, 2.0, math.pi / 2], [50.0, 50.0, 0.0, 4.0, 2.0, 2.0, 0.0]])
+    pts = np.array([[10.0, 1.9, 0.0], [10.9, -1.5, 0.5], [10.0, 2.1, 0.0],   # inside, inside, beyond the long side
+                    [10.0, 0.0, 1.4], [10.0, 0.0, 1.6], [50.0, 50.0, -2.0]])  # z within h/2 + 0.5, too high, too low
+    assert gt_visibility(gt, pts).tolist() == [3, 0]
+    assert gt_visibility(gt, np.zeros((0, 3))).tolist() == [0, 0]

@@ -1,0 +1,140 @@
+"""The detection and robustness studies end to end on a tiny LiDAR-only recording (2 USVs, 4 frames), the
+predictions-file round trip, the OPV2V input, and the errors on bad input."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import polars as pl
+import pytest
+import yaml
+from mmusv.cli import main
+from mmusv.studies.detection.data import read_recording
+from mmusv.studies.detection.sources import lidar_only
+
+SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "island_occlusion.yaml"
+
+
+def record(out: Path, usvs: tuple[str, ...], frames: int = 4) -> Path:
+    from mmusv.acquire import run
+
+    data = lidar_only(yaml.safe_load(SCENARIO.read_text(encoding="utf-8")))
+    data["vessels"] = [v for v in data["vessels"] if v["role"] != "usv" or v["id"] in usvs]
+    data["name"] = f"tiny_{len(usvs)}usv"
+    data["acquisition"]["frames"] = frames
+    return run(data, out_dir=out).recording
+
+
+@pytest.fixture(scope="module")
+def two_usv(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return record(tmp_path_factory.mktemp("rec2"), ("usv_1", "usv_3"))
+
+
+def test_recording_loads_with_gt_and_usvs(two_usv: Path) -> None:
+    seq = read_recording(two_usv)
+    assert seq.agent_ids == ("usv_1", "usv_3") and len(seq.frames) == 4
+    f = seq.frames[0]
+    assert f.target_ids == ("target_1", "tanker", "speedboat")  # USVs are not targets
+    assert len(f.usv_boxes) == 2
+    assert all(a.points.dtype == np.float32 and a.points.shape[1] == 4 for a in f.agents)
+
+
+def test_detection_study_end_to_end(two_usv: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "det"
+    assert main(["study", "detection", str(two_usv), "-o", str(out), "--no-progress"]) == 0
+    text = capsys.readouterr().out
+    assert "Table III" in text and "NOT the paper's learned model" in text
+    table = pl.read_csv(out / "detection_table.csv")
+    assert table["mode"].to_list() == ["none", "late", "early"]
+    assert table["det"].sum() > 0 and table["gt"][0] > 0
+    boxes = pl.read_parquet(out / "detection_boxes.parquet")
+    assert boxes.columns == ["sequence", "frame", "ego", "mode", "kind", "x", "y", "z", "l", "w", "h", "yaw",
+                             "score", "range_bin", "matched", "ego_points", "neighbour_points"]
+    assert table["gt_visible"][0] + table["gt_hidden"][0] + table["gt_unseen"][0] == table["gt"][0]
+    gt = boxes.filter(pl.col("kind") == "gt")
+    assert len(gt) == 3 * int(table["gt"][0])  # the same ground truth under each mode
+    assert set(gt["range_bin"].to_list()) <= {"0-50", "50-100", "100-150", "150-200"}
+    # The boxes file re-scores to the same table (the predictions interface round trip).
+    out2 = tmp_path / "rescored"
+    assert main(["study", "detection", str(two_usv), "--predictions", str(out / "detection_boxes.parquet"),
+                 "-o", str(out2), "--no-progress"]) == 0
+    again = pl.read_csv(out2 / "detection_table.csv")
+    for col in ("ap30", "ap50", "ap70", "recall50", "gt", "det"):
+        a, b = table[col].to_list(), again[col].to_list()
+        assert all((math.isnan(x) and math.isnan(y)) or x == pytest.approx(y) for x, y in zip(a, b, strict=True)), col
+    assert (out / "detection_ap.png").stat().st_size > 0
+
+
+def test_robustness_study_end_to_end(two_usv: Path, tmp_path: Path) -> None:
+    out = tmp_path / "rob"
+    assert main(["study", "robustness", str(two_usv), "--settings", "delay:1,noise:1/1", "-o", str(out),
+                 "--no-progress"]) == 0
+    wide = pl.read_csv(out / "robustness_table.csv")
+    assert wide["setting"].to_list() == ["clean", "delay:1", "noise:1/1"]
+    assert {"none", "late", "early"} <= set(wide.columns)
+    boxes = pl.read_parquet(out / "robustness_boxes.parquet")
+    assert "setting" in boxes.columns
+    assert boxes["frame"].min() == 1  # frames before the largest delay are skipped for every setting
+    # Same inputs and seed, same bytes (the pose noise is seeded).
+    again = tmp_path / "rob2"
+    assert main(["study", "robustness", str(two_usv), "--settings", "delay:1,noise:1/1", "-o", str(again),
+                 "--no-progress"]) == 0
+    for name in ("robustness_table.csv", "robustness_boxes.parquet"):
+        assert (out / name).read_bytes() == (again / name).read_bytes()
+
+
+def test_opv2v_input_gives_the_same_ground_truth(two_usv: Path, tmp_path: Path) -> None:
+    from mmusv.export.convert import convert
+
+    convert([two_usv], to="opv2v", out_dir=tmp_path / "opv2v", splits=None, extras="")
+    rec_out, opv_out = tmp_path / "a", tmp_path / "b"
+    assert main(["study", "detection", str(two_usv), "--modes", "none,early", "-o", str(rec_out), "--no-progress"]) == 0
+    assert main(["study", "detection", "--opv2v", str(tmp_path / "opv2v"), "--modes", "none,early", "-o", str(opv_out),
+                 "--no-progress"]) == 0
+    a, b = pl.read_csv(rec_out / "detection_table.csv"), pl.read_csv(opv_out / "detection_table.csv")
+    assert a["gt"].to_list() == b["gt"].to_list()
+    ga = pl.read_parquet(rec_out / "detection_boxes.parquet").filter(pl.col("kind") == "gt").sort(["frame", "x"])
+    gb = pl.read_parquet(opv_out / "detection_boxes.parquet").filter(pl.col("kind") == "gt").sort(["frame", "x"])
+    assert np.allclose(ga.select(["x", "y", "l", "w"]).to_numpy(), gb.select(["x", "y", "l", "w"]).to_numpy(), atol=1e-3)
+    # Same clouds (to 0.1 mm): the baseline finds the same boxes.
+    assert a["det"].to_list() == b["det"].to_list()
+
+
+def test_bad_input_errors(two_usv: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    one = record(tmp_path / "one", ("usv_1",), frames=2)
+
+    def err(args: list[str]) -> str:
+        assert main([*args, "-o", str(tmp_path / "o"), "--no-progress"]) == 2
+        return capsys.readouterr().err
+
+    assert "needs at least 2" in err(["study", "detection", str(one)])
+    assert main(["study", "detection", str(one), "--modes", "none", "-o", str(tmp_path / "o1"), "--no-progress"]) == 0
+    capsys.readouterr()
+    assert "unknown mode" in err(["study", "detection", str(two_usv), "--modes", "none,mid"])
+    assert "--settings" in err(["study", "robustness", str(two_usv), "--settings", "delay:x"])
+    (tmp_path / "empty").mkdir()
+    assert "no .mcap" in err(["study", "detection", str(tmp_path / "empty")])
+    assert "empty dataset" in err(["study", "detection"])
+    assert "not an OPV2V folder" in err(["study", "detection", "--opv2v", str(tmp_path / "empty")])
+    assert "empty dataset" in err(["study", "detection", str(two_usv), "--split", "test"])
+    assert "--split" in err(["study", "detection", str(two_usv), "--split", "bogus"])
+    notmcap = tmp_path / "x.mcap"
+    notmcap.write_text("hello")
+    assert "not an MCAP file" in err(["study", "detection", str(notmcap)])
+    assert "--detector" in err(["study", "detection", str(two_usv), "--detector", "nowhere:fn"])
+    assert "--predictions" in err(["study", "detection", str(two_usv), "--predictions", str(notmcap)])
+
+
+def test_rescore_of_the_boxes_parquet_gives_the_table(two_usv: Path, tmp_path: Path) -> None:
+    from mmusv.studies.detection.report import rescore
+
+    out = tmp_path / "det"
+    assert main(["study", "detection", str(two_usv), "-o", str(out), "--no-progress"]) == 0
+    table = pl.read_csv(out / "detection_table.csv")
+    boxes = pl.read_parquet(out / "detection_boxes.parquet")
+    for row in table.iter_rows(named=True):
+        got = rescore(boxes.filter(pl.col("mode") == row["mode"]))
+        for k in ("ap30", "ap50", "ap70", "gt", "det"):
+            assert (math.isnan(got[k]) and math.isnan(row[k])) or got[k] == pytest.approx(row[k]), k
