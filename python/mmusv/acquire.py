@@ -149,7 +149,7 @@ def run(
         IoError: the output exists and ``overwrite`` is false, or cannot be written.
         KeyboardInterrupt: re-raised after the recording was finished with every completed frame.
     """
-    from mmusv.record_frames import FrameRecorder  # the MCAP side, kept apart from the loop
+    from mmusv.recording.frames import FrameRecorder  # the MCAP side, kept apart from the loop
 
     scenario = load_scenario(cfg)
     total = scenario.acquisition.frames if frames is None else int(frames)

@@ -120,7 +120,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
 def _cmd_info(args: argparse.Namespace) -> int:
     from rich.table import Table
 
-    from mmusv.record import summary
+    from mmusv.recording import summary
 
     info = summary(args.recording)
     console = _console()

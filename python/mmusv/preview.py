@@ -8,7 +8,6 @@ picture shows what a user of the file gets.
 
 from __future__ import annotations
 
-import io
 import math
 from pathlib import Path
 from typing import Any
@@ -17,64 +16,11 @@ import numpy as np
 from PIL import Image
 
 from mmusv.classes import palette_array
-from mmusv.errors import ConfigError, IoError
+from mmusv.errors import ConfigError
+from mmusv.recording.reader import decode_image, decode_point_cloud, frame_messages
+from mmusv.recording import topics
 
-__all__ = ["decode_image", "decode_point_cloud", "frame_messages", "write_preview"]
-
-_NUMPY = {1: np.uint8, 2: np.int8, 3: np.uint16, 4: np.int16, 5: np.uint32, 6: np.int32, 7: np.float32, 8: np.float64}
-
-
-def decode_image(msg: Any) -> np.ndarray:
-    """A ``foxglove.RawImage`` or ``foxglove.CompressedImage`` (PNG) as a numpy array (``(H, W)`` or ``(H, W, 3)``)."""
-    if hasattr(msg, "format"):
-        return np.asarray(Image.open(io.BytesIO(msg.data)))
-    enc = msg.encoding
-    dtype = {"rgb8": np.uint8, "mono8": np.uint8, "8UC1": np.uint8, "16UC1": np.uint16, "mono16": np.uint16, "32FC1": np.float32, "32SC1": np.int32}.get(enc)
-    if dtype is None:
-        raise IoError(f"unsupported image encoding {enc!r}")
-    data = np.frombuffer(msg.data, dtype=np.dtype(dtype).newbyteorder("<"))
-    ch = 3 if enc == "rgb8" else 1
-    rows = data.reshape(msg.height, msg.step // np.dtype(dtype).itemsize)
-    img = rows[:, : msg.width * ch]
-    return img.reshape(msg.height, msg.width, 3) if ch == 3 else img
-
-
-def decode_point_cloud(msg: Any) -> dict[str, np.ndarray]:
-    """A ``foxglove.PointCloud`` as ``{field name: (N,) array}`` using the packed field offsets."""
-    stride = msg.point_stride
-    raw = np.frombuffer(msg.data, dtype=np.uint8)
-    n = raw.size // stride if stride else 0
-    rows = raw[: n * stride].reshape(n, stride)
-    out: dict[str, np.ndarray] = {}
-    for f in msg.fields:
-        dt = np.dtype(_NUMPY[int(f.type)]).newbyteorder("<")
-        out[f.name] = rows[:, f.offset : f.offset + dt.itemsize].copy().view(dt).reshape(n)
-    return out
-
-
-def frame_messages(path: str | Path, frame: int) -> dict[str, Any]:
-    """Every decoded message of acquisition index ``frame``, by topic (log time = frame / f)."""
-    from mcap.reader import make_reader
-    from mcap_protobuf.decoder import DecoderFactory
-
-    p = Path(path)
-    if not p.is_file():
-        raise IoError(f"recording {p} does not exist")
-    out: dict[str, Any] = {}
-    with p.open("rb") as f:
-        reader = make_reader(f, decoder_factories=[DecoderFactory()])
-        meta = {m.name: dict(m.metadata) for m in reader.iter_metadata()}
-        freq = float(meta.get("run", {}).get("frequency_hz", "0") or 0)
-        if freq <= 0:
-            raise IoError(f"{p} has no run metadata (frequency_hz); was it written by mmusv run?")
-        t = round(frame / freq * 1e9)
-        for _schema, channel, message, decoded in reader.iter_decoded_messages(start_time=t, end_time=t + 1):
-            out[channel.topic] = decoded
-            del message
-    if not out:
-        raise ConfigError(f"frame {frame} is not in {p}")
-    return out
-
+__all__ = ["write_preview"]
 
 def _colour_depth(d: np.ndarray, max_m: float = 300.0) -> np.ndarray:
     import matplotlib
@@ -124,12 +70,12 @@ def write_preview(path: str | Path, *, frame: int = 0, agent: str | None = None,
     a = agent or agents[0]
     if a not in agents:
         raise ConfigError(f"no agent {a!r} in {path}; agents: {', '.join(agents)}")
-    cams = sorted({t.split("/")[3] for t in msgs if t.startswith(f"/{a}/camera/")})
+    cams = sorted({t.split("/")[3] for t in msgs if t.startswith(topics.camera(a, ""))})
     tile = (320, 240)
     rows: list[list[Image.Image]] = [[], [], []]
     for c in cams:
         for r, kind in enumerate(("rgb", "depth", "semantic")):
-            m = msgs.get(f"/{a}/camera/{c}/{kind}")
+            m = msgs.get(topics.camera(a, c, kind))
             if m is None:
                 rows[r].append(Image.new("RGB", tile))
                 continue
@@ -141,13 +87,13 @@ def write_preview(path: str | Path, *, frame: int = 0, agent: str | None = None,
             rows[r].append(_panel(img, tile))
     extra: list[Image.Image] = []
     sq = (tile[1], tile[1])
-    ppi = msgs.get(f"/{a}/radar/ppi")
+    ppi = msgs.get(topics.radar_ppi(a))
     extra.append(_panel(decode_image(ppi), sq) if ppi is not None else Image.new("RGB", sq))
-    tv = msgs.get(f"/{a}/top_view/semantic")
+    tv = msgs.get(topics.top_view(a, "semantic"))
     if tv is not None:
         extra.append(_panel(palette_array()[np.clip(decode_image(tv).astype(int), 0, 255)], sq))
-    lidar = msgs.get(f"/{a}/lidar")
-    ann = msgs.get(f"/{a}/annotations")
+    lidar = msgs.get(topics.lidar(a))
+    ann = msgs.get(topics.annotations(a))
     pts = decode_point_cloud(lidar) if lidar is not None else {}
     extra.append(_panel(_bev(pts, list(ann.boxes_bev) if ann is not None else []), sq))
     width = max(tile[0] * max(len(cams), 1), sq[0] * len(extra))

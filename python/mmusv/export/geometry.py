@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mmusv.export.reader import AgentInfo, WorldFrame
+from mmusv.recording.reader import AgentInfo, WorldFrame
 from mmusv.frames import invert, pose_matrices
 
 __all__ = ["AgentView", "Target", "agent_view", "targets_of"]
