@@ -63,6 +63,16 @@ class AgentInfo:
     cameras: dict[str, CameraInfo]
     rig: dict[str, Any]
 
+    def sensor_poses(self, world: WorldFrame) -> tuple[np.ndarray, np.ndarray | None, dict[str, np.ndarray]]:
+        """``(body, lidar, cameras)`` at ``world``: ``(4, 4)`` vessel body → world (from the world-state pose) and
+        sensor → world = body · the recorded mount (LiDAR ``None`` without one; cameras by name, camera body frame
+        x forward = optical axis). The one place a reader of the file composes body and mount."""
+        from mmusv.frames import pose_matrices
+
+        body = pose_matrices(world.poses[self.index])
+        lidar = None if self.lidar_mount is None else body @ self.lidar_mount
+        return body, lidar, {name: body @ c.mount for name, c in self.cameras.items()}
+
     @property
     def ppi_metres_per_pixel(self) -> float | None:
         """Metres per pixel of the recorded radar PPI (``ppi_metres_per_pixel``, default ``range_m / (ppi_size_px
