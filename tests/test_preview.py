@@ -66,7 +66,7 @@ def test_one_titled_non_blank_panel_per_recorded_image(recording: Path) -> None:
 def test_2d_boxes_on_the_camera_edges(recording: Path) -> None:
     sheet, panels = compose_preview(recording, frame=0)
     arr = np.asarray(sheet)
-    ann = frame_messages(recording, 0)[topics.annotations("usv_1")]
+    ann = frame_messages(recording, 0)[topics.agent_annotations("usv_1")]
     boxes = [b for b in ann.boxes_camera if b.x_max - b.x_min >= 6 and b.y_max - b.y_min >= 6]
     assert boxes, "the test scenario must put a box of a few pixels in a camera"
     for b in boxes:
@@ -87,7 +87,7 @@ def test_2d_boxes_on_the_camera_edges(recording: Path) -> None:
 def test_3d_box_footprints_in_the_bev(recording: Path) -> None:
     sheet, panels = compose_preview(recording, frame=0, agent="usv_2")   # usv_2 has the tug in LiDAR range
     arr = np.asarray(sheet)
-    ann = frame_messages(recording, 0)[topics.annotations("usv_2")]
+    ann = frame_messages(recording, 0)[topics.agent_annotations("usv_2")]
     bev = next(p for p in panels if "BEV" in p.title)
     l, t, r, b = bev.box
     cu, cv = l + (r - l) / 2, t + (b - t) / 2

@@ -167,7 +167,7 @@ def compose_preview(path: str | Path, *, frame: int = 0, agent: str | None = Non
     if a_id not in agents:
         raise ConfigError(f"no agent {a_id!r} in {path}; agents: {', '.join(agents)}")
     a: AgentInfo = agents[a_id]
-    ann = msgs.get(topics.annotations(a_id))
+    ann = msgs.get(topics.agent_annotations(a_id))
     boxes2d = list(ann.boxes_camera) if ann is not None else []
     boxes3d = list(ann.boxes_lidar) if ann is not None else []
 

@@ -67,7 +67,7 @@ class KittiWriter(DatasetWriter):
     cameras = {"front": 2}
 
     def optional_topics(self) -> list[str]:
-        return super().optional_topics() + [topics.annotations(a.id) for a in self.agents]
+        return super().optional_topics() + [topics.agent_annotations(a.id) for a in self.agents]
 
     def _dir(self, agent: AgentInfo, sub: str) -> Path:
         return self.sink.mkdir(self.folder / str(cav_id(agent.index)) / sub)
@@ -98,7 +98,7 @@ class KittiWriter(DatasetWriter):
                   f"Tr_imu_to_velo: {_fmt(invert(a.lidar_mount)[:3, :])}"]
         self.put(self._dir(a, "calib") / f"{ts}.txt", ("\n".join(calib) + "\n").encode())
         boxes: dict[str, Any] = {}
-        ann = msgs.get(topics.annotations(a.id))
+        ann = msgs.get(topics.agent_annotations(a.id))
         if ann is not None:
             boxes = {b.target_id: b for b in ann.boxes_camera if b.camera == "front"}
         lines = [kitti_label(t, velo_to_cam, boxes.get(t.id)) if cam is not None else kitti_label(t, velo_to_cam, None) for t in targets]

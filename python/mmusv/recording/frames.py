@@ -125,7 +125,7 @@ class FrameRecorder:
                 self._radar(a.id, t, ac.radar, ac.radar_ppi)
             cols = annotations.get(a.id)
             if cols is not None:
-                rec.annotations(topics.annotations(a.id), log_time_ns=t, frame=cap.frame, time_s=cap.time_s, agent_id=a.id,
+                rec.annotations(topics.agent_annotations(a.id), log_time_ns=t, frame=cap.frame, time_s=cap.time_s, agent_id=a.id,
                                 lidar=cols["lidar"], bev=cols["bev"], camera=cols["camera"])
                 lid = cols["lidar"]
                 colours = np.array([_ROLE_COLOURS.get(self.roles.get(i, "target"), (1, 1, 1, 0.5)) for i in lid["target_id"]]).reshape(-1, 4)

@@ -9,8 +9,10 @@ Topics: ``/tf``, ``/world/state``, ``/{agent}/lidar``, ``/{agent}/camera/{name}/
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 __all__ = [
-    "CAMERA_KINDS", "TF", "WORLD_FRAME", "WORLD_STATE", "agent_of", "annotations", "boxes", "camera", "camera_frame",
+    "CAMERA_KINDS", "TF", "WORLD_FRAME", "WORLD_STATE", "agent_annotations", "agent_of", "boxes", "camera", "camera_frame",
     "lidar", "lidar_frame", "radar_frame", "radar_ppi", "radar_returns", "top_view", "top_view_frame",
 ]
 
@@ -24,9 +26,24 @@ CAMERA_KINDS: tuple[str, ...] = ("rgb", "depth", "semantic", "instance")
 """Image kinds a camera or the top view may publish, in this order."""
 
 
-def lidar(agent: str) -> str:
-    """``/{agent}/lidar`` (``foxglove.PointCloud`` in the LiDAR frame)."""
-    return f"/{agent}/lidar"
+def _per_agent(pattern: str, doc: str) -> Callable[[str], str]:
+    """A function ``agent -> pattern.format(agent=agent)`` documented as ``doc``."""
+
+    def name(agent: str) -> str:
+        return pattern.format(agent=agent)
+
+    name.__doc__ = f"``{pattern}``: {doc}"
+    return name
+
+
+lidar = _per_agent("/{agent}/lidar", "foxglove.PointCloud in the LiDAR frame.")
+radar_returns = _per_agent("/{agent}/radar/returns", "foxglove.PointCloud in the radar frame.")
+radar_ppi = _per_agent("/{agent}/radar/ppi", "colour-mapped PPI, PNG foxglove.CompressedImage.")
+boxes = _per_agent("/{agent}/boxes", "foxglove.SceneUpdate in the LiDAR frame.")
+agent_annotations = _per_agent("/{agent}/annotations", "mmusv.AgentAnnotations.")
+lidar_frame = _per_agent("{agent}/lidar", "frame id of the agent's LiDAR.")
+radar_frame = _per_agent("{agent}/radar", "frame id of the agent's radar.")
+top_view_frame = _per_agent("{agent}/top_view", "frame id (optical) of the agent's top-view camera.")
 
 
 def camera(agent: str, name: str, kind: str | None = None) -> str:
@@ -41,44 +58,9 @@ def top_view(agent: str, kind: str | None = None) -> str:
     return base if kind is None else f"{base}/{kind}"
 
 
-def radar_returns(agent: str) -> str:
-    """``/{agent}/radar/returns`` (``foxglove.PointCloud`` in the radar frame)."""
-    return f"/{agent}/radar/returns"
-
-
-def radar_ppi(agent: str) -> str:
-    """``/{agent}/radar/ppi`` (colour-mapped PPI PNG)."""
-    return f"/{agent}/radar/ppi"
-
-
-def boxes(agent: str) -> str:
-    """``/{agent}/boxes`` (``foxglove.SceneUpdate`` in the LiDAR frame)."""
-    return f"/{agent}/boxes"
-
-
-def annotations(agent: str) -> str:
-    """``/{agent}/annotations`` (``mmusv.AgentAnnotations``)."""
-    return f"/{agent}/annotations"
-
-
-def lidar_frame(agent: str) -> str:
-    """Frame id of the agent's LiDAR."""
-    return f"{agent}/lidar"
-
-
-def radar_frame(agent: str) -> str:
-    """Frame id of the agent's radar."""
-    return f"{agent}/radar"
-
-
 def camera_frame(agent: str, name: str) -> str:
     """Frame id (optical) of camera ``name`` of the agent."""
     return f"{agent}/camera/{name}"
-
-
-def top_view_frame(agent: str) -> str:
-    """Frame id (optical) of the agent's top-view camera."""
-    return f"{agent}/top_view"
 
 
 def agent_of(topic: str) -> str | None:
