@@ -25,7 +25,8 @@ def recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
     sc["rigs"] = {"usv_standard": {
         "lidar": {"channels": 16, "points_per_second": 16 * 360 * 5},
         "radar": {"range_m": 1000, "azimuth_bins": 256, "rays_el": 8, "ppi_size_px": 64},
-        "cameras": [{"name": n, "resolution": [320, 240], "mount": {"point": f"camera_{n}"}} for n in ("front", "left", "rear", "right")],
+        "cameras": [{"name": n, "resolution": [320, 240], "mount": {"point": f"camera_{n}"}}
+                    for n in ("front", "left", "rear", "right")],
         "top_view": {"resolution": [64, 64], "metres_per_pixel": 2.0},
     }}
     return run(sc, out_dir=tmp_path_factory.mktemp("prev")).recording

@@ -239,7 +239,9 @@ def compose_preview(path: str | Path, *, frame: int = 0, agent: str | None = Non
     return canvas, panels
 
 
-def write_preview(path: str | Path, *, frame: int = 0, agent: str | None = None, output: str | Path | None = None) -> Path:
+def write_preview(
+    path: str | Path, *, frame: int = 0, agent: str | None = None, output: str | Path | None = None
+) -> Path:
     """Writes the preview PNG of ``frame`` for ``agent`` (default: the first agent); returns its path."""
     canvas, panels = compose_preview(path, frame=frame, agent=agent)
     a = panels[0].title.split(" · ")[0]

@@ -439,9 +439,11 @@ def frame_messages(path: str | Path, frame: int) -> dict[str, Any]:
         if freq <= 0:
             raise IoError(f"{p} has no run metadata (frequency_hz); was it written by mmusv run?")
         t = round(frame / freq * 1e9)
-        for _schema, channel, message, decoded in reader.iter_decoded_messages(start_time=t, end_time=t + 1):
+        # messages come in log-time order from t on; the frame ends at the first later log time
+        for _schema, channel, message, decoded in reader.iter_decoded_messages(start_time=t):
+            if message.log_time != t:
+                break
             out[channel.topic] = decoded
-            del message
     if not out:
         raise ConfigError(f"frame {frame} is not in {p}")
     return out

@@ -12,7 +12,8 @@ from __future__ import annotations
 from collections.abc import Callable
 
 __all__ = [
-    "CAMERA_KINDS", "TF", "WORLD_FRAME", "WORLD_STATE", "agent_annotations", "agent_of", "boxes", "camera", "camera_frame",
+    "CAMERA_KINDS", "TF", "WORLD_FRAME", "WORLD_STATE", "agent_annotations", "agent_of", "boxes", "camera",
+    "camera_frame",
     "lidar", "lidar_frame", "radar_frame", "radar_ppi", "radar_returns", "top_view", "top_view_frame",
 ]
 
