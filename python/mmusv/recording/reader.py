@@ -440,7 +440,7 @@ def frame_messages(path: str | Path, frame: int) -> dict[str, Any]:
             raise IoError(f"{p} has no run metadata (frequency_hz); was it written by mmusv run?")
         t = round(frame / freq * 1e9)
         # messages come in log-time order from t on; the frame ends at the first later log time
-        for _schema, channel, message, decoded in reader.iter_decoded_messages(start_time=t):
+        for _schema, channel, message, decoded in reader.iter_decoded_messages(starting_at=t):
             if message.log_time != t:
                 break
             out[channel.topic] = decoded
