@@ -1,6 +1,6 @@
 """Encode throughput of the MCAP recorder (not a test): per frame, one 26,214-point LiDAR cloud
 (x, y, z, intensity float32 + ring uint16 = 18 B/point) and four 640x480 RGB PNGs, written through
-:class:`mmusv.record.Recording` into a temporary file.
+:class:`mmusv.recording.Recording` into a temporary file.
 
 Reports MB/s of raw input bytes (cloud bytes + 4 x 640x480x3) and frames/s, for camera-like images (smooth
 sky/water gradients with mild noise) and for worst-case uniform noise. Usage: ``python benches/record_throughput.py``.
@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import numpy.typing as npt
 
-from mmusv.record import Recording, to_ns
+from mmusv.recording import Recording, to_ns
 
 POINTS = 26_214
 W, H = 640, 480

@@ -17,7 +17,7 @@ from mcap_protobuf.decoder import DecoderFactory
 import mmusv
 from mmusv.acquire import run
 from mmusv.cli import main
-from mmusv.preview import decode_image, decode_point_cloud
+from mmusv.recording import decode_image, decode_point_cloud
 
 ROOT = Path(__file__).resolve().parents[1]
 

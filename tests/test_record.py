@@ -1,4 +1,4 @@
-"""The MCAP recorder (:mod:`mmusv.record` over ``mmusv._core.Recorder``).
+"""The MCAP recorder (:mod:`mmusv.recording` over ``mmusv._core.Recorder``).
 
 Every message kind is written from Python and read back with the ``mcap`` reader plus
 ``mcap-protobuf-support`` (the same decoders Foxglove-compatible tools use); every field value is compared with
@@ -17,7 +17,7 @@ import numpy.typing as npt
 import pytest
 from mcap.reader import make_reader
 from mmusv.errors import InputError, IoError
-from mmusv.record import Recording, read_messages, summary, to_ns
+from mmusv.recording import Recording, read_messages, summary, to_ns
 from PIL import Image
 
 # foxglove.PackedElementField.NumericType → numpy dtype

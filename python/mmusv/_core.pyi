@@ -333,7 +333,7 @@ def wave_height(wave: str | float) -> float:
 class Recorder:
     """Streams messages into one MCAP file (zstd chunks, deterministic bytes), written as ``<path>.partial`` and
     renamed to ``path`` by :meth:`finish`. Times are simulation times in integer nanoseconds (log = publish time).
-    Every method releases the GIL while it encodes and writes. Use :class:`mmusv.record.Recording` instead."""
+    Every method releases the GIL while it encodes and writes. Use :class:`mmusv.recording.Recording` instead."""
 
     def __new__(cls, path: str | os.PathLike[str], *, overwrite: bool = False) -> Recorder:
         """Starts a recording; an existing ``path`` raises ``IoError`` unless ``overwrite`` (replaced only on finish)."""

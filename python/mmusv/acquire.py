@@ -156,7 +156,7 @@ def run(
         IoError: the output exists and ``overwrite`` is false, or cannot be written.
         KeyboardInterrupt: re-raised after the recording was finished with every completed frame.
     """
-    from mmusv.record_frames import FrameRecorder  # the MCAP side, kept apart from the loop
+    from mmusv.recording.frames import FrameRecorder  # the MCAP side, kept apart from the loop
 
     if isinstance(cfg, (str, os.PathLike)) and Path(cfg).is_dir():
         raise ConfigError(

@@ -48,7 +48,9 @@ def _cmd_study_waves(args: argparse.Namespace) -> int:
     from mmusv.config import load_scenario
     from mmusv.studies.waves import run_wave_study
 
-    scenario = load_scenario(args.scenario)
+    from mmusv.bundled import resolve_scenario
+
+    scenario = load_scenario(resolve_scenario(args.scenario))
     if args.frames is not None:
         if args.frames < 2:
             raise MmusvError("--frames must be at least 2")
@@ -111,7 +113,9 @@ def _run_one_safe(path: str, out: str, overwrite: bool, frames: int | None, chec
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    src = Path(args.scenario)
+    from mmusv.bundled import resolve_scenario
+
+    src = resolve_scenario(args.scenario)
     checks = not args.no_checks
     if src.is_dir():
         files = sorted(p for p in src.glob("*.yaml") if p.name != "report.yaml")
@@ -159,10 +163,24 @@ def _report_folder(files: list[Path], results: list[tuple[str, str]]) -> int:
     return 1 if failed else 0
 
 
+def _cmd_scenarios(args: argparse.Namespace) -> int:
+    from rich.table import Table
+
+    from mmusv.bundled import bundled_scenarios
+
+    table = Table(title="Bundled scenarios (mmusv run NAME)")
+    for col in ("name", "map", "USVs", "targets", "frames", "description"):
+        table.add_column(col, justify="right" if col in ("USVs", "targets", "frames") else "left")
+    for b in bundled_scenarios():
+        table.add_row(b.name, b.map, str(b.usvs), str(b.targets), str(b.frames), b.description)
+    _console().print(table)
+    return 0
+
+
 def _cmd_info(args: argparse.Namespace) -> int:
     from rich.table import Table
 
-    from mmusv.record import summary
+    from mmusv.recording import summary
 
     info = summary(args.recording)
     console = _console()
@@ -215,6 +233,7 @@ def _parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True)
     sub.add_parser("version", help="print the version")
     sub.add_parser("assets", help="list the vessel library")
+    sub.add_parser("scenarios", help="list the bundled scenarios (mmusv run NAME runs one from any directory)")
     study = sub.add_parser("study", help="reproduce the paper's experiments")
     studies = study.add_subparsers(dest="study", required=True)
     waves = studies.add_parser("waves", help="Table I: heave/roll/pitch RMS under W0..W3")
@@ -271,6 +290,8 @@ def main(argv: list[str] | None = None) -> int:
             return 0
         if args.command == "assets":
             return _cmd_assets(args)
+        if args.command == "scenarios":
+            return _cmd_scenarios(args)
         if args.command == "study" and args.study == "waves":
             return _cmd_study_waves(args)
         if args.command == "study" and args.study == "agreement":

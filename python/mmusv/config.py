@@ -33,7 +33,7 @@ from pydantic import (
     model_validator,
 )
 
-from mmusv.errors import ConfigError
+from mmusv.errors import ConfigError, MmusvError, located
 from mmusv.sensors.config import RigConfig
 from mmusv.world.environment import Environment, wave_height_m
 from mmusv.world.vessels import asset_names, get_asset
@@ -243,6 +243,8 @@ def load_scenario(source: str | os.PathLike[str] | dict[str, Any] | Scenario) ->
         return Scenario.model_validate(data)
     except ValidationError as exc:
         raise validation_error(exc, where) from None
+    except MmusvError as exc:  # a validator that checks through the core (wave presets, ...)
+        raise located(exc, where) from None
 
 
 def scenario_hash(scenario: Scenario) -> str:

@@ -1,82 +1,57 @@
 """``mmusv preview REC.mcap --frame K``: one picture of a recorded frame, in the spirit of Fig. 5 of the paper.
 
-Panels for one agent: the surround RGB cameras (top row), their depth and semantic images, the radar PPI, the
-top-view semantic rendering, and a bird's-eye view of the LiDAR points (x forward up, y left to the left) with
-the agent's BEV boxes. Everything is read back from the recording (``mcap`` + ``mcap-protobuf-support``), so the
-picture shows what a user of the file gets.
+One sheet per agent and frame, every panel titled ``<USV> · <sensor> · <modality>``: the surround cameras (RGB with
+the annotated 2D boxes, depth, semantic; one row each), then the radar PPI with range rings labelled in metres,
+the top view (RGB, semantic) and a bird's-eye view of the LiDAR points (x forward up, y left to the left) with the
+footprints of the annotated 3D boxes. Only panels the recording holds are drawn, so none is empty. Everything is
+read back through :mod:`mmusv.recording.reader`, so the picture shows what a user of the file gets.
 """
 
 from __future__ import annotations
 
-import io
 import math
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-from PIL import Image
+from PIL import Image, ImageDraw, ImageFont
 
 from mmusv.classes import palette_array
-from mmusv.errors import ConfigError, IoError
+from mmusv.errors import ConfigError
+from mmusv.recording import topics
+from mmusv.recording.reader import AgentInfo, decode_image, decode_point_cloud, frame_messages, read_info
 
-__all__ = ["decode_image", "decode_point_cloud", "frame_messages", "write_preview"]
+__all__ = ["BOX_COLOUR", "Panel", "compose_preview", "write_preview"]
 
-_NUMPY = {1: np.uint8, 2: np.int8, 3: np.uint16, 4: np.int16, 5: np.uint32, 6: np.int32, 7: np.float32, 8: np.float64}
-
-
-def decode_image(msg: Any) -> np.ndarray:
-    """A ``foxglove.RawImage`` or ``foxglove.CompressedImage`` (PNG) as a numpy array (``(H, W)`` or ``(H, W, 3)``)."""
-    if hasattr(msg, "format"):
-        return np.asarray(Image.open(io.BytesIO(msg.data)))
-    enc = msg.encoding
-    dtype = {"rgb8": np.uint8, "mono8": np.uint8, "8UC1": np.uint8, "16UC1": np.uint16, "mono16": np.uint16, "32FC1": np.float32, "32SC1": np.int32}.get(enc)
-    if dtype is None:
-        raise IoError(f"unsupported image encoding {enc!r}")
-    data = np.frombuffer(msg.data, dtype=np.dtype(dtype).newbyteorder("<"))
-    ch = 3 if enc == "rgb8" else 1
-    rows = data.reshape(msg.height, msg.step // np.dtype(dtype).itemsize)
-    img = rows[:, : msg.width * ch]
-    return img.reshape(msg.height, msg.width, 3) if ch == 3 else img
+BOX_COLOUR = (255, 0, 200)
+"""RGB of the annotation boxes (2D on the camera images, 3D footprints in the LiDAR BEV)."""
+_TITLE_H = 22
+_BG = (24, 24, 28)
+_TEXT = (235, 235, 235)
+_RING = (120, 140, 120)
+_TILE = (320, 240)
+_DEPTH_MAX_M = 300.0
+_BEV_HALF_M = 100.0
 
 
-def decode_point_cloud(msg: Any) -> dict[str, np.ndarray]:
-    """A ``foxglove.PointCloud`` as ``{field name: (N,) array}`` using the packed field offsets."""
-    stride = msg.point_stride
-    raw = np.frombuffer(msg.data, dtype=np.uint8)
-    n = raw.size // stride if stride else 0
-    rows = raw[: n * stride].reshape(n, stride)
-    out: dict[str, np.ndarray] = {}
-    for f in msg.fields:
-        dt = np.dtype(_NUMPY[int(f.type)]).newbyteorder("<")
-        out[f.name] = rows[:, f.offset : f.offset + dt.itemsize].copy().view(dt).reshape(n)
-    return out
+@dataclass(frozen=True)
+class Panel:
+    """One titled panel of the sheet: ``box`` = ``(left, top, right, bottom)`` pixels of the image area (the title
+    strip is the ``_TITLE_H`` rows above it); ``scale`` = panel pixels per source pixel (cameras) or per metre (PPI,
+    BEV)."""
+
+    title: str
+    box: tuple[int, int, int, int]
+    scale: float
 
 
-def frame_messages(path: str | Path, frame: int) -> dict[str, Any]:
-    """Every decoded message of acquisition index ``frame``, by topic (log time = frame / f)."""
-    from mcap.reader import make_reader
-    from mcap_protobuf.decoder import DecoderFactory
-
-    p = Path(path)
-    if not p.is_file():
-        raise IoError(f"recording {p} does not exist")
-    out: dict[str, Any] = {}
-    with p.open("rb") as f:
-        reader = make_reader(f, decoder_factories=[DecoderFactory()])
-        meta = {m.name: dict(m.metadata) for m in reader.iter_metadata()}
-        freq = float(meta.get("run", {}).get("frequency_hz", "0") or 0)
-        if freq <= 0:
-            raise IoError(f"{p} has no run metadata (frequency_hz); was it written by mmusv run?")
-        t = round(frame / freq * 1e9)
-        for _schema, channel, message, decoded in reader.iter_decoded_messages(start_time=t, end_time=t + 1):
-            out[channel.topic] = decoded
-            del message
-    if not out:
-        raise ConfigError(f"frame {frame} is not in {p}")
-    return out
+def _font(size: int = 14) -> ImageFont.FreeTypeFont | ImageFont.ImageFont:
+    return ImageFont.load_default(size=size)
 
 
-def _colour_depth(d: np.ndarray, max_m: float = 300.0) -> np.ndarray:
+def _colour_depth(d: np.ndarray, max_m: float = _DEPTH_MAX_M) -> np.ndarray:
+    """``(H, W, 3)`` uint8 turbo rendering of a depth image in metres (sqrt scale to ``max_m``; sky black)."""
     import matplotlib
 
     finite = np.isfinite(d)
@@ -86,77 +61,190 @@ def _colour_depth(d: np.ndarray, max_m: float = 300.0) -> np.ndarray:
     return rgb
 
 
-def _panel(img: np.ndarray, size: tuple[int, int]) -> Image.Image:
-    return Image.fromarray(img).convert("RGB").resize(size, Image.Resampling.NEAREST)
+def _semantic(img: np.ndarray) -> np.ndarray:
+    return np.asarray(palette_array()[np.clip(img.astype(int), 0, 255)], dtype=np.uint8)
 
 
-def _bev(points: dict[str, np.ndarray], boxes: Any, extent: float = 100.0, px: int = 400) -> np.ndarray:
+def _fit(img: np.ndarray, size: tuple[int, int]) -> Image.Image:
+    return Image.fromarray(img).convert("RGB").resize(size, Image.Resampling.BILINEAR)
+
+
+def _nice_step(span_m: float) -> float:
+    """A 1-2-5 step giving about four rings over ``span_m``."""
+    raw = span_m / 4.0
+    base = 10.0 ** math.floor(math.log10(raw))
+    return next(base * k for k in (1.0, 2.0, 5.0, 10.0) if base * k >= raw)
+
+
+def _rings(draw: ImageDraw.ImageDraw, *, centre: tuple[float, float], px_per_m: float, max_m: float) -> None:
+    """Range rings every 1-2-5 step up to ``max_m``, each labelled with its range in metres."""
+    step = _nice_step(max_m)
+    font = _font(11)
+    r_m = step
+    while r_m <= max_m + 1e-9:
+        r = r_m * px_per_m
+        cx, cy = centre
+        draw.ellipse((cx - r, cy - r, cx + r, cy + r), outline=_RING)
+        label = f"{r_m:g} m"
+        draw.text((cx + r * 0.7071 + 2, cy - r * 0.7071 - 12), label, fill=_RING, font=font)
+        r_m += step
+
+
+def _camera_panel(img: np.ndarray, boxes: list[Any], size: tuple[int, int]) -> tuple[Image.Image, float]:
+    """The image fitted to ``size`` with ``boxes`` (``mmusv.Box2D``, source pixels) drawn; returns the scale."""
+    h, w = img.shape[:2]
+    pil = _fit(img, size)
+    sx, sy = size[0] / w, size[1] / h
+    draw = ImageDraw.Draw(pil)
+    font = _font(11)
+    for b in boxes:
+        x0, y0, x1, y1 = b.x_min * sx, b.y_min * sy, b.x_max * sx, b.y_max * sy
+        draw.rectangle((x0, y0, x1, y1), outline=BOX_COLOUR, width=2)
+        draw.text((x0, max(0.0, y0 - 13)), b.target_id, fill=BOX_COLOUR, font=font)
+    return pil, sx
+
+
+def _bev_panel(points: dict[str, np.ndarray], boxes: list[Any], px: int, half_m: float = _BEV_HALF_M) -> Image.Image:
+    """LiDAR points (LiDAR frame) seen from above, x forward up, y left to the left, coloured by class, with the
+    footprints of the 3D boxes (``mmusv.Box3D``: centre, size, yaw) and labelled range rings."""
     img = np.zeros((px, px, 3), dtype=np.uint8)
-    m = 2 * extent / px
+    img[:] = (10, 12, 16)
+    m = 2 * half_m / px
     if points:
         x, y = points["x"], points["y"]
-        u = (px / 2 - y / m).astype(int)
-        v = (px / 2 - x / m).astype(int)
-        ok = (u >= 0) & (u < px) & (v >= 0) & (v < px)
+        u = np.round(px / 2 - y / m).astype(int)
+        v = np.round(px / 2 - x / m).astype(int)
+        ok = (u >= 0) & (u < px - 1) & (v >= 0) & (v < px - 1)
         cls = points.get("class", np.zeros_like(x, dtype=np.uint16)).astype(int)
-        img[v[ok], u[ok]] = palette_array()[np.clip(cls[ok], 0, 255)]
-    from PIL import ImageDraw
-
+        col = palette_array()[np.clip(cls[ok], 0, 255)]
+        for du in (0, 1):
+            for dv in (0, 1):
+                img[v[ok] + dv, u[ok] + du] = col
     pil = Image.fromarray(img)
     draw = ImageDraw.Draw(pil)
+    _rings(draw, centre=(px / 2, px / 2), px_per_m=1 / m, max_m=half_m)
+    draw.polygon([(px / 2, px / 2 - 7), (px / 2 - 5, px / 2 + 5), (px / 2 + 5, px / 2 + 5)], fill=(255, 255, 255))
+    font = _font(11)
     for b in boxes:
+        cx, cy, length, width = b.center[0], b.center[1], b.size[0], b.size[1]
         c, s = math.cos(b.yaw), math.sin(b.yaw)
         pts = []
         for dx, dy in ((1, 1), (1, -1), (-1, -1), (-1, 1)):
-            bx = b.x + c * dx * b.length / 2 - s * dy * b.width / 2
-            by = b.y + s * dx * b.length / 2 + c * dy * b.width / 2
+            bx = cx + c * dx * length / 2 - s * dy * width / 2
+            by = cy + s * dx * length / 2 + c * dy * width / 2
             pts.append((px / 2 - by / m, px / 2 - bx / m))
-        draw.polygon(pts, outline=(255, 60, 60))
-    return np.asarray(pil)
+        draw.polygon(pts, outline=BOX_COLOUR, width=2)
+        draw.text((px / 2 - cy / m + 4, px / 2 - cx / m + 4), b.target_id, fill=BOX_COLOUR, font=font)
+    return pil
 
 
-def write_preview(path: str | Path, *, frame: int = 0, agent: str | None = None, output: str | Path | None = None) -> Path:
-    """Writes the preview PNG of ``frame`` for ``agent`` (default: the first agent); returns its path."""
+def _bev_half_extent(boxes: list[Any]) -> float:
+    """Half side (m) of the BEV square: ``_BEV_HALF_M``, widened to a 1-2-5 value that holds every box centre."""
+    reach = max([max(abs(b.center[0]), abs(b.center[1])) * 1.1 for b in boxes] + [_BEV_HALF_M])
+    base = 10.0 ** math.floor(math.log10(reach))
+    return min(next(base * k for k in (1.0, 2.0, 5.0, 10.0) if base * k >= reach), 1000.0)
+
+
+def _ppi_panel(img: np.ndarray, px: int, metres_per_pixel: float | None) -> tuple[Image.Image, float]:
+    """The colour-mapped PPI fitted to ``px`` square with labelled range rings; returns panel pixels per metre."""
+    h = img.shape[0]
+    pil = _fit(img, (px, px))
+    if metres_per_pixel is None:
+        return pil, 0.0
+    px_per_m = px / (h * metres_per_pixel)
+    _rings(ImageDraw.Draw(pil), centre=(px / 2, px / 2), px_per_m=px_per_m, max_m=h * metres_per_pixel / 2)
+    return pil, px_per_m
+
+
+def compose_preview(path: str | Path, *, frame: int = 0, agent: str | None = None) -> tuple[Image.Image, list[Panel]]:
+    """The preview sheet of ``frame`` for ``agent`` (default: the first agent) and its panels, in drawing order."""
+    info = read_info(path)
     msgs = frame_messages(path, frame)
-    agents = sorted({t.split("/")[1] for t in msgs if t.count("/") >= 2 and not t.startswith("/world")})
+    agents = {a.id: a for a in info.agents if any(topics.agent_of(t) == a.id for t in msgs)}
     if not agents:
         raise ConfigError(f"frame {frame} of {path} has no agent topics")
-    a = agent or agents[0]
-    if a not in agents:
-        raise ConfigError(f"no agent {a!r} in {path}; agents: {', '.join(agents)}")
-    cams = sorted({t.split("/")[3] for t in msgs if t.startswith(f"/{a}/camera/")})
-    tile = (320, 240)
-    rows: list[list[Image.Image]] = [[], [], []]
-    for c in cams:
-        for r, kind in enumerate(("rgb", "depth", "semantic")):
-            m = msgs.get(f"/{a}/camera/{c}/{kind}")
+    a_id = agent or next(iter(agents))
+    if a_id not in agents:
+        raise ConfigError(f"no agent {a_id!r} in {path}; agents: {', '.join(agents)}")
+    a: AgentInfo = agents[a_id]
+    ann = msgs.get(topics.agent_annotations(a_id))
+    boxes2d = list(ann.boxes_camera) if ann is not None else []
+    boxes3d = list(ann.boxes_lidar) if ann is not None else []
+
+    rows: list[list[tuple[str, Image.Image, float]]] = []
+    for kind in ("rgb", "depth", "semantic"):
+        row = []
+        for cam in sorted(a.cameras):
+            m = msgs.get(topics.camera(a_id, cam, kind))
             if m is None:
-                rows[r].append(Image.new("RGB", tile))
                 continue
             img = decode_image(m)
-            if kind == "depth":
-                img = _colour_depth(img.astype(np.float32))
-            elif kind == "semantic":
-                img = palette_array()[np.clip(img.astype(int), 0, 255)]
-            rows[r].append(_panel(img, tile))
-    extra: list[Image.Image] = []
-    sq = (tile[1], tile[1])
-    ppi = msgs.get(f"/{a}/radar/ppi")
-    extra.append(_panel(decode_image(ppi), sq) if ppi is not None else Image.new("RGB", sq))
-    tv = msgs.get(f"/{a}/top_view/semantic")
-    if tv is not None:
-        extra.append(_panel(palette_array()[np.clip(decode_image(tv).astype(int), 0, 255)], sq))
-    lidar = msgs.get(f"/{a}/lidar")
-    ann = msgs.get(f"/{a}/annotations")
-    pts = decode_point_cloud(lidar) if lidar is not None else {}
-    extra.append(_panel(_bev(pts, list(ann.boxes_bev) if ann is not None else []), sq))
-    width = max(tile[0] * max(len(cams), 1), sq[0] * len(extra))
-    canvas = Image.new("RGB", (width, tile[1] * 3 + sq[1]), (20, 20, 20))
-    for r, row in enumerate(rows):
-        for i, im in enumerate(row):
-            canvas.paste(im, (i * tile[0], r * tile[1]))
-    for i, im in enumerate(extra):
-        canvas.paste(im, (i * sq[0], 3 * tile[1]))
+            if kind == "rgb":
+                pil, scale = _camera_panel(img, [b for b in boxes2d if b.camera == cam], _TILE)
+                row.append((f"{a_id} · {cam} camera · RGB + 2D boxes", pil, scale))
+            elif kind == "depth":
+                pil = _fit(_colour_depth(img.astype(np.float32)), _TILE)
+                row.append((f"{a_id} · {cam} camera · depth 0-{_DEPTH_MAX_M:g} m", pil, _TILE[0] / img.shape[1]))
+            else:
+                pil = _fit(_semantic(img), _TILE)
+                row.append((f"{a_id} · {cam} camera · semantic", pil, _TILE[0] / img.shape[1]))
+        if row:
+            rows.append(row)
+    width = max([_TILE[0] * len(r) for r in rows] + [4 * _TILE[0]])
+
+    bottom: list[tuple[str, Any]] = []
+    if topics.radar_ppi(a_id) in msgs:
+        bottom.append(("ppi", msgs[topics.radar_ppi(a_id)]))
+    for kind in ("rgb", "semantic"):
+        if topics.top_view(a_id, kind) in msgs:
+            bottom.append((f"top_{kind}", msgs[topics.top_view(a_id, kind)]))
+    if topics.lidar(a_id) in msgs:
+        bottom.append(("bev", msgs[topics.lidar(a_id)]))
+    sq = width // max(len(bottom), 1)
+    last: list[tuple[str, Image.Image, float]] = []
+    for kind, m in bottom:
+        if kind == "ppi":
+            orient = str((a.rig.get("radar") or {}).get("ppi_orientation", "")).replace("_", "-")
+            pil, scale = _ppi_panel(decode_image(m), sq, a.ppi_metres_per_pixel)
+            last.append((f"{a_id} · radar · PPI ({orient})", pil, scale))
+        elif kind.startswith("top_"):
+            img = decode_image(m)
+            img = _semantic(img) if kind == "top_semantic" else img
+            tv = a.rig.get("top_view") or {}
+            pil = _fit(img, (sq, sq))
+            orient = str(tv.get("orientation", "")).replace("_", "-")
+            last.append((f"{a_id} · top view · {kind[4:]} ({orient})", pil, sq / img.shape[1]))
+        else:
+            half = _bev_half_extent(boxes3d)
+            pil = _bev_panel(decode_point_cloud(m), boxes3d, sq, half)
+            last.append((f"{a_id} · LiDAR · BEV ±{half:g} m + 3D boxes", pil, sq / (2 * half)))
+    if last:
+        rows.append(last)
+
+    height = sum(_TITLE_H + max(p.height for _, p, _ in r) for r in rows)
+    canvas = Image.new("RGB", (width, height), _BG)
+    draw = ImageDraw.Draw(canvas)
+    font = _font(13)
+    panels: list[Panel] = []
+    top = 0
+    for r in rows:
+        left = 0
+        for title, pil, scale in r:
+            draw.text((left + 6, top + 4), title, fill=_TEXT, font=font)
+            canvas.paste(pil, (left, top + _TITLE_H))
+            panels.append(Panel(title=title, box=(left, top + _TITLE_H, left + pil.width, top + _TITLE_H + pil.height),
+                                scale=scale))
+            left += pil.width
+        top += _TITLE_H + max(p.height for _, p, _ in r)
+    return canvas, panels
+
+
+def write_preview(
+    path: str | Path, *, frame: int = 0, agent: str | None = None, output: str | Path | None = None
+) -> Path:
+    """Writes the preview PNG of ``frame`` for ``agent`` (default: the first agent); returns its path."""
+    canvas, panels = compose_preview(path, frame=frame, agent=agent)
+    a = panels[0].title.split(" · ")[0]
     out = Path(output) if output is not None else Path(path).with_name(f"{Path(path).stem}_frame{frame:06d}_{a}.png")
     canvas.save(out)
     return out

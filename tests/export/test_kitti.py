@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from mmusv.export import convert
-from mmusv.preview import decode_point_cloud
-from mmusv.record import read_messages
+from mmusv.recording import decode_point_cloud
+from mmusv.recording import read_messages
 
 
 def read_calib(path: Path) -> dict[str, np.ndarray]:

@@ -17,8 +17,8 @@ import pytest
 import yaml
 
 from mmusv.export import convert
-from mmusv.preview import decode_image, decode_point_cloud
-from mmusv.record import read_messages
+from mmusv.recording import decode_image, decode_point_cloud
+from mmusv.recording import read_messages
 
 EXTRA_FILES = {"_depth{i}.png", "_semantic{i}.png"}
 YAML_KEYS = {"camera0", "camera1", "camera2", "camera3", "ego_speed", "lidar_pose", "plan_trajectory", "predicted_ego_pos",

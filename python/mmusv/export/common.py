@@ -91,7 +91,7 @@ def png_bytes(msg: Any) -> bytes:
     is decoded and encoded (fixed settings, so the bytes are deterministic)."""
     if hasattr(msg, "format") and str(msg.format).lower() == "png":
         return bytes(msg.data)
-    from mmusv.preview import decode_image
+    from mmusv.recording import decode_image
 
     return encode_png(decode_image(msg))
 
@@ -108,7 +108,7 @@ def encode_png(img: np.ndarray, *, compress_level: int = 6) -> bytes:
 def depth_png(msg: Any) -> bytes:
     """A depth image message (metres, float; +inf or 0 = no hit) as a uint16 PNG in units of
     :data:`DEPTH_UNIT_M` (0 = no hit, 65535 = saturated)."""
-    from mmusv.preview import decode_image
+    from mmusv.recording import decode_image
 
     d = np.asarray(decode_image(msg), dtype=np.float64)
     units = np.where(np.isfinite(d) & (d > 0), np.clip(np.rint(d / DEPTH_UNIT_M), 1, 65535), 0).astype(np.uint16)

@@ -23,7 +23,7 @@ from mmusv.errors import ConfigError, IoError
 from mmusv.export.common import DEFAULT_EXTRAS, TARGETS, Options, Sink, dump_yaml, parse_extras
 from mmusv.export.kitti import KittiWriter
 from mmusv.export.opv2v import Opv2vWriter
-from mmusv.export.reader import FrameStream, RecordingInfo, read_info
+from mmusv.recording.reader import FrameStream, RecordingInfo, read_info
 from mmusv.export.splits import SPLIT_NAMES, assign_splits, parse_ratios
 from mmusv.export.writer import DatasetWriter
 

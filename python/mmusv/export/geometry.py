@@ -2,7 +2,7 @@
 
 Everything here stays in mmusv's right-handed frames; the dataset writers change frames only through
 :mod:`mmusv.frames`. Sensor poses follow the recorder: sensor → world = vessel body → world (from the world
-state pose) · sensor mount in body.
+state pose) · sensor mount in body, composed by :meth:`mmusv.recording.reader.AgentInfo.sensor_poses`.
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mmusv.export.reader import AgentInfo, WorldFrame
+from mmusv.recording.reader import AgentInfo, WorldFrame
 from mmusv.frames import invert, pose_matrices
 
 __all__ = ["AgentView", "Target", "agent_view", "targets_of"]
@@ -49,9 +49,7 @@ class Target:
 
 def agent_view(agent: AgentInfo, world: WorldFrame) -> AgentView:
     """The sensor poses of ``agent`` in ``world``."""
-    body = pose_matrices(world.poses[agent.index])
-    lidar = None if agent.lidar_mount is None else body @ agent.lidar_mount
-    cams = {name: body @ c.mount for name, c in agent.cameras.items()}
+    body, lidar, cams = agent.sensor_poses(world)
     return AgentView(agent, body, lidar, cams, float(np.linalg.norm(world.velocities[agent.index])))
 
 

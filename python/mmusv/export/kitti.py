@@ -23,9 +23,10 @@ import numpy as np
 from mmusv.classes import class_name
 from mmusv.export.common import cav_id, depth_png, dump_yaml, png_bytes
 from mmusv.export.geometry import AgentView, Target
-from mmusv.export.reader import AgentInfo, Frame, WorldFrame
+from mmusv.recording.reader import AgentInfo, Frame, WorldFrame
 from mmusv.export.writer import DatasetWriter
 from mmusv.frames import BODY_TO_OPTICAL, invert, transform_points, wrap_rad
+from mmusv.recording import topics
 
 __all__ = ["KittiWriter", "kitti_label", "occlusion_level"]
 
@@ -66,19 +67,19 @@ class KittiWriter(DatasetWriter):
     cameras = {"front": 2}
 
     def optional_topics(self) -> list[str]:
-        return super().optional_topics() + [f"/{a.id}/annotations" for a in self.agents]
+        return super().optional_topics() + [topics.agent_annotations(a.id) for a in self.agents]
 
     def _dir(self, agent: AgentInfo, sub: str) -> Path:
         return self.sink.mkdir(self.folder / str(cav_id(agent.index)) / sub)
 
     def write_agent(self, frame: Frame, world: WorldFrame, view: AgentView, targets: list[Target]) -> None:
-        from mmusv.preview import decode_point_cloud
+        from mmusv.recording import decode_point_cloud
 
         a = view.agent
         assert view.lidar is not None and a.lidar_mount is not None
         ts = f"{frame.index:06d}"
         msgs = frame.messages
-        cloud = decode_point_cloud(msgs[f"/{a.id}/lidar"])
+        cloud = decode_point_cloud(msgs[topics.lidar(a.id)])
         n = len(cloud["x"])
         pts = np.column_stack([cloud["x"], cloud["y"], cloud["z"], cloud.get("intensity", np.zeros(n))]).astype("<f4")
         self.put(self._dir(a, "velodyne") / f"{ts}.bin", pts.tobytes())
@@ -97,13 +98,13 @@ class KittiWriter(DatasetWriter):
                   f"Tr_imu_to_velo: {_fmt(invert(a.lidar_mount)[:3, :])}"]
         self.put(self._dir(a, "calib") / f"{ts}.txt", ("\n".join(calib) + "\n").encode())
         boxes: dict[str, Any] = {}
-        ann = msgs.get(f"/{a.id}/annotations")
+        ann = msgs.get(topics.agent_annotations(a.id))
         if ann is not None:
             boxes = {b.target_id: b for b in ann.boxes_camera if b.camera == "front"}
         lines = [kitti_label(t, velo_to_cam, boxes.get(t.id)) if cam is not None else kitti_label(t, velo_to_cam, None) for t in targets]
         self.put(self._dir(a, "label_2") / f"{ts}.txt", "".join(line + "\n" for line in lines).encode())
         if cam is not None:
-            base = f"/{a.id}/camera/front/"
+            base = topics.camera(a.id, "front") + "/"
             if base + "rgb" in msgs:
                 self.put(self._dir(a, "image_2") / f"{ts}.png", png_bytes(msgs[base + "rgb"]))
             if "depth" in self.options.extras and base + "depth" in msgs:
@@ -111,11 +112,11 @@ class KittiWriter(DatasetWriter):
             for kind in ("semantic", "instance"):
                 if kind in self.options.extras and base + kind in msgs:
                     self.put(self._dir(a, f"{kind}_2") / f"{ts}.png", png_bytes(msgs[base + kind]), kind)
-        if "radar" in self.options.extras and f"/{a.id}/radar/ppi" in msgs:
-            self.put(self._dir(a, "radar_ppi") / f"{ts}.png", png_bytes(msgs[f"/{a.id}/radar/ppi"]), "radar")
+        if "radar" in self.options.extras and topics.radar_ppi(a.id) in msgs:
+            self.put(self._dir(a, "radar_ppi") / f"{ts}.png", png_bytes(msgs[topics.radar_ppi(a.id)]), "radar")
         if "top_view" in self.options.extras:
             for kind in ("rgb", "semantic"):
-                m = msgs.get(f"/{a.id}/top_view/{kind}")
+                m = msgs.get(topics.top_view(a.id, kind))
                 if m is not None:
                     self.put(self._dir(a, f"top_view_{kind}") / f"{ts}.png", png_bytes(m), "top_view")
 

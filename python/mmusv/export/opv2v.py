@@ -28,9 +28,10 @@ from mmusv.classes import class_name
 from mmusv.export.common import DEPTH_UNIT_M, cav_id, depth_png, dump_yaml, png_bytes, rounded
 from mmusv.export.geometry import AgentView, Target
 from mmusv.export.pcd import pcd_bytes
-from mmusv.export.reader import Frame, WorldFrame
+from mmusv.recording.reader import Frame, WorldFrame
 from mmusv.export.writer import DatasetWriter
 from mmusv.frames import carla_matrix, carla_pose, invert, mirror_points
+from mmusv.recording import topics
 
 __all__ = ["Opv2vWriter", "OPV2V_CAMERAS", "timestamp"]
 
@@ -71,14 +72,14 @@ class Opv2vWriter(DatasetWriter):
         return self.sink.mkdir(self.folder / str(cav_id(view.agent.index)))
 
     def write_agent(self, frame: Frame, world: WorldFrame, view: AgentView, targets: list[Target]) -> None:
-        from mmusv.preview import decode_point_cloud
+        from mmusv.recording import decode_point_cloud
 
         a = view.agent
         assert view.lidar is not None
         d = self.agent_dir(view)
         ts = timestamp(frame.index)
         msgs = frame.messages
-        cloud = decode_point_cloud(msgs[f"/{a.id}/lidar"])
+        cloud = decode_point_cloud(msgs[topics.lidar(a.id)])
         xyz = np.column_stack([cloud["x"], cloud["y"], cloud["z"]]).astype(np.float64)
         self.put(d / f"{ts}.pcd", pcd_bytes(mirror_points(xyz), cloud.get("intensity", np.zeros(len(xyz)))))
         lidar_pose = rounded(carla_pose(view.lidar))
@@ -101,10 +102,10 @@ class Opv2vWriter(DatasetWriter):
                 "intrinsic": _matrix_list(np.array([[fx, 0.0, cx], [0.0, fy, cy], [0.0, 0.0, 1.0]])),
                 "extrinsic": _matrix_list(invert(carla_matrix(np.array(cords))) @ lidar_m),
             }
-            rgb = msgs.get(f"/{a.id}/camera/{name}/rgb")
+            rgb = msgs.get(topics.camera(a.id, name, "rgb"))
             if rgb is not None:
                 self.put(d / f"{ts}_camera{idx}.png", png_bytes(rgb))
-            base = f"/{a.id}/camera/{name}/"
+            base = topics.camera(a.id, name) + "/"
             if "depth" in self.options.extras and base + "depth" in msgs:
                 self.put(d / f"{ts}_depth{idx}.png", depth_png(msgs[base + "depth"]), "depth")
             for kind in ("semantic", "instance"):
@@ -112,11 +113,11 @@ class Opv2vWriter(DatasetWriter):
                     self.put(d / f"{ts}_{kind}{idx}.png", png_bytes(msgs[base + kind]), kind)
         self.put(d / f"{ts}.yaml", dump_yaml(doc))
         self.put(d / f"{ts}_additional.yaml", dump_yaml(self._additional(frame, world, view, targets, cloud)))
-        if "radar" in self.options.extras and f"/{a.id}/radar/ppi" in msgs:
-            self.put(d / f"{ts}_radar_ppi.png", png_bytes(msgs[f"/{a.id}/radar/ppi"]), "radar")
+        if "radar" in self.options.extras and topics.radar_ppi(a.id) in msgs:
+            self.put(d / f"{ts}_radar_ppi.png", png_bytes(msgs[topics.radar_ppi(a.id)]), "radar")
         if "top_view" in self.options.extras:
             for kind in ("rgb", "semantic"):
-                m = msgs.get(f"/{a.id}/top_view/{kind}")
+                m = msgs.get(topics.top_view(a.id, kind))
                 if m is not None:
                     self.put(d / f"{ts}_topview_{kind}.png", png_bytes(m), "top_view")
 

@@ -7,7 +7,8 @@ from typing import Any
 
 from mmusv.export.common import Options, Sink
 from mmusv.export.geometry import AgentView, Target, agent_view, targets_of
-from mmusv.export.reader import AgentInfo, Frame, RecordingInfo, WorldFrame
+from mmusv.recording.reader import AgentInfo, Frame, RecordingInfo, WorldFrame
+from mmusv.recording import topics
 
 __all__ = ["DatasetWriter"]
 
@@ -43,12 +44,12 @@ class DatasetWriter:
 
     def required_topics(self) -> list[str]:
         """Topics a frame must hold to be converted."""
-        out = ["/world/state"]
+        out = [topics.WORLD_STATE]
         for a in self.agents:
-            out.append(f"/{a.id}/lidar")
+            out.append(topics.lidar(a.id))
             for name, _ in self.agent_cameras(a):
                 if "rgb" in a.cameras[name].outputs:
-                    out.append(f"/{a.id}/camera/{name}/rgb")
+                    out.append(topics.camera(a.id, name, "rgb"))
         return out
 
     def optional_topics(self) -> list[str]:
@@ -57,11 +58,11 @@ class DatasetWriter:
         out: list[str] = []
         for a in self.agents:
             for name, _ in self.agent_cameras(a):
-                out += [f"/{a.id}/camera/{name}/{kind}" for kind in ("depth", "semantic", "instance") if kind in ex]
+                out += [topics.camera(a.id, name, kind) for kind in ("depth", "semantic", "instance") if kind in ex]
             if "radar" in ex:
-                out.append(f"/{a.id}/radar/ppi")
+                out.append(topics.radar_ppi(a.id))
             if "top_view" in ex:
-                out += [f"/{a.id}/top_view/rgb", f"/{a.id}/top_view/semantic"]
+                out += [topics.top_view(a.id, "rgb"), topics.top_view(a.id, "semantic")]
         return out
 
     def topic_filter(self) -> set[str]:

@@ -52,7 +52,7 @@ from mmusv.config import (
     load_scenario,
     validation_error,
 )
-from mmusv.errors import ConfigError
+from mmusv.errors import ConfigError, MmusvError, located
 from mmusv.generate.families import FAMILIES
 from mmusv.generate.spec_constraints import (
     Constraints,
@@ -367,5 +367,7 @@ def load_spec(source: str | os.PathLike[str] | dict[str, Any] | GenerationSpec) 
         spec = GenerationSpec.model_validate(data)
     except ValidationError as exc:
         raise validation_error(exc, where, noun="spec", root="spec") from None
+    except MmusvError as exc:  # a validator that checks through the core (wave presets, ...)
+        raise located(exc, where) from None
     _cross_checks(spec, where)
     return spec

@@ -29,6 +29,7 @@ import shapely
 from scipy import ndimage
 
 from mmusv.annotate import box_corners
+from mmusv.bundled import resolve_scenario
 from mmusv.config import load_scenario
 from mmusv.frames import translation
 from mmusv.simulation import Simulation
@@ -124,7 +125,7 @@ def run_agreement_study(scenarios: list[str] | tuple[str, ...] = BUNDLED_SCENARI
     and evaluates every other vessel (see the module docstring)."""
     rows: list[dict[str, object]] = []
     for path in scenarios:
-        sc = load_scenario(path)
+        sc = load_scenario(resolve_scenario(path))
         sim = Simulation(sc)
         n = sc.acquisition.frames if frames is None else min(frames, sc.acquisition.frames)
         for k in range(0, n, stride):

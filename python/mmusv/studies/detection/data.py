@@ -118,9 +118,8 @@ def _box_mats(poses: np.ndarray, centres: np.ndarray) -> np.ndarray:
 
 
 def _reader() -> ModuleType:
-    """The project's recording reader: the one place this package imports it (it is moving from
-    ``mmusv.export.reader`` to ``mmusv.recording``; re-point this import then)."""
-    from mmusv.export import reader
+    """The project's one recording reader (:mod:`mmusv.recording.reader`): the one place this package imports it."""
+    from mmusv.recording import reader
 
     return reader
 
@@ -144,12 +143,13 @@ def recording_summary(path: str | Path) -> RecordingSummary:
 def read_recording(path: str | Path) -> SequenceData:
     """A recording (``mmusv run`` MCAP) as a sequence: every frame with the LiDAR of every instrumented USV that
     has one. Raises :class:`~mmusv.IoError` for a file that is not a readable recording."""
-    from mmusv.preview import decode_point_cloud
-
     reader = _reader()
+    decode_point_cloud = reader.decode_point_cloud
     info = reader.read_info(path)
     agents = [a for a in info.agents if a.lidar_mount is not None]
-    topics = {f"/{a.id}/lidar" for a in agents}
+    from mmusv.recording import topics as names
+
+    topics = {names.lidar(a.id) for a in agents}
     frames: list[SceneFrame] = []
     for fr in reader.FrameStream(info, want=topics.__contains__):
         w = fr.world
@@ -157,7 +157,7 @@ def read_recording(path: str | Path) -> SequenceData:
             continue
         afs = []
         for a in agents:
-            c = decode_point_cloud(fr.messages[f"/{a.id}/lidar"])
+            c = decode_point_cloud(fr.messages[names.lidar(a.id)])
             pts = np.column_stack([c["x"], c["y"], c["z"], c.get("intensity", np.zeros(len(c["x"])))])
             assert a.lidar_mount is not None
             afs.append(AgentFrame(a.id, pts.astype(np.float32), pose_matrices(w.poses[a.index]), a.lidar_mount))

@@ -1,4 +1,4 @@
-"""Recording to MCAP, and reading recordings back.
+"""Writing MCAP recordings (reading them back: :mod:`mmusv.recording.reader`).
 
 :class:`Recording` streams every USV's sensors and the world state of each frame into ONE MCAP file that opens
 in Foxglove and whose channels all decode with the ``mcap`` + ``mcap-protobuf-support`` readers. It wraps the
@@ -21,7 +21,7 @@ Frames: world x east, y north, z up, metres; sensor frames x forward, y left, z 
 from __future__ import annotations
 
 import os
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from types import TracebackType
 from typing import Any
@@ -32,7 +32,7 @@ import numpy.typing as npt
 from mmusv._native import core
 from mmusv.errors import InputError
 
-__all__ = ["Recording", "read_messages", "summary", "to_ns", "POINT_DTYPES"]
+__all__ = ["Recording", "to_ns", "POINT_DTYPES"]
 
 POINT_DTYPES: tuple[str, ...] = ("uint8", "int8", "uint16", "int16", "uint32", "int32", "float32", "float64")
 """dtypes a point-cloud column may have (others are refused; bool is stored as uint8)."""
@@ -359,67 +359,3 @@ class Recording:
 
     def __repr__(self) -> str:
         return f"Recording({repr(self._rec)})"
-
-
-def read_messages(
-    path: str | os.PathLike[str], topics: Sequence[str] | None = None
-) -> Iterator[tuple[str, int, Any]]:
-    """Yields ``(topic, log_time_ns, decoded_protobuf_message)`` in log-time order, optionally only ``topics``.
-    Works on finished files and on completed ``.partial`` files."""
-    from mcap.reader import make_reader
-    from mcap_protobuf.decoder import DecoderFactory
-
-    with open(path, "rb") as f:
-        reader = make_reader(f, decoder_factories=[DecoderFactory()])
-        wanted = None if topics is None else list(topics)
-        for _schema, channel, message, decoded in reader.iter_decoded_messages(topics=wanted):
-            yield channel.topic, message.log_time, decoded
-
-
-def summary(path: str | os.PathLike[str]) -> dict[str, Any]:
-    """What a recording holds: ``{"path", "complete", "messages", "start_ns", "end_ns", "duration_s",
-    "topics": {topic: {"schema", "encoding", "messages"}}, "metadata": {name: {key: value}},
-    "attachments": [name, ...]}``. ``complete`` is False for a ``.partial`` file or one without a summary
-    section (counted by scanning every message)."""
-    from mcap.reader import make_reader
-
-    topics: dict[str, dict[str, Any]] = {}
-    with open(path, "rb") as f:
-        reader = make_reader(f)
-        summ = reader.get_summary()
-        stats = None if summ is None else summ.statistics
-        if summ is not None and stats is not None:
-            for cid, ch in sorted(summ.channels.items()):
-                schema = summ.schemas.get(ch.schema_id)
-                topics[ch.topic] = {
-                    "schema": "" if schema is None else schema.name,
-                    "encoding": ch.message_encoding,
-                    "messages": int(stats.channel_message_counts.get(cid, 0)),
-                }
-            total, start, end = int(stats.message_count), int(stats.message_start_time), int(stats.message_end_time)
-            attachments = [a.name for a in summ.attachment_indexes]
-        else:
-            start, end, total = -1, -1, 0
-            for schema, channel, message in reader.iter_messages(log_time_order=False):
-                entry = topics.setdefault(
-                    channel.topic,
-                    {"schema": "" if schema is None else schema.name, "encoding": channel.message_encoding, "messages": 0},
-                )
-                entry["messages"] += 1
-                total += 1
-                start = message.log_time if start < 0 else min(start, message.log_time)
-                end = max(end, message.log_time)
-            start, end = max(start, 0), max(end, 0)
-            attachments = [a.name for a in reader.iter_attachments()]
-        metadata = {m.name: dict(m.metadata) for m in reader.iter_metadata()}
-    return {
-        "path": str(path),
-        "complete": summ is not None and not str(path).endswith(".partial"),
-        "messages": total,
-        "start_ns": start,
-        "end_ns": end,
-        "duration_s": (end - start) * 1e-9,
-        "topics": dict(sorted(topics.items())),
-        "metadata": metadata,
-        "attachments": attachments,
-    }

@@ -29,10 +29,11 @@ import yaml
 from scipy.spatial.transform import Rotation
 
 from mmusv.config import scenario_hash
-from mmusv.record import Recording
+from mmusv.recording.writer import Recording
 from mmusv.frames import BODY_TO_OPTICAL
 from mmusv.sensors.camera import CameraImages
 from mmusv.simulation import FrameCapture, Simulation
+from mmusv.recording import topics
 
 __all__ = ["FrameRecorder", "OPTICAL_IN_BODY", "pose7"]
 
@@ -83,23 +84,23 @@ class FrameRecorder:
         sim, st, rec = self.sim, cap.world, self.rec
         tfs: list[tuple[str, str, np.ndarray, np.ndarray]] = []
         for i, v in enumerate(sim.vessels):
-            tfs.append(("world", v.id, *pose7(st.matrices[i])))
+            tfs.append((topics.WORLD_FRAME, v.id, *pose7(st.matrices[i])))
         for a in sim.agents:
             ac = cap.agents.get(a.id)
             if ac is None:
                 continue
             body_inv = np.linalg.inv(st.matrices[a.index])
             if ac.lidar_pose is not None:
-                tfs.append((a.id, f"{a.id}/lidar", *pose7(body_inv @ ac.lidar_pose)))
+                tfs.append((a.id, topics.lidar_frame(a.id), *pose7(body_inv @ ac.lidar_pose)))
             if ac.radar_pose is not None:
-                tfs.append((a.id, f"{a.id}/radar", *pose7(body_inv @ ac.radar_pose)))
+                tfs.append((a.id, topics.radar_frame(a.id), *pose7(body_inv @ ac.radar_pose)))
             for name, p in ac.camera_poses.items():
-                tfs.append((a.id, f"{a.id}/camera/{name}", *pose7(body_inv @ p @ OPTICAL_IN_BODY)))
+                tfs.append((a.id, topics.camera_frame(a.id, name), *pose7(body_inv @ p @ OPTICAL_IN_BODY)))
             if ac.top_view_pose is not None:
-                tfs.append(("world", f"{a.id}/top_view", *pose7(ac.top_view_pose @ OPTICAL_IN_BODY)))
-        rec.frame_transforms("/tf", log_time_ns=t, transforms=tfs)
+                tfs.append((topics.WORLD_FRAME, topics.top_view_frame(a.id), *pose7(ac.top_view_pose @ OPTICAL_IN_BODY)))
+        rec.frame_transforms(topics.TF, log_time_ns=t, transforms=tfs)
         rec.world_state(
-            "/world/state", log_time_ns=t, frame=cap.frame, time_s=cap.time_s,
+            topics.WORLD_STATE, log_time_ns=t, frame=cap.frame, time_s=cap.time_s,
             ids=[v.id for v in sim.vessels], assets=[v.asset for v in sim.vessels], roles=[v.role for v in sim.vessels],
             classes=[v.semantic_class for v in sim.vessels], instance_ids=[v.instance_id for v in sim.vessels],
             poses=st.poses, velocities=st.velocities, box_centers=st.box_centers,
@@ -112,23 +113,23 @@ class FrameRecorder:
             if ac.lidar is not None:
                 pts = ac.lidar
                 rec.point_cloud(
-                    f"/{a.id}/lidar", log_time_ns=t, frame_id=f"{a.id}/lidar",
+                    topics.lidar(a.id), log_time_ns=t, frame_id=topics.lidar_frame(a.id),
                     columns={"x": pts.xyz[:, 0], "y": pts.xyz[:, 1], "z": pts.xyz[:, 2], "intensity": pts.intensity,
                              "ring": pts.ring, "azimuth": pts.azimuth, "class": pts.semantic_class, "instance": pts.instance},
                 )
             for name, img in ac.cameras.items():
-                self._images(f"/{a.id}/camera/{name}", f"{a.id}/camera/{name}", t, img, list(a.cameras[name][1].outputs))
+                self._images(topics.camera(a.id, name), topics.camera_frame(a.id, name), t, img, list(a.cameras[name][1].outputs))
             if ac.top_view is not None and a.rig.top_view is not None:
-                self._images(f"/{a.id}/top_view", f"{a.id}/top_view", t, ac.top_view, list(a.rig.top_view.outputs))
+                self._images(topics.top_view(a.id), topics.top_view_frame(a.id), t, ac.top_view, list(a.rig.top_view.outputs))
             if ac.radar is not None:
                 self._radar(a.id, t, ac.radar, ac.radar_ppi)
             cols = annotations.get(a.id)
             if cols is not None:
-                rec.annotations(f"/{a.id}/annotations", log_time_ns=t, frame=cap.frame, time_s=cap.time_s, agent_id=a.id,
+                rec.annotations(topics.agent_annotations(a.id), log_time_ns=t, frame=cap.frame, time_s=cap.time_s, agent_id=a.id,
                                 lidar=cols["lidar"], bev=cols["bev"], camera=cols["camera"])
                 lid = cols["lidar"]
                 colours = np.array([_ROLE_COLOURS.get(self.roles.get(i, "target"), (1, 1, 1, 0.5)) for i in lid["target_id"]]).reshape(-1, 4)
-                rec.boxes(f"/{a.id}/boxes", log_time_ns=t, frame_id=f"{a.id}/lidar", entity_id=f"{a.id}/targets",
+                rec.boxes(topics.boxes(a.id), log_time_ns=t, frame_id=topics.lidar_frame(a.id), entity_id=f"{a.id}/targets",
                           ids=lid["target_id"], centers=lid["center"], quaternions=lid["rotation"], sizes=lid["size"],
                           colors=colours)
 
@@ -150,13 +151,13 @@ class FrameRecorder:
         r, az, el = returns.range, returns.azimuth, returns.elevation
         ce = np.cos(el)
         self.rec.point_cloud(
-            f"/{agent}/radar/returns", log_time_ns=t, frame_id=f"{agent}/radar",
+            topics.radar_returns(agent), log_time_ns=t, frame_id=topics.radar_frame(agent),
             columns={"x": (r * ce * np.cos(az)).astype(np.float32), "y": (r * ce * np.sin(az)).astype(np.float32),
                      "z": (r * np.sin(el)).astype(np.float32), "range": r, "azimuth": az, "elevation": el,
                      "intensity": returns.intensity, "instance": returns.instance_id},
         )
         if ppi is not None:
-            self.rec.png_image(f"/{agent}/radar/ppi", log_time_ns=t, frame_id=f"{agent}/radar", image=ppi_colormap(ppi))
+            self.rec.png_image(topics.radar_ppi(agent), log_time_ns=t, frame_id=topics.radar_frame(agent), image=ppi_colormap(ppi))
 
     # ------------------------------------------------------------------------------------------ end
 

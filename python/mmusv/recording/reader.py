@@ -1,4 +1,8 @@
-"""Reading an ``mmusv run`` recording frame by frame, for conversion (also a truncated or ``.partial`` file).
+"""Reading ``mmusv run`` recordings: the one reader used by ``mmusv info``, ``mmusv preview``, export and studies.
+
+:func:`read_messages` iterates decoded messages, :func:`summary` says what a file holds, :func:`frame_messages`
+gives every decoded message of one frame, :func:`decode_image` / :func:`decode_point_cloud` turn Foxglove
+messages into arrays. Frame by frame, for conversion (also a truncated or ``.partial`` file):
 
 :func:`read_info` reads the metadata (``scenario``, ``manifest``, ``sensors``, ``run``) without decoding any
 message: from the summary section when the file has one, otherwise from the records before the first chunk.
@@ -10,18 +14,24 @@ stopped in :attr:`FrameStream.truncated`; the ``run`` metadata, written last, is
 
 from __future__ import annotations
 
+import io
 import json
-from collections.abc import Callable, Iterator
+import os
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any
 
 import numpy as np
 import yaml
+from PIL import Image
 
-from mmusv.errors import IoError
+from mmusv.errors import ConfigError, IoError
 
-__all__ = ["MCAP_MAGIC", "CameraInfo", "AgentInfo", "RecordingInfo", "WorldFrame", "Frame", "FrameStream", "read_info", "check_mcap"]
+__all__ = [
+    "MCAP_MAGIC", "CameraInfo", "AgentInfo", "RecordingInfo", "WorldFrame", "Frame", "FrameStream", "read_info",
+    "check_mcap", "decode_image", "decode_point_cloud", "frame_messages", "read_messages", "summary",
+]
 
 MCAP_MAGIC = b"\x89MCAP0\r\n"
 
@@ -52,6 +62,26 @@ class AgentInfo:
     radar_mount: np.ndarray | None
     cameras: dict[str, CameraInfo]
     rig: dict[str, Any]
+
+    def sensor_poses(self, world: WorldFrame) -> tuple[np.ndarray, np.ndarray | None, dict[str, np.ndarray]]:
+        """``(body, lidar, cameras)`` at ``world``: ``(4, 4)`` vessel body → world (from the world-state pose) and
+        sensor → world = body · the recorded mount (LiDAR ``None`` without one; cameras by name, camera body frame
+        x forward = optical axis). The one place a reader of the file composes body and mount."""
+        from mmusv.frames import pose_matrices
+
+        body = pose_matrices(world.poses[self.index])
+        lidar = None if self.lidar_mount is None else body @ self.lidar_mount
+        return body, lidar, {name: body @ c.mount for name, c in self.cameras.items()}
+
+    @property
+    def ppi_metres_per_pixel(self) -> float | None:
+        """Metres per pixel of the recorded radar PPI (``ppi_metres_per_pixel``, default ``range_m / (ppi_size_px
+        / 2)``, as in :class:`mmusv.sensors.config.RadarConfig`); ``None`` without a radar."""
+        radar = self.rig.get("radar")
+        if not radar:
+            return None
+        mpp = radar.get("ppi_metres_per_pixel")
+        return float(mpp) if mpp else float(radar["range_m"]) / (int(radar["ppi_size_px"]) / 2)
 
 
 @dataclass
@@ -296,3 +326,124 @@ class FrameStream:
             self.out_of_order.append(fr.index)
         seen.add(fr.index)
         return fr
+
+
+def read_messages(
+    path: str | os.PathLike[str], topics: Sequence[str] | None = None
+) -> Iterator[tuple[str, int, Any]]:
+    """Yields ``(topic, log_time_ns, decoded_protobuf_message)`` in log-time order, optionally only ``topics``.
+    Works on finished files and on completed ``.partial`` files."""
+    from mcap.reader import make_reader
+    from mcap_protobuf.decoder import DecoderFactory
+
+    with open(path, "rb") as f:
+        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        wanted = None if topics is None else list(topics)
+        for _schema, channel, message, decoded in reader.iter_decoded_messages(topics=wanted):
+            yield channel.topic, message.log_time, decoded
+
+
+def summary(path: str | os.PathLike[str]) -> dict[str, Any]:
+    """What a recording holds: ``{"path", "complete", "messages", "start_ns", "end_ns", "duration_s",
+    "topics": {topic: {"schema", "encoding", "messages"}}, "metadata": {name: {key: value}},
+    "attachments": [name, ...]}``. ``complete`` is False for a ``.partial`` file or one without a summary
+    section (counted by scanning every message)."""
+    from mcap.reader import make_reader
+
+    topics: dict[str, dict[str, Any]] = {}
+    with open(path, "rb") as f:
+        reader = make_reader(f)
+        summ = reader.get_summary()
+        stats = None if summ is None else summ.statistics
+        if summ is not None and stats is not None:
+            for cid, ch in sorted(summ.channels.items()):
+                schema = summ.schemas.get(ch.schema_id)
+                topics[ch.topic] = {
+                    "schema": "" if schema is None else schema.name,
+                    "encoding": ch.message_encoding,
+                    "messages": int(stats.channel_message_counts.get(cid, 0)),
+                }
+            total, start, end = int(stats.message_count), int(stats.message_start_time), int(stats.message_end_time)
+            attachments = [a.name for a in summ.attachment_indexes]
+        else:
+            start, end, total = -1, -1, 0
+            for schema, channel, message in reader.iter_messages(log_time_order=False):
+                entry = topics.setdefault(
+                    channel.topic,
+                    {"schema": "" if schema is None else schema.name, "encoding": channel.message_encoding, "messages": 0},
+                )
+                entry["messages"] += 1
+                total += 1
+                start = message.log_time if start < 0 else min(start, message.log_time)
+                end = max(end, message.log_time)
+            start, end = max(start, 0), max(end, 0)
+            attachments = [a.name for a in reader.iter_attachments()]
+        metadata = {m.name: dict(m.metadata) for m in reader.iter_metadata()}
+    return {
+        "path": str(path),
+        "complete": summ is not None and not str(path).endswith(".partial"),
+        "messages": total,
+        "start_ns": start,
+        "end_ns": end,
+        "duration_s": (end - start) * 1e-9,
+        "topics": dict(sorted(topics.items())),
+        "metadata": metadata,
+        "attachments": attachments,
+    }
+
+
+_NUMPY = {1: np.uint8, 2: np.int8, 3: np.uint16, 4: np.int16, 5: np.uint32, 6: np.int32, 7: np.float32, 8: np.float64}
+
+
+def decode_image(msg: Any) -> np.ndarray:
+    """A ``foxglove.RawImage`` or ``foxglove.CompressedImage`` (PNG) as a numpy array (``(H, W)`` or ``(H, W, 3)``)."""
+    if hasattr(msg, "format"):
+        return np.asarray(Image.open(io.BytesIO(msg.data)))
+    enc = msg.encoding
+    dtype = {"rgb8": np.uint8, "mono8": np.uint8, "8UC1": np.uint8, "16UC1": np.uint16, "mono16": np.uint16, "32FC1": np.float32, "32SC1": np.int32}.get(enc)
+    if dtype is None:
+        raise IoError(f"unsupported image encoding {enc!r}")
+    data = np.frombuffer(msg.data, dtype=np.dtype(dtype).newbyteorder("<"))
+    ch = 3 if enc == "rgb8" else 1
+    rows = data.reshape(msg.height, msg.step // np.dtype(dtype).itemsize)
+    img = rows[:, : msg.width * ch]
+    return img.reshape(msg.height, msg.width, 3) if ch == 3 else img
+
+
+def decode_point_cloud(msg: Any) -> dict[str, np.ndarray]:
+    """A ``foxglove.PointCloud`` as ``{field name: (N,) array}`` using the packed field offsets."""
+    stride = msg.point_stride
+    raw = np.frombuffer(msg.data, dtype=np.uint8)
+    n = raw.size // stride if stride else 0
+    rows = raw[: n * stride].reshape(n, stride)
+    out: dict[str, np.ndarray] = {}
+    for f in msg.fields:
+        dt = np.dtype(_NUMPY[int(f.type)]).newbyteorder("<")
+        out[f.name] = rows[:, f.offset : f.offset + dt.itemsize].copy().view(dt).reshape(n)
+    return out
+
+
+def frame_messages(path: str | Path, frame: int) -> dict[str, Any]:
+    """Every decoded message of acquisition index ``frame``, by topic (log time = frame / f)."""
+    from mcap.reader import make_reader
+    from mcap_protobuf.decoder import DecoderFactory
+
+    p = Path(path)
+    if not p.is_file():
+        raise IoError(f"recording {p} does not exist")
+    out: dict[str, Any] = {}
+    with p.open("rb") as f:
+        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        meta = {m.name: dict(m.metadata) for m in reader.iter_metadata()}
+        freq = float(meta.get("run", {}).get("frequency_hz", "0") or 0)
+        if freq <= 0:
+            raise IoError(f"{p} has no run metadata (frequency_hz); was it written by mmusv run?")
+        t = round(frame / freq * 1e9)
+        # messages come in log-time order from t on; the frame ends at the first later log time
+        for _schema, channel, message, decoded in reader.iter_decoded_messages(starting_at=t):
+            if message.log_time != t:
+                break
+            out[channel.topic] = decoded
+    if not out:
+        raise ConfigError(f"frame {frame} is not in {p}")
+    return out

@@ -1,0 +1,83 @@
+"""Scenarios and generation specs shipped with the package (``mmusv/scenarios``, package data).
+
+In the source tree ``python/mmusv/scenarios`` is a link to the repository's ``scenarios/`` folder; a wheel holds
+the files themselves. :func:`resolve_scenario` turns a user's argument into a file: an existing path wins, else a
+bare name (``port_entry``, ``port_entry.yaml``, ``scenarios/port_entry.yaml``) is looked up among the bundled
+scenarios, so ``mmusv run port_entry`` works from any directory.
+"""
+
+from __future__ import annotations
+
+import importlib.resources
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from mmusv.config import load_scenario
+from mmusv.errors import NotFoundError
+
+__all__ = ["BundledScenario", "bundled_dir", "bundled_scenarios", "resolve_scenario"]
+
+
+def bundled_dir() -> Path:
+    """The folder of the bundled scenarios (``specs/`` below it holds the bundled generation specs)."""
+    return Path(str(importlib.resources.files("mmusv") / "scenarios"))
+
+
+def _names() -> list[str]:
+    return sorted(p.stem for p in bundled_dir().glob("*.yaml"))
+
+
+def resolve_scenario(name: str | Path) -> Path:
+    """``name`` as a scenario file: the path itself when it exists, otherwise the bundled scenario of that name.
+
+    Raises :class:`~mmusv.errors.NotFoundError` naming the bundled scenarios when neither exists."""
+    p = Path(name)
+    if p.exists():
+        return p
+    stem = p.name[: -len(".yaml")] if p.name.endswith(".yaml") else p.name
+    if p.parent in (Path("."), Path("scenarios")):
+        cand = bundled_dir() / f"{stem}.yaml"
+        if cand.is_file():
+            return cand
+    raise NotFoundError(f"scenario file {str(name)!r} does not exist and is not a bundled scenario; "
+                        f"bundled: {', '.join(_names())}")
+
+
+@dataclass(frozen=True)
+class BundledScenario:
+    """One bundled scenario, as listed by ``mmusv scenarios``."""
+
+    name: str
+    path: Path
+    map: str
+    usvs: int
+    targets: int
+    frames: int
+    description: str
+
+
+def _description(text: str) -> str:
+    """The first sentence-line of the file's leading ``#`` comment block (empty when there is none)."""
+    lines = []
+    for line in text.splitlines():
+        if not line.startswith("#"):
+            break
+        lines.append(line.lstrip("#").strip())
+    first = " ".join(lines)
+    m = re.search(r"(?<!Fig)\.(\s|$)", first)
+    return first if m is None else first[: m.start() + 1]
+
+
+def bundled_scenarios() -> list[BundledScenario]:
+    """Every bundled scenario, sorted by name, loaded and validated (map type, USV/target counts, frames)."""
+    out = []
+    for stem in _names():
+        path = bundled_dir() / f"{stem}.yaml"
+        sc = load_scenario(path)
+        usvs = sum(1 for v in sc.vessels if v.role == "usv")
+        out.append(BundledScenario(
+            name=sc.name, path=path, map=sc.map.type, usvs=usvs, targets=len(sc.vessels) - usvs,
+            frames=sc.acquisition.frames, description=_description(path.read_text(encoding="utf-8")),
+        ))
+    return out

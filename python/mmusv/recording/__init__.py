@@ -1,0 +1,13 @@
+"""The recording format, both ways: :mod:`~mmusv.recording.topics` (topic names and frame ids, the one place they
+are spelled), :mod:`~mmusv.recording.writer` (:class:`Recording` over the core's MCAP recorder),
+:mod:`~mmusv.recording.frames` (:class:`FrameRecorder`: which topic gets what, per captured frame) and
+:mod:`~mmusv.recording.reader` (the one reader). The contract is ``docs/recording.md``.
+"""
+
+from mmusv.recording.reader import decode_image, decode_point_cloud, frame_messages, read_info, read_messages, summary
+from mmusv.recording.writer import POINT_DTYPES, Recording, to_ns
+
+__all__ = [
+    "POINT_DTYPES", "Recording", "decode_image", "decode_point_cloud", "frame_messages", "read_info", "read_messages",
+    "summary", "to_ns",
+]

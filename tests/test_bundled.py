@@ -1,0 +1,60 @@
+"""Bundled scenarios as package data (:mod:`mmusv.bundled`): names resolve from any directory."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+import yaml
+
+from mmusv.bundled import bundled_dir, bundled_scenarios, resolve_scenario
+from mmusv.cli import main
+from mmusv.errors import NotFoundError
+
+REPO_SCENARIOS = Path(__file__).resolve().parents[1] / "scenarios"
+
+
+def test_bundled_dir_holds_the_repo_scenarios() -> None:
+    names = sorted(p.name for p in bundled_dir().glob("*.yaml"))
+    assert names == sorted(p.name for p in REPO_SCENARIOS.glob("*.yaml"))
+    assert (bundled_dir() / "specs" / "island_demo.yaml").is_file()
+
+
+def test_bare_name_resolves_from_another_directory(tmp_path: Path) -> None:
+    cwd = os.getcwd()
+    os.chdir(tmp_path)
+    try:
+        for arg in ("port_entry", "port_entry.yaml", "scenarios/port_entry.yaml"):
+            p = resolve_scenario(arg)
+            assert p.is_file() and p.read_bytes() == (REPO_SCENARIOS / "port_entry.yaml").read_bytes()
+        with pytest.raises(NotFoundError, match="bundled: .*port_entry"):
+            resolve_scenario("no_such_scenario")
+        with pytest.raises(NotFoundError):
+            resolve_scenario("elsewhere/port_entry.yaml")   # a real path that is not there is not rewritten
+    finally:
+        os.chdir(cwd)
+
+
+def test_existing_file_wins(tmp_path: Path) -> None:
+    own = tmp_path / "port_entry.yaml"
+    own.write_text("name: mine\n")
+    assert resolve_scenario(own) == own
+
+
+def test_listing_counts_match_the_yaml() -> None:
+    rows = {b.name: b for b in bundled_scenarios()}
+    assert set(rows) == {p.stem for p in REPO_SCENARIOS.glob("*.yaml")}
+    doc = yaml.safe_load((REPO_SCENARIOS / "port_entry.yaml").read_text())
+    roles = [v["role"] for v in doc["vessels"]]
+    b = rows["port_entry"]
+    assert (b.map, b.usvs, b.targets, b.frames) == ("port", roles.count("usv"), roles.count("target"), 50)
+    assert b.description.startswith("Port map: three USVs") and b.description.endswith(".")
+    assert rows["island_occlusion"].description.startswith("Fig. 1 of the paper")
+
+
+def test_cli_scenarios_lists_every_bundled_scenario(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["scenarios"]) == 0
+    out = capsys.readouterr().out
+    for p in REPO_SCENARIOS.glob("*.yaml"):
+        assert p.stem in out
