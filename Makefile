@@ -21,8 +21,9 @@ test-py: ## pytest only (after `make dev`)
 fmt: ## format Rust and check Python style
 	cargo fmt --all
 
-lint: ## clippy + mypy + stubtest
+lint: ## clippy + ruff + mypy + stubtest
 	cargo clippy --workspace --all-targets
+	python3 -m ruff check python tests benches
 	python3 -m mypy
 	python3 -m mypy.stubtest mmusv._core
 
