@@ -75,3 +75,18 @@ def test_port_entry_shows_cooperation() -> None:
         others = set().union(*(t for b, t in seen.items() if b != a))
         assert s - others, f"{a} sees nothing the others do not: {sorted(s)}"
     assert any(role == "moored" for s in seen.values() for _, role in s)
+
+
+@pytest.mark.parametrize("path", BUNDLED, ids=lambda p: p.stem)
+def test_every_usv_lidar_hits_a_target_in_sampled_frames(path: Path) -> None:
+    """In range is not enough: in the first, middle and last frame, every USV's LiDAR returns at least 5 points
+    from some non-USV vessel (per-point instance ids, so terrain, water and other USVs do not count)."""
+    sim = Simulation(path)
+    targets = {v.instance_id: v.id for v in sim.vessels if v.role != "usv"}
+    for k in (0, sim.frames // 2, sim.frames - 1):
+        cap = sim.capture(k, sensors=["lidar"])
+        for a, c in cap.agents.items():
+            assert c.lidar is not None
+            ids, n = np.unique(c.lidar.instance, return_counts=True)
+            hit = sorted(targets[int(i)] for i, m in zip(ids, n, strict=True) if int(i) in targets and m >= 5)
+            assert hit, f"{path.stem} frame {k}: {a}'s LiDAR has no 5 points on any target"
