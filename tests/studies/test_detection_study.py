@@ -36,7 +36,7 @@ def test_recording_loads_with_gt_and_usvs(two_usv: Path) -> None:
     seq = read_recording(two_usv)
     assert seq.agent_ids == ("usv_1", "usv_3") and len(seq.frames) == 4
     f = seq.frames[0]
-    assert f.target_ids == ("target_1", "tanker", "speedboat", "workboat")  # USVs are not targets
+    assert f.target_ids == ("target_1", "tanker", "speedboat", "workboat", "trawler", "sailboat")  # no USVs
     assert len(f.usv_boxes) == 2
     assert all(a.points.dtype == np.float32 and a.points.shape[1] == 4 for a in f.agents)
 
