@@ -35,15 +35,16 @@ class CameraImages:
 def camera_from_config(cfg: CameraConfig) -> core.Camera:
     """The native pinhole camera for ``cfg`` (shades RGB when ``rgb`` is among its outputs)."""
     w, h = cfg.resolution
-    return core.Camera(width=w, height=h, rgb="rgb" in cfg.outputs, hfov=math.radians(cfg.hfov_deg), range_max=cfg.range_m)
+    rgb = "rgb" in cfg.outputs
+    return core.Camera(width=w, height=h, rgb=rgb, hfov=math.radians(cfg.hfov_deg), range_max=cfg.range_m)
 
 
 def top_view_from_config(cfg: TopViewConfig) -> core.Camera:
     """The native orthographic camera of a top view."""
     w, h = cfg.resolution
-    return core.Camera(
-        width=w, height=h, rgb="rgb" in cfg.outputs, metres_per_pixel=cfg.metres_per_pixel, range_max=cfg.altitude_m + 500.0
-    )
+    rgb = "rgb" in cfg.outputs
+    mpp, range_max = cfg.metres_per_pixel, cfg.altitude_m + 500.0
+    return core.Camera(width=w, height=h, rgb=rgb, metres_per_pixel=mpp, range_max=range_max)
 
 
 def render(camera: core.Camera, scene: Scene, *, pose: npt.ArrayLike, env: core.SensorEnv, seed: int) -> CameraImages:

@@ -219,7 +219,9 @@ class RadarConfig(_Model):
             raise ValueError(f"min_range_m ({self.min_range_m}) must be below range_m ({self.range_m})")
         bins = math.ceil(self.range_m / self.range_resolution_m)
         if bins > 2**20:
-            raise ValueError(f"range_m / range_resolution_m = {bins} range bins; at most 2**20 (raise range_resolution_m)")
+            raise ValueError(
+                f"range_m / range_resolution_m = {bins:,} range bins; at most {2**20:,} (raise range_resolution_m)"
+            )
         rays = self.azimuth_bins * self.rays_az * self.rays_el
         if rays > MAX_RADAR_RAYS:
             raise ValueError(

@@ -44,6 +44,9 @@ def sensor_env(
     zenith = zen_clear * (1 - cloud) + grey * cloud
     horizon = hor_clear * (1 - cloud) + grey * 1.05 * cloud
     direct = sun.intensity * (1.0 - 0.85 * cloud)
+    fog = env.weather.extinction_per_m if fog_extinction_per_m is None else fog_extinction_per_m
+    rain = env.weather.rain_mm_per_h if rain_mm_per_h is None else rain_mm_per_h
+    waves = env.wave_height_m if wave_height_m is None else wave_height_m
     return core.SensorEnv(
         sun_direction=[float(x) for x in sun.direction],
         sun_color=[float(x) for x in sun.color],
@@ -51,9 +54,9 @@ def sensor_env(
         ambient=float(sun.ambient),
         sky_zenith=[float(x) for x in zenith],
         sky_horizon=[float(x) for x in horizon],
-        fog_extinction_per_m=float(env.weather.extinction_per_m if fog_extinction_per_m is None else fog_extinction_per_m),
+        fog_extinction_per_m=float(fog),
         fog_color=list(FOG_COLOR),
-        rain_mm_per_h=float(env.weather.rain_mm_per_h if rain_mm_per_h is None else rain_mm_per_h),
-        wave_height_m=float(env.wave_height_m if wave_height_m is None else wave_height_m),
+        rain_mm_per_h=float(rain),
+        wave_height_m=float(waves),
         shadows=shadows,
     )

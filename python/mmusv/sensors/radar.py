@@ -124,7 +124,9 @@ class RadarReturns:
         return p.astype(np.float32)
 
 
-def radar_sweep(radar: core.Radar, scene: Scene, *, pose: npt.ArrayLike, env: core.SensorEnv, seed: int) -> RadarReturns:
+def radar_sweep(
+    radar: core.Radar, scene: Scene, *, pose: npt.ArrayLike, env: core.SensorEnv, seed: int
+) -> RadarReturns:
     """One full revolution of ``radar`` (:func:`radar_from_config`) at ``pose`` (``(4, 4)`` sensor → world;
     sensor x forward, y left, z up) in ``scene``, with sea clutter for the wave height of ``env``
     (:func:`mmusv.sensors.env.sensor_env`; 0..30 m, e.g. W0 = 0.5, W3 = 3.5) and its rain (0..500 mm/h).
