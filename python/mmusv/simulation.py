@@ -31,7 +31,7 @@ from mmusv.sensors.lidar import LidarPoints, lidar_from_config, scan
 from mmusv.sensors.radar import RadarReturns, ppi_image, radar_from_config, radar_sweep
 from mmusv.world.build import WorldScene, build_world_scene, pose_matrices
 from mmusv.world.environment import Environment
-from mmusv.world.maps import MapWorld, generate_map
+from mmusv.world.maps import MapWorld, generate_map_from
 from mmusv.world.vessels import VesselAsset, get_asset
 
 __all__ = [
@@ -181,7 +181,7 @@ class Simulation:
         self.scenario: Scenario = load_scenario(source)
         sc = self.scenario
         self.environment: Environment = sc.environment.resolve()
-        self.world: MapWorld = world if world is not None else generate_map(sc.map.type, seed=sc.map.seed, **sc.map.params)
+        self.world: MapWorld = world if world is not None else generate_map_from(sc.map.params, seed=sc.map.seed)
         self.fleet = build_fleet(sc)
         self.sensor_env: core.SensorEnv = sensor_env(self.environment)
         poses0 = np.asarray(self.fleet.poses_at_times(np.zeros(1)))[0]
