@@ -4,7 +4,6 @@
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use mmusv_core::sensors::ppi::{ppi_image, PpiConfig};
 use mmusv_core::sensors::radar::{radar_sweep, RadarConfig, RadarEnv};
-use mmusv_core::sensors::radar_model::ClutterModel;
 use mmusv_core::RigidPose;
 use std::hint::black_box;
 use std::time::Duration;
@@ -15,27 +14,8 @@ fn bench_radar(c: &mut Criterion) {
         return;
     };
     let pose = RigidPose::from_xyz_rpy([0.0, 0.0, mmusv_benches::RADAR_HEIGHT as f64], [0.0, 0.0, 0.3]);
-    // The paper rig with the scenario defaults of `mmusv.sensors.config.RadarConfig` (the core has no Default).
-    let cfg = RadarConfig {
-        range_min_m: 10.0,
-        range_max_m: 3000.0,
-        range_resolution_m: 3.0,
-        azimuth_bins: 2048,
-        beamwidth_az_rad: 1.2f64.to_radians(),
-        elevation_fan_rad: [(-10f64).to_radians(), 10f64.to_radians()],
-        rays_az: 3,
-        rays_el: 16,
-        horizon_fraction: 0.75,
-        horizon_band_rad: 1.0f64.to_radians(),
-        detection_threshold: 0.3,
-        range_noise_std_m: 0.0,
-        clutter: ClutterModel {
-            sea_sigma0_at_1m: 4.0e-7,
-            critical_range_per_m: 300.0,
-            sea_max_range_m: 2500.0,
-            rain_eta_at_1mm_h: 5.0e-9,
-        },
-    };
+    // The configuration of the core's tests (as before; the user defaults live in the scenario schema).
+    let cfg = RadarConfig::tuning();
     let mut g = c.benchmark_group("radar");
     g.sample_size(10).measurement_time(Duration::from_secs(6)).warm_up_time(Duration::from_secs(1));
     for (name, waves) in [("sweep_calm", 0.0f32), ("sweep_w3", 3.5)] {

@@ -84,11 +84,10 @@ pub struct RadarConfig {
 
 /// No `Default`: the radar's defaults are defined once, in the scenario schema
 /// (`mmusv.sensors.config.RadarConfig`), and the binding (`mmusv._core.Radar`) requires every field.
-#[cfg(test)]
 impl RadarConfig {
-    /// The configuration the core's unit tests were written against (the paper rig's geometry; threshold
-    /// 0.01 and [`ClutterModel::tuning`], which show plenty of clutter). A test fixture, not a user default.
-    pub(crate) fn tuning() -> Self {
+    /// The configuration the core's unit tests and benchmarks are written against (the paper rig's geometry;
+    /// threshold 0.01 and [`ClutterModel::tuning`], which show plenty of clutter). A fixture, not a user default.
+    pub fn tuning() -> Self {
         Self {
             range_min_m: 10.0,
             range_max_m: 3000.0,
