@@ -29,9 +29,9 @@ CAMERA_HEIGHT = 2.0
 def ray_sets() -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """The LiDAR and camera ray sets: name -> (origins (N,3) f32, directions (N,3) f32), world frame."""
     el = core.uniform_elevations(channels=64, lower=np.deg2rad(-25.0), upper=np.deg2rad(15.0))
-    lidar = np.asarray(core.lidar_directions(elevations=list(el), azimuth_steps=2048))
+    lidar = np.asarray(core._lidar_directions(elevations=list(el), azimuth_steps=2048))
     lidar = lidar[np.asarray(core.lidar_trace_order(channels=64, azimuth_steps=2048))]  # the sensor's trace order
-    body = np.asarray(core.pinhole_directions(width=640, height=480, hfov=np.pi / 2))
+    body = np.asarray(core._pinhole_directions(width=640, height=480, hfov=np.pi / 2))
     cams = []
     for k in range(4):
         yaw = 2 * np.pi * k / 4

@@ -14,7 +14,8 @@ fn bench_radar(c: &mut Criterion) {
         return;
     };
     let pose = RigidPose::from_xyz_rpy([0.0, 0.0, mmusv_benches::RADAR_HEIGHT as f64], [0.0, 0.0, 0.3]);
-    let cfg = RadarConfig::default();
+    // The configuration of the core's tests (as before; the user defaults live in the scenario schema).
+    let cfg = RadarConfig::tuning();
     let mut g = c.benchmark_group("radar");
     g.sample_size(10).measurement_time(Duration::from_secs(6)).warm_up_time(Duration::from_secs(1));
     for (name, waves) in [("sweep_calm", 0.0f32), ("sweep_w3", 3.5)] {

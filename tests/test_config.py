@@ -76,3 +76,37 @@ def test_bundled_scenarios_validate_and_hash_is_stable() -> None:
         assert scenario_hash(s) == scenario_hash(load_scenario(f))
     a = load_scenario(files[0])
     assert scenario_hash(a) != scenario_hash(a.with_wave("W3"))
+
+
+@pytest.mark.parametrize(
+    ("map_cfg", "path", "fragment"),
+    [
+        ({"type": "port", "params": {"n_moored": -1}}, "map.params.n_moored", "greater than or equal to 0"),
+        ({"type": "island", "params": {"n_moored": 3}}, "map.params.n_moored", "Extra inputs"),
+        ({"type": "port", "params": {"entrance_width_m": 5000}}, "map.params.entrance_width_m", "in [60, 860]"),
+        ({"type": "open_sea", "params": {"islet_radius_m": [50, 20]}}, "map.params.islet_radius_m", "a <= b"),
+        ({"type": "island", "params": {"extent_m": 20000}}, "map.params.grid_m", "extent_m / 2000 = 10"),
+        ({"type": "port", "params": {"vegetation": "yes"}}, "map.params.vegetation", "boolean"),
+    ],
+)
+def test_map_params_are_checked_when_the_scenario_loads(map_cfg: dict[str, object], path: str, fragment: str) -> None:
+    """``map.params`` is the parameter model of ``map.type``, validated with the scenario (no world is built)."""
+    with pytest.raises(mmusv.ConfigError) as info:
+        load_scenario({**minimal(), "map": map_cfg})
+    msg = str(info.value)
+    assert f"invalid config {path} = " in msg and fragment in msg, msg
+
+
+def test_map_params_are_typed_by_map_type_and_dump_as_given() -> None:
+    from mmusv.world.map_params import IslandParams, OpenSeaParams, PortParams
+
+    port = load_scenario({**minimal(), "map": {"type": "port", "seed": 3, "params": {"n_moored": 2}}})
+    assert isinstance(port.map.params, PortParams) and port.map.params.n_moored == 2
+    assert port.map.params.coast_offset_m == 250.0  # resolved from extent_m = 2000
+    assert port.model_dump(mode="json")["map"] == {"type": "port", "seed": 3, "params": {"n_moored": 2}}
+    assert port.map.param_values() == {"n_moored": 2}
+    assert load_scenario(port.model_dump(mode="json")) == port  # the dump loads back to the same scenario
+    sea = load_scenario({**minimal(), "map": {"type": "open_sea"}})
+    assert isinstance(sea.map.params, OpenSeaParams) and sea.map.params.extent_m == 4000.0
+    assert sea.model_dump()["map"]["params"] == {}
+    assert isinstance(load_scenario(minimal()).map.params, IslandParams)

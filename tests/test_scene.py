@@ -346,7 +346,7 @@ def _coherent_scene(rng: np.random.Generator) -> Scene:
 def test_coherent_camera_rays_match_brute_force() -> None:
     """A pinhole image: rows of neighbouring pixels are traced as packets internally."""
     s = _coherent_scene(np.random.default_rng(5))
-    body = _core.pinhole_directions(width=96, height=64, hfov=1.0)
+    body = _core._pinhole_directions(width=96, height=64, hfov=1.0)
     assert body.shape == (96 * 64, 3) and body.dtype == np.float32
     cam = rpy_matrix(0.0, 1.3, 0.2)
     dirs = (body.astype(np.float64) @ cam.T).astype(np.float32)
@@ -365,7 +365,7 @@ def test_coherent_camera_rays_match_brute_force() -> None:
 def test_coherent_lidar_sweep_in_trace_order_matches_brute_force() -> None:
     s = _coherent_scene(np.random.default_rng(6))
     elev = _core.uniform_elevations(channels=16, lower=-0.5, upper=0.2)
-    dirs = _core.lidar_directions(elevations=elev, azimuth_steps=240)
+    dirs = _core._lidar_directions(elevations=elev, azimuth_steps=240)
     order = _core.lidar_trace_order(channels=16, azimuth_steps=240, block=8)
     assert sorted(order.tolist()) == list(range(len(dirs)))
     dirs = dirs[order]
@@ -681,7 +681,7 @@ def test_native_module_surface() -> None:
     assert issubclass(_core.MmusvError, Exception)
     assert isinstance(mmusv.__version__, str) and mmusv.__version__ == _core.__version__
     with pytest.raises(TypeError):
-        _core.pinhole_directions(64, 48, 1.0)  # type: ignore[call-arg]  # keyword-only
+        _core._pinhole_directions(64, 48, 1.0)  # type: ignore[call-arg]  # keyword-only
     k = _core.pinhole_intrinsics(width=64, height=48, hfov=math.pi / 2)
     np.testing.assert_allclose(k, [32.0, 32.0, 32.0, 24.0])
 

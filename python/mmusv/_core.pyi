@@ -23,18 +23,19 @@ __all__ = [
     "InternalError",
     "Scene",
     "pinhole_intrinsics",
-    "pinhole_directions",
-    "lidar_directions",
     "uniform_elevations",
     "lidar_trace_order",
-    "radar_sweep",
-    "ppi_image",
+    "_pinhole_directions",
+    "_lidar_directions",
+    "SensorEnv",
     "Lidar",
     "Camera",
+    "Radar",
     "demo_scene",
     "Fleet",
     "default_amplitudes",
     "wave_height",
+    "wave_presets",
     "Recorder",
 ]
 
@@ -143,19 +144,52 @@ class Scene:
 def pinhole_intrinsics(*, width: int, height: int, hfov: float) -> npt.NDArray[np.float64]:
     """(4,) float64 ``[fx, fy, cx, cy]`` in pixels of a ``width × height`` pinhole camera with horizontal FOV ``hfov`` radians."""
 
-def pinhole_directions(*, width: int, height: int, hfov: float) -> npt.NDArray[np.float32]:
-    """(width·height, 3) float32 unit ray directions through pixel centres, camera body frame, row-major from top-left."""
+def _pinhole_directions(*, width: int, height: int, hfov: float) -> npt.NDArray[np.float32]:
+    """Test helper, not API. (width·height, 3) float32 unit ray directions through pixel centres, camera body
+    frame, row-major from top-left."""
 
-def lidar_directions(
+def _lidar_directions(
     *, elevations: Sequence[float] | npt.NDArray[np.floating[Any]], azimuth_steps: int
 ) -> npt.NDArray[np.float32]:
-    """(azimuth_steps·len(elevations), 3) float32 unit directions of one sweep (elevations in radians), LiDAR frame, azimuth-major."""
+    """Test helper, not API. (azimuth_steps·len(elevations), 3) float32 unit directions of one sweep (elevations
+    in radians), LiDAR frame, azimuth-major."""
 
 def uniform_elevations(*, channels: int, lower: float, upper: float) -> npt.NDArray[np.float64]:
     """(channels,) float64 elevation angles in radians, lowest first, spread uniformly over ``[lower, upper]``."""
 
 def lidar_trace_order(*, channels: int, azimuth_steps: int, block: int = 8) -> npt.NDArray[np.uint32]:
-    """(channels·azimuth_steps,) uint32 packet-friendly trace order: indices into ``lidar_directions``' azimuth-major order."""
+    """(channels·azimuth_steps,) uint32 packet-friendly trace order: indices into ``_lidar_directions``' azimuth-major order."""
+
+@final
+class SensorEnv:
+    """What every sensor sees of the environment: sun and sky (cameras; linear RGB, ``sun_direction`` a world
+    unit vector towards the sun), fog extinction 1/m (cameras, LiDAR), rain mm/h and wave height m (all).
+    Non-finite or negative values raise ``ConfigError`` naming ``env.<field>``."""
+
+    def __new__(
+        cls,
+        *,
+        sun_direction: Sequence[float],
+        sun_color: Sequence[float],
+        sun_intensity: float,
+        ambient: float,
+        sky_zenith: Sequence[float],
+        sky_horizon: Sequence[float],
+        fog_extinction_per_m: float,
+        fog_color: Sequence[float],
+        rain_mm_per_h: float,
+        wave_height_m: float,
+        shadows: bool = True,
+    ) -> SensorEnv: ...
+    @property
+    def fog_extinction_per_m(self) -> float:
+        """Atmospheric extinction, 1/m."""
+    @property
+    def rain_mm_per_h(self) -> float:
+        """Rain rate, mm/h."""
+    @property
+    def wave_height_m(self) -> float:
+        """Significant wave height, metres."""
 
 @final
 class Lidar:
@@ -181,24 +215,28 @@ class Lidar:
     def pattern(self) -> npt.NDArray[np.float32]:
         """(channels·azimuth_steps, 3) float32 unit directions, LiDAR frame, azimuth-major."""
     def scan(
-        self,
-        scene: Scene,
-        *,
-        pose: npt.NDArray[np.float64],
-        fog_extinction_per_m: float,
-        rain_mm_per_h: float,
-        wave_height_m: float,
-        seed: int,
+        self, scene: Scene, *, pose: npt.NDArray[np.float64], env: SensorEnv, seed: int
     ) -> dict[str, npt.NDArray[Any]]:
         """One sweep: xyz (N,3) f32 LiDAR frame, range, intensity, ring, azimuth, class, instance, ray_index."""
 
 @final
 class Camera:
-    """A pinhole (``hfov``) or orthographic (``metres_per_pixel``) camera with its rays computed once."""
+    """A pinhole (``hfov``) or orthographic (``metres_per_pixel``) camera with its rays computed once; ``rgb``:
+    whether it shades colour (depth, semantic and instance images always come)."""
 
     def __new__(
-        cls, *, width: int, height: int, hfov: float | None = None, metres_per_pixel: float | None = None, range_max: float = ...
+        cls,
+        *,
+        width: int,
+        height: int,
+        rgb: bool,
+        hfov: float | None = None,
+        metres_per_pixel: float | None = None,
+        range_max: float = ...,
     ) -> Camera: ...
+    @property
+    def rgb(self) -> bool:
+        """Whether render shades an RGB image."""
     @property
     def intrinsics(self) -> tuple[float, float, float, float] | None:
         """[fx, fy, cx, cy] pixels (pinhole) or None (orthographic)."""
@@ -208,72 +246,77 @@ class Camera:
     def world_rays(self, pose: npt.NDArray[np.float64]) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
         """World ray origins and unit directions (H·W, 3) float32, row-major."""
     def render(
-        self,
-        scene: Scene,
-        *,
-        pose: npt.NDArray[np.float64],
-        rgb: bool,
-        seed: int,
-        sun_direction: Sequence[float],
-        sun_color: Sequence[float],
-        sun_intensity: float,
-        ambient: float,
-        sky_zenith: Sequence[float],
-        sky_horizon: Sequence[float],
-        fog_extinction_per_m: float,
-        fog_color: Sequence[float],
-        rain_mm_per_h: float,
-        wave_height_m: float,
-        shadows: bool = True,
+        self, scene: Scene, *, pose: npt.NDArray[np.float64], env: SensorEnv, seed: int
     ) -> dict[str, npt.NDArray[Any]]:
-        """depth (H,W) f32, semantic (H,W) u16, instance (H,W) i32 and, if rgb, rgb (H,W,3) u8."""
+        """depth (H,W) f32, semantic (H,W) u16, instance (H,W) i32 and, for an rgb camera, rgb (H,W,3) u8."""
 
 # --- radar ---
 
-def radar_sweep(
-    scene: Scene,
-    *,
-    pose: npt.NDArray[np.float64],
-    range_min_m: float,
-    range_max_m: float,
-    range_resolution_m: float,
-    azimuth_bins: int,
-    beamwidth_az_rad: float,
-    elevation_fan_rad: tuple[float, float],
-    rays_az: int,
-    rays_el: int,
-    horizon_fraction: float,
-    horizon_band_rad: float,
-    detection_threshold: float,
-    range_noise_std_m: float,
-    sea_sigma0_at_1m: float,
-    critical_range_per_m: float,
-    sea_max_range_m: float,
-    rain_eta_at_1mm_h: float,
-    wave_height_m: float,
-    rain_mm_per_h: float,
-    seed: int,
-) -> dict[str, npt.NDArray[Any]]:
-    """One radar revolution from ``pose`` ((4, 4) float64 sensor → world); GIL released. Returns equal-length
-    arrays sorted by (azimuth bin, range bin): ``range`` (N,) f32 m, ``azimuth`` (N,) f32 rad sensor frame in
-    [0, 2π), ``elevation`` (N,) f32 rad, ``intensity`` (N,) f32 (1.0 = a 1 m² target at 1 km), ``instance``
-    (N,) i32 (-1 = clutter), ``class`` (N,) u16. Bad values raise ``ConfigError`` naming ``radar.<field>``."""
+@final
+class Radar:
+    """A rotating marine radar, configured once (metres, radians). Every field is required: the defaults live in
+    ``mmusv.sensors.config.RadarConfig``. A bad value raises ``ConfigError`` naming ``radar.<field>``."""
 
-def ppi_image(
-    *,
-    range: npt.NDArray[np.float32],
-    azimuth: npt.NDArray[np.float32],
-    intensity: npt.NDArray[np.float32],
-    size_px: int,
-    metres_per_pixel: float,
-    orientation: str,
-    sensor_yaw: float,
-    range_resolution_m: float,
-    azimuth_bins: int,
-) -> npt.NDArray[np.float32]:
-    """(size_px, size_px) float32 PPI of returns (``range`` m, ``azimuth`` rad sensor frame, ``intensity``; (N,)
-    float32 each): ego at pixel (size_px // 2, size_px // 2), row 0 at the top, a return at range R exactly
-    R / metres_per_pixel px from it; ``orientation`` "north_up" (rotated by ``sensor_yaw`` rad) or "head_up"."""
+    def __new__(
+        cls,
+        *,
+        range_min_m: float,
+        range_max_m: float,
+        range_resolution_m: float,
+        azimuth_bins: int,
+        beamwidth_az_rad: float,
+        elevation_fan_rad: tuple[float, float],
+        rays_az: int,
+        rays_el: int,
+        horizon_fraction: float,
+        horizon_band_rad: float,
+        detection_threshold: float,
+        range_noise_std_m: float,
+        sea_sigma0_at_1m: float,
+        critical_range_per_m: float,
+        sea_max_range_m: float,
+        rain_eta_at_1mm_h: float,
+    ) -> Radar: ...
+    @property
+    def range_max_m(self) -> float:
+        """Instrumented range, metres."""
+    @property
+    def range_resolution_m(self) -> float:
+        """Range bin size, metres."""
+    @property
+    def azimuth_bins(self) -> int:
+        """Beams per revolution."""
+    @property
+    def detection_threshold(self) -> float:
+        """Smallest reported intensity."""
+    @property
+    def sea_sigma0_at_1m(self) -> float:
+        """Sea-clutter σ⁰ at 1 m wave height."""
+    @property
+    def num_rays(self) -> int:
+        """Rays per sweep."""
+    def sweep(
+        self, scene: Scene, *, pose: npt.NDArray[np.float64], env: SensorEnv, seed: int
+    ) -> dict[str, npt.NDArray[Any]]:
+        """One revolution from ``pose`` ((4, 4) float64 sensor → world); GIL released. Returns equal-length
+        arrays sorted by (azimuth bin, range bin): ``range`` (N,) f32 m, ``azimuth`` (N,) f32 rad sensor frame in
+        [0, 2π), ``elevation`` (N,) f32 rad, ``intensity`` (N,) f32 (1.0 = a 1 m² target at 1 km), ``instance``
+        (N,) i32 (-1 = clutter), ``class`` (N,) u16."""
+    def ppi_image(
+        self,
+        *,
+        range: npt.NDArray[np.float32],
+        azimuth: npt.NDArray[np.float32],
+        intensity: npt.NDArray[np.float32],
+        size_px: int,
+        metres_per_pixel: float,
+        orientation: str,
+        sensor_yaw: float,
+    ) -> npt.NDArray[np.float32]:
+        """(size_px, size_px) float32 PPI of this radar's returns (``range`` m, ``azimuth`` rad sensor frame,
+        ``intensity``; (N,) float32 each): ego at pixel (size_px // 2, size_px // 2), row 0 at the top, a return at
+        range R exactly R / metres_per_pixel px from it; ``orientation`` "north_up" (rotated by ``sensor_yaw``
+        rad) or "head_up"."""
 
 
 # --- demo ---
@@ -326,6 +369,9 @@ def default_amplitudes() -> tuple[float, float, float]:
 
 def wave_height(wave: str | float) -> float:
     """Wave height H in metres of a preset "W0".."W3" or a height in metres (validated)."""
+
+def wave_presets() -> list[tuple[str, float]]:
+    """``[(name, H metres), ...]`` of the presets W0..W3 in order (the one definition of the presets)."""
 
 # --- record ---
 

@@ -26,12 +26,24 @@ from mmusv.frames import BODY_TO_OPTICAL, translation
 from mmusv.scene import Scene
 from mmusv.world.vessels import get_asset
 
-__all__ = ["Annotations", "annotate_agent", "box_corners", "SilhouetteCache"]
+__all__ = ["Annotations", "annotate_agent", "box_corners", "in_target_range", "SilhouetteCache"]
 
 # Corner order of a box: bit 0 → +x, bit 1 → +y, bit 2 → +z.
 _SIGNS = np.array([[(i & 1) * 2 - 1, ((i >> 1) & 1) * 2 - 1, ((i >> 2) & 1) * 2 - 1] for i in range(8)], dtype=np.float64)
 _EDGES = [(a, b) for a in range(8) for b in range(a + 1, 8) if bin(a ^ b).count("1") == 1]
 NEAR_M = 0.05
+
+
+def in_target_range(centres: np.ndarray, range_m: float) -> np.ndarray:
+    """The one target-selection rule: which box centres lie within ``range_m`` metres of the ego LiDAR in bird's-eye
+    view, ``hypot(x, y) <= range_m`` (height ignored). ``centres``: ``(..., 3)`` (or ``(..., 2)``) in the ego's
+    LiDAR frame (its body frame when it has none), metres; returns a bool array of shape ``centres.shape[:-1]``.
+
+    Used by the annotations (which vessels get a 3D/BEV box) and by the dataset export (which vessels are
+    labelled); it is the BEV distance the detection study evaluates within.
+    """
+    c = np.asarray(centres, dtype=np.float64)
+    return np.asarray(np.hypot(c[..., 0], c[..., 1]) <= range_m)
 
 
 def box_corners(matrix: np.ndarray, size: np.ndarray) -> np.ndarray:
@@ -175,7 +187,7 @@ def annotate_agent(
         lidar_pose: ``(4, 4)`` LiDAR → world (boxes are expressed in this frame; the vessel body if ``None``).
         lidar_instances: ``(N,)`` instance id of each LiDAR point (for the point counts).
         cameras: name -> (native camera, ``(4, 4)`` camera body → world, ``(H, W)`` instance image).
-        max_range_m: vessels farther than this from the LiDAR get no 3D/BEV box.
+        max_range_m: vessels outside this range of the LiDAR (:func:`in_target_range`) get no 3D/BEV box.
     """
     ann = Annotations(agent=agent_id, frame=frame, time_s=time_s)
     ref = lidar_pose if lidar_pose is not None else state.matrices[agent_index]
@@ -197,7 +209,7 @@ def annotate_agent(
         box_world = state.matrices[vi] @ translation(info.box_center_body)
         box_ref = ref_inv @ box_world
         rng = float(np.linalg.norm(box_ref[:3, 3]))
-        if rng <= max_range_m:
+        if in_target_range(box_ref[:3, 3], max_range_m):
             ann.lidar_ids.append(info.id)
             ann.lidar_instance.append(info.instance_id)
             ann.lidar_class.append(info.semantic_class)

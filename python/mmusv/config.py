@@ -28,7 +28,10 @@ from pydantic import (
     BaseModel,
     ConfigDict,
     Field,
+    SerializationInfo,
     ValidationError,
+    ValidationInfo,
+    field_serializer,
     field_validator,
     model_validator,
 )
@@ -36,6 +39,7 @@ from pydantic import (
 from mmusv.errors import ConfigError, MmusvError, located
 from mmusv.sensors.config import RigConfig
 from mmusv.world.environment import Environment, wave_height_m
+from mmusv.world.map_params import PARAM_MODELS, IslandParams, MapParams
 from mmusv.world.vessels import asset_names, get_asset
 from mmusv.yamlio import mapping_source
 
@@ -56,12 +60,34 @@ class _Model(BaseModel):
 
 
 class MapConfig(_Model):
-    """Which map to generate: ``type`` in {island, open_sea, port}, its ``seed`` and optional parameters
-    (``extent_m`` and the per-type knobs of :mod:`mmusv.world.maps`)."""
+    """Which map to generate: ``type`` in {island, open_sea, port}, its ``seed`` and optional ``params``: the
+    model of that type (:class:`~mmusv.world.map_params.IslandParams`, ``OpenSeaParams`` or ``PortParams``: a
+    union discriminated by ``type``), validated when the scenario loads, so errors name ``map.params.<field>``.
+    ``params`` dump as the values that were given (resolved port knobs stay on the model, out of the dump)."""
 
     type: Literal["island", "open_sea", "port"] = "island"
     seed: int = Field(default=0, ge=0)
-    params: dict[str, Any] = Field(default_factory=dict)
+    params: MapParams = Field(default=None, validate_default=True)
+
+    @field_validator("params", mode="before")
+    @classmethod
+    def _params_of_type(cls, v: Any, info: ValidationInfo) -> Any:
+        if "type" not in info.data:  # a bad type is reported on its own
+            return IslandParams()
+        model = PARAM_MODELS[info.data["type"]]
+        if v is None:
+            return model()
+        if isinstance(v, BaseModel):
+            return v if type(v) is model else model.model_validate(v.model_dump(exclude_unset=True))
+        return model.model_validate(v)
+
+    @field_serializer("params")
+    def _given_params(self, params: MapParams, info: SerializationInfo) -> dict[str, Any]:
+        return params.model_dump(mode=info.mode, exclude_unset=True)
+
+    def param_values(self) -> dict[str, Any]:
+        """The parameters that were given, as JSON values sorted by name (what a scenario file would say)."""
+        return dict(sorted(self.params.model_dump(mode="json", exclude_unset=True).items()))
 
 
 class EnvironmentConfig(_Model):

@@ -20,19 +20,23 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from mmusv._native import core
 from mmusv.config import Scenario, VesselConfig, load_scenario
 from mmusv.errors import ConfigError
 from mmusv.motion import build_fleet
-from mmusv.sensors.camera import CameraImages, camera_from_config, render, shading_kwargs, top_view_from_config
+from mmusv.sensors.camera import CameraImages, camera_from_config, render, top_view_from_config
 from mmusv.sensors.config import CameraConfig, Mount, RigConfig
+from mmusv.sensors.env import sensor_env
 from mmusv.sensors.lidar import LidarPoints, lidar_from_config, scan
-from mmusv.sensors.radar import RadarReturns, RadarSettings, ppi_image, radar_sweep
+from mmusv.sensors.radar import RadarReturns, ppi_image, radar_from_config, radar_sweep
 from mmusv.world.build import WorldScene, build_world_scene, pose_matrices
 from mmusv.world.environment import Environment
-from mmusv.world.maps import MapWorld, generate_map
+from mmusv.world.maps import MapWorld, generate_map_from
 from mmusv.world.vessels import VesselAsset, get_asset
 
-__all__ = ["Simulation", "Agent", "VesselInfo", "WorldState", "AgentCapture", "FrameCapture", "sensor_seed"]
+__all__ = [
+    "Simulation", "Agent", "VesselInfo", "WorldState", "SensorMount", "AgentCapture", "FrameCapture", "sensor_seed",
+]
 
 SENSOR_KINDS = ("lidar", "cameras", "top_view", "radar")
 _SENSOR_CODES = {"lidar": 1, "radar": 2, "camera": 3, "top_view": 4}
@@ -96,28 +100,55 @@ class WorldState:
 
 @dataclass
 class Agent:
-    """An instrumented USV and its native sensors."""
+    """An instrumented USV and its native sensors (each configured once from the rig)."""
 
     index: int  # position in Simulation.vessels
     vessel: VesselConfig
     asset: VesselAsset
     rig: RigConfig
-    lidar: Any | None
+    lidar: core.Lidar | None
     lidar_mount: np.ndarray | None
     radar_mount: np.ndarray | None
-    cameras: dict[str, tuple[Any, CameraConfig, np.ndarray]] = field(default_factory=dict)
-    top_view: Any | None = None
-    radar_settings: RadarSettings | None = None
+    cameras: dict[str, tuple[core.Camera, CameraConfig, np.ndarray]] = field(default_factory=dict)
+    top_view: core.Camera | None = None
+    radar: core.Radar | None = None
 
     @property
     def id(self) -> str:
         """The vessel id."""
         return self.vessel.id
 
+    def mounts(self) -> dict[str, np.ndarray]:
+        """``(4, 4)`` sensor → vessel body matrices of the body-mounted sensors: keys ``lidar``, ``radar``,
+        ``camera/<name>`` (camera body frame: x forward, y left, z up). The top view is not body-mounted."""
+        out: dict[str, np.ndarray] = {}
+        if self.lidar_mount is not None:
+            out["lidar"] = self.lidar_mount
+        if self.radar_mount is not None:
+            out["radar"] = self.radar_mount
+        for name, (_, _, m) in self.cameras.items():
+            out[f"camera/{name}"] = m
+        return out
+
+
+@dataclass(frozen=True, eq=False)
+class SensorMount:
+    """Where one sensor is at a frame: ``mount`` ``(4, 4)`` float64 sensor → vessel body, ``pose`` ``(4, 4)``
+    float64 sensor → world (``body · mount``). Fixed for body-mounted sensors; for the level top view the mount
+    is ``body⁻¹ · pose`` and changes with the vessel's attitude."""
+
+    mount: np.ndarray
+    pose: np.ndarray
+
 
 @dataclass
 class AgentCapture:
-    """Everything one USV's sensors produced at one frame, with the sensor poses (sensor → world)."""
+    """Everything one USV's sensors produced at one frame, with the sensor poses (sensor → world).
+
+    ``body`` is the USV's ``(4, 4)`` body → world matrix and ``sensors`` every sensor of the USV (captured or
+    not) as a :class:`SensorMount`, keyed ``lidar``, ``radar``, ``camera/<name>``, ``top_view``: read the mounts
+    and poses there rather than recomputing ``body · mount``.
+    """
 
     agent: str
     lidar: LidarPoints | None
@@ -129,6 +160,8 @@ class AgentCapture:
     radar: RadarReturns | None = None
     radar_ppi: np.ndarray | None = None
     radar_pose: np.ndarray | None = None
+    body: np.ndarray | None = None
+    sensors: dict[str, SensorMount] = field(default_factory=dict)
 
 
 @dataclass
@@ -148,9 +181,9 @@ class Simulation:
         self.scenario: Scenario = load_scenario(source)
         sc = self.scenario
         self.environment: Environment = sc.environment.resolve()
-        self.world: MapWorld = world if world is not None else generate_map(sc.map.type, seed=sc.map.seed, **sc.map.params)
+        self.world: MapWorld = world if world is not None else generate_map_from(sc.map.params, seed=sc.map.seed)
         self.fleet = build_fleet(sc)
-        self.lighting = shading_kwargs(self.environment)
+        self.sensor_env: core.SensorEnv = sensor_env(self.environment)
         poses0 = np.asarray(self.fleet.poses_at_times(np.zeros(1)))[0]
         self.ws: WorldScene = build_world_scene(self.world, [(v.asset, v.role) for v in sc.vessels], poses0)
         self.vessels: list[VesselInfo] = []
@@ -183,10 +216,7 @@ class Simulation:
             agent.lidar_mount = mount_matrix(asset, rig.lidar.mount, where=f"{where}.lidar.mount")
         if rig.radar is not None:
             agent.radar_mount = mount_matrix(asset, rig.radar.mount, where=f"{where}.radar.mount")
-            try:
-                agent.radar_settings = RadarSettings(**rig.radar.sensor_fields())  # type: ignore[arg-type]
-            except ConfigError as exc:
-                raise ConfigError(f"{where}.{exc}") from None
+            agent.radar = radar_from_config(rig.radar)
         for c in rig.cameras:
             m = mount_matrix(asset, c.mount, where=f"{where}.cameras[{c.name}].mount")
             agent.cameras[c.name] = (camera_from_config(c), c, m)
@@ -197,13 +227,8 @@ class Simulation:
 
     def _check_mounts(self, agent: Agent, where: str) -> None:
         """A sensor whose origin lies inside its own hull would see only the hull's inside: refuse it."""
-        mounts: list[tuple[str, np.ndarray]] = []
-        if agent.lidar_mount is not None:
-            mounts.append((f"{where}.lidar.mount", agent.lidar_mount))
-        if agent.radar_mount is not None:
-            mounts.append((f"{where}.radar.mount", agent.radar_mount))
-        mounts += [(f"{where}.cameras[{n}].mount", m) for n, (_, _, m) in agent.cameras.items()]
-        for name, m in mounts:
+        for key, m in agent.mounts().items():
+            name = f"{where}.cameras[{key[7:]}].mount" if key.startswith("camera/") else f"{where}.{key}.mount"
             if inside_mesh(agent.asset.mesh.vertices, agent.asset.mesh.faces, m[:3, 3]):
                 xyz = np.round(m[:3, 3], 3).tolist()
                 raise ConfigError(
@@ -257,13 +282,7 @@ class Simulation:
         """Sensor → world matrices of every sensor of ``agent`` in ``state``: keys ``lidar``, ``radar``,
         ``camera/<name>``, ``top_view``."""
         body = state.matrices[agent.index]
-        out: dict[str, np.ndarray] = {}
-        if agent.lidar_mount is not None:
-            out["lidar"] = body @ agent.lidar_mount
-        if agent.radar_mount is not None:
-            out["radar"] = body @ agent.radar_mount
-        for name, (_, _, m) in agent.cameras.items():
-            out[f"camera/{name}"] = body @ m
+        out = {key: body @ m for key, m in agent.mounts().items()}
         if agent.top_view is not None and agent.rig.top_view is not None:
             tv = agent.rig.top_view
             x, y, _, _, _, yaw = state.poses[agent.index]
@@ -298,55 +317,52 @@ class Simulation:
         if kinds - set(SENSOR_KINDS):
             raise ConfigError(f"unknown sensor kind(s) {sorted(kinds - set(SENSOR_KINDS))}; allowed: {', '.join(SENSOR_KINDS)}")
         state = self.set_frame(frame)
-        env = self.environment
+        env = self.sensor_env
         sc = self.scenario
         out: dict[str, AgentCapture] = {}
         for agent in self.agents:
             if agents is not None and agent.id not in agents:
                 continue
             poses = self.sensor_poses(agent, state)
-            cap = AgentCapture(agent.id, None, None, {}, {}, None, None)
+            body = state.matrices[agent.index]
+            mounts = agent.mounts()
+            cap = AgentCapture(agent.id, None, None, {}, {}, None, None, body=body)
+            for key, p in poses.items():
+                m = mounts[key] if key in mounts else np.linalg.inv(body) @ p
+                cap.sensors[key] = SensorMount(mount=m, pose=p)
             if agent.lidar is not None and "lidar" in kinds:
                 cap.lidar_pose = poses["lidar"]
                 cap.lidar = scan(
-                    agent.lidar, self.ws.scene, pose=cap.lidar_pose,
+                    agent.lidar, self.ws.scene, pose=cap.lidar_pose, env=env,
                     seed=sensor_seed(sc.seed, frame, agent.index, "lidar"),
-                    fog_extinction_per_m=env.weather.extinction_per_m, rain_mm_per_h=env.weather.rain_mm_per_h,
-                    wave_height_m=env.wave_height_m,
                 )
-            for k, (name, (cam, cfg, _)) in enumerate(agent.cameras.items()):
+            for k, (name, (cam, _, _)) in enumerate(agent.cameras.items()):
                 if "cameras" not in kinds:
                     break
                 p = poses[f"camera/{name}"]
                 cap.camera_poses[name] = p
                 cap.cameras[name] = render(
-                    cam, self.ws.scene, pose=p, seed=sensor_seed(sc.seed, frame, agent.index, "camera", k),
-                    rgb="rgb" in cfg.outputs, lighting=self.lighting,
+                    cam, self.ws.scene, pose=p, env=env, seed=sensor_seed(sc.seed, frame, agent.index, "camera", k)
                 )
-            if agent.top_view is not None and agent.rig.top_view is not None and "top_view" in kinds:
+            if agent.top_view is not None and "top_view" in kinds:
                 cap.top_view_pose = poses["top_view"]
                 cap.top_view = render(
-                    agent.top_view, self.ws.scene, pose=cap.top_view_pose,
+                    agent.top_view, self.ws.scene, pose=cap.top_view_pose, env=env,
                     seed=sensor_seed(sc.seed, frame, agent.index, "top_view"),
-                    rgb="rgb" in agent.rig.top_view.outputs, lighting=self.lighting,
                 )
-            if "radar" in kinds and agent.rig.radar is not None and "radar" in poses:
+            if "radar" in kinds and agent.radar is not None and agent.rig.radar is not None:
                 cap.radar_pose = poses["radar"]
-                self._radar(agent, cap, state, frame)
+                cfg = agent.rig.radar
+                cap.radar = radar_sweep(
+                    agent.radar, self.ws.scene, pose=cap.radar_pose, env=env,
+                    seed=sensor_seed(sc.seed, frame, agent.index, "radar"),
+                )
+                cap.radar_ppi = ppi_image(
+                    cap.radar, size_px=cfg.ppi_size_px, metres_per_pixel=cfg.ppi_metres_per_pixel,
+                    orientation=cfg.ppi_orientation,
+                )
             out[agent.id] = cap
         return FrameCapture(frame, state.time_s, state, out)
-
-    def _radar(self, agent: Agent, cap: AgentCapture, state: WorldState, frame: int) -> None:
-        cfg = agent.rig.radar
-        assert cfg is not None and cap.radar_pose is not None and agent.radar_settings is not None
-        cap.radar = radar_sweep(
-            self.ws.scene, pose=cap.radar_pose, settings=agent.radar_settings, wave_height_m=self.environment.wave_height_m,
-            rain_mm_per_h=self.environment.weather.rain_mm_per_h, seed=sensor_seed(self.scenario.seed, frame, agent.index, "radar"),
-        )
-        cap.radar_ppi = ppi_image(
-            cap.radar, size_px=cfg.ppi_size_px, metres_per_pixel=cfg.ppi_metres_per_pixel, orientation=cfg.ppi_orientation,
-            settings=agent.radar_settings,
-        )
 
 
 def inside_mesh(vertices: np.ndarray, faces: np.ndarray, point: np.ndarray, *, rays: int = 9) -> bool:

@@ -288,12 +288,20 @@ def test_include_usvs_lists_other_usvs_never_self(coop_rec: Path, tmp_path: Path
 
 
 def test_eval_range_filters_vehicles(coop_rec: Path, tmp_path: Path) -> None:
-    convert(coop_rec, to="opv2v", out_dir=tmp_path, splits=None, eval_range_m=40.0, extras=())
-    doc = load(tmp_path / "export_coop" / "1000" / "000000.yaml")
-    for obj in doc["vehicles"].values():
-        c = corners(obj, doc["lidar_pose"]).mean(axis=0)
-        assert abs(c[0]) <= 40 and abs(c[1]) <= 40
-    full = load(tmp_path / "export_coop" / "data_protocol.yaml")
+    """The export keeps exactly the vessels within the range in bird's-eye view (the one target rule, changed from
+    a square |x|, |y| window): those of a 200 m export whose centre is within 40 m."""
+    convert(coop_rec, to="opv2v", out_dir=tmp_path / "near", splits=None, eval_range_m=40.0, extras=())
+    convert(coop_rec, to="opv2v", out_dir=tmp_path / "all", splits=None, extras=())
+    doc = load(tmp_path / "near" / "export_coop" / "1000" / "000000.yaml")
+    every = load(tmp_path / "all" / "export_coop" / "1000" / "000000.yaml")
+
+    def bev(d: dict[str, Any], obj: dict[str, Any]) -> float:
+        c = corners(obj, d["lidar_pose"]).mean(axis=0)
+        return math.hypot(c[0], c[1])
+
+    assert all(bev(doc, obj) <= 40 for obj in doc["vehicles"].values())
+    assert set(doc["vehicles"]) == {k for k, obj in every["vehicles"].items() if bev(every, obj) <= 40}
+    full = load(tmp_path / "near" / "export_coop" / "data_protocol.yaml")
     assert full["mmusv"]["eval_range_m"] == 40.0
 
 

@@ -20,7 +20,7 @@ from mmusv.config import Scenario, load_scenario
 from mmusv.generate import generate
 from mmusv.motion import build_fleet
 from mmusv.world.build import build_static_scene
-from mmusv.world.maps import MapWorld, generate_map
+from mmusv.world.maps import MapWorld, generate_map_from
 from mmusv.world.vessels import get_asset
 
 TOL = 1e-6
@@ -109,7 +109,7 @@ _WORLDS: dict[tuple[str, int], MapWorld] = {}
 def world_of(sc: Scenario) -> MapWorld:
     key = (sc.map.type, sc.map.seed)
     if key not in _WORLDS:
-        _WORLDS[key] = generate_map(sc.map.type, seed=sc.map.seed, **sc.map.params)
+        _WORLDS[key] = generate_map_from(sc.map.params, seed=sc.map.seed)
     return _WORLDS[key]
 
 

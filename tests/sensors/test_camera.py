@@ -26,6 +26,7 @@ from mmusv.sensors import (
     TopViewConfig,
     camera_from_config,
     render,
+    sensor_env,
     top_view_from_config,
 )
 from mmusv.sensors.camera import BODY_TO_OPTICAL
@@ -107,7 +108,7 @@ def test_intrinsics_closed_form(width: int, height: int, hfov_deg: float) -> Non
 
 @pytest.mark.parametrize("w,h", [(40, 30), (33, 21), (1, 1)])
 def test_world_rays_match_intrinsics_and_conventions(w: int, h: int) -> None:
-    cam = core.Camera(width=w, height=h, hfov=math.radians(80))
+    cam = core.Camera(rgb=False, width=w, height=h, hfov=math.radians(80))
     pose = pose_matrices(np.array([1.0, 2.0, 3.0, 0.2, -0.3, 2.5]))
     origins, dirs = cam.world_rays(pose)
     assert origins.shape == (w * h, 3) and dirs.shape == (w * h, 3)
@@ -129,9 +130,9 @@ def test_depth_over_a_plane_is_the_analytic_distance(pitch_deg: float, roll_deg:
     w, h, hfov = 64, 48, math.radians(90)
     height_m, half = 10.0, 1e5
     scene = plane_scene(half, cls=1)
-    cam = core.Camera(width=w, height=h, hfov=hfov)
+    cam = core.Camera(rgb=False, width=w, height=h, hfov=hfov)
     pose = pose_matrices(np.array([5.0, -3.0, height_m, *np.radians([roll_deg, pitch_deg, yaw_deg])]))
-    img = render(cam, scene, pose=pose, seed=1, rgb=False)
+    img = render(cam, scene, pose=pose, env=sensor_env(), seed=1)
     assert img.depth.shape == (h, w) and img.depth.dtype == np.float32
     assert img.semantic.shape == (h, w) and img.semantic.dtype == np.uint16
     assert img.instance.shape == (h, w) and img.instance.dtype == np.int32
@@ -164,8 +165,8 @@ def test_pinhole_depth_is_along_the_axis_not_the_ray() -> None:
     """A wall facing the camera: every pixel has the same depth (the wall distance)."""
     s = Scene()
     add_box(s, (30.0, -500.0, -500.0), (31.0, 500.0, 500.0), cls=4)
-    cam = core.Camera(width=32, height=24, hfov=math.radians(100))
-    img = render(cam, s, pose=np.eye(4), seed=1, rgb=False)
+    cam = core.Camera(rgb=False, width=32, height=24, hfov=math.radians(100))
+    img = render(cam, s, pose=np.eye(4), env=sensor_env(), seed=1)
     np.testing.assert_allclose(img.depth, 30.0, rtol=1e-5)
     assert np.all(img.semantic == 4) and np.all(img.instance == 0)
 
@@ -173,17 +174,18 @@ def test_pinhole_depth_is_along_the_axis_not_the_ray() -> None:
 def test_range_max_cuts_far_surfaces() -> None:
     s = Scene()
     add_box(s, (30.0, -500.0, -500.0), (31.0, 500.0, 500.0), cls=4)
-    cam = core.Camera(width=8, height=6, hfov=math.radians(60), range_max=25.0)
-    img = render(cam, s, pose=np.eye(4), seed=1, rgb=False)
+    cam = core.Camera(rgb=False, width=8, height=6, hfov=math.radians(60), range_max=25.0)
+    img = render(cam, s, pose=np.eye(4), env=sensor_env(), seed=1)
     assert np.all(np.isposinf(img.depth)) and np.all(img.instance == -1) and np.all(img.semantic == 0)
 
 
 def test_rgb_only_when_asked() -> None:
     s = plane_scene(1000.0)
-    cam = core.Camera(width=16, height=12, hfov=math.radians(90))
+    colour = core.Camera(width=16, height=12, rgb=True, hfov=math.radians(90))
+    plain = core.Camera(width=16, height=12, rgb=False, hfov=math.radians(90))
     pose = pose_matrices(np.array([0.0, 0.0, 5.0, 0.0, 0.2, 0.0]))
-    with_rgb = render(cam, s, pose=pose, seed=1, rgb=True)
-    without = render(cam, s, pose=pose, seed=1, rgb=False)
+    with_rgb = render(colour, s, pose=pose, env=sensor_env(), seed=1)
+    without = render(plain, s, pose=pose, env=sensor_env(), seed=1)
     assert without.rgb is None
     assert with_rgb.rgb is not None and with_rgb.rgb.shape == (12, 16, 3) and with_rgb.rgb.dtype == np.uint8
     for name in ("depth", "semantic", "instance"):
@@ -234,7 +236,7 @@ def test_top_view_box_at_predicted_pixel(sim: Simulation, agent_id: str, orienta
     assert cam.intrinsics is None
     w, h = tv.resolution
     mpp = tv.metres_per_pixel
-    img = render(cam, scene, pose=pose, seed=1, rgb=False)
+    img = render(cam, scene, pose=pose, env=sensor_env(), seed=1)
     assert img.depth.shape == (h, w)
     mask = img.instance == box
     n = int(mask.sum())
@@ -371,12 +373,12 @@ def test_top_view_misconfig_names_the_field(make_scenario: Any) -> None:
 
 def test_native_camera_misconfig_names_the_field() -> None:
     with pytest.raises(mmusv.errors.ConfigError, match="camera.hfov_deg"):
-        core.Camera(width=8, height=8, hfov=math.pi)
+        core.Camera(rgb=False, width=8, height=8, hfov=math.pi)
     with pytest.raises(mmusv.errors.ConfigError, match="camera.resolution"):
-        core.Camera(width=0, height=8, hfov=1.0)
+        core.Camera(rgb=False, width=0, height=8, hfov=1.0)
     with pytest.raises(mmusv.errors.ConfigError, match="camera.range_m"):
-        core.Camera(width=8, height=8, hfov=1.0, range_max=-1.0)
+        core.Camera(rgb=False, width=8, height=8, hfov=1.0, range_max=-1.0)
     with pytest.raises(mmusv.errors.ConfigError, match="metres_per_pixel"):
-        core.Camera(width=8, height=8, metres_per_pixel=0.0)
+        core.Camera(rgb=False, width=8, height=8, metres_per_pixel=0.0)
     with pytest.raises(mmusv.errors.ConfigError, match="hfov"):
-        core.Camera(width=8, height=8, hfov=1.0, metres_per_pixel=1.0)
+        core.Camera(rgb=False, width=8, height=8, hfov=1.0, metres_per_pixel=1.0)

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 from mmusv._native import core
 from mmusv.scene import Scene, demo_scene
-from mmusv.sensors import LidarConfig, LidarPoints, lidar_from_config, scan
+from mmusv.sensors import LidarConfig, LidarPoints, lidar_from_config, scan, sensor_env
 from mmusv.simulation import Simulation
 from mmusv.world.build import pose_matrices
 
@@ -88,7 +88,9 @@ def room_truth(dirs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def do_scan(lidar: Any, scene: Scene, pose: np.ndarray | None = None, *, seed: int = 1, **env: float) -> LidarPoints:
-    return scan(lidar, scene, pose=np.eye(4) if pose is None else pose, seed=seed, **env)
+    """A scan in still, clear air unless ``env`` sets fog_extinction_per_m, rain_mm_per_h or wave_height_m."""
+    still = {"fog_extinction_per_m": 0.0, "rain_mm_per_h": 0.0, "wave_height_m": 0.0}
+    return scan(lidar, scene, pose=np.eye(4) if pose is None else pose, env=sensor_env(**{**still, **env}), seed=seed)
 
 
 # ------------------------------------------------------------------------------------------ geometry vs Open3D

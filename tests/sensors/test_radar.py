@@ -2,12 +2,12 @@
 determinism, sea clutter that grows with the waves, and configuration errors that name the field.
 
 Scenes are a sea plane (class WATER) with 10 m box "vessels" at known ranges and bearings; settings are small
-(512 beams, 1.5 km) so every sweep takes milliseconds.
+(512 beams, 1.5 km) so every sweep takes milliseconds, with the threshold 0.01 and σ⁰ 4e-6 these tests were
+written for (plenty of clutter); one test checks the schema defaults (0.3, 4e-7) on their own.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from pathlib import Path
 from typing import Any
@@ -18,9 +18,23 @@ import numpy.typing as npt
 import pytest
 from mmusv._native import core
 from mmusv.classes import SemanticClass
-from mmusv.sensors.radar import RadarReturns, RadarSettings, ppi_colormap, ppi_image, ppi_png, radar_sweep
+from mmusv.config import load_scenario
+from mmusv.sensors import RadarConfig, sensor_env
+from mmusv.sensors.radar import RadarReturns, ppi_colormap, ppi_image, ppi_png, radar_from_config, radar_sweep
+from pydantic import ValidationError
 
-SMALL = RadarSettings(range_m=1500.0, azimuth_bins=512, rays_el=32)
+SMALL = RadarConfig(range_m=1500.0, azimuth_bins=512, rays_el=32, detection_threshold=0.01, sea_clutter_sigma0=4.0e-6)
+RADAR = radar_from_config(SMALL)
+
+
+def small(**change: Any) -> RadarConfig:
+    """SMALL with some fields changed (validated)."""
+    return RadarConfig(**{**SMALL.model_dump(), **change})
+
+
+def env(*, waves: float = 0.0, rain: float = 0.0) -> Any:
+    """Clear air with ``waves`` metres of waves and ``rain`` mm/h."""
+    return sensor_env(fog_extinction_per_m=0.0, rain_mm_per_h=rain, wave_height_m=waves)
 MAST_HEIGHT = 3.0
 HALF = 5.0  # half side of the box targets, metres
 
@@ -87,7 +101,7 @@ def wrap(a: float | npt.NDArray[Any]) -> Any:
 def test_box_return_at_its_range_bearing_and_id(near_range: float, bearing_deg: float, yaw_deg: float) -> None:
     sea = Sea(near_range, math.radians(bearing_deg))
     yaw = math.radians(yaw_deg)
-    ret = radar_sweep(sea.scene, pose=pose_at(0, 0, MAST_HEIGHT, yaw), settings=SMALL, seed=0)
+    ret = radar_sweep(RADAR, sea.scene, pose=pose_at(0, 0, MAST_HEIGHT, yaw), env=env(), seed=0)
     mine = ret.instance_id == sea.target
     assert mine.any(), "the target box was not seen"
     assert set(np.unique(ret.instance_id)) <= {sea.target, sea.other}, "no clutter on a calm sea"
@@ -132,7 +146,7 @@ def test_ppi_scale_is_fixed_while_other_objects_move(orientation: str) -> None:
         dists = []
         for other_range, other_bearing in ((60.0, 0.5), (900.0, -2.0), (1450.0, 3.0)):
             sea.move_other(other_range, other_bearing)
-            ret = radar_sweep(sea.scene, pose=pose_at(0, 0, MAST_HEIGHT, yaw), settings=SMALL, seed=1)
+            ret = radar_sweep(RADAR, sea.scene, pose=pose_at(0, 0, MAST_HEIGHT, yaw), env=env(), seed=1)
             img = ppi_image(ret, size_px=size, metres_per_pixel=mpp, orientation=orientation)  # type: ignore[arg-type]
             assert img.shape == (size, size) and img.dtype == np.float32
             theta = bearing if orientation == "north_up" else bearing - yaw + math.pi / 2
@@ -146,20 +160,20 @@ def test_ppi_scale_is_fixed_while_other_objects_move(orientation: str) -> None:
 
 def test_ppi_default_scale_and_yaw_come_from_the_sweep() -> None:
     sea = Sea(700.0, 0.0)
-    ret = radar_sweep(sea.scene, pose=pose_at(0, 0, MAST_HEIGHT, 0.4), settings=SMALL, seed=0)
+    ret = radar_sweep(RADAR, sea.scene, pose=pose_at(0, 0, MAST_HEIGHT, 0.4), env=env(), seed=0)
     assert math.isclose(ret.sensor_yaw, 0.4, abs_tol=1e-9)
     default = ppi_image(ret, size_px=300)
-    explicit = ppi_image(ret, size_px=300, metres_per_pixel=SMALL.range_m / 150, sensor_yaw=0.4, settings=SMALL)
+    explicit = ppi_image(ret, size_px=300, metres_per_pixel=SMALL.range_m / 150, sensor_yaw=0.4)
     assert np.array_equal(default, explicit)
 
 
 def test_same_seed_same_arrays_other_seed_other_clutter() -> None:
     sea = Sea(500.0, 1.0)
-    settings = dataclasses.replace(SMALL, range_noise_std_m=0.4)
+    radar = radar_from_config(small(range_noise_std_m=0.4))
     pose = pose_at(0, 0, MAST_HEIGHT, 0.0)
-    a = radar_sweep(sea.scene, pose=pose, settings=settings, wave_height_m=2.0, seed=11)
-    b = radar_sweep(sea.scene, pose=pose, settings=settings, wave_height_m=2.0, seed=11)
-    c = radar_sweep(sea.scene, pose=pose, settings=settings, wave_height_m=2.0, seed=12)
+    a = radar_sweep(radar, sea.scene, pose=pose, env=env(waves=2.0), seed=11)
+    b = radar_sweep(radar, sea.scene, pose=pose, env=env(waves=2.0), seed=11)
+    c = radar_sweep(radar, sea.scene, pose=pose, env=env(waves=2.0), seed=12)
     fields = ("range", "azimuth", "elevation", "intensity", "instance_id", "semantic_class")
     for name in fields:
         assert np.array_equal(getattr(a, name), getattr(b, name)), name
@@ -181,7 +195,7 @@ def test_sea_clutter_grows_from_w0_to_w3() -> None:
     pose = pose_at(0, 0, MAST_HEIGHT, 0.0)
     heights = [core.wave_height(w) for w in ("W0", "W1", "W2", "W3")]
     assert heights[0] == 0.5 and heights[-1] == 3.5
-    rets = [radar_sweep(sea.scene, pose=pose, settings=SMALL, wave_height_m=h, seed=5) for h in heights]
+    rets = [radar_sweep(RADAR, sea.scene, pose=pose, env=env(waves=h), seed=5) for h in heights]
     counts = [clutter_count(r) for r in rets]
     reach = [float(r.range[r.is_clutter].max()) for r in rets]
     assert counts[0] > 0 and all(x < y for x, y in zip(counts, counts[1:])), counts
@@ -190,9 +204,9 @@ def test_sea_clutter_grows_from_w0_to_w3() -> None:
     assert reach[-1] < SMALL.sea_clutter_max_range_m
     # The target is still there, and calm water has no clutter at all.
     assert (rets[-1].instance_id == sea.target).any()
-    assert clutter_count(radar_sweep(sea.scene, pose=pose, settings=SMALL, seed=5)) == 0
+    assert clutter_count(radar_sweep(RADAR, sea.scene, pose=pose, env=env(), seed=5)) == 0
     # Rain adds (a little) clutter of class NONE and attenuates the target.
-    wet = radar_sweep(sea.scene, pose=pose, settings=SMALL, rain_mm_per_h=8.0, seed=5)
+    wet = radar_sweep(RADAR, sea.scene, pose=pose, env=env(rain=8.0), seed=5)
     assert 0 < clutter_count(wet) < counts[-1]
     assert (wet.semantic_class[wet.is_clutter] == SemanticClass.NONE).all()
 
@@ -216,23 +230,71 @@ def test_sea_clutter_grows_from_w0_to_w3() -> None:
         ({"sea_clutter_sigma0": float("nan")}, "sea_clutter_sigma0"),
     ],
 )
-def test_bad_settings_raise_config_error_naming_the_field(change: dict[str, Any], field: str) -> None:
-    sea = Sea(300.0, 0.0)
-    with pytest.raises(mmusv.ConfigError, match=field):
-        radar_sweep(sea.scene, pose=np.eye(4), settings=dataclasses.replace(SMALL, **change), seed=0)
+def test_bad_settings_raise_an_error_naming_the_field(change: dict[str, Any], field: str) -> None:
+    with pytest.raises(ValidationError, match=field):
+        small(**change)
+    # In a scenario, the error is a ConfigError with the whole path.
+    scenario = {
+        "rigs": {"r": {"radar": {**SMALL.model_dump(exclude={"mount"}), **change}}},
+        "vessels": [{"id": "u", "role": "usv", "asset": "usv_wamv", "rig": "r", "route": [[0, 0], [10, 0]]}],
+    }
+    with pytest.raises(mmusv.ConfigError, match=rf"rigs\.r\.radar\b.*{field}"):
+        load_scenario(scenario)
+
+
+def test_the_schema_limits_are_the_cores() -> None:
+    """A config the schema accepts never trips the core's own checks, at the edges of what is allowed."""
+    edges = [
+        {"azimuth_bins": 65536, "rays_az": 8, "rays_el": 16},  # 2**23 rays (the core allows 2**24)
+        {"range_m": 100_000.0, "range_resolution_m": 100_000.0 / 2**20},  # 2**20 range bins
+        {"beamwidth_deg": 90.0, "horizon_band_deg": 45.0, "horizon_fraction": 1.0, "elevation_fan_deg": (-89.9, 89.9)},
+        {"sea_clutter_sigma0": 1.0, "rain_clutter_eta": 1.0, "range_noise_std_m": 100_000.0, "min_range_m": 0.0},
+    ]
+    for change in edges:
+        radar_from_config(RadarConfig(**change))  # no error from the core
+    for change in [{"azimuth_bins": 65536, "rays_az": 8, "rays_el": 17}, {"range_resolution_m": 3000.0 / (2**20 + 1)}]:
+        with pytest.raises(ValidationError, match="at most"):
+            RadarConfig(**change)
+    for bad in [{"detection_threshold": float("inf")}, {"range_noise_std_m": 2e5}, {"sea_clutter_sigma0": 2.0}]:
+        with pytest.raises(ValidationError, match=next(iter(bad))):
+            RadarConfig(**bad)
+
+
+def test_defaults_come_from_the_schema_and_keep_clutter_near_the_ship() -> None:
+    """The binding has no defaults of its own: a radar from ``RadarConfig()`` has the schema's threshold 0.3 and
+    σ⁰ 4e-7. With them sea clutter still grows with every sea state but stays within a few hundred metres,
+    while the target at 1.2 km is seen."""
+    radar = radar_from_config(RadarConfig())
+    assert (radar.detection_threshold, radar.sea_sigma0_at_1m) == (0.3, 4.0e-7)
+    geometry = (radar.range_max_m, radar.range_resolution_m, radar.azimuth_bins, radar.num_rays)
+    assert geometry == (3000.0, 3.0, 2048, 2048 * 3 * 16)
+    sea = Sea(1200.0, 0.0)
+    pose = pose_at(0, 0, MAST_HEIGHT, 0.0)
+    schema = radar_from_config(RadarConfig(range_m=1500.0, azimuth_bins=512, rays_el=32))
+    rets = [radar_sweep(schema, sea.scene, pose=pose, env=env(waves=core.wave_height(w)), seed=5) for w in ("W0", "W3")]
+    counts = [clutter_count(r) for r in rets]
+    assert 0 < counts[0] < counts[1], counts
+    assert float(rets[1].range[rets[1].is_clutter].max()) < 400.0
+    assert all((r.instance_id == sea.target).any() for r in rets)
+    tuned = radar_sweep(RADAR, sea.scene, pose=pose, env=env(waves=3.5), seed=5)
+    assert clutter_count(tuned) > 3 * counts[1]
 
 
 def test_bad_environment_pose_and_ppi_arguments() -> None:
     sea = Sea(300.0, 0.0)
     with pytest.raises(mmusv.ConfigError, match="wave_height_m"):
-        radar_sweep(sea.scene, pose=np.eye(4), settings=SMALL, wave_height_m=-1.0, seed=0)
+        env(waves=-1.0)
+    with pytest.raises(mmusv.ConfigError, match="wave_height_m"):
+        radar_sweep(RADAR, sea.scene, pose=np.eye(4), env=env(waves=31.0), seed=0)
     with pytest.raises(mmusv.ConfigError, match="rain_mm_per_h"):
-        radar_sweep(sea.scene, pose=np.eye(4), settings=SMALL, rain_mm_per_h=float("inf"), seed=0)
+        env(rain=float("inf"))
+    with pytest.raises(mmusv.ConfigError, match="rain_mm_per_h"):
+        radar_sweep(RADAR, sea.scene, pose=np.eye(4), env=env(rain=501.0), seed=0)
     with pytest.raises(mmusv.InputError, match="pose"):
-        radar_sweep(sea.scene, pose=np.eye(3), settings=SMALL, seed=0)
+        radar_sweep(RADAR, sea.scene, pose=np.eye(3), env=env(), seed=0)
     with pytest.raises(mmusv.InputError, match="seed"):
-        radar_sweep(sea.scene, pose=np.eye(4), settings=SMALL, seed=-1)
-    ret = radar_sweep(sea.scene, pose=np.eye(4), settings=SMALL, seed=0)
+        radar_sweep(RADAR, sea.scene, pose=np.eye(4), env=env(), seed=-1)
+    ret = radar_sweep(RADAR, sea.scene, pose=np.eye(4), env=env(), seed=0)
     with pytest.raises(mmusv.ConfigError, match="orientation"):
         ppi_image(ret, orientation="sideways")  # type: ignore[arg-type]
     with pytest.raises(mmusv.ConfigError, match="metres_per_pixel"):
@@ -245,7 +307,7 @@ def test_colormap_and_png(tmp_path: Path) -> None:
     from PIL import Image
 
     sea = Sea(400.0, 0.3)
-    ret = radar_sweep(sea.scene, pose=pose_at(0, 0, MAST_HEIGHT, 0.0), settings=SMALL, wave_height_m=1.0, seed=0)
+    ret = radar_sweep(RADAR, sea.scene, pose=pose_at(0, 0, MAST_HEIGHT, 0.0), env=env(waves=1.0), seed=0)
     img = ppi_image(ret, size_px=256)
     rgb = ppi_colormap(img)
     assert rgb.shape == (256, 256, 3) and rgb.dtype == np.uint8

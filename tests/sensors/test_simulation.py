@@ -334,6 +334,27 @@ def test_sensor_poses_follow_mounts(sim: Simulation) -> None:
         np.testing.assert_allclose(up_in_image, [math.cos(heading), math.sin(heading), 0.0], atol=1e-12)
 
 
+def test_capture_carries_the_sensor_mounts(sim: Simulation) -> None:
+    """Every sensor of every USV is in ``AgentCapture.sensors`` with its mount (sensor → body) and pose (sensor →
+    world) = body · mount; the mounts are the asset's mount points; the top view's mount is body⁻¹ · its pose."""
+    cap = sim.capture(4, sensors=("lidar",))
+    for agent in sim.agents:
+        ac = cap.agents[agent.id]
+        body = cap.world.matrices[agent.index]
+        assert ac.body is not None and np.array_equal(ac.body, body)
+        assert set(ac.sensors) == {"lidar", "top_view", *(f"camera/{c.name}" for c in agent.rig.cameras)}
+        asset = get_asset(agent.vessel.asset)
+        lidar = ac.sensors["lidar"]
+        np.testing.assert_allclose(lidar.mount[:3, 3], asset.mounts["lidar"].xyz, atol=1e-12)
+        for key, sm in ac.sensors.items():
+            np.testing.assert_allclose(sm.pose, body @ sm.mount, atol=1e-9, err_msg=key)
+        assert ac.lidar_pose is not None and np.array_equal(ac.sensors["lidar"].pose, ac.lidar_pose)
+        # Cameras not captured this time still have their pose; the top view hangs level above the USV.
+        assert not ac.cameras and "camera/front" in ac.sensors
+        tv = ac.sensors["top_view"]
+        np.testing.assert_allclose(tv.pose[:3, 0], [0.0, 0.0, -1.0], atol=1e-12)
+
+
 # ------------------------------------------------------------------------------------------ misconfiguration
 
 

@@ -7,11 +7,15 @@ import math
 import pytest
 
 import mmusv
-from mmusv.world.environment import Environment, Weather, sun_at, wave_height_m
+from mmusv._native import core
+from mmusv.world.environment import WAVE_PRESETS, Environment, Weather, sun_at, wave_height_m
 
 
 def test_wave_presets_and_free_height() -> None:
     assert [wave_height_m(w) for w in ("W0", "w1", "W2", "W3")] == [0.5, 1.5, 2.5, 3.5]
+    # One definition: the core's presets, in order, are what Python uses (and what the core's parser gives).
+    assert list(WAVE_PRESETS.items()) == core.wave_presets() == [("W0", 0.5), ("W1", 1.5), ("W2", 2.5), ("W3", 3.5)]
+    assert all(core.wave_height(name) == h for name, h in WAVE_PRESETS.items())
     assert wave_height_m(2.0) == 2.0
     env = Environment.make(wave="W2")
     assert env.wave_amplitude_m == 1.25

@@ -155,8 +155,15 @@ fn wave_height(wave: &Bound<'_, PyAny>) -> PyResult<f64> {
     Ok(wave_from(wave)?.height_m())
 }
 
+/// `[(name, H metres), ...]` of the wave presets W0..W3 in order: the one definition of the presets.
+#[pyfunction]
+fn wave_presets() -> Vec<(&'static str, f64)> {
+    WaveSetting::PRESETS.iter().filter_map(|w| w.preset_name().map(|n| (n, w.height_m()))).collect()
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Fleet>()?;
+    m.add_function(wrap_pyfunction!(wave_presets, m)?)?;
     m.add_function(wrap_pyfunction!(default_amplitudes, m)?)?;
     m.add_function(wrap_pyfunction!(wave_height, m)?)?;
     Ok(())

@@ -17,16 +17,18 @@ fn pinhole_intrinsics<'py>(py: Python<'py>, width: u32, height: u32, hfov: f64) 
 }
 
 /// `(width·height, 3)` float32 unit ray directions through pixel centres, camera body frame, row-major.
+/// Test and benchmark helper (private in Python: `_pinhole_directions`).
 #[pyfunction]
-#[pyo3(signature = (*, width, height, hfov))]
+#[pyo3(name = "_pinhole_directions", signature = (*, width, height, hfov))]
 fn pinhole_directions<'py>(py: Python<'py>, width: u32, height: u32, hfov: f64) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let d = detached(py, || rays::pinhole_directions(width, height, hfov))?;
     rows_to_array(py, d)
 }
 
 /// `(azimuth_steps·len(elevations), 3)` float32 unit directions of one sweep, LiDAR frame, azimuth-major.
+/// Test and benchmark helper (private in Python: `_lidar_directions`).
 #[pyfunction]
-#[pyo3(signature = (*, elevations, azimuth_steps))]
+#[pyo3(name = "_lidar_directions", signature = (*, elevations, azimuth_steps))]
 fn lidar_directions<'py>(
     py: Python<'py>,
     elevations: Vec<f64>,
@@ -69,9 +71,108 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(lidar_directions, m)?)?;
     m.add_function(wrap_pyfunction!(uniform_elevations, m)?)?;
     m.add_function(wrap_pyfunction!(lidar_trace_order, m)?)?;
+    m.add_class::<SensorEnv>()?;
     m.add_class::<Lidar>()?;
     m.add_class::<Camera>()?;
     Ok(())
+}
+
+/// What every sensor sees of the environment at a frame: sun and sky (cameras), fog (cameras, LiDAR), rain
+/// and waves (all three). Built once per scenario from the resolved environment; passed to every
+/// `Lidar.scan`, `Camera.render` and `Radar.sweep`.
+#[pyclass(frozen, module = "mmusv._core")]
+pub struct SensorEnv {
+    pub(crate) shade: ShadeEnv,
+}
+
+fn triple(v: Vec<f32>, field: &str) -> PyResult<[f32; 3]> {
+    v.try_into().map_err(|_| crate::errors::InputError::new_err(format!("{field} must have 3 components")))
+}
+
+/// `value` if finite (and `>= 0` when `nonneg`), else a `ConfigError` naming `env.<field>`.
+fn env_value(field: &str, value: f32, nonneg: bool) -> PyResult<f32> {
+    if value.is_finite() && (!nonneg || value >= 0.0) {
+        Ok(value)
+    } else {
+        let allowed = if nonneg { "a finite number >= 0" } else { "a finite number" };
+        Err(crate::errors::ConfigError::new_err(format!("invalid config env.{field} = {value}: must be {allowed}")))
+    }
+}
+
+impl SensorEnv {
+    /// The LiDAR's share: fog, rain, waves.
+    pub(crate) fn lidar(&self) -> lidar::LidarEnv {
+        let s = &self.shade;
+        lidar::LidarEnv {
+            fog_extinction_per_m: s.fog_extinction_per_m,
+            rain_mm_per_h: s.rain_mm_per_h,
+            wave_height_m: s.wave_height_m,
+        }
+    }
+}
+
+#[pymethods]
+impl SensorEnv {
+    /// Lighting in linear RGB (`sun_direction` a world-frame unit vector towards the sun), `fog_extinction_per_m`
+    /// (1/m, 3 / visibility), `rain_mm_per_h`, `wave_height_m` (significant height H), and whether cameras
+    /// cast shadow rays. Every value must be finite; intensities, fog, rain and waves `>= 0`.
+    #[new]
+    #[pyo3(signature = (*, sun_direction, sun_color, sun_intensity, ambient, sky_zenith, sky_horizon,
+        fog_extinction_per_m, fog_color, rain_mm_per_h, wave_height_m, shadows=true))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        sun_direction: Vec<f32>,
+        sun_color: Vec<f32>,
+        sun_intensity: f32,
+        ambient: f32,
+        sky_zenith: Vec<f32>,
+        sky_horizon: Vec<f32>,
+        fog_extinction_per_m: f32,
+        fog_color: Vec<f32>,
+        rain_mm_per_h: f32,
+        wave_height_m: f32,
+        shadows: bool,
+    ) -> PyResult<Self> {
+        let colours = [("sun_direction", &sun_direction), ("sun_color", &sun_color), ("sky_zenith", &sky_zenith),
+            ("sky_horizon", &sky_horizon), ("fog_color", &fog_color)];
+        for (name, v) in colours {
+            for &x in v.iter() {
+                env_value(name, x, false)?;
+            }
+        }
+        let shade = ShadeEnv {
+            sun_direction: triple(sun_direction, "sun_direction")?,
+            sun_color: triple(sun_color, "sun_color")?,
+            sun_intensity: env_value("sun_intensity", sun_intensity, true)?,
+            ambient: env_value("ambient", ambient, true)?,
+            sky_zenith: triple(sky_zenith, "sky_zenith")?,
+            sky_horizon: triple(sky_horizon, "sky_horizon")?,
+            fog_extinction_per_m: env_value("fog_extinction_per_m", fog_extinction_per_m, true)?,
+            fog_color: triple(fog_color, "fog_color")?,
+            rain_mm_per_h: env_value("rain_mm_per_h", rain_mm_per_h, true)?,
+            wave_height_m: env_value("wave_height_m", wave_height_m, true)?,
+            shadows,
+        };
+        Ok(Self { shade })
+    }
+
+    /// Atmospheric extinction, 1/m.
+    #[getter]
+    fn fog_extinction_per_m(&self) -> f32 {
+        self.shade.fog_extinction_per_m
+    }
+
+    /// Rain rate, mm/h.
+    #[getter]
+    fn rain_mm_per_h(&self) -> f32 {
+        self.shade.rain_mm_per_h
+    }
+
+    /// Significant wave height, metres.
+    #[getter]
+    fn wave_height_m(&self) -> f32 {
+        self.shade.wave_height_m
+    }
 }
 
 /// A spinning multi-channel LiDAR with its ray pattern computed once (see `mmusv_core::sensors::lidar`).
@@ -124,23 +225,21 @@ impl Lidar {
         rows_to_array(py, self.inner.pattern().to_vec())
     }
 
-    /// One sweep on the current state of `scene` from the LiDAR at `pose` (4×4 LiDAR → world). Returns a dict
+    /// One sweep on the current state of `scene` from the LiDAR at `pose` (4×4 LiDAR → world) in `env` (fog, rain
+    /// and waves are used). Returns a dict
     /// of equal-length columns: xyz (N,3) f32 LiDAR frame, range, intensity (f32), ring (u16), azimuth (f32
     /// rad), class (u16), instance (i32), ray_index (u32).
-    #[pyo3(signature = (scene, *, pose, fog_extinction_per_m, rain_mm_per_h, wave_height_m, seed))]
-    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (scene, *, pose, env, seed))]
     fn scan<'py>(
         &self,
         py: Python<'py>,
         scene: &crate::scene::Scene,
         pose: PyReadonlyArray2<'py, f64>,
-        fog_extinction_per_m: f32,
-        rain_mm_per_h: f32,
-        wave_height_m: f32,
+        env: &SensorEnv,
         seed: u64,
     ) -> PyResult<Bound<'py, PyDict>> {
         let pose = pose_arg(&pose, "pose")?;
-        let env = lidar::LidarEnv { fog_extinction_per_m, rain_mm_per_h, wave_height_m };
+        let env = env.lidar();
         let s = scene.read(|s| detached(py, || self.inner.scan(s, &pose, &env, seed)))?;
         let d = PyDict::new(py);
         d.set_item("xyz", rows_to_array(py, s.xyz)?)?;
@@ -155,23 +254,22 @@ impl Lidar {
     }
 }
 
-/// A pinhole or orthographic camera with its rays computed once (see `mmusv_core::sensors::camera`).
+/// A pinhole or orthographic camera with its rays computed once (see `mmusv_core::sensors::camera`), and
+/// whether it shades RGB (depth, semantic and instance images are always produced).
 #[pyclass(frozen, module = "mmusv._core")]
 pub struct Camera {
     inner: camera::Camera,
-}
-
-fn triple(v: Vec<f32>, field: &str) -> PyResult<[f32; 3]> {
-    v.try_into().map_err(|_| crate::errors::InputError::new_err(format!("{field} must have 3 components")))
+    rgb: bool,
 }
 
 #[pymethods]
 impl Camera {
     #[new]
-    #[pyo3(signature = (*, width, height, hfov=None, metres_per_pixel=None, range_max=f32::INFINITY))]
+    #[pyo3(signature = (*, width, height, rgb, hfov=None, metres_per_pixel=None, range_max=f32::INFINITY))]
     fn new(
         width: u32,
         height: u32,
+        rgb: bool,
         hfov: Option<f64>,
         metres_per_pixel: Option<f64>,
         range_max: f32,
@@ -186,7 +284,13 @@ impl Camera {
             }
         };
         let cfg = camera::CameraConfig { width, height, projection, range_max };
-        Ok(Self { inner: camera::Camera::new(cfg).map_err(crate::errors::to_py)? })
+        Ok(Self { inner: camera::Camera::new(cfg).map_err(crate::errors::to_py)?, rgb })
+    }
+
+    /// Whether `render` shades an RGB image.
+    #[getter]
+    fn rgb(&self) -> bool {
+        self.rgb
     }
 
     /// `[fx, fy, cx, cy]` in pixels for a pinhole camera, `None` for an orthographic one.
@@ -212,47 +316,21 @@ impl Camera {
         Ok((rows_to_array(py, o)?, rows_to_array(py, d)?))
     }
 
-    /// Renders the current state of `scene` from `pose` (4×4 camera body → world). Returns a dict: depth
-    /// (H,W) f32 metres along the axis (inf = sky), semantic (H,W) u16, instance (H,W) i32 (−1 = sky) and, if
-    /// `rgb`, rgb (H,W,3) u8 sRGB. Lighting keywords are the fields of `ShadeEnv` (linear colours, world-frame
-    /// sun direction).
-    #[pyo3(signature = (scene, *, pose, rgb, seed, sun_direction, sun_color, sun_intensity, ambient, sky_zenith,
-        sky_horizon, fog_extinction_per_m, fog_color, rain_mm_per_h, wave_height_m, shadows=true))]
-    #[allow(clippy::too_many_arguments)]
+    /// Renders the current state of `scene` from `pose` (4×4 camera body → world) in `env`. Returns a dict:
+    /// depth (H,W) f32 metres along the axis (inf = sky), semantic (H,W) u16, instance (H,W) i32 (−1 = sky) and,
+    /// for a camera built with `rgb=True`, rgb (H,W,3) u8 sRGB.
+    #[pyo3(signature = (scene, *, pose, env, seed))]
     fn render<'py>(
         &self,
         py: Python<'py>,
         scene: &crate::scene::Scene,
         pose: PyReadonlyArray2<'py, f64>,
-        rgb: bool,
+        env: &SensorEnv,
         seed: u64,
-        sun_direction: Vec<f32>,
-        sun_color: Vec<f32>,
-        sun_intensity: f32,
-        ambient: f32,
-        sky_zenith: Vec<f32>,
-        sky_horizon: Vec<f32>,
-        fog_extinction_per_m: f32,
-        fog_color: Vec<f32>,
-        rain_mm_per_h: f32,
-        wave_height_m: f32,
-        shadows: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let pose = pose_arg(&pose, "pose")?;
-        let env = ShadeEnv {
-            sun_direction: triple(sun_direction, "sun_direction")?,
-            sun_color: triple(sun_color, "sun_color")?,
-            sun_intensity,
-            ambient,
-            sky_zenith: triple(sky_zenith, "sky_zenith")?,
-            sky_horizon: triple(sky_horizon, "sky_horizon")?,
-            fog_extinction_per_m,
-            fog_color: triple(fog_color, "fog_color")?,
-            rain_mm_per_h,
-            wave_height_m,
-            shadows,
-        };
-        let f = scene.read(|s| detached(py, || self.inner.render(s, &pose, &env, rgb, seed)))?;
+        let (env, rgb) = (&env.shade, self.rgb);
+        let f = scene.read(|s| detached(py, || self.inner.render(s, &pose, env, rgb, seed)))?;
         let (w, h) = (f.width as usize, f.height as usize);
         let shape_err = |e: numpy::ndarray::ShapeError| crate::errors::InternalError::new_err(e.to_string());
         let d = PyDict::new(py);

@@ -34,7 +34,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     g.add_argument("--split", default="0.7,0.15,0.15", help="train,validate,test fractions, by recording (default 0.7,0.15,0.15)")
     g.add_argument("--no-split", action="store_true", help="no train/validate/test folders: scenarios directly in the output")
     p.add_argument("--seed", type=int, default=0, help="seed of the split (default 0)")
-    p.add_argument("--range", type=float, default=200.0, dest="range_m", help="evaluation range in metres: targets within ±R (default 200)")
+    p.add_argument("--range", type=float, default=200.0, dest="range_m", help="evaluation range in metres: targets within R in BEV (default 200)")
     p.add_argument("--include-usvs", action="store_true", help="list the other USVs as targets too (default: not, as in the paper)")
     p.add_argument("--extras", default=",".join(DEFAULT_EXTRAS),
                    help=f"extra files, comma-separated from {','.join(EXTRAS)}; empty for none (default {','.join(DEFAULT_EXTRAS)})")

@@ -158,8 +158,8 @@ def convert(
         to: ``"opv2v"`` or ``"kitti"``.
         splits: ``(train, validate, test)`` fractions (split per recording, shuffled with ``seed``) or ``None``
             for one folder of scenarios.
-        eval_range_m: targets are vessels whose box centre lies within ±``eval_range_m`` (x and y) of the agent's
-            LiDAR.
+        eval_range_m: targets are vessels whose box centre lies within ``eval_range_m`` of the agent's LiDAR in
+            bird's-eye view (:func:`mmusv.annotate.in_target_range`).
         include_usvs: list the other USVs as targets too (default: only non-instrumented vessels).
         extras: any of ``depth``, ``semantic``, ``instance``, ``radar``, ``top_view`` (extra files stock loaders
             skip).

@@ -11,8 +11,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mmusv.recording.reader import AgentInfo, WorldFrame
+from mmusv.annotate import in_target_range
 from mmusv.frames import invert, pose_matrices
+from mmusv.recording.reader import AgentInfo, WorldFrame
 
 __all__ = ["AgentView", "Target", "agent_view", "targets_of"]
 
@@ -55,8 +56,8 @@ def agent_view(agent: AgentInfo, world: WorldFrame) -> AgentView:
 
 def targets_of(view: AgentView, world: WorldFrame, *, eval_range_m: float, include_usvs: bool) -> list[Target]:
     """The targets of ``view``'s agent, in world-state order: every vessel but the agent itself (and other USVs
-    unless ``include_usvs``) whose box centre lies within ``|x|, |y| <= eval_range_m`` in the agent's LiDAR frame
-    (its body frame when it has no LiDAR)."""
+    unless ``include_usvs``) whose box centre lies within ``eval_range_m`` of the agent's LiDAR (its body frame
+    when it has no LiDAR) by the one target rule, :func:`mmusv.annotate.in_target_range` (BEV distance)."""
     ref = view.lidar if view.lidar is not None else view.body
     ref_inv = invert(ref)
     out: list[Target] = []
@@ -67,7 +68,7 @@ def targets_of(view: AgentView, world: WorldFrame, *, eval_range_m: float, inclu
         box = mats[i].copy()
         box[:3, 3] = world.box_centers[i]
         in_lidar = ref_inv @ box
-        if abs(in_lidar[0, 3]) > eval_range_m or abs(in_lidar[1, 3]) > eval_range_m:
+        if not in_target_range(in_lidar[:3, 3], eval_range_m):
             continue
         out.append(Target(
             index=i, id=vid, asset=world.assets[i], role=world.roles[i], semantic_class=int(world.classes[i]),

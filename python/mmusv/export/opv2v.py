@@ -197,7 +197,7 @@ class Opv2vWriter(DatasetWriter):
                          "mmusv's right-handed frames (world x east, y north, z up; body x forward, y left, z up) with y mirrored",
                 "cavs": {cav_id(a.index): a.id for a in self.agents},
                 "eval_range_m": o.eval_range_m,
-                "gt_filter": "vehicles: every vessel whose box centre has |x| <= eval_range_m and |y| <= eval_range_m "
+                "gt_filter": "vehicles: every vessel whose box centre has hypot(x, y) <= eval_range_m "
                              "in the agent's LiDAR frame; the agent itself never, other USVs only if include_usvs",
                 "include_usvs": o.include_usvs,
                 "extras": list(o.extras),

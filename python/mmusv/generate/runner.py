@@ -129,13 +129,13 @@ def generate(
     unless ``force``) and writes ``report.json`` there; returns the report."""
     spec = load_spec(spec_source)
     out = Path(out_dir)
-    contexts = [map_context(m.type, m.seed, dict(m.params)) for m in (spec.map_of(c) for c in spec.combinations)]
+    contexts = [map_context(m.type, m.seed, m.param_values()) for m in (spec.map_of(c) for c in spec.combinations)]
     constraints = build_constraints(spec)
     _prepare_dir(out, force)
     report = RunReport(
         spec_name=spec.name,
         seed=spec.seed,
-        map={"type": spec.map.type, "seed": spec.map.seed, "params": dict(sorted(spec.map.params.items()))},
+        map={"type": spec.map.type, "seed": spec.map.seed, "params": spec.map.param_values()},
         constraints=[c.name for c in constraints],
     )
     total_attempts = 0

@@ -197,7 +197,7 @@ def sample_candidate(spec: GenerationSpec, combo_index: int, attempt: int, ctx: 
     data: dict[str, Any] = {
         "name": name,
         "seed": scenario_seed(spec.seed, combo_index, attempt),
-        "map": {"type": map_cfg.type, "seed": map_cfg.seed, "params": dict(sorted(map_cfg.params.items()))},
+        "map": {"type": map_cfg.type, "seed": map_cfg.seed, "params": map_cfg.param_values()},
         "environment": env,
         "acquisition": {"frequency_hz": acq.frequency_hz, "frames": acq.frames},
         "rigs": {spec.rig: dict(spec.rigs[spec.rig])},

@@ -65,7 +65,7 @@ class FrameRecorder:
         for a in sim.agents:
             cams = {}
             for name, (cam, cfg, mount) in a.cameras.items():
-                cams[name] = {"resolution": list(cfg.resolution), "hfov_deg": cfg.hfov_deg, "intrinsics": list(cam.intrinsics),
+                cams[name] = {"resolution": list(cfg.resolution), "hfov_deg": cfg.hfov_deg, "intrinsics": list(cam.intrinsics or ()),
                               "mount_in_body": np.round(mount, 9).tolist(), "outputs": list(cfg.outputs)}
             sensors[a.id] = {
                 "asset": a.asset.name,

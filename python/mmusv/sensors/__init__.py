@@ -5,9 +5,11 @@ All of them run in the Rust core on one frozen scene state. Configuration lives 
 :class:`mmusv.Scene` with a sensor pose given directly.
 """
 
-from mmusv.sensors.camera import CameraImages, camera_from_config, render, shading_kwargs, top_view_from_config
+from mmusv.sensors.camera import CameraImages, camera_from_config, render, top_view_from_config
 from mmusv.sensors.config import CameraConfig, LidarConfig, Mount, RadarConfig, RigConfig, TopViewConfig
+from mmusv.sensors.env import sensor_env
 from mmusv.sensors.lidar import LidarPoints, lidar_from_config, scan
+from mmusv.sensors.radar import RadarReturns, ppi_image, radar_from_config, radar_sweep
 
 __all__ = [
     "CameraConfig",
@@ -16,12 +18,16 @@ __all__ = [
     "LidarPoints",
     "Mount",
     "RadarConfig",
+    "RadarReturns",
     "RigConfig",
     "TopViewConfig",
     "camera_from_config",
     "lidar_from_config",
+    "ppi_image",
+    "radar_from_config",
+    "radar_sweep",
     "render",
     "scan",
-    "shading_kwargs",
+    "sensor_env",
     "top_view_from_config",
 ]

@@ -8,8 +8,6 @@ model.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
-
 import numpy as np
 import numpy.typing as npt
 
@@ -48,7 +46,7 @@ class LidarPoints:
         return int(self.xyz.shape[0])
 
 
-def lidar_from_config(cfg: LidarConfig) -> Any:
+def lidar_from_config(cfg: LidarConfig) -> core.Lidar:
     """The native LiDAR (pattern computed once) for ``cfg``."""
     return core.Lidar(
         elevations=cfg.elevations_rad(),
@@ -64,27 +62,12 @@ def lidar_from_config(cfg: LidarConfig) -> Any:
     )
 
 
-def scan(
-    lidar: Any,
-    scene: Scene,
-    *,
-    pose: npt.ArrayLike,
-    seed: int,
-    fog_extinction_per_m: float = 0.0,
-    rain_mm_per_h: float = 0.0,
-    wave_height_m: float = 0.0,
-) -> LidarPoints:
+def scan(lidar: core.Lidar, scene: Scene, *, pose: npt.ArrayLike, env: core.SensorEnv, seed: int) -> LidarPoints:
     """One sweep of ``lidar`` (from :func:`lidar_from_config`) at ``pose`` (``(4, 4)`` LiDAR → world) on the
-    current state of ``scene``. ``seed`` drives noise, dropout and water returns."""
+    current state of ``scene`` in ``env`` (:func:`mmusv.sensors.env.sensor_env`: fog, rain and waves are used).
+    ``seed`` drives noise, dropout and water returns."""
     p = np.ascontiguousarray(pose, dtype=np.float64).reshape(4, 4)
-    d = lidar.scan(
-        scene.native,
-        pose=p,
-        fog_extinction_per_m=float(fog_extinction_per_m),
-        rain_mm_per_h=float(rain_mm_per_h),
-        wave_height_m=float(wave_height_m),
-        seed=int(seed),
-    )
+    d = lidar.scan(scene.native, pose=p, env=env, seed=int(seed))
     return LidarPoints(
         xyz=d["xyz"], range=d["range"], intensity=d["intensity"], ring=d["ring"], azimuth=d["azimuth"],
         semantic_class=d["class"], instance=d["instance"], ray_index=d["ray_index"],

@@ -10,12 +10,16 @@ is documented in the Rust module ``mmusv_core::sensors::radar_model``.
 
 Intensity unit: linear, relative to the echo of a 1 m² target at 1 km in clear air (``0.01`` = −20 dB).
 Frames: the sensor frame is x forward, y left, z up; azimuth 0 is forward, counter-clockwise, in ``[0, 2π)``.
-Everything is deterministic for a given scene, pose, settings and ``seed`` (clutter and range noise are the
-only random parts).
+Everything is deterministic for a given scene, pose, configuration, environment and ``seed`` (clutter and
+range noise are the only random parts).
+
+Configuration: :class:`mmusv.sensors.config.RadarConfig` is the one definition of every knob, its defaults and
+its limits; :func:`radar_from_config` binds it once to the core's radar.
 
 Example::
 
-    ret = radar_sweep(scene, pose=mast_pose, settings=RadarSettings(range_m=2000), wave_height_m=1.25, seed=0)
+    radar = radar_from_config(RadarConfig(range_m=2000))
+    ret = radar_sweep(radar, scene, pose=mast_pose, env=sensor_env(wave_height_m=1.25), seed=0)
     img = ppi_image(ret, size_px=512, metres_per_pixel=8.0)  # (512, 512) float32, north up
     ppi_png("ppi.png", img)
 """
@@ -26,119 +30,44 @@ import math
 import os
 import tempfile
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Literal
 
 import numpy as np
 import numpy.typing as npt
 
 from mmusv._native import core
-from mmusv.errors import ConfigError, InputError
+from mmusv.errors import InputError
 from mmusv.scene import Scene, _pose
+from mmusv.sensors.config import RadarConfig
 
-__all__ = ["RadarSettings", "RadarReturns", "Orientation", "radar_sweep", "ppi_image", "ppi_colormap", "ppi_png"]
+__all__ = ["RadarReturns", "Orientation", "radar_from_config", "radar_sweep", "ppi_image", "ppi_colormap", "ppi_png"]
 
 Orientation = Literal["north_up", "head_up"]
 """Which way is up in a PPI: world north, or the sensor's forward axis."""
 
-# Core config field -> RadarSettings field, so that errors name the field the user set.
-_SETTINGS_NAME = {
-    "radar.range_max_m": "range_m",
-    "radar.range_min_m": "min_range_m",
-    "radar.beamwidth_az_rad": "beamwidth_deg",
-    "radar.elevation_fan_rad": "elevation_fan_deg",
-    "radar.horizon_band_rad": "horizon_band_deg",
-    "radar.clutter.sea_sigma0_at_1m": "sea_clutter_sigma0",
-    "radar.clutter.critical_range_per_m": "clutter_critical_range_per_m",
-    "radar.clutter.sea_max_range_m": "sea_clutter_max_range_m",
-    "radar.clutter.rain_eta_at_1mm_h": "rain_clutter_eta",
-}
 
-
-def _real(name: str, value: Any) -> float:
-    """``value`` as a float, or a :class:`ConfigError` naming ``name`` (e.g. ``radar.range_m``)."""
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise ConfigError(f"invalid config {name} = {value!r}: must be a real number")
-    return float(value)
-
-
-def _count(name: str, value: Any) -> int:
-    """``value`` as a uint32, or a :class:`ConfigError` naming ``name``."""
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 0 <= int(value) < 2**32:
-        raise ConfigError(f"invalid config {name} = {value!r}: must be a non-negative integer below 2**32")
-    return int(value)
-
-
-@dataclass(frozen=True)
-class RadarSettings:
-    """Every knob of the radar, in user units. Validated when a sweep runs (a bad value raises
-    :class:`mmusv.ConfigError` naming the field).
-
-    Attributes:
-        range_m: instrumented range, metres (``<= 100 km``).
-        min_range_m: blind range, metres (hides the own ship), ``0 <= min_range_m < range_m``.
-        range_resolution_m: range bin size, metres (``> 0``).
-        azimuth_bins: beams per revolution (``1..65536``).
-        beamwidth_deg: horizontal beamwidth, degrees, in ``(0, 90]``.
-        elevation_fan_deg: vertical fan ``(lower, upper)``, degrees, strictly within ``(-90, 90)``.
-        rays_az: rays per beam across the beamwidth (``>= 1``).
-        rays_el: rays per beam over the elevation fan (``>= 1``); ``azimuth_bins · rays_az · rays_el <= 2²⁴``.
-            Far, low targets are hit by few rays; raise it for steadier detection of small boats at km range.
-        horizon_fraction: share of the elevation rays spread over the band around the sea horizon (which follows
-            the sensor's roll and pitch), the rest over the remaining fan; ``0..1``, 0 = uniform over the fan.
-            Rays are weighted by the fan height they stand for, so intensities do not depend on it.
-        horizon_band_deg: half-height of that band, degrees (``0..45``).
-        detection_threshold: smallest reported intensity (``>= 0``; 1.0 = a 1 m² target at 1 km).
-        range_noise_std_m: Gaussian noise on the reported range, metres (``>= 0``).
-        sea_clutter_sigma0: sea-clutter σ⁰ (m²/m²) at 1 m wave height (scales with height²); 0 disables.
-        clutter_critical_range_per_m: metres of critical range per metre of wave height (sea clutter falls as
-            r⁻⁷ beyond it, r⁻³ before).
-        sea_clutter_max_range_m: no sea clutter beyond this range, metres.
-        rain_clutter_eta: rain volume reflectivity (m²/m³) at 1 mm/h (scales with rate^1.6); 0 disables.
-    """
-
-    range_m: float = 3000.0
-    min_range_m: float = 10.0
-    range_resolution_m: float = 3.0
-    azimuth_bins: int = 2048
-    beamwidth_deg: float = 1.2
-    elevation_fan_deg: tuple[float, float] = (-10.0, 10.0)
-    rays_az: int = 3
-    rays_el: int = 16
-    horizon_fraction: float = 0.75
-    horizon_band_deg: float = 1.0
-    detection_threshold: float = 0.01
-    range_noise_std_m: float = 0.0
-    sea_clutter_sigma0: float = 4.0e-6
-    clutter_critical_range_per_m: float = 300.0
-    sea_clutter_max_range_m: float = 2500.0
-    rain_clutter_eta: float = 5.0e-9
-
-    def core_kwargs(self) -> dict[str, Any]:
-        """The keyword arguments of ``mmusv._core.radar_sweep`` (SI units, radians)."""
-        fan = self.elevation_fan_deg
-        if not isinstance(fan, (tuple, list)) or len(fan) != 2:
-            raise ConfigError(f"invalid config radar.elevation_fan_deg = {fan!r}: must be (lower, upper) degrees")
-        return {
-            "range_min_m": _real("radar.min_range_m", self.min_range_m),
-            "range_max_m": _real("radar.range_m", self.range_m),
-            "range_resolution_m": _real("radar.range_resolution_m", self.range_resolution_m),
-            "azimuth_bins": _count("radar.azimuth_bins", self.azimuth_bins),
-            "beamwidth_az_rad": math.radians(_real("radar.beamwidth_deg", self.beamwidth_deg)),
-            "elevation_fan_rad": (
-                math.radians(_real("radar.elevation_fan_deg", fan[0])),
-                math.radians(_real("radar.elevation_fan_deg", fan[1])),
-            ),
-            "rays_az": _count("radar.rays_az", self.rays_az),
-            "rays_el": _count("radar.rays_el", self.rays_el),
-            "horizon_fraction": _real("radar.horizon_fraction", self.horizon_fraction),
-            "horizon_band_rad": math.radians(_real("radar.horizon_band_deg", self.horizon_band_deg)),
-            "detection_threshold": _real("radar.detection_threshold", self.detection_threshold),
-            "range_noise_std_m": _real("radar.range_noise_std_m", self.range_noise_std_m),
-            "sea_sigma0_at_1m": _real("radar.sea_clutter_sigma0", self.sea_clutter_sigma0),
-            "critical_range_per_m": _real("radar.clutter_critical_range_per_m", self.clutter_critical_range_per_m),
-            "sea_max_range_m": _real("radar.sea_clutter_max_range_m", self.sea_clutter_max_range_m),
-            "rain_eta_at_1mm_h": _real("radar.rain_clutter_eta", self.rain_clutter_eta),
-        }
+def radar_from_config(cfg: RadarConfig) -> core.Radar:
+    """The native radar for ``cfg`` (degrees become radians; the core checks everything again as a last guard,
+    naming ``radar.<core field>``, which a validated ``cfg`` never trips)."""
+    lo, hi = cfg.elevation_fan_deg
+    return core.Radar(
+        range_min_m=cfg.min_range_m,
+        range_max_m=cfg.range_m,
+        range_resolution_m=cfg.range_resolution_m,
+        azimuth_bins=cfg.azimuth_bins,
+        beamwidth_az_rad=math.radians(cfg.beamwidth_deg),
+        elevation_fan_rad=(math.radians(lo), math.radians(hi)),
+        rays_az=cfg.rays_az,
+        rays_el=cfg.rays_el,
+        horizon_fraction=cfg.horizon_fraction,
+        horizon_band_rad=math.radians(cfg.horizon_band_deg),
+        detection_threshold=cfg.detection_threshold,
+        range_noise_std_m=cfg.range_noise_std_m,
+        sea_sigma0_at_1m=cfg.sea_clutter_sigma0,
+        critical_range_per_m=cfg.clutter_critical_range_per_m,
+        sea_max_range_m=cfg.sea_clutter_max_range_m,
+        rain_eta_at_1mm_h=cfg.rain_clutter_eta,
+    )
 
 
 @dataclass(frozen=True, eq=False)
@@ -156,7 +85,7 @@ class RadarReturns:
         semantic_class: ``(N,)`` uint16, class of that echo (:mod:`mmusv.classes`); WATER (1) for sea
             clutter, NONE (0) for rain clutter.
         pose: ``(4, 4)`` float64 sensor → world pose of the sweep.
-        settings: the settings of the sweep.
+        radar: the radar that swept (its range and bins size the PPI).
     """
 
     range: npt.NDArray[np.float32]
@@ -166,7 +95,7 @@ class RadarReturns:
     instance_id: npt.NDArray[np.int32]
     semantic_class: npt.NDArray[np.uint16]
     pose: npt.NDArray[np.float64]
-    settings: RadarSettings
+    radar: core.Radar
 
     def __len__(self) -> int:
         return int(self.range.shape[0])
@@ -196,40 +125,22 @@ class RadarReturns:
 
 
 def radar_sweep(
-    scene: Scene,
-    *,
-    pose: npt.ArrayLike,
-    settings: RadarSettings | None = None,
-    wave_height_m: float = 0.0,
-    rain_mm_per_h: float = 0.0,
-    seed: int,
+    radar: core.Radar, scene: Scene, *, pose: npt.ArrayLike, env: core.SensorEnv, seed: int
 ) -> RadarReturns:
-    """One full revolution of the radar at ``pose`` (``(4, 4)`` sensor → world; sensor x forward, y left,
-    z up) in ``scene``, with sea clutter for waves of ``wave_height_m`` metres (0..30; e.g. W0 = 0.5,
-    W3 = 3.5) and rain of ``rain_mm_per_h`` (0..500). Releases the GIL and uses every core.
+    """One full revolution of ``radar`` (:func:`radar_from_config`) at ``pose`` (``(4, 4)`` sensor → world;
+    sensor x forward, y left, z up) in ``scene``, with sea clutter for the wave height of ``env``
+    (:func:`mmusv.sensors.env.sensor_env`; 0..30 m, e.g. W0 = 0.5, W3 = 3.5) and its rain (0..500 mm/h).
+    Releases the GIL and uses every core.
 
-    Raises :class:`mmusv.ConfigError` naming the field for bad settings, :class:`mmusv.InputError` for a
-    bad pose or seed.
+    Raises :class:`mmusv.ConfigError` for waves or rain out of range, :class:`mmusv.InputError` for a bad pose
+    or seed.
     """
-    s = RadarSettings() if settings is None else settings
-    if not isinstance(s, RadarSettings):
-        raise InputError(f"settings must be a RadarSettings, got {type(s).__name__}")
     if not isinstance(scene, Scene):
         raise InputError(f"scene must be an mmusv.Scene, got {type(scene).__name__}")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) < 2**64:
         raise InputError(f"seed must be an integer in 0..2**64, got {seed!r}")
     p = _pose(pose, name="pose")
-    kwargs = s.core_kwargs()
-    waves = _real("radar.wave_height_m", wave_height_m)
-    rain = _real("radar.rain_mm_per_h", rain_mm_per_h)
-    try:
-        out = core.radar_sweep(scene.native, pose=p, **kwargs, wave_height_m=waves, rain_mm_per_h=rain, seed=int(seed))
-    except ConfigError as exc:
-        msg = str(exc)
-        for core_name, name in _SETTINGS_NAME.items():
-            if core_name in msg:
-                raise ConfigError(f"RadarSettings.{name}: {msg}") from None
-        raise
+    out = radar.sweep(scene.native, pose=p, env=env, seed=int(seed))
     return RadarReturns(
         range=out["range"],
         azimuth=out["azimuth"],
@@ -238,7 +149,7 @@ def radar_sweep(
         instance_id=out["instance"],
         semantic_class=out["class"],
         pose=p,
-        settings=s,
+        radar=radar,
     )
 
 
@@ -249,24 +160,24 @@ def ppi_image(
     metres_per_pixel: float | None = None,
     orientation: Orientation = "north_up",
     sensor_yaw: float | None = None,
-    settings: RadarSettings | None = None,
 ) -> npt.NDArray[np.float32]:
     """The ``(size_px, size_px)`` float32 plan-position image of ``returns``: ego at pixel
     ``(size_px // 2, size_px // 2)``, row 0 at the top (north for ``"north_up"``, ahead for ``"head_up"``),
     each return painted over its range-bin × azimuth-bin polar cell with max compositing; 0 where nothing.
 
     The scale is fixed: a return at range R lies ``R / metres_per_pixel`` pixels from the centre in every
-    frame. ``metres_per_pixel`` defaults to ``settings.range_m / (size_px // 2)`` (the full range fills the
-    image); ``sensor_yaw`` (radians, for north-up) defaults to the sweep pose's yaw; ``settings`` (cell
-    size) to the sweep's.
+    frame. ``metres_per_pixel`` defaults to the radar's range over ``size_px // 2`` (the full range fills the
+    image); ``sensor_yaw`` (radians, for north-up) defaults to the sweep pose's yaw. Bad values raise
+    :class:`mmusv.ConfigError` naming ``ppi.<field>``.
     """
-    s = returns.settings if settings is None else settings
-    size = _count("ppi.size_px", size_px)
-    mpp = s.range_m / max(size // 2, 1) if metres_per_pixel is None else _real("ppi.metres_per_pixel", metres_per_pixel)
-    yaw = returns.sensor_yaw if sensor_yaw is None else _real("sensor_yaw", sensor_yaw)
-    kw = s.core_kwargs()
+    radar = returns.radar
+    if isinstance(size_px, bool) or not isinstance(size_px, (int, np.integer)) or not 0 <= int(size_px) < 2**32:
+        raise InputError(f"size_px must be a non-negative integer below 2**32, got {size_px!r}")
+    size = int(size_px)
+    mpp = radar.range_max_m / max(size // 2, 1) if metres_per_pixel is None else float(metres_per_pixel)
+    yaw = returns.sensor_yaw if sensor_yaw is None else float(sensor_yaw)
     return np.asarray(
-        core.ppi_image(
+        radar.ppi_image(
             range=np.ascontiguousarray(returns.range, dtype=np.float32),
             azimuth=np.ascontiguousarray(returns.azimuth, dtype=np.float32),
             intensity=np.ascontiguousarray(returns.intensity, dtype=np.float32),
@@ -274,8 +185,6 @@ def ppi_image(
             metres_per_pixel=mpp,
             orientation=orientation,
             sensor_yaw=yaw,
-            range_resolution_m=kw["range_resolution_m"],
-            azimuth_bins=kw["azimuth_bins"],
         )
     )
 

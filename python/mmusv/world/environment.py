@@ -20,12 +20,14 @@ import re
 from dataclasses import dataclass
 from typing import Literal
 
+from mmusv._native import core
 from mmusv.errors import ConfigError
 
 __all__ = ["WAVE_PRESETS", "Sun", "Weather", "Environment", "wave_height_m", "sun_at"]
 
-WAVE_PRESETS: dict[str, float] = {"W0": 0.5, "W1": 1.5, "W2": 2.5, "W3": 3.5}
-"""Significant wave height H in metres of each preset (paper, Table I)."""
+WAVE_PRESETS: dict[str, float] = dict(core.wave_presets())
+"""Significant wave height H in metres of each preset (paper, Table I), in order W0..W3: read from the core
+(``mmusv_core::kinematics::waves::WaveSetting::PRESETS``), their one definition."""
 
 WeatherKind = Literal["clear", "overcast", "fog", "rain"]
 _WEATHER: tuple[str, ...] = ("clear", "overcast", "fog", "rain")

@@ -1,16 +1,19 @@
-"""Parameters of the procedural maps: one frozen dataclass per kind, validated on construction.
+"""Parameters of the procedural maps: one frozen pydantic model per kind, the one definition of every knob.
 
-Every length is metres. A bad value raises :class:`MapConfigError` (a ``ValueError`` and an
-``mmusv.ConfigError``) naming the field and what is allowed; YAML-style lists are accepted for pairs.
+Every length is metres. In a scenario they sit under ``map.params`` and are checked when the scenario loads
+(:class:`mmusv.config.MapConfig` picks the model by ``map.type``), so an error names ``map.params.<field>``.
+From Python, :func:`make_params` (and :func:`mmusv.world.maps.generate_map`) raise :class:`MapConfigError` (a
+``ValueError`` and an ``mmusv.ConfigError``) naming the field and what is allowed. YAML-style lists are accepted
+for pairs. Knobs whose range depends on others (``grid_m`` on ``extent_m``, the port layout on the harbour) are
+checked by validators that run in field order, so every error still names its field.
 """
 
 from __future__ import annotations
 
-import dataclasses
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, StrictBool, ValidationError, ValidationInfo, field_validator
 
 from mmusv.errors import ConfigError
 
@@ -23,10 +26,13 @@ __all__ = [
     "OpenSeaParams",
     "PortParams",
     "MapParams",
+    "PARAM_MODELS",
     "make_params",
 ]
 
 MAP_KINDS = ("island", "open_sea", "port")
+_Berth = tuple[str, float, float]
+COAST_SIDES = ("north", "south", "east", "west")
 DEFAULT_MOORED_ASSETS: tuple[tuple[str, float, float], ...] = (
     # (asset name in the vessel library, length overall m, beam m), figures as in vessel_catalog.yaml
     ("container_ship_300m", 300.0, 48.2),
@@ -49,131 +55,132 @@ class MapConfigError(ConfigError, ValueError):  # type: ignore[misc,unused-ignor
         self.allowed = allowed
 
 
-# ---------------------------------------------------------------------------------------------- parameters
+def _within(value: float, lo: float, hi: float, *, integer: bool = False) -> float:
+    """``value`` if ``lo <= value <= hi``, else a ``ValueError`` saying the range."""
+    if not lo <= value <= hi:
+        kind = "an integer" if integer else "a number"
+        raise ValueError(f"must be {kind} in [{lo:g}, {hi:g}]")
+    return value
 
 
-def _num(obj: object, name: str, lo: float, hi: float, *, integer: bool = False) -> None:
-    v = getattr(obj, name)
-    kind = "an integer" if integer else "a number"
-    ok_type = isinstance(v, (int, np.integer)) if integer else isinstance(v, (int, float, np.integer, np.floating))
-    if isinstance(v, bool) or not ok_type or not np.isfinite(v) or not lo <= v <= hi:
-        raise MapConfigError(name, v, f"{kind} in [{lo:g}, {hi:g}]")
-    object.__setattr__(obj, name, int(v) if integer else float(v))
+def _pair(value: tuple[float, float], lo: float, hi: float) -> tuple[float, float]:
+    """``(a, b)`` if ``lo <= a <= b <= hi``, else a ``ValueError`` saying so."""
+    a, b = value
+    if not lo <= a <= b <= hi:
+        raise ValueError(f"must be two numbers [a, b] with {lo:g} <= a <= b <= {hi:g}")
+    return value
 
 
-def _pair(obj: object, name: str, lo: float, hi: float) -> None:
-    v = getattr(obj, name)
-    allowed = f"two numbers [a, b] with {lo:g} <= a <= b <= {hi:g}"
-    try:
-        a, b = (float(x) for x in v)
-    except (TypeError, ValueError):
-        raise MapConfigError(name, v, allowed) from None
-    if any(isinstance(x, bool) for x in v) or not (np.isfinite(a) and np.isfinite(b) and lo <= a <= b <= hi):
-        raise MapConfigError(name, v, allowed)
-    object.__setattr__(obj, name, (a, b))
+def _known(info: ValidationInfo, *names: str) -> bool:
+    """Whether every field in ``names`` validated (a field that failed is reported on its own)."""
+    return all(n in info.data and info.data[n] is not None for n in names)
 
 
-def _resolved(value: float | None) -> float:
-    if value is None:  # pragma: no cover - callers resolve first
-        raise RuntimeError("unresolved map parameter")
-    return float(value)
-
-
-@dataclass(frozen=True)
-class _CommonParams:
+class _CommonParams(BaseModel):
     """Parameters shared by every map kind (metres)."""
 
-    extent_m: float = 2000.0
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, validate_default=True)
+
+    extent_m: float = Field(default=2000.0, ge=200.0, le=20000.0)
     """Side of the square map."""
-    grid_m: float = 5.0
+    grid_m: float = Field(default=5.0, ge=1.0, le=20.0)
     """Terrain heightfield spacing (effective value: ``extent_m / round(extent_m / grid_m)``)."""
-    prior_resolution_m: float = 5.0
+    prior_resolution_m: float = Field(default=5.0, ge=0.5, le=50.0)
     """Prior raster cell size (effective value: ``extent_m / round(extent_m / prior_resolution_m)``)."""
-    draft_margin_m: float = 2.0
+    draft_margin_m: float = Field(default=2.0, ge=0.0, le=20.0)
     """Terrain shallower than this below the surface is not navigable."""
-    clearance_m: float = 30.0
-    """Shore / structure / map-edge clearance of the valid sampling zones."""
-    occlusion_height_m: float = 3.0
+    clearance_m: float = Field(default=30.0, ge=0.0)
+    """Shore / structure / map-edge clearance of the valid sampling zones (at most ``extent_m / 4``)."""
+    occlusion_height_m: float = Field(default=3.0, ge=0.5, le=100.0)
     """Terrain and structures higher than this block line of sight in the priors."""
-    n_buoys: int = 0
+    n_buoys: int = Field(default=0, ge=0, le=500)
     """Extra free-standing buoys placed at random in open water (at most this many)."""
 
-    def _validate(self) -> None:
-        _num(self, "extent_m", 200.0, 20000.0)
-        _num(self, "grid_m", 1.0, 20.0)
-        if (self.extent_m / self.grid_m) ** 2 > 4.0e6:
-            raise MapConfigError("grid_m", self.grid_m, f">= extent_m / 2000 = {self.extent_m / 2000.0:g}")
-        _num(self, "prior_resolution_m", 0.5, 50.0)
-        if self.extent_m / self.prior_resolution_m > 8000.0:
-            raise MapConfigError(
-                "prior_resolution_m", self.prior_resolution_m, f">= extent_m / 8000 = {self.extent_m / 8000.0:g}"
-            )
-        _num(self, "draft_margin_m", 0.0, 20.0)
-        _num(self, "clearance_m", 0.0, self.extent_m / 4.0)
-        _num(self, "occlusion_height_m", 0.5, 100.0)
-        _num(self, "n_buoys", 0, 500, integer=True)
+    @field_validator("grid_m")
+    @classmethod
+    def _grid(cls, v: float, info: ValidationInfo) -> float:
+        if _known(info, "extent_m") and (info.data["extent_m"] / v) ** 2 > 4.0e6:
+            raise ValueError(f"must be >= extent_m / 2000 = {info.data['extent_m'] / 2000.0:g}")
+        return v
+
+    @field_validator("prior_resolution_m")
+    @classmethod
+    def _prior(cls, v: float, info: ValidationInfo) -> float:
+        if _known(info, "extent_m") and info.data["extent_m"] / v > 8000.0:
+            raise ValueError(f"must be >= extent_m / 8000 = {info.data['extent_m'] / 8000.0:g}")
+        return v
+
+    @field_validator("clearance_m")
+    @classmethod
+    def _clearance(cls, v: float, info: ValidationInfo) -> float:
+        return _within(v, 0.0, info.data["extent_m"] / 4.0) if _known(info, "extent_m") else v
 
 
-@dataclass(frozen=True)
 class IslandParams(_CommonParams):
     """``island`` map: several islands of varied size on open water."""
 
-    n_islands: int = 5
+    n_buoys: int = Field(default=2, ge=0, le=500)
+    n_islands: int = Field(default=5, ge=0, le=50)
     island_radius_m: tuple[float, float] = (60.0, 280.0)
-    """Range of mean coast radii."""
+    """Range of mean coast radii (15 m to ``extent_m / 2``)."""
     island_height_m: tuple[float, float] = (15.0, 80.0)
     """Range of peak heights (capped at 0.35 x radius)."""
-    min_gap_m: float = 120.0
-    """Minimum open-water gap between two islands' coasts."""
-    coast_roughness: float = 0.25
+    min_gap_m: float = Field(default=120.0, ge=0.0)
+    """Minimum open-water gap between two islands' coasts (at most ``extent_m / 2``)."""
+    coast_roughness: float = Field(default=0.25, ge=0.0, le=0.5)
     """Relative coastline irregularity (0 = round)."""
-    vegetation: bool = True
+    vegetation: StrictBool = True
     """Label gentle terrain above ~4 m as VEGETATION."""
-    n_buoys: int = 2
 
-    def __post_init__(self) -> None:
-        self._validate()
-        _num(self, "n_islands", 0, 50, integer=True)
-        _pair(self, "island_radius_m", 15.0, self.extent_m / 2.0)
-        _pair(self, "island_height_m", 1.0, 500.0)
-        _num(self, "min_gap_m", 0.0, self.extent_m / 2.0)
-        _num(self, "coast_roughness", 0.0, 0.5)
-        if not isinstance(self.vegetation, bool):
-            raise MapConfigError("vegetation", self.vegetation, "true or false")
+    @field_validator("island_radius_m")
+    @classmethod
+    def _radius(cls, v: tuple[float, float], info: ValidationInfo) -> tuple[float, float]:
+        return _pair(v, 15.0, info.data["extent_m"] / 2.0) if _known(info, "extent_m") else v
+
+    @field_validator("island_height_m")
+    @classmethod
+    def _height(cls, v: tuple[float, float]) -> tuple[float, float]:
+        return _pair(v, 1.0, 500.0)
+
+    @field_validator("min_gap_m")
+    @classmethod
+    def _gap(cls, v: float, info: ValidationInfo) -> float:
+        return _within(v, 0.0, info.data["extent_m"] / 2.0) if _known(info, "extent_m") else v
 
 
-@dataclass(frozen=True)
 class OpenSeaParams(_CommonParams):
     """``open_sea`` map: open water, a few buoys and maybe one distant small islet."""
 
-    extent_m: float = 4000.0
-    islet_probability: float = 0.5
+    extent_m: float = Field(default=4000.0, ge=200.0, le=20000.0)
+    n_buoys: int = Field(default=4, ge=0, le=500)
+    islet_probability: float = Field(default=0.5, ge=0.0, le=1.0)
     islet_radius_m: tuple[float, float] = (25.0, 70.0)
+    """Range of islet radii (10 m to ``extent_m / 4``)."""
     islet_height_m: tuple[float, float] = (5.0, 20.0)
-    vegetation: bool = True
-    n_buoys: int = 4
+    vegetation: StrictBool = True
 
-    def __post_init__(self) -> None:
-        self._validate()
-        _num(self, "islet_probability", 0.0, 1.0)
-        _pair(self, "islet_radius_m", 10.0, self.extent_m / 4.0)
-        _pair(self, "islet_height_m", 1.0, 200.0)
-        if not isinstance(self.vegetation, bool):
-            raise MapConfigError("vegetation", self.vegetation, "true or false")
+    @field_validator("islet_radius_m")
+    @classmethod
+    def _radius(cls, v: tuple[float, float], info: ValidationInfo) -> tuple[float, float]:
+        return _pair(v, 10.0, info.data["extent_m"] / 4.0) if _known(info, "extent_m") else v
 
-
-COAST_SIDES = ("north", "south", "east", "west")
+    @field_validator("islet_height_m")
+    @classmethod
+    def _height(cls, v: tuple[float, float]) -> tuple[float, float]:
+        return _pair(v, 1.0, 200.0)
 
 
-@dataclass(frozen=True)
 class PortParams(_CommonParams):
     """``port`` map: land on one side with quay, piers, breakwaters and a harbour entrance, container yard,
     gantry cranes, buildings, channel buoys and moored ships. Layout distances are metres from the quay line.
 
     Layout knobs left at ``None`` scale with ``extent_m`` (values in brackets are those for 2000 m) and are
-    replaced by the resolved numbers, so ``MapWorld.params`` always records what was built.
+    replaced by the resolved numbers, so ``MapWorld.params`` always records what was built (a dump with
+    ``exclude_unset`` gives back only what the user set).
     """
 
+    extent_m: float = Field(default=2000.0, ge=600.0, le=20000.0)
+    """Side of the square map; a port needs at least 600 m."""
     coast_side: str = "north"
     """Side of the map the land is on: north, south, east or west."""
     coast_offset_m: float | None = None
@@ -184,87 +191,117 @@ class PortParams(_CommonParams):
     """Distance from the quay line out to the outer breakwater arms [0.21 extent: 420]."""
     entrance_width_m: float | None = None
     """Gap between the breakwater heads, at their toes [0.1 extent within 60..250: 200]."""
-    quay_height_m: float = 2.5
+    quay_height_m: float = Field(default=2.5, ge=1.0, le=6.0)
     basin_depth_m: float = 14.0
+    """Water depth in the basin, from ``draft_margin_m + 3`` to 40 m."""
+    pier_width_m: float = Field(default=24.0, ge=8.0, le=60.0)
     n_piers: int | None = None
     """Piers in the eastern 40 % of the harbour front [2, or as many as fit]."""
     pier_length_m: tuple[float, float] | None = None
     """Range of pier lengths [(0.07, 0.13) extent: (140, 260), at most harbour_depth_m - 100]."""
-    pier_width_m: float = 24.0
     n_cranes: int | None = None
     """Gantry cranes along the container-terminal quay [4, or as many as fit]."""
-    container_fill: float = 0.8
+    container_fill: float = Field(default=0.8, ge=0.0, le=1.0)
     """Probability that a container-stack slot in the yard is occupied."""
-    max_container_tiers: int = 5
-    n_buildings: int = 8
-    n_channel_buoy_pairs: int = 3
-    n_moored: int = 4
-    moored_assets: tuple[tuple[str, float, float], ...] = DEFAULT_MOORED_ASSETS
+    max_container_tiers: int = Field(default=5, ge=1, le=8)
+    n_buildings: int = Field(default=8, ge=0, le=200)
+    n_channel_buoy_pairs: int = Field(default=3, ge=0, le=50)
+    n_moored: int = Field(default=4, ge=0, le=50)
+    moored_assets: tuple[_Berth, ...] = DEFAULT_MOORED_ASSETS
     """Candidate moored ships: ``(asset_name, length_m, beam_m)``."""
-    hill_height_m: float = 35.0
-    vegetation: bool = True
+    hill_height_m: float = Field(default=35.0, ge=0.0, le=200.0)
+    vegetation: StrictBool = True
 
-    def _auto(self, name: str, value: object) -> None:
-        if getattr(self, name) is None:
-            object.__setattr__(self, name, value)
+    @field_validator("coast_side")
+    @classmethod
+    def _side(cls, v: str) -> str:
+        if v not in COAST_SIDES:
+            raise ValueError(f"must be one of {' | '.join(COAST_SIDES)}")
+        return v
 
-    def __post_init__(self) -> None:
-        self._validate()
-        e = self.extent_m
-        if e < 600.0:
-            raise MapConfigError("extent_m", e, "a number in [600, 20000] for a port map")
-        half = e / 2.0
-        if self.coast_side not in COAST_SIDES:
-            raise MapConfigError("coast_side", self.coast_side, " | ".join(COAST_SIDES))
-        self._auto("coast_offset_m", 0.125 * e)
-        _num(self, "coast_offset_m", -half + 300.0, half - 150.0)
-        self._auto("harbour_width_m", 0.5 * e)
-        _num(self, "harbour_width_m", 200.0, e - 300.0)
-        q, hw = _resolved(self.coast_offset_m), _resolved(self.harbour_width_m)
-        self._auto("harbour_depth_m", float(np.clip(0.21 * e, 120.0, q + half - 100.0)))
-        _num(self, "harbour_depth_m", 120.0, q + half - 100.0)
-        hd = _resolved(self.harbour_depth_m)
-        self._auto("entrance_width_m", float(np.clip(0.1 * e, 60.0, min(250.0, hw - 140.0))))
-        _num(self, "entrance_width_m", 60.0, hw - 140.0)
-        _num(self, "quay_height_m", 1.0, 6.0)
-        _num(self, "basin_depth_m", self.draft_margin_m + 3.0, 40.0)
-        _num(self, "pier_width_m", 8.0, 60.0)
-        piers_max = max(int((0.4 * hw - 60.0) // (self.pier_width_m + 80.0)), 0)
-        self._auto("n_piers", min(2, piers_max))
-        _num(self, "n_piers", 0, piers_max, integer=True)
-        longest = max(hd - 100.0, 30.0)
-        self._auto(
-            "pier_length_m", (min(max(round(0.07 * e, 1), 30.0), longest), min(max(round(0.13 * e, 1), 30.0), longest))
-        )
-        _pair(self, "pier_length_m", 30.0, longest)
-        terminal = (0.6 if self.n_piers else 1.0) * hw - 60.0
-        cranes_max = max(int(terminal // 35.0), 0)
-        self._auto("n_cranes", min(4, cranes_max))
-        _num(self, "n_cranes", 0, cranes_max, integer=True)
-        _num(self, "container_fill", 0.0, 1.0)
-        _num(self, "max_container_tiers", 1, 8, integer=True)
-        _num(self, "n_buildings", 0, 200, integer=True)
-        _num(self, "n_channel_buoy_pairs", 0, 50, integer=True)
-        _num(self, "n_moored", 0, 50, integer=True)
-        _num(self, "hill_height_m", 0.0, 200.0)
-        if not isinstance(self.vegetation, bool):
-            raise MapConfigError("vegetation", self.vegetation, "true or false")
-        allowed = "a list of [asset_name, length_m > 0, beam_m > 0] (non-empty when n_moored > 0)"
-        try:
-            assets = tuple((str(a), float(length), float(beam)) for a, length, beam in self.moored_assets)
-        except (TypeError, ValueError):
-            raise MapConfigError("moored_assets", self.moored_assets, allowed) from None
-        if any(not a or length <= 0.0 or beam <= 0.0 for a, length, beam in assets) or (self.n_moored and not assets):
-            raise MapConfigError("moored_assets", self.moored_assets, allowed)
-        object.__setattr__(self, "moored_assets", assets)
+    @field_validator("coast_offset_m")
+    @classmethod
+    def _offset(cls, v: float | None, info: ValidationInfo) -> float | None:
+        if not _known(info, "extent_m"):
+            return v
+        e = info.data["extent_m"]
+        return _within(0.125 * e if v is None else v, -e / 2.0 + 300.0, e / 2.0 - 150.0)
+
+    @field_validator("harbour_width_m")
+    @classmethod
+    def _width(cls, v: float | None, info: ValidationInfo) -> float | None:
+        if not _known(info, "extent_m"):
+            return v
+        e = info.data["extent_m"]
+        return _within(0.5 * e if v is None else v, 200.0, e - 300.0)
+
+    @field_validator("harbour_depth_m")
+    @classmethod
+    def _depth(cls, v: float | None, info: ValidationInfo) -> float | None:
+        if not _known(info, "extent_m", "coast_offset_m"):
+            return v
+        e, q = info.data["extent_m"], info.data["coast_offset_m"]
+        hi = q + e / 2.0 - 100.0
+        return _within(float(np.clip(0.21 * e, 120.0, hi)) if v is None else v, 120.0, hi)
+
+    @field_validator("entrance_width_m")
+    @classmethod
+    def _entrance(cls, v: float | None, info: ValidationInfo) -> float | None:
+        if not _known(info, "extent_m", "harbour_width_m"):
+            return v
+        e, hw = info.data["extent_m"], info.data["harbour_width_m"]
+        return _within(float(np.clip(0.1 * e, 60.0, min(250.0, hw - 140.0))) if v is None else v, 60.0, hw - 140.0)
+
+    @field_validator("basin_depth_m")
+    @classmethod
+    def _basin(cls, v: float, info: ValidationInfo) -> float:
+        return _within(v, info.data["draft_margin_m"] + 3.0, 40.0) if _known(info, "draft_margin_m") else v
+
+    @field_validator("n_piers")
+    @classmethod
+    def _piers(cls, v: int | None, info: ValidationInfo) -> int | None:
+        if not _known(info, "harbour_width_m", "pier_width_m"):
+            return v
+        most = max(int((0.4 * info.data["harbour_width_m"] - 60.0) // (info.data["pier_width_m"] + 80.0)), 0)
+        return int(_within(min(2, most) if v is None else v, 0, most, integer=True))
+
+    @field_validator("pier_length_m")
+    @classmethod
+    def _pier_length(cls, v: tuple[float, float] | None, info: ValidationInfo) -> tuple[float, float] | None:
+        if not _known(info, "extent_m", "harbour_depth_m"):
+            return v
+        e = info.data["extent_m"]
+        longest = max(info.data["harbour_depth_m"] - 100.0, 30.0)
+        if v is None:
+            v = (min(max(round(0.07 * e, 1), 30.0), longest), min(max(round(0.13 * e, 1), 30.0), longest))
+        return _pair(v, 30.0, longest)
+
+    @field_validator("n_cranes")
+    @classmethod
+    def _cranes(cls, v: int | None, info: ValidationInfo) -> int | None:
+        if not _known(info, "harbour_width_m", "n_piers"):
+            return v
+        terminal = (0.6 if info.data["n_piers"] else 1.0) * info.data["harbour_width_m"] - 60.0
+        most = max(int(terminal // 35.0), 0)
+        return int(_within(min(4, most) if v is None else v, 0, most, integer=True))
+
+    @field_validator("moored_assets")
+    @classmethod
+    def _moored(cls, v: tuple[_Berth, ...], info: ValidationInfo) -> tuple[_Berth, ...]:
+        if any(not a or length <= 0.0 or beam <= 0.0 for a, length, beam in v) or (info.data.get("n_moored") and not v):
+            raise ValueError("must be a list of [asset_name, length_m > 0, beam_m > 0] (non-empty when n_moored > 0)")
+        return v
 
 
 MapParams = IslandParams | OpenSeaParams | PortParams
-_PARAM_TYPES: dict[str, type[IslandParams] | type[OpenSeaParams] | type[PortParams]] = {
+"""The parameters of one map kind: a union discriminated by the map's ``type`` (see :data:`PARAM_MODELS`)."""
+
+PARAM_MODELS: dict[str, type[IslandParams] | type[OpenSeaParams] | type[PortParams]] = {
     "island": IslandParams,
     "open_sea": OpenSeaParams,
     "port": PortParams,
 }
+"""The parameter model of each map ``type``."""
 
 
 def make_params(kind: str, **params: Any) -> MapParams:
@@ -272,11 +309,15 @@ def make_params(kind: str, **params: Any) -> MapParams:
 
     Raises :class:`MapConfigError` naming ``kind`` or the first unknown/invalid field and the allowed values.
     """
-    if kind not in _PARAM_TYPES:
+    if kind not in PARAM_MODELS:
         raise MapConfigError("kind", kind, " | ".join(MAP_KINDS))
-    cls = _PARAM_TYPES[kind]
-    names = sorted(f.name for f in dataclasses.fields(cls))
-    for key in params:
-        if key not in names:
-            raise MapConfigError(key, params[key], f"a parameter of the {kind} map: {', '.join(names)}")
-    return cls(**params)
+    cls = PARAM_MODELS[kind]
+    try:
+        return cls.model_validate(params)
+    except ValidationError as exc:
+        first = exc.errors()[0]
+        field = str(first["loc"][0]) if first["loc"] else "params"
+        msg = str(first["msg"]).removeprefix("Value error, ").removeprefix("must be ")
+        if first["type"] == "extra_forbidden":
+            msg = f"a parameter of the {kind} map: {', '.join(sorted(cls.model_fields))}"
+        raise MapConfigError(field, params.get(field, first.get("input")), msg) from None

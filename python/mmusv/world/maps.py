@@ -49,6 +49,7 @@ __all__ = [
     "MapPriors",
     "make_params",
     "generate_map",
+    "generate_map_from",
     "generate_island",
     "generate_open_sea",
     "generate_port",
@@ -68,7 +69,7 @@ class MapWorld:
     Attributes:
         kind: ``"island"``, ``"open_sea"`` or ``"port"``.
         seed: the generation seed.
-        params: the validated parameter dataclass.
+        params: the validated parameters (a pydantic model of :mod:`mmusv.world.map_params`).
         static_meshes: name -> TriMesh in the world frame, keys sorted; a subset of ``"buoys"``,
             ``"port_structures"``, ``"terrain"``, ``"water"`` (empty parts are left out; ``"water"`` always there).
         moored: ships to instantiate from the vessel library: ``(asset_name, (x, y, yaw))`` (see module docstring).
@@ -380,9 +381,14 @@ def generate_map(kind: str, *, seed: int, **params: Any) -> MapWorld:
 
     Raises :class:`MapConfigError` (a ``ValueError``) naming the unknown kind or the bad field and what is allowed.
     """
-    p = make_params(kind, **params)
-    if isinstance(p, IslandParams):
-        return generate_island(seed=seed, params=p)
-    if isinstance(p, OpenSeaParams):
-        return generate_open_sea(seed=seed, params=p)
-    return generate_port(seed=seed, params=p)
+    return generate_map_from(make_params(kind, **params), seed=seed)
+
+
+def generate_map_from(params: MapParams, *, seed: int) -> MapWorld:
+    """Generates the map that validated ``params`` describe (their type says the kind), e.g. a scenario's
+    ``map.params`` (:class:`mmusv.config.MapConfig`)."""
+    if isinstance(params, IslandParams):
+        return generate_island(seed=seed, params=params)
+    if isinstance(params, OpenSeaParams):
+        return generate_open_sea(seed=seed, params=params)
+    return generate_port(seed=seed, params=params)

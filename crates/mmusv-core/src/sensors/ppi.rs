@@ -215,7 +215,7 @@ mod tests {
 
     #[test]
     fn target_at_range_r_is_r_over_mpp_pixels_from_centre() {
-        let radar = RadarConfig::default();
+        let radar = RadarConfig::tuning();
         for orientation in [PpiOrientation::NorthUp, PpiOrientation::HeadUp] {
             let cfg = PpiConfig { size_px: 401, metres_per_pixel: 7.5, orientation };
             let c = 200i64;
@@ -254,7 +254,7 @@ mod tests {
 
     #[test]
     fn orientation_and_arcs() {
-        let radar = RadarConfig { azimuth_bins: 64, range_resolution_m: 10.0, ..RadarConfig::default() };
+        let radar = RadarConfig { azimuth_bins: 64, range_resolution_m: 10.0, ..RadarConfig::tuning() };
         // Forward (azimuth 0) with the sensor facing east (yaw 0): right in north-up, up in head-up.
         let ret = one(500.0, 0.0, 1.0);
         let north = PpiConfig { size_px: 256, metres_per_pixel: 5.0, orientation: PpiOrientation::NorthUp };
@@ -285,7 +285,7 @@ mod tests {
 
     #[test]
     fn bad_inputs_are_errors() {
-        let r = RadarConfig::default();
+        let r = RadarConfig::tuning();
         let ok = one(100.0, 0.0, 1.0);
         let field = |res: Result<Vec<f32>>| match res {
             Err(MmusvError::Config { field, .. } | MmusvError::InvalidInput { field, .. }) => field,

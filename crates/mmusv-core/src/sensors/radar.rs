@@ -4,7 +4,8 @@
 //! `2π b / azimuth_bins` in the sensor frame (0 = forward +x, counter-clockwise towards +y). Each beam is
 //! sampled by `rays_az × rays_el` rays: `rays_az` azimuths at the centres of equal slices of the beamwidth,
 //! and for each of them `rays_el` elevations spread uniformly (stratified) over the elevation fan. Surface
-//! targets a kilometre away span a fraction of a degree of a fan some 20° tall, so by default three quarters
+//! targets a kilometre away span a fraction of a degree of a fan some 20° tall, so (with `horizon_fraction` 0.75,
+//! the scenario default) three quarters
 //! of the elevation rays are spread uniformly over the band `±horizon_band_rad` around the sea horizon (where the
 //! world's horizontal plane cuts the fan at that azimuth, from the sensor pose: it follows roll and pitch)
 //! and the rest uniformly over the remainder of the fan; every ray carries the fan height it stands for as
@@ -81,8 +82,12 @@ pub struct RadarConfig {
     pub clutter: ClutterModel,
 }
 
-impl Default for RadarConfig {
-    fn default() -> Self {
+/// No `Default`: the radar's defaults are defined once, in the scenario schema
+/// (`mmusv.sensors.config.RadarConfig`), and the binding (`mmusv._core.Radar`) requires every field.
+impl RadarConfig {
+    /// The configuration the core's unit tests and benchmarks are written against (the paper rig's geometry;
+    /// threshold 0.01 and [`ClutterModel::tuning`], which show plenty of clutter). A fixture, not a user default.
+    pub fn tuning() -> Self {
         Self {
             range_min_m: 10.0,
             range_max_m: 3000.0,
@@ -96,7 +101,7 @@ impl Default for RadarConfig {
             horizon_band_rad: 1.0f64.to_radians(),
             detection_threshold: 0.01,
             range_noise_std_m: 0.0,
-            clutter: ClutterModel::default(),
+            clutter: ClutterModel::tuning(),
         }
     }
 }

@@ -45,16 +45,13 @@ pub struct ClutterModel {
     pub rain_eta_at_1mm_h: f64,
 }
 
-impl Default for ClutterModel {
-    /// Tuned so that with the default radar (1.2° beam, 3 m cells, threshold 0.01) clutter reaches ≈200 m at
-    /// 0.5 m waves and ≈1.2 km at 3.5 m waves, and 10 mm/h of rain shows sparse clutter within ≈1 km.
-    fn default() -> Self {
-        Self {
-            sea_sigma0_at_1m: 4.0e-6,
-            critical_range_per_m: 300.0,
-            sea_max_range_m: 2500.0,
-            rain_eta_at_1mm_h: 5.0e-9,
-        }
+impl ClutterModel {
+    /// The clutter the core's unit tests and benchmarks are written against: with the 1.2° beam, 3 m cells and threshold
+    /// 0.01 of [`crate::sensors::radar::RadarConfig::tuning`], sea clutter reaches ≈200 m at 0.5 m waves and
+    /// ≈1 km at 3.5 m waves, and 10 mm/h of rain shows sparse clutter within ≈1 km. A test fixture: the user
+    /// defaults (σ⁰ 4e-7 with threshold 0.3) live in the scenario schema, `mmusv.sensors.config.RadarConfig`.
+    pub fn tuning() -> Self {
+        Self { sea_sigma0_at_1m: 4.0e-6, critical_range_per_m: 300.0, sea_max_range_m: 2500.0, rain_eta_at_1mm_h: 5.0e-9 }
     }
 }
 
@@ -160,7 +157,7 @@ mod tests {
 
     #[test]
     fn sea_clutter_grows_with_waves_and_falls_with_range() {
-        let m = ClutterModel::default();
+        let m = ClutterModel::tuning();
         let at = |h: f64, r: f64| clutter_mean(&m, &CELL, h, 0.0, r).0;
         assert_eq!(at(0.0, 100.0), 0.0);
         for r in [50.0, 200.0, 800.0, 2000.0] {

@@ -40,7 +40,7 @@ fn sea_with_box(range: f64, bearing: f64) -> Scene {
 }
 
 fn small_cfg() -> RadarConfig {
-    RadarConfig { azimuth_bins: 512, range_max_m: 1500.0, rays_el: 32, ..RadarConfig::default() }
+    RadarConfig { azimuth_bins: 512, range_max_m: 1500.0, rays_el: 32, ..RadarConfig::tuning() }
 }
 
 const MAST: RigidPose = RigidPose { rotation: parry3d::math::Mat3::IDENTITY, translation: Vec3::new(0.0, 0.0, 3.0) };
@@ -67,11 +67,11 @@ fn trace_order_is_a_permutation() {
 
 #[test]
 fn ray_pattern_spans_beam_and_fan() {
-    let uniform = RadarConfig { horizon_fraction: 0.0, ..RadarConfig::default() };
+    let uniform = RadarConfig { horizon_fraction: 0.0, ..RadarConfig::tuning() };
     let [lo, hi] = uniform.elevation_fan_rad;
     let rows = uniform.rays_el as usize;
     let mut column = vec![(0.0, 0.0); rows];
-    for cfg in [uniform, RadarConfig::default()] {
+    for cfg in [uniform, RadarConfig::tuning()] {
         let (mut min_el, mut max_el) = (f64::MAX, f64::MIN);
         for g in 0..cfg.rays_az * 64 {
             let b = g / cfg.rays_az;
@@ -91,7 +91,7 @@ fn ray_pattern_spans_beam_and_fan() {
         assert!(min_el - lo < 0.05 * row && hi - max_el < 0.05 * row, "{min_el} {max_el}");
     }
     // Default: three quarters of the rays within ±1° of the horizon, which follows the sensor's roll.
-    let cfg = RadarConfig::default();
+    let cfg = RadarConfig::tuning();
     let rolled = RigidPose::from_xyz_rpy([0.0, 0.0, 3.0], [0.1, 0.0, 0.0]);
     let left = horizon_elevation(&rolled, std::f64::consts::FRAC_PI_2).unwrap_or(f64::NAN);
     assert!((left + 0.1).abs() < 1e-6, "rolled right-side-down by 0.1 rad: the horizon on the left is 0.1 rad low");
@@ -142,7 +142,7 @@ fn bigger_and_nearer_targets_are_brighter_rain_attenuates() {
     let far = sweep(&sea_with_box(900.0, 0.5), &cfg, 0.0, 1);
     assert!(total(&near) > 3.0 * total(&far), "{} vs {}", total(&near), total(&far));
     let s = sea_with_box(900.0, 0.5);
-    let wet_cfg = RadarConfig { clutter: ClutterModel { rain_eta_at_1mm_h: 0.0, ..ClutterModel::default() }, ..cfg };
+    let wet_cfg = RadarConfig { clutter: ClutterModel { rain_eta_at_1mm_h: 0.0, ..ClutterModel::tuning() }, ..cfg };
     let wet = radar_sweep(&s, &MAST, &wet_cfg, &RadarEnv { wave_height_m: 0.0, rain_mm_per_h: 30.0 }, 1);
     let wet = wet.unwrap_or_default();
     assert!(!wet.is_empty() && total(&wet) < 0.97 * total(&far));
@@ -188,7 +188,7 @@ fn clutter_grows_with_waves_and_stops_at_range() {
     assert!(w0.iter().all(|c| rough.contains(c)));
     assert!(clutter(0.0).0.is_empty());
     // Nothing beyond the sea clutter limit.
-    let limited = RadarConfig { clutter: ClutterModel { sea_max_range_m: 150.0, ..ClutterModel::default() }, ..cfg };
+    let limited = RadarConfig { clutter: ClutterModel { sea_max_range_m: 150.0, ..ClutterModel::tuning() }, ..cfg };
     let r = sweep(&s, &limited, 3.5, 3);
     assert!((0..r.len()).filter(|&i| r.instance[i] == NO_HIT).all(|i| r.range[i] <= 150.0));
 }
@@ -200,7 +200,7 @@ fn misconfiguration_names_the_field() {
         Err(MmusvError::Config { field, .. }) => field,
         other => format!("no config error: {other:?}"),
     };
-    let d = RadarConfig::default();
+    let d = RadarConfig::tuning();
     let e = RadarEnv::default();
     let cases = [
         (RadarConfig { azimuth_bins: 0, ..d }, "radar.azimuth_bins"),
@@ -220,7 +220,7 @@ fn misconfiguration_names_the_field() {
         (RadarConfig { horizon_band_rad: -0.1, ..d }, "radar.horizon_band_rad"),
         (RadarConfig { range_noise_std_m: -1.0, ..d }, "radar.range_noise_std_m"),
         (
-            RadarConfig { clutter: ClutterModel { sea_sigma0_at_1m: -1.0, ..ClutterModel::default() }, ..d },
+            RadarConfig { clutter: ClutterModel { sea_sigma0_at_1m: -1.0, ..ClutterModel::tuning() }, ..d },
             "radar.clutter.sea_sigma0_at_1m",
         ),
     ];
