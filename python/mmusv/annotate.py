@@ -220,7 +220,7 @@ def annotate_agent(
             ann.lidar_points.append(counts.get(info.instance_id, 0))
             ann.lidar_range.append(rng)
             ann.lidar_role.append(info.role)
-            ann.lidar_static.append(bool(getattr(info, "static", False)))
+            ann.lidar_static.append(bool(info.static))
         corners_world = box_corners(box_world, info.box_size)
         for name, (cam, k, inv, pose, inst_img) in views.items():
             h, w = inst_img.shape
@@ -253,5 +253,5 @@ def annotate_agent(
             ann.cam_box_pixels.append(int((u1 - u0) * (v1 - v0)))
             ann.cam_occlusion.append(float(1.0 - visible / sil) if sil else 0.0)
             ann.cam_role.append(info.role)
-            ann.cam_static.append(bool(getattr(info, "static", False)))
+            ann.cam_static.append(bool(info.static))
     return ann

@@ -220,11 +220,8 @@ def _check_mount_points(v: VesselConfig, index: int, rig_name: str, rig: RigConf
     points = sorted(get_asset(v.asset).mounts)
     if not points:
         return
-    mounts = [("lidar.mount", rig.lidar.mount if rig.lidar else None),
-              ("radar.mount", rig.radar.mount if rig.radar else None)]
-    mounts += [(f"cameras[{i}].mount", c.mount) for i, c in enumerate(rig.cameras)]
-    for where, m in mounts:
-        if m is not None and m.point is not None and m.point not in points:
+    for where, m in rig.mounts():
+        if m.point is not None and m.point not in points:
             close = difflib.get_close_matches(m.point, points, n=1, cutoff=0.5)
             hint = f"did you mean {close[0]!r}? " if close else ""
             raise ValueError(

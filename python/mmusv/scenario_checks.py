@@ -70,6 +70,7 @@ def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[st
 def check_mounts(scenario: Scenario, *, source: str) -> list[str]:
     """Warns (and returns the warnings) for every sensor mount farther than :data:`MOUNT_WARN_FACTOR` hull
     lengths (at least 10 m) from its vessel's box."""
+    from mmusv.simulation import mount_matrix
     from mmusv.world.vessels import get_asset
 
     found: list[str] = []
@@ -80,16 +81,9 @@ def check_mounts(scenario: Scenario, *, source: str) -> list[str]:
         asset = get_asset(v.asset)
         lo, hi = np.asarray(asset.bbox[0], dtype=float), np.asarray(asset.bbox[1], dtype=float)
         limit = max(MOUNT_WARN_FACTOR * asset.length, 10.0)
-        mounts = [(f"rigs.{v.rig}.lidar.mount", rig.lidar.mount if rig.lidar else None),
-                  (f"rigs.{v.rig}.radar.mount", rig.radar.mount if rig.radar else None)]
-        mounts += [(f"rigs.{v.rig}.cameras[{i}].mount", c.mount) for i, c in enumerate(rig.cameras)]
-        for where, m in mounts:
-            if m is None:
-                continue
-            base = np.zeros(3)
-            if m.point is not None and m.point in asset.mounts:
-                base = np.asarray(asset.mounts[m.point].xyz, dtype=float)
-            p = base + np.asarray(m.xyz, dtype=float)
+        for path, m in rig.mounts():
+            where = f"rigs.{v.rig}.{path}"
+            p = mount_matrix(asset, m, where=where)[:3, 3]  # the sensor origin in the body frame, as simulated
             dist = float(np.linalg.norm(np.maximum(np.maximum(lo - p, p - hi), 0.0)))
             if dist > limit:
                 found.append(f"{source}: {where} (vessel {v.id}) is {dist:.0f} m from the {asset.name} hull; "

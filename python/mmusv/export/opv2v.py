@@ -56,6 +56,7 @@ class Opv2vWriter(DatasetWriter):
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         speeds = {str(v["id"]): float(v.get("speed_mps", 0.0)) * 3.6 for v in self.info.scenario.get("vessels", [])}
+        self.static_ids = {vid for vid, kmh in speeds.items() if kmh == 0.0}  # VesselConfig.static: speed 0
         self.plans: dict[str, list[list[float]]] = {}
         for v in self.info.scenario.get("vessels", []):
             route = np.asarray(v.get("route", []), dtype=np.float64).reshape(-1, 2)
@@ -157,10 +158,7 @@ class Opv2vWriter(DatasetWriter):
 
     def _static(self, t: Target) -> bool:
         """The vessel never moves: a moored ship, or a scenario vessel at speed 0 (``VesselConfig.static``)."""
-        if t.role == "moored":
-            return True
-        speeds = {str(v.get("id")): float(v.get("speed_mps", 0.0)) for v in self.info.scenario.get("vessels", [])}
-        return speeds.get(t.id, 0.0) == 0.0
+        return t.role == "moored" or t.id in self.static_ids
 
     def finish(self, frames: list[int], skipped: list[dict[str, Any]]) -> None:
         super().finish(frames, skipped)

@@ -286,6 +286,12 @@ class RigConfig(_Model):
                 return {**RIG_PRESETS[preset], **data}
         return data
 
+    def mounts(self) -> list[tuple[str, Mount]]:
+        """``(field path within the rig, mount)`` of every sensor the rig has: ``lidar.mount``, ``radar.mount``,
+        ``cameras[i].mount`` (the top view sits above the USV and has no mount)."""
+        out = [(f"{name}.mount", s.mount) for name, s in (("lidar", self.lidar), ("radar", self.radar)) if s is not None]
+        return out + [(f"cameras[{i}].mount", c.mount) for i, c in enumerate(self.cameras)]
+
     @model_validator(mode="after")
     def _unique(self) -> RigConfig:
         names = [c.name for c in self.cameras]
