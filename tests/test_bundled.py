@@ -58,3 +58,19 @@ def test_cli_scenarios_lists_every_bundled_scenario(capsys: pytest.CaptureFixtur
     out = capsys.readouterr().out
     for p in REPO_SCENARIOS.glob("*.yaml"):
         assert p.stem in out
+
+
+def test_bundled_specs_resolve_from_another_directory(tmp_path: Path) -> None:
+    """`mmusv study detection --generate` and `mmusv generate` find the bundled specs outside the repository."""
+    from mmusv.bundled import resolve_spec
+
+    cwd = os.getcwd()
+    os.chdir(tmp_path)
+    try:
+        for arg in ("coop_detection", "scenarios/specs/coop_detection.yaml", "specs/coop_detection.yaml"):
+            p = resolve_spec(arg)
+            assert p == bundled_dir() / "specs" / "coop_detection.yaml" and p.is_file()
+        with pytest.raises(NotFoundError, match="not a bundled spec; bundled: coop_detection, impossible_port"):
+            resolve_spec("no_such_spec")
+    finally:
+        os.chdir(cwd)

@@ -16,7 +16,7 @@ from pathlib import Path
 from mmusv.config import load_scenario
 from mmusv.errors import NotFoundError
 
-__all__ = ["BundledScenario", "bundled_dir", "bundled_scenarios", "resolve_scenario"]
+__all__ = ["BundledScenario", "bundled_dir", "bundled_scenarios", "resolve_scenario", "resolve_spec"]
 
 
 def bundled_dir() -> Path:
@@ -24,24 +24,38 @@ def bundled_dir() -> Path:
     return Path(str(importlib.resources.files("mmusv") / "scenarios"))
 
 
-def _names() -> list[str]:
-    return sorted(p.stem for p in bundled_dir().glob("*.yaml"))
+def _names(folder: Path | None = None) -> list[str]:
+    return sorted(p.stem for p in (folder or bundled_dir()).glob("*.yaml"))
+
+
+def _resolve(name: str | Path, folder: Path, parents: tuple[str, ...], noun: str) -> Path:
+    """``name`` itself when it exists, otherwise the bundled file of that stem in ``folder`` when ``name`` is bare
+    or under one of the repository-relative ``parents``; else :class:`~mmusv.errors.NotFoundError`."""
+    p = Path(name)
+    if p.exists():
+        return p
+    stem = p.name[: -len(".yaml")] if p.name.endswith(".yaml") else p.name
+    if p.parent in (Path("."), *(Path(x) for x in parents)):
+        cand = folder / f"{stem}.yaml"
+        if cand.is_file():
+            return cand
+    raise NotFoundError(f"{noun} file {str(name)!r} does not exist and is not a bundled {noun}; "
+                        f"bundled: {', '.join(_names(folder))}")
 
 
 def resolve_scenario(name: str | Path) -> Path:
     """``name`` as a scenario file: the path itself when it exists, otherwise the bundled scenario of that name.
 
     Raises :class:`~mmusv.errors.NotFoundError` naming the bundled scenarios when neither exists."""
-    p = Path(name)
-    if p.exists():
-        return p
-    stem = p.name[: -len(".yaml")] if p.name.endswith(".yaml") else p.name
-    if p.parent in (Path("."), Path("scenarios")):
-        cand = bundled_dir() / f"{stem}.yaml"
-        if cand.is_file():
-            return cand
-    raise NotFoundError(f"scenario file {str(name)!r} does not exist and is not a bundled scenario; "
-                        f"bundled: {', '.join(_names())}")
+    return _resolve(name, bundled_dir(), ("scenarios",), "scenario")
+
+
+def resolve_spec(name: str | Path) -> Path:
+    """``name`` as a generation spec: the path itself when it exists, otherwise the bundled spec of that name
+    (``coop_detection``, ``scenarios/specs/coop_detection.yaml``), so bundled specs work from any folder.
+
+    Raises :class:`~mmusv.errors.NotFoundError` naming the bundled specs when neither exists."""
+    return _resolve(name, bundled_dir() / "specs", ("specs", "scenarios/specs"), "spec")
 
 
 @dataclass(frozen=True)

@@ -137,9 +137,9 @@ def generate_dataset(
     from mmusv.config import load_scenario
     from mmusv.generate.runner import generate
 
-    sp = Path(spec)
-    if not sp.is_file():
-        raise IoError(f"--generate: spec {sp} not found (run from the repository root, or pass a spec path)")
+    from mmusv.bundled import resolve_spec
+
+    sp = resolve_spec(spec)
     out = Path(out_dir)
     scen_dir = out / "scenarios"
     generate(sp, scen_dir, force=True)
