@@ -18,12 +18,14 @@ test-rust: ## Rust unit tests of the core (no Python)
 test-py: ## pytest only (after `make dev`)
 	python3 -m pytest -q -p no:dash tests
 
-fmt: ## format Rust and check Python style
+fmt: ## format Rust and Python
 	cargo fmt --all
+	python3 -m ruff format python tests benches
 
 lint: ## clippy + ruff + mypy + stubtest
 	cargo clippy --workspace --all-targets
 	python3 -m ruff check python tests benches
+	python3 -m ruff format --check python tests benches
 	python3 -m mypy
 	python3 -m mypy.stubtest mmusv._core
 

@@ -16,9 +16,8 @@ import argparse
 import os
 import time
 
-import numpy as np
-
 import mmusv
+import numpy as np
 from mmusv._native import core
 from mmusv.scene import demo_scene
 
@@ -81,10 +80,14 @@ def main() -> None:
         theirs = o3d_scene.cast_rays(rays)["t_hit"].numpy()
         theirs = np.where(theirs <= args.max_range, theirs, np.inf)
         both = np.isfinite(ours) & np.isfinite(theirs)
-        agree = np.mean((np.isfinite(ours) == np.isfinite(theirs)))
-        close = np.mean(np.abs(ours[both] - theirs[both]) <= 1e-3 * np.maximum(theirs[both], 1.0)) if both.any() else 1.0
+        agree = np.mean(np.isfinite(ours) == np.isfinite(theirs))
+        close = (
+            np.mean(np.abs(ours[both] - theirs[both]) <= 1e-3 * np.maximum(theirs[both], 1.0)) if both.any() else 1.0
+        )
         n = o.shape[0]
-        print(f"{name:<20}{n:>10}{n / t_m / 1e6:>16.2f}{n / t_o / 1e6:>16.2f}{t_o / t_m:>8.2f}{min(agree, close):>8.4f}")
+        print(
+            f"{name:<20}{n:>10}{n / t_m / 1e6:>16.2f}{n / t_o / 1e6:>16.2f}{t_o / t_m:>8.2f}{min(agree, close):>8.4f}"
+        )
 
 
 if __name__ == "__main__":

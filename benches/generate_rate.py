@@ -41,8 +41,10 @@ def main() -> None:
             best = (dt, rep.accepted, rep.attempts)
     assert best is not None
     dt, accepted, attempts = best
-    print(f"spec {spec.name}: {accepted} scenarios accepted of {attempts} attempts "
-          f"(quota {sum(c.quota for c in spec.combinations)}), map built once in {t_map:.2f} s")
+    print(
+        f"spec {spec.name}: {accepted} scenarios accepted of {attempts} attempts "
+        f"(quota {sum(c.quota for c in spec.combinations)}), map built once in {t_map:.2f} s"
+    )
     print(f"cpus: {os.cpu_count()}  best of {args.repeat}: {dt:.2f} s")
     print(f"rate: {accepted / dt:.1f} scenarios/s  ({attempts / dt:.0f} attempts/s)")
 

@@ -15,7 +15,6 @@ from pathlib import Path
 
 import numpy as np
 import numpy.typing as npt
-
 from mmusv.recording import Recording, to_ns
 
 POINTS = 26_214

@@ -27,8 +27,9 @@ cargo bench --no-run --quiet
 echo "== pip install the package with test extras (builds the extension in release)"
 python3 -m pip install --quiet --disable-pip-version-check -e ".[test]"
 
-echo "== ruff (pyflakes rules) on the Python sources"
+echo "== ruff: lint and format check of the Python sources"
 python3 -m ruff check python tests benches
+python3 -m ruff format --check python tests benches
 
 echo "== type stubs match the compiled module (mypy stubtest) and the package type-checks"
 python3 -m mypy.stubtest mmusv._core

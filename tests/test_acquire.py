@@ -7,14 +7,13 @@ import json
 from pathlib import Path
 from typing import Any
 
+import mmusv
 import numpy as np
 import polars as pl
 import pytest
 import yaml
 from mcap.reader import make_reader
 from mcap_protobuf.decoder import DecoderFactory
-
-import mmusv
 from mmusv.acquire import run
 from mmusv.cli import main
 from mmusv.recording import decode_image, decode_point_cloud
@@ -33,7 +32,12 @@ def small_scenario(frames: int = 3) -> dict[str, Any]:
             "radar": {"range_m": 1000, "azimuth_bins": 256, "rays_el": 8, "ppi_size_px": 64},
             "cameras": [
                 {"name": "front", "resolution": [64, 48], "mount": {"point": "camera_front"}},
-                {"name": "rear", "resolution": [64, 48], "mount": {"point": "camera_rear"}, "outputs": ["rgb", "semantic"]},
+                {
+                    "name": "rear",
+                    "resolution": [64, 48],
+                    "mount": {"point": "camera_rear"},
+                    "outputs": ["rgb", "semantic"],
+                },
             ],
             "top_view": {"resolution": [64, 64], "metres_per_pixel": 1.0},
         }
@@ -55,14 +59,26 @@ def _messages(path: Path) -> list[tuple[str, int, Any, Any]]:
 
 
 def test_every_channel_decodes_and_frames_and_times_are_right(recorded: tuple[Path, Any]) -> None:
-    out, res = recorded
+    _out, res = recorded
     assert res.status == "complete" and res.frames_written == 3
     msgs = _messages(res.recording)
     topics = {t for t, *_ in msgs}
     for agent in ("usv_1", "usv_2"):
-        for suffix in ("lidar", "radar/returns", "radar/ppi", "camera/front/rgb", "camera/front/depth", "camera/front/semantic",
-                       "camera/front/instance", "camera/rear/rgb", "camera/rear/semantic", "top_view/rgb", "top_view/semantic",
-                       "boxes", "annotations"):
+        for suffix in (
+            "lidar",
+            "radar/returns",
+            "radar/ppi",
+            "camera/front/rgb",
+            "camera/front/depth",
+            "camera/front/semantic",
+            "camera/front/instance",
+            "camera/rear/rgb",
+            "camera/rear/semantic",
+            "top_view/rgb",
+            "top_view/semantic",
+            "boxes",
+            "annotations",
+        ):
             assert f"/{agent}/{suffix}" in topics
         assert f"/{agent}/camera/rear/depth" not in topics  # not among that camera's outputs
     assert {"/tf", "/world/state"} <= topics
@@ -78,7 +94,7 @@ def test_every_channel_decodes_and_frames_and_times_are_right(recorded: tuple[Pa
 
 
 def test_recorded_sensors_match_a_direct_capture(recorded: tuple[Path, Any]) -> None:
-    out, res = recorded
+    _out, res = recorded
     sim = mmusv.Simulation(small_scenario())
     cap = sim.capture(1)
     msgs = {t: d for t, lt, _m, d in _messages(res.recording) if lt == 200_000_000}
@@ -104,7 +120,7 @@ def test_recorded_sensors_match_a_direct_capture(recorded: tuple[Path, Any]) -> 
 
 
 def test_tables_and_manifest(recorded: tuple[Path, Any]) -> None:
-    out, res = recorded
+    out, _res = recorded
     ws = pl.read_parquet(out / "tables/world_state/*.parquet")
     assert ws.height == 3 * 11 and set(ws["frame"].unique()) == {0, 1, 2}
     b3 = pl.read_parquet(out / "tables/boxes_3d/*.parquet")
@@ -133,7 +149,9 @@ def test_existing_output_is_not_overwritten_unless_asked(recorded: tuple[Path, A
     assert res.recording.read_bytes() == before
 
 
-def test_malformed_scenario_fails_before_anything_is_written(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_malformed_scenario_fails_before_anything_is_written(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     bad = small_scenario()
     bad["rigs"]["usv_standard"]["lidar"]["channels"] = 0
     path = tmp_path / "bad.yaml"
@@ -161,7 +179,9 @@ def test_interrupted_run_leaves_a_readable_recording(tmp_path: Path) -> None:
     assert pl.read_parquet(tmp_path / "tables/world_state/*.parquet")["frame"].max() == 1
 
 
-def test_info_and_preview_commands(recorded: tuple[Path, Any], tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_info_and_preview_commands(
+    recorded: tuple[Path, Any], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     _out, res = recorded
     assert main(["info", str(res.recording)]) == 0
     text = capsys.readouterr().out

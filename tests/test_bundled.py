@@ -7,7 +7,6 @@ from pathlib import Path
 
 import pytest
 import yaml
-
 from mmusv.bundled import bundled_dir, bundled_scenarios, resolve_scenario
 from mmusv.cli import main
 from mmusv.errors import NotFoundError
@@ -31,7 +30,7 @@ def test_bare_name_resolves_from_another_directory(tmp_path: Path) -> None:
         with pytest.raises(NotFoundError, match="bundled: .*port_entry"):
             resolve_scenario("no_such_scenario")
         with pytest.raises(NotFoundError):
-            resolve_scenario("elsewhere/port_entry.yaml")   # a real path that is not there is not rewritten
+            resolve_scenario("elsewhere/port_entry.yaml")  # a real path that is not there is not rewritten
     finally:
         os.chdir(cwd)
 

@@ -4,16 +4,21 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import pytest
-
 import mmusv
+import pytest
 from mmusv.config import load_scenario, scenario_hash
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def minimal(**vessel: object) -> dict[str, object]:
-    v: dict[str, object] = {"id": "usv_1", "role": "usv", "asset": "usv_wamv", "speed_mps": 2.0, "route": [[0, 0], [100, 0]]}
+    v: dict[str, object] = {
+        "id": "usv_1",
+        "role": "usv",
+        "asset": "usv_wamv",
+        "speed_mps": 2.0,
+        "route": [[0, 0], [100, 0]],
+    }
     v.update(vessel)
     return {"vessels": [v]}
 

@@ -10,10 +10,9 @@ import math
 
 import numpy as np
 import pytest
-from scipy.spatial.transform import Rotation
-
 from mmusv import frames
 from mmusv.world.build import pose_matrices as reexported
+from scipy.spatial.transform import Rotation
 
 S = np.diag([1.0, -1.0, 1.0])
 
@@ -40,7 +39,9 @@ def loader_matrix(pose: list[float] | np.ndarray) -> np.ndarray:
 
 def random_eta(rng: np.random.Generator, n: int) -> np.ndarray:
     xyz = rng.uniform(-500, 500, (n, 3))
-    ang = np.column_stack([rng.uniform(-math.pi, math.pi, n), rng.uniform(-1.5, 1.5, n), rng.uniform(-math.pi, math.pi, n)])
+    ang = np.column_stack(
+        [rng.uniform(-math.pi, math.pi, n), rng.uniform(-1.5, 1.5, n), rng.uniform(-math.pi, math.pi, n)]
+    )
     return np.column_stack([xyz, ang])
 
 
@@ -59,7 +60,9 @@ def test_matrix_to_pose_inverts_pose_matrices() -> None:
     eta = random_eta(np.random.default_rng(1), 200)
     np.testing.assert_allclose(frames.matrix_to_pose(frames.pose_matrices(eta)), eta, atol=1e-9)
     lock = np.array([1.0, 2.0, 3.0, 0.0, math.pi / 2, 0.7])
-    np.testing.assert_allclose(frames.pose_matrices(frames.matrix_to_pose(frames.pose_matrices(lock))), frames.pose_matrices(lock), atol=1e-9)
+    np.testing.assert_allclose(
+        frames.pose_matrices(frames.matrix_to_pose(frames.pose_matrices(lock))), frames.pose_matrices(lock), atol=1e-9
+    )
 
 
 def test_invert_and_transform_points() -> None:
@@ -119,11 +122,15 @@ def test_points_and_x1_to_x2_commute_with_the_mirror() -> None:
     # a point in frame a moved to frame b: mirror after = mirror before and use the CARLA poses
     ours = frames.transform_points(frames.invert(b) @ a, p)
     t = np.linalg.inv(loader_matrix(frames.carla_pose(b))) @ loader_matrix(frames.carla_pose(a))
-    np.testing.assert_allclose(frames.mirror_points(ours), frames.transform_points(t, frames.mirror_points(p)), atol=1e-8)
+    np.testing.assert_allclose(
+        frames.mirror_points(ours), frames.transform_points(t, frames.mirror_points(p)), atol=1e-8
+    )
     np.testing.assert_allclose(frames.x1_to_x2(frames.carla_pose(a), frames.carla_pose(b)), t, atol=1e-9)
     np.testing.assert_allclose(frames.mirror_points(frames.mirror_points(p)), p)
 
 
 def test_wrap() -> None:
-    np.testing.assert_allclose(frames.wrap_deg([180.0, -180.0, 190.0, -190.0, 360.0]), [180.0, 180.0, -170.0, 170.0, 0.0])
+    np.testing.assert_allclose(
+        frames.wrap_deg([180.0, -180.0, 190.0, -190.0, 360.0]), [180.0, 180.0, -170.0, 170.0, 0.0]
+    )
     np.testing.assert_allclose(frames.wrap_rad([3 * math.pi, -math.pi / 2]), [math.pi, -math.pi / 2])

@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
+import mmusv
 import numpy as np
 import pytest
-
-import mmusv
 from mmusv.config import load_scenario
 from mmusv.motion import build_fleet, scenario_poses
 
@@ -55,4 +54,6 @@ def test_fleet_rejects_bad_values_by_name() -> None:
     s = load_scenario(scenario())
     with pytest.raises(mmusv.ConfigError, match=r"vessels\[0\]"):
         # The Rust side validates too: a route doubling on a point is caught with the vessel named.
-        build_fleet(s.model_copy(update={"vessels": [s.vessels[0].model_copy(update={"route": [(0.0, 0.0), (0.0, 0.0)]})]}))
+        build_fleet(
+            s.model_copy(update={"vessels": [s.vessels[0].model_copy(update={"route": [(0.0, 0.0), (0.0, 0.0)]})]})
+        )

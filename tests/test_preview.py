@@ -8,7 +8,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-
 from mmusv.acquire import run
 from mmusv.preview import _TITLE_H, BOX_COLOUR, compose_preview
 from mmusv.recording import frame_messages, read_info, topics
@@ -21,13 +20,17 @@ def recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
     sc = yaml.safe_load((ROOT / "scenarios/port_entry.yaml").read_text())
     sc["acquisition"]["frames"] = 1
     sc["vessels"] = [v for v in sc["vessels"] if v["id"] != "usv_3"]
-    sc["rigs"] = {"usv_standard": {
-        "lidar": {"channels": 16, "points_per_second": 16 * 360 * 5},
-        "radar": {"range_m": 1000, "azimuth_bins": 256, "rays_el": 8, "ppi_size_px": 64},
-        "cameras": [{"name": n, "resolution": [320, 240], "mount": {"point": f"camera_{n}"}}
-                    for n in ("front", "left", "rear", "right")],
-        "top_view": {"resolution": [64, 64], "metres_per_pixel": 2.0},
-    }}
+    sc["rigs"] = {
+        "usv_standard": {
+            "lidar": {"channels": 16, "points_per_second": 16 * 360 * 5},
+            "radar": {"range_m": 1000, "azimuth_bins": 256, "rays_el": 8, "ppi_size_px": 64},
+            "cameras": [
+                {"name": n, "resolution": [320, 240], "mount": {"point": f"camera_{n}"}}
+                for n in ("front", "left", "rear", "right")
+            ],
+            "top_view": {"resolution": [64, 64], "metres_per_pixel": 2.0},
+        }
+    }
     return run(sc, out_dir=tmp_path_factory.mktemp("prev")).recording
 
 
@@ -38,10 +41,16 @@ def _is_box(px: np.ndarray) -> np.ndarray:
 def test_one_titled_non_blank_panel_per_recorded_image(recording: Path) -> None:
     sheet, panels = compose_preview(recording, frame=0)
     msgs = frame_messages(recording, 0)
-    images = [t for t in msgs if topics.agent_of(t) == "usv_1" and (
-        "/camera/" in t and t.rsplit("/", 1)[1] in ("rgb", "depth", "semantic")
-        or t.startswith(topics.top_view("usv_1")) and t.rsplit("/", 1)[1] in ("rgb", "semantic")
-        or t in (topics.radar_ppi("usv_1"), topics.lidar("usv_1")))]
+    images = [
+        t
+        for t in msgs
+        if topics.agent_of(t) == "usv_1"
+        and (
+            ("/camera/" in t and t.rsplit("/", 1)[1] in ("rgb", "depth", "semantic"))
+            or (t.startswith(topics.top_view("usv_1")) and t.rsplit("/", 1)[1] in ("rgb", "semantic"))
+            or t in (topics.radar_ppi("usv_1"), topics.lidar("usv_1"))
+        )
+    ]
     assert len(panels) == len(images) == 4 * 3 + 4
     arr = np.asarray(sheet)
     titles = [p.title for p in panels]
@@ -55,11 +64,11 @@ def test_one_titled_non_blank_panel_per_recorded_image(recording: Path) -> None:
         l, t, r, b = p.box
         body = arr[t:b, l:r].reshape(-1, 3)
         assert len(np.unique(body, axis=0)) > 1, f"blank panel {p.title}"
-        strip = arr[t - _TITLE_H:t, l:r].reshape(-1, 3)
+        strip = arr[t - _TITLE_H : t, l:r].reshape(-1, 3)
         assert len(np.unique(strip, axis=0)) > 2, f"no title text on {p.title}"
     # panels tile the sheet without overlapping
     for i, p in enumerate(panels):
-        for q in panels[i + 1:]:
+        for q in panels[i + 1 :]:
             assert p.box[2] <= q.box[0] or q.box[2] <= p.box[0] or p.box[3] <= q.box[1] or q.box[3] <= p.box[1]
 
 
@@ -72,20 +81,24 @@ def test_2d_boxes_on_the_camera_edges(recording: Path) -> None:
     for b in boxes:
         p = next(p for p in panels if p.title.startswith(f"usv_1 · {b.camera} camera · RGB"))
         l, t = p.box[0], p.box[1]
-        x0, y0, x1, y1 = (round(l + b.x_min * p.scale), round(t + b.y_min * p.scale), round(l + b.x_max * p.scale),
-                          round(t + b.y_max * p.scale))
+        x0, y0, x1, y1 = (
+            round(l + b.x_min * p.scale),
+            round(t + b.y_min * p.scale),
+            round(l + b.x_max * p.scale),
+            round(t + b.y_max * p.scale),
+        )
         x1, y1 = min(x1, p.box[2] - 1), min(y1, p.box[3] - 1)
         # the left and right edges (skip the corners, where a label may sit above the top edge)
         for x in (x0, x1):
-            col = arr[y0 + 2:y1 - 1, max(x - 1, l):x + 2]
+            col = arr[y0 + 2 : y1 - 1, max(x - 1, l) : x + 2]
             assert _is_box(col).any(axis=1).all(), f"edge x={x} of box {b.target_id} in {b.camera} not drawn"
         # and the box interior is not filled
         if x1 - x0 > 8 and y1 - y0 > 8:
-            assert not _is_box(arr[y0 + 4:y1 - 3, x0 + 4:x1 - 3]).all()
+            assert not _is_box(arr[y0 + 4 : y1 - 3, x0 + 4 : x1 - 3]).all()
 
 
 def test_3d_box_footprints_in_the_bev(recording: Path) -> None:
-    sheet, panels = compose_preview(recording, frame=0, agent="usv_2")   # usv_2 has the tug in LiDAR range
+    sheet, panels = compose_preview(recording, frame=0, agent="usv_2")  # usv_2 has the tug in LiDAR range
     arr = np.asarray(sheet)
     ann = frame_messages(recording, 0)[topics.agent_annotations("usv_2")]
     bev = next(p for p in panels if "BEV" in p.title)
@@ -100,7 +113,7 @@ def test_3d_box_footprints_in_the_bev(recording: Path) -> None:
         by = box.center[1] + s * box.size[0] / 2 + c * box.size[1] / 2
         u, v = round(cu - by * bev.scale), round(cv - bx * bev.scale)
         if l + 2 <= u < r - 2 and t + 2 <= v < b - 2:
-            assert _is_box(arr[v - 2:v + 3, u - 2:u + 3]).any(), f"corner of {box.target_id} not drawn"
+            assert _is_box(arr[v - 2 : v + 3, u - 2 : u + 3]).any(), f"corner of {box.target_id} not drawn"
             drawn += 1
     assert drawn >= 1
 
@@ -109,7 +122,7 @@ def test_ppi_ring_scale_from_the_recording(recording: Path) -> None:
     _sheet, panels = compose_preview(recording, frame=0)
     ppi = next(p for p in panels if "PPI" in p.title)
     a = read_info(recording).agents[0]
-    assert a.ppi_metres_per_pixel == pytest.approx(1000 / 32)   # range_m / (ppi_size_px / 2)
+    assert a.ppi_metres_per_pixel == pytest.approx(1000 / 32)  # range_m / (ppi_size_px / 2)
     # the panel spans the PPI image: 64 px × m/px metres across
     assert ppi.scale * 64 * a.ppi_metres_per_pixel == pytest.approx(ppi.box[2] - ppi.box[0])
 

@@ -60,7 +60,14 @@ LIDAR: dict[str, Any] = {
     "lidar_points": [1200, 37],
     "range_m": [50.05, 80.1],
 }
-BEV: dict[str, Any] = {"target_id": ["target1"], "x": [50.0], "y": [1.0], "length": [120.0], "width": [20.0], "yaw": [0.25]}
+BEV: dict[str, Any] = {
+    "target_id": ["target1"],
+    "x": [50.0],
+    "y": [1.0],
+    "length": [120.0],
+    "width": [20.0],
+    "yaw": [0.25],
+}
 CAMERA: dict[str, Any] = {
     "target_id": ["target1", "target2"],
     "camera": ["front", "left"],
@@ -279,10 +286,9 @@ def test_partial_name_until_finish_and_existing_file_refused(tmp_path: Path) -> 
 
 def test_exception_inside_with_leaves_a_readable_partial_file(tmp_path: Path) -> None:
     path = tmp_path / "crash.mcap"
-    with pytest.raises(RuntimeError, match="boom"):
-        with Recording(path) as rec:
-            write_everything(rec, frames=1)
-            raise RuntimeError("boom")
+    with pytest.raises(RuntimeError, match="boom"), Recording(path) as rec:
+        write_everything(rec, frames=1)
+        raise RuntimeError("boom")
     assert not path.exists()
     partial = tmp_path / "crash.mcap.partial"
     assert len(list(read_messages(partial))) == TOPIC_COUNT

@@ -6,7 +6,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from mmusv.config import load_scenario
 from mmusv.simulation import Simulation
 
@@ -30,7 +29,9 @@ def test_island_hides_the_target_from_the_ego_but_not_from_the_others() -> None:
     target = next(v.instance_id for v in sim.vessels if v.id == "target_1")
     for k in (0, sim.frames - 1):
         cap = sim.capture(k, sensors=["lidar"])
-        seen = {a: int(np.count_nonzero(c.lidar.instance == target)) for a, c in cap.agents.items() if c.lidar is not None}
+        seen = {
+            a: int(np.count_nonzero(c.lidar.instance == target)) for a, c in cap.agents.items() if c.lidar is not None
+        }
         assert seen["usv_1"] == 0
         assert seen["usv_2"] + seen["usv_3"] > 0
 
@@ -68,8 +69,13 @@ def test_port_entry_shows_cooperation() -> None:
     names = {v.instance_id: (v.id, v.role) for v in sim.vessels}
     cap = sim.capture(sim.frames - 1)
     seen = {
-        a: {names[i] for i, n in zip(*np.unique(c.lidar.instance, return_counts=True), strict=True) if i in names and n >= 5}
-        for a, c in cap.agents.items() if c.lidar is not None
+        a: {
+            names[i]
+            for i, n in zip(*np.unique(c.lidar.instance, return_counts=True), strict=True)
+            if i in names and n >= 5
+        }
+        for a, c in cap.agents.items()
+        if c.lidar is not None
     }
     for a, s in seen.items():
         others = set().union(*(t for b, t in seen.items() if b != a))

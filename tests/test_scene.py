@@ -55,7 +55,9 @@ TIE_RTOL = 1e-4  # two hits this close in distance are a tie: ambiguous
 # ----------------------------------------------------------------------------------------------------------
 
 
-def random_soup(rng: np.random.Generator, n: int, *, spread: float = 10.0, size: float = 1.5) -> tuple[F32, npt.NDArray[np.int64]]:
+def random_soup(
+    rng: np.random.Generator, n: int, *, spread: float = 10.0, size: float = 1.5
+) -> tuple[F32, npt.NDArray[np.int64]]:
     """``n`` random triangles (3n float32 vertices, (n, 3) int64 faces) around random centres in a cube."""
     centres = rng.uniform(-spread, spread, size=(n, 1, 3))
     v = (centres + rng.uniform(-size, size, size=(n, 3, 3))).reshape(-1, 3).astype(np.float32)
@@ -80,7 +82,14 @@ def box_mesh(half: tuple[float, float, float]) -> tuple[F64, npt.NDArray[np.int6
 
 def rpy_matrix(roll: float, pitch: float, yaw: float) -> F64:
     """``Rz(yaw) @ Ry(pitch) @ Rx(roll)``."""
-    cr, sr, cp, sp, cy, sy = math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch), math.cos(yaw), math.sin(yaw)
+    cr, sr, cp, sp, cy, sy = (
+        math.cos(roll),
+        math.sin(roll),
+        math.cos(pitch),
+        math.sin(pitch),
+        math.cos(yaw),
+        math.sin(yaw),
+    )
     rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
     ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
     rx = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
@@ -113,7 +122,9 @@ def random_pose(rng: np.random.Generator, *, reach: float = 5.0) -> F64:
     return pose(quat_matrix(rng.normal(size=4)), rng.uniform(-reach, reach, size=3))
 
 
-def random_rays(rng: np.random.Generator, n: int, vertices: F32, faces: npt.ArrayLike, *, box: float = 15.0) -> tuple[F32, F32]:
+def random_rays(
+    rng: np.random.Generator, n: int, vertices: F32, faces: npt.ArrayLike, *, box: float = 15.0
+) -> tuple[F32, F32]:
     """Origins uniform in a cube; half the rays aimed at a random point inside a random triangle (so many hit),
     half in uniformly random directions."""
     f = np.asarray(faces)
@@ -144,7 +155,13 @@ class Reference:
         return self.tri >= 0
 
 
-def brute_force(vertices: npt.ArrayLike, faces: npt.ArrayLike, origins: npt.ArrayLike, directions: npt.ArrayLike, max_range: float = math.inf) -> Reference:
+def brute_force(
+    vertices: npt.ArrayLike,
+    faces: npt.ArrayLike,
+    origins: npt.ArrayLike,
+    directions: npt.ArrayLike,
+    max_range: float = math.inf,
+) -> Reference:
     """Two-sided Möller–Trumbore over every (ray, triangle) pair in float64, vectorised over both."""
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
@@ -199,7 +216,10 @@ def brute_force(vertices: npt.ArrayLike, faces: npt.ArrayLike, origins: npt.Arra
             # Distance in metres from the plane point to the nearest edge line: float32 coordinates resolve a few
             # micrometres, and a non-watertight ray-triangle test may crack within that band (see the xfail below).
             edge_m = np.minimum(
-                np.minimum((1.0 - u - w) * (area2 / np.linalg.norm(e2 - e1, axis=1))[None, :], u * (area2 / np.linalg.norm(e2, axis=1))[None, :]),
+                np.minimum(
+                    (1.0 - u - w) * (area2 / np.linalg.norm(e2 - e1, axis=1))[None, :],
+                    u * (area2 / np.linalg.norm(e2, axis=1))[None, :],
+                ),
                 w * (area2 / np.linalg.norm(e1, axis=1))[None, :],
             )
             near_edge = ((np.abs(margin) < edge_tol) | (np.abs(edge_m) < EDGE_TOL_M)) & (t > -1e-3)
@@ -259,7 +279,9 @@ def scene_with(vertices: npt.ArrayLike, faces: npt.ArrayLike, **mesh_kw: Any) ->
     return s
 
 
-def world_reference(scene: Scene, origins: F32, dirs: F32, max_range: float = math.inf) -> tuple[Reference, dict[str, np.ndarray]]:
+def world_reference(
+    scene: Scene, origins: F32, dirs: F32, max_range: float = math.inf
+) -> tuple[Reference, dict[str, np.ndarray]]:
     """Brute force over ``scene.world_mesh()``; ``ref.tri`` indexes world faces."""
     w = scene.world_mesh()
     return brute_force(w["vertices"], w["faces"], origins, dirs, max_range), w
@@ -271,7 +293,9 @@ def assert_world_hits_match(hits: RayHits, ref: Reference, w: dict[str, np.ndarr
     tri_ref = np.where(ref.hit, w["triangle_ids"][np.maximum(ref.tri, 0)].astype(np.int64), -1)
     r = ref.robust
     bad = r & (hits.instance_id != inst_ref)
-    assert not bad.any(), f"instance ids differ on {int(bad.sum())} rays: got {hits.instance_id[bad][:5]} want {inst_ref[bad][:5]}"
+    assert not bad.any(), (
+        f"instance ids differ on {int(bad.sum())} rays: got {hits.instance_id[bad][:5]} want {inst_ref[bad][:5]}"
+    )
     global_tri = np.full(len(hits.distance), -1, dtype=np.int64)  # world face index of each hit, for the comparison
     for k in np.flatnonzero(hits.instance_id >= 0):
         sel = np.flatnonzero((w["instance_ids"] == hits.instance_id[k]) & (w["triangle_ids"] == hits.triangle_id[k]))
@@ -469,7 +493,7 @@ def test_set_poses_moves_instances_and_only_them() -> None:
     hits = s.cast_rays(o, d)
     ref, w = world_reference(s, o, d)
     assert_world_hits_match(hits, ref, w, min_hits=500)
-    for iid, t in zip([ids[0], ids[2]], new):
+    for iid, t in zip([ids[0], ids[2]], new, strict=False):
         moved = v.astype(np.float64) @ t[:3, :3].T + t[:3, 3]
         aabb = s.instance_aabb(iid)
         assert aabb.shape == (2, 3) and aabb.dtype == np.float32
@@ -478,7 +502,7 @@ def test_set_poses_moves_instances_and_only_them() -> None:
     # A single (4, 4) pose for a single id is accepted too.
     s.set_poses(ids[1], pose(translation=(0.0, 0.0, 100.0)))
     assert s.instance_pose(ids[1])[2, 3] == pytest.approx(100.0)
-    target = v[f[0]].astype(np.float64).mean(axis=0) + (0.0, 0.0, 100.0)
+    target = v[f[0]].astype(np.float64).mean(axis=0) + np.array([0.0, 0.0, 100.0])
     up = s.cast_rays([target - (0.0, 0.0, 50.0)], [[0.0, 0.0, 1.0]])
     assert up.instance_id[0] == ids[1] and up.distance[0] <= 50.0 + 1e-4
 
@@ -724,77 +748,249 @@ BAD_CALLS: list[tuple[str, Callable[[Scene], object], type[MmusvError], str]] = 
     ("vertices_3d", lambda s: s.add_mesh(TRI_V[None], TRI_F), InputError, r"vertices must have shape"),
     ("faces_4_columns", lambda s: s.add_mesh(TRI_V, [[0, 1, 2, 0]]), InputError, r"faces must have shape \(N, 3\)"),
     ("vertices_strings", lambda s: s.add_mesh([["a", "b", "c"]] * 3, TRI_F), InputError, r"vertices must be numeric"),
-    ("vertices_object", lambda s: s.add_mesh(np.array([[0, 0, 0], [1, 0, 0], [0, 1, None]], dtype=object), TRI_F), InputError, r"vertices must be numeric"),
-    ("vertices_ragged", lambda s: s.add_mesh([[0, 0], [1, 0, 0]], TRI_F), InputError, r"vertices could not be converted"),
+    (
+        "vertices_object",
+        lambda s: s.add_mesh(np.array([[0, 0, 0], [1, 0, 0], [0, 1, None]], dtype=object), TRI_F),
+        InputError,
+        r"vertices must be numeric",
+    ),
+    (
+        "vertices_ragged",
+        lambda s: s.add_mesh([[0, 0], [1, 0, 0]], TRI_F),
+        InputError,
+        r"vertices could not be converted",
+    ),
     ("faces_strings", lambda s: s.add_mesh(TRI_V, [["0", "1", "2"]]), InputError, r"faces must be numeric"),
-    ("faces_float", lambda s: s.add_mesh(TRI_V, TRI_F.astype(np.float64)), InputError, r"faces must be an integer array"),
-    ("faces_object", lambda s: s.add_mesh(TRI_V, np.array([[0, 1, None]], dtype=object)), InputError, r"faces must be numeric"),
+    (
+        "faces_float",
+        lambda s: s.add_mesh(TRI_V, TRI_F.astype(np.float64)),
+        InputError,
+        r"faces must be an integer array",
+    ),
+    (
+        "faces_object",
+        lambda s: s.add_mesh(TRI_V, np.array([[0, 1, None]], dtype=object)),
+        InputError,
+        r"faces must be numeric",
+    ),
     ("vertices_nan", lambda s: s.add_mesh(nan_vertices, TRI_F), GeometryError, r"vertices\[1\].*not finite"),
-    ("vertices_inf_float32", lambda s: s.add_mesh(inf_vertices.astype(np.float32), TRI_F), GeometryError, r"vertices\[2\].*not finite"),
-    ("face_index_out_of_range", lambda s: s.add_mesh(TRI_V, [[0, 1, 3]]), GeometryError, r"faces\[0\].*outside the 3 vertices"),
-    ("face_index_negative", lambda s: s.add_mesh(TRI_V, [[0, 1, 2], [0, -1, 2]]), GeometryError, r"faces\[1\].*outside"),
-    ("face_index_uint32_max", lambda s: s.add_mesh(TRI_V, np.array([[0, 1, 2**32 - 1]], np.uint32)), GeometryError, r"faces\[0\]"),
+    (
+        "vertices_inf_float32",
+        lambda s: s.add_mesh(inf_vertices.astype(np.float32), TRI_F),
+        GeometryError,
+        r"vertices\[2\].*not finite",
+    ),
+    (
+        "face_index_out_of_range",
+        lambda s: s.add_mesh(TRI_V, [[0, 1, 3]]),
+        GeometryError,
+        r"faces\[0\].*outside the 3 vertices",
+    ),
+    (
+        "face_index_negative",
+        lambda s: s.add_mesh(TRI_V, [[0, 1, 2], [0, -1, 2]]),
+        GeometryError,
+        r"faces\[1\].*outside",
+    ),
+    (
+        "face_index_uint32_max",
+        lambda s: s.add_mesh(TRI_V, np.array([[0, 1, 2**32 - 1]], np.uint32)),
+        GeometryError,
+        r"faces\[0\]",
+    ),
     ("vertices_empty", lambda s: s.add_mesh(np.zeros((0, 3)), TRI_F), GeometryError, r"vertices.*no vertices"),
     ("faces_empty", lambda s: s.add_mesh(TRI_V, np.zeros((0, 3), np.int64)), GeometryError, r"faces.*no faces"),
-    ("classes_wrong_length", lambda s: s.add_mesh(TRI_V, TRI_F, classes=[1, 2]), InputError, r"classes.*2 classes for 1 faces"),
+    (
+        "classes_wrong_length",
+        lambda s: s.add_mesh(TRI_V, TRI_F, classes=[1, 2]),
+        InputError,
+        r"classes.*2 classes for 1 faces",
+    ),
     ("classes_negative", lambda s: s.add_mesh(TRI_V, TRI_F, classes=-1), InputError, r"classes must be in 0\.\.65535"),
-    ("classes_too_big", lambda s: s.add_mesh(TRI_V, TRI_F, classes=70000), InputError, r"classes must be in 0\.\.65535"),
+    (
+        "classes_too_big",
+        lambda s: s.add_mesh(TRI_V, TRI_F, classes=70000),
+        InputError,
+        r"classes must be in 0\.\.65535",
+    ),
     ("classes_float", lambda s: s.add_mesh(TRI_V, TRI_F, classes=1.5), InputError, r"classes must be an int"),
     # add_instance / set_poses
     ("instance_of_unknown_mesh", lambda s: s.add_instance(99), NotFoundError, r"unknown mesh id 99"),
     ("instance_of_negative_mesh", lambda s: s.add_instance(-1), NotFoundError, r"unknown mesh id -1"),
-    ("class_override_negative", lambda s: s.add_instance(0, class_override=-1), InputError, r"class_override must be in 0\.\.65535"),
-    ("class_override_too_big", lambda s: s.add_instance(0, class_override=70000), InputError, r"class_override must be in 0\.\.65535"),
+    (
+        "class_override_negative",
+        lambda s: s.add_instance(0, class_override=-1),
+        InputError,
+        r"class_override must be in 0\.\.65535",
+    ),
+    (
+        "class_override_too_big",
+        lambda s: s.add_instance(0, class_override=70000),
+        InputError,
+        r"class_override must be in 0\.\.65535",
+    ),
     ("pose_string", lambda s: s.add_instance(0, pose="identity"), InputError, r"pose must be a real numeric array"),
-    ("pose_complex", lambda s: s.add_instance(0, pose=np.eye(4) * 1j), InputError, r"pose must be a real numeric array"),
+    (
+        "pose_complex",
+        lambda s: s.add_instance(0, pose=np.eye(4) * 1j),
+        InputError,
+        r"pose must be a real numeric array",
+    ),
     ("pose_3x3", lambda s: s.add_instance(0, pose=np.eye(3)), InputError, r"pose must be a \(4, 4\)"),
-    ("pose_scaled", lambda s: s.add_instance(0, pose=np.diag([2.0, 1.0, 1.0, 1.0])), InputError, r"pose.*not orthonormal"),
-    ("pose_sheared", lambda s: s.add_instance(0, pose=np.array([[1, 0.3, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])), InputError, r"pose.*not orthonormal"),
-    ("pose_reflection", lambda s: s.add_instance(0, pose=np.diag([1.0, 1.0, -1.0, 1.0])), InputError, r"pose.*reflection"),
+    (
+        "pose_scaled",
+        lambda s: s.add_instance(0, pose=np.diag([2.0, 1.0, 1.0, 1.0])),
+        InputError,
+        r"pose.*not orthonormal",
+    ),
+    (
+        "pose_sheared",
+        lambda s: s.add_instance(0, pose=np.array([[1, 0.3, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])),
+        InputError,
+        r"pose.*not orthonormal",
+    ),
+    (
+        "pose_reflection",
+        lambda s: s.add_instance(0, pose=np.diag([1.0, 1.0, -1.0, 1.0])),
+        InputError,
+        r"pose.*reflection",
+    ),
     ("pose_nan", lambda s: s.add_instance(0, pose=np.where(np.eye(4) > 0, np.nan, 0.0)), InputError, r"pose.*NaN"),
-    ("pose_bad_last_row", lambda s: s.add_instance(0, pose=np.array([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [1, 0, 0, 1.0]])), InputError, r"pose.*last row"),
+    (
+        "pose_bad_last_row",
+        lambda s: s.add_instance(0, pose=np.array([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [1, 0, 0, 1.0]])),
+        InputError,
+        r"pose.*last row",
+    ),
     ("set_poses_unknown_instance", lambda s: s.set_poses([5], np.eye(4)), NotFoundError, r"unknown instance id 5"),
     ("set_poses_negative_id", lambda s: s.set_poses([-1], np.eye(4)), NotFoundError, r"unknown instance id -1"),
-    ("set_poses_id_2**32", lambda s: s.set_poses(np.array([2**32]), np.eye(4)), NotFoundError, r"unknown instance id 4294967296"),
-    ("set_poses_id_2**40", lambda s: s.set_poses([2**40], np.eye(4)), NotFoundError, r"unknown instance id 1099511627776"),
-    ("set_poses_flat_16", lambda s: s.set_poses([0], np.eye(4).ravel()), InputError, r"poses must have shape \(K, 4, 4\)"),
-    ("set_poses_4d", lambda s: s.set_poses([0], np.eye(4)[None, None]), InputError, r"poses must have shape \(K, 4, 4\)"),
+    (
+        "set_poses_id_2**32",
+        lambda s: s.set_poses(np.array([2**32]), np.eye(4)),
+        NotFoundError,
+        r"unknown instance id 4294967296",
+    ),
+    (
+        "set_poses_id_2**40",
+        lambda s: s.set_poses([2**40], np.eye(4)),
+        NotFoundError,
+        r"unknown instance id 1099511627776",
+    ),
+    (
+        "set_poses_flat_16",
+        lambda s: s.set_poses([0], np.eye(4).ravel()),
+        InputError,
+        r"poses must have shape \(K, 4, 4\)",
+    ),
+    (
+        "set_poses_4d",
+        lambda s: s.set_poses([0], np.eye(4)[None, None]),
+        InputError,
+        r"poses must have shape \(K, 4, 4\)",
+    ),
     ("set_poses_string", lambda s: s.set_poses([0], "identity"), InputError, r"poses must be a real numeric array"),
-    ("set_poses_complex", lambda s: s.set_poses([0], np.eye(4) + 0j), InputError, r"poses must be a real numeric array"),
-    ("set_poses_bool_ids", lambda s: s.set_poses([True], np.eye(4)), InputError, r"instance_ids must be a 1-D integer array"),
-    ("set_poses_float_ids", lambda s: s.set_poses([0.5], np.eye(4)), InputError, r"instance_ids must be a 1-D integer array"),
-    ("set_poses_count_mismatch", lambda s: s.set_poses([0, 0], np.eye(4)), InputError, r"poses must have shape \(2, 4, 4\)"),
-    ("set_poses_3x3", lambda s: s.set_poses([0], np.eye(3)), InputError, r"poses must have shape \(K, 4, 4\).*got \(3, 3\)"),
-    ("set_poses_non_rigid", lambda s: s.set_poses([0], np.diag([1.0, 3.0, 1.0, 1.0])), InputError, r"poses\[0\].*not orthonormal"),
-    ("set_poses_second_bad", lambda s: s.set_poses([0, 0], np.stack([np.eye(4), np.diag([1.0, 1.0, -1.0, 1.0])])), InputError, r"poses\[1\]"),
+    (
+        "set_poses_complex",
+        lambda s: s.set_poses([0], np.eye(4) + 0j),
+        InputError,
+        r"poses must be a real numeric array",
+    ),
+    (
+        "set_poses_bool_ids",
+        lambda s: s.set_poses([True], np.eye(4)),
+        InputError,
+        r"instance_ids must be a 1-D integer array",
+    ),
+    (
+        "set_poses_float_ids",
+        lambda s: s.set_poses([0.5], np.eye(4)),
+        InputError,
+        r"instance_ids must be a 1-D integer array",
+    ),
+    (
+        "set_poses_count_mismatch",
+        lambda s: s.set_poses([0, 0], np.eye(4)),
+        InputError,
+        r"poses must have shape \(2, 4, 4\)",
+    ),
+    (
+        "set_poses_3x3",
+        lambda s: s.set_poses([0], np.eye(3)),
+        InputError,
+        r"poses must have shape \(K, 4, 4\).*got \(3, 3\)",
+    ),
+    (
+        "set_poses_non_rigid",
+        lambda s: s.set_poses([0], np.diag([1.0, 3.0, 1.0, 1.0])),
+        InputError,
+        r"poses\[0\].*not orthonormal",
+    ),
+    (
+        "set_poses_second_bad",
+        lambda s: s.set_poses([0, 0], np.stack([np.eye(4), np.diag([1.0, 1.0, -1.0, 1.0])])),
+        InputError,
+        r"poses\[1\]",
+    ),
     ("aabb_unknown_instance", lambda s: s.instance_aabb(9), NotFoundError, r"unknown instance id 9"),
     ("aabb_negative_instance", lambda s: s.instance_aabb(-1), NotFoundError, r"unknown instance id -1"),
     ("pose_of_negative_instance", lambda s: s.instance_pose(-1), NotFoundError, r"unknown instance id -1"),
     ("pose_of_unknown_instance", lambda s: s.instance_pose(9), NotFoundError, r"unknown instance id 9"),
     # cast_rays
-    ("zero_direction", lambda s: s.cast_rays(np.zeros((2, 3)), [[0, 0, 1], [0, 0, 0]]), InputError, r"directions\[1\].*zero-length"),
+    (
+        "zero_direction",
+        lambda s: s.cast_rays(np.zeros((2, 3)), [[0, 0, 1], [0, 0, 0]]),
+        InputError,
+        r"directions\[1\].*zero-length",
+    ),
     ("nan_direction", lambda s: s.cast_rays(GOOD_O, [[np.nan, 0, 1]]), InputError, r"directions\[0\].*not finite"),
     ("inf_direction", lambda s: s.cast_rays(GOOD_O, [[np.inf, 0, 1]]), InputError, r"directions\[0\]"),
-    ("nan_origin", lambda s: s.cast_rays(np.array([[0, 0, 0], [0, np.nan, 0]]), np.ones((2, 3))), InputError, r"origins\[1\].*not finite"),
+    (
+        "nan_origin",
+        lambda s: s.cast_rays(np.array([[0, 0, 0], [0, np.nan, 0]]), np.ones((2, 3))),
+        InputError,
+        r"origins\[1\].*not finite",
+    ),
     ("length_mismatch", lambda s: s.cast_rays(np.zeros((2, 3)), GOOD_D), InputError, r"1 directions for 2 origins"),
-    ("origins_2_columns", lambda s: s.cast_rays(GOOD_O[:, :2], GOOD_D), InputError, r"origins must have shape \(N, 3\)"),
+    (
+        "origins_2_columns",
+        lambda s: s.cast_rays(GOOD_O[:, :2], GOOD_D),
+        InputError,
+        r"origins must have shape \(N, 3\)",
+    ),
     ("directions_1d", lambda s: s.cast_rays(GOOD_O, GOOD_D.ravel()), InputError, r"directions must have shape"),
     ("origins_strings", lambda s: s.cast_rays([["a", "b", "c"]], GOOD_D), InputError, r"origins must be numeric"),
-    ("directions_object", lambda s: s.cast_rays(GOOD_O, np.array([[0, 0, None]], dtype=object)), InputError, r"directions must be numeric"),
+    (
+        "directions_object",
+        lambda s: s.cast_rays(GOOD_O, np.array([[0, 0, None]], dtype=object)),
+        InputError,
+        r"directions must be numeric",
+    ),
     ("directions_complex", lambda s: s.cast_rays(GOOD_O, GOOD_D + 1j), InputError, r"directions must be real"),
     ("vertices_complex", lambda s: s.add_mesh(TRI_V + 0j, TRI_F), InputError, r"vertices must be real"),
     ("max_range_zero", lambda s: s.cast_rays(GOOD_O, GOOD_D, max_range=0.0), InputError, r"max_range"),
     ("max_range_negative", lambda s: s.cast_rays(GOOD_O, GOOD_D, max_range=-1.0), InputError, r"max_range"),
     ("max_range_nan", lambda s: s.cast_rays(GOOD_O, GOOD_D, max_range=float("nan")), InputError, r"max_range"),
     # export
-    ("export_bad_extension", lambda s: s.export("/nonexistent-mmusv-dir/world.stl"), InputError, r"extension.*stl.*\.ply or \.obj"),
+    (
+        "export_bad_extension",
+        lambda s: s.export("/nonexistent-mmusv-dir/world.stl"),
+        InputError,
+        r"extension.*stl.*\.ply or \.obj",
+    ),
     ("export_no_extension", lambda s: s.export("/nonexistent-mmusv-dir/world"), InputError, r"extension"),
-    ("export_missing_directory", lambda s: s.export("/nonexistent-mmusv-dir/world.ply"), IoError, r"nonexistent-mmusv-dir"),
+    (
+        "export_missing_directory",
+        lambda s: s.export("/nonexistent-mmusv-dir/world.ply"),
+        IoError,
+        r"nonexistent-mmusv-dir",
+    ),
 ]
 
 
 @pytest.mark.parametrize(("call", "exc", "match"), [c[1:] for c in BAD_CALLS], ids=[c[0] for c in BAD_CALLS])
-def test_bad_input_raises_named_mmusv_error(tri_scene: Scene, call: Callable[[Scene], object], exc: type[MmusvError], match: str) -> None:
+def test_bad_input_raises_named_mmusv_error(
+    tri_scene: Scene, call: Callable[[Scene], object], exc: type[MmusvError], match: str
+) -> None:
     n_before = (tri_scene.num_meshes, tri_scene.num_instances, tri_scene.num_world_triangles)
     with pytest.raises(exc, match=match) as info:
         call(tri_scene)
@@ -829,7 +1025,12 @@ def test_non_numeric_max_range(tri_scene: Scene, value: Any) -> None:
 
 @pytest.mark.parametrize(
     "call",
-    [lambda s: s.add_instance(0.7), lambda s: s.add_instance("0"), lambda s: s.instance_pose(0.9), lambda s: s.add_instance(0, class_override=2.5)],
+    [
+        lambda s: s.add_instance(0.7),
+        lambda s: s.add_instance("0"),
+        lambda s: s.instance_pose(0.9),
+        lambda s: s.add_instance(0, class_override=2.5),
+    ],
     ids=["mesh_id_float", "mesh_id_str", "instance_id_float", "class_override_float"],
 )
 def test_non_integer_ids_rejected(tri_scene: Scene, call: Callable[[Scene], object]) -> None:
@@ -1003,7 +1204,9 @@ def test_mutating_the_scene_during_a_cast_in_another_thread_does_not_deadlock() 
     Run in a subprocess, because a deadlock would hang the whole test run.
     """
     try:
-        out = subprocess.run([sys.executable, "-c", _DEADLOCK_SCRIPT], check=False, capture_output=True, text=True, timeout=30.0)
+        out = subprocess.run(
+            [sys.executable, "-c", _DEADLOCK_SCRIPT], check=False, capture_output=True, text=True, timeout=30.0
+        )
     except subprocess.TimeoutExpired:
         pytest.fail("deadlock: set_poses / add_instance / add_mesh during a cast_rays in another thread never returned")
     assert out.returncode == 0 and out.stdout.strip() == "ok", out.stderr
@@ -1042,7 +1245,12 @@ def test_demo_scene_pose_updates_keep_mesh_counts() -> None:
     w0 = s.world_mesh()
     rng = np.random.default_rng(16)
     for _ in range(5):
-        poses = np.stack([pose(rpy_matrix(0.0, 0.0, rng.uniform(0, 2 * math.pi)), (*rng.uniform(-500, 500, 2), 0.0)) for _ in vessels])
+        poses = np.stack(
+            [
+                pose(rpy_matrix(0.0, 0.0, rng.uniform(0, 2 * math.pi)), (*rng.uniform(-500, 500, 2), 0.0))
+                for _ in vessels
+            ]
+        )
         s.set_poses(vessels, poses)
         assert (s.num_meshes, s.num_instances, s.num_world_triangles) == counts
     np.testing.assert_allclose(np.stack([s.instance_pose(i) for i in vessels]), poses, atol=1e-5)
@@ -1072,7 +1280,9 @@ def test_demo_scene_small_extent_is_an_input_error() -> None:
 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
-    params=hnp.arrays(np.float32, st.tuples(st.integers(1, 12), st.just(3), st.just(3)), elements=st.floats(-3, 3, width=32)),
+    params=hnp.arrays(
+        np.float32, st.tuples(st.integers(1, 12), st.just(3), st.just(3)), elements=st.floats(-3, 3, width=32)
+    ),
     seed=st.integers(0, 2**32 - 1),
     max_range=st.one_of(st.just(math.inf), st.floats(0.5, 30.0)),
 )
@@ -1081,7 +1291,14 @@ def test_property_small_soup_matches_brute_force(params: F32, seed: int, max_ran
     values (zeros, repeats) still give real, mostly separate triangles."""
     n = len(params)
     centre = params[:, 0] + np.array([0.0, 0.0, 1.5], dtype=np.float32) * np.arange(n, dtype=np.float32)[:, None]
-    tris = np.stack([centre, centre + params[:, 1] + np.array([1, 0, 0], dtype=np.float32), centre + params[:, 2] + np.array([0, 1, 0], dtype=np.float32)], axis=1)
+    tris = np.stack(
+        [
+            centre,
+            centre + params[:, 1] + np.array([1, 0, 0], dtype=np.float32),
+            centre + params[:, 2] + np.array([0, 1, 0], dtype=np.float32),
+        ],
+        axis=1,
+    )
     v = tris.reshape(-1, 3).astype(np.float32)
     f = np.arange(len(v)).reshape(-1, 3)
     rng = np.random.default_rng(seed)

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-
 from mmusv.annotate import in_target_range
 
 

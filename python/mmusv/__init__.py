@@ -7,7 +7,9 @@ into an MCAP recording plus Parquet tables; :class:`mmusv.Simulation` captures s
 
 from __future__ import annotations
 
+from mmusv import config
 from mmusv._native import core as _core_module
+from mmusv.acquire import RunResult, run
 from mmusv.errors import (
     ConfigError,
     GeometryError,
@@ -18,25 +20,23 @@ from mmusv.errors import (
     NotFoundError,
 )
 from mmusv.scene import RayHits, Scene
-from mmusv import config
-from mmusv.acquire import RunResult, run
 from mmusv.simulation import Simulation
 
 __version__: str = _core_module.__version__
 
 __all__ = [
-    "__version__",
-    "Scene",
-    "RayHits",
-    "Simulation",
-    "run",
-    "RunResult",
-    "config",
-    "MmusvError",
-    "InputError",
-    "GeometryError",
     "ConfigError",
-    "NotFoundError",
-    "IoError",
+    "GeometryError",
+    "InputError",
     "InternalError",
+    "IoError",
+    "MmusvError",
+    "NotFoundError",
+    "RayHits",
+    "RunResult",
+    "Scene",
+    "Simulation",
+    "__version__",
+    "config",
+    "run",
 ]

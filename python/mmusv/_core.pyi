@@ -13,30 +13,30 @@ import numpy as np
 import numpy.typing as npt
 
 __all__ = [
-    "__version__",
-    "MmusvError",
-    "InputError",
-    "GeometryError",
+    "Camera",
     "ConfigError",
-    "NotFoundError",
-    "IoError",
+    "Fleet",
+    "GeometryError",
+    "InputError",
     "InternalError",
+    "IoError",
+    "Lidar",
+    "MmusvError",
+    "NotFoundError",
+    "Radar",
+    "Recorder",
     "Scene",
+    "SensorEnv",
+    "__version__",
+    "_lidar_directions",
+    "_pinhole_directions",
+    "default_amplitudes",
+    "demo_scene",
+    "lidar_trace_order",
     "pinhole_intrinsics",
     "uniform_elevations",
-    "lidar_trace_order",
-    "_pinhole_directions",
-    "_lidar_directions",
-    "SensorEnv",
-    "Lidar",
-    "Camera",
-    "Radar",
-    "demo_scene",
-    "Fleet",
-    "default_amplitudes",
     "wave_height",
     "wave_presets",
-    "Recorder",
 ]
 
 __version__: str
@@ -317,7 +317,6 @@ class Radar:
         ``intensity``; (N,) float32 each): ego at pixel (size_px // 2, size_px // 2), row 0 at the top, a return at
         range R exactly R / metres_per_pixel px from it; ``orientation`` "north_up" (rotated by ``sensor_yaw``
         rad) or "head_up"."""
-
 
 # --- demo ---
 

@@ -31,7 +31,7 @@ from mmusv.errors import ConfigError, IoError, MmusvError, located
 from mmusv.scenario_checks import check_mounts, check_routes
 from mmusv.simulation import FrameCapture, Simulation
 
-__all__ = ["RunResult", "run", "TABLE_PART_FRAMES", "recording_path"]
+__all__ = ["TABLE_PART_FRAMES", "RunResult", "recording_path", "run"]
 
 TABLE_PART_FRAMES = 200
 
@@ -68,38 +68,85 @@ class _Tables:
         st = cap.world
         for i, v in enumerate(sim.vessels):
             x, y, z, r, p, yaw = (float(a) for a in st.poses[i])
-            self.rows["world_state"].append({
-                "frame": cap.frame, "time_s": cap.time_s, "vessel_id": v.id, "asset": v.asset, "role": v.role,
-                "static": v.static,
-                "semantic_class": v.semantic_class, "instance_id": v.instance_id, "x": x, "y": y, "z": z,
-                "roll": r, "pitch": p, "yaw": yaw, "vx": float(st.velocities[i, 0]), "vy": float(st.velocities[i, 1]),
-                "vz": float(st.velocities[i, 2]), "box_cx": float(st.box_centers[i, 0]), "box_cy": float(st.box_centers[i, 1]),
-                "box_cz": float(st.box_centers[i, 2]), "length": float(v.box_size[0]), "beam": float(v.box_size[1]),
-                "height": float(v.box_size[2]),
-            })
+            self.rows["world_state"].append(
+                {
+                    "frame": cap.frame,
+                    "time_s": cap.time_s,
+                    "vessel_id": v.id,
+                    "asset": v.asset,
+                    "role": v.role,
+                    "static": v.static,
+                    "semantic_class": v.semantic_class,
+                    "instance_id": v.instance_id,
+                    "x": x,
+                    "y": y,
+                    "z": z,
+                    "roll": r,
+                    "pitch": p,
+                    "yaw": yaw,
+                    "vx": float(st.velocities[i, 0]),
+                    "vy": float(st.velocities[i, 1]),
+                    "vz": float(st.velocities[i, 2]),
+                    "box_cx": float(st.box_centers[i, 0]),
+                    "box_cy": float(st.box_centers[i, 1]),
+                    "box_cz": float(st.box_centers[i, 2]),
+                    "length": float(v.box_size[0]),
+                    "beam": float(v.box_size[1]),
+                    "height": float(v.box_size[2]),
+                }
+            )
 
     def add_annotations(self, ann: Annotations, cols: dict[str, Any]) -> None:
         """Rows of one agent's annotations; ``cols`` is ``ann.columns()``."""
         lid = cols["lidar"]
         for j, tid in enumerate(lid["target_id"]):
             c, s, q = lid["center"][j], lid["size"][j], lid["rotation"][j]
-            self.rows["boxes_3d"].append({
-                "frame": ann.frame, "time_s": ann.time_s, "agent": ann.agent, "target_id": tid,
-                "instance_id": int(lid["instance_id"][j]), "semantic_class": int(lid["semantic_class"][j]),
-                "x": float(c[0]), "y": float(c[1]), "z": float(c[2]), "length": float(s[0]), "beam": float(s[1]),
-                "height": float(s[2]), "qx": float(q[0]), "qy": float(q[1]), "qz": float(q[2]), "qw": float(q[3]),
-                "yaw": float(lid["yaw"][j]), "lidar_points": int(lid["lidar_points"][j]), "range_m": float(lid["range_m"][j]),
-                "role": lid["role"][j], "static": bool(lid["static"][j]),
-            })
+            self.rows["boxes_3d"].append(
+                {
+                    "frame": ann.frame,
+                    "time_s": ann.time_s,
+                    "agent": ann.agent,
+                    "target_id": tid,
+                    "instance_id": int(lid["instance_id"][j]),
+                    "semantic_class": int(lid["semantic_class"][j]),
+                    "x": float(c[0]),
+                    "y": float(c[1]),
+                    "z": float(c[2]),
+                    "length": float(s[0]),
+                    "beam": float(s[1]),
+                    "height": float(s[2]),
+                    "qx": float(q[0]),
+                    "qy": float(q[1]),
+                    "qz": float(q[2]),
+                    "qw": float(q[3]),
+                    "yaw": float(lid["yaw"][j]),
+                    "lidar_points": int(lid["lidar_points"][j]),
+                    "range_m": float(lid["range_m"][j]),
+                    "role": lid["role"][j],
+                    "static": bool(lid["static"][j]),
+                }
+            )
         cam = cols["camera"]
         for j, tid in enumerate(cam["target_id"]):
-            self.rows["boxes_2d"].append({
-                "frame": ann.frame, "time_s": ann.time_s, "agent": ann.agent, "camera": cam["camera"][j], "target_id": tid,
-                "x_min": float(cam["x_min"][j]), "y_min": float(cam["y_min"][j]), "x_max": float(cam["x_max"][j]),
-                "y_max": float(cam["y_max"][j]), "truncation": float(cam["truncation"][j]),
-                "visible_pixels": int(cam["visible_pixels"][j]), "box_pixels": int(cam["box_pixels"][j]),
-                "occlusion": float(cam["occlusion"][j]), "role": cam["role"][j], "static": bool(cam["static"][j]),
-            })
+            self.rows["boxes_2d"].append(
+                {
+                    "frame": ann.frame,
+                    "time_s": ann.time_s,
+                    "agent": ann.agent,
+                    "camera": cam["camera"][j],
+                    "target_id": tid,
+                    "x_min": float(cam["x_min"][j]),
+                    "y_min": float(cam["y_min"][j]),
+                    "x_max": float(cam["x_max"][j]),
+                    "y_max": float(cam["y_max"][j]),
+                    "truncation": float(cam["truncation"][j]),
+                    "visible_pixels": int(cam["visible_pixels"][j]),
+                    "box_pixels": int(cam["box_pixels"][j]),
+                    "occlusion": float(cam["occlusion"][j]),
+                    "role": cam["role"][j],
+                    "static": bool(cam["static"][j]),
+                }
+            )
 
     def flush(self) -> None:
         for name, rows in self.rows.items():
@@ -119,15 +166,20 @@ def annotations_for(sim: Simulation, cap: FrameCapture, silhouettes: SilhouetteC
         ac = cap.agents.get(agent.id)
         if ac is None:
             continue
-        cams = {
-            name: (agent.cameras[name][0], ac.camera_poses[name], img.instance) for name, img in ac.cameras.items()
-        }
+        cams = {name: (agent.cameras[name][0], ac.camera_poses[name], img.instance) for name, img in ac.cameras.items()}
         rng = agent.rig.lidar.range_m if agent.rig.lidar is not None else 200.0
         out[agent.id] = annotate_agent(
-            agent_id=agent.id, agent_index=agent.index, frame=cap.frame, time_s=cap.time_s, vessels=sim.vessels,
-            state=cap.world, lidar_pose=ac.lidar_pose,
+            agent_id=agent.id,
+            agent_index=agent.index,
+            frame=cap.frame,
+            time_s=cap.time_s,
+            vessels=sim.vessels,
+            state=cap.world,
+            lidar_pose=ac.lidar_pose,
             lidar_instances=ac.lidar.instance if ac.lidar is not None else None,
-            cameras=cams, silhouettes=silhouettes, max_range_m=rng,
+            cameras=cams,
+            silhouettes=silhouettes,
+            max_range_m=rng,
         )
     return out
 
@@ -188,7 +240,9 @@ def run(
             old.unlink()
     tables = _Tables(tables_dir)
     silhouettes = SilhouetteCache()
-    (out / "scenario.yaml").write_text(yaml.safe_dump(scenario.model_dump(mode="json"), sort_keys=False), encoding="utf-8")
+    (out / "scenario.yaml").write_text(
+        yaml.safe_dump(scenario.model_dump(mode="json"), sort_keys=False), encoding="utf-8"
+    )
     result = RunResult(recording=rec_path, tables=tables_dir, frames_written=0, status="complete", seconds=0.0)
     t0 = time.perf_counter()
     recorder = FrameRecorder(rec_path, sim, overwrite=overwrite)
@@ -217,7 +271,9 @@ def run(
         result.error = f"{type(exc).__name__}: {exc}"
         raise
     finally:
-        summary = recorder.finish(status=result.status, frames=result.frames_written, error=result.error, requested=total)
+        summary = recorder.finish(
+            status=result.status, frames=result.frames_written, error=result.error, requested=total
+        )
         result.messages, result.bytes = summary.get("messages", 0), summary.get("bytes", 0)
         tables.flush()
         result.seconds = time.perf_counter() - t0

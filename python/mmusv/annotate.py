@@ -26,10 +26,12 @@ from mmusv.frames import BODY_TO_OPTICAL, translation
 from mmusv.scene import Scene
 from mmusv.world.vessels import get_asset
 
-__all__ = ["Annotations", "annotate_agent", "box_corners", "in_target_range", "SilhouetteCache"]
+__all__ = ["Annotations", "SilhouetteCache", "annotate_agent", "box_corners", "in_target_range"]
 
 # Corner order of a box: bit 0 → +x, bit 1 → +y, bit 2 → +z.
-_SIGNS = np.array([[(i & 1) * 2 - 1, ((i >> 1) & 1) * 2 - 1, ((i >> 2) & 1) * 2 - 1] for i in range(8)], dtype=np.float64)
+_SIGNS = np.array(
+    [[(i & 1) * 2 - 1, ((i >> 1) & 1) * 2 - 1, ((i >> 2) & 1) * 2 - 1] for i in range(8)], dtype=np.float64
+)
 _EDGES = [(a, b) for a in range(8) for b in range(a + 1, 8) if bin(a ^ b).count("1") == 1]
 NEAR_M = 0.05
 

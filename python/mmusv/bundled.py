@@ -39,8 +39,9 @@ def _resolve(name: str | Path, folder: Path, parents: tuple[str, ...], noun: str
         cand = folder / f"{stem}.yaml"
         if cand.is_file():
             return cand
-    raise NotFoundError(f"{noun} file {str(name)!r} does not exist and is not a bundled {noun}; "
-                        f"bundled: {', '.join(_names(folder))}")
+    raise NotFoundError(
+        f"{noun} file {str(name)!r} does not exist and is not a bundled {noun}; bundled: {', '.join(_names(folder))}"
+    )
 
 
 def resolve_scenario(name: str | Path) -> Path:
@@ -90,8 +91,15 @@ def bundled_scenarios() -> list[BundledScenario]:
         path = bundled_dir() / f"{stem}.yaml"
         sc = load_scenario(path)
         usvs = sum(1 for v in sc.vessels if v.role == "usv")
-        out.append(BundledScenario(
-            name=sc.name, path=path, map=sc.map.type, usvs=usvs, targets=len(sc.vessels) - usvs,
-            frames=sc.acquisition.frames, description=_description(path.read_text(encoding="utf-8")),
-        ))
+        out.append(
+            BundledScenario(
+                name=sc.name,
+                path=path,
+                map=sc.map.type,
+                usvs=usvs,
+                targets=len(sc.vessels) - usvs,
+                frames=sc.acquisition.frames,
+                description=_description(path.read_text(encoding="utf-8")),
+            )
+        )
     return out

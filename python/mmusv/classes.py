@@ -10,7 +10,7 @@ from enum import IntEnum
 
 import numpy as np
 
-__all__ = ["SemanticClass", "PALETTE", "palette_array", "class_name"]
+__all__ = ["PALETTE", "SemanticClass", "class_name", "palette_array"]
 
 
 class SemanticClass(IntEnum):

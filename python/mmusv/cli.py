@@ -37,7 +37,16 @@ def _cmd_assets(args: argparse.Namespace) -> int:
     for col in ("name", "category", "class", "length m", "beam m", "height m", "draft m", "triangles"):
         table.add_column(col, justify="right" if col.endswith(("m", "triangles")) else "left")
     for a in library():
-        table.add_row(a.name, a.category, a.semantic_class.name.lower(), f"{a.length:.1f}", f"{a.beam:.1f}", f"{a.height:.1f}", f"{a.draft:.1f}", str(a.num_triangles))
+        table.add_row(
+            a.name,
+            a.category,
+            a.semantic_class.name.lower(),
+            f"{a.length:.1f}",
+            f"{a.beam:.1f}",
+            f"{a.height:.1f}",
+            f"{a.draft:.1f}",
+            str(a.num_triangles),
+        )
     _console().print(table)
     return 0
 
@@ -45,22 +54,31 @@ def _cmd_assets(args: argparse.Namespace) -> int:
 def _cmd_study_waves(args: argparse.Namespace) -> int:
     from rich.table import Table
 
+    from mmusv.bundled import resolve_scenario
     from mmusv.config import load_scenario
     from mmusv.studies.waves import run_wave_study
-
-    from mmusv.bundled import resolve_scenario
 
     scenario = load_scenario(resolve_scenario(args.scenario))
     if args.frames is not None:
         if args.frames < 2:
             raise MmusvError("--frames must be at least 2")
-        scenario = scenario.model_copy(update={"acquisition": scenario.acquisition.model_copy(update={"frames": args.frames})})
+        scenario = scenario.model_copy(
+            update={"acquisition": scenario.acquisition.model_copy(update={"frames": args.frames})}
+        )
     study = run_wave_study(scenario)
-    table = Table(title=f"Wave study on {scenario.name} ({study.table['usvs'][0]} USVs × {study.table['frames'][0]} frames)")
+    table = Table(
+        title=f"Wave study on {scenario.name} ({study.table['usvs'][0]} USVs × {study.table['frames'][0]} frames)"
+    )
     for col in ("wave", "H (m)", "heave RMS (m)", "roll RMS (°)", "pitch RMS (°)"):
         table.add_column(col, justify="right")
     for r in study.table.iter_rows(named=True):
-        table.add_row(str(r["wave"]), f"{r['H_m']:.1f}", f"{r['heave_rms_m']:.4f}", f"{r['roll_rms_deg']:.4f}", f"{r['pitch_rms_deg']:.4f}")
+        table.add_row(
+            str(r["wave"]),
+            f"{r['H_m']:.1f}",
+            f"{r['heave_rms_m']:.4f}",
+            f"{r['roll_rms_deg']:.4f}",
+            f"{r['pitch_rms_deg']:.4f}",
+        )
     console = _console()
     console.print(table)
     console.print("R² of a linear fit in H: " + ", ".join(f"{k} {v:.4f}" for k, v in study.r2.items()))
@@ -78,11 +96,19 @@ def _run_one(path: str, out: str, overwrite: bool, frames: int | None, show_prog
     if show_progress:
         from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
-        with Progress(TextColumn(f"[bold]{scenario.name}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn()) as bar:
+        with Progress(
+            TextColumn(f"[bold]{scenario.name}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn()
+        ) as bar:
             task = bar.add_task("frames", total=frames or scenario.acquisition.frames)
             try:
-                res = run(path, out_dir=out, overwrite=overwrite, frames=frames, checks=checks,
-                          progress=lambda done, total: bar.update(task, completed=done))
+                res = run(
+                    path,
+                    out_dir=out,
+                    overwrite=overwrite,
+                    frames=frames,
+                    checks=checks,
+                    progress=lambda done, total: bar.update(task, completed=done),
+                )
             except KeyboardInterrupt:
                 from mmusv.acquire import recording_path
 
@@ -92,8 +118,10 @@ def _run_one(path: str, out: str, overwrite: bool, frames: int | None, show_prog
     else:
         res = run(path, out_dir=out, overwrite=overwrite, frames=frames, checks=checks)
     fps = res.frames_written / res.seconds if res.seconds > 0 else float("nan")
-    return (f"{scenario.name}: {res.frames_written} frames in {res.seconds:.1f} s ({fps:.2f} frames/s), "
-            f"{res.messages} messages, {res.bytes / 1e6:.1f} MB -> {res.recording}")
+    return (
+        f"{scenario.name}: {res.frames_written} frames in {res.seconds:.1f} s ({fps:.2f} frames/s), "
+        f"{res.messages} messages, {res.bytes / 1e6:.1f} MB -> {res.recording}"
+    )
 
 
 def _run_one_safe(path: str, out: str, overwrite: bool, frames: int | None, checks: bool) -> tuple[str, str]:
@@ -136,8 +164,10 @@ def _cmd_run(args: argparse.Namespace) -> int:
             # threads can deadlock on a lock another thread held
             ctx = multiprocessing.get_context("spawn")
             with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
-                futures = [pool.submit(_run_one_safe, str(f), o, args.overwrite, args.frames, checks)
-                           for f, o in zip(files, outs, strict=True)]
+                futures = [
+                    pool.submit(_run_one_safe, str(f), o, args.overwrite, args.frames, checks)
+                    for f, o in zip(files, outs, strict=True)
+                ]
                 for fut in futures:
                     results.append(fut.result())
                     print(results[-1][1])
@@ -187,11 +217,17 @@ def _cmd_info(args: argparse.Namespace) -> int:
     meta = info.get("metadata", {})
     run_meta = meta.get("run", {})
     if not info.get("complete", True):
-        console.print("[yellow]incomplete recording (.partial or no summary): counts come from scanning the messages[/yellow]")
-    console.print(f"[bold]{args.recording}[/bold]: scenario {run_meta.get('scenario', '?')}, status {run_meta.get('status', '?')}, "
-                  f"{run_meta.get('frames_written', '?')} frames, agents {run_meta.get('agents', '?')}")
+        console.print(
+            "[yellow]incomplete recording (.partial or no summary): counts come from scanning the messages[/yellow]"
+        )
+    console.print(
+        f"[bold]{args.recording}[/bold]: scenario {run_meta.get('scenario', '?')}, status {run_meta.get('status', '?')}, "
+        f"{run_meta.get('frames_written', '?')} frames, agents {run_meta.get('agents', '?')}"
+    )
     start, end = info.get("start_ns", 0), info.get("end_ns", 0)
-    console.print(f"time {start / 1e9:.3f} .. {end / 1e9:.3f} s (duration {(end - start) / 1e9:.3f} s), {info.get('messages', 0)} messages")
+    console.print(
+        f"time {start / 1e9:.3f} .. {end / 1e9:.3f} s (duration {(end - start) / 1e9:.3f} s), {info.get('messages', 0)} messages"
+    )
     table = Table(title="topics")
     for col in ("topic", "schema", "messages"):
         table.add_column(col)
@@ -216,11 +252,24 @@ def _cmd_study_agreement(args: argparse.Namespace) -> int:
 
     study = run_agreement_study(args.scenarios or BUNDLED_SCENARIOS, frames=args.frames)
     table = Table(title="Annotation vs top-view rendering (Table II)")
-    for col in ("map", "valid samples", "median centre error (px)", "median centroid error (px)", "mean containment", "mean hull occupancy"):
+    for col in (
+        "map",
+        "valid samples",
+        "median centre error (px)",
+        "median centroid error (px)",
+        "mean containment",
+        "mean hull occupancy",
+    ):
         table.add_column(col, justify="right")
     for r in study.summary.iter_rows(named=True):
-        table.add_row(str(r["map"]), str(r["valid_samples"]), f"{r['median_centre_error_px']:.3f}", f"{r['median_centroid_error_px']:.3f}",
-                      f"{r['mean_containment']:.4f}", f"{r['mean_hull_occupancy']:.3f}")
+        table.add_row(
+            str(r["map"]),
+            str(r["valid_samples"]),
+            f"{r['median_centre_error_px']:.3f}",
+            f"{r['median_centroid_error_px']:.3f}",
+            f"{r['mean_containment']:.4f}",
+            f"{r['mean_hull_occupancy']:.3f}",
+        )
     console = _console()
     console.print(table)
     paths = study.write(Path(args.output))
@@ -229,7 +278,9 @@ def _cmd_study_agreement(args: argparse.Namespace) -> int:
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="mmusv", description="Headless maritime multi-USV simulator and dataset generator.")
+    p = argparse.ArgumentParser(
+        prog="mmusv", description="Headless maritime multi-USV simulator and dataset generator."
+    )
     sub = p.add_subparsers(dest="command", required=True)
     sub.add_parser("version", help="print the version")
     sub.add_parser("assets", help="list the vessel library")
@@ -237,7 +288,9 @@ def _parser() -> argparse.ArgumentParser:
     study = sub.add_parser("study", help="reproduce the paper's experiments")
     studies = study.add_subparsers(dest="study", required=True)
     waves = studies.add_parser("waves", help="Table I: heave/roll/pitch RMS under W0..W3")
-    waves.add_argument("--scenario", default=BUNDLED_WAVE_SCENARIO, help=f"scenario YAML (default {BUNDLED_WAVE_SCENARIO})")
+    waves.add_argument(
+        "--scenario", default=BUNDLED_WAVE_SCENARIO, help=f"scenario YAML (default {BUNDLED_WAVE_SCENARIO})"
+    )
     waves.add_argument("-o", "--output", default="out/wave_study", help="output folder for CSV and plot")
     waves.add_argument("--frames", type=int, default=None, help="override the scenario's frame count")
     agree = studies.add_parser("agreement", help="Table II: 3D-box annotations vs top-view semantic rendering")
@@ -252,9 +305,14 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("-o", "--output", default="out", help="output folder (default out/)")
     run.add_argument("--overwrite", action="store_true", help="replace an existing recording")
     run.add_argument("--frames", type=int, default=None, help="run only the first N frames")
-    run.add_argument("--jobs", type=int, default=1, help="for a folder: scenarios run in parallel processes (default 1)")
-    run.add_argument("--no-checks", action="store_true",
-                     help="skip the route checks on the map (in water: an error; clearances, separation: warnings)")
+    run.add_argument(
+        "--jobs", type=int, default=1, help="for a folder: scenarios run in parallel processes (default 1)"
+    )
+    run.add_argument(
+        "--no-checks",
+        action="store_true",
+        help="skip the route checks on the map (in water: an error; clearances, separation: warnings)",
+    )
     info = sub.add_parser("info", help="agents, topics, frames and duration of a recording")
     info.add_argument("recording", help="an .mcap written by mmusv run")
     prev = sub.add_parser("preview", help="one picture of a recorded frame (surround RGB, depth, semantic, PPI, BEV)")

@@ -44,11 +44,11 @@ from mmusv.world.vessels import asset_names, get_asset
 from mmusv.yamlio import mapping_source
 
 __all__ = [
-    "MapConfig",
-    "EnvironmentConfig",
     "AcquisitionConfig",
-    "VesselConfig",
+    "EnvironmentConfig",
+    "MapConfig",
     "Scenario",
+    "VesselConfig",
     "load_scenario",
     "scenario_hash",
     "validation_error",
@@ -192,7 +192,9 @@ class Scenario(_Model):
                 raise ValueError(f"vessel id {v.id!r} is used twice; ids must be unique")
             seen.add(v.id)
             if v.rig is not None and v.rig not in self.rigs:
-                raise ValueError(f"vessel {v.id!r} names rig {v.rig!r}, which is not defined under rigs: ({sorted(self.rigs)})")
+                raise ValueError(
+                    f"vessel {v.id!r} names rig {v.rig!r}, which is not defined under rigs: ({sorted(self.rigs)})"
+                )
         for i, v in enumerate(self.vessels):
             if v.rig is not None and v.role != "usv":
                 raise ValueError(
@@ -246,9 +248,13 @@ def validation_error(err: ValidationError, source: str, *, noun: str = "config",
     lines = []
     for e in err.errors():
         # Pydantic adds the union member or validator name to `loc`; drop the non-field parts.
-        loc = tuple(p for p in e["loc"] if not (isinstance(p, str) and ("[" in p or p in {"str", "float", "function-after"})))
+        loc = tuple(
+            p for p in e["loc"] if not (isinstance(p, str) and ("[" in p or p in {"str", "float", "function-after"}))
+        )
         value = e.get("input")
-        shown = repr(value) if not isinstance(value, (dict, list)) or len(repr(value)) < 80 else f"<{type(value).__name__}>"
+        shown = (
+            repr(value) if not isinstance(value, (dict, list)) or len(repr(value)) < 80 else f"<{type(value).__name__}>"
+        )
         msg = str(e["msg"]).removeprefix("Value error, ")
         if not loc and isinstance(value, dict):  # a check across fields: its message names the fields itself
             lines.append(f"invalid {noun}: {msg}")

@@ -17,13 +17,13 @@ IoError = core.IoError
 InternalError = core.InternalError
 
 __all__ = [
-    "MmusvError",
-    "InputError",
-    "GeometryError",
     "ConfigError",
-    "NotFoundError",
-    "IoError",
+    "GeometryError",
+    "InputError",
     "InternalError",
+    "IoError",
+    "MmusvError",
+    "NotFoundError",
 ]
 
 

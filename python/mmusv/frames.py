@@ -24,22 +24,22 @@ import numpy as np
 import numpy.typing as npt
 
 __all__ = [
-    "MIRROR_Y",
     "BODY_TO_OPTICAL",
-    "pose_matrices",
-    "translation",
-    "matrix_to_pose",
-    "invert",
-    "transform_points",
-    "mirror_points",
-    "mirror_transform",
-    "carla_rotation",
+    "MIRROR_Y",
     "carla_matrix",
     "carla_pose",
     "carla_pose_from_eta",
-    "x1_to_x2",
+    "carla_rotation",
+    "invert",
+    "matrix_to_pose",
+    "mirror_points",
+    "mirror_transform",
+    "pose_matrices",
+    "transform_points",
+    "translation",
     "wrap_deg",
     "wrap_rad",
+    "x1_to_x2",
 ]
 
 MIRROR_Y = np.diag([1.0, -1.0, 1.0, 1.0])
@@ -56,7 +56,7 @@ def pose_matrices(eta: npt.ArrayLike) -> np.ndarray:
     cr, sr = np.cos(eta[..., 3]), np.sin(eta[..., 3])
     cp, sp = np.cos(eta[..., 4]), np.sin(eta[..., 4])
     cy, sy = np.cos(eta[..., 5]), np.sin(eta[..., 5])
-    m = np.zeros(eta.shape[:-1] + (4, 4), dtype=np.float64)
+    m = np.zeros((*eta.shape[:-1], 4, 4), dtype=np.float64)
     m[..., 0, 0] = cy * cp
     m[..., 0, 1] = cy * sp * sr - sy * cr
     m[..., 0, 2] = cy * sp * cr + sy * sr
@@ -139,7 +139,7 @@ def carla_rotation(roll_deg: npt.ArrayLike, yaw_deg: npt.ArrayLike, pitch_deg: n
 def carla_matrix(pose: npt.ArrayLike) -> np.ndarray:
     """``(..., 4, 4)`` the CARLA transform of ``[x, y, z, roll, yaw, pitch]`` poses ``(..., 6)`` (left-handed)."""
     pose = np.asarray(pose, dtype=np.float64)
-    m = np.zeros(pose.shape[:-1] + (4, 4), dtype=np.float64)
+    m = np.zeros((*pose.shape[:-1], 4, 4), dtype=np.float64)
     m[..., :3, :3] = carla_rotation(pose[..., 3], pose[..., 4], pose[..., 5])
     m[..., :3, 3] = pose[..., :3]
     m[..., 3, 3] = 1.0
@@ -165,7 +165,14 @@ def carla_pose_from_eta(eta: npt.ArrayLike) -> np.ndarray:
     -deg(yaw), -deg(pitch)]`` (closed form of :func:`carla_pose` for Euler poses)."""
     eta = np.asarray(eta, dtype=np.float64)
     out: np.ndarray = np.stack(
-        [eta[..., 0], -eta[..., 1], eta[..., 2], np.degrees(eta[..., 3]), -np.degrees(eta[..., 5]), -np.degrees(eta[..., 4])],
+        [
+            eta[..., 0],
+            -eta[..., 1],
+            eta[..., 2],
+            np.degrees(eta[..., 3]),
+            -np.degrees(eta[..., 5]),
+            -np.degrees(eta[..., 4]),
+        ],
         axis=-1,
     )
     return out

@@ -232,8 +232,11 @@ def compose_preview(path: str | Path, *, frame: int = 0, agent: str | None = Non
         for title, pil, scale in r:
             draw.text((left + 6, top + 4), title, fill=_TEXT, font=font)
             canvas.paste(pil, (left, top + _TITLE_H))
-            panels.append(Panel(title=title, box=(left, top + _TITLE_H, left + pil.width, top + _TITLE_H + pil.height),
-                                scale=scale))
+            panels.append(
+                Panel(
+                    title=title, box=(left, top + _TITLE_H, left + pil.width, top + _TITLE_H + pil.height), scale=scale
+                )
+            )
             left += pil.width
         top += _TITLE_H + max(p.height for _, p, _ in r)
     return canvas, panels

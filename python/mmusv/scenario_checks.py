@@ -24,7 +24,7 @@ from mmusv.errors import ConfigError
 if TYPE_CHECKING:
     from mmusv.world.maps import MapWorld
 
-__all__ = ["MmusvWarning", "check_routes", "check_mounts", "MOUNT_WARN_FACTOR"]
+__all__ = ["MOUNT_WARN_FACTOR", "MmusvWarning", "check_mounts", "check_routes"]
 
 MOUNT_WARN_FACTOR = 2.0
 """A mount farther than this many hull lengths (at least 10 m) from the hull's box gets a warning."""
@@ -46,9 +46,18 @@ def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[st
     targets = tuple(v.id for v in scenario.vessels if v.role != "usv")
     ego = usvs[0] if usvs else scenario.vessels[0].id
     meta = CandidateMeta(
-        combination="scenario", family="scenario", difficulty="scenario", attempt=0, ego=ego,
-        cooperating=tuple(usvs[1:]), targets=targets, primary=targets[0] if targets else ego, ranged=(),
-        distractors=(), range_m=(0.0, math.inf), occlusion_share=None,
+        combination="scenario",
+        family="scenario",
+        difficulty="scenario",
+        attempt=0,
+        ego=ego,
+        cooperating=tuple(usvs[1:]),
+        targets=targets,
+        primary=targets[0] if targets else ego,
+        ranged=(),
+        distractors=(),
+        range_m=(0.0, math.inf),
+        occlusion_share=None,
     )
     spec = GenerationSpec.model_validate({"combinations": [{"family": "crossing"}]})
     samples = take_samples(scenario, meta, MapContext(world), spec)
@@ -57,8 +66,11 @@ def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[st
     if fail is not None:
         raise ConfigError(f"{source}: in_water: {fail}; routes must stay on navigable water (--no-checks skips this)")
     found: list[str] = []
-    for check in (ShoreClearance(cons.shore_clearance), StructureClearance(cons.structure_clearance),
-                  Separation(cons.separation)):
+    for check in (
+        ShoreClearance(cons.shore_clearance),
+        StructureClearance(cons.structure_clearance),
+        Separation(cons.separation),
+    ):
         msg = check.check(samples)
         if msg is not None:
             found.append(f"{source}: {check.name}: {msg}")
@@ -86,8 +98,9 @@ def check_mounts(scenario: Scenario, *, source: str) -> list[str]:
             p = mount_matrix(asset, m, where=where)[:3, 3]  # the sensor origin in the body frame, as simulated
             dist = float(np.linalg.norm(np.maximum(np.maximum(lo - p, p - hi), 0.0)))
             if dist > limit:
-                found.append(f"{source}: {where} (vessel {v.id}) is {dist:.0f} m from the {asset.name} hull; "
-                             f"xyz is in metres")
+                found.append(
+                    f"{source}: {where} (vessel {v.id}) is {dist:.0f} m from the {asset.name} hull; xyz is in metres"
+                )
     for w in found:
         warnings.warn(w, MmusvWarning, stacklevel=2)
     return found

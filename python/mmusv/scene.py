@@ -24,7 +24,7 @@ import numpy.typing as npt
 from mmusv._native import core
 from mmusv.errors import GeometryError, InputError, NotFoundError
 
-__all__ = ["Scene", "RayHits", "NO_HIT", "demo_scene"]
+__all__ = ["NO_HIT", "RayHits", "Scene", "demo_scene"]
 
 NO_HIT = -1
 """Value of ``RayHits.instance_id`` and ``triangle_id`` where the ray hit nothing."""
@@ -70,7 +70,7 @@ def _array(value: Any, *, name: str, dtype: Any, shape_tail: tuple[int, ...]) ->
     """Coerces ``value`` to a C-contiguous array of ``dtype`` with trailing shape ``shape_tail``."""
     try:
         arr = np.asarray(value)
-    except Exception as exc:  # noqa: BLE001 - any conversion failure is the caller's input
+    except Exception as exc:
         raise InputError(f"{name} could not be converted to an array: {exc}") from None
     if arr.dtype == object or not (np.issubdtype(arr.dtype, np.number) or arr.dtype == np.bool_):
         raise InputError(f"{name} must be numeric, got dtype {arr.dtype}")
@@ -162,7 +162,9 @@ class Scene:
             raise GeometryError(f"invalid geometry in vertices[{bad}]: vertex is not finite; remove NaN/inf vertices")
         return int(self._native.add_mesh(v, f, np.ascontiguousarray(c, dtype=np.uint16), name))
 
-    def add_instance(self, mesh_id: int, *, pose: npt.ArrayLike | None = None, class_override: int | None = None) -> int:
+    def add_instance(
+        self, mesh_id: int, *, pose: npt.ArrayLike | None = None, class_override: int | None = None
+    ) -> int:
         """Places mesh ``mesh_id`` at ``pose`` (``(4, 4)`` body → world, default identity); returns the instance id.
 
         ``class_override`` replaces the mesh's per-face classes for this instance (e.g. a vessel asset placed
@@ -188,14 +190,18 @@ class Scene:
             raise InputError(f"instance_ids must be a 1-D integer array, got {ids.dtype} with shape {ids.shape}")
         if ids.min() < 0 or ids.max() >= 2**32:
             bad = int(ids.min()) if ids.min() < 0 else int(ids.max())
-            raise NotFoundError(f"unknown instance id {bad}: instance ids are the non-negative ids add_instance returned")
+            raise NotFoundError(
+                f"unknown instance id {bad}: instance ids are the non-negative ids add_instance returned"
+            )
         if p.ndim == 2:
             p = p[None]
         if p.ndim != 3 or p.shape[1:] != (4, 4):
             raise InputError(f"poses must have shape (K, 4, 4) (or (4, 4) for one id), got {np.shape(poses)}")
         self._native.set_poses(np.ascontiguousarray(ids, dtype=np.uint32), np.ascontiguousarray(p))
 
-    def cast_rays(self, origins: npt.ArrayLike, directions: npt.ArrayLike, *, max_range: float = float("inf")) -> RayHits:
+    def cast_rays(
+        self, origins: npt.ArrayLike, directions: npt.ArrayLike, *, max_range: float = float("inf")
+    ) -> RayHits:
         """Casts ``N`` rays and returns the closest hit of each.
 
         Args:
@@ -250,7 +256,9 @@ class Scene:
         return repr(self._native)
 
 
-def demo_scene(*, seed: int = 1, extent: float = 2000.0, terrain_cells: int = 512, vessels: int = 48) -> tuple[Scene, list[int]]:
+def demo_scene(
+    *, seed: int = 1, extent: float = 2000.0, terrain_cells: int = 512, vessels: int = 48
+) -> tuple[Scene, list[int]]:
     """The synthetic maritime benchmark scene: seabed/islands heightfield (``2·terrain_cells²`` triangles,
     instance 0), water plane at z = 0 (instance 1) and ``vessels`` hull instances around the origin.
 

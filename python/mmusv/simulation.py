@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import hashlib
 import math
-from dataclasses import dataclass, field
 from collections.abc import Collection
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -35,7 +35,14 @@ from mmusv.world.maps import MapWorld, generate_map_from
 from mmusv.world.vessels import VesselAsset, get_asset
 
 __all__ = [
-    "Simulation", "Agent", "VesselInfo", "WorldState", "SensorMount", "AgentCapture", "FrameCapture", "sensor_seed",
+    "Agent",
+    "AgentCapture",
+    "FrameCapture",
+    "SensorMount",
+    "Simulation",
+    "VesselInfo",
+    "WorldState",
+    "sensor_seed",
 ]
 
 SENSOR_KINDS = ("lidar", "cameras", "top_view", "radar")
@@ -190,7 +197,9 @@ class Simulation:
         for v, inst in zip(sc.vessels, self.ws.vessel_instances, strict=True):
             self.vessels.append(self._info(v.id, v.asset, v.role, int(inst), static=v.static))
         self._moored_mats = []
-        for k, ((asset_name, (x, y, yaw)), inst) in enumerate(zip(self.world.moored, self.ws.moored_instances, strict=True)):
+        for k, ((asset_name, (x, y, yaw)), inst) in enumerate(
+            zip(self.world.moored, self.ws.moored_instances, strict=True)
+        ):
             self.vessels.append(self._info(f"moored_{k:02d}", asset_name, "moored", inst, static=True))
             self._moored_mats.append(pose_matrices(np.array([x, y, 0.0, 0.0, 0.0, yaw])))
         self._moored_eta = np.array([[x, y, 0.0, 0.0, 0.0, yaw] for _, (x, y, yaw) in self.world.moored]).reshape(-1, 6)
@@ -310,12 +319,16 @@ class Simulation:
         if agents is not None:
             unknown = sorted(set(agents) - {a.id for a in self.agents})
             if unknown:
-                raise ConfigError(f"no USV named {', '.join(map(repr, unknown))}; the USVs are {[a.id for a in self.agents]}")
+                raise ConfigError(
+                    f"no USV named {', '.join(map(repr, unknown))}; the USVs are {[a.id for a in self.agents]}"
+                )
         kinds = set(SENSOR_KINDS if sensors is None else sensors)
         if not radar:
             kinds.discard("radar")
         if kinds - set(SENSOR_KINDS):
-            raise ConfigError(f"unknown sensor kind(s) {sorted(kinds - set(SENSOR_KINDS))}; allowed: {', '.join(SENSOR_KINDS)}")
+            raise ConfigError(
+                f"unknown sensor kind(s) {sorted(kinds - set(SENSOR_KINDS))}; allowed: {', '.join(SENSOR_KINDS)}"
+            )
         state = self.set_frame(frame)
         env = self.sensor_env
         sc = self.scenario
@@ -333,7 +346,10 @@ class Simulation:
             if agent.lidar is not None and "lidar" in kinds:
                 cap.lidar_pose = poses["lidar"]
                 cap.lidar = scan(
-                    agent.lidar, self.ws.scene, pose=cap.lidar_pose, env=env,
+                    agent.lidar,
+                    self.ws.scene,
+                    pose=cap.lidar_pose,
+                    env=env,
                     seed=sensor_seed(sc.seed, frame, agent.index, "lidar"),
                 )
             for k, (name, (cam, _, _)) in enumerate(agent.cameras.items()):
@@ -347,18 +363,26 @@ class Simulation:
             if agent.top_view is not None and "top_view" in kinds:
                 cap.top_view_pose = poses["top_view"]
                 cap.top_view = render(
-                    agent.top_view, self.ws.scene, pose=cap.top_view_pose, env=env,
+                    agent.top_view,
+                    self.ws.scene,
+                    pose=cap.top_view_pose,
+                    env=env,
                     seed=sensor_seed(sc.seed, frame, agent.index, "top_view"),
                 )
             if "radar" in kinds and agent.radar is not None and agent.rig.radar is not None:
                 cap.radar_pose = poses["radar"]
                 cfg = agent.rig.radar
                 cap.radar = radar_sweep(
-                    agent.radar, self.ws.scene, pose=cap.radar_pose, env=env,
+                    agent.radar,
+                    self.ws.scene,
+                    pose=cap.radar_pose,
+                    env=env,
                     seed=sensor_seed(sc.seed, frame, agent.index, "radar"),
                 )
                 cap.radar_ppi = ppi_image(
-                    cap.radar, size_px=cfg.ppi_size_px, metres_per_pixel=cfg.ppi_metres_per_pixel,
+                    cap.radar,
+                    size_px=cfg.ppi_size_px,
+                    metres_per_pixel=cfg.ppi_metres_per_pixel,
                     orientation=cfg.ppi_orientation,
                 )
             out[agent.id] = cap

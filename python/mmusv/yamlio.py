@@ -23,7 +23,7 @@ import yaml
 
 from mmusv.errors import ConfigError
 
-__all__ = ["read_yaml", "parse_yaml", "mapping_source", "MAX_YAML_BYTES"]
+__all__ = ["MAX_YAML_BYTES", "mapping_source", "parse_yaml", "read_yaml"]
 
 MAX_YAML_BYTES = 64 * 1024 * 1024
 """Largest YAML input read (64 MiB): larger files are refused before they are read."""
@@ -86,7 +86,7 @@ def _decode(raw: bytes, where: str) -> str:
 def parse_yaml(text: str, where: str) -> Any:
     """Parses YAML ``text`` (``where`` names it in errors), refusing duplicate keys."""
     try:
-        return yaml.load(text, Loader=_UniqueKeyLoader)  # noqa: S506 - a SafeLoader subclass
+        return yaml.load(text, Loader=_UniqueKeyLoader)
     except _DuplicateKey as exc:
         raise ConfigError(f"{where}: {exc}; each key may appear once") from None
     except yaml.MarkedYAMLError as exc:

@@ -21,7 +21,10 @@ REPO = Path(__file__).resolve().parents[2]
 
 
 def small_rig() -> dict[str, Any]:
-    cams = [{"name": n, "resolution": [160, 120], "hfov_deg": 90, "mount": {"point": f"camera_{n}"}} for n in ("front", "left", "rear", "right")]
+    cams = [
+        {"name": n, "resolution": [160, 120], "hfov_deg": 90, "mount": {"point": f"camera_{n}"}}
+        for n in ("front", "left", "rear", "right")
+    ]
     return {
         "lidar": {"channels": 32, "points_per_second": 57600, "rotation_hz": 5},
         "cameras": cams,
@@ -38,9 +41,23 @@ COOP: dict[str, Any] = {
     "acquisition": {"frequency_hz": 5, "frames": 3},
     "rigs": {"r": small_rig()},
     "vessels": [
-        {"id": "usv_a", "role": "usv", "asset": "usv_patrol_12m", "rig": "r", "speed_mps": 3.0, "route": [[0, 0], [300, 200]]},
+        {
+            "id": "usv_a",
+            "role": "usv",
+            "asset": "usv_patrol_12m",
+            "rig": "r",
+            "speed_mps": 3.0,
+            "route": [[0, 0], [300, 200]],
+        },
         {"id": "tgt", "role": "target", "asset": "tug_32m", "speed_mps": 3.0, "route": [[34.1, 30.0], [334.1, 230.0]]},
-        {"id": "usv_b", "role": "usv", "asset": "usv_wamv", "rig": "r", "speed_mps": 2.0, "route": [[90, -30], [60, 0]]},
+        {
+            "id": "usv_b",
+            "role": "usv",
+            "asset": "usv_wamv",
+            "rig": "r",
+            "speed_mps": 2.0,
+            "route": [[90, -30], [60, 0]],
+        },
         {"id": "boat", "role": "target", "asset": "speedboat_5m", "speed_mps": 4.0, "route": [[20, 60], [80, 20]]},
     ],
 }

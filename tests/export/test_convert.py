@@ -10,14 +10,17 @@ from typing import Any
 
 import pytest
 import yaml
-
 from mmusv.errors import ConfigError, IoError, MmusvError
-from mmusv.export import convert
 from mmusv.export import cli as export_cli
+from mmusv.export import convert
 
 
 def tree(root: Path) -> dict[str, str]:
-    return {str(p.relative_to(root)): hashlib.sha256(p.read_bytes()).hexdigest() for p in sorted(root.rglob("*")) if p.is_file()}
+    return {
+        str(p.relative_to(root)): hashlib.sha256(p.read_bytes()).hexdigest()
+        for p in sorted(root.rglob("*"))
+        if p.is_file()
+    }
 
 
 def parse(argv: list[str]) -> argparse.Namespace:
@@ -56,12 +59,14 @@ def test_bad_options(coop_rec: Path, tmp_path: Path) -> None:
 
 
 def test_cli_errors_are_one_line(coop_rec: Path, tmp_path: Path) -> None:
-    for argv, kind in (([str(coop_rec), "--to", "coco", "-o", str(tmp_path / "o")], ConfigError),
-                       ([str(tmp_path / "missing.mcap"), "-o", str(tmp_path / "o")], IoError),
-                       ([str(coop_rec), "-o", str(tmp_path / "o"), "--extras", "depth,nope"], ConfigError),
-                       ([str(coop_rec), "-o", str(tmp_path / "o"), "--split", "1,2"], ConfigError)):
+    for argv, kind in (
+        ([str(coop_rec), "--to", "coco", "-o", str(tmp_path / "o")], ConfigError),
+        ([str(tmp_path / "missing.mcap"), "-o", str(tmp_path / "o")], IoError),
+        ([str(coop_rec), "-o", str(tmp_path / "o"), "--extras", "depth,nope"], ConfigError),
+        ([str(coop_rec), "-o", str(tmp_path / "o"), "--split", "1,2"], ConfigError),
+    ):
         with pytest.raises(kind) as exc:
-            export_cli.run(parse(argv + ["--no-progress"]))
+            export_cli.run(parse([*argv, "--no-progress"]))
         assert isinstance(exc.value, MmusvError) and "\n" not in str(exc.value)
 
 
@@ -154,7 +159,9 @@ def rechunk(src: Path, dst: Path, chunk_size: int) -> None:
             if isinstance(rec, Schema):
                 schemas[rec.id] = w.register_schema(rec.name, rec.encoding, rec.data)
             elif isinstance(rec, Channel):
-                channels[rec.id] = w.register_channel(rec.topic, rec.message_encoding, schemas.get(rec.schema_id, 0), rec.metadata)
+                channels[rec.id] = w.register_channel(
+                    rec.topic, rec.message_encoding, schemas.get(rec.schema_id, 0), rec.metadata
+                )
             elif isinstance(rec, Message):
                 w.add_message(channels[rec.channel_id], rec.log_time, rec.data, rec.publish_time, rec.sequence)
             elif isinstance(rec, Metadata):

@@ -9,10 +9,8 @@ from typing import Any
 
 import numpy as np
 import pytest
-
 from mmusv.export import convert
-from mmusv.recording import decode_point_cloud
-from mmusv.recording import read_messages
+from mmusv.recording import decode_point_cloud, read_messages
 
 
 def read_calib(path: Path) -> dict[str, np.ndarray]:
@@ -28,9 +26,18 @@ def parse_labels(path: Path) -> list[dict[str, Any]]:
     for line in path.read_text().splitlines():
         f = line.split()
         assert len(f) == 15
-        rows.append({"type": f[0], "truncated": float(f[1]), "occluded": int(f[2]), "alpha": float(f[3]),
-                     "bbox": [float(v) for v in f[4:8]], "hwl": [float(v) for v in f[8:11]],
-                     "xyz": np.array([float(v) for v in f[11:14]]), "ry": float(f[14])})
+        rows.append(
+            {
+                "type": f[0],
+                "truncated": float(f[1]),
+                "occluded": int(f[2]),
+                "alpha": float(f[3]),
+                "bbox": [float(v) for v in f[4:8]],
+                "hwl": [float(v) for v in f[8:11]],
+                "xyz": np.array([float(v) for v in f[11:14]]),
+                "ry": float(f[14]),
+            }
+        )
     return rows
 
 
@@ -40,7 +47,12 @@ def in_kitti_box(p_cam: np.ndarray, label: dict[str, Any], tol: float) -> np.nda
     c, s = math.cos(label["ry"]), math.sin(label["ry"])
     rot_y = np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
     local = (p_cam - label["xyz"]) @ rot_y  # rows: R^T (p - t)
-    inside: np.ndarray = (np.abs(local[:, 0]) <= length / 2 + tol) & (np.abs(local[:, 2]) <= w / 2 + tol) & (local[:, 1] <= tol) & (local[:, 1] >= -h - tol)
+    inside: np.ndarray = (
+        (np.abs(local[:, 0]) <= length / 2 + tol)
+        & (np.abs(local[:, 2]) <= w / 2 + tol)
+        & (local[:, 1] <= tol)
+        & (local[:, 1] >= -h - tol)
+    )
     return inside
 
 
@@ -55,7 +67,9 @@ def test_kitti_layout_and_boxes(kitti_out: Path, coop_rec: Path) -> None:
     clouds: dict[tuple[str, int], dict[str, np.ndarray]] = {}
     worlds: dict[int, Any] = {}
     anns: dict[tuple[str, int], Any] = {}
-    for topic, t, msg in read_messages(coop_rec, topics=["/usv_a/lidar", "/usv_b/lidar", "/world/state", "/usv_a/annotations", "/usv_b/annotations"]):
+    for topic, t, msg in read_messages(
+        coop_rec, topics=["/usv_a/lidar", "/usv_b/lidar", "/world/state", "/usv_a/annotations", "/usv_b/annotations"]
+    ):
         k = round(t * 5 / 1e9)
         if topic == "/world/state":
             worlds[k] = msg
@@ -66,8 +80,20 @@ def test_kitti_layout_and_boxes(kitti_out: Path, coop_rec: Path) -> None:
     checked = 0
     for cav, agent in (("1000", "usv_a"), ("1002", "usv_b")):
         d = kitti_out / cav
-        assert sorted(p.name for p in d.iterdir()) == sorted(["calib", "image_2", "label_2", "pose", "velodyne", "depth_2", "semantic_2",
-                                                              "radar_ppi", "top_view_rgb", "top_view_semantic"])
+        assert sorted(p.name for p in d.iterdir()) == sorted(
+            [
+                "calib",
+                "image_2",
+                "label_2",
+                "pose",
+                "velodyne",
+                "depth_2",
+                "semantic_2",
+                "radar_ppi",
+                "top_view_rgb",
+                "top_view_semantic",
+            ]
+        )
         for k in range(3):
             ts = f"{k:06d}"
             pts = np.fromfile(d / "velodyne" / f"{ts}.bin", dtype="<f4").reshape(-1, 4)
@@ -76,7 +102,9 @@ def test_kitti_layout_and_boxes(kitti_out: Path, coop_rec: Path) -> None:
             calib = read_calib(d / "calib" / f"{ts}.txt")
             assert set(calib) == {"P0", "P1", "P2", "P3", "R0_rect", "Tr_velo_to_cam", "Tr_imu_to_velo"}
             p2 = calib["P2"].reshape(3, 4)
-            assert p2[0, 0] == pytest.approx(80.0) and p2[0, 2] == pytest.approx(80.0) and p2[1, 2] == pytest.approx(60.0)
+            assert (
+                p2[0, 0] == pytest.approx(80.0) and p2[0, 2] == pytest.approx(80.0) and p2[1, 2] == pytest.approx(60.0)
+            )
             tr = np.vstack([calib["Tr_velo_to_cam"].reshape(3, 4), [0, 0, 0, 1]])
             p_cam = pts[:, :3].astype(np.float64) @ tr[:3, :3].T + tr[:3, 3]
             labels = parse_labels(d / "label_2" / f"{ts}.txt")

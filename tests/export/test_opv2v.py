@@ -15,14 +15,22 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
-
 from mmusv.export import convert
-from mmusv.recording import decode_image, decode_point_cloud
-from mmusv.recording import read_messages
+from mmusv.recording import decode_image, decode_point_cloud, read_messages
 
 EXTRA_FILES = {"_depth{i}.png", "_semantic{i}.png"}
-YAML_KEYS = {"camera0", "camera1", "camera2", "camera3", "ego_speed", "lidar_pose", "plan_trajectory", "predicted_ego_pos",
-             "true_ego_pos", "vehicles"}
+YAML_KEYS = {
+    "camera0",
+    "camera1",
+    "camera2",
+    "camera3",
+    "ego_speed",
+    "lidar_pose",
+    "plan_trajectory",
+    "predicted_ego_pos",
+    "true_ego_pos",
+    "vehicles",
+}
 VEHICLE_KEYS = {"location", "center", "extent", "angle", "speed"}
 TOL_M = 0.12  # range noise (2 cm σ) and 0.1 mm rounding of the PCD
 
@@ -146,8 +154,14 @@ def test_layout_names_and_keys(coop_out: Path, coop_rec_data: dict[int, Any]) ->
     for c in cavs:
         names = {p.name for p in (coop_out / c).iterdir()}
         for ts in stamps[c]:
-            expected = {f"{ts}.yaml", f"{ts}.pcd", f"{ts}_additional.yaml", f"{ts}_radar_ppi.png", f"{ts}_topview_rgb.png",
-                        f"{ts}_topview_semantic.png"}
+            expected = {
+                f"{ts}.yaml",
+                f"{ts}.pcd",
+                f"{ts}_additional.yaml",
+                f"{ts}_radar_ppi.png",
+                f"{ts}_topview_rgb.png",
+                f"{ts}_topview_semantic.png",
+            }
             expected |= {f"{ts}_camera{i}.png" for i in range(4)}
             expected |= {f"{ts}{pat.format(i=i)}" for pat in EXTRA_FILES for i in range(4)}
             assert expected <= names
@@ -222,7 +236,9 @@ def check_round_trip(out: Path, rec: dict[int, Any], agents: dict[str, str]) -> 
                     if cav != ego:
                         pts = to_ego(pts, docs[cav]["lidar_pose"], ego_pose)
                     ok = inside(pts, obj, ego_pose, TOL_M)
-                    assert ok.all(), f"ts {ts}: {(~ok).sum()} of {len(ok)} points of {vid} from {cav} outside the box seen by {ego}"
+                    assert ok.all(), (
+                        f"ts {ts}: {(~ok).sum()} of {len(ok)} points of {vid} from {cav} outside the box seen by {ego}"
+                    )
                     n["own" if cav == ego else "coop"] += len(pts)
     return n
 
@@ -262,7 +278,9 @@ def test_cameras_order_extrinsic_and_projection(coop_out: Path, coop_rec_data: d
             cam = doc[f"camera{i}"]
             ext = np.asarray(cam["extrinsic"])
             np.testing.assert_allclose(ext, x1_to_x2(doc["lidar_pose"], cam["cords"]), atol=1e-6)
-            assert math.degrees(wrap(math.radians(cam["cords"][4] - lidar_yaw - offsets[i]))) == pytest.approx(0.0, abs=2.0)
+            assert math.degrees(wrap(math.radians(cam["cords"][4] - lidar_yaw - offsets[i]))) == pytest.approx(
+                0.0, abs=2.0
+            )
             k_mat = np.asarray(cam["intrinsic"])
             assert k_mat[0, 0] == pytest.approx(160 / (2 * math.tan(math.radians(45))))
             assert (k_mat[0, 2], k_mat[1, 2]) == (80.0, 60.0)

@@ -6,7 +6,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from mmusv.errors import ConfigError
 from mmusv.export.pcd import pcd_bytes, read_pcd, write_pcd
 from mmusv.export.splits import assign_splits, parse_ratios, split_counts

@@ -7,7 +7,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from mmusv.config import load_scenario
 from mmusv.generate.runner import generate
 from mmusv.generate.spec import load_spec
@@ -60,7 +59,9 @@ def test_generated_scenarios_have_the_density_they_promise(generated: Path) -> N
 def test_target_density_rejects_a_lonely_usv(tmp_path: Path) -> None:
     """The same combination with distractors removed and density asking for 3 targets can never pass."""
     spec = load_spec(SPEC).model_dump()
-    spec["combinations"] = [dict(c, quota=1, max_attempts=20) for c in spec["combinations"] if c["name"] == "sea_crossing"]
+    spec["combinations"] = [
+        dict(c, quota=1, max_attempts=20) for c in spec["combinations"] if c["name"] == "sea_crossing"
+    ]
     spec["difficulties"]["mid"]["extra_targets"] = 0
     spec["constraints"]["target_density"]["min_targets"] = 3
     report = generate(spec, tmp_path)

@@ -11,7 +11,6 @@ from typing import Any
 
 import pytest
 import yaml
-
 from mmusv.config import load_scenario
 from mmusv.errors import ConfigError, IoError
 from mmusv.generate import FAMILIES, generate, load_spec
@@ -20,8 +19,16 @@ from mmusv.generate.cli import add_parser, run
 ROOT = Path(__file__).resolve().parents[2]
 SPECS = ROOT / "scenarios" / "specs"
 CHECK_NAMES = {
-    "in_water", "shore_clearance", "structure_clearance", "separation", "route_separation", "target_range",
-    "sensing_range", "cooperation", "line_of_sight", "occlusion",
+    "in_water",
+    "shore_clearance",
+    "structure_clearance",
+    "separation",
+    "route_separation",
+    "target_range",
+    "sensing_range",
+    "cooperation",
+    "line_of_sight",
+    "occlusion",
 }
 
 SMALL: dict[str, Any] = {
@@ -74,7 +81,10 @@ def test_outputs_are_valid_scenarios_with_a_rig_for_every_usv(small_run: tuple[P
         assert all(v.rig == "usv_standard" for v in sc.vessels if v.role == "usv")
         assert sc.vessels[0].id == entry["roles"]["ego"] == "usv_ego"
         assert {v.id for v in sc.vessels} == {
-            "usv_ego", *entry["roles"]["cooperating"], *entry["roles"]["targets"], *entry["roles"]["distractors"]
+            "usv_ego",
+            *entry["roles"]["cooperating"],
+            *entry["roles"]["targets"],
+            *entry["roles"]["distractors"],
         }
         seeds.add(sc.seed)
         for v in sc.vessels:  # numbers rounded to 0.01 before writing
@@ -124,20 +134,44 @@ def test_existing_output_is_not_overwritten_without_force(tmp_path: Path) -> Non
 
 
 BAD_SPECS: list[tuple[dict[str, Any], str]] = [
-    ({"combinations": [{"family": "crosing"}]}, r"combinations\[0\]\.family = 'crosing': unknown family; did you mean crossing"),
+    (
+        {"combinations": [{"family": "crosing"}]},
+        r"combinations\[0\]\.family = 'crosing': unknown family; did you mean crossing",
+    ),
     ({"combinations": [{"family": "crossing", "difficulty": "insane"}]}, r"combinations\[0\]\.difficulty = 'insane'"),
-    ({"combinations": [{"family": "crossing", "targets": ["tiny"]}]}, r"combinations\[0\]\.targets\[0\] = 'tiny': not a size class"),
+    (
+        {"combinations": [{"family": "crossing", "targets": ["tiny"]}]},
+        r"combinations\[0\]\.targets\[0\] = 'tiny': not a size class",
+    ),
     ({"combinations": [{"family": "crossing", "quota": 0}]}, r"combinations\[0\]\.quota = 0"),
     ({"combinations": [{"family": "crossing", "ego": "tug_32m"}]}, r"combinations\[0\]\.ego = 'tug_32m': .*USV"),
-    ({"combinations": [{"family": "port_entry"}]}, r"combinations\[0\]\.family = 'port_entry': needs a map of type port"),
+    (
+        {"combinations": [{"family": "port_entry"}]},
+        r"combinations\[0\]\.family = 'port_entry': needs a map of type port",
+    ),
     ({"combinations": [{"family": "occluded_by_island"}]}, r"combinations\[0\]\.cooperating = 0"),
     ({"combinations": []}, r"invalid spec combinations = \[\]"),
-    ({"combinations": [{"family": "crossing"}], "constraints": {"separation": {"min_m": -1}}}, r"constraints\.separation\.min_m = -1"),
-    ({"combinations": [{"family": "crossing"}], "constraints": {"cooperation": {"min_m": 900, "max_m": 100}}}, r"constraints\.cooperation"),
+    (
+        {"combinations": [{"family": "crossing"}], "constraints": {"separation": {"min_m": -1}}},
+        r"constraints\.separation\.min_m = -1",
+    ),
+    (
+        {"combinations": [{"family": "crossing"}], "constraints": {"cooperation": {"min_m": 900, "max_m": 100}}},
+        r"constraints\.cooperation",
+    ),
     ({"combinations": [{"family": "crossing"}], "constraints": {"sepration": {}}}, r"constraints\.sepration"),
-    ({"combinations": [{"family": "crossing"}], "size_classes": {"huge": {"length_m": [500, 900]}}}, r"size_classes\.huge\.length_m"),
-    ({"combinations": [{"family": "crossing"}], "difficulties": {"easy": {"range_m": [300, 100]}}}, r"difficulties\.easy\.range_m"),
-    ({"combinations": [{"family": "crossing"}], "environment": {"weather": ["clear", "snow"]}}, r"environment\.weather = 'snow'"),
+    (
+        {"combinations": [{"family": "crossing"}], "size_classes": {"huge": {"length_m": [500, 900]}}},
+        r"size_classes\.huge\.length_m",
+    ),
+    (
+        {"combinations": [{"family": "crossing"}], "difficulties": {"easy": {"range_m": [300, 100]}}},
+        r"difficulties\.easy\.range_m",
+    ),
+    (
+        {"combinations": [{"family": "crossing"}], "environment": {"weather": ["clear", "snow"]}},
+        r"environment\.weather = 'snow'",
+    ),
     ({"combinations": [{"family": "crossing"}], "rig": "missing"}, r"rig = 'missing': not defined under rigs"),
     ({"combinations": [{"family": "crossing"}, {"family": "crossing"}]}, r"combinations\[1\]\.name"),
     ({"combinations": [{"family": "crossing"}], "map": {"type": "lake"}}, r"map\.type = 'lake'"),

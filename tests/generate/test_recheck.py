@@ -15,7 +15,6 @@ from typing import Any
 import numpy as np
 import pytest
 import shapely
-
 from mmusv.config import Scenario, load_scenario
 from mmusv.generate import generate
 from mmusv.motion import build_fleet
@@ -150,7 +149,9 @@ def recheck(sc: Scenario, roles: dict[str, Any], cons: dict[str, Any]) -> None:
             c = cons[name]
             if not c["enabled"] or geom.is_empty:
                 continue
-            assert not shapely.dwithin(geom, rect, c["min_m"] - TOL).any(), f"{sc.name}: {v.id} {name} (hull) at some time"
+            assert not shapely.dwithin(geom, rect, c["min_m"] - TOL).any(), (
+                f"{sc.name}: {v.id} {name} (hull) at some time"
+            )
             assert not shapely.dwithin(geom, rect_route, c["min_m"] - TOL).any(), f"{sc.name}: {v.id} {name} on route"
 
     if cons["separation"]["enabled"]:
@@ -164,7 +165,9 @@ def recheck(sc: Scenario, roles: dict[str, Any], cons: dict[str, Any]) -> None:
             for b in usvs:
                 if a < b:
                     d = float(shapely.distance(shapely.linestrings(routes[a]), shapely.linestrings(routes[b])))
-                    assert d >= cons["route_separation"]["min_m"] - TOL, f"{sc.name}: routes {ids[a]}-{ids[b]} {d:.2f} m"
+                    assert d >= cons["route_separation"]["min_m"] - TOL, (
+                        f"{sc.name}: routes {ids[a]}-{ids[b]} {d:.2f} m"
+                    )
 
     xy = frames[:, :, :2]
     ego = idx[roles["ego"]]
@@ -241,8 +244,12 @@ def test_the_recheck_is_not_vacuous(tmp_path: Path) -> None:
     generate(spec, tmp_path)
     data = json.loads((tmp_path / "report.json").read_text())
     strict = _constraints(spec)
-    for key, tightened in (("separation", {"min_m": 400.0}), ("shore_clearance", {"min_m": 300.0}),
-                           ("route_separation", {"min_m": 500.0}), ("sensing_range", {"range_m": 20.0})):
+    for key, tightened in (
+        ("separation", {"min_m": 400.0}),
+        ("shore_clearance", {"min_m": 300.0}),
+        ("route_separation", {"min_m": 500.0}),
+        ("sensing_range", {"range_m": 20.0}),
+    ):
         cons = {k: dict(v) for k, v in strict.items()}
         cons[key].update(tightened)
         failures = 0

@@ -8,10 +8,9 @@ import warnings
 from pathlib import Path
 from typing import Any
 
+import mmusv
 import pytest
 import yaml
-
-import mmusv
 from mmusv.cli import main
 from mmusv.config import load_scenario
 from mmusv.errors import ConfigError, MmusvError
@@ -30,7 +29,10 @@ SPEC = ROOT / "scenarios/specs/island_demo.yaml"
 def tiny(**changes: Any) -> dict[str, Any]:
     """A fast open-sea scenario (LiDAR only, 2 frames); keyword arguments replace top-level keys."""
     d: dict[str, Any] = {
-        "name": "tiny", "seed": 1, "map": {"type": "open_sea", "seed": 0}, "acquisition": {"frames": 2},
+        "name": "tiny",
+        "seed": 1,
+        "map": {"type": "open_sea", "seed": 0},
+        "acquisition": {"frames": 2},
         "rigs": {"r": {"preset": "lidar_only", "lidar": {"channels": 8, "points_per_second": 8 * 64 * 5}}},
         "vessels": [
             {"id": "u", "role": "usv", "asset": "usv_wamv", "rig": "r", "speed_mps": 2, "route": [[0, 0], [50, 0]]},
@@ -65,7 +67,9 @@ def cli_error(capsys: pytest.CaptureFixture[str], argv: list[str]) -> str:
     ],
     ids=["latin1", "utf16", "binary"],
 )
-def test_bad_encodings_are_config_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str], encode: Any, expect: str) -> None:
+def test_bad_encodings_are_config_errors(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], encode: Any, expect: str
+) -> None:
     text = PORT.read_text(encoding="utf-8").replace("# Port map", "# Port map, café")
     f = tmp_path / "bad.yaml"
     f.write_bytes(encode(text))
@@ -124,7 +128,10 @@ def test_spec_ranges_with_infinite_bounds_are_refused() -> None:
 @pytest.mark.parametrize(
     ("rig", "field"),
     [
-        ({"cameras": [{"name": "c", "resolution": [16384, 16384]}]}, r"cameras\.0\.resolution|cameras\[0\]\.resolution"),
+        (
+            {"cameras": [{"name": "c", "resolution": [16384, 16384]}]},
+            r"cameras\.0\.resolution|cameras\[0\]\.resolution",
+        ),
         ({"lidar": {"channels": 1024, "points_per_second": 1024 * 65536 * 5.0}}, r"lidar"),
         ({"radar": {"azimuth_bins": 65536, "rays_az": 64, "rays_el": 256}}, r"radar"),
         ({"top_view": {"resolution": [16000, 16000]}}, r"top_view\.resolution"),
@@ -156,7 +163,9 @@ def test_a_rig_on_a_vessel_that_is_not_a_usv_is_an_error() -> None:
 def test_an_unknown_mount_point_lists_the_assets_points() -> None:
     d = tiny()
     d["rigs"]["r"]["lidar"]["mount"] = {"point": "lidr"}
-    with pytest.raises(ConfigError, match=r"rigs\.r\.lidar\.mount\.point = 'lidr'.*did you mean 'lidar'.*its points: camera_front"):
+    with pytest.raises(
+        ConfigError, match=r"rigs\.r\.lidar\.mount\.point = 'lidr'.*did you mean 'lidar'.*its points: camera_front"
+    ):
         load_scenario(d)
 
 
@@ -210,12 +219,14 @@ def test_run_of_a_directory_says_so(tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize("jobs", [1, 2])
-def test_folder_runs_report_each_file_and_keep_going(tmp_path: Path, capsys: pytest.CaptureFixture[str], jobs: int) -> None:
+def test_folder_runs_report_each_file_and_keep_going(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], jobs: int
+) -> None:
     src = tmp_path / "src"
     src.mkdir()
     write(src / "a_good.yaml", tiny(name="a_good"))
     write(src / "b_bad.yaml", tiny(name="b_bad", map={"type": "port", "seed": 3, "params": {"n_moored": 999}}))
-    (src / "c_broken.yaml").write_bytes("name: c\nvessels: ]\n".encode())
+    (src / "c_broken.yaml").write_bytes(b"name: c\nvessels: ]\n")
     write(src / "d_good.yaml", tiny(name="d_good"))
     assert main(["run", str(src), "-o", str(tmp_path / "out"), "--jobs", str(jobs)]) == 1
     out = capsys.readouterr().out

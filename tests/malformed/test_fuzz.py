@@ -16,7 +16,6 @@ import pytest
 import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-
 from mmusv.config import load_scenario
 from mmusv.errors import MmusvError
 from mmusv.generate.spec import load_spec
@@ -26,8 +25,28 @@ SCENARIOS = sorted((ROOT / "scenarios").glob("*.yaml"))
 SPECS = sorted((ROOT / "scenarios/specs").glob("*.yaml"))
 EXAMPLES = int(os.environ.get("MMUSV_FUZZ_EXAMPLES", "200"))
 
-ODD_VALUES = [None, "", "x", "7:30 pm", -1, 0, -1e12, 1e12, 10**30, math.nan, math.inf, -math.inf, True, [], {},
-              [1, 2, 3], {"a": 1}, "W9", 1e-9, -0.0]
+ODD_VALUES = [
+    None,
+    "",
+    "x",
+    "7:30 pm",
+    -1,
+    0,
+    -1e12,
+    1e12,
+    10**30,
+    math.nan,
+    math.inf,
+    -math.inf,
+    True,
+    [],
+    {},
+    [1, 2, 3],
+    {"a": 1},
+    "W9",
+    1e-9,
+    -0.0,
+]
 
 
 def _paths(node: Any, prefix: tuple[Any, ...] = ()) -> list[tuple[Any, ...]]:
@@ -105,8 +124,12 @@ def _check(tmp: Path, case: tuple[Path, bytes], loader: Any) -> None:
         resource.setrlimit(resource.RLIMIT_AS, (soft, hard))
 
 
-SETTINGS = settings(max_examples=EXAMPLES, deadline=5000, derandomize=True,
-                    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+SETTINGS = settings(
+    max_examples=EXAMPLES,
+    deadline=5000,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
 
 
 @SETTINGS
@@ -122,8 +145,12 @@ def test_mutated_specs_load_or_fail_cleanly(tmp_path: Path, case: tuple[Path, by
 
 
 @pytest.mark.slow
-@settings(max_examples=max(EXAMPLES, 2000), deadline=5000, derandomize=True,
-          suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+@settings(
+    max_examples=max(EXAMPLES, 2000),
+    deadline=5000,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
 @given(case=mutations(SCENARIOS + SPECS))
 def test_many_mutations(tmp_path: Path, case: tuple[Path, bytes]) -> None:
     _check(tmp_path, case, load_spec if case[0].parent.name == "specs" else load_scenario)

@@ -33,7 +33,9 @@ SMALL_SCENARIO: dict[str, Any] = {
     "rigs": {
         "r": {
             "lidar": {"channels": 32, "points_per_second": 57600, "rotation_hz": 5, "range_noise_std_m": 0.0},
-            "cameras": [{"name": "front", "resolution": [160, 120], "hfov_deg": 90, "mount": {"point": "camera_front"}}],
+            "cameras": [
+                {"name": "front", "resolution": [160, 120], "hfov_deg": 90, "mount": {"point": "camera_front"}}
+            ],
             "top_view": {"resolution": [160, 160], "metres_per_pixel": 1.0, "orientation": "heading_up"},
             "radar": None,
         },
@@ -59,9 +61,23 @@ SMALL_SCENARIO: dict[str, Any] = {
         },
     },
     "vessels": [
-        {"id": "usv_a", "role": "usv", "asset": "usv_patrol_12m", "rig": "r", "speed_mps": 3.0, "route": [[0, 0], [300, 200]]},
+        {
+            "id": "usv_a",
+            "role": "usv",
+            "asset": "usv_patrol_12m",
+            "rig": "r",
+            "speed_mps": 3.0,
+            "route": [[0, 0], [300, 200]],
+        },
         {"id": "tgt", "role": "target", "asset": "tug_32m", "speed_mps": 3.0, "route": [[34.1, 30.0], [334.1, 230.0]]},
-        {"id": "usv_b", "role": "usv", "asset": "usv_wamv", "rig": "rn", "speed_mps": 2.0, "route": [[90, -30], [60, 0]]},
+        {
+            "id": "usv_b",
+            "role": "usv",
+            "asset": "usv_wamv",
+            "rig": "rn",
+            "speed_mps": 2.0,
+            "route": [[90, -30], [60, 0]],
+        },
     ],
 }
 

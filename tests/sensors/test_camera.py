@@ -45,8 +45,20 @@ def add_box(scene: Scene, lo: Any, hi: Any, *, cls: int) -> int:
     lo_, hi_ = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
     v = np.array([[(hi_ if (i >> k) & 1 else lo_)[k] for k in range(3)] for i in range(8)])
     f = np.array(
-        [[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4],
-         [2, 6, 3], [3, 6, 7], [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5]],
+        [
+            [0, 2, 1],
+            [1, 2, 3],
+            [4, 5, 6],
+            [5, 7, 6],
+            [0, 1, 4],
+            [1, 5, 4],
+            [2, 6, 3],
+            [3, 6, 7],
+            [0, 4, 2],
+            [2, 4, 6],
+            [1, 3, 5],
+            [3, 7, 5],
+        ],
         dtype=np.int64,
     )
     return scene.add_instance(scene.add_mesh(v, f, classes=cls, name="box"))

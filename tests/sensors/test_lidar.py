@@ -35,8 +35,20 @@ def box_mesh(lo: Any, hi: Any) -> tuple[np.ndarray, np.ndarray]:
     lo_, hi_ = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
     v = np.array([[(hi_ if (i >> k) & 1 else lo_)[k] for k in range(3)] for i in range(8)])
     f = np.array(
-        [[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4],
-         [2, 6, 3], [3, 6, 7], [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5]],
+        [
+            [0, 2, 1],
+            [1, 2, 3],
+            [4, 5, 6],
+            [5, 7, 6],
+            [0, 1, 4],
+            [1, 5, 4],
+            [2, 6, 3],
+            [3, 6, 7],
+            [0, 4, 2],
+            [2, 4, 6],
+            [1, 3, 5],
+            [3, 7, 5],
+        ],
         dtype=np.int64,
     )
     return v, f
@@ -176,7 +188,9 @@ def test_range_limits() -> None:
 
 
 def test_ring_azimuth_ray_index_and_elevation() -> None:
-    cfg = LidarConfig(channels=16, points_per_second=57_600, rotation_hz=10, range_noise_std_m=0.03, vertical_fov_deg=(-25, 15))
+    cfg = LidarConfig(
+        channels=16, points_per_second=57_600, rotation_hz=10, range_noise_std_m=0.03, vertical_fov_deg=(-25, 15)
+    )
     assert cfg.azimuth_steps == 360
     lidar = lidar_from_config(cfg)
     assert lidar.num_rays == 16 * 360
@@ -283,7 +297,12 @@ def test_water_returns_follow_the_wave_model(wave_h: float) -> None:
     """Open water returns with probability p0 + k·H (clamped to 1) and only within r0 + c·H metres."""
     z0, p0, kp, r0, kr = 2.5, 0.05, 0.1, 20.0, 10.0
     lidar = exact_lidar(
-        32, 720, range_m=200.0, water_probability=p0, water_probability_per_wave_m=kp, water_range_m=r0,
+        32,
+        720,
+        range_m=200.0,
+        water_probability=p0,
+        water_probability_per_wave_m=kp,
+        water_range_m=r0,
         water_range_per_wave_m=kr,
     )
     pose = pose_matrices(np.array([3.0, -4.0, z0, 0.0, 0.0, 1.0]))

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from mmusv import Simulation
 from mmusv.world.vessels import library
 
@@ -28,8 +27,16 @@ def _scenario(asset: str) -> dict[str, object]:
         "environment": {"wave": "W2"},
         "acquisition": {"frequency_hz": 5, "frames": 4},
         "rigs": {"r": {"cameras": cams, "top_view": None, "radar": {"azimuth_bins": 512}}},
-        "vessels": [{"id": "u", "role": "usv", "asset": asset, "rig": "r", "speed_mps": 2.0,
-                     "route": [[0.0, 0.0], [200.0, 0.0]]}],
+        "vessels": [
+            {
+                "id": "u",
+                "role": "usv",
+                "asset": asset,
+                "rig": "r",
+                "speed_mps": 2.0,
+                "route": [[0.0, 0.0], [200.0, 0.0]],
+            }
+        ],
     }
 
 
@@ -58,8 +65,9 @@ def test_the_check_would_catch_a_blinded_camera() -> None:
     """A camera mounted looking back down at the deck sees its own hull: the measure above detects it."""
     cfg = _scenario("usv_patrol_12m")
     rig = cfg["rigs"]["r"]  # type: ignore[index]
-    rig["cameras"] = [{"name": "down", "resolution": [160, 120],
-                       "mount": {"point": "camera_front", "rpy_deg": [0.0, 60.0, 180.0]}}]
+    rig["cameras"] = [
+        {"name": "down", "resolution": [160, 120], "mount": {"point": "camera_front", "rpy_deg": [0.0, 60.0, 180.0]}}
+    ]
     sim = Simulation(cfg)
     img = sim.capture(0).agents["u"].cameras["down"].instance
     assert float(np.mean(img == sim.vessels[0].instance_id)) > 0.05

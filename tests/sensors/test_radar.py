@@ -8,6 +8,7 @@ written for (plenty of clutter); one test checks the schema defaults (0.3, 4e-7)
 
 from __future__ import annotations
 
+import itertools
 import math
 from pathlib import Path
 from typing import Any
@@ -35,6 +36,8 @@ def small(**change: Any) -> RadarConfig:
 def env(*, waves: float = 0.0, rain: float = 0.0) -> Any:
     """Clear air with ``waves`` metres of waves and ``rain`` mm/h."""
     return sensor_env(fog_extinction_per_m=0.0, rain_mm_per_h=rain, wave_height_m=waves)
+
+
 MAST_HEIGHT = 3.0
 HALF = 5.0  # half side of the box targets, metres
 
@@ -128,7 +131,7 @@ def test_box_return_at_its_range_bearing_and_id(near_range: float, bearing_deg: 
 
 
 def brightest_near(img: npt.NDArray[np.float32], row: float, col: float, radius: int = 6) -> tuple[int, int]:
-    r0, c0 = int(round(row)) - radius, int(round(col)) - radius
+    r0, c0 = round(row) - radius, round(col) - radius
     win = img[r0 : r0 + 2 * radius + 1, c0 : c0 + 2 * radius + 1]
     assert win.max() > 0, "nothing painted near the target"
     r, c = np.unravel_index(int(np.argmax(win)), win.shape)
@@ -180,7 +183,9 @@ def test_same_seed_same_arrays_other_seed_other_clutter() -> None:
     assert a.is_clutter.sum() > 100
 
     def cells(r: RadarReturns) -> set[tuple[float, float]]:
-        return {(float(x), float(y)) for x, y in zip(r.azimuth[r.is_clutter], np.rint(r.range[r.is_clutter]))}
+        return {
+            (float(x), float(y)) for x, y in zip(r.azimuth[r.is_clutter], np.rint(r.range[r.is_clutter]), strict=False)
+        }
 
     assert cells(a) != cells(c), "a different seed must give different clutter"
     assert (a.semantic_class[a.is_clutter] == SemanticClass.WATER).all()
@@ -198,7 +203,7 @@ def test_sea_clutter_grows_from_w0_to_w3() -> None:
     rets = [radar_sweep(RADAR, sea.scene, pose=pose, env=env(waves=h), seed=5) for h in heights]
     counts = [clutter_count(r) for r in rets]
     reach = [float(r.range[r.is_clutter].max()) for r in rets]
-    assert counts[0] > 0 and all(x < y for x, y in zip(counts, counts[1:])), counts
+    assert counts[0] > 0 and all(x < y for x, y in itertools.pairwise(counts)), counts
     assert counts[-1] > 3 * counts[0], counts
     assert reach[-1] > 2 * reach[0], reach
     assert reach[-1] < SMALL.sea_clutter_max_range_m

@@ -157,8 +157,13 @@ def test_capture_is_independent_of_the_thread_count(make_scenario: Any, sim: Sim
     here = runpy.run_path(str(script))["capture_digest"](sim, 5)
     env = {**os.environ, "RAYON_NUM_THREADS": "1"}
     out = subprocess.run(
-        [sys.executable, str(script), "5"], input=json.dumps(make_scenario()), env=env,
-        capture_output=True, text=True, timeout=120, check=True,
+        [sys.executable, str(script), "5"],
+        input=json.dumps(make_scenario()),
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=True,
     )
     assert out.stdout.strip() == here
 
@@ -205,7 +210,9 @@ def test_fallback_mounts_on_assets_without_mount_points(make_scenario: Any) -> N
     top = float(asset.bbox[1, 2]) + 0.5
     assert agent.lidar_mount is not None
     np.testing.assert_allclose(agent.lidar_mount, pose_matrices(np.array([0, 0, top, 0, 0, 0])), atol=1e-12)
-    np.testing.assert_allclose(agent.cameras["aux"][2], pose_matrices(np.array([0, 0, top, 0, 0, math.pi / 2])), atol=1e-12)
+    np.testing.assert_allclose(
+        agent.cameras["aux"][2], pose_matrices(np.array([0, 0, top, 0, 0, math.pi / 2])), atol=1e-12
+    )
     cap = s.capture(0, agents=["usv_b"], radar=False)
     lidar = cap.agents["usv_b"].lidar
     assert lidar is not None and not np.any(lidar.instance == s.vessels[2].instance_id), "no returns from its own hull"
@@ -214,7 +221,9 @@ def test_fallback_mounts_on_assets_without_mount_points(make_scenario: Any) -> N
 # ------------------------------------------------------------------------------------------ one state per frame
 
 
-def in_body_box(points_world: np.ndarray, state: WorldState, vessel: int, centre: np.ndarray, size: np.ndarray, margin: float) -> np.ndarray:
+def in_body_box(
+    points_world: np.ndarray, state: WorldState, vessel: int, centre: np.ndarray, size: np.ndarray, margin: float
+) -> np.ndarray:
     """``(N,)`` bool: world points inside vessel ``vessel``'s box (body frame, ±``margin`` metres) in ``state``."""
     m = state.matrices[vessel]
     body = (points_world - m[:3, 3]) @ m[:3, :3]
@@ -230,7 +239,8 @@ class SurfaceDistance:
         mesh = get_asset(asset_name).mesh
         self._scene = o3d.t.geometry.RaycastingScene()
         self._scene.add_triangles(
-            o3d.core.Tensor(np.asarray(mesh.vertices, dtype=np.float32)), o3d.core.Tensor(np.asarray(mesh.faces, dtype=np.uint32))
+            o3d.core.Tensor(np.asarray(mesh.vertices, dtype=np.float32)),
+            o3d.core.Tensor(np.asarray(mesh.faces, dtype=np.uint32)),
         )
         self._o3d = o3d
 
@@ -301,7 +311,9 @@ def test_all_sensors_see_the_frame_state(sim: Simulation, frame: int) -> None:
             w, h = tvc.resolution
             mpp = tvc.metres_per_pixel
             vv, uu = np.nonzero(mask)
-            local = np.stack([tv.depth[vv, uu].astype(np.float64), (w / 2 - (uu + 0.5)) * mpp, (h / 2 - (vv + 0.5)) * mpp], axis=1)
+            local = np.stack(
+                [tv.depth[vv, uu].astype(np.float64), (w / 2 - (uu + 0.5)) * mpp, (h / 2 - (vv + 0.5)) * mpp], axis=1
+            )
             world = local @ ac.top_view_pose[:3, :3].T + ac.top_view_pose[:3, 3]
             check(world, 0.02, f"{aid}/top_view")
             seen.append(f"{aid}/top_view")
@@ -320,7 +332,9 @@ def test_sensor_poses_follow_mounts(sim: Simulation) -> None:
         np.testing.assert_allclose(ac.lidar_pose[:3, 3], body[:3, :3] @ np.array(mp.xyz) + body[:3, 3], atol=1e-9)
         np.testing.assert_allclose(ac.lidar_pose[:3, :3], body[:3, :3], atol=1e-12)  # LiDAR mount not rotated
         fp = asset.mounts["camera_front"]
-        np.testing.assert_allclose(ac.camera_poses["front"][:3, 3], body[:3, :3] @ np.array(fp.xyz) + body[:3, 3], atol=1e-9)
+        np.testing.assert_allclose(
+            ac.camera_poses["front"][:3, 3], body[:3, :3] @ np.array(fp.xyz) + body[:3, 3], atol=1e-9
+        )
         if "aux" in ac.camera_poses:  # on the camera_left point: looks 90° to port
             np.testing.assert_allclose(ac.camera_poses["aux"][:3, 0], body[:3, 1], atol=1e-9)
         # Top view: level, altitude above the USV's (x, y), looking straight down.
@@ -363,14 +377,21 @@ def winding_number(vertices: np.ndarray, faces: np.ndarray, p: np.ndarray) -> fl
     a, b, c = (vertices[faces[:, k]].astype(np.float64) - p for k in range(3))
     la, lb, lc = (np.linalg.norm(x, axis=1) for x in (a, b, c))
     num = np.einsum("ij,ij->i", a, np.cross(b, c))
-    den = la * lb * lc + np.einsum("ij,ij->i", a, b) * lc + np.einsum("ij,ij->i", b, c) * la + np.einsum("ij,ij->i", c, a) * lb
+    den = (
+        la * lb * lc
+        + np.einsum("ij,ij->i", a, b) * lc
+        + np.einsum("ij,ij->i", b, c) * la
+        + np.einsum("ij,ij->i", c, a) * lb
+    )
     return float(2 * np.arctan2(num, den).sum() / (4 * np.pi))
 
 
 def test_mount_inside_hull_is_refused(make_scenario: Any) -> None:
     """A camera at 1 m above the WAM-V origin is inside its hull (winding number 1): refused, naming the mount."""
     asset = get_asset("usv_wamv")
-    assert winding_number(asset.mesh.vertices, asset.mesh.faces, np.array([0.0, 0.0, 1.0])) == pytest.approx(1.0, abs=1e-6)
+    assert winding_number(asset.mesh.vertices, asset.mesh.faces, np.array([0.0, 0.0, 1.0])) == pytest.approx(
+        1.0, abs=1e-6
+    )
     sc = make_scenario()
     sc["rigs"]["rn"]["cameras"][0]["mount"] = {"xyz": [0.0, 0.0, 1.0]}
     with pytest.raises(mmusv.ConfigError, match=r"rigs\.rn\.cameras\[front\]\.mount"):
@@ -386,7 +407,9 @@ def test_mount_inside_monohull_is_refused(make_scenario: Any, z: float) -> None:
     """``{xyz: [0, 0, z]}`` without a point is relative to the vessel origin (midship, waterline): inside the
     patrol boat's hull for these z (winding number 1), so the Simulation must refuse it, naming the mount."""
     asset = get_asset("usv_patrol_12m")
-    assert winding_number(asset.mesh.vertices, asset.mesh.faces, np.array([0.0, 0.0, z])) == pytest.approx(1.0, abs=1e-6)
+    assert winding_number(asset.mesh.vertices, asset.mesh.faces, np.array([0.0, 0.0, z])) == pytest.approx(
+        1.0, abs=1e-6
+    )
     sc = make_scenario()
     assert sc["vessels"][0]["asset"] == "usv_patrol_12m" and sc["vessels"][0]["rig"] == "r"
     sc["rigs"]["r"]["cameras"][0]["mount"] = {"xyz": [0.0, 0.0, z]}
@@ -397,7 +420,9 @@ def test_mount_inside_monohull_is_refused(make_scenario: Any, z: float) -> None:
 def test_mount_outside_hull_is_accepted(make_scenario: Any) -> None:
     """Between the WAM-V's pontoons at the waterline is outside the hull (winding number 0)."""
     asset = get_asset("usv_wamv")
-    assert winding_number(asset.mesh.vertices, asset.mesh.faces, np.array([0.0, 0.0, 0.0])) == pytest.approx(0.0, abs=1e-6)
+    assert winding_number(asset.mesh.vertices, asset.mesh.faces, np.array([0.0, 0.0, 0.0])) == pytest.approx(
+        0.0, abs=1e-6
+    )
     sc = make_scenario()
     sc["rigs"]["rn"]["cameras"][0]["mount"] = {"xyz": [0.0, 0.0, 3.0]}
     Simulation(sc)

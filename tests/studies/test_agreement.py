@@ -5,7 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-
 from mmusv.simulation import Simulation
 from mmusv.studies.agreement import run_agreement_study, sample_agreement
 
@@ -13,7 +12,9 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_bundled_scenarios_agree_within_a_pixel() -> None:
-    study = run_agreement_study([str(ROOT / "scenarios/open_sea_convoy.yaml"), str(ROOT / "scenarios/port_entry.yaml")], frames=1)
+    study = run_agreement_study(
+        [str(ROOT / "scenarios/open_sea_convoy.yaml"), str(ROOT / "scenarios/port_entry.yaml")], frames=1
+    )
     s = study.summary
     assert s.height == 2 and (s["valid_samples"] > 0).all()
     assert (s["median_centre_error_px"] <= 1.0).all()
@@ -35,8 +36,15 @@ def test_a_box_displaced_by_five_pixels_is_reported() -> None:
                 continue
             box = cap.world.matrices[vi].copy()
             box[:3, 3] = box[:3, :3] @ info.box_center_body + box[:3, 3] + np.array([shift * m, 0.0, 0.0])
-            r = sample_agreement(semantic=tv.top_view.semantic, instance=tv.top_view.instance, camera_pose=tv.top_view_pose,
-                                 metres_per_pixel=m, box_matrix=box, box_size=info.box_size, instance_id=info.instance_id)
+            r = sample_agreement(
+                semantic=tv.top_view.semantic,
+                instance=tv.top_view.instance,
+                camera_pose=tv.top_view_pose,
+                metres_per_pixel=m,
+                box_matrix=box,
+                box_size=info.box_size,
+                instance_id=info.instance_id,
+            )
             if r is not None:
                 results.append((shift, info.id, r))
     # Compare vessels valid both in place and displaced (a displaced hull can newly fit the image).

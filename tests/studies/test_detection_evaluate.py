@@ -23,6 +23,7 @@ def box(x: float, y: float, l: float = 4.0, w: float = 2.0, yaw: float = 0.0) ->
 
 # ---- IoU ---------------------------------------------------------------------------------------------------------
 
+
 def test_identical_boxes_iou_one_and_ap_one() -> None:
     b = np.array([box(10, 5, yaw=0.3), box(-20, 40, 6, 3, -1.0)])
     assert np.allclose(np.diag(bev_iou(b, b)), 1.0)
@@ -32,12 +33,15 @@ def test_identical_boxes_iou_one_and_ap_one() -> None:
     assert m["precision50"] == m["recall50"] == 1.0
 
 
-@pytest.mark.parametrize(("dx", "dy", "expected"), [
-    (1.0, 0.0, 6.0 / 10.0),        # 3 x 2 overlap of two 4 x 2 boxes: 6 / (8 + 8 - 6)
-    (1.0, 0.5, 4.5 / 11.5),        # 3 x 1.5 overlap
-    (0.0, 2.0, 0.0),               # touching edge
-    (5.0, 0.0, 0.0),               # apart
-])
+@pytest.mark.parametrize(
+    ("dx", "dy", "expected"),
+    [
+        (1.0, 0.0, 6.0 / 10.0),  # 3 x 2 overlap of two 4 x 2 boxes: 6 / (8 + 8 - 6)
+        (1.0, 0.5, 4.5 / 11.5),  # 3 x 1.5 overlap
+        (0.0, 2.0, 0.0),  # touching edge
+        (5.0, 0.0, 0.0),  # apart
+    ],
+)
 def test_shifted_boxes_analytic_iou(dx: float, dy: float, expected: float) -> None:
     iou = bev_iou([box(0, 0)], [box(dx, dy)])[0, 0]
     assert iou == pytest.approx(expected, abs=1e-12)
@@ -56,6 +60,7 @@ def test_rotated_90_degrees_and_180_degrees() -> None:
 
 
 # ---- matching ----------------------------------------------------------------------------------------------------
+
 
 def test_duplicate_detection_is_a_false_positive() -> None:
     gt = np.array([box(0, 0)])
@@ -98,8 +103,8 @@ def test_empty_frames() -> None:
     no_det = FrameMatch.evaluate(np.zeros((0, 7)), np.zeros(0), np.array([box(0, 0)]))
     both = FrameMatch.evaluate(np.zeros((0, 7)), np.zeros(0), np.zeros((0, 7)))
     assert no_gt.matches[0.5].tolist() == [-1]
-    assert math.isnan(summarize([no_gt])["ap50"])          # nothing to find: AP undefined
-    assert summarize([no_det])["ap50"] == 0.0               # nothing found
+    assert math.isnan(summarize([no_gt])["ap50"])  # nothing to find: AP undefined
+    assert summarize([no_det])["ap50"] == 0.0  # nothing found
     assert math.isnan(summarize([no_det])["precision50"])
     assert math.isnan(summarize([both])["ap50"])
     # A frame without ground truth adds its false positives to the others: one TP (0.8) and one FP (0.9).
@@ -112,15 +117,18 @@ def test_empty_frames() -> None:
 
 # ---- AP ----------------------------------------------------------------------------------------------------------
 
+
 def test_ap_interpolation_on_a_hand_computed_curve() -> None:
     # Scores descending: TP FP TP FP TP, 4 ground truths.
     # recall .25 .25 .5 .5 .75, precision 1 .5 2/3 .5 .6; interpolated precision at the recall steps:
     # .25 → 1, .5 → 2/3, .75 → .6, 1 → 0: AP = .25·(1 + 2/3 + .6) = 0.5666…
     expected = 0.25 * (1 + 2 / 3 + 0.6)
-    assert average_precision(np.array([0.9, 0.8, 0.7, 0.6, 0.5]), np.array([1, 0, 1, 0, 1], bool), 4) == \
-        pytest.approx(expected, abs=1e-12)
-    assert voc_ap(np.array([0.25, 0.25, 0.5, 0.5, 0.75]), np.array([1, 0.5, 2 / 3, 0.5, 0.6])) == \
-        pytest.approx(expected, abs=1e-12)
+    assert average_precision(np.array([0.9, 0.8, 0.7, 0.6, 0.5]), np.array([1, 0, 1, 0, 1], bool), 4) == pytest.approx(
+        expected, abs=1e-12
+    )
+    assert voc_ap(np.array([0.25, 0.25, 0.5, 0.5, 0.75]), np.array([1, 0.5, 2 / 3, 0.5, 0.6])) == pytest.approx(
+        expected, abs=1e-12
+    )
     # The same curve built from boxes over two frames (global sort by score across frames).
     gts = [np.array([box(0, 0), box(20, 0)]), np.array([box(0, 0), box(20, 0)])]
     f1 = FrameMatch.evaluate(np.array([box(0, 0), box(50, 50), box(20, 0)]), np.array([0.9, 0.6, 0.5]), gts[0])
@@ -129,6 +137,7 @@ def test_ap_interpolation_on_a_hand_computed_curve() -> None:
 
 
 # ---- range bins --------------------------------------------------------------------------------------------------
+
 
 def test_range_bins() -> None:
     xy = np.array([[0, 0], [49.9, 0], [50, 0], [0, -120], [141, 141], [200, 0], [250, 0]], dtype=float)
@@ -142,12 +151,13 @@ def test_ap_per_range_bin() -> None:
     assert fm.det_bins(0.5).tolist() == [0, 1, 3]
     s = summarize([fm])
     assert s["ap50_0-50"] == 1.0
-    assert s["ap50_50-100"] == 1.0          # the TP counts in its GT's bin
-    assert s["ap50_100-150"] == 0.0         # a GT, no detection
-    assert math.isnan(s["ap50_150-200"])    # an FP, no GT
+    assert s["ap50_50-100"] == 1.0  # the TP counts in its GT's bin
+    assert s["ap50_100-150"] == 0.0  # a GT, no detection
+    assert math.isnan(s["ap50_150-200"])  # an FP, no GT
 
 
 # ---- OpenCOOD's eval_utils, rewritten from its documented algorithm -----------------------------------------------
+
 
 def _clip(subject: list[tuple[float, float]], clipper: list[tuple[float, float]]) -> list[tuple[float, float]]:
     """Sutherland–Hodgman clipping of a polygon by a convex counter-clockwise polygon (no shapely)."""
@@ -158,8 +168,9 @@ def _clip(subject: list[tuple[float, float]], clipper: list[tuple[float, float]]
         def inside(p: tuple[float, float], a: tuple[float, float] = a, b: tuple[float, float] = b) -> bool:
             return (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]) >= 0
 
-        def cut(p: tuple[float, float], q: tuple[float, float], a: tuple[float, float] = a,
-                b: tuple[float, float] = b) -> tuple[float, float]:
+        def cut(
+            p: tuple[float, float], q: tuple[float, float], a: tuple[float, float] = a, b: tuple[float, float] = b
+        ) -> tuple[float, float]:
             d1 = (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
             d2 = (b[0] - a[0]) * (q[1] - a[1]) - (b[1] - a[1]) * (q[0] - a[0])
             t = d1 / (d1 - d2)
@@ -180,14 +191,25 @@ def _clip(subject: list[tuple[float, float]], clipper: list[tuple[float, float]]
 
 
 def _area(poly: list[tuple[float, float]]) -> float:
-    return 0.5 * abs(sum(poly[i][0] * poly[(i + 1) % len(poly)][1] - poly[(i + 1) % len(poly)][0] * poly[i][1]
-                         for i in range(len(poly)))) if len(poly) >= 3 else 0.0
+    return (
+        0.5
+        * abs(
+            sum(
+                poly[i][0] * poly[(i + 1) % len(poly)][1] - poly[(i + 1) % len(poly)][0] * poly[i][1]
+                for i in range(len(poly))
+            )
+        )
+        if len(poly) >= 3
+        else 0.0
+    )
 
 
 def _corners(b: np.ndarray) -> list[tuple[float, float]]:
     c, s = math.cos(b[6]), math.sin(b[6])
-    return [(b[0] + c * dx - s * dy, b[1] + s * dx + c * dy)
-            for dx, dy in ((b[3] / 2, b[4] / 2), (-b[3] / 2, b[4] / 2), (-b[3] / 2, -b[4] / 2), (b[3] / 2, -b[4] / 2))]
+    return [
+        (b[0] + c * dx - s * dy, b[1] + s * dx + c * dy)
+        for dx, dy in ((b[3] / 2, b[4] / 2), (-b[3] / 2, b[4] / 2), (-b[3] / 2, -b[4] / 2), (b[3] / 2, -b[4] / 2))
+    ]
 
 
 def _ref_iou(a: np.ndarray, b: np.ndarray) -> float:
@@ -205,7 +227,7 @@ def _ref_ap(frames: list[tuple[np.ndarray, np.ndarray, np.ndarray]], thr: float)
     n_gt = 0
     for dets, sc, gts in frames:
         n_gt += len(gts)
-        remaining = [g for g in gts]
+        remaining = list(gts)
         for i in sorted(range(len(dets)), key=lambda k: -sc[k]):
             ious = [_ref_iou(dets[i], g) for g in remaining]
             if not remaining or max(ious) < thr:
@@ -235,8 +257,16 @@ def test_matches_opencood_algorithm_on_random_cases(seed: int) -> None:
     frames = []
     for _ in range(int(rng.integers(1, 6))):
         n = int(rng.integers(0, 6))
-        gts = np.column_stack([rng.uniform(-60, 60, (n, 2)), np.zeros(n), rng.uniform(3, 15, n), rng.uniform(1.5, 5, n),
-                               np.full(n, 2.0), rng.uniform(-np.pi, np.pi, n)])
+        gts = np.column_stack(
+            [
+                rng.uniform(-60, 60, (n, 2)),
+                np.zeros(n),
+                rng.uniform(3, 15, n),
+                rng.uniform(1.5, 5, n),
+                np.full(n, 2.0),
+                rng.uniform(-np.pi, np.pi, n),
+            ]
+        )
         hit = gts[rng.random(n) < 0.8].copy()
         hit[:, :2] += rng.normal(0, 0.8, (len(hit), 2))
         hit[:, 3:5] *= rng.uniform(0.7, 1.3, (len(hit), 2))
@@ -244,11 +274,24 @@ def test_matches_opencood_algorithm_on_random_cases(seed: int) -> None:
         dup = hit[: int(rng.integers(0, len(hit) + 1))].copy()
         dup[:, :2] += rng.normal(0, 0.5, (len(dup), 2))
         k = int(rng.integers(0, 4))
-        fps = np.column_stack([rng.uniform(-60, 60, (k, 2)), np.zeros(k), rng.uniform(3, 15, k), rng.uniform(1.5, 5, k),
-                               np.full(k, 2.0), rng.uniform(-np.pi, np.pi, k)])
+        fps = np.column_stack(
+            [
+                rng.uniform(-60, 60, (k, 2)),
+                np.zeros(k),
+                rng.uniform(3, 15, k),
+                rng.uniform(1.5, 5, k),
+                np.full(k, 2.0),
+                rng.uniform(-np.pi, np.pi, k),
+            ]
+        )
         dets = np.concatenate([hit, dup, fps]).reshape(-1, 7)
-        frames.append((dets, rng.permutation(len(dets)) / 10.0 + rng.random() * 1e-3 + rng.random(len(dets)) * 1e-4,
-                       gts.reshape(-1, 7)))
+        frames.append(
+            (
+                dets,
+                rng.permutation(len(dets)) / 10.0 + rng.random() * 1e-3 + rng.random(len(dets)) * 1e-4,
+                gts.reshape(-1, 7),
+            )
+        )
     got = summarize([FrameMatch.evaluate(d, s, g) for d, s, g in frames])
     if sum(len(g) for _, _, g in frames) == 0:
         assert math.isnan(got["ap50"])
@@ -259,8 +302,9 @@ def test_matches_opencood_algorithm_on_random_cases(seed: int) -> None:
 
 def test_reference_iou_agrees_with_shapely_on_random_boxes() -> None:
     rng = np.random.default_rng(7)
-    a = np.column_stack([rng.uniform(-3, 3, (30, 2)), np.zeros(30), rng.uniform(1, 8, (30, 2)), np.ones(30),
-                         rng.uniform(-4, 4, 30)])
+    a = np.column_stack(
+        [rng.uniform(-3, 3, (30, 2)), np.zeros(30), rng.uniform(1, 8, (30, 2)), np.ones(30), rng.uniform(-4, 4, 30)]
+    )
     b = a.copy()
     b[:, :2] += rng.normal(0, 1.5, (30, 2))
     b[:, 6] += rng.normal(0, 0.7, 30)

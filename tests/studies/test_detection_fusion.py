@@ -64,6 +64,7 @@ def yaw_diff(a: float, b: float) -> float:
 
 # ---- detector ----------------------------------------------------------------------------------------------------
 
+
 def test_detector_finds_an_isolated_box_with_size_and_yaw() -> None:
     rng = np.random.default_rng(0)
     target = np.array([40.0, 10.0, -0.8, 10.0, 4.0, 3.0, math.radians(30)])
@@ -116,6 +117,7 @@ def test_load_detector() -> None:
 
 # ---- fusion ------------------------------------------------------------------------------------------------------
 
+
 def scene(rng: np.random.Generator) -> tuple[SceneFrame, AgentFrame, AgentFrame, np.ndarray]:
     ego_body = pose_matrices([100.0, -50.0, 0.2, 0.0, 0.0, math.radians(35)])
     nb_body = pose_matrices([180.0, 40.0, -0.1, 0.0, 0.0, math.radians(-120)])
@@ -157,8 +159,10 @@ def test_late_and_early_fusion_find_what_only_the_neighbour_sees() -> None:
 def test_late_fusion_merges_duplicates_with_rotated_nms() -> None:
     frame, ego, nb, nb_box = scene(np.random.default_rng(5))
     gt = gt_in_ego(frame, ego)
-    answers = {id(ego.points): (gt + [0.3, 0, 0, 0, 0, 0, 0.05], np.array([0.6])),
-               id(nb.points): (nb_box[None], np.array([0.9]))}
+    answers = {
+        id(ego.points): (gt + np.array([0.3, 0, 0, 0, 0, 0, 0.05]), np.array([0.6])),
+        id(nb.points): (nb_box[None], np.array([0.9])),
+    }
 
     def stub(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return answers[id(points)]
@@ -171,8 +175,8 @@ def test_late_fusion_merges_duplicates_with_rotated_nms() -> None:
 
 def test_rotated_nms_threshold() -> None:
     a = np.array([[0, 0, 0, 4, 2, 1, 0]], float)
-    near = np.array([[1.0, 0, 0, 4, 2, 1, 0]])      # IoU 0.6: suppressed
-    far = np.array([[3.8, 0, 0, 4, 2, 1, 0]])       # IoU 0.2/7.8 ≈ 0.026: kept
+    near = np.array([[1.0, 0, 0, 4, 2, 1, 0]])  # IoU 0.6: suppressed
+    far = np.array([[3.8, 0, 0, 4, 2, 1, 0]])  # IoU 0.2/7.8 ≈ 0.026: kept
     boxes = np.concatenate([a, near, far])
     keep = rotated_nms(boxes, np.array([0.9, 0.8, 0.7]))
     assert keep.tolist() == [0, 2]
@@ -187,13 +191,22 @@ def test_parse_modes() -> None:
 
 # ---- robustness --------------------------------------------------------------------------------------------------
 
+
 def sequence(n: int = 6) -> SequenceData:
     frames = []
     for t in range(n):
-        agents = tuple(AgentFrame(f"usv_{k}", np.full((3, 4), t * 10 + k, np.float32),
-                                  pose_matrices([t * 1.0, 10.0 * k, 0, 0, 0, 0.1 * k]), MOUNT) for k in range(3))
-        frames.append(SceneFrame(t, agents, (), np.zeros((0, 4, 4)), np.zeros((0, 3)), np.zeros((0, 4, 4)),
-                                 np.zeros((0, 3))))
+        agents = tuple(
+            AgentFrame(
+                f"usv_{k}",
+                np.full((3, 4), t * 10 + k, np.float32),
+                pose_matrices([t * 1.0, 10.0 * k, 0, 0, 0, 0.1 * k]),
+                MOUNT,
+            )
+            for k in range(3)
+        )
+        frames.append(
+            SceneFrame(t, agents, (), np.zeros((0, 4, 4)), np.zeros((0, 3)), np.zeros((0, 4, 4)), np.zeros((0, 3)))
+        )
     return SequenceData("seq", tuple(frames))
 
 
@@ -219,8 +232,14 @@ def test_pose_noise_is_seeded_shared_and_zero_mean() -> None:
     clean = neighbours_for(seq, 3, "usv_0", Setting(), seed=7)
     assert np.array_equal(clean[0].body, seq.frames[3].agents[1].body)
     from mmusv.frames import matrix_to_pose
-    draws = np.array([matrix_to_pose(neighbours_for(seq, 3, "usv_0", s, seed=k)[0].body)
-                      - matrix_to_pose(seq.frames[3].agents[1].body) for k in range(400)])
+
+    draws = np.array(
+        [
+            matrix_to_pose(neighbours_for(seq, 3, "usv_0", s, seed=k)[0].body)
+            - matrix_to_pose(seq.frames[3].agents[1].body)
+            for k in range(400)
+        ]
+    )
     assert np.all(np.abs(draws[:, :3].mean(axis=0)) < 0.2)
     assert np.allclose(draws[:, :3].std(axis=0), 1.0, atol=0.15)
     assert np.allclose(np.degrees(draws[:, 3:].std(axis=0)), 1.0, atol=0.15)
@@ -243,7 +262,15 @@ def test_gt_visibility_counts_points_inside_the_box() -> None:
     from mmusv.studies.detection.study import gt_visibility
 
     gt = np.array([[10.0, 0.0, 0.0, 4.0, 2.0, 2.0, math.pi / 2], [50.0, 50.0, 0.0, 4.0, 2.0, 2.0, 0.0]])
-    pts = np.array([[10.0, 1.9, 0.0], [10.9, -1.5, 0.5], [10.0, 2.1, 0.0],   # inside, inside, beyond the long side
-                    [10.0, 0.0, 1.4], [10.0, 0.0, 1.6], [50.0, 50.0, -2.0]])  # z within h/2 + 0.5, too high, too low
+    pts = np.array(
+        [
+            [10.0, 1.9, 0.0],
+            [10.9, -1.5, 0.5],
+            [10.0, 2.1, 0.0],  # inside, inside, beyond the long side
+            [10.0, 0.0, 1.4],
+            [10.0, 0.0, 1.6],
+            [50.0, 50.0, -2.0],
+        ]
+    )  # z within h/2 + 0.5, too high, too low
     assert gt_visibility(gt, pts).tolist() == [3, 0]
     assert gt_visibility(gt, np.zeros((0, 3))).tolist() == [0, 0]

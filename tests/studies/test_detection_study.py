@@ -50,16 +50,46 @@ def test_detection_study_end_to_end(two_usv: Path, tmp_path: Path, capsys: pytes
     assert table["mode"].to_list() == ["none", "late", "early"]
     assert table["det"].sum() > 0 and table["gt"][0] > 0
     boxes = pl.read_parquet(out / "detection_boxes.parquet")
-    assert boxes.columns == ["sequence", "frame", "ego", "mode", "kind", "x", "y", "z", "l", "w", "h", "yaw",
-                             "score", "range_bin", "matched", "ego_points", "neighbour_points"]
+    assert boxes.columns == [
+        "sequence",
+        "frame",
+        "ego",
+        "mode",
+        "kind",
+        "x",
+        "y",
+        "z",
+        "l",
+        "w",
+        "h",
+        "yaw",
+        "score",
+        "range_bin",
+        "matched",
+        "ego_points",
+        "neighbour_points",
+    ]
     assert table["gt_visible"][0] + table["gt_hidden"][0] + table["gt_unseen"][0] == table["gt"][0]
     gt = boxes.filter(pl.col("kind") == "gt")
     assert len(gt) == 3 * int(table["gt"][0])  # the same ground truth under each mode
     assert set(gt["range_bin"].to_list()) <= {"0-50", "50-100", "100-150", "150-200"}
     # The boxes file re-scores to the same table (the predictions interface round trip).
     out2 = tmp_path / "rescored"
-    assert main(["study", "detection", str(two_usv), "--predictions", str(out / "detection_boxes.parquet"),
-                 "-o", str(out2), "--no-progress"]) == 0
+    assert (
+        main(
+            [
+                "study",
+                "detection",
+                str(two_usv),
+                "--predictions",
+                str(out / "detection_boxes.parquet"),
+                "-o",
+                str(out2),
+                "--no-progress",
+            ]
+        )
+        == 0
+    )
     again = pl.read_csv(out2 / "detection_table.csv")
     for col in ("ap30", "ap50", "ap70", "recall50", "gt", "det"):
         a, b = table[col].to_list(), again[col].to_list()
@@ -69,8 +99,10 @@ def test_detection_study_end_to_end(two_usv: Path, tmp_path: Path, capsys: pytes
 
 def test_robustness_study_end_to_end(two_usv: Path, tmp_path: Path) -> None:
     out = tmp_path / "rob"
-    assert main(["study", "robustness", str(two_usv), "--settings", "delay:1,noise:1/1", "-o", str(out),
-                 "--no-progress"]) == 0
+    assert (
+        main(["study", "robustness", str(two_usv), "--settings", "delay:1,noise:1/1", "-o", str(out), "--no-progress"])
+        == 0
+    )
     wide = pl.read_csv(out / "robustness_table.csv")
     assert wide["setting"].to_list() == ["clean", "delay:1", "noise:1/1"]
     assert {"none", "late", "early"} <= set(wide.columns)
@@ -79,8 +111,12 @@ def test_robustness_study_end_to_end(two_usv: Path, tmp_path: Path) -> None:
     assert boxes["frame"].min() == 1  # frames before the largest delay are skipped for every setting
     # Same inputs and seed, same bytes (the pose noise is seeded).
     again = tmp_path / "rob2"
-    assert main(["study", "robustness", str(two_usv), "--settings", "delay:1,noise:1/1", "-o", str(again),
-                 "--no-progress"]) == 0
+    assert (
+        main(
+            ["study", "robustness", str(two_usv), "--settings", "delay:1,noise:1/1", "-o", str(again), "--no-progress"]
+        )
+        == 0
+    )
     for name in ("robustness_table.csv", "robustness_boxes.parquet"):
         assert (out / name).read_bytes() == (again / name).read_bytes()
 
@@ -91,13 +127,29 @@ def test_opv2v_input_gives_the_same_ground_truth(two_usv: Path, tmp_path: Path) 
     convert([two_usv], to="opv2v", out_dir=tmp_path / "opv2v", splits=None, extras="")
     rec_out, opv_out = tmp_path / "a", tmp_path / "b"
     assert main(["study", "detection", str(two_usv), "--modes", "none,early", "-o", str(rec_out), "--no-progress"]) == 0
-    assert main(["study", "detection", "--opv2v", str(tmp_path / "opv2v"), "--modes", "none,early", "-o", str(opv_out),
-                 "--no-progress"]) == 0
+    assert (
+        main(
+            [
+                "study",
+                "detection",
+                "--opv2v",
+                str(tmp_path / "opv2v"),
+                "--modes",
+                "none,early",
+                "-o",
+                str(opv_out),
+                "--no-progress",
+            ]
+        )
+        == 0
+    )
     a, b = pl.read_csv(rec_out / "detection_table.csv"), pl.read_csv(opv_out / "detection_table.csv")
     assert a["gt"].to_list() == b["gt"].to_list()
     ga = pl.read_parquet(rec_out / "detection_boxes.parquet").filter(pl.col("kind") == "gt").sort(["frame", "x"])
     gb = pl.read_parquet(opv_out / "detection_boxes.parquet").filter(pl.col("kind") == "gt").sort(["frame", "x"])
-    assert np.allclose(ga.select(["x", "y", "l", "w"]).to_numpy(), gb.select(["x", "y", "l", "w"]).to_numpy(), atol=1e-3)
+    assert np.allclose(
+        ga.select(["x", "y", "l", "w"]).to_numpy(), gb.select(["x", "y", "l", "w"]).to_numpy(), atol=1e-3
+    )
     # Same clouds (to 0.1 mm): the baseline finds the same boxes.
     assert a["det"].to_list() == b["det"].to_list()
 

@@ -6,7 +6,6 @@ from pathlib import Path
 
 import numpy as np
 import polars as pl
-
 from mmusv.config import load_scenario
 from mmusv.studies.waves import run_wave_study
 

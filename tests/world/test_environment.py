@@ -4,9 +4,8 @@ from __future__ import annotations
 
 import math
 
-import pytest
-
 import mmusv
+import pytest
 from mmusv._native import core
 from mmusv.world.environment import WAVE_PRESETS, Environment, Weather, sun_at, wave_height_m
 

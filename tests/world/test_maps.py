@@ -8,7 +8,6 @@ from typing import Any
 import numpy as np
 import pytest
 import shapely
-
 from mmusv.classes import SemanticClass
 from mmusv.world.maps import (
     MAP_KINDS,
@@ -25,23 +24,35 @@ from mmusv.world.primitives import TriMesh
 WATER = int(SemanticClass.WATER)
 
 SMALL: dict[str, dict[str, Any]] = {
-    "island": dict(extent_m=400.0, n_islands=2, island_radius_m=(30.0, 60.0), min_gap_m=30.0, clearance_m=15.0),
-    "open_sea": dict(extent_m=400.0, islet_probability=1.0, islet_radius_m=(15.0, 25.0), n_buoys=2, clearance_m=15.0),
-    "port": dict(
-        extent_m=800.0,
-        coast_offset_m=120.0,
-        harbour_width_m=420.0,
-        harbour_depth_m=230.0,
-        entrance_width_m=90.0,
-        n_piers=1,
-        pier_length_m=(60.0, 110.0),
-        n_cranes=2,
-        n_buildings=3,
-        n_channel_buoy_pairs=1,
-        n_moored=2,
-        n_buoys=1,
-        hill_height_m=20.0,
-    ),
+    "island": {
+        "extent_m": 400.0,
+        "n_islands": 2,
+        "island_radius_m": (30.0, 60.0),
+        "min_gap_m": 30.0,
+        "clearance_m": 15.0,
+    },
+    "open_sea": {
+        "extent_m": 400.0,
+        "islet_probability": 1.0,
+        "islet_radius_m": (15.0, 25.0),
+        "n_buoys": 2,
+        "clearance_m": 15.0,
+    },
+    "port": {
+        "extent_m": 800.0,
+        "coast_offset_m": 120.0,
+        "harbour_width_m": 420.0,
+        "harbour_depth_m": 230.0,
+        "entrance_width_m": 90.0,
+        "n_piers": 1,
+        "pier_length_m": (60.0, 110.0),
+        "n_cranes": 2,
+        "n_buildings": 3,
+        "n_channel_buoy_pairs": 1,
+        "n_moored": 2,
+        "n_buoys": 1,
+        "hill_height_m": 20.0,
+    },
 }
 
 
@@ -392,7 +403,7 @@ def test_shoreline_lies_on_the_waterline_and_occlusion_blocks_sight() -> None:
     i, j = np.unravel_index(np.argmax(w.heightfield.z), w.heightfield.z.shape)
     top = np.array([xs[j], ys[i]])
     assert w.heightfield.z[i, j] > w.params.occlusion_height_m
-    a, b = top + [-300.0, 0.0], top + [300.0, 0.0]
+    a, b = top + np.array([-300.0, 0.0]), top + np.array([300.0, 0.0])
     assert not pr.line_of_sight(a[None], b[None])[0]
     assert pr.line_of_sight(np.array([[-190.0, -190.0]]), np.array([[-189.0, -189.0]]))[0]
 

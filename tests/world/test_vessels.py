@@ -13,7 +13,6 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
-
 from mmusv.classes import SemanticClass
 from mmusv.world.primitives import TriMesh, box, merge
 from mmusv.world.vessels import (
@@ -36,6 +35,7 @@ REQUIRED_MOUNTS = {"lidar", "radar", "camera_front", "camera_left", "camera_rear
 
 
 # --------------------------------------------------------------------------------------------- helpers
+
 
 def _components(faces: np.ndarray, n_vertices: int) -> list[np.ndarray]:
     """Face-index arrays of the connected parts of a mesh (faces sharing vertices)."""
@@ -106,6 +106,7 @@ def _catalog_entries() -> dict[str, dict[str, Any]]:
 
 
 # ------------------------------------------------------------------------------------------- catalogue
+
 
 def test_library_has_at_least_30_distinct_vessels_sorted() -> None:
     lib = library()
@@ -217,6 +218,7 @@ def test_assets_are_cached_and_read_only() -> None:
 
 # ------------------------------------------------------------------------------------------------ USVs
 
+
 @pytest.mark.parametrize("name", ["usv_wamv", "usv_patrol_12m"])
 def test_usv_mounts(name: str) -> None:
     a = get_asset(name)
@@ -254,6 +256,7 @@ def test_ordinary_vessels_have_no_mounts() -> None:
 
 # ---------------------------------------------------------------------------------------------- errors
 
+
 def test_unknown_asset_lists_suggestions() -> None:
     with pytest.raises(UnknownAssetError) as info:
         get_asset("contaner_ship_300m")
@@ -277,16 +280,21 @@ def test_vessel_asset_rejects_uncentred_mesh() -> None:
     with pytest.raises(ValueError, match="waterline"):
         VesselAsset(name="floating", category="custom", semantic_class=SemanticClass.VESSEL, mesh=above)
     with pytest.raises(ValueError, match="semantic_class"):
-        VesselAsset(name="buoyish", category="custom", semantic_class=SemanticClass.BUOY,
-                    mesh=box(center=(0.0, 0.0, 0.0), size=(1.0, 1.0, 1.0), cls=7))
+        VesselAsset(
+            name="buoyish",
+            category="custom",
+            semantic_class=SemanticClass.BUOY,
+            mesh=box(center=(0.0, 0.0, 0.0), size=(1.0, 1.0, 1.0), cls=7),
+        )
 
 
 # ----------------------------------------------------------------------------------------- user assets
 
+
 def _file_boat(tmp_path: Path) -> Path:
     """A y-up OBJ whose bow points along file -z: hull box 2 (x) x 2.5 (y) x 8 (z) plus a bow marker."""
-    hull = box(center=(0.0, 0.75, 1.0), size=(2.0, 2.5, 8.0), cls=0)          # x [-1,1] y [-0.5,2] z [-3,5]
-    marker = box(center=(0.0, 2.5, -2.5), size=(1.0, 1.0, 1.0), cls=0)        # at the -z end, on top
+    hull = box(center=(0.0, 0.75, 1.0), size=(2.0, 2.5, 8.0), cls=0)  # x [-1,1] y [-0.5,2] z [-3,5]
+    marker = box(center=(0.0, 2.5, -2.5), size=(1.0, 1.0, 1.0), cls=0)  # at the -z end, on top
     p = tmp_path / "boat.obj"
     _write_obj(p, merge([hull, marker]))
     return p
@@ -295,15 +303,24 @@ def _file_boat(tmp_path: Path) -> Path:
 def test_user_obj_round_trip_with_axis_conversion(tmp_path: Path) -> None:
     pytest.importorskip("trimesh")
     obj = _file_boat(tmp_path)
-    a = load_asset_file({"name": "file_boat", "mesh": str(obj), "scale": 2.0, "up_axis": "y",
-                         "forward_axis": "-z", "waterline_z": 0.5, "category": "custom"})
+    a = load_asset_file(
+        {
+            "name": "file_boat",
+            "mesh": str(obj),
+            "scale": 2.0,
+            "up_axis": "y",
+            "forward_axis": "-z",
+            "waterline_z": 0.5,
+            "category": "custom",
+        }
+    )
     assert (a.length, a.beam, a.height, a.draft) == pytest.approx((16.0, 4.0, 7.0, 2.0))
     assert a.semantic_class == SemanticClass.VESSEL and a.source == "<mapping>"
     v = a.mesh.vertices
     np.testing.assert_allclose(a.bbox, [[-8.0, -2.0, -2.0], [8.0, 2.0, 5.0]], atol=1e-9)
     top = v[v[:, 2] > 5.0 - 1e-9]
     assert top.shape[0] > 0 and np.all(top[:, 0] >= 6.0 - 1e-9)  # the marker ends up at the bow (+x)
-    assert _signed_volume(v, a.mesh.faces) > 0.0                  # proper rotation keeps normals outward
+    assert _signed_volume(v, a.mesh.faces) > 0.0  # proper rotation keeps normals outward
     assert np.all(a.mesh.classes == int(SemanticClass.VESSEL))
 
 
@@ -311,11 +328,20 @@ def test_user_yaml_file_relative_mesh_register_and_duplicates(tmp_path: Path) ->
     pytest.importorskip("trimesh")
     _file_boat(tmp_path)
     y = tmp_path / "my_usv.yaml"
-    y.write_text(yaml.safe_dump({
-        "name": "test_my_usv", "category": "usv", "semantic_class": "usv", "mesh": "boat.obj",
-        "up_axis": "y", "forward_axis": "-z", "draft": 0.4,
-        "mounts": {"lidar": {"xyz": [0.0, 0.0, 3.5]}},
-    }))
+    y.write_text(
+        yaml.safe_dump(
+            {
+                "name": "test_my_usv",
+                "category": "usv",
+                "semantic_class": "usv",
+                "mesh": "boat.obj",
+                "up_axis": "y",
+                "forward_axis": "-z",
+                "draft": 0.4,
+                "mounts": {"lidar": {"xyz": [0.0, 0.0, 3.5]}},
+            }
+        )
+    )
     a = load_asset_file(y, register=True)
     try:
         assert a.draft == pytest.approx(0.4) and a.height == pytest.approx(3.5)
@@ -343,17 +369,20 @@ def test_register_rejects_builtin_names_and_unregister_builtin() -> None:
 def test_default_axes_z_up_x_forward(tmp_path: Path) -> None:
     pytest.importorskip("trimesh")
     p = tmp_path / "zup.obj"
-    _write_obj(p, box(center=(10.0, 3.0, 1.0), size=(6.0, 2.0, 3.0), cls=0))   # z from -0.5 to 2.5
+    _write_obj(p, box(center=(10.0, 3.0, 1.0), size=(6.0, 2.0, 3.0), cls=0))  # z from -0.5 to 2.5
     a = load_asset_file({"name": "zup", "mesh": str(p)})
     assert (a.length, a.beam, a.height, a.draft) == pytest.approx((6.0, 2.0, 3.0, 0.5))
 
 
 def test_procedural_user_entry_and_catalog_file(tmp_path: Path) -> None:
     entry = {
-        "name": "test_launch", "category": "launch",
+        "name": "test_launch",
+        "category": "launch",
         "hull": {"length": 8.0, "beam": 2.6, "draft": 0.6, "depth": 1.5, "bow": 0.4, "stern": 0.0},
-        "parts": [{"type": "house", "x": 0.5, "tiers": [[2.5, 1.8, 1.6]], "fit": 0.2},
-                  {"type": "mast", "x": 0.5, "base": 2.5, "top": 4.0, "width": 0.1}],
+        "parts": [
+            {"type": "house", "x": 0.5, "tiers": [[2.5, 1.8, 1.6]], "fit": 0.2},
+            {"type": "mast", "x": 0.5, "base": 2.5, "top": 4.0, "width": 0.1},
+        ],
     }
     a = load_asset_file(entry)
     assert (a.length, a.beam, a.draft, a.air_draft) == pytest.approx((8.0, 2.6, 0.6, 4.0))
@@ -400,12 +429,18 @@ HULL = {"length": 8.0, "beam": 2.6, "draft": 0.6, "depth": 1.5}
         ({"mesh": None, "hull": dict(HULL, wings=3)}, "bad_boat.hull.wings"),
         ({"mesh": None, "hull": dict(HULL, bow=0.0, bow_width=0.5)}, "bad_boat.hull.bow_width"),
         ({"mesh": None, "hull": HULL, "parts": [{"type": "spaceship"}]}, "bad_boat.parts[0].type"),
-        ({"mesh": None, "hull": HULL, "parts": [{"type": "box", "x": 0.0, "size": [1.0, 1.0]}]},
-         "bad_boat.parts[0].top"),
-        ({"mesh": None, "hull": HULL, "parts": [{"type": "box", "x": 3.9, "size": [1.0, 1.0], "height": 1.0}]},
-         "bad_boat.parts[0]"),
-        ({"mesh": None, "hull": HULL, "parts": [{"type": "mast", "x": 0.0, "top": 3.0, "wdth": 0.2}]},
-         "bad_boat.parts[0].wdth"),
+        (
+            {"mesh": None, "hull": HULL, "parts": [{"type": "box", "x": 0.0, "size": [1.0, 1.0]}]},
+            "bad_boat.parts[0].top",
+        ),
+        (
+            {"mesh": None, "hull": HULL, "parts": [{"type": "box", "x": 3.9, "size": [1.0, 1.0], "height": 1.0}]},
+            "bad_boat.parts[0]",
+        ),
+        (
+            {"mesh": None, "hull": HULL, "parts": [{"type": "mast", "x": 0.0, "top": 3.0, "wdth": 0.2}]},
+            "bad_boat.parts[0].wdth",
+        ),
         ({"mesh": None, "hull": HULL, "parts": "mast"}, "bad_boat.parts"),
     ],
 )

@@ -13,4 +13,4 @@ from __future__ import annotations
 from mmusv.export.common import DEFAULT_EXTRAS, EXTRAS, TARGETS
 from mmusv.export.convert import ConvertReport, RecordingReport, convert
 
-__all__ = ["convert", "ConvertReport", "RecordingReport", "TARGETS", "EXTRAS", "DEFAULT_EXTRAS"]
+__all__ = ["DEFAULT_EXTRAS", "EXTRAS", "TARGETS", "ConvertReport", "RecordingReport", "convert"]

@@ -31,13 +31,28 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     p.add_argument("--to", default="opv2v", help="target layout: opv2v (default) or kitti")
     p.add_argument("-o", "--output", required=True, help="output folder")
     g = p.add_mutually_exclusive_group()
-    g.add_argument("--split", default="0.7,0.15,0.15", help="train,validate,test fractions, by recording (default 0.7,0.15,0.15)")
-    g.add_argument("--no-split", action="store_true", help="no train/validate/test folders: scenarios directly in the output")
+    g.add_argument(
+        "--split", default="0.7,0.15,0.15", help="train,validate,test fractions, by recording (default 0.7,0.15,0.15)"
+    )
+    g.add_argument(
+        "--no-split", action="store_true", help="no train/validate/test folders: scenarios directly in the output"
+    )
     p.add_argument("--seed", type=int, default=0, help="seed of the split (default 0)")
-    p.add_argument("--range", type=float, default=200.0, dest="range_m", help="evaluation range in metres: targets within R in BEV (default 200)")
-    p.add_argument("--include-usvs", action="store_true", help="list the other USVs as targets too (default: not, as in the paper)")
-    p.add_argument("--extras", default=",".join(DEFAULT_EXTRAS),
-                   help=f"extra files, comma-separated from {','.join(EXTRAS)}; empty for none (default {','.join(DEFAULT_EXTRAS)})")
+    p.add_argument(
+        "--range",
+        type=float,
+        default=200.0,
+        dest="range_m",
+        help="evaluation range in metres: targets within R in BEV (default 200)",
+    )
+    p.add_argument(
+        "--include-usvs", action="store_true", help="list the other USVs as targets too (default: not, as in the paper)"
+    )
+    p.add_argument(
+        "--extras",
+        default=",".join(DEFAULT_EXTRAS),
+        help=f"extra files, comma-separated from {','.join(EXTRAS)}; empty for none (default {','.join(DEFAULT_EXTRAS)})",
+    )
     p.add_argument("--overwrite", action="store_true", help="replace a previous conversion in the output folder")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     return p
@@ -55,16 +70,30 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(f"unknown --to {args.to!r}; allowed: {', '.join(TARGETS)}")
     console = Console(width=None if sys.stdout.isatty() else 160)
     kwargs: dict[str, Any] = {
-        "to": args.to, "out_dir": args.output, "splits": None if args.no_split else args.split, "seed": args.seed,
-        "eval_range_m": args.range_m, "include_usvs": args.include_usvs, "extras": args.extras, "overwrite": args.overwrite,
+        "to": args.to,
+        "out_dir": args.output,
+        "splits": None if args.no_split else args.split,
+        "seed": args.seed,
+        "eval_range_m": args.range_m,
+        "include_usvs": args.include_usvs,
+        "extras": args.extras,
+        "overwrite": args.overwrite,
     }
     if args.no_progress:
         report = convert(args.recordings, **kwargs)
     else:
-        with Progress(TextColumn(f"[bold]convert → {args.to}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
-                      console=console, transient=True) as bar:
+        with Progress(
+            TextColumn(f"[bold]convert → {args.to}"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TimeRemainingColumn(),
+            console=console,
+            transient=True,
+        ) as bar:
             task = bar.add_task("frames", total=None)
-            report = convert(args.recordings, progress=lambda done, total: bar.update(task, completed=done, total=total), **kwargs)
+            report = convert(
+                args.recordings, progress=lambda done, total: bar.update(task, completed=done, total=total), **kwargs
+            )
     for line in report.lines():
         console.print(line, highlight=False, markup=False)
     return 0 if report.frames > 0 else 1

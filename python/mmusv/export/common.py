@@ -15,18 +15,18 @@ import yaml
 from mmusv.errors import ConfigError
 
 __all__ = [
-    "TARGETS",
-    "EXTRAS",
-    "DEFAULT_EXTRAS",
     "CAV_ID_BASE",
+    "DEFAULT_EXTRAS",
     "DEPTH_UNIT_M",
+    "EXTRAS",
+    "TARGETS",
     "Options",
     "Sink",
     "cav_id",
-    "parse_extras",
-    "png_bytes",
     "depth_png",
     "dump_yaml",
+    "parse_extras",
+    "png_bytes",
     "rounded",
 ]
 

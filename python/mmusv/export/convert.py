@@ -23,11 +23,11 @@ from mmusv.errors import ConfigError, IoError
 from mmusv.export.common import DEFAULT_EXTRAS, TARGETS, Options, Sink, dump_yaml, parse_extras
 from mmusv.export.kitti import KittiWriter
 from mmusv.export.opv2v import Opv2vWriter
-from mmusv.recording.reader import FrameStream, RecordingInfo, read_info
 from mmusv.export.splits import SPLIT_NAMES, assign_splits, parse_ratios
 from mmusv.export.writer import DatasetWriter
+from mmusv.recording.reader import FrameStream, RecordingInfo, read_info
 
-__all__ = ["ConvertReport", "RecordingReport", "convert", "REPORT_NAME"]
+__all__ = ["REPORT_NAME", "ConvertReport", "RecordingReport", "convert"]
 
 REPORT_NAME = "conversion.yaml"
 
@@ -50,10 +50,17 @@ class RecordingReport:
 
     def as_dict(self) -> dict[str, Any]:
         """The recording's entry of ``conversion.yaml``."""
-        return {"source": self.path.name, "scenario": self.scenario, "folder": self.folder, "split": self.split,
-                "run_status": self.status, "frames_converted": self.frames_converted,
-                "frames": None if self.first_frame is None else [self.first_frame, self.last_frame],
-                "skipped": self.skipped, "notes": self.notes}
+        return {
+            "source": self.path.name,
+            "scenario": self.scenario,
+            "folder": self.folder,
+            "split": self.split,
+            "run_status": self.status,
+            "frames_converted": self.frames_converted,
+            "frames": None if self.first_frame is None else [self.first_frame, self.last_frame],
+            "skipped": self.skipped,
+            "notes": self.notes,
+        }
 
 
 @dataclass
@@ -86,8 +93,10 @@ class ConvertReport:
             out.append(f"{r.path.name} -> {where}: {r.frames_converted} frames")
             out += [f"  skipped frames {s['frames'][0]}..{s['frames'][1]}: {s['reason']}" for s in r.skipped]
             out += [f"  note: {n}" for n in r.notes]
-        out.append(f"{self.frames} frames ({self.agent_frames} agent-frames), {self.files} files, {self.bytes / 1e6:.1f} MB "
-                   f"in {self.seconds:.1f} s -> {self.out_dir}")
+        out.append(
+            f"{self.frames} frames ({self.agent_frames} agent-frames), {self.files} files, {self.bytes / 1e6:.1f} MB "
+            f"in {self.seconds:.1f} s -> {self.out_dir}"
+        )
         return out
 
 
@@ -105,10 +114,14 @@ def _prepare_out(out: Path, overwrite: bool) -> None:
         raise IoError(f"output {out} exists and is not a folder")
     if out.exists() and any(out.iterdir()):
         if not overwrite:
-            raise IoError(f"output folder {out} already exists and is not empty; pass overwrite=True (--overwrite) to replace it")
+            raise IoError(
+                f"output folder {out} already exists and is not empty; pass overwrite=True (--overwrite) to replace it"
+            )
         if not (out / REPORT_NAME).is_file():
-            raise IoError(f"output folder {out} is not empty and holds no {REPORT_NAME} from a previous conversion; "
-                          "refusing to delete it, choose another folder")
+            raise IoError(
+                f"output folder {out} is not empty and holds no {REPORT_NAME} from a previous conversion; "
+                "refusing to delete it, choose another folder"
+            )
         shutil.rmtree(out)
     try:
         out.mkdir(parents=True, exist_ok=True)
@@ -183,20 +196,33 @@ def convert(
     paths = _as_list(recordings)
     infos = [read_info(p) for p in paths]  # validates every input before anything is written
     folders = _folders(infos)
-    split_of: dict[str, str | None] = {f: None for f in folders}
+    split_of: dict[str, str | None] = dict.fromkeys(folders)
     if ratios is not None:
         split_of = dict(assign_splits(folders, ratios, seed))
     out = Path(out_dir)
     _prepare_out(out, overwrite)
-    reports = [RecordingReport(path=i.path, scenario=i.scenario_name, folder=f, split=split_of[f]) for i, f in zip(infos, folders, strict=True)]
-    header = {"format": to, "options": {"eval_range_m": rng, "include_usvs": options.include_usvs, "extras": list(options.extras),
-              "splits": None if ratios is None else dict(zip(SPLIT_NAMES, [round(r, 9) for r in ratios], strict=True)), "seed": seed}}
+    reports = [
+        RecordingReport(path=i.path, scenario=i.scenario_name, folder=f, split=split_of[f])
+        for i, f in zip(infos, folders, strict=True)
+    ]
+    header = {
+        "format": to,
+        "options": {
+            "eval_range_m": rng,
+            "include_usvs": options.include_usvs,
+            "extras": list(options.extras),
+            "splits": None if ratios is None else dict(zip(SPLIT_NAMES, [round(r, 9) for r in ratios], strict=True)),
+            "seed": seed,
+        },
+    }
     (out / REPORT_NAME).write_bytes(dump_yaml({**header, "status": "in_progress"}))
     sink = Sink()
     report = ConvertReport(out_dir=out, target=to, recordings=reports)
     expected = sum(int(i.run.get("frames_written", i.frames_configured) or 0) for i in infos)
     done = 0
-    order = sorted(range(len(infos)), key=lambda j: (SPLIT_NAMES.index(reports[j].split) if reports[j].split else 0, folders[j]))
+    order = sorted(
+        range(len(infos)), key=lambda j: (SPLIT_NAMES.index(reports[j].split) if reports[j].split else 0, folders[j])
+    )
     for j in order:
         info, rep = infos[j], reports[j]
         folder = out / rep.split / rep.folder if rep.split else out / rep.folder
@@ -210,8 +236,12 @@ def convert(
         for fr in stream:
             missing = writer.missing(fr)
             if fr.world is None or missing or not writer.agents:
-                why = "no agent with a LiDAR" if not writer.agents else f"incomplete: missing {', '.join(missing[:4])}" + (
-                    f" and {len(missing) - 4} more" if len(missing) > 4 else "")
+                why = (
+                    "no agent with a LiDAR"
+                    if not writer.agents
+                    else f"incomplete: missing {', '.join(missing[:4])}"
+                    + (f" and {len(missing) - 4} more" if len(missing) > 4 else "")
+                )
                 incomplete.append((fr.index, why))
             else:
                 writer.write_frame(fr)
@@ -225,12 +255,17 @@ def convert(
             rep.skipped.append({"frames": [k, k], "reason": why})
         seen = set(converted) | {k for k, _ in incomplete}
         # the frames the run set out to write: --frames N cuts a run short on purpose, those after N are not missing
-        configured = int(stream.run.get("frames_requested", stream.run.get("frames_configured", info.frames_configured)) or 0)
+        configured = int(
+            stream.run.get("frames_requested", stream.run.get("frames_configured", info.frames_configured)) or 0
+        )
         absent = [k for k in range(configured) if k not in seen]
         if absent:
             written = stream.run.get("frames_written")
-            why = (f"not in the recording (run {rep.status}: {written} of {configured} frames written)" if written is not None
-                   else f"not in the recording (the run did not finish; {configured} frames configured)")
+            why = (
+                f"not in the recording (run {rep.status}: {written} of {configured} frames written)"
+                if written is not None
+                else f"not in the recording (the run did not finish; {configured} frames configured)"
+            )
             if stream.truncated:
                 why += "; " + stream.truncated
             rep.skipped += [{"frames": [a, b], "reason": why} for a, b in _ranges(absent)]
@@ -247,8 +282,13 @@ def convert(
         else:
             rep.notes.append("no complete frame: nothing written for this recording")
             shutil.rmtree(folder, ignore_errors=True)
-    doc = {**header, "status": "complete", "frames_converted": report.frames, "agent_frames": report.agent_frames,
-           "recordings": [r.as_dict() for r in sorted(reports, key=lambda r: (r.split or "", r.folder))]}
+    doc = {
+        **header,
+        "status": "complete",
+        "frames_converted": report.frames,
+        "agent_frames": report.agent_frames,
+        "recordings": [r.as_dict() for r in sorted(reports, key=lambda r: (r.split or "", r.folder))],
+    }
     data = dump_yaml(doc)
     (out / REPORT_NAME).write_bytes(data)
     report.files = sink.files + 1

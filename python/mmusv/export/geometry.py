@@ -70,9 +70,19 @@ def targets_of(view: AgentView, world: WorldFrame, *, eval_range_m: float, inclu
         in_lidar = ref_inv @ box
         if not in_target_range(in_lidar[:3, 3], eval_range_m):
             continue
-        out.append(Target(
-            index=i, id=vid, asset=world.assets[i], role=world.roles[i], semantic_class=int(world.classes[i]),
-            instance_id=int(world.instance_ids[i]), body=mats[i], box=box, box_in_lidar=in_lidar,
-            size=world.box_sizes[i].copy(), speed_mps=float(np.linalg.norm(world.velocities[i])),
-        ))
+        out.append(
+            Target(
+                index=i,
+                id=vid,
+                asset=world.assets[i],
+                role=world.roles[i],
+                semantic_class=int(world.classes[i]),
+                instance_id=int(world.instance_ids[i]),
+                body=mats[i],
+                box=box,
+                box_in_lidar=in_lidar,
+                size=world.box_sizes[i].copy(),
+                speed_mps=float(np.linalg.norm(world.velocities[i])),
+            )
+        )
     return out

@@ -23,10 +23,10 @@ import numpy as np
 from mmusv.classes import class_name
 from mmusv.export.common import cav_id, depth_png, dump_yaml, png_bytes
 from mmusv.export.geometry import AgentView, Target
-from mmusv.recording.reader import AgentInfo, Frame, WorldFrame
 from mmusv.export.writer import DatasetWriter
 from mmusv.frames import BODY_TO_OPTICAL, invert, transform_points, wrap_rad
 from mmusv.recording import topics
+from mmusv.recording.reader import AgentInfo, Frame, WorldFrame
 
 __all__ = ["KittiWriter", "kitti_label", "occlusion_level"]
 
@@ -94,14 +94,20 @@ class KittiWriter(DatasetWriter):
             fx, fy, cx, cy = cam.intrinsics
             k = np.array([[fx, 0.0, cx, 0.0], [0.0, fy, cy, 0.0], [0.0, 0.0, 1.0, 0.0]])
         calib = [f"P{i}: {_fmt(k)}" for i in range(4)]
-        calib += [f"R0_rect: {_fmt(np.eye(3))}", f"Tr_velo_to_cam: {_fmt(velo_to_cam[:3, :])}",
-                  f"Tr_imu_to_velo: {_fmt(invert(a.lidar_mount)[:3, :])}"]
+        calib += [
+            f"R0_rect: {_fmt(np.eye(3))}",
+            f"Tr_velo_to_cam: {_fmt(velo_to_cam[:3, :])}",
+            f"Tr_imu_to_velo: {_fmt(invert(a.lidar_mount)[:3, :])}",
+        ]
         self.put(self._dir(a, "calib") / f"{ts}.txt", ("\n".join(calib) + "\n").encode())
         boxes: dict[str, Any] = {}
         ann = msgs.get(topics.agent_annotations(a.id))
         if ann is not None:
             boxes = {b.target_id: b for b in ann.boxes_camera if b.camera == "front"}
-        lines = [kitti_label(t, velo_to_cam, boxes.get(t.id)) if cam is not None else kitti_label(t, velo_to_cam, None) for t in targets]
+        lines = [
+            kitti_label(t, velo_to_cam, boxes.get(t.id)) if cam is not None else kitti_label(t, velo_to_cam, None)
+            for t in targets
+        ]
         self.put(self._dir(a, "label_2") / f"{ts}.txt", "".join(line + "\n" for line in lines).encode())
         if cam is not None:
             base = topics.camera(a.id, "front") + "/"
@@ -125,9 +131,19 @@ class KittiWriter(DatasetWriter):
         if not frames:
             return
         o = self.options
-        self.put(self.folder / "mmusv_kitti.yaml", dump_yaml({
-            "source": self.info.path.name, "scenario": self.info.scenario_name, "config_hash": self.info.config_hash,
-            "agents": {cav_id(a.index): a.id for a in self.agents}, "eval_range_m": o.eval_range_m,
-            "include_usvs": o.include_usvs, "extras": list(o.extras), "frames_converted": len(frames),
-            "frames_skipped": skipped,
-        }))
+        self.put(
+            self.folder / "mmusv_kitti.yaml",
+            dump_yaml(
+                {
+                    "source": self.info.path.name,
+                    "scenario": self.info.scenario_name,
+                    "config_hash": self.info.config_hash,
+                    "agents": {cav_id(a.index): a.id for a in self.agents},
+                    "eval_range_m": o.eval_range_m,
+                    "include_usvs": o.include_usvs,
+                    "extras": list(o.extras),
+                    "frames_converted": len(frames),
+                    "frames_skipped": skipped,
+                }
+            ),
+        )

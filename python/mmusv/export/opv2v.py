@@ -28,12 +28,12 @@ from mmusv.classes import class_name
 from mmusv.export.common import DEPTH_UNIT_M, cav_id, depth_png, dump_yaml, png_bytes, rounded
 from mmusv.export.geometry import AgentView, Target
 from mmusv.export.pcd import pcd_bytes
-from mmusv.recording.reader import Frame, WorldFrame
 from mmusv.export.writer import DatasetWriter
 from mmusv.frames import carla_matrix, carla_pose, invert, mirror_points
 from mmusv.recording import topics
+from mmusv.recording.reader import Frame, WorldFrame
 
-__all__ = ["Opv2vWriter", "OPV2V_CAMERAS", "timestamp"]
+__all__ = ["OPV2V_CAMERAS", "Opv2vWriter", "timestamp"]
 
 OPV2V_CAMERAS = {"front": 0, "right": 1, "left": 2, "rear": 3, "back": 3}
 """Our camera name → OPV2V camera index."""
@@ -64,7 +64,9 @@ class Opv2vWriter(DatasetWriter):
         for a in self.agents:
             names = [n for n, _ in self.agent_cameras(a)]
             if len(names) < 4:
-                self.notes.append(f"agent {a.id}: cameras {names} cover {len(names)} of the 4 OPV2V cameras (front, right, left, rear)")
+                self.notes.append(
+                    f"agent {a.id}: cameras {names} cover {len(names)} of the 4 OPV2V cameras (front, right, left, rear)"
+                )
             other = sorted(set(a.cameras) - set(self.cameras))
             if other:
                 self.notes.append(f"agent {a.id}: cameras {other} have no OPV2V slot and are left out")
@@ -135,7 +137,9 @@ class Opv2vWriter(DatasetWriter):
             "speed": round(t.speed_mps * 3.6, 6),
         }
 
-    def _additional(self, frame: Frame, world: WorldFrame, view: AgentView, targets: list[Target], cloud: dict[str, np.ndarray]) -> dict[str, Any]:
+    def _additional(
+        self, frame: Frame, world: WorldFrame, view: AgentView, targets: list[Target], cloud: dict[str, np.ndarray]
+    ) -> dict[str, Any]:
         counts: dict[int, int] = {}
         inst = cloud.get("instance")
         if inst is not None and inst.size:
@@ -147,10 +151,16 @@ class Opv2vWriter(DatasetWriter):
                 "frame": frame.index,
                 "time_s": round(world.time_s, 9),
                 "vehicles": {
-                    cav_id(t.index): {"name": t.id, "asset": t.asset, "role": t.role, "static": self._static(t),
-                                      "semantic_class": t.semantic_class,
-                                      "class_name": class_name(t.semantic_class), "instance_id": t.instance_id,
-                                      "lidar_points": counts.get(t.instance_id, 0)}
+                    cav_id(t.index): {
+                        "name": t.id,
+                        "asset": t.asset,
+                        "role": t.role,
+                        "static": self._static(t),
+                        "semantic_class": t.semantic_class,
+                        "class_name": class_name(t.semantic_class),
+                        "instance_id": t.instance_id,
+                        "lidar_points": counts.get(t.instance_id, 0),
+                    }
                     for t in targets
                 },
             }
@@ -176,27 +186,34 @@ class Opv2vWriter(DatasetWriter):
                 "environment": info.scenario.get("environment", {}),
                 "map": info.scenario.get("map", {}),
             },
-            "vehicle_base": {"sensing": {"perception": {
-                "lidar": {
-                    "channels": lidar.get("channels"), "range": lidar.get("range_m"),
-                    "points_per_second": lidar.get("points_per_second"), "rotation_frequency": lidar.get("rotation_hz"),
-                    "upper_fov": (lidar.get("vertical_fov_deg") or [None, None])[1],
-                    "lower_fov": (lidar.get("vertical_fov_deg") or [None, None])[0],
-                    "noise_stddev": lidar.get("range_noise_std_m"), "dropoff_general_rate": lidar.get("dropout"),
-                },
-                "camera": {"num": 4, "order": ["front", "right", "left", "rear"]},
-            }}},
+            "vehicle_base": {
+                "sensing": {
+                    "perception": {
+                        "lidar": {
+                            "channels": lidar.get("channels"),
+                            "range": lidar.get("range_m"),
+                            "points_per_second": lidar.get("points_per_second"),
+                            "rotation_frequency": lidar.get("rotation_hz"),
+                            "upper_fov": (lidar.get("vertical_fov_deg") or [None, None])[1],
+                            "lower_fov": (lidar.get("vertical_fov_deg") or [None, None])[0],
+                            "noise_stddev": lidar.get("range_noise_std_m"),
+                            "dropoff_general_rate": lidar.get("dropout"),
+                        },
+                        "camera": {"num": 4, "order": ["front", "right", "left", "rear"]},
+                    }
+                }
+            },
             "mmusv": {
                 "source": info.path.name,
                 "scenario": info.scenario_name,
                 "config_hash": info.config_hash,
                 "mmusv_version": info.mmusv_version,
                 "frame": "CARLA/UE world, left-handed: x forward, y right, z up; metres; degrees; poses [x, y, z, roll, yaw, pitch]; "
-                         "mmusv's right-handed frames (world x east, y north, z up; body x forward, y left, z up) with y mirrored",
+                "mmusv's right-handed frames (world x east, y north, z up; body x forward, y left, z up) with y mirrored",
                 "cavs": {cav_id(a.index): a.id for a in self.agents},
                 "eval_range_m": o.eval_range_m,
                 "gt_filter": "vehicles: every vessel whose box centre has hypot(x, y) <= eval_range_m "
-                             "in the agent's LiDAR frame; the agent itself never, other USVs only if include_usvs",
+                "in the agent's LiDAR frame; the agent itself never, other USVs only if include_usvs",
                 "include_usvs": o.include_usvs,
                 "extras": list(o.extras),
                 "depth_png": {"unit_m": DEPTH_UNIT_M, "no_hit": 0, "saturated": 65535, "along": "optical axis"},

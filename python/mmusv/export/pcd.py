@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["pcd_bytes", "write_pcd", "read_pcd"]
+__all__ = ["pcd_bytes", "read_pcd", "write_pcd"]
 
 _HEADER = (
     "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F U\n"

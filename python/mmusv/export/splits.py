@@ -14,7 +14,7 @@ from collections.abc import Sequence
 
 from mmusv.errors import ConfigError
 
-__all__ = ["SPLIT_NAMES", "split_counts", "assign_splits", "parse_ratios"]
+__all__ = ["SPLIT_NAMES", "assign_splits", "parse_ratios", "split_counts"]
 
 SPLIT_NAMES = ("train", "validate", "test")
 
@@ -26,11 +26,15 @@ def parse_ratios(ratios: Sequence[float] | str) -> tuple[float, float, float]:
         try:
             vals = [float(x) for x in ratios.split(",")]
         except ValueError:
-            raise ConfigError(f"split {ratios!r}: expected three comma-separated fractions, e.g. 0.7,0.15,0.15") from None
+            raise ConfigError(
+                f"split {ratios!r}: expected three comma-separated fractions, e.g. 0.7,0.15,0.15"
+            ) from None
     else:
         vals = [float(x) for x in ratios]
     if len(vals) != 3:
-        raise ConfigError(f"split {list(ratios) if not isinstance(ratios, str) else ratios!r}: expected three fractions (train, validate, test)")
+        raise ConfigError(
+            f"split {list(ratios) if not isinstance(ratios, str) else ratios!r}: expected three fractions (train, validate, test)"
+        )
     if not all(math.isfinite(v) and v >= 0 for v in vals) or sum(vals) <= 0:
         raise ConfigError(f"split {vals}: fractions must be finite, non-negative and not all zero")
     total = sum(vals)

@@ -7,8 +7,8 @@ from typing import Any
 
 from mmusv.export.common import Options, Sink
 from mmusv.export.geometry import AgentView, Target, agent_view, targets_of
-from mmusv.recording.reader import AgentInfo, Frame, RecordingInfo, WorldFrame
 from mmusv.recording import topics
+from mmusv.recording.reader import AgentInfo, Frame, RecordingInfo, WorldFrame
 
 __all__ = ["DatasetWriter"]
 
@@ -34,7 +34,7 @@ class DatasetWriter:
                 self.notes.append(f"agent {a.id} has no LiDAR and is left out")
             else:
                 self.agents.append(a)
-        self.extra_counts: dict[str, int] = {e: 0 for e in options.extras}
+        self.extra_counts: dict[str, int] = dict.fromkeys(options.extras, 0)
 
     # ------------------------------------------------------------------------------------------ topics
 

@@ -29,8 +29,8 @@ import numpy as np
 
 from mmusv._native import core
 from mmusv.config import Scenario
-from mmusv.generate.mapctx import MapContext
 from mmusv.generate.hulls import axis_points, capsule, segment_distance
+from mmusv.generate.mapctx import MapContext
 from mmusv.generate.sampler import CandidateMeta
 from mmusv.generate.spec import (
     CooperationCheck,
@@ -47,7 +47,7 @@ from mmusv.generate.spec_constraints import TargetDensityCheck
 from mmusv.motion import build_fleet
 from mmusv.world.vessels import get_asset
 
-__all__ = ["Samples", "Constraint", "build_constraints", "first_failure", "take_samples"]
+__all__ = ["Constraint", "Samples", "build_constraints", "first_failure", "take_samples"]
 
 
 @dataclass
@@ -126,19 +126,21 @@ def take_samples(scenario: Scenario, meta: CandidateMeta, ctx: MapContext, spec:
     acq = scenario.acquisition
     t_last = (acq.frames - 1) / acq.frequency_hz
     dt = min(1.0 / acq.frequency_hz, step / max(float(speeds.max()), 1e-9))
-    n_t = max(int(math.ceil(t_last / dt)) + 1, 2)
+    n_t = max(math.ceil(t_last / dt) + 1, 2)
     times = np.linspace(0.0, t_last, n_t)
     frame_times = np.arange(acq.frames, dtype=np.float64) / acq.frequency_hz
     poses = np.asarray(fleet.poses_at_times(np.concatenate([times, frame_times])))
     motion, frames = poses[:n_t, :, :2], poses[n_t:, :, :2]
-    n_g = max(int(math.ceil(float(lengths.max()) / step)) + 1, 2)
+    n_g = max(math.ceil(float(lengths.max()) / step) + 1, 2)
     geo_fleet = core.Fleet(
         routes=[np.ascontiguousarray(v.route, dtype=np.float64) for v in vessels],
         end_behaviours=[v.end for v in vessels],
         speeds=lengths.copy(),
         start_offsets=np.zeros(len(vessels)),
         z_base=np.zeros(len(vessels)),
-        dims=np.array([[get_asset(v.asset).length, get_asset(v.asset).beam, get_asset(v.asset).height] for v in vessels]),
+        dims=np.array(
+            [[get_asset(v.asset).length, get_asset(v.asset).beam, get_asset(v.asset).height] for v in vessels]
+        ),
         amplitudes=np.zeros((len(vessels), 3)),
         seed=0,
         wave="W0",
@@ -274,7 +276,9 @@ class RouteSeparation:
                 d = np.linalg.norm(s.geo[:, i, None, :] - s.geo[None, :, j, :], axis=-1)
                 gap = float(d.min()) - s.geo_slack[i] - s.geo_slack[j]
                 if gap < self.min_m:
-                    return f"routes of {s.ids[i]} and {s.ids[j]} come within {max(gap, 0.0):.1f} m; need {self.min_m:g} m"
+                    return (
+                        f"routes of {s.ids[i]} and {s.ids[j]} come within {max(gap, 0.0):.1f} m; need {self.min_m:g} m"
+                    )
         return None
 
 
@@ -324,8 +328,10 @@ class TargetDensity:
         share = np.mean((d <= self.range_m).sum(axis=2) >= self.min_targets, axis=0)  # per USV
         worst = int(np.argmin(share))
         if share[worst] < self.share:
-            return (f"{s.ids[int(u[worst])]} has {self.min_targets}+ targets within {self.range_m:g} m in "
-                    f"{share[worst]:.0%} of frames; need {self.share:.0%}")
+            return (
+                f"{s.ids[int(u[worst])]} has {self.min_targets}+ targets within {self.range_m:g} m in "
+                f"{share[worst]:.0%} of frames; need {self.share:.0%}"
+            )
         return None
 
 
@@ -346,8 +352,10 @@ class Cooperation:
         share = np.mean((nearest >= self.lo) & (nearest <= self.hi), axis=0)
         k = int(np.argmin(share))
         if share[k] < self.share:
-            return (f"{s.ids[u[k]]} has its nearest USV within [{self.lo:g}, {self.hi:g}] m in {share[k]:.0%} of frames;"
-                    f" need {self.share:.0%}")
+            return (
+                f"{s.ids[u[k]]} has its nearest USV within [{self.lo:g}, {self.hi:g}] m in {share[k]:.0%} of frames;"
+                f" need {self.share:.0%}"
+            )
         return None
 
 
@@ -388,8 +396,10 @@ class Occlusion:
         seen = (~blocked[:, others] & s.in_range()[:, others, r]).any(axis=1) if others else np.zeros_like(occluded)
         other = float(seen[occluded].mean())
         if other < self.other:
-            return (f"while hidden from the ego, {s.meta.primary} is seen by another USV in {other:.0%} of those frames;"
-                    f" need {self.other:.0%}")
+            return (
+                f"while hidden from the ego, {s.meta.primary} is seen by another USV in {other:.0%} of those frames;"
+                f" need {self.other:.0%}"
+            )
         return None
 
 

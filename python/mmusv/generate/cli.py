@@ -27,7 +27,9 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     )
     p.add_argument("spec", help="generation spec YAML (e.g. scenarios/specs/island_demo.yaml)")
     p.add_argument("-o", "--output", default=None, help="output directory (default scenarios/generated/<spec name>)")
-    p.add_argument("--force", action="store_true", help="replace scenario files and report.json already in the directory")
+    p.add_argument(
+        "--force", action="store_true", help="replace scenario files and report.json already in the directory"
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     return p
 

@@ -35,7 +35,7 @@ from mmusv.generate.layout import (
 )
 from mmusv.generate.planner import PlannerError, harbour_planner
 
-__all__ = ["Family", "FAMILIES"]
+__all__ = ["FAMILIES", "Family"]
 
 
 @dataclass(frozen=True)
@@ -51,7 +51,9 @@ class Family:
     occlusion: bool = False
 
 
-def _cpa_point(ego_at: np.ndarray, v_e: np.ndarray, v_t: np.ndarray, r: float, rng: np.random.Generator, *, ahead: bool) -> np.ndarray:
+def _cpa_point(
+    ego_at: np.ndarray, v_e: np.ndarray, v_t: np.ndarray, r: float, rng: np.random.Generator, *, ahead: bool
+) -> np.ndarray:
     """Target position making ``ego_at`` -> target the CPA of their relative motion at distance ``r``; ``ahead``
     puts it in front of the ego (otherwise either side at random)."""
     w = v_t - v_e
@@ -231,7 +233,10 @@ def _occluded(inp: FamilyInput) -> Layout:
     tgt_at = occ.centre + (e2 + extra - d_e) * heading(behind)
     v_t = min(primary.speed, 4.0) * heading(behind + side * math.pi / 2.0)
     v_e = min(inp.ego.speed, 1.5) * heading(phi + side * math.pi / 2.0)
-    tracks = [straight_track(inp.ego, ego_at, v_e, t_e, big_t, rng), straight_track(primary, tgt_at, v_t, t_e, big_t, rng)]
+    tracks = [
+        straight_track(inp.ego, ego_at, v_e, t_e, big_t, rng),
+        straight_track(primary, tgt_at, v_t, t_e, big_t, rng),
+    ]
     for k, coop in enumerate(inp.coops):
 
         def make_coop(k: int = k, coop: Role = coop) -> list[Track]:
@@ -307,7 +312,9 @@ FAMILIES: dict[str, Family] = {
     for f in (
         Family("crossing", _encounter("crossing"), "a target crosses ahead of the ego at 90 ± 25 degrees"),
         Family("head_on", _encounter("head_on"), "a target meets the ego on a reciprocal course"),
-        Family("overtaking", _encounter("overtaking"), "a target overtakes the ego or is overtaken on a parallel course"),
+        Family(
+            "overtaking", _encounter("overtaking"), "a target overtakes the ego or is overtaken on a parallel course"
+        ),
         Family("convoy", _convoy, "the role targets sail in line; the ego keeps abeam of the lead"),
         Family("surround", _surround, "the USVs ring the primary target and sail with it"),
         Family(
@@ -317,7 +324,9 @@ FAMILIES: dict[str, Family] = {
             min_cooperating=1,
             occlusion=True,
         ),
-        Family("port_entry", _port_entry, "targets enter the harbour; the ego waits off the approach", map_types=("port",)),
+        Family(
+            "port_entry", _port_entry, "targets enter the harbour; the ego waits off the approach", map_types=("port",)
+        ),
     )
 }
 """The family templates by name."""

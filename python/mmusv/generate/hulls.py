@@ -17,7 +17,7 @@ import numpy as np
 
 from mmusv.world.vessels import get_asset
 
-__all__ = ["capsule", "axis_points", "segment_distance"]
+__all__ = ["axis_points", "capsule", "segment_distance"]
 
 
 def capsule(asset: str) -> tuple[float, float]:
@@ -32,7 +32,7 @@ def axis_points(xy: np.ndarray, yaw: np.ndarray, half: np.ndarray, spacing: floa
     """Points along every capsule axis: ``xy`` ``(N, V, 2)``, ``yaw`` ``(N, V)``, ``half`` ``(V,)`` ->
     ``(N, V, K, 2)`` points (the same K for all vessels, evenly spread from ``-a`` to ``+a``) and ``(V,)`` the
     largest distance from any axis point to its nearest sample (half the point spacing, at most ``spacing/2``)."""
-    k = max(int(math.ceil(2.0 * float(half.max(initial=0.0)) / spacing)) + 1, 1)
+    k = max(math.ceil(2.0 * float(half.max(initial=0.0)) / spacing) + 1, 1)
     f = np.linspace(-1.0, 1.0, k) if k > 1 else np.zeros(1)
     off = half[:, None] * f[None, :]  # (V, K)
     d = np.stack([np.cos(yaw), np.sin(yaw)], axis=-1)  # (N, V, 2)

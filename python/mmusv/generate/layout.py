@@ -15,17 +15,17 @@ from mmusv.errors import MmusvError
 from mmusv.generate.mapctx import MapContext
 
 __all__ = [
-    "Role",
-    "Track",
-    "Layout",
     "FamilyInput",
+    "Layout",
+    "Role",
     "SamplingError",
+    "Track",
+    "heading",
+    "perp",
     "pick_best",
     "straight_track",
     "track_clearance",
     "unit",
-    "heading",
-    "perp",
 ]
 
 
@@ -105,7 +105,9 @@ def unit(v: np.ndarray, fallback: np.ndarray) -> np.ndarray:
     return v / n if n > 1e-9 else fallback
 
 
-def straight_track(role: Role, at: np.ndarray, vel: np.ndarray, t_at: float, duration: float, rng: np.random.Generator) -> Track:
+def straight_track(
+    role: Role, at: np.ndarray, vel: np.ndarray, t_at: float, duration: float, rng: np.random.Generator
+) -> Track:
     """A track passing ``at`` at time ``t_at`` with velocity ``vel`` (m/s), covering ``[0, duration]``, with a
     middle waypoint bent sideways by up to 3 % of its length; at rest (speed 0) when it would move under 1 m."""
     speed = float(np.hypot(vel[0], vel[1]))
@@ -119,6 +121,7 @@ def straight_track(role: Role, at: np.ndarray, vel: np.ndarray, t_at: float, dur
     length = speed * duration
     mid = (start + end) / 2.0 + perp(u) * bend * length
     return Track(role, np.array([start, mid, end]), speed)
+
 
 def track_clearance(ctx: MapContext, track: Track) -> float:
     """Smallest conservative clearance (metres) minus hull radius along a track's waypoint polyline, sampled

@@ -151,7 +151,9 @@ class MapContext:
         if not ok.any():
             return out
         dirs = d[ok] / length[ok, None]
-        hits = self.scene.cast_rays(a[ok].astype(np.float32), dirs.astype(np.float32), max_range=float(length[ok].max()))
+        hits = self.scene.cast_rays(
+            a[ok].astype(np.float32), dirs.astype(np.float32), max_range=float(length[ok].max())
+        )
         out[ok] = np.isfinite(hits.distance) & (hits.distance.astype(np.float64) < length[ok] - 1e-3)
         return out
 
@@ -172,7 +174,9 @@ class MapContext:
             x0, y0, x1, y1 = poly.bounds
             if min(x0 + half, y0 + half, half - x1, half - y1) < 60.0:
                 continue
-            out.append(Occluder(polygon=poly, centre=np.array([c.x, c.y]), diameter=2.0 * math.sqrt(poly.area / math.pi)))
+            out.append(
+                Occluder(polygon=poly, centre=np.array([c.x, c.y]), diameter=2.0 * math.sqrt(poly.area / math.pi))
+            )
         return tuple(out)
 
     def ray_exit(self, centre: np.ndarray, angle: float, need: float, max_len: float) -> float | None:
@@ -182,7 +186,7 @@ class MapContext:
         s = np.arange(0.0, max_len, step)
         pts = centre[None, :] + s[:, None] * np.array([math.cos(angle), math.sin(angle)])[None, :]
         ok = self.clearance(pts) >= need
-        run = int(round(40.0 / step))
+        run = round(40.0 / step)
         if ok.size < run:
             return None
         # windows of `run` consecutive ok samples, after the first not-ok sample (we start inside the island)

@@ -84,7 +84,9 @@ class HarbourPlanner:
         reach = np.isfinite(dist)
         outside = np.flatnonzero(reach & ~self.in_basin)
         if outside.size == 0:
-            raise PlannerError(f"no navigable path from open water into the harbour for a hull needing {key:.0f} m of clearance")
+            raise PlannerError(
+                f"no navigable path from open water into the harbour for a hull needing {key:.0f} m of clearance"
+            )
         fld = _Field(dist=dist, pred=pred, outside=outside, entry_dist=float(dist[outside].min()))
         self._fields[key] = fld
         return fld
@@ -99,7 +101,9 @@ class HarbourPlanner:
         cand = fld.outside[np.abs(d - target) <= tol]
         if cand.size == 0:
             far = float(d.max()) - fld.entry_dist
-            raise PlannerError(f"open water reaches at most {far:.0f} m from the harbour entrance (wanted {entry_after_m:.0f} m)")
+            raise PlannerError(
+                f"open water reaches at most {far:.0f} m from the harbour entrance (wanted {entry_after_m:.0f} m)"
+            )
         cur = int(cand[rng.integers(cand.size)])
         cells = [cur]
         while fld.pred[cur] >= 0:

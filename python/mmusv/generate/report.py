@@ -140,12 +140,23 @@ class RunReport:
             table.add_column(col, justify="left" if col == "combination" else "right")
         for c in self.combos:
             table.add_row(
-                c.name, str(c.quota), str(c.accepted), str(c.attempts), *(str(c.rejected.get(n, 0)) for n in shown),
+                c.name,
+                str(c.quota),
+                str(c.accepted),
+                str(c.attempts),
+                *(str(c.rejected.get(n, 0)) for n in shown),
                 "[green]yes[/]" if c.met else "[red]no[/]",
             )
         rej = self.rejected
-        table.add_row("total", str(sum(c.quota for c in self.combos)), str(self.accepted), str(self.attempts),
-                      *(str(rej.get(n, 0)) for n in shown), "yes" if self.all_met else "no", style="bold")
+        table.add_row(
+            "total",
+            str(sum(c.quota for c in self.combos)),
+            str(self.accepted),
+            str(self.attempts),
+            *(str(rej.get(n, 0)) for n in shown),
+            "yes" if self.all_met else "no",
+            style="bold",
+        )
         console.print(table)
         for c in self.combos:
             if not c.met:

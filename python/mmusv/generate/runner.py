@@ -24,14 +24,14 @@ import yaml
 from mmusv.config import load_scenario
 from mmusv.errors import ConfigError, IoError, MmusvError
 from mmusv.generate.checks import build_constraints, first_failure, take_samples
+from mmusv.generate.hulls import capsule
 from mmusv.generate.layout import SamplingError
 from mmusv.generate.mapctx import MapContext, map_context
 from mmusv.generate.report import ComboReport, RunReport
-from mmusv.generate.hulls import capsule
 from mmusv.generate.sampler import sample_candidate
 from mmusv.generate.spec import GenerationSpec, class_assets, load_spec
 
-__all__ = ["generate", "dump_scenario", "Progress"]
+__all__ = ["Progress", "dump_scenario", "generate"]
 
 Progress = Callable[[str, int, int], None]
 """Called after every attempt with (combination name, accepted so far in total, attempts so far in total)."""
@@ -106,15 +106,19 @@ def _infeasible(spec: GenerationSpec, ctx: MapContext, idx: int) -> str | None:
     classes fits nowhere on the map), or None. Attempts still run (and are counted) so the report shows them."""
     combo = spec.combinations[idx]
     cons = spec.constraints
-    need = max(cons.shore_clearance.min_m if cons.shore_clearance.enabled else 0.0,
-               cons.structure_clearance.min_m if cons.structure_clearance.enabled else 0.0)
+    need = max(
+        cons.shore_clearance.min_m if cons.shore_clearance.enabled else 0.0,
+        cons.structure_clearance.min_m if cons.structure_clearance.enabled else 0.0,
+    )
     best = ctx.max_clearance()
     for cls in combo.targets:
         slimmest = min(class_assets(spec.size_classes[cls]), key=lambda a: capsule(a)[1])
         r = capsule(slimmest)[1]
         if r + need > best:
-            return (f"infeasible: size class {cls!r} needs {r + need:.0f} m of clearance ({slimmest} hull half-width"
-                    f" {r:.0f} m + {need:g} m) and the most open water on this map offers {best:.0f} m")
+            return (
+                f"infeasible: size class {cls!r} needs {r + need:.0f} m of clearance ({slimmest} hull half-width"
+                f" {r:.0f} m + {need:g} m) and the most open water on this map offers {best:.0f} m"
+            )
     return None
 
 
@@ -167,13 +171,18 @@ def generate(
                         raise MmusvError(f"internal: {path} does not read back as the scenario that was checked")
                     rep.accept(path.name)
                     report.scenarios.append(
-                        {"file": path.name, "combination": rep.name, "family": combo.family,
-                         "difficulty": combo.difficulty, "attempt": attempt, "seed": cand.data["seed"],
-                         "map": cand.data["map"]["type"],
-                         "roles": cand.meta.as_dict()}
+                        {
+                            "file": path.name,
+                            "combination": rep.name,
+                            "family": combo.family,
+                            "difficulty": combo.difficulty,
+                            "attempt": attempt,
+                            "seed": cand.data["seed"],
+                            "map": cand.data["map"]["type"],
+                            "roles": cand.meta.as_dict(),
+                        }
                     )
             if progress is not None:
                 progress(rep.name, report.accepted, total_attempts)
     (out / "report.json").write_text(report.to_json(), encoding="utf-8")
     return report
-

@@ -18,13 +18,13 @@ import numpy as np
 
 from mmusv.config import Scenario, load_scenario
 from mmusv.generate.families import FAMILIES
-from mmusv.generate.layout import FamilyInput, Layout, Role, SamplingError, Track, pick_best, straight_track
 from mmusv.generate.hulls import capsule
+from mmusv.generate.layout import FamilyInput, Layout, Role, SamplingError, Track, pick_best, straight_track
 from mmusv.generate.mapctx import MapContext
 from mmusv.generate.spec import Combination, GenerationSpec, class_assets
 from mmusv.world.vessels import get_asset
 
-__all__ = ["Candidate", "CandidateMeta", "sample_candidate", "attempt_rng", "scenario_seed", "hull_radius"]
+__all__ = ["Candidate", "CandidateMeta", "attempt_rng", "hull_radius", "sample_candidate", "scenario_seed"]
 
 
 @dataclass(frozen=True)

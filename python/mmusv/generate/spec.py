@@ -71,7 +71,11 @@ from mmusv.world.vessels import asset_names, get_asset
 from mmusv.yamlio import mapping_source
 
 __all__ = [
+    "Combination",
+    "Constraints",
     "CooperationCheck",
+    "Difficulty",
+    "GenerationSpec",
     "InWaterCheck",
     "LineOfSightCheck",
     "OcclusionCheck",
@@ -79,16 +83,12 @@ __all__ = [
     "SensingRangeCheck",
     "SeparationCheck",
     "ShoreClearanceCheck",
+    "SizeClass",
     "StructureClearanceCheck",
     "TargetRangeCheck",
-    "SizeClass",
     "UsvRoles",
-    "Difficulty",
-    "Combination",
-    "Constraints",
-    "GenerationSpec",
-    "load_spec",
     "class_assets",
+    "load_spec",
 ]
 
 Pair = tuple[float, float]
@@ -328,7 +328,12 @@ def _cross_checks(spec: GenerationSpec, source: str) -> None:
     if spec.rig not in spec.rigs:
         fail("rig", spec.rig, f"not defined under rigs: ({', '.join(sorted(spec.rigs))})")
     try:  # the rig must be valid in a scenario: validate it in a one-vessel scenario
-        load_scenario({"rigs": {spec.rig: spec.rigs[spec.rig]}, "vessels": [{"id": "probe", "asset": "usv_wamv", "route": [[0, 0], [1, 0]]}]})
+        load_scenario(
+            {
+                "rigs": {spec.rig: spec.rigs[spec.rig]},
+                "vessels": [{"id": "probe", "asset": "usv_wamv", "route": [[0, 0], [1, 0]]}],
+            }
+        )
     except ConfigError as exc:
         fail(f"rigs.{spec.rig}", spec.rigs[spec.rig], str(exc).removeprefix("scenario: "))
     for name, sc in spec.size_classes.items():
@@ -342,16 +347,26 @@ def _cross_checks(spec: GenerationSpec, source: str) -> None:
     for i, combo in enumerate(spec.combinations):
         where = f"combinations[{i}]"
         if combo.difficulty not in spec.difficulties:
-            fail(f"{where}.difficulty", combo.difficulty, f"not defined under difficulties: ({', '.join(spec.difficulties)})")
+            fail(
+                f"{where}.difficulty",
+                combo.difficulty,
+                f"not defined under difficulties: ({', '.join(spec.difficulties)})",
+            )
         for j, t in enumerate(combo.targets):
             if t not in spec.size_classes:
                 fail(f"{where}.targets[{j}]", t, f"not a size class ({', '.join(spec.size_classes)})")
         fam = FAMILIES[combo.family]
         map_type = spec.map_of(combo).type
         if fam.map_types and map_type not in fam.map_types:
-            fail(f"{where}.family", combo.family, f"needs a map of type {' or '.join(fam.map_types)} (map.type is {map_type})")
+            fail(
+                f"{where}.family",
+                combo.family,
+                f"needs a map of type {' or '.join(fam.map_types)} (map.type is {map_type})",
+            )
         if combo.cooperating < fam.min_cooperating:
-            fail(f"{where}.cooperating", combo.cooperating, f"family {combo.family} needs at least {fam.min_cooperating}")
+            fail(
+                f"{where}.cooperating", combo.cooperating, f"family {combo.family} needs at least {fam.min_cooperating}"
+            )
         label = combo.label()
         if label in labels:
             fail(f"{where}.name", label, "two combinations have this name; give them distinct `name:`s")

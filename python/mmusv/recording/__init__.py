@@ -8,6 +8,13 @@ from mmusv.recording.reader import decode_image, decode_point_cloud, frame_messa
 from mmusv.recording.writer import POINT_DTYPES, Recording, to_ns
 
 __all__ = [
-    "POINT_DTYPES", "Recording", "decode_image", "decode_point_cloud", "frame_messages", "read_info", "read_messages",
-    "summary", "to_ns",
+    "POINT_DTYPES",
+    "Recording",
+    "decode_image",
+    "decode_point_cloud",
+    "frame_messages",
+    "read_info",
+    "read_messages",
+    "summary",
+    "to_ns",
 ]

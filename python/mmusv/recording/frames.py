@@ -29,13 +29,13 @@ import yaml
 from scipy.spatial.transform import Rotation
 
 from mmusv.config import scenario_hash
-from mmusv.recording.writer import Recording
 from mmusv.frames import BODY_TO_OPTICAL
+from mmusv.recording import topics
+from mmusv.recording.writer import Recording
 from mmusv.sensors.camera import CameraImages
 from mmusv.simulation import FrameCapture, Simulation
-from mmusv.recording import topics
 
-__all__ = ["FrameRecorder", "OPTICAL_IN_BODY", "pose7"]
+__all__ = ["OPTICAL_IN_BODY", "FrameRecorder", "pose7"]
 
 OPTICAL_IN_BODY = np.eye(4)
 OPTICAL_IN_BODY[:3, :3] = BODY_TO_OPTICAL.T
@@ -57,7 +57,9 @@ class FrameRecorder:
         self.roles = {v.id: v.role for v in sim.vessels}
         self.rec = Recording(path, overwrite=overwrite)
         sc = sim.scenario
-        self.rec.metadata("scenario", {"name": sc.name, "yaml": yaml.safe_dump(sc.model_dump(mode="json"), sort_keys=False)})
+        self.rec.metadata(
+            "scenario", {"name": sc.name, "yaml": yaml.safe_dump(sc.model_dump(mode="json"), sort_keys=False)}
+        )
         from mmusv import __version__
 
         self.rec.metadata("manifest", {"mmusv_version": __version__, "seed": sc.seed, "config_hash": scenario_hash(sc)})
@@ -65,8 +67,13 @@ class FrameRecorder:
         for a in sim.agents:
             cams = {}
             for name, (cam, cfg, mount) in a.cameras.items():
-                cams[name] = {"resolution": list(cfg.resolution), "hfov_deg": cfg.hfov_deg, "intrinsics": list(cam.intrinsics or ()),
-                              "mount_in_body": np.round(mount, 9).tolist(), "outputs": list(cfg.outputs)}
+                cams[name] = {
+                    "resolution": list(cfg.resolution),
+                    "hfov_deg": cfg.hfov_deg,
+                    "intrinsics": list(cam.intrinsics or ()),
+                    "mount_in_body": np.round(mount, 9).tolist(),
+                    "outputs": list(cfg.outputs),
+                }
             sensors[a.id] = {
                 "asset": a.asset.name,
                 "lidar_mount_in_body": None if a.lidar_mount is None else np.round(a.lidar_mount, 9).tolist(),
@@ -97,13 +104,23 @@ class FrameRecorder:
             for name, p in ac.camera_poses.items():
                 tfs.append((a.id, topics.camera_frame(a.id, name), *pose7(body_inv @ p @ OPTICAL_IN_BODY)))
             if ac.top_view_pose is not None:
-                tfs.append((topics.WORLD_FRAME, topics.top_view_frame(a.id), *pose7(ac.top_view_pose @ OPTICAL_IN_BODY)))
+                tfs.append(
+                    (topics.WORLD_FRAME, topics.top_view_frame(a.id), *pose7(ac.top_view_pose @ OPTICAL_IN_BODY))
+                )
         rec.frame_transforms(topics.TF, log_time_ns=t, transforms=tfs)
         rec.world_state(
-            topics.WORLD_STATE, log_time_ns=t, frame=cap.frame, time_s=cap.time_s,
-            ids=[v.id for v in sim.vessels], assets=[v.asset for v in sim.vessels], roles=[v.role for v in sim.vessels],
-            classes=[v.semantic_class for v in sim.vessels], instance_ids=[v.instance_id for v in sim.vessels],
-            poses=st.poses, velocities=st.velocities, box_centers=st.box_centers,
+            topics.WORLD_STATE,
+            log_time_ns=t,
+            frame=cap.frame,
+            time_s=cap.time_s,
+            ids=[v.id for v in sim.vessels],
+            assets=[v.asset for v in sim.vessels],
+            roles=[v.role for v in sim.vessels],
+            classes=[v.semantic_class for v in sim.vessels],
+            instance_ids=[v.instance_id for v in sim.vessels],
+            poses=st.poses,
+            velocities=st.velocities,
+            box_centers=st.box_centers,
             box_sizes=np.array([v.box_size for v in sim.vessels]).reshape(-1, 3),
         )
         for a in sim.agents:
@@ -113,32 +130,69 @@ class FrameRecorder:
             if ac.lidar is not None:
                 pts = ac.lidar
                 rec.point_cloud(
-                    topics.lidar(a.id), log_time_ns=t, frame_id=topics.lidar_frame(a.id),
-                    columns={"x": pts.xyz[:, 0], "y": pts.xyz[:, 1], "z": pts.xyz[:, 2], "intensity": pts.intensity,
-                             "ring": pts.ring, "azimuth": pts.azimuth, "class": pts.semantic_class, "instance": pts.instance},
+                    topics.lidar(a.id),
+                    log_time_ns=t,
+                    frame_id=topics.lidar_frame(a.id),
+                    columns={
+                        "x": pts.xyz[:, 0],
+                        "y": pts.xyz[:, 1],
+                        "z": pts.xyz[:, 2],
+                        "intensity": pts.intensity,
+                        "ring": pts.ring,
+                        "azimuth": pts.azimuth,
+                        "class": pts.semantic_class,
+                        "instance": pts.instance,
+                    },
                 )
             for name, img in ac.cameras.items():
-                self._images(topics.camera(a.id, name), topics.camera_frame(a.id, name), t, img, list(a.cameras[name][1].outputs))
+                self._images(
+                    topics.camera(a.id, name), topics.camera_frame(a.id, name), t, img, list(a.cameras[name][1].outputs)
+                )
             if ac.top_view is not None and a.rig.top_view is not None:
-                self._images(topics.top_view(a.id), topics.top_view_frame(a.id), t, ac.top_view, list(a.rig.top_view.outputs))
+                self._images(
+                    topics.top_view(a.id), topics.top_view_frame(a.id), t, ac.top_view, list(a.rig.top_view.outputs)
+                )
             if ac.radar is not None:
                 self._radar(a.id, t, ac.radar, ac.radar_ppi)
             cols = annotations.get(a.id)
             if cols is not None:
-                rec.annotations(topics.agent_annotations(a.id), log_time_ns=t, frame=cap.frame, time_s=cap.time_s, agent_id=a.id,
-                                lidar=cols["lidar"], bev=cols["bev"], camera=cols["camera"])
+                rec.annotations(
+                    topics.agent_annotations(a.id),
+                    log_time_ns=t,
+                    frame=cap.frame,
+                    time_s=cap.time_s,
+                    agent_id=a.id,
+                    lidar=cols["lidar"],
+                    bev=cols["bev"],
+                    camera=cols["camera"],
+                )
                 lid = cols["lidar"]
-                colours = np.array([_ROLE_COLOURS.get(self.roles.get(i, "target"), (1, 1, 1, 0.5)) for i in lid["target_id"]]).reshape(-1, 4)
-                rec.boxes(topics.boxes(a.id), log_time_ns=t, frame_id=topics.lidar_frame(a.id), entity_id=f"{a.id}/targets",
-                          ids=lid["target_id"], centers=lid["center"], quaternions=lid["rotation"], sizes=lid["size"],
-                          colors=colours)
+                colours = np.array(
+                    [_ROLE_COLOURS.get(self.roles.get(i, "target"), (1, 1, 1, 0.5)) for i in lid["target_id"]]
+                ).reshape(-1, 4)
+                rec.boxes(
+                    topics.boxes(a.id),
+                    log_time_ns=t,
+                    frame_id=topics.lidar_frame(a.id),
+                    entity_id=f"{a.id}/targets",
+                    ids=lid["target_id"],
+                    centers=lid["center"],
+                    quaternions=lid["rotation"],
+                    sizes=lid["size"],
+                    colors=colours,
+                )
 
     def _images(self, topic: str, frame_id: str, t: int, img: CameraImages, outputs: list[str]) -> None:
         rec = self.rec
         if img.rgb is not None and "rgb" in outputs:
             rec.png_image(f"{topic}/rgb", log_time_ns=t, frame_id=frame_id, image=img.rgb)
         if "depth" in outputs:
-            rec.raw_image(f"{topic}/depth", log_time_ns=t, frame_id=frame_id, image=np.ascontiguousarray(img.depth, dtype=np.float32))
+            rec.raw_image(
+                f"{topic}/depth",
+                log_time_ns=t,
+                frame_id=frame_id,
+                image=np.ascontiguousarray(img.depth, dtype=np.float32),
+            )
         if "semantic" in outputs:
             rec.png_image(f"{topic}/semantic", log_time_ns=t, frame_id=frame_id, image=img.semantic)
         if "instance" in outputs:
@@ -151,22 +205,41 @@ class FrameRecorder:
         r, az, el = returns.range, returns.azimuth, returns.elevation
         ce = np.cos(el)
         self.rec.point_cloud(
-            topics.radar_returns(agent), log_time_ns=t, frame_id=topics.radar_frame(agent),
-            columns={"x": (r * ce * np.cos(az)).astype(np.float32), "y": (r * ce * np.sin(az)).astype(np.float32),
-                     "z": (r * np.sin(el)).astype(np.float32), "range": r, "azimuth": az, "elevation": el,
-                     "intensity": returns.intensity, "instance": returns.instance_id},
+            topics.radar_returns(agent),
+            log_time_ns=t,
+            frame_id=topics.radar_frame(agent),
+            columns={
+                "x": (r * ce * np.cos(az)).astype(np.float32),
+                "y": (r * ce * np.sin(az)).astype(np.float32),
+                "z": (r * np.sin(el)).astype(np.float32),
+                "range": r,
+                "azimuth": az,
+                "elevation": el,
+                "intensity": returns.intensity,
+                "instance": returns.instance_id,
+            },
         )
         if ppi is not None:
-            self.rec.png_image(topics.radar_ppi(agent), log_time_ns=t, frame_id=topics.radar_frame(agent), image=ppi_colormap(ppi))
+            self.rec.png_image(
+                topics.radar_ppi(agent), log_time_ns=t, frame_id=topics.radar_frame(agent), image=ppi_colormap(ppi)
+            )
 
     # ------------------------------------------------------------------------------------------ end
 
-    def finish(self, *, status: str, frames: int, error: str | None = None, requested: int | None = None) -> dict[str, Any]:
+    def finish(
+        self, *, status: str, frames: int, error: str | None = None, requested: int | None = None
+    ) -> dict[str, Any]:
         """Writes the ``run`` metadata and completes the file (also after an interruption: the file then holds
         every completed frame and says ``status: interrupted``)."""
         sc = self.sim.scenario
-        meta = {"scenario": sc.name, "status": status, "frames_written": frames, "frames_configured": sc.acquisition.frames,
-                "frequency_hz": sc.acquisition.frequency_hz, "agents": ",".join(a.id for a in self.sim.agents)}
+        meta = {
+            "scenario": sc.name,
+            "status": status,
+            "frames_written": frames,
+            "frames_configured": sc.acquisition.frames,
+            "frequency_hz": sc.acquisition.frequency_hz,
+            "agents": ",".join(a.id for a in self.sim.agents),
+        }
         if requested is not None:  # a run limited to its first N frames (--frames N)
             meta["frames_requested"] = requested
         if error:

@@ -29,8 +29,20 @@ from PIL import Image
 from mmusv.errors import ConfigError, IoError
 
 __all__ = [
-    "MCAP_MAGIC", "CameraInfo", "AgentInfo", "RecordingInfo", "WorldFrame", "Frame", "FrameStream", "read_info",
-    "check_mcap", "decode_image", "decode_point_cloud", "frame_messages", "read_messages", "summary",
+    "MCAP_MAGIC",
+    "AgentInfo",
+    "CameraInfo",
+    "Frame",
+    "FrameStream",
+    "RecordingInfo",
+    "WorldFrame",
+    "check_mcap",
+    "decode_image",
+    "decode_point_cloud",
+    "frame_messages",
+    "read_info",
+    "read_messages",
+    "summary",
 ]
 
 MCAP_MAGIC = b"\x89MCAP0\r\n"
@@ -133,10 +145,17 @@ class WorldFrame:
             return np.array([list(getattr(v, attr)) for v in vs], dtype=np.float64).reshape(len(vs), k)
 
         return WorldFrame(
-            frame=int(msg.frame), time_s=float(msg.time_s), ids=[v.id for v in vs], assets=[v.asset for v in vs],
-            roles=[v.role for v in vs], classes=np.array([v.semantic_class for v in vs], dtype=np.int64),
-            instance_ids=np.array([v.instance_id for v in vs], dtype=np.int64), poses=rows("pose", 6),
-            velocities=rows("velocity", 3), box_centers=rows("box_center", 3), box_sizes=rows("box_size", 3),
+            frame=int(msg.frame),
+            time_s=float(msg.time_s),
+            ids=[v.id for v in vs],
+            assets=[v.asset for v in vs],
+            roles=[v.role for v in vs],
+            classes=np.array([v.semantic_class for v in vs], dtype=np.int64),
+            instance_ids=np.array([v.instance_id for v in vs], dtype=np.int64),
+            poses=rows("pose", 6),
+            velocities=rows("velocity", 3),
+            box_centers=rows("box_center", 3),
+            box_sizes=rows("box_size", 3),
         )
 
 
@@ -225,22 +244,45 @@ def read_info(path: str | Path) -> RecordingInfo:
             raise IoError(f"{p}: sensors metadata names agent {aid!r}, which is not a scenario vessel")
         cams = {
             name: CameraInfo(
-                name=name, width=int(c["resolution"][0]), height=int(c["resolution"][1]), hfov_deg=float(c["hfov_deg"]),
-                intrinsics=(float(c["intrinsics"][0]), float(c["intrinsics"][1]), float(c["intrinsics"][2]), float(c["intrinsics"][3])),
-                mount=np.asarray(c["mount_in_body"], dtype=np.float64).reshape(4, 4), outputs=tuple(c.get("outputs", ())),
+                name=name,
+                width=int(c["resolution"][0]),
+                height=int(c["resolution"][1]),
+                hfov_deg=float(c["hfov_deg"]),
+                intrinsics=(
+                    float(c["intrinsics"][0]),
+                    float(c["intrinsics"][1]),
+                    float(c["intrinsics"][2]),
+                    float(c["intrinsics"][3]),
+                ),
+                mount=np.asarray(c["mount_in_body"], dtype=np.float64).reshape(4, 4),
+                outputs=tuple(c.get("outputs", ())),
             )
             for name, c in s.get("cameras", {}).items()
         }
-        agents.append(AgentInfo(id=aid, index=ids.index(aid), asset=str(s.get("asset", "")), lidar_mount=_mat(s.get("lidar_mount_in_body")),
-                                radar_mount=_mat(s.get("radar_mount_in_body")), cameras=cams, rig=dict(s.get("rig", {}))))
+        agents.append(
+            AgentInfo(
+                id=aid,
+                index=ids.index(aid),
+                asset=str(s.get("asset", "")),
+                lidar_mount=_mat(s.get("lidar_mount_in_body")),
+                radar_mount=_mat(s.get("radar_mount_in_body")),
+                cameras=cams,
+                rig=dict(s.get("rig", {})),
+            )
+        )
     agents.sort(key=lambda a: a.index)
     seed = manifest.get("seed", scenario.get("seed"))
     return RecordingInfo(
-        path=p, scenario_name=str(meta["scenario"].get("name", scenario.get("name", p.stem))), scenario=scenario,
-        config_hash=str(manifest.get("config_hash", "")), seed=None if seed in (None, "None") else int(seed),
+        path=p,
+        scenario_name=str(meta["scenario"].get("name", scenario.get("name", p.stem))),
+        scenario=scenario,
+        config_hash=str(manifest.get("config_hash", "")),
+        seed=None if seed in (None, "None") else int(seed),
         mmusv_version=str(manifest.get("mmusv_version", "")),
         frequency_hz=float(run.get("frequency_hz", acq.get("frequency_hz", 0.0)) or acq.get("frequency_hz", 0.0)),
-        frames_configured=int(run.get("frames_configured", acq.get("frames", 0)) or 0), agents=agents, run=dict(run),
+        frames_configured=int(run.get("frames_configured", acq.get("frames", 0)) or 0),
+        agents=agents,
+        run=dict(run),
         has_summary=has_summary,
     )
 
@@ -286,8 +328,10 @@ class FrameStream:
                 except StopIteration:
                     break
                 except Exception as exc:  # ends mid-record: keep what was read
-                    self.truncated = (f"the file is truncated: it ends inside a record ({type(exc).__name__}) at byte {size}; "
-                                      f"the last complete record ends at byte {good}")
+                    self.truncated = (
+                        f"the file is truncated: it ends inside a record ({type(exc).__name__}) at byte {size}; "
+                        f"the last complete record ends at byte {good}"
+                    )
                     break
                 good = f.tell()
                 if isinstance(rec, Schema):
@@ -328,9 +372,7 @@ class FrameStream:
         return fr
 
 
-def read_messages(
-    path: str | os.PathLike[str], topics: Sequence[str] | None = None
-) -> Iterator[tuple[str, int, Any]]:
+def read_messages(path: str | os.PathLike[str], topics: Sequence[str] | None = None) -> Iterator[tuple[str, int, Any]]:
     """Yields ``(topic, log_time_ns, decoded_protobuf_message)`` in log-time order, optionally only ``topics``.
     Works on finished files and on completed ``.partial`` files."""
     from mcap.reader import make_reader
@@ -370,7 +412,11 @@ def summary(path: str | os.PathLike[str]) -> dict[str, Any]:
             for schema, channel, message in reader.iter_messages(log_time_order=False):
                 entry = topics.setdefault(
                     channel.topic,
-                    {"schema": "" if schema is None else schema.name, "encoding": channel.message_encoding, "messages": 0},
+                    {
+                        "schema": "" if schema is None else schema.name,
+                        "encoding": channel.message_encoding,
+                        "messages": 0,
+                    },
                 )
                 entry["messages"] += 1
                 total += 1
@@ -400,7 +446,15 @@ def decode_image(msg: Any) -> np.ndarray:
     if hasattr(msg, "format"):
         return np.asarray(Image.open(io.BytesIO(msg.data)))
     enc = msg.encoding
-    dtype = {"rgb8": np.uint8, "mono8": np.uint8, "8UC1": np.uint8, "16UC1": np.uint16, "mono16": np.uint16, "32FC1": np.float32, "32SC1": np.int32}.get(enc)
+    dtype = {
+        "rgb8": np.uint8,
+        "mono8": np.uint8,
+        "8UC1": np.uint8,
+        "16UC1": np.uint16,
+        "mono16": np.uint16,
+        "32FC1": np.float32,
+        "32SC1": np.int32,
+    }.get(enc)
     if dtype is None:
         raise IoError(f"unsupported image encoding {enc!r}")
     data = np.frombuffer(msg.data, dtype=np.dtype(dtype).newbyteorder("<"))

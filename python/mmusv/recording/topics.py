@@ -12,9 +12,22 @@ from __future__ import annotations
 from collections.abc import Callable
 
 __all__ = [
-    "CAMERA_KINDS", "TF", "WORLD_FRAME", "WORLD_STATE", "agent_annotations", "agent_of", "boxes", "camera",
+    "CAMERA_KINDS",
+    "TF",
+    "WORLD_FRAME",
+    "WORLD_STATE",
+    "agent_annotations",
+    "agent_of",
+    "boxes",
+    "camera",
     "camera_frame",
-    "lidar", "lidar_frame", "radar_frame", "radar_ppi", "radar_returns", "top_view", "top_view_frame",
+    "lidar",
+    "lidar_frame",
+    "radar_frame",
+    "radar_ppi",
+    "radar_returns",
+    "top_view",
+    "top_view_frame",
 ]
 
 TF = "/tf"

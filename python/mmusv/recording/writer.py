@@ -32,7 +32,7 @@ import numpy.typing as npt
 from mmusv._native import core
 from mmusv.errors import InputError
 
-__all__ = ["Recording", "to_ns", "POINT_DTYPES"]
+__all__ = ["POINT_DTYPES", "Recording", "to_ns"]
 
 POINT_DTYPES: tuple[str, ...] = ("uint8", "int8", "uint16", "int16", "uint32", "int32", "float32", "float64")
 """dtypes a point-cloud column may have (others are refused; bool is stored as uint8)."""
@@ -42,7 +42,7 @@ def to_ns(time_s: float) -> int:
     """Simulation time in seconds → integer nanoseconds (rounded), the time unit of every record call."""
     if not np.isfinite(time_s) or time_s < 0:
         raise InputError(f"invalid time_s: {time_s} must be finite and >= 0")
-    return int(round(time_s * 1e9))
+    return round(time_s * 1e9)
 
 
 def _f64(a: npt.ArrayLike, name: str, cols: int) -> npt.NDArray[np.float64]:
@@ -69,9 +69,7 @@ def _u32(a: npt.ArrayLike, name: str) -> npt.NDArray[np.uint32]:
     return np.ascontiguousarray(arr, dtype=np.uint32)
 
 
-def _block(
-    table: Mapping[str, Any], group: str, n: int, floats: Sequence[tuple[str, int]]
-) -> npt.NDArray[np.float64]:
+def _block(table: Mapping[str, Any], group: str, n: int, floats: Sequence[tuple[str, int]]) -> npt.NDArray[np.float64]:
     """The float columns ``floats`` (key, width) of a dict table with ``n`` rows, side by side: (n, Σ width)."""
     parts = []
     for key, width in floats:
@@ -358,4 +356,4 @@ class Recording:
             self._rec.abandon()
 
     def __repr__(self) -> str:
-        return f"Recording({repr(self._rec)})"
+        return f"Recording({self._rec!r})"

@@ -19,7 +19,7 @@ from mmusv.frames import BODY_TO_OPTICAL
 from mmusv.scene import Scene
 from mmusv.sensors.config import CameraConfig, TopViewConfig
 
-__all__ = ["CameraImages", "camera_from_config", "top_view_from_config", "render", "BODY_TO_OPTICAL"]
+__all__ = ["BODY_TO_OPTICAL", "CameraImages", "camera_from_config", "render", "top_view_from_config"]
 
 
 @dataclass(frozen=True)

@@ -21,13 +21,13 @@ from typing import Literal
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 __all__ = [
-    "Mount",
-    "LidarConfig",
-    "RadarConfig",
-    "CameraConfig",
-    "TopViewConfig",
-    "RigConfig",
     "RIG_PRESETS",
+    "CameraConfig",
+    "LidarConfig",
+    "Mount",
+    "RadarConfig",
+    "RigConfig",
+    "TopViewConfig",
     "default_cameras",
 ]
 
@@ -289,7 +289,9 @@ class RigConfig(_Model):
     def mounts(self) -> list[tuple[str, Mount]]:
         """``(field path within the rig, mount)`` of every sensor the rig has: ``lidar.mount``, ``radar.mount``,
         ``cameras[i].mount`` (the top view sits above the USV and has no mount)."""
-        out = [(f"{name}.mount", s.mount) for name, s in (("lidar", self.lidar), ("radar", self.radar)) if s is not None]
+        out = [
+            (f"{name}.mount", s.mount) for name, s in (("lidar", self.lidar), ("radar", self.radar)) if s is not None
+        ]
         return out + [(f"cameras[{i}].mount", c.mount) for i, c in enumerate(self.cameras)]
 
     @model_validator(mode="after")

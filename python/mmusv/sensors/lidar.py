@@ -8,6 +8,7 @@ model.
 from __future__ import annotations
 
 from dataclasses import dataclass
+
 import numpy as np
 import numpy.typing as npt
 
@@ -69,6 +70,12 @@ def scan(lidar: core.Lidar, scene: Scene, *, pose: npt.ArrayLike, env: core.Sens
     p = np.ascontiguousarray(pose, dtype=np.float64).reshape(4, 4)
     d = lidar.scan(scene.native, pose=p, env=env, seed=int(seed))
     return LidarPoints(
-        xyz=d["xyz"], range=d["range"], intensity=d["intensity"], ring=d["ring"], azimuth=d["azimuth"],
-        semantic_class=d["class"], instance=d["instance"], ray_index=d["ray_index"],
+        xyz=d["xyz"],
+        range=d["range"],
+        intensity=d["intensity"],
+        ring=d["ring"],
+        azimuth=d["azimuth"],
+        semantic_class=d["class"],
+        instance=d["instance"],
+        ray_index=d["ray_index"],
     )

@@ -40,7 +40,7 @@ from mmusv.errors import InputError
 from mmusv.scene import Scene, _pose
 from mmusv.sensors.config import RadarConfig
 
-__all__ = ["RadarReturns", "Orientation", "radar_from_config", "radar_sweep", "ppi_image", "ppi_colormap", "ppi_png"]
+__all__ = ["Orientation", "RadarReturns", "ppi_colormap", "ppi_image", "ppi_png", "radar_from_config", "radar_sweep"]
 
 Orientation = Literal["north_up", "head_up"]
 """Which way is up in a PPI: world north, or the sensor's forward axis."""

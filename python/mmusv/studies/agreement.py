@@ -34,7 +34,7 @@ from mmusv.config import load_scenario
 from mmusv.frames import translation
 from mmusv.simulation import Simulation
 
-__all__ = ["AgreementStudy", "run_agreement_study", "sample_agreement", "BUNDLED_SCENARIOS"]
+__all__ = ["BUNDLED_SCENARIOS", "AgreementStudy", "run_agreement_study", "sample_agreement"]
 
 BUNDLED_SCENARIOS = ("scenarios/island_occlusion.yaml", "scenarios/open_sea_convoy.yaml", "scenarios/port_entry.yaml")
 _VESSEL_CLASSES = (10, 11)
@@ -80,7 +80,11 @@ def sample_agreement(
     if np.count_nonzero(owners == instance_id) < owners.size:
         return None  # merged with another vessel, or not this vessel at all
     px = np.stack([cols + 0.5, rows + 0.5], axis=1)
-    contained = float(np.mean(shapely.contains_xy(hull, px[:, 0], px[:, 1]) | shapely.intersects_xy(hull.boundary, px[:, 0], px[:, 1])))
+    contained = float(
+        np.mean(
+            shapely.contains_xy(hull, px[:, 0], px[:, 1]) | shapely.intersects_xy(hull.boundary, px[:, 0], px[:, 1])
+        )
+    )
     centre_body = inv[:3, :3] @ box_matrix[:3, 3] + inv[:3, 3]
     centre_uv = np.array([w / 2.0 - centre_body[1] / metres_per_pixel, h / 2.0 - centre_body[2] / metres_per_pixel])
     # The box's forward and port axes in the image plane.
@@ -120,7 +124,9 @@ class AgreementStudy:
         return paths
 
 
-def run_agreement_study(scenarios: list[str] | tuple[str, ...] = BUNDLED_SCENARIOS, *, frames: int | None = None, stride: int = 1) -> AgreementStudy:
+def run_agreement_study(
+    scenarios: list[str] | tuple[str, ...] = BUNDLED_SCENARIOS, *, frames: int | None = None, stride: int = 1
+) -> AgreementStudy:
     """Runs the top-view cameras of every USV over ``frames`` frames (default: the scenario's) of each scenario
     and evaluates every other vessel (see the module docstring)."""
     rows: list[dict[str, object]] = []
@@ -141,12 +147,25 @@ def run_agreement_study(scenarios: list[str] | tuple[str, ...] = BUNDLED_SCENARI
                         continue
                     box = state.matrices[vi] @ translation(info.box_center_body)
                     r = sample_agreement(
-                        semantic=ac.top_view.semantic, instance=ac.top_view.instance, camera_pose=ac.top_view_pose,
-                        metres_per_pixel=tv.metres_per_pixel, box_matrix=box, box_size=info.box_size,
+                        semantic=ac.top_view.semantic,
+                        instance=ac.top_view.instance,
+                        camera_pose=ac.top_view_pose,
+                        metres_per_pixel=tv.metres_per_pixel,
+                        box_matrix=box,
+                        box_size=info.box_size,
                         instance_id=info.instance_id,
                     )
                     if r is not None:
-                        rows.append({"map": sc.map.type, "scenario": sc.name, "frame": k, "agent": agent.id, "target": info.id, **r})
+                        rows.append(
+                            {
+                                "map": sc.map.type,
+                                "scenario": sc.name,
+                                "frame": k,
+                                "agent": agent.id,
+                                "target": info.id,
+                                **r,
+                            }
+                        )
     samples = pl.DataFrame(rows) if rows else pl.DataFrame(schema={"map": pl.String, "centre_error_px": pl.Float64})
     if samples.height == 0:
         summary = pl.DataFrame(schema={"map": pl.String, "valid_samples": pl.UInt32})

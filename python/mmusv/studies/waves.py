@@ -94,9 +94,13 @@ def _plot(study: WaveStudy, path: Path) -> None:
 
     t = study.table
     fig, axes = plt.subplots(1, 3, figsize=(11, 3.2), constrained_layout=True)
-    for ax, (col, label) in zip(axes, [("heave_rms_m", "heave RMS (m)"), ("roll_rms_deg", "roll RMS (°)"), ("pitch_rms_deg", "pitch RMS (°)")]):
+    for ax, (col, label) in zip(
+        axes,
+        [("heave_rms_m", "heave RMS (m)"), ("roll_rms_deg", "roll RMS (°)"), ("pitch_rms_deg", "pitch RMS (°)")],
+        strict=False,
+    ):
         ax.plot(t["H_m"], t[col], "o-")
-        for name, x, y in zip(t["wave"], t["H_m"], t[col]):
+        for name, x, y in zip(t["wave"], t["H_m"], t[col], strict=False):
             ax.annotate(str(name), (x, y), textcoords="offset points", xytext=(4, -10), fontsize=8)
         ax.set_xlabel("wave height H (m)")
         ax.set_ylabel(label)

@@ -23,7 +23,7 @@ from typing import Literal
 from mmusv._native import core
 from mmusv.errors import ConfigError
 
-__all__ = ["WAVE_PRESETS", "Sun", "Weather", "Environment", "wave_height_m", "sun_at"]
+__all__ = ["WAVE_PRESETS", "Environment", "Sun", "Weather", "sun_at", "wave_height_m"]
 
 WAVE_PRESETS: dict[str, float] = dict(core.wave_presets())
 """Significant wave height H in metres of each preset (paper, Table I), in order W0..W3: read from the core
@@ -67,7 +67,7 @@ class Sun:
 def _parse_time(text: str) -> float:
     m = _TIME_RE.match(text.strip())
     if not m or int(m.group(1)) > 23 or int(m.group(2)) > 59:
-        raise ConfigError(f"invalid config environment.time_of_day = {text!r}: use 24-hour \"HH:MM\", e.g. \"16:30\"")
+        raise ConfigError(f'invalid config environment.time_of_day = {text!r}: use 24-hour "HH:MM", e.g. "16:30"')
     return int(m.group(1)) + int(m.group(2)) / 60.0
 
 
@@ -92,7 +92,7 @@ def sun_at(time_of_day: str, *, latitude_deg: float = 45.0, day_of_year: int = 1
     up = max(0.0, math.sin(el))
     warm = 1.0 - min(1.0, up / 0.35)  # 1 at the horizon, 0 above ~20°
     color = (1.0, 1.0 - 0.35 * warm, 1.0 - 0.65 * warm)
-    intensity = up ** 0.6 if el > 0 else 0.0
+    intensity = up**0.6 if el > 0 else 0.0
     ambient = 0.08 + 0.5 * (max(0.0, sin_el + 0.1) / 1.1) ** 0.5
     return Sun(direction, math.degrees(el), math.degrees(az), color, intensity, min(1.0, ambient))
 
@@ -113,12 +113,21 @@ class Weather:
         return 3.0 / self.visibility_m
 
     @classmethod
-    def make(cls, kind: str = "clear", *, visibility_m: float | None = None, rain_mm_per_h: float | None = None) -> Weather:
+    def make(
+        cls, kind: str = "clear", *, visibility_m: float | None = None, rain_mm_per_h: float | None = None
+    ) -> Weather:
         """Weather of ``kind`` with sensible defaults (clear 20 km visibility, overcast 10 km, fog 500 m,
         rain 4 mm/h with 5 km)."""
         if kind not in _WEATHER:
-            raise ConfigError(f"invalid config environment.weather = {kind!r}: allowed values are {', '.join(_WEATHER)}")
-        defaults = {"clear": (20000.0, 0.0, 0.1), "overcast": (10000.0, 0.0, 0.9), "fog": (500.0, 0.0, 1.0), "rain": (5000.0, 4.0, 1.0)}
+            raise ConfigError(
+                f"invalid config environment.weather = {kind!r}: allowed values are {', '.join(_WEATHER)}"
+            )
+        defaults = {
+            "clear": (20000.0, 0.0, 0.1),
+            "overcast": (10000.0, 0.0, 0.9),
+            "fog": (500.0, 0.0, 1.0),
+            "rain": (5000.0, 4.0, 1.0),
+        }
         vis, rain, cloud = defaults[kind]
         vis = vis if visibility_m is None else float(visibility_m)
         rain = rain if rain_mm_per_h is None else float(rain_mm_per_h)

@@ -18,15 +18,15 @@ from pydantic import BaseModel, ConfigDict, Field, StrictBool, ValidationError, 
 from mmusv.errors import ConfigError
 
 __all__ = [
-    "MAP_KINDS",
     "COAST_SIDES",
     "DEFAULT_MOORED_ASSETS",
-    "MapConfigError",
+    "MAP_KINDS",
+    "PARAM_MODELS",
     "IslandParams",
+    "MapConfigError",
+    "MapParams",
     "OpenSeaParams",
     "PortParams",
-    "MapParams",
-    "PARAM_MODELS",
     "make_params",
 ]
 

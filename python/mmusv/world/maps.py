@@ -40,19 +40,19 @@ from mmusv.world.terrain import FaceClassifier, FractalNoise, Heightfield, Islan
 __all__ = [
     "MAP_KINDS",
     "TERRAIN_MESH_MIN_Z",
-    "MapConfigError",
     "IslandParams",
+    "MapConfigError",
+    "MapParams",
+    "MapPriors",
+    "MapWorld",
     "OpenSeaParams",
     "PortParams",
-    "MapParams",
-    "MapWorld",
-    "MapPriors",
-    "make_params",
+    "generate_island",
     "generate_map",
     "generate_map_from",
-    "generate_island",
     "generate_open_sea",
     "generate_port",
+    "make_params",
 ]
 
 TERRAIN_MESH_MIN_Z = -2.0
@@ -96,7 +96,7 @@ class MapWorld:
 
 
 def _grid(extent: float, target: float) -> tuple[float, np.ndarray]:
-    n = max(int(round(extent / target)), 1)
+    n = max(round(extent / target), 1)
     s = extent / n
     return s, -extent / 2.0 + np.arange(n + 1) * s
 

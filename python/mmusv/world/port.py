@@ -22,7 +22,7 @@ from mmusv.world.primitives import TriMesh, box, cylinder, merge, transformed
 if TYPE_CHECKING:
     from mmusv.world.map_params import PortParams
 
-__all__ = ["PortPlan", "Berth", "plan_port", "port_terrain", "port_structures", "buoy_mesh", "tapered_wall"]
+__all__ = ["Berth", "PortPlan", "buoy_mesh", "plan_port", "port_structures", "port_terrain", "tapered_wall"]
 
 Ground = Callable[[np.ndarray], np.ndarray]
 """Terrain height (metres) at canonical points ``(N, 2)`` -> ``(N,)``."""

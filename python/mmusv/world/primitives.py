@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["TriMesh", "merge", "box", "cylinder", "prism", "transformed", "rotation_z"]
+__all__ = ["TriMesh", "box", "cylinder", "merge", "prism", "rotation_z", "transformed"]
 
 
 @dataclass(frozen=True)
@@ -52,7 +52,7 @@ def merge(parts: list[TriMesh]) -> TriMesh:
     offsets = np.cumsum([0] + [p.vertices.shape[0] for p in parts[:-1]])
     return TriMesh(
         vertices=np.concatenate([p.vertices for p in parts]),
-        faces=np.concatenate([p.faces + o for p, o in zip(parts, offsets)]),
+        faces=np.concatenate([p.faces + o for p, o in zip(parts, offsets, strict=False)]),
         classes=np.concatenate([p.classes for p in parts]),
     )
 
@@ -63,7 +63,12 @@ def rotation_z(yaw: float) -> np.ndarray:
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
-def transformed(mesh: TriMesh, *, rotation: np.ndarray | None = None, translation: tuple[float, float, float] | np.ndarray = (0.0, 0.0, 0.0)) -> TriMesh:
+def transformed(
+    mesh: TriMesh,
+    *,
+    rotation: np.ndarray | None = None,
+    translation: tuple[float, float, float] | np.ndarray = (0.0, 0.0, 0.0),
+) -> TriMesh:
     """``mesh`` with vertices mapped by ``rotation @ v + translation`` (rotation ``(3, 3)``, proper)."""
     r = np.eye(3) if rotation is None else np.asarray(rotation, dtype=np.float64)
     v = mesh.vertices @ r.T + np.asarray(translation, dtype=np.float64)
@@ -71,19 +76,40 @@ def transformed(mesh: TriMesh, *, rotation: np.ndarray | None = None, translatio
 
 
 _BOX_FACES = np.array(
-    [[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4],
-     [1, 2, 6], [1, 6, 5], [2, 3, 7], [2, 7, 6], [3, 0, 4], [3, 4, 7]],
+    [
+        [0, 2, 1],
+        [0, 3, 2],
+        [4, 5, 6],
+        [4, 6, 7],
+        [0, 1, 5],
+        [0, 5, 4],
+        [1, 2, 6],
+        [1, 6, 5],
+        [2, 3, 7],
+        [2, 7, 6],
+        [3, 0, 4],
+        [3, 4, 7],
+    ],
     dtype=np.int64,
 )
 
 
-def box(*, center: tuple[float, float, float] | np.ndarray, size: tuple[float, float, float] | np.ndarray, cls: int, yaw: float = 0.0) -> TriMesh:
+def box(
+    *,
+    center: tuple[float, float, float] | np.ndarray,
+    size: tuple[float, float, float] | np.ndarray,
+    cls: int,
+    yaw: float = 0.0,
+) -> TriMesh:
     """Axis-aligned box of full ``size`` (x, y, z metres) at ``center``, rotated by ``yaw`` about its centre."""
     h = np.asarray(size, dtype=np.float64) / 2.0
-    corners = np.array(
-        [[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1], [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]],
-        dtype=np.float64,
-    ) * h
+    corners = (
+        np.array(
+            [[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1], [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]],
+            dtype=np.float64,
+        )
+        * h
+    )
     return transformed(TriMesh(corners, _BOX_FACES, np.array([cls])), rotation=rotation_z(yaw), translation=center)
 
 
@@ -110,7 +136,15 @@ def prism(*, outline: np.ndarray, z0: float, z1: float, cls: int, top_scale: flo
     return TriMesh(verts, np.vstack([sides, bottom, topf]), np.array([cls]))
 
 
-def cylinder(*, center: tuple[float, float, float] | np.ndarray, radius: float, height: float, cls: int, segments: int = 12, top_radius: float | None = None) -> TriMesh:
+def cylinder(
+    *,
+    center: tuple[float, float, float] | np.ndarray,
+    radius: float,
+    height: float,
+    cls: int,
+    segments: int = 12,
+    top_radius: float | None = None,
+) -> TriMesh:
     """Vertical cylinder (or cone frustum when ``top_radius`` differs) standing on ``center`` (its base centre)."""
     a = np.linspace(0.0, 2 * np.pi, segments, endpoint=False)
     outline = np.column_stack([np.cos(a), np.sin(a)]) * radius + np.asarray(center, dtype=np.float64)[:2]

@@ -132,10 +132,7 @@ class MapPriors:
         Eligible cells are :attr:`valid_zones` when ``min_clearance`` is None, otherwise water cells with
         ``shore_distance >= min_clearance``. Raises ``ValueError`` when no cell is eligible.
         """
-        if min_clearance is None:
-            ok = self.valid_zones
-        else:
-            ok = self.water_mask & (self.shore_distance >= min_clearance)
+        ok = self.valid_zones if min_clearance is None else self.water_mask & (self.shore_distance >= min_clearance)
         flat = np.flatnonzero(ok)
         if flat.size == 0:
             raise ValueError(
@@ -205,7 +202,7 @@ def build_priors(
     ``structures`` are rigid parts (each a TriMesh, buoys included) whose convex footprints are obstacles;
     ``buoys`` ``(B, 2)`` their positions; the raster has ``round(extent_m / resolution_m)`` cells a side.
     """
-    n = max(int(round(extent_m / resolution_m)), 1)
+    n = max(round(extent_m / resolution_m), 1)
     res = extent_m / n
     origin = (-extent_m / 2.0, -extent_m / 2.0)
     shape = (n, n)

@@ -22,11 +22,11 @@ from mmusv.world.primitives import TriMesh
 
 __all__ = [
     "FaceClassifier",
-    "ValueNoise",
     "FractalNoise",
-    "fbm",
     "Heightfield",
     "IslandSpec",
+    "ValueNoise",
+    "fbm",
     "island_heights",
     "polygons_of",
 ]
@@ -223,7 +223,7 @@ class Heightfield:
 
         def pool(a: np.ndarray, lo: np.ndarray, hi: np.ndarray, axis: int) -> np.ndarray:
             width = int((hi - lo).max()) + 1 if lo.size else 1
-            out = np.full(a.shape[:axis] + (lo.size,) + a.shape[axis + 1 :], -np.inf)
+            out = np.full((*a.shape[:axis], lo.size, *a.shape[axis + 1 :]), -np.inf)
             for o in range(width):
                 idx = np.minimum(lo + o, hi)
                 out = np.maximum(out, np.take(a, idx, axis=axis))

@@ -44,6 +44,7 @@ overlap (the union is what sensors see).
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
@@ -53,7 +54,7 @@ import numpy as np
 from mmusv.errors import ConfigError
 from mmusv.world.primitives import TriMesh, box, merge, prism, transformed
 
-__all__ = ["AssetSpecError", "Fields", "HullSpec", "build_procedural", "parse_hull", "PART_TYPES"]
+__all__ = ["PART_TYPES", "AssetSpecError", "Fields", "HullSpec", "build_procedural", "parse_hull"]
 
 
 class AssetSpecError(ConfigError, ValueError):
@@ -112,8 +113,15 @@ class Fields:
             raise AssetSpecError(self.at(key), f"must be <= {maximum}, got {f}")
         return f
 
-    def num(self, key: str, default: float | None = None, *, minimum: float | None = None,
-            maximum: float | None = None, exclusive: bool = False) -> float:
+    def num(
+        self,
+        key: str,
+        default: float | None = None,
+        *,
+        minimum: float | None = None,
+        maximum: float | None = None,
+        exclusive: bool = False,
+    ) -> float:
         """A number; required when ``default`` is ``None``. ``exclusive`` makes ``minimum`` a strict bound."""
         v = self.raw(key)
         if v is None:
@@ -122,8 +130,9 @@ class Fields:
             return default
         return self._check(key, _number(v, self.at(key)), minimum, maximum, exclusive)
 
-    def opt_num(self, key: str, *, minimum: float | None = None, maximum: float | None = None,
-                exclusive: bool = False) -> float | None:
+    def opt_num(
+        self, key: str, *, minimum: float | None = None, maximum: float | None = None, exclusive: bool = False
+    ) -> float | None:
         """An optional number (``None`` when absent)."""
         v = self.raw(key)
         if v is None:
@@ -256,8 +265,12 @@ class HullSpec:
         """The closed hull mesh (one lofted body, or two demihulls), labelled ``cls``."""
         if self.kind == "twin":
             off = (self.beam - self.demi_beam) / 2.0
-            return merge([self._loft(y0=-off, half=self.demi_beam / 2.0, cls=cls),
-                          self._loft(y0=off, half=self.demi_beam / 2.0, cls=cls)])
+            return merge(
+                [
+                    self._loft(y0=-off, half=self.demi_beam / 2.0, cls=cls),
+                    self._loft(y0=off, half=self.demi_beam / 2.0, cls=cls),
+                ]
+            )
         return self._loft(y0=0.0, half=self.beam / 2.0, cls=cls)
 
     def _loft(self, *, y0: float, half: float, cls: int) -> TriMesh:
@@ -266,8 +279,12 @@ class HullSpec:
         w = self.profile(u)
         tip = bool(w[-1] < 1e-9)
         length, draft = self.length, self.draft
-        levels = [(-draft, self.bottom), (-0.5 * draft, self.bottom + 0.9 * (self.flare - self.bottom)),
-                  (0.0, self.flare), (self.freeboard, 1.0)]
+        levels = [
+            (-draft, self.bottom),
+            (-0.5 * draft, self.bottom + 0.9 * (self.flare - self.bottom)),
+            (0.0, self.flare),
+            (self.freeboard, 1.0),
+        ]
         rings = []
         for k, (z, scale) in enumerate(levels):
             s = (z + draft) / self.depth
@@ -331,11 +348,23 @@ def parse_hull(data: object, *, path: str) -> HullSpec:
     rake = f.num("rake", 0.05, minimum=0.0, maximum=0.45)
     overhang = f.num("overhang", 0.0, minimum=0.0, maximum=0.45)
     spec = HullSpec(
-        kind=kind, length=length, beam=beam, draft=draft, depth=depth, demi_beam=demi, bow=bow, stern=stern,
+        kind=kind,
+        length=length,
+        beam=beam,
+        draft=draft,
+        depth=depth,
+        demi_beam=demi,
+        bow=bow,
+        stern=stern,
         bow_power=f.num("bow_power", 2.0, minimum=1.0, maximum=8.0),
         bow_shape=f.text("bow_shape", "pointed", choices=("pointed", "round")),
-        bow_width=bow_width, transom=transom, sheer=f.num("sheer", 0.0, minimum=0.0), rake=rake, overhang=overhang,
-        bottom=f.num("bottom", 0.8, minimum=0.02, maximum=1.0), flare=f.num("flare", 1.0, minimum=0.02, maximum=1.0),
+        bow_width=bow_width,
+        transom=transom,
+        sheer=f.num("sheer", 0.0, minimum=0.0),
+        rake=rake,
+        overhang=overhang,
+        bottom=f.num("bottom", 0.8, minimum=0.02, maximum=1.0),
+        flare=f.num("flare", 1.0, minimum=0.02, maximum=1.0),
     )
     f.finish()
     return spec
@@ -343,8 +372,10 @@ def parse_hull(data: object, *, path: str) -> HullSpec:
 
 # ---------------------------------------------------------------------------------------------- part helpers
 
-def _block(*, x: float, y: float, lx: float, ly: float, z0: float, z1: float, cls: int, taper: float = 1.0,
-           yaw: float = 0.0) -> TriMesh:
+
+def _block(
+    *, x: float, y: float, lx: float, ly: float, z0: float, z1: float, cls: int, taper: float = 1.0, yaw: float = 0.0
+) -> TriMesh:
     if taper == 1.0:
         return box(center=(x, y, (z0 + z1) / 2.0), size=(lx, ly, z1 - z0), cls=cls, yaw=yaw)
     c, s = math.cos(yaw), math.sin(yaw)
@@ -393,7 +424,7 @@ def _lathe(profile: Sequence[tuple[float, float]], *, cx: float, cy: float, segm
         verts.append(np.array([[cx, cy, profile[-1][1]]]))
         faces.append(np.column_stack([np.full(segments, count), s1 + i, s1 + j]))
         count += 1
-    for (lo, lo_pole), (hi, hi_pole) in zip(starts[:-1], starts[1:]):
+    for (lo, lo_pole), (hi, hi_pole) in itertools.pairwise(starts):
         if lo_pole:
             faces.append(np.column_stack([np.full(segments, lo), hi + j, hi + i]))
         elif hi_pole:
@@ -404,8 +435,8 @@ def _lathe(profile: Sequence[tuple[float, float]], *, cx: float, cy: float, segm
     return TriMesh(np.vstack(verts), np.vstack(faces), np.array([cls]))
 
 
-_ROT_X90 = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])   # (x, y, z) -> (x, -z, y)
-_ROT_Y90 = np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]])   # (x, y, z) -> (z, y, -x)
+_ROT_X90 = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])  # (x, y, z) -> (x, -z, y)
+_ROT_Y90 = np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]])  # (x, y, z) -> (z, y, -x)
 
 
 def _zspan(f: Fields, hull: HullSpec, x: float) -> tuple[float, float]:
@@ -438,8 +469,7 @@ def _part_box(f: Fields, hull: HullSpec, cls: int) -> TriMesh:
     z0, z1 = _zspan(f, hull, x)
     ly = _fit_width(f, hull, x0=x - lx / 2, x1=x + lx / 2, y=y, width=ly)
     taper = f.num("taper", 1.0, minimum=0.0, exclusive=True)
-    return _block(x=x, y=y, lx=lx, ly=ly, z0=z0, z1=z1, cls=cls, taper=taper,
-                  yaw=math.radians(f.num("yaw_deg", 0.0)))
+    return _block(x=x, y=y, lx=lx, ly=ly, z0=z0, z1=z1, cls=cls, taper=taper, yaw=math.radians(f.num("yaw_deg", 0.0)))
 
 
 def _part_house(f: Fields, hull: HullSpec, cls: int) -> TriMesh:
@@ -606,8 +636,9 @@ def _part_gantry(f: Fields, hull: HullSpec, cls: int) -> TriMesh:
     parts = []
     for side in (-1.0, 1.0):
         yy = side * span / 2.0
-        parts.append(_strut(np.array([x, yy, z0]), np.array([x + lean, yy, z1 - leg / 2.0]), width=leg,
-                            thickness=leg, cls=cls))
+        parts.append(
+            _strut(np.array([x, yy, z0]), np.array([x + lean, yy, z1 - leg / 2.0]), width=leg, thickness=leg, cls=cls)
+        )
     parts.append(_block(x=x + lean, y=0.0, lx=leg, ly=span + leg, z0=z1 - leg, z1=z1, cls=cls))
     return merge(parts)
 
@@ -626,8 +657,13 @@ def _part_crane(f: Fields, hull: HullSpec, cls: int) -> TriMesh:
     e, a = math.radians(elev), math.radians(yaw)
     p0 = np.array([x, y, top + 0.6 * r])
     p1 = p0 + jl * np.array([math.cos(e) * math.cos(a), math.cos(e) * math.sin(a), math.sin(e)])
-    return merge([_lathe([(r, z0), (r, top)], cx=x, cy=y, segments=10, cls=cls), cab,
-                  _strut(p0, p1, width=w, thickness=w, cls=cls)])
+    return merge(
+        [
+            _lathe([(r, z0), (r, top)], cx=x, cy=y, segments=10, cls=cls),
+            cab,
+            _strut(p0, p1, width=w, thickness=w, cls=cls),
+        ]
+    )
 
 
 def _part_gun(f: Fields, hull: HullSpec, cls: int) -> TriMesh:
@@ -641,17 +677,31 @@ def _part_gun(f: Fields, hull: HullSpec, cls: int) -> TriMesh:
     d = np.array([math.cos(e) * math.cos(a), math.cos(e) * math.sin(a), math.sin(e)])
     p0 = np.array([x, y, z0 + 0.55 * h])
     turret = _lathe([(r, z0), (0.75 * r, z0 + h)], cx=x, cy=y, segments=10, cls=cls)
-    return merge([turret, _strut(p0 + 0.5 * r * d, p0 + (r + barrel) * d, width=0.12 * r + 0.05,
-                                 thickness=0.12 * r + 0.05, cls=cls)])
+    return merge(
+        [
+            turret,
+            _strut(p0 + 0.5 * r * d, p0 + (r + barrel) * d, width=0.12 * r + 0.05, thickness=0.12 * r + 0.05, cls=cls),
+        ]
+    )
 
 
 PartBuilder = Callable[[Fields, HullSpec, int], TriMesh]
 
 PART_TYPES: dict[str, PartBuilder] = {
-    "box": _part_box, "house": _part_house, "hull_block": _part_hull_block, "row": _part_row,
-    "funnel": _part_funnel, "mast": _part_mast, "cylinder": _part_cylinder, "hcylinder": _part_hcylinder,
-    "dome": _part_dome, "strut": _part_strut, "plate": _part_plate, "gantry": _part_gantry,
-    "crane": _part_crane, "gun": _part_gun,
+    "box": _part_box,
+    "house": _part_house,
+    "hull_block": _part_hull_block,
+    "row": _part_row,
+    "funnel": _part_funnel,
+    "mast": _part_mast,
+    "cylinder": _part_cylinder,
+    "hcylinder": _part_hcylinder,
+    "dome": _part_dome,
+    "strut": _part_strut,
+    "plate": _part_plate,
+    "gantry": _part_gantry,
+    "crane": _part_crane,
+    "gun": _part_gun,
 }
 """Part type name -> builder ``(fields, hull, class_id) -> TriMesh``."""
 

@@ -89,10 +89,10 @@ class UnknownAssetError(NotFoundError, KeyError):
     def __init__(self, name: str, known: Sequence[str]) -> None:
         self.name = name
         self.suggestions = _suggest(name, known)
-        hint = (f"did you mean {', '.join(repr(s) for s in self.suggestions)}?" if self.suggestions
-                else "no close match")
-        self.message = (f"unknown vessel asset {name!r}; {hint} "
-                        f"(mmusv.world.vessels.asset_names() lists all {len(known)} assets)")
+        hint = f"did you mean {', '.join(repr(s) for s in self.suggestions)}?" if self.suggestions else "no close match"
+        self.message = (
+            f"unknown vessel asset {name!r}; {hint} (mmusv.world.vessels.asset_names() lists all {len(known)} assets)"
+        )
         super().__init__(self.message)
 
     def __str__(self) -> str:
@@ -169,8 +169,9 @@ class VesselAsset:
         if np.any(np.abs(centre) > 1e-6 * max(1.0, float(ext.max()))):
             raise AssetSpecError(f"{self.name}.mesh", f"x/y bounding box centre is {centre.tolist()}, not the origin")
         if not lo[2] < 0.0 < hi[2]:
-            raise AssetSpecError(f"{self.name}.mesh",
-                                 f"mesh spans z [{lo[2]:g}, {hi[2]:g}] m; it must cross the waterline z = 0")
+            raise AssetSpecError(
+                f"{self.name}.mesh", f"mesh spans z [{lo[2]:g}, {hi[2]:g}] m; it must cross the waterline z = 0"
+            )
         bbox = np.stack([lo, hi])
         bbox.setflags(write=False)
         mounts = {str(k): _as_mount(m, f"{self.name}.mounts.{k}") for k, m in dict(self.mounts).items()}
@@ -361,7 +362,7 @@ def _mounts(f: Fields) -> dict[str, MountPoint]:
         return {}
     mf = Fields(raw, f.at("mounts"))
     out = {}
-    for key in mf.keys():
+    for key in mf.keys():  # noqa: SIM118 (Fields is not a dict)
         m = Fields(mf.raw(key), mf.at(key))
         xyz = m.vec("xyz", 3)
         rpy = m.vec("rpy_deg", 3, (0.0, 0.0, 0.0))
@@ -395,10 +396,19 @@ def _build_entry(entry: object, *, base_dir: Path | None, source: str, builtin: 
     if np.any(np.abs(shift) > 1e-9 * max(1.0, float((b[1] - b[0]).max()))):
         mesh = TriMesh(mesh.vertices - shift, mesh.faces, mesh.classes)
         if has_hull:
-            mounts = {k: MountPoint((m.xyz[0] - shift[0], m.xyz[1] - shift[1], m.xyz[2]), m.rpy_deg)
-                      for k, m in mounts.items()}
-    return VesselAsset(name=name, category=category, semantic_class=cls, mesh=mesh, mounts=mounts,
-                       description=description, source=source)
+            mounts = {
+                k: MountPoint((m.xyz[0] - shift[0], m.xyz[1] - shift[1], m.xyz[2]), m.rpy_deg)
+                for k, m in mounts.items()
+            }
+    return VesselAsset(
+        name=name,
+        category=category,
+        semantic_class=cls,
+        mesh=mesh,
+        mounts=mounts,
+        description=description,
+        source=source,
+    )
 
 
 def _mesh_entry(f: Fields, *, base_dir: Path | None, cls: int) -> TriMesh:
@@ -416,7 +426,7 @@ def _mesh_entry(f: Fields, *, base_dir: Path | None, cls: int) -> TriMesh:
         raise AssetSpecError(f.at("draft"), "give either waterline_z or draft, not both")
     f.finish()
     v, fc = _load_mesh_file(mesh_path, f.at("mesh"))
-    rot = np.stack([fwd, np.cross(up, fwd), up])          # rows: body x, y, z in file coordinates
+    rot = np.stack([fwd, np.cross(up, fwd), up])  # rows: body x, y, z in file coordinates
     body = (v @ rot.T) * scale
     zmin, zmax = float(body[:, 2].min()), float(body[:, 2].max())
     if draft is not None:
@@ -429,13 +439,18 @@ def _mesh_entry(f: Fields, *, base_dir: Path | None, cls: int) -> TriMesh:
             raise AssetSpecError(
                 f.at("waterline_z"),
                 f"waterline {wl:g} m must lie inside the mesh's vertical extent [{zmin:g}, {zmax:g}] m "
-                "(after scaling; check up_axis and scale)")
+                "(after scaling; check up_axis and scale)",
+            )
         body[:, 2] -= wl
     return TriMesh(body, fc, np.array([cls]))
 
 
-def load_asset_file(entry: Mapping[str, Any] | str | os.PathLike[str], *,
-                    base_dir: str | os.PathLike[str] | None = None, register: bool = False) -> VesselAsset:
+def load_asset_file(
+    entry: Mapping[str, Any] | str | os.PathLike[str],
+    *,
+    base_dir: str | os.PathLike[str] | None = None,
+    register: bool = False,
+) -> VesselAsset:
     """Builds one user asset from a mapping or a YAML file holding one mapping.
 
     Mesh entry keys: ``name`` (required), ``category`` ("custom"), ``description``, ``semantic_class``
@@ -458,8 +473,9 @@ def load_asset_file(entry: Mapping[str, Any] | str | os.PathLike[str], *,
         path = Path(os.fspath(entry)).expanduser()
         data = _read_yaml(path)
         if not isinstance(data, Mapping) or "vessels" in data:
-            raise AssetSpecError("file", f"{str(path)!r} must hold one asset mapping; use load_asset_catalog() "
-                                         "for a list of assets")
+            raise AssetSpecError(
+                "file", f"{str(path)!r} must hold one asset mapping; use load_asset_catalog() for a list of assets"
+            )
         base = Path(base_dir) if base_dir is not None else path.parent
         source = str(path)
     asset = _build_entry(data, base_dir=base, source=source)

@@ -16,9 +16,11 @@ from typing import Any
 
 __all__ = ["add_parsers", "run"]
 
-_BOXES_HELP = ("Parquet columns: sequence, frame, ego, [setting], mode, kind (det|gt), x, y, z, l, w, h, yaw "
-               "(ego LiDAR frame, m, rad), score, range_bin, matched (at IoU 0.5), ego_points, neighbour_points (gt: "
-               "LiDAR points inside from the ego / the other USVs)")
+_BOXES_HELP = (
+    "Parquet columns: sequence, frame, ego, [setting], mode, kind (det|gt), x, y, z, l, w, h, yaw "
+    "(ego LiDAR frame, m, rad), score, range_bin, matched (at IoU 0.5), ego_points, neighbour_points (gt: "
+    "LiDAR points inside from the ego / the other USVs)"
+)
 
 
 def _common(p: argparse.ArgumentParser, default_out: str) -> None:
@@ -26,33 +28,62 @@ def _common(p: argparse.ArgumentParser, default_out: str) -> None:
 
     p.add_argument("inputs", nargs="*", help="recordings (.mcap) or folders of them")
     p.add_argument("--opv2v", default=None, help="an OPV2V folder written by mmusv convert --to opv2v")
-    p.add_argument("--generate", nargs="?", const=BUNDLED_SPEC, default=None, metavar="SPEC",
-                   help=f"generate SPEC (default {BUNDLED_SPEC}) and record it LiDAR-only into OUT, then evaluate")
-    p.add_argument("--split", default=None, help="train, validate, test or all (default: test with --generate, "
-                   "else all); the split is made by sequence")
-    p.add_argument("--split-ratios", default="0.7,0.15,0.15", help="train,validate,test fractions (default 0.7,0.15,0.15)")
+    p.add_argument(
+        "--generate",
+        nargs="?",
+        const=BUNDLED_SPEC,
+        default=None,
+        metavar="SPEC",
+        help=f"generate SPEC (default {BUNDLED_SPEC}) and record it LiDAR-only into OUT, then evaluate",
+    )
+    p.add_argument(
+        "--split",
+        default=None,
+        help="train, validate, test or all (default: test with --generate, else all); the split is made by sequence",
+    )
+    p.add_argument(
+        "--split-ratios", default="0.7,0.15,0.15", help="train,validate,test fractions (default 0.7,0.15,0.15)"
+    )
     p.add_argument("--seed", type=int, default=0, help="seed of the split and of the pose noise (default 0)")
     p.add_argument("--modes", default="none,late,early", help="fusion modes, from none,late,early (default all)")
-    p.add_argument("--detector", default="baseline",
-                   help="'baseline' (training-free, not the paper's learned model) or package.module:function, a "
-                        "callable (points (N,4) float32 ego LiDAR frame) -> (boxes (M,7) x,y,z,l,w,h,yaw, scores (M,))")
-    p.add_argument("--predictions", default=None, help="a Parquet of detections instead of a detector (layout of "
-                   "the boxes Parquet this command writes, kind=det rows)")
-    p.add_argument("--range", dest="range_m", type=float, default=200.0, help="evaluation range in metres (default 200)")
+    p.add_argument(
+        "--detector",
+        default="baseline",
+        help="'baseline' (training-free, not the paper's learned model) or package.module:function, a "
+        "callable (points (N,4) float32 ego LiDAR frame) -> (boxes (M,7) x,y,z,l,w,h,yaw, scores (M,))",
+    )
+    p.add_argument(
+        "--predictions",
+        default=None,
+        help="a Parquet of detections instead of a detector (layout of "
+        "the boxes Parquet this command writes, kind=det rows)",
+    )
+    p.add_argument(
+        "--range", dest="range_m", type=float, default=200.0, help="evaluation range in metres (default 200)"
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("-o", "--output", default=default_out, help=f"output folder (default {default_out})")
 
 
 def add_parsers(studies: Any) -> None:
     """Adds ``detection`` and ``robustness`` to ``studies`` (the ``study`` command's sub-parsers)."""
-    det = studies.add_parser("detection", help="Table III: no / late / early fusion AP by IoU and range",
-                             description="Cooperative 3D detection benchmark (Table III). " + _BOXES_HELP)
+    det = studies.add_parser(
+        "detection",
+        help="Table III: no / late / early fusion AP by IoU and range",
+        description="Cooperative 3D detection benchmark (Table III). " + _BOXES_HELP,
+    )
     _common(det, "out/detection_study")
-    rob = studies.add_parser("robustness", help="Table IV: AP@0.5 under fixed delay and pose noise",
-                             description="Robustness of late and early fusion (Table IV). " + _BOXES_HELP)
+    rob = studies.add_parser(
+        "robustness",
+        help="Table IV: AP@0.5 under fixed delay and pose noise",
+        description="Robustness of late and early fusion (Table IV). " + _BOXES_HELP,
+    )
     _common(rob, "out/robustness_study")
-    rob.add_argument("--settings", default="delay:1,delay:2,delay:3,noise:0.5/0.5,noise:1/1,noise:2/2",
-                     help="delay:K (frames) and noise:SIGMA_XYZ_M/SIGMA_RPY_DEG items (clean is always included)")
+    rob.add_argument(
+        "--settings",
+        default="delay:1,delay:2,delay:3,noise:0.5/0.5,noise:1/1,noise:2/2",
+        help="delay:K (frames) and noise:SIGMA_XYZ_M/SIGMA_RPY_DEG items (clean is always included)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -86,22 +117,34 @@ def run(args: argparse.Namespace) -> int:
         if inputs or args.opv2v:
             raise InputError("--generate makes its own recordings: give no recordings and no --opv2v with it")
         with _bar(console, "generate + record (LiDAR-only)", args.no_progress) as (bar, task):
-            inputs = generate_dataset(out / "dataset", spec=args.generate,
-                                      progress=lambda name, done, total: bar.update(task, completed=done, total=total)
-                                      if bar is not None else None)
+            inputs = generate_dataset(
+                out / "dataset",
+                spec=args.generate,
+                progress=lambda name, done, total: (
+                    bar.update(task, completed=done, total=total) if bar is not None else None
+                ),
+            )
         console.print(f"dataset: {len(inputs)} recordings in {out / 'dataset'} ({time.perf_counter() - t0:.1f} s)")
     split = args.split or ("test" if args.generate is not None else "all")
-    dataset = resolve_dataset(inputs, opv2v=args.opv2v, split=split, ratios=parse_ratios(args.split_ratios),
-                              seed=args.seed)
-    options = StudyOptions(modes=modes, settings=settings, detector=detector, predictions=predictions,
-                           range_m=args.range_m, seed=args.seed)
+    dataset = resolve_dataset(
+        inputs, opv2v=args.opv2v, split=split, ratios=parse_ratios(args.split_ratios), seed=args.seed
+    )
+    options = StudyOptions(
+        modes=modes, settings=settings, detector=detector, predictions=predictions, range_m=args.range_m, seed=args.seed
+    )
     total = dataset.count_frames()
     t1 = time.perf_counter()
     with _bar(console, f"{args.study} study", args.no_progress) as (bar, task):
-        res = run_study(dataset.sequences(), options=options, total_frames=total,
-                        progress=lambda done, tot: bar.update(task, completed=done, total=tot) if bar is not None else None)
+        res = run_study(
+            dataset.sequences(),
+            options=options,
+            total_frames=total,
+            progress=lambda done, tot: bar.update(task, completed=done, total=tot) if bar is not None else None,
+        )
     if res.ego_frames == 0:
-        raise InputError(f"empty dataset: the {len(dataset.sources)} sequence(s) of split {split!r} hold no frame to evaluate")
+        raise InputError(
+            f"empty dataset: the {len(dataset.sources)} sequence(s) of split {split!r} hold no frame to evaluate"
+        )
     eval_s = time.perf_counter() - t1
     from mmusv.studies.detection import report
 
@@ -113,9 +156,12 @@ def run(args: argparse.Namespace) -> int:
         _print_detection(console, res)
     if detector is not None and args.detector == "baseline":
         console.print(f"[yellow]{BASELINE_NOTE}[/]")
-    console.print(f"split {split}: {len(res.sequences)} sequences, {res.frames} frames, {res.ego_frames} ego-frames, "
-                  f"{res.gt_boxes / max(res.ego_frames, 1):.2f} ground-truth boxes per ego-frame; evaluation "
-                  f"{eval_s:.1f} s, total {time.perf_counter() - t0:.1f} s", highlight=False)
+    console.print(
+        f"split {split}: {len(res.sequences)} sequences, {res.frames} frames, {res.ego_frames} ego-frames, "
+        f"{res.gt_boxes / max(res.ego_frames, 1):.2f} ground-truth boxes per ego-frame; evaluation "
+        f"{eval_s:.1f} s, total {time.perf_counter() - t0:.1f} s",
+        highlight=False,
+    )
     console.print("wrote " + ", ".join(str(p) for p in paths.values()), highlight=False)
     return 0
 
@@ -139,8 +185,15 @@ class _bar:
             TimeRemainingColumn,
         )
 
-        self.progress = Progress(TextColumn(f"[bold]{self.title}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-                                 TimeRemainingColumn(), console=self.console, transient=True)
+        self.progress = Progress(
+            TextColumn(f"[bold]{self.title}"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TimeElapsedColumn(),
+            TimeRemainingColumn(),
+            console=self.console,
+            transient=True,
+        )
         self.progress.__enter__()
         return self.progress, self.progress.add_task(self.title, total=None)
 
@@ -156,19 +209,46 @@ def _print_detection(console: Any, res: Any) -> None:
 
     t = detection_table(res)
     table = Table(title="Cooperative detection (Table III)")
-    heads = ["mode", "AP@0.3", "AP@0.5", "AP@0.7", "P@0.5", "R@0.5", *[f"AP@0.5 {b} m" for b in BINS],
-             "R@0.5 visible", "R@0.5 hidden", "R@0.3 hidden"]
+    heads = [
+        "mode",
+        "AP@0.3",
+        "AP@0.5",
+        "AP@0.7",
+        "P@0.5",
+        "R@0.5",
+        *[f"AP@0.5 {b} m" for b in BINS],
+        "R@0.5 visible",
+        "R@0.5 hidden",
+        "R@0.3 hidden",
+    ]
     for h in heads:
         table.add_column(h, justify="right")
     for r in t.iter_rows(named=True):
-        table.add_row(r["mode"], *[fmt(r[k]) for k in ("ap30", "ap50", "ap70", "precision50", "recall50",
-                                                       *[f"ap50_{b}" for b in BINS], "recall50_visible",
-                                                       "recall50_hidden", "recall30_hidden")])
+        table.add_row(
+            r["mode"],
+            *[
+                fmt(r[k])
+                for k in (
+                    "ap30",
+                    "ap50",
+                    "ap70",
+                    "precision50",
+                    "recall50",
+                    *[f"ap50_{b}" for b in BINS],
+                    "recall50_visible",
+                    "recall50_hidden",
+                    "recall30_hidden",
+                )
+            ],
+        )
     console.print(table)
     r0 = t.row(0, named=True)
-    console.print(f"ground truth: {int(r0['gt'])} boxes: {int(r0['gt_visible'])} visible to the ego, "
-                  f"{int(r0['gt_hidden'])} hidden from it but seen by neighbours, {int(r0['gt_unseen'])} seen by "
-                  "neither (seen = at least 5 LiDAR points inside)", highlight=False)
+    console.print(
+        f"ground truth: {int(r0['gt'])} boxes: {int(r0['gt_visible'])} visible to the ego, "
+        f"{int(r0['gt_hidden'])} hidden from it but seen by neighbours, {int(r0['gt_unseen'])} seen by "
+        "neither (seen = at least 5 LiDAR points inside)",
+        highlight=False,
+    )
 
 
 def _print_robustness(console: Any, res: Any) -> None:

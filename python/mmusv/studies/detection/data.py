@@ -163,12 +163,17 @@ def read_recording(path: str | Path) -> SequenceData:
             afs.append(AgentFrame(a.id, pts.astype(np.float32), pose_matrices(w.poses[a.index]), a.lidar_mount))
         is_usv = np.array([r == "usv" for r in w.roles], dtype=bool)
         boxes = _box_mats(w.poses, w.box_centers)
-        frames.append(SceneFrame(
-            frame=fr.index, agents=tuple(afs),
-            target_ids=tuple(i for i, u in zip(w.ids, is_usv, strict=True) if not u),
-            targets=boxes[~is_usv], target_sizes=w.box_sizes[~is_usv], usv_boxes=boxes[is_usv],
-            usv_sizes=w.box_sizes[is_usv],
-        ))
+        frames.append(
+            SceneFrame(
+                frame=fr.index,
+                agents=tuple(afs),
+                target_ids=tuple(i for i, u in zip(w.ids, is_usv, strict=True) if not u),
+                targets=boxes[~is_usv],
+                target_sizes=w.box_sizes[~is_usv],
+                usv_boxes=boxes[is_usv],
+                usv_sizes=w.box_sizes[is_usv],
+            )
+        )
     frames.sort(key=lambda f: f.frame)
     return SequenceData(info.path.stem, tuple(frames))
 
@@ -231,12 +236,17 @@ def read_opv2v(folder: str | Path) -> SequenceData:
             continue
         ids = sorted(k for k in vehicles if k not in {a.id for a in afs})
         usv = np.stack([a.body for a in afs])
-        frames.append(SceneFrame(
-            frame=int(ts), agents=tuple(afs), target_ids=tuple(ids),
-            targets=np.stack([vehicles[k] for k in ids]) if ids else np.zeros((0, 4, 4)),
-            target_sizes=np.stack([sizes[k] for k in ids]) if ids else np.zeros((0, 3)),
-            usv_boxes=usv, usv_sizes=np.tile([2 * OPV2V_USV_RADIUS_M, 2 * OPV2V_USV_RADIUS_M, 5.0], (len(afs), 1)),
-        ))
+        frames.append(
+            SceneFrame(
+                frame=int(ts),
+                agents=tuple(afs),
+                target_ids=tuple(ids),
+                targets=np.stack([vehicles[k] for k in ids]) if ids else np.zeros((0, 4, 4)),
+                target_sizes=np.stack([sizes[k] for k in ids]) if ids else np.zeros((0, 3)),
+                usv_boxes=usv,
+                usv_sizes=np.tile([2 * OPV2V_USV_RADIUS_M, 2 * OPV2V_USV_RADIUS_M, 5.0], (len(afs), 1)),
+            )
+        )
     return SequenceData(d.name, tuple(frames))
 
 

@@ -56,8 +56,10 @@ __all__ = [
 Detector = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
 """``(points (N, 4) float32 ego LiDAR frame) -> (boxes (M, 7), scores (M,))``."""
 
-BASELINE_NOTE = ("baseline detector: training-free BEV clustering with oriented box fitting, NOT the paper's "
-                 "learned model; absolute AP values are not comparable with the paper's")
+BASELINE_NOTE = (
+    "baseline detector: training-free BEV clustering with oriented box fitting, NOT the paper's "
+    "learned model; absolute AP values are not comparable with the paper's"
+)
 
 
 @dataclass(frozen=True)
@@ -106,8 +108,15 @@ def water_plane(points: np.ndarray, *, cell_m: float = 10.0, rounds: int = 3, to
     return np.asarray(coef, dtype=np.float64)
 
 
-def fit_box(xy: np.ndarray, *, z_low: float, z_high: float, min_width_m: float = 0.8, beam_ratio: float = 0.25,
-            min_length_m: float = 3.0) -> np.ndarray:
+def fit_box(
+    xy: np.ndarray,
+    *,
+    z_low: float,
+    z_high: float,
+    min_width_m: float = 0.8,
+    beam_ratio: float = 0.25,
+    min_length_m: float = 3.0,
+) -> np.ndarray:
     """``(7,)`` box ``x, y, z, l, w, h, yaw`` of the BEV points ``xy`` ``(K, 2)`` (K ≥ 1): minimum-area
     rectangle, length along the longer side, yaw in (-π/2, π/2]; a width under ``max(min_width_m, beam_ratio ·
     length)`` is widened to it away from the origin (the sensor); a length under ``min_length_m`` is raised."""
@@ -171,8 +180,9 @@ def baseline_detect(points: np.ndarray, params: BaselineParams | None = None) ->
         ok = d <= np.minimum(gap[pairs[:, 0]], gap[pairs[:, 1]])
         pairs = pairs[ok]
     n = uniq.shape[0]
-    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])) if len(pairs) else ([], ([], [])),
-                       shape=(n, n))
+    graph = coo_matrix(
+        (np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])) if len(pairs) else ([], ([], [])), shape=(n, n)
+    )
     _, cell_label = connected_components(graph, directed=False)
     label = cell_label[inv]
     boxes: list[np.ndarray] = []
@@ -185,8 +195,14 @@ def baseline_detect(points: np.ndarray, params: BaselineParams | None = None) ->
             continue
         pts = q[group]
         z_low = float(np.mean(a * pts[:, 0] + b * pts[:, 1] + c))
-        box = fit_box(pts[:, :2], z_low=z_low, z_high=float(pts[:, 2].max()), min_width_m=prm.min_width_m,
-                      beam_ratio=prm.beam_ratio, min_length_m=prm.min_length_m)
+        box = fit_box(
+            pts[:, :2],
+            z_low=z_low,
+            z_high=float(pts[:, 2].max()),
+            min_width_m=prm.min_width_m,
+            beam_ratio=prm.beam_ratio,
+            min_length_m=prm.min_length_m,
+        )
         if box[3] > prm.max_length_m or box[4] > prm.max_width_m:
             continue
         boxes.append(box)

@@ -81,7 +81,11 @@ def bev_iou(a: np.ndarray | Sequence[Sequence[float]], b: np.ndarray | Sequence[
 
 
 def match_frame(
-    det_boxes: np.ndarray, det_scores: np.ndarray, gt_boxes: np.ndarray, *, iou_threshold: float,
+    det_boxes: np.ndarray,
+    det_scores: np.ndarray,
+    gt_boxes: np.ndarray,
+    *,
+    iou_threshold: float,
     iou: np.ndarray | None = None,
 ) -> np.ndarray:
     """The ground-truth index each detection is matched to (``-1``: false positive), ``(D,)`` int64 in the input
@@ -160,8 +164,12 @@ class FrameMatch:
     matches: dict[float, np.ndarray] = field(default_factory=dict)
 
     @staticmethod
-    def evaluate(det_boxes: np.ndarray, det_scores: np.ndarray, gt_boxes: np.ndarray,
-                 thresholds: Sequence[float] = IOU_THRESHOLDS) -> FrameMatch:
+    def evaluate(
+        det_boxes: np.ndarray,
+        det_scores: np.ndarray,
+        gt_boxes: np.ndarray,
+        thresholds: Sequence[float] = IOU_THRESHOLDS,
+    ) -> FrameMatch:
         """Matches one frame at every threshold."""
         d, g = _boxes(det_boxes), _boxes(gt_boxes)
         s = np.asarray(det_scores, dtype=np.float64).reshape(-1)

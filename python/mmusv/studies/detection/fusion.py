@@ -73,7 +73,7 @@ def rotated_nms(boxes: np.ndarray, scores: np.ndarray, *, iou_threshold: float =
         if not alive[i]:
             continue
         keep.append(int(order[i]))
-        alive[i + 1:] &= iou[i, i + 1:] <= iou_threshold
+        alive[i + 1 :] &= iou[i, i + 1 :] <= iou_threshold
     return np.array(keep, dtype=np.int64)
 
 
@@ -91,8 +91,13 @@ def early_points(ego: AgentFrame, neighbours: Sequence[AgentFrame], *, crop_m: f
 
 
 def fuse(
-    mode: str, ego: AgentFrame, neighbours: Sequence[AgentFrame], *, detector: Detector,
-    own_detections: Callable[[AgentFrame], Boxes] | None = None, crop_m: float = 220.0,
+    mode: str,
+    ego: AgentFrame,
+    neighbours: Sequence[AgentFrame],
+    *,
+    detector: Detector,
+    own_detections: Callable[[AgentFrame], Boxes] | None = None,
+    crop_m: float = 220.0,
 ) -> Boxes:
     """Boxes ``(M, 7)`` and scores ``(M,)`` in ``ego``'s LiDAR frame for fusion ``mode`` (module docstring).
     ``own_detections(agent)`` returns the detector's output on an agent's own cloud (a cache may back it)."""

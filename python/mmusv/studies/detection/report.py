@@ -25,9 +25,27 @@ def fmt(v: float) -> str:
 def detection_table(res: StudyResult) -> pl.DataFrame:
     """Table III: one row per fusion mode (clean setting)."""
     t = res.table().filter(pl.col("setting") == "clean")
-    cols = ["mode", "ap30", "ap50", "ap70", "precision50", "recall50", *[f"ap50_{b}" for b in BINS],
-            "recall50_visible", "recall50_hidden", "recall50_unseen", "recall30_visible", "recall30_hidden",
-            "recall30_unseen", "gt_visible", "gt_hidden", "gt_unseen", "gt", "det", "frames"]
+    cols = [
+        "mode",
+        "ap30",
+        "ap50",
+        "ap70",
+        "precision50",
+        "recall50",
+        *[f"ap50_{b}" for b in BINS],
+        "recall50_visible",
+        "recall50_hidden",
+        "recall50_unseen",
+        "recall30_visible",
+        "recall30_hidden",
+        "recall30_unseen",
+        "gt_visible",
+        "gt_hidden",
+        "gt_unseen",
+        "gt",
+        "det",
+        "frames",
+    ]
     return t.select(cols)
 
 
@@ -49,8 +67,12 @@ def write_detection(res: StudyResult, out: Path, *, detector: str) -> dict[str, 
     ``detection_note.txt`` into ``out``; returns the paths."""
     out.mkdir(parents=True, exist_ok=True)
     table = detection_table(res)
-    paths = {"csv": out / "detection_table.csv", "parquet": out / "detection_boxes.parquet",
-             "png": out / "detection_ap.png", "note": out / "detection_note.txt"}
+    paths = {
+        "csv": out / "detection_table.csv",
+        "parquet": out / "detection_boxes.parquet",
+        "png": out / "detection_ap.png",
+        "note": out / "detection_note.txt",
+    }
     table.write_csv(paths["csv"])
     res.boxes_frame(with_setting=False).write_parquet(paths["parquet"])
     _plot_detection(table, paths["png"])
@@ -62,9 +84,13 @@ def write_robustness(res: StudyResult, out: Path, *, detector: str) -> dict[str,
     """Writes ``robustness_table.csv`` (AP@0.5 per setting and mode), ``robustness_metrics.csv`` (every metric),
     ``robustness_boxes.parquet``, ``robustness_ap.png`` and ``robustness_note.txt`` into ``out``."""
     out.mkdir(parents=True, exist_ok=True)
-    paths = {"csv": out / "robustness_table.csv", "metrics": out / "robustness_metrics.csv",
-             "parquet": out / "robustness_boxes.parquet", "png": out / "robustness_ap.png",
-             "note": out / "robustness_note.txt"}
+    paths = {
+        "csv": out / "robustness_table.csv",
+        "metrics": out / "robustness_metrics.csv",
+        "parquet": out / "robustness_boxes.parquet",
+        "png": out / "robustness_ap.png",
+        "note": out / "robustness_note.txt",
+    }
     wide = robustness_table(res)
     wide.write_csv(paths["csv"])
     res.table().write_csv(paths["metrics"])
@@ -78,9 +104,13 @@ def _note(res: StudyResult, detector: str) -> str:
     lines = [f"detector: {_detector_name(res, detector)}"]
     if detector == "baseline" and res.options.predictions is None:
         lines.append(BASELINE_NOTE)
-    lines += [f"sequences: {len(res.sequences)} ({', '.join(res.sequences)})", f"frames: {res.frames}",
-              f"ego-frames: {res.ego_frames}", f"ground-truth boxes: {res.gt_boxes}",
-              f"range: {res.options.range_m:g} m; seed: {res.options.seed}"]
+    lines += [
+        f"sequences: {len(res.sequences)} ({', '.join(res.sequences)})",
+        f"frames: {res.frames}",
+        f"ego-frames: {res.ego_frames}",
+        f"ground-truth boxes: {res.gt_boxes}",
+        f"range: {res.options.range_m:g} m; seed: {res.options.seed}",
+    ]
     return "\n".join(lines) + "\n"
 
 
@@ -135,8 +165,13 @@ def _plot_robustness(res: StudyResult, path: Path) -> None:
             xs = [0.0, *sub[xcol].cast(pl.Float64).to_list()]
             ys = [clean.get(m, math.nan), *sub["ap50"].to_list()]
             a.plot(xs, ys, marker="o", label=m)
-    _finish(fig, ax, [("delay (frames)", "AP@0.5"), ("pose noise σ_xyz (m) = σ_rpy (°)", "AP@0.5")],
-            "Robustness (Table IV)", path)
+    _finish(
+        fig,
+        ax,
+        [("delay (frames)", "AP@0.5"), ("pose noise σ_xyz (m) = σ_rpy (°)", "AP@0.5")],
+        "Robustness (Table IV)",
+        path,
+    )
 
 
 def rescore(boxes: pl.DataFrame) -> dict[str, float]:
@@ -148,6 +183,9 @@ def rescore(boxes: pl.DataFrame) -> dict[str, float]:
     for _, g in boxes.group_by(["sequence", "frame", "ego"], maintain_order=True):
         d = g.filter(pl.col("kind") == "det")
         t = g.filter(pl.col("kind") == "gt")
-        frames.append(FrameMatch.evaluate(d.select(list(BOX_COLUMNS)).to_numpy(), d["score"].to_numpy(),
-                                          t.select(list(BOX_COLUMNS)).to_numpy()))
+        frames.append(
+            FrameMatch.evaluate(
+                d.select(list(BOX_COLUMNS)).to_numpy(), d["score"].to_numpy(), t.select(list(BOX_COLUMNS)).to_numpy()
+            )
+        )
     return summarize(frames)

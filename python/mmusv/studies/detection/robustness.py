@@ -47,8 +47,12 @@ class Setting:
 
 
 DEFAULT_SETTINGS = (
-    Setting(), Setting(delay_frames=1), Setting(delay_frames=2), Setting(delay_frames=3),
-    Setting(sigma_xyz_m=0.5, sigma_rpy_deg=0.5), Setting(sigma_xyz_m=1.0, sigma_rpy_deg=1.0),
+    Setting(),
+    Setting(delay_frames=1),
+    Setting(delay_frames=2),
+    Setting(delay_frames=3),
+    Setting(sigma_xyz_m=0.5, sigma_rpy_deg=0.5),
+    Setting(sigma_xyz_m=1.0, sigma_rpy_deg=1.0),
     Setting(sigma_xyz_m=2.0, sigma_rpy_deg=2.0),
 )
 
@@ -77,16 +81,24 @@ def parse_settings(text: str | Sequence[str]) -> tuple[Setting, ...]:
             else:
                 raise ValueError
         except ValueError:
-            raise InputError(f"--settings item {it!r}: expected clean, delay:K (K ≥ 1 frames) or "
-                             "noise:SIGMA_XYZ_M/SIGMA_RPY_DEG (non-negative, not both 0)") from None
+            raise InputError(
+                f"--settings item {it!r}: expected clean, delay:K (K ≥ 1 frames) or "
+                "noise:SIGMA_XYZ_M/SIGMA_RPY_DEG (non-negative, not both 0)"
+            ) from None
         if st not in out:
             out.append(st)
     return tuple(out)
 
 
 def _seed_words(seed: int, seq: str, frame: int, ego: str, nb: str, setting: Setting) -> list[int]:
-    return [seed & 0xFFFFFFFF, zlib.crc32(seq.encode()), frame, zlib.crc32(ego.encode()), zlib.crc32(nb.encode()),
-            zlib.crc32(setting.name.encode())]
+    return [
+        seed & 0xFFFFFFFF,
+        zlib.crc32(seq.encode()),
+        frame,
+        zlib.crc32(ego.encode()),
+        zlib.crc32(nb.encode()),
+        zlib.crc32(setting.name.encode()),
+    ]
 
 
 def neighbours_for(seq: SequenceData, index: int, ego_id: str, setting: Setting, *, seed: int) -> list[AgentFrame]:
@@ -104,8 +116,9 @@ def neighbours_for(seq: SequenceData, index: int, ego_id: str, setting: Setting,
         nb = by_id[a.id]
         if setting.sigma_xyz_m or setting.sigma_rpy_deg:
             rng = np.random.default_rng(_seed_words(seed, seq.name, now.frame, ego_id, a.id, setting))
-            noise = np.concatenate([rng.normal(0.0, setting.sigma_xyz_m, 3),
-                                    np.radians(rng.normal(0.0, setting.sigma_rpy_deg, 3))])
+            noise = np.concatenate(
+                [rng.normal(0.0, setting.sigma_xyz_m, 3), np.radians(rng.normal(0.0, setting.sigma_rpy_deg, 3))]
+            )
             nb = replace(nb, body=pose_matrices(matrix_to_pose(nb.body) + noise))
         out.append(nb)
     return out

@@ -51,8 +51,9 @@ class Dataset:
         """Frames over all sequences (cheap for recordings: from their metadata)."""
         if self.kind == "recording":
             return sum(recording_summary(p).frames_configured for p in self.sources.values())
-        return sum(len({f.stem for c in p.iterdir() if c.is_dir() for f in c.glob("*.pcd")})
-                   for p in self.sources.values())
+        return sum(
+            len({f.stem for c in p.iterdir() if c.is_dir() for f in c.glob("*.pcd")}) for p in self.sources.values()
+        )
 
 
 def _recordings(inputs: Sequence[str | Path]) -> list[Path]:
@@ -87,7 +88,11 @@ def _sequence_names(recs: Sequence[Path]) -> dict[str, Path]:
 
 
 def resolve_dataset(
-    inputs: Sequence[str | Path], *, opv2v: str | Path | None, split: str, ratios: Sequence[float] = (0.7, 0.15, 0.15),
+    inputs: Sequence[str | Path],
+    *,
+    opv2v: str | Path | None,
+    split: str,
+    ratios: Sequence[float] = (0.7, 0.15, 0.15),
     seed: int = 0,
 ) -> Dataset:
     """The sequences of ``split`` from recordings ``inputs`` or the OPV2V folder ``opv2v`` (not both). Raises
@@ -97,8 +102,10 @@ def resolve_dataset(
     if opv2v is not None:
         folders = opv2v_scenarios(opv2v)
         kind = "opv2v"
-        names = {f.name if f.parent.name not in ("train", "validate", "test") else f"{f.parent.name}/{f.name}": f
-                 for f in folders}
+        names = {
+            f.name if f.parent.name not in ("train", "validate", "test") else f"{f.parent.name}/{f.name}": f
+            for f in folders
+        }
         presplit = all(f.parent.name in ("train", "validate", "test") for f in folders)
         if presplit and split != "all":
             chosen = {n: f for n, f in names.items() if f.parent.name == split}
@@ -122,22 +129,26 @@ def lidar_only(data: dict[str, Any]) -> dict[str, Any]:
     """A scenario dict whose rigs keep only their LiDAR (no cameras, radar or top view)."""
     out = dict(data)
     rigs = out.get("rigs") or {}
-    out["rigs"] = {name: {**(r or {}), "cameras": [], "radar": None, "top_view": None} if isinstance(r, dict) or r is None
-                   else r for name, r in rigs.items()}
+    out["rigs"] = {
+        name: {**(r or {}), "cameras": [], "radar": None, "top_view": None} if isinstance(r, dict) or r is None else r
+        for name, r in rigs.items()
+    }
     return out
 
 
 def generate_dataset(
-    out_dir: str | Path, *, spec: str | Path = BUNDLED_SPEC, progress: Callable[[str, int, int], None] | None = None,
+    out_dir: str | Path,
+    *,
+    spec: str | Path = BUNDLED_SPEC,
+    progress: Callable[[str, int, int], None] | None = None,
 ) -> list[Path]:
     """Generates ``spec`` into ``out_dir/scenarios`` and records every scenario LiDAR-only into
     ``out_dir/recordings/<name>/``; returns the recordings. An existing recording of the same scenario is kept
     (delete ``out_dir`` to redo it)."""
     from mmusv.acquire import recording_path, run
+    from mmusv.bundled import resolve_spec
     from mmusv.config import load_scenario
     from mmusv.generate.runner import generate
-
-    from mmusv.bundled import resolve_spec
 
     sp = resolve_spec(spec)
     out = Path(out_dir)
@@ -163,6 +174,7 @@ def generate_dataset(
 def _same_scenario(path: Path, scenario: Any) -> bool:
     """Whether the complete recording at ``path`` was made from ``scenario`` (same config hash)."""
     from mmusv.config import scenario_hash
+
     try:
         info = recording_summary(path)
     except IoError:

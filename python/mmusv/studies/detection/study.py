@@ -114,9 +114,17 @@ class StudyResult:
         for s in self.options.settings:
             for m in self.options.modes:
                 if (s.name, m) in self.matches:
-                    recs.append({"setting": s.name, "kind": s.kind, "delay_frames": s.delay_frames,
-                                 "sigma_xyz_m": s.sigma_xyz_m, "sigma_rpy_deg": s.sigma_rpy_deg, "mode": m,
-                                 **self.metrics((s.name, m))})
+                    recs.append(
+                        {
+                            "setting": s.name,
+                            "kind": s.kind,
+                            "delay_frames": s.delay_frames,
+                            "sigma_xyz_m": s.sigma_xyz_m,
+                            "sigma_rpy_deg": s.sigma_rpy_deg,
+                            "mode": m,
+                            **self.metrics((s.name, m)),
+                        }
+                    )
         return pl.DataFrame(recs)
 
     def boxes_frame(self, *, with_setting: bool) -> pl.DataFrame:
@@ -129,9 +137,18 @@ class StudyResult:
 
 
 _ROW_SCHEMA: dict[str, Any] = {
-    "sequence": pl.Utf8, "frame": pl.Int64, "ego": pl.Utf8, "setting": pl.Utf8, "mode": pl.Utf8, "kind": pl.Utf8,
-    **{c: pl.Float64 for c in BOX_COLUMNS}, "score": pl.Float64, "range_bin": pl.Utf8, "matched": pl.Boolean,
-    "ego_points": pl.Int64, "neighbour_points": pl.Int64,
+    "sequence": pl.Utf8,
+    "frame": pl.Int64,
+    "ego": pl.Utf8,
+    "setting": pl.Utf8,
+    "mode": pl.Utf8,
+    "kind": pl.Utf8,
+    **dict.fromkeys(BOX_COLUMNS, pl.Float64),
+    "score": pl.Float64,
+    "range_bin": pl.Utf8,
+    "matched": pl.Boolean,
+    "ego_points": pl.Int64,
+    "neighbour_points": pl.Int64,
 }
 
 
@@ -179,8 +196,9 @@ def gt_visibility(gt: np.ndarray, points: np.ndarray, *, z_margin_m: float = 0.5
     return out
 
 
-def _keep(boxes: np.ndarray, scores: np.ndarray, usv: np.ndarray, *, range_m: float,
-          margin: float) -> tuple[np.ndarray, np.ndarray]:
+def _keep(
+    boxes: np.ndarray, scores: np.ndarray, usv: np.ndarray, *, range_m: float, margin: float
+) -> tuple[np.ndarray, np.ndarray]:
     sel = np.hypot(boxes[:, 0], boxes[:, 1]) < range_m
     if len(usv) and len(boxes):
         plat = shapely.union_all(shapely.buffer(box_polygons(usv), margin))
@@ -189,7 +207,10 @@ def _keep(boxes: np.ndarray, scores: np.ndarray, usv: np.ndarray, *, range_m: fl
 
 
 def run_study(
-    sequences: Iterable[SequenceData], *, options: StudyOptions, total_frames: int | None = None,
+    sequences: Iterable[SequenceData],
+    *,
+    options: StudyOptions,
+    total_frames: int | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> StudyResult:
     """Evaluates ``sequences`` (see the module docstring). With delays, the first ``max delay`` frames of every
@@ -198,8 +219,20 @@ def run_study(
     if o.detector is None and o.predictions is None:
         raise InputError("no detector and no predictions given")
     res = StudyResult(options=o)
-    for k in ("sequence", "frame", "ego", "setting", "mode", "kind", *BOX_COLUMNS, "score", "range_bin", "matched",
-              "ego_points", "neighbour_points"):
+    for k in (
+        "sequence",
+        "frame",
+        "ego",
+        "setting",
+        "mode",
+        "kind",
+        *BOX_COLUMNS,
+        "score",
+        "range_bin",
+        "matched",
+        "ego_points",
+        "neighbour_points",
+    ):
         res.rows[k] = []
     start = max(s.delay_frames for s in o.settings)
     fusion = [m for m in o.modes if m != "none"]
@@ -208,8 +241,10 @@ def run_study(
         if not seq.frames:
             continue
         if fusion and len(seq.agent_ids) < 2:
-            raise InputError(f"sequence {seq.name}: {len(seq.agent_ids)} instrumented USV(s) with a LiDAR; "
-                             f"{'/'.join(fusion)} fusion needs at least 2 (use --modes none)")
+            raise InputError(
+                f"sequence {seq.name}: {len(seq.agent_ids)} instrumented USV(s) with a LiDAR; "
+                f"{'/'.join(fusion)} fusion needs at least 2 (use --modes none)"
+            )
         res.sequences.append(seq.name)
         own = _OwnDetections(o.detector)
         for t in range(start, len(seq.frames)):
@@ -221,8 +256,10 @@ def run_study(
             if progress is not None:
                 progress(done, total_frames or done)
     if o.predictions is not None and res.predictions_used == 0 and res.ego_frames:
-        raise InputError("--predictions: no row matches any (sequence, frame, ego, mode) evaluated; check the "
-                         f"sequence names ({', '.join(res.sequences[:3])}, ...) and the ego ids")
+        raise InputError(
+            "--predictions: no row matches any (sequence, frame, ego, mode) evaluated; check the "
+            f"sequence names ({', '.join(res.sequences[:3])}, ...) and the ego ids"
+        )
     return res
 
 
@@ -243,8 +280,14 @@ class _OwnDetections:
         return self.cache[key]
 
 
-def _score_ego(res: StudyResult, seq: SequenceData, t: int, frame: SceneFrame, ego: AgentFrame,
-               own: Callable[[AgentFrame], tuple[np.ndarray, np.ndarray]]) -> None:
+def _score_ego(
+    res: StudyResult,
+    seq: SequenceData,
+    t: int,
+    frame: SceneFrame,
+    ego: AgentFrame,
+    own: Callable[[AgentFrame], tuple[np.ndarray, np.ndarray]],
+) -> None:
     o = res.options
     res.ego_frames += 1
     gt = gt_in_ego(frame, ego, range_m=o.range_m)
@@ -269,8 +312,7 @@ def _score_ego(res: StudyResult, seq: SequenceData, t: int, frame: SceneFrame, e
                 boxes, scores = got if got is not None else (np.zeros((0, 7)), np.zeros(0))
             else:
                 assert o.detector is not None
-                boxes, scores = fuse(mode, ego, nbs, detector=o.detector, own_detections=own,
-                                     crop_m=o.range_m + 20.0)
+                boxes, scores = fuse(mode, ego, nbs, detector=o.detector, own_detections=own, crop_m=o.range_m + 20.0)
             boxes, scores = _keep(boxes, scores, usv, range_m=o.range_m, margin=o.platform_margin_m)
             fm = FrameMatch.evaluate(boxes, scores, gt)
             key = (s.name, mode)
@@ -280,8 +322,19 @@ def _score_ego(res: StudyResult, seq: SequenceData, t: int, frame: SceneFrame, e
             _add_rows(res, seq.name, frame.frame, ego.id, s.name, mode, fm, gm, gbin, vis, nb_vis)
 
 
-def _add_rows(res: StudyResult, seq: str, frame: int, ego: str, setting: str, mode: str, fm: FrameMatch,
-              gm: np.ndarray, gbin: np.ndarray, vis: np.ndarray, nb_vis: np.ndarray) -> None:
+def _add_rows(
+    res: StudyResult,
+    seq: str,
+    frame: int,
+    ego: str,
+    setting: str,
+    mode: str,
+    fm: FrameMatch,
+    gm: np.ndarray,
+    gbin: np.ndarray,
+    vis: np.ndarray,
+    nb_vis: np.ndarray,
+) -> None:
     r = res.rows
     dbin = fm.det_bins(0.5)
     tp = fm.matches[0.5] >= 0
