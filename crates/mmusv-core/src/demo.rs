@@ -217,7 +217,7 @@ pub fn maritime_demo(p: DemoParams) -> Result<DemoScene> {
 pub fn lidar_rays(position: [f32; 3], channels: u32, azimuth_steps: u32) -> Result<(Vec<[f32; 3]>, Vec<[f32; 3]>)> {
     let el = rays::uniform_elevations(channels, (-25f64).to_radians(), 15f64.to_radians())?;
     let dirs = rays::lidar_directions(&el, azimuth_steps)?;
-    let order = rays::lidar_trace_order(channels, azimuth_steps, crate::packet::PACKET as u32)?;
+    let order = rays::lidar_trace_order(channels, azimuth_steps, rays::TRACE_BLOCK)?;
     let traced: Vec<[f32; 3]> = order.iter().map(|&i| dirs[i as usize]).collect();
     Ok((vec![position; traced.len()], traced))
 }

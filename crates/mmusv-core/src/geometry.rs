@@ -1,9 +1,10 @@
-//! Rigid poses and the ray–triangle test shared by every ray query.
+//! Rigid poses and the watertight ray–triangle test shared by every ray query (one triangle, or a block of four).
 //!
 //! Poses are rigid transforms `p_world = R · p_local + t` (no scale), stored in `f32` because the
 //! scene itself is `f32`; kinematics works in `f64` and converts at the scene boundary.
 
 use crate::error::{MmusvError, Result};
+use crate::ray::RayPrep;
 use parry3d::math::{Mat3, Vec3};
 
 /// Tolerance on `RᵀR = I` and `det R = 1` when a pose is given as a 4×4 matrix.
@@ -136,53 +137,253 @@ impl RigidPose {
     }
 }
 
-/// A triangle stored for fast intersection: first vertex and the two edges from it.
+/// A triangle stored for intersection: its three vertices as given (never re-derived from edges, so triangles
+/// that share an edge share its exact endpoints, which is what makes the test watertight) and its normal.
 #[derive(Debug, Clone, Copy)]
 pub struct PreparedTriangle {
-    /// First vertex.
-    pub v0: Vec3,
-    /// `v1 - v0`.
-    pub e1: Vec3,
-    /// `v2 - v0`.
-    pub e2: Vec3,
+    /// Vertices `a, b, c` in winding order.
+    pub v: [Vec3; 3],
+    /// The unnormalised normal `(b − a) × (c − a)`.
+    pub n: Vec3,
 }
 
 impl PreparedTriangle {
     /// Prepares the triangle `(a, b, c)`.
     pub fn new(a: Vec3, b: Vec3, c: Vec3) -> Self {
-        Self { v0: a, e1: b - a, e2: c - a }
+        Self { v: [a, b, c], n: (b - a).cross(c - a) }
     }
 
-    /// The unnormalised geometric normal `e1 × e2` (follows the winding `a → b → c`).
+    /// The unnormalised geometric normal `(b − a) × (c − a)` (follows the winding `a → b → c`).
     #[inline(always)]
     pub fn normal(&self) -> Vec3 {
-        self.e1.cross(self.e2)
+        self.n
     }
 
-    /// Two-sided Möller–Trumbore test: the ray parameter `t` in `(0, t_max)` of the hit, if any.
+    /// The centroid.
+    pub fn centroid(&self) -> Vec3 {
+        (self.v[0] + self.v[1] + self.v[2]) / 3.0
+    }
+
+    /// Two-sided watertight test (see [`crate::ray`]): the ray parameter `t` in `(0, t_max)` of the hit, if any.
     ///
-    /// Both faces are hit (no culling); whether a hit is on the back face is decided by the caller from the
-    /// sign of `normal · dir`. `dir` need not be unit length; `t` is in units of `|dir|`.
+    /// Whether the ray hits is decided by the sheared edge functions (watertight); the distance is then taken
+    /// from the triangle's plane, `t = n·(a − o) / n·d`, which stays accurate for triangles much larger than the
+    /// distance to them (a water plane kilometres wide seen from a few metres). Both faces are hit (no culling);
+    /// `t` is in units of `|dir|`. Gives bit for bit the `t` of [`TriBlock::intersect`] and
+    /// [`triangle_across_rays`] for the same triangle and ray.
     #[inline(always)]
-    pub fn intersect(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<f32> {
-        let p = dir.cross(self.e2);
-        let det = self.e1.dot(p);
-        if det == 0.0 || !det.is_finite() {
-            return None;
+    pub fn intersect(&self, ray: &RayPrep, t_max: f32) -> Option<f32> {
+        let [kx, ky, kz] = ray.k;
+        let [sx, sy] = ray.s;
+        let o = ray.o;
+        let rel = |p: Vec3| {
+            let p = p.to_array();
+            [p[0] - o[0], p[1] - o[1], p[2] - o[2]]
+        };
+        let (ra, rb, rc) = (rel(self.v[0]), rel(self.v[1]), rel(self.v[2]));
+        let shear = |r: [f32; 3]| (r[kx] - sx * r[kz], r[ky] - sy * r[kz]);
+        let (ax, ay) = shear(ra);
+        let (bx, by) = shear(rb);
+        let (cx, cy) = shear(rc);
+        let mut u = cx * by - cy * bx;
+        let mut v = ax * cy - ay * cx;
+        let mut w = bx * ay - by * ax;
+        if u == 0.0 || v == 0.0 || w == 0.0 {
+            (u, v, w) = edges_f64([ax, ay, bx, by, cx, cy]);
         }
-        let inv = 1.0 / det;
-        let s = origin - self.v0;
-        let u = s.dot(p) * inv;
-        if !(0.0..=1.0).contains(&u) {
-            return None;
+        let n = self.n.to_array();
+        let num = n[0] * ra[0] + n[1] * ra[1] + n[2] * ra[2];
+        let den = n[0] * ray.d[0] + n[1] * ray.d[1] + n[2] * ray.d[2];
+        let neg = u < 0.0 || v < 0.0 || w < 0.0;
+        let pos = u > 0.0 || v > 0.0 || w > 0.0;
+        let t = num / den;
+        (!(neg && pos) && u + v + w != 0.0 && t > 0.0 && t < t_max).then_some(t)
+    }
+}
+
+/// Edge functions recomputed in `f64` when one of them is exactly zero in `f32` (an edge through the ray):
+/// the paper's fallback that decides such rays consistently for both triangles of the edge.
+#[inline(never)]
+fn edges_f64(p: [f32; 6]) -> (f32, f32, f32) {
+    let [ax, ay, bx, by, cx, cy] = p.map(f64::from);
+    ((cx * by - cy * bx) as f32, (ax * cy - ay * cx) as f32, (bx * ay - by * ax) as f32)
+}
+
+/// Tests one triangle (vertices `tri[vertex][axis]`, normal `n`) against every ray of a packet whose rays
+/// share the dominant axis `KZ` (the lanes of the arrays are rays: origins `o[axis][ray]`, directions
+/// `d[axis][ray]`, shear constants `s[c][ray]`), with the arithmetic of [`PreparedTriangle::intersect`], so each
+/// lane's `t` is bit for bit the one-ray result. Returns the hit distance per ray, `+inf` where the triangle
+/// is missed or not closer than `best`.
+#[inline(always)]
+pub fn triangle_across_rays<const KZ: usize, const N: usize>(
+    tri: [[f32; 3]; 3],
+    n: [f32; 3],
+    o: &[[f32; N]; 3],
+    d: &[[f32; N]; 3],
+    s: &[[f32; N]; 2],
+    best: &[f32; N],
+) -> [f32; N] {
+    let (kx, ky) = ((KZ + 1) % 3, (KZ + 2) % 3);
+    let mut sh = [[[0f32; N]; 2]; 3];
+    let mut num = [0f32; N];
+    for (vert, p) in tri.iter().enumerate() {
+        for r in 0..N {
+            let rel = [p[0] - o[0][r], p[1] - o[1][r], p[2] - o[2][r]];
+            sh[vert][0][r] = rel[kx] - s[0][r] * rel[KZ];
+            sh[vert][1][r] = rel[ky] - s[1][r] * rel[KZ];
+            if vert == 0 {
+                num[r] = n[0] * rel[0] + n[1] * rel[1] + n[2] * rel[2];
+            }
         }
-        let q = s.cross(self.e1);
-        let v = dir.dot(q) * inv;
-        if v < 0.0 || u + v > 1.0 {
-            return None;
+    }
+    let [a, b, c] = &sh;
+    let mut u = [0f32; N];
+    let mut v = [0f32; N];
+    let mut w = [0f32; N];
+    let mut zero = false;
+    for r in 0..N {
+        u[r] = c[0][r] * b[1][r] - c[1][r] * b[0][r];
+        v[r] = a[0][r] * c[1][r] - a[1][r] * c[0][r];
+        w[r] = b[0][r] * a[1][r] - b[1][r] * a[0][r];
+        zero |= (u[r] == 0.0) | (v[r] == 0.0) | (w[r] == 0.0);
+    }
+    if zero {
+        for r in 0..N {
+            if u[r] == 0.0 || v[r] == 0.0 || w[r] == 0.0 {
+                (u[r], v[r], w[r]) = edges_f64([a[0][r], a[1][r], b[0][r], b[1][r], c[0][r], c[1][r]]);
+            }
         }
-        let t = self.e2.dot(q) * inv;
-        (t > 0.0 && t < t_max).then_some(t)
+    }
+    let mut t = [0f32; N];
+    for r in 0..N {
+        let neg = (u[r] < 0.0) | (v[r] < 0.0) | (w[r] < 0.0);
+        let pos = (u[r] > 0.0) | (v[r] > 0.0) | (w[r] > 0.0);
+        let den = n[0] * d[0][r] + n[1] * d[1][r] + n[2] * d[2][r];
+        let tl = num[r] / den;
+        let ok = !(neg & pos) & (u[r] + v[r] + w[r] != 0.0) & (tl > 0.0) & (tl < best[r]);
+        t[r] = if ok { tl } else { f32::INFINITY };
+    }
+    t
+}
+
+/// Triangles per [`TriBlock`].
+pub const BLOCK: usize = 4;
+
+/// Up to [`BLOCK`] triangles in structure-of-arrays form, tested against one ray at once. Unused lanes repeat
+/// lane 0 (same triangle, same id), so they can never change a result.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[repr(C, align(16))]
+pub struct TriBlock {
+    /// `v[vertex][axis][lane]`.
+    pub v: [[[f32; BLOCK]; 3]; 3],
+    /// `n[axis][lane]`: each triangle's unnormalised normal.
+    pub n: [[f32; BLOCK]; 3],
+    /// The triangle index of each lane.
+    pub id: [u32; BLOCK],
+}
+
+impl TriBlock {
+    /// Packs `tris` (1 to [`BLOCK`] of them) with their ids.
+    pub fn new(tris: &[(u32, PreparedTriangle)]) -> Self {
+        let mut b = TriBlock { v: [[[0.0; BLOCK]; 3]; 3], n: [[0.0; BLOCK]; 3], id: [0; BLOCK] };
+        let zero = (0, PreparedTriangle::new(Vec3::ZERO, Vec3::ZERO, Vec3::ZERO));
+        for lane in 0..BLOCK {
+            let (id, t) = tris.get(lane).or(tris.first()).copied().unwrap_or(zero);
+            b.id[lane] = id;
+            for (vert, p) in t.v.iter().enumerate() {
+                let p = p.to_array();
+                for a in 0..3 {
+                    b.v[vert][a][lane] = p[a];
+                }
+            }
+            let n = t.n.to_array();
+            for a in 0..3 {
+                b.n[a][lane] = n[a];
+            }
+        }
+        b
+    }
+
+    /// The vertices of lane `lane` as `[vertex][axis]`, and its normal.
+    #[inline(always)]
+    pub fn lane(&self, lane: usize) -> ([[f32; 3]; 3], [f32; 3]) {
+        let v = &self.v;
+        (
+            [
+                [v[0][0][lane], v[0][1][lane], v[0][2][lane]],
+                [v[1][0][lane], v[1][1][lane], v[1][2][lane]],
+                [v[2][0][lane], v[2][1][lane], v[2][2][lane]],
+            ],
+            [self.n[0][lane], self.n[1][lane], self.n[2][lane]],
+        )
+    }
+
+    /// The closest hit in `(0, t_max)` over the block's triangles: `(t, triangle id)`. Ties go to the lowest lane.
+    #[inline(always)]
+    pub fn intersect(&self, ray: &RayPrep, t_max: f32) -> Option<(f32, u32)> {
+        // One monomorphic version per dominant axis, so every load has a fixed offset and the lanes vectorise.
+        match ray.k[2] {
+            0 => self.intersect_k::<0>(ray, t_max),
+            1 => self.intersect_k::<1>(ray, t_max),
+            _ => self.intersect_k::<2>(ray, t_max),
+        }
+    }
+
+    #[inline(always)]
+    fn intersect_k<const KZ: usize>(&self, ray: &RayPrep, t_max: f32) -> Option<(f32, u32)> {
+        let (kx, ky) = ((KZ + 1) % 3, (KZ + 2) % 3);
+        let [sx, sy] = ray.s;
+        let o = ray.o;
+        let mut sh = [[[0f32; BLOCK]; 2]; 3]; // sh[vertex][0: x, 1: y][lane], sheared
+        let mut num = [0f32; BLOCK];
+        for vert in 0..3 {
+            let p = &self.v[vert];
+            for l in 0..BLOCK {
+                let rel = [p[0][l] - o[0], p[1][l] - o[1], p[2][l] - o[2]];
+                sh[vert][0][l] = rel[kx] - sx * rel[KZ];
+                sh[vert][1][l] = rel[ky] - sy * rel[KZ];
+                if vert == 0 {
+                    num[l] = self.n[0][l] * rel[0] + self.n[1][l] * rel[1] + self.n[2][l] * rel[2];
+                }
+            }
+        }
+        let [a, b, c] = &sh;
+        let mut u = [0f32; BLOCK];
+        let mut v = [0f32; BLOCK];
+        let mut w = [0f32; BLOCK];
+        for l in 0..BLOCK {
+            u[l] = c[0][l] * b[1][l] - c[1][l] * b[0][l];
+            v[l] = a[0][l] * c[1][l] - a[1][l] * c[0][l];
+            w[l] = b[0][l] * a[1][l] - b[1][l] * a[0][l];
+        }
+        let mut zero = false;
+        for l in 0..BLOCK {
+            zero |= (u[l] == 0.0) | (v[l] == 0.0) | (w[l] == 0.0);
+        }
+        if zero {
+            for l in 0..BLOCK {
+                if u[l] == 0.0 || v[l] == 0.0 || w[l] == 0.0 {
+                    (u[l], v[l], w[l]) = edges_f64([a[0][l], a[1][l], b[0][l], b[1][l], c[0][l], c[1][l]]);
+                }
+            }
+        }
+        let d = ray.d;
+        let mut t = [0f32; BLOCK];
+        for l in 0..BLOCK {
+            let neg = (u[l] < 0.0) | (v[l] < 0.0) | (w[l] < 0.0);
+            let pos = (u[l] > 0.0) | (v[l] > 0.0) | (w[l] > 0.0);
+            let den = self.n[0][l] * d[0] + self.n[1][l] * d[1] + self.n[2][l] * d[2];
+            let tl = num[l] / den;
+            let ok = !(neg & pos) & (u[l] + v[l] + w[l] != 0.0) & (tl > 0.0) & (tl < t_max);
+            t[l] = if ok { tl } else { f32::INFINITY };
+        }
+        let mut best = (t[0], 0usize);
+        for (l, &tl) in t.iter().enumerate().skip(1) {
+            if tl < best.0 {
+                best = (tl, l);
+            }
+        }
+        (best.0 < f32::INFINITY).then(|| (best.0, self.id[best.1]))
     }
 }
 
@@ -190,16 +391,74 @@ impl PreparedTriangle {
 mod tests {
     use super::*;
 
+    fn prep(o: [f32; 3], d: [f32; 3]) -> RayPrep {
+        RayPrep::new(o, d)
+    }
+
     #[test]
     fn triangle_hit_front_and_back() {
         let tri = PreparedTriangle::new(Vec3::ZERO, Vec3::X, Vec3::Y);
-        let down = tri.intersect(Vec3::new(0.2, 0.2, 5.0), Vec3::NEG_Z, f32::MAX);
+        let down = tri.intersect(&prep([0.2, 0.2, 5.0], [0.0, 0.0, -1.0]), f32::MAX);
         assert!((down.unwrap_or(f32::NAN) - 5.0).abs() < 1e-6);
-        let up = tri.intersect(Vec3::new(0.2, 0.2, -2.0), Vec3::Z, f32::MAX);
+        let up = tri.intersect(&prep([0.2, 0.2, -2.0], [0.0, 0.0, 1.0]), f32::MAX);
         assert!((up.unwrap_or(f32::NAN) - 2.0).abs() < 1e-6);
-        assert!(tri.intersect(Vec3::new(0.8, 0.8, 1.0), Vec3::NEG_Z, f32::MAX).is_none());
-        assert!(tri.intersect(Vec3::new(0.2, 0.2, 5.0), Vec3::NEG_Z, 4.0).is_none());
-        assert!(tri.intersect(Vec3::new(0.2, 0.2, 5.0), Vec3::Z, f32::MAX).is_none());
+        assert!(tri.intersect(&prep([0.8, 0.8, 1.0], [0.0, 0.0, -1.0]), f32::MAX).is_none());
+        assert!(tri.intersect(&prep([0.2, 0.2, 5.0], [0.0, 0.0, -1.0]), 4.0).is_none());
+        assert!(tri.intersect(&prep([0.2, 0.2, 5.0], [0.0, 0.0, 1.0]), f32::MAX).is_none());
+        // An oblique ray, distance in units of |d|: from (0.1, 0.1, 3) along (0.1, 0.1, -1) · 2.
+        let t = tri.intersect(&prep([0.1, 0.1, 3.0], [0.2, 0.2, -2.0]), f32::MAX).unwrap_or(f32::NAN);
+        assert!((t - 1.5).abs() < 1e-6, "{t}");
+    }
+
+    #[test]
+    fn block_lanes_equal_the_scalar_test_bit_for_bit() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let mut p = || Vec3::new(rng.random_range(-2.0..2.0), rng.random_range(-2.0..2.0), rng.random_range(-2.0..2.0));
+        for _ in 0..2000 {
+            let tris: Vec<(u32, PreparedTriangle)> =
+                (0..4).map(|i| (i, PreparedTriangle::new(p(), p(), p()))).collect();
+            let n = 1 + (p().x.abs() * 1.4) as usize % 4;
+            let block = TriBlock::new(&tris[..n]);
+            let o = p() * 3.0;
+            let d = p();
+            if d.length() < 1e-3 {
+                continue;
+            }
+            let ray = prep(o.to_array(), d.to_array());
+            let scalar = tris[..n].iter().filter_map(|(id, t)| t.intersect(&ray, 50.0).map(|t| (t, *id))).fold(
+                None,
+                |best: Option<(f32, u32)>, h| match best {
+                    Some(b) if b.0 <= h.0 => Some(b),
+                    _ => Some(h),
+                },
+            );
+            assert_eq!(block.intersect(&ray, 50.0), scalar);
+        }
+    }
+
+    #[test]
+    fn shared_edges_leak_no_ray() {
+        // A fan of triangles around a vertex that every ray is aimed at, and rays along their shared edges:
+        // each ray must hit (the two-sided watertight test hits an edge or vertex from both sides).
+        let c = Vec3::new(0.3, -0.2, 0.0);
+        let ring: Vec<Vec3> = (0..7)
+            .map(|k| {
+                let a = k as f32 * 0.9;
+                c + Vec3::new(a.cos(), a.sin(), 0.05 * a)
+            })
+            .collect();
+        let tris: Vec<PreparedTriangle> =
+            (0..7).map(|k| PreparedTriangle::new(c, ring[k], ring[(k + 1) % 7])).collect();
+        for k in 0..7 {
+            for f in [0.0f32, 0.25, 0.5, 0.75, 0.999] {
+                let target = c + (ring[k] - c) * f;
+                for o in [Vec3::new(0.0, 0.0, 5.0), Vec3::new(1.3, 2.1, 4.0), Vec3::new(-3.0, 0.5, -2.0)] {
+                    let ray = prep(o.to_array(), (target - o).to_array());
+                    assert!(tris.iter().any(|t| t.intersect(&ray, 2.0).is_some()), "edge {k} at {f} from {o:?}");
+                }
+            }
+        }
     }
 
     #[test]

@@ -6,10 +6,11 @@
 //!
 //! Modules, one job each:
 //! - [`error`]: the one error enum every fallible call returns.
-//! - [`geometry`]: rigid poses, rays and the ray–triangle test.
-//! - [`bvh`]: the 4-wide traversal layout flattened from parry's BVH.
-//! - [`packet`]: coherent rays traced together.
-//! - [`mesh`]: triangle meshes with per-face semantic classes and a parry bottom-level BVH built once.
+//! - [`geometry`]: rigid poses and the watertight ray–triangle test (one triangle or a block of four).
+//! - [`ray`]: a ray prepared once for its box and triangle tests.
+//! - [`bvh`]: binned-SAH BVHs collapsed to 8-wide nodes, traversed nearest child first.
+//! - [`simd`]: run-time CPU feature dispatch (AVX2 where available, portable otherwise).
+//! - [`mesh`]: triangle meshes with per-face semantic classes and a bottom-level BVH built once.
 //! - [`scene`]: meshes placed as instances, a top-level BVH over them, and batch ray casting over rayon.
 //! - [`export`]: the world triangles at the current poses as PLY or OBJ.
 //! - [`sensors`]: sensor ray patterns (LiDAR sweeps, pinhole cameras), the marine radar and its PPI image.
@@ -26,10 +27,11 @@ pub mod export;
 pub mod geometry;
 pub mod kinematics;
 pub mod mesh;
-pub mod packet;
+pub mod ray;
 pub mod record;
 pub mod scene;
 pub mod sensors;
+pub mod simd;
 
 pub use error::{MmusvError, Result};
 pub use geometry::RigidPose;

@@ -1,17 +1,15 @@
 //! Triangle meshes with per-face semantic classes and a bottom-level BVH.
 //!
-//! A [`Mesh`] is built once (validated, triangles prepared, parry [`Bvh`] built over the face AABBs) and is
-//! then shared, read-only, by every instance that places it in a [`crate::Scene`]. Moving an instance never
-//! touches its mesh.
+//! A [`Mesh`] is built once (validated, an 8-wide [`Bvh`] built over the face boxes, the faces packed four to a
+//! [`TriBlock`] in leaf order) and is then shared, read-only, by every instance that places it in a
+//! [`crate::Scene`]. Moving an instance never touches its mesh.
 
-use crate::bvh::{Bvh4, RayInv};
+use crate::bvh::{Box3, Bvh, Packet, PacketStack, PacketVisit, Stack, Visit, PACKET};
 use crate::error::{MmusvError, Result};
-use crate::geometry::PreparedTriangle;
-use crate::packet::{Packet, PACKET};
+use crate::geometry::{PreparedTriangle, TriBlock, BLOCK};
+use crate::ray::RayPrep;
 use parry3d::bounding_volume::Aabb;
 use parry3d::math::Vec3;
-use parry3d::partitioning::{Bvh, BvhBuildStrategy};
-use parry3d::query::Ray;
 
 /// A validated triangle mesh in its local frame, with a bottom-level BVH.
 #[derive(Debug, Clone)]
@@ -22,8 +20,8 @@ pub struct Mesh {
     classes: Vec<u16>,
     triangles: Vec<PreparedTriangle>,
     bvh: Bvh,
-    /// The flattened 4-wide copy of `bvh` used for traversal, with triangles in its leaf order.
-    fast: Option<(Bvh4, Vec<PreparedTriangle>)>,
+    /// One block of up to [`BLOCK`] triangles per BVH leaf, by leaf index.
+    blocks: Vec<TriBlock>,
     aabb: Aabb,
 }
 
@@ -84,21 +82,28 @@ impl Mesh {
             .iter()
             .map(|f| PreparedTriangle::new(verts[f[0] as usize], verts[f[1] as usize], verts[f[2] as usize]))
             .collect();
-        let bvh = Bvh::from_iter(
-            BvhBuildStrategy::Binned,
-            checked.iter().enumerate().map(|(i, f)| {
-                let a = verts[f[0] as usize];
-                let b = verts[f[1] as usize];
-                let c = verts[f[2] as usize];
-                (i, Aabb::new(a.min(b).min(c), a.max(b).max(c)))
-            }),
-        );
+        let boxes: Vec<Box3> = triangles
+            .iter()
+            .map(|t| {
+                let mut b = Box3::EMPTY;
+                for p in t.v {
+                    b.grow_point(p.to_array());
+                }
+                b
+            })
+            .collect();
+        let bvh = Bvh::new(&boxes, BLOCK);
+        let blocks = bvh
+            .leaves()
+            .iter()
+            .map(|lf| {
+                let ids = &bvh.order()[lf.start as usize..(lf.start + lf.count) as usize];
+                let tris: Vec<(u32, PreparedTriangle)> = ids.iter().map(|&i| (i, triangles[i as usize])).collect();
+                TriBlock::new(&tris)
+            })
+            .collect();
         let aabb = Aabb::from_points(verts.iter().copied());
-        let fast = Bvh4::from_parry(&bvh, triangles.len()).map(|b4| {
-            let ordered = b4.order().iter().map(|&i| triangles[i as usize]).collect();
-            (b4, ordered)
-        });
-        Ok(Self { name, vertices: verts, faces: checked, classes, triangles, bvh, fast, aabb })
+        Ok(Self { name, vertices: verts, faces: checked, classes, triangles, bvh, blocks, aabb })
     }
 
     /// The mesh's name (free text, used in exports and errors).
@@ -125,6 +130,10 @@ impl Mesh {
     pub fn aabb(&self) -> &Aabb {
         &self.aabb
     }
+    /// The BVH over the faces.
+    pub fn bvh(&self) -> &Bvh {
+        &self.bvh
+    }
     /// The prepared triangle `i` (panics-free: callers only pass ids returned by the BVH).
     pub(crate) fn triangle(&self, i: u32) -> &PreparedTriangle {
         &self.triangles[i as usize]
@@ -133,75 +142,154 @@ impl Mesh {
     /// Closest hit of the ray `origin + t·dir`, `0 < t < t_max`, in the local frame.
     #[inline]
     pub fn cast_local(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<LocalHit> {
-        self.cast_local_with(origin, dir, t_max, &mut Vec::new())
+        self.closest(&RayPrep::new(origin.to_array(), dir.to_array()), t_max, &mut Stack::default())
     }
 
-    /// [`Mesh::cast_local`] with caller-owned traversal scratch space (reuse it across rays).
-    #[inline]
-    pub fn cast_local_with(
-        &self,
-        origin: Vec3,
-        dir: Vec3,
-        t_max: f32,
-        stack: &mut Vec<(u32, f32)>,
-    ) -> Option<LocalHit> {
-        match &self.fast {
-            Some((b4, tris)) => b4
-                .closest(&RayInv::new(origin, dir), t_max, stack, |k, best| {
-                    tris[k as usize].intersect(origin, dir, best)
-                })
-                .map(|(k, t)| LocalHit { t, triangle: b4.order()[k as usize] }),
-            None => self.cast_local_parry(origin, dir, t_max),
-        }
+    /// Closest hit of a prepared ray (local frame) below `t_max`, with caller-owned traversal scratch space.
+    #[inline(always)]
+    pub fn closest(&self, ray: &RayPrep, t_max: f32, stack: &mut Stack) -> Option<LocalHit> {
+        let mut v = Blocks { blocks: &self.blocks, ray, hit: u32::MAX };
+        let t = self.bvh.closest(ray, t_max, stack, &mut v);
+        (v.hit != u32::MAX).then_some(LocalHit { t, triangle: v.hit })
     }
 
-    /// Traces a packet (in this mesh's local frame). Rays that hit closer than their current best get the
-    /// new distance and, in `prim`, the index of the triangle hit; other rays are left unchanged.
-    #[inline]
-    pub fn cast_packet_local(&self, p: &mut Packet, stack: &mut Vec<(u32, f32)>) {
-        match &self.fast {
-            Some((b4, tris)) => {
-                p.prim = [u32::MAX; PACKET];
-                b4.closest_packet(p, stack, |k, p| p.intersect_triangle(&tris[k as usize], k));
-                for prim in p.prim.iter_mut().filter(|k| **k != u32::MAX) {
-                    *prim = b4.order()[*prim as usize];
-                }
-            }
-            None => {
-                for r in 0..PACKET {
-                    p.prim[r] = u32::MAX;
-                    let o = Vec3::new(p.o[0][r], p.o[1][r], p.o[2][r]);
-                    let d = Vec3::new(p.d[0][r], p.d[1][r], p.d[2][r]);
-                    if p.best[r] > 0.0 {
-                        if let Some(h) = self.cast_local_parry(o, d, p.best[r]) {
-                            p.best[r] = h.t;
-                            p.prim[r] = h.triangle;
-                        }
-                    }
-                }
-            }
-        }
+    /// Whether the prepared ray (local frame) hits any triangle below `t_max`.
+    #[inline(always)]
+    pub fn any(&self, ray: &RayPrep, t_max: f32, stack: &mut Stack) -> bool {
+        let mut v = Blocks { blocks: &self.blocks, ray, hit: u32::MAX };
+        self.bvh.any(ray, t_max, stack, &mut v)
     }
 
-    /// Closest hit using parry's own best-first BVH query (the fallback of [`Mesh::cast_local`]).
-    pub fn cast_local_parry(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<LocalHit> {
-        let ray = Ray::new(origin, dir);
-        let tris = &self.triangles;
-        self.bvh
-            .cast_ray(&ray, t_max, |leaf, best| tris[leaf as usize].intersect(origin, dir, best))
-            .map(|(triangle, t)| LocalHit { t, triangle })
+    /// Traces a packet (local frame): every ray `r` that hits closer than `p.best[r]` gets the new distance and,
+    /// in `tri[r]`, the triangle hit; other rays are left unchanged.
+    #[inline(always)]
+    pub fn closest_packet(&self, p: &mut Packet, stack: &mut PacketStack, tri: &mut [u32; PACKET]) {
+        let mut v = PacketBlocks { blocks: &self.blocks, tri, any: false };
+        self.bvh.closest_packet(p, stack, &mut v);
+    }
+
+    /// Occlusion for a packet (local frame): every ray `r` that hits anything below `p.best[r]` gets
+    /// `p.best[r] = -1`.
+    #[inline(always)]
+    pub fn any_packet(&self, p: &mut Packet, stack: &mut PacketStack) {
+        let mut tri = [0u32; PACKET];
+        let mut v = PacketBlocks { blocks: &self.blocks, tri: &mut tri, any: true };
+        self.bvh.any_packet(p, stack, &mut v);
     }
 
     /// Brute-force closest hit over every triangle: the independent reference the tests compare against.
     pub fn cast_local_brute_force(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<LocalHit> {
+        let ray = RayPrep::new(origin.to_array(), dir.to_array());
         let mut best: Option<LocalHit> = None;
         for (i, tri) in self.triangles.iter().enumerate() {
             let limit = best.map_or(t_max, |h| h.t);
-            if let Some(t) = tri.intersect(origin, dir, limit) {
+            if let Some(t) = tri.intersect(&ray, limit) {
                 best = Some(LocalHit { t, triangle: i as u32 });
             }
         }
         best
+    }
+}
+
+/// The leaf visitor of a mesh: one triangle block per leaf.
+struct Blocks<'a> {
+    blocks: &'a [TriBlock],
+    ray: &'a RayPrep,
+    hit: u32,
+}
+
+/// The leaf visitor of a mesh for packets.
+struct PacketBlocks<'a> {
+    blocks: &'a [TriBlock],
+    tri: &'a mut [u32; PACKET],
+    any: bool,
+}
+
+impl PacketVisit for PacketBlocks<'_> {
+    #[inline(always)]
+    fn leaf(&mut self, leaf: u32, rays: u32, p: &mut Packet) {
+        let block = &self.blocks[leaf as usize];
+        if p.uniform_k && rays.count_ones() > 2 {
+            match p.ray[0].k[2] {
+                0 => self.across::<0>(block, rays, p),
+                1 => self.across::<1>(block, rays, p),
+                _ => self.across::<2>(block, rays, p),
+            }
+            return;
+        }
+        let mut m = rays;
+        while m != 0 {
+            let r = m.trailing_zeros() as usize;
+            m &= m - 1;
+            if let Some((t, id)) = block.intersect(&p.ray[r], p.best[r]) {
+                if self.any {
+                    p.best[r] = -1.0;
+                } else {
+                    p.best[r] = t;
+                    self.tri[r] = id;
+                }
+            }
+        }
+    }
+}
+
+impl PacketBlocks<'_> {
+    /// The block's triangles tested across the packet's rays (lanes = rays), one triangle at a time in lane
+    /// order, keeping a hit only when strictly closer: the same result as testing each ray on its own.
+    #[inline(always)]
+    fn across<const KZ: usize>(&mut self, block: &TriBlock, rays: u32, p: &mut Packet) {
+        let mut best = [-1f32; PACKET];
+        for r in 0..PACKET {
+            if rays & (1 << r) != 0 {
+                best[r] = p.best[r];
+            }
+        }
+        let start = best;
+        let mut hit = [u32::MAX; PACKET];
+        let mut lane_best = [f32::INFINITY; PACKET];
+        for lane in 0..BLOCK {
+            if lane > 0 && block.id[lane] == block.id[0] {
+                break; // padding repeats lane 0
+            }
+            let (tri, n) = block.lane(lane);
+            let t = crate::geometry::triangle_across_rays::<KZ, PACKET>(
+                tri,
+                n,
+                p.origins(),
+                p.directions(),
+                &p.shear,
+                &start,
+            );
+            for r in 0..PACKET {
+                if t[r] < lane_best[r] {
+                    lane_best[r] = t[r];
+                    hit[r] = block.id[lane];
+                }
+            }
+        }
+        for r in 0..PACKET {
+            if hit[r] != u32::MAX && lane_best[r] < best[r] {
+                if self.any {
+                    p.best[r] = -1.0;
+                } else {
+                    p.best[r] = lane_best[r];
+                    self.tri[r] = hit[r];
+                }
+            }
+        }
+    }
+}
+
+impl Visit for Blocks<'_> {
+    #[inline(always)]
+    fn leaf(&mut self, leaf: u32, best: f32) -> f32 {
+        match self.blocks[leaf as usize].intersect(self.ray, best) {
+            Some((t, id)) => {
+                self.hit = id;
+                t
+            }
+            None => best,
+        }
     }
 }
 
@@ -242,12 +330,11 @@ pub(crate) mod tests {
                 .normalize();
             let a = mesh.cast_local(o, d, 1e3);
             let b = mesh.cast_local_brute_force(o, d, 1e3);
-            let c = mesh.cast_local_parry(o, d, 1e3);
-            assert_eq!(a.map(|h| h.triangle), c.map(|h| h.triangle));
             match (a, b) {
                 (Some(a), Some(b)) => {
                     hits += 1;
-                    assert!((a.t - b.t).abs() <= 1e-4 * b.t.max(1.0), "{a:?} vs {b:?}");
+                    // The same triangle test on the same numbers: the same hit, bit for bit.
+                    assert_eq!(a, b);
                 }
                 (None, None) => {}
                 other => panic!("bvh and brute force disagree: {other:?}"),
@@ -257,16 +344,16 @@ pub(crate) mod tests {
     }
 
     #[test]
-    fn fast_bvh_is_built_for_small_and_large_meshes() {
+    fn bvh_finds_every_triangle_of_small_and_large_meshes() {
         let mut rng = ChaCha8Rng::seed_from_u64(3);
         for n in [1usize, 2, 3, 5, 17, 1000] {
             let (v, f) = random_soup(&mut rng, n);
             let mesh = Mesh::new("soup", &v, &f, &[1]).unwrap_or_else(|e| unreachable!("{e}"));
-            assert!(mesh.fast.is_some(), "flattening failed for {n} triangles");
+            assert_eq!(mesh.blocks.len(), mesh.bvh.leaves().len());
             let o = Vec3::new(0.0, 0.0, 50.0);
             for (i, t) in mesh.triangles.iter().enumerate() {
                 // Aim at each triangle's centroid: the hit must be found, at or before the centroid.
-                let c = t.v0 + (t.e1 + t.e2) / 3.0;
+                let c = t.centroid();
                 let d = (c - o).normalize();
                 let brute = mesh.cast_local_brute_force(o, d, 1e3);
                 let fast = mesh.cast_local(o, d, 1e3);

@@ -1,36 +1,33 @@
 //! A scene: meshes placed as instances, a top-level BVH over the instances, and batch ray casting.
 //!
-//! Two levels, as in hardware ray tracers: every [`Mesh`] owns a bottom-level parry BVH built once; the scene
-//! keeps one top-level parry BVH over the instances' world-space boxes. Moving instances recomputes their
-//! boxes and rebuilds only the top level (tens of instances: microseconds); no mesh BVH is ever rebuilt.
-//! Static geometry (terrain, quays) is simply an instance that never moves.
+//! Two levels, as in hardware ray tracers: every [`Mesh`] owns a bottom-level BVH built once; the scene
+//! keeps one top-level BVH over the instances' world-space boxes. Moving instances recomputes their boxes and
+//! rebuilds only the top level (tens of instances: microseconds); no mesh BVH is ever rebuilt. Static geometry
+//! (terrain, quays) is simply an instance that never moves. Within a top-level leaf the instances are tested
+//! cheapest first (fewest triangles), so a 2-triangle water plane shortens a ray before a 500k-triangle
+//! terrain sharing its leaf is entered.
 //!
-//! Rays are cast in parallel over rayon. Distances are metres along the normalised direction.
+//! Rays are cast in parallel over rayon, one ray at a time through 8-wide nodes (see [`crate::bvh`]), with
+//! AVX2 where the CPU has it ([`crate::simd`]). Distances are metres along the normalised direction.
 
-use crate::bvh::{Bvh4, RayInv};
+use crate::bvh::{box_entry, Box3, Bvh, Packet, PacketStack, PacketVisit, Stack, Visit, PACKET};
 use crate::error::{MmusvError, Result};
 use crate::geometry::RigidPose;
 use crate::mesh::Mesh;
-use crate::packet::{Packet, PACKET};
+use crate::ray::RayPrep;
 use parry3d::bounding_volume::Aabb;
 use parry3d::math::Vec3;
-use parry3d::partitioning::{Bvh, BvhBuildStrategy};
-use parry3d::query::Ray;
 use rayon::prelude::*;
-use std::cell::Cell;
 use std::sync::Arc;
 
 /// Value of `instance`, `triangle` for a ray that hit nothing.
 pub const NO_HIT: i32 = -1;
 /// Semantic class reported for a ray that hit nothing (sky / no return).
 pub const CLASS_NONE: u16 = 0;
-/// Rays per rayon task: large enough to amortise scheduling, small enough to balance (a multiple of [`PACKET`]).
+/// Rays per rayon task: large enough to amortise scheduling, small enough to balance.
 const CHUNK: usize = 512;
-/// Rays whose directions lie within ≈8° of each other and whose origins lie within 4 m are traced as a packet
-/// (camera pixels share an origin; the parallel rays of 8 neighbouring top-view pixels span ≈ 4 m).
-const COHERENT_COS: f32 = 0.990;
-/// See [`COHERENT_COS`].
-const COHERENT_RADIUS: f32 = 4.0;
+/// Instances per top-level leaf.
+const TLAS_LEAF: usize = 4;
 
 /// One placed copy of a mesh.
 #[derive(Debug, Clone)]
@@ -108,9 +105,17 @@ impl RayHits {
 /// Per-thread traversal stacks, reused across rays.
 #[derive(Debug, Default)]
 pub struct Scratch {
-    top: Vec<(u32, f32)>,
-    bottom: Vec<(u32, f32)>,
+    top: Stack,
+    bottom: Stack,
+    packet_top: PacketStack,
+    packet_bottom: PacketStack,
 }
+
+/// Rays traced as one packet must start within this many metres of the packet's first ray (camera pixels share
+/// an origin; neighbouring shadow-ray or top-view origins lie close together).
+const COHERENT_RADIUS: f32 = 4.0;
+/// ... and point within ≈ 11° of its direction.
+const COHERENT_COS: f32 = 0.98;
 
 /// Meshes, instances and the top-level BVH.
 #[derive(Debug, Clone, Default)]
@@ -118,9 +123,12 @@ pub struct Scene {
     meshes: Vec<Arc<Mesh>>,
     instances: Vec<Instance>,
     world_aabbs: Vec<Aabb>,
+    /// Top-level BVH over `world_aabbs`.
     tlas: Bvh,
-    /// Flattened copy of `tlas` used for traversal (`None` only if flattening failed or the scene is empty).
-    tlas4: Option<Bvh4>,
+    /// `tlas.order()` with every leaf's instances sorted cheapest first.
+    tlas_order: Vec<u32>,
+    /// World box of the instance at each position of `tlas_order` (tested before a ray enters its mesh).
+    tlas_boxes: Vec<Box3>,
 }
 
 impl Scene {
@@ -179,11 +187,16 @@ impl Scene {
             let he = abs * h;
             self.world_aabbs[id as usize] = Aabb::new(c - he, c + he);
         }
-        self.tlas = Bvh::from_iter(BvhBuildStrategy::Binned, self.world_aabbs.iter().copied().enumerate());
-        let (instances, meshes) = (&self.instances, &self.meshes);
-        self.tlas4 = Bvh4::from_parry_with_cost(&self.tlas, instances.len(), |i| {
-            meshes[instances[i as usize].mesh as usize].num_triangles() as f32
-        });
+        let boxes: Vec<Box3> =
+            self.world_aabbs.iter().map(|a| Box3 { lo: a.mins.to_array(), hi: a.maxs.to_array() }).collect();
+        self.tlas = Bvh::new(&boxes, TLAS_LEAF);
+        let mut order = self.tlas.order().to_vec();
+        let cost = |i: u32| self.meshes[self.instances[i as usize].mesh as usize].num_triangles();
+        for lf in self.tlas.leaves() {
+            order[lf.start as usize..(lf.start + lf.count) as usize].sort_by_key(|&i| (cost(i), i));
+        }
+        self.tlas_boxes = order.iter().map(|&i| boxes[i as usize]).collect();
+        self.tlas_order = order;
     }
 
     fn check_mesh(&self, mesh: u32) -> Result<()> {
@@ -235,82 +248,63 @@ impl Scene {
     }
 
     /// [`Scene::cast_ray`] with caller-owned traversal scratch space (reuse one per thread).
-    #[inline]
+    #[inline(always)]
     pub fn cast_ray_with(&self, origin: Vec3, dir: Vec3, max_range: f32, scratch: &mut Scratch) -> Option<Hit> {
-        let best_tri = Cell::new(u32::MAX);
-        let Scratch { top, bottom } = scratch;
-        let mut cast_instance = |leaf: u32, best: f32| {
-            let inst = &self.instances[leaf as usize];
-            let mesh = &self.meshes[inst.mesh as usize];
-            let o = inst.pose.inverse_transform_point(origin);
-            let d = inst.pose.inverse_transform_vector(dir);
-            let hit = mesh.cast_local_with(o, d, best, bottom)?;
-            best_tri.set(hit.triangle);
-            Some(hit.t)
-        };
-        let (instance, distance) = match &self.tlas4 {
-            Some(t4) => {
-                let (k, t) = t4.closest(&RayInv::new(origin, dir), max_range, top, |k, best| {
-                    cast_instance(t4.order()[k as usize], best)
-                })?;
-                (t4.order()[k as usize], t)
-            }
-            None => {
-                let cell = std::cell::RefCell::new(cast_instance);
-                self.tlas.cast_ray(&Ray::new(origin, dir), max_range, |leaf, best| (cell.borrow_mut())(leaf, best))?
-            }
-        };
-        Some(Hit { distance, instance, triangle: best_tri.get() })
+        self.cast_prepared(&RayPrep::new(origin.to_array(), dir.to_array()), max_range, scratch)
     }
 
-    /// Closest hits of up to [`PACKET`] coherent rays traced together (`dirs` unit length). Results are the
-    /// same as [`Scene::cast_ray_with`] per ray.
-    pub fn cast_packet_with(
-        &self,
-        origins: &[[f32; 3]],
-        dirs: &[[f32; 3]],
-        max_range: f32,
-        scratch: &mut Scratch,
-    ) -> [Option<Hit>; PACKET] {
-        let mut out = [None; PACKET];
-        let Some(t4) = &self.tlas4 else {
-            for (r, (o, d)) in origins.iter().zip(dirs).take(PACKET).enumerate() {
-                out[r] = self.cast_ray_with(Vec3::from_array(*o), Vec3::from_array(*d), max_range, scratch);
-            }
-            return out;
+    /// [`Scene::cast_ray_with`] for a prepared world ray.
+    #[inline(always)]
+    pub fn cast_prepared(&self, ray: &RayPrep, max_range: f32, scratch: &mut Scratch) -> Option<Hit> {
+        let mut v = Instances { scene: self, ray, stack: &mut scratch.bottom, instance: u32::MAX, triangle: u32::MAX };
+        let t = self.tlas.closest(ray, max_range, &mut scratch.top, &mut v);
+        (v.instance != u32::MAX).then_some(Hit { distance: t, instance: v.instance, triangle: v.triangle })
+    }
+
+    /// Traces a packet of prepared world rays: for every ray `r`, `p.best[r]` becomes its closest hit distance
+    /// (unchanged if nothing is hit closer) and the returned arrays hold the instance and triangle hit
+    /// (`u32::MAX` for none). Each ray's hit is the one [`Scene::cast_ray_with`] finds for it.
+    #[inline(always)]
+    pub fn cast_packet_with(&self, p: &mut Packet, scratch: &mut Scratch) -> ([u32; PACKET], [u32; PACKET]) {
+        let mut v = PacketInstances {
+            scene: self,
+            scratch_single: &mut scratch.bottom,
+            stack: &mut scratch.packet_bottom,
+            instance: [u32::MAX; PACKET],
+            triangle: [u32::MAX; PACKET],
+            any: false,
         };
-        let mut p = Packet::new(origins, dirs, max_range);
-        let mut tri = [u32::MAX; PACKET];
-        let Scratch { top, bottom } = scratch;
-        t4.closest_packet(&mut p, top, |k, p| {
-            let id = t4.order()[k as usize];
-            let inst = &self.instances[id as usize];
-            let mut local = *p;
-            let rt = inst.pose.rotation.transpose();
-            for r in 0..PACKET {
-                let o = rt * (Vec3::new(p.o[0][r], p.o[1][r], p.o[2][r]) - inst.pose.translation);
-                let d = rt * Vec3::new(p.d[0][r], p.d[1][r], p.d[2][r]);
-                for a in 0..3 {
-                    local.o[a][r] = o[a];
-                    local.d[a][r] = d[a];
-                }
-            }
-            local.refresh_inverse();
-            self.meshes[inst.mesh as usize].cast_packet_local(&mut local, bottom);
-            for r in 0..PACKET {
-                if local.prim[r] != u32::MAX {
-                    p.best[r] = local.best[r];
-                    p.prim[r] = id;
-                    tri[r] = local.prim[r];
-                }
-            }
-        });
-        for r in 0..origins.len().min(PACKET) {
-            if p.prim[r] != u32::MAX {
-                out[r] = Some(Hit { distance: p.best[r], instance: p.prim[r], triangle: tri[r] });
-            }
-        }
-        out
+        self.tlas.closest_packet(p, &mut scratch.packet_top, &mut v);
+        (v.instance, v.triangle)
+    }
+
+    /// Occlusion for a packet of prepared world rays: afterwards `p.best[r] < 0` for every ray blocked below its
+    /// starting `p.best[r]`.
+    #[inline(always)]
+    pub fn occluded_packet_with(&self, p: &mut Packet, scratch: &mut Scratch) {
+        let mut v = PacketInstances {
+            scene: self,
+            scratch_single: &mut scratch.bottom,
+            stack: &mut scratch.packet_bottom,
+            instance: [u32::MAX; PACKET],
+            triangle: [u32::MAX; PACKET],
+            any: true,
+        };
+        self.tlas.any_packet(p, &mut scratch.packet_top, &mut v);
+    }
+
+    /// Whether the ray `origin + t·dir` (`dir` unit length) hits anything with `0 < t < max_range`: the shadow-ray
+    /// query, which stops at the first hit found instead of looking for the closest.
+    #[inline(always)]
+    pub fn occluded_with(&self, origin: Vec3, dir: Vec3, max_range: f32, scratch: &mut Scratch) -> bool {
+        self.occluded_prepared(&RayPrep::new(origin.to_array(), dir.to_array()), max_range, scratch)
+    }
+
+    /// [`Scene::occluded_with`] for a prepared world ray.
+    #[inline(always)]
+    pub fn occluded_prepared(&self, ray: &RayPrep, max_range: f32, scratch: &mut Scratch) -> bool {
+        let mut v = AnyInstance { scene: self, ray, stack: &mut scratch.bottom };
+        self.tlas.any(ray, max_range, &mut scratch.top, &mut v)
     }
 
     /// Unit world normal (triangle winding) and semantic class of a hit.
@@ -345,39 +339,22 @@ impl Scene {
         )
             .into_par_iter()
             .for_each(|(dist, inst, tri, nrm, cls, back, o, d)| {
-                let mut scratch = Scratch::default();
-                let mut store = |i: usize, dir: Vec3, hit: Option<Hit>| {
-                    if let Some(hit) = hit {
-                        let (n, c) = self.hit_normal_class(&hit);
-                        dist[i] = hit.distance;
-                        inst[i] = hit.instance as i32;
-                        tri[i] = hit.triangle as i32;
-                        nrm[3 * i..3 * i + 3].copy_from_slice(&n.to_array());
-                        cls[i] = c;
-                        back[i] = n.dot(dir) > 0.0;
-                    }
-                };
-                for start in (0..o.len()).step_by(PACKET) {
-                    let end = (start + PACKET).min(o.len());
-                    let mut unit = [[0.0f32; 3]; PACKET];
-                    for (u, src) in unit.iter_mut().zip(&d[start..end]) {
-                        *u = unit_direction(src);
-                    }
-                    let unit = &unit[..end - start];
-                    if end - start > 1 && Packet::is_coherent(&o[start..end], unit, COHERENT_COS, COHERENT_RADIUS) {
-                        let hits = self.cast_packet_with(&o[start..end], unit, limit, &mut scratch);
-                        for (r, hit) in hits.into_iter().take(end - start).enumerate() {
-                            store(start + r, Vec3::from_array(unit[r]), hit);
-                        }
-                    } else {
-                        for (r, u) in unit.iter().enumerate() {
-                            let dir = Vec3::from_array(*u);
-                            let hit = self.cast_ray_with(Vec3::from_array(o[start + r]), dir, limit, &mut scratch);
-                            store(start + r, dir, hit);
-                        }
-                    }
-                }
+                trace_chunk(self, o, d, limit, ChunkOut { dist, inst, tri, nrm, cls, back });
             });
+        Ok(out)
+    }
+
+    /// Shadow-ray batch: for each ray, whether anything is hit with `0 < t < max_range` (see
+    /// [`Scene::occluded_with`]). Same argument rules and errors as [`Scene::cast_rays`].
+    pub fn occluded_rays(&self, origins: &[[f32; 3]], dirs: &[[f32; 3]], max_range: f32) -> Result<Vec<bool>> {
+        validate_rays(origins, dirs, max_range)?;
+        let mut out = vec![false; origins.len()];
+        let limit = if max_range.is_finite() { max_range } else { f32::MAX };
+        out.par_chunks_mut(CHUNK).zip(origins.par_chunks(CHUNK)).zip(dirs.par_chunks(CHUNK)).for_each(
+            |((out, o), d)| {
+                occlusion_chunk(self, o, d, limit, out);
+            },
+        );
         Ok(out)
     }
 
@@ -397,6 +374,274 @@ impl Scene {
             w.triangles.extend(0..mesh.num_triangles() as u32);
         }
         w
+    }
+}
+
+/// The top-level leaf visitor of [`Scene::cast_ray_with`]: each instance's mesh, cheapest first, in its local
+/// frame (instances at the identity pose use the world ray as it is).
+struct Instances<'a> {
+    scene: &'a Scene,
+    ray: &'a RayPrep,
+    stack: &'a mut Stack,
+    instance: u32,
+    triangle: u32,
+}
+
+impl Visit for Instances<'_> {
+    #[inline(always)]
+    fn leaf(&mut self, leaf: u32, mut best: f32) -> f32 {
+        let sc = self.scene;
+        let lf = sc.tlas.leaves()[leaf as usize];
+        for k in lf.start as usize..(lf.start + lf.count) as usize {
+            if !box_entry(&sc.tlas_boxes[k], self.ray, best) {
+                continue;
+            }
+            let id = sc.tlas_order[k];
+            let inst = &sc.instances[id as usize];
+            let mesh = &sc.meshes[inst.mesh as usize];
+            let local = local_ray(self.ray, &inst.pose);
+            if let Some(h) = mesh.closest(local.as_ref().unwrap_or(self.ray), best, self.stack) {
+                best = h.t;
+                self.instance = id;
+                self.triangle = h.triangle;
+            }
+        }
+        best
+    }
+}
+
+/// The top-level leaf visitor of [`Scene::occluded_with`].
+struct AnyInstance<'a> {
+    scene: &'a Scene,
+    ray: &'a RayPrep,
+    stack: &'a mut Stack,
+}
+
+impl Visit for AnyInstance<'_> {
+    #[inline(always)]
+    fn leaf(&mut self, leaf: u32, best: f32) -> f32 {
+        let sc = self.scene;
+        let lf = sc.tlas.leaves()[leaf as usize];
+        for k in lf.start as usize..(lf.start + lf.count) as usize {
+            if !box_entry(&sc.tlas_boxes[k], self.ray, best) {
+                continue;
+            }
+            let id = sc.tlas_order[k];
+            let inst = &sc.instances[id as usize];
+            let local = local_ray(self.ray, &inst.pose);
+            if sc.meshes[inst.mesh as usize].any(local.as_ref().unwrap_or(self.ray), best, self.stack) {
+                return 0.0;
+            }
+        }
+        best
+    }
+}
+
+/// The ray in an instance's local frame, or `None` when the pose is the identity (the world ray then serves).
+#[inline(always)]
+fn local_ray(ray: &RayPrep, pose: &RigidPose) -> Option<RayPrep> {
+    if *pose == RigidPose::IDENTITY {
+        return None;
+    }
+    let rt = pose.rotation.transpose();
+    let o = rt * (Vec3::from_array(ray.o) - pose.translation);
+    let d = rt * Vec3::from_array(ray.d);
+    Some(RayPrep::new(o.to_array(), d.to_array()))
+}
+
+/// Output slices of one chunk of [`Scene::cast_rays`].
+struct ChunkOut<'a> {
+    dist: &'a mut [f32],
+    inst: &'a mut [i32],
+    tri: &'a mut [i32],
+    nrm: &'a mut [f32],
+    cls: &'a mut [u16],
+    back: &'a mut [bool],
+}
+
+/// Whether the prepared rays are worth tracing as one packet (see [`COHERENT_RADIUS`], [`COHERENT_COS`]).
+#[inline(always)]
+fn coherent(rays: &[RayPrep]) -> bool {
+    let Some(r0) = rays.first() else { return false };
+    rays.len() > 1
+        && rays.iter().all(|r| {
+            let dc = r.d[0] * r0.d[0] + r.d[1] * r0.d[1] + r.d[2] * r0.d[2];
+            let o2 = (r.o[0] - r0.o[0]).powi(2) + (r.o[1] - r0.o[1]).powi(2) + (r.o[2] - r0.o[2]).powi(2);
+            dc >= COHERENT_COS && o2 <= COHERENT_RADIUS * COHERENT_RADIUS
+        })
+}
+
+crate::dispatch! {
+    /// Traces one chunk of rays (normalising each direction) and stores the hits: coherent groups of
+    /// [`PACKET`] consecutive rays as packets, the others one by one; both give each ray the same hit.
+    fn trace_chunk(scene: &Scene, o: &[[f32; 3]], d: &[[f32; 3]], limit: f32, out: ChunkOut<'_>) {
+        let mut scratch = Scratch::default();
+        let mut store = |i: usize, dir: Vec3, hit: Hit| {
+            let (n, c) = scene.hit_normal_class(&hit);
+            out.dist[i] = hit.distance;
+            out.inst[i] = hit.instance as i32;
+            out.tri[i] = hit.triangle as i32;
+            out.nrm[3 * i..3 * i + 3].copy_from_slice(&n.to_array());
+            out.cls[i] = c;
+            out.back[i] = n.dot(dir) > 0.0;
+        };
+        for start in (0..o.len()).step_by(PACKET) {
+            let end = (start + PACKET).min(o.len());
+            let mut rays = [RayPrep::new([0.0; 3], [1.0, 0.0, 0.0]); PACKET];
+            for i in start..end {
+                rays[i - start] = RayPrep::new(o[i], unit_direction(&d[i]));
+            }
+            let rays = &rays[..end - start];
+            let packet = if coherent(rays) { Packet::new(rays, limit) } else { None };
+            if let Some(mut p) = packet {
+                let (inst, tri) = scene.cast_packet_with(&mut p, &mut scratch);
+                for r in 0..rays.len() {
+                    if inst[r] != u32::MAX {
+                        let hit = Hit { distance: p.best[r], instance: inst[r], triangle: tri[r] };
+                        store(start + r, Vec3::from_array(rays[r].d), hit);
+                    }
+                }
+            } else {
+                for (r, ray) in rays.iter().enumerate() {
+                    if let Some(hit) = scene.cast_prepared(ray, limit, &mut scratch) {
+                        store(start + r, Vec3::from_array(ray.d), hit);
+                    }
+                }
+            }
+        }
+    }
+}
+
+crate::dispatch! {
+    /// Shadow-ray queries of one chunk (directions normalised here), packets where the rays are coherent.
+    fn occlusion_chunk(scene: &Scene, o: &[[f32; 3]], d: &[[f32; 3]], limit: f32, out: &mut [bool]) {
+        let mut scratch = Scratch::default();
+        for start in (0..o.len()).step_by(PACKET) {
+            let end = (start + PACKET).min(o.len());
+            let mut rays = [RayPrep::new([0.0; 3], [1.0, 0.0, 0.0]); PACKET];
+            for i in start..end {
+                rays[i - start] = RayPrep::new(o[i], unit_direction(&d[i]));
+            }
+            let rays = &rays[..end - start];
+            let packet = if coherent(rays) { Packet::new(rays, limit) } else { None };
+            if let Some(mut p) = packet {
+                scene.occluded_packet_with(&mut p, &mut scratch);
+                for r in 0..rays.len() {
+                    out[start + r] = p.best[r] < 0.0;
+                }
+            } else {
+                for (r, ray) in rays.iter().enumerate() {
+                    out[start + r] = scene.occluded_prepared(ray, limit, &mut scratch);
+                }
+            }
+        }
+    }
+}
+
+/// The top-level leaf visitor of packets: each instance whose box some ray enters, cheapest first; its mesh
+/// is traced with the rays that enter its box, as a packet in the instance's frame where their directions
+/// still share signs there, else ray by ray.
+struct PacketInstances<'a> {
+    scene: &'a Scene,
+    scratch_single: &'a mut Stack,
+    stack: &'a mut PacketStack,
+    instance: [u32; PACKET],
+    triangle: [u32; PACKET],
+    any: bool,
+}
+
+impl PacketVisit for PacketInstances<'_> {
+    #[inline(always)]
+    fn leaf(&mut self, leaf: u32, rays: u32, p: &mut Packet) {
+        let sc = self.scene;
+        let lf = sc.tlas.leaves()[leaf as usize];
+        for k in lf.start as usize..(lf.start + lf.count) as usize {
+            let bx = &sc.tlas_boxes[k];
+            let mut mask = 0u32;
+            let mut m = rays;
+            while m != 0 {
+                let r = m.trailing_zeros() as usize;
+                m &= m - 1;
+                if p.best[r] >= 0.0 && box_entry(bx, &p.ray[r], p.best[r]) {
+                    mask |= 1 << r;
+                }
+            }
+            if mask == 0 {
+                continue;
+            }
+            let id = sc.tlas_order[k];
+            let inst = &sc.instances[id as usize];
+            let mesh = &sc.meshes[inst.mesh as usize];
+            if inst.pose == RigidPose::IDENTITY {
+                // Trace the world packet, with the rays outside `mask` switched off for this instance.
+                let saved = p.best;
+                for r in 0..PACKET {
+                    if mask & (1 << r) == 0 {
+                        p.best[r] = -1.0;
+                    }
+                }
+                let mut tri = [u32::MAX; PACKET];
+                if self.any {
+                    mesh.any_packet(p, self.stack);
+                } else {
+                    mesh.closest_packet(p, self.stack, &mut tri);
+                }
+                for r in 0..PACKET {
+                    if mask & (1 << r) == 0 {
+                        p.best[r] = saved[r];
+                    } else if !self.any && p.best[r] < saved[r] {
+                        self.instance[r] = id;
+                        self.triangle[r] = tri[r];
+                    }
+                }
+                continue;
+            }
+            // Moved instance: the rays in its frame.
+            let mut local = [p.ray[0]; PACKET];
+            let mut lane = [0usize; PACKET];
+            let mut n = 0;
+            let mut m = mask;
+            while m != 0 {
+                let r = m.trailing_zeros() as usize;
+                m &= m - 1;
+                local[n] = local_ray(&p.ray[r], &inst.pose).unwrap_or(p.ray[r]);
+                lane[n] = r;
+                n += 1;
+            }
+            let sub = if n > 1 { Packet::new(&local[..n], 0.0) } else { None };
+            if let Some(mut q) = sub {
+                for j in 0..n {
+                    q.best[j] = p.best[lane[j]];
+                }
+                let mut tri = [u32::MAX; PACKET];
+                if self.any {
+                    mesh.any_packet(&mut q, self.stack);
+                } else {
+                    mesh.closest_packet(&mut q, self.stack, &mut tri);
+                }
+                for j in 0..n {
+                    let r = lane[j];
+                    if q.best[j] < p.best[r] {
+                        p.best[r] = q.best[j];
+                        self.instance[r] = id;
+                        self.triangle[r] = tri[j];
+                    }
+                }
+            } else {
+                for j in 0..n {
+                    let r = lane[j];
+                    if self.any {
+                        if mesh.any(&local[j], p.best[r], self.scratch_single) {
+                            p.best[r] = -1.0;
+                        }
+                    } else if let Some(h) = mesh.closest(&local[j], p.best[r], self.scratch_single) {
+                        p.best[r] = h.t;
+                        self.instance[r] = id;
+                        self.triangle[r] = h.triangle;
+                    }
+                }
+            }
+        }
     }
 }
 
@@ -541,7 +786,7 @@ mod tests {
     }
 
     #[test]
-    fn coherent_packets_match_single_rays_and_brute_force() {
+    fn batch_matches_single_rays_and_brute_force() {
         let mut rng = ChaCha8Rng::seed_from_u64(5);
         let (v, f) = crate::mesh::tests::random_soup(&mut rng, 300);
         let mut s = Scene::new();
@@ -553,7 +798,7 @@ mod tests {
             let _ =
                 s.add_instance(boxm, RigidPose::from_xyz_rpy([8.0 * a.cos(), 8.0 * a.sin(), 0.0], [0.0, 0.0, a]), None);
         }
-        // A 96x64 pinhole image from above: rows of 8 neighbouring pixels form coherent packets.
+        // A 96x64 pinhole image from above.
         let body = crate::sensors::rays::pinhole_directions(96, 64, 1.6).unwrap_or_default();
         let cam = RigidPose::from_xyz_rpy([0.0, 0.0, 25.0], [0.0, 1.3, 0.2]);
         let dirs: Vec<[f32; 3]> = body.iter().map(|d| cam.transform_vector(Vec3::from_array(*d)).to_array()).collect();
@@ -576,7 +821,7 @@ mod tests {
             let brute = tris
                 .iter()
                 .enumerate()
-                .filter_map(|(k, t)| t.intersect(Vec3::from_array(origins[i]), d, 100.0).map(|t| (t, k)))
+                .filter_map(|(k, t)| t.intersect(&RayPrep::new(origins[i], d.to_array()), 100.0).map(|t| (t, k)))
                 .min_by(|a, b| a.0.total_cmp(&b.0));
             match brute {
                 Some((t, k)) => {

@@ -133,8 +133,13 @@ impl SensorEnv {
         wave_height_m: f32,
         shadows: bool,
     ) -> PyResult<Self> {
-        let colours = [("sun_direction", &sun_direction), ("sun_color", &sun_color), ("sky_zenith", &sky_zenith),
-            ("sky_horizon", &sky_horizon), ("fog_color", &fog_color)];
+        let colours = [
+            ("sun_direction", &sun_direction),
+            ("sun_color", &sun_color),
+            ("sky_zenith", &sky_zenith),
+            ("sky_horizon", &sky_horizon),
+            ("fog_color", &fog_color),
+        ];
         for (name, v) in colours {
             for &x in v.iter() {
                 env_value(name, x, false)?;

@@ -194,7 +194,7 @@ impl Lidar {
     pub fn new(cfg: LidarConfig) -> Result<Self> {
         cfg.validate()?;
         let pattern = rays::lidar_directions(&cfg.elevations, cfg.azimuth_steps)?;
-        let order = rays::lidar_trace_order(cfg.elevations.len() as u32, cfg.azimuth_steps, 8)?;
+        let order = rays::lidar_trace_order(cfg.elevations.len() as u32, cfg.azimuth_steps, rays::TRACE_BLOCK)?;
         Ok(Self { cfg, pattern, order })
     }
 

@@ -44,7 +44,7 @@ pub const MAX_RAYS: u64 = 1 << 24;
 /// Largest `range_max_m`, metres.
 pub const MAX_RANGE_M: f64 = 100_000.0;
 /// Neighbouring azimuth samples traced together (one packet per elevation row).
-const TRACE_BLOCK: usize = crate::packet::PACKET;
+const TRACE_BLOCK: usize = super::rays::TRACE_BLOCK as usize;
 /// Golden-ratio conjugate: the elevation offset of azimuth sample `g` is `frac(g · φ⁻¹)`.
 const GOLDEN: f64 = 0.618_033_988_749_894_8;
 /// A clutter-only cell whose mean is below `threshold / CLUTTER_CUTOFF` is detected with probability

@@ -97,8 +97,12 @@ pub fn lidar_directions(elevations: &[f64], azimuth_steps: u32) -> Result<Vec<[f
     Ok(out)
 }
 
+/// Neighbouring columns traced one after the other by the LiDAR and radar ([`lidar_trace_order`]): consecutive
+/// rays are then nearly parallel and walk nearly the same BVH nodes, which keeps them in cache.
+pub const TRACE_BLOCK: u32 = 8;
+
 /// The order in which a sweep is best traced: blocks of `block` neighbouring columns, and within a block each
-/// channel's `block` rays consecutively, so consecutive rays are nearly parallel and form coherent packets.
+/// channel's `block` rays consecutively, so consecutive rays are nearly parallel and visit nearly the same nodes.
 /// Entry `i` is the index, in [`lidar_directions`]'s azimuth-major order, of the `i`-th ray to trace.
 pub fn lidar_trace_order(channels: u32, azimuth_steps: u32, block: u32) -> Result<Vec<u32>> {
     if channels == 0 || channels > MAX_CHANNELS {

@@ -1,0 +1,337 @@
+//! Bounding volume hierarchies: an 8-wide BVH built by binned SAH and traversed one ray at a time with every
+//! node's eight box tests done together.
+//!
+//! * [`build`]: the binary SAH build over primitive boxes (parallel, deterministic).
+//! * [`wide`]: the collapse into 8-wide nodes in structure-of-arrays layout.
+//! * [`packet`]: coherent rays traced together, with interval arithmetic at the nodes.
+//! * [`Bvh`] (here): the tree plus traversal, nearest child first with early termination ([`Bvh::closest`]) or
+//!   stopping at the first hit ([`Bvh::any`]). What a leaf holds is the caller's business: a [`Visit`]
+//!   implementation tests a leaf's primitives (a block of four triangles for a mesh, instances for a scene).
+//!
+//! The box tests are plain loops over the eight lanes of a node, written so the compiler turns them into SIMD
+//! instructions; the callers compile the traversal once per CPU feature level (see [`crate::simd`]), so the
+//! same binary uses AVX2 where the CPU has it and stays portable.
+
+pub mod build;
+pub mod packet;
+pub mod wide;
+
+use crate::ray::RayPrep;
+pub use build::{BinTree, Box3};
+pub use packet::{Packet, PacketStack, PacketVisit, PACKET};
+pub use wide::{Leaf, Node, Wide, EMPTY, LEAF, WIDTH};
+
+/// Primitives per SIMD block, the unit of leaf cost in the SAH build ([`crate::geometry::BLOCK`]).
+pub const BLOCK: usize = crate::geometry::BLOCK;
+
+/// `1 + 2γ₃` (pbrt's bound on the rounding of a slab test): far distances are scaled by it so rounding can never
+/// make a box test miss a ray that the watertight triangle test inside it hits.
+pub(crate) const FAR_SCALE: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
+
+/// Tests a leaf's primitives for [`Bvh::closest`] and [`Bvh::any`].
+pub trait Visit {
+    /// Tests the primitives of leaf `leaf` against the ray and returns the new closest distance (`best` if
+    /// nothing closer was hit). Implementations record what they hit themselves.
+    fn leaf(&mut self, leaf: u32, best: f32) -> f32;
+}
+
+/// Traversal scratch space, reused across rays (one per thread).
+#[derive(Debug, Default, Clone)]
+pub struct Stack {
+    entries: Vec<(u32, f32)>,
+}
+
+/// An 8-wide BVH over primitives `0..n`, with leaves of up to `max_leaf` primitives.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Bvh {
+    wide: Wide,
+    order: Vec<u32>,
+}
+
+impl Bvh {
+    /// Builds the tree over one box per primitive (boxes must be finite). An empty slice gives an empty tree.
+    pub fn new(boxes: &[Box3], max_leaf: usize) -> Self {
+        let tree = build::build(boxes, max_leaf);
+        let wide = wide::collapse(&tree);
+        Self { wide, order: tree.order }
+    }
+
+    /// Leaf order → primitive index.
+    pub fn order(&self) -> &[u32] {
+        &self.order
+    }
+
+    /// The leaves (ranges of [`Bvh::order`]), by leaf index.
+    pub fn leaves(&self) -> &[Leaf] {
+        &self.wide.leaves
+    }
+
+    /// The nodes.
+    pub fn nodes(&self) -> &[Node] {
+        &self.wide.nodes
+    }
+
+    /// Bounds of everything in the tree ([`Box3::EMPTY`] when empty).
+    pub fn bounds(&self) -> Box3 {
+        self.wide.bounds
+    }
+
+    /// Whether the tree holds no primitive.
+    pub fn is_empty(&self) -> bool {
+        self.wide.root == EMPTY
+    }
+
+    /// Closest hit along `ray` below `t_max`: walks the tree nearest child first, calls `visit.leaf` for every
+    /// leaf whose box the ray enters before the current best, and returns the final best distance (`t_max` if
+    /// nothing was hit).
+    #[inline(always)]
+    pub fn closest<V: Visit>(&self, ray: &RayPrep, t_max: f32, stack: &mut Stack, visit: &mut V) -> f32 {
+        let mut best = t_max;
+        let st = &mut stack.entries;
+        st.clear();
+        let mut cur = self.wide.root;
+        loop {
+            if cur != EMPTY {
+                if cur & LEAF != 0 {
+                    best = visit.leaf(cur & !LEAF, best);
+                } else {
+                    let node = &self.wide.nodes[cur as usize];
+                    let (mask, tn) = node_entry(node, ray, best);
+                    if mask != 0 {
+                        cur = push_nearest_last(node, mask, &tn, st);
+                        continue;
+                    }
+                }
+            }
+            // Pop the next entry that can still hold a closer hit.
+            loop {
+                let Some((next, t)) = st.pop() else { return best };
+                if t < best {
+                    cur = next;
+                    break;
+                }
+            }
+        }
+    }
+
+    /// Whether anything is hit along `ray` below `t_max`: like [`Bvh::closest`] but stops at the first leaf
+    /// that reports a hit (its returned distance below `t_max`).
+    #[inline(always)]
+    pub fn any<V: Visit>(&self, ray: &RayPrep, t_max: f32, stack: &mut Stack, visit: &mut V) -> bool {
+        let st = &mut stack.entries;
+        st.clear();
+        let mut cur = self.wide.root;
+        loop {
+            if cur != EMPTY {
+                if cur & LEAF != 0 {
+                    if visit.leaf(cur & !LEAF, t_max) < t_max {
+                        return true;
+                    }
+                } else {
+                    let node = &self.wide.nodes[cur as usize];
+                    let (mask, tn) = node_entry(node, ray, t_max);
+                    if mask != 0 {
+                        cur = push_nearest_last(node, mask, &tn, st);
+                        continue;
+                    }
+                }
+            }
+            let Some((next, _)) = st.pop() else { return false };
+            cur = next;
+        }
+    }
+}
+
+/// Entry distances of `ray` into the node's eight boxes and the mask of lanes it enters before `t_max`.
+#[inline(always)]
+pub fn node_entry(node: &Node, ray: &RayPrep, t_max: f32) -> (u32, [f32; WIDTH]) {
+    let [ox, oy, oz] = ray.o;
+    let [ix, iy, iz] = ray.inv;
+    let [nx, ny, nz] = ray.near;
+    let b = &node.bounds;
+    let (near_x, near_y, near_z) = (&b[nx], &b[ny], &b[nz]);
+    let (far_x, far_y, far_z) = (&b[(nx + 3) % 6], &b[(ny + 3) % 6], &b[(nz + 3) % 6]);
+    let mut t0 = [0f32; WIDTH];
+    let mut hit = [false; WIDTH];
+    for l in 0..WIDTH {
+        let a = max(max((near_x[l] - ox) * ix, (near_y[l] - oy) * iy), max((near_z[l] - oz) * iz, 0.0));
+        let f = min(min((far_x[l] - ox) * ix, (far_y[l] - oy) * iy), (far_z[l] - oz) * iz) * FAR_SCALE;
+        t0[l] = a;
+        hit[l] = a <= min(f, t_max);
+    }
+    let mut mask = 0u32;
+    for (l, &h) in hit.iter().enumerate() {
+        mask |= u32::from(h) << l;
+    }
+    (mask, t0)
+}
+
+/// Whether `ray` enters the box `b` before `t_max` (the same slab test as [`node_entry`], for one box).
+#[inline(always)]
+pub fn box_entry(b: &Box3, ray: &RayPrep, t_max: f32) -> bool {
+    let mut t0 = 0f32;
+    let mut t1 = t_max;
+    for a in 0..3 {
+        let (lo, hi) = (b.lo[a], b.hi[a]);
+        let (n, f) = if ray.near[a] == a { (lo, hi) } else { (hi, lo) };
+        t0 = max(t0, (n - ray.o[a]) * ray.inv[a]);
+        t1 = min(t1, (f - ray.o[a]) * ray.inv[a] * FAR_SCALE);
+    }
+    t0 <= t1
+}
+
+/// Pushes the hit children of `node` (lanes in `mask`, at least one) on `stack` farthest first, except the
+/// nearest, which is returned to be visited next.
+#[inline(always)]
+fn push_nearest_last(node: &Node, mask: u32, tn: &[f32; WIDTH], stack: &mut Vec<(u32, f32)>) -> u32 {
+    if mask & (mask - 1) == 0 {
+        return node.child[mask.trailing_zeros() as usize];
+    }
+    // Sort the hits by distance, descending, into a small array (insertion sort of at most eight).
+    let mut hits = [(EMPTY, 0f32); WIDTH];
+    let mut n = 0usize;
+    let mut m = mask;
+    while m != 0 {
+        let l = m.trailing_zeros() as usize;
+        m &= m - 1;
+        let e = (node.child[l], tn[l]);
+        let mut j = n;
+        while j > 0 && hits[j - 1].1 < e.1 {
+            hits[j] = hits[j - 1];
+            j -= 1;
+        }
+        hits[j] = e;
+        n += 1;
+    }
+    stack.extend_from_slice(&hits[..n - 1]);
+    hits[n - 1].0
+}
+
+/// `max` without NaN handling, so it compiles to one SIMD lane operation.
+#[inline(always)]
+pub(crate) fn max(a: f32, b: f32) -> f32 {
+    if a > b {
+        a
+    } else {
+        b
+    }
+}
+
+/// `min` without NaN handling, so it compiles to one SIMD lane operation.
+#[inline(always)]
+pub(crate) fn min(a: f32, b: f32) -> f32 {
+    if a < b {
+        a
+    } else {
+        b
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// Leaves hold spheres (centre, radius): the visitor intersects them exactly.
+    struct Spheres<'a> {
+        bvh: &'a Bvh,
+        s: &'a [([f32; 3], f32)],
+        ray: RayPrep,
+        hit: Option<u32>,
+        leaves_visited: usize,
+    }
+
+    fn sphere_t(c: [f32; 3], r: f32, ray: &RayPrep) -> Option<f32> {
+        let oc = [ray.o[0] - c[0], ray.o[1] - c[1], ray.o[2] - c[2]];
+        let b = oc[0] * ray.d[0] + oc[1] * ray.d[1] + oc[2] * ray.d[2];
+        let cc = oc[0] * oc[0] + oc[1] * oc[1] + oc[2] * oc[2] - r * r;
+        let disc = b * b - cc;
+        if disc < 0.0 {
+            return None;
+        }
+        let t = -b - disc.sqrt();
+        (t > 0.0).then_some(t)
+    }
+
+    impl Visit for Spheres<'_> {
+        fn leaf(&mut self, leaf: u32, mut best: f32) -> f32 {
+            self.leaves_visited += 1;
+            let lf = self.bvh.leaves()[leaf as usize];
+            for k in lf.start..lf.start + lf.count {
+                let p = self.bvh.order()[k as usize];
+                let (c, r) = self.s[p as usize];
+                if let Some(t) = sphere_t(c, r, &self.ray) {
+                    if t < best {
+                        best = t;
+                        self.hit = Some(p);
+                    }
+                }
+            }
+            best
+        }
+    }
+
+    #[test]
+    fn closest_and_any_match_brute_force() {
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let spheres: Vec<([f32; 3], f32)> = (0..3000)
+            .map(|_| {
+                let c = [rng.random_range(-60.0..60.0), rng.random_range(-60.0..60.0), rng.random_range(-10.0..10.0)];
+                (c, rng.random_range(0.2..2.0))
+            })
+            .collect();
+        let boxes: Vec<Box3> = spheres
+            .iter()
+            .map(|&(c, r)| Box3 { lo: [c[0] - r, c[1] - r, c[2] - r], hi: [c[0] + r, c[1] + r, c[2] + r] })
+            .collect();
+        let bvh = Bvh::new(&boxes, 4);
+        let mut stack = Stack::default();
+        let mut hits = 0;
+        let mut visited = 0;
+        for _ in 0..3000 {
+            let o = [rng.random_range(-70.0..70.0), rng.random_range(-70.0..70.0), rng.random_range(-15.0..15.0)];
+            let mut d: [f32; 3] =
+                [rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-0.3..0.3)];
+            if rng.random_range(0..4) == 0 {
+                d = [d[0], 0.0, 0.0]; // axis-parallel rays exercise the clamped reciprocal
+            }
+            let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            if n < 1e-3 {
+                continue;
+            }
+            let d = [d[0] / n, d[1] / n, d[2] / n];
+            let ray = RayPrep::new(o, d);
+            let brute = spheres
+                .iter()
+                .enumerate()
+                .filter_map(|(i, &(c, r))| sphere_t(c, r, &ray).filter(|&t| t < 100.0).map(|t| (t, i as u32)))
+                .min_by(|a, b| a.0.total_cmp(&b.0));
+            let mut v = Spheres { bvh: &bvh, s: &spheres, ray, hit: None, leaves_visited: 0 };
+            let best = bvh.closest(&ray, 100.0, &mut stack, &mut v);
+            visited += v.leaves_visited;
+            match brute {
+                Some((t, i)) => {
+                    hits += 1;
+                    assert_eq!(v.hit, Some(i));
+                    assert_eq!(best, t);
+                }
+                None => assert!(v.hit.is_none() && best == 100.0),
+            }
+            let mut v = Spheres { bvh: &bvh, s: &spheres, ray, hit: None, leaves_visited: 0 };
+            assert_eq!(bvh.any(&ray, 100.0, &mut stack, &mut v), brute.is_some());
+        }
+        assert!(hits > 500, "{hits}");
+        // The tree culls: far fewer leaves than primitives are visited per ray.
+        assert!(visited < 3000 * 40, "{visited} leaves visited");
+    }
+
+    #[test]
+    fn tiny_trees_and_empty_trees() {
+        let empty = Bvh::new(&[], 4);
+        assert!(empty.is_empty());
+        let one = Bvh::new(&[Box3 { lo: [-1.0; 3], hi: [1.0; 3] }], 4);
+        assert_eq!(one.leaves().len(), 1);
+        assert!(one.nodes().is_empty(), "a single leaf needs no node");
+    }
+}
