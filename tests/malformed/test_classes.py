@@ -18,7 +18,7 @@ from mmusv.generate.layout import SamplingError
 from mmusv.generate.planner import PlannerError
 from mmusv.generate.spec import load_spec
 from mmusv.scenario_checks import MmusvWarning
-from mmusv.world.vessel_shapes import AssetSpecError
+from mmusv.world.asset_spec import AssetSpecError
 from mmusv.world.vessels import UnknownAssetError, get_asset
 
 ROOT = Path(__file__).resolve().parents[2]
