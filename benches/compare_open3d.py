@@ -13,6 +13,7 @@ Run: ``python benches/compare_open3d.py`` (needs ``pip install open3d-cpu``).
 from __future__ import annotations
 
 import argparse
+import functools
 import os
 import time
 
@@ -74,8 +75,8 @@ def main() -> None:
     print(f"{'ray set':<20}{'rays':>10}{'mmusv Mrays/s':>16}{'open3d Mrays/s':>16}{'ratio':>8}{'agree':>8}")
     for name, (o, d) in ray_sets().items():
         rays = o3d.core.Tensor(np.concatenate([o, d], axis=1))
-        t_m = best_of(lambda: scene.cast_rays(o, d, max_range=args.max_range), args.repeat)
-        t_o = best_of(lambda: o3d_scene.cast_rays(rays), args.repeat)
+        t_m = best_of(functools.partial(scene.cast_rays, o, d, max_range=args.max_range), args.repeat)
+        t_o = best_of(functools.partial(o3d_scene.cast_rays, rays), args.repeat)
         ours = scene.cast_rays(o, d, max_range=args.max_range).distance
         theirs = o3d_scene.cast_rays(rays)["t_hit"].numpy()
         theirs = np.where(theirs <= args.max_range, theirs, np.inf)

@@ -19,9 +19,9 @@ Hull keys (``type: mono | twin``)::
     rake=0.05, overhang=0.0           fractions of length by which the keel is shorter at bow / stern
     bottom=0.8, flare=1.0             half-width fraction at the keel / at the waterline (deck is 1)
 
-Part types (:mod:`mmusv.world.part_spec`; each ``{type: ..., ...}``; ``base`` defaults to the deck height at the part's x; vertical extent
-is ``top`` (absolute z) or ``height`` (above ``base``); ``fit: m`` narrows a part so it stays ``m`` metres
-inside the deck outline)::
+Part types (:mod:`mmusv.world.part_spec`; each ``{type: ..., ...}``; ``base`` defaults to the deck height at the
+part's x; vertical extent is ``top`` (absolute z) or ``height`` (above ``base``); ``fit: m`` narrows a part so it
+stays ``m`` metres inside the deck outline)::
 
     box        x, y=0, size [lx, ly], base, top|height, taper=1, yaw_deg=0, fit
     house      x, y=0, align=center|aft|fore, base, tiers [[lx, ly, h(, dx)], ...], taper=1, fit,
