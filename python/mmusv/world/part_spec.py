@@ -74,6 +74,19 @@ class _Span(Spec):
         return self
 
 
+class _Along(Spec):
+    """A part spanning ``x0`` to ``x1`` along the hull (``x1 > x0``)."""
+
+    x0: Number
+    x1: Number
+
+    @model_validator(mode="after")
+    def _ordered(self) -> _Along:
+        if self.x1 <= self.x0:
+            raise invalid_field("x1", f"must be > x0 ({self.x0}), got {self.x1}")
+        return self
+
+
 class BoxPart(_Span):
     """A box, optionally tapered towards the top and turned by ``yaw_deg``."""
 
@@ -103,20 +116,12 @@ class HousePart(Spec):
     wings: Vec2 | None = None
 
 
-class HullBlockPart(_Span):
+class HullBlockPart(_Along, _Span):
     """A block following the deck outline between ``x0`` and ``x1``, ``inset`` metres inside it (mono hulls)."""
 
     type: Literal["hull_block"]
-    x0: Number
-    x1: Number
     inset: NonNegative = 0.0
     taper: Positive = 1.0
-
-    @model_validator(mode="after")
-    def _ordered(self) -> HullBlockPart:
-        if self.x1 <= self.x0:
-            raise invalid_field("x1", f"must be > x0 ({self.x0}), got {self.x1}")
-        return self
 
 
 class RowPart(Spec):
@@ -177,22 +182,14 @@ class CylinderPart(_Span):
     segments: Segments = 12
 
 
-class HcylinderPart(Spec):
+class HcylinderPart(_Along):
     """A horizontal cylinder along x from ``x0`` to ``x1``, axis at ``(y, z)``."""
 
     type: Literal["hcylinder"]
-    x0: Number
-    x1: Number
     y: Number = 0.0
     z: Number
     radius: Positive
     segments: Segments = 12
-
-    @model_validator(mode="after")
-    def _ordered(self) -> HcylinderPart:
-        if self.x1 <= self.x0:
-            raise invalid_field("x1", f"must be > x0 ({self.x0}), got {self.x1}")
-        return self
 
 
 class DomePart(Spec):

@@ -56,6 +56,7 @@ __all__ = [
     "asset_names",
     "categories",
     "get_asset",
+    "known_asset",
     "library",
     "load_asset_catalog",
     "load_asset_file",
@@ -248,6 +249,17 @@ def asset_names() -> list[str]:
     """Names of all assets (built-in and registered), sorted. Builds nothing."""
     with _lock:
         return sorted(set(_builtin_entries()) | set(_user))
+
+
+def known_asset(name: str) -> str:
+    """``name`` when the library has an asset of that name; else a ``ValueError`` (for schema validators) naming
+    up to three close matches and the command that lists them all. Builds nothing."""
+    names = asset_names()
+    if name not in names:
+        close = difflib.get_close_matches(name, names, n=3, cutoff=0.5)
+        hint = f"; did you mean {', '.join(close)}?" if close else ""
+        raise ValueError(f"unknown asset{hint} (`mmusv assets` lists all {len(names)})")
+    return name
 
 
 def get_asset(name: str) -> VesselAsset:
