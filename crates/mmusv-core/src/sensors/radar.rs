@@ -40,7 +40,7 @@ use crate::error::Result;
 use crate::geometry::RigidPose;
 use crate::scene::{Scene, NO_HIT};
 use crate::sensors::radar_model::{self, CLASS_WATER};
-use cells::{group_cells, BeamContext, RayEcho, Return};
+use cells::{group_cells, BeamContext, Echo, Return};
 use clutter::clutter_table;
 use pattern::trace_index;
 use rayon::prelude::*;
@@ -145,7 +145,7 @@ pub fn radar_sweep(
                     let cos = (n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2]) as f64;
                     let [elevation, weight] = meta[i];
                     let power = radar_model::ray_power(class, cos, az_width * weight as f64, d, rain);
-                    echoes.push(RayEcho { bin, instance, class, power, elevation: elevation as f64 });
+                    echoes.push(Echo { bin, instance, class, power, elevation: elevation as f64 });
                 }
             }
             ctx.returns(b, &group_cells(echoes))

@@ -7,19 +7,10 @@ use crate::sensors::radar::clutter::{CellDraws, ClutterBin};
 use crate::sensors::radar::{horizon_elevation, RadarConfig, RadarEnv};
 use crate::sensors::radar_model::CLASS_WATER;
 
-/// One cell's target echo: summed power, winning instance and class, echo-weighted elevation.
+/// A target echo in range bin `bin`: one ray's contribution, or a whole cell's (summed power, the instance and
+/// class with the largest summed echo, echo-weighted elevation in radians).
 #[derive(Debug, Clone, Copy)]
-pub(super) struct TargetCell {
-    bin: u32,
-    power: f64,
-    instance: i32,
-    class: u16,
-    elevation: f64,
-}
-
-/// One ray's contribution.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct RayEcho {
+pub(super) struct Echo {
     pub(super) bin: u32,
     pub(super) instance: i32,
     pub(super) class: u16,
@@ -27,14 +18,14 @@ pub(super) struct RayEcho {
     pub(super) elevation: f64,
 }
 
-/// Groups the ray echoes of one beam into cells (sorted by bin).
-pub(super) fn group_cells(mut echoes: Vec<RayEcho>) -> Vec<TargetCell> {
+/// Groups the ray echoes of one beam into one echo per cell (sorted by bin).
+pub(super) fn group_cells(mut echoes: Vec<Echo>) -> Vec<Echo> {
     echoes.sort_by(|a, b| (a.bin, a.instance).cmp(&(b.bin, b.instance)).then(b.power.total_cmp(&a.power)));
-    let mut cells: Vec<TargetCell> = Vec::new();
+    let mut cells: Vec<Echo> = Vec::new();
     let mut i = 0;
     while i < echoes.len() {
         let bin = echoes[i].bin;
-        let mut cell = TargetCell { bin, power: 0.0, instance: NO_HIT, class: 0, elevation: 0.0 };
+        let mut cell = Echo { bin, power: 0.0, instance: NO_HIT, class: 0, elevation: 0.0 };
         let (mut best, mut weighted_el) = (f64::NEG_INFINITY, 0.0);
         while i < echoes.len() && echoes[i].bin == bin {
             // Within the bin, echoes of one instance are consecutive, strongest ray first.
@@ -83,13 +74,13 @@ pub(super) struct Return {
 
 impl BeamContext<'_> {
     /// Merges the target cells of beam `b` with its clutter draws into returns, by range bin.
-    pub(super) fn returns(&self, b: u32, cells: &[TargetCell]) -> Vec<Return> {
+    pub(super) fn returns(&self, b: u32, cells: &[Echo]) -> Vec<Return> {
         let mut draws = CellDraws::new(self.seed, b);
         let azimuth = self.cfg.beam_azimuth(b) as f32;
         let horizon = horizon_elevation(self.pose, azimuth as f64).unwrap_or(0.0);
         let mut out = Vec::with_capacity(self.table.len() + cells.len());
         let thr = self.cfg.detection_threshold;
-        let mut emit = |bin: u32, target: Option<&TargetCell>, clutter: Option<ClutterBin>| {
+        let mut emit = |bin: u32, target: Option<&Echo>, clutter: Option<ClutterBin>| {
             let (u, w) = draws.at(bin);
             let ClutterBin { mean, sea, p_detect } = clutter.unwrap_or_else(|| ClutterBin::at(self.cfg, self.env, bin));
             // Clutter alone is detected iff mean · (−ln u) ≥ threshold, i.e. u ≤ exp(−threshold / mean).
