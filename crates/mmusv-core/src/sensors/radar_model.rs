@@ -51,7 +51,12 @@ impl ClutterModel {
     /// ≈1 km at 3.5 m waves, and 10 mm/h of rain shows sparse clutter within ≈1 km. A test fixture: the user
     /// defaults (σ⁰ 4e-7 with threshold 0.3) live in the scenario schema, `mmusv.sensors.config.RadarConfig`.
     pub fn tuning() -> Self {
-        Self { sea_sigma0_at_1m: 4.0e-6, critical_range_per_m: 300.0, sea_max_range_m: 2500.0, rain_eta_at_1mm_h: 5.0e-9 }
+        Self {
+            sea_sigma0_at_1m: 4.0e-6,
+            critical_range_per_m: 300.0,
+            sea_max_range_m: 2500.0,
+            rain_eta_at_1mm_h: 5.0e-9,
+        }
     }
 }
 
