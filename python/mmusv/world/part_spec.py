@@ -87,24 +87,27 @@ class _Along(Spec):
         return self
 
 
-class BoxPart(_Span):
+class _Placed(Spec):
+    """A part standing at ``(x, y)`` in the body frame (metres)."""
+
+    x: Number
+    y: Number = 0.0
+
+
+class BoxPart(_Placed, _Span):
     """A box, optionally tapered towards the top and turned by ``yaw_deg``."""
 
     type: Literal["box"]
-    x: Number
-    y: Number = 0.0
     size: Vec2
     fit: NonNegative | None = None
     taper: Positive = 1.0
     yaw_deg: Number = 0.0
 
 
-class HousePart(Spec):
+class HousePart(_Placed):
     """A deckhouse of stacked tiers ``[lx, ly, h(, dx)]`` aligned at ``x``, with optional bridge ``wings``."""
 
     type: Literal["house"]
-    x: Number
-    y: Number = 0.0
     align: Literal["center", "aft", "fore"] = "center"
     taper: Positive = 1.0
     tiers: Annotated[
@@ -124,12 +127,10 @@ class HullBlockPart(_Along, _Span):
     taper: Positive = 1.0
 
 
-class RowPart(Spec):
+class RowPart(_Along):
     """``count`` boxes in a row from ``x0`` to ``x1`` with ``gap`` between them, heights cycled from ``heights``."""
 
     type: Literal["row"]
-    x0: Number
-    x1: Number
     count: Annotated[Whole, Field(ge=1)]
     gap: NonNegative = 0.0
     y: Number = 0.0
@@ -145,23 +146,19 @@ class RowPart(Spec):
         return self
 
 
-class FunnelPart(_Span):
+class FunnelPart(_Placed, _Span):
     """A funnel, square (``shape: box``) or elliptic (``shape: round``) in plan, narrowing by ``taper``."""
 
     type: Literal["funnel"]
-    x: Number
-    y: Number = 0.0
     size: Vec2
     taper: Positive = 0.9
     shape: Literal["box", "round"] = "box"
 
 
-class MastPart(_Span):
+class MastPart(_Placed, _Span):
     """A square mast of side ``width``, with a crosswise ``yard`` at fraction ``yard_at`` of its height."""
 
     type: Literal["mast"]
-    x: Number
-    y: Number = 0.0
     width: Positive = 0.3
     yard: NonNegative = 0.0
     yard_at: Fraction = 0.8
@@ -171,12 +168,10 @@ Segments = Annotated[Whole, Field(ge=3, le=64)]
 """Facets around a round part."""
 
 
-class CylinderPart(_Span):
+class CylinderPart(_Placed, _Span):
     """A vertical cylinder (a cone frustum with ``top_radius``)."""
 
     type: Literal["cylinder"]
-    x: Number
-    y: Number = 0.0
     radius: Positive
     top_radius: Positive | None = None
     segments: Segments = 12
@@ -192,12 +187,10 @@ class HcylinderPart(_Along):
     segments: Segments = 12
 
 
-class DomePart(Spec):
+class DomePart(_Placed):
     """A sphere cap of ``radius`` with its top at ``top``, on a skirt down to ``base``."""
 
     type: Literal["dome"]
-    x: Number
-    y: Number = 0.0
     radius: Positive
     top: Number
     base: Number | None = None
@@ -252,12 +245,10 @@ class GantryPart(_Span):
     lean: Number = 0.0
 
 
-class CranePart(Spec):
+class CranePart(_Placed):
     """A deck crane: ``pedestal [radius, height]``, a cab, and a ``jib [length, elevation_deg, yaw_deg]``."""
 
     type: Literal["crane"]
-    x: Number
-    y: Number = 0.0
     base: Number | None = None
     pedestal: Vec2
     jib: Vec3
@@ -270,12 +261,10 @@ class CranePart(Spec):
         return self
 
 
-class GunPart(Spec):
+class GunPart(_Placed):
     """A gun turret of ``radius`` and ``height`` with a ``barrel`` pointing along ``yaw_deg``/``elevation_deg``."""
 
     type: Literal["gun"]
-    x: Number
-    y: Number = 0.0
     base: Number | None = None
     radius: Positive
     height: Positive
