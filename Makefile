@@ -22,8 +22,9 @@ fmt: ## format Rust and Python
 	cargo fmt --all
 	python3 -m ruff format python tests benches
 
-lint: ## clippy + ruff + mypy + stubtest
-	cargo clippy --workspace --all-targets
+lint: ## rustfmt + clippy + ruff + mypy + stubtest (as CI runs them)
+	cargo fmt --all --check
+	cargo clippy -p mmusv-core -p mmusv-benches -p mmusv-py --release --all-targets -- -D warnings
 	python3 -m ruff check python tests benches
 	python3 -m ruff format --check python tests benches
 	python3 -m mypy

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs everything the tests need on a fresh machine and runs them all:
-# Rust unit tests (mmusv-core alone, no Python), benches compile check, the Python package with its test
-# extras, the type-stub check, and pytest. Exits non-zero on any failure (pytest's "no tests" included).
+# rustfmt, Rust unit tests (mmusv-core alone, no Python), benches compile check, the Python package with its test
+# extras, clippy, ruff, the type-stub check, mypy and pytest (warnings are errors). Exits non-zero on any failure
+# (pytest's "no tests" included).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -17,6 +18,13 @@ echo "== toolchains"
 command -v cargo >/dev/null || { echo "cargo not found: install a Rust toolchain (rustup) first" >&2; exit 1; }
 cargo --version
 python3 --version
+if ! cargo fmt --version >/dev/null 2>&1 || ! cargo clippy --version >/dev/null 2>&1; then
+    command -v rustup >/dev/null || { echo "rustfmt and clippy not found: install them (rustup component add)" >&2; exit 1; }
+    rustup component add rustfmt clippy
+fi
+
+echo "== cargo fmt --check (Rust formatting)"
+cargo fmt --all --check
 
 echo "== cargo test (mmusv-core alone, no Python)"
 cargo test -p mmusv-core --release --quiet
@@ -26,6 +34,9 @@ cargo bench --no-run --quiet
 
 echo "== pip install the package with test extras (builds the extension in release)"
 python3 -m pip install --quiet --disable-pip-version-check -e ".[test]"
+
+echo "== cargo clippy, warnings are errors (release: reuses the build scripts and proc macros built above)"
+cargo clippy -p mmusv-core -p mmusv-benches -p mmusv-py --release --all-targets --quiet -- -D warnings
 
 echo "== ruff: lint and format check of the Python sources"
 python3 -m ruff check python tests benches

@@ -190,5 +190,6 @@ def test_info_and_preview_commands(
     assert main(["preview", str(res.recording), "--frame", "2", "--agent", "usv_2", "-o", str(png)]) == 0
     from PIL import Image
 
-    assert Image.open(png).size[0] > 100
+    with Image.open(png) as image:
+        assert image.size[0] > 100
     assert main(["preview", str(res.recording), "--frame", "9"]) == 2

@@ -27,7 +27,7 @@ def test_bare_name_resolves_from_another_directory(tmp_path: Path) -> None:
         for arg in ("port_entry", "port_entry.yaml", "scenarios/port_entry.yaml"):
             p = resolve_scenario(arg)
             assert p.is_file() and p.read_bytes() == (REPO_SCENARIOS / "port_entry.yaml").read_bytes()
-        with pytest.raises(NotFoundError, match="bundled: .*port_entry"):
+        with pytest.raises(NotFoundError, match=r"bundled: .*port_entry"):
             resolve_scenario("no_such_scenario")
         with pytest.raises(NotFoundError):
             resolve_scenario("elsewhere/port_entry.yaml")  # a real path that is not there is not rewritten

@@ -61,10 +61,10 @@ def test_one_titled_non_blank_panel_per_recorded_image(recording: Path) -> None:
     assert any("PPI" in t for t in titles) and any("BEV" in t for t in titles)
     assert sum("top view" in t for t in titles) == 2
     for p in panels:
-        l, t, r, b = p.box
-        body = arr[t:b, l:r].reshape(-1, 3)
+        left, t, r, b = p.box
+        body = arr[t:b, left:r].reshape(-1, 3)
         assert len(np.unique(body, axis=0)) > 1, f"blank panel {p.title}"
-        strip = arr[t - _TITLE_H : t, l:r].reshape(-1, 3)
+        strip = arr[t - _TITLE_H : t, left:r].reshape(-1, 3)
         assert len(np.unique(strip, axis=0)) > 2, f"no title text on {p.title}"
     # panels tile the sheet without overlapping
     for i, p in enumerate(panels):
@@ -80,17 +80,17 @@ def test_2d_boxes_on_the_camera_edges(recording: Path) -> None:
     assert boxes, "the test scenario must put a box of a few pixels in a camera"
     for b in boxes:
         p = next(p for p in panels if p.title.startswith(f"usv_1 · {b.camera} camera · RGB"))
-        l, t = p.box[0], p.box[1]
+        left, t = p.box[0], p.box[1]
         x0, y0, x1, y1 = (
-            round(l + b.x_min * p.scale),
+            round(left + b.x_min * p.scale),
             round(t + b.y_min * p.scale),
-            round(l + b.x_max * p.scale),
+            round(left + b.x_max * p.scale),
             round(t + b.y_max * p.scale),
         )
         x1, y1 = min(x1, p.box[2] - 1), min(y1, p.box[3] - 1)
         # the left and right edges (skip the corners, where a label may sit above the top edge)
         for x in (x0, x1):
-            col = arr[y0 + 2 : y1 - 1, max(x - 1, l) : x + 2]
+            col = arr[y0 + 2 : y1 - 1, max(x - 1, left) : x + 2]
             assert _is_box(col).any(axis=1).all(), f"edge x={x} of box {b.target_id} in {b.camera} not drawn"
         # and the box interior is not filled
         if x1 - x0 > 8 and y1 - y0 > 8:
@@ -102,8 +102,8 @@ def test_3d_box_footprints_in_the_bev(recording: Path) -> None:
     arr = np.asarray(sheet)
     ann = frame_messages(recording, 0)[topics.agent_annotations("usv_2")]
     bev = next(p for p in panels if "BEV" in p.title)
-    l, t, r, b = bev.box
-    cu, cv = l + (r - l) / 2, t + (b - t) / 2
+    left, t, r, b = bev.box
+    cu, cv = left + (r - left) / 2, t + (b - t) / 2
     assert list(ann.boxes_lidar)
     drawn = 0
     for box in ann.boxes_lidar:
@@ -112,7 +112,7 @@ def test_3d_box_footprints_in_the_bev(recording: Path) -> None:
         bx = box.center[0] + c * box.size[0] / 2 - s * box.size[1] / 2
         by = box.center[1] + s * box.size[0] / 2 + c * box.size[1] / 2
         u, v = round(cu - by * bev.scale), round(cv - bx * bev.scale)
-        if l + 2 <= u < r - 2 and t + 2 <= v < b - 2:
+        if left + 2 <= u < r - 2 and t + 2 <= v < b - 2:
             assert _is_box(arr[v - 2 : v + 3, u - 2 : u + 3]).any(), f"corner of {box.target_id} not drawn"
             drawn += 1
     assert drawn >= 1
@@ -130,5 +130,5 @@ def test_ppi_ring_scale_from_the_recording(recording: Path) -> None:
 def test_unknown_agent_is_a_clear_error(recording: Path) -> None:
     from mmusv.errors import ConfigError
 
-    with pytest.raises(ConfigError, match="no agent 'nobody'.*usv_1"):
+    with pytest.raises(ConfigError, match=r"no agent 'nobody'.*usv_1"):
         compose_preview(recording, frame=0, agent="nobody")

@@ -308,7 +308,7 @@ def test_bad_inputs_are_refused(tmp_path: Path) -> None:
         with pytest.raises(InputError, match="PNG"):
             rec.png_image("/i", log_time_ns=0, frame_id="f", image=np.zeros((4, 4), np.float32))
         rec.raw_image("/i", log_time_ns=0, frame_id="f", image=np.zeros((4, 4), np.uint8))
-        with pytest.raises(InputError, match="already carries foxglove.RawImage"):
+        with pytest.raises(InputError, match=r"already carries foxglove\.RawImage"):
             rec.world_state("/i", log_time_ns=0, frame=0, time_s=0.0, **WORLD)
         with pytest.raises(InputError, match="unit length"):
             rec.frame_transforms("/tf", log_time_ns=0, transforms=[("a", "b", [0, 0, 0], [0, 0, 0, 2])])

@@ -7,31 +7,16 @@ into an MCAP recording plus Parquet tables; :class:`mmusv.Simulation` captures s
 
 from __future__ import annotations
 
-from mmusv import config
+from mmusv import config, errors
 from mmusv._native import core as _core_module
 from mmusv.acquire import RunResult, run
-from mmusv.errors import (
-    ConfigError,
-    GeometryError,
-    InputError,
-    InternalError,
-    IoError,
-    MmusvError,
-    NotFoundError,
-)
+from mmusv.errors import *  # noqa: F403 (the exception tree, as listed once in mmusv.errors.__all__)
 from mmusv.scene import RayHits, Scene
 from mmusv.simulation import Simulation
 
 __version__: str = _core_module.__version__
 
 __all__ = [
-    "ConfigError",
-    "GeometryError",
-    "InputError",
-    "InternalError",
-    "IoError",
-    "MmusvError",
-    "NotFoundError",
     "RayHits",
     "RunResult",
     "Scene",
@@ -40,3 +25,4 @@ __all__ = [
     "config",
     "run",
 ]
+__all__ += errors.__all__

@@ -81,13 +81,16 @@ class Scene:
         classes: npt.NDArray[np.uint16],
         name: str,
     ) -> int:
-        """Adds a mesh: ``vertices`` (V, 3) float32 metres (mesh frame), ``faces`` (F, 3) int64 in ``0..V``, ``classes`` (1,) or (F,) uint16; returns the mesh id."""
+        """Adds a mesh: ``vertices`` (V, 3) float32 metres (mesh frame), ``faces`` (F, 3) int64 in ``0..V``,
+        ``classes`` (1,) or (F,) uint16; returns the mesh id."""
 
     def add_instance(self, mesh_id: int, pose: npt.NDArray[np.float64], class_override: int | None = None) -> int:
-        """Places mesh ``mesh_id`` at ``pose`` ((4, 4) float64 rigid body → world); ``class_override`` uint16 or None; returns the instance id."""
+        """Places mesh ``mesh_id`` at ``pose`` ((4, 4) float64 rigid body → world); ``class_override`` uint16 or None;
+        returns the instance id."""
 
     def set_poses(self, ids: npt.NDArray[np.uint32], poses: npt.NDArray[np.float64]) -> None:
-        """Moves instances ``ids`` (K,) uint32 to ``poses`` (K, 4, 4) float64 rigid body → world; rebuilds only the top-level BVH."""
+        """Moves instances ``ids`` (K,) uint32 to ``poses`` (K, 4, 4) float64 rigid body → world; rebuilds only the
+        top-level BVH."""
 
     def cast_rays(
         self,
@@ -102,7 +105,9 @@ class Scene:
         npt.NDArray[np.uint16],
         npt.NDArray[np.bool_],
     ]:
-        """Casts N rays (``origins``, ``directions`` (N, 3) float32 world frame, ``max_range`` metres > 0); returns ``(distance (N,) f32 m / inf, instance_id (N,) i32 / -1, triangle_id (N,) i32 / -1, normal (N, 3) f32 unit world, semantic_class (N,) u16 / 0, backface (N,) bool)``."""
+        """Casts N rays (``origins``, ``directions`` (N, 3) float32 world frame, ``max_range`` metres > 0); returns
+        ``(distance (N,) f32 m / inf, instance_id (N,) i32 / -1, triangle_id (N,) i32 / -1, normal (N, 3) f32 unit
+        world, semantic_class (N,) u16 / 0, backface (N,) bool)``."""
 
     def world_mesh(
         self,
@@ -113,10 +118,12 @@ class Scene:
         npt.NDArray[np.uint32],
         npt.NDArray[np.uint32],
     ]:
-        """World triangles at the current poses: ``(vertices (V, 3) f32 world m, faces (F, 3) u32, classes (F,) u16, instance_ids (F,) u32, triangle_ids (F,) u32)``."""
+        """World triangles at the current poses: ``(vertices (V, 3) f32 world m, faces (F, 3) u32, classes (F,) u16,
+        instance_ids (F,) u32, triangle_ids (F,) u32)``."""
 
     def export(self, path: str | os.PathLike[str]) -> None:
-        """Writes the world triangles at the current poses to ``path`` (``.ply`` or ``.obj``, world frame, metres), atomically."""
+        """Writes the world triangles at the current poses to ``path`` (``.ply`` or ``.obj``, world frame, metres),
+        atomically."""
 
     def instance_aabb(self, instance_id: int) -> npt.NDArray[np.float32]:
         """(2, 3) float32 world-frame AABB in metres of an instance at its current pose: min row, max row."""
@@ -142,7 +149,8 @@ class Scene:
 # --- sensors ---
 
 def pinhole_intrinsics(*, width: int, height: int, hfov: float) -> npt.NDArray[np.float64]:
-    """(4,) float64 ``[fx, fy, cx, cy]`` in pixels of a ``width × height`` pinhole camera with horizontal FOV ``hfov`` radians."""
+    """(4,) float64 ``[fx, fy, cx, cy]`` in pixels of a ``width × height`` pinhole camera with horizontal FOV ``hfov``
+    radians."""
 
 def _pinhole_directions(*, width: int, height: int, hfov: float) -> npt.NDArray[np.float32]:
     """Test helper, not API. (width·height, 3) float32 unit ray directions through pixel centres, camera body
@@ -158,7 +166,8 @@ def uniform_elevations(*, channels: int, lower: float, upper: float) -> npt.NDAr
     """(channels,) float64 elevation angles in radians, lowest first, spread uniformly over ``[lower, upper]``."""
 
 def lidar_trace_order(*, channels: int, azimuth_steps: int, block: int = 8) -> npt.NDArray[np.uint32]:
-    """(channels·azimuth_steps,) uint32 packet-friendly trace order: indices into ``_lidar_directions``' azimuth-major order."""
+    """(channels·azimuth_steps,) uint32 packet-friendly trace order: indices into ``_lidar_directions``' azimuth-major
+    order."""
 
 @final
 class SensorEnv:
@@ -323,7 +332,8 @@ class Radar:
 def demo_scene(
     *, seed: int = 1, extent: float = 2000.0, terrain_cells: int = 512, vessels: int = 48
 ) -> tuple[Scene, list[int]]:
-    """The synthetic maritime scene (terrain instance 0, water plane instance 1, vessels; ``extent`` metres); returns ``(scene, vessel_instance_ids)``."""
+    """The synthetic maritime scene (terrain instance 0, water plane instance 1, vessels; ``extent`` metres); returns
+    ``(scene, vessel_instance_ids)``."""
 
 # --- kinematics ---
 
@@ -346,7 +356,8 @@ class Fleet:
         wave: str | float,
     ) -> Fleet:
         """Per vessel i: routes[i] (K,2) m, end_behaviours[i] in {stop, loop, ping_pong}, speeds (V,) m/s,
-        start_offsets (V,) m, z_base (V,) m, dims (V,3) length/beam/height m, amplitudes (V,3) heave m/roll rad/pitch rad."""
+        start_offsets (V,) m, z_base (V,) m, dims (V,3) length/beam/height m, amplitudes (V,3) heave m/roll rad/pitch
+        rad."""
     def __len__(self) -> int:
         """Number of vessels."""
     @property
@@ -381,7 +392,8 @@ class Recorder:
     Every method releases the GIL while it encodes and writes. Use :class:`mmusv.recording.Recording` instead."""
 
     def __new__(cls, path: str | os.PathLike[str], *, overwrite: bool = False) -> Recorder:
-        """Starts a recording; an existing ``path`` raises ``IoError`` unless ``overwrite`` (replaced only on finish)."""
+        """Starts a recording; an existing ``path`` raises ``IoError`` unless ``overwrite`` (replaced only on
+        finish)."""
 
     @property
     def path(self) -> str:
@@ -405,13 +417,18 @@ class Recorder:
         columns: Sequence[npt.NDArray[Any]],
         pose: Sequence[float] | None = None,
     ) -> None:
-        """``foxglove.PointCloud``: ``columns[i]`` is a C-contiguous 1-D array (one value per point) of uint8, int8, uint16, int16, uint32, int32, float32 or float64 named ``names[i]``, packed row-interleaved little-endian in the order given; ``pose`` = ``(x, y, z, qx, qy, qz, qw)`` of the cloud origin in ``frame_id`` or None (identity)."""
+        """``foxglove.PointCloud``: ``columns[i]`` is a C-contiguous 1-D array (one value per point) of uint8, int8,
+        uint16, int16, uint32, int32, float32 or float64 named ``names[i]``, packed row-interleaved little-endian in
+        the order given; ``pose`` = ``(x, y, z, qx, qy, qz, qw)`` of the cloud origin in ``frame_id`` or None
+        (identity)."""
 
     def raw_image(self, topic: str, *, log_time_ns: int, frame_id: str, image: npt.NDArray[Any]) -> None:
-        """``foxglove.RawImage``: (H, W) uint8 → mono8, (H, W, 3) uint8 → rgb8, (H, W) uint16 → 16UC1, (H, W) float32 → 32FC1; C-contiguous."""
+        """``foxglove.RawImage``: (H, W) uint8 → mono8, (H, W, 3) uint8 → rgb8, (H, W) uint16 → 16UC1, (H, W) float32 →
+        32FC1; C-contiguous."""
 
     def png_image(self, topic: str, *, log_time_ns: int, frame_id: str, image: npt.NDArray[Any]) -> None:
-        """``foxglove.CompressedImage`` format png of a C-contiguous (H, W) uint8, (H, W, 3) uint8 or (H, W) uint16 image."""
+        """``foxglove.CompressedImage`` format png of a C-contiguous (H, W) uint8, (H, W, 3) uint8 or (H, W) uint16
+        image."""
 
     def frame_transforms(
         self,
@@ -423,7 +440,8 @@ class Recorder:
         translations: npt.NDArray[np.float64],
         rotations: npt.NDArray[np.float64],
     ) -> None:
-        """``foxglove.FrameTransforms``: pose of ``children[i]`` in ``parents[i]``, ``translations`` (N, 3) float64 metres, ``rotations`` (N, 4) float64 unit quaternions x, y, z, w."""
+        """``foxglove.FrameTransforms``: pose of ``children[i]`` in ``parents[i]``, ``translations`` (N, 3) float64
+        metres, ``rotations`` (N, 4) float64 unit quaternions x, y, z, w."""
 
     def boxes(
         self,
@@ -439,7 +457,9 @@ class Recorder:
         colors: npt.NDArray[np.float32],
         labels: Sequence[str],
     ) -> None:
-        """``foxglove.SceneUpdate`` with one frame-locked entity ``entity_id`` in ``frame_id``: one cube per box (``centers`` (N, 3) m, ``quaternions`` (N, 4) x, y, z, w, ``sizes`` (N, 3) m, ``colors`` (N, 4) float32 RGBA 0..1) and a text per non-empty label; ``ids`` unique."""
+        """``foxglove.SceneUpdate`` with one frame-locked entity ``entity_id`` in ``frame_id``: one cube per box
+        (``centers`` (N, 3) m, ``quaternions`` (N, 4) x, y, z, w, ``sizes`` (N, 3) m, ``colors`` (N, 4) float32 RGBA
+        0..1) and a text per non-empty label; ``ids`` unique."""
 
     def world_state(
         self,
@@ -458,7 +478,9 @@ class Recorder:
         box_centers: npt.NDArray[np.float64],
         box_sizes: npt.NDArray[np.float64],
     ) -> None:
-        """``mmusv.WorldState``, one vessel per row: ``classes``/``instance_ids`` (N,) uint32, ``poses`` (N, 6) x, y, z, roll, pitch, yaw (world, m, rad), ``velocities`` (N, 3) m/s, ``box_centers`` (N, 3) m, ``box_sizes`` (N, 3) length, beam, height m."""
+        """``mmusv.WorldState``, one vessel per row: ``classes``/``instance_ids`` (N,) uint32, ``poses`` (N, 6) x, y,
+        z, roll, pitch, yaw (world, m, rad), ``velocities`` (N, 3) m/s, ``box_centers`` (N, 3) m, ``box_sizes`` (N,
+        3) length, beam, height m."""
 
     def annotations(
         self,
@@ -478,7 +500,10 @@ class Recorder:
         camera_ints: npt.NDArray[np.uint32],
         camera_values: npt.NDArray[np.float64],
     ) -> None:
-        """``mmusv.AgentAnnotations`` from packed columns: ``lidar_ints`` (N, 3) [instance_id, semantic_class, lidar_points], ``lidar_values`` (N, 12) [center xyz, size lwh, rotation xyzw, yaw, range_m]; ``bev_values`` (M, 5) [x, y, length, width, yaw]; ``camera_ints`` (K, 2) [visible_pixels, box_pixels], ``camera_values`` (K, 6) [x_min, y_min, x_max, y_max, truncation, occlusion]."""
+        """``mmusv.AgentAnnotations`` from packed columns: ``lidar_ints`` (N, 3) [instance_id, semantic_class,
+        lidar_points], ``lidar_values`` (N, 12) [center xyz, size lwh, rotation xyzw, yaw, range_m]; ``bev_values``
+        (M, 5) [x, y, length, width, yaw]; ``camera_ints`` (K, 2) [visible_pixels, box_pixels], ``camera_values``
+        (K, 6) [x_min, y_min, x_max, y_max, truncation, occlusion]."""
 
     def metadata(self, name: str, mapping: Mapping[str, str]) -> None:
         """An MCAP metadata record ``name`` holding ``mapping``."""

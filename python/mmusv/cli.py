@@ -1,8 +1,9 @@
 """The ``mmusv`` command line.
 
 Subcommands: ``run`` (a scenario or a folder of them into MCAP + Parquet), ``info`` and ``preview`` (inspect a
-recording), ``convert`` (to OPV2V or KITTI), ``generate`` (batch scenario generation), ``assets`` (the vessel library), ``study waves`` (Table I)
-and ``study agreement`` (Table II), ``study detection`` / ``study robustness`` (Tables III, IV), ``version``.
+recording), ``convert`` (to OPV2V or KITTI), ``generate`` (batch scenario generation), ``assets`` (the vessel
+library), ``study waves`` (Table I) and ``study agreement`` (Table II), ``study detection`` / ``study robustness``
+(Tables III, IV), ``version``.
 Errors in the input end with a one-line message naming the problem and exit status 2, never a traceback.
 """
 
@@ -221,12 +222,14 @@ def _cmd_info(args: argparse.Namespace) -> int:
             "[yellow]incomplete recording (.partial or no summary): counts come from scanning the messages[/yellow]"
         )
     console.print(
-        f"[bold]{args.recording}[/bold]: scenario {run_meta.get('scenario', '?')}, status {run_meta.get('status', '?')}, "
+        f"[bold]{args.recording}[/bold]: scenario {run_meta.get('scenario', '?')}, "
+        f"status {run_meta.get('status', '?')}, "
         f"{run_meta.get('frames_written', '?')} frames, agents {run_meta.get('agents', '?')}"
     )
     start, end = info.get("start_ns", 0), info.get("end_ns", 0)
     console.print(
-        f"time {start / 1e9:.3f} .. {end / 1e9:.3f} s (duration {(end - start) / 1e9:.3f} s), {info.get('messages', 0)} messages"
+        f"time {start / 1e9:.3f} .. {end / 1e9:.3f} s (duration {(end - start) / 1e9:.3f} s), "
+        f"{info.get('messages', 0)} messages"
     )
     table = Table(title="topics")
     for col in ("topic", "schema", "messages"):

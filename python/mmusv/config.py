@@ -40,7 +40,7 @@ from mmusv.errors import ConfigError, MmusvError, located
 from mmusv.sensors.config import RigConfig
 from mmusv.world.environment import Environment, wave_height_m
 from mmusv.world.map_params import PARAM_MODELS, IslandParams, MapParams
-from mmusv.world.vessels import asset_names, get_asset
+from mmusv.world.vessels import get_asset, known_asset
 from mmusv.yamlio import mapping_source
 
 __all__ = [
@@ -151,12 +151,7 @@ class VesselConfig(_Model):
     @field_validator("asset")
     @classmethod
     def _asset(cls, v: str) -> str:
-        names = asset_names()
-        if v not in names:
-            close = difflib.get_close_matches(v, names, n=3, cutoff=0.5)
-            hint = f"; did you mean {', '.join(close)}?" if close else ""
-            raise ValueError(f"unknown asset{hint} (`mmusv assets` lists all {len(names)})")
-        return v
+        return known_asset(v)
 
     @property
     def static(self) -> bool:

@@ -181,7 +181,8 @@ class Scene:
         return int(self._native.add_instance(_id(mesh_id, name="mesh_id", kind="mesh"), p, cls))
 
     def set_poses(self, instance_ids: npt.ArrayLike, poses: npt.ArrayLike) -> None:
-        """Moves instances: ``instance_ids`` ``(K,)`` ints, ``poses`` ``(K, 4, 4)`` float. Only the top level is rebuilt."""
+        """Moves instances: ``instance_ids`` ``(K,)`` ints, ``poses`` ``(K, 4, 4)`` float. Only the top level is
+        rebuilt."""
         ids = np.atleast_1d(np.asarray(instance_ids))
         p = _floats(poses, name="poses")
         if ids.size == 0 and p.size == 0:

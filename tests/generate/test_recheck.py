@@ -3,7 +3,8 @@
 The re-check re-implements the route geometry (centripetal Catmull-Rom through the waypoints, sampled every few
 centimetres), samples the motion ~40x denser than the generator's check step, and measures clearances with
 shapely against the map's vector layers (land polygons, structure footprints, moored hulls) using the hull
-*rectangles* at their yaw (in motion, and along the whole route at the tangent heading), separation between hull rectangles, and line of sight with its own ray casts.
+*rectangles* at their yaw (in motion, and along the whole route at the tangent heading), separation between hull
+rectangles, and line of sight with its own ray casts.
 """
 
 from __future__ import annotations

@@ -18,7 +18,7 @@ from mmusv.generate.layout import SamplingError
 from mmusv.generate.planner import PlannerError
 from mmusv.generate.spec import load_spec
 from mmusv.scenario_checks import MmusvWarning
-from mmusv.world.vessel_shapes import AssetSpecError
+from mmusv.world.asset_spec import AssetSpecError
 from mmusv.world.vessels import UnknownAssetError, get_asset
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -73,10 +73,10 @@ def test_bad_encodings_are_config_errors(
     text = PORT.read_text(encoding="utf-8").replace("# Port map", "# Port map, café")
     f = tmp_path / "bad.yaml"
     f.write_bytes(encode(text))
-    with pytest.raises(ConfigError, match="bad.yaml") as exc:
+    with pytest.raises(ConfigError, match=r"bad\.yaml") as exc:
         load_scenario(f)
     assert expect in str(exc.value)
-    with pytest.raises(ConfigError, match="bad.yaml"):
+    with pytest.raises(ConfigError, match=r"bad\.yaml"):
         load_spec(f)
     err = cli_error(capsys, ["run", str(f), "-o", str(tmp_path / "out")])
     assert "bad.yaml" in err
@@ -214,7 +214,7 @@ def test_world_build_errors_name_the_file(tmp_path: Path, capsys: pytest.Capture
 
 
 def test_run_of_a_directory_says_so(tmp_path: Path) -> None:
-    with pytest.raises(ConfigError, match="is a directory; mmusv.run takes one scenario file"):
+    with pytest.raises(ConfigError, match=r"is a directory; mmusv\.run takes one scenario file"):
         mmusv.run(tmp_path, out_dir=tmp_path / "o")
 
 

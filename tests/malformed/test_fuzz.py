@@ -1,7 +1,8 @@
 """Property tests: mutations of every bundled scenario and spec (wrong types, NaN and inf, huge and negative
 values, dropped and duplicated keys, bad encodings) either load or raise an MmusvError naming the file; never
-another exception. 200 examples per target in CI; set MMUSV_FUZZ_EXAMPLES (e.g. 5000) for the long run, which
-the ``slow`` marker also selects at 2000."""
+another exception. Mutated vessel catalogue entries build or raise an AssetSpecError naming the field. 200
+examples per target in CI; set MMUSV_FUZZ_EXAMPLES (e.g. 5000) for the long run, which the ``slow`` marker also
+selects at 2000."""
 
 from __future__ import annotations
 
@@ -19,10 +20,13 @@ from hypothesis import strategies as st
 from mmusv.config import load_scenario
 from mmusv.errors import MmusvError
 from mmusv.generate.spec import load_spec
+from mmusv.world.asset_spec import AssetSpecError
+from mmusv.world.vessels import load_asset_file
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENARIOS = sorted((ROOT / "scenarios").glob("*.yaml"))
 SPECS = sorted((ROOT / "scenarios/specs").glob("*.yaml"))
+CATALOGUE = yaml.safe_load((ROOT / "python/mmusv/world/vessel_catalog.yaml").read_text(encoding="utf-8"))["vessels"]
 EXAMPLES = int(os.environ.get("MMUSV_FUZZ_EXAMPLES", "200"))
 
 ODD_VALUES = [
@@ -154,3 +158,36 @@ def test_mutated_specs_load_or_fail_cleanly(tmp_path: Path, case: tuple[Path, by
 @given(case=mutations(SCENARIOS + SPECS))
 def test_many_mutations(tmp_path: Path, case: tuple[Path, bytes]) -> None:
     _check(tmp_path, case, load_spec if case[0].parent.name == "specs" else load_scenario)
+
+
+@st.composite
+def asset_mutations(draw: st.DrawFn) -> dict[str, Any]:
+    entry = copy.deepcopy(draw(st.sampled_from(CATALOGUE)))
+    for _ in range(draw(st.integers(min_value=1, max_value=3))):
+        paths = _paths(entry)
+        if not paths:
+            break
+        path = draw(st.sampled_from(paths))
+        op = draw(st.sampled_from(["drop", "replace", "scale", "unknown"]))
+        value = copy.deepcopy(draw(st.sampled_from(ODD_VALUES)))
+        if op == "unknown":  # a key the schema does not know, beside the chosen one
+            parent = entry
+            for p in path[:-1]:
+                parent = parent[p]
+            if isinstance(parent, dict):
+                parent["colour"] = value
+            continue
+        entry = _mutate(entry, path, op, value)
+    return entry
+
+
+@SETTINGS
+@given(entry=asset_mutations())
+def test_mutated_vessel_assets_build_or_name_the_field(entry: dict[str, Any]) -> None:
+    try:
+        load_asset_file(entry)
+    except AssetSpecError as exc:
+        msg = str(exc)
+        assert msg.startswith(f"{exc.field}: ") and "\n" not in msg, msg
+        # the path starts at the asset's name, or at the entry's root when the name itself is unusable
+        assert exc.field.startswith((f"{entry.get('name')}.", "name", "hull", "parts", "mesh", "colour")), msg

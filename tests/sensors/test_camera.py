@@ -384,11 +384,11 @@ def test_top_view_misconfig_names_the_field(make_scenario: Any) -> None:
 
 
 def test_native_camera_misconfig_names_the_field() -> None:
-    with pytest.raises(mmusv.errors.ConfigError, match="camera.hfov_deg"):
+    with pytest.raises(mmusv.errors.ConfigError, match=r"camera\.hfov_deg"):
         core.Camera(rgb=False, width=8, height=8, hfov=math.pi)
-    with pytest.raises(mmusv.errors.ConfigError, match="camera.resolution"):
+    with pytest.raises(mmusv.errors.ConfigError, match=r"camera\.resolution"):
         core.Camera(rgb=False, width=0, height=8, hfov=1.0)
-    with pytest.raises(mmusv.errors.ConfigError, match="camera.range_m"):
+    with pytest.raises(mmusv.errors.ConfigError, match=r"camera\.range_m"):
         core.Camera(rgb=False, width=8, height=8, hfov=1.0, range_max=-1.0)
     with pytest.raises(mmusv.errors.ConfigError, match="metres_per_pixel"):
         core.Camera(rgb=False, width=8, height=8, metres_per_pixel=0.0)

@@ -17,8 +17,8 @@ from mmusv.studies.detection.evaluate import (
 )
 
 
-def box(x: float, y: float, l: float = 4.0, w: float = 2.0, yaw: float = 0.0) -> list[float]:
-    return [x, y, 0.0, l, w, 1.5, yaw]
+def box(x: float, y: float, length: float = 4.0, w: float = 2.0, yaw: float = 0.0) -> list[float]:
+    return [x, y, 0.0, length, w, 1.5, yaw]
 
 
 # ---- IoU ---------------------------------------------------------------------------------------------------------

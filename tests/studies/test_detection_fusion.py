@@ -274,3 +274,20 @@ def test_gt_visibility_counts_points_inside_the_box() -> None:
     )  # z within h/2 + 0.5, too high, too low
     assert gt_visibility(gt, pts).tolist() == [3, 0]
     assert gt_visibility(gt, np.zeros((0, 3))).tolist() == [0, 0]
+
+
+def test_ground_truth_and_detections_follow_the_one_target_rule() -> None:
+    """A target exactly at the evaluation range counts (BEV distance <= range, as annotations and export)."""
+    from mmusv.studies.detection.study import _keep
+
+    centres = np.array([[200.0, 0.0, 1.0], [120.0, -160.0, 0.0], [0.0, 200.000001, 0.0], [150.0, 140.0, 0.0]])
+    targets = np.tile(np.eye(4), (len(centres), 1, 1))
+    targets[:, :3, 3] = centres
+    sizes = np.tile([10.0, 3.0, 2.0], (len(centres), 1))
+    ego = AgentFrame("usv_1", np.zeros((0, 4), np.float32), np.eye(4), np.eye(4))  # LiDAR frame = world
+    frame = SceneFrame(0, (ego,), ("a", "b", "c", "d"), targets, sizes, np.zeros((0, 4, 4)), np.zeros((0, 3)))
+    gt = gt_in_ego(frame, ego, range_m=200.0)
+    assert gt[:, :3].tolist() == centres[:2].tolist()  # 200 m and 120-160-200 m in, the others beyond
+    boxes = np.column_stack([centres, sizes, np.zeros(len(centres))])
+    kept, scores = _keep(boxes, np.arange(4.0), np.zeros((0, 7)), range_m=200.0, margin=5.0)
+    assert kept[:, :3].tolist() == centres[:2].tolist() and scores.tolist() == [0.0, 1.0]

@@ -19,7 +19,7 @@ def test_wave_presets_and_free_height() -> None:
     env = Environment.make(wave="W2")
     assert env.wave_amplitude_m == 1.25
     for bad in ("W4", -1.0, float("nan")):
-        with pytest.raises(mmusv.ConfigError, match="environment.wave"):
+        with pytest.raises(mmusv.ConfigError, match=r"environment\.wave"):
             wave_height_m(bad)
 
 
@@ -41,7 +41,7 @@ def test_weather_defaults_and_validation() -> None:
     fog = Weather.make("fog", visibility_m=800)
     assert fog.extinction_per_m == pytest.approx(3.0 / 800)
     assert Weather.make("rain").rain_mm_per_h > 0
-    with pytest.raises(mmusv.ConfigError, match="environment.weather"):
+    with pytest.raises(mmusv.ConfigError, match=r"environment\.weather"):
         Weather.make("snow")
     with pytest.raises(mmusv.ConfigError, match="visibility_m"):
         Weather.make("fog", visibility_m=0)

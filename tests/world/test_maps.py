@@ -451,7 +451,7 @@ def test_bad_parameters_are_rejected_naming_the_field(kind: str, params: dict[st
 
 
 def test_unknown_kind_lists_the_kinds_and_bad_seed_is_rejected() -> None:
-    with pytest.raises(MapConfigError, match="island | open_sea | port"):
+    with pytest.raises(MapConfigError, match=r"island \| open_sea \| port"):
         make_params("volcano")
     with pytest.raises(MapConfigError) as err:
         generate_map("island", seed=-3)

@@ -211,10 +211,13 @@ pub fn maritime_demo(p: DemoParams) -> Result<DemoScene> {
     Ok(DemoScene { scene, vessel_instances })
 }
 
+/// Origins and unit directions of a set of rays: `(origins, directions)`, each `(N, 3)`, world frame, metres.
+pub type Rays = (Vec<[f32; 3]>, Vec<[f32; 3]>);
+
 /// Origins and unit directions of one sweep (`channels` beams over −25°…+15°, `azimuth_steps` columns) from a
 /// LiDAR at `position` with the body axes aligned to the world, in [`rays::lidar_trace_order`] (blocks of 8
 /// columns), the order the LiDAR sensor traces them in.
-pub fn lidar_rays(position: [f32; 3], channels: u32, azimuth_steps: u32) -> Result<(Vec<[f32; 3]>, Vec<[f32; 3]>)> {
+pub fn lidar_rays(position: [f32; 3], channels: u32, azimuth_steps: u32) -> Result<Rays> {
     let el = rays::uniform_elevations(channels, (-25f64).to_radians(), 15f64.to_radians())?;
     let dirs = rays::lidar_directions(&el, azimuth_steps)?;
     let order = rays::lidar_trace_order(channels, azimuth_steps, rays::TRACE_BLOCK)?;
@@ -223,13 +226,7 @@ pub fn lidar_rays(position: [f32; 3], channels: u32, azimuth_steps: u32) -> Resu
 }
 
 /// Origins and unit world directions of `count` surround pinhole cameras (yaw 0, 360/count, ...) at `position`.
-pub fn surround_camera_rays(
-    position: [f32; 3],
-    count: u32,
-    width: u32,
-    height: u32,
-    hfov: f64,
-) -> Result<(Vec<[f32; 3]>, Vec<[f32; 3]>)> {
+pub fn surround_camera_rays(position: [f32; 3], count: u32, width: u32, height: u32, hfov: f64) -> Result<Rays> {
     let body = rays::pinhole_directions(width, height, hfov)?;
     let mut dirs = Vec::with_capacity(body.len() * count as usize);
     for c in 0..count {

@@ -20,6 +20,10 @@
 //!
 //! Conventions: metres, seconds, radians; world frame right-handed, x east, y north, z up, water at z = 0.
 
+// SIMD-style code: loops over lanes index several parallel arrays at once (boxes, rays, triangles); iterating
+// over one of them would hide the structure-of-arrays layout the compiler vectorises.
+#![allow(clippy::needless_range_loop)]
+
 pub mod bvh;
 pub mod demo;
 pub mod error;

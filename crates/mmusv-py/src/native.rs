@@ -69,6 +69,9 @@ pub fn pose_arg(pose: &PyReadonlyArray2<'_, f64>, field: &str) -> PyResult<Rigid
     pose_from(m, field)
 }
 
+/// Ray origins and unit directions, each an `(N, 3)` float32 numpy array.
+pub type RayArrays<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>);
+
 /// Moves rows of `K` into a new owned `(N, K)` numpy array.
 pub fn rows_to_array<'py, T: numpy::Element, const K: usize>(
     py: Python<'py>,

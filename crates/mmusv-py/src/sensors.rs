@@ -1,6 +1,6 @@
 //! Bindings for `mmusv_core::sensors`: ray patterns, the spinning LiDAR and the cameras.
 
-use crate::native::{detached, pose_arg, rows_to_array};
+use crate::native::{detached, pose_arg, rows_to_array, RayArrays};
 use mmusv_core::sensors::shade::ShadeEnv;
 use mmusv_core::sensors::{camera, lidar, rays};
 use numpy::ndarray::{Array2, Array3};
@@ -311,11 +311,7 @@ impl Camera {
     }
 
     /// World ray origins and unit directions `(H·W, 3)` float32 for the camera at `pose`, row-major.
-    fn world_rays<'py>(
-        &self,
-        py: Python<'py>,
-        pose: PyReadonlyArray2<'py, f64>,
-    ) -> PyResult<(Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>)> {
+    fn world_rays<'py>(&self, py: Python<'py>, pose: PyReadonlyArray2<'py, f64>) -> PyResult<RayArrays<'py>> {
         let pose = pose_arg(&pose, "pose")?;
         let (o, d) = self.inner.world_rays(&pose);
         Ok((rows_to_array(py, o)?, rows_to_array(py, d)?))

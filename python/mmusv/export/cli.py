@@ -51,7 +51,8 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     p.add_argument(
         "--extras",
         default=",".join(DEFAULT_EXTRAS),
-        help=f"extra files, comma-separated from {','.join(EXTRAS)}; empty for none (default {','.join(DEFAULT_EXTRAS)})",
+        help=f"extra files, comma-separated from {','.join(EXTRAS)}; empty for none "
+        f"(default {','.join(DEFAULT_EXTRAS)})",
     )
     p.add_argument("--overwrite", action="store_true", help="replace a previous conversion in the output folder")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")

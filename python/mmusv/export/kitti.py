@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -64,7 +64,7 @@ def kitti_label(target: Target, velo_to_cam: np.ndarray, box2d: Any | None) -> s
 class KittiWriter(DatasetWriter):
     """Writes one recording as KITTI-style per-agent folders (see the module docstring)."""
 
-    cameras = {"front": 2}
+    cameras: ClassVar[dict[str, int]] = {"front": 2}
 
     def optional_topics(self) -> list[str]:
         return super().optional_topics() + [topics.agent_annotations(a.id) for a in self.agents]

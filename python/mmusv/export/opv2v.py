@@ -20,7 +20,7 @@ counts of the listed vehicles), ``<ts>_depth{i}.png`` (uint16 cm), ``<ts>_semant
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -51,7 +51,7 @@ def _matrix_list(m: np.ndarray) -> list[list[float]]:
 class Opv2vWriter(DatasetWriter):
     """Writes one recording as one OPV2V scenario folder (see the module docstring)."""
 
-    cameras = {k: v for k, v in OPV2V_CAMERAS.items() if k != "back"}
+    cameras: ClassVar[dict[str, int]] = {k: v for k, v in OPV2V_CAMERAS.items() if k != "back"}
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
@@ -65,7 +65,8 @@ class Opv2vWriter(DatasetWriter):
             names = [n for n, _ in self.agent_cameras(a)]
             if len(names) < 4:
                 self.notes.append(
-                    f"agent {a.id}: cameras {names} cover {len(names)} of the 4 OPV2V cameras (front, right, left, rear)"
+                    f"agent {a.id}: cameras {names} cover {len(names)} of the 4 OPV2V cameras "
+                    "(front, right, left, rear)"
                 )
             other = sorted(set(a.cameras) - set(self.cameras))
             if other:
@@ -208,8 +209,9 @@ class Opv2vWriter(DatasetWriter):
                 "scenario": info.scenario_name,
                 "config_hash": info.config_hash,
                 "mmusv_version": info.mmusv_version,
-                "frame": "CARLA/UE world, left-handed: x forward, y right, z up; metres; degrees; poses [x, y, z, roll, yaw, pitch]; "
-                "mmusv's right-handed frames (world x east, y north, z up; body x forward, y left, z up) with y mirrored",
+                "frame": "CARLA/UE world, left-handed: x forward, y right, z up; metres; degrees; "
+                "poses [x, y, z, roll, yaw, pitch]; mmusv's right-handed frames (world x east, y north, z up; "
+                "body x forward, y left, z up) with y mirrored",
                 "cavs": {cav_id(a.index): a.id for a in self.agents},
                 "eval_range_m": o.eval_range_m,
                 "gt_filter": "vehicles: every vessel whose box centre has hypot(x, y) <= eval_range_m "

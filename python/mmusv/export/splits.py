@@ -33,7 +33,8 @@ def parse_ratios(ratios: Sequence[float] | str) -> tuple[float, float, float]:
         vals = [float(x) for x in ratios]
     if len(vals) != 3:
         raise ConfigError(
-            f"split {list(ratios) if not isinstance(ratios, str) else ratios!r}: expected three fractions (train, validate, test)"
+            f"split {list(ratios) if not isinstance(ratios, str) else ratios!r}: "
+            "expected three fractions (train, validate, test)"
         )
     if not all(math.isfinite(v) and v >= 0 for v in vals) or sum(vals) <= 0:
         raise ConfigError(f"split {vals}: fractions must be finite, non-negative and not all zero")

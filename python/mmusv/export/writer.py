@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 from mmusv.export.common import Options, Sink
 from mmusv.export.geometry import AgentView, Target, agent_view, targets_of
@@ -20,7 +20,7 @@ class DatasetWriter:
     and :meth:`finish`. An agent without a LiDAR cannot be an OPV2V/KITTI agent and is left out (with a note).
     """
 
-    cameras: dict[str, int] = {}
+    cameras: ClassVar[dict[str, int]] = {}
 
     def __init__(self, info: RecordingInfo, folder: Path, options: Options, sink: Sink) -> None:
         self.info = info

@@ -12,7 +12,8 @@ Continuous guarantees: between two samples a vessel is within ``δ`` of one (hal
 (:mod:`mmusv.generate.mapctx`), so the clearance and separation checks subtract both and hold for every point of
 every route and every instant, not just the samples. Hulls are capsules covering the hull rectangle at the
 vessel's yaw (:mod:`mmusv.generate.hulls`); between samples the capsule axis ends also turn with the yaw, which
-adds ``a·|Δyaw|/2`` (largest yaw step between samples) to ``δ``. Frame-based checks (ranges, shares, line of sight) are evaluated at the acquisition frames.
+adds ``a·|Δyaw|/2`` (largest yaw step between samples) to ``δ``. Frame-based checks (ranges, shares, line of
+sight) are evaluated at the acquisition frames.
 Line of sight: a ray from the USV sensor (``sensor_height_m`` above the water) to the middle of the target's
 above-water height, cast against the static map (terrain, structures, buoys, moored ships) in one batch.
 
@@ -255,7 +256,10 @@ class Separation:
         if gap.min() < 0.0:
             k, j = np.unravel_index(int(np.argmin(gap)), gap.shape)
             a, b = int(iu[j]), int(ju[j])
-            return f"{s.ids[a]} and {s.ids[b]} come {hull[k, j]:.1f} m apart (hulls) at t={s.times[k]:.1f} s; need {self.min_m:g} m"
+            return (
+                f"{s.ids[a]} and {s.ids[b]} come {hull[k, j]:.1f} m apart (hulls) at t={s.times[k]:.1f} s; "
+                f"need {self.min_m:g} m"
+            )
         return None
 
 

@@ -51,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
     maps = {(m.type, m.seed): m for m in (spec.map_of(c) for c in spec.combinations)}
     for (kind, seed), m in sorted(maps.items()):
         with console.status(f"building map {kind} seed {seed}", spinner="dots"):
-            map_context(m.type, m.seed, m.param_values()).scene
+            _ = map_context(m.type, m.seed, m.param_values()).scene  # built here, so the progress bar is generation
     t_map = time.perf_counter() - t0
     t0 = time.perf_counter()
     if args.no_progress:

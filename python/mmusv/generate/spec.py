@@ -67,7 +67,7 @@ from mmusv.generate.spec_constraints import (
     StructureClearanceCheck,
     TargetRangeCheck,
 )
-from mmusv.world.vessels import asset_names, get_asset
+from mmusv.world.vessels import asset_names, get_asset, known_asset
 from mmusv.yamlio import mapping_source
 
 __all__ = [
@@ -104,15 +104,6 @@ def _ordered(v: Pair, what: str) -> Pair:
     return v
 
 
-def _known_asset(v: str) -> str:
-    names = asset_names()
-    if v not in names:
-        close = difflib.get_close_matches(v, names, n=3, cutoff=0.5)
-        hint = f"; did you mean {', '.join(close)}?" if close else ""
-        raise ValueError(f"unknown asset{hint} (`mmusv assets` lists all {len(names)})")
-    return v
-
-
 class SizeClass(_Model):
     """A target size class: assets whose length lies in ``length_m`` (or the explicit ``assets`` list), moving
     at a speed drawn uniformly from ``speed_mps``."""
@@ -133,7 +124,7 @@ class SizeClass(_Model):
     def _assets(cls, v: list[str] | None) -> list[str] | None:
         if v is not None:
             for name in v:
-                _known_asset(name)
+                known_asset(name)
                 if get_asset(name).is_usv:
                     raise ValueError(f"{name} is a USV; targets must be other vessels")
         return v
@@ -171,7 +162,7 @@ class UsvRoles(_Model):
     @classmethod
     def _assets(cls, v: list[str]) -> list[str]:
         for name in v:
-            _known_asset(name)
+            known_asset(name)
             if not get_asset(name).is_usv:
                 raise ValueError(f"{name} is not a USV asset (USVs: {', '.join(_usv_names())})")
         return v
@@ -252,7 +243,7 @@ class Combination(_Model):
     @classmethod
     def _ego(cls, v: str | None) -> str | None:
         if v is not None:
-            _known_asset(v)
+            known_asset(v)
             if not get_asset(v).is_usv:
                 raise ValueError(f"the ego must be a USV asset ({', '.join(_usv_names())})")
         return v

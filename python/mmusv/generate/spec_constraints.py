@@ -42,19 +42,22 @@ class InWaterCheck(_Check):
 
 
 class ShoreClearanceCheck(_Check):
-    """Hull (bounding circle) at least ``min_m`` from non-navigable cells (land, shallows, structures, map edge)."""
+    """Hull at least ``min_m`` from non-navigable cells (land, shallows, structures, map edge). The hull is the
+    capsule covering its rectangle at the vessel's yaw (:mod:`mmusv.generate.hulls`)."""
 
     min_m: float = Field(default=10.0, ge=0.0)
 
 
 class StructureClearanceCheck(_Check):
-    """Hull at least ``min_m`` from port structures, buoys and moored ships."""
+    """Hull (the capsule covering its rectangle at the vessel's yaw, :mod:`mmusv.generate.hulls`) at least
+    ``min_m`` from port structures, buoys and moored ships."""
 
     min_m: float = Field(default=15.0, ge=0.0)
 
 
 class SeparationCheck(_Check):
-    """Hull-to-hull distance (bounding circles) at least ``min_m`` between every two vessels at every time."""
+    """Hull-to-hull distance at least ``min_m`` between every two vessels at every time, each hull the capsule
+    covering its rectangle at the vessel's yaw (:mod:`mmusv.generate.hulls`)."""
 
     min_m: float = Field(default=15.0, ge=0.0)
 

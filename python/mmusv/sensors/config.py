@@ -124,7 +124,8 @@ class LidarConfig(_Model):
             raise ValueError(f"range_min_m ({self.range_min_m}) must be below range_m ({self.range_m})")
         if not 1 <= self.azimuth_steps <= 65536:
             raise ValueError(
-                f"points_per_second / (rotation_hz * channels) = {self.azimuth_steps} columns per sweep; must be 1..65536"
+                f"points_per_second / (rotation_hz * channels) = {self.azimuth_steps} columns per sweep; "
+                "must be 1..65536"
             )
         rays = self.azimuth_steps * self.channels
         if rays > MAX_LIDAR_RAYS:
@@ -225,7 +226,8 @@ class RadarConfig(_Model):
         rays = self.azimuth_bins * self.rays_az * self.rays_el
         if rays > MAX_RADAR_RAYS:
             raise ValueError(
-                f"azimuth_bins x rays_az x rays_el = {rays:,} rays per sweep would take about {rays * 48 / 1e9:.1f} GB; "
+                f"azimuth_bins x rays_az x rays_el = {rays:,} rays per sweep would take about "
+                f"{rays * 48 / 1e9:.1f} GB; "
                 f"at most {MAX_RADAR_RAYS:,} are allowed"
             )
         return self

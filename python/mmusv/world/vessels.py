@@ -6,8 +6,9 @@ the waterline, so the hull reaches down to ``z = -draft``) plus its dimensions, 
 bounding box: ``length`` = x extent, ``beam`` = y extent, ``height`` = z extent (keel to top), ``draft`` =
 ``-min z``. All in metres.
 
-Built-in assets are described in ``vessel_catalog.yaml`` (hull + parts vocabulary of
-:mod:`mmusv.world.vessel_shapes`) and built on first use, then cached. Users add their own with
+Built-in assets are described in ``vessel_catalog.yaml`` (entries validated by the schema in
+:mod:`mmusv.world.asset_spec`, procedural meshes built by :mod:`mmusv.world.vessel_shapes`) and built on first use,
+then cached. Users add their own with
 :func:`load_asset_file` (a mesh file, OBJ/STL/PLY/GLB via trimesh, or a procedural hull/parts entry) and
 :func:`register_asset`::
 
@@ -21,7 +22,6 @@ from __future__ import annotations
 
 import difflib
 import os
-import re
 import threading
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -35,8 +35,17 @@ import yaml
 
 from mmusv.classes import SemanticClass
 from mmusv.errors import ConfigError, NotFoundError
+from mmusv.validation import join
+from mmusv.world.asset_spec import (
+    AXES,
+    NAME_PATTERN,
+    AssetSpecError,
+    MeshAssetSpec,
+    ProceduralAssetSpec,
+    parse_asset,
+)
 from mmusv.world.primitives import TriMesh
-from mmusv.world.vessel_shapes import AssetSpecError, Fields, build_procedural
+from mmusv.world.vessel_shapes import build_procedural
 from mmusv.yamlio import parse_yaml, read_yaml
 
 __all__ = [
@@ -47,6 +56,7 @@ __all__ = [
     "asset_names",
     "categories",
     "get_asset",
+    "known_asset",
     "library",
     "load_asset_catalog",
     "load_asset_file",
@@ -54,7 +64,6 @@ __all__ = [
     "unregister_asset",
 ]
 
-_NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.\-]*$")
 _ALLOWED_CLASSES = (SemanticClass.VESSEL, SemanticClass.USV)
 _YamlLoader: Any = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
@@ -84,7 +93,10 @@ def _as_mount(m: object, where: str) -> MountPoint:
 
 
 class UnknownAssetError(NotFoundError, KeyError):
-    """No asset has this name (a :class:`mmusv.NotFoundError`, and a ``KeyError`` as before). ``suggestions`` holds close matches; ``str()`` is a readable message."""
+    """No asset has this name (a :class:`mmusv.NotFoundError`, and a ``KeyError`` as before).
+
+    ``suggestions`` holds close matches; ``str()`` is a readable message.
+    """
 
     def __init__(self, name: str, known: Sequence[str]) -> None:
         self.name = name
@@ -145,7 +157,7 @@ class VesselAsset:
     bbox: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        if not isinstance(self.name, str) or not _NAME_RE.match(self.name):
+        if not isinstance(self.name, str) or not NAME_PATTERN.match(self.name):
             raise AssetSpecError("name", f"must be letters, digits, '_', '-' or '.', got {self.name!r}")
         cls = SemanticClass(self.semantic_class)
         if cls not in _ALLOWED_CLASSES:
@@ -239,6 +251,17 @@ def asset_names() -> list[str]:
         return sorted(set(_builtin_entries()) | set(_user))
 
 
+def known_asset(name: str) -> str:
+    """``name`` when the library has an asset of that name; else a ``ValueError`` (for schema validators) naming
+    up to three close matches and the command that lists them all. Builds nothing."""
+    names = asset_names()
+    if name not in names:
+        close = difflib.get_close_matches(name, names, n=3, cutoff=0.5)
+        hint = f"; did you mean {', '.join(close)}?" if close else ""
+        raise ValueError(f"unknown asset{hint} (`mmusv assets` lists all {len(names)})")
+    return name
+
+
 def get_asset(name: str) -> VesselAsset:
     """The asset called ``name`` (built on first use, then cached).
 
@@ -302,16 +325,10 @@ def unregister_asset(name: str) -> None:
 
 # ------------------------------------------------------------------------------------------- user assets
 
-_AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
 
-
-def _axis(f: Fields, key: str, default: str) -> np.ndarray:
-    s = f.text(key, default).strip().lower()
-    sign = -1.0 if s.startswith("-") else 1.0
-    letter = s.lstrip("+-")
-    if letter not in _AXES or len(s) - len(letter) > 1:
-        raise AssetSpecError(f.at(key), f"must be one of x, y, z, -x, -y, -z; got {s!r}")
-    return sign * np.array(_AXES[letter])
+def _axis(name: str) -> np.ndarray:
+    """The unit vector of a validated axis name (``x`` ... ``-z``)."""
+    return (-1.0 if name.startswith("-") else 1.0) * np.array(AXES[name[-1]])
 
 
 def _load_mesh_file(path: Path, where: str) -> tuple[np.ndarray, np.ndarray]:
@@ -338,106 +355,62 @@ def _load_mesh_file(path: Path, where: str) -> tuple[np.ndarray, np.ndarray]:
     return v, fc
 
 
-def _semantic_class(f: Fields) -> SemanticClass:
-    v = f.raw("semantic_class")
-    if v is None:
-        return SemanticClass.VESSEL
-    cls: SemanticClass | None = None
-    try:
-        if isinstance(v, str):
-            cls = SemanticClass[v.upper()]
-        elif isinstance(v, int) and not isinstance(v, bool):
-            cls = SemanticClass(v)
-    except (KeyError, ValueError):
-        cls = None
-    if cls not in _ALLOWED_CLASSES:
-        raise AssetSpecError(f.at("semantic_class"), f"must be 'vessel' or 'usv', got {v!r}")
-    assert cls is not None
-    return cls
-
-
-def _mounts(f: Fields) -> dict[str, MountPoint]:
-    raw = f.raw("mounts")
-    if raw is None:
-        return {}
-    mf = Fields(raw, f.at("mounts"))
-    out = {}
-    for key in mf.keys():  # noqa: SIM118 (Fields is not a dict)
-        m = Fields(mf.raw(key), mf.at(key))
-        xyz = m.vec("xyz", 3)
-        rpy = m.vec("rpy_deg", 3, (0.0, 0.0, 0.0))
-        m.finish()
-        out[str(key)] = MountPoint((xyz[0], xyz[1], xyz[2]), (rpy[0], rpy[1], rpy[2]))
-    return out
-
-
 def _build_entry(entry: object, *, base_dir: Path | None, source: str, builtin: bool = False) -> VesselAsset:
     name_guess = entry.get("name") if isinstance(entry, Mapping) else None
-    f = Fields(entry, name_guess if isinstance(name_guess, str) and _NAME_RE.match(name_guess) else "")
-    name = f.text("name")
-    if not _NAME_RE.match(name):
-        raise AssetSpecError(f.at("name"), f"must be letters, digits, '_', '-' or '.', got {name!r}")
-    category = f.text("category", "custom")
-    description = str(f.raw("description") or "")
-    cls = _semantic_class(f)
-    mounts = _mounts(f)
-    has_mesh, has_hull = f.has("mesh"), f.has("hull")
-    if has_mesh == has_hull:
-        raise AssetSpecError(f.at("mesh"), "give exactly one of 'mesh' (a mesh file) or 'hull' (procedural)")
-    if has_hull:
-        mesh = build_procedural(hull=f.raw("hull"), parts=f.raw("parts"), path=f.path, cls=int(cls))
-        f.finish()
+    path = name_guess if isinstance(name_guess, str) and NAME_PATTERN.match(name_guess) else ""
+    spec = parse_asset(entry, path=path)
+    cls = spec.semantic_class
+    mounts = {k: MountPoint(_triple(m.xyz), _triple(m.rpy_deg)) for k, m in spec.mounts.items()}
+    if isinstance(spec, ProceduralAssetSpec):
+        mesh = build_procedural(hull=spec.hull, parts=spec.parts, path=path, cls=int(cls))
     else:
         if builtin:
-            raise AssetSpecError(f.at("mesh"), "built-in assets are procedural")
-        mesh = _mesh_entry(f, base_dir=base_dir, cls=int(cls))
+            raise AssetSpecError(join(path, "mesh"), "built-in assets are procedural")
+        mesh = _mesh_entry(spec, path=path, base_dir=base_dir, cls=int(cls))
     b = mesh.bounds
     shift = np.array([(b[0, 0] + b[1, 0]) / 2.0, (b[0, 1] + b[1, 1]) / 2.0, 0.0])
     if np.any(np.abs(shift) > 1e-9 * max(1.0, float((b[1] - b[0]).max()))):
         mesh = TriMesh(mesh.vertices - shift, mesh.faces, mesh.classes)
-        if has_hull:
+        if isinstance(spec, ProceduralAssetSpec):
             mounts = {
                 k: MountPoint((m.xyz[0] - shift[0], m.xyz[1] - shift[1], m.xyz[2]), m.rpy_deg)
                 for k, m in mounts.items()
             }
     return VesselAsset(
-        name=name,
-        category=category,
+        name=spec.name,
+        category=spec.category,
         semantic_class=cls,
         mesh=mesh,
         mounts=mounts,
-        description=description,
+        description=spec.description,
         source=source,
     )
 
 
-def _mesh_entry(f: Fields, *, base_dir: Path | None, cls: int) -> TriMesh:
-    mesh_path = Path(os.fspath(f.text("mesh"))).expanduser()
+def _triple(v: tuple[float, ...]) -> tuple[float, float, float]:
+    return (v[0], v[1], v[2])
+
+
+def _mesh_entry(spec: MeshAssetSpec, *, path: str, base_dir: Path | None, cls: int) -> TriMesh:
+    mesh_path = Path(os.fspath(spec.mesh)).expanduser()
     if not mesh_path.is_absolute():
         mesh_path = (base_dir or Path.cwd()) / mesh_path
-    scale = f.num("scale", 1.0, minimum=0.0, exclusive=True)
-    up = _axis(f, "up_axis", "z")
-    fwd = _axis(f, "forward_axis", "x")
-    if abs(float(up @ fwd)) > 0.5:
-        raise AssetSpecError(f.at("forward_axis"), "must be perpendicular to up_axis")
-    waterline = f.opt_num("waterline_z")
-    draft = f.opt_num("draft", minimum=0.0, exclusive=True)
-    if waterline is not None and draft is not None:
-        raise AssetSpecError(f.at("draft"), "give either waterline_z or draft, not both")
-    f.finish()
-    v, fc = _load_mesh_file(mesh_path, f.at("mesh"))
+    up, fwd = _axis(spec.up_axis), _axis(spec.forward_axis)
+    v, fc = _load_mesh_file(mesh_path, join(path, "mesh"))
     rot = np.stack([fwd, np.cross(up, fwd), up])  # rows: body x, y, z in file coordinates
-    body = (v @ rot.T) * scale
+    body = (v @ rot.T) * spec.scale
     zmin, zmax = float(body[:, 2].min()), float(body[:, 2].max())
-    if draft is not None:
-        if draft >= zmax - zmin:
-            raise AssetSpecError(f.at("draft"), f"{draft:g} m is not less than the mesh height {zmax - zmin:g} m")
-        body[:, 2] -= zmin + draft
+    if spec.draft is not None:
+        if spec.draft >= zmax - zmin:
+            raise AssetSpecError(
+                join(path, "draft"), f"{spec.draft:g} m is not less than the mesh height {zmax - zmin:g} m"
+            )
+        body[:, 2] -= zmin + spec.draft
     else:
-        wl = (waterline or 0.0) * scale
+        wl = (spec.waterline_z or 0.0) * spec.scale
         if not zmin < wl < zmax:
             raise AssetSpecError(
-                f.at("waterline_z"),
+                join(path, "waterline_z"),
                 f"waterline {wl:g} m must lie inside the mesh's vertical extent [{zmin:g}, {zmax:g}] m "
                 "(after scaling; check up_axis and scale)",
             )
@@ -459,7 +432,7 @@ def load_asset_file(
     ``up_axis`` (``z``; ``y`` for glTF-style files; any of ±x/±y/±z), ``forward_axis`` (bow direction in the file,
     ``x``; any of ±x/±y/±z perpendicular to up), ``waterline_z`` (waterline height along ``up_axis`` in file units,
     0.0) or ``draft`` (metres above the lowest point), ``mounts`` (``{name: {xyz, rpy_deg}}`` in the asset frame).
-    A procedural entry gives ``hull`` and ``parts`` instead of ``mesh`` (see :mod:`mmusv.world.vessel_shapes`).
+    A procedural entry gives ``hull`` and ``parts`` instead of ``mesh`` (see :mod:`mmusv.world.asset_spec`).
 
     The mesh is rotated to the body frame, scaled, shifted so the waterline is z = 0 and re-centred in x/y;
     dimensions come from its bounding box. Raises :class:`AssetSpecError` (a ``ValueError``) naming the field.

@@ -7,6 +7,7 @@
 //! - [`shade`]: the RGB shading model (sun, sky, water, shadows, fog, rain);
 //! - [`noise`]: counter-based random draws, so results never depend on thread scheduling.
 
+#[allow(clippy::neg_cmp_op_on_partial_ord, reason = "`!(x > 0.0)` rejects NaN on purpose; `partial_cmp` hides that")]
 pub mod camera;
 pub mod lidar;
 pub mod noise;

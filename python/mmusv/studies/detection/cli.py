@@ -205,42 +205,15 @@ class _bar:
 def _print_detection(console: Any, res: Any) -> None:
     from rich.table import Table
 
-    from mmusv.studies.detection.report import BINS, detection_table, fmt
+    from mmusv.studies.detection.report import DETECTION_METRICS, detection_table, fmt
 
     t = detection_table(res)
     table = Table(title="Cooperative detection (Table III)")
-    heads = [
-        "mode",
-        "AP@0.3",
-        "AP@0.5",
-        "AP@0.7",
-        "P@0.5",
-        "R@0.5",
-        *[f"AP@0.5 {b} m" for b in BINS],
-        "R@0.5 visible",
-        "R@0.5 hidden",
-        "R@0.3 hidden",
-    ]
-    for h in heads:
+    shown = [(column, heading) for column, heading in DETECTION_METRICS if heading]
+    for h in ["mode", *(heading for _, heading in shown)]:
         table.add_column(h, justify="right")
     for r in t.iter_rows(named=True):
-        table.add_row(
-            r["mode"],
-            *[
-                fmt(r[k])
-                for k in (
-                    "ap30",
-                    "ap50",
-                    "ap70",
-                    "precision50",
-                    "recall50",
-                    *[f"ap50_{b}" for b in BINS],
-                    "recall50_visible",
-                    "recall50_hidden",
-                    "recall30_hidden",
-                )
-            ],
-        )
+        table.add_row(r["mode"], *[fmt(r[column]) for column, _ in shown])
     console.print(table)
     r0 = t.row(0, named=True)
     console.print(

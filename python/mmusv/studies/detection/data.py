@@ -7,7 +7,8 @@ scenario folder). Sequences are split (train / validate / test) by a seeded shuf
 agent-as-ego expansion (:func:`split_sequences`), so no scene is in two splits.
 
 Ground truth for an ego (:func:`gt_in_ego`): every target box (USVs excluded) moved into the ego LiDAR frame and
-kept when its BEV centre is within ``range_m`` (200 m) of the sensor. USV platforms (:func:`usv_boxes_in_ego`)
+kept when its BEV centre is within ``range_m`` (200 m) of the sensor (:func:`mmusv.annotate.in_target_range`, the
+rule of the annotations and the export). USV platforms (:func:`usv_boxes_in_ego`)
 are returned separately: detections centred on them are ignored in evaluation.
 """
 
@@ -21,6 +22,7 @@ from types import ModuleType
 import numpy as np
 import yaml
 
+from mmusv.annotate import in_target_range
 from mmusv.errors import InputError, IoError
 from mmusv.frames import carla_matrix, invert, mirror_transform, pose_matrices
 
@@ -100,9 +102,10 @@ def boxes_in_frame(to_frame: np.ndarray, boxes: np.ndarray, sizes: np.ndarray) -
 
 
 def gt_in_ego(frame: SceneFrame, ego: AgentFrame, *, range_m: float = 200.0) -> np.ndarray:
-    """``(G, 7)`` ground-truth target boxes in ``ego``'s LiDAR frame within ``range_m`` (BEV distance)."""
+    """``(G, 7)`` ground-truth target boxes in ``ego``'s LiDAR frame within ``range_m`` by the one target rule,
+    :func:`mmusv.annotate.in_target_range` (BEV distance ``<= range_m``)."""
     b = boxes_in_frame(invert(ego.lidar), frame.targets, frame.target_sizes)
-    out: np.ndarray = b[np.hypot(b[:, 0], b[:, 1]) < range_m] if len(b) else b
+    out: np.ndarray = b[in_target_range(b[:, :3], range_m)] if len(b) else b
     return out
 
 

@@ -12,9 +12,25 @@ from mmusv.studies.detection.detector import BASELINE_NOTE
 from mmusv.studies.detection.evaluate import RANGE_BINS, bin_label
 from mmusv.studies.detection.study import StudyResult
 
-__all__ = ["detection_table", "fmt", "robustness_table", "write_detection", "write_robustness"]
+__all__ = ["DETECTION_METRICS", "detection_table", "fmt", "robustness_table", "write_detection", "write_robustness"]
 
 BINS = [bin_label(k) for k in range(len(RANGE_BINS))]
+
+DETECTION_METRICS: tuple[tuple[str, str | None], ...] = (
+    ("ap30", "AP@0.3"),
+    ("ap50", "AP@0.5"),
+    ("ap70", "AP@0.7"),
+    ("precision50", "P@0.5"),
+    ("recall50", "R@0.5"),
+    *((f"ap50_{b}", f"AP@0.5 {b} m") for b in BINS),
+    ("recall50_visible", "R@0.5 visible"),
+    ("recall50_hidden", "R@0.5 hidden"),
+    ("recall50_unseen", None),
+    ("recall30_visible", None),
+    ("recall30_hidden", "R@0.3 hidden"),
+    ("recall30_unseen", None),
+)
+"""Table III's metric columns in CSV order, each with its heading in the printed table (``None``: CSV only)."""
 
 
 def fmt(v: float) -> str:
@@ -25,27 +41,7 @@ def fmt(v: float) -> str:
 def detection_table(res: StudyResult) -> pl.DataFrame:
     """Table III: one row per fusion mode (clean setting)."""
     t = res.table().filter(pl.col("setting") == "clean")
-    cols = [
-        "mode",
-        "ap30",
-        "ap50",
-        "ap70",
-        "precision50",
-        "recall50",
-        *[f"ap50_{b}" for b in BINS],
-        "recall50_visible",
-        "recall50_hidden",
-        "recall50_unseen",
-        "recall30_visible",
-        "recall30_hidden",
-        "recall30_unseen",
-        "gt_visible",
-        "gt_hidden",
-        "gt_unseen",
-        "gt",
-        "det",
-        "frames",
-    ]
+    cols = ["mode", *(c for c, _ in DETECTION_METRICS), "gt_visible", "gt_hidden", "gt_unseen", "gt", "det", "frames"]
     return t.select(cols)
 
 

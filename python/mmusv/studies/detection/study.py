@@ -33,6 +33,7 @@ import numpy as np
 import polars as pl
 import shapely
 
+from mmusv.annotate import in_target_range
 from mmusv.errors import InputError
 from mmusv.frames import transform_points
 from mmusv.studies.detection.data import (
@@ -199,7 +200,7 @@ def gt_visibility(gt: np.ndarray, points: np.ndarray, *, z_margin_m: float = 0.5
 def _keep(
     boxes: np.ndarray, scores: np.ndarray, usv: np.ndarray, *, range_m: float, margin: float
 ) -> tuple[np.ndarray, np.ndarray]:
-    sel = np.hypot(boxes[:, 0], boxes[:, 1]) < range_m
+    sel = in_target_range(boxes[:, :3], range_m)
     if len(usv) and len(boxes):
         plat = shapely.union_all(shapely.buffer(box_polygons(usv), margin))
         sel &= ~shapely.contains_xy(plat, boxes[:, 0], boxes[:, 1])

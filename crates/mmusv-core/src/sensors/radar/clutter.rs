@@ -1,0 +1,89 @@
+//! Clutter: the mean sea and rain clutter of each range bin (shared by every beam, cut off where clutter
+//! alone can no longer be detected) and the seeded per-cell draws that make it a random picture.
+
+use crate::sensors::radar::{RadarConfig, RadarEnv};
+use crate::sensors::radar_model;
+use rand::{RngCore, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// A clutter-only cell whose mean is below `threshold / CLUTTER_CUTOFF` is detected with probability
+/// `< e⁻⁵⁰`; past the first such range the clutter-only scan of a beam stops.
+const CLUTTER_CUTOFF: f64 = 50.0;
+
+/// Per-cell random draws: clutter `u ∈ (0, 1]` and a standard normal for the range noise.
+pub(super) struct CellDraws {
+    rng: ChaCha8Rng,
+    next: Option<u32>,
+}
+
+impl CellDraws {
+    /// The draws of beam `beam` (stream `beam` of the generator seeded with `seed`).
+    pub(super) fn new(seed: u64, beam: u32) -> Self {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        rng.set_stream(beam as u64);
+        Self { rng, next: None }
+    }
+
+    /// The draws of cell `bin`: `(u, w)` with `u` uniform in `(0, 1]` for clutter and `w` the raw word that
+    /// [`CellDraws::normal`] turns into the range noise.
+    pub(super) fn at(&mut self, bin: u32) -> (f64, u64) {
+        if self.next != Some(bin) {
+            self.rng.set_word_pos(bin as u128 * 4);
+        }
+        self.next = Some(bin + 1);
+        let a = self.rng.next_u64();
+        let w = self.rng.next_u64();
+        (((a >> 11) + 1) as f64 * (1.0 / (1u64 << 53) as f64), w)
+    }
+
+    /// A standard normal from one 64-bit word (Box–Muller on its two 32-bit halves).
+    pub(super) fn normal(w: u64) -> f64 {
+        let u1 = ((w >> 32) + 1) as f64 * (1.0 / 4_294_967_296.0);
+        let u2 = (w & 0xffff_ffff) as f64 * (1.0 / 4_294_967_296.0);
+        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+    }
+}
+
+/// Clutter of one range bin: mean intensity, whether sea (not rain) dominates, and the probability that
+/// clutter alone passes the threshold.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct ClutterBin {
+    pub(super) mean: f64,
+    pub(super) sea: bool,
+    pub(super) p_detect: f64,
+}
+
+impl ClutterBin {
+    /// The clutter of range bin `bin`.
+    pub(super) fn at(cfg: &RadarConfig, env: &RadarEnv, bin: u32) -> Self {
+        let (sea, rain) = radar_model::clutter_mean(
+            &cfg.clutter,
+            &cfg.cell_shape(),
+            env.wave_height_m as f64,
+            env.rain_mm_per_h as f64,
+            cfg.bin_centre(bin),
+        );
+        let mean = sea + rain;
+        let p_detect = if mean > 0.0 { (-cfg.detection_threshold / mean).exp() } else { 0.0 };
+        Self { mean, sea: sea >= rain, p_detect }
+    }
+}
+
+/// Clutter of the range bins from `first` on, shared by every beam, up to the first bin where clutter alone
+/// cannot be detected (`mean < threshold / CLUTTER_CUTOFF`; the means fall monotonically with range).
+pub(super) fn clutter_table(cfg: &RadarConfig, env: &RadarEnv, first: u32, end: u32) -> Vec<ClutterBin> {
+    let mut table = Vec::new();
+    for k in first..end {
+        let c = ClutterBin::at(cfg, env, k);
+        let negligible = if cfg.detection_threshold > 0.0 {
+            c.mean * CLUTTER_CUTOFF < cfg.detection_threshold
+        } else {
+            c.mean <= 0.0
+        };
+        if negligible {
+            break;
+        }
+        table.push(c);
+    }
+    table
+}

@@ -1,0 +1,131 @@
+//! Where the radar's rays go: beam and sample azimuths, the stratified elevation fan with its horizon band,
+//! range bins, the trace order of the rays, and their world directions for one sweep.
+
+use crate::geometry::RigidPose;
+use crate::sensors::radar::RadarConfig;
+use crate::sensors::radar_model::CellShape;
+use parry3d::math::Vec3;
+use rayon::prelude::*;
+
+/// Neighbouring azimuth samples traced together (one packet per elevation row).
+const TRACE_BLOCK: usize = crate::sensors::rays::TRACE_BLOCK as usize;
+/// Golden-ratio conjugate: the elevation offset of azimuth sample `g` is `frac(g · φ⁻¹)`.
+const GOLDEN: f64 = 0.618_033_988_749_894_8;
+
+impl RadarConfig {
+    /// The range bins that are not blind: `first..end` (bin centres in `[range_min_m, range_max_m)`).
+    pub fn range_bins(&self) -> (u32, u32) {
+        let res = self.range_resolution_m;
+        let first = (self.range_min_m / res - 0.5).ceil().max(0.0) as u32;
+        let end = (self.range_max_m / res - 0.5).ceil().max(0.0) as u32;
+        (first, end.max(first))
+    }
+
+    /// Centre of range bin `k`, metres.
+    pub fn bin_centre(&self, k: u32) -> f64 {
+        (k as f64 + 0.5) * self.range_resolution_m
+    }
+
+    /// Azimuth of beam `b` in the sensor frame, radians in `[0, 2π)`.
+    pub fn beam_azimuth(&self, b: u32) -> f64 {
+        std::f64::consts::TAU * b as f64 / self.azimuth_bins as f64
+    }
+
+    /// Azimuth (radians, sensor frame) of azimuth sample `g = b · rays_az + j`, the `j`-th ray across beam `b`.
+    pub fn sample_azimuth(&self, g: u32) -> f64 {
+        let (b, j) = (g / self.rays_az, g % self.rays_az);
+        self.beam_azimuth(b) + ((j as f64 + 0.5) / self.rays_az as f64 - 0.5) * self.beamwidth_az_rad
+    }
+
+    /// Elevations (radians, sensor frame) and weights (the fan height in radians each ray stands for; they sum
+    /// to the fan height) of the `rays_el` rays of azimuth sample `g`, whose sea horizon lies at elevation
+    /// `horizon` (`None`: not in view). Written into `out` (length `rays_el`).
+    pub fn sample_elevations(&self, g: u32, horizon: Option<f64>, out: &mut [(f64, f64)]) {
+        let [lo, hi] = self.elevation_fan_rad;
+        let k_all = out.len();
+        let offset = (g as f64 * GOLDEN).fract();
+        let (b0, b1) = match horizon {
+            Some(e) if self.horizon_fraction > 0.0 && self.horizon_band_rad > 0.0 => {
+                ((e - self.horizon_band_rad).max(lo), (e + self.horizon_band_rad).min(hi))
+            }
+            _ => (lo, lo),
+        };
+        let band = (b1 - b0).max(0.0);
+        let rest = (hi - lo) - band;
+        let k_band = if band <= 0.0 {
+            0
+        } else if rest <= 0.0 {
+            k_all
+        } else {
+            ((self.horizon_fraction * k_all as f64).round() as usize).min(k_all - 1)
+        };
+        let k_rest = k_all - k_band;
+        for (k, slot) in out.iter_mut().enumerate() {
+            *slot = if k < k_band {
+                (b0 + band * (k as f64 + offset) / k_band as f64, band / k_band as f64)
+            } else if rest > 0.0 {
+                let t = rest * ((k - k_band) as f64 + offset) / k_rest as f64;
+                let below = b0 - lo;
+                (if t < below { lo + t } else { b1 + (t - below) }, rest / k_rest as f64)
+            } else {
+                // A zero-height fan: every ray at the one elevation, sharing one beamwidth of height.
+                (lo, self.cell_shape().fan_height / k_all as f64)
+            };
+        }
+    }
+
+    /// The beam's cell: azimuth beamwidth, fan height and range resolution (for the intensity model).
+    pub(super) fn cell_shape(&self) -> CellShape {
+        let [lo, hi] = self.elevation_fan_rad;
+        CellShape {
+            beamwidth_az: self.beamwidth_az_rad,
+            fan_height: (hi - lo).max(self.beamwidth_az_rad),
+            range_resolution: self.range_resolution_m,
+        }
+    }
+}
+
+/// Elevation (sensor frame, radians) at which the world's horizontal plane through the sensor cuts azimuth
+/// `az`, for a sensor whose rotation (sensor → world) is `pose`; `None` when the sensor is tipped 90° or more.
+pub fn horizon_elevation(pose: &RigidPose, az: f64) -> Option<f64> {
+    let r = pose.rotation;
+    let (r20, r21, r22) = (r.x_axis.z as f64, r.y_axis.z as f64, r.z_axis.z as f64);
+    (r22 > 1e-6).then(|| (-(r20 * az.cos() + r21 * az.sin()) / r22).atan())
+}
+
+/// Index in the trace order of ray `k` (elevation) of azimuth sample `g`: blocks of [`TRACE_BLOCK`]
+/// neighbouring azimuth samples, each elevation row of a block consecutive (coherent packets).
+#[inline]
+pub(super) fn trace_index(g: usize, k: usize, samples: usize, rows: usize) -> usize {
+    let start = g / TRACE_BLOCK * TRACE_BLOCK;
+    let len = TRACE_BLOCK.min(samples - start);
+    start * rows + k * len + (g - start)
+}
+
+/// The rays of one sweep from `sensor_to_world`, in trace order: world unit directions, and per ray its
+/// elevation in the sensor frame (radians) and the fan height it stands for (radians).
+pub(super) fn sweep_rays(cfg: &RadarConfig, sensor_to_world: &RigidPose) -> (Vec<[f32; 3]>, Vec<[f32; 2]>) {
+    let samples = (cfg.azimuth_bins * cfg.rays_az) as usize;
+    let rows = cfg.rays_el as usize;
+    let mut dirs = vec![[0.0f32; 3]; samples * rows];
+    let mut meta = vec![[0.0f32; 2]; samples * rows];
+    dirs.par_chunks_mut(TRACE_BLOCK * rows).zip(meta.par_chunks_mut(TRACE_BLOCK * rows)).enumerate().for_each(
+        |(block, (chunk, meta))| {
+            let start = block * TRACE_BLOCK;
+            let len = TRACE_BLOCK.min(samples - start);
+            let mut column = vec![(0.0, 0.0); rows];
+            for g in start..start + len {
+                let az = cfg.sample_azimuth(g as u32);
+                cfg.sample_elevations(g as u32, horizon_elevation(sensor_to_world, az), &mut column);
+                let (sa, ca) = az.sin_cos();
+                for (k, &(el, weight)) in column.iter().enumerate() {
+                    let (se, ce) = el.sin_cos();
+                    let body = Vec3::new((ce * ca) as f32, (ce * sa) as f32, se as f32);
+                    chunk[k * len + g - start] = sensor_to_world.transform_vector(body).to_array();
+                    meta[k * len + g - start] = [el as f32, weight as f32];
+                }
+            }
+        },
+    );
+    (dirs, meta)
+}

@@ -1,0 +1,294 @@
+"""The schema of a vessel asset entry: frozen pydantic models, and their errors as :class:`AssetSpecError`.
+
+An entry (one item of ``vessel_catalog.yaml``, or a user's YAML/mapping) is either a **mesh asset** (``mesh``: a
+file read by :mod:`mmusv.world.vessels`) or a **procedural asset** (``hull`` and ``parts``, built by
+:mod:`mmusv.world.vessel_shapes`). Every number is in metres (angles in degrees where the key ends in ``_deg``), in
+the vessel body frame: x forward (bow at +x), y left, z up, z = 0 at the waterline, x measured from midship. A key
+set to ``null`` counts as not given. Checks that need the hull's shape (a part's base on the deck, ``fit``, the
+footprint) belong to the mesh builder; everything a part can say about itself is checked here.
+
+Hull keys (``type: mono | twin``)::
+
+    length, beam, draft, depth        overall length, beam, hull draft, keel-to-deck depth at midship
+    demi_beam                         twin only: beam of each of the two demihulls
+    bow=0.2, stern=0.1                fractions of the length over which the hull tapers at bow / stern
+    bow_shape=pointed|round           plan form of the bow taper; bow_power=2.0 is its fullness (>= 1)
+    bow_width=0                       half-width left at the stem (1 = square barge bow; needs bow=0)
+    transom=0.9                       half-width fraction at the transom (must be 1 when stern=0)
+    sheer=0                           deck rise at the stem above the midship deck, rising quadratically
+    rake=0.05, overhang=0.0           fractions of length by which the keel is shorter at bow / stern
+    bottom=0.8, flare=1.0             half-width fraction at the keel / at the waterline (deck is 1)
+
+Part types (:mod:`mmusv.world.part_spec`; each ``{type: ..., ...}``; ``base`` defaults to the deck height at the
+part's x; vertical extent is ``top`` (absolute z) or ``height`` (above ``base``); ``fit: m`` narrows a part so it
+stays ``m`` metres inside the deck outline)::
+
+    box        x, y=0, size [lx, ly], base, top|height, taper=1, yaw_deg=0, fit
+    house      x, y=0, align=center|aft|fore, base, tiers [[lx, ly, h(, dx)], ...], taper=1, fit,
+               wings [lx, ly] (bridge wings beside the top tier)
+    hull_block x0, x1, inset=0, base, top|height, taper=1          (a block following the deck outline)
+    row        x0, x1, count, gap=0, y=0, width, heights [h, ...] (cycled), base, fit  (hatches, stacks)
+    funnel     x, y=0, size [lx, ly], base, top|height, shape=box|round, taper=0.9
+    mast       x, y=0, base, top|height, width=0.3, yard=0, yard_at=0.8
+    cylinder   x, y=0, radius, base, top|height, top_radius, segments=12
+    hcylinder  x0, x1, y=0, z, radius, segments=12                 (axis along x)
+    dome       x, y=0, radius, top, base, segments=16              (sphere cap on a skirt)
+    strut      from [x, y, z], to [x, y, z], width, thickness=width (absolute coordinates)
+    plate      y=0, thickness, points [[x, z], ...] (convex profile extruded across y)
+    gantry     x, span, base, top|height, leg=0.5, lean=0           (A-frame / portal)
+    crane      x, y=0, base, pedestal [radius, height], jib [length, elevation_deg, yaw_deg], width=0.6
+    gun        x, y=0, base, radius, height, barrel, yaw_deg=0, elevation_deg=5
+
+Mesh asset keys: ``mesh`` (file path), ``scale=1``, ``up_axis=z``, ``forward_axis=x`` (any of ±x/±y/±z),
+``waterline_z`` or ``draft``. Both kinds: ``name``, ``category=custom``, ``description``, ``semantic_class=vessel``
+(``vessel`` | ``usv``), ``mounts`` (``{name: {xyz, rpy_deg=[0, 0, 0]}}``).
+
+:func:`parse_asset` validates an entry; errors are one :class:`AssetSpecError` whose ``field`` is the dotted path
+of the first problem (``tug_32m.hull.beam``, ``tug_32m.parts[3].top``) and whose message says what is allowed.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, BeforeValidator, Field, ValidationError, model_validator
+
+from mmusv.classes import SemanticClass
+from mmusv.errors import ConfigError
+from mmusv.validation import (
+    Fraction,
+    NonNegative,
+    Number,
+    Positive,
+    Spec,
+    Text,
+    Vec3,
+    describe,
+    invalid,
+    invalid_field,
+    join,
+)
+from mmusv.world.part_spec import PartSpec
+
+__all__ = [
+    "AXES",
+    "NAME_PATTERN",
+    "AssetSpec",
+    "AssetSpecError",
+    "HullSpec",
+    "MeshAssetSpec",
+    "MountSpec",
+    "ProceduralAssetSpec",
+    "parse_asset",
+    "spec_error",
+]
+
+
+class AssetSpecError(ConfigError, ValueError):
+    """A vessel asset entry is invalid (a :class:`mmusv.ConfigError`, and a ``ValueError`` as before).
+
+    ``field`` is the dotted path of the offending key (``tug_32m.hull.beam``), ``reason`` what is wrong with it.
+    """
+
+    def __init__(self, field: str, message: str) -> None:
+        super().__init__(f"{field}: {message}")
+        self.field = field
+        self.reason = message
+
+    def __reduce__(self) -> tuple[type[AssetSpecError], tuple[str, str]]:
+        return (type(self), (self.field, self.reason))
+
+
+NAME_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.\-]*$")
+"""What an asset name may be: letters, digits, ``_``, ``-`` and ``.``, starting with a letter or digit."""
+
+AXES: dict[str, tuple[float, float, float]] = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
+"""The axis letters of a mesh file's ``up_axis`` / ``forward_axis`` (optionally with a sign) as unit vectors."""
+
+
+def _axis_name(value: object) -> str:
+    s = value.strip().lower() if isinstance(value, str) else ""
+    letter = s.lstrip("+-")
+    if letter not in AXES or len(s) - len(letter) > 1:
+        raise invalid(f"must be one of x, y, z, -x, -y, -z; got {value!r}")
+    return ("-" if s.startswith("-") else "") + letter
+
+
+def _semantic_class(value: object) -> SemanticClass:
+    cls: SemanticClass | None = None
+    try:
+        if isinstance(value, str):
+            cls = SemanticClass[value.upper()]
+        elif isinstance(value, int) and not isinstance(value, bool):
+            cls = SemanticClass(value)
+    except (KeyError, ValueError):
+        cls = None
+    if cls not in (SemanticClass.VESSEL, SemanticClass.USV):
+        raise invalid(f"must be 'vessel' or 'usv', got {value!r}")
+    assert cls is not None
+    return cls
+
+
+def _asset_name(value: object) -> object:
+    if isinstance(value, str) and value and not NAME_PATTERN.match(value):
+        raise invalid(f"must be letters, digits, '_', '-' or '.', got {value!r}")
+    return value
+
+
+Axis = Annotated[str, BeforeValidator(_axis_name)]
+"""A body axis of a mesh file, normalised to ``x``, ``y``, ``z``, ``-x``, ``-y`` or ``-z``."""
+
+
+# ------------------------------------------------------------------------------------------------------ hull
+
+
+class HullSpec(Spec):
+    """The hull of a procedural asset (module docstring); lengths in metres, the rest dimensionless."""
+
+    type: Literal["mono", "twin"] = "mono"
+    length: Positive
+    beam: Positive
+    draft: Positive
+    depth: Positive
+    """Keel-to-deck depth at midship; more than ``draft``."""
+    demi_beam: Positive | None = None
+    """Twin hulls only (required there): beam of each demihull, less than ``beam / 2``."""
+    bow: Annotated[Number, Field(ge=0.0, le=0.95)] = 0.2
+    stern: Annotated[Number, Field(ge=0.0, le=0.95)] = 0.1
+    """Taper fractions; ``bow + stern <= 1``."""
+    bow_width: Fraction | None = None
+    """Half-width fraction left at the stem; default 0 with a bow taper, and it must be 1 without one."""
+    transom: Annotated[Number, Field(ge=0.02, le=1.0)] | None = None
+    """Half-width fraction at the transom; default 0.9 with a stern taper, and it must be 1 without one."""
+    rake: Annotated[Number, Field(ge=0.0, le=0.45)] = 0.05
+    overhang: Annotated[Number, Field(ge=0.0, le=0.45)] = 0.0
+    bow_power: Annotated[Number, Field(ge=1.0, le=8.0)] = 2.0
+    bow_shape: Literal["pointed", "round"] = "pointed"
+    sheer: NonNegative = 0.0
+    bottom: Annotated[Number, Field(ge=0.02, le=1.0)] = 0.8
+    flare: Annotated[Number, Field(ge=0.02, le=1.0)] = 1.0
+
+    @model_validator(mode="after")
+    def _consistent(self) -> HullSpec:
+        if self.depth <= self.draft:
+            raise invalid_field("depth", f"must be > draft ({self.draft}), got {self.depth}")
+        if self.type == "twin" and self.demi_beam is None:
+            raise invalid_field("demi_beam", "is required for a twin hull")
+        if self.type == "mono" and self.demi_beam is not None:
+            raise invalid_field("demi_beam", "is for twin hulls only (type: twin)")
+        if self.demi_beam is not None and self.demi_beam > self.beam / 2.0:
+            raise invalid_field("demi_beam", f"must be <= beam / 2 ({self.beam / 2.0}), got {self.demi_beam}")
+        if self.bow + self.stern > 1.0:
+            raise invalid_field("stern", f"bow + stern must be <= 1, got {self.bow} + {self.stern}")
+        if self.bow == 0 and self.bow_width not in (None, 1.0):
+            raise invalid_field("bow_width", "must be 1 when bow is 0 (no taper)")
+        if self.stern == 0 and self.transom not in (None, 1.0):
+            raise invalid_field("transom", "must be 1 when stern is 0 (no taper)")
+        return self
+
+    @property
+    def freeboard(self) -> float:
+        """Deck height above the waterline at midship, metres."""
+        return self.depth - self.draft
+
+    @property
+    def demi_width(self) -> float:
+        """The beam of one demihull (twin), or the beam (mono), metres."""
+        return self.beam if self.demi_beam is None else self.demi_beam
+
+    @property
+    def stem_width(self) -> float:
+        """``bow_width`` with its default resolved."""
+        if self.bow_width is not None:
+            return self.bow_width
+        return 0.0 if self.bow > 0 else 1.0
+
+    @property
+    def transom_width(self) -> float:
+        """``transom`` with its default resolved."""
+        if self.transom is not None:
+            return self.transom
+        return 0.9 if self.stern > 0 else 1.0
+
+
+# ---------------------------------------------------------------------------------------------------- entries
+
+
+class MountSpec(Spec):
+    """A sensor mount in the body frame: ``xyz`` metres and ``rpy_deg`` roll/pitch/yaw degrees."""
+
+    xyz: Vec3
+    rpy_deg: Vec3 = (0.0, 0.0, 0.0)
+
+
+class _AssetSpec(Spec):
+    """What every asset entry says about itself."""
+
+    name: Annotated[Text, BeforeValidator(_asset_name)]
+    category: Text = "custom"
+    description: Annotated[str, BeforeValidator(str)] = ""
+    semantic_class: Annotated[SemanticClass, BeforeValidator(_semantic_class)] = SemanticClass.VESSEL
+    mounts: dict[Annotated[str, BeforeValidator(str)], MountSpec] = Field(default_factory=dict)
+
+
+class MeshAssetSpec(_AssetSpec):
+    """An asset whose mesh is read from a file and turned into the body frame."""
+
+    mesh: Text
+    """The mesh file (OBJ/STL/PLY/GLB/... read with trimesh); relative to the YAML file's folder."""
+    scale: Positive = 1.0
+    """File units -> metres."""
+    up_axis: Axis = "z"
+    forward_axis: Axis = "x"
+    """The bow direction in the file, perpendicular to ``up_axis``."""
+    waterline_z: Number | None = None
+    """Waterline height along ``up_axis`` in file units (default 0); or give ``draft``."""
+    draft: Positive | None = None
+    """Metres of the mesh below the waterline, measured from its lowest point."""
+
+    @model_validator(mode="after")
+    def _consistent(self) -> MeshAssetSpec:
+        if self.up_axis[-1] == self.forward_axis[-1]:
+            raise invalid_field("forward_axis", "must be perpendicular to up_axis")
+        if self.waterline_z is not None and self.draft is not None:
+            raise invalid_field("draft", "give either waterline_z or draft, not both")
+        return self
+
+
+class ProceduralAssetSpec(_AssetSpec):
+    """An asset built from a hull and superstructure parts (module docstring)."""
+
+    hull: HullSpec
+    parts: tuple[PartSpec, ...] = ()
+
+
+AssetSpec = MeshAssetSpec | ProceduralAssetSpec
+"""One asset entry: a mesh file or a procedural hull with parts."""
+
+
+def parse_asset(data: object, *, path: str) -> AssetSpec:
+    """Validates one asset entry; ``path`` (the asset's name, or ``""``) starts the field paths of errors.
+
+    An entry with ``hull`` is procedural, one with ``mesh`` a mesh asset; giving both or neither is an error at
+    ``<path>.mesh``. Raises :class:`AssetSpecError` naming the first invalid key and what is allowed there.
+    """
+    if not isinstance(data, Mapping):
+        raise AssetSpecError(path or "entry", f"must be a mapping, got {type(data).__name__}")
+    given = {k for k in ("mesh", "hull") if data.get(k) is not None}
+    if len(given) != 1:
+        raise AssetSpecError(join(path, "mesh"), "give exactly one of 'mesh' (a mesh file) or 'hull' (procedural)")
+    model: type[MeshAssetSpec] | type[ProceduralAssetSpec] = MeshAssetSpec if "mesh" in given else ProceduralAssetSpec
+    try:
+        return model.model_validate(data)
+    except ValidationError as exc:
+        raise spec_error(exc, model=model, path=path) from None
+
+
+def spec_error(err: ValidationError, *, model: type[BaseModel], path: str) -> AssetSpecError:
+    """``err`` (from validating ``model``) as one :class:`AssetSpecError`: the first problem's dotted path below
+    ``path`` is its ``field``; its message lists every problem with what is allowed there."""
+    problems = [describe(e, model, path) for e in err.errors()]
+    (field, first), rest = problems[0], problems[1:]
+    return AssetSpecError(field, "; ".join([first, *(f"{f}: {m}" for f, m in rest)]))
