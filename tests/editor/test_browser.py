@@ -226,6 +226,7 @@ def test_time_slider_matches_world_state(browser: Any, live_server: LiveServer) 
             )
             want = page_xy(v, float(state.poses[i, 0]), float(state.poses[i, 1]))
             assert math.dist(r, want) <= 1.0, (vessel.id, scale, r, want)
+    set_view(browser, -40.0, -150.0, 1.1)
     shot(browser, "timeline.png")
 
 

@@ -102,7 +102,7 @@ class MapBody(_Strict):
 
 
 class RunBody(_Strict):
-    name: str = Field(max_length=200)
+    name: str = Field(max_length=1000)
     frames: int | None = Field(default=None, ge=1)
 
 
@@ -378,7 +378,7 @@ def create_app(
     def run_cancel(job_id: int) -> dict[str, Any]:
         return jobs.cancel(job_id).as_dict()
 
-    @app.api_route("/api/{rest:path}", methods=["GET", "POST", "PUT", "DELETE", "PATCH"], include_in_schema=False)
+    @app.api_route("/api/{rest:path}", methods=["GET", "POST", "PUT"], include_in_schema=False)
     def unknown(rest: str) -> Response:
         raise NotFoundError(f"no API endpoint /api/{rest}")
 

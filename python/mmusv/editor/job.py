@@ -34,9 +34,12 @@ def main(argv: list[str] | None = None) -> int:
         _say({"warning": str(message)})
 
     warnings.showwarning = _warn
-    from mmusv.acquire import run
-    from mmusv.errors import MmusvError
-
+    try:  # imports inside: a stop (SIGINT) while they load still ends with a status line
+        from mmusv.acquire import run
+        from mmusv.errors import MmusvError
+    except KeyboardInterrupt:
+        _say({"status": "interrupted", "error": "stopped before the first frame"})
+        return 130
     try:
         res = run(
             args.scenario,

@@ -44,6 +44,7 @@ class Job:
     seconds: float | None = None
     warnings: list[str] = field(default_factory=list)
     process: subprocess.Popen[str] | None = field(default=None, repr=False)
+    stop_requested: bool = field(default=False, repr=False)
 
     def as_dict(self) -> dict[str, Any]:
         """The job as JSON (without the process)."""
@@ -107,7 +108,10 @@ class Jobs:
         err = proc.stderr.read()
         code = proc.wait()
         with self._lock:
-            if final is None:
+            if final is None and job.stop_requested:  # stopped while Python was still starting
+                job.status = "interrupted"
+                job.error = "stopped before the first frame"
+            elif final is None:
                 job.status = "failed"
                 tail = err.strip().splitlines()[-1:] if err.strip() else []
                 job.error = f"the run process ended with status {code}" + (f": {tail[0]}" if tail else "")
@@ -135,6 +139,7 @@ class Jobs:
         """Stops a running run with SIGINT (its recording keeps every completed frame)."""
         job = self.get(job_id)
         if job.status == "running" and job.process is not None and job.process.poll() is None:
+            job.stop_requested = True
             job.process.send_signal(signal.SIGINT)
         return job
 
