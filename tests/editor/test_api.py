@@ -203,8 +203,12 @@ def test_reading_files(client: TestClient, folder: Path) -> None:
     )
     r = client.get("/api/files/invalid.yaml").json()
     assert r["valid"] is False and r["document"]["vessels"][0]["speed_mps"] == -2  # opened as written, to be fixed
+    (folder / "shapeless.yaml").write_text("vessels: {a: 1}\n")
+    r = client.get("/api/files/shapeless.yaml")
+    assert r.status_code == 422 and "vessels" in r.json()["error"] and "as text" in r.json()["error"]
     (folder / "notes.txt").write_text("not a scenario")
-    assert [f["name"] for f in client.get("/api/files").json()] == ["broken.yaml", "invalid.yaml", "list.yaml"]
+    names = [f["name"] for f in client.get("/api/files").json()]
+    assert names == ["broken.yaml", "invalid.yaml", "list.yaml", "shapeless.yaml"]
 
 
 # ------------------------------------------------------------------------------------------------ map and checks

@@ -179,8 +179,30 @@ def _load_document(text: str, where: str) -> tuple[dict[str, Any], bool]:
         raise ConfigError(f"{where}: a scenario must be a YAML mapping with at least `vessels:`")
     try:
         return to_document(load_scenario(data)), True
-    except MmusvError:
+    except MmusvError as exc:
+        if not _editable(data):  # the page could not show it: say what is wrong instead
+            raise ConfigError(
+                f"{exc}; the editor opens files whose vessels and routes are lists (fix it as text)"
+            ) from None
         return json.loads(json.dumps(data, default=str)), False
+
+
+def _editable(data: dict[str, Any]) -> bool:
+    """Whether an invalid scenario mapping still has the shape the page draws: sections are mappings, ``vessels``
+    a list of mappings whose ``route`` is a list of ``[x, y]`` numbers."""
+    if any(k in data and not isinstance(data[k], dict) for k in ("map", "environment", "acquisition", "rigs")):
+        return False
+    vessels = data.get("vessels", [])
+    if not isinstance(vessels, list) or not all(isinstance(v, dict) for v in vessels):
+        return False
+    for v in vessels:
+        route = v.get("route", [])
+        if not isinstance(route, list):
+            return False
+        for p in route:
+            if not (isinstance(p, list) and len(p) == 2 and all(isinstance(c, (int, float)) for c in p)):
+                return False
+    return True
 
 
 def create_app(
