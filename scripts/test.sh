@@ -14,6 +14,14 @@ if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = "0" ]; then
     fi
 fi
 
+echo "== headless Chromium and its driver (the editor's browser tests drive Debian's chromium through Selenium)"
+if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = "0" ]; then
+    if ! command -v chromium >/dev/null 2>&1 || ! command -v chromedriver >/dev/null 2>&1; then
+        apt-get update -qq
+        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium chromium-driver >/dev/null
+    fi
+fi
+
 echo "== toolchains"
 command -v cargo >/dev/null || { echo "cargo not found: install a Rust toolchain (rustup) first" >&2; exit 1; }
 cargo --version

@@ -3,7 +3,7 @@
 Subcommands: ``run`` (a scenario or a folder of them into MCAP + Parquet), ``info`` and ``preview`` (inspect a
 recording), ``convert`` (to OPV2V or KITTI), ``generate`` (batch scenario generation), ``assets`` (the vessel
 library), ``study waves`` (Table I) and ``study agreement`` (Table II), ``study detection`` / ``study robustness``
-(Tables III, IV), ``version``.
+(Tables III, IV), ``editor`` (the scenario editor in the browser), ``version``.
 Errors in the input end with a one-line message naming the problem and exit status 2, never a traceback.
 """
 
@@ -323,11 +323,13 @@ def _parser() -> argparse.ArgumentParser:
     prev.add_argument("--frame", type=int, default=0, help="acquisition index (default 0)")
     prev.add_argument("--agent", default=None, help="USV id (default: the first)")
     prev.add_argument("-o", "--output", default=None, help="PNG path (default: next to the recording)")
+    from mmusv.editor.cli import add_parser as add_editor_parser
     from mmusv.export.cli import add_parser as add_convert_parser
     from mmusv.generate.cli import add_parser as add_generate_parser
 
     add_generate_parser(sub)
     add_convert_parser(sub)
+    add_editor_parser(sub)
     return p
 
 
@@ -375,6 +377,10 @@ def main(argv: list[str] | None = None) -> int:
             from mmusv.generate.cli import run as _run_generate
 
             return _run_generate(args)
+        if args.command == "editor":
+            from mmusv.editor.cli import run as _run_editor
+
+            return _run_editor(args)
     except MmusvError as exc:
         print(f"mmusv: error: {exc}", file=sys.stderr)
         return 2

@@ -52,6 +52,7 @@ __all__ = [
     "load_scenario",
     "scenario_hash",
     "validation_error",
+    "validation_problems",
 ]
 
 
@@ -237,10 +238,11 @@ def _field_path(loc: tuple[int | str, ...], root: str) -> str:
     return out or root
 
 
-def validation_error(err: ValidationError, source: str, *, noun: str = "config", root: str = "scenario") -> ConfigError:
-    """A pydantic ``ValidationError`` as one :class:`ConfigError` line per problem: ``invalid <noun> <field
-    path> = <value>: <what is allowed>``; ``root`` names the whole document when the problem has no field."""
-    lines = []
+def validation_problems(err: ValidationError, *, root: str = "scenario") -> list[tuple[str, str, str]]:
+    """A pydantic ``ValidationError`` as ``(field path, value shown, what is allowed)`` per problem, the field path
+    as in messages (``vessels[2].speed_mps``); a check across fields has the empty path and names the fields in its
+    message; ``root`` names the whole document when a problem has no field but is not such a check."""
+    out = []
     for e in err.errors():
         # Pydantic adds the union member or validator name to `loc`; drop the non-field parts.
         loc = tuple(
@@ -252,9 +254,19 @@ def validation_error(err: ValidationError, source: str, *, noun: str = "config",
         )
         msg = str(e["msg"]).removeprefix("Value error, ")
         if not loc and isinstance(value, dict):  # a check across fields: its message names the fields itself
-            lines.append(f"invalid {noun}: {msg}")
+            out.append(("", shown, msg))
             continue
-        lines.append(f"invalid {noun} {_field_path(loc, root)} = {shown}: {msg}")
+        out.append((_field_path(loc, root), shown, msg))
+    return out
+
+
+def validation_error(err: ValidationError, source: str, *, noun: str = "config", root: str = "scenario") -> ConfigError:
+    """A pydantic ``ValidationError`` as one :class:`ConfigError` line per problem: ``invalid <noun> <field
+    path> = <value>: <what is allowed>``; ``root`` names the whole document when the problem has no field."""
+    lines = [
+        f"invalid {noun}: {msg}" if not field else f"invalid {noun} {field} = {shown}: {msg}"
+        for field, shown, msg in validation_problems(err, root=root)
+    ]
     return ConfigError(f"{source}: " + "; ".join(lines))
 
 

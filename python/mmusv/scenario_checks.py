@@ -8,12 +8,17 @@ what a user wants). ``mmusv run --no-checks`` and ``mmusv.run(..., checks=False)
 
 :func:`check_mounts` warns about sensor mounts far from their hull (a units mistake: millimetres for metres).
 Warnings are :class:`MmusvWarning` through :mod:`warnings`; the CLI prints each as one line.
+
+:func:`map_findings` is what the scenario editor (``mmusv editor``) shows: the same samples and named checks, plus
+the frame-based ones (sensing range at the USVs' LiDAR range, cooperation distance, line of sight), every failure
+with the vessels and the place it concerns (:class:`~mmusv.generate.checks.Finding`).
 """
 
 from __future__ import annotations
 
 import math
 import warnings
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -22,9 +27,22 @@ from mmusv.config import Scenario
 from mmusv.errors import ConfigError
 
 if TYPE_CHECKING:
+    from mmusv.generate.checks import Finding, Samples
+    from mmusv.generate.mapctx import MapContext
+    from mmusv.generate.spec import GenerationSpec
     from mmusv.world.maps import MapWorld
 
-__all__ = ["MOUNT_WARN_FACTOR", "MmusvWarning", "check_mounts", "check_routes"]
+__all__ = [
+    "MOUNT_WARN_FACTOR",
+    "MapFinding",
+    "MmusvWarning",
+    "check_mounts",
+    "check_routes",
+    "map_check_spec",
+    "map_findings",
+    "scenario_samples",
+    "sensing_range_m",
+]
 
 MOUNT_WARN_FACTOR = 2.0
 """A mount farther than this many hull lengths (at least 10 m) from the hull's box gets a warning."""
@@ -34,11 +52,10 @@ class MmusvWarning(UserWarning):
     """A scenario that runs but is probably not what was meant (a close pass, a far-away mount)."""
 
 
-def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[str]:
-    """Runs the generator's ``in_water`` check (an error) and clearance/separation checks (warnings, also
-    returned) on ``scenario`` sailing on ``world``; ``source`` names the file in messages."""
-    from mmusv.generate.checks import InWater, Separation, ShoreClearance, StructureClearance, take_samples
-    from mmusv.generate.mapctx import MapContext
+def scenario_samples(scenario: Scenario, ctx: MapContext, spec: GenerationSpec | None = None) -> Samples:
+    """The generator's samples (:func:`~mmusv.generate.checks.take_samples`) of a hand-written scenario: the first
+    USV is the ego, every other vessel a role target; ``spec`` gives the thresholds (default: the generator's)."""
+    from mmusv.generate.checks import take_samples
     from mmusv.generate.sampler import CandidateMeta
     from mmusv.generate.spec import GenerationSpec
 
@@ -59,8 +76,20 @@ def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[st
         range_m=(0.0, math.inf),
         occlusion_share=None,
     )
+    if spec is None:
+        spec = GenerationSpec.model_validate({"combinations": [{"family": "crossing"}]})
+    return take_samples(scenario, meta, ctx, spec)
+
+
+def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[str]:
+    """Runs the generator's ``in_water`` check (an error) and clearance/separation checks (warnings, also
+    returned) on ``scenario`` sailing on ``world``; ``source`` names the file in messages."""
+    from mmusv.generate.checks import InWater, Separation, ShoreClearance, StructureClearance
+    from mmusv.generate.mapctx import MapContext
+    from mmusv.generate.spec import GenerationSpec
+
     spec = GenerationSpec.model_validate({"combinations": [{"family": "crossing"}]})
-    samples = take_samples(scenario, meta, MapContext(world), spec)
+    samples = scenario_samples(scenario, MapContext(world), spec)
     cons = spec.constraints
     fail = InWater().check(samples)
     if fail is not None:
@@ -77,6 +106,84 @@ def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[st
     for w in found:
         warnings.warn(w, MmusvWarning, stacklevel=2)
     return found
+
+
+def sensing_range_m(scenario: Scenario) -> float:
+    """The largest LiDAR range (metres) of the scenario's USVs (a USV without ``rig`` carries the default rig);
+    the default LiDAR range when no USV has a LiDAR."""
+    from mmusv.sensors.config import LidarConfig, RigConfig
+
+    ranges = [
+        lidar.range_m
+        for v in scenario.usvs
+        if (lidar := (scenario.rigs[v.rig] if v.rig is not None else RigConfig()).lidar) is not None
+    ]
+    return max(ranges, default=LidarConfig().range_m)
+
+
+@dataclass(frozen=True)
+class MapFinding:
+    """One failure of a named check on a scenario: ``check`` (``in_water``, ``shore_clearance``, ...),
+    ``severity`` (``error``: ``mmusv run`` refuses the scenario; ``warning``: it runs) and the ``finding``."""
+
+    check: str
+    severity: str
+    finding: Finding
+
+
+def map_check_spec(scenario: Scenario) -> GenerationSpec:
+    """The thresholds :func:`map_findings` applies: the generator's defaults, the sensing range at the USVs' LiDAR
+    range (:func:`sensing_range_m`) and the line-of-sight check switched on."""
+    from mmusv.generate.spec import GenerationSpec
+
+    return GenerationSpec.model_validate(
+        {
+            "combinations": [{"family": "crossing"}],
+            "constraints": {
+                "sensing_range": {"range_m": sensing_range_m(scenario)},
+                "line_of_sight": {"enabled": True},
+            },
+        }
+    )
+
+
+def map_findings(
+    scenario: Scenario, ctx: MapContext, spec: GenerationSpec | None = None
+) -> tuple[Samples, list[MapFinding]]:
+    """The samples and every failure of the named checks on ``scenario`` sailing on ``ctx``'s map, in check order:
+    ``in_water`` (an error, as in ``mmusv run``), then as warnings ``shore_clearance``, ``structure_clearance``,
+    ``separation``, ``sensing_range`` (every target within range of a USV in a share of the frames),
+    ``cooperation`` (each USV's nearest USV within a distance band) and ``line_of_sight`` (each target seen past
+    the static map by a USV within range in a share of the frames), with ``spec``'s thresholds (default
+    :func:`map_check_spec`)."""
+    from mmusv.generate.checks import (
+        Cooperation,
+        InWater,
+        LineOfSight,
+        SensingRange,
+        Separation,
+        ShoreClearance,
+        StructureClearance,
+    )
+
+    spec = spec if spec is not None else map_check_spec(scenario)
+    samples = scenario_samples(scenario, ctx, spec)
+    cons = spec.constraints
+    checks = (
+        InWater(),
+        ShoreClearance(cons.shore_clearance),
+        StructureClearance(cons.structure_clearance),
+        Separation(cons.separation),
+        SensingRange(cons.sensing_range),
+        Cooperation(cons.cooperation),
+        LineOfSight(cons.line_of_sight),
+    )
+    found = [
+        MapFinding(c.name, "error" if c.name == "in_water" else "warning", f)
+        for c in checks
+        for f in c.findings(samples)
+    ]
+    return samples, found
 
 
 def check_mounts(scenario: Scenario, *, source: str) -> list[str]:

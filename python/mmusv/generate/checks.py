@@ -17,7 +17,10 @@ sight) are evaluated at the acquisition frames.
 Line of sight: a ray from the USV sensor (``sensor_height_m`` above the water) to the middle of the target's
 above-water height, cast against the static map (terrain, structures, buoys, moored ships) in one batch.
 
-World frame, metres, seconds. Each check returns None (pass) or a one-line reason.
+World frame, metres, seconds. Each check returns None (pass) or a one-line reason. The checks the scenario editor
+shows on its map (in water, clearances, separation, sensing range, cooperation, line of sight) also have
+``findings(samples)``: every failure, one :class:`Finding` per vessel or pair, with where it happens; ``check`` is
+the first of them, so the generator and the editor say the same thing.
 """
 
 from __future__ import annotations
@@ -48,7 +51,23 @@ from mmusv.generate.spec_constraints import TargetDensityCheck
 from mmusv.motion import build_fleet
 from mmusv.world.vessels import get_asset
 
-__all__ = ["Constraint", "Samples", "build_constraints", "first_failure", "take_samples"]
+__all__ = ["Constraint", "Finding", "Samples", "build_constraints", "first_failure", "sample_counts", "take_samples"]
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One failure of a check: ``message`` (the check's one-line reason), the ``vessels`` at fault (ids), a world
+    ``point`` ``(x, y)`` metres where it happens (None when no single place says it) and, for the clearance checks,
+    ``route``: per vessel id a ``(G,)`` bool mask over the route samples ``Samples.geo[:, v]`` that fail."""
+
+    message: str
+    vessels: tuple[str, ...]
+    point: tuple[float, float] | None = None
+    route: dict[str, np.ndarray] = field(default_factory=dict)
+
+
+def _first(findings: list[Finding]) -> str | None:
+    return findings[0].message if findings else None
 
 
 @dataclass
@@ -117,6 +136,20 @@ def _half_turn(yaw: np.ndarray) -> np.ndarray:
     return out
 
 
+def _counts(scenario: Scenario, lengths: np.ndarray, step: float) -> tuple[int, int]:
+    """``(motion samples, route samples)`` per vessel for route ``lengths`` (metres) at spacing ``step``."""
+    acq = scenario.acquisition
+    t_last = (acq.frames - 1) / acq.frequency_hz
+    dt = min(1.0 / acq.frequency_hz, step / max(max(v.speed_mps for v in scenario.vessels), 1e-9))
+    return max(math.ceil(t_last / dt) + 1, 2), max(math.ceil(float(lengths.max()) / step) + 1, 2)
+
+
+def sample_counts(scenario: Scenario, spec: GenerationSpec) -> tuple[int, int]:
+    """``(motion samples, route samples)`` per vessel that :func:`take_samples` would take (one cheap fleet build),
+    so a caller can refuse a scenario whose checks would not fit in memory before sampling it."""
+    return _counts(scenario, np.asarray(build_fleet(scenario).route_lengths(), dtype=np.float64), spec.check_step_m)
+
+
 def take_samples(scenario: Scenario, meta: CandidateMeta, ctx: MapContext, spec: GenerationSpec) -> Samples:
     """Samples a candidate's routes, motion and frames (two fleet evaluations in Rust)."""
     step = spec.check_step_m
@@ -126,13 +159,11 @@ def take_samples(scenario: Scenario, meta: CandidateMeta, ctx: MapContext, spec:
     speeds = np.array([v.speed_mps for v in vessels], dtype=np.float64)
     acq = scenario.acquisition
     t_last = (acq.frames - 1) / acq.frequency_hz
-    dt = min(1.0 / acq.frequency_hz, step / max(float(speeds.max()), 1e-9))
-    n_t = max(math.ceil(t_last / dt) + 1, 2)
+    n_t, n_g = _counts(scenario, lengths, step)
     times = np.linspace(0.0, t_last, n_t)
     frame_times = np.arange(acq.frames, dtype=np.float64) / acq.frequency_hz
     poses = np.asarray(fleet.poses_at_times(np.concatenate([times, frame_times])))
     motion, frames = poses[:n_t, :, :2], poses[n_t:, :, :2]
-    n_g = max(math.ceil(float(lengths.max()) / step) + 1, 2)
     geo_fleet = core.Fleet(
         routes=[np.ascontiguousarray(v.route, dtype=np.float64) for v in vessels],
         end_behaviours=[v.end for v in vessels],
@@ -197,9 +228,17 @@ class _Clearance:
         self.raster, self.need, self.hull, self.what = raster, need, hull, what
 
     def check(self, s: Samples) -> str | None:
+        return _first(self.findings(s))
+
+    def findings(self, s: Samples) -> list[Finding]:
+        """One finding per failing vessel, at its first failing sample (route samples before motion samples);
+        ordered by that sample, so the first is the reason :meth:`check` gives. ``route`` masks the failing route
+        samples of each failing vessel."""
         raster = getattr(s.ctx, self.raster)
         runs = ((s.geo, s.geo_yaw, s.geo_slack, s.geo_turn), (s.motion, s.motion_yaw, s.motion_slack, s.motion_turn))
-        for pts, yaw, slack, turn in runs:
+        first: dict[int, tuple[int, int, np.ndarray]] = {}
+        route_bad: np.ndarray | None = None
+        for r, (pts, yaw, slack, turn) in enumerate(runs):
             if self.hull:
                 axis, axis_slack = axis_points(pts, yaw, s.half, self.axis_spacing)
                 d = s.ctx.lookup(raster, axis).min(axis=2)
@@ -207,12 +246,22 @@ class _Clearance:
             else:
                 margin = s.ctx.lookup(raster, pts) - s.ctx.cell_slack - slack[None, :]
             bad = margin < self.need if self.hull else margin <= 0.0
-            if bad.any():
-                k, v = (int(x[0]) for x in np.nonzero(bad))
-                if not self.hull:
-                    return f"{s.ids[v]} leaves {self.what} near {_where(pts[k, v])}"
-                return f"{s.ids[v]} comes within {self.need:g} m of {self.what} near {_where(pts[k, v])}"
-        return None
+            if r == 0:
+                route_bad = bad
+            for vi in np.flatnonzero(bad.any(axis=0)):
+                if int(vi) not in first:
+                    k = int(np.argmax(bad[:, vi]))
+                    first[int(vi)] = (r, k, pts[k, vi])
+        out = []
+        for v, (_, _, at) in sorted(first.items(), key=lambda kv: (kv[1][0], kv[1][1], kv[0])):
+            what = (
+                f"{s.ids[v]} leaves {self.what} near {_where(at)}"
+                if not self.hull
+                else f"{s.ids[v]} comes within {self.need:g} m of {self.what} near {_where(at)}"
+            )
+            mask = {s.ids[v]: route_bad[:, v].copy()} if route_bad is not None and route_bad[:, v].any() else {}
+            out.append(Finding(what, (s.ids[v],), (float(at[0]), float(at[1])), mask))
+        return out
 
 
 class InWater(_Clearance):
@@ -243,9 +292,13 @@ class Separation:
         self.min_m = cfg.min_m
 
     def check(self, s: Samples) -> str | None:
+        return _first(self.findings(s))
+
+    def findings(self, s: Samples) -> list[Finding]:
+        """One finding per pair of vessels that come too close, at their closest moment; the tightest first."""
         n = len(s.ids)
         if n < 2:
-            return None
+            return []
         iu, ju = np.triu_indices(n, 1)
         d = np.stack([np.cos(s.motion_yaw), np.sin(s.motion_yaw)], axis=-1) * s.half[None, :, None]
         p, q = s.motion - d, s.motion + d  # capsule axes (T, V, 2)
@@ -253,14 +306,21 @@ class Separation:
         hull = dist - (s.radius[iu] + s.radius[ju])[None, :]
         slack = s.motion_slack + s.motion_turn
         gap = hull - (slack[iu] + slack[ju])[None, :] - self.min_m
-        if gap.min() < 0.0:
-            k, j = np.unravel_index(int(np.argmin(gap)), gap.shape)
+        worst = gap.min(axis=0)
+        out = []
+        for j in sorted(np.flatnonzero(worst < 0.0), key=lambda j: (float(worst[j]), int(j))):
+            k = int(np.argmin(gap[:, j]))
             a, b = int(iu[j]), int(ju[j])
-            return (
-                f"{s.ids[a]} and {s.ids[b]} come {hull[k, j]:.1f} m apart (hulls) at t={s.times[k]:.1f} s; "
-                f"need {self.min_m:g} m"
+            mid = (s.motion[k, a] + s.motion[k, b]) / 2.0
+            out.append(
+                Finding(
+                    f"{s.ids[a]} and {s.ids[b]} come {hull[k, j]:.1f} m apart (hulls) at t={s.times[k]:.1f} s; "
+                    f"need {self.min_m:g} m",
+                    (s.ids[a], s.ids[b]),
+                    (float(mid[0]), float(mid[1])),
+                )
             )
-        return None
+        return out
 
 
 class RouteSeparation:
@@ -306,15 +366,24 @@ class SensingRange:
         self.range_m, self.share, self.targets = cfg.range_m, cfg.min_share, cfg.targets
 
     def check(self, s: Samples) -> str | None:
+        return _first(self.findings(s))
+
+    def findings(self, s: Samples) -> list[Finding]:
+        """One finding per target too rarely within range of a USV, in target order (every target when there is
+        no USV)."""
         tids = list(s.meta.targets) + (list(s.meta.distractors) if self.targets == "all" else [])
-        u = np.asarray(s.usvs)
+        u = np.asarray(s.usvs, dtype=np.int64)
+        out = []
         for tid in tids:
             t = s.index(tid)
-            d = np.linalg.norm(s.frames[:, u, :] - s.frames[:, t, None, :], axis=-1).min(axis=1)
-            share = float(np.mean(d <= self.range_m))
+            share = 0.0
+            if u.size:
+                d = np.linalg.norm(s.frames[:, u, :] - s.frames[:, t, None, :], axis=-1).min(axis=1)
+                share = float(np.mean(d <= self.range_m))
             if share < self.share:
-                return f"{tid} is within {self.range_m:g} m of a USV in {share:.0%} of frames; need {self.share:.0%}"
-        return None
+                msg = f"{tid} is within {self.range_m:g} m of a USV in {share:.0%} of frames; need {self.share:.0%}"
+                out.append(Finding(msg, (tid,)))
+        return out
 
 
 class TargetDensity:
@@ -346,21 +415,27 @@ class Cooperation:
         self.lo, self.hi, self.share = cfg.min_m, cfg.max_m, cfg.min_share
 
     def check(self, s: Samples) -> str | None:
+        return _first(self.findings(s))
+
+    def findings(self, s: Samples) -> list[Finding]:
+        """One finding per USV whose nearest USV is too rarely in the distance band; the lowest share first."""
         u = np.asarray(s.usvs)
         if u.size < 2:
-            return None
+            return []
         p = s.frames[:, u, :]
         d = np.linalg.norm(p[:, :, None, :] - p[:, None, :, :], axis=-1)
         d[:, np.arange(u.size), np.arange(u.size)] = np.inf
         nearest = d.min(axis=2)
         share = np.mean((nearest >= self.lo) & (nearest <= self.hi), axis=0)
-        k = int(np.argmin(share))
-        if share[k] < self.share:
-            return (
+        return [
+            Finding(
                 f"{s.ids[u[k]]} has its nearest USV within [{self.lo:g}, {self.hi:g}] m in {share[k]:.0%} of frames;"
-                f" need {self.share:.0%}"
+                f" need {self.share:.0%}",
+                (s.ids[u[k]],),
             )
-        return None
+            for k in np.argsort(share, kind="stable")
+            if share[k] < self.share
+        ]
 
 
 class LineOfSight:
@@ -370,12 +445,23 @@ class LineOfSight:
         self.share = cfg.min_share
 
     def check(self, s: Samples) -> str | None:
-        seen = (~s.blocked() & s.in_range()).any(axis=1)  # (F, R)
-        share = seen.mean(axis=0)
-        k = int(np.argmin(share))
-        if share[k] < self.share:
-            return f"{s.meta.targets[k]} is seen by a USV in {share[k]:.0%} of frames; need {self.share:.0%}"
-        return None
+        return _first(self.findings(s))
+
+    def findings(self, s: Samples) -> list[Finding]:
+        """One finding per role target too rarely seen by a USV; the lowest share first (every target when there
+        is no USV)."""
+        if not s.meta.targets:
+            return []
+        seen = (~s.blocked() & s.in_range()).any(axis=1) if s.usvs else np.zeros((1, len(s.meta.targets)), bool)
+        share = seen.mean(axis=0)  # (F, R) -> (R,)
+        return [
+            Finding(
+                f"{s.meta.targets[k]} is seen by a USV in {share[k]:.0%} of frames; need {self.share:.0%}",
+                (s.meta.targets[k],),
+            )
+            for k in np.argsort(share, kind="stable")
+            if share[k] < self.share
+        ]
 
 
 class Occlusion:

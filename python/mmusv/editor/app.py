@@ -1,0 +1,415 @@
+"""The editor's web application (FastAPI): the page, its static files and the JSON API.
+
+Endpoints (JSON in and out unless said otherwise; errors are ``{"error": "..."}`` with a 4xx status):
+
+========================  =====================================================================================
+``GET /``                 the page (``static/index.html``); ``/static/...`` its CSS and JavaScript modules
+``GET /api/info``         version, folder, the scenario given on the command line, choices from the schema
+``GET /api/assets``       the vessel library (name, category, class, sizes in metres, USV or not)
+``GET /api/bundled``      the bundled scenarios; ``GET /api/bundled/{name}`` one of them as a document
+``GET /api/files``        the scenario files in the folder; ``GET /api/files/{name}`` one as a document
+``PUT /api/files/{name}`` saves ``{document, comment, overwrite}`` as YAML into the folder (409 if it exists)
+``POST /api/map``         ``{map}`` -> the map's layers (:mod:`mmusv.editor.maplayers`)
+``POST /api/evaluate``    ``{document}`` -> validation, checks and motion (:mod:`mmusv.editor.evaluate`)
+``POST /api/poses``       ``{document, frame}`` -> every vessel's ``[x, y, yaw]`` at that index
+``POST /api/preview``     ``{document, frame, agent}`` -> PNG of the ``mmusv preview`` sheet of that frame
+``POST /api/runs``        ``{name, frames}`` starts ``mmusv run`` of a saved file; ``GET /api/runs[/{id}]``
+                          progress; ``DELETE /api/runs/{id}`` stops one
+========================  =====================================================================================
+
+Status codes: 400 bad input (a file name, a request the server cannot serve), 404 nothing of that name, 409 the
+file exists, 413 the request is too large, 422 the request body or the scenario does not validate (the message
+names the field). Nothing outside the folder is read or written (:mod:`mmusv.editor.files`); the page loads
+nothing from elsewhere (a Content-Security-Policy says so to the browser).
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import threading
+import traceback
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, get_args
+
+from fastapi import FastAPI, Request
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import FileResponse, JSONResponse, Response
+from fastapi.staticfiles import StaticFiles
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from starlette.exceptions import HTTPException as StarletteHTTPException
+from starlette.middleware.trustedhost import TrustedHostMiddleware
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
+
+from mmusv.config import EnvironmentConfig, MapConfig, Scenario, VesselConfig, load_scenario, validation_problems
+from mmusv.editor.document import leading_comment, scenario_yaml, to_document
+from mmusv.editor.evaluate import MAX_BULK_FRAMES, evaluate, poses_at, validate
+from mmusv.editor.files import FileExistsInFolder, ScenarioFolder, check_name
+from mmusv.editor.jobs import Jobs
+from mmusv.editor.maplayers import map_layers
+from mmusv.errors import ConfigError, InputError, MmusvError, NotFoundError
+from mmusv.yamlio import parse_yaml
+
+__all__ = ["MAX_BODY_BYTES", "STATIC_DIR", "InitialScenario", "create_app"]
+
+STATIC_DIR = Path(__file__).parent / "static"
+"""The page's files (HTML, CSS, JavaScript modules), shipped in the package."""
+MAX_BODY_BYTES = 16 * 1024 * 1024
+"""Largest request body (16 MiB); larger requests get 413."""
+_CSP = (
+    "default-src 'self'; img-src 'self' data: blob:; style-src 'self'; script-src 'self'; connect-src 'self'; "
+    "object-src 'none'; base-uri 'none'; frame-ancestors 'none'"
+)
+
+
+@dataclass(frozen=True)
+class InitialScenario:
+    """The scenario named on the command line: the file ``name`` it will be saved as in the folder, its document
+    and leading comment; ``in_folder``: it is that file of the folder (saving it replaces it)."""
+
+    name: str
+    document: dict[str, Any]
+    comment: str
+    in_folder: bool = False
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class DocumentBody(_Strict):
+    """A scenario document (the JSON form of a scenario file)."""
+
+    document: dict[str, Any]
+
+
+class SaveBody(DocumentBody):
+    comment: str = Field(default="", max_length=20_000)
+    overwrite: bool = False
+
+
+class FrameBody(DocumentBody):
+    frame: int = Field(ge=0)
+
+
+class PreviewBody(FrameBody):
+    agent: str | None = Field(default=None, max_length=64)
+
+
+class MapBody(_Strict):
+    map: dict[str, Any]
+
+
+class RunBody(_Strict):
+    name: str = Field(max_length=1000)
+    frames: int | None = Field(default=None, ge=1)
+
+
+def _error(status: int, message: str) -> JSONResponse:
+    return JSONResponse({"error": message}, status_code=status)
+
+
+def _status(exc: MmusvError) -> int:
+    if isinstance(exc, FileExistsInFolder):
+        return 409
+    if isinstance(exc, NotFoundError):
+        return 404
+    if isinstance(exc, ConfigError):
+        return 422
+    if isinstance(exc, InputError):
+        return 400
+    return 500
+
+
+class _BodyLimit:
+    """Refuses request bodies over ``limit`` bytes with 413, whether or not they say their length up front."""
+
+    def __init__(self, app: ASGIApp, limit: int) -> None:
+        self.app, self.limit = app, limit
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        length = dict(scope.get("headers") or []).get(b"content-length")
+        if length is not None and (not length.isdigit() or int(length) > self.limit):
+            await _error(413, f"the request body is larger than {self.limit} bytes")(scope, receive, send)
+            return
+        seen = 0
+
+        async def counted() -> Message:
+            nonlocal seen
+            msg = await receive()
+            seen += len(msg.get("body", b""))
+            if seen > self.limit:
+                raise _TooLarge
+            return msg
+
+        try:
+            await self.app(scope, counted, send)
+        except _TooLarge:
+            await _error(413, f"the request body is larger than {self.limit} bytes")(scope, receive, send)
+
+
+class _TooLarge(Exception):
+    pass
+
+
+def _choices(model: type[BaseModel], name: str) -> list[str]:
+    return list(get_args(model.model_fields[name].annotation))
+
+
+def _request_error(exc: RequestValidationError) -> str:
+    parts = []
+    for e in exc.errors():
+        loc = ".".join(str(p) for p in e.get("loc", ()) if p != "body") or "body"
+        if e.get("type") == "json_invalid":
+            parts.append(f"the request body is not valid JSON ({e.get('ctx', {}).get('error', 'unreadable')})")
+        else:
+            parts.append(f"{loc}: {e.get('msg', 'invalid')}")
+    return "malformed request: " + "; ".join(parts)
+
+
+def _load_document(text: str, where: str) -> tuple[dict[str, Any], bool]:
+    """``(document, valid)`` of a scenario file's text: the editor's document of a valid scenario, else the raw
+    mapping (the page then lists what is wrong); :class:`ConfigError` when it is not a YAML mapping."""
+    data = parse_yaml(text, where)
+    if not isinstance(data, dict):
+        raise ConfigError(f"{where}: a scenario must be a YAML mapping with at least `vessels:`")
+    try:
+        return to_document(load_scenario(data)), True
+    except MmusvError as exc:
+        if not _editable(data):  # the page could not show it: say what is wrong instead
+            raise ConfigError(
+                f"{exc}; the editor opens files whose vessels and routes are lists (fix it as text)"
+            ) from None
+        return json.loads(json.dumps(data, default=str)), False
+
+
+def _editable(data: dict[str, Any]) -> bool:
+    """Whether an invalid scenario mapping still has the shape the page draws: sections are mappings, ``vessels``
+    a list of mappings whose ``route`` is a list of ``[x, y]`` numbers."""
+    if any(k in data and not isinstance(data[k], dict) for k in ("map", "environment", "acquisition", "rigs")):
+        return False
+    vessels = data.get("vessels", [])
+    if not isinstance(vessels, list) or not all(isinstance(v, dict) for v in vessels):
+        return False
+    for v in vessels:
+        route = v.get("route", [])
+        if not isinstance(route, list):
+            return False
+        for p in route:
+            if not (isinstance(p, list) and len(p) == 2 and all(isinstance(c, (int, float)) for c in p)):
+                return False
+    return True
+
+
+def create_app(
+    folder: str | Path, *, initial: InitialScenario | None = None, allowed_hosts: list[str] | None = None
+) -> FastAPI:
+    """The editor application serving scenario files of ``folder``; ``initial`` is opened when the page loads;
+    ``allowed_hosts`` are the host names requests may address (default: any; the command line passes the bound
+    host and its loopback names, so other sites cannot reach the server through DNS rebinding)."""
+    store = ScenarioFolder(folder)
+    jobs = Jobs(store.root)
+    evaluate_lock, preview_lock = threading.Lock(), threading.Lock()
+    app = FastAPI(title="mmusv editor", docs_url=None, redoc_url=None, openapi_url=None)
+    app.state.jobs = jobs
+    app.state.folder = store
+
+    @app.exception_handler(MmusvError)
+    async def _mmusv_error(request: Request, exc: MmusvError) -> JSONResponse:
+        return _error(_status(exc), str(exc))
+
+    @app.exception_handler(RequestValidationError)
+    async def _bad_request(request: Request, exc: RequestValidationError) -> JSONResponse:
+        return _error(422, _request_error(exc))
+
+    @app.exception_handler(StarletteHTTPException)
+    async def _http_error(request: Request, exc: StarletteHTTPException) -> JSONResponse:
+        return _error(exc.status_code, str(exc.detail))
+
+    @app.exception_handler(Exception)
+    async def _internal(request: Request, exc: Exception) -> JSONResponse:
+        traceback.print_exception(exc, file=sys.stderr)  # for the person running the server, not the client
+        return _error(500, f"internal error ({type(exc).__name__}); the server's console has the details")
+
+    @app.middleware("http")
+    async def _headers(request: Request, call_next: Any) -> Response:
+        response: Response = await call_next(request)
+        response.headers["Content-Security-Policy"] = _CSP
+        response.headers["X-Content-Type-Options"] = "nosniff"
+        response.headers["Cache-Control"] = "no-store"
+        return response
+
+    @app.get("/", include_in_schema=False)
+    def index() -> FileResponse:
+        return FileResponse(STATIC_DIR / "index.html", media_type="text/html")
+
+    app.mount("/static", StaticFiles(directory=STATIC_DIR), name="static")
+
+    @app.get("/api/info")
+    def info() -> dict[str, Any]:
+        from mmusv import __version__
+        from mmusv.sensors.config import RIG_PRESETS
+        from mmusv.world.environment import WAVE_PRESETS
+
+        return {
+            "version": __version__,
+            "folder": str(store.root),
+            "initial": None if initial is None else initial.__dict__,
+            "choices": {
+                "map_type": _choices(MapConfig, "type"),
+                "weather": _choices(EnvironmentConfig, "weather"),
+                "wave": [{"name": k, "height_m": v} for k, v in WAVE_PRESETS.items()],
+                "role": _choices(VesselConfig, "role"),
+                "end": _choices(VesselConfig, "end"),
+                "rig_preset": sorted(RIG_PRESETS),
+            },
+            "limits": {"bulk_frames": MAX_BULK_FRAMES, "body_bytes": MAX_BODY_BYTES},
+        }
+
+    @app.get("/api/assets")
+    def assets() -> list[dict[str, Any]]:
+        from mmusv.world.vessels import library
+
+        return [
+            {
+                "name": a.name,
+                "category": a.category,
+                "class": a.semantic_class.name.lower(),
+                "usv": a.is_usv,
+                "length": round(a.length, 2),
+                "beam": round(a.beam, 2),
+                "height": round(a.height, 2),
+                "draft": round(a.draft, 2),
+                "description": a.description,
+            }
+            for a in library()
+        ]
+
+    @app.get("/api/bundled")
+    def bundled() -> list[dict[str, Any]]:
+        from mmusv.bundled import bundled_scenarios
+
+        return [
+            {
+                "name": b.name,
+                "file": b.path.name,
+                "map": b.map,
+                "usvs": b.usvs,
+                "targets": b.targets,
+                "frames": b.frames,
+                "description": b.description,
+            }
+            for b in bundled_scenarios()
+        ]
+
+    @app.get("/api/bundled/{name:path}")
+    def bundled_one(name: str) -> dict[str, Any]:
+        from mmusv.bundled import bundled_dir
+
+        files = {p.stem: p for p in bundled_dir().glob("*.yaml")}
+        stem = name.removesuffix(".yaml")
+        if stem not in files:
+            raise NotFoundError(f"no bundled scenario {name!r}; bundled: {', '.join(sorted(files))}")
+        text = files[stem].read_text(encoding="utf-8")
+        doc, valid = _load_document(text, f"bundled {files[stem].name}")
+        return {"name": files[stem].name, "document": doc, "valid": valid, "comment": leading_comment(text)}
+
+    @app.get("/api/files")
+    def files() -> list[dict[str, Any]]:
+        return [{"name": f.name, "size": f.size} for f in store.files()]
+
+    @app.get("/api/files/{name:path}")
+    def read_file(name: str) -> dict[str, Any]:
+        _, text = store.read_text(name)
+        doc, valid = _load_document(text, name)
+        return {"name": name, "document": doc, "valid": valid, "comment": leading_comment(text)}
+
+    @app.put("/api/files/{name:path}")
+    def write_file(name: str, body: SaveBody) -> dict[str, Any]:
+        check_name(name)
+        scenario, errors = validate(body.document)
+        if scenario is None:
+            raise ConfigError(
+                f"{name}: not saved, the scenario does not validate: " + "; ".join(e["message"] for e in errors)
+            )
+        path = store.write_text(name, scenario_yaml(scenario, comment=body.comment), overwrite=body.overwrite)
+        return {"name": name, "path": str(path), "bytes": path.stat().st_size}
+
+    @app.post("/api/map")
+    def map_(body: MapBody) -> Response:
+        try:
+            cfg = MapConfig.model_validate(body.map)
+        except ValidationError as exc:
+            raise ConfigError(
+                "; ".join(
+                    f"map.{f} = {shown}: {msg}" if f else msg for f, shown, msg in validation_problems(exc, root="")
+                )
+            ) from None
+        with evaluate_lock:
+            text = map_layers(cfg.type, cfg.seed, cfg.param_values())
+        return Response(text, media_type="application/json")
+
+    @app.post("/api/evaluate")
+    def evaluate_(body: DocumentBody) -> dict[str, Any]:
+        with evaluate_lock:
+            return evaluate(body.document)
+
+    def _valid(document: dict[str, Any]) -> Scenario:
+        scenario, errors = validate(document)
+        if scenario is None:
+            raise ConfigError("the scenario does not validate: " + "; ".join(e["message"] for e in errors))
+        return scenario
+
+    @app.post("/api/poses")
+    def poses(body: FrameBody) -> dict[str, Any]:
+        scenario = _valid(body.document)
+        return {"frame": body.frame, "poses": poses_at(scenario, body.frame)}
+
+    @app.post("/api/preview")
+    def preview(body: PreviewBody) -> Response:
+        from mmusv.editor.preview import preview_png
+        from mmusv.generate.mapctx import map_context
+
+        scenario = _valid(body.document)
+        with evaluate_lock:
+            world = map_context(scenario.map.type, scenario.map.seed, scenario.map.param_values()).world
+        with preview_lock:
+            png = preview_png(scenario, frame=body.frame, agent=body.agent, world=world)
+        return Response(png, media_type="image/png")
+
+    @app.post("/api/runs")
+    def start_run(body: RunBody) -> dict[str, Any]:
+        path = store.path(body.name)
+        if not path.is_file():
+            raise NotFoundError(f"no scenario file {body.name!r} in the editor's folder; save it first")
+        return jobs.start(path, frames=body.frames).as_dict()
+
+    @app.get("/api/runs")
+    def runs() -> list[dict[str, Any]]:
+        return [j.as_dict() for j in jobs.all()]
+
+    @app.get("/api/runs/{job_id}")
+    def run_status(job_id: int) -> dict[str, Any]:
+        return jobs.get(job_id).as_dict()
+
+    @app.delete("/api/runs/{job_id}")
+    def run_cancel(job_id: int) -> dict[str, Any]:
+        return jobs.cancel(job_id).as_dict()
+
+    @app.api_route("/api/{rest:path}", methods=["GET", "POST", "PUT"], include_in_schema=False)
+    def unknown(rest: str) -> Response:
+        raise NotFoundError(f"no API endpoint /api/{rest}")
+
+    app.add_middleware(_BodyLimitMiddleware)
+    if allowed_hosts is not None:
+        app.add_middleware(TrustedHostMiddleware, allowed_hosts=allowed_hosts)
+    return app
+
+
+class _BodyLimitMiddleware(_BodyLimit):
+    def __init__(self, app: ASGIApp) -> None:
+        super().__init__(app, MAX_BODY_BYTES)

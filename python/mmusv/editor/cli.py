@@ -1,0 +1,104 @@
+"""``mmusv editor [SCENARIO] [--port N] [--dir FOLDER] [--host H]``: serves the scenario editor on a local port.
+
+The folder (``--dir``; default: the folder of SCENARIO when it is a file there, else the current folder) is the
+only place the server reads and writes scenario files. SCENARIO (a file or a bundled name) opens when the page
+loads and is saved into the folder under its file name. The server binds to 127.0.0.1 unless ``--host`` says
+otherwise, prints its URL and runs until Ctrl-C.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import socket
+import sys
+from pathlib import Path
+from typing import Any
+
+from mmusv.errors import ConfigError, IoError
+
+__all__ = ["DEFAULT_PORT", "add_parser", "run", "serve"]
+
+DEFAULT_PORT = 8765
+
+
+def add_parser(sub: Any) -> None:
+    """Adds the ``editor`` subcommand to the ``mmusv`` parser's subparsers ``sub``."""
+    p = sub.add_parser(
+        "editor",
+        help="the scenario editor in the browser: a top-down map, vessels, routes, live checks, save, preview, run",
+    )
+    p.add_argument("scenario", nargs="?", default=None, help="scenario to open (a YAML file or a bundled name)")
+    p.add_argument("--port", type=int, default=DEFAULT_PORT, help=f"port (default {DEFAULT_PORT}; 0 picks a free one)")
+    p.add_argument("--dir", default=None, help="folder the editor reads and saves scenarios in (see above)")
+    p.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1: this machine only)")
+
+
+def _bind(host: str, port: int) -> socket.socket:
+    if not 0 <= port <= 65535:
+        raise ConfigError(f"--port {port}: must be in 0..65535 (0 picks a free port)")
+    try:
+        infos = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)
+    except socket.gaierror as exc:
+        raise ConfigError(f"--host {host!r}: not an address of this machine ({exc.strerror})") from None
+    family, _, _, _, addr = infos[0]
+    sock = socket.socket(family, socket.SOCK_STREAM)
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    try:
+        sock.bind(addr)
+    except OSError as exc:
+        sock.close()
+        raise IoError(
+            f"cannot listen on {host}:{port}: {exc.strerror}; pass another --port (0 picks a free one)"
+        ) from None
+    sock.listen(64)
+    return sock
+
+
+def serve(app: Any, *, host: str, port: int, announce: bool = True) -> None:
+    """Serves ``app`` on ``host``:``port`` until interrupted, printing the URL first."""
+    import uvicorn
+
+    sock = _bind(host, port)
+    bound = sock.getsockname()[1]
+    shown = f"[{host}]" if ":" in host else host
+    if announce:
+        print(
+            f"mmusv editor: http://{shown}:{bound}/  (scenarios in {app.state.folder.root}; Ctrl-C stops)", flush=True
+        )
+    server = uvicorn.Server(uvicorn.Config(app, log_level="warning", access_log=False, lifespan="off"))
+    try:
+        server.run(sockets=[sock])
+    finally:
+        app.state.jobs.shutdown()
+        sock.close()
+
+
+def run(args: argparse.Namespace) -> int:
+    """Runs ``mmusv editor`` with parsed ``args``; returns the exit status."""
+    from mmusv.bundled import resolve_scenario
+    from mmusv.config import load_scenario
+    from mmusv.editor.app import InitialScenario, create_app
+    from mmusv.editor.document import leading_comment, to_document
+    from mmusv.editor.files import check_name
+
+    initial = None
+    folder = Path(args.dir) if args.dir is not None else Path.cwd()
+    if args.scenario is not None:
+        path = resolve_scenario(args.scenario)
+        if args.dir is None and Path(args.scenario).is_file():
+            folder = path.parent
+        scenario = load_scenario(path)
+        initial = InitialScenario(
+            name=check_name(path.name if path.suffix in (".yaml", ".yml") else f"{path.name}.yaml"),
+            document=to_document(scenario),
+            comment=leading_comment(path.read_text(encoding="utf-8", errors="replace")),
+            in_folder=path.resolve().parent == folder.resolve(),
+        )
+    host = str(args.host)
+    hosts = ["*"] if host in ("0.0.0.0", "::", "") else sorted({host, "127.0.0.1", "localhost", "[::1]"})
+    app = create_app(folder, initial=initial, allowed_hosts=hosts)
+    with contextlib.suppress(KeyboardInterrupt):
+        serve(app, host=host, port=int(args.port))
+    print("mmusv editor: stopped", file=sys.stderr)
+    return 0

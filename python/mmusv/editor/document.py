@@ -1,0 +1,132 @@
+"""A scenario as the editor holds it: a compact JSON document, and its YAML file.
+
+:func:`to_document` turns a validated :class:`~mmusv.config.Scenario` into the JSON object the page edits: the
+keys a person writes by hand (name, seed, map, environment, acquisition, rigs, vessels with id, role, asset, rig,
+speed and route) always, everything else only where it differs from its default, and each rig only where it
+differs from its ``preset``. Validating the document again gives a scenario equal to the original, which is why
+"load, save unchanged" gives an equal scenario. :func:`scenario_yaml` writes it the way the bundled scenarios are
+written (top-level blocks, one flow line per vessel), with the file's leading comment kept.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import yaml
+
+from mmusv.config import Scenario, VesselConfig
+from mmusv.sensors.config import RIG_PRESETS, RigConfig
+
+__all__ = ["leading_comment", "scenario_yaml", "to_document"]
+
+_ALWAYS_VESSEL = ("id", "role", "asset", "speed_mps", "route")
+
+
+def _rig_document(rig: RigConfig) -> dict[str, Any]:
+    """The keys of ``rig`` that differ from what its preset gives (``{}`` for the paper's full suite); nested
+    models (a LiDAR, each camera) only with their non-default keys."""
+    preset = RIG_PRESETS[rig.preset]
+    given = rig.model_dump(mode="json", exclude_defaults=True)
+    full = rig.model_dump(mode="json")
+    out: dict[str, Any] = {"preset": rig.preset} if rig.preset != "full" else {}
+    for key, value in full.items():
+        if key == "preset":
+            continue
+        if key in preset:
+            if value != preset[key]:  # e.g. a radar added back to a LiDAR-only rig, maybe with all defaults
+                out[key] = given.get(key, {} if isinstance(value, dict) else value)
+        elif key in given:
+            out[key] = given[key]
+    return out
+
+
+def _vessel_document(v: VesselConfig) -> dict[str, Any]:
+    full = v.model_dump(mode="json")
+    given = v.model_dump(mode="json", exclude_defaults=True)
+    return {k: val for k, val in full.items() if k in _ALWAYS_VESSEL or k in given}
+
+
+def to_document(scenario: Scenario) -> dict[str, Any]:
+    """The editor's JSON document of ``scenario`` (see the module docstring); key order as in a hand-written file."""
+    full = scenario.model_dump(mode="json")
+    env_given = scenario.environment.model_dump(mode="json", exclude_defaults=True)
+    env = {k: full["environment"][k] for k in ("time_of_day", "weather", "wave")}
+    env.update({k: v for k, v in env_given.items() if k not in env})
+    map_doc: dict[str, Any] = {"type": scenario.map.type, "seed": scenario.map.seed}
+    params = scenario.map.param_values()
+    if params:
+        map_doc["params"] = params
+    return {
+        "name": scenario.name,
+        "seed": scenario.seed,
+        "map": map_doc,
+        "environment": env,
+        "acquisition": full["acquisition"],
+        "rigs": {name: _rig_document(rig) for name, rig in scenario.rigs.items()},
+        "vessels": [_vessel_document(v) for v in scenario.vessels],
+    }
+
+
+class _Dumper(yaml.SafeDumper):
+    """Block style for the top level and the ``rigs``/``vessels`` lists, flow style below."""
+
+
+def _flow(dumper: yaml.SafeDumper, data: Any) -> yaml.Node:
+    if isinstance(data, dict):
+        return dumper.represent_mapping("tag:yaml.org,2002:map", data, flow_style=True)
+    return dumper.represent_sequence("tag:yaml.org,2002:seq", data, flow_style=True)
+
+
+class _FlowMap(dict[str, Any]):
+    pass
+
+
+class _FlowList(list[Any]):
+    pass
+
+
+def _float(dumper: yaml.SafeDumper, data: float) -> yaml.Node:
+    """Whole numbers without ``.0`` (waypoints read like hand-written ones); others as Python's shortest repr."""
+    if data.is_integer() and abs(data) < 1e15:
+        return dumper.represent_int(int(data))
+    return dumper.represent_float(data)
+
+
+_Dumper.add_representer(_FlowMap, _flow)
+_Dumper.add_representer(_FlowList, _flow)
+_Dumper.add_representer(float, _float)
+
+
+def _flowed(value: Any) -> Any:
+    if isinstance(value, dict):
+        return _FlowMap({k: _flowed(v) for k, v in value.items()})
+    if isinstance(value, list):
+        return _FlowList([_flowed(v) for v in value])
+    return value
+
+
+def leading_comment(text: str) -> str:
+    """The file's leading ``#`` comment block without the ``#`` marks (lines joined by newlines; empty if none)."""
+    lines = []
+    for line in text.splitlines():
+        if not line.startswith("#"):
+            break
+        body = line[1:]
+        lines.append(body[1:] if body.startswith(" ") else body)
+    return "\n".join(lines)
+
+
+def scenario_yaml(scenario: Scenario, *, comment: str = "") -> str:
+    """The YAML text of ``scenario`` (its :func:`to_document`), ``comment`` as a leading ``#`` block."""
+    doc = to_document(scenario)
+    top: dict[str, Any] = {}
+    for key, value in doc.items():
+        if key == "rigs":
+            top[key] = {name: _flowed(rig) for name, rig in value.items()}
+        elif key == "vessels":
+            top[key] = [_flowed(v) for v in value]
+        else:
+            top[key] = _flowed(value)
+    body = yaml.dump(top, Dumper=_Dumper, sort_keys=False, allow_unicode=True, width=120, indent=2)
+    head = "".join(f"# {line}".rstrip() + "\n" for line in comment.splitlines()) if comment.strip() else ""
+    return head + body

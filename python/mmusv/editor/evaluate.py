@@ -1,0 +1,198 @@
+"""Live validation and motion of the document the editor holds: what the page draws and lists after every edit.
+
+:func:`evaluate` validates the document with the scenario schema (:mod:`mmusv.config`), builds the fleet with the
+Rust kinematics (:func:`mmusv.motion.build_fleet`; route geometry errors such as repeated waypoints surface here)
+and runs the named checks on the map (:func:`mmusv.scenario_checks.map_findings`, the generator's checks). It
+returns, JSON-ready:
+
+* ``errors``: schema and route problems, each ``{field, message, vessel}``: ``field`` is the path in the scenario
+  (``vessels[2].speed_mps``), ``vessel`` the id of the vessel it belongs to (or None);
+* ``problems``: check failures, each ``{check, severity, message, field, vessels, point, segments}``:
+  ``segments`` maps a vessel id to ``[first, last]`` index ranges of its ``path`` samples that fail (clearance
+  checks: the red part of a route), ``point`` the world ``[x, y]`` where it happens;
+* ``vessels``: per scenario vessel ``{id, role, asset, length, beam, path, poses, rings}``: ``path`` the spline
+  sampled along its whole length as the simulator sails it (the route samples the checks test), ``poses`` ``[x,
+  y, yaw]`` at every acquisition index (None above :data:`MAX_BULK_FRAMES` frames: ask :func:`poses_at`),
+  ``rings`` the LiDAR and radar ranges of a USV's rig (metres);
+* ``valid`` (the schema and the routes are fine; problems may remain), ``frames``, ``frequency_hz``, ``map``.
+
+World frame, metres, radians (yaw from +x, counter-clockwise); coordinates rounded to millimetres.
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+from typing import Any
+
+import numpy as np
+from pydantic import ValidationError
+
+from mmusv.config import Scenario, validation_problems
+from mmusv.errors import ConfigError, MmusvError
+from mmusv.generate.checks import sample_counts
+from mmusv.generate.mapctx import map_context
+from mmusv.motion import build_fleet
+from mmusv.scenario_checks import check_mounts, map_check_spec, map_findings
+from mmusv.sensors.config import RigConfig
+from mmusv.world.vessels import get_asset
+
+__all__ = ["MAX_BULK_FRAMES", "MAX_CHECK_SAMPLES", "evaluate", "poses_at", "validate"]
+
+MAX_BULK_FRAMES = 3000
+"""Above this many frames the evaluation leaves the per-frame poses out; the page asks for one index at a time."""
+MAX_CHECK_SAMPLES = 5_000_000
+"""Most samples x vessels the live checks take (route or motion samples); above, the editor says so instead."""
+
+_FIELD = re.compile(r"invalid config (\S+) = ")
+_VESSEL_FIELD = re.compile(r"^vessels\[(\d+)\]")
+
+
+def _vessel_of(field: str, document: dict[str, Any]) -> str | None:
+    m = _VESSEL_FIELD.match(field)
+    vessels = document.get("vessels")
+    if m is None or not isinstance(vessels, list) or int(m.group(1)) >= len(vessels):
+        return None
+    v = vessels[int(m.group(1))]
+    vid = v.get("id") if isinstance(v, dict) else None
+    return vid if isinstance(vid, str) else None
+
+
+def _error(field: str, message: str, document: dict[str, Any]) -> dict[str, Any]:
+    return {"field": field, "message": message, "vessel": _vessel_of(field, document)}
+
+
+def validate(document: dict[str, Any]) -> tuple[Scenario | None, list[dict[str, Any]]]:
+    """The scenario of ``document`` (None when invalid) and its schema and route errors (see module docstring)."""
+    try:
+        scenario = Scenario.model_validate(document)
+    except ValidationError as exc:
+        return None, [
+            _error(f, f"{f or 'scenario'} = {shown}: {msg}" if f else msg, document)
+            for f, shown, msg in validation_problems(exc)
+        ]
+    except MmusvError as exc:
+        m = _FIELD.search(str(exc))
+        return None, [_error(m.group(1) if m else "", str(exc), document)]
+    try:
+        build_fleet(scenario)
+    except MmusvError as exc:
+        m = _FIELD.search(str(exc))
+        return None, [_error(m.group(1) if m else "vessels", str(exc).removeprefix("invalid config "), document)]
+    return scenario, []
+
+
+def _runs(mask: np.ndarray) -> list[list[int]]:
+    """``[first, last]`` index ranges of the True runs of a bool ``mask``."""
+    idx = np.flatnonzero(mask)
+    if idx.size == 0:
+        return []
+    breaks = np.flatnonzero(np.diff(idx) > 1)
+    starts = np.concatenate([[idx[0]], idx[breaks + 1]])
+    ends = np.concatenate([idx[breaks], [idx[-1]]])
+    return [[int(a), int(b)] for a, b in zip(starts, ends, strict=True)]
+
+
+def _rings(scenario: Scenario, rig: str | None) -> dict[str, float | None]:
+    r = scenario.rigs[rig] if rig is not None else RigConfig()
+    return {
+        "lidar": r.lidar.range_m if r.lidar is not None else None,
+        "radar": r.radar.range_m if r.radar is not None else None,
+    }
+
+
+def _frame_poses(fleet: Any, scenario: Scenario, frames: np.ndarray) -> np.ndarray:
+    """``(F, V, 3)`` ``[x, y, yaw]`` at acquisition indices ``frames`` (t = k / f), rounded."""
+    eta = np.asarray(fleet.poses_at_times(frames.astype(np.float64) / scenario.acquisition.frequency_hz))
+    out = eta[:, :, [0, 1, 5]]
+    out[:, :, :2] = np.round(out[:, :, :2], 3)
+    out[:, :, 2] = np.round(out[:, :, 2], 6)
+    return out
+
+
+def poses_at(scenario: Scenario, frame: int) -> list[list[float]]:
+    """``[x, y, yaw]`` of every scenario vessel at acquisition index ``frame``."""
+    if not 0 <= frame < scenario.acquisition.frames:
+        raise ConfigError(f"frame {frame} is outside the acquisition (0..{scenario.acquisition.frames - 1})")
+    return _frame_poses(build_fleet(scenario), scenario, np.array([frame]))[0].tolist()  # type: ignore[no-any-return]
+
+
+def evaluate(document: dict[str, Any]) -> dict[str, Any]:
+    """Validates ``document`` and, when valid, samples its motion and runs the named checks (module docstring)."""
+    out: dict[str, Any] = {"valid": False, "errors": [], "problems": [], "vessels": [], "frames": None}
+    scenario, errors = validate(document)
+    if scenario is None:
+        out["errors"] = errors
+        return out
+    acq = scenario.acquisition
+    out.update(frames=acq.frames, frequency_hz=acq.frequency_hz, valid=True)
+    out["map"] = {"type": scenario.map.type, "seed": scenario.map.seed, "params": scenario.map.param_values()}
+    spec = map_check_spec(scenario)
+    n_motion, n_route = sample_counts(scenario, spec)
+    n_v = len(scenario.vessels)
+    if max(n_motion, n_route) * n_v > MAX_CHECK_SAMPLES:
+        out["valid"] = False
+        out["errors"] = [
+            _error(
+                "vessels",
+                f"the checks would take {max(n_motion, n_route) * n_v:,} samples ({n_motion:,} in time, {n_route:,} "
+                f"along the routes, x {n_v} vessels); the editor checks at most {MAX_CHECK_SAMPLES:,}: shorten the "
+                "routes or the acquisition or lower the speeds",
+                document,
+            )
+        ]
+        return out
+    ctx = map_context(scenario.map.type, scenario.map.seed, scenario.map.param_values())
+    samples, findings = map_findings(scenario, ctx, spec)
+    index = {v.id: i for i, v in enumerate(scenario.vessels)}
+    for mf in findings:
+        f = mf.finding
+        first = index[f.vessels[0]] if f.vessels else None
+        field = f"vessels[{first}]" if first is not None else ""
+        if mf.check in ("in_water", "shore_clearance", "structure_clearance"):
+            field += ".route"
+        out["problems"].append(
+            {
+                "check": mf.check,
+                "severity": mf.severity,
+                "message": f.message,
+                "field": field,
+                "vessels": list(f.vessels),
+                "point": None if f.point is None else [round(f.point[0], 2), round(f.point[1], 2)],
+                "segments": {vid: _runs(mask) for vid, mask in sorted(f.route.items())},
+            }
+        )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        mounts = check_mounts(scenario, source="scenario")
+    for msg in mounts:
+        text = msg.removeprefix("scenario: ")
+        out["problems"].append(
+            {
+                "check": "mounts",
+                "severity": "warning",
+                "message": text,
+                "field": text.split(" ", 1)[0],
+                "vessels": [],
+                "point": None,
+                "segments": {},
+            }
+        )
+    fleet = build_fleet(scenario)
+    poses = _frame_poses(fleet, scenario, np.arange(acq.frames)) if acq.frames <= MAX_BULK_FRAMES else None
+    geo = np.round(samples.geo, 3)
+    for i, v in enumerate(scenario.vessels):
+        a = get_asset(v.asset)
+        out["vessels"].append(
+            {
+                "id": v.id,
+                "role": v.role,
+                "asset": v.asset,
+                "length": a.length,
+                "beam": a.beam,
+                "path": geo[:, i].tolist(),
+                "poses": None if poses is None else poses[:, i].tolist(),
+                "rings": _rings(scenario, v.rig) if v.role == "usv" else None,
+            }
+        )
+    return out

@@ -1,0 +1,69 @@
+"""``python -m mmusv.editor.job SCENARIO OUT [--frames N]``: one ``mmusv run`` for the editor, in its own process.
+
+It calls :func:`mmusv.acquire.run` (what ``mmusv run SCENARIO -o OUT --overwrite`` runs) and reports on stdout one
+JSON object per line: ``{"done": k, "total": n}`` after every frame, ``{"warning": "..."}`` for each check warning,
+and last ``{"status": "complete", "frames": k, "recording": path, "seconds": s}``, ``{"status": "failed",
+"error": "..."}`` (exit status 2) or ``{"status": "interrupted", ...}`` after SIGINT (exit status 130; the
+recording then holds every completed frame).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import warnings
+from typing import Any
+
+__all__ = ["main"]
+
+
+def _say(obj: dict[str, Any]) -> None:
+    print(json.dumps(obj), flush=True)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Runs the scenario; returns the exit status (see the module docstring)."""
+    p = argparse.ArgumentParser(prog="python -m mmusv.editor.job")
+    p.add_argument("scenario")
+    p.add_argument("output")
+    p.add_argument("--frames", type=int, default=None)
+    args = p.parse_args(argv)
+
+    def _warn(message: Warning | str, *rest: object, **kw: object) -> None:
+        _say({"warning": str(message)})
+
+    warnings.showwarning = _warn
+    try:  # imports inside: a stop (SIGINT) while they load still ends with a status line
+        from mmusv.acquire import run
+        from mmusv.errors import MmusvError
+    except KeyboardInterrupt:
+        _say({"status": "interrupted", "error": "stopped before the first frame"})
+        return 130
+    try:
+        res = run(
+            args.scenario,
+            out_dir=args.output,
+            overwrite=True,
+            frames=args.frames,
+            progress=lambda done, total: _say({"done": done, "total": total}),
+        )
+    except MmusvError as exc:
+        _say({"status": "failed", "error": str(exc)})
+        return 2
+    except KeyboardInterrupt:
+        _say({"status": "interrupted", "error": "stopped; the recording holds every completed frame"})
+        return 130
+    _say(
+        {
+            "status": res.status,
+            "frames": res.frames_written,
+            "recording": str(res.recording),
+            "seconds": round(res.seconds, 3),
+        }
+    )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,154 @@
+"""Background runs started from the editor: one process per run (:mod:`mmusv.editor.job`), its progress read from
+the JSON lines it prints.
+
+A run of ``NAME.yaml`` in the editor's folder writes into ``<folder>/out/<NAME>/`` (replacing an earlier run of
+the same file), like ``mmusv run NAME.yaml -o out/NAME --overwrite``. :meth:`Jobs.cancel` sends SIGINT, so the
+recording is finished with every completed frame, exactly as Ctrl-C on the command line.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import os
+import signal
+import subprocess
+import sys
+import threading
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from mmusv.errors import InputError, NotFoundError
+
+__all__ = ["MAX_RUNNING", "Job", "Jobs"]
+
+MAX_RUNNING = 2
+"""Runs at a time; a further start is refused until one ends."""
+
+
+@dataclass
+class Job:
+    """One run: ``status`` is ``running``, ``complete``, ``failed`` or ``interrupted``; ``done``/``total``
+    frames; ``command`` the equivalent ``mmusv run`` command line (relative to the folder)."""
+
+    id: int
+    scenario: str
+    output: str
+    command: str
+    status: str = "running"
+    done: int = 0
+    total: int | None = None
+    error: str | None = None
+    recording: str | None = None
+    seconds: float | None = None
+    warnings: list[str] = field(default_factory=list)
+    process: subprocess.Popen[str] | None = field(default=None, repr=False)
+    stop_requested: bool = field(default=False, repr=False)
+
+    def as_dict(self) -> dict[str, Any]:
+        """The job as JSON (without the process)."""
+        keys = ("id", "scenario", "output", "command", "status", "done", "total", "error", "recording", "seconds")
+        return {**{k: getattr(self, k) for k in keys}, "warnings": list(self.warnings)}
+
+
+class Jobs:
+    """The runs of one editor server, for scenario files in ``root``."""
+
+    def __init__(self, root: Path) -> None:
+        self.root = root
+        self._jobs: dict[int, Job] = {}
+        self._ids = itertools.count(1)
+        self._lock = threading.Lock()
+
+    def start(self, path: Path, *, frames: int | None = None) -> Job:
+        """Starts ``mmusv run`` of the scenario file ``path`` (in the folder) into ``out/<stem>``."""
+        with self._lock:
+            running = sum(1 for j in self._jobs.values() if j.status == "running")
+            if running >= MAX_RUNNING:
+                raise InputError(f"{running} runs are going on already; wait for one to end or stop it")
+            out = self.root / "out" / path.stem
+            rel_out = out.relative_to(self.root)
+            cmd = [sys.executable, "-m", "mmusv.editor.job", str(path), str(out)]
+            shown = f"mmusv run {path.name} -o {rel_out} --overwrite"
+            if frames is not None:
+                cmd += ["--frames", str(frames)]
+                shown += f" --frames {frames}"
+            job = Job(id=next(self._ids), scenario=path.name, output=str(rel_out), command=shown)
+            job.process = subprocess.Popen(
+                cmd,
+                cwd=self.root,
+                stdout=subprocess.PIPE,
+                stderr=subprocess.PIPE,
+                text=True,
+                env={**os.environ, "PYTHONUNBUFFERED": "1"},
+            )
+            self._jobs[job.id] = job
+        threading.Thread(target=self._follow, args=(job,), daemon=True).start()
+        return job
+
+    def _follow(self, job: Job) -> None:
+        proc = job.process
+        assert proc is not None and proc.stdout is not None and proc.stderr is not None
+        final: dict[str, Any] | None = None
+        for line in proc.stdout:
+            try:
+                msg = json.loads(line)
+            except json.JSONDecodeError:
+                continue
+            if not isinstance(msg, dict):
+                continue
+            with self._lock:
+                if "done" in msg:
+                    job.done, job.total = int(msg["done"]), int(msg["total"])
+                elif "warning" in msg:
+                    job.warnings.append(str(msg["warning"]))
+                elif "status" in msg:
+                    final = msg
+        err = proc.stderr.read()
+        code = proc.wait()
+        with self._lock:
+            if final is None and job.stop_requested:  # stopped while Python was still starting
+                job.status = "interrupted"
+                job.error = "stopped before the first frame"
+            elif final is None:
+                job.status = "failed"
+                tail = err.strip().splitlines()[-1:] if err.strip() else []
+                job.error = f"the run process ended with status {code}" + (f": {tail[0]}" if tail else "")
+            else:
+                job.status = str(final["status"])
+                job.error = final.get("error")
+                job.recording = final.get("recording")
+                job.seconds = final.get("seconds")
+                if "frames" in final:
+                    job.done = int(final["frames"])
+
+    def get(self, job_id: int) -> Job:
+        """The run ``job_id``; :class:`NotFoundError` when there is none."""
+        with self._lock:
+            if job_id not in self._jobs:
+                raise NotFoundError(f"no run {job_id}")
+            return self._jobs[job_id]
+
+    def all(self) -> list[Job]:
+        """Every run of this server, newest first."""
+        with self._lock:
+            return sorted(self._jobs.values(), key=lambda j: -j.id)
+
+    def cancel(self, job_id: int) -> Job:
+        """Stops a running run with SIGINT (its recording keeps every completed frame)."""
+        job = self.get(job_id)
+        if job.status == "running" and job.process is not None and job.process.poll() is None:
+            job.stop_requested = True
+            job.process.send_signal(signal.SIGINT)
+        return job
+
+    def shutdown(self) -> None:
+        """Stops every running run and waits for them (at most a few seconds each)."""
+        for job in self.all():
+            if job.process is not None and job.process.poll() is None:
+                job.process.send_signal(signal.SIGINT)
+                try:
+                    job.process.wait(timeout=10)
+                except subprocess.TimeoutExpired:
+                    job.process.kill()

@@ -1,0 +1,334 @@
+// Boots the editor: loads the choices, the vessel library and the first scenario, then wires the toolbar (open,
+// save, undo, preview, run), the timeline and the keyboard. window.mmusvEditor exposes the state and the view for
+// people poking at the page from the browser console (and for the browser tests).
+
+import { api } from "./api.js";
+import { MapView } from "./mapview.js";
+import { Panels } from "./panels.js";
+import { EditorState } from "./state.js";
+
+const $ = (id) => document.getElementById(id);
+const state = new EditorState();
+const map = new MapView(state, $("map"));
+const panels = new Panels(state, map);
+let bundled = [];
+let runTimer = null;
+let currentRun = null;
+
+function status(text, error = false) {
+  const s = $("status");
+  s.textContent = text;
+  s.classList.toggle("error", error);
+}
+state.on("status", ({ text, error }) => status(text, error));
+
+// ------------------------------------------------------------------------------------- map layers
+
+async function ensureMap() {
+  const m = state.doc?.map;
+  if (!m) return;
+  const key = JSON.stringify([m.type, m.seed, m.params || {}]);
+  if (key === state.mapKey) return;
+  state.mapKey = key;
+  status("generating the map…");
+  try {
+    const layers = await api.map({ type: m.type, seed: m.seed, ...(m.params ? { params: m.params } : {}) });
+    if (state.mapKey !== key) return;
+    const first = !state.mapLayers;
+    state.mapLayers = layers;
+    map.renderMap();
+    if (first) map.fitScenario();
+    map.renderScreen();
+    status(`${layers.kind.replace("_", " ")} map, seed ${layers.seed}, ${layers.extent} m square`);
+  } catch (err) {
+    status(`map: ${err.message}`, true);
+  }
+}
+
+// ------------------------------------------------------------------------------------- timeline
+
+function renderTimeline() {
+  const ev = state.evaluation?.valid ? state.evaluation : state.lastGood;
+  const frames = ev?.frames || state.doc?.acquisition?.frames || 1;
+  const f = ev?.frequency_hz || state.doc?.acquisition?.frequency_hz || 5;
+  const slider = $("frame");
+  slider.max = String(Math.max(0, frames - 1));
+  if (document.activeElement !== slider) slider.value = String(state.frame);
+  $("frame-text").textContent = `frame ${state.frame} / ${frames - 1} · t = ${(state.frame / f).toFixed(2)} s`;
+}
+
+let playing = null;
+function togglePlay() {
+  if (playing) {
+    cancelAnimationFrame(playing.raf);
+    playing = null;
+    $("play").textContent = "Play";
+    return;
+  }
+  const ev = state.evaluation?.valid ? state.evaluation : null;
+  if (!ev) return;
+  $("play").textContent = "Pause";
+  const t0 = performance.now(), k0 = state.frame >= ev.frames - 1 ? 0 : state.frame;
+  const step = () => {
+    const k = Math.min(ev.frames - 1, k0 + Math.floor(((performance.now() - t0) / 1000) * ev.frequency_hz));
+    if (k !== state.frame) state.setFrame(k);
+    if (k >= ev.frames - 1) return togglePlay();
+    playing.raf = requestAnimationFrame(step);
+  };
+  playing = { raf: requestAnimationFrame(step) };
+}
+
+// ------------------------------------------------------------------------------------- open and save
+
+async function refreshOpen() {
+  const files = await api.files();
+  const sel = $("open");
+  const keep = sel.value;
+  sel.replaceChildren();
+  const head = document.createElement("option");
+  head.value = "";
+  head.textContent = "open…";
+  sel.appendChild(head);
+  const group = (label, items) => {
+    const g = document.createElement("optgroup");
+    g.label = label;
+    for (const [value, text] of items) {
+      const o = document.createElement("option");
+      o.value = value;
+      o.textContent = text;
+      g.appendChild(o);
+    }
+    sel.appendChild(g);
+  };
+  group("this folder", files.map((f) => [`file:${f.name}`, f.name]));
+  group("bundled scenarios", bundled.map((b) => [`bundled:${b.name}`, `${b.name} (${b.map}, ${b.usvs} USVs, ${b.targets} targets)`]));
+  sel.value = keep && [...sel.options].some((o) => o.value === keep) ? keep : "";
+}
+
+async function open(value) {
+  if (!value) return;
+  if (state.dirty && !window.confirm("Discard the unsaved changes?")) return;
+  const [kind, name] = [value.slice(0, value.indexOf(":")), value.slice(value.indexOf(":") + 1)];
+  try {
+    const res = kind === "file" ? await api.readFile(name) : await api.bundledOne(name);
+    state.load({ document: res.document, comment: res.comment, name: res.name, savedName: kind === "file" ? res.name : null });
+    status(`opened ${kind === "file" ? name : `bundled ${name}`}${res.valid ? "" : " (it does not validate: see Checks)"}`);
+  } catch (err) {
+    status(err.message, true);
+  }
+  $("open").value = "";
+}
+
+async function save(overwrite = false) {
+  const name = $("file-name").value.trim();
+  $("save-confirm").hidden = true;
+  if (!name) {
+    status("give the file a name ending in .yaml", true);
+    return false;
+  }
+  try {
+    const res = await api.writeFile(name, { document: state.doc, comment: state.comment, overwrite: overwrite || name === state.savedName });
+    state.savedName = name;
+    state.fileName = name;
+    state.dirty = false;
+    status(`saved ${res.name} (${res.bytes} bytes)`);
+    document.body.dataset.saved = name;
+    await refreshOpen();
+    return true;
+  } catch (err) {
+    if (err.status === 409) {
+      $("save-confirm-text").textContent = `${name} exists.`;
+      $("save-confirm").hidden = false;
+    } else {
+      status(`not saved: ${err.message}`, true);
+    }
+    return false;
+  }
+}
+
+// ------------------------------------------------------------------------------------- preview and run
+
+async function preview() {
+  const usvs = (state.doc?.vessels || []).filter((v) => v.role === "usv").map((v) => v.id);
+  const agent = usvs.includes(state.selected) ? state.selected : usvs[0];
+  $("preview-modal").hidden = false;
+  $("preview-img").hidden = true;
+  $("preview-wait").hidden = false;
+  $("preview-wait").textContent = "Rendering with the real sensors…";
+  $("preview-title").textContent = `Preview · ${agent || "no USV"} · frame ${state.frame}`;
+  try {
+    const blob = await api.preview(state.doc, state.frame, agent || null);
+    const img = $("preview-img");
+    if (img.src) URL.revokeObjectURL(img.src);
+    img.src = URL.createObjectURL(blob);
+    img.onload = () => {
+      $("preview-wait").hidden = true;
+      img.hidden = false;
+    };
+  } catch (err) {
+    $("preview-wait").textContent = `No preview: ${err.message}`;
+  }
+}
+
+function showRun(job) {
+  currentRun = job;
+  const box = $("run-status");
+  box.hidden = false;
+  box.className = `run-status ${job.status}`;
+  box.dataset.status = job.status;
+  const p = $("run-progress");
+  p.max = job.total || 1;
+  p.value = job.done;
+  $("run-stop").hidden = job.status !== "running";
+  let text = `${job.status} · frame ${job.done}${job.total ? ` / ${job.total}` : ""}`;
+  if (job.status === "complete") text = `done: ${job.done} frames in ${job.seconds} s → ${job.output}/`;
+  if (job.status === "failed" || job.status === "interrupted") text = `${job.status}: ${job.error}`;
+  $("run-text").textContent = text;
+  $("run-text").title = `${job.command}${job.warnings.length ? "\n" + job.warnings.join("\n") : ""}`;
+}
+
+async function run() {
+  if (!(await save(false))) return;
+  const framesText = $("run-frames").value.trim();
+  try {
+    const job = await api.startRun(state.savedName, framesText ? Number(framesText) : null);
+    showRun(job);
+    clearInterval(runTimer);
+    runTimer = setInterval(async () => {
+      try {
+        const j = await api.run(job.id);
+        showRun(j);
+        if (j.status !== "running") clearInterval(runTimer);
+      } catch (err) {
+        clearInterval(runTimer);
+        status(err.message, true);
+      }
+    }, 400);
+  } catch (err) {
+    status(`run: ${err.message}`, true);
+  }
+}
+
+// ------------------------------------------------------------------------------------- wiring
+
+function renderAll() {
+  panels.renderFleet();
+  panels.renderVessel();
+  panels.renderProblems();
+  panels.renderScenario();
+  map.renderScenario();
+  renderTimeline();
+  $("undo").disabled = !state.undoStack.length;
+  $("redo").disabled = !state.redoStack.length;
+  if (document.activeElement !== $("file-name")) $("file-name").value = state.fileName;
+  document.title = `${state.dirty ? "● " : ""}${state.fileName || "scenario"} · mmusv editor`;
+}
+
+state.on("loaded", () => {
+  ensureMap();
+});
+state.on("doc", () => {
+  ensureMap();
+  renderAll();
+});
+state.on("evaluated", () => {
+  renderAll();
+  const ev = state.evaluation;
+  if (!ev) status(`cannot check: ${state.evalError}`, true);
+  else if (!ev.valid) status(`${ev.errors.length} error(s): the scenario does not validate`, true);
+  else {
+    const errors = ev.problems.filter((p) => p.severity === "error").length;
+    status(`${ev.vessels.length} vessels · ${ev.frames} frames · ${errors} error(s), ${ev.problems.length - errors} warning(s)`, errors > 0);
+  }
+});
+state.on("selection", () => {
+  panels.renderFleet();
+  panels.renderVessel();
+  map.renderScenario();
+});
+state.on("frame", () => {
+  map.renderFrame();
+  renderTimeline();
+});
+state.on("mode", ({ mode, asset, vessel }) => {
+  const box = $("drawing");
+  box.hidden = mode === "select";
+  $("drawing-text").textContent = mode === "place"
+    ? `Click the map to place ${asset.name} (${asset.length} × ${asset.beam} m)`
+    : mode === "draw" ? `Click to add waypoints to ${vessel}; double-click or Enter to finish` : "";
+  $("mode-hint").textContent = mode === "select"
+    ? "Pick a vessel, then click the map to place it and click again to add waypoints."
+    : $("drawing-text").textContent;
+  panels.renderLibrary();
+});
+
+$("open").addEventListener("change", (ev) => open(ev.target.value));
+$("file-name").addEventListener("change", (ev) => {
+  state.fileName = ev.target.value.trim();
+});
+$("save").addEventListener("click", () => save(false));
+$("save-overwrite").addEventListener("click", () => save(true));
+$("save-cancel").addEventListener("click", () => {
+  $("save-confirm").hidden = true;
+});
+$("undo").addEventListener("click", () => state.undo());
+$("redo").addEventListener("click", () => state.redo());
+$("preview").addEventListener("click", preview);
+$("preview-close").addEventListener("click", () => {
+  $("preview-modal").hidden = true;
+});
+$("run").addEventListener("click", run);
+$("run-stop").addEventListener("click", async () => {
+  if (currentRun) showRun(await api.stopRun(currentRun.id));
+});
+$("frame").addEventListener("input", (ev) => state.setFrame(Number(ev.target.value)));
+$("play").addEventListener("click", togglePlay);
+$("fit").addEventListener("click", () => map.fitScenario());
+$("fit-map").addEventListener("click", () => map.fitMap());
+$("zoom-in").addEventListener("click", () => map.zoomAt(1.5, map.size().w / 2, map.size().h / 2));
+$("zoom-out").addEventListener("click", () => map.zoomAt(1 / 1.5, map.size().w / 2, map.size().h / 2));
+$("drawing-done").addEventListener("click", () => map.setMode("select"));
+window.addEventListener("keydown", (ev) => {
+  const typing = ["INPUT", "TEXTAREA", "SELECT"].includes(document.activeElement?.tagName);
+  if ((ev.ctrlKey || ev.metaKey) && ev.key.toLowerCase() === "s") {
+    ev.preventDefault();
+    save(false);
+  } else if (!typing && (ev.ctrlKey || ev.metaKey) && ev.key.toLowerCase() === "z") {
+    ev.preventDefault();
+    if (ev.shiftKey) state.redo();
+    else state.undo();
+  } else if (!typing && (ev.key === "Enter" || ev.key === "Escape") && map.mode !== "select") {
+    map.setMode("select");
+  }
+});
+window.addEventListener("beforeunload", (ev) => {
+  if (state.dirty) ev.preventDefault();
+});
+
+async function boot() {
+  try {
+    const [info, assets, bundledList] = await Promise.all([api.info(), api.assets(), api.bundled()]);
+    bundled = bundledList;
+    panels.init(info.choices, assets);
+    await refreshOpen();
+    if (info.initial) {
+      state.load({
+        document: info.initial.document,
+        comment: info.initial.comment,
+        name: info.initial.name,
+        savedName: info.initial.in_folder ? info.initial.name : null,
+      });
+    } else {
+      const first = bundled.find((b) => b.name === "port_entry") || bundled[0];
+      const res = await api.bundledOne(first.name);
+      state.load({ document: res.document, comment: res.comment, name: res.name });
+    }
+    map.applyView();
+    document.body.dataset.ready = "1";
+  } catch (err) {
+    status(`cannot start: ${err.message}`, true);
+  }
+}
+
+window.mmusvEditor = { state, map, api };
+boot();

@@ -1,0 +1,186 @@
+// The editor's state: the scenario document (the JSON form of the YAML file), the last evaluation by the server,
+// the selection, the current acquisition index and the undo history. Views subscribe with on(event, fn).
+
+import { api } from "./api.js";
+
+const HISTORY = 100;
+
+export class EditorState {
+  constructor() {
+    this.doc = null; // scenario document, as /api/evaluate and the YAML file know it
+    this.comment = "";
+    this.fileName = "";
+    this.savedName = null; // the folder file this document was loaded from or saved to
+    this.dirty = false;
+    this.evaluation = null; // last answer of /api/evaluate for the current document (null while pending)
+    this.lastGood = null; // last evaluation that had motion (valid schema), for drawing while one is pending
+    this.selected = null; // vessel id
+    this.frame = 0;
+    this.framePoses = null; // [[x, y, yaw], ...] at this.frame when the evaluation has no bulk poses
+    this.mapKey = null;
+    this.mapLayers = null;
+    this.assets = [];
+    this.choices = null;
+    this.undoStack = [];
+    this.redoStack = [];
+    this.listeners = {};
+    this.seq = 0; // evaluation requests sent
+    this.inFlight = false;
+    this.queued = false;
+    this.evalError = null;
+  }
+
+  on(event, fn) {
+    (this.listeners[event] ||= []).push(fn);
+  }
+
+  emit(event, arg) {
+    for (const fn of this.listeners[event] || []) fn(arg);
+  }
+
+  vessel(id = this.selected) {
+    return this.doc?.vessels?.find((v) => v.id === id) || null;
+  }
+
+  vesselIndex(id) {
+    return this.doc?.vessels?.findIndex((v) => v.id === id) ?? -1;
+  }
+
+  /** Replaces the whole document (opening a file): clears the history. */
+  load({ document, comment, name, savedName }) {
+    this.doc = structuredClone(document);
+    this.comment = comment || "";
+    this.fileName = name || "";
+    this.savedName = savedName || null;
+    this.dirty = false;
+    this.undoStack = [];
+    this.redoStack = [];
+    this.selected = null;
+    this.frame = 0;
+    this.evaluation = null;
+    this.lastGood = null;
+    this.emit("loaded");
+    this.changed();
+  }
+
+  /** Applies fn(doc) as one undoable edit. `live` edits (a drag in progress) push history once per gesture. */
+  edit(fn, { gesture = null } = {}) {
+    if (!this.doc) return;
+    if (gesture === null || gesture !== this.lastGesture) {
+      this.undoStack.push(JSON.stringify(this.doc));
+      if (this.undoStack.length > HISTORY) this.undoStack.shift();
+      this.redoStack = [];
+    }
+    this.lastGesture = gesture;
+    fn(this.doc);
+    this.dirty = true;
+    this.changed();
+  }
+
+  undo() {
+    if (!this.undoStack.length) return;
+    this.redoStack.push(JSON.stringify(this.doc));
+    this.doc = JSON.parse(this.undoStack.pop());
+    this.lastGesture = null;
+    this.dirty = true;
+    if (this.selected && !this.vessel()) this.selected = null;
+    this.changed();
+  }
+
+  redo() {
+    if (!this.redoStack.length) return;
+    this.undoStack.push(JSON.stringify(this.doc));
+    this.doc = JSON.parse(this.redoStack.pop());
+    this.lastGesture = null;
+    this.dirty = true;
+    if (this.selected && !this.vessel()) this.selected = null;
+    this.changed();
+  }
+
+  select(id) {
+    this.selected = id;
+    this.emit("selection");
+  }
+
+  setFrame(k) {
+    this.frame = k;
+    this.framePoses = null;
+    this.emit("frame");
+    this.fetchFramePoses();
+  }
+
+  /** Poses at the current frame: from the evaluation's bulk poses, or fetched one index at a time. */
+  posesAt(k = this.frame) {
+    const ev = this.evaluation?.valid ? this.evaluation : null;
+    if (!ev) return null;
+    if (ev.vessels.length && ev.vessels[0].poses) {
+      return ev.vessels.map((v) => v.poses[Math.min(k, v.poses.length - 1)]);
+    }
+    return this.framePoses;
+  }
+
+  async fetchFramePoses() {
+    const ev = this.evaluation;
+    if (!ev?.valid || !ev.vessels.length || ev.vessels[0].poses) return;
+    const k = this.frame;
+    try {
+      const res = await api.poses(this.doc, k);
+      if (this.frame === k && this.evaluation === ev) {
+        this.framePoses = res.poses;
+        this.emit("frame");
+      }
+    } catch (err) {
+      this.emit("status", { text: err.message, error: true });
+    }
+  }
+
+  changed() {
+    this.evaluation = null;
+    this.emit("doc");
+    this.requestEvaluation();
+  }
+
+  pending() {
+    return this.inFlight || this.queued;
+  }
+
+  /** One evaluation in flight at a time; edits made meanwhile are evaluated once it returns (latest wins). */
+  requestEvaluation() {
+    if (this.inFlight) {
+      this.queued = true;
+      document.body.dataset.pending = "1";
+      return;
+    }
+    this.runEvaluation();
+  }
+
+  async runEvaluation() {
+    this.inFlight = true;
+    this.queued = false;
+    document.body.dataset.pending = "1";
+    const sent = JSON.stringify(this.doc);
+    const seq = ++this.seq;
+    let result = null;
+    try {
+      result = await api.evaluate(JSON.parse(sent));
+      this.evalError = null;
+    } catch (err) {
+      this.evalError = err.message;
+    }
+    this.inFlight = false;
+    if (this.queued || JSON.stringify(this.doc) !== sent) {
+      this.runEvaluation();
+      return;
+    }
+    this.evaluation = result;
+    if (result?.valid) {
+      this.lastGood = result;
+      const last = Math.max(0, (result.frames || 1) - 1);
+      if (this.frame > last) this.frame = last;
+    }
+    document.body.dataset.pending = "0";
+    document.body.dataset.evaluations = String(seq);
+    this.emit("evaluated");
+    this.fetchFramePoses();
+  }
+}
