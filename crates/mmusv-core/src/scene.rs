@@ -82,11 +82,12 @@ pub struct RayHits {
 }
 
 impl RayHits {
-    fn with_len(n: usize) -> Self {
+    /// Zeroed arrays (cheap: fresh zero pages); the tracer writes every entry of every ray.
+    fn zeroed(n: usize) -> Self {
         Self {
-            distance: vec![f32::INFINITY; n],
-            instance: vec![NO_HIT; n],
-            triangle: vec![NO_HIT; n],
+            distance: vec![0.0; n],
+            instance: vec![0; n],
+            triangle: vec![0; n],
             normal: vec![0.0; 3 * n],
             class: vec![CLASS_NONE; n],
             backface: vec![false; n],
@@ -324,10 +325,10 @@ impl Scene {
     ///
     /// Errors name the first offending ray.
     pub fn cast_rays(&self, origins: &[[f32; 3]], dirs: &[[f32; 3]], max_range: f32) -> Result<RayHits> {
-        validate_rays(origins, dirs, max_range)?;
-        let mut out = RayHits::with_len(origins.len());
+        check_batch(origins, dirs, max_range)?;
+        let mut out = RayHits::zeroed(origins.len());
         let limit = if max_range.is_finite() { max_range } else { f32::MAX };
-        (
+        let bad = (
             out.distance.par_chunks_mut(CHUNK),
             out.instance.par_chunks_mut(CHUNK),
             out.triangle.par_chunks_mut(CHUNK),
@@ -338,23 +339,30 @@ impl Scene {
             dirs.par_chunks(CHUNK),
         )
             .into_par_iter()
-            .for_each(|(dist, inst, tri, nrm, cls, back, o, d)| {
-                trace_chunk(self, o, d, limit, ChunkOut { dist, inst, tri, nrm, cls, back });
-            });
+            .enumerate()
+            .map(|(k, (dist, inst, tri, nrm, cls, back, o, d))| {
+                let out = ChunkOut { dist, inst, tri, nrm, cls, back };
+                BadRays::offset(trace_chunk(self, o, d, limit, out), k * CHUNK)
+            })
+            .reduce(BadRays::default, BadRays::min);
+        bad.check(origins, dirs)?;
         Ok(out)
     }
 
     /// Shadow-ray batch: for each ray, whether anything is hit with `0 < t < max_range` (see
     /// [`Scene::occluded_with`]). Same argument rules and errors as [`Scene::cast_rays`].
     pub fn occluded_rays(&self, origins: &[[f32; 3]], dirs: &[[f32; 3]], max_range: f32) -> Result<Vec<bool>> {
-        validate_rays(origins, dirs, max_range)?;
+        check_batch(origins, dirs, max_range)?;
         let mut out = vec![false; origins.len()];
         let limit = if max_range.is_finite() { max_range } else { f32::MAX };
-        out.par_chunks_mut(CHUNK).zip(origins.par_chunks(CHUNK)).zip(dirs.par_chunks(CHUNK)).for_each(
-            |((out, o), d)| {
-                occlusion_chunk(self, o, d, limit, out);
-            },
-        );
+        let bad = out
+            .par_chunks_mut(CHUNK)
+            .zip(origins.par_chunks(CHUNK))
+            .zip(dirs.par_chunks(CHUNK))
+            .enumerate()
+            .map(|(k, ((out, o), d))| BadRays::offset(occlusion_chunk(self, o, d, limit, out), k * CHUNK))
+            .reduce(BadRays::default, BadRays::min);
+        bad.check(origins, dirs)?;
         Ok(out)
     }
 
@@ -459,6 +467,28 @@ struct ChunkOut<'a> {
     back: &'a mut [bool],
 }
 
+impl ChunkOut<'_> {
+    /// Ray `i` hit nothing.
+    #[inline(always)]
+    fn miss(&mut self, i: usize) {
+        self.dist[i] = f32::INFINITY;
+        self.inst[i] = NO_HIT;
+        self.tri[i] = NO_HIT;
+    }
+
+    /// Ray `i` (unit direction `dir`) hit `hit`.
+    #[inline(always)]
+    fn hit(&mut self, scene: &Scene, i: usize, dir: Vec3, hit: &Hit) {
+        let (n, c) = scene.hit_normal_class(hit);
+        self.dist[i] = hit.distance;
+        self.inst[i] = hit.instance as i32;
+        self.tri[i] = hit.triangle as i32;
+        self.nrm[3 * i..3 * i + 3].copy_from_slice(&n.to_array());
+        self.cls[i] = c;
+        self.back[i] = n.dot(dir) > 0.0;
+    }
+}
+
 /// Whether the prepared rays are worth tracing as one packet (see [`COHERENT_RADIUS`], [`COHERENT_COS`]).
 #[inline(always)]
 fn coherent(rays: &[RayPrep]) -> bool {
@@ -474,23 +504,16 @@ fn coherent(rays: &[RayPrep]) -> bool {
 crate::dispatch! {
     /// Traces one chunk of rays (normalising each direction) and stores the hits: coherent groups of
     /// [`PACKET`] consecutive rays as packets, the others one by one; both give each ray the same hit.
-    fn trace_chunk(scene: &Scene, o: &[[f32; 3]], d: &[[f32; 3]], limit: f32, out: ChunkOut<'_>) {
+    fn trace_chunk(scene: &Scene, o: &[[f32; 3]], d: &[[f32; 3]], limit: f32, out: ChunkOut<'_>) -> BadRays {
         let mut scratch = Scratch::default();
-        let mut store = |i: usize, dir: Vec3, hit: Hit| {
-            let (n, c) = scene.hit_normal_class(&hit);
-            out.dist[i] = hit.distance;
-            out.inst[i] = hit.instance as i32;
-            out.tri[i] = hit.triangle as i32;
-            out.nrm[3 * i..3 * i + 3].copy_from_slice(&n.to_array());
-            out.cls[i] = c;
-            out.back[i] = n.dot(dir) > 0.0;
-        };
+        let mut bad = BadRays::default();
+        let mut out = out;
         for start in (0..o.len()).step_by(PACKET) {
             let end = (start + PACKET).min(o.len());
-            let mut rays = [RayPrep::new([0.0; 3], [1.0, 0.0, 0.0]); PACKET];
             for i in start..end {
-                rays[i - start] = RayPrep::new(o[i], unit_direction(&d[i]));
+                out.miss(i);
             }
+            let Some(rays) = prepare(o, d, start, end, &mut bad) else { continue };
             let rays = &rays[..end - start];
             let packet = if coherent(rays) { Packet::new(rays, limit) } else { None };
             if let Some(mut p) = packet {
@@ -498,30 +521,29 @@ crate::dispatch! {
                 for r in 0..rays.len() {
                     if inst[r] != u32::MAX {
                         let hit = Hit { distance: p.best[r], instance: inst[r], triangle: tri[r] };
-                        store(start + r, Vec3::from_array(rays[r].d), hit);
+                        out.hit(scene, start + r, Vec3::from_array(rays[r].d), &hit);
                     }
                 }
             } else {
                 for (r, ray) in rays.iter().enumerate() {
                     if let Some(hit) = scene.cast_prepared(ray, limit, &mut scratch) {
-                        store(start + r, Vec3::from_array(ray.d), hit);
+                        out.hit(scene, start + r, Vec3::from_array(ray.d), &hit);
                     }
                 }
             }
         }
+        bad
     }
 }
 
 crate::dispatch! {
     /// Shadow-ray queries of one chunk (directions normalised here), packets where the rays are coherent.
-    fn occlusion_chunk(scene: &Scene, o: &[[f32; 3]], d: &[[f32; 3]], limit: f32, out: &mut [bool]) {
+    fn occlusion_chunk(scene: &Scene, o: &[[f32; 3]], d: &[[f32; 3]], limit: f32, out: &mut [bool]) -> BadRays {
         let mut scratch = Scratch::default();
+        let mut bad = BadRays::default();
         for start in (0..o.len()).step_by(PACKET) {
             let end = (start + PACKET).min(o.len());
-            let mut rays = [RayPrep::new([0.0; 3], [1.0, 0.0, 0.0]); PACKET];
-            for i in start..end {
-                rays[i - start] = RayPrep::new(o[i], unit_direction(&d[i]));
-            }
+            let Some(rays) = prepare(o, d, start, end, &mut bad) else { continue };
             let rays = &rays[..end - start];
             let packet = if coherent(rays) { Packet::new(rays, limit) } else { None };
             if let Some(mut p) = packet {
@@ -535,6 +557,74 @@ crate::dispatch! {
                 }
             }
         }
+        bad
+    }
+}
+
+/// Prepares rays `start..end` of a chunk (directions normalised), or records the first invalid origin and
+/// direction in `bad` and returns `None` (the batch then fails with an error naming the ray).
+#[inline(always)]
+fn prepare(o: &[[f32; 3]], d: &[[f32; 3]], start: usize, end: usize, bad: &mut BadRays) -> Option<[RayPrep; PACKET]> {
+    let mut rays = [RayPrep::new([0.0; 3], [1.0, 0.0, 0.0]); PACKET];
+    let mut ok = true;
+    for i in start..end {
+        let (oi, di) = (&o[i], &d[i]);
+        let bad_o = !(oi[0].is_finite() && oi[1].is_finite() && oi[2].is_finite());
+        let bad_d = !(di[0].is_finite() && di[1].is_finite() && di[2].is_finite())
+            || (di[0] == 0.0 && di[1] == 0.0 && di[2] == 0.0);
+        if bad_o || bad_d {
+            bad.note(i, bad_o, bad_d);
+            ok = false;
+            continue;
+        }
+        rays[i - start] = RayPrep::new(*oi, unit_direction(di));
+    }
+    ok.then_some(rays)
+}
+
+/// The first invalid origin and direction of a batch (indices within the chunk, then the batch).
+#[derive(Debug, Default, Clone, Copy)]
+struct BadRays {
+    origin: Option<usize>,
+    direction: Option<usize>,
+}
+
+impl BadRays {
+    fn note(&mut self, i: usize, origin: bool, direction: bool) {
+        if origin && self.origin.is_none() {
+            self.origin = Some(i);
+        }
+        if direction && self.direction.is_none() {
+            self.direction = Some(i);
+        }
+    }
+
+    fn offset(self, by: usize) -> Self {
+        Self { origin: self.origin.map(|i| i + by), direction: self.direction.map(|i| i + by) }
+    }
+
+    fn min(a: Self, b: Self) -> Self {
+        let m = |x: Option<usize>, y: Option<usize>| match (x, y) {
+            (Some(x), Some(y)) => Some(x.min(y)),
+            (x, None) => x,
+            (None, y) => y,
+        };
+        Self { origin: m(a.origin, b.origin), direction: m(a.direction, b.direction) }
+    }
+
+    /// The error for the first bad origin, else the first bad direction (checked in that order, as the rays are
+    /// given).
+    fn check(self, origins: &[[f32; 3]], dirs: &[[f32; 3]]) -> Result<()> {
+        if let Some(i) = self.origin {
+            return Err(MmusvError::input(format!("origins[{i}]"), format!("{:?} is not finite", origins[i])));
+        }
+        if let Some(i) = self.direction {
+            return Err(MmusvError::input(
+                format!("directions[{i}]"),
+                format!("{:?} is zero-length or not finite; directions must be finite and non-zero", dirs[i]),
+            ));
+        }
+        Ok(())
     }
 }
 
@@ -669,7 +759,8 @@ fn unit_direction(d: &[f32; 3]) -> [f32; 3] {
     [(x / n) as f32, (y / n) as f32, (z / n) as f32]
 }
 
-fn validate_rays(origins: &[[f32; 3]], dirs: &[[f32; 3]], max_range: f32) -> Result<()> {
+/// The checks of a batch that need no pass over the rays (each ray is checked as it is traced).
+fn check_batch(origins: &[[f32; 3]], dirs: &[[f32; 3]], max_range: f32) -> Result<()> {
     if origins.len() != dirs.len() {
         return Err(MmusvError::input(
             "directions",
@@ -678,16 +769,6 @@ fn validate_rays(origins: &[[f32; 3]], dirs: &[[f32; 3]], max_range: f32) -> Res
     }
     if max_range.is_nan() || max_range <= 0.0 {
         return Err(MmusvError::input("max_range", format!("{max_range} is not allowed; give a range > 0 metres")));
-    }
-    if let Some(i) = origins.par_iter().position_first(|o| o.iter().any(|c| !c.is_finite())) {
-        return Err(MmusvError::input(format!("origins[{i}]"), format!("{:?} is not finite", origins[i])));
-    }
-    if let Some(i) = dirs.par_iter().position_first(|d| d.iter().any(|c| !c.is_finite()) || d.iter().all(|&c| c == 0.0))
-    {
-        return Err(MmusvError::input(
-            format!("directions[{i}]"),
-            format!("{:?} is zero-length or not finite; directions must be finite and non-zero", dirs[i]),
-        ));
     }
     Ok(())
 }

@@ -206,7 +206,7 @@ impl Bvh {
             return;
         }
         if root & LEAF != 0 {
-            let all = (1u32 << p.n) - 1;
+            let all = (u64::MAX >> (64 - p.n)) as u32;
             visit.leaf(root & !LEAF, all, p);
             return;
         }
@@ -257,7 +257,7 @@ impl Bvh {
     /// The rays of `p` that enter the box of lane `lane` of node `parent` (all rays for the root).
     #[inline(always)]
     fn rays_into(&self, p: &Packet, parent: u32, lane: u32) -> u32 {
-        let live = (1u32 << p.n) - 1;
+        let live = (u64::MAX >> (64 - p.n)) as u32;
         if parent == u32::MAX {
             return live;
         }
