@@ -1,5 +1,6 @@
-"""Where the sequences of a detection study come from: recordings given on the command line (files, or folders
-searched for ``*.mcap``), an OPV2V folder, or the bundled detection spec generated and recorded LiDAR-only.
+"""Where the sequences of a detection study come from: recordings given on the command line (files, folders
+holding a batch run's ``dataset.json`` (its complete recordings), or other folders searched for ``*.mcap`` and
+parts manifests of split recordings), an OPV2V folder, or the bundled detection spec generated and recorded LiDAR-only.
 
 Sequences are split by sequence before any agent-as-ego expansion: recordings and OPV2V scenario folders without
 split folders by :func:`~mmusv.studies.detection.data.split_sequences`; an OPV2V tree that already has
@@ -18,9 +19,11 @@ import yaml
 from mmusv.errors import InputError, IoError
 from mmusv.studies.detection.data import (
     SequenceData,
+    find_recordings,
     opv2v_scenarios,
     read_opv2v,
     read_recording,
+    recording_name,
     recording_summary,
     split_sequences,
 )
@@ -57,11 +60,14 @@ class Dataset:
 
 
 def _recordings(inputs: Sequence[str | Path]) -> list[Path]:
+    from mmusv.batch.index import dataset_recordings, find_index
+
     out: list[Path] = []
     for x in inputs:
         p = Path(x)
         if p.is_dir():
-            found = sorted(p.rglob("*.mcap"))
+            index = find_index(p)
+            found = dataset_recordings(index) if index is not None else find_recordings(p)
             if not found:
                 raise InputError(f"{p}: folder holds no .mcap recording")
             out.extend(found)
@@ -73,18 +79,18 @@ def _recordings(inputs: Sequence[str | Path]) -> list[Path]:
 
 
 def _sequence_names(recs: Sequence[Path]) -> dict[str, Path]:
-    """Sequence name → recording: the file stem, or, when two recordings share a stem, the path below the
-    inputs' common folder without the suffix (``island/recordings/x/x``)."""
+    """Sequence name → recording: the recording's name (file name without ``.mcap`` / ``.parts.json``), or, when
+    two recordings share a name, the path below the inputs' common folder to it (``island/recordings/x/x``)."""
     import os
 
     uniq = sorted({r.resolve() for r in recs})
     if len(uniq) != len(recs):
         raise InputError("the same recording is given twice")
-    stems = [r.stem for r in uniq]
+    stems = [recording_name(r) for r in uniq]
     if len(set(stems)) == len(stems):
         return dict(zip(stems, uniq, strict=True))
     root = Path(os.path.commonpath([str(r.parent) for r in uniq]))
-    return {str(r.relative_to(root).with_suffix("")): r for r in uniq}
+    return {str(r.parent.relative_to(root) / recording_name(r)): r for r in uniq}
 
 
 def resolve_dataset(
