@@ -103,13 +103,17 @@ def print_report(report: BatchReport, console: Console) -> None:
     for col in ("scenario", "status", "frames", "parts", "retried", "result"):
         table.add_column(col, overflow="fold", justify="right" if col in ("frames", "parts", "retried") else "left")
     colour = {"done": "green", "skipped": "cyan", "failed": "red"}
+
+    def where(path: Path | None) -> str:
+        return "" if path is None else str(path.relative_to(report.out_dir))
+
     for o in report.outcomes:
         if o.status == "failed":
             result = o.error or ""
         elif o.status == "skipped":
-            result = f"complete, same config hash: {o.recording}"
+            result = f"complete, same config hash: {where(o.recording)}"
         else:
-            result = f"{o.frames} frames in {o.seconds:.1f} s -> {o.recording}"
+            result = f"{o.frames} frames in {o.seconds:.1f} s -> {where(o.recording)}"
         table.add_row(
             o.file.name,
             f"[{colour[o.status]}]{o.status}[/{colour[o.status]}]",

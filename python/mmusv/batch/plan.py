@@ -316,7 +316,10 @@ def prepare(plan: ScenarioPlan) -> None:
         old.unlink()
     _remove_parts(folder, keep={Path(t.out_dir).name for t in plan.tasks})
     assert plan.recording is not None
-    write_parts_manifest(plan.recording, plan.parts)
+    from mmusv.jsonio import dump_json
+
+    if not (plan.recording.is_file() and plan.recording.read_bytes() == dump_json(plan.parts.as_dict())):
+        write_parts_manifest(plan.recording, plan.parts)  # (an unchanged manifest is left as it is)
 
 
 def _remove_parts(folder: Path, keep: set[str]) -> None:

@@ -49,8 +49,10 @@ class RayExecutor:
         self.num_cpus = num_cpus
         self.max_retries = max_retries
         self.owned = False
+        self._refs: dict[Any, Task] = {}
         if not ray.is_initialized():
-            where = None if address is True or address in ("local", "") else str(address)
+            # "local" always starts a new instance (Ray would otherwise join one it finds on this machine)
+            where = "local" if address is True or address in ("local", "") else str(address)
             try:
                 ray.init(
                     address=where,
@@ -60,7 +62,7 @@ class RayExecutor:
                     configure_logging=True,
                 )
             except (ConnectionError, RuntimeError, ValueError) as exc:
-                raise IoError(f"--ray {where or 'local'}: cannot start or join Ray: {exc}") from None
+                raise IoError(f"--ray {where}: cannot start or join Ray: {exc}") from None
             self.owned = True
         total = ray.cluster_resources().get("CPU", 0)
         if total < num_cpus:
@@ -69,7 +71,6 @@ class RayExecutor:
                 f"cpus per task = {num_cpus}, but the Ray cluster has {total:g} CPUs: no task could ever be scheduled"
             )
         self._remote = ray.remote(execute)
-        self._refs: dict[Any, Task] = {}
 
     @property
     def cluster_cpus(self) -> float:

@@ -209,9 +209,9 @@ def run_many(
     todo = [t for p in plans for t in p.to_run]
     total_frames = sum(p.frames for p in plans if not p.error)
     done_frames = total_frames - sum(t.expected_frames for t in todo)
+    write()
     if progress is not None:
         progress(done_frames, total_frames)
-    write()
     by_key = {t.key: t for t in todo}
     plan_of = {t.key: p for p in plans for t in p.to_run}
     left = {p.name: len(p.to_run) for p in plans}
