@@ -24,7 +24,7 @@ cargo test -p mmusv-core --release --quiet
 echo "== cargo bench --no-run (benches keep compiling)"
 cargo bench --no-run --quiet
 
-echo "== pip install the package with test extras (builds the extension in release)"
+echo "== pip install the package with test extras (builds the extension in release; ray for the batch tests)"
 python3 -m pip install --quiet --disable-pip-version-check -e ".[test]"
 
 echo "== ruff: lint and format check of the Python sources"
