@@ -121,7 +121,7 @@ def test_a_bad_index_is_named(tmp_path: Path) -> None:
     with pytest.raises(IoError, match="status outside"):
         write_index(tmp_path / "dataset.json", [Entry("a", "a.yaml", "a", None, None, None, "done", 0, 0, 0, 0)])
     (tmp_path / "plain").mkdir()
-    with pytest.raises(IoError, match="plain is a folder without a dataset.json"):
+    with pytest.raises(IoError, match="plain is not a file but a folder without a dataset.json"):
         convert(tmp_path / "plain", out_dir=tmp_path / "o")
 
 

@@ -112,7 +112,7 @@ def _as_list(recordings: str | Path | Iterable[str | Path]) -> list[Path]:
             index = find_index(p)
             if index is None:
                 raise IoError(
-                    f"{p} is a folder without a dataset.json; give recordings (.mcap, .parts.json) or a batch output"
+                    f"{p} is not a file but a folder without a dataset.json; give recordings (.mcap, .parts.json) or a batch output folder"
                 )
             found = dataset_recordings(index)
             if not found:
