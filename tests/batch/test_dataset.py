@@ -137,3 +137,17 @@ def test_a_killed_batch_leaves_an_index_of_what_is_done(tmp_path: Path) -> None:
     assert run_many(src, out_dir=out, progress=watch).ok
     assert [t["complete"] for t in seen] == [0, 1, 2, 3] and all(t["pending"] == 3 - t["complete"] for t in seen)
     assert not [p for p in out.iterdir() if p.name.endswith(".tmp")] and os.path.isfile(out / "dataset.json")
+
+
+def test_detection_generate_records_through_the_batch_runner(tmp_path: Path) -> None:
+    from mmusv.studies.detection.sources import generate_dataset
+
+    spec = write(tmp_path / "tinyset.yaml", SPEC)
+    ticks: list[tuple[str, int, int]] = []
+    recs = generate_dataset(tmp_path / "d", spec=spec, progress=lambda *a: ticks.append(a))
+    assert len(recs) == 3 and all(p.is_file() for p in recs) and ticks[-1] == ("recording", 18, 18)
+    assert read_index(tmp_path / "d/recordings")["totals"]["complete"] == 3
+    names = [p.parent.name for p in recs]
+    before = stamps(tmp_path / "d/recordings", names)
+    assert generate_dataset(tmp_path / "d", spec=spec) == recs  # a second call records nothing again
+    assert stamps(tmp_path / "d/recordings", names) == before

@@ -148,41 +148,36 @@ def generate_dataset(
     spec: str | Path = BUNDLED_SPEC,
     progress: Callable[[str, int, int], None] | None = None,
 ) -> list[Path]:
-    """Generates ``spec`` into ``out_dir/scenarios`` and records every scenario LiDAR-only into
-    ``out_dir/recordings/<name>/``; returns the recordings. An existing recording of the same scenario is kept
-    (delete ``out_dir`` to redo it)."""
-    from mmusv.acquire import recording_path, run
+    """Generates ``spec`` into ``out_dir/scenarios``, writes their LiDAR-only versions into ``out_dir/lidar_only``
+    and records those with the batch runner (:func:`mmusv.batch.run_many`) into ``out_dir/recordings/<name>/``;
+    returns the recordings. A complete recording of the same configuration is kept (delete ``out_dir`` to redo
+    it). ``progress``: ``("recording", frames done, frames in all)``. Raises :class:`~mmusv.InputError` when a
+    scenario could not be recorded."""
+    from mmusv.batch import dataset_recordings, run_many
     from mmusv.bundled import resolve_spec
-    from mmusv.config import load_scenario
     from mmusv.generate.runner import generate
 
     sp = resolve_spec(spec)
     out = Path(out_dir)
-    scen_dir = out / "scenarios"
+    scen_dir, lidar_dir = out / "scenarios", out / "lidar_only"
     generate(sp, scen_dir, force=True)
     files = sorted(scen_dir.glob("*.yaml"))
     if not files:
         raise InputError(f"--generate: spec {sp} produced no scenario (see {scen_dir / 'report.json'})")
-    recs: list[Path] = []
-    for i, f in enumerate(files):
+    lidar_dir.mkdir(parents=True, exist_ok=True)
+    for old in lidar_dir.glob("*.yaml"):
+        old.unlink()
+    for f in files:
         data = lidar_only(yaml.safe_load(f.read_text(encoding="utf-8")))
-        rec_dir = out / "recordings" / f.stem
-        scenario = load_scenario(data)
-        path = recording_path(rec_dir, scenario)
-        if not (path.exists() and _same_scenario(path, scenario)):
-            run(scenario, out_dir=rec_dir, overwrite=True)
-        recs.append(path)
-        if progress is not None:
-            progress(f.stem, i + 1, len(files))
-    return recs
-
-
-def _same_scenario(path: Path, scenario: Any) -> bool:
-    """Whether the complete recording at ``path`` was made from ``scenario`` (same config hash)."""
-    from mmusv.config import scenario_hash
-
-    try:
-        info = recording_summary(path)
-    except IoError:
-        return False
-    return info.complete and info.config_hash == scenario_hash(scenario)
+        (lidar_dir / f.name).write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+    report = run_many(
+        lidar_dir,
+        out_dir=out / "recordings",
+        progress=None if progress is None else (lambda done, total: progress("recording", done, total)),
+    )
+    failed = [o for o in report.outcomes if o.status == "failed"]
+    if failed:
+        raise InputError(
+            f"--generate: {len(failed)} of {len(files)} scenarios could not be recorded; first: {failed[0].error}"
+        )
+    return dataset_recordings(out / "recordings")
