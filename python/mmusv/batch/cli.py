@@ -95,6 +95,19 @@ def _bar(console: Console, title: str) -> Iterator[Callable[[str, int, int], Non
         yield update
 
 
+@contextmanager
+def _resume_hint(args: argparse.Namespace) -> Iterator[None]:
+    """On Ctrl-C: one line saying that the same command finishes the run."""
+    try:
+        yield
+    except KeyboardInterrupt:
+        print(
+            "mmusv: stopped; complete recordings are kept, run the same command again to record the rest",
+            file=sys.stderr,
+        )
+        raise
+
+
 def print_report(report: BatchReport, console: Console) -> None:
     """The table of a batch run, its warnings and the summary line."""
     from rich.table import Table
@@ -134,7 +147,7 @@ def run_batch(args: argparse.Namespace, source: Path | list[Path]) -> int:
     from mmusv.batch.runner import run_many
 
     console = _console()
-    with _bar(console, "mmusv run") as update:
+    with _bar(console, "mmusv run") as update, _resume_hint(args):
         report = run_many(
             source,
             out_dir=args.output,
@@ -176,7 +189,7 @@ def run_dataset(args: argparse.Namespace) -> int:
     if args.jobs < 1:
         raise ConfigError(f"--jobs {args.jobs}: must be at least 1")
     console = _console()
-    with _bar(console, "mmusv dataset") as update:
+    with _bar(console, "mmusv dataset") as update, _resume_hint(args):
         rep = build_dataset(
             args.spec,
             out_dir=args.output,
