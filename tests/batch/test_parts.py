@@ -79,6 +79,10 @@ def test_parts_read_as_one_sequence(
         assert got == {t: m.SerializeToString() for t, m in frame_messages(whole(reference, name), 37).items()}
     assert main(["info", str(split / "a_sea/a_sea.parts.json")]) == 0
     assert "status complete, 60 frames" in capsys.readouterr().out
+    assert main(["preview", str(split / "a_sea/a_sea.parts.json"), "--frame", "30"]) == 0
+    picture = split / "a_sea/a_sea_frame000030_u.png"  # named after the recording, from the part holding frame 30
+    assert picture.stat().st_size > 0
+    picture.unlink()
     # a folder search finds the manifests, not their parts
     assert find_recordings(split) == [split / n / f"{n}.parts.json" for n in GOOD]
 

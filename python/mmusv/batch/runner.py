@@ -27,7 +27,7 @@ from mmusv.batch.executors import Executor, PoolExecutor, SerialExecutor, availa
 from mmusv.batch.index import INDEX_NAME, Entry, folder_bytes, write_index
 from mmusv.batch.plan import ScenarioPlan, plan_scenarios, prepare, scenario_files
 from mmusv.batch.task import TaskResult
-from mmusv.errors import ConfigError
+from mmusv.errors import ConfigError, MmusvError
 
 __all__ = ["BatchReport", "ScenarioOutcome", "run_many"]
 
@@ -106,7 +106,7 @@ def _entry(plan: ScenarioPlan, status: str, error: str | None, root: Path) -> En
     for t in plan.tasks:
         try:
             m = read_json(Path(t.out_dir) / "manifest.json")
-        except Exception:  # no manifest: nothing of this task recorded
+        except MmusvError:  # no (readable) manifest: nothing of this task recorded
             continue
         if m.get("config_hash") == plan.config_hash:
             frames += int(m.get("frames_written", 0) or 0)
