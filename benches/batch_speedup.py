@@ -1,9 +1,10 @@
 """Speed-up of the batch runner over one process, and the overhead of a pool process and of a Ray task.
 
-    python benches/batch_speedup.py [--scenarios 6] [--frames 40] [--cpus N] [--skip-ray]
+    python benches/batch_speedup.py [--scenarios 6] [--frames 40] [--rig lidar|full] [--cpus N] [--repeat 2]
 
-Writes a folder of ``--scenarios`` LiDAR-only scenarios (open sea, 2 USVs with the default 64-channel LiDAR and
-3 targets, ``--frames`` frames at 5 Hz, each its own seed) and records it, each time into a fresh folder, with:
+Writes a folder of ``--scenarios`` scenarios (open sea, 2 USVs with the ``--rig`` sensors: the 64-channel LiDAR
+alone or the full suite, 3 targets, ``--frames`` frames at 5 Hz, each its own seed) and records it, each time
+into a fresh folder, with:
 
 * ``one process``: :func:`mmusv.run_many` with ``jobs=1``, in this process, the core on every CPU;
 * ``pool, 1 process x N threads``: one spawned worker with every CPU: the same work as one process, so the
@@ -38,15 +39,19 @@ import yaml
 from mmusv.batch import run_many
 from mmusv.batch.executors import available_cpus
 
+RIGS: dict[str, dict[str, Any]] = {"lidar": {"preset": "lidar_only"}, "full": {}}
+"""``lidar``: the detection-dataset rig (64-channel LiDAR); ``full``: the paper's suite (LiDAR, radar + PPI, four
+640x480 cameras, top view)."""
 
-def scenario(name: str, seed: int, frames: int) -> dict[str, Any]:
-    """A detection-dataset-like scenario: two USVs with the default LiDAR, three targets, open sea."""
+
+def scenario(name: str, seed: int, frames: int, rig: str = "lidar") -> dict[str, Any]:
+    """Two USVs with the rig ``rig``, three targets, open sea."""
     return {
         "name": name,
         "seed": seed,
         "map": {"type": "open_sea", "seed": 2},
         "acquisition": {"frequency_hz": 5, "frames": frames},
-        "rigs": {"r": {"preset": "lidar_only"}},
+        "rigs": {"r": RIGS[rig]},
         "vessels": [
             {"id": "u1", "role": "usv", "asset": "usv_wamv", "rig": "r", "speed_mps": 2, "route": [[0, 0], [80, 0]]},
             {"id": "u2", "role": "usv", "asset": "usv_wamv", "rig": "r", "speed_mps": 2, "route": [[0, 40], [80, 40]]},
@@ -75,6 +80,7 @@ def main() -> int:
     ap.add_argument("--frames", type=int, default=40)
     ap.add_argument("--cpus", type=int, default=available_cpus(), help="CPUs to use (default: all)")
     ap.add_argument("--repeat", type=int, default=2, help="rounds over every mode; the fastest round counts")
+    ap.add_argument("--rig", choices=sorted(RIGS), default="lidar", help="sensor rig of the USVs (default lidar)")
     ap.add_argument("--skip-ray", action="store_true")
     args = ap.parse_args()
     n, s = args.cpus, args.scenarios
@@ -83,11 +89,11 @@ def main() -> int:
     src.mkdir()
     for i in range(s):
         (src / f"s{i:02d}.yaml").write_text(
-            yaml.safe_dump(scenario(f"s{i:02d}", 100 + i, args.frames), sort_keys=False)
+            yaml.safe_dump(scenario(f"s{i:02d}", 100 + i, args.frames, args.rig), sort_keys=False)
         )
     warm = work / "warm"
     warm.mkdir()
-    (warm / "w.yaml").write_text(yaml.safe_dump(scenario("w", 1, 1), sort_keys=False))
+    (warm / "w.yaml").write_text(yaml.safe_dump(scenario("w", 1, 1, args.rig), sort_keys=False))
     run_many(warm, out_dir=work / "warm_out")  # imports, assets and map caches of this process, outside the timings
 
     modes: list[tuple[str, dict[str, Any]]] = [
@@ -108,7 +114,7 @@ def main() -> int:
         ]
     best: dict[str, tuple[float, float, float, float]] = {}  # wall, seconds inside the tasks, load before, after
     ref: dict[str, str] | None = None
-    print(f"{s} scenarios x {args.frames} frames, {n} CPUs, {args.repeat} rounds, {work}")
+    print(f"{s} scenarios x {args.frames} frames, rig {args.rig}, {n} CPUs, {args.repeat} rounds, {work}")
     if not args.skip_ray:
         print(f"ray.init (local, not in the batch times): {ray_init:.2f} s")
     try:
