@@ -74,6 +74,23 @@ def load() -> float:
     return os.getloadavg()[0]
 
 
+def _ray_round_trip(ray: Any, cpus: int, calls: int = 20) -> tuple[float, float]:
+    """Seconds of the first call of an empty Ray task with the options the batch runner uses (``cpus`` CPUs, its
+    own ``RAYON_NUM_THREADS``: a worker is started), and the mean of ``calls`` more, one after the other."""
+
+    def noop() -> int:
+        return 0
+
+    task = ray.remote(noop).options(num_cpus=cpus, runtime_env={"env_vars": {"RAYON_NUM_THREADS": str(cpus)}})
+    t0 = time.perf_counter()
+    ray.get(task.remote())
+    first = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    for _ in range(calls):
+        ray.get(task.remote())
+    return first, (time.perf_counter() - t0) / calls
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--scenarios", type=int, default=6)
@@ -108,6 +125,7 @@ def main() -> int:
         t0 = time.perf_counter()
         ray.init(num_cpus=n, include_dashboard=False, log_to_driver=False, logging_level=logging.WARNING)
         ray_init = time.perf_counter() - t0
+        noop_first, noop_warm = _ray_round_trip(ray, n)
         modes += [
             (f"ray, 1 task x {n} CPUs", {"ray": True, "cpus_per_task": n}),
             (f"ray, {n} tasks x 1 CPU", {"ray": True, "cpus_per_task": 1}),
@@ -117,6 +135,10 @@ def main() -> int:
     print(f"{s} scenarios x {args.frames} frames, rig {args.rig}, {n} CPUs, {args.repeat} rounds, {work}")
     if not args.skip_ray:
         print(f"ray.init (local, not in the batch times): {ray_init:.2f} s")
+        print(
+            f"ray empty task with the batch's options: first {noop_first:.2f} s (starts a worker), "
+            f"then {noop_warm * 1e3:.1f} ms a task"
+        )
     try:
         for r in range(args.repeat):
             for k, (label, kw) in enumerate(modes):
