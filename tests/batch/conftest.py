@@ -186,9 +186,10 @@ class WorkerKiller(threading.Thread):
             time.sleep(0.003)
 
 
-def cli(*args: str, **kw: Any) -> subprocess.Popen[str]:
+def cli(*args: str, extra_env: dict[str, str] | None = None, **kw: Any) -> subprocess.Popen[str]:
     """``python -m mmusv.cli ARGS`` as a child in its own session (its process group is its pid)."""
     env = {**os.environ, "PYTHONPATH": str(ROOT / "python") + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    env.update(extra_env or {})
     return subprocess.Popen(
         [sys.executable, "-m", "mmusv.cli", *args],
         cwd=ROOT,

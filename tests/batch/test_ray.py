@@ -101,12 +101,24 @@ def test_a_killed_ray_worker_is_retried_with_the_same_result(
     assert tree(out) == ref
 
 
-def test_cli_joins_a_cluster_and_splits_long_scenarios(
+def test_cli_joins_the_cluster_of_ray_address_and_splits_long_scenarios(
     address: str, reference: tuple[Path, dict[str, str]], tmp_path: Path
 ) -> None:
     src, _ref = reference
     out = tmp_path / "out"
-    proc = cli("run", str(src), "-o", str(out), "--ray", address, "--split-frames", "25", "--cpus-per-task", "2")
+    proc = cli(  # "auto": the cluster named by RAY_ADDRESS
+        "run",
+        str(src),
+        "-o",
+        str(out),
+        "--ray",
+        "auto",
+        "--split-frames",
+        "25",
+        "--cpus-per-task",
+        "2",
+        extra_env={"RAY_ADDRESS": address},
+    )
     stdout, stderr = proc.communicate(timeout=600)
     assert proc.returncode == 0, stderr
     assert "3 done, 0 failed, 0 skipped, 0 retried" in stdout and "on ray" in stdout
