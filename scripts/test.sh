@@ -40,7 +40,7 @@ cargo test -p mmusv-core --release --quiet
 echo "== cargo bench --no-run (benches keep compiling)"
 cargo bench --no-run --quiet
 
-echo "== pip install the package with test extras (builds the extension in release)"
+echo "== pip install the package with test extras (builds the extension in release; ray for the batch tests)"
 python3 -m pip install --quiet --disable-pip-version-check -e ".[test]"
 
 echo "== cargo clippy, warnings are errors (release: reuses the build scripts and proc macros built above)"

@@ -192,6 +192,7 @@ def run(
     frames: int | None = None,
     progress: Callable[[int, int], None] | None = None,
     checks: bool = True,
+    frame_range: tuple[int, int] | None = None,
 ) -> RunResult:
     """Runs a scenario (a YAML path, a dict or a :class:`~mmusv.config.Scenario`) into ``out_dir``.
 
@@ -200,6 +201,9 @@ def run(
         overwrite: replace an existing recording of the same scenario name; otherwise that is an error.
         frames: run only the first ``frames`` indices (default: the scenario's ``acquisition.frames``).
         progress: called with (frames done, frames total) after every frame.
+        frame_range: ``(first, stop)``: run only acquisition indices ``first .. stop - 1`` (one part of a
+            recording split into frame ranges, :mod:`mmusv.batch`); every frame is the same as in a whole run
+            (each frame is captured from its own frozen state and seeds). Not together with ``frames``.
         checks: run the generator's route checks on the map (:mod:`mmusv.scenario_checks`): a route over land
             is an error, clearance and separation problems and far-away mounts are warnings.
 
@@ -219,6 +223,16 @@ def run(
     total = scenario.acquisition.frames if frames is None else int(frames)
     if not 1 <= total <= scenario.acquisition.frames:
         raise ConfigError(f"frames = {frames}: must be in 1..{scenario.acquisition.frames} (acquisition.frames)")
+    first = 0
+    if frame_range is not None:
+        if frames is not None:
+            raise ConfigError("give frames or frame_range, not both")
+        first, total = int(frame_range[0]), int(frame_range[1])
+        if not 0 <= first < total <= scenario.acquisition.frames:
+            raise ConfigError(
+                f"frame_range = {tuple(frame_range)}: must be (first, stop) with 0 <= first < stop <= "
+                f"{scenario.acquisition.frames} (acquisition.frames)"
+            )
     out = Path(out_dir)
     rec_path = recording_path(out, scenario)
     if rec_path.exists() and not overwrite:
@@ -247,7 +261,7 @@ def run(
     t0 = time.perf_counter()
     recorder = FrameRecorder(rec_path, sim, overwrite=overwrite)
     try:
-        for k in range(total):
+        for k in range(first, total):
             tf = time.perf_counter()
             cap = sim.capture(k)
             anns = annotations_for(sim, cap, silhouettes)
@@ -257,12 +271,12 @@ def run(
             for agent, a in anns.items():
                 tables.add_annotations(a, cols[agent])
             del cap
-            result.frames_written = k + 1
+            result.frames_written = k + 1 - first
             result.frame_seconds.append(time.perf_counter() - tf)
             if (k + 1) % TABLE_PART_FRAMES == 0:
                 tables.flush()
             if progress is not None:
-                progress(k + 1, total)
+                progress(k + 1 - first, total - first)
     except KeyboardInterrupt:
         result.status = "interrupted"
         raise
@@ -272,7 +286,11 @@ def run(
         raise
     finally:
         summary = recorder.finish(
-            status=result.status, frames=result.frames_written, error=result.error, requested=total
+            status=result.status,
+            frames=result.frames_written,
+            error=result.error,
+            requested=total - first,
+            first_frame=None if frame_range is None else first,
         )
         result.messages, result.bytes = summary.get("messages", 0), summary.get("bytes", 0)
         tables.flush()
@@ -284,12 +302,14 @@ def run(
             "config_hash": scenario_hash(scenario),
             "status": result.status,
             "frames_written": result.frames_written,
-            "frames_requested": total,
+            "frames_requested": total - first,
             "frequency_hz": scenario.acquisition.frequency_hz,
             "agents": [a.id for a in sim.agents],
             "recording": rec_path.name,
             "tables": sorted(p.name for p in tables_dir.iterdir()) if tables_dir.exists() else [],
         }
+        if frame_range is not None:
+            manifest["first_frame"] = first
         (out / "manifest.json").write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")
     return result
 

@@ -1,9 +1,10 @@
 """The ``mmusv`` command line.
 
-Subcommands: ``run`` (a scenario or a folder of them into MCAP + Parquet), ``info`` and ``preview`` (inspect a
-recording), ``convert`` (to OPV2V or KITTI), ``generate`` (batch scenario generation), ``assets`` (the vessel
-library), ``study waves`` (Table I) and ``study agreement`` (Table II), ``study detection`` / ``study robustness``
-(Tables III, IV), ``editor`` (the scenario editor in the browser), ``version``.
+Subcommands: ``run`` (a scenario or a folder of them into MCAP + Parquet; folders through :mod:`mmusv.batch`,
+on a local pool or Ray), ``dataset`` (spec → recordings → OPV2V, :mod:`mmusv.batch.dataset`), ``info`` and
+``preview`` (inspect a recording), ``convert`` (to OPV2V or KITTI), ``generate`` (batch scenario generation),
+``assets`` (the vessel library), ``study waves`` (Table I) and ``study agreement`` (Table II), ``study detection`` /
+``study robustness`` (Tables III, IV), ``editor`` (the scenario editor in the browser), ``version``.
 Errors in the input end with a one-line message naming the problem and exit status 2, never a traceback.
 """
 
@@ -125,73 +126,17 @@ def _run_one(path: str, out: str, overwrite: bool, frames: int | None, show_prog
     )
 
 
-def _run_one_safe(path: str, out: str, overwrite: bool, frames: int | None, checks: bool) -> tuple[str, str]:
-    """``(status, message)`` of one scenario of a folder run: never raises, so nothing has to be pickled back
-    from a worker but two strings. ``status``: ``done`` or ``failed``; a failure names its file."""
-    import warnings
-
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            return "done", _run_one(path, out, overwrite, frames, False, checks)
-    except MmusvError as exc:
-        msg = str(exc)
-        return "failed", msg if path in msg else f"{path}: {msg}"
-    except Exception as exc:  # a bug, not bad input: still reported per file, with its type
-        return "failed", f"{path}: internal error {type(exc).__name__}: {exc}"
-
-
 def _cmd_run(args: argparse.Namespace) -> int:
+    from mmusv.batch.cli import run_batch, uses_batch
     from mmusv.bundled import resolve_scenario
 
     src = resolve_scenario(args.scenario)
-    checks = not args.no_checks
     if src.is_dir():
-        files = sorted(p for p in src.glob("*.yaml") if p.name != "report.yaml")
-        if not files:
-            raise MmusvError(f"{src} holds no *.yaml scenarios")
-        jobs = max(1, int(args.jobs))
-        outs = [str(Path(args.output) / f.stem) for f in files]
-        results: list[tuple[str, str]] = []
-        if jobs == 1:
-            for f, o in zip(files, outs, strict=True):
-                results.append(_run_one_safe(str(f), o, args.overwrite, args.frames, checks))
-                print(results[-1][1])
-        else:
-            import multiprocessing
-            from concurrent.futures import ProcessPoolExecutor
-
-            # spawn, not fork: the parent already runs the core's thread pool, and a forked copy of a process with
-            # threads can deadlock on a lock another thread held
-            ctx = multiprocessing.get_context("spawn")
-            with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
-                futures = [
-                    pool.submit(_run_one_safe, str(f), o, args.overwrite, args.frames, checks)
-                    for f, o in zip(files, outs, strict=True)
-                ]
-                for fut in futures:
-                    results.append(fut.result())
-                    print(results[-1][1])
-        return _report_folder(files, results)
-    print(_run_one(str(src), args.output, args.overwrite, args.frames, sys.stdout.isatty(), checks))
+        return run_batch(args, src)
+    if uses_batch(args):  # one file with --ray, --retries, --split-frames: a batch of one (OUT/<stem>/)
+        return run_batch(args, [src])
+    print(_run_one(str(src), args.output, args.overwrite, args.frames, sys.stdout.isatty(), not args.no_checks))
     return 0
-
-
-def _report_folder(files: list[Path], results: list[tuple[str, str]]) -> int:
-    """Prints the table of a folder run (file, status, message); returns 1 if any scenario failed."""
-    from rich.table import Table
-
-    table = Table(title="mmusv run: folder")
-    for col in ("scenario", "status", "result"):
-        table.add_column(col, overflow="fold")
-    for f, (status, msg) in zip(files, results, strict=True):
-        colour = "green" if status == "done" else "red"
-        table.add_row(f.name, f"[{colour}]{status}[/{colour}]", msg)
-    console = _console()
-    console.print(table)
-    failed = sum(1 for st, _ in results if st != "done")
-    console.print(f"{len(results) - failed} done, {failed} failed")
-    return 1 if failed else 0
 
 
 def _cmd_scenarios(args: argparse.Namespace) -> int:
@@ -311,6 +256,10 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument(
         "--jobs", type=int, default=1, help="for a folder: scenarios run in parallel processes (default 1)"
     )
+    from mmusv.batch.cli import add_dataset_parser, add_run_options
+
+    add_run_options(run)
+    add_dataset_parser(sub)
     run.add_argument(
         "--no-checks",
         action="store_true",
@@ -381,6 +330,10 @@ def main(argv: list[str] | None = None) -> int:
             from mmusv.editor.cli import run as _run_editor
 
             return _run_editor(args)
+        if args.command == "dataset":
+            from mmusv.batch.cli import run_dataset
+
+            return run_dataset(args)
     except MmusvError as exc:
         print(f"mmusv: error: {exc}", file=sys.stderr)
         return 2

@@ -20,7 +20,14 @@ from PIL import Image, ImageDraw, ImageFont
 from mmusv.classes import palette_array
 from mmusv.errors import ConfigError
 from mmusv.recording import topics
-from mmusv.recording.reader import AgentInfo, decode_image, decode_point_cloud, frame_messages, read_info
+from mmusv.recording.reader import (
+    AgentInfo,
+    decode_image,
+    decode_point_cloud,
+    frame_messages,
+    read_info,
+    recording_name,
+)
 
 __all__ = ["BOX_COLOUR", "Panel", "compose_preview", "write_preview"]
 
@@ -248,6 +255,8 @@ def write_preview(
     """Writes the preview PNG of ``frame`` for ``agent`` (default: the first agent); returns its path."""
     canvas, panels = compose_preview(path, frame=frame, agent=agent)
     a = panels[0].title.split(" · ")[0]
-    out = Path(output) if output is not None else Path(path).with_name(f"{Path(path).stem}_frame{frame:06d}_{a}.png")
+    out = (
+        Path(output) if output is not None else Path(path).with_name(f"{recording_name(path)}_frame{frame:06d}_{a}.png")
+    )
     canvas.save(out)
     return out

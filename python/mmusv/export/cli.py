@@ -27,7 +27,12 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         description="Converts mmusv recordings into the OPV2V layout (CARLA frame, per-agent folders) or KITTI-style "
         "per-agent folders, split into train/validate/test by recording with a fixed seed.",
     )
-    p.add_argument("recordings", nargs="+", help=".mcap files written by mmusv run (.mcap.partial accepted)")
+    p.add_argument(
+        "recordings",
+        nargs="+",
+        help=".mcap files written by mmusv run (.mcap.partial accepted), .parts.json of split recordings, or "
+        "batch output folders (their dataset.json)",
+    )
     p.add_argument("--to", default="opv2v", help="target layout: opv2v (default) or kitti")
     p.add_argument("-o", "--output", required=True, help="output folder")
     g = p.add_mutually_exclusive_group()

@@ -101,9 +101,26 @@ class ConvertReport:
 
 
 def _as_list(recordings: str | Path | Iterable[str | Path]) -> list[Path]:
-    if isinstance(recordings, (str, Path)):
-        return [Path(recordings)]
-    out = [Path(r) for r in recordings]
+    """The recordings given: files (``.mcap``, parts manifests) as they are, a folder holding a ``dataset.json``
+    (a batch run's output) as its complete recordings."""
+    from mmusv.batch.index import dataset_recordings, find_index
+
+    given = [Path(recordings)] if isinstance(recordings, (str, Path)) else [Path(r) for r in recordings]
+    out: list[Path] = []
+    for p in given:
+        if p.is_dir():
+            index = find_index(p)
+            if index is None:
+                raise IoError(
+                    f"{p} is not a file but a folder without a dataset.json; give recordings (.mcap, .parts.json) "
+                    "or a batch output folder"
+                )
+            found = dataset_recordings(index)
+            if not found:
+                raise ConfigError(f"{index} lists no complete recording")
+            out.extend(found)
+        else:
+            out.append(p)
     if not out:
         raise ConfigError("no recordings given")
     return out
@@ -167,7 +184,9 @@ def convert(
 
     Args:
         recordings: ``.mcap`` files written by ``mmusv run`` (also ``.mcap.partial`` or truncated ones: their
-            complete frames are converted, the rest reported as skipped).
+            complete frames are converted, the rest reported as skipped), parts manifests of recordings split
+            into frame ranges (read as one sequence), or folders holding a ``dataset.json`` (their complete
+            recordings).
         to: ``"opv2v"`` or ``"kitti"``.
         splits: ``(train, validate, test)`` fractions (split per recording, shuffled with ``seed``) or ``None``
             for one folder of scenarios.
@@ -258,7 +277,8 @@ def convert(
         configured = int(
             stream.run.get("frames_requested", stream.run.get("frames_configured", info.frames_configured)) or 0
         )
-        absent = [k for k in range(configured) if k not in seen]
+        first = int(stream.run.get("first_frame", 0) or 0)  # one part of a split recording given alone
+        absent = [k for k in range(first, first + configured) if k not in seen]
         if absent:
             written = stream.run.get("frames_written")
             why = (

@@ -227,10 +227,17 @@ class FrameRecorder:
     # ------------------------------------------------------------------------------------------ end
 
     def finish(
-        self, *, status: str, frames: int, error: str | None = None, requested: int | None = None
+        self,
+        *,
+        status: str,
+        frames: int,
+        error: str | None = None,
+        requested: int | None = None,
+        first_frame: int | None = None,
     ) -> dict[str, Any]:
         """Writes the ``run`` metadata and completes the file (also after an interruption: the file then holds
-        every completed frame and says ``status: interrupted``)."""
+        every completed frame and says ``status: interrupted``). ``first_frame``: the first acquisition index of
+        a part of a recording split into frame ranges (then ``requested`` frames from there)."""
         sc = self.sim.scenario
         meta = {
             "scenario": sc.name,
@@ -242,6 +249,8 @@ class FrameRecorder:
         }
         if requested is not None:  # a run limited to its first N frames (--frames N)
             meta["frames_requested"] = requested
+        if first_frame is not None:  # one part of a split recording: frames first_frame .. + requested - 1
+            meta["first_frame"] = first_frame
         if error:
             meta["error"] = error
         self.rec.metadata("run", meta)

@@ -10,6 +10,12 @@ message: from the summary section when the file has one, otherwise from the reco
 topics asked for and yields one :class:`Frame` per log time (every message of a frame shares its log time). A
 file that ends in the middle of a record (a killed writer) yields every frame read so far and says where it
 stopped in :attr:`FrameStream.truncated`; the ``run`` metadata, written last, is picked up when present.
+
+A recording split into frame ranges (:mod:`mmusv.recording.parts`) is read through its ``<name>.parts.json``
+manifest wherever an ``.mcap`` is accepted: :func:`read_info` merges the parts' metadata (``run.status`` is
+``complete`` only when every part is), :class:`FrameStream`, :func:`read_messages`, :func:`summary` and
+:func:`frame_messages` walk the parts in frame order as one sequence. A part not recorded yet is left out (its
+frames are missing, as those of an interrupted run); :func:`recording_name` is the sequence's name either way.
 """
 
 from __future__ import annotations
@@ -27,6 +33,7 @@ import yaml
 from PIL import Image
 
 from mmusv.errors import ConfigError, IoError
+from mmusv.recording.parts import is_parts_manifest, read_parts_manifest
 
 __all__ = [
     "MCAP_MAGIC",
@@ -39,9 +46,11 @@ __all__ = [
     "check_mcap",
     "decode_image",
     "decode_point_cloud",
+    "find_recordings",
     "frame_messages",
     "read_info",
     "read_messages",
+    "recording_name",
     "summary",
 ]
 
@@ -111,6 +120,8 @@ class RecordingInfo:
     agents: list[AgentInfo]
     run: dict[str, str]
     has_summary: bool
+    parts: tuple[Path, ...] = ()
+    """For a parts manifest: the recorded part files in frame order (``path`` is the manifest); else empty."""
 
     @property
     def vessel_ids(self) -> list[str]:
@@ -219,8 +230,87 @@ def _mat(v: Any) -> np.ndarray | None:
     return np.asarray(v, dtype=np.float64).reshape(4, 4)
 
 
+def recording_name(path: str | os.PathLike[str]) -> str:
+    """The name of the recording at ``path``: the file name without ``.mcap`` (``.mcap.partial``) or
+    ``.parts.json``."""
+    name = Path(path).name
+    for suffix in (".parts.json", ".mcap.partial", ".mcap"):
+        if name.endswith(suffix):
+            return name[: -len(suffix)]
+    return Path(path).stem
+
+
+def find_recordings(folder: str | os.PathLike[str]) -> list[Path]:
+    """The recordings below ``folder``, sorted: every parts manifest and every ``.mcap`` that is not one of a
+    manifest's parts."""
+    root = Path(folder)
+    manifests = sorted(root.rglob("*.parts.json"))
+    parts = set()
+    for m in manifests:
+        parts |= {(m.parent / p.recording).resolve() for p in read_parts_manifest(m).parts}
+    mcaps = [p for p in sorted(root.rglob("*.mcap")) if p.resolve() not in parts]
+    return sorted([*manifests, *mcaps])
+
+
+def _part_files(path: Path) -> list[tuple[int, int, Path | None]]:
+    """``(first_frame, stop, file or None)`` of every part of the manifest at ``path``: the finished ``.mcap``,
+    else its ``.partial`` (an interrupted part), else None (not recorded yet)."""
+    m = read_parts_manifest(path)
+    out: list[tuple[int, int, Path | None]] = []
+    for part in m.parts:
+        f = path.parent / part.recording
+        partial = f.with_name(f.name + ".partial")
+        out.append((part.first_frame, part.stop, f if f.is_file() else partial if partial.is_file() else None))
+    return out
+
+
+def _read_parts_info(p: Path) -> RecordingInfo:
+    m = read_parts_manifest(p)
+    files = _part_files(p)
+    infos = [(first, read_info(f)) for first, _stop, f in files if f is not None]
+    if not infos:
+        raise IoError(
+            f"{p}: none of its {len(files)} parts is recorded yet (the first is {p.parent / m.parts[0].recording})"
+        )
+    for first, i in infos:
+        if i.config_hash != m.config_hash:
+            raise IoError(
+                f"{p}: part {i.path} was recorded from another configuration (config hash {i.config_hash[:12]}, "
+                f"the manifest says {m.config_hash[:12]})"
+            )
+        got = i.run.get("first_frame")
+        if got is not None and int(got) != first:
+            raise IoError(f"{p}: part {i.path} starts at frame {got}, the manifest says {first}")
+    base = infos[0][1]
+    done = sum(1 for _f, i in infos if i.run.get("status") == "complete")
+    status = "complete" if done == len(files) else f"incomplete ({done} of {len(files)} parts complete)"
+    run = {k: v for k, v in base.run.items() if k not in ("status", "error", "first_frame")}
+    run.update(
+        status=status,
+        frames_written=str(sum(int(i.run.get("frames_written", 0) or 0) for _f, i in infos)),
+        frames_requested=str(m.frames),
+        parts=str(len(files)),
+    )
+    return RecordingInfo(
+        path=p,
+        scenario_name=base.scenario_name,
+        scenario=base.scenario,
+        config_hash=m.config_hash,
+        seed=base.seed,
+        mmusv_version=base.mmusv_version,
+        frequency_hz=base.frequency_hz,
+        frames_configured=base.frames_configured,
+        agents=base.agents,
+        run=run,
+        has_summary=status == "complete" and all(i.has_summary for _f, i in infos),
+        parts=tuple(i.path for _f, i in infos),
+    )
+
+
 def read_info(path: str | Path) -> RecordingInfo:
-    """The metadata of the recording at ``path`` (see the module docstring)."""
+    """The metadata of the recording at ``path`` (an ``.mcap`` or a parts manifest; see the module docstring)."""
+    if is_parts_manifest(path):
+        return _read_parts_info(Path(path))
     p = check_mcap(path)
     with p.open("rb") as f:
         meta = _metadata_from_summary(f)
@@ -308,6 +398,11 @@ class FrameStream:
         return round(log_time_ns * self.info.frequency_hz / 1e9)
 
     def __iter__(self) -> Iterator[Frame]:
+        seen: set[int] = set()
+        for path in self.info.parts or (self.info.path,):
+            yield from self._file(path, seen)
+
+    def _file(self, path: Path, seen: set[int]) -> Iterator[Frame]:
         from mcap.records import Channel, Message, Metadata, Schema
         from mcap.stream_reader import StreamReader
         from mcap_protobuf.decoder import DecoderFactory
@@ -317,9 +412,8 @@ class FrameStream:
         channels: dict[int, Channel] = {}
         decoders: dict[int, Callable[[bytes], Any] | None] = {}
         current: Frame | None = None
-        seen: set[int] = set()
-        with self.info.path.open("rb") as f:
-            size = self.info.path.stat().st_size
+        with path.open("rb") as f:
+            size = path.stat().st_size
             records = StreamReader(f, emit_chunks=False).records
             good = 0
             while True:
@@ -328,10 +422,12 @@ class FrameStream:
                 except StopIteration:
                     break
                 except Exception as exc:  # ends mid-record: keep what was read
-                    self.truncated = (
-                        f"the file is truncated: it ends inside a record ({type(exc).__name__}) at byte {size}; "
+                    where = f"part {path.name} of {self.info.path.name}" if self.info.parts else "the file"
+                    truncated = (
+                        f"{where} is truncated: it ends inside a record ({type(exc).__name__}) at byte {size}; "
                         f"the last complete record ends at byte {good}"
                     )
+                    self.truncated = truncated if self.truncated is None else f"{self.truncated}; {truncated}"
                     break
                 good = f.tell()
                 if isinstance(rec, Schema):
@@ -339,7 +435,7 @@ class FrameStream:
                 elif isinstance(rec, Channel):
                     channels[rec.id] = rec
                 elif isinstance(rec, Metadata):
-                    if rec.name == "run":
+                    if rec.name == "run" and not self.info.parts:  # parts: the merged run of read_info stands
                         self.run = dict(rec.metadata)
                 elif isinstance(rec, Message):
                     ch = channels.get(rec.channel_id)
@@ -374,10 +470,15 @@ class FrameStream:
 
 def read_messages(path: str | os.PathLike[str], topics: Sequence[str] | None = None) -> Iterator[tuple[str, int, Any]]:
     """Yields ``(topic, log_time_ns, decoded_protobuf_message)`` in log-time order, optionally only ``topics``.
-    Works on finished files and on completed ``.partial`` files."""
+    Works on finished files, on completed ``.partial`` files and on parts manifests (the recorded parts in order)."""
     from mcap.reader import make_reader
     from mcap_protobuf.decoder import DecoderFactory
 
+    if is_parts_manifest(path):
+        for _first, _stop, part in _part_files(Path(path)):
+            if part is not None:
+                yield from read_messages(part, topics)
+        return
     with open(path, "rb") as f:
         reader = make_reader(f, decoder_factories=[DecoderFactory()])
         wanted = None if topics is None else list(topics)
@@ -389,9 +490,12 @@ def summary(path: str | os.PathLike[str]) -> dict[str, Any]:
     """What a recording holds: ``{"path", "complete", "messages", "start_ns", "end_ns", "duration_s",
     "topics": {topic: {"schema", "encoding", "messages"}}, "metadata": {name: {key: value}},
     "attachments": [name, ...]}``. ``complete`` is False for a ``.partial`` file or one without a summary
-    section (counted by scanning every message)."""
+    section (counted by scanning every message). A parts manifest gives the sums over its recorded parts, the
+    metadata of the first with the merged ``run`` of :func:`read_info`, and ``parts`` (how many there are)."""
     from mcap.reader import make_reader
 
+    if is_parts_manifest(path):
+        return _parts_summary(Path(path))
     topics: dict[str, dict[str, Any]] = {}
     with open(path, "rb") as f:
         reader = make_reader(f)
@@ -438,6 +542,28 @@ def summary(path: str | os.PathLike[str]) -> dict[str, Any]:
     }
 
 
+def _parts_summary(path: Path) -> dict[str, Any]:
+    info = _read_parts_info(path)
+    sums = [summary(p) for p in info.parts]
+    topics: dict[str, dict[str, Any]] = {}
+    for s in sums:
+        for topic, t in s["topics"].items():
+            topics.setdefault(topic, {**t, "messages": 0})["messages"] += t["messages"]
+    start, end = min(s["start_ns"] for s in sums), max(s["end_ns"] for s in sums)
+    return {
+        "path": str(path),
+        "complete": info.run["status"] == "complete" and all(s["complete"] for s in sums),
+        "messages": sum(s["messages"] for s in sums),
+        "start_ns": start,
+        "end_ns": end,
+        "duration_s": (end - start) * 1e-9,
+        "topics": dict(sorted(topics.items())),
+        "metadata": {**sums[0]["metadata"], "run": dict(info.run)},
+        "attachments": sums[0]["attachments"],
+        "parts": int(info.run["parts"]),
+    }
+
+
 _NUMPY = {1: np.uint8, 2: np.int8, 3: np.uint16, 4: np.int16, 5: np.uint32, 6: np.int32, 7: np.float32, 8: np.float64}
 
 
@@ -478,11 +604,19 @@ def decode_point_cloud(msg: Any) -> dict[str, np.ndarray]:
 
 
 def frame_messages(path: str | Path, frame: int) -> dict[str, Any]:
-    """Every decoded message of acquisition index ``frame``, by topic (log time = frame / f)."""
+    """Every decoded message of acquisition index ``frame``, by topic (log time = frame / f); for a parts
+    manifest, from the part holding ``frame``."""
     from mcap.reader import make_reader
     from mcap_protobuf.decoder import DecoderFactory
 
     p = Path(path)
+    if is_parts_manifest(p):
+        for first, stop, part in _part_files(p):
+            if first <= frame < stop:
+                if part is None:
+                    raise ConfigError(f"frame {frame} is not in {p}: its part is not recorded yet")
+                return frame_messages(part, frame)
+        raise ConfigError(f"frame {frame} is not in {p}")
     if not p.is_file():
         raise IoError(f"recording {p} does not exist")
     out: dict[str, Any] = {}

@@ -143,6 +143,19 @@ def recording_summary(path: str | Path) -> RecordingSummary:
     return RecordingSummary(int(info.frames_configured), str(info.config_hash), bool(info.has_summary))
 
 
+def find_recordings(folder: str | Path) -> list[Path]:
+    """The recordings below ``folder`` (``.mcap`` files and parts manifests of split recordings, whose parts are
+    not listed on their own), sorted."""
+    found: list[Path] = _reader().find_recordings(folder)
+    return found
+
+
+def recording_name(path: str | Path) -> str:
+    """A recording's name: its file name without ``.mcap`` or ``.parts.json``."""
+    name: str = _reader().recording_name(path)
+    return name
+
+
 def read_recording(path: str | Path) -> SequenceData:
     """A recording (``mmusv run`` MCAP) as a sequence: every frame with the LiDAR of every instrumented USV that
     has one. Raises :class:`~mmusv.IoError` for a file that is not a readable recording."""
@@ -178,7 +191,7 @@ def read_recording(path: str | Path) -> SequenceData:
             )
         )
     frames.sort(key=lambda f: f.frame)
-    return SequenceData(info.path.stem, tuple(frames))
+    return SequenceData(recording_name(info.path), tuple(frames))
 
 
 def opv2v_scenarios(root: str | Path) -> list[Path]:

@@ -1,5 +1,6 @@
-"""Where the sequences of a detection study come from: recordings given on the command line (files, or folders
-searched for ``*.mcap``), an OPV2V folder, or the bundled detection spec generated and recorded LiDAR-only.
+"""Where the sequences of a detection study come from: recordings given on the command line (files, folders
+holding a batch run's ``dataset.json`` (its complete recordings), or other folders searched for ``*.mcap`` and
+parts manifests of split recordings), an OPV2V folder, or the bundled detection spec generated and recorded LiDAR-only.
 
 Sequences are split by sequence before any agent-as-ego expansion: recordings and OPV2V scenario folders without
 split folders by :func:`~mmusv.studies.detection.data.split_sequences`; an OPV2V tree that already has
@@ -18,9 +19,11 @@ import yaml
 from mmusv.errors import InputError, IoError
 from mmusv.studies.detection.data import (
     SequenceData,
+    find_recordings,
     opv2v_scenarios,
     read_opv2v,
     read_recording,
+    recording_name,
     recording_summary,
     split_sequences,
 )
@@ -57,11 +60,14 @@ class Dataset:
 
 
 def _recordings(inputs: Sequence[str | Path]) -> list[Path]:
+    from mmusv.batch.index import dataset_recordings, find_index
+
     out: list[Path] = []
     for x in inputs:
         p = Path(x)
         if p.is_dir():
-            found = sorted(p.rglob("*.mcap"))
+            index = find_index(p)
+            found = dataset_recordings(index) if index is not None else find_recordings(p)
             if not found:
                 raise InputError(f"{p}: folder holds no .mcap recording")
             out.extend(found)
@@ -73,18 +79,18 @@ def _recordings(inputs: Sequence[str | Path]) -> list[Path]:
 
 
 def _sequence_names(recs: Sequence[Path]) -> dict[str, Path]:
-    """Sequence name → recording: the file stem, or, when two recordings share a stem, the path below the
-    inputs' common folder without the suffix (``island/recordings/x/x``)."""
+    """Sequence name → recording: the recording's name (file name without ``.mcap`` / ``.parts.json``), or, when
+    two recordings share a name, the path below the inputs' common folder to it (``island/recordings/x/x``)."""
     import os
 
     uniq = sorted({r.resolve() for r in recs})
     if len(uniq) != len(recs):
         raise InputError("the same recording is given twice")
-    stems = [r.stem for r in uniq]
+    stems = [recording_name(r) for r in uniq]
     if len(set(stems)) == len(stems):
         return dict(zip(stems, uniq, strict=True))
     root = Path(os.path.commonpath([str(r.parent) for r in uniq]))
-    return {str(r.relative_to(root).with_suffix("")): r for r in uniq}
+    return {str(r.parent.relative_to(root) / recording_name(r)): r for r in uniq}
 
 
 def resolve_dataset(
@@ -142,41 +148,36 @@ def generate_dataset(
     spec: str | Path = BUNDLED_SPEC,
     progress: Callable[[str, int, int], None] | None = None,
 ) -> list[Path]:
-    """Generates ``spec`` into ``out_dir/scenarios`` and records every scenario LiDAR-only into
-    ``out_dir/recordings/<name>/``; returns the recordings. An existing recording of the same scenario is kept
-    (delete ``out_dir`` to redo it)."""
-    from mmusv.acquire import recording_path, run
+    """Generates ``spec`` into ``out_dir/scenarios``, writes their LiDAR-only versions into ``out_dir/lidar_only``
+    and records those with the batch runner (:func:`mmusv.batch.run_many`) into ``out_dir/recordings/<name>/``;
+    returns the recordings. A complete recording of the same configuration is kept (delete ``out_dir`` to redo
+    it). ``progress``: ``("recording", frames done, frames in all)``. Raises :class:`~mmusv.InputError` when a
+    scenario could not be recorded."""
+    from mmusv.batch import dataset_recordings, run_many
     from mmusv.bundled import resolve_spec
-    from mmusv.config import load_scenario
     from mmusv.generate.runner import generate
 
     sp = resolve_spec(spec)
     out = Path(out_dir)
-    scen_dir = out / "scenarios"
+    scen_dir, lidar_dir = out / "scenarios", out / "lidar_only"
     generate(sp, scen_dir, force=True)
     files = sorted(scen_dir.glob("*.yaml"))
     if not files:
         raise InputError(f"--generate: spec {sp} produced no scenario (see {scen_dir / 'report.json'})")
-    recs: list[Path] = []
-    for i, f in enumerate(files):
+    lidar_dir.mkdir(parents=True, exist_ok=True)
+    for old in lidar_dir.glob("*.yaml"):
+        old.unlink()
+    for f in files:
         data = lidar_only(yaml.safe_load(f.read_text(encoding="utf-8")))
-        rec_dir = out / "recordings" / f.stem
-        scenario = load_scenario(data)
-        path = recording_path(rec_dir, scenario)
-        if not (path.exists() and _same_scenario(path, scenario)):
-            run(scenario, out_dir=rec_dir, overwrite=True)
-        recs.append(path)
-        if progress is not None:
-            progress(f.stem, i + 1, len(files))
-    return recs
-
-
-def _same_scenario(path: Path, scenario: Any) -> bool:
-    """Whether the complete recording at ``path`` was made from ``scenario`` (same config hash)."""
-    from mmusv.config import scenario_hash
-
-    try:
-        info = recording_summary(path)
-    except IoError:
-        return False
-    return info.complete and info.config_hash == scenario_hash(scenario)
+        (lidar_dir / f.name).write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+    report = run_many(
+        lidar_dir,
+        out_dir=out / "recordings",
+        progress=None if progress is None else (lambda done, total: progress("recording", done, total)),
+    )
+    failed = [o for o in report.outcomes if o.status == "failed"]
+    if failed:
+        raise InputError(
+            f"--generate: {len(failed)} of {len(files)} scenarios could not be recorded; first: {failed[0].error}"
+        )
+    return dataset_recordings(out / "recordings")

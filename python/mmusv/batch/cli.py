@@ -1,0 +1,214 @@
+"""The command-line faces of the batch runner: the batch options of ``mmusv run`` (:func:`add_run_options`,
+:func:`run_batch`) and ``mmusv dataset SPEC -o DIR`` (:func:`add_dataset_parser`, :func:`run_dataset`).
+
+Both show a rich progress bar over the frames of the whole batch (on a terminal), then the table of every
+scenario (done, skipped, failed with its error, retried) and one summary line; the exit status is 1 when a
+scenario failed. Bad options raise :class:`mmusv.errors.MmusvError` (one line, exit status 2).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from mmusv.errors import ConfigError
+
+if TYPE_CHECKING:
+    from rich.console import Console
+
+    from mmusv.batch.runner import BatchReport
+
+__all__ = ["add_dataset_parser", "add_run_options", "print_report", "run_batch", "run_dataset", "uses_batch"]
+
+
+def _batch_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--ray",
+        nargs="?",
+        const="local",
+        default=None,
+        metavar="ADDRESS",
+        help="run every scenario as a Ray task: no ADDRESS starts a local Ray instance, 'auto' or HOST:PORT joins "
+        "a cluster (the output folder must be on storage every node sees); needs pip install 'mmusv[ray]'",
+    )
+    p.add_argument(
+        "--cpus-per-task",
+        type=int,
+        default=None,
+        metavar="N",
+        help="CPUs (= core threads, RAYON_NUM_THREADS) per task (default: 1 on Ray, the CPUs shared between --jobs)",
+    )
+    p.add_argument(
+        "--retries", type=int, default=0, metavar="N", help="run a failed task up to N more times (default 0)"
+    )
+    p.add_argument(
+        "--split-frames",
+        type=int,
+        default=None,
+        metavar="N",
+        help="record scenarios longer than N frames as parts of N frames, one task each, tied by <name>.parts.json",
+    )
+
+
+def add_run_options(run: argparse.ArgumentParser) -> None:
+    """Adds the batch options (``--ray``, ``--cpus-per-task``, ``--retries``, ``--split-frames``) to ``run``."""
+    _batch_options(run)
+
+
+def uses_batch(args: argparse.Namespace) -> bool:
+    """Whether a ``mmusv run FILE`` asks for the batch runner (then it runs as a batch of one)."""
+    return args.ray is not None or args.retries or args.split_frames is not None or args.cpus_per_task is not None
+
+
+def _console() -> Console:
+    from rich.console import Console
+
+    return Console(width=None if sys.stdout.isatty() else 160)
+
+
+@contextmanager
+def _bar(console: Console, title: str) -> Iterator[Callable[[str, int, int], None]]:
+    """A progress callback ``(stage, done, total)``: one bar per stage on a terminal, nothing otherwise."""
+    if not console.is_terminal:
+        yield lambda stage, done, total: None
+        return
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    with Progress(
+        TextColumn(f"[bold]{title}" + " {task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        console=console,
+    ) as bar:
+        tasks: dict[str, Any] = {}
+
+        def update(stage: str, done: int, total: int) -> None:
+            if stage not in tasks:
+                tasks[stage] = bar.add_task(stage, total=total)
+            bar.update(tasks[stage], completed=done, total=total)
+
+        yield update
+
+
+@contextmanager
+def _resume_hint(args: argparse.Namespace) -> Iterator[None]:
+    """On Ctrl-C: one line saying that the same command finishes the run."""
+    try:
+        yield
+    except KeyboardInterrupt:
+        print(
+            "mmusv: stopped; complete recordings are kept, run the same command again to record the rest",
+            file=sys.stderr,
+        )
+        raise
+
+
+def print_report(report: BatchReport, console: Console) -> None:
+    """The table of a batch run, its warnings and the summary line."""
+    from rich.table import Table
+
+    table = Table(title=f"mmusv run: {len(report.outcomes)} scenarios on {report.backend} -> {report.out_dir}")
+    for col in ("scenario", "status", "frames", "parts", "retried", "result"):
+        table.add_column(col, overflow="fold", justify="right" if col in ("frames", "parts", "retried") else "left")
+    colour = {"done": "green", "skipped": "cyan", "failed": "red"}
+
+    def where(path: Path | None) -> str:
+        return "" if path is None else str(path.relative_to(report.out_dir))
+
+    for o in report.outcomes:
+        if o.status == "failed":
+            result = o.error or ""
+        elif o.status == "skipped":
+            result = f"complete, same config hash: {where(o.recording)}"
+        else:
+            result = f"{o.frames} frames in {o.seconds:.1f} s -> {where(o.recording)}"
+        table.add_row(
+            o.file.name,
+            f"[{colour[o.status]}]{o.status}[/{colour[o.status]}]",
+            f"{o.frames}/{o.frames_requested}",
+            str(o.parts),
+            str(o.retried),
+            result,
+        )
+    console.print(table)
+    for o in report.outcomes:
+        for w in o.warnings:
+            console.print(f"mmusv: warning: {w}", markup=False, highlight=False)
+    console.print(f"{report.summary()} in {report.seconds:.1f} s; index {report.index}")
+
+
+def run_batch(args: argparse.Namespace, source: Path | list[Path]) -> int:
+    """``mmusv run DIR`` (or a file with batch options): runs the batch, prints the table; 1 if a scenario failed."""
+    from mmusv.batch.runner import run_many
+
+    console = _console()
+    with _bar(console, "mmusv run") as update, _resume_hint(args):
+        report = run_many(
+            source,
+            out_dir=args.output,
+            jobs=int(args.jobs),
+            ray=args.ray if args.ray is not None else False,
+            cpus_per_task=args.cpus_per_task,
+            retries=int(args.retries),
+            split_frames=args.split_frames,
+            frames=args.frames,
+            overwrite=args.overwrite,
+            checks=not args.no_checks,
+            progress=lambda done, total: update("frames", done, total),
+        )
+    print_report(report, console)
+    return 0 if report.ok else 1
+
+
+def add_dataset_parser(subparsers: Any) -> argparse.ArgumentParser:
+    """Adds ``dataset`` to the ``mmusv`` sub-parsers."""
+    p: argparse.ArgumentParser = subparsers.add_parser(
+        "dataset",
+        help="generate a spec, record every scenario, convert to OPV2V and index it (dataset.json), restartable",
+        description="Generates SPEC into DIR/scenarios, records every scenario into DIR/recordings (local pool or "
+        "Ray), converts the complete recordings to OPV2V into DIR/opv2v and writes DIR/dataset.json. Run the "
+        "same command again to finish an interrupted or partly failed dataset: what is complete is skipped.",
+    )
+    p.add_argument("spec", help="generation spec YAML (or a bundled spec name, e.g. coop_detection)")
+    p.add_argument("-o", "--output", required=True, help="dataset folder")
+    p.add_argument("--jobs", type=int, default=1, help="local pool processes (default 1); ignored with --ray")
+    p.add_argument("--no-checks", action="store_true", help="skip the route checks when recording")
+    _batch_options(p)
+    return p
+
+
+def run_dataset(args: argparse.Namespace) -> int:
+    """Runs ``mmusv dataset``; 0 when every scenario was recorded and converted, 1 otherwise."""
+    from mmusv.batch.dataset import build_dataset
+
+    if args.jobs < 1:
+        raise ConfigError(f"--jobs {args.jobs}: must be at least 1")
+    console = _console()
+    with _bar(console, "mmusv dataset") as update, _resume_hint(args):
+        rep = build_dataset(
+            args.spec,
+            out_dir=args.output,
+            jobs=args.jobs,
+            ray=args.ray if args.ray is not None else False,
+            cpus_per_task=args.cpus_per_task,
+            retries=args.retries,
+            split_frames=args.split_frames,
+            checks=not args.no_checks,
+            progress=update,
+        )
+    console.print(
+        f"scenarios: {'generated' if rep.generated else 'kept (same spec)'} in {rep.out_dir / 'scenarios'}"
+        + (f"; quota not met: {', '.join(rep.shortfall)}" if rep.shortfall else "")
+    )
+    print_report(rep.batch, console)
+    console.print(
+        f"opv2v: {rep.converted} frames converted into {rep.opv2v}"
+        if rep.converted is not None
+        else f"opv2v: {rep.opv2v} is up to date"
+    )
+    return 0 if rep.ok else 1

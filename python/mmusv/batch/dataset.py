@@ -1,0 +1,139 @@
+"""From a generation spec to a dataset in one call: ``mmusv dataset SPEC.yaml -o DIR`` / :func:`build_dataset`.
+
+Steps, each skipped on a re-run when its result is already there:
+
+1. generate the spec (:func:`mmusv.generate.generate`) into ``DIR/scenarios`` (skipped when ``DIR/dataset.json``
+   names the same spec hash and ``DIR/scenarios/report.json`` exists);
+2. record every scenario into ``DIR/recordings/<stem>/`` with the batch runner (:func:`mmusv.batch.run_many`: the
+   local pool or Ray, complete recordings skipped);
+3. convert the complete recordings to OPV2V (:func:`mmusv.export.convert`) into ``DIR/opv2v`` (skipped when the
+   last conversion was of the same recordings and configurations);
+4. ``DIR/dataset.json`` (:mod:`mmusv.batch.index`) lists every recording, with sections ``spec`` (file name,
+   name, hash) and ``opv2v`` (folder, frames converted, the recordings converted with their hashes).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from mmusv.batch.index import INDEX_NAME, read_index, write_index
+from mmusv.batch.runner import BatchReport, run_many
+from mmusv.errors import MmusvError
+
+__all__ = ["DatasetReport", "build_dataset"]
+
+Progress = Callable[[str, int, int], None]
+"""``(stage, done, total)`` with stage ``generate`` (scenarios), ``record`` or ``convert`` (frames)."""
+
+
+@dataclass
+class DatasetReport:
+    """What :func:`build_dataset` did: whether it generated (``False``: reused), the batch report, frames
+    converted (``None``: conversion skipped, up to date) and quota shortfalls of the generation."""
+
+    out_dir: Path
+    generated: bool
+    shortfall: list[str]
+    batch: BatchReport
+    converted: int | None
+    opv2v: Path
+
+    @property
+    def ok(self) -> bool:
+        """True when every scenario was recorded."""
+        return self.batch.ok
+
+
+def _spec_hash(spec: Any) -> str:
+    text = json.dumps(spec.model_dump(mode="json"), sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def build_dataset(
+    spec: str | os.PathLike[str],
+    *,
+    out_dir: str | os.PathLike[str],
+    jobs: int = 1,
+    ray: bool | str = False,
+    cpus_per_task: int | None = None,
+    retries: int = 0,
+    split_frames: int | None = None,
+    checks: bool = True,
+    progress: Progress | None = None,
+) -> DatasetReport:
+    """Generates, records, converts and indexes the dataset of ``spec`` into ``out_dir`` (see the module
+    docstring); the batch options are those of :func:`mmusv.batch.run_many`."""
+    from mmusv.bundled import resolve_spec
+    from mmusv.export.convert import REPORT_NAME, convert
+    from mmusv.generate.runner import generate
+    from mmusv.generate.spec import load_spec
+
+    sp = resolve_spec(Path(spec))
+    loaded = load_spec(sp)
+    out = Path(out_dir)
+    scen_dir, rec_dir, opv2v = out / "scenarios", out / "recordings", out / "opv2v"
+    index_path = out / INDEX_NAME
+    try:
+        old: dict[str, Any] = read_index(index_path) if index_path.is_file() else {}
+    except MmusvError:
+        old = {}
+    spec_section = {"file": Path(sp).name, "name": loaded.name, "hash": _spec_hash(loaded)}
+    generated = not (old.get("spec") == spec_section and (scen_dir / "report.json").is_file())
+    shortfall: list[str] = []
+    quota = sum(c.quota for c in loaded.combinations)
+    if generated:
+
+        def tick(_name: str, accepted: int, _attempts: int) -> None:
+            if progress is not None:
+                progress("generate", accepted, quota)
+
+        report = generate(loaded, scen_dir, force=True, progress=tick)
+        shortfall = [f"{c.name}: {c.accepted} of {c.quota}" for c in report.combos if not c.met]
+    if progress is not None:
+        progress("generate", quota, quota)
+    batch = run_many(
+        scen_dir,
+        out_dir=rec_dir,
+        jobs=jobs,
+        ray=ray,
+        cpus_per_task=cpus_per_task,
+        retries=retries,
+        split_frames=split_frames,
+        checks=checks,
+        index=index_path,
+        index_extra={"spec": spec_section, "opv2v": old.get("opv2v")},
+        progress=None if progress is None else (lambda d, t: progress("record", d, t)),
+    )
+    doc = read_index(index_path)
+    sources = {r["name"]: r["config_hash"] for r in doc["recordings"] if r["status"] == "complete"}
+    section = old.get("opv2v") or {}
+    converted: int | None = None
+    up_to_date = (
+        section.get("sources") == sources and section.get("status") == "complete" and (opv2v / REPORT_NAME).is_file()
+    )
+    if sources and not up_to_date:
+        recs = [out / r["recording"] for r in doc["recordings"] if r["name"] in sources]
+        conv = convert(
+            recs,
+            to="opv2v",
+            out_dir=opv2v,
+            overwrite=True,
+            progress=None if progress is None else (lambda d, t: progress("convert", d, t)),
+        )
+        converted = conv.frames
+        section = {"folder": opv2v.name, "status": "complete", "frames": conv.frames, "sources": sources}
+    elif not sources:
+        section = {"folder": opv2v.name, "status": "nothing to convert", "frames": 0, "sources": {}}
+    from mmusv.batch.index import Entry
+
+    entries = [Entry(**{k: r[k] for k in Entry.__dataclass_fields__}) for r in doc["recordings"]]
+    write_index(index_path, entries, {"spec": spec_section, "opv2v": section})
+    return DatasetReport(
+        out_dir=out, generated=generated, shortfall=shortfall, batch=batch, converted=converted, opv2v=opv2v
+    )

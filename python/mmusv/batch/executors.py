@@ -1,0 +1,161 @@
+"""Where the tasks of a batch run: in the driver itself (one job), a local process pool (``--jobs N``), or Ray
+(:mod:`mmusv.batch.ray_backend`). Every executor has the same three calls: :meth:`~Executor.submit` a task,
+:meth:`~Executor.next_done` (blocks until one attempt ended, returns the task and its
+:class:`~mmusv.batch.task.TaskResult`) and :meth:`~Executor.close`.
+
+The pool spawns its workers (not fork: the driver already runs the core's thread pool, and a forked copy of a
+process with threads can deadlock on a lock another thread held). Each worker sets ``RAYON_NUM_THREADS`` to the
+task's CPU share before the core starts its thread pool, and exits when the driver is gone (a killed driver
+leaves no worker writing on). A worker that dies breaks the pool: every task in flight comes back ``lost``, and
+the pool is started afresh for the next submission.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+from typing import Protocol
+
+from mmusv.batch.plan import Task
+from mmusv.batch.task import TaskResult, execute, lost
+
+__all__ = ["Executor", "PoolExecutor", "SerialExecutor", "available_cpus"]
+
+
+def available_cpus() -> int:
+    """CPUs this process may run on (its affinity where the OS says, else the CPU count)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not Linux
+        return os.cpu_count() or 1
+
+
+class Executor(Protocol):
+    """What the batch runner needs of an executor (see the module docstring)."""
+
+    name: str
+    retries_lost_workers: bool
+    """True when the executor itself re-runs the task of a lost worker (Ray's ``max_retries``)."""
+
+    def submit(self, task: Task) -> None: ...
+
+    def next_done(self) -> tuple[Task, TaskResult]: ...
+
+    def in_flight(self) -> int: ...
+
+    def close(self, *, cancel: bool) -> None: ...
+
+
+class SerialExecutor:
+    """Runs each task in the driver process when :meth:`next_done` asks for it (``--jobs 1``)."""
+
+    name = "serial"
+    retries_lost_workers = False
+
+    def __init__(self, run: Callable[[Task], TaskResult] = execute) -> None:
+        self._queue: list[Task] = []
+        self._run = run
+
+    def submit(self, task: Task) -> None:
+        self._queue.append(task)
+
+    def next_done(self) -> tuple[Task, TaskResult]:
+        task = self._queue.pop(0)
+        return task, self._run(task)
+
+    def in_flight(self) -> int:
+        return len(self._queue)
+
+    def close(self, *, cancel: bool) -> None:
+        self._queue.clear()
+
+
+def _init_worker(threads: int | None, driver_pid: int) -> None:
+    """Pool worker start: the core's thread pool size, and a watchdog that ends the worker when the driver is
+    gone (its parent changes)."""
+    import threading
+    import time
+
+    if threads is not None:
+        os.environ["RAYON_NUM_THREADS"] = str(threads)
+
+    def watch() -> None:
+        while True:
+            time.sleep(0.5)
+            if os.getppid() != driver_pid:
+                os._exit(70)
+
+    threading.Thread(target=watch, name="mmusv-driver-watch", daemon=True).start()
+
+
+class PoolExecutor:
+    """A local pool of ``jobs`` spawned processes, each with ``threads`` core threads (``None``: the core's
+    default, every CPU)."""
+
+    name = "pool"
+    retries_lost_workers = False
+
+    def __init__(self, jobs: int, threads: int | None) -> None:
+        from concurrent.futures import Future, ProcessPoolExecutor
+
+        self.jobs = jobs
+        self.threads = threads
+        self._pool: ProcessPoolExecutor | None = None
+        self._futures: dict[Future[TaskResult], Task] = {}
+
+    def _ensure(self) -> None:
+        import multiprocessing
+        from concurrent.futures import ProcessPoolExecutor
+
+        if self._pool is None:
+            self._pool = ProcessPoolExecutor(
+                max_workers=self.jobs,
+                mp_context=multiprocessing.get_context("spawn"),
+                initializer=_init_worker,
+                initargs=(self.threads, os.getpid()),
+            )
+
+    def submit(self, task: Task) -> None:
+        from concurrent.futures.process import BrokenProcessPool
+
+        self._ensure()
+        assert self._pool is not None
+        try:
+            fut = self._pool.submit(execute, task)
+        except BrokenProcessPool:  # broken since the last answer: start afresh
+            self._pool.shutdown(wait=False, cancel_futures=True)
+            self._pool = None
+            self._ensure()
+            assert self._pool is not None
+            fut = self._pool.submit(execute, task)
+        self._futures[fut] = task
+
+    def next_done(self) -> tuple[Task, TaskResult]:
+        from concurrent.futures import FIRST_COMPLETED, wait
+        from concurrent.futures.process import BrokenProcessPool
+
+        done, _ = wait(list(self._futures), return_when=FIRST_COMPLETED)
+        fut = min(done, key=lambda f: self._futures[f].key)
+        task = self._futures.pop(fut)
+        try:
+            return task, fut.result()
+        except BrokenProcessPool:
+            if self._pool is not None:
+                self._pool.shutdown(wait=False, cancel_futures=True)
+                self._pool = None
+            return task, lost(task, "a process of the local pool died (killed, or out of memory)")
+
+    def in_flight(self) -> int:
+        return len(self._futures)
+
+    def close(self, *, cancel: bool) -> None:
+        if self._pool is not None:
+            if cancel:  # stop now: workers still running are ended, their recordings stay incomplete
+                procs = list(getattr(self._pool, "_processes", {}).values())
+                self._pool.shutdown(wait=False, cancel_futures=True)
+                for p in procs:
+                    p.terminate()
+            else:
+                self._pool.shutdown(wait=True)
+            self._pool = None
+        self._futures.clear()

@@ -1,0 +1,164 @@
+"""``dataset.json``: the index of a folder of recordings written by a batch run (``mmusv run DIR``,
+:func:`mmusv.run_many`, ``mmusv dataset``).
+
+One entry per scenario, sorted by name::
+
+    {"format": "mmusv.dataset", "version": 1,
+     "recordings": [{"name": "a", "scenario_file": "a.yaml", "scenario": "a", "config_hash": SHA256, "seed": 1,
+                     "recording": "a/a.mcap", "status": "complete", "frames": 20, "frames_requested": 20,
+                     "parts": 1, "bytes": 123456, "error": null}, ...],
+     "totals": {"recordings": 3, "complete": 3, "failed": 0, "pending": 0, "frames": 60, "bytes": ...},
+     ...}
+
+``status`` is ``complete``, ``failed`` (``error`` says why) or ``pending`` (not run yet, or interrupted);
+``recording`` (relative to the index's folder) is an ``.mcap`` or a parts manifest (:mod:`mmusv.recording.parts`);
+``bytes`` is the size of every file of the recording's folder. The file holds no times or absolute paths, so a
+finished dataset's index is the same bytes however many runs it took. ``mmusv dataset`` adds ``spec`` and
+``opv2v`` sections. Conversion (:func:`mmusv.export.convert`) and the studies take a folder holding a
+``dataset.json`` and read its complete recordings (:func:`dataset_recordings`).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from mmusv.errors import IoError
+
+__all__ = [
+    "INDEX_FORMAT",
+    "INDEX_NAME",
+    "STATUSES",
+    "Entry",
+    "dataset_recordings",
+    "find_index",
+    "read_index",
+    "write_index",
+]
+
+INDEX_NAME = "dataset.json"
+INDEX_FORMAT = "mmusv.dataset"
+STATUSES = ("complete", "failed", "pending")
+_VERSION = 1
+
+
+@dataclass(frozen=True)
+class Entry:
+    """One scenario of the index (see the module docstring); ``recording`` relative to the index's folder
+    (POSIX), ``None`` when the scenario could not even be loaded."""
+
+    name: str
+    scenario_file: str
+    scenario: str | None
+    config_hash: str | None
+    seed: int | None
+    recording: str | None
+    status: str
+    frames: int
+    frames_requested: int
+    parts: int
+    bytes: int
+    error: str | None = None
+
+    def as_dict(self) -> dict[str, Any]:
+        """The entry's JSON object."""
+        return {
+            "name": self.name,
+            "scenario_file": self.scenario_file,
+            "scenario": self.scenario,
+            "config_hash": self.config_hash,
+            "seed": self.seed,
+            "recording": self.recording,
+            "status": self.status,
+            "frames": self.frames,
+            "frames_requested": self.frames_requested,
+            "parts": self.parts,
+            "bytes": self.bytes,
+            "error": self.error,
+        }
+
+
+def folder_bytes(folder: Path) -> int:
+    """Bytes of every file below ``folder`` (0 when it does not exist)."""
+    total = 0
+    for root, _dirs, files in os.walk(folder):
+        for f in files:
+            try:
+                total += (Path(root) / f).stat().st_size
+            except OSError:
+                continue
+    return total
+
+
+def write_index(path: str | os.PathLike[str], entries: Iterable[Entry], extra: Mapping[str, Any] | None = None) -> Path:
+    """Writes the index (entries sorted by name, totals, then the ``extra`` sections) atomically to ``path``."""
+    from mmusv.jsonio import write_json
+
+    rows = sorted(entries, key=lambda e: e.name)
+    bad = [e.name for e in rows if e.status not in STATUSES]
+    if bad:
+        raise IoError(f"{path}: entries {bad} have a status outside {STATUSES}")
+    doc: dict[str, Any] = {
+        "format": INDEX_FORMAT,
+        "version": _VERSION,
+        "recordings": [e.as_dict() for e in rows],
+        "totals": {
+            "recordings": len(rows),
+            **{s: sum(1 for e in rows if e.status == s) for s in STATUSES},
+            "frames": sum(e.frames for e in rows),
+            "bytes": sum(e.bytes for e in rows),
+        },
+    }
+    for key, value in (extra or {}).items():
+        if key in doc:
+            raise IoError(f"{path}: section {key!r} is the index's own")
+        doc[key] = value
+    return write_json(path, doc)
+
+
+def find_index(folder: str | os.PathLike[str]) -> Path | None:
+    """``folder/dataset.json`` when it exists."""
+    p = Path(folder) / INDEX_NAME
+    return p if p.is_file() else None
+
+
+def read_index(path: str | os.PathLike[str]) -> dict[str, Any]:
+    """The index at ``path`` (a ``dataset.json`` or a folder holding one); :class:`~mmusv.errors.IoError` naming the
+    file when it is not one."""
+    from mmusv.jsonio import read_json
+
+    p = Path(path)
+    if p.is_dir():
+        p = p / INDEX_NAME
+    doc = read_json(p)
+    if doc.get("format") != INDEX_FORMAT or doc.get("version") != _VERSION:
+        raise IoError(
+            f"{p}: not an mmusv dataset index (format = {doc.get('format')!r}, version = {doc.get('version')!r}; "
+            f"expected {INDEX_FORMAT!r}, {_VERSION})"
+        )
+    recs = doc.get("recordings")
+    if not isinstance(recs, list) or not all(isinstance(r, dict) and "name" in r and "status" in r for r in recs):
+        raise IoError(f"{p}: field 'recordings' must be a list of entries with a name and a status")
+    return doc
+
+
+def dataset_recordings(path: str | os.PathLike[str], *, statuses: Iterable[str] = ("complete",)) -> list[Path]:
+    """The recordings (``.mcap`` or parts manifests) of the index at ``path`` whose status is in ``statuses``,
+    in the index's order, as paths below the index's folder. Raises :class:`~mmusv.errors.IoError` when a listed
+    recording is missing."""
+    p = Path(path)
+    doc = read_index(p)
+    root = p if p.is_dir() else p.parent
+    want = set(statuses)
+    out: list[Path] = []
+    for i, r in enumerate(doc["recordings"]):
+        if r["status"] not in want or not r.get("recording"):
+            continue
+        rec = root / str(r["recording"])
+        if not rec.is_file():
+            raise IoError(f"{root / INDEX_NAME}: recordings[{i}] ({r['name']}) lists {rec}, which does not exist")
+        out.append(rec)
+    return out

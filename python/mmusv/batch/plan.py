@@ -1,0 +1,333 @@
+"""Planning a batch run: the scenario files, the tasks of each (a whole recording, or frame-range parts), and
+which of them are already complete.
+
+Layout of the output folder ``OUT``: one folder per scenario file, ``OUT/<file stem>/``, holding what
+:func:`mmusv.acquire.run` writes (``<name>.mcap``, ``tables/``, ``scenario.yaml``, ``manifest.json``) or, for a
+recording split into frame ranges, ``<name>.parts.json`` (:mod:`mmusv.recording.parts`) and one such folder per
+part, ``parts/<first>-<last>/``; ``OUT/dataset.json`` (:mod:`mmusv.batch.index`); ``OUT/.mmusv/`` (one small lock
+and attempt file per task, :mod:`mmusv.batch.task`).
+
+A task is complete when its folder's ``manifest.json`` (written last by :func:`mmusv.acquire.run`, and removed
+before a task starts) says ``status: complete`` with the scenario's config hash
+(:func:`mmusv.config.scenario_hash`) and the frames asked for. A re-run skips a scenario whose recording is
+complete in either layout; other tasks run again from scratch. A complete recording of another configuration
+is replaced only with ``overwrite``.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from mmusv.errors import ConfigError, MmusvError
+from mmusv.recording.parts import (
+    PARTS_SUFFIX,
+    Part,
+    PartsManifest,
+    part_folder,
+    read_parts_manifest,
+    split_ranges,
+    write_parts_manifest,
+)
+
+__all__ = ["STATE_DIR", "ScenarioPlan", "Task", "plan_scenarios", "prepare", "scenario_files", "task_complete"]
+
+STATE_DIR = ".mmusv"
+"""Hidden folder of ``OUT`` with one lock and attempt file per task."""
+
+_PART_DIR = re.compile(r"^\d{6}-\d{6}$")
+
+
+@dataclass(frozen=True)
+class Task:
+    """One unit of work for a worker: :func:`mmusv.acquire.run` of ``scenario_file`` into ``out_dir`` (absolute
+    paths), all frames, the first ``frames`` or the ``frame_range`` ``(first, stop)``. Picklable."""
+
+    key: str
+    name: str
+    scenario_file: str
+    out_dir: str
+    frames: int | None
+    frame_range: tuple[int, int] | None
+    expected_frames: int
+    config_hash: str
+    checks: bool
+    state_file: str
+    run_id: str
+
+    @property
+    def first_frame(self) -> int:
+        """The first acquisition index this task records."""
+        return 0 if self.frame_range is None else self.frame_range[0]
+
+
+@dataclass
+class ScenarioPlan:
+    """One scenario file of the batch: what it is, where it goes, its tasks and which of them must run.
+    ``error``: it cannot run (invalid file, a conflicting recording); ``parts``: the split layout to write."""
+
+    name: str
+    file: Path
+    folder: Path
+    scenario: str | None = None
+    config_hash: str | None = None
+    seed: int | None = None
+    frames: int = 0
+    recording: Path | None = None
+    tasks: list[Task] = field(default_factory=list)
+    to_run: list[Task] = field(default_factory=list)
+    error: str | None = None
+    parts: PartsManifest | None = None
+
+    @property
+    def split(self) -> bool:
+        """Whether the recording is (planned as) parts."""
+        return self.recording is not None and self.recording.name.endswith(PARTS_SUFFIX)
+
+
+def scenario_files(source: str | os.PathLike[str] | Sequence[str | os.PathLike[str]]) -> list[Path]:
+    """The scenario files of ``source``: a folder's ``*.yaml`` (not ``report.yaml``), sorted, or the files given.
+    Raises :class:`~mmusv.errors.ConfigError` for an empty folder or two files with the same stem (their output
+    folders would clash)."""
+    if isinstance(source, (str, os.PathLike)):
+        src = Path(source)
+        if src.is_dir():
+            files = sorted(p for p in src.glob("*.yaml") if p.name != "report.yaml")
+            if not files:
+                raise ConfigError(f"{src} holds no *.yaml scenarios")
+            return [f.resolve() for f in files]
+        files = [src]
+    else:
+        files = [Path(s) for s in source]
+        if not files:
+            raise ConfigError("no scenario files given")
+    for f in files:
+        if not f.is_file():
+            raise ConfigError(f"{f}: no such scenario file")
+    stems = [f.stem for f in files]
+    dup = sorted({s for s in stems if stems.count(s) > 1})
+    if dup:
+        raise ConfigError(
+            f"scenario files {dup} share a file stem; each gets the output folder OUT/<stem>, rename them"
+        )
+    return sorted((f.resolve() for f in files), key=lambda f: f.stem)
+
+
+def _manifest(folder: Path) -> dict[str, Any] | None:
+    from mmusv.jsonio import read_json
+
+    try:
+        return read_json(folder / "manifest.json")
+    except MmusvError:
+        return None
+
+
+def task_complete(out_dir: Path, *, scenario: str, config_hash: str, frames: int, first_frame: int = 0) -> bool:
+    """Whether ``out_dir`` holds a complete recording of ``scenario`` with ``config_hash``, frames
+    ``first_frame .. first_frame + frames - 1``."""
+    m = _manifest(out_dir)
+    return (
+        m is not None
+        and m.get("status") == "complete"
+        and m.get("config_hash") == config_hash
+        and m.get("frames_written") == frames
+        and m.get("frames_requested") == frames
+        and m.get("first_frame", 0) == first_frame
+        and m.get("recording") == f"{scenario}.mcap"
+        and (out_dir / f"{scenario}.mcap").is_file()
+    )
+
+
+def _complete_parts(path: Path, *, config_hash: str, frames: int) -> bool:
+    try:
+        pm = read_parts_manifest(path)
+    except MmusvError:
+        return False
+    return (
+        pm.config_hash == config_hash
+        and pm.frames == frames
+        and all(
+            task_complete(
+                (path.parent / p.recording).parent,
+                scenario=pm.scenario,
+                config_hash=config_hash,
+                frames=p.frames,
+                first_frame=p.first_frame,
+            )
+            for p in pm.parts
+        )
+    )
+
+
+def _conflict(folder: Path, scenario: str, config_hash: str) -> str | None:
+    """A message when ``folder`` holds a recording of ``scenario`` made from another configuration."""
+    m = _manifest(folder)
+    if m is not None and m.get("status") == "complete" and m.get("config_hash") != config_hash:
+        return f"{folder / str(m.get('recording'))} is a complete recording of another configuration"
+    pm_path = folder / f"{scenario}{PARTS_SUFFIX}"
+    if pm_path.is_file():
+        try:
+            other = read_parts_manifest(pm_path).config_hash != config_hash
+        except MmusvError:
+            other = False
+        if other:
+            return f"{pm_path} lists the parts of a recording of another configuration"
+    return None
+
+
+def plan_scenarios(
+    files: Sequence[Path],
+    out: Path,
+    *,
+    frames: int | None,
+    split_frames: int | None,
+    overwrite: bool,
+    checks: bool,
+    run_id: str,
+) -> list[ScenarioPlan]:
+    """The plan of every file (see the module docstring); loading a file validates it (a failure becomes the
+    plan's ``error``, never an exception)."""
+    from mmusv.config import load_scenario, scenario_hash
+
+    if split_frames is not None and split_frames < 1:
+        raise ConfigError(f"split_frames = {split_frames}: must be at least 1 frame per part")
+    plans: list[ScenarioPlan] = []
+    for f in files:
+        plan = ScenarioPlan(name=f.stem, file=f, folder=out / f.stem)
+        plans.append(plan)
+        try:
+            sc = load_scenario(f)
+        except MmusvError as exc:
+            msg = str(exc)
+            plan.error = msg if str(f) in msg or f.name in msg else f"{f}: {msg}"
+            continue
+        plan.scenario, plan.config_hash, plan.seed = sc.name, scenario_hash(sc), sc.seed
+        acq = sc.acquisition.frames
+        total = acq if frames is None else int(frames)
+        if not 1 <= total <= acq:
+            plan.error = f"{f}: frames = {frames}: must be in 1..{acq} (acquisition.frames)"
+            continue
+        plan.frames = total
+        h, name, folder = plan.config_hash, sc.name, plan.folder
+        pm_path = folder / f"{name}{PARTS_SUFFIX}"
+        if not overwrite:
+            if task_complete(folder, scenario=name, config_hash=h, frames=total):
+                plan.recording = folder / f"{name}.mcap"
+                plan.tasks = [_task(plan, f, folder, frames, None, total, checks, out, run_id)]
+                continue
+            if pm_path.is_file() and _complete_parts(pm_path, config_hash=h, frames=total):
+                pm = read_parts_manifest(pm_path)
+                plan.recording = pm_path
+                plan.tasks = [
+                    _task(
+                        plan,
+                        f,
+                        (pm_path.parent / p.recording).parent,
+                        None,
+                        (p.first_frame, p.stop),
+                        p.frames,
+                        checks,
+                        out,
+                        run_id,
+                    )
+                    for p in pm.parts
+                ]
+                continue
+            conflict = _conflict(folder, name, h)
+            if conflict is not None:
+                plan.error = (
+                    f"{conflict} (config hash differs from {f.name}'s); pass --overwrite (overwrite=True) to replace it"
+                )
+                continue
+        if split_frames is not None and total > split_frames:
+            ranges = split_ranges(total, split_frames)
+            plan.recording = pm_path
+            plan.parts = PartsManifest(
+                scenario=name,
+                config_hash=h,
+                frames=total,
+                parts=tuple(Part(a, b - a, f"parts/{part_folder(a, b)}/{name}.mcap") for a, b in ranges),
+            )
+            plan.tasks = [
+                _task(plan, f, folder / "parts" / part_folder(a, b), None, (a, b), b - a, checks, out, run_id)
+                for a, b in ranges
+            ]
+        else:
+            plan.recording = folder / f"{name}.mcap"
+            plan.tasks = [_task(plan, f, folder, frames, None, total, checks, out, run_id)]
+        plan.to_run = [
+            t
+            for t in plan.tasks
+            if overwrite
+            or not task_complete(
+                Path(t.out_dir), scenario=name, config_hash=h, frames=t.expected_frames, first_frame=t.first_frame
+            )
+        ]
+    return plans
+
+
+def _task(
+    plan: ScenarioPlan,
+    file: Path,
+    out_dir: Path,
+    frames: int | None,
+    frame_range: tuple[int, int] | None,
+    expected: int,
+    checks: bool,
+    out: Path,
+    run_id: str,
+) -> Task:
+    key = plan.name if frame_range is None else f"{plan.name}@{part_folder(*frame_range)}"
+    assert plan.config_hash is not None
+    return Task(
+        key=key,
+        name=plan.name,
+        scenario_file=str(file),
+        out_dir=str(out_dir),
+        frames=frames,
+        frame_range=frame_range,
+        expected_frames=expected,
+        config_hash=plan.config_hash,
+        checks=checks,
+        state_file=str(out / STATE_DIR / f"{key}.task"),
+        run_id=run_id,
+    )
+
+
+def prepare(plan: ScenarioPlan) -> None:
+    """Before the tasks of ``plan`` run: removes what the other layout left in its folder (a whole recording
+    when it is now split, or parts when it is now whole), part folders of another split, and writes the parts
+    manifest."""
+    if not plan.to_run or plan.scenario is None:
+        return
+    folder, name = plan.folder, plan.scenario
+    if plan.parts is None:
+        (folder / f"{name}{PARTS_SUFFIX}").unlink(missing_ok=True)
+        _remove_parts(folder, keep=set())
+        return
+    for leftover in (f"{name}.mcap", f"{name}.mcap.partial", "manifest.json", "scenario.yaml"):
+        (folder / leftover).unlink(missing_ok=True)
+    for old in sorted(folder.glob("tables/*/part-*.parquet")):
+        old.unlink()
+    _remove_parts(folder, keep={Path(t.out_dir).name for t in plan.tasks})
+    assert plan.recording is not None
+    from mmusv.jsonio import dump_json
+
+    if not (plan.recording.is_file() and plan.recording.read_bytes() == dump_json(plan.parts.as_dict())):
+        write_parts_manifest(plan.recording, plan.parts)  # (an unchanged manifest is left as it is)
+
+
+def _remove_parts(folder: Path, keep: set[str]) -> None:
+    parts = folder / "parts"
+    if not parts.is_dir():
+        return
+    for d in sorted(parts.iterdir()):
+        if d.is_dir() and _PART_DIR.match(d.name) and d.name not in keep:
+            shutil.rmtree(d)
+    if not any(parts.iterdir()):
+        parts.rmdir()

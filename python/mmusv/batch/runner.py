@@ -1,0 +1,294 @@
+"""The batch runner: every scenario of a folder (or a list of files) through :func:`mmusv.acquire.run`, on the
+local pool or Ray, restartable and fault-tolerant. ``mmusv run DIR`` and :func:`mmusv.run_many` both end here.
+
+1. Plan (:mod:`mmusv.batch.plan`): load every file (an invalid one fails alone), hash it, skip the recordings
+   that are complete with the same config hash, split long ones into frame ranges when asked.
+2. Run the remaining tasks on the executor (:mod:`mmusv.batch.executors`, :mod:`mmusv.batch.ray_backend`). A
+   failed task is run again up to ``retries`` times unless its input is bad (it would fail the same way); a
+   task whose worker died is run again up to ``lost_worker_retries`` times (by Ray itself on Ray).
+3. Keep ``dataset.json`` (:mod:`mmusv.batch.index`) up to date after every task, so a killed driver leaves an
+   index of what is done; the finished index holds no times, so it is the same bytes however many runs it took.
+
+Determinism: a task's bytes depend only on its scenario and frames, never on the executor, the worker or the
+order of completion.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+import uuid
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from mmusv.batch.executors import Executor, PoolExecutor, SerialExecutor, available_cpus
+from mmusv.batch.index import INDEX_NAME, Entry, folder_bytes, write_index
+from mmusv.batch.plan import ScenarioPlan, plan_scenarios, prepare, scenario_files
+from mmusv.batch.task import TaskResult
+from mmusv.errors import ConfigError, MmusvError
+
+__all__ = ["BatchReport", "ScenarioOutcome", "run_many"]
+
+
+@dataclass
+class ScenarioOutcome:
+    """How one scenario of a batch ended: ``status`` ``done`` (recorded now), ``skipped`` (already complete) or
+    ``failed`` (``error``); frames recorded (all of them, old parts included), ``retried`` attempts of this run,
+    ``seconds`` of work summed over its tasks, warnings raised while it ran, ``threads`` (the core threads its
+    workers used, ``RAYON_NUM_THREADS``; ``None`` when not set)."""
+
+    name: str
+    file: Path
+    status: str
+    scenario: str | None
+    config_hash: str | None
+    frames: int
+    frames_requested: int
+    parts: int
+    recording: Path | None
+    retried: int = 0
+    error: str | None = None
+    seconds: float = 0.0
+    warnings: list[str] = field(default_factory=list)
+    threads: list[str | None] = field(default_factory=list)
+
+
+@dataclass
+class BatchReport:
+    """What a batch run did: one :class:`ScenarioOutcome` per file (sorted by name), the executor (``serial``,
+    ``pool`` or ``ray``), the index written and the wall time."""
+
+    out_dir: Path
+    backend: str
+    outcomes: list[ScenarioOutcome]
+    index: Path
+    seconds: float = 0.0
+
+    def count(self, status: str) -> int:
+        """How many scenarios ended with ``status``."""
+        return sum(1 for o in self.outcomes if o.status == status)
+
+    @property
+    def retried(self) -> int:
+        """Attempts made again in this run, over all scenarios."""
+        return sum(o.retried for o in self.outcomes)
+
+    @property
+    def ok(self) -> bool:
+        """True when no scenario failed."""
+        return self.count("failed") == 0
+
+    def summary(self) -> str:
+        """``"3 done, 1 failed, 2 skipped, 1 retried"``."""
+        return (
+            f"{self.count('done')} done, {self.count('failed')} failed, {self.count('skipped')} skipped, "
+            f"{self.retried} retried"
+        )
+
+
+def _executor(jobs: int, ray: bool | str, cpus_per_task: int | None, lost_worker_retries: int) -> Executor:
+    if ray is not False and ray is not None:
+        from mmusv.batch.ray_backend import RayExecutor
+
+        return RayExecutor(ray, num_cpus=cpus_per_task or 1, max_retries=lost_worker_retries)
+    if jobs == 1 and cpus_per_task is None:
+        return SerialExecutor()
+    threads = cpus_per_task if cpus_per_task is not None else max(1, available_cpus() // jobs)
+    return PoolExecutor(jobs, threads)
+
+
+def _entry(plan: ScenarioPlan, status: str, error: str | None, root: Path) -> Entry:
+    from mmusv.jsonio import read_json
+
+    frames = 0
+    for t in plan.tasks:
+        try:
+            m = read_json(Path(t.out_dir) / "manifest.json")
+        except MmusvError:  # no (readable) manifest: nothing of this task recorded
+            continue
+        if m.get("config_hash") == plan.config_hash:
+            frames += int(m.get("frames_written", 0) or 0)
+    rec = None if plan.recording is None else plan.recording.relative_to(root).as_posix()
+    return Entry(
+        name=plan.name,
+        scenario_file=plan.file.name,
+        scenario=plan.scenario,
+        config_hash=plan.config_hash,
+        seed=plan.seed,
+        recording=rec,
+        status=status,
+        frames=frames,
+        frames_requested=plan.frames,
+        parts=len(plan.tasks) if plan.split else (1 if plan.tasks else 0),
+        bytes=folder_bytes(plan.folder) if plan.folder.is_dir() else 0,
+        error=error,
+    )
+
+
+def run_many(
+    source: str | os.PathLike[str] | Sequence[str | os.PathLike[str]],
+    *,
+    out_dir: str | os.PathLike[str],
+    jobs: int = 1,
+    ray: bool | str = False,
+    cpus_per_task: int | None = None,
+    retries: int = 0,
+    lost_worker_retries: int = 3,
+    split_frames: int | None = None,
+    frames: int | None = None,
+    overwrite: bool = False,
+    checks: bool = True,
+    index: str | os.PathLike[str] | None = None,
+    index_extra: Mapping[str, Any] | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> BatchReport:
+    """Runs every scenario of ``source`` (a folder of ``*.yaml``, or a list of files) into ``out_dir/<stem>/``.
+
+    Args:
+        jobs: processes of the local pool (1: in this process); ignored with ``ray``.
+        ray: ``False`` (the local pool), ``True`` / ``"local"`` (a local Ray instance), ``"auto"`` or an address
+            (join a cluster); see :mod:`mmusv.batch.ray_backend`.
+        cpus_per_task: CPUs of one task = its core threads (``RAYON_NUM_THREADS``). Default: 1 on Ray, the CPUs
+            shared out between ``jobs`` on the pool, the core's default in this process.
+        retries: runs of a failed task after the first (not for bad input, which fails the same way again).
+        lost_worker_retries: runs of a task whose worker died (Ray's ``max_retries`` on Ray).
+        split_frames: record scenarios longer than this as parts of this many frames, one task each.
+        frames: record only the first ``frames`` of every scenario.
+        overwrite: run every scenario again, and replace complete recordings of another configuration (without
+            it those fail).
+        checks: the route checks of :func:`mmusv.acquire.run`.
+        index: where ``dataset.json`` goes (default ``out_dir/dataset.json``); ``index_extra``: extra sections.
+        progress: called with (frames done, frames in all) after each task (skipped frames count as done).
+
+    Returns:
+        the :class:`BatchReport`; ``report.ok`` is False when a scenario failed.
+
+    Raises:
+        ConfigError: bad options, an empty folder, Ray asked for but missing. A bad scenario is not raised: it is
+        reported as failed while the others run.
+        KeyboardInterrupt: after the executor stopped and the index says what is done.
+    """
+    t0 = time.perf_counter()
+    if int(jobs) < 1:
+        raise ConfigError(f"jobs = {jobs}: must be at least 1")
+    if int(retries) < 0 or int(lost_worker_retries) < 0:
+        raise ConfigError("retries and lost_worker_retries must be 0 or more")
+    if cpus_per_task is not None and int(cpus_per_task) < 1:
+        raise ConfigError(f"cpus_per_task = {cpus_per_task}: must be at least 1")
+    files = scenario_files(source)
+    out = Path(out_dir).resolve()
+    index_path = Path(index).resolve() if index is not None else out / INDEX_NAME
+    root = index_path.parent
+    plans = plan_scenarios(
+        files,
+        out,
+        frames=frames,
+        split_frames=split_frames,
+        overwrite=overwrite,
+        checks=checks,
+        run_id=uuid.uuid4().hex,
+    )
+    for p in plans:
+        if p.recording is not None and not p.recording.is_relative_to(root):
+            raise ConfigError(f"index {index_path} must be in a folder above the output {out}")
+    status: dict[str, str] = {}
+    errors: dict[str, str | None] = {}
+    retried: dict[str, int] = {}
+    results: dict[str, TaskResult] = {}
+    for p in plans:
+        status[p.name] = "failed" if p.error else "pending" if p.to_run else "complete"
+        errors[p.name] = p.error
+    entries = {p.name: _entry(p, status[p.name], errors[p.name], root) for p in plans}
+
+    def write() -> None:
+        write_index(index_path, entries.values(), index_extra)
+
+    out.mkdir(parents=True, exist_ok=True)
+    todo = [t for p in plans for t in p.to_run]
+    total_frames = sum(p.frames for p in plans if not p.error)
+    done_frames = total_frames - sum(t.expected_frames for t in todo)
+    write()
+    if progress is not None:
+        progress(done_frames, total_frames)
+    by_key = {t.key: t for t in todo}
+    plan_of = {t.key: p for p in plans for t in p.to_run}
+    left = {p.name: len(p.to_run) for p in plans}
+    executor = _executor(int(jobs), ray, cpus_per_task, int(lost_worker_retries)) if todo else SerialExecutor()
+    interrupted = False
+    try:
+        for p in plans:
+            prepare(p)
+        for t in todo:
+            executor.submit(t)
+        tries = dict.fromkeys(by_key, 1)
+        lost_tries = dict.fromkeys(by_key, 0)
+        while executor.in_flight():
+            task, res = executor.next_done()
+            plan = plan_of[task.key]
+            if res.status != "done":
+                again = False
+                if res.lost and not executor.retries_lost_workers and lost_tries[task.key] < lost_worker_retries:
+                    lost_tries[task.key] += 1
+                    again = True
+                elif res.retryable and tries[task.key] <= retries:
+                    tries[task.key] += 1
+                    again = True
+                if again:
+                    retried[task.key] = retried.get(task.key, 0) + 1
+                    executor.submit(task)
+                    continue
+            results[task.key] = res
+            left[plan.name] -= 1
+            done_frames += task.expected_frames
+            if res.status != "done" and errors[plan.name] is None:
+                errors[plan.name] = res.error
+            if left[plan.name] == 0:
+                status[plan.name] = "failed" if errors[plan.name] else "complete"
+                entries[plan.name] = _entry(plan, status[plan.name], errors[plan.name], root)
+                write()
+            if progress is not None:
+                progress(done_frames, total_frames)
+    except KeyboardInterrupt:
+        interrupted = True
+        raise
+    finally:
+        executor.close(cancel=interrupted)
+        if interrupted:
+            write()
+    outcomes = [_outcome(p, status[p.name], errors[p.name], retried, results) for p in plans]
+    return BatchReport(
+        out_dir=out, backend=executor.name, outcomes=outcomes, index=index_path, seconds=time.perf_counter() - t0
+    )
+
+
+def _outcome(
+    plan: ScenarioPlan, status: str, error: str | None, retried: dict[str, int], results: dict[str, TaskResult]
+) -> ScenarioOutcome:
+    ran = [results[t.key] for t in plan.to_run if t.key in results]
+    # a task's attempts beyond the first: resubmitted by the runner, or re-run by Ray after a lost worker (seen
+    # only in the attempt lines of the task file, which count every attempt that got as far as its lock)
+    again = sum(max(retried.get(t.key, 0), results[t.key].attempts - 1 if t.key in results else 0) for t in plan.to_run)
+    shown = "failed" if status == "failed" else "done" if plan.to_run else "skipped"
+    frames = 0 if plan.error else plan.frames
+    if status == "failed":
+        frames = sum(r.frames for r in ran if r.status == "done") + sum(
+            t.expected_frames for t in plan.tasks if t not in plan.to_run
+        )
+    return ScenarioOutcome(
+        name=plan.name,
+        file=plan.file,
+        status=shown,
+        scenario=plan.scenario,
+        config_hash=plan.config_hash,
+        frames=frames,
+        frames_requested=plan.frames,
+        parts=len(plan.tasks) if plan.split else (1 if plan.tasks else 0),
+        recording=plan.recording,
+        retried=again,
+        error=error,
+        seconds=sum(r.seconds for r in ran),
+        warnings=sorted({w for r in ran for w in r.warnings}),
+        threads=[r.threads for r in ran],
+    )

@@ -1,0 +1,54 @@
+"""JSON files the project writes for itself (``dataset.json``, parts manifests): one layout and atomic writes.
+
+:func:`dump_json` gives the bytes (2-space indent, keys in the order given, a final newline, no NaN), so two
+writes of the same document are byte-identical; :func:`write_json` replaces a file atomically (a reader or a
+killed writer never leaves half a file behind); :func:`read_json` reads one object and names the file in every
+error (:class:`~mmusv.errors.IoError`).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+from mmusv.errors import IoError
+
+__all__ = ["dump_json", "read_json", "write_json"]
+
+
+def dump_json(doc: Any) -> bytes:
+    """The UTF-8 bytes of ``doc``: indented, insertion order kept, ending in a newline; NaN/inf are refused."""
+    return (json.dumps(doc, indent=2, ensure_ascii=False, allow_nan=False) + "\n").encode("utf-8")
+
+
+def write_json(path: str | os.PathLike[str], doc: Any) -> Path:
+    """Writes ``doc`` to ``path`` through a temporary file in the same folder and an atomic rename."""
+    p = Path(path)
+    tmp = p.with_name(f".{p.name}.{os.getpid()}.tmp")
+    try:
+        p.parent.mkdir(parents=True, exist_ok=True)
+        tmp.write_bytes(dump_json(doc))
+        os.replace(tmp, p)
+    except OSError as exc:
+        tmp.unlink(missing_ok=True)
+        raise IoError(f"cannot write {p}: {exc.strerror or exc}") from None
+    return p
+
+
+def read_json(path: str | os.PathLike[str]) -> dict[str, Any]:
+    """The JSON object in ``path``; :class:`~mmusv.errors.IoError` naming the file when it is missing, not
+    UTF-8 JSON, or not an object."""
+    p = Path(path)
+    try:
+        doc = json.loads(p.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise IoError(f"{p} does not exist") from None
+    except OSError as exc:
+        raise IoError(f"cannot read {p}: {exc.strerror or exc}") from None
+    except (UnicodeDecodeError, ValueError) as exc:
+        raise IoError(f"{p} is not a JSON file: {exc}") from None
+    if not isinstance(doc, dict):
+        raise IoError(f"{p}: expected a JSON object at the top, got {type(doc).__name__}")
+    return doc
