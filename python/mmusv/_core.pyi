@@ -88,6 +88,17 @@ class Scene:
         """Places mesh ``mesh_id`` at ``pose`` ((4, 4) float64 rigid body → world); ``class_override`` uint16 or None;
         returns the instance id."""
 
+    def set_sea(self, surface: int, moving: npt.NDArray[np.uint32]) -> None:
+        """Declares instance ``surface`` the sea surface (a horizontal plane) and ``moving`` (K,) uint32 the
+        instances that will move: enables the exact sea and sky shortcuts."""
+
+    def clear_sea(self) -> None:
+        """Forgets the sea surface: every ray is traced fully again."""
+
+    @property
+    def sea_instance(self) -> int | None:
+        """The sea surface instance id, or None."""
+
     def set_poses(self, ids: npt.NDArray[np.uint32], poses: npt.NDArray[np.float64]) -> None:
         """Moves instances ``ids`` (K,) uint32 to ``poses`` (K, 4, 4) float64 rigid body → world; rebuilds only the
         top-level BVH."""

@@ -200,6 +200,30 @@ class Scene:
             raise InputError(f"poses must have shape (K, 4, 4) (or (4, 4) for one id), got {np.shape(poses)}")
         self._native.set_poses(np.ascontiguousarray(ids, dtype=np.uint32), np.ascontiguousarray(p))
 
+    def set_sea(self, surface: int, *, moving: npt.ArrayLike = ()) -> None:
+        """Declares instance ``surface`` the sea surface, a horizontal plane (else :class:`InputError`), and
+        ``moving`` the instances that will move (vessels).
+
+        Rays that can then only meet the surface or the sky are answered from a height map of everything else
+        instead of a full trace: exactly the same hits (the surface hit is still computed by its mesh), fewer
+        node visits. Moving another instance later is allowed (it is treated as moving from then on); moving
+        the surface itself switches the shortcuts off.
+        """
+        ids = np.atleast_1d(np.asarray(moving, dtype=np.int64))
+        if ids.size and (ids.min() < 0 or ids.max() >= 2**32):
+            raise NotFoundError(f"unknown instance id in moving: {ids.tolist()}")
+        self._native.set_sea(_id(surface, name="surface", kind="instance"), np.ascontiguousarray(ids, np.uint32))
+
+    def clear_sea(self) -> None:
+        """Forgets the sea surface: every ray is traced fully again (results are the same either way)."""
+        self._native.clear_sea()
+
+    @property
+    def sea_instance(self) -> int | None:
+        """The sea surface instance id (see :meth:`set_sea`), or ``None``."""
+        sea: int | None = self._native.sea_instance
+        return sea
+
     def cast_rays(
         self, origins: npt.ArrayLike, directions: npt.ArrayLike, *, max_range: float = float("inf")
     ) -> RayHits:

@@ -10,6 +10,7 @@
 //! - [`ray`]: a ray prepared once for its box and triangle tests.
 //! - [`bvh`]: binned-SAH BVHs collapsed to 8-wide nodes, traversed nearest child first.
 //! - [`simd`]: run-time CPU feature dispatch (AVX2 where available, portable otherwise).
+//! - [`sea`]: exact shortcuts for rays that can only meet the sea surface or the sky (a height bound map).
 //! - [`mesh`]: triangle meshes with per-face semantic classes and a bottom-level BVH built once.
 //! - [`scene`]: meshes placed as instances, a top-level BVH over them, and batch ray casting over rayon.
 //! - [`export`]: the world triangles at the current poses as PLY or OBJ.
@@ -34,6 +35,7 @@ pub mod mesh;
 pub mod ray;
 pub mod record;
 pub mod scene;
+pub mod sea;
 pub mod sensors;
 pub mod simd;
 

@@ -15,6 +15,7 @@ use crate::error::{MmusvError, Result};
 use crate::geometry::RigidPose;
 use crate::mesh::Mesh;
 use crate::ray::RayPrep;
+use crate::sea::Sea;
 use parry3d::bounding_volume::Aabb;
 use parry3d::math::Vec3;
 use rayon::prelude::*;
@@ -28,6 +29,11 @@ pub const CLASS_NONE: u16 = 0;
 const CHUNK: usize = 512;
 /// Instances per top-level leaf.
 const TLAS_LEAF: usize = 4;
+/// Longest height-map walks (cells) worth trying before a full trace: down to the sea, up into the sky (camera
+/// rays), up towards the sun (shadow rays).
+const SEA_WALK_DOWN: usize = 12;
+const SEA_WALK_SKY: usize = 2;
+const SEA_WALK_SHADOW: usize = 2;
 
 /// One placed copy of a mesh.
 #[derive(Debug, Clone)]
@@ -130,6 +136,8 @@ pub struct Scene {
     tlas_order: Vec<u32>,
     /// World box of the instance at each position of `tlas_order` (tested before a ray enters its mesh).
     tlas_boxes: Vec<Box3>,
+    /// The sea surface and the height bound of everything else, once declared ([`Scene::set_sea`]).
+    sea: Option<Sea>,
 }
 
 impl Scene {
@@ -198,6 +206,119 @@ impl Scene {
         }
         self.tlas_boxes = order.iter().map(|&i| boxes[i as usize]).collect();
         self.tlas_order = order;
+        if let Some(sea) = &mut self.sea {
+            if changed.contains(&sea.instance) {
+                self.sea = None; // the surface itself moved: no longer a known plane
+            } else {
+                for &id in changed {
+                    sea.add_moving(id);
+                }
+                sea.update(sea.moving().to_vec().into_iter().map(|i| boxes[i as usize]));
+            }
+        }
+    }
+
+    /// Declares instance `surface` the sea surface, so rays that can only meet it or the sky are answered
+    /// without a full trace (see [`crate::sea`]); `moving` lists the instances that will move (vessels): the
+    /// height bound takes their boxes after every move, and everything else triangle by triangle. Answers stay
+    /// exactly those of the full trace.
+    ///
+    /// The surface's world triangles must all lie at one height (a horizontal plane), else an input error.
+    pub fn set_sea(&mut self, surface: u32, moving: &[u32]) -> Result<()> {
+        self.check_instance(surface)?;
+        for &id in moving {
+            self.check_instance(id)?;
+        }
+        let inst = &self.instances[surface as usize];
+        let mesh = &self.meshes[inst.mesh as usize];
+        let level = inst.pose.transform_point(mesh.vertices()[0]).z;
+        if mesh.vertices().iter().any(|&v| inst.pose.transform_point(v).z != level) {
+            return Err(MmusvError::input(
+                "surface",
+                format!("instance {surface} is not a horizontal plane; the sea surface must be flat and level"),
+            ));
+        }
+        let mut bounds = Box3::EMPTY;
+        let mut fixed = Vec::new();
+        for (id, inst) in self.instances.iter().enumerate() {
+            let id = id as u32;
+            if id == surface {
+                continue;
+            }
+            let a = &self.world_aabbs[id as usize];
+            bounds.grow(&Box3 { lo: a.mins.to_array(), hi: a.maxs.to_array() });
+            if !moving.contains(&id) {
+                let mesh = &self.meshes[inst.mesh as usize];
+                fixed.extend(
+                    mesh.faces().iter().map(|f| f.map(|k| inst.pose.transform_point(mesh.vertices()[k as usize]))),
+                );
+            }
+        }
+        let mut sea = Sea::new(surface, level, bounds, moving.to_vec(), &fixed);
+        let boxes = &self.world_aabbs;
+        sea.update(
+            moving
+                .iter()
+                .map(|&i| Box3 { lo: boxes[i as usize].mins.to_array(), hi: boxes[i as usize].maxs.to_array() }),
+        );
+        self.sea = Some(sea);
+        Ok(())
+    }
+
+    /// Forgets the sea surface: every ray is traced fully again.
+    pub fn clear_sea(&mut self) {
+        self.sea = None;
+    }
+
+    /// The declared sea surface instance, if any.
+    pub fn sea_instance(&self) -> Option<u32> {
+        self.sea.as_ref().map(|s| s.instance)
+    }
+
+    /// The sea shortcut for a closest-hit query: `Some(Some(hit))` when the ray goes down from above the surface
+    /// and nothing can be hit before it (the hit is the surface's, found by testing its mesh alone), `Some(None)`
+    /// when the ray rises clear above everything (a miss), `None` when the ray needs the full trace.
+    #[inline(always)]
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a < b)` on purpose: a NaN must take the full trace
+    pub fn sea_closest(&self, ray: &RayPrep, limit: f32, scratch: &mut Scratch) -> Option<Option<Hit>> {
+        let sea = self.sea.as_ref()?;
+        let (oz, dz) = (ray.o[2], ray.d[2]);
+        if !(oz > sea.level) {
+            return None;
+        }
+        if dz < 0.0 {
+            let t_w = (sea.level - oz) / dz;
+            if !(t_w < limit) || !sea.path_clear(ray.o, ray.d, t_w, SEA_WALK_DOWN) {
+                return None;
+            }
+            let inst = &self.instances[sea.instance as usize];
+            let local = local_ray(ray, &inst.pose);
+            let mesh = &self.meshes[inst.mesh as usize];
+            let h = mesh.closest(local.as_ref().unwrap_or(ray), limit, &mut scratch.bottom)?;
+            return Some(Some(Hit { distance: h.t, instance: sea.instance, triangle: h.triangle }));
+        }
+        self.sea_clear_within(ray, limit, SEA_WALK_SKY).then_some(None)
+    }
+
+    /// The sea shortcut for an any-hit query: whether the ray rises from above the surface and stays clear of
+    /// everything (then nothing is hit below `limit`).
+    #[inline(always)]
+    pub fn sea_clear(&self, ray: &RayPrep, limit: f32) -> bool {
+        self.sea_clear_within(ray, limit, SEA_WALK_SHADOW)
+    }
+
+    #[inline(always)]
+    fn sea_clear_within(&self, ray: &RayPrep, limit: f32, max_cells: usize) -> bool {
+        let Some(sea) = &self.sea else { return false };
+        let (oz, dz) = (ray.o[2], ray.d[2]);
+        if !(oz > sea.level && dz > 0.0) {
+            return false;
+        }
+        if oz > sea.top() {
+            return true;
+        }
+        let t_top = (sea.top() - oz) / dz;
+        sea.path_clear(ray.o, ray.d, t_top.min(limit), max_cells)
     }
 
     fn check_mesh(&self, mesh: u32) -> Result<()> {
@@ -514,20 +635,35 @@ crate::dispatch! {
                 out.miss(i);
             }
             let Some(rays) = prepare(o, d, start, end, &mut bad) else { continue };
-            let rays = &rays[..end - start];
-            let packet = if coherent(rays) { Packet::new(rays, limit) } else { None };
+            // Rays the sea shortcut settles are done; the others are traced (as a packet when coherent).
+            let mut rest = [rays[0]; PACKET];
+            let mut lane = [0usize; PACKET];
+            let mut n = 0;
+            for (r, ray) in rays[..end - start].iter().enumerate() {
+                match scene.sea_closest(ray, limit, &mut scratch) {
+                    Some(Some(hit)) => out.hit(scene, start + r, Vec3::from_array(ray.d), &hit),
+                    Some(None) => {}
+                    None => {
+                        rest[n] = *ray;
+                        lane[n] = r;
+                        n += 1;
+                    }
+                }
+            }
+            let rest = &rest[..n];
+            let packet = if coherent(rest) { Packet::new(rest, limit) } else { None };
             if let Some(mut p) = packet {
                 let (inst, tri) = scene.cast_packet_with(&mut p, &mut scratch);
-                for r in 0..rays.len() {
-                    if inst[r] != u32::MAX {
-                        let hit = Hit { distance: p.best[r], instance: inst[r], triangle: tri[r] };
-                        out.hit(scene, start + r, Vec3::from_array(rays[r].d), &hit);
+                for j in 0..n {
+                    if inst[j] != u32::MAX {
+                        let hit = Hit { distance: p.best[j], instance: inst[j], triangle: tri[j] };
+                        out.hit(scene, start + lane[j], Vec3::from_array(rest[j].d), &hit);
                     }
                 }
             } else {
-                for (r, ray) in rays.iter().enumerate() {
+                for (j, ray) in rest.iter().enumerate() {
                     if let Some(hit) = scene.cast_prepared(ray, limit, &mut scratch) {
-                        out.hit(scene, start + r, Vec3::from_array(ray.d), &hit);
+                        out.hit(scene, start + lane[j], Vec3::from_array(ray.d), &hit);
                     }
                 }
             }
@@ -544,16 +680,28 @@ crate::dispatch! {
         for start in (0..o.len()).step_by(PACKET) {
             let end = (start + PACKET).min(o.len());
             let Some(rays) = prepare(o, d, start, end, &mut bad) else { continue };
-            let rays = &rays[..end - start];
-            let packet = if coherent(rays) { Packet::new(rays, limit) } else { None };
+            let mut rest = [rays[0]; PACKET];
+            let mut lane = [0usize; PACKET];
+            let mut n = 0;
+            for (r, ray) in rays[..end - start].iter().enumerate() {
+                if scene.sea_clear(ray, limit) {
+                    out[start + r] = false;
+                } else {
+                    rest[n] = *ray;
+                    lane[n] = r;
+                    n += 1;
+                }
+            }
+            let rest = &rest[..n];
+            let packet = if coherent(rest) { Packet::new(rest, limit) } else { None };
             if let Some(mut p) = packet {
                 scene.occluded_packet_with(&mut p, &mut scratch);
-                for r in 0..rays.len() {
-                    out[start + r] = p.best[r] < 0.0;
+                for j in 0..n {
+                    out[start + lane[j]] = p.best[j] < 0.0;
                 }
             } else {
-                for (r, ray) in rays.iter().enumerate() {
-                    out[start + r] = scene.occluded_prepared(ray, limit, &mut scratch);
+                for (j, ray) in rest.iter().enumerate() {
+                    out[start + lane[j]] = scene.occluded_prepared(ray, limit, &mut scratch);
                 }
             }
         }
@@ -930,5 +1078,84 @@ mod tests {
         assert_eq!(h.instance[0], NO_HIT);
         let h = s.cast_rays(&[[0.0; 3]], &[[1.0, 0.0, 0.0]], 9.5).unwrap_or_default();
         assert_eq!(h.instance[0], 0);
+    }
+
+    /// A small maritime world: the demo heightfield and hulls, a water plane, vessels that move.
+    fn sea_world() -> (Scene, Vec<u32>) {
+        let p = crate::demo::DemoParams { terrain_cells: 96, vessels: 24, extent: 600.0, ..Default::default() };
+        let demo = crate::demo::maritime_demo(p).unwrap_or_else(|e| unreachable!("{e}"));
+        let ids = demo.vessel_instances.clone();
+        (demo.scene, ids)
+    }
+
+    /// Rays of the kinds the sensors cast: camera-like rays from a few metres up in every direction, steep
+    /// and grazing, and shadow-like rays from the water surface towards a sun.
+    fn sensor_rays(rng: &mut ChaCha8Rng, n: usize) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
+        let mut o = Vec::with_capacity(n);
+        let mut d = Vec::with_capacity(n);
+        for k in 0..n {
+            let origin =
+                [rng.random_range(-250.0..250.0), rng.random_range(-250.0..250.0), rng.random_range(0.5..40.0)];
+            let az: f32 = rng.random_range(0.0..std::f32::consts::TAU);
+            let el: f32 = match k % 4 {
+                0 => rng.random_range(-1.5..-0.01),
+                1 => rng.random_range(-0.05..0.05),
+                2 => rng.random_range(0.0..1.5),
+                _ => -std::f32::consts::FRAC_PI_2,
+            };
+            o.push(origin);
+            d.push([az.cos() * el.cos(), az.sin() * el.cos(), el.sin()]);
+        }
+        (o, d)
+    }
+
+    #[test]
+    fn sea_shortcuts_give_exactly_the_full_trace() {
+        let (mut s, vessels) = sea_world();
+        let mut rng = ChaCha8Rng::seed_from_u64(21);
+        for frame in 0..3 {
+            // Move the vessels (the height map follows their boxes), then compare with and without the sea.
+            let poses: Vec<RigidPose> = vessels
+                .iter()
+                .map(|_| {
+                    let (x, y) = (rng.random_range(-200.0..200.0), rng.random_range(-200.0..200.0));
+                    RigidPose::from_xyz_rpy([x, y, 0.3], [0.02, -0.03, rng.random_range(0.0..std::f64::consts::TAU)])
+                })
+                .collect();
+            s.set_poses(&vessels, &poses).unwrap_or_else(|e| unreachable!("{e}"));
+            let mut with = s.clone();
+            with.set_sea(1, &vessels).unwrap_or_else(|e| unreachable!("{e}"));
+            let (o, d) = sensor_rays(&mut rng, 20_000);
+            let full = s.cast_rays(&o, &d, 800.0).unwrap_or_default();
+            let fast = with.cast_rays(&o, &d, 800.0).unwrap_or_default();
+            assert_eq!(full, fast, "frame {frame}");
+            // The shortcut did settle many of them.
+            let mut scratch = Scratch::default();
+            let settled = o
+                .iter()
+                .zip(&d)
+                .filter(|(o, d)| with.sea_closest(&RayPrep::new(**o, unit_direction(d)), 800.0, &mut scratch).is_some())
+                .count();
+            assert!(settled > 2_000, "only {settled} of 20000 rays settled by the sea shortcut");
+            // Shadow rays: from just above the water towards the sun, and from above everything.
+            let sun = [0.4f32, 0.3, 0.866];
+            let so: Vec<[f32; 3]> =
+                o.iter().enumerate().map(|(k, p)| [p[0], p[1], if k % 2 == 0 { 0.03 } else { 150.0 }]).collect();
+            let sd = vec![sun; so.len()];
+            assert_eq!(s.occluded_rays(&so, &sd, 5000.0).ok(), with.occluded_rays(&so, &sd, 5000.0).ok());
+            let clear = so.iter().filter(|p| with.sea_clear(&RayPrep::new(**p, sun), 5000.0)).count();
+            assert!(clear >= 10_000, "only {clear} shadow rays settled");
+        }
+        // A moving surface is no longer trusted; a tilted one is refused.
+        let mut with = s.clone();
+        with.set_sea(1, &vessels).unwrap_or_else(|e| unreachable!("{e}"));
+        with.set_poses(&[1], &[RigidPose::from_xyz_rpy([0.0, 0.0, 1.0], [0.0; 3])])
+            .unwrap_or_else(|e| unreachable!("{e}"));
+        assert_eq!(with.sea_instance(), None);
+        let mut tilted = s.clone();
+        tilted
+            .set_poses(&[1], &[RigidPose::from_xyz_rpy([0.0; 3], [0.1, 0.0, 0.0])])
+            .unwrap_or_else(|e| unreachable!("{e}"));
+        assert!(tilted.set_sea(1, &vessels).is_err());
     }
 }

@@ -125,6 +125,28 @@ impl Scene {
         self.write(|s| s.set_poses(ids, &parsed))?.map_err(crate::errors::to_py)
     }
 
+    /// Declares instance `surface` the sea surface (a horizontal plane) and `moving` the instances that will
+    /// move, enabling the exact sea and sky shortcuts (see mmusv_core::sea). Builds the height map with the GIL
+    /// released.
+    #[pyo3(signature = (surface, moving))]
+    fn set_sea(&self, py: Python<'_>, surface: u32, moving: PyReadonlyArray1<'_, u32>) -> PyResult<()> {
+        let moving = flat(&moving, "moving")?.to_vec();
+        let mut scene = self.read(|s| Ok(s.clone()))?;
+        detached(py, || scene.set_sea(surface, &moving))?;
+        self.write(|s| *s = scene)
+    }
+
+    /// Forgets the sea surface: every ray is traced fully again.
+    fn clear_sea(&self) -> PyResult<()> {
+        self.write(|s| s.clear_sea())
+    }
+
+    /// The sea surface instance id, or None.
+    #[getter]
+    fn sea_instance(&self) -> PyResult<Option<u32>> {
+        self.read(|s| Ok(s.sea_instance()))
+    }
+
     /// Casts rays (GIL released, all cores). Returns
     /// `(distance, instance_id, triangle_id, normal, semantic_class, backface)`.
     #[pyo3(signature = (origins, directions, max_range))]

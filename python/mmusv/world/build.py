@@ -89,4 +89,7 @@ def build_world_scene(world: MapWorld, vessels: list[tuple[str, str]], initial_p
         override = int(SemanticClass.USV) if role == "usv" else None
         ids.append(ws.scene.add_instance(_mesh_for(ws, asset_name), pose=m, class_override=override))
     ws.vessel_instances = np.asarray(ids, dtype=np.int64)
+    if "water" in ws.static_instances:
+        # Exact shortcuts for rays that can only meet the sea or the sky (vessels are the instances that move).
+        ws.scene.set_sea(ws.static_instances["water"], moving=ws.vessel_instances)
     return ws

@@ -13,7 +13,7 @@
 //! (uint16, 0 for sky), instance id (int32, −1 for sky) and optionally sRGB (uint8 × 3).
 
 use super::rays;
-use super::shade::{self, ShadeEnv, SurfaceHit};
+use super::shade::{self, ShadeEnv, Shader, SurfaceHit};
 use crate::error::{MmusvError, Result};
 use crate::geometry::RigidPose;
 use crate::scene::Scene;
@@ -68,14 +68,36 @@ pub struct CameraFrame {
     pub rgb: Vec<u8>,
 }
 
+/// Side of the square pixel tiles rays are traced in: a tile's 16 rays form one packet (see
+/// [`crate::bvh::packet`]), much tighter than 16 pixels of a row.
+const TILE: u32 = 4;
+
 /// A camera with its ray pattern computed once.
 #[derive(Debug, Clone)]
 pub struct Camera {
     cfg: CameraConfig,
-    /// Body-frame ray direction of each pixel (pinhole) or the common direction (orthographic).
+    /// Body-frame ray direction of each pixel (pinhole) or the common direction (orthographic), in trace order.
     dirs: Vec<[f32; 3]>,
-    /// Body-frame ray origin of each pixel (orthographic only).
+    /// Body-frame ray origin of each pixel (orthographic only), in trace order.
     origins: Vec<[f32; 3]>,
+    /// Trace order: entry `k` is the row-major index of the `k`-th pixel traced ([`TILE`]² tiles, row by row).
+    order: Vec<u32>,
+}
+
+/// Row-major pixel indices of a `w × h` image in [`TILE`]×[`TILE`] tiles, tiles row by row, pixels within a tile
+/// row by row (partial tiles at the right and bottom edges).
+fn tile_order(w: u32, h: u32) -> Vec<u32> {
+    let mut order = Vec::with_capacity(w as usize * h as usize);
+    for ty in (0..h).step_by(TILE as usize) {
+        for tx in (0..w).step_by(TILE as usize) {
+            for y in ty..(ty + TILE).min(h) {
+                for x in tx..(tx + TILE).min(w) {
+                    order.push(y * w + x);
+                }
+            }
+        }
+    }
+    order
 }
 
 impl Camera {
@@ -103,24 +125,26 @@ impl Camera {
                          use several cameras for a wider view",
                     ));
                 }
-                (rays::pinhole_directions(w, h, hfov)?, Vec::new())
+                let dirs = rays::pinhole_directions(w, h, hfov)?;
+                (tile_order(w, h).iter().map(|&i| dirs[i as usize]).collect(), Vec::new())
             }
             Projection::Orthographic { metres_per_pixel: m } => {
                 if !(m.is_finite() && m > 0.0) {
                     return Err(MmusvError::config("camera.metres_per_pixel", m, "must be a finite distance > 0"));
                 }
-                let mut origins = Vec::with_capacity(w as usize * h as usize);
-                for v in 0..h {
-                    for u in 0..w {
+                let origins = tile_order(w, h)
+                    .iter()
+                    .map(|&i| {
+                        let (u, v) = (i % w, i / w);
                         let y = (w as f64 / 2.0 - (u as f64 + 0.5)) * m;
                         let z = (h as f64 / 2.0 - (v as f64 + 0.5)) * m;
-                        origins.push([0.0, y as f32, z as f32]);
-                    }
-                }
+                        [0.0, y as f32, z as f32]
+                    })
+                    .collect();
                 (vec![[1.0, 0.0, 0.0]], origins)
             }
         };
-        Ok(Self { cfg, dirs, origins })
+        Ok(Self { cfg, dirs, origins, order: tile_order(w, h) })
     }
 
     /// The configuration.
@@ -138,6 +162,18 @@ impl Camera {
 
     /// World-frame ray origins and unit directions of every pixel, row-major.
     pub fn world_rays(&self, pose: &RigidPose) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
+        let (o, d) = self.traced_rays(pose);
+        let mut origins = vec![[0f32; 3]; o.len()];
+        let mut dirs = vec![[0f32; 3]; d.len()];
+        for (k, &i) in self.order.iter().enumerate() {
+            origins[i as usize] = o[k];
+            dirs[i as usize] = d[k];
+        }
+        (origins, dirs)
+    }
+
+    /// World-frame ray origins and unit directions of every pixel in trace order (see [`Camera`]).
+    fn traced_rays(&self, pose: &RigidPose) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
         let n = self.cfg.width as usize * self.cfg.height as usize;
         if self.origins.is_empty() {
             let o = pose.translation.to_array();
@@ -152,8 +188,12 @@ impl Camera {
 
     /// Renders the frozen `scene` from `pose` (camera body → world). `rgb` asks for the shaded image (one more
     /// ray per sunlit surface pixel); `seed` drives the water ripples and rain streaks.
+    ///
+    /// Rays are traced in [`TILE`]×[`TILE`] tiles (coherent packets), shadow rays as occlusion queries that stop
+    /// at the first occluder, and the results scattered back to row-major order: the same image as tracing and
+    /// shading pixel by pixel.
     pub fn render(&self, scene: &Scene, pose: &RigidPose, env: &ShadeEnv, rgb: bool, seed: u64) -> Result<CameraFrame> {
-        let (origins, dirs) = self.world_rays(pose);
+        let (origins, dirs) = self.traced_rays(pose);
         let hits = scene.cast_rays(&origins, &dirs, self.cfg.range_max)?;
         let n = origins.len();
         let axis = pose.transform_vector(Vec3::X);
@@ -161,66 +201,77 @@ impl Camera {
             width: self.cfg.width,
             height: self.cfg.height,
             depth: vec![f32::INFINITY; n],
-            semantic: hits.class.clone(),
-            instance: hits.instance.clone(),
+            semantic: vec![0; n],
+            instance: vec![0; n],
             rgb: Vec::new(),
         };
-        frame.depth.par_iter_mut().zip(hits.distance.par_iter()).zip(dirs.par_iter()).for_each(|((out, &t), d)| {
+        for (k, &i) in self.order.iter().enumerate() {
+            let i = i as usize;
+            let t = hits.distance[k];
             if t.is_finite() {
-                *out = t * Vec3::from_array(*d).dot(axis);
+                frame.depth[i] = t * Vec3::from_array(dirs[k]).dot(axis);
             }
-        });
+            frame.semantic[i] = hits.class[k];
+            frame.instance[i] = hits.instance[k];
+        }
         if !rgb {
             return Ok(frame);
         }
-        let surface = |i: usize| -> Option<SurfaceHit> {
-            let t = hits.distance[i];
+        let surface = |k: usize| -> Option<SurfaceHit> {
+            let t = hits.distance[k];
             if !t.is_finite() {
                 return None;
             }
-            let d = Vec3::from_array(dirs[i]);
-            let mut normal = Vec3::new(hits.normal[3 * i], hits.normal[3 * i + 1], hits.normal[3 * i + 2]);
+            let d = Vec3::from_array(dirs[k]);
+            let mut normal = Vec3::new(hits.normal[3 * k], hits.normal[3 * k + 1], hits.normal[3 * k + 2]);
             if normal.dot(d) > 0.0 {
                 normal = -normal;
             }
-            let point = Vec3::from_array(origins[i]) + d * t;
-            Some(SurfaceHit { t, point, normal, class: hits.class[i], instance: hits.instance[i] })
+            let point = Vec3::from_array(origins[k]) + d * t;
+            Some(SurfaceHit { t, point, normal, class: hits.class[k], instance: hits.instance[k] })
         };
-        // Shadow rays from every surface point facing the sun.
+        // Shadow rays from every surface point facing the sun (in trace order: neighbouring points, one packet).
         let sun = Vec3::from_array(env.sun_direction).normalize_or_zero();
         let mut lit = vec![false; n];
         if env.sun_intensity > 0.0 && sun.z > 0.0 {
             let facing: Vec<(usize, [f32; 3])> = (0..n)
                 .into_par_iter()
-                .filter_map(|i| {
-                    surface(i).filter(|h| h.normal.dot(sun) > 0.0 || h.class == 1).map(|h| {
+                .filter_map(|k| {
+                    surface(k).filter(|h| h.normal.dot(sun) > 0.0 || h.class == 1).map(|h| {
                         let eps = 0.02 + 1e-4 * h.t;
-                        (i, (h.point + h.normal * eps).to_array())
+                        (k, (h.point + h.normal * eps).to_array())
                     })
                 })
                 .collect();
             if env.shadows {
                 let so: Vec<[f32; 3]> = facing.iter().map(|(_, o)| *o).collect();
                 let sd = vec![sun.to_array(); so.len()];
-                let blocked = scene.cast_rays(&so, &sd, 5_000.0)?;
-                for (k, (i, _)) in facing.iter().enumerate() {
-                    lit[*i] = !blocked.distance[k].is_finite();
+                let blocked = scene.occluded_rays(&so, &sd, 5_000.0)?;
+                for (j, (k, _)) in facing.iter().enumerate() {
+                    lit[*k] = !blocked[j];
                 }
             } else {
-                for (i, _) in &facing {
-                    lit[*i] = true;
+                for (k, _) in &facing {
+                    lit[*k] = true;
                 }
             }
         }
         let w = self.cfg.width;
-        let mut out = vec![0u8; 3 * n];
-        out.par_chunks_mut(3).enumerate().for_each(|(i, px)| {
-            let d = Vec3::from_array(dirs[i]);
-            let h = surface(i);
-            let c = shade::shade(env, d, h.as_ref(), lit[i], seed);
-            let c = shade::rain(env, c, i as u32 % w, i as u32 / w, seed);
+        let shader = Shader::new(env, seed);
+        let mut traced = vec![0u8; 3 * n];
+        traced.par_chunks_mut(3).enumerate().for_each(|(k, px)| {
+            let i = self.order[k];
+            let d = Vec3::from_array(dirs[k]);
+            let h = surface(k);
+            let c = shader.shade(d, h.as_ref(), lit[k]);
+            let c = shade::rain(env, c, i % w, i / w, seed);
             px.copy_from_slice(&shade::to_srgb8(c));
         });
+        let mut out = vec![0u8; 3 * n];
+        for (k, &i) in self.order.iter().enumerate() {
+            let i = i as usize;
+            out[3 * i..3 * i + 3].copy_from_slice(&traced[3 * k..3 * k + 3]);
+        }
         frame.rgb = out;
         Ok(frame)
     }

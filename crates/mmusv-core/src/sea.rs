@@ -1,0 +1,279 @@
+//! Exact shortcuts for rays that can only meet the sea surface or the sky, from a height map of the scene.
+//!
+//! A maritime scene is mostly empty space over a flat sea. [`Sea`] records which instance is the sea surface
+//! (a horizontal plane at `level`) and a grid over the scene's extent holding, per cell, an upper bound of the
+//! height of everything else there: static geometry triangle by triangle, moving vessels by their world
+//! boxes, every contribution widened by one cell and raised by a margin. The scene uses it for two questions:
+//!
+//! * a ray from above the surface going down meets the surface at `t_w`: if the ray stays above the bound of
+//!   every cell its path crosses before that point ([`Sea::path_clear`]), nothing else can be hit first, and the
+//!   hit is found by testing the surface mesh alone (the same triangle test on the same mesh as the full trace);
+//! * a ray going up (a shadow ray) that stays above every cell it crosses until it is higher than everything
+//!   in the scene hits nothing.
+//!
+//! So the shortcuts give exactly the full trace's answers; a ray the bound cannot settle is traced fully.
+
+use crate::bvh::Box3;
+use parry3d::math::Vec3;
+
+/// Most cells per side of the height grid.
+const MAX_CELLS: usize = 512;
+/// Smallest cell side, metres.
+const MIN_CELL_M: f32 = 2.0;
+/// Heights are raised by this much (metres) so rounding in the walk can never hide a surface.
+const MARGIN_M: f32 = 0.05;
+
+/// The sea surface of a scene and the height bound of everything else (see the module docs).
+#[derive(Debug, Clone)]
+pub struct Sea {
+    /// Instance id of the sea surface.
+    pub instance: u32,
+    /// Height of the surface (world z, metres).
+    pub level: f32,
+    /// Instances rasterised by their world box after every move.
+    moving: Vec<u32>,
+    /// Grid: lower corner (world x, y), cell side (m), cells per side.
+    x0: f32,
+    y0: f32,
+    cell: f32,
+    nx: usize,
+    ny: usize,
+    /// Height bound of the static geometry per cell (`-inf` where empty), row-major `y · nx + x`.
+    fixed: Vec<f32>,
+    /// `fixed` raised by the moving instances' boxes at their current poses.
+    heights: Vec<f32>,
+    /// Highest bound anywhere.
+    top: f32,
+    /// Whether every moving box lies inside the grid (else leaving the grid proves nothing).
+    contained: bool,
+}
+
+impl Sea {
+    /// Builds the height grid over `bounds` (a world box holding every instance but the surface) with the
+    /// static geometry `fixed` (world-space triangles), for surface instance `instance` at height `level`;
+    /// `moving` lists the instances rasterised by box on every [`Sea::update`].
+    pub fn new(instance: u32, level: f32, bounds: Box3, moving: Vec<u32>, fixed: &[[Vec3; 3]]) -> Self {
+        let lo = [bounds.lo[0].min(bounds.hi[0]), bounds.lo[1].min(bounds.hi[1])];
+        let (w, h) = ((bounds.hi[0] - lo[0]).max(1.0), (bounds.hi[1] - lo[1]).max(1.0));
+        let cell = (w.max(h) / MAX_CELLS as f32).max(MIN_CELL_M);
+        let nx = ((w / cell).ceil() as usize + 1).clamp(1, MAX_CELLS + 2);
+        let ny = ((h / cell).ceil() as usize + 1).clamp(1, MAX_CELLS + 2);
+        let mut sea = Self {
+            instance,
+            level,
+            moving,
+            x0: lo[0],
+            y0: lo[1],
+            cell,
+            nx,
+            ny,
+            fixed: vec![f32::NEG_INFINITY; nx * ny],
+            heights: Vec::new(),
+            top: f32::NEG_INFINITY,
+            contained: true,
+        };
+        let mut grid = std::mem::take(&mut sea.fixed);
+        for tri in fixed {
+            let mut b = Box3::EMPTY;
+            for p in tri {
+                b.grow_point(p.to_array());
+            }
+            sea.raster(&mut grid, &b);
+        }
+        sea.fixed = grid;
+        sea.heights = sea.fixed.clone();
+        sea.top = sea.heights.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+        sea
+    }
+
+    /// Instances rasterised by box.
+    pub fn moving(&self) -> &[u32] {
+        &self.moving
+    }
+
+    /// Treats instance `id` as moving from now on (its static contribution, if any, stays: still an upper
+    /// bound).
+    pub fn add_moving(&mut self, id: u32) {
+        if !self.moving.contains(&id) {
+            self.moving.push(id);
+        }
+    }
+
+    /// Recomputes the bound from the static geometry and the moving instances' current world boxes.
+    pub fn update(&mut self, moving_boxes: impl Iterator<Item = Box3>) {
+        let mut grid = self.fixed.clone();
+        self.contained = true;
+        for b in moving_boxes {
+            let inside = b.lo[0] >= self.x0
+                && b.lo[1] >= self.y0
+                && b.hi[0] <= self.x0 + self.nx as f32 * self.cell
+                && b.hi[1] <= self.y0 + self.ny as f32 * self.cell;
+            self.contained &= inside;
+            self.raster(&mut grid, &b);
+        }
+        self.top = grid.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+        self.heights = grid;
+    }
+
+    /// Raises the cells under `b` (widened by one cell) to `b`'s top plus the margin.
+    fn raster(&self, grid: &mut [f32], b: &Box3) {
+        let z = b.hi[2] + MARGIN_M;
+        let cx = |x: f32| ((x - self.x0) / self.cell).floor();
+        let cy = |y: f32| ((y - self.y0) / self.cell).floor();
+        let clamp = |v: f32, n: usize| (v.max(0.0) as usize).min(n - 1);
+        let (x_lo, x_hi) = (clamp(cx(b.lo[0]) - 1.0, self.nx), clamp(cx(b.hi[0]) + 1.0, self.nx));
+        let (y_lo, y_hi) = (clamp(cy(b.lo[1]) - 1.0, self.ny), clamp(cy(b.hi[1]) + 1.0, self.ny));
+        for y in y_lo..=y_hi {
+            for c in &mut grid[y * self.nx + x_lo..=y * self.nx + x_hi] {
+                if z > *c {
+                    *c = z;
+                }
+            }
+        }
+    }
+
+    /// Highest height bound in the scene (metres).
+    pub fn top(&self) -> f32 {
+        self.top
+    }
+
+    /// Whether the ray `o + t·d`, `t ∈ [0, t_end]`, stays strictly above the height bound of every cell it
+    /// crosses. `false` also when the path is longer than `max_cells` cells (tracing it is then cheaper) or
+    /// leaves a grid that does not hold everything.
+    #[inline]
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a < b)` on purpose: a NaN must answer "not clear"
+    pub fn path_clear(&self, o: [f32; 3], d: [f32; 3], t_end: f32, max_cells: usize) -> bool {
+        if !(t_end.is_finite() && t_end >= 0.0) {
+            return false;
+        }
+        let run = t_end * (d[0] * d[0] + d[1] * d[1]).sqrt() / self.cell;
+        if !(run < max_cells as f32) {
+            return false;
+        }
+        let (gx1, gy1) = (self.x0 + self.nx as f32 * self.cell, self.y0 + self.ny as f32 * self.cell);
+        // Clip the segment to the grid rectangle; outside it there is nothing (when `contained`).
+        let mut t0 = 0f32;
+        let mut t1 = t_end;
+        for (oa, da, lo, hi) in [(o[0], d[0], self.x0, gx1), (o[1], d[1], self.y0, gy1)] {
+            if da == 0.0 {
+                if oa < lo || oa > hi {
+                    return self.contained;
+                }
+            } else {
+                let (a, b) = ((lo - oa) / da, (hi - oa) / da);
+                let (a, b) = if a < b { (a, b) } else { (b, a) };
+                t0 = t0.max(a);
+                t1 = t1.min(b);
+            }
+        }
+        if t0 > t1 {
+            return self.contained;
+        }
+        if (t0 > 0.0 || t1 < t_end) && !self.contained {
+            return false;
+        }
+        // 2D cell walk (Amanatides–Woo) from t0 to t1; in each cell the ray's lowest point is at the end of
+        // its stretch there when going down, at the start when going up.
+        let px = o[0] + d[0] * t0;
+        let py = o[1] + d[1] * t0;
+        let clampi = |v: f32, n: usize| (v.floor().max(0.0) as usize).min(n - 1);
+        let mut ix = clampi((px - self.x0) / self.cell, self.nx);
+        let mut iy = clampi((py - self.y0) / self.cell, self.ny);
+        let step = |da: f32| if da > 0.0 { 1isize } else { -1 };
+        let next = |i: usize, da: f32, oa: f32, lo: f32| {
+            if da == 0.0 {
+                f32::INFINITY
+            } else {
+                let edge = lo + (i as f32 + if da > 0.0 { 1.0 } else { 0.0 }) * self.cell;
+                (edge - oa) / da
+            }
+        };
+        let (sx, sy) = (step(d[0]), step(d[1]));
+        let (dtx, dty) = (
+            if d[0] == 0.0 { f32::INFINITY } else { self.cell / d[0].abs() },
+            if d[1] == 0.0 { f32::INFINITY } else { self.cell / d[1].abs() },
+        );
+        let mut tx = next(ix, d[0], o[0], self.x0);
+        let mut ty = next(iy, d[1], o[1], self.y0);
+        let mut t = t0;
+        for _ in 0..=2 * max_cells + 2 {
+            let t_exit = tx.min(ty).min(t1);
+            let low_t = if d[2] < 0.0 { t_exit } else { t };
+            let z_low = o[2] + d[2] * low_t;
+            if !(z_low > self.heights[iy * self.nx + ix]) {
+                return false;
+            }
+            if t_exit >= t1 {
+                return true;
+            }
+            t = t_exit;
+            if tx <= ty {
+                let n = ix as isize + sx;
+                if n < 0 || n >= self.nx as isize {
+                    return self.contained;
+                }
+                ix = n as usize;
+                tx += dtx;
+            } else {
+                let n = iy as isize + sy;
+                if n < 0 || n >= self.ny as isize {
+                    return self.contained;
+                }
+                iy = n as usize;
+                ty += dty;
+            }
+        }
+        false
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tri(x: f32, y: f32, z: f32) -> [Vec3; 3] {
+        [Vec3::new(x, y, z), Vec3::new(x + 1.0, y, z), Vec3::new(x, y + 1.0, z)]
+    }
+
+    #[test]
+    fn walk_sees_a_tower_and_not_the_empty_sea() {
+        let bounds = Box3 { lo: [-100.0, -100.0, -20.0], hi: [100.0, 100.0, 30.0] };
+        let sea = Sea::new(0, 0.0, bounds, vec![], &[tri(50.0, 0.0, 30.0), tri(-80.0, -80.0, -20.0)]);
+        // Down from 10 m towards (40, 0): clear (the tower is at x = 50..51).
+        let o = [0.0, 0.0, 10.0];
+        let to = |x: f32, y: f32| {
+            let d = [x - o[0], y - o[1], -o[2]];
+            let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            ([d[0] / n, d[1] / n, d[2] / n], n)
+        };
+        let (d, t) = to(40.0, 0.0);
+        assert!(sea.path_clear(o, d, t, 512));
+        // Towards (60, 0): the path passes over the tower at z ≈ 1.7 m < 30 m.
+        let (d, t) = to(60.0, 0.0);
+        assert!(!sea.path_clear(o, d, t, 512));
+        // The seabed triangle far below does not block anything above the surface.
+        let (d, t) = to(-79.5, -79.5);
+        assert!(sea.path_clear(o, d, t, 512));
+        // Up past everything: clear once above the top.
+        assert!(sea.path_clear(o, [0.0, 0.6, 0.8], 100.0, 512));
+        // ... but not when the walk would be longer than allowed.
+        assert!(!sea.path_clear(o, [0.0, 0.6, 0.8], 100.0, 2));
+        // Up over the tower, below its top: blocked.
+        assert!(!sea.path_clear([45.0, 0.5, 1.0], [0.98, 0.0, 0.2], 60.0, 512));
+    }
+
+    #[test]
+    fn moving_boxes_raise_cells_and_leaving_the_grid_is_unknown_then() {
+        let bounds = Box3 { lo: [-50.0, -50.0, 0.0], hi: [50.0, 50.0, 5.0] };
+        let mut sea = Sea::new(0, 0.0, bounds, vec![1], &[]);
+        let boat = Box3 { lo: [10.0, -2.0, -1.0], hi: [20.0, 2.0, 4.0] };
+        sea.update([boat].into_iter());
+        assert!(!sea.path_clear([0.0, 0.0, 3.0], [1.0, 0.0, 0.0], 30.0, 512));
+        assert!(sea.path_clear([0.0, 0.0, 3.0], [-1.0, 0.0, 0.0], 30.0, 512));
+        // The boat sails out of the grid: leaving the grid no longer proves anything.
+        let away = Box3 { lo: [60.0, -2.0, -1.0], hi: [70.0, 2.0, 4.0] };
+        sea.update([away].into_iter());
+        assert!(!sea.path_clear([0.0, 0.0, 3.0], [1.0, 0.0, 0.0], 200.0, 512));
+        assert!(sea.path_clear([0.0, 0.0, 3.0], [1.0, 0.0, 0.0], 40.0, 512));
+    }
+}
