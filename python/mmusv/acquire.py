@@ -28,6 +28,7 @@ import yaml
 from mmusv.annotate import Annotations, SilhouetteCache, annotate_agent
 from mmusv.config import Scenario, load_scenario, scenario_hash
 from mmusv.errors import ConfigError, IoError, MmusvError, located
+from mmusv.profiling import RunProfile
 from mmusv.scenario_checks import check_mounts, check_routes
 from mmusv.simulation import FrameCapture, Simulation
 
@@ -49,6 +50,7 @@ class RunResult:
     bytes: int = 0
     error: str | None = None
     frame_seconds: list[float] = field(default_factory=list)
+    profile: RunProfile | None = None
 
 
 def recording_path(out_dir: Path, scenario: Scenario) -> Path:
@@ -192,6 +194,7 @@ def run(
     frames: int | None = None,
     progress: Callable[[int, int], None] | None = None,
     checks: bool = True,
+    profile: bool = False,
 ) -> RunResult:
     """Runs a scenario (a YAML path, a dict or a :class:`~mmusv.config.Scenario`) into ``out_dir``.
 
@@ -202,6 +205,8 @@ def run(
         progress: called with (frames done, frames total) after every frame.
         checks: run the generator's route checks on the map (:mod:`mmusv.scenario_checks`): a route over land
             is an error, clearance and separation problems and far-away mounts are warnings.
+        profile: time every stage (each sensor, annotation, encoding, writing, the rest) into
+            ``RunResult.profile`` (:class:`~mmusv.profiling.RunProfile`); the output bytes are the same.
 
     Raises:
         ConfigError: the scenario is invalid (nothing is written).
@@ -245,17 +250,31 @@ def run(
     )
     result = RunResult(recording=rec_path, tables=tables_dir, frames_written=0, status="complete", seconds=0.0)
     t0 = time.perf_counter()
-    recorder = FrameRecorder(rec_path, sim, overwrite=overwrite)
+    prof = RunProfile() if profile else None
+    result.profile = prof
+    recorder = FrameRecorder(rec_path, sim, overwrite=overwrite, profile=prof)
+    if prof is not None:
+        prof.start()
     try:
         for k in range(total):
             tf = time.perf_counter()
             cap = sim.capture(k)
+            t1 = time.perf_counter()
             anns = annotations_for(sim, cap, silhouettes)
             cols = {agent: a.columns() for agent, a in anns.items()}
+            t2 = time.perf_counter()
             recorder.write_frame(cap, cols)
+            t3 = time.perf_counter()
             tables.add_world(sim, cap)
             for agent, a in anns.items():
                 tables.add_annotations(a, cols[agent])
+            if prof is not None:
+                prof.add("main:capture", t1 - tf)
+                for key, sec in cap.sensor_seconds.items():
+                    prof.add("main:capture/" + key.split("/", 1)[1], sec)
+                prof.add("main:annotate", t2 - t1)
+                prof.add("main:write", t3 - t2)
+                prof.add("main:tables", time.perf_counter() - t3)
             del cap
             result.frames_written = k + 1
             result.frame_seconds.append(time.perf_counter() - tf)
@@ -277,6 +296,8 @@ def run(
         result.messages, result.bytes = summary.get("messages", 0), summary.get("bytes", 0)
         tables.flush()
         result.seconds = time.perf_counter() - t0
+        if prof is not None:
+            prof.stop(result.frames_written)
         manifest = {
             "mmusv_version": _version(),
             "scenario": scenario.name,

@@ -87,7 +87,15 @@ def _cmd_study_waves(args: argparse.Namespace) -> int:
     return 0
 
 
-def _run_one(path: str, out: str, overwrite: bool, frames: int | None, show_progress: bool, checks: bool = True) -> str:
+def _run_one(
+    path: str,
+    out: str,
+    overwrite: bool,
+    frames: int | None,
+    show_progress: bool,
+    checks: bool = True,
+    profile: bool = False,
+) -> str:
     """Runs one scenario; returns a one-line report. Used directly and in worker processes."""
     from mmusv.acquire import run
     from mmusv.config import load_scenario
@@ -107,6 +115,7 @@ def _run_one(path: str, out: str, overwrite: bool, frames: int | None, show_prog
                     overwrite=overwrite,
                     frames=frames,
                     checks=checks,
+                    profile=profile,
                     progress=lambda done, total: bar.update(task, completed=done),
                 )
             except KeyboardInterrupt:
@@ -116,12 +125,13 @@ def _run_one(path: str, out: str, overwrite: bool, frames: int | None, show_prog
                 print(f"mmusv: interrupted; {rec} is a valid recording holding every completed frame", file=sys.stderr)
                 raise
     else:
-        res = run(path, out_dir=out, overwrite=overwrite, frames=frames, checks=checks)
+        res = run(path, out_dir=out, overwrite=overwrite, frames=frames, checks=checks, profile=profile)
     fps = res.frames_written / res.seconds if res.seconds > 0 else float("nan")
-    return (
+    line = (
         f"{scenario.name}: {res.frames_written} frames in {res.seconds:.1f} s ({fps:.2f} frames/s), "
         f"{res.messages} messages, {res.bytes / 1e6:.1f} MB -> {res.recording}"
     )
+    return line if res.profile is None else f"{res.profile.render()}\n{line}"
 
 
 def _run_one_safe(path: str, out: str, overwrite: bool, frames: int | None, checks: bool) -> tuple[str, str]:
@@ -146,6 +156,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
     src = resolve_scenario(args.scenario)
     checks = not args.no_checks
     if src.is_dir():
+        if args.profile:
+            raise MmusvError("--profile times one scenario; give a scenario file, not a folder")
         files = sorted(p for p in src.glob("*.yaml") if p.name != "report.yaml")
         if not files:
             raise MmusvError(f"{src} holds no *.yaml scenarios")
@@ -172,7 +184,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
                     results.append(fut.result())
                     print(results[-1][1])
         return _report_folder(files, results)
-    print(_run_one(str(src), args.output, args.overwrite, args.frames, sys.stdout.isatty(), checks))
+    print(_run_one(str(src), args.output, args.overwrite, args.frames, sys.stdout.isatty(), checks, args.profile))
     return 0
 
 
@@ -312,6 +324,11 @@ def _parser() -> argparse.ArgumentParser:
         "--no-checks",
         action="store_true",
         help="skip the route checks on the map (in water: an error; clearances, separation: warnings)",
+    )
+    run.add_argument(
+        "--profile",
+        action="store_true",
+        help="print the time per stage per frame (each sensor, annotation, encoding, writing, the rest)",
     )
     info = sub.add_parser("info", help="agents, topics, frames and duration of a recording")
     info.add_argument("recording", help="an .mcap written by mmusv run")

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+import time
 from collections.abc import Collection
 from dataclasses import dataclass, field
 from typing import Any
@@ -179,6 +180,9 @@ class FrameCapture:
     time_s: float
     world: WorldState
     agents: dict[str, AgentCapture]
+    sensor_seconds: dict[str, float] = field(default_factory=dict, compare=False)
+    """Wall seconds each sensor's work took, keyed ``<agent>/<sensor>`` (``lidar``, ``camera/<name>``,
+    ``top_view``, ``radar``, ``ppi``): for profiling only, never recorded."""
 
 
 class Simulation:
@@ -333,6 +337,7 @@ class Simulation:
         env = self.sensor_env
         sc = self.scenario
         out: dict[str, AgentCapture] = {}
+        secs: dict[str, float] = {}
         for agent in self.agents:
             if agents is not None and agent.id not in agents:
                 continue
@@ -345,6 +350,7 @@ class Simulation:
                 cap.sensors[key] = SensorMount(mount=m, pose=p)
             if agent.lidar is not None and "lidar" in kinds:
                 cap.lidar_pose = poses["lidar"]
+                t0 = time.perf_counter()
                 cap.lidar = scan(
                     agent.lidar,
                     self.ws.scene,
@@ -352,16 +358,20 @@ class Simulation:
                     env=env,
                     seed=sensor_seed(sc.seed, frame, agent.index, "lidar"),
                 )
+                secs[f"{agent.id}/lidar"] = time.perf_counter() - t0
             for k, (name, (cam, _, _)) in enumerate(agent.cameras.items()):
                 if "cameras" not in kinds:
                     break
                 p = poses[f"camera/{name}"]
                 cap.camera_poses[name] = p
+                t0 = time.perf_counter()
                 cap.cameras[name] = render(
                     cam, self.ws.scene, pose=p, env=env, seed=sensor_seed(sc.seed, frame, agent.index, "camera", k)
                 )
+                secs[f"{agent.id}/camera/{name}"] = time.perf_counter() - t0
             if agent.top_view is not None and "top_view" in kinds:
                 cap.top_view_pose = poses["top_view"]
+                t0 = time.perf_counter()
                 cap.top_view = render(
                     agent.top_view,
                     self.ws.scene,
@@ -369,9 +379,11 @@ class Simulation:
                     env=env,
                     seed=sensor_seed(sc.seed, frame, agent.index, "top_view"),
                 )
+                secs[f"{agent.id}/top_view"] = time.perf_counter() - t0
             if "radar" in kinds and agent.radar is not None and agent.rig.radar is not None:
                 cap.radar_pose = poses["radar"]
                 cfg = agent.rig.radar
+                t0 = time.perf_counter()
                 cap.radar = radar_sweep(
                     agent.radar,
                     self.ws.scene,
@@ -379,14 +391,17 @@ class Simulation:
                     env=env,
                     seed=sensor_seed(sc.seed, frame, agent.index, "radar"),
                 )
+                t1 = time.perf_counter()
+                secs[f"{agent.id}/radar"] = t1 - t0
                 cap.radar_ppi = ppi_image(
                     cap.radar,
                     size_px=cfg.ppi_size_px,
                     metres_per_pixel=cfg.ppi_metres_per_pixel,
                     orientation=cfg.ppi_orientation,
                 )
+                secs[f"{agent.id}/ppi"] = time.perf_counter() - t1
             out[agent.id] = cap
-        return FrameCapture(frame, state.time_s, state, out)
+        return FrameCapture(frame, state.time_s, state, out, secs)
 
 
 def inside_mesh(vertices: np.ndarray, faces: np.ndarray, point: np.ndarray, *, rays: int = 9) -> bool:

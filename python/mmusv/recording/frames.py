@@ -21,6 +21,7 @@ Metadata records: ``scenario`` (the resolved YAML), ``manifest`` (mmusv version,
 from __future__ import annotations
 
 import json
+import time
 from pathlib import Path
 from typing import Any
 
@@ -30,6 +31,7 @@ from scipy.spatial.transform import Rotation
 
 from mmusv.config import scenario_hash
 from mmusv.frames import BODY_TO_OPTICAL
+from mmusv.profiling import RunProfile
 from mmusv.recording import topics
 from mmusv.recording.writer import Recording
 from mmusv.sensors.camera import CameraImages
@@ -52,8 +54,11 @@ def pose7(m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 class FrameRecorder:
     """Streams :class:`~mmusv.simulation.FrameCapture` frames of ``sim`` into ``path``."""
 
-    def __init__(self, path: Path, sim: Simulation, *, overwrite: bool = False) -> None:
+    def __init__(
+        self, path: Path, sim: Simulation, *, overwrite: bool = False, profile: RunProfile | None = None
+    ) -> None:
         self.sim = sim
+        self.profile = profile
         self.roles = {v.id: v.role for v in sim.vessels}
         self.rec = Recording(path, overwrite=overwrite)
         sc = sim.scenario
@@ -184,6 +189,7 @@ class FrameRecorder:
 
     def _images(self, topic: str, frame_id: str, t: int, img: CameraImages, outputs: list[str]) -> None:
         rec = self.rec
+        t0 = time.perf_counter()
         if img.rgb is not None and "rgb" in outputs:
             rec.png_image(f"{topic}/rgb", log_time_ns=t, frame_id=frame_id, image=img.rgb)
         if "depth" in outputs:
@@ -198,6 +204,8 @@ class FrameRecorder:
         if "instance" in outputs:
             inst = np.where(img.instance < 0, 65535, img.instance).astype(np.uint16)
             rec.png_image(f"{topic}/instance", log_time_ns=t, frame_id=frame_id, image=inst)
+        if self.profile is not None:
+            self.profile.add("main:write/encode", time.perf_counter() - t0)
 
     def _radar(self, agent: str, t: int, returns: Any, ppi: np.ndarray | None) -> None:
         from mmusv.sensors.radar import ppi_colormap
