@@ -30,6 +30,7 @@ __all__ = [
     "__version__",
     "_lidar_directions",
     "_pinhole_directions",
+    "capture_frame",
     "default_amplitudes",
     "demo_scene",
     "lidar_trace_order",
@@ -317,6 +318,22 @@ class Radar:
         ``intensity``; (N,) float32 each): ego at pixel (size_px // 2, size_px // 2), row 0 at the top, a return at
         range R exactly R / metres_per_pixel px from it; ``orientation`` "north_up" (rotated by ``sensor_yaw``
         rad) or "head_up"."""
+
+# --- one frame of every sensor ---
+
+_CaptureTask = (
+    tuple[Lidar | Camera | Radar, npt.NDArray[np.float64], int]
+    | tuple[Radar, npt.NDArray[np.float64], int, tuple[int, float, str, float] | None]
+)
+
+def capture_frame(
+    scene: Scene, *, env: SensorEnv, tasks: Sequence[_CaptureTask]
+) -> list[tuple[dict[str, npt.NDArray[Any]], float, float]]:
+    """Every sensor task of a frame on the current state of ``scene``, concurrently over all cores, GIL released.
+    A task is ``(sensor, pose, seed)`` (pose (4, 4) float64 sensor → world) or ``(radar, pose, seed, ppi)`` with
+    ``ppi = (size_px, metres_per_pixel, orientation, sensor_yaw)`` or None. Returns, in task order,
+    ``(outputs, seconds, ppi_seconds)``: the dict ``scan``/``render``/``sweep`` return (bit-identical to those
+    calls; a radar's has ``ppi`` (size_px, size_px) f32 when asked for) and the task's wall seconds (profiling)."""
 
 # --- demo ---
 

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import hashlib
 import math
-import time
 from collections.abc import Collection
 from dataclasses import dataclass, field
 from typing import Any
@@ -25,11 +24,11 @@ from mmusv._native import core
 from mmusv.config import Scenario, VesselConfig, load_scenario
 from mmusv.errors import ConfigError
 from mmusv.motion import build_fleet
-from mmusv.sensors.camera import CameraImages, camera_from_config, render, top_view_from_config
+from mmusv.sensors.camera import CameraImages, camera_from_config, top_view_from_config
 from mmusv.sensors.config import CameraConfig, Mount, RigConfig
 from mmusv.sensors.env import sensor_env
-from mmusv.sensors.lidar import LidarPoints, lidar_from_config, scan
-from mmusv.sensors.radar import RadarReturns, ppi_image, radar_from_config, radar_sweep
+from mmusv.sensors.lidar import LidarPoints, lidar_from_config
+from mmusv.sensors.radar import RadarReturns, ppi_request, radar_from_config
 from mmusv.world.build import WorldScene, build_world_scene, pose_matrices
 from mmusv.world.environment import Environment
 from mmusv.world.maps import MapWorld, generate_map_from
@@ -319,6 +318,11 @@ class Simulation:
 
         ``agents`` limits the USVs (ids), ``sensors`` the sensor kinds (``lidar``, ``cameras``, ``top_view``,
         ``radar``); ``None`` means all. ``radar=False`` leaves the radar out whatever ``sensors`` says.
+
+        Every selected sensor of every selected USV runs in one native call (``core.capture_frame``: concurrent
+        tasks over all cores, GIL released), with the outputs bit-identical to calling :func:`~mmusv.sensors.
+        lidar.scan`, :func:`~mmusv.sensors.camera.render`, :func:`~mmusv.sensors.radar.radar_sweep` and
+        :func:`~mmusv.sensors.radar.ppi_image` one by one with the same poses and :func:`sensor_seed` seeds.
         """
         if agents is not None:
             unknown = sorted(set(agents) - {a.id for a in self.agents})
@@ -334,10 +338,10 @@ class Simulation:
                 f"unknown sensor kind(s) {sorted(kinds - set(SENSOR_KINDS))}; allowed: {', '.join(SENSOR_KINDS)}"
             )
         state = self.set_frame(frame)
-        env = self.sensor_env
         sc = self.scenario
         out: dict[str, AgentCapture] = {}
-        secs: dict[str, float] = {}
+        tasks: list[core._CaptureTask] = []
+        slots: list[tuple[Agent, AgentCapture, str]] = []  # where each task's output goes
         for agent in self.agents:
             if agents is not None and agent.id not in agents:
                 continue
@@ -350,58 +354,53 @@ class Simulation:
                 cap.sensors[key] = SensorMount(mount=m, pose=p)
             if agent.lidar is not None and "lidar" in kinds:
                 cap.lidar_pose = poses["lidar"]
-                t0 = time.perf_counter()
-                cap.lidar = scan(
-                    agent.lidar,
-                    self.ws.scene,
-                    pose=cap.lidar_pose,
-                    env=env,
-                    seed=sensor_seed(sc.seed, frame, agent.index, "lidar"),
-                )
-                secs[f"{agent.id}/lidar"] = time.perf_counter() - t0
+                tasks.append((agent.lidar, _pose(cap.lidar_pose), sensor_seed(sc.seed, frame, agent.index, "lidar")))
+                slots.append((agent, cap, "lidar"))
             for k, (name, (cam, _, _)) in enumerate(agent.cameras.items()):
                 if "cameras" not in kinds:
                     break
                 p = poses[f"camera/{name}"]
                 cap.camera_poses[name] = p
-                t0 = time.perf_counter()
-                cap.cameras[name] = render(
-                    cam, self.ws.scene, pose=p, env=env, seed=sensor_seed(sc.seed, frame, agent.index, "camera", k)
-                )
-                secs[f"{agent.id}/camera/{name}"] = time.perf_counter() - t0
+                tasks.append((cam, _pose(p), sensor_seed(sc.seed, frame, agent.index, "camera", k)))
+                slots.append((agent, cap, f"camera/{name}"))
             if agent.top_view is not None and "top_view" in kinds:
                 cap.top_view_pose = poses["top_view"]
-                t0 = time.perf_counter()
-                cap.top_view = render(
-                    agent.top_view,
-                    self.ws.scene,
-                    pose=cap.top_view_pose,
-                    env=env,
-                    seed=sensor_seed(sc.seed, frame, agent.index, "top_view"),
-                )
-                secs[f"{agent.id}/top_view"] = time.perf_counter() - t0
+                seed = sensor_seed(sc.seed, frame, agent.index, "top_view")
+                tasks.append((agent.top_view, _pose(cap.top_view_pose), seed))
+                slots.append((agent, cap, "top_view"))
             if "radar" in kinds and agent.radar is not None and agent.rig.radar is not None:
-                cap.radar_pose = poses["radar"]
+                cap.radar_pose = _pose(poses["radar"])
                 cfg = agent.rig.radar
-                t0 = time.perf_counter()
-                cap.radar = radar_sweep(
+                ppi = ppi_request(
                     agent.radar,
-                    self.ws.scene,
                     pose=cap.radar_pose,
-                    env=env,
-                    seed=sensor_seed(sc.seed, frame, agent.index, "radar"),
-                )
-                t1 = time.perf_counter()
-                secs[f"{agent.id}/radar"] = t1 - t0
-                cap.radar_ppi = ppi_image(
-                    cap.radar,
                     size_px=cfg.ppi_size_px,
                     metres_per_pixel=cfg.ppi_metres_per_pixel,
                     orientation=cfg.ppi_orientation,
                 )
-                secs[f"{agent.id}/ppi"] = time.perf_counter() - t1
+                tasks.append((agent.radar, cap.radar_pose, sensor_seed(sc.seed, frame, agent.index, "radar"), ppi))
+                slots.append((agent, cap, "radar"))
             out[agent.id] = cap
+        results = core.capture_frame(self.ws.scene.native, env=self.sensor_env, tasks=tasks) if tasks else []
+        secs: dict[str, float] = {}
+        for (agent, cap, key), (d, seconds, ppi_seconds) in zip(slots, results, strict=True):
+            secs[f"{agent.id}/{key}"] = seconds
+            if key == "lidar":
+                cap.lidar = LidarPoints.from_native(d)
+            elif key == "top_view":
+                cap.top_view = CameraImages.from_native(d)
+            elif key == "radar" and agent.radar is not None and cap.radar_pose is not None:
+                cap.radar = RadarReturns.from_native(d, pose=cap.radar_pose, radar=agent.radar)
+                cap.radar_ppi = d["ppi"]
+                secs[f"{agent.id}/ppi"] = ppi_seconds
+            else:
+                cap.cameras[key.removeprefix("camera/")] = CameraImages.from_native(d)
         return FrameCapture(frame, state.time_s, state, out, secs)
+
+
+def _pose(m: np.ndarray) -> npt.NDArray[np.float64]:
+    """A ``(4, 4)`` pose as the core takes it: C-contiguous float64."""
+    return np.ascontiguousarray(m, dtype=np.float64)
 
 
 def inside_mesh(vertices: np.ndarray, faces: np.ndarray, point: np.ndarray, *, rays: int = 9) -> bool:

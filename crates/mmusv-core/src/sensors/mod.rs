@@ -5,9 +5,11 @@
 //! - [`radar`]: the rotating ray-cast marine radar ([`radar_model`]: its intensity, rain and clutter
 //!   formulas) and [`ppi`]: the PPI image at a fixed metres-per-pixel scale;
 //! - [`shade`]: the RGB shading model (sun, sky, water, shadows, fog, rain);
+//! - [`capture`]: every sensor of a frame in one call, as concurrent tasks over rayon;
 //! - [`noise`]: counter-based random draws, so results never depend on thread scheduling.
 
 pub mod camera;
+pub mod capture;
 pub mod lidar;
 pub mod noise;
 pub mod ppi;
