@@ -430,6 +430,19 @@ class Recorder:
     def png_image(self, topic: str, *, log_time_ns: int, frame_id: str, image: npt.NDArray[Any]) -> None:
         """``foxglove.CompressedImage`` format png of a C-contiguous (H, W) uint8, (H, W, 3) uint8 or (H, W) uint16 image."""
 
+    def images(
+        self,
+        *,
+        log_time_ns: int,
+        topics: Sequence[str],
+        frame_ids: Sequence[str],
+        images: Sequence[npt.NDArray[Any]],
+        formats: Sequence[str],
+    ) -> tuple[float, float]:
+        """Image ``i`` to ``topics[i]`` in ``frame_ids[i]`` as ``formats[i]`` (``"png"`` like :meth:`png_image`,
+        ``"raw"`` like :meth:`raw_image`): all encoded in parallel before the recorder is locked, then written in
+        list order (the bytes of one call per image). Returns (encode seconds, write seconds), for profiling."""
+
     def frame_transforms(
         self,
         topic: str,
