@@ -13,8 +13,9 @@
 use super::image::Pixels;
 use super::messages::{pixels_message, png_message};
 use super::writer::{EncodedMessage, Recorder};
-use crate::error::Result;
+use crate::error::{MmusvError, Result};
 use rayon::prelude::*;
+use std::collections::BTreeMap;
 use std::sync::OnceLock;
 
 /// How one image is stored.
@@ -76,8 +77,20 @@ pub fn encode_images(log_time_ns: u64, jobs: &[ImageJob<'_>]) -> Result<Vec<Enco
 
 impl Recorder {
     /// Writes `messages` (from [`encode_images`] or [`EncodedMessage::encode`]) in order, all at
-    /// `log_time_ns`.
+    /// `log_time_ns`. Every topic is checked first ([`Recorder::check_topic`], and one schema per topic within
+    /// the batch), so a refused batch writes nothing.
     pub fn write_messages(&mut self, log_time_ns: u64, messages: &[EncodedMessage]) -> Result<()> {
+        let mut schemas: BTreeMap<&str, &str> = BTreeMap::new();
+        for m in messages {
+            self.check_topic(&m.topic, &m.schema.name)?;
+            let first = *schemas.entry(&m.topic).or_insert(&m.schema.name);
+            if first != m.schema.name {
+                return Err(MmusvError::input(
+                    "topic",
+                    format!("{} gets both {first} and {} in one batch", m.topic, m.schema.name),
+                ));
+            }
+        }
         messages.iter().try_for_each(|m| self.write_message(log_time_ns, m))
     }
 }
@@ -165,5 +178,32 @@ mod tests {
         assert!(encode_images(0, &[ok, float_png]).is_err());
         assert!(encode_images(0, &[ok, wrong_size]).is_err());
         assert!(encode_images(0, &[ok, ok]).is_ok_and(|m| m.len() == 2));
+    }
+
+    #[test]
+    fn a_refused_batch_writes_nothing() -> Result<()> {
+        let px = [7u8; 12];
+        let png = ImageJob {
+            topic: "/a",
+            frame_id: "f",
+            width: 2,
+            height: 2,
+            pixels: Pixels::Rgb8(&px),
+            format: ImageFormat::Png,
+        };
+        let path = scratch("refused.mcap");
+        let mut rec = Recorder::create(&path, false)?;
+        let empty_topic = encode_images(0, &[png, ImageJob { topic: "", ..png }])?;
+        assert!(rec.write_messages(0, &empty_topic).is_err());
+        let mixed = encode_images(0, &[png, ImageJob { format: ImageFormat::Raw, ..png }])?;
+        assert!(rec.write_messages(0, &mixed).is_err());
+        assert_eq!(rec.messages(), 0);
+        rec.write_messages(0, &encode_images(0, &[png])?)?;
+        let raw_on_png =
+            encode_images(1, &[ImageJob { topic: "/b", ..png }, ImageJob { format: ImageFormat::Raw, ..png }])?;
+        assert!(rec.write_messages(1, &raw_on_png).is_err());
+        assert_eq!(rec.messages(), 1);
+        rec.finish()?;
+        Ok(())
     }
 }

@@ -189,20 +189,10 @@ impl Recorder {
         message_encoding: &str,
         data: &[u8],
     ) -> Result<()> {
-        if topic.is_empty() {
-            return Err(MmusvError::input("topic", "must not be empty (e.g. /usv0/lidar)"));
-        }
+        self.check_topic(topic, &schema.name)?;
         let partial = self.partial.clone();
         let slot = match self.channels.get_mut(topic) {
-            Some(slot) => {
-                if slot.schema != schema.name {
-                    return Err(MmusvError::input(
-                        "topic",
-                        format!("{topic} already carries {}, cannot write {} on it", slot.schema, schema.name),
-                    ));
-                }
-                slot
-            }
+            Some(slot) => slot,
             None => {
                 let w = self.writer()?;
                 let schema_id =
@@ -226,6 +216,21 @@ impl Recorder {
         self.writer()?.write_to_known_channel(&header, data).map_err(mcap_err(&partial))?;
         self.messages += 1;
         Ok(())
+    }
+
+    /// Checks that a message of schema `schema` may go to `topic`: a non-empty topic that carries no other
+    /// schema yet.
+    pub fn check_topic(&self, topic: &str, schema: &str) -> Result<()> {
+        if topic.is_empty() {
+            return Err(MmusvError::input("topic", "must not be empty (e.g. /usv0/lidar)"));
+        }
+        match self.channels.get(topic) {
+            Some(slot) if slot.schema != schema => Err(MmusvError::input(
+                "topic",
+                format!("{topic} already carries {}, cannot write {schema} on it", slot.schema),
+            )),
+            _ => Ok(()),
+        }
     }
 
     /// Writes an MCAP metadata record `name` holding `map` (e.g. scenario name, seed, mmusv version).
