@@ -234,18 +234,20 @@ def _yaw(pose: npt.NDArray[np.float64]) -> float:
 def ppi_colormap(img: npt.ArrayLike, *, vmin_db: float = -20.0, vmax_db: float = 30.0) -> npt.NDArray[np.uint8]:
     """``(H, W, 3)`` uint8 radar-green rendering of a PPI: intensity in dB (``10·log10``) mapped linearly from
     ``vmin_db`` (dark green) to ``vmax_db`` (near white); pixels ``<= 0`` are black. Fixed limits by default,
-    so frames are comparable."""
+    so frames are comparable. Only the lit pixels are computed (a PPI is mostly empty): per pixel, the same
+    operations as over the whole image."""
     a = np.asarray(img, dtype=np.float64)
     if a.ndim != 2:
         raise InputError(f"img must be a (H, W) intensity image, got shape {a.shape}")
     if not vmax_db > vmin_db:
         raise InputError(f"need vmax_db > vmin_db, got {vmin_db} and {vmax_db}")
-    with np.errstate(divide="ignore", invalid="ignore"):
-        db = 10.0 * np.log10(a)
+    lit = a > 0
+    db = 10.0 * np.log10(a[lit])
     t = np.clip((db - vmin_db) / (vmax_db - vmin_db), 0.0, 1.0)
     rgb = np.stack([255.0 * t**3, 50.0 + 205.0 * t**0.6, 30.0 * t + 200.0 * t**4], axis=-1)
-    rgb[~(a > 0)] = 0.0
-    return np.ascontiguousarray(np.rint(rgb), dtype=np.uint8)
+    out = np.zeros((*a.shape, 3), dtype=np.uint8)
+    out[lit] = np.rint(rgb).astype(np.uint8)
+    return out
 
 
 def ppi_png(path: str | os.PathLike[str], img: npt.ArrayLike, **colormap: float) -> None:
