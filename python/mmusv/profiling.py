@@ -122,7 +122,8 @@ class RunProfile:
         la = " ".join(f"{x:.2f}" for x in self.load_average)
         lines.append(
             f"wall {self.wall_s:.1f} s for {self.frames} frames: {self.frames_per_s:.2f} frames/s, "
-            f"CPU {self.cpu_percent:.0f} % ({os.cpu_count()} cores), peak RSS {self.peak_rss_mb:.0f} MB, "
+            f"CPU {self.cpu_percent:.0f} % ({os.cpu_count()} cores, {self.cpu_s / max(self.frames, 1):.2f} CPU s per "
+            f"frame), peak RSS {self.peak_rss_mb:.0f} MB, "
             f"load average {la}"
         )
         lines.append("indented rows: task times inside the stage above them (sensors of one frame run concurrently,")
