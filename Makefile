@@ -1,4 +1,4 @@
-.PHONY: help install dev test test-rust test-py fmt lint bench bench-peers
+.PHONY: help install dev test test-rust test-py fmt lint bench bench-peers profile
 
 help: ## list the targets
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  %-12s %s\n", $$1, $$2}'
@@ -35,3 +35,6 @@ bench: ## criterion ray-casting benchmarks (rays/s)
 
 bench-peers: ## mmusv vs Open3D/Embree on the same scene and rays
 	python3 benches/compare_open3d.py
+
+profile: ## where the main job's time goes, per stage per frame (50 frames of scenarios/port_entry.yaml)
+	python3 benches/profile_run.py

@@ -193,3 +193,156 @@ def test_info_and_preview_commands(
     with Image.open(png) as image:
         assert image.size[0] > 100
     assert main(["preview", str(res.recording), "--frame", "9"]) == 2
+
+
+# ------------------------------------------------------------------ the overlapped pipeline (issue #12)
+
+
+def _sequential(tmp_path: Path, frames: int) -> bytes:
+    """The recording written the plain way: capture, annotate, write, one frame after the other, one thread."""
+    from mmusv.acquire import annotations_for
+    from mmusv.annotate import SilhouetteCache
+    from mmusv.recording.frames import FrameRecorder
+
+    sim = mmusv.Simulation(small_scenario(frames))
+    path = tmp_path / "sequential.mcap"
+    rec = FrameRecorder(path, sim)
+    silhouettes = SilhouetteCache()
+    for k in range(frames):
+        cap = sim.capture(k)
+        rec.write_frame(cap, {a: ann.columns() for a, ann in annotations_for(sim, cap, silhouettes).items()})
+    rec.finish(status="complete", frames=frames, requested=frames)
+    return path.read_bytes()
+
+
+def test_overlapped_run_writes_the_bytes_of_the_sequential_loop(recorded: tuple[Path, Any], tmp_path: Path) -> None:
+    _out, res = recorded
+    assert res.recording.read_bytes() == _sequential(tmp_path, 3)
+
+
+def test_profiled_run_writes_the_same_bytes_and_times_every_stage(recorded: tuple[Path, Any], tmp_path: Path) -> None:
+    out, res = recorded
+    prof = run(small_scenario(), out_dir=tmp_path, profile=True)
+    assert prof.recording.read_bytes() == res.recording.read_bytes()
+    for table in ("world_state", "boxes_3d", "boxes_2d"):
+        part = f"tables/{table}/part-00000.parquet"
+        assert (tmp_path / part).read_bytes() == (out / part).read_bytes()
+    assert res.profile is None and prof.profile is not None
+    p = prof.profile
+    stages = {r.stage: r for r in p.rows()}
+    for sensor in ("lidar", "camera/front", "camera/rear", "top_view", "radar", "ppi"):
+        assert stages[f"main:capture/{sensor}"].overlapping
+    for stage in ("main:capture", "main:annotate", "main:wait", "main:python", "writer:write", "writer:tables"):
+        assert not stages[stage].overlapping
+    assert stages["writer:write/encode"].seconds > 0
+    assert p.frames == 3 and p.wall_s > 0 and p.cpu_s > 0 and p.peak_rss_mb > 0
+    # the main thread's stages and its rest add up to the wall time; the writer's and its idle time too
+    for thread, rest in (("main", "python"), ("writer", "idle")):
+        flat = [r.seconds for r in p.rows() if r.stage.startswith(thread + ":") and not r.overlapping]
+        assert sum(flat) == pytest.approx(p.wall_s, rel=1e-9) or stages[f"{thread}:{rest}"].seconds == 0
+    text = p.render()
+    assert "main:capture/camera/front" in text and "frames/s" in text and "load average" in text
+
+
+def test_interrupt_while_a_frame_is_being_written(
+    recorded: tuple[Path, Any], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Ctrl-C lands while the writer thread is inside frame 1: frames 0 and 1 are complete in the file."""
+    import threading
+
+    from mmusv.recording.frames import FrameRecorder
+
+    writing_1 = threading.Event()
+    original = FrameRecorder.write_frame
+
+    def slow_write(self: FrameRecorder, cap: Any, annotations: Any) -> None:
+        if cap.frame == 1:
+            writing_1.set()
+            threading.Event().wait(0.5)  # still writing when the main thread is interrupted
+        original(self, cap, annotations)
+
+    monkeypatch.setattr(FrameRecorder, "write_frame", slow_write)
+
+    def stop(done: int, total: int) -> None:
+        if done == 2:
+            assert writing_1.wait(10)
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run(small_scenario(frames=5), out_dir=tmp_path, progress=stop)
+    rec = tmp_path / "port_entry.mcap"
+    assert rec.exists() and not (tmp_path / "port_entry.mcap.partial").exists()
+    msgs = _messages(rec)
+    per_time: dict[int, set[str]] = {}
+    for topic, lt, _m, _d in msgs:
+        per_time.setdefault(lt, set()).add(topic)
+    assert sorted(per_time) == [0, 200_000_000]
+    every_topic = {t for t, *_ in _messages(recorded[1].recording)}
+    assert per_time[0] == per_time[200_000_000] == every_topic  # both frames complete
+    with rec.open("rb") as f:
+        meta = {m.name: dict(m.metadata) for m in make_reader(f).iter_metadata()}
+    assert meta["run"]["status"] == "interrupted" and meta["run"]["frames_written"] == "2"
+    assert json.loads((tmp_path / "manifest.json").read_text())["frames_written"] == 2
+    assert sorted(pl.read_parquet(tmp_path / "tables/world_state/*.parquet")["frame"].unique()) == [0, 1]
+
+
+def test_a_failing_write_fails_the_run_and_keeps_the_frames_before_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from mmusv.recording.frames import FrameRecorder
+
+    original = FrameRecorder.write_frame
+
+    def failing(self: FrameRecorder, cap: Any, annotations: Any) -> None:
+        if cap.frame == 2:
+            raise mmusv.IoError("out.mcap: no space left on device")
+        original(self, cap, annotations)
+
+    monkeypatch.setattr(FrameRecorder, "write_frame", failing)
+    with pytest.raises(mmusv.IoError, match="no space left"):
+        run(small_scenario(frames=5), out_dir=tmp_path)
+    rec = tmp_path / "port_entry.mcap"
+    assert sorted({lt for _t, lt, _m, _d in _messages(rec)}) == [0, 200_000_000]
+    with rec.open("rb") as f:
+        meta = {m.name: dict(m.metadata) for m in make_reader(f).iter_metadata()}
+    assert meta["run"]["status"] == "failed" and meta["run"]["frames_written"] == "2"
+    assert "no space left" in meta["run"]["error"]
+    man = json.loads((tmp_path / "manifest.json").read_text())
+    assert man["status"] == "failed" and man["frames_written"] == 2
+    assert sorted(pl.read_parquet(tmp_path / "tables/world_state/*.parquet")["frame"].unique()) == [0, 1]
+
+
+def test_tf_holds_the_sensor_mounts_exactly(recorded: tuple[Path, Any]) -> None:
+    """/tf agent → sensor is the mount itself (not body⁻¹ · pose): exact, and the same in every frame."""
+    from mmusv.recording.frames import OPTICAL_IN_BODY, pose7
+
+    _out, res = recorded
+    sim = mmusv.Simulation(small_scenario())
+    tfs = [d for t, _lt, _m, d in _messages(res.recording) if t == "/tf"]
+    assert len(tfs) == 3
+    for agent in sim.agents:
+        assert agent.lidar_mount is not None and agent.radar_mount is not None
+        want = {
+            f"{agent.id}/lidar": pose7(agent.lidar_mount),
+            f"{agent.id}/radar": pose7(agent.radar_mount),
+            **{f"{agent.id}/camera/{n}": pose7(m @ OPTICAL_IN_BODY) for n, (_, _, m) in agent.cameras.items()},
+        }
+        for msg in tfs:
+            got = {t.child_frame_id: t for t in msg.transforms if t.parent_frame_id == agent.id}
+            assert set(got) == set(want)
+            for child, (xyz, q) in want.items():
+                t = got[child]
+                assert [t.translation.x, t.translation.y, t.translation.z] == xyz.tolist(), child
+                assert [t.rotation.x, t.rotation.y, t.rotation.z, t.rotation.w] == q.tolist(), child
+
+
+def test_cli_profile_prints_the_table(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = tmp_path / "small.yaml"
+    path.write_text(yaml.safe_dump(small_scenario(frames=2)))
+    assert main(["run", str(path), "-o", str(tmp_path / "out"), "--profile"]) == 0
+    text = capsys.readouterr().out
+    for row in ("main:capture", "main:capture/lidar", "main:capture/radar", "main:annotate", "writer:write/encode"):
+        assert row in text
+    assert "2 frames in" in text and "frames/s" in text and "CPU" in text
+    assert main(["run", str(tmp_path), "-o", str(tmp_path / "o2"), "--profile"]) == 2  # a folder: one line
+    assert "--profile times one scenario" in capsys.readouterr().err

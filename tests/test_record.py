@@ -338,3 +338,43 @@ def test_threads_share_one_recorder(tmp_path: Path) -> None:
             t.join(timeout=60)
     s = summary(path)
     assert s["messages"] == 80 and all(v["messages"] == 20 for v in s["topics"].values())
+
+
+def test_images_batch_writes_the_bytes_of_one_call_per_image(tmp_path: Path) -> None:
+    """Encoded in parallel, written in list order: the same file as png_image / raw_image one by one."""
+    items = [
+        ("/c/rgb", "cam", RGB, "png"),
+        ("/c/depth", "cam", DEPTH, "raw"),
+        ("/c/semantic", "cam", SEMANTIC, "png"),
+        ("/c/instance", "cam", INSTANCE, "png"),
+        ("/d/rgb", "cam_d", RGB[::-1].copy(), "png"),
+    ]
+    with Recording(tmp_path / "one.mcap") as rec:
+        for k in range(3):
+            for topic, frame_id, image, fmt in items:
+                call = rec.png_image if fmt == "png" else rec.raw_image
+                call(topic, log_time_ns=to_ns(0.2 * k), frame_id=frame_id, image=image)
+    with Recording(tmp_path / "batch.mcap") as rec:
+        for k in range(3):
+            encode_s, write_s = rec.images(log_time_ns=to_ns(0.2 * k), images=items)  # type: ignore[arg-type]
+            assert encode_s >= 0 and write_s >= 0
+    one, batch = (tmp_path / "one.mcap").read_bytes(), (tmp_path / "batch.mcap").read_bytes()
+    assert len(one) > 5_000 and one == batch
+    msgs = list(read_messages(tmp_path / "batch.mcap", topics=["/c/instance"]))
+    assert len(msgs) == 3
+    got = np.asarray(Image.open(io.BytesIO(msgs[0][2].data)))
+    np.testing.assert_array_equal(got, INSTANCE)
+
+
+def test_images_batch_refuses_bad_images_before_writing_any(tmp_path: Path) -> None:
+    with Recording(tmp_path / "bad.mcap") as rec:
+        good = ("/ok", "f", RGB, "png")
+        with pytest.raises(InputError, match=r"images\[1\]: PNG holds uint8 or uint16"):
+            rec.images(log_time_ns=0, images=[good, ("/d", "f", DEPTH, "png")])
+        with pytest.raises(InputError, match=r"images\[1\] format 'jpeg'"):
+            rec.images(log_time_ns=0, images=[good, ("/j", "f", RGB, "jpeg")])  # type: ignore[list-item]
+        with pytest.raises(InputError, match=r"invalid images\[0\]"):
+            rec.images(log_time_ns=0, images=[("/x", "f", np.zeros((4, 4, 2), np.uint8), "raw")])
+        with pytest.raises(InputError, match="topic"):
+            rec.images(log_time_ns=0, images=[good, ("", "f", RGB, "png")])
+    assert summary(tmp_path / "bad.mcap")["messages"] == 0  # nothing of a refused batch was written

@@ -30,6 +30,7 @@ __all__ = [
     "__version__",
     "_lidar_directions",
     "_pinhole_directions",
+    "capture_frame",
     "default_amplitudes",
     "demo_scene",
     "lidar_trace_order",
@@ -338,6 +339,22 @@ class Radar:
         range R exactly R / metres_per_pixel px from it; ``orientation`` "north_up" (rotated by ``sensor_yaw``
         rad) or "head_up"."""
 
+# --- one frame of every sensor ---
+
+_CaptureTask = (
+    tuple[Lidar | Camera | Radar, npt.NDArray[np.float64], int]
+    | tuple[Radar, npt.NDArray[np.float64], int, tuple[int, float, str, float] | None]
+)
+
+def capture_frame(
+    scene: Scene, *, env: SensorEnv, tasks: Sequence[_CaptureTask]
+) -> list[tuple[dict[str, npt.NDArray[Any]], float, float]]:
+    """Every sensor task of a frame on the current state of ``scene``, concurrently over all cores, GIL released.
+    A task is ``(sensor, pose, seed)`` (pose (4, 4) float64 sensor → world) or ``(radar, pose, seed, ppi)`` with
+    ``ppi = (size_px, metres_per_pixel, orientation, sensor_yaw)`` or None. Returns, in task order,
+    ``(outputs, seconds, ppi_seconds)``: the dict ``scan``/``render``/``sweep`` return (bit-identical to those
+    calls; a radar's has ``ppi`` (size_px, size_px) f32 when asked for) and the task's wall seconds (profiling)."""
+
 # --- demo ---
 
 def demo_scene(
@@ -440,6 +457,19 @@ class Recorder:
     def png_image(self, topic: str, *, log_time_ns: int, frame_id: str, image: npt.NDArray[Any]) -> None:
         """``foxglove.CompressedImage`` format png of a C-contiguous (H, W) uint8, (H, W, 3) uint8 or (H, W) uint16
         image."""
+
+    def images(
+        self,
+        *,
+        log_time_ns: int,
+        topics: Sequence[str],
+        frame_ids: Sequence[str],
+        images: Sequence[npt.NDArray[Any]],
+        formats: Sequence[str],
+    ) -> tuple[float, float]:
+        """Image ``i`` to ``topics[i]`` in ``frame_ids[i]`` as ``formats[i]`` (``"png"`` like :meth:`png_image`,
+        ``"raw"`` like :meth:`raw_image`): all encoded in parallel before the recorder is locked, then written in
+        list order (the bytes of one call per image). Returns (encode seconds, write seconds), for profiling."""
 
     def frame_transforms(
         self,

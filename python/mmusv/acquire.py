@@ -6,6 +6,11 @@ captures every sensor of every USV on the frozen state of t_k = k / f, derives t
 (Algorithm 1 of the paper). Frames are written as they are produced, so memory stays flat however long the
 run; tables are flushed to Parquet parts every ``TABLE_PART_FRAMES`` frames.
 
+No core waits: all sensors of a frame run in one native call (:meth:`~mmusv.simulation.Simulation.capture`),
+and frame k is written (images encoded in parallel, MCAP, tables) on a writer thread while frame k+1 is
+captured (:mod:`mmusv.recording.background`; at most one frame waits between the two, so memory stays flat).
+One thread writes every frame in order, so the files are byte-identical to writing them one after another.
+
 Output in ``out_dir``: ``<name>.mcap`` (see ``docs/recording.md``), ``tables/{world_state,boxes_3d,boxes_2d}/
 part-NNNNN.parquet`` (polars), ``scenario.yaml`` (the resolved scenario) and ``manifest.json``. A run stopped by
 Ctrl-C or an error still finishes the MCAP (every completed frame is in it, its ``run`` metadata says
@@ -22,12 +27,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import polars as pl
 import yaml
 
 from mmusv.annotate import Annotations, SilhouetteCache, annotate_agent
 from mmusv.config import Scenario, load_scenario, scenario_hash
 from mmusv.errors import ConfigError, IoError, MmusvError, located
+from mmusv.profiling import RunProfile
+from mmusv.recording.background import BackgroundWriter
+from mmusv.recording.tables import TableWriter
 from mmusv.scenario_checks import check_mounts, check_routes
 from mmusv.simulation import FrameCapture, Simulation
 
@@ -49,6 +56,7 @@ class RunResult:
     bytes: int = 0
     error: str | None = None
     frame_seconds: list[float] = field(default_factory=list)
+    profile: RunProfile | None = None
 
 
 def recording_path(out_dir: Path, scenario: Scenario) -> Path:
@@ -56,107 +64,13 @@ def recording_path(out_dir: Path, scenario: Scenario) -> Path:
     return out_dir / f"{scenario.name}.mcap"
 
 
-class _Tables:
-    """Buffers table rows and flushes them as numbered Parquet parts."""
+@dataclass(frozen=True, eq=False)
+class _Frame:
+    """One captured and annotated frame on its way to the writer: the capture and, per agent, its
+    :class:`~mmusv.annotate.Annotations` with their ``columns()``."""
 
-    def __init__(self, root: Path) -> None:
-        self.root = root
-        self.rows: dict[str, list[dict[str, Any]]] = {"world_state": [], "boxes_3d": [], "boxes_2d": []}
-        self.part = 0
-
-    def add_world(self, sim: Simulation, cap: FrameCapture) -> None:
-        st = cap.world
-        for i, v in enumerate(sim.vessels):
-            x, y, z, r, p, yaw = (float(a) for a in st.poses[i])
-            self.rows["world_state"].append(
-                {
-                    "frame": cap.frame,
-                    "time_s": cap.time_s,
-                    "vessel_id": v.id,
-                    "asset": v.asset,
-                    "role": v.role,
-                    "static": v.static,
-                    "semantic_class": v.semantic_class,
-                    "instance_id": v.instance_id,
-                    "x": x,
-                    "y": y,
-                    "z": z,
-                    "roll": r,
-                    "pitch": p,
-                    "yaw": yaw,
-                    "vx": float(st.velocities[i, 0]),
-                    "vy": float(st.velocities[i, 1]),
-                    "vz": float(st.velocities[i, 2]),
-                    "box_cx": float(st.box_centers[i, 0]),
-                    "box_cy": float(st.box_centers[i, 1]),
-                    "box_cz": float(st.box_centers[i, 2]),
-                    "length": float(v.box_size[0]),
-                    "beam": float(v.box_size[1]),
-                    "height": float(v.box_size[2]),
-                }
-            )
-
-    def add_annotations(self, ann: Annotations, cols: dict[str, Any]) -> None:
-        """Rows of one agent's annotations; ``cols`` is ``ann.columns()``."""
-        lid = cols["lidar"]
-        for j, tid in enumerate(lid["target_id"]):
-            c, s, q = lid["center"][j], lid["size"][j], lid["rotation"][j]
-            self.rows["boxes_3d"].append(
-                {
-                    "frame": ann.frame,
-                    "time_s": ann.time_s,
-                    "agent": ann.agent,
-                    "target_id": tid,
-                    "instance_id": int(lid["instance_id"][j]),
-                    "semantic_class": int(lid["semantic_class"][j]),
-                    "x": float(c[0]),
-                    "y": float(c[1]),
-                    "z": float(c[2]),
-                    "length": float(s[0]),
-                    "beam": float(s[1]),
-                    "height": float(s[2]),
-                    "qx": float(q[0]),
-                    "qy": float(q[1]),
-                    "qz": float(q[2]),
-                    "qw": float(q[3]),
-                    "yaw": float(lid["yaw"][j]),
-                    "lidar_points": int(lid["lidar_points"][j]),
-                    "range_m": float(lid["range_m"][j]),
-                    "role": lid["role"][j],
-                    "static": bool(lid["static"][j]),
-                }
-            )
-        cam = cols["camera"]
-        for j, tid in enumerate(cam["target_id"]):
-            self.rows["boxes_2d"].append(
-                {
-                    "frame": ann.frame,
-                    "time_s": ann.time_s,
-                    "agent": ann.agent,
-                    "camera": cam["camera"][j],
-                    "target_id": tid,
-                    "x_min": float(cam["x_min"][j]),
-                    "y_min": float(cam["y_min"][j]),
-                    "x_max": float(cam["x_max"][j]),
-                    "y_max": float(cam["y_max"][j]),
-                    "truncation": float(cam["truncation"][j]),
-                    "visible_pixels": int(cam["visible_pixels"][j]),
-                    "box_pixels": int(cam["box_pixels"][j]),
-                    "occlusion": float(cam["occlusion"][j]),
-                    "role": cam["role"][j],
-                    "static": bool(cam["static"][j]),
-                }
-            )
-
-    def flush(self) -> None:
-        for name, rows in self.rows.items():
-            if not rows:
-                continue
-            d = self.root / name
-            d.mkdir(parents=True, exist_ok=True)
-            pl.DataFrame(rows).write_parquet(d / f"part-{self.part:05d}.parquet")
-            rows.clear()
-        self.part += 1
+    capture: FrameCapture
+    annotations: dict[str, tuple[Annotations, dict[str, Any]]]
 
 
 def annotations_for(sim: Simulation, cap: FrameCapture, silhouettes: SilhouetteCache) -> dict[str, Annotations]:
@@ -193,6 +107,7 @@ def run(
     progress: Callable[[int, int], None] | None = None,
     checks: bool = True,
     frame_range: tuple[int, int] | None = None,
+    profile: bool = False,
 ) -> RunResult:
     """Runs a scenario (a YAML path, a dict or a :class:`~mmusv.config.Scenario`) into ``out_dir``.
 
@@ -200,12 +115,15 @@ def run(
         out_dir: output folder (created).
         overwrite: replace an existing recording of the same scenario name; otherwise that is an error.
         frames: run only the first ``frames`` indices (default: the scenario's ``acquisition.frames``).
-        progress: called with (frames done, frames total) after every frame.
+        progress: called (on the calling thread) with (frames done, frames total) after every frame has been
+            captured, annotated and handed to the writer.
         frame_range: ``(first, stop)``: run only acquisition indices ``first .. stop - 1`` (one part of a
             recording split into frame ranges, :mod:`mmusv.batch`); every frame is the same as in a whole run
             (each frame is captured from its own frozen state and seeds). Not together with ``frames``.
         checks: run the generator's route checks on the map (:mod:`mmusv.scenario_checks`): a route over land
             is an error, clearance and separation problems and far-away mounts are warnings.
+        profile: time every stage (each sensor, annotation, encoding, writing, the rest) into
+            ``RunResult.profile`` (:class:`~mmusv.profiling.RunProfile`); the output bytes are the same.
 
     Raises:
         ConfigError: the scenario is invalid (nothing is written).
@@ -252,31 +170,55 @@ def run(
     if tables_dir.exists() and overwrite:
         for old in sorted(tables_dir.glob("*/part-*.parquet")):
             old.unlink()
-    tables = _Tables(tables_dir)
+    tables = TableWriter(tables_dir)
     silhouettes = SilhouetteCache()
     (out / "scenario.yaml").write_text(
         yaml.safe_dump(scenario.model_dump(mode="json"), sort_keys=False), encoding="utf-8"
     )
     result = RunResult(recording=rec_path, tables=tables_dir, frames_written=0, status="complete", seconds=0.0)
     t0 = time.perf_counter()
+    prof = RunProfile() if profile else None
+    result.profile = prof
     recorder = FrameRecorder(rec_path, sim, overwrite=overwrite)
+
+    def write(frame: _Frame) -> None:  # on the writer thread, in frame order
+        t = time.perf_counter()
+        encoded = recorder.encode_seconds
+        recorder.write_frame(frame.capture, {agent: cols for agent, (_, cols) in frame.annotations.items()})
+        tw = time.perf_counter()
+        tables.add_frame(sim.vessels, frame.capture, frame.annotations)
+        if (frame.capture.frame + 1) % TABLE_PART_FRAMES == 0:  # parts end at the same indices in every run
+            tables.flush()
+        if prof is not None:
+            prof.add("writer:write", tw - t)
+            prof.add("writer:write/encode", recorder.encode_seconds - encoded)
+            prof.add("writer:tables", time.perf_counter() - tw)
+
+    writer = BackgroundWriter(write, depth=1)
+    if prof is not None:
+        prof.start()
     try:
         for k in range(first, total):
             tf = time.perf_counter()
             cap = sim.capture(k)
+            t1 = time.perf_counter()
             anns = annotations_for(sim, cap, silhouettes)
-            cols = {agent: a.columns() for agent, a in anns.items()}
-            recorder.write_frame(cap, cols)
-            tables.add_world(sim, cap)
-            for agent, a in anns.items():
-                tables.add_annotations(a, cols[agent])
-            del cap
-            result.frames_written = k + 1 - first
+            frame = _Frame(cap, {agent: (a, a.columns()) for agent, a in anns.items()})
+            t2 = time.perf_counter()
+            waited = writer.wait_seconds
+            writer.submit(frame)  # written while the next frame is captured
+            if prof is not None:
+                prof.add("main:capture", t1 - tf)
+                for key, sec in cap.sensor_seconds.items():  # keyed <agent>/<sensor>: summed over the agents
+                    prof.add("main:capture/" + key.split("/", 1)[1], sec)
+                prof.add("main:annotate", t2 - t1)
+                prof.add("main:wait", writer.wait_seconds - waited)
+            del cap, frame
             result.frame_seconds.append(time.perf_counter() - tf)
-            if (k + 1) % TABLE_PART_FRAMES == 0:
-                tables.flush()
             if progress is not None:
                 progress(k + 1 - first, total - first)
+        writer.close()
+        writer.raise_pending()
     except KeyboardInterrupt:
         result.status = "interrupted"
         raise
@@ -285,6 +227,8 @@ def run(
         result.error = f"{type(exc).__name__}: {exc}"
         raise
     finally:
+        writer.close()  # every frame handed over is written, also after an error or a Ctrl-C
+        result.frames_written = writer.done
         summary = recorder.finish(
             status=result.status,
             frames=result.frames_written,
@@ -293,8 +237,10 @@ def run(
             first_frame=None if frame_range is None else first,
         )
         result.messages, result.bytes = summary.get("messages", 0), summary.get("bytes", 0)
-        tables.flush()
+        tables.flush()  # the writer thread has ended: the tables are the main thread's again
         result.seconds = time.perf_counter() - t0
+        if prof is not None:
+            prof.stop(result.frames_written)
         manifest = {
             "mmusv_version": _version(),
             "scenario": scenario.name,

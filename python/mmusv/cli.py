@@ -89,7 +89,15 @@ def _cmd_study_waves(args: argparse.Namespace) -> int:
     return 0
 
 
-def _run_one(path: str, out: str, overwrite: bool, frames: int | None, show_progress: bool, checks: bool = True) -> str:
+def _run_one(
+    path: str,
+    out: str,
+    overwrite: bool,
+    frames: int | None,
+    show_progress: bool,
+    checks: bool = True,
+    profile: bool = False,
+) -> str:
     """Runs one scenario; returns a one-line report. Used directly and in worker processes."""
     from mmusv.acquire import run
     from mmusv.config import load_scenario
@@ -109,6 +117,7 @@ def _run_one(path: str, out: str, overwrite: bool, frames: int | None, show_prog
                     overwrite=overwrite,
                     frames=frames,
                     checks=checks,
+                    profile=profile,
                     progress=lambda done, total: bar.update(task, completed=done),
                 )
             except KeyboardInterrupt:
@@ -118,12 +127,13 @@ def _run_one(path: str, out: str, overwrite: bool, frames: int | None, show_prog
                 print(f"mmusv: interrupted; {rec} is a valid recording holding every completed frame", file=sys.stderr)
                 raise
     else:
-        res = run(path, out_dir=out, overwrite=overwrite, frames=frames, checks=checks)
+        res = run(path, out_dir=out, overwrite=overwrite, frames=frames, checks=checks, profile=profile)
     fps = res.frames_written / res.seconds if res.seconds > 0 else float("nan")
-    return (
+    line = (
         f"{scenario.name}: {res.frames_written} frames in {res.seconds:.1f} s ({fps:.2f} frames/s), "
         f"{res.messages} messages, {res.bytes / 1e6:.1f} MB -> {res.recording}"
     )
+    return line if res.profile is None else f"{res.profile.render()}\n{line}"
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
@@ -132,10 +142,18 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
     src = resolve_scenario(args.scenario)
     if src.is_dir():
+        if args.profile:
+            raise MmusvError("--profile times one scenario; give a scenario file, not a folder")
         return run_batch(args, src)
     if uses_batch(args):  # one file with --ray, --retries, --split-frames: a batch of one (OUT/<stem>/)
+        if args.profile:
+            raise MmusvError("--profile times one run in this process; leave out --ray, --retries and --split-frames")
         return run_batch(args, [src])
-    print(_run_one(str(src), args.output, args.overwrite, args.frames, sys.stdout.isatty(), not args.no_checks))
+    print(
+        _run_one(
+            str(src), args.output, args.overwrite, args.frames, sys.stdout.isatty(), not args.no_checks, args.profile
+        )
+    )
     return 0
 
 
@@ -264,6 +282,11 @@ def _parser() -> argparse.ArgumentParser:
         "--no-checks",
         action="store_true",
         help="skip the route checks on the map (in water: an error; clearances, separation: warnings)",
+    )
+    run.add_argument(
+        "--profile",
+        action="store_true",
+        help="print the time per stage per frame (each sensor, annotation, encoding, writing, the rest)",
     )
     info = sub.add_parser("info", help="agents, topics, frames and duration of a recording")
     info.add_argument("recording", help="an .mcap written by mmusv run")

@@ -24,11 +24,11 @@ from mmusv._native import core
 from mmusv.config import Scenario, VesselConfig, load_scenario
 from mmusv.errors import ConfigError
 from mmusv.motion import build_fleet
-from mmusv.sensors.camera import CameraImages, camera_from_config, render, top_view_from_config
+from mmusv.sensors.camera import CameraImages, camera_from_config, top_view_from_config
 from mmusv.sensors.config import CameraConfig, Mount, RigConfig
 from mmusv.sensors.env import sensor_env
-from mmusv.sensors.lidar import LidarPoints, lidar_from_config, scan
-from mmusv.sensors.radar import RadarReturns, ppi_image, radar_from_config, radar_sweep
+from mmusv.sensors.lidar import LidarPoints, lidar_from_config
+from mmusv.sensors.radar import RadarReturns, ppi_request, radar_from_config
 from mmusv.world.build import WorldScene, build_world_scene, pose_matrices
 from mmusv.world.environment import Environment
 from mmusv.world.maps import MapWorld, generate_map_from
@@ -180,6 +180,9 @@ class FrameCapture:
     time_s: float
     world: WorldState
     agents: dict[str, AgentCapture]
+    sensor_seconds: dict[str, float] = field(default_factory=dict, compare=False)
+    """Wall seconds each sensor's work took, keyed ``<agent>/<sensor>`` (``lidar``, ``camera/<name>``,
+    ``top_view``, ``radar``, ``ppi``): for profiling only, never recorded."""
 
 
 class Simulation:
@@ -316,6 +319,11 @@ class Simulation:
 
         ``agents`` limits the USVs (ids), ``sensors`` the sensor kinds (``lidar``, ``cameras``, ``top_view``,
         ``radar``); ``None`` means all. ``radar=False`` leaves the radar out whatever ``sensors`` says.
+
+        Every selected sensor of every selected USV runs in one native call (``core.capture_frame``: concurrent
+        tasks over all cores, GIL released), with the outputs bit-identical to calling :func:`~mmusv.sensors.
+        lidar.scan`, :func:`~mmusv.sensors.camera.render`, :func:`~mmusv.sensors.radar.radar_sweep` and
+        :func:`~mmusv.sensors.radar.ppi_image` one by one with the same poses and :func:`sensor_seed` seeds.
         """
         if agents is not None:
             unknown = sorted(set(agents) - {a.id for a in self.agents})
@@ -331,9 +339,10 @@ class Simulation:
                 f"unknown sensor kind(s) {sorted(kinds - set(SENSOR_KINDS))}; allowed: {', '.join(SENSOR_KINDS)}"
             )
         state = self.set_frame(frame)
-        env = self.sensor_env
         sc = self.scenario
         out: dict[str, AgentCapture] = {}
+        tasks: list[core._CaptureTask] = []
+        slots: list[tuple[Agent, AgentCapture, str]] = []  # where each task's output goes
         for agent in self.agents:
             if agents is not None and agent.id not in agents:
                 continue
@@ -346,48 +355,53 @@ class Simulation:
                 cap.sensors[key] = SensorMount(mount=m, pose=p)
             if agent.lidar is not None and "lidar" in kinds:
                 cap.lidar_pose = poses["lidar"]
-                cap.lidar = scan(
-                    agent.lidar,
-                    self.ws.scene,
-                    pose=cap.lidar_pose,
-                    env=env,
-                    seed=sensor_seed(sc.seed, frame, agent.index, "lidar"),
-                )
+                tasks.append((agent.lidar, _pose(cap.lidar_pose), sensor_seed(sc.seed, frame, agent.index, "lidar")))
+                slots.append((agent, cap, "lidar"))
             for k, (name, (cam, _, _)) in enumerate(agent.cameras.items()):
                 if "cameras" not in kinds:
                     break
                 p = poses[f"camera/{name}"]
                 cap.camera_poses[name] = p
-                cap.cameras[name] = render(
-                    cam, self.ws.scene, pose=p, env=env, seed=sensor_seed(sc.seed, frame, agent.index, "camera", k)
-                )
+                tasks.append((cam, _pose(p), sensor_seed(sc.seed, frame, agent.index, "camera", k)))
+                slots.append((agent, cap, f"camera/{name}"))
             if agent.top_view is not None and "top_view" in kinds:
                 cap.top_view_pose = poses["top_view"]
-                cap.top_view = render(
-                    agent.top_view,
-                    self.ws.scene,
-                    pose=cap.top_view_pose,
-                    env=env,
-                    seed=sensor_seed(sc.seed, frame, agent.index, "top_view"),
-                )
+                seed = sensor_seed(sc.seed, frame, agent.index, "top_view")
+                tasks.append((agent.top_view, _pose(cap.top_view_pose), seed))
+                slots.append((agent, cap, "top_view"))
             if "radar" in kinds and agent.radar is not None and agent.rig.radar is not None:
-                cap.radar_pose = poses["radar"]
+                cap.radar_pose = _pose(poses["radar"])
                 cfg = agent.rig.radar
-                cap.radar = radar_sweep(
+                ppi = ppi_request(
                     agent.radar,
-                    self.ws.scene,
                     pose=cap.radar_pose,
-                    env=env,
-                    seed=sensor_seed(sc.seed, frame, agent.index, "radar"),
-                )
-                cap.radar_ppi = ppi_image(
-                    cap.radar,
                     size_px=cfg.ppi_size_px,
                     metres_per_pixel=cfg.ppi_metres_per_pixel,
                     orientation=cfg.ppi_orientation,
                 )
+                tasks.append((agent.radar, cap.radar_pose, sensor_seed(sc.seed, frame, agent.index, "radar"), ppi))
+                slots.append((agent, cap, "radar"))
             out[agent.id] = cap
-        return FrameCapture(frame, state.time_s, state, out)
+        results = core.capture_frame(self.ws.scene.native, env=self.sensor_env, tasks=tasks) if tasks else []
+        secs: dict[str, float] = {}
+        for (agent, cap, key), (d, seconds, ppi_seconds) in zip(slots, results, strict=True):
+            secs[f"{agent.id}/{key}"] = seconds
+            if key == "lidar":
+                cap.lidar = LidarPoints.from_native(d)
+            elif key == "top_view":
+                cap.top_view = CameraImages.from_native(d)
+            elif key == "radar" and agent.radar is not None and cap.radar_pose is not None:
+                cap.radar = RadarReturns.from_native(d, pose=cap.radar_pose, radar=agent.radar)
+                cap.radar_ppi = d["ppi"]
+                secs[f"{agent.id}/ppi"] = ppi_seconds
+            else:
+                cap.cameras[key.removeprefix("camera/")] = CameraImages.from_native(d)
+        return FrameCapture(frame, state.time_s, state, out, secs)
+
+
+def _pose(m: np.ndarray) -> npt.NDArray[np.float64]:
+    """A ``(4, 4)`` pose as the core takes it: C-contiguous float64."""
+    return np.ascontiguousarray(m, dtype=np.float64)
 
 
 def inside_mesh(vertices: np.ndarray, faces: np.ndarray, point: np.ndarray, *, rays: int = 9) -> bool:

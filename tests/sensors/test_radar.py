@@ -308,6 +308,24 @@ def test_bad_environment_pose_and_ppi_arguments() -> None:
         ppi_image(ret, size_px=0)
 
 
+def test_colormap_matches_its_formula_pixel_by_pixel() -> None:
+    """dB mapped linearly from -20 to 30 dB, then (255 t³, 50 + 205 t^0.6, 30 t + 200 t⁴) rounded; black where the
+    intensity is not > 0 (NaN included). Checked one pixel at a time in plain Python."""
+    rng = np.random.default_rng(3)
+    img = np.where(rng.random((40, 50)) < 0.2, 10 ** rng.uniform(-4, 5, (40, 50)), 0.0).astype(np.float32)
+    img[0, :6] = [np.inf, np.nan, -1.0, 1e-30, 0.01, 1000.0]
+    rgb = ppi_colormap(img)
+    for (i, j), v in np.ndenumerate(img):
+        if not v > 0:
+            want = (0, 0, 0)
+        else:
+            t = min(max((10.0 * math.log10(float(v)) + 20.0) / 50.0, 0.0), 1.0)
+            want = (round(255.0 * t**3), round(50.0 + 205.0 * t**0.6), round(30.0 * t + 200.0 * t**4))
+        got = tuple(int(c) for c in rgb[i, j])
+        assert all(abs(g - w) <= 1 for g, w in zip(got, want, strict=True)), ((i, j), v, got, want)
+    assert tuple(rgb[0, 4]) == (0, 50, 0) and tuple(rgb[0, 5]) == (255, 255, 230)  # -20 dB, +30 dB
+
+
 def test_colormap_and_png(tmp_path: Path) -> None:
     from PIL import Image
 

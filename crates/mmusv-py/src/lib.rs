@@ -6,6 +6,7 @@
 
 use pyo3::prelude::*;
 
+mod capture;
 mod demo;
 mod errors;
 mod kinematics;
@@ -24,6 +25,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     kinematics::register(m)?;
     sensors::register(m)?;
     radar::register(m)?;
+    capture::register(m)?;
     record::register(m)?;
     demo::register(m)?;
     Ok(())

@@ -5,8 +5,9 @@ use crate::errors::to_py;
 use crate::native::{detached, flat, pose_arg};
 use crate::scene::Scene;
 use crate::sensors::SensorEnv;
+use mmusv_core::sensors::capture;
 use mmusv_core::sensors::ppi::{self, PpiConfig, PpiOrientation};
-use mmusv_core::sensors::radar::{self, RadarConfig, RadarEnv, RadarReturns};
+use mmusv_core::sensors::radar::{self, RadarConfig, RadarReturns};
 use mmusv_core::sensors::radar_model::ClutterModel;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
@@ -17,7 +18,7 @@ use pyo3::types::PyDict;
 /// field is required: the defaults live in one place, the scenario schema `mmusv.sensors.config.RadarConfig`.
 #[pyclass(frozen, module = "mmusv._core")]
 pub struct Radar {
-    cfg: RadarConfig,
+    pub(crate) cfg: RadarConfig,
 }
 
 #[pymethods]
@@ -117,17 +118,10 @@ impl Radar {
         seed: u64,
     ) -> PyResult<Bound<'py, PyDict>> {
         let pose = pose_arg(&pose, "pose")?;
-        let env = RadarEnv { wave_height_m: env.shade.wave_height_m, rain_mm_per_h: env.shade.rain_mm_per_h };
+        let env = capture::radar_env(&env.shade);
         let cfg = &self.cfg;
         let ret = scene.get().read(|s| detached(py, || radar::radar_sweep(s, &pose, cfg, &env, seed)))?;
-        let out = PyDict::new(py);
-        out.set_item("range", ret.range.into_pyarray(py))?;
-        out.set_item("azimuth", ret.azimuth.into_pyarray(py))?;
-        out.set_item("elevation", ret.elevation.into_pyarray(py))?;
-        out.set_item("intensity", ret.intensity.into_pyarray(py))?;
-        out.set_item("instance", ret.instance.into_pyarray(py))?;
-        out.set_item("class", ret.class.into_pyarray(py))?;
-        Ok(out)
+        returns_dict(py, ret)
     }
 
     /// `(size_px, size_px)` float32 PPI of returns of this radar (`range` m, `azimuth` rad sensor frame,
@@ -161,6 +155,18 @@ impl Radar {
             .map(|a| a.into_pyarray(py))
             .map_err(|e| crate::errors::InternalError::new_err(e.to_string()))
     }
+}
+
+/// The dict of one sweep as `Radar.sweep` returns it (columns moved into numpy, no copy).
+pub(crate) fn returns_dict(py: Python<'_>, ret: RadarReturns) -> PyResult<Bound<'_, PyDict>> {
+    let out = PyDict::new(py);
+    out.set_item("range", ret.range.into_pyarray(py))?;
+    out.set_item("azimuth", ret.azimuth.into_pyarray(py))?;
+    out.set_item("elevation", ret.elevation.into_pyarray(py))?;
+    out.set_item("intensity", ret.intensity.into_pyarray(py))?;
+    out.set_item("instance", ret.instance.into_pyarray(py))?;
+    out.set_item("class", ret.class.into_pyarray(py))?;
+    Ok(out)
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

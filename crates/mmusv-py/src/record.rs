@@ -2,12 +2,13 @@
 //!
 //! Concurrency: the core recorder sits behind a mutex that is only ever locked inside [`detached`] (GIL
 //! released), so a thread waiting for it never holds the GIL and two Python threads cannot deadlock.
+//! `images` encodes before it takes the lock: the lock is held only to append the finished messages.
 
 use crate::errors::InputError;
 use crate::native::{detached, flat, rows};
 use mmusv_core::record::{
-    AgentAnnotations, BevBox, Box2D, Box3D, BoxMarker, Column, PackedType, Pixels, Recorder as CoreRecorder, Transform,
-    VesselState, WorldState,
+    encode_images, AgentAnnotations, BevBox, Box2D, Box3D, BoxMarker, Column, ImageFormat, ImageJob, PackedType,
+    Pixels, Recorder as CoreRecorder, Transform, VesselState, WorldState,
 };
 use mmusv_core::MmusvError;
 use numpy::PyUntypedArrayMethods;
@@ -18,6 +19,7 @@ use pyo3::types::PyDict;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::Mutex;
+use std::time::Instant;
 
 /// One point-cloud column of any supported dtype, borrowed read-only.
 enum ColumnArray<'py> {
@@ -137,11 +139,14 @@ impl Recorder {
         py: Python<'_>,
         f: impl FnOnce(&mut CoreRecorder) -> mmusv_core::Result<T> + Send,
     ) -> PyResult<T> {
-        detached(py, || {
-            let mut guard = self.inner.lock().map_err(|_| self.closed_error("an earlier internal error"))?;
-            let rec = guard.as_mut().ok_or_else(|| self.closed_error("finish() or abandon() was called"))?;
-            f(rec)
-        })
+        detached(py, || self.locked(f))
+    }
+
+    /// Runs `f` on the open recorder under its lock (call with the GIL released, inside [`detached`]).
+    fn locked<T>(&self, f: impl FnOnce(&mut CoreRecorder) -> mmusv_core::Result<T>) -> mmusv_core::Result<T> {
+        let mut guard = self.inner.lock().map_err(|_| self.closed_error("an earlier internal error"))?;
+        let rec = guard.as_mut().ok_or_else(|| self.closed_error("finish() or abandon() was called"))?;
+        f(rec)
     }
 
     /// Takes the recorder out (GIL released); `None` when it is already closed.
@@ -250,6 +255,44 @@ impl Recorder {
         let arr = ImageArray::from_any(image)?;
         let (w, h, px) = arr.pixels()?;
         self.with(py, |r| r.png_image(topic, log_time_ns, frame_id, w, h, &px))
+    }
+
+    /// Several images at one time: image `i` goes to `topics[i]` in `frame_ids[i]`, stored as `formats[i]`
+    /// (`"png"`: `foxglove.CompressedImage`, `"raw"`: `foxglove.RawImage`). They are encoded in parallel
+    /// before the recorder is locked, then written in list order (the bytes of one call per image). Returns
+    /// the wall seconds spent encoding and writing (for profiling).
+    #[pyo3(signature = (*, log_time_ns, topics, frame_ids, images, formats))]
+    fn images(
+        &self,
+        py: Python<'_>,
+        log_time_ns: u64,
+        topics: Vec<String>,
+        frame_ids: Vec<String>,
+        images: Vec<Bound<'_, PyAny>>,
+        formats: Vec<String>,
+    ) -> PyResult<(f64, f64)> {
+        let n = topics.len();
+        same_len(n, "topics", &[("frame_ids", frame_ids.len()), ("images", images.len()), ("formats", formats.len())])?;
+        let arrays = images.iter().map(ImageArray::from_any).collect::<PyResult<Vec<_>>>()?;
+        let mut jobs = Vec::with_capacity(n);
+        for (i, arr) in arrays.iter().enumerate() {
+            let (width, height, pixels) = arr.pixels()?;
+            let format = match formats[i].as_str() {
+                "png" => ImageFormat::Png,
+                "raw" => ImageFormat::Raw,
+                other => {
+                    return Err(InputError::new_err(format!("formats[{i}] must be \"png\" or \"raw\", got {other:?}")))
+                }
+            };
+            jobs.push(ImageJob { topic: &topics[i], frame_id: &frame_ids[i], width, height, pixels, format });
+        }
+        detached(py, || {
+            let start = Instant::now();
+            let encoded = encode_images(log_time_ns, &jobs)?;
+            let encoded_at = Instant::now();
+            self.locked(|r| r.write_messages(log_time_ns, &encoded))?;
+            Ok(((encoded_at - start).as_secs_f64(), encoded_at.elapsed().as_secs_f64()))
+        })
     }
 
     /// `foxglove.FrameTransforms`: transform `i` is the pose of `children[i]` in `parents[i]`.

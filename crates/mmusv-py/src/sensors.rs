@@ -2,7 +2,7 @@
 
 use crate::native::{detached, pose_arg, rows_to_array, RayArrays};
 use mmusv_core::sensors::shade::ShadeEnv;
-use mmusv_core::sensors::{camera, lidar, rays};
+use mmusv_core::sensors::{camera, capture, lidar, rays};
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -102,12 +102,7 @@ fn env_value(field: &str, value: f32, nonneg: bool) -> PyResult<f32> {
 impl SensorEnv {
     /// The LiDAR's share: fog, rain, waves.
     pub(crate) fn lidar(&self) -> lidar::LidarEnv {
-        let s = &self.shade;
-        lidar::LidarEnv {
-            fog_extinction_per_m: s.fog_extinction_per_m,
-            rain_mm_per_h: s.rain_mm_per_h,
-            wave_height_m: s.wave_height_m,
-        }
+        capture::lidar_env(&self.shade)
     }
 }
 
@@ -183,7 +178,7 @@ impl SensorEnv {
 /// A spinning multi-channel LiDAR with its ray pattern computed once (see `mmusv_core::sensors::lidar`).
 #[pyclass(frozen, module = "mmusv._core")]
 pub struct Lidar {
-    inner: lidar::Lidar,
+    pub(crate) inner: lidar::Lidar,
 }
 
 #[pymethods]
@@ -246,16 +241,7 @@ impl Lidar {
         let pose = pose_arg(&pose, "pose")?;
         let env = env.lidar();
         let s = scene.read(|s| detached(py, || self.inner.scan(s, &pose, &env, seed)))?;
-        let d = PyDict::new(py);
-        d.set_item("xyz", rows_to_array(py, s.xyz)?)?;
-        d.set_item("range", s.range.into_pyarray(py))?;
-        d.set_item("intensity", s.intensity.into_pyarray(py))?;
-        d.set_item("ring", s.ring.into_pyarray(py))?;
-        d.set_item("azimuth", s.azimuth.into_pyarray(py))?;
-        d.set_item("class", s.class.into_pyarray(py))?;
-        d.set_item("instance", s.instance.into_pyarray(py))?;
-        d.set_item("ray_index", s.ray_index.into_pyarray(py))?;
-        Ok(d)
+        scan_dict(py, s)
     }
 }
 
@@ -263,8 +249,8 @@ impl Lidar {
 /// whether it shades RGB (depth, semantic and instance images are always produced).
 #[pyclass(frozen, module = "mmusv._core")]
 pub struct Camera {
-    inner: camera::Camera,
-    rgb: bool,
+    pub(crate) inner: camera::Camera,
+    pub(crate) rgb: bool,
 }
 
 #[pymethods]
@@ -332,15 +318,34 @@ impl Camera {
         let pose = pose_arg(&pose, "pose")?;
         let (env, rgb) = (&env.shade, self.rgb);
         let f = scene.read(|s| detached(py, || self.inner.render(s, &pose, env, rgb, seed)))?;
-        let (w, h) = (f.width as usize, f.height as usize);
-        let shape_err = |e: numpy::ndarray::ShapeError| crate::errors::InternalError::new_err(e.to_string());
-        let d = PyDict::new(py);
-        d.set_item("depth", Array2::from_shape_vec((h, w), f.depth).map_err(shape_err)?.into_pyarray(py))?;
-        d.set_item("semantic", Array2::from_shape_vec((h, w), f.semantic).map_err(shape_err)?.into_pyarray(py))?;
-        d.set_item("instance", Array2::from_shape_vec((h, w), f.instance).map_err(shape_err)?.into_pyarray(py))?;
-        if rgb {
-            d.set_item("rgb", Array3::from_shape_vec((h, w, 3), f.rgb).map_err(shape_err)?.into_pyarray(py))?;
-        }
-        Ok(d)
+        frame_dict(py, f, rgb)
     }
+}
+
+/// The dict of one sweep as `Lidar.scan` returns it (columns moved into numpy, no copy).
+pub(crate) fn scan_dict(py: Python<'_>, s: lidar::LidarScan) -> PyResult<Bound<'_, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("xyz", rows_to_array(py, s.xyz)?)?;
+    d.set_item("range", s.range.into_pyarray(py))?;
+    d.set_item("intensity", s.intensity.into_pyarray(py))?;
+    d.set_item("ring", s.ring.into_pyarray(py))?;
+    d.set_item("azimuth", s.azimuth.into_pyarray(py))?;
+    d.set_item("class", s.class.into_pyarray(py))?;
+    d.set_item("instance", s.instance.into_pyarray(py))?;
+    d.set_item("ray_index", s.ray_index.into_pyarray(py))?;
+    Ok(d)
+}
+
+/// The dict of one image set as `Camera.render` returns it (`rgb` only when shaded).
+pub(crate) fn frame_dict(py: Python<'_>, f: camera::CameraFrame, rgb: bool) -> PyResult<Bound<'_, PyDict>> {
+    let (w, h) = (f.width as usize, f.height as usize);
+    let shape_err = |e: numpy::ndarray::ShapeError| crate::errors::InternalError::new_err(e.to_string());
+    let d = PyDict::new(py);
+    d.set_item("depth", Array2::from_shape_vec((h, w), f.depth).map_err(shape_err)?.into_pyarray(py))?;
+    d.set_item("semantic", Array2::from_shape_vec((h, w), f.semantic).map_err(shape_err)?.into_pyarray(py))?;
+    d.set_item("instance", Array2::from_shape_vec((h, w), f.instance).map_err(shape_err)?.into_pyarray(py))?;
+    if rgb {
+        d.set_item("rgb", Array3::from_shape_vec((h, w, 3), f.rgb).map_err(shape_err)?.into_pyarray(py))?;
+    }
+    Ok(d)
 }

@@ -1,7 +1,9 @@
 """The recording format, both ways: :mod:`~mmusv.recording.topics` (topic names and frame ids, the one place they
 are spelled), :mod:`~mmusv.recording.writer` (:class:`Recording` over the core's MCAP recorder),
-:mod:`~mmusv.recording.frames` (:class:`FrameRecorder`: which topic gets what, per captured frame) and
-:mod:`~mmusv.recording.reader` (the one reader). The contract is ``docs/recording.md``.
+:mod:`~mmusv.recording.frames` (:class:`FrameRecorder`: which topic gets what, per captured frame),
+:mod:`~mmusv.recording.tables` (the Parquet tables beside the MCAP), :mod:`~mmusv.recording.background` (frames
+written on a writer thread while the next is captured) and :mod:`~mmusv.recording.reader` (the one reader). The
+contract is ``docs/recording.md``.
 """
 
 from mmusv.recording.reader import decode_image, decode_point_cloud, frame_messages, read_info, read_messages, summary

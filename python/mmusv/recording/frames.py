@@ -21,6 +21,7 @@ Metadata records: ``scenario`` (the resolved YAML), ``manifest`` (mmusv version,
 from __future__ import annotations
 
 import json
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -31,7 +32,7 @@ from scipy.spatial.transform import Rotation
 from mmusv.config import scenario_hash
 from mmusv.frames import BODY_TO_OPTICAL
 from mmusv.recording import topics
-from mmusv.recording.writer import Recording
+from mmusv.recording.writer import ImageFormat, Recording
 from mmusv.sensors.camera import CameraImages
 from mmusv.simulation import FrameCapture, Simulation
 
@@ -44,6 +45,25 @@ OPTICAL_IN_BODY[:3, :3] = BODY_TO_OPTICAL.T
 _ROLE_COLOURS = {"usv": (0.2, 0.9, 0.9, 0.5), "target": (1.0, 0.3, 0.2, 0.5), "moored": (1.0, 0.8, 0.2, 0.5)}
 
 
+def _images(
+    topic: str, frame_id: str, img: CameraImages, outputs: Sequence[str]
+) -> list[tuple[str, str, np.ndarray, ImageFormat]]:
+    """The images of one camera as :meth:`Recording.images` takes them, in topic order: ``rgb`` (PNG), ``depth``
+    (raw float32 metres), ``semantic`` (PNG uint16), ``instance`` (PNG uint16, 65535 = sky)."""
+    out: list[tuple[str, str, np.ndarray, ImageFormat]] = []
+    if img.rgb is not None and "rgb" in outputs:
+        out.append((f"{topic}/rgb", frame_id, img.rgb, "png"))
+    if "depth" in outputs:
+        out.append((f"{topic}/depth", frame_id, np.ascontiguousarray(img.depth, dtype=np.float32), "raw"))
+    if "semantic" in outputs:
+        out.append((f"{topic}/semantic", frame_id, img.semantic, "png"))
+    if "instance" in outputs:
+        out.append(
+            (f"{topic}/instance", frame_id, np.where(img.instance < 0, 65535, img.instance).astype(np.uint16), "png")
+        )
+    return out
+
+
 def pose7(m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Translation ``(3,)`` and quaternion ``(4,)`` (x, y, z, w) of a ``(4, 4)`` rigid transform."""
     return m[:3, 3].copy(), Rotation.from_matrix(m[:3, :3]).as_quat()
@@ -54,6 +74,8 @@ class FrameRecorder:
 
     def __init__(self, path: Path, sim: Simulation, *, overwrite: bool = False) -> None:
         self.sim = sim
+        self.encode_seconds = 0.0
+        """Wall seconds spent encoding images so far (for profiling)."""
         self.roles = {v.id: v.role for v in sim.vessels}
         self.rec = Recording(path, overwrite=overwrite)
         sc = sim.scenario
@@ -96,13 +118,14 @@ class FrameRecorder:
             ac = cap.agents.get(a.id)
             if ac is None:
                 continue
-            body_inv = np.linalg.inv(st.matrices[a.index])
+            mounts = ac.sensors  # sensor → body as resolved for the capture (not recomputed from the poses)
             if ac.lidar_pose is not None:
-                tfs.append((a.id, topics.lidar_frame(a.id), *pose7(body_inv @ ac.lidar_pose)))
+                tfs.append((a.id, topics.lidar_frame(a.id), *pose7(mounts["lidar"].mount)))
             if ac.radar_pose is not None:
-                tfs.append((a.id, topics.radar_frame(a.id), *pose7(body_inv @ ac.radar_pose)))
-            for name, p in ac.camera_poses.items():
-                tfs.append((a.id, topics.camera_frame(a.id, name), *pose7(body_inv @ p @ OPTICAL_IN_BODY)))
+                tfs.append((a.id, topics.radar_frame(a.id), *pose7(mounts["radar"].mount)))
+            for name in ac.camera_poses:
+                mount = mounts[f"camera/{name}"].mount
+                tfs.append((a.id, topics.camera_frame(a.id, name), *pose7(mount @ OPTICAL_IN_BODY)))
             if ac.top_view_pose is not None:
                 tfs.append(
                     (topics.WORLD_FRAME, topics.top_view_frame(a.id), *pose7(ac.top_view_pose @ OPTICAL_IN_BODY))
@@ -144,14 +167,15 @@ class FrameRecorder:
                         "instance": pts.instance,
                     },
                 )
+            images: list[tuple[str, str, np.ndarray, ImageFormat]] = []
             for name, img in ac.cameras.items():
-                self._images(
-                    topics.camera(a.id, name), topics.camera_frame(a.id, name), t, img, list(a.cameras[name][1].outputs)
-                )
+                outputs = a.cameras[name][1].outputs
+                images += _images(topics.camera(a.id, name), topics.camera_frame(a.id, name), img, outputs)
             if ac.top_view is not None and a.rig.top_view is not None:
-                self._images(
-                    topics.top_view(a.id), topics.top_view_frame(a.id), t, ac.top_view, list(a.rig.top_view.outputs)
-                )
+                outputs = a.rig.top_view.outputs
+                images += _images(topics.top_view(a.id), topics.top_view_frame(a.id), ac.top_view, outputs)
+            if images:  # one call per agent: encoded in parallel, written in this order
+                self.encode_seconds += rec.images(log_time_ns=t, images=images)[0]
             if ac.radar is not None:
                 self._radar(a.id, t, ac.radar, ac.radar_ppi)
             cols = annotations.get(a.id)
@@ -181,23 +205,6 @@ class FrameRecorder:
                     sizes=lid["size"],
                     colors=colours,
                 )
-
-    def _images(self, topic: str, frame_id: str, t: int, img: CameraImages, outputs: list[str]) -> None:
-        rec = self.rec
-        if img.rgb is not None and "rgb" in outputs:
-            rec.png_image(f"{topic}/rgb", log_time_ns=t, frame_id=frame_id, image=img.rgb)
-        if "depth" in outputs:
-            rec.raw_image(
-                f"{topic}/depth",
-                log_time_ns=t,
-                frame_id=frame_id,
-                image=np.ascontiguousarray(img.depth, dtype=np.float32),
-            )
-        if "semantic" in outputs:
-            rec.png_image(f"{topic}/semantic", log_time_ns=t, frame_id=frame_id, image=img.semantic)
-        if "instance" in outputs:
-            inst = np.where(img.instance < 0, 65535, img.instance).astype(np.uint16)
-            rec.png_image(f"{topic}/instance", log_time_ns=t, frame_id=frame_id, image=inst)
 
     def _radar(self, agent: str, t: int, returns: Any, ppi: np.ndarray | None) -> None:
         from mmusv.sensors.radar import ppi_colormap

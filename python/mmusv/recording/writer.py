@@ -24,7 +24,7 @@ import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from types import TracebackType
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 import numpy.typing as npt
@@ -32,7 +32,10 @@ import numpy.typing as npt
 from mmusv._native import core
 from mmusv.errors import InputError
 
-__all__ = ["POINT_DTYPES", "Recording", "to_ns"]
+__all__ = ["POINT_DTYPES", "ImageFormat", "Recording", "to_ns"]
+
+ImageFormat = Literal["png", "raw"]
+"""How :meth:`Recording.images` stores an image: ``foxglove.CompressedImage`` PNG or ``foxglove.RawImage``."""
 
 POINT_DTYPES: tuple[str, ...] = ("uint8", "int8", "uint16", "int16", "uint32", "int32", "float32", "float64")
 """dtypes a point-cloud column may have (others are refused; bool is stored as uint8)."""
@@ -188,6 +191,32 @@ class Recording:
         if arr.dtype == np.float32:
             raise InputError("invalid image: PNG holds uint8 or uint16; record float32 images with raw_image")
         self._rec.png_image(topic, log_time_ns=log_time_ns, frame_id=frame_id, image=arr)
+
+    def images(
+        self,
+        *,
+        log_time_ns: int,
+        images: Sequence[tuple[str, str, npt.ArrayLike, ImageFormat]],
+    ) -> tuple[float, float]:
+        """Several images at ``log_time_ns``, each ``(topic, frame_id, image, format)`` with format ``"png"``
+        (as :meth:`png_image`) or ``"raw"`` (as :meth:`raw_image`). They are encoded in parallel, on all cores
+        and before the recording is locked, then written in the order given: the file gets the bytes of one
+        call per image. Returns the wall seconds spent encoding and writing (for profiling)."""
+        topics, frame_ids, arrays, formats = [], [], [], []
+        for i, (topic, frame_id, image, fmt) in enumerate(images):
+            arr = _image(image, f"images[{i}]")
+            if fmt == "png" and arr.dtype == np.float32:
+                raise InputError(f"invalid images[{i}]: PNG holds uint8 or uint16; store float32 images as 'raw'")
+            if fmt not in ("png", "raw"):
+                raise InputError(f"invalid images[{i}] format {fmt!r}: use 'png' or 'raw'")
+            topics.append(topic)
+            frame_ids.append(frame_id)
+            arrays.append(arr)
+            formats.append(fmt)
+        encode_s, write_s = self._rec.images(
+            log_time_ns=log_time_ns, topics=topics, frame_ids=frame_ids, images=arrays, formats=formats
+        )
+        return float(encode_s), float(write_s)
 
     def frame_transforms(
         self,

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -31,6 +32,11 @@ class CameraImages:
     instance: npt.NDArray[np.int32]
     rgb: npt.NDArray[np.uint8] | None
 
+    @classmethod
+    def from_native(cls, d: dict[str, npt.NDArray[Any]]) -> CameraImages:
+        """The images from the dict of ``core.Camera.render`` (or of ``core.capture_frame``)."""
+        return cls(depth=d["depth"], semantic=d["semantic"], instance=d["instance"], rgb=d.get("rgb"))
+
 
 def camera_from_config(cfg: CameraConfig) -> core.Camera:
     """The native pinhole camera for ``cfg`` (shades RGB when ``rgb`` is among its outputs)."""
@@ -51,5 +57,4 @@ def render(camera: core.Camera, scene: Scene, *, pose: npt.ArrayLike, env: core.
     """Renders ``scene`` (current state) with ``camera`` at ``pose`` (``(4, 4)`` camera body → world) in ``env``
     (:func:`mmusv.sensors.env.sensor_env`)."""
     p = np.ascontiguousarray(pose, dtype=np.float64).reshape(4, 4)
-    d = camera.render(scene.native, pose=p, env=env, seed=int(seed))
-    return CameraImages(depth=d["depth"], semantic=d["semantic"], instance=d["instance"], rgb=d.get("rgb"))
+    return CameraImages.from_native(camera.render(scene.native, pose=p, env=env, seed=int(seed)))

@@ -8,6 +8,7 @@ model.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -46,6 +47,20 @@ class LidarPoints:
     def __len__(self) -> int:
         return int(self.xyz.shape[0])
 
+    @classmethod
+    def from_native(cls, d: dict[str, npt.NDArray[Any]]) -> LidarPoints:
+        """The sweep from the dict of ``core.Lidar.scan`` (or of ``core.capture_frame``)."""
+        return cls(
+            xyz=d["xyz"],
+            range=d["range"],
+            intensity=d["intensity"],
+            ring=d["ring"],
+            azimuth=d["azimuth"],
+            semantic_class=d["class"],
+            instance=d["instance"],
+            ray_index=d["ray_index"],
+        )
+
 
 def lidar_from_config(cfg: LidarConfig) -> core.Lidar:
     """The native LiDAR (pattern computed once) for ``cfg``."""
@@ -68,14 +83,4 @@ def scan(lidar: core.Lidar, scene: Scene, *, pose: npt.ArrayLike, env: core.Sens
     current state of ``scene`` in ``env`` (:func:`mmusv.sensors.env.sensor_env`: fog, rain and waves are used).
     ``seed`` drives noise, dropout and water returns."""
     p = np.ascontiguousarray(pose, dtype=np.float64).reshape(4, 4)
-    d = lidar.scan(scene.native, pose=p, env=env, seed=int(seed))
-    return LidarPoints(
-        xyz=d["xyz"],
-        range=d["range"],
-        intensity=d["intensity"],
-        ring=d["ring"],
-        azimuth=d["azimuth"],
-        semantic_class=d["class"],
-        instance=d["instance"],
-        ray_index=d["ray_index"],
-    )
+    return LidarPoints.from_native(lidar.scan(scene.native, pose=p, env=env, seed=int(seed)))

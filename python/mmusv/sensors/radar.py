@@ -30,7 +30,7 @@ import math
 import os
 import tempfile
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 import numpy.typing as npt
@@ -40,7 +40,16 @@ from mmusv.errors import InputError
 from mmusv.scene import Scene, _pose
 from mmusv.sensors.config import RadarConfig
 
-__all__ = ["Orientation", "RadarReturns", "ppi_colormap", "ppi_image", "ppi_png", "radar_from_config", "radar_sweep"]
+__all__ = [
+    "Orientation",
+    "RadarReturns",
+    "ppi_colormap",
+    "ppi_image",
+    "ppi_png",
+    "ppi_request",
+    "radar_from_config",
+    "radar_sweep",
+]
 
 Orientation = Literal["north_up", "head_up"]
 """Which way is up in a PPI: world north, or the sensor's forward axis."""
@@ -100,6 +109,22 @@ class RadarReturns:
     def __len__(self) -> int:
         return int(self.range.shape[0])
 
+    @classmethod
+    def from_native(
+        cls, d: dict[str, npt.NDArray[Any]], *, pose: npt.NDArray[np.float64], radar: core.Radar
+    ) -> RadarReturns:
+        """The returns from the dict of ``core.Radar.sweep`` (or of ``core.capture_frame``) swept at ``pose``."""
+        return cls(
+            range=d["range"],
+            azimuth=d["azimuth"],
+            elevation=d["elevation"],
+            intensity=d["intensity"],
+            instance_id=d["instance"],
+            semantic_class=d["class"],
+            pose=pose,
+            radar=radar,
+        )
+
     @property
     def is_clutter(self) -> npt.NDArray[np.bool_]:
         """``(N,)`` bool, True for clutter returns (no scene object)."""
@@ -108,7 +133,7 @@ class RadarReturns:
     @property
     def sensor_yaw(self) -> float:
         """World yaw of the sensor's forward axis, radians (counter-clockwise from east)."""
-        return math.atan2(float(self.pose[1, 0]), float(self.pose[0, 0]))
+        return _yaw(self.pose)
 
     def points(self, frame: Literal["sensor", "world"] = "sensor") -> npt.NDArray[np.float32]:
         """``(N, 3)`` float32 positions of the returns (range, azimuth, elevation) in metres, in the sensor
@@ -140,17 +165,7 @@ def radar_sweep(
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) < 2**64:
         raise InputError(f"seed must be an integer in 0..2**64, got {seed!r}")
     p = _pose(pose, name="pose")
-    out = radar.sweep(scene.native, pose=p, env=env, seed=int(seed))
-    return RadarReturns(
-        range=out["range"],
-        azimuth=out["azimuth"],
-        elevation=out["elevation"],
-        intensity=out["intensity"],
-        instance_id=out["instance"],
-        semantic_class=out["class"],
-        pose=p,
-        radar=radar,
-    )
+    return RadarReturns.from_native(radar.sweep(scene.native, pose=p, env=env, seed=int(seed)), pose=p, radar=radar)
 
 
 def ppi_image(
@@ -170,40 +185,69 @@ def ppi_image(
     image); ``sensor_yaw`` (radians, for north-up) defaults to the sweep pose's yaw. Bad values raise
     :class:`mmusv.ConfigError` naming ``ppi.<field>``.
     """
-    radar = returns.radar
-    if isinstance(size_px, bool) or not isinstance(size_px, (int, np.integer)) or not 0 <= int(size_px) < 2**32:
-        raise InputError(f"size_px must be a non-negative integer below 2**32, got {size_px!r}")
-    size = int(size_px)
-    mpp = radar.range_max_m / max(size // 2, 1) if metres_per_pixel is None else float(metres_per_pixel)
-    yaw = returns.sensor_yaw if sensor_yaw is None else float(sensor_yaw)
+    size, mpp, orient, yaw = ppi_request(
+        returns.radar,
+        pose=returns.pose,
+        size_px=size_px,
+        metres_per_pixel=metres_per_pixel,
+        orientation=orientation,
+        sensor_yaw=sensor_yaw,
+    )
     return np.asarray(
-        radar.ppi_image(
+        returns.radar.ppi_image(
             range=np.ascontiguousarray(returns.range, dtype=np.float32),
             azimuth=np.ascontiguousarray(returns.azimuth, dtype=np.float32),
             intensity=np.ascontiguousarray(returns.intensity, dtype=np.float32),
             size_px=size,
             metres_per_pixel=mpp,
-            orientation=orientation,
+            orientation=orient,
             sensor_yaw=yaw,
         )
     )
 
 
+def ppi_request(
+    radar: core.Radar,
+    *,
+    pose: npt.NDArray[np.float64],
+    size_px: int = 512,
+    metres_per_pixel: float | None = None,
+    orientation: Orientation = "north_up",
+    sensor_yaw: float | None = None,
+) -> tuple[int, float, str, float]:
+    """``(size_px, metres_per_pixel, orientation, sensor_yaw)`` of the PPI :func:`ppi_image` draws for a sweep of
+    ``radar`` at ``pose`` (``(4, 4)`` sensor → world), with its defaults filled in; the same tuple is the ``ppi``
+    of a radar task of ``core.capture_frame``."""
+    if isinstance(size_px, bool) or not isinstance(size_px, (int, np.integer)) or not 0 <= int(size_px) < 2**32:
+        raise InputError(f"size_px must be a non-negative integer below 2**32, got {size_px!r}")
+    size = int(size_px)
+    mpp = radar.range_max_m / max(size // 2, 1) if metres_per_pixel is None else float(metres_per_pixel)
+    yaw = _yaw(pose) if sensor_yaw is None else float(sensor_yaw)
+    return size, mpp, str(orientation), yaw
+
+
+def _yaw(pose: npt.NDArray[np.float64]) -> float:
+    """World yaw of the forward axis of a ``(4, 4)`` sensor → world pose, radians (counter-clockwise from east)."""
+    return math.atan2(float(pose[1, 0]), float(pose[0, 0]))
+
+
 def ppi_colormap(img: npt.ArrayLike, *, vmin_db: float = -20.0, vmax_db: float = 30.0) -> npt.NDArray[np.uint8]:
     """``(H, W, 3)`` uint8 radar-green rendering of a PPI: intensity in dB (``10·log10``) mapped linearly from
     ``vmin_db`` (dark green) to ``vmax_db`` (near white); pixels ``<= 0`` are black. Fixed limits by default,
-    so frames are comparable."""
+    so frames are comparable. Only the lit pixels are computed (a PPI is mostly empty): per pixel, the same
+    operations as over the whole image."""
     a = np.asarray(img, dtype=np.float64)
     if a.ndim != 2:
         raise InputError(f"img must be a (H, W) intensity image, got shape {a.shape}")
     if not vmax_db > vmin_db:
         raise InputError(f"need vmax_db > vmin_db, got {vmin_db} and {vmax_db}")
-    with np.errstate(divide="ignore", invalid="ignore"):
-        db = 10.0 * np.log10(a)
+    lit = a > 0
+    db = 10.0 * np.log10(a[lit])
     t = np.clip((db - vmin_db) / (vmax_db - vmin_db), 0.0, 1.0)
     rgb = np.stack([255.0 * t**3, 50.0 + 205.0 * t**0.6, 30.0 * t + 200.0 * t**4], axis=-1)
-    rgb[~(a > 0)] = 0.0
-    return np.ascontiguousarray(np.rint(rgb), dtype=np.uint8)
+    out = np.zeros((*a.shape, 3), dtype=np.uint8)
+    out[lit] = np.rint(rgb).astype(np.uint8)
+    return out
 
 
 def ppi_png(path: str | os.PathLike[str], img: npt.ArrayLike, **colormap: float) -> None:

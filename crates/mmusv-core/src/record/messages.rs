@@ -82,6 +82,69 @@ fn pose(position: &[f64; 3], q: &[f64; 4], field: &str) -> Result<Pose> {
     Ok(Pose { position: Some(vec3(position)), orientation: Some(unit_quaternion(q, field)?) })
 }
 
+/// A `foxglove.RawImage` of `data`, `height` rows of `step` bytes in `encoding` (checked).
+fn raw_message(
+    log_time_ns: u64,
+    frame_id: &str,
+    width: u32,
+    height: u32,
+    encoding: &str,
+    step: u32,
+    data: Bytes,
+) -> Result<RawImage> {
+    let bpp = raw_bytes_per_pixel(encoding)?;
+    if (step as u64) < width as u64 * bpp as u64 || data.len() as u64 != step as u64 * height as u64 {
+        return Err(MmusvError::input(
+            "image",
+            format!(
+                "{} bytes do not make {height} rows of step {step} for width {width} {encoding} \
+                 (step >= {} and data = step * height)",
+                data.len(),
+                width as u64 * bpp as u64
+            ),
+        ));
+    }
+    Ok(RawImage {
+        timestamp: Some(timestamp(log_time_ns)?),
+        frame_id: frame_id.to_string(),
+        width,
+        height,
+        encoding: encoding.to_string(),
+        step,
+        data,
+    })
+}
+
+/// The `foxglove.RawImage` of `pixels` (encoding from the pixel kind, rows unpadded, little-endian).
+pub fn pixels_message(
+    log_time_ns: u64,
+    frame_id: &str,
+    width: u32,
+    height: u32,
+    pixels: &Pixels<'_>,
+) -> Result<RawImage> {
+    pixels.check(width, height)?;
+    let step = width * pixels.bytes_per_pixel();
+    raw_message(log_time_ns, frame_id, width, height, pixels.encoding(), step, Bytes::from(pixels.le_bytes()))
+}
+
+/// The `foxglove.CompressedImage` (format `png`) of `pixels`: 8-bit gray, 8-bit RGB or 16-bit gray.
+pub fn png_message(
+    log_time_ns: u64,
+    frame_id: &str,
+    width: u32,
+    height: u32,
+    pixels: &Pixels<'_>,
+) -> Result<CompressedImage> {
+    let png = encode_png(width, height, pixels)?;
+    Ok(CompressedImage {
+        timestamp: Some(timestamp(log_time_ns)?),
+        frame_id: frame_id.to_string(),
+        data: Bytes::from(png),
+        format: "png".to_string(),
+    })
+}
+
 impl Recorder {
     /// Writes a `foxglove.PointCloud`: `fields` packed back to back in each `point_stride`-byte point of
     /// `data` (little-endian; `point_stride` may exceed the fields' total to leave padding). `pose_of_frame`
@@ -148,27 +211,7 @@ impl Recorder {
         step: u32,
         data: &[u8],
     ) -> Result<()> {
-        let bpp = raw_bytes_per_pixel(encoding)?;
-        if (step as u64) < width as u64 * bpp as u64 || data.len() as u64 != step as u64 * height as u64 {
-            return Err(MmusvError::input(
-                "image",
-                format!(
-                    "{} bytes do not make {height} rows of step {step} for width {width} {encoding} \
-                     (step >= {} and data = step * height)",
-                    data.len(),
-                    width as u64 * bpp as u64
-                ),
-            ));
-        }
-        let message = RawImage {
-            timestamp: Some(timestamp(log_time_ns)?),
-            frame_id: frame_id.to_string(),
-            width,
-            height,
-            encoding: encoding.to_string(),
-            step,
-            data: Bytes::copy_from_slice(data),
-        };
+        let message = raw_message(log_time_ns, frame_id, width, height, encoding, step, Bytes::copy_from_slice(data))?;
         self.write(topic, log_time_ns, &message)
     }
 
@@ -182,9 +225,7 @@ impl Recorder {
         height: u32,
         pixels: &Pixels<'_>,
     ) -> Result<()> {
-        pixels.check(width, height)?;
-        let step = width * pixels.bytes_per_pixel();
-        self.raw_image(topic, log_time_ns, frame_id, width, height, pixels.encoding(), step, &pixels.le_bytes())
+        self.write(topic, log_time_ns, &pixels_message(log_time_ns, frame_id, width, height, pixels)?)
     }
 
     /// Encodes `pixels` as PNG (8-bit gray, 8-bit RGB or 16-bit gray) and writes a `foxglove.CompressedImage`
@@ -198,14 +239,7 @@ impl Recorder {
         height: u32,
         pixels: &Pixels<'_>,
     ) -> Result<()> {
-        let png = encode_png(width, height, pixels)?;
-        let message = CompressedImage {
-            timestamp: Some(timestamp(log_time_ns)?),
-            frame_id: frame_id.to_string(),
-            data: Bytes::from(png),
-            format: "png".to_string(),
-        };
-        self.write(topic, log_time_ns, &message)
+        self.write(topic, log_time_ns, &png_message(log_time_ns, frame_id, width, height, pixels)?)
     }
 
     /// Writes a `foxglove.FrameTransforms` holding every transform, all stamped `log_time_ns`.

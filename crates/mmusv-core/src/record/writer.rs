@@ -30,6 +30,44 @@ pub struct RecordSummary {
     pub bytes: u64,
 }
 
+/// A message serialised for its topic, ready for [`Recorder::write_message`]; needs no recorder to build, so
+/// it can be made outside the recorder's lock.
+#[derive(Clone)]
+pub struct EncodedMessage {
+    /// The topic it goes to.
+    pub topic: String,
+    /// Its schema (name, encoding, descriptor).
+    pub schema: foxglove::Schema,
+    /// Its message encoding (`protobuf`).
+    pub message_encoding: String,
+    /// The serialised message.
+    pub data: Vec<u8>,
+}
+
+impl std::fmt::Debug for EncodedMessage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("EncodedMessage")
+            .field("topic", &self.topic)
+            .field("schema", &self.schema.name)
+            .field("bytes", &self.data.len())
+            .finish()
+    }
+}
+
+impl EncodedMessage {
+    /// Serialises `message` for `topic`.
+    pub fn encode<M: Encode>(topic: &str, message: &M) -> Result<Self> {
+        let mut data = Vec::with_capacity(message.encoded_len().unwrap_or(1024));
+        message
+            .encode(&mut data)
+            .map_err(|e| MmusvError::input(topic.to_string(), format!("message could not be encoded: {e}")))?;
+        let Some(schema) = M::get_schema() else {
+            return Err(MmusvError::input(topic.to_string(), "message type has no schema"));
+        };
+        Ok(Self { topic: topic.to_string(), schema, message_encoding: M::get_message_encoding(), data })
+    }
+}
+
 /// A channel created on first use of its topic.
 struct Slot {
     id: u16,
@@ -133,14 +171,13 @@ impl Recorder {
     /// Encodes `message` and writes it on `topic` at simulation time `log_time_ns` (also the publish time).
     /// The channel and its schema are created on the first message of a topic; a topic keeps one schema.
     pub fn write<M: Encode>(&mut self, topic: &str, log_time_ns: u64, message: &M) -> Result<()> {
-        let mut buf = Vec::with_capacity(message.encoded_len().unwrap_or(1024));
-        message
-            .encode(&mut buf)
-            .map_err(|e| MmusvError::input(topic.to_string(), format!("message could not be encoded: {e}")))?;
-        let Some(schema) = M::get_schema() else {
-            return Err(MmusvError::input(topic.to_string(), "message type has no schema"));
-        };
-        self.write_encoded(topic, log_time_ns, &schema, &M::get_message_encoding(), &buf)
+        self.write_message(log_time_ns, &EncodedMessage::encode(topic, message)?)
+    }
+
+    /// Writes a message encoded beforehand (e.g. on other threads, see [`super::batch`]): the same bytes as
+    /// [`write`](Self::write) of the message it was encoded from.
+    pub fn write_message(&mut self, log_time_ns: u64, message: &EncodedMessage) -> Result<()> {
+        self.write_encoded(&message.topic, log_time_ns, &message.schema, &message.message_encoding, &message.data)
     }
 
     /// Writes already-encoded bytes with the given schema (used by [`write`](Self::write)).
@@ -152,20 +189,10 @@ impl Recorder {
         message_encoding: &str,
         data: &[u8],
     ) -> Result<()> {
-        if topic.is_empty() {
-            return Err(MmusvError::input("topic", "must not be empty (e.g. /usv0/lidar)"));
-        }
+        self.check_topic(topic, &schema.name)?;
         let partial = self.partial.clone();
         let slot = match self.channels.get_mut(topic) {
-            Some(slot) => {
-                if slot.schema != schema.name {
-                    return Err(MmusvError::input(
-                        "topic",
-                        format!("{topic} already carries {}, cannot write {} on it", slot.schema, schema.name),
-                    ));
-                }
-                slot
-            }
+            Some(slot) => slot,
             None => {
                 let w = self.writer()?;
                 let schema_id =
@@ -189,6 +216,21 @@ impl Recorder {
         self.writer()?.write_to_known_channel(&header, data).map_err(mcap_err(&partial))?;
         self.messages += 1;
         Ok(())
+    }
+
+    /// Checks that a message of schema `schema` may go to `topic`: a non-empty topic that carries no other
+    /// schema yet.
+    pub fn check_topic(&self, topic: &str, schema: &str) -> Result<()> {
+        if topic.is_empty() {
+            return Err(MmusvError::input("topic", "must not be empty (e.g. /usv0/lidar)"));
+        }
+        match self.channels.get(topic) {
+            Some(slot) if slot.schema != schema => Err(MmusvError::input(
+                "topic",
+                format!("{topic} already carries {}, cannot write {schema} on it", slot.schema),
+            )),
+            _ => Ok(()),
+        }
     }
 
     /// Writes an MCAP metadata record `name` holding `map` (e.g. scenario name, seed, mmusv version).

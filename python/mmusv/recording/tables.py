@@ -1,0 +1,197 @@
+"""The Parquet tables of a run: ``world_state``, ``boxes_3d`` and ``boxes_2d``, one row per vessel / box and frame.
+
+:class:`TableWriter` gathers each frame's rows column-wise (one array per column and frame, no per-row
+objects) and writes them as numbered parts ``<root>/<table>/part-NNNNN.parquet`` (polars) on :meth:`flush`.
+Column names, order and dtypes are fixed by :data:`SCHEMAS`; a table without rows in a part writes no file.
+
+Units and frames: metres, seconds, radians; ``world_state`` in the world frame (x east, y north, z up; poses
+``x, y, z, roll, pitch, yaw``, velocities m/s), ``boxes_3d`` in the agent's LiDAR frame (quaternion ``qx, qy,
+qz, qw``), ``boxes_2d`` in pixels (origin top-left). See ``docs/recording.md``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import polars as pl
+
+if TYPE_CHECKING:
+    from mmusv.annotate import Annotations
+    from mmusv.simulation import FrameCapture, VesselInfo
+
+__all__ = ["SCHEMAS", "TableWriter"]
+
+_F = pl.Float64
+_I = pl.Int64
+_S = pl.String
+_B = pl.Boolean
+
+SCHEMAS: dict[str, dict[str, Any]] = {
+    "world_state": {
+        "frame": _I,
+        "time_s": _F,
+        "vessel_id": _S,
+        "asset": _S,
+        "role": _S,
+        "static": _B,
+        "semantic_class": _I,
+        "instance_id": _I,
+        **dict.fromkeys(("x", "y", "z", "roll", "pitch", "yaw", "vx", "vy", "vz"), _F),
+        **dict.fromkeys(("box_cx", "box_cy", "box_cz", "length", "beam", "height"), _F),
+    },
+    "boxes_3d": {
+        "frame": _I,
+        "time_s": _F,
+        "agent": _S,
+        "target_id": _S,
+        "instance_id": _I,
+        "semantic_class": _I,
+        **dict.fromkeys(("x", "y", "z", "length", "beam", "height", "qx", "qy", "qz", "qw", "yaw"), _F),
+        "lidar_points": _I,
+        "range_m": _F,
+        "role": _S,
+        "static": _B,
+    },
+    "boxes_2d": {
+        "frame": _I,
+        "time_s": _F,
+        "agent": _S,
+        "camera": _S,
+        "target_id": _S,
+        **dict.fromkeys(("x_min", "y_min", "x_max", "y_max", "truncation"), _F),
+        "visible_pixels": _I,
+        "box_pixels": _I,
+        "occlusion": _F,
+        "role": _S,
+        "static": _B,
+    },
+}
+"""Column name → polars dtype of each table, in column order."""
+
+
+class TableWriter:
+    """Collects table rows column-wise and flushes them as numbered Parquet parts under ``root``."""
+
+    def __init__(self, root: Path) -> None:
+        self.root = root
+        self.part = 0
+        self.frames = 0
+        """Frames added since the last flush."""
+        self._cols: dict[str, dict[str, list[Any]]] = {t: {c: [] for c in s} for t, s in SCHEMAS.items()}
+        self._rows = dict.fromkeys(SCHEMAS, 0)
+
+    def _add(self, table: str, n: int, columns: dict[str, Any]) -> None:
+        if n == 0:
+            return
+        cols = self._cols[table]
+        for name in SCHEMAS[table]:
+            cols[name].append(columns[name])
+        self._rows[table] += n
+
+    def add_frame(
+        self,
+        vessels: list[VesselInfo],
+        cap: FrameCapture,
+        annotations: dict[str, tuple[Annotations, dict[str, Any]]],
+    ) -> None:
+        """The rows of one frame: every vessel's state, and each agent's boxes; ``annotations`` maps an agent to
+        its :class:`~mmusv.annotate.Annotations` and their ``columns()``."""
+        self.add_world(vessels, cap)
+        for ann, cols in annotations.values():
+            self.add_annotations(ann, cols)
+        self.frames += 1
+
+    def add_world(self, vessels: list[VesselInfo], cap: FrameCapture) -> None:
+        """One ``world_state`` row per vessel (``cap.world`` holds them in the order of ``vessels``)."""
+        st = cap.world
+        n = len(vessels)
+        poses = np.asarray(st.poses, dtype=np.float64).reshape(n, 6)
+        vel = np.asarray(st.velocities, dtype=np.float64).reshape(n, 3)
+        centres = np.asarray(st.box_centers, dtype=np.float64).reshape(n, 3)
+        size = np.array([v.box_size for v in vessels], dtype=np.float64).reshape(n, 3)
+        cols: dict[str, Any] = {
+            "frame": np.full(n, cap.frame, dtype=np.int64),
+            "time_s": np.full(n, cap.time_s, dtype=np.float64),
+            "vessel_id": [v.id for v in vessels],
+            "asset": [v.asset for v in vessels],
+            "role": [v.role for v in vessels],
+            "static": np.array([bool(v.static) for v in vessels], dtype=bool),
+            "semantic_class": np.array([v.semantic_class for v in vessels], dtype=np.int64),
+            "instance_id": np.array([v.instance_id for v in vessels], dtype=np.int64),
+        }
+        for j, k in enumerate(("x", "y", "z", "roll", "pitch", "yaw")):
+            cols[k] = poses[:, j]
+        for j, k in enumerate(("vx", "vy", "vz")):
+            cols[k] = vel[:, j]
+        for j, k in enumerate(("box_cx", "box_cy", "box_cz")):
+            cols[k] = centres[:, j]
+        for j, k in enumerate(("length", "beam", "height")):
+            cols[k] = size[:, j]
+        self._add("world_state", n, cols)
+
+    def add_annotations(self, ann: Annotations, cols: dict[str, Any]) -> None:
+        """One ``boxes_3d`` row per LiDAR box and one ``boxes_2d`` row per camera box of one agent's annotations;
+        ``cols`` is ``ann.columns()``."""
+        lid = cols["lidar"]
+        n = len(lid["target_id"])
+        c = np.asarray(lid["center"], dtype=np.float64).reshape(n, 3)
+        s = np.asarray(lid["size"], dtype=np.float64).reshape(n, 3)
+        q = np.asarray(lid["rotation"], dtype=np.float64).reshape(n, 4)
+        box3: dict[str, Any] = {
+            "frame": np.full(n, ann.frame, dtype=np.int64),
+            "time_s": np.full(n, ann.time_s, dtype=np.float64),
+            "agent": [ann.agent] * n,
+            "target_id": list(lid["target_id"]),
+            "instance_id": np.asarray(lid["instance_id"], dtype=np.int64),
+            "semantic_class": np.asarray(lid["semantic_class"], dtype=np.int64),
+            "yaw": np.asarray(lid["yaw"], dtype=np.float64),
+            "lidar_points": np.asarray(lid["lidar_points"], dtype=np.int64),
+            "range_m": np.asarray(lid["range_m"], dtype=np.float64),
+            "role": list(lid["role"]),
+            "static": np.asarray(lid["static"], dtype=bool),
+        }
+        for j, k in enumerate(("x", "y", "z")):
+            box3[k] = c[:, j]
+        for j, k in enumerate(("length", "beam", "height")):
+            box3[k] = s[:, j]
+        for j, k in enumerate(("qx", "qy", "qz", "qw")):
+            box3[k] = q[:, j]
+        self._add("boxes_3d", n, box3)
+        cam = cols["camera"]
+        m = len(cam["target_id"])
+        box2: dict[str, Any] = {
+            "frame": np.full(m, ann.frame, dtype=np.int64),
+            "time_s": np.full(m, ann.time_s, dtype=np.float64),
+            "agent": [ann.agent] * m,
+            "camera": list(cam["camera"]),
+            "target_id": list(cam["target_id"]),
+            "visible_pixels": np.asarray(cam["visible_pixels"], dtype=np.int64),
+            "box_pixels": np.asarray(cam["box_pixels"], dtype=np.int64),
+            "role": list(cam["role"]),
+            "static": np.asarray(cam["static"], dtype=bool),
+        }
+        for k in ("x_min", "y_min", "x_max", "y_max", "truncation", "occlusion"):
+            box2[k] = np.asarray(cam[k], dtype=np.float64)
+        self._add("boxes_2d", m, box2)
+
+    def flush(self) -> None:
+        """Writes the rows gathered since the last flush as part ``part`` of every table that has rows."""
+        for table, schema in SCHEMAS.items():
+            if not self._rows[table]:
+                continue
+            data: dict[str, Any] = {}
+            for name, dtype in schema.items():
+                parts = self._cols[table][name]
+                if dtype == _S:
+                    data[name] = [x for p in parts for x in p]
+                else:
+                    data[name] = np.concatenate([np.asarray(p) for p in parts])
+                parts.clear()
+            d = self.root / table
+            d.mkdir(parents=True, exist_ok=True)
+            pl.DataFrame(data, schema=schema).write_parquet(d / f"part-{self.part:05d}.parquet")
+            self._rows[table] = 0
+        self.part += 1
+        self.frames = 0

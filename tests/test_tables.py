@@ -1,0 +1,162 @@
+"""The Parquet tables (:mod:`mmusv.recording.tables`): gathered column-wise, they equal the row-wise ones."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import polars as pl
+from mmusv.acquire import annotations_for
+from mmusv.annotate import Annotations, SilhouetteCache
+from mmusv.recording.tables import SCHEMAS, TableWriter
+from mmusv.simulation import FrameCapture, Simulation
+from test_acquire import small_scenario
+
+
+class _RowWise:
+    """The tables as main built them before issue #12: one dict per row (the reference)."""
+
+    def __init__(self, root: Path) -> None:
+        self.root = root
+        self.rows: dict[str, list[dict[str, Any]]] = {"world_state": [], "boxes_3d": [], "boxes_2d": []}
+        self.part = 0
+
+    def add_world(self, sim: Simulation, cap: FrameCapture) -> None:
+        st = cap.world
+        for i, v in enumerate(sim.vessels):
+            x, y, z, r, p, yaw = (float(a) for a in st.poses[i])
+            self.rows["world_state"].append(
+                {
+                    "frame": cap.frame,
+                    "time_s": cap.time_s,
+                    "vessel_id": v.id,
+                    "asset": v.asset,
+                    "role": v.role,
+                    "static": v.static,
+                    "semantic_class": v.semantic_class,
+                    "instance_id": v.instance_id,
+                    "x": x,
+                    "y": y,
+                    "z": z,
+                    "roll": r,
+                    "pitch": p,
+                    "yaw": yaw,
+                    "vx": float(st.velocities[i, 0]),
+                    "vy": float(st.velocities[i, 1]),
+                    "vz": float(st.velocities[i, 2]),
+                    "box_cx": float(st.box_centers[i, 0]),
+                    "box_cy": float(st.box_centers[i, 1]),
+                    "box_cz": float(st.box_centers[i, 2]),
+                    "length": float(v.box_size[0]),
+                    "beam": float(v.box_size[1]),
+                    "height": float(v.box_size[2]),
+                }
+            )
+
+    def add_annotations(self, ann: Annotations, cols: dict[str, Any]) -> None:
+        """Rows of one agent's annotations; ``cols`` is ``ann.columns()``."""
+        lid = cols["lidar"]
+        for j, tid in enumerate(lid["target_id"]):
+            c, s, q = lid["center"][j], lid["size"][j], lid["rotation"][j]
+            self.rows["boxes_3d"].append(
+                {
+                    "frame": ann.frame,
+                    "time_s": ann.time_s,
+                    "agent": ann.agent,
+                    "target_id": tid,
+                    "instance_id": int(lid["instance_id"][j]),
+                    "semantic_class": int(lid["semantic_class"][j]),
+                    "x": float(c[0]),
+                    "y": float(c[1]),
+                    "z": float(c[2]),
+                    "length": float(s[0]),
+                    "beam": float(s[1]),
+                    "height": float(s[2]),
+                    "qx": float(q[0]),
+                    "qy": float(q[1]),
+                    "qz": float(q[2]),
+                    "qw": float(q[3]),
+                    "yaw": float(lid["yaw"][j]),
+                    "lidar_points": int(lid["lidar_points"][j]),
+                    "range_m": float(lid["range_m"][j]),
+                    "role": lid["role"][j],
+                    "static": bool(lid["static"][j]),
+                }
+            )
+        cam = cols["camera"]
+        for j, tid in enumerate(cam["target_id"]):
+            self.rows["boxes_2d"].append(
+                {
+                    "frame": ann.frame,
+                    "time_s": ann.time_s,
+                    "agent": ann.agent,
+                    "camera": cam["camera"][j],
+                    "target_id": tid,
+                    "x_min": float(cam["x_min"][j]),
+                    "y_min": float(cam["y_min"][j]),
+                    "x_max": float(cam["x_max"][j]),
+                    "y_max": float(cam["y_max"][j]),
+                    "truncation": float(cam["truncation"][j]),
+                    "visible_pixels": int(cam["visible_pixels"][j]),
+                    "box_pixels": int(cam["box_pixels"][j]),
+                    "occlusion": float(cam["occlusion"][j]),
+                    "role": cam["role"][j],
+                    "static": bool(cam["static"][j]),
+                }
+            )
+
+    def flush(self) -> None:
+        for name, rows in self.rows.items():
+            if not rows:
+                continue
+            d = self.root / name
+            d.mkdir(parents=True, exist_ok=True)
+            pl.DataFrame(rows).write_parquet(d / f"part-{self.part:05d}.parquet")
+            rows.clear()
+        self.part += 1
+
+
+def test_column_wise_tables_equal_the_row_wise_ones(tmp_path: Path) -> None:
+    sim = Simulation(small_scenario(frames=4))
+    silhouettes = SilhouetteCache()
+    new, ref = TableWriter(tmp_path / "new"), _RowWise(tmp_path / "ref")
+    for k in range(4):
+        cap = sim.capture(k)
+        anns = annotations_for(sim, cap, silhouettes)
+        cols = {agent: a.columns() for agent, a in anns.items()}
+        new.add_frame(sim.vessels, cap, {agent: (a, cols[agent]) for agent, a in anns.items()})
+        ref.add_world(sim, cap)
+        for agent, a in anns.items():
+            ref.add_annotations(a, cols[agent])
+        if k == 1:  # two parts
+            new.flush()
+            ref.flush()
+    new.flush()
+    ref.flush()
+    for table, schema in SCHEMAS.items():
+        parts = sorted(p.name for p in (tmp_path / "ref" / table).glob("*.parquet"))
+        assert parts == ["part-00000.parquet", "part-00001.parquet"], table
+        assert sorted(p.name for p in (tmp_path / "new" / table).glob("*.parquet")) == parts
+        for part in parts:
+            a = pl.read_parquet(tmp_path / "new" / table / part)
+            b = pl.read_parquet(tmp_path / "ref" / table / part)
+            assert a.height > 0 and a.schema == b.schema and dict(a.schema) == schema
+            assert a.equals(b), (table, part)
+            assert (tmp_path / "new" / table / part).read_bytes() == (tmp_path / "ref" / table / part).read_bytes()
+    b2 = pl.read_parquet(tmp_path / "new/boxes_2d/*.parquet")
+    assert b2.height > 0 and set(b2["camera"]) <= {"front", "rear"} and (b2["visible_pixels"] <= b2["box_pixels"]).all()
+
+
+def test_a_table_without_rows_writes_no_part(tmp_path: Path) -> None:
+    sim = Simulation(small_scenario(frames=1))
+    cap = sim.capture(0)
+    empty = Annotations(agent="usv_1", frame=0, time_s=0.0)
+    w = TableWriter(tmp_path)
+    w.add_frame(sim.vessels, cap, {"usv_1": (empty, empty.columns())})
+    w.flush()
+    assert [p.name for p in tmp_path.iterdir()] == ["world_state"]
+    ws = pl.read_parquet(tmp_path / "world_state/part-00000.parquet")
+    assert ws.height == len(sim.vessels)
+    np.testing.assert_array_equal(ws["x"].to_numpy(), cap.world.poses[:, 0])
+    assert ws["vessel_id"].to_list() == [v.id for v in sim.vessels]
