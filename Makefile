@@ -1,4 +1,4 @@
-.PHONY: help install dev test test-rust test-py fmt lint bench bench-peers profile
+.PHONY: help install dev test test-rust test-py fmt lint bench bench-peers profile screenshots
 
 help: ## list the targets
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  %-12s %s\n", $$1, $$2}'
@@ -38,3 +38,6 @@ bench-peers: ## mmusv vs Open3D/Embree on the same scene and rays
 
 profile: ## where the main job's time goes, per stage per frame (50 frames of scenarios/port_entry.yaml)
 	python3 benches/profile_run.py
+
+screenshots: ## the editor screenshots in docs/editor/ (the browser tests, saving their pictures there)
+	MMUSV_EDITOR_SCREENSHOTS=docs/editor python3 -m pytest -q -p no:dash tests/editor/test_browser.py

@@ -1,6 +1,7 @@
 """The editor in a real headless Chromium (Selenium): open, place vessels by clicking, draw and drag routes onto
 land and back, save and run what was drawn, scrub the time slider against ``Simulation.world_state``, preview a
-frame, run in the background, and refuse traversal and malformed requests. Screenshots go to ``docs/editor/``.
+frame, run in the background, and refuse traversal and malformed requests. Screenshots go to
+``$MMUSV_EDITOR_SCREENSHOTS`` (``make screenshots``: ``docs/editor/``).
 
 Synchronisation is by explicit waits on the page's own state: ``body[data-ready]`` once booted and
 ``body[data-pending="0"]`` when no evaluation is in flight or queued after the last edit.
@@ -9,6 +10,8 @@ Synchronisation is by explicit waits on the page's own state: ``body[data-ready]
 from __future__ import annotations
 
 import math
+import os
+import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -24,7 +27,9 @@ from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
 from selenium.webdriver.support.ui import WebDriverWait
 
-DOCS = Path(__file__).resolve().parents[2] / "docs" / "editor"
+# Screenshots: into the folder named by MMUSV_EDITOR_SCREENSHOTS (`make screenshots` gives docs/editor/), else a
+# temporary folder, so a test run leaves the checkout as it was.
+DOCS = Path(os.environ.get("MMUSV_EDITOR_SCREENSHOTS") or tempfile.mkdtemp(prefix="mmusv-editor-shots-"))
 WAIT_S = 60
 LiveServer = Any  # the live_server fixture of conftest.py: .url, .folder, .app
 
