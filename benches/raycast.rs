@@ -1,5 +1,9 @@
-//! `cargo bench`: ray-casting throughput (rays/s) on the synthetic maritime scene, and the cost of moving
-//! vessel instances (top-level rebuild only).
+//! `cargo bench`: ray-casting throughput (rays/s) on the synthetic maritime scene in its two layouts, and the
+//! cost of moving vessel instances (top-level rebuild only).
+//!
+//! * `instanced`: terrain, water plane and vessels as separate instances (how `mmusv` builds its worlds);
+//! * `single_mesh`: the same triangles concatenated into one mesh at the identity pose, no instancing (how a
+//!   user's own meshes often look). `benches/compare_open3d.py` times Open3D (Embree) on both layouts.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use mmusv_core::RigidPose;
@@ -21,12 +25,25 @@ fn bench_raycast(c: &mut Criterion) {
         lidar.0.len(),
         cams.0.len()
     );
+    let single = match mmusv_benches::single_mesh(&demo.scene) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("could not build the single-mesh scene: {e}");
+            return;
+        }
+    };
     let mut g = c.benchmark_group("raycast");
     g.sample_size(10).measurement_time(Duration::from_secs(6)).warm_up_time(Duration::from_secs(1));
-    g.throughput(Throughput::Elements(lidar.0.len() as u64));
-    g.bench_function("lidar_64x2048", |b| b.iter(|| black_box(demo.scene.cast_rays(&lidar.0, &lidar.1, 2000.0))));
-    g.throughput(Throughput::Elements(cams.0.len() as u64));
-    g.bench_function("cameras_4x640x480", |b| b.iter(|| black_box(demo.scene.cast_rays(&cams.0, &cams.1, 2000.0))));
+    for (layout, scene) in [("instanced", &demo.scene), ("single_mesh", &single)] {
+        g.throughput(Throughput::Elements(lidar.0.len() as u64));
+        g.bench_function(format!("{layout}/lidar_64x2048"), |b| {
+            b.iter(|| black_box(scene.cast_rays(&lidar.0, &lidar.1, 2000.0)))
+        });
+        g.throughput(Throughput::Elements(cams.0.len() as u64));
+        g.bench_function(format!("{layout}/cameras_4x640x480"), |b| {
+            b.iter(|| black_box(scene.cast_rays(&cams.0, &cams.1, 2000.0)))
+        });
+    }
     g.finish();
 
     let mut scene = demo.scene.clone();
