@@ -266,6 +266,11 @@ class Camera:
         """(width, height) pixels."""
     def world_rays(self, pose: npt.NDArray[np.float64]) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
         """World ray origins and unit directions (H·W, 3) float32, row-major."""
+    def pixel_rays(
+        self, pose: npt.NDArray[np.float64], pixels: npt.NDArray[np.int64]
+    ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
+        """World ray origins and unit directions (N, 3) float32 of the row-major pixel indices ``pixels`` (N,)
+        int64, in that order: the rows of ``world_rays`` for those pixels."""
     def render(
         self, scene: Scene, *, pose: npt.NDArray[np.float64], env: SensorEnv, seed: int
     ) -> dict[str, npt.NDArray[Any]]:

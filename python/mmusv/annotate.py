@@ -198,7 +198,6 @@ def annotate_agent(
     if lidar_instances is not None and lidar_instances.size:
         ids, cnt = np.unique(lidar_instances, return_counts=True)
         counts = {int(i): int(c) for i, c in zip(ids, cnt, strict=True)}
-    rays: dict[str, tuple[np.ndarray, np.ndarray]] = {}
     # Per pinhole camera, once: intrinsics and the world → camera-body transform.
     views = {
         name: (cam, cam.intrinsics, np.linalg.inv(pose), pose, inst_img)
@@ -240,11 +239,9 @@ def annotate_agent(
             window = inst_img[v0:v1, u0:u1]
             visible = int(np.count_nonzero(window == info.instance_id))
             vv, uu = np.mgrid[v0:v1, u0:u1]
-            pix = (vv * w + uu).reshape(-1)
-            if name not in rays:
-                rays[name] = cam.world_rays(np.ascontiguousarray(pose))
-            o, d = rays[name]
-            sil = int(np.count_nonzero(silhouettes.hits(info.asset, state.matrices[vi], o[pix], d[pix])))
+            pix = np.ascontiguousarray((vv * w + uu).reshape(-1), dtype=np.int64)
+            o, d = cam.pixel_rays(np.ascontiguousarray(pose), pix)
+            sil = int(np.count_nonzero(silhouettes.hits(info.asset, state.matrices[vi], o, d)))
             if sil == 0 and visible == 0:
                 continue
             ann.cam_ids.append(info.id)

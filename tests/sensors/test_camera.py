@@ -137,6 +137,30 @@ def test_world_rays_match_intrinsics_and_conventions(w: int, h: int) -> None:
     assert np.all(np.diff(grid[:, :, 2], axis=0) < 0), "v grows downwards (−z)"
 
 
+@pytest.mark.parametrize(
+    "cam",
+    [
+        core.Camera(rgb=False, width=33, height=21, hfov=math.radians(80)),
+        core.Camera(rgb=False, width=10, height=7, metres_per_pixel=0.25),
+    ],
+    ids=["pinhole", "orthographic"],
+)
+def test_pixel_rays_are_the_world_rays_of_those_pixels(cam: Any) -> None:
+    """The annotation's silhouette rays: ``pixel_rays`` gives exactly the ``world_rays`` rows it is asked for."""
+    w, h = cam.resolution
+    pose = pose_matrices(np.array([1.0, 2.0, 3.0, 0.2, -0.3, 2.5]))
+    origins, dirs = cam.world_rays(pose)
+    pix = np.random.default_rng(3).permutation(w * h)[: w * h // 2].astype(np.int64)
+    o, d = cam.pixel_rays(pose, pix)
+    assert o.dtype == d.dtype == np.float32
+    np.testing.assert_array_equal(o, origins[pix])
+    np.testing.assert_array_equal(d, dirs[pix])
+    with pytest.raises(mmusv.MmusvError, match=r"pixels\[1\].*outside"):
+        cam.pixel_rays(pose, np.array([0, w * h], dtype=np.int64))
+    with pytest.raises(TypeError, match="float64"):  # dtypes are checked by the binding, as for every array
+        cam.pixel_rays(pose, np.array([0.5]))
+
+
 @pytest.mark.parametrize("pitch_deg,roll_deg,yaw_deg", [(20.0, 6.0, 17.0), (60.0, -10.0, -120.0), (-5.0, 0.0, 90.0)])
 def test_depth_over_a_plane_is_the_analytic_distance(pitch_deg: float, roll_deg: float, yaw_deg: float) -> None:
     w, h, hfov = 64, 48, math.radians(90)

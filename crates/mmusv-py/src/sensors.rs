@@ -1,10 +1,10 @@
 //! Bindings for `mmusv_core::sensors`: ray patterns, the spinning LiDAR and the cameras.
 
-use crate::native::{detached, pose_arg, rows_to_array, RayArrays};
+use crate::native::{detached, flat, pose_arg, rows_to_array, RayArrays};
 use mmusv_core::sensors::shade::ShadeEnv;
 use mmusv_core::sensors::{camera, capture, lidar, rays};
 use numpy::ndarray::{Array2, Array3};
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -300,6 +300,20 @@ impl Camera {
     fn world_rays<'py>(&self, py: Python<'py>, pose: PyReadonlyArray2<'py, f64>) -> PyResult<RayArrays<'py>> {
         let pose = pose_arg(&pose, "pose")?;
         let (o, d) = self.inner.world_rays(&pose);
+        Ok((rows_to_array(py, o)?, rows_to_array(py, d)?))
+    }
+
+    /// World ray origins and unit directions `(N, 3)` float32 of the row-major pixel indices `pixels` (N,)
+    /// int64, in that order: the rows of `world_rays` for those pixels.
+    fn pixel_rays<'py>(
+        &self,
+        py: Python<'py>,
+        pose: PyReadonlyArray2<'py, f64>,
+        pixels: PyReadonlyArray1<'py, i64>,
+    ) -> PyResult<RayArrays<'py>> {
+        let pose = pose_arg(&pose, "pose")?;
+        let pixels = flat(&pixels, "pixels")?;
+        let (o, d) = self.inner.pixel_rays(&pose, pixels).map_err(crate::errors::to_py)?;
         Ok((rows_to_array(py, o)?, rows_to_array(py, d)?))
     }
 

@@ -72,6 +72,9 @@ pub struct CameraFrame {
 /// [`crate::bvh::packet`]), much tighter than 16 pixels of a row.
 const TILE: u32 = 4;
 
+/// World-frame ray origins and unit directions, one row per ray.
+pub type WorldRays = (Vec<[f32; 3]>, Vec<[f32; 3]>);
+
 /// A camera with its ray pattern computed once.
 #[derive(Debug, Clone)]
 pub struct Camera {
@@ -170,6 +173,41 @@ impl Camera {
             dirs[i as usize] = d[k];
         }
         (origins, dirs)
+    }
+
+    /// World-frame ray origins and unit directions of the pixels `pixels` (row-major indices `v · W + u`), in
+    /// the order given: the same values as the rows of [`Camera::world_rays`], without computing the others.
+    /// An index outside the image is an error naming it (`pixels[i]`).
+    pub fn pixel_rays(&self, pose: &RigidPose, pixels: &[i64]) -> Result<WorldRays> {
+        let n = self.cfg.width as i64 * self.cfg.height as i64;
+        if let Some((i, &p)) = pixels.iter().enumerate().find(|(_, &p)| !(0..n).contains(&p)) {
+            return Err(MmusvError::input(
+                format!("pixels[{i}]"),
+                format!("{p} is outside the {}×{} image (0..{n})", self.cfg.width, self.cfg.height),
+            ));
+        }
+        let ks = pixels.iter().map(|&p| self.trace_index(p as u32));
+        if self.origins.is_empty() {
+            let o = pose.translation.to_array();
+            let d = ks.map(|k| pose.transform_vector(Vec3::from_array(self.dirs[k])).to_array()).collect();
+            Ok((vec![o; pixels.len()], d))
+        } else {
+            let d = pose.transform_vector(Vec3::from_array(self.dirs[0])).to_array();
+            let o = ks.map(|k| pose.transform_point(Vec3::from_array(self.origins[k])).to_array()).collect();
+            Ok((o, vec![d; pixels.len()]))
+        }
+    }
+
+    /// Position in trace order of row-major pixel `i` (the inverse of [`tile_order`]).
+    fn trace_index(&self, i: u32) -> usize {
+        let (w, h) = (self.cfg.width as usize, self.cfg.height as usize);
+        let (x, y) = (i as usize % w, i as usize / w);
+        let t = TILE as usize;
+        let (tx, ty) = (x / t, y / t);
+        // Tile rows above, tiles to the left in this tile row (all full width), then the pixel in its tile.
+        let th = t.min(h - ty * t);
+        let tw = t.min(w - tx * t);
+        ty * t * w + tx * t * th + (y - ty * t) * tw + (x - tx * t)
     }
 
     /// World-frame ray origins and unit directions of every pixel in trace order (see [`Camera`]).
@@ -360,6 +398,30 @@ mod tests {
         assert_eq!(f.instance[px(100, 65)], 0);
         assert_eq!(f.instance[px(105, 60)], 0);
         assert!(f.rgb.is_empty());
+    }
+
+    #[test]
+    fn pixel_rays_are_the_world_rays_of_those_pixels() {
+        // Sizes with partial tiles at the right and bottom edges, both projections.
+        for (w, h, projection) in [
+            (13u32, 7u32, Projection::Pinhole { hfov: 1.2 }),
+            (8, 8, Projection::Pinhole { hfov: 0.7 }),
+            (9, 6, Projection::Orthographic { metres_per_pixel: 0.5 }),
+        ] {
+            let cam = Camera::new(CameraConfig { width: w, height: h, projection, range_max: 100.0 });
+            let Ok(cam) = cam else { panic!("camera {w}x{h}") };
+            let pose = RigidPose::from_xyz_rpy([3.0, -2.0, 5.0], [0.1, 0.4, -0.7]);
+            let (o, d) = cam.world_rays(&pose);
+            let all: Vec<i64> = (0..(w * h) as i64).rev().collect();
+            let Ok((po, pd)) = cam.pixel_rays(&pose, &all) else { panic!("pixel_rays {w}x{h}") };
+            for (j, &p) in all.iter().enumerate() {
+                assert_eq!(po[j], o[p as usize], "origin of pixel {p} ({w}x{h})");
+                assert_eq!(pd[j], d[p as usize], "direction of pixel {p} ({w}x{h})");
+            }
+            let err = cam.pixel_rays(&pose, &[0, (w * h) as i64]).err().map(|e| e.to_string()).unwrap_or_default();
+            assert!(err.contains("pixels[1]"), "{err}");
+            assert!(cam.pixel_rays(&pose, &[-1]).is_err());
+        }
     }
 
     #[test]
