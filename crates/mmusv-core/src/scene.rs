@@ -35,6 +35,17 @@ const SEA_WALK_DOWN: usize = 12;
 const SEA_WALK_SKY: usize = 2;
 const SEA_WALK_SHADOW: usize = 2;
 
+/// How the sea shortcut settles a closest-hit query.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum SeaRoute {
+    /// Down onto the surface with nothing in between: test the surface mesh alone.
+    Surface,
+    /// Up and clear of everything: a miss.
+    Sky,
+    /// Anything else: the full trace.
+    Trace,
+}
+
 /// One placed copy of a mesh.
 #[derive(Debug, Clone)]
 pub struct Instance {
@@ -279,25 +290,81 @@ impl Scene {
     /// and nothing can be hit before it (the hit is the surface's, found by testing its mesh alone), `Some(None)`
     /// when the ray rises clear above everything (a miss), `None` when the ray needs the full trace.
     #[inline(always)]
-    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a < b)` on purpose: a NaN must take the full trace
     pub fn sea_closest(&self, ray: &RayPrep, limit: f32, scratch: &mut Scratch) -> Option<Option<Hit>> {
-        let sea = self.sea.as_ref()?;
+        match self.sea_route(ray, limit) {
+            SeaRoute::Sky => Some(None),
+            SeaRoute::Trace => None,
+            SeaRoute::Surface => self.sea_surface_hit(ray, limit, scratch).map(Some),
+        }
+    }
+
+    /// Which way the sea shortcut settles a closest-hit query (see [`Scene::sea_closest`]).
+    #[inline(always)]
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a < b)` on purpose: a NaN must take the full trace
+    fn sea_route(&self, ray: &RayPrep, limit: f32) -> SeaRoute {
+        let Some(sea) = self.sea.as_ref() else { return SeaRoute::Trace };
         let (oz, dz) = (ray.o[2], ray.d[2]);
         if !(oz > sea.level) {
-            return None;
+            return SeaRoute::Trace;
         }
         if dz < 0.0 {
             let t_w = (sea.level - oz) / dz;
             if !(t_w < limit) || !sea.path_clear(ray.o, ray.d, t_w, SEA_WALK_DOWN) {
-                return None;
+                return SeaRoute::Trace;
             }
-            let inst = &self.instances[sea.instance as usize];
-            let local = local_ray(ray, &inst.pose);
-            let mesh = &self.meshes[inst.mesh as usize];
-            let h = mesh.closest(local.as_ref().unwrap_or(ray), limit, &mut scratch.bottom)?;
-            return Some(Some(Hit { distance: h.t, instance: sea.instance, triangle: h.triangle }));
+            return SeaRoute::Surface;
         }
-        self.sea_clear_within(ray, limit, SEA_WALK_SKY).then_some(None)
+        if self.sea_clear_within(ray, limit, SEA_WALK_SKY) {
+            SeaRoute::Sky
+        } else {
+            SeaRoute::Trace
+        }
+    }
+
+    /// The closest hit of a ray [`Scene::sea_route`] sent to the surface, from the surface mesh alone (`None`
+    /// when it misses the mesh: the ray then needs the full trace).
+    #[inline(always)]
+    fn sea_surface_hit(&self, ray: &RayPrep, limit: f32, scratch: &mut Scratch) -> Option<Hit> {
+        let sea = self.sea.as_ref()?;
+        let inst = &self.instances[sea.instance as usize];
+        let local = local_ray(ray, &inst.pose);
+        let mesh = &self.meshes[inst.mesh as usize];
+        let h = mesh.closest(local.as_ref().unwrap_or(ray), limit, &mut scratch.bottom)?;
+        Some(Hit { distance: h.t, instance: sea.instance, triangle: h.triangle })
+    }
+
+    /// [`Scene::sea_surface_hit`] for up to [`PACKET`] rays at once, traced as one packet against the surface
+    /// mesh when they are coherent (each ray gets the hit it gets alone).
+    #[inline(always)]
+    fn sea_surface_hits(&self, rays: &[RayPrep], limit: f32, scratch: &mut Scratch) -> [Option<Hit>; PACKET] {
+        let mut out = [None; PACKET];
+        let Some(sea) = self.sea.as_ref() else { return out };
+        let inst = &self.instances[sea.instance as usize];
+        let mesh = &self.meshes[inst.mesh as usize];
+        let mut local = [rays[0]; PACKET];
+        for (j, ray) in rays.iter().enumerate() {
+            local[j] = local_ray(ray, &inst.pose).unwrap_or(*ray);
+        }
+        let local = &local[..rays.len()];
+        let packet = if coherent(local) { Packet::new(local, limit) } else { None };
+        if let Some(mut p) = packet {
+            let mut tri = [u32::MAX; PACKET];
+            mesh.closest_packet(&mut p, &mut scratch.packet_bottom, &mut tri);
+            for j in 0..rays.len() {
+                if tri[j] != u32::MAX {
+                    out[j] = Some(Hit { distance: p.best[j], instance: sea.instance, triangle: tri[j] });
+                }
+            }
+        } else {
+            for (j, ray) in local.iter().enumerate() {
+                out[j] = mesh.closest(ray, limit, &mut scratch.bottom).map(|h| Hit {
+                    distance: h.t,
+                    instance: sea.instance,
+                    triangle: h.triangle,
+                });
+            }
+        }
+        out
     }
 
     /// The sea shortcut for an any-hit query: whether the ray rises from above the surface and stays clear of
@@ -635,18 +702,39 @@ crate::dispatch! {
                 out.miss(i);
             }
             let Some(rays) = prepare(o, d, start, end, &mut bad) else { continue };
-            // Rays the sea shortcut settles are done; the others are traced (as a packet when coherent).
+            // Rays the sea shortcut settles are done (those it sends to the surface tested against the surface
+            // mesh alone, as one packet); the others are traced (as a packet when coherent).
             let mut rest = [rays[0]; PACKET];
             let mut lane = [0usize; PACKET];
             let mut n = 0;
+            let mut water = [rays[0]; PACKET];
+            let mut water_lane = [0usize; PACKET];
+            let mut nw = 0;
             for (r, ray) in rays[..end - start].iter().enumerate() {
-                match scene.sea_closest(ray, limit, &mut scratch) {
-                    Some(Some(hit)) => out.hit(scene, start + r, Vec3::from_array(ray.d), &hit),
-                    Some(None) => {}
-                    None => {
+                match scene.sea_route(ray, limit) {
+                    SeaRoute::Surface => {
+                        water[nw] = *ray;
+                        water_lane[nw] = r;
+                        nw += 1;
+                    }
+                    SeaRoute::Sky => {}
+                    SeaRoute::Trace => {
                         rest[n] = *ray;
                         lane[n] = r;
                         n += 1;
+                    }
+                }
+            }
+            if nw > 0 {
+                let hits = scene.sea_surface_hits(&water[..nw], limit, &mut scratch);
+                for j in 0..nw {
+                    match &hits[j] {
+                        Some(hit) => out.hit(scene, start + water_lane[j], Vec3::from_array(water[j].d), hit),
+                        None => {
+                            rest[n] = water[j];
+                            lane[n] = water_lane[j];
+                            n += 1;
+                        }
                     }
                 }
             }
@@ -1137,6 +1225,26 @@ mod tests {
                 .filter(|(o, d)| with.sea_closest(&RayPrep::new(**o, unit_direction(d)), 800.0, &mut scratch).is_some())
                 .count();
             assert!(settled > 2_000, "only {settled} of 20000 rays settled by the sea shortcut");
+            // Coherent sets, in 4x4 tiles as the cameras trace them (the surface then answers whole packets):
+            // a pinhole fan from 3 m up looking at the water and the horizon, and a top view's vertical rays.
+            let (mut co, mut cd) = (Vec::new(), Vec::new());
+            let eye = [rng.random_range(-150.0..150.0), rng.random_range(-150.0..150.0), 3.0f32];
+            for top_view in [false, true] {
+                for tile in 0..64u32 {
+                    for k in 0..16u32 {
+                        let (u, v) = ((tile % 8) * 4 + k % 4, (tile / 8) * 4 + k / 4);
+                        if top_view {
+                            co.push([eye[0] + 0.5 * u as f32, eye[1] + 0.5 * v as f32, 120.0]);
+                            cd.push([0.0, 0.0, -1.0]);
+                        } else {
+                            let (az, el) = (0.03 * u as f32 - 0.5, -0.02 * v as f32 + 0.05);
+                            co.push(eye);
+                            cd.push([az.cos() * el.cos(), az.sin() * el.cos(), el.sin()]);
+                        }
+                    }
+                }
+            }
+            assert_eq!(s.cast_rays(&co, &cd, 800.0).ok(), with.cast_rays(&co, &cd, 800.0).ok(), "frame {frame}");
             // Shadow rays: from just above the water towards the sun, and from above everything.
             let sun = [0.4f32, 0.3, 0.866];
             let so: Vec<[f32; 3]> =
