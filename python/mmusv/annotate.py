@@ -198,9 +198,9 @@ def annotate_agent(
     if lidar_instances is not None and lidar_instances.size:
         ids, cnt = np.unique(lidar_instances, return_counts=True)
         counts = {int(i): int(c) for i, c in zip(ids, cnt, strict=True)}
-    # Per pinhole camera, once: intrinsics and the world → camera-body transform.
+    # Per pinhole camera, once: intrinsics, the world → camera-body transform and the pose as the binding takes it.
     views = {
-        name: (cam, cam.intrinsics, np.linalg.inv(pose), pose, inst_img)
+        name: (cam, cam.intrinsics, np.linalg.inv(pose), np.ascontiguousarray(pose, dtype=np.float64), inst_img)
         for name, (cam, pose, inst_img) in cameras.items()
         if cam.intrinsics is not None
     }
@@ -240,7 +240,7 @@ def annotate_agent(
             visible = int(np.count_nonzero(window == info.instance_id))
             vv, uu = np.mgrid[v0:v1, u0:u1]
             pix = np.ascontiguousarray((vv * w + uu).reshape(-1), dtype=np.int64)
-            o, d = cam.pixel_rays(np.ascontiguousarray(pose), pix)
+            o, d = cam.pixel_rays(pose, pix)
             sil = int(np.count_nonzero(silhouettes.hits(info.asset, state.matrices[vi], o, d)))
             if sil == 0 and visible == 0:
                 continue

@@ -356,12 +356,8 @@ impl Scene {
                 }
             }
         } else {
-            for (j, ray) in local.iter().enumerate() {
-                out[j] = mesh.closest(ray, limit, &mut scratch.bottom).map(|h| Hit {
-                    distance: h.t,
-                    instance: sea.instance,
-                    triangle: h.triangle,
-                });
+            for (j, ray) in rays.iter().enumerate() {
+                out[j] = self.sea_surface_hit(ray, limit, scratch);
             }
         }
         out

@@ -164,7 +164,7 @@ impl Camera {
     }
 
     /// World-frame ray origins and unit directions of every pixel, row-major.
-    pub fn world_rays(&self, pose: &RigidPose) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
+    pub fn world_rays(&self, pose: &RigidPose) -> WorldRays {
         let (o, d) = self.traced_rays(pose);
         let mut origins = vec![[0f32; 3]; o.len()];
         let mut dirs = vec![[0f32; 3]; d.len()];
@@ -186,16 +186,7 @@ impl Camera {
                 format!("{p} is outside the {}×{} image (0..{n})", self.cfg.width, self.cfg.height),
             ));
         }
-        let ks = pixels.iter().map(|&p| self.trace_index(p as u32));
-        if self.origins.is_empty() {
-            let o = pose.translation.to_array();
-            let d = ks.map(|k| pose.transform_vector(Vec3::from_array(self.dirs[k])).to_array()).collect();
-            Ok((vec![o; pixels.len()], d))
-        } else {
-            let d = pose.transform_vector(Vec3::from_array(self.dirs[0])).to_array();
-            let o = ks.map(|k| pose.transform_point(Vec3::from_array(self.origins[k])).to_array()).collect();
-            Ok((o, vec![d; pixels.len()]))
-        }
+        Ok(self.rays_at(pose, pixels.iter().map(|&p| self.trace_index(p as u32))))
     }
 
     /// Position in trace order of row-major pixel `i` (the inverse of [`tile_order`]).
@@ -211,15 +202,20 @@ impl Camera {
     }
 
     /// World-frame ray origins and unit directions of every pixel in trace order (see [`Camera`]).
-    fn traced_rays(&self, pose: &RigidPose) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
-        let n = self.cfg.width as usize * self.cfg.height as usize;
+    fn traced_rays(&self, pose: &RigidPose) -> WorldRays {
+        self.rays_at(pose, 0..self.cfg.width as usize * self.cfg.height as usize)
+    }
+
+    /// World-frame ray origins and unit directions of the rays at trace positions `ks`, in that order.
+    fn rays_at(&self, pose: &RigidPose, ks: impl ExactSizeIterator<Item = usize>) -> WorldRays {
+        let n = ks.len();
         if self.origins.is_empty() {
             let o = pose.translation.to_array();
-            let d = self.dirs.iter().map(|d| pose.transform_vector(Vec3::from_array(*d)).to_array()).collect();
+            let d = ks.map(|k| pose.transform_vector(Vec3::from_array(self.dirs[k])).to_array()).collect();
             (vec![o; n], d)
         } else {
             let d = pose.transform_vector(Vec3::from_array(self.dirs[0])).to_array();
-            let o = self.origins.iter().map(|o| pose.transform_point(Vec3::from_array(*o)).to_array()).collect();
+            let o = ks.map(|k| pose.transform_point(Vec3::from_array(self.origins[k])).to_array()).collect();
             (o, vec![d; n])
         }
     }
