@@ -11,10 +11,16 @@
 //! * a ray going up (a shadow ray) that stays above every cell it crosses until it is higher than everything
 //!   in the scene hits nothing.
 //!
+//! * a batch of shadow rays all towards one sun direction asks the [`SunMask`] instead: the cells from which a
+//!   ray in that direction can pass over some cell at or below that cell's bound, found once per sun direction
+//!   and height map by sweeping every occupied cell against the sun. A ray from above the surface whose cell is
+//!   not in the mask hits nothing, however far it goes, in one lookup.
+//!
 //! So the shortcuts give exactly the full trace's answers; a ray the bound cannot settle is traced fully.
 
 use crate::bvh::Box3;
 use parry3d::math::Vec3;
+use std::sync::{Arc, Mutex};
 
 /// Most cells per side of the height grid.
 const MAX_CELLS: usize = 512;
@@ -46,6 +52,43 @@ pub struct Sea {
     top: f32,
     /// Whether every moving box lies inside the grid (else leaving the grid proves nothing).
     contained: bool,
+    /// Counts the height maps: bumped by every [`Sea::update`], so a cached [`SunMask`] knows its map.
+    generation: u64,
+    /// The moving instances' world boxes of the current map.
+    boxes: Vec<Box3>,
+    /// The last sun mask of the static geometry alone, for its direction (generation 0).
+    fixed_sun: SunCache,
+    /// The last sun mask built, for its direction and generation.
+    sun_cache: SunCache,
+}
+
+/// The cells of a [`Sea`] grid from which a ray towards one sun direction may meet something (see the module
+/// docs): a ray from above the surface starting in any other cell of the grid hits nothing.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SunMask {
+    /// The unit direction the mask was built for.
+    dir: [f32; 3],
+    /// The height map's generation it was built from.
+    generation: u64,
+    /// Per cell, row-major like the height map: whether a ray from there may meet something.
+    blocked: Vec<bool>,
+}
+
+impl SunMask {
+    /// Share of the grid's cells in the mask, in `[0, 1]` (for tests and profiles).
+    pub fn blocked_share(&self) -> f64 {
+        self.blocked.iter().filter(|&&b| b).count() as f64 / self.blocked.len().max(1) as f64
+    }
+}
+
+/// The last [`SunMask`] built; a copy of a [`Sea`] starts with an empty cache.
+#[derive(Debug, Default)]
+struct SunCache(Mutex<Option<Arc<SunMask>>>);
+
+impl Clone for SunCache {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
 }
 
 impl Sea {
@@ -71,6 +114,10 @@ impl Sea {
             heights: Vec::new(),
             top: f32::NEG_INFINITY,
             contained: true,
+            generation: 0,
+            boxes: Vec::new(),
+            fixed_sun: SunCache::default(),
+            sun_cache: SunCache::default(),
         };
         let mut grid = std::mem::take(&mut sea.fixed);
         for tri in fixed {
@@ -103,7 +150,9 @@ impl Sea {
     pub fn update(&mut self, moving_boxes: impl Iterator<Item = Box3>) {
         let mut grid = self.fixed.clone();
         self.contained = true;
+        self.boxes.clear();
         for b in moving_boxes {
+            self.boxes.push(b);
             let inside = b.lo[0] >= self.x0
                 && b.lo[1] >= self.y0
                 && b.hi[0] <= self.x0 + self.nx as f32 * self.cell
@@ -113,16 +162,138 @@ impl Sea {
         }
         self.top = grid.iter().copied().fold(f32::NEG_INFINITY, f32::max);
         self.heights = grid;
+        self.generation += 1;
+    }
+
+    /// The [`SunMask`] of unit direction `dir` for the current height map, built on first use and kept until
+    /// the map or the direction changes. `None` when `dir` does not rise (`dir.z <= 0`, or not finite) or a
+    /// moving box lies outside the grid (the map then does not hold everything).
+    ///
+    /// The static geometry's part is built once per direction and kept across maps; each map adds the moving
+    /// boxes' sweeps to a copy. Callers on several threads may ask at once: one builds, the others wait (the
+    /// build is sequential).
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > b)` on purpose: a NaN must answer "no"
+    pub fn sun_mask(&self, dir: [f32; 3]) -> Option<Arc<SunMask>> {
+        if !(dir[2] > 0.0 && dir.iter().all(|v| v.is_finite()) && self.contained) {
+            return None;
+        }
+        let mut cache = self.sun_cache.0.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        if let Some(m) = cache.as_ref() {
+            if m.dir == dir && m.generation == self.generation {
+                return Some(Arc::clone(m));
+            }
+        }
+        let fixed = {
+            let mut fixed = self.fixed_sun.0.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+            match fixed.as_ref() {
+                Some(m) if m.dir == dir => Arc::clone(m),
+                _ => {
+                    let m = Arc::new(self.fixed_sun_mask(dir));
+                    *fixed = Some(Arc::clone(&m));
+                    m
+                }
+            }
+        };
+        let mut blocked = fixed.blocked.clone();
+        let (nx, ny) = (self.nx, self.ny);
+        for b in &self.boxes {
+            let h = b.hi[2] + MARGIN_M;
+            let ([x_lo, x_hi], [y_lo, y_hi]) = self.cells_under(b);
+            for iy in y_lo..=y_hi {
+                for ix in x_lo..=x_hi {
+                    self.sweep(ix, iy, h, dir, |gx, gy| {
+                        for y in gy.saturating_sub(1)..=(gy + 1).min(ny - 1) {
+                            blocked[y * nx + gx.saturating_sub(1)..=y * nx + (gx + 1).min(nx - 1)].fill(true);
+                        }
+                    });
+                }
+            }
+        }
+        let mask = Arc::new(SunMask { dir, generation: self.generation, blocked });
+        *cache = Some(Arc::clone(&mask));
+        Some(mask)
+    }
+
+    /// The sun mask of the static geometry alone (the moving boxes left out).
+    fn fixed_sun_mask(&self, dir: [f32; 3]) -> SunMask {
+        let (nx, ny) = (self.nx, self.ny);
+        let mut centre = vec![false; nx * ny];
+        for iy in 0..ny {
+            for ix in 0..nx {
+                self.sweep(ix, iy, self.fixed[iy * nx + ix], dir, |gx, gy| centre[gy * nx + gx] = true);
+            }
+        }
+        // Widen by one cell (a 3×3 maximum, done separably).
+        let mut rows = vec![false; nx * ny];
+        for iy in 0..ny {
+            for ix in 0..nx {
+                let r = &centre[iy * nx..(iy + 1) * nx];
+                rows[iy * nx + ix] = r[ix.saturating_sub(1)..=(ix + 1).min(nx - 1)].iter().any(|&b| b);
+            }
+        }
+        let mut blocked = vec![false; nx * ny];
+        for iy in 0..ny {
+            for ix in 0..nx {
+                blocked[iy * nx + ix] = (iy.saturating_sub(1)..=(iy + 1).min(ny - 1)).any(|y| rows[y * nx + ix]);
+            }
+        }
+        SunMask { dir, generation: 0, blocked }
+    }
+
+    /// Sweeps cell `(ix, iy)` with height bound `h` against the sun `dir`, calling `mark(gx, gy)` for the cell
+    /// of every sample (clamped into the grid); the caller widens each mark by one cell.
+    ///
+    /// A ray from height `z >= level` passes over the cell at height at most `h` only if its start lies in the
+    /// cell moved back along the horizontal sun direction by up to `(h - level) · |d_xy| / d_z`. The sweep is
+    /// sampled every half cell, so the widened marks cover every point within 0.75 cells of a sample: the whole
+    /// swept square. A cell bounded at or below the surface is skipped: a ray from above it never gets there.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > b)` on purpose: a NaN must answer "no"
+    #[inline]
+    fn sweep(&self, ix: usize, iy: usize, h: f32, dir: [f32; 3], mut mark: impl FnMut(usize, usize)) {
+        if !(h > self.level) {
+            return;
+        }
+        let (nx, ny) = (self.nx, self.ny);
+        let hlen = (dir[0] * dir[0] + dir[1] * dir[1]).sqrt();
+        let (ux, uy) = if hlen > 0.0 { (dir[0] / hlen, dir[1] / hlen) } else { (0.0, 0.0) };
+        let step = 0.5 * self.cell;
+        // Horizontal run while rising from the surface to `h`, padded against rounding.
+        let run = (h - self.level) / dir[2] * hlen * 1.001 + step;
+        let samples = if hlen > 0.0 { (run / step).ceil() as usize } else { 0 };
+        let cx = self.x0 + (ix as f32 + 0.5) * self.cell;
+        let cy = self.y0 + (iy as f32 + 0.5) * self.cell;
+        for k in 0..=samples {
+            let back = k as f32 * step;
+            let gx = ((cx - back * ux - self.x0) / self.cell).floor();
+            let gy = ((cy - back * uy - self.y0) / self.cell).floor();
+            // Outside the grid by more than the widening: moving on only goes further out.
+            if gx < -1.0 || gy < -1.0 || gx > nx as f32 || gy > ny as f32 {
+                break;
+            }
+            mark(gx.clamp(0.0, (nx - 1) as f32) as usize, gy.clamp(0.0, (ny - 1) as f32) as usize);
+        }
+    }
+
+    /// Whether a ray from `o` in the direction of `mask` surely hits nothing: `o` is above the surface and
+    /// inside the grid, in a cell outside the mask. `false` means "not known" (trace it).
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > b)` on purpose: a NaN must answer "no"
+    #[inline(always)]
+    pub fn sun_clear(&self, mask: &SunMask, o: [f32; 3]) -> bool {
+        if !(o[2] > self.level) {
+            return false;
+        }
+        let gx = ((o[0] - self.x0) / self.cell).floor();
+        let gy = ((o[1] - self.y0) / self.cell).floor();
+        if !(gx >= 0.0 && gy >= 0.0 && gx < self.nx as f32 && gy < self.ny as f32) {
+            return false;
+        }
+        !mask.blocked[gy as usize * self.nx + gx as usize]
     }
 
     /// Raises the cells under `b` (widened by one cell) to `b`'s top plus the margin.
     fn raster(&self, grid: &mut [f32], b: &Box3) {
         let z = b.hi[2] + MARGIN_M;
-        let cx = |x: f32| ((x - self.x0) / self.cell).floor();
-        let cy = |y: f32| ((y - self.y0) / self.cell).floor();
-        let clamp = |v: f32, n: usize| (v.max(0.0) as usize).min(n - 1);
-        let (x_lo, x_hi) = (clamp(cx(b.lo[0]) - 1.0, self.nx), clamp(cx(b.hi[0]) + 1.0, self.nx));
-        let (y_lo, y_hi) = (clamp(cy(b.lo[1]) - 1.0, self.ny), clamp(cy(b.hi[1]) + 1.0, self.ny));
+        let ([x_lo, x_hi], [y_lo, y_hi]) = self.cells_under(b);
         for y in y_lo..=y_hi {
             for c in &mut grid[y * self.nx + x_lo..=y * self.nx + x_hi] {
                 if z > *c {
@@ -130,6 +301,16 @@ impl Sea {
                 }
             }
         }
+    }
+
+    /// The cell ranges `[x_lo, x_hi], [y_lo, y_hi]` (inclusive) that [`Sea::raster`] raises for box `b`.
+    fn cells_under(&self, b: &Box3) -> ([usize; 2], [usize; 2]) {
+        let cx = |x: f32| ((x - self.x0) / self.cell).floor();
+        let cy = |y: f32| ((y - self.y0) / self.cell).floor();
+        let clamp = |v: f32, n: usize| (v.max(0.0) as usize).min(n - 1);
+        let x = [clamp(cx(b.lo[0]) - 1.0, self.nx), clamp(cx(b.hi[0]) + 1.0, self.nx)];
+        let y = [clamp(cy(b.lo[1]) - 1.0, self.ny), clamp(cy(b.hi[1]) + 1.0, self.ny)];
+        (x, y)
     }
 
     /// Highest height bound in the scene (metres).
@@ -260,6 +441,50 @@ mod tests {
         assert!(!sea.path_clear(o, [0.0, 0.6, 0.8], 100.0, 2));
         // Up over the tower, below its top: blocked.
         assert!(!sea.path_clear([45.0, 0.5, 1.0], [0.98, 0.0, 0.2], 60.0, 512));
+    }
+
+    #[test]
+    fn sun_mask_clears_only_rays_the_unlimited_walk_clears() {
+        // A tower and a low quay on a 200 m grid, a moving boat; suns from steep to low, one straight up.
+        let bounds = Box3 { lo: [-100.0, -100.0, -20.0], hi: [100.0, 100.0, 30.0] };
+        let mut fixed = vec![tri(50.0, 0.0, 30.0), tri(-80.0, -80.0, -20.0)];
+        fixed.extend((0..40).map(|i| tri(-60.0 + i as f32, 40.0, 2.0)));
+        let mut sea = Sea::new(0, 0.0, bounds, vec![1], &fixed);
+        sea.update([Box3 { lo: [0.0, -30.0, -1.0], hi: [12.0, -26.0, 6.0] }].into_iter());
+        let mut state = 7u64;
+        let mut rand = |lo: f32, hi: f32| {
+            state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+            lo + (hi - lo) * ((state >> 40) as f32 / (1u64 << 24) as f32)
+        };
+        for sun in [[0.4f32, 0.3, 0.866], [-0.9, 0.1, 0.42], [0.0, -0.97, 0.24], [0.0, 0.0, 1.0]] {
+            let n = (sun[0] * sun[0] + sun[1] * sun[1] + sun[2] * sun[2]).sqrt();
+            let d = [sun[0] / n, sun[1] / n, sun[2] / n];
+            let Some(mask) = sea.sun_mask(d) else { panic!("no mask for {d:?}") };
+            let (mut cleared, mut shaded) = (0, 0);
+            for _ in 0..20_000 {
+                let o = [rand(-110.0, 110.0), rand(-110.0, 110.0), rand(0.001, 3.0)];
+                let t_top = (sea.top() - o[2]) / d[2];
+                let walk = sea.path_clear(o, d, t_top, 100_000);
+                if sea.sun_clear(&mask, o) {
+                    assert!(walk, "mask clears {o:?} towards {d:?}, the walk does not");
+                    cleared += 1;
+                }
+                shaded += usize::from(!walk);
+            }
+            // The mask settles most of the open water, and the shade is real.
+            assert!(cleared > 12_000, "only {cleared} cleared towards {d:?}");
+            assert!(shaded > 100, "only {shaded} shaded towards {d:?}");
+            // Cached: the same mask again, until the map changes.
+            assert!(sea.sun_mask(d).is_some_and(|m| Arc::ptr_eq(&m, &mask)));
+        }
+        assert!(sea.sun_mask([0.6, 0.0, -0.8]).is_none(), "a sun below the horizon has no mask");
+        let before = sea.sun_mask([0.0, 0.0, 1.0]);
+        sea.update([Box3 { lo: [-50.0, 60.0, -1.0], hi: [-40.0, 64.0, 6.0] }].into_iter());
+        let after = sea.sun_mask([0.0, 0.0, 1.0]);
+        assert!(before.is_some() && after.is_some() && before != after, "a new map gives a new mask");
+        // A boat outside the grid: no mask.
+        sea.update([Box3 { lo: [160.0, 0.0, 0.0], hi: [170.0, 4.0, 4.0] }].into_iter());
+        assert!(sea.sun_mask([0.0, 0.0, 1.0]).is_none());
     }
 
     #[test]
