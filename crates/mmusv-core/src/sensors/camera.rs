@@ -264,48 +264,58 @@ impl Camera {
             let point = Vec3::from_array(origins[k]) + d * t;
             Some(SurfaceHit { t, point, normal, class: hits.class[k], instance: hits.instance[k] })
         };
-        // Shadow rays from every surface point facing the sun (in trace order: neighbouring points, one packet).
+        // Shadow rays from every surface point facing the sun, in trace order (neighbouring points, one packet),
+        // gathered block by block.
         let sun = Vec3::from_array(env.sun_direction).normalize_or_zero();
         let mut lit = vec![false; n];
         if env.sun_intensity > 0.0 && sun.z > 0.0 {
-            let facing: Vec<(usize, [f32; 3])> = (0..n)
+            const BLOCK: usize = 4096;
+            let blocks: Vec<(Vec<u32>, Vec<[f32; 3]>)> = (0..n.div_ceil(BLOCK))
                 .into_par_iter()
-                .filter_map(|k| {
-                    surface(k).filter(|h| h.normal.dot(sun) > 0.0 || h.class == 1).map(|h| {
-                        let eps = 0.02 + 1e-4 * h.t;
-                        (k, (h.point + h.normal * eps).to_array())
-                    })
+                .map(|b| {
+                    let (mut ks, mut os) = (Vec::new(), Vec::new());
+                    for k in b * BLOCK..((b + 1) * BLOCK).min(n) {
+                        if let Some(h) = surface(k).filter(|h| h.normal.dot(sun) > 0.0 || h.class == 1) {
+                            let eps = 0.02 + 1e-4 * h.t;
+                            ks.push(k as u32);
+                            os.push((h.point + h.normal * eps).to_array());
+                        }
+                    }
+                    (ks, os)
                 })
                 .collect();
+            let facing: Vec<u32> = blocks.iter().flat_map(|(ks, _)| ks.iter().copied()).collect();
             if env.shadows {
-                let so: Vec<[f32; 3]> = facing.iter().map(|(_, o)| *o).collect();
+                let so: Vec<[f32; 3]> = blocks.into_iter().flat_map(|(_, os)| os).collect();
                 let sd = vec![sun.to_array(); so.len()];
                 let blocked = scene.occluded_rays(&so, &sd, 5_000.0)?;
-                for (j, (k, _)) in facing.iter().enumerate() {
-                    lit[*k] = !blocked[j];
+                for (&k, b) in facing.iter().zip(blocked) {
+                    lit[k as usize] = !b;
                 }
             } else {
-                for (k, _) in &facing {
-                    lit[*k] = true;
+                for &k in &facing {
+                    lit[k as usize] = true;
                 }
             }
         }
-        let w = self.cfg.width;
+        // Shade tile row by tile row: the trace positions of a tile row are exactly the row-major pixels of its
+        // image rows, so each row block is written in place.
+        let w = self.cfg.width as usize;
+        let rows = TILE as usize * w;
         let shader = Shader::new(env, seed);
-        let mut traced = vec![0u8; 3 * n];
-        traced.par_chunks_mut(3).enumerate().for_each(|(k, px)| {
-            let i = self.order[k];
-            let d = Vec3::from_array(dirs[k]);
-            let h = surface(k);
-            let c = shader.shade(d, h.as_ref(), lit[k]);
-            let c = shade::rain(env, c, i % w, i / w, seed);
-            px.copy_from_slice(&shade::to_srgb8(c));
-        });
         let mut out = vec![0u8; 3 * n];
-        for (k, &i) in self.order.iter().enumerate() {
-            let i = i as usize;
-            out[3 * i..3 * i + 3].copy_from_slice(&traced[3 * k..3 * k + 3]);
-        }
+        out.par_chunks_mut(3 * rows).enumerate().for_each(|(r, px)| {
+            let base = r * rows;
+            for k in base..base + px.len() / 3 {
+                let i = self.order[k] as usize;
+                let d = Vec3::from_array(dirs[k]);
+                let h = surface(k);
+                let c = shader.shade(d, h.as_ref(), lit[k]);
+                let c = shade::rain(env, c, (i % w) as u32, (i / w) as u32, seed);
+                let j = 3 * (i - base);
+                px[j..j + 3].copy_from_slice(&shade::to_srgb8(c));
+            }
+        });
         frame.rgb = out;
         Ok(frame)
     }
