@@ -1,0 +1,329 @@
+//! Batch ray casting over a [`Scene`]: closest hits ([`Scene::cast_rays`]) and shadow rays
+//! ([`Scene::occluded_rays`]) in parallel chunks over rayon.
+//!
+//! Each chunk prepares its rays (normalising directions, noting the first invalid one so the batch fails with an
+//! error naming it), lets the sea shortcuts settle what they can ([`crate::sea`]), and traces the rest as
+//! packets of [`PACKET`] coherent rays or one by one; both give each ray the same hit.
+
+use super::{Hit, RayHits, Scene, Scratch, SeaRoute, NO_HIT};
+use crate::bvh::{Packet, PACKET};
+use crate::error::{MmusvError, Result};
+use crate::ray::RayPrep;
+use crate::sea::SunMask;
+use parry3d::math::Vec3;
+use rayon::prelude::*;
+
+impl Scene {
+    /// Casts a batch of rays in parallel.
+    ///
+    /// * `origins`, `dirs`: the same length; finite; directions non-zero (normalised here).
+    /// * `max_range`: metres, `> 0` (may be infinite).
+    ///
+    /// Errors name the first offending ray.
+    pub fn cast_rays(&self, origins: &[[f32; 3]], dirs: &[[f32; 3]], max_range: f32) -> Result<RayHits> {
+        check_batch(origins, dirs, max_range)?;
+        let mut out = RayHits::zeroed(origins.len());
+        let limit = if max_range.is_finite() { max_range } else { f32::MAX };
+        let bad = (
+            out.distance.par_chunks_mut(CHUNK),
+            out.instance.par_chunks_mut(CHUNK),
+            out.triangle.par_chunks_mut(CHUNK),
+            out.normal.par_chunks_mut(3 * CHUNK),
+            out.class.par_chunks_mut(CHUNK),
+            out.backface.par_chunks_mut(CHUNK),
+            origins.par_chunks(CHUNK),
+            dirs.par_chunks(CHUNK),
+        )
+            .into_par_iter()
+            .enumerate()
+            .map(|(k, (dist, inst, tri, nrm, cls, back, o, d))| {
+                let out = ChunkOut { dist, inst, tri, nrm, cls, back };
+                BadRays::offset(trace_chunk(self, o, d, limit, out), k * CHUNK)
+            })
+            .reduce(BadRays::default, BadRays::min);
+        bad.check(origins, dirs)?;
+        Ok(out)
+    }
+
+    /// Shadow-ray batch: for each ray, whether anything is hit with `0 < t < max_range` (see
+    /// [`Scene::occluded_with`]). Same argument rules and errors as [`Scene::cast_rays`].
+    pub fn occluded_rays(&self, origins: &[[f32; 3]], dirs: &[[f32; 3]], max_range: f32) -> Result<Vec<bool>> {
+        check_batch(origins, dirs, max_range)?;
+        let mut out = vec![false; origins.len()];
+        let limit = if max_range.is_finite() { max_range } else { f32::MAX };
+        // Shadow rays all towards one sun: the sea's sun mask settles those that start over open water.
+        let mask = match (&self.sea, dirs.first()) {
+            (Some(sea), Some(d0)) if dirs.iter().all(|d| d == d0) => sea.sun_mask(unit_direction(d0)),
+            _ => None,
+        };
+        let mask = mask.as_deref();
+        let bad = out
+            .par_chunks_mut(CHUNK)
+            .zip(origins.par_chunks(CHUNK))
+            .zip(dirs.par_chunks(CHUNK))
+            .enumerate()
+            .map(|(k, ((out, o), d))| BadRays::offset(occlusion_chunk(self, o, d, limit, mask, out), k * CHUNK))
+            .reduce(BadRays::default, BadRays::min);
+        bad.check(origins, dirs)?;
+        Ok(out)
+    }
+}
+
+/// Rays per rayon task: large enough to amortise scheduling, small enough to balance.
+const CHUNK: usize = 512;
+
+/// Rays traced as one packet must start within this many metres of the packet's first ray (camera pixels share
+/// an origin; neighbouring shadow-ray or top-view origins lie close together).
+const COHERENT_RADIUS: f32 = 4.0;
+/// ... and point within ≈ 11° of its direction.
+const COHERENT_COS: f32 = 0.98;
+
+/// Output slices of one chunk of [`Scene::cast_rays`].
+struct ChunkOut<'a> {
+    dist: &'a mut [f32],
+    inst: &'a mut [i32],
+    tri: &'a mut [i32],
+    nrm: &'a mut [f32],
+    cls: &'a mut [u16],
+    back: &'a mut [bool],
+}
+
+impl ChunkOut<'_> {
+    /// Ray `i` hit nothing.
+    #[inline(always)]
+    fn miss(&mut self, i: usize) {
+        self.dist[i] = f32::INFINITY;
+        self.inst[i] = NO_HIT;
+        self.tri[i] = NO_HIT;
+    }
+
+    /// Ray `i` (unit direction `dir`) hit `hit`.
+    #[inline(always)]
+    fn hit(&mut self, scene: &Scene, i: usize, dir: Vec3, hit: &Hit) {
+        let (n, c) = scene.hit_normal_class(hit);
+        self.dist[i] = hit.distance;
+        self.inst[i] = hit.instance as i32;
+        self.tri[i] = hit.triangle as i32;
+        self.nrm[3 * i..3 * i + 3].copy_from_slice(&n.to_array());
+        self.cls[i] = c;
+        self.back[i] = n.dot(dir) > 0.0;
+    }
+}
+
+/// Whether the prepared rays are worth tracing as one packet (see [`COHERENT_RADIUS`], [`COHERENT_COS`]).
+#[inline(always)]
+pub(super) fn coherent(rays: &[RayPrep]) -> bool {
+    let Some(r0) = rays.first() else { return false };
+    rays.len() > 1
+        && rays.iter().all(|r| {
+            let dc = r.d[0] * r0.d[0] + r.d[1] * r0.d[1] + r.d[2] * r0.d[2];
+            let o2 = (r.o[0] - r0.o[0]).powi(2) + (r.o[1] - r0.o[1]).powi(2) + (r.o[2] - r0.o[2]).powi(2);
+            dc >= COHERENT_COS && o2 <= COHERENT_RADIUS * COHERENT_RADIUS
+        })
+}
+
+crate::dispatch! {
+    /// Traces one chunk of rays (normalising each direction) and stores the hits: coherent groups of
+    /// [`PACKET`] consecutive rays as packets, the others one by one; both give each ray the same hit.
+    fn trace_chunk(scene: &Scene, o: &[[f32; 3]], d: &[[f32; 3]], limit: f32, out: ChunkOut<'_>) -> BadRays {
+        let mut scratch = Scratch::default();
+        let mut bad = BadRays::default();
+        let mut out = out;
+        for start in (0..o.len()).step_by(PACKET) {
+            let end = (start + PACKET).min(o.len());
+            for i in start..end {
+                out.miss(i);
+            }
+            let Some(rays) = prepare(o, d, start, end, &mut bad) else { continue };
+            // Rays the sea shortcut settles are done (those it sends to the surface tested against the surface
+            // mesh alone, as one packet); the others are traced (as a packet when coherent).
+            let mut rest = [rays[0]; PACKET];
+            let mut lane = [0usize; PACKET];
+            let mut n = 0;
+            let mut water = [rays[0]; PACKET];
+            let mut water_lane = [0usize; PACKET];
+            let mut nw = 0;
+            for (r, ray) in rays[..end - start].iter().enumerate() {
+                match scene.sea_route(ray, limit) {
+                    SeaRoute::Surface => {
+                        water[nw] = *ray;
+                        water_lane[nw] = r;
+                        nw += 1;
+                    }
+                    SeaRoute::Sky => {}
+                    SeaRoute::Trace => {
+                        rest[n] = *ray;
+                        lane[n] = r;
+                        n += 1;
+                    }
+                }
+            }
+            if nw > 0 {
+                let hits = scene.sea_surface_hits(&water[..nw], limit, &mut scratch);
+                for j in 0..nw {
+                    match &hits[j] {
+                        Some(hit) => out.hit(scene, start + water_lane[j], Vec3::from_array(water[j].d), hit),
+                        None => {
+                            rest[n] = water[j];
+                            lane[n] = water_lane[j];
+                            n += 1;
+                        }
+                    }
+                }
+            }
+            let rest = &rest[..n];
+            let packet = if coherent(rest) { Packet::new(rest, limit) } else { None };
+            if let Some(mut p) = packet {
+                let (inst, tri) = scene.cast_packet_with(&mut p, &mut scratch);
+                for j in 0..n {
+                    if inst[j] != u32::MAX {
+                        let hit = Hit { distance: p.best[j], instance: inst[j], triangle: tri[j] };
+                        out.hit(scene, start + lane[j], Vec3::from_array(rest[j].d), &hit);
+                    }
+                }
+            } else {
+                for (j, ray) in rest.iter().enumerate() {
+                    if let Some(hit) = scene.cast_prepared(ray, limit, &mut scratch) {
+                        out.hit(scene, start + lane[j], Vec3::from_array(ray.d), &hit);
+                    }
+                }
+            }
+        }
+        bad
+    }
+}
+
+crate::dispatch! {
+    /// Shadow-ray queries of one chunk (directions normalised here), packets where the rays are coherent.
+    /// `mask`, when given, is the sea's sun mask for the direction every ray of the chunk has.
+    fn occlusion_chunk(
+        scene: &Scene,
+        o: &[[f32; 3]],
+        d: &[[f32; 3]],
+        limit: f32,
+        mask: Option<&SunMask>,
+        out: &mut [bool],
+    ) -> BadRays {
+        let mut scratch = Scratch::default();
+        let mut bad = BadRays::default();
+        for start in (0..o.len()).step_by(PACKET) {
+            let end = (start + PACKET).min(o.len());
+            let Some(rays) = prepare(o, d, start, end, &mut bad) else { continue };
+            let mut rest = [rays[0]; PACKET];
+            let mut lane = [0usize; PACKET];
+            let mut n = 0;
+            for (r, ray) in rays[..end - start].iter().enumerate() {
+                if scene.sun_clear(mask, ray) || scene.sea_clear(ray, limit) {
+                    out[start + r] = false;
+                } else {
+                    rest[n] = *ray;
+                    lane[n] = r;
+                    n += 1;
+                }
+            }
+            let rest = &rest[..n];
+            let packet = if coherent(rest) { Packet::new(rest, limit) } else { None };
+            if let Some(mut p) = packet {
+                scene.occluded_packet_with(&mut p, &mut scratch);
+                for j in 0..n {
+                    out[start + lane[j]] = p.best[j] < 0.0;
+                }
+            } else {
+                for (j, ray) in rest.iter().enumerate() {
+                    out[start + lane[j]] = scene.occluded_prepared(ray, limit, &mut scratch);
+                }
+            }
+        }
+        bad
+    }
+}
+
+/// Prepares rays `start..end` of a chunk (directions normalised), or records the first invalid origin and
+/// direction in `bad` and returns `None` (the batch then fails with an error naming the ray).
+#[inline(always)]
+fn prepare(o: &[[f32; 3]], d: &[[f32; 3]], start: usize, end: usize, bad: &mut BadRays) -> Option<[RayPrep; PACKET]> {
+    let mut rays = [RayPrep::new([0.0; 3], [1.0, 0.0, 0.0]); PACKET];
+    let mut ok = true;
+    for i in start..end {
+        let (oi, di) = (&o[i], &d[i]);
+        let bad_o = !(oi[0].is_finite() && oi[1].is_finite() && oi[2].is_finite());
+        let bad_d = !(di[0].is_finite() && di[1].is_finite() && di[2].is_finite())
+            || (di[0] == 0.0 && di[1] == 0.0 && di[2] == 0.0);
+        if bad_o || bad_d {
+            bad.note(i, bad_o, bad_d);
+            ok = false;
+            continue;
+        }
+        rays[i - start] = RayPrep::new(*oi, unit_direction(di));
+    }
+    ok.then_some(rays)
+}
+
+/// The first invalid origin and direction of a batch (indices within the chunk, then the batch).
+#[derive(Debug, Default, Clone, Copy)]
+struct BadRays {
+    origin: Option<usize>,
+    direction: Option<usize>,
+}
+
+impl BadRays {
+    fn note(&mut self, i: usize, origin: bool, direction: bool) {
+        if origin && self.origin.is_none() {
+            self.origin = Some(i);
+        }
+        if direction && self.direction.is_none() {
+            self.direction = Some(i);
+        }
+    }
+
+    fn offset(self, by: usize) -> Self {
+        Self { origin: self.origin.map(|i| i + by), direction: self.direction.map(|i| i + by) }
+    }
+
+    fn min(a: Self, b: Self) -> Self {
+        let m = |x: Option<usize>, y: Option<usize>| match (x, y) {
+            (Some(x), Some(y)) => Some(x.min(y)),
+            (x, None) => x,
+            (None, y) => y,
+        };
+        Self { origin: m(a.origin, b.origin), direction: m(a.direction, b.direction) }
+    }
+
+    /// The error for the first bad origin, else the first bad direction (checked in that order, as the rays are
+    /// given).
+    fn check(self, origins: &[[f32; 3]], dirs: &[[f32; 3]]) -> Result<()> {
+        if let Some(i) = self.origin {
+            return Err(MmusvError::input(format!("origins[{i}]"), format!("{:?} is not finite", origins[i])));
+        }
+        if let Some(i) = self.direction {
+            return Err(MmusvError::input(
+                format!("directions[{i}]"),
+                format!("{:?} is zero-length or not finite; directions must be finite and non-zero", dirs[i]),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// `d / |d|` computed in `f64`, so any finite non-zero `f32` direction (even 1e-30 or 1e30 long) normalises
+/// exactly instead of under- or overflowing in `f32`.
+#[inline]
+pub(super) fn unit_direction(d: &[f32; 3]) -> [f32; 3] {
+    let (x, y, z) = (d[0] as f64, d[1] as f64, d[2] as f64);
+    let n = (x * x + y * y + z * z).sqrt();
+    [(x / n) as f32, (y / n) as f32, (z / n) as f32]
+}
+
+/// The checks of a batch that need no pass over the rays (each ray is checked as it is traced).
+fn check_batch(origins: &[[f32; 3]], dirs: &[[f32; 3]], max_range: f32) -> Result<()> {
+    if origins.len() != dirs.len() {
+        return Err(MmusvError::input(
+            "directions",
+            format!("{} directions for {} origins; give one direction per origin", dirs.len(), origins.len()),
+        ));
+    }
+    if max_range.is_nan() || max_range <= 0.0 {
+        return Err(MmusvError::input("max_range", format!("{max_range} is not allowed; give a range > 0 metres")));
+    }
+    Ok(())
+}
