@@ -74,13 +74,6 @@ pub struct SunMask {
     blocked: Vec<bool>,
 }
 
-impl SunMask {
-    /// Share of the grid's cells in the mask, in `[0, 1]` (for tests and profiles).
-    pub fn blocked_share(&self) -> f64 {
-        self.blocked.iter().filter(|&&b| b).count() as f64 / self.blocked.len().max(1) as f64
-    }
-}
-
 /// The last [`SunMask`] built; a copy of a [`Sea`] starts with an empty cache.
 #[derive(Debug, Default)]
 struct SunCache(Mutex<Option<Arc<SunMask>>>);
@@ -285,28 +278,9 @@ impl Sea {
             return false;
         }
         let d = mask.dir;
-        let (gx1, gy1) = (self.x0 + self.nx as f32 * self.cell, self.y0 + self.ny as f32 * self.cell);
-        let inside = o[0] >= self.x0 && o[0] < gx1 && o[1] >= self.y0 && o[1] < gy1;
-        let (px, py) = if inside {
-            (o[0], o[1])
-        } else {
-            let (mut t0, mut t1) = (0f32, f32::INFINITY);
-            for (oa, da, lo, hi) in [(o[0], d[0], self.x0, gx1), (o[1], d[1], self.y0, gy1)] {
-                if da == 0.0 {
-                    if !(oa >= lo && oa <= hi) {
-                        return true; // never over the grid
-                    }
-                } else {
-                    let (a, b) = ((lo - oa) / da, (hi - oa) / da);
-                    t0 = t0.max(a.min(b));
-                    t1 = t1.min(a.max(b));
-                }
-            }
-            if !(t0 <= t1) {
-                return true; // never over the grid
-            }
-            (o[0] + d[0] * t0, o[1] + d[1] * t0)
-        };
+        // From outside the grid, the rest of the ray is the ray from where it enters.
+        let Some((t0, _)) = self.grid_span(o, d, f32::INFINITY) else { return true }; // never over the grid
+        let (px, py) = (o[0] + d[0] * t0, o[1] + d[1] * t0);
         let gx = ((px - self.x0) / self.cell).floor().clamp(0.0, (self.nx - 1) as f32);
         let gy = ((py - self.y0) / self.cell).floor().clamp(0.0, (self.ny - 1) as f32);
         !mask.blocked[gy as usize * self.nx + gx as usize]
@@ -335,6 +309,28 @@ impl Sea {
         (x, y)
     }
 
+    /// The part `[t0, t1]` of the segment `o + t·d`, `t ∈ [0, t_end]`, that lies over the grid rectangle
+    /// (horizontally), or `None` when none of it does.
+    #[inline]
+    fn grid_span(&self, o: [f32; 3], d: [f32; 3], t_end: f32) -> Option<(f32, f32)> {
+        let (gx1, gy1) = (self.x0 + self.nx as f32 * self.cell, self.y0 + self.ny as f32 * self.cell);
+        let mut t0 = 0f32;
+        let mut t1 = t_end;
+        for (oa, da, lo, hi) in [(o[0], d[0], self.x0, gx1), (o[1], d[1], self.y0, gy1)] {
+            if da == 0.0 {
+                if oa < lo || oa > hi {
+                    return None;
+                }
+            } else {
+                let (a, b) = ((lo - oa) / da, (hi - oa) / da);
+                let (a, b) = if a < b { (a, b) } else { (b, a) };
+                t0 = t0.max(a);
+                t1 = t1.min(b);
+            }
+        }
+        (t0 <= t1).then_some((t0, t1))
+    }
+
     /// Highest height bound in the scene (metres).
     pub fn top(&self) -> f32 {
         self.top
@@ -353,25 +349,8 @@ impl Sea {
         if !(run < max_cells as f32) {
             return false;
         }
-        let (gx1, gy1) = (self.x0 + self.nx as f32 * self.cell, self.y0 + self.ny as f32 * self.cell);
         // Clip the segment to the grid rectangle; outside it there is nothing (when `contained`).
-        let mut t0 = 0f32;
-        let mut t1 = t_end;
-        for (oa, da, lo, hi) in [(o[0], d[0], self.x0, gx1), (o[1], d[1], self.y0, gy1)] {
-            if da == 0.0 {
-                if oa < lo || oa > hi {
-                    return self.contained;
-                }
-            } else {
-                let (a, b) = ((lo - oa) / da, (hi - oa) / da);
-                let (a, b) = if a < b { (a, b) } else { (b, a) };
-                t0 = t0.max(a);
-                t1 = t1.min(b);
-            }
-        }
-        if t0 > t1 {
-            return self.contained;
-        }
+        let Some((t0, t1)) = self.grid_span(o, d, t_end) else { return self.contained };
         if (t0 > 0.0 || t1 < t_end) && !self.contained {
             return false;
         }
