@@ -173,7 +173,7 @@ impl PreparedTriangle {
     /// [`triangle_across_rays`] for the same triangle and ray.
     #[inline(always)]
     pub fn intersect(&self, ray: &RayPrep, t_max: f32) -> Option<f32> {
-        let [kx, ky, kz] = ray.k;
+        let [kx, ky, kz] = ray.k.map(usize::from);
         let [sx, sy] = ray.s;
         let o = ray.o;
         let rel = |p: Vec3| {

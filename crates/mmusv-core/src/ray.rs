@@ -17,10 +17,10 @@ pub struct RayPrep {
     pub inv: [f32; 3],
     /// Per axis, the index of the near box plane in [`crate::bvh::Node::bounds`] (the max plane, `axis + 3`, when
     /// the direction component is negative); the far plane is the other one.
-    pub near: [usize; 3],
+    pub near: [u8; 3],
     /// Axis permutation `[kx, ky, kz]`: `kz` is the axis of the largest direction component, `kx = kz + 1`,
     /// `ky = kz + 2` (mod 3).
-    pub k: [usize; 3],
+    pub k: [u8; 3],
     /// Shear constants `[d[kx]/d[kz], d[ky]/d[kz]]` (the paper's third, `1/d[kz]`, is not needed: distances come
     /// from the triangle's plane).
     pub s: [f32; 2],
@@ -52,8 +52,8 @@ impl RayPrep {
             o,
             d,
             inv,
-            near: [usize::from(inv[0] < 0.0) * 3, 1 + usize::from(inv[1] < 0.0) * 3, 2 + usize::from(inv[2] < 0.0) * 3],
-            k: [kx, ky, kz],
+            near: [u8::from(inv[0] < 0.0) * 3, 1 + u8::from(inv[1] < 0.0) * 3, 2 + u8::from(inv[2] < 0.0) * 3],
+            k: [kx as u8, ky as u8, kz as u8],
             s: [d[kx] * sz, d[ky] * sz],
         }
     }

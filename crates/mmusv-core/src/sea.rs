@@ -311,7 +311,7 @@ impl Sea {
 
     /// The part `[t0, t1]` of the segment `o + t·d`, `t ∈ [0, t_end]`, that lies over the grid rectangle
     /// (horizontally), or `None` when none of it does.
-    #[inline]
+    #[inline(always)]
     fn grid_span(&self, o: [f32; 3], d: [f32; 3], t_end: f32) -> Option<(f32, f32)> {
         let (gx1, gy1) = (self.x0 + self.nx as f32 * self.cell, self.y0 + self.ny as f32 * self.cell);
         let mut t0 = 0f32;
@@ -339,7 +339,7 @@ impl Sea {
     /// Whether the ray `o + t·d`, `t ∈ [0, t_end]`, stays strictly above the height bound of every cell it
     /// crosses. `false` also when the path is longer than `max_cells` cells (tracing it is then cheaper) or
     /// leaves a grid that does not hold everything.
-    #[inline]
+    #[inline(always)]
     #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a < b)` on purpose: a NaN must answer "not clear"
     pub fn path_clear(&self, o: [f32; 3], d: [f32; 3], t_end: f32, max_cells: usize) -> bool {
         if !(t_end.is_finite() && t_end >= 0.0) {

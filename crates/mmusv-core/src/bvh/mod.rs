@@ -147,7 +147,7 @@ impl Bvh {
 pub fn node_entry(node: &Node, ray: &RayPrep, t_max: f32) -> (u32, [f32; WIDTH]) {
     let [ox, oy, oz] = ray.o;
     let [ix, iy, iz] = ray.inv;
-    let [nx, ny, nz] = ray.near;
+    let [nx, ny, nz] = ray.near.map(usize::from);
     let b = &node.bounds;
     let (near_x, near_y, near_z) = (&b[nx], &b[ny], &b[nz]);
     let (far_x, far_y, far_z) = (&b[(nx + 3) % 6], &b[(ny + 3) % 6], &b[(nz + 3) % 6]);
@@ -173,7 +173,7 @@ pub fn box_entry(b: &Box3, ray: &RayPrep, t_max: f32) -> bool {
     let mut t1 = t_max;
     for a in 0..3 {
         let (lo, hi) = (b.lo[a], b.hi[a]);
-        let (n, f) = if ray.near[a] == a { (lo, hi) } else { (hi, lo) };
+        let (n, f) = if usize::from(ray.near[a]) == a { (lo, hi) } else { (hi, lo) };
         t0 = max(t0, (n - ray.o[a]) * ray.inv[a]);
         t1 = min(t1, (f - ray.o[a]) * ray.inv[a] * FAR_SCALE);
     }

@@ -51,8 +51,8 @@ impl Packet {
     #[inline(always)]
     pub fn new(rays: &[RayPrep], t_max: f32) -> Option<Self> {
         let first = rays.first()?;
-        let near = first.near;
-        if rays.len() > PACKET || rays.iter().any(|r| r.near != near) {
+        let near = first.near.map(usize::from);
+        if rays.len() > PACKET || rays.iter().any(|r| r.near != first.near) {
             return None;
         }
         let mut p = Packet {

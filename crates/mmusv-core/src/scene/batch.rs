@@ -135,6 +135,18 @@ crate::dispatch! {
                 out.miss(i);
             }
             let Some(rays) = prepare(o, d, start, end, &mut bad) else { continue };
+            let rays = &rays[..end - start];
+            let mut route = [SeaRoute::Trace; PACKET];
+            let mut all_traced = true;
+            for (r, ray) in rays.iter().enumerate() {
+                route[r] = scene.sea_route(ray, limit);
+                all_traced &= route[r] == SeaRoute::Trace;
+            }
+            if all_traced {
+                // Nothing for the sea shortcut (the usual case away from open water): trace the rays in place.
+                trace_rest(scene, rays, |j| start + j, limit, &mut scratch, &mut out);
+                continue;
+            }
             // Rays the sea shortcut settles are done (those it sends to the surface tested against the surface
             // mesh alone, as one packet); the others are traced (as a packet when coherent).
             let mut rest = [rays[0]; PACKET];
@@ -143,8 +155,8 @@ crate::dispatch! {
             let mut water = [rays[0]; PACKET];
             let mut water_lane = [0usize; PACKET];
             let mut nw = 0;
-            for (r, ray) in rays[..end - start].iter().enumerate() {
-                match scene.sea_route(ray, limit) {
+            for (r, ray) in rays.iter().enumerate() {
+                match route[r] {
                     SeaRoute::Surface => {
                         water[nw] = *ray;
                         water_lane[nw] = r;
@@ -171,25 +183,38 @@ crate::dispatch! {
                     }
                 }
             }
-            let rest = &rest[..n];
-            let packet = if coherent(rest) { Packet::new(rest, limit) } else { None };
-            if let Some(mut p) = packet {
-                let (inst, tri) = scene.cast_packet_with(&mut p, &mut scratch);
-                for j in 0..n {
-                    if inst[j] != u32::MAX {
-                        let hit = Hit { distance: p.best[j], instance: inst[j], triangle: tri[j] };
-                        out.hit(scene, start + lane[j], Vec3::from_array(rest[j].d), &hit);
-                    }
-                }
-            } else {
-                for (j, ray) in rest.iter().enumerate() {
-                    if let Some(hit) = scene.cast_prepared(ray, limit, &mut scratch) {
-                        out.hit(scene, start + lane[j], Vec3::from_array(ray.d), &hit);
-                    }
-                }
-            }
+            trace_rest(scene, &rest[..n], |j| start + lane[j], limit, &mut scratch, &mut out);
         }
         bad
+    }
+}
+
+/// Traces `rays` fully (as one packet when coherent, else one by one) and stores each hit at chunk index
+/// `at(j)` for ray `j`.
+#[inline(always)]
+fn trace_rest(
+    scene: &Scene,
+    rays: &[RayPrep],
+    at: impl Fn(usize) -> usize,
+    limit: f32,
+    scratch: &mut Scratch,
+    out: &mut ChunkOut<'_>,
+) {
+    let packet = if coherent(rays) { Packet::new(rays, limit) } else { None };
+    if let Some(mut p) = packet {
+        let (inst, tri) = scene.cast_packet_with(&mut p, scratch);
+        for (j, ray) in rays.iter().enumerate() {
+            if inst[j] != u32::MAX {
+                let hit = Hit { distance: p.best[j], instance: inst[j], triangle: tri[j] };
+                out.hit(scene, at(j), Vec3::from_array(ray.d), &hit);
+            }
+        }
+    } else {
+        for (j, ray) in rays.iter().enumerate() {
+            if let Some(hit) = scene.cast_prepared(ray, limit, scratch) {
+                out.hit(scene, at(j), Vec3::from_array(ray.d), &hit);
+            }
+        }
     }
 }
 
@@ -240,11 +265,15 @@ crate::dispatch! {
 
 /// Prepares rays `start..end` of a chunk (directions normalised), or records the first invalid origin and
 /// direction in `bad` and returns `None` (the batch then fails with an error naming the ray).
+///
+/// The arithmetic runs across the rays (lanes), so it vectorises; each ray gets exactly
+/// `RayPrep::new(o, unit_direction(d))` (the same correctly rounded operations in the same order).
 #[inline(always)]
 fn prepare(o: &[[f32; 3]], d: &[[f32; 3]], start: usize, end: usize, bad: &mut BadRays) -> Option<[RayPrep; PACKET]> {
-    let mut rays = [RayPrep::new([0.0; 3], [1.0, 0.0, 0.0]); PACKET];
+    let m = end - start;
     let mut ok = true;
-    for i in start..end {
+    let mut dir = [[1f64; PACKET], [0f64; PACKET], [0f64; PACKET]];
+    for (j, i) in (start..end).enumerate() {
         let (oi, di) = (&o[i], &d[i]);
         let bad_o = !(oi[0].is_finite() && oi[1].is_finite() && oi[2].is_finite());
         let bad_d = !(di[0].is_finite() && di[1].is_finite() && di[2].is_finite())
@@ -254,9 +283,71 @@ fn prepare(o: &[[f32; 3]], d: &[[f32; 3]], start: usize, end: usize, bad: &mut B
             ok = false;
             continue;
         }
-        rays[i - start] = RayPrep::new(*oi, unit_direction(di));
+        for a in 0..3 {
+            dir[a][j] = di[a] as f64;
+        }
     }
-    ok.then_some(rays)
+    if !ok {
+        return None;
+    }
+    // unit_direction, across the rays.
+    let mut u = [[0f32; PACKET]; 3];
+    for j in 0..PACKET {
+        let (x, y, z) = (dir[0][j], dir[1][j], dir[2][j]);
+        let n = (x * x + y * y + z * z).sqrt();
+        u[0][j] = (x / n) as f32;
+        u[1][j] = (y / n) as f32;
+        u[2][j] = (z / n) as f32;
+    }
+    // RayPrep::new, across the rays.
+    let mut inv = [[0f32; PACKET]; 3];
+    for a in 0..3 {
+        for j in 0..PACKET {
+            let x = u[a][j];
+            inv[a][j] = if x.abs() < 1e-20 { 1e20f32.copysign(x) } else { 1.0 / x };
+        }
+    }
+    let mut kz = [2u8; PACKET];
+    let mut sc = [[0f32; PACKET]; 2];
+    for j in 0..PACKET {
+        let (x, y, z) = (u[0][j], u[1][j], u[2][j]);
+        let (ax, ay, az) = (x.abs(), y.abs(), z.abs());
+        let k = if ax > ay {
+            if ax > az {
+                0u8
+            } else {
+                2
+            }
+        } else if ay > az {
+            1
+        } else {
+            2
+        };
+        // (d[kx], d[ky], d[kz]) with kx = kz + 1, ky = kz + 2 (mod 3).
+        let (dkx, dky, dkz) = match k {
+            0 => (y, z, x),
+            1 => (z, x, y),
+            _ => (x, y, z),
+        };
+        let sz = 1.0 / dkz;
+        kz[j] = k;
+        sc[0][j] = dkx * sz;
+        sc[1][j] = dky * sz;
+    }
+    let mut rays = [RayPrep::new([0.0; 3], [1.0, 0.0, 0.0]); PACKET];
+    for (j, ray) in rays.iter_mut().enumerate().take(m) {
+        let k = kz[j];
+        let inv = [inv[0][j], inv[1][j], inv[2][j]];
+        *ray = RayPrep {
+            o: o[start + j],
+            d: [u[0][j], u[1][j], u[2][j]],
+            inv,
+            near: [u8::from(inv[0] < 0.0) * 3, 1 + u8::from(inv[1] < 0.0) * 3, 2 + u8::from(inv[2] < 0.0) * 3],
+            k: [(k + 1) % 3, (k + 2) % 3, k],
+            s: [sc[0][j], sc[1][j]],
+        };
+    }
+    Some(rays)
 }
 
 /// The first invalid origin and direction of a batch (indices within the chunk, then the batch).
@@ -326,4 +417,61 @@ fn check_batch(origins: &[[f32; 3]], dirs: &[[f32; 3]], max_range: f32) -> Resul
         return Err(MmusvError::input("max_range", format!("{max_range} is not allowed; give a range > 0 metres")));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// The lane-wise preparation gives every ray exactly what `RayPrep::new(o, unit_direction(d))` gives it:
+    /// random directions, axis-aligned ones, tiny and signed-zero components, ties between axes, short packets.
+    #[test]
+    fn prepare_matches_ray_by_ray_preparation() {
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let special = [
+            [0.0, 0.0, -1.0],
+            [-0.0, 0.0, 1.0],
+            [1.0, -0.0, 0.0],
+            [0.0, -3.0, 0.0],
+            [1.0, 1.0, 1.0],
+            [-1.0, 1.0, 0.0],
+            [1e-30, -1e-25, -1.0],
+            [-2e-18, 6e-17, -1.0],
+            [3e-21, 1.0, 1.0],
+            [1e30, 1e-30, 0.0],
+            [0.5, -0.5, 0.5],
+            [-7.0, 7.0, -7.0],
+        ];
+        let mut o = Vec::new();
+        let mut d = Vec::new();
+        for i in 0..20_000 {
+            o.push([rng.random_range(-500.0..500.0), rng.random_range(-500.0..500.0), rng.random_range(-5.0..50.0)]);
+            let dir = if i % 3 == 0 {
+                special[(i / 3) % special.len()]
+            } else {
+                [rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)]
+            };
+            d.push(dir);
+        }
+        for start in (0..o.len()).step_by(PACKET) {
+            // Short packets too: every length from 1 to PACKET.
+            let end = (start + 1 + (start / PACKET) % PACKET).min(o.len());
+            let mut bad = BadRays::default();
+            let Some(rays) = prepare(&o, &d, start, end, &mut bad) else { unreachable!("valid rays") };
+            for (j, i) in (start..end).enumerate() {
+                assert_eq!(rays[j], RayPrep::new(o[i], unit_direction(&d[i])), "ray {i}: {:?} {:?}", o[i], d[i]);
+            }
+        }
+    }
+
+    #[test]
+    fn prepare_names_the_first_bad_ray() {
+        let o = vec![[0.0; 3], [f32::NAN, 0.0, 0.0], [0.0; 3], [0.0; 3]];
+        let d = vec![[1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0; 3], [f32::INFINITY, 0.0, 0.0]];
+        let mut bad = BadRays::default();
+        assert!(prepare(&o, &d, 0, 4, &mut bad).is_none());
+        assert_eq!((bad.origin, bad.direction), (Some(1), Some(2)));
+    }
 }
