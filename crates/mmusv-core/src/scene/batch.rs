@@ -8,7 +8,7 @@
 use super::{Hit, RayHits, Scene, Scratch, SeaRoute, NO_HIT};
 use crate::bvh::{Packet, PACKET};
 use crate::error::{MmusvError, Result};
-use crate::ray::RayPrep;
+use crate::ray::{prepare_lanes, RayPrep};
 use crate::sea::SunMask;
 use parry3d::math::Vec3;
 use rayon::prelude::*;
@@ -299,55 +299,9 @@ fn prepare(o: &[[f32; 3]], d: &[[f32; 3]], start: usize, end: usize, bad: &mut B
         u[1][j] = (y / n) as f32;
         u[2][j] = (z / n) as f32;
     }
-    // RayPrep::new, across the rays.
-    let mut inv = [[0f32; PACKET]; 3];
-    for a in 0..3 {
-        for j in 0..PACKET {
-            let x = u[a][j];
-            inv[a][j] = if x.abs() < 1e-20 { 1e20f32.copysign(x) } else { 1.0 / x };
-        }
-    }
-    let mut kz = [2u8; PACKET];
-    let mut sc = [[0f32; PACKET]; 2];
-    for j in 0..PACKET {
-        let (x, y, z) = (u[0][j], u[1][j], u[2][j]);
-        let (ax, ay, az) = (x.abs(), y.abs(), z.abs());
-        let k = if ax > ay {
-            if ax > az {
-                0u8
-            } else {
-                2
-            }
-        } else if ay > az {
-            1
-        } else {
-            2
-        };
-        // (d[kx], d[ky], d[kz]) with kx = kz + 1, ky = kz + 2 (mod 3).
-        let (dkx, dky, dkz) = match k {
-            0 => (y, z, x),
-            1 => (z, x, y),
-            _ => (x, y, z),
-        };
-        let sz = 1.0 / dkz;
-        kz[j] = k;
-        sc[0][j] = dkx * sz;
-        sc[1][j] = dky * sz;
-    }
-    let mut rays = [RayPrep::new([0.0; 3], [1.0, 0.0, 0.0]); PACKET];
-    for (j, ray) in rays.iter_mut().enumerate().take(m) {
-        let k = kz[j];
-        let inv = [inv[0][j], inv[1][j], inv[2][j]];
-        *ray = RayPrep {
-            o: o[start + j],
-            d: [u[0][j], u[1][j], u[2][j]],
-            inv,
-            near: [u8::from(inv[0] < 0.0) * 3, 1 + u8::from(inv[1] < 0.0) * 3, 2 + u8::from(inv[2] < 0.0) * 3],
-            k: [(k + 1) % 3, (k + 2) % 3, k],
-            s: [sc[0][j], sc[1][j]],
-        };
-    }
-    Some(rays)
+    let mut origin = [[0f32; 3]; PACKET];
+    origin[..m].copy_from_slice(&o[start..end]);
+    Some(prepare_lanes(&origin, &u))
 }
 
 /// The first invalid origin and direction of a batch (indices within the chunk, then the batch).
