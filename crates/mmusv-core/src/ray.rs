@@ -30,33 +30,54 @@ impl RayPrep {
     /// Prepares the ray `o + t·d`. `d` must be finite and non-zero.
     #[inline(always)]
     pub fn new(o: [f32; 3], d: [f32; 3]) -> Self {
-        let f = |x: f32| if x.abs() < 1e-20 { 1e20f32.copysign(x) } else { 1.0 / x };
-        let inv = [f(d[0]), f(d[1]), f(d[2])];
-        let (ax, ay, az) = (d[0].abs(), d[1].abs(), d[2].abs());
-        let kz = if ax > ay {
-            if ax > az {
-                0
-            } else {
-                2
-            }
-        } else if ay > az {
-            1
-        } else {
-            2
-        };
+        let inv = d.map(recip);
+        let kz = dominant_axis(d);
         // The paper swaps kx and ky when d[kz] < 0 to keep the winding; the tests here are two-sided, where the
         // swap only flips the signs of all three edge functions together, so it is left out.
-        let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
+        let k = axes(kz);
+        let [kx, ky, kz] = k.map(usize::from);
         let sz = 1.0 / d[kz]; // d[kz] is the largest component, never zero for a non-zero direction
-        Self {
-            o,
-            d,
-            inv,
-            near: [u8::from(inv[0] < 0.0) * 3, 1 + u8::from(inv[1] < 0.0) * 3, 2 + u8::from(inv[2] < 0.0) * 3],
-            k: [kx as u8, ky as u8, kz as u8],
-            s: [d[kx] * sz, d[ky] * sz],
-        }
+        Self { o, d, inv, near: near_planes(inv), k, s: [d[kx] * sz, d[ky] * sz] }
     }
+}
+
+/// `1 / x`, with components below `1e-20` in magnitude clamped to `±1e20` (no `inf · 0` in slab tests).
+#[inline(always)]
+fn recip(x: f32) -> f32 {
+    if x.abs() < 1e-20 {
+        1e20f32.copysign(x)
+    } else {
+        1.0 / x
+    }
+}
+
+/// The axis of the largest direction component (`kz`; ties go to the later axis).
+#[inline(always)]
+fn dominant_axis(d: [f32; 3]) -> u8 {
+    let (ax, ay, az) = (d[0].abs(), d[1].abs(), d[2].abs());
+    if ax > ay {
+        if ax > az {
+            0
+        } else {
+            2
+        }
+    } else if ay > az {
+        1
+    } else {
+        2
+    }
+}
+
+/// The permutation `[kx, ky, kz]` for dominant axis `kz`.
+#[inline(always)]
+fn axes(kz: u8) -> [u8; 3] {
+    [(kz + 1) % 3, (kz + 2) % 3, kz]
+}
+
+/// [`RayPrep::near`] from the reciprocal direction.
+#[inline(always)]
+fn near_planes(inv: [f32; 3]) -> [u8; 3] {
+    [u8::from(inv[0] < 0.0) * 3, 1 + u8::from(inv[1] < 0.0) * 3, 2 + u8::from(inv[2] < 0.0) * 3]
 }
 
 /// [`RayPrep::new`] for `N` rays at once: ray `j` has origin `o[j]` and direction `(d[0][j], d[1][j], d[2][j])`
@@ -68,27 +89,15 @@ pub fn prepare_lanes<const N: usize>(o: &[[f32; 3]; N], d: &[[f32; N]; 3]) -> [R
     let mut inv = [[0f32; N]; 3];
     for a in 0..3 {
         for j in 0..N {
-            let x = d[a][j];
-            inv[a][j] = if x.abs() < 1e-20 { 1e20f32.copysign(x) } else { 1.0 / x };
+            inv[a][j] = recip(d[a][j]);
         }
     }
     let mut kz = [2u8; N];
     let mut sc = [[0f32; N]; 2];
     for j in 0..N {
         let (x, y, z) = (d[0][j], d[1][j], d[2][j]);
-        let (ax, ay, az) = (x.abs(), y.abs(), z.abs());
-        let k = if ax > ay {
-            if ax > az {
-                0u8
-            } else {
-                2
-            }
-        } else if ay > az {
-            1
-        } else {
-            2
-        };
-        // (d[kx], d[ky], d[kz]) with kx = kz + 1, ky = kz + 2 (mod 3).
+        let k = dominant_axis([x, y, z]);
+        // (d[kx], d[ky], d[kz]) as `axes` orders them, spelled out so the lanes vectorise.
         let (dkx, dky, dkz) = match k {
             0 => (y, z, x),
             1 => (z, x, y),
@@ -100,43 +109,47 @@ pub fn prepare_lanes<const N: usize>(o: &[[f32; 3]; N], d: &[[f32; N]; 3]) -> [R
         sc[1][j] = dky * sz;
     }
     std::array::from_fn(|j| {
-        let k = kz[j];
         let inv = [inv[0][j], inv[1][j], inv[2][j]];
         RayPrep {
             o: o[j],
             d: [d[0][j], d[1][j], d[2][j]],
             inv,
-            near: [u8::from(inv[0] < 0.0) * 3, 1 + u8::from(inv[1] < 0.0) * 3, 2 + u8::from(inv[2] < 0.0) * 3],
-            k: [(k + 1) % 3, (k + 2) % 3, k],
+            near: near_planes(inv),
+            k: axes(kz[j]),
             s: [sc[0][j], sc[1][j]],
         }
     })
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
+
+    /// Directions that stress the preparation: axis-aligned, signed zeros, ties between axes, components tiny
+    /// enough to be clamped, huge and small magnitudes together.
+    pub(crate) const SPECIAL_DIRECTIONS: [[f32; 3]; 12] = [
+        [0.0, 0.0, -1.0],
+        [-0.0, 0.0, 1.0],
+        [1.0, -0.0, 0.0],
+        [0.0, -3.0, -0.0],
+        [1.0, 1.0, 1.0],
+        [-1.0, 1.0, 0.0],
+        [1e-30, -1e-25, -1.0],
+        [-2e-18, 6e-17, -1.0],
+        [3e-21, 1.0, 1.0],
+        [1e30, 1e-30, 0.0],
+        [0.5, -0.5, 0.5],
+        [-7.0, 7.0, -7.0],
+    ];
 
     /// Lane by lane, [`prepare_lanes`] is [`RayPrep::new`]: random and special directions (axis-aligned, tiny,
     /// signed zeros, ties between axes, long and short vectors).
     #[test]
     fn lanes_match_ray_by_ray_preparation() {
         let mut rng = ChaCha8Rng::seed_from_u64(9);
-        let special = [
-            [0.0, 0.0, -1.0],
-            [-0.0, 0.0, 1.0],
-            [1.0, -0.0, 0.0],
-            [0.0, -3.0, -0.0],
-            [1.0, 1.0, 1.0],
-            [-1.0, 1.0, 0.0],
-            [1e-30, -1e-25, -1.0],
-            [-2e-18, 6e-17, -1.0],
-            [3e-21, 1.0, 1.0],
-            [1e30, 1e-30, 0.0],
-            [-7.0, 7.0, -7.0],
-        ];
+        let special = SPECIAL_DIRECTIONS;
         for round in 0..2_000 {
             let mut o = [[0f32; 3]; 16];
             let mut d = [[0f32; 16]; 3];

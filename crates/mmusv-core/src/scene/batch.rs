@@ -384,20 +384,7 @@ mod tests {
     #[test]
     fn prepare_matches_ray_by_ray_preparation() {
         let mut rng = ChaCha8Rng::seed_from_u64(5);
-        let special = [
-            [0.0, 0.0, -1.0],
-            [-0.0, 0.0, 1.0],
-            [1.0, -0.0, 0.0],
-            [0.0, -3.0, 0.0],
-            [1.0, 1.0, 1.0],
-            [-1.0, 1.0, 0.0],
-            [1e-30, -1e-25, -1.0],
-            [-2e-18, 6e-17, -1.0],
-            [3e-21, 1.0, 1.0],
-            [1e30, 1e-30, 0.0],
-            [0.5, -0.5, 0.5],
-            [-7.0, 7.0, -7.0],
-        ];
+        let special = crate::ray::tests::SPECIAL_DIRECTIONS;
         let mut o = Vec::new();
         let mut d = Vec::new();
         for i in 0..20_000 {
