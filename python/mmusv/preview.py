@@ -20,10 +20,9 @@ from PIL import Image, ImageDraw, ImageFont
 from mmusv.classes import palette_array
 from mmusv.errors import ConfigError
 from mmusv.recording import topics
+from mmusv.recording.decode import decode_image, decode_point_cloud
 from mmusv.recording.reader import (
     AgentInfo,
-    decode_image,
-    decode_point_cloud,
     frame_messages,
     read_info,
     recording_name,

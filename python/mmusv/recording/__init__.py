@@ -2,11 +2,12 @@
 are spelled), :mod:`~mmusv.recording.writer` (:class:`Recording` over the core's MCAP recorder),
 :mod:`~mmusv.recording.frames` (:class:`FrameRecorder`: which topic gets what, per captured frame),
 :mod:`~mmusv.recording.tables` (the Parquet tables beside the MCAP), :mod:`~mmusv.recording.background` (frames
-written on a writer thread while the next is captured) and :mod:`~mmusv.recording.reader` (the one reader). The
-contract is ``docs/recording.md``.
+written on a writer thread while the next is captured), :mod:`~mmusv.recording.reader` (the one reader) and
+:mod:`~mmusv.recording.decode` (its messages as numpy arrays). The contract is ``docs/recording.md``.
 """
 
-from mmusv.recording.reader import decode_image, decode_point_cloud, frame_messages, read_info, read_messages, summary
+from mmusv.recording.decode import decode_image, decode_point_cloud
+from mmusv.recording.reader import frame_messages, read_info, read_messages, summary
 from mmusv.recording.writer import POINT_DTYPES, Recording, to_ns
 
 __all__ = [

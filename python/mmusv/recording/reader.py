@@ -1,8 +1,8 @@
 """Reading ``mmusv run`` recordings: the one reader used by ``mmusv info``, ``mmusv preview``, export and studies.
 
 :func:`read_messages` iterates decoded messages, :func:`summary` says what a file holds, :func:`frame_messages`
-gives every decoded message of one frame, :func:`decode_image` / :func:`decode_point_cloud` turn Foxglove
-messages into arrays. Frame by frame, for conversion (also a truncated or ``.partial`` file):
+gives every decoded message of one frame (:mod:`mmusv.recording.decode` turns Foxglove messages into arrays).
+Frame by frame, for conversion (also a truncated or ``.partial`` file):
 
 :func:`read_info` reads the metadata (``scenario``, ``manifest``, ``sensors``, ``run``) without decoding any
 message: from the summary section when the file has one, otherwise from the records before the first chunk.
@@ -20,7 +20,6 @@ frames are missing, as those of an interrupted run); :func:`recording_name` is t
 
 from __future__ import annotations
 
-import io
 import json
 import os
 from collections.abc import Callable, Iterator, Sequence
@@ -30,7 +29,6 @@ from typing import IO, Any
 
 import numpy as np
 import yaml
-from PIL import Image
 
 from mmusv.errors import ConfigError, IoError
 from mmusv.recording.parts import is_parts_manifest, read_parts_manifest
@@ -44,8 +42,6 @@ __all__ = [
     "RecordingInfo",
     "WorldFrame",
     "check_mcap",
-    "decode_image",
-    "decode_point_cloud",
     "find_recordings",
     "frame_messages",
     "read_info",
@@ -562,45 +558,6 @@ def _parts_summary(path: Path) -> dict[str, Any]:
         "attachments": sums[0]["attachments"],
         "parts": int(info.run["parts"]),
     }
-
-
-_NUMPY = {1: np.uint8, 2: np.int8, 3: np.uint16, 4: np.int16, 5: np.uint32, 6: np.int32, 7: np.float32, 8: np.float64}
-
-
-def decode_image(msg: Any) -> np.ndarray:
-    """A ``foxglove.RawImage`` or ``foxglove.CompressedImage`` (PNG) as a numpy array (``(H, W)`` or ``(H, W, 3)``)."""
-    if hasattr(msg, "format"):
-        return np.asarray(Image.open(io.BytesIO(msg.data)))
-    enc = msg.encoding
-    dtype = {
-        "rgb8": np.uint8,
-        "mono8": np.uint8,
-        "8UC1": np.uint8,
-        "16UC1": np.uint16,
-        "mono16": np.uint16,
-        "32FC1": np.float32,
-        "32SC1": np.int32,
-    }.get(enc)
-    if dtype is None:
-        raise IoError(f"unsupported image encoding {enc!r}")
-    data = np.frombuffer(msg.data, dtype=np.dtype(dtype).newbyteorder("<"))
-    ch = 3 if enc == "rgb8" else 1
-    rows = data.reshape(msg.height, msg.step // np.dtype(dtype).itemsize)
-    img = rows[:, : msg.width * ch]
-    return img.reshape(msg.height, msg.width, 3) if ch == 3 else img
-
-
-def decode_point_cloud(msg: Any) -> dict[str, np.ndarray]:
-    """A ``foxglove.PointCloud`` as ``{field name: (N,) array}`` using the packed field offsets."""
-    stride = msg.point_stride
-    raw = np.frombuffer(msg.data, dtype=np.uint8)
-    n = raw.size // stride if stride else 0
-    rows = raw[: n * stride].reshape(n, stride)
-    out: dict[str, np.ndarray] = {}
-    for f in msg.fields:
-        dt = np.dtype(_NUMPY[int(f.type)]).newbyteorder("<")
-        out[f.name] = rows[:, f.offset : f.offset + dt.itemsize].copy().view(dt).reshape(n)
-    return out
 
 
 def frame_messages(path: str | Path, frame: int) -> dict[str, Any]:

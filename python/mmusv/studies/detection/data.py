@@ -159,8 +159,9 @@ def recording_name(path: str | Path) -> str:
 def read_recording(path: str | Path) -> SequenceData:
     """A recording (``mmusv run`` MCAP) as a sequence: every frame with the LiDAR of every instrumented USV that
     has one. Raises :class:`~mmusv.IoError` for a file that is not a readable recording."""
+    from mmusv.recording.decode import decode_point_cloud
+
     reader = _reader()
-    decode_point_cloud = reader.decode_point_cloud
     info = reader.read_info(path)
     agents = [a for a in info.agents if a.lidar_mount is not None]
     from mmusv.recording import topics as names
