@@ -108,17 +108,21 @@ pub fn prepare_lanes<const N: usize>(o: &[[f32; 3]; N], d: &[[f32; N]; 3]) -> [R
         sc[0][j] = dkx * sz;
         sc[1][j] = dky * sz;
     }
-    std::array::from_fn(|j| {
+    // A plain loop over a filled array: `std::array::from_fn` was compiled out of line (`try_from_fn`, 3.7 % of
+    // a frame's samples).
+    let mut out = [RayPrep { o: [0.0; 3], d: [0.0; 3], inv: [0.0; 3], near: [0; 3], k: [0; 3], s: [0.0; 2] }; N];
+    for (j, r) in out.iter_mut().enumerate() {
         let inv = [inv[0][j], inv[1][j], inv[2][j]];
-        RayPrep {
+        *r = RayPrep {
             o: o[j],
             d: [d[0][j], d[1][j], d[2][j]],
             inv,
             near: near_planes(inv),
             k: axes(kz[j]),
             s: [sc[0][j], sc[1][j]],
-        }
-    })
+        };
+    }
+    out
 }
 
 #[cfg(test)]

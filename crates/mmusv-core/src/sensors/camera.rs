@@ -16,7 +16,7 @@ use super::rays;
 use super::shade::{self, ShadeEnv, Shader, SurfaceHit};
 use crate::error::{MmusvError, Result};
 use crate::geometry::RigidPose;
-use crate::scene::Scene;
+use crate::scene::{RayHits, Scene};
 use parry3d::math::Vec3;
 use rayon::prelude::*;
 
@@ -251,19 +251,7 @@ impl Camera {
         if !rgb {
             return Ok(frame);
         }
-        let surface = |k: usize| -> Option<SurfaceHit> {
-            let t = hits.distance[k];
-            if !t.is_finite() {
-                return None;
-            }
-            let d = Vec3::from_array(dirs[k]);
-            let mut normal = Vec3::new(hits.normal[3 * k], hits.normal[3 * k + 1], hits.normal[3 * k + 2]);
-            if normal.dot(d) > 0.0 {
-                normal = -normal;
-            }
-            let point = Vec3::from_array(origins[k]) + d * t;
-            Some(SurfaceHit { t, point, normal, class: hits.class[k], instance: hits.instance[k] })
-        };
+        let surface = |k: usize| surface_at(&hits, &origins, &dirs, k);
         // Shadow rays from every surface point facing the sun, in trace order (neighbouring points, one packet),
         // gathered block by block.
         let sun = Vec3::from_array(env.sun_direction).normalize_or_zero();
@@ -304,20 +292,54 @@ impl Camera {
         let rows = TILE as usize * w;
         let shader = Shader::new(env, seed);
         let mut out = vec![0u8; 3 * n];
+        let traced = Traced { order: &self.order, origins: &origins, dirs: &dirs, hits: &hits, lit: &lit };
         out.par_chunks_mut(3 * rows).enumerate().for_each(|(r, px)| {
-            let base = r * rows;
-            for k in base..base + px.len() / 3 {
-                let i = self.order[k] as usize;
-                let d = Vec3::from_array(dirs[k]);
-                let h = surface(k);
-                let c = shader.shade(d, h.as_ref(), lit[k]);
-                let c = shade::rain(env, c, (i % w) as u32, (i / w) as u32, seed);
-                let j = 3 * (i - base);
-                px[j..j + 3].copy_from_slice(&shade::to_srgb8(c));
-            }
+            shade_rows(px, r * rows, w, &traced, &shader, seed);
         });
         frame.rgb = out;
         Ok(frame)
+    }
+}
+
+/// The hit of trace position `k` as shading needs it (normal turned towards the camera), `None` for a miss.
+#[inline(always)]
+fn surface_at(hits: &RayHits, origins: &[[f32; 3]], dirs: &[[f32; 3]], k: usize) -> Option<SurfaceHit> {
+    let t = hits.distance[k];
+    if !t.is_finite() {
+        return None;
+    }
+    let d = Vec3::from_array(dirs[k]);
+    let mut normal = Vec3::new(hits.normal[3 * k], hits.normal[3 * k + 1], hits.normal[3 * k + 2]);
+    if normal.dot(d) > 0.0 {
+        normal = -normal;
+    }
+    let point = Vec3::from_array(origins[k]) + d * t;
+    Some(SurfaceHit { t, point, normal, class: hits.class[k], instance: hits.instance[k] })
+}
+
+/// One render's traced rays, in trace order, with their hits and whether each hit sees the sun.
+struct Traced<'a> {
+    order: &'a [u32],
+    origins: &'a [[f32; 3]],
+    dirs: &'a [[f32; 3]],
+    hits: &'a RayHits,
+    lit: &'a [bool],
+}
+
+crate::dispatch! {
+    /// Shades the trace positions `base..` that fill `px` (row-major RGB8 of the image rows starting at pixel
+    /// `base`; `w` pixels a row). Under the AVX2 dispatch: the shading maths inlines into it, and the bytes are
+    /// the portable build's (Rust never contracts a multiply and an add into an FMA).
+    fn shade_rows(px: &mut [u8], base: usize, w: usize, traced: &Traced<'_>, shader: &Shader, seed: u64) {
+        for k in base..base + px.len() / 3 {
+            let i = traced.order[k] as usize;
+            let d = Vec3::from_array(traced.dirs[k]);
+            let h = surface_at(traced.hits, traced.origins, traced.dirs, k);
+            let c = shader.shade(d, h.as_ref(), traced.lit[k]);
+            let c = shader.rain(c, (i % w) as u32, (i / w) as u32, seed);
+            let j = 3 * (i - base);
+            px[j..j + 3].copy_from_slice(&shade::to_srgb8(c));
+        }
     }
 }
 

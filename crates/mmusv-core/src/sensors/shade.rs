@@ -79,6 +79,7 @@ fn v3(a: [f32; 3]) -> Vec3 {
     Vec3::from_array(a)
 }
 
+#[inline]
 fn hash_tint(id: u64, seed: u64) -> Vec3 {
     let h = noise::hash3(seed, 0xC0105, id);
     let f = |s: u32| 0.55 + 0.45 * ((h >> s) & 0xFF) as f32 / 255.0;
@@ -86,6 +87,7 @@ fn hash_tint(id: u64, seed: u64) -> Vec3 {
 }
 
 /// Linear albedo of a surface.
+#[inline]
 fn albedo(hit: &SurfaceHit) -> Vec3 {
     match hit.class {
         2 => Vec3::new(0.33, 0.27, 0.18),
@@ -188,7 +190,7 @@ impl Shader {
     }
 
     /// Sky colour seen along unit direction `d`.
-    #[inline]
+    #[inline(always)]
     pub fn sky(&self, d: Vec3) -> Vec3 {
         let env = &self.env;
         let up = d.z.max(0.0).sqrt();
@@ -209,7 +211,7 @@ impl Shader {
     }
 
     /// Slope of the water surface at `p` (x, y): sum of three swell components and a ripple.
-    #[inline]
+    #[inline(always)]
     fn water_normal(&self, p: Vec3) -> Vec3 {
         let mut gx = 0.0;
         let mut gy = 0.0;
@@ -222,7 +224,7 @@ impl Shader {
         Vec3::new(-gx, -gy, 1.0).normalize_or_zero()
     }
 
-    #[inline]
+    #[inline(always)]
     fn fog(&self, c: Vec3, t: f32) -> Vec3 {
         let f = (-self.env.fog_extinction_per_m * t).exp();
         c * f + self.fog_color * (1.0 - f)
@@ -230,7 +232,7 @@ impl Shader {
 
     /// Linear RGB of one camera ray `d` (world, unit) given its hit (or `None` for the sky) and whether the hit
     /// point sees the sun.
-    #[inline]
+    #[inline(always)]
     pub fn shade(&self, d: Vec3, hit: Option<&SurfaceHit>, sunlit: bool) -> Vec3 {
         let Some(hit) = hit else {
             return self.sky(d);
@@ -258,9 +260,16 @@ impl Shader {
         };
         self.fog(c, hit.t)
     }
+
+    /// [`rain`] with this render's environment.
+    #[inline(always)]
+    pub fn rain(&self, c: Vec3, u: u32, v: u32, seed: u64) -> Vec3 {
+        rain(&self.env, c, u, v, seed)
+    }
 }
 
 /// Rain: darkening and streaks on a linear colour at pixel `(u, v)`.
+#[inline(always)]
 pub fn rain(env: &ShadeEnv, c: Vec3, u: u32, v: u32, seed: u64) -> Vec3 {
     if env.rain_mm_per_h <= 0.0 {
         return c;
@@ -289,17 +298,18 @@ const BUCKETS: usize = 4096;
 
 /// The encoding as tables: `steps[b]` is the smallest linear value the formula encodes as `b` or more (found
 /// once by bisection over the float bit patterns of `[0, 1]`, so the tables reproduce the formula exactly;
-/// `steps[256] = +inf`), and `start[i]` the encoding of `i / BUCKETS`. No bucket holds more than two steps
-/// (checked when the tables are built), so a lookup is one table read and two comparisons.
+/// `steps[256] = steps[257] = +inf`, the last one so that no lookup needs a bounds check), and `start[i]` the
+/// encoding of `i / BUCKETS`. No bucket holds more than two steps (checked when the tables are built), so a
+/// lookup is one table read and two comparisons.
 struct SrgbTables {
-    steps: [f32; 257],
-    start: Vec<u8>,
+    steps: [f32; 258],
+    start: Box<[u8; BUCKETS + 1]>,
 }
 
 fn srgb_tables() -> &'static SrgbTables {
     static TABLES: std::sync::OnceLock<SrgbTables> = std::sync::OnceLock::new();
     TABLES.get_or_init(|| {
-        let mut steps = [f32::INFINITY; 257];
+        let mut steps = [f32::INFINITY; 258];
         steps[0] = 0.0;
         let one = 1.0f32.to_bits();
         for (b, slot) in steps.iter_mut().enumerate().take(256).skip(1) {
@@ -315,7 +325,10 @@ fn srgb_tables() -> &'static SrgbTables {
             }
             *slot = f32::from_bits(lo);
         }
-        let start: Vec<u8> = (0..=BUCKETS).map(|i| srgb8_formula(i as f32 / BUCKETS as f32)).collect();
+        let mut start = Box::new([0u8; BUCKETS + 1]);
+        for (i, slot) in start.iter_mut().enumerate() {
+            *slot = srgb8_formula(i as f32 / BUCKETS as f32);
+        }
         for i in 0..BUCKETS {
             assert!(start[i + 1] - start[i] <= 2, "more than two sRGB steps in bucket {i}");
         }
@@ -325,14 +338,15 @@ fn srgb_tables() -> &'static SrgbTables {
 
 /// Linear `[0, ∞)` to 8-bit sRGB (`round(255 · srgb(clamp(x, 0, 1)))`), by table: the same bytes as the
 /// formula, without a `powf` per channel.
-#[inline]
+#[inline(always)]
 pub fn to_srgb8(c: Vec3) -> [u8; 3] {
     let t = srgb_tables();
     let enc = |x: f32| {
         // Above 1 encodes as 1 (and +inf must not pass `steps[256] = +inf`); NaN stays NaN and compares false.
         let x = if x > 1.0 { 1.0 } else { x };
-        // `as usize` saturates: negative values and NaN go to bucket 0.
-        let i = ((x * BUCKETS as f32) as usize).min(BUCKETS);
+        // `max` sends negative values and NaN to bucket 0 (NaN then compares false below); `x ≤ 1` keeps the
+        // index within the table, and a 32-bit conversion is shorter code than a saturating `usize` one.
+        let i = ((x.max(0.0) * BUCKETS as f32) as u32 as usize).min(BUCKETS);
         let mut b = t.start[i] as usize;
         b += usize::from(t.steps[b + 1] <= x);
         b += usize::from(t.steps[b + 1] <= x);
