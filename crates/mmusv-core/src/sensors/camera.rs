@@ -13,7 +13,7 @@
 //! (uint16, 0 for sky), instance id (int32, −1 for sky) and optionally sRGB (uint8 × 3).
 
 use super::rays;
-use super::shade::{self, ShadeEnv, Shader, SurfaceHit};
+use super::shade::{self, Lanes, ShadeEnv, Shader, SurfaceHit, LANES};
 use crate::error::{MmusvError, Result};
 use crate::geometry::RigidPose;
 use crate::scene::{RayHits, Scene};
@@ -328,17 +328,29 @@ struct Traced<'a> {
 
 crate::dispatch! {
     /// Shades the trace positions `base..` that fill `px` (row-major RGB8 of the image rows starting at pixel
-    /// `base`; `w` pixels a row). Under the AVX2 dispatch: the shading maths inlines into it, and the bytes are
-    /// the portable build's (Rust never contracts a multiply and an add into an FMA).
+    /// `base`; `w` pixels a row). Under the AVX2 dispatch: the shading maths ([`Shader::shade_lanes`], [`LANES`]
+    /// pixels at a time) inlines into it and vectorises; the bytes are the portable build's and
+    /// [`Shader::shade`]'s (Rust never contracts a multiply and an add into an FMA).
     fn shade_rows(px: &mut [u8], base: usize, w: usize, traced: &Traced<'_>, shader: &Shader, seed: u64) {
-        for k in base..base + px.len() / 3 {
-            let i = traced.order[k] as usize;
-            let d = Vec3::from_array(traced.dirs[k]);
-            let h = surface_at(traced.hits, traced.origins, traced.dirs, k);
-            let c = shader.shade(d, h.as_ref(), traced.lit[k]);
-            let c = shader.rain(c, (i % w) as u32, (i / w) as u32, seed);
-            let j = 3 * (i - base);
-            px[j..j + 3].copy_from_slice(&shade::to_srgb8(c));
+        let end = base + px.len() / 3;
+        let mut k0 = base;
+        while k0 < end {
+            // LANES pixels at a time (the last group padded with copies of its last pixel).
+            let m = LANES.min(end - k0);
+            let mut lanes = Lanes::default();
+            for j in 0..LANES {
+                let k = k0 + j.min(m - 1);
+                let h = surface_at(traced.hits, traced.origins, traced.dirs, k);
+                lanes.set(j, Vec3::from_array(traced.dirs[k]), h.as_ref(), traced.lit[k]);
+            }
+            let c = shader.shade_lanes(&lanes);
+            for j in 0..m {
+                let i = traced.order[k0 + j] as usize;
+                let c = shader.rain(Vec3::new(c[0][j], c[1][j], c[2][j]), (i % w) as u32, (i / w) as u32, seed);
+                let at = 3 * (i - base);
+                px[at..at + 3].copy_from_slice(&shade::to_srgb8(c));
+            }
+            k0 += m;
         }
     }
 }

@@ -14,6 +14,9 @@
 use super::noise::{self, stream};
 use parry3d::math::Vec3;
 
+mod lanes;
+pub use lanes::{LaneColors, Lanes, LANES};
+
 /// Lighting and weather for shading. Colours are linear RGB in `[0, 1]`; directions are world-frame unit vectors.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ShadeEnv {
