@@ -193,7 +193,7 @@ impl Shader {
     }
 
     /// Sky colour seen along unit direction `d`.
-    #[inline(always)]
+    #[inline]
     pub fn sky(&self, d: Vec3) -> Vec3 {
         let env = &self.env;
         let up = d.z.max(0.0).sqrt();
@@ -214,7 +214,7 @@ impl Shader {
     }
 
     /// Slope of the water surface at `p` (x, y): sum of three swell components and a ripple.
-    #[inline(always)]
+    #[inline]
     fn water_normal(&self, p: Vec3) -> Vec3 {
         let mut gx = 0.0;
         let mut gy = 0.0;
@@ -227,15 +227,15 @@ impl Shader {
         Vec3::new(-gx, -gy, 1.0).normalize_or_zero()
     }
 
-    #[inline(always)]
+    #[inline]
     fn fog(&self, c: Vec3, t: f32) -> Vec3 {
         let f = (-self.env.fog_extinction_per_m * t).exp();
         c * f + self.fog_color * (1.0 - f)
     }
 
     /// Linear RGB of one camera ray `d` (world, unit) given its hit (or `None` for the sky) and whether the hit
-    /// point sees the sun.
-    #[inline(always)]
+    /// point sees the sun. Cameras shade with [`Shader::shade_lanes`], the same bits for [`LANES`] pixels at once.
+    #[inline]
     pub fn shade(&self, d: Vec3, hit: Option<&SurfaceHit>, sunlit: bool) -> Vec3 {
         let Some(hit) = hit else {
             return self.sky(d);
@@ -362,6 +362,20 @@ pub fn to_srgb8(c: Vec3) -> [u8; 3] {
 mod tests {
     use super::*;
 
+    /// Environments the shading tests run in: clear noon; low sun with fog and 3.5 m waves; night.
+    pub(super) fn test_envs() -> [ShadeEnv; 3] {
+        [
+            ShadeEnv::default(),
+            ShadeEnv {
+                sun_direction: [0.9, 0.0, 0.436],
+                wave_height_m: 3.5,
+                fog_extinction_per_m: 0.01,
+                ..ShadeEnv::default()
+            },
+            ShadeEnv { sun_intensity: 0.0, ambient: 0.05, ..ShadeEnv::default() },
+        ]
+    }
+
     #[test]
     fn sky_brighter_towards_sun_and_fog_veils() {
         let env = ShadeEnv::default();
@@ -462,16 +476,7 @@ mod tests {
             let f = (-env.fog_extinction_per_m * hit.t).exp();
             c * f + v3(env.fog_color) * env.ambient.max(0.1) * 1.3 * (1.0 - f)
         }
-        let envs = [
-            ShadeEnv::default(),
-            ShadeEnv {
-                sun_direction: [0.9, 0.0, 0.436],
-                wave_height_m: 3.5,
-                fog_extinction_per_m: 0.01,
-                ..ShadeEnv::default()
-            },
-            ShadeEnv { sun_intensity: 0.0, ambient: 0.05, ..ShadeEnv::default() },
-        ];
+        let envs = test_envs();
         let mut k = 0u64;
         for env in &envs {
             let sh = Shader::new(env, 42);

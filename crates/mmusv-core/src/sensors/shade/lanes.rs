@@ -125,9 +125,10 @@ impl Shader {
                 }
             }
         }
+        let sky_fog = self.sky_fog.to_array();
         for j in 0..LANES {
             for a in 0..3 {
-                c[a][j] = c[a][j] * self.sky_keep + self.sky_fog.to_array()[a];
+                c[a][j] = c[a][j] * self.sky_keep + sky_fog[a];
             }
         }
         c
@@ -235,7 +236,6 @@ impl Shader {
 
 #[cfg(test)]
 mod tests {
-    use super::super::ShadeEnv;
     use super::*;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
@@ -254,16 +254,7 @@ mod tests {
     /// in clear noon, low sun with fog and swell, and night.
     #[test]
     fn lanes_equal_the_per_pixel_shading() {
-        let envs = [
-            ShadeEnv::default(),
-            ShadeEnv {
-                sun_direction: [0.9, 0.0, 0.436],
-                wave_height_m: 3.5,
-                fog_extinction_per_m: 0.01,
-                ..ShadeEnv::default()
-            },
-            ShadeEnv { sun_intensity: 0.0, ambient: 0.05, ..ShadeEnv::default() },
-        ];
+        let envs = super::super::tests::test_envs();
         let mut rng = ChaCha8Rng::seed_from_u64(7);
         let mut glints = 0;
         let mut discs = 0;
