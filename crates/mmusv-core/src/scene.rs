@@ -810,4 +810,66 @@ mod tests {
             .unwrap_or_else(|e| unreachable!("{e}"));
         assert!(tilted.set_sea(1, &vessels).is_err());
     }
+
+    #[test]
+    fn horizons_of_one_origin_batches_give_exactly_the_full_trace() {
+        let (mut s, vessels) = sea_world();
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let poses: Vec<RigidPose> = vessels
+            .iter()
+            .map(|_| {
+                let (x, y) = (rng.random_range(-200.0..200.0), rng.random_range(-200.0..200.0));
+                RigidPose::from_xyz_rpy([x, y, 0.2], [0.03, -0.02, rng.random_range(0.0..std::f64::consts::TAU)])
+            })
+            .collect();
+        s.set_poses(&vessels, &poses).unwrap_or_else(|e| unreachable!("{e}"));
+        let mut with = s.clone();
+        with.set_sea(1, &vessels).unwrap_or_else(|e| unreachable!("{e}"));
+        // Viewpoints: over open water, on (and in) the vessels' boxes as a USV's cameras are, high above all.
+        let mut eyes: Vec<[f32; 3]> = (0..6)
+            .map(|_| [rng.random_range(-250.0..250.0), rng.random_range(-250.0..250.0), rng.random_range(0.5..6.0)])
+            .collect();
+        for &v in vessels.iter().take(8) {
+            let b = with.world_aabbs[v as usize];
+            let (c, h) = (b.center(), b.half_extents());
+            eyes.push([c.x + 0.3 * h.x, c.y - 0.2 * h.y, b.maxs.z - 0.3 * h.z]);
+            eyes.push([c.x, c.y, b.maxs.z + 0.02]);
+            eyes.push([b.maxs.x + 0.05, c.y, c.z]);
+        }
+        eyes.push([0.0, 0.0, 400.0]);
+        // Every direction on a 96 × 64 grid (the pole rows included), most of them rising.
+        let mut dirs = Vec::new();
+        for i in 0..96 {
+            for j in 0..64 {
+                let az = i as f32 * std::f32::consts::TAU / 96.0 + 0.001;
+                let el = -0.3 + 1.8708 * j as f32 / 63.0;
+                dirs.push([az.cos() * el.cos(), az.sin() * el.cos(), el.sin()]);
+            }
+        }
+        // (settled, rising) over the open-water viewpoints and over those on the decks.
+        let (mut water, mut decks) = ((0, 0), (0, 0));
+        for (k, eye) in eyes.iter().enumerate() {
+            let o = vec![*eye; dirs.len()];
+            let full = s.cast_rays(&o, &dirs, 900.0).unwrap_or_default();
+            let fast = with.cast_rays(&o, &dirs, 900.0).unwrap_or_default();
+            assert_eq!(full, fast, "viewpoint {eye:?}");
+            let Some(h) = with.horizon(*eye) else { continue };
+            let tally = if k < 6 {
+                &mut water
+            } else if k % 3 == 1 {
+                &mut decks
+            } else {
+                continue;
+            };
+            for d in &dirs {
+                let d = unit_direction(d);
+                tally.1 += usize::from(d[2] >= 0.0);
+                tally.0 += usize::from(h.clear(d));
+            }
+        }
+        // Islands of 45-95 m hide some of the sky over the water; a deck's own mast and neighbours more.
+        assert!(water.0 * 10 > water.1 * 6, "the horizons settled only {water:?} rising rays over the water");
+        assert!(decks.0 * 10 > decks.1 * 4, "the horizons settled only {decks:?} rising rays on the decks");
+        assert!(with.horizon([0.0, 0.0, -1.0]).is_none(), "no horizon under the surface");
+    }
 }

@@ -16,11 +16,19 @@
 //!   and height map by sweeping every occupied cell against the sun. A ray from above the surface whose cell is
 //!   not in the mask hits nothing, however far it goes, in one lookup.
 //!
+//! * a batch of rays that all leave one point (a camera's pixels) asks that point's [`Horizon`]: per azimuth,
+//!   the slope above which a ray from there passes over everything (`sea/horizon.rs`).
+//!
 //! So the shortcuts give exactly the full trace's answers; a ray the bound cannot settle is traced fully.
 
 use crate::bvh::Box3;
+use horizon::MaxPyramid;
 use parry3d::math::Vec3;
 use std::sync::{Arc, Mutex};
+
+mod horizon;
+
+pub use horizon::Horizon;
 
 /// Most cells per side of the height grid.
 const MAX_CELLS: usize = 512;
@@ -60,6 +68,8 @@ pub struct Sea {
     fixed_sun: SunCache,
     /// The last sun mask built, for its direction and generation.
     sun_cache: SunCache,
+    /// Max pyramid of `fixed`, for [`Horizon`]s.
+    pyramid: MaxPyramid,
 }
 
 /// The cells of a [`Sea`] grid from which a ray towards one sun direction may meet something (see the module
@@ -111,6 +121,7 @@ impl Sea {
             boxes: Vec::new(),
             fixed_sun: SunCache::default(),
             sun_cache: SunCache::default(),
+            pyramid: MaxPyramid::default(),
         };
         let mut grid = std::mem::take(&mut sea.fixed);
         for tri in fixed {
@@ -120,6 +131,7 @@ impl Sea {
             }
             sea.raster(&mut grid, &b);
         }
+        sea.pyramid = MaxPyramid::new(nx, ny, &grid);
         sea.fixed = grid;
         sea.heights = sea.fixed.clone();
         sea.top = sea.heights.iter().copied().fold(f32::NEG_INFINITY, f32::max);
@@ -156,6 +168,32 @@ impl Sea {
         self.top = grid.iter().copied().fold(f32::NEG_INFINITY, f32::max);
         self.heights = grid;
         self.generation += 1;
+    }
+
+    /// The [`Horizon`] of viewpoint `origin` over the static geometry and the moving instances' boxes, with the
+    /// moving instances whose boxes stand over it (the caller adds their triangles: [`Horizon::add_triangle`]).
+    /// `None` when `origin` is not above the surface or a moving box lies outside the grid.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > b)` on purpose: a NaN must answer "no"
+    pub fn horizon(&self, origin: [f32; 3]) -> Option<(Horizon, Vec<u32>)> {
+        if !(self.contained && origin[2] > self.level && origin.iter().all(|v| v.is_finite())) {
+            return None;
+        }
+        let mut h = Horizon::new(origin);
+        self.pyramid.add_to(&mut h, self.x0, self.y0, self.cell);
+        let mut near = Vec::new();
+        for (&id, b) in self.moving.iter().zip(&self.boxes) {
+            let (lo, hi) = ([f64::from(b.lo[0]), f64::from(b.lo[1])], [f64::from(b.hi[0]), f64::from(b.hi[1])]);
+            let top = b.hi[2] + MARGIN_M;
+            if top < origin[2] {
+                continue;
+            }
+            if h.over(lo, hi) {
+                near.push(id);
+            } else {
+                h.add_rect(lo, hi, f64::from(top));
+            }
+        }
+        Some((h, near))
     }
 
     /// The [`SunMask`] of unit direction `dir` for the current height map, built on first use and kept until

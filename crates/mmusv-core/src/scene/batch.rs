@@ -9,7 +9,7 @@ use super::{Hit, RayHits, Scene, Scratch, SeaRoute, NO_HIT};
 use crate::bvh::{Packet, PACKET};
 use crate::error::{MmusvError, Result};
 use crate::ray::{prepare_lanes, RayPrep};
-use crate::sea::SunMask;
+use crate::sea::{Horizon, SunMask};
 use parry3d::math::Vec3;
 use rayon::prelude::*;
 
@@ -24,6 +24,9 @@ impl Scene {
         check_batch(origins, dirs, max_range)?;
         let mut out = RayHits::zeroed(origins.len());
         let limit = if max_range.is_finite() { max_range } else { f32::MAX };
+        // Rays that all leave one point (a camera's pixels): its horizon settles those rising over everything.
+        let horizon = self.batch_horizon(origins);
+        let horizon = horizon.as_ref();
         let bad = (
             out.distance.par_chunks_mut(CHUNK),
             out.instance.par_chunks_mut(CHUNK),
@@ -38,11 +41,21 @@ impl Scene {
             .enumerate()
             .map(|(k, (dist, inst, tri, nrm, cls, back, o, d))| {
                 let out = ChunkOut { dist, inst, tri, nrm, cls, back };
-                BadRays::offset(trace_chunk(self, o, d, limit, out), k * CHUNK)
+                BadRays::offset(trace_chunk(self, o, d, limit, horizon, out), k * CHUNK)
             })
             .reduce(BadRays::default, BadRays::min);
         bad.check(origins, dirs)?;
         Ok(out)
+    }
+
+    /// The [`Horizon`] of the batch's one origin, when every ray leaves the same point and there are enough of
+    /// them to pay for building it.
+    fn batch_horizon(&self, origins: &[[f32; 3]]) -> Option<Horizon> {
+        let o0 = *origins.first()?;
+        if origins.len() < HORIZON_MIN_RAYS || origins.iter().any(|o| *o != o0) {
+            return None;
+        }
+        self.horizon(o0)
     }
 
     /// Shadow-ray batch: for each ray, whether anything is hit with `0 < t < max_range` (see
@@ -68,6 +81,9 @@ impl Scene {
         Ok(out)
     }
 }
+
+/// Fewest rays from one point for which [`Scene::cast_rays`] builds that point's [`Horizon`] (about a millisecond).
+const HORIZON_MIN_RAYS: usize = 4096;
 
 /// Rays per rayon task: large enough to amortise scheduling, small enough to balance.
 const CHUNK: usize = 512;
@@ -125,7 +141,14 @@ pub(super) fn coherent(rays: &[RayPrep]) -> bool {
 crate::dispatch! {
     /// Traces one chunk of rays (normalising each direction) and stores the hits: coherent groups of
     /// [`PACKET`] consecutive rays as packets, the others one by one; both give each ray the same hit.
-    fn trace_chunk(scene: &Scene, o: &[[f32; 3]], d: &[[f32; 3]], limit: f32, out: ChunkOut<'_>) -> BadRays {
+    fn trace_chunk(
+        scene: &Scene,
+        o: &[[f32; 3]],
+        d: &[[f32; 3]],
+        limit: f32,
+        horizon: Option<&Horizon>,
+        out: ChunkOut<'_>,
+    ) -> BadRays {
         let mut scratch = Scratch::default();
         let mut bad = BadRays::default();
         let mut out = out;
@@ -139,7 +162,7 @@ crate::dispatch! {
             let mut route = [SeaRoute::Trace; PACKET];
             let mut all_traced = true;
             for (r, ray) in rays.iter().enumerate() {
-                route[r] = scene.sea_route(ray, limit);
+                route[r] = scene.sea_route(ray, limit, horizon);
                 all_traced &= route[r] == SeaRoute::Trace;
             }
             if all_traced {

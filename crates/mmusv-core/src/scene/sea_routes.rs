@@ -5,7 +5,7 @@ use super::{coherent, local_ray, Hit, Scene, Scratch};
 use crate::bvh::{Box3, Packet, PACKET};
 use crate::error::{MmusvError, Result};
 use crate::ray::RayPrep;
-use crate::sea::{Sea, SunMask};
+use crate::sea::{Horizon, Sea, SunMask};
 
 /// Longest height-map walks (cells) worth trying before a full trace: down to the sea, up into the sky (camera
 /// rays), up towards the sun (shadow rays).
@@ -87,17 +87,18 @@ impl Scene {
     /// when the ray rises clear above everything (a miss), `None` when the ray needs the full trace.
     #[inline(always)]
     pub fn sea_closest(&self, ray: &RayPrep, limit: f32, scratch: &mut Scratch) -> Option<Option<Hit>> {
-        match self.sea_route(ray, limit) {
+        match self.sea_route(ray, limit, None) {
             SeaRoute::Sky => Some(None),
             SeaRoute::Trace => None,
             SeaRoute::Surface => self.sea_surface_hit(ray, limit, scratch).map(Some),
         }
     }
 
-    /// Which way the sea shortcut settles a closest-hit query (see [`Scene::sea_closest`]).
+    /// Which way the sea shortcut settles a closest-hit query (see [`Scene::sea_closest`]); `horizon`, when
+    /// given, is the [`Horizon`] of the ray's origin.
     #[inline(always)]
     #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a < b)` on purpose: a NaN must take the full trace
-    pub(super) fn sea_route(&self, ray: &RayPrep, limit: f32) -> SeaRoute {
+    pub(super) fn sea_route(&self, ray: &RayPrep, limit: f32, horizon: Option<&Horizon>) -> SeaRoute {
         let Some(sea) = self.sea.as_ref() else { return SeaRoute::Trace };
         let (oz, dz) = (ray.o[2], ray.d[2]);
         if !(oz > sea.level) {
@@ -110,11 +111,31 @@ impl Scene {
             }
             return SeaRoute::Surface;
         }
+        if let Some(h) = horizon {
+            debug_assert_eq!(h.origin(), ray.o, "a horizon answers only for rays from its viewpoint");
+            if h.clear(ray.d) {
+                return SeaRoute::Sky;
+            }
+        }
         if self.sea_clear_within(ray, limit, SEA_WALK_SKY) {
             SeaRoute::Sky
         } else {
             SeaRoute::Trace
         }
+    }
+
+    /// The [`Horizon`] of viewpoint `origin` (see [`crate::sea`]): the static height map, the moving instances'
+    /// boxes, and the triangles of those whose boxes stand over it. `None` when the sea shortcuts do not apply.
+    pub(super) fn horizon(&self, origin: [f32; 3]) -> Option<Horizon> {
+        let (mut h, near) = self.sea.as_ref()?.horizon(origin)?;
+        for id in near {
+            let inst = &self.instances[id as usize];
+            let mesh = &self.meshes[inst.mesh as usize];
+            for f in mesh.faces() {
+                h.add_triangle(f.map(|k| inst.pose.transform_point(mesh.vertices()[k as usize]).to_array()));
+            }
+        }
+        Some(h)
     }
 
     /// The closest hit of a ray [`Scene::sea_route`] sent to the surface, from the surface mesh alone (`None`
