@@ -833,7 +833,7 @@ mod tests {
             let b = with.world_aabbs[v as usize];
             let (c, h) = (b.center(), b.half_extents());
             eyes.push([c.x + 0.3 * h.x, c.y - 0.2 * h.y, b.maxs.z - 0.3 * h.z]);
-            eyes.push([c.x, c.y, b.maxs.z + 0.02]);
+            eyes.push([c.x, c.y, b.maxs.z + 0.5]);
             eyes.push([b.maxs.x + 0.05, c.y, c.z]);
         }
         eyes.push([0.0, 0.0, 400.0]);
@@ -847,7 +847,7 @@ mod tests {
             }
         }
         // (settled, rising) over the open-water viewpoints and over those on the decks.
-        let (mut water, mut decks) = ((0, 0), (0, 0));
+        let (mut water, mut decks, mut down) = ((0, 0), (0, 0), (0, 0));
         for (k, eye) in eyes.iter().enumerate() {
             let o = vec![*eye; dirs.len()];
             let full = s.cast_rays(&o, &dirs, 900.0).unwrap_or_default();
@@ -862,11 +862,18 @@ mod tests {
                 continue;
             };
             for d in &dirs {
-                let d = unit_direction(d);
-                tally.1 += usize::from(d[2] >= 0.0);
-                tally.0 += usize::from(h.clear(d));
+                let ray = RayPrep::new(*eye, unit_direction(d));
+                tally.1 += usize::from(ray.d[2] >= 0.0);
+                tally.0 += usize::from(h.clear(ray.d));
+                if k % 3 == 1 && k >= 6 && ray.d[2] < 0.0 {
+                    let surface = |h| with.sea_route(&ray, 900.0, h) == SeaRoute::Surface;
+                    down.0 += usize::from(surface(Some(&h)));
+                    down.1 += usize::from(surface(None));
+                }
             }
         }
+        // From the decks, the horizon sends rays down to the surface past the vessel's own box.
+        assert!(down.0 > down.1 + 1000, "rays down to the surface from the decks: {down:?} (with, without)");
         // Islands of 45-95 m hide some of the sky over the water; a deck's own mast and neighbours more.
         assert!(water.0 * 10 > water.1 * 6, "the horizons settled only {water:?} rising rays over the water");
         assert!(decks.0 * 10 > decks.1 * 4, "the horizons settled only {decks:?} rising rays on the decks");

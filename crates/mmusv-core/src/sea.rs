@@ -171,7 +171,8 @@ impl Sea {
     }
 
     /// The [`Horizon`] of viewpoint `origin` over the static geometry and the moving instances' boxes, with the
-    /// moving instances whose boxes stand over it (the caller adds their triangles: [`Horizon::add_triangle`]).
+    /// moving instances whose boxes stand over it (the caller adds their triangles: [`Horizon::add_triangle`];
+    /// the horizon's ground map leaves their boxes out).
     /// `None` when `origin` is not above the surface or a moving box lies outside the grid.
     #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > b)` on purpose: a NaN must answer "no"
     pub fn horizon(&self, origin: [f32; 3]) -> Option<(Horizon, Vec<u32>)> {
@@ -183,15 +184,20 @@ impl Sea {
         let mut near = Vec::new();
         for (&id, b) in self.moving.iter().zip(&self.boxes) {
             let (lo, hi) = ([f64::from(b.lo[0]), f64::from(b.lo[1])], [f64::from(b.hi[0]), f64::from(b.hi[1])]);
-            let top = b.hi[2] + MARGIN_M;
-            if top < origin[2] {
-                continue;
-            }
             if h.over(lo, hi) {
                 near.push(id);
             } else {
-                h.add_rect(lo, hi, f64::from(top));
+                h.add_rect(lo, hi, f64::from(b.hi[2] + MARGIN_M));
             }
+        }
+        if !near.is_empty() {
+            let mut ground = self.fixed.clone();
+            for (id, b) in self.moving.iter().zip(&self.boxes) {
+                if !near.contains(id) {
+                    self.raster(&mut ground, b);
+                }
+            }
+            h.ground = Some(ground);
         }
         Some((h, near))
     }
@@ -378,8 +384,22 @@ impl Sea {
     /// crosses. `false` also when the path is longer than `max_cells` cells (tracing it is then cheaper) or
     /// leaves a grid that does not hold everything.
     #[inline(always)]
-    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a < b)` on purpose: a NaN must answer "not clear"
     pub fn path_clear(&self, o: [f32; 3], d: [f32; 3], t_end: f32, max_cells: usize) -> bool {
+        self.walk(&self.heights, o, d, t_end, max_cells)
+    }
+
+    /// [`Sea::path_clear`] for a ray from the viewpoint of `h` over `h`'s ground map (the height map without the
+    /// instances standing over the viewpoint; the ray must be clear of their triangles:
+    /// [`Horizon::clear_of_near`]).
+    #[inline(always)]
+    pub fn path_clear_from(&self, h: &Horizon, o: [f32; 3], d: [f32; 3], t_end: f32, max_cells: usize) -> bool {
+        self.walk(h.ground.as_deref().unwrap_or(&self.heights), o, d, t_end, max_cells)
+    }
+
+    /// [`Sea::path_clear`] over the height map `heights` (this grid's shape).
+    #[inline(always)]
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a < b)` on purpose: a NaN must answer "not clear"
+    fn walk(&self, heights: &[f32], o: [f32; 3], d: [f32; 3], t_end: f32, max_cells: usize) -> bool {
         if !(t_end.is_finite() && t_end >= 0.0) {
             return false;
         }
@@ -420,7 +440,7 @@ impl Sea {
             let t_exit = tx.min(ty).min(t1);
             let low_t = if d[2] < 0.0 { t_exit } else { t };
             let z_low = o[2] + d[2] * low_t;
-            if !(z_low > self.heights[iy * self.nx + ix]) {
+            if !(z_low > heights[iy * self.nx + ix]) {
                 return false;
             }
             if t_exit >= t1 {

@@ -106,10 +106,13 @@ impl Scene {
         }
         if dz < 0.0 {
             let t_w = (sea.level - oz) / dz;
-            if !(t_w < limit) || !sea.path_clear(ray.o, ray.d, t_w, SEA_WALK_DOWN) {
-                return SeaRoute::Trace;
-            }
-            return SeaRoute::Surface;
+            let clear = t_w < limit
+                && match horizon {
+                    // From a viewpoint over a vessel (a USV's camera): clear of its triangles, then of the rest.
+                    Some(h) => h.clear_of_near(ray.d) && sea.path_clear_from(h, ray.o, ray.d, t_w, SEA_WALK_DOWN),
+                    None => sea.path_clear(ray.o, ray.d, t_w, SEA_WALK_DOWN),
+                };
+            return if clear { SeaRoute::Surface } else { SeaRoute::Trace };
         }
         if let Some(h) = horizon {
             debug_assert_eq!(h.origin(), ray.o, "a horizon answers only for rays from its viewpoint");

@@ -10,11 +10,15 @@
 //!
 //! The obstacles are the cells of the static height map (through a max pyramid, so far blocks count as one), the
 //! moving instances by their world boxes, and, triangle by triangle, any moving instance whose box stands over
-//! `P` (a USV's own hull). A column standing over `P` and rising above it settles nothing. A triangle wholly
-//! above `P` (a sensor pod's roof, a radar arch) only hides the slopes at which a ray can reach its height
-//! range over its footprint: a bitmap of azimuth × slope bins holds those. Tops carry the height map's margin,
-//! distances lose a millimetre and slope bounds a relative 1e-5, so a settled ray passes clear of everything:
-//! the answer, a miss, is exactly the full trace's.
+//! `P` (a USV's own hull). A column standing over `P` and rising above it settles nothing. The triangles of those
+//! near instances mark, in a bitmap of azimuth × slope cells, every direction in which a ray from `P` can meet
+//! them (a sensor pod's roof hides only the steep slopes, the deck only the downward ones). Tops carry the
+//! height map's margin, distances lose a millimetre and slope bounds a relative 1e-5, so a settled ray passes
+//! clear of everything: the answer, a miss, is exactly the full trace's.
+//!
+//! The same bitmap serves the rays going down: a ray whose direction cell is free of the near triangles can
+//! only be stopped by the height map without the near instances ([`Horizon::ground`]), so the sea's walk over
+//! that map settles it as it would from open water.
 
 /// Azimuth bins around the viewpoint.
 const BINS: usize = 2048;
@@ -95,17 +99,20 @@ pub struct Horizon {
     origin: [f32; 3],
     /// Per azimuth bin, the slope a ray must exceed to pass over every column (`f32::MIN` where none stands).
     slope: Vec<f32>,
-    /// Slope bins hidden by floating obstacles, [`SLOPE_WORDS`] words of bits per azimuth bin (bit `e` of a bin:
-    /// slopes `s` with `s / (1 + s)` in `[e, e + 1) / SLOPE_BINS`).
-    floating: Vec<u64>,
-    /// Whether any floating bit is set.
-    any_floating: bool,
-    /// A column stands over the viewpoint and rises above it: no ray is settled.
+    /// Direction cells the triangles of the near instances may lie in: [`SLOPE_WORDS`] words of bits per
+    /// azimuth bin, bit `e` for the slopes `s` with `(q + 1) / 2` in `[e, e + 1) / SLOPE_BINS`, where
+    /// `q = s / (1 + |s|)` (−1 straight down, 1 straight up).
+    bands: Vec<u64>,
+    /// Whether any band bit is set.
+    any_bands: bool,
+    /// A column stands over the viewpoint and rises above it: no rising ray is settled.
     covered: bool,
+    /// The height map without the near instances' boxes (their triangles are in `bands`), when there are any.
+    pub(super) ground: Option<Vec<f32>>,
 }
 
-/// Slope bins of [`Horizon::floating`] per azimuth bin.
-const SLOPE_BINS: usize = 256;
+/// Slope bins of [`Horizon::bands`] per azimuth bin.
+const SLOPE_BINS: usize = 512;
 /// `u64` words per azimuth bin.
 const SLOPE_WORDS: usize = SLOPE_BINS / 64;
 
@@ -115,9 +122,10 @@ impl Horizon {
         Self {
             origin,
             slope: vec![f32::MIN; BINS],
-            floating: vec![0; BINS * SLOPE_WORDS],
-            any_floating: false,
+            bands: vec![0; BINS * SLOPE_WORDS],
+            any_bands: false,
             covered: false,
+            ground: None,
         }
     }
 
@@ -127,7 +135,7 @@ impl Horizon {
     }
 
     /// Whether a ray from the viewpoint with unit direction `d` surely hits nothing: it does not go down, rises
-    /// more steeply than the columns of its azimuth bin, and no floating obstacle hides its slope there.
+    /// more steeply than the columns of its azimuth bin, and its direction cell holds no near triangle.
     /// `false` means "not known".
     #[inline(always)]
     #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > b)` on purpose: a NaN must answer "not known"
@@ -136,16 +144,25 @@ impl Horizon {
             return false;
         }
         let run = (d[0] * d[0] + d[1] * d[1]).sqrt();
-        let bin = ((pseudo_angle_f32(d[0], d[1]) * (BINS / 4) as f32) as usize).min(BINS - 1);
+        let bin = azimuth_bin(d);
         if !(d[2] > self.slope[bin] * run) {
             return false;
         }
-        if !self.any_floating {
-            return true;
-        }
-        // s / (1 + s) with s = d_z / run, in [0, 1] (1 straight up).
-        let e = ((d[2] / (run + d[2]) * SLOPE_BINS as f32) as usize).min(SLOPE_BINS - 1);
-        self.floating[bin * SLOPE_WORDS + e / 64] & (1 << (e % 64)) == 0
+        !self.any_bands || self.band_free(bin, d, run)
+    }
+
+    /// Whether the direction cell of a ray from the viewpoint with unit direction `d` holds no triangle of the
+    /// near instances (then only the height map without them, [`Horizon::ground`], can stop the ray).
+    #[inline(always)]
+    pub fn clear_of_near(&self, d: [f32; 3]) -> bool {
+        !self.any_bands || self.band_free(azimuth_bin(d), d, (d[0] * d[0] + d[1] * d[1]).sqrt())
+    }
+
+    #[inline(always)]
+    fn band_free(&self, bin: usize, d: [f32; 3], run: f32) -> bool {
+        let q = d[2] / (run + d[2].abs());
+        let e = (((q + 1.0) * (SLOPE_BINS / 2) as f32) as usize).min(SLOPE_BINS - 1);
+        self.bands[bin * SLOPE_WORDS + e / 64] & (1 << (e % 64)) == 0
     }
 
     /// Adds a column over the rectangle `lo..hi` (world x, y) holding everything there at or below `top`
@@ -169,41 +186,47 @@ impl Horizon {
         }
     }
 
-    /// Adds a triangle (world frame), widened up and down by [`TRIANGLE_MARGIN_M`]. One reaching down to the
-    /// viewpoint's height counts as a column; one wholly above it hides only the slopes at which a ray can
-    /// pass through its height range over its footprint (a ray below them passes under it).
+    /// Adds a triangle of a near instance (world frame), widened up and down by [`TRIANGLE_MARGIN_M`]: the
+    /// direction cells of every slope at which a ray from the viewpoint can meet its height range over its
+    /// footprint (`z / r` over heights `z` and horizontal distances `r` of the triangle), in its azimuth range
+    /// (all of them when it lies over or under the viewpoint).
     pub(crate) fn add_triangle(&mut self, tri: [[f32; 3]; 3]) {
         let p = self.origin.map(f64::from);
         let (zlo, zhi) = tri.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), v| (a.min(v[2]), b.max(v[2])));
-        let (bottom, top) = (f64::from(zlo - TRIANGLE_MARGIN_M), f64::from(zhi + TRIANGLE_MARGIN_M));
-        if top < p[2] {
-            return;
-        }
+        let (a, b) = (f64::from(zlo - TRIANGLE_MARGIN_M) - p[2], f64::from(zhi + TRIANGLE_MARGIN_M) - p[2]);
         let xy = tri.map(|v| [f64::from(v[0]) - p[0], f64::from(v[1]) - p[1]]);
         let r_min = triangle_distance(&xy) - DISTANCE_SLACK_M;
         let r_max = xy.iter().map(|v| v[0].hypot(v[1])).fold(0.0, f64::max) + DISTANCE_SLACK_M;
-        let corners = tri.map(|v| [f64::from(v[0]), f64::from(v[1])]);
-        let (b0, b1) = if r_min > 0.0 { self.bins_of(&corners) } else { (0, BINS as i64 - 1) };
-        let s_hi = if r_min > 0.0 { (top - p[2]) / r_min * (1.0 + 1e-5) } else { f64::INFINITY };
-        let s_lo = if bottom > p[2] { (bottom - p[2]) / r_max * (1.0 - 1e-5) } else { 0.0 };
-        if s_lo <= 0.0 && r_min > 0.0 {
-            for b in b0..=b1 {
-                let v = &mut self.slope[b.rem_euclid(BINS as i64) as usize];
-                *v = v.max(s_hi as f32);
+        let (bins, s_lo, s_hi) = if r_min > 0.0 {
+            let corners = tri.map(|v| [f64::from(v[0]), f64::from(v[1])]);
+            (self.bins_of(&corners), (a / r_min).min(a / r_max), (b / r_min).max(b / r_max))
+        } else {
+            let lo = if a > 0.0 { a / r_max } else { f64::NEG_INFINITY };
+            let hi = if b < 0.0 { b / r_max } else { f64::INFINITY };
+            ((0, BINS as i64 - 1), lo, hi)
+        };
+        // Slope bins, widened by one on each side (q is ±1 for infinite slopes).
+        let e = |s: f64, widen: i64| {
+            let q = if s.is_finite() { s / (1.0 + s.abs()) } else { s.signum() };
+            ((q + 1.0) * (SLOPE_BINS / 2) as f64).floor() as i64 + widen
+        };
+        let e0 = e(s_lo, -1).clamp(0, SLOPE_BINS as i64 - 1) as usize;
+        let e1 = e(s_hi, 1).clamp(0, SLOPE_BINS as i64 - 1) as usize;
+        let mut mask = [0u64; SLOPE_WORDS];
+        for (w, m) in mask.iter_mut().enumerate() {
+            let (lo, hi) = (e0.max(64 * w), e1.min(64 * w + 63));
+            if lo <= hi {
+                let span = hi - lo + 1;
+                *m = (if span == 64 { u64::MAX } else { (1u64 << span) - 1 }) << (lo - 64 * w);
             }
-            return;
         }
-        // Slope bins, widened by one on each side (s / (1 + s) is 1 for an infinite slope).
-        let q = |s: f64| if s.is_finite() { s / (1.0 + s) } else { 1.0 };
-        let e0 = ((q(s_lo) * SLOPE_BINS as f64).floor() as i64 - 1).max(0) as usize;
-        let e1 = ((q(s_hi) * SLOPE_BINS as f64).floor() as i64 + 1).min(SLOPE_BINS as i64 - 1) as usize;
-        for b in b0..=b1 {
-            let row = b.rem_euclid(BINS as i64) as usize * SLOPE_WORDS;
-            for e in e0..=e1 {
-                self.floating[row + e / 64] |= 1 << (e % 64);
+        for bin in bins.0..=bins.1 {
+            let row = bin.rem_euclid(BINS as i64) as usize * SLOPE_WORDS;
+            for (word, m) in self.bands[row..row + SLOPE_WORDS].iter_mut().zip(&mask) {
+                *word |= m;
             }
         }
-        self.any_floating = true;
+        self.any_bands = true;
     }
 
     /// Whether the rectangle `lo..hi` (world x, y) stands over the viewpoint, or within the distance slack of it.
@@ -279,6 +302,12 @@ fn pseudo_angle(x: f64, y: f64) -> f64 {
     } else {
         v
     }
+}
+
+/// The azimuth bin of a ray direction.
+#[inline(always)]
+fn azimuth_bin(d: [f32; 3]) -> usize {
+    ((pseudo_angle_f32(d[0], d[1]) * (BINS / 4) as f32) as usize).min(BINS - 1)
 }
 
 /// [`pseudo_angle`] in `f32`, for rays.
@@ -385,6 +414,23 @@ mod tests {
     }
 
     #[test]
+    fn a_deck_under_the_viewpoint_hides_only_the_steep_downward_rays() {
+        // A 2 m square deck 1 m below the eye: rays steeper than its far corner (slope -0.99 / 1.414) may meet it.
+        let mut h = Horizon::new([0.0, 0.0, 2.0]);
+        h.add_triangle([[-1.0, -1.0, 1.0], [1.0, -1.0, 1.0], [1.0, 1.0, 1.0]]);
+        h.add_triangle([[-1.0, -1.0, 1.0], [1.0, 1.0, 1.0], [-1.0, 1.0, 1.0]]);
+        let down = |az: f32, slope: f32| {
+            let n = (1.0 + slope * slope).sqrt();
+            [az.cos() / n, az.sin() / n, slope / n]
+        };
+        for az in [0.0f32, 0.8, 2.0, 3.1, 4.0, 5.5] {
+            assert!(!h.clear_of_near(down(az, -3.0)) && !h.clear_of_near([0.0, 0.0, -1.0]), "steep at {az}");
+            assert!(h.clear_of_near(down(az, -0.6)) && h.clear_of_near(down(az, -0.05)), "shallow at {az}");
+            assert!(h.clear(down(az, 0.1)), "rising at {az}: the deck is below");
+        }
+    }
+
+    #[test]
     fn footprints_across_angle_zero_mark_both_ends() {
         let mut h = Horizon::new([0.0, 0.0, 1.0]);
         h.add_triangle([[10.0, -1.0, 0.0], [10.0, 1.0, 0.0], [12.0, 0.0, 5.0]]);
@@ -395,9 +441,10 @@ mod tests {
         assert!(!h.clear(d(0.5)) && !h.clear(d(-0.5)), "both sides of angle 0 are hidden");
         assert!(h.clear(d(4.0)) && h.clear(d(-4.0)), "beside the triangle is clear");
         // ±0.1 rad is ±0.091 in pseudo-angle, ±47 bins.
-        let marked = h.slope.iter().filter(|&&s| s > f32::MIN).count();
+        let row = |b: usize| &h.bands[b * SLOPE_WORDS..(b + 1) * SLOPE_WORDS];
+        let marked = (0..BINS).filter(|&b| row(b).iter().any(|&w| w != 0)).count();
         assert!((90..=100).contains(&marked), "{marked} bins marked");
-        assert_eq!(h.slope[BINS / 2], f32::MIN, "the opposite direction is free");
+        assert!(row(BINS / 2).iter().all(|&w| w == 0), "the opposite direction is free");
     }
 
     #[test]
