@@ -280,23 +280,32 @@ impl Horizon {
     }
 }
 
+/// The diamond angle of `(x, y)` (not both zero) in either float type: `y / (x + y)` in the first quadrant, one
+/// more per quarter turn. One formula for [`pseudo_angle`] (footprints) and [`pseudo_angle_f32`] (rays).
+macro_rules! diamond {
+    ($x:expr, $y:expr) => {{
+        let (x, y) = ($x, $y);
+        if y >= 0.0 {
+            if x >= 0.0 {
+                y / (x + y)
+            } else {
+                1.0 - x / (y - x)
+            }
+        } else if x < 0.0 {
+            2.0 - y / (-x - y)
+        } else {
+            3.0 + x / (x - y)
+        }
+    }};
+}
+
 /// A monotone stand-in for the azimuth of `(x, y)` in `[0, 4)` (the "diamond angle": 1 per quarter turn,
 /// opposite directions 2 apart), without trigonometry.
 fn pseudo_angle(x: f64, y: f64) -> f64 {
     if x == 0.0 && y == 0.0 {
         return 0.0;
     }
-    let v = if y >= 0.0 {
-        if x >= 0.0 {
-            y / (x + y)
-        } else {
-            1.0 - x / (y - x)
-        }
-    } else if x < 0.0 {
-        2.0 - y / (-x - y)
-    } else {
-        3.0 + x / (x - y)
-    };
+    let v: f64 = diamond!(x, y);
     if v >= 4.0 {
         0.0
     } else {
@@ -310,23 +319,13 @@ fn azimuth_bin(d: [f32; 3]) -> usize {
     ((pseudo_angle_f32(d[0], d[1]) * (BINS / 4) as f32) as usize).min(BINS - 1)
 }
 
-/// [`pseudo_angle`] in `f32`, for rays.
+/// [`pseudo_angle`] in `f32`, for rays (a rounded 4.0 is left as it is: its bin is clamped to the last).
 #[inline(always)]
 fn pseudo_angle_f32(x: f32, y: f32) -> f32 {
     if x == 0.0 && y == 0.0 {
         return 0.0;
     }
-    if y >= 0.0 {
-        if x >= 0.0 {
-            y / (x + y)
-        } else {
-            1.0 - x / (y - x)
-        }
-    } else if x < 0.0 {
-        2.0 - y / (-x - y)
-    } else {
-        3.0 + x / (x - y)
-    }
+    diamond!(x, y)
 }
 
 /// Horizontal distance from the origin to a triangle given relative to it (x, y), 0 when it lies over the
