@@ -8,6 +8,7 @@ use crate::bvh::{Box3, Bvh, Packet, PacketStack, PacketVisit, Stack, Visit, PACK
 use crate::error::{MmusvError, Result};
 use crate::geometry::{PreparedTriangle, TriBlock, BLOCK};
 use crate::ray::RayPrep;
+use crate::simd::{Level, Portable};
 use parry3d::bounding_volume::Aabb;
 use parry3d::math::Vec3;
 
@@ -142,39 +143,34 @@ impl Mesh {
     /// Closest hit of the ray `origin + t·dir`, `0 < t < t_max`, in the local frame.
     #[inline]
     pub fn cast_local(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<LocalHit> {
-        self.closest(&RayPrep::new(origin.to_array(), dir.to_array()), t_max, &mut Stack::default())
+        self.closest(Portable, &RayPrep::new(origin.to_array(), dir.to_array()), t_max, &mut Stack::default())
     }
 
-    /// Closest hit of a prepared ray (local frame) below `t_max`, with caller-owned traversal scratch space.
+    /// Closest hit of a prepared ray (local frame) below `t_max`, with caller-owned traversal scratch space;
+    /// the walk runs at level `lv`.
     #[inline(always)]
-    pub fn closest(&self, ray: &RayPrep, t_max: f32, stack: &mut Stack) -> Option<LocalHit> {
-        let mut v = Blocks { blocks: &self.blocks, ray, hit: u32::MAX };
-        let t = self.bvh.closest(ray, t_max, stack, &mut v);
-        (v.hit != u32::MAX).then_some(LocalHit { t, triangle: v.hit })
+    pub fn closest<L: Level>(&self, lv: L, ray: &RayPrep, t_max: f32, stack: &mut Stack) -> Option<LocalHit> {
+        closest_kernel(lv, self, ray, t_max, stack)
     }
 
-    /// Whether the prepared ray (local frame) hits any triangle below `t_max`.
+    /// Whether the prepared ray (local frame) hits any triangle below `t_max`; the walk runs at level `lv`.
     #[inline(always)]
-    pub fn any(&self, ray: &RayPrep, t_max: f32, stack: &mut Stack) -> bool {
-        let mut v = Blocks { blocks: &self.blocks, ray, hit: u32::MAX };
-        self.bvh.any(ray, t_max, stack, &mut v)
+    pub fn any<L: Level>(&self, lv: L, ray: &RayPrep, t_max: f32, stack: &mut Stack) -> bool {
+        any_kernel(lv, self, ray, t_max, stack)
     }
 
     /// Traces a packet (local frame): every ray `r` that hits closer than `p.best[r]` gets the new distance and,
-    /// in `tri[r]`, the triangle hit; other rays are left unchanged.
+    /// in `tri[r]`, the triangle hit; other rays are left unchanged. The walk runs at level `lv`.
     #[inline(always)]
-    pub fn closest_packet(&self, p: &mut Packet, stack: &mut PacketStack, tri: &mut [u32; PACKET]) {
-        let mut v = PacketBlocks { blocks: &self.blocks, tri, any: false };
-        self.bvh.closest_packet(p, stack, &mut v);
+    pub fn closest_packet<L: Level>(&self, lv: L, p: &mut Packet, stack: &mut PacketStack, tri: &mut [u32; PACKET]) {
+        closest_packet_kernel(lv, self, p, stack, tri);
     }
 
     /// Occlusion for a packet (local frame): every ray `r` that hits anything below `p.best[r]` gets
-    /// `p.best[r] = -1`.
+    /// `p.best[r] = -1`. The walk runs at level `lv`.
     #[inline(always)]
-    pub fn any_packet(&self, p: &mut Packet, stack: &mut PacketStack) {
-        let mut tri = [0u32; PACKET];
-        let mut v = PacketBlocks { blocks: &self.blocks, tri: &mut tri, any: true };
-        self.bvh.any_packet(p, stack, &mut v);
+    pub fn any_packet<L: Level>(&self, lv: L, p: &mut Packet, stack: &mut PacketStack) {
+        any_packet_kernel(lv, self, p, stack);
     }
 
     /// Brute-force closest hit over every triangle: the independent reference the tests compare against.
@@ -188,6 +184,40 @@ impl Mesh {
             }
         }
         best
+    }
+}
+
+crate::kernel! {
+    /// [`Mesh::closest`]'s walk, out of line per level.
+    fn closest_kernel(mesh: &Mesh, ray: &RayPrep, t_max: f32, stack: &mut Stack) -> Option<LocalHit> {
+        let mut v = Blocks { blocks: &mesh.blocks, ray, hit: u32::MAX };
+        let t = mesh.bvh.closest(ray, t_max, stack, &mut v);
+        (v.hit != u32::MAX).then_some(LocalHit { t, triangle: v.hit })
+    }
+}
+
+crate::kernel! {
+    /// [`Mesh::any`]'s walk, out of line per level.
+    fn any_kernel(mesh: &Mesh, ray: &RayPrep, t_max: f32, stack: &mut Stack) -> bool {
+        let mut v = Blocks { blocks: &mesh.blocks, ray, hit: u32::MAX };
+        mesh.bvh.any(ray, t_max, stack, &mut v)
+    }
+}
+
+crate::kernel! {
+    /// [`Mesh::closest_packet`]'s walk, out of line per level.
+    fn closest_packet_kernel(mesh: &Mesh, p: &mut Packet, stack: &mut PacketStack, tri: &mut [u32; PACKET]) {
+        let mut v = PacketBlocks { blocks: &mesh.blocks, tri, any: false };
+        mesh.bvh.closest_packet(p, stack, &mut v);
+    }
+}
+
+crate::kernel! {
+    /// [`Mesh::any_packet`]'s walk, out of line per level.
+    fn any_packet_kernel(mesh: &Mesh, p: &mut Packet, stack: &mut PacketStack) {
+        let mut tri = [0u32; PACKET];
+        let mut v = PacketBlocks { blocks: &mesh.blocks, tri: &mut tri, any: true };
+        mesh.bvh.any_packet(p, stack, &mut v);
     }
 }
 

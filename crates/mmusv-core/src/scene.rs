@@ -18,6 +18,7 @@ use crate::geometry::RigidPose;
 use crate::mesh::Mesh;
 use crate::ray::RayPrep;
 use crate::sea::Sea;
+use crate::simd::{Level, Portable};
 use parry3d::bounding_volume::Aabb;
 use parry3d::math::Vec3;
 use std::sync::Arc;
@@ -262,23 +263,31 @@ impl Scene {
     /// [`Scene::cast_ray`] with caller-owned traversal scratch space (reuse one per thread).
     #[inline(always)]
     pub fn cast_ray_with(&self, origin: Vec3, dir: Vec3, max_range: f32, scratch: &mut Scratch) -> Option<Hit> {
-        self.cast_prepared(&RayPrep::new(origin.to_array(), dir.to_array()), max_range, scratch)
+        self.cast_prepared(Portable, &RayPrep::new(origin.to_array(), dir.to_array()), max_range, scratch)
     }
 
-    /// [`Scene::cast_ray_with`] for a prepared world ray.
+    /// [`Scene::cast_ray_with`] for a prepared world ray, the meshes walked at level `lv`.
     #[inline(always)]
-    pub fn cast_prepared(&self, ray: &RayPrep, max_range: f32, scratch: &mut Scratch) -> Option<Hit> {
-        let mut v = Instances { scene: self, ray, stack: &mut scratch.bottom, instance: u32::MAX, triangle: u32::MAX };
+    pub fn cast_prepared<L: Level>(&self, lv: L, ray: &RayPrep, max_range: f32, scratch: &mut Scratch) -> Option<Hit> {
+        let mut v =
+            Instances { lv, scene: self, ray, stack: &mut scratch.bottom, instance: u32::MAX, triangle: u32::MAX };
         let t = self.tlas.closest(ray, max_range, &mut scratch.top, &mut v);
         (v.instance != u32::MAX).then_some(Hit { distance: t, instance: v.instance, triangle: v.triangle })
     }
 
     /// Traces a packet of prepared world rays: for every ray `r`, `p.best[r]` becomes its closest hit distance
     /// (unchanged if nothing is hit closer) and the returned arrays hold the instance and triangle hit
-    /// (`u32::MAX` for none). Each ray's hit is the one [`Scene::cast_ray_with`] finds for it.
+    /// (`u32::MAX` for none). Each ray's hit is the one [`Scene::cast_ray_with`] finds for it. The meshes are
+    /// walked at level `lv`.
     #[inline(always)]
-    pub fn cast_packet_with(&self, p: &mut Packet, scratch: &mut Scratch) -> ([u32; PACKET], [u32; PACKET]) {
+    pub fn cast_packet_with<L: Level>(
+        &self,
+        lv: L,
+        p: &mut Packet,
+        scratch: &mut Scratch,
+    ) -> ([u32; PACKET], [u32; PACKET]) {
         let mut v = PacketInstances {
+            lv,
             scene: self,
             scratch_single: &mut scratch.bottom,
             stack: &mut scratch.packet_bottom,
@@ -291,10 +300,11 @@ impl Scene {
     }
 
     /// Occlusion for a packet of prepared world rays: afterwards `p.best[r] < 0` for every ray blocked below its
-    /// starting `p.best[r]`.
+    /// starting `p.best[r]`. The meshes are walked at level `lv`.
     #[inline(always)]
-    pub fn occluded_packet_with(&self, p: &mut Packet, scratch: &mut Scratch) {
+    pub fn occluded_packet_with<L: Level>(&self, lv: L, p: &mut Packet, scratch: &mut Scratch) {
         let mut v = PacketInstances {
+            lv,
             scene: self,
             scratch_single: &mut scratch.bottom,
             stack: &mut scratch.packet_bottom,
@@ -309,18 +319,18 @@ impl Scene {
     /// query, which stops at the first hit found instead of looking for the closest.
     #[inline(always)]
     pub fn occluded_with(&self, origin: Vec3, dir: Vec3, max_range: f32, scratch: &mut Scratch) -> bool {
-        self.occluded_prepared(&RayPrep::new(origin.to_array(), dir.to_array()), max_range, scratch)
+        self.occluded_prepared(Portable, &RayPrep::new(origin.to_array(), dir.to_array()), max_range, scratch)
     }
 
-    /// [`Scene::occluded_with`] for a prepared world ray.
+    /// [`Scene::occluded_with`] for a prepared world ray, the meshes walked at level `lv`.
     #[inline(always)]
-    pub fn occluded_prepared(&self, ray: &RayPrep, max_range: f32, scratch: &mut Scratch) -> bool {
-        let mut v = AnyInstance { scene: self, ray, stack: &mut scratch.bottom };
+    pub fn occluded_prepared<L: Level>(&self, lv: L, ray: &RayPrep, max_range: f32, scratch: &mut Scratch) -> bool {
+        let mut v = AnyInstance { lv, scene: self, ray, stack: &mut scratch.bottom };
         self.tlas.any(ray, max_range, &mut scratch.top, &mut v)
     }
 
     /// Unit world normal (triangle winding) and semantic class of a hit.
-    #[inline]
+    #[inline(always)]
     pub fn hit_normal_class(&self, hit: &Hit) -> (Vec3, u16) {
         let inst = &self.instances[hit.instance as usize];
         let mesh = &self.meshes[inst.mesh as usize];
@@ -350,7 +360,8 @@ impl Scene {
 
 /// The top-level leaf visitor of [`Scene::cast_ray_with`]: each instance's mesh, cheapest first, in its local
 /// frame (instances at the identity pose use the world ray as it is).
-struct Instances<'a> {
+struct Instances<'a, L> {
+    lv: L,
     scene: &'a Scene,
     ray: &'a RayPrep,
     stack: &'a mut Stack,
@@ -358,7 +369,7 @@ struct Instances<'a> {
     triangle: u32,
 }
 
-impl Visit for Instances<'_> {
+impl<L: Level> Visit for Instances<'_, L> {
     #[inline(always)]
     fn leaf(&mut self, leaf: u32, mut best: f32) -> f32 {
         let sc = self.scene;
@@ -371,7 +382,7 @@ impl Visit for Instances<'_> {
             let inst = &sc.instances[id as usize];
             let mesh = &sc.meshes[inst.mesh as usize];
             let local = local_ray(self.ray, &inst.pose);
-            if let Some(h) = mesh.closest(local.as_ref().unwrap_or(self.ray), best, self.stack) {
+            if let Some(h) = mesh.closest(self.lv, local.as_ref().unwrap_or(self.ray), best, self.stack) {
                 best = h.t;
                 self.instance = id;
                 self.triangle = h.triangle;
@@ -382,13 +393,14 @@ impl Visit for Instances<'_> {
 }
 
 /// The top-level leaf visitor of [`Scene::occluded_with`].
-struct AnyInstance<'a> {
+struct AnyInstance<'a, L> {
+    lv: L,
     scene: &'a Scene,
     ray: &'a RayPrep,
     stack: &'a mut Stack,
 }
 
-impl Visit for AnyInstance<'_> {
+impl<L: Level> Visit for AnyInstance<'_, L> {
     #[inline(always)]
     fn leaf(&mut self, leaf: u32, best: f32) -> f32 {
         let sc = self.scene;
@@ -400,7 +412,7 @@ impl Visit for AnyInstance<'_> {
             let id = sc.tlas_order[k];
             let inst = &sc.instances[id as usize];
             let local = local_ray(self.ray, &inst.pose);
-            if sc.meshes[inst.mesh as usize].any(local.as_ref().unwrap_or(self.ray), best, self.stack) {
+            if sc.meshes[inst.mesh as usize].any(self.lv, local.as_ref().unwrap_or(self.ray), best, self.stack) {
                 return 0.0;
             }
         }
@@ -423,7 +435,8 @@ fn local_ray(ray: &RayPrep, pose: &RigidPose) -> Option<RayPrep> {
 /// The top-level leaf visitor of packets: each instance whose box some ray enters, cheapest first; its mesh
 /// is traced with the rays that enter its box, as a packet in the instance's frame where their directions
 /// still share signs there, else ray by ray.
-struct PacketInstances<'a> {
+struct PacketInstances<'a, L> {
+    lv: L,
     scene: &'a Scene,
     scratch_single: &'a mut Stack,
     stack: &'a mut PacketStack,
@@ -432,7 +445,7 @@ struct PacketInstances<'a> {
     any: bool,
 }
 
-impl PacketVisit for PacketInstances<'_> {
+impl<L: Level> PacketVisit for PacketInstances<'_, L> {
     #[inline(always)]
     fn leaf(&mut self, leaf: u32, rays: u32, p: &mut Packet) {
         let sc = self.scene;
@@ -464,9 +477,9 @@ impl PacketVisit for PacketInstances<'_> {
                 }
                 let mut tri = [u32::MAX; PACKET];
                 if self.any {
-                    mesh.any_packet(p, self.stack);
+                    mesh.any_packet(self.lv, p, self.stack);
                 } else {
-                    mesh.closest_packet(p, self.stack, &mut tri);
+                    mesh.closest_packet(self.lv, p, self.stack, &mut tri);
                 }
                 for r in 0..PACKET {
                     if mask & (1 << r) == 0 {
@@ -497,9 +510,9 @@ impl PacketVisit for PacketInstances<'_> {
                 }
                 let mut tri = [u32::MAX; PACKET];
                 if self.any {
-                    mesh.any_packet(&mut q, self.stack);
+                    mesh.any_packet(self.lv, &mut q, self.stack);
                 } else {
-                    mesh.closest_packet(&mut q, self.stack, &mut tri);
+                    mesh.closest_packet(self.lv, &mut q, self.stack, &mut tri);
                 }
                 for j in 0..n {
                     let r = lane[j];
@@ -513,10 +526,10 @@ impl PacketVisit for PacketInstances<'_> {
                 for j in 0..n {
                     let r = lane[j];
                     if self.any {
-                        if mesh.any(&local[j], p.best[r], self.scratch_single) {
+                        if mesh.any(self.lv, &local[j], p.best[r], self.scratch_single) {
                             p.best[r] = -1.0;
                         }
-                    } else if let Some(h) = mesh.closest(&local[j], p.best[r], self.scratch_single) {
+                    } else if let Some(h) = mesh.closest(self.lv, &local[j], p.best[r], self.scratch_single) {
                         p.best[r] = h.t;
                         self.instance[r] = id;
                         self.triangle[r] = h.triangle;
@@ -756,7 +769,10 @@ mod tests {
             let settled = o
                 .iter()
                 .zip(&d)
-                .filter(|(o, d)| with.sea_closest(&RayPrep::new(**o, unit_direction(d)), 800.0, &mut scratch).is_some())
+                .filter(|(o, d)| {
+                    with.sea_closest(crate::simd::Portable, &RayPrep::new(**o, unit_direction(d)), 800.0, &mut scratch)
+                        .is_some()
+                })
                 .count();
             assert!(settled > 2_000, "only {settled} of 20000 rays settled by the sea shortcut");
             // Coherent sets, in 4x4 tiles as the cameras trace them (the surface then answers whole packets):
@@ -878,5 +894,59 @@ mod tests {
         assert!(water.0 * 10 > water.1 * 6, "the horizons settled only {water:?} rising rays over the water");
         assert!(decks.0 * 10 > decks.1 * 4, "the horizons settled only {decks:?} rising rays on the decks");
         assert!(with.horizon([0.0, 0.0, -1.0]).is_none(), "no horizon under the surface");
+    }
+
+    /// The AVX2 and portable versions of the batch casts (and of the mesh kernels they call) give the same
+    /// bits: LiDAR-like and camera-like ray sets, packets and single rays, with and without the sea shortcuts,
+    /// closest hits and shadow rays.
+    #[test]
+    fn every_simd_level_gives_the_same_bits() {
+        let (mut s, vessels) = sea_world();
+        let mut rng = ChaCha8Rng::seed_from_u64(21);
+        let mut origins = Vec::new();
+        let mut dirs = Vec::new();
+        for k in 0..6000 {
+            let o = if k < 4096 { [3.0, -2.0, 2.5] } else { [rng.random_range(-250.0..250.0), 0.0, 30.0] };
+            origins.push(o);
+            dirs.push([rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-0.6..0.3)]);
+        }
+        let sun = vec![[0.3, 0.2, 0.9]; origins.len()];
+        let mut runs = Vec::new();
+        for sea in [false, true] {
+            if sea {
+                s.set_sea(1, &vessels).unwrap_or_else(|e| unreachable!("{e}"));
+            }
+            for portable in [true, false] {
+                crate::simd::set_portable(portable);
+                let hits = s.cast_rays(&origins, &dirs, 900.0).unwrap_or_default();
+                let shadow = s.occluded_rays(&origins, &sun, 900.0).unwrap_or_default();
+                runs.push((sea, portable, hits, shadow));
+            }
+        }
+        crate::simd::set_portable(false);
+        for pair in runs.chunks(2) {
+            let ((sea, _, a, sa), (_, _, b, sb)) = (&pair[0], &pair[1]);
+            assert!(a.instance.iter().filter(|&&i| i >= 0).count() > 2000, "sea {sea}: too few hits");
+            assert!(sa.iter().filter(|&&x| x).count() > 100, "sea {sea}: too few shadowed rays");
+            let bits = |h: &RayHits| h.distance.iter().chain(&h.normal).map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(a), bits(b), "sea {sea}: distances or normals differ between the levels");
+            assert_eq!(
+                (&a.instance, &a.triangle, &a.class, &a.backface),
+                (&b.instance, &b.triangle, &b.class, &b.backface)
+            );
+            assert_eq!(sa, sb, "sea {sea}: shadow rays differ between the levels");
+        }
+        // The mesh kernels called directly with each token.
+        if let Some(avx2) = crate::simd::Avx2::detect() {
+            let mesh = &s.meshes()[0];
+            let mut stack = Stack::default();
+            for (o, d) in origins.iter().zip(&dirs) {
+                let ray = RayPrep::new(*o, unit_direction(d));
+                let a = mesh.closest(Portable, &ray, 900.0, &mut stack);
+                let b = mesh.closest(avx2, &ray, 900.0, &mut stack);
+                assert_eq!(a.map(|h| (h.t.to_bits(), h.triangle)), b.map(|h| (h.t.to_bits(), h.triangle)));
+                assert_eq!(mesh.any(Portable, &ray, 900.0, &mut stack), mesh.any(avx2, &ray, 900.0, &mut stack));
+            }
+        }
     }
 }

@@ -10,6 +10,7 @@ use crate::bvh::{Packet, PACKET};
 use crate::error::{MmusvError, Result};
 use crate::ray::{prepare_lanes, RayPrep};
 use crate::sea::{Horizon, SunMask};
+use crate::simd::Level;
 use parry3d::math::Vec3;
 use rayon::prelude::*;
 
@@ -141,7 +142,7 @@ pub(super) fn coherent(rays: &[RayPrep]) -> bool {
 crate::dispatch! {
     /// Traces one chunk of rays (normalising each direction) and stores the hits: coherent groups of
     /// [`PACKET`] consecutive rays as packets, the others one by one; both give each ray the same hit.
-    fn trace_chunk(
+    fn trace_chunk[lv](
         scene: &Scene,
         o: &[[f32; 3]],
         d: &[[f32; 3]],
@@ -167,7 +168,7 @@ crate::dispatch! {
             }
             if all_traced {
                 // Nothing for the sea shortcut (the usual case away from open water): trace the rays in place.
-                trace_rest(scene, rays, |j| start + j, limit, &mut scratch, &mut out);
+                trace_rest(lv, scene, rays, |j| start + j, limit, &mut scratch, &mut out);
                 continue;
             }
             // Rays the sea shortcut settles are done (those it sends to the surface tested against the surface
@@ -194,7 +195,7 @@ crate::dispatch! {
                 }
             }
             if nw > 0 {
-                let hits = scene.sea_surface_hits(&water[..nw], limit, &mut scratch);
+                let hits = scene.sea_surface_hits(lv, &water[..nw], limit, &mut scratch);
                 for j in 0..nw {
                     match &hits[j] {
                         Some(hit) => out.hit(scene, start + water_lane[j], Vec3::from_array(water[j].d), hit),
@@ -206,7 +207,7 @@ crate::dispatch! {
                     }
                 }
             }
-            trace_rest(scene, &rest[..n], |j| start + lane[j], limit, &mut scratch, &mut out);
+            trace_rest(lv, scene, &rest[..n], |j| start + lane[j], limit, &mut scratch, &mut out);
         }
         bad
     }
@@ -215,7 +216,8 @@ crate::dispatch! {
 /// Traces `rays` fully (as one packet when coherent, else one by one) and stores each hit at chunk index
 /// `at(j)` for ray `j`.
 #[inline(always)]
-fn trace_rest(
+fn trace_rest<L: Level>(
+    lv: L,
     scene: &Scene,
     rays: &[RayPrep],
     at: impl Fn(usize) -> usize,
@@ -225,7 +227,7 @@ fn trace_rest(
 ) {
     let packet = if coherent(rays) { Packet::new(rays, limit) } else { None };
     if let Some(mut p) = packet {
-        let (inst, tri) = scene.cast_packet_with(&mut p, scratch);
+        let (inst, tri) = scene.cast_packet_with(lv, &mut p, scratch);
         for (j, ray) in rays.iter().enumerate() {
             if inst[j] != u32::MAX {
                 let hit = Hit { distance: p.best[j], instance: inst[j], triangle: tri[j] };
@@ -234,7 +236,7 @@ fn trace_rest(
         }
     } else {
         for (j, ray) in rays.iter().enumerate() {
-            if let Some(hit) = scene.cast_prepared(ray, limit, scratch) {
+            if let Some(hit) = scene.cast_prepared(lv, ray, limit, scratch) {
                 out.hit(scene, at(j), Vec3::from_array(ray.d), &hit);
             }
         }
@@ -244,7 +246,7 @@ fn trace_rest(
 crate::dispatch! {
     /// Shadow-ray queries of one chunk (directions normalised here), packets where the rays are coherent.
     /// `mask`, when given, is the sea's sun mask for the direction every ray of the chunk has.
-    fn occlusion_chunk(
+    fn occlusion_chunk[lv](
         scene: &Scene,
         o: &[[f32; 3]],
         d: &[[f32; 3]],
@@ -272,13 +274,13 @@ crate::dispatch! {
             let rest = &rest[..n];
             let packet = if coherent(rest) { Packet::new(rest, limit) } else { None };
             if let Some(mut p) = packet {
-                scene.occluded_packet_with(&mut p, &mut scratch);
+                scene.occluded_packet_with(lv, &mut p, &mut scratch);
                 for j in 0..n {
                     out[start + lane[j]] = p.best[j] < 0.0;
                 }
             } else {
                 for (j, ray) in rest.iter().enumerate() {
-                    out[start + lane[j]] = scene.occluded_prepared(ray, limit, &mut scratch);
+                    out[start + lane[j]] = scene.occluded_prepared(lv, ray, limit, &mut scratch);
                 }
             }
         }

@@ -6,6 +6,7 @@ use crate::bvh::{Box3, Packet, PACKET};
 use crate::error::{MmusvError, Result};
 use crate::ray::RayPrep;
 use crate::sea::{Horizon, Sea, SunMask};
+use crate::simd::Level;
 
 /// Longest height-map walks (cells) worth trying before a full trace: down to the sea, up into the sky (camera
 /// rays), up towards the sun (shadow rays).
@@ -86,11 +87,17 @@ impl Scene {
     /// and nothing can be hit before it (the hit is the surface's, found by testing its mesh alone), `Some(None)`
     /// when the ray rises clear above everything (a miss), `None` when the ray needs the full trace.
     #[inline(always)]
-    pub fn sea_closest(&self, ray: &RayPrep, limit: f32, scratch: &mut Scratch) -> Option<Option<Hit>> {
+    pub fn sea_closest<L: Level>(
+        &self,
+        lv: L,
+        ray: &RayPrep,
+        limit: f32,
+        scratch: &mut Scratch,
+    ) -> Option<Option<Hit>> {
         match self.sea_route(ray, limit, None) {
             SeaRoute::Sky => Some(None),
             SeaRoute::Trace => None,
-            SeaRoute::Surface => self.sea_surface_hit(ray, limit, scratch).map(Some),
+            SeaRoute::Surface => self.sea_surface_hit(lv, ray, limit, scratch).map(Some),
         }
     }
 
@@ -144,20 +151,21 @@ impl Scene {
     /// The closest hit of a ray [`Scene::sea_route`] sent to the surface, from the surface mesh alone (`None`
     /// when it misses the mesh: the ray then needs the full trace).
     #[inline(always)]
-    fn sea_surface_hit(&self, ray: &RayPrep, limit: f32, scratch: &mut Scratch) -> Option<Hit> {
+    fn sea_surface_hit<L: Level>(&self, lv: L, ray: &RayPrep, limit: f32, scratch: &mut Scratch) -> Option<Hit> {
         let sea = self.sea.as_ref()?;
         let inst = &self.instances[sea.instance as usize];
         let local = local_ray(ray, &inst.pose);
         let mesh = &self.meshes[inst.mesh as usize];
-        let h = mesh.closest(local.as_ref().unwrap_or(ray), limit, &mut scratch.bottom)?;
+        let h = mesh.closest(lv, local.as_ref().unwrap_or(ray), limit, &mut scratch.bottom)?;
         Some(Hit { distance: h.t, instance: sea.instance, triangle: h.triangle })
     }
 
     /// [`Scene::sea_surface_hit`] for up to [`PACKET`] rays at once, traced as one packet against the surface
     /// mesh when they are coherent (each ray gets the hit it gets alone).
     #[inline(always)]
-    pub(super) fn sea_surface_hits(
+    pub(super) fn sea_surface_hits<L: Level>(
         &self,
+        lv: L,
         rays: &[RayPrep],
         limit: f32,
         scratch: &mut Scratch,
@@ -174,7 +182,7 @@ impl Scene {
         let packet = if coherent(local) { Packet::new(local, limit) } else { None };
         if let Some(mut p) = packet {
             let mut tri = [u32::MAX; PACKET];
-            mesh.closest_packet(&mut p, &mut scratch.packet_bottom, &mut tri);
+            mesh.closest_packet(lv, &mut p, &mut scratch.packet_bottom, &mut tri);
             for j in 0..rays.len() {
                 if tri[j] != u32::MAX {
                     out[j] = Some(Hit { distance: p.best[j], instance: sea.instance, triangle: tri[j] });
@@ -182,7 +190,7 @@ impl Scene {
             }
         } else {
             for (j, ray) in rays.iter().enumerate() {
-                out[j] = self.sea_surface_hit(ray, limit, scratch);
+                out[j] = self.sea_surface_hit(lv, ray, limit, scratch);
             }
         }
         out
