@@ -181,11 +181,19 @@ pub fn box_entry(b: &Box3, ray: &RayPrep, t_max: f32) -> bool {
 }
 
 /// Pushes the hit children of `node` (lanes in `mask`, at least one) on `stack` farthest first, except the
-/// nearest, which is returned to be visited next.
+/// nearest, which is returned to be visited next; or, when the entry on top of the stack (an ancestor's
+/// sibling) is nearer than every child, pushes them all under it and returns that entry instead. (A huge
+/// primitive near the root, a water plane over a terrain, is then hit before the walk goes down the terrain
+/// below it.)
 #[inline(always)]
 fn push_nearest_last(node: &Node, mask: u32, tn: &[f32; WIDTH], stack: &mut Vec<(u32, f32)>) -> u32 {
     if mask & (mask - 1) == 0 {
-        return node.child[mask.trailing_zeros() as usize];
+        let l = mask.trailing_zeros() as usize;
+        return match stack.last_mut() {
+            // The entry on top of the stack (an ancestor's sibling) is nearer than the only child: visit it first.
+            Some(top) if top.1 < tn[l] => std::mem::replace(top, (node.child[l], tn[l])).0,
+            _ => node.child[l],
+        };
     }
     // Sort the hits by distance, descending, into a small array (insertion sort of at most eight).
     let mut hits = [(EMPTY, 0f32); WIDTH];
@@ -203,8 +211,18 @@ fn push_nearest_last(node: &Node, mask: u32, tn: &[f32; WIDTH], stack: &mut Vec<
         hits[j] = e;
         n += 1;
     }
-    stack.extend_from_slice(&hits[..n - 1]);
-    hits[n - 1].0
+    match stack.pop() {
+        // Every child is farther than the entry on top of the stack (an ancestor's sibling): visit that first.
+        Some(top) if top.1 < hits[n - 1].1 => {
+            stack.extend_from_slice(&hits[..n]);
+            top.0
+        }
+        top => {
+            stack.extend(top);
+            stack.extend_from_slice(&hits[..n - 1]);
+            hits[n - 1].0
+        }
+    }
 }
 
 /// `max` without NaN handling, so it compiles to one SIMD lane operation.
@@ -324,6 +342,90 @@ mod tests {
         assert!(hits > 500, "{hits}");
         // The tree culls: far fewer leaves than primitives are visited per ray.
         assert!(visited < 3000 * 40, "{visited} leaves visited");
+    }
+
+    /// Leaves hold boxes; a ray hits a box where it enters it (origins lie outside every box).
+    struct Boxes<'a> {
+        bvh: &'a Bvh,
+        b: &'a [Box3],
+        ray: RayPrep,
+        hit: Option<u32>,
+        leaves_visited: usize,
+    }
+
+    fn box_t(b: &Box3, ray: &RayPrep) -> Option<f32> {
+        let (mut t0, mut t1) = (0f32, f32::INFINITY);
+        for a in 0..3 {
+            let (lo, hi) = ((b.lo[a] - ray.o[a]) / ray.d[a], (b.hi[a] - ray.o[a]) / ray.d[a]);
+            t0 = t0.max(lo.min(hi));
+            t1 = t1.min(lo.max(hi));
+        }
+        (t0 <= t1 && t0 > 0.0).then_some(t0)
+    }
+
+    impl Visit for Boxes<'_> {
+        fn leaf(&mut self, leaf: u32, mut best: f32) -> f32 {
+            self.leaves_visited += 1;
+            let lf = self.bvh.leaves()[leaf as usize];
+            for k in lf.start..lf.start + lf.count {
+                let p = self.bvh.order()[k as usize];
+                if let Some(t) = box_t(&self.b[p as usize], &self.ray).filter(|&t| t < best) {
+                    best = t;
+                    self.hit = Some(p);
+                }
+            }
+            best
+        }
+    }
+
+    /// A flat sheet over the whole map (a water plane) above a grid of small boxes (a seabed) with a few tall
+    /// ones (islands): rays going down from just above the sheet, away from the islands, hit it first. The walk visits the sheet's leaf (near the root) before it goes
+    /// down the field's subtree that the ray enters first, so it needs about one leaf per ray, and the hits are
+    /// those of brute force.
+    #[test]
+    fn a_near_entry_high_in_the_tree_is_visited_before_a_far_subtree() {
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        let mut boxes: Vec<Box3> = (0..10_000)
+            .map(|i| {
+                let (x, y, z) = ((i % 100) as f32 * 10.0 - 500.0, (i / 100) as f32 * 10.0 - 500.0, -20.0);
+                Box3 {
+                    lo: [x, y, z - rng.random_range(1.0..3.0)],
+                    hi: [x + 10.0, y + 10.0, z + rng.random_range(0.0..3.0)],
+                }
+            })
+            .collect();
+        // Islands: a few tall boxes, so the field's upper nodes reach above the rays' origins.
+        let islands: Vec<Box3> = (0..24)
+            .map(|_| {
+                let (x, y) = (rng.random_range(-500.0..500.0), rng.random_range(-500.0..500.0));
+                Box3 { lo: [x - 20.0, y - 20.0, -20.0], hi: [x + 20.0, y + 20.0, 40.0] }
+            })
+            .collect();
+        boxes.extend_from_slice(&islands);
+        boxes.push(Box3 { lo: [-510.0, -510.0, -0.01], hi: [510.0, 510.0, 0.0] });
+        let sheet = (boxes.len() - 1) as u32;
+        let bvh = Bvh::new(&boxes, 4);
+        let mut stack = Stack::default();
+        let (mut leaves, mut rays) = (0, 0);
+        for _ in 0..2000 {
+            let o = [rng.random_range(-400.0..400.0), rng.random_range(-400.0..400.0), 2.5];
+            if islands.iter().any(|b| (0..2).all(|a| b.lo[a] - 10.0 < o[a] && o[a] < b.hi[a] + 10.0)) {
+                continue; // over an island (or close to one)
+            }
+            let (az, el) = (rng.random_range(0.0..std::f32::consts::TAU), rng.random_range(0.3f32..1.5));
+            let ray = RayPrep::new(o, [az.cos() * el.cos(), az.sin() * el.cos(), -el.sin()]);
+            let brute = (0..boxes.len())
+                .filter_map(|i| box_t(&boxes[i], &ray).map(|t| (t, i as u32)))
+                .min_by(|a, b| a.0.total_cmp(&b.0));
+            let mut v = Boxes { bvh: &bvh, b: &boxes, ray, hit: None, leaves_visited: 0 };
+            let best = bvh.closest(&ray, 1e4, &mut stack, &mut v);
+            assert_eq!(v.hit, Some(sheet));
+            assert_eq!(brute, Some((best, sheet)));
+            leaves += v.leaves_visited;
+            rays += 1;
+        }
+        assert!(rays > 1000, "{rays}");
+        assert!(leaves < rays * 5 / 4, "{leaves} leaves visited for {rays} rays");
     }
 
     #[test]

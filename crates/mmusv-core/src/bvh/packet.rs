@@ -248,9 +248,15 @@ impl Bvh {
                 hits[j] = e;
                 n += 1;
             }
+            // ... under the entry on top of the stack when that is nearer than every child (as in `Bvh::closest`).
+            let top = match st.last() {
+                Some(top) if top.1 < hits[n - 1].1 => st.pop(),
+                _ => None,
+            };
             for &(c, t, l) in &hits[..n] {
                 st.push((c, t, cur, l));
             }
+            st.extend(top);
         }
     }
 
