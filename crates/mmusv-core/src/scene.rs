@@ -451,16 +451,7 @@ impl<L: Level> PacketVisit for PacketInstances<'_, L> {
         let sc = self.scene;
         let lf = sc.tlas.leaves()[leaf as usize];
         for k in lf.start as usize..(lf.start + lf.count) as usize {
-            let bx = &sc.tlas_boxes[k];
-            let mut mask = 0u32;
-            let mut m = rays;
-            while m != 0 {
-                let r = m.trailing_zeros() as usize;
-                m &= m - 1;
-                if p.best[r] >= 0.0 && box_entry(bx, &p.ray[r], p.best[r]) {
-                    mask |= 1 << r;
-                }
-            }
+            let mask = p.rays_entering_box(&sc.tlas_boxes[k]) & rays;
             if mask == 0 {
                 continue;
             }
