@@ -5,11 +5,12 @@
 //! height of everything else there: static geometry triangle by triangle, moving vessels by their world
 //! boxes, every contribution widened by one cell and raised by a margin. The scene uses it for two questions:
 //!
-//! * a ray from above the surface going down meets the surface at `t_w`: if the ray stays above the bound of
-//!   every cell its path crosses before that point ([`Sea::path_clear`]), nothing else can be hit first, and the
-//!   hit is found by testing the surface mesh alone (the same triangle test on the same mesh as the full trace);
-//! * a ray going up (a shadow ray) that stays above every cell it crosses until it is higher than everything
-//!   in the scene hits nothing.
+//! * a ray going up (a shadow ray, a camera's sky pixel) that stays above every cell it crosses
+//!   ([`Sea::path_clear`]) until it is higher than everything in the scene hits nothing.
+//!
+//! (Rays going down are traced: the scene's walk meets the surface, a large primitive near the top of the tree,
+//! about as soon as a walk over the height map could show the way down clear; an earlier route that sent them
+//! to the surface mesh alone cost more than it saved.)
 //!
 //! * a batch of shadow rays all towards one sun direction asks the [`SunMask`] instead: the cells from which a
 //!   ray in that direction can pass over some cell at or below that cell's bound, found once per sun direction
@@ -171,8 +172,7 @@ impl Sea {
     }
 
     /// The [`Horizon`] of viewpoint `origin` over the static geometry and the moving instances' boxes, with the
-    /// moving instances whose boxes stand over it (the caller adds their triangles: [`Horizon::add_triangle`];
-    /// the horizon's ground map leaves their boxes out).
+    /// moving instances whose boxes stand over it (the caller adds their triangles: [`Horizon::add_triangle`]).
     /// `None` when `origin` is not above the surface or a moving box lies outside the grid.
     #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > b)` on purpose: a NaN must answer "no"
     pub fn horizon(&self, origin: [f32; 3]) -> Option<(Horizon, Vec<u32>)> {
@@ -189,15 +189,6 @@ impl Sea {
             } else {
                 h.add_rect(lo, hi, f64::from(b.hi[2] + MARGIN_M));
             }
-        }
-        if !near.is_empty() {
-            let mut ground = self.fixed.clone();
-            for (id, b) in self.moving.iter().zip(&self.boxes) {
-                if !near.contains(id) {
-                    self.raster(&mut ground, b);
-                }
-            }
-            h.ground = Some(ground);
         }
         Some((h, near))
     }
@@ -386,14 +377,6 @@ impl Sea {
     #[inline(always)]
     pub fn path_clear(&self, o: [f32; 3], d: [f32; 3], t_end: f32, max_cells: usize) -> bool {
         self.walk(&self.heights, o, d, t_end, max_cells)
-    }
-
-    /// [`Sea::path_clear`] for a ray from the viewpoint of `h` over `h`'s ground map (the height map without the
-    /// instances standing over the viewpoint; the ray must be clear of their triangles:
-    /// [`Horizon::clear_of_near`]).
-    #[inline(always)]
-    pub fn path_clear_from(&self, h: &Horizon, o: [f32; 3], d: [f32; 3], t_end: f32, max_cells: usize) -> bool {
-        self.walk(h.ground.as_deref().unwrap_or(&self.heights), o, d, t_end, max_cells)
     }
 
     /// [`Sea::path_clear`] over the height map `heights` (this grid's shape).

@@ -2,10 +2,11 @@
 //! ([`Scene::occluded_rays`]) in parallel chunks over rayon.
 //!
 //! Each chunk prepares its rays (normalising directions, noting the first invalid one so the batch fails with an
-//! error naming it), lets the sea shortcuts settle what they can ([`crate::sea`]), and traces the rest as
-//! packets of [`PACKET`] coherent rays or one by one; both give each ray the same hit.
+//! error naming it), lets the sea shortcuts settle what they can ([`crate::sea`]: rays rising clear of
+//! everything, shadow rays from open water), and traces the rest as packets of [`PACKET`] coherent rays or one by
+//! one; both give each ray the same hit.
 
-use super::{Hit, RayHits, Scene, Scratch, SeaRoute, NO_HIT};
+use super::{Hit, RayHits, Scene, Scratch, NO_HIT};
 use crate::bvh::{Packet, PACKET};
 use crate::error::{MmusvError, Result};
 use crate::ray::{prepare_lanes, RayPrep};
@@ -129,7 +130,7 @@ impl ChunkOut<'_> {
 
 /// Whether the prepared rays are worth tracing as one packet (see [`COHERENT_RADIUS`], [`COHERENT_COS`]).
 #[inline(always)]
-pub(super) fn coherent(rays: &[RayPrep]) -> bool {
+fn coherent(rays: &[RayPrep]) -> bool {
     let Some(r0) = rays.first() else { return false };
     rays.len() > 1
         && rays.iter().all(|r| {
@@ -160,51 +161,26 @@ crate::dispatch! {
             }
             let Some(rays) = prepare(o, d, start, end, &mut bad) else { continue };
             let rays = &rays[..end - start];
-            let mut route = [SeaRoute::Trace; PACKET];
-            let mut all_traced = true;
+            let mut sky = [false; PACKET];
+            let mut any_sky = false;
             for (r, ray) in rays.iter().enumerate() {
-                route[r] = scene.sea_route(ray, limit, horizon);
-                all_traced &= route[r] == SeaRoute::Trace;
+                sky[r] = scene.sea_sky(ray, limit, horizon);
+                any_sky |= sky[r];
             }
-            if all_traced {
-                // Nothing for the sea shortcut (the usual case away from open water): trace the rays in place.
+            if !any_sky {
+                // Nothing for the sea shortcut: trace the rays in place.
                 trace_rest(lv, scene, rays, |j| start + j, limit, &mut scratch, &mut out);
                 continue;
             }
-            // Rays the sea shortcut settles are done (those it sends to the surface tested against the surface
-            // mesh alone, as one packet); the others are traced (as a packet when coherent).
+            // Rays the sea shortcut settles are misses; the others are traced (as a packet when coherent).
             let mut rest = [rays[0]; PACKET];
             let mut lane = [0usize; PACKET];
             let mut n = 0;
-            let mut water = [rays[0]; PACKET];
-            let mut water_lane = [0usize; PACKET];
-            let mut nw = 0;
             for (r, ray) in rays.iter().enumerate() {
-                match route[r] {
-                    SeaRoute::Surface => {
-                        water[nw] = *ray;
-                        water_lane[nw] = r;
-                        nw += 1;
-                    }
-                    SeaRoute::Sky => {}
-                    SeaRoute::Trace => {
-                        rest[n] = *ray;
-                        lane[n] = r;
-                        n += 1;
-                    }
-                }
-            }
-            if nw > 0 {
-                let hits = scene.sea_surface_hits(lv, &water[..nw], limit, &mut scratch);
-                for j in 0..nw {
-                    match &hits[j] {
-                        Some(hit) => out.hit(scene, start + water_lane[j], Vec3::from_array(water[j].d), hit),
-                        None => {
-                            rest[n] = water[j];
-                            lane[n] = water_lane[j];
-                            n += 1;
-                        }
-                    }
+                if !sky[r] {
+                    rest[n] = *ray;
+                    lane[n] = r;
+                    n += 1;
                 }
             }
             trace_rest(lv, scene, &rest[..n], |j| start + lane[j], limit, &mut scratch, &mut out);

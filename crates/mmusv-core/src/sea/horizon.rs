@@ -12,13 +12,9 @@
 //! moving instances by their world boxes, and, triangle by triangle, any moving instance whose box stands over
 //! `P` (a USV's own hull). A column standing over `P` and rising above it settles nothing. The triangles of those
 //! near instances mark, in a bitmap of azimuth × slope cells, every direction in which a ray from `P` can meet
-//! them (a sensor pod's roof hides only the steep slopes, the deck only the downward ones). Tops carry the
-//! height map's margin, distances lose a millimetre and slope bounds a relative 1e-5, so a settled ray passes
-//! clear of everything: the answer, a miss, is exactly the full trace's.
-//!
-//! The same bitmap serves the rays going down: a ray whose direction cell is free of the near triangles can
-//! only be stopped by the height map without the near instances ([`Horizon::ground`]), so the sea's walk over
-//! that map settles it as it would from open water.
+//! them among the rising directions (a sensor pod's roof hides only the steep slopes; a deck below the viewpoint
+//! hides none). Tops carry the height map's margin, distances lose a millimetre and slope bounds a relative
+//! 1e-5, so a settled ray passes clear of everything: the answer, a miss, is exactly the full trace's.
 
 /// Azimuth bins around the viewpoint.
 const BINS: usize = 2048;
@@ -101,14 +97,13 @@ pub struct Horizon {
     slope: Vec<f32>,
     /// Direction cells the triangles of the near instances may lie in: [`SLOPE_WORDS`] words of bits per
     /// azimuth bin, bit `e` for the slopes `s` with `(q + 1) / 2` in `[e, e + 1) / SLOPE_BINS`, where
-    /// `q = s / (1 + |s|)` (−1 straight down, 1 straight up).
+    /// `q = s / (1 + |s|)` (−1 straight down, 1 straight up). Only the rising half (`e ≥ SLOPE_BINS / 2`) is
+    /// marked and read.
     bands: Vec<u64>,
     /// Whether any band bit is set.
     any_bands: bool,
     /// A column stands over the viewpoint and rises above it: no rising ray is settled.
     covered: bool,
-    /// The height map without the near instances' boxes (their triangles are in `bands`), when there are any.
-    pub(super) ground: Option<Vec<f32>>,
 }
 
 /// Slope bins of [`Horizon::bands`] per azimuth bin.
@@ -125,7 +120,6 @@ impl Horizon {
             bands: vec![0; BINS * SLOPE_WORDS],
             any_bands: false,
             covered: false,
-            ground: None,
         }
     }
 
@@ -149,13 +143,6 @@ impl Horizon {
             return false;
         }
         !self.any_bands || self.band_free(bin, d, run)
-    }
-
-    /// Whether the direction cell of a ray from the viewpoint with unit direction `d` holds no triangle of the
-    /// near instances (then only the height map without them, [`Horizon::ground`], can stop the ray).
-    #[inline(always)]
-    pub fn clear_of_near(&self, d: [f32; 3]) -> bool {
-        !self.any_bands || self.band_free(azimuth_bin(d), d, (d[0] * d[0] + d[1] * d[1]).sqrt())
     }
 
     #[inline(always)]
@@ -210,8 +197,13 @@ impl Horizon {
             let q = if s.is_finite() { s / (1.0 + s.abs()) } else { s.signum() };
             ((q + 1.0) * (SLOPE_BINS / 2) as f64).floor() as i64 + widen
         };
-        let e0 = e(s_lo, -1).clamp(0, SLOPE_BINS as i64 - 1) as usize;
-        let e1 = e(s_hi, 1).clamp(0, SLOPE_BINS as i64 - 1) as usize;
+        // Only the rising half is ever read ([`Horizon::clear`]): a triangle wholly below it marks nothing.
+        let e1 = e(s_hi, 1).min(SLOPE_BINS as i64 - 1);
+        if e1 < (SLOPE_BINS / 2) as i64 {
+            return;
+        }
+        let e0 = e(s_lo, -1).clamp((SLOPE_BINS / 2) as i64, e1) as usize;
+        let e1 = e1 as usize;
         let mut mask = [0u64; SLOPE_WORDS];
         for (w, m) in mask.iter_mut().enumerate() {
             let (lo, hi) = (e0.max(64 * w), e1.min(64 * w + 63));
@@ -413,20 +405,25 @@ mod tests {
     }
 
     #[test]
-    fn a_deck_under_the_viewpoint_hides_only_the_steep_downward_rays() {
-        // A 2 m square deck 1 m below the eye: rays steeper than its far corner (slope -0.99 / 1.414) may meet it.
+    fn a_deck_under_the_viewpoint_hides_no_rising_ray() {
+        // A 2 m square deck 1 m below the eye marks no direction (only rising ones are ever asked about) ...
         let mut h = Horizon::new([0.0, 0.0, 2.0]);
         h.add_triangle([[-1.0, -1.0, 1.0], [1.0, -1.0, 1.0], [1.0, 1.0, 1.0]]);
         h.add_triangle([[-1.0, -1.0, 1.0], [1.0, 1.0, 1.0], [-1.0, 1.0, 1.0]]);
-        let down = |az: f32, slope: f32| {
+        assert!(!h.any_bands);
+        let dir = |az: f32, slope: f32| {
             let n = (1.0 + slope * slope).sqrt();
             [az.cos() / n, az.sin() / n, slope / n]
         };
         for az in [0.0f32, 0.8, 2.0, 3.1, 4.0, 5.5] {
-            assert!(!h.clear_of_near(down(az, -3.0)) && !h.clear_of_near([0.0, 0.0, -1.0]), "steep at {az}");
-            assert!(h.clear_of_near(down(az, -0.6)) && h.clear_of_near(down(az, -0.05)), "shallow at {az}");
-            assert!(h.clear(down(az, 0.1)), "rising at {az}: the deck is below");
+            assert!(h.clear(dir(az, 0.1)) && h.clear(dir(az, 0.0)), "rising at {az}: the deck is below");
+            assert!(!h.clear(dir(az, -0.1)), "a ray going down is never settled");
         }
+        // ... while a rail 1.5 m away reaching 0.2 m above the eye hides the rays rising less than 0.2 / 1.5 there.
+        h.add_triangle([[1.5, -0.5, 1.0], [1.5, 0.5, 1.0], [1.5, 0.0, 2.2]]);
+        assert!(h.any_bands);
+        assert!(!h.clear(dir(0.0, 0.0)) && !h.clear(dir(0.0, 0.1)) && h.clear(dir(0.0, 0.5)));
+        assert!(h.clear(dir(3.1, 0.0)), "behind the eye the rail hides nothing");
     }
 
     #[test]
