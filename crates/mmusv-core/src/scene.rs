@@ -794,7 +794,7 @@ mod tests {
             // The sun mask (one direction for the whole batch) settles most of the water points by itself.
             let unit = unit_direction(&sun);
             let mask = with.sea.as_ref().and_then(|sea| sea.sun_mask(unit));
-            let by_mask = so.iter().filter(|p| with.sun_clear(mask.as_deref(), &RayPrep::new(**p, unit))).count();
+            let by_mask = so.iter().filter(|p| with.sun_clear(mask.as_deref(), **p)).count();
             assert!(by_mask >= 6_000, "only {by_mask} shadow rays settled by the sun mask");
         }
         // A moving surface is no longer trusted; a tilted one is refused.
@@ -808,6 +808,25 @@ mod tests {
             .set_poses(&[1], &[RigidPose::from_xyz_rpy([0.0; 3], [0.1, 0.0, 0.0])])
             .unwrap_or_else(|e| unreachable!("{e}"));
         assert!(tilted.set_sea(1, &vessels).is_err());
+    }
+
+    /// With the sea declared and one sun direction (the sun mask settles rays from their origins alone), a bad
+    /// origin is still an error naming it, and the settled rays are those of the full trace.
+    #[test]
+    fn shadow_batches_with_a_sun_mask_name_bad_origins() {
+        let (mut s, vessels) = sea_world();
+        let full = s.clone();
+        s.set_sea(1, &vessels).unwrap_or_else(|e| unreachable!("{e}"));
+        let mut o: Vec<[f32; 3]> =
+            (0..2000).map(|k| [(k % 50) as f32 * 9.0 - 220.0, (k / 50) as f32 * 9.0 - 180.0, 0.05]).collect();
+        let sun = vec![[0.2f32, -0.4, 0.7]; o.len()];
+        let want = full.occluded_rays(&o, &sun, 5000.0).unwrap_or_default();
+        assert_eq!(s.occluded_rays(&o, &sun, 5000.0).ok(), Some(want));
+        for bad in [[f32::NAN, 0.0, 3.0], [10.0, f32::INFINITY, 3.0], [10.0, 0.0, f32::NAN]] {
+            o[1234] = bad;
+            let err = s.occluded_rays(&o, &sun, 5000.0).err().map(|e| e.to_string()).unwrap_or_default();
+            assert!(err.contains("origins[1234]"), "{bad:?}: {err}");
+        }
     }
 
     #[test]

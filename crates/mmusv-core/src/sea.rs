@@ -313,9 +313,14 @@ impl Sea {
             return false;
         }
         let d = mask.dir;
-        // From outside the grid, the rest of the ray is the ray from where it enters.
-        let Some((t0, _)) = self.grid_span(o, d, f32::INFINITY) else { return true }; // never over the grid
-        let (px, py) = (o[0] + d[0] * t0, o[1] + d[1] * t0);
+        let (gx1, gy1) = (self.x0 + self.nx as f32 * self.cell, self.y0 + self.ny as f32 * self.cell);
+        let (px, py) = if o[0] >= self.x0 && o[0] <= gx1 && o[1] >= self.y0 && o[1] <= gy1 {
+            (o[0], o[1]) // over the grid (what grid_span's entry at t = 0 gives, without its divisions)
+        } else {
+            // From outside the grid, the rest of the ray is the ray from where it enters.
+            let Some((t0, _)) = self.grid_span(o, d, f32::INFINITY) else { return true }; // never over the grid
+            (o[0] + d[0] * t0, o[1] + d[1] * t0)
+        };
         let gx = ((px - self.x0) / self.cell).floor().clamp(0.0, (self.nx - 1) as f32);
         let gy = ((py - self.y0) / self.cell).floor().clamp(0.0, (self.ny - 1) as f32);
         !mask.blocked[gy as usize * self.nx + gx as usize]

@@ -159,7 +159,7 @@ crate::dispatch! {
             for i in start..end {
                 out.miss(i);
             }
-            let Some(rays) = prepare(o, d, start, end, &mut bad) else { continue };
+            let Some(rays) = prepare(o, d, start..end, &mut bad) else { continue };
             let rays = &rays[..end - start];
             let mut sky = [false; PACKET];
             let mut any_sky = false;
@@ -234,16 +234,31 @@ crate::dispatch! {
         let mut bad = BadRays::default();
         for start in (0..o.len()).step_by(PACKET) {
             let end = (start + PACKET).min(o.len());
-            let Some(rays) = prepare(o, d, start, end, &mut bad) else { continue };
+            // Rays the sun mask settles need no preparation: it reads their origins alone (the direction is
+            // the batch's one, valid since it has a mask).
+            let mut todo = [0usize; PACKET];
+            let mut m = 0;
+            for i in start..end {
+                if scene.sun_clear(mask, o[i]) {
+                    out[i] = false;
+                } else {
+                    todo[m] = i;
+                    m += 1;
+                }
+            }
+            if m == 0 {
+                continue;
+            }
+            let Some(rays) = prepare(o, d, todo[..m].iter().copied(), &mut bad) else { continue };
             let mut rest = [rays[0]; PACKET];
             let mut lane = [0usize; PACKET];
             let mut n = 0;
-            for (r, ray) in rays[..end - start].iter().enumerate() {
-                if scene.sun_clear(mask, ray) || scene.sea_clear(ray, limit) {
-                    out[start + r] = false;
+            for (j, ray) in rays[..m].iter().enumerate() {
+                if scene.sea_clear(ray, limit) {
+                    out[todo[j]] = false;
                 } else {
                     rest[n] = *ray;
-                    lane[n] = r;
+                    lane[n] = todo[j];
                     n += 1;
                 }
             }
@@ -252,11 +267,11 @@ crate::dispatch! {
             if let Some(mut p) = packet {
                 scene.occluded_packet_with(lv, &mut p, &mut scratch);
                 for j in 0..n {
-                    out[start + lane[j]] = p.best[j] < 0.0;
+                    out[lane[j]] = p.best[j] < 0.0;
                 }
             } else {
                 for (j, ray) in rest.iter().enumerate() {
-                    out[start + lane[j]] = scene.occluded_prepared(lv, ray, limit, &mut scratch);
+                    out[lane[j]] = scene.occluded_prepared(lv, ray, limit, &mut scratch);
                 }
             }
         }
@@ -264,17 +279,23 @@ crate::dispatch! {
     }
 }
 
-/// Prepares rays `start..end` of a chunk (directions normalised), or records the first invalid origin and
-/// direction in `bad` and returns `None` (the batch then fails with an error naming the ray).
+/// Prepares the rays `idx` of a chunk (at most [`PACKET`]; directions normalised) as lanes `0..idx.len()`, or
+/// records the first invalid origin and direction in `bad` and returns `None` (the batch then fails with an
+/// error naming the ray).
 ///
 /// The arithmetic runs across the rays (lanes), so it vectorises; each ray gets exactly
 /// `RayPrep::new(o, unit_direction(d))` (the same correctly rounded operations in the same order).
 #[inline(always)]
-fn prepare(o: &[[f32; 3]], d: &[[f32; 3]], start: usize, end: usize, bad: &mut BadRays) -> Option<[RayPrep; PACKET]> {
-    let m = end - start;
+fn prepare(
+    o: &[[f32; 3]],
+    d: &[[f32; 3]],
+    idx: impl Iterator<Item = usize>,
+    bad: &mut BadRays,
+) -> Option<[RayPrep; PACKET]> {
     let mut ok = true;
     let mut dir = [[1f64; PACKET], [0f64; PACKET], [0f64; PACKET]];
-    for (j, i) in (start..end).enumerate() {
+    let mut origin = [[0f32; 3]; PACKET];
+    for (j, i) in idx.enumerate() {
         let (oi, di) = (&o[i], &d[i]);
         let bad_o = !(oi[0].is_finite() && oi[1].is_finite() && oi[2].is_finite());
         let bad_d = !(di[0].is_finite() && di[1].is_finite() && di[2].is_finite())
@@ -284,6 +305,7 @@ fn prepare(o: &[[f32; 3]], d: &[[f32; 3]], start: usize, end: usize, bad: &mut B
             ok = false;
             continue;
         }
+        origin[j] = *oi;
         for a in 0..3 {
             dir[a][j] = di[a] as f64;
         }
@@ -300,8 +322,6 @@ fn prepare(o: &[[f32; 3]], d: &[[f32; 3]], start: usize, end: usize, bad: &mut B
         u[1][j] = (y / n) as f32;
         u[2][j] = (z / n) as f32;
     }
-    let mut origin = [[0f32; 3]; PACKET];
-    origin[..m].copy_from_slice(&o[start..end]);
     Some(prepare_lanes(&origin, &u))
 }
 
@@ -401,7 +421,7 @@ mod tests {
             // Short packets too: every length from 1 to PACKET.
             let end = (start + 1 + (start / PACKET) % PACKET).min(o.len());
             let mut bad = BadRays::default();
-            let Some(rays) = prepare(&o, &d, start, end, &mut bad) else { unreachable!("valid rays") };
+            let Some(rays) = prepare(&o, &d, start..end, &mut bad) else { unreachable!("valid rays") };
             for (j, i) in (start..end).enumerate() {
                 assert_eq!(rays[j], RayPrep::new(o[i], unit_direction(&d[i])), "ray {i}: {:?} {:?}", o[i], d[i]);
             }
@@ -413,7 +433,7 @@ mod tests {
         let o = vec![[0.0; 3], [f32::NAN, 0.0, 0.0], [0.0; 3], [0.0; 3]];
         let d = vec![[1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0; 3], [f32::INFINITY, 0.0, 0.0]];
         let mut bad = BadRays::default();
-        assert!(prepare(&o, &d, 0, 4, &mut bad).is_none());
+        assert!(prepare(&o, &d, 0..4, &mut bad).is_none());
         assert_eq!((bad.origin, bad.direction), (Some(1), Some(2)));
     }
 }

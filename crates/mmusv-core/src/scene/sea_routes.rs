@@ -106,12 +106,12 @@ impl Scene {
         self.sea_clear_within(ray, limit, SEA_WALK_SHADOW)
     }
 
-    /// The sun-mask shortcut for an any-hit query: whether `ray` (with the direction `mask` was built for)
-    /// starts above the surface in a cell no occluder can shade.
+    /// The sun-mask shortcut for an any-hit query: whether a ray from `origin` (with the direction `mask` was
+    /// built for) starts above the surface in a cell no occluder can shade. `false` for a non-finite origin.
     #[inline(always)]
-    pub(super) fn sun_clear(&self, mask: Option<&SunMask>, ray: &RayPrep) -> bool {
+    pub(super) fn sun_clear(&self, mask: Option<&SunMask>, origin: [f32; 3]) -> bool {
         match (&self.sea, mask) {
-            (Some(sea), Some(mask)) => sea.sun_clear(mask, ray.o),
+            (Some(sea), Some(mask)) => origin.iter().all(|v| v.is_finite()) && sea.sun_clear(mask, origin),
             _ => false,
         }
     }
