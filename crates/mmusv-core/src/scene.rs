@@ -113,6 +113,7 @@ pub struct Scratch {
     bottom: Stack,
     packet_top: PacketStack,
     packet_bottom: PacketStack,
+    sub_packet: Packet,
 }
 
 /// Meshes, instances and the top-level BVH.
@@ -288,6 +289,7 @@ impl Scene {
             scene: self,
             scratch_single: &mut scratch.bottom,
             stack: &mut scratch.packet_bottom,
+            sub: &mut scratch.sub_packet,
             instance: [u32::MAX; PACKET],
             triangle: [u32::MAX; PACKET],
             any: false,
@@ -305,6 +307,7 @@ impl Scene {
             scene: self,
             scratch_single: &mut scratch.bottom,
             stack: &mut scratch.packet_bottom,
+            sub: &mut scratch.sub_packet,
             instance: [u32::MAX; PACKET],
             triangle: [u32::MAX; PACKET],
             any: true,
@@ -437,6 +440,8 @@ struct PacketInstances<'a, L> {
     scene: &'a Scene,
     scratch_single: &'a mut Stack,
     stack: &'a mut PacketStack,
+    /// The packet of a moved instance's rays in its frame (filled anew for each such instance).
+    sub: &'a mut Packet,
     instance: [u32; PACKET],
     triangle: [u32; PACKET],
     any: bool,
@@ -491,16 +496,16 @@ impl<L: Level> PacketVisit for PacketInstances<'_, L> {
                 lane[n] = r;
                 n += 1;
             }
-            let sub = if n > 1 { Packet::new(&local[..n], 0.0) } else { None };
-            if let Some(mut q) = sub {
+            let q = &mut *self.sub;
+            if n > 1 && q.fill(&local[..n], 0.0) {
                 for j in 0..n {
                     q.best[j] = p.best[lane[j]];
                 }
                 let mut tri = [u32::MAX; PACKET];
                 if self.any {
-                    mesh.any_packet(self.lv, &mut q, self.stack);
+                    mesh.any_packet(self.lv, q, self.stack);
                 } else {
-                    mesh.closest_packet(self.lv, &mut q, self.stack, &mut tri);
+                    mesh.closest_packet(self.lv, q, self.stack, &mut tri);
                 }
                 for j in 0..n {
                     let r = lane[j];

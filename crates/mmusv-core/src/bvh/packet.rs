@@ -16,7 +16,7 @@ use crate::ray::RayPrep;
 pub const PACKET: usize = 16;
 
 /// The rays of a packet: each ray prepared on its own, plus the packet's intervals.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Packet {
     /// Number of rays (the first `n` entries are used).
     pub n: usize,
@@ -45,44 +45,77 @@ pub struct Packet {
     inv_hi: [f32; 3],
 }
 
-impl Packet {
-    /// Builds a packet of the prepared rays `rays` (1 to [`PACKET`]) with range `t_max`, or `None` when their
-    /// directions do not share a sign on every axis (interval bounds would then be useless).
-    #[inline(always)]
-    pub fn new(rays: &[RayPrep], t_max: f32) -> Option<Self> {
-        let first = rays.first()?;
-        let near = first.near.map(usize::from);
-        if rays.len() > PACKET || rays.iter().any(|r| r.near != first.near) {
-            return None;
-        }
-        let mut p = Packet {
-            n: rays.len(),
-            ray: [*first; PACKET],
+impl Default for Packet {
+    /// An empty packet (no ray), to [`Packet::fill`].
+    fn default() -> Self {
+        let ray = RayPrep::new([0.0; 3], [1.0, 0.0, 0.0]);
+        Packet {
+            n: 0,
+            ray: [ray; PACKET],
             o: [[0.0; PACKET]; 3],
             d: [[1.0; PACKET]; 3],
             inv: [[1.0; PACKET]; 3],
             best: [-1.0; PACKET],
             shear: [[0.0; PACKET]; 2],
-            uniform_k: rays.iter().all(|r| r.k == first.k),
-            near,
+            uniform_k: true,
+            near: ray.near.map(usize::from),
             o_entry: [0.0; 3],
             o_exit: [0.0; 3],
             inv_lo: [0.0; 3],
             inv_hi: [0.0; 3],
-        };
+        }
+    }
+}
+
+impl Packet {
+    /// Builds a packet of the prepared rays `rays` (1 to [`PACKET`]) with range `t_max`, or `None` when their
+    /// directions do not share a sign on every axis (interval bounds would then be useless).
+    #[inline(always)]
+    pub fn new(rays: &[RayPrep], t_max: f32) -> Option<Self> {
+        let mut p = Self::default();
+        p.fill(rays, t_max).then_some(p)
+    }
+
+    /// [`Packet::new`] in place: makes `self` the packet of `rays` with range `t_max` (every field as `new`
+    /// sets it) and returns `true`, or returns `false` (leaving `self` unspecified) when the rays' directions do
+    /// not share a sign on every axis or there are none or too many. A packet reused across calls saves
+    /// building and copying a new one each time.
+    #[inline(always)]
+    pub fn fill(&mut self, rays: &[RayPrep], t_max: f32) -> bool {
+        let Some(first) = rays.first() else { return false };
+        if rays.len() > PACKET || rays.iter().any(|r| r.near != first.near) {
+            return false;
+        }
+        let near = first.near.map(usize::from);
+        self.n = rays.len();
+        self.uniform_k = rays.iter().all(|r| r.k == first.k);
+        self.near = near;
         let mut o_lo = first.o;
         let mut o_hi = first.o;
         let mut inv_lo = first.inv;
         let mut inv_hi = first.inv;
-        for (r, ray) in rays.iter().enumerate() {
-            p.ray[r] = *ray;
-            p.best[r] = t_max;
-            p.shear[0][r] = ray.s[0];
-            p.shear[1][r] = ray.s[1];
+        for r in 0..PACKET {
+            let Some(ray) = rays.get(r) else {
+                // Unused lanes: the first ray, finished (best < 0), neutral arrays.
+                self.ray[r] = *first;
+                self.best[r] = -1.0;
+                self.shear[0][r] = 0.0;
+                self.shear[1][r] = 0.0;
+                for a in 0..3 {
+                    self.o[a][r] = 0.0;
+                    self.d[a][r] = 1.0;
+                    self.inv[a][r] = 1.0;
+                }
+                continue;
+            };
+            self.ray[r] = *ray;
+            self.best[r] = t_max;
+            self.shear[0][r] = ray.s[0];
+            self.shear[1][r] = ray.s[1];
             for a in 0..3 {
-                p.o[a][r] = ray.o[a];
-                p.d[a][r] = ray.d[a];
-                p.inv[a][r] = ray.inv[a];
+                self.o[a][r] = ray.o[a];
+                self.d[a][r] = ray.d[a];
+                self.inv[a][r] = ray.inv[a];
                 o_lo[a] = o_lo[a].min(ray.o[a]);
                 o_hi[a] = o_hi[a].max(ray.o[a]);
                 inv_lo[a] = inv_lo[a].min(ray.inv[a]);
@@ -91,12 +124,12 @@ impl Packet {
         }
         for a in 0..3 {
             let neg = near[a] != a;
-            p.o_entry[a] = if neg { o_lo[a] } else { o_hi[a] };
-            p.o_exit[a] = if neg { o_hi[a] } else { o_lo[a] };
+            self.o_entry[a] = if neg { o_lo[a] } else { o_hi[a] };
+            self.o_exit[a] = if neg { o_hi[a] } else { o_lo[a] };
         }
-        p.inv_lo = inv_lo;
-        p.inv_hi = inv_hi;
-        Some(p)
+        self.inv_lo = inv_lo;
+        self.inv_hi = inv_hi;
+        true
     }
 
     /// Origins per axis and ray.
@@ -287,6 +320,34 @@ mod tests {
     use crate::bvh::box_entry;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
+
+    /// A packet refilled in place is the packet `new` builds: every field, the unused lanes included, after a
+    /// fuller packet of other rays; rays whose directions differ in sign make no packet.
+    #[test]
+    fn fill_in_place_equals_new() {
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let mut p = Packet::default();
+        for _ in 0..200 {
+            let n = rng.random_range(1..=PACKET);
+            let o = [rng.random_range(-5.0..5.0), rng.random_range(-5.0..5.0), rng.random_range(-5.0..5.0)];
+            let rays: Vec<RayPrep> = (0..n)
+                .map(|_| {
+                    let d: [f32; 3] =
+                        [rng.random_range(0.2..1.0), rng.random_range(-1.0..-0.2), rng.random_range(-0.3..0.3)];
+                    let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                    RayPrep::new(o, d.map(|x| x / l))
+                })
+                .collect();
+            let t = rng.random_range(1.0..100.0);
+            let mixed = rays.iter().any(|r| r.near != rays[0].near);
+            assert_eq!(p.fill(&rays, t), !mixed);
+            match Packet::new(&rays, t) {
+                Some(q) => assert_eq!(p, q),
+                None => assert!(mixed),
+            }
+        }
+        assert!(!p.fill(&[], 1.0), "no rays, no packet");
+    }
 
     /// The packet's box test gives every ray exactly the single-ray slab test's answer (rays with a negative best,
     /// finished or unused lanes, enter nothing), for boxes in front, behind, around and beside the rays.

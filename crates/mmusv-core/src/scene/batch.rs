@@ -152,6 +152,7 @@ crate::dispatch! {
         out: ChunkOut<'_>,
     ) -> BadRays {
         let mut scratch = Scratch::default();
+        let mut packet = Packet::default();
         let mut bad = BadRays::default();
         let mut out = out;
         for start in (0..o.len()).step_by(PACKET) {
@@ -169,7 +170,7 @@ crate::dispatch! {
             }
             if !any_sky {
                 // Nothing for the sea shortcut: trace the rays in place.
-                trace_rest(lv, scene, rays, |j| start + j, limit, &mut scratch, &mut out);
+                trace_rest(lv, scene, rays, |j| start + j, limit, &mut scratch, &mut packet, &mut out);
                 continue;
             }
             // Rays the sea shortcut settles are misses; the others are traced (as a packet when coherent).
@@ -183,7 +184,7 @@ crate::dispatch! {
                     n += 1;
                 }
             }
-            trace_rest(lv, scene, &rest[..n], |j| start + lane[j], limit, &mut scratch, &mut out);
+            trace_rest(lv, scene, &rest[..n], |j| start + lane[j], limit, &mut scratch, &mut packet, &mut out);
         }
         bad
     }
@@ -192,6 +193,7 @@ crate::dispatch! {
 /// Traces `rays` fully (as one packet when coherent, else one by one) and stores each hit at chunk index
 /// `at(j)` for ray `j`.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn trace_rest<L: Level>(
     lv: L,
     scene: &Scene,
@@ -199,11 +201,11 @@ fn trace_rest<L: Level>(
     at: impl Fn(usize) -> usize,
     limit: f32,
     scratch: &mut Scratch,
+    p: &mut Packet,
     out: &mut ChunkOut<'_>,
 ) {
-    let packet = if coherent(rays) { Packet::new(rays, limit) } else { None };
-    if let Some(mut p) = packet {
-        let (inst, tri) = scene.cast_packet_with(lv, &mut p, scratch);
+    if coherent(rays) && p.fill(rays, limit) {
+        let (inst, tri) = scene.cast_packet_with(lv, p, scratch);
         for (j, ray) in rays.iter().enumerate() {
             if inst[j] != u32::MAX {
                 let hit = Hit { distance: p.best[j], instance: inst[j], triangle: tri[j] };
@@ -231,6 +233,7 @@ crate::dispatch! {
         out: &mut [bool],
     ) -> BadRays {
         let mut scratch = Scratch::default();
+        let mut packet = Packet::default();
         let mut bad = BadRays::default();
         for start in (0..o.len()).step_by(PACKET) {
             let end = (start + PACKET).min(o.len());
@@ -263,11 +266,10 @@ crate::dispatch! {
                 }
             }
             let rest = &rest[..n];
-            let packet = if coherent(rest) { Packet::new(rest, limit) } else { None };
-            if let Some(mut p) = packet {
-                scene.occluded_packet_with(lv, &mut p, &mut scratch);
+            if coherent(rest) && packet.fill(rest, limit) {
+                scene.occluded_packet_with(lv, &mut packet, &mut scratch);
                 for j in 0..n {
-                    out[lane[j]] = p.best[j] < 0.0;
+                    out[lane[j]] = packet.best[j] < 0.0;
                 }
             } else {
                 for (j, ray) in rest.iter().enumerate() {
