@@ -251,13 +251,34 @@ mod tests {
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
-    /// Leaves hold spheres (centre, radius): the visitor intersects them exactly.
-    struct Spheres<'a> {
+    /// The leaf visitor of the tests: primitive `p` is hit at `t(p, ray)` (exactly, by the test's own formula).
+    struct Prims<'a, F> {
         bvh: &'a Bvh,
-        s: &'a [([f32; 3], f32)],
+        t: F,
         ray: RayPrep,
         hit: Option<u32>,
         leaves_visited: usize,
+    }
+
+    impl<'a, F: Fn(u32, &RayPrep) -> Option<f32>> Prims<'a, F> {
+        fn new(bvh: &'a Bvh, t: F, ray: RayPrep) -> Self {
+            Self { bvh, t, ray, hit: None, leaves_visited: 0 }
+        }
+    }
+
+    impl<F: Fn(u32, &RayPrep) -> Option<f32>> Visit for Prims<'_, F> {
+        fn leaf(&mut self, leaf: u32, mut best: f32) -> f32 {
+            self.leaves_visited += 1;
+            let lf = self.bvh.leaves()[leaf as usize];
+            for k in lf.start..lf.start + lf.count {
+                let p = self.bvh.order()[k as usize];
+                if let Some(t) = (self.t)(p, &self.ray).filter(|&t| t < best) {
+                    best = t;
+                    self.hit = Some(p);
+                }
+            }
+            best
+        }
     }
 
     fn sphere_t(c: [f32; 3], r: f32, ray: &RayPrep) -> Option<f32> {
@@ -270,24 +291,6 @@ mod tests {
         }
         let t = -b - disc.sqrt();
         (t > 0.0).then_some(t)
-    }
-
-    impl Visit for Spheres<'_> {
-        fn leaf(&mut self, leaf: u32, mut best: f32) -> f32 {
-            self.leaves_visited += 1;
-            let lf = self.bvh.leaves()[leaf as usize];
-            for k in lf.start..lf.start + lf.count {
-                let p = self.bvh.order()[k as usize];
-                let (c, r) = self.s[p as usize];
-                if let Some(t) = sphere_t(c, r, &self.ray) {
-                    if t < best {
-                        best = t;
-                        self.hit = Some(p);
-                    }
-                }
-            }
-            best
-        }
     }
 
     #[test]
@@ -304,6 +307,7 @@ mod tests {
             .map(|&(c, r)| Box3 { lo: [c[0] - r, c[1] - r, c[2] - r], hi: [c[0] + r, c[1] + r, c[2] + r] })
             .collect();
         let bvh = Bvh::new(&boxes, 4);
+        let sphere_at = |p: u32, ray: &RayPrep| sphere_t(spheres[p as usize].0, spheres[p as usize].1, ray);
         let mut stack = Stack::default();
         let mut hits = 0;
         let mut visited = 0;
@@ -325,7 +329,7 @@ mod tests {
                 .enumerate()
                 .filter_map(|(i, &(c, r))| sphere_t(c, r, &ray).filter(|&t| t < 100.0).map(|t| (t, i as u32)))
                 .min_by(|a, b| a.0.total_cmp(&b.0));
-            let mut v = Spheres { bvh: &bvh, s: &spheres, ray, hit: None, leaves_visited: 0 };
+            let mut v = Prims::new(&bvh, sphere_at, ray);
             let best = bvh.closest(&ray, 100.0, &mut stack, &mut v);
             visited += v.leaves_visited;
             match brute {
@@ -336,7 +340,7 @@ mod tests {
                 }
                 None => assert!(v.hit.is_none() && best == 100.0),
             }
-            let mut v = Spheres { bvh: &bvh, s: &spheres, ray, hit: None, leaves_visited: 0 };
+            let mut v = Prims::new(&bvh, sphere_at, ray);
             assert_eq!(bvh.any(&ray, 100.0, &mut stack, &mut v), brute.is_some());
         }
         assert!(hits > 500, "{hits}");
@@ -344,15 +348,7 @@ mod tests {
         assert!(visited < 3000 * 40, "{visited} leaves visited");
     }
 
-    /// Leaves hold boxes; a ray hits a box where it enters it (origins lie outside every box).
-    struct Boxes<'a> {
-        bvh: &'a Bvh,
-        b: &'a [Box3],
-        ray: RayPrep,
-        hit: Option<u32>,
-        leaves_visited: usize,
-    }
-
+    /// Where a ray from outside box `b` enters it.
     fn box_t(b: &Box3, ray: &RayPrep) -> Option<f32> {
         let (mut t0, mut t1) = (0f32, f32::INFINITY);
         for a in 0..3 {
@@ -361,21 +357,6 @@ mod tests {
             t1 = t1.min(lo.max(hi));
         }
         (t0 <= t1 && t0 > 0.0).then_some(t0)
-    }
-
-    impl Visit for Boxes<'_> {
-        fn leaf(&mut self, leaf: u32, mut best: f32) -> f32 {
-            self.leaves_visited += 1;
-            let lf = self.bvh.leaves()[leaf as usize];
-            for k in lf.start..lf.start + lf.count {
-                let p = self.bvh.order()[k as usize];
-                if let Some(t) = box_t(&self.b[p as usize], &self.ray).filter(|&t| t < best) {
-                    best = t;
-                    self.hit = Some(p);
-                }
-            }
-            best
-        }
     }
 
     /// A flat sheet over the whole map (a water plane) above a grid of small boxes (a seabed) with a few tall
@@ -417,7 +398,7 @@ mod tests {
             let brute = (0..boxes.len())
                 .filter_map(|i| box_t(&boxes[i], &ray).map(|t| (t, i as u32)))
                 .min_by(|a, b| a.0.total_cmp(&b.0));
-            let mut v = Boxes { bvh: &bvh, b: &boxes, ray, hit: None, leaves_visited: 0 };
+            let mut v = Prims::new(&bvh, |p, ray: &RayPrep| box_t(&boxes[p as usize], ray), ray);
             let best = bvh.closest(&ray, 1e4, &mut stack, &mut v);
             assert_eq!(v.hit, Some(sheet));
             assert_eq!(brute, Some((best, sheet)));
