@@ -157,12 +157,10 @@ impl Sea {
         let mut grid = self.fixed.clone();
         self.contained = true;
         self.boxes.clear();
+        let [gx1, gy1] = self.grid_far_corner();
         for b in moving_boxes {
             self.boxes.push(b);
-            let inside = b.lo[0] >= self.x0
-                && b.lo[1] >= self.y0
-                && b.hi[0] <= self.x0 + self.nx as f32 * self.cell
-                && b.hi[1] <= self.y0 + self.ny as f32 * self.cell;
+            let inside = b.lo[0] >= self.x0 && b.lo[1] >= self.y0 && b.hi[0] <= gx1 && b.hi[1] <= gy1;
             self.contained &= inside;
             self.raster(&mut grid, &b);
         }
@@ -313,7 +311,7 @@ impl Sea {
             return false;
         }
         let d = mask.dir;
-        let (gx1, gy1) = (self.x0 + self.nx as f32 * self.cell, self.y0 + self.ny as f32 * self.cell);
+        let [gx1, gy1] = self.grid_far_corner();
         let (px, py) = if o[0] >= self.x0 && o[0] <= gx1 && o[1] >= self.y0 && o[1] <= gy1 {
             (o[0], o[1]) // over the grid (what grid_span's entry at t = 0 gives, without its divisions)
         } else {
@@ -349,11 +347,17 @@ impl Sea {
         (x, y)
     }
 
+    /// The upper corner (world x, y) of the grid rectangle; the lower one is `(x0, y0)`.
+    #[inline(always)]
+    fn grid_far_corner(&self) -> [f32; 2] {
+        [self.x0 + self.nx as f32 * self.cell, self.y0 + self.ny as f32 * self.cell]
+    }
+
     /// The part `[t0, t1]` of the segment `o + t·d`, `t ∈ [0, t_end]`, that lies over the grid rectangle
     /// (horizontally), or `None` when none of it does.
     #[inline(always)]
     fn grid_span(&self, o: [f32; 3], d: [f32; 3], t_end: f32) -> Option<(f32, f32)> {
-        let (gx1, gy1) = (self.x0 + self.nx as f32 * self.cell, self.y0 + self.ny as f32 * self.cell);
+        let [gx1, gy1] = self.grid_far_corner();
         let mut t0 = 0f32;
         let mut t1 = t_end;
         for (oa, da, lo, hi) in [(o[0], d[0], self.x0, gx1), (o[1], d[1], self.y0, gy1)] {
