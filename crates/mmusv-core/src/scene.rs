@@ -549,4 +549,4 @@ pub struct WorldMesh {
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

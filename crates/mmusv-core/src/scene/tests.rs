@@ -6,7 +6,8 @@ use super::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-fn box_mesh(half: [f32; 3]) -> Mesh {
+/// A box of half extents `half` centred on the origin, every face of class `class`, outward normals.
+pub(crate) fn box_mesh(half: [f32; 3], class: u16) -> Mesh {
     let [a, b, c] = half;
     let v = [[-a, -b, -c], [a, -b, -c], [a, b, -c], [-a, b, -c], [-a, -b, c], [a, -b, c], [a, b, c], [-a, b, c]];
     let f = [
@@ -23,13 +24,13 @@ fn box_mesh(half: [f32; 3]) -> Mesh {
         [3, 0, 4],
         [3, 4, 7],
     ];
-    Mesh::new("box", &v, &f, &[9]).unwrap_or_else(|e| unreachable!("{e}"))
+    Mesh::new("box", &v, &f, &[class]).unwrap_or_else(|e| unreachable!("{e}"))
 }
 
 #[test]
 fn analytic_box_hit_and_backface() {
     let mut s = Scene::new();
-    let m = s.add_mesh(box_mesh([2.0, 1.0, 0.5]));
+    let m = s.add_mesh(box_mesh([2.0, 1.0, 0.5], 9));
     let pose = RigidPose::from_xyz_rpy([10.0, 0.0, 0.0], [0.0, 0.0, 0.0]);
     let id = s.add_instance(m, pose, None).unwrap_or(99);
     let hits = s.cast_rays(&[[0.0, 0.0, 0.0], [10.0, 0.0, 0.0]], &[[3.0, 0.0, 0.0], [1.0, 0.0, 0.0]], 100.0);
@@ -81,7 +82,7 @@ fn instance_pose_equals_pretransformed_mesh() {
 #[test]
 fn bad_rays_and_ids_are_errors_not_panics() {
     let mut s = Scene::new();
-    let m = s.add_mesh(box_mesh([1.0, 1.0, 1.0]));
+    let m = s.add_mesh(box_mesh([1.0, 1.0, 1.0], 9));
     assert!(matches!(s.add_instance(m + 1, RigidPose::IDENTITY, None), Err(MmusvError::UnknownId { .. })));
     assert!(s.set_poses(&[3], &[RigidPose::IDENTITY]).is_err());
     assert!(s.cast_rays(&[[0.0; 3]], &[[0.0; 3]], 10.0).is_err());
@@ -99,7 +100,7 @@ fn batch_matches_single_rays_and_brute_force() {
     let (v, f) = crate::mesh::tests::random_soup(&mut rng, 300);
     let mut s = Scene::new();
     let soup = s.add_mesh(Mesh::new("soup", &v, &f, &[2]).unwrap_or_else(|e| unreachable!("{e}")));
-    let boxm = s.add_mesh(box_mesh([1.5, 0.7, 0.5]));
+    let boxm = s.add_mesh(box_mesh([1.5, 0.7, 0.5], 9));
     let _ = s.add_instance(soup, RigidPose::from_xyz_rpy([0.0, 0.0, -3.0], [0.1, 0.0, 0.4]), None);
     for k in 0..12 {
         let a = k as f64 * 0.5;
@@ -146,7 +147,7 @@ fn batch_matches_single_rays_and_brute_force() {
 #[test]
 fn max_range_is_honoured() {
     let mut s = Scene::new();
-    let m = s.add_mesh(box_mesh([1.0, 1.0, 1.0]));
+    let m = s.add_mesh(box_mesh([1.0, 1.0, 1.0], 9));
     let _ = s.add_instance(m, RigidPose::from_xyz_rpy([10.0, 0.0, 0.0], [0.0; 3]), None);
     let h = s.cast_rays(&[[0.0; 3]], &[[1.0, 0.0, 0.0]], 8.5).unwrap_or_default();
     assert_eq!(h.instance[0], NO_HIT);
@@ -182,20 +183,26 @@ fn sensor_rays(rng: &mut ChaCha8Rng, n: usize) -> (Vec<[f32; 3]>, Vec<[f32; 3]>)
     (o, d)
 }
 
+/// Moves the vessels to random places within 200 m of the origin, random headings, at height, roll and pitch
+/// `[z, roll, pitch]`.
+fn scatter(s: &mut Scene, vessels: &[u32], rng: &mut ChaCha8Rng, [z, roll, pitch]: [f64; 3]) {
+    let poses: Vec<RigidPose> = vessels
+        .iter()
+        .map(|_| {
+            let (x, y) = (rng.random_range(-200.0..200.0), rng.random_range(-200.0..200.0));
+            RigidPose::from_xyz_rpy([x, y, z], [roll, pitch, rng.random_range(0.0..std::f64::consts::TAU)])
+        })
+        .collect();
+    s.set_poses(vessels, &poses).unwrap_or_else(|e| unreachable!("{e}"));
+}
+
 #[test]
 fn sea_shortcuts_give_exactly_the_full_trace() {
     let (mut s, vessels) = sea_world();
     let mut rng = ChaCha8Rng::seed_from_u64(21);
     for frame in 0..3 {
         // Move the vessels (the height map follows their boxes), then compare with and without the sea.
-        let poses: Vec<RigidPose> = vessels
-            .iter()
-            .map(|_| {
-                let (x, y) = (rng.random_range(-200.0..200.0), rng.random_range(-200.0..200.0));
-                RigidPose::from_xyz_rpy([x, y, 0.3], [0.02, -0.03, rng.random_range(0.0..std::f64::consts::TAU)])
-            })
-            .collect();
-        s.set_poses(&vessels, &poses).unwrap_or_else(|e| unreachable!("{e}"));
+        scatter(&mut s, &vessels, &mut rng, [0.3, 0.02, -0.03]);
         let mut with = s.clone();
         with.set_sea(1, &vessels).unwrap_or_else(|e| unreachable!("{e}"));
         let (o, d) = sensor_rays(&mut rng, 20_000);
@@ -282,14 +289,7 @@ fn shadow_batches_with_a_sun_mask_name_bad_origins() {
 fn horizons_of_one_origin_batches_give_exactly_the_full_trace() {
     let (mut s, vessels) = sea_world();
     let mut rng = ChaCha8Rng::seed_from_u64(5);
-    let poses: Vec<RigidPose> = vessels
-        .iter()
-        .map(|_| {
-            let (x, y) = (rng.random_range(-200.0..200.0), rng.random_range(-200.0..200.0));
-            RigidPose::from_xyz_rpy([x, y, 0.2], [0.03, -0.02, rng.random_range(0.0..std::f64::consts::TAU)])
-        })
-        .collect();
-    s.set_poses(&vessels, &poses).unwrap_or_else(|e| unreachable!("{e}"));
+    scatter(&mut s, &vessels, &mut rng, [0.2, 0.03, -0.02]);
     let mut with = s.clone();
     with.set_sea(1, &vessels).unwrap_or_else(|e| unreachable!("{e}"));
     // Viewpoints: over open water, on (and in) the vessels' boxes as a USV's cameras are, high above all.

@@ -2,26 +2,7 @@
 
 use super::*;
 use crate::mesh::Mesh;
-
-fn box_mesh(half: [f32; 3], class: u16) -> Mesh {
-    let [a, b, c] = half;
-    let v = [[-a, -b, -c], [a, -b, -c], [a, b, -c], [-a, b, -c], [-a, -b, c], [a, -b, c], [a, b, c], [-a, b, c]];
-    let f = [
-        [0, 2, 1],
-        [0, 3, 2],
-        [4, 5, 6],
-        [4, 6, 7],
-        [0, 1, 5],
-        [0, 5, 4],
-        [1, 2, 6],
-        [1, 6, 5],
-        [2, 3, 7],
-        [2, 7, 6],
-        [3, 0, 4],
-        [3, 4, 7],
-    ];
-    Mesh::new("box", &v, &f, &[class]).unwrap_or_else(|e| unreachable!("{e}"))
-}
+use crate::scene::tests::box_mesh;
 
 /// A sea plane (instance 0) and a 10 m cube (instance 1) whose near face is at `range` and `bearing`
 /// (world frame, from the origin), standing on the water.
