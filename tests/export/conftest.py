@@ -4,7 +4,8 @@
   ``usv_b`` heading towards the tug, so both LiDARs see the tug; a speedboat crosses nearby; 3 frames;
 * ``port`` — the bundled ``port_entry`` scenario (3 USVs, moored ships) with small sensors, 3 frames;
 * ``short`` — ``coop`` renamed, stopped after 2 of its 3 frames (its ``run`` metadata says so);
-* ``many`` — five 2-frame variants of ``coop`` (names and seeds differ) for the splits.
+* ``many`` — five 2-frame variants of ``coop`` (names and seeds differ) for the splits;
+* ``no_camera`` / ``no_lidar`` — ``coop`` for 1 frame with a rig without cameras / without LiDAR (bad input).
 """
 
 from __future__ import annotations
@@ -113,3 +114,23 @@ def many_recs(tmp_path_factory: pytest.TempPathFactory) -> list[Path]:
         cfg["acquisition"] = {"frequency_hz": 5, "frames": 2}
         out.append(_run(cfg, root / f"seq_{i}"))
     return out
+
+
+def _one_frame(name: str, rig: dict[str, Any]) -> dict[str, Any]:
+    cfg = coop(name=name)
+    cfg["acquisition"] = {"frequency_hz": 5, "frames": 1}
+    cfg["rigs"] = {"r": rig}
+    return cfg
+
+
+@pytest.fixture(scope="session")
+def no_camera_rec(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    rig = {**small_rig(), "cameras": [], "top_view": None}
+    return _run(_one_frame("export_no_camera", rig), tmp_path_factory.mktemp("no_camera"))
+
+
+@pytest.fixture(scope="session")
+def no_lidar_rec(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    rig = {**small_rig(), "lidar": None, "radar": None, "top_view": None}
+    rig["cameras"] = rig["cameras"][:1]
+    return _run(_one_frame("export_no_lidar", rig), tmp_path_factory.mktemp("no_lidar"))

@@ -45,8 +45,8 @@ def test_missing_and_non_mcap_inputs(tmp_path: Path) -> None:
 
 
 def test_bad_options(coop_rec: Path, tmp_path: Path) -> None:
-    with pytest.raises(ConfigError, match="unknown target 'coco'"):
-        convert(coop_rec, to="coco", out_dir=tmp_path / "o")
+    with pytest.raises(ConfigError, match="unknown target 'pascal'"):
+        convert(coop_rec, to="pascal", out_dir=tmp_path / "o")
     with pytest.raises(ConfigError, match="unknown extra"):
         convert(coop_rec, out_dir=tmp_path / "o", extras=("depth", "lidar2"))
     with pytest.raises(ConfigError, match="eval_range_m"):
@@ -60,7 +60,7 @@ def test_bad_options(coop_rec: Path, tmp_path: Path) -> None:
 
 def test_cli_errors_are_one_line(coop_rec: Path, tmp_path: Path) -> None:
     for argv, kind in (
-        ([str(coop_rec), "--to", "coco", "-o", str(tmp_path / "o")], ConfigError),
+        ([str(coop_rec), "--to", "pascal", "-o", str(tmp_path / "o")], ConfigError),
         ([str(tmp_path / "missing.mcap"), "-o", str(tmp_path / "o")], IoError),
         ([str(coop_rec), "-o", str(tmp_path / "o"), "--extras", "depth,nope"], ConfigError),
         ([str(coop_rec), "-o", str(tmp_path / "o"), "--split", "1,2"], ConfigError),

@@ -1,5 +1,5 @@
-"""``mmusv convert REC.mcap [REC ...] --to opv2v|kitti -o DIR``: the command-line face of
-:func:`mmusv.export.convert`.
+"""``mmusv convert REC.mcap [REC ...] --to opv2v|kitti|ros2|coco|yolo|mastr|semantickitti -o DIR``: the
+command-line face of :func:`mmusv.export.convert`.
 
 :func:`add_parser` adds the subcommand to the ``mmusv`` argparse sub-parsers and :func:`run` executes it (a rich
 progress bar, then one line per recording and the totals). Bad input raises :class:`mmusv.errors.MmusvError`,
@@ -23,9 +23,11 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
 
     p: argparse.ArgumentParser = subparsers.add_parser(
         "convert",
-        help="convert recordings into an OPV2V (or KITTI-style) dataset",
-        description="Converts mmusv recordings into the OPV2V layout (CARLA frame, per-agent folders) or KITTI-style "
-        "per-agent folders, split into train/validate/test by recording with a fixed seed.",
+        help="convert recordings into a dataset: OPV2V, KITTI, ROS 2 bags, COCO, YOLO, MaSTr or SemanticKITTI",
+        description="Converts mmusv recordings into the OPV2V layout (CARLA frame, per-agent folders), KITTI-style "
+        "per-agent folders, rosbag2 folders (one per recording), COCO or YOLO 2D detection sets, MaSTr1325-style "
+        "obstacle/water/sky masks or SemanticKITTI LiDAR scans and labels, split into train/validate/test by "
+        "recording with a fixed seed (docs/exports.md).",
     )
     p.add_argument(
         "recordings",
@@ -33,7 +35,12 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         help=".mcap files written by mmusv run (.mcap.partial accepted), .parts.json of split recordings, or "
         "batch output folders (their dataset.json)",
     )
-    p.add_argument("--to", default="opv2v", help="target layout: opv2v (default) or kitti")
+    p.add_argument(
+        "--to",
+        default="opv2v",
+        help="target layout: opv2v (default), kitti, ros2 (rosbag2 folders, never split), coco, yolo, mastr or "
+        "semantickitti",
+    )
     p.add_argument("-o", "--output", required=True, help="output folder")
     g = p.add_mutually_exclusive_group()
     g.add_argument(
@@ -59,6 +66,18 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         help=f"extra files, comma-separated from {','.join(EXTRAS)}; empty for none "
         f"(default {','.join(DEFAULT_EXTRAS)})",
     )
+    p.add_argument(
+        "--min-box-px",
+        type=float,
+        default=0.0,
+        help="coco, yolo: leave out 2D boxes whose shorter side is under this many pixels (default 0)",
+    )
+    p.add_argument(
+        "--max-occlusion",
+        type=float,
+        default=1.0,
+        help="coco, yolo: leave out 2D boxes hidden by more than this fraction, 0..1 (default 1: keep all)",
+    )
     p.add_argument("--overwrite", action="store_true", help="replace a previous conversion in the output folder")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     return p
@@ -83,6 +102,8 @@ def run(args: argparse.Namespace) -> int:
         "eval_range_m": args.range_m,
         "include_usvs": args.include_usvs,
         "extras": args.extras,
+        "min_box_px": args.min_box_px,
+        "max_occlusion": args.max_occlusion,
         "overwrite": args.overwrite,
     }
     if args.no_progress:

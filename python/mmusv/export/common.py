@@ -30,7 +30,7 @@ __all__ = [
     "rounded",
 ]
 
-TARGETS = ("opv2v", "kitti")
+TARGETS = ("opv2v", "kitti", "ros2", "coco", "yolo", "mastr", "semantickitti")
 EXTRAS = ("depth", "semantic", "instance", "radar", "top_view")
 DEFAULT_EXTRAS = ("depth", "semantic", "radar", "top_view")
 CAV_ID_BASE = 1000
@@ -64,6 +64,10 @@ class Options:
     eval_range_m: float = 200.0
     include_usvs: bool = False
     extras: tuple[str, ...] = DEFAULT_EXTRAS
+    min_box_px: float = 0.0
+    """COCO/YOLO: 2D boxes whose shorter side is under this many pixels are left out."""
+    max_occlusion: float = 1.0
+    """COCO/YOLO: 2D boxes whose occlusion (fraction hidden, 0..1) is above this are left out."""
 
 
 @dataclass
@@ -78,6 +82,11 @@ class Sink:
         path.write_bytes(data)
         self.files += 1
         self.bytes += len(data)
+
+    def count(self, path: Path) -> None:
+        """Counts a file another library wrote."""
+        self.files += 1
+        self.bytes += path.stat().st_size
 
     def mkdir(self, path: Path) -> Path:
         if not path.exists():

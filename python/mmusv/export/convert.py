@@ -1,10 +1,16 @@
-"""``convert``: recordings → an OPV2V (or KITTI-style) dataset folder, optionally split by sequence.
+"""``convert``: recordings → a dataset folder in one of the formats of :data:`~mmusv.export.common.TARGETS`,
+optionally split by sequence.
 
-Output root ``out_dir``: ``{train,validate,test}/<scenario>/...`` (or ``<scenario>/...`` with ``splits=None``)
-plus ``conversion.yaml`` (options, sources, split of every recording, frames converted and skipped; no times
-or absolute paths, so two conversions of the same input are byte-identical). ``conversion.yaml`` is written
-first with ``status: in_progress`` and rewritten at the end; an existing ``out_dir`` is replaced only with
-``overwrite`` and only when it is empty or holds a previous conversion (its ``conversion.yaml``).
+One job for every format: it reads and validates every recording (:mod:`mmusv.recording.reader`), splits them by
+sequence (:mod:`mmusv.export.splits`), selects the complete frames, reports progress and skipped frames, and hands
+each complete frame to the format's :class:`~mmusv.export.writer.DatasetWriter`. Output root ``out_dir``:
+``{train,validate,test}/<scenario>/...`` (or ``<scenario>/...`` with ``splits=None``) for the formats with one
+folder per recording (OPV2V, KITTI, MaSTr; ROS 2 bags, never split), the format's own layout for the others (COCO,
+YOLO, SemanticKITTI: see their modules), plus ``conversion.yaml`` (options, sources, split of every recording,
+frames converted and skipped; no times or absolute paths, so two conversions of the same input are
+byte-identical). ``conversion.yaml`` is written first with ``status: in_progress`` and rewritten at the end; an
+existing ``out_dir`` is replaced only with ``overwrite`` and only when it is empty or holds a previous conversion
+(its ``conversion.yaml``).
 """
 
 from __future__ import annotations
@@ -21,15 +27,46 @@ import yaml
 
 from mmusv.errors import ConfigError, IoError
 from mmusv.export.common import DEFAULT_EXTRAS, TARGETS, Options, Sink, dump_yaml, parse_extras
-from mmusv.export.kitti import KittiWriter
-from mmusv.export.opv2v import Opv2vWriter
-from mmusv.export.splits import SPLIT_NAMES, assign_splits, parse_ratios
+from mmusv.export.splits import DEFAULT_RATIOS, SPLIT_NAMES, assign_splits, parse_ratios
 from mmusv.export.writer import DatasetWriter
 from mmusv.recording.reader import FrameStream, RecordingInfo, read_info
 
-__all__ = ["REPORT_NAME", "ConvertReport", "RecordingReport", "convert"]
+__all__ = ["REPORT_NAME", "ConvertReport", "RecordingReport", "convert", "writer_class"]
 
 REPORT_NAME = "conversion.yaml"
+
+
+def writer_class(to: str) -> type[DatasetWriter]:
+    """The writer of format ``to`` (one of :data:`~mmusv.export.common.TARGETS`)."""
+    if to == "opv2v":
+        from mmusv.export.opv2v import Opv2vWriter
+
+        return Opv2vWriter
+    if to == "kitti":
+        from mmusv.export.kitti import KittiWriter
+
+        return KittiWriter
+    if to == "ros2":
+        from mmusv.export.ros2 import Ros2Writer
+
+        return Ros2Writer
+    if to == "coco":
+        from mmusv.export.coco import CocoWriter
+
+        return CocoWriter
+    if to == "yolo":
+        from mmusv.export.yolo import YoloWriter
+
+        return YoloWriter
+    if to == "mastr":
+        from mmusv.export.mastr import MastrWriter
+
+        return MastrWriter
+    if to == "semantickitti":
+        from mmusv.export.semantickitti import SemanticKittiWriter
+
+        return SemanticKittiWriter
+    raise ConfigError(f"unknown target {to!r}; allowed: {', '.join(TARGETS)}")
 
 
 @dataclass
@@ -167,16 +204,32 @@ def _folders(infos: list[RecordingInfo]) -> list[str]:
     return [n if names.count(n) == 1 else k for n, k in zip(names, keys, strict=True)]
 
 
+def _box_filter(min_box_px: Any, max_occlusion: Any) -> tuple[float, float]:
+    try:
+        px, occ = float(min_box_px), float(max_occlusion)
+    except (TypeError, ValueError):
+        raise ConfigError(
+            f"min_box_px = {min_box_px!r}, max_occlusion = {max_occlusion!r}: must be numbers (pixels, fraction)"
+        ) from None
+    if not (math.isfinite(px) and px >= 0):
+        raise ConfigError(f"min_box_px = {min_box_px!r}: must be a finite number of pixels >= 0")
+    if not (math.isfinite(occ) and 0 <= occ <= 1):
+        raise ConfigError(f"max_occlusion = {max_occlusion!r}: must be a fraction in [0, 1]")
+    return px, occ
+
+
 def convert(
     recordings: str | Path | Iterable[str | Path],
     *,
     to: str = "opv2v",
     out_dir: str | Path,
-    splits: Sequence[float] | str | None = (0.7, 0.15, 0.15),
+    splits: Sequence[float] | str | None = DEFAULT_RATIOS,
     seed: int = 0,
     eval_range_m: float = 200.0,
     include_usvs: bool = False,
     extras: Iterable[str] | str | None = DEFAULT_EXTRAS,
+    min_box_px: float = 0.0,
+    max_occlusion: float = 1.0,
     overwrite: bool = False,
     progress: Callable[[int, int], None] | None = None,
 ) -> ConvertReport:
@@ -187,14 +240,18 @@ def convert(
             complete frames are converted, the rest reported as skipped), parts manifests of recordings split
             into frame ranges (read as one sequence), or folders holding a ``dataset.json`` (their complete
             recordings).
-        to: ``"opv2v"`` or ``"kitti"``.
+        to: one of :data:`~mmusv.export.common.TARGETS`: ``"opv2v"``, ``"kitti"``, ``"ros2"`` (a rosbag2 folder
+            per recording), ``"coco"``, ``"yolo"``, ``"mastr"``, ``"semantickitti"`` (``docs/exports.md``).
         splits: ``(train, validate, test)`` fractions (split per recording, shuffled with ``seed``) or ``None``
-            for one folder of scenarios.
+            for one folder of scenarios. ROS 2 bags are never split: with ``to="ros2"`` only the default or
+            ``None`` is accepted.
         eval_range_m: targets are vessels whose box centre lies within ``eval_range_m`` of the agent's LiDAR in
             bird's-eye view (:func:`mmusv.annotate.in_target_range`).
         include_usvs: list the other USVs as targets too (default: only non-instrumented vessels).
-        extras: any of ``depth``, ``semantic``, ``instance``, ``radar``, ``top_view`` (extra files stock loaders
-            skip).
+        extras: any of ``depth``, ``semantic``, ``instance``, ``radar``, ``top_view`` (OPV2V and KITTI: extra
+            files stock loaders skip).
+        min_box_px: COCO and YOLO: leave out 2D boxes whose shorter side is under this many pixels.
+        max_occlusion: COCO and YOLO: leave out 2D boxes hidden by more than this fraction (0..1).
         overwrite: replace a previous conversion in ``out_dir``.
         progress: called with (frames done, frames expected) after every frame.
 
@@ -202,8 +259,7 @@ def convert(
         ConfigError: bad options. IoError: missing, unreadable or non-MCAP recordings; an existing output.
     """
     t0 = time.perf_counter()
-    if to not in TARGETS:
-        raise ConfigError(f"unknown target {to!r}; allowed: {', '.join(TARGETS)}")
+    cls = writer_class(to)
     try:
         rng = float(eval_range_m)
     except (TypeError, ValueError):
@@ -211,9 +267,23 @@ def convert(
     if not math.isfinite(rng) or rng <= 0:
         raise ConfigError(f"eval_range_m = {eval_range_m!r}: must be a positive, finite number of metres")
     ratios = None if splits is None else parse_ratios(splits)
-    options = Options(to=to, eval_range_m=rng, include_usvs=bool(include_usvs), extras=parse_extras(extras))
+    if not cls.splits and ratios is not None:
+        if ratios != parse_ratios(DEFAULT_RATIOS):
+            raise ConfigError(f"split {splits!r}: --to {to} writes one folder per recording and is never split")
+        ratios = None
+    box_px, max_occ = _box_filter(min_box_px, max_occlusion)
+    options = Options(
+        to=to,
+        eval_range_m=rng,
+        include_usvs=bool(include_usvs),
+        extras=parse_extras(extras),
+        min_box_px=box_px,
+        max_occlusion=max_occ,
+    )
     paths = _as_list(recordings)
     infos = [read_info(p) for p in paths]  # validates every input before anything is written
+    for i in infos:
+        cls.check(i)
     folders = _folders(infos)
     split_of: dict[str, str | None] = dict.fromkeys(folders)
     if ratios is not None:
@@ -230,12 +300,14 @@ def convert(
             "eval_range_m": rng,
             "include_usvs": options.include_usvs,
             "extras": list(options.extras),
+            **({"min_box_px": box_px, "max_occlusion": max_occ} if to in ("coco", "yolo") else {}),
             "splits": None if ratios is None else dict(zip(SPLIT_NAMES, [round(r, 9) for r in ratios], strict=True)),
             "seed": seed,
         },
     }
     (out / REPORT_NAME).write_bytes(dump_yaml({**header, "status": "in_progress"}))
     sink = Sink()
+    shared = cls.start(out, options, sink)
     report = ConvertReport(out_dir=out, target=to, recordings=reports)
     expected = sum(int(i.run.get("frames_written", i.frames_configured) or 0) for i in infos)
     done = 0
@@ -245,9 +317,9 @@ def convert(
     for j in order:
         info, rep = infos[j], reports[j]
         folder = out / rep.split / rep.folder if rep.split else out / rep.folder
-        sink.mkdir(folder)
-        cls: type[DatasetWriter] = Opv2vWriter if to == "opv2v" else KittiWriter
-        writer = cls(info, folder, options, sink)
+        if cls.owns_folder:
+            sink.mkdir(folder)
+        writer = cls(info, folder, options, sink, split=rep.split, shared=shared)
         wanted = writer.topic_filter()
         stream = FrameStream(info, wanted.__contains__)
         converted: list[int] = []
@@ -256,7 +328,7 @@ def convert(
             missing = writer.missing(fr)
             if fr.world is None or missing or not writer.agents:
                 why = (
-                    "no agent with a LiDAR"
+                    writer.no_agent_reason
                     if not writer.agents
                     else f"incomplete: missing {', '.join(missing[:4])}"
                     + (f" and {len(missing) - 4} more" if len(missing) > 4 else "")
@@ -301,7 +373,9 @@ def convert(
             rep.first_frame, rep.last_frame = min(converted), max(converted)
         else:
             rep.notes.append("no complete frame: nothing written for this recording")
-            shutil.rmtree(folder, ignore_errors=True)
+            if cls.owns_folder:
+                shutil.rmtree(folder, ignore_errors=True)
+    cls.finish_all(shared, out, sink)
     doc = {
         **header,
         "status": "complete",

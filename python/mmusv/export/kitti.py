@@ -28,7 +28,7 @@ from mmusv.frames import BODY_TO_OPTICAL, invert, transform_points, wrap_rad
 from mmusv.recording import topics
 from mmusv.recording.reader import AgentInfo, Frame, WorldFrame
 
-__all__ = ["KittiWriter", "kitti_label", "occlusion_level"]
+__all__ = ["KittiWriter", "front_calib", "kitti_label", "kitti_numbers", "occlusion_level"]
 
 
 def occlusion_level(occlusion: float | None) -> int:
@@ -38,8 +38,23 @@ def occlusion_level(occlusion: float | None) -> int:
     return 0 if occlusion < 0.25 else 1 if occlusion < 0.6 else 2
 
 
-def _fmt(values: Any) -> str:
+def kitti_numbers(values: Any) -> str:
+    """The values of an array, row-major, as KITTI's calibration and pose files write them (``%.6e``)."""
     return " ".join(f"{float(v) + 0.0:.6e}" for v in np.asarray(values, dtype=np.float64).reshape(-1))
+
+
+def front_calib(agent: AgentInfo, view: AgentView) -> tuple[np.ndarray, np.ndarray]:
+    """KITTI's camera 0 of ``agent`` at ``view``: the front camera's ``K·[I|0]`` ``(3, 4)`` and the LiDAR → front
+    optical frame transform ``(4, 4)``; zeros and the identity when the agent has no front camera."""
+    assert view.lidar is not None
+    cam = agent.cameras.get("front")
+    if cam is None:
+        return np.zeros((3, 4)), np.eye(4)
+    opt = np.eye(4)
+    opt[:3, :3] = BODY_TO_OPTICAL
+    velo_to_cam = opt @ invert(view.cameras["front"]) @ view.lidar
+    fx, fy, cx, cy = cam.intrinsics
+    return np.array([[fx, 0.0, cx, 0.0], [0.0, fy, cy, 0.0], [0.0, 0.0, 1.0, 0.0]]), velo_to_cam
 
 
 def kitti_label(target: Target, velo_to_cam: np.ndarray, box2d: Any | None) -> str:
@@ -83,21 +98,14 @@ class KittiWriter(DatasetWriter):
         n = len(cloud["x"])
         pts = np.column_stack([cloud["x"], cloud["y"], cloud["z"], cloud.get("intensity", np.zeros(n))]).astype("<f4")
         self.put(self._dir(a, "velodyne") / f"{ts}.bin", pts.tobytes())
-        self.put(self._dir(a, "pose") / f"{ts}.txt", (_fmt(view.lidar[:3, :]) + "\n").encode())
+        self.put(self._dir(a, "pose") / f"{ts}.txt", (kitti_numbers(view.lidar[:3, :]) + "\n").encode())
         cam = a.cameras.get("front")
-        velo_to_cam = np.eye(4)
-        k = np.zeros((3, 4))
-        if cam is not None:
-            opt = np.eye(4)
-            opt[:3, :3] = BODY_TO_OPTICAL
-            velo_to_cam = opt @ invert(view.cameras["front"]) @ view.lidar
-            fx, fy, cx, cy = cam.intrinsics
-            k = np.array([[fx, 0.0, cx, 0.0], [0.0, fy, cy, 0.0], [0.0, 0.0, 1.0, 0.0]])
-        calib = [f"P{i}: {_fmt(k)}" for i in range(4)]
+        k, velo_to_cam = front_calib(a, view)
+        calib = [f"P{i}: {kitti_numbers(k)}" for i in range(4)]
         calib += [
-            f"R0_rect: {_fmt(np.eye(3))}",
-            f"Tr_velo_to_cam: {_fmt(velo_to_cam[:3, :])}",
-            f"Tr_imu_to_velo: {_fmt(invert(a.lidar_mount)[:3, :])}",
+            f"R0_rect: {kitti_numbers(np.eye(3))}",
+            f"Tr_velo_to_cam: {kitti_numbers(velo_to_cam[:3, :])}",
+            f"Tr_imu_to_velo: {kitti_numbers(invert(a.lidar_mount)[:3, :])}",
         ]
         self.put(self._dir(a, "calib") / f"{ts}.txt", ("\n".join(calib) + "\n").encode())
         boxes: dict[str, Any] = {}

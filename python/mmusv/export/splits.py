@@ -14,9 +14,11 @@ from collections.abc import Sequence
 
 from mmusv.errors import ConfigError
 
-__all__ = ["SPLIT_NAMES", "assign_splits", "parse_ratios", "split_counts"]
+__all__ = ["DEFAULT_RATIOS", "SPLIT_NAMES", "assign_splits", "parse_ratios", "split_counts"]
 
 SPLIT_NAMES = ("train", "validate", "test")
+DEFAULT_RATIOS = (0.7, 0.15, 0.15)
+"""The default ``(train, validate, test)`` fractions."""
 
 
 def parse_ratios(ratios: Sequence[float] | str) -> tuple[float, float, float]:

@@ -1,10 +1,13 @@
-"""The part every dataset writer shares: which agents and topics a scenario folder needs, and frame checks."""
+"""The part every dataset writer shares: which agents and topics a recording needs, frame checks, and the hooks
+through which :func:`mmusv.export.convert` drives every format (one folder per recording, or one layout shared by
+every recording of the conversion)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 from typing import Any, ClassVar
 
+from mmusv.errors import ConfigError
 from mmusv.export.common import Options, Sink
 from mmusv.export.geometry import AgentView, Target, agent_view, targets_of
 from mmusv.recording import topics
@@ -14,27 +17,84 @@ __all__ = ["DatasetWriter"]
 
 
 class DatasetWriter:
-    """Base of the OPV2V and KITTI writers: one instance per recording (scenario folder).
+    """Base of every format's writer: one instance per recording.
 
-    Subclasses set :attr:`cameras` (our camera name → the dataset's index) and implement :meth:`write_agent`
-    and :meth:`finish`. An agent without a LiDAR cannot be an OPV2V/KITTI agent and is left out (with a note).
+    :func:`mmusv.export.convert` reads, validates, splits and selects the frames of every recording, reports
+    progress, and calls, in this order: :meth:`check` (every recording, before anything is written), :meth:`start`
+    (once: state shared by the recordings of one conversion), the constructor, :meth:`write_frame` per complete
+    frame, :meth:`finish` per recording and :meth:`finish_all` (once). Subclasses set :attr:`cameras` (our camera
+    name → the dataset's index) and implement :meth:`write_agent` (or :meth:`write_frame`) and :meth:`finish`.
+
+    By default an agent without a LiDAR is left out (with a note), as OPV2V and KITTI need one; a format that
+    needs cameras instead overrides :meth:`uses_agent`. ``owns_folder``: convert creates the recording's folder
+    ``<split>/<scenario>`` and deletes it when no frame was converted; a format with one layout for every
+    recording (COCO, YOLO, SemanticKITTI) writes under the output root instead. ``splits``: whether the
+    train/validate/test split applies to the format. ``needs_agent``: a recording without an agent the format uses
+    is an error (:meth:`check`) rather than a recording whose frames are all skipped.
     """
 
     cameras: ClassVar[dict[str, int]] = {}
+    owns_folder: ClassVar[bool] = True
+    splits: ClassVar[bool] = True
+    no_agent_reason: ClassVar[str] = "no agent with a LiDAR"
+    needs_agent: ClassVar[bool] = False
 
-    def __init__(self, info: RecordingInfo, folder: Path, options: Options, sink: Sink) -> None:
+    def __init__(
+        self,
+        info: RecordingInfo,
+        folder: Path,
+        options: Options,
+        sink: Sink,
+        *,
+        split: str | None = None,
+        shared: Any = None,
+    ) -> None:
         self.info = info
         self.folder = folder
         self.options = options
         self.sink = sink
+        self.split = split
+        self.shared = shared
         self.notes: list[str] = []
         self.agents: list[AgentInfo] = []
         for a in info.agents:
-            if a.lidar_mount is None:
-                self.notes.append(f"agent {a.id} has no LiDAR and is left out")
-            else:
+            why = self.uses_agent(a)
+            if why is None:
                 self.agents.append(a)
+            else:
+                self.notes.append(f"agent {a.id} {why} and is left out")
         self.extra_counts: dict[str, int] = dict.fromkeys(options.extras, 0)
+
+    # ------------------------------------------------------------------------------------------ the conversion
+
+    @classmethod
+    def check(cls, info: RecordingInfo) -> None:
+        """Raises :class:`~mmusv.errors.ConfigError` naming the file when ``info``'s recording cannot be converted
+        to this format at all (called for every recording before anything is written). With :attr:`needs_agent`,
+        a recording without an agent this format uses is such an error (otherwise its frames are skipped, with
+        :attr:`no_agent_reason`)."""
+        if cls.needs_agent and not any(cls.uses_agent(a) is None for a in info.agents):
+            raise ConfigError(f"{info.path}: cannot convert to {cls.format_name()}: {cls.no_agent_reason}")
+
+    @classmethod
+    def format_name(cls) -> str:
+        """The format's ``--to`` name (the class name without ``Writer``, lower case)."""
+        return cls.__name__.removesuffix("Writer").lower()
+
+    @classmethod
+    def uses_agent(cls, agent: AgentInfo) -> str | None:
+        """``None`` when this format converts ``agent``, else why not (``"has no LiDAR"``)."""
+        return None if agent.lidar_mount is not None else "has no LiDAR"
+
+    @classmethod
+    def start(cls, out: Path, options: Options, sink: Sink) -> Any:
+        """State shared by every recording of one conversion into ``out`` (passed to each writer as
+        ``shared``); ``None`` by default."""
+        return None
+
+    @classmethod
+    def finish_all(cls, shared: Any, out: Path, sink: Sink) -> None:
+        """Called once after the last recording (files that describe the whole conversion)."""
 
     # ------------------------------------------------------------------------------------------ topics
 

@@ -1,0 +1,192 @@
+"""What the image datasets (COCO, YOLO, MaSTr) share: one sample per agent camera per frame, its key, its 2D boxes
+and the box filter.
+
+A sample is one camera image of one agent at one frame; its key ``<scenario>/<agent>/<camera>/<frame:06d>`` names
+its files in every layout, so no two samples of a conversion share a name. Boxes are the recording's 2D camera
+annotations (``mmusv.AgentAnnotations.boxes_camera``: the vessel's projected 3D box clipped to the image, with
+truncation, visible pixels and occlusion; :mod:`mmusv.annotate`), with the vessel's class, instance and role from
+the frame's world state.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, ClassVar
+
+from mmusv.classes import SemanticClass, class_name
+from mmusv.export.common import Options, Sink
+from mmusv.export.writer import DatasetWriter
+from mmusv.recording import topics
+from mmusv.recording.reader import AgentInfo, CameraInfo, Frame, WorldFrame
+
+__all__ = ["CATEGORIES", "CameraWriter", "ImageBox", "Sample", "Shared"]
+
+CATEGORIES: tuple[int, ...] = tuple(int(c) for c in SemanticClass if c != SemanticClass.NONE)
+"""The detection categories: every semantic class of :mod:`mmusv.classes` but ``NONE`` (0, nothing hit), by id."""
+
+
+@dataclass(frozen=True)
+class ImageBox:
+    """One vessel's 2D box in one image: pixels ``x_min, y_min, x_max, y_max`` (origin at the top-left corner of
+    the image, x right, y down), its vessel id, semantic class, instance id and role (``target``, ``usv``,
+    ``moored``), truncation and occlusion (fractions, 0..1) and visible pixels."""
+
+    target_id: str
+    semantic_class: int
+    instance_id: int
+    role: str
+    x_min: float
+    y_min: float
+    x_max: float
+    y_max: float
+    truncation: float
+    occlusion: float
+    visible_pixels: int
+
+    @property
+    def width(self) -> float:
+        return self.x_max - self.x_min
+
+    @property
+    def height(self) -> float:
+        return self.y_max - self.y_min
+
+
+@dataclass(frozen=True)
+class Sample:
+    """One camera image of one agent at one frame: ``key`` (``<scenario>/<agent>/<camera>/<frame:06d>``), the
+    split it belongs to (``all`` without a split) and the frame's decoded messages."""
+
+    key: str
+    split: str
+    agent: AgentInfo
+    camera: CameraInfo
+    frame: Frame
+    world: WorldFrame
+
+    def message(self, kind: str) -> Any:
+        """The camera's ``kind`` image message (``rgb``, ``depth``, ``semantic``, ``instance``)."""
+        return self.frame.messages[topics.camera(self.agent.id, self.camera.name, kind)]
+
+
+@dataclass
+class Shared:
+    """State of one conversion shared by its recordings: the output root."""
+
+    out: Path
+
+
+class CameraWriter(DatasetWriter):
+    """Base of the image datasets: :meth:`write_sample` per camera image (see the module docstring).
+
+    Subclasses set :attr:`kinds` (the image kinds a camera must record to be used) and :attr:`boxes` (whether
+    the samples need the agent's annotations).
+    """
+
+    owns_folder: ClassVar[bool] = False
+    needs_agent: ClassVar[bool] = True
+    kinds: ClassVar[tuple[str, ...]] = ("rgb",)
+    boxes: ClassVar[bool] = False
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.extra_counts = {}
+        self.cams: dict[str, list[str]] = {}
+        for a in self.agents:
+            self.cams[a.id] = [n for n, c in sorted(a.cameras.items()) if self.camera_ok(c)]
+            other = [n for n in sorted(a.cameras) if n not in self.cams[a.id]]
+            if other:
+                self.notes.append(
+                    f"agent {a.id}: cameras {other} do not record {' and '.join(self.kinds)} images and are left out"
+                )
+
+    @classmethod
+    def camera_ok(cls, cam: CameraInfo) -> bool:
+        """The camera records every image kind of :attr:`kinds`."""
+        return all(k in cam.outputs for k in cls.kinds)
+
+    @classmethod
+    def uses_agent(cls, agent: AgentInfo) -> str | None:
+        if any(cls.camera_ok(c) for c in agent.cameras.values()):
+            return None
+        return f"has no camera recording {' and '.join(cls.kinds)} images"
+
+    @classmethod
+    def start(cls, out: Path, options: Options, sink: Sink) -> Any:
+        return Shared(out=out)
+
+    @property
+    def root(self) -> Path:
+        """The conversion's output folder."""
+        out: Path = self.shared.out
+        return out
+
+    @property
+    def split_name(self) -> str:
+        """The recording's split, ``all`` without a split."""
+        return self.split or "all"
+
+    def required_topics(self) -> list[str]:
+        out = [topics.WORLD_STATE]
+        for a in self.agents:
+            out += [topics.camera(a.id, n, k) for n in self.cams[a.id] for k in self.kinds]
+            if self.boxes:
+                out.append(topics.agent_annotations(a.id))
+        return out
+
+    def optional_topics(self) -> list[str]:
+        return []
+
+    def write_frame(self, frame: Frame) -> None:
+        world = frame.world
+        assert world is not None
+        for a in self.agents:
+            for name in self.cams[a.id]:
+                key = f"{self.folder.name}/{a.id}/{name}/{frame.index:06d}"
+                self.write_sample(Sample(key, self.split_name, a, a.cameras[name], frame, world))
+
+    def write_sample(self, sample: Sample) -> None:
+        raise NotImplementedError
+
+    def file(self, *parts: str) -> Path:
+        """``root/parts...``, its folder created."""
+        p = self.root.joinpath(*parts)
+        self.sink.mkdir(p.parent)
+        return p
+
+    def boxes_of(self, sample: Sample) -> list[ImageBox]:
+        """The sample's 2D boxes kept by the options: a box with no visible pixel is always left out, and so are
+        boxes whose shorter side is under ``min_box_px`` or whose occlusion is above ``max_occlusion``."""
+        ann = sample.frame.messages[topics.agent_annotations(sample.agent.id)]
+        w = sample.world
+        row = {vid: i for i, vid in enumerate(w.ids)}
+        out = []
+        for b in ann.boxes_camera:
+            if b.camera != sample.camera.name or b.target_id not in row:
+                continue
+            i = row[b.target_id]
+            box = ImageBox(
+                target_id=b.target_id,
+                semantic_class=int(w.classes[i]),
+                instance_id=int(w.instance_ids[i]),
+                role=w.roles[i],
+                x_min=float(b.x_min),
+                y_min=float(b.y_min),
+                x_max=float(b.x_max),
+                y_max=float(b.y_max),
+                truncation=float(b.truncation),
+                occlusion=float(b.occlusion),
+                visible_pixels=int(b.visible_pixels),
+            )
+            if box.visible_pixels == 0 or box.occlusion > self.options.max_occlusion:
+                continue
+            if min(box.width, box.height) < self.options.min_box_px:
+                continue
+            out.append(box)
+        return out
+
+
+def category_names() -> dict[int, str]:
+    """:data:`CATEGORIES` by id → class name."""
+    return {c: class_name(c) for c in CATEGORIES}

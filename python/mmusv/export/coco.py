@@ -1,0 +1,130 @@
+"""``--to coco``: COCO instance annotations, one file per split.
+
+Layout: ``images/<split>/<scenario>/<agent>/<camera>/<frame>.png`` (the recorded RGB PNG, copied) and
+``annotations/instances_<split>.json`` (``split`` = ``train``, ``validate``, ``test``, or ``all`` without a split;
+the split is made by recording, :mod:`mmusv.export.splits`). Each file: ``info``, ``licenses`` (empty),
+``images`` (``id`` from 1, ``file_name`` relative to ``images/<split>``, ``width``, ``height``, and mmusv's
+``scenario``, ``agent``, ``camera``, ``frame``, ``time_s``), ``annotations`` and ``categories`` (every mmusv
+semantic class but ``none``: ``id`` = the class id of :mod:`mmusv.classes`, ``name`` its name).
+
+An annotation per kept 2D box (:meth:`mmusv.export.camera.CameraWriter.boxes_of`): ``bbox`` ``[x, y, w, h]``
+pixels (the recording's box: the vessel's projected 3D box clipped to the image), ``category_id`` the vessel's
+semantic class, ``segmentation`` the run-length encoding (pycocotools, ``counts`` as a string) of the instance
+image's pixels equal to the vessel's instance id, ``area`` that mask's pixel count, ``iscrowd`` 0, and the extra
+fields ``truncation``, ``occlusion`` (fractions), ``role``, ``mmusv_id`` (vessel id), ``instance_id`` and
+``visible_pixels``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+
+from mmusv.errors import ConfigError
+from mmusv.export.camera import CATEGORIES, CameraWriter, Sample, Shared, category_names
+from mmusv.export.common import Options, Sink, png_bytes
+from mmusv.export.splits import SPLIT_NAMES
+from mmusv.jsonio import dump_json
+from mmusv.recording.reader import RecordingInfo
+
+__all__ = ["CocoWriter", "annotations_file"]
+
+
+def annotations_file(split: str) -> str:
+    """``annotations/instances_<split>.json``."""
+    return f"annotations/instances_{split}.json"
+
+
+class _CocoShared(Shared):
+    def __init__(self, out: Path) -> None:
+        super().__init__(out=out)
+        self.images: dict[str, list[dict[str, Any]]] = {}
+        self.annotations: dict[str, list[dict[str, Any]]] = {}
+
+
+class CocoWriter(CameraWriter):
+    """Writes COCO instance annotations (see the module docstring)."""
+
+    kinds: ClassVar[tuple[str, ...]] = ("rgb", "instance")
+    boxes: ClassVar[bool] = True
+    no_agent_reason: ClassVar[str] = "no camera recording rgb and instance images (COCO masks need instance images)"
+
+    @classmethod
+    def check(cls, info: RecordingInfo) -> None:
+        try:
+            import pycocotools.mask  # noqa: F401
+        except ImportError:
+            raise ConfigError("--to coco needs the Python package pycocotools (pip install pycocotools)") from None
+        super().check(info)
+
+    @classmethod
+    def start(cls, out: Path, options: Options, sink: Sink) -> Any:
+        return _CocoShared(out)
+
+    def write_sample(self, sample: Sample) -> None:
+        from pycocotools import mask as mask_util
+
+        from mmusv.recording import decode_image
+
+        st: _CocoShared = self.shared
+        images = st.images.setdefault(sample.split, [])
+        anns = st.annotations.setdefault(sample.split, [])
+        name = f"{sample.key}.png"
+        self.put(self.file("images", sample.split, name), png_bytes(sample.message("rgb")))
+        inst = np.asarray(decode_image(sample.message("instance")))
+        h, w = inst.shape
+        image_id = len(images) + 1
+        images.append(
+            {
+                "id": image_id,
+                "file_name": name,
+                "width": w,
+                "height": h,
+                "scenario": self.info.scenario_name,
+                "agent": sample.agent.id,
+                "camera": sample.camera.name,
+                "frame": sample.frame.index,
+                "time_s": round(sample.world.time_s, 9),
+            }
+        )
+        for b in self.boxes_of(sample):
+            rle = mask_util.encode(np.asfortranarray(inst == b.instance_id, dtype=np.uint8))
+            area = int(mask_util.area(rle))
+            anns.append(
+                {
+                    "id": len(anns) + 1,
+                    "image_id": image_id,
+                    "category_id": b.semantic_class,
+                    "bbox": [round(v, 3) + 0.0 for v in (b.x_min, b.y_min, b.width, b.height)],
+                    "area": area,
+                    "iscrowd": 0,
+                    "segmentation": {"size": [h, w], "counts": rle["counts"].decode("ascii")},
+                    "truncation": round(b.truncation, 6),
+                    "occlusion": round(b.occlusion, 6),
+                    "role": b.role,
+                    "mmusv_id": b.target_id,
+                    "instance_id": b.instance_id,
+                    "visible_pixels": b.visible_pixels,
+                }
+            )
+
+    @classmethod
+    def finish_all(cls, shared: Any, out: Path, sink: Sink) -> None:
+        st: _CocoShared = shared
+        names = category_names()
+        cats = [{"id": c, "name": names[c], "supercategory": "maritime"} for c in CATEGORIES]
+        for split in [*SPLIT_NAMES, "all"]:
+            if split not in st.images:
+                continue
+            doc = {
+                "info": {"description": f"mmusv recordings, split {split}", "version": "1.0"},
+                "licenses": [],
+                "images": st.images[split],
+                "annotations": st.annotations.get(split, []),
+                "categories": cats,
+            }
+            path = out / annotations_file(split)
+            sink.mkdir(path.parent)
+            sink.write(path, dump_json(doc))

@@ -1,0 +1,534 @@
+"""``--to ros2``: one rosbag2 folder per recording (``<out>/<scenario>/metadata.yaml`` + ``<scenario>.mcap``).
+
+Written with rosbags' rosbag2 writer (:class:`rosbags.rosbag2.Writer`, format version 8, MCAP storage: profile
+``ros2``, ``ros2msg`` schemas, ``cdr`` messages, zstd chunks; it also writes ``metadata.yaml`` and the ``rosbag2``
+metadata record), messages serialised by rosbags' CDR serialiser from the types of
+:func:`mmusv.export.ros2_types.typestore`. Standard message types only; ``docs/exports.md`` lists every topic.
+
+Stamps (header, log time) are the scenario's sim time, published on ``/clock``. Frames (REP 105/103): ``map`` (the
+mmusv world: x east, y north, z up); per instrumented USV ``<usv>/odom`` (= ``map``, static) → ``<usv>/base_link``
+(x forward, y left, z up; ``/tf`` every frame) → ``<usv>/lidar``, ``<usv>/radar``, ``<usv>/camera_<name>`` (x
+forward) → ``<usv>/camera_<name>_optical`` (x right, y down, z forward) on ``/tf_static`` (transient local);
+every other vessel ``map`` → ``<vessel>/base_link`` on ``/tf``; the top-view camera ``map`` →
+``<usv>/top_view_optical`` on ``/tf``.
+"""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar, Literal
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from mmusv.classes import class_name
+from mmusv.errors import ConfigError
+from mmusv.export.writer import DatasetWriter
+from mmusv.frames import BODY_TO_OPTICAL, pose_matrices
+from mmusv.recording import topics
+from mmusv.recording.reader import AgentInfo, Frame, RecordingInfo, WorldFrame
+
+__all__ = [
+    "MAP_FRAME",
+    "Ros2Writer",
+    "base_link",
+    "camera_frame",
+    "camera_info_topic",
+    "detections_2d_topic",
+    "detections_3d_topic",
+    "odom_frame",
+    "odom_topic",
+    "optical_frame",
+    "top_view_frame",
+]
+
+MAP_FRAME = "map"
+TF_TOPIC = "/tf"
+TF_STATIC_TOPIC = "/tf_static"
+CLOCK_TOPIC = "/clock"
+BAG_VERSION: Literal[8] = 8
+"""rosbag2 metadata version (Jazzy's)."""
+
+OPTICAL_IN_BODY = np.eye(4)
+OPTICAL_IN_BODY[:3, :3] = BODY_TO_OPTICAL.T
+"""``(4, 4)`` optical frame → camera body frame."""
+
+ROLE_COLOURS = {"usv": (0.2, 0.9, 0.9, 0.5), "target": (1.0, 0.3, 0.2, 0.5), "moored": (1.0, 0.8, 0.2, 0.5)}
+"""RViz box colour (r, g, b, a) per vessel role."""
+
+
+def base_link(vessel: str) -> str:
+    """``<vessel>/base_link``: the vessel body (x forward, y left, z up)."""
+    return f"{vessel}/base_link"
+
+
+def odom_frame(agent: str) -> str:
+    """``<usv>/odom``: the odometry frame of an instrumented USV (ground truth: the same as ``map``)."""
+    return f"{agent}/odom"
+
+
+def camera_frame(agent: str, name: str) -> str:
+    """``<usv>/camera_<name>``: camera body frame (x forward = optical axis, y left, z up)."""
+    return f"{agent}/camera_{name}"
+
+
+def optical_frame(agent: str, name: str) -> str:
+    """``<usv>/camera_<name>_optical``: the camera's optical frame (x right, y down, z forward; REP 103)."""
+    return f"{camera_frame(agent, name)}_optical"
+
+
+def top_view_frame(agent: str) -> str:
+    """``<usv>/top_view_optical``: optical frame of the agent's top-view camera."""
+    return f"{agent}/top_view_optical"
+
+
+def odom_topic(agent: str) -> str:
+    """``/<usv>/odom``: ``nav_msgs/Odometry``."""
+    return f"/{agent}/odom"
+
+
+def camera_info_topic(agent: str, name: str) -> str:
+    """``/<usv>/camera/<name>/camera_info``."""
+    return f"{topics.camera(agent, name)}/camera_info"
+
+
+def detections_2d_topic(agent: str, name: str) -> str:
+    """``/<usv>/camera/<name>/detections``: ``vision_msgs/Detection2DArray``."""
+    return f"{topics.camera(agent, name)}/detections"
+
+
+def detections_3d_topic(agent: str) -> str:
+    """``/<usv>/detections``: ``vision_msgs/Detection3DArray`` in the LiDAR frame."""
+    return f"/{agent}/detections"
+
+
+def _stamp(ts: Any, t_ns: int) -> Any:
+    return ts.types["builtin_interfaces/msg/Time"](sec=int(t_ns // 1_000_000_000), nanosec=int(t_ns % 1_000_000_000))
+
+
+class _Msgs:
+    """Builds messages of the typestore ``ts`` from numpy values."""
+
+    def __init__(self, ts: Any) -> None:
+        self.ts = ts
+        self.T = ts.types
+
+    def header(self, t_ns: int, frame_id: str) -> Any:
+        return self.T["std_msgs/msg/Header"](stamp=_stamp(self.ts, t_ns), frame_id=frame_id)
+
+    def vector3(self, v: Any) -> Any:
+        return self.T["geometry_msgs/msg/Vector3"](x=float(v[0]), y=float(v[1]), z=float(v[2]))
+
+    def quaternion(self, q: Any) -> Any:
+        return self.T["geometry_msgs/msg/Quaternion"](x=float(q[0]), y=float(q[1]), z=float(q[2]), w=float(q[3]))
+
+    def pose(self, m: np.ndarray) -> Any:
+        t = m[:3, 3]
+        return self.T["geometry_msgs/msg/Pose"](
+            position=self.T["geometry_msgs/msg/Point"](x=float(t[0]), y=float(t[1]), z=float(t[2])),
+            orientation=self.quaternion(Rotation.from_matrix(m[:3, :3]).as_quat()),
+        )
+
+    def transform(self, t_ns: int, parent: str, child: str, m: np.ndarray) -> Any:
+        tr = self.T["geometry_msgs/msg/Transform"](
+            translation=self.vector3(m[:3, 3]), rotation=self.quaternion(Rotation.from_matrix(m[:3, :3]).as_quat())
+        )
+        return self.T["geometry_msgs/msg/TransformStamped"](
+            header=self.header(t_ns, parent), child_frame_id=child, transform=tr
+        )
+
+    def tf(self, transforms: list[Any]) -> Any:
+        return self.T["tf2_msgs/msg/TFMessage"](transforms=transforms)
+
+    def point_cloud(self, t_ns: int, frame_id: str, cloud: dict[str, np.ndarray], fields: list[str]) -> Any:
+        """A dense ``PointCloud2`` (height 1, little-endian, fields packed in the order given)."""
+        pf = self.T["sensor_msgs/msg/PointField"]
+        codes = {
+            np.dtype("int8"): pf.INT8,
+            np.dtype("uint8"): pf.UINT8,
+            np.dtype("int16"): pf.INT16,
+            np.dtype("uint16"): pf.UINT16,
+            np.dtype("int32"): pf.INT32,
+            np.dtype("uint32"): pf.UINT32,
+            np.dtype("float32"): pf.FLOAT32,
+            np.dtype("float64"): pf.FLOAT64,
+        }
+        names = [f for f in fields if f in cloud]
+        n = len(cloud[names[0]]) if names else 0
+        dtype = np.dtype([(f, cloud[f].dtype.newbyteorder("<")) for f in names])
+        packed = np.empty(n, dtype=dtype)
+        for f in names:
+            packed[f] = cloud[f]
+        out_fields = [
+            pf(name=f, offset=int(dtype.fields[f][1]), datatype=int(codes[np.dtype(cloud[f].dtype.name)]), count=1)
+            for f in names
+            if dtype.fields is not None
+        ]
+        return self.T["sensor_msgs/msg/PointCloud2"](
+            header=self.header(t_ns, frame_id),
+            height=1,
+            width=n,
+            fields=out_fields,
+            is_bigendian=False,
+            point_step=dtype.itemsize,
+            row_step=dtype.itemsize * n,
+            data=np.frombuffer(packed.tobytes(), dtype=np.uint8),
+            is_dense=True,
+        )
+
+    def image(self, t_ns: int, frame_id: str, img: np.ndarray, encoding: str) -> Any:
+        """A ``sensor_msgs/Image`` of ``img`` (``(H, W)`` or ``(H, W, 3)``, little-endian, rows top to bottom)."""
+        a = np.ascontiguousarray(img)
+        a = a.astype(a.dtype.newbyteorder("<"), copy=False)
+        h, w = a.shape[:2]
+        return self.T["sensor_msgs/msg/Image"](
+            header=self.header(t_ns, frame_id),
+            height=h,
+            width=w,
+            encoding=encoding,
+            is_bigendian=0,
+            step=int(a.strides[0]),
+            data=np.frombuffer(a.tobytes(), dtype=np.uint8),
+        )
+
+    def compressed(self, t_ns: int, frame_id: str, data: bytes, fmt: str) -> Any:
+        return self.T["sensor_msgs/msg/CompressedImage"](
+            header=self.header(t_ns, frame_id), format=fmt, data=np.frombuffer(data, dtype=np.uint8)
+        )
+
+
+class Ros2Writer(DatasetWriter):
+    """Writes one recording as one rosbag2 folder (see the module docstring)."""
+
+    owns_folder: ClassVar[bool] = False
+    splits: ClassVar[bool] = False
+    needs_agent: ClassVar[bool] = False
+    no_agent_reason: ClassVar[str] = "no instrumented USV"
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        from mmusv.export.ros2_types import typestore
+
+        self.extra_counts = {}
+        self.ts = typestore()
+        self.m = _Msgs(self.ts)
+        self.bag: Any = None
+        self.connections: dict[str, Any] = {}
+
+    @classmethod
+    def check(cls, info: RecordingInfo) -> None:
+        try:
+            import rosbags.rosbag2  # noqa: F401
+        except ImportError:
+            raise ConfigError("--to ros2 needs the Python package rosbags (pip install rosbags)") from None
+        super().check(info)
+
+    @classmethod
+    def uses_agent(cls, agent: AgentInfo) -> str | None:
+        return None
+
+    # ------------------------------------------------------------------------------------------ topics
+
+    def required_topics(self) -> list[str]:
+        return [topics.WORLD_STATE]
+
+    def optional_topics(self) -> list[str]:
+        out = []
+        for a in self.agents:
+            out += [topics.lidar(a.id), topics.radar_returns(a.id), topics.radar_ppi(a.id)]
+            out += [topics.agent_annotations(a.id), topics.TF]
+            for name in a.cameras:
+                out += [topics.camera(a.id, name, kind) for kind in topics.CAMERA_KINDS]
+            out += [topics.top_view(a.id, kind) for kind in topics.CAMERA_KINDS]
+        return out
+
+    # ------------------------------------------------------------------------------------------ writing
+
+    def _open(self) -> None:
+        from rosbags.interfaces import Qos, QosDurability, QosHistory, QosLiveliness, QosReliability, QosTime
+        from rosbags.rosbag2 import CompressionFormat, CompressionMode, StoragePlugin, Writer
+
+        self.bag = Writer(self.folder, version=BAG_VERSION, storage_plugin=StoragePlugin.MCAP)
+        self.bag.set_compression(CompressionMode.STORAGE, CompressionFormat.ZSTD)
+        self.bag.open()
+        never = QosTime(0, 0)
+        self.latched = Qos(
+            QosHistory.KEEP_LAST,
+            1,
+            QosReliability.RELIABLE,
+            QosDurability.TRANSIENT_LOCAL,
+            never,
+            never,
+            QosLiveliness.AUTOMATIC,
+            never,
+            False,
+        )
+
+    def _put(self, topic: str, msgtype: str, msg: Any, t_ns: int, *, latched: bool = False) -> None:
+        conn = self.connections.get(topic)
+        if conn is None:
+            qos = (self.latched,) if latched else ()
+            conn = self.bag.add_connection(topic, msgtype, typestore=self.ts, offered_qos_profiles=qos)
+            self.connections[topic] = conn
+        self.bag.write(conn, t_ns, self.ts.serialize_cdr(msg, msgtype))
+
+    def write_frame(self, frame: Frame) -> None:
+        world = frame.world
+        assert world is not None
+        t = frame.log_time_ns
+        m = self.m
+        if self.bag is None:
+            self._open()
+            self._put(TF_STATIC_TOPIC, "tf2_msgs/msg/TFMessage", m.tf(self._static(t)), t, latched=True)
+        self._put(
+            CLOCK_TOPIC,
+            "rosgraph_msgs/msg/Clock",
+            self.ts.types["rosgraph_msgs/msg/Clock"](clock=_stamp(self.ts, t)),
+            t,
+        )
+        self._put(TF_TOPIC, "tf2_msgs/msg/TFMessage", m.tf(self._dynamic(frame, world)), t)
+        for a in self.agents:
+            self._agent(frame, world, a)
+
+    def _static(self, t: int) -> list[Any]:
+        """map → odom of every USV, and its sensor mounts (constant)."""
+        m = self.m
+        out = []
+        for a in self.agents:
+            out.append(m.transform(t, MAP_FRAME, odom_frame(a.id), np.eye(4)))
+            base = base_link(a.id)
+            if a.lidar_mount is not None:
+                out.append(m.transform(t, base, topics.lidar_frame(a.id), a.lidar_mount))
+            if a.radar_mount is not None:
+                out.append(m.transform(t, base, topics.radar_frame(a.id), a.radar_mount))
+            for name, cam in sorted(a.cameras.items()):
+                out.append(m.transform(t, base, camera_frame(a.id, name), cam.mount))
+                out.append(m.transform(t, camera_frame(a.id, name), optical_frame(a.id, name), OPTICAL_IN_BODY))
+        return out
+
+    def _dynamic(self, frame: Frame, world: WorldFrame) -> list[Any]:
+        """Every vessel's body pose (USVs through their odom frame) and the top-view cameras."""
+        m, t = self.m, frame.log_time_ns
+        agents = {a.id for a in self.agents}
+        mats = pose_matrices(world.poses)
+        out = [
+            m.transform(t, odom_frame(vid) if vid in agents else MAP_FRAME, base_link(vid), mats[i])
+            for i, vid in enumerate(world.ids)
+        ]
+        tf = frame.messages.get(topics.TF)
+        if tf is not None:
+            tops = {topics.top_view_frame(a.id): a.id for a in self.agents}
+            for x in tf.transforms:
+                if x.child_frame_id in tops and x.parent_frame_id == topics.WORLD_FRAME:
+                    mat = np.eye(4)
+                    mat[:3, 3] = (x.translation.x, x.translation.y, x.translation.z)
+                    q = (x.rotation.x, x.rotation.y, x.rotation.z, x.rotation.w)
+                    mat[:3, :3] = Rotation.from_quat(q).as_matrix()
+                    out.append(m.transform(t, MAP_FRAME, top_view_frame(tops[x.child_frame_id]), mat))
+        return out
+
+    def _agent(self, frame: Frame, world: WorldFrame, a: AgentInfo) -> None:
+        from mmusv.recording import decode_image, decode_point_cloud
+
+        m, t, msgs = self.m, frame.log_time_ns, frame.messages
+        body = pose_matrices(world.poses[a.index])
+        twist = self.T("geometry_msgs/msg/Twist")(
+            linear=m.vector3(body[:3, :3].T @ world.velocities[a.index]), angular=m.vector3((0.0, 0.0, 0.0))
+        )
+        odom = self.T("nav_msgs/msg/Odometry")(
+            header=m.header(t, odom_frame(a.id)),
+            child_frame_id=base_link(a.id),
+            pose=self.T("geometry_msgs/msg/PoseWithCovariance")(pose=m.pose(body), covariance=np.zeros(36)),
+            twist=self.T("geometry_msgs/msg/TwistWithCovariance")(twist=twist, covariance=np.zeros(36)),
+        )
+        self._put(odom_topic(a.id), "nav_msgs/msg/Odometry", odom, t)
+        lidar = msgs.get(topics.lidar(a.id))
+        if lidar is not None:
+            cloud = decode_point_cloud(lidar)
+            fields = ["x", "y", "z", "intensity", "ring", "azimuth", "class", "instance"]
+            pc = m.point_cloud(t, topics.lidar_frame(a.id), cloud, fields)
+            self._put(topics.lidar(a.id), "sensor_msgs/msg/PointCloud2", pc, t)
+        radar = msgs.get(topics.radar_returns(a.id))
+        if radar is not None:
+            cloud = decode_point_cloud(radar)
+            fields = ["x", "y", "z", "range", "azimuth", "elevation", "intensity", "instance"]
+            pc = m.point_cloud(t, topics.radar_frame(a.id), cloud, fields)
+            self._put(topics.radar_returns(a.id), "sensor_msgs/msg/PointCloud2", pc, t)
+        ppi = msgs.get(topics.radar_ppi(a.id))
+        if ppi is not None:
+            img = decode_image(ppi)
+            enc = "rgb8" if img.ndim == 3 else "mono8"
+            self._put(
+                topics.radar_ppi(a.id), "sensor_msgs/msg/Image", m.image(t, topics.radar_frame(a.id), img, enc), t
+            )
+        for name in sorted(a.cameras):
+            self._camera(frame, a, name, optical_frame(a.id, name), topics.camera(a.id, name))
+            self._put(camera_info_topic(a.id, name), "sensor_msgs/msg/CameraInfo", self._camera_info(t, a, name), t)
+        self._camera(frame, a, "", top_view_frame(a.id), topics.top_view(a.id))
+        ann = msgs.get(topics.agent_annotations(a.id))
+        if ann is not None:
+            self._annotations(t, world, a, ann)
+
+    def T(self, name: str) -> Any:
+        """The message class ``name``."""
+        return self.ts.types[name]
+
+    def _camera(self, frame: Frame, a: AgentInfo, name: str, frame_id: str, base: str) -> None:
+        """The images of one camera (or the top view): RGB as PNG ``CompressedImage`` on ``<base>/rgb/compressed``
+        (image_transport's name), depth ``32FC1`` metres (+inf: no hit), semantic and instance ``16UC1``."""
+        from mmusv.recording import decode_image
+
+        m, t, msgs = self.m, frame.log_time_ns, frame.messages
+        rgb = msgs.get(f"{base}/rgb")
+        if rgb is not None:
+            if str(getattr(rgb, "format", "")).lower() == "png":
+                self._put(
+                    f"{base}/rgb/compressed",
+                    "sensor_msgs/msg/CompressedImage",
+                    m.compressed(t, frame_id, bytes(rgb.data), "png"),
+                    t,
+                )
+            else:
+                self._put(f"{base}/rgb", "sensor_msgs/msg/Image", m.image(t, frame_id, decode_image(rgb), "rgb8"), t)
+        depth = msgs.get(f"{base}/depth")
+        if depth is not None:
+            img = np.asarray(decode_image(depth), dtype=np.float32)
+            self._put(f"{base}/depth", "sensor_msgs/msg/Image", m.image(t, frame_id, img, "32FC1"), t)
+        for kind in ("semantic", "instance"):
+            msg = msgs.get(f"{base}/{kind}")
+            if msg is not None:
+                img = np.asarray(decode_image(msg), dtype=np.uint16)
+                self._put(f"{base}/{kind}", "sensor_msgs/msg/Image", m.image(t, frame_id, img, "16UC1"), t)
+
+    def _camera_info(self, t: int, a: AgentInfo, name: str) -> Any:
+        """Pinhole intrinsics, no distortion (``plumb_bob`` with zero coefficients), R = I, P = [K | 0]."""
+        cam = a.cameras[name]
+        fx, fy, cx, cy = cam.intrinsics
+        k = np.array([fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0])
+        p = np.array([fx, 0.0, cx, 0.0, 0.0, fy, cy, 0.0, 0.0, 0.0, 1.0, 0.0])
+        roi = self.T("sensor_msgs/msg/RegionOfInterest")(x_offset=0, y_offset=0, height=0, width=0, do_rectify=False)
+        return self.T("sensor_msgs/msg/CameraInfo")(
+            header=self.m.header(t, optical_frame(a.id, name)),
+            height=cam.height,
+            width=cam.width,
+            distortion_model="plumb_bob",
+            d=np.zeros(5),
+            k=k,
+            r=np.eye(3).reshape(9),
+            p=p,
+            binning_x=0,
+            binning_y=0,
+            roi=roi,
+        )
+
+    def _annotations(self, t: int, world: WorldFrame, a: AgentInfo, ann: Any) -> None:
+        """``Detection3DArray`` and a ``MarkerArray`` of boxes in the LiDAR frame; a ``Detection2DArray`` per
+        camera in its optical frame. Class ids are mmusv class names (``vessel``, ``usv``), score 1 (ground
+        truth), detection ids the vessel ids."""
+        m = self.m
+        row = {vid: i for i, vid in enumerate(world.ids)}
+        lidar = topics.lidar_frame(a.id)
+        hyp = self.T("vision_msgs/msg/ObjectHypothesis")
+        hyp_pose = self.T("vision_msgs/msg/ObjectHypothesisWithPose")
+        pwc = self.T("geometry_msgs/msg/PoseWithCovariance")
+        marker = self.T("visualization_msgs/msg/Marker")
+        dets3, markers = [], [self._marker(t, lidar, marker.DELETEALL, 0, np.eye(4), (0.0, 0.0, 0.0), (0, 0, 0, 0))]
+        for i, b in enumerate(ann.boxes_lidar):
+            mat = np.eye(4)
+            mat[:3, :3] = Rotation.from_quat(list(b.rotation)).as_matrix()
+            mat[:3, 3] = list(b.center)
+            pose = m.pose(mat)
+            name = class_name(int(b.semantic_class))
+            dets3.append(
+                self.T("vision_msgs/msg/Detection3D")(
+                    header=m.header(t, lidar),
+                    results=[
+                        hyp_pose(hypothesis=hyp(class_id=name, score=1.0), pose=pwc(pose=pose, covariance=np.zeros(36)))
+                    ],
+                    bbox=self.T("vision_msgs/msg/BoundingBox3D")(center=pose, size=m.vector3(list(b.size))),
+                    id=b.target_id,
+                )
+            )
+            role = world.roles[row[b.target_id]] if b.target_id in row else "target"
+            markers.append(
+                self._marker(t, lidar, marker.ADD, i, mat, list(b.size), ROLE_COLOURS.get(role, (1, 1, 1, 0.5)))
+            )
+        self._put(
+            detections_3d_topic(a.id),
+            "vision_msgs/msg/Detection3DArray",
+            self.T("vision_msgs/msg/Detection3DArray")(header=m.header(t, lidar), detections=dets3),
+            t,
+        )
+        self._put(
+            topics.boxes(a.id),
+            "visualization_msgs/msg/MarkerArray",
+            self.T("visualization_msgs/msg/MarkerArray")(markers=markers),
+            t,
+        )
+        by_cam: dict[str, list[Any]] = {name: [] for name in a.cameras}
+        ident = m.pose(np.eye(4))
+        for b in ann.boxes_camera:
+            if b.camera not in by_cam:
+                continue
+            j = row.get(b.target_id)
+            name = class_name(int(world.classes[j])) if j is not None else "unknown"
+            centre = self.T("vision_msgs/msg/Pose2D")(
+                position=self.T("vision_msgs/msg/Point2D")(x=(b.x_min + b.x_max) / 2.0, y=(b.y_min + b.y_max) / 2.0),
+                theta=0.0,
+            )
+            by_cam[b.camera].append(
+                self.T("vision_msgs/msg/Detection2D")(
+                    header=m.header(t, optical_frame(a.id, b.camera)),
+                    results=[
+                        hyp_pose(
+                            hypothesis=hyp(class_id=name, score=1.0), pose=pwc(pose=ident, covariance=np.zeros(36))
+                        )
+                    ],
+                    bbox=self.T("vision_msgs/msg/BoundingBox2D")(
+                        center=centre, size_x=float(b.x_max - b.x_min), size_y=float(b.y_max - b.y_min)
+                    ),
+                    id=b.target_id,
+                )
+            )
+        for cam, dets in sorted(by_cam.items()):
+            msg = self.T("vision_msgs/msg/Detection2DArray")(
+                header=m.header(t, optical_frame(a.id, cam)), detections=dets
+            )
+            self._put(detections_2d_topic(a.id, cam), "vision_msgs/msg/Detection2DArray", msg, t)
+
+    def _marker(self, t: int, frame_id: str, action: int, i: int, mat: np.ndarray, size: Any, rgba: Any) -> Any:
+        T = self.T
+        return T("visualization_msgs/msg/Marker")(
+            header=self.m.header(t, frame_id),
+            ns="targets",
+            id=i,
+            type=T("visualization_msgs/msg/Marker").CUBE,
+            action=action,
+            pose=self.m.pose(mat),
+            scale=self.m.vector3(size),
+            color=T("std_msgs/msg/ColorRGBA")(r=float(rgba[0]), g=float(rgba[1]), b=float(rgba[2]), a=float(rgba[3])),
+            lifetime=T("builtin_interfaces/msg/Duration")(sec=0, nanosec=0),
+            frame_locked=False,
+            points=[],
+            colors=[],
+            texture_resource="",
+            texture=T("sensor_msgs/msg/CompressedImage")(
+                header=self.m.header(0, ""), format="", data=np.zeros(0, dtype=np.uint8)
+            ),
+            uv_coordinates=[],
+            text="",
+            mesh_resource="",
+            mesh_file=T("visualization_msgs/msg/MeshFile")(filename="", data=np.zeros(0, dtype=np.uint8)),
+            mesh_use_embedded_materials=False,
+        )
+
+    def finish(self, frames: list[int], skipped: list[dict[str, Any]]) -> None:
+        super().finish(frames, skipped)
+        if self.bag is None:
+            return
+        self.bag.set_custom_data("mmusv.source", self.info.path.name)
+        self.bag.set_custom_data("mmusv.scenario", self.info.scenario_name)
+        self.bag.set_custom_data("mmusv.config_hash", self.info.config_hash)
+        self.bag.close()
+        self.bag = None
+        for p in sorted(self.folder.iterdir()):
+            self.sink.count(p)

@@ -1,0 +1,76 @@
+"""``--to yolo``: the Ultralytics detection layout.
+
+``images/<split>/<scenario>/<agent>/<camera>/<frame>.png`` (the recorded RGB PNG, copied),
+``labels/<split>/<same path>.txt`` (one line per kept 2D box: ``class x_centre y_centre width height``, the box
+normalised by the image width and height, 6 decimals; an empty file for an image without boxes) and ``data.yaml``
+(``train``/``val``/``test``: the image folders of the splits that hold images, relative to the file's folder,
+which Ultralytics takes as the dataset root when ``path`` is absent; ``names``: class index → name). Splits are
+made by recording (:mod:`mmusv.export.splits`); without a split, ``images/all`` is both ``train`` and ``val``, and
+``val`` is the ``train`` folder when no recording went to ``validate`` (Ultralytics requires both keys).
+
+Class index = the position of the vessel's semantic class in :data:`mmusv.export.camera.CATEGORIES` (every mmusv
+class but ``none``, by id), so ``names`` lists the classes in id order. Boxes are those of
+:meth:`mmusv.export.camera.CameraWriter.boxes_of` (the COCO export's).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, ClassVar
+
+from mmusv.export.camera import CATEGORIES, CameraWriter, Sample, Shared, category_names
+from mmusv.export.common import Options, Sink, dump_yaml, png_bytes
+from mmusv.export.splits import SPLIT_NAMES
+
+__all__ = ["YoloWriter", "yolo_class"]
+
+_YOLO_SPLIT = {"train": "train", "validate": "val", "test": "test"}
+
+
+def yolo_class(semantic_class: int) -> int:
+    """The YOLO class index of an mmusv semantic class (its position in ``CATEGORIES``)."""
+    return CATEGORIES.index(int(semantic_class))
+
+
+class _YoloShared(Shared):
+    def __init__(self, out: Path) -> None:
+        super().__init__(out=out)
+        self.splits: set[str] = set()
+
+
+class YoloWriter(CameraWriter):
+    """Writes the Ultralytics layout (see the module docstring)."""
+
+    kinds: ClassVar[tuple[str, ...]] = ("rgb",)
+    boxes: ClassVar[bool] = True
+    no_agent_reason: ClassVar[str] = "no camera recording rgb images"
+
+    @classmethod
+    def start(cls, out: Path, options: Options, sink: Sink) -> Any:
+        return _YoloShared(out)
+
+    def write_sample(self, sample: Sample) -> None:
+        self.shared.splits.add(sample.split)
+        cam = sample.camera
+        self.put(self.file("images", sample.split, f"{sample.key}.png"), png_bytes(sample.message("rgb")))
+        lines = []
+        for b in self.boxes_of(sample):
+            cx, cy = (b.x_min + b.x_max) / 2.0 / cam.width, (b.y_min + b.y_max) / 2.0 / cam.height
+            w, h = b.width / cam.width, b.height / cam.height
+            lines.append(f"{yolo_class(b.semantic_class)} {cx:.6f} {cy:.6f} {w:.6f} {h:.6f}\n")
+        self.put(self.file("labels", sample.split, f"{sample.key}.txt"), "".join(lines).encode())
+
+    @classmethod
+    def finish_all(cls, shared: Any, out: Path, sink: Sink) -> None:
+        st: _YoloShared = shared
+        if not st.splits:
+            return
+        doc: dict[str, Any] = {}
+        for split in [*SPLIT_NAMES, "all"]:
+            if split in st.splits:
+                doc[_YOLO_SPLIT.get(split, "train")] = f"images/{split}"
+        doc.setdefault("train", doc.get("val", doc.get("test")))
+        doc.setdefault("val", doc["train"])  # Ultralytics requires both keys
+        names = category_names()
+        doc["names"] = {i: names[c] for i, c in enumerate(CATEGORIES)}
+        sink.write(out / "data.yaml", dump_yaml(doc))
