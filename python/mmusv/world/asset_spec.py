@@ -18,6 +18,9 @@ Hull keys (``type: mono | twin``)::
     sheer=0                           deck rise at the stem above the midship deck, rising quadratically
     rake=0.05, overhang=0.0           fractions of length by which the keel is shorter at bow / stern
     bottom=0.8, flare=1.0             half-width fraction at the keel / at the waterline (deck is 1)
+    bulb=0                            mono only: width of a bulbous bow as a fraction of the beam (0 = none)
+    topside=hull_black, deck=deck_steel   materials (mmusv.world.materials) of the topsides and the deck;
+                                      below them the boot-top band and antifouling red
 
 Part types (:mod:`mmusv.world.part_spec`; each ``{type: ..., ...}``; ``base`` defaults to the deck height at the
 part's x; vertical extent is ``top`` (absolute z) or ``height`` (above ``base``); ``fit: m`` narrows a part so it
@@ -70,7 +73,7 @@ from mmusv.validation import (
     invalid_field,
     join,
 )
-from mmusv.world.part_spec import PartSpec
+from mmusv.world.part_spec import MaterialName, PartSpec
 
 __all__ = [
     "AXES",
@@ -169,6 +172,10 @@ class HullSpec(Spec):
     sheer: NonNegative = 0.0
     bottom: Annotated[Number, Field(ge=0.02, le=1.0)] = 0.8
     flare: Annotated[Number, Field(ge=0.02, le=1.0)] = 1.0
+    bulb: Annotated[Number, Field(ge=0.0, le=0.5)] = 0.0
+    """Mono hulls: bulbous bow width as a fraction of the beam (0 = no bulb)."""
+    topside: MaterialName = "hull_black"
+    deck: MaterialName = "deck_steel"
 
     @model_validator(mode="after")
     def _consistent(self) -> HullSpec:
@@ -184,6 +191,8 @@ class HullSpec(Spec):
             raise invalid_field("stern", f"bow + stern must be <= 1, got {self.bow} + {self.stern}")
         if self.bow == 0 and self.bow_width not in (None, 1.0):
             raise invalid_field("bow_width", "must be 1 when bow is 0 (no taper)")
+        if self.bulb > 0 and self.type == "twin":
+            raise invalid_field("bulb", "is for mono hulls only")
         if self.stern == 0 and self.transom not in (None, 1.0):
             raise invalid_field("transom", "must be 1 when stern is 0 (no taper)")
         return self

@@ -15,8 +15,9 @@ from collections.abc import Sequence
 from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import Field, model_validator
+from pydantic import BeforeValidator, Field, model_validator
 
+from mmusv.errors import ConfigError
 from mmusv.validation import (
     Fraction,
     NonNegative,
@@ -26,29 +27,63 @@ from mmusv.validation import (
     Vec2,
     Vec3,
     Whole,
+    invalid,
     invalid_field,
     sequence,
 )
+from mmusv.world.materials import material_id
 
 __all__ = [
+    "DEFAULT_MATERIALS",
     "PART_MODELS",
+    "AntennasPart",
+    "BollardsPart",
     "BoxPart",
+    "ContainersPart",
     "CranePart",
     "CylinderPart",
     "DomePart",
+    "FendersPart",
     "FunnelPart",
     "GantryPart",
     "GunPart",
+    "HatchesPart",
     "HcylinderPart",
     "HousePart",
     "HullBlockPart",
+    "LifeboatsPart",
     "MastPart",
+    "MaterialName",
+    "NavLightsPart",
     "PartSpec",
+    "PipesPart",
     "PlatePart",
+    "RadarPart",
+    "RailingPart",
     "RowPart",
     "StrutPart",
+    "TubePart",
+    "WinchPart",
+    "WindowsPart",
     "profile_area",
 ]
+
+
+def _material_name(value: object) -> object:
+    if not isinstance(value, str):
+        raise invalid(f"must be a material name (mmusv.world.materials), got {value!r}")
+    try:
+        material_id(value)
+    except ConfigError as exc:
+        raise invalid(str(exc)) from None
+    return value
+
+
+MaterialName = Annotated[str, BeforeValidator(_material_name)]
+"""The name of a material of :mod:`mmusv.world.materials` (checked)."""
+
+Side = Literal["both", "port", "starboard"]
+"""Which side of the vessel a sided part goes on (port = +y)."""
 
 
 def profile_area(points: Sequence[Sequence[float]] | np.ndarray) -> float:
@@ -58,7 +93,13 @@ def profile_area(points: Sequence[Sequence[float]] | np.ndarray) -> float:
     return 0.5 * float(np.sum(pts[:, 0] * d[:, 1] - d[:, 0] * pts[:, 1]))
 
 
-class _Span(Spec):
+class _Part(Spec):
+    """Every part: ``material`` (a name of :mod:`mmusv.world.materials`; default: :data:`DEFAULT_MATERIALS`)."""
+
+    material: MaterialName | None = None
+
+
+class _Span(_Part):
     """A part standing from ``base`` (default: the deck at the part's x) up to ``top`` or ``base + height``."""
 
     base: Number | None = None
@@ -74,7 +115,7 @@ class _Span(Spec):
         return self
 
 
-class _Along(Spec):
+class _Along(_Part):
     """A part spanning ``x0`` to ``x1`` along the hull (``x1 > x0``)."""
 
     x0: Number
@@ -87,7 +128,7 @@ class _Along(Spec):
         return self
 
 
-class _Placed(Spec):
+class _Placed(_Part):
     """A part standing at ``(x, y)`` in the body frame (metres)."""
 
     x: Number
@@ -102,6 +143,8 @@ class BoxPart(_Placed, _Span):
     fit: NonNegative | None = None
     taper: Positive = 1.0
     yaw_deg: Number = 0.0
+    windows: Vec3 | None = None
+    """``[width, height, pitch]`` of a window band round the box (not with ``yaw_deg``)."""
 
 
 class HousePart(_Placed):
@@ -109,6 +152,8 @@ class HousePart(_Placed):
 
     type: Literal["house"]
     align: Literal["center", "aft", "fore"] = "center"
+    windows: Vec3 | None = None
+    """``[width, height, pitch]`` of the window bands on every tier (the top tier's front gets a bridge band)."""
     taper: Positive = 1.0
     tiers: Annotated[
         tuple[Annotated[tuple[Number, ...], sequence(3, 4, "a list of 3 to 4 numbers")], ...],
@@ -153,6 +198,10 @@ class FunnelPart(_Placed, _Span):
     size: Vec2
     taper: Positive = 0.9
     shape: Literal["box", "round"] = "box"
+    band: MaterialName | None = None
+    """A company colour band around the upper funnel (below the black top)."""
+    pipes: Annotated[Whole, Field(ge=0, le=6)] = 2
+    """Exhaust pipes standing out of the top."""
 
 
 class MastPart(_Placed, _Span):
@@ -203,7 +252,7 @@ class DomePart(_Placed):
         return self
 
 
-class StrutPart(Spec):
+class StrutPart(_Part):
     """A beam of ``width`` x ``thickness`` from ``from`` to ``to`` (absolute body-frame points)."""
 
     type: Literal["strut"]
@@ -220,7 +269,7 @@ class StrutPart(Spec):
         return self
 
 
-class PlatePart(Spec):
+class PlatePart(_Part):
     """A convex ``[x, z]`` profile ``points`` extruded ``thickness`` across y, centred at ``y``."""
 
     type: Literal["plate"]
@@ -273,6 +322,199 @@ class GunPart(_Placed):
     elevation_deg: Number = 5.0
 
 
+class RailingPart(_Part):
+    """Guard rails of stanchions and ``rails`` horizontal rails, ``height`` tall: along the deck edge (``inset``
+    inside it) between ``x0`` and ``x1`` (default: the whole hull), joined round the ``bow``/across the ``stern``
+    when asked; or, with ``width``, round a rectangle ``x0..x1`` by ``width`` centred at ``y`` on ``base``."""
+
+    type: Literal["railing"]
+    x0: Number | None = None
+    x1: Number | None = None
+    side: Side = "both"
+    inset: NonNegative = 0.1
+    height: Positive = 1.0
+    spacing: Positive = 1.5
+    rails: Annotated[Whole, Field(ge=1, le=5)] = 2
+    base: Number | None = None
+    width: Positive | None = None
+    y: Number = 0.0
+    bow: bool = False
+    stern: bool = False
+    radius: Positive | None = None
+    """Tube radius (default ``0.02 + 0.01 * height``)."""
+
+    @model_validator(mode="after")
+    def _span(self) -> RailingPart:
+        if self.x0 is not None and self.x1 is not None and self.x1 <= self.x0:
+            raise invalid_field("x1", f"must be > x0 ({self.x0}), got {self.x1}")
+        if self.width is not None and (self.x0 is None or self.x1 is None or self.base is None):
+            raise invalid_field("width", "a rectangular railing needs x0, x1 and base")
+        return self
+
+
+class WindowsPart(_Along):
+    """A band of windows (raised glass in a frame) from ``x0`` to ``x1``: ``rows`` rows ``row_pitch`` apart from
+    ``z`` (bottom of the lowest row), each window ``width`` x ``height`` every ``pitch`` metres, on a wall at
+    ``|y| = y`` or, without ``y``, on the deck outline ``inset`` inside it (``wall: outline``) or on the hull's side
+    (``wall: hull``); ``shape: round`` makes portholes."""
+
+    type: Literal["windows"]
+    z: Number
+    width: Positive
+    height: Positive
+    pitch: Positive
+    rows: Annotated[Whole, Field(ge=1, le=40)] = 1
+    row_pitch: Positive = 2.8
+    side: Side = "both"
+    y: Positive | None = None
+    inset: NonNegative = 0.0
+    wall: Literal["outline", "hull"] = "outline"
+    shape: Literal["rect", "round"] = "rect"
+
+    @model_validator(mode="after")
+    def _pitch(self) -> WindowsPart:
+        if self.pitch < self.width:
+            raise invalid_field("pitch", f"must be >= width ({self.width}), got {self.pitch}")
+        return self
+
+
+class ContainersPart(_Along):
+    """Container stacks: ``bays`` bays from ``x0`` to ``x1`` (``gap`` between bays), ``rows`` containers across a
+    stack ``width`` wide, ``tiers`` high per bay (cycled), each box its own colour (a fixed hash of its slot and
+    ``seed``); ``height`` is one container's (2.59 m standard)."""
+
+    type: Literal["containers"]
+    bays: Annotated[Whole, Field(ge=1, le=60)]
+    rows: Annotated[Whole, Field(ge=1, le=30)]
+    tiers: Annotated[tuple[Annotated[Whole, Field(ge=1, le=12)], ...], sequence(1, None, "a list of whole numbers")]
+    width: Positive
+    base: Number | None = None
+    gap: NonNegative = 0.6
+    height: Positive = 2.59
+    seed: Annotated[Whole, Field(ge=0)] = 0
+
+
+class HatchesPart(_Along):
+    """``count`` hatch covers on coamings from ``x0`` to ``x1`` (``gap`` apart), ``width`` across (narrowed by
+    ``fit``), ``height`` from ``base`` to the cover top, each cover with ``ribs`` transverse stiffeners."""
+
+    type: Literal["hatches"]
+    count: Annotated[Whole, Field(ge=1)]
+    gap: NonNegative = 0.0
+    width: Positive
+    height: Positive
+    base: Number | None = None
+    fit: NonNegative | None = None
+    ribs: Annotated[Whole, Field(ge=0, le=40)] = 6
+
+
+class LifeboatsPart(_Placed):
+    """``count`` enclosed lifeboats ``length`` long every ``pitch`` metres aft from ``x`` at ``|y| = y`` with the
+    keel at ``z`` and a davit pair each (``kind: davit``); or one free-fall boat on a stern ramp at ``x``
+    (``kind: freefall``, on the centreline)."""
+
+    type: Literal["lifeboats"]
+    z: Number
+    length: Positive
+    count: Annotated[Whole, Field(ge=1, le=12)] = 1
+    pitch: NonNegative = 0.0
+    side: Side = "both"
+    kind: Literal["davit", "freefall"] = "davit"
+
+
+class FendersPart(_Along):
+    """``count`` fenders hung on the hull side between ``x0`` and ``x1`` with their centres at ``z``: tyres
+    (``kind: tyre``, outer ``radius``) or rubber cylinders (``kind: cylinder``); all within the beam."""
+
+    type: Literal["fenders"]
+    count: Annotated[Whole, Field(ge=1, le=80)]
+    z: Number
+    radius: Positive
+    side: Side = "both"
+    kind: Literal["tyre", "cylinder"] = "tyre"
+
+
+class NavLightsPart(_Part):
+    """COLREG navigation lights as small lanterns: ``masthead`` white (a list of ``[x, y, z]``; default: below the
+    top of the tallest mast), ``sides`` red to port and green to starboard at ``[x, |y|, z]`` (default: on the
+    bridge wings, else at the bow), ``stern`` white at ``[x, y, z]`` (default: on the transom); ``size`` is the
+    lantern's height."""
+
+    type: Literal["nav_lights"]
+    masthead: tuple[Vec3, ...] | None = None
+    sides: Vec3 | None = None
+    stern: Vec3 | None = None
+    size: Positive = 0.3
+
+
+class RadarPart(_Placed):
+    """A radar scanner: pedestal and gearbox on ``base`` with an open-array antenna ``length`` long turned by
+    ``yaw_deg``."""
+
+    type: Literal["radar"]
+    base: Number
+    length: Positive = 2.0
+    yaw_deg: Number = 0.0
+
+
+class AntennasPart(_Part):
+    """Whip antennas: one per ``[x, y, z, height]`` of ``at`` (standing on z), tube ``radius``."""
+
+    type: Literal["antennas"]
+    at: Annotated[
+        tuple[Annotated[tuple[Number, ...], sequence(4, 4, "[x, y, z, height]")], ...], sequence(1, None, "a list")
+    ]
+    radius: Positive = 0.03
+
+
+class BollardsPart(_Along):
+    """``count`` double bollards per side from ``x0`` to ``x1``, ``inset`` inside the deck edge, post ``radius``."""
+
+    type: Literal["bollards"]
+    count: Annotated[Whole, Field(ge=1, le=40)]
+    inset: NonNegative = 0.8
+    radius: Positive = 0.2
+    side: Side = "both"
+
+
+class TubePart(_Part):
+    """A round tube (``segments``-gon) of ``radius`` (to ``end_radius``) from ``from`` to ``to`` (absolute points):
+    booms, derricks, pipes, bow fenders."""
+
+    type: Literal["tube"]
+    start: Vec3 = Field(alias="from")
+    end: Vec3 = Field(alias="to")
+    radius: Positive
+    end_radius: Positive | None = None
+    segments: Segments = 12
+
+    @model_validator(mode="after")
+    def _long(self) -> TubePart:
+        if math.dist(self.start, self.end) <= 1e-9:
+            raise invalid_field("to", "must differ from 'from'")
+        return self
+
+
+class PipesPart(_Along):
+    """A pipe rack: pipes along x at each of ``ys`` at height ``z`` on supports every ``support`` metres."""
+
+    type: Literal["pipes"]
+    ys: Annotated[tuple[Number, ...], sequence(1, None, "a list of numbers")]
+    z: Number
+    radius: Positive = 0.2
+    support: Positive = 6.0
+    base: Number | None = None
+
+
+class WinchPart(_Placed):
+    """A winch: a drum of ``radius`` and ``width`` (across y) between two cheek plates on ``base``."""
+
+    type: Literal["winch"]
+    base: Number | None = None
+    radius: Positive
+    width: Positive
+
+
 PartSpec = Annotated[
     BoxPart
     | HousePart
@@ -287,7 +529,20 @@ PartSpec = Annotated[
     | PlatePart
     | GantryPart
     | CranePart
-    | GunPart,
+    | GunPart
+    | RailingPart
+    | WindowsPart
+    | ContainersPart
+    | HatchesPart
+    | LifeboatsPart
+    | FendersPart
+    | NavLightsPart
+    | RadarPart
+    | AntennasPart
+    | BollardsPart
+    | TubePart
+    | PipesPart
+    | WinchPart,
     Field(discriminator="type"),
 ]
 """One superstructure part, chosen by its ``type``."""
@@ -296,3 +551,37 @@ PART_MODELS: dict[str, type[Spec]] = {
     typing.get_args(m.model_fields["type"].annotation)[0]: m for m in typing.get_args(typing.get_args(PartSpec)[0])
 }
 """Part ``type`` -> its model."""
+
+DEFAULT_MATERIALS: dict[str, str] = {
+    "box": "superstructure_white",
+    "house": "superstructure_white",
+    "hull_block": "<topside>",
+    "row": "paint_grey",
+    "funnel": "superstructure_white",
+    "mast": "paint_cream",
+    "cylinder": "paint_grey",
+    "hcylinder": "paint_grey",
+    "dome": "fibreglass_white",
+    "strut": "steel",
+    "plate": "paint_grey",
+    "gantry": "paint_orange",
+    "crane": "paint_yellow",
+    "gun": "hull_grey",
+    "railing": "steel",
+    "windows": "glass",
+    "containers": "<per box>",
+    "hatches": "paint_red",
+    "lifeboats": "lifeboat_orange",
+    "fenders": "rubber",
+    "nav_lights": "<per lamp>",
+    "radar": "superstructure_white",
+    "antennas": "fibreglass_white",
+    "bollards": "hull_black",
+    "tube": "steel",
+    "pipes": "steel",
+    "winch": "paint_grey",
+}
+"""Part ``type`` -> the material of its main body when ``material`` is not given. ``<topside>`` is the hull's
+topside paint; containers take a colour per box and navigation lights their COLREG lamp materials (their
+``material`` is the lantern housing's). Secondary pieces have fixed materials: window frames aluminium, funnel tops
+funnel_black, davits steel, crane cab windows glass, radar pedestals paint_grey."""

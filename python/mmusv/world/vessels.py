@@ -1,6 +1,7 @@
 """The vessel asset library: procedural vessels from 3 m to 330 m, instrumented USVs, and user assets.
 
-Every asset is a :class:`VesselAsset`: a closed, outward-facing triangle mesh in the vessel **body frame**
+Every asset is a :class:`VesselAsset`: a triangle mesh of closed, outward-facing pieces with a material per face
+(:mod:`mmusv.world.materials`) in the vessel **body frame**
 (x forward with the bow at +x, y left, z up; origin at the waterline centre of the bounding box in x/y; z = 0 is
 the waterline, so the hull reaches down to ``z = -draft``) plus its dimensions, which are always the mesh's
 bounding box: ``length`` = x extent, ``beam`` = y extent, ``height`` = z extent (keel to top), ``draft`` =
@@ -10,7 +11,8 @@ Built-in assets are described in ``vessel_catalog.yaml`` (entries validated by t
 :mod:`mmusv.world.asset_spec`, procedural meshes built by :mod:`mmusv.world.vessel_shapes`) and built on first use,
 then cached. Users add their own with
 :func:`load_asset_file` (a mesh file, OBJ/STL/PLY/GLB via trimesh, or a procedural hull/parts entry) and
-:func:`register_asset`::
+:func:`register_asset`; glTF/GLB files bring their PBR materials (registered with
+:func:`mmusv.world.materials.register_material`)::
 
     from mmusv.world.vessels import get_asset, library
     ship = get_asset("container_ship_300m")
@@ -44,6 +46,7 @@ from mmusv.world.asset_spec import (
     ProceduralAssetSpec,
     parse_asset,
 )
+from mmusv.world.materials import NAV_LAMP_RADIANCE, Material, register_material
 from mmusv.world.primitives import TriMesh
 from mmusv.world.vessel_shapes import build_procedural
 from mmusv.yamlio import parse_yaml, read_yaml
@@ -150,6 +153,8 @@ class VesselAsset:
     mounts: Mapping[str, MountPoint] = field(default_factory=dict, repr=False)
     description: str = field(default="", repr=False)
     source: str = "builtin"
+    parts: tuple[str, ...] = field(default=(), repr=False)
+    """The part types of a procedural asset, in catalogue order (empty for a mesh file)."""
     length: float = field(init=False)
     beam: float = field(init=False)
     height: float = field(init=False)
@@ -166,15 +171,16 @@ class VesselAsset:
         v = np.array(self.mesh.vertices, dtype=np.float64)
         fc = np.array(self.mesh.faces, dtype=np.int64)
         c = np.array(self.mesh.classes, dtype=np.uint16)
+        mat = np.array(self.mesh.materials, dtype=np.uint16)
         if fc.shape[0] == 0 or v.shape[0] == 0:
             raise AssetSpecError(f"{self.name}.mesh", "mesh has no triangles")
         if not np.all(np.isfinite(v)):
             raise AssetSpecError(f"{self.name}.mesh", "mesh has non-finite vertices")
         if fc.min() < 0 or fc.max() >= v.shape[0]:
             raise AssetSpecError(f"{self.name}.mesh", "face indices out of range")
-        for a in (v, fc, c):
+        for a in (v, fc, c, mat):
             a.setflags(write=False)
-        mesh = TriMesh(v, fc, c)
+        mesh = TriMesh(v, fc, c, mat)
         lo, hi = v[fc.reshape(-1)].min(axis=0), v[fc.reshape(-1)].max(axis=0)
         ext = hi - lo
         centre = (lo[:2] + hi[:2]) / 2.0
@@ -190,6 +196,7 @@ class VesselAsset:
         object.__setattr__(self, "mesh", mesh)
         object.__setattr__(self, "mounts", MappingProxyType(mounts))
         object.__setattr__(self, "bbox", bbox)
+        object.__setattr__(self, "parts", tuple(str(t) for t in self.parts))
         object.__setattr__(self, "length", float(ext[0]))
         object.__setattr__(self, "beam", float(ext[1]))
         object.__setattr__(self, "height", float(ext[2]))
@@ -204,6 +211,11 @@ class VesselAsset:
     def num_triangles(self) -> int:
         """Number of mesh triangles."""
         return self.mesh.num_triangles
+
+    @property
+    def num_parts(self) -> int:
+        """Number of catalogue parts of a procedural asset (0 for a mesh file)."""
+        return len(self.parts)
 
     @property
     def is_usv(self) -> bool:
@@ -331,28 +343,127 @@ def _axis(name: str) -> np.ndarray:
     return (-1.0 if name.startswith("-") else 1.0) * np.array(AXES[name[-1]])
 
 
-def _load_mesh_file(path: Path, where: str) -> tuple[np.ndarray, np.ndarray]:
+GLTF_EMISSIVE_SCALE = 0.05 * NAV_LAMP_RADIANCE
+"""cd/m² of a glTF ``emissiveFactor`` of 1 (glTF's emission is relative; 1e3 cd/m² is a bright lit panel)."""
+
+
+def _srgb_to_linear(c: np.ndarray) -> np.ndarray:
+    c = np.clip(np.asarray(c, dtype=np.float64), 0.0, 1.0)
+    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+
+
+def _unit_factor(value: object, n: int, default: float) -> np.ndarray:
+    """A trimesh colour/factor as floats in [0, 1] (trimesh keeps colour factors as uint8)."""
+    if value is None:
+        return np.full(n, default)
+    a = np.asarray(value).reshape(-1)[:n]
+    f = a.astype(np.float64) / 255.0 if a.dtype.kind in "ui" else a.astype(np.float64)
+    return np.pad(f, (0, n - f.shape[0]), constant_values=default)
+
+
+def _pbr_material(mat: object, name: str) -> Material:
+    """A :class:`Material` from a trimesh material (glTF PBR; a plain material's diffuse colour otherwise).
+
+    glTF's ``baseColorFactor`` is linear and multiplies the sRGB-encoded ``baseColorTexture``, whose mean is
+    taken in linear RGB; roughness and metallic factors default to 1 as in glTF; ``emissiveFactor`` is scaled by
+    :data:`GLTF_EMISSIVE_SCALE`.
+    """
+    base = np.ones(3)
+    rough, metal, emis = 1.0, 1.0, np.zeros(3)
+    factor = getattr(mat, "baseColorFactor", None)
+    if factor is not None or hasattr(mat, "roughnessFactor"):
+        base = _unit_factor(factor, 3, 1.0)
+        tex = getattr(mat, "baseColorTexture", None)
+        if tex is not None:
+            pix = np.asarray(tex.convert("RGB"), dtype=np.float64).reshape(-1, 3) / 255.0
+            base = base * _srgb_to_linear(pix).mean(axis=0)
+        r = getattr(mat, "roughnessFactor", None)
+        m = getattr(mat, "metallicFactor", None)
+        rough = 1.0 if r is None else float(r)
+        metal = 1.0 if m is None else float(m)
+        e = getattr(mat, "emissiveFactor", None)
+        emis = np.zeros(3) if e is None else _unit_factor(e, 3, 0.0) * GLTF_EMISSIVE_SCALE
+    else:
+        diffuse = getattr(mat, "diffuse", None)
+        base = _srgb_to_linear(_unit_factor(diffuse, 3, 1.0)) if diffuse is not None else np.full(3, 0.5)
+        rough, metal = 0.5, 0.0
+    return Material(
+        name=name,
+        base_color=(float(base[0]), float(base[1]), float(base[2])),
+        roughness=float(np.clip(rough, 0.02, 1.0)),
+        metallic=float(np.clip(metal, 0.0, 1.0)),
+        emissive=(float(emis[0]), float(emis[1]), float(emis[2])),
+    )
+
+
+def _material_ids(mat: object, stem: str, cache: dict[int, int]) -> int:
+    """The registered id of a trimesh material (named ``<file stem>:<material name>``, suffixed if that name is
+    taken by another material)."""
+    key = id(mat)
+    if key in cache:
+        return cache[key]
+    label = str(getattr(mat, "name", None) or "material")
+    k = 1
+    while True:
+        name = f"{stem}:{label}" if k == 1 else f"{stem}:{label}#{k}"
+        m = _pbr_material(mat, name)
+        try:
+            cache[key] = register_material(m)
+            return cache[key]
+        except ConfigError as exc:
+            if "already registered" not in str(exc):
+                raise
+            k += 1
+
+
+def _load_mesh_file(path: Path, where: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Vertices ``(V, 3)``, faces ``(F, 3)`` and material ids ``(F,)`` of a mesh file (glTF/GLB: its PBR
+    materials, registered; other formats: material 0)."""
     if not path.is_file():
         raise AssetSpecError(where, f"mesh file {str(path)!r} does not exist")
     try:
         import trimesh
     except ImportError as exc:  # pragma: no cover - depends on the install
         raise AssetSpecError(where, "loading mesh files needs the 'trimesh' package (pip install trimesh)") from exc
+    gltf = path.suffix.lower() in (".glb", ".gltf")
     try:
-        loaded = trimesh.load(str(path), force="mesh")
+        loaded = trimesh.load(str(path), force="scene" if gltf else "mesh")
     except Exception as exc:  # trimesh raises many types for unreadable files
         raise AssetSpecError(where, f"cannot read {str(path)!r}: {exc}") from exc
-    if not isinstance(loaded, trimesh.Trimesh):
+    if gltf and isinstance(loaded, trimesh.Scene):
+        pieces = [g for g in loaded.dump() if isinstance(g, trimesh.Trimesh)]
+        cache: dict[int, int] = {}
+        mats = [
+            np.full(
+                len(g.faces),
+                _material_ids(getattr(g.visual, "material", None), path.stem, cache)
+                if hasattr(g.visual, "material")
+                else 0,
+                dtype=np.uint16,
+            )
+            for g in pieces
+        ]
+        if not pieces:
+            raise AssetSpecError(where, f"{str(path)!r} holds no triangles")
+        offsets = np.cumsum([0] + [len(g.vertices) for g in pieces[:-1]])
+        v = np.concatenate([np.asarray(g.vertices, dtype=np.float64) for g in pieces])
+        fc = np.concatenate([np.asarray(g.faces, dtype=np.int64) + o for g, o in zip(pieces, offsets, strict=True)])
+        fm = np.concatenate(mats)
+    elif isinstance(loaded, trimesh.Trimesh):
+        v = np.asarray(loaded.vertices, dtype=np.float64).reshape(-1, 3)
+        fc = np.asarray(loaded.faces, dtype=np.int64).reshape(-1, 3)
+        fm = np.zeros(fc.shape[0], dtype=np.uint16)
+    else:
         raise AssetSpecError(where, f"{str(path)!r} does not hold a triangle mesh")
-    v = np.asarray(loaded.vertices, dtype=np.float64).reshape(-1, 3)
-    fc = np.asarray(loaded.faces, dtype=np.int64).reshape(-1, 3)
+    v = v.reshape(-1, 3)
+    fc = fc.reshape(-1, 3)
     if fc.shape[0] == 0:
         raise AssetSpecError(where, f"{str(path)!r} holds no triangles")
     used, inverse = np.unique(fc.reshape(-1), return_inverse=True)
     v, fc = v[used], inverse.reshape(-1, 3).astype(np.int64)
     if not np.all(np.isfinite(v)):
         raise AssetSpecError(where, f"{str(path)!r} has non-finite vertices")
-    return v, fc
+    return v, fc, fm
 
 
 def _build_entry(entry: object, *, base_dir: Path | None, source: str, builtin: bool = False) -> VesselAsset:
@@ -361,8 +472,10 @@ def _build_entry(entry: object, *, base_dir: Path | None, source: str, builtin: 
     spec = parse_asset(entry, path=path)
     cls = spec.semantic_class
     mounts = {k: MountPoint(_triple(m.xyz), _triple(m.rpy_deg)) for k, m in spec.mounts.items()}
+    part_types: tuple[str, ...] = ()
     if isinstance(spec, ProceduralAssetSpec):
         mesh = build_procedural(hull=spec.hull, parts=spec.parts, path=path, cls=int(cls))
+        part_types = tuple(p.type for p in spec.parts)
     else:
         if builtin:
             raise AssetSpecError(join(path, "mesh"), "built-in assets are procedural")
@@ -370,7 +483,7 @@ def _build_entry(entry: object, *, base_dir: Path | None, source: str, builtin: 
     b = mesh.bounds
     shift = np.array([(b[0, 0] + b[1, 0]) / 2.0, (b[0, 1] + b[1, 1]) / 2.0, 0.0])
     if np.any(np.abs(shift) > 1e-9 * max(1.0, float((b[1] - b[0]).max()))):
-        mesh = TriMesh(mesh.vertices - shift, mesh.faces, mesh.classes)
+        mesh = TriMesh(mesh.vertices - shift, mesh.faces, mesh.classes, mesh.materials)
         if isinstance(spec, ProceduralAssetSpec):
             mounts = {
                 k: MountPoint((m.xyz[0] - shift[0], m.xyz[1] - shift[1], m.xyz[2]), m.rpy_deg)
@@ -384,6 +497,7 @@ def _build_entry(entry: object, *, base_dir: Path | None, source: str, builtin: 
         mounts=mounts,
         description=spec.description,
         source=source,
+        parts=part_types,
     )
 
 
@@ -396,7 +510,7 @@ def _mesh_entry(spec: MeshAssetSpec, *, path: str, base_dir: Path | None, cls: i
     if not mesh_path.is_absolute():
         mesh_path = (base_dir or Path.cwd()) / mesh_path
     up, fwd = _axis(spec.up_axis), _axis(spec.forward_axis)
-    v, fc = _load_mesh_file(mesh_path, join(path, "mesh"))
+    v, fc, fm = _load_mesh_file(mesh_path, join(path, "mesh"))
     rot = np.stack([fwd, np.cross(up, fwd), up])  # rows: body x, y, z in file coordinates
     body = (v @ rot.T) * spec.scale
     zmin, zmax = float(body[:, 2].min()), float(body[:, 2].max())
@@ -415,7 +529,7 @@ def _mesh_entry(spec: MeshAssetSpec, *, path: str, base_dir: Path | None, cls: i
                 "(after scaling; check up_axis and scale)",
             )
         body[:, 2] -= wl
-    return TriMesh(body, fc, np.array([cls]))
+    return TriMesh(body, fc, np.array([cls]), fm)
 
 
 def load_asset_file(

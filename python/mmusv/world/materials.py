@@ -1,0 +1,229 @@
+"""The material table of mmusv: a small named list of PBR materials, one id per face of every mesh.
+
+A :class:`Material` is a metallic-roughness PBR description (the glTF 2.0 model): linear-RGB albedo
+``base_color`` in [0, 1], perceptual ``roughness`` in [0.02, 1] (the GGX alpha is ``roughness**2``), ``metallic``
+in [0, 1], ``emissive`` radiance (linear RGB, cd/m² scale; a lit navigation lamp is about 2e4) and ``nav_light``
+(the lamp emits only on vessels under way, COLREG lights). A material's id is its index in the table; id 0 is
+``class_default``: the shading falls back to the semantic class colour (maps, user meshes without materials).
+
+The built-in values are typical PBR values from common PBR charts (the Physically Based database,
+physicallybased.info; the Substance/Allegorithmic PBR guide's albedo chart; glTF sample materials) converted to
+linear RGB, rounded: dielectric paints and plastics have albedo 0.02-0.85 and metallic 0, bare metals their
+measured specular colour with metallic 1. They are plausible, not measured on a particular ship.
+
+User meshes (glTF/GLB through trimesh, :mod:`mmusv.world.vessels`) add theirs with :func:`register_material`;
+:func:`material_table` is the ``(M, 9)`` float32 array the renderer takes (:meth:`mmusv.Scene.set_materials`).
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from dataclasses import dataclass
+
+import numpy as np
+
+from mmusv.errors import ConfigError
+
+__all__ = [
+    "BUILTIN_COUNT",
+    "MATERIALS",
+    "NAV_LAMP_RADIANCE",
+    "Material",
+    "all_materials",
+    "material_id",
+    "material_table",
+    "register_material",
+]
+
+NAV_LAMP_RADIANCE = 2.0e4
+"""Emitted radiance of a lit navigation lamp's lens, cd/m² (a 10 W LED lantern of a few cm², order of magnitude)."""
+
+
+@dataclass(frozen=True)
+class Material:
+    """One PBR material (module docstring); checked on construction (``ConfigError`` naming the field)."""
+
+    name: str
+    base_color: tuple[float, float, float]
+    """Linear RGB albedo in [0, 1]."""
+    roughness: float
+    """Perceptual roughness in [0.02, 1] (GGX alpha = roughness**2)."""
+    metallic: float
+    """0 (dielectric) .. 1 (metal)."""
+    emissive: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    """Emitted radiance, linear RGB, cd/m² scale (a lit navigation lamp is about 2e4)."""
+    nav_light: bool = False
+    """True: emits only on vessels under way (COLREG lights)."""
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name.strip():
+            raise ConfigError(f"material.name: must be a non-empty string, got {self.name!r}")
+        where = f"material {self.name!r}"
+        base = _triple(self.base_color, f"{where}.base_color")
+        if any(not 0.0 <= c <= 1.0 for c in base):
+            raise ConfigError(f"{where}.base_color: must be linear RGB in [0, 1], got {list(base)}")
+        emis = _triple(self.emissive, f"{where}.emissive")
+        if any(c < 0.0 for c in emis):
+            raise ConfigError(f"{where}.emissive: must be >= 0 (cd/m²), got {list(emis)}")
+        rough = _number(self.roughness, f"{where}.roughness")
+        if not 0.02 <= rough <= 1.0:
+            raise ConfigError(f"{where}.roughness: must be in [0.02, 1], got {rough}")
+        metal = _number(self.metallic, f"{where}.metallic")
+        if not 0.0 <= metal <= 1.0:
+            raise ConfigError(f"{where}.metallic: must be in [0, 1], got {metal}")
+        object.__setattr__(self, "base_color", base)
+        object.__setattr__(self, "emissive", emis)
+        object.__setattr__(self, "roughness", rough)
+        object.__setattr__(self, "metallic", metal)
+        object.__setattr__(self, "nav_light", bool(self.nav_light))
+
+    def row(self) -> tuple[float, ...]:
+        """The material as the 9 numbers of a :func:`material_table` row."""
+        return (*self.base_color, self.roughness, self.metallic, *self.emissive, 1.0 if self.nav_light else 0.0)
+
+
+def _number(value: object, where: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float | np.floating | np.integer):
+        raise ConfigError(f"{where}: must be a number, got {value!r}")
+    x = float(value)
+    if not math.isfinite(x):
+        raise ConfigError(f"{where}: must be finite, got {x}")
+    return x
+
+
+def _triple(value: object, where: str) -> tuple[float, float, float]:
+    try:
+        items = list(value)  # type: ignore[call-overload]
+    except TypeError:
+        raise ConfigError(f"{where}: must be three numbers, got {value!r}") from None
+    if len(items) != 3:
+        raise ConfigError(f"{where}: must be three numbers, got {value!r}")
+    a, b, c = (_number(v, where) for v in items)
+    return (a, b, c)
+
+
+def _m(
+    name: str,
+    rgb: tuple[float, float, float],
+    roughness: float,
+    metallic: float = 0.0,
+    emissive: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    nav: bool = False,
+) -> Material:
+    return Material(name, rgb, roughness, metallic, emissive, nav)
+
+
+_L = NAV_LAMP_RADIANCE
+
+# Typical PBR values (linear RGB albedo, roughness, metallic) after the common PBR charts named in the module
+# docstring: marine paints are semi-gloss dielectrics (roughness 0.35-0.6), antifouling is matt, bare metals use
+# their measured specular colour (aluminium 0.91/0.92/0.92, steel 0.56/0.57/0.58).
+MATERIALS: tuple[Material, ...] = (
+    _m("class_default", (0.5, 0.5, 0.5), 0.5),
+    # hull paint, topsides
+    _m("hull_black", (0.025, 0.025, 0.027), 0.4),
+    _m("hull_navy", (0.018, 0.035, 0.10), 0.4),
+    _m("hull_blue", (0.02, 0.09, 0.30), 0.4),
+    _m("hull_white", (0.80, 0.80, 0.78), 0.35),
+    _m("hull_grey", (0.22, 0.24, 0.26), 0.5),  # naval haze grey
+    _m("hull_red", (0.38, 0.02, 0.02), 0.4),
+    _m("hull_green", (0.02, 0.16, 0.06), 0.4),
+    _m("hull_orange", (0.85, 0.22, 0.015), 0.4),  # pilot/rescue/tug orange
+    # below and at the waterline
+    _m("antifouling_red", (0.30, 0.035, 0.02), 0.75),
+    _m("boot_top", (0.015, 0.015, 0.015), 0.5),
+    # superstructure and decks
+    _m("superstructure_white", (0.78, 0.78, 0.75), 0.4),
+    _m("paint_cream", (0.70, 0.62, 0.45), 0.45),
+    _m("paint_grey", (0.35, 0.36, 0.37), 0.5),
+    _m("paint_yellow", (0.80, 0.55, 0.02), 0.45),  # cranes, safety yellow
+    _m("paint_orange", (0.85, 0.30, 0.02), 0.45),
+    _m("paint_red", (0.50, 0.03, 0.02), 0.45),
+    _m("paint_blue", (0.03, 0.12, 0.40), 0.45),
+    _m("paint_green", (0.03, 0.20, 0.06), 0.45),
+    _m("deck_steel", (0.16, 0.17, 0.17), 0.7),
+    _m("deck_green", (0.04, 0.14, 0.06), 0.7),  # green non-slip deck paint
+    _m("deck_wood", (0.28, 0.15, 0.07), 0.75),  # teak
+    _m("glass", (0.02, 0.025, 0.03), 0.05),
+    _m("rubber", (0.02, 0.02, 0.02), 0.9),  # fenders, tyres
+    _m("inflatable_grey", (0.13, 0.14, 0.15), 0.6),  # hypalon tubes and pontoons
+    _m("aluminium", (0.91, 0.92, 0.92), 0.35, 1.0),
+    _m("steel", (0.56, 0.57, 0.58), 0.45, 1.0),
+    _m("fibreglass_white", (0.82, 0.82, 0.80), 0.25),  # gelcoat
+    # containers
+    _m("container_red", (0.40, 0.05, 0.03), 0.6),
+    _m("container_blue", (0.03, 0.10, 0.35), 0.6),
+    _m("container_green", (0.04, 0.22, 0.08), 0.6),
+    _m("container_grey", (0.40, 0.41, 0.42), 0.6),
+    _m("container_orange", (0.75, 0.25, 0.03), 0.6),
+    _m("container_white", (0.75, 0.75, 0.72), 0.6),
+    _m("container_brown", (0.20, 0.08, 0.04), 0.6),
+    _m("container_yellow", (0.75, 0.55, 0.03), 0.6),
+    # funnel bands
+    _m("funnel_black", (0.02, 0.02, 0.02), 0.6),  # soot band
+    _m("funnel_red", (0.55, 0.03, 0.02), 0.45),
+    _m("funnel_blue", (0.02, 0.10, 0.40), 0.45),
+    _m("funnel_yellow", (0.80, 0.60, 0.03), 0.45),
+    # lifesaving, rigging
+    _m("lifeboat_orange", (0.90, 0.25, 0.02), 0.5),
+    _m("sail_cloth", (0.85, 0.84, 0.80), 0.8),
+    _m("rope_canvas", (0.50, 0.45, 0.35), 0.9),
+    # sensors
+    _m("sensor_housing", (0.06, 0.06, 0.065), 0.35),  # dark plastic radome / LiDAR housing
+    # COLREG navigation lights: emissive only on vessels under way
+    _m("nav_masthead_white", (0.80, 0.80, 0.80), 0.1, 0.0, (_L, _L, 0.92 * _L), True),
+    _m("nav_port_red", (0.60, 0.02, 0.02), 0.1, 0.0, (_L, 0.02 * _L, 0.01 * _L), True),
+    _m("nav_starboard_green", (0.02, 0.50, 0.20), 0.1, 0.0, (0.02 * _L, _L, 0.45 * _L), True),
+    _m("nav_stern_white", (0.80, 0.80, 0.80), 0.1, 0.0, (_L, _L, 0.92 * _L), True),
+)
+"""The built-in materials; a material's id is its index (:func:`all_materials` adds the registered ones)."""
+
+BUILTIN_COUNT = len(MATERIALS)
+"""Number of built-in materials (ids ``0 .. BUILTIN_COUNT-1``)."""
+
+_lock = threading.Lock()
+_all: list[Material] = list(MATERIALS)
+_ids: dict[str, int] = {m.name: i for i, m in enumerate(MATERIALS)}
+_MAX = 65535
+
+
+def all_materials() -> tuple[Material, ...]:
+    """Every material of this process, built-in then registered; a material's id is its index."""
+    with _lock:
+        return tuple(_all)
+
+
+def material_id(name: str) -> int:
+    """The id of the material called ``name``; an unknown name raises :class:`mmusv.ConfigError` listing them."""
+    with _lock:
+        if name in _ids:
+            return _ids[name]
+        known = ", ".join(m.name for m in _all)
+    raise ConfigError(f"unknown material {name!r}; known materials: {known}")
+
+
+def register_material(m: Material) -> int:
+    """Adds ``m`` to the table (user meshes, glTF PBR) and returns its id; the same material again returns the
+    same id. A different material under a name already taken raises :class:`mmusv.ConfigError`."""
+    if not isinstance(m, Material):
+        raise TypeError(f"register_material() takes a Material, got {type(m).__name__}")
+    with _lock:
+        if m.name in _ids:
+            i = _ids[m.name]
+            if _all[i] == m:
+                return i
+            raise ConfigError(f"material {m.name!r} is already registered with other values")
+        if len(_all) > _MAX:
+            raise ConfigError(f"the material table is full ({_MAX + 1} materials)")
+        _all.append(m)
+        _ids[m.name] = len(_all) - 1
+        return len(_all) - 1
+
+
+def material_table() -> np.ndarray:
+    """``(M, 9)`` float32, one row per material id: r, g, b (linear albedo), roughness, metallic, er, eg, eb
+    (emitted radiance, cd/m² scale), nav_light (0/1)."""
+    with _lock:
+        rows = [m.row() for m in _all]
+    return np.asarray(rows, dtype=np.float32).reshape(-1, 9)

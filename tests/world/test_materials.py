@@ -1,0 +1,238 @@
+"""The material table (mmusv.world.materials), per-face materials of TriMesh and the batched mesh builders
+(mmusv.world.primitives), and glTF PBR materials read through trimesh (mmusv.world.vessels)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from mmusv.errors import ConfigError
+from mmusv.world.materials import (
+    BUILTIN_COUNT,
+    MATERIALS,
+    Material,
+    all_materials,
+    material_id,
+    material_table,
+    register_material,
+)
+from mmusv.world.primitives import TriMesh, box, boxes, lathe, merge, placed, sweep, torus, transformed, tubes
+from mmusv.world.vessels import load_asset_file
+
+REQUIRED = [
+    "class_default",
+    "antifouling_red",
+    "boot_top",
+    "hull_black",
+    "hull_blue",
+    "hull_white",
+    "hull_grey",
+    "superstructure_white",
+    "deck_steel",
+    "deck_wood",
+    "glass",
+    "rubber",
+    "aluminium",
+    "lifeboat_orange",
+    "sail_cloth",
+    "rope_canvas",
+    "sensor_housing",
+    "funnel_black",
+    "nav_masthead_white",
+    "nav_port_red",
+    "nav_starboard_green",
+    "nav_stern_white",
+]
+
+
+def _closed_outward(m: TriMesh) -> tuple[bool, float]:
+    """Whether every edge of ``m`` is used once in each direction (closed, consistently oriented), and the
+    signed volume (m³, > 0 when the normals face outwards)."""
+    f = m.faces
+    e = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
+    n = int(m.vertices.shape[0])
+    key = e[:, 0] * n + e[:, 1]
+    rev = e[:, 1] * n + e[:, 0]
+    ok = np.unique(key).shape[0] == key.shape[0] and bool(np.isin(rev, key).all())
+    t = m.vertices[f]
+    vol = float(np.einsum("ij,ij->i", t[:, 0], np.cross(t[:, 1], t[:, 2])).sum() / 6.0)
+    return ok, vol
+
+
+# ------------------------------------------------------------------------------------------------ table
+
+
+def test_table_has_the_named_materials_and_id_zero_is_the_class_default() -> None:
+    names = [m.name for m in MATERIALS]
+    assert names[0] == "class_default" and material_id("class_default") == 0
+    assert len(set(names)) == len(names)
+    for n in REQUIRED:
+        assert MATERIALS[material_id(n)].name == n
+    assert sum(n.startswith("container_") for n in names) >= 6
+    assert sum(n.startswith("funnel_") for n in names) >= 3
+    assert sum(n.startswith("hull_") for n in names) >= 4
+
+
+def test_table_rows_are_the_materials() -> None:
+    t = material_table()
+    assert t.dtype == np.float32 and t.shape == (len(all_materials()), 9) and len(all_materials()) >= BUILTIN_COUNT
+    for i, m in enumerate(MATERIALS):
+        want = [*m.base_color, m.roughness, m.metallic, *m.emissive, float(m.nav_light)]
+        np.testing.assert_allclose(t[i], want, rtol=1e-6)
+    assert np.all((t[:, :3] >= 0) & (t[:, :3] <= 1)) and np.all((t[:, 3] >= 0.02) & (t[:, 3] <= 1))
+
+
+def test_physical_character_of_key_materials() -> None:
+    glass = MATERIALS[material_id("glass")]
+    assert glass.roughness == pytest.approx(0.05) and glass.metallic == 0.0 and max(glass.base_color) < 0.1
+    assert MATERIALS[material_id("aluminium")].metallic == 1.0
+    assert MATERIALS[material_id("rubber")].roughness >= 0.8
+    for n in ("nav_masthead_white", "nav_port_red", "nav_starboard_green", "nav_stern_white"):
+        m = MATERIALS[material_id(n)]
+        assert m.nav_light and max(m.emissive) >= 1e4
+    red, green = MATERIALS[material_id("nav_port_red")], MATERIALS[material_id("nav_starboard_green")]
+    assert red.emissive[0] > 10 * red.emissive[1] and green.emissive[1] > 2 * green.emissive[0]
+    assert not any(m.nav_light or max(m.emissive) > 0 for m in MATERIALS if not m.name.startswith("nav_"))
+
+
+def test_unknown_name_lists_the_known_ones() -> None:
+    with pytest.raises(ConfigError, match=r"unknown material 'hull_purple'.*known materials: class_default"):
+        material_id("hull_purple")
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "field"),
+    [
+        ({"base_color": (1.2, 0.0, 0.0)}, "base_color"),
+        ({"base_color": (0.1, 0.2)}, "base_color"),
+        ({"roughness": 0.0}, "roughness"),
+        ({"metallic": 1.5}, "metallic"),
+        ({"emissive": (-1.0, 0.0, 0.0)}, "emissive"),
+        ({"roughness": float("nan")}, "roughness"),
+    ],
+)
+def test_material_checks_its_fields(kwargs: dict[str, object], field: str) -> None:
+    args: dict[str, object] = {"name": "bad", "base_color": (0.5, 0.5, 0.5), "roughness": 0.5, "metallic": 0.0}
+    args.update(kwargs)
+    with pytest.raises(ConfigError, match=f"material 'bad'.{field}"):
+        Material(**args)  # type: ignore[arg-type]
+
+
+def test_register_same_material_twice_gives_the_same_id() -> None:
+    m = Material("test_reg:paint", (0.1, 0.2, 0.3), 0.4, 0.0)
+    i = register_material(m)
+    assert i >= BUILTIN_COUNT and register_material(Material("test_reg:paint", (0.1, 0.2, 0.3), 0.4, 0.0)) == i
+    assert material_id("test_reg:paint") == i and all_materials()[i] == m
+    np.testing.assert_allclose(material_table()[i], [0.1, 0.2, 0.3, 0.4, 0, 0, 0, 0, 0], rtol=1e-6)
+    with pytest.raises(ConfigError, match="already registered"):
+        register_material(Material("test_reg:paint", (0.9, 0.2, 0.3), 0.4, 0.0))
+    assert register_material(MATERIALS[3]) == 3
+
+
+# ------------------------------------------------------------------------------------------- TriMesh
+
+
+def test_trimesh_materials_default_broadcast_merge_and_transform() -> None:
+    a = box(center=(0.0, 0.0, 0.0), size=(1.0, 1.0, 1.0), cls=10)
+    assert a.materials.dtype == np.uint16 and a.materials.shape == (12,) and not a.materials.any()
+    b = TriMesh(a.vertices, a.faces, a.classes, np.array([7]))
+    assert np.all(b.materials == 7)
+    with pytest.raises(ValueError, match="materials has 3 entries for 12 faces"):
+        TriMesh(a.vertices, a.faces, a.classes, np.array([1, 2, 3]))
+    m = merge([a, b])
+    assert m.materials.tolist() == [0] * 12 + [7] * 12
+    t = transformed(b, rotation=np.eye(3), translation=(1.0, 2.0, 3.0))
+    assert np.array_equal(t.materials, b.materials)
+
+
+# ------------------------------------------------------------------------------------------ builders
+
+
+def test_boxes_are_closed_with_their_volume_and_materials() -> None:
+    rng = np.random.default_rng(0)
+    c = rng.normal(size=(5, 3)) * 10
+    s = rng.uniform(0.5, 3.0, size=(5, 3))
+    m = boxes(centers=c, sizes=s, cls=3, material=np.arange(5), yaw=rng.uniform(-3, 3, 5))
+    ok, vol = _closed_outward(m)
+    assert ok and vol == pytest.approx(float(np.prod(s, axis=1).sum()), rel=1e-12)
+    assert m.materials.tolist() == np.repeat(np.arange(5), 12).tolist()
+    ref = merge([box(center=c[i], size=s[i], cls=3) for i in range(5)])  # unturned reference
+    flat = boxes(centers=c, sizes=s, cls=3)
+    np.testing.assert_allclose(flat.vertices, ref.vertices, atol=1e-12)
+
+
+def test_tubes_are_closed_prisms_of_their_polygon_volume() -> None:
+    p0 = np.array([[0.0, 0.0, 0.0], [1.0, 2.0, 3.0], [0.0, 0.0, 5.0]])
+    p1 = np.array([[3.0, 0.0, 0.0], [1.0, 2.0, 7.0], [2.0, 1.0, 6.0]])
+    r, n = 0.3, 8
+    m = tubes(starts=p0, ends=p1, radius=r, cls=1, segments=n)
+    ok, vol = _closed_outward(m)
+    length = np.linalg.norm(p1 - p0, axis=1).sum()
+    assert ok and vol == pytest.approx(n / 2 * r * r * math.sin(2 * math.pi / n) * length, rel=1e-9)
+    assert m.num_triangles == 3 * 4 * n
+
+
+def test_lathe_sweep_torus_and_placed_are_closed() -> None:
+    cyl = lathe([(1.0, 0.0), (1.0, 2.0)], cls=1, segments=16, material=5)
+    ok, vol = _closed_outward(cyl)
+    assert ok and vol == pytest.approx(8 * math.sin(2 * math.pi / 16) * 2.0, rel=1e-12)
+    banded = lathe([(0.0, 0.0), (1.0, 0.5), (0.8, 1.0), (0.0, 1.2)], cls=1, segments=10, material=np.array([1, 2, 3]))
+    assert _closed_outward(banded)[0] and set(banded.materials.tolist()) == {1, 2, 3}
+    path = np.array([[0.0, 0.0, 0.0], [5.0, 0.0, 0.0], [5.0, 5.0, 0.0]])
+    s = sweep(path, radius=0.1, cls=1, segments=6)
+    assert _closed_outward(s)[0] and _closed_outward(s)[1] > 0
+    loop = sweep(
+        np.array([[0.0, 0.0, 1.0], [4.0, 0.0, 1.0], [4.0, 3.0, 1.0], [0.0, 3.0, 1.0]]), radius=0.1, cls=1, closed=True
+    )
+    assert _closed_outward(loop)[0] and _closed_outward(loop)[1] > 0
+    t = torus(major=1.0, minor=0.25, cls=1, segments=(32, 16))
+    ok, vol = _closed_outward(t)
+    # Pappus with the 16-gon section's area, times the 32-gon revolution's area ratio to the circle's
+    section = 8 * 0.25**2 * math.sin(2 * math.pi / 16)
+    ring = 16 * math.sin(2 * math.pi / 32) / math.pi
+    assert ok and vol == pytest.approx(2 * math.pi * 1.0 * section * ring, rel=1e-3)
+    many = placed(t, rotations=np.array([0.0, 1.0]), translations=np.array([[0.0, 0.0, 0.0], [5.0, 0.0, 0.0]]))
+    ok2, vol2 = _closed_outward(many)
+    assert ok2 and vol2 == pytest.approx(2 * vol, rel=1e-12)
+
+
+# -------------------------------------------------------------------------------------------------- glTF
+
+
+def test_gltf_pbr_materials_come_through_per_face(tmp_path: Path) -> None:
+    trimesh = pytest.importorskip("trimesh")
+    from trimesh.visual.material import PBRMaterial
+
+    red = PBRMaterial(name="red_paint", baseColorFactor=[0.8, 0.1, 0.1, 1.0], metallicFactor=0.0, roughnessFactor=0.6)
+    blue = PBRMaterial(
+        name="blue_metal",
+        baseColorFactor=[0.1, 0.2, 0.9, 1.0],
+        metallicFactor=1.0,
+        roughnessFactor=0.3,
+        emissiveFactor=[0.0, 0.0, 0.5],
+    )
+    a = trimesh.creation.box(extents=(2.0, 1.0, 1.0))
+    a.apply_translation((-1.0, 0.0, 0.0))
+    a.visual = trimesh.visual.TextureVisuals(material=red)
+    b = trimesh.creation.box(extents=(2.0, 1.0, 2.0))
+    b.apply_translation((1.0, 0.0, 0.5))
+    b.visual = trimesh.visual.TextureVisuals(material=blue)
+    path = tmp_path / "two.glb"
+    path.write_bytes(trimesh.Scene([a, b]).export(file_type="glb"))
+    asset = load_asset_file({"name": "two_boxes", "mesh": str(path), "waterline_z": 0.0})
+    mesh = asset.mesh
+    centroid_x = mesh.vertices[mesh.faces].mean(axis=1)[:, 0]
+    ids_a = set(mesh.materials[centroid_x < -0.01].tolist())
+    ids_b = set(mesh.materials[centroid_x > 0.01].tolist())
+    assert len(ids_a) == 1 and len(ids_b) == 1 and ids_a != ids_b
+    ma, mb = all_materials()[ids_a.pop()], all_materials()[ids_b.pop()]
+    assert ma.name == "two:red_paint" and mb.name == "two:blue_metal"
+    # glTF's baseColorFactor is linear (stored by trimesh as 8-bit): the factors, to 1/255
+    np.testing.assert_allclose(ma.base_color, [0.8, 0.1, 0.1], atol=1 / 255)
+    np.testing.assert_allclose(mb.base_color, [0.1, 0.2, 0.9], atol=1 / 255)
+    assert (ma.roughness, ma.metallic, mb.roughness, mb.metallic) == pytest.approx((0.6, 0.0, 0.3, 1.0))
+    assert mb.emissive[2] > 0 and ma.emissive == (0.0, 0.0, 0.0)
+    again = load_asset_file({"name": "two_boxes", "mesh": str(path), "waterline_z": 0.0})
+    assert np.array_equal(again.mesh.materials, mesh.materials)  # the same materials, the same ids
