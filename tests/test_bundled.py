@@ -73,3 +73,21 @@ def test_bundled_specs_resolve_from_another_directory(tmp_path: Path) -> None:
             resolve_spec("no_such_spec")
     finally:
         os.chdir(cwd)
+
+
+def test_python_api_takes_bundled_names(tmp_path: Path) -> None:
+    import mmusv
+    from mmusv.config import load_scenario
+    from mmusv.errors import ConfigError
+
+    cwd = os.getcwd()
+    os.chdir(tmp_path)
+    try:
+        want = load_scenario(REPO_SCENARIOS / "port_entry.yaml")
+        assert load_scenario("port_entry") == want == mmusv.Simulation("port_entry").scenario
+        res = mmusv.run("port_entry", out_dir=tmp_path / "out", frames=1)
+        assert Path(res.recording).name == "port_entry.mcap"
+        with pytest.raises(ConfigError, match="'no_such_scenario' does not exist"):
+            load_scenario("no_such_scenario")
+    finally:
+        os.chdir(cwd)

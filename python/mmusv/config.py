@@ -17,6 +17,7 @@ Units: metres, seconds, metres per second; angles in degrees only in keys ending
 
 from __future__ import annotations
 
+import contextlib
 import difflib
 import hashlib
 import json
@@ -271,9 +272,17 @@ def validation_error(err: ValidationError, source: str, *, noun: str = "config",
 
 
 def load_scenario(source: str | os.PathLike[str] | dict[str, Any] | Scenario) -> Scenario:
-    """Validates a scenario given as a YAML path, a dict, or a :class:`Scenario` (returned as is)."""
+    """Validates a scenario given as a YAML path, a dict, or a :class:`Scenario` (returned as is). A path that does
+    not exist but names a bundled scenario (``"port_entry"``) is that scenario, as on the command line
+    (:func:`mmusv.bundled.resolve_scenario`)."""
     if isinstance(source, Scenario):
         return source
+    if isinstance(source, (str, os.PathLike)) and not os.path.exists(source):
+        from mmusv.bundled import resolve_scenario
+        from mmusv.errors import NotFoundError
+
+        with contextlib.suppress(NotFoundError):  # not bundled either: the file error below names the path
+            source = resolve_scenario(os.fspath(source))
     data, where = mapping_source(source, kind="scenario", root_hint="at least `vessels:`")
     try:
         return Scenario.model_validate(data)
