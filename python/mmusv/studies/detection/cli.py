@@ -116,6 +116,9 @@ def run(args: argparse.Namespace) -> int:
     if args.generate is not None:
         if inputs or args.opv2v:
             raise InputError("--generate makes its own recordings: give no recordings and no --opv2v with it")
+        from rich.markup import escape
+
+        shortfalls: list[str] = []
         with _bar(console, "generate + record (LiDAR-only)", args.no_progress) as (bar, task):
             inputs = generate_dataset(
                 out / "dataset",
@@ -123,8 +126,15 @@ def run(args: argparse.Namespace) -> int:
                 progress=lambda name, done, total: (
                     bar.update(task, completed=done, total=total) if bar is not None else None
                 ),
+                shortfall=shortfalls.append,
             )
-        console.print(f"dataset: {len(inputs)} recordings in {out / 'dataset'} ({time.perf_counter() - t0:.1f} s)")
+        for line in shortfalls[1:]:
+            console.print(f"[yellow]generate: {escape(line)}[/]", highlight=False)
+        short = f" (quotas not met: {shortfalls[0]})" if shortfalls else ""
+        console.print(
+            f"dataset: {len(inputs)} recordings in {out / 'dataset'}{short} ({time.perf_counter() - t0:.1f} s)",
+            highlight=False,
+        )
     split = args.split or ("test" if args.generate is not None else "all")
     dataset = resolve_dataset(
         inputs, opv2v=args.opv2v, split=split, ratios=parse_ratios(args.split_ratios), seed=args.seed

@@ -147,12 +147,16 @@ def generate_dataset(
     *,
     spec: str | Path = BUNDLED_SPEC,
     progress: Callable[[str, int, int], None] | None = None,
+    shortfall: Callable[[str], None] | None = None,
 ) -> list[Path]:
     """Generates ``spec`` into ``out_dir/scenarios``, writes their LiDAR-only versions into ``out_dir/lidar_only``
     and records those with the batch runner (:func:`mmusv.batch.run_many`) into ``out_dir/recordings/<name>/``;
     returns the recordings. A complete recording of the same configuration is kept (delete ``out_dir`` to redo
-    it). ``progress``: ``("recording", frames done, frames in all)``. Raises :class:`~mmusv.InputError` when a
-    scenario could not be recorded."""
+    it). ``progress``: ``("recording", frames done, frames in all)``. When a quota was not met, ``shortfall`` is
+    called with how many scenarios were generated of how many asked for, then with one line per role combination
+    whose quota the generator did not meet, with the generator's reason
+    (:meth:`mmusv.generate.report.ComboReport.why`). Raises :class:`~mmusv.InputError` when a scenario could not
+    be recorded."""
     from mmusv.batch import dataset_recordings, run_many
     from mmusv.bundled import resolve_spec
     from mmusv.generate.runner import generate
@@ -160,7 +164,12 @@ def generate_dataset(
     sp = resolve_spec(spec)
     out = Path(out_dir)
     scen_dir, lidar_dir = out / "scenarios", out / "lidar_only"
-    generate(sp, scen_dir, force=True)
+    gen = generate(sp, scen_dir, force=True)
+    if shortfall is not None and not gen.all_met:
+        shortfall(f"{gen.accepted} of the {sum(c.quota for c in gen.combos)} scenarios the spec asks for")
+        for c in gen.combos:
+            if not c.met:
+                shortfall(f"quota not met {c.name}: {c.why()}")
     files = sorted(scen_dir.glob("*.yaml"))
     if not files:
         raise InputError(f"--generate: spec {sp} produced no scenario (see {scen_dir / 'report.json'})")
