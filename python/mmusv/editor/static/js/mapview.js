@@ -288,10 +288,19 @@ export class MapView {
     }
     const m = this.state.mapLayers;
     if (m && this.view.scale > 0.6) {
+      const overlays = this.overlayRects();
       for (const ship of m.moored) {
         const [sx, sy] = this.toScreen(ship.x, ship.y);
         const t = el("text", { class: "moored-label", x: sx - 20, y: sy + 4 }, labels);
         t.textContent = ship.asset;
+        // A label at the top of the map that would sit under the map buttons (or the legend) moves down to
+        // just below them, so it stays readable.
+        const b = t.getBBox();
+        for (const o of overlays) {
+          if (b.x < o.x1 && b.x + b.width > o.x0 && b.y < o.y1 && b.y + b.height > o.y0) {
+            t.setAttribute("y", o.y1 + (sy + 4 - b.y));
+          }
+        }
       }
     }
     const v = this.state.vessel();
@@ -307,6 +316,19 @@ export class MapView {
         el("title", {}, h).textContent = `${v.id} waypoint ${i}: (${x}, ${y}) m · drag to move · right-click to delete`;
       });
     }
+  }
+
+  /** Rectangles (SVG pixels, with a 4 px margin) of the controls drawn over the map: the Fit/Map/+/− buttons
+   * and the legend. Hidden controls are left out. */
+  overlayRects() {
+    const base = this.svg.getBoundingClientRect();
+    const out = [];
+    for (const id of ["map-tools", "legend"]) {
+      const r = document.getElementById(id)?.getBoundingClientRect();
+      if (!r || r.width === 0 || r.height === 0) continue;
+      out.push({ x0: r.left - base.left - 4, y0: r.top - base.top - 4, x1: r.right - base.left + 4, y1: r.bottom - base.top + 4 });
+    }
+    return out;
   }
 
   renderScale() {
