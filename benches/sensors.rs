@@ -4,7 +4,7 @@
 //! included), and a 512×512 top view. Throughput is reported per ray (= per pixel for cameras).
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use mmusv_core::sensors::camera::{Camera, CameraConfig, Projection};
+use mmusv_core::sensors::camera::{Camera, CameraConfig, ImageOptions, Projection, Quality};
 use mmusv_core::sensors::lidar::{Lidar, LidarConfig, LidarEnv};
 use mmusv_core::sensors::shade::ShadeEnv;
 use mmusv_core::RigidPose;
@@ -32,12 +32,14 @@ fn bench_sensors(c: &mut Criterion) {
             height: 480,
             projection: Projection::Pinhole { hfov: std::f64::consts::FRAC_PI_2 },
             range_max: 5000.0,
+            image: ImageOptions::default(),
         }),
         Camera::new(CameraConfig {
             width: 512,
             height: 512,
             projection: Projection::Orthographic { metres_per_pixel: 0.5 },
             range_max: 1000.0,
+            image: ImageOptions::default(),
         }),
     ) else {
         eprintln!("could not build the sensors");
@@ -53,9 +55,14 @@ fn bench_sensors(c: &mut Criterion) {
     g.bench_function("camera_640x480_depth_semantic", |b| {
         b.iter(|| black_box(cam.render(scene, &cam_pose, &env, false, 1)))
     });
-    g.bench_function("camera_640x480_rgb_shaded", |b| {
-        b.iter(|| black_box(cam.render(scene, &cam_pose, &env, true, 1)))
-    });
+    // The RGB at each quality level (draft: no reflections or anti-aliasing).
+    for quality in [Quality::Draft, Quality::Standard, Quality::High] {
+        let cfg = CameraConfig { image: ImageOptions { quality, ..ImageOptions::default() }, ..*cam.config() };
+        let Ok(q) = Camera::new(cfg) else { continue };
+        g.bench_function(format!("camera_640x480_rgb_{quality:?}").to_lowercase(), |b| {
+            b.iter(|| black_box(q.render(scene, &cam_pose, &env, true, 1)))
+        });
+    }
     g.throughput(Throughput::Elements(512 * 512));
     g.bench_function("top_view_512x512_rgb", |b| b.iter(|| black_box(top.render(scene, &top_pose, &env, true, 1))));
     g.finish();

@@ -81,9 +81,18 @@ class Scene:
         faces: npt.NDArray[np.int64],
         classes: npt.NDArray[np.uint16],
         name: str,
+        materials: npt.NDArray[np.uint16] | None = None,
     ) -> int:
         """Adds a mesh: ``vertices`` (V, 3) float32 metres (mesh frame), ``faces`` (F, 3) int64 in ``0..V``,
-        ``classes`` (1,) or (F,) uint16; returns the mesh id."""
+        ``classes`` (1,) or (F,) uint16, ``materials`` None, (1,) or (F,) uint16 ids into the material table;
+        returns the mesh id."""
+    def set_materials(self, table: npt.NDArray[np.float32]) -> None:
+        """Sets the material table (M, 9) float32: r, g, b, roughness, metallic, er, eg, eb, nav_light."""
+    @property
+    def num_materials(self) -> int:
+        """Rows of the material table."""
+    def set_lights(self, ids: npt.NDArray[np.uint32], on: bool) -> None:
+        """Turns the navigation lights of instances ``ids`` on or off."""
 
     def add_instance(self, mesh_id: int, pose: npt.NDArray[np.float64], class_override: int | None = None) -> int:
         """Places mesh ``mesh_id`` at ``pose`` ((4, 4) float64 rigid body → world); ``class_override`` uint16 or None;
@@ -183,25 +192,35 @@ def lidar_trace_order(*, channels: int, azimuth_steps: int, block: int = 8) -> n
 
 @final
 class SensorEnv:
-    """What every sensor sees of the environment: sun and sky (cameras; linear RGB, ``sun_direction`` a world
-    unit vector towards the sun), fog extinction 1/m (cameras, LiDAR), rain mm/h and wave height m (all).
-    Non-finite or negative values raise ``ConfigError`` naming ``env.<field>``."""
+    """The physical environment every sensor sees: sun direction (world unit vector towards it), Preetham
+    turbidity (1.7..10), cloud cover and ground albedo in [0, 1], fog extinction 1/m, rain mm/h, significant wave
+    height m, wind m/s, the water body's linear RGB albedo, a fixed exposure (EV100) or None for metered, and
+    whether cameras cast shadow rays. A value out of range raises ``ConfigError`` naming ``env.<field>``."""
 
     def __new__(
         cls,
         *,
         sun_direction: Sequence[float],
-        sun_color: Sequence[float],
-        sun_intensity: float,
-        ambient: float,
-        sky_zenith: Sequence[float],
-        sky_horizon: Sequence[float],
+        turbidity: float,
+        cloud_cover: float,
+        ground_albedo: float,
         fog_extinction_per_m: float,
-        fog_color: Sequence[float],
         rain_mm_per_h: float,
         wave_height_m: float,
+        wind_speed_m_s: float,
+        water_albedo: Sequence[float],
+        exposure_ev100: float | None = None,
         shadows: bool = True,
     ) -> SensorEnv: ...
+    @property
+    def exposure(self) -> tuple[float, float]:
+        """(horizontal illuminance of sun and sky in lux, exposure scale from cd/m² to the tone curve's input)."""
+    def sky_radiance(self, dirs: npt.NDArray[np.float32], *, sun_disc: bool = False) -> npt.NDArray[np.float32]:
+        """Sky radiance (N, 3) float32 cd/m² along unit world directions ``dirs`` (N, 3) (ground below the
+        horizon), with the sun's disc when ``sun_disc``."""
+    @property
+    def sun_irradiance(self) -> tuple[float, float, float]:
+        """Direct-normal irradiance of the sun, lux (linear RGB); zero at night."""
     @property
     def fog_extinction_per_m(self) -> float:
         """Atmospheric extinction, 1/m."""
@@ -254,10 +273,16 @@ class Camera:
         hfov: float | None = None,
         metres_per_pixel: float | None = None,
         range_max: float = ...,
+        quality: str = "standard",
+        distortion: Sequence[float] | None = None,
+        noise: tuple[float, float] | None = None,
     ) -> Camera: ...
     @property
     def rgb(self) -> bool:
         """Whether render shades an RGB image."""
+    @property
+    def distortion(self) -> tuple[float, float, float, float, float] | None:
+        """Brown–Conrady [k1, k2, p1, p2, k3] (OpenCV order) or None."""
     @property
     def intrinsics(self) -> tuple[float, float, float, float] | None:
         """[fx, fy, cx, cy] pixels (pinhole) or None (orthographic)."""
@@ -272,9 +297,17 @@ class Camera:
         """World ray origins and unit directions (N, 3) float32 of the row-major pixel indices ``pixels`` (N,)
         int64, in that order: the rows of ``world_rays`` for those pixels."""
     def render(
-        self, scene: Scene, *, pose: npt.NDArray[np.float64], env: SensorEnv, seed: int
+        self,
+        scene: Scene,
+        *,
+        pose: npt.NDArray[np.float64],
+        env: SensorEnv,
+        seed: int,
+        wakes: npt.NDArray[np.float32] | None = None,
+        radiance: bool = False,
     ) -> dict[str, npt.NDArray[Any]]:
-        """depth (H,W) f32, semantic (H,W) u16, instance (H,W) i32 and, for an rgb camera, rgb (H,W,3) u8."""
+        """depth (H,W) f32, semantic (H,W) u16, instance (H,W) i32 and, for an rgb camera, rgb (H,W,3) u8; with
+        ``radiance``, radiance (H,W,3) f32 cd/m². ``wakes`` (K, 6) f32: x, y, heading, speed, length, beam."""
 
 # --- radar ---
 
@@ -352,7 +385,11 @@ _CaptureTask = (
 )
 
 def capture_frame(
-    scene: Scene, *, env: SensorEnv, tasks: Sequence[_CaptureTask]
+    scene: Scene,
+    *,
+    env: SensorEnv,
+    tasks: Sequence[_CaptureTask],
+    wakes: npt.NDArray[np.float32] | None = None,
 ) -> list[tuple[dict[str, npt.NDArray[Any]], float, float]]:
     """Every sensor task of a frame on the current state of ``scene``, concurrently over all cores, GIL released.
     A task is ``(sensor, pose, seed)`` (pose (4, 4) float64 sensor → world) or ``(radar, pose, seed, ppi)`` with

@@ -141,6 +141,7 @@ class Scene:
         *,
         classes: int | npt.ArrayLike = 0,
         name: str = "",
+        materials: int | npt.ArrayLike | None = None,
     ) -> int:
         """Adds a triangle mesh and returns its mesh id.
 
@@ -149,6 +150,8 @@ class Scene:
             faces: ``(F, 3)`` integer vertex indices in ``0..V``.
             classes: one semantic class id for the whole mesh, or ``(F,)`` ids, one per face (0..65535).
             name: free text, shown in errors and exports.
+            materials: one material id or ``(F,)`` ids into the table of :meth:`set_materials` (0: the class's
+                default look; the cameras' shading only). ``None``: no materials.
         """
         v = _array(vertices, name="vertices", dtype=np.float32, shape_tail=(3,))
         f = _array(faces, name="faces", dtype=np.int64, shape_tail=(3,))
@@ -160,7 +163,39 @@ class Scene:
         if v.shape[0] and not np.isfinite(np.asarray(vertices, dtype=np.float64)).all():
             bad = int(np.argwhere(~np.isfinite(np.asarray(vertices, dtype=np.float64)).all(axis=1))[0, 0])
             raise GeometryError(f"invalid geometry in vertices[{bad}]: vertex is not finite; remove NaN/inf vertices")
-        return int(self._native.add_mesh(v, f, np.ascontiguousarray(c, dtype=np.uint16), name))
+        m = None
+        if materials is not None:
+            m = np.atleast_1d(np.asarray(materials))
+            if m.ndim != 1 or not np.issubdtype(m.dtype, np.integer):
+                raise InputError(f"materials must be an int or a 1-D integer array, got {m.dtype} with shape {m.shape}")
+            if m.size and (m.min() < 0 or m.max() > 65535):
+                raise InputError("materials must be in 0..65535")
+            m = np.ascontiguousarray(m, dtype=np.uint16)
+        return int(self._native.add_mesh(v, f, np.ascontiguousarray(c, dtype=np.uint16), name, m))
+
+    def set_materials(self, table: npt.ArrayLike) -> None:
+        """Sets the material table: ``(M, 9)`` float rows ``r, g, b, roughness, metallic, er, eg, eb, nav_light``
+        (linear base colour and roughness, metallic in [0, 1]; emitted radiance in cd/m²; nav_light 0 or 1, a
+        light that glows only on instances whose lights are on). Row 0 is never read (material id 0 means none).
+        :func:`mmusv.world.materials.material_table` gives the library's."""
+        t = np.ascontiguousarray(np.asarray(table, dtype=np.float32))
+        if t.ndim != 2 or t.shape[1] != 9:
+            raise InputError(f"materials must have shape (M, 9), got {t.shape}")
+        self._native.set_materials(t)
+
+    @property
+    def num_materials(self) -> int:
+        """Rows of the material table (0 before :meth:`set_materials`)."""
+        return int(self._native.num_materials)
+
+    def set_lights(self, instance_ids: npt.ArrayLike, *, on: bool) -> None:
+        """Turns the navigation lights (materials with ``nav_light``) of ``instance_ids`` on or off."""
+        ids = np.atleast_1d(np.asarray(instance_ids))
+        if ids.size == 0:
+            return
+        if ids.ndim != 1 or not np.issubdtype(ids.dtype, np.integer) or ids.min() < 0 or ids.max() >= 2**32:
+            raise InputError(f"instance_ids must be non-negative instance ids, got {ids!r}")
+        self._native.set_lights(np.ascontiguousarray(ids, dtype=np.uint32), bool(on))
 
     def add_instance(
         self, mesh_id: int, *, pose: npt.ArrayLike | None = None, class_override: int | None = None

@@ -208,6 +208,9 @@ class Simulation:
             self._moored_mats.append(pose_matrices(np.array([x, y, 0.0, 0.0, 0.0, yaw])))
         self._moored_eta = np.array([[x, y, 0.0, 0.0, 0.0, yaw] for _, (x, y, yaw) in self.world.moored]).reshape(-1, 6)
         self.agents: list[Agent] = [self._agent(i, v) for i, v in enumerate(sc.vessels) if v.role == "usv"]
+        # COLREG lights burn on the vessels under way (not on moored ships or vessels at speed 0).
+        under_way = [int(inst) for v, inst in zip(sc.vessels, self.ws.vessel_instances, strict=True) if not v.static]
+        self.ws.scene.set_lights(under_way, on=True)
         self._frame: int | None = None
 
     # ------------------------------------------------------------------------------------------ building
@@ -283,6 +286,20 @@ class Simulation:
         self.ws.scene.set_poses(self.ws.vessel_instances, state.matrices[:n])
         self._frame = frame
         return state
+
+    def wakes(self, state: WorldState) -> np.ndarray:
+        """``(K, 6)`` float32 rows ``x, y, heading, speed, length, beam`` (world metres, radians, m/s) of the
+        scenario vessels under way (horizontal speed above 0.3 m/s) in ``state``: the wakes the cameras draw."""
+        n = len(self.scenario.vessels)
+        rows = []
+        for i in range(n):
+            vx, vy = float(state.velocities[i, 0]), float(state.velocities[i, 1])
+            speed = math.hypot(vx, vy)
+            if speed > 0.3:
+                size = self.vessels[i].box_size
+                x, y, yaw = (float(state.poses[i, k]) for k in (0, 1, 5))
+                rows.append((x, y, yaw, speed, float(size[0]), float(size[1])))
+        return np.asarray(rows, dtype=np.float32).reshape(-1, 6)
 
     def agent(self, agent_id: str) -> Agent:
         """The agent (USV) named ``agent_id``."""
@@ -382,7 +399,10 @@ class Simulation:
                 tasks.append((agent.radar, cap.radar_pose, sensor_seed(sc.seed, frame, agent.index, "radar"), ppi))
                 slots.append((agent, cap, "radar"))
             out[agent.id] = cap
-        results = core.capture_frame(self.ws.scene.native, env=self.sensor_env, tasks=tasks) if tasks else []
+        wakes = self.wakes(state)
+        results = (
+            core.capture_frame(self.ws.scene.native, env=self.sensor_env, tasks=tasks, wakes=wakes) if tasks else []
+        )
         secs: dict[str, float] = {}
         for (agent, cap, key), (d, seconds, ppi_seconds) in zip(slots, results, strict=True):
             secs[f"{agent.id}/{key}"] = seconds

@@ -45,6 +45,7 @@ def _check_frame(sim: Simulation, frame: int) -> None:
     cap = sim.capture(frame)  # the batch
     seed = sim.scenario.seed
     env, scene = sim.sensor_env, sim.ws.scene  # the scene is at `frame` after the capture
+    wakes = sim.wakes(sim.world_state(frame))  # the vessels under way, whose wakes the cameras draw
     checked = 0
     for agent in sim.agents:
         ac = cap.agents[agent.id]
@@ -56,7 +57,12 @@ def _check_frame(sim: Simulation, frame: int) -> None:
         checked += 1
         for k, (name, (cam, _, _)) in enumerate(agent.cameras.items()):
             img = render(
-                cam, scene, pose=ac.camera_poses[name], env=env, seed=sensor_seed(seed, frame, agent.index, "camera", k)
+                cam,
+                scene,
+                pose=ac.camera_poses[name],
+                env=env,
+                seed=sensor_seed(seed, frame, agent.index, "camera", k),
+                wakes=wakes,
             )
             got = ac.cameras[name]
             for part in ("depth", "semantic", "instance"):
@@ -72,9 +78,12 @@ def _check_frame(sim: Simulation, frame: int) -> None:
             pose=ac.top_view_pose,
             env=env,
             seed=sensor_seed(seed, frame, agent.index, "top_view"),
+            wakes=wakes,
         )
         assert _same(ac.top_view.depth, tv.depth) and _same(ac.top_view.instance, tv.instance)
         assert (ac.top_view.rgb is None) == (tv.rgb is None)
+        if ac.top_view.rgb is not None and tv.rgb is not None:
+            assert _same(ac.top_view.rgb, tv.rgb)
         checked += 1
         assert agent.radar is not None and agent.rig.radar is not None and ac.radar is not None
         assert ac.radar_pose is not None and ac.radar_ppi is not None

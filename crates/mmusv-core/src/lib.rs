@@ -12,6 +12,7 @@
 //! - [`simd`]: run-time CPU feature dispatch (AVX2 where available, portable otherwise).
 //! - [`sea`]: exact shortcuts for rays that can only meet the sea surface or the sky (a height bound map).
 //! - [`mesh`]: triangle meshes with per-face semantic classes and a bottom-level BVH built once.
+//! - [`material`]: surface materials (base colour, roughness, metallic, emission) for the cameras' shading.
 //! - [`scene`]: meshes placed as instances, a top-level BVH over them, and batch ray casting over rayon.
 //! - [`export`]: the world triangles at the current poses as PLY or OBJ.
 //! - [`sensors`]: sensor ray patterns (LiDAR sweeps, pinhole cameras), the marine radar and its PPI image.
@@ -31,6 +32,7 @@ pub mod error;
 pub mod export;
 pub mod geometry;
 pub mod kinematics;
+pub mod material;
 pub mod mesh;
 pub mod ray;
 pub mod record;

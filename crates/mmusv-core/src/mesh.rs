@@ -19,6 +19,8 @@ pub struct Mesh {
     vertices: Vec<Vec3>,
     faces: Vec<[u32; 3]>,
     classes: Vec<u16>,
+    /// Material index per face into the scene's table (0: none); empty when no face has one.
+    materials: Vec<u16>,
     triangles: Vec<PreparedTriangle>,
     bvh: Bvh,
     /// One block of up to [`BLOCK`] triangles per BVH leaf, by leaf index.
@@ -104,7 +106,7 @@ impl Mesh {
             })
             .collect();
         let aabb = Aabb::from_points(verts.iter().copied());
-        Ok(Self { name, vertices: verts, faces: checked, classes, triangles, bvh, blocks, aabb })
+        Ok(Self { name, vertices: verts, faces: checked, classes, materials: Vec::new(), triangles, bvh, blocks, aabb })
     }
 
     /// The mesh's name (free text, used in exports and errors).
@@ -122,6 +124,35 @@ impl Mesh {
     /// Semantic class per face.
     pub fn classes(&self) -> &[u16] {
         &self.classes
+    }
+
+    /// Gives the faces materials: one index for the whole mesh (length 1) or one per face (length `F`), into the
+    /// table of the scene the mesh is added to (0: no material). The error names `materials`.
+    pub fn with_materials(mut self, materials: &[u16]) -> Result<Self> {
+        self.materials = match materials.len() {
+            0 => Vec::new(),
+            1 if materials[0] == 0 => Vec::new(),
+            1 => vec![materials[0]; self.faces.len()],
+            n if n == self.faces.len() => materials.to_vec(),
+            n => {
+                return Err(MmusvError::input(
+                    "materials",
+                    format!("got {n} materials for {} faces; give one or one per face", self.faces.len()),
+                ))
+            }
+        };
+        Ok(self)
+    }
+
+    /// Material index of face `triangle` (0 when the mesh has none).
+    #[inline]
+    pub fn material(&self, triangle: u32) -> u16 {
+        self.materials.get(triangle as usize).copied().unwrap_or(0)
+    }
+
+    /// Largest material index any face names (0 when none).
+    pub fn max_material(&self) -> u16 {
+        self.materials.iter().copied().max().unwrap_or(0)
     }
     /// Number of triangles.
     pub fn num_triangles(&self) -> usize {

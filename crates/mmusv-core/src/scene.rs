@@ -15,6 +15,7 @@
 use crate::bvh::{box_entry, Box3, Bvh, Packet, PacketStack, PacketVisit, Stack, Visit, PACKET};
 use crate::error::{MmusvError, Result};
 use crate::geometry::RigidPose;
+use crate::material::Material;
 use crate::mesh::Mesh;
 use crate::ray::RayPrep;
 use crate::sea::Sea;
@@ -38,6 +39,8 @@ pub struct Instance {
     mesh: u32,
     pose: RigidPose,
     class_override: Option<u16>,
+    /// Whether the instance's navigation lights are on (see [`crate::material::Material::nav_light`]).
+    lights_on: bool,
 }
 
 impl Instance {
@@ -52,6 +55,10 @@ impl Instance {
     /// If set, the semantic class of every face of this instance (else the mesh's per-face classes).
     pub fn class_override(&self) -> Option<u16> {
         self.class_override
+    }
+    /// Whether the instance's navigation lights are on.
+    pub fn lights_on(&self) -> bool {
+        self.lights_on
     }
 }
 
@@ -130,6 +137,8 @@ pub struct Scene {
     tlas_boxes: Vec<Box3>,
     /// The sea surface and the height bound of everything else, once declared ([`Scene::set_sea`]).
     sea: Option<Sea>,
+    /// The material table faces index into ([`Scene::set_materials`]); index 0 is "no material".
+    materials: Arc<Vec<Material>>,
 }
 
 impl Scene {
@@ -149,11 +158,67 @@ impl Scene {
     /// `class_override`, when given, replaces the mesh's per-face classes for this instance.
     pub fn add_instance(&mut self, mesh: u32, pose: RigidPose, class_override: Option<u16>) -> Result<u32> {
         self.check_mesh(mesh)?;
-        self.instances.push(Instance { mesh, pose, class_override });
+        self.instances.push(Instance { mesh, pose, class_override, lights_on: false });
         self.world_aabbs.push(Aabb::new_invalid());
         let id = (self.instances.len() - 1) as u32;
         self.refresh(&[id]);
         Ok(id)
+    }
+
+    /// Sets the material table every mesh's per-face indices refer to (row 0 is never read: index 0 means no
+    /// material). Fails, changing nothing, when a mesh names an index past the table (naming the mesh).
+    pub fn set_materials(&mut self, table: Vec<Material>) -> Result<()> {
+        if let Some(m) = self.meshes.iter().find(|m| m.max_material() as usize >= table.len().max(1)) {
+            return Err(MmusvError::input(
+                "materials",
+                format!(
+                    "mesh '{}' uses material {} but the table has {} rows",
+                    m.name(),
+                    m.max_material(),
+                    table.len()
+                ),
+            ));
+        }
+        self.materials = Arc::new(table);
+        Ok(())
+    }
+
+    /// Number of rows in the material table.
+    pub fn num_materials(&self) -> usize {
+        self.materials.len()
+    }
+
+    /// Turns the navigation lights of instances `ids` on or off. Validates every id first.
+    pub fn set_lights(&mut self, ids: &[u32], on: bool) -> Result<()> {
+        for &id in ids {
+            self.check_instance(id)?;
+        }
+        for &id in ids {
+            self.instances[id as usize].lights_on = on;
+        }
+        Ok(())
+    }
+
+    /// Material index of triangle `triangle` of instance `instance` (0 for none or a miss).
+    #[inline]
+    pub fn material_index(&self, instance: i32, triangle: i32) -> u16 {
+        match (usize::try_from(instance), u32::try_from(triangle)) {
+            (Ok(i), Ok(t)) if i < self.instances.len() => self.meshes[self.instances[i].mesh as usize].material(t),
+            _ => 0,
+        }
+    }
+
+    /// The material of triangle `triangle` of instance `instance`, `None` for no material (index 0), a miss
+    /// or an index past the table.
+    #[inline]
+    pub fn material_of(&self, instance: i32, triangle: i32) -> Option<&Material> {
+        let inst = self.instances.get(usize::try_from(instance).ok()?)?;
+        let id = self.meshes[inst.mesh as usize].material(u32::try_from(triangle).ok()?);
+        if id == 0 {
+            None
+        } else {
+            self.materials.get(id as usize)
+        }
     }
 
     /// Moves instances; `ids` and `poses` have the same length. Only the top-level BVH is rebuilt.

@@ -77,19 +77,22 @@ fn task<'a>(i: usize, item: &'a Item<'_>) -> PyResult<SensorTask<'a>> {
 /// `Lidar`, `Camera` or `Radar`, pose `(4, 4)` float64 sensor → world, or `(radar, pose, seed, ppi)` with
 /// `ppi = (size_px, metres_per_pixel, orientation, sensor_yaw)` or None. Returns, in task order,
 /// `(outputs, seconds, ppi_seconds)`: the dict `scan` / `render` / `sweep` return (a radar's with `ppi`
-/// `(size_px, size_px)` float32 when asked), and the task's wall seconds (profiling only).
+/// `(size_px, size_px)` float32 when asked), and the task's wall seconds (profiling only). `wakes` (K, 6)
+/// float32 are the vessels under way (see `Camera.render`).
 #[pyfunction]
-#[pyo3(signature = (scene, *, env, tasks))]
+#[pyo3(signature = (scene, *, env, tasks, wakes=None))]
 fn capture_frame<'py>(
     py: Python<'py>,
     scene: &Scene,
     env: &SensorEnv,
     tasks: Vec<Bound<'py, PyAny>>,
+    wakes: Option<numpy::PyReadonlyArray2<'py, f32>>,
 ) -> PyResult<Bound<'py, PyList>> {
+    let wakes = crate::sensors::wakes_arg(wakes.as_ref())?;
     let items = tasks.iter().enumerate().map(|(i, t)| parse_item(i, t)).collect::<PyResult<Vec<_>>>()?;
     let core_tasks = items.iter().enumerate().map(|(i, it)| task(i, it)).collect::<PyResult<Vec<_>>>()?;
     let shade = &env.shade;
-    let results = scene.read(|s| detached(py, || capture::capture_frame(s, shade, &core_tasks)))?;
+    let results = scene.read(|s| detached(py, || capture::capture_frame(s, shade, &wakes, &core_tasks)))?;
     let out = PyList::empty(py);
     for (r, t) in results.into_iter().zip(&core_tasks) {
         let d = match (r.output, t) {

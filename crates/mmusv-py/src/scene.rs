@@ -73,8 +73,9 @@ impl Scene {
         Self::from_core(CoreScene::new())
     }
 
-    /// Adds a mesh; builds its BVH with the GIL released. Returns the mesh id.
-    #[pyo3(signature = (vertices, faces, classes, name))]
+    /// Adds a mesh; builds its BVH with the GIL released. Returns the mesh id. `materials`: one index or one
+    /// per face into the scene's material table (0: none); an index past a table already set is an error.
+    #[pyo3(signature = (vertices, faces, classes, name, materials=None))]
     fn add_mesh(
         &self,
         py: Python<'_>,
@@ -82,12 +83,49 @@ impl Scene {
         faces: PyReadonlyArray2<'_, i64>,
         classes: PyReadonlyArray1<'_, u16>,
         name: &str,
+        materials: Option<PyReadonlyArray1<'_, u16>>,
     ) -> PyResult<u32> {
         let v = rows::<f32, 3>(&vertices, "vertices")?;
         let f = rows::<i64, 3>(&faces, "faces")?;
         let c = flat(&classes, "classes")?;
-        let mesh = detached(py, || Mesh::new(name, v, f, c))?;
+        let m: &[u16] = match &materials {
+            Some(m) => flat(m, "materials")?,
+            None => &[],
+        };
+        let mesh = detached(py, || Mesh::new(name, v, f, c).and_then(|mesh| mesh.with_materials(m)))?;
+        let limit = self.read(|s| Ok(s.num_materials()))?;
+        if mesh.max_material() > 0 && mesh.max_material() as usize >= limit {
+            return Err(InputError::new_err(format!(
+                "materials: mesh '{name}' uses material {} but the scene's table has {limit} rows (set_materials first)",
+                mesh.max_material()
+            )));
+        }
         self.write(|s| s.add_mesh(mesh))
+    }
+
+    /// Sets the material table `(M, 9)` float32, one row per material: r, g, b (linear base colour),
+    /// roughness, metallic, er, eg, eb (emitted radiance, cd/m²), nav_light (0 or 1). Row 0 is never read.
+    fn set_materials(&self, table: PyReadonlyArray2<'_, f32>) -> PyResult<()> {
+        let rows = rows::<f32, { mmusv_core::material::COLUMNS }>(&table, "materials")?;
+        let mats = rows
+            .iter()
+            .enumerate()
+            .map(|(i, r)| mmusv_core::material::Material::from_row(i, r))
+            .collect::<mmusv_core::Result<Vec<_>>>()
+            .map_err(crate::errors::to_py)?;
+        self.write(|s| s.set_materials(mats))?.map_err(crate::errors::to_py)
+    }
+
+    /// Rows of the material table (0 before `set_materials`).
+    #[getter]
+    fn num_materials(&self) -> PyResult<usize> {
+        self.read(|s| Ok(s.num_materials()))
+    }
+
+    /// Turns the navigation lights of instances `ids` (K,) uint32 on or off.
+    fn set_lights(&self, ids: PyReadonlyArray1<'_, u32>, on: bool) -> PyResult<()> {
+        let ids = flat(&ids, "instance_ids")?;
+        self.write(|s| s.set_lights(ids, on))?.map_err(crate::errors::to_py)
     }
 
     /// Places mesh `mesh_id` at `pose` (4x4 float64); returns the instance id.

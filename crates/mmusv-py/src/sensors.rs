@@ -1,6 +1,7 @@
 //! Bindings for `mmusv_core::sensors`: ray patterns, the spinning LiDAR and the cameras.
 
 use crate::native::{detached, flat, pose_arg, rows_to_array, RayArrays};
+use mmusv_core::sensors::shade::water::Wake;
 use mmusv_core::sensors::shade::ShadeEnv;
 use mmusv_core::sensors::{camera, capture, lidar, rays};
 use numpy::ndarray::{Array2, Array3};
@@ -99,6 +100,15 @@ fn env_value(field: &str, value: f32, nonneg: bool) -> PyResult<f32> {
     }
 }
 
+/// `value` if in `[0, 1]`, else a `ConfigError` naming `env.<field>`.
+fn env_fraction(field: &str, value: f32) -> PyResult<f32> {
+    if value.is_finite() && (0.0..=1.0).contains(&value) {
+        Ok(value)
+    } else {
+        Err(crate::errors::ConfigError::new_err(format!("invalid config env.{field} = {value}: must be in [0, 1]")))
+    }
+}
+
 impl SensorEnv {
     /// The LiDAR's share: fog, rain, waves.
     pub(crate) fn lidar(&self) -> lidar::LidarEnv {
@@ -108,52 +118,95 @@ impl SensorEnv {
 
 #[pymethods]
 impl SensorEnv {
-    /// Lighting in linear RGB (`sun_direction` a world-frame unit vector towards the sun), `fog_extinction_per_m`
-    /// (1/m, 3 / visibility), `rain_mm_per_h`, `wave_height_m` (significant height H), and whether cameras
-    /// cast shadow rays. Every value must be finite; intensities, fog, rain and waves `>= 0`.
+    /// The physical environment: `sun_direction` a world-frame unit vector towards the sun (below the horizon
+    /// at night), `turbidity` (Preetham, 1.7..10), `cloud_cover` in [0, 1], `ground_albedo` in [0, 1] (the sea
+    /// below the horizon for sky light), `fog_extinction_per_m` (1/m, 3 / visibility), `rain_mm_per_h`,
+    /// `wave_height_m` (significant height H), `wind_speed_m_s` (capillary roughness, whitecaps),
+    /// `water_albedo` (linear RGB diffuse reflectance of the water body), `exposure_ev100` (None: metered from
+    /// the scene's light), and whether cameras cast shadow rays. Every value must be finite and in range.
     #[new]
-    #[pyo3(signature = (*, sun_direction, sun_color, sun_intensity, ambient, sky_zenith, sky_horizon,
-        fog_extinction_per_m, fog_color, rain_mm_per_h, wave_height_m, shadows=true))]
+    #[pyo3(signature = (*, sun_direction, turbidity, cloud_cover, ground_albedo, fog_extinction_per_m,
+        rain_mm_per_h, wave_height_m, wind_speed_m_s, water_albedo, exposure_ev100=None, shadows=true))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         sun_direction: Vec<f32>,
-        sun_color: Vec<f32>,
-        sun_intensity: f32,
-        ambient: f32,
-        sky_zenith: Vec<f32>,
-        sky_horizon: Vec<f32>,
+        turbidity: f32,
+        cloud_cover: f32,
+        ground_albedo: f32,
         fog_extinction_per_m: f32,
-        fog_color: Vec<f32>,
         rain_mm_per_h: f32,
         wave_height_m: f32,
+        wind_speed_m_s: f32,
+        water_albedo: Vec<f32>,
+        exposure_ev100: Option<f32>,
         shadows: bool,
     ) -> PyResult<Self> {
-        let colours = [
-            ("sun_direction", &sun_direction),
-            ("sun_color", &sun_color),
-            ("sky_zenith", &sky_zenith),
-            ("sky_horizon", &sky_horizon),
-            ("fog_color", &fog_color),
-        ];
-        for (name, v) in colours {
-            for &x in v.iter() {
-                env_value(name, x, false)?;
-            }
+        for &x in sun_direction.iter() {
+            env_value("sun_direction", x, false)?;
         }
+        for &x in water_albedo.iter() {
+            env_fraction("water_albedo", x)?;
+        }
+        let sun = triple(sun_direction, "sun_direction")?;
+        if sun.iter().map(|x| x * x).sum::<f32>() < 1e-12 {
+            return Err(crate::errors::ConfigError::new_err(
+                "invalid config env.sun_direction = [0, 0, 0]: must be a non-zero vector",
+            ));
+        }
+        if !(turbidity.is_finite() && (1.7..=10.0).contains(&turbidity)) {
+            return Err(crate::errors::ConfigError::new_err(format!(
+                "invalid config env.turbidity = {turbidity}: must be in [1.7, 10]"
+            )));
+        }
+        let exposure_ev100 = match exposure_ev100 {
+            Some(ev) => env_value("exposure_ev100", ev, false)?,
+            None => f32::NAN,
+        };
         let shade = ShadeEnv {
-            sun_direction: triple(sun_direction, "sun_direction")?,
-            sun_color: triple(sun_color, "sun_color")?,
-            sun_intensity: env_value("sun_intensity", sun_intensity, true)?,
-            ambient: env_value("ambient", ambient, true)?,
-            sky_zenith: triple(sky_zenith, "sky_zenith")?,
-            sky_horizon: triple(sky_horizon, "sky_horizon")?,
+            sun_direction: sun,
+            turbidity,
+            cloud_cover: env_fraction("cloud_cover", cloud_cover)?,
+            ground_albedo: env_fraction("ground_albedo", ground_albedo)?,
             fog_extinction_per_m: env_value("fog_extinction_per_m", fog_extinction_per_m, true)?,
-            fog_color: triple(fog_color, "fog_color")?,
             rain_mm_per_h: env_value("rain_mm_per_h", rain_mm_per_h, true)?,
             wave_height_m: env_value("wave_height_m", wave_height_m, true)?,
+            wind_speed_m_s: env_value("wind_speed_m_s", wind_speed_m_s, true)?,
+            water_albedo: triple(water_albedo, "water_albedo")?,
+            exposure_ev100,
             shadows,
         };
         Ok(Self { shade })
+    }
+
+    /// Horizontal illuminance of the sun and sky (lux) and the exposure scale the cameras use (radiance in
+    /// cd/m² times it is the tone curve's input).
+    #[getter]
+    fn exposure(&self) -> (f32, f32) {
+        let l = mmusv_core::sensors::shade::envlight::Lighting::shared(&self.shade.lighting_key());
+        let k = mmusv_core::sensors::shade::tonemap::exposure_scale(self.shade.exposure_ev100, l.horizontal_lux);
+        (l.horizontal_lux, k)
+    }
+
+    /// Radiance of the sky (cd/m², linear sRGB primaries) along unit world directions `dirs` (N, 3) float32,
+    /// without the sun's disc (`sun_disc=False`) or with it; below the horizon, the ground's radiance.
+    #[pyo3(signature = (dirs, *, sun_disc=false))]
+    fn sky_radiance<'py>(
+        &self,
+        py: Python<'py>,
+        dirs: PyReadonlyArray2<'py, f32>,
+        sun_disc: bool,
+    ) -> PyResult<Bound<'py, PyArray2<f32>>> {
+        let d = crate::native::rows::<f32, 3>(&dirs, "dirs")?;
+        let l = mmusv_core::sensors::shade::envlight::Lighting::shared(&self.shade.lighting_key());
+        let out: Vec<[f32; 3]> = d.iter().map(|v| l.radiance_along(*v, sun_disc)).collect();
+        rows_to_array(py, out)
+    }
+
+    /// Direct-normal irradiance of the sun (lux, linear sRGB primaries), zero at night.
+    #[getter]
+    fn sun_irradiance(&self) -> [f32; 3] {
+        let l = mmusv_core::sensors::shade::envlight::Lighting::shared(&self.shade.lighting_key());
+        l.sky.sun_irradiance().to_array()
     }
 
     /// Atmospheric extinction, 1/m.
@@ -256,7 +309,9 @@ pub struct Camera {
 #[pymethods]
 impl Camera {
     #[new]
-    #[pyo3(signature = (*, width, height, rgb, hfov=None, metres_per_pixel=None, range_max=f32::INFINITY))]
+    #[pyo3(signature = (*, width, height, rgb, hfov=None, metres_per_pixel=None, range_max=f32::INFINITY,
+        quality="standard", distortion=None, noise=None))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         width: u32,
         height: u32,
@@ -264,7 +319,37 @@ impl Camera {
         hfov: Option<f64>,
         metres_per_pixel: Option<f64>,
         range_max: f32,
+        quality: &str,
+        distortion: Option<[f64; 5]>,
+        noise: Option<(f32, f32)>,
     ) -> PyResult<Self> {
+        let quality = match quality {
+            "draft" => camera::Quality::Draft,
+            "standard" => camera::Quality::Standard,
+            "high" => camera::Quality::High,
+            other => {
+                return Err(crate::errors::ConfigError::new_err(format!(
+                    "invalid config camera.quality = {other:?}: allowed values are draft, standard, high"
+                )))
+            }
+        };
+        let noise = match noise {
+            Some((full_well, read_noise)) => {
+                if !(full_well.is_finite() && full_well > 0.0 && read_noise.is_finite() && read_noise >= 0.0) {
+                    return Err(crate::errors::ConfigError::new_err(format!(
+                        "invalid config camera.noise = ({full_well}, {read_noise}): full well must be > 0 \
+                         electrons and read noise >= 0"
+                    )));
+                }
+                Some(mmusv_core::sensors::shade::tonemap::SensorNoise { full_well, read_noise })
+            }
+            None => None,
+        };
+        let image = camera::ImageOptions {
+            quality,
+            distortion: distortion.map(|coefficients| camera::Distortion { coefficients }),
+            noise,
+        };
         let projection = match (hfov, metres_per_pixel) {
             (Some(hfov), None) => camera::Projection::Pinhole { hfov },
             (None, Some(m)) => camera::Projection::Orthographic { metres_per_pixel: m },
@@ -274,7 +359,7 @@ impl Camera {
                 ))
             }
         };
-        let cfg = camera::CameraConfig { width, height, projection, range_max };
+        let cfg = camera::CameraConfig { width, height, projection, range_max, image };
         Ok(Self { inner: camera::Camera::new(cfg).map_err(crate::errors::to_py)?, rgb })
     }
 
@@ -288,6 +373,12 @@ impl Camera {
     #[getter]
     fn intrinsics(&self) -> Option<[f64; 4]> {
         self.inner.intrinsics()
+    }
+
+    /// Brown–Conrady `[k1, k2, p1, p2, k3]` (OpenCV's order), `None` without distortion.
+    #[getter]
+    fn distortion(&self) -> Option<[f64; 5]> {
+        self.inner.config().image.distortion.map(|d| d.coefficients)
     }
 
     /// `(width, height)` in pixels.
@@ -319,8 +410,11 @@ impl Camera {
 
     /// Renders the current state of `scene` from `pose` (4×4 camera body → world) in `env`. Returns a dict:
     /// depth (H,W) f32 metres along the axis (inf = sky), semantic (H,W) u16, instance (H,W) i32 (−1 = sky) and,
-    /// for a camera built with `rgb=True`, rgb (H,W,3) u8 sRGB.
-    #[pyo3(signature = (scene, *, pose, env, seed))]
+    /// for a camera built with `rgb=True`, rgb (H,W,3) u8 sRGB; with `radiance=True`, radiance (H,W,3) f32
+    /// linear cd/m² (before noise and exposure). `wakes` (K, 6) float32 rows `x, y, heading, speed, length,
+    /// beam` (world metres, radians, m/s) are the vessels under way whose wakes the water shows.
+    #[pyo3(signature = (scene, *, pose, env, seed, wakes=None, radiance=false))]
+    #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
         py: Python<'py>,
@@ -328,10 +422,14 @@ impl Camera {
         pose: PyReadonlyArray2<'py, f64>,
         env: &SensorEnv,
         seed: u64,
+        wakes: Option<PyReadonlyArray2<'py, f32>>,
+        radiance: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let pose = pose_arg(&pose, "pose")?;
+        let wakes = wakes_arg(wakes.as_ref())?;
         let (env, rgb) = (&env.shade, self.rgb);
-        let f = scene.read(|s| detached(py, || self.inner.render(s, &pose, env, rgb, seed)))?;
+        let options = camera::RenderOptions { rgb, radiance, seed, wakes: &wakes };
+        let f = scene.read(|s| detached(py, || self.inner.render_with(s, &pose, env, &options)))?;
         frame_dict(py, f, rgb)
     }
 }
@@ -361,5 +459,25 @@ pub(crate) fn frame_dict(py: Python<'_>, f: camera::CameraFrame, rgb: bool) -> P
     if rgb {
         d.set_item("rgb", Array3::from_shape_vec((h, w, 3), f.rgb).map_err(shape_err)?.into_pyarray(py))?;
     }
+    if !f.radiance.is_empty() {
+        d.set_item("radiance", Array3::from_shape_vec((h, w, 3), f.radiance).map_err(shape_err)?.into_pyarray(py))?;
+    }
     Ok(d)
+}
+
+/// Wakes from a `(K, 6)` float32 array (`x, y, heading, speed, length, beam`), checked finite.
+pub(crate) fn wakes_arg(wakes: Option<&PyReadonlyArray2<'_, f32>>) -> PyResult<Vec<Wake>> {
+    let Some(w) = wakes else { return Ok(Vec::new()) };
+    let rows = crate::native::rows::<f32, 6>(w, "wakes")?;
+    rows.iter()
+        .enumerate()
+        .map(|(i, r)| {
+            if r.iter().any(|x| !x.is_finite()) || r[3] < 0.0 || r[4] <= 0.0 || r[5] <= 0.0 {
+                return Err(crate::errors::InputError::new_err(format!(
+                    "wakes[{i}] = {r:?}: must be finite, with speed >= 0 and length, beam > 0"
+                )));
+            }
+            Ok(Wake { x: r[0], y: r[1], heading: r[2], speed: r[3], length: r[4], beam: r[5] })
+        })
+        .collect()
 }

@@ -31,18 +31,35 @@ class CameraImages:
     semantic: npt.NDArray[np.uint16]
     instance: npt.NDArray[np.int32]
     rgb: npt.NDArray[np.uint8] | None
+    radiance: npt.NDArray[np.float32] | None = None
 
     @classmethod
     def from_native(cls, d: dict[str, npt.NDArray[Any]]) -> CameraImages:
         """The images from the dict of ``core.Camera.render`` (or of ``core.capture_frame``)."""
-        return cls(depth=d["depth"], semantic=d["semantic"], instance=d["instance"], rgb=d.get("rgb"))
+        return cls(
+            depth=d["depth"],
+            semantic=d["semantic"],
+            instance=d["instance"],
+            rgb=d.get("rgb"),
+            radiance=d.get("radiance"),
+        )
 
 
 def camera_from_config(cfg: CameraConfig) -> core.Camera:
     """The native pinhole camera for ``cfg`` (shades RGB when ``rgb`` is among its outputs)."""
     w, h = cfg.resolution
     rgb = "rgb" in cfg.outputs
-    return core.Camera(width=w, height=h, rgb=rgb, hfov=math.radians(cfg.hfov_deg), range_max=cfg.range_m)
+    noise = None if cfg.noise is None else (cfg.noise.full_well_e, cfg.noise.read_noise_e)
+    return core.Camera(
+        width=w,
+        height=h,
+        rgb=rgb,
+        hfov=math.radians(cfg.hfov_deg),
+        range_max=cfg.range_m,
+        quality=cfg.quality,
+        distortion=None if cfg.distortion is None else list(cfg.distortion),
+        noise=noise,
+    )
 
 
 def top_view_from_config(cfg: TopViewConfig) -> core.Camera:
@@ -50,11 +67,24 @@ def top_view_from_config(cfg: TopViewConfig) -> core.Camera:
     w, h = cfg.resolution
     rgb = "rgb" in cfg.outputs
     mpp, range_max = cfg.metres_per_pixel, cfg.altitude_m + 500.0
-    return core.Camera(width=w, height=h, rgb=rgb, metres_per_pixel=mpp, range_max=range_max)
+    return core.Camera(width=w, height=h, rgb=rgb, metres_per_pixel=mpp, range_max=range_max, quality=cfg.quality)
 
 
-def render(camera: core.Camera, scene: Scene, *, pose: npt.ArrayLike, env: core.SensorEnv, seed: int) -> CameraImages:
+def render(
+    camera: core.Camera,
+    scene: Scene,
+    *,
+    pose: npt.ArrayLike,
+    env: core.SensorEnv,
+    seed: int,
+    wakes: npt.ArrayLike | None = None,
+    radiance: bool = False,
+) -> CameraImages:
     """Renders ``scene`` (current state) with ``camera`` at ``pose`` (``(4, 4)`` camera body → world) in ``env``
-    (:func:`mmusv.sensors.env.sensor_env`)."""
+    (:func:`mmusv.sensors.env.sensor_env`). ``wakes``: ``(K, 6)`` rows ``x, y, heading, speed, length, beam``
+    (world metres, radians, m/s) of the vessels under way; ``radiance`` also returns the linear radiance
+    ``(H, W, 3)`` float32 in cd/m² (linear sRGB primaries, before sensor noise and exposure)."""
     p = np.ascontiguousarray(pose, dtype=np.float64).reshape(4, 4)
-    return CameraImages.from_native(camera.render(scene.native, pose=p, env=env, seed=int(seed)))
+    w = None if wakes is None else np.ascontiguousarray(wakes, dtype=np.float32).reshape(-1, 6)
+    out = camera.render(scene.native, pose=p, env=env, seed=int(seed), wakes=w, radiance=radiance)
+    return CameraImages.from_native(out)

@@ -39,6 +39,9 @@ RIG_PRESETS: dict[str, dict[str, object]] = {
 """Defaults each preset puts in place of the paper's full suite (keys given explicitly in the rig win)."""
 
 CameraOutput = Literal["rgb", "depth", "semantic", "instance"]
+Quality = Literal["draft", "standard", "high"]
+"""Work spent on a camera's RGB: ``draft`` one sample per pixel and water reflecting the sky; ``standard`` traced
+water reflections and 4 stratified samples on edge pixels; ``high`` the same with 16 samples."""
 _ALL_OUTPUTS: tuple[CameraOutput, ...] = ("rgb", "depth", "semantic", "instance")
 _TOP_OUTPUTS: tuple[CameraOutput, ...] = ("rgb", "semantic", "instance")
 
@@ -233,9 +236,20 @@ class RadarConfig(_Model):
         return self
 
 
+class SensorNoiseConfig(_Model):
+    """Shot and read noise of an image sensor: ``full_well_e`` electrons at full scale (before the tone curve)
+    and ``read_noise_e`` electrons RMS."""
+
+    full_well_e: float = Field(default=10000.0, gt=0)
+    read_noise_e: float = Field(default=3.0, ge=0)
+
+
 class CameraConfig(_Model):
     """A pinhole camera: ``resolution`` ``[width, height]`` pixels, horizontal field of view ``hfov_deg`` (< 180),
-    the images to produce, and its mount (optical axis = the mount's x axis)."""
+    the images to produce, and its mount (optical axis = the mount's x axis). ``quality`` (:data:`Quality`) sets
+    the RGB's anti-aliasing and reflections; ``distortion`` is Brown–Conrady ``[k1, k2, p1, p2, k3]`` in OpenCV's
+    order (none by default); ``noise`` adds seeded shot and read noise (none by default). Depth, semantic and
+    instance images always come from the pixel centres."""
 
     name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$")
     resolution: tuple[int, int] = (640, 480)
@@ -243,8 +257,20 @@ class CameraConfig(_Model):
     outputs: list[CameraOutput] = Field(default_factory=lambda: list(_ALL_OUTPUTS))
     range_m: float = Field(default=5000.0, gt=0)
     mount: Mount = Mount()
+    quality: Quality = "standard"
+    distortion: tuple[float, float, float, float, float] | None = None
+    noise: SensorNoiseConfig | None = None
 
     _res = field_validator("resolution")(_check_resolution)
+
+    @field_validator("distortion")
+    @classmethod
+    def _finite_distortion(
+        cls, v: tuple[float, float, float, float, float] | None
+    ) -> tuple[float, float, float, float, float] | None:
+        if v is not None and not all(math.isfinite(x) for x in v):
+            raise ValueError("every coefficient must be finite")
+        return v
 
 
 class TopViewConfig(_Model):
@@ -257,6 +283,7 @@ class TopViewConfig(_Model):
     metres_per_pixel: float = Field(default=0.5, gt=0)
     orientation: Literal["heading_up", "north_up"] = "heading_up"
     outputs: list[CameraOutput] = Field(default_factory=lambda: list(_TOP_OUTPUTS))
+    quality: Quality = "standard"
 
     _res = field_validator("resolution")(_check_resolution)
 

@@ -1,25 +1,46 @@
 """The environment as the sensors see it: one :class:`mmusv._core.SensorEnv` per scenario, passed to every
 LiDAR scan, camera render and radar sweep.
 
-From a resolved :class:`~mmusv.world.environment.Environment`: the sun (direction towards it, world frame;
-colour; intensity dimmed by clouds), a sky gradient from the sun height and cloud cover (linear RGB), fog
-extinction σ = 3 / visibility (1/m), rain (mm/h) and the significant wave height H (m). Cameras use all of it;
-the LiDAR fog, rain and waves; the radar rain and waves.
+From a resolved :class:`~mmusv.world.environment.Environment`: the direction towards the sun (world frame;
+below the horizon at night), the air's turbidity, the cloud cover, fog extinction σ = 3 / visibility (1/m),
+rain (mm/h), the significant wave height H (m), the wind and the water's colour. The cameras turn these into
+radiance with the physical models of the core (Preetham sky, ESRA sun, GGX surfaces, Cox–Munk water,
+Monahan whitecaps: ``crates/mmusv-core/src/sensors/shade/``); the LiDAR uses fog, rain and waves; the radar rain
+and waves.
+
+* **Turbidity** from the meteorological visibility ``V``: ``T = 1.9 + 30 / V_km``, clamped to [1.9, 10], a
+  monotone mapping chosen so that a clear 20 km day is T ≈ 3.4 and a 5 km haze T ≈ 7.9 (the range over which
+  Preetham et al. 1999 fitted their model); fog and rain, whose skies are overcast, saturate it.
+* **Wind** (m/s at 10 m), when the scenario does not give one: the wind of a fully developed Pierson–Moskowitz
+  sea of the scenario's significant height, ``U = √(H g / 0.21)``.
+* **Water body**: diffuse reflectance (linear RGB) of clear open-ocean water, blue (Morel 1988's case-1 water:
+  a few per cent in the blue, well under one in the red).
 """
 
 from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from mmusv._native import core
 from mmusv.world.environment import Environment
 
-__all__ = ["FOG_COLOR", "sensor_env"]
+__all__ = ["SEA_ALBEDO", "WATER_ALBEDO", "sensor_env", "turbidity_from_visibility", "wind_from_wave_height"]
 
-FOG_COLOR = (0.72, 0.75, 0.78)
-"""Linear RGB that distant surfaces fade to in fog."""
+SEA_ALBEDO = 0.06
+"""Albedo of the sea surface under a high sun (Payne 1972): the lower hemisphere of the cameras' sky light."""
+
+WATER_ALBEDO = (0.004, 0.018, 0.03)
+"""Diffuse reflectance of the water body, linear RGB."""
+
+
+def turbidity_from_visibility(visibility_m: float) -> float:
+    """Preetham turbidity (1.9..10) of air with meteorological visibility ``visibility_m`` (metres)."""
+    return float(min(10.0, max(1.9, 1.9 + 30.0 / max(visibility_m / 1000.0, 1e-3))))
+
+
+def wind_from_wave_height(wave_height_m: float) -> float:
+    """Wind speed (m/s) of a fully developed Pierson–Moskowitz sea of significant height ``wave_height_m``."""
+    return math.sqrt(max(0.0, wave_height_m) * 9.81 / 0.21)
 
 
 def sensor_env(
@@ -28,35 +49,30 @@ def sensor_env(
     fog_extinction_per_m: float | None = None,
     rain_mm_per_h: float | None = None,
     wave_height_m: float | None = None,
+    wind_speed_m_s: float | None = None,
+    exposure_ev100: float | None = None,
     shadows: bool = True,
 ) -> core.SensorEnv:
     """The sensors' view of ``environment`` (default: clear noon, ``Environment.make()``). The keyword values,
-    when given, replace its fog extinction (1/m), rain (mm/h) and wave height (m): for driving one sensor by
-    hand. Raises :class:`mmusv.ConfigError` naming ``env.<field>`` for a negative or non-finite value."""
+    when given, replace its fog extinction (1/m), rain (mm/h), wave height (m) and wind (m/s; default from the
+    wave height), and fix the cameras' exposure (EV at ISO 100; default metered from the scene's light): for
+    driving one sensor by hand. Raises :class:`mmusv.ConfigError` naming ``env.<field>`` for a value out of
+    range."""
     env = environment if environment is not None else Environment.make()
-    sun = env.sun
-    cloud = env.weather.cloud_cover
-    elev = max(0.0, math.sin(math.radians(sun.elevation_deg)))
-    zen_clear = np.array([0.10, 0.28, 0.70]) * (0.3 + 0.7 * elev) + np.array([0.02, 0.02, 0.05])
-    dusk = np.array([0.25, 0.1, 0.0]) * (1 - elev) * sun.intensity
-    hor_clear = np.array([0.62, 0.70, 0.82]) * (0.4 + 0.6 * elev) + dusk
-    grey = np.array([0.55, 0.57, 0.6])
-    zenith = zen_clear * (1 - cloud) + grey * cloud
-    horizon = hor_clear * (1 - cloud) + grey * 1.05 * cloud
-    direct = sun.intensity * (1.0 - 0.85 * cloud)
     fog = env.weather.extinction_per_m if fog_extinction_per_m is None else fog_extinction_per_m
     rain = env.weather.rain_mm_per_h if rain_mm_per_h is None else rain_mm_per_h
     waves = env.wave_height_m if wave_height_m is None else wave_height_m
+    wind = wind_from_wave_height(waves) if wind_speed_m_s is None else wind_speed_m_s
     return core.SensorEnv(
-        sun_direction=[float(x) for x in sun.direction],
-        sun_color=[float(x) for x in sun.color],
-        sun_intensity=float(direct),
-        ambient=float(sun.ambient),
-        sky_zenith=[float(x) for x in zenith],
-        sky_horizon=[float(x) for x in horizon],
+        sun_direction=[float(x) for x in env.sun.direction],
+        turbidity=turbidity_from_visibility(env.weather.visibility_m),
+        cloud_cover=float(env.weather.cloud_cover),
+        ground_albedo=SEA_ALBEDO,
         fog_extinction_per_m=float(fog),
-        fog_color=list(FOG_COLOR),
         rain_mm_per_h=float(rain),
         wave_height_m=float(waves),
+        wind_speed_m_s=float(wind),
+        water_albedo=list(WATER_ALBEDO),
+        exposure_ev100=exposure_ev100,
         shadows=shadows,
     )

@@ -15,6 +15,7 @@ from mmusv.classes import SemanticClass
 from mmusv.frames import pose_matrices  # re-exported: the pose convention lives in mmusv.frames
 from mmusv.scene import Scene
 from mmusv.world.maps import MapWorld
+from mmusv.world.materials import material_table
 from mmusv.world.primitives import TriMesh
 from mmusv.world.vessels import get_asset
 
@@ -41,7 +42,12 @@ class WorldScene:
 
 
 def _add(scene: Scene, mesh: TriMesh, name: str) -> int:
-    return scene.add_mesh(mesh.vertices, mesh.faces, classes=mesh.classes, name=name)
+    """Adds ``mesh`` with its materials; the scene's material table is (re)set first when the mesh names a
+    material it does not have yet (user assets register theirs when they load)."""
+    mats = mesh.materials
+    if mats.size and int(mats.max()) >= scene.num_materials:
+        scene.set_materials(material_table())
+    return scene.add_mesh(mesh.vertices, mesh.faces, classes=mesh.classes, name=name, materials=mats)
 
 
 def build_static_scene(world: MapWorld, *, include_water: bool = True, include_moored: bool = True) -> WorldScene:
@@ -50,6 +56,7 @@ def build_static_scene(world: MapWorld, *, include_water: bool = True, include_m
     ``include_water=False`` leaves the water plane out (useful for line-of-sight checks above the surface).
     """
     scene = Scene()
+    scene.set_materials(material_table())
     static: dict[str, int] = {}
     for name, mesh in world.static_meshes.items():
         if name == "water" and not include_water:

@@ -8,17 +8,27 @@
 //!   centred on the camera; depth is the distance along the axis. Mounted with pitch +90° it looks straight
 //!   down with the vessel's forward direction at the top of the image.
 //!
-//! One render casts every pixel's primary ray at once on the frozen scene and, for RGB, one shadow ray per lit
-//! surface pixel towards the sun. Outputs per pixel: depth (float32 metres, +inf for sky), semantic class
-//! (uint16, 0 for sky), instance id (int32, −1 for sky) and optionally sRGB (uint8 × 3).
+//! * Lens distortion (optional, pinhole only): Brown–Conrady in OpenCV's convention (D. C. Brown,
+//!   "Decentering Distortion of Lenses", Photogrammetric Engineering 32(3), 1966): a pixel at distorted
+//!   normalised coordinates `(x_d, y_d)` sees the ray of the undistorted `(x, y)` with
+//!   `x_d = x (1 + k1 r² + k2 r⁴ + k3 r⁶) + 2 p1 x y + p2 (r² + 2 x²)`, `y_d = y (…) + p1 (r² + 2 y²) + 2 p2 x y`.
+//!
+//! One render casts every pixel's primary ray at once on the frozen scene; RGB adds shadow rays, reflected rays
+//! on water and sub-pixel rays on edges ([`radiance`], [`Quality`]). Outputs per pixel: depth (float32 metres,
+//! +inf for sky), semantic class (uint16, 0 for sky), instance id (int32, −1 for sky), all from the pixel centre,
+//! and optionally sRGB (uint8 × 3) and linear radiance (float32 × 3, cd/m²).
 
 use super::rays;
-use super::shade::{self, Lanes, ShadeEnv, Shader, SurfaceHit, LANES};
+use super::shade::tonemap::{self, SensorNoise};
+use super::shade::water::Wake;
+use super::shade::{ShadeEnv, Shader};
 use crate::error::{MmusvError, Result};
 use crate::geometry::RigidPose;
-use crate::scene::{RayHits, Scene};
+use crate::scene::Scene;
 use parry3d::math::Vec3;
 use rayon::prelude::*;
+
+pub mod radiance;
 
 /// Largest image side, pixels.
 pub const MAX_SIDE: u32 = 16_384;
@@ -38,6 +48,88 @@ pub enum Projection {
     },
 }
 
+/// How much work the RGB image gets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Quality {
+    /// One sample per pixel; water reflects the sky only.
+    Draft,
+    /// Traced water reflections; 4 stratified samples on edge pixels.
+    #[default]
+    Standard,
+    /// Traced water reflections; 16 stratified samples on edge pixels.
+    High,
+}
+
+impl Quality {
+    /// Samples averaged on an edge pixel (1: no anti-aliasing).
+    pub fn edge_samples(self) -> u32 {
+        match self {
+            Quality::Draft => 1,
+            Quality::Standard => 4,
+            Quality::High => 16,
+        }
+    }
+    /// Whether water reflections are traced.
+    pub fn reflections(self) -> bool {
+        !matches!(self, Quality::Draft)
+    }
+}
+
+/// Brown–Conrady distortion coefficients, OpenCV's order and convention (see the module docs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Distortion {
+    /// `[k1, k2, p1, p2, k3]`.
+    pub coefficients: [f64; 5],
+}
+
+impl Distortion {
+    /// Distorted normalised coordinates of undistorted `(x, y)`.
+    pub fn distort(&self, x: f64, y: f64) -> (f64, f64) {
+        let [k1, k2, p1, p2, k3] = self.coefficients;
+        let r2 = x * x + y * y;
+        let radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+        (
+            x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x),
+            y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y,
+        )
+    }
+
+    /// Undistorted normalised coordinates of distorted `(xd, yd)`: Newton's method on [`Distortion::distort`]
+    /// (numerical Jacobian), from `(xd, yd)`.
+    pub fn undistort(&self, xd: f64, yd: f64) -> (f64, f64) {
+        let (mut x, mut y) = (xd, yd);
+        for _ in 0..30 {
+            let (fx, fy) = self.distort(x, y);
+            let (ex, ey) = (fx - xd, fy - yd);
+            if ex.abs() < 1e-12 && ey.abs() < 1e-12 {
+                break;
+            }
+            let h = 1e-7;
+            let (ax, ay) = self.distort(x + h, y);
+            let (bx, by) = self.distort(x, y + h);
+            let (j11, j21, j12, j22) = ((ax - fx) / h, (ay - fy) / h, (bx - fx) / h, (by - fy) / h);
+            let det = j11 * j22 - j12 * j21;
+            if det.abs() < 1e-12 {
+                break;
+            }
+            x -= (j22 * ex - j12 * ey) / det;
+            y -= (-j21 * ex + j11 * ey) / det;
+        }
+        (x, y)
+    }
+}
+
+/// How the RGB image is formed: quality, lens distortion, sensor noise.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ImageOptions {
+    /// Anti-aliasing and reflections.
+    pub quality: Quality,
+    /// Lens distortion (pinhole cameras only).
+    pub distortion: Option<Distortion>,
+    /// Shot and read noise added before the tone curve.
+    pub noise: Option<SensorNoise>,
+}
+
 /// Configuration of a camera.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CameraConfig {
@@ -49,6 +141,21 @@ pub struct CameraConfig {
     pub projection: Projection,
     /// Farthest surface rendered (metres, > 0; may be infinite).
     pub range_max: f32,
+    /// Image formation of the RGB.
+    pub image: ImageOptions,
+}
+
+/// What one render produces beyond depth, class and instance.
+#[derive(Debug, Clone, Copy)]
+pub struct RenderOptions<'a> {
+    /// The tone-mapped sRGB image.
+    pub rgb: bool,
+    /// The linear radiance (cd/m²; rain included, before sensor noise and exposure).
+    pub radiance: bool,
+    /// Swell, rain, jitter and noise seed.
+    pub seed: u64,
+    /// Vessels under way, for their wakes.
+    pub wakes: &'a [Wake],
 }
 
 /// One rendered image set. Arrays are row-major, `width · height` long (`× 3` for RGB).
@@ -66,6 +173,16 @@ pub struct CameraFrame {
     pub instance: Vec<i32>,
     /// sRGB, 3 bytes per pixel; empty unless RGB was requested.
     pub rgb: Vec<u8>,
+    /// Linear radiance (cd/m², linear sRGB primaries), 3 floats per pixel; empty unless requested.
+    pub radiance: Vec<f32>,
+}
+
+/// Checks distortion coefficients are finite.
+fn check_distortion(d: &Distortion) -> Result<()> {
+    if d.coefficients.iter().any(|c| !c.is_finite()) {
+        return Err(MmusvError::config("camera.distortion", format!("{:?}", d.coefficients), "must be finite"));
+    }
+    Ok(())
 }
 
 /// Side of the square pixel tiles rays are traced in: a tile's 16 rays form one packet (see
@@ -128,10 +245,41 @@ impl Camera {
                          use several cameras for a wider view",
                     ));
                 }
-                let dirs = rays::pinhole_directions(w, h, hfov)?;
+                let mut dirs = rays::pinhole_directions(w, h, hfov)?;
+                if let Some(dist) = &cfg.image.distortion {
+                    check_distortion(dist)?;
+                    let f = w as f64 / (2.0 * (hfov / 2.0).tan());
+                    for (i, d) in dirs.iter_mut().enumerate() {
+                        let (u, v) = ((i as u32 % w) as f64 + 0.5, (i as u32 / w) as f64 + 0.5);
+                        let (xd, yd) = ((u - w as f64 / 2.0) / f, (v - h as f64 / 2.0) / f);
+                        let (x, y) = dist.undistort(xd, yd);
+                        let (rx, ry) = dist.distort(x, y);
+                        if !((rx - xd).abs() < 1e-6 && (ry - yd).abs() < 1e-6) {
+                            return Err(MmusvError::config(
+                                "camera.distortion",
+                                format!("{:?}", dist.coefficients),
+                                format!(
+                                    "no ray maps to pixel ({}, {}): the distortion folds over within the image; \
+                                     use smaller coefficients",
+                                    u - 0.5,
+                                    v - 0.5
+                                ),
+                            ));
+                        }
+                        let nrm = (x * x + y * y + 1.0).sqrt();
+                        *d = [(1.0 / nrm) as f32, (-x / nrm) as f32, (-y / nrm) as f32];
+                    }
+                }
                 (tile_order(w, h).iter().map(|&i| dirs[i as usize]).collect(), Vec::new())
             }
             Projection::Orthographic { metres_per_pixel: m } => {
+                if cfg.image.distortion.is_some() {
+                    return Err(MmusvError::config(
+                        "camera.distortion",
+                        "given",
+                        "lens distortion applies to pinhole cameras only",
+                    ));
+                }
                 if !(m.is_finite() && m > 0.0) {
                     return Err(MmusvError::config("camera.metres_per_pixel", m, "must be a finite distance > 0"));
                 }
@@ -220,13 +368,27 @@ impl Camera {
         }
     }
 
-    /// Renders the frozen `scene` from `pose` (camera body → world). `rgb` asks for the shaded image (one more
-    /// ray per sunlit surface pixel); `seed` drives the water ripples and rain streaks.
-    ///
-    /// Rays are traced in [`TILE`]×[`TILE`] tiles (coherent packets), shadow rays as occlusion queries that stop
-    /// at the first occluder, and the results scattered back to row-major order: the same image as tracing and
-    /// shading pixel by pixel.
+    /// Renders the frozen `scene` from `pose` (camera body → world). `rgb` asks for the shaded image; `seed`
+    /// drives the swell, rain streaks, anti-aliasing jitter and sensor noise. No vessel wakes: see
+    /// [`Camera::render_with`].
     pub fn render(&self, scene: &Scene, pose: &RigidPose, env: &ShadeEnv, rgb: bool, seed: u64) -> Result<CameraFrame> {
+        self.render_with(scene, pose, env, &RenderOptions { rgb, radiance: false, seed, wakes: &[] })
+    }
+
+    /// Renders the frozen `scene` from `pose` (camera body → world) with `options`.
+    ///
+    /// Depth, semantic class and instance come from each pixel's centre ray. The RGB image (and the linear
+    /// radiance, when asked) is shaded by [`radiance::radiance`]: shadow rays towards the sun, traced water
+    /// reflections above `draft` quality, and, on pixels at an edge (a change of instance, class or material, or
+    /// of depth by more than 5 %), the mean of [`Quality::edge_samples`] stratified sub-pixel rays. Then rain,
+    /// sensor noise, exposure and the tone curve.
+    pub fn render_with(
+        &self,
+        scene: &Scene,
+        pose: &RigidPose,
+        env: &ShadeEnv,
+        options: &RenderOptions<'_>,
+    ) -> Result<CameraFrame> {
         let (origins, dirs) = self.traced_rays(pose);
         let hits = scene.cast_rays(&origins, &dirs, self.cfg.range_max)?;
         let n = origins.len();
@@ -238,7 +400,9 @@ impl Camera {
             semantic: vec![0; n],
             instance: vec![0; n],
             rgb: Vec::new(),
+            radiance: Vec::new(),
         };
+        let mut material = if options.rgb || options.radiance { vec![0u16; n] } else { Vec::new() };
         for (k, &i) in self.order.iter().enumerate() {
             let i = i as usize;
             let t = hits.distance[k];
@@ -247,112 +411,140 @@ impl Camera {
             }
             frame.semantic[i] = hits.class[k];
             frame.instance[i] = hits.instance[k];
+            if !material.is_empty() {
+                material[i] = scene.material_index(hits.instance[k], hits.triangle[k]);
+            }
         }
-        if !rgb {
+        if !(options.rgb || options.radiance) {
             return Ok(frame);
         }
-        let surface = |k: usize| surface_at(&hits, &origins, &dirs, k);
-        // Shadow rays from every surface point facing the sun, in trace order (neighbouring points, one packet),
-        // gathered block by block.
-        let sun = Vec3::from_array(env.sun_direction).normalize_or_zero();
-        let mut lit = vec![false; n];
-        if env.sun_intensity > 0.0 && sun.z > 0.0 {
-            const BLOCK: usize = 4096;
-            let blocks: Vec<(Vec<u32>, Vec<[f32; 3]>)> = (0..n.div_ceil(BLOCK))
-                .into_par_iter()
-                .map(|b| {
-                    let (mut ks, mut os) = (Vec::new(), Vec::new());
-                    for k in b * BLOCK..((b + 1) * BLOCK).min(n) {
-                        if let Some(h) = surface(k).filter(|h| h.normal.dot(sun) > 0.0 || h.class == 1) {
-                            let eps = 0.02 + 1e-4 * h.t;
-                            ks.push(k as u32);
-                            os.push((h.point + h.normal * eps).to_array());
-                        }
-                    }
-                    (ks, os)
-                })
-                .collect();
-            let facing: Vec<u32> = blocks.iter().flat_map(|(ks, _)| ks.iter().copied()).collect();
-            if env.shadows {
-                let so: Vec<[f32; 3]> = blocks.into_iter().flat_map(|(_, os)| os).collect();
-                let sd = vec![sun.to_array(); so.len()];
-                let blocked = scene.occluded_rays(&so, &sd, 5_000.0)?;
-                for (&k, b) in facing.iter().zip(blocked) {
-                    lit[k as usize] = !b;
-                }
-            } else {
-                for &k in &facing {
-                    lit[k as usize] = true;
+        let q = self.cfg.image.quality;
+        let shader = Shader::new(env, options.seed, options.wakes);
+        let traced = radiance::radiance(scene, &shader, env.shadows, q.reflections(), &origins, &dirs, &hits)?;
+        let mut linear = vec![Vec3::ZERO; n];
+        for (k, &i) in self.order.iter().enumerate() {
+            linear[i as usize] = traced[k];
+        }
+        let s = q.edge_samples();
+        if s > 1 {
+            let edges = edge_pixels(&frame, &material);
+            if !edges.is_empty() {
+                let (so, sd) = self.sample_rays(pose, &edges, s, options.seed);
+                let shits = scene.cast_rays(&so, &sd, self.cfg.range_max)?;
+                let samples = radiance::radiance(scene, &shader, env.shadows, q.reflections(), &so, &sd, &shits)?;
+                let per = s as usize;
+                for (e, &i) in edges.iter().enumerate() {
+                    let sum: Vec3 = samples[e * per..(e + 1) * per].iter().copied().sum();
+                    linear[i as usize] = sum / s as f32;
                 }
             }
         }
-        // Shade tile row by tile row: the trace positions of a tile row are exactly the row-major pixels of its
-        // image rows, so each row block is written in place.
         let w = self.cfg.width as usize;
-        let rows = TILE as usize * w;
-        let shader = Shader::new(env, seed);
-        let mut out = vec![0u8; 3 * n];
-        let traced = Traced { order: &self.order, origins: &origins, dirs: &dirs, hits: &hits, lit: &lit };
-        out.par_chunks_mut(3 * rows).enumerate().for_each(|(r, px)| {
-            shade_rows(px, r * rows, w, &traced, &shader, seed);
-        });
-        frame.rgb = out;
+        if self.cfg.image.noise.is_some() || env.rain_mm_per_h > 0.0 {
+            linear.par_iter_mut().enumerate().for_each(|(i, c)| {
+                *c = shader.rain(*c, (i % w) as u32, (i / w) as u32, options.seed);
+            });
+        }
+        if options.radiance {
+            frame.radiance = linear.iter().flat_map(|c| c.to_array()).collect();
+        }
+        if options.rgb {
+            let k = shader.exposure();
+            let noise = self.cfg.image.noise;
+            let mut out = vec![0u8; 3 * n];
+            out.par_chunks_mut(3 * w).zip(linear.par_chunks(w)).enumerate().for_each(|(row, (px, cs))| {
+                for (j, c) in cs.iter().enumerate() {
+                    let mut x = *c * k;
+                    if let Some(nz) = noise {
+                        let p = (row * w + j) as u64;
+                        x = Vec3::new(
+                            nz.apply(x.x, options.seed, p, 0),
+                            nz.apply(x.y, options.seed, p, 1),
+                            nz.apply(x.z, options.seed, p, 2),
+                        );
+                    }
+                    px[3 * j..3 * j + 3].copy_from_slice(&tonemap::to_srgb8(x, 1.0));
+                }
+            });
+            frame.rgb = out;
+        }
         Ok(frame)
     }
-}
 
-/// The hit of trace position `k` as shading needs it (normal turned towards the camera), `None` for a miss.
-#[inline(always)]
-fn surface_at(hits: &RayHits, origins: &[[f32; 3]], dirs: &[[f32; 3]], k: usize) -> Option<SurfaceHit> {
-    let t = hits.distance[k];
-    if !t.is_finite() {
-        return None;
-    }
-    let d = Vec3::from_array(dirs[k]);
-    let mut normal = Vec3::new(hits.normal[3 * k], hits.normal[3 * k + 1], hits.normal[3 * k + 2]);
-    if normal.dot(d) > 0.0 {
-        normal = -normal;
-    }
-    let point = Vec3::from_array(origins[k]) + d * t;
-    Some(SurfaceHit { t, point, normal, class: hits.class[k], instance: hits.instance[k] })
-}
-
-/// One render's traced rays, in trace order, with their hits and whether each hit sees the sun.
-struct Traced<'a> {
-    order: &'a [u32],
-    origins: &'a [[f32; 3]],
-    dirs: &'a [[f32; 3]],
-    hits: &'a RayHits,
-    lit: &'a [bool],
-}
-
-crate::dispatch! {
-    /// Shades the trace positions `base..` that fill `px` (row-major RGB8 of the image rows starting at pixel
-    /// `base`; `w` pixels a row). Under the AVX2 dispatch: the shading maths ([`Shader::shade_lanes`], [`LANES`]
-    /// pixels at a time) inlines into it and vectorises; the bytes are the portable build's and
-    /// [`Shader::shade`]'s (Rust never contracts a multiply and an add into an FMA).
-    fn shade_rows(px: &mut [u8], base: usize, w: usize, traced: &Traced<'_>, shader: &Shader, seed: u64) {
-        let end = base + px.len() / 3;
-        let mut k0 = base;
-        while k0 < end {
-            // LANES pixels at a time (the last group padded with copies of its last pixel).
-            let m = LANES.min(end - k0);
-            let mut lanes = Lanes::default();
-            for j in 0..LANES {
-                let k = k0 + j.min(m - 1);
-                let h = surface_at(traced.hits, traced.origins, traced.dirs, k);
-                lanes.set(j, Vec3::from_array(traced.dirs[k]), h.as_ref(), traced.lit[k]);
+    /// World rays of `samples` stratified sub-pixel positions (a `√s × √s` grid, jittered by `seed`) in every
+    /// pixel of `pixels` (row-major indices), pixel by pixel.
+    fn sample_rays(&self, pose: &RigidPose, pixels: &[u32], samples: u32, seed: u64) -> WorldRays {
+        let g = (samples as f64).sqrt().round().max(1.0) as u32;
+        let w = self.cfg.width;
+        let cap = pixels.len() * (g * g) as usize;
+        let (mut o, mut d) = (Vec::with_capacity(cap), Vec::with_capacity(cap));
+        for &i in pixels {
+            let (u, v) = ((i % w) as f64, (i / w) as f64);
+            for a in 0..g {
+                for b in 0..g {
+                    let key = (i as u64) << 8 | (a * g + b) as u64;
+                    let ju = crate::sensors::noise::uniform(seed, 0xAA, 2 * key);
+                    let jv = crate::sensors::noise::uniform(seed, 0xAA, 2 * key + 1);
+                    let su = u + (b as f64 + ju) / g as f64;
+                    let sv = v + (a as f64 + jv) / g as f64;
+                    let (bo, bd) = self.body_ray(su, sv);
+                    o.push(pose.transform_point(Vec3::from_array(bo)).to_array());
+                    d.push(pose.transform_vector(Vec3::from_array(bd)).normalize().to_array());
+                }
             }
-            let c = shader.shade_lanes(&lanes);
-            for j in 0..m {
-                let i = traced.order[k0 + j] as usize;
-                let c = shader.rain(Vec3::new(c[0][j], c[1][j], c[2][j]), (i % w) as u32, (i / w) as u32, seed);
-                let at = 3 * (i - base);
-                px[at..at + 3].copy_from_slice(&shade::to_srgb8(c));
+        }
+        (o, d)
+    }
+
+    /// Body-frame origin and unit direction of the ray through image point `(u, v)` (pixels, `(0, 0)` the
+    /// top-left corner of the image).
+    fn body_ray(&self, u: f64, v: f64) -> ([f32; 3], [f32; 3]) {
+        let (w, h) = (self.cfg.width as f64, self.cfg.height as f64);
+        match self.cfg.projection {
+            Projection::Pinhole { hfov } => {
+                let f = w / (2.0 * (hfov / 2.0).tan());
+                let (xd, yd) = ((u - w / 2.0) / f, (v - h / 2.0) / f);
+                let (x, y) = match &self.cfg.image.distortion {
+                    Some(dist) => dist.undistort(xd, yd),
+                    None => (xd, yd),
+                };
+                let nrm = (x * x + y * y + 1.0).sqrt();
+                ([0.0; 3], [(1.0 / nrm) as f32, (-x / nrm) as f32, (-y / nrm) as f32])
             }
-            k0 += m;
+            Projection::Orthographic { metres_per_pixel: m } => {
+                ([0.0, ((w / 2.0 - u) * m) as f32, ((h / 2.0 - v) * m) as f32], [1.0, 0.0, 0.0])
+            }
         }
     }
+}
+
+/// Row-major indices of the pixels at an edge: a 4-neighbour with another instance, class or material, or a
+/// depth differing by more than 5 %.
+fn edge_pixels(frame: &CameraFrame, material: &[u16]) -> Vec<u32> {
+    let (w, h) = (frame.width as usize, frame.height as usize);
+    let differs = |a: usize, b: usize| {
+        if frame.instance[a] != frame.instance[b]
+            || frame.semantic[a] != frame.semantic[b]
+            || material[a] != material[b]
+        {
+            return true;
+        }
+        let (da, db) = (frame.depth[a], frame.depth[b]);
+        da.is_finite() && db.is_finite() && (da - db).abs() > 0.05 * da.min(db)
+    };
+    (0..h)
+        .into_par_iter()
+        .flat_map_iter(|y| {
+            (0..w).filter_map(move |x| {
+                let i = y * w + x;
+                let edge = (x > 0 && differs(i, i - 1))
+                    || (x + 1 < w && differs(i, i + 1))
+                    || (y > 0 && differs(i, i - w))
+                    || (y + 1 < h && differs(i, i + w));
+                edge.then_some(i as u32)
+            })
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -401,6 +593,7 @@ mod tests {
             height: 48,
             projection: Projection::Pinhole { hfov: 1.5 },
             range_max: 1e4,
+            image: Default::default(),
         });
         let Ok(cam) = cam else { return };
         let pose = RigidPose::from_xyz_rpy([0.0, 0.0, 2.0], [0.0, 0.0, 0.0]);
@@ -424,6 +617,7 @@ mod tests {
             height: 200,
             projection: Projection::Orthographic { metres_per_pixel: m },
             range_max: 1e4,
+            image: Default::default(),
         });
         let Ok(cam) = cam else { return };
         // 100 m up, looking down (pitch +90°), forward = +x at the top of the image.
@@ -448,7 +642,13 @@ mod tests {
             (8, 8, Projection::Pinhole { hfov: 0.7 }),
             (9, 6, Projection::Orthographic { metres_per_pixel: 0.5 }),
         ] {
-            let cam = Camera::new(CameraConfig { width: w, height: h, projection, range_max: 100.0 });
+            let cam = Camera::new(CameraConfig {
+                width: w,
+                height: h,
+                projection,
+                range_max: 100.0,
+                image: Default::default(),
+            });
             let Ok(cam) = cam else { panic!("camera {w}x{h}") };
             let pose = RigidPose::from_xyz_rpy([3.0, -2.0, 5.0], [0.1, 0.4, -0.7]);
             let (o, d) = cam.world_rays(&pose);
@@ -467,7 +667,13 @@ mod tests {
     #[test]
     fn bad_configs_name_the_field() {
         let bad = |c: CameraConfig| Camera::new(c).err().map(|e| e.to_string()).unwrap_or_default();
-        let ok = CameraConfig { width: 8, height: 8, projection: Projection::Pinhole { hfov: 1.0 }, range_max: 10.0 };
+        let ok = CameraConfig {
+            width: 8,
+            height: 8,
+            projection: Projection::Pinhole { hfov: 1.0 },
+            range_max: 10.0,
+            image: ImageOptions::default(),
+        };
         assert!(bad(CameraConfig { projection: Projection::Pinhole { hfov: std::f64::consts::PI }, ..ok })
             .contains("camera.hfov_deg"));
         assert!(bad(CameraConfig { width: 0, ..ok }).contains("camera.resolution"));

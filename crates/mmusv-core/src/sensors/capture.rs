@@ -9,10 +9,11 @@
 //! Each result also carries the wall time its task took (start to end of that sensor's work while it shares the
 //! cores with the other tasks), for profiling only: nothing that is recorded depends on it.
 
-use super::camera::{Camera, CameraFrame};
+use super::camera::{Camera, CameraFrame, RenderOptions};
 use super::lidar::{Lidar, LidarEnv, LidarScan};
 use super::ppi::{ppi_image, PpiConfig};
 use super::radar::{radar_sweep, RadarConfig, RadarEnv, RadarReturns};
+use super::shade::water::Wake;
 use super::shade::ShadeEnv;
 use crate::error::Result;
 use crate::geometry::RigidPose;
@@ -107,15 +108,16 @@ pub struct TaskResult {
     pub ppi_seconds: f64,
 }
 
-/// Runs one task on the frozen `scene`.
-pub fn run_task(scene: &Scene, env: &ShadeEnv, task: &SensorTask<'_>) -> Result<TaskResult> {
+/// Runs one task on the frozen `scene`, with `wakes` behind the vessels under way (cameras).
+pub fn run_task(scene: &Scene, env: &ShadeEnv, wakes: &[Wake], task: &SensorTask<'_>) -> Result<TaskResult> {
     let start = Instant::now();
     let (output, ppi_seconds) = match *task {
         SensorTask::Lidar { lidar, ref pose, seed } => {
             (SensorOutput::Lidar(lidar.scan(scene, pose, &lidar_env(env), seed)?), 0.0)
         }
         SensorTask::Camera { camera, rgb, ref pose, seed } => {
-            (SensorOutput::Camera(camera.render(scene, pose, env, rgb, seed)?), 0.0)
+            let options = RenderOptions { rgb, radiance: false, seed, wakes };
+            (SensorOutput::Camera(camera.render_with(scene, pose, env, &options)?), 0.0)
         }
         SensorTask::Radar { radar, ref pose, seed, ppi } => {
             let returns = radar_sweep(scene, pose, radar, &radar_env(env), seed)?;
@@ -134,8 +136,14 @@ pub fn run_task(scene: &Scene, env: &ShadeEnv, task: &SensorTask<'_>) -> Result<
 
 /// Runs every task of a frame concurrently on the current rayon pool (each sensor's own rays in parallel
 /// inside its task) and returns the results in task order. The first error (in task order) is returned.
-pub fn capture_frame(scene: &Scene, env: &ShadeEnv, tasks: &[SensorTask<'_>]) -> Result<Vec<TaskResult>> {
-    tasks.par_iter().with_max_len(1).map(|task| run_task(scene, env, task)).collect()
+/// `wakes` are the vessels under way at this frame (their wakes in the cameras).
+pub fn capture_frame(
+    scene: &Scene,
+    env: &ShadeEnv,
+    wakes: &[Wake],
+    tasks: &[SensorTask<'_>],
+) -> Result<Vec<TaskResult>> {
+    tasks.par_iter().with_max_len(1).map(|task| run_task(scene, env, wakes, task)).collect()
 }
 
 #[cfg(test)]
@@ -169,12 +177,14 @@ mod tests {
             height: 48,
             projection: Projection::Pinhole { hfov: 1.5 },
             range_max: 2000.0,
+            image: Default::default(),
         })?;
         let ortho = Camera::new(CameraConfig {
             width: 32,
             height: 32,
             projection: Projection::Orthographic { metres_per_pixel: 2.0 },
             range_max: 600.0,
+            image: Default::default(),
         })?;
         let radar = RadarConfig { azimuth_bins: 128, rays_el: 4, range_max_m: 800.0, ..RadarConfig::tuning() };
         let ppi = PpiRequest {
@@ -191,7 +201,8 @@ mod tests {
             SensorTask::Radar { radar: &radar, pose: a, seed: 16, ppi: None },
             SensorTask::Lidar { lidar: &lidar, pose: b, seed: 17 },
         ];
-        let batch = capture_frame(&scene, &env, &tasks)?;
+        let wakes = [Wake { x: 0.0, y: 0.0, heading: 0.3, speed: 9.0, length: 20.0, beam: 5.0 }];
+        let batch = capture_frame(&scene, &env, &wakes, &tasks)?;
         assert_eq!(batch.len(), tasks.len());
         let one = |t: &SensorTask<'_>| -> Result<SensorOutput> {
             Ok(match *t {
@@ -199,7 +210,8 @@ mod tests {
                     SensorOutput::Lidar(lidar.scan(&scene, pose, &lidar_env(&env), seed)?)
                 }
                 SensorTask::Camera { camera, rgb, ref pose, seed } => {
-                    SensorOutput::Camera(camera.render(&scene, pose, &env, rgb, seed)?)
+                    let options = RenderOptions { rgb, radiance: false, seed, wakes: &wakes };
+                    SensorOutput::Camera(camera.render_with(&scene, pose, &env, &options)?)
                 }
                 SensorTask::Radar { radar, ref pose, seed, ppi } => {
                     let returns = radar_sweep(&scene, pose, radar, &radar_env(&env), seed)?;
@@ -229,7 +241,7 @@ mod tests {
                 .scene;
         let bad = RadarConfig { azimuth_bins: 0, ..RadarConfig::tuning() };
         let tasks = [SensorTask::Radar { radar: &bad, pose: pose(0.0, 0.0, 3.0, 0.0)?, seed: 1, ppi: None }];
-        let err = capture_frame(&scene, &ShadeEnv::default(), &tasks).err().map(|e| e.to_string());
+        let err = capture_frame(&scene, &ShadeEnv::default(), &[], &tasks).err().map(|e| e.to_string());
         assert!(err.is_some_and(|e| e.contains("azimuth_bins")), "a bad radar config must fail with its field");
         Ok(())
     }

@@ -1,64 +1,92 @@
-//! Plausible (not photoreal) RGB shading of camera hits from the environment.
+//! Physically based RGB shading of camera rays: radiance in cd/m² (linear sRGB primaries), then exposure and a
+//! filmic tone curve into 8-bit sRGB.
 //!
-//! Linear-light model, encoded to sRGB at the end:
-//! * sky (no hit): a gradient from the horizon colour to the zenith colour by ray elevation, plus the sun disc
-//!   and a glow around it;
-//! * surfaces: per-class albedo (containers and vessels varied per object) lit by ambient sky light and the sun
-//!   (Lambert), the sun term switched off in shadow (a shadow ray towards the sun, cast by the camera);
-//! * water: the geometric normal perturbed by a few deterministic swell components whose slope grows with the
-//!   wave height, a Fresnel mix (Schlick, F0 = 0.02) of the dark water body and the reflected sky, and a sun
-//!   glint;
-//! * fog: Koschmieder blending towards the fog colour, `c · e^{−σ t} + fog · (1 − e^{−σ t})`;
-//! * rain: overall darkening and thin bright streaks, positions drawn from the seed.
+//! The models, each in its own file with its sources:
+//! * [`sky`]: the Preetham clear sky, the CIE overcast sky, the sun's beam and its true-size disc;
+//! * [`brdf`]: GGX/Smith microfacet specular with Schlick's Fresnel over a Lambert diffuse (metallic workflow);
+//! * [`envlight`]: the sky (and the sea below the horizon) as image-based light, irradiance and split-sum
+//!   prefiltered maps;
+//! * [`water`]: Cox–Munk capillary roughness, Monahan whitecaps, Kelvin wakes and the water body;
+//! * [`tonemap`]: physical exposure from the scene's illuminance and the ACES filmic curve.
+//!
+//! A surface of material `m` seen along `d` (`v = −d`) is lit by the sun (irradiance `E_s` along `s`, when the
+//! camera's shadow ray finds it unoccluded) and by the environment:
+//! `L = L_e + (f_d + f_s(v, s)) E_s (n·s) + f_d E_env(n) + P(r, roughness) (F0 A + B)`, with `f_d = (1 − metallic)
+//! base / π`. Water is a dielectric (IOR 1.33) with swell normals: `L = F(θ_o) L_r + glint + L_body`, where `L_r`
+//! is the radiance along the reflected ray (traced by the camera, so ships mirror in it; the sky's otherwise),
+//! the glint is the sun through a Cox–Munk GGX lobe, and `L_body` the smooth-plastic water body; foam (whitecaps
+//! and wakes) is Lambertian on top. Aerial perspective: `L·T + L_air (1 − T)`, `T = e^{−σ t}` (Koschmieder),
+//! `L_air` the horizon sky's radiance along the view's azimuth.
 
 use super::noise::{self, stream};
+use crate::material::Material;
 use parry3d::math::Vec3;
+use std::sync::Arc;
 
-mod lanes;
-pub use lanes::{LaneColors, Lanes, LANES};
+pub mod brdf;
+pub mod envlight;
+pub mod sky;
+pub mod tonemap;
+pub mod water;
 
-/// Lighting and weather for shading. Colours are linear RGB in `[0, 1]`; directions are world-frame unit vectors.
+use brdf::{dfg, fresnel_dielectric, specular_cos};
+use envlight::{Lighting, LightingKey, WATER_IOR};
+use water::{Foam, Wake, FOAM_ALBEDO};
+
+/// The environment as the cameras see it (and, for fog, rain and waves, the LiDAR and the radar).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ShadeEnv {
-    /// Unit vector towards the sun (world frame).
+    /// Unit vector towards the sun (world frame); below the horizon at night.
     pub sun_direction: [f32; 3],
-    /// Sun colour.
-    pub sun_color: [f32; 3],
-    /// Sun strength, 0 at night, 1 at zenith in clear sky.
-    pub sun_intensity: f32,
-    /// Ambient (sky) light level in `[0, 1]`.
-    pub ambient: f32,
-    /// Sky colour straight up.
-    pub sky_zenith: [f32; 3],
-    /// Sky colour at the horizon.
-    pub sky_horizon: [f32; 3],
+    /// Preetham turbidity of the air (2 very clear .. 10 hazy).
+    pub turbidity: f32,
+    /// Cloud cover in `[0, 1]`: mixes in the CIE overcast sky and dims the sun's beam.
+    pub cloud_cover: f32,
+    /// Albedo of the lower hemisphere for image-based light (the sea: 0.06).
+    pub ground_albedo: f32,
     /// Atmospheric extinction (1/m), 3 / visibility.
     pub fog_extinction_per_m: f32,
-    /// Colour surfaces fade to with distance.
-    pub fog_color: [f32; 3],
     /// Rain rate (mm/h).
     pub rain_mm_per_h: f32,
     /// Significant wave height (m).
     pub wave_height_m: f32,
+    /// Wind speed at 10 m (m/s): capillary roughness and whitecaps.
+    pub wind_speed_m_s: f32,
+    /// Diffuse reflectance of the water body, linear RGB.
+    pub water_albedo: [f32; 3],
+    /// Fixed exposure value at ISO 100; `NaN` meters it from the scene's horizontal illuminance.
+    pub exposure_ev100: f32,
     /// Whether to cast shadow rays.
     pub shadows: bool,
 }
 
 impl Default for ShadeEnv {
-    /// Clear noon.
+    /// Clear noon, a light breeze.
     fn default() -> Self {
         Self {
             sun_direction: [0.3, 0.2, 0.93],
-            sun_color: [1.0, 0.98, 0.95],
-            sun_intensity: 1.0,
-            ambient: 0.55,
-            sky_zenith: [0.12, 0.3, 0.7],
-            sky_horizon: [0.6, 0.72, 0.88],
+            turbidity: 3.0,
+            cloud_cover: 0.1,
+            ground_albedo: 0.06,
             fog_extinction_per_m: 3.0 / 20_000.0,
-            fog_color: [0.7, 0.75, 0.8],
             rain_mm_per_h: 0.0,
             wave_height_m: 0.5,
+            wind_speed_m_s: 5.0,
+            water_albedo: [0.004, 0.018, 0.03],
+            exposure_ev100: f32::NAN,
             shadows: true,
+        }
+    }
+}
+
+impl ShadeEnv {
+    /// The key of this environment's sky lighting.
+    pub fn lighting_key(&self) -> LightingKey {
+        LightingKey {
+            sun: self.sun_direction,
+            turbidity: self.turbidity,
+            cloud: self.cloud_cover,
+            ground_albedo: self.ground_albedo,
         }
     }
 }
@@ -76,10 +104,18 @@ pub struct SurfaceHit {
     pub class: u16,
     /// Scene instance id.
     pub instance: i32,
+    /// The face's material, `None` for the class's default.
+    pub material: Option<Material>,
+    /// Whether the instance's navigation lights are on.
+    pub lights_on: bool,
 }
 
-fn v3(a: [f32; 3]) -> Vec3 {
-    Vec3::from_array(a)
+impl SurfaceHit {
+    /// Whether this is the sea surface.
+    #[inline]
+    pub fn is_water(&self) -> bool {
+        self.class == 1
+    }
 }
 
 #[inline]
@@ -89,15 +125,15 @@ fn hash_tint(id: u64, seed: u64) -> Vec3 {
     Vec3::new(f(0), f(8), f(16))
 }
 
-/// Linear albedo of a surface.
+/// The material a face without one gets from its class: base colour (containers varied per container-sized
+/// cell of space, vessels per instance), roughness, metallic.
 #[inline]
-fn albedo(hit: &SurfaceHit) -> Vec3 {
-    match hit.class {
-        2 => Vec3::new(0.33, 0.27, 0.18),
-        3 => Vec3::new(0.07, 0.18, 0.05),
-        4 => Vec3::new(0.38, 0.38, 0.37),
+pub fn class_material(hit: &SurfaceHit) -> Material {
+    let (base, roughness, metallic) = match hit.class {
+        2 => (Vec3::new(0.33, 0.27, 0.18), 0.9, 0.0),
+        3 => (Vec3::new(0.07, 0.18, 0.05), 0.85, 0.0),
+        4 => (Vec3::new(0.38, 0.38, 0.37), 0.8, 0.0),
         5 => {
-            // One colour per container-sized cell of space.
             let p = hit.point;
             let cell = ((p.x / 6.1).floor() as i64 as u64).wrapping_mul(73_856_093)
                 ^ ((p.y / 2.5).floor() as i64 as u64).wrapping_mul(19_349_663)
@@ -110,32 +146,17 @@ fn albedo(hit: &SurfaceHit) -> Vec3 {
                 [0.45, 0.45, 0.45],
                 [0.5, 0.22, 0.05],
             ];
-            v3(PALETTE[(noise::hash3(5, 5, cell) % 6) as usize])
+            (Vec3::from_array(PALETTE[(noise::hash3(5, 5, cell) % 6) as usize]), 0.5, 0.0)
         }
-        6 => Vec3::new(0.6, 0.42, 0.04),
-        7 => Vec3::new(0.75, 0.15, 0.08),
-        8 => Vec3::new(0.42, 0.4, 0.38),
-        10 => Vec3::new(0.62, 0.62, 0.62) * hash_tint(hit.instance.max(0) as u64, 10),
-        11 => Vec3::new(0.15, 0.45, 0.45),
-        _ => Vec3::splat(0.3),
-    }
+        6 => (Vec3::new(0.6, 0.42, 0.04), 0.45, 0.0),
+        7 => (Vec3::new(0.75, 0.15, 0.08), 0.4, 0.0),
+        8 => (Vec3::new(0.42, 0.4, 0.38), 0.8, 0.0),
+        10 => (Vec3::new(0.62, 0.62, 0.62) * hash_tint(hit.instance.max(0) as u64, 10), 0.5, 0.0),
+        11 => (Vec3::new(0.15, 0.45, 0.45), 0.4, 0.0),
+        _ => (Vec3::splat(0.3), 0.7, 0.0),
+    };
+    Material { base_color: base.to_array(), roughness, metallic, emissive: [0.0; 3], nav_light: false }
 }
-
-/// Sky colour seen along unit direction `d`.
-pub fn sky(env: &ShadeEnv, d: Vec3) -> Vec3 {
-    Shader::new(env, 0).sky(d)
-}
-
-/// Linear RGB of one camera ray `d` (world, unit) given its hit (or `None` for the sky) and whether the hit
-/// point sees the sun.
-pub fn shade(env: &ShadeEnv, d: Vec3, hit: Option<&SurfaceHit>, sunlit: bool, seed: u64) -> Vec3 {
-    Shader::new(env, seed).shade(d, hit, sunlit)
-}
-
-/// `x^300` rounds to exactly 0 for every `x ≤ GLINT_ZERO` (`0.7^300 ≈ 3e-47`, below half the smallest subnormal).
-const GLINT_ZERO: f32 = 0.7;
-/// `x^2000` rounds to exactly 0 for every `x ≤ SUN_DISC_ZERO` (`0.949^2000 ≈ 3.5e-46`).
-const SUN_DISC_ZERO: f32 = 0.949;
 
 /// One swell component of the water surface: direction `(cos, sin)`, wave number, phase and slope amplitude.
 #[derive(Debug, Clone, Copy)]
@@ -147,25 +168,26 @@ struct Swell {
     amp_k: f32,
 }
 
-/// Shading of one render: everything that depends only on the environment and the seed, computed once
-/// (swell components, light colours, the sky's fog veil), then [`Shader::shade`] per pixel. Gives bit for bit
-/// what the formulas give evaluated per pixel.
-#[derive(Debug, Clone, Copy)]
+/// Shading of one render: the environment's lighting (shared between renders), swell, foam and exposure,
+/// computed once; then [`Shader::shade`] per ray.
+#[derive(Debug, Clone)]
 pub struct Shader {
     env: ShadeEnv,
+    light: Arc<Lighting>,
     swell: [Swell; 4],
     sun: Vec3,
-    sun_lit: Vec3,
-    ambient_light: Vec3,
-    sky_keep: f32,
-    sky_fog: Vec3,
-    sky_brightness: f32,
-    fog_color: Vec3,
+    sun_e: Vec3,
+    water_alpha: f32,
+    water_fdr: f32,
+    water_rho: Vec3,
+    foam: Foam,
+    exposure: f32,
 }
 
 impl Shader {
-    /// Precomputes the shading of a render with environment `env` and seed `seed` (ripples, rain streaks).
-    pub fn new(env: &ShadeEnv, seed: u64) -> Self {
+    /// Precomputes the shading of a render with environment `env`, seed `seed` (swell and rain streaks) and the
+    /// vessels under way `wakes`.
+    pub fn new(env: &ShadeEnv, seed: u64, wakes: &[Wake]) -> Self {
         let h = env.wave_height_m.max(0.05);
         let swell = std::array::from_fn(|i| {
             let i = i as u64;
@@ -178,44 +200,75 @@ impl Shader {
             let (s, c) = dir.sin_cos();
             Swell { c, s, k, phase, amp_k: amp * k }
         });
-        let veil = 1.0 - (-env.fog_extinction_per_m * 3000.0).exp();
+        let light = Lighting::shared(&env.lighting_key());
+        let exposure = tonemap::exposure_scale(env.exposure_ev100, light.horizontal_lux);
         Self {
             env: *env,
+            sun: light.sky.sun,
+            sun_e: light.sky.sun_irradiance(),
+            light,
             swell,
-            sun: v3(env.sun_direction),
-            sun_lit: v3(env.sun_color) * env.sun_intensity,
-            ambient_light: (v3(env.sky_zenith) * 0.5 + v3(env.sky_horizon) * 0.5) * (0.4 + 1.2 * env.ambient),
-            sky_keep: 1.0 - veil,
-            sky_fog: v3(env.fog_color) * env.ambient.max(0.1) * 1.3 * veil,
-            sky_brightness: 0.25 + 1.3 * env.ambient,
-            fog_color: v3(env.fog_color) * env.ambient.max(0.1) * 1.3,
+            water_alpha: water::cox_munk_alpha(env.wind_speed_m_s),
+            water_fdr: water::internal_diffuse_reflectance(WATER_IOR),
+            water_rho: Vec3::from_array(env.water_albedo),
+            foam: Foam::new(water::monahan_coverage(env.wind_speed_m_s), wakes, 0x5EA),
+            exposure,
         }
     }
 
-    /// Sky colour seen along unit direction `d`.
+    /// The lighting (sky, sun, image-based light).
+    pub fn lighting(&self) -> &Lighting {
+        &self.light
+    }
+
+    /// Multiplier from radiance (cd/m²) to the tone curve's input.
+    pub fn exposure(&self) -> f32 {
+        self.exposure
+    }
+
+    /// Unit vector towards the sun.
+    pub fn sun(&self) -> Vec3 {
+        self.sun
+    }
+
+    /// Whether the sun lights anything (it is up and not behind full cloud).
+    pub fn sun_up(&self) -> bool {
+        self.sun_e.max_element() > 0.0 && self.sun.z > 0.0
+    }
+
+    /// Radiance of the sky along unit `d`, with the sun's disc, veiled by fog.
     #[inline]
     pub fn sky(&self, d: Vec3) -> Vec3 {
-        let env = &self.env;
-        let up = d.z.max(0.0).sqrt();
-        let mut c = (v3(env.sky_horizon) * (1.0 - up) + v3(env.sky_zenith) * up) * self.sky_brightness;
-        if d.z < 0.0 {
-            c *= 0.8;
-        }
-        if env.sun_intensity > 0.0 {
-            let cs = d.dot(self.sun).max(0.0);
-            if cs > 0.0 {
-                // cs^2000 is exactly 0 below SUN_DISC_ZERO (it rounds to zero): skip powf's slow underflow path.
-                let disc = if cs > SUN_DISC_ZERO { cs.powf(2000.0) } else { 0.0 };
-                c += v3(env.sun_color) * env.sun_intensity * (cs.powi(8) * 0.25 + disc * 20.0);
-            }
-        }
-        // Fog thickens the whole sky towards the fog colour.
-        c * self.sky_keep + self.sky_fog
+        let c = self.light.sky.radiance(d) + self.light.sky.sun_disc(d);
+        let keep = (-self.env.fog_extinction_per_m * 3000.0).exp();
+        c * keep + self.air_light(d) * (1.0 - keep)
     }
 
-    /// Slope of the water surface at `p` (x, y): sum of three swell components and a ripple.
+    /// Radiance of the sky without the sun's disc along unit `d` (what a reflected ray sees; the sun's
+    /// reflection is the glint), veiled by fog.
     #[inline]
-    fn water_normal(&self, p: Vec3) -> Vec3 {
+    fn sky_no_sun(&self, d: Vec3) -> Vec3 {
+        let keep = (-self.env.fog_extinction_per_m * 3000.0).exp();
+        self.light.sky.radiance(d) * keep + self.air_light(d) * (1.0 - keep)
+    }
+
+    /// Radiance distant objects fade into along `d`: the horizon sky's, at `d`'s azimuth.
+    #[inline]
+    pub fn air_light(&self, d: Vec3) -> Vec3 {
+        let h = Vec3::new(d.x, d.y, 0.0).normalize_or(Vec3::X);
+        self.light.sky.radiance(Vec3::new(h.x, h.y, 0.02))
+    }
+
+    /// Aerial perspective over a path of `t` metres along `d`.
+    #[inline]
+    pub fn fog(&self, c: Vec3, d: Vec3, t: f32) -> Vec3 {
+        let f = (-self.env.fog_extinction_per_m * t).exp();
+        c * f + self.air_light(d) * (1.0 - f)
+    }
+
+    /// Swell normal of the water surface at `p`.
+    #[inline]
+    pub fn water_normal(&self, p: Vec3) -> Vec3 {
         let mut gx = 0.0;
         let mut gy = 0.0;
         for w in &self.swell {
@@ -227,288 +280,195 @@ impl Shader {
         Vec3::new(-gx, -gy, 1.0).normalize_or_zero()
     }
 
+    /// The shading normal of a water hit seen along `d` (the swell's, or the geometric one where the swell
+    /// would face away).
     #[inline]
-    fn fog(&self, c: Vec3, t: f32) -> Vec3 {
-        let f = (-self.env.fog_extinction_per_m * t).exp();
-        c * f + self.fog_color * (1.0 - f)
+    fn water_shading_normal(&self, d: Vec3, hit: &SurfaceHit) -> Vec3 {
+        let n = self.water_normal(hit.point);
+        if n.dot(d) > 0.0 {
+            hit.normal
+        } else {
+            n
+        }
     }
 
-    /// Linear RGB of one camera ray `d` (world, unit) given its hit (or `None` for the sky) and whether the hit
-    /// point sees the sun. Cameras shade with [`Shader::shade_lanes`], the same bits for [`LANES`] pixels at once.
+    /// Origin and unit direction of the ray reflected by a water hit seen along `d` (never below the horizon).
     #[inline]
-    pub fn shade(&self, d: Vec3, hit: Option<&SurfaceHit>, sunlit: bool) -> Vec3 {
+    pub fn reflection_ray(&self, d: Vec3, hit: &SurfaceHit) -> (Vec3, Vec3) {
+        let n = self.water_shading_normal(d, hit);
+        let mut r = d - n * (2.0 * d.dot(n));
+        r.z = r.z.abs().max(1e-4);
+        (hit.point + hit.normal * (0.02 + 1e-4 * hit.t), r.normalize())
+    }
+
+    /// Radiance (before aerial perspective) of a non-water surface seen along `d`, lit by the sun when `sunlit`.
+    #[inline]
+    pub fn surface(&self, d: Vec3, hit: &SurfaceHit, sunlit: bool) -> Vec3 {
+        let m = hit.material.unwrap_or_else(|| class_material(hit));
+        let base = Vec3::from_array(m.base_color);
+        let n = hit.normal;
+        let v = -d;
+        let nv = n.dot(v).max(1e-4);
+        let f0 = Vec3::splat(0.04) * (1.0 - m.metallic) + base * m.metallic;
+        let diffuse = base * ((1.0 - m.metallic) / std::f32::consts::PI);
+        let alpha = (m.roughness * m.roughness).max(brdf::ALPHA_MIN);
+        let mut c = diffuse * self.light.irradiance(n);
+        let r = d - n * (2.0 * d.dot(n));
+        let [a, b] = dfg(nv, m.roughness);
+        c += self.light.prefiltered(r, m.roughness) * (f0 * a + Vec3::splat(b));
+        if sunlit {
+            let ns = n.dot(self.sun);
+            if ns > 0.0 {
+                c += (diffuse * ns + specular_cos(n, v, self.sun, alpha, f0)) * self.sun_e;
+            }
+        }
+        if !m.nav_light || hit.lights_on {
+            c += Vec3::from_array(m.emissive);
+        }
+        c
+    }
+
+    /// Radiance (before aerial perspective) of the water seen along `d`: Fresnel-weighted `reflected` radiance
+    /// (along [`Shader::reflection_ray`]; `None` reads the sky there), the sun's Cox–Munk glint when `sunlit`,
+    /// the water body, and foam.
+    #[inline]
+    pub fn water(&self, d: Vec3, hit: &SurfaceHit, sunlit: bool, reflected: Option<Vec3>) -> Vec3 {
+        let n = self.water_shading_normal(d, hit);
+        let v = -d;
+        let cos_o = n.dot(v).clamp(1e-4, 1.0);
+        let f_o = fresnel_dielectric(cos_o, WATER_IOR);
+        let l_r = match reflected {
+            Some(l) => l,
+            None => self.sky_no_sun(self.reflection_ray(d, hit).1),
+        };
+        let mut c = l_r * f_o;
+        let mut entering = self.light.water_entering;
+        if sunlit {
+            let ns = n.dot(self.sun);
+            if ns > 0.0 {
+                // The glint: GGX with the Cox–Munk roughness, weighted by the exact Fresnel at the half vector.
+                let h = (v + self.sun).normalize_or_zero();
+                let f = fresnel_dielectric(v.dot(h), WATER_IOR);
+                c += specular_cos(n, v, self.sun, self.water_alpha, Vec3::ONE) * self.sun_e * f;
+                entering += self.sun_e * (ns * (1.0 - fresnel_dielectric(ns, WATER_IOR)));
+            }
+        }
+        c += water::body_factor(self.water_rho, self.water_fdr, cos_o, WATER_IOR) * entering;
+        if !self.foam.is_empty() {
+            let cover = self.foam.cover(hit.point.x, hit.point.y);
+            if cover > 0.0 {
+                let mut e = self.light.irradiance(n);
+                if sunlit {
+                    e += self.sun_e * n.dot(self.sun).max(0.0);
+                }
+                c = c * (1.0 - cover) + e * (cover * FOAM_ALBEDO / std::f32::consts::PI);
+            }
+        }
+        c
+    }
+
+    /// Radiance along camera ray `d` with its hit (or `None` for the sky), whether the hit sees the sun, and for
+    /// water the radiance along its reflected ray (`None`: the sky's); aerial perspective included.
+    #[inline]
+    pub fn shade(&self, d: Vec3, hit: Option<&SurfaceHit>, sunlit: bool, reflected: Option<Vec3>) -> Vec3 {
         let Some(hit) = hit else {
             return self.sky(d);
         };
-        let sun = self.sun;
-        let sun_light = self.sun_lit * if sunlit { 1.0 } else { 0.0 };
-        let ambient_light = self.ambient_light;
-        let c = if hit.class == 1 {
-            let mut n = self.water_normal(hit.point);
-            if n.dot(d) > 0.0 {
-                n = hit.normal;
-            }
-            let cos = (-d.dot(n)).clamp(0.0, 1.0);
-            let fresnel = 0.02 + 0.98 * (1.0 - cos).powi(5);
-            let mut r = d - n * (2.0 * d.dot(n));
-            r.z = r.z.abs();
-            let body = Vec3::new(0.01, 0.045, 0.06) * (ambient_light + sun_light * n.dot(sun).max(0.0));
-            let rs = r.dot(sun).max(0.0);
-            // rs^300 is exactly 0 below GLINT_ZERO: skip powf's slow underflow path.
-            let glint = sun_light * if rs > GLINT_ZERO { rs.powf(300.0) } else { 0.0 } * 4.0;
-            body * (1.0 - fresnel) + self.sky(r) * fresnel + glint
-        } else {
-            let a = albedo(hit);
-            a * (ambient_light + sun_light * hit.normal.dot(sun).max(0.0))
-        };
-        self.fog(c, hit.t)
+        let c = if hit.is_water() { self.water(d, hit, sunlit, reflected) } else { self.surface(d, hit, sunlit) };
+        self.fog(c, d, hit.t)
     }
 
-    /// [`rain`] with this render's environment.
-    #[inline(always)]
+    /// Radiance a reflected ray `d` brings back: its hit's (no further reflection), or the sky without the
+    /// sun's disc.
+    #[inline]
+    pub fn reflected(&self, d: Vec3, hit: Option<&SurfaceHit>, sunlit: bool) -> Vec3 {
+        match hit {
+            None => self.sky_no_sun(d),
+            Some(h) => self.shade(d, Some(h), sunlit, None),
+        }
+    }
+
+    /// Rain on a radiance at pixel `(u, v)`: darkening, and thin bright streaks (positions drawn from `seed`).
+    #[inline]
     pub fn rain(&self, c: Vec3, u: u32, v: u32, seed: u64) -> Vec3 {
-        rain(&self.env, c, u, v, seed)
-    }
-}
-
-/// Rain: darkening and streaks on a linear colour at pixel `(u, v)`.
-#[inline(always)]
-pub fn rain(env: &ShadeEnv, c: Vec3, u: u32, v: u32, seed: u64) -> Vec3 {
-    if env.rain_mm_per_h <= 0.0 {
-        return c;
-    }
-    let strength = (env.rain_mm_per_h / 16.0).min(1.0);
-    let mut out = c * (1.0 - 0.3 * strength);
-    let len = 12u32;
-    let offset = (noise::hash3(seed, stream::RAIN, u as u64) % len as u64) as u32;
-    let segment = (v + offset) / len;
-    let key = ((u as u64) << 32) | segment as u64;
-    if noise::uniform(seed, stream::RAIN, key) < 0.03 * strength as f64 {
-        out += Vec3::splat(0.12);
-    }
-    out
-}
-
-/// Linear `[0, 1]` to 8-bit sRGB by the formula (the reference [`to_srgb8`] reproduces exactly).
-fn srgb8_formula(x: f32) -> u8 {
-    let x = x.clamp(0.0, 1.0);
-    let s = if x <= 0.003_130_8 { 12.92 * x } else { 1.055 * x.powf(1.0 / 2.4) - 0.055 };
-    (s * 255.0 + 0.5) as u8
-}
-
-/// Buckets of the direct table in front of the step search (`x · BUCKETS` picks one).
-const BUCKETS: usize = 4096;
-
-/// The encoding as tables: `steps[b]` is the smallest linear value the formula encodes as `b` or more (found
-/// once by bisection over the float bit patterns of `[0, 1]`, so the tables reproduce the formula exactly;
-/// `steps[256] = steps[257] = +inf`, the last one so that no lookup needs a bounds check), and `start[i]` the
-/// encoding of `i / BUCKETS`. No bucket holds more than two steps (checked when the tables are built), so a
-/// lookup is one table read and two comparisons.
-struct SrgbTables {
-    steps: [f32; 258],
-    start: Box<[u8; BUCKETS + 1]>,
-}
-
-fn srgb_tables() -> &'static SrgbTables {
-    static TABLES: std::sync::OnceLock<SrgbTables> = std::sync::OnceLock::new();
-    TABLES.get_or_init(|| {
-        let mut steps = [f32::INFINITY; 258];
-        steps[0] = 0.0;
-        let one = 1.0f32.to_bits();
-        for (b, slot) in steps.iter_mut().enumerate().take(256).skip(1) {
-            // Smallest bit pattern in [0, one] whose encoding is >= b (encodings only grow with the value).
-            let (mut lo, mut hi) = (0u32, one);
-            while lo < hi {
-                let mid = lo + (hi - lo) / 2;
-                if srgb8_formula(f32::from_bits(mid)) as usize >= b {
-                    hi = mid;
-                } else {
-                    lo = mid + 1;
-                }
-            }
-            *slot = f32::from_bits(lo);
+        let env = &self.env;
+        if env.rain_mm_per_h <= 0.0 {
+            return c;
         }
-        let mut start = Box::new([0u8; BUCKETS + 1]);
-        for (i, slot) in start.iter_mut().enumerate() {
-            *slot = srgb8_formula(i as f32 / BUCKETS as f32);
+        let strength = (env.rain_mm_per_h / 16.0).min(1.0);
+        let mut out = c * (1.0 - 0.3 * strength);
+        let len = 12u32;
+        let offset = (noise::hash3(seed, stream::RAIN, u as u64) % len as u64) as u32;
+        let segment = (v + offset) / len;
+        let key = ((u as u64) << 32) | segment as u64;
+        if noise::uniform(seed, stream::RAIN, key) < 0.03 * strength as f64 {
+            // A streak adds 12 % of full scale.
+            out += Vec3::splat(0.12 / self.exposure);
         }
-        for i in 0..BUCKETS {
-            assert!(start[i + 1] - start[i] <= 2, "more than two sRGB steps in bucket {i}");
-        }
-        SrgbTables { steps, start }
-    })
-}
-
-/// Linear `[0, ∞)` to 8-bit sRGB (`round(255 · srgb(clamp(x, 0, 1)))`), by table: the same bytes as the
-/// formula, without a `powf` per channel.
-#[inline(always)]
-pub fn to_srgb8(c: Vec3) -> [u8; 3] {
-    let t = srgb_tables();
-    let enc = |x: f32| {
-        // Above 1 encodes as 1 (and +inf must not pass `steps[256] = +inf`); NaN stays NaN and compares false.
-        let x = if x > 1.0 { 1.0 } else { x };
-        // `max` sends negative values and NaN to bucket 0 (NaN then compares false below); `x ≤ 1` keeps the
-        // index within the table, and a 32-bit conversion is shorter code than a saturating `usize` one.
-        let i = ((x.max(0.0) * BUCKETS as f32) as u32 as usize).min(BUCKETS);
-        let mut b = t.start[i] as usize;
-        b += usize::from(t.steps[b + 1] <= x);
-        b += usize::from(t.steps[b + 1] <= x);
-        b as u8
-    };
-    [enc(c.x), enc(c.y), enc(c.z)]
+        out
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// Environments the shading tests run in: clear noon; low sun with fog and 3.5 m waves; night.
-    pub(super) fn test_envs() -> [ShadeEnv; 3] {
-        [
-            ShadeEnv::default(),
-            ShadeEnv {
-                sun_direction: [0.9, 0.0, 0.436],
-                wave_height_m: 3.5,
-                fog_extinction_per_m: 0.01,
-                ..ShadeEnv::default()
-            },
-            ShadeEnv { sun_intensity: 0.0, ambient: 0.05, ..ShadeEnv::default() },
-        ]
+    fn hit(class: u16, material: Option<Material>) -> SurfaceHit {
+        SurfaceHit { t: 10.0, point: Vec3::ZERO, normal: Vec3::Z, class, instance: 0, material, lights_on: false }
     }
 
     #[test]
-    fn sky_brighter_towards_sun_and_fog_veils() {
-        let env = ShadeEnv::default();
-        let s = v3(env.sun_direction);
-        assert!(sky(&env, s).x > sky(&env, -s + Vec3::new(0.0, 0.0, 1.5)).x);
-        let hit = SurfaceHit { t: 5000.0, point: Vec3::ZERO, normal: Vec3::Z, class: 2, instance: 0 };
-        let near = SurfaceHit { t: 10.0, ..hit };
-        let foggy = ShadeEnv { fog_extinction_per_m: 3.0 / 300.0, ..env };
-        let far_c = shade(&foggy, -Vec3::Z, Some(&hit), true, 1);
-        let fog_c = v3(foggy.fog_color) * foggy.ambient * 1.3;
-        assert!((far_c - fog_c).length() < 1e-3, "far surface disappears in fog");
-        assert!((shade(&foggy, -Vec3::Z, Some(&near), true, 1) - fog_c).length() > 0.05);
-        assert_eq!(to_srgb8(Vec3::ZERO), [0, 0, 0]);
-        assert_eq!(to_srgb8(Vec3::ONE), [255, 255, 255]);
+    fn lambert_plane_under_the_sun_is_albedo_times_irradiance_over_pi() {
+        let env = ShadeEnv { fog_extinction_per_m: 0.0, ..ShadeEnv::default() };
+        let sh = Shader::new(&env, 1, &[]);
+        let m = Material { base_color: [0.5; 3], roughness: 1.0, metallic: 0.0, emissive: [0.0; 3], nav_light: false };
+        // The specular part of a rough dielectric is small; compare the diffuse share in closed form.
+        let lit = sh.surface(-Vec3::Z, &hit(2, Some(m)), true);
+        let dark = sh.surface(-Vec3::Z, &hit(2, Some(m)), false);
+        let sun = sh.sun();
+        let want = sh.sun_e * (0.5 / std::f32::consts::PI * sun.z);
+        let got = lit - dark;
+        let spec = specular_cos(Vec3::Z, Vec3::Z, sun, 1.0, Vec3::splat(0.04)) * sh.sun_e;
+        assert!(((got - spec) - want).length() < 1e-3 * want.length(), "{got} {want}");
+        // Shadowed: only the environment, which for the up normal is the sky's irradiance.
+        let e = sh.lighting().irradiance(Vec3::Z);
+        assert!((dark.y - 0.5 / std::f32::consts::PI * e.y).abs() < 0.05 * dark.y, "{dark} {e}");
     }
 
     #[test]
-    fn skipped_powers_are_exactly_zero() {
-        for i in 0..=100_000 {
-            let x = GLINT_ZERO * i as f32 / 100_000.0;
-            assert_eq!(x.powf(300.0), 0.0, "{x}");
-            let y = SUN_DISC_ZERO * i as f32 / 100_000.0;
-            assert_eq!(y.powf(2000.0), 0.0, "{y}");
-        }
+    fn nav_lights_glow_only_when_on_and_fog_veils() {
+        let env = ShadeEnv { sun_direction: [0.0, 0.9, -0.436], ..ShadeEnv::default() };
+        let sh = Shader::new(&env, 1, &[]);
+        let lamp = Material {
+            base_color: [0.8, 0.1, 0.1],
+            roughness: 0.3,
+            metallic: 0.0,
+            emissive: [2e4, 0.0, 0.0],
+            nav_light: true,
+        };
+        let off = sh.surface(-Vec3::X, &SurfaceHit { normal: Vec3::X, ..hit(10, Some(lamp)) }, false);
+        let on = sh.surface(-Vec3::X, &SurfaceHit { normal: Vec3::X, lights_on: true, ..hit(10, Some(lamp)) }, false);
+        assert!(on.x > 1e4 && off.x < 10.0, "{on} {off}");
+        let foggy = Shader::new(&ShadeEnv { fog_extinction_per_m: 0.01, ..ShadeEnv::default() }, 1, &[]);
+        let far = foggy.shade(-Vec3::X, Some(&SurfaceHit { t: 5000.0, normal: Vec3::X, ..hit(2, None) }), true, None);
+        let air = foggy.air_light(-Vec3::X);
+        assert!((far - air).length() < 1e-3 * air.length());
     }
 
     #[test]
-    fn srgb_table_equals_the_formula() {
-        // Every step boundary and its neighbours, a dense sweep, and values outside [0, 1].
-        let steps = &srgb_tables().steps;
-        let mut xs: Vec<f32> = vec![-1.0, -0.0, 0.0, 1.0, 1.5, f32::INFINITY, f32::NAN, 1e-30, 0.003_130_8];
-        for &t in steps.iter().take(256) {
-            let b = t.to_bits();
-            xs.extend((b.saturating_sub(3)..b + 3).map(f32::from_bits));
-        }
-        xs.extend((0..200_000).map(|i| i as f32 / 200_000.0));
-        // ... and every bucket edge with its neighbours.
-        for i in 0..=BUCKETS {
-            let b = (i as f32 / BUCKETS as f32).to_bits();
-            xs.extend((b.saturating_sub(2)..b + 2).map(f32::from_bits));
-        }
-        for x in xs {
-            let want = srgb8_formula(x);
-            assert_eq!(to_srgb8(Vec3::splat(x)), [want; 3], "x = {x:e}");
-        }
-    }
-
-    #[test]
-    fn precomputed_shader_equals_the_per_pixel_formulas() {
-        // The shading as it was written per pixel (before the constants were hoisted), as a reference.
-        fn reference(env: &ShadeEnv, d: Vec3, hit: Option<&SurfaceHit>, sunlit: bool, seed: u64) -> Vec3 {
-            let sky = |d: Vec3| {
-                let up = d.z.max(0.0).sqrt();
-                let brightness = 0.25 + 1.3 * env.ambient;
-                let mut c = (v3(env.sky_horizon) * (1.0 - up) + v3(env.sky_zenith) * up) * brightness;
-                if d.z < 0.0 {
-                    c *= 0.8;
-                }
-                if env.sun_intensity > 0.0 {
-                    let cs = d.dot(v3(env.sun_direction)).max(0.0);
-                    c += v3(env.sun_color) * env.sun_intensity * (cs.powi(8) * 0.25 + cs.powf(2000.0) * 20.0);
-                }
-                let veil = 1.0 - (-env.fog_extinction_per_m * 3000.0).exp();
-                c * (1.0 - veil) + v3(env.fog_color) * env.ambient.max(0.1) * 1.3 * veil
-            };
-            let Some(hit) = hit else { return sky(d) };
-            let sun = v3(env.sun_direction);
-            let sun_light = v3(env.sun_color) * env.sun_intensity * if sunlit { 1.0 } else { 0.0 };
-            let ambient_light = (v3(env.sky_zenith) * 0.5 + v3(env.sky_horizon) * 0.5) * (0.4 + 1.2 * env.ambient);
-            let c = if hit.class == 1 {
-                let h = env.wave_height_m.max(0.05);
-                let (mut gx, mut gy) = (0.0f32, 0.0f32);
-                for i in 0..4u64 {
-                    let dir = std::f32::consts::TAU * noise::uniform(seed, stream::RIPPLE, 2 * i) as f32;
-                    let phase = std::f32::consts::TAU * noise::uniform(seed, stream::RIPPLE, 2 * i + 1) as f32;
-                    let wavelength = [41.0f32, 23.0, 11.0, 3.7][i as usize];
-                    let k = std::f32::consts::TAU / wavelength;
-                    let amp = (0.5 * h).min(0.05 * wavelength) * [0.5f32, 0.3, 0.15, 0.05][i as usize];
-                    let (s, c) = dir.sin_cos();
-                    let slope = amp * k * (k * (c * hit.point.x + s * hit.point.y) + phase).cos();
-                    gx += slope * c;
-                    gy += slope * s;
-                }
-                let mut n = Vec3::new(-gx, -gy, 1.0).normalize_or_zero();
-                if n.dot(d) > 0.0 {
-                    n = hit.normal;
-                }
-                let cos = (-d.dot(n)).clamp(0.0, 1.0);
-                let fresnel = 0.02 + 0.98 * (1.0 - cos).powi(5);
-                let mut r = d - n * (2.0 * d.dot(n));
-                r.z = r.z.abs();
-                let body = Vec3::new(0.01, 0.045, 0.06) * (ambient_light + sun_light * n.dot(sun).max(0.0));
-                let glint = sun_light * r.dot(sun).max(0.0).powf(300.0) * 4.0;
-                body * (1.0 - fresnel) + sky(r) * fresnel + glint
-            } else {
-                albedo(hit) * (ambient_light + sun_light * hit.normal.dot(sun).max(0.0))
-            };
-            let f = (-env.fog_extinction_per_m * hit.t).exp();
-            c * f + v3(env.fog_color) * env.ambient.max(0.1) * 1.3 * (1.0 - f)
-        }
-        let envs = test_envs();
-        let mut k = 0u64;
-        for env in &envs {
-            let sh = Shader::new(env, 42);
-            for i in 0..4000 {
-                k += 1;
-                let a = i as f32 * 0.37;
-                let d = Vec3::new(a.cos() * 0.8, a.sin() * 0.8, (i as f32 * 0.011).sin()).normalize();
-                let class = [1u16, 2, 5, 10][i % 4];
-                let hit = SurfaceHit {
-                    t: 3.0 + i as f32 * 0.7,
-                    point: Vec3::new(i as f32 * 1.3 - 900.0, (k % 97) as f32 * 5.1, 0.0),
-                    normal: Vec3::Z,
-                    class,
-                    instance: (i % 7) as i32,
-                };
-                for sunlit in [true, false] {
-                    assert_eq!(sh.shade(d, Some(&hit), sunlit), reference(env, d, Some(&hit), sunlit, 42));
-                }
-                assert_eq!(sh.shade(d, None, true), reference(env, d, None, true, 42));
-            }
-        }
-    }
-
-    #[test]
-    fn shadow_darkens_and_rain_darkens() {
-        let env = ShadeEnv::default();
-        let hit = SurfaceHit { t: 10.0, point: Vec3::ZERO, normal: Vec3::Z, class: 2, instance: 0 };
-        let lit = shade(&env, -Vec3::Z, Some(&hit), true, 1);
-        let dark = shade(&env, -Vec3::Z, Some(&hit), false, 1);
-        assert!(lit.x > dark.x * 1.5);
-        let wet = ShadeEnv { rain_mm_per_h: 16.0, ..env };
-        let sum: f32 = (0..64).map(|v| rain(&wet, lit, 3, v, 1).x).sum();
-        assert!(sum < lit.x * 64.0);
+    fn water_reflects_by_fresnel() {
+        let env = ShadeEnv { wave_height_m: 0.0, wind_speed_m_s: 0.0, ..ShadeEnv::default() };
+        let sh = Shader::new(&env, 1, &[]);
+        let w = hit(1, None);
+        // Looking straight down (no glint: the sun is not behind the camera) the reflected radiance is weighted
+        // by F(0) = 0.02; at grazing incidence by much more.
+        let bright = Vec3::splat(1000.0);
+        let down = sh.water(-Vec3::Z, &w, false, Some(bright)) - sh.water(-Vec3::Z, &w, false, Some(Vec3::ZERO));
+        let n = sh.water_shading_normal(-Vec3::Z, &w);
+        let f = fresnel_dielectric(n.dot(Vec3::Z), WATER_IOR);
+        assert!((down.x - 1000.0 * f).abs() < 0.01, "{down} {f}");
+        let g = Vec3::new(1.0, 0.0, -0.05).normalize();
+        let graze = sh.water(g, &w, false, Some(bright)) - sh.water(g, &w, false, Some(Vec3::ZERO));
+        assert!(graze.x > 5.0 * down.x);
     }
 }

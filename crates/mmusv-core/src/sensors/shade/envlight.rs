@@ -1,0 +1,287 @@
+//! Image-based lighting from the sky: the environment's radiance (the [`Sky`] above the horizon, a uniform
+//! ground/sea below it) integrated once per environment into an irradiance map for Lambert surfaces and
+//! GGX-prefiltered maps for glossy ones (the split sum of [`super::brdf`]).
+//!
+//! The source grids are cylindrical equal-area (columns uniform in azimuth, rows uniform in `z`), so every
+//! texel has the same solid angle `4π / (W H)` and the integrals are plain sums; the output maps are read
+//! bilinearly on a grid uniform in azimuth and polar angle whose first and last rows are the poles (so the up
+//! and down normals, the commonest, are exact):
+//! * irradiance `E(n) = Σ L(ω) max(0, n·ω) Δω`;
+//! * prefiltered radiance `P(r, α) = Σ L(ω) w(ω) / Σ w(ω)` with the GGX lobe weight `w = D(h) (h·r) / (4 h·ω)
+//!   · max(0, r·ω)` around the mirror direction `r` (Karis 2013's `n = v = r` assumption).
+//!
+//! The lower hemisphere's radiance is `a_g E_h / π`: the light a Lambert ground of albedo `a_g` under the
+//! horizontal illuminance `E_h` reflects; for the sea `a_g` = 0.06, the sea-surface albedo under a high sun
+//! (G. R. Payne, "Albedo of the Sea Surface", J. Atmos. Sci. 29, 1972).
+//!
+//! Built once per environment and kept in a small process-wide cache (every camera of a run shares it).
+
+use super::brdf::{fresnel_dielectric, ggx_d};
+use super::sky::{luminance, Sky};
+use parry3d::math::Vec3;
+use std::sync::{Arc, Mutex};
+
+/// Source grid of the irradiance integral (azimuth × z).
+const SRC_IRR: (usize, usize) = (128, 64);
+/// Source grid of the prefiltered maps.
+const SRC_PRE: (usize, usize) = (64, 32);
+/// Output grid of every map.
+const OUT: (usize, usize) = (32, 17);
+/// Roughness of the prefiltered levels; below the first, the sky is read along the mirror direction.
+pub const LEVELS: [f32; 5] = [0.2, 0.35, 0.5, 0.7, 1.0];
+/// Roughness up to which a surface reads the sky directly along its mirror direction.
+const MIRROR_UP_TO: f32 = 0.1;
+
+/// Index of refraction of sea water.
+pub const WATER_IOR: f32 = 1.33;
+
+/// What the lighting depends on (the cache key).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LightingKey {
+    /// Unit vector towards the sun.
+    pub sun: [f32; 3],
+    /// Preetham turbidity.
+    pub turbidity: f32,
+    /// Cloud cover in `[0, 1]`.
+    pub cloud: f32,
+    /// Albedo of the lower hemisphere (the sea).
+    pub ground_albedo: f32,
+}
+
+/// The sky and its precomputed environment lighting.
+#[derive(Debug)]
+pub struct Lighting {
+    /// The sky and the sun.
+    pub sky: Sky,
+    /// Radiance of the lower hemisphere (linear RGB, cd/m²).
+    pub ground: Vec3,
+    /// Horizontal illuminance from the sky and the sun (lux, luminance of the RGB).
+    pub horizontal_lux: f32,
+    /// `∫ (1 − F_water(θ)) L(ω) cos θ dω` over the upper hemisphere for the normal `+z`: the sky light that enters
+    /// a level water surface (linear RGB, lux).
+    pub water_entering: Vec3,
+    irradiance: Vec<Vec3>,
+    prefiltered: Vec<Vec<Vec3>>,
+}
+
+/// Unit direction of the centre of texel `(i, j)` of a `w × h` equal-area grid.
+fn texel_dir(i: usize, j: usize, w: usize, h: usize) -> Vec3 {
+    let phi = (i as f32 + 0.5) / w as f32 * std::f32::consts::TAU - std::f32::consts::PI;
+    let z = (j as f32 + 0.5) / h as f32 * 2.0 - 1.0;
+    let s = (1.0 - z * z).max(0.0).sqrt();
+    Vec3::new(s * phi.cos(), s * phi.sin(), z)
+}
+
+/// Unit direction of node `(i, j)` of the `w × h` output grid (row 0 straight down, row `h − 1` straight up).
+fn node_dir(i: usize, j: usize, w: usize, h: usize) -> Vec3 {
+    let phi = (i as f32 + 0.5) / w as f32 * std::f32::consts::TAU - std::f32::consts::PI;
+    let theta = j as f32 / (h - 1) as f32 * std::f32::consts::PI;
+    let (st, ct) = theta.sin_cos();
+    Vec3::new(st * phi.cos(), st * phi.sin(), -ct)
+}
+
+/// Bilinear read of an `OUT`-sized map along unit direction `d` (wrapping in azimuth).
+#[inline]
+fn read(map: &[Vec3], d: Vec3) -> Vec3 {
+    let (w, h) = OUT;
+    let phi = d.y.atan2(d.x);
+    let x = (phi + std::f32::consts::PI) / std::f32::consts::TAU * w as f32 - 0.5;
+    let y = ((-d.z).clamp(-1.0, 1.0).acos() / std::f32::consts::PI * (h - 1) as f32).clamp(0.0, (h - 1) as f32);
+    let x0 = x.floor();
+    let fx = x - x0;
+    let i0 = (x0 as i32).rem_euclid(w as i32) as usize;
+    let i1 = (i0 + 1) % w;
+    let j0 = y as usize;
+    let j1 = (j0 + 1).min(h - 1);
+    let fy = y - j0 as f32;
+    let a = map[j0 * w + i0] * (1.0 - fx) + map[j0 * w + i1] * fx;
+    let b = map[j1 * w + i0] * (1.0 - fx) + map[j1 * w + i1] * fx;
+    a * (1.0 - fy) + b * fy
+}
+
+impl Lighting {
+    /// Computes the lighting of `key` (tens of milliseconds; use [`Lighting::shared`]).
+    pub fn new(key: &LightingKey) -> Self {
+        let sky = Sky::new(Vec3::from_array(key.sun), key.turbidity, key.cloud);
+        let sun_h = sky.sun_irradiance() * sky.sun.z.max(0.0);
+        // Horizontal sky irradiance, from the upper half of the irradiance source grid.
+        let (sw, sh) = SRC_IRR;
+        let d_omega = 4.0 * std::f32::consts::PI / (sw * sh) as f32;
+        let src: Vec<(Vec3, Vec3)> = (0..sh)
+            .flat_map(|j| (0..sw).map(move |i| texel_dir(i, j, sw, sh)))
+            .filter(|d| d.z > 0.0)
+            .map(|d| (d, sky.radiance(d)))
+            .collect();
+        let sky_h: Vec3 = src.iter().map(|(d, l)| *l * d.z).sum::<Vec3>() * d_omega;
+        let e_h = sky_h + sun_h;
+        let ground = e_h * (key.ground_albedo / std::f32::consts::PI);
+        let water_entering: Vec3 =
+            src.iter().map(|(d, l)| *l * (d.z * (1.0 - fresnel_dielectric(d.z, WATER_IOR)))).sum::<Vec3>() * d_omega;
+        let env = |d: Vec3| if d.z > 0.0 { sky.radiance(d) } else { ground };
+        let (ow, oh) = OUT;
+        // Irradiance: the upper hemisphere from the sky texels, the lower one from the uniform ground (its share
+        // of a normal's cosine lobe in closed form: π (1 − n_z) / 2 for a uniform lower hemisphere).
+        let mut irradiance = vec![Vec3::ZERO; ow * oh];
+        for j in 0..oh {
+            for i in 0..ow {
+                let n = node_dir(i, j, ow, oh);
+                let up: Vec3 = src.iter().map(|(d, l)| *l * n.dot(*d).max(0.0)).sum::<Vec3>() * d_omega;
+                irradiance[j * ow + i] = up + ground_share(n) * ground;
+            }
+        }
+        let (pw, ph) = SRC_PRE;
+        let pre_src: Vec<(Vec3, Vec3)> =
+            (0..ph).flat_map(|j| (0..pw).map(move |i| texel_dir(i, j, pw, ph))).map(|d| (d, env(d))).collect();
+        let prefiltered = LEVELS
+            .iter()
+            .map(|&rough| {
+                let alpha = rough * rough;
+                let mut map = vec![Vec3::ZERO; ow * oh];
+                for j in 0..oh {
+                    for i in 0..ow {
+                        let r = node_dir(i, j, ow, oh);
+                        let (mut acc, mut wsum) = (Vec3::ZERO, 0.0f32);
+                        for (d, l) in &pre_src {
+                            let rd = r.dot(*d);
+                            if rd <= 0.0 {
+                                continue;
+                            }
+                            let hv = (r + *d).normalize_or_zero();
+                            let hd = hv.dot(*d).max(1e-4);
+                            let w = ggx_d(hv.dot(r), alpha) * hv.dot(r) / (4.0 * hd) * rd;
+                            acc += *l * w;
+                            wsum += w;
+                        }
+                        map[j * ow + i] = if wsum > 0.0 { acc / wsum } else { env(r) };
+                    }
+                }
+                map
+            })
+            .collect();
+        Self { sky, ground, horizontal_lux: luminance(e_h), water_entering, irradiance, prefiltered }
+    }
+
+    /// The lighting of `key`, computed once per process and shared (a cache of the last few environments).
+    pub fn shared(key: &LightingKey) -> Arc<Lighting> {
+        static CACHE: Mutex<Vec<(LightingKey, Arc<Lighting>)>> = Mutex::new(Vec::new());
+        if let Ok(cache) = CACHE.lock() {
+            if let Some((_, l)) = cache.iter().find(|(k, _)| k == key) {
+                return Arc::clone(l);
+            }
+        }
+        let l = Arc::new(Lighting::new(key));
+        if let Ok(mut cache) = CACHE.lock() {
+            if cache.len() >= 8 {
+                cache.remove(0);
+            }
+            cache.push((*key, Arc::clone(&l)));
+        }
+        l
+    }
+
+    /// Radiance of the environment (sky above the horizon, ground below, no sun disc) along unit `d`.
+    #[inline]
+    pub fn environment(&self, d: Vec3) -> Vec3 {
+        if d.z > 0.0 {
+            self.sky.radiance(d)
+        } else {
+            self.ground
+        }
+    }
+
+    /// [`Lighting::environment`] along `d` (normalised here), plus the sun's disc when `sun_disc`.
+    pub fn radiance_along(&self, d: [f32; 3], sun_disc: bool) -> [f32; 3] {
+        let v = Vec3::from_array(d).normalize_or_zero();
+        let disc = if sun_disc { self.sky.sun_disc(v) } else { Vec3::ZERO };
+        (self.environment(v) + disc).to_array()
+    }
+
+    /// Irradiance (lux, linear RGB) on a surface with unit normal `n` from the sky and the ground (not the sun).
+    #[inline]
+    pub fn irradiance(&self, n: Vec3) -> Vec3 {
+        read(&self.irradiance, n)
+    }
+
+    /// GGX-prefiltered environment radiance around the mirror direction `r` for perceptual `roughness`.
+    #[inline]
+    pub fn prefiltered(&self, r: Vec3, roughness: f32) -> Vec3 {
+        if roughness <= MIRROR_UP_TO {
+            return self.environment(r);
+        }
+        if roughness < LEVELS[0] {
+            let f = (roughness - MIRROR_UP_TO) / (LEVELS[0] - MIRROR_UP_TO);
+            return self.environment(r) * (1.0 - f) + read(&self.prefiltered[0], r) * f;
+        }
+        let k = LEVELS.iter().rposition(|&l| l <= roughness).unwrap_or(0);
+        if k + 1 >= LEVELS.len() {
+            return read(&self.prefiltered[k], r);
+        }
+        let f = (roughness - LEVELS[k]) / (LEVELS[k + 1] - LEVELS[k]);
+        read(&self.prefiltered[k], r) * (1.0 - f) + read(&self.prefiltered[k + 1], r) * f
+    }
+}
+
+/// `(1/π) ∫_{lower hemisphere} max(0, n·ω) dω` for unit `n`: the share of a cosine lobe that sees the ground,
+/// `(1 − n_z) / 2`, times π.
+#[inline]
+fn ground_share(n: Vec3) -> f32 {
+    std::f32::consts::PI * (1.0 - n.z.clamp(-1.0, 1.0)) * 0.5
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn key(cloud: f32) -> LightingKey {
+        LightingKey { sun: [0.5, 0.3, 0.81], turbidity: 3.0, cloud, ground_albedo: 0.06 }
+    }
+
+    #[test]
+    fn uniform_sky_gives_pi_l_and_prefilter_keeps_it() {
+        // A fully overcast sky under a zenith sun is not uniform, so test the integrals on their own closed
+        // form: irradiance of the up normal equals the horizontal sky illuminance.
+        let l = Lighting::new(&key(0.0));
+        let e_up = luminance(l.irradiance(Vec3::Z));
+        let sun_h = luminance(l.sky.sun_irradiance()) * l.sky.sun.z;
+        assert!(
+            (e_up + sun_h - l.horizontal_lux).abs() / l.horizontal_lux < 0.02,
+            "{e_up} {sun_h} {}",
+            l.horizontal_lux
+        );
+        // A downward normal sees only the ground: π L_g.
+        let down = l.irradiance(-Vec3::Z);
+        assert!((luminance(down) - std::f32::consts::PI * luminance(l.ground)).abs() < 0.02 * luminance(down));
+        // The roughest prefiltered map straight down sees only the uniform ground.
+        let p = l.prefiltered(-Vec3::Z, 1.0);
+        assert!((luminance(p) - luminance(l.ground)).abs() < 0.1 * luminance(l.ground), "{p} {}", l.ground);
+    }
+
+    #[test]
+    fn irradiance_matches_a_dense_integral() {
+        let l = Lighting::new(&key(0.1));
+        for n in [Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.3, -0.4, 0.866).normalize(), Vec3::new(-0.7, 0.7, 0.1)] {
+            let n = n.normalize();
+            let (nt, np) = (400, 400);
+            let mut e = Vec3::ZERO;
+            for i in 0..nt {
+                let z = (i as f32 + 0.5) / nt as f32 * 2.0 - 1.0;
+                for j in 0..np {
+                    let phi = (j as f32 + 0.5) / np as f32 * std::f32::consts::TAU;
+                    let s = (1.0 - z * z).sqrt();
+                    let d = Vec3::new(s * phi.cos(), s * phi.sin(), z);
+                    e += l.environment(d) * n.dot(d).max(0.0);
+                }
+            }
+            e *= 4.0 * std::f32::consts::PI / (nt * np) as f32;
+            let got = l.irradiance(n);
+            assert!((luminance(got) - luminance(e)).abs() < 0.03 * luminance(e), "n {n}: {got} vs {e}");
+        }
+    }
+
+    #[test]
+    fn shared_is_cached() {
+        let a = Lighting::shared(&key(0.3));
+        let b = Lighting::shared(&key(0.3));
+        assert!(Arc::ptr_eq(&a, &b));
+    }
+}

@@ -1,0 +1,110 @@
+//! Image formation after the radiance: exposure, the filmic tone curve, sRGB encoding and sensor noise.
+//!
+//! * **Exposure** like an incident-light meter: the scene's horizontal illuminance `E_h` (sun and sky) sets the
+//!   scale so that an 18 % grey Lambert card lying flat under that light, of radiance `0.18 E_h / π`, reaches
+//!   0.18 before the tone curve: `k = π / E_h`. `E_h` is floored at 10 lux (the camera's longest exposure and
+//!   highest gain), so nights stay dark and lights stand out. A fixed `EV100` instead gives the
+//!   saturation-based scale `k = 1 / (1.2 · 2^EV100)` (ISO 12232; S. Lagarde & C. de Rousiers, "Moving
+//!   Frostbite to Physically Based Rendering", SIGGRAPH 2014 course notes).
+//! * **Tone curve**: K. Narkowicz's fit of the ACES filmic reference rendering transform (2016),
+//!   `f(x) = x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14)`, clamped to `[0, 1]`, per channel.
+//! * **sRGB**: the IEC 61966-2-1 transfer function, rounded to 8 bits.
+//! * **Sensor noise** (optional): shot noise of `full_well · x` electrons (Poisson, drawn as a Gaussian with its
+//!   variance) plus Gaussian read noise, in the linear exposed signal `x`, seeded per pixel.
+
+use super::super::noise;
+use parry3d::math::Vec3;
+
+/// Darkest horizontal illuminance the automatic exposure adapts to, lux.
+pub const MIN_METERED_LUX: f32 = 10.0;
+
+/// Multiplier from radiance (cd/m²) to the tone curve's input: metered from `horizontal_lux` when `ev100` is
+/// `NaN`, else the saturation-based scale of `ev100`.
+pub fn exposure_scale(ev100: f32, horizontal_lux: f32) -> f32 {
+    if ev100.is_finite() {
+        1.0 / (1.2 * 2f32.powf(ev100))
+    } else {
+        std::f32::consts::PI / horizontal_lux.max(MIN_METERED_LUX)
+    }
+}
+
+/// Narkowicz's ACES fit on one exposed channel value.
+#[inline]
+pub fn aces(x: f32) -> f32 {
+    let x = x.max(0.0);
+    (x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0)
+}
+
+/// IEC 61966-2-1 sRGB encoding of a display-linear value in `[0, 1]`, to 8 bits.
+#[inline]
+pub fn srgb8(x: f32) -> u8 {
+    let x = x.clamp(0.0, 1.0);
+    let s = if x <= 0.003_130_8 { 12.92 * x } else { 1.055 * x.powf(1.0 / 2.4) - 0.055 };
+    (s * 255.0 + 0.5) as u8
+}
+
+/// Exposed, tone-mapped, sRGB-encoded pixel of radiance `c` under exposure `k`.
+#[inline]
+pub fn to_srgb8(c: Vec3, k: f32) -> [u8; 3] {
+    [srgb8(aces(c.x * k)), srgb8(aces(c.y * k)), srgb8(aces(c.z * k))]
+}
+
+/// Shot and read noise of a sensor (electrons).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SensorNoise {
+    /// Electrons at an exposed signal of 1.0 (`> 0`).
+    pub full_well: f32,
+    /// Read noise, electrons RMS (`>= 0`).
+    pub read_noise: f32,
+}
+
+impl SensorNoise {
+    /// Adds noise to the exposed linear signal `x` of channel `ch` of pixel `pixel`, drawn from `seed`.
+    #[inline]
+    pub fn apply(&self, x: f32, seed: u64, pixel: u64, ch: u64) -> f32 {
+        let e = x.max(0.0) * self.full_well;
+        let sigma = (e + self.read_noise * self.read_noise).sqrt();
+        let z = noise::normal(seed, 0x5E_4501, pixel * 3 + ch) as f32;
+        (e + sigma * z).max(0.0) / self.full_well
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grey_card_meters_to_0_18_and_curve_is_monotone() {
+        let e_h = 100_000.0f32;
+        let k = exposure_scale(f32::NAN, e_h);
+        let card = 0.18 * e_h / std::f32::consts::PI;
+        assert!((card * k - 0.18).abs() < 1e-6);
+        // EV100 15 (sunny 16): L_max = 1.2 · 2^15 cd/m² maps to 1.
+        assert!((exposure_scale(15.0, 0.0) * 1.2 * 32768.0 - 1.0).abs() < 1e-6);
+        let mut last = -1.0;
+        for i in 0..1000 {
+            let y = aces(i as f32 * 0.02);
+            assert!(y >= last);
+            last = y;
+        }
+        assert_eq!(aces(0.0), 0.0);
+        assert!(aces(1e6) == 1.0);
+        assert_eq!(srgb8(0.0), 0);
+        assert_eq!(srgb8(1.0), 255);
+        // 0.5 display-linear is sRGB 188.
+        assert_eq!(srgb8(0.5), 188);
+    }
+
+    #[test]
+    fn sensor_noise_has_its_variance() {
+        let n = SensorNoise { full_well: 1000.0, read_noise: 5.0 };
+        let x = 0.4;
+        let m = 20_000u64;
+        let v: Vec<f32> = (0..m).map(|i| n.apply(x, 3, i, 0)).collect();
+        let mean = v.iter().sum::<f32>() / m as f32;
+        let var = v.iter().map(|a| (a - mean).powi(2)).sum::<f32>() / m as f32;
+        let want = (x * 1000.0 + 25.0) / 1e6;
+        assert!((mean - x).abs() < 0.002, "{mean}");
+        assert!((var - want).abs() < 0.05 * want, "{var} vs {want}");
+    }
+}
