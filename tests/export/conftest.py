@@ -5,7 +5,8 @@
 * ``port`` — the bundled ``port_entry`` scenario (3 USVs, moored ships) with small sensors, 3 frames;
 * ``short`` — ``coop`` renamed, stopped after 2 of its 3 frames (its ``run`` metadata says so);
 * ``many`` — five 2-frame variants of ``coop`` (names and seeds differ) for the splits;
-* ``no_camera`` / ``no_lidar`` — ``coop`` for 1 frame with a rig without cameras / without LiDAR (bad input).
+* ``no_camera`` / ``no_lidar`` — ``coop`` for 1 frame with a rig without cameras / without LiDAR (bad input; the
+  ``no_lidar`` camera has lens distortion).
 """
 
 from __future__ import annotations
@@ -116,6 +117,10 @@ def many_recs(tmp_path_factory: pytest.TempPathFactory) -> list[Path]:
     return out
 
 
+DISTORTION = [-0.12, 0.03, 0.001, -0.002, 0.0]
+"""Brown–Conrady coefficients of the ``no_lidar`` recording's camera."""
+
+
 def _one_frame(name: str, rig: dict[str, Any]) -> dict[str, Any]:
     cfg = coop(name=name)
     cfg["acquisition"] = {"frequency_hz": 5, "frames": 1}
@@ -132,5 +137,11 @@ def no_camera_rec(tmp_path_factory: pytest.TempPathFactory) -> Path:
 @pytest.fixture(scope="session")
 def no_lidar_rec(tmp_path_factory: pytest.TempPathFactory) -> Path:
     rig = {**small_rig(), "lidar": None, "radar": None, "top_view": None}
-    rig["cameras"] = rig["cameras"][:1]
+    rig["cameras"] = [{**rig["cameras"][0], "distortion": DISTORTION}]
     return _run(_one_frame("export_no_lidar", rig), tmp_path_factory.mktemp("no_lidar"))
+
+
+@pytest.fixture()
+def no_lidar_distortion() -> list[float]:
+    """The lens distortion of the ``no_lidar`` recording's camera."""
+    return list(DISTORTION)

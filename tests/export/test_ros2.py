@@ -226,3 +226,15 @@ def test_split_is_refused_and_output_is_deterministic(coop_rec: Path, tmp_path: 
     convert(coop_rec, to="ros2", out_dir=b)
     for name in ("metadata.yaml", "export_coop.mcap"):
         assert (a / "export_coop" / name).read_bytes() == (b / "export_coop" / name).read_bytes()
+
+
+def test_camera_info_carries_the_lens_distortion(
+    no_lidar_rec: Path, no_lidar_distortion: list[float], tmp_path: Path
+) -> None:
+    convert(no_lidar_rec, to="ros2", out_dir=tmp_path / "o")
+    with AnyReader([tmp_path / "o" / "export_no_lidar"]) as r:
+        infos = [r.deserialize(raw, c.msgtype) for c, _t, raw in r.messages() if c.topic.endswith("/camera_info")]
+    assert len(infos) == 2  # two USVs, one camera each, one frame
+    for ci in infos:
+        assert ci.distortion_model == "plumb_bob"
+        np.testing.assert_array_equal(ci.d, no_lidar_distortion)

@@ -31,6 +31,7 @@ __all__ = [
     "MAP_FRAME",
     "Ros2Writer",
     "base_link",
+    "camera_distortion",
     "camera_frame",
     "camera_info_topic",
     "detections_2d_topic",
@@ -99,6 +100,15 @@ def detections_2d_topic(agent: str, name: str) -> str:
 def detections_3d_topic(agent: str) -> str:
     """``/<usv>/detections``: ``vision_msgs/Detection3DArray`` in the LiDAR frame."""
     return f"/{agent}/detections"
+
+
+def camera_distortion(agent: AgentInfo, name: str) -> np.ndarray:
+    """``(5,)`` float64 ``[k1, k2, p1, p2, k3]`` of the agent's camera ``name`` from its recorded rig (OpenCV's
+    order, which is ROS's ``plumb_bob``); zeros for a camera without distortion or a rig that does not say."""
+    for c in agent.rig.get("cameras") or []:
+        if isinstance(c, dict) and c.get("name") == name and c.get("distortion") is not None:
+            return np.asarray(c["distortion"], dtype=np.float64).reshape(5)
+    return np.zeros(5)
 
 
 def _stamp(ts: Any, t_ns: int) -> Any:
@@ -400,7 +410,8 @@ class Ros2Writer(DatasetWriter):
                 self._put(f"{base}/{kind}", "sensor_msgs/msg/Image", m.image(t, frame_id, img, "16UC1"), t)
 
     def _camera_info(self, t: int, a: AgentInfo, name: str) -> Any:
-        """Pinhole intrinsics, no distortion (``plumb_bob`` with zero coefficients), R = I, P = [K | 0]."""
+        """Pinhole intrinsics; ``plumb_bob`` distortion = the camera's Brown–Conrady ``[k1, k2, p1, p2, k3]`` as
+        recorded in its rig (:func:`camera_distortion`), zeros without; R = I, P = [K | 0]."""
         cam = a.cameras[name]
         fx, fy, cx, cy = cam.intrinsics
         k = np.array([fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0])
@@ -411,7 +422,7 @@ class Ros2Writer(DatasetWriter):
             height=cam.height,
             width=cam.width,
             distortion_model="plumb_bob",
-            d=np.zeros(5),
+            d=camera_distortion(a, name),
             k=k,
             r=np.eye(3).reshape(9),
             p=p,
