@@ -371,9 +371,9 @@ class Ros2Writer(DatasetWriter):
                 topics.radar_ppi(a.id), "sensor_msgs/msg/Image", m.image(t, topics.radar_frame(a.id), img, enc), t
             )
         for name in sorted(a.cameras):
-            self._camera(frame, a, name, optical_frame(a.id, name), topics.camera(a.id, name))
+            self._camera(frame, optical_frame(a.id, name), topics.camera(a.id, name))
             self._put(camera_info_topic(a.id, name), "sensor_msgs/msg/CameraInfo", self._camera_info(t, a, name), t)
-        self._camera(frame, a, "", top_view_frame(a.id), topics.top_view(a.id))
+        self._camera(frame, top_view_frame(a.id), topics.top_view(a.id))
         ann = msgs.get(topics.agent_annotations(a.id))
         if ann is not None:
             self._annotations(t, world, a, ann)
@@ -382,7 +382,7 @@ class Ros2Writer(DatasetWriter):
         """The message class ``name``."""
         return self.ts.types[name]
 
-    def _camera(self, frame: Frame, a: AgentInfo, name: str, frame_id: str, base: str) -> None:
+    def _camera(self, frame: Frame, frame_id: str, base: str) -> None:
         """The images of one camera (or the top view): RGB as PNG ``CompressedImage`` on ``<base>/rgb/compressed``
         (image_transport's name), depth ``32FC1`` metres (+inf: no hit), semantic and instance ``16UC1``."""
         from mmusv.recording import decode_image
