@@ -25,13 +25,14 @@ import os
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import IO, Any
+from typing import Any
 
 import numpy as np
 import yaml
 
 from mmusv.errors import ConfigError, IoError
 from mmusv.recording.parts import is_parts_manifest, read_parts_manifest
+from mmusv.recording.scan import Scan
 
 __all__ = [
     "MCAP_MAGIC",
@@ -48,6 +49,7 @@ __all__ = [
     "read_messages",
     "recording_name",
     "summary",
+    "warn_missing",
 ]
 
 MCAP_MAGIC = b"\x89MCAP0\r\n"
@@ -177,47 +179,34 @@ class Frame:
 
 
 def check_mcap(path: str | Path) -> Path:
-    """``path`` as a Path after checking it is an existing file that starts with the MCAP magic."""
+    """``path`` as a Path after checking it is an existing, readable, non-empty file that starts with the MCAP
+    magic; :class:`~mmusv.errors.IoError` naming the file otherwise."""
     p = Path(path)
-    if not p.exists():
-        raise IoError(f"recording {p} does not exist")
-    if not p.is_file():
-        raise IoError(f"recording {p} is not a file")
-    with p.open("rb") as f:
-        head = f.read(len(MCAP_MAGIC))
+    try:
+        if not p.exists():
+            raise IoError(f"recording {p} does not exist")
+        if not p.is_file():
+            raise IoError(f"recording {p} is not a file" + (" (it is a directory)" if p.is_dir() else ""))
+        with p.open("rb") as f:
+            head = f.read(len(MCAP_MAGIC))
+    except OSError as exc:
+        raise IoError(f"recording {p} cannot be read: {exc.strerror or exc}") from None
+    if not head:
+        raise IoError(f"{p} is empty (0 bytes): not an MCAP recording")
     if head != MCAP_MAGIC:
         raise IoError(f"{p} is not an MCAP file (it does not start with the MCAP magic bytes)")
     return p
 
 
-def _metadata_from_summary(f: IO[bytes]) -> dict[str, dict[str, str]] | None:
-    from mcap.reader import make_reader
-
+def _scan_metadata(p: Path) -> Scan:
+    """A walk over the records of ``p`` that hops over the chunks: its metadata, whether it is complete."""
+    scan = Scan(p, chunks=False)
     try:
-        reader = make_reader(f)
-        summary = reader.get_summary()
-        if summary is None:
-            return None
-        return {m.name: dict(m.metadata) for m in reader.iter_metadata()}
-    except Exception:  # a truncated file has no usable summary: fall back to streaming
-        return None
-
-
-def _metadata_from_head(f: IO[bytes]) -> dict[str, dict[str, str]]:
-    from mcap.records import Chunk, DataEnd, Message, Metadata
-    from mcap.stream_reader import StreamReader
-
-    out: dict[str, dict[str, str]] = {}
-    f.seek(0)
-    try:
-        for rec in StreamReader(f, emit_chunks=True).records:
-            if isinstance(rec, Metadata):
-                out[rec.name] = dict(rec.metadata)
-            elif isinstance(rec, (Chunk, Message, DataEnd)):
-                break
-    except Exception:
-        pass
-    return out
+        for _ in scan.messages():
+            pass
+    except OSError as exc:
+        raise IoError(f"recording {p} cannot be read: {exc.strerror or exc}") from None
+    return scan
 
 
 def _mat(v: Any) -> np.ndarray | None:
@@ -308,18 +297,25 @@ def read_info(path: str | Path) -> RecordingInfo:
     if is_parts_manifest(path):
         return _read_parts_info(Path(path))
     p = check_mcap(path)
-    with p.open("rb") as f:
-        meta = _metadata_from_summary(f)
-        has_summary = meta is not None
-        if meta is None:
-            meta = _metadata_from_head(f)
+    scan = _scan_metadata(p)
+    meta = scan.metadata
     if "sensors" not in meta or "scenario" not in meta:
-        raise IoError(f"{p} has no scenario/sensors metadata; was it written by mmusv run?")
+        hurt = "; ".join(d.describe() for d in scan.damage if not d.truncated or not meta)
+        raise IoError(
+            f"{p} has no scenario/sensors metadata; was it written by mmusv run?"
+            + (f" (damaged: {hurt})" if hurt else "")
+        )
     try:
-        sensors = json.loads(meta["sensors"]["json"])
-        scenario = yaml.safe_load(meta["scenario"]["yaml"])
-    except (KeyError, ValueError, yaml.YAMLError) as exc:
-        raise IoError(f"{p}: unreadable scenario/sensors metadata ({exc})") from None
+        return _info(p, meta, scan.complete and not scan.damage)
+    except (KeyError, IndexError, TypeError, ValueError, AttributeError, yaml.YAMLError) as exc:
+        raise IoError(f"{p}: unreadable scenario/sensors metadata ({type(exc).__name__}: {exc})") from None
+
+
+def _info(p: Path, meta: dict[str, dict[str, str]], has_summary: bool) -> RecordingInfo:
+    sensors = json.loads(meta["sensors"]["json"])
+    scenario = yaml.safe_load(meta["scenario"]["yaml"])
+    if not isinstance(sensors, dict) or not isinstance(scenario, dict):
+        raise ValueError("the scenario and sensors metadata must be mappings")
     manifest = meta.get("manifest", {})
     run = meta.get("run", {})
     ids = [str(v["id"]) for v in scenario.get("vessels", [])]
@@ -373,20 +369,59 @@ def read_info(path: str | Path) -> RecordingInfo:
     )
 
 
+def _ranges(frames: Sequence[int]) -> str:
+    """``0..3, 7, 9..12`` of sorted frame indices."""
+    out: list[str] = []
+    run: list[int] = []
+    for k in sorted(set(frames)):
+        if run and k == run[-1] + 1:
+            run.append(k)
+            continue
+        if run:
+            out.append(f"{run[0]}..{run[-1]}" if len(run) > 1 else str(run[0]))
+        run = [k]
+    if run:
+        out.append(f"{run[0]}..{run[-1]}" if len(run) > 1 else str(run[0]))
+    return ", ".join(out)
+
+
 class FrameStream:
     """Iterates the frames of a recording once (see the module docstring).
 
     Args:
         info: from :func:`read_info`.
         want: which topics to decode (``/world/state`` always is); others are skipped undecoded.
+
+    Damaged input (:mod:`mmusv.recording.scan`): a damaged chunk is skipped and the walk goes on after it; a file
+    that ends inside a record yields what came before. Only complete frames are yielded: a frame whose messages
+    were (partly) in a damaged chunk, or that borders damaged bytes and lacks a topic the intact frames have, is
+    left out and listed in :attr:`incomplete`. After the iteration :attr:`damage` lists every damaged region,
+    :attr:`truncated` says it in one line (``None`` for an intact file), :meth:`missing` gives the frames the run
+    set out to write that were not yielded and :meth:`report` one line for the user (``None`` when nothing is
+    missing). :attr:`topic_counts`, :attr:`messages`, :attr:`start_ns`, :attr:`end_ns`, :attr:`metadata` and
+    :attr:`attachments` describe what was read (every message, decoded or not).
     """
 
     def __init__(self, info: RecordingInfo, want: Callable[[str], bool]) -> None:
         self.info = info
         self.want = want
         self.truncated: str | None = None
+        self.damage: list[str] = []
+        self.incomplete: list[tuple[int, str]] = []
+        self.yielded: list[int] = []
         self.run: dict[str, str] = dict(info.run)
         self.out_of_order: list[int] = []
+        self.topic_counts: dict[str, int] = {}
+        self.topic_schemas: dict[str, tuple[str, str]] = {}
+        self.messages = 0
+        self.start_ns = -1
+        self.end_ns = -1
+        self.metadata: dict[str, dict[str, str]] = {}
+        self.attachments: list[str] = []
+        self.complete = True
+        """Every file read ends with its data end, summary and footer, without damage."""
+        self._missing_parts: list[tuple[int, int, str]] = []
+        self._ended = False
 
     def _index(self, log_time_ns: int, world: WorldFrame | None) -> int:
         if world is not None:
@@ -395,177 +430,348 @@ class FrameStream:
 
     def __iter__(self) -> Iterator[Frame]:
         seen: set[int] = set()
-        for path in self.info.parts or (self.info.path,):
-            yield from self._file(path, seen)
+        if is_parts_manifest(self.info.path):
+            for first, stop, f in _part_files(self.info.path):
+                if f is None:
+                    self._missing_parts.append((first, stop, f"part {first}..{stop - 1}"))
+                    self.complete = False
+                    continue
+                yield from self._file(f, seen)
+        else:
+            yield from self._file(self.info.path, seen)
+        self._ended = True
+
+    def _note(self, line: str) -> None:
+        self.damage.append(line)
+        self.truncated = "; ".join(self.damage)
 
     def _file(self, path: Path, seen: set[int]) -> Iterator[Frame]:
-        from mcap.records import Channel, Message, Metadata, Schema
-        from mcap.stream_reader import StreamReader
         from mcap_protobuf.decoder import DecoderFactory
 
         factory = DecoderFactory()
-        schemas: dict[int, Schema] = {}
-        channels: dict[int, Channel] = {}
         decoders: dict[int, Callable[[bytes], Any] | None] = {}
-        current: Frame | None = None
-        with path.open("rb") as f:
-            size = path.stat().st_size
-            records = StreamReader(f, emit_chunks=False).records
-            good = 0
-            while True:
+        where = f"part {path.name} of {self.info.path.name}" if self.info.parts else "the file"
+        scan = Scan(path)
+        lost: list[tuple[int, int]] = []  # log times of damaged chunks
+        reference: set[str] = set()  # topics of the intact frames so far
+        cur: Frame | None = None
+        topics: set[str] = set()
+        suspect = after_damage = False
+        bad: str | None = None
+        try:
+            for msg, dmg in scan.messages():
+                if dmg is not None:
+                    text = dmg.describe(self.info.frequency_hz)
+                    self._note(f"{where} is truncated: {text}" if dmg.truncated else f"{where} is damaged at {text}")
+                    if dmg.times is not None:
+                        lost.append(dmg.times)
+                    suspect = suspect or cur is not None
+                    after_damage = True
+                    continue
+                if cur is None or msg.log_time != cur.log_time_ns:
+                    if cur is not None:
+                        done = self._close(cur, topics, suspect, bad, lost, reference, scan, seen)
+                        if done is not None:
+                            yield done
+                    cur = Frame(index=-1, log_time_ns=msg.log_time, world=None)
+                    topics, suspect, bad, after_damage = set(), after_damage, None, False
+                ch = scan.channels.get(msg.channel_id)
+                self.messages += 1
+                self.start_ns = msg.log_time if self.start_ns < 0 else min(self.start_ns, msg.log_time)
+                self.end_ns = max(self.end_ns, msg.log_time)
+                if ch is None:
+                    bad = bad or f"a message on channel {msg.channel_id}, whose definition was in a damaged chunk"
+                    continue
+                topic = ch.topic
+                self.topic_counts[topic] = self.topic_counts.get(topic, 0) + 1
+                if topic not in self.topic_schemas:
+                    schema = scan.schemas.get(ch.schema_id)
+                    self.topic_schemas[topic] = ("" if schema is None else schema.name, ch.message_encoding)
+                topics.add(topic)
+                if topic != "/world/state" and not self.want(topic):
+                    continue
                 try:
-                    rec = next(records)
-                except StopIteration:
-                    break
-                except Exception as exc:  # ends mid-record: keep what was read
-                    where = f"part {path.name} of {self.info.path.name}" if self.info.parts else "the file"
-                    truncated = (
-                        f"{where} is truncated: it ends inside a record ({type(exc).__name__}) at byte {size}; "
-                        f"the last complete record ends at byte {good}"
-                    )
-                    self.truncated = truncated if self.truncated is None else f"{self.truncated}; {truncated}"
-                    break
-                good = f.tell()
-                if isinstance(rec, Schema):
-                    schemas[rec.id] = rec
-                elif isinstance(rec, Channel):
-                    channels[rec.id] = rec
-                elif isinstance(rec, Metadata):
-                    if rec.name == "run" and not self.info.parts:  # parts: the merged run of read_info stands
-                        self.run = dict(rec.metadata)
-                elif isinstance(rec, Message):
-                    ch = channels.get(rec.channel_id)
-                    if ch is None:
-                        continue
-                    topic = ch.topic
-                    if topic != "/world/state" and not self.want(topic):
-                        continue
-                    if rec.channel_id not in decoders:
-                        decoders[rec.channel_id] = factory.decoder_for(ch.message_encoding, schemas.get(ch.schema_id))
-                    dec = decoders[rec.channel_id]
+                    if msg.channel_id not in decoders:
+                        decoders[msg.channel_id] = factory.decoder_for(
+                            ch.message_encoding, scan.schemas.get(ch.schema_id)
+                        )
+                    dec = decoders[msg.channel_id]
                     if dec is None:
                         continue
-                    if current is None or rec.log_time != current.log_time_ns:
-                        if current is not None:
-                            yield self._close(current, seen)
-                        current = Frame(index=-1, log_time_ns=rec.log_time, world=None)
-                    msg = dec(rec.data)
+                    decoded = dec(msg.data)
                     if topic == "/world/state":
-                        current.world = WorldFrame.from_message(msg)
-                    current.messages[topic] = msg
-        if current is not None:
-            yield self._close(current, seen)
+                        cur.world = WorldFrame.from_message(decoded)
+                except Exception as exc:  # a message whose bytes do not decode: the frame is not usable
+                    bad = bad or f"its {topic} message does not decode ({type(exc).__name__})"
+                    continue
+                cur.messages[topic] = decoded
+            if cur is not None:
+                done = self._close(cur, topics, suspect, bad, lost, reference, scan, seen)
+                if done is not None:
+                    yield done
+        except OSError as exc:
+            raise IoError(f"{path} cannot be read: {exc.strerror or exc}") from None
+        if scan.damage or not scan.complete:
+            self.complete = False
+        if not self.info.parts:
+            if "run" in scan.metadata:  # parts: the merged run of read_info stands
+                self.run = dict(scan.metadata["run"])
+            self.metadata = dict(scan.metadata)
+            self.attachments = list(scan.attachments)
+        elif not self.metadata:
+            self.metadata = dict(scan.metadata)
+            self.attachments = list(scan.attachments)
 
-    def _close(self, fr: Frame, seen: set[int]) -> Frame:
+    def _close(
+        self,
+        fr: Frame,
+        topics: set[str],
+        suspect: bool,
+        bad: str | None,
+        lost: list[tuple[int, int]],
+        reference: set[str],
+        scan: Scan,
+        seen: set[int],
+    ) -> Frame | None:
         fr.index = self._index(fr.log_time_ns, fr.world)
+        t = fr.log_time_ns
+        why = bad
+        if why is None and any(a <= t <= b for a, b in lost):
+            why = "some of its messages were in a damaged chunk"
+        if why is None and suspect:
+            expected = reference or {c.topic for c in scan.channels.values()}
+            gone = sorted(expected - topics)
+            if gone:
+                why = f"it borders damaged bytes and lacks {', '.join(gone[:3])}" + (
+                    f" and {len(gone) - 3} more" if len(gone) > 3 else ""
+                )
+        if why is not None:
+            self.incomplete.append((fr.index, why))
+            return None
+        if not suspect:
+            reference |= topics
         if fr.index in seen:
             self.out_of_order.append(fr.index)
         seen.add(fr.index)
+        self.yielded.append(fr.index)
         return fr
 
+    def expected(self) -> tuple[range, bool]:
+        """The frames the run set out to write and whether the run said so itself (``False``: it did not finish,
+        so this is the scenario's configured range)."""
+        run = self.run
+        if is_parts_manifest(self.info.path):
+            return range(int(run.get("frames_requested", self.info.frames_configured) or 0)), True
+        first = int(run.get("first_frame", 0) or 0)
+        if "frames_requested" in run or "frames_written" in run:
+            n = int(run.get("frames_requested", run.get("frames_written", 0)) or 0)
+            return range(first, first + n), True
+        return range(first, first + self.info.frames_configured), False
 
-def read_messages(path: str | os.PathLike[str], topics: Sequence[str] | None = None) -> Iterator[tuple[str, int, Any]]:
-    """Yields ``(topic, log_time_ns, decoded_protobuf_message)`` in log-time order, optionally only ``topics``.
-    Works on finished files, on completed ``.partial`` files and on parts manifests (the recorded parts in order)."""
-    from mcap.reader import make_reader
+    def missing(self) -> list[int]:
+        """The frames of :meth:`expected` that were not yielded (call after the iteration)."""
+        got = set(self.yielded)
+        return [k for k in self.expected()[0] if k not in got]
+
+    def report(self) -> str | None:
+        """One line saying which frames are missing and why, or ``None`` when every expected frame was read and
+        the file is intact (call after the iteration)."""
+        missing = self.missing()
+        if not missing and not self.damage and not self.incomplete:
+            return None
+        span, said = self.expected()
+        parts = [f"{self.info.path}: {len(set(self.yielded))} of {len(span)} frames read"]
+        if missing:
+            why = [] if said else ["the run did not finish (no run metadata)"]
+            status = self.run.get("status")
+            if said and status and status != "complete":
+                why.append(f"run status {status}: {self.run.get('frames_written', '?')} frames written")
+            parts.append(f"frames {_ranges(missing)} missing" + (f" ({'; '.join(why)})" if why else ""))
+        if self.incomplete:
+            parts.append(
+                "incomplete frames left out: "
+                + "; ".join(f"{k} ({why})" for k, why in self.incomplete[:4])
+                + (f" and {len(self.incomplete) - 4} more" if len(self.incomplete) > 4 else "")
+            )
+        for first, stop, name in self._missing_parts:
+            parts.append(f"{name} (frames {first}..{stop - 1}) is not recorded")
+        parts += self.damage
+        return "; ".join(parts)
+
+
+def warn_missing(stream: FrameStream, *, reader: str) -> None:
+    """Warns (:class:`mmusv.scenario_checks.MmusvWarning`, one ``mmusv: warning:`` line on the command line)
+    when ``stream`` read fewer frames than the run set out to write or met damaged bytes; ``reader`` says who
+    read it (``"the detection study"``)."""
+    import warnings
+
+    from mmusv.scenario_checks import MmusvWarning
+
+    line = stream.report()
+    if line is not None:
+        warnings.warn(f"{reader}: {line}", MmusvWarning, stacklevel=2)
+
+
+def read_messages(
+    path: str | os.PathLike[str], topics: Sequence[str] | None = None, *, damage: list[str] | None = None
+) -> Iterator[tuple[str, int, Any]]:
+    """Yields ``(topic, log_time_ns, decoded_protobuf_message)`` in file order (= log-time order for files of
+    mmusv), optionally only ``topics``. Works on finished files, on ``.partial`` files and on parts manifests (the
+    recorded parts in order); damaged chunks are skipped (:mod:`mmusv.recording.scan`) and described in
+    ``damage`` when a list is given."""
     from mcap_protobuf.decoder import DecoderFactory
 
     if is_parts_manifest(path):
         for _first, _stop, part in _part_files(Path(path)):
             if part is not None:
-                yield from read_messages(part, topics)
+                yield from read_messages(part, topics, damage=damage)
+            elif damage is not None:
+                damage.append(f"{path}: part {_first}..{_stop - 1} is not recorded")
         return
-    with open(path, "rb") as f:
-        reader = make_reader(f, decoder_factories=[DecoderFactory()])
-        wanted = None if topics is None else list(topics)
-        for _schema, channel, message, decoded in reader.iter_decoded_messages(topics=wanted):
-            yield channel.topic, message.log_time, decoded
+    p = check_mcap(Path(path))
+    wanted = None if topics is None else set(topics)
+    factory = DecoderFactory()
+    decoders: dict[int, Callable[[bytes], Any] | None] = {}
+    scan = Scan(p)
+    try:
+        for msg, dmg in scan.messages():
+            if dmg is not None:
+                if damage is not None:
+                    damage.append(f"{p}: {dmg.describe()}")
+                continue
+            ch = scan.channels.get(msg.channel_id)
+            if ch is None or (wanted is not None and ch.topic not in wanted):
+                continue
+            if msg.channel_id not in decoders:
+                try:
+                    decoders[msg.channel_id] = factory.decoder_for(ch.message_encoding, scan.schemas.get(ch.schema_id))
+                except Exception as exc:
+                    raise IoError(f"{p}: channel {ch.topic} has an unreadable schema ({type(exc).__name__})") from None
+            dec = decoders[msg.channel_id]
+            if dec is None:
+                continue
+            try:
+                decoded = dec(msg.data)
+            except Exception as exc:
+                if damage is not None:
+                    damage.append(f"{p}: a {ch.topic} message does not decode ({type(exc).__name__})")
+                continue
+            yield ch.topic, msg.log_time, decoded
+    except OSError as exc:
+        raise IoError(f"{p} cannot be read: {exc.strerror or exc}") from None
 
 
 def summary(path: str | os.PathLike[str]) -> dict[str, Any]:
     """What a recording holds: ``{"path", "complete", "messages", "start_ns", "end_ns", "duration_s",
     "topics": {topic: {"schema", "encoding", "messages"}}, "metadata": {name: {key: value}},
-    "attachments": [name, ...]}``. ``complete`` is False for a ``.partial`` file or one without a summary
-    section (counted by scanning every message). A parts manifest gives the sums over its recorded parts, the
-    metadata of the first with the merged ``run`` of :func:`read_info`, and ``parts`` (how many there are)."""
-    from mcap.reader import make_reader
+    "attachments": [name, ...], "damage": [line, ...], "frames": {...} or None}``, counted by reading every
+    chunk (checking its CRC). ``complete`` is False for a ``.partial`` file, one without a summary section or one
+    with damage. ``frames`` (for a recording of mmusv): ``{"read", "expected", "missing", "report"}``, the
+    complete frames read, how many the run set out to write, the missing ones and the one-line report of
+    :meth:`FrameStream.report` (``None`` when all is well). A parts manifest gives the sums over its recorded parts,
+    the metadata of the first with the merged ``run`` of :func:`read_info`, and ``parts`` (how many there are)."""
+    p = Path(path)
+    if is_parts_manifest(p):
+        return _parts_summary(p)
+    check_mcap(p)
+    try:
+        info: RecordingInfo | None = read_info(p)
+    except IoError:
+        info = None  # not a recording of mmusv run (or its metadata is damaged): messages only
+    if info is None:
+        return _plain_summary(p)
+    stream = FrameStream(info, want=lambda _t: False)
+    for _ in stream:
+        pass
+    return _summary_dict(p, stream, complete=stream.complete and not str(p).endswith(".partial"))
 
-    if is_parts_manifest(path):
-        return _parts_summary(Path(path))
-    topics: dict[str, dict[str, Any]] = {}
-    with open(path, "rb") as f:
-        reader = make_reader(f)
-        summ = reader.get_summary()
-        stats = None if summ is None else summ.statistics
-        if summ is not None and stats is not None:
-            for cid, ch in sorted(summ.channels.items()):
-                schema = summ.schemas.get(ch.schema_id)
-                topics[ch.topic] = {
-                    "schema": "" if schema is None else schema.name,
-                    "encoding": ch.message_encoding,
-                    "messages": int(stats.channel_message_counts.get(cid, 0)),
-                }
-            total, start, end = int(stats.message_count), int(stats.message_start_time), int(stats.message_end_time)
-            attachments = [a.name for a in summ.attachment_indexes]
-        else:
-            start, end, total = -1, -1, 0
-            for schema, channel, message in reader.iter_messages(log_time_order=False):
-                entry = topics.setdefault(
-                    channel.topic,
-                    {
-                        "schema": "" if schema is None else schema.name,
-                        "encoding": channel.message_encoding,
-                        "messages": 0,
-                    },
-                )
-                entry["messages"] += 1
-                total += 1
-                start = message.log_time if start < 0 else min(start, message.log_time)
-                end = max(end, message.log_time)
-            start, end = max(start, 0), max(end, 0)
-            attachments = [a.name for a in reader.iter_attachments()]
-        metadata = {m.name: dict(m.metadata) for m in reader.iter_metadata()}
+
+def _summary_dict(p: Path, stream: FrameStream, *, complete: bool) -> dict[str, Any]:
+    start, end = max(stream.start_ns, 0), max(stream.end_ns, 0)
+    topics = {
+        t: {"schema": stream.topic_schemas[t][0], "encoding": stream.topic_schemas[t][1], "messages": n}
+        for t, n in stream.topic_counts.items()
+    }
+    span, _said = stream.expected()
+    missing = stream.missing()
     return {
-        "path": str(path),
-        "complete": summ is not None and not str(path).endswith(".partial"),
+        "path": str(p),
+        "complete": complete,
+        "messages": stream.messages,
+        "start_ns": start,
+        "end_ns": end,
+        "duration_s": (end - start) * 1e-9,
+        "topics": dict(sorted(topics.items())),
+        "metadata": stream.metadata,
+        "attachments": stream.attachments,
+        "damage": list(stream.damage),
+        "frames": {
+            "read": len(set(stream.yielded)),
+            "expected": len(span),
+            "missing": missing,
+            "incomplete": [k for k, _ in stream.incomplete],
+            "report": stream.report(),
+        },
+    }
+
+
+def _plain_summary(p: Path) -> dict[str, Any]:
+    scan = Scan(p)
+    topics: dict[str, dict[str, Any]] = {}
+    start, end, total = -1, -1, 0
+    damage: list[str] = []
+    try:
+        for msg, dmg in scan.messages():
+            if dmg is not None:
+                damage.append(dmg.describe())
+                continue
+            total += 1
+            start = msg.log_time if start < 0 else min(start, msg.log_time)
+            end = max(end, msg.log_time)
+            ch = scan.channels.get(msg.channel_id)
+            if ch is None:
+                continue
+            schema = scan.schemas.get(ch.schema_id)
+            entry = topics.setdefault(
+                ch.topic,
+                {"schema": "" if schema is None else schema.name, "encoding": ch.message_encoding, "messages": 0},
+            )
+            entry["messages"] += 1
+    except OSError as exc:
+        raise IoError(f"{p} cannot be read: {exc.strerror or exc}") from None
+    start, end = max(start, 0), max(end, 0)
+    return {
+        "path": str(p),
+        "complete": scan.complete and not scan.damage and not str(p).endswith(".partial"),
         "messages": total,
         "start_ns": start,
         "end_ns": end,
         "duration_s": (end - start) * 1e-9,
         "topics": dict(sorted(topics.items())),
-        "metadata": metadata,
-        "attachments": attachments,
+        "metadata": scan.metadata,
+        "attachments": scan.attachments,
+        "damage": damage,
+        "frames": None,
     }
 
 
 def _parts_summary(path: Path) -> dict[str, Any]:
     info = _read_parts_info(path)
-    sums = [summary(p) for p in info.parts]
-    topics: dict[str, dict[str, Any]] = {}
-    for s in sums:
-        for topic, t in s["topics"].items():
-            topics.setdefault(topic, {**t, "messages": 0})["messages"] += t["messages"]
-    start, end = min(s["start_ns"] for s in sums), max(s["end_ns"] for s in sums)
-    return {
-        "path": str(path),
-        "complete": info.run["status"] == "complete" and all(s["complete"] for s in sums),
-        "messages": sum(s["messages"] for s in sums),
-        "start_ns": start,
-        "end_ns": end,
-        "duration_s": (end - start) * 1e-9,
-        "topics": dict(sorted(topics.items())),
-        "metadata": {**sums[0]["metadata"], "run": dict(info.run)},
-        "attachments": sums[0]["attachments"],
-        "parts": int(info.run["parts"]),
-    }
+    stream = FrameStream(info, want=lambda _t: False)
+    for _ in stream:
+        pass
+    out = _summary_dict(path, stream, complete=info.run["status"] == "complete" and stream.complete)
+    first = summary(info.parts[0])
+    out["metadata"] = {**first["metadata"], "run": dict(info.run)}
+    out["attachments"] = first["attachments"]
+    out["parts"] = int(info.run["parts"])
+    return out
 
 
 def frame_messages(path: str | Path, frame: int) -> dict[str, Any]:
-    """Every decoded message of acquisition index ``frame``, by topic (log time = frame / f); for a parts
-    manifest, from the part holding ``frame``."""
-    from mcap.reader import make_reader
-    from mcap_protobuf.decoder import DecoderFactory
-
+    """Every decoded message of acquisition index ``frame``, by topic; for a parts manifest, from the part
+    holding ``frame``. Raises :class:`~mmusv.errors.IoError` when the frame is damaged (naming the damage) and
+    :class:`~mmusv.errors.ConfigError` when the recording does not hold it."""
     p = Path(path)
     if is_parts_manifest(p):
         for first, stop, part in _part_files(p):
@@ -574,21 +780,15 @@ def frame_messages(path: str | Path, frame: int) -> dict[str, Any]:
                     raise ConfigError(f"frame {frame} is not in {p}: its part is not recorded yet")
                 return frame_messages(part, frame)
         raise ConfigError(f"frame {frame} is not in {p}")
-    if not p.is_file():
-        raise IoError(f"recording {p} does not exist")
-    out: dict[str, Any] = {}
-    with p.open("rb") as f:
-        reader = make_reader(f, decoder_factories=[DecoderFactory()])
-        meta = {m.name: dict(m.metadata) for m in reader.iter_metadata()}
-        freq = float(meta.get("run", {}).get("frequency_hz", "0") or 0)
-        if freq <= 0:
-            raise IoError(f"{p} has no run metadata (frequency_hz); was it written by mmusv run?")
-        t = round(frame / freq * 1e9)
-        # messages come in log-time order from t on; the frame ends at the first later log time
-        for _schema, channel, message, decoded in reader.iter_decoded_messages(starting_at=t):
-            if message.log_time != t:
-                break
-            out[channel.topic] = decoded
-    if not out:
-        raise ConfigError(f"frame {frame} is not in {p}")
-    return out
+    info = read_info(p)
+    stream = FrameStream(info, want=lambda _t: True)
+    for fr in stream:
+        if fr.index == frame:
+            return dict(fr.messages)
+        if fr.index > frame and not stream.damage:
+            break
+    bad = [why for k, why in stream.incomplete if k == frame]
+    if bad:
+        raise IoError(f"frame {frame} of {p} is damaged: {bad[0]}; {stream.truncated}")
+    where = f" ({stream.truncated})" if stream.truncated else ""
+    raise ConfigError(f"frame {frame} is not in {p}{where}")

@@ -11,6 +11,8 @@ qz, qw``), ``boxes_2d`` in pixels (origin top-left). See ``docs/recording.md``.
 
 from __future__ import annotations
 
+import os
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -21,7 +23,7 @@ if TYPE_CHECKING:
     from mmusv.annotate import Annotations
     from mmusv.simulation import FrameCapture, VesselInfo
 
-__all__ = ["SCHEMAS", "TableWriter"]
+__all__ = ["SCHEMAS", "TableRead", "TableWriter", "read_table"]
 
 _F = pl.Float64
 _I = pl.Int64
@@ -81,6 +83,10 @@ class TableWriter:
         """Frames added since the last flush."""
         self._cols: dict[str, dict[str, list[Any]]] = {t: {c: [] for c in s} for t, s in SCHEMAS.items()}
         self._rows = dict.fromkeys(SCHEMAS, 0)
+
+    def add_rows(self, table: str, n: int, columns: dict[str, Any]) -> None:
+        """``n`` rows of ``table``: one array (or list) of ``n`` values per column of :data:`SCHEMAS`."""
+        self._add(table, n, columns)
 
     def _add(self, table: str, n: int, columns: dict[str, Any]) -> None:
         if n == 0:
@@ -177,7 +183,8 @@ class TableWriter:
         self._add("boxes_2d", m, box2)
 
     def flush(self) -> None:
-        """Writes the rows gathered since the last flush as part ``part`` of every table that has rows."""
+        """Writes the rows gathered since the last flush as part ``part`` of every table that has rows; a part
+        that cannot be written raises ``OSError`` (and leaves no file)."""
         for table, schema in SCHEMAS.items():
             if not self._rows[table]:
                 continue
@@ -191,7 +198,70 @@ class TableWriter:
                 parts.clear()
             d = self.root / table
             d.mkdir(parents=True, exist_ok=True)
-            pl.DataFrame(data, schema=schema).write_parquet(d / f"part-{self.part:05d}.parquet")
+            # written under a temporary name and renamed: a part file is complete or absent, never half-written
+            final = d / f"part-{self.part:05d}.parquet"
+            tmp = final.with_name(final.name + ".tmp")
+            try:
+                pl.DataFrame(data, schema=schema).write_parquet(tmp)
+            except pl.exceptions.PolarsError as exc:  # a failed write (a full disk) comes back as a polars error
+                tmp.unlink(missing_ok=True)
+                raise OSError(f"{final}: the Parquet part could not be written ({exc})") from exc
+            os.replace(tmp, final)
             self._rows[table] = 0
         self.part += 1
         self.frames = 0
+
+
+@dataclass
+class TableRead:
+    """One table read back from its parts: the rows of every readable part (``frame`` order), the parts that
+    could not be read (``damaged``: one line each, naming the file and why) and the frames of ``expected`` that
+    are not in the rows (``missing``)."""
+
+    table: str
+    rows: pl.DataFrame
+    damaged: list[str] = field(default_factory=list)
+    missing: list[int] = field(default_factory=list)
+
+    def report(self) -> str | None:
+        """One line about what is wrong, or ``None``."""
+        if not self.damaged and not self.missing:
+            return None
+        from mmusv.recording.reader import _ranges
+
+        parts = list(self.damaged)
+        if self.missing:
+            parts.append(f"frames {_ranges(self.missing)} have no {self.table} rows")
+        return f"table {self.table}: " + "; ".join(parts)
+
+
+def read_table(root: str | os.PathLike[str], table: str, *, expected: range | None = None) -> TableRead:
+    """The table ``table`` of the tables folder ``root`` (``<root>/<table>/part-*.parquet``), every part that
+    reads and has the table's columns; a damaged part is left out and named. ``expected``: the frames the run
+    wrote (their absence from the rows is reported in ``missing``; only meaningful for ``world_state``, which
+    has rows in every frame)."""
+    if table not in SCHEMAS:
+        raise ValueError(f"unknown table {table!r}; tables: {', '.join(SCHEMAS)}")
+    schema = SCHEMAS[table]
+    frames: list[pl.DataFrame] = []
+    damaged: list[str] = []
+    for part in sorted((Path(root) / table).glob("part-*.parquet")):
+        try:
+            df = pl.read_parquet(part)
+        except Exception as exc:  # polars raises several kinds for a damaged file; any means unreadable
+            first = str(exc).strip().splitlines()[0][:120] if str(exc).strip() else ""
+            damaged.append(
+                f"{part} is not a readable Parquet file ({type(exc).__name__}{': ' + first if first else ''})"
+            )
+            continue
+        if list(df.columns) != list(schema) or any(df.schema[c] != t for c, t in schema.items()):
+            damaged.append(f"{part} does not have the columns and types of table {table}")
+            continue
+        frames.append(df)
+    rows = pl.concat(frames) if frames else pl.DataFrame(schema=schema)
+    rows = rows.sort("frame", maintain_order=True)
+    missing: list[int] = []
+    if expected is not None:
+        have = set(rows["frame"].to_list())
+        missing = [k for k in expected if k not in have]
+    return TableRead(table, rows, damaged, missing)

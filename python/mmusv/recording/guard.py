@@ -1,0 +1,160 @@
+"""Guarding an output folder: one writer at a time (:class:`FolderLock`), and naming why a write failed
+(:func:`write_cause`).
+
+:class:`FolderLock` is an advisory lock (``fcntl.flock``, released by the kernel when its holder exits, however it
+exits) on the folder itself. A second ``mmusv run`` (or batch) into the same folder does not wait for it: it refuses
+at once and names the process holding it, so two writers never interleave their bytes in one file. On systems
+without ``fcntl``, and on file systems that cannot lock a folder, the lock is a no-op.
+
+:func:`write_cause` turns a failed write into its cause as the operating system names it (``No space left on
+device``, ``Permission denied``, ``Read-only file system``): from the exception chain when an ``OSError`` (or an
+``os error N`` in a message of the core) is there, else by a small probe write into the folder, else from the
+folder's free space. The MCAP recorder of the core reports a failed write without its ``io::Error`` after the
+first one, so the probe is what names the cause of a full disk there.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import errno
+import os
+import re
+import tempfile
+from pathlib import Path
+from types import TracebackType
+
+from mmusv.errors import IoError
+
+__all__ = ["FolderLock", "write_cause"]
+
+_OS_ERROR = re.compile(r"os error (\d+)")
+_PROBE_BYTES = 1 << 16
+
+
+class FolderLock:
+    """The lock of the folder ``folder`` (it must exist) held by this process; ``what`` says in messages what
+    the holder does (``"mmusv run"``). The lock is taken on the folder itself (``flock`` of the directory), so
+    it adds no file to the folder."""
+
+    def __init__(self, folder: str | os.PathLike[str], *, what: str) -> None:
+        self.folder = Path(folder)
+        self.what = what
+        self._fd = -1
+
+    def acquire(self) -> FolderLock:
+        """Takes the lock at once; :class:`~mmusv.errors.IoError` naming the holder when another process has it.
+        Where the file system cannot lock folders (some network file systems) this is a no-op."""
+        try:
+            import fcntl
+        except ImportError:  # not POSIX: no lock
+            return self
+        try:
+            fd = os.open(self.folder, os.O_RDONLY)
+        except OSError as exc:
+            raise IoError(f"cannot open the output folder {self.folder}: {write_cause(self.folder, exc)}") from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError as exc:
+            if exc.errno not in (errno.EWOULDBLOCK, errno.EAGAIN):
+                os.close(fd)  # the file system cannot lock it: go on unlocked
+                return self
+            holder = _holder(fd)
+            os.close(fd)
+            raise IoError(
+                f"{self.folder} is being written by another {self.what}"
+                + (f" (process {holder})" if holder else "")
+                + "; two writers in one folder would corrupt each other's files: wait until it ends, or write "
+                "somewhere else"
+            ) from None
+        self._fd = fd
+        return self
+
+    def release(self) -> None:
+        """Releases the lock."""
+        if self._fd >= 0:
+            os.close(self._fd)
+            self._fd = -1
+
+    def __enter__(self) -> FolderLock:
+        return self.acquire()
+
+    def __exit__(
+        self, exc_type: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
+    ) -> None:
+        self.release()
+
+
+def _holder(fd: int) -> int | None:
+    """The process holding a ``flock`` on the file of ``fd``, from ``/proc/locks`` (Linux), else None."""
+    try:
+        st = os.fstat(fd)
+        with open("/proc/locks", encoding="ascii", errors="replace") as f:
+            lines = f.read().splitlines()
+    except OSError:
+        return None
+    want = f":{st.st_ino}"
+    for line in lines:
+        parts = line.split()
+        if len(parts) >= 6 and parts[1] == "FLOCK" and parts[5].endswith(want):
+            dev = parts[5][: -len(want)]
+            major, _, minor = dev.partition(":")
+            try:
+                if (int(major, 16), int(minor, 16)) == (os.major(st.st_dev), os.minor(st.st_dev)):
+                    return int(parts[4])
+            except ValueError:
+                continue
+    return None
+
+
+def _errno_of(exc: BaseException | None) -> int | None:
+    seen = 0
+    while exc is not None and seen < 10:
+        if isinstance(exc, OSError) and exc.errno:
+            return int(exc.errno)
+        m = _OS_ERROR.search(str(exc))
+        if m:
+            return int(m.group(1))
+        exc = exc.__cause__ or exc.__context__
+        seen += 1
+    return None
+
+
+def _probe(folder: Path) -> int | None:
+    """The errno of a small write (created, written, synced, removed) into ``folder``, or None when it works."""
+    try:
+        fd, tmp = tempfile.mkstemp(dir=folder, prefix=".mmusv-probe-")
+    except OSError as exc:
+        return exc.errno
+    try:
+        os.write(fd, b"\0" * _PROBE_BYTES)
+        os.fsync(fd)
+    except OSError as exc:
+        return exc.errno
+    finally:
+        os.close(fd)
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+    return None
+
+
+def write_cause(folder: str | os.PathLike[str], exc: BaseException | None = None) -> str:
+    """Why writing into ``folder`` failed, as the operating system names it (see the module docstring); the
+    message of ``exc`` when nothing more precise is found."""
+    code = _errno_of(exc)
+    where = Path(folder)
+    while not where.exists() and where != where.parent:
+        where = where.parent
+    if code is None or code == errno.EIO:
+        probed = _probe(where) if where.is_dir() else None
+        if probed is not None:
+            code = probed
+    if code is None:
+        try:
+            st = os.statvfs(where)
+            if st.f_bavail * st.f_frsize < _PROBE_BYTES:
+                code = errno.ENOSPC
+        except OSError:
+            pass
+    if code is not None:
+        return os.strerror(code)
+    return str(exc) if exc is not None else "unknown cause"

@@ -1,0 +1,481 @@
+"""Walking the records of an MCAP file that may be damaged: the ground floor of :mod:`mmusv.recording.reader`.
+
+:class:`Scan` reads one file front to back, record by record, with plain reads (no memory map: a file that
+shrinks under a reader must not crash it) and never trusts a length it has not checked against the file size:
+
+- every chunk is decompressed into at most its stated size (bounded by :data:`MAX_CHUNK_BYTES`) and its CRC of
+  the uncompressed records is checked; a chunk that fails (CRC mismatch, bad compression, records that do not
+  parse) is skipped and reported as a :class:`Damage`, and the walk goes on after it, so the frames after a
+  damaged chunk are kept;
+- a record whose header is garbage (an unknown opcode, a length running past the end of the file) is skipped by
+  searching forward for the next record that checks out in full (a chunk, metadata, a message index or the data
+  end, each with lengths that agree with each other); the bytes in between are one damaged region;
+- a file that ends inside a record (a killed writer, a ``.partial`` file, a truncated copy) yields everything
+  before that record and reports where it ends;
+- the data section's CRC (in the data end record) is checked as well, so damage outside the chunks (metadata,
+  message indexes) is reported too.
+
+Schemas and channels come from the chunks as they appear and, when the file has a readable summary, from the
+summary up front (so the messages of a channel whose defining chunk is damaged still decode).
+"""
+
+from __future__ import annotations
+
+import io
+import struct
+import zlib
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import IO, Any
+
+__all__ = ["MAGIC", "MAX_CHUNK_BYTES", "Damage", "Scan"]
+
+MAGIC = b"\x89MCAP0\r\n"
+MAX_CHUNK_BYTES = 1 << 30
+"""Largest uncompressed chunk a reader accepts (the recorder writes chunks of 4 MiB): a damaged size field can
+never make it allocate more."""
+
+_HEADER, _FOOTER, _SCHEMA, _CHANNEL, _MESSAGE, _CHUNK, _MESSAGE_INDEX = 0x01, 0x02, 0x03, 0x04, 0x05, 0x06, 0x07
+_CHUNK_INDEX, _ATTACHMENT, _ATTACHMENT_INDEX, _STATISTICS, _METADATA = 0x08, 0x09, 0x0A, 0x0B, 0x0C
+_METADATA_INDEX, _SUMMARY_OFFSET, _DATA_END = 0x0D, 0x0E, 0x0F
+_NAMES = {
+    _HEADER: "header",
+    _FOOTER: "footer",
+    _SCHEMA: "schema",
+    _CHANNEL: "channel",
+    _MESSAGE: "message",
+    _CHUNK: "chunk",
+    _MESSAGE_INDEX: "message index",
+    _CHUNK_INDEX: "chunk index",
+    _ATTACHMENT: "attachment",
+    _ATTACHMENT_INDEX: "attachment index",
+    _STATISTICS: "statistics",
+    _METADATA: "metadata",
+    _METADATA_INDEX: "metadata index",
+    _SUMMARY_OFFSET: "summary offset",
+    _DATA_END: "data end",
+}
+_BLOCK = 1 << 20
+
+
+class _Bad(Exception):
+    """A record that does not check out (the message says why)."""
+
+
+@dataclass(frozen=True)
+class Damage:
+    """A damaged or missing region of a file: bytes ``start .. end`` (``end`` = the file size for a file that ends
+    inside a record), ``what`` happened, and the log times (ns) of the messages lost there when the damaged
+    chunk's header still says so (``None`` otherwise)."""
+
+    start: int
+    end: int
+    what: str
+    times: tuple[int, int] | None = None
+    truncated: bool = False
+
+    def describe(self, frequency_hz: float = 0.0) -> str:
+        """One line: where, what, and which frames when known (``frequency_hz`` > 0)."""
+        where = f"bytes {self.start}..{self.end}"
+        frames = ""
+        if self.times is not None and frequency_hz > 0:
+            a, b = (round(t * frequency_hz / 1e9) for t in self.times)
+            frames = f" (frame{'s' if a != b else ''} {a}{f'..{b}' if a != b else ''})"
+        return f"{where}{frames}: {self.what}"
+
+
+@dataclass
+class _Chunk:
+    start: int
+    end: int
+    usize: int
+    crc: int
+    compression: str
+    data: bytes
+
+
+def _u64(b: bytes, at: int) -> int:
+    return int(struct.unpack_from("<Q", b, at)[0])
+
+
+def _u32(b: bytes, at: int) -> int:
+    return int(struct.unpack_from("<I", b, at)[0])
+
+
+def _string(b: bytes, at: int) -> tuple[str, int]:
+    n = _u32(b, at)
+    if at + 4 + n > len(b):
+        raise _Bad("a string runs past its record")
+    return b[at + 4 : at + 4 + n].decode("utf-8"), at + 4 + n
+
+
+def _parse_chunk(body: bytes) -> _Chunk:
+    if len(body) < 40:
+        raise _Bad(f"a chunk record of {len(body)} bytes is shorter than its fixed fields")
+    start, end, usize, crc = struct.unpack_from("<QQQI", body, 0)
+    clen = _u32(body, 28)
+    if clen > 16 or 32 + clen + 8 > len(body):
+        raise _Bad("the chunk's compression field is unreadable")
+    compression = body[32 : 32 + clen].decode("ascii", errors="replace")
+    rlen = _u64(body, 32 + clen)
+    if 40 + clen + rlen != len(body):
+        raise _Bad(f"the chunk's data length ({rlen}) does not match its record length ({len(body)})")
+    return _Chunk(int(start), int(end), int(usize), int(crc), compression, body[40 + clen :])
+
+
+def _decompress(c: _Chunk) -> bytes:
+    if c.usize > MAX_CHUNK_BYTES:
+        raise _Bad(f"the chunk says it holds {c.usize} bytes, more than any chunk mmusv writes")
+    if c.compression == "zstd":
+        import zstandard
+
+        try:
+            with zstandard.ZstdDecompressor().stream_reader(io.BytesIO(c.data), read_across_frames=True) as r:
+                raw = r.read(c.usize + 1)
+        except zstandard.ZstdError as exc:
+            raise _Bad(f"its zstd data does not decompress ({exc})") from None
+    elif c.compression == "lz4":
+        import lz4.frame
+
+        try:
+            with lz4.frame.LZ4FrameFile(io.BytesIO(c.data), "rb") as r:
+                raw = r.read(c.usize + 1)
+        except (RuntimeError, EOFError, OSError) as exc:
+            raise _Bad(f"its lz4 data does not decompress ({exc})") from None
+    elif c.compression == "":
+        raw = c.data
+    else:
+        raise _Bad(f"unknown compression {c.compression!r}")
+    if len(raw) != c.usize:
+        raise _Bad(f"it decompresses to {len(raw)} bytes, its header says {c.usize}")
+    if c.crc != 0 and zlib.crc32(raw) != c.crc:
+        raise _Bad("CRC mismatch: its records are not the bytes that were written")
+    return raw
+
+
+def _read_record(opcode: int, body: bytes) -> Any:
+    """The mcap record class of ``opcode`` read from ``body``, which it must use exactly (``Message`` and
+    unknown opcodes: ``None`` for unknown)."""
+    from mcap.data_stream import ReadDataStream
+    from mcap.exceptions import McapError
+    from mcap.records import Attachment, Channel, Message, Metadata, Schema
+
+    cls: Any = {_SCHEMA: Schema, _CHANNEL: Channel, _METADATA: Metadata, _ATTACHMENT: Attachment}.get(opcode)
+    stream = ReadDataStream(io.BytesIO(body))
+    try:
+        if opcode == _MESSAGE:
+            if len(body) < 22:
+                raise _Bad("a message record is shorter than its fixed fields")
+            return Message.read(stream, len(body))
+        if cls is None:
+            return None
+        rec = cls.read(stream)
+    except (struct.error, UnicodeDecodeError, McapError, ValueError) as exc:
+        raise _Bad(f"a {_NAMES.get(opcode, 'record')} record does not parse ({type(exc).__name__})") from None
+    if stream.count != len(body):
+        raise _Bad(f"a {_NAMES[opcode]} record does not fill its length")
+    return rec
+
+
+def _inner(raw: bytes) -> list[tuple[int, Any]]:
+    """``(opcode, record)`` of the records inside a chunk (schemas, channels, messages; others are skipped)."""
+    out: list[tuple[int, Any]] = []
+    at = 0
+    while at < len(raw):
+        if at + 9 > len(raw):
+            raise _Bad("its last record header is cut off")
+        op, n = raw[at], _u64(raw, at + 1)
+        if at + 9 + n > len(raw):
+            raise _Bad("a record inside it runs past its end")
+        body = raw[at + 9 : at + 9 + n]
+        if op in (_SCHEMA, _CHANNEL, _MESSAGE):
+            out.append((op, _read_record(op, body)))
+        at += 9 + n
+    return out
+
+
+def _plausible(head: bytes, size: int, at: int) -> bool:
+    """Whether a record starting at file offset ``at`` with the first bytes ``head`` checks out in full (the
+    records the resynchronisation looks for)."""
+    if len(head) < 9:
+        return False
+    op, n = head[0], _u64(head, 1)
+    if at + 9 + n > size:
+        return False
+    b = head[9:]
+    try:
+        if op == _CHUNK:
+            if n < 40 or len(b) < 40:
+                return False
+            clen = _u32(b, 28)
+            if clen not in (0, 3, 4) or len(b) < 40 + clen:
+                return False
+            comp = b[32 : 32 + clen]
+            if comp not in (b"", b"lz4", b"zstd"):
+                return False
+            return 40 + clen + _u64(b, 32 + clen) == n and _u64(b, 16) <= MAX_CHUNK_BYTES and _u64(b, 0) <= _u64(b, 8)
+        if op == _MESSAGE_INDEX:
+            if n < 6 or len(b) < 6:
+                return False
+            rl = _u32(b, 2)
+            return 2 + 4 + rl == n and rl % 16 == 0
+        if op == _METADATA:
+            if len(b) < 4:
+                return False
+            nl = _u32(b, 0)
+            if 4 + nl + 4 > len(b) or nl > 256:
+                return False
+            b[4 : 4 + nl].decode("utf-8")
+            return 4 + nl + 4 + _u32(b, 4 + nl) == n
+        if op == _DATA_END:
+            return n == 4
+    except (struct.error, UnicodeDecodeError):
+        return False
+    return False
+
+
+@dataclass
+class Scan:
+    """One walk over the MCAP file at ``path`` (see the module docstring).
+
+    ``chunks``: decompress and check the chunks and yield their messages; without it the chunks are hopped over
+    (for the metadata alone). After :meth:`messages` ran: ``damage`` (every damaged region, in file order),
+    ``complete`` (the file ends with its data end, summary and footer), ``metadata`` by name, ``attachments``
+    (names), ``schemas`` and ``channels`` by id.
+    """
+
+    path: Path
+    chunks: bool = True
+    size: int = 0
+    damage: list[Damage] = field(default_factory=list)
+    complete: bool = False
+    data_end: bool = False
+    metadata: dict[str, dict[str, str]] = field(default_factory=dict)
+    attachments: list[str] = field(default_factory=list)
+    schemas: dict[int, Any] = field(default_factory=dict)
+    channels: dict[int, Any] = field(default_factory=dict)
+    has_summary: bool = False
+    _summary_bad: bool = False
+
+    def messages(self) -> Iterator[tuple[Any, Damage | None]]:
+        """Yields ``(message, None)`` for every message of every intact chunk in file order, and ``(None,
+        damage)`` where a damaged region lies between them."""
+        with self.path.open("rb") as f:
+            f.seek(0, io.SEEK_END)
+            self.size = f.tell()
+            self._summary(f)
+            yield from self._walk(f)
+
+    # ------------------------------------------------------------------------------------------ summary
+
+    def _summary(self, f: IO[bytes]) -> None:
+        """Schemas and channels of the summary section, when the file ends with a readable footer and the
+        summary's CRC matches."""
+        size = self.size
+        if size < 8 + 9 + 20 + 8:
+            return
+        f.seek(size - 8 - 29)
+        tail = f.read(29 + 8)
+        if tail[-8:] != MAGIC or tail[0] != _FOOTER or _u64(tail, 1) != 20:
+            return
+        start = _u64(tail, 9)
+        end = size - 8 - 29
+        if not 8 <= start <= end or end - start > 256 << 20:
+            return
+        f.seek(start)
+        data = f.read(end - start)
+        stored = _u32(tail, 25)
+        if stored != 0 and zlib.crc32(tail[:25], zlib.crc32(data)) != stored:
+            self._summary_bad = True  # the summary was changed: its schemas and channels are not trusted
+            return
+        at = 0
+        found: list[tuple[int, Any]] = []
+        try:
+            while at < len(data):
+                if at + 9 > len(data):
+                    return
+                op, n = data[at], _u64(data, at + 1)
+                if at + 9 + n > len(data):
+                    return
+                if op in (_SCHEMA, _CHANNEL):
+                    found.append((op, _read_record(op, data[at + 9 : at + 9 + n])))
+                at += 9 + n
+        except _Bad:
+            return
+        for op, rec in found:
+            (self.schemas if op == _SCHEMA else self.channels)[rec.id] = rec
+        self.has_summary = True
+
+    # ------------------------------------------------------------------------------------------ data section
+
+    def _walk(self, f: IO[bytes]) -> Iterator[tuple[Any, Damage | None]]:
+        size = self.size
+        f.seek(0)
+        head = f.read(8)
+        crc = zlib.crc32(head)
+        crc_valid = head == MAGIC
+        pos = 8
+        while True:
+            if pos >= size:
+                d = Damage(pos, size, "the file ends without its data end, summary and footer", truncated=True)
+                self.damage.append(d)
+                yield None, d
+                return
+            f.seek(pos)
+            head = f.read(9)
+            if len(head) < 9:
+                d = Damage(pos, size, f"the file ends inside a record header at byte {size}", truncated=True)
+                self.damage.append(d)
+                yield None, d
+                return
+            op, n = head[0], _u64(head, 1)
+            end = pos + 9 + n
+            if op not in _NAMES or end > size:
+                nxt = self._resync(f, pos + 1)
+                if nxt is None and op in _NAMES:
+                    d = Damage(
+                        pos,
+                        size,
+                        f"the file ends inside a {_NAMES[op]} record: it starts at byte {pos} and needs {n + 9} "
+                        f"bytes, {size - pos} are there",
+                        truncated=True,
+                    )
+                    f.seek(pos + 9)
+                    if op == _CHUNK and size - pos - 9 >= 16:  # the lost frames start here
+                        t0, t1 = struct.unpack("<QQ", f.read(16))
+                        if t0 <= t1:
+                            d = Damage(d.start, d.end, d.what, (int(t0), int(t1)), truncated=True)
+                    self.damage.append(d)
+                    yield None, d
+                    return
+                what = f"unknown record type 0x{op:02x}" if op not in _NAMES else f"a {_NAMES[op]} record's length"
+                d = Damage(
+                    pos,
+                    size if nxt is None else nxt,
+                    f"unreadable bytes ({what} is garbage); "
+                    + ("nothing readable follows" if nxt is None else f"reading goes on at byte {nxt}"),
+                )
+                self.damage.append(d)
+                yield None, d
+                if nxt is None:
+                    return
+                pos, crc_valid = nxt, False
+                continue
+            if op == _CHUNK and not self.chunks:
+                f.seek(end)
+                pos, crc_valid = end, False
+                continue
+            body = f.read(n)
+            if op == _DATA_END:
+                stored = _u32(body, 0) if len(body) >= 4 else 0
+                self.data_end = True
+                if self.chunks and crc_valid and stored != 0 and stored != crc:
+                    d = Damage(
+                        0,
+                        pos,
+                        "the data section's CRC does not match: bytes outside the chunks (metadata, indexes) "
+                        "were changed",
+                    )
+                    self.damage.append(d)
+                    yield None, d
+                self._footer(f)
+                if not self.complete:
+                    d = Damage(
+                        end,
+                        size,
+                        "the summary section after the data is cut off or damaged (every message is before it)",
+                        truncated=True,
+                    )
+                    self.damage.append(d)
+                    yield None, d
+                elif self._summary_bad:
+                    d = Damage(end, size, "the summary section's CRC does not match (every message is before it)")
+                    self.damage.append(d)
+                    yield None, d
+                return
+            crc = zlib.crc32(body, zlib.crc32(head, crc))
+            if op == _CHUNK:
+                try:
+                    chunk = _parse_chunk(body)
+                except _Bad as exc:  # its own length may be the damage: look for the next record right after
+                    nxt = self._resync(f, pos + 1)
+                    d = Damage(pos, size if nxt is None else nxt, f"damaged chunk: {exc}")
+                    self.damage.append(d)
+                    yield None, d
+                    if nxt is None:
+                        return
+                    pos, crc_valid = nxt, False
+                    continue
+                try:
+                    records = _inner(_decompress(chunk))
+                except _Bad as exc:
+                    d = Damage(pos, end, f"damaged chunk, skipped: {exc}", (chunk.start, chunk.end))
+                    self.damage.append(d)
+                    yield None, d
+                    pos = end
+                    continue
+                for rop, rec in records:
+                    if rop == _SCHEMA:
+                        self.schemas[rec.id] = rec
+                    elif rop == _CHANNEL:
+                        self.channels[rec.id] = rec
+                    else:
+                        yield rec, None
+            elif op in (_METADATA, _ATTACHMENT, _SCHEMA, _CHANNEL, _MESSAGE):
+                try:
+                    rec = _read_record(op, body)
+                except _Bad as exc:
+                    d = Damage(pos, end, f"damaged {_NAMES[op]} record: {exc}")
+                    self.damage.append(d)
+                    yield None, d
+                    pos = end
+                    continue
+                if op == _METADATA:
+                    self.metadata[rec.name] = dict(rec.metadata)
+                elif op == _ATTACHMENT:
+                    self.attachments.append(rec.name)
+                elif op == _SCHEMA:
+                    self.schemas[rec.id] = rec
+                elif op == _CHANNEL:
+                    self.channels[rec.id] = rec
+                else:
+                    yield rec, None
+            elif op == _FOOTER:  # a footer without a data end: the data section ends here
+                return
+            pos = end
+
+    def _footer(self, f: IO[bytes]) -> None:
+        size = self.size
+        if size >= 8 + 29:
+            f.seek(size - 8 - 29)
+            tail = f.read(37)
+            self.complete = tail[-8:] == MAGIC and tail[0] == _FOOTER
+
+    def _resync(self, f: IO[bytes], start: int) -> int | None:
+        """The offset of the first record at or after ``start`` that checks out in full (see :func:`_plausible`),
+        or ``None``."""
+        size = self.size
+        at = start
+        while at < size:
+            f.seek(at)
+            block = f.read(_BLOCK + 64)
+            if not block:
+                return None
+            limit = min(len(block), _BLOCK)
+            i = 0
+            while i < limit:
+                # the nearest candidate opcode from i
+                cands = [j for j in (block.find(bytes([o]), i, limit) for o in (6, 7, 12, 15)) if j >= 0]
+                if not cands:
+                    break
+                j = min(cands)
+                head = block[j : j + 9 + 64]
+                if len(head) < 9 + 64 and at + j + len(head) < size:
+                    f.seek(at + j)
+                    head = f.read(9 + 64)
+                if _plausible(head, size, at + j):
+                    return at + j
+                i = j + 1
+            at += _BLOCK
+        return None
