@@ -34,6 +34,7 @@ from mmusv.config import Scenario, load_scenario, scenario_hash
 from mmusv.errors import ConfigError, IoError, MmusvError, located
 from mmusv.profiling import RunProfile
 from mmusv.recording.background import BackgroundWriter
+from mmusv.recording.guard import FolderLock, write_cause
 from mmusv.recording.tables import TableWriter
 from mmusv.scenario_checks import check_mounts, check_routes
 from mmusv.simulation import FrameCapture, Simulation
@@ -108,6 +109,7 @@ def run(
     checks: bool = True,
     frame_range: tuple[int, int] | None = None,
     profile: bool = False,
+    notes: list[str] | None = None,
 ) -> RunResult:
     """Runs a scenario (a YAML path, a dict or a :class:`~mmusv.config.Scenario`) into ``out_dir``.
 
@@ -124,13 +126,18 @@ def run(
             is an error, clearance and separation problems and far-away mounts are warnings.
         profile: time every stage (each sensor, annotation, encoding, writing, the rest) into
             ``RunResult.profile`` (:class:`~mmusv.profiling.RunProfile`); the output bytes are the same.
+        notes: lines for the user are appended here (an interrupted run found and recorded again).
+
+    The folder is locked while the run writes it (:class:`~mmusv.recording.guard.FolderLock`): a second run into
+    the same folder fails at once. A ``.partial`` recording left by a killed run is recorded again from scratch
+    (a clean redo; ``notes`` says so), and table parts of an earlier run are removed first.
 
     Raises:
         ConfigError: the scenario is invalid (nothing is written).
-        IoError: the output exists and ``overwrite`` is false, or cannot be written.
+        IoError: the output exists and ``overwrite`` is false, another run writes the folder, or it cannot be
+            written (the message names the cause, e.g. ``No space left on device``, and the frames that are safe).
         KeyboardInterrupt: re-raised after the recording was finished with every completed frame.
     """
-    from mmusv.recording.frames import FrameRecorder  # the MCAP side, kept apart from the loop
 
     if isinstance(cfg, (str, os.PathLike)) and Path(cfg).is_dir():
         raise ConfigError(
@@ -165,21 +172,69 @@ def run(
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise IoError(f"cannot create output folder {out}: {exc.strerror}") from None
+        raise IoError(f"cannot create output folder {out}: {write_cause(out, exc)}") from None
+    lock = FolderLock(out, what="mmusv run").acquire()  # a second run into `out` refuses at once
+    try:
+        return _record(
+            scenario, sim, out, rec_path, overwrite, first, total, frame_range, progress, profile, notes=notes
+        )
+    finally:
+        lock.release()
+
+
+def _record(
+    scenario: Scenario,
+    sim: Simulation,
+    out: Path,
+    rec_path: Path,
+    overwrite: bool,
+    first: int,
+    total: int,
+    frame_range: tuple[int, int] | None,
+    progress: Callable[[int, int], None] | None,
+    profile: bool,
+    *,
+    notes: list[str] | None,
+) -> RunResult:
+    """The recording part of :func:`run`, with the folder locked."""
+    from mmusv.recording.frames import FrameRecorder  # the MCAP side, kept apart from the loop
+
+    if rec_path.exists() and not overwrite:  # again, now that no other run can be writing it
+        raise IoError(f"{rec_path} already exists; pass overwrite=True (mmusv run --overwrite) to replace it")
+
+    partial = rec_path.with_name(rec_path.name + ".partial")
     tables_dir = out / "tables"
-    if tables_dir.exists() and overwrite:
-        for old in sorted(tables_dir.glob("*/part-*.parquet")):
+    stale = sorted(tables_dir.glob("*/part-*.parquet")) if tables_dir.exists() else []
+    if partial.exists():  # a run killed before it could finish: recorded again from its first frame
+        line = (
+            f"{partial} was left by an interrupted run; recording {scenario.name} again from frame {first} "
+            f"(a clean redo: the interrupted run is not resumed"
+            + ("; its table parts are removed" if stale else "")
+            + f"; `mmusv recover {out}` would have kept its frames instead)"
+        )
+        if notes is not None:
+            notes.append(line)
+    try:
+        (out / "manifest.json").unlink(missing_ok=True)  # written last: a run in progress never has one
+        for old in stale:  # tables of another run (replaced, or killed before it finished) never mix with these
             old.unlink()
-    tables = TableWriter(tables_dir)
+        tables = TableWriter(tables_dir)
+        (out / "scenario.yaml").write_text(
+            yaml.safe_dump(scenario.model_dump(mode="json"), sort_keys=False), encoding="utf-8"
+        )
+    except OSError as exc:
+        raise IoError(f"cannot write into {out}: {write_cause(out, exc)}") from None
     silhouettes = SilhouetteCache()
-    (out / "scenario.yaml").write_text(
-        yaml.safe_dump(scenario.model_dump(mode="json"), sort_keys=False), encoding="utf-8"
-    )
     result = RunResult(recording=rec_path, tables=tables_dir, frames_written=0, status="complete", seconds=0.0)
     t0 = time.perf_counter()
     prof = RunProfile() if profile else None
     result.profile = prof
-    recorder = FrameRecorder(rec_path, sim, overwrite=overwrite)
+    try:
+        recorder = FrameRecorder(rec_path, sim, overwrite=overwrite)
+    except MmusvError as exc:  # the metadata could not be written (a full disk): say why
+        if not _writes_into(exc, out):
+            raise
+        raise IoError(_write_failure(out, rec_path, [("starting the recording", exc)])[0]) from None
 
     def write(frame: _Frame) -> None:  # on the writer thread, in frame order
         t = time.perf_counter()
@@ -197,6 +252,7 @@ def run(
     writer = BackgroundWriter(write, depth=1)
     if prof is not None:
         prof.start()
+    failure: BaseException | None = None
     try:
         for k in range(first, total):
             tf = time.perf_counter()
@@ -219,16 +275,20 @@ def run(
                 progress(k + 1 - first, total - first)
         writer.close()
         writer.raise_pending()
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM through the command line's handler
         result.status = "interrupted"
-        raise
+        failure = exc
     except Exception as exc:
         result.status = "failed"
         result.error = f"{type(exc).__name__}: {exc}"
-        raise
-    finally:
-        writer.close()  # every frame handed over is written, also after an error or a Ctrl-C
-        result.frames_written = writer.done
+        failure = exc
+    writer.close()  # every frame handed over is written, also after an error or a Ctrl-C
+    if writer.interrupted and failure is None:
+        result.status, failure = "interrupted", KeyboardInterrupt()
+    result.frames_written = writer.done
+    # finish what can be finished; a write that fails here (a full disk) is named below, not raised half-way
+    problems: list[tuple[str, BaseException]] = []
+    try:
         summary = recorder.finish(
             status=result.status,
             frames=result.frames_written,
@@ -237,27 +297,84 @@ def run(
             first_frame=None if frame_range is None else first,
         )
         result.messages, result.bytes = summary.get("messages", 0), summary.get("bytes", 0)
+    except (MmusvError, OSError) as exc:
+        problems.append((f"finishing {rec_path.name}", exc))
+    try:
         tables.flush()  # the writer thread has ended: the tables are the main thread's again
-        result.seconds = time.perf_counter() - t0
-        if prof is not None:
-            prof.stop(result.frames_written)
-        manifest = {
-            "mmusv_version": _version(),
-            "scenario": scenario.name,
-            "seed": scenario.seed,
-            "config_hash": scenario_hash(scenario),
-            "status": result.status,
-            "frames_written": result.frames_written,
-            "frames_requested": total - first,
-            "frequency_hz": scenario.acquisition.frequency_hz,
-            "agents": [a.id for a in sim.agents],
-            "recording": rec_path.name,
-            "tables": sorted(p.name for p in tables_dir.iterdir()) if tables_dir.exists() else [],
-        }
-        if frame_range is not None:
-            manifest["first_frame"] = first
-        (out / "manifest.json").write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")
+    except OSError as exc:
+        problems.append(("writing the tables", exc))
+    result.seconds = time.perf_counter() - t0
+    if prof is not None:
+        prof.stop(result.frames_written)
+    message = None
+    if failure is not None and _writes_into(failure, out):
+        problems.insert(0, ("writing a frame", failure))
+    if problems:  # the disk is full, or the folder went read-only: say why and what is safe
+        result.status = "failed"
+        message, safe = _write_failure(out, rec_path, problems)
+        result.frames_written = safe
+    manifest = {
+        "mmusv_version": _version(),
+        "scenario": scenario.name,
+        "seed": scenario.seed,
+        "config_hash": scenario_hash(scenario),
+        "status": result.status,
+        "frames_written": result.frames_written,
+        "frames_requested": total - first,
+        "frequency_hz": scenario.acquisition.frequency_hz,
+        "agents": [a.id for a in sim.agents],
+        "recording": rec_path.name,
+        "tables": sorted(p.name for p in tables_dir.iterdir()) if tables_dir.exists() else [],
+    }
+    if frame_range is not None:
+        manifest["first_frame"] = first
+    tmp = out / ".manifest.json.tmp"  # renamed into place: never half-written
+    try:
+        tmp.write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")
+        os.replace(tmp, out / "manifest.json")
+    except OSError as exc:
+        tmp.unlink(missing_ok=True)
+        if message is None:
+            message, _safe = _write_failure(out, rec_path, [("writing manifest.json", exc)])
+    if message is not None:
+        raise IoError(message) from None
+    if failure is not None:
+        raise failure
     return result
+
+
+def _writes_into(exc: BaseException, out: Path) -> bool:
+    """Whether ``exc`` is a failed write into the folder ``out`` (the recorder's or the tables')."""
+    if isinstance(exc, OSError):
+        return exc.filename is None or str(out) in str(exc.filename) or str(out) in str(exc)
+    return isinstance(exc, IoError) and str(out) in str(exc)
+
+
+def _write_failure(out: Path, rec_path: Path, problems: list[tuple[str, BaseException]]) -> tuple[str, int]:
+    """The message of a run stopped by a failed write (the cause as the system names it, what failed, the frames
+    that are safe and where) and how many frames are safe."""
+    cause = write_cause(out, problems[0][1])
+    what = ", ".join(dict.fromkeys(w for w, _ in problems))
+    partial = rec_path.with_name(rec_path.name + ".partial")
+    target = partial if partial.exists() else rec_path
+    safe, kept = "no frame is safe", 0
+    if target.exists():
+        try:
+            from mmusv.recording.reader import FrameStream, _ranges, read_info
+
+            stream = FrameStream(read_info(target), want=lambda _t: False)
+            frames = [fr.index for fr in stream]
+            kept = len(frames)
+            if frames:
+                safe = (
+                    f"frames {_ranges(frames)} are safe in {target} (the last completely written frame is "
+                    f"{max(frames)})"
+                )
+                if target == partial:
+                    safe += f"; `mmusv recover {out}` finishes it once there is room"
+        except MmusvError:
+            pass
+    return f"cannot write into {out}: {cause} (while {what}); {safe}", kept
 
 
 def _version() -> str:

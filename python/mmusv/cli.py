@@ -103,31 +103,42 @@ def _run_one(
     from mmusv.config import load_scenario
 
     scenario = load_scenario(path)
-    if show_progress:
-        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+    notes: list[str] = []
+    try:
+        if show_progress:
+            from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
-        with Progress(
-            TextColumn(f"[bold]{scenario.name}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn()
-        ) as bar:
-            task = bar.add_task("frames", total=frames or scenario.acquisition.frames)
-            try:
-                res = run(
-                    path,
-                    out_dir=out,
-                    overwrite=overwrite,
-                    frames=frames,
-                    checks=checks,
-                    profile=profile,
-                    progress=lambda done, total: bar.update(task, completed=done),
-                )
-            except KeyboardInterrupt:
-                from mmusv.acquire import recording_path
+            with Progress(
+                TextColumn(f"[bold]{scenario.name}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn()
+            ) as bar:
+                task = bar.add_task("frames", total=frames or scenario.acquisition.frames)
+                try:
+                    res = run(
+                        path,
+                        out_dir=out,
+                        overwrite=overwrite,
+                        frames=frames,
+                        checks=checks,
+                        profile=profile,
+                        progress=lambda done, total: bar.update(task, completed=done),
+                        notes=notes,
+                    )
+                except KeyboardInterrupt:
+                    from mmusv.acquire import recording_path
 
-                rec = recording_path(Path(out), scenario)
-                print(f"mmusv: interrupted; {rec} is a valid recording holding every completed frame", file=sys.stderr)
-                raise
-    else:
-        res = run(path, out_dir=out, overwrite=overwrite, frames=frames, checks=checks, profile=profile)
+                    rec = recording_path(Path(out), scenario)
+                    print(
+                        f"mmusv: interrupted; {rec} is a valid recording holding every completed frame",
+                        file=sys.stderr,
+                    )
+                    raise
+        else:
+            res = run(
+                path, out_dir=out, overwrite=overwrite, frames=frames, checks=checks, profile=profile, notes=notes
+            )
+    finally:
+        for note in notes:  # e.g. an interrupted run found in the folder and recorded again
+            print(f"mmusv: note: {note}", file=sys.stderr)
     fps = res.frames_written / res.seconds if res.seconds > 0 else float("nan")
     line = (
         f"{scenario.name}: {res.frames_written} frames in {res.seconds:.1f} s ({fps:.2f} frames/s), "
@@ -175,19 +186,38 @@ def _cmd_info(args: argparse.Namespace) -> int:
     from rich.table import Table
 
     from mmusv.recording import summary
+    from mmusv.recording.reader import recording_name
 
-    info = summary(args.recording)
+    target = Path(args.recording)
+    folder: Path | None = None
+    if target.is_dir():  # a run folder: its recording (finished, else the .partial) and its tables
+        folder = target
+        found = sorted(target.glob("*.parts.json")) or sorted(target.glob("*.mcap"))
+        found = found or sorted(target.glob("*.mcap.partial"))
+        if not found:
+            raise MmusvError(f"{target} is a folder without a recording (*.mcap, *.mcap.partial or *.parts.json)")
+        if len(found) > 1:
+            raise MmusvError(f"{target} holds {len(found)} recordings ({', '.join(f.name for f in found)}); name one")
+        target = found[0]
+    info = summary(target)
     console = _console()
     meta = info.get("metadata", {})
     run_meta = meta.get("run", {})
+    frames = info.get("frames") or {}
     if not info.get("complete", True):
         console.print(
-            "[yellow]incomplete recording (.partial or no summary): counts come from scanning the messages[/yellow]"
+            "[yellow]incomplete recording (.partial, no summary or damaged): counts come from reading every "
+            "chunk[/yellow]"
         )
+    written = run_meta.get("frames_written", "?")
+    if frames:
+        written = f"{frames['read']} of {frames['expected']}" if frames["read"] != frames["expected"] else written
     console.print(
-        f"[bold]{args.recording}[/bold]: scenario {run_meta.get('scenario', '?')}, "
-        f"status {run_meta.get('status', '?')}, "
-        f"{run_meta.get('frames_written', '?')} frames, agents {run_meta.get('agents', '?')}"
+        f"[bold]{target}[/bold]: scenario {run_meta.get('scenario', recording_name(target))}, "
+        f"status {run_meta.get('status', 'unfinished (no run metadata: the run was killed or is still going)')}, "
+        f"{written} frames, agents {run_meta.get('agents', '?')}",
+        markup=True,
+        highlight=False,
     )
     start, end = info.get("start_ns", 0), info.get("end_ns", 0)
     console.print(
@@ -200,6 +230,45 @@ def _cmd_info(args: argparse.Namespace) -> int:
     for topic, t in sorted(info.get("topics", {}).items()):
         table.add_row(topic, t["schema"], str(t["messages"]))
     console.print(table)
+    problems = [frames["report"]] if frames and frames.get("report") else list(info.get("damage", []))
+    if folder is not None:
+        problems += _table_problems(folder, frames)
+    for line in problems:
+        console.print(f"mmusv: warning: {line}", markup=False, highlight=False, style="yellow")
+    if target.name.endswith(".mcap.partial"):
+        console.print(f"`mmusv recover {target.parent}` finishes it into {recording_name(target)}.mcap with its tables")
+    return 0
+
+
+def _table_problems(folder: Path, frames: dict[str, object]) -> list[str]:
+    """What is wrong with the Parquet tables of a run folder (damaged parts, frames without rows)."""
+    from mmusv.recording.tables import SCHEMAS, read_table
+
+    tables = folder / "tables"
+    if not tables.is_dir():
+        return [f"{tables} does not exist (a run killed before its first table flush; `mmusv recover` rebuilds it)"]
+    out = []
+    read = frames.get("read") if frames else None
+    missing = set(frames.get("missing", [])) if frames else set()  # type: ignore[call-overload]
+    expected = frames.get("expected") if frames else None
+    for name in SCHEMAS:
+        span = None
+        if name == "world_state" and isinstance(expected, int) and isinstance(read, int):
+            span = range(expected)
+        got = read_table(tables, name, expected=span)
+        got.missing = [k for k in got.missing if k not in missing]  # frames the recording lacks too: said above
+        line = got.report()
+        if line is not None:
+            out.append(line)
+    return out
+
+
+def _cmd_recover(args: argparse.Namespace) -> int:
+    from mmusv.recording.recover import recover
+
+    res = recover(args.target, overwrite=args.overwrite)
+    for line in res.lines():
+        print(line)
     return 0
 
 
@@ -288,8 +357,16 @@ def _parser() -> argparse.ArgumentParser:
         action="store_true",
         help="print the time per stage per frame (each sensor, annotation, encoding, writing, the rest)",
     )
-    info = sub.add_parser("info", help="agents, topics, frames and duration of a recording")
-    info.add_argument("recording", help="an .mcap written by mmusv run")
+    info = sub.add_parser(
+        "info", help="agents, topics, frames and duration of a recording; damage and missing frames if any"
+    )
+    info.add_argument("recording", help="an .mcap (or .mcap.partial, .parts.json) written by mmusv run, or its folder")
+    rec = sub.add_parser(
+        "recover",
+        help="finish the .partial recording of a killed run into a valid MCAP (summary, index) and rebuild its tables",
+    )
+    rec.add_argument("target", help="the run folder (holding NAME.mcap.partial) or the .partial file")
+    rec.add_argument("--overwrite", action="store_true", help="replace an existing NAME.mcap")
     prev = sub.add_parser("preview", help="one picture of a recorded frame (surround RGB, depth, semantic, PPI, BEV)")
     prev.add_argument("recording", help="an .mcap written by mmusv run")
     prev.add_argument("--frame", type=int, default=0, help="acquisition index (default 0)")
@@ -305,6 +382,45 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
+class _Signals:
+    """While a command runs: SIGTERM (a ``kill``, a service manager) and SIGINT (Ctrl-C) both end it the way
+    Ctrl-C always did — raised as ``KeyboardInterrupt`` in the main thread, so the current frame is finished or
+    abandoned, files are closed and background jobs are stopped — and the exit status is 128 + the signal's
+    number. The previous handlers come back afterwards (``main`` may be called in-process)."""
+
+    SIGNALS = ("SIGINT", "SIGTERM")
+
+    def __init__(self) -> None:
+        self.received: int | None = None
+        self._old: dict[int, object] = {}
+
+    def _handle(self, signum: int, frame: object) -> None:
+        if self.received is None:
+            self.received = signum
+        raise KeyboardInterrupt
+
+    def __enter__(self) -> _Signals:
+        import signal
+        import threading
+
+        if threading.current_thread() is threading.main_thread():
+            for name in self.SIGNALS:
+                num = getattr(signal, name, None)
+                if num is not None:
+                    self._old[num] = signal.signal(num, self._handle)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        import signal
+
+        for num, old in self._old.items():
+            signal.signal(num, old)  # type: ignore[arg-type]
+
+    def status(self, default: int) -> int:
+        """128 + the signal received, else ``default``."""
+        return default if self.received is None else 128 + self.received
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``mmusv`` command; returns the exit status."""
     args = _parser().parse_args(sys.argv[1:] if argv is None else argv)
@@ -317,52 +433,66 @@ def main(argv: list[str] | None = None) -> int:
         print(prefix + str(message), file=sys.stderr)
 
     warnings.showwarning = _show  # one line per warning, never a source excerpt
-    try:
-        if args.command == "version":
-            from mmusv import __version__
+    with _Signals() as signals:
+        try:
+            code = _dispatch(args)
+        except MmusvError as exc:
+            print(f"mmusv: error: {exc}", file=sys.stderr)
+            code = 2
+        except OSError as exc:  # a file the command reads or writes (a full disk, a read-only folder): one line
+            where = f"{exc.filename}: " if exc.filename else ""
+            print(f"mmusv: error: {where}{exc.strerror or exc}", file=sys.stderr)
+            code = 2
+        except KeyboardInterrupt:
+            name = "terminated (SIGTERM)" if signals.received not in (None, 2) else "interrupted"
+            print(f"mmusv: {name}", file=sys.stderr)
+            return signals.status(130)
+        return signals.status(code)
 
-            print(f"mmusv {__version__}")
-            return 0
-        if args.command == "assets":
-            return _cmd_assets(args)
-        if args.command == "scenarios":
-            return _cmd_scenarios(args)
-        if args.command == "study" and args.study == "waves":
-            return _cmd_study_waves(args)
-        if args.command == "study" and args.study == "agreement":
-            return _cmd_study_agreement(args)
-        if args.command == "study" and args.study in ("detection", "robustness"):
-            from mmusv.studies.detection.cli import run as _run_detection
 
-            return _run_detection(args)
-        if args.command == "run":
-            return _cmd_run(args)
-        if args.command == "info":
-            return _cmd_info(args)
-        if args.command == "preview":
-            return _cmd_preview(args)
-        if args.command == "convert":
-            from mmusv.export.cli import run as _run_convert
+def _dispatch(args: argparse.Namespace) -> int:
+    """Runs the parsed command; returns its exit status."""
+    if args.command == "version":
+        from mmusv import __version__
 
-            return _run_convert(args)
-        if args.command == "generate":
-            from mmusv.generate.cli import run as _run_generate
+        print(f"mmusv {__version__}")
+        return 0
+    if args.command == "assets":
+        return _cmd_assets(args)
+    if args.command == "scenarios":
+        return _cmd_scenarios(args)
+    if args.command == "study" and args.study == "waves":
+        return _cmd_study_waves(args)
+    if args.command == "study" and args.study == "agreement":
+        return _cmd_study_agreement(args)
+    if args.command == "study" and args.study in ("detection", "robustness"):
+        from mmusv.studies.detection.cli import run as _run_detection
 
-            return _run_generate(args)
-        if args.command == "editor":
-            from mmusv.editor.cli import run as _run_editor
+        return _run_detection(args)
+    if args.command == "run":
+        return _cmd_run(args)
+    if args.command == "info":
+        return _cmd_info(args)
+    if args.command == "recover":
+        return _cmd_recover(args)
+    if args.command == "preview":
+        return _cmd_preview(args)
+    if args.command == "convert":
+        from mmusv.export.cli import run as _run_convert
 
-            return _run_editor(args)
-        if args.command == "dataset":
-            from mmusv.batch.cli import run_dataset
+        return _run_convert(args)
+    if args.command == "generate":
+        from mmusv.generate.cli import run as _run_generate
 
-            return run_dataset(args)
-    except MmusvError as exc:
-        print(f"mmusv: error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("mmusv: interrupted", file=sys.stderr)
-        return 130
+        return _run_generate(args)
+    if args.command == "editor":
+        from mmusv.editor.cli import run as _run_editor
+
+        return _run_editor(args)
+    if args.command == "dataset":
+        from mmusv.batch.cli import run_dataset
+
+        return run_dataset(args)
     return 2
 
 

@@ -46,6 +46,11 @@ def _batch_options(p: argparse.ArgumentParser) -> None:
         "--retries", type=int, default=0, metavar="N", help="run a failed task up to N more times (default 0)"
     )
     p.add_argument(
+        "--stop-on-full-disk",
+        action="store_true",
+        help="stop the batch when a recording fails because the disk is full (default: mark it failed, go on)",
+    )
+    p.add_argument(
         "--split-frames",
         type=int,
         default=None,
@@ -139,6 +144,8 @@ def print_report(report: BatchReport, console: Console) -> None:
     for o in report.outcomes:
         for w in o.warnings:
             console.print(f"mmusv: warning: {w}", markup=False, highlight=False)
+    if report.index_error is not None:
+        console.print(f"mmusv: warning: {report.index_error}", markup=False, highlight=False)
     console.print(f"{report.summary()} in {report.seconds:.1f} s; index {report.index}")
 
 
@@ -160,6 +167,7 @@ def run_batch(args: argparse.Namespace, source: Path | list[Path]) -> int:
             overwrite=args.overwrite,
             checks=not args.no_checks,
             progress=lambda done, total: update("frames", done, total),
+            stop_on_full_disk=args.stop_on_full_disk,
         )
     print_report(report, console)
     return 0 if report.ok else 1
@@ -200,6 +208,7 @@ def run_dataset(args: argparse.Namespace) -> int:
             split_frames=args.split_frames,
             checks=not args.no_checks,
             progress=update,
+            stop_on_full_disk=args.stop_on_full_disk,
         )
     console.print(
         f"scenarios: {'generated' if rep.generated else 'kept (same spec)'} in {rep.out_dir / 'scenarios'}"

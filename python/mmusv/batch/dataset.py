@@ -66,6 +66,7 @@ def build_dataset(
     split_frames: int | None = None,
     checks: bool = True,
     progress: Progress | None = None,
+    stop_on_full_disk: bool = False,
 ) -> DatasetReport:
     """Generates, records, converts and indexes the dataset of ``spec`` into ``out_dir`` (see the module
     docstring); the batch options are those of :func:`mmusv.batch.run_many`."""
@@ -109,6 +110,7 @@ def build_dataset(
         index=index_path,
         index_extra={"spec": spec_section, "opv2v": old.get("opv2v")},
         progress=None if progress is None else (lambda d, t: progress("record", d, t)),
+        stop_on_full_disk=stop_on_full_disk,
     )
     doc = read_index(index_path)
     sources = {r["name"]: r["config_hash"] for r in doc["recordings"] if r["status"] == "complete"}

@@ -21,6 +21,9 @@ from mmusv.batch.task import TaskResult, execute, lost
 
 __all__ = ["Executor", "PoolExecutor", "SerialExecutor", "available_cpus"]
 
+_REAP_S = 15.0
+"""How long a stopped pool worker may take to finish its recording before it is killed."""
+
 
 def available_cpus() -> int:
     """CPUs this process may run on (its affinity where the OS says, else the CPU count)."""
@@ -42,6 +45,10 @@ class Executor(Protocol):
     def next_done(self) -> tuple[Task, TaskResult]: ...
 
     def in_flight(self) -> int: ...
+
+    def cancel_pending(self) -> list[Task]:
+        """Takes back the tasks submitted but not started (they will not run) and returns them."""
+        ...
 
     def close(self, *, cancel: bool) -> None: ...
 
@@ -66,6 +73,10 @@ class SerialExecutor:
     def in_flight(self) -> int:
         return len(self._queue)
 
+    def cancel_pending(self) -> list[Task]:
+        out, self._queue = self._queue, []
+        return out
+
     def close(self, *, cancel: bool) -> None:
         self._queue.clear()
 
@@ -78,6 +89,10 @@ def _init_worker(threads: int | None, driver_pid: int) -> None:
 
     if threads is not None:
         os.environ["RAYON_NUM_THREADS"] = str(threads)
+    import signal
+
+    signal.signal(signal.SIGTERM, _stop)
+    signal.signal(signal.SIGINT, _stop)
 
     def watch() -> None:
         while True:
@@ -86,6 +101,28 @@ def _init_worker(threads: int | None, driver_pid: int) -> None:
                 os._exit(70)
 
     threading.Thread(target=watch, name="mmusv-driver-watch", daemon=True).start()
+
+
+_IN_TASK = False
+"""True in a pool worker while it runs a task."""
+
+
+def _execute(task: Task) -> TaskResult:
+    """:func:`~mmusv.batch.task.execute` in a pool worker, marked as running (for :func:`_stop`)."""
+    global _IN_TASK
+    _IN_TASK = True
+    try:
+        return execute(task)
+    finally:
+        _IN_TASK = False
+
+
+def _stop(signum: int, frame: object) -> None:
+    """SIGTERM or SIGINT in a pool worker: a running task finishes its recording as interrupted (raised as
+    ``KeyboardInterrupt`` inside it); an idle worker just exits (no traceback)."""
+    if _IN_TASK:
+        raise KeyboardInterrupt
+    os._exit(128 + signum)
 
 
 class PoolExecutor:
@@ -121,13 +158,13 @@ class PoolExecutor:
         self._ensure()
         assert self._pool is not None
         try:
-            fut = self._pool.submit(execute, task)
+            fut = self._pool.submit(_execute, task)
         except BrokenProcessPool:  # broken since the last answer: start afresh
             self._pool.shutdown(wait=False, cancel_futures=True)
             self._pool = None
             self._ensure()
             assert self._pool is not None
-            fut = self._pool.submit(execute, task)
+            fut = self._pool.submit(_execute, task)
         self._futures[fut] = task
 
     def next_done(self) -> tuple[Task, TaskResult]:
@@ -148,13 +185,23 @@ class PoolExecutor:
     def in_flight(self) -> int:
         return len(self._futures)
 
+    def cancel_pending(self) -> list[Task]:
+        out = [task for fut, task in self._futures.items() if fut.cancel()]
+        self._futures = {f: t for f, t in self._futures.items() if not f.cancelled()}
+        return out
+
     def close(self, *, cancel: bool) -> None:
         if self._pool is not None:
-            if cancel:  # stop now: workers still running are ended, their recordings stay incomplete
+            if cancel:  # stop now: each worker finishes its recording as interrupted (SIGTERM), then is reaped
                 procs = list(getattr(self._pool, "_processes", {}).values())
                 self._pool.shutdown(wait=False, cancel_futures=True)
                 for p in procs:
                     p.terminate()
+                for p in procs:
+                    p.join(timeout=_REAP_S)
+                    if p.is_alive():
+                        p.kill()
+                        p.join(timeout=_REAP_S)
             else:
                 self._pool.shutdown(wait=True)
             self._pool = None

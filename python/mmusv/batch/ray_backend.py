@@ -102,6 +102,10 @@ class RayExecutor:
     def in_flight(self) -> int:
         return len(self._refs)
 
+    def cancel_pending(self) -> list[Task]:
+        """Ray does not say which tasks have started: none is taken back (those running fail on their own)."""
+        return []
+
     def close(self, *, cancel: bool) -> None:
         if cancel:
             for ref in list(self._refs):

@@ -27,7 +27,8 @@ from mmusv.batch.executors import Executor, PoolExecutor, SerialExecutor, availa
 from mmusv.batch.index import INDEX_NAME, Entry, folder_bytes, write_index
 from mmusv.batch.plan import ScenarioPlan, plan_scenarios, prepare, scenario_files
 from mmusv.batch.task import TaskResult
-from mmusv.errors import ConfigError, MmusvError
+from mmusv.errors import ConfigError, IoError, MmusvError
+from mmusv.recording.guard import FolderLock, write_cause
 
 __all__ = ["BatchReport", "ScenarioOutcome", "run_many"]
 
@@ -65,6 +66,8 @@ class BatchReport:
     outcomes: list[ScenarioOutcome]
     index: Path
     seconds: float = 0.0
+    index_error: str | None = None
+    """Why the index could not be written at the end (a full disk), else None."""
 
     def count(self, status: str) -> int:
         """How many scenarios ended with ``status``."""
@@ -143,6 +146,7 @@ def run_many(
     index: str | os.PathLike[str] | None = None,
     index_extra: Mapping[str, Any] | None = None,
     progress: Callable[[int, int], None] | None = None,
+    stop_on_full_disk: bool = False,
 ) -> BatchReport:
     """Runs every scenario of ``source`` (a folder of ``*.yaml``, or a list of files) into ``out_dir/<stem>/``.
 
@@ -161,6 +165,12 @@ def run_many(
         checks: the route checks of :func:`mmusv.acquire.run`.
         index: where ``dataset.json`` goes (default ``out_dir/dataset.json``); ``index_extra``: extra sections.
         progress: called with (frames done, frames in all) after each task (skipped frames count as done).
+        stop_on_full_disk: when a task fails because the disk is full (``No space left on device``), stop: the
+            tasks not started are cancelled and reported as failed with that cause (the default goes on, marking
+            each recording that cannot be written failed).
+
+    The output folder is locked while the batch runs (:class:`~mmusv.recording.guard.FolderLock`): a second batch
+    (or ``mmusv run``) into it fails at once.
 
     Returns:
         the :class:`BatchReport`; ``report.ok`` is False when a scenario failed.
@@ -193,6 +203,47 @@ def run_many(
     for p in plans:
         if p.recording is not None and not p.recording.is_relative_to(root):
             raise ConfigError(f"index {index_path} must be in a folder above the output {out}")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise IoError(f"cannot create output folder {out}: {write_cause(out, exc)}") from None
+    lock = FolderLock(out, what="mmusv run (batch)").acquire()
+    try:
+        return _run(
+            plans,
+            out,
+            root,
+            index_path,
+            index_extra,
+            jobs,
+            ray,
+            cpus_per_task,
+            retries,
+            lost_worker_retries,
+            progress,
+            stop_on_full_disk,
+            t0,
+        )
+    finally:
+        lock.release()
+
+
+def _run(
+    plans: list[ScenarioPlan],
+    out: Path,
+    root: Path,
+    index_path: Path,
+    index_extra: Mapping[str, Any] | None,
+    jobs: int,
+    ray: bool | str,
+    cpus_per_task: int | None,
+    retries: int,
+    lost_worker_retries: int,
+    progress: Callable[[int, int], None] | None,
+    stop_on_full_disk: bool,
+    t0: float,
+) -> BatchReport:
+    """The batch of :func:`run_many` once planned, with the output folder locked."""
     status: dict[str, str] = {}
     errors: dict[str, str | None] = {}
     retried: dict[str, int] = {}
@@ -202,10 +253,15 @@ def run_many(
         errors[p.name] = p.error
     entries = {p.name: _entry(p, status[p.name], errors[p.name], root) for p in plans}
 
-    def write() -> None:
-        write_index(index_path, entries.values(), index_extra)
+    index_error: list[str] = []
 
-    out.mkdir(parents=True, exist_ok=True)
+    def write() -> None:  # a full disk must not stop the batch: the index is written again after the next task
+        try:
+            write_index(index_path, entries.values(), index_extra)
+            index_error.clear()
+        except IoError as exc:
+            index_error[:] = [str(exc)]
+
     todo = [t for p in plans for t in p.to_run]
     total_frames = sum(p.frames for p in plans if not p.error)
     done_frames = total_frames - sum(t.expected_frames for t in todo)
@@ -217,6 +273,7 @@ def run_many(
     left = {p.name: len(p.to_run) for p in plans}
     executor = _executor(int(jobs), ray, cpus_per_task, int(lost_worker_retries)) if todo else SerialExecutor()
     interrupted = False
+    full_disk: str | None = None
     try:
         for p in plans:
             prepare(p)
@@ -227,9 +284,25 @@ def run_many(
         while executor.in_flight():
             task, res = executor.next_done()
             plan = plan_of[task.key]
+            if res.status != "done" and res.disk_full and stop_on_full_disk and full_disk is None:
+                full_disk = res.error or "No space left on device"
+                for t in executor.cancel_pending():  # not started: they would fail the same way
+                    results[t.key] = TaskResult(
+                        key=t.key, status="failed", error=f"not run: the disk is full ({task.key}: {full_disk})"
+                    )
+                    left[plan_of[t.key].name] -= 1
+                    if errors[plan_of[t.key].name] is None:
+                        errors[plan_of[t.key].name] = results[t.key].error
+                    if left[plan_of[t.key].name] == 0:
+                        name = plan_of[t.key].name
+                        status[name] = "failed"
+                        entries[name] = _entry(plan_of[t.key], "failed", errors[name], root)
+                write()
             if res.status != "done":
                 again = False
-                if res.lost and not executor.retries_lost_workers and lost_tries[task.key] < lost_worker_retries:
+                if full_disk is not None:
+                    pass  # stopping: nothing is run again
+                elif res.lost and not executor.retries_lost_workers and lost_tries[task.key] < lost_worker_retries:
                     lost_tries[task.key] += 1
                     again = True
                 elif res.retryable and tries[task.key] <= retries:
@@ -258,8 +331,15 @@ def run_many(
         if interrupted:
             write()
     outcomes = [_outcome(p, status[p.name], errors[p.name], retried, results) for p in plans]
+    if index_error:
+        write()
     return BatchReport(
-        out_dir=out, backend=executor.name, outcomes=outcomes, index=index_path, seconds=time.perf_counter() - t0
+        out_dir=out,
+        backend=executor.name,
+        outcomes=outcomes,
+        index=index_path,
+        seconds=time.perf_counter() - t0,
+        index_error=index_error[0] if index_error else None,
     )
 
 

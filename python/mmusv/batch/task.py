@@ -9,6 +9,7 @@ It never raises for a failure of the scenario: everything comes back as a :class
 
 from __future__ import annotations
 
+import errno
 import os
 import time
 import warnings
@@ -30,7 +31,7 @@ class TaskResult:
     """How one attempt of a task ended: ``status`` ``done`` or ``failed`` (``error``; ``retryable`` unless the
     input itself is bad), ``attempts`` (of this run, this one included), frames and bytes written, the worker's
     ``pid`` and ``threads`` (its ``RAYON_NUM_THREADS``, ``None`` when unset), warnings raised while it ran.
-    ``lost``: the worker died before it could answer (killed, out of memory)."""
+    ``lost``: the worker died before it could answer (killed, out of memory); ``disk_full``: see the field."""
 
     key: str
     status: str
@@ -44,6 +45,8 @@ class TaskResult:
     threads: str | None = None
     warnings: list[str] = field(default_factory=list)
     lost: bool = False
+    disk_full: bool = False
+    """It failed because the disk is full (``No space left on device``)."""
 
 
 def lost(task: Task, why: str) -> TaskResult:
@@ -114,6 +117,7 @@ def execute(task: Task) -> TaskResult:
         with _TaskState(Path(task.state_file), task.run_id) as state:
             res.attempts = state.attempts
             (Path(task.out_dir) / "manifest.json").unlink(missing_ok=True)
+            notes: list[str] = []
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always")
                 out = run(
@@ -123,8 +127,9 @@ def execute(task: Task) -> TaskResult:
                     frames=task.frames,
                     frame_range=task.frame_range,
                     checks=task.checks,
+                    notes=notes,
                 )
-            res.warnings = sorted({str(w.message) for w in caught})
+            res.warnings = sorted({str(w.message) for w in caught} | set(notes))
             res.frames, res.bytes = out.frames_written, out.bytes
             if out.frames_written != task.expected_frames:  # cannot happen without an exception; never call it done
                 raise InternalError(f"{task.key}: {out.frames_written} of {task.expected_frames} frames written")
@@ -137,6 +142,7 @@ def execute(task: Task) -> TaskResult:
         )
         # bad input fails the same way every time; a file system or internal problem may not
         res.retryable = isinstance(exc, (IoError, InternalError))
+        res.disk_full = isinstance(exc, IoError) and os.strerror(errno.ENOSPC) in msg
     except Exception as exc:  # a bug, not bad input: still reported per task, with its type
         res.error = f"{task.scenario_file}: internal error {type(exc).__name__}: {exc}"
         res.retryable = True

@@ -166,7 +166,9 @@ def generate(
                     rep.reject(*fail)
                 else:
                     path = out / f"{name}.yaml"
-                    path.write_text(dump_scenario(cand.data), encoding="utf-8")
+                    tmp = path.with_name(f".{path.name}.tmp")  # renamed into place: a stop never leaves half a file
+                    tmp.write_text(dump_scenario(cand.data), encoding="utf-8")
+                    os.replace(tmp, path)
                     if load_scenario(yaml.load(path.read_text(encoding="utf-8"), Loader=_LOADER)) != cand.scenario:
                         raise MmusvError(f"internal: {path} does not read back as the scenario that was checked")
                     rep.accept(path.name)
@@ -184,5 +186,7 @@ def generate(
                     )
             if progress is not None:
                 progress(rep.name, report.accepted, total_attempts)
-    (out / "report.json").write_text(report.to_json(), encoding="utf-8")
+    tmp = out / ".report.json.tmp"
+    tmp.write_text(report.to_json(), encoding="utf-8")
+    os.replace(tmp, out / "report.json")
     return report

@@ -168,7 +168,8 @@ def read_recording(path: str | Path) -> SequenceData:
 
     topics = {names.lidar(a.id) for a in agents}
     frames: list[SceneFrame] = []
-    for fr in reader.FrameStream(info, want=topics.__contains__):
+    stream = reader.FrameStream(info, want=topics.__contains__)
+    for fr in stream:
         w = fr.world
         if w is None or not all(t in fr.messages for t in topics):
             continue
@@ -191,6 +192,7 @@ def read_recording(path: str | Path) -> SequenceData:
                 usv_sizes=w.box_sizes[is_usv],
             )
         )
+    reader.warn_missing(stream, reader="the detection study")  # frames missing or damaged: said, not dropped silently
     frames.sort(key=lambda f: f.frame)
     return SequenceData(recording_name(info.path), tuple(frames))
 
