@@ -7,8 +7,10 @@ Endpoints (JSON in and out unless said otherwise; errors are ``{"error": "..."}`
 ``GET /api/info``         version, folder, the scenario given on the command line, choices from the schema
 ``GET /api/assets``       the vessel library (name, category, class, sizes in metres, USV or not)
 ``GET /api/bundled``      the bundled scenarios; ``GET /api/bundled/{name}`` one of them as a document
-``GET /api/files``        the scenario files in the folder; ``GET /api/files/{name}`` one as a document
-``PUT /api/files/{name}`` saves ``{document, comment, overwrite}`` as YAML into the folder (409 if it exists)
+``GET /api/files``        the scenario files in the folder; ``GET /api/files/{name}`` one as a document, with
+                          its ``etag`` (also the ``ETag`` header)
+``PUT /api/files/{name}`` saves ``{document, comment, overwrite}`` as YAML into the folder (409 if it exists);
+                          with ``If-Match: ETAG`` only if the file is still that version (412 if it changed)
 ``POST /api/map``         ``{map}`` -> the map's layers (:mod:`mmusv.editor.maplayers`)
 ``POST /api/evaluate``    ``{document}`` -> validation, checks and motion (:mod:`mmusv.editor.evaluate`)
 ``POST /api/poses``       ``{document, frame}`` -> every vessel's ``[x, y, yaw]`` at that index
@@ -18,9 +20,10 @@ Endpoints (JSON in and out unless said otherwise; errors are ``{"error": "..."}`
 ========================  =====================================================================================
 
 Status codes: 400 bad input (a file name, a request the server cannot serve), 404 nothing of that name, 409 the
-file exists, 413 the request is too large, 422 the request body or the scenario does not validate (the message
-names the field). Nothing outside the folder is read or written (:mod:`mmusv.editor.files`); the page loads
-nothing from elsewhere (a Content-Security-Policy says so to the browser).
+file exists, 412 the file changed since the client read it (If-Match), 413 the request is too large, 422 the
+request body or the scenario does not validate (the message names the field). Nothing outside the folder is read
+or written (:mod:`mmusv.editor.files`); the page loads nothing from elsewhere (a Content-Security-Policy says so
+to the browser).
 """
 
 from __future__ import annotations
@@ -29,7 +32,7 @@ import json
 import sys
 import threading
 import traceback
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, get_args
 
@@ -45,7 +48,7 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 from mmusv.config import EnvironmentConfig, MapConfig, Scenario, VesselConfig, load_scenario, validation_problems
 from mmusv.editor.document import leading_comment, scenario_yaml, to_document
 from mmusv.editor.evaluate import MAX_BULK_FRAMES, evaluate, poses_at, validate
-from mmusv.editor.files import FileExistsInFolder, ScenarioFolder, check_name
+from mmusv.editor.files import ChangedInFolder, FileExistsInFolder, ScenarioFolder, check_name, etag
 from mmusv.editor.jobs import Jobs
 from mmusv.editor.maplayers import map_layers
 from mmusv.errors import ConfigError, InputError, MmusvError, NotFoundError
@@ -72,6 +75,8 @@ class InitialScenario:
     document: dict[str, Any]
     comment: str
     in_folder: bool = False
+    etag: str | None = None
+    """The ETag of the file when ``in_folder`` (the page saves it with ``If-Match``)."""
 
 
 class _Strict(BaseModel):
@@ -113,6 +118,8 @@ def _error(status: int, message: str) -> JSONResponse:
 def _status(exc: MmusvError) -> int:
     if isinstance(exc, FileExistsInFolder):
         return 409
+    if isinstance(exc, ChangedInFolder):
+        return 412
     if isinstance(exc, NotFoundError):
         return 404
     if isinstance(exc, ConfigError):
@@ -212,6 +219,8 @@ def create_app(
     ``allowed_hosts`` are the host names requests may address (default: any; the command line passes the bound
     host and its loopback names, so other sites cannot reach the server through DNS rebinding)."""
     store = ScenarioFolder(folder)
+    if initial is not None and initial.in_folder and initial.etag is None:  # the version the page starts from
+        initial = replace(initial, etag=store.etag_of(initial.name))
     jobs = Jobs(store.root)
     evaluate_lock, preview_lock = threading.Lock(), threading.Lock()
     app = FastAPI(title="mmusv editor", docs_url=None, redoc_url=None, openapi_url=None)
@@ -323,21 +332,31 @@ def create_app(
         return [{"name": f.name, "size": f.size} for f in store.files()]
 
     @app.get("/api/files/{name:path}")
-    def read_file(name: str) -> dict[str, Any]:
-        _, text = store.read_text(name)
+    def read_file(name: str) -> JSONResponse:
+        path, text = store.read_text(name)
         doc, valid = _load_document(text, name)
-        return {"name": name, "document": doc, "valid": valid, "comment": leading_comment(text)}
+        tag = etag(path.read_bytes())
+        return JSONResponse(
+            {"name": name, "document": doc, "valid": valid, "comment": leading_comment(text), "etag": tag},
+            headers={"ETag": f'"{tag}"'},
+        )
 
     @app.put("/api/files/{name:path}")
-    def write_file(name: str, body: SaveBody) -> dict[str, Any]:
+    def write_file(name: str, body: SaveBody, request: Request) -> JSONResponse:
         check_name(name)
         scenario, errors = validate(body.document)
         if scenario is None:
             raise ConfigError(
                 f"{name}: not saved, the scenario does not validate: " + "; ".join(e["message"] for e in errors)
             )
-        path = store.write_text(name, scenario_yaml(scenario, comment=body.comment), overwrite=body.overwrite)
-        return {"name": name, "path": str(path), "bytes": path.stat().st_size}
+        match = request.headers.get("if-match")
+        if_match = None if match is None else match.strip().removeprefix("W/").strip('"')
+        text = scenario_yaml(scenario, comment=body.comment)
+        path = store.write_text(name, text, overwrite=body.overwrite, if_match=if_match)
+        tag = etag(text.encode("utf-8"))
+        return JSONResponse(
+            {"name": name, "path": str(path), "bytes": path.stat().st_size, "etag": tag}, headers={"ETag": f'"{tag}"'}
+        )
 
     @app.post("/api/map")
     def map_(body: MapBody) -> Response:

@@ -60,6 +60,7 @@ class Jobs:
         self._jobs: dict[int, Job] = {}
         self._ids = itertools.count(1)
         self._lock = threading.Lock()
+        self._followers: list[threading.Thread] = []
 
     def start(self, path: Path, *, frames: int | None = None) -> Job:
         """Starts ``mmusv run`` of the scenario file ``path`` (in the folder) into ``out/<stem>``."""
@@ -84,7 +85,9 @@ class Jobs:
                 env={**os.environ, "PYTHONUNBUFFERED": "1"},
             )
             self._jobs[job.id] = job
-        threading.Thread(target=self._follow, args=(job,), daemon=True).start()
+        follower = threading.Thread(target=self._follow, args=(job,), daemon=True)
+        self._followers.append(follower)
+        follower.start()
         return job
 
     def _follow(self, job: Job) -> None:
@@ -143,12 +146,24 @@ class Jobs:
             job.process.send_signal(signal.SIGINT)
         return job
 
-    def shutdown(self) -> None:
-        """Stops every running run and waits for them (at most a few seconds each)."""
-        for job in self.all():
-            if job.process is not None and job.process.poll() is None:
-                job.process.send_signal(signal.SIGINT)
-                try:
-                    job.process.wait(timeout=10)
-                except subprocess.TimeoutExpired:
-                    job.process.kill()
+    def shutdown(self, *, timeout: float = 10.0) -> None:
+        """Stops every running run (SIGINT: each finishes its recording with every completed frame), waits for
+        them all (``timeout`` seconds in all), kills any still running, and reaps every process and the threads
+        that follow them, so the server leaves no child behind."""
+        import time
+
+        running = [j for j in self.all() if j.process is not None and j.process.poll() is None]
+        for job in running:
+            assert job.process is not None
+            job.stop_requested = True
+            job.process.send_signal(signal.SIGINT)
+        deadline = time.monotonic() + timeout
+        for job in running:
+            assert job.process is not None
+            try:
+                job.process.wait(timeout=max(0.0, deadline - time.monotonic()))
+            except subprocess.TimeoutExpired:
+                job.process.kill()
+                job.process.wait()
+        for follower in self._followers:
+            follower.join(timeout=max(0.1, deadline - time.monotonic()))

@@ -7,8 +7,8 @@ export class ApiError extends Error {
   }
 }
 
-async function call(method, path, body) {
-  const init = { method, headers: {} };
+async function call(method, path, body, headers = {}) {
+  const init = { method, headers: { ...headers } };
   if (body !== undefined) {
     init.headers["Content-Type"] = "application/json";
     init.body = JSON.stringify(body);
@@ -39,7 +39,9 @@ export const api = {
   bundledOne: (name) => call("GET", `/api/bundled/${encodeURIComponent(name)}`),
   files: () => call("GET", "/api/files"),
   readFile: (name) => call("GET", `/api/files/${encodeURIComponent(name)}`),
-  writeFile: (name, body) => call("PUT", `/api/files/${encodeURIComponent(name)}`, body),
+  // etag: the version this page read or last saved; the server refuses (412) to replace a file changed since
+  writeFile: (name, body, etag) =>
+    call("PUT", `/api/files/${encodeURIComponent(name)}`, body, etag ? { "If-Match": `"${etag}"` } : {}),
   map: (map) => call("POST", "/api/map", { map }),
   evaluate: (document) => call("POST", "/api/evaluate", { document }),
   poses: (document, frame) => call("POST", "/api/poses", { document, frame }),

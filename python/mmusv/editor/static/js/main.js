@@ -112,12 +112,17 @@ async function open(value) {
   try {
     const res = kind === "file" ? await api.readFile(name) : await api.bundledOne(name);
     state.load({ document: res.document, comment: res.comment, name: res.name, savedName: kind === "file" ? res.name : null });
+    savedEtag = kind === "file" ? res.etag : null;
     status(`opened ${kind === "file" ? name : `bundled ${name}`}${res.valid ? "" : " (it does not validate: see Checks)"}`);
   } catch (err) {
     status(err.message, true);
   }
   $("open").value = "";
 }
+
+// The ETag of the folder file this page last read or saved (state.savedName): a save of that file sends it, so a
+// version saved meanwhile by another tab or program is never overwritten without asking (412 from the server).
+let savedEtag = null;
 
 async function save(overwrite = false) {
   const name = $("file-name").value.trim();
@@ -127,7 +132,10 @@ async function save(overwrite = false) {
     return false;
   }
   try {
-    const res = await api.writeFile(name, { document: state.doc, comment: state.comment, overwrite: overwrite || name === state.savedName });
+    const same = name === state.savedName;
+    const body = { document: state.doc, comment: state.comment, overwrite: overwrite || same };
+    const res = await api.writeFile(name, body, same && !overwrite ? savedEtag : null);
+    savedEtag = res.etag;
     state.savedName = name;
     state.fileName = name;
     state.dirty = false;
@@ -138,6 +146,10 @@ async function save(overwrite = false) {
   } catch (err) {
     if (err.status === 409) {
       $("save-confirm-text").textContent = `${name} exists.`;
+      $("save-confirm").hidden = false;
+    } else if (err.status === 412) {
+      status(`not saved: ${err.message}`, true);
+      $("save-confirm-text").textContent = `${name} was changed by another tab or program since you opened it.`;
       $("save-confirm").hidden = false;
     } else {
       status(`not saved: ${err.message}`, true);
@@ -318,6 +330,7 @@ async function boot() {
         name: info.initial.name,
         savedName: info.initial.in_folder ? info.initial.name : null,
       });
+      savedEtag = info.initial.in_folder ? info.initial.etag : null;
     } else {
       const first = bundled.find((b) => b.name === "port_entry") || bundled[0];
       const res = await api.bundledOne(first.name);
