@@ -25,6 +25,7 @@ __all__ = [
     "boot_top_band",
     "deck_z",
     "half_width",
+    "half_widths",
     "hull_mesh",
     "profile",
     "resolution",
@@ -63,22 +64,27 @@ def _bow_progress(hull: HullSpec, u: np.ndarray) -> np.ndarray:
     return np.clip((u - (1.0 - hull.bow)) / hull.bow, 0.0, 1.0)
 
 
-def resolution(hull: HullSpec) -> tuple[int, int]:
-    """Stations along the hull and levels keel to deck used for lofting (more for larger vessels)."""
+def resolution(hull: HullSpec) -> tuple[int, int, int, int]:
+    """Stations in the bow taper, the stern taper and the parallel middle body, and levels keel to deck, used
+    for lofting: the ends, where the hull curves in plan and section, get most of them; more for larger hulls."""
     if hull.length < 15.0:
-        return 56, 18
+        return 30, 14, 10, 22
     if hull.length < 80.0:
-        return 88, 22
-    return 128, 28
+        return 36, 16, 12, 22
+    return 52, 22, 16, 28
 
 
 def stations(hull: HullSpec) -> np.ndarray:
-    """Sorted station parameters ``(N,)`` used for lofting, denser towards the ends where the outline curves."""
-    n, _ = resolution(hull)
-    s = np.linspace(0.0, 1.0, n)
-    u = 0.45 * s + 0.55 * (1.0 - np.cos(np.pi * s)) / 2.0
-    breaks = [hull.stern, 1.0 - hull.bow] if hull.bow > 0 or hull.stern > 0 else []
-    return np.unique(np.round(np.clip(np.concatenate([u, breaks]), 0.0, 1.0), 12))
+    """Sorted station parameters ``(N,)`` used for lofting: cosine-spaced over the bow and stern tapers (dense at
+    the stem and transom), evenly over the middle body (where only the sheer curves)."""
+    n_bow, n_stern, n_mid, _ = resolution(hull)
+    ub, us = 1.0 - hull.bow, hull.stern
+    parts = [np.linspace(us, ub, n_mid + 1)]
+    if hull.bow > 0:
+        parts.append(ub + hull.bow * np.sin(np.linspace(0.0, 1.0, n_bow) * np.pi / 2.0))
+    if hull.stern > 0:
+        parts.append(hull.stern * (1.0 - np.cos(np.linspace(0.0, 1.0, n_stern) * np.pi / 2.0)))
+    return np.unique(np.round(np.clip(np.concatenate([[0.0, 1.0], *parts]), 0.0, 1.0), 12))
 
 
 def deck_z(hull: HullSpec, x: float) -> float:
@@ -100,6 +106,15 @@ def half_width(hull: HullSpec, x: float) -> float:
     if hull.type == "twin":
         return (hull.beam - hull.demi_width) / 2.0 + hull.demi_width / 2.0 * w
     return hull.beam / 2.0 * w
+
+
+def half_widths(hull: HullSpec, x: np.ndarray) -> np.ndarray:
+    """:func:`half_width` at every body-frame ``x`` ``(N,)`` metres, vectorised: ``(N,)`` metres."""
+    x = np.asarray(x, dtype=np.float64)
+    w = profile(hull, np.clip((x + hull.length / 2.0) / hull.length, 0.0, 1.0))
+    twin = hull.type == "twin"
+    hw = (hull.beam - hull.demi_width) / 2.0 + hull.demi_width / 2.0 * w if twin else hull.beam / 2.0 * w
+    return np.where(np.abs(x) > hull.length / 2.0 + 1e-9, 0.0, hw)
 
 
 def boot_top_band(hull: HullSpec) -> tuple[float, float]:
@@ -139,7 +154,7 @@ def side_half_width(hull: HullSpec, x: np.ndarray, z: np.ndarray) -> np.ndarray:
 def _levels(hull: HullSpec) -> tuple[np.ndarray, np.ndarray, int, int]:
     """Level heights: ``below`` (q fractions, keel to waterline) and ``above`` (deck fractions, waterline to
     deck) and the level indices where the boot-top band starts and ends."""
-    _, n = resolution(hull)
+    n = resolution(hull)[3]
     lo, hi = boot_top_band(hull)
     nb = max(4, round(n * hull.draft / hull.depth))
     s = np.linspace(0.0, 1.0, nb)
@@ -158,7 +173,9 @@ def _loft(hull: HullSpec, *, y0: float, half: float, cls: int, mats: tuple[int, 
     u = stations(hull)
     n = u.shape[0]
     w = profile(hull, u)
-    tip = bool(w[-1] < 1e-9)
+    tip = bool(w[-1] < 1e-6)
+    if tip:
+        w[-1] = 0.0  # a stem that closes to (nearly) nothing closes to a point
     length, draft, depth = hull.length, hull.draft, hull.depth
     q, f, k_lo, k_hi = _levels(hull)
     x_deck = -length / 2.0 + u * length

@@ -144,6 +144,7 @@ MATERIALS: tuple[Material, ...] = (
     _m("paint_green", (0.03, 0.20, 0.06), 0.45),
     _m("deck_steel", (0.16, 0.17, 0.17), 0.7),
     _m("deck_green", (0.04, 0.14, 0.06), 0.7),  # green non-slip deck paint
+    _m("deck_red", (0.22, 0.04, 0.03), 0.7),  # red-oxide deck paint
     _m("deck_wood", (0.28, 0.15, 0.07), 0.75),  # teak
     _m("glass", (0.02, 0.025, 0.03), 0.05),
     _m("rubber", (0.02, 0.02, 0.02), 0.9),  # fenders, tyres

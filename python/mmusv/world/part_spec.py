@@ -342,6 +342,10 @@ class RailingPart(_Part):
     stern: bool = False
     radius: Positive | None = None
     """Tube radius (default ``0.02 + 0.01 * height``)."""
+    posts: bool = True
+    """False: rails alone (a rubbing strake or fender band along the sheer, with ``lift`` below the deck edge)."""
+    lift: Number = 0.0
+    """Metres the whole railing is raised above (negative: lowered below) its deck line or ``base``."""
 
     @model_validator(mode="after")
     def _span(self) -> RailingPart:
@@ -381,7 +385,7 @@ class WindowsPart(_Along):
 class ContainersPart(_Along):
     """Container stacks: ``bays`` bays from ``x0`` to ``x1`` (``gap`` between bays), ``rows`` containers across a
     stack ``width`` wide, ``tiers`` high per bay (cycled), each box its own colour (a fixed hash of its slot and
-    ``seed``); ``height`` is one container's (2.59 m standard)."""
+    ``seed``); ``height`` is one container's (2.59 m standard); ``fit`` drops outer rows where the hull narrows."""
 
     type: Literal["containers"]
     bays: Annotated[Whole, Field(ge=1, le=60)]
@@ -392,6 +396,8 @@ class ContainersPart(_Along):
     gap: NonNegative = 0.6
     height: Positive = 2.59
     seed: Annotated[Whole, Field(ge=0)] = 0
+    fit: NonNegative | None = None
+    """Drop outer rows of a bay (keeping it centred) until it stays ``fit`` metres inside the deck outline."""
 
 
 class HatchesPart(_Along):

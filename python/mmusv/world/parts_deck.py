@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from mmusv.world.hull_form import _deck_z, half_width, side_half_width
+from mmusv.world.hull_form import _deck_z, half_width, half_widths, side_half_width
 from mmusv.world.materials import material_id
 from mmusv.world.part_context import Ctx
 from mmusv.world.part_spec import (
@@ -57,37 +57,25 @@ _SIDES = {"both": (1.0, -1.0), "port": (1.0,), "starboard": (-1.0,)}
 
 
 def _half_widths(ctx: Ctx, xs: np.ndarray) -> np.ndarray:
-    return np.array([half_width(ctx.hull, float(x)) for x in xs])
+    return half_widths(ctx.hull, xs)
 
 
 def _rail_meshes(
     paths: list[tuple[np.ndarray, bool]], posts: np.ndarray, *, height: float, rails: int, radius: float, ctx: Ctx
 ) -> TriMesh:
-    """Stanchions standing on ``posts`` ``(N, 3)`` and ``rails`` rails along each ``(deck path, closed)``."""
-    out = [
-        tubes(
-            starts=posts,
-            ends=posts + np.array([0.0, 0.0, height]),
-            radius=radius,
-            cls=ctx.cls,
-            material=ctx.mat,
-            segments=6,
-        )
-    ]
+    """Stanchions standing on ``posts`` ``(N, 3)`` (none when ``posts`` is empty) and ``rails`` rails along each
+    ``(deck path, closed)``; thick rails alone (rubbing strakes) get 12-sided sections."""
+    out = []
+    if posts.shape[0]:
+        top = posts + np.array([0.0, 0.0, height])
+        out.append(tubes(starts=posts, ends=top, radius=radius, cls=ctx.cls, material=ctx.mat, segments=6))
+    seg = 6 if posts.shape[0] else 12
     for path, closed in paths:
         for k in range(1, rails + 1):
-            r = radius * (1.25 if k == rails else 0.8)
-            lift = height * k / rails - (r if k == rails else 0.0)
-            out.append(
-                sweep(
-                    path + np.array([0.0, 0.0, lift]),
-                    radius=r,
-                    cls=ctx.cls,
-                    material=ctx.mat,
-                    segments=6,
-                    closed=closed,
-                )
-            )
+            r = radius * (1.25 if k == rails and posts.shape[0] else 0.8 if posts.shape[0] else 1.0)
+            lift = height * k / rails - (r if k == rails and posts.shape[0] else 0.0)
+            up = path + np.array([0.0, 0.0, lift])
+            out.append(sweep(up, radius=r, cls=ctx.cls, material=ctx.mat, segments=seg, closed=closed))
     return merge(out)
 
 
@@ -99,7 +87,13 @@ def _spaced(p0: np.ndarray, p1: np.ndarray, spacing: float) -> np.ndarray:
 
 
 def railing_mesh(p: RailingPart, ctx: Ctx) -> TriMesh:
-    """Guard rails along the deck edge (or round a rectangle, with ``width``)."""
+    """Guard rails along the deck edge (or round a rectangle, with ``width``), raised by ``lift``; rails alone
+    without ``posts``."""
+    m = _railing(p, ctx)
+    return transformed(m, translation=(0.0, 0.0, p.lift)) if p.lift else m
+
+
+def _railing(p: RailingPart, ctx: Ctx) -> TriMesh:
     hull = ctx.hull
     r = p.radius if p.radius is not None else 0.02 + 0.01 * p.height
     if p.width is not None:
@@ -111,7 +105,7 @@ def railing_mesh(p: RailingPart, ctx: Ctx) -> TriMesh:
             for i in range(4)
         ]
         loop = np.vstack(pts)
-        return _rail_meshes([(loop, True)], loop, height=p.height, rails=p.rails, radius=r, ctx=ctx)
+        return _rail_meshes([(loop, True)], _posts(p, loop), height=p.height, rails=p.rails, radius=r, ctx=ctx)
     half_l = hull.length / 2.0
     x0 = -half_l + max(p.inset, r) + 0.05 if p.x0 is None else p.x0
     x1 = half_l - 0.05 if p.x1 is None else p.x1
@@ -126,7 +120,9 @@ def railing_mesh(p: RailingPart, ctx: Ctx) -> TriMesh:
     sides = _SIDES[p.side]
     if p.side != "both" or not (p.bow or p.stern):
         paths = [(np.column_stack([xs, s * ys, zs]), False) for s in sides]
-        return _rail_meshes(paths, np.vstack([q for q, _ in paths]), height=p.height, rails=p.rails, radius=r, ctx=ctx)
+        return _rail_meshes(
+            paths, _posts(p, np.vstack([q for q, _ in paths])), height=p.height, rails=p.rails, radius=r, ctx=ctx
+        )
     stb = np.column_stack([xs, -ys, zs])
     port = np.column_stack([xs, ys, zs])[::-1]
     post_sets = [stb, port]
@@ -140,7 +136,11 @@ def railing_mesh(p: RailingPart, ctx: Ctx) -> TriMesh:
         paths = [(np.vstack([stb, port]), False)]
     else:
         paths = [(np.vstack([port, stb]), False)]
-    return _rail_meshes(paths, np.vstack(post_sets), height=p.height, rails=p.rails, radius=r, ctx=ctx)
+    return _rail_meshes(paths, _posts(p, np.vstack(post_sets)), height=p.height, rails=p.rails, radius=r, ctx=ctx)
+
+
+def _posts(p: RailingPart, pts: np.ndarray) -> np.ndarray:
+    return pts if p.posts else pts[:0]
 
 
 def containers_mesh(p: ContainersPart, ctx: Ctx) -> TriMesh:
@@ -157,19 +157,28 @@ def containers_mesh(p: ContainersPart, ctx: Ctx) -> TriMesh:
         nt = p.tiers[b % len(p.tiers)]
         xb = p.x0 + b * (lb + p.gap)
         z0 = ctx.base(p.base, xb + lb / 2.0)
-        g = np.stack(np.meshgrid(np.arange(n_long), np.arange(p.rows), np.arange(nt), indexing="ij"), axis=-1).reshape(
-            -1, 3
-        )
+        rows = np.arange(p.rows, dtype=np.float64)
+        if p.fit is not None:
+            room = min(half_width(ctx.hull, xb), half_width(ctx.hull, xb + lb)) - p.fit
+            keep = int((2.0 * room + 0.08) // (cw + 0.08))
+            drop = max(0, p.rows - keep)
+            rows = rows[(drop + 1) // 2 : p.rows - drop // 2] if drop < p.rows else rows[:0]
+            if drop % 2:  # an odd number dropped: shift the bay by half a row to keep it centred
+                rows = rows - 0.5
+        g = np.stack(np.meshgrid(np.arange(n_long), rows, np.arange(nt), indexing="ij"), axis=-1).reshape(-1, 3)
         bay.append(np.full(g.shape[0], b))
         lon.append(g[:, 0])
         row.append(g[:, 1])
         tier.append(g[:, 2])
         base.append(np.full(g.shape[0], z0))
     bi, li, ri, ti, zb = (np.concatenate(a) for a in (bay, lon, row, tier, base))
+    if bi.shape[0] == 0:
+        raise ctx.error("fit", "no container row fits inside the deck outline")
+    bi, li, ti = bi.astype(np.int64), li.astype(np.int64), ti.astype(np.int64)
     cx = p.x0 + bi * (lb + p.gap) + li * (cl + 0.25) + cl / 2.0
     cy = -p.width / 2.0 + cw / 2.0 + ri * (cw + 0.08)
     cz = zb + ti * (ch + 0.03) + ch / 2.0
-    key = (bi.astype(np.uint64) * np.uint64(73856093)) ^ (ri.astype(np.uint64) * np.uint64(19349663))
+    key = (bi.astype(np.uint64) * np.uint64(73856093)) ^ (np.floor(ri * 2).astype(np.uint64) * np.uint64(19349663))
     key ^= ti.astype(np.uint64) * np.uint64(83492791)
     key ^= li.astype(np.uint64) * np.uint64(2654435761)
     key ^= np.uint64(p.seed) * np.uint64(97531)

@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from mmusv.world.hull_form import half_width, side_half_width
+from mmusv.world.hull_form import half_width, half_widths, side_half_width
 from mmusv.world.materials import material_id
 from mmusv.world.part_context import Ctx, block
 from mmusv.world.part_spec import (
@@ -55,6 +55,7 @@ def window_panes(
     height: float,
     cls: int,
     round_: bool = False,
+    pane: int | None = None,
 ) -> TriMesh:
     """Windows centred on a wall at ``centers`` ``(N, 3)``, the wall's outward normal at angle ``yaw + 90°``
     (``yaw`` ``(N,)`` radians is the wall's direction): a frame proud of the wall and raised glass inside it."""
@@ -65,7 +66,8 @@ def window_panes(
     yw = np.broadcast_to(np.asarray(yaw, dtype=np.float64).reshape(-1), (n,))
     frame = min(0.08, 0.12 * min(width, height))
     d = min(0.06, 0.25 * min(width, height))
-    glass, alu = material_id(_GLASS), material_id(_FRAME)
+    glass = material_id(_GLASS) if pane is None else pane
+    alu = material_id(_FRAME)
     if round_:
         normal = np.column_stack([-np.sin(yw), np.cos(yw), np.zeros(n)])
         r = width / 2.0
@@ -81,6 +83,12 @@ def window_panes(
             boxes(centers=c, sizes=(width, 2.2 * d, height), cls=cls, material=glass, yaw=yw),
         ]
     )
+
+
+def _footprint_y(beam: float, width: float, height: float) -> float:
+    """The largest wall ``|y|`` at which a window of that size stays inside the beam (it stands proud of the wall)."""
+    d = min(0.06, 0.25 * min(width, height))
+    return beam / 2.0 - 2.0 * d - 1e-6
 
 
 def _slots(length: float, pitch: float, width: float) -> np.ndarray:
@@ -101,8 +109,10 @@ def _block_windows(
     spec: tuple[float, ...],
     cls: int,
     bridge: bool,
+    half_length: float,
 ) -> TriMesh:
-    """A window band round the four walls of a block (``bridge``: a continuous band of tall windows in front)."""
+    """A window band round the four walls of a block (``bridge``: a continuous band of tall windows in front);
+    an end wall within a window's depth of the hull's ends (``half_length``) gets none."""
     w, h, pitch = spec
     hgt = z1 - z0
     h = min(h, 0.5 * hgt)
@@ -116,12 +126,12 @@ def _block_windows(
         xs = x + _slots(2 * hx, pitch, w)
         centers.append(np.column_stack([xs, np.full_like(xs, y + sgn * hy), np.full_like(xs, zc)]))
         yaws.append(np.full(xs.shape[0], 0.0 if sgn > 0 else math.pi))
-        if not (bridge and sgn > 0):
+        if not (bridge and sgn > 0) and abs(x + sgn * hx) + 0.2 <= half_length:
             ys = y + _slots(2 * hy, pitch, w)
             centers.append(np.column_stack([np.full_like(ys, x + sgn * hx), ys, np.full_like(ys, zc)]))
             yaws.append(np.full(ys.shape[0], -math.pi / 2.0 if sgn > 0 else math.pi / 2.0))
     out = [window_panes(centers=np.vstack(centers), yaw=np.concatenate(yaws), width=w, height=h, cls=cls)]
-    if bridge:
+    if bridge and abs(x + hx) + 0.2 <= half_length:
         bp = max(0.9, 0.55 * pitch)
         ys = y + _slots(2 * hy, bp, 0.85 * bp)
         c = np.column_stack([np.full_like(ys, x + hx), ys, np.full_like(ys, z0 + 0.6 * hgt)])
@@ -150,7 +160,19 @@ def box_mesh(p: BoxPart, ctx: Ctx) -> TriMesh:
         return body
     if p.yaw_deg != 0.0:
         raise ctx.error("windows", "windows need an unturned box (yaw_deg 0)")
-    win = _block_windows(x=x, y=y, lx=lx, ly=ly, z0=z0, z1=z1, taper=p.taper, spec=p.windows, cls=ctx.cls, bridge=False)
+    win = _block_windows(
+        x=x,
+        y=y,
+        lx=lx,
+        ly=ly,
+        z0=z0,
+        z1=z1,
+        taper=p.taper,
+        spec=p.windows,
+        cls=ctx.cls,
+        bridge=False,
+        half_length=ctx.hull.length / 2.0,
+    )
     return merge([body, win])
 
 
@@ -180,6 +202,7 @@ def house_mesh(p: HousePart, ctx: Ctx) -> TriMesh:
                     spec=p.windows,
                     cls=ctx.cls,
                     bridge=k == n - 1,
+                    half_length=ctx.hull.length / 2.0,
                 )
             )
         z += h
@@ -208,15 +231,24 @@ def windows_mesh(p: WindowsPart, ctx: Ctx) -> TriMesh:
                 yy = side_half_width(hull, xs, zz) - p.inset
                 ahead = side_half_width(hull, xs + 0.1, zz) - p.inset
             else:
-                yy = np.array([half_width(hull, float(v)) for v in xs]) - p.inset
-                ahead = np.array([half_width(hull, float(v) + 0.1) for v in xs]) - p.inset
+                yy = half_widths(hull, xs) - p.inset
+                ahead = half_widths(hull, xs + 0.1) - p.inset
             ang = np.arctan2(ahead - yy, 0.1)
+        yy = np.minimum(yy, _footprint_y(hull.beam, p.width, p.height) - (p.width / 2.0 + 0.08) * np.abs(np.sin(ang)))
         ok = yy > p.width
         for s in sides:
             c = np.column_stack([xs[ok], s * yy[ok], zz[ok]])
             yaw = s * ang[ok] + (0.0 if s > 0 else math.pi)
             out.append(
-                window_panes(centers=c, yaw=yaw, width=p.width, height=p.height, cls=ctx.cls, round_=p.shape == "round")
+                window_panes(
+                    centers=c,
+                    yaw=yaw,
+                    width=p.width,
+                    height=p.height,
+                    cls=ctx.cls,
+                    round_=p.shape == "round",
+                    pane=ctx.mat,
+                )
             )
     if not out or sum(m.num_triangles for m in out) == 0:
         raise ctx.error("x0", "no window fits between x0 and x1")
@@ -474,10 +506,11 @@ def crane_mesh(p: CranePart, ctx: Ctx) -> TriMesh:
     up = np.cross(side, d)
     nb = int(min(16, max(4, jl / (2.0 * w))))
     t = np.linspace(0.0, 1.0, nb + 1)
-    half = (w / 2.0) * (1.0 - 0.55 * t)[:, None]
-    axis = p0 + t[:, None] * jl * d
-    corners = [axis + half * (sa * side + sb * up) for sa, sb in ((1, 1), (-1, 1), (-1, -1), (1, -1))]
     rc = max(0.08 * w, 0.02)
+    half_side = (w / 2.0) * (1.0 - 0.55 * t)[:, None]  # the jib narrows in plan towards its tip
+    half_up = w / 2.0 - rc  # and keeps its depth, so its top stays that of a w x w box
+    axis = p0 + t[:, None] * jl * d
+    corners = [axis + sa * half_side * side + sb * half_up * up for sa, sb in ((1, 1), (-1, 1), (-1, -1), (1, -1))]
     chords = tubes(
         starts=np.vstack([c[:-1] for c in corners]),
         ends=np.vstack([c[1:] for c in corners]),

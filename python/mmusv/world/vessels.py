@@ -181,7 +181,9 @@ class VesselAsset:
         for a in (v, fc, c, mat):
             a.setflags(write=False)
         mesh = TriMesh(v, fc, c, mat)
-        lo, hi = v[fc.reshape(-1)].min(axis=0), v[fc.reshape(-1)].max(axis=0)
+        used = np.zeros(v.shape[0], dtype=bool)
+        used[fc.reshape(-1)] = True
+        lo, hi = v[used].min(axis=0), v[used].max(axis=0)
         ext = hi - lo
         centre = (lo[:2] + hi[:2]) / 2.0
         if np.any(np.abs(centre) > 1e-6 * max(1.0, float(ext.max()))):
