@@ -36,8 +36,8 @@ def _cmd_assets(args: argparse.Namespace) -> int:
     from mmusv.world.vessels import library
 
     table = Table(title="mmusv vessel library")
-    for col in ("name", "category", "class", "length m", "beam m", "height m", "draft m", "triangles"):
-        table.add_column(col, justify="right" if col.endswith(("m", "triangles")) else "left")
+    for col in ("name", "category", "class", "length m", "beam m", "height m", "draft m", "triangles", "parts"):
+        table.add_column(col, justify="right" if col.endswith(("m", "triangles", "parts")) else "left")
     for a in library():
         table.add_row(
             a.name,
@@ -48,8 +48,13 @@ def _cmd_assets(args: argparse.Namespace) -> int:
             f"{a.height:.1f}",
             f"{a.draft:.1f}",
             str(a.num_triangles),
+            str(a.num_parts),
         )
     _console().print(table)
+    if args.render is not None:  # one close-up per asset and a contact sheet of them all
+        from mmusv.world.contact_sheet import write_contact_sheet
+
+        _console().print(f"wrote {write_contact_sheet(args.render)}")
     return 0
 
 
@@ -318,7 +323,8 @@ def _parser() -> argparse.ArgumentParser:
     )
     sub = p.add_subparsers(dest="command", required=True)
     sub.add_parser("version", help="print the version")
-    sub.add_parser("assets", help="list the vessel library")
+    p_assets = sub.add_parser("assets", help="list the vessel library")
+    p_assets.add_argument("--render", metavar="DIR", help="also write a close-up PNG per asset and contact_sheet.png")
     sub.add_parser("scenarios", help="list the bundled scenarios (mmusv run NAME runs one from any directory)")
     study = sub.add_parser("study", help="reproduce the paper's experiments")
     studies = study.add_subparsers(dest="study", required=True)

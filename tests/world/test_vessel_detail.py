@@ -235,3 +235,16 @@ def test_contact_sheet_grid_labels_and_determinism(tmp_path: Path) -> None:
     again = write_contact_sheet(tmp_path / "b", names=names, tile=(80, 60), asset_size=(96, 72))
     assert again.read_bytes() == path.read_bytes()
     assert sheet_layout(37, (1, 1)).cols == 7 and sheet_layout(37, (1, 1)).rows == 6
+
+
+def test_cli_assets_lists_parts_and_render_names_a_bad_folder(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from mmusv.cli import main
+
+    afile = tmp_path / "a_file"
+    afile.write_text("x")
+    assert main(["assets", "--render", str(afile)]) == 2
+    out, err = capsys.readouterr()
+    assert "parts" in out and "mmusv: error: --render:" in err and "is a file, not a folder" in err
+    assert not list(tmp_path.glob("*.png"))

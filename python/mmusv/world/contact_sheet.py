@@ -60,22 +60,26 @@ def sheet_layout(n: int, tile: tuple[int, int]) -> SheetLayout:
 
 def camera_pose(bbox: np.ndarray, *, size: tuple[int, int], hfov_deg: float = _HFOV_DEG) -> np.ndarray:
     """``(4, 4)`` camera body → asset frame pose looking at the centre of ``bbox`` ``(2, 3)`` (metres) from the
-    three-quarter view, far enough that the bounding sphere fits the narrower field of view."""
+    three-quarter view, as close as keeps all eight corners of the box inside the picture (5 % margin)."""
     lo, hi = np.asarray(bbox, dtype=np.float64)
     centre = (lo + hi) / 2.0
-    radius = float(np.linalg.norm(hi - lo)) / 2.0
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
     w, h = size
-    half_h = math.atan(math.tan(math.radians(hfov_deg) / 2.0) * h / w)
-    half = min(math.radians(hfov_deg) / 2.0, half_h)
-    dist = 1.02 * radius / math.sin(half)
+    tan_h = math.tan(math.radians(hfov_deg) / 2.0) * 0.95
+    tan_v = tan_h * h / w
     az, el = math.radians(_AZIMUTH_DEG), math.radians(_ELEVATION_DEG)
-    eye = centre + dist * np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)])
-    fwd = (centre - eye) / np.linalg.norm(centre - eye)
+    back = np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)])
+    fwd = -back
     left = np.cross([0.0, 0.0, 1.0], fwd)
     left /= np.linalg.norm(left)
     up = np.cross(fwd, left)
+    rel = corners - centre
+    # corner k at distance d: depth d + rel.fwd, sideways rel.left, up rel.up; the closest d that fits them all
+    depth0, side, rise = rel @ fwd, np.abs(rel @ left), np.abs(rel @ up)
+    dist = float(np.max(np.maximum(side / tan_h, rise / tan_v) - depth0))
+    dist = max(dist, float(np.max(-depth0)) + 1e-3)
     pose = np.eye(4)
-    pose[:3, 0], pose[:3, 1], pose[:3, 2], pose[:3, 3] = fwd, left, up, eye
+    pose[:3, 0], pose[:3, 1], pose[:3, 2], pose[:3, 3] = fwd, left, up, centre + dist * back
     return pose
 
 
