@@ -236,3 +236,22 @@ def test_gltf_pbr_materials_come_through_per_face(tmp_path: Path) -> None:
     assert mb.emissive[2] > 0 and ma.emissive == (0.0, 0.0, 0.0)
     again = load_asset_file({"name": "two_boxes", "mesh": str(path), "waterline_z": 0.0})
     assert np.array_equal(again.mesh.materials, mesh.materials)  # the same materials, the same ids
+
+
+def test_gltf_base_colour_texture_mean_is_taken_in_linear_rgb(tmp_path: Path) -> None:
+    trimesh = pytest.importorskip("trimesh")
+    from PIL import Image
+    from trimesh.visual.material import PBRMaterial
+
+    img = Image.fromarray(np.array([[[255, 0, 0], [0, 0, 188]]], dtype=np.uint8))  # sRGB red and a darker blue
+    b = trimesh.creation.box(extents=(2.0, 1.0, 1.0))
+    uv = (b.vertices[:, :2] - b.vertices[:, :2].min(axis=0)) / np.ptp(b.vertices[:, :2], axis=0)
+    mat = PBRMaterial(name="textured", baseColorFactor=[1.0, 0.5, 1.0, 1.0], baseColorTexture=img)
+    b.visual = trimesh.visual.TextureVisuals(uv=uv, material=mat)
+    path = tmp_path / "tex.glb"
+    path.write_bytes(trimesh.Scene([b]).export(file_type="glb"))
+    a = load_asset_file({"name": "tex_box", "mesh": str(path)})
+    m = all_materials()[int(a.mesh.materials[0])]
+    # sRGB 188/255 decodes to ((188/255 + 0.055) / 1.055) ** 2.4 linear; the mean of the two pixels, times the factor
+    blue = ((188 / 255 + 0.055) / 1.055) ** 2.4
+    np.testing.assert_allclose(m.base_color, [0.5 * 1.0, 0.0, 0.5 * blue], atol=1e-6)
