@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable
-from typing import Protocol
+from typing import Any, Protocol
 
 from mmusv.batch.plan import Task
 from mmusv.batch.task import TaskResult, execute, lost
@@ -105,11 +105,15 @@ def _init_worker(threads: int | None, driver_pid: int) -> None:
 
 _IN_TASK = False
 """True in a pool worker while it runs a task."""
+_STOPPING = False
+"""True in a pool worker once it was told to stop: it starts no further task (one may already be queued)."""
 
 
 def _execute(task: Task) -> TaskResult:
     """:func:`~mmusv.batch.task.execute` in a pool worker, marked as running (for :func:`_stop`)."""
     global _IN_TASK
+    if _STOPPING:
+        raise KeyboardInterrupt
     _IN_TASK = True
     try:
         return execute(task)
@@ -119,10 +123,34 @@ def _execute(task: Task) -> TaskResult:
 
 def _stop(signum: int, frame: object) -> None:
     """SIGTERM or SIGINT in a pool worker: a running task finishes its recording as interrupted (raised as
-    ``KeyboardInterrupt`` inside it); an idle worker just exits (no traceback)."""
+    ``KeyboardInterrupt`` inside it) and no further task starts; an idle worker just exits (no traceback)."""
+    global _STOPPING
+    _STOPPING = True
     if _IN_TASK:
         raise KeyboardInterrupt
     os._exit(128 + signum)
+
+
+def _reap(procs: list[Any]) -> None:
+    """Stops pool workers: SIGTERM (a running task finishes its recording as interrupted), again every second
+    (a worker idle by then exits at once), SIGKILL after :data:`_REAP_S`; every worker is joined (reaped)."""
+    import time
+
+    deadline = time.monotonic() + _REAP_S
+    while True:
+        alive = [p for p in procs if p.is_alive()]
+        if not alive:
+            return
+        if time.monotonic() > deadline:
+            for p in alive:
+                p.kill()
+            for p in alive:
+                p.join(timeout=5)
+            return
+        for p in alive:
+            p.terminate()
+        for p in alive:
+            p.join(timeout=max(0.0, min(1.0, deadline - time.monotonic())))
 
 
 class PoolExecutor:
@@ -195,13 +223,7 @@ class PoolExecutor:
             if cancel:  # stop now: each worker finishes its recording as interrupted (SIGTERM), then is reaped
                 procs = list(getattr(self._pool, "_processes", {}).values())
                 self._pool.shutdown(wait=False, cancel_futures=True)
-                for p in procs:
-                    p.terminate()
-                for p in procs:
-                    p.join(timeout=_REAP_S)
-                    if p.is_alive():
-                        p.kill()
-                        p.join(timeout=_REAP_S)
+                _reap(procs)
             else:
                 self._pool.shutdown(wait=True)
             self._pool = None

@@ -33,6 +33,7 @@ import yaml
 from mmusv.errors import ConfigError, IoError
 from mmusv.recording.parts import is_parts_manifest, read_parts_manifest
 from mmusv.recording.scan import Scan
+from mmusv.recording.topics import WORLD_STATE
 
 __all__ = [
     "MCAP_MAGIC",
@@ -385,6 +386,16 @@ def _ranges(frames: Sequence[int]) -> str:
     return ", ".join(out)
 
 
+@dataclass
+class _Open:
+    """A frame being read: its topics so far, whether it borders damaged bytes, why it is unusable (or None)."""
+
+    frame: Frame
+    suspect: bool = False
+    topics: set[str] = field(default_factory=set)
+    bad: str | None = None
+
+
 class FrameStream:
     """Iterates the frames of a recording once (see the module docstring).
 
@@ -454,10 +465,9 @@ class FrameStream:
         scan = Scan(path)
         lost: list[tuple[int, int]] = []  # log times of damaged chunks
         reference: set[str] = set()  # topics of the intact frames so far
-        cur: Frame | None = None
-        topics: set[str] = set()
-        suspect = after_damage = False
-        bad: str | None = None
+        pending: list[_Open] = []  # frames next to damage, waiting for an intact frame to compare with
+        cur: _Open | None = None
+        after_damage = False
         try:
             for msg, dmg in scan.messages():
                 if dmg is not None:
@@ -465,30 +475,33 @@ class FrameStream:
                     self._note(f"{where} is truncated: {text}" if dmg.truncated else f"{where} is damaged at {text}")
                     if dmg.times is not None:
                         lost.append(dmg.times)
-                    suspect = suspect or cur is not None
+                    if cur is not None:
+                        cur.suspect = True
                     after_damage = True
                     continue
-                if cur is None or msg.log_time != cur.log_time_ns:
+                if cur is None or msg.log_time != cur.frame.log_time_ns:
                     if cur is not None:
-                        done = self._close(cur, topics, suspect, bad, lost, reference, scan, seen)
-                        if done is not None:
-                            yield done
-                    cur = Frame(index=-1, log_time_ns=msg.log_time, world=None)
-                    topics, suspect, bad, after_damage = set(), after_damage, None, False
+                        yield from self._close(cur, pending, lost, reference, scan, seen, final=False)
+                    cur = _Open(Frame(index=-1, log_time_ns=msg.log_time, world=None), suspect=after_damage)
+                    after_damage = False
                 ch = scan.channels.get(msg.channel_id)
                 self.messages += 1
                 self.start_ns = msg.log_time if self.start_ns < 0 else min(self.start_ns, msg.log_time)
                 self.end_ns = max(self.end_ns, msg.log_time)
                 if ch is None:
-                    bad = bad or f"a message on channel {msg.channel_id}, whose definition was in a damaged chunk"
+                    cur.bad = (
+                        cur.bad or f"a message on channel {msg.channel_id}, whose definition was in a damaged chunk"
+                    )
                     continue
                 topic = ch.topic
                 self.topic_counts[topic] = self.topic_counts.get(topic, 0) + 1
                 if topic not in self.topic_schemas:
                     schema = scan.schemas.get(ch.schema_id)
                     self.topic_schemas[topic] = ("" if schema is None else schema.name, ch.message_encoding)
-                topics.add(topic)
-                if topic != "/world/state" and not self.want(topic):
+                if topic in cur.topics:
+                    cur.bad = cur.bad or f"it holds two {topic} messages"
+                cur.topics.add(topic)
+                if topic != WORLD_STATE and not self.want(topic):
                     continue
                 try:
                     if msg.channel_id not in decoders:
@@ -499,16 +512,16 @@ class FrameStream:
                     if dec is None:
                         continue
                     decoded = dec(msg.data)
-                    if topic == "/world/state":
-                        cur.world = WorldFrame.from_message(decoded)
+                    if topic == WORLD_STATE:
+                        cur.frame.world = WorldFrame.from_message(decoded)
                 except Exception as exc:  # a message whose bytes do not decode: the frame is not usable
-                    bad = bad or f"its {topic} message does not decode ({type(exc).__name__})"
+                    cur.bad = cur.bad or f"its {topic} message does not decode ({type(exc).__name__})"
                     continue
-                cur.messages[topic] = decoded
+                cur.frame.messages[topic] = decoded
             if cur is not None:
-                done = self._close(cur, topics, suspect, bad, lost, reference, scan, seen)
-                if done is not None:
-                    yield done
+                yield from self._close(cur, pending, lost, reference, scan, seen, final=True)
+            elif pending:
+                yield from self._flush(pending, lost, reference, scan, seen)
         except OSError as exc:
             raise IoError(f"{path} cannot be read: {exc.strerror or exc}") from None
         if scan.damage or not scan.complete:
@@ -524,32 +537,64 @@ class FrameStream:
 
     def _close(
         self,
-        fr: Frame,
-        topics: set[str],
-        suspect: bool,
-        bad: str | None,
+        op: _Open,
+        pending: list[_Open],
         lost: list[tuple[int, int]],
         reference: set[str],
         scan: Scan,
         seen: set[int],
-    ) -> Frame | None:
-        fr.index = self._index(fr.log_time_ns, fr.world)
-        t = fr.log_time_ns
-        why = bad
-        if why is None and any(a <= t <= b for a, b in lost):
-            why = "some of its messages were in a damaged chunk"
-        if why is None and suspect:
+        *,
+        final: bool,
+    ) -> Iterator[Frame]:
+        """Yields the frames decided by closing ``op``: a frame next to damage waits (in ``pending``) until an
+        intact frame says which topics a frame has; an intact frame settles the waiting ones, then itself."""
+        if op.suspect and not reference and not final:
+            pending.append(op)
+            return
+        if not op.suspect:
+            why = self._why(op, lost, reference, scan)
+            if why is None:
+                reference |= op.topics
+            yield from self._flush(pending, lost, reference, scan, seen)
+            if why is None:
+                yield self._accept(op.frame, seen)
+            else:
+                self.incomplete.append((self._index(op.frame.log_time_ns, op.frame.world), why))
+            return
+        pending.append(op)
+        yield from self._flush(pending, lost, reference, scan, seen)
+
+    def _flush(
+        self, pending: list[_Open], lost: list[tuple[int, int]], reference: set[str], scan: Scan, seen: set[int]
+    ) -> Iterator[Frame]:
+        for op in pending:
+            why = self._why(op, lost, reference, scan)
+            if why is None:
+                yield self._accept(op.frame, seen)
+            else:
+                self.incomplete.append((self._index(op.frame.log_time_ns, op.frame.world), why))
+        pending.clear()
+
+    def _why(self, op: _Open, lost: list[tuple[int, int]], reference: set[str], scan: Scan) -> str | None:
+        """Why the frame of ``op`` is incomplete, or None."""
+        t = op.frame.log_time_ns
+        if op.bad is not None:
+            return op.bad
+        if op.frame.world is None:
+            return f"it has no {WORLD_STATE} message"
+        if any(a <= t <= b for a, b in lost):
+            return "some of its messages were in a damaged chunk"
+        if op.suspect:
             expected = reference or {c.topic for c in scan.channels.values()}
-            gone = sorted(expected - topics)
+            gone = sorted(expected - op.topics)
             if gone:
-                why = f"it borders damaged bytes and lacks {', '.join(gone[:3])}" + (
+                return f"it borders damaged bytes and lacks {', '.join(gone[:3])}" + (
                     f" and {len(gone) - 3} more" if len(gone) > 3 else ""
                 )
-        if why is not None:
-            self.incomplete.append((fr.index, why))
-            return None
-        if not suspect:
-            reference |= topics
+        return None
+
+    def _accept(self, fr: Frame, seen: set[int]) -> Frame:
+        fr.index = self._index(fr.log_time_ns, fr.world)
         if fr.index in seen:
             self.out_of_order.append(fr.index)
         seen.add(fr.index)
