@@ -1,0 +1,101 @@
+"""Damaged Parquet table parts and parts manifests: the damage is named (file and why), the frames it costs are
+listed, everything else is read; ``mmusv recover`` rebuilds the tables from the recording."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import polars as pl
+import pytest
+from mmusv.errors import IoError, MmusvError
+
+from .conftest import api_readers, check_against, cli_main, frames_of, scenario, write_yaml
+
+
+@pytest.fixture(scope="module")
+def parted(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A 12-frame run whose tables are flushed every 4 frames (3 parts per table)."""
+    import mmusv.acquire
+    from mmusv.acquire import run
+
+    base = tmp_path_factory.mktemp("parted")
+    mp = pytest.MonkeyPatch()
+    mp.setattr(mmusv.acquire, "TABLE_PART_FRAMES", 4)
+    try:
+        run(scenario("tiny", frames=12), out_dir=base / "run")
+    finally:
+        mp.undo()
+    assert len(list((base / "run/tables/world_state").glob("part-*.parquet"))) == 3
+    return base / "run"
+
+
+def test_a_damaged_parquet_part_is_named_and_its_frames_listed(parted: Path, tmp_path: Path) -> None:
+    from mmusv.recording.recover import rebuild_tables
+    from mmusv.recording.tables import read_table
+
+    folder = tmp_path / "run"
+    shutil.copytree(parted, folder)
+    part = folder / "tables/world_state/part-00001.parquet"
+    data = part.read_bytes()
+    part.write_bytes(data[: len(data) // 2])  # a torn write
+    got = read_table(folder / "tables", "world_state", expected=range(12))
+    assert len(got.damaged) == 1 and str(part) in got.damaged[0] and "not a readable Parquet file" in got.damaged[0]
+    assert got.missing == [4, 5, 6, 7]
+    assert sorted(set(got.rows["frame"].to_list())) == [0, 1, 2, 3, 8, 9, 10, 11]
+    code, out, err = cli_main("info", str(folder))
+    assert code == 0 and "Traceback" not in err
+    assert f"{part}" in out.replace("\n", "") or "part-00001.parquet" in out, out
+    assert "frames 4..7 have no world_state rows" in out.replace("\n", " ")
+    # the tables are rebuilt from the recording: the same rows as the run wrote
+    original = pl.read_parquet(parted / "tables/world_state/*.parquet")
+    import mmusv.acquire
+
+    mp = pytest.MonkeyPatch()
+    mp.setattr(mmusv.acquire, "TABLE_PART_FRAMES", 4)
+    try:
+        stream = rebuild_tables(folder / "tiny.mcap", folder / "tables")
+    finally:
+        mp.undo()
+    assert stream.report() is None
+    for table in ("world_state", "boxes_3d"):
+        for name in ("part-00000.parquet", "part-00001.parquet", "part-00002.parquet"):
+            a, b = parted / "tables" / table / name, folder / "tables" / table / name
+            if a.exists():
+                assert pl.read_parquet(a).equals(pl.read_parquet(b)), (table, name)
+    assert read_table(folder / "tables", "world_state", expected=range(12)).rows.equals(original)
+
+
+def test_a_parts_manifest_naming_a_missing_part(tmp_path: Path) -> None:
+    from mmusv.batch import run_many
+    from mmusv.recording.reader import summary
+
+    src = tmp_path / "src"
+    write_yaml(src / "tiny.yaml", scenario("tiny", frames=12))
+    rep = run_many(src, out_dir=tmp_path / "out", split_frames=4)
+    assert rep.ok
+    manifest = tmp_path / "out/tiny/tiny.parts.json"
+    whole, _ = frames_of(manifest)
+    assert sorted(whole) == list(range(12))
+    shutil.rmtree(tmp_path / "out/tiny/parts/000004-000007")
+    results = api_readers(manifest)
+    check_against(results, whole)
+    frames, stream = results["frames"]
+    assert sorted(frames) == [0, 1, 2, 3, 8, 9, 10, 11]
+    assert stream.missing() == [4, 5, 6, 7]
+    assert "part 4..7 (frames 4..7) is not recorded" in str(stream.report())
+    s = summary(manifest)
+    assert not s["complete"] and s["frames"]["missing"] == [4, 5, 6, 7]
+    code, out, err = cli_main("info", str(manifest))
+    assert code == 0 and "mmusv: warning:" in out and "4..7" in out, out
+    with pytest.raises(MmusvError, match="not recorded"):
+        from mmusv.recording.reader import frame_messages
+
+        frame_messages(manifest, 5)
+    # a manifest that is not JSON, or names a part outside its folder: one line naming the file
+    manifest.write_text('{"format": "mmusv.parts", "version": 1, "parts": [', encoding="utf-8")
+    for call in (lambda: summary(manifest), lambda: frames_of(manifest)):
+        with pytest.raises(IoError, match=r"tiny\.parts\.json"):
+            call()
+    code, _out, err = cli_main("info", str(manifest))
+    assert code == 2 and err.startswith("mmusv: error: ") and "tiny.parts.json" in err and err.count("\n") == 1
