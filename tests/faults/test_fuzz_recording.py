@@ -90,6 +90,7 @@ def test_mutated_recordings_give_a_clean_error_or_the_right_frames(
     )
     @given(ops=mutations(len(data)))
     @example(ops=[("delete", 2179, 1, b"")])  # found by the long run: the first chunk's channels lost with it
+    @example(ops=[("duplicate", 1142, 61, b""), ("cut", 3154, 1, b"")])  # metadata garbled but parseable
     def check(ops: list[tuple[str, int, int, bytes]]) -> None:
         path.write_bytes(mutate(data, ops))
         with time_limit(TIME_LIMIT_S):

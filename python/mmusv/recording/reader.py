@@ -21,6 +21,7 @@ frames are missing, as those of an interrupted run); :func:`recording_name` is t
 from __future__ import annotations
 
 import json
+import math
 import os
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
@@ -355,6 +356,10 @@ def _info(p: Path, meta: dict[str, dict[str, str]], has_summary: bool) -> Record
         )
     agents.sort(key=lambda a: a.index)
     seed = manifest.get("seed", scenario.get("seed"))
+    frequency = float(run.get("frequency_hz", acq.get("frequency_hz", 0.0)) or acq.get("frequency_hz", 0.0))
+    frames = int(run.get("frames_configured", acq.get("frames", 0)) or 0)
+    if not (math.isfinite(frequency) and frequency > 0 and frames > 0):  # damaged metadata, not a run's
+        raise ValueError(f"acquisition frequency_hz = {frequency}, frames = {frames}")
     return RecordingInfo(
         path=p,
         scenario_name=str(meta["scenario"].get("name", scenario.get("name", p.stem))),
@@ -362,8 +367,8 @@ def _info(p: Path, meta: dict[str, dict[str, str]], has_summary: bool) -> Record
         config_hash=str(manifest.get("config_hash", "")),
         seed=None if seed in (None, "None") else int(seed),
         mmusv_version=str(manifest.get("mmusv_version", "")),
-        frequency_hz=float(run.get("frequency_hz", acq.get("frequency_hz", 0.0)) or acq.get("frequency_hz", 0.0)),
-        frames_configured=int(run.get("frames_configured", acq.get("frames", 0)) or 0),
+        frequency_hz=frequency,
+        frames_configured=frames,
         agents=agents,
         run=dict(run),
         has_summary=has_summary,

@@ -11,7 +11,8 @@ shrinks under a reader must not crash it) and never trusts a length it has not c
   searching forward for the next record that checks out in full (a chunk, metadata, a message index or the data
   end, each with lengths that agree with each other); the bytes in between are one damaged region;
 - a file that ends inside a record (a killed writer, a ``.partial`` file, a truncated copy) yields everything
-  before that record and reports where it ends;
+  before that record and reports where it ends; the chunk the recorder was writing when it was killed (its length
+  still the placeholder ``2**64 - 1``) is read as far as its zstd stream and records are complete;
 - the data section's CRC (in the data end record) is checked as well, so damage outside the chunks (metadata,
   message indexes) is reported too.
 
@@ -57,6 +58,9 @@ _NAMES = {
     _DATA_END: "data end",
 }
 _BLOCK = 1 << 20
+_OPEN = (1 << 64) - 1
+"""The length of a chunk record while the ``mcap`` crate (the core's recorder) still writes it: the record is
+streamed to the file and its lengths, times and CRC are filled in when the chunk is closed."""
 
 
 class _Bad(Exception):
@@ -331,6 +335,19 @@ class Scan:
                 return
             op, n = head[0], _u64(head, 1)
             end = pos + 9 + n
+            if op == _CHUNK and n == _OPEN and self.chunks:  # the chunk being written when the writer stopped
+                for rec in self._open_chunk(f, pos):
+                    yield rec, None
+                d = Damage(
+                    pos,
+                    size,
+                    "the file ends inside the chunk that was being written (a killed writer): its complete records "
+                    "were read, without a CRC to check them against",
+                    truncated=True,
+                )
+                self.damage.append(d)
+                yield None, d
+                return
             if op not in _NAMES or end > size:
                 nxt = self._resync(f, pos + 1)
                 if nxt is None and op in _NAMES:
@@ -444,6 +461,58 @@ class Scan:
             elif op == _FOOTER:  # a footer without a data end: the data section ends here
                 return
             pos = end
+
+    def _open_chunk(self, f: IO[bytes], pos: int) -> list[Any]:
+        """The complete messages of a chunk whose writer was killed (see :data:`_OPEN`): its zstd stream
+        decompressed as far as it goes (at most :data:`MAX_CHUNK_BYTES`), its records read up to the first one cut
+        off; schemas and channels are taken in as they come."""
+        f.seek(pos + 9)
+        body = f.read(self.size - pos - 9)
+        if len(body) < 40:
+            return []
+        clen = _u32(body, 28)
+        if clen > 16 or len(body) < 40 + clen:
+            return []
+        comp, data = body[32 : 32 + clen], body[40 + clen :]
+        raw = b""
+        if comp == b"zstd":
+            import zstandard
+
+            pieces: list[bytes] = []
+            got = 0
+            try:
+                with zstandard.ZstdDecompressor().stream_reader(io.BytesIO(data), read_across_frames=True) as r:
+                    while got < MAX_CHUNK_BYTES:
+                        piece = r.read(1 << 16)
+                        if not piece:
+                            break
+                        pieces.append(piece)
+                        got += len(piece)
+            except zstandard.ZstdError:
+                pass  # the stream ends where the writer stopped: keep what decoded
+            raw = b"".join(pieces)
+        elif comp == b"":
+            raw = data
+        out: list[Any] = []
+        at = 0
+        while at + 9 <= len(raw):
+            op, n = raw[at], _u64(raw, at + 1)
+            if at + 9 + n > len(raw):
+                break
+            rec: Any = None
+            try:
+                if op in (_SCHEMA, _CHANNEL, _MESSAGE):
+                    rec = _read_record(op, raw[at + 9 : at + 9 + n])
+            except _Bad:
+                break
+            if op == _SCHEMA:
+                self.schemas[rec.id] = rec
+            elif op == _CHANNEL:
+                self.channels[rec.id] = rec
+            elif op == _MESSAGE:
+                out.append(rec)
+            at += 9 + n
+        return out
 
     def _footer(self, f: IO[bytes]) -> None:
         size = self.size
