@@ -123,9 +123,9 @@ class ScenarioFolder:
                 now = self.etag_of(name)
                 if now is not None and now != if_match:
                     raise ChangedInFolder(
-                        f"{name} was changed since you opened it (another tab or program saved it); not saved, "
-                        "so neither edit is lost: open it again to see the other version, save under another "
-                        "name, or overwrite it"
+                        f"{name} was changed since you opened it (another tab or program saved it), so neither "
+                        "edit is lost: open it again to see the other version, save under another name, or "
+                        "overwrite it"
                     )
             fd, tmp = tempfile.mkstemp(dir=self.root, prefix=".mmusv-editor-", suffix=".tmp")
             try:
