@@ -17,7 +17,10 @@ from mmusv.world.materials import material_id
 from mmusv.world.part_spec import DEFAULT_MATERIALS, PartSpec
 from mmusv.world.primitives import TriMesh, box, prism
 
-__all__ = ["Ctx", "block", "material_of"]
+__all__ = ["MAX_PIECES", "Ctx", "block", "material_of"]
+
+MAX_PIECES = 20000
+"""The most repeated pieces (stanchions, windows, containers, supports, ...) one part may make."""
 
 
 def material_of(part: PartSpec, hull: HullSpec) -> int:
@@ -61,6 +64,12 @@ class Ctx:
         if room <= 0.0:
             raise AssetSpecError(f"{self.where}.fit", f"no room inside the deck outline between x={x0:g} and x={x1:g}")
         return min(width, 2.0 * room)
+
+    def count(self, n: float, key: str, what: str) -> int:
+        """``n`` as the number of pieces a part makes, checked against :data:`MAX_PIECES` (an error at ``key``)."""
+        if not n <= MAX_PIECES:  # also catches nan
+            raise self.error(key, f"would make {n:.3g} {what}; at most {MAX_PIECES} per part")
+        return int(n)
 
     def error(self, key: str, message: str) -> AssetSpecError:
         """An :class:`AssetSpecError` at ``<where>.<key>``."""

@@ -85,6 +85,9 @@ MaterialName = Annotated[str, BeforeValidator(_material_name)]
 Side = Literal["both", "port", "starboard"]
 """Which side of the vessel a sided part goes on (port = +y)."""
 
+WindowBand = Annotated[tuple[Positive, ...], sequence(3, 3, "a list of 3 numbers > 0: [width, height, pitch]")]
+"""``[width, height, pitch]`` of a window band, metres."""
+
 
 def profile_area(points: Sequence[Sequence[float]] | np.ndarray) -> float:
     """Signed area (m², > 0 anticlockwise) of a closed polygon ``points`` ``(N, 2)`` (shoelace formula)."""
@@ -143,7 +146,7 @@ class BoxPart(_Placed, _Span):
     fit: NonNegative | None = None
     taper: Positive = 1.0
     yaw_deg: Number = 0.0
-    windows: Vec3 | None = None
+    windows: WindowBand | None = None
     """``[width, height, pitch]`` of a window band round the box (not with ``yaw_deg``)."""
 
 
@@ -152,7 +155,7 @@ class HousePart(_Placed):
 
     type: Literal["house"]
     align: Literal["center", "aft", "fore"] = "center"
-    windows: Vec3 | None = None
+    windows: WindowBand | None = None
     """``[width, height, pitch]`` of the window bands on every tier (the top tier's front gets a bridge band)."""
     taper: Positive = 1.0
     tiers: Annotated[

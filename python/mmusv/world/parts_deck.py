@@ -79,9 +79,9 @@ def _rail_meshes(
     return merge(out)
 
 
-def _spaced(p0: np.ndarray, p1: np.ndarray, spacing: float) -> np.ndarray:
+def _spaced(p0: np.ndarray, p1: np.ndarray, spacing: float, ctx: Ctx) -> np.ndarray:
     """Points from ``p0`` to ``p1`` (both included) about ``spacing`` apart."""
-    n = max(1, math.ceil(float(np.linalg.norm(p1 - p0)) / spacing))
+    n = max(1, ctx.count(math.ceil(float(np.linalg.norm(p1 - p0)) / spacing), "spacing", "stanchions"))
     t = np.linspace(0.0, 1.0, n + 1)[:, None]
     return np.asarray(p0 + t * (p1 - p0), dtype=np.float64)
 
@@ -101,7 +101,7 @@ def _railing(p: RailingPart, ctx: Ctx) -> TriMesh:
         hy = p.width / 2.0
         corners = np.array([[p.x0, p.y - hy], [p.x1, p.y - hy], [p.x1, p.y + hy], [p.x0, p.y + hy]])
         pts = [
-            _spaced(np.append(corners[i], p.base), np.append(corners[(i + 1) % 4], p.base), p.spacing)[:-1]
+            _spaced(np.append(corners[i], p.base), np.append(corners[(i + 1) % 4], p.base), p.spacing, ctx)[:-1]
             for i in range(4)
         ]
         loop = np.vstack(pts)
@@ -109,7 +109,7 @@ def _railing(p: RailingPart, ctx: Ctx) -> TriMesh:
     half_l = hull.length / 2.0
     x0 = -half_l + max(p.inset, r) + 0.05 if p.x0 is None else p.x0
     x1 = half_l - 0.05 if p.x1 is None else p.x1
-    n = max(2, math.ceil((x1 - x0) / p.spacing) + 1)
+    n = max(2, ctx.count(math.ceil((x1 - x0) / p.spacing) + 1, "spacing", "stanchions"))
     xs = np.linspace(x0, x1, n)
     ys = _half_widths(ctx, xs) - max(p.inset, r)
     ok = ys > max(2.0 * r, 0.02)
@@ -127,9 +127,9 @@ def _railing(p: RailingPart, ctx: Ctx) -> TriMesh:
     port = np.column_stack([xs, ys, zs])[::-1]
     post_sets = [stb, port]
     if p.bow:
-        post_sets.append(_spaced(stb[-1], port[0], p.spacing)[1:-1])
+        post_sets.append(_spaced(stb[-1], port[0], p.spacing, ctx)[1:-1])
     if p.stern:
-        post_sets.append(_spaced(port[-1], stb[0], p.spacing)[1:-1])
+        post_sets.append(_spaced(port[-1], stb[0], p.spacing, ctx)[1:-1])
     if p.bow and p.stern:
         paths = [(np.vstack([stb, port]), True)]
     elif p.bow:
@@ -148,7 +148,11 @@ def containers_mesh(p: ContainersPart, ctx: Ctx) -> TriMesh:
     lb = (p.x1 - p.x0 - p.gap * (p.bays - 1)) / p.bays
     if lb <= 1.0:
         raise ctx.error("bays", f"{p.bays} bays with gap {p.gap:g} leave {lb:.2f} m per bay")
-    n_long = max(1, round(lb / 12.5))
+    n_long = max(
+        1,
+        ctx.count(round(lb / 12.5) * p.bays * p.rows * max(p.tiers), "x1", "containers")
+        // (p.bays * p.rows * max(p.tiers)),
+    )
     cl = (lb - 0.25 * (n_long - 1)) / n_long
     cw = (p.width - 0.08 * (p.rows - 1)) / p.rows
     ch = p.height
@@ -191,6 +195,7 @@ def containers_mesh(p: ContainersPart, ctx: Ctx) -> TriMesh:
 
 def hatches_mesh(p: HatchesPart, ctx: Ctx) -> TriMesh:
     """Hatch covers on coamings, each with transverse stiffener ribs; top at ``base + height``."""
+    ctx.count(p.count * (p.ribs + 2), "count", "hatch pieces")
     lx = (p.x1 - p.x0 - p.gap * (p.count - 1)) / p.count
     if lx <= 0.5:
         raise ctx.error("count", f"{p.count} hatches do not fit between x0 and x1")
@@ -362,7 +367,7 @@ def pipes_mesh(p: PipesPart, ctx: Ctx) -> TriMesh:
     starts = np.column_stack([np.full_like(ys, p.x0), ys, np.full_like(ys, p.z)])
     ends = starts + np.array([p.x1 - p.x0, 0.0, 0.0])
     pipes = tubes(starts=starts, ends=ends, radius=p.radius, cls=ctx.cls, material=ctx.mat, segments=12)
-    n = max(2, int((p.x1 - p.x0) // p.support) + 1)
+    n = max(2, ctx.count((p.x1 - p.x0) // p.support + 1, "support", "pipe supports"))
     sx = np.linspace(p.x0 + 0.3, p.x1 - 0.3, n)
     z0 = _deck_z(ctx.hull, sx) if p.base is None else np.full(n, p.base)
     top = p.z - p.radius

@@ -160,6 +160,7 @@ def box_mesh(p: BoxPart, ctx: Ctx) -> TriMesh:
         return body
     if p.yaw_deg != 0.0:
         raise ctx.error("windows", "windows need an unturned box (yaw_deg 0)")
+    ctx.count(2.0 * (lx + ly) / p.windows[2], "windows", "windows")
     win = _block_windows(
         x=x,
         y=y,
@@ -190,6 +191,7 @@ def house_mesh(p: HousePart, ctx: Ctx) -> TriMesh:
         ly = ctx.fit_width(p.fit, x0=xc - lx / 2, x1=xc + lx / 2, y=y, width=ly)
         parts.append(block(x=xc, y=y, lx=lx, ly=ly, z0=z, z1=z + h, cls=ctx.cls, material=ctx.mat, taper=p.taper))
         if p.windows is not None:
+            ctx.count(4.0 * (lx + ly) / p.windows[2], "windows", "windows")
             parts.append(
                 _block_windows(
                     x=xc,
@@ -217,7 +219,8 @@ def house_mesh(p: HousePart, ctx: Ctx) -> TriMesh:
 def windows_mesh(p: WindowsPart, ctx: Ctx) -> TriMesh:
     """Rows of windows on a wall, the deck outline or the hull side (see :class:`WindowsPart`)."""
     hull = ctx.hull
-    xs = p.x0 + p.width / 2.0 + np.arange(int((p.x1 - p.x0 - p.width) // p.pitch) + 1) * p.pitch
+    n = ctx.count(((p.x1 - p.x0 - p.width) // p.pitch + 1) * p.rows, "pitch", "windows") // p.rows
+    xs = p.x0 + p.width / 2.0 + np.arange(n) * p.pitch
     out: list[TriMesh] = []
     sides = {"both": (1.0, -1.0), "port": (1.0,), "starboard": (-1.0,)}[p.side]
     for r in range(p.rows):
