@@ -24,11 +24,12 @@ Hull keys (``type: mono | twin``)::
 
 Part types (:mod:`mmusv.world.part_spec`; each ``{type: ..., ...}``; ``base`` defaults to the deck height at the
 part's x; vertical extent is ``top`` (absolute z) or ``height`` (above ``base``); ``fit: m`` narrows a part so it
-stays ``m`` metres inside the deck outline)::
+stays ``m`` metres inside the deck outline; every part takes ``material`` (a name of
+:mod:`mmusv.world.materials`, default per type: :data:`mmusv.world.part_spec.DEFAULT_MATERIALS`))::
 
-    box        x, y=0, size [lx, ly], base, top|height, taper=1, yaw_deg=0, fit
+    box        x, y=0, size [lx, ly], base, top|height, taper=1, yaw_deg=0, fit, windows [w, h, pitch]
     house      x, y=0, align=center|aft|fore, base, tiers [[lx, ly, h(, dx)], ...], taper=1, fit,
-               wings [lx, ly] (bridge wings beside the top tier)
+               wings [lx, ly] (bridge wings beside the top tier), windows [w, h, pitch] (a band on every tier)
     hull_block x0, x1, inset=0, base, top|height, taper=1          (a block following the deck outline)
     row        x0, x1, count, gap=0, y=0, width, heights [h, ...] (cycled), base, fit  (hatches, stacks)
     funnel     x, y=0, size [lx, ly], base, top|height, shape=box|round, taper=0.9
@@ -41,6 +42,23 @@ stays ``m`` metres inside the deck outline)::
     gantry     x, span, base, top|height, leg=0.5, lean=0           (A-frame / portal)
     crane      x, y=0, base, pedestal [radius, height], jib [length, elevation_deg, yaw_deg], width=0.6
     gun        x, y=0, base, radius, height, barrel, yaw_deg=0, elevation_deg=5
+    railing    x0, x1 (default: the whole hull), side=both|port|starboard, inset=0.1, height=1, spacing=1.5,
+               rails=2, base, bow=false, stern=false, radius, posts=true, lift=0; or width (+ y, x0, x1, base):
+               round a rectangle
+    windows    x0, x1, z, width, height, pitch, rows=1, row_pitch=2.8, side, y | inset (wall=outline|hull),
+               shape=rect|round
+    containers x0, x1, bays, rows, tiers [n, ...] (cycled), width, base, gap=0.6, height=2.59, seed=0, fit
+    hatches    x0, x1, count, gap=0, width, height, base, fit, ribs=6
+    lifeboats  x, y, z (keel), length, count=1, pitch=0, side, kind=davit|freefall
+    fenders    x0, x1, count, z, radius, side, kind=tyre|cylinder
+    nav_lights masthead [[x, y, z], ...], sides [x, |y|, z], stern [x, y, z] (each defaults from the masts,
+               bridge wings, bow and transom), size=0.3
+    radar      x, y=0, base, length=2, yaw_deg=0
+    antennas   at [[x, y, z, height], ...], radius=0.03
+    bollards   x0, x1, count, inset=0.8, radius=0.2, side
+    tube       from [x, y, z], to [x, y, z], radius, end_radius, segments=12
+    pipes      x0, x1, ys [y, ...], z, radius=0.2, support=6, base
+    winch      x, y=0, base, radius, width
 
 Mesh asset keys: ``mesh`` (file path), ``scale=1``, ``up_axis=z``, ``forward_axis=x`` (any of ±x/±y/±z),
 ``waterline_z`` or ``draft``. Both kinds: ``name``, ``category=custom``, ``description``, ``semantic_class=vessel``
