@@ -518,8 +518,8 @@ impl Camera {
     }
 }
 
-/// Row-major indices of the pixels at an edge: a 4-neighbour with another instance, class or material, or a
-/// depth differing by more than 5 %.
+/// Row-major indices of the pixels at an edge: a 4-neighbour with another instance, class or material, or (off
+/// the water) a depth differing by more than 5 %.
 fn edge_pixels(frame: &CameraFrame, material: &[u16]) -> Vec<u32> {
     let (w, h) = (frame.width as usize, frame.height as usize);
     let differs = |a: usize, b: usize| {
@@ -529,8 +529,9 @@ fn edge_pixels(frame: &CameraFrame, material: &[u16]) -> Vec<u32> {
         {
             return true;
         }
+        // Depth steps matter between surfaces, not across the open water (its shading varies smoothly).
         let (da, db) = (frame.depth[a], frame.depth[b]);
-        da.is_finite() && db.is_finite() && (da - db).abs() > 0.05 * da.min(db)
+        frame.semantic[a] != 1 && da.is_finite() && db.is_finite() && (da - db).abs() > 0.05 * da.min(db)
     };
     (0..h)
         .into_par_iter()

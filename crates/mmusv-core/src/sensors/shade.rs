@@ -108,6 +108,8 @@ pub struct SurfaceHit {
     pub material: Option<Material>,
     /// Whether the instance's navigation lights are on.
     pub lights_on: bool,
+    /// The shading normal: the geometric one, or for water the swell's ([`Shader::with_swell`]).
+    pub shading_normal: Vec3,
 }
 
 impl SurfaceHit {
@@ -188,7 +190,7 @@ impl Shader {
     /// Precomputes the shading of a render with environment `env`, seed `seed` (swell and rain streaks) and the
     /// vessels under way `wakes`.
     pub fn new(env: &ShadeEnv, seed: u64, wakes: &[Wake]) -> Self {
-        let h = env.wave_height_m.max(0.05);
+        let h = env.wave_height_m.max(0.0);
         let swell = std::array::from_fn(|i| {
             let i = i as u64;
             let dir = std::f32::consts::TAU * noise::uniform(seed, stream::RIPPLE, 2 * i) as f32;
@@ -239,7 +241,7 @@ impl Shader {
     /// Radiance of the sky along unit `d`, with the sun's disc, veiled by fog.
     #[inline]
     pub fn sky(&self, d: Vec3) -> Vec3 {
-        let c = self.light.sky.radiance(d) + self.light.sky.sun_disc(d);
+        let c = self.light.sky_radiance(d) + self.light.sky.sun_disc(d);
         let keep = (-self.env.fog_extinction_per_m * 3000.0).exp();
         c * keep + self.air_light(d) * (1.0 - keep)
     }
@@ -249,14 +251,13 @@ impl Shader {
     #[inline]
     fn sky_no_sun(&self, d: Vec3) -> Vec3 {
         let keep = (-self.env.fog_extinction_per_m * 3000.0).exp();
-        self.light.sky.radiance(d) * keep + self.air_light(d) * (1.0 - keep)
+        self.light.sky_radiance(d) * keep + self.air_light(d) * (1.0 - keep)
     }
 
     /// Radiance distant objects fade into along `d`: the horizon sky's, at `d`'s azimuth.
     #[inline]
     pub fn air_light(&self, d: Vec3) -> Vec3 {
-        let h = Vec3::new(d.x, d.y, 0.0).normalize_or(Vec3::X);
-        self.light.sky.radiance(Vec3::new(h.x, h.y, 0.02))
+        self.light.horizon_radiance(d)
     }
 
     /// Aerial perspective over a path of `t` metres along `d`.
@@ -280,22 +281,25 @@ impl Shader {
         Vec3::new(-gx, -gy, 1.0).normalize_or_zero()
     }
 
-    /// The shading normal of a water hit seen along `d` (the swell's, or the geometric one where the swell
-    /// would face away).
+    /// `hit` with its shading normal set: for water seen along `d`, the swell's (or the geometric one where the
+    /// swell would face away); for anything else, the geometric normal.
     #[inline]
-    fn water_shading_normal(&self, d: Vec3, hit: &SurfaceHit) -> Vec3 {
-        let n = self.water_normal(hit.point);
-        if n.dot(d) > 0.0 {
-            hit.normal
-        } else {
-            n
+    pub fn with_swell(&self, d: Vec3, mut hit: SurfaceHit) -> SurfaceHit {
+        hit.shading_normal = hit.normal;
+        if hit.is_water() {
+            let n = self.water_normal(hit.point);
+            if n.dot(d) <= 0.0 {
+                hit.shading_normal = n;
+            }
         }
+        hit
     }
 
-    /// Origin and unit direction of the ray reflected by a water hit seen along `d` (never below the horizon).
+    /// Origin and unit direction of the ray reflected by a water hit seen along `d` (never below the horizon),
+    /// about its shading normal.
     #[inline]
     pub fn reflection_ray(&self, d: Vec3, hit: &SurfaceHit) -> (Vec3, Vec3) {
-        let n = self.water_shading_normal(d, hit);
+        let n = hit.shading_normal;
         let mut r = d - n * (2.0 * d.dot(n));
         r.z = r.z.abs().max(1e-4);
         (hit.point + hit.normal * (0.02 + 1e-4 * hit.t), r.normalize())
@@ -333,7 +337,7 @@ impl Shader {
     /// the water body, and foam.
     #[inline]
     pub fn water(&self, d: Vec3, hit: &SurfaceHit, sunlit: bool, reflected: Option<Vec3>) -> Vec3 {
-        let n = self.water_shading_normal(d, hit);
+        let n = hit.shading_normal;
         let v = -d;
         let cos_o = n.dot(v).clamp(1e-4, 1.0);
         let f_o = fresnel_dielectric(cos_o, WATER_IOR);
@@ -353,7 +357,7 @@ impl Shader {
                 entering += self.sun_e * (ns * (1.0 - fresnel_dielectric(ns, WATER_IOR)));
             }
         }
-        c += water::body_factor(self.water_rho, self.water_fdr, cos_o, WATER_IOR) * entering;
+        c += water::body_factor(self.water_rho, self.water_fdr, f_o, WATER_IOR) * entering;
         if !self.foam.is_empty() {
             let cover = self.foam.cover(hit.point.x, hit.point.y);
             if cover > 0.0 {
@@ -414,7 +418,16 @@ mod tests {
     use super::*;
 
     fn hit(class: u16, material: Option<Material>) -> SurfaceHit {
-        SurfaceHit { t: 10.0, point: Vec3::ZERO, normal: Vec3::Z, class, instance: 0, material, lights_on: false }
+        SurfaceHit {
+            t: 10.0,
+            point: Vec3::ZERO,
+            normal: Vec3::Z,
+            class,
+            instance: 0,
+            material,
+            lights_on: false,
+            shading_normal: Vec3::Z,
+        }
     }
 
     #[test]
@@ -459,16 +472,17 @@ mod tests {
     fn water_reflects_by_fresnel() {
         let env = ShadeEnv { wave_height_m: 0.0, wind_speed_m_s: 0.0, ..ShadeEnv::default() };
         let sh = Shader::new(&env, 1, &[]);
-        let w = hit(1, None);
+        let w = sh.with_swell(-Vec3::Z, hit(1, None));
         // Looking straight down (no glint: the sun is not behind the camera) the reflected radiance is weighted
         // by F(0) = 0.02; at grazing incidence by much more.
         let bright = Vec3::splat(1000.0);
         let down = sh.water(-Vec3::Z, &w, false, Some(bright)) - sh.water(-Vec3::Z, &w, false, Some(Vec3::ZERO));
-        let n = sh.water_shading_normal(-Vec3::Z, &w);
+        let n = w.shading_normal;
         let f = fresnel_dielectric(n.dot(Vec3::Z), WATER_IOR);
         assert!((down.x - 1000.0 * f).abs() < 0.01, "{down} {f}");
         let g = Vec3::new(1.0, 0.0, -0.05).normalize();
-        let graze = sh.water(g, &w, false, Some(bright)) - sh.water(g, &w, false, Some(Vec3::ZERO));
+        let wg = sh.with_swell(g, hit(1, None));
+        let graze = sh.water(g, &wg, false, Some(bright)) - sh.water(g, &wg, false, Some(Vec3::ZERO));
         assert!(graze.x > 5.0 * down.x);
     }
 }

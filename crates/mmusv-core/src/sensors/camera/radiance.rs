@@ -15,10 +15,11 @@ const SHADOW_RANGE: f32 = 5_000.0;
 /// Farthest a reflected ray looks for a surface, metres.
 const REFLECTION_RANGE: f32 = 20_000.0;
 
-/// The hit of ray `k` as shading needs it (normal turned towards the ray, the face's material), `None` for a
-/// miss.
+/// The hit of ray `k` as shading needs it (normal turned towards the ray, the face's material, the swell's
+/// normal on water), `None` for a miss.
 #[inline]
 pub(crate) fn surface_at(
+    shader: &Shader,
     scene: &Scene,
     hits: &RayHits,
     origins: &[[f32; 3]],
@@ -36,7 +37,7 @@ pub(crate) fn surface_at(
     }
     let point = Vec3::from_array(origins[k]) + d * t;
     let (instance, triangle) = (hits.instance[k], hits.triangle[k]);
-    Some(SurfaceHit {
+    let hit = SurfaceHit {
         t,
         point,
         normal,
@@ -44,7 +45,9 @@ pub(crate) fn surface_at(
         instance,
         material: scene.material_of(instance, triangle).copied(),
         lights_on: scene.instances().get(instance as usize).is_some_and(|i| i.lights_on()),
-    })
+        shading_normal: normal,
+    };
+    Some(shader.with_swell(d, hit))
 }
 
 /// Which of `surfaces` see the sun (all false at night; all that face it when shadows are off).
@@ -97,7 +100,7 @@ pub fn radiance(
 ) -> Result<Vec<Vec3>> {
     let n = origins.len();
     let surfaces: Vec<Option<SurfaceHit>> =
-        (0..n).into_par_iter().map(|k| surface_at(scene, hits, origins, dirs, k)).collect();
+        (0..n).into_par_iter().map(|k| surface_at(shader, scene, hits, origins, dirs, k)).collect();
     let lit = sunlit(scene, shader, shadows, &surfaces)?;
     // Reflected rays of the water hits, traced, and the radiance they bring back.
     let mut reflected: Vec<Option<Vec3>> = vec![None; n];
@@ -116,7 +119,7 @@ pub fn radiance(
             let rd: Vec<[f32; 3]> = water.iter().map(|w| w.2).collect();
             let rhits = scene.cast_rays(&ro, &rd, REFLECTION_RANGE)?;
             let rsurf: Vec<Option<SurfaceHit>> =
-                (0..ro.len()).into_par_iter().map(|j| surface_at(scene, &rhits, &ro, &rd, j)).collect();
+                (0..ro.len()).into_par_iter().map(|j| surface_at(shader, scene, &rhits, &ro, &rd, j)).collect();
             let rlit = sunlit(scene, shader, shadows, &rsurf)?;
             let values: Vec<Vec3> = (0..ro.len())
                 .into_par_iter()

@@ -3,9 +3,11 @@
 //! GGX-prefiltered maps for glossy ones (the split sum of [`super::brdf`]).
 //!
 //! The source grids are cylindrical equal-area (columns uniform in azimuth, rows uniform in `z`), so every
-//! texel has the same solid angle `4π / (W H)` and the integrals are plain sums; the output maps are read
-//! bilinearly on a grid uniform in azimuth and polar angle whose first and last rows are the poles (so the up
-//! and down normals, the commonest, are exact):
+//! texel has the same solid angle `4π / (W H)` and the integrals are plain sums. The output maps, and a dense
+//! table of the sky's own radiance that the cameras read instead of evaluating the sky model per pixel, are
+//! read bilinearly without trigonometry: columns uniform in the "diamond" pseudo-angle of the azimuth, rows
+//! uniform in `z` with the poles as first and last rows (the up and down normals, the commonest, are exact;
+//! the sky table's rows follow `(√z + 1 − √(1 − z)) / 2`, dense in angle at the horizon and the zenith):
 //! * irradiance `E(n) = Σ L(ω) max(0, n·ω) Δω`;
 //! * prefiltered radiance `P(r, α) = Σ L(ω) w(ω) / Σ w(ω)` with the GGX lobe weight `w = D(h) (h·r) / (4 h·ω)
 //!   · max(0, r·ω)` around the mirror direction `r` (Karis 2013's `n = v = r` assumption).
@@ -62,6 +64,10 @@ pub struct Lighting {
     pub water_entering: Vec3,
     irradiance: Vec<Vec3>,
     prefiltered: Vec<Vec<Vec3>>,
+    /// The sky's radiance (no sun disc) on the `SKY` grid.
+    sky_table: Vec<Vec3>,
+    /// The sky's radiance just above the horizon (elevation ~1.1°), per column of the `SKY` grid.
+    horizon: Vec<Vec3>,
 }
 
 /// Unit direction of the centre of texel `(i, j)` of a `w × h` equal-area grid.
@@ -72,24 +78,62 @@ fn texel_dir(i: usize, j: usize, w: usize, h: usize) -> Vec3 {
     Vec3::new(s * phi.cos(), s * phi.sin(), z)
 }
 
-/// Unit direction of node `(i, j)` of the `w × h` output grid (row 0 straight down, row `h − 1` straight up).
-fn node_dir(i: usize, j: usize, w: usize, h: usize) -> Vec3 {
-    let phi = (i as f32 + 0.5) / w as f32 * std::f32::consts::TAU - std::f32::consts::PI;
-    let theta = j as f32 / (h - 1) as f32 * std::f32::consts::PI;
-    let (st, ct) = theta.sin_cos();
-    Vec3::new(st * phi.cos(), st * phi.sin(), -ct)
+/// The "diamond angle" of `(x, y)` in `[0, 4)`: a monotone stand-in for the azimuth (1 per quarter turn)
+/// without trigonometry.
+#[inline]
+fn diamond(x: f32, y: f32) -> f32 {
+    let s = x.abs() + y.abs();
+    if s == 0.0 {
+        return 0.0;
+    }
+    let p = if y >= 0.0 {
+        if x >= 0.0 {
+            y / s
+        } else {
+            1.0 - x / s
+        }
+    } else if x < 0.0 {
+        2.0 - y / s
+    } else {
+        3.0 + x / s
+    };
+    if p >= 4.0 {
+        0.0
+    } else {
+        p
+    }
 }
 
-/// Bilinear read of an `OUT`-sized map along unit direction `d` (wrapping in azimuth).
+/// Unit horizontal `(x, y)` of diamond angle `p` in `[0, 4)`.
+fn diamond_dir(p: f32) -> (f32, f32) {
+    let q = p.floor();
+    let f = p - q;
+    let (x, y) = match q as i32 {
+        0 => (1.0 - f, f),
+        1 => (-f, 1.0 - f),
+        2 => (f - 1.0, -f),
+        _ => (f, f - 1.0),
+    };
+    let n = (x * x + y * y).sqrt();
+    (x / n, y / n)
+}
+
+/// Unit direction of node `(i, j)` of a `w × h` output grid (row 0 straight down, row `h − 1` straight up).
+fn node_dir(i: usize, j: usize, w: usize, h: usize) -> Vec3 {
+    let (x, y) = diamond_dir((i as f32 + 0.5) / w as f32 * 4.0);
+    let z = (j as f32 / (h - 1) as f32 * 2.0 - 1.0).clamp(-1.0, 1.0);
+    let s = (1.0 - z * z).max(0.0).sqrt();
+    Vec3::new(s * x, s * y, z)
+}
+
+/// Bilinear read of a `w × h` map at column coordinate `x` (wrapping) and row coordinate `y` (clamped).
 #[inline]
-fn read(map: &[Vec3], d: Vec3) -> Vec3 {
-    let (w, h) = OUT;
-    let phi = d.y.atan2(d.x);
-    let x = (phi + std::f32::consts::PI) / std::f32::consts::TAU * w as f32 - 0.5;
-    let y = ((-d.z).clamp(-1.0, 1.0).acos() / std::f32::consts::PI * (h - 1) as f32).clamp(0.0, (h - 1) as f32);
-    let x0 = x.floor();
-    let fx = x - x0;
-    let i0 = (x0 as i32).rem_euclid(w as i32) as usize;
+fn bilinear(map: &[Vec3], w: usize, h: usize, x: f32, y: f32) -> Vec3 {
+    let y = y.clamp(0.0, (h - 1) as f32);
+    // floor without a call: x > -1 here (a column coordinate is at least -0.5).
+    let xi = (x + 1.0) as i32 - 1;
+    let fx = x - xi as f32;
+    let i0 = xi.rem_euclid(w as i32) as usize;
     let i1 = (i0 + 1) % w;
     let j0 = y as usize;
     let j1 = (j0 + 1).min(h - 1);
@@ -97,6 +141,49 @@ fn read(map: &[Vec3], d: Vec3) -> Vec3 {
     let a = map[j0 * w + i0] * (1.0 - fx) + map[j0 * w + i1] * fx;
     let b = map[j1 * w + i0] * (1.0 - fx) + map[j1 * w + i1] * fx;
     a * (1.0 - fy) + b * fy
+}
+
+/// Bilinear read of an `OUT`-sized map along unit direction `d`.
+#[inline]
+fn read(map: &[Vec3], d: Vec3) -> Vec3 {
+    let (w, h) = OUT;
+    let x = diamond(d.x, d.y) / 4.0 * w as f32 - 0.5;
+    let y = (d.z + 1.0) * 0.5 * (h - 1) as f32;
+    bilinear(map, w, h, x, y)
+}
+
+/// Size of the sky table (azimuth × rows over `√z` in `[0, 1]`) and of the horizon table.
+const SKY: (usize, usize) = (512, 192);
+
+/// Row parameter of height `z` in `[0, 1]` in the sky table: `(√z + 1 − √(1 − z)) / 2`, dense in angle both at
+/// the horizon (`√z`) and at the zenith (`√(1 − z)` grows like the zenith angle).
+#[inline]
+fn sky_row(z: f32) -> f32 {
+    let z = z.clamp(0.0, 1.0);
+    0.5 * (z.sqrt() + 1.0 - (1.0 - z).sqrt())
+}
+
+/// The `z` whose [`sky_row`] is `t` (bisection; the mapping is monotone).
+fn sky_row_z(t: f32) -> f32 {
+    let (mut lo, mut hi) = (0.0f32, 1.0f32);
+    for _ in 0..40 {
+        let mid = 0.5 * (lo + hi);
+        if sky_row(mid) < t {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// Sky radiance along unit direction `d` (`d.z` clamped to `[0, 1]`) from the `SKY` table.
+#[inline]
+fn sky_read(table: &[Vec3], d: Vec3) -> Vec3 {
+    let (w, h) = SKY;
+    let x = diamond(d.x, d.y) / 4.0 * w as f32 - 0.5;
+    let y = sky_row(d.z) * (h - 1) as f32;
+    bilinear(table, w, h, x, y)
 }
 
 impl Lighting {
@@ -158,7 +245,47 @@ impl Lighting {
                 map
             })
             .collect();
-        Self { sky, ground, horizontal_lux: luminance(e_h), water_entering, irradiance, prefiltered }
+        let (kw, kh) = SKY;
+        let mut sky_table = vec![Vec3::ZERO; kw * kh];
+        for j in 0..kh {
+            let z = sky_row_z(j as f32 / (kh - 1) as f32);
+            let s = (1.0 - z * z).max(0.0).sqrt();
+            for i in 0..kw {
+                let (x, y) = diamond_dir((i as f32 + 0.5) / kw as f32 * 4.0);
+                sky_table[j * kw + i] = sky.radiance(Vec3::new(s * x, s * y, z));
+            }
+        }
+        let horizon = (0..kw)
+            .map(|i| {
+                let (x, y) = diamond_dir((i as f32 + 0.5) / kw as f32 * 4.0);
+                sky.radiance(Vec3::new(x, y, 0.02).normalize())
+            })
+            .collect();
+        Self {
+            sky,
+            ground,
+            horizontal_lux: luminance(e_h),
+            water_entering,
+            irradiance,
+            prefiltered,
+            sky_table,
+            horizon,
+        }
+    }
+
+    /// The sky's radiance along unit `d` (no sun disc; below the horizon, the horizon's), read from a dense
+    /// table of [`Sky::radiance`].
+    #[inline]
+    pub fn sky_radiance(&self, d: Vec3) -> Vec3 {
+        sky_read(&self.sky_table, d)
+    }
+
+    /// The sky's radiance just above the horizon at `d`'s azimuth (what distant things fade into).
+    #[inline]
+    pub fn horizon_radiance(&self, d: Vec3) -> Vec3 {
+        let (w, _) = SKY;
+        let x = diamond(d.x, d.y) / 4.0 * w as f32 - 0.5;
+        bilinear(&self.horizon, w, 1, x, 0.0)
     }
 
     /// The lighting of `key`, computed once per process and shared (a cache of the last few environments).
@@ -183,7 +310,7 @@ impl Lighting {
     #[inline]
     pub fn environment(&self, d: Vec3) -> Vec3 {
         if d.z > 0.0 {
-            self.sky.radiance(d)
+            self.sky_radiance(d)
         } else {
             self.ground
         }
@@ -275,6 +402,27 @@ mod tests {
             e *= 4.0 * std::f32::consts::PI / (nt * np) as f32;
             let got = l.irradiance(n);
             assert!((luminance(got) - luminance(e)).abs() < 0.03 * luminance(e), "n {n}: {got} vs {e}");
+        }
+    }
+
+    #[test]
+    fn sky_table_matches_the_model() {
+        let l = Lighting::new(&key(0.1));
+        let mut worst = 0.0f32;
+        for i in 0..2000 {
+            let a = i as f32 * 0.7311;
+            let z = ((i as f32 * 0.37).sin() * 0.5 + 0.5).max(0.001);
+            let s = (1.0 - z * z).sqrt();
+            let d = Vec3::new(s * a.cos(), s * a.sin(), z);
+            let want = l.sky.radiance(d);
+            let got = l.sky_radiance(d);
+            let e = (luminance(got) - luminance(want)).abs() / luminance(want);
+            worst = worst.max(e);
+        }
+        assert!(worst < 0.01, "worst relative error {worst}");
+        for p in [0.0f32, 0.3, 1.0, 1.7, 2.5, 3.9] {
+            let (x, y) = diamond_dir(p);
+            assert!((diamond(x, y) - p).abs() < 1e-5, "{p}");
         }
     }
 

@@ -43,10 +43,22 @@ pub fn srgb8(x: f32) -> u8 {
     (s * 255.0 + 0.5) as u8
 }
 
+/// Entries of the sRGB encoding table over `[0, 1]`.
+const SRGB_LUT: usize = 1 << 16;
+
+/// [`srgb8`] tabulated at `SRGB_LUT` points (the table's step, 1.5·10⁻⁵, is a twentieth of the finest 8-bit
+/// step of the curve, so an entry differs from the formula only for values within that of a rounding edge).
+fn srgb_lut() -> &'static [u8] {
+    static LUT: std::sync::OnceLock<Vec<u8>> = std::sync::OnceLock::new();
+    LUT.get_or_init(|| (0..SRGB_LUT).map(|i| srgb8(i as f32 / (SRGB_LUT - 1) as f32)).collect())
+}
+
 /// Exposed, tone-mapped, sRGB-encoded pixel of radiance `c` under exposure `k`.
 #[inline]
 pub fn to_srgb8(c: Vec3, k: f32) -> [u8; 3] {
-    [srgb8(aces(c.x * k)), srgb8(aces(c.y * k)), srgb8(aces(c.z * k))]
+    let lut = srgb_lut();
+    let enc = |x: f32| lut[((aces(x * k) * (SRGB_LUT - 1) as f32 + 0.5) as usize).min(SRGB_LUT - 1)];
+    [enc(c.x), enc(c.y), enc(c.z)]
 }
 
 /// Shot and read noise of a sensor (electrons).
@@ -93,6 +105,16 @@ mod tests {
         assert_eq!(srgb8(1.0), 255);
         // 0.5 display-linear is sRGB 188.
         assert_eq!(srgb8(0.5), 188);
+    }
+
+    #[test]
+    fn srgb_table_is_within_one_step_of_the_formula() {
+        for i in 0..=100_000 {
+            let x = i as f32 / 100_000.0;
+            let a = to_srgb8(Vec3::splat(x), 1.0)[0] as i32;
+            let b = srgb8(aces(x)) as i32;
+            assert!((a - b).abs() <= 1, "{x}: {a} vs {b}");
+        }
     }
 
     #[test]

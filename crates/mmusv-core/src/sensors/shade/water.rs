@@ -21,7 +21,6 @@
 //!   diffuse reflectance (here integrated exactly, with total internal reflection).
 
 use super::super::noise;
-use super::brdf::fresnel_dielectric;
 use parry3d::math::Vec3;
 
 /// Albedo of dense foam.
@@ -72,11 +71,11 @@ pub fn internal_diffuse_reflectance(eta: f32) -> f32 {
     s as f32
 }
 
-/// Radiance scattered out of the water body per unit entering irradiance, `ρ / (1 − F_dr) (1 − F(θ_o)) / (η² π)`,
-/// for a view at `cos_o` to the normal.
+/// Radiance scattered out of the water body per unit entering irradiance, `ρ / (1 − F_dr) (1 − F_o) / (η² π)`,
+/// for a view whose Fresnel reflectance is `f_o`.
 #[inline]
-pub fn body_factor(rho: Vec3, fdr: f32, cos_o: f32, eta: f32) -> Vec3 {
-    rho * ((1.0 - fresnel_dielectric(cos_o, eta)) / ((1.0 - fdr) * eta * eta * std::f32::consts::PI))
+pub fn body_factor(rho: Vec3, fdr: f32, f_o: f32, eta: f32) -> Vec3 {
+    rho * ((1.0 - f_o) / ((1.0 - fdr) * eta * eta * std::f32::consts::PI))
 }
 
 /// A vessel under way, as its wake needs it (world frame).
@@ -127,34 +126,74 @@ pub fn foam_noise(seed: u64, x: f32, y: f32) -> f32 {
     s / 0.875
 }
 
+/// The `(1 − coverage)` quantile of the foam noise, from a fixed sample of it (cached per coverage and seed:
+/// every render of a run asks for the same one).
+fn foam_threshold(coverage: f32, seed: u64) -> f32 {
+    static CACHE: std::sync::Mutex<Vec<(u32, u64, f32)>> = std::sync::Mutex::new(Vec::new());
+    if let Ok(c) = CACHE.lock() {
+        if let Some(&(_, _, t)) = c.iter().find(|(k, s, _)| *k == coverage.to_bits() && *s == seed) {
+            return t;
+        }
+    }
+    let mut v: Vec<f32> = (0..16_384u64)
+        .map(|i| {
+            let x = noise::uniform(seed, FOAM_STREAM + 1, 2 * i) as f32 * 4000.0;
+            let y = noise::uniform(seed, FOAM_STREAM + 1, 2 * i + 1) as f32 * 4000.0;
+            foam_noise(seed, x, y)
+        })
+        .collect();
+    v.sort_by(f32::total_cmp);
+    let t = v[((1.0 - coverage) * (v.len() - 1) as f32).round() as usize];
+    if let Ok(mut c) = CACHE.lock() {
+        if c.len() >= 16 {
+            c.remove(0);
+        }
+        c.push((coverage.to_bits(), seed, t));
+    }
+    t
+}
+
 /// The foam of one render: whitecaps at a coverage and the wakes of the vessels under way.
 #[derive(Debug, Clone, Default)]
 pub struct Foam {
     /// Noise level above which the surface is a whitecap (`> 1`: none).
     threshold: f32,
     seed: u64,
-    wakes: Vec<Wake>,
+    wakes: Vec<WakeShape>,
+}
+
+/// A wake prepared for lookups: its stern, unit heading, reach and sizes.
+#[derive(Debug, Clone, Copy, Default)]
+struct WakeShape {
+    stern: [f32; 2],
+    dir: [f32; 2],
+    /// Farthest distance behind the stern with foam.
+    reach: f32,
+    speed: f32,
+    length: f32,
+    beam: f32,
 }
 
 impl Foam {
     /// Foam for whitecap `coverage` in `[0, 1]` and `wakes`, placed by `seed`.
     pub fn new(coverage: f32, wakes: &[Wake], seed: u64) -> Self {
-        let threshold = if coverage <= 0.0 {
-            2.0
-        } else {
-            // The (1 − W) quantile of the noise, from a fixed sample of it.
-            let mut v: Vec<f32> = (0..16_384u64)
-                .map(|i| {
-                    let x = noise::uniform(seed, FOAM_STREAM + 1, 2 * i) as f32 * 4000.0;
-                    let y = noise::uniform(seed, FOAM_STREAM + 1, 2 * i + 1) as f32 * 4000.0;
-                    foam_noise(seed, x, y)
-                })
-                .collect();
-            v.sort_by(f32::total_cmp);
-            let k = ((1.0 - coverage.min(1.0)) * (v.len() - 1) as f32).round() as usize;
-            v[k]
-        };
-        Self { threshold, seed, wakes: wakes.iter().filter(|w| w.speed > 0.05).copied().collect() }
+        let threshold = if coverage <= 0.0 { 2.0 } else { foam_threshold(coverage.min(1.0), seed) };
+        let wakes = wakes
+            .iter()
+            .filter(|w| w.speed > 0.05)
+            .map(|w| {
+                let (s, c) = w.heading.sin_cos();
+                WakeShape {
+                    stern: [w.x - c * w.length * 0.5, w.y - s * w.length * 0.5],
+                    dir: [c, s],
+                    reach: w.speed * WAKE_FADE_S * 4.0,
+                    speed: w.speed,
+                    length: w.length,
+                    beam: w.beam,
+                }
+            })
+            .collect();
+        Self { threshold, seed, wakes }
     }
 
     /// Whether there is any foam at all.
@@ -168,19 +207,25 @@ impl Foam {
         let mut c = 0.0f32;
         let mut nz = None;
         let mut noise_at = || *nz.get_or_insert_with(|| foam_noise(self.seed, x, y));
-        if self.threshold <= 1.0 {
+        // The first octave bounds the sum: skip the rest where it cannot reach the threshold.
+        if self.threshold <= 1.0
+            && (0.5 * value_noise(self.seed, x / 6.0, y / 6.0) + 0.375) / 0.875 > self.threshold - 0.015
+        {
             let n = noise_at();
             // A soft edge over 0.03 of the noise range.
             c = ((n - self.threshold) / 0.03 + 0.5).clamp(0.0, 1.0);
         }
         for w in &self.wakes {
-            let (s, co) = w.heading.sin_cos();
-            let (dx, dy) = (x - (w.x - co * w.length * 0.5), y - (w.y - s * w.length * 0.5));
+            let [co, s] = w.dir;
+            let (dx, dy) = (x - w.stern[0], y - w.stern[1]);
             let behind = -(dx * co + dy * s);
-            if behind <= -0.1 * w.length || behind > w.speed * WAKE_FADE_S * 4.0 {
+            if behind <= -0.1 * w.length || behind > w.reach {
                 continue;
             }
             let lateral = (-dx * s + dy * co).abs();
+            if lateral > 0.6 * w.beam + behind.max(0.0) * (KELVIN_TAN + 0.07) + 0.3 {
+                continue;
+            }
             let fade = (-behind.max(0.0) / (w.speed * WAKE_FADE_S)).exp();
             // Turbulent track behind the stern.
             let half = 0.5 * w.beam * (1.0 + (behind.max(0.0) / w.beam.max(1.0)).sqrt() * 0.25);
@@ -197,7 +242,7 @@ impl Foam {
             if f > 0.0 {
                 // Broken up by the noise, as real foam is.
                 let n = noise_at();
-                c = c.max((f * (0.6 + 0.8 * n)).min(1.0));
+                c = c.max((f * (0.2 + 1.2 * n)).min(1.0));
             }
         }
         c
