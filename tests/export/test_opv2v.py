@@ -168,7 +168,8 @@ def test_layout_names_and_keys(coop_out: Path, coop_rec_data: dict[int, Any]) ->
             doc = load(coop_out / c / f"{ts}.yaml")
             assert set(doc) == YAML_KEYS
             for i in range(4):
-                assert set(doc[f"camera{i}"]) == {"cords", "intrinsic", "extrinsic"}
+                assert set(doc[f"camera{i}"]) == {"cords", "intrinsic", "extrinsic", "distortion"}
+                assert doc[f"camera{i}"]["distortion"] == [0.0] * 5  # the test rig has ideal pinholes
                 assert np.asarray(doc[f"camera{i}"]["intrinsic"]).shape == (3, 3)
                 assert np.asarray(doc[f"camera{i}"]["extrinsic"]).shape == (4, 4)
             for key in ("lidar_pose", "true_ego_pos", "predicted_ego_pos"):

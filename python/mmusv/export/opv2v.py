@@ -104,6 +104,8 @@ class Opv2vWriter(DatasetWriter):
             doc[f"camera{idx}"] = {
                 "cords": cords,
                 "intrinsic": _matrix_list(np.array([[fx, 0.0, cx], [0.0, fy, cy], [0.0, 0.0, 1.0]])),
+                # Brown–Conrady [k1, k2, p1, p2, k3] (OpenCV's order); zeros for an ideal pinhole.
+                "distortion": rounded(cam.distortion or (0.0, 0.0, 0.0, 0.0, 0.0), 9),
                 "extrinsic": _matrix_list(invert(carla_matrix(np.array(cords))) @ lidar_m),
             }
             rgb = msgs.get(topics.camera(a.id, name, "rgb"))

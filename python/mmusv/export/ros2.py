@@ -103,8 +103,12 @@ def detections_3d_topic(agent: str) -> str:
 
 
 def camera_distortion(agent: AgentInfo, name: str) -> np.ndarray:
-    """``(5,)`` float64 ``[k1, k2, p1, p2, k3]`` of the agent's camera ``name`` from its recorded rig (OpenCV's
-    order, which is ROS's ``plumb_bob``); zeros for a camera without distortion or a rig that does not say."""
+    """``(5,)`` float64 ``[k1, k2, p1, p2, k3]`` of the agent's camera ``name`` as recorded beside its intrinsics
+    (or, in older recordings, in its rig; OpenCV's order, which is ROS's ``plumb_bob``); zeros for a camera
+    without distortion."""
+    cam = agent.cameras.get(name)
+    if cam is not None and cam.distortion is not None:
+        return np.asarray(cam.distortion, dtype=np.float64)
     for c in agent.rig.get("cameras") or []:
         if isinstance(c, dict) and c.get("name") == name and c.get("distortion") is not None:
             return np.asarray(c["distortion"], dtype=np.float64).reshape(5)

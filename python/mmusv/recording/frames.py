@@ -93,6 +93,8 @@ class FrameRecorder:
                     "resolution": list(cfg.resolution),
                     "hfov_deg": cfg.hfov_deg,
                     "intrinsics": list(cam.intrinsics or ()),
+                    "distortion": None if cfg.distortion is None else list(cfg.distortion),
+                    "quality": cfg.quality,
                     "mount_in_body": np.round(mount, 9).tolist(),
                     "outputs": list(cfg.outputs),
                 }

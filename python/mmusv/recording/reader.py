@@ -60,7 +60,8 @@ MCAP_MAGIC = b"\x89MCAP0\r\n"
 @dataclass(frozen=True)
 class CameraInfo:
     """A pinhole camera of an agent: image size, intrinsics ``(fx, fy, cx, cy)`` pixels, ``mount``
-    ``(4, 4)`` camera body (x forward = optical axis, y left, z up) → vessel body, recorded outputs."""
+    ``(4, 4)`` camera body (x forward = optical axis, y left, z up) → vessel body, recorded outputs, and its
+    Brown–Conrady ``distortion`` ``(k1, k2, p1, p2, k3)`` (OpenCV's order; ``None``: an ideal pinhole)."""
 
     name: str
     width: int
@@ -69,6 +70,17 @@ class CameraInfo:
     intrinsics: tuple[float, float, float, float]
     mount: np.ndarray
     outputs: tuple[str, ...]
+    distortion: tuple[float, float, float, float, float] | None = None
+
+
+def _distortion(value: Any) -> tuple[float, float, float, float, float] | None:
+    """A recorded camera's ``distortion`` entry: five finite numbers, or ``None`` (absent or null)."""
+    if value is None:
+        return None
+    vals = [float(x) for x in value]
+    if len(vals) != 5 or not all(math.isfinite(x) for x in vals):
+        raise IoError(f"camera distortion must be five finite numbers [k1, k2, p1, p2, k3], got {value!r}")
+    return (vals[0], vals[1], vals[2], vals[3], vals[4])
 
 
 @dataclass(frozen=True)
@@ -340,6 +352,7 @@ def _info(p: Path, meta: dict[str, dict[str, str]], has_summary: bool) -> Record
                 ),
                 mount=np.asarray(c["mount_in_body"], dtype=np.float64).reshape(4, 4),
                 outputs=tuple(c.get("outputs", ())),
+                distortion=_distortion(c.get("distortion")),
             )
             for name, c in s.get("cameras", {}).items()
         }

@@ -1,0 +1,258 @@
+"""The physically based camera image: exposure, sun disc, anti-aliasing, lens distortion, sensor noise, nav lights,
+whitecaps and wakes, each against an independent computation (closed forms, a forward model in numpy, the
+Monahan formula) rather than against pictures."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import mmusv
+import numpy as np
+import pytest
+from mmusv._native import core
+from mmusv.scene import Scene
+from mmusv.sensors.camera import render
+from mmusv.sensors.env import sensor_env
+from mmusv.world.build import pose_matrices
+from mmusv.world.environment import Environment
+
+
+def _env(**kw: float) -> core.SensorEnv:
+    base = {"fog_extinction_per_m": 0.0, "rain_mm_per_h": 0.0, "wave_height_m": 0.0, "wind_speed_m_s": 0.0}
+    base.update(kw)
+    return sensor_env(**base)  # type: ignore[arg-type]
+
+
+def _box(s: Scene, lo: tuple[float, float, float], hi: tuple[float, float, float], *, cls: int, mat: int = 0) -> int:
+    v = np.array([[(hi if (i >> k) & 1 else lo)[k] for k in range(3)] for i in range(8)], dtype=np.float64)
+    f = np.array(
+        [
+            [0, 2, 1],
+            [1, 2, 3],
+            [4, 5, 6],
+            [5, 7, 6],
+            [0, 1, 4],
+            [1, 5, 4],
+            [2, 6, 3],
+            [3, 6, 7],
+            [0, 4, 2],
+            [2, 4, 6],
+            [1, 3, 5],
+            [3, 7, 5],
+        ]
+    )
+    return s.add_instance(s.add_mesh(v, f, classes=cls, name="box", materials=mat))
+
+
+def _water(s: Scene, half: float = 5000.0) -> int:
+    v = np.array([[-half, -half, 0.0], [half, -half, 0.0], [half, half, 0.0], [-half, half, 0.0]])
+    return s.add_instance(s.add_mesh(v, np.array([[0, 1, 2], [0, 2, 3]]), classes=1, name="water"))
+
+
+def test_metered_exposure_puts_a_grey_card_at_0_18() -> None:
+    env = _env()
+    lux, k = env.exposure
+    assert lux > 50_000  # a clear noon: sun and sky together
+    assert k == pytest.approx(math.pi / lux, rel=1e-6)
+    # A fixed EV100 gives the saturation-based scale 1 / (1.2 · 2^EV).
+    fixed = sensor_env(exposure_ev100=14.0)
+    assert fixed.exposure[1] == pytest.approx(1.0 / (1.2 * 2.0**14), rel=1e-6)
+
+
+def test_sun_disc_has_its_true_angular_size() -> None:
+    """Looking at the sun with a narrow camera: the pixels inside the disc cover a 0.533° circle."""
+    env = sensor_env(Environment.make(time_of_day="15:00"))
+    sun = np.asarray(env.sky_radiance(np.array([[0, 0, 1]], dtype=np.float32)))  # just to touch the API
+    assert sun.shape == (1, 3)
+    # Point the camera at the sun: direction from the environment.
+    d = np.asarray(Environment.make(time_of_day="15:00").sun.direction)
+    yaw, pitch = math.atan2(d[1], d[0]), -math.asin(d[2])
+    w = h = 101
+    hfov = math.radians(2.0)
+    cam = core.Camera(width=w, height=h, rgb=True, hfov=hfov, quality="draft")
+    img = render(cam, Scene(), pose=pose_matrices(np.array([0, 0, 0, 0, pitch, yaw])), env=env, seed=1, radiance=True)
+    assert img.radiance is not None
+    lum = img.radiance @ np.array([0.2126, 0.7152, 0.0722])
+    disc = lum > 0.5 * lum.max()
+    pixel_deg = 2.0 / w
+    want = math.pi * (0.5333 / 2 / pixel_deg) ** 2
+    assert disc.sum() == pytest.approx(want, rel=0.1), (disc.sum(), want)
+    # The disc is ~10^5 times brighter than the sky beside it.
+    assert lum.max() / np.median(lum) > 1e4
+
+
+def test_edge_pixels_are_averaged_and_labels_stay_exact() -> None:
+    """A dark box on a bright sky: at standard quality its silhouette pixels take intermediate values equal to
+    the covered fraction (checked against an analytic edge), while depth, class and instance stay the centre's."""
+    s = Scene()
+    black = np.zeros((2, 9), dtype=np.float32)
+    black[1, :3] = 0.0  # material 1: black, rough
+    black[1, 3] = 1.0
+    s.set_materials(black)
+    # A wall whose left edge is at y = 0.3 m, 10 m ahead: it crosses pixel columns at a fraction.
+    _box(s, (10.0, -50.0, -50.0), (10.5, 0.3, 50.0), cls=4, mat=1)
+    env = _env()
+    pose = np.eye(4)
+    hard = core.Camera(width=40, height=20, rgb=True, hfov=math.radians(40), quality="draft")
+    soft = core.Camera(width=40, height=20, rgb=True, hfov=math.radians(40), quality="high")
+    a = render(hard, s, pose=pose, env=env, seed=3, radiance=True)
+    b = render(soft, s, pose=pose, env=env, seed=3, radiance=True)
+    for name in ("depth", "semantic", "instance"):
+        assert np.array_equal(getattr(a, name), getattr(b, name)), name
+    assert a.radiance is not None and b.radiance is not None
+    lum_a = a.radiance @ np.array([0.2126, 0.7152, 0.0722])
+    lum_b = b.radiance @ np.array([0.2126, 0.7152, 0.0722])
+    row = 10
+    # Column of the edge: u = cx - fy·y/x with y = 0.3, x = 10 (body y left = image u decreasing).
+    fx = 40 / (2 * math.tan(math.radians(20)))
+    u_edge = 20 - fx * 0.3 / 10.0
+    col = int(u_edge)
+    covered = (col + 1) - u_edge  # the wall covers the right part [u_edge, col + 1) of that pixel
+    sky, wall = lum_a[row, col - 1], lum_a[row, col + 1]  # the neighbours, one on each side of the edge
+    assert wall < 0.05 * sky
+    # Draft: one sample at the centre, all sky or all wall. High: the covered fraction of each.
+    assert lum_a[row, col] == pytest.approx(wall if covered > 0.5 else sky, rel=0.15)
+    expect = (1 - covered) * sky + covered * wall
+    assert lum_b[row, col] == pytest.approx(expect, rel=0.15), (lum_b[row, col], expect, covered)
+
+
+def test_brown_conrady_rays_land_where_the_forward_model_projects() -> None:
+    """A distorted camera: a small marker's pixel equals the projection of its centre through the Brown–Conrady
+    forward model (written here in numpy, OpenCV's convention)."""
+    k = (-0.25, 0.06, 0.001, -0.002, 0.0)
+    w, h, hfov = 160, 120, math.radians(80)
+    cam = core.Camera(width=w, height=h, rgb=False, hfov=hfov, distortion=list(k))
+    assert cam.distortion == pytest.approx(k)
+    f = w / (2 * math.tan(hfov / 2))
+    for y, z in ((3.0, 2.0), (-4.0, -2.5), (0.0, 0.0), (5.5, 3.5)):
+        s = Scene()
+        _box(s, (10.0, y - 0.1, z - 0.1), (10.1, y + 0.1, z + 0.1), cls=7)
+        img = render(cam, s, pose=np.eye(4), env=_env(), seed=1)
+        vs, us = np.nonzero(img.instance == 0)
+        assert len(us) > 0, (y, z)
+        # Optical coordinates of the marker: x right = -y, y down = -z, over the depth 10.
+        xn, yn = -y / 10.0, -z / 10.0
+        r2 = xn * xn + yn * yn
+        k1, k2, p1, p2, k3 = k
+        radial = 1 + k1 * r2 + k2 * r2 * r2 + k3 * r2**3
+        xd = xn * radial + 2 * p1 * xn * yn + p2 * (r2 + 2 * xn * xn)
+        yd = yn * radial + p1 * (r2 + 2 * yn * yn) + 2 * p2 * xn * yn
+        u, v = w / 2 + f * xd, h / 2 + f * yd
+        assert abs((us.mean() + 0.5) - u) < 1.0 and abs((vs.mean() + 0.5) - v) < 1.0, (us.mean(), vs.mean(), u, v)
+    # A barrel strong enough to fold over inside the image leaves pixels without a ray: refused, naming the field.
+    with pytest.raises(mmusv.ConfigError, match=r"camera\.distortion"):
+        core.Camera(width=w, height=h, rgb=False, hfov=hfov, distortion=[-2.0, 0, 0, 0, 0])
+
+
+def test_sensor_noise_has_shot_and_read_variance() -> None:
+    """A uniform grey wall: with noise on, the sRGB spread is positive and reproducible from the seed; off, the
+    wall is flat."""
+    s = Scene()
+    _box(s, (5.0, -50.0, -50.0), (5.5, 50.0, 50.0), cls=4)
+    env = _env()
+    clean = core.Camera(width=64, height=48, rgb=True, hfov=math.radians(40), quality="draft")
+    noisy = core.Camera(width=64, height=48, rgb=True, hfov=math.radians(40), quality="draft", noise=(400.0, 5.0))
+    a = render(clean, s, pose=np.eye(4), env=env, seed=2).rgb
+    b = render(noisy, s, pose=np.eye(4), env=env, seed=2).rgb
+    c = render(noisy, s, pose=np.eye(4), env=env, seed=2).rgb
+    d = render(noisy, s, pose=np.eye(4), env=env, seed=9).rgb
+    assert a is not None and b is not None and c is not None and d is not None
+    assert a[..., 1].std() < 0.6
+    assert b[..., 1].astype(float).std() > 2.0
+    assert np.array_equal(b, c) and not np.array_equal(b, d)
+
+
+def test_nav_lights_glow_at_night_only_under_way() -> None:
+    s = Scene()
+    table = np.zeros((2, 9), dtype=np.float32)
+    table[1] = [0.8, 0.05, 0.05, 0.3, 0.0, 2e4, 0.0, 0.0, 1.0]  # a red sidelight
+    s.set_materials(table)
+    lamp = _box(s, (20.0, -0.2, 1.8), (20.3, 0.2, 2.2), cls=10, mat=1)
+    night = sensor_env(Environment.make(time_of_day="23:30"))
+    cam = core.Camera(width=64, height=48, rgb=True, hfov=math.radians(30), quality="draft")
+    pose = pose_matrices(np.array([0.0, 0.0, 2.0, 0.0, 0.0, 0.0]))
+    off = render(cam, s, pose=pose, env=night, seed=1).rgb
+    s.set_lights([lamp], on=True)
+    on = render(cam, s, pose=pose, env=night, seed=1).rgb
+    assert off is not None and on is not None
+    centre = (24, 32)
+    assert on[centre][0] > 200 and on[centre][0] > 3 * on[centre][1]
+    assert off[centre][0] < 60
+
+
+def test_whitecap_cover_follows_monahan() -> None:
+    """The top view of open water at 14 m/s: the share of foam pixels is Monahan's W = 3.84e-6 U^3.41."""
+    u = 14.0
+    want = 3.84e-6 * u**3.41
+    s = Scene()
+    _water(s)
+    env = _env(wind_speed_m_s=u)
+    calm = _env(wind_speed_m_s=0.0)
+    top = core.Camera(width=256, height=256, rgb=True, metres_per_pixel=2.0, quality="draft", range_max=500.0)
+    pose = pose_matrices(np.array([137.0, -59.0, 300.0, 0.0, math.pi / 2, 0.0]))
+    windy = render(top, s, pose=pose, env=env, seed=4, radiance=True).radiance
+    still = render(top, s, pose=pose, env=calm, seed=4, radiance=True).radiance
+    assert windy is not None and still is not None
+    lum_w = windy @ np.array([0.2126, 0.7152, 0.0722])
+    lum_s = still @ np.array([0.2126, 0.7152, 0.0722])
+    foam = lum_w > 5 * np.median(lum_s)
+    assert foam.mean() == pytest.approx(want, rel=0.35, abs=0.004), (foam.mean(), want)
+
+
+def test_wake_lies_behind_a_vessel_under_way() -> None:
+    s = Scene()
+    _water(s)
+    env = _env()
+    top = core.Camera(width=200, height=200, rgb=True, metres_per_pixel=1.0, quality="draft", range_max=500.0)
+    pose = pose_matrices(np.array([0.0, 0.0, 300.0, 0.0, math.pi / 2, 0.0]))  # bow (+x) at the image top
+    wakes = np.array([[20.0, 0.0, 0.0, 10.0, 12.0, 4.0]], dtype=np.float32)  # at x = 20 m heading +x, 10 m/s
+    a = render(top, s, pose=pose, env=env, seed=1, wakes=wakes, radiance=True).radiance
+    b = render(top, s, pose=pose, env=env, seed=1, radiance=True).radiance
+    assert a is not None and b is not None
+    diff = (a - b) @ np.array([0.2126, 0.7152, 0.0722])
+    foam = diff > 0.05 * np.median(b @ np.array([0.2126, 0.7152, 0.0722]))
+    rows, _ = np.nonzero(foam)
+    assert foam.sum() > 100
+    # Image row v is world x = (100 - v - 0.5) m: foam lies behind the stern (x < 14 m), none ahead of the bow.
+    x = 100 - rows - 0.5
+    assert (x < 14.5).mean() > 0.99
+
+
+def test_camera_image_options_reach_the_recording(tmp_path: Path) -> None:
+    """quality, distortion and noise from the scenario schema reach the native camera, and the distortion is
+    written beside the intrinsics (recording metadata, read back by the one reader)."""
+    import yaml
+    from mmusv.acquire import run
+    from mmusv.recording.reader import read_info
+
+    root = Path(__file__).resolve().parents[2]
+    sc = yaml.safe_load((root / "scenarios/port_entry.yaml").read_text())
+    sc["acquisition"]["frames"] = 1
+    sc["vessels"] = [v for v in sc["vessels"] if v["id"] != "usv_3" and v["id"] != "usv_2"]
+    k = [-0.1, 0.01, 0.0, 0.0, 0.0]
+    sc["rigs"] = {
+        "usv_standard": {
+            "lidar": None,
+            "radar": None,
+            "top_view": None,
+            "cameras": [
+                {
+                    "name": "front",
+                    "resolution": [48, 32],
+                    "mount": {"point": "camera_front"},
+                    "quality": "draft",
+                    "distortion": k,
+                    "noise": {"full_well_e": 5000, "read_noise_e": 2},
+                }
+            ],
+        }
+    }
+    res = run(sc, out_dir=tmp_path)
+    info = read_info(res.recording)
+    cam = info.agents[0].cameras["front"]
+    assert cam.distortion == pytest.approx(tuple(k))
+    bad = dict(sc)
+    bad["rigs"] = {"usv_standard": {"cameras": [{"name": "front", "quality": "ultra"}]}}
+    with pytest.raises(mmusv.ConfigError, match="quality"):
+        run(bad, out_dir=tmp_path / "bad")
