@@ -127,3 +127,35 @@ def test_damage_in_the_real_recorder_output(small: Path, tmp_path: Path) -> None
     res = api_readers(path)
     check_against(res, reference)
     assert sorted(res["frames"][0]) == list(range(12))
+
+
+def test_the_batch_index_and_the_editor_open_damaged_files_cleanly(small: Path, tmp_path: Path) -> None:
+    """A damaged ``dataset.json`` (the batch index that ``convert`` and the studies read) and a damaged scenario
+    file opened in the editor: one error naming the file."""
+    import warnings
+
+    from mmusv.batch.index import dataset_recordings
+
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out/dataset.json").write_bytes(b'{"format": "mmusv.dataset", "version": 1, "recordings": [\x00')
+    with pytest.raises(IoError, match=r"dataset\.json"):
+        dataset_recordings(tmp_path / "out")
+    code, _out, err = cli_main("convert", str(tmp_path / "out"), "-o", str(tmp_path / "c"), "--no-progress")
+    assert code == 2 and "dataset.json" in err and err.count("\n") == 1, err
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # starlette's notice about its httpx-based test client
+        from fastapi.testclient import TestClient
+    from mmusv.editor.app import create_app
+
+    folder = tmp_path / "scenarios"
+    folder.mkdir()
+    (folder / "bad.yaml").write_bytes((small / "tiny.mcap").read_bytes()[:3000])  # binary garbage
+    (folder / "cut.yaml").write_text((small / "scenario.yaml").read_text()[:200], encoding="utf-8")
+    client = TestClient(create_app(folder))
+    for name in ("bad.yaml", "cut.yaml"):
+        r = client.get(f"/api/files/{name}")
+        assert r.status_code in (200, 422) and "Traceback" not in r.text, r.text
+        if r.status_code == 422:
+            assert name in r.json()["error"]
+        else:
+            assert r.json()["valid"] is False
