@@ -1,0 +1,285 @@
+"""Renders the before/after pictures of issue #28 (docs/realism/) with whichever mmusv is on the path.
+
+Usage: ``python3 scripts/realism_pictures.py --out DIR --label before|after [--only VIEW ...]``
+
+Every view is a small scenario dict built here and rendered through APIs that exist both before issue #28
+(commit 66e5052) and after it: :class:`mmusv.Simulation`, ``Simulation.capture``, :func:`mmusv.run` and
+:func:`mmusv.preview.write_preview`. So the same script, run once with the old package on ``PYTHONPATH`` and once
+with the new one, draws the same frames from the same poses. Each view is written as ``DIR/<view>_<label>.png``:
+
+* ``port_entry_preview``: the ``mmusv preview`` sheet of ``port_entry`` frame 10 (an 11-frame run);
+* ``container_150m``: a 300 m container ship under way, its centre 150 m from the camera;
+* ``tug_30m``: a 32 m tug under way, its centre 30 m from the camera;
+* ``ferry_dusk``: a 90 m ro-pax ferry under way at 21:00 (sun 10° below the horizon), 120 m off;
+* ``ferry_dusk_zoom``: its mast and bridge enlarged 4× (the lights are a few pixels each);
+* ``whitecaps_w3``: open water at wave level W3, from 8 m above the sea;
+* ``wake_chase``: a 35 m patrol boat at 14 m/s, seen from 20 m above a vessel following 100 m behind;
+* ``wake_top``: the same boat in its own top view (orthographic, heading up, 0.6 m per pixel);
+* ``lidar_bulk_100m``: the points of the default 64-channel LiDAR and of a dense 128-channel one on a 190 m bulk
+  carrier whose centre line is 100 m off, in the ship's frame (side and plan views, coloured by intensity).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import tempfile
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import mmusv
+import numpy as np
+from mmusv.bundled import resolve_scenario
+from mmusv.preview import write_preview
+
+# The camera vessel: a small USV lying still at the origin, heading east (yaw 0), so a mount's yaw is a world
+# bearing (counter-clockwise from east) and its pitch looks down (positive) or up.
+_OBSERVER = {"id": "observer", "role": "usv", "asset": "usv_wamv", "rig": "view", "route": [[0.0, 0.0], [10.0, 0.0]]}
+_OPEN_SEA = {"type": "open_sea", "seed": 1, "params": {"n_buoys": 0, "islet_probability": 0.0}}
+
+
+def _camera_rig(
+    *, resolution: tuple[int, int], hfov_deg: float, xyz: tuple[float, float, float], yaw_deg: float, pitch_deg: float
+) -> dict[str, Any]:
+    """A rig with one camera and nothing else; the mount is relative to the vessel origin (body frame)."""
+    camera = {
+        "name": "view",
+        "resolution": list(resolution),
+        "hfov_deg": hfov_deg,
+        "outputs": ["rgb"],
+        "mount": {"xyz": list(xyz), "rpy_deg": [0.0, pitch_deg, yaw_deg]},
+    }
+    return {"lidar": None, "radar": None, "top_view": None, "cameras": [camera]}
+
+
+def _scenario(
+    name: str, *, rig: dict[str, Any], vessels: list[dict[str, Any]], environment: dict[str, Any], observer: Any = None
+) -> dict[str, Any]:
+    return {
+        "name": name,
+        "seed": 28,
+        "map": _OPEN_SEA,
+        "environment": environment,
+        "acquisition": {"frequency_hz": 5, "frames": 1},
+        "rigs": {"view": rig},
+        "vessels": [observer or _OBSERVER, *vessels],
+    }
+
+
+def _route(x: float, y: float, heading_deg: float, length_m: float = 2000.0) -> list[list[float]]:
+    """A straight route starting at ``(x, y)`` (where the vessel is at frame 0) along ``heading_deg``."""
+    h = math.radians(heading_deg)
+    return [[x, y], [x + length_m * math.cos(h), y + length_m * math.sin(h)]]
+
+
+def _at(bearing_deg: float, range_m: float) -> tuple[float, float]:
+    b = math.radians(bearing_deg)
+    return range_m * math.cos(b), range_m * math.sin(b)
+
+
+def _save_rgb(scenario: dict[str, Any], path: Path) -> None:
+    """Captures frame 0 of ``scenario``'s cameras and writes the first USV's camera ``view`` as a PNG."""
+    from PIL import Image
+
+    sim = mmusv.Simulation(scenario)
+    cap = sim.capture(0, sensors=["cameras"])
+    rgb = cap.agents[sim.agents[0].id].cameras["view"].rgb
+    assert rgb is not None
+    Image.fromarray(np.asarray(rgb)).save(path)
+
+
+# ---------------------------------------------------------------------------------------------------- views
+
+
+def port_entry_preview(path: Path) -> None:
+    """The ``mmusv preview`` sheet of port_entry frame 10."""
+    with tempfile.TemporaryDirectory(prefix="realism_") as tmp:
+        result = mmusv.run(str(resolve_scenario("port_entry")), out_dir=tmp, frames=11)
+        write_preview(result.recording, frame=10, output=path)
+
+
+def container_150m(path: Path) -> None:
+    """A container ship under way (5 m/s), its centre 150 m due east of the camera, 30° off broadside."""
+    x, y = _at(0.0, 150.0)
+    ship = {"id": "ship", "asset": "container_ship_300m", "speed_mps": 5.0, "route": _route(x, y, 120.0)}
+    rig = _camera_rig(resolution=(1024, 512), hfov_deg=100.0, xyz=(0.0, 0.0, 3.0), yaw_deg=15.0, pitch_deg=-8.0)
+    env = {"time_of_day": "10:30", "weather": "clear", "wave": "W1"}
+    _save_rgb(_scenario("container_150m", rig=rig, vessels=[ship], environment=env), path)
+
+
+def tug_30m(path: Path) -> None:
+    """A tug under way (2 m/s), its centre 30 m from the camera, broadside on."""
+    x, y = _at(0.0, 30.0)
+    tug = {"id": "tug", "asset": "tug_32m", "speed_mps": 2.0, "route": _route(x, y, 100.0)}
+    rig = _camera_rig(resolution=(800, 600), hfov_deg=80.0, xyz=(0.0, 0.0, 3.0), yaw_deg=0.0, pitch_deg=-8.0)
+    env = {"time_of_day": "10:30", "weather": "clear", "wave": "W1"}
+    _save_rgb(_scenario("tug_30m", rig=rig, vessels=[tug], environment=env), path)
+
+
+def ferry_dusk(path: Path) -> None:
+    """A ro-pax ferry under way at 21:00 on 21 June at 45° N (sun 10° below the horizon, to the north-west:
+    nautical twilight), 120 m off towards the afterglow, heading west-south-west so its bow, port side (red
+    sidelight) and masthead light face the camera."""
+    bearing = 140.0
+    x, y = _at(bearing, 120.0)
+    ferry = {"id": "ferry", "asset": "ropax_ferry_90m", "speed_mps": 6.0, "route": _route(x, y, 265.0)}
+    rig = _camera_rig(resolution=(960, 540), hfov_deg=60.0, xyz=(0.0, 0.0, 3.0), yaw_deg=bearing, pitch_deg=-5.0)
+    env = {"time_of_day": "21:00", "weather": "clear", "wave": "W1"}
+    _save_rgb(_scenario("ferry_dusk", rig=rig, vessels=[ferry], environment=env), path)
+
+
+def ferry_dusk_zoom(path: Path) -> None:
+    """The mast and bridge of ``ferry_dusk`` (pixels 330..530 × 150..270 of the same render) enlarged 4× without
+    smoothing, so the navigation lights (a few pixels each) can be seen."""
+    from PIL import Image
+
+    with tempfile.TemporaryDirectory(prefix="realism_") as tmp:
+        full = Path(tmp) / "full.png"
+        ferry_dusk(full)
+        with Image.open(full) as im:
+            im.crop((330, 150, 530, 270)).resize((800, 480), Image.Resampling.NEAREST).save(path)
+
+
+def whitecaps_w3(path: Path) -> None:
+    """Open water at W3 (clear, 11:00), looking north-west (down-sun) from 8 m above the sea."""
+    rig = _camera_rig(resolution=(960, 540), hfov_deg=90.0, xyz=(0.0, 0.0, 8.0), yaw_deg=120.0, pitch_deg=8.0)
+    env = {"time_of_day": "11:00", "weather": "clear", "wave": "W3"}
+    buoy = {"id": "far", "asset": "fishing_boat_12m", "speed_mps": 0.0, "route": _route(*_at(125.0, 220.0), 0.0)}
+    _save_rgb(_scenario("whitecaps_w3", rig=rig, vessels=[buoy], environment=env), path)
+
+
+_FAST = {"id": "fast", "asset": "patrol_boat_35m", "speed_mps": 14.0, "route": _route(0.0, 0.0, 90.0, 4000.0)}
+
+
+def wake_chase(path: Path) -> None:
+    """A patrol boat at 14 m/s heading north, from 20 m above a vessel 100 m behind it and 15 m to the side,
+    going the same speed."""
+    chase = {**_OBSERVER, "speed_mps": 14.0, "route": _route(-15.0, -100.0, 90.0, 4000.0)}
+    yaw = math.degrees(math.atan2(15.0, 100.0))  # body frame: heading north, the boat 8.5° to the right
+    rig = _camera_rig(resolution=(960, 540), hfov_deg=70.0, xyz=(0.0, 0.0, 20.0), yaw_deg=-yaw, pitch_deg=16.0)
+    env = {"time_of_day": "12:00", "weather": "clear", "wave": "W1"}
+    _save_rgb(_scenario("wake_chase", rig=rig, vessels=[_FAST], environment=env, observer=chase), path)
+
+
+def wake_top(path: Path) -> None:
+    """The patrol boat's own top view: 120 m up, heading up, 0.6 m per pixel, 640 × 640 (384 m square)."""
+    from PIL import Image
+
+    rig = {
+        "lidar": None,
+        "radar": None,
+        "cameras": [],
+        "top_view": {"resolution": [640, 640], "metres_per_pixel": 0.6, "outputs": ["rgb"]},
+    }
+    boat = {**_FAST, "role": "usv", "rig": "view"}
+    env = {"time_of_day": "12:00", "weather": "clear", "wave": "W1"}
+    sc = {**_scenario("wake_top", rig=rig, vessels=[], environment=env, observer=boat)}
+    sim = mmusv.Simulation(sc)
+    top = sim.capture(0, sensors=["top_view"]).agents["fast"].top_view
+    assert top is not None and top.rgb is not None
+    Image.fromarray(np.asarray(top.rgb)).save(path)
+
+
+_DENSE_LIDAR = {
+    "channels": 128,
+    "vertical_fov_deg": [-5.0, 20.0],
+    "points_per_second": 128 * 3600 * 5.0,
+    "rotation_hz": 5.0,
+}
+"""A dense scan (128 channels over -5..20°, 0.1° between columns) that resolves the hull's detail at 100 m."""
+
+
+def _ship_points(lidar: dict[str, Any]) -> tuple[np.ndarray, np.ndarray, Any]:
+    """The LiDAR points on a bulk carrier lying still, its centre line 100 m north of the LiDAR, heading east:
+    ``(N, 3)`` float64 points in the ship's body frame (metres), their ``(N,)`` intensities and the ship's
+    :class:`~mmusv.simulation.VesselInfo`."""
+    ship = {"id": "bulk", "asset": "bulk_carrier_190m", "speed_mps": 0.0, "route": _route(0.0, 100.0, 0.0)}
+    rig = {"lidar": lidar, "radar": None, "cameras": [], "top_view": None}
+    env = {"time_of_day": "12:00", "weather": "clear", "wave": "W0"}
+    sim = mmusv.Simulation(_scenario("lidar_bulk_100m", rig=rig, vessels=[ship], environment=env))
+    cap = sim.capture(0, sensors=["lidar"])
+    ac = cap.agents["observer"]
+    assert ac.lidar is not None and ac.lidar_pose is not None
+    k = [v.id for v in sim.vessels].index("bulk")
+    info = sim.vessels[k]
+    on_ship = ac.lidar.instance == info.instance_id
+    world = ac.lidar.xyz[on_ship].astype(np.float64) @ ac.lidar_pose[:3, :3].T + ac.lidar_pose[:3, 3]
+    ship_mat = cap.world.matrices[k]
+    return (world - ship_mat[:3, 3]) @ ship_mat[:3, :3], ac.lidar.intensity[on_ship], info
+
+
+def lidar_bulk_100m(path: Path, label: str) -> None:
+    """Side (x, z) and plan (x, y) views, in the ship's frame and coloured by intensity, of the points of two
+    LiDARs on the USV on a bulk carrier whose centre line is 100 m off: the default (64 channels over -25..15°,
+    131,072 points/s at 5 Hz: 0.88° between columns) and :data:`_DENSE_LIDAR`."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    scans = [("default 64-channel LiDAR", {}), ("dense 128-channel LiDAR, 0.1° columns", _DENSE_LIDAR)]
+    data = [(title, *_ship_points(cfg)) for title, cfg in scans]
+    info = data[0][3]
+    size = info.box_size
+    fig, axes = plt.subplots(
+        4, 1, figsize=(10, 11), layout="constrained", gridspec_kw={"height_ratios": [size[2], size[1]] * 2}
+    )
+    half = size / 2 + 4.0
+    sc = None
+    for row, (title, body, intensity, _) in enumerate(data):
+        side, plan = axes[2 * row], axes[2 * row + 1]
+        dot = 2.0 if row == 0 else 0.4
+        for ax, j, name in ((side, 2, "z (up)"), (plan, 1, "y (port)")):
+            sc = ax.scatter(body[:, 0], body[:, j], c=intensity, s=dot, cmap="viridis", vmin=0.0, vmax=0.3, lw=0)
+            ax.set_xlim(info.box_center_body[0] - half[0], info.box_center_body[0] + half[0])
+            ax.set_ylim(info.box_center_body[j] - half[j], info.box_center_body[j] + half[j])
+            ax.set_aspect("equal")
+            ax.set_ylabel(f"{name}, m")
+            ax.grid(alpha=0.3)
+        side.set_title(f"{label}: {title}, {len(body):,} points on the ship (side, then plan)", fontsize=10)
+    axes[-1].set_xlabel("x (bow →), m, ship frame")
+    assert sc is not None
+    fig.colorbar(sc, ax=list(axes), label="intensity", shrink=0.6)
+    fig.suptitle("bulk_carrier_190m, centre line 100 m from the LiDAR, starboard side towards it", fontsize=11)
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+VIEWS: dict[str, Callable[[Path], None]] = {
+    "port_entry_preview": port_entry_preview,
+    "container_150m": container_150m,
+    "tug_30m": tug_30m,
+    "ferry_dusk": ferry_dusk,
+    "ferry_dusk_zoom": ferry_dusk_zoom,
+    "whitecaps_w3": whitecaps_w3,
+    "wake_chase": wake_chase,
+    "wake_top": wake_top,
+}
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", required=True, type=Path, help="output folder")
+    parser.add_argument("--label", required=True, choices=["before", "after"], help="suffix of the file names")
+    parser.add_argument("--only", nargs="*", choices=[*VIEWS, "lidar_bulk_100m"], help="render only these views")
+    args = parser.parse_args(argv)
+    args.out.mkdir(parents=True, exist_ok=True)
+    print(f"mmusv from {Path(mmusv.__file__).parent}", file=sys.stderr)
+    for name in [*VIEWS, "lidar_bulk_100m"]:
+        if args.only and name not in args.only:
+            continue
+        path = args.out / f"{name}_{args.label}.png"
+        t0 = time.perf_counter()
+        if name == "lidar_bulk_100m":
+            lidar_bulk_100m(path, args.label)
+        else:
+            VIEWS[name](path)
+        print(f"{path}  {time.perf_counter() - t0:.1f} s", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
