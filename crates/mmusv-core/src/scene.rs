@@ -183,6 +183,11 @@ impl Scene {
         Ok(())
     }
 
+    /// The material table (shared, cheap to clone).
+    pub fn material_table(&self) -> Arc<Vec<Material>> {
+        Arc::clone(&self.materials)
+    }
+
     /// Number of rows in the material table.
     pub fn num_materials(&self) -> usize {
         self.materials.len()

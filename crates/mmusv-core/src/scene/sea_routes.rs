@@ -7,9 +7,11 @@ use crate::error::{MmusvError, Result};
 use crate::ray::RayPrep;
 use crate::sea::{Horizon, Sea, SunMask};
 
-/// Longest height-map walks (cells) worth trying before a full trace: up into the sky (camera rays), up towards
-/// the sun (shadow rays).
+/// Longest height-map walks (cells) worth trying before a full trace: up into the sky (camera rays, which ask
+/// their viewpoint's horizon first), up into the sky from many origins (no horizon: rays reflected by the
+/// water, each of which would otherwise be traced in full), up towards the sun (shadow rays).
 const SEA_WALK_SKY: usize = 2;
+const SEA_WALK_SKY_NO_HORIZON: usize = 48;
 const SEA_WALK_SHADOW: usize = 2;
 
 impl Scene {
@@ -81,8 +83,9 @@ impl Scene {
             if h.clear(ray.d) {
                 return true;
             }
+            return self.sea_clear_within(ray, limit, SEA_WALK_SKY);
         }
-        self.sea_clear_within(ray, limit, SEA_WALK_SKY)
+        self.sea_clear_within(ray, limit, SEA_WALK_SKY_NO_HORIZON)
     }
 
     /// The [`Horizon`] of viewpoint `origin` (see [`crate::sea`]): the static height map, the moving instances'

@@ -30,6 +30,8 @@ use rayon::prelude::*;
 
 pub mod radiance;
 
+use radiance::Reflections;
+
 /// Largest image side, pixels.
 pub const MAX_SIDE: u32 = 16_384;
 
@@ -53,10 +55,10 @@ pub enum Projection {
 pub enum Quality {
     /// One sample per pixel; water reflects the sky only.
     Draft,
-    /// Traced water reflections; 4 stratified samples on edge pixels.
+    /// Traced water reflections, one per 2 × 2 block of water pixels; 4 stratified samples on edge pixels.
     #[default]
     Standard,
-    /// Traced water reflections; 16 stratified samples on edge pixels.
+    /// Traced water reflections for every pixel; 16 stratified samples on edge pixels.
     High,
 }
 
@@ -419,8 +421,19 @@ impl Camera {
             return Ok(frame);
         }
         let q = self.cfg.image.quality;
-        let shader = Shader::new(env, options.seed, options.wakes);
-        let traced = radiance::radiance(scene, &shader, env.shadows, q.reflections(), &origins, &dirs, &hits)?;
+        let shader = Shader::new(env, options.seed, options.wakes).with_materials(scene.material_table());
+        // Standard quality shares one traced reflection per 2 × 2 block of water pixels; high traces each.
+        let block = |k: usize| {
+            let i = self.order[k];
+            let (x, y) = (i % self.cfg.width, i / self.cfg.width);
+            self.trace_index((y & !1) * self.cfg.width + (x & !1))
+        };
+        let refl = match q {
+            Quality::Draft => Reflections::Sky,
+            Quality::Standard => Reflections::Shared(&block),
+            Quality::High => Reflections::Every,
+        };
+        let traced = radiance::radiance(scene, &shader, env.shadows, refl, &origins, &dirs, &hits)?;
         let mut linear = vec![Vec3::ZERO; n];
         for (k, &i) in self.order.iter().enumerate() {
             linear[i as usize] = traced[k];
@@ -431,7 +444,8 @@ impl Camera {
             if !edges.is_empty() {
                 let (so, sd) = self.sample_rays(pose, &edges, s, options.seed);
                 let shits = scene.cast_rays(&so, &sd, self.cfg.range_max)?;
-                let samples = radiance::radiance(scene, &shader, env.shadows, q.reflections(), &so, &sd, &shits)?;
+                let refl = if q.reflections() { Reflections::Every } else { Reflections::Sky };
+                let samples = radiance::radiance(scene, &shader, env.shadows, refl, &so, &sd, &shits)?;
                 let per = s as usize;
                 for (e, &i) in edges.iter().enumerate() {
                     let sum: Vec3 = samples[e * per..(e + 1) * per].iter().copied().sum();

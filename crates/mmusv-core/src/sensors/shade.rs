@@ -104,8 +104,9 @@ pub struct SurfaceHit {
     pub class: u16,
     /// Scene instance id.
     pub instance: i32,
-    /// The face's material, `None` for the class's default.
-    pub material: Option<Material>,
+    /// The face's material: an index into the shader's table ([`Shader::with_materials`]), 0 for the class's
+    /// default.
+    pub material: u16,
     /// Whether the instance's navigation lights are on.
     pub lights_on: bool,
     /// The shading normal: the geometric one, or for water the swell's ([`Shader::with_swell`]).
@@ -160,6 +161,20 @@ pub fn class_material(hit: &SurfaceHit) -> Material {
     Material { base_color: base.to_array(), roughness, metallic, emissive: [0.0; 3], nav_light: false }
 }
 
+/// `cos x` to within 10⁻⁶ without a library call: the argument reduced to `[−π, π]` in `f64`, folded onto
+/// `[0, π/2]`, then the Taylor series to `x¹²` (remainder below `(π/2)¹⁴ / 14! ≈ 6·10⁻⁹`).
+#[inline(always)]
+fn fast_cos(x: f32) -> f32 {
+    let x = x as f64;
+    let r = x - std::f64::consts::TAU * (x / std::f64::consts::TAU).round();
+    let a = r.abs();
+    let (a, sign) = if a > std::f64::consts::FRAC_PI_2 { (std::f64::consts::PI - a, -1.0) } else { (a, 1.0) };
+    let z = a * a;
+    let c =
+        1.0 - z / 2.0 * (1.0 - z / 12.0 * (1.0 - z / 30.0 * (1.0 - z / 56.0 * (1.0 - z / 90.0 * (1.0 - z / 132.0)))));
+    (sign * c) as f32
+}
+
 /// One swell component of the water surface: direction `(cos, sin)`, wave number, phase and slope amplitude.
 #[derive(Debug, Clone, Copy)]
 struct Swell {
@@ -184,6 +199,7 @@ pub struct Shader {
     water_rho: Vec3,
     foam: Foam,
     exposure: f32,
+    materials: Arc<Vec<Material>>,
 }
 
 impl Shader {
@@ -215,7 +231,14 @@ impl Shader {
             water_rho: Vec3::from_array(env.water_albedo),
             foam: Foam::new(water::monahan_coverage(env.wind_speed_m_s), wakes, 0x5EA),
             exposure,
+            materials: Arc::new(Vec::new()),
         }
+    }
+
+    /// This shader reading face materials from `table` (a scene's, [`crate::Scene::material_table`]).
+    pub fn with_materials(mut self, table: Arc<Vec<Material>>) -> Self {
+        self.materials = table;
+        self
     }
 
     /// The lighting (sky, sun, image-based light).
@@ -274,7 +297,7 @@ impl Shader {
         let mut gy = 0.0;
         for w in &self.swell {
             let arg = w.k * (w.c * p.x + w.s * p.y) + w.phase;
-            let slope = w.amp_k * arg.cos();
+            let slope = w.amp_k * fast_cos(arg);
             gx += slope * w.c;
             gy += slope * w.s;
         }
@@ -308,7 +331,10 @@ impl Shader {
     /// Radiance (before aerial perspective) of a non-water surface seen along `d`, lit by the sun when `sunlit`.
     #[inline]
     pub fn surface(&self, d: Vec3, hit: &SurfaceHit, sunlit: bool) -> Vec3 {
-        let m = hit.material.unwrap_or_else(|| class_material(hit));
+        let m = match self.materials.get(hit.material as usize) {
+            Some(m) if hit.material != 0 => *m,
+            _ => class_material(hit),
+        };
         let base = Vec3::from_array(m.base_color);
         let n = hit.normal;
         let v = -d;
@@ -417,7 +443,7 @@ impl Shader {
 mod tests {
     use super::*;
 
-    fn hit(class: u16, material: Option<Material>) -> SurfaceHit {
+    fn hit(class: u16, material: u16) -> SurfaceHit {
         SurfaceHit {
             t: 10.0,
             point: Vec3::ZERO,
@@ -431,13 +457,26 @@ mod tests {
     }
 
     #[test]
+    fn fast_cos_is_cos() {
+        for i in -200_000..200_000 {
+            let x = i as f32 * 0.001_37;
+            assert!((fast_cos(x) - (x as f64).cos() as f32).abs() < 2e-6, "{x}");
+        }
+    }
+
+    /// A table whose material 1 is `m`.
+    fn table(m: Material) -> Arc<Vec<Material>> {
+        Arc::new(vec![m, m])
+    }
+
+    #[test]
     fn lambert_plane_under_the_sun_is_albedo_times_irradiance_over_pi() {
         let env = ShadeEnv { fog_extinction_per_m: 0.0, ..ShadeEnv::default() };
-        let sh = Shader::new(&env, 1, &[]);
         let m = Material { base_color: [0.5; 3], roughness: 1.0, metallic: 0.0, emissive: [0.0; 3], nav_light: false };
+        let sh = Shader::new(&env, 1, &[]).with_materials(table(m));
         // The specular part of a rough dielectric is small; compare the diffuse share in closed form.
-        let lit = sh.surface(-Vec3::Z, &hit(2, Some(m)), true);
-        let dark = sh.surface(-Vec3::Z, &hit(2, Some(m)), false);
+        let lit = sh.surface(-Vec3::Z, &hit(2, 1), true);
+        let dark = sh.surface(-Vec3::Z, &hit(2, 1), false);
         let sun = sh.sun();
         let want = sh.sun_e * (0.5 / std::f32::consts::PI * sun.z);
         let got = lit - dark;
@@ -451,7 +490,6 @@ mod tests {
     #[test]
     fn nav_lights_glow_only_when_on_and_fog_veils() {
         let env = ShadeEnv { sun_direction: [0.0, 0.9, -0.436], ..ShadeEnv::default() };
-        let sh = Shader::new(&env, 1, &[]);
         let lamp = Material {
             base_color: [0.8, 0.1, 0.1],
             roughness: 0.3,
@@ -459,11 +497,12 @@ mod tests {
             emissive: [2e4, 0.0, 0.0],
             nav_light: true,
         };
-        let off = sh.surface(-Vec3::X, &SurfaceHit { normal: Vec3::X, ..hit(10, Some(lamp)) }, false);
-        let on = sh.surface(-Vec3::X, &SurfaceHit { normal: Vec3::X, lights_on: true, ..hit(10, Some(lamp)) }, false);
+        let sh = Shader::new(&env, 1, &[]).with_materials(table(lamp));
+        let off = sh.surface(-Vec3::X, &SurfaceHit { normal: Vec3::X, ..hit(10, 1) }, false);
+        let on = sh.surface(-Vec3::X, &SurfaceHit { normal: Vec3::X, lights_on: true, ..hit(10, 1) }, false);
         assert!(on.x > 1e4 && off.x < 10.0, "{on} {off}");
         let foggy = Shader::new(&ShadeEnv { fog_extinction_per_m: 0.01, ..ShadeEnv::default() }, 1, &[]);
-        let far = foggy.shade(-Vec3::X, Some(&SurfaceHit { t: 5000.0, normal: Vec3::X, ..hit(2, None) }), true, None);
+        let far = foggy.shade(-Vec3::X, Some(&SurfaceHit { t: 5000.0, normal: Vec3::X, ..hit(2, 0) }), true, None);
         let air = foggy.air_light(-Vec3::X);
         assert!((far - air).length() < 1e-3 * air.length());
     }
@@ -472,7 +511,7 @@ mod tests {
     fn water_reflects_by_fresnel() {
         let env = ShadeEnv { wave_height_m: 0.0, wind_speed_m_s: 0.0, ..ShadeEnv::default() };
         let sh = Shader::new(&env, 1, &[]);
-        let w = sh.with_swell(-Vec3::Z, hit(1, None));
+        let w = sh.with_swell(-Vec3::Z, hit(1, 0));
         // Looking straight down (no glint: the sun is not behind the camera) the reflected radiance is weighted
         // by F(0) = 0.02; at grazing incidence by much more.
         let bright = Vec3::splat(1000.0);
@@ -481,7 +520,7 @@ mod tests {
         let f = fresnel_dielectric(n.dot(Vec3::Z), WATER_IOR);
         assert!((down.x - 1000.0 * f).abs() < 0.01, "{down} {f}");
         let g = Vec3::new(1.0, 0.0, -0.05).normalize();
-        let wg = sh.with_swell(g, hit(1, None));
+        let wg = sh.with_swell(g, hit(1, 0));
         let graze = sh.water(g, &wg, false, Some(bright)) - sh.water(g, &wg, false, Some(Vec3::ZERO));
         assert!(graze.x > 5.0 * down.x);
     }

@@ -2,7 +2,9 @@
 //! reflections by traced rays (with their own shadow rays), then the [`Shader`] per ray.
 //!
 //! Every stage is one batch over the scene (parallel, coherent packets in the order given), so a camera's
-//! pixels, its anti-aliasing samples and any other ray set go through the same code.
+//! pixels, its anti-aliasing samples and any other ray set go through the same code. Hits are turned into
+//! [`SurfaceHit`]s on the fly in each pass rather than stored (a stored hit per pixel costs more in memory
+//! traffic than recomputing it).
 
 use crate::error::Result;
 use crate::scene::{RayHits, Scene};
@@ -43,26 +45,31 @@ pub(crate) fn surface_at(
         normal,
         class: hits.class[k],
         instance,
-        material: scene.material_of(instance, triangle).copied(),
+        material: scene.material_index(instance, triangle),
         lights_on: scene.instances().get(instance as usize).is_some_and(|i| i.lights_on()),
         shading_normal: normal,
     };
     Some(shader.with_swell(d, hit))
 }
 
-/// Which of `surfaces` see the sun (all false at night; all that face it when shadows are off).
-fn sunlit(scene: &Scene, shader: &Shader, shadows: bool, surfaces: &[Option<SurfaceHit>]) -> Result<Vec<bool>> {
-    let n = surfaces.len();
+/// Which of the `n` rays' hits (`surface(k)`) see the sun: all false at night, all that face it when shadows
+/// are off.
+fn sunlit(
+    scene: &Scene,
+    shader: &Shader,
+    shadows: bool,
+    n: usize,
+    surface: impl Fn(usize) -> Option<SurfaceHit> + Sync,
+) -> Result<Vec<bool>> {
     let mut lit = vec![false; n];
     if !shader.sun_up() {
         return Ok(lit);
     }
     let sun = shader.sun();
-    let facing: Vec<(u32, [f32; 3])> = surfaces
-        .par_iter()
-        .enumerate()
-        .filter_map(|(k, h)| {
-            let h = h.as_ref()?;
+    let facing: Vec<(u32, [f32; 3])> = (0..n)
+        .into_par_iter()
+        .filter_map(|k| {
+            let h = surface(k)?;
             if h.normal.dot(sun) > 0.0 || h.is_water() {
                 let eps = 0.02 + 1e-4 * h.t;
                 Some((k as u32, (h.point + h.normal * eps).to_array()))
@@ -86,59 +93,84 @@ fn sunlit(scene: &Scene, shader: &Shader, shadows: bool, surfaces: &[Option<Surf
     Ok(lit)
 }
 
+/// Where water reflections are traced.
+#[derive(Clone, Copy)]
+pub enum Reflections<'a> {
+    /// Not at all: water reflects the sky.
+    Sky,
+    /// For every water ray.
+    Every,
+    /// Once per group: ray `k` takes the reflected radiance of ray `representative(k)` when that one is water
+    /// too (its own otherwise); a representative is its own.
+    Shared(&'a (dyn Fn(usize) -> usize + Sync)),
+}
+
 /// Radiance (linear RGB, cd/m², aerial perspective included) along every ray `origins[k] + t dirs[k]` whose
-/// closest hits are `hits`. `reflections` traces the rays water reflects (else water reflects the sky);
-/// `shadows` casts shadow rays (else every surface facing the sun is lit).
+/// closest hits are `hits`, with water `reflections` traced as asked; `shadows` casts shadow rays (else every
+/// surface facing the sun is lit).
 pub fn radiance(
     scene: &Scene,
     shader: &Shader,
     shadows: bool,
-    reflections: bool,
+    reflections: Reflections<'_>,
     origins: &[[f32; 3]],
     dirs: &[[f32; 3]],
     hits: &RayHits,
 ) -> Result<Vec<Vec3>> {
     let n = origins.len();
-    let surfaces: Vec<Option<SurfaceHit>> =
-        (0..n).into_par_iter().map(|k| surface_at(shader, scene, hits, origins, dirs, k)).collect();
-    let lit = sunlit(scene, shader, shadows, &surfaces)?;
-    // Reflected rays of the water hits, traced, and the radiance they bring back.
-    let mut reflected: Vec<Option<Vec3>> = vec![None; n];
-    if reflections {
-        let water: Vec<(u32, [f32; 3], [f32; 3])> = surfaces
+    let surface = |k: usize| surface_at(shader, scene, hits, origins, dirs, k);
+    let is_water = |k: usize| hits.distance[k].is_finite() && hits.class[k] == 1;
+    let lit = sunlit(scene, shader, shadows, n, surface)?;
+    // Reflected rays of the water hits (their representatives'), traced, and the radiance they bring back:
+    // `slot[k]` is the index into `values` of ray k's reflected radiance.
+    let mut slot: Vec<u32> = Vec::new();
+    let mut values: Vec<Vec3> = Vec::new();
+    if !matches!(reflections, Reflections::Sky) {
+        let owner = |k: usize| match reflections {
+            Reflections::Shared(rep) => {
+                let r = rep(k);
+                if r < n && is_water(r) {
+                    r
+                } else {
+                    k
+                }
+            }
+            _ => k,
+        };
+        let traced: Vec<u32> = (0..n).filter(|&k| is_water(k) && owner(k) == k).map(|k| k as u32).collect();
+        let rays: Vec<([f32; 3], [f32; 3])> = traced
             .par_iter()
-            .enumerate()
-            .filter_map(|(k, h)| {
-                let h = h.as_ref().filter(|h| h.is_water())?;
-                let (o, r) = shader.reflection_ray(Vec3::from_array(dirs[k]), h);
-                Some((k as u32, o.to_array(), r.to_array()))
+            .map(|&k| {
+                let k = k as usize;
+                let h = surface(k).unwrap_or_else(|| unreachable!("ray {k} was a water hit"));
+                let (o, r) = shader.reflection_ray(Vec3::from_array(dirs[k]), &h);
+                (o.to_array(), r.to_array())
             })
             .collect();
-        if !water.is_empty() {
-            let ro: Vec<[f32; 3]> = water.iter().map(|w| w.1).collect();
-            let rd: Vec<[f32; 3]> = water.iter().map(|w| w.2).collect();
-            let rhits = scene.cast_rays(&ro, &rd, REFLECTION_RANGE)?;
-            let rsurf: Vec<Option<SurfaceHit>> =
-                (0..ro.len()).into_par_iter().map(|j| surface_at(shader, scene, &rhits, &ro, &rd, j)).collect();
-            let rlit = sunlit(scene, shader, shadows, &rsurf)?;
-            let values: Vec<Vec3> = (0..ro.len())
-                .into_par_iter()
-                .map(|j| {
-                    let d = Vec3::from_array(rd[j]);
-                    match rsurf[j].as_ref() {
-                        // A reflection meeting the water again (a wave face) reads the sky along it.
-                        Some(h) if h.is_water() => shader.reflected(d, None, false),
-                        h => shader.reflected(d, h, rlit[j]),
-                    }
-                })
-                .collect();
-            for (w, v) in water.iter().zip(values) {
-                reflected[w.0 as usize] = Some(v);
-            }
+        let (ro, rd): (Vec<[f32; 3]>, Vec<[f32; 3]>) = rays.into_iter().unzip();
+        let rhits = scene.cast_rays(&ro, &rd, REFLECTION_RANGE)?;
+        let rsurface = |j: usize| surface_at(shader, scene, &rhits, &ro, &rd, j).filter(|h| !h.is_water());
+        let rlit = sunlit(scene, shader, shadows, ro.len(), rsurface)?;
+        values = (0..ro.len())
+            .into_par_iter()
+            .map(|j| {
+                // A reflection meeting the water again (a wave face) reads the sky along it.
+                let h = rsurface(j);
+                shader.reflected(Vec3::from_array(rd[j]), h.as_ref(), rlit[j])
+            })
+            .collect();
+        let mut index = vec![u32::MAX; n];
+        for (j, &k) in traced.iter().enumerate() {
+            index[k as usize] = j as u32;
         }
+        slot = (0..n).map(|k| if is_water(k) { index[owner(k)] } else { u32::MAX }).collect();
     }
     Ok((0..n)
         .into_par_iter()
-        .map(|k| shader.shade(Vec3::from_array(dirs[k]), surfaces[k].as_ref(), lit[k], reflected[k]))
+        .map(|k| {
+            let h = surface(k);
+            let refl = slot.get(k).and_then(|&j| values.get(j as usize)).copied();
+            shader.shade(Vec3::from_array(dirs[k]), h.as_ref(), lit[k], refl)
+        })
         .collect())
 }
