@@ -407,8 +407,9 @@ def surface_bsdf(mi: Any, m: Material) -> dict[str, Any]:
 
 def water_bsdf(mi: Any, env: Env, part: str) -> dict[str, Any]:
     """The water as Mitsuba sees it in one layer: ``body`` (the plastic without its mirror), ``mirror`` (the
-    Fresnel mirror alone), ``glint`` (the sun's GGX lobe of mmusv's Cox–Munk ``α = √(0.003 + 5.12·10⁻³ U)``)."""
-    if part not in ("body", "mirror", "glint"):
+    Fresnel mirror alone), ``glint`` (the sun's GGX lobe of mmusv's Cox–Munk ``α = √(0.003 + 5.12·10⁻³ U)``),
+    ``smooth`` (the whole smooth plastic, mirror and body; no glint: for full path tracing)."""
+    if part not in ("body", "mirror", "glint", "smooth"):
         raise ValueError(f"unknown water part {part!r}")
     if part == "glint":
         alpha = math.sqrt(0.003 + 5.12e-3 * max(env.wind_speed_m_s, 0.0))
@@ -555,6 +556,47 @@ class MitsubaImage:
     seconds: dict[str, float]
 
 
+def render_layer(
+    scene: RefScene,
+    layer: Layer,
+    width: int,
+    height: int,
+    *,
+    seed: int,
+    workdir: Path,
+    envmap: Any,
+    only: npt.NDArray[np.bool_] | None = None,
+) -> npt.NDArray[np.float32]:
+    """One Mitsuba layer ``(H, W, 3)`` float32; with ``only`` ``(H, W)``, just the window around those pixels
+    (zero elsewhere)."""
+    mi = _mi()
+    crop = None
+    if only is not None:
+        rows, cols = np.nonzero(only)
+        x0, y0 = int(cols.min()), int(rows.min())
+        crop = (x0, y0, int(cols.max()) + 1 - x0, int(rows.max()) + 1 - y0)
+    sc = mi.load_dict(mitsuba_dict(scene, layer, width, height, workdir, seed, envmap, crop))
+    window = np.asarray(mi.render(sc, seed=seed), dtype=np.float32)[..., :3]
+    if crop is None:
+        return window
+    img = np.zeros((height, width, 3), dtype=np.float32)
+    img[crop[1] : crop[1] + crop[3], crop[0] : crop[0] + crop[2]] = window
+    return img
+
+
+def render_path_traced(
+    scene: RefScene, width: int, height: int, *, spp: int, seed: int, workdir: Path, max_depth: int = 8
+) -> npt.NDArray[np.float32]:
+    """Mitsuba's full path tracing of ``scene`` (every object together under sun and sky, paths up to
+    ``max_depth``: occlusion of the sky, interreflections; the water smooth plastic without the sun's glint):
+    what mmusv's direct-light model leaves out, for information (not the test's reference)."""
+    mi = _mi()
+    envmap = mi.Bitmap(envmap_bitmap(scene.env.sensor_env()))
+    everything = tuple(range(len(scene.objects)))
+    layer = Layer("path traced", everything, True, True, "smooth", max_depth, spp, (*everything, -1))
+    return render_layer(scene, layer, width, height, seed=seed, workdir=workdir, envmap=envmap)
+
+
 def render_mitsuba(
     scene: RefScene, instance: npt.NDArray[np.int32], width: int, height: int, *, spp: int, seed: int, workdir: Path
 ) -> MitsubaImage:
@@ -567,16 +609,9 @@ def render_mitsuba(
     for k, layer in enumerate(layers(scene, spp)):
         t0 = time.perf_counter()
         mask = np.isin(instance, layer.pixels)
-        rows, cols = np.nonzero(mask)
-        if rows.size == 0:
+        if not mask.any():
             continue
-        # Only the window of the pixels this layer stands for.
-        x0, y0 = int(cols.min()), int(rows.min())
-        crop = (x0, y0, int(cols.max()) + 1 - x0, int(rows.max()) + 1 - y0)
-        sc = mi.load_dict(mitsuba_dict(scene, layer, width, height, workdir, seed, envmap, crop))
-        img = np.zeros((height, width, 3), dtype=np.float32)
-        window = np.asarray(mi.render(sc, seed=seed + 101 * k), dtype=np.float32)[..., :3]
-        img[y0 : y0 + crop[3], x0 : x0 + crop[2]] = window
+        img = render_layer(scene, layer, width, height, seed=seed + 101 * k, workdir=workdir, envmap=envmap, only=mask)
         seconds[layer.name] = time.perf_counter() - t0
         images[layer.name] = img
         total += img * mask[..., None]
