@@ -161,12 +161,15 @@ pub fn class_material(hit: &SurfaceHit) -> Material {
     Material { base_color: base.to_array(), roughness, metallic, emissive: [0.0; 3], nav_light: false }
 }
 
-/// `cos x` to within 10⁻⁶ without a library call: the argument reduced to `[−π, π]` in `f64`, folded onto
-/// `[0, π/2]`, then the Taylor series to `x¹²` (remainder below `(π/2)¹⁴ / 14! ≈ 6·10⁻⁹`).
+/// `cos x` to within 10⁻⁶ without a library call (for `|x| < 10⁹`): the argument reduced to `[−π, π]` in `f64`,
+/// folded onto `[0, π/2]`, then the Taylor series to `x¹²` (remainder below `(π/2)¹⁴ / 14! ≈ 6·10⁻⁹`).
 #[inline(always)]
 fn fast_cos(x: f32) -> f32 {
     let x = x as f64;
-    let r = x - std::f64::consts::TAU * (x / std::f64::consts::TAU).round();
+    // Round to nearest by the 1.5·2⁵² trick (|x / 2π| is far below 2⁵¹ for any swell argument).
+    const SHIFT: f64 = 6_755_399_441_055_744.0;
+    let turns = (x / std::f64::consts::TAU + SHIFT) - SHIFT;
+    let r = x - std::f64::consts::TAU * turns;
     let a = r.abs();
     let (a, sign) = if a > std::f64::consts::FRAC_PI_2 { (std::f64::consts::PI - a, -1.0) } else { (a, 1.0) };
     let z = a * a;

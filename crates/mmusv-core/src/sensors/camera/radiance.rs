@@ -52,15 +52,45 @@ pub(crate) fn surface_at(
     Some(shader.with_swell(d, hit))
 }
 
-/// Which of the `n` rays' hits (`surface(k)`) see the sun: all false at night, all that face it when shadows
-/// are off.
+/// Where a shadow ray from the hit of ray `k` starts (just off the surface, on the camera's side), if that hit
+/// could see the sun (it faces it, or it is water, whose swell may face it), else `None`; `keep` filters hits
+/// by class.
+#[inline]
+fn shadow_origin(
+    hits: &RayHits,
+    origins: &[[f32; 3]],
+    dirs: &[[f32; 3]],
+    k: usize,
+    sun: Vec3,
+    keep: impl Fn(u16) -> bool,
+) -> Option<[f32; 3]> {
+    let t = hits.distance[k];
+    if !t.is_finite() || !keep(hits.class[k]) {
+        return None;
+    }
+    let d = Vec3::from_array(dirs[k]);
+    let mut normal = Vec3::new(hits.normal[3 * k], hits.normal[3 * k + 1], hits.normal[3 * k + 2]);
+    if normal.dot(d) > 0.0 {
+        normal = -normal;
+    }
+    if normal.dot(sun) > 0.0 || hits.class[k] == 1 {
+        let point = Vec3::from_array(origins[k]) + d * t;
+        Some((point + normal * (0.02 + 1e-4 * t)).to_array())
+    } else {
+        None
+    }
+}
+
+/// Which of the rays' hits see the sun (hits of the classes `keep` accepts): all false at night, all that could
+/// when shadows are off.
 fn sunlit(
     scene: &Scene,
     shader: &Shader,
     shadows: bool,
-    n: usize,
-    surface: impl Fn(usize) -> Option<SurfaceHit> + Sync,
+    (hits, origins, dirs): (&RayHits, &[[f32; 3]], &[[f32; 3]]),
+    keep: impl Fn(u16) -> bool + Sync + Copy,
 ) -> Result<Vec<bool>> {
+    let n = origins.len();
     let mut lit = vec![false; n];
     if !shader.sun_up() {
         return Ok(lit);
@@ -68,15 +98,7 @@ fn sunlit(
     let sun = shader.sun();
     let facing: Vec<(u32, [f32; 3])> = (0..n)
         .into_par_iter()
-        .filter_map(|k| {
-            let h = surface(k)?;
-            if h.normal.dot(sun) > 0.0 || h.is_water() {
-                let eps = 0.02 + 1e-4 * h.t;
-                Some((k as u32, (h.point + h.normal * eps).to_array()))
-            } else {
-                None
-            }
-        })
+        .filter_map(|k| shadow_origin(hits, origins, dirs, k, sun, keep).map(|o| (k as u32, o)))
         .collect();
     if shadows {
         let origins: Vec<[f32; 3]> = facing.iter().map(|(_, o)| *o).collect();
@@ -120,7 +142,7 @@ pub fn radiance(
     let n = origins.len();
     let surface = |k: usize| surface_at(shader, scene, hits, origins, dirs, k);
     let is_water = |k: usize| hits.distance[k].is_finite() && hits.class[k] == 1;
-    let lit = sunlit(scene, shader, shadows, n, surface)?;
+    let lit = sunlit(scene, shader, shadows, (hits, origins, dirs), |_| true)?;
     // Reflected rays of the water hits (their representatives'), traced, and the radiance they bring back:
     // `slot[k]` is the index into `values` of ray k's reflected radiance.
     let mut slot: Vec<u32> = Vec::new();
@@ -150,7 +172,7 @@ pub fn radiance(
         let (ro, rd): (Vec<[f32; 3]>, Vec<[f32; 3]>) = rays.into_iter().unzip();
         let rhits = scene.cast_rays(&ro, &rd, REFLECTION_RANGE)?;
         let rsurface = |j: usize| surface_at(shader, scene, &rhits, &ro, &rd, j).filter(|h| !h.is_water());
-        let rlit = sunlit(scene, shader, shadows, ro.len(), rsurface)?;
+        let rlit = sunlit(scene, shader, shadows, (&rhits, &ro, &rd), |class| class != 1)?;
         values = (0..ro.len())
             .into_par_iter()
             .map(|j| {
