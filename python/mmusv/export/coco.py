@@ -56,7 +56,7 @@ class CocoWriter(CameraWriter):
         try:
             import pycocotools.mask  # noqa: F401
         except ImportError:
-            raise ConfigError("--to coco needs the Python package pycocotools (pip install pycocotools)") from None
+            raise ConfigError("--to coco needs the Python package pycocotools: pip install 'mmusv[export]'") from None
         super().check(info)
 
     @classmethod

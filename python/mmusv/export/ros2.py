@@ -233,7 +233,7 @@ class Ros2Writer(DatasetWriter):
         try:
             import rosbags.rosbag2  # noqa: F401
         except ImportError:
-            raise ConfigError("--to ros2 needs the Python package rosbags (pip install rosbags)") from None
+            raise ConfigError("--to ros2 needs the Python package rosbags: pip install 'mmusv[export]'") from None
         super().check(info)
 
     @classmethod
