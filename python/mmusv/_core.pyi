@@ -93,6 +93,10 @@ class Scene:
         """Rows of the material table."""
     def set_lights(self, ids: npt.NDArray[np.uint32], on: bool) -> None:
         """Turns the navigation lights of instances ``ids`` on or off."""
+    def set_seabed(
+        self, z: npt.NDArray[np.float32] | None, *, x0: float = 0.0, y0: float = 0.0, spacing: float = 1.0
+    ) -> None:
+        """Seabed heights (ny, nx) float32 world z at (x0 + j·spacing, y0 + i·spacing), for shallow-water optics."""
 
     def add_instance(self, mesh_id: int, pose: npt.NDArray[np.float64], class_override: int | None = None) -> int:
         """Places mesh ``mesh_id`` at ``pose`` ((4, 4) float64 rigid body → world); ``class_override`` uint16 or None;

@@ -188,6 +188,20 @@ class Scene:
         """Rows of the material table (0 before :meth:`set_materials`)."""
         return int(self._native.num_materials)
 
+    def set_seabed(
+        self, heights: npt.ArrayLike | None, *, x0: float = 0.0, y0: float = 0.0, spacing: float = 1.0
+    ) -> None:
+        """Sets the seabed the cameras see through shallow water: ``heights`` ``(ny, nx)`` world z in metres
+        (negative below the sea surface) at vertices ``(x0 + j·spacing, y0 + i·spacing)``, row ``i`` northwards;
+        ``None`` clears it (water is then deep everywhere). Outside the grid the water is deep."""
+        if heights is None:
+            self._native.set_seabed(None)
+            return
+        z = np.ascontiguousarray(np.asarray(heights, dtype=np.float32))
+        if z.ndim != 2:
+            raise InputError(f"seabed heights must have shape (ny, nx), got {z.shape}")
+        self._native.set_seabed(z, x0=float(x0), y0=float(y0), spacing=float(spacing))
+
     def set_lights(self, instance_ids: npt.ArrayLike, *, on: bool) -> None:
         """Turns the navigation lights (materials with ``nav_light``) of ``instance_ids`` on or off."""
         ids = np.atleast_1d(np.asarray(instance_ids))

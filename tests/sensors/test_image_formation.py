@@ -256,3 +256,27 @@ def test_camera_image_options_reach_the_recording(tmp_path: Path) -> None:
     bad["rigs"] = {"usv_standard": {"cameras": [{"name": "front", "quality": "ultra"}]}}
     with pytest.raises(mmusv.ConfigError, match="quality"):
         run(bad, out_dir=tmp_path / "bad")
+
+
+def test_shallow_water_shows_the_bottom() -> None:
+    """Over a seabed 3 m down the water body is brighter than over 30 m, and 300 m is the deep water's colour:
+    Maritorena's exp(−2 K_d d) towards the sand bottom, blue reaching deepest."""
+    top = core.Camera(width=32, height=32, rgb=True, metres_per_pixel=1.0, quality="draft", range_max=500.0)
+    pose = pose_matrices(np.array([0.0, 0.0, 100.0, 0.0, math.pi / 2, 0.0]))
+    env = _env()
+
+    def lum(depth: float | None) -> np.ndarray:
+        s = Scene()
+        _water(s)
+        if depth is not None:
+            s.set_seabed(np.full((3, 3), -depth), x0=-500.0, y0=-500.0, spacing=500.0)
+        out = render(top, s, pose=pose, env=env, seed=1, radiance=True).radiance
+        assert out is not None
+        return np.asarray(out.reshape(-1, 3).mean(axis=0))
+
+    deep, d3, d30, d300 = lum(None), lum(3.0), lum(30.0), lum(300.0)
+    assert np.all(d3 > d30) and np.all(d30 >= deep)
+    np.testing.assert_allclose(d300, deep, rtol=1e-4)
+    gain3, gain30 = d3 - deep, d30 - deep
+    # At 30 m little red survives the round trip (exp(-2·0.324·30) ~ 4e-9), blue still does (exp(-4.3) ~ 1 %).
+    assert gain30[0] < 1e-3 * gain3[0] and gain30[2] > 1e-3 * gain3[2]

@@ -19,6 +19,7 @@ use crate::material::Material;
 use crate::mesh::Mesh;
 use crate::ray::RayPrep;
 use crate::sea::Sea;
+use crate::seabed::Seabed;
 use crate::simd::{Level, Portable};
 use parry3d::bounding_volume::Aabb;
 use parry3d::math::Vec3;
@@ -139,6 +140,8 @@ pub struct Scene {
     sea: Option<Sea>,
     /// The material table faces index into ([`Scene::set_materials`]); index 0 is "no material".
     materials: Arc<Vec<Material>>,
+    /// The seabed under the water, for shallow-water optics ([`Scene::set_seabed`]).
+    seabed: Option<Arc<Seabed>>,
 }
 
 impl Scene {
@@ -181,6 +184,16 @@ impl Scene {
         }
         self.materials = Arc::new(table);
         Ok(())
+    }
+
+    /// Sets (or clears) the seabed under the water, read by the cameras' water body.
+    pub fn set_seabed(&mut self, seabed: Option<Seabed>) {
+        self.seabed = seabed.map(Arc::new);
+    }
+
+    /// The seabed, if set (shared, cheap to clone).
+    pub fn seabed(&self) -> Option<Arc<Seabed>> {
+        self.seabed.clone()
     }
 
     /// The material table (shared, cheap to clone).

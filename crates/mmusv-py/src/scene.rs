@@ -116,6 +116,26 @@ impl Scene {
         self.write(|s| s.set_materials(mats))?.map_err(crate::errors::to_py)
     }
 
+    /// Sets the seabed under the water for the cameras' shallow-water optics: heights `z` (ny, nx) float32
+    /// metres (world z, negative below the surface) at vertices `(x0 + j·spacing, y0 + i·spacing)`; `None`
+    /// clears it.
+    #[pyo3(signature = (z, *, x0=0.0, y0=0.0, spacing=1.0))]
+    fn set_seabed(&self, z: Option<PyReadonlyArray2<'_, f32>>, x0: f32, y0: f32, spacing: f32) -> PyResult<()> {
+        let seabed = match z {
+            None => None,
+            Some(z) => {
+                let shape = z.shape();
+                let (ny, nx) = (shape[0], shape[1]);
+                let data = z.as_slice().map_err(|_| InputError::new_err("seabed heights must be C-contiguous"))?;
+                Some(
+                    mmusv_core::seabed::Seabed::new(x0, y0, spacing, nx, ny, data.to_vec())
+                        .map_err(crate::errors::to_py)?,
+                )
+            }
+        };
+        self.write(|s| s.set_seabed(seabed))
+    }
+
     /// Rows of the material table (0 before `set_materials`).
     #[getter]
     fn num_materials(&self) -> PyResult<usize> {

@@ -64,6 +64,9 @@ def build_static_scene(world: MapWorld, *, include_water: bool = True, include_m
         if mesh.num_triangles == 0:
             continue
         static[name] = scene.add_instance(_add(scene, mesh, name))
+    hf = world.heightfield
+    # The bottom the cameras see through shallow water (the terrain's heights, below the sea surface there).
+    scene.set_seabed(hf.z, x0=hf.x0, y0=hf.y0, spacing=hf.spacing)
     out = WorldScene(scene=scene, static_instances=static)
     if include_moored:
         for asset_name, (x, y, yaw) in world.moored:

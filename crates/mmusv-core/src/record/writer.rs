@@ -84,6 +84,9 @@ pub struct Recorder {
     partial: PathBuf,
     channels: BTreeMap<String, Slot>,
     messages: u64,
+    /// The reason of the first failed write: the MCAP writer refuses every write after one fails, with a
+    /// message that no longer says why, so later errors repeat this one.
+    first_failure: Option<String>,
 }
 
 impl std::fmt::Debug for Recorder {
@@ -107,8 +110,24 @@ fn io_err(path: &Path) -> impl Fn(std::io::Error) -> MmusvError + '_ {
     move |e| MmusvError::Io { path: path.display().to_string(), reason: e.to_string() }
 }
 
+/// The text of an MCAP error with its whole `source()` chain, so the operating system's reason (`No space left on
+/// device (os error 28)`, `Read-only file system`) reaches the user rather than the crate's summary alone.
+fn mcap_reason(e: &mcap::McapError) -> String {
+    let mut reason = format!("MCAP write failed: {e}");
+    let mut source = std::error::Error::source(e);
+    while let Some(s) = source {
+        let text = s.to_string();
+        if !reason.contains(&text) {
+            reason.push_str(": ");
+            reason.push_str(&text);
+        }
+        source = s.source();
+    }
+    reason
+}
+
 fn mcap_err(path: &Path) -> impl Fn(mcap::McapError) -> MmusvError + '_ {
-    move |e| MmusvError::Io { path: path.display().to_string(), reason: format!("MCAP write failed: {e}") }
+    move |e| MmusvError::Io { path: path.display().to_string(), reason: mcap_reason(&e) }
 }
 
 /// Completes the MCAP (summary, footer), flushes and syncs the file.
@@ -142,7 +161,14 @@ impl Recorder {
             .profile("")
             .library(format!("mmusv {}", env!("CARGO_PKG_VERSION")));
         let writer = options.create(BufWriter::with_capacity(1 << 20, file)).map_err(mcap_err(&partial))?;
-        Ok(Self { writer: Some(writer), path: path.to_path_buf(), partial, channels: BTreeMap::new(), messages: 0 })
+        Ok(Self {
+            writer: Some(writer),
+            path: path.to_path_buf(),
+            partial,
+            channels: BTreeMap::new(),
+            messages: 0,
+            first_failure: None,
+        })
     }
 
     /// The final name of the recording.
@@ -213,7 +239,8 @@ impl Recorder {
             publish_time: log_time_ns,
         };
         slot.next_sequence = slot.next_sequence.wrapping_add(1);
-        self.writer()?.write_to_known_channel(&header, data).map_err(mcap_err(&partial))?;
+        let written = self.writer()?.write_to_known_channel(&header, data);
+        written.map_err(|e| self.failed(&partial, &e))?;
         self.messages += 1;
         Ok(())
     }
@@ -237,7 +264,21 @@ impl Recorder {
     pub fn metadata(&mut self, name: &str, map: &BTreeMap<String, String>) -> Result<()> {
         let partial = self.partial.clone();
         let record = Metadata { name: name.to_string(), metadata: map.clone() };
-        self.writer()?.write_metadata(&record).map_err(mcap_err(&partial))
+        let written = self.writer()?.write_metadata(&record);
+        written.map_err(|e| self.failed(&partial, &e))
+    }
+
+    /// The error of a failed write: its reason, remembered if it is the first, else the first one's too.
+    fn failed(&mut self, partial: &Path, e: &mcap::McapError) -> MmusvError {
+        let reason = match &self.first_failure {
+            Some(first) => format!("{} (after an earlier failure: {first})", mcap_reason(e)),
+            None => {
+                let r = mcap_reason(e);
+                self.first_failure = Some(r.clone());
+                r
+            }
+        };
+        MmusvError::Io { path: partial.display().to_string(), reason }
     }
 
     /// Writes an attachment (e.g. the scenario YAML); `log_time_ns` is also used as its create time.
@@ -250,7 +291,8 @@ impl Recorder {
             media_type: media_type.to_string(),
             data: Cow::Borrowed(data),
         };
-        self.writer()?.attach(&a).map_err(mcap_err(&partial))
+        let written = self.writer()?.attach(&a);
+        written.map_err(|e| self.failed(&partial, &e))
     }
 
     /// Completes the file and renames it from `<path>.partial` to `path` (replacing `path` if it exists).
@@ -287,5 +329,17 @@ impl Drop for Recorder {
         if let Some(writer) = self.writer.take() {
             let _ = close(writer, &self.partial);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn write_errors_name_the_operating_systems_reason() {
+        let e = mcap::McapError::Io(std::io::Error::from_raw_os_error(28));
+        let r = mcap_reason(&e);
+        assert!(r.contains("No space left on device"), "{r}");
     }
 }

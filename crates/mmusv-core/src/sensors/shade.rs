@@ -11,8 +11,9 @@
 //!
 //! A surface of material `m` seen along `d` (`v = −d`) is lit by the sun (irradiance `E_s` along `s`, when the
 //! camera's shadow ray finds it unoccluded) and by the environment:
-//! `L = L_e + (f_d + f_s(v, s)) E_s (n·s) + f_d E_env(n) + P(r, roughness) (F0 A + B)`, with `f_d = (1 − metallic)
-//! base / π`. Water is a dielectric (IOR 1.33) with swell normals: `L = F(θ_o) L_r + glint + L_body`, where `L_r`
+//! `L = L_e + (f_d + f_s(v, s)) E_s (n·s) + f_d E_env(n) + P(r', roughness) (F0 A + B)`, with `f_d = (1 − metallic)
+//! base / π` and `r'` the rough lobe's dominant direction (Lagarde & de Rousiers 2014). The environment light is
+//! not occluded (no ambient occlusion): every surface sees the whole sky and the sea, a known limit of the model. Water is a dielectric (IOR 1.33) with swell normals: `L = F(θ_o) L_r + glint + L_body`, where `L_r`
 //! is the radiance along the reflected ray (traced by the camera, so ships mirror in it; the sky's otherwise),
 //! the glint is the sun through a Cox–Munk GGX lobe, and `L_body` the smooth-plastic water body; foam (whitecaps
 //! and wakes) is Lambertian on top. Aerial perspective: `L·T + L_air (1 − T)`, `T = e^{−σ t}` (Koschmieder),
@@ -20,6 +21,7 @@
 
 use super::noise::{self, stream};
 use crate::material::Material;
+use crate::seabed::Seabed;
 use parry3d::math::Vec3;
 use std::sync::Arc;
 
@@ -203,6 +205,7 @@ pub struct Shader {
     foam: Foam,
     exposure: f32,
     materials: Arc<Vec<Material>>,
+    seabed: Option<Arc<Seabed>>,
 }
 
 impl Shader {
@@ -235,7 +238,14 @@ impl Shader {
             foam: Foam::new(water::monahan_coverage(env.wind_speed_m_s), wakes, 0x5EA),
             exposure,
             materials: Arc::new(Vec::new()),
+            seabed: None,
         }
+    }
+
+    /// This shader showing the bottom through shallow water over `seabed` (a scene's, [`crate::Scene::seabed`]).
+    pub fn with_seabed(mut self, seabed: Option<Arc<Seabed>>) -> Self {
+        self.seabed = seabed;
+        self
     }
 
     /// This shader reading face materials from `table` (a scene's, [`crate::Scene::material_table`]).
@@ -328,7 +338,9 @@ impl Shader {
         let n = hit.shading_normal;
         let mut r = d - n * (2.0 * d.dot(n));
         r.z = r.z.abs().max(1e-4);
-        (hit.point + hit.normal * (0.02 + 1e-4 * hit.t), r.normalize())
+        // A small offset off the surface (2 mm, growing with the distance like the coordinates' rounding), so a
+        // reflected silhouette is not shifted by it.
+        (hit.point + hit.normal * (2e-3 + 1e-5 * hit.t), r.normalize())
     }
 
     /// Radiance (before aerial perspective) of a non-water surface seen along `d`, lit by the sun when `sunlit`.
@@ -347,8 +359,12 @@ impl Shader {
         let alpha = (m.roughness * m.roughness).max(brdf::ALPHA_MIN);
         let mut c = diffuse * self.light.irradiance(n);
         let r = d - n * (2.0 * d.dot(n));
+        // The rough lobe's dominant direction leans from the mirror direction towards the normal (Lagarde & de
+        // Rousiers 2014, "Moving Frostbite to PBR", section 4.9.3), where the split sum reads the environment.
+        let lean = (1.0 - alpha) * ((1.0 - alpha).sqrt() + alpha);
+        let dominant = (n + (r - n) * lean).normalize_or(r);
         let [a, b] = dfg(nv, m.roughness);
-        c += self.light.prefiltered(r, m.roughness) * (f0 * a + Vec3::splat(b));
+        c += self.light.prefiltered(dominant, m.roughness) * (f0 * a + Vec3::splat(b));
         if sunlit {
             let ns = n.dot(self.sun);
             if ns > 0.0 {
@@ -386,7 +402,11 @@ impl Shader {
                 entering += self.sun_e * (ns * (1.0 - fresnel_dielectric(ns, WATER_IOR)));
             }
         }
-        c += water::body_factor(self.water_rho, self.water_fdr, f_o, WATER_IOR) * entering;
+        let rho = match self.seabed.as_ref().and_then(|s| s.depth(hit.point.x, hit.point.y, 0.0)) {
+            Some(depth) => water::shallow_albedo(self.water_rho, depth),
+            None => self.water_rho,
+        };
+        c += water::body_factor(rho, self.water_fdr, f_o, WATER_IOR) * entering;
         if !self.foam.is_empty() {
             let cover = self.foam.cover(hit.point.x, hit.point.y);
             if cover > 0.0 {

@@ -6,7 +6,8 @@
 //! texel has the same solid angle `4π / (W H)` and the integrals are plain sums. The output maps, and a dense
 //! table of the sky's own radiance that the cameras read instead of evaluating the sky model per pixel, are
 //! read bilinearly without trigonometry: columns uniform in the "diamond" pseudo-angle of the azimuth, rows
-//! uniform in `z` with the poles as first and last rows (the up and down normals, the commonest, are exact;
+//! uniform in `(√(1 + z) − √(1 − z)) / √2` (nearly uniform in angle) with the poles as first and last rows (the
+//! up and down normals, the commonest, are exact;
 //! the sky table's rows follow `(√z + 1 − √(1 − z)) / 2`, dense in angle at the horizon and the zenith):
 //! * irradiance `E(n) = Σ L(ω) max(0, n·ω) Δω`;
 //! * prefiltered radiance `P(r, α) = Σ L(ω) w(ω) / Σ w(ω)` with the GGX lobe weight `w = D(h) (h·r) / (4 h·ω)
@@ -118,10 +119,20 @@ fn diamond_dir(p: f32) -> (f32, f32) {
     (x / n, y / n)
 }
 
+/// Row parameter `t` in `[−1, 1]` of height `z` in the output grids: `(√(1 + z) − √(1 − z)) / √2`, whose rows
+/// are at most √2 apart in angle anywhere (rows uniform in `z` would be 29° apart at the poles).
+#[inline]
+fn row_of(z: f32) -> f32 {
+    let z = z.clamp(-1.0, 1.0);
+    ((1.0 + z).sqrt() - (1.0 - z).sqrt()) * std::f32::consts::FRAC_1_SQRT_2
+}
+
 /// Unit direction of node `(i, j)` of a `w × h` output grid (row 0 straight down, row `h − 1` straight up).
 fn node_dir(i: usize, j: usize, w: usize, h: usize) -> Vec3 {
     let (x, y) = diamond_dir((i as f32 + 0.5) / w as f32 * 4.0);
-    let z = (j as f32 / (h - 1) as f32 * 2.0 - 1.0).clamp(-1.0, 1.0);
+    let t = j as f32 / (h - 1) as f32 * 2.0 - 1.0;
+    // The inverse of `row_of`: z = t √(2 − t²).
+    let z = (t * (2.0 - t * t).max(0.0).sqrt()).clamp(-1.0, 1.0);
     let s = (1.0 - z * z).max(0.0).sqrt();
     Vec3::new(s * x, s * y, z)
 }
@@ -148,7 +159,7 @@ fn bilinear(map: &[Vec3], w: usize, h: usize, x: f32, y: f32) -> Vec3 {
 fn read(map: &[Vec3], d: Vec3) -> Vec3 {
     let (w, h) = OUT;
     let x = diamond(d.x, d.y) / 4.0 * w as f32 - 0.5;
-    let y = (d.z + 1.0) * 0.5 * (h - 1) as f32;
+    let y = (row_of(d.z) + 1.0) * 0.5 * (h - 1) as f32;
     bilinear(map, w, h, x, y)
 }
 

@@ -15,6 +15,12 @@
 //!   slowly) and two arms at the Kelvin angle `asin(1/3) = 19.47°` (Lord Kelvin, 1887), both fading with their
 //!   age `distance / speed` (e-folding 60 s), the arms only for fast craft (strength `min(1, (V / 8 m/s)²)`).
 //!   The wake follows the vessel's current heading (a straight track).
+//! * **Shallow water**: over a seabed `d` metres down, the water body's diffuse reflectance is
+//!   `ρ(d) = ρ∞ + (A_b − ρ∞) exp(−2 K_d d)` (S. Maritorena, A. Morel & B. Gentili, "Diffuse reflectance of
+//!   oceanic shallow waters: influence of water depth and bottom albedo", Limnol. Oceanogr. 39(7), 1994), with a
+//!   sand bottom of albedo `A_b` and the diffuse attenuation `K_d` of clear coastal water: pure water's
+//!   absorption at the channels' wavelengths (R. M. Pope & E. S. Fry, Appl. Opt. 36(33), 1997: 0.264, 0.057 and
+//!   0.012 m⁻¹ at 610, 550 and 465 nm) plus 0.06 m⁻¹ for scattering and dissolved matter (an approximation).
 //! * **Water body**: the light scattered back out of the water is the smooth-plastic model of Mitsuba 3 — a
 //!   dielectric interface (IOR 1.33) over a Lambertian body of diffuse reflectance `ρ`: radiance
 //!   `ρ / (1 − F_dr) · (1 − F(θ_o)) / η² · ∫ (1 − F(θ_i)) L cos θ_i dω / π`, with `F_dr` the interface's internal
@@ -22,6 +28,20 @@
 
 use super::super::noise;
 use parry3d::math::Vec3;
+
+/// Albedo of a sand bottom, linear RGB.
+pub const BOTTOM_ALBEDO: [f32; 3] = [0.36, 0.31, 0.22];
+/// Diffuse attenuation of clear coastal water, 1/m, per channel (see the module docs).
+pub const K_D: [f32; 3] = [0.324, 0.117, 0.072];
+
+/// Diffuse reflectance of the water body `rho_deep` over a sand bottom `depth` metres down (Maritorena et al.).
+#[inline]
+pub fn shallow_albedo(rho_deep: Vec3, depth: f32) -> Vec3 {
+    let d = depth.max(0.0);
+    let k = Vec3::from_array(K_D) * (-2.0 * d);
+    let f = Vec3::new(k.x.exp(), k.y.exp(), k.z.exp());
+    rho_deep + (Vec3::from_array(BOTTOM_ALBEDO) - rho_deep) * f
+}
 
 /// Albedo of dense foam.
 pub const FOAM_ALBEDO: f32 = 0.55;
@@ -264,6 +284,16 @@ mod tests {
         // gives 1 − (1/1.33)² = 0.435; the Fresnel inside the cone adds a little.
         let f = internal_diffuse_reflectance(1.33);
         assert!(f > 0.435 && f < 0.48, "{f}");
+    }
+
+    #[test]
+    fn shallow_water_tends_to_the_bottom_and_the_deep() {
+        let deep = Vec3::new(0.004, 0.018, 0.03);
+        assert!((shallow_albedo(deep, 0.0) - Vec3::from_array(BOTTOM_ALBEDO)).length() < 1e-6);
+        assert!((shallow_albedo(deep, 1000.0) - deep).length() < 1e-6);
+        // At 5 m the blue channel keeps exp(-2·0.072·5) = 0.487 of the bottom's contrast.
+        let b = shallow_albedo(deep, 5.0).z;
+        assert!((b - (0.03 + (0.22 - 0.03) * (-0.72f32).exp())).abs() < 1e-5);
     }
 
     #[test]
