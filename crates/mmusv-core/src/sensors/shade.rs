@@ -167,16 +167,19 @@ pub fn class_material(hit: &SurfaceHit) -> Material {
 /// folded onto `[0, π/2]`, then the Taylor series to `x¹²` (remainder below `(π/2)¹⁴ / 14! ≈ 6·10⁻⁹`).
 #[inline(always)]
 fn fast_cos(x: f32) -> f32 {
-    let x = x as f64;
-    // Round to nearest by the 1.5·2⁵² trick (|x / 2π| is far below 2⁵¹ for any swell argument).
+    use std::f64::consts::{FRAC_PI_2, PI, TAU};
+    // Round to nearest by the 1.5·2⁵² trick (|x / 2π| is far below 2⁵¹ for any swell argument); multiplications
+    // by reciprocals throughout (a division costs several times more).
     const SHIFT: f64 = 6_755_399_441_055_744.0;
-    let turns = (x / std::f64::consts::TAU + SHIFT) - SHIFT;
-    let r = x - std::f64::consts::TAU * turns;
-    let a = r.abs();
-    let (a, sign) = if a > std::f64::consts::FRAC_PI_2 { (std::f64::consts::PI - a, -1.0) } else { (a, 1.0) };
+    const INV_TAU: f64 = 1.0 / TAU;
+    let x = x as f64;
+    let turns = (x * INV_TAU + SHIFT) - SHIFT;
+    let a = (x - TAU * turns).abs();
+    let (a, sign) = if a > FRAC_PI_2 { (PI - a, -1.0) } else { (a, 1.0) };
     let z = a * a;
+    const C: [f64; 6] = [1.0 / 2.0, 1.0 / 12.0, 1.0 / 30.0, 1.0 / 56.0, 1.0 / 90.0, 1.0 / 132.0];
     let c =
-        1.0 - z / 2.0 * (1.0 - z / 12.0 * (1.0 - z / 30.0 * (1.0 - z / 56.0 * (1.0 - z / 90.0 * (1.0 - z / 132.0)))));
+        1.0 - z * C[0] * (1.0 - z * C[1] * (1.0 - z * C[2] * (1.0 - z * C[3] * (1.0 - z * C[4] * (1.0 - z * C[5])))));
     (sign * c) as f32
 }
 
@@ -206,6 +209,27 @@ pub struct Shader {
     exposure: f32,
     materials: Arc<Vec<Material>>,
     seabed: Option<Arc<Seabed>>,
+}
+
+/// Intervals of the water's Fresnel table over `cos θ` in `[0, 1]`.
+const FRESNEL_STEPS: usize = 1024;
+
+/// The exact Fresnel reflectance of water at `FRESNEL_STEPS + 1` evenly spaced `cos θ` (built once).
+fn water_fresnel_table() -> &'static [f32] {
+    static TABLE: std::sync::OnceLock<Vec<f32>> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| {
+        (0..=FRESNEL_STEPS).map(|i| fresnel_dielectric(i as f32 / FRESNEL_STEPS as f32, WATER_IOR)).collect()
+    })
+}
+
+/// [`fresnel_dielectric`] of water at `cos θ`, linearly interpolated in its table (within 2·10⁻⁴ of it, tested).
+#[inline]
+fn water_fresnel(cos: f32) -> f32 {
+    let t = water_fresnel_table();
+    let x = cos.clamp(0.0, 1.0) * FRESNEL_STEPS as f32;
+    let i = (x as usize).min(FRESNEL_STEPS - 1);
+    let f = x - i as f32;
+    t[i] + (t[i + 1] - t[i]) * f
 }
 
 impl Shader {
@@ -385,7 +409,7 @@ impl Shader {
         let n = hit.shading_normal;
         let v = -d;
         let cos_o = n.dot(v).clamp(1e-4, 1.0);
-        let f_o = fresnel_dielectric(cos_o, WATER_IOR);
+        let f_o = water_fresnel(cos_o);
         let l_r = match reflected {
             Some(l) => l,
             None => self.sky_no_sun(self.reflection_ray(d, hit).1),
@@ -397,9 +421,9 @@ impl Shader {
             if ns > 0.0 {
                 // The glint: GGX with the Cox–Munk roughness, weighted by the exact Fresnel at the half vector.
                 let h = (v + self.sun).normalize_or_zero();
-                let f = fresnel_dielectric(v.dot(h), WATER_IOR);
+                let f = water_fresnel(v.dot(h));
                 c += specular_cos(n, v, self.sun, self.water_alpha, Vec3::ONE) * self.sun_e * f;
-                entering += self.sun_e * (ns * (1.0 - fresnel_dielectric(ns, WATER_IOR)));
+                entering += self.sun_e * (ns * (1.0 - water_fresnel(ns)));
             }
         }
         let rho = match self.seabed.as_ref().and_then(|s| s.depth(hit.point.x, hit.point.y, 0.0)) {
@@ -476,6 +500,15 @@ mod tests {
             material,
             lights_on: false,
             shading_normal: Vec3::Z,
+        }
+    }
+
+    #[test]
+    fn water_fresnel_table_is_the_formula() {
+        for i in 0..=100_000 {
+            let c = i as f32 / 100_000.0;
+            let (a, b) = (water_fresnel(c), fresnel_dielectric(c, WATER_IOR));
+            assert!((a - b).abs() < 2e-4, "{c}: {a} vs {b}");
         }
     }
 

@@ -141,11 +141,11 @@ fn node_dir(i: usize, j: usize, w: usize, h: usize) -> Vec3 {
 #[inline]
 fn bilinear(map: &[Vec3], w: usize, h: usize, x: f32, y: f32) -> Vec3 {
     let y = y.clamp(0.0, (h - 1) as f32);
-    // floor without a call: x > -1 here (a column coordinate is at least -0.5).
+    // floor without a call: x > -1 here (a column coordinate is at least -0.5); wrap without a modulo.
     let xi = (x + 1.0) as i32 - 1;
     let fx = x - xi as f32;
-    let i0 = xi.rem_euclid(w as i32) as usize;
-    let i1 = (i0 + 1) % w;
+    let i0 = if xi < 0 { w - 1 } else { (xi as usize).min(w - 1) };
+    let i1 = if i0 + 1 == w { 0 } else { i0 + 1 };
     let j0 = y as usize;
     let j1 = (j0 + 1).min(h - 1);
     let fy = y - j0 as f32;
