@@ -16,6 +16,7 @@ from mmusv.sensors.camera import render
 from mmusv.sensors.env import sensor_env
 from mmusv.world.build import pose_matrices
 from mmusv.world.environment import Environment
+from mmusv.world.primitives import box
 
 
 def _env(**kw: float) -> core.SensorEnv:
@@ -25,24 +26,10 @@ def _env(**kw: float) -> core.SensorEnv:
 
 
 def _box(s: Scene, lo: tuple[float, float, float], hi: tuple[float, float, float], *, cls: int, mat: int = 0) -> int:
-    v = np.array([[(hi if (i >> k) & 1 else lo)[k] for k in range(3)] for i in range(8)], dtype=np.float64)
-    f = np.array(
-        [
-            [0, 2, 1],
-            [1, 2, 3],
-            [4, 5, 6],
-            [5, 7, 6],
-            [0, 1, 4],
-            [1, 5, 4],
-            [2, 6, 3],
-            [3, 6, 7],
-            [0, 4, 2],
-            [2, 4, 6],
-            [1, 3, 5],
-            [3, 7, 5],
-        ]
-    )
-    return s.add_instance(s.add_mesh(v, f, classes=cls, name="box", materials=mat))
+    """An axis-aligned box from corner ``lo`` to ``hi`` (the library's box primitive), material ``mat``."""
+    lo_, hi_ = np.asarray(lo), np.asarray(hi)
+    m = box(center=(lo_ + hi_) / 2.0, size=hi_ - lo_, cls=cls)
+    return s.add_instance(s.add_mesh(m.vertices, m.faces, classes=cls, name="box", materials=mat))
 
 
 def _water(s: Scene, half: float = 5000.0) -> int:
