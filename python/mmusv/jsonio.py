@@ -15,7 +15,7 @@ from typing import Any
 
 from mmusv.errors import IoError
 
-__all__ = ["dump_json", "read_json", "write_json"]
+__all__ = ["dump_json", "read_json", "remove_stale_temps", "write_json"]
 
 
 def dump_json(doc: Any) -> bytes:
@@ -23,12 +23,34 @@ def dump_json(doc: Any) -> bytes:
     return (json.dumps(doc, indent=2, ensure_ascii=False, allow_nan=False) + "\n").encode("utf-8")
 
 
+def _alive(pid: int) -> bool:
+    """Whether process ``pid`` exists (a process we may not signal exists too)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def remove_stale_temps(path: Path) -> None:
+    """Removes the temporary files of earlier writes of ``path`` (``.NAME.PID.tmp`` beside it) whose writer no
+    longer runs: what a writer killed between writing and renaming leaves behind."""
+    for tmp in path.parent.glob(f".{path.name}.*.tmp"):
+        pid = tmp.name[len(path.name) + 2 : -len(".tmp")]
+        if pid.isdigit() and int(pid) != os.getpid() and not _alive(int(pid)):
+            tmp.unlink(missing_ok=True)
+
+
 def write_json(path: str | os.PathLike[str], doc: Any) -> Path:
-    """Writes ``doc`` to ``path`` through a temporary file in the same folder and an atomic rename."""
+    """Writes ``doc`` to ``path`` through a temporary file in the same folder and an atomic rename; temporary
+    files left beside it by a killed writer are removed."""
     p = Path(path)
     tmp = p.with_name(f".{p.name}.{os.getpid()}.tmp")
     try:
         p.parent.mkdir(parents=True, exist_ok=True)
+        remove_stale_temps(p)
         tmp.write_bytes(dump_json(doc))
         os.replace(tmp, p)
     except OSError as exc:
