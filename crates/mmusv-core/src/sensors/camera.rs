@@ -404,7 +404,9 @@ impl Camera {
             rgb: Vec::new(),
             radiance: Vec::new(),
         };
-        let mut material = if options.rgb || options.radiance { vec![0u16; n] } else { Vec::new() };
+        // Material ids per pixel, for the anti-aliasing's edge test only.
+        let edges_wanted = (options.rgb || options.radiance) && self.cfg.image.quality.edge_samples() > 1;
+        let mut material = if edges_wanted { vec![0u16; n] } else { Vec::new() };
         for (k, &i) in self.order.iter().enumerate() {
             let i = i as usize;
             let t = hits.distance[k];
