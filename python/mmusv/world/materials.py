@@ -174,8 +174,10 @@ MATERIALS: tuple[Material, ...] = (
     _m("sensor_housing", (0.06, 0.06, 0.065), 0.35),  # dark plastic radome / LiDAR housing
     # COLREG navigation lights: emissive only on vessels under way
     _m("nav_masthead_white", (0.80, 0.80, 0.80), 0.1, 0.0, (_L, _L, 0.92 * _L), True),
-    _m("nav_port_red", (0.60, 0.02, 0.02), 0.1, 0.0, (_L, 0.02 * _L, 0.01 * _L), True),
-    _m("nav_starboard_green", (0.02, 0.50, 0.20), 0.1, 0.0, (0.02 * _L, _L, 0.45 * _L), True),
+    # COLREG sidelights: red, and a bluish green, with no light at all in the other channels (a faint share there
+    # would still saturate under a night exposure and draw the lamp white).
+    _m("nav_port_red", (0.60, 0.02, 0.02), 0.1, 0.0, (_L, 0.0, 0.0), True),
+    _m("nav_starboard_green", (0.02, 0.50, 0.20), 0.1, 0.0, (0.0, _L, 0.45 * _L), True),
     _m("nav_stern_white", (0.80, 0.80, 0.80), 0.1, 0.0, (_L, _L, 0.92 * _L), True),
 )
 """The built-in materials; a material's id is its index (:func:`all_materials` adds the registered ones)."""

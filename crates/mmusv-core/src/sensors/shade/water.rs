@@ -12,9 +12,10 @@
 //! * **Wind from the sea state** when the scenario gives none: a fully developed Pierson–Moskowitz sea,
 //!   `H_s = 0.21 U² / g` (W. J. Pierson & L. Moskowitz, JGR 69(24), 1964), so `U = √(H_s g / 0.21)`.
 //! * **Wakes**: behind every vessel under way, turbulent foam along its track (as wide as its beam, widening
-//!   slowly) and two arms at the Kelvin angle `asin(1/3) = 19.47°` (Lord Kelvin, 1887), both fading with their
-//!   age `distance / speed` (e-folding 60 s), the arms only for fast craft (strength `min(1, (V / 8 m/s)²)`).
-//!   The wake follows the vessel's current heading (a straight track).
+//!   slowly) and two arms at the Kelvin angle `asin(1/3) = 19.47°` (Lord Kelvin, 1887) from the bow, both fading
+//!   with their age `distance / speed` (e-folding 30 s); the foam grows with speed (track `min(1, (V / 6 m/s)²)`,
+//!   arms `min(1, (V / 8 m/s)²)`), so a slow craft leaves a faint trace. The wake follows the vessel's current
+//!   heading (a straight track): an approximation where the route bends.
 //! * **Shallow water**: over a seabed `d` metres down, the water body's diffuse reflectance is
 //!   `ρ(d) = ρ∞ + (A_b − ρ∞) exp(−2 K_d d)` (S. Maritorena, A. Morel & B. Gentili, "Diffuse reflectance of
 //!   oceanic shallow waters: influence of water depth and bottom albedo", Limnol. Oceanogr. 39(7), 1994), with a
@@ -46,7 +47,7 @@ pub fn shallow_albedo(rho_deep: Vec3, depth: f32) -> Vec3 {
 /// Albedo of dense foam.
 pub const FOAM_ALBEDO: f32 = 0.55;
 /// e-folding age of wake foam, seconds.
-const WAKE_FADE_S: f32 = 60.0;
+const WAKE_FADE_S: f32 = 30.0;
 /// `tan` of the Kelvin half-angle.
 const KELVIN_TAN: f32 = 0.353_553_4;
 /// Stream of the foam noise.
@@ -243,17 +244,19 @@ impl Foam {
                 continue;
             }
             let lateral = (-dx * s + dy * co).abs();
-            if lateral > 0.6 * w.beam + behind.max(0.0) * (KELVIN_TAN + 0.07) + 0.3 {
+            if lateral > 0.6 * w.beam + (behind.max(0.0) + w.length) * (KELVIN_TAN + 0.07) + 0.3 {
                 continue;
             }
             let fade = (-behind.max(0.0) / (w.speed * WAKE_FADE_S)).exp();
             // Turbulent track behind the stern.
             let half = 0.5 * w.beam * (1.0 + (behind.max(0.0) / w.beam.max(1.0)).sqrt() * 0.25);
-            let mut f = if lateral < half { (1.0 - lateral / half).sqrt() * fade } else { 0.0 };
-            // Kelvin arms.
+            let track = (w.speed / 6.0).powi(2).min(1.0);
+            let mut f = if lateral < half { (1.0 - lateral / half).sqrt() * fade * track } else { 0.0 };
+            // Kelvin arms, from the bow.
+            let from_bow = behind + w.length;
             if behind > 0.0 {
-                let width = 0.3 + 0.02 * behind + 0.1 * w.beam;
-                let off = (lateral - behind * KELVIN_TAN).abs();
+                let width = 0.3 + 0.02 * from_bow + 0.1 * w.beam;
+                let off = (lateral - from_bow * KELVIN_TAN).abs();
                 if off < width {
                     let strength = (w.speed / 8.0).powi(2).min(1.0);
                     f = f.max((1.0 - off / width) * fade * strength * 0.8);
@@ -320,10 +323,14 @@ mod tests {
         // Right behind the stern: foam. Ahead of the bow: none.
         assert!(foam.cover(-10.0, 0.0) > 0.3);
         assert_eq!(foam.cover(30.0, 0.0), 0.0);
-        // 100 m behind the stern, the arms are at ±35.4 m; between them and the track, none.
+        // 100 m behind the stern (110 m behind the bow), the arms are at ±38.9 m; between them and the track,
+        // none.
         let behind = -5.0 - 100.0;
-        assert!(foam.cover(behind, 35.36) > 0.2);
-        assert!(foam.cover(behind, -35.36) > 0.2);
+        assert!(foam.cover(behind, 38.89) > 0.2);
+        assert!(foam.cover(behind, -38.89) > 0.2);
         assert_eq!(foam.cover(behind, 18.0), 0.0);
+        // A slow craft leaves a faint track.
+        let slow = Foam::new(0.0, &[Wake { speed: 1.5, ..w }], 3);
+        assert!(slow.cover(-10.0, 0.0) < 0.1 * foam.cover(-10.0, 0.0) + 1e-6);
     }
 }
