@@ -10,6 +10,7 @@ from typing import Any
 
 import pytest
 import yaml
+from mcap_rechunk import rechunk
 from mmusv.errors import ConfigError, IoError, MmusvError
 from mmusv.export import cli as export_cli
 from mmusv.export import convert
@@ -142,31 +143,6 @@ def test_interrupted_run(tmp_path: Path, make_coop: Callable[..., dict[str, Any]
     rep = convert(rec, out_dir=tmp_path / "o", splits=None, extras=())
     assert rep.frames == 2
     assert rep.skipped[0]["frames"] == [2, 2] and "interrupted" in rep.skipped[0]["reason"]
-
-
-def rechunk(src: Path, dst: Path, chunk_size: int) -> None:
-    """Copies a recording record by record into small chunks (a real run's chunks are ~4 MiB)."""
-    from mcap.records import Channel, Message, Metadata, Schema
-    from mcap.stream_reader import StreamReader
-    from mcap.writer import CompressionType, Writer
-
-    with src.open("rb") as f, dst.open("wb") as g:
-        w = Writer(g, chunk_size=chunk_size, compression=CompressionType.ZSTD)
-        w.start(profile="", library="test")
-        schemas: dict[int, int] = {}
-        channels: dict[int, int] = {}
-        for rec in StreamReader(f).records:
-            if isinstance(rec, Schema):
-                schemas[rec.id] = w.register_schema(rec.name, rec.encoding, rec.data)
-            elif isinstance(rec, Channel):
-                channels[rec.id] = w.register_channel(
-                    rec.topic, rec.message_encoding, schemas.get(rec.schema_id, 0), rec.metadata
-                )
-            elif isinstance(rec, Message):
-                w.add_message(channels[rec.channel_id], rec.log_time, rec.data, rec.publish_time, rec.sequence)
-            elif isinstance(rec, Metadata):
-                w.add_metadata(rec.name, rec.metadata)
-        w.finish()  # type: ignore[no-untyped-call]
 
 
 def test_truncated_partial_file(coop_rec: Path, tmp_path: Path) -> None:

@@ -18,6 +18,7 @@ from typing import Any
 
 import pytest
 import yaml
+from mcap_rechunk import rechunk
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -43,31 +44,6 @@ def write_yaml(path: Path, data: dict[str, Any]) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
     return path
-
-
-def rechunk(src: Path, dst: Path, chunk_size: int) -> None:
-    """Copies a recording record by record into small zstd chunks (with CRCs) using the official writer."""
-    from mcap.records import Channel, Message, Metadata, Schema
-    from mcap.stream_reader import StreamReader
-    from mcap.writer import CompressionType, Writer
-
-    with src.open("rb") as f, dst.open("wb") as g:
-        w = Writer(g, chunk_size=chunk_size, compression=CompressionType.ZSTD)
-        w.start(profile="", library="test")
-        schemas: dict[int, int] = {}
-        channels: dict[int, int] = {}
-        for rec in StreamReader(f).records:
-            if isinstance(rec, Schema):
-                schemas[rec.id] = w.register_schema(rec.name, rec.encoding, rec.data)
-            elif isinstance(rec, Channel):
-                channels[rec.id] = w.register_channel(
-                    rec.topic, rec.message_encoding, schemas.get(rec.schema_id, 0), rec.metadata
-                )
-            elif isinstance(rec, Message):
-                w.add_message(channels[rec.channel_id], rec.log_time, rec.data, rec.publish_time, rec.sequence)
-            elif isinstance(rec, Metadata):
-                w.add_metadata(rec.name, rec.metadata)
-        w.finish()  # type: ignore[no-untyped-call]
 
 
 def chunk_spans(path: Path) -> list[tuple[int, int]]:
