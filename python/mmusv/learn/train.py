@@ -43,7 +43,7 @@ from mmusv.learn.loss import centerpoint_loss
 from mmusv.learn.model import PillarNet
 from mmusv.learn.presets import PRESETS, Preset, preset
 
-__all__ = ["TrainResult", "TrainingSet", "main", "plot_losses", "train"]
+__all__ = ["TrainResult", "TrainingSet", "main", "plot_losses", "plot_runs", "train"]
 
 WARMUP_STEPS = 100
 LOG_EVERY = 10
@@ -256,6 +256,29 @@ def plot_losses(log_path: str | Path, png: str | Path) -> Path:
     ax.set_ylabel("loss per object")
     ax.legend()
     ax.set_title(f"training loss: {Path(log_path).parent.name}")
+    fig.tight_layout()
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
+    return Path(png)
+
+
+def plot_runs(logs: dict[str, str | Path], png: str | Path, *, title: str) -> Path:
+    """The total loss of several runs' ``log.jsonl`` (by label) over the optimiser steps in one plot."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4))
+    for label, path in logs.items():
+        rows = [json.loads(x) for x in Path(path).read_text(encoding="utf-8").splitlines() if x.strip()]
+        steps = [r for r in rows if "loss" in r]
+        ax.plot([r["step"] for r in steps], [r["loss"] for r in steps], label=label, lw=0.9)
+    ax.set_yscale("log")
+    ax.set_xlabel("optimiser step")
+    ax.set_ylabel("loss per object")
+    ax.legend()
+    ax.set_title(title)
     fig.tight_layout()
     fig.savefig(png, dpi=110)
     plt.close(fig)
