@@ -145,7 +145,7 @@ impl Mesh {
     }
 
     /// Material index of face `triangle` (0 when the mesh has none).
-    #[inline]
+    #[inline(always)]
     pub fn material(&self, triangle: u32) -> u16 {
         self.materials.get(triangle as usize).copied().unwrap_or(0)
     }

@@ -93,6 +93,19 @@ pub struct RayHits {
 }
 
 impl RayHits {
+    /// The hits of rays `which`, in that order.
+    pub fn select(&self, which: &[u32]) -> RayHits {
+        let at = |k: &u32| *k as usize;
+        RayHits {
+            distance: which.iter().map(|k| self.distance[at(k)]).collect(),
+            instance: which.iter().map(|k| self.instance[at(k)]).collect(),
+            triangle: which.iter().map(|k| self.triangle[at(k)]).collect(),
+            normal: which.iter().flat_map(|k| self.normal[3 * at(k)..3 * at(k) + 3].iter().copied()).collect(),
+            class: which.iter().map(|k| self.class[at(k)]).collect(),
+            backface: which.iter().map(|k| self.backface[at(k)]).collect(),
+        }
+    }
+
     /// Zeroed arrays (cheap: fresh zero pages); the tracer writes every entry of every ray.
     fn zeroed(n: usize) -> Self {
         Self {
@@ -218,7 +231,7 @@ impl Scene {
     }
 
     /// Material index of triangle `triangle` of instance `instance` (0 for none or a miss).
-    #[inline]
+    #[inline(always)]
     pub fn material_index(&self, instance: i32, triangle: i32) -> u16 {
         match (usize::try_from(instance), u32::try_from(triangle)) {
             (Ok(i), Ok(t)) if i < self.instances.len() => self.meshes[self.instances[i].mesh as usize].material(t),

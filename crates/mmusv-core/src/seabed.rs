@@ -12,6 +12,8 @@ pub struct Seabed {
     x0: f32,
     y0: f32,
     spacing: f32,
+    /// `1 / spacing`.
+    inv_spacing: f32,
     nx: usize,
     ny: usize,
     z: Vec<f32>,
@@ -37,15 +39,15 @@ impl Seabed {
         if let Some(i) = z.iter().position(|v| !v.is_finite()) {
             return Err(MmusvError::input(format!("seabed.heights[{i}]"), "must be finite"));
         }
-        Ok(Self { x0, y0, spacing, nx, ny, z })
+        Ok(Self { x0, y0, spacing, inv_spacing: 1.0 / spacing, nx, ny, z })
     }
 
     /// Water depth (metres, `>= 0`) over the seabed at world `(x, y)` below a surface at `level`; `None` outside
     /// the raster.
-    #[inline]
+    #[inline(always)]
     pub fn depth(&self, x: f32, y: f32, level: f32) -> Option<f32> {
-        let u = (x - self.x0) / self.spacing;
-        let v = (y - self.y0) / self.spacing;
+        let u = (x - self.x0) * self.inv_spacing;
+        let v = (y - self.y0) * self.inv_spacing;
         if !(u >= 0.0 && v >= 0.0 && u <= (self.nx - 1) as f32 && v <= (self.ny - 1) as f32) {
             return None;
         }

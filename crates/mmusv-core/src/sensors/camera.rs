@@ -204,6 +204,8 @@ pub struct Camera {
     origins: Vec<[f32; 3]>,
     /// Trace order: entry `k` is the row-major index of the `k`-th pixel traced ([`TILE`]² tiles, row by row).
     order: Vec<u32>,
+    /// The inverse of `order`: entry `i` is the trace position of row-major pixel `i`.
+    rank: Vec<u32>,
 }
 
 /// Row-major pixel indices of a `w × h` image in [`TILE`]×[`TILE`] tiles, tiles row by row, pixels within a tile
@@ -297,7 +299,12 @@ impl Camera {
                 (vec![[1.0, 0.0, 0.0]], origins)
             }
         };
-        Ok(Self { cfg, dirs, origins, order: tile_order(w, h) })
+        let order = tile_order(w, h);
+        let mut rank = vec![0u32; order.len()];
+        for (k, &i) in order.iter().enumerate() {
+            rank[i as usize] = k as u32;
+        }
+        Ok(Self { cfg, dirs, origins, order, rank })
     }
 
     /// The configuration.
@@ -404,9 +411,9 @@ impl Camera {
             rgb: Vec::new(),
             radiance: Vec::new(),
         };
-        // Material ids per pixel, for the anti-aliasing's edge test only.
+        // Instance, class and material per pixel in one word, for the anti-aliasing's edge test only.
         let edges_wanted = (options.rgb || options.radiance) && self.cfg.image.quality.edge_samples() > 1;
-        let mut material = if edges_wanted { vec![0u16; n] } else { Vec::new() };
+        let mut surface = if edges_wanted { vec![0u64; n] } else { Vec::new() };
         for (k, &i) in self.order.iter().enumerate() {
             let i = i as usize;
             let t = hits.distance[k];
@@ -415,8 +422,9 @@ impl Camera {
             }
             frame.semantic[i] = hits.class[k];
             frame.instance[i] = hits.instance[k];
-            if !material.is_empty() {
-                material[i] = scene.material_index(hits.instance[k], hits.triangle[k]);
+            if !surface.is_empty() {
+                let material = scene.material_index(hits.instance[k], hits.triangle[k]);
+                surface[i] = (hits.instance[k] as u32 as u64) << 32 | (hits.class[k] as u64) << 16 | material as u64;
             }
         }
         if !(options.rgb || options.radiance) {
@@ -430,30 +438,76 @@ impl Camera {
         let block = |k: usize| {
             let i = self.order[k];
             let (x, y) = (i % self.cfg.width, i / self.cfg.width);
-            self.trace_index((y & !1) * self.cfg.width + (x & !1))
+            self.rank[((y & !1) * self.cfg.width + (x & !1)) as usize] as usize
         };
         let refl = match q {
             Quality::Draft => Reflections::Sky,
             Quality::Standard => Reflections::Shared(&block),
             Quality::High => Reflections::Every,
         };
-        let traced = radiance::radiance(scene, &shader, env.shadows, refl, &origins, &dirs, &hits)?;
+        // Below `high`, open water and sky share their shading over the pixels between even rows and columns
+        // wherever the even pixels around agree (radiance::radiance).
+        let w = self.cfg.width;
+        let anchors = |k: usize| -> ([u32; 4], usize) {
+            let i = self.order[k];
+            let (x, y) = (i % w, i / w);
+            let xs: &[u32] = if x & 1 == 0 { &[x, x] } else { &[x - 1, x + 1] };
+            let ys: &[u32] = if y & 1 == 0 { &[y, y] } else { &[y - 1, y + 1] };
+            let (nx, ny) = (1 + (x & 1) as usize, 1 + (y & 1) as usize);
+            if nx * ny == 1 || xs[nx - 1] >= w || ys[ny - 1] >= self.cfg.height {
+                return ([0; 4], 0);
+            }
+            let mut ids = [0u32; 4];
+            for (a, &yy) in ys[..ny].iter().enumerate() {
+                for (b, &xx) in xs[..nx].iter().enumerate() {
+                    ids[a * nx + b] = self.rank[(yy * w + xx) as usize];
+                }
+            }
+            (ids, nx * ny)
+        };
+        let shared: Option<radiance::Anchors<'_>> = if q == Quality::High { None } else { Some(&anchors) };
+        let traced = radiance::radiance(scene, &shader, env.shadows, refl, shared, (&origins, &dirs, &hits))?;
         let mut linear = vec![Vec3::ZERO; n];
         for (k, &i) in self.order.iter().enumerate() {
             linear[i as usize] = traced[k];
         }
         let s = q.edge_samples();
         if s > 1 {
-            let edges = edge_pixels(&frame, &material);
+            let exposure = shader.exposure();
+            let edges = edge_pixels(&frame, &surface, |a, b| !radiance::alike(linear[a], linear[b], exposure));
             if !edges.is_empty() {
                 let (so, sd) = self.sample_rays(pose, &edges, s, options.seed);
                 let shits = scene.cast_rays(&so, &sd, self.cfg.range_max)?;
-                let refl = if q.reflections() { Reflections::Every } else { Reflections::Sky };
-                let samples = radiance::radiance(scene, &shader, env.shadows, refl, &so, &sd, &shits)?;
                 let per = s as usize;
-                for (e, &i) in edges.iter().enumerate() {
-                    let sum: Vec3 = samples[e * per..(e + 1) * per].iter().copied().sum();
-                    linear[i as usize] = sum / s as f32;
+                // A pixel whose samples all see its centre's surface (the edge runs through its neighbour)
+                // keeps its centre's shading; the others are shaded sample by sample.
+                let key = |j: usize| {
+                    let m = scene.material_index(shits.instance[j], shits.triangle[j]);
+                    (shits.instance[j] as u32 as u64) << 32 | (shits.class[j] as u64) << 16 | m as u64
+                };
+                let mixed: Vec<u32> = (0..edges.len())
+                    .into_par_iter()
+                    .filter(|&e| {
+                        let i = edges[e] as usize;
+                        let t = hits.distance[self.rank[i] as usize];
+                        (e * per..(e + 1) * per).any(|j| {
+                            let tj = shits.distance[j];
+                            key(j) != surface[i]
+                                || frame.semantic[i] != 1 && t.is_finite() && (tj - t).abs() > 0.05 * tj.min(t)
+                        })
+                    })
+                    .map(|e| e as u32)
+                    .collect();
+                let rays: Vec<u32> =
+                    mixed.iter().flat_map(|&e| (e as usize * per..(e as usize + 1) * per).map(|j| j as u32)).collect();
+                let (mo, md): (Vec<[f32; 3]>, Vec<[f32; 3]>) =
+                    rays.iter().map(|&j| (so[j as usize], sd[j as usize])).unzip();
+                let mhits = shits.select(&rays);
+                let refl = if q.reflections() { Reflections::Every } else { Reflections::Sky };
+                let samples = radiance::radiance(scene, &shader, env.shadows, refl, None, (&mo, &md, &mhits))?;
+                for (m, &e) in mixed.iter().enumerate() {
+                    let sum: Vec3 = samples[m * per..(m + 1) * per].iter().copied().sum();
+                    linear[edges[e as usize] as usize] = sum / s as f32;
                 }
             }
         }
@@ -536,24 +590,24 @@ impl Camera {
     }
 }
 
-/// Row-major indices of the pixels at an edge: a 4-neighbour with another instance, class or material, or (off
-/// the water) a depth differing by more than 5 %.
-fn edge_pixels(frame: &CameraFrame, material: &[u16]) -> Vec<u32> {
+/// Row-major indices of the pixels at a visible edge: a 4-neighbour on another surface (`surface`: instance,
+/// class and material in one word) or, off the water, at a depth differing by more than 5 %, and whose centre
+/// colour differs from that neighbour's (`contrast(a, b)`, so an edge between two surfaces that look alike,
+/// [`radiance::alike`], keeps its one sample).
+fn edge_pixels(frame: &CameraFrame, surface: &[u64], contrast: impl Fn(usize, usize) -> bool + Sync) -> Vec<u32> {
     let (w, h) = (frame.width as usize, frame.height as usize);
     let differs = |a: usize, b: usize| {
-        if frame.instance[a] != frame.instance[b]
-            || frame.semantic[a] != frame.semantic[b]
-            || material[a] != material[b]
-        {
-            return true;
-        }
-        // Depth steps matter between surfaces, not across the open water (its shading varies smoothly).
-        let (da, db) = (frame.depth[a], frame.depth[b]);
-        frame.semantic[a] != 1 && da.is_finite() && db.is_finite() && (da - db).abs() > 0.05 * da.min(db)
+        let geometric = surface[a] != surface[b] || {
+            // Depth steps matter between surfaces, not across the open water (its shading varies smoothly).
+            let (da, db) = (frame.depth[a], frame.depth[b]);
+            frame.semantic[a] != 1 && da.is_finite() && db.is_finite() && (da - db).abs() > 0.05 * da.min(db)
+        };
+        geometric && contrast(a, b)
     };
     (0..h)
         .into_par_iter()
         .flat_map_iter(|y| {
+            let differs = &differs;
             (0..w).filter_map(move |x| {
                 let i = y * w + x;
                 let edge = (x > 0 && differs(i, i - 1))
@@ -603,6 +657,58 @@ mod tests {
             let _ = s.add_instance(id, RigidPose::IDENTITY, None);
         }
         s
+    }
+
+    /// Open water and sky shared between anchors (below `high`) look like every pixel shaded: over open water
+    /// (where draft's sky reflections and high's traced ones agree), away from the horizon's anti-aliased
+    /// edge, draft's shared shading stays within a few sRGB levels of high's per-pixel shading.
+    #[test]
+    fn shared_shading_matches_every_pixel_shaded() {
+        let mut water = Scene::new();
+        let g = [[-5e3, -5e3, 0.0], [5e3, -5e3, 0.0], [5e3, 5e3, 0.0], [-5e3, 5e3, 0.0]];
+        if let Ok(m) = Mesh::new("water", &g, &[[0i64, 1, 2], [0, 2, 3]], &[1, 1]) {
+            let id = water.add_mesh(m);
+            let _ = water.add_instance(id, RigidPose::IDENTITY, None);
+        }
+        let (w, h) = (96usize, 64usize);
+        let render = |quality: Quality| {
+            let cfg = CameraConfig {
+                width: w as u32,
+                height: h as u32,
+                projection: Projection::Pinhole { hfov: 1.5 },
+                range_max: 1e4,
+                image: ImageOptions { quality, ..Default::default() },
+            };
+            let cam = Camera::new(cfg).ok()?;
+            let pose = RigidPose::from_xyz_rpy([0.0, 0.0, 3.0], [0.0, 0.15, 0.3]);
+            // A low sun ahead, so the frame holds a glint as well as smooth water and sky.
+            let sun = Vec3::new(1.0, 0.25, 0.25).normalize().to_array();
+            let env = ShadeEnv { sun_direction: sun, wave_height_m: 0.5, wind_speed_m_s: 4.0, ..ShadeEnv::default() };
+            let opts = RenderOptions { rgb: true, radiance: false, seed: 3, wakes: &[] };
+            cam.render_with(&water, &pose, &env, &opts).ok()
+        };
+        let (Some(draft), Some(high)) = (render(Quality::Draft), render(Quality::High)) else {
+            panic!("render failed")
+        };
+        let (mut compared, mut worst, mut sum) = (0usize, 0u8, 0u64);
+        for y in 1..h - 1 {
+            for x in 1..w - 1 {
+                let i = y * w + x;
+                let class = |j: usize| high.semantic[j];
+                if [i - 1, i + 1, i - w, i + w].iter().any(|&j| class(j) != class(i)) {
+                    continue;
+                }
+                compared += 1;
+                for c in 0..3 {
+                    let d = draft.rgb[3 * i + c].abs_diff(high.rgb[3 * i + c]);
+                    worst = worst.max(d);
+                    sum += d as u64;
+                }
+            }
+        }
+        assert!(compared > 5000, "{compared} pixels compared");
+        let mean = sum as f64 / (3 * compared) as f64;
+        assert!(mean < 0.1 && worst <= 10, "mean {mean:.3}, worst {worst} levels");
     }
 
     #[test]

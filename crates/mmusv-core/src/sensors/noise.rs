@@ -29,7 +29,7 @@ fn splitmix64(mut z: u64) -> u64 {
 }
 
 /// A 64-bit hash of `(seed, stream, index)`.
-#[inline]
+#[inline(always)]
 pub fn hash3(seed: u64, stream: u64, index: u64) -> u64 {
     splitmix64(splitmix64(splitmix64(seed) ^ stream.wrapping_mul(0xD6E8_FEB8_6659_FD93)) ^ index)
 }

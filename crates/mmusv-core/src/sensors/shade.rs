@@ -33,7 +33,7 @@ pub mod water;
 
 use brdf::{dfg, fresnel_dielectric, specular_cos};
 use envlight::{Lighting, LightingKey, WATER_IOR};
-use water::{Foam, Wake, FOAM_ALBEDO};
+use water::{Foam, ShallowWater, Wake, FOAM_ALBEDO};
 
 /// The environment as the cameras see it (and, for fog, rain and waves, the LiDAR and the radar).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -163,24 +163,27 @@ pub fn class_material(hit: &SurfaceHit) -> Material {
     Material { base_color: base.to_array(), roughness, metallic, emissive: [0.0; 3], nav_light: false }
 }
 
-/// `cos x` to within 10⁻⁶ without a library call (for `|x| < 10⁹`): the argument reduced to `[−π, π]` in `f64`,
-/// folded onto `[0, π/2]`, then the Taylor series to `x¹²` (remainder below `(π/2)¹⁴ / 14! ≈ 6·10⁻⁹`).
+/// Intervals per turn of [`fast_cos`]'s table.
+const COS_STEPS: usize = 4096;
+
+/// `cos` at `COS_STEPS + 1` evenly spaced points of one turn (built once).
+fn cos_table() -> &'static [f32] {
+    static TABLE: std::sync::OnceLock<Vec<f32>> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| {
+        (0..=COS_STEPS).map(|i| (i as f64 / COS_STEPS as f64 * std::f64::consts::TAU).cos() as f32).collect()
+    })
+}
+
+/// `cos x` to within 10⁻⁶ without a library call (for `|x| < 10⁹`): the argument reduced to turns in `f64`,
+/// then a table of [`COS_STEPS`] intervals per turn read linearly (error below `(2π/4096)² / 8 ≈ 3·10⁻⁷`).
 #[inline(always)]
 fn fast_cos(x: f32) -> f32 {
-    use std::f64::consts::{FRAC_PI_2, PI, TAU};
-    // Round to nearest by the 1.5·2⁵² trick (|x / 2π| is far below 2⁵¹ for any swell argument); multiplications
-    // by reciprocals throughout (a division costs several times more).
-    const SHIFT: f64 = 6_755_399_441_055_744.0;
-    const INV_TAU: f64 = 1.0 / TAU;
-    let x = x as f64;
-    let turns = (x * INV_TAU + SHIFT) - SHIFT;
-    let a = (x - TAU * turns).abs();
-    let (a, sign) = if a > FRAC_PI_2 { (PI - a, -1.0) } else { (a, 1.0) };
-    let z = a * a;
-    const C: [f64; 6] = [1.0 / 2.0, 1.0 / 12.0, 1.0 / 30.0, 1.0 / 56.0, 1.0 / 90.0, 1.0 / 132.0];
-    let c =
-        1.0 - z * C[0] * (1.0 - z * C[1] * (1.0 - z * C[2] * (1.0 - z * C[3] * (1.0 - z * C[4] * (1.0 - z * C[5])))));
-    (sign * c) as f32
+    let t = x as f64 * (COS_STEPS as f64 / std::f64::consts::TAU);
+    let f = t.floor();
+    let i = (f as i64).rem_euclid(COS_STEPS as i64) as usize;
+    let w = (t - f) as f32;
+    let table = cos_table();
+    table[i] + (table[i + 1] - table[i]) * w
 }
 
 /// One swell component of the water surface: direction `(cos, sin)`, wave number, phase and slope amplitude.
@@ -205,8 +208,11 @@ pub struct Shader {
     water_alpha: f32,
     water_fdr: f32,
     water_rho: Vec3,
+    shallow: Arc<ShallowWater>,
     foam: Foam,
     exposure: f32,
+    /// Share of the sky's own radiance that reaches the camera through the fog (3 km of it).
+    sky_keep: f32,
     materials: Arc<Vec<Material>>,
     seabed: Option<Arc<Seabed>>,
 }
@@ -259,8 +265,10 @@ impl Shader {
             water_alpha: water::cox_munk_alpha(env.wind_speed_m_s),
             water_fdr: water::internal_diffuse_reflectance(WATER_IOR),
             water_rho: Vec3::from_array(env.water_albedo),
+            shallow: ShallowWater::shared(Vec3::from_array(env.water_albedo)),
             foam: Foam::new(water::monahan_coverage(env.wind_speed_m_s), wakes, 0x5EA),
             exposure,
+            sky_keep: (-env.fog_extinction_per_m * 3000.0).exp(),
             materials: Arc::new(Vec::new()),
             seabed: None,
         }
@@ -299,36 +307,36 @@ impl Shader {
     }
 
     /// Radiance of the sky along unit `d`, with the sun's disc, veiled by fog.
-    #[inline]
+    #[inline(always)]
     pub fn sky(&self, d: Vec3) -> Vec3 {
-        let c = self.light.sky_radiance(d) + self.light.sky.sun_disc(d);
-        let keep = (-self.env.fog_extinction_per_m * 3000.0).exp();
-        c * keep + self.air_light(d) * (1.0 - keep)
+        let (sky, air) = self.light.sky_and_horizon(d);
+        let c = sky + self.light.sky.sun_disc(d);
+        c * self.sky_keep + air * (1.0 - self.sky_keep)
     }
 
     /// Radiance of the sky without the sun's disc along unit `d` (what a reflected ray sees; the sun's
     /// reflection is the glint), veiled by fog.
-    #[inline]
+    #[inline(always)]
     fn sky_no_sun(&self, d: Vec3) -> Vec3 {
-        let keep = (-self.env.fog_extinction_per_m * 3000.0).exp();
-        self.light.sky_radiance(d) * keep + self.air_light(d) * (1.0 - keep)
+        let (sky, air) = self.light.sky_and_horizon(d);
+        sky * self.sky_keep + air * (1.0 - self.sky_keep)
     }
 
     /// Radiance distant objects fade into along `d`: the horizon sky's, at `d`'s azimuth.
-    #[inline]
+    #[inline(always)]
     pub fn air_light(&self, d: Vec3) -> Vec3 {
         self.light.horizon_radiance(d)
     }
 
     /// Aerial perspective over a path of `t` metres along `d`.
-    #[inline]
+    #[inline(always)]
     pub fn fog(&self, c: Vec3, d: Vec3, t: f32) -> Vec3 {
         let f = (-self.env.fog_extinction_per_m * t).exp();
         c * f + self.air_light(d) * (1.0 - f)
     }
 
     /// Swell normal of the water surface at `p`.
-    #[inline]
+    #[inline(always)]
     pub fn water_normal(&self, p: Vec3) -> Vec3 {
         let mut gx = 0.0;
         let mut gy = 0.0;
@@ -343,7 +351,7 @@ impl Shader {
 
     /// `hit` with its shading normal set: for water seen along `d`, the swell's (or the geometric one where the
     /// swell would face away); for anything else, the geometric normal.
-    #[inline]
+    #[inline(always)]
     pub fn with_swell(&self, d: Vec3, mut hit: SurfaceHit) -> SurfaceHit {
         hit.shading_normal = hit.normal;
         if hit.is_water() {
@@ -357,7 +365,7 @@ impl Shader {
 
     /// Origin and unit direction of the ray reflected by a water hit seen along `d` (never below the horizon),
     /// about its shading normal.
-    #[inline]
+    #[inline(always)]
     pub fn reflection_ray(&self, d: Vec3, hit: &SurfaceHit) -> (Vec3, Vec3) {
         let n = hit.shading_normal;
         let mut r = d - n * (2.0 * d.dot(n));
@@ -368,7 +376,7 @@ impl Shader {
     }
 
     /// Radiance (before aerial perspective) of a non-water surface seen along `d`, lit by the sun when `sunlit`.
-    #[inline]
+    #[inline(always)]
     pub fn surface(&self, d: Vec3, hit: &SurfaceHit, sunlit: bool) -> Vec3 {
         let m = match self.materials.get(hit.material as usize) {
             Some(m) if hit.material != 0 => *m,
@@ -404,7 +412,7 @@ impl Shader {
     /// Radiance (before aerial perspective) of the water seen along `d`: Fresnel-weighted `reflected` radiance
     /// (along [`Shader::reflection_ray`]; `None` reads the sky there), the sun's Cox–Munk glint when `sunlit`,
     /// the water body, and foam.
-    #[inline]
+    #[inline(always)]
     pub fn water(&self, d: Vec3, hit: &SurfaceHit, sunlit: bool, reflected: Option<Vec3>) -> Vec3 {
         let n = hit.shading_normal;
         let v = -d;
@@ -422,12 +430,12 @@ impl Shader {
                 // The glint: GGX with the Cox–Munk roughness, weighted by the exact Fresnel at the half vector.
                 let h = (v + self.sun).normalize_or_zero();
                 let f = water_fresnel(v.dot(h));
-                c += specular_cos(n, v, self.sun, self.water_alpha, Vec3::ONE) * self.sun_e * f;
+                c += self.sun_e * (brdf::microfacet_cos(n, v, self.sun, self.water_alpha) * f);
                 entering += self.sun_e * (ns * (1.0 - water_fresnel(ns)));
             }
         }
         let rho = match self.seabed.as_ref().and_then(|s| s.depth(hit.point.x, hit.point.y, 0.0)) {
-            Some(depth) => water::shallow_albedo(self.water_rho, depth),
+            Some(depth) => self.shallow.albedo(depth),
             None => self.water_rho,
         };
         c += water::body_factor(rho, self.water_fdr, f_o, WATER_IOR) * entering;
@@ -446,7 +454,7 @@ impl Shader {
 
     /// Radiance along camera ray `d` with its hit (or `None` for the sky), whether the hit sees the sun, and for
     /// water the radiance along its reflected ray (`None`: the sky's); aerial perspective included.
-    #[inline]
+    #[inline(always)]
     pub fn shade(&self, d: Vec3, hit: Option<&SurfaceHit>, sunlit: bool, reflected: Option<Vec3>) -> Vec3 {
         let Some(hit) = hit else {
             return self.sky(d);
@@ -457,7 +465,7 @@ impl Shader {
 
     /// Radiance a reflected ray `d` brings back: its hit's (no further reflection), or the sky without the
     /// sun's disc.
-    #[inline]
+    #[inline(always)]
     pub fn reflected(&self, d: Vec3, hit: Option<&SurfaceHit>, sunlit: bool) -> Vec3 {
         match hit {
             None => self.sky_no_sun(d),

@@ -8,6 +8,7 @@
 
 use crate::error::Result;
 use crate::scene::{RayHits, Scene};
+use crate::sensors::shade::tonemap;
 use crate::sensors::shade::{Shader, SurfaceHit};
 use parry3d::math::Vec3;
 use rayon::prelude::*;
@@ -19,7 +20,7 @@ const REFLECTION_RANGE: f32 = 20_000.0;
 
 /// The hit of ray `k` as shading needs it (normal turned towards the ray, the face's material, the swell's
 /// normal on water), `None` for a miss.
-#[inline]
+#[inline(always)]
 pub(crate) fn surface_at(
     shader: &Shader,
     scene: &Scene,
@@ -53,8 +54,8 @@ pub(crate) fn surface_at(
 }
 
 /// Where a shadow ray from the hit of ray `k` starts (just off the surface, on the camera's side), if that hit
-/// could see the sun (it faces it, or it is water, whose swell may face it), else `None`; `keep` filters hits
-/// by class.
+/// could see the sun (it faces it, or it is water, whose swell may face it), else `None`; `keep` filters the
+/// rays.
 #[inline]
 fn shadow_origin(
     hits: &RayHits,
@@ -62,10 +63,10 @@ fn shadow_origin(
     dirs: &[[f32; 3]],
     k: usize,
     sun: Vec3,
-    keep: impl Fn(u16) -> bool,
+    keep: impl Fn(usize) -> bool,
 ) -> Option<[f32; 3]> {
     let t = hits.distance[k];
-    if !t.is_finite() || !keep(hits.class[k]) {
+    if !t.is_finite() || !keep(k) {
         return None;
     }
     let d = Vec3::from_array(dirs[k]);
@@ -81,14 +82,14 @@ fn shadow_origin(
     }
 }
 
-/// Which of the rays' hits see the sun (hits of the classes `keep` accepts): all false at night, all that could
-/// when shadows are off.
+/// Which of the rays' hits see the sun (of the rays `keep` accepts; the others are false): all false at
+/// night, all that could when shadows are off.
 fn sunlit(
     scene: &Scene,
     shader: &Shader,
     shadows: bool,
     (hits, origins, dirs): (&RayHits, &[[f32; 3]], &[[f32; 3]]),
-    keep: impl Fn(u16) -> bool + Sync + Copy,
+    keep: impl Fn(usize) -> bool + Sync + Copy,
 ) -> Result<Vec<bool>> {
     let n = origins.len();
     let mut lit = vec![false; n];
@@ -115,6 +116,39 @@ fn sunlit(
     Ok(lit)
 }
 
+/// [`sunlit`] of the rays `which` only, in that order.
+fn sunlit_of(
+    scene: &Scene,
+    shader: &Shader,
+    shadows: bool,
+    (hits, origins, dirs): (&RayHits, &[[f32; 3]], &[[f32; 3]]),
+    which: &[u32],
+) -> Result<Vec<bool>> {
+    let mut lit = vec![false; which.len()];
+    if !shader.sun_up() {
+        return Ok(lit);
+    }
+    let sun = shader.sun();
+    let facing: Vec<(u32, [f32; 3])> = which
+        .par_iter()
+        .enumerate()
+        .filter_map(|(j, &k)| shadow_origin(hits, origins, dirs, k as usize, sun, |_| true).map(|o| (j as u32, o)))
+        .collect();
+    if shadows {
+        let origins: Vec<[f32; 3]> = facing.iter().map(|(_, o)| *o).collect();
+        let dirs = vec![sun.to_array(); origins.len()];
+        let blocked = scene.occluded_rays(&origins, &dirs, SHADOW_RANGE)?;
+        for ((j, _), b) in facing.iter().zip(blocked) {
+            lit[*j as usize] = !b;
+        }
+    } else {
+        for (j, _) in &facing {
+            lit[*j as usize] = true;
+        }
+    }
+    Ok(lit)
+}
+
 /// Where water reflections are traced.
 #[derive(Clone, Copy)]
 pub enum Reflections<'a> {
@@ -127,22 +161,72 @@ pub enum Reflections<'a> {
     Shared(&'a (dyn Fn(usize) -> usize + Sync)),
 }
 
+/// Shading shared between neighbouring rays (a camera's pixels): `anchors(k)` gives up to four rays (and how
+/// many) whose mean ray `k` may take instead of being shaded; an anchor has none itself.
+pub type Anchors<'a> = &'a (dyn Fn(usize) -> ([u32; 4], usize) + Sync);
+
+/// Largest difference (sRGB levels of 255, any channel, after exposure `k` and the tone curve) between two
+/// colours that count as alike: where the anchors of a ray agree this well, their mean stands for it, and an
+/// edge between alike pixels needs no anti-aliasing (a mixture of the two differs from either by no more).
+pub const ALIKE_LEVELS: u8 = 2;
+
+/// Whether radiances `a` and `b` look alike under exposure `k` ([`ALIKE_LEVELS`]).
+#[inline]
+pub fn alike(a: Vec3, b: Vec3, k: f32) -> bool {
+    alike_shown(tonemap::to_srgb8(a, k), tonemap::to_srgb8(b, k))
+}
+
+/// Whether two tone-mapped colours are alike ([`ALIKE_LEVELS`]).
+#[inline]
+fn alike_shown(a: [u8; 3], b: [u8; 3]) -> bool {
+    (0..3).all(|c| a[c].abs_diff(b[c]) <= ALIKE_LEVELS)
+}
+
+/// What a ray sees, for sharing shading: 0 a surface other than water (never shared), 1 the sky, 2 water.
+#[inline]
+fn kind(hits: &RayHits, k: usize) -> u8 {
+    if !hits.distance[k].is_finite() {
+        1
+    } else if hits.class[k] == 1 {
+        2
+    } else {
+        0
+    }
+}
+
 /// Radiance (linear RGB, cd/m², aerial perspective included) along every ray `origins[k] + t dirs[k]` whose
 /// closest hits are `hits`, with water `reflections` traced as asked; `shadows` casts shadow rays (else every
 /// surface facing the sun is lit).
+///
+/// With `shared`, a ray that sees the open water or the sky, as all its anchors do, takes their mean when their
+/// colours are alike ([`alike`] under the shader's exposure) and is shaded itself otherwise: smooth water and
+/// sky cost one shading per anchor, while glints, foam and the sun's disc, whose anchors differ, keep every
+/// pixel.
 pub fn radiance(
     scene: &Scene,
     shader: &Shader,
     shadows: bool,
     reflections: Reflections<'_>,
-    origins: &[[f32; 3]],
-    dirs: &[[f32; 3]],
-    hits: &RayHits,
+    shared: Option<Anchors<'_>>,
+    (origins, dirs, hits): (&[[f32; 3]], &[[f32; 3]], &RayHits),
 ) -> Result<Vec<Vec3>> {
     let n = origins.len();
     let surface = |k: usize| surface_at(shader, scene, hits, origins, dirs, k);
     let is_water = |k: usize| hits.distance[k].is_finite() && hits.class[k] == 1;
-    let lit = sunlit(scene, shader, shadows, (hits, origins, dirs), |_| true)?;
+    // Candidates for a shared shading: the ray and its anchors all see water, or all the sky.
+    let candidate: Vec<bool> = match shared {
+        None => Vec::new(),
+        Some(anchors) => (0..n)
+            .into_par_iter()
+            .map(|k| {
+                let kk = kind(hits, k);
+                let (ids, m) = anchors(k);
+                kk != 0 && m > 0 && ids[..m].iter().all(|&j| kind(hits, j as usize) == kk)
+            })
+            .collect(),
+    };
+    let is_candidate = |k: usize| candidate.get(k).copied().unwrap_or(false);
+    let lit = sunlit(scene, shader, shadows, (hits, origins, dirs), |k| !is_candidate(k))?;
     // Reflected rays of the water hits (their representatives'), traced, and the radiance they bring back:
     // `slot[k]` is the index into `values` of ray k's reflected radiance.
     let mut slot: Vec<u32> = Vec::new();
@@ -159,7 +243,15 @@ pub fn radiance(
             }
             _ => k,
         };
-        let traced: Vec<u32> = (0..n).filter(|&k| is_water(k) && owner(k) == k).map(|k| k as u32).collect();
+        // A candidate's own reflection is traced only if it is its own representative (its shading may fall
+        // back to its own); with a shared one, the representative's serves.
+        let traced: Vec<u32> = (0..n)
+            .into_par_iter()
+            .filter(|&k| {
+                is_water(k) && owner(k) == k && !(is_candidate(k) && matches!(reflections, Reflections::Shared(_)))
+            })
+            .map(|k| k as u32)
+            .collect();
         let rays: Vec<([f32; 3], [f32; 3])> = traced
             .par_iter()
             .map(|&k| {
@@ -172,7 +264,7 @@ pub fn radiance(
         let (ro, rd): (Vec<[f32; 3]>, Vec<[f32; 3]>) = rays.into_iter().unzip();
         let rhits = scene.cast_rays(&ro, &rd, REFLECTION_RANGE)?;
         let rsurface = |j: usize| surface_at(shader, scene, &rhits, &ro, &rd, j).filter(|h| !h.is_water());
-        let rlit = sunlit(scene, shader, shadows, (&rhits, &ro, &rd), |class| class != 1)?;
+        let rlit = sunlit(scene, shader, shadows, (&rhits, &ro, &rd), |j| rhits.class[j] != 1)?;
         values = (0..ro.len())
             .into_par_iter()
             .map(|j| {
@@ -185,14 +277,88 @@ pub fn radiance(
         for (j, &k) in traced.iter().enumerate() {
             index[k as usize] = j as u32;
         }
-        slot = (0..n).map(|k| if is_water(k) { index[owner(k)] } else { u32::MAX }).collect();
+        slot = (0..n).into_par_iter().map(|k| if is_water(k) { index[owner(k)] } else { u32::MAX }).collect();
     }
-    Ok((0..n)
-        .into_par_iter()
-        .map(|k| {
-            let h = surface(k);
-            let refl = slot.get(k).and_then(|&j| values.get(j as usize)).copied();
-            shader.shade(Vec3::from_array(dirs[k]), h.as_ref(), lit[k], refl)
-        })
-        .collect())
+    let mut out = vec![Vec3::ZERO; n];
+    let rays = Rays { scene, hits, origins, dirs };
+    out.par_chunks_mut(SHADE_CHUNK).enumerate().for_each(|(c, chunk)| {
+        shade_chunk(shader, &rays, (&lit, &slot, &values), (c * SHADE_CHUNK, &|k| !is_candidate(k)), chunk);
+    });
+    if let Some(anchors) = shared {
+        // The candidates: the anchors' mean where they look alike, NaN where the ray needs its own shading.
+        let k_exp = shader.exposure();
+        // The anchors' colours as shown (each tone-mapped once).
+        let shown: Vec<[u8; 3]> = (0..n)
+            .into_par_iter()
+            .map(|k| if is_candidate(k) { [0; 3] } else { tonemap::to_srgb8(out[k], k_exp) })
+            .collect();
+        let mean: Vec<Vec3> = (0..n)
+            .into_par_iter()
+            .map(|k| {
+                if !is_candidate(k) {
+                    return out[k];
+                }
+                let (ids, m) = anchors(k);
+                let first = shown[ids[0] as usize];
+                if ids[1..m].iter().all(|&j| alike_shown(first, shown[j as usize])) {
+                    ids[..m].iter().map(|&j| out[j as usize]).sum::<Vec3>() / m as f32
+                } else {
+                    Vec3::NAN
+                }
+            })
+            .collect();
+        out = mean;
+        // The rays whose anchors differ: shaded themselves, with their own shadow rays.
+        let redo: Vec<u32> = (0..n).into_par_iter().filter(|&k| out[k].x.is_nan()).map(|k| k as u32).collect();
+        let lit = sunlit_of(scene, shader, shadows, (hits, origins, dirs), &redo)?;
+        let shaded: Vec<Vec3> = redo
+            .par_iter()
+            .zip(lit.par_iter())
+            .map(|(&k, &lit)| {
+                let k = k as usize;
+                let refl = slot.get(k).and_then(|&i| values.get(i as usize)).copied();
+                shader.shade(Vec3::from_array(dirs[k]), surface(k).as_ref(), lit, refl)
+            })
+            .collect();
+        for (&k, c) in redo.iter().zip(shaded) {
+            out[k as usize] = c;
+        }
+    }
+    Ok(out)
+}
+
+/// Rays shaded together per task of the final pass.
+const SHADE_CHUNK: usize = 4096;
+
+/// A batch of rays and their closest hits in a scene.
+struct Rays<'a> {
+    scene: &'a Scene,
+    hits: &'a RayHits,
+    origins: &'a [[f32; 3]],
+    dirs: &'a [[f32; 3]],
+}
+
+crate::dispatch! {
+    /// Shades the rays `start..start + out.len()` that `which` accepts into `out` (the others are left as they
+    /// are), with their sun visibility `lit` and, for water, the reflected radiance `values[slot[k]]` (none:
+    /// the sky's).
+    fn shade_chunk(
+        shader: &Shader,
+        rays: &Rays<'_>,
+        reflected: (&[bool], &[u32], &[Vec3]),
+        range: (usize, &(dyn Fn(usize) -> bool + Sync)),
+        out: &mut [Vec3],
+    ) {
+        let (lit, slot, values) = reflected;
+        let (start, which) = range;
+        for (j, c) in out.iter_mut().enumerate() {
+            let k = start + j;
+            if !which(k) {
+                continue;
+            }
+            let h = surface_at(shader, rays.scene, rays.hits, rays.origins, rays.dirs, k);
+            let refl = slot.get(k).and_then(|&i| values.get(i as usize)).copied();
+            *c = shader.shade(Vec3::from_array(rays.dirs[k]), h.as_ref(), lit[k], refl);
+        }
+    }
 }

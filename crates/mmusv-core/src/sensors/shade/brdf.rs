@@ -25,7 +25,7 @@ use std::sync::OnceLock;
 pub const ALPHA_MIN: f32 = 1e-3;
 
 /// GGX normal distribution `D` for `cos θ_h = n·h` and roughness `alpha`.
-#[inline]
+#[inline(always)]
 pub fn ggx_d(n_dot_h: f32, alpha: f32) -> f32 {
     if n_dot_h <= 0.0 {
         return 0.0;
@@ -36,7 +36,7 @@ pub fn ggx_d(n_dot_h: f32, alpha: f32) -> f32 {
 }
 
 /// Smith masking `G1` of GGX for a direction at `cos θ` from the normal.
-#[inline]
+#[inline(always)]
 pub fn smith_g1(cos_theta: f32, alpha: f32) -> f32 {
     if cos_theta <= 0.0 {
         return 0.0;
@@ -47,7 +47,7 @@ pub fn smith_g1(cos_theta: f32, alpha: f32) -> f32 {
 }
 
 /// Schlick's Fresnel approximation.
-#[inline]
+#[inline(always)]
 pub fn schlick(f0: Vec3, cos_theta: f32) -> Vec3 {
     let m = (1.0 - cos_theta.clamp(0.0, 1.0)).powi(5);
     f0 + (Vec3::ONE - f0) * m
@@ -55,7 +55,7 @@ pub fn schlick(f0: Vec3, cos_theta: f32) -> Vec3 {
 
 /// Exact unpolarised Fresnel reflectance of a dielectric interface (from the side of index 1 into index `eta`)
 /// at incidence `cos θ_i` in `[0, 1]`.
-#[inline]
+#[inline(always)]
 pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
     let cos_i = cos_i.clamp(0.0, 1.0);
     let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
@@ -70,16 +70,34 @@ pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
 
 /// GGX specular reflectance times `cos θ_l`, `f_s (n·l)`, for unit normal `n`, view `v` and light `l` (both
 /// leaving the surface) and Fresnel at normal incidence `f0`.
-#[inline]
+#[inline(always)]
 pub fn specular_cos(n: Vec3, v: Vec3, l: Vec3, alpha: f32, f0: Vec3) -> Vec3 {
     let (nl, nv) = (n.dot(l), n.dot(v));
     if nl <= 0.0 || nv <= 0.0 {
         return Vec3::ZERO;
     }
     let h = (v + l).normalize_or_zero();
-    let d = ggx_d(n.dot(h), alpha);
+    schlick(f0, v.dot(h)) * dg_over_4nv(n.dot(h), nl, nv, alpha)
+}
+
+/// The GGX/Smith part of [`specular_cos`] without the Fresnel factor, `D G / (4 n·l n·v) · n·l`, for a caller
+/// that weights it by a Fresnel of its own: zero where `l` or `v` is below the surface.
+#[inline(always)]
+pub fn microfacet_cos(n: Vec3, v: Vec3, l: Vec3, alpha: f32) -> f32 {
+    let (nl, nv) = (n.dot(l), n.dot(v));
+    if nl <= 0.0 || nv <= 0.0 {
+        return 0.0;
+    }
+    let h = (v + l).normalize_or_zero();
+    dg_over_4nv(n.dot(h), nl, nv, alpha)
+}
+
+/// `D(n·h) G(n·l, n·v) / (4 n·v)` of GGX with Smith masking.
+#[inline(always)]
+fn dg_over_4nv(nh: f32, nl: f32, nv: f32, alpha: f32) -> f32 {
+    let d = ggx_d(nh, alpha);
     let g = smith_g1(nl, alpha) * smith_g1(nv, alpha);
-    schlick(f0, v.dot(h)) * (d * g / (4.0 * nv))
+    d * g / (4.0 * nv)
 }
 
 /// Resolution of the split-sum table in `n·v` and in roughness.
@@ -134,7 +152,7 @@ pub fn dfg_integral(nv: f32, alpha: f32, m: usize) -> [f32; 2] {
 }
 
 /// `(A, B)` of the split sum at `n·v` and roughness (bilinear in the table).
-#[inline]
+#[inline(always)]
 pub fn dfg(nv: f32, roughness: f32) -> [f32; 2] {
     let t = dfg_table();
     let x = (nv.clamp(0.0, 1.0) * LUT as f32 - 0.5).clamp(0.0, (LUT - 1) as f32);

@@ -81,7 +81,7 @@ fn texel_dir(i: usize, j: usize, w: usize, h: usize) -> Vec3 {
 
 /// The "diamond angle" of `(x, y)` in `[0, 4)`: a monotone stand-in for the azimuth (1 per quarter turn)
 /// without trigonometry.
-#[inline]
+#[inline(always)]
 fn diamond(x: f32, y: f32) -> f32 {
     let s = x.abs() + y.abs();
     if s == 0.0 {
@@ -121,7 +121,7 @@ fn diamond_dir(p: f32) -> (f32, f32) {
 
 /// Row parameter `t` in `[−1, 1]` of height `z` in the output grids: `(√(1 + z) − √(1 − z)) / √2`, whose rows
 /// are at most √2 apart in angle anywhere (rows uniform in `z` would be 29° apart at the poles).
-#[inline]
+#[inline(always)]
 fn row_of(z: f32) -> f32 {
     let z = z.clamp(-1.0, 1.0);
     ((1.0 + z).sqrt() - (1.0 - z).sqrt()) * std::f32::consts::FRAC_1_SQRT_2
@@ -137,15 +137,21 @@ fn node_dir(i: usize, j: usize, w: usize, h: usize) -> Vec3 {
     Vec3::new(s * x, s * y, z)
 }
 
-/// Bilinear read of a `w × h` map at column coordinate `x` (wrapping) and row coordinate `y` (clamped).
-#[inline]
-fn bilinear(map: &[Vec3], w: usize, h: usize, x: f32, y: f32) -> Vec3 {
-    let y = y.clamp(0.0, (h - 1) as f32);
+/// The two columns and the weight of the second for column coordinate `x` (wrapping) of a map `w` wide.
+#[inline(always)]
+fn columns(w: usize, x: f32) -> (usize, usize, f32) {
     // floor without a call: x > -1 here (a column coordinate is at least -0.5); wrap without a modulo.
     let xi = (x + 1.0) as i32 - 1;
     let fx = x - xi as f32;
     let i0 = if xi < 0 { w - 1 } else { (xi as usize).min(w - 1) };
     let i1 = if i0 + 1 == w { 0 } else { i0 + 1 };
+    (i0, i1, fx)
+}
+
+/// Bilinear read of a `w × h` map at the columns of [`columns`] and row coordinate `y` (clamped).
+#[inline(always)]
+fn bilinear_at(map: &[Vec3], w: usize, h: usize, (i0, i1, fx): (usize, usize, f32), y: f32) -> Vec3 {
+    let y = y.clamp(0.0, (h - 1) as f32);
     let j0 = y as usize;
     let j1 = (j0 + 1).min(h - 1);
     let fy = y - j0 as f32;
@@ -154,8 +160,14 @@ fn bilinear(map: &[Vec3], w: usize, h: usize, x: f32, y: f32) -> Vec3 {
     a * (1.0 - fy) + b * fy
 }
 
+/// Bilinear read of a `w × h` map at column coordinate `x` (wrapping) and row coordinate `y` (clamped).
+#[inline(always)]
+fn bilinear(map: &[Vec3], w: usize, h: usize, x: f32, y: f32) -> Vec3 {
+    bilinear_at(map, w, h, columns(w, x), y)
+}
+
 /// Bilinear read of an `OUT`-sized map along unit direction `d`.
-#[inline]
+#[inline(always)]
 fn read(map: &[Vec3], d: Vec3) -> Vec3 {
     let (w, h) = OUT;
     let x = diamond(d.x, d.y) / 4.0 * w as f32 - 0.5;
@@ -168,7 +180,7 @@ const SKY: (usize, usize) = (512, 192);
 
 /// Row parameter of height `z` in `[0, 1]` in the sky table: `(√z + 1 − √(1 − z)) / 2`, dense in angle both at
 /// the horizon (`√z`) and at the zenith (`√(1 − z)` grows like the zenith angle).
-#[inline]
+#[inline(always)]
 fn sky_row(z: f32) -> f32 {
     let z = z.clamp(0.0, 1.0);
     0.5 * (z.sqrt() + 1.0 - (1.0 - z).sqrt())
@@ -189,7 +201,7 @@ fn sky_row_z(t: f32) -> f32 {
 }
 
 /// Sky radiance along unit direction `d` (`d.z` clamped to `[0, 1]`) from the `SKY` table.
-#[inline]
+#[inline(always)]
 fn sky_read(table: &[Vec3], d: Vec3) -> Vec3 {
     let (w, h) = SKY;
     let x = diamond(d.x, d.y) / 4.0 * w as f32 - 0.5;
@@ -286,17 +298,27 @@ impl Lighting {
 
     /// The sky's radiance along unit `d` (no sun disc; below the horizon, the horizon's), read from a dense
     /// table of [`Sky::radiance`].
-    #[inline]
+    #[inline(always)]
     pub fn sky_radiance(&self, d: Vec3) -> Vec3 {
         sky_read(&self.sky_table, d)
     }
 
     /// The sky's radiance just above the horizon at `d`'s azimuth (what distant things fade into).
-    #[inline]
+    #[inline(always)]
     pub fn horizon_radiance(&self, d: Vec3) -> Vec3 {
         let (w, _) = SKY;
         let x = diamond(d.x, d.y) / 4.0 * w as f32 - 0.5;
         bilinear(&self.horizon, w, 1, x, 0.0)
+    }
+
+    /// [`Lighting::sky_radiance`] and [`Lighting::horizon_radiance`] along unit `d` at once (they share the
+    /// azimuth's columns): the same values, for one azimuth computation instead of two.
+    #[inline(always)]
+    pub fn sky_and_horizon(&self, d: Vec3) -> (Vec3, Vec3) {
+        let (w, h) = SKY;
+        let cols = columns(w, diamond(d.x, d.y) / 4.0 * w as f32 - 0.5);
+        let sky = bilinear_at(&self.sky_table, w, h, cols, sky_row(d.z) * (h - 1) as f32);
+        (sky, bilinear_at(&self.horizon, w, 1, cols, 0.0))
     }
 
     /// The lighting of `key`, computed once per process and shared (a cache of the last few environments).
@@ -318,7 +340,7 @@ impl Lighting {
     }
 
     /// Radiance of the environment (sky above the horizon, ground below, no sun disc) along unit `d`.
-    #[inline]
+    #[inline(always)]
     pub fn environment(&self, d: Vec3) -> Vec3 {
         if d.z > 0.0 {
             self.sky_radiance(d)
@@ -335,13 +357,13 @@ impl Lighting {
     }
 
     /// Irradiance (lux, linear RGB) on a surface with unit normal `n` from the sky and the ground (not the sun).
-    #[inline]
+    #[inline(always)]
     pub fn irradiance(&self, n: Vec3) -> Vec3 {
         read(&self.irradiance, n)
     }
 
     /// GGX-prefiltered environment radiance around the mirror direction `r` for perceptual `roughness`.
-    #[inline]
+    #[inline(always)]
     pub fn prefiltered(&self, r: Vec3, roughness: f32) -> Vec3 {
         if roughness <= MIRROR_UP_TO {
             return self.environment(r);
@@ -361,7 +383,7 @@ impl Lighting {
 
 /// `(1/π) ∫_{lower hemisphere} max(0, n·ω) dω` for unit `n`: the share of a cosine lobe that sees the ground,
 /// `(1 − n_z) / 2`, times π.
-#[inline]
+#[inline(always)]
 fn ground_share(n: Vec3) -> f32 {
     std::f32::consts::PI * (1.0 - n.z.clamp(-1.0, 1.0)) * 0.5
 }

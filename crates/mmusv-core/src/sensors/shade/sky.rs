@@ -189,7 +189,7 @@ impl Sky {
     }
 
     /// Radiance of the sun's disc (linear RGB, cd/m²) if `d` points into it, else zero.
-    #[inline]
+    #[inline(always)]
     pub fn sun_disc(&self, d: Vec3) -> Vec3 {
         if d.dot(self.sun) >= self.cos_sun_radius {
             self.sun_radiance

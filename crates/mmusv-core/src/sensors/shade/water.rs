@@ -36,12 +36,67 @@ pub const BOTTOM_ALBEDO: [f32; 3] = [0.36, 0.31, 0.22];
 pub const K_D: [f32; 3] = [0.324, 0.117, 0.072];
 
 /// Diffuse reflectance of the water body `rho_deep` over a sand bottom `depth` metres down (Maritorena et al.).
-#[inline]
+#[inline(always)]
 pub fn shallow_albedo(rho_deep: Vec3, depth: f32) -> Vec3 {
     let d = depth.max(0.0);
     let k = Vec3::from_array(K_D) * (-2.0 * d);
     let f = Vec3::new(k.x.exp(), k.y.exp(), k.z.exp());
     rho_deep + (Vec3::from_array(BOTTOM_ALBEDO) - rho_deep) * f
+}
+
+/// Depth steps per metre of [`ShallowWater`]'s table.
+const SHALLOW_STEPS_PER_M: f32 = 32.0;
+/// Depth past which [`ShallowWater`] takes the water as deep: the bottom's share `e^(−2 K_D d)` is below
+/// `e^(−2 · 0.072 · 64) ≈ 10⁻⁴` in every channel.
+const SHALLOW_MAX_M: f32 = 64.0;
+
+/// [`shallow_albedo`] of one water body tabulated over depth (every 1/32 m to 64 m, read linearly: within
+/// `10⁻⁴` of the formula relative to the bottom's contrast), so a pixel costs no exponentials.
+#[derive(Debug)]
+pub struct ShallowWater {
+    rho_deep: Vec3,
+    table: Vec<Vec3>,
+}
+
+impl ShallowWater {
+    /// The table for a water body of deep albedo `rho_deep`.
+    pub fn new(rho_deep: Vec3) -> Self {
+        let n = (SHALLOW_MAX_M * SHALLOW_STEPS_PER_M) as usize;
+        let table = (0..=n).map(|i| shallow_albedo(rho_deep, i as f32 / SHALLOW_STEPS_PER_M)).collect();
+        Self { rho_deep, table }
+    }
+
+    /// The table of `rho_deep`, built once per process and shared (a cache of the last few).
+    pub fn shared(rho_deep: Vec3) -> std::sync::Arc<Self> {
+        use std::sync::{Arc, Mutex};
+        static CACHE: Mutex<Vec<Arc<ShallowWater>>> = Mutex::new(Vec::new());
+        if let Ok(c) = CACHE.lock() {
+            if let Some(t) = c.iter().find(|t| t.rho_deep == rho_deep) {
+                return Arc::clone(t);
+            }
+        }
+        let t = Arc::new(Self::new(rho_deep));
+        if let Ok(mut c) = CACHE.lock() {
+            if c.len() >= 8 {
+                c.remove(0);
+            }
+            c.push(Arc::clone(&t));
+        }
+        t
+    }
+
+    /// Diffuse reflectance over a sand bottom `depth` metres down.
+    #[inline(always)]
+    pub fn albedo(&self, depth: f32) -> Vec3 {
+        let x = depth.max(0.0) * SHALLOW_STEPS_PER_M;
+        let last = self.table.len() - 1;
+        if x >= last as f32 {
+            return self.rho_deep;
+        }
+        let i = x as usize;
+        let f = x - i as f32;
+        self.table[i] * (1.0 - f) + self.table[i + 1] * f
+    }
 }
 
 /// Albedo of dense foam.
@@ -94,7 +149,7 @@ pub fn internal_diffuse_reflectance(eta: f32) -> f32 {
 
 /// Radiance scattered out of the water body per unit entering irradiance, `ρ / (1 − F_dr) (1 − F_o) / (η² π)`,
 /// for a view whose Fresnel reflectance is `f_o`.
-#[inline]
+#[inline(always)]
 pub fn body_factor(rho: Vec3, fdr: f32, f_o: f32, eta: f32) -> Vec3 {
     rho * ((1.0 - f_o) / ((1.0 - fdr) * eta * eta * std::f32::consts::PI))
 }
@@ -117,7 +172,7 @@ pub struct Wake {
 }
 
 /// Smooth value noise in `[0, 1]` at `(x, y)` on a unit lattice (hashed corners, smoothstep blend).
-#[inline]
+#[inline(always)]
 fn value_noise(seed: u64, x: f32, y: f32) -> f32 {
     let (xf, yf) = (x.floor(), y.floor());
     let (ix, iy) = (xf as i64, yf as i64);
@@ -134,7 +189,7 @@ fn value_noise(seed: u64, x: f32, y: f32) -> f32 {
 }
 
 /// Three octaves of value noise at world `(x, y)` metres, in `[0, 1]` (feature size ~6 m).
-#[inline]
+#[inline(always)]
 pub fn foam_noise(seed: u64, x: f32, y: f32) -> f32 {
     let mut s = 0.0;
     let mut w = 0.5;
@@ -223,7 +278,7 @@ impl Foam {
     }
 
     /// Foam cover in `[0, 1]` at world point `(x, y)`.
-    #[inline]
+    #[inline(always)]
     pub fn cover(&self, x: f32, y: f32) -> f32 {
         let mut c = 0.0f32;
         let mut nz = None;
@@ -287,6 +342,20 @@ mod tests {
         // gives 1 − (1/1.33)² = 0.435; the Fresnel inside the cone adds a little.
         let f = internal_diffuse_reflectance(1.33);
         assert!(f > 0.435 && f < 0.48, "{f}");
+    }
+
+    #[test]
+    fn shallow_table_is_the_formula() {
+        let rho = Vec3::new(0.02, 0.03, 0.025);
+        let t = ShallowWater::new(rho);
+        let contrast = (Vec3::from_array(BOTTOM_ALBEDO) - rho).max_element();
+        for i in 0..20_000 {
+            let d = i as f32 * 0.0049;
+            let err = (t.albedo(d) - shallow_albedo(rho, d)).abs().max_element();
+            assert!(err < 1e-4 * contrast, "{d} m: {err}");
+        }
+        assert_eq!(t.albedo(1e9), rho);
+        assert_eq!(t.albedo(-1.0), shallow_albedo(rho, 0.0));
     }
 
     #[test]
