@@ -206,6 +206,8 @@ pub struct Camera {
     order: Vec<u32>,
     /// The inverse of `order`: entry `i` is the trace position of row-major pixel `i`.
     rank: Vec<u32>,
+    /// Column and row of the pixel at each trace position.
+    pos: Vec<[u16; 2]>,
 }
 
 /// Row-major pixel indices of a `w × h` image in [`TILE`]×[`TILE`] tiles, tiles row by row, pixels within a tile
@@ -304,7 +306,8 @@ impl Camera {
         for (k, &i) in order.iter().enumerate() {
             rank[i as usize] = k as u32;
         }
-        Ok(Self { cfg, dirs, origins, order, rank })
+        let pos = order.iter().map(|&i| [(i % w) as u16, (i / w) as u16]).collect();
+        Ok(Self { cfg, dirs, origins, order, rank, pos })
     }
 
     /// The configuration.
@@ -436,8 +439,7 @@ impl Camera {
             .with_seabed(scene.seabed());
         // Standard quality shares one traced reflection per 2 × 2 block of water pixels; high traces each.
         let block = |k: usize| {
-            let i = self.order[k];
-            let (x, y) = (i % self.cfg.width, i / self.cfg.width);
+            let [x, y] = self.pos[k].map(u32::from);
             self.rank[((y & !1) * self.cfg.width + (x & !1)) as usize] as usize
         };
         let refl = match q {
@@ -449,8 +451,7 @@ impl Camera {
         // wherever the even pixels around agree (radiance::radiance).
         let w = self.cfg.width;
         let anchors = |k: usize| -> ([u32; 4], usize) {
-            let i = self.order[k];
-            let (x, y) = (i % w, i / w);
+            let [x, y] = self.pos[k].map(u32::from);
             let xs: &[u32] = if x & 1 == 0 { &[x, x] } else { &[x - 1, x + 1] };
             let ys: &[u32] = if y & 1 == 0 { &[y, y] } else { &[y - 1, y + 1] };
             let (nx, ny) = (1 + (x & 1) as usize, 1 + (y & 1) as usize);
