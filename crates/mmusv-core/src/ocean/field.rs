@@ -43,7 +43,7 @@ use rayon::prelude::*;
 use std::f64::consts::TAU;
 
 /// Components of a field made by [`WaveField::new`].
-pub const DEFAULT_COMPONENTS: usize = 128;
+pub const DEFAULT_COMPONENTS: usize = 256;
 /// Directional strata per group of consecutive frequency components.
 pub const DIRECTION_STRATA: usize = 8;
 /// Allowed number of components.
@@ -533,7 +533,8 @@ mod tests {
             let f = ok(WaveField::new(&sp, seed));
             // 20 000 s, 2 500 peak periods: long enough to resolve neighbouring components near the peak.
             let dt = 1.0;
-            let series: Vec<f64> = (0..20_000).map(|i| f.elevation(31.0, -12.0, i as f64 * dt)).collect();
+            let series: Vec<f64> =
+                (0..20_000).into_par_iter().map(|i| f.elevation(31.0, -12.0, i as f64 * dt)).collect();
             let mean = series.iter().sum::<f64>() / series.len() as f64;
             let var = series.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / series.len() as f64;
             let hs = 4.0 * var.sqrt();
