@@ -41,8 +41,8 @@ from pydantic import (
 from mmusv.errors import ConfigError, MmusvError, located
 from mmusv.sensors.config import RigConfig
 from mmusv.world.environment import Environment, wave_height_m
-from mmusv.world.sea_state import SeaSpec
 from mmusv.world.map_params import PARAM_MODELS, IslandParams, MapParams
+from mmusv.world.sea_state import SeaSpec
 from mmusv.world.vessels import get_asset, known_asset
 from mmusv.yamlio import mapping_source
 
