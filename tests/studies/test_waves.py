@@ -29,3 +29,39 @@ def test_wave_study_on_bundled_scenario(tmp_path: Path) -> None:
     paths = study.write(tmp_path)
     assert pl.read_csv(paths["csv"]).shape == (4, 7)
     assert paths["png"].stat().st_size > 10_000
+
+
+def test_paper_mode_is_the_default_and_physical_rises_with_the_sea(tmp_path: Path) -> None:
+    from mmusv.studies.waves import PAPER_TABLE_I, run_physical_wave_study
+
+    s = load_scenario(
+        {
+            "seed": 5,
+            "acquisition": {"frequency_hz": 2, "frames": 10},
+            "vessels": [
+                {"id": "usv", "role": "usv", "asset": "usv_wamv", "speed_mps": 3.0, "route": [[0, 0], [4000, 300]]},
+                {"id": "tug", "asset": "tug_32m", "speed_mps": 4.0, "route": [[0, 400], [-3000, 2000]]},
+                {"id": "bulk", "asset": "bulk_carrier_190m", "speed_mps": 6.0, "route": [[0, -900], [5000, -2000]]},
+            ],
+        }
+    )
+    assert s.environment.motion == "physical"
+    assert run_wave_study(s).table.equals(run_wave_study(s, motion="paper").table)
+    study = run_physical_wave_study(s, record_s=600.0)
+    t = study.summary
+    assert t["frames"].to_list() == [1200] * 4
+    for col in ("heave_rms_m", "roll_rms_deg", "pitch_rms_deg"):
+        assert np.all(np.diff(t[f"fleet_{col}"].to_numpy()) > 0), col  # pooled over the mixed fleet
+    for vid in ("usv", "tug", "bulk"):  # heave rises for every hull
+        assert np.all(np.diff(study.vessels.filter(pl.col("id") == vid)["heave_rms_m"].to_numpy()) > 0), vid
+    # A 5 m craft's roll and pitch follow the short waves, whose energy a fully developed sea hardly changes above
+    # W1 (the PM tail ∝ Hs²·ωp⁴ is the same for every Hs): they rise from W0 and then stay within 25 %.
+    pitch = t["physical_pitch_rms_deg"].to_numpy()
+    assert pitch[1] > pitch[0] and np.ptp(pitch[1:]) < 0.25 * pitch[1:].mean()
+    assert t["table1_heave_rms_m"].to_list() == [PAPER_TABLE_I[w][0] for w in ("W0", "W1", "W2", "W3")]
+    # Small craft follow the surface (heave RMS near Hs/4 in W3); the bulk carrier moves far less.
+    v = study.vessels.filter(pl.col("wave") == "W3")
+    heave = dict(zip(v["id"].to_list(), v["heave_rms_m"].to_list(), strict=True))
+    assert 0.7 * 3.5 / 4 < heave["usv"] < 1.2 * 3.5 / 4 and heave["bulk"] < 0.5 * heave["usv"]
+    paths = study.write(tmp_path)
+    assert pl.read_csv(paths["vessels"]).shape == (12, 7)
