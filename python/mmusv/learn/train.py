@@ -8,7 +8,9 @@ Run from a tensor cache (:mod:`mmusv.learn.cache`) with torch and numpy alone::
 or through ``mmusv train`` (which builds the cache first). Files in the output folder:
 
 - ``last.pt``: the latest checkpoint (model, optimiser, epoch, step, log; written to a temporary file and
-  renamed, so an interruption leaves the previous one whole); training resumes from it when started again;
+  renamed, so an interruption leaves the previous one whole); training resumes from it when started again (a run
+  stopped inside an epoch, by ``time_limit_s`` or ``max_steps``, resumes at that epoch's start with the weights
+  it had reached);
 - ``model.pt``: the weights, preset and mode for inference (:mod:`mmusv.learn.detector`), after every epoch;
 - ``log.jsonl``: one line per logged step (``epoch, step, loss, heatmap, regression, lr, seconds``) and one per
   epoch (``"epoch_end": true``); :func:`plot_losses` draws it.
