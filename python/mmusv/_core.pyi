@@ -106,6 +106,28 @@ class Scene:
         """Declares instance ``surface`` the sea surface (a horizontal plane) and ``moving`` (K,) uint32 the
         instances that will move: enables the exact sea and sky shortcuts."""
 
+    def set_wave_surface(
+        self,
+        components: npt.NDArray[np.float64] | None,
+        *,
+        time_s: float,
+        foci: npt.NDArray[np.float32],
+        level: float = 0.0,
+        tile_m: float = 16.0,
+        near_m: float = 40.0,
+        radius_m: float = 900.0,
+        taper_m: float = 150.0,
+    ) -> None:
+        """Sets the displaced sea surface of the frame: ``components`` (N, 5) float64 rows
+        ``amplitude, kx, ky, omega, phase`` sampled at ``time_s`` around ``foci`` (F, 2) float32; None clears it."""
+
+    def wave_heights(self, xy: npt.NDArray[np.float32]) -> npt.NDArray[np.float32]:
+        """Heights (N,) float32 of the displaced sea surface at ``xy`` (N, 2) float32 world x, y."""
+
+    @property
+    def wave_top(self) -> float | None:
+        """The crest bound of the displaced sea surface, or None."""
+
     def clear_sea(self) -> None:
         """Forgets the sea surface: every ray is traced fully again."""
 

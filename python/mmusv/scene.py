@@ -263,6 +263,48 @@ class Scene:
             raise NotFoundError(f"unknown instance id in moving: {ids.tolist()}")
         self._native.set_sea(_id(surface, name="surface", kind="instance"), np.ascontiguousarray(ids, np.uint32))
 
+    def set_wave_surface(
+        self,
+        components: npt.ArrayLike | None,
+        *,
+        time_s: float,
+        foci: npt.ArrayLike,
+        level: float = 0.0,
+        radius_m: float = 900.0,
+    ) -> None:
+        """Sets the displaced sea surface of one frame time (see ``mmusv_core::sea::WaveSurface``), which replaces
+        the sea instance's flat mesh for every ray: crests occlude, beams meet wave faces. The scene must have a
+        sea (:meth:`set_sea`); ``None`` clears it.
+
+        Args:
+            components: ``(N, 5)`` float rows ``amplitude (m), kx, ky (rad/m), omega (rad/s), phase (rad)`` of
+                ``eta = sum a cos(kx x + ky y - omega t + phase)``, world frame.
+            time_s: the frame time, seconds.
+            foci: ``(F, 2)`` float world x, y (metres) the sampling is finest around (the USVs); the same foci
+                for every sensor of a frame give every sensor the same surface.
+            level: still water level, world z (metres).
+            radius_m: the waves taper to still water this far from the nearest focus (metres, > 0).
+        """
+        if components is None:
+            self._native.set_wave_surface(None, time_s=0.0, foci=np.zeros((0, 2), np.float32))
+            return
+        c = _array(components, name="components", dtype=np.float64, shape_tail=(5,))
+        f = _array(foci, name="foci", dtype=np.float32, shape_tail=(2,))
+        self._native.set_wave_surface(
+            c, time_s=float(time_s), foci=f, level=float(level), radius_m=float(radius_m), taper_m=min(150.0, radius_m)
+        )
+
+    def wave_heights(self, xy: npt.ArrayLike) -> npt.NDArray[np.float32]:
+        """``(N,)`` float32 world z of the sea surface at ``xy`` ``(N, 2)`` world x, y (metres): the displaced
+        surface of :meth:`set_wave_surface`, or the still level 0 where there is none."""
+        return self._native.wave_heights(_array(xy, name="xy", dtype=np.float32, shape_tail=(2,)))
+
+    @property
+    def wave_top(self) -> float | None:
+        """The crest bound (highest world z) of the displaced sea surface, or ``None`` when none is set."""
+        top: float | None = self._native.wave_top
+        return top
+
     def clear_sea(self) -> None:
         """Forgets the sea surface: every ray is traced fully again (results are the same either way)."""
         self._native.clear_sea()

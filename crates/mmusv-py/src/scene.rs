@@ -4,6 +4,7 @@
 use crate::errors::InputError;
 use crate::native::{detached, flat, pose_from, rows, rows_to_array};
 use mmusv_core::export::{write_world_mesh, MeshFormat};
+use mmusv_core::sea::{SurfaceSpec, WaveComponent, WaveSurface};
 use mmusv_core::{Mesh, Scene as CoreScene};
 use numpy::ndarray::Array2;
 use numpy::{
@@ -192,6 +193,73 @@ impl Scene {
         let mut scene = self.read(|s| Ok(s.clone()))?;
         detached(py, || scene.set_sea(surface, &moving))?;
         self.write(|s| *s = scene)
+    }
+
+    /// Sets the displaced sea surface of the current frame (see mmusv_core::sea::WaveSurface): `components`
+    /// (N, 5) float64 rows `amplitude, kx, ky, omega, phase` sampled at `time_s` around `foci` (F, 2) float32
+    /// world x, y; `None` clears it. Samples with the GIL released.
+    #[pyo3(signature = (components, *, time_s, foci, level=0.0, tile_m=16.0, near_m=40.0, radius_m=900.0, taper_m=150.0))]
+    #[allow(clippy::too_many_arguments)]
+    fn set_wave_surface(
+        &self,
+        py: Python<'_>,
+        components: Option<PyReadonlyArray2<'_, f64>>,
+        time_s: f64,
+        foci: PyReadonlyArray2<'_, f32>,
+        level: f32,
+        tile_m: f32,
+        near_m: f32,
+        radius_m: f32,
+        taper_m: f32,
+    ) -> PyResult<()> {
+        let Some(components) = components else {
+            return self.write(|s| s.set_wave_surface(None))?.map_err(crate::errors::to_py);
+        };
+        let comps: Vec<WaveComponent> = rows::<f64, 5>(&components, "components")?
+            .iter()
+            .map(|r| WaveComponent { amplitude: r[0], kx: r[1], ky: r[2], omega: r[3], phase: r[4] })
+            .collect();
+        let foci = rows::<f32, 2>(&foci, "foci")?;
+        for (name, v) in [("tile_m", tile_m), ("near_m", near_m), ("radius_m", radius_m)] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(InputError::new_err(format!("{name} = {v} is not allowed; give a distance > 0 metres")));
+            }
+        }
+        if !(taper_m.is_finite() && (0.0..=radius_m).contains(&taper_m)) {
+            return Err(InputError::new_err(format!("taper_m = {taper_m} must be in [0, radius_m]")));
+        }
+        if !(time_s.is_finite() && level.is_finite())
+            || comps.iter().any(|c| ![c.amplitude, c.kx, c.ky, c.omega, c.phase].iter().all(|v| v.is_finite()))
+            || foci.iter().any(|f| !(f[0].is_finite() && f[1].is_finite()))
+        {
+            return Err(InputError::new_err("wave surface: time_s, level, components and foci must be finite"));
+        }
+        let spec = SurfaceSpec { tile_m, near_m, radius_m, taper_m };
+        let surface = detached(py, || Ok(WaveSurface::new(&comps, time_s, level, &foci, spec)))?;
+        self.write(|s| s.set_wave_surface(Some(surface)))?.map_err(crate::errors::to_py)
+    }
+
+    /// Heights (N,) float32 of the displaced sea surface at `xy` (N, 2) float32 world x, y (the still level
+    /// where no surface is set or outside it).
+    fn wave_heights<'py>(
+        &self,
+        py: Python<'py>,
+        xy: PyReadonlyArray2<'py, f32>,
+    ) -> PyResult<Bound<'py, PyArray1<f32>>> {
+        let xy = rows::<f32, 2>(&xy, "xy")?;
+        let out = self.read(|s| {
+            Ok(match s.wave_surface() {
+                Some(w) => xy.iter().map(|p| w.height(p[0], p[1])).collect::<Vec<f32>>(),
+                None => vec![0.0; xy.len()],
+            })
+        })?;
+        Ok(out.into_pyarray(py))
+    }
+
+    /// The crest bound (highest world z) of the displaced sea surface, or None when none is set.
+    #[getter]
+    fn wave_top(&self) -> PyResult<Option<f32>> {
+        self.read(|s| Ok(s.wave_surface().map(|w| w.zmax())))
     }
 
     /// Forgets the sea surface: every ray is traced fully again.
