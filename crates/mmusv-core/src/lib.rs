@@ -20,6 +20,7 @@
 //! - [`record`]: the MCAP recorder (Foxglove schemas plus the project's own world state and annotations).
 //! - [`demo`]: a synthetic maritime scene for benchmarks and comparisons.
 //! - [`kinematics`]: spline routes at nominal speed with wave-driven heave, roll and pitch.
+//! - [`ocean`]: the physical sea (JONSWAP spectrum, seeded wave field) and the vessels' response to it.
 //!
 //! Conventions: metres, seconds, radians; world frame right-handed, x east, y north, z up, water at z = 0.
 
@@ -35,6 +36,7 @@ pub mod geometry;
 pub mod kinematics;
 pub mod material;
 pub mod mesh;
+pub mod ocean;
 pub mod ray;
 pub mod record;
 pub mod scene;

@@ -1,0 +1,621 @@
+//! The sea surface as a deterministic, seeded sum of linear deep-water waves (a random-phase realisation of a
+//! directional JONSWAP spectrum).
+//!
+//! Model: first-order (Airy) linear wave theory in deep water, superposed (e.g. Faltinsen, O. M. (1990),
+//! "Sea Loads on Ships and Offshore Structures", ch. 2; DNV-RP-C205 §3.2 and §3.5.8 for the random-phase
+//! realisation of a spectrum). For components `i` with amplitude `aᵢ`, angular frequency `ωᵢ`, wavenumber
+//! `kᵢ = ωᵢ²/g`, travel direction `θᵢ` and phase `φᵢ`:
+//!
+//! ```text
+//! ψᵢ(x, y, t) = kᵢ (x cos θᵢ + y sin θᵢ) − ωᵢ t + φᵢ
+//! η           = Σ aᵢ cos ψᵢ                                    (m, z up, mean level 0)
+//! ∂η/∂x       = −Σ aᵢ kᵢ cos θᵢ sin ψᵢ,  ∂η/∂y = −Σ aᵢ kᵢ sin θᵢ sin ψᵢ
+//! u, v        =  Σ aᵢ ωᵢ e^{kᵢ z} cos ψᵢ (cos θᵢ, sin θᵢ),  w = Σ aᵢ ωᵢ e^{kᵢ z} sin ψᵢ
+//! ```
+//!
+//! Above the mean level (z > 0) the velocities are those at z = 0 (constant extension, a common stand-in for
+//! Wheeler stretching).
+//!
+//! Sampling ([`WaveField::with_components`], `N` components, default [`DEFAULT_COMPONENTS`]):
+//! - **Frequencies, equal energy.** Component `i` takes the frequency where the spectrum's cumulative variance
+//!   is `uᵢ = (i + ξᵢ)/N`, `ξᵢ` uniform in [0, 1) (clamped to `1 − 1/(16N)` so the last bin stays finite). Every
+//!   amplitude is `a = √(2 m0 / N) = Hs/√(8N)`, so the variance is `m0 = Hs²/16` exactly and no two
+//!   components share a frequency: the sea never repeats.
+//! - **Directions, stratified twice.** The cos-2s distribution is cut into `N` equal-probability strata, grouped
+//!   into [`DIRECTION_STRATA`] coarse strata of `G = N/DIRECTION_STRATA`. Each group of `DIRECTION_STRATA`
+//!   consecutive frequency components takes every coarse stratum once (in shuffled order), and across the `G`
+//!   groups each coarse stratum hands out its fine strata in shuffled order: `Δ = F_D⁻¹((fine + ξ)/N)`. So every
+//!   frequency band carries the whole spread, and the `N` directions together sample every quantile once.
+//! - **Phases** uniform in [0, 2π).
+//!
+//! Draw order from a `ChaCha8Rng` seeded with `seed`: all `N` frequency jitters `ξᵢ`; one Fisher–Yates shuffle
+//! of the `G` groups per coarse stratum; then per group, a shuffle of the coarse strata followed, for each
+//! component of the group, by its direction jitter and its phase. `N` is a multiple of [`DIRECTION_STRATA`]. The generator is platform-independent: one seed gives one sea everywhere.
+
+use super::spectrum::{CosTwoS, Jonswap, GRAVITY};
+use crate::error::{MmusvError, Result};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use std::f64::consts::TAU;
+
+/// Components of a field made by [`WaveField::new`].
+pub const DEFAULT_COMPONENTS: usize = 128;
+/// Directional strata per group of consecutive frequency components.
+pub const DIRECTION_STRATA: usize = 8;
+/// Allowed number of components.
+pub const COMPONENTS_RANGE: [usize; 2] = [8, 4096];
+/// Largest allowed peak steepness `2π Hs / (g Tp²)`: waves break beyond about 1/7 (DNV-RP-C205 §3.5.5.4 gives
+/// 1/15 as the upper end of observed average seas).
+pub const MAX_STEEPNESS: f64 = 1.0 / 7.0;
+
+/// The sea state: a directional JONSWAP spectrum.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SeaSpec {
+    /// Significant wave height Hs (m), finite, in `[0, 25]`; 0 is a flat sea.
+    pub hs: f64,
+    /// Peak period Tp (s), finite, in `[0.5, 30]`.
+    pub tp: f64,
+    /// JONSWAP peak enhancement γ in `[1, 7]` (1 is Pierson–Moskowitz, 3.3 the JONSWAP mean).
+    pub gamma: f64,
+    /// Mean travel direction θ̄ of the waves (rad, world frame, counter-clockwise from +x, towards which they
+    /// travel), finite.
+    pub direction_rad: f64,
+    /// cos-2s spreading exponent s in `[0.5, 100]` (larger is more long-crested).
+    pub spread_s: f64,
+}
+
+impl SeaSpec {
+    /// Checks every field; errors are [`MmusvError::Config`] naming `hs_m`, `tp_s`, `gamma`, `direction_rad`
+    /// or `spread_s` and the allowed range.
+    pub fn validate(&self) -> Result<()> {
+        if !self.hs.is_finite() || !(0.0..=25.0).contains(&self.hs) {
+            return Err(MmusvError::config("hs_m", self.hs, "must be a significant wave height in [0, 25] m"));
+        }
+        if !self.tp.is_finite() || !(0.5..=30.0).contains(&self.tp) {
+            return Err(MmusvError::config("tp_s", self.tp, "must be a peak period in [0.5, 30] s"));
+        }
+        if !self.direction_rad.is_finite() {
+            return Err(MmusvError::config("direction_rad", self.direction_rad, "must be a finite angle in radians"));
+        }
+        let steep = self.steepness();
+        if steep > MAX_STEEPNESS {
+            return Err(MmusvError::config(
+                "hs_m",
+                self.hs,
+                format!(
+                    "with tp_s = {} the peak steepness 2π·Hs/(g·Tp²) is {steep:.3}, above the breaking limit 1/7; \
+                     lower hs_m or raise tp_s (tp_s >= {:.2} s for this height)",
+                    self.tp,
+                    (TAU * self.hs / (GRAVITY * MAX_STEEPNESS)).sqrt()
+                ),
+            ));
+        }
+        Jonswap::new(self.hs, self.tp, self.gamma)?;
+        CosTwoS::new(self.spread_s)?;
+        Ok(())
+    }
+
+    /// Peak steepness `2π Hs / (g Tp²)`.
+    pub fn steepness(&self) -> f64 {
+        TAU * self.hs / (GRAVITY * self.tp * self.tp)
+    }
+
+    /// Peak wavelength `λp = g Tp² / (2π)` (m), deep water.
+    pub fn peak_wavelength(&self) -> f64 {
+        GRAVITY * self.tp * self.tp / TAU
+    }
+}
+
+/// One linear wave of the sum.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WaveComponent {
+    /// Amplitude `a` (m).
+    pub amplitude_m: f64,
+    /// Angular frequency `ω` (rad/s).
+    pub omega_rad_s: f64,
+    /// Wavenumber `k = ω²/g` (rad/m).
+    pub k_rad_m: f64,
+    /// Travel direction `θ` (rad, world frame).
+    pub direction_rad: f64,
+    /// Phase `φ` (rad) in [0, 2π).
+    pub phase_rad: f64,
+    /// `k cos θ` (rad/m).
+    pub kx: f64,
+    /// `k sin θ` (rad/m).
+    pub ky: f64,
+}
+
+impl WaveComponent {
+    /// The phase `ψ = kx·x + ky·y − ω t + φ` (rad).
+    #[inline]
+    pub fn phase_at(&self, x: f64, y: f64, t: f64) -> f64 {
+        self.kx * x + self.ky * y - self.omega_rad_s * t + self.phase_rad
+    }
+}
+
+/// A realised sea: elevation, slope and orbital velocity anywhere, at any time.
+#[derive(Debug, Clone)]
+pub struct WaveField {
+    spec: SeaSpec,
+    seed: u64,
+    components: Vec<WaveComponent>,
+    max_elevation: f64,
+}
+
+impl WaveField {
+    /// The field of `spec` with [`DEFAULT_COMPONENTS`] components drawn from `seed`.
+    pub fn new(spec: &SeaSpec, seed: u64) -> Result<Self> {
+        Self::with_components(spec, seed, DEFAULT_COMPONENTS)
+    }
+
+    /// The field of `spec` with `n` components (in [`COMPONENTS_RANGE`]; errors name `components`). A flat sea
+    /// (`hs = 0`) has no components.
+    pub fn with_components(spec: &SeaSpec, seed: u64, n: usize) -> Result<Self> {
+        spec.validate()?;
+        if !(COMPONENTS_RANGE[0]..=COMPONENTS_RANGE[1]).contains(&n) || !n.is_multiple_of(DIRECTION_STRATA) {
+            return Err(MmusvError::config("components", n, "must be a multiple of 8 wave components in [8, 4096]"));
+        }
+        if spec.hs == 0.0 {
+            return Ok(Self { spec: *spec, seed, components: Vec::new(), max_elevation: 0.0 });
+        }
+        let spectrum = Jonswap::new(spec.hs, spec.tp, spec.gamma)?;
+        let spread = CosTwoS::new(spec.spread_s)?;
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let nf = n as f64;
+        let u_max = 1.0 - 1.0 / (16.0 * nf);
+        let jitter: Vec<f64> = (0..n).map(|_| rng.random::<f64>()).collect();
+        let amplitude = (2.0 * spectrum.m0() / nf).sqrt();
+        let groups = n / DIRECTION_STRATA;
+        // Fine direction stratum of (group g, coarse stratum j): j·groups + fine[j][g].
+        let fine: Vec<Vec<usize>> = (0..DIRECTION_STRATA).map(|_| shuffled(&mut rng, groups)).collect();
+        let mut components = Vec::with_capacity(n);
+        for g in 0..groups {
+            for (m, stratum) in shuffled(&mut rng, DIRECTION_STRATA).into_iter().enumerate() {
+                let i = g * DIRECTION_STRATA + m;
+                let u = ((i as f64 + jitter[i]) / nf).min(u_max);
+                let omega = spectrum.quantile(u);
+                let k = omega * omega / GRAVITY;
+                let q = ((stratum * groups + fine[stratum][g]) as f64 + rng.random::<f64>()) / nf;
+                let direction = spec.direction_rad + spread.quantile(q);
+                let phase = TAU * rng.random::<f64>();
+                components.push(WaveComponent {
+                    amplitude_m: amplitude,
+                    omega_rad_s: omega,
+                    k_rad_m: k,
+                    direction_rad: direction,
+                    phase_rad: phase,
+                    kx: k * direction.cos(),
+                    ky: k * direction.sin(),
+                });
+            }
+        }
+        let max_elevation = components.iter().map(|c| c.amplitude_m).sum();
+        Ok(Self { spec: *spec, seed, components, max_elevation })
+    }
+
+    /// The sea state it realises.
+    pub fn spec(&self) -> &SeaSpec {
+        &self.spec
+    }
+
+    /// The seed it was drawn from.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// The components, in increasing frequency.
+    pub fn components(&self) -> &[WaveComponent] {
+        &self.components
+    }
+
+    /// A hard bound on `|η|` (m): the sum of amplitudes. No crest rises above it, no trough sinks below minus it.
+    pub fn max_elevation(&self) -> f64 {
+        self.max_elevation
+    }
+
+    /// A hard bound on the slope magnitude `|∇η|`: `Σ aᵢ kᵢ`.
+    pub fn max_slope(&self) -> f64 {
+        self.components.iter().map(|c| c.amplitude_m * c.k_rad_m).sum()
+    }
+
+    /// Surface elevation `η(x, y, t)` (m) above the mean level, world frame.
+    pub fn elevation(&self, x: f64, y: f64, t: f64) -> f64 {
+        self.components.iter().map(|c| c.amplitude_m * c.phase_at(x, y, t).cos()).sum()
+    }
+
+    /// Surface slope `[∂η/∂x, ∂η/∂y]` (dimensionless).
+    pub fn slope(&self, x: f64, y: f64, t: f64) -> [f64; 2] {
+        let mut s = [0.0, 0.0];
+        for c in &self.components {
+            let a = c.amplitude_m * c.phase_at(x, y, t).sin();
+            s[0] -= a * c.kx;
+            s[1] -= a * c.ky;
+        }
+        s
+    }
+
+    /// Rate of rise `∂η/∂t` (m/s).
+    pub fn elevation_rate(&self, x: f64, y: f64, t: f64) -> f64 {
+        self.components.iter().map(|c| c.amplitude_m * c.omega_rad_s * c.phase_at(x, y, t).sin()).sum()
+    }
+
+    /// Orbital velocity `[u, v, w]` (m/s, world frame) of the water at `(x, y, z)` (z up, m; values above the
+    /// mean level are those at z = 0), deep-water linear theory.
+    pub fn orbital_velocity(&self, x: f64, y: f64, z: f64, t: f64) -> [f64; 3] {
+        let z = z.min(0.0);
+        let mut v = [0.0; 3];
+        for c in &self.components {
+            let decay = c.amplitude_m * c.omega_rad_s * (c.k_rad_m * z).exp();
+            let (s, co) = c.phase_at(x, y, t).sin_cos();
+            let h = decay * co;
+            v[0] += h * c.direction_rad.cos();
+            v[1] += h * c.direction_rad.sin();
+            v[2] += decay * s;
+        }
+        v
+    }
+
+    /// Elevations on a regular grid, row-major `ny × nx`: entry `j·nx + i` is `η(x0 + i·dx, y0 + j·dx, t)` (m,
+    /// f32). Each row advances every component's phasor by one complex multiplication per point; rows run over
+    /// rayon. `dx` must be finite and > 0 (errors name `dx`).
+    pub fn elevation_grid(&self, x0: f64, y0: f64, dx: f64, nx: usize, ny: usize, t: f64) -> Result<Vec<f32>> {
+        Ok(self.surface_grid(x0, y0, dx, nx, ny, t, false)?.0)
+    }
+
+    /// Elevations and slopes on the grid of [`elevation_grid`](Self::elevation_grid): `(η, ∂η/∂x, ∂η/∂y)`, each
+    /// row-major `ny × nx` f32.
+    pub fn elevation_slope_grid(
+        &self,
+        x0: f64,
+        y0: f64,
+        dx: f64,
+        nx: usize,
+        ny: usize,
+        t: f64,
+    ) -> Result<(Vec<f32>, Vec<f32>, Vec<f32>)> {
+        self.surface_grid(x0, y0, dx, nx, ny, t, true)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn surface_grid(
+        &self,
+        x0: f64,
+        y0: f64,
+        dx: f64,
+        nx: usize,
+        ny: usize,
+        t: f64,
+        slopes: bool,
+    ) -> Result<(Vec<f32>, Vec<f32>, Vec<f32>)> {
+        if !dx.is_finite() || dx <= 0.0 {
+            return Err(MmusvError::input("dx", format!("grid spacing must be finite and > 0 m, got {dx}")));
+        }
+        for (name, v) in [("x0", x0), ("y0", y0), ("t", t)] {
+            if !v.is_finite() {
+                return Err(MmusvError::input(name, format!("must be finite, got {v}")));
+            }
+        }
+        let n = nx * ny;
+        let mut eta = vec![0f32; n];
+        let (mut sx, mut sy) = if slopes { (vec![0f32; n], vec![0f32; n]) } else { (Vec::new(), Vec::new()) };
+        if n == 0 || self.components.is_empty() {
+            return Ok((eta, sx, sy));
+        }
+        let steps: Vec<(f64, f64)> = self.components.iter().map(|c| (c.kx * dx).sin_cos()).collect();
+        let row = |j: usize, e: &mut [f32], gx: &mut [f32], gy: &mut [f32]| {
+            let y = y0 + j as f64 * dx;
+            // Phasor p = a·exp(iψ) at the row start.
+            let mut p: Vec<(f64, f64)> = self
+                .components
+                .iter()
+                .map(|c| {
+                    let (s, co) = c.phase_at(x0, y, t).sin_cos();
+                    (c.amplitude_m * co, c.amplitude_m * s)
+                })
+                .collect();
+            for i in 0..nx {
+                let (mut h, mut ax, mut ay) = (0.0, 0.0, 0.0);
+                for ((pr, pi), (c, &(ss, sc))) in p.iter_mut().zip(self.components.iter().zip(&steps)) {
+                    h += *pr;
+                    ax -= *pi * c.kx;
+                    ay -= *pi * c.ky;
+                    let r = *pr * sc - *pi * ss;
+                    *pi = *pr * ss + *pi * sc;
+                    *pr = r;
+                }
+                e[i] = h as f32;
+                if slopes {
+                    gx[i] = ax as f32;
+                    gy[i] = ay as f32;
+                }
+            }
+        };
+        if slopes {
+            eta.par_chunks_mut(nx)
+                .zip(sx.par_chunks_mut(nx))
+                .zip(sy.par_chunks_mut(nx))
+                .enumerate()
+                .for_each(|(j, ((e, gx), gy))| row(j, e, gx, gy));
+        } else {
+            eta.par_chunks_mut(nx).enumerate().for_each(|(j, e)| row(j, e, &mut [], &mut []));
+        }
+        Ok((eta, sx, sy))
+    }
+}
+
+/// A Fisher–Yates shuffle of `0..n` (draws `n − 1` integers).
+fn shuffled(rng: &mut ChaCha8Rng, n: usize) -> Vec<usize> {
+    let mut v: Vec<usize> = (0..n).collect();
+    for i in (1..n).rev() {
+        let j = rng.random_range(0..=i);
+        v.swap(i, j);
+    }
+    v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ok<T>(r: Result<T>) -> T {
+        r.unwrap_or_else(|e| unreachable!("{e}"))
+    }
+
+    fn spec(hs: f64, tp: f64, gamma: f64, s: f64) -> SeaSpec {
+        SeaSpec { hs, tp, gamma, direction_rad: 0.6, spread_s: s }
+    }
+
+    /// Periodogram of a real series at the Fourier frequencies `ω_j = 2πj/T` in `[omega_min, omega_max]`, by
+    /// direct DFT (Hann window, a rotating phasor per bin; scaled so that the bins sum to the variance):
+    /// `(ω_j, energy_j)`.
+    fn periodogram(x: &[f64], dt: f64, omega_min: f64, omega_max: f64) -> Vec<(f64, f64)> {
+        let n = x.len();
+        let mean = x.iter().sum::<f64>() / n as f64;
+        let w: Vec<f64> = (0..n).map(|i| 0.5 - 0.5 * (TAU * i as f64 / n as f64).cos()).collect();
+        let w2 = w.iter().map(|v| v * v).sum::<f64>();
+        let xw: Vec<f64> = x.iter().zip(&w).map(|(v, wi)| (v - mean) * wi).collect();
+        let t_total = n as f64 * dt;
+        let j0 = (omega_min * t_total / TAU).ceil().max(1.0) as usize;
+        let j1 = (omega_max * t_total / TAU) as usize;
+        (j0..=j1)
+            .into_par_iter()
+            .map(|j| {
+                let om = TAU * j as f64 / t_total;
+                let (rs, rc) = (om * dt).sin_cos();
+                let (mut pr, mut pi) = (1.0, 0.0);
+                let (mut re, mut im) = (0.0, 0.0);
+                for &v in &xw {
+                    re += v * pr;
+                    im += v * pi;
+                    let t = pr * rc - pi * rs;
+                    pi = pr * rs + pi * rc;
+                    pr = t;
+                }
+                (om, 2.0 * (re * re + im * im) / (w2 * n as f64))
+            })
+            .collect()
+    }
+
+    /// Peak of `Σ eᵢ K(ω − ωᵢ)`, `K` Gaussian of width `bw`, on a grid of `ω`.
+    fn smoothed_peak(bins: &[(f64, f64)], lo: f64, hi: f64, bw: f64) -> f64 {
+        let mut best = (0.0, lo);
+        for g in 0..2000 {
+            let om = lo + (hi - lo) * g as f64 / 1999.0;
+            let d: f64 = bins.iter().map(|&(w, e)| e * (-(om - w).powi(2) / (2.0 * bw * bw)).exp()).sum();
+            if d > best.0 {
+                best = (d, om);
+            }
+        }
+        best.1
+    }
+
+    #[test]
+    fn derivatives_agree_with_finite_differences_and_continuity() {
+        let f = ok(WaveField::new(&spec(2.0, 7.0, 3.3, 4.0), 5));
+        let h = 1e-4;
+        for k in 0..20 {
+            let (x, y, t) = (13.0 * k as f64 - 40.0, 7.0 * k as f64, 3.1 * k as f64);
+            let s = f.slope(x, y, t);
+            let fx = (f.elevation(x + h, y, t) - f.elevation(x - h, y, t)) / (2.0 * h);
+            let fy = (f.elevation(x, y + h, t) - f.elevation(x, y - h, t)) / (2.0 * h);
+            let ft = (f.elevation(x, y, t + h) - f.elevation(x, y, t - h)) / (2.0 * h);
+            assert!((s[0] - fx).abs() < 1e-6 && (s[1] - fy).abs() < 1e-6);
+            // Kinematic surface condition (linear): w(z = 0) = ∂η/∂t.
+            assert!((f.orbital_velocity(x, y, 0.0, t)[2] - ft).abs() < 1e-6);
+            assert!((f.elevation_rate(x, y, t) - ft).abs() < 1e-6);
+            // Incompressible: ∂u/∂x + ∂v/∂y + ∂w/∂z = 0 below the surface.
+            let z = -1.5;
+            let du = (f.orbital_velocity(x + h, y, z, t)[0] - f.orbital_velocity(x - h, y, z, t)[0]) / (2.0 * h);
+            let dv = (f.orbital_velocity(x, y + h, z, t)[1] - f.orbital_velocity(x, y - h, z, t)[1]) / (2.0 * h);
+            let dw = (f.orbital_velocity(x, y, z + h, t)[2] - f.orbital_velocity(x, y, z - h, t)[2]) / (2.0 * h);
+            assert!((du + dv + dw).abs() < 1e-6, "divergence {}", du + dv + dw);
+        }
+    }
+
+    #[test]
+    fn grids_match_pointwise_evaluation() {
+        let f = ok(WaveField::new(&spec(3.5, 9.0, 3.3, 10.0), 11));
+        let (x0, y0, dx, nx, ny, t) = (-300.0, 120.0, 0.75, 400, 5, 42.0);
+        let g = ok(f.elevation_grid(x0, y0, dx, nx, ny, t));
+        let (e, gx, gy) = ok(f.elevation_slope_grid(x0, y0, dx, nx, ny, t));
+        assert_eq!(g, e);
+        for j in 0..ny {
+            for i in (0..nx).step_by(7) {
+                let (x, y) = (x0 + i as f64 * dx, y0 + j as f64 * dx);
+                let idx = j * nx + i;
+                assert!((f64::from(g[idx]) - f.elevation(x, y, t)).abs() < 1e-5);
+                let s = f.slope(x, y, t);
+                assert!((f64::from(gx[idx]) - s[0]).abs() < 1e-5 && (f64::from(gy[idx]) - s[1]).abs() < 1e-5);
+            }
+        }
+        assert!(matches!(f.elevation_grid(0.0, 0.0, 0.0, 2, 2, 0.0), Err(MmusvError::InvalidInput { .. })));
+    }
+
+    #[test]
+    fn same_seed_same_sea_and_bound_holds() {
+        let sp = spec(2.5, 8.0, 3.3, 5.0);
+        let (a, b, c) = (ok(WaveField::new(&sp, 9)), ok(WaveField::new(&sp, 9)), ok(WaveField::new(&sp, 10)));
+        let bits = |f: &WaveField| (0..200).map(|k| f.elevation(k as f64, 0.5, 0.3).to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&a), bits(&b));
+        assert_ne!(bits(&a), bits(&c));
+        let g = ok(a.elevation_grid(-500.0, -500.0, 2.0, 500, 500, 17.0));
+        let peak = g.iter().fold(0f32, |m, v| m.max(v.abs()));
+        assert!(f64::from(peak) <= a.max_elevation() && a.max_elevation() > 0.0);
+        // Frequencies strictly increase: no two components share one.
+        assert!(a.components().windows(2).all(|w| w[1].omega_rad_s > w[0].omega_rad_s));
+        let flat = ok(WaveField::new(&spec(0.0, 8.0, 1.0, 5.0), 1));
+        assert_eq!((flat.elevation(3.0, 4.0, 5.0), flat.max_elevation()), (0.0, 0.0));
+    }
+
+    #[test]
+    fn point_time_series_gives_hs_and_tp_within_five_percent() {
+        for (gamma, seed) in [(3.3, 1), (3.3, 2), (3.3, 3), (2.0, 4), (5.0, 5)] {
+            let sp = spec(2.5, 8.0, gamma, 6.0);
+            let f = ok(WaveField::new(&sp, seed));
+            // 20 000 s, 2 500 peak periods: long enough to resolve neighbouring components near the peak.
+            let dt = 1.0;
+            let series: Vec<f64> = (0..20_000).map(|i| f.elevation(31.0, -12.0, i as f64 * dt)).collect();
+            let mean = series.iter().sum::<f64>() / series.len() as f64;
+            let var = series.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / series.len() as f64;
+            let hs = 4.0 * var.sqrt();
+            let wp = TAU / sp.tp;
+            let bins = periodogram(&series, dt, 0.4 * wp, 2.5 * wp);
+            let tp = TAU / smoothed_peak(&bins, 0.5 * wp, 2.0 * wp, 0.04 * wp);
+            eprintln!(
+                "time series γ={gamma} seed {seed}: Hs {hs:.3} m ({:+.2} %), Tp {tp:.3} s ({:+.2} %)",
+                100.0 * (hs / sp.hs - 1.0),
+                100.0 * (tp / sp.tp - 1.0)
+            );
+            assert!((hs / sp.hs - 1.0).abs() < 0.05 && (tp / sp.tp - 1.0).abs() < 0.05);
+        }
+    }
+
+    /// Energy per Fourier wave vector of a Hann-windowed `n × n` snapshot (spacing `dx`), by a separable direct
+    /// DFT over the half plane `ky ≥ 0`, `|kx|, ky ≤ kmax`: `(kx, ky, energy)`.
+    fn wavenumber_periodogram(g: &[f32], n: usize, dx: f64, kmax: f64) -> Vec<(f64, f64, f64)> {
+        let l = n as f64 * dx;
+        let jm = (kmax * l / TAU) as i64;
+        let w: Vec<f64> = (0..n).map(|i| 0.5 - 0.5 * (TAU * i as f64 / n as f64).cos()).collect();
+        let mean = g.iter().map(|&v| f64::from(v)).sum::<f64>() / g.len() as f64;
+        // Along x for every row.
+        let kxs: Vec<i64> = (-jm..=jm).collect();
+        let rows: Vec<Vec<(f64, f64)>> = (0..n)
+            .into_par_iter()
+            .map(|r| {
+                kxs.iter()
+                    .map(|&jx| {
+                        let kx = TAU * jx as f64 / l;
+                        let (mut re, mut im) = (0.0, 0.0);
+                        for i in 0..n {
+                            let v = (f64::from(g[r * n + i]) - mean) * w[i] * w[r];
+                            let (s, c) = (kx * i as f64 * dx).sin_cos();
+                            re += v * c;
+                            im -= v * s;
+                        }
+                        (re, im)
+                    })
+                    .collect()
+            })
+            .collect();
+        let mut out = Vec::new();
+        for (ix, &jx) in kxs.iter().enumerate() {
+            for jy in 0..=jm {
+                if jy == 0 && jx <= 0 {
+                    continue;
+                }
+                let ky = TAU * jy as f64 / l;
+                let (mut re, mut im) = (0.0, 0.0);
+                for (r, row) in rows.iter().enumerate() {
+                    let (s, c) = (ky * r as f64 * dx).sin_cos();
+                    let (a, b) = row[ix];
+                    re += a * c + b * s;
+                    im += b * c - a * s;
+                }
+                out.push((TAU * jx as f64 / l, ky, re * re + im * im));
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn spatial_snapshot_gives_hs_tp_and_spread() {
+        for (s, seed) in [(2.0, 21), (10.0, 22)] {
+            let sp = spec(3.0, 8.0, 3.3, s);
+            let f = ok(WaveField::new(&sp, seed));
+            let lp = sp.peak_wavelength();
+            let (n, dx) = (384, lp / 16.0);
+            let g = ok(f.elevation_grid(-1000.0, 500.0, dx, n, n, 123.0));
+            let mean = g.iter().map(|&v| f64::from(v)).sum::<f64>() / g.len() as f64;
+            let var = g.iter().map(|&v| (f64::from(v) - mean).powi(2)).sum::<f64>() / g.len() as f64;
+            let hs = 4.0 * var.sqrt();
+            let kp = TAU / lp;
+            let spec2 = wavenumber_periodogram(&g, n, dx, 3.0 * kp);
+            // Omnidirectional frequency spectrum: energy of each wave vector at ω = √(g|k|).
+            let bins: Vec<(f64, f64)> = spec2.iter().map(|&(kx, ky, e)| ((GRAVITY * kx.hypot(ky)).sqrt(), e)).collect();
+            let wp = TAU / sp.tp;
+            let tp = TAU / smoothed_peak(&bins, 0.5 * wp, 2.0 * wp, 0.04 * wp);
+            // Second circular moment of the energy about the mean direction (the snapshot cannot tell θ from θ+π).
+            let (mut c2, mut tot) = (0.0, 0.0);
+            for &(kx, ky, e) in &spec2 {
+                let k = kx.hypot(ky);
+                if k > 0.4 * kp && k < 2.5 * kp {
+                    c2 += e * (2.0 * (ky.atan2(kx) - sp.direction_rad)).cos();
+                    tot += e;
+                }
+            }
+            let s_est = CosTwoS::s_from_mean_cos2(c2 / tot);
+            eprintln!(
+                "snapshot s={s}: Hs {hs:.3} ({:+.2} %), Tp {tp:.3} ({:+.2} %), s {s_est:.2} ({:+.1} %)",
+                100.0 * (hs / sp.hs - 1.0),
+                100.0 * (tp / sp.tp - 1.0),
+                100.0 * (s_est / s - 1.0)
+            );
+            assert!((hs / sp.hs - 1.0).abs() < 0.05);
+            assert!((tp / sp.tp - 1.0).abs() < 0.05);
+            assert!((s_est / s - 1.0).abs() < 0.10);
+        }
+    }
+
+    #[test]
+    fn component_directions_follow_the_spreading() {
+        for (s, seed) in [(1.0, 31), (4.0, 32), (10.0, 33), (40.0, 34)] {
+            let sp = spec(2.0, 7.0, 3.3, s);
+            let f = ok(WaveField::new(&sp, seed));
+            let (mut c, mut sn, mut tot) = (0.0, 0.0, 0.0);
+            for comp in f.components() {
+                let e = comp.amplitude_m.powi(2);
+                c += e * (comp.direction_rad - sp.direction_rad).cos();
+                sn += e * (comp.direction_rad - sp.direction_rad).sin();
+                tot += e;
+            }
+            let r = c.hypot(sn) / tot;
+            let s_est = CosTwoS::s_from_mean_cos(r);
+            eprintln!("components s={s}: estimate {s_est:.2} ({:+.1} %)", 100.0 * (s_est / s - 1.0));
+            assert!((s_est / s - 1.0).abs() < 0.10, "s={s}: {s_est}");
+            assert!((sn / tot).abs() < 0.05 * r.max(0.1) + 0.02, "mean direction off: {}", sn / tot);
+            let var: f64 = f.components().iter().map(|c| c.amplitude_m.powi(2) / 2.0).sum();
+            assert!((4.0 * var.sqrt() / sp.hs - 1.0).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn bad_specs_name_their_field() {
+        let good = spec(2.0, 8.0, 3.3, 5.0);
+        for (bad, field) in [
+            (SeaSpec { hs: -1.0, ..good }, "hs_m"),
+            (SeaSpec { hs: 30.0, ..good }, "hs_m"),
+            (SeaSpec { tp: 0.1, ..good }, "tp_s"),
+            (SeaSpec { gamma: 9.0, ..good }, "gamma"),
+            (SeaSpec { direction_rad: f64::NAN, ..good }, "direction_rad"),
+            (SeaSpec { spread_s: 0.0, ..good }, "spread_s"),
+            (SeaSpec { hs: 5.0, tp: 3.0, ..good }, "hs_m"),
+        ] {
+            match WaveField::new(&bad, 1) {
+                Err(MmusvError::Config { field: f, reason, .. }) => assert_eq!(f, field, "{reason}"),
+                other => unreachable!("{bad:?}: {other:?}"),
+            }
+        }
+        assert!(matches!(WaveField::with_components(&good, 1, 2), Err(MmusvError::Config { .. })));
+    }
+}
