@@ -28,10 +28,12 @@ use parry3d::math::Vec3;
 use std::sync::{Arc, Mutex};
 
 mod horizon;
-mod surface;
+pub(crate) mod surface;
 
 pub use horizon::Horizon;
-pub use surface::{SurfaceHit, SurfaceSpec, WaveComponent, WaveSurface, FLAT_PIECE, TILE_CELLS};
+#[cfg(test)]
+pub(crate) use surface::tests::Cosines;
+pub use surface::{SurfaceHit, SurfaceSampler, SurfaceSpec, WaveSurface, FLAT_PIECE, TILE_CELLS};
 
 /// Most cells per side of the height grid.
 const MAX_CELLS: usize = 512;

@@ -4,7 +4,8 @@
 use crate::errors::InputError;
 use crate::native::{detached, flat, pose_from, rows, rows_to_array};
 use mmusv_core::export::{write_world_mesh, MeshFormat};
-use mmusv_core::sea::{SurfaceSpec, WaveComponent, WaveSurface};
+use mmusv_core::ocean::{SeaSpec, WaveField};
+use mmusv_core::sea::{SurfaceSpec, WaveSurface};
 use mmusv_core::{Mesh, Scene as CoreScene};
 use numpy::ndarray::Array2;
 use numpy::{
@@ -12,7 +13,7 @@ use numpy::{
 };
 use pyo3::prelude::*;
 use std::path::PathBuf;
-use std::sync::{Arc, RwLock};
+use std::sync::{Arc, Mutex, RwLock};
 
 /// Tuple of arrays returned by `Scene.cast_rays` (see the `.pyi` for shapes and dtypes).
 type RayHitArrays<'py> = (
@@ -42,6 +43,8 @@ type WorldMeshArrays<'py> = (
 #[pyclass(frozen, module = "mmusv._core")]
 pub struct Scene {
     inner: RwLock<Arc<CoreScene>>,
+    /// The last wave field drawn by `set_wave_surface`, with its sea and seed (reused while they stay).
+    wave_field: Mutex<Option<(SeaSpec, u64, Arc<WaveField>)>>,
 }
 
 fn poisoned() -> PyErr {
@@ -51,7 +54,7 @@ fn poisoned() -> PyErr {
 impl Scene {
     /// Wraps a core scene built in Rust.
     pub fn from_core(scene: CoreScene) -> Self {
-        Self { inner: RwLock::new(Arc::new(scene)) }
+        Self { inner: RwLock::new(Arc::new(scene)), wave_field: Mutex::new(None) }
     }
 
     /// Runs `f` on a snapshot of the scene (the lock is released before `f` runs).
@@ -195,31 +198,36 @@ impl Scene {
         self.write(|s| *s = scene)
     }
 
-    /// Sets the displaced sea surface of the current frame (see mmusv_core::sea::WaveSurface): `components`
-    /// (N, 5) float64 rows `amplitude, kx, ky, omega, phase` sampled at `time_s` around `foci` (F, 2) float32
-    /// world x, y; `None` clears it. Samples with the GIL released.
-    #[pyo3(signature = (components, *, time_s, foci, level=0.0, tile_m=16.0, near_m=40.0, radius_m=900.0, taper_m=150.0))]
+    /// Sets the displaced sea surface of the current frame (see mmusv_core::sea::WaveSurface): the wave field
+    /// of the directional JONSWAP sea `hs_m`, `tp_s`, `gamma`, `direction_rad`, `spread_s` drawn from `seed`
+    /// (mmusv_core::ocean::WaveField), sampled at `time_s` around `foci` (F, 2) float32 world x, y; `hs_m=None`
+    /// clears it. Samples with the GIL released.
+    #[pyo3(signature = (hs_m, *, tp_s=8.0, gamma=3.3, direction_rad=0.0, spread_s=10.0, seed=0, time_s=0.0, foci=None, level=0.0, tile_m=16.0, near_m=40.0, radius_m=900.0, taper_m=150.0))]
     #[allow(clippy::too_many_arguments)]
     fn set_wave_surface(
         &self,
         py: Python<'_>,
-        components: Option<PyReadonlyArray2<'_, f64>>,
+        hs_m: Option<f64>,
+        tp_s: f64,
+        gamma: f64,
+        direction_rad: f64,
+        spread_s: f64,
+        seed: u64,
         time_s: f64,
-        foci: PyReadonlyArray2<'_, f32>,
+        foci: Option<PyReadonlyArray2<'_, f32>>,
         level: f32,
         tile_m: f32,
         near_m: f32,
         radius_m: f32,
         taper_m: f32,
     ) -> PyResult<()> {
-        let Some(components) = components else {
+        let Some(hs) = hs_m else {
             return self.write(|s| s.set_wave_surface(None))?.map_err(crate::errors::to_py);
         };
-        let comps: Vec<WaveComponent> = rows::<f64, 5>(&components, "components")?
-            .iter()
-            .map(|r| WaveComponent { amplitude: r[0], kx: r[1], ky: r[2], omega: r[3], phase: r[4] })
-            .collect();
-        let foci = rows::<f32, 2>(&foci, "foci")?;
+        let foci: Vec<[f32; 2]> = match &foci {
+            Some(f) => rows::<f32, 2>(f, "foci")?.to_vec(),
+            None => Vec::new(),
+        };
         for (name, v) in [("tile_m", tile_m), ("near_m", near_m), ("radius_m", radius_m)] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(InputError::new_err(format!("{name} = {v} is not allowed; give a distance > 0 metres")));
@@ -228,14 +236,30 @@ impl Scene {
         if !(taper_m.is_finite() && (0.0..=radius_m).contains(&taper_m)) {
             return Err(InputError::new_err(format!("taper_m = {taper_m} must be in [0, radius_m]")));
         }
-        if !(time_s.is_finite() && level.is_finite())
-            || comps.iter().any(|c| ![c.amplitude, c.kx, c.ky, c.omega, c.phase].iter().all(|v| v.is_finite()))
-            || foci.iter().any(|f| !(f[0].is_finite() && f[1].is_finite()))
-        {
-            return Err(InputError::new_err("wave surface: time_s, level, components and foci must be finite"));
+        if !(time_s.is_finite() && level.is_finite()) || foci.iter().any(|f| !(f[0].is_finite() && f[1].is_finite())) {
+            return Err(InputError::new_err("wave surface: time_s, level and foci must be finite"));
         }
+        let sea = SeaSpec { hs, tp: tp_s, gamma, direction_rad, spread_s };
         let spec = SurfaceSpec { tile_m, near_m, radius_m, taper_m };
-        let surface = detached(py, || Ok(WaveSurface::new(&comps, time_s, level, &foci, spec)))?;
+        let cached = self
+            .wave_field
+            .lock()
+            .map_err(|_| poisoned())?
+            .as_ref()
+            .filter(|(s, k, _)| *s == sea && *k == seed)
+            .map(|(_, _, f)| Arc::clone(f));
+        let (field, surface) = detached(py, || {
+            let field = match cached {
+                Some(f) => f,
+                None => {
+                    sea.validate()?;
+                    Arc::new(WaveField::new(&sea, seed)?)
+                }
+            };
+            let surface = WaveSurface::new(field.as_ref(), time_s, level, &foci, spec)?;
+            Ok((field, surface))
+        })?;
+        *self.wave_field.lock().map_err(|_| poisoned())? = Some((sea, seed, field));
         self.write(|s| s.set_wave_surface(Some(surface)))?.map_err(crate::errors::to_py)
     }
 

@@ -395,20 +395,16 @@ fn every_simd_level_gives_the_same_bits() {
 }
 
 /// An irregular sea for the wave-surface tests: eight components, 12..80 m long, amplitudes summing to 1.6 m.
-fn wave_components() -> Vec<crate::sea::WaveComponent> {
-    (0..8)
-        .map(|i| {
-            let k = std::f64::consts::TAU / (12.0 + 9.5 * i as f64);
-            let dir = 0.4 + 0.37 * i as f64;
-            crate::sea::WaveComponent {
-                amplitude: 0.2,
-                kx: k * dir.cos(),
-                ky: k * dir.sin(),
-                omega: (9.81 * k).sqrt(),
-                phase: 1.3 * i as f64,
-            }
-        })
-        .collect()
+fn wave_components() -> crate::sea::Cosines {
+    crate::sea::Cosines(
+        (0..8)
+            .map(|i| {
+                let k = std::f64::consts::TAU / (12.0 + 9.5 * i as f64);
+                let dir = 0.4 + 0.37 * i as f64;
+                [0.2, k * dir.cos(), k * dir.sin(), (9.81 * k).sqrt(), 1.3 * i as f64]
+            })
+            .collect(),
+    )
 }
 
 /// With a wave surface, every batch (packets, the sea shortcuts lifted over the crests, horizons, the sun mask)
@@ -428,7 +424,7 @@ fn wave_surface_batches_give_exactly_the_ray_by_ray_reference() {
     s.set_sea(1, &vessels).unwrap_or_else(|e| unreachable!("{e}"));
     let foci = [[0.0f32, 0.0], [120.0, -80.0]];
     let spec = SurfaceSpec { radius_m: 400.0, taper_m: 80.0, ..SurfaceSpec::default() };
-    let surface = WaveSurface::new(&wave_components(), 7.0, 0.0, &foci, spec);
+    let surface = WaveSurface::new(&wave_components(), 7.0, 0.0, &foci, spec).unwrap_or_else(|e| unreachable!("{e}"));
     let w = surface.clone();
     s.set_wave_surface(Some(surface)).unwrap_or_else(|e| unreachable!("{e}"));
     let (mut o, mut d) = sensor_rays(&mut rng, 12_000);

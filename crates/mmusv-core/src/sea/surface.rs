@@ -1,10 +1,9 @@
 //! The displaced sea surface of one frame: a heightfield sampled from a sum of wave components, which every ray
 //! of every sensor meets (crests occlude what lies behind them).
 //!
-//! Model: linear (Airy) waves, `η(x, y, t) = Σ_k a_k cos(kx_k x + ky_k y − ω_k t + φ_k)`, the first-order
-//! random-phase realisation of a directional spectrum (e.g. Tessendorf, "Simulating Ocean Water", SIGGRAPH
-//! course notes 2001, §3; the components themselves come from `crate::ocean`). The surface is sampled once
-//! per frame time on a world-aligned lattice of square tiles ([`TILE_CELLS`] cells a side, [`SurfaceSpec::
+//! Model: the elevation `η(x, y, t)` of a [`SurfaceSampler`] — in the simulator the linear (Airy) wave field of
+//! [`crate::ocean::WaveField`], a random-phase realisation of a directional spectrum — triangulated. The
+//! surface is sampled once per frame time on a world-aligned lattice of square tiles ([`TILE_CELLS`] cells a side, [`SurfaceSpec::
 //! tile_m`] metres): fine near the *foci* (the USVs, every sensor's platform), coarser with distance (each level
 //! doubles the cell), and tapered to the still level beyond [`SurfaceSpec::radius_m`] (flat there). The level of
 //! detail depends only on the frame's foci, so every sensor and every agent sees the same surface at one frame.
@@ -17,10 +16,12 @@
 //! step between two tiles of different detail is closed by a vertical wall (hit where the sign flips at the tile
 //! boundary). Tiles and cells whose sampled maximum lies below the ray are skipped whole.
 //!
-//! Heights are evaluated per tile with the separable form `Re(A e^{i kx x} e^{i ky y})` (one complex rotation
-//! per row and column), so a tile of `(n+1)²` nodes costs about `2 (n+1)²` multiply-adds per component. The
-//! slope `∇η` is summed alongside, for smooth shading normals ([`WaveSurface::shading_normal`]).
+//! Heights and slopes `∇η` (for smooth shading normals, [`WaveSurface::shading_normal`]) come per tile from the
+//! sampler's regular-grid evaluation (the wave field's phasor recurrence, [`crate::ocean::WaveField::
+//! elevation_slope_grid`]).
 
+use crate::error::Result;
+use crate::ocean::WaveField;
 use rayon::prelude::*;
 
 /// Cells along a side of a finest-level tile (a tile at level `L` has `TILE_CELLS >> L`).
@@ -30,19 +31,17 @@ const MAX_LEVEL: u32 = 5;
 /// Piece id of the still, flat water (outside the sampled tiles or in a flat tile).
 pub const FLAT_PIECE: u32 = u32::MAX - 1;
 
-/// One linear wave component: `a cos(kx x + ky y − ω t + φ)` (metres, rad/m, rad/s, rad).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct WaveComponent {
-    /// Amplitude, metres.
-    pub amplitude: f64,
-    /// Wave-number vector, rad/m (world x east, y north).
-    pub kx: f64,
-    /// Wave-number vector, rad/m.
-    pub ky: f64,
-    /// Angular frequency, rad/s.
-    pub omega: f64,
-    /// Phase, rad.
-    pub phase: f64,
+/// A sea elevation that can be sampled on regular grids.
+pub trait SurfaceSampler: Sync {
+    /// `(η, ∂η/∂x, ∂η/∂y)` at `(x0 + i·dx, y0 + j·dx)`, `i, j < n`, time `t`: each row-major `n × n` (entry
+    /// `j·n + i`), metres above the still level and dimensionless slopes.
+    fn sample_grid(&self, x0: f64, y0: f64, dx: f64, n: usize, t: f64) -> Result<(Vec<f32>, Vec<f32>, Vec<f32>)>;
+}
+
+impl SurfaceSampler for WaveField {
+    fn sample_grid(&self, x0: f64, y0: f64, dx: f64, n: usize, t: f64) -> Result<(Vec<f32>, Vec<f32>, Vec<f32>)> {
+        self.elevation_slope_grid(x0, y0, dx, n, n, t)
+    }
 }
 
 /// How finely the surface is sampled around its foci.
@@ -104,9 +103,15 @@ pub struct SurfaceHit {
 }
 
 impl WaveSurface {
-    /// Samples `components` at time `time_s` around the `foci` (world x, y), with still level `level`.
-    /// Deterministic: the same inputs give the same surface, whatever the thread count.
-    pub fn new(components: &[WaveComponent], time_s: f64, level: f32, foci: &[[f32; 2]], spec: SurfaceSpec) -> Self {
+    /// Samples `sea` at time `time_s` around the `foci` (world x, y), with still level `level`. Deterministic:
+    /// the same inputs give the same surface, whatever the thread count. Errors are the sampler's.
+    pub fn new(
+        sea: &impl SurfaceSampler,
+        time_s: f64,
+        level: f32,
+        foci: &[[f32; 2]],
+        spec: SurfaceSpec,
+    ) -> Result<Self> {
         let tile_m = spec.tile_m.max(1e-3);
         let reach = spec.radius_m.max(0.0);
         let (mut lo, mut hi) = ([f32::INFINITY; 2], [f32::NEG_INFINITY; 2]);
@@ -116,7 +121,7 @@ impl WaveSurface {
                 hi[a] = hi[a].max(f[a] + reach);
             }
         }
-        let empty = foci.is_empty() || components.is_empty() || reach == 0.0;
+        let empty = foci.is_empty() || reach == 0.0;
         let (x0, y0, ntx, nty) = if empty {
             (0.0, 0.0, 0, 0)
         } else {
@@ -130,9 +135,9 @@ impl WaveSurface {
                 let (ix, iy) = (k % ntx, k / ntx);
                 let tx = x0 + ix as f32 * tile_m;
                 let ty = y0 + iy as f32 * tile_m;
-                sample_tile(components, time_s, level, foci, &spec, tx, ty, tile_m)
+                sample_tile(sea, time_s, level, foci, &spec, tx, ty, tile_m)
             })
-            .collect();
+            .collect::<Result<_>>()?;
         let mut zmin = level;
         let mut zmax = level;
         for t in &tiles {
@@ -141,7 +146,7 @@ impl WaveSurface {
                 zmax = zmax.max(t.zmax);
             }
         }
-        Self { level, time_s, x0, y0, tile_m, ntx, nty, tiles, zmin, zmax }
+        Ok(Self { level, time_s, x0, y0, tile_m, ntx, nty, tiles, zmin, zmax })
     }
 
     /// The still water level (world z).
@@ -525,7 +530,7 @@ fn nearest(foci: &[[f32; 2]], x: f32, y: f32) -> f32 {
 /// flat when wholly beyond the radius.
 #[allow(clippy::too_many_arguments)]
 fn sample_tile(
-    comps: &[WaveComponent],
+    sea: &impl SurfaceSampler,
     time_s: f64,
     level: f32,
     foci: &[[f32; 2]],
@@ -533,47 +538,16 @@ fn sample_tile(
     tx: f32,
     ty: f32,
     tile_m: f32,
-) -> Tile {
+) -> Result<Tile> {
     let half = 0.5 * tile_m;
     let dc = nearest(foci, tx + half, ty + half);
     if dc - std::f32::consts::SQRT_2 * half >= spec.radius_m {
-        return Tile::default();
+        return Ok(Tile::default());
     }
     let lvl = if dc <= spec.near_m { 0 } else { ((dc / spec.near_m).log2().ceil() as u32).min(MAX_LEVEL) };
     let n = TILE_CELLS >> lvl;
     let w = n + 1;
-    let cs = f64::from(tile_m) / n as f64;
-    let mut acc_h = vec![0f64; w * w];
-    let mut acc_gx = vec![0f64; w * w];
-    let mut acc_gy = vec![0f64; w * w];
-    let mut px = vec![(0f64, 0f64); w];
-    let (x0, y0) = (f64::from(tx), f64::from(ty));
-    for c in comps {
-        // a e^{i (kx x + ky y − ω t + φ)} = [a e^{i(kx x0 + ky y0 − ω t + φ)} e^{i kx i cs}] · e^{i ky j cs}
-        let base = c.kx * x0 + c.ky * y0 - c.omega * time_s + c.phase;
-        let (bs, bc) = base.sin_cos();
-        let (sx, cx) = (c.kx * cs).sin_cos();
-        let (sy, cy) = (c.ky * cs).sin_cos();
-        let (mut pr, mut pi) = (c.amplitude * bc, c.amplitude * bs);
-        for p in px.iter_mut() {
-            *p = (pr, pi);
-            (pr, pi) = (pr * cx - pi * sx, pr * sx + pi * cx);
-        }
-        let (mut qr, mut qi) = (1.0f64, 0.0f64);
-        for j in 0..w {
-            let row = j * w;
-            for i in 0..w {
-                let (a, b) = px[i];
-                let re = a * qr - b * qi;
-                let im = a * qi + b * qr;
-                acc_h[row + i] += re;
-                // ∂/∂x of a cos(θ) = −a kx sin θ.
-                acc_gx[row + i] -= c.kx * im;
-                acc_gy[row + i] -= c.ky * im;
-            }
-            (qr, qi) = (qr * cy - qi * sy, qr * sy + qi * cy);
-        }
-    }
+    let (eta, sx, sy) = sea.sample_grid(f64::from(tx), f64::from(ty), f64::from(tile_m) / n as f64, w, time_s)?;
     let mut h = vec![0f32; w * w];
     let mut g = vec![[0f32; 2]; w * w];
     let (mut zmin, mut zmax) = (f32::INFINITY, f32::NEG_INFINITY);
@@ -590,48 +564,72 @@ fn sample_tile(
                 (spec.radius_m - dn) / (spec.radius_m - inner)
             };
             let k = j * w + i;
-            let z = level + (acc_h[k] as f32) * taper;
+            let z = level + eta[k] * taper;
             h[k] = z;
-            g[k] = [acc_gx[k] as f32 * taper, acc_gy[k] as f32 * taper];
+            g[k] = [sx[k] * taper, sy[k] * taper];
             zmin = zmin.min(z);
             zmax = zmax.max(z);
         }
     }
-    Tile { n, zmin, zmax, h, g }
+    Ok(Tile { n, zmin, zmax, h, g })
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+
+    /// A sum of cosines `[a, kx, ky, ω, φ]`, evaluated point by point (the independent reference).
+    pub(crate) struct Cosines(pub(crate) Vec<[f64; 5]>);
+
+    impl SurfaceSampler for Cosines {
+        fn sample_grid(&self, x0: f64, y0: f64, dx: f64, n: usize, t: f64) -> Result<(Vec<f32>, Vec<f32>, Vec<f32>)> {
+            let mut out = (vec![0f32; n * n], vec![0f32; n * n], vec![0f32; n * n]);
+            for j in 0..n {
+                for i in 0..n {
+                    let (x, y) = (x0 + i as f64 * dx, y0 + j as f64 * dx);
+                    let (mut h, mut gx, mut gy) = (0.0, 0.0, 0.0);
+                    for &[a, kx, ky, w, p] in &self.0 {
+                        let (s, c) = (kx * x + ky * y - w * t + p).sin_cos();
+                        h += a * c;
+                        gx -= a * kx * s;
+                        gy -= a * ky * s;
+                    }
+                    out.0[j * n + i] = h as f32;
+                    out.1[j * n + i] = gx as f32;
+                    out.2[j * n + i] = gy as f32;
+                }
+            }
+            Ok(out)
+        }
+    }
 
     /// A small irregular sea: eight components over directions and wavelengths 12..80 m, amplitudes summing
     /// to 1.6 m.
-    pub(crate) fn test_sea() -> Vec<WaveComponent> {
-        (0..8)
-            .map(|i| {
-                let lam = 12.0 + 9.5 * i as f64;
-                let k = std::f64::consts::TAU / lam;
-                let dir = 0.4 + 0.37 * i as f64;
-                WaveComponent {
-                    amplitude: 0.2,
-                    kx: k * dir.cos(),
-                    ky: k * dir.sin(),
-                    omega: (9.81 * k).sqrt(),
-                    phase: 1.3 * i as f64,
-                }
-            })
-            .collect()
+    pub(crate) fn test_sea() -> Cosines {
+        Cosines(
+            (0..8)
+                .map(|i| {
+                    let k = std::f64::consts::TAU / (12.0 + 9.5 * i as f64);
+                    let dir = 0.4 + 0.37 * i as f64;
+                    [0.2, k * dir.cos(), k * dir.sin(), (9.81 * k).sqrt(), 1.3 * i as f64]
+                })
+                .collect(),
+        )
     }
 
-    fn eta(c: &[WaveComponent], x: f64, y: f64, t: f64) -> f64 {
-        c.iter().map(|w| w.amplitude * (w.kx * x + w.ky * y - w.omega * t + w.phase).cos()).sum()
+    fn eta(c: &Cosines, x: f64, y: f64, t: f64) -> f64 {
+        c.0.iter().map(|w| w[0] * (w[1] * x + w[2] * y - w[3] * t + w[4]).cos()).sum()
+    }
+
+    fn surface(sea: &impl SurfaceSampler, t: f64, foci: &[[f32; 2]], spec: SurfaceSpec) -> WaveSurface {
+        WaveSurface::new(sea, t, 0.0, foci, spec).unwrap_or_else(|e| unreachable!("{e}"))
     }
 
     #[test]
     fn nodes_hold_the_analytic_elevation_and_slope() {
         let c = test_sea();
         let spec = SurfaceSpec { radius_m: 2000.0, ..SurfaceSpec::default() };
-        let s = WaveSurface::new(&c, 12.5, 0.0, &[[130.0, -40.0]], spec);
+        let s = surface(&c, 12.5, &[[130.0, -40.0]], spec);
         let mut checked = 0;
         for (k, tile) in s.tiles.iter().enumerate() {
             if tile.n == 0 || k % 7 != 0 {
@@ -648,10 +646,8 @@ mod tests {
                     }
                     let e = eta(&c, x, y, 12.5);
                     assert!((f64::from(tile.h[j * w + i]) - e).abs() < 2e-4, "tile {k} node {i},{j}");
-                    let gx: f64 = c
-                        .iter()
-                        .map(|w| -w.amplitude * w.kx * (w.kx * x + w.ky * y - w.omega * 12.5 + w.phase).sin())
-                        .sum();
+                    let gx: f64 =
+                        c.0.iter().map(|w| -w[0] * w[1] * (w[1] * x + w[2] * y - w[3] * 12.5 + w[4]).sin()).sum();
                     assert!((f64::from(tile.g[j * w + i][0]) - gx).abs() < 2e-4);
                     checked += 1;
                 }
@@ -692,7 +688,7 @@ mod tests {
     fn intersect_matches_a_dense_march_of_the_surface() {
         let c = test_sea();
         let spec = SurfaceSpec { radius_m: 300.0, taper_m: 60.0, ..SurfaceSpec::default() };
-        let s = WaveSurface::new(&c, 3.0, 0.0, &[[0.0, 0.0], [90.0, 40.0]], spec);
+        let s = surface(&c, 3.0, &[[0.0, 0.0], [90.0, 40.0]], spec);
         let mut state = 11u64;
         let mut rand = |lo: f32, hi: f32| {
             state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
@@ -734,8 +730,7 @@ mod tests {
         // One long-crested swell along x, 1 m amplitude, 60 m long (crests at x = 0, 60, 120 m): from 1.2 m
         // above the still level looking along x at a point 0.3 m above it 150 m away, the crest at 60 m hides it.
         let k = std::f64::consts::TAU / 60.0;
-        let c = [WaveComponent { amplitude: 1.0, kx: k, ky: 0.0, omega: 0.0, phase: 0.0 }];
-        let s = WaveSurface::new(&c, 0.0, 0.0, &[[0.0, 0.0]], SurfaceSpec::default());
+        let s = surface(&Cosines(vec![[1.0, k, 0.0, 0.0, 0.0]]), 0.0, &[[0.0, 0.0]], SurfaceSpec::default());
         let o = [0.0, 0.0, 1.2];
         let target = [150.0f32, 0.0, 0.3];
         let dv = [target[0] - o[0], target[1] - o[1], target[2] - o[2]];
@@ -754,8 +749,7 @@ mod tests {
     #[test]
     fn normals_face_up_and_follow_the_slope() {
         let k = std::f64::consts::TAU / 40.0;
-        let c = [WaveComponent { amplitude: 0.8, kx: k, ky: 0.0, omega: 0.0, phase: 0.0 }];
-        let s = WaveSurface::new(&c, 0.0, 0.0, &[[0.0, 0.0]], SurfaceSpec::default());
+        let s = surface(&Cosines(vec![[0.8, k, 0.0, 0.0, 0.0]]), 0.0, &[[0.0, 0.0]], SurfaceSpec::default());
         // At x = 10 m (a quarter wave) the slope is −a k: the normal leans towards +x.
         let n = s.shading_normal(10.0, 3.0);
         let want = (0.8 * k) as f32;
