@@ -17,10 +17,13 @@
 //! Wheeler stretching).
 //!
 //! Sampling ([`WaveField::with_components`], `N` components, default [`DEFAULT_COMPONENTS`]):
-//! - **Frequencies, equal energy.** Component `i` takes the frequency where the spectrum's cumulative variance
-//!   is `uᵢ = (i + ξᵢ)/N`, `ξᵢ` uniform in [0, 1) (clamped to `1 − 1/(16N)` so the last bin stays finite). Every
-//!   amplitude is `a = √(2 m0 / N) = Hs/√(8N)`, so the variance is `m0 = Hs²/16` exactly and no two
-//!   components share a frequency: the sea never repeats.
+//! - **Frequencies, stratified half by energy, half by log-frequency.** The `N` bins are equal-probability bins
+//!   of the mixture `P(ω) = ½ F(ω) + ½ ln(ω/ω₀)/ln(ω₁/ω₀)` (clamped to [0, 1]), `F` the spectrum's cumulative
+//!   variance, `[ω₀, ω₁] = [`[`LOG_BAND`]`]·ωp`. Half the components thus follow the energy (the peak), half
+//!   cover the flanks evenly in log-frequency, so short waves (slopes, small craft's roll resonance) are
+//!   sampled too. Component `i` sits at `P⁻¹((i + ξᵢ)/N)`, `ξᵢ` uniform in [0, 1) (at most `1 − 1/(16N)` in
+//!   the last bin), with the variance of its whole bin: `aᵢ² = 2 m0 (F(eᵢ₊₁) − F(eᵢ))`, `eᵢ = P⁻¹(i/N)`. The
+//!   variance is `m0 = Hs²/16` exactly and no two components share a frequency: the sea never repeats.
 //! - **Directions, stratified twice.** The cos-2s distribution is cut into `N` equal-probability strata, grouped
 //!   into [`DIRECTION_STRATA`] coarse strata of `G = N/DIRECTION_STRATA`. Each group of `DIRECTION_STRATA`
 //!   consecutive frequency components takes every coarse stratum once (in shuffled order), and across the `G`
@@ -165,7 +168,15 @@ impl WaveField {
         let nf = n as f64;
         let u_max = 1.0 - 1.0 / (16.0 * nf);
         let jitter: Vec<f64> = (0..n).map(|_| rng.random::<f64>()).collect();
-        let amplitude = (2.0 * spectrum.m0() / nf).sqrt();
+        let mix = Mixture::new(&spectrum);
+        // Cumulative variance fraction at the bin edges e_0 = 0 .. e_N = ∞.
+        let edges: Vec<f64> = (0..=n)
+            .map(|i| match i {
+                0 => 0.0,
+                i if i == n => 1.0,
+                i => spectrum.cumulative(mix.quantile(i as f64 / nf)),
+            })
+            .collect();
         let groups = n / DIRECTION_STRATA;
         // Fine direction stratum of (group g, coarse stratum j): j·groups + fine[j][g].
         let fine: Vec<Vec<usize>> = (0..DIRECTION_STRATA).map(|_| shuffled(&mut rng, groups)).collect();
@@ -174,7 +185,8 @@ impl WaveField {
             for (m, stratum) in shuffled(&mut rng, DIRECTION_STRATA).into_iter().enumerate() {
                 let i = g * DIRECTION_STRATA + m;
                 let u = ((i as f64 + jitter[i]) / nf).min(u_max);
-                let omega = spectrum.quantile(u);
+                let omega = mix.quantile(u);
+                let amplitude = (2.0 * spectrum.m0() * (edges[i + 1] - edges[i]).max(0.0)).sqrt();
                 let k = omega * omega / GRAVITY;
                 let q = ((stratum * groups + fine[stratum][g]) as f64 + rng.random::<f64>()) / nf;
                 let direction = spec.direction_rad + spread.quantile(q);
@@ -341,6 +353,52 @@ impl WaveField {
             eta.par_chunks_mut(nx).enumerate().for_each(|(j, e)| row(j, e, &mut [], &mut []));
         }
         Ok((eta, sx, sy))
+    }
+}
+
+/// Stream index of the sea in [`crate::kinematics::mix_seed`], far from the vessel indices 0, 1, 2, ...
+pub const SEA_STREAM: u64 = 0x0CEA_0000_0000_0001;
+
+/// The seed of a scenario's wave field: `mix_seed(scenario_seed, SEA_STREAM)`. Every consumer (vessel response,
+/// water surface, shading) builds the scenario's field with `WaveField::new(&spec, sea_seed(scenario_seed))`.
+pub fn sea_seed(scenario_seed: u64) -> u64 {
+    crate::kinematics::mix_seed(scenario_seed, SEA_STREAM)
+}
+
+/// Band `[ω₀, ω₁]` of the log-uniform half of the frequency sampling, in units of ωp.
+pub const LOG_BAND: [f64; 2] = [0.6, 8.0];
+
+/// The sampling mixture `P(ω) = ½ F(ω) + ½ clamp(ln(ω/ω₀)/ln(ω₁/ω₀), 0, 1)`.
+struct Mixture<'a> {
+    spectrum: &'a Jonswap,
+    lo: f64,
+    hi: f64,
+}
+
+impl<'a> Mixture<'a> {
+    fn new(spectrum: &'a Jonswap) -> Self {
+        let wp = spectrum.omega_p();
+        Self { spectrum, lo: LOG_BAND[0] * wp, hi: LOG_BAND[1] * wp }
+    }
+
+    fn cdf(&self, omega: f64) -> f64 {
+        let log = ((omega / self.lo).ln() / (self.hi / self.lo).ln()).clamp(0.0, 1.0);
+        0.5 * self.spectrum.cumulative(omega) + 0.5 * log
+    }
+
+    /// `P⁻¹(u)` by bisection (1e-12 relative).
+    fn quantile(&self, u: f64) -> f64 {
+        let wp = self.spectrum.omega_p();
+        let (mut lo, mut hi) = (0.05 * wp, 200.0 * wp);
+        while hi - lo > 1e-12 * wp {
+            let mid = 0.5 * (lo + hi);
+            if self.cdf(mid) < u {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        0.5 * (lo + hi)
     }
 }
 

@@ -10,5 +10,5 @@
 pub mod field;
 pub mod spectrum;
 
-pub use field::{SeaSpec, WaveComponent, WaveField, DEFAULT_COMPONENTS};
+pub use field::{sea_seed, SeaSpec, WaveComponent, WaveField, DEFAULT_COMPONENTS};
 pub use spectrum::{CosTwoS, Jonswap, GRAVITY};
