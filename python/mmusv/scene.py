@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 import numpy.typing as npt
@@ -28,6 +28,30 @@ __all__ = ["NO_HIT", "RayHits", "Scene", "demo_scene"]
 
 NO_HIT = -1
 """Value of ``RayHits.instance_id`` and ``triangle_id`` where the ray hit nothing."""
+
+
+class SeaState(Protocol):
+    """A directional JONSWAP sea as the wave surface takes it (the ocean's sea specification has these)."""
+
+    @property
+    def hs_m(self) -> float:
+        """Significant wave height, metres."""
+
+    @property
+    def tp_s(self) -> float:
+        """Peak period, seconds."""
+
+    @property
+    def gamma(self) -> float:
+        """JONSWAP peak enhancement."""
+
+    @property
+    def direction_rad(self) -> float:
+        """Mean travel direction, radians, counter-clockwise from world +x."""
+
+    @property
+    def spread_s(self) -> float:
+        """cos-2s spreading exponent."""
 
 
 @dataclass(frozen=True)
@@ -265,33 +289,41 @@ class Scene:
 
     def set_wave_surface(
         self,
-        components: npt.ArrayLike | None,
+        sea: SeaState | None,
         *,
+        scenario_seed: int,
         time_s: float,
         foci: npt.ArrayLike,
-        level: float = 0.0,
-        radius_m: float = 900.0,
+        radius_m: float = 320.0,
     ) -> None:
-        """Sets the displaced sea surface of one frame time (see ``mmusv_core::sea::WaveSurface``), which replaces
-        the sea instance's flat mesh for every ray: crests occlude, beams meet wave faces. The scene must have a
-        sea (:meth:`set_sea`); ``None`` clears it.
+        """Sets the displaced sea surface of one frame time (``mmusv_core::sea::WaveSurface``), which replaces the
+        sea instance's flat mesh for every ray: crests occlude, beams meet wave faces. The scene must have a sea
+        (:meth:`set_sea`); ``sea=None`` clears it.
 
         Args:
-            components: ``(N, 5)`` float rows ``amplitude (m), kx, ky (rad/m), omega (rad/s), phase (rad)`` of
-                ``eta = sum a cos(kx x + ky y - omega t + phase)``, world frame.
+            sea: the directional JONSWAP sea; its wave field is drawn from the scenario's sea seed, the one field
+                the hulls ride.
+            scenario_seed: the scenario's seed.
             time_s: the frame time, seconds.
-            foci: ``(F, 2)`` float world x, y (metres) the sampling is finest around (the USVs); the same foci
-                for every sensor of a frame give every sensor the same surface.
-            level: still water level, world z (metres).
+            foci: ``(F, 2)`` float world x, y (metres) the sampling is finest around (the USVs); the same foci for
+                every sensor of a frame give every sensor the same surface.
             radius_m: the waves taper to still water this far from the nearest focus (metres, > 0).
         """
-        if components is None:
-            self._native.set_wave_surface(None, time_s=0.0, foci=np.zeros((0, 2), np.float32))
+        if sea is None:
+            self._native.set_wave_surface(None)
             return
-        c = _array(components, name="components", dtype=np.float64, shape_tail=(5,))
         f = _array(foci, name="foci", dtype=np.float32, shape_tail=(2,))
         self._native.set_wave_surface(
-            c, time_s=float(time_s), foci=f, level=float(level), radius_m=float(radius_m), taper_m=min(150.0, radius_m)
+            float(sea.hs_m),
+            tp_s=float(sea.tp_s),
+            gamma=float(sea.gamma),
+            direction_rad=float(sea.direction_rad),
+            spread_s=float(sea.spread_s),
+            scenario_seed=int(scenario_seed),
+            time_s=float(time_s),
+            foci=f,
+            radius_m=float(radius_m),
+            taper_m=min(60.0, float(radius_m)),
         )
 
     def wave_heights(self, xy: npt.ArrayLike) -> npt.NDArray[np.float32]:

@@ -32,8 +32,8 @@ pub(crate) mod surface;
 
 pub use horizon::Horizon;
 #[cfg(test)]
-pub(crate) use surface::tests::Cosines;
-pub use surface::{SurfaceHit, SurfaceSampler, SurfaceSpec, WaveSurface, FLAT_PIECE, TILE_CELLS};
+pub(crate) use surface::tests::comp as test_component;
+pub use surface::{SurfaceHit, SurfaceSpec, WaveSurface, FLAT_PIECE, SKIN_M, TILE_CELLS};
 
 /// Most cells per side of the height grid.
 const MAX_CELLS: usize = 512;
@@ -338,7 +338,7 @@ impl Sea {
     #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > b)` on purpose: a NaN must answer "no"
     #[inline(always)]
     pub fn sun_clear(&self, mask: &SunMask, o: [f32; 3]) -> bool {
-        if !(o[2] > self.surface_top()) {
+        if !(o[2] > self.level) {
             return false;
         }
         let d = mask.dir;

@@ -4,7 +4,7 @@
 use crate::errors::InputError;
 use crate::native::{detached, flat, pose_from, rows, rows_to_array};
 use mmusv_core::export::{write_world_mesh, MeshFormat};
-use mmusv_core::ocean::{SeaSpec, WaveField};
+use mmusv_core::ocean::{sea_seed, SeaSpec, WaveField};
 use mmusv_core::sea::{SurfaceSpec, WaveSurface};
 use mmusv_core::{Mesh, Scene as CoreScene};
 use numpy::ndarray::Array2;
@@ -199,10 +199,10 @@ impl Scene {
     }
 
     /// Sets the displaced sea surface of the current frame (see mmusv_core::sea::WaveSurface): the wave field
-    /// of the directional JONSWAP sea `hs_m`, `tp_s`, `gamma`, `direction_rad`, `spread_s` drawn from `seed`
-    /// (mmusv_core::ocean::WaveField), sampled at `time_s` around `foci` (F, 2) float32 world x, y; `hs_m=None`
+    /// of the directional JONSWAP sea `hs_m`, `tp_s`, `gamma`, `direction_rad`, `spread_s` drawn from the scenario's
+    /// sea seed (mmusv_core::ocean::WaveField, `sea_seed(scenario_seed)`: the field the hulls ride), sampled at `time_s` around `foci` (F, 2) float32 world x, y; `hs_m=None`
     /// clears it. Samples with the GIL released.
-    #[pyo3(signature = (hs_m, *, tp_s=8.0, gamma=3.3, direction_rad=0.0, spread_s=10.0, seed=0, time_s=0.0, foci=None, level=0.0, tile_m=16.0, near_m=40.0, radius_m=900.0, taper_m=150.0))]
+    #[pyo3(signature = (hs_m, *, tp_s=8.0, gamma=3.3, direction_rad=0.0, spread_s=10.0, scenario_seed=0, time_s=0.0, foci=None, level=0.0, tile_m=32.0, near_m=40.0, radius_m=320.0, taper_m=60.0))]
     #[allow(clippy::too_many_arguments)]
     fn set_wave_surface(
         &self,
@@ -212,7 +212,7 @@ impl Scene {
         gamma: f64,
         direction_rad: f64,
         spread_s: f64,
-        seed: u64,
+        scenario_seed: u64,
         time_s: f64,
         foci: Option<PyReadonlyArray2<'_, f32>>,
         level: f32,
@@ -240,6 +240,7 @@ impl Scene {
             return Err(InputError::new_err("wave surface: time_s, level and foci must be finite"));
         }
         let sea = SeaSpec { hs, tp: tp_s, gamma, direction_rad, spread_s };
+        let seed = sea_seed(scenario_seed);
         let spec = SurfaceSpec { tile_m, near_m, radius_m, taper_m };
         let cached = self
             .wave_field
@@ -256,7 +257,7 @@ impl Scene {
                     Arc::new(WaveField::new(&sea, seed)?)
                 }
             };
-            let surface = WaveSurface::new(field.as_ref(), time_s, level, &foci, spec)?;
+            let surface = WaveSurface::new(field.components(), time_s, level, &foci, spec);
             Ok((field, surface))
         })?;
         *self.wave_field.lock().map_err(|_| poisoned())? = Some((sea, seed, field));

@@ -132,11 +132,13 @@ impl Scene {
     }
 
     /// A rising ray that starts among the waves (below their crest bound), carried up to just over the bound
-    /// when nothing meets it on the way: the wave surface (exactly) and every other surface (the height map walk
-    /// over at most [`SEA_WALK_LIFT`] cells). Without waves, or from above the bound, the origin as it is.
+    /// when nothing meets it on the way: the wave surface (exactly; none for a ray leaving the water,
+    /// [`crate::sea::WaveSurface::leaves`], which only needs to clear the still level) and every other surface
+    /// (the height map walk over at most [`SEA_WALK_LIFT`] cells). Without waves, or from above the bound, the
+    /// origin as it is.
     #[inline(always)]
     fn lift_over_waves(&self, sea: &crate::sea::Sea, o: [f32; 3], d: [f32; 3], limit: f32) -> Lift {
-        let top = sea.surface_top();
+        let mut top = sea.surface_top();
         if o[2] > top {
             return Lift::Above(o);
         }
@@ -144,8 +146,15 @@ impl Scene {
         if !(d[2] > 0.0) {
             return Lift::Unknown;
         }
+        let leaves = w.leaves(o, d);
+        if leaves {
+            top = sea.level;
+            if o[2] > top {
+                return Lift::Above(o);
+            }
+        }
         let t = ((top - o[2]) / d[2]) * 1.0001 + 1e-3 / d[2];
-        if w.occludes(o, d, t.min(limit)) || !sea.path_clear(o, d, t.min(limit), SEA_WALK_LIFT) {
+        if (!leaves && w.occludes(o, d, t.min(limit))) || !sea.path_clear(o, d, t.min(limit), SEA_WALK_LIFT) {
             return Lift::Unknown;
         }
         if t >= limit {

@@ -395,16 +395,14 @@ fn every_simd_level_gives_the_same_bits() {
 }
 
 /// An irregular sea for the wave-surface tests: eight components, 12..80 m long, amplitudes summing to 1.6 m.
-fn wave_components() -> crate::sea::Cosines {
-    crate::sea::Cosines(
-        (0..8)
-            .map(|i| {
-                let k = std::f64::consts::TAU / (12.0 + 9.5 * i as f64);
-                let dir = 0.4 + 0.37 * i as f64;
-                [0.2, k * dir.cos(), k * dir.sin(), (9.81 * k).sqrt(), 1.3 * i as f64]
-            })
-            .collect(),
-    )
+fn wave_components() -> Vec<crate::ocean::WaveComponent> {
+    (0..8)
+        .map(|i| {
+            let k = std::f64::consts::TAU / (12.0 + 9.5 * i as f64);
+            let dir = 0.4 + 0.37 * i as f64;
+            crate::sea::test_component(0.2, k * dir.cos(), k * dir.sin(), (9.81 * k).sqrt(), 1.3 * i as f64)
+        })
+        .collect()
 }
 
 /// With a wave surface, every batch (packets, the sea shortcuts lifted over the crests, horizons, the sun mask)
@@ -424,7 +422,7 @@ fn wave_surface_batches_give_exactly_the_ray_by_ray_reference() {
     s.set_sea(1, &vessels).unwrap_or_else(|e| unreachable!("{e}"));
     let foci = [[0.0f32, 0.0], [120.0, -80.0]];
     let spec = SurfaceSpec { radius_m: 400.0, taper_m: 80.0, ..SurfaceSpec::default() };
-    let surface = WaveSurface::new(&wave_components(), 7.0, 0.0, &foci, spec).unwrap_or_else(|e| unreachable!("{e}"));
+    let surface = WaveSurface::new(&wave_components(), 7.0, 0.0, &foci, spec);
     let w = surface.clone();
     s.set_wave_surface(Some(surface)).unwrap_or_else(|e| unreachable!("{e}"));
     let (mut o, mut d) = sensor_rays(&mut rng, 12_000);
@@ -440,7 +438,7 @@ fn wave_surface_batches_give_exactly_the_ray_by_ray_reference() {
     let mut water = 0;
     for i in 0..o.len() {
         let u = unit_direction(&d[i]);
-        let wh = w.intersect(o[i], u, limit);
+        let wh = if w.leaves(o[i], u) { None } else { w.intersect(o[i], u, limit) };
         let mh = reference.cast_ray(Vec3::from_array(o[i]), Vec3::from_array(u), limit);
         let (dist, inst) = match (wh, mh) {
             (Some(a), Some(b)) if b.distance < a.t => (b.distance, b.instance as i32),
@@ -469,21 +467,27 @@ fn wave_surface_batches_give_exactly_the_ray_by_ray_reference() {
         let fast = s.cast_rays(&co, &cd, limit).unwrap_or_default();
         for i in 0..co.len() {
             let u = unit_direction(&cd[i]);
-            let t_w = w.intersect(co[i], u, limit).map_or(f32::INFINITY, |h| h.t);
+            let t_w = if w.leaves(co[i], u) { None } else { w.intersect(co[i], u, limit) };
+            let t_w = t_w.map_or(f32::INFINITY, |h| h.t);
             let t_m = reference
                 .cast_ray(Vec3::from_array(co[i]), Vec3::from_array(u), limit)
                 .map_or(f32::INFINITY, |h| h.distance);
             assert_eq!(fast.distance[i], t_w.min(t_m), "eye {z}: ray {i}");
         }
     }
-    // Shadow rays from the wave surface towards the sun (the sun mask, lifted over the crests) and from above.
-    let sun = [0.8f32, 0.3, 0.12];
+    // Shadow rays towards the sun from the wave surface (leaving the water: the waves do not shade them), from
+    // just over the skin above it (the sun mask, lifted over the crests that shade them) and from above everything.
+    let sun = [0.8f32, 0.3, 0.05];
     let su = unit_direction(&sun);
     let so: Vec<[f32; 3]> = o
         .iter()
         .enumerate()
         .map(|(k, p)| {
-            let z = if k % 2 == 0 { w.height(p[0], p[1]) + 0.02 } else { 150.0 };
+            let z = match k % 3 {
+                0 => w.height(p[0], p[1]) + 0.02,
+                1 => w.height(p[0], p[1]) + crate::sea::SKIN_M + 0.05,
+                _ => 150.0,
+            };
             [p[0], p[1], z]
         })
         .collect();
@@ -491,13 +495,14 @@ fn wave_surface_batches_give_exactly_the_ray_by_ray_reference() {
     let fast = s.occluded_rays(&so, &sd, 5000.0).unwrap_or_default();
     let mut by_waves = 0;
     for i in 0..so.len() {
-        let wb = w.occludes(so[i], su, 5000.0);
+        let wb = !w.leaves(so[i], su) && w.occludes(so[i], su, 5000.0);
+        assert_eq!(w.leaves(so[i], su), i % 3 == 0, "shadow ray {i}");
         let mb =
             reference.occluded_with(Vec3::from_array(so[i]), Vec3::from_array(su), 5000.0, &mut Scratch::default());
         by_waves += usize::from(wb && !mb);
         assert_eq!(fast[i], wb || mb, "shadow ray {i} from {:?}", so[i]);
     }
-    assert!(by_waves > 50, "only {by_waves} points shaded by the crests alone");
+    assert!(by_waves > 20, "only {by_waves} points shaded by the crests alone");
     // Clearing the sea clears the waves; setting waves without a sea is an error.
     s.clear_sea();
     assert!(s.wave_surface().is_none());

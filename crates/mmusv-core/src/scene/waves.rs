@@ -52,9 +52,13 @@ impl Scene {
     }
 
     /// The ray's hit with the wave surface below `limit`, as a hit on the sea instance.
+    /// Rays leaving the water ([`WaveSurface::leaves`]) meet none.
     #[inline(always)]
     pub(super) fn wave_hit(&self, ray: &RayPrep, limit: f32) -> Option<Hit> {
         let w = self.waves.as_ref()?;
+        if w.leaves(ray.o, ray.d) {
+            return None;
+        }
         let h = w.intersect(ray.o, ray.d, limit)?;
         Some(Hit { distance: h.t, instance: self.hidden_instance(), triangle: h.piece })
     }
@@ -66,7 +70,7 @@ impl Scene {
         let w = self.waves.as_ref()?;
         let mut pieces = [u32::MAX; PACKET];
         for r in 0..p.n {
-            if p.best[r] < 0.0 {
+            if p.best[r] < 0.0 || w.leaves(p.ray[r].o, p.ray[r].d) {
                 continue;
             }
             if let Some(h) = w.intersect(p.ray[r].o, p.ray[r].d, p.best[r]) {
@@ -82,7 +86,8 @@ impl Scene {
     pub(super) fn wave_block_packet(&self, p: &mut Packet) {
         let Some(w) = &self.waves else { return };
         for r in 0..p.n {
-            if p.best[r] >= 0.0 && w.occludes(p.ray[r].o, p.ray[r].d, p.best[r]) {
+            let ray = &p.ray[r];
+            if p.best[r] >= 0.0 && !w.leaves(ray.o, ray.d) && w.occludes(ray.o, ray.d, p.best[r]) {
                 p.best[r] = -1.0;
             }
         }

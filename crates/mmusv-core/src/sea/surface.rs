@@ -1,8 +1,8 @@
 //! The displaced sea surface of one frame: a heightfield sampled from a sum of wave components, which every ray
 //! of every sensor meets (crests occlude what lies behind them).
 //!
-//! Model: the elevation `η(x, y, t)` of a [`SurfaceSampler`] — in the simulator the linear (Airy) wave field of
-//! [`crate::ocean::WaveField`], a random-phase realisation of a directional spectrum — triangulated. The
+//! Model: the elevation `η(x, y, t) = Σ a cos(kx x + ky y − ω t + φ)` of the linear (Airy) wave components of
+//! [`crate::ocean::WaveField`] (a random-phase realisation of a directional spectrum), triangulated. The
 //! surface is sampled once per frame time on a world-aligned lattice of square tiles ([`TILE_CELLS`] cells a side, [`SurfaceSpec::
 //! tile_m`] metres): fine near the *foci* (the USVs, every sensor's platform), coarser with distance (each level
 //! doubles the cell), and tapered to the still level beyond [`SurfaceSpec::radius_m`] (flat there). The level of
@@ -16,33 +16,25 @@
 //! step between two tiles of different detail is closed by a vertical wall (hit where the sign flips at the tile
 //! boundary). Tiles and cells whose sampled maximum lies below the ray are skipped whole.
 //!
-//! Heights and slopes `∇η` (for smooth shading normals, [`WaveSurface::shading_normal`]) come per tile from the
-//! sampler's regular-grid evaluation (the wave field's phasor recurrence, [`crate::ocean::WaveField::
-//! elevation_slope_grid`]).
+//! Heights and slopes `∇η` (for smooth shading normals, [`WaveSurface::shading_normal`]) are summed per tile by
+//! a two-dimensional phasor recurrence: every component's `a e^{iψ}` at a tile's corner comes from the
+//! rectangle's corner by one rotation per tile column and row (tabulated once per frame), then one rotation per
+//! node column and row inside the tile; the only `sin_cos` calls are a few per component and frame, and the
+//! inner loop is a vectorisable multiply-add over a row of nodes (the same values as
+//! [`crate::ocean::WaveField::elevation_slope_grid`] to rounding, tested).
 
-use crate::error::Result;
-use crate::ocean::WaveField;
+use crate::ocean::WaveComponent;
 use rayon::prelude::*;
 
 /// Cells along a side of a finest-level tile (a tile at level `L` has `TILE_CELLS >> L`).
 pub const TILE_CELLS: usize = 32;
 /// Coarsest level (one cell per tile).
 const MAX_LEVEL: u32 = 5;
+/// Rays that rise from within this height (metres) above the surface under their origin leave the water: the
+/// surface does not occlude them ([`WaveSurface::leaves`]).
+pub const SKIN_M: f32 = 0.25;
 /// Piece id of the still, flat water (outside the sampled tiles or in a flat tile).
 pub const FLAT_PIECE: u32 = u32::MAX - 1;
-
-/// A sea elevation that can be sampled on regular grids.
-pub trait SurfaceSampler: Sync {
-    /// `(η, ∂η/∂x, ∂η/∂y)` at `(x0 + i·dx, y0 + j·dx)`, `i, j < n`, time `t`: each row-major `n × n` (entry
-    /// `j·n + i`), metres above the still level and dimensionless slopes.
-    fn sample_grid(&self, x0: f64, y0: f64, dx: f64, n: usize, t: f64) -> Result<(Vec<f32>, Vec<f32>, Vec<f32>)>;
-}
-
-impl SurfaceSampler for WaveField {
-    fn sample_grid(&self, x0: f64, y0: f64, dx: f64, n: usize, t: f64) -> Result<(Vec<f32>, Vec<f32>, Vec<f32>)> {
-        self.elevation_slope_grid(x0, y0, dx, n, n, t)
-    }
-}
 
 /// How finely the surface is sampled around its foci.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -59,9 +51,10 @@ pub struct SurfaceSpec {
 }
 
 impl Default for SurfaceSpec {
-    /// 0.5 m cells within ~40 m, 1 m to ~80 m, ..., waves out to 900 m around every focus.
+    /// 1 m cells within ~40 m, 2 m to ~80 m, 4 m to ~160 m, 8 m to ~320 m, waves out to 320 m around every
+    /// focus (tapered over the last 60 m).
     fn default() -> Self {
-        Self { tile_m: 16.0, near_m: 40.0, radius_m: 900.0, taper_m: 150.0 }
+        Self { tile_m: 32.0, near_m: 40.0, radius_m: 320.0, taper_m: 60.0 }
     }
 }
 
@@ -103,15 +96,9 @@ pub struct SurfaceHit {
 }
 
 impl WaveSurface {
-    /// Samples `sea` at time `time_s` around the `foci` (world x, y), with still level `level`. Deterministic:
-    /// the same inputs give the same surface, whatever the thread count. Errors are the sampler's.
-    pub fn new(
-        sea: &impl SurfaceSampler,
-        time_s: f64,
-        level: f32,
-        foci: &[[f32; 2]],
-        spec: SurfaceSpec,
-    ) -> Result<Self> {
+    /// Samples `components` at time `time_s` around the `foci` (world x, y), with still level `level`.
+    /// Deterministic: the same inputs give the same surface, whatever the thread count.
+    pub fn new(components: &[WaveComponent], time_s: f64, level: f32, foci: &[[f32; 2]], spec: SurfaceSpec) -> Self {
         let tile_m = spec.tile_m.max(1e-3);
         let reach = spec.radius_m.max(0.0);
         let (mut lo, mut hi) = ([f32::INFINITY; 2], [f32::NEG_INFINITY; 2]);
@@ -121,7 +108,7 @@ impl WaveSurface {
                 hi[a] = hi[a].max(f[a] + reach);
             }
         }
-        let empty = foci.is_empty() || reach == 0.0;
+        let empty = foci.is_empty() || reach == 0.0 || components.is_empty();
         let (x0, y0, ntx, nty) = if empty {
             (0.0, 0.0, 0, 0)
         } else {
@@ -129,15 +116,14 @@ impl WaveSurface {
             let y0 = (lo[1] / tile_m).floor() * tile_m;
             (x0, y0, ((hi[0] - x0) / tile_m).ceil() as usize, ((hi[1] - y0) / tile_m).ceil() as usize)
         };
+        let phasors = Phasors::new(components, time_s, x0, y0, tile_m, ntx, nty);
         let tiles: Vec<Tile> = (0..ntx * nty)
             .into_par_iter()
             .map(|k| {
                 let (ix, iy) = (k % ntx, k / ntx);
-                let tx = x0 + ix as f32 * tile_m;
-                let ty = y0 + iy as f32 * tile_m;
-                sample_tile(sea, time_s, level, foci, &spec, tx, ty, tile_m)
+                phasors.tile(ix, iy, level, foci, &spec)
             })
-            .collect::<Result<_>>()?;
+            .collect();
         let mut zmin = level;
         let mut zmax = level;
         for t in &tiles {
@@ -146,7 +132,7 @@ impl WaveSurface {
                 zmax = zmax.max(t.zmax);
             }
         }
-        Ok(Self { level, time_s, x0, y0, tile_m, ntx, nty, tiles, zmin, zmax })
+        Self { level, time_s, x0, y0, tile_m, ntx, nty, tiles, zmin, zmax }
     }
 
     /// The still water level (world z).
@@ -216,12 +202,13 @@ impl WaveSurface {
         unit([-p[1] / s, -p[2] / s, 1.0])
     }
 
-    /// Smooth unit normal at world `(x, y)`: the sampled slopes `∇η` interpolated bilinearly (up-facing).
-    pub fn shading_normal(&self, x: f32, y: f32) -> [f32; 3] {
-        let Some((ix, iy)) = self.tile_at(x, y) else { return [0.0, 0.0, 1.0] };
+    /// Smooth unit normal at world `(x, y)`: the sampled slopes `∇η` interpolated bilinearly (up-facing); `None`
+    /// over still water (outside the sampled tiles), where the caller's own small-scale normals serve.
+    pub fn shading_normal(&self, x: f32, y: f32) -> Option<[f32; 3]> {
+        let (ix, iy) = self.tile_at(x, y)?;
         let t = &self.tiles[iy * self.ntx + ix];
         if t.n == 0 {
-            return [0.0, 0.0, 1.0];
+            return None;
         }
         let s = self.tile_m / t.n as f32;
         let u = ((x - (self.x0 + ix as f32 * self.tile_m)) / s).clamp(0.0, t.n as f32);
@@ -233,7 +220,7 @@ impl WaveSurface {
         let (g00, g10, g01, g11) = (g(ci, cj), g(ci + 1, cj), g(ci, cj + 1), g(ci + 1, cj + 1));
         let mix =
             |a: usize| (g00[a] * (1.0 - fu) + g10[a] * fu) * (1.0 - fv) + (g01[a] * (1.0 - fu) + g11[a] * fu) * fv;
-        unit([-mix(0), -mix(1), 1.0])
+        Some(unit([-mix(0), -mix(1), 1.0]))
     }
 
     /// The first crossing of the ray `o + t·d` (`d` unit, `0 <= t < t_max`) with the surface, from either side,
@@ -275,6 +262,19 @@ impl WaveSurface {
                 None
             }
         }
+    }
+
+    /// Whether the ray `o + t·d` rises from the water itself: its origin lies no more than [`SKIN_M`] above (and
+    /// not below) the surface under it. Such rays — a camera's reflected rays and shadow rays from the water it
+    /// sees — are not occluded by the waves (no wave self-shadowing; the capillary slopes' shading stands in for
+    /// it), which the scene applies to every such ray alike, so its shortcuts stay exact.
+    #[inline]
+    pub fn leaves(&self, o: [f32; 3], d: [f32; 3]) -> bool {
+        if !(d[2] > 0.0) || o[2] > self.zmax + SKIN_M || o[2] < self.zmin {
+            return false;
+        }
+        let h = self.height(o[0], o[1]);
+        o[2] >= h && o[2] <= h + SKIN_M
     }
 
     /// Whether the ray `o + t·d` crosses the surface with `0 <= t < t_max`.
@@ -526,103 +526,175 @@ fn nearest(foci: &[[f32; 2]], x: f32, y: f32) -> f32 {
     foci.iter().map(|f| (f[0] - x).hypot(f[1] - y)).fold(f32::INFINITY, f32::min)
 }
 
-/// Samples the tile with lower corner `(tx, ty)`: its level from the distance of its centre to the nearest focus,
-/// flat when wholly beyond the radius.
-#[allow(clippy::too_many_arguments)]
-fn sample_tile(
-    sea: &impl SurfaceSampler,
-    time_s: f64,
-    level: f32,
-    foci: &[[f32; 2]],
-    spec: &SurfaceSpec,
-    tx: f32,
-    ty: f32,
+/// Complex number `(re, im)`.
+type C64 = (f64, f64);
+
+#[inline(always)]
+fn cmul(a: C64, b: C64) -> C64 {
+    (a.0 * b.0 - a.1 * b.1, a.0 * b.1 + a.1 * b.0)
+}
+
+#[inline(always)]
+fn cis(x: f64) -> C64 {
+    let (s, c) = x.sin_cos();
+    (c, s)
+}
+
+/// The phasor tables of one frame (see the module docs): per component `a e^{iψ}` at each tile column's corner
+/// on the rectangle's bottom edge, the rotation to each tile row, and per level the rotation per node step.
+struct Phasors<'a> {
+    comps: &'a [WaveComponent],
+    x0: f32,
+    y0: f32,
     tile_m: f32,
-) -> Result<Tile> {
-    let half = 0.5 * tile_m;
-    let dc = nearest(foci, tx + half, ty + half);
-    if dc - std::f32::consts::SQRT_2 * half >= spec.radius_m {
-        return Ok(Tile::default());
-    }
-    let lvl = if dc <= spec.near_m { 0 } else { ((dc / spec.near_m).log2().ceil() as u32).min(MAX_LEVEL) };
-    let n = TILE_CELLS >> lvl;
-    let w = n + 1;
-    let (eta, sx, sy) = sea.sample_grid(f64::from(tx), f64::from(ty), f64::from(tile_m) / n as f64, w, time_s)?;
-    let mut h = vec![0f32; w * w];
-    let mut g = vec![[0f32; 2]; w * w];
-    let (mut zmin, mut zmax) = (f32::INFINITY, f32::NEG_INFINITY);
-    let inner = spec.radius_m - spec.taper_m.max(0.0);
-    for j in 0..w {
-        for i in 0..w {
-            let (x, y) = (tx + i as f32 * tile_m / n as f32, ty + j as f32 * tile_m / n as f32);
-            let dn = nearest(foci, x, y);
-            let taper = if dn <= inner {
-                1.0
-            } else if dn >= spec.radius_m {
-                0.0
-            } else {
-                (spec.radius_m - dn) / (spec.radius_m - inner)
-            };
-            let k = j * w + i;
-            let z = level + eta[k] * taper;
-            h[k] = z;
-            g[k] = [sx[k] * taper, sy[k] * taper];
-            zmin = zmin.min(z);
-            zmax = zmax.max(z);
+    /// `[ix · ncomp + c]`: `a e^{iψ}` at `(x0 + ix · tile_m, y0)`.
+    col: Vec<C64>,
+    /// `[iy · ncomp + c]`: `e^{i ky iy tile_m}`.
+    row: Vec<C64>,
+    /// `[level · ncomp + c]`: `(e^{i kx d}, e^{i ky d})` for the node step `d` of that level.
+    step: Vec<(C64, C64)>,
+}
+
+impl<'a> Phasors<'a> {
+    fn new(comps: &'a [WaveComponent], t: f64, x0: f32, y0: f32, tile_m: f32, ntx: usize, nty: usize) -> Self {
+        let nc = comps.len();
+        let tm = f64::from(tile_m);
+        let mut col = vec![(0.0, 0.0); ntx * nc];
+        let mut row = vec![(0.0, 0.0); nty * nc];
+        let mut step = vec![((0.0, 0.0), (0.0, 0.0)); (MAX_LEVEL as usize + 1) * nc];
+        for (c, w) in comps.iter().enumerate() {
+            let base = cis(w.phase_at(f64::from(x0), f64::from(y0), t));
+            let (ex, ey) = (cis(w.kx * tm), cis(w.ky * tm));
+            let mut p = (w.amplitude_m * base.0, w.amplitude_m * base.1);
+            for ix in 0..ntx {
+                col[ix * nc + c] = p;
+                p = cmul(p, ex);
+            }
+            let mut q = (1.0, 0.0);
+            for iy in 0..nty {
+                row[iy * nc + c] = q;
+                q = cmul(q, ey);
+            }
+            for lvl in 0..=MAX_LEVEL as usize {
+                let d = tm / (TILE_CELLS >> lvl) as f64;
+                step[lvl * nc + c] = (cis(w.kx * d), cis(w.ky * d));
+            }
         }
+        Self { comps, x0, y0, tile_m, col, row, step }
     }
-    Ok(Tile { n, zmin, zmax, h, g })
+
+    /// Samples tile `(ix, iy)`: its level from the distance of its centre to the nearest focus, flat when wholly
+    /// beyond the radius.
+    fn tile(&self, ix: usize, iy: usize, level: f32, foci: &[[f32; 2]], spec: &SurfaceSpec) -> Tile {
+        let tile_m = self.tile_m;
+        let (tx, ty) = (self.x0 + ix as f32 * tile_m, self.y0 + iy as f32 * tile_m);
+        let half = 0.5 * tile_m;
+        let dc = nearest(foci, tx + half, ty + half);
+        if dc - std::f32::consts::SQRT_2 * half >= spec.radius_m {
+            return Tile::default();
+        }
+        let lvl = if dc <= spec.near_m { 0 } else { ((dc / spec.near_m).log2().ceil() as u32).min(MAX_LEVEL) };
+        let n = TILE_CELLS >> lvl;
+        let w = n + 1;
+        let nc = self.comps.len();
+        let mut eta = vec![0f32; w * w];
+        let mut sx = vec![0f32; w * w];
+        let mut sy = vec![0f32; w * w];
+        let (mut pr, mut pi) = (vec![0f32; w], vec![0f32; w]);
+        for (c, comp) in self.comps.iter().enumerate() {
+            let (stx, sty) = self.step[lvl as usize * nc + c];
+            let mut p = cmul(self.col[ix * nc + c], self.row[iy * nc + c]);
+            for i in 0..w {
+                pr[i] = p.0 as f32;
+                pi[i] = p.1 as f32;
+                p = cmul(p, stx);
+            }
+            let (kx, ky) = (comp.kx as f32, comp.ky as f32);
+            let mut q: C64 = (1.0, 0.0);
+            for j in 0..w {
+                let (fr, fi) = (q.0 as f32, q.1 as f32);
+                let rows = j * w..(j + 1) * w;
+                let (e, gx, gy) = (&mut eta[rows.clone()], &mut sx[rows.clone()], &mut sy[rows]);
+                let (a, b) = (&pr[..w], &pi[..w]);
+                for i in 0..w {
+                    let re = a[i] * fr - b[i] * fi;
+                    let im = a[i] * fi + b[i] * fr;
+                    e[i] += re;
+                    gx[i] -= kx * im;
+                    gy[i] -= ky * im;
+                }
+                q = cmul(q, sty);
+            }
+        }
+        let mut h = vec![0f32; w * w];
+        let mut g = vec![[0f32; 2]; w * w];
+        let (mut zmin, mut zmax) = (f32::INFINITY, f32::NEG_INFINITY);
+        let inner = spec.radius_m - spec.taper_m.max(0.0);
+        // Every node within `inner` of a focus is untapered: no distances when the whole tile is.
+        let all_inner = dc + std::f32::consts::SQRT_2 * half <= inner;
+        for j in 0..w {
+            for i in 0..w {
+                let k = j * w + i;
+                let taper = if all_inner {
+                    1.0
+                } else {
+                    let (x, y) = (tx + i as f32 * tile_m / n as f32, ty + j as f32 * tile_m / n as f32);
+                    let dn = nearest(foci, x, y);
+                    if dn <= inner {
+                        1.0
+                    } else if dn >= spec.radius_m {
+                        0.0
+                    } else {
+                        (spec.radius_m - dn) / (spec.radius_m - inner)
+                    }
+                };
+                let z = level + eta[k] * taper;
+                h[k] = z;
+                g[k] = [sx[k] * taper, sy[k] * taper];
+                zmin = zmin.min(z);
+                zmax = zmax.max(z);
+            }
+        }
+        Tile { n, zmin, zmax, h, g }
+    }
 }
 
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
 
-    /// A sum of cosines `[a, kx, ky, ω, φ]`, evaluated point by point (the independent reference).
-    pub(crate) struct Cosines(pub(crate) Vec<[f64; 5]>);
-
-    impl SurfaceSampler for Cosines {
-        fn sample_grid(&self, x0: f64, y0: f64, dx: f64, n: usize, t: f64) -> Result<(Vec<f32>, Vec<f32>, Vec<f32>)> {
-            let mut out = (vec![0f32; n * n], vec![0f32; n * n], vec![0f32; n * n]);
-            for j in 0..n {
-                for i in 0..n {
-                    let (x, y) = (x0 + i as f64 * dx, y0 + j as f64 * dx);
-                    let (mut h, mut gx, mut gy) = (0.0, 0.0, 0.0);
-                    for &[a, kx, ky, w, p] in &self.0 {
-                        let (s, c) = (kx * x + ky * y - w * t + p).sin_cos();
-                        h += a * c;
-                        gx -= a * kx * s;
-                        gy -= a * ky * s;
-                    }
-                    out.0[j * n + i] = h as f32;
-                    out.1[j * n + i] = gx as f32;
-                    out.2[j * n + i] = gy as f32;
-                }
-            }
-            Ok(out)
+    /// A wave component `a cos(kx x + ky y − ω t + φ)` (the derived fields filled in).
+    pub(crate) fn comp(a: f64, kx: f64, ky: f64, omega: f64, phase: f64) -> WaveComponent {
+        WaveComponent {
+            amplitude_m: a,
+            omega_rad_s: omega,
+            k_rad_m: kx.hypot(ky),
+            direction_rad: ky.atan2(kx),
+            phase_rad: phase,
+            kx,
+            ky,
         }
     }
 
     /// A small irregular sea: eight components over directions and wavelengths 12..80 m, amplitudes summing
     /// to 1.6 m.
-    pub(crate) fn test_sea() -> Cosines {
-        Cosines(
-            (0..8)
-                .map(|i| {
-                    let k = std::f64::consts::TAU / (12.0 + 9.5 * i as f64);
-                    let dir = 0.4 + 0.37 * i as f64;
-                    [0.2, k * dir.cos(), k * dir.sin(), (9.81 * k).sqrt(), 1.3 * i as f64]
-                })
-                .collect(),
-        )
+    pub(crate) fn test_sea() -> Vec<WaveComponent> {
+        (0..8)
+            .map(|i| {
+                let k = std::f64::consts::TAU / (12.0 + 9.5 * i as f64);
+                let dir = 0.4 + 0.37 * i as f64;
+                comp(0.2, k * dir.cos(), k * dir.sin(), (9.81 * k).sqrt(), 1.3 * i as f64)
+            })
+            .collect()
     }
 
-    fn eta(c: &Cosines, x: f64, y: f64, t: f64) -> f64 {
-        c.0.iter().map(|w| w[0] * (w[1] * x + w[2] * y - w[3] * t + w[4]).cos()).sum()
+    /// The elevation summed point by point (the independent reference).
+    fn eta(c: &[WaveComponent], x: f64, y: f64, t: f64) -> f64 {
+        c.iter().map(|w| w.amplitude_m * (w.kx * x + w.ky * y - w.omega_rad_s * t + w.phase_rad).cos()).sum()
     }
 
-    fn surface(sea: &impl SurfaceSampler, t: f64, foci: &[[f32; 2]], spec: SurfaceSpec) -> WaveSurface {
-        WaveSurface::new(sea, t, 0.0, foci, spec).unwrap_or_else(|e| unreachable!("{e}"))
+    fn surface(sea: &[WaveComponent], t: f64, foci: &[[f32; 2]], spec: SurfaceSpec) -> WaveSurface {
+        WaveSurface::new(sea, t, 0.0, foci, spec)
     }
 
     #[test]
@@ -646,8 +718,7 @@ pub(crate) mod tests {
                     }
                     let e = eta(&c, x, y, 12.5);
                     assert!((f64::from(tile.h[j * w + i]) - e).abs() < 2e-4, "tile {k} node {i},{j}");
-                    let gx: f64 =
-                        c.0.iter().map(|w| -w[0] * w[1] * (w[1] * x + w[2] * y - w[3] * 12.5 + w[4]).sin()).sum();
+                    let gx: f64 = c.iter().map(|w| -w.amplitude_m * w.kx * w.phase_at(x, y, 12.5).sin()).sum();
                     assert!((f64::from(tile.g[j * w + i][0]) - gx).abs() < 2e-4);
                     checked += 1;
                 }
@@ -682,6 +753,38 @@ pub(crate) mod tests {
             fa = fb;
         }
         None
+    }
+
+    /// The tiles of a real wave field against the field's own row-recurrence grid over each tile.
+    #[test]
+    fn field_tiles_match_the_fields_own_grids() {
+        use crate::ocean::{SeaSpec, WaveField};
+        let spec = SeaSpec { hs: 3.5, tp: 9.0, gamma: 3.3, direction_rad: 0.7, spread_s: 8.0 };
+        let f = WaveField::new(&spec, 77).unwrap_or_else(|e| unreachable!("{e}"));
+        let foci = [[-1234.5f32, 877.25]];
+        let spec = SurfaceSpec { radius_m: 500.0, taper_m: 0.0, ..SurfaceSpec::default() };
+        let s = WaveSurface::new(f.components(), 41.3, 0.0, &foci, spec);
+        let mut levels = [0usize; 6];
+        for (k, tile) in s.tiles.iter().enumerate() {
+            if tile.n == 0 {
+                continue;
+            }
+            levels[(TILE_CELLS / tile.n).trailing_zeros() as usize] += 1;
+            let (ix, iy) = (k % s.ntx, k / s.ntx);
+            let (x0, y0) = (f64::from(s.x0 + ix as f32 * s.tile_m), f64::from(s.y0 + iy as f32 * s.tile_m));
+            let w = tile.n + 1;
+            let dx = f64::from(s.tile_m) / tile.n as f64;
+            let (h, gx, gy) = f.elevation_slope_grid(x0, y0, dx, w, w, 41.3).unwrap_or_else(|e| unreachable!("{e}"));
+            for q in 0..w * w {
+                let (xq, yq) = (x0 + (q % w) as f64 * dx, y0 + (q / w) as f64 * dx);
+                if nearest(&foci, xq as f32, yq as f32) >= spec.radius_m {
+                    continue; // still water beyond the radius
+                }
+                assert!((tile.h[q] - h[q]).abs() < 1e-4, "tile {k} node {q}: {} vs {}", tile.h[q], h[q]);
+                assert!((tile.g[q][0] - gx[q]).abs() < 1e-4 && (tile.g[q][1] - gy[q]).abs() < 1e-4);
+            }
+        }
+        assert!(levels[..5].iter().all(|&c| c > 0), "every level sampled: {levels:?}");
     }
 
     #[test]
@@ -730,7 +833,7 @@ pub(crate) mod tests {
         // One long-crested swell along x, 1 m amplitude, 60 m long (crests at x = 0, 60, 120 m): from 1.2 m
         // above the still level looking along x at a point 0.3 m above it 150 m away, the crest at 60 m hides it.
         let k = std::f64::consts::TAU / 60.0;
-        let s = surface(&Cosines(vec![[1.0, k, 0.0, 0.0, 0.0]]), 0.0, &[[0.0, 0.0]], SurfaceSpec::default());
+        let s = surface(&[comp(1.0, k, 0.0, 0.0, 0.0)], 0.0, &[[0.0, 0.0]], SurfaceSpec::default());
         let o = [0.0, 0.0, 1.2];
         let target = [150.0f32, 0.0, 0.3];
         let dv = [target[0] - o[0], target[1] - o[1], target[2] - o[2]];
@@ -749,9 +852,9 @@ pub(crate) mod tests {
     #[test]
     fn normals_face_up_and_follow_the_slope() {
         let k = std::f64::consts::TAU / 40.0;
-        let s = surface(&Cosines(vec![[0.8, k, 0.0, 0.0, 0.0]]), 0.0, &[[0.0, 0.0]], SurfaceSpec::default());
+        let s = surface(&[comp(0.8, k, 0.0, 0.0, 0.0)], 0.0, &[[0.0, 0.0]], SurfaceSpec::default());
         // At x = 10 m (a quarter wave) the slope is −a k: the normal leans towards +x.
-        let n = s.shading_normal(10.0, 3.0);
+        let n = s.shading_normal(10.0, 3.0).unwrap_or_default();
         let want = (0.8 * k) as f32;
         assert!((n[0] / n[2] - want).abs() < 1e-3, "{n:?}");
         let h = s.intersect([10.0, 3.0, 5.0], [0.0, 0.0, -1.0], 10.0).unwrap();

@@ -358,8 +358,8 @@ impl Shader {
     pub fn with_swell(&self, d: Vec3, mut hit: SurfaceHit) -> SurfaceHit {
         hit.shading_normal = hit.normal;
         if hit.is_water() {
-            let n = match &self.waves {
-                Some(w) => Vec3::from_array(w.shading_normal(hit.point.x, hit.point.y)),
+            let n = match self.waves.as_ref().and_then(|w| w.shading_normal(hit.point.x, hit.point.y)) {
+                Some(n) => Vec3::from_array(n),
                 None => self.water_normal(hit.point),
             };
             if n.dot(d) <= 0.0 {
