@@ -145,7 +145,8 @@ class SilhouetteCache:
 
     def hits(self, asset: str, pose: np.ndarray, origins: np.ndarray, directions: np.ndarray) -> np.ndarray:
         """``(N,)`` bool: which rays hit the vessel ``asset`` at ``pose`` (body → world), alone in the world."""
-        return np.isfinite(self.distances(asset, pose, origins, directions))
+        hit: np.ndarray = np.isfinite(self.distances(asset, pose, origins, directions))
+        return hit
 
     def distances(self, asset: str, pose: np.ndarray, origins: np.ndarray, directions: np.ndarray) -> np.ndarray:
         """``(N,)`` float32 distance (metres along each normalised direction) at which each ray meets the vessel

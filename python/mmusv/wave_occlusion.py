@@ -60,7 +60,7 @@ def exposed_hidden(
         return n, 0
     if scene_instance is None:
         hits = scene.cast_rays(o[exposed].astype(np.float32), d[exposed].astype(np.float32))
-        first = hits.instance
+        first = hits.instance_id
     else:
         first = np.asarray(scene_instance)[exposed]
     return n, int(np.count_nonzero(first == water))
@@ -87,4 +87,3 @@ def lidar_box_rays(
     dirs = (p[keep] @ lidar_pose[:3, :3].T).astype(np.float32)
     origins = np.tile(lidar_pose[:3, 3].astype(np.float32), (dirs.shape[0], 1))
     return origins, dirs
-

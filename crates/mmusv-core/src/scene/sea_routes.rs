@@ -137,6 +137,7 @@ impl Scene {
     /// (the height map walk over at most [`SEA_WALK_LIFT`] cells). Without waves, or from above the bound, the
     /// origin as it is.
     #[inline(always)]
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > b)` on purpose: a NaN must answer "not known"
     fn lift_over_waves(&self, sea: &crate::sea::Sea, o: [f32; 3], d: [f32; 3], limit: f32) -> Lift {
         let mut top = sea.surface_top();
         if o[2] > top {
@@ -169,6 +170,7 @@ impl Scene {
     }
 
     #[inline(always)]
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > b)` on purpose: a NaN must answer "not clear"
     fn sea_clear_within(&self, ray: &RayPrep, limit: f32, max_cells: usize) -> bool {
         let Some(sea) = &self.sea else { return false };
         if !(ray.d[2] > 0.0) {

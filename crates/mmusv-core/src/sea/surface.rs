@@ -269,6 +269,7 @@ impl WaveSurface {
     /// sees — are not occluded by the waves (no wave self-shadowing; the capillary slopes' shading stands in for
     /// it), which the scene applies to every such ray alike, so its shortcuts stay exact.
     #[inline]
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > b)` on purpose: a NaN must answer "no"
     pub fn leaves(&self, o: [f32; 3], d: [f32; 3]) -> bool {
         if !(d[2] > 0.0) || o[2] > self.zmax + SKIN_M || o[2] < self.zmin {
             return false;
@@ -839,13 +840,13 @@ pub(crate) mod tests {
         let dv = [target[0] - o[0], target[1] - o[1], target[2] - o[2]];
         let len = (dv[0] * dv[0] + dv[2] * dv[2]).sqrt();
         let d = [dv[0] / len, 0.0, dv[2] / len];
-        let h = s.intersect(o, d, len).expect("the crest at x = 60 m hides the target");
+        let Some(h) = s.intersect(o, d, len) else { panic!("the crest at x = 60 m hides the target") };
         let x = o[0] + d[0] * h.t;
         assert!((45.0..=60.0).contains(&x), "hit at x = {x}");
         // A ray above every crest meets nothing, whatever its length.
         assert!(s.intersect([0.0, 0.0, 1.2], [1.0, 0.0, 0.0], 1e6).is_none());
         // The flat beyond the radius: a ray down far away meets the still level.
-        let far = s.intersect([5000.0, 0.0, 10.0], [0.0, 0.0, -1.0], 100.0).expect("still water");
+        let Some(far) = s.intersect([5000.0, 0.0, 10.0], [0.0, 0.0, -1.0], 100.0) else { panic!("still water") };
         assert!((far.t - 10.0).abs() < 1e-4 && far.piece == FLAT_PIECE);
     }
 
@@ -857,7 +858,7 @@ pub(crate) mod tests {
         let n = s.shading_normal(10.0, 3.0).unwrap_or_default();
         let want = (0.8 * k) as f32;
         assert!((n[0] / n[2] - want).abs() < 1e-3, "{n:?}");
-        let h = s.intersect([10.0, 3.0, 5.0], [0.0, 0.0, -1.0], 10.0).unwrap();
+        let Some(h) = s.intersect([10.0, 3.0, 5.0], [0.0, 0.0, -1.0], 10.0) else { panic!("a ray straight down") };
         let g = s.piece_normal(h.piece);
         assert!(g[2] > 0.0 && (g[0] / g[2] - want).abs() < 0.01, "{g:?}");
     }
