@@ -13,7 +13,7 @@ from mmusv.scene import Scene
 from mmusv.sensors.config import LidarConfig
 from mmusv.sensors.env import sensor_env
 from mmusv.sensors.lidar import lidar_from_config, scan
-from mmusv.wave_occlusion import exposed_hidden, lidar_box_rays, share
+from mmusv.wave_occlusion import exposed_hidden, lidar_box_rays, pattern_angles, share
 
 
 @dataclass(frozen=True)
@@ -119,7 +119,7 @@ def test_flat_sea_hides_nothing_and_lidar_box_rays_cover_the_box() -> None:
     corners = np.array(
         [[150 + sx * 2.5, sy * 1.0, 0.2 + sz * 1.0] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]
     )
-    bo, bd = lidar_box_rays(pattern, pose, corners)
+    bo, bd = lidar_box_rays(pattern, pattern_angles(pattern), pose, corners)
     full = np.isfinite(alone.cast_rays(np.tile(pose[:3, 3], (len(pattern), 1)), pattern).distance).sum()
     assert full > 0 and np.isfinite(alone.cast_rays(bo, bd).distance).sum() == full
 

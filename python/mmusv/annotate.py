@@ -27,7 +27,7 @@ from scipy.spatial.transform import Rotation
 
 from mmusv.frames import BODY_TO_OPTICAL, translation
 from mmusv.scene import Scene
-from mmusv.wave_occlusion import exposed_hidden, lidar_box_rays, share
+from mmusv.wave_occlusion import exposed_hidden, lidar_box_rays, pattern_angles, share
 from mmusv.world.vessels import get_asset
 
 __all__ = ["Annotations", "SilhouetteCache", "annotate_agent", "box_corners", "in_target_range"]
@@ -210,6 +210,7 @@ def annotate_agent(
         lidar_pattern: ``(M, 3)`` float32 unit beam directions in the LiDAR frame (for the 3D boxes' share).
     """
     waves = scene is not None and scene.wave_top is not None
+    angles = pattern_angles(lidar_pattern) if waves and lidar_pattern is not None else None
     ann = Annotations(agent=agent_id, frame=frame, time_s=time_s)
     ref = lidar_pose if lidar_pose is not None else state.matrices[agent_index]
     ref_inv = np.linalg.inv(ref)
@@ -242,8 +243,8 @@ def annotate_agent(
             ann.lidar_role.append(info.role)
             ann.lidar_static.append(bool(info.static))
             wave = 0.0
-            if waves and scene is not None and lidar_pose is not None and lidar_pattern is not None:
-                o, d = lidar_box_rays(lidar_pattern, lidar_pose, box_corners(box_world, info.box_size))
+            if scene is not None and lidar_pose is not None and lidar_pattern is not None and angles is not None:
+                o, d = lidar_box_rays(lidar_pattern, angles, lidar_pose, box_corners(box_world, info.box_size))
                 t = silhouettes.distances(info.asset, state.matrices[vi], o, d)
                 wave = share(*exposed_hidden(scene, o, d, t))
             ann.lidar_wave_occlusion.append(wave)

@@ -292,9 +292,10 @@ class Simulation:
             self.ws.scene.set_wave_surface(None, scenario_seed=self.scenario.seed, time_s=0.0, foci=np.zeros((0, 2)))
         self._frame = None
 
-    def set_frame(self, frame: int) -> WorldState:
+    def set_frame(self, frame: int, *, sea_radius_m: float = 320.0) -> WorldState:
         """Moves every vessel to its pose at ``frame`` (and, over a physical sea, the water to its surface at the
-        frame time: :meth:`set_sea_surface`) and returns the world state."""
+        frame time, displaced out to ``sea_radius_m`` around every USV: :meth:`set_sea_surface`) and returns the
+        world state."""
         if not 0 <= frame < self.frames:
             raise ConfigError(f"frame {frame} is outside the acquisition (0..{self.frames - 1})")
         state = self.world_state(frame)
@@ -302,7 +303,9 @@ class Simulation:
         self.ws.scene.set_poses(self.ws.vessel_instances, state.matrices[:n])
         if self.sea is not None and "water" in self.ws.static_instances:
             foci = np.array([state.poses[a.index, :2] for a in self.agents], dtype=np.float32).reshape(-1, 2)
-            self.ws.scene.set_wave_surface(self.sea, scenario_seed=self.scenario.seed, time_s=state.time_s, foci=foci)
+            self.ws.scene.set_wave_surface(
+                self.sea, scenario_seed=self.scenario.seed, time_s=state.time_s, foci=foci, radius_m=sea_radius_m
+            )
         self._frame = frame
         return state
 
@@ -374,7 +377,11 @@ class Simulation:
             raise ConfigError(
                 f"unknown sensor kind(s) {sorted(kinds - set(SENSOR_KINDS))}; allowed: {', '.join(SENSOR_KINDS)}"
             )
-        state = self.set_frame(frame)
+        # The waves reach as far as the sensors look: a LiDAR-only capture needs them within its range only.
+        lidar_only = kinds <= {"lidar"}
+        ranges = [a.rig.lidar.range_m for a in self.agents if a.rig.lidar is not None]
+        radius = min(320.0, max(ranges) + 40.0) if lidar_only and ranges else 320.0
+        state = self.set_frame(frame, sea_radius_m=radius)
         sc = self.scenario
         out: dict[str, AgentCapture] = {}
         tasks: list[core._CaptureTask] = []

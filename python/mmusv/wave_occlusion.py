@@ -22,7 +22,7 @@ import numpy.typing as npt
 
 from mmusv.scene import Scene
 
-__all__ = ["exposed_hidden", "lidar_box_rays", "share"]
+__all__ = ["exposed_hidden", "lidar_box_rays", "pattern_angles", "share"]
 
 
 def share(exposed: int, hidden: int) -> float:
@@ -66,24 +66,34 @@ def exposed_hidden(
     return n, int(np.count_nonzero(first == water))
 
 
+def pattern_angles(pattern: npt.NDArray[np.float32]) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """``(azimuth, elevation)`` ``(M,)`` radians of a LiDAR's unit beam directions ``pattern`` ``(M, 3)`` (LiDAR
+    frame); compute once per LiDAR and pass to :func:`lidar_box_rays`."""
+    p = np.asarray(pattern, dtype=np.float64)
+    return np.arctan2(p[:, 1], p[:, 0]), np.arctan2(p[:, 2], np.hypot(p[:, 0], p[:, 1]))
+
+
 def lidar_box_rays(
-    pattern: npt.NDArray[np.float32], lidar_pose: npt.NDArray[np.float64], corners_world: npt.NDArray[np.float64]
+    pattern: npt.NDArray[np.float32],
+    angles: tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]],
+    lidar_pose: npt.NDArray[np.float64],
+    corners_world: npt.NDArray[np.float64],
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
     """The LiDAR's world rays ``(origins, directions)`` (each ``(K, 3)`` float32) whose direction lies within the
     azimuth and elevation extent of the box ``corners_world`` ``(8, 3)`` seen from the LiDAR at ``lidar_pose``
-    ``(4, 4)`` LiDAR → world; ``pattern`` ``(M, 3)`` unit directions in the LiDAR frame."""
+    ``(4, 4)`` LiDAR → world; ``pattern`` ``(M, 3)`` unit directions in the LiDAR frame, ``angles`` their
+    :func:`pattern_angles`."""
     inv = np.linalg.inv(lidar_pose)
     c = corners_world @ inv[:3, :3].T + inv[:3, 3]
     az = np.arctan2(c[:, 1], c[:, 0])
     el = np.arctan2(c[:, 2], np.hypot(c[:, 0], c[:, 1]))
-    p = np.asarray(pattern, dtype=np.float64)
-    paz = np.arctan2(p[:, 1], p[:, 0])
-    pel = np.arctan2(p[:, 2], np.hypot(p[:, 0], p[:, 1]))
+    paz, pel = angles
     # Azimuths relative to the box's mean direction, so a box straddling ±π is one interval.
     mid = np.arctan2(np.sin(az).mean(), np.cos(az).mean())
     rel = np.angle(np.exp(1j * (az - mid)))
-    prel = np.angle(np.exp(1j * (paz - mid)))
-    keep = (prel >= rel.min()) & (prel <= rel.max()) & (pel >= el.min()) & (pel <= el.max())
-    dirs = (p[keep] @ lidar_pose[:3, :3].T).astype(np.float32)
+    near = (pel >= el.min()) & (pel <= el.max())
+    prel = np.angle(np.exp(1j * (paz[near] - mid)))
+    idx = np.flatnonzero(near)[(prel >= rel.min()) & (prel <= rel.max())]
+    dirs = (np.asarray(pattern, dtype=np.float64)[idx] @ lidar_pose[:3, :3].T).astype(np.float32)
     origins = np.tile(lidar_pose[:3, 3].astype(np.float32), (dirs.shape[0], 1))
     return origins, dirs
