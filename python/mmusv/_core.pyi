@@ -27,14 +27,21 @@ __all__ = [
     "Recorder",
     "Scene",
     "SensorEnv",
+    "WaveField",
     "__version__",
     "_lidar_directions",
     "_pinhole_directions",
     "capture_frame",
     "default_amplitudes",
     "demo_scene",
+    "dnv_gamma",
+    "fully_developed",
+    "hull_rao",
     "lidar_trace_order",
     "pinhole_intrinsics",
+    "response_variance",
+    "sea_presets",
+    "sea_seed",
     "uniform_elevations",
     "wave_height",
     "wave_presets",
@@ -456,10 +463,16 @@ class Fleet:
         amplitudes: npt.NDArray[np.float64],
         seed: int,
         wave: str | float,
+        sea: WaveField | None = None,
+        hulls: npt.NDArray[np.float64] | None = None,
     ) -> Fleet:
         """Per vessel i: routes[i] (K,2) m, end_behaviours[i] in {stop, loop, ping_pong}, speeds (V,) m/s,
         start_offsets (V,) m, z_base (V,) m, dims (V,3) length/beam/height m, amplitudes (V,3) heave m/roll rad/pitch
-        rad."""
+        rad. With ``sea`` the vessels move physically (heave/roll/pitch through closed-form RAOs of ``hulls``, (V,5)
+        length, beam, draft m, block coefficient, GM m) instead of by the paper's formula."""
+    @property
+    def physical(self) -> bool:
+        """Whether the fleet moves physically in a wave field."""
     def __len__(self) -> int:
         """Number of vessels."""
     @property
@@ -484,6 +497,84 @@ def wave_height(wave: str | float) -> float:
 
 def wave_presets() -> list[tuple[str, float]]:
     """``[(name, H metres), ...]`` of the presets W0..W3 in order (the one definition of the presets)."""
+
+# --- ocean ---
+
+@final
+class WaveField:
+    """A seeded sum of linear deep-water waves realising a directional JONSWAP spectrum (world frame, z up, m, s)."""
+
+    def __new__(
+        cls, *, hs_m: float, tp_s: float, gamma: float, direction_rad: float, spread_s: float, seed: int
+    ) -> WaveField:
+        """Hs (m), Tp (s), peak enhancement γ, mean travel direction (rad), cos-2s exponent, seed."""
+    @property
+    def spec(self) -> tuple[float, float, float, float, float]:
+        """(hs_m, tp_s, gamma, direction_rad, spread_s)."""
+    @property
+    def seed(self) -> int:
+        """The seed of the components."""
+    @property
+    def max_elevation(self) -> float:
+        """Hard bound on |elevation| (m): the sum of the amplitudes."""
+    @property
+    def max_slope(self) -> float:
+        """Hard bound on the slope magnitude."""
+    def components(self) -> npt.NDArray[np.float64]:
+        """(N, 5) float64: amplitude m, ω rad/s, k rad/m, direction rad, phase rad."""
+    def elevation(self, x: npt.NDArray[np.float64], y: npt.NDArray[np.float64], t: float) -> npt.NDArray[np.float64]:
+        """(N,) float64 elevations (m) at (N,) world x, y (m), time t (s)."""
+    def slope(self, x: npt.NDArray[np.float64], y: npt.NDArray[np.float64], t: float) -> npt.NDArray[np.float64]:
+        """(N, 2) float64 slopes [dη/dx, dη/dy]."""
+    def orbital_velocity(self, points: npt.NDArray[np.float64], t: float) -> npt.NDArray[np.float64]:
+        """(N, 3) float64 orbital velocities (m/s) at (N, 3) world points (m)."""
+    def elevation_grid(self, *, x0: float, y0: float, dx: float, nx: int, ny: int, t: float) -> npt.NDArray[np.float32]:
+        """(ny, nx) float32 elevations (m); [j, i] at (x0 + i·dx, y0 + j·dx)."""
+    def hull_response(
+        self,
+        *,
+        hull: Sequence[float] | npt.NDArray[np.float64],
+        positions: npt.NDArray[np.float64],
+        yaw: npt.NDArray[np.float64],
+        velocities: npt.NDArray[np.float64],
+        times: npt.NDArray[np.float64],
+    ) -> npt.NDArray[np.float64]:
+        """(T, 3) float64 [heave m, roll rad, pitch rad] of a hull [length, beam, draft, Cb, GM] at (T, 2) positions,
+        (T,) headings, (T, 2) velocities and (T,) times; GIL released."""
+
+def sea_seed(scenario_seed: int) -> int:
+    """The seed of a scenario's wave field."""
+
+def sea_presets() -> list[tuple[str, str, float, float, float, float]]:
+    """[(name, description, hs_m, tp_s, gamma, wind_mps), ...]: WMO codes "0".."9", then "W0".."W3"."""
+
+def fully_developed(hs_m: float) -> tuple[float, float]:
+    """(tp_s, wind_mps) of a fully developed Pierson–Moskowitz sea."""
+
+def dnv_gamma(hs_m: float, tp_s: float) -> float:
+    """DNV-RP-C205 peak enhancement for Hs, Tp."""
+
+def hull_rao(
+    *,
+    hull: Sequence[float] | npt.NDArray[np.float64],
+    omega: npt.NDArray[np.float64],
+    beta: npt.NDArray[np.float64],
+    omega_e: npt.NDArray[np.float64],
+) -> npt.NDArray[np.complex128]:
+    """(N, 3) complex128 RAOs (heave m/m, roll rad/m, pitch rad/m)."""
+
+def response_variance(
+    *,
+    hull: Sequence[float] | npt.NDArray[np.float64],
+    hs_m: float,
+    tp_s: float,
+    gamma: float,
+    direction_rad: float,
+    spread_s: float,
+    yaw: float,
+    speed_mps: float,
+) -> tuple[float, float, float]:
+    """Spectral prediction (heave m², roll rad², pitch rad²)."""
 
 # --- record ---
 

@@ -19,6 +19,8 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from rich.console import Console
 
+    from mmusv.config import Scenario
+
 from mmusv.errors import MmusvError
 
 BUNDLED_WAVE_SCENARIO = "scenarios/island_port_waves.yaml"
@@ -73,6 +75,8 @@ def _cmd_study_waves(args: argparse.Namespace) -> int:
         scenario = scenario.model_copy(
             update={"acquisition": scenario.acquisition.model_copy(update={"frames": args.frames})}
         )
+    if args.motion == "physical":
+        return _print_physical_wave_study(scenario, args)
     study = run_wave_study(scenario)
     table = Table(
         title=f"Wave study on {scenario.name} ({study.table['usvs'][0]} USVs × {study.table['frames'][0]} frames)"
@@ -92,6 +96,61 @@ def _cmd_study_waves(args: argparse.Namespace) -> int:
     console.print("R² of a linear fit in H: " + ", ".join(f"{k} {v:.4f}" for k, v in study.r2.items()))
     paths = study.write(Path(args.output))
     console.print(f"wrote {paths['csv']} and {paths['png']}")
+    return 0
+
+
+def _print_physical_wave_study(scenario: Scenario, args: argparse.Namespace) -> int:
+    from rich.table import Table
+
+    from mmusv.studies.waves import run_physical_wave_study
+
+    study = run_physical_wave_study(scenario, record_s=None if args.frames is not None else 1200.0)
+    s = study.summary
+    frames, hz = int(s["frames"][0]), scenario.acquisition.frequency_hz
+    table = Table(
+        title=f"Wave study, physical motion, on {scenario.name}: USVs pooled, {frames} frames ({frames / hz:.0f} s) "
+        "per sea state; heave m / roll ° / pitch ° RMS"
+    )
+    for col in ("wave", "Hs (m)", "Tp (s)", "paper Table I", "paper mode", "physical (USVs)", "physical (fleet)"):
+        table.add_column(col, justify="right")
+
+    def trio(r: dict[str, object], prefix: str) -> str:
+        return (
+            f"{r[prefix + '_heave_rms_m']:.3f} / {r[prefix + '_roll_rms_deg']:.2f} / {r[prefix + '_pitch_rms_deg']:.2f}"
+        )
+
+    for r in s.iter_rows(named=True):
+        table.add_row(
+            str(r["wave"]),
+            f"{r['Hs_m']:.1f}",
+            f"{r['Tp_s']:.1f}",
+            trio(r, "table1"),
+            trio(r, "paper"),
+            trio(r, "physical"),
+            trio(r, "fleet"),
+        )
+    console = _console()
+    console.print(table)
+    per = Table(title="Physical motion per vessel: heave m / roll ° / pitch ° RMS")
+    per.add_column("vessel")
+    per.add_column("asset")
+    waves = s["wave"].to_list()
+    for w in waves:
+        per.add_column(str(w), justify="right")
+    v = study.vessels
+    for vid in v["id"].unique(maintain_order=True).to_list():
+        rows = v.filter(v["id"] == vid)
+        cells = [
+            f"{r['heave_rms_m']:.3f} / {r['roll_rms_deg']:.2f} / {r['pitch_rms_deg']:.2f}"
+            for r in rows.iter_rows(named=True)
+        ]
+        per.add_row(str(vid), str(rows["asset"][0]), *cells)
+    console.print(per)
+    mono = study.monotonic()
+    rising = sorted(k for k, ok in mono.items() if ok)
+    console.print(f"all three RMS rise with the sea state for {len(rising)} of {len(mono)} vessels")
+    paths = study.write(Path(args.output))
+    console.print(f"wrote {paths['summary']} and {paths['vessels']}")
     return 0
 
 
@@ -335,6 +394,12 @@ def _parser() -> argparse.ArgumentParser:
     )
     waves.add_argument("-o", "--output", default="out/wave_study", help="output folder for CSV and plot")
     waves.add_argument("--frames", type=int, default=None, help="override the scenario's frame count")
+    waves.add_argument(
+        "--motion",
+        choices=("paper", "physical"),
+        default="paper",
+        help="paper: Table I with the paper's formula (default); physical: every hull's response to the sea",
+    )
     agree = studies.add_parser("agreement", help="Table II: 3D-box annotations vs top-view semantic rendering")
     agree.add_argument("scenarios", nargs="*", help="scenario YAMLs (default: the three bundled map scenarios)")
     agree.add_argument("-o", "--output", default="out/agreement_study", help="output folder")

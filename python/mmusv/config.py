@@ -23,6 +23,7 @@ import hashlib
 import json
 import math
 import os
+from dataclasses import replace
 from typing import Any, Literal
 
 from pydantic import (
@@ -40,6 +41,7 @@ from pydantic import (
 from mmusv.errors import ConfigError, MmusvError, located
 from mmusv.sensors.config import RigConfig
 from mmusv.world.environment import Environment, wave_height_m
+from mmusv.world.sea_state import SeaSpec
 from mmusv.world.map_params import PARAM_MODELS, IslandParams, MapParams
 from mmusv.world.vessels import get_asset, known_asset
 from mmusv.yamlio import mapping_source
@@ -49,6 +51,7 @@ __all__ = [
     "EnvironmentConfig",
     "MapConfig",
     "Scenario",
+    "SeaConfig",
     "VesselConfig",
     "load_scenario",
     "scenario_hash",
@@ -92,8 +95,51 @@ class MapConfig(_Model):
         return dict(sorted(self.params.model_dump(mode="json", exclude_unset=True).items()))
 
 
+class SeaConfig(_Model):
+    """The physical sea (:mod:`mmusv.world.sea_state`): either a WMO sea ``state`` 0..9 (Douglas scale, fully
+    developed), or a significant height ``hs_m`` with optional peak period ``tp_s`` (default: fully developed,
+    Pierson–Moskowitz) and peak enhancement ``gamma`` (default: 1 when fully developed, else DNV-RP-C205's value
+    for Tp/√Hs); plus the waves' travel direction ``direction_deg`` (counter-clockwise from east, towards) and the
+    cos-2s spreading ``spread_s`` (10: a wind sea; larger is longer-crested)."""
+
+    state: int | None = Field(default=None, ge=0, le=9)
+    hs_m: float | None = Field(default=None, ge=0, le=25)
+    tp_s: float | None = Field(default=None, ge=0.5, le=30)
+    gamma: float | None = Field(default=None, ge=1, le=7)
+    direction_deg: float = 0.0
+    spread_s: float = Field(default=10.0, ge=0.5, le=100)
+
+    @model_validator(mode="after")
+    def _one_height(self) -> SeaConfig:
+        if (self.state is None) == (self.hs_m is None):
+            raise ValueError("environment.sea: give either `state` (WMO sea state 0..9) or `hs_m` (metres), not both")
+        if self.state is not None and self.tp_s is not None:
+            raise ValueError("environment.sea: `tp_s` goes with `hs_m`; a WMO `state` is a fully developed sea")
+        self.spec()  # the core checks the steepness and the ranges together
+        return self
+
+    def spec(self) -> SeaSpec:
+        """The resolved sea."""
+        from mmusv.world.sea_state import sea_spec_for_height, sea_spec_for_preset
+
+        if self.state is not None:
+            p = sea_spec_for_preset(str(self.state), direction_deg=self.direction_deg, spread_s=self.spread_s)
+            return p if self.gamma is None else replace(p, gamma=self.gamma)
+        assert self.hs_m is not None
+        spec = sea_spec_for_height(
+            self.hs_m, tp_s=self.tp_s, gamma=self.gamma, direction_deg=self.direction_deg, spread_s=self.spread_s
+        )
+        try:
+            spec.field(scenario_seed=0)
+        except MmusvError as exc:
+            raise ValueError(f"environment.sea: {exc}") from None
+        return spec
+
+
 class EnvironmentConfig(_Model):
-    """Time of day (``"HH:MM"``), weather, visibility, rain and the wave setting (``W0``..``W3`` or metres)."""
+    """Time of day (``"HH:MM"``), weather, visibility, rain, the wave setting (``W0``..``W3`` or metres), the
+    physical ``sea`` (optional; else it follows ``wave``) and the vessels' ``motion``: ``physical`` (default: each
+    hull's response to the sea through its RAOs) or ``paper`` (the paper's formula, driven by ``wave``)."""
 
     time_of_day: str = "12:00"
     weather: Literal["clear", "overcast", "fog", "rain"] = "clear"
@@ -102,6 +148,8 @@ class EnvironmentConfig(_Model):
     wave: str | float = "W0"
     latitude_deg: float = Field(default=45.0, ge=-90, le=90)
     day_of_year: int = Field(default=172, ge=1, le=366)
+    sea: SeaConfig | None = None
+    motion: Literal["physical", "paper"] = "physical"
 
     @field_validator("time_of_day")
     @classmethod
@@ -122,7 +170,18 @@ class EnvironmentConfig(_Model):
 
     def resolve(self) -> Environment:
         """The resolved :class:`~mmusv.world.environment.Environment` (sun, weather, wave height)."""
-        return Environment.make(**self.model_dump())
+        return Environment.make(**self.model_dump(exclude={"sea", "motion"}))
+
+    def sea_spec(self) -> SeaSpec:
+        """The physical sea: ``sea`` when given, else the fully developed sea of ``wave`` (a preset W0..W3 or
+        Hs in metres)."""
+        from mmusv.world.sea_state import sea_spec_for_height, sea_spec_for_preset
+
+        if self.sea is not None:
+            return self.sea.spec()
+        if isinstance(self.wave, str):
+            return sea_spec_for_preset(self.wave)
+        return sea_spec_for_height(float(self.wave))
 
 
 class AcquisitionConfig(_Model):
@@ -211,6 +270,13 @@ class Scenario(_Model):
         """A copy with another wave setting (everything else unchanged)."""
         env = self.environment.model_copy(update={"wave": EnvironmentConfig._wave(wave)})
         return self.model_copy(update={"environment": env})
+
+    def with_sea(self, sea: SeaConfig | None, *, motion: Literal["physical", "paper"] | None = None) -> Scenario:
+        """A copy with another physical sea (``None``: the sea of ``wave``) and optionally another ``motion``."""
+        update: dict[str, Any] = {"sea": sea}
+        if motion is not None:
+            update["motion"] = motion
+        return self.model_copy(update={"environment": self.environment.model_copy(update=update)})
 
 
 def _check_mount_points(v: VesselConfig, index: int, rig_name: str, rig: RigConfig) -> None:

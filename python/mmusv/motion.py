@@ -1,7 +1,10 @@
-"""Vessel motion for a scenario: the Rust fleet (spline routes + wave perturbations) built from the config.
+"""Vessel motion for a scenario: the Rust fleet (spline routes + wave motion) built from the config.
 
-Poses are ``η = [x, y, z, roll, pitch, yaw]`` in the world frame (metres, radians), equation 4 of the paper;
-the vessel size factor α_v uses each asset's bounding box (length, beam, height).
+Poses are ``η = [x, y, z, roll, pitch, yaw]`` in the world frame (metres, radians), equation 4 of the paper.
+Heave, roll and pitch come, with ``environment.motion: physical`` (the default), from each hull's response to the
+scenario's wave field (closed-form RAOs from the asset's length, beam, draft, block coefficient and GM:
+:mod:`mmusv.world.hydrostatics`, :mod:`mmusv.world.sea_state`); with ``motion: paper``, from the paper's formula
+``S_wave(H)·α_v·r·g(t)`` (the vessel size factor α_v from each asset's bounding box: length, beam, height).
 """
 
 from __future__ import annotations
@@ -13,6 +16,7 @@ import numpy.typing as npt
 
 from mmusv._native import core
 from mmusv.config import Scenario
+from mmusv.world.hydrostatics import hull_particulars
 from mmusv.world.vessels import get_asset
 
 __all__ = ["build_fleet", "scenario_poses"]
@@ -20,10 +24,17 @@ __all__ = ["build_fleet", "scenario_poses"]
 
 def build_fleet(scenario: Scenario, *, wave: str | float | None = None) -> Any:
     """The ``mmusv._core.Fleet`` of ``scenario`` (vessel ``i`` = ``scenario.vessels[i]``), optionally with another
-    wave setting. Wave phases and frequencies come from ``scenario.seed``."""
+    wave setting (``wave`` drives the paper's formula, and the physical sea when ``environment.sea`` is not set).
+    Wave phases and frequencies come from ``scenario.seed``."""
     vessels = scenario.vessels
-    dims = np.array([[a.length, a.beam, a.height] for a in (get_asset(v.asset) for v in vessels)], dtype=np.float64)
+    assets = [get_asset(v.asset) for v in vessels]
+    dims = np.array([[a.length, a.beam, a.height] for a in assets], dtype=np.float64)
     amps = np.tile(np.array(core.default_amplitudes(), dtype=np.float64), (len(vessels), 1))
+    env = scenario.environment if wave is None else scenario.with_wave(wave).environment
+    physical: dict[str, Any] = {}
+    if env.motion == "physical":
+        physical["sea"] = env.sea_spec().field(scenario_seed=scenario.seed)
+        physical["hulls"] = np.array([hull_particulars(a) for a in assets], dtype=np.float64).reshape(-1, 5)
     return core.Fleet(
         routes=[np.ascontiguousarray(v.route, dtype=np.float64) for v in vessels],
         end_behaviours=[v.end for v in vessels],
@@ -33,7 +44,8 @@ def build_fleet(scenario: Scenario, *, wave: str | float | None = None) -> Any:
         dims=dims,
         amplitudes=amps,
         seed=scenario.seed,
-        wave=scenario.environment.wave if wave is None else wave,
+        wave=env.wave,
+        **physical,
     )
 
 

@@ -2,14 +2,16 @@
 
 use crate::errors::{to_py, InputError};
 use crate::native::{detached, flat, rows, rows_to_array};
+use crate::ocean::{hull_from, WaveField};
 use mmusv_core::kinematics::{
     BaseAmplitudes, EndBehaviour, Fleet as CoreFleet, Route, VesselDims, VesselMotion, VesselParams, WaveSetting,
-    WaveSignals,
+    WaveSignals, REFERENCE_HULL,
 };
 use mmusv_core::MmusvError;
 use numpy::ndarray::Array3;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
+use std::sync::Arc;
 
 /// Parses a wave setting: a preset name `"W0".."W3"` or a significant wave height in metres.
 fn wave_from(obj: &Bound<'_, PyAny>) -> PyResult<WaveSetting> {
@@ -34,7 +36,7 @@ impl Fleet {
     /// {"stop", "loop", "ping_pong"}, `speeds[i]` m/s, `start_offsets[i]` m along the route, `z_base[i]` m,
     /// `dims[i]` = (length, beam, height) m, `amplitudes[i]` = (heave m, roll rad, pitch rad).
     #[new]
-    #[pyo3(signature = (*, routes, end_behaviours, speeds, start_offsets, z_base, dims, amplitudes, seed, wave))]
+    #[pyo3(signature = (*, routes, end_behaviours, speeds, start_offsets, z_base, dims, amplitudes, seed, wave, sea=None, hulls=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         routes: Vec<PyReadonlyArray2<'_, f64>>,
@@ -46,6 +48,8 @@ impl Fleet {
         amplitudes: PyReadonlyArray2<'_, f64>,
         seed: u64,
         wave: &Bound<'_, PyAny>,
+        sea: Option<PyRef<'_, WaveField>>,
+        hulls: Option<PyReadonlyArray2<'_, f64>>,
     ) -> PyResult<Self> {
         let n = routes.len();
         let speeds = flat(&speeds, "speeds")?;
@@ -53,6 +57,23 @@ impl Fleet {
         let z = flat(&z_base, "z_base")?;
         let dims = rows::<f64, 3>(&dims, "dims")?;
         let amps = rows::<f64, 3>(&amplitudes, "amplitudes")?;
+        let hull_rows = match &hulls {
+            Some(h) => Some(rows::<f64, 5>(h, "hulls")?),
+            None if sea.is_some() => {
+                return Err(InputError::new_err(
+                    "a fleet in a sea needs hulls: (V, 5) [length, beam, draft, block_coefficient, gm] per vessel",
+                ))
+            }
+            None => None,
+        };
+        if let Some(h) = hull_rows {
+            if h.len() != n {
+                return Err(InputError::new_err(format!(
+                    "hulls has {} entries for {n} routes; give one per vessel",
+                    h.len()
+                )));
+            }
+        }
         for (name, len) in [
             ("end_behaviours", end_behaviours.len()),
             ("speeds", speeds.len()),
@@ -87,17 +108,28 @@ impl Fleet {
                     z_base_m: z[i],
                     dims: VesselDims { length_m: dims[i][0], beam_m: dims[i][1], height_m: dims[i][2] },
                     amplitudes: BaseAmplitudes { heave_m: amps[i][0], roll_rad: amps[i][1], pitch_rad: amps[i][2] },
+                    hull: match hull_rows {
+                        Some(h) => hull_from(&h[i])?,
+                        None => REFERENCE_HULL,
+                    },
                 };
                 VesselMotion::new(route, params, WaveSignals::from_seed(seed, i as u64))
             };
             vessels.push(build().map_err(|e| to_py(e.within(&prefix)))?);
         }
-        Ok(Self { inner: CoreFleet::new(vessels, wave) })
+        let fleet = CoreFleet::new(vessels, wave);
+        Ok(Self { inner: if let Some(s) = sea { fleet.with_sea(Arc::clone(&s.inner)) } else { fleet } })
     }
 
     /// Number of vessels.
     fn __len__(&self) -> usize {
         self.inner.len()
+    }
+
+    /// Whether the fleet moves physically in a wave field (else by the paper's formula).
+    #[getter]
+    fn physical(&self) -> bool {
+        self.inner.sea().is_some()
     }
 
     /// Wave height H in metres of the fleet's wave setting.

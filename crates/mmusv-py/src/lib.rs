@@ -11,6 +11,7 @@ mod demo;
 mod errors;
 mod kinematics;
 mod native;
+mod ocean;
 mod radar;
 mod record;
 mod scene;
@@ -23,6 +24,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     errors::register(m)?;
     scene::register(m)?;
     kinematics::register(m)?;
+    ocean::register(m)?;
     sensors::register(m)?;
     radar::register(m)?;
     capture::register(m)?;

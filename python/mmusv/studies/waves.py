@@ -3,12 +3,19 @@
 A controlled scenario, routes and sensors fixed, only the wave setting varied. Heave RMS is taken after removing
 each USV's mean height over the sequence; roll and pitch RMS are in degrees; all statistics pool every USV and
 every acquisition frame. A straight-line fit of each statistic against H gives R².
+
+``motion="paper"`` (the default, Table I as published) moves the vessels by the paper's formula. With
+``motion="physical"`` every vessel responds to the fully developed sea of each setting (Hs = H, Pierson–Moskowitz
+Tp; :mod:`mmusv.world.sea_state`) through its hull's RAOs; :func:`run_physical_wave_study` then reports, beside
+the paper's Table I (:data:`PAPER_TABLE_I`) and the paper mode, the RMS of the USVs and of every vessel of the
+mixed fleet, one row per vessel and sea state.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Literal
 
 import numpy as np
 import polars as pl
@@ -17,7 +24,15 @@ from mmusv.config import Scenario
 from mmusv.motion import scenario_poses
 from mmusv.world.environment import WAVE_PRESETS, wave_height_m
 
-__all__ = ["WaveStudy", "run_wave_study"]
+__all__ = ["PAPER_TABLE_I", "PhysicalWaveStudy", "WaveStudy", "run_physical_wave_study", "run_wave_study"]
+
+PAPER_TABLE_I: dict[str, tuple[float, float, float]] = {
+    "W0": (0.0274, 0.2054, 0.0684),
+    "W1": (0.0818, 0.6134, 0.2062),
+    "W2": (0.1379, 1.0345, 0.3395),
+    "W3": (0.1923, 1.4421, 0.4774),
+}
+"""The paper's Table I: (heave RMS m, roll RMS °, pitch RMS °) of its USVs under W0..W3."""
 
 
 @dataclass(frozen=True)
@@ -58,13 +73,25 @@ def _r2(x: np.ndarray, y: np.ndarray) -> float:
     return 1.0 - float(np.sum(resid**2)) / ss_tot if ss_tot > 0 else 1.0
 
 
-def run_wave_study(scenario: Scenario, *, waves: tuple[str | float, ...] = tuple(WAVE_PRESETS)) -> WaveStudy:
-    """Runs the study on ``scenario``'s USVs for each wave setting (names ``W0``.. or heights in metres)."""
+def _usv_indices(scenario: Scenario) -> list[int]:
     usv_idx = [i for i, v in enumerate(scenario.vessels) if v.role == "usv"]
     if not usv_idx:
         from mmusv.errors import ConfigError
 
         raise ConfigError("invalid config vessels: the wave study needs at least one vessel with role: usv")
+    return usv_idx
+
+
+def run_wave_study(
+    scenario: Scenario,
+    *,
+    waves: tuple[str | float, ...] = tuple(WAVE_PRESETS),
+    motion: Literal["paper", "physical"] = "paper",
+) -> WaveStudy:
+    """Runs the study on ``scenario``'s USVs for each wave setting (names ``W0``.. or heights in metres), with the
+    paper's motion formula (default) or the physical response to the fully developed sea of each setting."""
+    usv_idx = _usv_indices(scenario)
+    scenario = scenario.with_sea(None, motion=motion)
     rows = []
     for w in waves:
         poses = scenario_poses(scenario, wave=w)[:, usv_idx, :]
@@ -84,6 +111,110 @@ def run_wave_study(scenario: Scenario, *, waves: tuple[str | float, ...] = tuple
     h = table["H_m"].to_numpy()
     r2 = {k: _r2(h, table[k].to_numpy()) for k in ("heave_rms_m", "roll_rms_deg", "pitch_rms_deg")}
     return WaveStudy(table, r2)
+
+
+@dataclass(frozen=True)
+class PhysicalWaveStudy:
+    """Result of :func:`run_physical_wave_study`: ``summary`` (one row per setting: wave, Hs_m, Tp_s, the paper's
+    Table I, the paper mode and the physical mode for the USVs, and the physical mode pooled over the whole fleet)
+    and ``vessels`` (one row per setting and vessel: wave, id, asset, role, heave_rms_m, roll_rms_deg,
+    pitch_rms_deg), sorted by setting then vessel order."""
+
+    summary: pl.DataFrame
+    vessels: pl.DataFrame
+
+    def monotonic(self) -> dict[str, bool]:
+        """Per vessel id: whether heave, roll and pitch RMS all rise strictly from setting to setting."""
+        out = {}
+        for vid in self.vessels["id"].unique(maintain_order=True).to_list():
+            v = self.vessels.filter(pl.col("id") == vid)
+            out[str(vid)] = all(
+                bool(np.all(np.diff(v[c].to_numpy()) > 0)) for c in ("heave_rms_m", "roll_rms_deg", "pitch_rms_deg")
+            )
+        return out
+
+    def write(self, out_dir: Path) -> dict[str, Path]:
+        """Writes ``wave_study_physical.csv`` (summary) and ``wave_study_vessels.csv`` into ``out_dir``."""
+        out_dir.mkdir(parents=True, exist_ok=True)
+        paths = {"summary": out_dir / "wave_study_physical.csv", "vessels": out_dir / "wave_study_vessels.csv"}
+        self.summary.write_csv(paths["summary"])
+        self.vessels.write_csv(paths["vessels"])
+        return paths
+
+
+def _per_vessel_rms(poses: np.ndarray) -> np.ndarray:
+    """``(V, 3)``: heave (mean removed), roll (°), pitch (°) RMS per vessel of ``(T, V, 6)`` poses."""
+    z = poses[:, :, 2] - poses[:, :, 2].mean(axis=0, keepdims=True)
+    return np.stack(
+        [
+            np.sqrt(np.mean(z**2, axis=0)),
+            np.sqrt(np.mean(np.degrees(poses[:, :, 3]) ** 2, axis=0)),
+            np.sqrt(np.mean(np.degrees(poses[:, :, 4]) ** 2, axis=0)),
+        ],
+        axis=1,
+    )
+
+
+PHYSICAL_RECORD_S = 1200.0
+"""Default record length of the physical study: 20 minutes, the usual length of a seakeeping record, so that the
+RMS of waves of 4–10 s periods are estimated to a few per cent (the scenario's own frames are used when longer)."""
+
+
+def run_physical_wave_study(
+    scenario: Scenario,
+    *,
+    waves: tuple[str, ...] = tuple(WAVE_PRESETS),
+    record_s: float | None = PHYSICAL_RECORD_S,
+) -> PhysicalWaveStudy:
+    """Heave, roll and pitch RMS of every vessel of ``scenario`` (a mixed fleet) under the physical sea of each
+    preset in ``waves`` (``W0``..``W3``), beside the paper's Table I and the paper mode (USVs pooled). The record
+    lasts ``record_s`` seconds at the scenario's frequency, or the scenario's own frames when longer or when
+    ``record_s`` is ``None``."""
+    from mmusv.world.sea_state import SEA_PRESETS
+
+    usv_idx = _usv_indices(scenario)
+    acq = scenario.acquisition
+    if record_s is not None and record_s * acq.frequency_hz > acq.frames:
+        frames = round(record_s * acq.frequency_hz)
+        scenario = scenario.model_copy(update={"acquisition": acq.model_copy(update={"frames": frames})})
+    physical = scenario.with_sea(None, motion="physical")
+    paper = scenario.with_sea(None, motion="paper")
+    rows, vessel_rows = [], []
+    for w in waves:
+        p_phys = scenario_poses(physical, wave=w)
+        p_paper = scenario_poses(paper, wave=w)[:, usv_idx, :]
+        phys_usv = _rms_stats(p_phys[:, usv_idx, :])
+        fleet = _rms_stats(p_phys)
+        ref = PAPER_TABLE_I.get(w, (float("nan"),) * 3)
+        preset = SEA_PRESETS[w]
+        rows.append(
+            {
+                "wave": w,
+                "Hs_m": preset.hs_m,
+                "Tp_s": preset.tp_s,
+                "frames": p_phys.shape[0],
+                **{f"table1_{k}": v for k, v in zip(_COLS, ref, strict=True)},
+                **{f"paper_{k}": v for k, v in zip(_COLS, _rms_stats(p_paper), strict=True)},
+                **{f"physical_{k}": v for k, v in zip(_COLS, phys_usv, strict=True)},
+                **{f"fleet_{k}": v for k, v in zip(_COLS, fleet, strict=True)},
+            }
+        )
+        for v, r in zip(scenario.vessels, _per_vessel_rms(p_phys), strict=True):
+            vessel_rows.append(
+                {
+                    "wave": w,
+                    "id": v.id,
+                    "asset": v.asset,
+                    "role": v.role,
+                    "heave_rms_m": float(r[0]),
+                    "roll_rms_deg": float(r[1]),
+                    "pitch_rms_deg": float(r[2]),
+                }
+            )
+    return PhysicalWaveStudy(pl.DataFrame(rows), pl.DataFrame(vessel_rows))
+
+
+_COLS = ("heave_rms_m", "roll_rms_deg", "pitch_rms_deg")
 
 
 def _plot(study: WaveStudy, path: Path) -> None:

@@ -22,8 +22,10 @@ pub use spline::{wrap_angle, EndBehaviour, Route};
 pub use waves::{mix_seed, BaseAmplitudes, PeriodicSignal, VesselDims, WaveSetting, WaveSignals};
 
 use crate::error::{MmusvError, Result};
+use crate::ocean::{response::response, Hull, WaveField};
 use rayon::prelude::*;
 use std::f64::consts::PI;
+use std::sync::Arc;
 
 /// Checks that a simulation time is finite and ≥ 0; `field` names it in the [`MmusvError::InvalidInput`].
 pub fn check_time(t: f64, field: &str) -> Result<()> {
@@ -47,7 +49,20 @@ pub struct VesselParams {
     pub dims: VesselDims,
     /// Base amplitudes `r_z`, `r_φ`, `r_θ`.
     pub amplitudes: BaseAmplitudes,
+    /// Hull particulars for the physical response (used only when the fleet sails in a [`WaveField`]).
+    pub hull: Hull,
 }
+
+/// The reference USV hull: 5 m × 2.5 m, draft 0.45 m, Cb 0.45, GM 0.6 m, default roll gyradius and damping.
+pub const REFERENCE_HULL: Hull = Hull {
+    length_m: 5.0,
+    beam_m: 2.5,
+    draft_m: 0.45,
+    block_coefficient: 0.45,
+    gm_m: 0.6,
+    roll_gyradius_m: crate::ocean::response::ROLL_GYRADIUS_RATIO * 2.5,
+    roll_damping_ratio: crate::ocean::response::ROLL_DAMPING_RATIO,
+};
 
 impl Default for VesselParams {
     /// At rest at the route start, `z_base = 0`, reference USV size and amplitudes.
@@ -58,6 +73,7 @@ impl Default for VesselParams {
             z_base_m: 0.0,
             dims: VesselDims::REFERENCE,
             amplitudes: BaseAmplitudes::default(),
+            hull: REFERENCE_HULL,
         }
     }
 }
@@ -94,6 +110,7 @@ impl VesselMotion {
         }
         p.dims.validate()?;
         p.amplitudes.validate()?;
+        p.hull.validate()?;
         let alpha = p.dims.alpha();
         Ok(Self { route, params, signals, alpha })
     }
@@ -134,47 +151,91 @@ impl VesselMotion {
     /// Yaw `θ` is in `[-π, π]`; travelling backwards on a ping-pong route it is the route heading + π.
     pub fn pose_at(&self, t: f64, wave: &WaveSetting) -> Result<[f64; 6]> {
         check_time(t, "t")?;
-        Ok(self.pose_unchecked(t, wave))
+        Ok(self.pose_unchecked(t, wave, None))
+    }
+
+    /// The pose with the physical response to `sea` (heave, roll, pitch through the hull's RAOs at the vessel's
+    /// position, heading and velocity) instead of the paper's perturbation.
+    pub fn pose_in_sea(&self, t: f64, sea: &WaveField) -> Result<[f64; 6]> {
+        check_time(t, "t")?;
+        Ok(self.pose_unchecked(t, &WaveSetting::W0, Some(sea)))
     }
 
     /// World-frame linear velocity `[vx, vy, vz]` in m/s at time `t`: `u·σ·tangent(s)` horizontally (zero at
-    /// rest at the end of a `Stop` route) and `dΔz/dt` vertically.
+    /// rest at the end of a `Stop` route) and `dΔz/dt` vertically (in a sea: the heave rate at the current heading
+    /// and velocity, exact on straight legs).
     pub fn velocity_at(&self, t: f64, wave: &WaveSetting) -> Result<[f64; 3]> {
         check_time(t, "t")?;
-        Ok(self.velocity_unchecked(t, wave))
+        Ok(self.velocity_unchecked(t, wave, None))
     }
 
-    fn pose_unchecked(&self, t: f64, wave: &WaveSetting) -> [f64; 6] {
+    fn pose_unchecked(&self, t: f64, wave: &WaveSetting, sea: Option<&WaveField>) -> [f64; 6] {
         let (s, sign) = self.route.distance_to_arc(self.travelled_m(t));
         let [x, y] = self.route.position(s);
         let mut yaw = self.route.yaw(s);
         if sign < 0.0 {
             yaw = wrap_angle(yaw + PI);
         }
-        let [dz, roll, pitch] = self.perturbation_at(t, wave);
+        let [dz, roll, pitch] = match sea {
+            None => self.perturbation_at(t, wave),
+            Some(field) => {
+                let [vx, vy] = self.horizontal_velocity(s, sign);
+                response(field, &self.params.hull, x, y, yaw, vx, vy, t)[0]
+            }
+        };
         [x, y, self.params.z_base_m + dz, roll, pitch, yaw]
     }
 
-    fn velocity_unchecked(&self, t: f64, wave: &WaveSetting) -> [f64; 3] {
-        let (s, sign) = self.route.distance_to_arc(self.travelled_m(t));
+    /// World-frame horizontal velocity at arc length `s` travelled in direction `sign`.
+    fn horizontal_velocity(&self, s: f64, sign: f64) -> [f64; 2] {
         let v = self.params.speed_mps * sign;
         let [tx, ty] = if v == 0.0 { [0.0, 0.0] } else { self.route.tangent(s) };
-        let vz = wave.scale() * self.alpha * self.params.amplitudes.heave_m * self.signals.heave.derivative(t);
-        [v * tx, v * ty, vz]
+        [v * tx, v * ty]
+    }
+
+    fn velocity_unchecked(&self, t: f64, wave: &WaveSetting, sea: Option<&WaveField>) -> [f64; 3] {
+        let (s, sign) = self.route.distance_to_arc(self.travelled_m(t));
+        let [vx, vy] = self.horizontal_velocity(s, sign);
+        let vz = match sea {
+            None => wave.scale() * self.alpha * self.params.amplitudes.heave_m * self.signals.heave.derivative(t),
+            Some(field) => {
+                let [x, y] = self.route.position(s);
+                let mut yaw = self.route.yaw(s);
+                if sign < 0.0 {
+                    yaw = wrap_angle(yaw + PI);
+                }
+                response(field, &self.params.hull, x, y, yaw, vx, vy, t)[1][0]
+            }
+        };
+        [vx, vy, vz]
     }
 }
 
-/// All vessels of a scenario under one wave setting.
+/// All vessels of a scenario under one wave setting: the paper's perturbation, or, with a sea
+/// ([`Fleet::with_sea`]), each hull's physical response to that wave field.
 #[derive(Debug, Clone)]
 pub struct Fleet {
     vessels: Vec<VesselMotion>,
     wave: WaveSetting,
+    sea: Option<Arc<WaveField>>,
 }
 
 impl Fleet {
-    /// A fleet of `vessels` (index order is kept in every output) under `wave`.
+    /// A fleet of `vessels` (index order is kept in every output) under `wave`, moved by the paper's formula.
     pub fn new(vessels: Vec<VesselMotion>, wave: WaveSetting) -> Self {
-        Self { vessels, wave }
+        Self { vessels, wave, sea: None }
+    }
+
+    /// The same fleet moved physically by `sea`: heave, roll and pitch from each hull's RAOs
+    /// ([`crate::ocean::response`]) instead of the paper's perturbation.
+    pub fn with_sea(mut self, sea: Arc<WaveField>) -> Self {
+        self.sea = Some(sea);
+        self
+    }
+
+    /// The wave field the fleet sails in, when physical.
+    pub fn sea(&self) -> Option<&WaveField> {
+        self.sea.as_deref()
     }
 
     /// The vessels, in order.
@@ -205,13 +266,13 @@ impl Fleet {
     /// Poses `η = [x, y, z, roll, pitch, yaw]` of every vessel at time `t` (finite, ≥ 0), in vessel order.
     pub fn poses_at(&self, t: f64) -> Result<Vec<[f64; 6]>> {
         check_time(t, "t")?;
-        Ok(self.vessels.iter().map(|v| v.pose_unchecked(t, &self.wave)).collect())
+        Ok(self.vessels.iter().map(|v| v.pose_unchecked(t, &self.wave, self.sea())).collect())
     }
 
     /// World-frame linear velocities `[vx, vy, vz]` (m/s) of every vessel at time `t`, in vessel order.
     pub fn velocities_at(&self, t: f64) -> Result<Vec<[f64; 3]>> {
         check_time(t, "t")?;
-        Ok(self.vessels.iter().map(|v| v.velocity_unchecked(t, &self.wave)).collect())
+        Ok(self.vessels.iter().map(|v| v.velocity_unchecked(t, &self.wave, self.sea())).collect())
     }
 
     /// Poses at many times, flattened time-major: entry `k · len() + v` is vessel `v` at `times[k]`
@@ -227,7 +288,7 @@ impl Fleet {
         }
         out.par_chunks_mut(nv).zip(times.par_iter()).for_each(|(row, &t)| {
             for (slot, v) in row.iter_mut().zip(&self.vessels) {
-                *slot = v.pose_unchecked(t, &self.wave);
+                *slot = v.pose_unchecked(t, &self.wave, self.sea());
             }
         });
         Ok(out)
@@ -430,5 +491,35 @@ mod tests {
         let err = f.poses_at_times(&[0.0, 1.0, -2.0]);
         assert!(matches!(err, Err(MmusvError::InvalidInput { ref field, .. }) if field == "times[2]"));
         assert_eq!(Fleet::new(Vec::new(), WaveSetting::W0).poses_at_times(&[1.0]).map(|v| v.len()), Ok(0));
+    }
+
+    #[test]
+    fn a_fleet_in_a_sea_moves_by_its_hulls_response() {
+        use crate::ocean::{SeaSpec, WaveField};
+        let sea = SeaSpec { hs: 2.5, tp: 8.0, gamma: 3.3, direction_rad: 0.5, spread_s: 10.0 };
+        let field = Arc::new(ok(WaveField::new(&sea, 9)));
+        let paper = fleet(VesselDims::REFERENCE, WaveSetting::W2, 4);
+        let physical = paper.clone().with_sea(Arc::clone(&field));
+        let t = 37.5;
+        let (pp, pq) = (ok(paper.poses_at(t)), ok(physical.poses_at(t)));
+        for (v, (a, b)) in paper.vessels().iter().zip(pp.iter().zip(&pq)) {
+            // Same route position and heading; heave, roll, pitch from the RAOs at that place and velocity.
+            assert_eq!((a[0], a[1], a[5]), (b[0], b[1], b[5]));
+            let vel = ok(v.velocity_at(t, &WaveSetting::W2));
+            let r = response(&field, &v.params().hull, b[0], b[1], b[5], vel[0], vel[1], t)[0];
+            assert_eq!([b[2] - v.params().z_base_m, b[3], b[4]], r);
+            assert_eq!(ok(v.pose_in_sea(t, &field)), *b);
+        }
+        // Vertical velocity is the time derivative of the heave at the current heading and velocity (exact on
+        // straight legs; on this curve the turning changes it by a few per cent).
+        let h = 1e-5;
+        let (a, b) = (ok(physical.poses_at(t - h)), ok(physical.poses_at(t + h)));
+        let vz = ok(physical.velocities_at(t));
+        for i in 0..physical.len() {
+            let fd = (b[i][2] - a[i][2]) / (2.0 * h);
+            assert!((fd - vz[i][2]).abs() < 0.05 * (vz[i][2].abs() + 0.01));
+        }
+        // The paper fleet is untouched by the existence of a sea.
+        assert!(paper.sea().is_none() && physical.sea().is_some());
     }
 }

@@ -19,10 +19,12 @@
 //! Sampling ([`WaveField::with_components`], `N` components, default [`DEFAULT_COMPONENTS`]):
 //! - **Frequencies, stratified half by energy, half by log-frequency.** The `N` bins are equal-probability bins
 //!   of the mixture `P(ω) = ½ F(ω) + ½ ln(ω/ω₀)/ln(ω₁/ω₀)` (clamped to [0, 1]), `F` the spectrum's cumulative
-//!   variance, `[ω₀, ω₁] = [`[`LOG_BAND`]`]·ωp`. Half the components thus follow the energy (the peak), half
-//!   cover the flanks evenly in log-frequency, so short waves (slopes, small craft's roll resonance) are
-//!   sampled too. Component `i` sits at `P⁻¹((i + ξᵢ)/N)`, `ξᵢ` uniform in [0, 1) (at most `1 − 1/(16N)` in
-//!   the last bin), with the variance of its whole bin: `aᵢ² = 2 m0 (F(eᵢ₊₁) − F(eᵢ))`, `eᵢ = P⁻¹(i/N)`. The
+//!   variance, `[ω₀, ω₁] = [`[`LOG_BAND`]`]·ωp`: half the bins follow the energy (the peak), half cover the
+//!   flanks evenly in log-frequency, so long waves (big ships' heave), short waves (slopes) and small craft's
+//!   roll resonance are all sampled. Component `i` carries the variance of its whole bin,
+//!   `aᵢ² = 2 m0 (F(eᵢ₊₁) − F(eᵢ))`, `eᵢ = P⁻¹(i/N)`, and sits where the spectrum itself puts a fraction `ξᵢ`
+//!   (uniform in [0, 1); at most 15/16 in the unbounded last bin) of that variance:
+//!   `ωᵢ = F⁻¹(F(eᵢ) + ξᵢ (F(eᵢ₊₁) − F(eᵢ)))`, an unbiased sample of the bin for any response operator. The
 //!   variance is `m0 = Hs²/16` exactly and no two components share a frequency: the sea never repeats.
 //! - **Directions, stratified twice.** The cos-2s distribution is cut into `N` equal-probability strata, grouped
 //!   into [`DIRECTION_STRATA`] coarse strata of `G = N/DIRECTION_STRATA`. Each group of `DIRECTION_STRATA`
@@ -43,7 +45,7 @@ use rayon::prelude::*;
 use std::f64::consts::TAU;
 
 /// Components of a field made by [`WaveField::new`].
-pub const DEFAULT_COMPONENTS: usize = 128;
+pub const DEFAULT_COMPONENTS: usize = 256;
 /// Directional strata per group of consecutive frequency components.
 pub const DIRECTION_STRATA: usize = 8;
 /// Allowed number of components.
@@ -166,15 +168,23 @@ impl WaveField {
         let spread = CosTwoS::new(spec.spread_s)?;
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let nf = n as f64;
-        let u_max = 1.0 - 1.0 / (16.0 * nf);
         let jitter: Vec<f64> = (0..n).map(|_| rng.random::<f64>()).collect();
         let mix = Mixture::new(&spectrum);
-        // Cumulative variance fraction at the bin edges e_0 = 0 .. e_N = ∞.
-        let edges: Vec<f64> = (0..=n)
+        // Bin edges e_0 = 0 .. e_N = ∞ (rad/s) and the cumulative variance fraction F there.
+        let edge_w: Vec<f64> = (0..=n)
             .map(|i| match i {
                 0 => 0.0,
+                i if i == n => f64::INFINITY,
+                i => mix.quantile(i as f64 / nf),
+            })
+            .collect();
+        let edges: Vec<f64> = edge_w
+            .iter()
+            .enumerate()
+            .map(|(i, &w)| match i {
+                0 => 0.0,
                 i if i == n => 1.0,
-                i => spectrum.cumulative(mix.quantile(i as f64 / nf)),
+                _ => spectrum.cumulative(w),
             })
             .collect();
         let groups = n / DIRECTION_STRATA;
@@ -184,9 +194,14 @@ impl WaveField {
         for g in 0..groups {
             for (m, stratum) in shuffled(&mut rng, DIRECTION_STRATA).into_iter().enumerate() {
                 let i = g * DIRECTION_STRATA + m;
-                let u = ((i as f64 + jitter[i]) / nf).min(u_max);
-                let omega = mix.quantile(u);
-                let amplitude = (2.0 * spectrum.m0() * (edges[i + 1] - edges[i]).max(0.0)).sqrt();
+                // Within its bin, the component's frequency follows the spectrum itself, so that it is an unbiased
+                // sample of the bin's variance for any response operator.
+                let mass = (edges[i + 1] - edges[i]).max(0.0);
+                let xi = if i + 1 == n { jitter[i].min(LAST_BIN_QUANTILE) } else { jitter[i] };
+                let lo = if i == 0 { 0.05 * spectrum.omega_p() } else { edge_w[i] };
+                let hi = edge_w[i + 1].min(200.0 * spectrum.omega_p());
+                let omega = spectrum.quantile(edges[i] + xi * mass).clamp(lo, hi);
+                let amplitude = (2.0 * spectrum.m0() * mass).sqrt();
                 let k = omega * omega / GRAVITY;
                 let q = ((stratum * groups + fine[stratum][g]) as f64 + rng.random::<f64>()) / nf;
                 let direction = spec.direction_rad + spread.quantile(q);
@@ -365,6 +380,9 @@ pub fn sea_seed(scenario_seed: u64) -> u64 {
     crate::kinematics::mix_seed(scenario_seed, SEA_STREAM)
 }
 
+/// The highest quantile of the last (unbounded) bin's variance at which its component may sit.
+const LAST_BIN_QUANTILE: f64 = 0.9375;
+
 /// Band `[ω₀, ω₁]` of the log-uniform half of the frequency sampling, in units of ωp.
 pub const LOG_BAND: [f64; 2] = [0.6, 8.0];
 
@@ -533,7 +551,8 @@ mod tests {
             let f = ok(WaveField::new(&sp, seed));
             // 20 000 s, 2 500 peak periods: long enough to resolve neighbouring components near the peak.
             let dt = 1.0;
-            let series: Vec<f64> = (0..20_000).map(|i| f.elevation(31.0, -12.0, i as f64 * dt)).collect();
+            let series: Vec<f64> =
+                (0..20_000).into_par_iter().map(|i| f.elevation(31.0, -12.0, i as f64 * dt)).collect();
             let mean = series.iter().sum::<f64>() / series.len() as f64;
             let var = series.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / series.len() as f64;
             let hs = 4.0 * var.sqrt();
