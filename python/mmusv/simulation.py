@@ -213,7 +213,12 @@ class Simulation:
         under_way = [int(inst) for v, inst in zip(sc.vessels, self.ws.vessel_instances, strict=True) if not v.static]
         self.ws.scene.set_lights(under_way, on=True)
         self._frame: int | None = None
+        # The physical sea (``environment.motion: physical``, the default) displaces the water every sensor sees;
+        # with ``motion: paper`` the water stays the flat plane of the paper.
         self.sea: SeaState | None = None
+        if sc.environment.motion == "physical":
+            spec = sc.environment.sea_spec()
+            self.sea = spec if spec.hs_m > 0.0 else None
 
     # ------------------------------------------------------------------------------------------ building
 
@@ -283,12 +288,13 @@ class Simulation:
         """Makes the water the displaced surface of the physical sea ``sea`` (its wave field drawn from the
         scenario's sea seed) from the next :meth:`set_frame` on, or flat again with ``None``.
 
+        Scenarios with ``environment.motion: physical`` (the default) start with their ``environment.sea_spec()``.
         Every frame then samples the surface at the frame time, finest around the USVs (the same surface for
         every sensor of every agent): crests occlude, LiDAR beams meet wave faces, the radar's sea clutter follows
         sea state and grazing angle, and the annotations carry each box's ``wave_occlusion``.
         """
-        self.sea = sea
-        if sea is None:
+        self.sea = sea if sea is None or sea.hs_m > 0.0 else None
+        if self.sea is None:
             self.ws.scene.set_wave_surface(None, scenario_seed=self.scenario.seed, time_s=0.0, foci=np.zeros((0, 2)))
         self._frame = None
 
