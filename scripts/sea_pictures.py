@@ -45,7 +45,7 @@ def _scenario(wave: str) -> dict[str, Any]:
         "resolution": [640, 360],
         "hfov_deg": 12.0,
         "outputs": ["rgb", "instance"],
-        "mount": {"xyz": [2.0, 0.0, 2.6], "rpy_deg": [0.0, 0.6, 0.0]},
+        "mount": {"xyz": [2.0, 0.0, 3.5], "rpy_deg": [0.0, 0.8, 0.0]},
     }
     # A long-range LiDAR (128 rings over 12°, 0.18° columns) so a 5 m craft at 150 m gets beams at all.
     lidar = {"channels": 128, "vertical_fov_deg": [-8.0, 4.0], "points_per_second": 128 * 2000 * 5.0, "range_m": 200.0}
@@ -81,9 +81,10 @@ def craft_views(out: Path, lines: list[str]) -> None:
     sim.set_sea_surface(SEAS["W3"])
     # The frame where the crests hide closest to half of the craft (camera annotations).
     best, best_frame = 2.0, 0
-    for f in range(0, sim.frames, 2):
+    for f in range(sim.frames):
         cap = sim.capture(f, sensors=["cameras", "lidar"], radar=False)
         s = _share(annotations_for(sim, cap, sil)["usv"], "camera", "craft")
+        print(f"frame {f}: camera wave occlusion {s:.2f}")
         if s == s and abs(s - 0.5) < abs(best - 0.5):
             best, best_frame = s, f
     rows = []
