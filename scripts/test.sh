@@ -40,8 +40,9 @@ cargo test -p mmusv-core --release --quiet
 echo "== cargo bench --no-run (benches keep compiling)"
 cargo bench --no-run --quiet
 
-echo "== pip install the package with test extras (builds the extension in release; ray for the batch tests)"
-python3 -m pip install --quiet --disable-pip-version-check -e ".[test]"
+echo "== pip install the package with test and learn extras (builds the extension in release; ray for the batch"
+echo "   tests; torch for the learned detector's tests in tests/learn)"
+python3 -m pip install --quiet --disable-pip-version-check -e ".[test,learn]"
 
 echo "== cargo clippy, warnings are errors (release: reuses the build scripts and proc macros built above)"
 cargo clippy -p mmusv-core -p mmusv-benches -p mmusv-py --release --all-targets --quiet -- -D warnings

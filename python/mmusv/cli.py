@@ -447,10 +447,12 @@ def _parser() -> argparse.ArgumentParser:
     from mmusv.editor.cli import add_parser as add_editor_parser
     from mmusv.export.cli import add_parser as add_convert_parser
     from mmusv.generate.cli import add_parser as add_generate_parser
+    from mmusv.learn.cli import add_parser as add_train_parser
 
     add_generate_parser(sub)
     add_convert_parser(sub)
     add_editor_parser(sub)
+    add_train_parser(sub)
     return p
 
 
@@ -557,6 +559,10 @@ def _dispatch(args: argparse.Namespace) -> int:
         from mmusv.generate.cli import run as _run_generate
 
         return _run_generate(args)
+    if args.command == "train":
+        from mmusv.learn.cli import run as _run_train
+
+        return _run_train(args)
     if args.command == "editor":
         from mmusv.editor.cli import run as _run_editor
 

@@ -15,6 +15,9 @@ location + center component-wise). Camera order: 0 front, 1 right, 2 left, 3 rea
 Files beyond stock OPV2V, which stock loaders skip: ``<ts>_additional.yaml`` (our names, classes and LiDAR point
 counts of the listed vehicles), ``<ts>_depth{i}.png`` (uint16 cm), ``<ts>_semantic{i}.png``,
 ``<ts>_instance{i}.png`` (uint16 ids), ``<ts>_radar_ppi.png``, ``<ts>_topview_{rgb,semantic}.png``.
+
+Beside the export, ``opencood/point_pillar_{early,late,intermediate}_fusion.yaml``: OpenCOOD hypes sized from
+the exported vessels and distances (:mod:`mmusv.export.opencood`, ``docs/opencood.md``).
 """
 
 from __future__ import annotations
@@ -27,6 +30,7 @@ import numpy as np
 from mmusv.classes import class_name
 from mmusv.export.common import DEPTH_UNIT_M, cav_id, depth_png, dump_yaml, png_bytes, rounded
 from mmusv.export.geometry import AgentView, Target
+from mmusv.export.opencood import HypesStats, constants, hypes
 from mmusv.export.pcd import pcd_bytes
 from mmusv.export.writer import DatasetWriter
 from mmusv.frames import carla_matrix, carla_pose, invert, mirror_points
@@ -71,6 +75,30 @@ class Opv2vWriter(DatasetWriter):
             other = sorted(set(a.cameras) - set(self.cameras))
             if other:
                 self.notes.append(f"agent {a.id}: cameras {other} have no OPV2V slot and are left out")
+
+    @classmethod
+    def start(cls, out: Path, options: Any, sink: Any) -> HypesStats:
+        """The vessel sizes and distances of the whole export, for the OpenCOOD hypes files."""
+        return HypesStats(range_m=float(options.eval_range_m))
+
+    @classmethod
+    def finish_all(cls, shared: Any, out: Path, sink: Any) -> None:
+        """Writes ``opencood/point_pillar_{early,late,intermediate}_fusion.yaml`` (:mod:`mmusv.export.opencood`)."""
+        st: HypesStats = shared
+        if not st.usv_positions:
+            return
+        split = (out / "train").is_dir()
+        root = "train" if split else "."
+        val = "validate" if split else "."
+        consts = constants(st)
+        header = (
+            "# OpenCOOD hypes written by mmusv convert --to opv2v (docs/opencood.md). root_dir and validate_dir are\n"
+            "# relative to the export folder (run OpenCOOD from there, or make them absolute).\n"
+            "# Also change in OpenCOOD's code:\n" + "".join(f"#   {k}: {v}\n" for k, v in consts.items())
+        ).encode("utf-8")
+        sink.mkdir(out / "opencood")
+        for stem, doc in hypes(st, root_dir=root, validate_dir=val).items():
+            sink.write(out / "opencood" / f"{stem}.yaml", header + dump_yaml(doc))
 
     def agent_dir(self, view: AgentView) -> Path:
         return self.sink.mkdir(self.folder / str(cav_id(view.agent.index)))
@@ -118,6 +146,11 @@ class Opv2vWriter(DatasetWriter):
                 if kind in self.options.extras and base + kind in msgs:
                     self.put(d / f"{ts}_{kind}{idx}.png", png_bytes(msgs[base + kind]), kind)
         self.put(d / f"{ts}.yaml", dump_yaml(doc))
+        if isinstance(self.shared, HypesStats):
+            boxes = [[*t.box_in_lidar[:3, 3], *t.size, 0.0] for t in targets]
+            self.shared.add(
+                key=(str(self.folder), frame.index), lidar_world=view.lidar[:3, 3], boxes_lidar=np.array(boxes)
+            )
         self.put(d / f"{ts}_additional.yaml", dump_yaml(self._additional(frame, world, view, targets, cloud)))
         if "radar" in self.options.extras and topics.radar_ppi(a.id) in msgs:
             self.put(d / f"{ts}_radar_ppi.png", png_bytes(msgs[topics.radar_ppi(a.id)]), "radar")

@@ -45,12 +45,24 @@ def _common(p: argparse.ArgumentParser, default_out: str) -> None:
         "--split-ratios", default="0.7,0.15,0.15", help="train,validate,test fractions (default 0.7,0.15,0.15)"
     )
     p.add_argument("--seed", type=int, default=0, help="seed of the split and of the pose noise (default 0)")
-    p.add_argument("--modes", default="none,late,early", help="fusion modes, from none,late,early (default all)")
+    p.add_argument(
+        "--modes",
+        default=None,
+        help="fusion modes, from none,late,early,intermediate (default none,late,early; with --model every mode "
+        "its models serve; intermediate needs --model)",
+    )
     p.add_argument(
         "--detector",
         default="baseline",
         help="'baseline' (training-free, not the paper's learned model) or package.module:function, a "
         "callable (points (N,4) float32 ego LiDAR frame) -> (boxes (M,7) x,y,z,l,w,h,yaw, scores (M,))",
+    )
+    p.add_argument(
+        "--model",
+        default=None,
+        metavar="CKPT",
+        help="a learned model (mmusv train's output folder, or one model.pt; needs the learn extra): single "
+        "serves none/late, early and intermediate their own",
     )
     p.add_argument(
         "--predictions",
@@ -100,13 +112,23 @@ def run(args: argparse.Namespace) -> int:
 
     robust = args.study == "robustness"
     console = Console(width=None if sys.stdout.isatty() else 160)
-    modes = parse_modes(args.modes)
+    learned = None
+    if args.model is not None:
+        if args.predictions is not None or args.detector != "baseline":
+            raise InputError("give one of --model, --detector or --predictions")
+        from mmusv.learn.cli import load_for_study
+
+        learned = load_for_study(args.model)
+    modes = parse_modes(args.modes or (",".join(learned.fusion_modes) if learned is not None else "none,late,early"))
     settings = parse_settings(args.settings) if robust else (Setting(),)
     if robust and not any(m != "none" for m in modes):
         raise InputError("--modes: the robustness study needs late and/or early fusion")
     if args.predictions is not None and args.detector != "baseline":
         raise InputError("give --detector or --predictions, not both")
-    detector = None if args.predictions is not None else load_detector(args.detector)
+    detector = (
+        learned if learned is not None else None if args.predictions is not None else load_detector(args.detector)
+    )
+    detector_name = f"learned model {args.model}" if learned is not None else args.detector
     predictions = load_predictions(args.predictions) if args.predictions is not None else None
     if not (args.range_m > 0):
         raise InputError(f"--range {args.range_m}: must be > 0 metres")
@@ -139,39 +161,62 @@ def run(args: argparse.Namespace) -> int:
     dataset = resolve_dataset(
         inputs, opv2v=args.opv2v, split=split, ratios=parse_ratios(args.split_ratios), seed=args.seed
     )
-    options = StudyOptions(
-        modes=modes, settings=settings, detector=detector, predictions=predictions, range_m=args.range_m, seed=args.seed
-    )
-    total = dataset.count_frames()
-    t1 = time.perf_counter()
-    with _bar(console, f"{args.study} study", args.no_progress) as (bar, task):
-        res = run_study(
-            dataset.sequences(),
-            options=options,
-            total_frames=total,
-            progress=lambda done, tot: bar.update(task, completed=done, total=tot) if bar is not None else None,
+    runs: list[tuple[Any, str, tuple[str, ...], Path]] = [(detector, detector_name, modes, out)]
+    if learned is not None:  # the learned model beside the baseline, on the same frames
+        base_modes = tuple(m for m in modes if m != "intermediate")
+        if base_modes and (not robust or any(m != "none" for m in base_modes)):
+            runs.append((load_detector("baseline"), "baseline", base_modes, out / "baseline"))
+    paths: dict[str, Path] = {}
+    for det, name, run_modes, run_out in runs:
+        options = StudyOptions(
+            modes=run_modes,
+            settings=settings,
+            detector=det,
+            predictions=predictions,
+            range_m=args.range_m,
+            seed=args.seed,
         )
-    if res.ego_frames == 0:
-        raise InputError(
-            f"empty dataset: the {len(dataset.sources)} sequence(s) of split {split!r} hold no frame to evaluate"
-        )
-    eval_s = time.perf_counter() - t1
-    from mmusv.studies.detection import report
+        total = dataset.count_frames()
+        t1 = time.perf_counter()
+        with _bar(console, f"{args.study} study ({name})", args.no_progress) as (bar, task):
+            res = run_study(
+                dataset.sequences(),
+                options=options,
+                total_frames=total,
+                progress=lambda done, tot: bar.update(task, completed=done, total=tot) if bar is not None else None,
+            )
+        if res.ego_frames == 0:
+            raise InputError(
+                f"empty dataset: the {len(dataset.sources)} sequence(s) of split {split!r} hold no frame to evaluate"
+            )
+        eval_s = time.perf_counter() - t1
+        from mmusv.studies.detection import report
 
-    if robust:
-        paths = report.write_robustness(res, out, detector=args.detector)
-        _print_robustness(console, res)
-    else:
-        paths = report.write_detection(res, out, detector=args.detector)
-        _print_detection(console, res)
-    if detector is not None and args.detector == "baseline":
-        console.print(f"[yellow]{BASELINE_NOTE}[/]")
-    console.print(
-        f"split {split}: {len(res.sequences)} sequences, {res.frames} frames, {res.ego_frames} ego-frames, "
-        f"{res.gt_boxes / max(res.ego_frames, 1):.2f} ground-truth boxes per ego-frame; evaluation "
-        f"{eval_s:.1f} s, total {time.perf_counter() - t0:.1f} s",
-        highlight=False,
-    )
+        if len(runs) > 1:
+            console.print(f"[bold]{name}[/]", highlight=False)
+        if robust:
+            paths.update({f"{name}:{k}": v for k, v in report.write_robustness(res, run_out, detector=name).items()})
+            _print_robustness(console, res)
+        else:
+            paths.update({f"{name}:{k}": v for k, v in report.write_detection(res, run_out, detector=name).items()})
+            _print_detection(console, res)
+        if det is learned and learned is not None:
+            console.print(f"learned models: {learned.describe()}", highlight=False)
+            if learned.shared_bytes:
+                kb = sum(learned.shared_bytes) / len(learned.shared_bytes) / 1024
+                console.print(
+                    f"intermediate fusion: {kb:.1f} KiB shared per ego-frame on average (the neighbours' pillar "
+                    f"features, float32, and cells; {len(learned.shared_bytes)} ego-frames)",
+                    highlight=False,
+                )
+        elif det is not None and name == "baseline":
+            console.print(f"[yellow]{BASELINE_NOTE}[/]")
+        console.print(
+            f"split {split}: {len(res.sequences)} sequences, {res.frames} frames, {res.ego_frames} ego-frames, "
+            f"{res.gt_boxes / max(res.ego_frames, 1):.2f} ground-truth boxes per ego-frame; evaluation "
+            f"{eval_s:.1f} s, total {time.perf_counter() - t0:.1f} s",
+            highlight=False,
+        )
     console.print("wrote " + ", ".join(str(p) for p in paths.values()), highlight=False)
     return 0
 
@@ -241,7 +286,7 @@ def _print_robustness(console: Any, res: Any) -> None:
 
     w = robustness_table(res)
     table = Table(title="Robustness: AP@0.5 (Table IV)")
-    modes = [m for m in ("none", "late", "early") if m in w.columns]
+    modes = [m for m in ("none", "late", "early", "intermediate") if m in w.columns]
     table.add_column("setting")
     for m in modes:
         table.add_column(m, justify="right")

@@ -1,10 +1,16 @@
-"""No, late and early fusion of LiDAR detections for one ego USV at one frame (ego LiDAR frame, metres).
+"""No, late, early and intermediate fusion of LiDAR detections for one ego USV at one frame (ego LiDAR frame,
+metres).
 
 - ``none``: the detector on the ego's own cloud.
 - ``late``: every USV runs the detector on its own cloud in its own LiDAR frame; the boxes are moved into the
   ego LiDAR frame (:func:`transform_boxes`) and merged with rotated NMS at BEV IoU 0.10 (:func:`rotated_nms`).
 - ``early``: the neighbours' points are moved into the ego LiDAR frame and concatenated with the ego's; the
-  detector runs once on the aggregate (cropped to ``crop_m`` around the ego).
+  detector runs once on the aggregate (cropped to ``crop_m`` around the ego). A detector with an ``early``
+  method (a learned model trained on aggregated clouds, :class:`mmusv.learn.detector.LearnedDetector`) runs
+  that instead.
+- ``intermediate``: only for a detector with an ``intermediate(ego_points, [(points, rel)])`` method (a learned
+  model): each neighbour's own cloud and its pose in the ego LiDAR frame go to the model, which fuses the
+  neighbours' encoded features (:mod:`mmusv.learn.model`).
 
 The neighbours' poses come from :class:`~mmusv.studies.detection.data.AgentFrame` as given: the robustness study
 hands in delayed or noisy ones (:mod:`mmusv.studies.detection.robustness`).
@@ -22,9 +28,11 @@ from mmusv.studies.detection.data import AgentFrame
 from mmusv.studies.detection.detector import Detector
 from mmusv.studies.detection.evaluate import bev_iou
 
-__all__ = ["MODES", "NMS_IOU", "fuse", "parse_modes", "relative", "rotated_nms", "transform_boxes"]
+__all__ = ["DEFAULT_MODES", "MODES", "NMS_IOU", "fuse", "parse_modes", "relative", "rotated_nms", "transform_boxes"]
 
-MODES = ("none", "late", "early")
+MODES = ("none", "late", "early", "intermediate")
+DEFAULT_MODES = ("none", "late", "early")
+"""The modes any points → boxes detector can run (intermediate fusion needs a learned model)."""
 NMS_IOU = 0.10
 """BEV IoU above which late fusion suppresses the lower-scored of two boxes."""
 
@@ -114,7 +122,13 @@ def fuse(
         keep = rotated_nms(boxes, scores)
         return boxes[keep], scores[keep]
     if mode == "early":
-        return _as_boxes(detector(early_points(ego, neighbours, crop_m=crop_m)))
+        early = getattr(detector, "early", detector)
+        return _as_boxes(early(early_points(ego, neighbours, crop_m=crop_m)))
+    if mode == "intermediate":
+        inter = getattr(detector, "intermediate", None)
+        if inter is None:
+            raise InputError("intermediate fusion needs a learned model (--model), not a points -> boxes detector")
+        return _as_boxes(inter(ego.points, [(nb.points, relative(ego, nb)) for nb in neighbours]))
     raise InputError(f"fusion mode {mode!r}: allowed: {', '.join(MODES)}")
 
 

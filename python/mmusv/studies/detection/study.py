@@ -15,10 +15,11 @@ Recall at IoU 0.5 and 0.3 is reported for each class.
 
 **Predictions file** (``--predictions``, instead of a detector): a Parquet file with one row per detection and
 columns ``sequence`` (recording stem or OPV2V scenario folder name), ``frame`` (acquisition index), ``ego``
-(USV id, or CAV id for OPV2V), ``mode`` (``none``/``late``/``early``), ``x, y, z, l, w, h, yaw`` (ego LiDAR
-frame, mmusv axes: x forward, y left, z up; metres, radians), ``score``; optionally ``setting`` (robustness
-study, e.g. ``delay:2``; missing = ``clean``) and ``kind`` (rows with ``kind != "det"`` are skipped). A frame with
-no row has no detection. The Parquet this study writes has that layout, so its output can be re-scored.
+(USV id, or CAV id for OPV2V), ``mode`` (``none``/``late``/``early``/``intermediate``), ``x, y, z, l, w, h,
+yaw`` (ego LiDAR frame, mmusv axes: x forward, y left, z up; metres, radians), ``score``; optionally
+``setting`` (robustness study, e.g. ``delay:2``; missing = ``clean``) and ``kind`` (rows with
+``kind != "det"`` are skipped). A frame with no row has no detection. The Parquet this study writes has that
+layout, so its output can be re-scored.
 """
 
 from __future__ import annotations
@@ -53,7 +54,7 @@ from mmusv.studies.detection.evaluate import (
     range_bin,
     summarize,
 )
-from mmusv.studies.detection.fusion import MODES, _as_boxes, fuse, relative
+from mmusv.studies.detection.fusion import DEFAULT_MODES, MODES, _as_boxes, fuse, relative
 from mmusv.studies.detection.robustness import Setting, neighbours_for
 
 __all__ = ["StudyOptions", "StudyResult", "gt_visibility", "load_predictions", "run_study"]
@@ -68,7 +69,7 @@ class StudyOptions:
     """What to evaluate: ``modes``, ``settings`` (``(Setting(),)`` for Table III), range, seed of the pose
     noise, and either a ``detector`` or ``predictions`` (from :func:`load_predictions`)."""
 
-    modes: tuple[str, ...] = MODES
+    modes: tuple[str, ...] = DEFAULT_MODES
     settings: tuple[Setting, ...] = (Setting(),)
     detector: Detector | None = None
     predictions: dict[tuple[str, int, str, str, str], tuple[np.ndarray, np.ndarray]] | None = None

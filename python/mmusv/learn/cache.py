@@ -1,0 +1,194 @@
+"""The tensor cache: a split of the detection dataset packed into one ``.npz`` file that trains with numpy and
+torch alone (on a machine without mmusv's native extension).
+
+:func:`build_cache` reads the sequences through the detection study's own dataset code
+(:func:`mmusv.studies.detection.sources.resolve_dataset`: recordings or an OPV2V export, split by sequence) and
+takes, for every frame and every instrumented USV as the ego, its ground truth from
+:func:`mmusv.studies.detection.data.gt_in_ego` (the study's one target rule). :class:`Cache` reads it back.
+
+Layout (all arrays of one ``np.savez_compressed`` file):
+
+- ``xyz_cm`` ``(N, 3)`` int16: every cloud's points, LiDAR frame, centimetres (±327 m; points beyond are dropped);
+  ``intensity`` ``(N,)`` uint8 (intensity · 255); ``cloud_offsets`` ``(C + 1,)`` int64;
+- ``cloud_lidar`` ``(C, 4, 4)`` float64 LiDAR → world; ``cloud_frame`` ``(C,)`` int64 frame slot;
+  ``cloud_agent`` ``(C,)`` the USV (or OPV2V CAV) id;
+- ``frame_seq`` ``(F,)`` int64 sequence slot, ``frame_index`` ``(F,)`` acquisition index, ``sequences`` ``(S,)``;
+- ``sample_cloud`` ``(K,)`` int64 the ego's cloud of each sample; ``gt`` ``(G, 7)`` float32 ego-frame boxes
+  ``x, y, z, l, w, h, yaw``; ``gt_offsets`` ``(K + 1,)`` int64;
+- ``meta`` a JSON string: the split, ratios, seed and sources.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from mmusv.learn._errors import input_error
+
+__all__ = ["Cache", "Sample", "build_cache"]
+
+Sample = tuple[np.ndarray, list[tuple[np.ndarray, np.ndarray]], np.ndarray]
+"""``(ego points (N, 4) float32, [(neighbour points (N_i, 4) float32 own frame, rel (4, 4) neighbour → ego)],
+ground truth (G, 7) float64)``."""
+
+_LIMIT_CM = 32767
+
+
+def build_cache(
+    inputs: Sequence[str | Path],
+    out: str | Path,
+    *,
+    opv2v: str | None = None,
+    split: str = "train",
+    ratios: Sequence[float] = (0.7, 0.15, 0.15),
+    seed: int = 0,
+    range_m: float = 200.0,
+    frame_stride: int = 1,
+) -> Path:
+    """Packs ``split`` of the dataset (recordings ``inputs`` or the OPV2V folder ``opv2v``) into ``out``
+    (module docstring), every ``frame_stride``-th frame of each sequence; returns ``out``. Written to a
+    temporary name and renamed, so a killed build leaves no file that looks complete."""
+    from mmusv.studies.detection.data import gt_in_ego
+    from mmusv.studies.detection.sources import resolve_dataset
+
+    ds = resolve_dataset(list(inputs), opv2v=opv2v, split=split, ratios=tuple(ratios), seed=seed)
+    xyz: list[np.ndarray] = []
+    inten: list[np.ndarray] = []
+    counts: list[int] = []
+    lidar: list[np.ndarray] = []
+    cloud_frame: list[int] = []
+    cloud_agent: list[str] = []
+    frame_seq: list[int] = []
+    frame_index: list[int] = []
+    names: list[str] = []
+    sample_cloud: list[int] = []
+    gts: list[np.ndarray] = []
+    for s, seq in enumerate(ds.sequences()):
+        names.append(seq.name)
+        for fr in seq.frames[:: max(1, frame_stride)]:
+            f = len(frame_seq)
+            frame_seq.append(s)
+            frame_index.append(fr.frame)
+            for a in fr.agents:
+                c = len(counts)
+                pts = np.asarray(a.points, dtype=np.float64)
+                q = np.round(pts[:, :3] * 100.0)
+                ok = (np.abs(q) <= _LIMIT_CM).all(axis=1)
+                xyz.append(q[ok].astype(np.int16))
+                inten.append(np.round(np.clip(pts[ok, 3], 0.0, 1.0) * 255).astype(np.uint8))
+                counts.append(int(ok.sum()))
+                lidar.append(a.lidar)
+                cloud_frame.append(f)
+                cloud_agent.append(a.id)
+                sample_cloud.append(c)
+                gts.append(gt_in_ego(fr, a, range_m=range_m).astype(np.float32))
+    if not counts:
+        raise input_error(f"split {split!r} of {list(inputs) or opv2v}: no frame to cache")
+    out_p = Path(out)
+    out_p.parent.mkdir(parents=True, exist_ok=True)
+    tmp = out_p.with_name(f".{out_p.name}.partial.npz")
+    meta = {
+        "frame_stride": frame_stride,
+        "split": split,
+        "ratios": list(ratios),
+        "seed": seed,
+        "range_m": range_m,
+        "sources": sorted(ds.sources),
+    }
+    np.savez_compressed(
+        tmp,
+        xyz_cm=np.concatenate(xyz),
+        intensity=np.concatenate(inten),
+        cloud_offsets=np.concatenate([[0], np.cumsum(counts)]).astype(np.int64),
+        cloud_lidar=np.stack(lidar),
+        cloud_frame=np.array(cloud_frame, dtype=np.int64),
+        cloud_agent=np.array(cloud_agent),
+        frame_seq=np.array(frame_seq, dtype=np.int64),
+        frame_index=np.array(frame_index, dtype=np.int64),
+        sequences=np.array(names),
+        sample_cloud=np.array(sample_cloud, dtype=np.int64),
+        gt=np.concatenate(gts) if gts else np.zeros((0, 7), np.float32),
+        gt_offsets=np.concatenate([[0], np.cumsum([len(g) for g in gts])]).astype(np.int64),
+        meta=np.array(json.dumps(meta)),
+    )
+    tmp.replace(out_p)
+    return out_p
+
+
+class Cache:
+    """A tensor cache read back (module docstring): :meth:`sample` gives one ego's inputs and ground truth."""
+
+    KEYS = (
+        "xyz_cm",
+        "intensity",
+        "cloud_offsets",
+        "cloud_lidar",
+        "cloud_frame",
+        "frame_seq",
+        "frame_index",
+        "sequences",
+        "sample_cloud",
+        "gt",
+        "gt_offsets",
+        "meta",
+    )
+
+    def __init__(self, path: str | Path) -> None:
+        p = Path(path)
+        try:
+            with np.load(p, allow_pickle=False) as z:
+                missing = [k for k in self.KEYS if k not in z.files]
+                if missing:
+                    raise input_error(f"--cache {p}: not an mmusv.learn cache (missing {missing})")
+                self.arrays: dict[str, np.ndarray] = {k: z[k] for k in self.KEYS}
+                if "cloud_agent" in z.files:  # caches written before it was added lack it
+                    self.arrays["cloud_agent"] = z["cloud_agent"]
+        except (OSError, ValueError) as exc:
+            raise input_error(f"--cache {p}: not a readable .npz cache ({type(exc).__name__}: {exc})") from None
+        self.path = p
+        self.meta: dict[str, Any] = json.loads(str(self.arrays["meta"]))
+        a = self.arrays
+        self.frame_clouds: list[np.ndarray] = [np.zeros(0, np.int64)] * len(a["frame_seq"])
+        order = np.argsort(a["cloud_frame"], kind="stable")
+        bounds = np.searchsorted(a["cloud_frame"][order], np.arange(len(a["frame_seq"]) + 1))
+        self.frame_clouds = [order[bounds[f] : bounds[f + 1]] for f in range(len(a["frame_seq"]))]
+
+    def __len__(self) -> int:
+        return len(self.arrays["sample_cloud"])
+
+    def cloud(self, c: int) -> np.ndarray:
+        """``(N, 4)`` float32 points of cloud ``c`` (LiDAR frame, metres; intensity in [0, 1])."""
+        a = self.arrays
+        lo, hi = a["cloud_offsets"][c], a["cloud_offsets"][c + 1]
+        out = np.empty((hi - lo, 4), dtype=np.float32)
+        out[:, :3] = a["xyz_cm"][lo:hi].astype(np.float32) / 100.0
+        out[:, 3] = a["intensity"][lo:hi].astype(np.float32) / 255.0
+        return out
+
+    def key(self, c: int) -> tuple[str, int, str]:
+        """``(sequence, acquisition index, agent id)`` of cloud ``c``: the detection study's key of an ego."""
+        a = self.arrays
+        f = int(a["cloud_frame"][c])
+        agent = str(a["cloud_agent"][c]) if "cloud_agent" in a else str(c)
+        return str(a["sequences"][a["frame_seq"][f]]), int(a["frame_index"][f]), agent
+
+    def frame_position(self, k: int) -> int:
+        """The position of sample ``k``'s frame within its sequence (0 for the first frame)."""
+        a = self.arrays
+        f = int(a["cloud_frame"][a["sample_cloud"][k]])
+        first = int(np.searchsorted(a["frame_seq"], a["frame_seq"][f]))
+        return f - first
+
+    def sample(self, k: int) -> Sample:
+        """Sample ``k``: the ego's cloud, every neighbour's cloud with its pose in the ego frame, the ground truth."""
+        a = self.arrays
+        c = int(a["sample_cloud"][k])
+        f = int(a["cloud_frame"][c])
+        inv = np.linalg.inv(a["cloud_lidar"][c])
+        nbs = [(self.cloud(int(o)), inv @ a["cloud_lidar"][o]) for o in self.frame_clouds[f] if int(o) != c]
+        gt = a["gt"][a["gt_offsets"][k] : a["gt_offsets"][k + 1]].astype(np.float64)
+        return self.cloud(c), nbs, gt

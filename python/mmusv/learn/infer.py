@@ -1,0 +1,92 @@
+"""Batch inference over a tensor cache with torch and numpy alone (a GPU machine without mmusv installed): the
+heatmap peaks (:func:`mmusv.learn.decode.peaks`, before rotated NMS) of the single-agent model on every cloud,
+and of the early- and intermediate-fusion models on every sample (the ego with its current neighbours).
+
+Output ``.npz``: for each of ``single`` (per cloud), ``early`` and ``intermediate`` (per sample): ``<m>_boxes``
+``(M, 7)`` float32 ego-frame ``x, y, z, l, w, h, yaw``, ``<m>_scores`` ``(M,)``, ``<m>_offsets`` (rows of item
+``i`` are ``offsets[i]:offsets[i+1]``); and ``intermediate_bytes`` ``(K,)`` the bytes the neighbours sent.
+:mod:`mmusv.learn.replay` turns it into the detection study's predictions Parquet (rotated NMS and late fusion
+done there by the study's own code).
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from mmusv.learn.cache import Cache
+from mmusv.learn.decode import peaks
+from mmusv.learn.example import collate, make_example, message_bytes
+from mmusv.learn.model import PillarNet
+from mmusv.learn.presets import Preset
+
+__all__ = ["infer_cache", "main"]
+
+
+def _model(path: Path, dev: torch.device) -> PillarNet:
+    ck = torch.load(path, map_location=dev, weights_only=False)
+    m = PillarNet(Preset.from_dict(ck["preset"]), ck["mode"])
+    m.load_state_dict(ck["model"])
+    return m.to(dev).eval()
+
+
+def infer_cache(
+    cache: Cache, models: str | Path, out: str | Path, *, device: str | None = None, limit: int | None = None
+) -> Path:
+    """Writes the peaks of every model found under ``models`` (``<mode>/model.pt``) on ``cache`` to ``out``
+    (the first ``limit`` items per model only, when given: smoke tests)."""
+    dev = torch.device(device or ("cuda" if torch.cuda.is_available() else "cpu"))
+    root = Path(models)
+    arrays: dict[str, np.ndarray] = {}
+    n_clouds = len(cache.arrays["cloud_offsets"]) - 1
+    for mode in ("single", "early", "intermediate"):
+        f = root / mode / "model.pt"
+        if not f.is_file():
+            continue
+        model = _model(f, dev)
+        p = model.preset
+        items = range(n_clouds) if mode == "single" else range(len(cache))
+        if limit is not None:
+            items = items[:limit]
+        boxes, scores, counts, sent = [], [], [], []
+        t0 = time.perf_counter()
+        for i in items:
+            if mode == "single":
+                ex = make_example(cache.cloud(i), [], None, mode=mode, p=p)
+            else:
+                ego, nbs, _ = cache.sample(i)
+                ex = make_example(ego, nbs, None, mode=mode, p=p)
+                if ex.nb is not None:
+                    sent.append(message_bytes(ex.nb, p.pfn_channels))
+            with torch.no_grad():
+                b, s = peaks(model(collate([ex]).to(dev)), p)
+            boxes.append(b.astype(np.float32))
+            scores.append(s.astype(np.float32))
+            counts.append(len(s))
+        arrays[f"{mode}_boxes"] = np.concatenate(boxes) if boxes else np.zeros((0, 7), np.float32)
+        arrays[f"{mode}_scores"] = np.concatenate(scores) if scores else np.zeros(0, np.float32)
+        arrays[f"{mode}_offsets"] = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+        if mode == "intermediate":
+            arrays["intermediate_bytes"] = np.array(sent, dtype=np.int64)
+        print(f"{mode}: {len(counts)} inferences, {time.perf_counter() - t0:.1f} s", flush=True)
+    out_p = Path(out)
+    np.savez_compressed(out_p, **arrays)  # type: ignore[arg-type]
+    return out_p
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``scripts/learn_train.py infer --cache C --models DIR -o OUT.npz``."""
+    ap = argparse.ArgumentParser(description="Heatmap peaks of trained models on a tensor cache (torch + numpy only).")
+    ap.add_argument("--cache", required=True)
+    ap.add_argument("--models", required=True, help="folder with <mode>/model.pt")
+    ap.add_argument("-o", "--out", required=True, help="output .npz")
+    ap.add_argument("--device", default=None)
+    ap.add_argument("--limit", type=int, default=None, help="first N items per model (smoke tests)")
+    a = ap.parse_args(argv)
+    infer_cache(Cache(a.cache), a.models, a.out, device=a.device, limit=a.limit)
+    return 0

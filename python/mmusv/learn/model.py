@@ -1,0 +1,48 @@
+"""The detector network: PointPillars' pillar encoder and scatter (:mod:`~mmusv.learn.pillars`), its 2D
+backbone (:mod:`~mmusv.learn.backbone`) and the CenterPoint head (:mod:`~mmusv.learn.head`).
+
+For intermediate fusion the neighbours' pillars go through the same encoder and are max-fused into the ego's
+canvas (:func:`~mmusv.learn.pillars.scatter_max`) before the backbone (F-Cooper's voxel-feature fusion,
+Chen et al., SEC 2019). Output: the head's maps, each ``(B, C, ny / out_stride, nx / out_stride)``.
+"""
+
+from __future__ import annotations
+
+import torch
+from torch import nn
+
+from mmusv.learn._errors import input_error
+from mmusv.learn.backbone import Backbone
+from mmusv.learn.example import MODES, Batch
+from mmusv.learn.head import CenterHead
+from mmusv.learn.pillars import PillarEncoder, scatter, scatter_max
+from mmusv.learn.presets import Preset
+
+__all__ = ["PillarNet"]
+
+
+class PillarNet(nn.Module):
+    """PointPillars + CenterPoint of preset ``p`` for training ``mode`` (``single``, ``early``,
+    ``intermediate``)."""
+
+    def __init__(self, p: Preset, mode: str) -> None:
+        super().__init__()
+        if mode not in MODES:
+            raise input_error(f"mode {mode!r}: allowed: {', '.join(MODES)}")
+        self.preset, self.mode = p, mode
+        self.encoder = PillarEncoder(p.pfn_channels)
+        self.backbone = Backbone(p, p.pfn_channels)
+        self.head = CenterHead(self.backbone.out_channels, p.head_channels)
+
+    def canvas(self, b: Batch) -> torch.Tensor:
+        """The BEV pillar canvas ``(B, C, ny, nx)`` (neighbours max-fused in intermediate mode)."""
+        f = self.encoder(b.features, b.mask)
+        out = scatter(f, b.coords, b.batch, size=b.size, grid=self.preset.grid)
+        if self.mode == "intermediate" and len(b.nb_cells):
+            g = self.encoder(b.nb_features, b.nb_mask)
+            out = scatter_max(out, g, b.nb_cells, b.nb_batch)
+        return out
+
+    def forward(self, b: Batch) -> dict[str, torch.Tensor]:
+        out: dict[str, torch.Tensor] = self.head(self.backbone(self.canvas(b)))
+        return out

@@ -1,0 +1,160 @@
+"""Training presets: the pillar grid, the network's widths and the optimiser, by name.
+
+- ``paper``: the paper's configuration (Sec. V): 0.4 m pillars over [-200, 200] m in x and y and [-20, 40] m in
+  z, Adam at 2e-3, batch 4, 30 epochs. Meant for a GPU.
+- ``cpu``: chosen to train on a 2-core CPU in under 45 minutes on the bundled detection dataset (three models:
+  single, early, intermediate): 2 m pillars over the same ±200 m (the evaluation range), two narrow backbone
+  stages, output cells of 4 m, every second frame of each training sequence (consecutive frames at 5 Hz are
+  nearly the same scene), 5 epochs. Run it with one thread per process (``--threads 1``) on a shared machine.
+- ``tiny``: for the tests (a few frames, seconds).
+
+All lengths in metres; ranges in the ego LiDAR frame (x forward, y left, z up).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, replace
+from typing import Any
+
+__all__ = ["PRESETS", "Preset", "preset"]
+
+
+@dataclass(frozen=True)
+class Preset:
+    """One training configuration.
+
+    ``pillar_m``: pillar edge; ``x_range``/``y_range``/``z_range``: ``(lo, hi)`` of the grid (points outside are
+    dropped); ``max_pillars``, ``max_points``: the non-empty pillars kept per cloud and points per pillar (the
+    rest dropped, in a seeded order); ``pfn_channels``: pillar feature width; ``blocks``: ``(channels, layers,
+    stride)`` of each backbone stage; ``up_channels``: each stage's upsampled width; ``out_stride``: output cell
+    = ``out_stride * pillar_m``; ``head_channels``: the head's shared conv width; ``lr``, ``batch``, ``epochs``,
+    ``weight_decay``; augmentation: ``flip``, ``rot_deg`` (uniform ±), ``scale`` (uniform ``(lo, hi)``);
+    ``frame_stride``: train on every k-th frame of a sequence; ``min_radius``: CenterPoint's least Gaussian
+    radius (cells); ``score_threshold``, ``top_k``, ``nms_iou``: decoding; ``yaw_double``: regress ``sin 2ψ,
+    cos 2ψ`` instead of ``sin ψ, cos ψ`` (a BEV box is the same at ψ and ψ + π, and a hull seen from one side
+    rarely shows which end is the bow: regressing ψ itself makes the head average the two answers; the study's
+    IoU does not depend on the direction). Default off, so checkpoints from before it was added decode as they
+    were trained; every preset sets it."""
+
+    name: str
+    pillar_m: float
+    x_range: tuple[float, float]
+    y_range: tuple[float, float]
+    z_range: tuple[float, float]
+    max_pillars: int
+    max_points: int
+    pfn_channels: int
+    blocks: tuple[tuple[int, int, int], ...]
+    up_channels: int
+    out_stride: int
+    head_channels: int
+    lr: float
+    batch: int
+    epochs: int
+    weight_decay: float = 1e-2
+    flip: bool = True
+    rot_deg: float = 45.0
+    scale: tuple[float, float] = (0.95, 1.05)
+    frame_stride: int = 1
+    min_radius: int = 2
+    score_threshold: float = 0.1
+    top_k: int = 100
+    nms_iou: float = 0.1
+    yaw_double: bool = False
+
+    @property
+    def grid(self) -> tuple[int, int]:
+        """``(nx, ny)`` pillars along x and y."""
+        nx = round((self.x_range[1] - self.x_range[0]) / self.pillar_m)
+        ny = round((self.y_range[1] - self.y_range[0]) / self.pillar_m)
+        return nx, ny
+
+    @property
+    def out_grid(self) -> tuple[int, int]:
+        """``(nx, ny)`` cells of the head's output maps."""
+        nx, ny = self.grid
+        return nx // self.out_stride, ny // self.out_stride
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain values (tuples as lists), for checkpoints and logs."""
+        return asdict(self)
+
+    @staticmethod
+    def from_dict(d: dict[str, Any]) -> Preset:
+        """The inverse of :meth:`to_dict`."""
+        v = dict(d)
+        for k in ("x_range", "y_range", "z_range", "scale"):
+            v[k] = tuple(v[k])
+        v["blocks"] = tuple(tuple(b) for b in v["blocks"])
+        return Preset(**v)
+
+
+PRESETS: dict[str, Preset] = {
+    "paper": Preset(
+        name="paper",
+        pillar_m=0.4,
+        x_range=(-200.0, 200.0),
+        y_range=(-200.0, 200.0),
+        z_range=(-20.0, 40.0),
+        max_pillars=40000,
+        max_points=32,
+        pfn_channels=64,
+        blocks=((64, 3, 2), (128, 5, 2), (256, 5, 2)),
+        up_channels=128,
+        out_stride=2,
+        head_channels=64,
+        lr=2e-3,
+        batch=4,
+        epochs=30,
+        yaw_double=True,
+    ),
+    "cpu": Preset(
+        name="cpu",
+        pillar_m=2.0,
+        x_range=(-200.0, 200.0),
+        y_range=(-200.0, 200.0),
+        z_range=(-20.0, 40.0),
+        max_pillars=12000,
+        max_points=8,
+        pfn_channels=16,
+        blocks=((24, 1, 2), (48, 1, 2)),
+        up_channels=32,
+        out_stride=2,
+        head_channels=16,
+        lr=2e-3,
+        batch=4,
+        epochs=5,
+        frame_stride=2,
+        yaw_double=True,
+    ),
+    "tiny": Preset(
+        name="tiny",
+        pillar_m=1.0,
+        x_range=(-32.0, 32.0),
+        y_range=(-32.0, 32.0),
+        z_range=(-5.0, 15.0),
+        max_pillars=2000,
+        max_points=8,
+        pfn_channels=16,
+        blocks=((16, 1, 1), (32, 1, 2)),
+        up_channels=16,
+        out_stride=1,
+        head_channels=16,
+        lr=3e-3,
+        batch=2,
+        epochs=1,
+        rot_deg=0.0,
+        flip=False,
+        scale=(1.0, 1.0),
+        min_radius=1,
+        yaw_double=True,
+    ),
+}
+
+
+def preset(name: str, **overrides: Any) -> Preset:
+    """The preset ``name`` (``paper``, ``cpu``, ``tiny``) with ``overrides`` applied; raises ``KeyError`` naming
+    the allowed ones for an unknown name."""
+    if name not in PRESETS:
+        raise KeyError(f"preset {name!r}: allowed: {', '.join(PRESETS)}")
+    return replace(PRESETS[name], **overrides)

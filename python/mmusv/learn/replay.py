@@ -1,0 +1,135 @@
+"""The detection study's predictions Parquet from the heatmap peaks of :mod:`mmusv.learn.infer` (inference done
+elsewhere, e.g. on a GPU machine without mmusv installed), for ``mmusv study detection --predictions``.
+
+Each cloud's or sample's peaks get the rotated NMS of :func:`mmusv.learn.decode.decode` (the study's own
+:func:`~mmusv.studies.detection.fusion.rotated_nms` at the preset's ``nms_iou``): that is ``none`` (the ego's own
+cloud), ``early`` and ``intermediate``. ``late`` is made by the study's :func:`~mmusv.studies.detection.fusion.fuse`
+from the single-agent detections of the ego and its current neighbours, as ``--model`` would. Clean setting only
+(the robustness settings re-run early and intermediate fusion on delayed or noisy inputs: use ``--model``).
+
+``python -m mmusv.learn.replay PEAKS.npz CACHE.npz RECORDINGS... [--split test] -o PREDICTIONS.parquet``
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from mmusv.learn.cache import Cache
+
+__all__ = ["main", "write_predictions"]
+
+Key = tuple[str, int, str]
+
+
+def _no_detector(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Late fusion reads the cached single-agent detections only; this is never called."""
+    raise AssertionError("late fusion called the detector")
+
+
+def _rows(z: dict[str, np.ndarray], mode: str, i: int) -> tuple[np.ndarray, np.ndarray]:
+    o = z[f"{mode}_offsets"]
+    return z[f"{mode}_boxes"][o[i] : o[i + 1]].astype(np.float64), z[f"{mode}_scores"][o[i] : o[i + 1]].astype(
+        np.float64
+    )
+
+
+def write_predictions(
+    peaks: str | Path,
+    cache: Cache,
+    inputs: Sequence[str | Path],
+    out: str | Path,
+    *,
+    split: str = "test",
+    ratios: Sequence[float] = (0.7, 0.15, 0.15),
+    seed: int = 0,
+    nms_iou: float = 0.1,
+) -> Path:
+    """Writes the predictions Parquet (module docstring) of ``peaks`` on ``cache`` (built from the same
+    ``inputs`` and split) to ``out``; returns ``out``."""
+    import polars as pl
+
+    from mmusv.studies.detection.data import AgentFrame
+    from mmusv.studies.detection.fusion import fuse, rotated_nms
+    from mmusv.studies.detection.robustness import Setting, neighbours_for
+    from mmusv.studies.detection.sources import resolve_dataset
+
+    with np.load(peaks) as f:
+        z = {k: f[k] for k in f.files}
+
+    def nms(b: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        keep = rotated_nms(b, s, iou_threshold=nms_iou)
+        return b[keep], s[keep]
+
+    own: dict[Key, tuple[np.ndarray, np.ndarray]] = {}
+    fused: dict[tuple[Key, str], tuple[np.ndarray, np.ndarray]] = {}
+    n_clouds = len(cache.arrays["cloud_offsets"]) - 1
+    for c in range(n_clouds):
+        if "single_offsets" in z:
+            own[cache.key(c)] = nms(*_rows(z, "single", c))
+    for k in range(len(cache)):
+        key = cache.key(int(cache.arrays["sample_cloud"][k]))
+        for mode in ("early", "intermediate"):
+            if f"{mode}_offsets" in z:
+                fused[(key, mode)] = nms(*_rows(z, mode, k))
+    ds = resolve_dataset(list(inputs), opv2v=None, split=split, ratios=tuple(ratios), seed=seed)
+    cols: dict[str, list[object]] = {
+        c: [] for c in ("sequence", "frame", "ego", "mode", "x", "y", "z", "l", "w", "h", "yaw", "score")
+    }
+
+    def add(key: Key, mode: str, b: np.ndarray, s: np.ndarray) -> None:
+        for row, sc in zip(b, s, strict=True):
+            for name, v in zip(("sequence", "frame", "ego", "mode"), (*key, mode), strict=True):
+                cols[name].append(v)
+            for name, v in zip(("x", "y", "z", "l", "w", "h", "yaw"), row, strict=True):
+                cols[name].append(float(v))
+            cols["score"].append(float(sc))
+
+    for seq in ds.sequences():
+        for t, frame in enumerate(seq.frames):
+            for ego in frame.agents:
+                key = (seq.name, frame.frame, ego.id)
+                if key in own:
+                    add(key, "none", *own[key])
+                    nbs = neighbours_for(seq, t, ego.id, Setting(), seed=seed)
+
+                    def mine(a: AgentFrame, f: int = frame.frame, s: str = seq.name) -> tuple[np.ndarray, np.ndarray]:
+                        return own[(s, f, a.id)]
+
+                    late = fuse("late", ego, nbs, detector=_no_detector, own_detections=mine)
+                    add(key, "late", *late)
+                for mode in ("early", "intermediate"):
+                    if (key, mode) in fused:
+                        add(key, mode, *fused[(key, mode)])
+    out_p = Path(out)
+    out_p.parent.mkdir(parents=True, exist_ok=True)
+    pl.DataFrame(
+        cols,
+        schema={
+            **dict.fromkeys(("sequence", "ego", "mode"), pl.Utf8),
+            "frame": pl.Int64,
+            **dict.fromkeys(("x", "y", "z", "l", "w", "h", "yaw", "score"), pl.Float64),
+        },
+    ).select(list(cols)).write_parquet(out_p)
+    return out_p
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """The command line of the module docstring."""
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0] if __doc__ else None)
+    ap.add_argument("peaks")
+    ap.add_argument("cache")
+    ap.add_argument("inputs", nargs="+")
+    ap.add_argument("--split", default="test")
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("-o", "--out", required=True)
+    a = ap.parse_args(argv)
+    print(write_predictions(a.peaks, Cache(a.cache), a.inputs, a.out, split=a.split, seed=a.seed))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

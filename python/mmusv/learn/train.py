@@ -1,0 +1,330 @@
+"""Training loop: seeded shuffling and augmentation, Adam with a warm-up and cosine decay, a tqdm progress bar,
+a JSON-lines log, a checkpoint after every epoch and resumption from it.
+
+Run from a tensor cache (:mod:`mmusv.learn.cache`) with torch and numpy alone::
+
+    PYTHONPATH=python python3 scripts/learn_train.py --cache CACHE.npz --preset paper --mode single -o OUT
+
+or through ``mmusv train`` (which builds the cache first). Files in the output folder:
+
+- ``last.pt``: the latest checkpoint (model, optimiser, epoch, step, log; written to a temporary file and
+  renamed, so an interruption leaves the previous one whole); training resumes from it when started again;
+- ``model.pt``: the weights, preset and mode for inference (:mod:`mmusv.learn.detector`), after every epoch;
+- ``log.jsonl``: one line per logged step (``epoch, step, loss, heatmap, regression, lr, seconds``) and one per
+  epoch (``"epoch_end": true``); :func:`plot_losses` draws it.
+
+Determinism: weights are initialised after ``torch.manual_seed(seed)``; the order of an epoch is a permutation
+drawn from ``(seed, epoch)``; each sample's augmentation from ``(seed, epoch, index)``, so it does not depend on
+the number of loader workers. On CPU with ``torch.use_deterministic_algorithms``, the same seed gives the same
+weights. With ``time_limit_s`` the run stops at the first epoch end past the limit (or mid-epoch, checkpointed,
+when an epoch would overrun), and the learning-rate schedule runs on elapsed time instead of steps.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+
+from mmusv.learn._errors import input_error
+from mmusv.learn.augment import apply, draw
+from mmusv.learn.cache import Cache
+from mmusv.learn.example import MODES, Example, collate, make_example
+from mmusv.learn.loss import centerpoint_loss
+from mmusv.learn.model import PillarNet
+from mmusv.learn.presets import PRESETS, Preset, preset
+
+__all__ = ["TrainResult", "TrainingSet", "main", "plot_losses", "plot_runs", "train"]
+
+WARMUP_STEPS = 100
+LOG_EVERY = 10
+
+
+class TrainingSet(torch.utils.data.Dataset[Example]):
+    """The cache's samples (every ``frame_stride``-th frame of each sequence, or ``indices``) as augmented
+    examples of ``mode``; :attr:`epoch` selects the augmentation draws. ``cache`` is a :class:`Cache` or any
+    object with its ``__len__``, ``sample`` and ``frame_position``."""
+
+    def __init__(
+        self,
+        cache: Cache,
+        p: Preset,
+        mode: str,
+        *,
+        seed: int,
+        augment: bool = True,
+        indices: Sequence[int] | None = None,
+    ) -> None:
+        self.cache, self.p, self.mode, self.seed, self.augment = cache, p, mode, seed, augment
+        if indices is None:
+            indices = [k for k in range(len(cache)) if cache.frame_position(k) % p.frame_stride == 0]
+        self.indices = list(indices)
+        self.epoch = 0
+
+    def __len__(self) -> int:
+        return len(self.indices)
+
+    def __getitem__(self, i: int) -> Example:
+        k = self.indices[i]
+        ego, nbs, gt = self.cache.sample(k)
+        if self.augment:
+            rng = np.random.default_rng([self.seed, self.epoch, k])
+            ego, nbs, gt = apply(draw(rng, self.p), ego, nbs, gt)
+        return make_example(ego, nbs, gt, mode=self.mode, p=self.p)
+
+
+@dataclass(frozen=True)
+class TrainResult:
+    """Where the run wrote (``out``), the epochs completed, the optimiser steps and the wall time (s)."""
+
+    out: Path
+    epochs: int
+    steps: int
+    seconds: float
+    finished: bool
+
+
+def _lr(p: Preset, step: int, progress: float) -> float:
+    warm = min(1.0, (step + 1) / WARMUP_STEPS)
+    return p.lr * warm * (0.02 + 0.98 * 0.5 * (1 + math.cos(math.pi * min(1.0, progress))))
+
+
+def _save(obj: dict[str, Any], path: Path) -> None:
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    torch.save(obj, tmp)
+    tmp.replace(path)
+
+
+def train(
+    cache: Cache | str | Path,
+    *,
+    p: Preset,
+    mode: str,
+    out: str | Path,
+    seed: int = 0,
+    epochs: int | None = None,
+    time_limit_s: float | None = None,
+    max_steps: int | None = None,
+    device: str | None = None,
+    workers: int = 0,
+    progress: bool = True,
+    indices: Sequence[int] | None = None,
+    augment: bool = True,
+) -> TrainResult:
+    """Trains model ``mode`` of preset ``p`` on ``cache`` into ``out`` (module docstring); resumes from
+    ``out/last.pt`` when present. ``epochs`` defaults to the preset's; ``max_steps`` stops early (tests)."""
+    if mode not in MODES:
+        raise input_error(f"--mode {mode!r}: allowed: {', '.join(MODES)}")
+    c = Cache(cache) if isinstance(cache, (str, Path)) else cache
+    out_p = Path(out)
+    out_p.mkdir(parents=True, exist_ok=True)
+    dev = torch.device(device or ("cuda" if torch.cuda.is_available() else "cpu"))
+    if dev.type == "cpu":
+        torch.use_deterministic_algorithms(True)
+    else:
+        torch.backends.cuda.matmul.allow_tf32 = True
+        torch.backends.cudnn.allow_tf32 = True
+        torch.backends.cudnn.benchmark = True
+    n_epochs = epochs if epochs is not None else p.epochs
+    torch.manual_seed(seed)
+    model = PillarNet(p, mode).to(dev)
+    opt = torch.optim.AdamW(model.parameters(), lr=p.lr, weight_decay=p.weight_decay)
+    data = TrainingSet(c, p, mode, seed=seed, augment=augment, indices=indices)
+    if len(data) == 0:
+        raise input_error(f"--cache {getattr(c, 'path', c)}: no training sample")
+    steps_per_epoch = math.ceil(len(data) / p.batch)
+    start_epoch, step, log, spent = 0, 0, [], 0.0
+    last = out_p / "last.pt"
+    if last.is_file():
+        ck = torch.load(last, map_location=dev, weights_only=False)
+        if ck["preset"] != p.to_dict() or ck["mode"] != mode or ck["seed"] != seed:
+            raise input_error(f"{last}: a checkpoint of another run (preset/mode/seed differ); use another --out")
+        model.load_state_dict(ck["model"])
+        opt.load_state_dict(ck["optimizer"])
+        start_epoch, step, log, spent = ck["epoch"], ck["step"], ck["log"], ck["seconds"]
+    log_path = out_p / "log.jsonl"
+    t0 = time.perf_counter() - spent
+    finished = True
+    amp = dev.type == "cuda"
+    bar: Any = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=n_epochs * steps_per_epoch, initial=step, desc=f"train {mode} ({p.name})", unit="step")
+    epoch = start_epoch
+    while epoch < n_epochs:
+        data.epoch = epoch
+        order = np.random.default_rng([seed, epoch, 7]).permutation(len(data))
+        sampler = [int(i) for i in order]
+        loader = torch.utils.data.DataLoader(
+            data,
+            batch_size=p.batch,
+            sampler=sampler,
+            collate_fn=collate,
+            num_workers=workers,
+            drop_last=False,
+            pin_memory=dev.type == "cuda",
+        )
+        model.train()
+        stopped = False
+        for batch in loader:
+            elapsed = time.perf_counter() - t0
+            prog = step / max(1, n_epochs * steps_per_epoch)
+            if time_limit_s:
+                prog = max(prog, elapsed / time_limit_s)
+            lr = _lr(p, step, prog)
+            for g in opt.param_groups:
+                g["lr"] = lr
+            b = batch.to(dev)
+            with torch.autocast(device_type=dev.type, dtype=torch.bfloat16, enabled=amp):
+                outs = model(b)
+            assert b.heatmap is not None and b.index is not None and b.reg_mask is not None and b.reg is not None
+            losses = centerpoint_loss(outs, b.heatmap, b.index, b.reg_mask, b.reg)
+            opt.zero_grad(set_to_none=True)
+            losses["loss"].backward()  # type: ignore[no-untyped-call]
+            torch.nn.utils.clip_grad_norm_(model.parameters(), 35.0)
+            opt.step()
+            step += 1
+            if bar is not None:
+                bar.update(1)
+                bar.set_postfix(loss=f"{losses['loss'].item():.3f}", epoch=epoch + 1)
+            if step % LOG_EVERY == 0 or step == 1:
+                rec = {k: round(float(v.item()), 6) for k, v in losses.items()}
+                log.append({"epoch": epoch, "step": step, **rec, "lr": lr, "seconds": round(elapsed, 2)})
+            if (max_steps is not None and step >= max_steps) or (
+                time_limit_s and time.perf_counter() - t0 > time_limit_s
+            ):
+                stopped = True
+                break
+        epoch_done = not stopped
+        if epoch_done:
+            epoch += 1
+            log.append({"epoch": epoch, "step": step, "epoch_end": True, "seconds": round(time.perf_counter() - t0, 2)})
+            if bar is None:
+                print(
+                    f"{mode}: epoch {epoch}/{n_epochs}, step {step}, loss {losses['loss'].item():.4f}, "
+                    f"{time.perf_counter() - t0:.1f} s",
+                    flush=True,
+                )
+        state = {
+            "preset": p.to_dict(),
+            "mode": mode,
+            "seed": seed,
+            "epoch": epoch,
+            "step": step,
+            "log": log,
+            "seconds": time.perf_counter() - t0,
+        }
+        _save({**state, "model": model.state_dict(), "optimizer": opt.state_dict()}, last)
+        _save({**state, "model": model.state_dict(), "log": []}, out_p / "model.pt")
+        log_path.write_text("".join(json.dumps(r) + "\n" for r in log), encoding="utf-8")
+        if stopped:
+            finished = max_steps is not None and step >= max_steps
+            break
+    if bar is not None:
+        bar.close()
+    return TrainResult(out_p, epoch, step, time.perf_counter() - t0, finished and epoch >= n_epochs)
+
+
+def plot_losses(log_path: str | Path, png: str | Path) -> Path:
+    """Draws the total, heatmap and regression losses of ``log.jsonl`` (or several: one per line style) over
+    the optimiser steps into ``png``; returns ``png``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    rows = [json.loads(line) for line in Path(log_path).read_text(encoding="utf-8").splitlines() if line.strip()]
+    steps = [r for r in rows if "loss" in r]
+    fig, ax = plt.subplots(figsize=(7, 4))
+    for key, style in (("loss", "-"), ("heatmap", "--"), ("regression", ":")):
+        ax.plot([r["step"] for r in steps], [r[key] for r in steps], style, label=key)
+    for r in rows:
+        if r.get("epoch_end"):
+            ax.axvline(r["step"], color="0.85", lw=0.8)
+    ax.set_yscale("log")
+    ax.set_xlabel("optimiser step (grey: epoch ends)")
+    ax.set_ylabel("loss per object")
+    ax.legend()
+    ax.set_title(f"training loss: {Path(log_path).parent.name}")
+    fig.tight_layout()
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
+    return Path(png)
+
+
+def plot_runs(logs: dict[str, str | Path], png: str | Path, *, title: str) -> Path:
+    """The total loss of several runs' ``log.jsonl`` (by label) over the optimiser steps in one plot."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4))
+    for label, path in logs.items():
+        rows = [json.loads(x) for x in Path(path).read_text(encoding="utf-8").splitlines() if x.strip()]
+        steps = [r for r in rows if "loss" in r]
+        ax.plot([r["step"] for r in steps], [r["loss"] for r in steps], label=label, lw=0.9)
+    ax.set_yscale("log")
+    ax.set_xlabel("optimiser step")
+    ax.set_ylabel("loss per object")
+    ax.legend()
+    ax.set_title(title)
+    fig.tight_layout()
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
+    return Path(png)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``python -m mmusv.learn.train`` / ``scripts/learn_train.py``: train one or more modes from a cache."""
+    ap = argparse.ArgumentParser(description="Train mmusv.learn models from a tensor cache (torch + numpy only).")
+    ap.add_argument("--cache", required=True, help="the .npz tensor cache (mmusv train --cache-only writes one)")
+    ap.add_argument("--preset", default="cpu", choices=sorted(PRESETS))
+    ap.add_argument("--modes", default="single,early,intermediate", help="models to train, in turn")
+    ap.add_argument("-o", "--out", required=True, help="output folder (one sub-folder per mode)")
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--epochs", type=int, default=None, help="epochs (default: the preset's)")
+    ap.add_argument("--time-limit", type=float, default=None, help="seconds per mode (stops at the limit)")
+    ap.add_argument("--max-steps", type=int, default=None, help="stop after this many steps (smoke tests)")
+    ap.add_argument("--workers", type=int, default=0, help="data-loader worker processes")
+    ap.add_argument("--device", default=None, help="cpu or cuda (default: cuda when available)")
+    ap.add_argument("--threads", type=int, default=None, help="CPU threads of torch (default: torch's)")
+    ap.add_argument("--no-progress", action="store_true")
+    a = ap.parse_args(argv)
+    if a.threads is not None:
+        torch.set_num_threads(max(1, a.threads))
+    p = preset(a.preset)
+    cache = Cache(a.cache)
+    for mode in [m.strip() for m in a.modes.split(",") if m.strip()]:
+        r = train(
+            cache,
+            p=p,
+            mode=mode,
+            out=Path(a.out) / mode,
+            seed=a.seed,
+            epochs=a.epochs,
+            time_limit_s=a.time_limit,
+            max_steps=a.max_steps,
+            device=a.device,
+            workers=a.workers,
+            progress=not a.no_progress,
+        )
+        print(
+            f"{mode}: {r.epochs} epochs, {r.steps} steps, {r.seconds:.1f} s, finished={r.finished} -> {r.out}",
+            flush=True,
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,24 @@
+"""Packs the models of ``scripts/learn_train.py``'s output folder for transfer: ``SRC/<mode>/model.pt`` →
+``DST/<mode>.pt`` with float16 weights (half the size; :func:`mmusv.learn.detector.load_models` loads them back
+into float32) and ``SRC/<mode>/log.jsonl`` → ``DST/<mode>.jsonl``. Needs torch only.
+Usage: ``python3 scripts/learn_pack.py SRC DST``."""
+
+from __future__ import annotations
+
+import shutil
+import sys
+from pathlib import Path
+
+import torch
+
+if __name__ == "__main__":
+    src, dst = Path(sys.argv[1]), Path(sys.argv[2])
+    dst.mkdir(parents=True, exist_ok=True)
+    for d in sorted(x for x in src.iterdir() if (x / "model.pt").is_file()):
+        ck = torch.load(d / "model.pt", map_location="cpu", weights_only=False)
+        ck["model"] = {k: (v.half() if v.is_floating_point() else v) for k, v in ck["model"].items()}
+        torch.save(ck, dst / f"{d.name}.pt")
+        shutil.copy(d / "log.jsonl", dst / f"{d.name}.jsonl")
+        print(
+            f"{d.name}: epoch {ck['epoch']}, step {ck['step']}, {(dst / f'{d.name}.pt').stat().st_size / 2**20:.1f} MiB"
+        )

@@ -1,0 +1,61 @@
+"""Training: a tiny model overfits a few synthetic frames, the loss falls, the same seed gives the same weights,
+and an interrupted run resumes."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import torch
+from mmusv.learn.detector import load_models
+from mmusv.learn.presets import preset
+from mmusv.learn.train import plot_losses, train
+from mmusv.studies.detection.evaluate import FrameMatch, summarize
+
+from learn.scenes import SCENES, MemorySource
+
+OVERFIT_STEPS = 150
+
+
+def _losses(out: Path) -> list[float]:
+    rows = [json.loads(x) for x in (out / "log.jsonl").read_text().splitlines()]
+    return [r["loss"] for r in rows if "loss" in r]
+
+
+def test_tiny_model_overfits_a_few_frames(tmp_path: Path) -> None:
+    src = MemorySource(SCENES)
+    p = preset("tiny", score_threshold=0.3)
+    r = train(
+        src, p=p, mode="single", out=tmp_path, epochs=10_000, max_steps=OVERFIT_STEPS, progress=False, augment=False
+    )
+    assert r.steps == OVERFIT_STEPS
+    det = load_models(tmp_path / "model.pt")
+    frames = []
+    for k in range(len(src)):
+        pts, _, gt = src.sample(k)
+        boxes, scores = det(pts)
+        frames.append(FrameMatch.evaluate(boxes, scores, gt))
+    m = summarize(frames)
+    assert m["ap50"] >= 0.9, m
+    losses = _losses(tmp_path)
+    assert np.mean(losses[-3:]) < 0.25 * np.mean(losses[:3])  # the loss falls
+    png = plot_losses(tmp_path / "log.jsonl", tmp_path / "loss.png")
+    assert png.stat().st_size > 0
+
+
+def test_same_seed_same_weights_and_resume(tmp_path: Path) -> None:
+    src = MemorySource(SCENES[:2])
+    p = preset("tiny")
+    runs = []
+    for name, seed in (("a", 4), ("b", 4), ("c", 5)):
+        train(src, p=p, mode="intermediate", out=tmp_path / name, seed=seed, epochs=3, progress=False)
+        runs.append(torch.load(tmp_path / name / "model.pt", weights_only=False)["model"])
+    assert all(torch.equal(runs[0][k], runs[1][k]) for k in runs[0])
+    assert any(not torch.equal(runs[0][k], runs[2][k]) for k in runs[0] if runs[0][k].is_floating_point())
+    # interrupted after one epoch, then started again: the same weights as the run that went through
+    train(src, p=p, mode="intermediate", out=tmp_path / "d", seed=4, epochs=1, progress=False)
+    r = train(src, p=p, mode="intermediate", out=tmp_path / "d", seed=4, epochs=3, progress=False)
+    assert r.epochs == 3
+    resumed = torch.load(tmp_path / "d" / "model.pt", weights_only=False)["model"]
+    assert all(torch.equal(runs[0][k], resumed[k]) for k in runs[0])
