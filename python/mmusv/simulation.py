@@ -383,11 +383,7 @@ class Simulation:
             raise ConfigError(
                 f"unknown sensor kind(s) {sorted(kinds - set(SENSOR_KINDS))}; allowed: {', '.join(SENSOR_KINDS)}"
             )
-        # The waves reach as far as the sensors look: a LiDAR-only capture needs them within its range only.
-        lidar_only = kinds <= {"lidar"}
-        ranges = [a.rig.lidar.range_m for a in self.agents if a.rig.lidar is not None]
-        radius = min(320.0, max(ranges) + 40.0) if lidar_only and ranges else 320.0
-        state = self.set_frame(frame, sea_radius_m=radius)
+        state = self.set_frame(frame)
         sc = self.scenario
         out: dict[str, AgentCapture] = {}
         tasks: list[core._CaptureTask] = []

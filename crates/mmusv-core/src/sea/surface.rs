@@ -68,7 +68,12 @@ struct Tile {
     h: Vec<f32>,
     /// `(n+1)²` slopes `(∂η/∂x, ∂η/∂y)`.
     g: Vec<[f32; 2]>,
+    /// Highest node of each block of [`BLOCK`] × [`BLOCK`] cells, row-major (empty when `n <= BLOCK`).
+    bmax: Vec<f32>,
 }
+
+/// Cells along a side of a block, the march's middle level: a ray over a block's highest node skips it whole.
+const BLOCK: usize = 4;
 
 /// The displaced sea surface of one frame (see the module docs).
 #[derive(Debug, Clone)]
@@ -415,15 +420,81 @@ impl March<'_> {
             return None; // wholly under the tile's troughs, and already under water
         }
         let n = tile.n;
+        if n <= BLOCK {
+            return self.cells(ix, iy, ta, tb, [0, 0], [n - 1, n - 1]);
+        }
+        // Block by block (2D DDA over BLOCK × BLOCK cells), skipping the blocks the ray passes over.
+        let nb = n / BLOCK;
+        let bs = s.tile_m / nb as f32;
+        let (tx0, ty0) = (s.x0 + ix as f32 * s.tile_m, s.y0 + iy as f32 * s.tile_m);
+        let (o, d) = (self.o, self.d);
+        let (u0, v0) = ((o[0] - tx0) / bs, (o[1] - ty0) / bs);
+        let (du, dv) = (d[0] / bs, d[1] / bs);
+        let clampb = |v: f32| (v.floor().max(0.0) as usize).min(nb - 1);
+        let (mut bi, mut bj) = (clampb(u0 + du * ta), clampb(v0 + dv * ta));
+        let next = |c: usize, da: f32, base: f32| {
+            if da == 0.0 {
+                f32::INFINITY
+            } else {
+                (c as f32 + if da > 0.0 { 1.0 } else { 0.0 } - base) / da
+            }
+        };
+        let (mut tu, mut tv) = (next(bi, du, u0), next(bj, dv, v0));
+        let dtu = if du == 0.0 { f32::INFINITY } else { 1.0 / du.abs() };
+        let dtv = if dv == 0.0 { f32::INFINITY } else { 1.0 / dv.abs() };
+        let mut t = ta;
+        loop {
+            let t_exit = tu.min(tv).min(tb);
+            if t_exit >= t {
+                let top = tile.bmax[bj * nb + bi];
+                if self.z(t).min(self.z(t_exit)) > top && self.above != Some(false) {
+                    self.above = Some(true);
+                } else {
+                    let lo = [bi * BLOCK, bj * BLOCK];
+                    let hi = [lo[0] + BLOCK - 1, lo[1] + BLOCK - 1];
+                    if let Some(h) = self.cells(ix, iy, t, t_exit, lo, hi) {
+                        return Some(h);
+                    }
+                }
+            }
+            if t_exit >= tb {
+                return None;
+            }
+            t = t_exit;
+            if tu <= tv {
+                let nc = bi as isize + if du > 0.0 { 1 } else { -1 };
+                if nc < 0 || nc >= nb as isize {
+                    return None;
+                }
+                bi = nc as usize;
+                tu += dtu;
+            } else {
+                let nc = bj as isize + if dv > 0.0 { 1 } else { -1 };
+                if nc < 0 || nc >= nb as isize {
+                    return None;
+                }
+                bj = nc as usize;
+                tv += dtv;
+            }
+        }
+    }
+
+    /// The stretch `[ta, tb]` over the cells `lo..=hi` (column, row) of tile `(ix, iy)`: cell by cell (2D DDA),
+    /// triangle by triangle.
+    fn cells(&mut self, ix: usize, iy: usize, ta: f32, tb: f32, lo: [usize; 2], hi: [usize; 2]) -> Option<SurfaceHit> {
+        let s = self.s;
+        let k = iy * s.ntx + ix;
+        let tile = &s.tiles[k];
+        let n = tile.n;
         let cs = s.tile_m / n as f32;
         let (tx0, ty0) = (s.x0 + ix as f32 * s.tile_m, s.y0 + iy as f32 * s.tile_m);
         let (o, d) = (self.o, self.d);
         // Cell coordinates (u, v) along the ray: u(t) = (o.x + d.x t - tx0) / cs.
         let (u0, v0) = ((o[0] - tx0) / cs, (o[1] - ty0) / cs);
         let (du, dv) = (d[0] / cs, d[1] / cs);
-        let clampc = |v: f32| (v.floor().max(0.0) as usize).min(n - 1);
-        let mut ci = clampc(u0 + du * ta);
-        let mut cj = clampc(v0 + dv * ta);
+        let clampc = |v: f32, a: usize| (v.floor().max(lo[a] as f32) as usize).min(hi[a]);
+        let mut ci = clampc(u0 + du * ta, 0);
+        let mut cj = clampc(v0 + dv * ta, 1);
         let next = |c: usize, da: f32, base: f32| {
             if da == 0.0 {
                 f32::INFINITY
@@ -488,14 +559,14 @@ impl March<'_> {
             t = t_exit;
             if tu <= tv {
                 let nc = ci as isize + if du > 0.0 { 1 } else { -1 };
-                if nc < 0 || nc >= n as isize {
+                if nc < lo[0] as isize || nc > hi[0] as isize {
                     return None;
                 }
                 ci = nc as usize;
                 tu += dtu;
             } else {
                 let nc = cj as isize + if dv > 0.0 { 1 } else { -1 };
-                if nc < 0 || nc >= n as isize {
+                if nc < lo[1] as isize || nc > hi[1] as isize {
                     return None;
                 }
                 cj = nc as usize;
@@ -656,8 +727,31 @@ impl<'a> Phasors<'a> {
                 zmax = zmax.max(z);
             }
         }
-        Tile { n, zmin, zmax, h, g }
+        let bmax = block_maxima(n, &h);
+        Tile { n, zmin, zmax, h, g, bmax }
     }
+}
+
+/// The highest node of every [`BLOCK`] × [`BLOCK`]-cell block of an `n`-cell tile's heights `h` (none when the
+/// tile is a single block).
+fn block_maxima(n: usize, h: &[f32]) -> Vec<f32> {
+    if n <= BLOCK {
+        return Vec::new();
+    }
+    let (nb, w) = (n / BLOCK, n + 1);
+    let mut out = vec![f32::NEG_INFINITY; nb * nb];
+    for j in 0..w {
+        for i in 0..w {
+            // A node on a block edge belongs to both blocks.
+            for bj in (j.saturating_sub(1) / BLOCK)..=(j / BLOCK).min(nb - 1) {
+                for bi in (i.saturating_sub(1) / BLOCK)..=(i / BLOCK).min(nb - 1) {
+                    let m = &mut out[bj * nb + bi];
+                    *m = m.max(h[j * w + i]);
+                }
+            }
+        }
+    }
+    out
 }
 
 #[cfg(test)]
