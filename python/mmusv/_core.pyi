@@ -113,6 +113,34 @@ class Scene:
         """Declares instance ``surface`` the sea surface (a horizontal plane) and ``moving`` (K,) uint32 the
         instances that will move: enables the exact sea and sky shortcuts."""
 
+    def set_wave_surface(
+        self,
+        hs_m: float | None,
+        *,
+        tp_s: float = 8.0,
+        gamma: float = 3.3,
+        direction_rad: float = 0.0,
+        spread_s: float = 10.0,
+        scenario_seed: int = 0,
+        time_s: float = 0.0,
+        foci: npt.NDArray[np.float32] | None = None,
+        level: float = 0.0,
+        tile_m: float = 32.0,
+        near_m: float = 40.0,
+        radius_m: float = 320.0,
+        taper_m: float = 60.0,
+    ) -> None:
+        """Sets the displaced sea surface of the frame: the JONSWAP wave field of (hs_m, tp_s, gamma,
+        direction_rad, spread_s) drawn from the scenario's sea seed, sampled at ``time_s`` around ``foci`` (F, 2)
+        float32; ``hs_m=None`` clears it."""
+
+    def wave_heights(self, xy: npt.NDArray[np.float32]) -> npt.NDArray[np.float32]:
+        """Heights (N,) float32 of the displaced sea surface at ``xy`` (N, 2) float32 world x, y."""
+
+    @property
+    def wave_top(self) -> float | None:
+        """The crest bound of the displaced sea surface, or None."""
+
     def clear_sea(self) -> None:
         """Forgets the sea surface: every ray is traced fully again."""
 

@@ -95,6 +95,8 @@ def annotations_for(sim: Simulation, cap: FrameCapture, silhouettes: SilhouetteC
             cameras=cams,
             silhouettes=silhouettes,
             max_range_m=rng,
+            scene=sim.ws.scene,
+            lidar_pattern=agent.lidar.pattern() if agent.lidar is not None else None,
         )
     return out
 

@@ -10,6 +10,9 @@ For every agent (USV) and frame, for every other vessel (the agent's own hull is
   image, with ``truncation`` = 1 − clipped area / unclipped area, ``visible_pixels`` (pixels whose instance is
   the vessel), ``box_pixels`` (the clipped box area) and ``occlusion`` = 1 − visible / silhouette, where the
   silhouette is the vessel's pixels with everything else removed (its rays cast against the vessel alone).
+* over a displaced sea (a scene with a wave surface), per 3D box and per 2D box, ``wave_occlusion``: the share of
+  the vessel's part above the still water level that the water hides from that sensor (:mod:`mmusv.wave_occlusion`);
+  0 over a flat sea.
 
 Frames: LiDAR frame x forward, y left, z up; image u right, v down, pixel centres at +0.5.
 """
@@ -24,6 +27,7 @@ from scipy.spatial.transform import Rotation
 
 from mmusv.frames import BODY_TO_OPTICAL, translation
 from mmusv.scene import Scene
+from mmusv.wave_occlusion import exposed_hidden, lidar_box_rays, pattern_angles, share
 from mmusv.world.vessels import get_asset
 
 __all__ = ["Annotations", "SilhouetteCache", "annotate_agent", "box_corners", "in_target_range"]
@@ -74,6 +78,7 @@ class Annotations:
     lidar_range: list[float] = field(default_factory=list)
     lidar_role: list[str] = field(default_factory=list)
     lidar_static: list[bool] = field(default_factory=list)
+    lidar_wave_occlusion: list[float] = field(default_factory=list)
     cam_ids: list[str] = field(default_factory=list)
     cam_camera: list[str] = field(default_factory=list)
     cam_box: list[np.ndarray] = field(default_factory=list)
@@ -83,6 +88,7 @@ class Annotations:
     cam_occlusion: list[float] = field(default_factory=list)
     cam_role: list[str] = field(default_factory=list)
     cam_static: list[bool] = field(default_factory=list)
+    cam_wave_occlusion: list[float] = field(default_factory=list)
 
     def columns(self) -> dict[str, Any]:
         """Numpy columns: ``lidar`` and ``bev`` and ``camera`` dicts of arrays (shapes in the docstrings above)."""
@@ -101,6 +107,7 @@ class Annotations:
             "range_m": np.array(self.lidar_range, dtype=np.float64),
             "role": list(self.lidar_role),
             "static": np.array(self.lidar_static, dtype=bool),
+            "wave_occlusion": np.array(self.lidar_wave_occlusion, dtype=np.float64),
         }
         bev = {
             "target_id": list(self.lidar_ids),
@@ -125,6 +132,7 @@ class Annotations:
             "occlusion": np.array(self.cam_occlusion, dtype=np.float64),
             "role": list(self.cam_role),
             "static": np.array(self.cam_static, dtype=bool),
+            "wave_occlusion": np.array(self.cam_wave_occlusion, dtype=np.float64),
         }
         return {"lidar": lidar, "bev": bev, "camera": camera}
 
@@ -137,6 +145,12 @@ class SilhouetteCache:
 
     def hits(self, asset: str, pose: np.ndarray, origins: np.ndarray, directions: np.ndarray) -> np.ndarray:
         """``(N,)`` bool: which rays hit the vessel ``asset`` at ``pose`` (body → world), alone in the world."""
+        hit: np.ndarray = np.isfinite(self.distances(asset, pose, origins, directions))
+        return hit
+
+    def distances(self, asset: str, pose: np.ndarray, origins: np.ndarray, directions: np.ndarray) -> np.ndarray:
+        """``(N,)`` float32 distance (metres along each normalised direction) at which each ray meets the vessel
+        ``asset`` at ``pose`` (body → world), alone in the world; ``inf`` where it misses."""
         if asset not in self._scenes:
             a = get_asset(asset)
             s = Scene()
@@ -145,8 +159,8 @@ class SilhouetteCache:
         scene, inst = self._scenes[asset]
         scene.set_poses([inst], pose[None])
         if origins.shape[0] == 0:
-            return np.zeros(0, dtype=bool)
-        return scene.cast_rays(origins, directions).hit
+            return np.zeros(0, dtype=np.float32)
+        return scene.cast_rays(origins, directions).distance
 
 
 def _project_box(corners_opt: np.ndarray, k: tuple[float, float, float, float]) -> np.ndarray | None:
@@ -180,6 +194,8 @@ def annotate_agent(
     cameras: dict[str, tuple[Any, np.ndarray, np.ndarray]],
     silhouettes: SilhouetteCache,
     max_range_m: float,
+    scene: Scene | None = None,
+    lidar_pattern: np.ndarray | None = None,
 ) -> Annotations:
     """Annotations of one agent (see the module docstring).
 
@@ -190,7 +206,11 @@ def annotate_agent(
         lidar_instances: ``(N,)`` instance id of each LiDAR point (for the point counts).
         cameras: name -> (native camera, ``(4, 4)`` camera body → world, ``(H, W)`` instance image).
         max_range_m: vessels outside this range of the LiDAR (:func:`in_target_range`) get no 3D/BEV box.
+        scene: the full scene; where it has a wave surface, the boxes' ``wave_occlusion`` is computed (else 0).
+        lidar_pattern: ``(M, 3)`` float32 unit beam directions in the LiDAR frame (for the 3D boxes' share).
     """
+    waves = scene is not None and scene.wave_top is not None
+    angles = pattern_angles(lidar_pattern) if waves and lidar_pattern is not None else None
     ann = Annotations(agent=agent_id, frame=frame, time_s=time_s)
     ref = lidar_pose if lidar_pose is not None else state.matrices[agent_index]
     ref_inv = np.linalg.inv(ref)
@@ -222,6 +242,12 @@ def annotate_agent(
             ann.lidar_range.append(rng)
             ann.lidar_role.append(info.role)
             ann.lidar_static.append(bool(info.static))
+            wave = 0.0
+            if scene is not None and lidar_pose is not None and lidar_pattern is not None and angles is not None:
+                o, d = lidar_box_rays(lidar_pattern, angles, lidar_pose, box_corners(box_world, info.box_size))
+                t = silhouettes.distances(info.asset, state.matrices[vi], o, d)
+                wave = share(*exposed_hidden(scene, o, d, t))
+            ann.lidar_wave_occlusion.append(wave)
         corners_world = box_corners(box_world, info.box_size)
         for name, (cam, k, inv, pose, inst_img) in views.items():
             h, w = inst_img.shape
@@ -241,7 +267,8 @@ def annotate_agent(
             vv, uu = np.mgrid[v0:v1, u0:u1]
             pix = np.ascontiguousarray((vv * w + uu).reshape(-1), dtype=np.int64)
             o, d = cam.pixel_rays(pose, pix)
-            sil = int(np.count_nonzero(silhouettes.hits(info.asset, state.matrices[vi], o, d)))
+            t_alone = silhouettes.distances(info.asset, state.matrices[vi], o, d)
+            sil = int(np.count_nonzero(np.isfinite(t_alone)))
             if sil == 0 and visible == 0:
                 continue
             ann.cam_ids.append(info.id)
@@ -253,4 +280,9 @@ def annotate_agent(
             ann.cam_occlusion.append(float(1.0 - visible / sil) if sil else 0.0)
             ann.cam_role.append(info.role)
             ann.cam_static.append(bool(info.static))
+            wave = 0.0
+            if waves and scene is not None and sil:
+                dn = d / np.linalg.norm(d, axis=1, keepdims=True)
+                wave = share(*exposed_hidden(scene, o, dn, t_alone, scene_instance=window.reshape(-1)))
+            ann.cam_wave_occlusion.append(wave)
     return ann

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 import numpy.typing as npt
@@ -28,6 +28,30 @@ __all__ = ["NO_HIT", "RayHits", "Scene", "demo_scene"]
 
 NO_HIT = -1
 """Value of ``RayHits.instance_id`` and ``triangle_id`` where the ray hit nothing."""
+
+
+class SeaState(Protocol):
+    """A directional JONSWAP sea as the wave surface takes it (the ocean's sea specification has these)."""
+
+    @property
+    def hs_m(self) -> float:
+        """Significant wave height, metres."""
+
+    @property
+    def tp_s(self) -> float:
+        """Peak period, seconds."""
+
+    @property
+    def gamma(self) -> float:
+        """JONSWAP peak enhancement."""
+
+    @property
+    def direction_rad(self) -> float:
+        """Mean travel direction, radians, counter-clockwise from world +x."""
+
+    @property
+    def spread_s(self) -> float:
+        """cos-2s spreading exponent."""
 
 
 @dataclass(frozen=True)
@@ -262,6 +286,56 @@ class Scene:
         if ids.size and (ids.min() < 0 or ids.max() >= 2**32):
             raise NotFoundError(f"unknown instance id in moving: {ids.tolist()}")
         self._native.set_sea(_id(surface, name="surface", kind="instance"), np.ascontiguousarray(ids, np.uint32))
+
+    def set_wave_surface(
+        self,
+        sea: SeaState | None,
+        *,
+        scenario_seed: int,
+        time_s: float,
+        foci: npt.ArrayLike,
+        radius_m: float = 320.0,
+    ) -> None:
+        """Sets the displaced sea surface of one frame time (``mmusv_core::sea::WaveSurface``), which replaces the
+        sea instance's flat mesh for every ray: crests occlude, beams meet wave faces. The scene must have a sea
+        (:meth:`set_sea`); ``sea=None`` clears it.
+
+        Args:
+            sea: the directional JONSWAP sea; its wave field is drawn from the scenario's sea seed, the one field
+                the hulls ride.
+            scenario_seed: the scenario's seed.
+            time_s: the frame time, seconds.
+            foci: ``(F, 2)`` float world x, y (metres) the sampling is finest around (the USVs); the same foci for
+                every sensor of a frame give every sensor the same surface.
+            radius_m: the waves taper to still water this far from the nearest focus (metres, > 0).
+        """
+        if sea is None:
+            self._native.set_wave_surface(None)
+            return
+        f = _array(foci, name="foci", dtype=np.float32, shape_tail=(2,))
+        self._native.set_wave_surface(
+            float(sea.hs_m),
+            tp_s=float(sea.tp_s),
+            gamma=float(sea.gamma),
+            direction_rad=float(sea.direction_rad),
+            spread_s=float(sea.spread_s),
+            scenario_seed=int(scenario_seed),
+            time_s=float(time_s),
+            foci=f,
+            radius_m=float(radius_m),
+            taper_m=min(60.0, float(radius_m)),
+        )
+
+    def wave_heights(self, xy: npt.ArrayLike) -> npt.NDArray[np.float32]:
+        """``(N,)`` float32 world z of the sea surface at ``xy`` ``(N, 2)`` world x, y (metres): the displaced
+        surface of :meth:`set_wave_surface`, or the still level 0 where there is none."""
+        return self._native.wave_heights(_array(xy, name="xy", dtype=np.float32, shape_tail=(2,)))
+
+    @property
+    def wave_top(self) -> float | None:
+        """The crest bound (highest world z) of the displaced sea surface, or ``None`` when none is set."""
+        top: float | None = self._native.wave_top
+        return top
 
     def clear_sea(self) -> None:
         """Forgets the sea surface: every ray is traced fully again (results are the same either way)."""

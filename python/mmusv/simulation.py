@@ -24,6 +24,7 @@ from mmusv._native import core
 from mmusv.config import Scenario, VesselConfig, load_scenario
 from mmusv.errors import ConfigError
 from mmusv.motion import build_fleet
+from mmusv.scene import SeaState
 from mmusv.sensors.camera import CameraImages, camera_from_config, top_view_from_config
 from mmusv.sensors.config import CameraConfig, Mount, RigConfig
 from mmusv.sensors.env import sensor_env
@@ -212,6 +213,12 @@ class Simulation:
         under_way = [int(inst) for v, inst in zip(sc.vessels, self.ws.vessel_instances, strict=True) if not v.static]
         self.ws.scene.set_lights(under_way, on=True)
         self._frame: int | None = None
+        # The physical sea (``environment.motion: physical``, the default) displaces the water every sensor sees;
+        # with ``motion: paper`` the water stays the flat plane of the paper.
+        self.sea: SeaState | None = None
+        if sc.environment.motion == "physical":
+            spec = sc.environment.sea_spec()
+            self.sea = spec if spec.hs_m > 0.0 else None
 
     # ------------------------------------------------------------------------------------------ building
 
@@ -277,13 +284,34 @@ class Simulation:
         centres = np.einsum("vij,vj->vi", mats[:, :3, :3], centres_body) + mats[:, :3, 3]
         return WorldState(frame, t, eta_all, vel_all, centres, mats)
 
-    def set_frame(self, frame: int) -> WorldState:
-        """Moves every vessel to its pose at ``frame`` and returns the world state."""
+    def set_sea_surface(self, sea: SeaState | None) -> None:
+        """Makes the water the displaced surface of the physical sea ``sea`` (its wave field drawn from the
+        scenario's sea seed) from the next :meth:`set_frame` on, or flat again with ``None``.
+
+        Scenarios with ``environment.motion: physical`` (the default) start with their ``environment.sea_spec()``.
+        Every frame then samples the surface at the frame time, finest around the USVs (the same surface for
+        every sensor of every agent): crests occlude, LiDAR beams meet wave faces, the radar's sea clutter follows
+        sea state and grazing angle, and the annotations carry each box's ``wave_occlusion``.
+        """
+        self.sea = sea if sea is None or sea.hs_m > 0.0 else None
+        if self.sea is None:
+            self.ws.scene.set_wave_surface(None, scenario_seed=self.scenario.seed, time_s=0.0, foci=np.zeros((0, 2)))
+        self._frame = None
+
+    def set_frame(self, frame: int, *, sea_radius_m: float = 320.0) -> WorldState:
+        """Moves every vessel to its pose at ``frame`` (and, over a physical sea, the water to its surface at the
+        frame time, displaced out to ``sea_radius_m`` around every USV: :meth:`set_sea_surface`) and returns the
+        world state."""
         if not 0 <= frame < self.frames:
             raise ConfigError(f"frame {frame} is outside the acquisition (0..{self.frames - 1})")
         state = self.world_state(frame)
         n = len(self.scenario.vessels)
         self.ws.scene.set_poses(self.ws.vessel_instances, state.matrices[:n])
+        if self.sea is not None and "water" in self.ws.static_instances:
+            foci = np.array([state.poses[a.index, :2] for a in self.agents], dtype=np.float32).reshape(-1, 2)
+            self.ws.scene.set_wave_surface(
+                self.sea, scenario_seed=self.scenario.seed, time_s=state.time_s, foci=foci, radius_m=sea_radius_m
+            )
         self._frame = frame
         return state
 

@@ -115,6 +115,9 @@ def _demo_case() -> tuple[Scene, np.ndarray]:
 
 
 def _sim_case(sim: Simulation) -> tuple[Scene, np.ndarray]:
+    """Frame 7 over the flat sea: Open3D sees the world mesh, the flat water plane included (the displaced
+    surface is checked against a dense march in tests/test_wave_occlusion.py and the core's tests)."""
+    sim.set_sea_surface(None)
     cap = sim.capture(7, agents=["usv_a"], radar=False)
     pose = cap.agents["usv_a"].lidar_pose
     assert pose is not None
@@ -124,6 +127,14 @@ def _sim_case(sim: Simulation) -> tuple[Scene, np.ndarray]:
 @pytest.mark.parametrize("case", ["demo_scene", "simulation_frame"])
 def test_geometry_matches_open3d(case: str, sim: Simulation) -> None:
     o3d = pytest.importorskip("open3d")
+    sea = sim.sea
+    try:
+        _check_open3d(case, sim, o3d)
+    finally:
+        sim.set_sea_surface(sea)
+
+
+def _check_open3d(case: str, sim: Simulation, o3d: Any) -> None:
     scene, pose = _demo_case() if case == "demo_scene" else _sim_case(sim)
     rmax = 200.0
     lidar = exact_lidar(32, 720, range_m=rmax)

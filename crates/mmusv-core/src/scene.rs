@@ -18,7 +18,7 @@ use crate::geometry::RigidPose;
 use crate::material::Material;
 use crate::mesh::Mesh;
 use crate::ray::RayPrep;
-use crate::sea::Sea;
+use crate::sea::{Sea, WaveSurface};
 use crate::seabed::Seabed;
 use crate::simd::{Level, Portable};
 use parry3d::bounding_volume::Aabb;
@@ -27,6 +27,7 @@ use std::sync::Arc;
 
 mod batch;
 mod sea_routes;
+mod waves;
 
 /// Value of `instance`, `triangle` for a ray that hit nothing.
 pub const NO_HIT: i32 = -1;
@@ -155,6 +156,9 @@ pub struct Scene {
     materials: Arc<Vec<Material>>,
     /// The seabed under the water, for shallow-water optics ([`Scene::set_seabed`]).
     seabed: Option<Arc<Seabed>>,
+    /// The displaced sea surface of the current frame, which replaces the sea instance's flat mesh for every ray
+    /// ([`Scene::set_wave_surface`], `scene/waves.rs`).
+    waves: Option<Arc<WaveSurface>>,
 }
 
 impl Scene {
@@ -234,7 +238,10 @@ impl Scene {
     #[inline(always)]
     pub fn material_index(&self, instance: i32, triangle: i32) -> u16 {
         match (usize::try_from(instance), u32::try_from(triangle)) {
-            (Ok(i), Ok(t)) if i < self.instances.len() => self.meshes[self.instances[i].mesh as usize].material(t),
+            (Ok(i), Ok(t)) if i < self.instances.len() => {
+                let t = if self.is_wave_hit(i as u32) { 0 } else { t };
+                self.meshes[self.instances[i].mesh as usize].material(t)
+            }
             _ => 0,
         }
     }
@@ -244,7 +251,8 @@ impl Scene {
     #[inline]
     pub fn material_of(&self, instance: i32, triangle: i32) -> Option<&Material> {
         let inst = self.instances.get(usize::try_from(instance).ok()?)?;
-        let id = self.meshes[inst.mesh as usize].material(u32::try_from(triangle).ok()?);
+        let triangle = if self.is_wave_hit(instance as u32) { 0 } else { u32::try_from(triangle).ok()? };
+        let id = self.meshes[inst.mesh as usize].material(triangle);
         if id == 0 {
             None
         } else {
@@ -297,6 +305,7 @@ impl Scene {
         if let Some(sea) = &mut self.sea {
             if changed.contains(&sea.instance) {
                 self.sea = None; // the surface itself moved: no longer a known plane
+                self.waves = None;
             } else {
                 for &id in changed {
                     sea.add_moving(id);
@@ -363,10 +372,25 @@ impl Scene {
     /// [`Scene::cast_ray_with`] for a prepared world ray, the meshes walked at level `lv`.
     #[inline(always)]
     pub fn cast_prepared<L: Level>(&self, lv: L, ray: &RayPrep, max_range: f32, scratch: &mut Scratch) -> Option<Hit> {
-        let mut v =
-            Instances { lv, scene: self, ray, stack: &mut scratch.bottom, instance: u32::MAX, triangle: u32::MAX };
-        let t = self.tlas.closest(ray, max_range, &mut scratch.top, &mut v);
-        (v.instance != u32::MAX).then_some(Hit { distance: t, instance: v.instance, triangle: v.triangle })
+        // The wave surface first (it shortens the ray before the tree is walked).
+        let water = self.wave_hit(ray, max_range);
+        let limit = water.map_or(max_range, |h| h.distance);
+        let hidden = self.hidden_instance();
+        let mut v = Instances {
+            lv,
+            scene: self,
+            ray,
+            stack: &mut scratch.bottom,
+            instance: u32::MAX,
+            triangle: u32::MAX,
+            hidden,
+        };
+        let t = self.tlas.closest(ray, limit, &mut scratch.top, &mut v);
+        if v.instance != u32::MAX {
+            Some(Hit { distance: t, instance: v.instance, triangle: v.triangle })
+        } else {
+            water
+        }
     }
 
     /// Traces a packet of prepared world rays: for every ray `r`, `p.best[r]` becomes its closest hit distance
@@ -380,6 +404,7 @@ impl Scene {
         p: &mut Packet,
         scratch: &mut Scratch,
     ) -> ([u32; PACKET], [u32; PACKET]) {
+        let water = self.wave_hits_packet(p);
         let mut v = PacketInstances {
             lv,
             scene: self,
@@ -389,8 +414,17 @@ impl Scene {
             instance: [u32::MAX; PACKET],
             triangle: [u32::MAX; PACKET],
             any: false,
+            hidden: self.hidden_instance(),
         };
         self.tlas.closest_packet(p, &mut scratch.packet_top, &mut v);
+        if let Some((sid, pieces)) = water {
+            for r in 0..p.n {
+                if v.instance[r] == u32::MAX && pieces[r] != u32::MAX {
+                    v.instance[r] = sid;
+                    v.triangle[r] = pieces[r];
+                }
+            }
+        }
         (v.instance, v.triangle)
     }
 
@@ -398,6 +432,7 @@ impl Scene {
     /// starting `p.best[r]`. The meshes are walked at level `lv`.
     #[inline(always)]
     pub fn occluded_packet_with<L: Level>(&self, lv: L, p: &mut Packet, scratch: &mut Scratch) {
+        self.wave_block_packet(p);
         let mut v = PacketInstances {
             lv,
             scene: self,
@@ -407,6 +442,7 @@ impl Scene {
             instance: [u32::MAX; PACKET],
             triangle: [u32::MAX; PACKET],
             any: true,
+            hidden: self.hidden_instance(),
         };
         self.tlas.any_packet(p, &mut scratch.packet_top, &mut v);
     }
@@ -421,7 +457,11 @@ impl Scene {
     /// [`Scene::occluded_with`] for a prepared world ray, the meshes walked at level `lv`.
     #[inline(always)]
     pub fn occluded_prepared<L: Level>(&self, lv: L, ray: &RayPrep, max_range: f32, scratch: &mut Scratch) -> bool {
-        let mut v = AnyInstance { lv, scene: self, ray, stack: &mut scratch.bottom };
+        if self.wave_hit(ray, max_range).is_some() {
+            return true;
+        }
+        let hidden = self.hidden_instance();
+        let mut v = AnyInstance { lv, scene: self, ray, stack: &mut scratch.bottom, hidden };
         self.tlas.any(ray, max_range, &mut scratch.top, &mut v)
     }
 
@@ -430,6 +470,9 @@ impl Scene {
     pub fn hit_normal_class(&self, hit: &Hit) -> (Vec3, u16) {
         let inst = &self.instances[hit.instance as usize];
         let mesh = &self.meshes[inst.mesh as usize];
+        if let Some(n) = self.wave_piece_normal(hit.instance, hit.triangle) {
+            return (n, inst.class_override.unwrap_or(mesh.classes()[0]));
+        }
         let n = inst.pose.transform_vector(mesh.triangle(hit.triangle).normal()).normalize_or_zero();
         let class = inst.class_override.unwrap_or(mesh.classes()[hit.triangle as usize]);
         (n, class)
@@ -463,6 +506,8 @@ struct Instances<'a, L> {
     stack: &'a mut Stack,
     instance: u32,
     triangle: u32,
+    /// An instance left out (the flat sea mesh while the wave surface stands in for it), or `u32::MAX`.
+    hidden: u32,
 }
 
 impl<L: Level> Visit for Instances<'_, L> {
@@ -471,10 +516,10 @@ impl<L: Level> Visit for Instances<'_, L> {
         let sc = self.scene;
         let lf = sc.tlas.leaves()[leaf as usize];
         for k in lf.start as usize..(lf.start + lf.count) as usize {
-            if !box_entry(&sc.tlas_boxes[k], self.ray, best) {
+            let id = sc.tlas_order[k];
+            if id == self.hidden || !box_entry(&sc.tlas_boxes[k], self.ray, best) {
                 continue;
             }
-            let id = sc.tlas_order[k];
             let inst = &sc.instances[id as usize];
             let mesh = &sc.meshes[inst.mesh as usize];
             let local = local_ray(self.ray, &inst.pose);
@@ -494,6 +539,7 @@ struct AnyInstance<'a, L> {
     scene: &'a Scene,
     ray: &'a RayPrep,
     stack: &'a mut Stack,
+    hidden: u32,
 }
 
 impl<L: Level> Visit for AnyInstance<'_, L> {
@@ -502,10 +548,10 @@ impl<L: Level> Visit for AnyInstance<'_, L> {
         let sc = self.scene;
         let lf = sc.tlas.leaves()[leaf as usize];
         for k in lf.start as usize..(lf.start + lf.count) as usize {
-            if !box_entry(&sc.tlas_boxes[k], self.ray, best) {
+            let id = sc.tlas_order[k];
+            if id == self.hidden || !box_entry(&sc.tlas_boxes[k], self.ray, best) {
                 continue;
             }
-            let id = sc.tlas_order[k];
             let inst = &sc.instances[id as usize];
             let local = local_ray(self.ray, &inst.pose);
             if sc.meshes[inst.mesh as usize].any(self.lv, local.as_ref().unwrap_or(self.ray), best, self.stack) {
@@ -541,6 +587,7 @@ struct PacketInstances<'a, L> {
     instance: [u32; PACKET],
     triangle: [u32; PACKET],
     any: bool,
+    hidden: u32,
 }
 
 impl<L: Level> PacketVisit for PacketInstances<'_, L> {
@@ -549,11 +596,14 @@ impl<L: Level> PacketVisit for PacketInstances<'_, L> {
         let sc = self.scene;
         let lf = sc.tlas.leaves()[leaf as usize];
         for k in lf.start as usize..(lf.start + lf.count) as usize {
+            let id = sc.tlas_order[k];
+            if id == self.hidden {
+                continue;
+            }
             let mask = p.rays_entering_box(&sc.tlas_boxes[k]) & rays;
             if mask == 0 {
                 continue;
             }
-            let id = sc.tlas_order[k];
             let inst = &sc.instances[id as usize];
             let mesh = &sc.meshes[inst.mesh as usize];
             if inst.pose == RigidPose::IDENTITY {

@@ -28,8 +28,12 @@ use parry3d::math::Vec3;
 use std::sync::{Arc, Mutex};
 
 mod horizon;
+pub(crate) mod surface;
 
 pub use horizon::Horizon;
+#[cfg(test)]
+pub(crate) use surface::tests::comp as test_component;
+pub use surface::{SurfaceHit, SurfaceSpec, WaveSurface, FLAT_PIECE, SKIN_M, TILE_CELLS};
 
 /// Most cells per side of the height grid.
 const MAX_CELLS: usize = 512;
@@ -71,6 +75,9 @@ pub struct Sea {
     sun_cache: SunCache,
     /// Max pyramid of `fixed`, for [`Horizon`]s.
     pyramid: MaxPyramid,
+    /// The crest bound of the displaced surface, when waves are set ([`Sea::set_wave_top`]): rays must start
+    /// above it (and above `level`) for the shortcuts to apply.
+    wave_top: Option<f32>,
 }
 
 /// The cells of a [`Sea`] grid from which a ray towards one sun direction may meet something (see the module
@@ -92,6 +99,13 @@ struct SunCache(Mutex<Option<Arc<SunMask>>>);
 impl Clone for SunCache {
     fn clone(&self) -> Self {
         Self::default()
+    }
+}
+
+impl SunMask {
+    /// The unit direction the mask was built for.
+    pub fn dir(&self) -> [f32; 3] {
+        self.dir
     }
 }
 
@@ -123,6 +137,7 @@ impl Sea {
             fixed_sun: SunCache::default(),
             sun_cache: SunCache::default(),
             pyramid: MaxPyramid::default(),
+            wave_top: None,
         };
         let mut grid = std::mem::take(&mut sea.fixed);
         for tri in fixed {
@@ -137,6 +152,22 @@ impl Sea {
         sea.heights = sea.fixed.clone();
         sea.top = sea.heights.iter().copied().fold(f32::NEG_INFINITY, f32::max);
         sea
+    }
+
+    /// Sets (or clears) the crest bound of the displaced sea surface: no water lies above `top`. The shortcuts
+    /// then answer only for rays that start above both the still level and `top`.
+    pub fn set_wave_top(&mut self, top: Option<f32>) {
+        self.wave_top = top;
+    }
+
+    /// The height above which a ray start is over every part of the water (the still level, or the crest bound
+    /// of the waves).
+    #[inline(always)]
+    pub fn surface_top(&self) -> f32 {
+        match self.wave_top {
+            Some(t) => t.max(self.level),
+            None => self.level,
+        }
     }
 
     /// Instances rasterised by box.
@@ -174,7 +205,7 @@ impl Sea {
     /// `None` when `origin` is not above the surface or a moving box lies outside the grid.
     #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > b)` on purpose: a NaN must answer "no"
     pub fn horizon(&self, origin: [f32; 3]) -> Option<(Horizon, Vec<u32>)> {
-        if !(self.contained && origin[2] > self.level && origin.iter().all(|v| v.is_finite())) {
+        if !(self.contained && origin[2] > self.surface_top() && origin.iter().all(|v| v.is_finite())) {
             return None;
         }
         let mut h = Horizon::new(origin);

@@ -4,6 +4,8 @@
 use crate::errors::InputError;
 use crate::native::{detached, flat, pose_from, rows, rows_to_array};
 use mmusv_core::export::{write_world_mesh, MeshFormat};
+use mmusv_core::ocean::{sea_seed, SeaSpec, WaveField};
+use mmusv_core::sea::{SurfaceSpec, WaveSurface};
 use mmusv_core::{Mesh, Scene as CoreScene};
 use numpy::ndarray::Array2;
 use numpy::{
@@ -11,7 +13,7 @@ use numpy::{
 };
 use pyo3::prelude::*;
 use std::path::PathBuf;
-use std::sync::{Arc, RwLock};
+use std::sync::{Arc, Mutex, RwLock};
 
 /// Tuple of arrays returned by `Scene.cast_rays` (see the `.pyi` for shapes and dtypes).
 type RayHitArrays<'py> = (
@@ -41,6 +43,8 @@ type WorldMeshArrays<'py> = (
 #[pyclass(frozen, module = "mmusv._core")]
 pub struct Scene {
     inner: RwLock<Arc<CoreScene>>,
+    /// The last wave field drawn by `set_wave_surface`, with its sea and seed (reused while they stay).
+    wave_field: Mutex<Option<(SeaSpec, u64, Arc<WaveField>)>>,
 }
 
 fn poisoned() -> PyErr {
@@ -50,7 +54,7 @@ fn poisoned() -> PyErr {
 impl Scene {
     /// Wraps a core scene built in Rust.
     pub fn from_core(scene: CoreScene) -> Self {
-        Self { inner: RwLock::new(Arc::new(scene)) }
+        Self { inner: RwLock::new(Arc::new(scene)), wave_field: Mutex::new(None) }
     }
 
     /// Runs `f` on a snapshot of the scene (the lock is released before `f` runs).
@@ -192,6 +196,95 @@ impl Scene {
         let mut scene = self.read(|s| Ok(s.clone()))?;
         detached(py, || scene.set_sea(surface, &moving))?;
         self.write(|s| *s = scene)
+    }
+
+    /// Sets the displaced sea surface of the current frame (see mmusv_core::sea::WaveSurface): the wave field
+    /// of the directional JONSWAP sea `hs_m`, `tp_s`, `gamma`, `direction_rad`, `spread_s` drawn from the scenario's
+    /// sea seed (mmusv_core::ocean::WaveField, `sea_seed(scenario_seed)`: the field the hulls ride), sampled at `time_s` around `foci` (F, 2) float32 world x, y; `hs_m=None`
+    /// clears it. Samples with the GIL released.
+    #[pyo3(signature = (hs_m, *, tp_s=8.0, gamma=3.3, direction_rad=0.0, spread_s=10.0, scenario_seed=0, time_s=0.0, foci=None, level=0.0, tile_m=32.0, near_m=40.0, radius_m=320.0, taper_m=60.0))]
+    #[allow(clippy::too_many_arguments)]
+    fn set_wave_surface(
+        &self,
+        py: Python<'_>,
+        hs_m: Option<f64>,
+        tp_s: f64,
+        gamma: f64,
+        direction_rad: f64,
+        spread_s: f64,
+        scenario_seed: u64,
+        time_s: f64,
+        foci: Option<PyReadonlyArray2<'_, f32>>,
+        level: f32,
+        tile_m: f32,
+        near_m: f32,
+        radius_m: f32,
+        taper_m: f32,
+    ) -> PyResult<()> {
+        let Some(hs) = hs_m else {
+            return self.write(|s| s.set_wave_surface(None))?.map_err(crate::errors::to_py);
+        };
+        let foci: Vec<[f32; 2]> = match &foci {
+            Some(f) => rows::<f32, 2>(f, "foci")?.to_vec(),
+            None => Vec::new(),
+        };
+        for (name, v) in [("tile_m", tile_m), ("near_m", near_m), ("radius_m", radius_m)] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(InputError::new_err(format!("{name} = {v} is not allowed; give a distance > 0 metres")));
+            }
+        }
+        if !(taper_m.is_finite() && (0.0..=radius_m).contains(&taper_m)) {
+            return Err(InputError::new_err(format!("taper_m = {taper_m} must be in [0, radius_m]")));
+        }
+        if !(time_s.is_finite() && level.is_finite()) || foci.iter().any(|f| !(f[0].is_finite() && f[1].is_finite())) {
+            return Err(InputError::new_err("wave surface: time_s, level and foci must be finite"));
+        }
+        let sea = SeaSpec { hs, tp: tp_s, gamma, direction_rad, spread_s };
+        let seed = sea_seed(scenario_seed);
+        let spec = SurfaceSpec { tile_m, near_m, radius_m, taper_m };
+        let cached = self
+            .wave_field
+            .lock()
+            .map_err(|_| poisoned())?
+            .as_ref()
+            .filter(|(s, k, _)| *s == sea && *k == seed)
+            .map(|(_, _, f)| Arc::clone(f));
+        let (field, surface) = detached(py, || {
+            let field = match cached {
+                Some(f) => f,
+                None => {
+                    sea.validate()?;
+                    Arc::new(WaveField::new(&sea, seed)?)
+                }
+            };
+            let surface = WaveSurface::new(field.components(), time_s, level, &foci, spec);
+            Ok((field, surface))
+        })?;
+        *self.wave_field.lock().map_err(|_| poisoned())? = Some((sea, seed, field));
+        self.write(|s| s.set_wave_surface(Some(surface)))?.map_err(crate::errors::to_py)
+    }
+
+    /// Heights (N,) float32 of the displaced sea surface at `xy` (N, 2) float32 world x, y (the still level
+    /// where no surface is set or outside it).
+    fn wave_heights<'py>(
+        &self,
+        py: Python<'py>,
+        xy: PyReadonlyArray2<'py, f32>,
+    ) -> PyResult<Bound<'py, PyArray1<f32>>> {
+        let xy = rows::<f32, 2>(&xy, "xy")?;
+        let out = self.read(|s| {
+            Ok(match s.wave_surface() {
+                Some(w) => xy.iter().map(|p| w.height(p[0], p[1])).collect::<Vec<f32>>(),
+                None => vec![0.0; xy.len()],
+            })
+        })?;
+        Ok(out.into_pyarray(py))
+    }
+
+    /// The crest bound (highest world z) of the displaced sea surface, or None when none is set.
+    #[getter]
+    fn wave_top(&self) -> PyResult<Option<f32>> {
+        self.read(|s| Ok(s.wave_surface().map(|w| w.zmax())))
     }
 
     /// Forgets the sea surface: every ray is traced fully again.

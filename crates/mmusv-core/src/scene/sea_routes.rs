@@ -13,6 +13,8 @@ use crate::sea::{Horizon, Sea, SunMask};
 const SEA_WALK_SKY: usize = 2;
 const SEA_WALK_SKY_NO_HORIZON: usize = 48;
 const SEA_WALK_SHADOW: usize = 2;
+/// Longest walk (cells) over the height map for the stretch of a rising ray among the waves.
+const SEA_WALK_LIFT: usize = 8;
 
 impl Scene {
     /// Declares instance `surface` the sea surface, so rays that can only meet it or the sky are answered
@@ -59,12 +61,14 @@ impl Scene {
                 .map(|&i| Box3 { lo: boxes[i as usize].mins.to_array(), hi: boxes[i as usize].maxs.to_array() }),
         );
         self.sea = Some(sea);
+        self.waves = None;
         Ok(())
     }
 
     /// Forgets the sea surface: every ray is traced fully again.
     pub fn clear_sea(&mut self) {
         self.sea = None;
+        self.waves = None;
     }
 
     /// The declared sea surface instance, if any.
@@ -114,22 +118,91 @@ impl Scene {
     #[inline(always)]
     pub(super) fn sun_clear(&self, mask: Option<&SunMask>, origin: [f32; 3]) -> bool {
         match (&self.sea, mask) {
-            (Some(sea), Some(mask)) => origin.iter().all(|v| v.is_finite()) && sea.sun_clear(mask, origin),
+            (Some(sea), Some(mask)) => {
+                if !origin.iter().all(|v| v.is_finite()) {
+                    return false;
+                }
+                match self.lift_over_waves(sea, origin, mask.dir(), f32::MAX) {
+                    Lift::Above(o) => sea.sun_clear(mask, o),
+                    Lift::Beyond | Lift::Unknown => false,
+                }
+            }
             _ => false,
         }
     }
 
+    /// A rising ray that starts among the waves (below their crest bound), carried up to just over the bound
+    /// when nothing meets it on the way: the wave surface (exactly; none for a ray leaving the water,
+    /// [`crate::sea::WaveSurface::leaves`], which only needs to clear the still level) and every other surface
+    /// (the height map walk over at most [`SEA_WALK_LIFT`] cells). Without waves, or from above the bound, the
+    /// origin as it is.
     #[inline(always)]
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > b)` on purpose: a NaN must answer "not known"
+    fn lift_over_waves(&self, sea: &crate::sea::Sea, o: [f32; 3], d: [f32; 3], limit: f32) -> Lift {
+        let mut top = sea.surface_top();
+        if o[2] > top {
+            return Lift::Above(o);
+        }
+        let Some(w) = &self.waves else { return Lift::Unknown };
+        if !(d[2] > 0.0) {
+            return Lift::Unknown;
+        }
+        let leaves = w.leaves(o, d);
+        if leaves {
+            top = sea.level;
+            if o[2] > top {
+                return Lift::Above(o);
+            }
+        }
+        let t = ((top - o[2]) / d[2]) * 1.0001 + 1e-3 / d[2];
+        if (!leaves && w.occludes(o, d, t.min(limit))) || !sea.path_clear(o, d, t.min(limit), SEA_WALK_LIFT) {
+            return Lift::Unknown;
+        }
+        if t >= limit {
+            return Lift::Beyond;
+        }
+        let lifted = [o[0] + d[0] * t, o[1] + d[1] * t, o[2] + d[2] * t];
+        if lifted[2] > top {
+            Lift::Above(lifted)
+        } else {
+            Lift::Unknown
+        }
+    }
+
+    #[inline(always)]
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > b)` on purpose: a NaN must answer "not clear"
     fn sea_clear_within(&self, ray: &RayPrep, limit: f32, max_cells: usize) -> bool {
         let Some(sea) = &self.sea else { return false };
-        let (oz, dz) = (ray.o[2], ray.d[2]);
-        if !(oz > sea.level && dz > 0.0) {
+        if !(ray.d[2] > 0.0) {
+            return false;
+        }
+        let (o, limit) = match self.lift_over_waves(sea, ray.o, ray.d, limit) {
+            Lift::Above(o) if o == ray.o => (o, limit),
+            Lift::Above(o) => {
+                let t = (o[2] - ray.o[2]) / ray.d[2];
+                (o, limit - t)
+            }
+            Lift::Beyond => return true,
+            Lift::Unknown => return false,
+        };
+        let (oz, dz) = (o[2], ray.d[2]);
+        if !(oz > sea.level) {
             return false;
         }
         if oz > sea.top() {
             return true;
         }
         let t_top = (sea.top() - oz) / dz;
-        sea.path_clear(ray.o, ray.d, t_top.min(limit), max_cells)
+        sea.path_clear(o, ray.d, t_top.min(limit), max_cells)
     }
+}
+
+/// Where a rising ray stands against the waves ([`Scene::lift_over_waves`]).
+enum Lift {
+    /// It is (or, nothing met on the way, continues as the ray from) this point above the crest bound.
+    Above([f32; 3]),
+    /// Nothing is met before its end.
+    Beyond,
+    /// Not known: trace it.
+    Unknown,
 }

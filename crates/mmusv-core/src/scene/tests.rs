@@ -393,3 +393,118 @@ fn every_simd_level_gives_the_same_bits() {
         }
     }
 }
+
+/// An irregular sea for the wave-surface tests: eight components, 12..80 m long, amplitudes summing to 1.6 m.
+fn wave_components() -> Vec<crate::ocean::WaveComponent> {
+    (0..8)
+        .map(|i| {
+            let k = std::f64::consts::TAU / (12.0 + 9.5 * i as f64);
+            let dir = 0.4 + 0.37 * i as f64;
+            crate::sea::test_component(0.2, k * dir.cos(), k * dir.sin(), (9.81 * k).sqrt(), 1.3 * i as f64)
+        })
+        .collect()
+}
+
+/// With a wave surface, every batch (packets, the sea shortcuts lifted over the crests, horizons, the sun mask)
+/// gives exactly the hits of a ray-by-ray reference: the closer of the surface's own intersection and the scene
+/// traced without the flat sea mesh.
+#[test]
+fn wave_surface_batches_give_exactly_the_ray_by_ray_reference() {
+    use crate::sea::{SurfaceSpec, WaveSurface};
+    let (mut s, vessels) = sea_world();
+    let mut rng = ChaCha8Rng::seed_from_u64(33);
+    scatter(&mut s, &vessels, &mut rng, [0.3, 0.02, -0.03]);
+    // The reference scene: no sea declared, the flat mesh moved out of every ray's reach.
+    let mut reference = s.clone();
+    reference
+        .set_poses(&[1], &[RigidPose::from_xyz_rpy([0.0, 0.0, -5000.0], [0.0; 3])])
+        .unwrap_or_else(|e| unreachable!("{e}"));
+    s.set_sea(1, &vessels).unwrap_or_else(|e| unreachable!("{e}"));
+    let foci = [[0.0f32, 0.0], [120.0, -80.0]];
+    let spec = SurfaceSpec { radius_m: 400.0, taper_m: 80.0, ..SurfaceSpec::default() };
+    let surface = WaveSurface::new(&wave_components(), 7.0, 0.0, &foci, spec);
+    let w = surface.clone();
+    s.set_wave_surface(Some(surface)).unwrap_or_else(|e| unreachable!("{e}"));
+    let (mut o, mut d) = sensor_rays(&mut rng, 12_000);
+    // Grazing rays from among the crests, as a low USV's sensors cast them.
+    for k in 0..4000 {
+        let az: f32 = rng.random_range(0.0..std::f32::consts::TAU);
+        let el: f32 = rng.random_range(-0.08..0.03);
+        o.push([rng.random_range(-200.0..200.0), rng.random_range(-200.0..200.0), 1.7 + 0.001 * k as f32]);
+        d.push([az.cos() * el.cos(), az.sin() * el.cos(), el.sin()]);
+    }
+    let limit = 800.0;
+    let fast = s.cast_rays(&o, &d, limit).unwrap_or_default();
+    let mut water = 0;
+    for i in 0..o.len() {
+        let u = unit_direction(&d[i]);
+        let wh = if w.leaves(o[i], u) { None } else { w.intersect(o[i], u, limit) };
+        let mh = reference.cast_ray(Vec3::from_array(o[i]), Vec3::from_array(u), limit);
+        let (dist, inst) = match (wh, mh) {
+            (Some(a), Some(b)) if b.distance < a.t => (b.distance, b.instance as i32),
+            (Some(a), _) => (a.t, 1),
+            (None, Some(b)) => (b.distance, b.instance as i32),
+            (None, None) => (f32::INFINITY, NO_HIT),
+        };
+        assert_eq!((fast.distance[i], fast.instance[i]), (dist, inst), "ray {i}: {:?} {:?}", o[i], d[i]);
+        if inst == 1 {
+            water += 1;
+            let n = w.piece_normal(fast.triangle[i] as u32);
+            assert_eq!(&fast.normal[3 * i..3 * i + 3], &n, "ray {i}: the normal of the piece hit");
+            assert_eq!(fast.class[i], s.hit_normal_class(&Hit { distance: 0.0, instance: 1, triangle: 0 }).1);
+        }
+    }
+    assert!(water > 5000, "only {water} rays met the waves");
+    // One viewpoint (a camera above the crests, with its horizon) and one among them.
+    for z in [6.0f32, 1.2] {
+        let eye = [30.0f32, -20.0, z];
+        let (mut co, mut cd) = (Vec::new(), Vec::new());
+        for k in 0..8192u32 {
+            let (az, el) = (0.0008 * k as f32, -0.3 + 0.4 * ((k * 37) % 8192) as f32 / 8192.0);
+            co.push(eye);
+            cd.push([az.cos() * el.cos(), az.sin() * el.cos(), el.sin()]);
+        }
+        let fast = s.cast_rays(&co, &cd, limit).unwrap_or_default();
+        for i in 0..co.len() {
+            let u = unit_direction(&cd[i]);
+            let t_w = if w.leaves(co[i], u) { None } else { w.intersect(co[i], u, limit) };
+            let t_w = t_w.map_or(f32::INFINITY, |h| h.t);
+            let t_m = reference
+                .cast_ray(Vec3::from_array(co[i]), Vec3::from_array(u), limit)
+                .map_or(f32::INFINITY, |h| h.distance);
+            assert_eq!(fast.distance[i], t_w.min(t_m), "eye {z}: ray {i}");
+        }
+    }
+    // Shadow rays towards the sun from the wave surface (leaving the water: the waves do not shade them), from
+    // just over the skin above it (the sun mask, lifted over the crests that shade them) and from above everything.
+    let sun = [0.8f32, 0.3, 0.05];
+    let su = unit_direction(&sun);
+    let so: Vec<[f32; 3]> = o
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            let z = match k % 3 {
+                0 => w.height(p[0], p[1]) + 0.02,
+                1 => w.height(p[0], p[1]) + crate::sea::SKIN_M + 0.05,
+                _ => 150.0,
+            };
+            [p[0], p[1], z]
+        })
+        .collect();
+    let sd = vec![sun; so.len()];
+    let fast = s.occluded_rays(&so, &sd, 5000.0).unwrap_or_default();
+    let mut by_waves = 0;
+    for i in 0..so.len() {
+        let wb = !w.leaves(so[i], su) && w.occludes(so[i], su, 5000.0);
+        assert_eq!(w.leaves(so[i], su), i % 3 == 0, "shadow ray {i}");
+        let mb =
+            reference.occluded_with(Vec3::from_array(so[i]), Vec3::from_array(su), 5000.0, &mut Scratch::default());
+        by_waves += usize::from(wb && !mb);
+        assert_eq!(fast[i], wb || mb, "shadow ray {i} from {:?}", so[i]);
+    }
+    assert!(by_waves > 20, "only {by_waves} points shaded by the crests alone");
+    // Clearing the sea clears the waves; setting waves without a sea is an error.
+    s.clear_sea();
+    assert!(s.wave_surface().is_none());
+    assert!(s.set_wave_surface(Some(w)).is_err());
+}

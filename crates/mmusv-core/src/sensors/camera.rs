@@ -436,7 +436,8 @@ impl Camera {
         let q = self.cfg.image.quality;
         let shader = Shader::new(env, options.seed, options.wakes)
             .with_materials(scene.material_table())
-            .with_seabed(scene.seabed());
+            .with_seabed(scene.seabed())
+            .with_waves(scene.wave_surface());
         // Standard quality shares one traced reflection per 2 × 2 block of water pixels; high traces each.
         let block = |k: usize| {
             let [x, y] = self.pos[k].map(u32::from);

@@ -27,6 +27,7 @@ pub fn lidar_env(env: &ShadeEnv) -> LidarEnv {
         fog_extinction_per_m: env.fog_extinction_per_m,
         rain_mm_per_h: env.rain_mm_per_h,
         wave_height_m: env.wave_height_m,
+        wind_speed_m_s: env.wind_speed_m_s,
     }
 }
 

@@ -8,9 +8,13 @@
 //! Per ray, in this order (each random draw is a pure function of `(seed, ray index)`, see [`noise`]):
 //! 1. the exact hit (distance `r`, normal `n`, class, instance) or a miss;
 //! 2. `r < range_min` or `r > range_max`: no return;
-//! 3. open water (class 1): a return only with probability `p_w = water_probability + water_probability_per_wave_m · H`
-//!    (clamped to 1) and only within `water_range_m + water_range_per_wave_m · H` — calm water is a mirror at
-//!    905 nm, waves give the beam facets to return from;
+//! 3. open water (class 1): on a scene with a displaced wave surface ([`crate::Scene::wave_surface`]), a return
+//!    with the probability of the physical model in [`super::lidar_water`] (quasi-specular glints off the wave
+//!    facet met, at its incidence angle, and whitecaps, detected through speckle), with that model's intensity;
+//!    on a flat sea, the empirical rule: a return only with probability
+//!    `p_w = water_probability + water_probability_per_wave_m · H` (clamped to 1) and only within
+//!    `water_range_m + water_range_per_wave_m · H` — calm water is a mirror at 905 nm, waves give the beam facets
+//!    to return from;
 //! 4. weather: two-way transmission `τ = exp(−2 (σ_fog + σ_rain) r)` with `σ_fog` the visibility extinction
 //!    (Koschmieder, 3 / V) and `σ_rain = 1e-5 · R^0.6` per metre (R in mm/h); the return is lost with
 //!    probability `1 − τ`;
@@ -20,6 +24,7 @@
 //! Intensity in `[0, 1]`: `ρ(class) · |cos θ| · τ / (1 + (r / 100 m)²)`, θ the incidence angle, ρ a per-class
 //! reflectivity ([`reflectivity`]).
 
+use super::lidar_water;
 use super::noise::{self, stream};
 use super::rays;
 use crate::error::{MmusvError, Result};
@@ -128,6 +133,8 @@ pub struct LidarEnv {
     pub rain_mm_per_h: f32,
     /// Significant wave height H (m).
     pub wave_height_m: f32,
+    /// Wind speed at 10 m (m/s): capillary roughness and whitecaps of the physical water returns.
+    pub wind_speed_m_s: f32,
 }
 
 /// The points of one sweep, in pattern order (azimuth column, then ring) with the rays that gave no return
@@ -229,6 +236,7 @@ impl Lidar {
         let p_water = (cfg.water_probability + cfg.water_probability_per_wave_m * h).clamp(0.0, 1.0) as f64;
         let water_range = cfg.water_range_m + cfg.water_range_per_wave_m * h;
         let sigma = env.fog_extinction_per_m.max(0.0) + 1e-5 * env.rain_mm_per_h.max(0.0).powf(0.6);
+        let waves = scene.wave_surface().is_some();
         let mut out = LidarScan::default();
         for (i, &k) in slot.iter().enumerate() {
             let k = k as usize;
@@ -238,10 +246,21 @@ impl Lidar {
                 continue;
             }
             let idx = i as u64;
-            if class == CLASS_WATER && (r > water_range || noise::uniform(seed, stream::WATER, idx) >= p_water) {
-                continue;
-            }
             let tau = (-2.0 * sigma * r).exp();
+            let n = Vec3::new(hits.normal[3 * k], hits.normal[3 * k + 1], hits.normal[3 * k + 2]);
+            let cos = n.dot(Vec3::from_array(dirs[k])).abs().min(1.0);
+            let mut water_intensity = None;
+            if class == CLASS_WATER {
+                if waves {
+                    let mean = lidar_water::mean_intensity(cos, env.wind_speed_m_s, r, tau);
+                    if noise::uniform(seed, stream::WATER, idx) >= f64::from(lidar_water::detection_probability(mean)) {
+                        continue;
+                    }
+                    water_intensity = Some(mean.clamp(0.0, 1.0));
+                } else if r > water_range || noise::uniform(seed, stream::WATER, idx) >= p_water {
+                    continue;
+                }
+            }
             if sigma > 0.0 && noise::uniform(seed, stream::WEATHER, idx) >= tau as f64 {
                 continue;
             }
@@ -254,9 +273,9 @@ impl Lidar {
                 r
             };
             let d = self.pattern[i];
-            let n = Vec3::new(hits.normal[3 * k], hits.normal[3 * k + 1], hits.normal[3 * k + 2]);
-            let cos = n.dot(Vec3::from_array(dirs[k])).abs().min(1.0);
-            let intensity = (reflectivity(class) * cos * tau / (1.0 + (r / 100.0) * (r / 100.0))).clamp(0.0, 1.0);
+            let intensity = water_intensity.unwrap_or_else(|| {
+                (reflectivity(class) * cos * tau / (1.0 + (r / 100.0) * (r / 100.0))).clamp(0.0, 1.0)
+            });
             let column = i / channels;
             out.xyz.push([d[0] * measured, d[1] * measured, d[2] * measured]);
             out.range.push(measured);

@@ -35,6 +35,7 @@ mod cells;
 mod clutter;
 mod config;
 mod pattern;
+pub mod sea_clutter;
 
 use crate::error::Result;
 use crate::geometry::RigidPose;
@@ -110,7 +111,11 @@ pub fn radar_sweep(
     drop(origins);
 
     let (first, end) = cfg.range_bins();
-    let table = clutter_table(cfg, env, first, end);
+    // Over the physical sea (a displaced wave surface), sea clutter follows sea state and grazing angle.
+    let physical = scene.wave_surface().map(|w| {
+        sea_clutter::PhysicalSea::new(env.wave_height_m as f64, f64::from(sensor_to_world.translation.z - w.level()))
+    });
+    let table = clutter_table(cfg, env, physical.as_ref(), first, end);
     // Solid angle of a ray = (beamwidth / rays_az) · its fan-height weight.
     let az_width = cfg.beamwidth_az_rad / cfg.rays_az as f64;
     let rain = env.rain_mm_per_h as f64;
@@ -122,6 +127,7 @@ pub fn radar_sweep(
         end,
         table: &table,
         sensor_height: sensor_to_world.translation.z.max(0.0) as f64,
+        physical,
         pose: sensor_to_world,
     };
     let per_beam: Vec<Vec<Return>> = (0..cfg.azimuth_bins)

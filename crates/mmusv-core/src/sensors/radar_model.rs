@@ -16,6 +16,9 @@
 //!   `R_c = critical_range_per_m · H` the interference fall-off `g = (R_c / r)⁴` (so clutter falls as `r⁻³`
 //!   close in and `r⁻⁷` beyond `R_c`: higher waves give stronger clutter reaching farther); zero beyond
 //!   `sea_max_range_m` and for `H = 0`.
+//!   Over the physical sea (a scene with a displaced wave surface) σ⁰ instead follows sea state and grazing
+//!   angle by the NRL model of Gregers-Hansen & Mital (2012), `sensors/radar/sea_clutter.rs`, and the sea part
+//!   is `σ⁰ · A(r) · (R_ref/r)⁴ · L_rain(r)` ([`clutter_mean_sigma0`]).
 //! * **Rain clutter**: volume reflectivity `η = rain_eta_at_1mm_h · R^1.6` (the Marshall–Palmer `Z ∝ R^1.6`)
 //!   times the cell volume `r² · θ_az · θ_el · Δr`, same `(R_ref/r)⁴ · L_rain(r)`.
 //! * A cell's clutter intensity is exponentially distributed (Rayleigh amplitude) with mean `μ_sea + μ_rain`,
@@ -133,6 +136,26 @@ pub fn clutter_mean(
     let rain = if rain_mm_per_h > 0.0 {
         let eta = model.rain_eta_at_1mm_h * rain_mm_per_h.powf(1.6);
         eta * r * r * cell.beamwidth_az * cell.fan_height * cell.range_resolution * common
+    } else {
+        0.0
+    };
+    (sea, rain)
+}
+
+/// Mean clutter intensity `(sea, rain)` of the cell at range `r` metres over the physical sea, whose
+/// normalised reflectivity there is `sigma0` (m²/m², see [`crate::sensors::radar::sea_clutter`]): the sea part is
+/// `σ⁰ · A(r) · (R_ref/r)⁴ · L_rain(r)` (no fall-off factor: the low-grazing fall is in σ⁰), zero beyond
+/// `sea_max_range_m`; the rain part as in [`clutter_mean`].
+pub fn clutter_mean_sigma0(
+    model: &ClutterModel,
+    cell: &CellShape,
+    sigma0: f64,
+    rain_mm_per_h: f64,
+    r: f64,
+) -> (f64, f64) {
+    let (_, rain) = clutter_mean(model, cell, 0.0, rain_mm_per_h, r);
+    let sea = if sigma0 > 0.0 && r <= model.sea_max_range_m {
+        sigma0 * r * cell.beamwidth_az * cell.range_resolution * range_term(r) * rain_loss(rain_mm_per_h, r)
     } else {
         0.0
     };

@@ -213,3 +213,57 @@ fn misconfiguration_names_the_field() {
     // An empty scene is not an error: no targets, no clutter without waves.
     assert!(radar_sweep(&s, &MAST, &d, &e, 0).is_ok_and(|r| r.is_empty()));
 }
+
+/// Over the physical sea, the clutter-only detections of each range band occur at the rate the NRL model's mean
+/// gives (`exp(−threshold / μ)` per cell, `μ = σ⁰_NRL(SS, ψ) · A · (R_ref/r)⁴`), and grow with the sea state.
+#[test]
+fn physical_sea_clutter_follows_the_nrl_model() {
+    use crate::ocean::{sea_seed, SeaSpec, WaveField};
+    use crate::sea::{SurfaceSpec, WaveSurface};
+    use crate::sensors::radar::sea_clutter::PhysicalSea;
+    let cfg = RadarConfig {
+        azimuth_bins: 1024,
+        range_max_m: 1200.0,
+        rays_el: 8,
+        detection_threshold: 0.3,
+        ..RadarConfig::tuning()
+    };
+    let detections = |hs: f64, tp: f64| {
+        let mut s = sea_with_box(5000.0, 0.0);
+        s.set_sea(0, &[]).unwrap_or_else(|e| unreachable!("{e}"));
+        let spec = SeaSpec { hs, tp, gamma: 3.3, direction_rad: 0.3, spread_s: 10.0 };
+        let field = WaveField::new(&spec, sea_seed(5)).unwrap_or_else(|e| unreachable!("{e}"));
+        let w = WaveSurface::new(field.components(), 0.0, 0.0, &[[0.0, 0.0]], SurfaceSpec::default());
+        s.set_wave_surface(Some(w)).unwrap_or_else(|e| unreachable!("{e}"));
+        let r = sweep(&s, &cfg, hs as f32, 11);
+        (0..r.len()).filter(|&i| r.instance[i] == NO_HIT).map(|i| r.range[i] as f64).collect::<Vec<f64>>()
+    };
+    let expected = |hs: f64, lo: f64, hi: f64| {
+        let sea = PhysicalSea::new(hs, f64::from(MAST.translation.z));
+        let (first, _) = cfg.range_bins();
+        let mut n = 0.0;
+        for bin in first.. {
+            let r = cfg.bin_centre(bin);
+            if r >= hi {
+                break;
+            }
+            if r >= lo {
+                let (mu, _) = radar_model::clutter_mean_sigma0(&cfg.clutter, &cfg.cell_shape(), sea.sigma0(r), 0.0, r);
+                n += (-cfg.detection_threshold / mu).exp() * cfg.azimuth_bins as f64;
+            }
+        }
+        n
+    };
+    let (w1, w3) = (detections(1.5, 6.0), detections(3.5, 9.0));
+    assert!(w3.len() > w1.len() && !w1.is_empty(), "{} vs {}", w3.len(), w1.len());
+    for (hs, got) in [(1.5, &w1), (3.5, &w3)] {
+        for (lo, hi) in [(10.0, 100.0), (100.0, 300.0), (300.0, 1200.0)] {
+            let n = got.iter().filter(|&&r| r >= lo && r < hi).count() as f64;
+            let want = expected(hs, lo, hi);
+            // Binomial counts: within 4 standard deviations (and 2 cells) of the model's expectation.
+            let sd = want.sqrt();
+            eprintln!("clutter Hs {hs} m, {lo}-{hi} m: {n} detections, NRL model {want:.1}");
+            assert!((n - want).abs() <= 4.0 * sd + 2.0, "Hs {hs}, {lo}-{hi} m: {n} detections, model {want:.1}");
+        }
+    }
+}

@@ -21,6 +21,7 @@
 
 use super::noise::{self, stream};
 use crate::material::Material;
+use crate::sea::WaveSurface;
 use crate::seabed::Seabed;
 use parry3d::math::Vec3;
 use std::sync::Arc;
@@ -215,6 +216,8 @@ pub struct Shader {
     sky_keep: f32,
     materials: Arc<Vec<Material>>,
     seabed: Option<Arc<Seabed>>,
+    /// The displaced sea surface, whose slopes replace the swell's normals ([`Shader::with_waves`]).
+    waves: Option<Arc<WaveSurface>>,
 }
 
 /// Intervals of the water's Fresnel table over `cos θ` in `[0, 1]`.
@@ -271,12 +274,20 @@ impl Shader {
             sky_keep: (-env.fog_extinction_per_m * 3000.0).exp(),
             materials: Arc::new(Vec::new()),
             seabed: None,
+            waves: None,
         }
     }
 
     /// This shader showing the bottom through shallow water over `seabed` (a scene's, [`crate::Scene::seabed`]).
     pub fn with_seabed(mut self, seabed: Option<Arc<Seabed>>) -> Self {
         self.seabed = seabed;
+        self
+    }
+
+    /// This shader taking water normals from the displaced sea surface `waves` (a scene's,
+    /// [`crate::Scene::wave_surface`]) instead of the swell.
+    pub fn with_waves(mut self, waves: Option<Arc<WaveSurface>>) -> Self {
+        self.waves = waves;
         self
     }
 
@@ -355,7 +366,10 @@ impl Shader {
     pub fn with_swell(&self, d: Vec3, mut hit: SurfaceHit) -> SurfaceHit {
         hit.shading_normal = hit.normal;
         if hit.is_water() {
-            let n = self.water_normal(hit.point);
+            let n = match self.waves.as_ref().and_then(|w| w.shading_normal(hit.point.x, hit.point.y)) {
+                Some(n) => Vec3::from_array(n),
+                None => self.water_normal(hit.point),
+            };
             if n.dot(d) <= 0.0 {
                 hit.shading_normal = n;
             }

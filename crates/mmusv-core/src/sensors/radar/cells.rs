@@ -58,6 +58,8 @@ pub(super) struct BeamContext<'a> {
     pub(super) end: u32,
     pub(super) table: &'a [ClutterBin],
     pub(super) sensor_height: f64,
+    /// The physical sea's clutter geometry, when the scene has a wave surface.
+    pub(super) physical: Option<crate::sensors::radar::sea_clutter::PhysicalSea>,
     pub(super) pose: &'a RigidPose,
 }
 
@@ -82,7 +84,8 @@ impl BeamContext<'_> {
         let thr = self.cfg.detection_threshold;
         let mut emit = |bin: u32, target: Option<&Echo>, clutter: Option<ClutterBin>| {
             let (u, w) = draws.at(bin);
-            let ClutterBin { mean, sea, p_detect } = clutter.unwrap_or_else(|| ClutterBin::at(self.cfg, self.env, bin));
+            let ClutterBin { mean, sea, p_detect } =
+                clutter.unwrap_or_else(|| ClutterBin::at(self.cfg, self.env, self.physical.as_ref(), bin));
             // Clutter alone is detected iff mean · (−ln u) ≥ threshold, i.e. u ≤ exp(−threshold / mean).
             if target.is_none() && u > p_detect {
                 return;

@@ -1,6 +1,7 @@
 //! Clutter: the mean sea and rain clutter of each range bin (shared by every beam, cut off where clutter
 //! alone can no longer be detected) and the seeded per-cell draws that make it a random picture.
 
+use crate::sensors::radar::sea_clutter::PhysicalSea;
 use crate::sensors::radar::{RadarConfig, RadarEnv};
 use crate::sensors::radar_model;
 use rand::{RngCore, SeedableRng};
@@ -55,14 +56,25 @@ pub(super) struct ClutterBin {
 
 impl ClutterBin {
     /// The clutter of range bin `bin`.
-    pub(super) fn at(cfg: &RadarConfig, env: &RadarEnv, bin: u32) -> Self {
-        let (sea, rain) = radar_model::clutter_mean(
-            &cfg.clutter,
-            &cfg.cell_shape(),
-            env.wave_height_m as f64,
-            env.rain_mm_per_h as f64,
-            cfg.bin_centre(bin),
-        );
+    /// Over the physical sea (`physical`), σ⁰ is the NRL model's ([`super::sea_clutter`]).
+    pub(super) fn at(cfg: &RadarConfig, env: &RadarEnv, physical: Option<&PhysicalSea>, bin: u32) -> Self {
+        let r = cfg.bin_centre(bin);
+        let (sea, rain) = match physical {
+            None => radar_model::clutter_mean(
+                &cfg.clutter,
+                &cfg.cell_shape(),
+                env.wave_height_m as f64,
+                env.rain_mm_per_h as f64,
+                r,
+            ),
+            Some(p) => radar_model::clutter_mean_sigma0(
+                &cfg.clutter,
+                &cfg.cell_shape(),
+                p.sigma0(r),
+                env.rain_mm_per_h as f64,
+                r,
+            ),
+        };
         let mean = sea + rain;
         let p_detect = if mean > 0.0 { (-cfg.detection_threshold / mean).exp() } else { 0.0 };
         Self { mean, sea: sea >= rain, p_detect }
@@ -71,10 +83,16 @@ impl ClutterBin {
 
 /// Clutter of the range bins from `first` on, shared by every beam, up to the first bin where clutter alone
 /// cannot be detected (`mean < threshold / CLUTTER_CUTOFF`; the means fall monotonically with range).
-pub(super) fn clutter_table(cfg: &RadarConfig, env: &RadarEnv, first: u32, end: u32) -> Vec<ClutterBin> {
+pub(super) fn clutter_table(
+    cfg: &RadarConfig,
+    env: &RadarEnv,
+    physical: Option<&PhysicalSea>,
+    first: u32,
+    end: u32,
+) -> Vec<ClutterBin> {
     let mut table = Vec::new();
     for k in first..end {
-        let c = ClutterBin::at(cfg, env, k);
+        let c = ClutterBin::at(cfg, env, physical, k);
         let negligible = if cfg.detection_threshold > 0.0 {
             c.mean * CLUTTER_CUTOFF < cfg.detection_threshold
         } else {

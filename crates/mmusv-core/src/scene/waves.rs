@@ -1,0 +1,105 @@
+//! The displaced sea surface in a [`Scene`]: while a [`WaveSurface`] is set, it stands in for the declared sea
+//! instance's flat mesh for every ray (closest hits, shadow rays, packets), reported as hits on that instance
+//! with the surface's piece as the triangle index; normals come from the piece, the class and material from the
+//! sea mesh.
+
+use super::{Hit, Scene};
+use crate::bvh::{Packet, PACKET};
+use crate::error::{MmusvError, Result};
+use crate::ray::RayPrep;
+use crate::sea::WaveSurface;
+use parry3d::math::Vec3;
+use std::sync::Arc;
+
+impl Scene {
+    /// Sets (or with `None` clears) the displaced sea surface of the current frame. The scene must have a sea
+    /// ([`Scene::set_sea`]): the surface replaces that instance's flat mesh for every ray, and the sea shortcuts
+    /// learn its crest bound ([`WaveSurface::zmax`]). [`Scene::set_sea`] and [`Scene::clear_sea`] clear it.
+    pub fn set_wave_surface(&mut self, surface: Option<WaveSurface>) -> Result<()> {
+        let Some(sea) = &mut self.sea else {
+            if surface.is_none() {
+                self.waves = None;
+                return Ok(());
+            }
+            return Err(MmusvError::input(
+                "surface",
+                "the scene has no sea surface; declare it with set_sea before setting a wave surface",
+            ));
+        };
+        sea.set_wave_top(surface.as_ref().map(WaveSurface::zmax));
+        self.waves = surface.map(Arc::new);
+        Ok(())
+    }
+
+    /// The displaced sea surface of the current frame, if set (shared, cheap to clone).
+    pub fn wave_surface(&self) -> Option<Arc<WaveSurface>> {
+        self.waves.clone()
+    }
+
+    /// The instance the wave surface stands in for (left out of the tree walks), or `u32::MAX`.
+    #[inline(always)]
+    pub(super) fn hidden_instance(&self) -> u32 {
+        match (&self.waves, &self.sea) {
+            (Some(_), Some(sea)) => sea.instance,
+            _ => u32::MAX,
+        }
+    }
+
+    /// Whether hits on `instance` are wave-surface hits (their triangle index is a surface piece).
+    #[inline(always)]
+    pub(super) fn is_wave_hit(&self, instance: u32) -> bool {
+        self.waves.is_some() && self.hidden_instance() == instance
+    }
+
+    /// The ray's hit with the wave surface below `limit`, as a hit on the sea instance.
+    /// Rays leaving the water ([`WaveSurface::leaves`]) meet none.
+    #[inline(always)]
+    pub(super) fn wave_hit(&self, ray: &RayPrep, limit: f32) -> Option<Hit> {
+        let w = self.waves.as_ref()?;
+        if w.leaves(ray.o, ray.d) {
+            return None;
+        }
+        let h = w.intersect(ray.o, ray.d, limit)?;
+        Some(Hit { distance: h.t, instance: self.hidden_instance(), triangle: h.piece })
+    }
+
+    /// Intersects every ray of `p` with the wave surface below its `best`, shortening `best` where it hits; the
+    /// sea instance and the piece per ray (`u32::MAX` where none), or `None` without a wave surface.
+    #[inline(always)]
+    pub(super) fn wave_hits_packet(&self, p: &mut Packet) -> Option<(u32, [u32; PACKET])> {
+        let w = self.waves.as_ref()?;
+        let mut pieces = [u32::MAX; PACKET];
+        for r in 0..p.n {
+            if p.best[r] < 0.0 || w.leaves(p.ray[r].o, p.ray[r].d) {
+                continue;
+            }
+            if let Some(h) = w.intersect(p.ray[r].o, p.ray[r].d, p.best[r]) {
+                p.best[r] = h.t;
+                pieces[r] = h.piece;
+            }
+        }
+        Some((self.hidden_instance(), pieces))
+    }
+
+    /// Marks the rays of `p` the wave surface blocks below their `best` (`best = -1`).
+    #[inline(always)]
+    pub(super) fn wave_block_packet(&self, p: &mut Packet) {
+        let Some(w) = &self.waves else { return };
+        for r in 0..p.n {
+            let ray = &p.ray[r];
+            if p.best[r] >= 0.0 && !w.leaves(ray.o, ray.d) && w.occludes(ray.o, ray.d, p.best[r]) {
+                p.best[r] = -1.0;
+            }
+        }
+    }
+
+    /// The unit normal of a wave-surface hit (`instance`, `triangle` as a hit reports them), `None` for any
+    /// other hit.
+    #[inline(always)]
+    pub(super) fn wave_piece_normal(&self, instance: u32, triangle: u32) -> Option<Vec3> {
+        if !self.is_wave_hit(instance) {
+            return None;
+        }
+        Some(Vec3::from_array(self.waves.as_ref()?.piece_normal(triangle)))
+    }
+}

@@ -1,0 +1,959 @@
+//! The displaced sea surface of one frame: a heightfield sampled from a sum of wave components, which every ray
+//! of every sensor meets (crests occlude what lies behind them).
+//!
+//! Model: the elevation `η(x, y, t) = Σ a cos(kx x + ky y − ω t + φ)` of the linear (Airy) wave components of
+//! [`crate::ocean::WaveField`] (a random-phase realisation of a directional spectrum), triangulated. The
+//! surface is sampled once per frame time on a world-aligned lattice of square tiles ([`TILE_CELLS`] cells a side, [`SurfaceSpec::
+//! tile_m`] metres): fine near the *foci* (the USVs, every sensor's platform), coarser with distance (each level
+//! doubles the cell), and tapered to the still level beyond [`SurfaceSpec::radius_m`] (flat there). The level of
+//! detail depends only on the frame's foci, so every sensor and every agent sees the same surface at one frame.
+//!
+//! Each cell is two triangles (split along the `(0,0)–(1,1)` diagonal). A ray is intersected exactly with that
+//! piecewise-planar surface by a *sign march*: only the part of the ray inside the band `[zmin, zmax]` of the
+//! sampled heights is walked (above the band nothing can be hit: the crest bound), tile by tile, cell by cell,
+//! triangle by triangle; on every piece the height of the ray above the surface is linear in `t`, so its sign
+//! change gives the hit. The sign is carried from piece to piece, so no ray slips through a shared edge, and a
+//! step between two tiles of different detail is closed by a vertical wall (hit where the sign flips at the tile
+//! boundary). Tiles and cells whose sampled maximum lies below the ray are skipped whole.
+//!
+//! Heights and slopes `∇η` (for smooth shading normals, [`WaveSurface::shading_normal`]) are summed per tile by
+//! a two-dimensional phasor recurrence: every component's `a e^{iψ}` at a tile's corner comes from the
+//! rectangle's corner by one rotation per tile column and row (tabulated once per frame), then one rotation per
+//! node column and row inside the tile; the only `sin_cos` calls are a few per component and frame, and the
+//! inner loop is a vectorisable multiply-add over a row of nodes (the same values as
+//! [`crate::ocean::WaveField::elevation_slope_grid`] to rounding, tested).
+
+use crate::ocean::WaveComponent;
+use rayon::prelude::*;
+
+/// Cells along a side of a finest-level tile (a tile at level `L` has `TILE_CELLS >> L`).
+pub const TILE_CELLS: usize = 32;
+/// Coarsest level (one cell per tile).
+const MAX_LEVEL: u32 = 5;
+/// Rays that rise from within this height (metres) above the surface under their origin leave the water: the
+/// surface does not occlude them ([`WaveSurface::leaves`]).
+pub const SKIN_M: f32 = 0.25;
+/// Piece id of the still, flat water (outside the sampled tiles or in a flat tile).
+pub const FLAT_PIECE: u32 = u32::MAX - 1;
+
+/// How finely the surface is sampled around its foci.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfaceSpec {
+    /// Side of a tile, metres (the finest cell is `tile_m / 32`).
+    pub tile_m: f32,
+    /// Tiles whose centre lies within this distance of a focus are sampled at the finest level; each doubling of
+    /// the distance halves the detail.
+    pub near_m: f32,
+    /// The waves taper to the still level between `radius_m - taper_m` and `radius_m` from the nearest focus.
+    pub radius_m: f32,
+    /// Width of that taper, metres.
+    pub taper_m: f32,
+}
+
+impl Default for SurfaceSpec {
+    /// 1 m cells within ~40 m, 2 m to ~80 m, 4 m to ~160 m, 8 m to ~320 m, waves out to 320 m around every
+    /// focus (tapered over the last 60 m).
+    fn default() -> Self {
+        Self { tile_m: 32.0, near_m: 40.0, radius_m: 320.0, taper_m: 60.0 }
+    }
+}
+
+/// One sampled tile: `n` cells a side (0: flat at the still level), node heights and slopes row-major.
+#[derive(Debug, Clone, Default)]
+struct Tile {
+    n: usize,
+    zmin: f32,
+    zmax: f32,
+    /// `(n+1)²` heights, world z.
+    h: Vec<f32>,
+    /// `(n+1)²` slopes `(∂η/∂x, ∂η/∂y)`.
+    g: Vec<[f32; 2]>,
+    /// Highest node of each block of [`BLOCK`] × [`BLOCK`] cells, row-major (empty when `n <= BLOCK`).
+    bmax: Vec<f32>,
+}
+
+/// Cells along a side of a block, the march's middle level: a ray over a block's highest node skips it whole.
+const BLOCK: usize = 4;
+
+/// The displaced sea surface of one frame (see the module docs).
+#[derive(Debug, Clone)]
+pub struct WaveSurface {
+    level: f32,
+    time_s: f64,
+    /// Lower corner of the tile rectangle (world x, y).
+    x0: f32,
+    y0: f32,
+    tile_m: f32,
+    ntx: usize,
+    nty: usize,
+    tiles: Vec<Tile>,
+    zmin: f32,
+    zmax: f32,
+}
+
+/// A hit of a ray with the surface: distance and the piece (tile, cell, triangle) hit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfaceHit {
+    /// Distance along the ray's direction.
+    pub t: f32,
+    /// The piece: see [`WaveSurface::piece_normal`].
+    pub piece: u32,
+}
+
+impl WaveSurface {
+    /// Samples `components` at time `time_s` around the `foci` (world x, y), with still level `level`.
+    /// Deterministic: the same inputs give the same surface, whatever the thread count.
+    pub fn new(components: &[WaveComponent], time_s: f64, level: f32, foci: &[[f32; 2]], spec: SurfaceSpec) -> Self {
+        let tile_m = spec.tile_m.max(1e-3);
+        let reach = spec.radius_m.max(0.0);
+        let (mut lo, mut hi) = ([f32::INFINITY; 2], [f32::NEG_INFINITY; 2]);
+        for f in foci {
+            for a in 0..2 {
+                lo[a] = lo[a].min(f[a] - reach);
+                hi[a] = hi[a].max(f[a] + reach);
+            }
+        }
+        let empty = foci.is_empty() || reach == 0.0 || components.is_empty();
+        let (x0, y0, ntx, nty) = if empty {
+            (0.0, 0.0, 0, 0)
+        } else {
+            let x0 = (lo[0] / tile_m).floor() * tile_m;
+            let y0 = (lo[1] / tile_m).floor() * tile_m;
+            (x0, y0, ((hi[0] - x0) / tile_m).ceil() as usize, ((hi[1] - y0) / tile_m).ceil() as usize)
+        };
+        let phasors = Phasors::new(components, time_s, x0, y0, tile_m, ntx, nty);
+        let tiles: Vec<Tile> = (0..ntx * nty)
+            .into_par_iter()
+            .map(|k| {
+                let (ix, iy) = (k % ntx, k / ntx);
+                phasors.tile(ix, iy, level, foci, &spec)
+            })
+            .collect();
+        let mut zmin = level;
+        let mut zmax = level;
+        for t in &tiles {
+            if t.n > 0 {
+                zmin = zmin.min(t.zmin);
+                zmax = zmax.max(t.zmax);
+            }
+        }
+        Self { level, time_s, x0, y0, tile_m, ntx, nty, tiles, zmin, zmax }
+    }
+
+    /// The still water level (world z).
+    pub fn level(&self) -> f32 {
+        self.level
+    }
+    /// The frame time the surface was sampled at, seconds.
+    pub fn time_s(&self) -> f64 {
+        self.time_s
+    }
+    /// Highest point of the surface (world z): no ray above it can meet the water.
+    pub fn zmax(&self) -> f32 {
+        self.zmax
+    }
+    /// Lowest point of the surface (world z).
+    pub fn zmin(&self) -> f32 {
+        self.zmin
+    }
+    /// Number of sampled (non-flat) tiles.
+    pub fn sampled_tiles(&self) -> usize {
+        self.tiles.iter().filter(|t| t.n > 0).count()
+    }
+
+    /// The tile holding world `(x, y)`, if inside the rectangle.
+    #[inline]
+    fn tile_at(&self, x: f32, y: f32) -> Option<(usize, usize)> {
+        let fx = ((x - self.x0) / self.tile_m).floor();
+        let fy = ((y - self.y0) / self.tile_m).floor();
+        (fx >= 0.0 && fy >= 0.0 && (fx as usize) < self.ntx && (fy as usize) < self.nty)
+            .then_some((fx as usize, fy as usize))
+    }
+
+    /// Height of the surface at world `(x, y)` (the triangulated surface; the still level outside).
+    pub fn height(&self, x: f32, y: f32) -> f32 {
+        let Some((ix, iy)) = self.tile_at(x, y) else { return self.level };
+        let k = iy * self.ntx + ix;
+        let t = &self.tiles[k];
+        if t.n == 0 {
+            return self.level;
+        }
+        let s = self.tile_m / t.n as f32;
+        let u = ((x - (self.x0 + ix as f32 * self.tile_m)) / s).clamp(0.0, t.n as f32);
+        let v = ((y - (self.y0 + iy as f32 * self.tile_m)) / s).clamp(0.0, t.n as f32);
+        let (ci, cj) = ((u as usize).min(t.n - 1), (v as usize).min(t.n - 1));
+        let (fu, fv) = (u - ci as f32, v - cj as f32);
+        let (plane, _) = cell_planes(t, ci, cj);
+        let p = if fu >= fv { plane[0] } else { plane[1] };
+        p[0] + p[1] * fu + p[2] * fv
+    }
+
+    /// Unit geometric normal (up-facing) of piece `piece` (a [`SurfaceHit::piece`]).
+    pub fn piece_normal(&self, piece: u32) -> [f32; 3] {
+        if piece == FLAT_PIECE {
+            return [0.0, 0.0, 1.0];
+        }
+        let per_tile = (2 * TILE_CELLS * TILE_CELLS) as u32;
+        let (k, rest) = ((piece / per_tile) as usize, piece % per_tile);
+        let Some(t) = self.tiles.get(k).filter(|t| t.n > 0) else { return [0.0, 0.0, 1.0] };
+        let (cell, tri) = ((rest / 2) as usize, (rest % 2) as usize);
+        let (ci, cj) = (cell % t.n, cell / t.n);
+        if cj >= t.n {
+            return [0.0, 0.0, 1.0];
+        }
+        let s = self.tile_m / t.n as f32;
+        let (plane, _) = cell_planes(t, ci, cj);
+        let p = plane[tri];
+        unit([-p[1] / s, -p[2] / s, 1.0])
+    }
+
+    /// Smooth unit normal at world `(x, y)`: the sampled slopes `∇η` interpolated bilinearly (up-facing); `None`
+    /// over still water (outside the sampled tiles), where the caller's own small-scale normals serve.
+    pub fn shading_normal(&self, x: f32, y: f32) -> Option<[f32; 3]> {
+        let (ix, iy) = self.tile_at(x, y)?;
+        let t = &self.tiles[iy * self.ntx + ix];
+        if t.n == 0 {
+            return None;
+        }
+        let s = self.tile_m / t.n as f32;
+        let u = ((x - (self.x0 + ix as f32 * self.tile_m)) / s).clamp(0.0, t.n as f32);
+        let v = ((y - (self.y0 + iy as f32 * self.tile_m)) / s).clamp(0.0, t.n as f32);
+        let (ci, cj) = ((u as usize).min(t.n - 1), (v as usize).min(t.n - 1));
+        let (fu, fv) = (u - ci as f32, v - cj as f32);
+        let w = t.n + 1;
+        let g = |i: usize, j: usize| t.g[j * w + i];
+        let (g00, g10, g01, g11) = (g(ci, cj), g(ci + 1, cj), g(ci, cj + 1), g(ci + 1, cj + 1));
+        let mix =
+            |a: usize| (g00[a] * (1.0 - fu) + g10[a] * fu) * (1.0 - fv) + (g01[a] * (1.0 - fu) + g11[a] * fu) * fv;
+        Some(unit([-mix(0), -mix(1), 1.0]))
+    }
+
+    /// The first crossing of the ray `o + t·d` (`d` unit, `0 <= t < t_max`) with the surface, from either side,
+    /// or `None`.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN must answer "no hit"
+    pub fn intersect(&self, o: [f32; 3], d: [f32; 3], t_max: f32) -> Option<SurfaceHit> {
+        // The band [zmin, zmax] of the ray.
+        let (oz, dz) = (o[2], d[2]);
+        let (mut t0, mut t1) = (0.0f32, t_max);
+        if dz > 0.0 {
+            t1 = t1.min((self.zmax - oz) / dz);
+            t0 = t0.max((self.zmin - oz) / dz);
+        } else if dz < 0.0 {
+            t0 = t0.max((self.zmax - oz) / dz);
+            t1 = t1.min((self.zmin - oz) / dz);
+        } else if !(oz >= self.zmin && oz <= self.zmax) {
+            return None;
+        }
+        if !(t0 <= t1) {
+            return None;
+        }
+        let mut m = March { s: self, o, d, above: None };
+        // Split [t0, t1] into the parts before, inside and after the tile rectangle.
+        let span = self.rect_span(o, d, t0, t1);
+        match span {
+            None => m.flat(t0, t1),
+            Some((a, b)) => {
+                if a > t0 {
+                    if let Some(h) = m.flat(t0, a) {
+                        return Some(h);
+                    }
+                }
+                if let Some(h) = m.tiles(a, b) {
+                    return Some(h);
+                }
+                if b < t1 {
+                    return m.flat(b, t1);
+                }
+                None
+            }
+        }
+    }
+
+    /// Whether the ray `o + t·d` rises from the water itself: its origin lies no more than [`SKIN_M`] above (and
+    /// not below) the surface under it. Such rays — a camera's reflected rays and shadow rays from the water it
+    /// sees — are not occluded by the waves (no wave self-shadowing; the capillary slopes' shading stands in for
+    /// it), which the scene applies to every such ray alike, so its shortcuts stay exact.
+    #[inline]
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > b)` on purpose: a NaN must answer "no"
+    pub fn leaves(&self, o: [f32; 3], d: [f32; 3]) -> bool {
+        if !(d[2] > 0.0) || o[2] > self.zmax + SKIN_M || o[2] < self.zmin {
+            return false;
+        }
+        let h = self.height(o[0], o[1]);
+        o[2] >= h && o[2] <= h + SKIN_M
+    }
+
+    /// Whether the ray `o + t·d` crosses the surface with `0 <= t < t_max`.
+    #[inline]
+    pub fn occludes(&self, o: [f32; 3], d: [f32; 3], t_max: f32) -> bool {
+        self.intersect(o, d, t_max).is_some()
+    }
+
+    /// The part of `[t0, t1]` of the ray over the tile rectangle, or `None`.
+    fn rect_span(&self, o: [f32; 3], d: [f32; 3], t0: f32, t1: f32) -> Option<(f32, f32)> {
+        if self.ntx == 0 {
+            return None;
+        }
+        let hi = [self.x0 + self.ntx as f32 * self.tile_m, self.y0 + self.nty as f32 * self.tile_m];
+        let lo = [self.x0, self.y0];
+        let (mut a, mut b) = (t0, t1);
+        for ax in 0..2 {
+            if d[ax] == 0.0 {
+                if o[ax] < lo[ax] || o[ax] >= hi[ax] {
+                    return None;
+                }
+            } else {
+                let (p, q) = ((lo[ax] - o[ax]) / d[ax], (hi[ax] - o[ax]) / d[ax]);
+                a = a.max(p.min(q));
+                b = b.min(p.max(q));
+            }
+        }
+        (a < b).then_some((a, b))
+    }
+}
+
+/// The state of one sign march: the ray and whether it was last above the surface (`None` before the first
+/// piece).
+struct March<'a> {
+    s: &'a WaveSurface,
+    o: [f32; 3],
+    d: [f32; 3],
+    above: Option<bool>,
+}
+
+impl March<'_> {
+    #[inline(always)]
+    fn z(&self, t: f32) -> f32 {
+        self.o[2] + self.d[2] * t
+    }
+
+    /// A piece on which the ray's height above the surface goes linearly from `fa` (at `ta`) to `fb` (at `tb`):
+    /// the hit, if the sign changes (at `ta` against the carried sign, or inside).
+    #[inline(always)]
+    fn piece(&mut self, ta: f32, tb: f32, fa: f32, fb: f32, piece: u32) -> Option<SurfaceHit> {
+        let a_above = fa > 0.0;
+        if let Some(prev) = self.above {
+            if prev != a_above {
+                return Some(SurfaceHit { t: ta, piece });
+            }
+        }
+        let b_above = fb > 0.0;
+        self.above = Some(b_above);
+        if a_above != b_above {
+            let f = fa / (fa - fb);
+            let t = if f.is_finite() { ta + (tb - ta) * f.clamp(0.0, 1.0) } else { ta };
+            return Some(SurfaceHit { t, piece });
+        }
+        None
+    }
+
+    /// A stretch over still water.
+    fn flat(&mut self, ta: f32, tb: f32) -> Option<SurfaceHit> {
+        let l = self.s.level;
+        self.piece(ta, tb, self.z(ta) - l, self.z(tb) - l, FLAT_PIECE)
+    }
+
+    /// The stretch `[ta, tb]` inside the tile rectangle: tile by tile (2D DDA).
+    fn tiles(&mut self, ta: f32, tb: f32) -> Option<SurfaceHit> {
+        let s = self.s;
+        let (o, d) = (self.o, self.d);
+        let px = o[0] + d[0] * ta;
+        let py = o[1] + d[1] * ta;
+        let clampi = |v: f32, n: usize| (v.floor().max(0.0) as usize).min(n - 1);
+        let mut ix = clampi((px - s.x0) / s.tile_m, s.ntx);
+        let mut iy = clampi((py - s.y0) / s.tile_m, s.nty);
+        let next = |i: usize, da: f32, oa: f32, lo: f32| {
+            if da == 0.0 {
+                f32::INFINITY
+            } else {
+                (lo + (i as f32 + if da > 0.0 { 1.0 } else { 0.0 }) * s.tile_m - oa) / da
+            }
+        };
+        let mut tx = next(ix, d[0], o[0], s.x0);
+        let mut ty = next(iy, d[1], o[1], s.y0);
+        let dtx = if d[0] == 0.0 { f32::INFINITY } else { s.tile_m / d[0].abs() };
+        let dty = if d[1] == 0.0 { f32::INFINITY } else { s.tile_m / d[1].abs() };
+        let mut t = ta;
+        loop {
+            let t_exit = tx.min(ty).min(tb);
+            if t_exit > t {
+                if let Some(h) = self.tile(ix, iy, t, t_exit) {
+                    return Some(h);
+                }
+            }
+            if t_exit >= tb {
+                return None;
+            }
+            t = t_exit;
+            if tx <= ty {
+                let n = ix as isize + if d[0] > 0.0 { 1 } else { -1 };
+                if n < 0 || n >= s.ntx as isize {
+                    return None;
+                }
+                ix = n as usize;
+                tx += dtx;
+            } else {
+                let n = iy as isize + if d[1] > 0.0 { 1 } else { -1 };
+                if n < 0 || n >= s.nty as isize {
+                    return None;
+                }
+                iy = n as usize;
+                ty += dty;
+            }
+        }
+    }
+
+    /// The stretch `[ta, tb]` over tile `(ix, iy)`.
+    fn tile(&mut self, ix: usize, iy: usize, ta: f32, tb: f32) -> Option<SurfaceHit> {
+        let s = self.s;
+        let k = iy * s.ntx + ix;
+        let tile = &s.tiles[k];
+        if tile.n == 0 {
+            return self.flat(ta, tb);
+        }
+        let (za, zb) = (self.z(ta), self.z(tb));
+        if za.min(zb) > tile.zmax && self.above != Some(false) {
+            self.above = Some(true);
+            return None; // wholly above every crest of the tile
+        }
+        if za.max(zb) <= tile.zmin && self.above == Some(false) {
+            return None; // wholly under the tile's troughs, and already under water
+        }
+        let n = tile.n;
+        if n <= BLOCK {
+            return self.cells(ix, iy, ta, tb, [0, 0], [n - 1, n - 1]);
+        }
+        // Block by block (2D DDA over BLOCK × BLOCK cells), skipping the blocks the ray passes over.
+        let nb = n / BLOCK;
+        let bs = s.tile_m / nb as f32;
+        let (tx0, ty0) = (s.x0 + ix as f32 * s.tile_m, s.y0 + iy as f32 * s.tile_m);
+        let (o, d) = (self.o, self.d);
+        let (u0, v0) = ((o[0] - tx0) / bs, (o[1] - ty0) / bs);
+        let (du, dv) = (d[0] / bs, d[1] / bs);
+        let clampb = |v: f32| (v.floor().max(0.0) as usize).min(nb - 1);
+        let (mut bi, mut bj) = (clampb(u0 + du * ta), clampb(v0 + dv * ta));
+        let next = |c: usize, da: f32, base: f32| {
+            if da == 0.0 {
+                f32::INFINITY
+            } else {
+                (c as f32 + if da > 0.0 { 1.0 } else { 0.0 } - base) / da
+            }
+        };
+        let (mut tu, mut tv) = (next(bi, du, u0), next(bj, dv, v0));
+        let dtu = if du == 0.0 { f32::INFINITY } else { 1.0 / du.abs() };
+        let dtv = if dv == 0.0 { f32::INFINITY } else { 1.0 / dv.abs() };
+        let mut t = ta;
+        loop {
+            let t_exit = tu.min(tv).min(tb);
+            if t_exit >= t {
+                let top = tile.bmax[bj * nb + bi];
+                if self.z(t).min(self.z(t_exit)) > top && self.above != Some(false) {
+                    self.above = Some(true);
+                } else {
+                    let lo = [bi * BLOCK, bj * BLOCK];
+                    let hi = [lo[0] + BLOCK - 1, lo[1] + BLOCK - 1];
+                    if let Some(h) = self.cells(ix, iy, t, t_exit, lo, hi) {
+                        return Some(h);
+                    }
+                }
+            }
+            if t_exit >= tb {
+                return None;
+            }
+            t = t_exit;
+            if tu <= tv {
+                let nc = bi as isize + if du > 0.0 { 1 } else { -1 };
+                if nc < 0 || nc >= nb as isize {
+                    return None;
+                }
+                bi = nc as usize;
+                tu += dtu;
+            } else {
+                let nc = bj as isize + if dv > 0.0 { 1 } else { -1 };
+                if nc < 0 || nc >= nb as isize {
+                    return None;
+                }
+                bj = nc as usize;
+                tv += dtv;
+            }
+        }
+    }
+
+    /// The stretch `[ta, tb]` over the cells `lo..=hi` (column, row) of tile `(ix, iy)`: cell by cell (2D DDA),
+    /// triangle by triangle.
+    fn cells(&mut self, ix: usize, iy: usize, ta: f32, tb: f32, lo: [usize; 2], hi: [usize; 2]) -> Option<SurfaceHit> {
+        let s = self.s;
+        let k = iy * s.ntx + ix;
+        let tile = &s.tiles[k];
+        let n = tile.n;
+        let cs = s.tile_m / n as f32;
+        let (tx0, ty0) = (s.x0 + ix as f32 * s.tile_m, s.y0 + iy as f32 * s.tile_m);
+        let (o, d) = (self.o, self.d);
+        // Cell coordinates (u, v) along the ray: u(t) = (o.x + d.x t - tx0) / cs.
+        let (u0, v0) = ((o[0] - tx0) / cs, (o[1] - ty0) / cs);
+        let (du, dv) = (d[0] / cs, d[1] / cs);
+        let clampc = |v: f32, a: usize| (v.floor().max(lo[a] as f32) as usize).min(hi[a]);
+        let mut ci = clampc(u0 + du * ta, 0);
+        let mut cj = clampc(v0 + dv * ta, 1);
+        let next = |c: usize, da: f32, base: f32| {
+            if da == 0.0 {
+                f32::INFINITY
+            } else {
+                (c as f32 + if da > 0.0 { 1.0 } else { 0.0 } - base) / da
+            }
+        };
+        let mut tu = next(ci, du, u0);
+        let mut tv = next(cj, dv, v0);
+        let dtu = if du == 0.0 { f32::INFINITY } else { 1.0 / du.abs() };
+        let dtv = if dv == 0.0 { f32::INFINITY } else { 1.0 / dv.abs() };
+        let base = (k * 2 * TILE_CELLS * TILE_CELLS) as u32;
+        let mut t = ta;
+        let w = n + 1;
+        loop {
+            let t_exit = tu.min(tv).min(tb);
+            if t_exit >= t {
+                let h = &tile.h;
+                let (h00, h10) = (h[cj * w + ci], h[cj * w + ci + 1]);
+                let (h01, h11) = (h[(cj + 1) * w + ci], h[(cj + 1) * w + ci + 1]);
+                let cmax = h00.max(h10).max(h01).max(h11);
+                let (zt, ze) = (self.z(t), self.z(t_exit));
+                if zt.min(ze) > cmax && self.above != Some(false) {
+                    self.above = Some(true);
+                } else {
+                    let (plane, _) = cell_planes(tile, ci, cj);
+                    let id = base + 2 * (cj * n + ci) as u32;
+                    // Local (fu, fv) at t: u(t) - ci.
+                    let fu = |t: f32| u0 + du * t - ci as f32;
+                    let fv = |t: f32| v0 + dv * t - cj as f32;
+                    let (oz, dz) = (o[2], d[2]);
+                    let f_at = |t: f32, tri: usize| {
+                        let p = plane[tri];
+                        oz + dz * t - (p[0] + p[1] * fu(t) + p[2] * fv(t))
+                    };
+                    let tri_of = |t: f32| usize::from(fu(t) < fv(t));
+                    // Diagonal crossing: fu(t) = fv(t).
+                    let dd = du - dv;
+                    let td = if dd != 0.0 { (v0 - cj as f32 - (u0 - ci as f32)) / dd } else { f32::NAN };
+                    if td > t && td < t_exit {
+                        let tri_a = tri_of(0.5 * (t + td));
+                        if let Some(hh) = self.piece(t, td, f_at(t, tri_a), f_at(td, tri_a), id + tri_a as u32) {
+                            return Some(hh);
+                        }
+                        let tri_b = 1 - tri_a;
+                        if let Some(hh) =
+                            self.piece(td, t_exit, f_at(td, tri_b), f_at(t_exit, tri_b), id + tri_b as u32)
+                        {
+                            return Some(hh);
+                        }
+                    } else {
+                        let tri = tri_of(0.5 * (t + t_exit));
+                        if let Some(hh) = self.piece(t, t_exit, f_at(t, tri), f_at(t_exit, tri), id + tri as u32) {
+                            return Some(hh);
+                        }
+                    }
+                }
+            }
+            if t_exit >= tb {
+                return None;
+            }
+            t = t_exit;
+            if tu <= tv {
+                let nc = ci as isize + if du > 0.0 { 1 } else { -1 };
+                if nc < lo[0] as isize || nc > hi[0] as isize {
+                    return None;
+                }
+                ci = nc as usize;
+                tu += dtu;
+            } else {
+                let nc = cj as isize + if dv > 0.0 { 1 } else { -1 };
+                if nc < lo[1] as isize || nc > hi[1] as isize {
+                    return None;
+                }
+                cj = nc as usize;
+                tv += dtv;
+            }
+        }
+    }
+}
+
+/// The two triangle planes of cell `(ci, cj)` as `[h0, ∂h/∂fu, ∂h/∂fv]` over the cell's local `(fu, fv) ∈ [0,1]²`:
+/// `[0]` for `fu >= fv` (corners 00, 10, 11), `[1]` for `fu < fv` (00, 11, 01); and the cell's highest corner.
+#[inline(always)]
+fn cell_planes(t: &Tile, ci: usize, cj: usize) -> ([[f32; 3]; 2], f32) {
+    let w = t.n + 1;
+    let (h00, h10) = (t.h[cj * w + ci], t.h[cj * w + ci + 1]);
+    let (h01, h11) = (t.h[(cj + 1) * w + ci], t.h[(cj + 1) * w + ci + 1]);
+    ([[h00, h10 - h00, h11 - h10], [h00, h11 - h01, h01 - h00]], h00.max(h10).max(h01).max(h11))
+}
+
+#[inline]
+fn unit(v: [f32; 3]) -> [f32; 3] {
+    let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    [v[0] / n, v[1] / n, v[2] / n]
+}
+
+/// Distance from `(x, y)` to the nearest focus.
+#[inline]
+fn nearest(foci: &[[f32; 2]], x: f32, y: f32) -> f32 {
+    foci.iter().map(|f| (f[0] - x).hypot(f[1] - y)).fold(f32::INFINITY, f32::min)
+}
+
+/// Complex number `(re, im)`.
+type C64 = (f64, f64);
+
+#[inline(always)]
+fn cmul(a: C64, b: C64) -> C64 {
+    (a.0 * b.0 - a.1 * b.1, a.0 * b.1 + a.1 * b.0)
+}
+
+#[inline(always)]
+fn cis(x: f64) -> C64 {
+    let (s, c) = x.sin_cos();
+    (c, s)
+}
+
+/// The phasor tables of one frame (see the module docs): per component `a e^{iψ}` at each tile column's corner
+/// on the rectangle's bottom edge, the rotation to each tile row, and per level the rotation per node step.
+struct Phasors<'a> {
+    comps: &'a [WaveComponent],
+    x0: f32,
+    y0: f32,
+    tile_m: f32,
+    /// `[ix · ncomp + c]`: `a e^{iψ}` at `(x0 + ix · tile_m, y0)`.
+    col: Vec<C64>,
+    /// `[iy · ncomp + c]`: `e^{i ky iy tile_m}`.
+    row: Vec<C64>,
+    /// `[level · ncomp + c]`: `(e^{i kx d}, e^{i ky d})` for the node step `d` of that level.
+    step: Vec<(C64, C64)>,
+}
+
+impl<'a> Phasors<'a> {
+    fn new(comps: &'a [WaveComponent], t: f64, x0: f32, y0: f32, tile_m: f32, ntx: usize, nty: usize) -> Self {
+        let nc = comps.len();
+        let tm = f64::from(tile_m);
+        let mut col = vec![(0.0, 0.0); ntx * nc];
+        let mut row = vec![(0.0, 0.0); nty * nc];
+        let mut step = vec![((0.0, 0.0), (0.0, 0.0)); (MAX_LEVEL as usize + 1) * nc];
+        for (c, w) in comps.iter().enumerate() {
+            let base = cis(w.phase_at(f64::from(x0), f64::from(y0), t));
+            let (ex, ey) = (cis(w.kx * tm), cis(w.ky * tm));
+            let mut p = (w.amplitude_m * base.0, w.amplitude_m * base.1);
+            for ix in 0..ntx {
+                col[ix * nc + c] = p;
+                p = cmul(p, ex);
+            }
+            let mut q = (1.0, 0.0);
+            for iy in 0..nty {
+                row[iy * nc + c] = q;
+                q = cmul(q, ey);
+            }
+            for lvl in 0..=MAX_LEVEL as usize {
+                let d = tm / (TILE_CELLS >> lvl) as f64;
+                step[lvl * nc + c] = (cis(w.kx * d), cis(w.ky * d));
+            }
+        }
+        Self { comps, x0, y0, tile_m, col, row, step }
+    }
+
+    /// Samples tile `(ix, iy)`: its level from the distance of its centre to the nearest focus, flat when wholly
+    /// beyond the radius.
+    fn tile(&self, ix: usize, iy: usize, level: f32, foci: &[[f32; 2]], spec: &SurfaceSpec) -> Tile {
+        let tile_m = self.tile_m;
+        let (tx, ty) = (self.x0 + ix as f32 * tile_m, self.y0 + iy as f32 * tile_m);
+        let half = 0.5 * tile_m;
+        let dc = nearest(foci, tx + half, ty + half);
+        if dc - std::f32::consts::SQRT_2 * half >= spec.radius_m {
+            return Tile::default();
+        }
+        let lvl = if dc <= spec.near_m { 0 } else { ((dc / spec.near_m).log2().ceil() as u32).min(MAX_LEVEL) };
+        let n = TILE_CELLS >> lvl;
+        let w = n + 1;
+        let nc = self.comps.len();
+        let mut eta = vec![0f32; w * w];
+        let mut sx = vec![0f32; w * w];
+        let mut sy = vec![0f32; w * w];
+        let (mut pr, mut pi) = (vec![0f32; w], vec![0f32; w]);
+        for (c, comp) in self.comps.iter().enumerate() {
+            let (stx, sty) = self.step[lvl as usize * nc + c];
+            let mut p = cmul(self.col[ix * nc + c], self.row[iy * nc + c]);
+            for i in 0..w {
+                pr[i] = p.0 as f32;
+                pi[i] = p.1 as f32;
+                p = cmul(p, stx);
+            }
+            let (kx, ky) = (comp.kx as f32, comp.ky as f32);
+            let mut q: C64 = (1.0, 0.0);
+            for j in 0..w {
+                let (fr, fi) = (q.0 as f32, q.1 as f32);
+                let rows = j * w..(j + 1) * w;
+                let (e, gx, gy) = (&mut eta[rows.clone()], &mut sx[rows.clone()], &mut sy[rows]);
+                let (a, b) = (&pr[..w], &pi[..w]);
+                for i in 0..w {
+                    let re = a[i] * fr - b[i] * fi;
+                    let im = a[i] * fi + b[i] * fr;
+                    e[i] += re;
+                    gx[i] -= kx * im;
+                    gy[i] -= ky * im;
+                }
+                q = cmul(q, sty);
+            }
+        }
+        let mut h = vec![0f32; w * w];
+        let mut g = vec![[0f32; 2]; w * w];
+        let (mut zmin, mut zmax) = (f32::INFINITY, f32::NEG_INFINITY);
+        let inner = spec.radius_m - spec.taper_m.max(0.0);
+        // Every node within `inner` of a focus is untapered: no distances when the whole tile is.
+        let all_inner = dc + std::f32::consts::SQRT_2 * half <= inner;
+        for j in 0..w {
+            for i in 0..w {
+                let k = j * w + i;
+                let taper = if all_inner {
+                    1.0
+                } else {
+                    let (x, y) = (tx + i as f32 * tile_m / n as f32, ty + j as f32 * tile_m / n as f32);
+                    let dn = nearest(foci, x, y);
+                    if dn <= inner {
+                        1.0
+                    } else if dn >= spec.radius_m {
+                        0.0
+                    } else {
+                        (spec.radius_m - dn) / (spec.radius_m - inner)
+                    }
+                };
+                let z = level + eta[k] * taper;
+                h[k] = z;
+                g[k] = [sx[k] * taper, sy[k] * taper];
+                zmin = zmin.min(z);
+                zmax = zmax.max(z);
+            }
+        }
+        let bmax = block_maxima(n, &h);
+        Tile { n, zmin, zmax, h, g, bmax }
+    }
+}
+
+/// The highest node of every [`BLOCK`] × [`BLOCK`]-cell block of an `n`-cell tile's heights `h` (none when the
+/// tile is a single block).
+fn block_maxima(n: usize, h: &[f32]) -> Vec<f32> {
+    if n <= BLOCK {
+        return Vec::new();
+    }
+    let (nb, w) = (n / BLOCK, n + 1);
+    let mut out = vec![f32::NEG_INFINITY; nb * nb];
+    for j in 0..w {
+        for i in 0..w {
+            // A node on a block edge belongs to both blocks.
+            for bj in (j.saturating_sub(1) / BLOCK)..=(j / BLOCK).min(nb - 1) {
+                for bi in (i.saturating_sub(1) / BLOCK)..=(i / BLOCK).min(nb - 1) {
+                    let m = &mut out[bj * nb + bi];
+                    *m = m.max(h[j * w + i]);
+                }
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    /// A wave component `a cos(kx x + ky y − ω t + φ)` (the derived fields filled in).
+    pub(crate) fn comp(a: f64, kx: f64, ky: f64, omega: f64, phase: f64) -> WaveComponent {
+        WaveComponent {
+            amplitude_m: a,
+            omega_rad_s: omega,
+            k_rad_m: kx.hypot(ky),
+            direction_rad: ky.atan2(kx),
+            phase_rad: phase,
+            kx,
+            ky,
+        }
+    }
+
+    /// A small irregular sea: eight components over directions and wavelengths 12..80 m, amplitudes summing
+    /// to 1.6 m.
+    pub(crate) fn test_sea() -> Vec<WaveComponent> {
+        (0..8)
+            .map(|i| {
+                let k = std::f64::consts::TAU / (12.0 + 9.5 * i as f64);
+                let dir = 0.4 + 0.37 * i as f64;
+                comp(0.2, k * dir.cos(), k * dir.sin(), (9.81 * k).sqrt(), 1.3 * i as f64)
+            })
+            .collect()
+    }
+
+    /// The elevation summed point by point (the independent reference).
+    fn eta(c: &[WaveComponent], x: f64, y: f64, t: f64) -> f64 {
+        c.iter().map(|w| w.amplitude_m * (w.kx * x + w.ky * y - w.omega_rad_s * t + w.phase_rad).cos()).sum()
+    }
+
+    fn surface(sea: &[WaveComponent], t: f64, foci: &[[f32; 2]], spec: SurfaceSpec) -> WaveSurface {
+        WaveSurface::new(sea, t, 0.0, foci, spec)
+    }
+
+    #[test]
+    fn nodes_hold_the_analytic_elevation_and_slope() {
+        let c = test_sea();
+        let spec = SurfaceSpec { radius_m: 2000.0, ..SurfaceSpec::default() };
+        let s = surface(&c, 12.5, &[[130.0, -40.0]], spec);
+        let mut checked = 0;
+        for (k, tile) in s.tiles.iter().enumerate() {
+            if tile.n == 0 || k % 7 != 0 {
+                continue;
+            }
+            let (ix, iy) = (k % s.ntx, k / s.ntx);
+            let w = tile.n + 1;
+            for j in (0..w).step_by(3) {
+                for i in (0..w).step_by(5) {
+                    let x = f64::from(s.x0 + ix as f32 * s.tile_m) + i as f64 * f64::from(s.tile_m) / tile.n as f64;
+                    let y = f64::from(s.y0 + iy as f32 * s.tile_m) + j as f64 * f64::from(s.tile_m) / tile.n as f64;
+                    if nearest(&[[130.0, -40.0]], x as f32, y as f32) > spec.radius_m - spec.taper_m {
+                        continue; // tapered
+                    }
+                    let e = eta(&c, x, y, 12.5);
+                    assert!((f64::from(tile.h[j * w + i]) - e).abs() < 2e-4, "tile {k} node {i},{j}");
+                    let gx: f64 = c.iter().map(|w| -w.amplitude_m * w.kx * w.phase_at(x, y, 12.5).sin()).sum();
+                    assert!((f64::from(tile.g[j * w + i][0]) - gx).abs() < 2e-4);
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 500);
+        assert!(s.zmax() > 0.5 && s.zmax() <= 1.6 && s.zmin() < -0.5);
+    }
+
+    /// Brute force: march the ray in tiny steps against [`WaveSurface::height`] (the same triangulated surface,
+    /// read point by point) and bisect the first sign change.
+    fn brute(s: &WaveSurface, o: [f32; 3], d: [f32; 3], t_max: f32, step: f32) -> Option<f32> {
+        let f = |t: f32| o[2] + d[2] * t - s.height(o[0] + d[0] * t, o[1] + d[1] * t);
+        let mut t = 0.0;
+        let mut fa = f(0.0);
+        while t < t_max {
+            let tb = (t + step).min(t_max);
+            let fb = f(tb);
+            if (fa > 0.0) != (fb > 0.0) {
+                let (mut lo, mut hi) = (t, tb);
+                for _ in 0..40 {
+                    let m = 0.5 * (lo + hi);
+                    if (f(m) > 0.0) == (fa > 0.0) {
+                        lo = m
+                    } else {
+                        hi = m
+                    }
+                }
+                return Some(0.5 * (lo + hi));
+            }
+            t = tb;
+            fa = fb;
+        }
+        None
+    }
+
+    /// The tiles of a real wave field against the field's own row-recurrence grid over each tile.
+    #[test]
+    fn field_tiles_match_the_fields_own_grids() {
+        use crate::ocean::{SeaSpec, WaveField};
+        let spec = SeaSpec { hs: 3.5, tp: 9.0, gamma: 3.3, direction_rad: 0.7, spread_s: 8.0 };
+        let f = WaveField::new(&spec, 77).unwrap_or_else(|e| unreachable!("{e}"));
+        let foci = [[-1234.5f32, 877.25]];
+        let spec = SurfaceSpec { radius_m: 500.0, taper_m: 0.0, ..SurfaceSpec::default() };
+        let s = WaveSurface::new(f.components(), 41.3, 0.0, &foci, spec);
+        let mut levels = [0usize; 6];
+        for (k, tile) in s.tiles.iter().enumerate() {
+            if tile.n == 0 {
+                continue;
+            }
+            levels[(TILE_CELLS / tile.n).trailing_zeros() as usize] += 1;
+            let (ix, iy) = (k % s.ntx, k / s.ntx);
+            let (x0, y0) = (f64::from(s.x0 + ix as f32 * s.tile_m), f64::from(s.y0 + iy as f32 * s.tile_m));
+            let w = tile.n + 1;
+            let dx = f64::from(s.tile_m) / tile.n as f64;
+            let (h, gx, gy) = f.elevation_slope_grid(x0, y0, dx, w, w, 41.3).unwrap_or_else(|e| unreachable!("{e}"));
+            for q in 0..w * w {
+                let (xq, yq) = (x0 + (q % w) as f64 * dx, y0 + (q / w) as f64 * dx);
+                if nearest(&foci, xq as f32, yq as f32) >= spec.radius_m {
+                    continue; // still water beyond the radius
+                }
+                assert!((tile.h[q] - h[q]).abs() < 1e-4, "tile {k} node {q}: {} vs {}", tile.h[q], h[q]);
+                assert!((tile.g[q][0] - gx[q]).abs() < 1e-4 && (tile.g[q][1] - gy[q]).abs() < 1e-4);
+            }
+        }
+        assert!(levels[..5].iter().all(|&c| c > 0), "every level sampled: {levels:?}");
+    }
+
+    #[test]
+    fn intersect_matches_a_dense_march_of_the_surface() {
+        let c = test_sea();
+        let spec = SurfaceSpec { radius_m: 300.0, taper_m: 60.0, ..SurfaceSpec::default() };
+        let s = surface(&c, 3.0, &[[0.0, 0.0], [90.0, 40.0]], spec);
+        let mut state = 11u64;
+        let mut rand = |lo: f32, hi: f32| {
+            state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+            lo + (hi - lo) * ((state >> 40) as f32 / (1u64 << 24) as f32)
+        };
+        let (mut hits, mut grazing, mut agree) = (0, 0, 0);
+        let n = 1500;
+        for i in 0..n {
+            let o = [rand(-60.0, 60.0), rand(-60.0, 60.0), rand(1.0, 6.0)];
+            // Mostly grazing rays (crests occlude), some steep, some up.
+            let el = if i % 10 == 0 { rand(0.0, 0.3) } else { -rand(0.002, if i % 3 == 0 { 1.2 } else { 0.08 }) };
+            let az = rand(0.0, std::f32::consts::TAU);
+            let d = [el.cos() * az.cos(), el.cos() * az.sin(), el.sin()];
+            let t_max = 400.0;
+            let fast = s.intersect(o, d, t_max).map(|h| h.t);
+            let slow = brute(&s, o, d, t_max, 0.01);
+            match (fast, slow) {
+                (Some(a), Some(b)) => {
+                    assert!((a - b).abs() < 0.02 + 1e-4 * b, "ray {i}: {a} vs brute {b} ({o:?} {d:?})");
+                    hits += 1;
+                    grazing += usize::from(d[2] > -0.08);
+                    agree += 1;
+                }
+                (None, None) => agree += 1,
+                // A crossing thinner than the brute force's step can be missed by it, never by the march.
+                (Some(a), None) => {
+                    let h = s.height(o[0] + d[0] * a, o[1] + d[1] * a);
+                    assert!((o[2] + d[2] * a - h).abs() < 1e-3, "ray {i}: a hit at {a} off the surface");
+                }
+                (None, Some(b)) => panic!("ray {i}: brute force hits at {b}, the march misses ({o:?} {d:?})"),
+            }
+        }
+        assert!(agree > n * 99 / 100, "{agree} of {n} agree");
+        assert!(hits > 1000 && grazing > 500, "{hits} hits, {grazing} grazing");
+    }
+
+    #[test]
+    fn crests_hide_what_lies_behind_them() {
+        // One long-crested swell along x, 1 m amplitude, 60 m long (crests at x = 0, 60, 120 m): from 1.2 m
+        // above the still level looking along x at a point 0.3 m above it 150 m away, the crest at 60 m hides it.
+        let k = std::f64::consts::TAU / 60.0;
+        let s = surface(&[comp(1.0, k, 0.0, 0.0, 0.0)], 0.0, &[[0.0, 0.0]], SurfaceSpec::default());
+        let o = [0.0, 0.0, 1.2];
+        let target = [150.0f32, 0.0, 0.3];
+        let dv = [target[0] - o[0], target[1] - o[1], target[2] - o[2]];
+        let len = (dv[0] * dv[0] + dv[2] * dv[2]).sqrt();
+        let d = [dv[0] / len, 0.0, dv[2] / len];
+        let Some(h) = s.intersect(o, d, len) else { panic!("the crest at x = 60 m hides the target") };
+        let x = o[0] + d[0] * h.t;
+        assert!((45.0..=60.0).contains(&x), "hit at x = {x}");
+        // A ray above every crest meets nothing, whatever its length.
+        assert!(s.intersect([0.0, 0.0, 1.2], [1.0, 0.0, 0.0], 1e6).is_none());
+        // The flat beyond the radius: a ray down far away meets the still level.
+        let Some(far) = s.intersect([5000.0, 0.0, 10.0], [0.0, 0.0, -1.0], 100.0) else { panic!("still water") };
+        assert!((far.t - 10.0).abs() < 1e-4 && far.piece == FLAT_PIECE);
+    }
+
+    #[test]
+    fn normals_face_up_and_follow_the_slope() {
+        let k = std::f64::consts::TAU / 40.0;
+        let s = surface(&[comp(0.8, k, 0.0, 0.0, 0.0)], 0.0, &[[0.0, 0.0]], SurfaceSpec::default());
+        // At x = 10 m (a quarter wave) the slope is −a k: the normal leans towards +x.
+        let n = s.shading_normal(10.0, 3.0).unwrap_or_default();
+        let want = (0.8 * k) as f32;
+        assert!((n[0] / n[2] - want).abs() < 1e-3, "{n:?}");
+        let Some(h) = s.intersect([10.0, 3.0, 5.0], [0.0, 0.0, -1.0], 10.0) else { panic!("a ray straight down") };
+        let g = s.piece_normal(h.piece);
+        assert!(g[2] > 0.0 && (g[0] / g[2] - want).abs() < 0.01, "{g:?}");
+    }
+}

@@ -1,0 +1,99 @@
+"""Wave occlusion: the share of a target hidden by the sea surface, per annotated box.
+
+A target's *exposed silhouette* is the set of a sensor's rays that meet the vessel when it is alone in the
+world (:class:`~mmusv.annotate.SilhouetteCache`) at a point above the still water level (world z > 0): the part
+of the hull a flat calm sea would never hide. Its wave-occlusion share is the fraction of those rays that the
+full scene stops at the water first — a crest in front, or the local surface over that part of the hull. With a
+flat sea the share is 0 by construction; it is only computed where the scene has a displaced wave surface
+(:meth:`~mmusv.scene.Scene.set_wave_surface`).
+
+* Cameras: the rays of the box's pixels; "stopped at the water" reads the captured instance image (the water
+  instance there).
+* LiDAR: the LiDAR's own beams within the box's angular extent (azimuth and elevation of its corners seen from
+  the LiDAR), cast against the vessel alone and then against the full scene.
+
+Frames: world x east, y north, z up, metres; directions need not be unit length.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+
+from mmusv.scene import Scene
+
+__all__ = ["exposed_hidden", "lidar_box_rays", "pattern_angles", "share"]
+
+
+def share(exposed: int, hidden: int) -> float:
+    """``hidden / exposed``, 0 for an empty exposed silhouette."""
+    return float(hidden / exposed) if exposed else 0.0
+
+
+def exposed_hidden(
+    scene: Scene,
+    origins: npt.NDArray[np.float32],
+    directions: npt.NDArray[np.float32],
+    vessel_t: npt.NDArray[np.float32],
+    *,
+    scene_instance: npt.NDArray[np.int32] | None = None,
+) -> tuple[int, int]:
+    """``(exposed, hidden)`` ray counts of one target (see the module docstring).
+
+    Args:
+        scene: the full scene, with its sea and wave surface set.
+        origins, directions: ``(N, 3)`` float32 world rays (any non-zero direction length).
+        vessel_t: ``(N,)`` float32 distance (in units of each direction's length) at which each ray meets the
+            vessel alone, ``inf`` where it misses it.
+        scene_instance: ``(N,)`` int32 instance each ray meets first in the full scene, when already known (a
+            camera's instance image); else the rays are cast here.
+    """
+    o = np.asarray(origins, dtype=np.float64)
+    d = np.asarray(directions, dtype=np.float64)
+    t = np.asarray(vessel_t, dtype=np.float64)
+    hit = np.isfinite(t)
+    z = o[:, 2] + d[:, 2] * np.where(hit, t, 0.0)
+    exposed = hit & (z > 0.0)
+    n = int(np.count_nonzero(exposed))
+    water = scene.sea_instance
+    if n == 0 or water is None or scene.wave_top is None:
+        return n, 0
+    if scene_instance is None:
+        hits = scene.cast_rays(o[exposed].astype(np.float32), d[exposed].astype(np.float32))
+        first = hits.instance_id
+    else:
+        first = np.asarray(scene_instance)[exposed]
+    return n, int(np.count_nonzero(first == water))
+
+
+def pattern_angles(pattern: npt.NDArray[np.float32]) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """``(azimuth, elevation)`` ``(M,)`` radians of a LiDAR's unit beam directions ``pattern`` ``(M, 3)`` (LiDAR
+    frame); compute once per LiDAR and pass to :func:`lidar_box_rays`."""
+    p = np.asarray(pattern, dtype=np.float64)
+    return np.arctan2(p[:, 1], p[:, 0]), np.arctan2(p[:, 2], np.hypot(p[:, 0], p[:, 1]))
+
+
+def lidar_box_rays(
+    pattern: npt.NDArray[np.float32],
+    angles: tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]],
+    lidar_pose: npt.NDArray[np.float64],
+    corners_world: npt.NDArray[np.float64],
+) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
+    """The LiDAR's world rays ``(origins, directions)`` (each ``(K, 3)`` float32) whose direction lies within the
+    azimuth and elevation extent of the box ``corners_world`` ``(8, 3)`` seen from the LiDAR at ``lidar_pose``
+    ``(4, 4)`` LiDAR → world; ``pattern`` ``(M, 3)`` unit directions in the LiDAR frame, ``angles`` their
+    :func:`pattern_angles`."""
+    inv = np.linalg.inv(lidar_pose)
+    c = corners_world @ inv[:3, :3].T + inv[:3, 3]
+    az = np.arctan2(c[:, 1], c[:, 0])
+    el = np.arctan2(c[:, 2], np.hypot(c[:, 0], c[:, 1]))
+    paz, pel = angles
+    # Azimuths relative to the box's mean direction, so a box straddling ±π is one interval.
+    mid = np.arctan2(np.sin(az).mean(), np.cos(az).mean())
+    rel = np.angle(np.exp(1j * (az - mid)))
+    near = (pel >= el.min()) & (pel <= el.max())
+    prel = np.angle(np.exp(1j * (paz[near] - mid)))
+    idx = np.flatnonzero(near)[(prel >= rel.min()) & (prel <= rel.max())]
+    dirs = (np.asarray(pattern, dtype=np.float64)[idx] @ lidar_pose[:3, :3].T).astype(np.float32)
+    origins = np.tile(lidar_pose[:3, 3].astype(np.float32), (dirs.shape[0], 1))
+    return origins, dirs

@@ -1,0 +1,227 @@
+"""The pictures and counts of docs/sea (issue #29, the water every sensor sees): before (the flat sea) and after
+(the displaced surface of the physical sea), same scenario, frame and seeds.
+
+* a small craft 150 m ahead of a USV at W3, partly hidden by crests, in the camera and the LiDAR, with its
+  wave-occlusion share (the annotations' ``wave_occlusion``);
+* the LiDAR's water returns within 60 m at W0 and W3 (on wave faces after; on the flat plane before);
+* the radar PPI at W0 and W3.
+
+Usage: ``python scripts/sea_pictures.py [-o docs/sea]``; prints the counts of docs/sea/README.md.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from mmusv.acquire import annotations_for
+from mmusv.annotate import SilhouetteCache
+from mmusv.simulation import Simulation
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@dataclass(frozen=True)
+class Sea:
+    """A directional JONSWAP sea (:class:`mmusv.scene.SeaState`)."""
+
+    hs_m: float
+    tp_s: float
+    gamma: float = 3.3
+    direction_rad: float = math.pi  # travelling towards the observer: crests across the line of sight
+    spread_s: float = 15.0
+
+
+SEAS = {"W0": Sea(0.5, 3.5), "W3": Sea(3.5, 9.4)}
+
+
+def _scenario(wave: str) -> dict[str, Any]:
+    camera = {
+        "name": "view",
+        "resolution": [640, 360],
+        "hfov_deg": 12.0,
+        "outputs": ["rgb", "instance"],
+        "mount": {"xyz": [2.0, 0.0, 3.5], "rpy_deg": [0.0, 0.8, 0.0]},
+    }
+    # A long-range LiDAR (128 rings over 12°, 0.18° columns) so a 5 m craft at 150 m gets beams at all.
+    lidar = {"channels": 128, "vertical_fov_deg": [-8.0, 4.0], "points_per_second": 128 * 2000 * 5.0, "range_m": 200.0}
+    rig = {"cameras": [camera], "top_view": None, "lidar": lidar}
+    return {
+        "name": f"sea_{wave.lower()}",
+        "seed": 29,
+        "map": {"type": "open_sea", "seed": 1, "params": {"n_buoys": 0, "islet_probability": 0.0}},
+        "environment": {"time_of_day": "15:00", "weather": "clear", "wave": wave},
+        "acquisition": {"frequency_hz": 5, "frames": 40},
+        "rigs": {"view": rig},
+        "vessels": [
+            {"id": "usv", "role": "usv", "asset": "usv_wamv", "rig": "view", "speed_mps": 0.5,
+             "route": [[0.0, 0.0], [200.0, 0.0]]},
+            {"id": "craft", "role": "target", "asset": "speedboat_5m", "speed_mps": 0.5,
+             "route": [[150.0, -3.0], [150.0, 200.0]]},
+        ],
+    }  # fmt: skip
+
+
+def _share(ann: Any, key: str, target: str) -> float:
+    cols = ann.columns()[key]
+    ids = list(cols["target_id"])
+    return float(cols["wave_occlusion"][ids.index(target)]) if target in ids else float("nan")
+
+
+def craft_views(out: Path, lines: list[str]) -> None:
+    """The W3 craft at 150 m: camera and LiDAR, before and after, with the wave-occlusion shares."""
+    from PIL import Image
+
+    sim = Simulation(_scenario("W3"))
+    sil = SilhouetteCache()
+    sim.set_sea_surface(SEAS["W3"])
+    # The frame where the crests hide closest to half of the craft (camera annotations).
+    best, best_frame = 2.0, 0
+    for f in range(sim.frames):
+        cap = sim.capture(f, sensors=["cameras", "lidar"], radar=False)
+        s = _share(annotations_for(sim, cap, sil)["usv"], "camera", "craft")
+        print(f"frame {f}: camera wave occlusion {s:.2f}")
+        if s == s and abs(s - 0.5) < abs(best - 0.5):
+            best, best_frame = s, f
+    rows = []
+    for name, sea in (("before", None), ("after", SEAS["W3"])):
+        sim.set_sea_surface(sea)
+        cap = sim.capture(best_frame, radar=False)
+        ann = annotations_for(sim, cap, sil)["usv"]
+        ac = cap.agents["usv"]
+        rgb = ac.cameras["view"].rgb
+        assert rgb is not None
+        Image.fromarray(np.asarray(rgb)).save(out / f"craft_w3_camera_{name}.png")
+        cam, lid = _share(ann, "camera", "craft"), _share(ann, "lidar", "craft")
+        lidar = ac.lidar
+        assert lidar is not None and ac.lidar_pose is not None
+        craft = sim.vessels[1].instance_id
+        n_craft = int(np.count_nonzero(lidar.instance == craft))
+        rows.append((name, cam, lid, n_craft, lidar, ac.lidar_pose))
+        lines.append(f"| {name} | {best_frame} | {cam:.2f} | {lid:.2f} | {n_craft} |")
+    _lidar_side(rows, out / "craft_w3_lidar.png", craft_x=150.0)
+
+
+def _lidar_side(rows: list[Any], path: Path, *, craft_x: float) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(len(rows), 1, figsize=(9, 2.6 * len(rows)), sharex=True, sharey=True)
+    for ax, (name, cam, lid, n_craft, lidar, pose) in zip(axes, rows, strict=True):
+        p = lidar.xyz.astype(np.float64) @ pose[:3, :3].T + pose[:3, 3]
+        sector = np.abs(np.arctan2(p[:, 1] - pose[1, 3], p[:, 0] - pose[0, 3])) < math.radians(4.0)
+        cls = lidar.semantic_class
+        for c, colour, label in ((1, "tab:blue", "water"), (10, "tab:red", "craft")):
+            m = sector & (cls == c)
+            ax.scatter(p[m, 0], p[m, 2], s=3, c=colour, label=label)
+        ax.set_title(f"{name}: LiDAR returns within ±4° of the craft's bearing; craft points {n_craft}, "
+                     f"wave occlusion LiDAR {lid:.2f}, camera {cam:.2f}", fontsize=9)  # fmt: skip
+        ax.set_ylabel("world z (m)")
+        ax.axvline(craft_x, color="grey", lw=0.5)
+        ax.legend(loc="upper left", fontsize=8)
+    axes[-1].set_xlabel("world x (m), the USV at 0 looking along +x")
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def lidar_faces(out: Path, lines: list[str]) -> None:
+    """Water returns within 60 m of the USV's LiDAR, W0 and W3, before and after: plan view coloured by height."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, 2, figsize=(10, 9))
+    for j, wave in enumerate(("W0", "W3")):
+        sim = Simulation(_scenario(wave))
+        for i, (name, sea) in enumerate((("before", None), ("after", SEAS[wave]))):
+            sim.set_sea_surface(sea)
+            zs, n = [], 0
+            for f in (0, 10, 20, 30):
+                ac = sim.capture(f, sensors=["lidar"], radar=False).agents["usv"]
+                assert ac.lidar is not None and ac.lidar_pose is not None
+                p = ac.lidar.xyz.astype(np.float64) @ ac.lidar_pose[:3, :3].T + ac.lidar_pose[:3, 3]
+                near = (ac.lidar.semantic_class == 1) & (
+                    np.hypot(p[:, 0] - ac.lidar_pose[0, 3], p[:, 1] - ac.lidar_pose[1, 3]) < 60.0
+                )
+                zs.append(p[near, 2])
+                n += int(near.sum())
+                if f == 0:
+                    ax = axes[i, j]
+                    sc = ax.scatter(p[near, 0], p[near, 1], s=2, c=p[near, 2], cmap="viridis", vmin=-2, vmax=2)
+                    ax.set_aspect("equal")
+                    ax.set_title(f"{wave} {name}: {int(near.sum())} water returns (frame 0)", fontsize=9)
+            z = np.concatenate(zs)
+            lines.append(f"| {wave} | {name} | {n} | {z.std():.3f} | {z.std() / (SEAS[wave].hs_m / 4):.2f} |")
+    fig.colorbar(sc, ax=axes, label="world z (m)", shrink=0.6)
+    fig.savefig(out / "lidar_wave_faces.png", dpi=90)
+    plt.close(fig)
+
+
+def radar_ppi(out: Path, lines: list[str]) -> None:
+    """The radar PPI at W0 and W3, before and after."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, 2, figsize=(9, 9))
+    for j, wave in enumerate(("W0", "W3")):
+        scenario = _scenario(wave)
+        scenario["rigs"]["view"]["cameras"] = []
+        sim = Simulation(scenario)
+        for i, (name, sea) in enumerate((("before", None), ("after", SEAS[wave]))):
+            sim.set_sea_surface(sea)
+            ac = sim.capture(0, sensors=["radar"]).agents["usv"]
+            assert ac.radar is not None and ac.radar_ppi is not None
+            clutter = int(np.count_nonzero(ac.radar.instance_id < 0))
+            r = ac.radar.range[ac.radar.instance_id < 0]
+            far = float(np.percentile(r, 95)) if r.size else 0.0
+            img = np.asarray(ac.radar_ppi, dtype=np.float64)
+            if img.ndim == 3:
+                img = img.mean(axis=2)
+            c, half = img.shape[0] // 2, img.shape[0] // 16  # the inner sixteenth of the PPI's span
+            crop = img[c - half : c + half, c - half : c + half]
+            # Log scale: 60 dB below the brightest pixel up to it.
+            shown = np.log10(1.0 + crop / max(float(crop.max()) * 1e-6, 1e-12))
+            axes[i, j].imshow(shown, cmap="gray")
+            span = sim.agents[0].rig.radar.range_m / 8 if sim.agents[0].rig.radar is not None else 0.0
+            axes[i, j].set_title(f"{wave} {name}: {clutter} clutter returns (inner ±{span:.0f} m)", fontsize=9)
+            axes[i, j].axis("off")
+            lines.append(f"| {wave} | {name} | {clutter} | {far:.0f} |")
+    fig.tight_layout()
+    fig.savefig(out / "radar_ppi_w0_w3.png", dpi=90)
+    plt.close(fig)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("-o", "--out", default=str(ROOT / "docs/sea"))
+    args = ap.parse_args()
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    lines = [
+        "| sea | frame | wave occlusion, camera | wave occlusion, LiDAR | LiDAR points on the craft |",
+        "|---|---|---|---|---|",
+    ]
+    craft_views(out, lines)
+    lines += [
+        "",
+        "| sea state | sea | water returns within 60 m (4 sweeps) | world-z std (m) | std / (Hs/4) |",
+        "|---|---|---|---|---|",
+    ]
+    lidar_faces(out, lines)
+    lines += ["", "| sea state | sea | clutter returns | 95th percentile clutter range (m) |", "|---|---|---|---|"]
+    radar_ppi(out, lines)
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()
