@@ -127,10 +127,16 @@ def average_precision(scores: np.ndarray, tp: np.ndarray, n_gt: int) -> float:
         return math.nan
     if len(scores) == 0:
         return 0.0
-    order = np.argsort(-np.asarray(scores, dtype=np.float64), kind="stable")
+    s = np.asarray(scores, dtype=np.float64)
+    order = np.argsort(-s, kind="stable")
     t = np.asarray(tp, dtype=bool)[order]
     ctp = np.cumsum(t)
     cfp = np.cumsum(~t)
+    # Detections of equal score have no order: the curve takes a point only after the last of each tie, so the
+    # AP does not depend on the order the detections came in.
+    ss = s[order]
+    last = np.append(ss[1:] != ss[:-1], True)
+    ctp, cfp = ctp[last], cfp[last]
     return voc_ap(ctp / n_gt, ctp / (ctp + cfp))
 
 
