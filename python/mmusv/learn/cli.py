@@ -40,7 +40,7 @@ def load_for_study(path: str) -> Any:
 def add_parser(sub: Any) -> None:
     """Adds ``train`` to the ``mmusv`` sub-parsers."""
     from mmusv.learn.presets import PRESETS
-    from mmusv.studies.detection.sources import BUNDLED_SPEC
+    from mmusv.studies.detection.cli import add_dataset_arguments
 
     p = sub.add_parser(
         "train",
@@ -48,16 +48,7 @@ def add_parser(sub: Any) -> None:
         description="Trains the single-agent (no/late fusion), early- and intermediate-fusion models on the train "
         "split (by sequence, agent as ego, the detection study's ground truth). Needs the learn extra.",
     )
-    p.add_argument("inputs", nargs="*", help="recordings (.mcap) or folders of them")
-    p.add_argument("--opv2v", default=None, help="an OPV2V folder written by mmusv convert --to opv2v")
-    p.add_argument(
-        "--generate",
-        nargs="?",
-        const=BUNDLED_SPEC,
-        default=None,
-        metavar="SPEC",
-        help=f"generate SPEC (default {BUNDLED_SPEC}) LiDAR-only into OUT/dataset first",
-    )
+    add_dataset_arguments(p, into="OUT/dataset", then="train")
     p.add_argument("--split", default="train", help="the split to train on (default train)")
     p.add_argument("--split-ratios", default="0.7,0.15,0.15", help="train,validate,test fractions")
     p.add_argument("--seed", type=int, default=0, help="seed of the split, the weights and the augmentation")

@@ -14,7 +14,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-__all__ = ["add_parsers", "run"]
+__all__ = ["add_dataset_arguments", "add_parsers", "run"]
 
 _BOXES_HELP = (
     "Parquet columns: sequence, frame, ego, [setting], mode, kind (det|gt), x, y, z, l, w, h, yaw "
@@ -23,7 +23,9 @@ _BOXES_HELP = (
 )
 
 
-def _common(p: argparse.ArgumentParser, default_out: str) -> None:
+def add_dataset_arguments(p: argparse.ArgumentParser, *, into: str, then: str) -> None:
+    """The dataset a detection command reads: ``inputs`` (recordings or folders), ``--opv2v`` or ``--generate
+    [SPEC]`` (the bundled spec recorded LiDAR-only into the folder ``into``, then ``then``)."""
     from mmusv.studies.detection.sources import BUNDLED_SPEC
 
     p.add_argument("inputs", nargs="*", help="recordings (.mcap) or folders of them")
@@ -34,8 +36,12 @@ def _common(p: argparse.ArgumentParser, default_out: str) -> None:
         const=BUNDLED_SPEC,
         default=None,
         metavar="SPEC",
-        help=f"generate SPEC (default {BUNDLED_SPEC}) and record it LiDAR-only into OUT, then evaluate",
+        help=f"generate SPEC (default {BUNDLED_SPEC}) and record it LiDAR-only into {into}, then {then}",
     )
+
+
+def _common(p: argparse.ArgumentParser, default_out: str) -> None:
+    add_dataset_arguments(p, into="OUT", then="evaluate")
     p.add_argument(
         "--split",
         default=None,
