@@ -346,19 +346,7 @@ impl Camera {
                 format!("{p} is outside the {}×{} image (0..{n})", self.cfg.width, self.cfg.height),
             ));
         }
-        Ok(self.rays_at(pose, pixels.iter().map(|&p| self.trace_index(p as u32))))
-    }
-
-    /// Position in trace order of row-major pixel `i` (the inverse of [`tile_order`]).
-    fn trace_index(&self, i: u32) -> usize {
-        let (w, h) = (self.cfg.width as usize, self.cfg.height as usize);
-        let (x, y) = (i as usize % w, i as usize / w);
-        let t = TILE as usize;
-        let (tx, ty) = (x / t, y / t);
-        // Tile rows above, tiles to the left in this tile row (all full width), then the pixel in its tile.
-        let th = t.min(h - ty * t);
-        let tw = t.min(w - tx * t);
-        ty * t * w + tx * t * th + (y - ty * t) * tw + (x - tx * t)
+        Ok(self.rays_at(pose, pixels.iter().map(|&p| self.rank[p as usize] as usize)))
     }
 
     /// World-frame ray origins and unit directions of every pixel in trace order (see [`Camera`]).
@@ -427,7 +415,7 @@ impl Camera {
             frame.instance[i] = hits.instance[k];
             if !surface.is_empty() {
                 let material = scene.material_index(hits.instance[k], hits.triangle[k]);
-                surface[i] = (hits.instance[k] as u32 as u64) << 32 | (hits.class[k] as u64) << 16 | material as u64;
+                surface[i] = surface_key(hits.instance[k], hits.class[k], material);
             }
         }
         if !(options.rgb || options.radiance) {
@@ -485,7 +473,7 @@ impl Camera {
                 // keeps its centre's shading; the others are shaded sample by sample.
                 let key = |j: usize| {
                     let m = scene.material_index(shits.instance[j], shits.triangle[j]);
-                    (shits.instance[j] as u32 as u64) << 32 | (shits.class[j] as u64) << 16 | m as u64
+                    surface_key(shits.instance[j], shits.class[j], m)
                 };
                 let mixed: Vec<u32> = (0..edges.len())
                     .into_par_iter()
@@ -590,6 +578,12 @@ impl Camera {
             }
         }
     }
+}
+
+/// Instance, class and material of a hit in one word (what the anti-aliasing compares).
+#[inline]
+fn surface_key(instance: i32, class: u16, material: u16) -> u64 {
+    (instance as u32 as u64) << 32 | (class as u64) << 16 | material as u64
 }
 
 /// Row-major indices of the pixels at a visible edge: a 4-neighbour on another surface (`surface`: instance,

@@ -92,28 +92,15 @@ fn sunlit(
     keep: impl Fn(usize) -> bool + Sync + Copy,
 ) -> Result<Vec<bool>> {
     let n = origins.len();
-    let mut lit = vec![false; n];
     if !shader.sun_up() {
-        return Ok(lit);
+        return Ok(vec![false; n]);
     }
     let sun = shader.sun();
     let facing: Vec<(u32, [f32; 3])> = (0..n)
         .into_par_iter()
         .filter_map(|k| shadow_origin(hits, origins, dirs, k, sun, keep).map(|o| (k as u32, o)))
         .collect();
-    if shadows {
-        let origins: Vec<[f32; 3]> = facing.iter().map(|(_, o)| *o).collect();
-        let dirs = vec![sun.to_array(); origins.len()];
-        let blocked = scene.occluded_rays(&origins, &dirs, SHADOW_RANGE)?;
-        for ((k, _), b) in facing.iter().zip(blocked) {
-            lit[*k as usize] = !b;
-        }
-    } else {
-        for (k, _) in &facing {
-            lit[*k as usize] = true;
-        }
-    }
-    Ok(lit)
+    lit_slots(scene, sun, shadows, &facing, n)
 }
 
 /// [`sunlit`] of the rays `which` only, in that order.
@@ -124,9 +111,8 @@ fn sunlit_of(
     (hits, origins, dirs): (&RayHits, &[[f32; 3]], &[[f32; 3]]),
     which: &[u32],
 ) -> Result<Vec<bool>> {
-    let mut lit = vec![false; which.len()];
     if !shader.sun_up() {
-        return Ok(lit);
+        return Ok(vec![false; which.len()]);
     }
     let sun = shader.sun();
     let facing: Vec<(u32, [f32; 3])> = which
@@ -134,6 +120,13 @@ fn sunlit_of(
         .enumerate()
         .filter_map(|(j, &k)| shadow_origin(hits, origins, dirs, k as usize, sun, |_| true).map(|o| (j as u32, o)))
         .collect();
+    lit_slots(scene, sun, shadows, &facing, which.len())
+}
+
+/// `len` flags, true at the slots of `facing` (slot, shadow-ray origin) whose shadow ray towards `sun` is not
+/// blocked (all of them when `shadows` is off).
+fn lit_slots(scene: &Scene, sun: Vec3, shadows: bool, facing: &[(u32, [f32; 3])], len: usize) -> Result<Vec<bool>> {
+    let mut lit = vec![false; len];
     if shadows {
         let origins: Vec<[f32; 3]> = facing.iter().map(|(_, o)| *o).collect();
         let dirs = vec![sun.to_array(); origins.len()];
@@ -142,7 +135,7 @@ fn sunlit_of(
             lit[*j as usize] = !b;
         }
     } else {
-        for (j, _) in &facing {
+        for (j, _) in facing {
             lit[*j as usize] = true;
         }
     }
