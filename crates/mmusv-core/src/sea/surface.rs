@@ -84,6 +84,8 @@ pub struct WaveSurface {
     x0: f32,
     y0: f32,
     tile_m: f32,
+    /// `1 / tile_m`.
+    inv_tile_m: f32,
     ntx: usize,
     nty: usize,
     tiles: Vec<Tile>,
@@ -137,7 +139,7 @@ impl WaveSurface {
                 zmax = zmax.max(t.zmax);
             }
         }
-        Self { level, time_s, x0, y0, tile_m, ntx, nty, tiles, zmin, zmax }
+        Self { level, time_s, x0, y0, tile_m, inv_tile_m: 1.0 / tile_m, ntx, nty, tiles, zmin, zmax }
     }
 
     /// The still water level (world z).
@@ -162,15 +164,29 @@ impl WaveSurface {
     }
 
     /// The tile holding world `(x, y)`, if inside the rectangle.
-    #[inline]
+    #[inline(always)]
     fn tile_at(&self, x: f32, y: f32) -> Option<(usize, usize)> {
-        let fx = ((x - self.x0) / self.tile_m).floor();
-        let fy = ((y - self.y0) / self.tile_m).floor();
-        (fx >= 0.0 && fy >= 0.0 && (fx as usize) < self.ntx && (fy as usize) < self.nty)
-            .then_some((fx as usize, fy as usize))
+        let (u, v) = ((x - self.x0) * self.inv_tile_m, (y - self.y0) * self.inv_tile_m);
+        // Truncation is the floor here: negative and NaN coordinates are out (`!(u >= 0)`).
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
+        if !(u >= 0.0 && v >= 0.0 && u < self.ntx as f32 && v < self.nty as f32) {
+            return None;
+        }
+        Some(((u as usize).min(self.ntx - 1), (v as usize).min(self.nty - 1)))
+    }
+
+    /// Tile `(ix, iy)`'s cell holding world `(x, y)` and the local `(fu, fv)` in it (clamped into the tile).
+    #[inline(always)]
+    fn cell_at(&self, t: &Tile, ix: usize, iy: usize, x: f32, y: f32) -> ([usize; 2], [f32; 2]) {
+        let inv = t.n as f32 * self.inv_tile_m;
+        let u = ((x - (self.x0 + ix as f32 * self.tile_m)) * inv).clamp(0.0, t.n as f32);
+        let v = ((y - (self.y0 + iy as f32 * self.tile_m)) * inv).clamp(0.0, t.n as f32);
+        let (ci, cj) = ((u as usize).min(t.n - 1), (v as usize).min(t.n - 1));
+        ([ci, cj], [u - ci as f32, v - cj as f32])
     }
 
     /// Height of the surface at world `(x, y)` (the triangulated surface; the still level outside).
+    #[inline]
     pub fn height(&self, x: f32, y: f32) -> f32 {
         let Some((ix, iy)) = self.tile_at(x, y) else { return self.level };
         let k = iy * self.ntx + ix;
@@ -178,17 +194,14 @@ impl WaveSurface {
         if t.n == 0 {
             return self.level;
         }
-        let s = self.tile_m / t.n as f32;
-        let u = ((x - (self.x0 + ix as f32 * self.tile_m)) / s).clamp(0.0, t.n as f32);
-        let v = ((y - (self.y0 + iy as f32 * self.tile_m)) / s).clamp(0.0, t.n as f32);
-        let (ci, cj) = ((u as usize).min(t.n - 1), (v as usize).min(t.n - 1));
-        let (fu, fv) = (u - ci as f32, v - cj as f32);
+        let ([ci, cj], [fu, fv]) = self.cell_at(t, ix, iy, x, y);
         let (plane, _) = cell_planes(t, ci, cj);
         let p = if fu >= fv { plane[0] } else { plane[1] };
         p[0] + p[1] * fu + p[2] * fv
     }
 
     /// Unit geometric normal (up-facing) of piece `piece` (a [`SurfaceHit::piece`]).
+    #[inline]
     pub fn piece_normal(&self, piece: u32) -> [f32; 3] {
         if piece == FLAT_PIECE {
             return [0.0, 0.0, 1.0];
@@ -209,17 +222,14 @@ impl WaveSurface {
 
     /// Smooth unit normal at world `(x, y)`: the sampled slopes `∇η` interpolated bilinearly (up-facing); `None`
     /// over still water (outside the sampled tiles), where the caller's own small-scale normals serve.
+    #[inline]
     pub fn shading_normal(&self, x: f32, y: f32) -> Option<[f32; 3]> {
         let (ix, iy) = self.tile_at(x, y)?;
         let t = &self.tiles[iy * self.ntx + ix];
         if t.n == 0 {
             return None;
         }
-        let s = self.tile_m / t.n as f32;
-        let u = ((x - (self.x0 + ix as f32 * self.tile_m)) / s).clamp(0.0, t.n as f32);
-        let v = ((y - (self.y0 + iy as f32 * self.tile_m)) / s).clamp(0.0, t.n as f32);
-        let (ci, cj) = ((u as usize).min(t.n - 1), (v as usize).min(t.n - 1));
-        let (fu, fv) = (u - ci as f32, v - cj as f32);
+        let ([ci, cj], [fu, fv]) = self.cell_at(t, ix, iy, x, y);
         let w = t.n + 1;
         let g = |i: usize, j: usize| t.g[j * w + i];
         let (g00, g10, g01, g11) = (g(ci, cj), g(ci + 1, cj), g(ci, cj + 1), g(ci + 1, cj + 1));
@@ -230,8 +240,14 @@ impl WaveSurface {
 
     /// The first crossing of the ray `o + t·d` (`d` unit, `0 <= t < t_max`) with the surface, from either side,
     /// or `None`.
-    #[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN must answer "no hit"
     pub fn intersect(&self, o: [f32; 3], d: [f32; 3], t_max: f32) -> Option<SurfaceHit> {
+        intersect_with(self, o, d, t_max)
+    }
+
+    /// [`WaveSurface::intersect`]'s body, inlined into each instruction-set copy of [`intersect_with`].
+    #[inline(always)]
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN must answer "no hit"
+    fn intersect_in(&self, o: [f32; 3], d: [f32; 3], t_max: f32) -> Option<SurfaceHit> {
         // The band [zmin, zmax] of the ray.
         let (oz, dz) = (o[2], d[2]);
         let (mut t0, mut t1) = (0.0f32, t_max);
@@ -247,7 +263,8 @@ impl WaveSurface {
         if !(t0 <= t1) {
             return None;
         }
-        let mut m = March { s: self, o, d, above: None };
+        let inv = [0, 1].map(|a| if d[a] == 0.0 { f32::INFINITY } else { 1.0 / d[a] });
+        let mut m = March { s: self, o, d, inv, above: None };
         // Split [t0, t1] into the parts before, inside and after the tile rectangle.
         let span = self.rect_span(o, d, t0, t1);
         match span {
@@ -290,6 +307,7 @@ impl WaveSurface {
     }
 
     /// The part of `[t0, t1]` of the ray over the tile rectangle, or `None`.
+    #[inline(always)]
     fn rect_span(&self, o: [f32; 3], d: [f32; 3], t0: f32, t1: f32) -> Option<(f32, f32)> {
         if self.ntx == 0 {
             return None;
@@ -312,13 +330,79 @@ impl WaveSurface {
     }
 }
 
+crate::dispatch! {
+    /// [`WaveSurface::intersect`], compiled for AVX2/FMA where the CPU has them (the march's floors and
+    /// divisions are single instructions there; the results are the same bits).
+    fn intersect_with(s: &WaveSurface, o: [f32; 3], d: [f32; 3], t_max: f32) -> Option<SurfaceHit> {
+        s.intersect_in(o, d, t_max)
+    }
+}
+
 /// The state of one sign march: the ray and whether it was last above the surface (`None` before the first
 /// piece).
 struct March<'a> {
     s: &'a WaveSurface,
     o: [f32; 3],
     d: [f32; 3],
+    /// `1 / d.x`, `1 / d.y` (infinite along an axis the ray does not move on): the march multiplies by these
+    /// instead of dividing.
+    inv: [f32; 2],
     above: Option<bool>,
+}
+
+/// A 2D DDA over a square grid: the current cell, the ray distances to the next column and row boundaries, and
+/// the distance between boundaries (infinite along an axis the ray does not cross).
+struct Dda {
+    cell: [usize; 2],
+    next: [f32; 2],
+    step: [f32; 2],
+}
+
+impl Dda {
+    /// Starts at ray distance `t` on the grid with lower corner `g` and cells of side `c` (`inv_c = 1 / c`),
+    /// cells `lo..=hi` per axis (the start cell clamped into them).
+    #[inline(always)]
+    fn new(m: &March<'_>, t: f32, g: [f32; 2], c: f32, inv_c: f32, lo: [usize; 2], hi: [usize; 2]) -> Self {
+        let mut cell = [0usize; 2];
+        let mut next = [f32::INFINITY; 2];
+        let mut step = [f32::INFINITY; 2];
+        for a in 0..2 {
+            let u = (m.o[a] + m.d[a] * t - g[a]) * inv_c;
+            cell[a] = (floor(u).max(lo[a] as f32) as usize).min(hi[a]);
+            if m.d[a] != 0.0 {
+                let side = if m.d[a] > 0.0 { 1.0 } else { 0.0 };
+                next[a] = (g[a] + (cell[a] as f32 + side) * c - m.o[a]) * m.inv[a];
+                step[a] = c * m.inv[a].abs();
+            }
+        }
+        Self { cell, next, step }
+    }
+
+    /// The ray distance where the current cell is left.
+    #[inline(always)]
+    fn exit(&self) -> f32 {
+        self.next[0].min(self.next[1])
+    }
+
+    /// Moves to the next cell along the ray; `false` when that leaves `lo..=hi`.
+    #[inline(always)]
+    fn advance(&mut self, d: [f32; 3], lo: [usize; 2], hi: [usize; 2]) -> bool {
+        let a = usize::from(self.next[0] > self.next[1]);
+        let c = self.cell[a];
+        if d[a] > 0.0 {
+            if c >= hi[a] {
+                return false;
+            }
+            self.cell[a] = c + 1;
+        } else {
+            if c <= lo[a] {
+                return false;
+            }
+            self.cell[a] = c - 1;
+        }
+        self.next[a] += self.step[a];
+        true
+    }
 }
 
 impl March<'_> {
@@ -348,62 +432,35 @@ impl March<'_> {
     }
 
     /// A stretch over still water.
+    #[inline(always)]
     fn flat(&mut self, ta: f32, tb: f32) -> Option<SurfaceHit> {
         let l = self.s.level;
         self.piece(ta, tb, self.z(ta) - l, self.z(tb) - l, FLAT_PIECE)
     }
 
     /// The stretch `[ta, tb]` inside the tile rectangle: tile by tile (2D DDA).
+    #[inline(always)]
     fn tiles(&mut self, ta: f32, tb: f32) -> Option<SurfaceHit> {
         let s = self.s;
-        let (o, d) = (self.o, self.d);
-        let px = o[0] + d[0] * ta;
-        let py = o[1] + d[1] * ta;
-        let clampi = |v: f32, n: usize| (v.floor().max(0.0) as usize).min(n - 1);
-        let mut ix = clampi((px - s.x0) / s.tile_m, s.ntx);
-        let mut iy = clampi((py - s.y0) / s.tile_m, s.nty);
-        let next = |i: usize, da: f32, oa: f32, lo: f32| {
-            if da == 0.0 {
-                f32::INFINITY
-            } else {
-                (lo + (i as f32 + if da > 0.0 { 1.0 } else { 0.0 }) * s.tile_m - oa) / da
-            }
-        };
-        let mut tx = next(ix, d[0], o[0], s.x0);
-        let mut ty = next(iy, d[1], o[1], s.y0);
-        let dtx = if d[0] == 0.0 { f32::INFINITY } else { s.tile_m / d[0].abs() };
-        let dty = if d[1] == 0.0 { f32::INFINITY } else { s.tile_m / d[1].abs() };
+        let (lo, hi) = ([0, 0], [s.ntx - 1, s.nty - 1]);
+        let mut g = Dda::new(self, ta, [s.x0, s.y0], s.tile_m, s.inv_tile_m, lo, hi);
         let mut t = ta;
         loop {
-            let t_exit = tx.min(ty).min(tb);
+            let t_exit = g.exit().min(tb);
             if t_exit > t {
-                if let Some(h) = self.tile(ix, iy, t, t_exit) {
+                if let Some(h) = self.tile(g.cell[0], g.cell[1], t, t_exit) {
                     return Some(h);
                 }
             }
-            if t_exit >= tb {
+            if t_exit >= tb || !g.advance(self.d, lo, hi) {
                 return None;
             }
             t = t_exit;
-            if tx <= ty {
-                let n = ix as isize + if d[0] > 0.0 { 1 } else { -1 };
-                if n < 0 || n >= s.ntx as isize {
-                    return None;
-                }
-                ix = n as usize;
-                tx += dtx;
-            } else {
-                let n = iy as isize + if d[1] > 0.0 { 1 } else { -1 };
-                if n < 0 || n >= s.nty as isize {
-                    return None;
-                }
-                iy = n as usize;
-                ty += dty;
-            }
         }
     }
 
     /// The stretch `[ta, tb]` over tile `(ix, iy)`.
+    #[inline(always)]
     fn tile(&mut self, ix: usize, iy: usize, ta: f32, tb: f32) -> Option<SurfaceHit> {
         let s = self.s;
         let k = iy * s.ntx + ix;
@@ -420,99 +477,69 @@ impl March<'_> {
             return None; // wholly under the tile's troughs, and already under water
         }
         let n = tile.n;
+        let corner = [s.x0 + ix as f32 * s.tile_m, s.y0 + iy as f32 * s.tile_m];
         if n <= BLOCK {
-            return self.cells(ix, iy, ta, tb, [0, 0], [n - 1, n - 1]);
+            return self.cells(k, corner, ta, tb, [0, 0], [n - 1, n - 1]);
         }
         // Block by block (2D DDA over BLOCK × BLOCK cells), skipping the blocks the ray passes over.
         let nb = n / BLOCK;
+        let inv_bs = nb as f32 * s.inv_tile_m;
         let bs = s.tile_m / nb as f32;
-        let (tx0, ty0) = (s.x0 + ix as f32 * s.tile_m, s.y0 + iy as f32 * s.tile_m);
-        let (o, d) = (self.o, self.d);
-        let (u0, v0) = ((o[0] - tx0) / bs, (o[1] - ty0) / bs);
-        let (du, dv) = (d[0] / bs, d[1] / bs);
-        let clampb = |v: f32| (v.floor().max(0.0) as usize).min(nb - 1);
-        let (mut bi, mut bj) = (clampb(u0 + du * ta), clampb(v0 + dv * ta));
-        let next = |c: usize, da: f32, base: f32| {
-            if da == 0.0 {
-                f32::INFINITY
-            } else {
-                (c as f32 + if da > 0.0 { 1.0 } else { 0.0 } - base) / da
-            }
-        };
-        let (mut tu, mut tv) = (next(bi, du, u0), next(bj, dv, v0));
-        let dtu = if du == 0.0 { f32::INFINITY } else { 1.0 / du.abs() };
-        let dtv = if dv == 0.0 { f32::INFINITY } else { 1.0 / dv.abs() };
+        let (lo, hi) = ([0, 0], [nb - 1, nb - 1]);
+        let mut g = Dda::new(self, ta, corner, bs, inv_bs, lo, hi);
         let mut t = ta;
         loop {
-            let t_exit = tu.min(tv).min(tb);
+            let t_exit = g.exit().min(tb);
             if t_exit >= t {
+                let [bi, bj] = g.cell;
                 let top = tile.bmax[bj * nb + bi];
                 if self.z(t).min(self.z(t_exit)) > top && self.above != Some(false) {
                     self.above = Some(true);
                 } else {
-                    let lo = [bi * BLOCK, bj * BLOCK];
-                    let hi = [lo[0] + BLOCK - 1, lo[1] + BLOCK - 1];
-                    if let Some(h) = self.cells(ix, iy, t, t_exit, lo, hi) {
+                    let clo = [bi * BLOCK, bj * BLOCK];
+                    let chi = [clo[0] + BLOCK - 1, clo[1] + BLOCK - 1];
+                    if let Some(h) = self.cells(k, corner, t, t_exit, clo, chi) {
                         return Some(h);
                     }
                 }
             }
-            if t_exit >= tb {
+            if t_exit >= tb || !g.advance(self.d, lo, hi) {
                 return None;
             }
             t = t_exit;
-            if tu <= tv {
-                let nc = bi as isize + if du > 0.0 { 1 } else { -1 };
-                if nc < 0 || nc >= nb as isize {
-                    return None;
-                }
-                bi = nc as usize;
-                tu += dtu;
-            } else {
-                let nc = bj as isize + if dv > 0.0 { 1 } else { -1 };
-                if nc < 0 || nc >= nb as isize {
-                    return None;
-                }
-                bj = nc as usize;
-                tv += dtv;
-            }
         }
     }
 
-    /// The stretch `[ta, tb]` over the cells `lo..=hi` (column, row) of tile `(ix, iy)`: cell by cell (2D DDA),
-    /// triangle by triangle.
-    fn cells(&mut self, ix: usize, iy: usize, ta: f32, tb: f32, lo: [usize; 2], hi: [usize; 2]) -> Option<SurfaceHit> {
+    /// The stretch `[ta, tb]` over the cells `lo..=hi` (column, row) of tile `k` (lower corner `corner`): cell by
+    /// cell (2D DDA), triangle by triangle.
+    #[inline(always)]
+    fn cells(
+        &mut self,
+        k: usize,
+        corner: [f32; 2],
+        ta: f32,
+        tb: f32,
+        lo: [usize; 2],
+        hi: [usize; 2],
+    ) -> Option<SurfaceHit> {
         let s = self.s;
-        let k = iy * s.ntx + ix;
         let tile = &s.tiles[k];
         let n = tile.n;
+        let inv_cs = n as f32 * s.inv_tile_m;
         let cs = s.tile_m / n as f32;
-        let (tx0, ty0) = (s.x0 + ix as f32 * s.tile_m, s.y0 + iy as f32 * s.tile_m);
         let (o, d) = (self.o, self.d);
-        // Cell coordinates (u, v) along the ray: u(t) = (o.x + d.x t - tx0) / cs.
-        let (u0, v0) = ((o[0] - tx0) / cs, (o[1] - ty0) / cs);
-        let (du, dv) = (d[0] / cs, d[1] / cs);
-        let clampc = |v: f32, a: usize| (v.floor().max(lo[a] as f32) as usize).min(hi[a]);
-        let mut ci = clampc(u0 + du * ta, 0);
-        let mut cj = clampc(v0 + dv * ta, 1);
-        let next = |c: usize, da: f32, base: f32| {
-            if da == 0.0 {
-                f32::INFINITY
-            } else {
-                (c as f32 + if da > 0.0 { 1.0 } else { 0.0 } - base) / da
-            }
-        };
-        let mut tu = next(ci, du, u0);
-        let mut tv = next(cj, dv, v0);
-        let dtu = if du == 0.0 { f32::INFINITY } else { 1.0 / du.abs() };
-        let dtv = if dv == 0.0 { f32::INFINITY } else { 1.0 / dv.abs() };
+        // Cell coordinates (u, v) along the ray: u(t) = (o.x + d.x t - corner.x) / cs.
+        let (u0, v0) = ((o[0] - corner[0]) * inv_cs, (o[1] - corner[1]) * inv_cs);
+        let (du, dv) = (d[0] * inv_cs, d[1] * inv_cs);
+        let mut g = Dda::new(self, ta, corner, cs, inv_cs, lo, hi);
         let base = (k * 2 * TILE_CELLS * TILE_CELLS) as u32;
         let mut t = ta;
         let w = n + 1;
+        let h = &tile.h;
         loop {
-            let t_exit = tu.min(tv).min(tb);
+            let t_exit = g.exit().min(tb);
             if t_exit >= t {
-                let h = &tile.h;
+                let [ci, cj] = g.cell;
                 let (h00, h10) = (h[cj * w + ci], h[cj * w + ci + 1]);
                 let (h01, h11) = (h[(cj + 1) * w + ci], h[(cj + 1) * w + ci + 1]);
                 let cmax = h00.max(h10).max(h01).max(h11);
@@ -520,7 +547,7 @@ impl March<'_> {
                 if zt.min(ze) > cmax && self.above != Some(false) {
                     self.above = Some(true);
                 } else {
-                    let (plane, _) = cell_planes(tile, ci, cj);
+                    let plane = [[h00, h10 - h00, h11 - h10], [h00, h11 - h01, h01 - h00]];
                     let id = base + 2 * (cj * n + ci) as u32;
                     // Local (fu, fv) at t: u(t) - ci.
                     let fu = |t: f32| u0 + du * t - ci as f32;
@@ -553,25 +580,10 @@ impl March<'_> {
                     }
                 }
             }
-            if t_exit >= tb {
+            if t_exit >= tb || !g.advance(d, lo, hi) {
                 return None;
             }
             t = t_exit;
-            if tu <= tv {
-                let nc = ci as isize + if du > 0.0 { 1 } else { -1 };
-                if nc < lo[0] as isize || nc > hi[0] as isize {
-                    return None;
-                }
-                ci = nc as usize;
-                tu += dtu;
-            } else {
-                let nc = cj as isize + if dv > 0.0 { 1 } else { -1 };
-                if nc < lo[1] as isize || nc > hi[1] as isize {
-                    return None;
-                }
-                cj = nc as usize;
-                tv += dtv;
-            }
         }
     }
 }
@@ -584,6 +596,18 @@ fn cell_planes(t: &Tile, ci: usize, cj: usize) -> ([[f32; 3]; 2], f32) {
     let (h00, h10) = (t.h[cj * w + ci], t.h[cj * w + ci + 1]);
     let (h01, h11) = (t.h[(cj + 1) * w + ci], t.h[(cj + 1) * w + ci + 1]);
     ([[h00, h10 - h00, h11 - h10], [h00, h11 - h01, h01 - h00]], h00.max(h10).max(h01).max(h11))
+}
+
+/// `x.floor()` without a call into libm where the CPU lacks a rounding instruction (exact for |x| < 2³¹; NaN
+/// gives 0, which every caller clamps or rejects).
+#[inline(always)]
+fn floor(x: f32) -> f32 {
+    let i = x as i32 as f32;
+    if i > x {
+        i - 1.0
+    } else {
+        i
+    }
 }
 
 #[inline]

@@ -1,0 +1,65 @@
+//! `cargo run --release -p mmusv-benches --example wavetime -- REPS`: times `WaveSurface::intersect` alone on the
+//! paper's W1 sea around one focus: straight-down rays (a top view) and rays from a camera 3 m up.
+
+use mmusv_core::ocean::{paper_sea_states, WaveField};
+use mmusv_core::sea::{SurfaceSpec, WaveSurface};
+
+fn main() {
+    let reps: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(5);
+    let preset = paper_sea_states()[1];
+    let Ok(field) = WaveField::new(&preset.spec(0.3, 10.0), 7) else { return };
+    let t0 = std::time::Instant::now();
+    let s = WaveSurface::new(field.components(), 12.0, 0.0, &[[0.0, 0.0]], SurfaceSpec::default());
+    println!("build (one focus): {:.2} ms, {} sampled tiles", t0.elapsed().as_secs_f64() * 1e3, s.sampled_tiles());
+    let ks: Vec<f64> = field.components().iter().map(|c| c.kx.hypot(c.ky)).collect();
+    let kmax = ks.iter().copied().fold(0.0, f64::max);
+    let mut sorted = ks.clone();
+    sorted.sort_by(f64::total_cmp);
+    println!(
+        "zmin {:.2} zmax {:.2}; shortest wavelength {:.2} m, 99th pct {:.2} m, 90th {:.2} m, median {:.2} m",
+        s.zmin(),
+        s.zmax(),
+        std::f64::consts::TAU / kmax,
+        std::f64::consts::TAU / sorted[sorted.len() * 99 / 100],
+        std::f64::consts::TAU / sorted[sorted.len() * 9 / 10],
+        std::f64::consts::TAU / sorted[sorted.len() / 2]
+    );
+    let same = vec![([3.3f32, 4.4, 120.0], [0.0f32, 0.0, -1.0]); 262144];
+    let mut top = Vec::new();
+    for j in 0..512 {
+        for i in 0..512 {
+            top.push(([-128.0 + i as f32 * 0.5, -128.0 + j as f32 * 0.5, 120.0], [0.0, 0.0, -1.0]));
+        }
+    }
+    let mut cam = Vec::new();
+    for j in 240..480 {
+        for i in 0..640 {
+            let x = (i as f32 - 320.0) / 320.0;
+            let z = -(j as f32 - 240.0 + 0.5) / 320.0;
+            let n = (1.0 + x * x + z * z).sqrt();
+            cam.push(([0.0, 0.0, 3.0], [1.0 / n, x / n, z / n]));
+        }
+    }
+    let band = |lo: usize, hi: usize| -> Vec<([f32; 3], [f32; 3])> { cam[(lo - 240) * 640..(hi - 240) * 640].to_vec() };
+    let (b1, b2, b3, b4) = (band(240, 250), band(250, 270), band(270, 330), band(330, 480));
+    for (name, rays) in [
+        ("same", &same),
+        ("top", &top),
+        ("camera-lower-half", &cam),
+        ("rows 240-250", &b1),
+        ("rows 250-270", &b2),
+        ("rows 270-330", &b3),
+        ("rows 330-480", &b4),
+    ] {
+        if std::env::var("ONLY").is_ok_and(|o| o != name) {
+            continue;
+        }
+        let t0 = std::time::Instant::now();
+        let mut hits = 0usize;
+        for _ in 0..reps {
+            hits += rays.iter().filter(|(o, d)| s.intersect(*o, *d, 5000.0).is_some()).count();
+        }
+        let dt = t0.elapsed().as_secs_f64();
+        println!("{name}: {:.1} ns per ray, hits {}", dt / (rays.len() * reps) as f64 * 1e9, hits / reps);
+    }
+}
