@@ -10,7 +10,7 @@ import numpy as np
 import torch
 from mmusv.learn.detector import load_models
 from mmusv.learn.presets import preset
-from mmusv.learn.train import plot_losses, train
+from mmusv.learn.train import TrainingSet, plot_losses, train
 from mmusv.studies.detection.evaluate import FrameMatch, summarize
 
 from learn.scenes import SCENES, MemorySource
@@ -59,3 +59,18 @@ def test_same_seed_same_weights_and_resume(tmp_path: Path) -> None:
     assert r.epochs == 3
     resumed = torch.load(tmp_path / "d" / "model.pt", weights_only=False)["model"]
     assert all(torch.equal(runs[0][k], resumed[k]) for k in runs[0])
+
+
+def test_min_points_drops_the_targets_of_unseen_boxes() -> None:
+    # scene 0's two boxes have points; a third box on empty water gets no heatmap peak with min_points 1, but
+    # one with min_points 0 (CenterPoint's default: every box)
+    src = MemorySource(SCENES[:1])
+    empty = np.array([[-20.0, 20.0, 1.0, 6.0, 2.0, 2.0, 0.0]])
+    pts, _, gt = src.sample(0)
+    src.items = [(pts, np.concatenate([gt, empty]))]
+    peaks = {}
+    for n in (0, 1):
+        ex = TrainingSet(src, preset("tiny", min_points=n), "single", seed=0, augment=False)[0]
+        assert ex.targets is not None
+        peaks[n] = int((ex.targets.heatmap == 1.0).sum())
+    assert peaks == {0: 3, 1: 2}

@@ -58,6 +58,7 @@ class Batch:
     index: torch.Tensor | None = None
     reg_mask: torch.Tensor | None = None
     reg: torch.Tensor | None = None
+    reg_weight: torch.Tensor | None = None
 
     def to(self, device: torch.device | str) -> Batch:
         """The batch on ``device``."""
@@ -154,4 +155,5 @@ def collate(examples: Sequence[Example]) -> Batch:
         b.index = t(np.stack([x.index for x in tg]))  # type: ignore[union-attr]
         b.reg_mask = t(np.stack([x.mask for x in tg]))  # type: ignore[union-attr]
         b.reg = t(np.stack([x.reg for x in tg]))  # type: ignore[union-attr]
+        b.reg_weight = t(np.stack([x.weight for x in tg]))  # type: ignore[union-attr]
     return b

@@ -33,19 +33,28 @@ def gather(feature: torch.Tensor, index: torch.Tensor) -> torch.Tensor:
 
 
 def regression_loss(
-    out: dict[str, torch.Tensor], index: torch.Tensor, mask: torch.Tensor, reg: torch.Tensor
+    out: dict[str, torch.Tensor], index: torch.Tensor, weight: torch.Tensor, reg: torch.Tensor
 ) -> torch.Tensor:
-    """Sum of the L1 errors of ``offset, z, size, rot`` at the ground-truth cells (``mask`` ``(B, K)``)."""
+    """Sum of the L1 errors of ``offset, z, size, rot`` at the target rows, each times its ``weight`` ``(B, K)``
+    (a bool mask counts as 0/1)."""
     pred = torch.cat([gather(out[k].float(), index) for k in ("offset", "z", "size", "rot")], dim=-1)
-    m = mask.unsqueeze(-1).float()
+    m = weight.unsqueeze(-1).float()
     return (torch.abs(pred - reg) * m).sum()
 
 
 def centerpoint_loss(
-    out: dict[str, torch.Tensor], heatmap: torch.Tensor, index: torch.Tensor, mask: torch.Tensor, reg: torch.Tensor
+    out: dict[str, torch.Tensor],
+    heatmap: torch.Tensor,
+    index: torch.Tensor,
+    mask: torch.Tensor,
+    reg: torch.Tensor,
+    weight: torch.Tensor | None = None,
 ) -> dict[str, torch.Tensor]:
-    """``{"loss", "heatmap", "regression"}``: total, focal and weighted L1 parts, each per object."""
+    """``{"loss", "heatmap", "regression"}``: total, focal and weighted L1 parts. The focal part is per object
+    (``mask``: the centre rows); the L1 part per unit of row ``weight`` (default ``mask``: per object, as in
+    CenterPoint)."""
     n = mask.sum().clamp(min=1).float()
+    w = mask.float() if weight is None else weight.float()
     hm = focal_loss(out["heatmap"], heatmap) / n
-    rg = REG_WEIGHT * regression_loss(out, index, mask, reg) / n
+    rg = REG_WEIGHT * regression_loss(out, index, w, reg) / w.sum().clamp(min=1.0)
     return {"loss": hm + rg, "heatmap": hm.detach(), "regression": rg.detach()}

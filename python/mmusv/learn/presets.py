@@ -34,7 +34,12 @@ class Preset:
     cos 2ψ`` instead of ``sin ψ, cos ψ`` (a BEV box is the same at ψ and ψ + π, and a hull seen from one side
     rarely shows which end is the bow: regressing ψ itself makes the head average the two answers; the study's
     IoU does not depend on the direction). Default off, so checkpoints from before it was added decode as they
-    were trained; every preset sets it."""
+    were trained; every preset sets it. ``reg_radius``: cells around each centre that also get regression rows
+    (:mod:`mmusv.learn.targets`; 0 = CenterPoint's centre row only). ``min_points``: training targets only for
+    the boxes with at least this many points of the model's own input inside (the ego's cloud for ``single``, the
+    ego's and its neighbours' for ``early`` and ``intermediate``; :func:`mmusv.learn.targets.points_in_boxes`),
+    so that a model is not taught to put a centre on empty water where a vessel no sensor saw happens to lie (as
+    KITTI-style pipelines drop boxes without points); 0 keeps every box. Evaluation always scores every box."""
 
     name: str
     pillar_m: float
@@ -61,6 +66,8 @@ class Preset:
     top_k: int = 100
     nms_iou: float = 0.1
     yaw_double: bool = False
+    reg_radius: int = 0
+    min_points: int = 0
 
     @property
     def grid(self) -> tuple[int, int]:
@@ -86,6 +93,8 @@ class Preset:
         for k in ("x_range", "y_range", "z_range", "scale"):
             v[k] = tuple(v[k])
         v["blocks"] = tuple(tuple(b) for b in v["blocks"])
+        v.setdefault("reg_radius", 0)  # checkpoints from before these were added
+        v.setdefault("min_points", 0)
         return Preset(**v)
 
 

@@ -40,10 +40,11 @@ import torch
 from mmusv.learn._errors import input_error
 from mmusv.learn.augment import apply, draw
 from mmusv.learn.cache import Cache
-from mmusv.learn.example import MODES, Example, collate, make_example
+from mmusv.learn.example import MODES, Example, collate, early_cloud, make_example
 from mmusv.learn.loss import centerpoint_loss
 from mmusv.learn.model import PillarNet
 from mmusv.learn.presets import PRESETS, Preset, preset
+from mmusv.learn.targets import points_in_boxes
 
 __all__ = ["TrainResult", "TrainingSet", "main", "plot_losses", "plot_runs", "train"]
 
@@ -53,7 +54,8 @@ LOG_EVERY = 10
 
 class TrainingSet(torch.utils.data.Dataset[Example]):
     """The cache's samples (every ``frame_stride``-th frame of each sequence, or ``indices``) as augmented
-    examples of ``mode``; :attr:`epoch` selects the augmentation draws. ``cache`` is a :class:`Cache` or any
+    examples of ``mode`` (targets: the boxes with the preset's ``min_points`` in the mode's input cloud);
+    :attr:`epoch` selects the augmentation draws. ``cache`` is a :class:`Cache` or any
     object with its ``__len__``, ``sample`` and ``frame_position``."""
 
     def __init__(
@@ -81,6 +83,9 @@ class TrainingSet(torch.utils.data.Dataset[Example]):
         if self.augment:
             rng = np.random.default_rng([self.seed, self.epoch, k])
             ego, nbs, gt = apply(draw(rng, self.p), ego, nbs, gt)
+        if self.p.min_points > 0 and len(gt):
+            seen = ego if self.mode == "single" else early_cloud(ego, nbs)
+            gt = gt[points_in_boxes(seen, gt) >= self.p.min_points]
         return make_example(ego, nbs, gt, mode=self.mode, p=self.p)
 
 
@@ -190,7 +195,7 @@ def train(
             with torch.autocast(device_type=dev.type, dtype=torch.bfloat16, enabled=amp):
                 outs = model(b)
             assert b.heatmap is not None and b.index is not None and b.reg_mask is not None and b.reg is not None
-            losses = centerpoint_loss(outs, b.heatmap, b.index, b.reg_mask, b.reg)
+            losses = centerpoint_loss(outs, b.heatmap, b.index, b.reg_mask, b.reg, b.reg_weight)
             opt.zero_grad(set_to_none=True)
             losses["loss"].backward()  # type: ignore[no-untyped-call]
             torch.nn.utils.clip_grad_norm_(model.parameters(), 35.0)
