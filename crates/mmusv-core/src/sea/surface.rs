@@ -68,12 +68,7 @@ struct Tile {
     h: Vec<f32>,
     /// `(n+1)²` slopes `(∂η/∂x, ∂η/∂y)`.
     g: Vec<[f32; 2]>,
-    /// Highest node of each block of [`BLOCK`] × [`BLOCK`] cells, row-major (empty when `n <= BLOCK`).
-    bmax: Vec<f32>,
 }
-
-/// Cells along a side of a block, the march's middle level: a ray over a block's highest node skips it whole.
-const BLOCK: usize = 4;
 
 /// The displaced sea surface of one frame (see the module docs).
 #[derive(Debug, Clone)]
@@ -265,6 +260,13 @@ impl WaveSurface {
         }
         let inv = [0, 1].map(|a| if d[a] == 0.0 { f32::INFINITY } else { 1.0 / d[a] });
         let mut m = March { s: self, o, d, inv, above: None };
+        // A steep ray crosses the band within one tile: straight to it.
+        let at = |t: f32| self.tile_at(o[0] + d[0] * t, o[1] + d[1] * t);
+        if let (Some(a), Some(b)) = (at(t0), at(t1)) {
+            if a == b {
+                return m.tile(a.0, a.1, t0, t1);
+            }
+        }
         // Split [t0, t1] into the parts before, inside and after the tile rectangle.
         let span = self.rect_span(o, d, t0, t1);
         match span {
@@ -368,7 +370,7 @@ impl Dda {
         let mut step = [f32::INFINITY; 2];
         for a in 0..2 {
             let u = (m.o[a] + m.d[a] * t - g[a]) * inv_c;
-            cell[a] = (floor(u).max(lo[a] as f32) as usize).min(hi[a]);
+            cell[a] = (u.floor().max(lo[a] as f32) as usize).min(hi[a]);
             if m.d[a] != 0.0 {
                 let side = if m.d[a] > 0.0 { 1.0 } else { 0.0 };
                 next[a] = (g[a] + (cell[a] as f32 + side) * c - m.o[a]) * m.inv[a];
@@ -478,36 +480,7 @@ impl March<'_> {
         }
         let n = tile.n;
         let corner = [s.x0 + ix as f32 * s.tile_m, s.y0 + iy as f32 * s.tile_m];
-        if n <= BLOCK {
-            return self.cells(k, corner, ta, tb, [0, 0], [n - 1, n - 1]);
-        }
-        // Block by block (2D DDA over BLOCK × BLOCK cells), skipping the blocks the ray passes over.
-        let nb = n / BLOCK;
-        let inv_bs = nb as f32 * s.inv_tile_m;
-        let bs = s.tile_m / nb as f32;
-        let (lo, hi) = ([0, 0], [nb - 1, nb - 1]);
-        let mut g = Dda::new(self, ta, corner, bs, inv_bs, lo, hi);
-        let mut t = ta;
-        loop {
-            let t_exit = g.exit().min(tb);
-            if t_exit >= t {
-                let [bi, bj] = g.cell;
-                let top = tile.bmax[bj * nb + bi];
-                if self.z(t).min(self.z(t_exit)) > top && self.above != Some(false) {
-                    self.above = Some(true);
-                } else {
-                    let clo = [bi * BLOCK, bj * BLOCK];
-                    let chi = [clo[0] + BLOCK - 1, clo[1] + BLOCK - 1];
-                    if let Some(h) = self.cells(k, corner, t, t_exit, clo, chi) {
-                        return Some(h);
-                    }
-                }
-            }
-            if t_exit >= tb || !g.advance(self.d, lo, hi) {
-                return None;
-            }
-            t = t_exit;
-        }
+        self.cells(k, corner, ta, tb, [0, 0], [n - 1, n - 1])
     }
 
     /// The stretch `[ta, tb]` over the cells `lo..=hi` (column, row) of tile `k` (lower corner `corner`): cell by
@@ -596,18 +569,6 @@ fn cell_planes(t: &Tile, ci: usize, cj: usize) -> ([[f32; 3]; 2], f32) {
     let (h00, h10) = (t.h[cj * w + ci], t.h[cj * w + ci + 1]);
     let (h01, h11) = (t.h[(cj + 1) * w + ci], t.h[(cj + 1) * w + ci + 1]);
     ([[h00, h10 - h00, h11 - h10], [h00, h11 - h01, h01 - h00]], h00.max(h10).max(h01).max(h11))
-}
-
-/// `x.floor()` without a call into libm where the CPU lacks a rounding instruction (exact for |x| < 2³¹; NaN
-/// gives 0, which every caller clamps or rejects).
-#[inline(always)]
-fn floor(x: f32) -> f32 {
-    let i = x as i32 as f32;
-    if i > x {
-        i - 1.0
-    } else {
-        i
-    }
 }
 
 #[inline]
@@ -751,31 +712,8 @@ impl<'a> Phasors<'a> {
                 zmax = zmax.max(z);
             }
         }
-        let bmax = block_maxima(n, &h);
-        Tile { n, zmin, zmax, h, g, bmax }
+        Tile { n, zmin, zmax, h, g }
     }
-}
-
-/// The highest node of every [`BLOCK`] × [`BLOCK`]-cell block of an `n`-cell tile's heights `h` (none when the
-/// tile is a single block).
-fn block_maxima(n: usize, h: &[f32]) -> Vec<f32> {
-    if n <= BLOCK {
-        return Vec::new();
-    }
-    let (nb, w) = (n / BLOCK, n + 1);
-    let mut out = vec![f32::NEG_INFINITY; nb * nb];
-    for j in 0..w {
-        for i in 0..w {
-            // A node on a block edge belongs to both blocks.
-            for bj in (j.saturating_sub(1) / BLOCK)..=(j / BLOCK).min(nb - 1) {
-                for bi in (i.saturating_sub(1) / BLOCK)..=(i / BLOCK).min(nb - 1) {
-                    let m = &mut out[bj * nb + bi];
-                    *m = m.max(h[j * w + i]);
-                }
-            }
-        }
-    }
-    out
 }
 
 #[cfg(test)]
