@@ -1,5 +1,6 @@
 //! `cargo run --release -p mmusv-benches --example wavetime -- REPS`: times `WaveSurface::intersect` alone on the
-//! paper's W1 sea around one focus: straight-down rays (a top view) and rays from a camera 3 m up.
+//! paper's W1 sea around one focus: a radar's grazing beams, straight-down rays (one point; a top view) and rays from
+//! a camera 3 m up (its lower half, and by bands of rows), plus the surface's build time.
 
 use mmusv_core::ocean::{paper_sea_states, WaveField};
 use mmusv_core::sea::{SurfaceSpec, WaveSurface};
@@ -40,9 +41,19 @@ fn main() {
             cam.push(([0.0, 0.0, 3.0], [1.0 / n, x / n, z / n]));
         }
     }
+    // A marine radar's beams: 4 m up, 0.25°-4° down, all round.
+    let mut radar = Vec::new();
+    for e in 0..16 {
+        let el = -(0.25 + e as f32 * 0.25f32).to_radians();
+        for a in 0..2048 {
+            let az = a as f32 / 2048.0 * std::f32::consts::TAU;
+            radar.push(([0.0, 0.0, 4.0], [el.cos() * az.cos(), el.cos() * az.sin(), el.sin()]));
+        }
+    }
     let band = |lo: usize, hi: usize| -> Vec<([f32; 3], [f32; 3])> { cam[(lo - 240) * 640..(hi - 240) * 640].to_vec() };
     let (b1, b2, b3, b4) = (band(240, 250), band(250, 270), band(270, 330), band(330, 480));
     for (name, rays) in [
+        ("radar", &radar),
         ("same", &same),
         ("top", &top),
         ("camera-lower-half", &cam),

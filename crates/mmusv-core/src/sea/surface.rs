@@ -358,6 +358,8 @@ struct Dda {
     cell: [usize; 2],
     next: [f32; 2],
     step: [f32; 2],
+    /// The cell step along each axis: +1, -1, or 0 where the ray does not move along it.
+    dir: [isize; 2],
 }
 
 impl Dda {
@@ -368,6 +370,7 @@ impl Dda {
         let mut cell = [0usize; 2];
         let mut next = [f32::INFINITY; 2];
         let mut step = [f32::INFINITY; 2];
+        let mut dir = [0isize; 2];
         for a in 0..2 {
             let u = (m.o[a] + m.d[a] * t - g[a]) * inv_c;
             cell[a] = (u.floor().max(lo[a] as f32) as usize).min(hi[a]);
@@ -375,9 +378,10 @@ impl Dda {
                 let side = if m.d[a] > 0.0 { 1.0 } else { 0.0 };
                 next[a] = (g[a] + (cell[a] as f32 + side) * c - m.o[a]) * m.inv[a];
                 step[a] = c * m.inv[a].abs();
+                dir[a] = if m.d[a] > 0.0 { 1 } else { -1 };
             }
         }
-        Self { cell, next, step }
+        Self { cell, next, step, dir }
     }
 
     /// The ray distance where the current cell is left.
@@ -386,22 +390,16 @@ impl Dda {
         self.next[0].min(self.next[1])
     }
 
-    /// Moves to the next cell along the ray; `false` when that leaves `lo..=hi`.
+    /// Moves to the next cell along the ray; `false` when that leaves `lo..=hi`. The axis is picked by index,
+    /// not by a branch (along a diagonal ray the two alternate unpredictably).
     #[inline(always)]
-    fn advance(&mut self, d: [f32; 3], lo: [usize; 2], hi: [usize; 2]) -> bool {
+    fn advance(&mut self, lo: [usize; 2], hi: [usize; 2]) -> bool {
         let a = usize::from(self.next[0] > self.next[1]);
-        let c = self.cell[a];
-        if d[a] > 0.0 {
-            if c >= hi[a] {
-                return false;
-            }
-            self.cell[a] = c + 1;
-        } else {
-            if c <= lo[a] {
-                return false;
-            }
-            self.cell[a] = c - 1;
+        let c = self.cell[a].wrapping_add(self.dir[a] as usize);
+        if c < lo[a] || c > hi[a] {
+            return false;
         }
+        self.cell[a] = c;
         self.next[a] += self.step[a];
         true
     }
@@ -454,7 +452,7 @@ impl March<'_> {
                     return Some(h);
                 }
             }
-            if t_exit >= tb || !g.advance(self.d, lo, hi) {
+            if t_exit >= tb || !g.advance(lo, hi) {
                 return None;
             }
             t = t_exit;
@@ -553,7 +551,7 @@ impl March<'_> {
                     }
                 }
             }
-            if t_exit >= tb || !g.advance(d, lo, hi) {
+            if t_exit >= tb || !g.advance(lo, hi) {
                 return None;
             }
             t = t_exit;
