@@ -59,6 +59,7 @@ LIDAR: dict[str, Any] = {
     "yaw": [0.0, 1.5707963267948966],
     "lidar_points": [1200, 37],
     "range_m": [50.05, 80.1],
+    "wave_occlusion": [0.0, 0.375],
 }
 BEV: dict[str, Any] = {
     "target_id": ["target1"],
@@ -79,6 +80,7 @@ CAMERA: dict[str, Any] = {
     "visible_pixels": [250, 12],
     "box_pixels": [300, 20],
     "occlusion": [1 - 250 / 300, 0.4],
+    "wave_occlusion": [0.125, 0.0],
 }
 POSE = [1.0, 2.0, 3.0, 0.0, 0.0, 0.0, 1.0]
 

@@ -82,6 +82,7 @@ class _RowWise:
                     "range_m": float(lid["range_m"][j]),
                     "role": lid["role"][j],
                     "static": bool(lid["static"][j]),
+                    "wave_occlusion": float(lid["wave_occlusion"][j]),
                 }
             )
         cam = cols["camera"]
@@ -103,6 +104,7 @@ class _RowWise:
                     "occlusion": float(cam["occlusion"][j]),
                     "role": cam["role"][j],
                     "static": bool(cam["static"][j]),
+                    "wave_occlusion": float(cam["wave_occlusion"][j]),
                 }
             )
 
@@ -160,3 +162,30 @@ def test_a_table_without_rows_writes_no_part(tmp_path: Path) -> None:
     assert ws.height == len(sim.vessels)
     np.testing.assert_array_equal(ws["x"].to_numpy(), cap.world.poses[:, 0])
     assert ws["vessel_id"].to_list() == [v.id for v in sim.vessels]
+
+
+def test_parts_written_before_wave_occlusion_read_with_it_null(tmp_path: Path) -> None:
+    """A part of an older mmusv (no ``wave_occlusion`` column) reads with that column null, not as damaged and
+    not as zeros; a part missing any other column is still damaged."""
+    from mmusv.recording.tables import read_table
+
+    sim = Simulation(small_scenario(frames=2))
+    silhouettes = SilhouetteCache()
+    w = TableWriter(tmp_path / "new")
+    for k in range(2):
+        cap = sim.capture(k)
+        anns = annotations_for(sim, cap, silhouettes)
+        w.add_frame(sim.vessels, cap, {agent: (a, a.columns()) for agent, a in anns.items()})
+    w.flush()
+    for table in ("boxes_3d", "boxes_2d"):
+        new = pl.read_parquet(tmp_path / "new" / table / "part-00000.parquet")
+        assert new["wave_occlusion"].null_count() == 0
+        old_dir = tmp_path / "old" / table
+        old_dir.mkdir(parents=True)
+        new.drop("wave_occlusion").write_parquet(old_dir / "part-00000.parquet")
+        new.drop("wave_occlusion", "role").write_parquet(old_dir / "part-00001.parquet")
+        got = read_table(tmp_path / "old", table)
+        assert got.rows.columns == list(SCHEMAS[table])
+        assert got.rows["wave_occlusion"].null_count() == new.height
+        assert got.rows.drop("wave_occlusion").equals(new.drop("wave_occlusion"))
+        assert len(got.damaged) == 1 and "part-00001" in got.damaged[0]

@@ -5,6 +5,7 @@ sea state."""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -150,3 +151,51 @@ def test_lidar_water_returns_follow_the_waves(sea: Sea, lo: float, hi: float) ->
     ratio = float(zz.std()) / (sea.hs_m / 4.0)
     print(f"Hs {sea.hs_m} m: {zz.size} water returns within 60 m, world-z std {zz.std():.3f} m = {ratio:.2f} Hs/4")
     assert lo < ratio < hi, ratio
+
+
+def test_recordings_carry_the_shares_as_annotated(tmp_path: Path) -> None:
+    """A W3 run writes each box's wave-occlusion share to the Parquet tables and to the MCAP annotation messages,
+    equal to the annotations of the same frames computed afresh."""
+    import sys
+
+    from mmusv.acquire import annotations_for, run
+    from mmusv.annotate import SilhouetteCache
+    from mmusv.recording.reader import read_messages
+    from mmusv.recording.tables import read_table
+    from mmusv.simulation import Simulation
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from test_acquire import small_scenario
+
+    sc = small_scenario(frames=2)
+    sc["environment"]["wave"] = "W3"
+    res = run(sc, out_dir=tmp_path)
+    assert res.status == "complete"
+    sim, sil = Simulation(sc), SilhouetteCache()
+    want3: dict[tuple[int, str, str], float] = {}
+    want2: dict[tuple[int, str, str, str], float] = {}
+    for k in range(2):
+        for agent, ann in annotations_for(sim, sim.capture(k), sil).items():
+            cols = ann.columns()
+            for t, w in zip(cols["lidar"]["target_id"], cols["lidar"]["wave_occlusion"], strict=True):
+                want3[(k, agent, t)] = float(w)
+            cam = cols["camera"]
+            for t, c, w in zip(cam["target_id"], cam["camera"], cam["wave_occlusion"], strict=True):
+                want2[(k, agent, c, t)] = float(w)
+    assert any(v > 0 for v in [*want3.values(), *want2.values()])  # W3 crests hide part of some box
+    b3 = read_table(tmp_path / "tables", "boxes_3d").rows
+    b2 = read_table(tmp_path / "tables", "boxes_2d").rows
+    got3 = {(r["frame"], r["agent"], r["target_id"]): r["wave_occlusion"] for r in b3.iter_rows(named=True)}
+    got2 = {
+        (r["frame"], r["agent"], r["camera"], r["target_id"]): r["wave_occlusion"] for r in b2.iter_rows(named=True)
+    }
+    assert got3 == want3 and got2 == want2
+    msg3: dict[tuple[int, str, str], float] = {}
+    msg2: dict[tuple[int, str, str, str], float] = {}
+    for topic, _, msg in read_messages(res.recording):
+        if topic.endswith("/annotations"):
+            for b in msg.boxes_lidar:
+                msg3[(msg.frame, msg.agent_id, b.target_id)] = b.wave_occlusion
+            for b in msg.boxes_camera:
+                msg2[(msg.frame, msg.agent_id, b.camera, b.target_id)] = b.wave_occlusion
+    assert msg3 == want3 and msg2 == want2

@@ -707,9 +707,9 @@ class Recorder:
         camera_values: npt.NDArray[np.float64],
     ) -> None:
         """``mmusv.AgentAnnotations`` from packed columns: ``lidar_ints`` (N, 3) [instance_id, semantic_class,
-        lidar_points], ``lidar_values`` (N, 12) [center xyz, size lwh, rotation xyzw, yaw, range_m]; ``bev_values``
-        (M, 5) [x, y, length, width, yaw]; ``camera_ints`` (K, 2) [visible_pixels, box_pixels], ``camera_values``
-        (K, 6) [x_min, y_min, x_max, y_max, truncation, occlusion]."""
+        lidar_points], ``lidar_values`` (N, 13) [center xyz, size lwh, rotation xyzw, yaw, range_m, wave_occlusion];
+        ``bev_values`` (M, 5) [x, y, length, width, yaw]; ``camera_ints`` (K, 2) [visible_pixels, box_pixels],
+        ``camera_values`` (K, 7) [x_min, y_min, x_max, y_max, truncation, occlusion, wave_occlusion]."""
 
     def metadata(self, name: str, mapping: Mapping[str, str]) -> None:
         """An MCAP metadata record ``name`` holding ``mapping``."""

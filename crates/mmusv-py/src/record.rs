@@ -448,12 +448,12 @@ impl Recorder {
         camera_values: PyReadonlyArray2<'_, f64>,
     ) -> PyResult<()> {
         let li = rows::<u32, 3>(&lidar_ints, "lidar_ints")?;
-        let lv = rows::<f64, 12>(&lidar_values, "lidar_values")?;
+        let lv = rows::<f64, 13>(&lidar_values, "lidar_values")?;
         same_len(lidar_ids.len(), "lidar_ids", &[("lidar_ints", li.len()), ("lidar_values", lv.len())])?;
         let bv = rows::<f64, 5>(&bev_values, "bev_values")?;
         same_len(bev_ids.len(), "bev_ids", &[("bev_values", bv.len())])?;
         let ci = rows::<u32, 2>(&camera_ints, "camera_ints")?;
-        let cv = rows::<f64, 6>(&camera_values, "camera_values")?;
+        let cv = rows::<f64, 7>(&camera_values, "camera_values")?;
         same_len(
             camera_ids.len(),
             "camera_ids",
@@ -472,6 +472,7 @@ impl Recorder {
                 yaw: v[10],
                 lidar_points: i[2],
                 range_m: v[11],
+                wave_occlusion: v[12],
             })
             .collect();
         let boxes_bev = bev_ids
@@ -494,6 +495,7 @@ impl Recorder {
                 visible_pixels: i[0],
                 box_pixels: i[1],
                 occlusion: v[5],
+                wave_occlusion: v[6],
             })
             .collect();
         let ann = AgentAnnotations { frame, time_s, agent_id, boxes_lidar, boxes_bev, boxes_camera };

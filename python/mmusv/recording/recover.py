@@ -146,6 +146,7 @@ def _box_rows(ann: Any, roles: dict[str, str], static: dict[str, bool]) -> tuple
         "range_m": np.array([b.range_m for b in lid], dtype=np.float64),
         "role": [role(b.target_id) for b in lid],
         "static": np.array([stat(b.target_id) for b in lid], dtype=bool),
+        "wave_occlusion": _waves(lid),
     }
     for j, k in enumerate(("x", "y", "z")):
         box3[k] = c[:, j]
@@ -166,7 +167,16 @@ def _box_rows(ann: Any, roles: dict[str, str], static: dict[str, bool]) -> tuple
     }
     for k in ("x_min", "y_min", "x_max", "y_max", "truncation", "occlusion"):
         box2[k] = np.array([getattr(b, k) for b in cam], dtype=np.float64)
+    box2["wave_occlusion"] = _waves(cam)
     return box3, box2
+
+
+def _waves(boxes: list[Any]) -> Any:
+    """The boxes' ``wave_occlusion``; NaN (null in the table) for boxes from a recording made before the field
+    existed (its embedded schema lacks it)."""
+    import numpy as np
+
+    return np.array([getattr(b, "wave_occlusion", np.nan) for b in boxes], dtype=np.float64)
 
 
 def _want(topic: str) -> bool:

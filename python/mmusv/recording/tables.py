@@ -55,6 +55,7 @@ SCHEMAS: dict[str, dict[str, Any]] = {
         "range_m": _F,
         "role": _S,
         "static": _B,
+        "wave_occlusion": _F,
     },
     "boxes_2d": {
         "frame": _I,
@@ -68,9 +69,16 @@ SCHEMAS: dict[str, dict[str, Any]] = {
         "occlusion": _F,
         "role": _S,
         "static": _B,
+        "wave_occlusion": _F,
     },
 }
-"""Column name → polars dtype of each table, in column order."""
+"""Column name → polars dtype of each table, in column order. ``wave_occlusion`` (boxes): the share of the
+target's part above the still water level that the waves hide from the agent's LiDAR (``boxes_3d``) or that
+camera (``boxes_2d``), 0..1, 0 over a flat sea; tables written before it existed read with it null."""
+
+LEGACY_MISSING: dict[str, tuple[str, ...]] = {"boxes_3d": ("wave_occlusion",), "boxes_2d": ("wave_occlusion",)}
+"""Columns each table gained after its first release: a part without them (written by an older mmusv) reads with
+them null (not recorded), never as zeros."""
 
 
 class TableWriter:
@@ -157,6 +165,7 @@ class TableWriter:
             "range_m": np.asarray(lid["range_m"], dtype=np.float64),
             "role": list(lid["role"]),
             "static": np.asarray(lid["static"], dtype=bool),
+            "wave_occlusion": np.asarray(lid["wave_occlusion"], dtype=np.float64),
         }
         for j, k in enumerate(("x", "y", "z")):
             box3[k] = c[:, j]
@@ -178,7 +187,7 @@ class TableWriter:
             "role": list(cam["role"]),
             "static": np.asarray(cam["static"], dtype=bool),
         }
-        for k in ("x_min", "y_min", "x_max", "y_max", "truncation", "occlusion"):
+        for k in ("x_min", "y_min", "x_max", "y_max", "truncation", "occlusion", "wave_occlusion"):
             box2[k] = np.asarray(cam[k], dtype=np.float64)
         self._add("boxes_2d", m, box2)
 
@@ -193,6 +202,11 @@ class TableWriter:
                 parts = self._cols[table][name]
                 if dtype == _S:
                     data[name] = [x for p in parts for x in p]
+                elif name in LEGACY_MISSING.get(table, ()):
+                    # NaN marks a value not recorded (a rebuilt table of an older recording): null in the table.
+                    data[name] = pl.Series(name, np.concatenate([np.asarray(p) for p in parts]), dtype=dtype).fill_nan(
+                        None
+                    )
                 else:
                     data[name] = np.concatenate([np.asarray(p) for p in parts])
                 parts.clear()
@@ -254,6 +268,9 @@ def read_table(root: str | os.PathLike[str], table: str, *, expected: range | No
                 f"{part} is not a readable Parquet file ({type(exc).__name__}{': ' + first if first else ''})"
             )
             continue
+        legacy = [c for c in LEGACY_MISSING.get(table, ()) if c not in df.columns]
+        if legacy and list(df.columns) == [c for c in schema if c not in legacy]:
+            df = df.with_columns(pl.lit(None, dtype=schema[c]).alias(c) for c in legacy).select(list(schema))
         if list(df.columns) != list(schema) or any(df.schema[c] != t for c, t in schema.items()):
             damaged.append(f"{part} does not have the columns and types of table {table}")
             continue

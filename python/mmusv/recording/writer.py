@@ -321,18 +321,25 @@ class Recording:
 
         - ``lidar`` (LiDAR frame): ``target_id`` [str], ``instance_id``, ``semantic_class``, ``lidar_points``
           [ints], ``center`` (N, 3) m, ``size`` (N, 3) length, width, height m, ``rotation`` (N, 4) x, y, z, w,
-          ``yaw`` (N,) rad, ``range_m`` (N,) m;
+          ``yaw`` (N,) rad, ``range_m`` (N,) m, ``wave_occlusion`` (N,) share of the target's part above the still
+          water level hidden by the waves, 0..1 (optional: 0 when absent);
         - ``bev``: ``target_id`` [str], ``x``, ``y``, ``length``, ``width`` (N,) m, ``yaw`` (N,) rad;
         - ``camera`` (pixels, origin top-left): ``target_id``, ``camera`` [str], ``x_min``, ``y_min``, ``x_max``,
-          ``y_max``, ``truncation``, ``occlusion`` (N,) floats, ``visible_pixels``, ``box_pixels`` (N,) ints.
+          ``y_max``, ``truncation``, ``occlusion``, ``wave_occlusion`` (optional: 0 when absent) (N,) floats,
+          ``visible_pixels``, ``box_pixels`` (N,) ints.
         """
         lid, bev_t, cam = dict(lidar or {}), dict(bev or {}), dict(camera or {})
         lidar_ids = _strs(lid.get("target_id", []), "lidar.target_id")
         bev_ids = _strs(bev_t.get("target_id", []), "bev.target_id")
         camera_ids = _strs(cam.get("target_id", []), "camera.target_id")
         n, m, k = len(lidar_ids), len(bev_ids), len(camera_ids)
-        lidar_spec = (("center", 3), ("size", 3), ("rotation", 4), ("yaw", 1), ("range_m", 1))
-        camera_spec = (("x_min", 1), ("y_min", 1), ("x_max", 1), ("y_max", 1), ("truncation", 1), ("occlusion", 1))
+        # The wave-occlusion shares are optional: absent, the boxes were not hidden by waves (a flat sea).
+        lid.setdefault("wave_occlusion", np.zeros(n))
+        cam.setdefault("wave_occlusion", np.zeros(k))
+        lidar_spec = (("center", 3), ("size", 3), ("rotation", 4), ("yaw", 1), ("range_m", 1), ("wave_occlusion", 1))
+        camera_spec = (
+            *((k, 1) for k in ("x_min", "y_min", "x_max", "y_max", "truncation", "occlusion", "wave_occlusion")),
+        )
         self._rec.annotations(
             topic,
             log_time_ns=log_time_ns,

@@ -92,6 +92,10 @@ pub struct Box3D {
     /// Range from the sensor to the box centre, metres.
     #[prost(double, tag = "9")]
     pub range_m: f64,
+    /// Share of the target's part above the still water level that the waves hide from the LiDAR, 0..1 (0 over a
+    /// flat sea).
+    #[prost(double, tag = "10")]
+    pub wave_occlusion: f64,
 }
 
 /// A bird's-eye-view box label (agent's BEV frame, metres and radians).
@@ -150,6 +154,10 @@ pub struct Box2D {
     /// Fraction of the target hidden by other objects, 0..1.
     #[prost(double, tag = "10")]
     pub occlusion: f64,
+    /// Share of the target's part above the still water level that the waves hide from the camera, 0..1 (0 over
+    /// a flat sea).
+    #[prost(double, tag = "11")]
+    pub wave_occlusion: f64,
 }
 
 /// Every label one agent produces at one frame.
@@ -218,6 +226,7 @@ const LAYOUT: &[(&str, Fields)] = &[
             ("yaw", 7, Kind::F64),
             ("lidar_points", 8, Kind::U32),
             ("range_m", 9, Kind::F64),
+            ("wave_occlusion", 10, Kind::F64),
         ],
     ),
     (
@@ -244,6 +253,7 @@ const LAYOUT: &[(&str, Fields)] = &[
             ("visible_pixels", 8, Kind::U32),
             ("box_pixels", 9, Kind::U32),
             ("occlusion", 10, Kind::F64),
+            ("wave_occlusion", 11, Kind::F64),
         ],
     ),
     (
@@ -385,8 +395,9 @@ mod tests {
         assert_eq!(ann.field[3].type_name(), ".mmusv.Box3D");
         assert_eq!(ann.field[3].label(), Label::Repeated);
         let box2d = &file.message_type[4];
-        assert_eq!(box2d.field.len(), 10);
+        assert_eq!(box2d.field.len(), 11);
         assert_eq!(box2d.field[9].name(), "occlusion");
+        assert_eq!(box2d.field[10].name(), "wave_occlusion");
         assert_eq!(box2d.field[7].json_name(), "visiblePixels");
     }
 
