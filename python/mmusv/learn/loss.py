@@ -7,6 +7,8 @@ Inputs are the head's outputs (:mod:`mmusv.learn.head`) and the batched targets 
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import torch
 
 __all__ = ["REG_WEIGHT", "centerpoint_loss", "focal_loss", "regression_loss"]
@@ -33,13 +35,20 @@ def gather(feature: torch.Tensor, index: torch.Tensor) -> torch.Tensor:
 
 
 def regression_loss(
-    out: dict[str, torch.Tensor], index: torch.Tensor, weight: torch.Tensor, reg: torch.Tensor
+    out: dict[str, torch.Tensor],
+    index: torch.Tensor,
+    weight: torch.Tensor,
+    reg: torch.Tensor,
+    code_weights: Sequence[float] | None = None,
 ) -> torch.Tensor:
     """Sum of the L1 errors of ``offset, z, size, rot`` at the target rows, each times its ``weight`` ``(B, K)``
-    (a bool mask counts as 0/1)."""
+    (a bool mask counts as 0/1) and its column's ``code_weights`` (CenterPoint's, default all 1)."""
     pred = torch.cat([gather(out[k].float(), index) for k in ("offset", "z", "size", "rot")], dim=-1)
     m = weight.unsqueeze(-1).float()
-    return (torch.abs(pred - reg) * m).sum()
+    err = torch.abs(pred - reg) * m
+    if code_weights is not None:
+        err = err * torch.as_tensor(code_weights, dtype=err.dtype, device=err.device)
+    return err.sum()
 
 
 def centerpoint_loss(
@@ -49,12 +58,13 @@ def centerpoint_loss(
     mask: torch.Tensor,
     reg: torch.Tensor,
     weight: torch.Tensor | None = None,
+    code_weights: Sequence[float] | None = None,
 ) -> dict[str, torch.Tensor]:
     """``{"loss", "heatmap", "regression"}``: total, focal and weighted L1 parts. The focal part is per object
     (``mask``: the centre rows); the L1 part per unit of row ``weight`` (default ``mask``: per object, as in
-    CenterPoint)."""
+    CenterPoint); ``code_weights`` per column (:func:`regression_loss`)."""
     n = mask.sum().clamp(min=1).float()
     w = mask.float() if weight is None else weight.float()
     hm = focal_loss(out["heatmap"], heatmap) / n
-    rg = REG_WEIGHT * regression_loss(out, index, w, reg) / w.sum().clamp(min=1.0)
+    rg = REG_WEIGHT * regression_loss(out, index, w, reg, code_weights) / w.sum().clamp(min=1.0)
     return {"loss": hm + rg, "heatmap": hm.detach(), "regression": rg.detach()}

@@ -195,7 +195,7 @@ def train(
             with torch.autocast(device_type=dev.type, dtype=torch.bfloat16, enabled=amp):
                 outs = model(b)
             assert b.heatmap is not None and b.index is not None and b.reg_mask is not None and b.reg is not None
-            losses = centerpoint_loss(outs, b.heatmap, b.index, b.reg_mask, b.reg, b.reg_weight)
+            losses = centerpoint_loss(outs, b.heatmap, b.index, b.reg_mask, b.reg, b.reg_weight, p.code_weights)
             opt.zero_grad(set_to_none=True)
             losses["loss"].backward()  # type: ignore[no-untyped-call]
             torch.nn.utils.clip_grad_norm_(model.parameters(), 35.0)
