@@ -9,9 +9,15 @@ fn main() {
     let reps: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(5);
     let preset = paper_sea_states()[1];
     let Ok(field) = WaveField::new(&preset.spec(0.3, 10.0), 7) else { return };
-    let t0 = std::time::Instant::now();
+    let mut best = f64::INFINITY;
+    for k in 0..8 {
+        let t0 = std::time::Instant::now();
+        let s = WaveSurface::new(field.components(), 12.0 + k as f64, 0.0, &[[0.0, 0.0]], SurfaceSpec::default());
+        best = best.min(t0.elapsed().as_secs_f64());
+        std::hint::black_box(s);
+    }
     let s = WaveSurface::new(field.components(), 12.0, 0.0, &[[0.0, 0.0]], SurfaceSpec::default());
-    println!("build (one focus): {:.2} ms, {} sampled tiles", t0.elapsed().as_secs_f64() * 1e3, s.sampled_tiles());
+    println!("build (one focus, least of 8): {:.2} ms, {} sampled tiles", best * 1e3, s.sampled_tiles());
     let ks: Vec<f64> = field.components().iter().map(|c| c.kx.hypot(c.ky)).collect();
     let kmax = ks.iter().copied().fold(0.0, f64::max);
     let mut sorted = ks.clone();
