@@ -24,7 +24,18 @@ pub struct RayPrep {
     /// Shear constants `[d[kx]/d[kz], d[ky]/d[kz]]` (the paper's third, `1/d[kz]`, is not needed: distances come
     /// from the triangle's plane).
     pub s: [f32; 2],
+    /// Whether the ray leaves the water ([`crate::sea::WaveSurface::leaves`] of the scene's wave surface), when a
+    /// batch worked it out once for every test that asks: [`LEAVES_UNKNOWN`] (work it out), [`LEAVES_NO`] or
+    /// [`LEAVES_YES`]. It sits in what was padding: the struct is no larger.
+    pub leaves: u8,
 }
+
+/// [`RayPrep::leaves`]: not worked out.
+pub const LEAVES_UNKNOWN: u8 = 0;
+/// [`RayPrep::leaves`]: the ray does not leave the water.
+pub const LEAVES_NO: u8 = 1;
+/// [`RayPrep::leaves`]: the ray leaves the water.
+pub const LEAVES_YES: u8 = 2;
 
 impl RayPrep {
     /// Prepares the ray `o + t·d`. `d` must be finite and non-zero.
@@ -37,7 +48,7 @@ impl RayPrep {
         let k = axes(kz);
         let [kx, ky, kz] = k.map(usize::from);
         let sz = 1.0 / d[kz]; // d[kz] is the largest component, never zero for a non-zero direction
-        Self { o, d, inv, near: near_planes(inv), k, s: [d[kx] * sz, d[ky] * sz] }
+        Self { o, d, inv, near: near_planes(inv), k, s: [d[kx] * sz, d[ky] * sz], leaves: LEAVES_UNKNOWN }
     }
 }
 
@@ -110,7 +121,8 @@ pub fn prepare_lanes<const N: usize>(o: &[[f32; 3]; N], d: &[[f32; N]; 3]) -> [R
     }
     // A plain loop over a filled array: `std::array::from_fn` was compiled out of line (`try_from_fn`, 3.7 % of
     // a frame's samples).
-    let mut out = [RayPrep { o: [0.0; 3], d: [0.0; 3], inv: [0.0; 3], near: [0; 3], k: [0; 3], s: [0.0; 2] }; N];
+    let blank = RayPrep { o: [0.0; 3], d: [0.0; 3], inv: [0.0; 3], near: [0; 3], k: [0; 3], s: [0.0; 2], leaves: 0 };
+    let mut out = [blank; N];
     for (j, r) in out.iter_mut().enumerate() {
         let inv = [inv[0][j], inv[1][j], inv[2][j]];
         *r = RayPrep {
@@ -120,6 +132,7 @@ pub fn prepare_lanes<const N: usize>(o: &[[f32; 3]; N], d: &[[f32; N]; 3]) -> [R
             near: near_planes(inv),
             k: axes(kz[j]),
             s: [sc[0][j], sc[1][j]],
+            leaves: LEAVES_UNKNOWN,
         };
     }
     out

@@ -160,8 +160,11 @@ crate::dispatch! {
             for i in start..end {
                 out.miss(i);
             }
-            let Some(rays) = prepare(o, d, start..end, &mut bad) else { continue };
-            let rays = &rays[..end - start];
+            let Some(mut rays) = prepare(o, d, start..end, &mut bad) else { continue };
+            let rays = &mut rays[..end - start];
+            // Whether each ray leaves the water, worked out once for the sea shortcut and the wave test alike.
+            scene.mark_leaves(rays);
+            let rays = &*rays;
             let mut sky = [false; PACKET];
             let mut any_sky = false;
             for (r, ray) in rays.iter().enumerate() {
@@ -252,7 +255,8 @@ crate::dispatch! {
             if m == 0 {
                 continue;
             }
-            let Some(rays) = prepare(o, d, todo[..m].iter().copied(), &mut bad) else { continue };
+            let Some(mut rays) = prepare(o, d, todo[..m].iter().copied(), &mut bad) else { continue };
+            scene.mark_leaves(&mut rays[..m]);
             let mut rest = [rays[0]; PACKET];
             let mut lane = [0usize; PACKET];
             let mut n = 0;

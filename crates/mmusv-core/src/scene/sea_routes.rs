@@ -4,7 +4,7 @@
 use super::Scene;
 use crate::bvh::Box3;
 use crate::error::{MmusvError, Result};
-use crate::ray::RayPrep;
+use crate::ray::{RayPrep, LEAVES_NO, LEAVES_YES};
 use crate::sea::{Horizon, Sea, SunMask};
 
 /// Longest height-map walks (cells) worth trying before a full trace: up into the sky (camera rays, which ask
@@ -122,7 +122,7 @@ impl Scene {
                 if !origin.iter().all(|v| v.is_finite()) {
                     return false;
                 }
-                match self.lift_over_waves(sea, origin, mask.dir(), f32::MAX) {
+                match self.lift_over_waves(sea, origin, mask.dir(), f32::MAX, None) {
                     Lift::Above(o) => sea.sun_clear(mask, o),
                     Lift::Beyond | Lift::Unknown => false,
                 }
@@ -135,10 +135,17 @@ impl Scene {
     /// when nothing meets it on the way: the wave surface (exactly; none for a ray leaving the water,
     /// [`crate::sea::WaveSurface::leaves`], which only needs to clear the still level) and every other surface
     /// (the height map walk over at most [`SEA_WALK_LIFT`] cells). Without waves, or from above the bound, the
-    /// origin as it is.
+    /// origin as it is. `leaves`: [`crate::sea::WaveSurface::leaves`] of the ray when already known.
     #[inline(always)]
     #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > b)` on purpose: a NaN must answer "not known"
-    fn lift_over_waves(&self, sea: &crate::sea::Sea, o: [f32; 3], d: [f32; 3], limit: f32) -> Lift {
+    fn lift_over_waves(
+        &self,
+        sea: &crate::sea::Sea,
+        o: [f32; 3],
+        d: [f32; 3],
+        limit: f32,
+        leaves: Option<bool>,
+    ) -> Lift {
         let mut top = sea.surface_top();
         if o[2] > top {
             return Lift::Above(o);
@@ -147,7 +154,7 @@ impl Scene {
         if !(d[2] > 0.0) {
             return Lift::Unknown;
         }
-        let leaves = w.leaves(o, d);
+        let leaves = leaves.unwrap_or_else(|| w.leaves(o, d));
         if leaves {
             top = sea.level;
             if o[2] > top {
@@ -176,7 +183,12 @@ impl Scene {
         if !(ray.d[2] > 0.0) {
             return false;
         }
-        let (o, limit) = match self.lift_over_waves(sea, ray.o, ray.d, limit) {
+        let known = match ray.leaves {
+            LEAVES_YES => Some(true),
+            LEAVES_NO => Some(false),
+            _ => None,
+        };
+        let (o, limit) = match self.lift_over_waves(sea, ray.o, ray.d, limit, known) {
             Lift::Above(o) if o == ray.o => (o, limit),
             Lift::Above(o) => {
                 let t = (o[2] - ray.o[2]) / ray.d[2];

@@ -6,7 +6,7 @@
 use super::{Hit, Scene};
 use crate::bvh::{Packet, PACKET};
 use crate::error::{MmusvError, Result};
-use crate::ray::RayPrep;
+use crate::ray::{RayPrep, LEAVES_NO, LEAVES_UNKNOWN, LEAVES_YES};
 use crate::sea::WaveSurface;
 use parry3d::math::Vec3;
 use std::sync::Arc;
@@ -51,12 +51,34 @@ impl Scene {
         self.waves.is_some() && self.hidden_instance() == instance
     }
 
+    /// Whether `ray` leaves the water ([`WaveSurface::leaves`]; false without a wave surface), read from the
+    /// ray when its batch worked it out ([`RayPrep::leaves`]).
+    #[inline(always)]
+    pub(super) fn ray_leaves(&self, ray: &RayPrep) -> bool {
+        match ray.leaves {
+            LEAVES_YES => true,
+            LEAVES_NO => false,
+            _ => self.waves.as_ref().is_some_and(|w| w.leaves(ray.o, ray.d)),
+        }
+    }
+
+    /// Works out [`RayPrep::leaves`] of `rays` once (with a wave surface; left unknown without one).
+    #[inline(always)]
+    pub(super) fn mark_leaves(&self, rays: &mut [RayPrep]) {
+        let Some(w) = &self.waves else { return };
+        for r in rays {
+            if r.leaves == LEAVES_UNKNOWN {
+                r.leaves = if w.leaves(r.o, r.d) { LEAVES_YES } else { LEAVES_NO };
+            }
+        }
+    }
+
     /// The ray's hit with the wave surface below `limit`, as a hit on the sea instance.
     /// Rays leaving the water ([`WaveSurface::leaves`]) meet none.
     #[inline(always)]
     pub(super) fn wave_hit(&self, ray: &RayPrep, limit: f32) -> Option<Hit> {
         let w = self.waves.as_ref()?;
-        if w.leaves(ray.o, ray.d) {
+        if self.ray_leaves(ray) {
             return None;
         }
         let h = w.intersect(ray.o, ray.d, limit)?;
@@ -70,7 +92,7 @@ impl Scene {
         let w = self.waves.as_ref()?;
         let mut pieces = [u32::MAX; PACKET];
         for r in 0..p.n {
-            if p.best[r] < 0.0 || w.leaves(p.ray[r].o, p.ray[r].d) {
+            if p.best[r] < 0.0 || self.ray_leaves(&p.ray[r]) {
                 continue;
             }
             if let Some(h) = w.intersect(p.ray[r].o, p.ray[r].d, p.best[r]) {
@@ -87,7 +109,7 @@ impl Scene {
         let Some(w) = &self.waves else { return };
         for r in 0..p.n {
             let ray = &p.ray[r];
-            if p.best[r] >= 0.0 && !w.leaves(ray.o, ray.d) && w.occludes(ray.o, ray.d, p.best[r]) {
+            if p.best[r] >= 0.0 && !self.ray_leaves(ray) && w.occludes(ray.o, ray.d, p.best[r]) {
                 p.best[r] = -1.0;
             }
         }
