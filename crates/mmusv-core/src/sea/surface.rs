@@ -18,9 +18,10 @@
 //!
 //! Heights and slopes `∇η` (for smooth shading normals, [`WaveSurface::shading_normal`]) are summed per tile by
 //! a two-dimensional phasor recurrence: every component's `a e^{iψ}` at a tile's corner comes from the
-//! rectangle's corner by one rotation per tile column and row (tabulated once per frame), then one rotation per
-//! node column and row inside the tile; the only `sin_cos` calls are a few per component and frame, and the
-//! inner loop is a vectorisable multiply-add over a row of nodes (the same values as
+//! rectangle's corner by one rotation per tile column and row (tabulated once per frame), then one product with
+//! the level's tabulated powers per node column and row inside the tile (independent products, no chain of
+//! rotations); the only `sin_cos` calls are a few per component and frame, and the inner loop is a vectorisable
+//! multiply-add over a row of nodes (the same values as
 //! [`crate::ocean::WaveField::elevation_slope_grid`] to rounding, tested).
 
 use crate::ocean::WaveComponent;
@@ -606,8 +607,10 @@ struct Phasors<'a> {
     col: Vec<C64>,
     /// `[iy · ncomp + c]`: `e^{i ky iy tile_m}`.
     row: Vec<C64>,
-    /// `[level · ncomp + c]`: `(e^{i kx d}, e^{i ky d})` for the node step `d` of that level.
-    step: Vec<(C64, C64)>,
+    /// Per level, `[c · w + i]`: `(e^{i kx d i}, e^{i ky d i})` for the node step `d` of that level and the
+    /// level's `w` nodes a side (the powers tabulated once per frame, so a tile's nodes need no chain of
+    /// rotations: every node's phasor is one product, independent of the others).
+    powers: Vec<Vec<(C64, C64)>>,
 }
 
 impl<'a> Phasors<'a> {
@@ -616,7 +619,8 @@ impl<'a> Phasors<'a> {
         let tm = f64::from(tile_m);
         let mut col = vec![(0.0, 0.0); ntx * nc];
         let mut row = vec![(0.0, 0.0); nty * nc];
-        let mut step = vec![((0.0, 0.0), (0.0, 0.0)); (MAX_LEVEL as usize + 1) * nc];
+        let mut powers: Vec<Vec<(C64, C64)>> =
+            (0..=MAX_LEVEL).map(|l| vec![((1.0, 0.0), (1.0, 0.0)); nc * ((TILE_CELLS >> l) + 1)]).collect();
         for (c, w) in comps.iter().enumerate() {
             let base = cis(w.phase_at(f64::from(x0), f64::from(y0), t));
             let (ex, ey) = (cis(w.kx * tm), cis(w.ky * tm));
@@ -630,12 +634,19 @@ impl<'a> Phasors<'a> {
                 row[iy * nc + c] = q;
                 q = cmul(q, ey);
             }
-            for lvl in 0..=MAX_LEVEL as usize {
-                let d = tm / (TILE_CELLS >> lvl) as f64;
-                step[lvl * nc + c] = (cis(w.kx * d), cis(w.ky * d));
+            for (lvl, table) in powers.iter_mut().enumerate() {
+                let n = TILE_CELLS >> lvl;
+                let d = tm / n as f64;
+                let (sx, sy) = (cis(w.kx * d), cis(w.ky * d));
+                let (mut px, mut py) = ((1.0, 0.0), (1.0, 0.0));
+                for i in 0..=n {
+                    table[c * (n + 1) + i] = (px, py);
+                    px = cmul(px, sx);
+                    py = cmul(py, sy);
+                }
             }
         }
-        Self { comps, x0, y0, tile_m, col, row, step }
+        Self { comps, x0, y0, tile_m, col, row, powers }
     }
 
     /// Samples tile `(ix, iy)`: its level from the distance of its centre to the nearest focus, flat when wholly
@@ -656,17 +667,18 @@ impl<'a> Phasors<'a> {
         let mut sx = vec![0f32; w * w];
         let mut sy = vec![0f32; w * w];
         let (mut pr, mut pi) = (vec![0f32; w], vec![0f32; w]);
+        let table = &self.powers[lvl as usize];
         for (c, comp) in self.comps.iter().enumerate() {
-            let (stx, sty) = self.step[lvl as usize * nc + c];
-            let mut p = cmul(self.col[ix * nc + c], self.row[iy * nc + c]);
+            let pw = &table[c * w..(c + 1) * w];
+            let p = cmul(self.col[ix * nc + c], self.row[iy * nc + c]);
             for i in 0..w {
-                pr[i] = p.0 as f32;
-                pi[i] = p.1 as f32;
-                p = cmul(p, stx);
+                let v = cmul(p, pw[i].0);
+                pr[i] = v.0 as f32;
+                pi[i] = v.1 as f32;
             }
             let (kx, ky) = (comp.kx as f32, comp.ky as f32);
-            let mut q: C64 = (1.0, 0.0);
             for j in 0..w {
+                let q = pw[j].1;
                 let (fr, fi) = (q.0 as f32, q.1 as f32);
                 let rows = j * w..(j + 1) * w;
                 let (e, gx, gy) = (&mut eta[rows.clone()], &mut sx[rows.clone()], &mut sy[rows]);
@@ -678,7 +690,6 @@ impl<'a> Phasors<'a> {
                     gx[i] -= kx * im;
                     gy[i] -= ky * im;
                 }
-                q = cmul(q, sty);
             }
         }
         let mut h = vec![0f32; w * w];
