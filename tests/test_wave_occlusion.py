@@ -199,3 +199,44 @@ def test_recordings_carry_the_shares_as_annotated(tmp_path: Path) -> None:
             for b in msg.boxes_camera:
                 msg2[(msg.frame, msg.agent_id, b.camera, b.target_id)] = b.wave_occlusion
     assert msg3 == want3 and msg2 == want2
+
+
+def _box_beams_by_testing_every_beam(pattern: np.ndarray, pose: np.ndarray, corners: np.ndarray) -> np.ndarray:
+    """Indices of the beams within the box's azimuth and elevation extent, every beam tested (the definition)."""
+    p = np.asarray(pattern, dtype=np.float64)
+    paz, pel = np.arctan2(p[:, 1], p[:, 0]), np.arctan2(p[:, 2], np.hypot(p[:, 0], p[:, 1]))
+    inv = np.linalg.inv(pose)
+    c = corners @ inv[:3, :3].T + inv[:3, 3]
+    az, el = np.arctan2(c[:, 1], c[:, 0]), np.arctan2(c[:, 2], np.hypot(c[:, 0], c[:, 1]))
+    mid = np.arctan2(np.sin(az).mean(), np.cos(az).mean())
+    rel = np.angle(np.exp(1j * (az - mid)))
+    inside = (pel >= el.min()) & (pel <= el.max())
+    prel = np.angle(np.exp(1j * (paz - mid)))
+    return np.flatnonzero(inside & (prel >= rel.min()) & (prel <= rel.max()))
+
+
+def test_lidar_box_rays_find_the_beams_that_testing_every_beam_finds() -> None:
+    """The binary search over sorted azimuths selects exactly the beams a test of every beam selects, boxes
+    behind the LiDAR (straddling ±π) and boxes wider than half a turn included."""
+    el = np.deg2rad(np.linspace(-25.0, 15.0, 64))
+    az = np.linspace(-np.pi, np.pi, 512, endpoint=False)
+    a, e = np.meshgrid(az, el, indexing="ij")
+    pattern = np.stack([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)], -1).reshape(-1, 3)
+    pattern = pattern.astype(np.float32)
+    angles = pattern_angles(pattern)
+    rng = np.random.default_rng(3)
+    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=np.float64)
+    for k in range(200):
+        th = rng.uniform(-np.pi, np.pi)
+        pose = np.eye(4)
+        pose[:2, :2] = [[np.cos(th), -np.sin(th)], [np.sin(th), np.cos(th)]]
+        pose[:3, 3] = rng.normal(size=3) * 5.0
+        centre = np.array([rng.uniform(-200, 200), rng.uniform(-200, 200), rng.uniform(0, 10)])
+        if k % 4 == 0:  # straight behind the sensor: the box straddles azimuth ±π
+            centre[:2] = pose[:2, 3] - 80.0 * pose[:2, 0]
+        half = rng.uniform([1.0, 0.5, 0.5], [150.0, 20.0, 15.0])
+        corners = centre + half * signs
+        _, dirs = lidar_box_rays(pattern, angles, pose, corners)
+        want = _box_beams_by_testing_every_beam(pattern, pose, corners)
+        expected = (pattern.astype(np.float64)[want] @ pose[:3, :3].T).astype(np.float32)
+        assert dirs.shape == expected.shape and np.array_equal(dirs, expected), k

@@ -17,12 +17,14 @@ Frames: world x east, y north, z up, metres; directions need not be unit length.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 import numpy.typing as npt
 
 from mmusv.scene import Scene
 
-__all__ = ["exposed_hidden", "lidar_box_rays", "pattern_angles", "share"]
+__all__ = ["BeamAngles", "exposed_hidden", "lidar_box_rays", "pattern_angles", "share"]
 
 
 def share(exposed: int, hidden: int) -> float:
@@ -66,34 +68,82 @@ def exposed_hidden(
     return n, int(np.count_nonzero(first == water))
 
 
-def pattern_angles(pattern: npt.NDArray[np.float32]) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
-    """``(azimuth, elevation)`` ``(M,)`` radians of a LiDAR's unit beam directions ``pattern`` ``(M, 3)`` (LiDAR
-    frame); compute once per LiDAR and pass to :func:`lidar_box_rays`."""
-    p = np.asarray(pattern, dtype=np.float64)
-    return np.arctan2(p[:, 1], p[:, 0]), np.arctan2(p[:, 2], np.hypot(p[:, 0], p[:, 1]))
+class BeamAngles(NamedTuple):
+    """A LiDAR pattern's beam angles (:func:`pattern_angles`): ``az``, ``el`` ``(M,)`` radians in pattern order,
+    and the beams sorted by azimuth (``order``, ``az_sorted``) to find a box's beams without testing them all."""
+
+    az: npt.NDArray[np.float64]
+    el: npt.NDArray[np.float64]
+    order: npt.NDArray[np.int64]
+    az_sorted: npt.NDArray[np.float64]
+
+
+_ANGLES: dict[tuple[tuple[int, ...], int], BeamAngles] = {}
+
+
+def pattern_angles(pattern: npt.NDArray[np.float32]) -> BeamAngles:
+    """The :class:`BeamAngles` (azimuth, elevation, radians) of a LiDAR's unit beam directions ``pattern``
+    ``(M, 3)`` (LiDAR frame), to pass to :func:`lidar_box_rays`. Remembered by content: a rig's pattern is worked
+    out once, not per frame."""
+    p = np.ascontiguousarray(pattern, dtype=np.float32)
+    key = (p.shape, hash(p.tobytes()))
+    hit = _ANGLES.get(key)
+    if hit is not None:
+        return hit
+    q = p.astype(np.float64)
+    az = np.arctan2(q[:, 1], q[:, 0])
+    el = np.arctan2(q[:, 2], np.hypot(q[:, 0], q[:, 1]))
+    order = np.argsort(az, kind="stable")
+    out = BeamAngles(az, el, order, az[order])
+    if len(_ANGLES) >= 16:
+        _ANGLES.clear()
+    _ANGLES[key] = out
+    return out
 
 
 def lidar_box_rays(
     pattern: npt.NDArray[np.float32],
-    angles: tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]],
+    angles: BeamAngles,
     lidar_pose: npt.NDArray[np.float64],
     corners_world: npt.NDArray[np.float64],
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
-    """The LiDAR's world rays ``(origins, directions)`` (each ``(K, 3)`` float32) whose direction lies within the
-    azimuth and elevation extent of the box ``corners_world`` ``(8, 3)`` seen from the LiDAR at ``lidar_pose``
-    ``(4, 4)`` LiDAR → world; ``pattern`` ``(M, 3)`` unit directions in the LiDAR frame, ``angles`` their
-    :func:`pattern_angles`."""
+    """The LiDAR's world rays ``(origins, directions)`` (each ``(K, 3)`` float32, in pattern order) whose
+    direction lies within the azimuth and elevation extent of the box ``corners_world`` ``(8, 3)`` seen from the
+    LiDAR at ``lidar_pose`` ``(4, 4)`` LiDAR → world; ``pattern`` ``(M, 3)`` unit directions in the LiDAR frame,
+    ``angles`` their :func:`pattern_angles`."""
     inv = np.linalg.inv(lidar_pose)
     c = corners_world @ inv[:3, :3].T + inv[:3, 3]
     az = np.arctan2(c[:, 1], c[:, 0])
     el = np.arctan2(c[:, 2], np.hypot(c[:, 0], c[:, 1]))
-    paz, pel = angles
     # Azimuths relative to the box's mean direction, so a box straddling ±π is one interval.
     mid = np.arctan2(np.sin(az).mean(), np.cos(az).mean())
     rel = np.angle(np.exp(1j * (az - mid)))
+    # Candidates: the beams whose azimuth lies in the window (a margin wider, wrapped into [-π, π]) by binary
+    # search on the sorted azimuths; the exact test below then keeps what testing every beam would keep.
+    lo, hi = mid + rel.min() - 1e-6, mid + rel.max() + 1e-6
+    cand = _azimuth_window(angles, lo, hi)
+    paz, pel = angles.az[cand], angles.el[cand]
     near = (pel >= el.min()) & (pel <= el.max())
     prel = np.angle(np.exp(1j * (paz[near] - mid)))
-    idx = np.flatnonzero(near)[(prel >= rel.min()) & (prel <= rel.max())]
+    idx = cand[near][(prel >= rel.min()) & (prel <= rel.max())]
     dirs = (np.asarray(pattern, dtype=np.float64)[idx] @ lidar_pose[:3, :3].T).astype(np.float32)
     origins = np.tile(lidar_pose[:3, 3].astype(np.float32), (dirs.shape[0], 1))
     return origins, dirs
+
+
+def _azimuth_window(angles: BeamAngles, lo: float, hi: float) -> npt.NDArray[np.int64]:
+    """Pattern indices (ascending) of the beams with azimuth in ``[lo, hi]`` taken modulo 2π (all beams when the
+    window spans a whole turn)."""
+    width = hi - lo
+    if width >= 2 * np.pi:
+        return np.arange(angles.az.shape[0])
+    start = (lo + np.pi) % (2 * np.pi) - np.pi  # in [-π, π)
+    end = start + width
+    s = angles.az_sorted
+    a = int(np.searchsorted(s, start, side="left"))
+    if end <= np.pi:
+        idx = angles.order[a : int(np.searchsorted(s, end, side="right"))]
+    else:  # the window wraps past π
+        b = int(np.searchsorted(s, end - 2 * np.pi, side="right"))
+        idx = np.concatenate([angles.order[a:], angles.order[:b]])
+    return np.sort(idx)
