@@ -240,3 +240,17 @@ def test_lidar_box_rays_find_the_beams_that_testing_every_beam_finds() -> None:
         want = _box_beams_by_testing_every_beam(pattern, pose, corners)
         expected = (pattern.astype(np.float64)[want] @ pose[:3, :3].T).astype(np.float32)
         assert dirs.shape == expected.shape and np.array_equal(dirs, expected), k
+
+
+def test_pattern_angles_are_remembered_by_content() -> None:
+    """The same pattern twice gives the remembered angles; another pattern its own (not a stale entry)."""
+    rng = np.random.default_rng(5)
+    for _ in range(3):
+        p = rng.normal(size=(257, 3)).astype(np.float32)
+        p /= np.linalg.norm(p, axis=1, keepdims=True)
+        first, again = pattern_angles(p), pattern_angles(p.copy())
+        assert again is first
+        q = p.astype(np.float64)
+        np.testing.assert_array_equal(first.az, np.arctan2(q[:, 1], q[:, 0]))
+        np.testing.assert_array_equal(first.el, np.arctan2(q[:, 2], np.hypot(q[:, 0], q[:, 1])))
+        np.testing.assert_array_equal(first.az_sorted, np.sort(first.az))

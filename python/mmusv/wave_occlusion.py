@@ -78,7 +78,7 @@ class BeamAngles(NamedTuple):
     az_sorted: npt.NDArray[np.float64]
 
 
-_ANGLES: dict[tuple[tuple[int, ...], int], BeamAngles] = {}
+_ANGLES: dict[tuple[tuple[int, ...], int], tuple[npt.NDArray[np.float32], BeamAngles]] = {}
 
 
 def pattern_angles(pattern: npt.NDArray[np.float32]) -> BeamAngles:
@@ -88,8 +88,8 @@ def pattern_angles(pattern: npt.NDArray[np.float32]) -> BeamAngles:
     p = np.ascontiguousarray(pattern, dtype=np.float32)
     key = (p.shape, hash(p.tobytes()))
     hit = _ANGLES.get(key)
-    if hit is not None:
-        return hit
+    if hit is not None and np.array_equal(hit[0], p):  # a hash is not proof: the pattern itself is compared
+        return hit[1]
     q = p.astype(np.float64)
     az = np.arctan2(q[:, 1], q[:, 0])
     el = np.arctan2(q[:, 2], np.hypot(q[:, 0], q[:, 1]))
@@ -97,7 +97,7 @@ def pattern_angles(pattern: npt.NDArray[np.float32]) -> BeamAngles:
     out = BeamAngles(az, el, order, az[order])
     if len(_ANGLES) >= 16:
         _ANGLES.clear()
-    _ANGLES[key] = out
+    _ANGLES[key] = (p.copy(), out)
     return out
 
 
