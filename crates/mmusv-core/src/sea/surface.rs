@@ -506,20 +506,15 @@ impl March<'_> {
         let mut g = Dda::new(self, ta, corner, cs, inv_cs, lo, hi);
         let base = (k * 2 * TILE_CELLS * TILE_CELLS) as u32;
         let mut t = ta;
-        let w = n + 1;
-        let h = &tile.h;
         loop {
             let t_exit = g.exit().min(tb);
             if t_exit >= t {
                 let [ci, cj] = g.cell;
-                let (h00, h10) = (h[cj * w + ci], h[cj * w + ci + 1]);
-                let (h01, h11) = (h[(cj + 1) * w + ci], h[(cj + 1) * w + ci + 1]);
-                let cmax = h00.max(h10).max(h01).max(h11);
+                let (plane, cmax) = cell_planes(tile, ci, cj);
                 let (zt, ze) = (self.z(t), self.z(t_exit));
                 if zt.min(ze) > cmax && self.above != Some(false) {
                     self.above = Some(true);
                 } else {
-                    let plane = [[h00, h10 - h00, h11 - h10], [h00, h11 - h01, h01 - h00]];
                     let id = base + 2 * (cj * n + ci) as u32;
                     // Local (fu, fv) at t: u(t) - ci.
                     let fu = |t: f32| u0 + du * t - ci as f32;
