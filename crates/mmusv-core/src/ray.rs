@@ -50,6 +50,16 @@ impl RayPrep {
         let sz = 1.0 / d[kz]; // d[kz] is the largest component, never zero for a non-zero direction
         Self { o, d, inv, near: near_planes(inv), k, s: [d[kx] * sz, d[ky] * sz], leaves: LEAVES_UNKNOWN }
     }
+
+    /// [`RayPrep::leaves`] as known: `Some(leaves)` once a batch worked it out, else `None`.
+    #[inline(always)]
+    pub fn leaves_known(&self) -> Option<bool> {
+        match self.leaves {
+            LEAVES_YES => Some(true),
+            LEAVES_NO => Some(false),
+            _ => None,
+        }
+    }
 }
 
 /// `1 / x`, with components below `1e-20` in magnitude clamped to `±1e20` (no `inf · 0` in slab tests).

@@ -4,7 +4,7 @@
 use super::Scene;
 use crate::bvh::Box3;
 use crate::error::{MmusvError, Result};
-use crate::ray::{RayPrep, LEAVES_NO, LEAVES_YES};
+use crate::ray::RayPrep;
 use crate::sea::{Horizon, Sea, SunMask};
 
 /// Longest height-map walks (cells) worth trying before a full trace: up into the sky (camera rays, which ask
@@ -183,12 +183,7 @@ impl Scene {
         if !(ray.d[2] > 0.0) {
             return false;
         }
-        let known = match ray.leaves {
-            LEAVES_YES => Some(true),
-            LEAVES_NO => Some(false),
-            _ => None,
-        };
-        let (o, limit) = match self.lift_over_waves(sea, ray.o, ray.d, limit, known) {
+        let (o, limit) = match self.lift_over_waves(sea, ray.o, ray.d, limit, ray.leaves_known()) {
             Lift::Above(o) if o == ray.o => (o, limit),
             Lift::Above(o) => {
                 let t = (o[2] - ray.o[2]) / ray.d[2];

@@ -55,11 +55,7 @@ impl Scene {
     /// ray when its batch worked it out ([`RayPrep::leaves`]).
     #[inline(always)]
     pub(super) fn ray_leaves(&self, ray: &RayPrep) -> bool {
-        match ray.leaves {
-            LEAVES_YES => true,
-            LEAVES_NO => false,
-            _ => self.waves.as_ref().is_some_and(|w| w.leaves(ray.o, ray.d)),
-        }
+        ray.leaves_known().unwrap_or_else(|| self.waves.as_ref().is_some_and(|w| w.leaves(ray.o, ray.d)))
     }
 
     /// Works out [`RayPrep::leaves`] of `rays` once (with a wave surface; left unknown without one).
