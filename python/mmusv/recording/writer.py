@@ -337,9 +337,8 @@ class Recording:
         lid.setdefault("wave_occlusion", np.zeros(n))
         cam.setdefault("wave_occlusion", np.zeros(k))
         lidar_spec = (("center", 3), ("size", 3), ("rotation", 4), ("yaw", 1), ("range_m", 1), ("wave_occlusion", 1))
-        camera_spec = (
-            *((k, 1) for k in ("x_min", "y_min", "x_max", "y_max", "truncation", "occlusion", "wave_occlusion")),
-        )
+        camera_keys = ("x_min", "y_min", "x_max", "y_max", "truncation", "occlusion", "wave_occlusion")
+        camera_spec = [(key, 1) for key in camera_keys]
         self._rec.annotations(
             topic,
             log_time_ns=log_time_ns,
