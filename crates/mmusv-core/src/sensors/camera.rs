@@ -426,36 +426,17 @@ impl Camera {
             .with_materials(scene.material_table())
             .with_seabed(scene.seabed())
             .with_waves(scene.wave_surface());
-        // Standard quality shares one traced reflection per 2 × 2 block of water pixels; high traces each.
-        let block = |k: usize| {
-            let [x, y] = self.pos[k].map(u32::from);
-            self.rank[((y & !1) * self.cfg.width + (x & !1)) as usize] as usize
-        };
+        // Standard quality shares one traced reflection per 2 × 2 block of water pixels; high traces each. Below
+        // `high`, open water and sky share their shading over the pixels between even rows and columns wherever
+        // the even pixels around agree (radiance::radiance).
+        let grid =
+            radiance::PixelGrid { width: self.cfg.width, height: self.cfg.height, pos: &self.pos, rank: &self.rank };
         let refl = match q {
             Quality::Draft => Reflections::Sky,
-            Quality::Standard => Reflections::Shared(&block),
+            Quality::Standard => Reflections::Shared(grid),
             Quality::High => Reflections::Every,
         };
-        // Below `high`, open water and sky share their shading over the pixels between even rows and columns
-        // wherever the even pixels around agree (radiance::radiance).
-        let w = self.cfg.width;
-        let anchors = |k: usize| -> ([u32; 4], usize) {
-            let [x, y] = self.pos[k].map(u32::from);
-            let xs: &[u32] = if x & 1 == 0 { &[x, x] } else { &[x - 1, x + 1] };
-            let ys: &[u32] = if y & 1 == 0 { &[y, y] } else { &[y - 1, y + 1] };
-            let (nx, ny) = (1 + (x & 1) as usize, 1 + (y & 1) as usize);
-            if nx * ny == 1 || xs[nx - 1] >= w || ys[ny - 1] >= self.cfg.height {
-                return ([0; 4], 0);
-            }
-            let mut ids = [0u32; 4];
-            for (a, &yy) in ys[..ny].iter().enumerate() {
-                for (b, &xx) in xs[..nx].iter().enumerate() {
-                    ids[a * nx + b] = self.rank[(yy * w + xx) as usize];
-                }
-            }
-            (ids, nx * ny)
-        };
-        let shared: Option<radiance::Anchors<'_>> = if q == Quality::High { None } else { Some(&anchors) };
+        let shared = if q == Quality::High { None } else { Some(grid) };
         let traced = radiance::radiance(scene, &shader, env.shadows, refl, shared, (&origins, &dirs, &hits))?;
         let mut linear = vec![Vec3::ZERO; n];
         for (k, &i) in self.order.iter().enumerate() {
@@ -515,6 +496,10 @@ impl Camera {
             let noise = self.cfg.image.noise;
             let mut out = vec![0u8; 3 * n];
             out.par_chunks_mut(3 * w).zip(linear.par_chunks(w)).enumerate().for_each(|(row, (px, cs))| {
+                if noise.is_none() {
+                    tonemap::to_srgb8_all(cs, k, px);
+                    return;
+                }
                 for (j, c) in cs.iter().enumerate() {
                     let mut x = *c * k;
                     if let Some(nz) = noise {
@@ -620,6 +605,44 @@ fn edge_pixels(frame: &CameraFrame, surface: &[u64], contrast: impl Fn(usize, us
 mod tests {
     use super::*;
     use crate::mesh::Mesh;
+
+    /// The pixel grid's anchors, in the camera's trace order, are the pixels at even rows and columns around
+    /// each pixel (by brute force over the whole image, odd sizes included), and its block is the even corner.
+    #[test]
+    fn anchors_are_the_even_pixels_around() {
+        let cfg = CameraConfig {
+            width: 7,
+            height: 5,
+            projection: Projection::Pinhole { hfov: 1.5 },
+            range_max: 100.0,
+            image: Default::default(),
+        };
+        let Ok(cam) = Camera::new(cfg) else { panic!("a valid camera") };
+        let grid = radiance::PixelGrid { width: 7, height: 5, pos: &cam.pos, rank: &cam.rank };
+        for (k, &i) in cam.order.iter().enumerate() {
+            let (x, y) = ((i % 7) as i64, (i / 7) as i64);
+            let mut want: Vec<(i64, i64)> = Vec::new();
+            for yy in [y - 1, y, y + 1] {
+                for xx in [x - 1, x, x + 1] {
+                    if xx % 2 == 0 && yy % 2 == 0 && (xx - x).abs() + (yy - y).abs() == (x % 2) + (y % 2) {
+                        want.push((xx, yy));
+                    }
+                }
+            }
+            let inside = want.iter().all(|&(xx, yy)| (0..7).contains(&xx) && (0..5).contains(&yy));
+            if (x % 2, y % 2) == (0, 0) || !inside {
+                want.clear();
+            }
+            let (ids, m) = grid.anchors(k);
+            let mut got: Vec<(i64, i64)> =
+                ids[..m].iter().map(|&j| cam.order[j as usize]).map(|p| ((p % 7) as i64, (p / 7) as i64)).collect();
+            got.sort_unstable();
+            want.sort_unstable();
+            assert_eq!(got, want, "pixel ({x}, {y})");
+            let b = cam.order[grid.block(k)];
+            assert_eq!(((b % 7) as i64, (b / 7) as i64), (x & !1, y & !1));
+        }
+    }
 
     fn ground_with_box() -> Scene {
         let mut s = Scene::new();

@@ -61,6 +61,32 @@ pub fn to_srgb8(c: Vec3, k: f32) -> [u8; 3] {
     [enc(c.x), enc(c.y), enc(c.z)]
 }
 
+/// Colours tone-mapped per block of [`to_srgb8_all`].
+const BLOCK: usize = 8;
+
+crate::dispatch! {
+    /// [`to_srgb8`] of every colour of `linear` under exposure `k`, into `out` (three bytes per colour, as many
+    /// colours as both hold): the same bytes, [`BLOCK`] colours at a time, so that the tone curve's arithmetic
+    /// runs in vector lanes (the table lookups stay one by one).
+    pub fn to_srgb8_all(linear: &[Vec3], k: f32, out: &mut [u8]) {
+        let lut = srgb_lut();
+        for (cs, px) in linear.chunks(BLOCK).zip(out.chunks_mut(3 * BLOCK)) {
+            let mut v = [0f32; 3 * BLOCK];
+            for (j, c) in cs.iter().enumerate() {
+                v[3 * j..3 * j + 3].copy_from_slice(&[c.x * k, c.y * k, c.z * k]);
+            }
+            let mut idx = [0u32; 3 * BLOCK];
+            for (i, x) in idx.iter_mut().zip(v) {
+                *i = ((aces(x) * (SRGB_LUT - 1) as f32 + 0.5) as u32).min(SRGB_LUT as u32 - 1);
+            }
+            let m = px.len().min(3 * cs.len());
+            for (p, &i) in px[..m].iter_mut().zip(&idx) {
+                *p = lut[i as usize];
+            }
+        }
+    }
+}
+
 /// Shot and read noise of a sensor (electrons).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SensorNoise {
@@ -105,6 +131,26 @@ mod tests {
         assert_eq!(srgb8(1.0), 255);
         // 0.5 display-linear is sRGB 188.
         assert_eq!(srgb8(0.5), 188);
+    }
+
+    /// The blockwise tone mapping gives [`to_srgb8`]'s bytes for every colour, odd lengths, out-of-range and
+    /// non-finite values included.
+    #[test]
+    fn tone_mapping_a_whole_image_matches_pixel_by_pixel() {
+        let mut state = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let mut colours: Vec<Vec3> = (0..1001).map(|_| Vec3::new(next() * 3.0, next() * 0.01, next() * 40.0)).collect();
+        colours.extend([Vec3::splat(-1.0), Vec3::splat(f32::NAN), Vec3::splat(f32::INFINITY), Vec3::ZERO]);
+        for k in [1.0f32, 0.37, 2.0e-4] {
+            let mut out = vec![0u8; 3 * colours.len()];
+            to_srgb8_all(&colours, k, &mut out);
+            for (c, px) in colours.iter().zip(out.chunks(3)) {
+                assert_eq!(px, to_srgb8(*c, k), "{c:?} at {k}");
+            }
+        }
     }
 
     #[test]
