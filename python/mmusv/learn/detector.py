@@ -7,7 +7,8 @@ holding ``single/``, ``early/`` and ``intermediate/`` sub-folders (what ``mmusv 
 fusion code (:func:`mmusv.studies.detection.fusion.fuse`) calls :meth:`LearnedDetector.early` on the aggregated
 cloud and :meth:`LearnedDetector.intermediate` with the ego and its neighbours (as delayed or noisy as the
 robustness setting makes them). :attr:`LearnedDetector.shared_bytes` records, per intermediate-fusion call, the
-bytes the neighbours sent (:func:`mmusv.learn.example.message_bytes`).
+bytes the neighbours sent (:func:`mmusv.learn.example.message_bytes`). By default the boxes of ``cpu``-preset
+models are tightened on the points by the geometric second stage of :mod:`mmusv.learn.refine` (``refine``).
 """
 
 from __future__ import annotations
@@ -24,6 +25,8 @@ from mmusv.learn.decode import decode
 from mmusv.learn.example import MODES, collate, make_example, message_bytes
 from mmusv.learn.model import PillarNet
 from mmusv.learn.presets import Preset
+from mmusv.learn.refine import RefineParams, refine_boxes
+from mmusv.studies.detection.fusion import rotated_nms
 
 __all__ = ["LearnedDetector", "load_models"]
 
@@ -40,9 +43,11 @@ def _load(path: Path, device: torch.device) -> tuple[PillarNet, dict[str, Any]]:
     return model, ck
 
 
-def load_models(path: str | Path, *, device: str = "cpu") -> LearnedDetector:
+def load_models(path: str | Path, *, device: str = "cpu", refine: bool | None = None) -> LearnedDetector:
     """The models at ``path`` (module docstring) as one detector; raises ``InputError`` naming the path when
-    there is none or one is unreadable."""
+    there is none or one is unreadable. ``refine``: apply the geometric second stage
+    (:mod:`mmusv.learn.refine`) to every model's boxes; ``None`` (default): only when every model is of the
+    ``cpu`` preset, the one it was measured on."""
     p = Path(path)
     dev = torch.device(device)
     files: dict[str, Path] = {}
@@ -63,14 +68,22 @@ def load_models(path: str | Path, *, device: str = "cpu") -> LearnedDetector:
             "step": int(ck["step"]),
             "preset": ck["preset"]["name"],
         }
-    return LearnedDetector(models, info)
+    if refine is None:
+        refine = all(v["preset"] == "cpu" for v in info.values())
+    return LearnedDetector(models, info, refine=RefineParams() if refine else None)
 
 
 class LearnedDetector:
-    """Trained models by training mode (``single``, ``early``, ``intermediate``; module docstring)."""
+    """Trained models by training mode (``single``, ``early``, ``intermediate``; module docstring). With
+    ``refine``, every model's decoded boxes go through :func:`mmusv.learn.refine.refine_boxes` on the points the
+    model was given (the aggregate for early fusion; the ego's own cloud for intermediate fusion, whose
+    neighbours send features, not points) and the preset's rotated NMS again (two proposals on one hull can grow
+    into the same box); the scores stay the network's."""
 
-    def __init__(self, models: dict[str, PillarNet], info: dict[str, dict[str, Any]]) -> None:
-        self.models, self.info = models, info
+    def __init__(
+        self, models: dict[str, PillarNet], info: dict[str, dict[str, Any]], *, refine: RefineParams | None = None
+    ) -> None:
+        self.models, self.info, self.refine = models, info, refine
         self.shared_bytes: list[int] = []
 
     @property
@@ -83,12 +96,24 @@ class LearnedDetector:
 
     def describe(self) -> str:
         """One line: each model's file, preset and the epochs it was trained for."""
-        return "; ".join(
+        models = "; ".join(
             f"{m}: {v['file']} (preset {v['preset']}, {v['epoch']} epochs, {v['step']} steps)"
             for m, v in self.info.items()
         )
+        second = self.refine.describe() if self.refine is not None else "no box refinement (network boxes as decoded)"
+        return f"{models}; {second}"
 
     def _run(
+        self, mode: str, ego: np.ndarray, neighbours: Sequence[tuple[np.ndarray, np.ndarray]]
+    ) -> tuple[np.ndarray, np.ndarray]:
+        boxes, scores = self._infer(mode, ego, neighbours)
+        if self.refine is None or len(boxes) == 0:
+            return boxes, scores
+        boxes = refine_boxes(ego, boxes, params=self.refine)
+        keep = rotated_nms(boxes, scores, iou_threshold=self.models[mode].preset.nms_iou)
+        return boxes[keep], scores[keep]
+
+    def _infer(
         self, mode: str, ego: np.ndarray, neighbours: Sequence[tuple[np.ndarray, np.ndarray]]
     ) -> tuple[np.ndarray, np.ndarray]:
         if mode not in self.models:

@@ -47,7 +47,9 @@ __all__ = [
     "BASELINE_NOTE",
     "BaselineParams",
     "Detector",
+    "above_water",
     "baseline_detect",
+    "closeness_axis",
     "fit_box",
     "load_detector",
     "water_plane",
@@ -108,6 +110,53 @@ def water_plane(points: np.ndarray, *, cell_m: float = 10.0, rounds: int = 3, to
     return np.asarray(coef, dtype=np.float64)
 
 
+def above_water(points: np.ndarray, params: BaselineParams | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Steps 1–2 of the module docstring: ``(N,)`` bool mask of the ``points`` ``(N, ≥3)`` (ego LiDAR frame,
+    metres) more than ``params.min_height_m`` above the fitted water plane and farther than
+    ``params.self_radius_m`` from the sensor, and that plane ``(a, b, c)`` (:func:`water_plane`)."""
+    prm = params or BaselineParams()
+    p = np.asarray(points, dtype=np.float64)
+    if p.shape[0] == 0:
+        return np.zeros(0, dtype=bool), np.zeros(3)
+    plane = water_plane(p, cell_m=prm.plane_cell_m)
+    height = p[:, 2] - (plane[0] * p[:, 0] + plane[1] * p[:, 1] + plane[2])
+    keep: np.ndarray = (height > prm.min_height_m) & (np.hypot(p[:, 0], p[:, 1]) > prm.self_radius_m)
+    return keep, plane
+
+
+def closeness_axis(xy: np.ndarray, *, d0_m: float = 0.1) -> np.ndarray | None:
+    """``(2,)`` unit direction of one side of the rectangle that best fits the BEV points ``xy`` ``(K, 2)`` as
+    seen from one place, by the closeness criterion of L-shape fitting (Zhang et al., "Efficient L-shape fitting
+    for vehicle detection using laser scanners", IEEE IV 2017): for a direction, each point's distance to the
+    nearer of the rectangle's two sides along each axis (the side the points lie closer to, as a whole), the
+    smaller of the two, floored at ``d0_m``; the score is the sum of the inverses. The candidate directions are
+    the edges of the points' convex hull (one of which the minimum-area rectangle has, by rotating calipers).
+    Unlike the minimum area, the criterion does not tie for an L of points: the rectangle on the hypotenuse of
+    a right triangle has the same area as the one on its legs. ``None`` for fewer than 3 points or collinear
+    ones."""
+    pts = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+    if pts.shape[0] < 3:
+        return None
+    hull = shapely.convex_hull(shapely.multipoints(pts))
+    if hull.geom_type != "Polygon":
+        return None
+    ring = np.asarray(hull.exterior.coords)
+    edges = np.diff(ring, axis=0)
+    edges = edges[np.hypot(edges[:, 0], edges[:, 1]) > 1e-9]
+    best, best_score = None, -1.0
+    for e in edges:
+        u = e / np.hypot(*e)
+        d = np.full(len(pts), np.inf)
+        for ax in (u, np.array([-u[1], u[0]])):
+            c = pts @ ax
+            lo, hi = c - c.min(), c.max() - c
+            d = np.minimum(d, lo if np.linalg.norm(lo) <= np.linalg.norm(hi) else hi)
+        score = float(np.sum(1.0 / np.maximum(d, d0_m)))
+        if score > best_score + 1e-9:
+            best, best_score = u, score
+    return best
+
+
 def fit_box(
     xy: np.ndarray,
     *,
@@ -116,21 +165,31 @@ def fit_box(
     min_width_m: float = 0.8,
     beam_ratio: float = 0.25,
     min_length_m: float = 3.0,
+    criterion: str = "area",
 ) -> np.ndarray:
-    """``(7,)`` box ``x, y, z, l, w, h, yaw`` of the BEV points ``xy`` ``(K, 2)`` (K ≥ 1): minimum-area
-    rectangle, length along the longer side, yaw in (-π/2, π/2]; a width under ``max(min_width_m, beam_ratio ·
-    length)`` is widened to it away from the origin (the sensor); a length under ``min_length_m`` is raised."""
+    """``(7,)`` box ``x, y, z, l, w, h, yaw`` of the BEV points ``xy`` ``(K, 2)`` (K ≥ 1): the bounding
+    rectangle chosen by ``criterion`` (``"area"``: the minimum-area one; ``"closeness"``:
+    :func:`closeness_axis`), length along the longer side, yaw in (-π/2, π/2]; a width under
+    ``max(min_width_m, beam_ratio · length)`` is widened to it away from the origin (the sensor); a length under
+    ``min_length_m`` is raised."""
     pts = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
-    rect = shapely.minimum_rotated_rectangle(shapely.multipoints(pts))
-    if rect.geom_type == "Polygon":
-        c = np.asarray(rect.exterior.coords)[:4]
-        e1, e2 = c[1] - c[0], c[2] - c[1]
-        centre = c.mean(axis=0)
-    else:  # a segment or a point
-        c = np.asarray(rect.coords) if rect.geom_type == "LineString" else pts[:1]
-        e1 = c[-1] - c[0] if len(c) > 1 else np.array([0.0, 0.0])
-        e2 = np.zeros(2)  # no extent across
-        centre = c.mean(axis=0)
+    axis = closeness_axis(pts) if criterion == "closeness" else None
+    if axis is not None:
+        across = np.array([-axis[1], axis[0]])
+        pu, pv = pts @ axis, pts @ across
+        e1, e2 = axis * float(np.ptp(pu)), across * float(np.ptp(pv))
+        centre = axis * (pu.min() + pu.max()) / 2.0 + across * (pv.min() + pv.max()) / 2.0
+    else:
+        rect = shapely.minimum_rotated_rectangle(shapely.multipoints(pts))
+        if rect.geom_type == "Polygon":
+            c = np.asarray(rect.exterior.coords)[:4]
+            e1, e2 = c[1] - c[0], c[2] - c[1]
+            centre = c.mean(axis=0)
+        else:  # a segment or a point
+            c = np.asarray(rect.coords) if rect.geom_type == "LineString" else pts[:1]
+            e1 = c[-1] - c[0] if len(c) > 1 else np.array([0.0, 0.0])
+            e2 = np.zeros(2)  # no extent across
+            centre = c.mean(axis=0)
     if np.hypot(*e2) > np.hypot(*e1):
         e1, e2 = e2, e1
     length, width = float(np.hypot(*e1)), float(np.hypot(*e2))
@@ -162,9 +221,7 @@ def baseline_detect(points: np.ndarray, params: BaselineParams | None = None) ->
     p = np.asarray(points, dtype=np.float64).reshape(-1, 4) if np.size(points) else np.zeros((0, 4))
     if p.shape[0] == 0:
         return np.zeros((0, 7)), np.zeros(0)
-    a, b, c = water_plane(p, cell_m=prm.plane_cell_m)
-    height = p[:, 2] - (a * p[:, 0] + b * p[:, 1] + c)
-    keep = (height > prm.min_height_m) & (np.hypot(p[:, 0], p[:, 1]) > prm.self_radius_m)
+    keep, (a, b, c) = above_water(p, prm)
     q = p[keep]
     if q.shape[0] < prm.min_points:
         return np.zeros((0, 7)), np.zeros(0)

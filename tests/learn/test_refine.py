@@ -1,0 +1,119 @@
+"""The geometric second stage (mmusv.learn.refine) on hand-built clouds, checked with shapely's own polygon IoU."""
+
+from __future__ import annotations
+
+import numpy as np
+import shapely
+from mmusv.learn.refine import RefineParams, refine_boxes
+
+WATER_Z = -2.3  # the water 2.3 m below the sensor
+
+
+def polygon(box: np.ndarray) -> shapely.Polygon:
+    """The BEV rectangle of ``(7,)`` ``box``, built here (not with the study's box_polygons)."""
+    x, y, _, ln, wd, _, yaw = box
+    u = np.array([np.cos(yaw), np.sin(yaw)])
+    v = np.array([-u[1], u[0]])
+    c = np.array([x, y])
+    pts = [c + su * ln / 2 * u + sv * wd / 2 * v for su, sv in ((1, 1), (-1, 1), (-1, -1), (1, -1))]
+    return shapely.Polygon(pts)
+
+
+def iou(a: np.ndarray, b: np.ndarray) -> float:
+    pa, pb = polygon(a), polygon(b)
+    return float(pa.intersection(pb).area / pa.union(pb).area)
+
+
+def water(rng: np.random.Generator, n: int = 4000) -> np.ndarray:
+    xy = rng.uniform(-150.0, 150.0, size=(n, 2))
+    z = WATER_Z + rng.normal(0.0, 0.05, size=n)
+    return np.column_stack([xy, z, np.full(n, 0.1)])
+
+
+def faces(box: np.ndarray, *, spacing: float, side: bool = True, end: bool = True) -> np.ndarray:
+    """Points on the faces of ``box`` that look at the sensor (origin): the near long side and/or the near end,
+    between 0.5 m and 3 m above the water."""
+    x, y, _, ln, wd, _, yaw = box
+    u = np.array([np.cos(yaw), np.sin(yaw)])
+    v = np.array([-u[1], u[0]])
+    c = np.array([x, y])
+    near_v = -np.sign(c @ v) or 1.0  # the side whose outward normal points at the sensor
+    near_u = -np.sign(c @ u) or 1.0
+    out = []
+    for z in (WATER_Z + 0.8, WATER_Z + 1.6, WATER_Z + 2.6):
+        if side:
+            for t in np.arange(-ln / 2 + spacing / 2, ln / 2, spacing):
+                out.append([*(c + t * u + near_v * wd / 2 * v), z, 0.5])
+        if end:
+            for t in np.arange(-wd / 2 + spacing / 2, wd / 2, spacing):
+                out.append([*(c + near_u * ln / 2 * u + t * v), z, 0.5])
+    return np.array(out)
+
+
+TRUE = np.array([80.0, 30.0, WATER_Z + 2.0, 20.0, 6.0, 4.0, 0.4])
+
+
+def test_l_shaped_points_give_the_true_rectangle() -> None:
+    rng = np.random.default_rng(1)
+    hull = faces(TRUE, spacing=0.25)
+    assert len(hull) >= RefineParams().dense_points
+    cloud = np.vstack([water(rng), hull])
+    loose = np.array([81.5, 29.0, 0.0, 15.0, 8.0, 3.0, 0.4 + np.radians(9.0)])
+    out = refine_boxes(cloud, loose[None])[0]
+    assert iou(loose, TRUE) < 0.6
+    # both faces seen: the points' span plus the pads (0.5 m each end, 0.25 m each side) at most
+    assert iou(out, TRUE) >= 0.85
+    assert abs(np.degrees(out[6] - TRUE[6])) < 0.5
+    assert 19.5 <= out[3] <= 21.0 and 5.75 <= out[4] <= 6.5
+    assert np.hypot(*(out[:2] - TRUE[:2])) < 0.5
+    assert out[2] == loose[2] and out[5] == loose[5]  # height kept from the network
+
+
+def test_one_face_keeps_the_network_beam_and_holds_the_points() -> None:
+    rng = np.random.default_rng(2)
+    hull = faces(TRUE, spacing=0.5, end=False)  # the long side alone: 120 points, no beam
+    cloud = np.vstack([water(rng), hull])
+    loose = np.array([79.0, 31.0, 0.0, 17.0, 5.0, 3.0, 0.4 - np.radians(12.0)])
+    out = refine_boxes(cloud, loose[None])[0]
+    assert abs(np.degrees(out[6] - TRUE[6])) < 0.5  # the heading from the points
+    assert out[4] == loose[4]  # the beam the points cannot show: the network's
+    assert 19.5 <= out[3] <= 21.0  # the length they do show
+    poly = shapely.buffer(polygon(out), 1e-6)
+    assert shapely.contains_xy(poly, hull[:, 0], hull[:, 1]).all()
+    assert iou(out, TRUE) > iou(loose, TRUE) + 0.05
+
+
+def test_a_long_hull_is_followed_past_the_proposal() -> None:
+    rng = np.random.default_rng(3)
+    long_hull = np.array([60.0, -90.0, 0.0, 150.0, 22.0, 10.0, -0.3])
+    hull = faces(long_hull, spacing=0.5)
+    cloud = np.vstack([water(rng), hull])
+    # the network saw 50 m of it, off-centre
+    u = np.array([np.cos(-0.3), np.sin(-0.3)])
+    loose = np.array([*(long_hull[:2] + 40.0 * u), 0.0, 50.0, 20.0, 8.0, -0.25])
+    out = refine_boxes(cloud, loose[None])[0]
+    assert iou(loose, long_hull) < 0.35
+    assert iou(out, long_hull) > 0.85
+    assert 149.0 <= out[3] <= 152.0
+
+
+def test_boxes_without_points_stay_as_they_are() -> None:
+    rng = np.random.default_rng(4)
+    cloud = np.vstack([water(rng), faces(TRUE, spacing=0.25)])
+    far = np.array([[-60.0, -40.0, 0.0, 10.0, 4.0, 3.0, 1.0], [0.0, 100.0, 1.0, 5.0, 2.0, 2.0, -0.5]])
+    np.testing.assert_array_equal(refine_boxes(cloud, far), far)
+    # water alone (below the threshold) is not a hull
+    on_water = np.array([[30.0, 30.0, WATER_Z, 12.0, 4.0, 2.0, 0.2]])
+    np.testing.assert_array_equal(refine_boxes(water(rng), on_water), on_water)
+    assert refine_boxes(cloud, np.zeros((0, 7))).shape == (0, 7)
+    np.testing.assert_array_equal(refine_boxes(np.zeros((0, 4)), far), far)
+
+
+def test_two_points_are_too_few() -> None:
+    rng = np.random.default_rng(5)
+    two = np.array([[80.0, 30.0, WATER_Z + 2.0, 0.5], [81.0, 30.5, WATER_Z + 2.0, 0.5]])
+    cloud = np.vstack([water(rng), two])
+    box = np.array([[80.5, 30.0, 0.0, 6.0, 2.0, 2.0, 0.1]])
+    np.testing.assert_array_equal(refine_boxes(cloud, box), box)
+    three = np.vstack([cloud, [[80.5, 31.0, WATER_Z + 2.0, 0.5]]])
+    assert not np.array_equal(refine_boxes(three, box), box)
