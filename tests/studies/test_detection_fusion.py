@@ -27,6 +27,7 @@ from mmusv.studies.detection.evaluate import bev_iou
 from mmusv.studies.detection.fusion import (
     early_points,
     fuse,
+    fuse_boxes,
     parse_modes,
     relative,
     rotated_nms,
@@ -171,6 +172,45 @@ def test_late_fusion_merges_duplicates_with_rotated_nms() -> None:
     assert len(boxes) == 1
     assert scores[0] == 0.9
     assert np.allclose(boxes[0, :3], gt[0, :3], atol=1e-9)
+
+
+def test_late_fusion_wbf_averages_the_agreeing_boxes() -> None:
+    frame, ego, nb, nb_box = scene(np.random.default_rng(5))
+    gt = gt_in_ego(frame, ego)
+    mine = gt + np.array([0.3, 0, 0, 0, 0, 0, 0.05])
+    answers = {id(ego.points): (mine, np.array([0.6])), id(nb.points): (nb_box[None], np.array([0.2]))}
+
+    def stub(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return answers[id(points)]
+
+    boxes, scores = fuse("late", ego, [nb], detector=stub, late_merge="wbf")
+    assert len(boxes) == 1
+    assert scores[0] == pytest.approx(1 - 0.4 * 0.8)  # noisy-OR of the two USVs
+    # weights 0.6/0.8 and 0.2/0.8; the neighbour's box lands on the ground truth
+    assert np.allclose(boxes[0, :6], 0.75 * mine[0, :6] + 0.25 * gt[0, :6], atol=1e-9)
+    assert boxes[0, 6] == pytest.approx(gt[0, 6] + 0.75 * 0.05, abs=1e-3)
+    with pytest.raises(InputError, match="late merge"):
+        fuse("late", ego, [nb], detector=stub, late_merge="mean")
+
+
+def test_fuse_boxes_groups_by_iou_and_agent() -> None:
+    a = np.array([0.0, 0, 0, 10, 4, 2, np.pi / 2 - 0.05])
+    same = np.array([0.5, 0, 0, 10, 4, 2, -np.pi / 2 + 0.05])  # the same heading across ±π/2
+    far = np.array([30.0, 0, 0, 10, 4, 2, 0.0])
+    boxes = np.stack([a, same, far, same])
+    scores = np.array([0.5, 0.5, 0.9, 0.4])
+    agents = np.array([0, 1, 0, 0])  # the last: a second box of agent 0 on the same vessel
+    fb, fs = fuse_boxes(boxes, scores, agents)
+    assert fs.tolist() == pytest.approx([0.9, 0.75])  # agent 0's second box does not add confidence
+    np.testing.assert_array_equal(fb[0], far)
+    assert fb[1, 0] == pytest.approx(0.25)
+    assert abs(abs(fb[1, 6]) - np.pi / 2) < 1e-9  # not the naive mean 0
+    # one agent alone: its boxes as they are (a box under the threshold is not merged)
+    one, sc = fuse_boxes(boxes[:3], np.array([0.5, 0.4, 0.9]), np.zeros(3, int), iou_threshold=0.95)
+    assert sc.tolist() == [0.9, 0.5, 0.4]
+    np.testing.assert_array_equal(one, boxes[[2, 0, 1]])
+    empty = fuse_boxes(np.zeros((0, 7)), np.zeros(0), np.zeros(0, int))
+    assert empty[0].shape == (0, 7) and empty[1].shape == (0,)
 
 
 def test_rotated_nms_threshold() -> None:

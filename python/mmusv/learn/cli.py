@@ -29,12 +29,13 @@ def _torch() -> None:
         raise InputError(f"mmusv.learn {_INSTALL}") from None
 
 
-def load_for_study(path: str) -> Any:
-    """The :class:`~mmusv.learn.detector.LearnedDetector` at ``path`` (``--model``)."""
+def load_for_study(path: str, *, refine: bool | None = None) -> Any:
+    """The :class:`~mmusv.learn.detector.LearnedDetector` at ``path`` (``--model``); ``refine``: the geometric
+    second stage on or off (``None``: the default of :func:`~mmusv.learn.detector.load_models`)."""
     _torch()
     from mmusv.learn.detector import load_models
 
-    return load_models(path)
+    return load_models(path, refine=refine)
 
 
 def add_parser(sub: Any) -> None:

@@ -71,6 +71,20 @@ def _common(p: argparse.ArgumentParser, default_out: str) -> None:
         "serves none/late, early and intermediate their own",
     )
     p.add_argument(
+        "--refine",
+        choices=("auto", "on", "off"),
+        default="auto",
+        help="with --model: tighten the network's boxes on the LiDAR points (mmusv.learn.refine, geometric); "
+        "auto (default) = on for cpu-preset models, where it was measured",
+    )
+    p.add_argument(
+        "--late-merge",
+        choices=("nms", "wbf"),
+        default="nms",
+        help="how late fusion merges the USVs' boxes: nms (rotated NMS at BEV IoU 0.1, default) or wbf "
+        "(score-weighted box fusion at IoU 0.3, noisy-OR score of the agreeing USVs)",
+    )
+    p.add_argument(
         "--predictions",
         default=None,
         help="a Parquet of detections instead of a detector (layout of "
@@ -124,7 +138,9 @@ def run(args: argparse.Namespace) -> int:
             raise InputError("give one of --model, --detector or --predictions")
         from mmusv.learn.cli import load_for_study
 
-        learned = load_for_study(args.model)
+        learned = load_for_study(args.model, refine={"auto": None, "on": True, "off": False}[args.refine])
+    if args.model is None and args.refine != "auto":
+        raise InputError(f"--refine {args.refine}: only with --model (the learned detector's second stage)")
     modes = parse_modes(args.modes or (",".join(learned.fusion_modes) if learned is not None else "none,late,early"))
     settings = parse_settings(args.settings) if robust else (Setting(),)
     if robust and not any(m != "none" for m in modes):
@@ -181,6 +197,7 @@ def run(args: argparse.Namespace) -> int:
             predictions=predictions,
             range_m=args.range_m,
             seed=args.seed,
+            late_merge=args.late_merge,
         )
         total = dataset.count_frames()
         t1 = time.perf_counter()
@@ -217,6 +234,8 @@ def run(args: argparse.Namespace) -> int:
                 )
         elif det is not None and name == "baseline":
             console.print(f"[yellow]{BASELINE_NOTE}[/]")
+        if any(m == "late" for m in run_modes):
+            console.print(f"late fusion merge: {args.late_merge}", highlight=False)
         console.print(
             f"split {split}: {len(res.sequences)} sequences, {res.frames} frames, {res.ego_frames} ego-frames, "
             f"{res.gt_boxes / max(res.ego_frames, 1):.2f} ground-truth boxes per ego-frame; evaluation "

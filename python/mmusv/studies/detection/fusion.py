@@ -3,7 +3,9 @@ metres).
 
 - ``none``: the detector on the ego's own cloud.
 - ``late``: every USV runs the detector on its own cloud in its own LiDAR frame; the boxes are moved into the
-  ego LiDAR frame (:func:`transform_boxes`) and merged with rotated NMS at BEV IoU 0.10 (:func:`rotated_nms`).
+  ego LiDAR frame (:func:`transform_boxes`) and merged with rotated NMS at BEV IoU 0.10 (:func:`rotated_nms`,
+  ``late_merge="nms"``, the default) or by score-weighted box fusion (:func:`fuse_boxes`, ``late_merge="wbf"``:
+  a vessel that several USVs detect gets one averaged box whose score rises with their agreement).
 - ``early``: the neighbours' points are moved into the ego LiDAR frame and concatenated with the ego's; the
   detector runs once on the aggregate (cropped to ``crop_m`` around the ego). A detector with an ``early``
   method (a learned model trained on aggregated clouds, :class:`mmusv.learn.detector.LearnedDetector`) runs
@@ -28,13 +30,30 @@ from mmusv.studies.detection.data import AgentFrame
 from mmusv.studies.detection.detector import Detector
 from mmusv.studies.detection.evaluate import bev_iou
 
-__all__ = ["DEFAULT_MODES", "MODES", "NMS_IOU", "fuse", "parse_modes", "relative", "rotated_nms", "transform_boxes"]
+__all__ = [
+    "DEFAULT_MODES",
+    "LATE_MERGES",
+    "MODES",
+    "NMS_IOU",
+    "WBF_IOU",
+    "fuse",
+    "fuse_boxes",
+    "parse_modes",
+    "relative",
+    "rotated_nms",
+    "transform_boxes",
+]
 
 MODES = ("none", "late", "early", "intermediate")
 DEFAULT_MODES = ("none", "late", "early")
 """The modes any points → boxes detector can run (intermediate fusion needs a learned model)."""
 NMS_IOU = 0.10
 """BEV IoU above which late fusion suppresses the lower-scored of two boxes."""
+WBF_IOU = 0.3
+"""BEV IoU above which :func:`fuse_boxes` takes two boxes for the same vessel (chosen on the validation split of the
+bundled dataset from 0.1, 0.2, 0.3 and 0.5; docs/studies/detection.md)."""
+LATE_MERGES = ("nms", "wbf")
+"""How late fusion merges the USVs' boxes: rotated NMS or score-weighted box fusion."""
 
 Boxes = tuple[np.ndarray, np.ndarray]
 
@@ -85,6 +104,47 @@ def rotated_nms(boxes: np.ndarray, scores: np.ndarray, *, iou_threshold: float =
     return np.array(keep, dtype=np.int64)
 
 
+def fuse_boxes(boxes: np.ndarray, scores: np.ndarray, agents: np.ndarray, *, iou_threshold: float = WBF_IOU) -> Boxes:
+    """Score-weighted box fusion of several USVs' boxes ``(M, 7)`` (one frame), ``scores`` ``(M,)`` in [0, 1] and
+    the ``agents`` ``(M,)`` that made them. After weighted boxes fusion (Solovyev, Wang and Gabruseva, "Weighted
+    boxes fusion: ensembling boxes from different object detection models", Image Vision Comput. 107, 2021),
+    greedy in descending score (stable): the highest-scored unused box and every unused box with BEV IoU above
+    ``iou_threshold`` with it form a group; of each agent the group keeps its best box; the fused box is the
+    score-weighted mean of those in ``x, y, z, l, w, h`` and in heading (as ``2ψ``: a BEV box is the same at ψ
+    and ψ + π), its score the noisy-OR ``1 − Π(1 − s)`` of theirs (independent agents that agree make a
+    detection likelier; one agent alone keeps its score and box). Returns the fused boxes ``(K, 7)`` and scores
+    ``(K,)`` by descending score (stable)."""
+    b = np.asarray(boxes, dtype=np.float64).reshape(-1, 7)
+    s = np.asarray(scores, dtype=np.float64).reshape(-1)
+    ag = np.asarray(agents).reshape(-1)
+    if s.size == 0:
+        return np.zeros((0, 7)), np.zeros(0)
+    order = np.argsort(-s, kind="stable")
+    iou = bev_iou(b, b)
+    used = np.zeros(len(s), dtype=bool)
+    out_b: list[np.ndarray] = []
+    out_s: list[float] = []
+    for i in order:
+        if used[i]:
+            continue
+        group = order[(~used[order]) & (iou[i, order] > iou_threshold)]
+        group = np.unique(np.r_[i, group])
+        group = group[np.argsort(-s[group], kind="stable")]
+        used[group] = True
+        _, first = np.unique(ag[group], return_index=True)
+        members = group[np.sort(first)]
+        w = s[members] / max(float(s[members].sum()), 1e-12)
+        fused = b[i].copy()
+        if len(members) > 1:
+            fused[:6] = w @ b[members, :6]
+            fused[6] = 0.5 * np.arctan2(w @ np.sin(2 * b[members, 6]), w @ np.cos(2 * b[members, 6]))
+        out_b.append(fused)
+        out_s.append(float(1.0 - np.prod(1.0 - s[members])))
+    fb, fs = np.array(out_b), np.array(out_s)
+    rank = np.argsort(-fs, kind="stable")
+    return fb[rank], fs[rank]
+
+
 def early_points(ego: AgentFrame, neighbours: Sequence[AgentFrame], *, crop_m: float) -> np.ndarray:
     """``(N, 4)`` float32 the ego's points and the neighbours' moved into the ego LiDAR frame, cropped to BEV
     distance ``crop_m``."""
@@ -106,19 +166,26 @@ def fuse(
     detector: Detector,
     own_detections: Callable[[AgentFrame], Boxes] | None = None,
     crop_m: float = 220.0,
+    late_merge: str = "nms",
 ) -> Boxes:
     """Boxes ``(M, 7)`` and scores ``(M,)`` in ``ego``'s LiDAR frame for fusion ``mode`` (module docstring).
-    ``own_detections(agent)`` returns the detector's output on an agent's own cloud (a cache may back it)."""
+    ``own_detections(agent)`` returns the detector's output on an agent's own cloud (a cache may back it);
+    ``late_merge``: one of :data:`LATE_MERGES`."""
     own = own_detections or (lambda a: _as_boxes(detector(a.points)))
     if mode == "none":
         return own(ego)
     if mode == "late":
+        if late_merge not in LATE_MERGES:
+            raise InputError(f"late merge {late_merge!r}: allowed: {', '.join(LATE_MERGES)}")
         bs, ss = [own(ego)[0]], [own(ego)[1]]
         for nb in neighbours:
             b, s = own(nb)
             bs.append(transform_boxes(relative(ego, nb), b))
             ss.append(s)
         boxes, scores = np.concatenate(bs, axis=0), np.concatenate(ss)
+        if late_merge == "wbf":
+            agents = np.concatenate([np.full(len(x), k) for k, x in enumerate(ss)])
+            return fuse_boxes(boxes, scores, agents)
         keep = rotated_nms(boxes, scores)
         return boxes[keep], scores[keep]
     if mode == "early":

@@ -106,6 +106,7 @@ def _note(res: StudyResult, detector: str) -> str:
         f"ego-frames: {res.ego_frames}",
         f"ground-truth boxes: {res.gt_boxes}",
         f"range: {res.options.range_m:g} m; seed: {res.options.seed}",
+        f"late fusion merge: {res.options.late_merge}",
     ]
     return "\n".join(lines) + "\n"
 

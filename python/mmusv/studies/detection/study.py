@@ -67,7 +67,8 @@ SEEN_POINTS = 5
 @dataclass(frozen=True)
 class StudyOptions:
     """What to evaluate: ``modes``, ``settings`` (``(Setting(),)`` for Table III), range, seed of the pose
-    noise, and either a ``detector`` or ``predictions`` (from :func:`load_predictions`)."""
+    noise, either a ``detector`` or ``predictions`` (from :func:`load_predictions`), and how late fusion merges
+    the USVs' boxes (``late_merge``, :data:`~mmusv.studies.detection.fusion.LATE_MERGES`)."""
 
     modes: tuple[str, ...] = DEFAULT_MODES
     settings: tuple[Setting, ...] = (Setting(),)
@@ -76,6 +77,7 @@ class StudyOptions:
     range_m: float = 200.0
     platform_margin_m: float = 2.0
     seed: int = 0
+    late_merge: str = "nms"
 
 
 @dataclass
@@ -314,7 +316,15 @@ def _score_ego(
                 boxes, scores = got if got is not None else (np.zeros((0, 7)), np.zeros(0))
             else:
                 assert o.detector is not None
-                boxes, scores = fuse(mode, ego, nbs, detector=o.detector, own_detections=own, crop_m=o.range_m + 20.0)
+                boxes, scores = fuse(
+                    mode,
+                    ego,
+                    nbs,
+                    detector=o.detector,
+                    own_detections=own,
+                    crop_m=o.range_m + 20.0,
+                    late_merge=o.late_merge,
+                )
             boxes, scores = _keep(boxes, scores, usv, range_m=o.range_m, margin=o.platform_margin_m)
             fm = FrameMatch.evaluate(boxes, scores, gt)
             key = (s.name, mode)
