@@ -66,7 +66,7 @@ const BLOCK: usize = 8;
 
 crate::dispatch! {
     /// [`to_srgb8`] of every colour of `linear` under exposure `k`, into `out` (three bytes per colour, as many
-    /// colours as both hold): the same bytes, [`BLOCK`] colours at a time, so that the tone curve's arithmetic
+    /// colours as both hold): the same bytes, eight colours at a time, so that the tone curve's arithmetic
     /// runs in vector lanes (the table lookups stay one by one).
     pub fn to_srgb8_all(linear: &[Vec3], k: f32, out: &mut [u8]) {
         let lut = srgb_lut();
