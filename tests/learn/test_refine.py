@@ -117,3 +117,13 @@ def test_two_points_are_too_few() -> None:
     np.testing.assert_array_equal(refine_boxes(cloud, box), box)
     three = np.vstack([cloud, [[80.5, 31.0, WATER_Z + 2.0, 0.5]]])
     assert not np.array_equal(refine_boxes(three, box), box)
+
+
+def test_a_blob_keeps_the_network_heading() -> None:
+    rng = np.random.default_rng(6)
+    squat = np.array([80.0, 30.0, 0.0, 7.0, 5.0, 3.0, 0.4])  # long/short 1.4 < min_elongation
+    cloud = np.vstack([water(rng), faces(squat, spacing=0.25)])
+    loose = np.array([80.5, 30.5, 0.0, 6.0, 4.0, 3.0, 0.55])
+    out = refine_boxes(cloud, loose[None])[0]
+    assert out[6] == loose[6]
+    assert iou(out, squat) > iou(loose, squat)

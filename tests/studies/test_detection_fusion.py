@@ -19,6 +19,7 @@ from mmusv.studies.detection.data import (
 from mmusv.studies.detection.detector import (
     BaselineParams,
     baseline_detect,
+    closeness_axis,
     fit_box,
     load_detector,
     water_plane,
@@ -211,6 +212,22 @@ def test_fuse_boxes_groups_by_iou_and_agent() -> None:
     np.testing.assert_array_equal(one, boxes[[2, 0, 1]])
     empty = fuse_boxes(np.zeros((0, 7)), np.zeros(0), np.zeros(0, int))
     assert empty[0].shape == (0, 7) and empty[1].shape == (0,)
+
+
+def test_closeness_axis_follows_the_legs_of_an_l() -> None:
+    yaw = 0.4
+    u, v = np.array([np.cos(yaw), np.sin(yaw)]), np.array([-np.sin(yaw), np.cos(yaw)])
+    legs = [t * u for t in np.linspace(0, 20, 81)] + [t * v for t in np.linspace(0, 6, 25)]
+    pts = np.array(legs) + np.array([50.0, 10.0])
+    axis = closeness_axis(pts)
+    assert axis is not None
+    assert min(abs(float(axis @ u)), abs(float(axis @ v))) < 1e-9  # along a leg, not the hypotenuse
+    box = fit_box(pts, z_low=0.0, z_high=1.0, min_width_m=0.0, beam_ratio=0.0, criterion="closeness")
+    assert box[3] == pytest.approx(20.0) and box[4] == pytest.approx(6.0)
+    assert box[6] == pytest.approx(yaw)
+    assert closeness_axis(pts[:2]) is None  # too few
+    line = closeness_axis(pts[:81])  # one leg: its own direction (or None where shapely finds no area)
+    assert line is None or abs(abs(float(line @ u)) - 1.0) < 1e-6
 
 
 def test_rotated_nms_threshold() -> None:

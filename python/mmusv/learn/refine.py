@@ -1,21 +1,24 @@
 """A geometric second stage for the learned detector: each CenterPoint box tightened on the LiDAR points in it.
 
 Not learned: it fits a rectangle to the points of each proposal with the detection study's training-free steps (the
-baseline's water removal, :func:`mmusv.studies.detection.detector.above_water`, and its minimum-area rectangle,
-:func:`mmusv.studies.detection.detector.fit_box`) and combines that rectangle with the network's box. The network
-keeps what the points cannot show (a hull seen from one side shows its length but not its beam) and its score;
-the points give what 4 m output cells cannot (where the faces are, the heading, and the length of hulls longer
-than the network's receptive field). The rule, with the constants of :class:`RefineParams` (chosen on the
-validation split; docs/studies/detection.md gives the measurements):
+baseline's water removal, :func:`mmusv.studies.detection.detector.above_water`, and its rectangle fit,
+:func:`mmusv.studies.detection.detector.fit_box`, here with the closeness criterion of L-shape fitting) and
+combines that rectangle with the network's box. The network keeps what the points cannot show (a hull seen from
+one side shows its length but not its beam) and its score; the points give what 4 m output cells cannot (where
+the faces are, the heading, and the length of hulls longer than the network's receptive field). The rule, with
+the constants of :class:`RefineParams` (chosen on the validation split of the bundled dataset;
+docs/studies/detection.md gives the measurements):
 
 1. **Points.** The cloud's points above the water: the baseline's plane and ``water.min_height_m`` (0.5 m), and
    within ``near_m`` (50 m) of the sensor ``near_min_height_m`` (1 m), where the wave faces' returns stand above
    0.5 m. Of those, the ones whose BEV position lies in the box grown by ``margin_length_m`` (10 m) at each end
    and ``margin_m`` (3 m) at each side. Fewer than ``min_points`` (3): the box is left as it is.
-2. **Heading.** The minimum-area rectangle of those points (``fit_box`` without its widening) has two axes; the
-   one nearer the network's heading becomes the length axis, when the rectangle is elongated (long side ≥
-   ``min_elongation`` (1.5) × short side and ≥ ``min_span_m`` (1 m)); otherwise the network's heading is kept (a
-   blob of points has no reliable orientation).
+2. **Heading.** The rectangle ``fit_box`` fits to those points (without its widening; the side directions by the
+   closeness criterion, :func:`~mmusv.studies.detection.detector.closeness_axis`: the minimum-area rectangle
+   ties between the legs and the hypotenuse of an L of points) has two axes; the one nearer the network's
+   heading becomes the length axis, when the rectangle is elongated (long side ≥ ``min_elongation`` (3) × short
+   side and ≥ ``min_span_m`` (1 m)); otherwise the network's heading is kept (a blob of points, or a hull seen
+   end-on, shows no reliable orientation).
 3. **Extent, per axis** (length along the heading, beam across). The points' span on the axis, grown by
    ``pad_length_m`` (0.5 m) or ``pad_beam_m`` (0.25 m) at each end (the outermost returns lie inside the hull's
    outline: a tapering bow, a point spacing), is taken as the extent when the box holds at least
@@ -45,13 +48,14 @@ __all__ = ["RefineParams", "refine_box", "refine_boxes", "surface_points"]
 
 @dataclass(frozen=True)
 class RefineParams:
-    """The constants of the rule (module docstring; metres unless said otherwise). ``water``: the baseline's
-    parameters, of which the water plane, ``min_height_m`` and ``self_radius_m`` are used."""
+    """The constants of the rule (module docstring; metres unless said otherwise). ``criterion``: ``fit_box``'s
+    (``"closeness"`` or ``"area"``). ``water``: the baseline's parameters, of which the water plane,
+    ``min_height_m`` and ``self_radius_m`` are used."""
 
     margin_m: float = 3.0
     margin_length_m: float = 10.0
     min_points: int = 3
-    min_elongation: float = 1.5
+    min_elongation: float = 3.0
     min_span_m: float = 1.0
     dense_points: int = 100
     span_fraction: float = 0.6

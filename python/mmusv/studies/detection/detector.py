@@ -132,8 +132,8 @@ def closeness_axis(xy: np.ndarray, *, d0_m: float = 0.1) -> np.ndarray | None:
     smaller of the two, floored at ``d0_m``; the score is the sum of the inverses. The candidate directions are
     the edges of the points' convex hull (one of which the minimum-area rectangle has, by rotating calipers).
     Unlike the minimum area, the criterion does not tie for an L of points: the rectangle on the hypotenuse of
-    a right triangle has the same area as the one on its legs. ``None`` for fewer than 3 points or collinear
-    ones."""
+    a right triangle has the same area as the one on its legs. ``None`` for fewer than 3 points or a hull
+    without area (collinear points)."""
     pts = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
     if pts.shape[0] < 3:
         return None
