@@ -1,0 +1,140 @@
+//! Anti-aliasing of a camera's shaded image where it matters: a pixel at a visible edge (a 4-neighbour on another
+//! surface, instance, class or material, or, off the water, at a depth differing by more than 5 %, whose shading
+//! differs from that neighbour's by more than [`radiance::alike`] allows) gets [`super::Quality::edge_samples`]
+//! stratified sub-pixel rays (a `√s × √s` grid, jittered by the frame's seed). Where all of them see the pixel
+//! centre's surface (the edge runs through the neighbour) the pixel keeps its centre's shading; elsewhere it
+//! takes the mean of its samples' radiance, each shaded like a pixel at `high` quality (traced reflections above
+//! `draft`). Depth, class and instance stay those of the centre.
+
+use super::radiance::{self, Reflections};
+use super::{Camera, CameraFrame, WorldRays};
+use crate::error::Result;
+use crate::geometry::RigidPose;
+use crate::scene::{RayHits, Scene};
+use crate::sensors::shade::Shader;
+use parry3d::math::Vec3;
+use rayon::prelude::*;
+
+/// What the pixel centres saw: the frame (row-major depth, class, instance), each pixel's [`surface_key`], and
+/// the centre rays' hits (in trace order).
+pub(super) struct Centres<'a> {
+    pub frame: &'a CameraFrame,
+    pub surface: &'a [u64],
+    pub hits: &'a RayHits,
+}
+
+impl Camera {
+    /// Replaces the radiance of the edge pixels of `linear` (row-major, linear RGB) by the mean of their
+    /// sub-pixel samples (see the module docs); `shading` is the shader, whether shadows are cast, and the seed.
+    pub(super) fn antialias(
+        &self,
+        scene: &Scene,
+        pose: &RigidPose,
+        shading: (&Shader, bool, u64),
+        centres: Centres<'_>,
+        linear: &mut [Vec3],
+    ) -> Result<()> {
+        let (shader, shadows, seed) = shading;
+        let Centres { frame, surface, hits } = centres;
+        let q = self.cfg.image.quality;
+        let s = q.edge_samples();
+        let exposure = shader.exposure();
+        let edges = edge_pixels(frame, surface, |a, b| !radiance::alike(linear[a], linear[b], exposure));
+        if edges.is_empty() {
+            return Ok(());
+        }
+        let (so, sd) = self.sample_rays(pose, &edges, s, seed);
+        let shits = scene.cast_rays(&so, &sd, self.cfg.range_max)?;
+        let per = s as usize;
+        // A pixel whose samples all see its centre's surface (the edge runs through its neighbour) keeps its
+        // centre's shading; the others are shaded sample by sample.
+        let key = |j: usize| {
+            let m = scene.material_index(shits.instance[j], shits.triangle[j]);
+            surface_key(shits.instance[j], shits.class[j], m)
+        };
+        let mixed: Vec<u32> = (0..edges.len())
+            .into_par_iter()
+            .filter(|&e| {
+                let i = edges[e] as usize;
+                let t = hits.distance[self.rank[i] as usize];
+                (e * per..(e + 1) * per).any(|j| {
+                    let tj = shits.distance[j];
+                    key(j) != surface[i] || frame.semantic[i] != 1 && t.is_finite() && (tj - t).abs() > 0.05 * tj.min(t)
+                })
+            })
+            .map(|e| e as u32)
+            .collect();
+        let rays: Vec<u32> =
+            mixed.iter().flat_map(|&e| (e as usize * per..(e as usize + 1) * per).map(|j| j as u32)).collect();
+        let (mo, md): (Vec<[f32; 3]>, Vec<[f32; 3]>) = rays.iter().map(|&j| (so[j as usize], sd[j as usize])).unzip();
+        let mhits = shits.select(&rays);
+        let refl = if q.reflections() { Reflections::Every } else { Reflections::Sky };
+        let samples = radiance::radiance(scene, shader, shadows, refl, None, (&mo, &md, &mhits))?;
+        for (m, &e) in mixed.iter().enumerate() {
+            let sum: Vec3 = samples[m * per..(m + 1) * per].iter().copied().sum();
+            linear[edges[e as usize] as usize] = sum / s as f32;
+        }
+        Ok(())
+    }
+
+    /// World rays of `samples` stratified sub-pixel positions (a `√s × √s` grid, jittered by `seed`) in every
+    /// pixel of `pixels` (row-major indices), pixel by pixel.
+    fn sample_rays(&self, pose: &RigidPose, pixels: &[u32], samples: u32, seed: u64) -> WorldRays {
+        let g = (samples as f64).sqrt().round().max(1.0) as u32;
+        let w = self.cfg.width;
+        let cap = pixels.len() * (g * g) as usize;
+        let (mut o, mut d) = (Vec::with_capacity(cap), Vec::with_capacity(cap));
+        for &i in pixels {
+            let (u, v) = ((i % w) as f64, (i / w) as f64);
+            for a in 0..g {
+                for b in 0..g {
+                    let key = (i as u64) << 8 | (a * g + b) as u64;
+                    let ju = crate::sensors::noise::uniform(seed, 0xAA, 2 * key);
+                    let jv = crate::sensors::noise::uniform(seed, 0xAA, 2 * key + 1);
+                    let su = u + (b as f64 + ju) / g as f64;
+                    let sv = v + (a as f64 + jv) / g as f64;
+                    let (bo, bd) = self.body_ray(su, sv);
+                    o.push(pose.transform_point(Vec3::from_array(bo)).to_array());
+                    d.push(pose.transform_vector(Vec3::from_array(bd)).normalize().to_array());
+                }
+            }
+        }
+        (o, d)
+    }
+}
+
+/// Instance, class and material of a hit in one word (what the anti-aliasing compares).
+#[inline]
+pub(super) fn surface_key(instance: i32, class: u16, material: u16) -> u64 {
+    (instance as u32 as u64) << 32 | (class as u64) << 16 | material as u64
+}
+
+/// Row-major indices of the pixels at a visible edge: a 4-neighbour on another surface (`surface`: instance,
+/// class and material in one word) or, off the water, at a depth differing by more than 5 %, and whose centre
+/// colour differs from that neighbour's (`contrast(a, b)`, so an edge between two surfaces that look alike,
+/// [`radiance::alike`], keeps its one sample).
+fn edge_pixels(frame: &CameraFrame, surface: &[u64], contrast: impl Fn(usize, usize) -> bool + Sync) -> Vec<u32> {
+    let (w, h) = (frame.width as usize, frame.height as usize);
+    let differs = |a: usize, b: usize| {
+        let geometric = surface[a] != surface[b] || {
+            // Depth steps matter between surfaces, not across the open water (its shading varies smoothly).
+            let (da, db) = (frame.depth[a], frame.depth[b]);
+            frame.semantic[a] != 1 && da.is_finite() && db.is_finite() && (da - db).abs() > 0.05 * da.min(db)
+        };
+        geometric && contrast(a, b)
+    };
+    (0..h)
+        .into_par_iter()
+        .flat_map_iter(|y| {
+            let differs = &differs;
+            (0..w).filter_map(move |x| {
+                let i = y * w + x;
+                let edge = (x > 0 && differs(i, i - 1))
+                    || (x + 1 < w && differs(i, i + 1))
+                    || (y > 0 && differs(i, i - w))
+                    || (y + 1 < h && differs(i, i + w));
+                edge.then_some(i as u32)
+            })
+        })
+        .collect()
+}
