@@ -115,24 +115,37 @@ pub(super) fn surface_key(instance: i32, class: u16, material: u16) -> u64 {
 /// [`radiance::alike`], keeps its one sample).
 fn edge_pixels(frame: &CameraFrame, surface: &[u64], contrast: impl Fn(usize, usize) -> bool + Sync) -> Vec<u32> {
     let (w, h) = (frame.width as usize, frame.height as usize);
-    let differs = |a: usize, b: usize| {
-        let geometric = surface[a] != surface[b] || {
-            // Depth steps matter between surfaces, not across the open water (its shading varies smoothly).
-            let (da, db) = (frame.depth[a], frame.depth[b]);
-            frame.semantic[a] != 1 && da.is_finite() && db.is_finite() && (da - db).abs() > 0.05 * da.min(db)
-        };
-        geometric && contrast(a, b)
+    // Each pair of 4-neighbours once: bit 0 (1) of pixel `a` when `a` sees an edge towards `b`, bit 1 (2) when
+    // `b` sees one towards `a` (the depth step counts from a pixel off the water only), for its right neighbour
+    // in the low two bits and the one below in the next two. The colours are compared only at a geometric edge.
+    let pair = |a: usize, b: usize| -> u8 {
+        let same = surface[a] == surface[b];
+        let (da, db) = (frame.depth[a], frame.depth[b]);
+        let step = da.is_finite() && db.is_finite() && (da - db).abs() > 0.05 * da.min(db);
+        let from_a = !same || step && frame.semantic[a] != 1;
+        let from_b = !same || step && frame.semantic[b] != 1;
+        if !(from_a || from_b) || !contrast(a, b) {
+            return 0;
+        }
+        u8::from(from_a) | u8::from(from_b) << 1
     };
+    let mut flags = vec![0u8; w * h];
+    flags.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for (x, f) in row.iter_mut().enumerate() {
+            let i = y * w + x;
+            let right = if x + 1 < w { pair(i, i + 1) } else { 0 };
+            let down = if y + 1 < h { pair(i, i + w) } else { 0 };
+            *f = right | down << 2;
+        }
+    });
+    let flags = &flags;
     (0..h)
         .into_par_iter()
         .flat_map_iter(|y| {
-            let differs = &differs;
             (0..w).filter_map(move |x| {
                 let i = y * w + x;
-                let edge = (x > 0 && differs(i, i - 1))
-                    || (x + 1 < w && differs(i, i + 1))
-                    || (y > 0 && differs(i, i - w))
-                    || (y + 1 < h && differs(i, i + w));
+                let edge =
+                    flags[i] & (1 | 4) != 0 || (x > 0 && flags[i - 1] & 2 != 0) || (y > 0 && flags[i - w] & 8 != 0);
                 edge.then_some(i as u32)
             })
         })
