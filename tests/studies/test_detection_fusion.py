@@ -225,6 +225,8 @@ def test_closeness_axis_follows_the_legs_of_an_l() -> None:
     box = fit_box(pts, z_low=0.0, z_high=1.0, min_width_m=0.0, beam_ratio=0.0, criterion="closeness")
     assert box[3] == pytest.approx(20.0) and box[4] == pytest.approx(6.0)
     assert box[6] == pytest.approx(yaw)
+    with pytest.raises(ValueError, match="criterion"):
+        fit_box(pts, z_low=0.0, z_high=1.0, criterion="hull")
     assert closeness_axis(pts[:2]) is None  # too few
     line = closeness_axis(pts[:81])  # one leg: its own direction (or None where shapely finds no area)
     assert line is None or abs(abs(float(line @ u)) - 1.0) < 1e-6

@@ -172,6 +172,8 @@ def fit_box(
     :func:`closeness_axis`), length along the longer side, yaw in (-π/2, π/2]; a width under
     ``max(min_width_m, beam_ratio · length)`` is widened to it away from the origin (the sensor); a length under
     ``min_length_m`` is raised."""
+    if criterion not in ("area", "closeness"):
+        raise ValueError(f"fit_box criterion {criterion!r}: allowed: area, closeness")
     pts = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
     axis = closeness_axis(pts) if criterion == "closeness" else None
     if axis is not None:
