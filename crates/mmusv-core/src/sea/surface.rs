@@ -262,7 +262,28 @@ fn cell_planes(t: &Tile, ci: usize, cj: usize) -> ([[f32; 3]; 2], f32) {
     let w = t.n + 1;
     let (h00, h10) = (t.h[cj * w + ci], t.h[cj * w + ci + 1]);
     let (h01, h11) = (t.h[(cj + 1) * w + ci], t.h[(cj + 1) * w + ci + 1]);
-    ([[h00, h10 - h00, h11 - h10], [h00, h11 - h01, h01 - h00]], h00.max(h10).max(h01).max(h11))
+    ([[h00, h10 - h00, h11 - h10], [h00, h11 - h01, h01 - h00]], fmax(fmax(h00, h10), fmax(h01, h11)))
+}
+
+/// The smaller of `a` and `b`, for a march's distances and heights (never NaN where it is used: one
+/// instruction, where `f32::min`'s care for NaN costs two more); `a` when they are equal or `b` is NaN.
+#[inline(always)]
+fn fmin(a: f32, b: f32) -> f32 {
+    if b < a {
+        b
+    } else {
+        a
+    }
+}
+
+/// The larger of `a` and `b` (see [`fmin`]).
+#[inline(always)]
+fn fmax(a: f32, b: f32) -> f32 {
+    if b > a {
+        b
+    } else {
+        a
+    }
 }
 
 #[inline]

@@ -8,7 +8,7 @@
 //! boundary). Tiles and cells whose sampled maximum lies below the ray are skipped whole; a ray that crosses the
 //! band within one tile goes straight to it.
 
-use super::{cell_planes, SurfaceHit, WaveSurface, FLAT_PIECE, TILE_CELLS};
+use super::{cell_planes, fmax, fmin, SurfaceHit, WaveSurface, FLAT_PIECE, TILE_CELLS};
 
 impl WaveSurface {
     /// [`WaveSurface::intersect`]'s body, inlined into each instruction-set copy of [`intersect_with`].
@@ -19,11 +19,11 @@ impl WaveSurface {
         let (oz, dz) = (o[2], d[2]);
         let (mut t0, mut t1) = (0.0f32, t_max);
         if dz > 0.0 {
-            t1 = t1.min((self.zmax - oz) / dz);
-            t0 = t0.max((self.zmin - oz) / dz);
+            t1 = fmin(t1, (self.zmax - oz) / dz);
+            t0 = fmax(t0, (self.zmin - oz) / dz);
         } else if dz < 0.0 {
-            t0 = t0.max((self.zmax - oz) / dz);
-            t1 = t1.min((self.zmin - oz) / dz);
+            t0 = fmax(t0, (self.zmax - oz) / dz);
+            t1 = fmin(t1, (self.zmin - oz) / dz);
         } else if !(oz >= self.zmin && oz <= self.zmax) {
             return None;
         }
@@ -76,8 +76,8 @@ impl WaveSurface {
                 }
             } else {
                 let (p, q) = ((lo[ax] - o[ax]) / d[ax], (hi[ax] - o[ax]) / d[ax]);
-                a = a.max(p.min(q));
-                b = b.min(p.max(q));
+                a = fmax(a, fmin(p, q));
+                b = fmin(b, fmax(p, q));
             }
         }
         (a < b).then_some((a, b))
@@ -139,7 +139,7 @@ impl Dda {
     /// The ray distance where the current cell is left.
     #[inline(always)]
     fn exit(&self) -> f32 {
-        self.next[0].min(self.next[1])
+        fmin(self.next[0], self.next[1])
     }
 
     /// Moves to the next cell along the ray; `false` when that leaves `lo..=hi`. The axis is picked by index,
@@ -198,7 +198,7 @@ impl March<'_> {
         let mut g = Dda::new(self, ta, [s.x0, s.y0], s.tile_m, s.inv_tile_m, lo, hi);
         let mut t = ta;
         loop {
-            let t_exit = g.exit().min(tb);
+            let t_exit = fmin(g.exit(), tb);
             if t_exit > t {
                 if let Some(h) = self.tile(g.cell[0], g.cell[1], t, t_exit) {
                     return Some(h);
@@ -221,11 +221,11 @@ impl March<'_> {
             return self.flat(ta, tb);
         }
         let (za, zb) = (self.z(ta), self.z(tb));
-        if za.min(zb) > tile.zmax && self.above != Some(false) {
+        if fmin(za, zb) > tile.zmax && self.above != Some(false) {
             self.above = Some(true);
             return None; // wholly above every crest of the tile
         }
-        if za.max(zb) <= tile.zmin && self.above == Some(false) {
+        if fmax(za, zb) <= tile.zmin && self.above == Some(false) {
             return None; // wholly under the tile's troughs, and already under water
         }
         let n = tile.n;
@@ -258,12 +258,12 @@ impl March<'_> {
         let base = (k * 2 * TILE_CELLS * TILE_CELLS) as u32;
         let mut t = ta;
         loop {
-            let t_exit = g.exit().min(tb);
+            let t_exit = fmin(g.exit(), tb);
             if t_exit >= t {
                 let [ci, cj] = g.cell;
                 let (plane, cmax) = cell_planes(tile, ci, cj);
                 let (zt, ze) = (self.z(t), self.z(t_exit));
-                if zt.min(ze) > cmax && self.above != Some(false) {
+                if fmin(zt, ze) > cmax && self.above != Some(false) {
                     self.above = Some(true);
                 } else {
                     let id = base + 2 * (cj * n + ci) as u32;
