@@ -38,6 +38,15 @@ def test_tiny_model_overfits_a_few_frames(tmp_path: Path) -> None:
         frames.append(FrameMatch.evaluate(boxes, scores, gt))
     m = summarize(frames)
     assert m["ap50"] >= 0.9, m
+    # the geometric second stage: off by default for the tiny preset, on request it keeps the network's scores
+    assert det.refine is None and "no box refinement" in det.describe()
+    refined = load_models(tmp_path / "model.pt", refine=True)
+    assert refined.refine is not None and "refinement on the points" in refined.describe()
+    for k in range(len(src)):
+        pts, _, _ = src.sample(k)
+        _, s0 = det(pts)
+        b1, s1 = refined(pts)
+        assert b1.shape == (len(s1), 7) and set(s1.tolist()) <= set(s0.tolist())
     losses = _losses(tmp_path)
     assert np.mean(losses[-3:]) < 0.25 * np.mean(losses[:3])  # the loss falls
     png = plot_losses(tmp_path / "log.jsonl", tmp_path / "loss.png")

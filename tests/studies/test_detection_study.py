@@ -163,6 +163,7 @@ def test_bad_input_errors(two_usv: Path, tmp_path: Path, capsys: pytest.CaptureF
         return capsys.readouterr().err
 
     assert "needs at least 2" in err(["study", "detection", str(one)])
+    assert "only with --model" in err(["study", "detection", str(two_usv), "--refine", "off"])
     assert main(["study", "detection", str(one), "--modes", "none", "-o", str(tmp_path / "o1"), "--no-progress"]) == 0
     capsys.readouterr()
     assert "unknown mode" in err(["study", "detection", str(two_usv), "--modes", "none,mid"])
@@ -191,3 +192,14 @@ def test_rescore_of_the_boxes_parquet_gives_the_table(two_usv: Path, tmp_path: P
         got = rescore(boxes.filter(pl.col("mode") == row["mode"]))
         for k in ("ap30", "ap50", "ap70", "gt", "det"):
             assert (math.isnan(got[k]) and math.isnan(row[k])) or got[k] == pytest.approx(row[k]), k
+
+
+def test_late_merge_option_is_recorded(two_usv: Path, tmp_path: Path) -> None:
+    out = {}
+    for merge in ("nms", "wbf"):
+        out[merge] = tmp_path / merge
+        args = ["study", "detection", str(two_usv), "--modes", "none,late", "--late-merge", merge]
+        assert main([*args, "-o", str(out[merge]), "--no-progress"]) == 0
+        assert f"late fusion merge: {merge}" in (out[merge] / "detection_note.txt").read_text()
+    tables = {m: pl.read_csv(p / "detection_table.csv") for m, p in out.items()}
+    assert tables["nms"].filter(pl.col("mode") == "none").equals(tables["wbf"].filter(pl.col("mode") == "none"))
