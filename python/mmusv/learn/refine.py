@@ -2,10 +2,11 @@
 
 Not learned: it fits a rectangle to the points of each proposal with the detection study's training-free steps (the
 baseline's water removal, :func:`mmusv.studies.detection.detector.above_water`, and its rectangle fit,
-:func:`mmusv.studies.detection.detector.fit_box`, here with the closeness criterion of L-shape fitting) and
-combines that rectangle with the network's box. The network keeps what the points cannot show (a hull seen from
-one side shows its length but not its beam) and its score; the points give what 4 m output cells cannot (where
-the faces are, the heading, and the length of hulls longer than the network's receptive field). The rule, with
+:func:`mmusv.studies.detection.detector.fit_box`, here with the closeness criterion of L-shape fitting: Zhang et
+al., "Efficient L-shape fitting for vehicle detection using laser scanners", IEEE IV 2017) and combines that
+rectangle with the network's box. The network keeps what the points cannot show (a hull seen from one side shows
+its length but not its beam) and its score; the points give what 4 m output cells cannot (where the faces are,
+the heading, and the length of hulls longer than the network's receptive field). The rule, with
 the constants of :class:`RefineParams` (chosen on the validation split of the bundled dataset;
 docs/studies/detection.md gives the measurements):
 
