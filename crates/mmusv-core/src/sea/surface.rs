@@ -200,7 +200,8 @@ impl WaveSurface {
         let (k, rest) = ((piece / per_tile) as usize, piece % per_tile);
         let Some(t) = self.tiles.get(k).filter(|t| t.n > 0) else { return [0.0, 0.0, 1.0] };
         let (cell, tri) = ((rest / 2) as usize, (rest % 2) as usize);
-        let (ci, cj) = (cell % t.n, cell / t.n);
+        // n is a power of two: the column and row by mask and shift.
+        let (ci, cj) = (cell & (t.n - 1), cell >> t.n.trailing_zeros());
         if cj >= t.n {
             return [0.0, 0.0, 1.0];
         }
