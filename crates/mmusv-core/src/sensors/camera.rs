@@ -431,8 +431,7 @@ impl Camera {
         // Standard quality shares one traced reflection per 2 × 2 block of water pixels; high traces each. Below
         // `high`, open water and sky share their shading over the pixels between even rows and columns wherever
         // the even pixels around agree (radiance::radiance).
-        let grid =
-            radiance::PixelGrid { width: self.cfg.width, height: self.cfg.height, pos: &self.pos, rank: &self.rank };
+        let grid = self.pixel_grid();
         let refl = match q {
             Quality::Draft => Reflections::Sky,
             Quality::Standard => Reflections::Shared(grid),
@@ -462,26 +461,29 @@ impl Camera {
             let noise = self.cfg.image.noise;
             let mut out = vec![0u8; 3 * n];
             out.par_chunks_mut(3 * w).zip(linear.par_chunks(w)).enumerate().for_each(|(row, (px, cs))| {
-                if noise.is_none() {
+                let Some(nz) = noise else {
                     tonemap::to_srgb8_all(cs, k, px);
                     return;
-                }
+                };
                 for (j, c) in cs.iter().enumerate() {
-                    let mut x = *c * k;
-                    if let Some(nz) = noise {
-                        let p = (row * w + j) as u64;
-                        x = Vec3::new(
-                            nz.apply(x.x, options.seed, p, 0),
-                            nz.apply(x.y, options.seed, p, 1),
-                            nz.apply(x.z, options.seed, p, 2),
-                        );
-                    }
+                    let x = *c * k;
+                    let p = (row * w + j) as u64;
+                    let x = Vec3::new(
+                        nz.apply(x.x, options.seed, p, 0),
+                        nz.apply(x.y, options.seed, p, 1),
+                        nz.apply(x.z, options.seed, p, 2),
+                    );
                     px[3 * j..3 * j + 3].copy_from_slice(&tonemap::to_srgb8(x, 1.0));
                 }
             });
             frame.rgb = out;
         }
         Ok(frame)
+    }
+
+    /// The traced rays as a pixel grid (what the shading shared between neighbouring pixels reads).
+    fn pixel_grid(&self) -> radiance::PixelGrid<'_> {
+        radiance::PixelGrid { width: self.cfg.width, height: self.cfg.height, pos: &self.pos, rank: &self.rank }
     }
 
     /// Body-frame origin and unit direction of the ray through image point `(u, v)` (pixels, `(0, 0)` the
@@ -523,7 +525,7 @@ mod tests {
             image: Default::default(),
         };
         let Ok(cam) = Camera::new(cfg) else { panic!("a valid camera") };
-        let grid = radiance::PixelGrid { width: 7, height: 5, pos: &cam.pos, rank: &cam.rank };
+        let grid = cam.pixel_grid();
         for (k, &i) in cam.order.iter().enumerate() {
             let (x, y) = ((i % 7) as i64, (i / 7) as i64);
             let mut want: Vec<(i64, i64)> = Vec::new();

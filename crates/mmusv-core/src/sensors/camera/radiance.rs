@@ -330,28 +330,24 @@ pub fn radiance(
             .with_min_len(PASS_CHUNK)
             .map(|k| if is_candidate(k) || kinds[k] == 0 { [0; 3] } else { tonemap::to_srgb8(out[k], k_exp) })
             .collect();
-        let means: Vec<Option<Vec3>> = (0..n)
+        // Each candidate with its anchors' mean, or `None` where they differ (or the mean is not a number).
+        let means: Vec<(u32, Option<Vec3>)> = (0..n)
             .into_par_iter()
             .with_min_len(PASS_CHUNK)
+            .filter(|&k| is_candidate(k))
             .map(|k| {
-                if !is_candidate(k) {
-                    return None;
-                }
                 let (ids, m) = grid.anchors(k);
                 let first = shown[ids[0] as usize];
-                if ids[1..m].iter().all(|&j| alike_shown(first, shown[j as usize])) {
-                    Some(ids[..m].iter().map(|&j| out[j as usize]).sum::<Vec3>() / m as f32)
-                } else {
-                    Some(Vec3::NAN)
-                }
+                let alike = ids[1..m].iter().all(|&j| alike_shown(first, shown[j as usize]));
+                let mean = alike.then(|| ids[..m].iter().map(|&j| out[j as usize]).sum::<Vec3>() / m as f32);
+                (k as u32, mean.filter(|c| !c.x.is_nan()))
             })
             .collect();
         let mut redo: Vec<u32> = Vec::new();
-        for (k, m) in means.into_iter().enumerate() {
-            match m {
-                Some(c) if c.x.is_nan() => redo.push(k as u32),
-                Some(c) => out[k] = c,
-                None => {}
+        for (k, mean) in means {
+            match mean {
+                Some(c) => out[k as usize] = c,
+                None => redo.push(k),
             }
         }
         // The rays whose anchors differ: shaded themselves. Their sun visibility is their anchors' where those
