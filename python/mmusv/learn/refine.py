@@ -82,9 +82,8 @@ def surface_points(points: np.ndarray, p: RefineParams) -> np.ndarray:
     pts = np.asarray(points, dtype=np.float64)
     if pts.shape[0] == 0:
         return np.zeros((0, 2))
-    keep, plane = above_water(pts[:, :3], p.water)
+    keep, height, _ = above_water(pts[:, :3], p.water)
     if p.near_m > 0:
-        height = pts[:, 2] - (plane[0] * pts[:, 0] + plane[1] * pts[:, 1] + plane[2])
         keep &= (np.hypot(pts[:, 0], pts[:, 1]) > p.near_m) | (height > p.near_min_height_m)
     return pts[keep, :2]
 

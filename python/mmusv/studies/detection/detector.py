@@ -110,18 +110,19 @@ def water_plane(points: np.ndarray, *, cell_m: float = 10.0, rounds: int = 3, to
     return np.asarray(coef, dtype=np.float64)
 
 
-def above_water(points: np.ndarray, params: BaselineParams | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Steps 1–2 of the module docstring: ``(N,)`` bool mask of the ``points`` ``(N, ≥3)`` (ego LiDAR frame,
-    metres) more than ``params.min_height_m`` above the fitted water plane and farther than
-    ``params.self_radius_m`` from the sensor, and that plane ``(a, b, c)`` (:func:`water_plane`)."""
+def above_water(points: np.ndarray, params: BaselineParams | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Steps 1–2 of the module docstring, for the ``points`` ``(N, ≥3)`` (ego LiDAR frame, metres): the
+    ``(N,)`` bool mask of those more than ``params.min_height_m`` above the fitted water plane and farther than
+    ``params.self_radius_m`` from the sensor, every point's ``(N,)`` float64 height above that plane (metres),
+    and the plane ``(a, b, c)`` (:func:`water_plane`)."""
     prm = params or BaselineParams()
     p = np.asarray(points, dtype=np.float64)
     if p.shape[0] == 0:
-        return np.zeros(0, dtype=bool), np.zeros(3)
+        return np.zeros(0, dtype=bool), np.zeros(0), np.zeros(3)
     plane = water_plane(p, cell_m=prm.plane_cell_m)
     height = p[:, 2] - (plane[0] * p[:, 0] + plane[1] * p[:, 1] + plane[2])
     keep: np.ndarray = (height > prm.min_height_m) & (np.hypot(p[:, 0], p[:, 1]) > prm.self_radius_m)
-    return keep, plane
+    return keep, height, plane
 
 
 def closeness_axis(xy: np.ndarray, *, d0_m: float = 0.1) -> np.ndarray | None:
@@ -223,7 +224,7 @@ def baseline_detect(points: np.ndarray, params: BaselineParams | None = None) ->
     p = np.asarray(points, dtype=np.float64).reshape(-1, 4) if np.size(points) else np.zeros((0, 4))
     if p.shape[0] == 0:
         return np.zeros((0, 7)), np.zeros(0)
-    keep, (a, b, c) = above_water(p, prm)
+    keep, _, (a, b, c) = above_water(p, prm)
     q = p[keep]
     if q.shape[0] < prm.min_points:
         return np.zeros((0, 7)), np.zeros(0)
