@@ -177,7 +177,8 @@ def fuse(
     if mode == "late":
         if late_merge not in LATE_MERGES:
             raise InputError(f"late merge {late_merge!r}: allowed: {', '.join(LATE_MERGES)}")
-        bs, ss = [own(ego)[0]], [own(ego)[1]]
+        b0, s0 = own(ego)
+        bs, ss = [b0], [s0]
         for nb in neighbours:
             b, s = own(nb)
             bs.append(transform_boxes(relative(ego, nb), b))
