@@ -1,7 +1,8 @@
 """Train mmusv.learn models from a tensor cache on a machine with torch and numpy but without mmusv installed
 (no native extension, no polars): ``PYTHONPATH=python python3 scripts/learn_train.py --cache C.npz --preset
 paper -o OUT``. Arguments: those of :func:`mmusv.learn.train.main`; with ``infer`` first, those of
-:func:`mmusv.learn.infer.main` (heatmap peaks of trained models on a cache).
+:func:`mmusv.learn.infer.main` (heatmap peaks of trained models on a cache); with ``merge`` first, those of
+:func:`mmusv.learn.infer.merge_main` (join per-mode peak files).
 
 ``import mmusv.learn`` would run ``mmusv/__init__.py``, which loads the native extension; this entry registers
 ``mmusv`` as a bare package over its source folder first, so only the training core (torch + numpy) loads.
@@ -23,6 +24,10 @@ if __name__ == "__main__":
         from mmusv.learn.infer import main
 
         raise SystemExit(main(sys.argv[2:]))
+    if sys.argv[1:2] == ["merge"]:
+        from mmusv.learn.infer import merge_main
+
+        raise SystemExit(merge_main(sys.argv[2:]))
     from mmusv.learn.train import main
 
     raise SystemExit(main())

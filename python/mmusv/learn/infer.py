@@ -19,13 +19,14 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from mmusv.learn._errors import input_error
 from mmusv.learn.cache import Cache
 from mmusv.learn.decode import peaks
-from mmusv.learn.example import collate, make_example, message_bytes
+from mmusv.learn.example import MODES, collate, make_example, message_bytes
 from mmusv.learn.model import PillarNet
 from mmusv.learn.presets import Preset
 
-__all__ = ["infer_cache", "main"]
+__all__ = ["infer_cache", "main", "merge_main", "merge_peaks"]
 
 
 def _model(path: Path, dev: torch.device) -> PillarNet:
@@ -36,17 +37,27 @@ def _model(path: Path, dev: torch.device) -> PillarNet:
 
 
 def infer_cache(
-    cache: Cache, models: str | Path, out: str | Path, *, device: str | None = None, limit: int | None = None
+    cache: Cache,
+    models: str | Path,
+    out: str | Path,
+    *,
+    device: str | None = None,
+    limit: int | None = None,
+    modes: Sequence[str] = MODES,
 ) -> Path:
-    """Writes the peaks of every model found under ``models`` (``<mode>/model.pt``) on ``cache`` to ``out``
-    (the first ``limit`` items per model only, when given: smoke tests)."""
+    """Writes the peaks of every model of ``modes`` found under ``models`` (``<mode>/model.pt``) on ``cache`` to
+    ``out`` (the first ``limit`` items per model only, when given: smoke tests). One process per mode, each
+    with its own ``out``, runs the models side by side; :func:`merge_peaks` joins their files."""
+    unknown = sorted(set(modes) - set(MODES))
+    if unknown:
+        raise input_error(f"--modes {','.join(unknown)}: allowed: {', '.join(MODES)}")
     dev = torch.device(device or ("cuda" if torch.cuda.is_available() else "cpu"))
     root = Path(models)
     arrays: dict[str, np.ndarray] = {}
     n_clouds = len(cache.arrays["cloud_offsets"]) - 1
-    for mode in ("single", "early", "intermediate"):
+    for mode in MODES:
         f = root / mode / "model.pt"
-        if not f.is_file():
+        if mode not in modes or not f.is_file():
             continue
         model = _model(f, dev)
         p = model.preset
@@ -79,6 +90,22 @@ def infer_cache(
     return out_p
 
 
+def merge_peaks(parts: Sequence[str | Path], out: str | Path) -> Path:
+    """Joins the peak files ``parts`` of :func:`infer_cache` (one mode or more each, no mode twice) into
+    ``out``; a missing part is skipped (a model that was not trained)."""
+    arrays: dict[str, np.ndarray] = {}
+    for part in parts:
+        if not Path(part).is_file():
+            continue
+        with np.load(part) as f:
+            for k in f.files:
+                if k in arrays:
+                    raise input_error(f"{part}: {k} is in two of the peak files")
+                arrays[k] = f[k]
+    np.savez_compressed(Path(out), **arrays)  # type: ignore[arg-type]
+    return Path(out)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """``scripts/learn_train.py infer --cache C --models DIR -o OUT.npz``."""
     ap = argparse.ArgumentParser(description="Heatmap peaks of trained models on a tensor cache (torch + numpy only).")
@@ -87,6 +114,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("-o", "--out", required=True, help="output .npz")
     ap.add_argument("--device", default=None)
     ap.add_argument("--limit", type=int, default=None, help="first N items per model (smoke tests)")
+    ap.add_argument("--modes", default=",".join(MODES), help="the models to run (default: every one found)")
     a = ap.parse_args(argv)
-    infer_cache(Cache(a.cache), a.models, a.out, device=a.device, limit=a.limit)
+    modes = [m.strip() for m in a.modes.split(",") if m.strip()]
+    infer_cache(Cache(a.cache), a.models, a.out, device=a.device, limit=a.limit, modes=modes)
+    return 0
+
+
+def merge_main(argv: Sequence[str] | None = None) -> int:
+    """``scripts/learn_train.py merge -o OUT.npz PART.npz...``: :func:`merge_peaks`."""
+    ap = argparse.ArgumentParser(description="Join per-mode peak files of scripts/learn_train.py infer.")
+    ap.add_argument("parts", nargs="+")
+    ap.add_argument("-o", "--out", required=True, help="output .npz")
+    a = ap.parse_args(argv)
+    print(merge_peaks(a.parts, a.out))
     return 0

@@ -16,10 +16,12 @@ All lengths in metres; ranges in the ego LiDAR frame (x forward, y left, z up).
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, replace
+import json
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass, fields, replace
 from typing import Any
 
-__all__ = ["PRESETS", "Preset", "preset"]
+__all__ = ["PRESETS", "Preset", "parse_overrides", "preset"]
 
 
 @dataclass(frozen=True)
@@ -179,3 +181,44 @@ def preset(name: str, **overrides: Any) -> Preset:
     if name not in PRESETS:
         raise KeyError(f"preset {name!r}: allowed: {', '.join(PRESETS)}")
     return replace(PRESETS[name], **overrides)
+
+
+def parse_overrides(items: Sequence[str]) -> dict[str, Any]:
+    """``{field: value}`` from ``KEY=VALUE`` strings (``--set`` on the command line): ``KEY`` a :class:`Preset`
+    field other than ``name``, ``VALUE`` JSON of that field's kind (a number, ``true``/``false``, or a list for
+    the tuple fields, e.g. ``code_weights=[1,1,0.1,1,1,1,1,1]``); ``blocks`` as a list of ``[channels, layers,
+    stride]`` lists. Raises the training core's input error naming the item and what is allowed."""
+    from mmusv.learn._errors import input_error
+
+    defaults = {f.name: getattr(PRESETS["paper"], f.name) for f in fields(Preset) if f.name != "name"}
+    out: dict[str, Any] = {}
+    for item in items:
+        key, sep, text = item.partition("=")
+        key = key.strip()
+        if not sep or key not in defaults:
+            raise input_error(f"--set {item!r}: expected KEY=VALUE with KEY one of {', '.join(defaults)}")
+        try:
+            value = json.loads(text)
+        except json.JSONDecodeError:
+            raise input_error(f"--set {item!r}: the value is not JSON (a number, true/false or a list)") from None
+        old = defaults[key]
+        if isinstance(old, tuple):
+            ok = isinstance(value, list) and (key != "code_weights" or len(value) == len(old))
+            if ok and key == "blocks":
+                ok = all(isinstance(b, list) and len(b) == 3 and all(type(v) is int for v in b) for b in value)
+                value = tuple(tuple(b) for b in value) if ok else value
+            elif ok:
+                ok = all(type(v) in (int, float) for v in value) and (key == "code_weights" or len(value) == 2)
+                value = tuple(float(v) for v in value) if ok else value
+            what = "a list of [channels, layers, stride]" if key == "blocks" else f"a list of {len(old)} numbers"
+        elif isinstance(old, bool):
+            ok, what = type(value) is bool, "true or false"
+        elif isinstance(old, int):
+            ok, what = type(value) is int, "an integer"
+        else:
+            ok, what = type(value) in (int, float), "a number"
+            value = float(value) if ok else value
+        if not ok:
+            raise input_error(f"--set {item!r}: {key} must be {what}")
+        out[key] = value
+    return out

@@ -3,22 +3,33 @@ elsewhere, e.g. on a GPU machine without mmusv installed), for ``mmusv study det
 
 Each cloud's or sample's peaks get the rotated NMS of :func:`mmusv.learn.decode.decode` (the study's own
 :func:`~mmusv.studies.detection.fusion.rotated_nms` at the preset's ``nms_iou``): that is ``none`` (the ego's own
-cloud), ``early`` and ``intermediate``. ``late`` is made by the study's :func:`~mmusv.studies.detection.fusion.fuse`
-from the single-agent detections of the ego and its current neighbours, as ``--model`` would. Clean setting only
-(the robustness settings re-run early and intermediate fusion on delayed or noisy inputs: use ``--model``).
+cloud), ``early`` and ``intermediate``. With ``refine`` (``--refine``) the boxes then go through the geometric
+second stage as :class:`mmusv.learn.detector.LearnedDetector` applies it (:func:`mmusv.learn.refine.refine_boxes`
+on the points the model was given, then the rotated NMS again): the cloud's own points for ``none`` and
+``intermediate``, the ego's and its neighbours' points in the ego frame
+(:func:`mmusv.learn.example.early_cloud`) for ``early``; the points are the cache's, the model's very input.
+``late`` is made by the study's :func:`~mmusv.studies.detection.fusion.fuse` from the (refined) single-agent
+detections of the ego and its current neighbours, merged by rotated NMS or WBF (``late_merge``), as ``--model``
+would. Clean setting only (the robustness settings re-run early and intermediate fusion on delayed or noisy
+inputs: use ``--model``).
 
-``python -m mmusv.learn.replay PEAKS.npz CACHE.npz RECORDINGS... [--split test] -o PREDICTIONS.parquet``
+``python -m mmusv.learn.replay PEAKS.npz CACHE.npz RECORDINGS... [--split test] [--refine] [--late-merge wbf]
+-o PREDICTIONS.parquet``
 """
 
 from __future__ import annotations
 
 import argparse
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from functools import partial
 from pathlib import Path
 
 import numpy as np
 
+from mmusv.learn._errors import input_error
 from mmusv.learn.cache import Cache
+from mmusv.learn.example import early_cloud
+from mmusv.learn.refine import RefineParams, refine_boxes
 
 __all__ = ["main", "write_predictions"]
 
@@ -37,6 +48,12 @@ def _rows(z: dict[str, np.ndarray], mode: str, i: int) -> tuple[np.ndarray, np.n
     )
 
 
+def _aggregate(cache: Cache, k: int) -> np.ndarray:
+    """Sample ``k``'s ego and neighbour points in the ego frame: the early-fusion model's input."""
+    ego, nbs, _ = cache.sample(k)
+    return early_cloud(ego, nbs)
+
+
 def write_predictions(
     peaks: str | Path,
     cache: Cache,
@@ -47,34 +64,48 @@ def write_predictions(
     ratios: Sequence[float] = (0.7, 0.15, 0.15),
     seed: int = 0,
     nms_iou: float = 0.1,
+    refine: RefineParams | None = None,
+    late_merge: str = "nms",
 ) -> Path:
     """Writes the predictions Parquet (module docstring) of ``peaks`` on ``cache`` (built from the same
-    ``inputs`` and split) to ``out``; returns ``out``."""
+    ``inputs`` and split) to ``out``; returns ``out``. ``refine``: the second stage's parameters, or ``None`` for
+    the network's boxes; ``late_merge``: one of :data:`mmusv.studies.detection.fusion.LATE_MERGES`."""
     import polars as pl
 
     from mmusv.studies.detection.data import AgentFrame
-    from mmusv.studies.detection.fusion import fuse, rotated_nms
+    from mmusv.studies.detection.fusion import LATE_MERGES, fuse, rotated_nms
     from mmusv.studies.detection.robustness import Setting, neighbours_for
     from mmusv.studies.detection.sources import resolve_dataset
 
     with np.load(peaks) as f:
         z = {k: f[k] for k in f.files}
 
+    if late_merge not in LATE_MERGES:
+        raise input_error(f"--late-merge {late_merge!r}: allowed: {', '.join(LATE_MERGES)}")
+
     def nms(b: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         keep = rotated_nms(b, s, iou_threshold=nms_iou)
         return b[keep], s[keep]
+
+    def stage(b: np.ndarray, s: np.ndarray, points: Callable[[], np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        b, s = nms(b, s)
+        if refine is None or len(s) == 0:
+            return b, s
+        return nms(refine_boxes(points(), b, params=refine), s)
 
     own: dict[Key, tuple[np.ndarray, np.ndarray]] = {}
     fused: dict[tuple[Key, str], tuple[np.ndarray, np.ndarray]] = {}
     n_clouds = len(cache.arrays["cloud_offsets"]) - 1
     for c in range(n_clouds):
         if "single_offsets" in z:
-            own[cache.key(c)] = nms(*_rows(z, "single", c))
+            own[cache.key(c)] = stage(*_rows(z, "single", c), partial(cache.cloud, c))
     for k in range(len(cache)):
-        key = cache.key(int(cache.arrays["sample_cloud"][k]))
-        for mode in ("early", "intermediate"):
-            if f"{mode}_offsets" in z:
-                fused[(key, mode)] = nms(*_rows(z, mode, k))
+        ego_cloud = int(cache.arrays["sample_cloud"][k])
+        key = cache.key(ego_cloud)
+        if "early_offsets" in z:
+            fused[(key, "early")] = stage(*_rows(z, "early", k), partial(_aggregate, cache, k))
+        if "intermediate_offsets" in z:
+            fused[(key, "intermediate")] = stage(*_rows(z, "intermediate", k), partial(cache.cloud, ego_cloud))
     ds = resolve_dataset(list(inputs), opv2v=None, split=split, ratios=tuple(ratios), seed=seed)
     cols: dict[str, list[object]] = {
         c: [] for c in ("sequence", "frame", "ego", "mode", "x", "y", "z", "l", "w", "h", "yaw", "score")
@@ -99,7 +130,7 @@ def write_predictions(
                     def mine(a: AgentFrame, f: int = frame.frame, s: str = seq.name) -> tuple[np.ndarray, np.ndarray]:
                         return own[(s, f, a.id)]
 
-                    late = fuse("late", ego, nbs, detector=_no_detector, own_detections=mine)
+                    late = fuse("late", ego, nbs, detector=_no_detector, own_detections=mine, late_merge=late_merge)
                     add(key, "late", *late)
                 for mode in ("early", "intermediate"):
                     if (key, mode) in fused:
@@ -125,9 +156,17 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("inputs", nargs="+")
     ap.add_argument("--split", default="test")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument(
+        "--refine", action="store_true", help="the geometric second stage on every box (mmusv.learn.refine)"
+    )
+    ap.add_argument("--late-merge", default="nms", help="late fusion's merge: nms (default) or wbf")
     ap.add_argument("-o", "--out", required=True)
     a = ap.parse_args(argv)
-    print(write_predictions(a.peaks, Cache(a.cache), a.inputs, a.out, split=a.split, seed=a.seed))
+    refine = RefineParams() if a.refine else None
+    path = write_predictions(
+        a.peaks, Cache(a.cache), a.inputs, a.out, split=a.split, seed=a.seed, refine=refine, late_merge=a.late_merge
+    )
+    print(path)
     return 0
 
 

@@ -43,7 +43,7 @@ from mmusv.learn.cache import Cache
 from mmusv.learn.example import MODES, Example, collate, early_cloud, make_example
 from mmusv.learn.loss import centerpoint_loss
 from mmusv.learn.model import PillarNet
-from mmusv.learn.presets import PRESETS, Preset, preset
+from mmusv.learn.presets import PRESETS, Preset, parse_overrides, preset
 from mmusv.learn.targets import points_in_boxes
 
 __all__ = ["TrainResult", "TrainingSet", "main", "plot_losses", "plot_runs", "train"]
@@ -307,10 +307,21 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--device", default=None, help="cpu or cuda (default: cuda when available)")
     ap.add_argument("--threads", type=int, default=None, help="CPU threads of torch (default: torch's)")
     ap.add_argument("--no-progress", action="store_true")
+    ap.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a field of the preset (repeatable; VALUE as JSON), e.g. --set min_points=1 "
+        "--set code_weights=[1,1,0.1,1,1,1,1,1]; the checkpoint records the preset as trained",
+    )
     a = ap.parse_args(argv)
     if a.threads is not None:
         torch.set_num_threads(max(1, a.threads))
-    p = preset(a.preset)
+    overrides = parse_overrides(a.set)
+    p = preset(a.preset, **overrides)
+    if overrides:
+        print(f"preset {p.name} with {overrides}", flush=True)
     cache = Cache(a.cache)
     for mode in [m.strip() for m in a.modes.split(",") if m.strip()]:
         r = train(
@@ -327,7 +338,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             progress=not a.no_progress,
         )
         print(
-            f"{mode}: {r.epochs} epochs, {r.steps} steps, {r.seconds:.1f} s, finished={r.finished} -> {r.out}",
+            f"{mode}: {r.epochs} epochs, {r.steps} steps, {r.seconds:.1f} s "
+            f"({r.steps / max(r.seconds, 1e-9):.2f} steps/s), finished={r.finished} -> {r.out}",
             flush=True,
         )
     return 0

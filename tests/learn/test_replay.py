@@ -1,0 +1,114 @@
+"""Inference per mode and its merge, and the replay of the peaks (:mod:`mmusv.learn.replay`) against the study's
+learned detector: the peaks of ``scripts/learn_train.py infer`` run one mode at a time and merged equal one run
+of every mode, and the predictions replayed from them, with and without the second stage, equal what
+:class:`mmusv.learn.detector.LearnedDetector` gives on the same clouds (the model's input: the cache's points)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import polars as pl
+import pytest
+import yaml
+from mmusv.errors import InputError
+from mmusv.learn.cache import Cache, build_cache
+from mmusv.learn.detector import load_models
+from mmusv.learn.example import MODES, early_cloud
+from mmusv.learn.infer import infer_cache, merge_peaks
+from mmusv.learn.presets import preset
+from mmusv.learn.refine import RefineParams
+from mmusv.learn.replay import write_predictions
+from mmusv.learn.train import train
+from mmusv.studies.detection.sources import lidar_only
+
+SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "island_occlusion.yaml"
+
+
+@pytest.fixture(scope="module")
+def trained(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Cache, Path]:
+    """A 3-frame, 2-USV recording, its cache, and tiny models of every mode trained for a few steps (a low
+    score threshold, so that every cloud has peaks to refine)."""
+    from mmusv.acquire import run
+
+    root = tmp_path_factory.mktemp("replay")
+    data = lidar_only(yaml.safe_load(SCENARIO.read_text(encoding="utf-8")))
+    data["vessels"] = [v for v in data["vessels"] if v["role"] != "usv" or v["id"] in ("usv_1", "usv_3")]
+    data["name"] = "tiny_replay"
+    data["acquisition"]["frames"] = 3
+    rec = run(data, out_dir=root / "rec").recording
+    cache = Cache(build_cache([rec], root / "cache.npz", split="all"))
+    p = preset("tiny", x_range=(-48.0, 48.0), y_range=(-48.0, 48.0), score_threshold=0.02)
+    for mode in MODES:
+        train(cache, p=p, mode=mode, out=root / "models" / mode, epochs=1, max_steps=4, progress=False)
+    return rec, cache, root
+
+
+def test_per_mode_inference_merges_to_one_run(trained: tuple[Path, Cache, Path], tmp_path: Path) -> None:
+    _, cache, root = trained
+    models = root / "models"
+    whole = np.load(infer_cache(cache, models, tmp_path / "all.npz"))
+    parts = [infer_cache(cache, models, tmp_path / f"{m}.npz", modes=[m]) for m in MODES]
+    assert set(np.load(parts[0]).files) == {"single_boxes", "single_scores", "single_offsets"}
+    merged = np.load(merge_peaks([*parts, tmp_path / "missing.npz"], tmp_path / "merged.npz"))
+    assert sorted(merged.files) == sorted(whole.files)
+    assert all(np.array_equal(merged[k], whole[k]) for k in whole.files)
+    assert len(whole["single_scores"]) > 0
+    with pytest.raises(InputError, match="in two of the peak files"):
+        merge_peaks([parts[0], parts[0]], tmp_path / "twice.npz")
+    with pytest.raises(InputError, match="allowed: single, early, intermediate"):
+        infer_cache(cache, models, tmp_path / "bad.npz", modes=["late"])
+
+
+def _rows(df: pl.DataFrame, key: tuple[str, int, str], mode: str) -> tuple[np.ndarray, np.ndarray]:
+    sel = df.filter(
+        (pl.col("sequence") == key[0])
+        & (pl.col("frame") == key[1])
+        & (pl.col("ego") == key[2])
+        & (pl.col("mode") == mode)
+    )
+    return sel.select(["x", "y", "z", "l", "w", "h", "yaw"]).to_numpy(), sel["score"].to_numpy()
+
+
+@pytest.mark.parametrize("refine", [False, True])
+def test_replay_equals_the_detector_on_the_same_clouds(
+    trained: tuple[Path, Cache, Path], tmp_path: Path, refine: bool
+) -> None:
+    rec, cache, root = trained
+    peaks = infer_cache(cache, root / "models", tmp_path / "peaks.npz")
+    out = write_predictions(
+        peaks, cache, [rec], tmp_path / "pred.parquet", split="all", refine=RefineParams() if refine else None
+    )
+    df = pl.read_parquet(out)
+    assert set(df["mode"].unique().to_list()) == {"none", "late", "early", "intermediate"}
+    det = load_models(root / "models", refine=refine)
+    moved = 0
+    for k in range(len(cache)):
+        c = int(cache.arrays["sample_cloud"][k])
+        key = cache.key(c)
+        ego, nbs, _ = cache.sample(k)
+        expect = {
+            "none": det(ego),
+            "early": det.early(early_cloud(ego, nbs)),
+            "intermediate": det.intermediate(ego, nbs),
+        }
+        for mode, (b, s) in expect.items():
+            got_b, got_s = _rows(df, key, mode)
+            assert got_b.shape == b.shape, (key, mode)
+            np.testing.assert_allclose(got_s, s, rtol=1e-6)
+            np.testing.assert_allclose(got_b, b, atol=1e-3)
+        if refine:  # the second stage changed boxes: the network's own differ
+            net_b, _ = load_models(root / "models", refine=False)(ego)
+            moved += int(net_b.shape != expect["none"][0].shape or not np.allclose(net_b, expect["none"][0]))
+    assert len(cache) > 0
+    if refine:
+        assert moved > 0
+
+
+def test_replay_rejects_an_unknown_late_merge(trained: tuple[Path, Cache, Path], tmp_path: Path) -> None:
+    rec, cache, root = trained
+    peaks = infer_cache(cache, root / "models", tmp_path / "peaks.npz", modes=["single"])
+    with pytest.raises(InputError, match="--late-merge 'mean': allowed: nms, wbf"):
+        write_predictions(peaks, cache, [rec], tmp_path / "p.parquet", split="all", late_merge="mean")
+    out = write_predictions(peaks, cache, [rec], tmp_path / "p.parquet", split="all", late_merge="wbf")
+    assert set(pl.read_parquet(out)["mode"].unique().to_list()) == {"none", "late"}
