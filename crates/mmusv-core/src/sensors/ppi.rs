@@ -96,6 +96,23 @@ fn wrap(a: f64) -> f64 {
     (a + PI).rem_euclid(TAU) - PI
 }
 
+/// The trigonometry of one screen angle `θ` of a return: `(sin, cos)` of its cell's two edges `θ ∓ π/N` and of
+/// `θ` itself, and of each screen axis the cell spans (`None` for the others).
+#[derive(Debug, Clone, Copy)]
+struct Direction {
+    edges: [(f64, f64); 2],
+    axes: [Option<(f64, f64)>; 4],
+    centre: (f64, f64),
+}
+
+impl Direction {
+    fn new(theta: f64, half_az: f64) -> Self {
+        let edges = [(theta - half_az).sin_cos(), (theta + half_az).sin_cos()];
+        let axes = [0.0, FRAC_PI_2, PI, -FRAC_PI_2].map(|a| (wrap(a - theta).abs() <= half_az).then(|| a.sin_cos()));
+        Self { edges, axes, centre: theta.sin_cos() }
+    }
+}
+
 /// The `size × size` float32 PPI (row-major, row 0 at the top) of `returns` from a sensor with world yaw
 /// `sensor_yaw` (radians; used by north-up only). `cfg_radar` gives the cell size (`range_resolution_m`,
 /// `azimuth_bins`); only `range`, `azimuth` and `intensity` of the returns are read. Pixels without a return
@@ -144,9 +161,20 @@ pub fn ppi_image(
     let half_az = PI / cfg_radar.azimuth_bins as f64;
     let c = (cfg.size_px / 2) as f64;
     let yaw = sensor_yaw as f64;
+    // The trigonometry of a return depends on its azimuth alone, and a sweep's returns come azimuth by azimuth:
+    // worked out once per run of equal azimuths (the same values, so the same image).
+    let mut dir: Option<(f64, Direction)> = None;
     for i in 0..n {
         let (r, v) = (returns.range[i] as f64, returns.intensity[i]);
         let theta = cfg.screen_angle(returns.azimuth[i] as f64, yaw);
+        let g = match dir {
+            Some((t, g)) if t.to_bits() == theta.to_bits() => g,
+            _ => {
+                let g = Direction::new(theta, half_az);
+                dir = Some((theta, g));
+                g
+            }
+        };
         let (rho0, rho1) = (((r - half_range) / mpp).max(0.0), (r + half_range) / mpp);
         let mut paint = |row: i64, col: i64| {
             if (0..size as i64).contains(&row) && (0..size as i64).contains(&col) {
@@ -156,21 +184,18 @@ pub fn ppi_image(
         };
         // Bounding box of the annular sector: its corners plus the axis directions it spans.
         let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-        let mut add = |rho: f64, a: f64| {
-            let (s, co) = a.sin_cos();
+        let mut add = |rho: f64, (s, co): (f64, f64)| {
             x0 = x0.min(rho * co);
             x1 = x1.max(rho * co);
             y0 = y0.min(rho * s);
             y1 = y1.max(rho * s);
         };
-        for a in [theta - half_az, theta + half_az] {
-            add(rho0, a);
-            add(rho1, a);
+        for sc in g.edges {
+            add(rho0, sc);
+            add(rho1, sc);
         }
-        for axis in [0.0, FRAC_PI_2, PI, -FRAC_PI_2] {
-            if wrap(axis - theta).abs() <= half_az {
-                add(rho1, axis);
-            }
+        for sc in g.axes.iter().flatten() {
+            add(rho1, *sc);
         }
         let (col0, col1) = ((c + x0).floor() as i64, (c + x1).ceil() as i64);
         let (row0, row1) = ((c - y1).floor() as i64, (c - y0).ceil() as i64);
@@ -189,7 +214,7 @@ pub fn ppi_image(
             }
         }
         let rho = r / mpp;
-        paint((c - rho * theta.sin()).round() as i64, (c + rho * theta.cos()).round() as i64);
+        paint((c - rho * g.centre.0).round() as i64, (c + rho * g.centre.1).round() as i64);
     }
     Ok(img)
 }
