@@ -160,7 +160,7 @@ def test_recordings_carry_the_shares_as_annotated(tmp_path: Path) -> None:
 
     from mmusv.acquire import annotations_for, run
     from mmusv.annotate import SilhouetteCache
-    from mmusv.recording.reader import read_messages
+    from mmusv.recording.messages import read_messages
     from mmusv.recording.tables import read_table
     from mmusv.simulation import Simulation
 

@@ -362,14 +362,15 @@ def _write_failure(out: Path, rec_path: Path, problems: list[tuple[str, BaseExce
     safe, kept = "no frame is safe", 0
     if target.exists():
         try:
-            from mmusv.recording.reader import FrameStream, _ranges, read_info
+            from mmusv.recording.info import read_info
+            from mmusv.recording.stream import FrameStream, frame_ranges
 
             stream = FrameStream(read_info(target), want=lambda _t: False)
             frames = [fr.index for fr in stream]
             kept = len(frames)
             if frames:
                 safe = (
-                    f"frames {_ranges(frames)} are safe in {target} (the last completely written frame is "
+                    f"frames {frame_ranges(frames)} are safe in {target} (the last completely written frame is "
                     f"{max(frames)})"
                 )
                 if target == partial:

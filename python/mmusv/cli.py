@@ -251,7 +251,7 @@ def _cmd_info(args: argparse.Namespace) -> int:
     from rich.table import Table
 
     from mmusv.recording import summary
-    from mmusv.recording.reader import recording_name
+    from mmusv.recording.info import recording_name
 
     target = Path(args.recording)
     folder: Path | None = None

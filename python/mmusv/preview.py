@@ -4,7 +4,8 @@ One sheet per agent and frame, every panel titled ``<USV> · <sensor> · <modali
 the annotated 2D boxes, depth, semantic; one row each), then the radar PPI with range rings labelled in metres,
 the top view (RGB, semantic) and a bird's-eye view of the LiDAR points (x forward up, y left to the left) with the
 footprints of the annotated 3D boxes. Only panels the recording holds are drawn, so none is empty. Everything is
-read back through :mod:`mmusv.recording.reader`, so the picture shows what a user of the file gets.
+read back through the one reader (:mod:`mmusv.recording.info`, :mod:`mmusv.recording.messages`), so the picture
+shows what a user of the file gets.
 """
 
 from __future__ import annotations
@@ -21,12 +22,8 @@ from mmusv.classes import palette_array
 from mmusv.errors import ConfigError
 from mmusv.recording import topics
 from mmusv.recording.decode import decode_image, decode_point_cloud
-from mmusv.recording.reader import (
-    AgentInfo,
-    frame_messages,
-    read_info,
-    recording_name,
-)
+from mmusv.recording.info import AgentInfo, read_info, recording_name
+from mmusv.recording.messages import frame_messages
 
 __all__ = ["BOX_COLOUR", "Panel", "compose_preview", "write_preview"]
 

@@ -16,8 +16,11 @@ from mmusv.batch import run_many
 from mmusv.cli import main
 from mmusv.errors import ConfigError, IoError
 from mmusv.export import convert
+from mmusv.recording.contents import summary
+from mmusv.recording.info import find_recordings, read_info
+from mmusv.recording.messages import frame_messages
 from mmusv.recording.parts import read_parts_manifest
-from mmusv.recording.reader import FrameStream, find_recordings, frame_messages, read_info, summary
+from mmusv.recording.stream import FrameStream
 from mmusv.studies.detection.data import read_recording
 from mmusv.studies.detection.sources import resolve_dataset
 

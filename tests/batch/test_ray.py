@@ -14,7 +14,8 @@ import pytest
 import ray
 from mmusv.batch import build_dataset, run_many
 from mmusv.cli import main
-from mmusv.recording.reader import FrameStream, read_info
+from mmusv.recording.info import read_info
+from mmusv.recording.stream import FrameStream
 
 from .conftest import (
     GOOD,

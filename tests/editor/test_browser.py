@@ -21,7 +21,7 @@ import pytest
 from mmusv.bundled import resolve_scenario
 from mmusv.config import load_scenario
 from mmusv.generate.mapctx import map_context
-from mmusv.recording.reader import read_info
+from mmusv.recording.info import read_info
 from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys

@@ -67,7 +67,8 @@ def chunk_spans(path: Path) -> list[tuple[int, int]]:
 
 def frames_of(path: Path) -> tuple[dict[int, dict[str, bytes]], Any]:
     """``({frame: {topic: message bytes}}, stream)``: every frame the one reader yields, every topic decoded."""
-    from mmusv.recording.reader import FrameStream, read_info
+    from mmusv.recording.info import read_info
+    from mmusv.recording.stream import FrameStream
 
     stream = FrameStream(read_info(path), want=lambda _t: True)
     out = {fr.index: {t: m.SerializeToString() for t, m in fr.messages.items()} for fr in stream}
@@ -88,7 +89,9 @@ def cli_main(*args: str) -> tuple[int, str, str]:
 def api_readers(path: Path) -> dict[str, Any]:
     """Every API reader of the recording at ``path``: the result of each, or the ``MmusvError`` it raised."""
     from mmusv.errors import MmusvError
-    from mmusv.recording.reader import frame_messages, read_info, read_messages, summary
+    from mmusv.recording.contents import summary
+    from mmusv.recording.info import read_info
+    from mmusv.recording.messages import frame_messages, read_messages
 
     results: dict[str, Any] = {}
     calls: dict[str, Callable[[], Any]] = {

@@ -57,7 +57,7 @@ def _term(proc: Any, ready: Any, *, timeout: float = 120) -> tuple[str, str]:
 
 
 def test_sigterm_ends_a_run_with_its_frames_kept(tmp_path: Path) -> None:
-    from mmusv.recording.reader import summary
+    from mmusv.recording.contents import summary
 
     src = write_yaml(tmp_path / "long.yaml", scenario("long", frames=400, dense=True))
     out = tmp_path / "out"
@@ -98,7 +98,7 @@ def test_sigterm_ends_dataset_and_reaps_its_pool_workers(tmp_path: Path) -> None
         return bool(started) and time.monotonic() - started[0] > 1.0
 
     _term(proc, recording, timeout=240)
-    from mmusv.recording.reader import summary
+    from mmusv.recording.contents import summary
 
     finished = 0
     for manifest in (out / "recordings").glob("*/manifest.json"):

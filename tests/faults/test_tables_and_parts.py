@@ -68,7 +68,7 @@ def test_a_damaged_parquet_part_is_named_and_its_frames_listed(parted: Path, tmp
 
 def test_a_parts_manifest_naming_a_missing_part(tmp_path: Path) -> None:
     from mmusv.batch import run_many
-    from mmusv.recording.reader import summary
+    from mmusv.recording.contents import summary
 
     src = tmp_path / "src"
     write_yaml(src / "tiny.yaml", scenario("tiny", frames=12))
@@ -89,7 +89,7 @@ def test_a_parts_manifest_naming_a_missing_part(tmp_path: Path) -> None:
     code, out, err = cli_main("info", str(manifest))
     assert code == 0 and "mmusv: warning:" in out and "4..7" in out, out
     with pytest.raises(MmusvError, match="not recorded"):
-        from mmusv.recording.reader import frame_messages
+        from mmusv.recording.messages import frame_messages
 
         frame_messages(manifest, 5)
     # a manifest that is not JSON, or names a part outside its folder: one line naming the file

@@ -211,7 +211,7 @@ def test_camera_image_options_reach_the_recording(tmp_path: Path) -> None:
     written beside the intrinsics (recording metadata, read back by the one reader)."""
     import yaml
     from mmusv.acquire import run
-    from mmusv.recording.reader import read_info
+    from mmusv.recording.info import read_info
 
     root = Path(__file__).resolve().parents[2]
     sc = yaml.safe_load((root / "scenarios/port_entry.yaml").read_text())

@@ -1,7 +1,7 @@
 """Converting recordings into public dataset layouts (``mmusv convert REC.mcap --to FORMAT -o DIR``): OPV2V,
 KITTI-style per-agent folders, ROS 2 bags, COCO, YOLO, MaSTr1325-style masks and SemanticKITTI (``docs/exports.md``).
 
-Modules, one job each: :mod:`~mmusv.recording.reader` (recording → frames), :mod:`~mmusv.export.convert` (the one
+Modules, one job each: :mod:`~mmusv.recording.stream` (recording → frames), :mod:`~mmusv.export.convert` (the one
 job every format shares: reading, validation, splitting, frame selection, progress and its report),
 :mod:`~mmusv.export.writer` (the writer base and its hooks), :mod:`~mmusv.export.geometry` (sensor poses and
 targets per agent, mmusv frames), :mod:`~mmusv.export.splits` (train/validate/test by sequence),

@@ -18,7 +18,9 @@ from mmusv.classes import SemanticClass, class_name
 from mmusv.export.common import Options, Sink
 from mmusv.export.writer import DatasetWriter
 from mmusv.recording import topics
-from mmusv.recording.reader import AgentInfo, CameraInfo, Frame, WorldFrame
+from mmusv.recording.decode import WorldFrame
+from mmusv.recording.info import AgentInfo, CameraInfo
+from mmusv.recording.stream import Frame
 
 __all__ = ["CATEGORIES", "CameraWriter", "ImageBox", "Sample", "Shared"]
 

@@ -27,7 +27,7 @@ from mmusv.export.camera import CATEGORIES, CameraWriter, Sample, Shared, catego
 from mmusv.export.common import Options, Sink, png_bytes
 from mmusv.export.splits import SPLIT_NAMES
 from mmusv.jsonio import dump_json
-from mmusv.recording.reader import RecordingInfo
+from mmusv.recording.info import RecordingInfo
 
 __all__ = ["CocoWriter", "annotations_file"]
 

@@ -1,9 +1,10 @@
 """``convert``: recordings → a dataset folder in one of the formats of :data:`~mmusv.export.common.TARGETS`,
 optionally split by sequence.
 
-One job for every format: it reads and validates every recording (:mod:`mmusv.recording.reader`), splits them by
-sequence (:mod:`mmusv.export.splits`), selects the complete frames, reports progress and skipped frames, and hands
-each complete frame to the format's :class:`~mmusv.export.writer.DatasetWriter`. Output root ``out_dir``:
+One job for every format: it reads and validates every recording (:mod:`mmusv.recording.info`,
+:mod:`mmusv.recording.stream`), splits them by sequence (:mod:`mmusv.export.splits`), selects the complete frames,
+reports progress and skipped frames, and hands each complete frame to the format's
+:class:`~mmusv.export.writer.DatasetWriter`. Output root ``out_dir``:
 ``{train,validate,test}/<scenario>/...`` (or ``<scenario>/...`` with ``splits=None``) for the formats with one
 folder per recording (OPV2V, KITTI, MaSTr; ROS 2 bags, never split), the format's own layout for the others (COCO,
 YOLO, SemanticKITTI: see their modules), plus ``conversion.yaml`` (options, sources, split of every recording,
@@ -29,7 +30,8 @@ from mmusv.errors import ConfigError, IoError
 from mmusv.export.common import DEFAULT_EXTRAS, TARGETS, Options, Sink, dump_yaml, parse_extras
 from mmusv.export.splits import DEFAULT_RATIOS, SPLIT_NAMES, assign_splits, parse_ratios
 from mmusv.export.writer import DatasetWriter
-from mmusv.recording.reader import FrameStream, RecordingInfo, read_info
+from mmusv.recording.info import RecordingInfo, read_info
+from mmusv.recording.stream import FrameStream
 
 __all__ = ["REPORT_NAME", "ConvertReport", "RecordingReport", "convert", "writer_class"]
 

@@ -2,7 +2,7 @@
 
 Everything here stays in mmusv's right-handed frames; the dataset writers change frames only through
 :mod:`mmusv.frames`. Sensor poses follow the recorder: sensor → world = vessel body → world (from the world
-state pose) · sensor mount in body, composed by :meth:`mmusv.recording.reader.AgentInfo.sensor_poses`.
+state pose) · sensor mount in body, composed by :meth:`mmusv.recording.info.AgentInfo.sensor_poses`.
 """
 
 from __future__ import annotations
@@ -13,7 +13,8 @@ import numpy as np
 
 from mmusv.annotate import in_target_range
 from mmusv.frames import invert, pose_matrices
-from mmusv.recording.reader import AgentInfo, WorldFrame
+from mmusv.recording.decode import WorldFrame
+from mmusv.recording.info import AgentInfo
 
 __all__ = ["AgentView", "Target", "agent_view", "targets_of"]
 

@@ -26,7 +26,9 @@ from mmusv.export.geometry import AgentView, Target
 from mmusv.export.writer import DatasetWriter
 from mmusv.frames import BODY_TO_OPTICAL, invert, transform_points, wrap_rad
 from mmusv.recording import topics
-from mmusv.recording.reader import AgentInfo, Frame, WorldFrame
+from mmusv.recording.decode import WorldFrame
+from mmusv.recording.info import AgentInfo
+from mmusv.recording.stream import Frame
 
 __all__ = ["KittiWriter", "front_calib", "kitti_label", "kitti_numbers", "occlusion_level"]
 

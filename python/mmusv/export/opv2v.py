@@ -35,7 +35,8 @@ from mmusv.export.pcd import pcd_bytes
 from mmusv.export.writer import DatasetWriter
 from mmusv.frames import carla_matrix, carla_pose, invert, mirror_points
 from mmusv.recording import topics
-from mmusv.recording.reader import Frame, WorldFrame
+from mmusv.recording.decode import WorldFrame
+from mmusv.recording.stream import Frame
 
 __all__ = ["OPV2V_CAMERAS", "Opv2vWriter", "timestamp"]
 

@@ -25,7 +25,9 @@ from mmusv.errors import ConfigError
 from mmusv.export.writer import DatasetWriter
 from mmusv.frames import BODY_TO_OPTICAL, pose_matrices
 from mmusv.recording import topics
-from mmusv.recording.reader import AgentInfo, Frame, RecordingInfo, WorldFrame
+from mmusv.recording.decode import WorldFrame
+from mmusv.recording.info import AgentInfo, RecordingInfo
+from mmusv.recording.stream import Frame
 
 __all__ = [
     "MAP_FRAME",

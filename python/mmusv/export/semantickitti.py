@@ -33,7 +33,7 @@ from mmusv.export.kitti import front_calib, kitti_numbers
 from mmusv.export.writer import DatasetWriter
 from mmusv.frames import invert
 from mmusv.recording import topics
-from mmusv.recording.reader import Frame
+from mmusv.recording.stream import Frame
 
 __all__ = ["LABEL_MAP_NAME", "SemanticKittiWriter", "label_words"]
 

@@ -11,7 +11,9 @@ from mmusv.errors import ConfigError
 from mmusv.export.common import Options, Sink
 from mmusv.export.geometry import AgentView, Target, agent_view, targets_of
 from mmusv.recording import topics
-from mmusv.recording.reader import AgentInfo, Frame, RecordingInfo, WorldFrame
+from mmusv.recording.decode import WorldFrame
+from mmusv.recording.info import AgentInfo, RecordingInfo
+from mmusv.recording.stream import Frame
 
 __all__ = ["DatasetWriter"]
 

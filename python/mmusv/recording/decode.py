@@ -1,9 +1,12 @@
-"""Foxglove messages of a recording as numpy arrays: images (``RawImage``, PNG ``CompressedImage``) and point
-clouds (``PointCloud``, packed fields). Used by every reader of recordings (preview, export, studies)."""
+"""Messages of a recording as numpy arrays: Foxglove images (``RawImage``, PNG ``CompressedImage``) and point
+clouds (``PointCloud``, packed fields), and mmusv's ``/world/state`` (:class:`WorldFrame`: per-vessel poses,
+velocities and boxes in the world frame, metres, radians). Used by every reader of recordings (preview, export,
+studies)."""
 
 from __future__ import annotations
 
 import io
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -11,7 +14,7 @@ from PIL import Image
 
 from mmusv.errors import IoError
 
-__all__ = ["decode_image", "decode_point_cloud"]
+__all__ = ["WorldFrame", "decode_image", "decode_point_cloud"]
 
 _NUMPY = {1: np.uint8, 2: np.int8, 3: np.uint16, 4: np.int16, 5: np.uint32, 6: np.int32, 7: np.float32, 8: np.float64}
 
@@ -50,3 +53,44 @@ def decode_point_cloud(msg: Any) -> dict[str, np.ndarray]:
         dt = np.dtype(_NUMPY[int(f.type)]).newbyteorder("<")
         out[f.name] = rows[:, f.offset : f.offset + dt.itemsize].copy().view(dt).reshape(n)
     return out
+
+
+@dataclass(frozen=True)
+class WorldFrame:
+    """One ``/world/state``: per vessel (scenario vessels in file order, then moored ships) its id, asset,
+    role, class, instance, pose ``(V, 6)`` [x, y, z, roll, pitch, yaw], velocity ``(V, 3)``, box centre
+    ``(V, 3)`` (world) and box size ``(V, 3)`` (length, beam, height)."""
+
+    frame: int
+    time_s: float
+    ids: list[str]
+    assets: list[str]
+    roles: list[str]
+    classes: np.ndarray
+    instance_ids: np.ndarray
+    poses: np.ndarray
+    velocities: np.ndarray
+    box_centers: np.ndarray
+    box_sizes: np.ndarray
+
+    @staticmethod
+    def from_message(msg: Any) -> WorldFrame:
+        """From a decoded ``mmusv.WorldState``."""
+        vs = list(msg.vessels)
+
+        def rows(attr: str, k: int) -> np.ndarray:
+            return np.array([list(getattr(v, attr)) for v in vs], dtype=np.float64).reshape(len(vs), k)
+
+        return WorldFrame(
+            frame=int(msg.frame),
+            time_s=float(msg.time_s),
+            ids=[v.id for v in vs],
+            assets=[v.asset for v in vs],
+            roles=[v.role for v in vs],
+            classes=np.array([v.semantic_class for v in vs], dtype=np.int64),
+            instance_ids=np.array([v.instance_id for v in vs], dtype=np.int64),
+            poses=rows("pose", 6),
+            velocities=rows("velocity", 3),
+            box_centers=rows("box_center", 3),
+            box_sizes=rows("box_size", 3),
+        )

@@ -2,8 +2,9 @@
 
 A long scenario can be recorded as parts, each written by its own task (:mod:`mmusv.batch`) with
 :func:`mmusv.acquire.run` ``frame_range=(first, stop)``. The parts manifest ``<name>.parts.json`` lists them in
-frame order; :mod:`mmusv.recording.reader` reads a manifest as one sequence (every consumer: ``info``, preview,
-conversion, the studies). Layout (JSON object)::
+frame order; the readers (:mod:`mmusv.recording.info`, :mod:`mmusv.recording.stream`,
+:mod:`mmusv.recording.messages`, :mod:`mmusv.recording.contents`) read a manifest as one sequence (every consumer:
+``info``, preview, conversion, the studies), each part through :func:`part_files`. Layout (JSON object)::
 
     {"format": "mmusv.parts", "version": 1, "scenario": NAME, "config_hash": SHA256, "frames": N,
      "parts": [{"first_frame": 0, "frames": 50, "recording": "parts/000000-000049/NAME.mcap"}, ...]}
@@ -26,6 +27,7 @@ __all__ = [
     "Part",
     "PartsManifest",
     "is_parts_manifest",
+    "part_files",
     "part_folder",
     "read_parts_manifest",
     "split_ranges",
@@ -146,3 +148,15 @@ def read_parts_manifest(path: str | os.PathLike[str]) -> PartsManifest:
         raise IoError(f"{p}: invalid field value ({exc})") from None
     _check(p, m)
     return m
+
+
+def part_files(path: Path) -> list[tuple[int, int, Path | None]]:
+    """``(first_frame, stop, file or None)`` of every part of the manifest at ``path``: the finished ``.mcap``,
+    else its ``.partial`` (an interrupted part), else None (not recorded yet)."""
+    m = read_parts_manifest(path)
+    out: list[tuple[int, int, Path | None]] = []
+    for part in m.parts:
+        f = path.parent / part.recording
+        partial = f.with_name(f.name + ".partial")
+        out.append((part.first_frame, part.stop, f if f.is_file() else partial if partial.is_file() else None))
+    return out

@@ -28,8 +28,9 @@ from pathlib import Path
 from typing import Any
 
 from mmusv.errors import IoError
-from mmusv.recording.reader import FrameStream, RecordingInfo, check_mcap, read_info
+from mmusv.recording.info import RecordingInfo, check_mcap, read_info
 from mmusv.recording.scan import Scan
+from mmusv.recording.stream import FrameStream
 from mmusv.recording.tables import TableWriter
 
 __all__ = ["Recovered", "find_partial", "rebuild_tables", "recover"]
@@ -52,9 +53,9 @@ class Recovered:
 
     def lines(self) -> list[str]:
         """What to tell the user, one line each."""
-        from mmusv.recording.reader import _ranges
+        from mmusv.recording.stream import frame_ranges
 
-        got = f"frames {_ranges(self.frames)}" if self.frames else "no complete frame"
+        got = f"frames {frame_ranges(self.frames)}" if self.frames else "no complete frame"
         out = [
             f"recovered {len(self.frames)} of {self.frames_configured} frames ({got}) from {self.source} "
             f"into {self.recording}"

@@ -1,4 +1,6 @@
-"""Walking the records of an MCAP file that may be damaged: the ground floor of :mod:`mmusv.recording.reader`.
+"""Walking the records of an MCAP file that may be damaged: the ground floor of the reader
+(:mod:`mmusv.recording.info`, :mod:`mmusv.recording.stream`, :mod:`mmusv.recording.messages`,
+:mod:`mmusv.recording.contents`).
 
 :class:`Scan` reads one file front to back, record by record, with plain reads (no memory map: a file that
 shrinks under a reader must not crash it) and never trusts a length it has not checked against the file size:

@@ -241,11 +241,11 @@ class TableRead:
         """One line about what is wrong, or ``None``."""
         if not self.damaged and not self.missing:
             return None
-        from mmusv.recording.reader import _ranges
+        from mmusv.recording.stream import frame_ranges
 
         parts = list(self.damaged)
         if self.missing:
-            parts.append(f"frames {_ranges(self.missing)} have no {self.table} rows")
+            parts.append(f"frames {frame_ranges(self.missing)} have no {self.table} rows")
         return f"table {self.table}: " + "; ".join(parts)
 
 

@@ -1,4 +1,5 @@
-"""Writing MCAP recordings (reading them back: :mod:`mmusv.recording.reader`).
+"""Writing MCAP recordings (reading them back: :mod:`mmusv.recording.info`, :mod:`mmusv.recording.stream`,
+:mod:`mmusv.recording.messages`, :mod:`mmusv.recording.contents`).
 
 :class:`Recording` streams every USV's sensors and the world state of each frame into ONE MCAP file that opens
 in Foxglove and whose channels all decode with the ``mcap`` + ``mcap-protobuf-support`` readers. It wraps the

@@ -17,7 +17,6 @@ from __future__ import annotations
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from types import ModuleType
 
 import numpy as np
 import yaml
@@ -120,13 +119,6 @@ def _box_mats(poses: np.ndarray, centres: np.ndarray) -> np.ndarray:
     return m
 
 
-def _reader() -> ModuleType:
-    """The project's one recording reader (:mod:`mmusv.recording.reader`): the one place this package imports it."""
-    from mmusv.recording import reader
-
-    return reader
-
-
 @dataclass(frozen=True)
 class RecordingSummary:
     """What a recording says about itself without reading its frames."""
@@ -139,36 +131,41 @@ class RecordingSummary:
 def recording_summary(path: str | Path) -> RecordingSummary:
     """The frame count, config hash and completeness (summary section present) of a recording; raises
     :class:`~mmusv.IoError` for a file that is not one."""
-    info = _reader().read_info(path)
+    from mmusv.recording.info import read_info
+
+    info = read_info(path)
     return RecordingSummary(int(info.frames_configured), str(info.config_hash), bool(info.has_summary))
 
 
 def find_recordings(folder: str | Path) -> list[Path]:
     """The recordings below ``folder`` (``.mcap`` files and parts manifests of split recordings, whose parts are
     not listed on their own), sorted."""
-    found: list[Path] = _reader().find_recordings(folder)
-    return found
+    from mmusv.recording.info import find_recordings as find
+
+    return find(folder)
 
 
 def recording_name(path: str | Path) -> str:
     """A recording's name: its file name without ``.mcap`` or ``.parts.json``."""
-    name: str = _reader().recording_name(path)
-    return name
+    from mmusv.recording.info import recording_name as name
+
+    return name(path)
 
 
 def read_recording(path: str | Path) -> SequenceData:
     """A recording (``mmusv run`` MCAP) as a sequence: every frame with the LiDAR of every instrumented USV that
     has one. Raises :class:`~mmusv.IoError` for a file that is not a readable recording."""
     from mmusv.recording.decode import decode_point_cloud
+    from mmusv.recording.info import read_info
+    from mmusv.recording.stream import FrameStream, warn_missing
 
-    reader = _reader()
-    info = reader.read_info(path)
+    info = read_info(path)
     agents = [a for a in info.agents if a.lidar_mount is not None]
     from mmusv.recording import topics as names
 
     topics = {names.lidar(a.id) for a in agents}
     frames: list[SceneFrame] = []
-    stream = reader.FrameStream(info, want=topics.__contains__)
+    stream = FrameStream(info, want=topics.__contains__)
     for fr in stream:
         w = fr.world
         if w is None or not all(t in fr.messages for t in topics):
@@ -192,7 +189,7 @@ def read_recording(path: str | Path) -> SequenceData:
                 usv_sizes=w.box_sizes[is_usv],
             )
         )
-    reader.warn_missing(stream, reader="the detection study")  # frames missing or damaged: said, not dropped silently
+    warn_missing(stream, reader="the detection study")  # frames missing or damaged: said, not dropped silently
     frames.sort(key=lambda f: f.frame)
     return SequenceData(recording_name(info.path), tuple(frames))
 

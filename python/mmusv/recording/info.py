@@ -1,0 +1,309 @@
+"""The metadata of an ``mmusv run`` recording, read without decoding any message: what a recording says about
+itself (:class:`RecordingInfo`: scenario, config hash, seed, rate, frames, its instrumented agents and ``run``).
+
+:func:`read_info` reads the metadata records (``scenario``, ``manifest``, ``sensors``, ``run``) from the summary
+section when the file has one, otherwise from the records before the first chunk (a truncated or ``.partial``
+file; :mod:`mmusv.recording.scan` hops over the chunks). Given a parts manifest (:mod:`mmusv.recording.parts`) it
+merges the recorded parts' metadata (``run.status`` is ``complete`` only when every part is). Mounts are
+``(4, 4)`` sensor → vessel body matrices (metres; body frame x forward, y left, z up); camera intrinsics are
+pixels. :func:`check_mcap` says whether a path is an MCAP file at all, :func:`recording_name` and
+:func:`find_recordings` name and find recordings (an ``.mcap`` or a parts manifest, which stands for its parts).
+The frames themselves: :mod:`mmusv.recording.stream`.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import yaml
+
+from mmusv.errors import IoError
+from mmusv.recording.parts import is_parts_manifest, part_files, read_parts_manifest
+from mmusv.recording.scan import MAGIC, Scan
+
+if TYPE_CHECKING:
+    from mmusv.recording.decode import WorldFrame
+
+__all__ = [
+    "AgentInfo",
+    "CameraInfo",
+    "RecordingInfo",
+    "check_mcap",
+    "find_recordings",
+    "read_info",
+    "recording_name",
+]
+
+
+@dataclass(frozen=True)
+class CameraInfo:
+    """A pinhole camera of an agent: image size, intrinsics ``(fx, fy, cx, cy)`` pixels, ``mount``
+    ``(4, 4)`` camera body (x forward = optical axis, y left, z up) → vessel body, recorded outputs, and its
+    Brown–Conrady ``distortion`` ``(k1, k2, p1, p2, k3)`` (OpenCV's order; ``None``: an ideal pinhole)."""
+
+    name: str
+    width: int
+    height: int
+    hfov_deg: float
+    intrinsics: tuple[float, float, float, float]
+    mount: np.ndarray
+    outputs: tuple[str, ...]
+    distortion: tuple[float, float, float, float, float] | None = None
+
+
+def _distortion(value: Any) -> tuple[float, float, float, float, float] | None:
+    """A recorded camera's ``distortion`` entry: five finite numbers, or ``None`` (absent or null)."""
+    if value is None:
+        return None
+    vals = [float(x) for x in value]
+    if len(vals) != 5 or not all(math.isfinite(x) for x in vals):
+        raise IoError(f"camera distortion must be five finite numbers [k1, k2, p1, p2, k3], got {value!r}")
+    return (vals[0], vals[1], vals[2], vals[3], vals[4])
+
+
+@dataclass(frozen=True)
+class AgentInfo:
+    """An instrumented USV: ``index`` in the scenario's vessel list (= its row in the world state), mounts
+    ``(4, 4)`` sensor → vessel body, its cameras and the rig as recorded."""
+
+    id: str
+    index: int
+    asset: str
+    lidar_mount: np.ndarray | None
+    radar_mount: np.ndarray | None
+    cameras: dict[str, CameraInfo]
+    rig: dict[str, Any]
+
+    def sensor_poses(self, world: WorldFrame) -> tuple[np.ndarray, np.ndarray | None, dict[str, np.ndarray]]:
+        """``(body, lidar, cameras)`` at ``world``: ``(4, 4)`` vessel body → world (from the world-state pose) and
+        sensor → world = body · the recorded mount (LiDAR ``None`` without one; cameras by name, camera body frame
+        x forward = optical axis). The one place a reader of the file composes body and mount."""
+        from mmusv.frames import pose_matrices
+
+        body = pose_matrices(world.poses[self.index])
+        lidar = None if self.lidar_mount is None else body @ self.lidar_mount
+        return body, lidar, {name: body @ c.mount for name, c in self.cameras.items()}
+
+    @property
+    def ppi_metres_per_pixel(self) -> float | None:
+        """Metres per pixel of the recorded radar PPI (``ppi_metres_per_pixel``, default ``range_m / (ppi_size_px
+        / 2)``, as in :class:`mmusv.sensors.config.RadarConfig`); ``None`` without a radar."""
+        radar = self.rig.get("radar")
+        if not radar:
+            return None
+        mpp = radar.get("ppi_metres_per_pixel")
+        return float(mpp) if mpp else float(radar["range_m"]) / (int(radar["ppi_size_px"]) / 2)
+
+
+@dataclass
+class RecordingInfo:
+    """What a recording says about itself (metadata only)."""
+
+    path: Path
+    scenario_name: str
+    scenario: dict[str, Any]
+    config_hash: str
+    seed: int | None
+    mmusv_version: str
+    frequency_hz: float
+    frames_configured: int
+    agents: list[AgentInfo]
+    run: dict[str, str]
+    has_summary: bool
+    parts: tuple[Path, ...] = ()
+    """For a parts manifest: the recorded part files in frame order (``path`` is the manifest); else empty."""
+
+    @property
+    def vessel_ids(self) -> list[str]:
+        """Scenario vessel ids in file order (rows ``0..n-1`` of every world state)."""
+        return [str(v["id"]) for v in self.scenario.get("vessels", [])]
+
+
+def check_mcap(path: str | Path) -> Path:
+    """``path`` as a Path after checking it is an existing, readable, non-empty file that starts with the MCAP
+    magic; :class:`~mmusv.errors.IoError` naming the file otherwise."""
+    p = Path(path)
+    try:
+        if not p.exists():
+            raise IoError(f"recording {p} does not exist")
+        if not p.is_file():
+            raise IoError(f"recording {p} is not a file" + (" (it is a directory)" if p.is_dir() else ""))
+        with p.open("rb") as f:
+            head = f.read(len(MAGIC))
+    except OSError as exc:
+        raise IoError(f"recording {p} cannot be read: {exc.strerror or exc}") from None
+    if not head:
+        raise IoError(f"{p} is empty (0 bytes): not an MCAP recording")
+    if head != MAGIC:
+        raise IoError(f"{p} is not an MCAP file (it does not start with the MCAP magic bytes)")
+    return p
+
+
+def _scan_metadata(p: Path) -> Scan:
+    """A walk over the records of ``p`` that hops over the chunks: its metadata, whether it is complete."""
+    scan = Scan(p, chunks=False)
+    try:
+        for _ in scan.messages():
+            pass
+    except OSError as exc:
+        raise IoError(f"recording {p} cannot be read: {exc.strerror or exc}") from None
+    return scan
+
+
+def _mat(v: Any) -> np.ndarray | None:
+    if v is None:
+        return None
+    return np.asarray(v, dtype=np.float64).reshape(4, 4)
+
+
+def recording_name(path: str | os.PathLike[str]) -> str:
+    """The name of the recording at ``path``: the file name without ``.mcap`` (``.mcap.partial``) or
+    ``.parts.json``."""
+    name = Path(path).name
+    for suffix in (".parts.json", ".mcap.partial", ".mcap"):
+        if name.endswith(suffix):
+            return name[: -len(suffix)]
+    return Path(path).stem
+
+
+def find_recordings(folder: str | os.PathLike[str]) -> list[Path]:
+    """The recordings below ``folder``, sorted: every parts manifest and every ``.mcap`` that is not one of a
+    manifest's parts."""
+    root = Path(folder)
+    manifests = sorted(root.rglob("*.parts.json"))
+    parts = set()
+    for m in manifests:
+        parts |= {(m.parent / p.recording).resolve() for p in read_parts_manifest(m).parts}
+    mcaps = [p for p in sorted(root.rglob("*.mcap")) if p.resolve() not in parts]
+    return sorted([*manifests, *mcaps])
+
+
+def _read_parts_info(p: Path) -> RecordingInfo:
+    m = read_parts_manifest(p)
+    files = part_files(p)
+    infos = [(first, read_info(f)) for first, _stop, f in files if f is not None]
+    if not infos:
+        raise IoError(
+            f"{p}: none of its {len(files)} parts is recorded yet (the first is {p.parent / m.parts[0].recording})"
+        )
+    for first, i in infos:
+        if i.config_hash != m.config_hash:
+            raise IoError(
+                f"{p}: part {i.path} was recorded from another configuration (config hash {i.config_hash[:12]}, "
+                f"the manifest says {m.config_hash[:12]})"
+            )
+        got = i.run.get("first_frame")
+        if got is not None and int(got) != first:
+            raise IoError(f"{p}: part {i.path} starts at frame {got}, the manifest says {first}")
+    base = infos[0][1]
+    done = sum(1 for _f, i in infos if i.run.get("status") == "complete")
+    status = "complete" if done == len(files) else f"incomplete ({done} of {len(files)} parts complete)"
+    run = {k: v for k, v in base.run.items() if k not in ("status", "error", "first_frame")}
+    run.update(
+        status=status,
+        frames_written=str(sum(int(i.run.get("frames_written", 0) or 0) for _f, i in infos)),
+        frames_requested=str(m.frames),
+        parts=str(len(files)),
+    )
+    return RecordingInfo(
+        path=p,
+        scenario_name=base.scenario_name,
+        scenario=base.scenario,
+        config_hash=m.config_hash,
+        seed=base.seed,
+        mmusv_version=base.mmusv_version,
+        frequency_hz=base.frequency_hz,
+        frames_configured=base.frames_configured,
+        agents=base.agents,
+        run=run,
+        has_summary=status == "complete" and all(i.has_summary for _f, i in infos),
+        parts=tuple(i.path for _f, i in infos),
+    )
+
+
+def read_info(path: str | Path) -> RecordingInfo:
+    """The metadata of the recording at ``path`` (an ``.mcap`` or a parts manifest; see the module docstring)."""
+    if is_parts_manifest(path):
+        return _read_parts_info(Path(path))
+    p = check_mcap(path)
+    scan = _scan_metadata(p)
+    meta = scan.metadata
+    if "sensors" not in meta or "scenario" not in meta:
+        hurt = "; ".join(d.describe() for d in scan.damage if not d.truncated or not meta)
+        raise IoError(
+            f"{p} has no scenario/sensors metadata; was it written by mmusv run?"
+            + (f" (damaged: {hurt})" if hurt else "")
+        )
+    try:
+        return _info(p, meta, scan.complete and not scan.damage)
+    except (KeyError, IndexError, TypeError, ValueError, AttributeError, yaml.YAMLError) as exc:
+        raise IoError(f"{p}: unreadable scenario/sensors metadata ({type(exc).__name__}: {exc})") from None
+
+
+def _info(p: Path, meta: dict[str, dict[str, str]], has_summary: bool) -> RecordingInfo:
+    sensors = json.loads(meta["sensors"]["json"])
+    scenario = yaml.safe_load(meta["scenario"]["yaml"])
+    if not isinstance(sensors, dict) or not isinstance(scenario, dict):
+        raise ValueError("the scenario and sensors metadata must be mappings")
+    manifest = meta.get("manifest", {})
+    run = meta.get("run", {})
+    ids = [str(v["id"]) for v in scenario.get("vessels", [])]
+    acq = scenario.get("acquisition", {})
+    agents: list[AgentInfo] = []
+    for aid, s in sensors.items():
+        if aid not in ids:
+            raise IoError(f"{p}: sensors metadata names agent {aid!r}, which is not a scenario vessel")
+        cams = {
+            name: CameraInfo(
+                name=name,
+                width=int(c["resolution"][0]),
+                height=int(c["resolution"][1]),
+                hfov_deg=float(c["hfov_deg"]),
+                intrinsics=(
+                    float(c["intrinsics"][0]),
+                    float(c["intrinsics"][1]),
+                    float(c["intrinsics"][2]),
+                    float(c["intrinsics"][3]),
+                ),
+                mount=np.asarray(c["mount_in_body"], dtype=np.float64).reshape(4, 4),
+                outputs=tuple(c.get("outputs", ())),
+                distortion=_distortion(c.get("distortion")),
+            )
+            for name, c in s.get("cameras", {}).items()
+        }
+        agents.append(
+            AgentInfo(
+                id=aid,
+                index=ids.index(aid),
+                asset=str(s.get("asset", "")),
+                lidar_mount=_mat(s.get("lidar_mount_in_body")),
+                radar_mount=_mat(s.get("radar_mount_in_body")),
+                cameras=cams,
+                rig=dict(s.get("rig", {})),
+            )
+        )
+    agents.sort(key=lambda a: a.index)
+    seed = manifest.get("seed", scenario.get("seed"))
+    frequency = float(run.get("frequency_hz", acq.get("frequency_hz", 0.0)) or acq.get("frequency_hz", 0.0))
+    frames = int(run.get("frames_configured", acq.get("frames", 0)) or 0)
+    if not (math.isfinite(frequency) and frequency > 0 and frames > 0):  # damaged metadata, not a run's
+        raise ValueError(f"acquisition frequency_hz = {frequency}, frames = {frames}")
+    return RecordingInfo(
+        path=p,
+        scenario_name=str(meta["scenario"].get("name", scenario.get("name", p.stem))),
+        scenario=scenario,
+        config_hash=str(manifest.get("config_hash", "")),
+        seed=None if seed in (None, "None") else int(seed),
+        mmusv_version=str(manifest.get("mmusv_version", "")),
+        frequency_hz=frequency,
+        frames_configured=frames,
+        agents=agents,
+        run=dict(run),
+        has_summary=has_summary,
+    )

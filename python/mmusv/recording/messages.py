@@ -1,0 +1,97 @@
+"""Decoded messages of an ``mmusv run`` recording as they are: :func:`read_messages` iterates
+``(topic, log_time_ns, message)`` in file order (every message, optionally only some topics), :func:`frame_messages`
+gives every message of one acquisition index by topic (through :class:`~mmusv.recording.stream.FrameStream`). The
+messages are decoded protobuf objects; :mod:`mmusv.recording.decode` turns them into numpy arrays. Both work on
+finished, truncated and ``.partial`` files (damaged chunks skipped, :mod:`mmusv.recording.scan`) and on parts
+manifests (:mod:`mmusv.recording.parts`: the recorded parts in frame order, as one sequence).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+from mmusv.errors import ConfigError, IoError
+from mmusv.recording.info import check_mcap, read_info
+from mmusv.recording.parts import is_parts_manifest, part_files
+from mmusv.recording.scan import Scan
+from mmusv.recording.stream import FrameStream
+
+__all__ = ["frame_messages", "read_messages"]
+
+
+def read_messages(
+    path: str | os.PathLike[str], topics: Sequence[str] | None = None, *, damage: list[str] | None = None
+) -> Iterator[tuple[str, int, Any]]:
+    """Yields ``(topic, log_time_ns, decoded_protobuf_message)`` in file order (= log-time order for files of
+    mmusv), optionally only ``topics``. Works on finished files, on ``.partial`` files and on parts manifests (the
+    recorded parts in order); damaged chunks are skipped (:mod:`mmusv.recording.scan`) and described in
+    ``damage`` when a list is given."""
+    from mcap_protobuf.decoder import DecoderFactory
+
+    if is_parts_manifest(path):
+        for _first, _stop, part in part_files(Path(path)):
+            if part is not None:
+                yield from read_messages(part, topics, damage=damage)
+            elif damage is not None:
+                damage.append(f"{path}: part {_first}..{_stop - 1} is not recorded")
+        return
+    p = check_mcap(Path(path))
+    wanted = None if topics is None else set(topics)
+    factory = DecoderFactory()
+    decoders: dict[int, Callable[[bytes], Any] | None] = {}
+    scan = Scan(p)
+    try:
+        for msg, dmg in scan.messages():
+            if dmg is not None:
+                if damage is not None:
+                    damage.append(f"{p}: {dmg.describe()}")
+                continue
+            ch = scan.channels.get(msg.channel_id)
+            if ch is None or (wanted is not None and ch.topic not in wanted):
+                continue
+            if msg.channel_id not in decoders:
+                try:
+                    decoders[msg.channel_id] = factory.decoder_for(ch.message_encoding, scan.schemas.get(ch.schema_id))
+                except Exception as exc:
+                    raise IoError(f"{p}: channel {ch.topic} has an unreadable schema ({type(exc).__name__})") from None
+            dec = decoders[msg.channel_id]
+            if dec is None:
+                continue
+            try:
+                decoded = dec(msg.data)
+            except Exception as exc:
+                if damage is not None:
+                    damage.append(f"{p}: a {ch.topic} message does not decode ({type(exc).__name__})")
+                continue
+            yield ch.topic, msg.log_time, decoded
+    except OSError as exc:
+        raise IoError(f"{p} cannot be read: {exc.strerror or exc}") from None
+
+
+def frame_messages(path: str | Path, frame: int) -> dict[str, Any]:
+    """Every decoded message of acquisition index ``frame``, by topic; for a parts manifest, from the part
+    holding ``frame``. Raises :class:`~mmusv.errors.IoError` when the frame is damaged (naming the damage) and
+    :class:`~mmusv.errors.ConfigError` when the recording does not hold it."""
+    p = Path(path)
+    if is_parts_manifest(p):
+        for first, stop, part in part_files(p):
+            if first <= frame < stop:
+                if part is None:
+                    raise ConfigError(f"frame {frame} is not in {p}: its part is not recorded yet")
+                return frame_messages(part, frame)
+        raise ConfigError(f"frame {frame} is not in {p}")
+    info = read_info(p)
+    stream = FrameStream(info, want=lambda _t: True)
+    for fr in stream:
+        if fr.index == frame:
+            return dict(fr.messages)
+        if fr.index > frame and not stream.damage:
+            break
+    bad = [why for k, why in stream.incomplete if k == frame]
+    if bad:
+        raise IoError(f"frame {frame} of {p} is damaged: {bad[0]}; {stream.truncated}")
+    where = f" ({stream.truncated})" if stream.truncated else ""
+    raise ConfigError(f"frame {frame} is not in {p}{where}")

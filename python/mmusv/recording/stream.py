@@ -1,0 +1,325 @@
+"""The frames of an ``mmusv run`` recording, one at a time: :class:`FrameStream` walks the file once, front to back
+(:mod:`mmusv.recording.scan`), decodes only the topics asked for and yields one :class:`Frame` per log time (every
+message of a frame shares its log time; the frame's index is its ``/world/state`` frame number). It works on
+finished, truncated and ``.partial`` files alike: a file that ends in the middle of a record (a killed writer)
+yields every frame read so far and says where it stopped in :attr:`FrameStream.truncated`; the ``run`` metadata,
+written last, is picked up when present. The metadata it starts from: :func:`mmusv.recording.info.read_info`.
+
+A recording split into frame ranges (:mod:`mmusv.recording.parts`) is walked part by part in frame order as one
+sequence; a part not recorded yet is left out (its frames are missing, as those of an interrupted run).
+:func:`warn_missing` says when frames are missing, :func:`frame_ranges` writes frame indices as ``0..3, 7``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from mmusv.errors import IoError
+from mmusv.recording.decode import WorldFrame
+from mmusv.recording.info import RecordingInfo
+from mmusv.recording.parts import is_parts_manifest, part_files
+from mmusv.recording.scan import Scan
+from mmusv.recording.topics import WORLD_STATE
+
+__all__ = ["Frame", "FrameStream", "frame_ranges", "warn_missing"]
+
+
+@dataclass
+class Frame:
+    """Every decoded message of one acquisition index: ``messages`` by topic."""
+
+    index: int
+    log_time_ns: int
+    world: WorldFrame | None
+    messages: dict[str, Any] = field(default_factory=dict)
+
+
+def frame_ranges(frames: Sequence[int]) -> str:
+    """Frame indices as text, ``0..3, 7, 9..12`` (sorted, each index once; runs of consecutive indices as
+    ``first..last``)."""
+    out: list[str] = []
+    run: list[int] = []
+    for k in sorted(set(frames)):
+        if run and k == run[-1] + 1:
+            run.append(k)
+            continue
+        if run:
+            out.append(f"{run[0]}..{run[-1]}" if len(run) > 1 else str(run[0]))
+        run = [k]
+    if run:
+        out.append(f"{run[0]}..{run[-1]}" if len(run) > 1 else str(run[0]))
+    return ", ".join(out)
+
+
+@dataclass
+class _Open:
+    """A frame being read: its topics so far, whether it borders damaged bytes, why it is unusable (or None)."""
+
+    frame: Frame
+    suspect: bool = False
+    topics: set[str] = field(default_factory=set)
+    bad: str | None = None
+
+
+class FrameStream:
+    """Iterates the frames of a recording once (see the module docstring).
+
+    Args:
+        info: from :func:`~mmusv.recording.info.read_info`.
+        want: which topics to decode (``/world/state`` always is); others are skipped undecoded.
+
+    Damaged input (:mod:`mmusv.recording.scan`): a damaged chunk is skipped and the walk goes on after it; a file
+    that ends inside a record yields what came before. Only complete frames are yielded: a frame whose messages
+    were (partly) in a damaged chunk, or that borders damaged bytes and lacks a topic the intact frames have, is
+    left out and listed in :attr:`incomplete`. After the iteration :attr:`damage` lists every damaged region,
+    :attr:`truncated` says it in one line (``None`` for an intact file), :meth:`missing` gives the frames the run
+    set out to write that were not yielded and :meth:`report` one line for the user (``None`` when nothing is
+    missing). :attr:`topic_counts`, :attr:`messages`, :attr:`start_ns`, :attr:`end_ns`, :attr:`metadata` and
+    :attr:`attachments` describe what was read (every message, decoded or not).
+    """
+
+    def __init__(self, info: RecordingInfo, want: Callable[[str], bool]) -> None:
+        self.info = info
+        self.want = want
+        self.truncated: str | None = None
+        self.damage: list[str] = []
+        self.incomplete: list[tuple[int, str]] = []
+        self.yielded: list[int] = []
+        self.run: dict[str, str] = dict(info.run)
+        self.out_of_order: list[int] = []
+        self.topic_counts: dict[str, int] = {}
+        self.topic_schemas: dict[str, tuple[str, str]] = {}
+        self.messages = 0
+        self.start_ns = -1
+        self.end_ns = -1
+        self.metadata: dict[str, dict[str, str]] = {}
+        self.attachments: list[str] = []
+        self.complete = True
+        """Every file read ends with its data end, summary and footer, without damage."""
+        self._missing_parts: list[tuple[int, int, str]] = []
+        self._ended = False
+
+    def _index(self, log_time_ns: int, world: WorldFrame | None) -> int:
+        if world is not None:
+            return world.frame
+        return round(log_time_ns * self.info.frequency_hz / 1e9)
+
+    def __iter__(self) -> Iterator[Frame]:
+        seen: set[int] = set()
+        if is_parts_manifest(self.info.path):
+            for first, stop, f in part_files(self.info.path):
+                if f is None:
+                    self._missing_parts.append((first, stop, f"part {first}..{stop - 1}"))
+                    self.complete = False
+                    continue
+                yield from self._file(f, seen)
+        else:
+            yield from self._file(self.info.path, seen)
+        self._ended = True
+
+    def _note(self, line: str) -> None:
+        self.damage.append(line)
+        self.truncated = "; ".join(self.damage)
+
+    def _file(self, path: Path, seen: set[int]) -> Iterator[Frame]:
+        from mcap_protobuf.decoder import DecoderFactory
+
+        factory = DecoderFactory()
+        decoders: dict[int, Callable[[bytes], Any] | None] = {}
+        where = f"part {path.name} of {self.info.path.name}" if self.info.parts else "the file"
+        scan = Scan(path)
+        lost: list[tuple[int, int]] = []  # log times of damaged chunks
+        reference: set[str] = set()  # topics of the intact frames so far
+        pending: list[_Open] = []  # frames next to damage, waiting for an intact frame to compare with
+        cur: _Open | None = None
+        after_damage = False
+        try:
+            for msg, dmg in scan.messages():
+                if dmg is not None:
+                    text = dmg.describe(self.info.frequency_hz)
+                    self._note(f"{where} is truncated: {text}" if dmg.truncated else f"{where} is damaged at {text}")
+                    if dmg.times is not None:
+                        lost.append(dmg.times)
+                    if cur is not None:
+                        cur.suspect = True
+                    after_damage = True
+                    continue
+                if cur is None or msg.log_time != cur.frame.log_time_ns:
+                    if cur is not None:
+                        yield from self._close(cur, pending, lost, reference, scan, seen, final=False)
+                    cur = _Open(Frame(index=-1, log_time_ns=msg.log_time, world=None), suspect=after_damage)
+                    after_damage = False
+                ch = scan.channels.get(msg.channel_id)
+                self.messages += 1
+                self.start_ns = msg.log_time if self.start_ns < 0 else min(self.start_ns, msg.log_time)
+                self.end_ns = max(self.end_ns, msg.log_time)
+                if ch is None:
+                    cur.bad = (
+                        cur.bad or f"a message on channel {msg.channel_id}, whose definition was in a damaged chunk"
+                    )
+                    continue
+                topic = ch.topic
+                self.topic_counts[topic] = self.topic_counts.get(topic, 0) + 1
+                if topic not in self.topic_schemas:
+                    schema = scan.schemas.get(ch.schema_id)
+                    self.topic_schemas[topic] = ("" if schema is None else schema.name, ch.message_encoding)
+                if topic in cur.topics:
+                    cur.bad = cur.bad or f"it holds two {topic} messages"
+                cur.topics.add(topic)
+                if topic != WORLD_STATE and not self.want(topic):
+                    continue
+                try:
+                    if msg.channel_id not in decoders:
+                        decoders[msg.channel_id] = factory.decoder_for(
+                            ch.message_encoding, scan.schemas.get(ch.schema_id)
+                        )
+                    dec = decoders[msg.channel_id]
+                    if dec is None:
+                        continue
+                    decoded = dec(msg.data)
+                    if topic == WORLD_STATE:
+                        cur.frame.world = WorldFrame.from_message(decoded)
+                except Exception as exc:  # a message whose bytes do not decode: the frame is not usable
+                    cur.bad = cur.bad or f"its {topic} message does not decode ({type(exc).__name__})"
+                    continue
+                cur.frame.messages[topic] = decoded
+            if cur is not None:
+                yield from self._close(cur, pending, lost, reference, scan, seen, final=True)
+            elif pending:
+                yield from self._flush(pending, lost, reference, scan, seen)
+        except OSError as exc:
+            raise IoError(f"{path} cannot be read: {exc.strerror or exc}") from None
+        if scan.damage or not scan.complete:
+            self.complete = False
+        if not self.info.parts:
+            if "run" in scan.metadata:  # parts: the merged run of read_info stands
+                self.run = dict(scan.metadata["run"])
+            self.metadata = dict(scan.metadata)
+            self.attachments = list(scan.attachments)
+        elif not self.metadata:
+            self.metadata = dict(scan.metadata)
+            self.attachments = list(scan.attachments)
+
+    def _close(
+        self,
+        op: _Open,
+        pending: list[_Open],
+        lost: list[tuple[int, int]],
+        reference: set[str],
+        scan: Scan,
+        seen: set[int],
+        *,
+        final: bool,
+    ) -> Iterator[Frame]:
+        """Yields the frames decided by closing ``op``: a frame next to damage waits (in ``pending``) until an
+        intact frame says which topics a frame has; an intact frame settles the waiting ones, then itself."""
+        if op.suspect and not reference and not final:
+            pending.append(op)
+            return
+        if not op.suspect:
+            why = self._why(op, lost, reference, scan)
+            if why is None:
+                reference |= op.topics
+            yield from self._flush(pending, lost, reference, scan, seen)
+            if why is None:
+                yield self._accept(op.frame, seen)
+            else:
+                self.incomplete.append((self._index(op.frame.log_time_ns, op.frame.world), why))
+            return
+        pending.append(op)
+        yield from self._flush(pending, lost, reference, scan, seen)
+
+    def _flush(
+        self, pending: list[_Open], lost: list[tuple[int, int]], reference: set[str], scan: Scan, seen: set[int]
+    ) -> Iterator[Frame]:
+        for op in pending:
+            why = self._why(op, lost, reference, scan)
+            if why is None:
+                yield self._accept(op.frame, seen)
+            else:
+                self.incomplete.append((self._index(op.frame.log_time_ns, op.frame.world), why))
+        pending.clear()
+
+    def _why(self, op: _Open, lost: list[tuple[int, int]], reference: set[str], scan: Scan) -> str | None:
+        """Why the frame of ``op`` is incomplete, or None."""
+        t = op.frame.log_time_ns
+        if op.bad is not None:
+            return op.bad
+        if op.frame.world is None:
+            return f"it has no {WORLD_STATE} message"
+        if any(a <= t <= b for a, b in lost):
+            return "some of its messages were in a damaged chunk"
+        if op.suspect:
+            expected = reference or {c.topic for c in scan.channels.values()}
+            gone = sorted(expected - op.topics)
+            if gone:
+                return f"it borders damaged bytes and lacks {', '.join(gone[:3])}" + (
+                    f" and {len(gone) - 3} more" if len(gone) > 3 else ""
+                )
+        return None
+
+    def _accept(self, fr: Frame, seen: set[int]) -> Frame:
+        fr.index = self._index(fr.log_time_ns, fr.world)
+        if fr.index in seen:
+            self.out_of_order.append(fr.index)
+        seen.add(fr.index)
+        self.yielded.append(fr.index)
+        return fr
+
+    def expected(self) -> tuple[range, bool]:
+        """The frames the run set out to write and whether the run said so itself (``False``: it did not finish,
+        so this is the scenario's configured range)."""
+        run = self.run
+        if is_parts_manifest(self.info.path):
+            return range(int(run.get("frames_requested", self.info.frames_configured) or 0)), True
+        first = int(run.get("first_frame", 0) or 0)
+        if "frames_requested" in run or "frames_written" in run:
+            n = int(run.get("frames_requested", run.get("frames_written", 0)) or 0)
+            return range(first, first + n), True
+        return range(first, first + self.info.frames_configured), False
+
+    def missing(self) -> list[int]:
+        """The frames of :meth:`expected` that were not yielded (call after the iteration)."""
+        got = set(self.yielded)
+        return [k for k in self.expected()[0] if k not in got]
+
+    def report(self) -> str | None:
+        """One line saying which frames are missing and why, or ``None`` when every expected frame was read and
+        the file is intact (call after the iteration)."""
+        missing = self.missing()
+        if not missing and not self.damage and not self.incomplete:
+            return None
+        span, said = self.expected()
+        parts = [f"{self.info.path}: {len(set(self.yielded))} of {len(span)} frames read"]
+        if missing:
+            why = [] if said else ["the run did not finish (no run metadata)"]
+            status = self.run.get("status")
+            if said and status and status != "complete":
+                why.append(f"run status {status}: {self.run.get('frames_written', '?')} frames written")
+            parts.append(f"frames {frame_ranges(missing)} missing" + (f" ({'; '.join(why)})" if why else ""))
+        if self.incomplete:
+            parts.append(
+                "incomplete frames left out: "
+                + "; ".join(f"{k} ({why})" for k, why in self.incomplete[:4])
+                + (f" and {len(self.incomplete) - 4} more" if len(self.incomplete) > 4 else "")
+            )
+        for first, stop, name in self._missing_parts:
+            parts.append(f"{name} (frames {first}..{stop - 1}) is not recorded")
+        parts += self.damage
+        return "; ".join(parts)
+
+
+def warn_missing(stream: FrameStream, *, reader: str) -> None:
+    """Warns (:class:`mmusv.scenario_checks.MmusvWarning`, one ``mmusv: warning:`` line on the command line)
+    when ``stream`` read fewer frames than the run set out to write or met damaged bytes; ``reader`` says who
+    read it (``"the detection study"``)."""
+    import warnings
+
+    from mmusv.scenario_checks import MmusvWarning
+
+    line = stream.report()
+    if line is not None:
+        warnings.warn(f"{reader}: {line}", MmusvWarning, stacklevel=2)
