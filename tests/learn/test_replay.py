@@ -1,7 +1,8 @@
-"""Inference per mode and its merge, and the replay of the peaks (:mod:`mmusv.learn.replay`) against the study's
-learned detector: the peaks of ``scripts/learn_train.py infer`` run one mode at a time and merged equal one run
-of every mode, and the predictions replayed from them, with and without the second stage, equal what
-:class:`mmusv.learn.detector.LearnedDetector` gives on the same clouds (the model's input: the cache's points)."""
+"""Training's ``--set`` on the command line, inference per mode and its merge, and the replay of the peaks
+(:mod:`mmusv.learn.replay`) against the study's learned detector: the peaks of ``scripts/learn_train.py infer``
+run one mode at a time and merged equal one run of every mode, and the predictions replayed from them, with and
+without the second stage, equal what :class:`mmusv.learn.detector.LearnedDetector` gives on the same clouds (the
+model's input: the cache's points)."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import polars as pl
 import pytest
+import torch
 import yaml
 from mmusv.errors import InputError
 from mmusv.learn.cache import Cache, build_cache
@@ -19,6 +21,7 @@ from mmusv.learn.infer import infer_cache, merge_peaks
 from mmusv.learn.presets import preset
 from mmusv.learn.refine import RefineParams
 from mmusv.learn.replay import write_predictions
+from mmusv.learn.train import main as train_main
 from mmusv.learn.train import train
 from mmusv.studies.detection.sources import lidar_only
 
@@ -112,3 +115,15 @@ def test_replay_rejects_an_unknown_late_merge(trained: tuple[Path, Cache, Path],
         write_predictions(peaks, cache, [rec], tmp_path / "p.parquet", split="all", late_merge="mean")
     out = write_predictions(peaks, cache, [rec], tmp_path / "p.parquet", split="all", late_merge="wbf")
     assert set(pl.read_parquet(out)["mode"].unique().to_list()) == {"none", "late"}
+
+
+def test_train_command_line_applies_set(trained: tuple[Path, Cache, Path], tmp_path: Path) -> None:
+    _, _, root = trained
+    args = ["--cache", str(root / "cache.npz"), "--preset", "tiny", "--modes", "single", "-o", str(tmp_path)]
+    args += ["--max-steps", "1", "--no-progress", "--threads", "1"]
+    assert train_main([*args, "--set", "min_points=1", "--set", "code_weights=[1,1,0.1,1,1,1,1,1]"]) == 0
+    ck = torch.load(tmp_path / "single" / "model.pt", weights_only=False)
+    assert ck["preset"]["min_points"] == 1 and ck["preset"]["code_weights"][2] == 0.1
+    assert ck["preset"]["pillar_m"] == preset("tiny").pillar_m
+    with pytest.raises(InputError, match="--set 'min_point=1'"):
+        train_main([*args, "--set", "min_point=1"])
