@@ -8,10 +8,8 @@
 //!   centred on the camera; depth is the distance along the axis. Mounted with pitch +90° it looks straight
 //!   down with the vessel's forward direction at the top of the image.
 //!
-//! * Lens distortion (optional, pinhole only): Brown–Conrady in OpenCV's convention (D. C. Brown,
-//!   "Decentering Distortion of Lenses", Photogrammetric Engineering 32(3), 1966): a pixel at distorted
-//!   normalised coordinates `(x_d, y_d)` sees the ray of the undistorted `(x, y)` with
-//!   `x_d = x (1 + k1 r² + k2 r⁴ + k3 r⁶) + 2 p1 x y + p2 (r² + 2 x²)`, `y_d = y (…) + p1 (r² + 2 y²) + 2 p2 x y`.
+//! * Lens distortion (optional, pinhole only): Brown–Conrady in OpenCV's convention ([`Distortion`]): a pixel at
+//!   distorted normalised coordinates `(x_d, y_d)` sees the ray of the undistorted `(x, y)`.
 //!
 //! One render casts every pixel's primary ray at once on the frozen scene; RGB adds shadow rays, reflected rays
 //! on water and sub-pixel rays on edges ([`radiance`], [`Quality`]). Outputs per pixel: depth (float32 metres,
@@ -29,9 +27,12 @@ use parry3d::math::Vec3;
 use rayon::prelude::*;
 
 mod antialias;
+mod distortion;
 pub mod radiance;
 
 use antialias::surface_key;
+use distortion::check_distortion;
+pub use distortion::Distortion;
 use radiance::Reflections;
 
 /// Largest image side, pixels.
@@ -76,50 +77,6 @@ impl Quality {
     /// Whether water reflections are traced.
     pub fn reflections(self) -> bool {
         !matches!(self, Quality::Draft)
-    }
-}
-
-/// Brown–Conrady distortion coefficients, OpenCV's order and convention (see the module docs).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Distortion {
-    /// `[k1, k2, p1, p2, k3]`.
-    pub coefficients: [f64; 5],
-}
-
-impl Distortion {
-    /// Distorted normalised coordinates of undistorted `(x, y)`.
-    pub fn distort(&self, x: f64, y: f64) -> (f64, f64) {
-        let [k1, k2, p1, p2, k3] = self.coefficients;
-        let r2 = x * x + y * y;
-        let radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
-        (
-            x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x),
-            y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y,
-        )
-    }
-
-    /// Undistorted normalised coordinates of distorted `(xd, yd)`: Newton's method on [`Distortion::distort`]
-    /// (numerical Jacobian), from `(xd, yd)`.
-    pub fn undistort(&self, xd: f64, yd: f64) -> (f64, f64) {
-        let (mut x, mut y) = (xd, yd);
-        for _ in 0..30 {
-            let (fx, fy) = self.distort(x, y);
-            let (ex, ey) = (fx - xd, fy - yd);
-            if ex.abs() < 1e-12 && ey.abs() < 1e-12 {
-                break;
-            }
-            let h = 1e-7;
-            let (ax, ay) = self.distort(x + h, y);
-            let (bx, by) = self.distort(x, y + h);
-            let (j11, j21, j12, j22) = ((ax - fx) / h, (ay - fy) / h, (bx - fx) / h, (by - fy) / h);
-            let det = j11 * j22 - j12 * j21;
-            if det.abs() < 1e-12 {
-                break;
-            }
-            x -= (j22 * ex - j12 * ey) / det;
-            y -= (-j21 * ex + j11 * ey) / det;
-        }
-        (x, y)
     }
 }
 
@@ -179,14 +136,6 @@ pub struct CameraFrame {
     pub rgb: Vec<u8>,
     /// Linear radiance (cd/m², linear sRGB primaries), 3 floats per pixel; empty unless requested.
     pub radiance: Vec<f32>,
-}
-
-/// Checks distortion coefficients are finite.
-fn check_distortion(d: &Distortion) -> Result<()> {
-    if d.coefficients.iter().any(|c| !c.is_finite()) {
-        return Err(MmusvError::config("camera.distortion", format!("{:?}", d.coefficients), "must be finite"));
-    }
-    Ok(())
 }
 
 /// Side of the square pixel tiles rays are traced in: a tile's 16 rays form one packet (see
