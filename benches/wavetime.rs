@@ -1,6 +1,7 @@
 //! `cargo run --release -p mmusv-benches --example wavetime -- REPS`: times `WaveSurface::intersect` alone on the
 //! paper's W1 sea around one focus: a radar's grazing beams, straight-down rays (one point; a top view) and rays from
-//! a camera 3 m up (its lower half, and by bands of rows), plus the surface's build time.
+//! a camera 3 m up (its lower half, and by bands of rows), plus the surface's build time; and on the paper's W3 sea,
+//! a 64-channel LiDAR (−25° to 15°, 410 columns) 2 m above the water under it, as a USV carries it among the waves.
 
 use mmusv_core::ocean::{paper_sea_states, WaveField};
 use mmusv_core::sea::{SurfaceSpec, WaveSurface};
@@ -78,5 +79,39 @@ fn main() {
         }
         let dt = t0.elapsed().as_secs_f64();
         println!("{name}: {:.1} ns per ray, hits {}", dt / (rays.len() * reps) as f64 * 1e9, hits / reps);
+    }
+    let w3 = paper_sea_states()[3];
+    let Ok(field3) = WaveField::new(&w3.spec(0.3, 10.0), 7) else { return };
+    let s3 = WaveSurface::new(field3.components(), 12.0, 0.0, &[[0.0, 0.0]], SurfaceSpec::default());
+    let oz = s3.height(0.0, 0.0) + 2.0;
+    let mut lidar = Vec::new();
+    for c in 0..64 {
+        let el = (-25.0 + 40.0 * c as f32 / 63.0).to_radians();
+        for a in 0..410 {
+            let az = a as f32 / 410.0 * std::f32::consts::TAU;
+            lidar.push(([0.0, 0.0, oz], [el.cos() * az.cos(), el.cos() * az.sin(), el.sin()]));
+        }
+    }
+    if std::env::var("ONLY").is_ok_and(|o| o != "lidar-w3") {
+        return;
+    }
+    let t0 = std::time::Instant::now();
+    let mut hits = 0usize;
+    for _ in 0..reps {
+        hits += lidar.iter().filter(|(o, d)| s3.intersect(*o, *d, 200.0).is_some()).count();
+    }
+    let dt = t0.elapsed().as_secs_f64();
+    println!("lidar-w3: {:.1} ns per ray, hits {}", dt / (lidar.len() * reps) as f64 * 1e9, hits / reps);
+    // By elevation band (channels of 410 rays each).
+    for (name, lo, hi) in [("below -10°", 0, 24), ("-10° to -2°", 24, 37), ("-2° to 2°", 37, 43), ("above 2°", 43, 64)]
+    {
+        let rays = &lidar[lo * 410..hi * 410];
+        let t0 = std::time::Instant::now();
+        let mut hits = 0usize;
+        for _ in 0..reps {
+            hits += rays.iter().filter(|(o, d)| s3.intersect(*o, *d, 200.0).is_some()).count();
+        }
+        let dt = t0.elapsed().as_secs_f64();
+        println!("  {name}: {:.1} ns per ray, hits {}", dt / (rays.len() * reps) as f64 * 1e9, hits / reps);
     }
 }

@@ -228,9 +228,28 @@ impl March<'_> {
         if fmax(za, zb) <= tile.zmin && self.above == Some(false) {
             return None; // wholly under the tile's troughs, and already under water
         }
+        // Only the part of the stretch below the tile's crest bound can meet it: a falling ray is walked from
+        // where it comes down to the bound, a rising one until it rises above it (strictly above every node of the
+        // tile before and after, so the carried sign there is "above").
+        let (mut ta, mut tb) = (ta, tb);
+        let mut rises_clear = false;
+        if self.above != Some(false) {
+            let t_top = (tile.zmax - self.o[2]) / self.d[2];
+            if self.d[2] > 0.0 && t_top < tb {
+                tb = fmax(t_top, ta);
+                rises_clear = true;
+            } else if self.d[2] < 0.0 && t_top > ta {
+                ta = fmin(t_top, tb);
+                self.above = Some(true);
+            }
+        }
         let n = tile.n;
         let corner = [s.x0 + ix as f32 * s.tile_m, s.y0 + iy as f32 * s.tile_m];
-        self.cells(k, corner, ta, tb, [0, 0], [n - 1, n - 1])
+        let hit = self.cells(k, corner, ta, tb, [0, 0], [n - 1, n - 1]);
+        if hit.is_none() && rises_clear {
+            self.above = Some(true);
+        }
+        hit
     }
 
     /// The stretch `[ta, tb]` over the cells `lo..=hi` (column, row) of tile `k` (lower corner `corner`): cell by
