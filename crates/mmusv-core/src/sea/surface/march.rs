@@ -30,7 +30,7 @@ impl WaveSurface {
         if !(t0 <= t1) {
             return None;
         }
-        let inv = [0, 1].map(|a| if d[a] == 0.0 { f32::INFINITY } else { 1.0 / d[a] });
+        let inv = [0, 1, 2].map(|a| if d[a] == 0.0 { f32::INFINITY } else { 1.0 / d[a] });
         let mut m = March { s: self, o, d, inv, above: None };
         // A steep ray crosses the band within one tile: straight to it.
         let at = |t: f32| self.tile_at(o[0] + d[0] * t, o[1] + d[1] * t);
@@ -98,9 +98,9 @@ struct March<'a> {
     s: &'a WaveSurface,
     o: [f32; 3],
     d: [f32; 3],
-    /// `1 / d.x`, `1 / d.y` (infinite along an axis the ray does not move on): the march multiplies by these
-    /// instead of dividing.
-    inv: [f32; 2],
+    /// `1 / d.x`, `1 / d.y`, `1 / d.z` (infinite along an axis the ray does not move on): the march multiplies
+    /// by these instead of dividing.
+    inv: [f32; 3],
     above: Option<bool>,
 }
 
@@ -234,7 +234,7 @@ impl March<'_> {
         let (mut ta, mut tb) = (ta, tb);
         let mut rises_clear = false;
         if self.above != Some(false) {
-            let t_top = (tile.zmax - self.o[2]) / self.d[2];
+            let t_top = (tile.zmax - self.o[2]) * self.inv[2];
             if self.d[2] > 0.0 && t_top < tb {
                 tb = fmax(t_top, ta);
                 rises_clear = true;
