@@ -83,3 +83,41 @@ def test_min_points_drops_the_targets_of_unseen_boxes() -> None:
         assert ex.targets is not None
         peaks[n] = int((ex.targets.heatmap == 1.0).sum())
     assert peaks == {0: 3, 1: 2}
+
+
+def test_channels_last_model_is_the_same_function() -> None:
+    """The layout training and inference use on CUDA (PillarNet.channels_last) changes no output: the same weights
+    in NCHW and NHWC give the same maps on the same batch (here on CPU), in training mode and after a step."""
+    from mmusv.learn.example import collate, make_example
+    from mmusv.learn.loss import centerpoint_loss
+    from mmusv.learn.model import PillarNet
+
+    src = MemorySource(SCENES[:2])
+    p = preset("tiny")
+    batch = collate([make_example(*src.sample(k), mode="single", p=p) for k in range(2)])
+    torch.manual_seed(3)
+    a = PillarNet(p, "single")
+    b = PillarNet(p, "single")
+    b.load_state_dict(a.state_dict())
+    b.channels_last()
+    assert any(
+        w.dim() == 4 and w.is_contiguous(memory_format=torch.channels_last) and not w.is_contiguous()
+        for w in b.parameters()
+    )
+    # The same maps before training (rounding apart: NHWC convolutions sum in another order, and training-mode batch
+    # norm divides by small batch variances; a wrong layout would differ by the maps' own size, O(1)) ...
+    oa, ob = a(batch), b(batch)
+    assert oa.keys() == ob.keys()
+    for k in oa:
+        torch.testing.assert_close(oa[k], ob[k], rtol=1e-3, atol=1e-3)
+    # ... and after a step of the same gradients (those rounding differences grown by one update).
+    for model in (a, b):
+        opt = torch.optim.SGD(model.parameters(), lr=0.1)
+        out = model(batch)
+        loss = centerpoint_loss(out, batch.heatmap, batch.index, batch.reg_mask, batch.reg, batch.reg_weight)
+        opt.zero_grad()
+        loss["loss"].backward()
+        opt.step()
+    oa, ob = a(batch), b(batch)
+    for k in oa:
+        torch.testing.assert_close(oa[k], ob[k], rtol=5e-3, atol=5e-2)

@@ -40,6 +40,8 @@ def _load(path: Path, device: torch.device) -> tuple[PillarNet, dict[str, Any]]:
     except (OSError, KeyError, TypeError, RuntimeError, ValueError) as exc:
         raise input_error(f"--model {path}: not an mmusv.learn model.pt ({type(exc).__name__}: {exc})") from None
     model.to(device).eval()
+    if device.type == "cuda":
+        model.channels_last()
     return model, ck
 
 

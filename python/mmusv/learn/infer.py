@@ -33,7 +33,8 @@ def _model(path: Path, dev: torch.device) -> PillarNet:
     ck = torch.load(path, map_location=dev, weights_only=False)
     m = PillarNet(Preset.from_dict(ck["preset"]), ck["mode"])
     m.load_state_dict(ck["model"])
-    return m.to(dev).eval()
+    m = m.to(dev)
+    return (m.channels_last() if dev.type == "cuda" else m).eval()
 
 
 def infer_cache(

@@ -34,6 +34,16 @@ class PillarNet(nn.Module):
         self.backbone = Backbone(p, p.pfn_channels)
         self.head = CenterHead(self.backbone.out_channels, p.head_channels)
 
+    def channels_last(self) -> PillarNet:
+        """Stores the backbone's and the head's convolution weights channels-last (NHWC) and returns the model:
+        the same function (a test compares the outputs), but cuDNN then runs the convolutions and batch norms
+        without converting between layouts around every layer. Measured on one H200 (bf16 autocast, the `paper`
+        preset, batch 4, model step alone): 11.8 → 24.3 steps/s; batch-norm kernels and NCHW↔NHWC conversions were
+        70 % of the step's GPU time before. Used on CUDA by training and inference."""
+        self.backbone.to(memory_format=torch.channels_last)
+        self.head.to(memory_format=torch.channels_last)
+        return self
+
     def canvas(self, b: Batch) -> torch.Tensor:
         """The BEV pillar canvas ``(B, C, ny, nx)`` (neighbours max-fused in intermediate mode)."""
         f = self.encoder(b.features, b.mask)

@@ -144,6 +144,8 @@ def train(
     n_epochs = epochs if epochs is not None else p.epochs
     torch.manual_seed(seed)
     model = PillarNet(p, mode).to(dev)
+    if dev.type == "cuda":
+        model.channels_last()
     opt = torch.optim.AdamW(model.parameters(), lr=p.lr, weight_decay=p.weight_decay)
     data = TrainingSet(c, p, mode, seed=seed, augment=augment, indices=indices)
     if len(data) == 0:
