@@ -72,13 +72,7 @@ fn main() {
         if std::env::var("ONLY").is_ok_and(|o| o != name) {
             continue;
         }
-        let t0 = std::time::Instant::now();
-        let mut hits = 0usize;
-        for _ in 0..reps {
-            hits += rays.iter().filter(|(o, d)| s.intersect(*o, *d, 5000.0).is_some()).count();
-        }
-        let dt = t0.elapsed().as_secs_f64();
-        println!("{name}: {:.1} ns per ray, hits {}", dt / (rays.len() * reps) as f64 * 1e9, hits / reps);
+        time(name, &s, rays, 5000.0, reps);
     }
     let w3 = paper_sea_states()[3];
     let Ok(field3) = WaveField::new(&w3.spec(0.3, 10.0), 7) else { return };
@@ -95,23 +89,21 @@ fn main() {
     if std::env::var("ONLY").is_ok_and(|o| o != "lidar-w3") {
         return;
     }
-    let t0 = std::time::Instant::now();
-    let mut hits = 0usize;
-    for _ in 0..reps {
-        hits += lidar.iter().filter(|(o, d)| s3.intersect(*o, *d, 200.0).is_some()).count();
-    }
-    let dt = t0.elapsed().as_secs_f64();
-    println!("lidar-w3: {:.1} ns per ray, hits {}", dt / (lidar.len() * reps) as f64 * 1e9, hits / reps);
+    time("lidar-w3", &s3, &lidar, 200.0, reps);
     // By elevation band (channels of 410 rays each).
     for (name, lo, hi) in [("below -10°", 0, 24), ("-10° to -2°", 24, 37), ("-2° to 2°", 37, 43), ("above 2°", 43, 64)]
     {
-        let rays = &lidar[lo * 410..hi * 410];
-        let t0 = std::time::Instant::now();
-        let mut hits = 0usize;
-        for _ in 0..reps {
-            hits += rays.iter().filter(|(o, d)| s3.intersect(*o, *d, 200.0).is_some()).count();
-        }
-        let dt = t0.elapsed().as_secs_f64();
-        println!("  {name}: {:.1} ns per ray, hits {}", dt / (rays.len() * reps) as f64 * 1e9, hits / reps);
+        time(&format!("  {name}"), &s3, &lidar[lo * 410..hi * 410], 200.0, reps);
     }
+}
+
+/// Prints the mean time of `surface.intersect` over `rays` (`reps` passes) and the hits per pass.
+fn time(name: &str, surface: &WaveSurface, rays: &[([f32; 3], [f32; 3])], t_max: f32, reps: usize) {
+    let t0 = std::time::Instant::now();
+    let mut hits = 0usize;
+    for _ in 0..reps {
+        hits += rays.iter().filter(|(o, d)| surface.intersect(*o, *d, t_max).is_some()).count();
+    }
+    let dt = t0.elapsed().as_secs_f64();
+    println!("{name}: {:.1} ns per ray, hits {}", dt / (rays.len() * reps) as f64 * 1e9, hits / reps);
 }
