@@ -254,3 +254,26 @@ def test_pattern_angles_are_remembered_by_content() -> None:
         np.testing.assert_array_equal(first.az, np.arctan2(q[:, 1], q[:, 0]))
         np.testing.assert_array_equal(first.el, np.arctan2(q[:, 2], np.hypot(q[:, 0], q[:, 1])))
         np.testing.assert_array_equal(first.az_sorted, np.sort(first.az))
+
+
+def test_pattern_angles_trust_identity_only_for_frozen_arrays() -> None:
+    """A read-only array that owns its data (a rig's pattern, as ``Agent.lidar_pattern`` keeps it) is recognised
+    by identity; a writeable one changed in place, or a read-only view of a changing base, gets fresh angles."""
+    rng = np.random.default_rng(9)
+    p = rng.normal(size=(64, 3)).astype(np.float32)
+    p /= np.linalg.norm(p, axis=1, keepdims=True)
+    frozen = p.copy()
+    frozen.flags.writeable = False
+    assert pattern_angles(frozen) is pattern_angles(frozen)
+    w = p.copy()
+    before = pattern_angles(w).az.copy()
+    w[:, :2] *= -1.0  # every azimuth turns by π
+    after = pattern_angles(w).az
+    assert not np.allclose(before, after)
+    np.testing.assert_array_equal(after, np.arctan2(w[:, 1].astype(np.float64), w[:, 0].astype(np.float64)))
+    base = p.copy()
+    view = base[:]
+    view.flags.writeable = False
+    first = pattern_angles(view).az.copy()
+    base[:, :2] *= -1.0
+    assert not np.allclose(first, pattern_angles(view).az)

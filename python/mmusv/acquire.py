@@ -96,7 +96,7 @@ def annotations_for(sim: Simulation, cap: FrameCapture, silhouettes: SilhouetteC
             silhouettes=silhouettes,
             max_range_m=rng,
             scene=sim.ws.scene,
-            lidar_pattern=agent.lidar.pattern() if agent.lidar is not None else None,
+            lidar_pattern=agent.lidar_pattern,
         )
     return out
 

@@ -15,6 +15,7 @@ import hashlib
 import math
 from collections.abc import Collection
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -126,6 +127,16 @@ class Agent:
     def id(self) -> str:
         """The vessel id."""
         return self.vessel.id
+
+    @cached_property
+    def lidar_pattern(self) -> npt.NDArray[np.float32] | None:
+        """``(M, 3)`` float32 unit beam directions of the LiDAR, LiDAR frame, in pattern order (read-only; worked
+        out once: the rig never changes), or ``None`` without a LiDAR."""
+        if self.lidar is None:
+            return None
+        p = np.array(self.lidar.pattern(), dtype=np.float32, order="C", copy=True)
+        p.flags.writeable = False
+        return p
 
     def mounts(self) -> dict[str, np.ndarray]:
         """``(4, 4)`` sensor → vessel body matrices of the body-mounted sensors: keys ``lidar``, ``radar``,
