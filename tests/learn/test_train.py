@@ -15,7 +15,9 @@ from mmusv.studies.detection.evaluate import FrameMatch, summarize
 
 from learn.scenes import SCENES, MemorySource
 
-OVERFIT_STEPS = 150
+# 150 steps passed with the torch earlier CI runs installed, but torch 2.15.0 on one thread reaches only AP@0.5 0.17
+# there (1.0 at 200): the model was at the edge. 250 steps reach 1.0 with seeds 0-3 on 2.15.0, a margin.
+OVERFIT_STEPS = 250
 
 
 def _losses(out: Path) -> list[float]:
