@@ -3,6 +3,13 @@ and trains the single-agent, early- and intermediate-fusion models of a preset (
 into ``OUT/<mode>/`` with its checkpoint, log and loss plot (``loss.png``); started again, it resumes.
 ``mmusv study detection|robustness --model OUT`` then scores them (:func:`load_for_study`).
 
+On a CPU the models train side by side, each in a process of its own (``--jobs``, by default one per model), with
+the cores shared out among them as torch threads (``--threads``, by default the cores over the jobs, at least
+one): a small network keeps one core busy far better than it keeps two, so three one-thread processes on two cores
+finish well before three models trained in turn. On a GPU they train in turn.
+A model trained in a process of its own with one thread has the same weights as one trained in turn with one
+thread (CPU training is deterministic for a given thread count).
+
 Without the ``learn`` extra (PyTorch) both raise :class:`mmusv.errors.InputError` saying how to install it.
 """
 
@@ -10,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import time
 from pathlib import Path
 from typing import Any
@@ -54,7 +62,13 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--split-ratios", default="0.7,0.15,0.15", help="train,validate,test fractions")
     p.add_argument("--seed", type=int, default=0, help="seed of the split, the weights and the augmentation")
     p.add_argument("--preset", default="cpu", choices=sorted(PRESETS), help="cpu (default), paper (a GPU) or tiny")
-    p.add_argument("--modes", default="single,early,intermediate", help="models to train, in turn")
+    p.add_argument("--modes", default="single,early,intermediate", help="models to train")
+    p.add_argument(
+        "--jobs",
+        default="auto",
+        help="models trained at once, each in a process of its own (default auto: on a CPU one per model, sharing "
+        "the cores; on a GPU 1, in turn)",
+    )
     p.add_argument("--epochs", type=int, default=None, help="epochs per model (default: the preset's)")
     p.add_argument("--time-limit", type=float, default=None, help="seconds per model at most")
     p.add_argument("--workers", type=int, default=0, help="data-loader worker processes (default 0)")
@@ -63,8 +77,9 @@ def add_parser(sub: Any) -> None:
         "--threads",
         type=int,
         default=None,
-        help="CPU threads of torch (default: torch's; 1 on a machine other jobs share: spinning threads that wait "
-        "for a core made a 2-thread step 30x slower than a 1-thread one on the shared 2-core machine)",
+        help="CPU threads of torch per model (default: the cores over the jobs, at least 1; with one job, torch's "
+        "own default). 1 on a machine other jobs share: spinning threads that wait for a core made a 2-thread step "
+        "30x slower than a 1-thread one on the shared 2-core machine",
     )
     p.add_argument("--cache-only", action="store_true", help="build OUT/cache_<split>.npz and stop")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -79,12 +94,14 @@ def run(args: argparse.Namespace) -> int:
     from mmusv.learn.cache import build_cache
     from mmusv.learn.example import MODES
     from mmusv.learn.presets import preset
-    from mmusv.learn.train import plot_losses, train
 
     modes = [m.strip() for m in args.modes.split(",") if m.strip()]
     bad = [m for m in modes if m not in MODES]
     if bad or not modes:
         raise InputError(f"--modes {args.modes}: unknown {bad}; allowed: {', '.join(MODES)}")
+    if args.threads is not None and args.threads < 1:
+        raise InputError(f"--threads {args.threads}: must be >= 1")
+    jobs = _jobs(args.jobs, len(modes), args.device)
     out = Path(args.output)
     inputs: list[Any] = list(args.inputs)
     if args.generate is not None:
@@ -104,38 +121,95 @@ def run(args: argparse.Namespace) -> int:
         print(f"cache: {cache} ({cache.stat().st_size / 2**20:.1f} MiB, {time.perf_counter() - t0:.1f} s)", flush=True)
     if args.cache_only:
         return 0
-    if args.threads is not None:
-        if args.threads < 1:
-            raise InputError(f"--threads {args.threads}: must be >= 1")
-        import torch
-
-        torch.set_num_threads(args.threads)
+    threads = args.threads
+    if threads is None and jobs > 1:
+        threads = max(1, (os.cpu_count() or 1) // jobs)
     p = preset(args.preset)
-    summary: dict[str, Any] = {"preset": p.to_dict(), "seed": args.seed, "models": {}}
-    for mode in modes:
-        r = train(
-            cache,
-            p=p,
-            mode=mode,
-            out=out / mode,
-            seed=args.seed,
-            epochs=args.epochs,
-            time_limit_s=args.time_limit,
-            device=args.device,
-            workers=args.workers,
-            progress=not args.no_progress,
-        )
-        png = plot_losses(out / mode / "log.jsonl", out / mode / "loss.png")
-        summary["models"][mode] = {
-            "epochs": r.epochs,
-            "steps": r.steps,
-            "seconds": round(r.seconds, 1),
-            "finished": r.finished,
-        }
+    summary: dict[str, Any] = {"preset": p.to_dict(), "seed": args.seed, "jobs": jobs, "models": {}}
+    task = {
+        "cache": str(cache),
+        "preset": args.preset,
+        "seed": args.seed,
+        "epochs": args.epochs,
+        "time_limit": args.time_limit,
+        "device": args.device,
+        "workers": args.workers,
+        "threads": threads,
+        "progress": not args.no_progress and jobs == 1,
+    }
+    if jobs == 1:
+        results = [_train_one({**task, "mode": mode, "out": str(out / mode)}) for mode in modes]
+    else:
+        import multiprocessing
+        from concurrent.futures import ProcessPoolExecutor
+
+        print(f"training {', '.join(modes)} side by side: {jobs} processes, {threads} torch thread(s) each", flush=True)
+        ctx = multiprocessing.get_context("spawn")  # a fresh interpreter per model: no forked torch thread pools
+        with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
+            futures = [pool.submit(_train_one, {**task, "mode": mode, "out": str(out / mode)}) for mode in modes]
+            results = [f.result() for f in futures]
+    for mode, r in zip(modes, results, strict=True):
+        summary["models"][mode] = {k: r[k] for k in ("epochs", "steps", "seconds", "finished")}
         print(
-            f"{mode}: {r.epochs} epochs, {r.steps} steps, {r.seconds:.1f} s of training -> {r.out} ({png.name})",
+            f"{mode}: {r['epochs']} epochs, {r['steps']} steps, {r['seconds']:.1f} s of training -> {r['out']} "
+            f"({r['plot']})",
             flush=True,
         )
     (out / "train_summary.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
     print(f"total {time.perf_counter() - t0:.1f} s; score with: mmusv study detection --model {out} ...", flush=True)
     return 0
+
+
+def _jobs(value: str, models: int, device: str | None) -> int:
+    """``--jobs``: a positive count (at most ``models``), or ``auto`` (on a CPU ``models``; 1 on a GPU)."""
+    if value == "auto":
+        if device is not None and device != "cpu":
+            return 1
+        if device is None:
+            import torch
+
+            if torch.cuda.is_available():
+                return 1
+        return max(1, models)
+    try:
+        n = int(value)
+    except ValueError:
+        raise InputError(f"--jobs {value}: a positive whole number or auto") from None
+    if n < 1:
+        raise InputError(f"--jobs {value}: must be >= 1 (or auto)")
+    return min(n, models)
+
+
+def _train_one(task: dict[str, Any]) -> dict[str, Any]:
+    """Trains one model (``task``: the cache, preset name, mode, output folder and the run's options) and plots
+    its losses; returns its epochs, steps, seconds, whether it finished, and where it wrote. Runs in this process
+    or in a worker process of ``--jobs``."""
+    import torch
+
+    from mmusv.learn.presets import preset
+    from mmusv.learn.train import plot_losses, train
+
+    if task["threads"] is not None:
+        torch.set_num_threads(task["threads"])
+    out = Path(task["out"])
+    r = train(
+        task["cache"],
+        p=preset(task["preset"]),
+        mode=task["mode"],
+        out=out,
+        seed=task["seed"],
+        epochs=task["epochs"],
+        time_limit_s=task["time_limit"],
+        device=task["device"],
+        workers=task["workers"],
+        progress=task["progress"],
+    )
+    png = plot_losses(out / "log.jsonl", out / "loss.png")
+    return {
+        "epochs": r.epochs,
+        "steps": r.steps,
+        "seconds": round(r.seconds, 1),
+        "finished": r.finished,
+        "out": str(r.out),
+        "plot": png.name,
+    }
