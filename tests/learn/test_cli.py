@@ -1,5 +1,6 @@
 """``mmusv train``: the models trained side by side in processes of their own (``--jobs``) are the models trained
-in turn in this process, weight for weight, and bad ``--jobs`` values get a clear error."""
+in turn in this process, weight for weight; one that fails does not stop the others; bad ``--jobs`` values get a
+clear error."""
 
 from __future__ import annotations
 
@@ -46,6 +47,21 @@ def test_side_by_side_models_equal_models_trained_in_turn(recording: Path, tmp_p
     summary = json.loads((tmp_path / "side" / "train_summary.json").read_text(encoding="utf-8"))
     assert summary["jobs"] == 3 and sorted(summary["models"]) == ["early", "intermediate", "single"]
     assert all(m["epochs"] == 2 and m["finished"] for m in summary["models"].values())
+
+
+def test_a_failing_model_does_not_stop_the_others(
+    recording: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # a checkpoint of another run in early/ makes that model refuse to start; the other two train
+    (tmp_path / "early").mkdir(parents=True)
+    torch.save({"preset": {}, "mode": "early", "seed": 0}, tmp_path / "early" / "last.pt")
+    assert _train(recording, tmp_path, "--jobs", "3", "--threads", "1") != 0
+    err = capsys.readouterr().err
+    assert "early: failed" in err and "a checkpoint of another run" in err and "Traceback" not in err
+    summary = json.loads((tmp_path / "train_summary.json").read_text(encoding="utf-8"))
+    assert sorted(summary["models"]) == ["intermediate", "single"]
+    assert (tmp_path / "single" / "model.pt").is_file() and (tmp_path / "intermediate" / "model.pt").is_file()
+    assert not (tmp_path / "early" / "model.pt").exists()
 
 
 def test_jobs_values() -> None:

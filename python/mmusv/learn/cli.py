@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -141,13 +142,24 @@ def run(args: argparse.Namespace) -> int:
         results = [_train_one({**task, "mode": mode, "out": str(out / mode)}) for mode in modes]
     else:
         import multiprocessing
-        from concurrent.futures import ProcessPoolExecutor
+        from concurrent.futures import ProcessPoolExecutor, as_completed
 
         print(f"training {', '.join(modes)} side by side: {jobs} processes, {threads} torch thread(s) each", flush=True)
         ctx = multiprocessing.get_context("spawn")  # a fresh interpreter per model: no forked torch thread pools
+        # A model that fails does not stop the others: each is reported, the summary holds those that finished,
+        # and the first failure is raised after them (as training in turn would raise it).
+        failures: list[tuple[str, BaseException]] = []
+        done: dict[str, dict[str, Any]] = {}
         with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
-            futures = [pool.submit(_train_one, {**task, "mode": mode, "out": str(out / mode)}) for mode in modes]
-            results = [f.result() for f in futures]
+            futures = {pool.submit(_train_one, {**task, "mode": mode, "out": str(out / mode)}): mode for mode in modes}
+            for f in as_completed(futures):
+                try:
+                    done[futures[f]] = f.result()
+                except Exception as e:  # reported below, the first one raised after the others
+                    failures.append((futures[f], e))
+                    print(f"{futures[f]}: failed: {e}", file=sys.stderr, flush=True)
+        results = [done[m] for m in modes if m in done]
+        modes = [m for m in modes if m in done]
     for mode, r in zip(modes, results, strict=True):
         summary["models"][mode] = {k: r[k] for k in ("epochs", "steps", "seconds", "finished")}
         print(
@@ -156,6 +168,8 @@ def run(args: argparse.Namespace) -> int:
             flush=True,
         )
     (out / "train_summary.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
+    if jobs > 1 and failures:
+        raise failures[0][1]
     print(f"total {time.perf_counter() - t0:.1f} s; score with: mmusv study detection --model {out} ...", flush=True)
     return 0
 
