@@ -52,15 +52,18 @@ impl Camera {
             let m = scene.material_index(shits.instance[j], shits.triangle[j]);
             surface_key(shits.instance[j], shits.class[j], m)
         };
-        let mixed: Vec<u32> = radiance::filter_map_range(edges.len(), |e| {
-            let i = edges[e] as usize;
-            let t = hits.distance[self.rank[i] as usize];
-            let mixed = (e * per..(e + 1) * per).any(|j| {
-                let tj = shits.distance[j];
-                key(j) != surface[i] || frame.semantic[i] != 1 && t.is_finite() && (tj - t).abs() > 0.05 * tj.min(t)
-            });
-            mixed.then_some(e as u32)
-        });
+        let mixed: Vec<u32> = (0..edges.len())
+            .into_par_iter()
+            .filter(|&e| {
+                let i = edges[e] as usize;
+                let t = hits.distance[self.rank[i] as usize];
+                (e * per..(e + 1) * per).any(|j| {
+                    let tj = shits.distance[j];
+                    key(j) != surface[i] || frame.semantic[i] != 1 && t.is_finite() && (tj - t).abs() > 0.05 * tj.min(t)
+                })
+            })
+            .map(|e| e as u32)
+            .collect();
         let rays: Vec<u32> =
             mixed.iter().flat_map(|&e| (e as usize * per..(e as usize + 1) * per).map(|j| j as u32)).collect();
         let (mo, md): (Vec<[f32; 3]>, Vec<[f32; 3]>) = rays.iter().map(|&j| (so[j as usize], sd[j as usize])).unzip();

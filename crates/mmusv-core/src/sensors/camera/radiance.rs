@@ -96,8 +96,10 @@ fn sunlit(
         return Ok(vec![false; n]);
     }
     let sun = shader.sun();
-    let facing: Vec<(u32, [f32; 3])> =
-        filter_map_range(n, |k| shadow_origin(hits, origins, dirs, k, sun, keep).map(|o| (k as u32, o)));
+    let facing: Vec<(u32, [f32; 3])> = (0..n)
+        .into_par_iter()
+        .filter_map(|k| shadow_origin(hits, origins, dirs, k, sun, keep).map(|o| (k as u32, o)))
+        .collect();
     lit_slots(scene, sun, shadows, &facing, n)
 }
 
@@ -113,9 +115,11 @@ fn sunlit_of(
         return Ok(vec![false; which.len()]);
     }
     let sun = shader.sun();
-    let facing: Vec<(u32, [f32; 3])> = filter_map_range(which.len(), |j| {
-        shadow_origin(hits, origins, dirs, which[j] as usize, sun, |_| true).map(|o| (j as u32, o))
-    });
+    let facing: Vec<(u32, [f32; 3])> = which
+        .par_iter()
+        .enumerate()
+        .filter_map(|(j, &k)| shadow_origin(hits, origins, dirs, k as usize, sun, |_| true).map(|o| (j as u32, o)))
+        .collect();
     lit_slots(scene, sun, shadows, &facing, which.len())
 }
 
@@ -278,10 +282,13 @@ pub fn radiance(
         };
         // A candidate's own reflection is traced only if it is its own representative (its shading may fall
         // back to its own); with a shared one, the representative's serves.
-        let traced: Vec<u32> = filter_map_range(n, |k| {
-            let own = is_water(k) && owner(k) == k;
-            (own && !(is_candidate(k) && matches!(reflections, Reflections::Shared(_)))).then_some(k as u32)
-        });
+        let traced: Vec<u32> = (0..n)
+            .into_par_iter()
+            .filter(|&k| {
+                is_water(k) && owner(k) == k && !(is_candidate(k) && matches!(reflections, Reflections::Shared(_)))
+            })
+            .map(|k| k as u32)
+            .collect();
         let rays: Vec<([f32; 3], [f32; 3])> = traced
             .par_iter()
             .map(|&k| {
@@ -384,21 +391,6 @@ pub fn radiance(
 const SHADE_CHUNK: usize = 4096;
 /// Least rays per task of the cheap per-ray passes (kinds, candidates, means).
 const PASS_CHUNK: usize = 4096;
-
-/// `f(k)` for every `k` in `0..n` where it is `Some`, in order of `k`: each task scans a run of [`PASS_CHUNK`]
-/// indices into a vector of its own, and the runs are joined once (rather than rayon's item-wise
-/// `filter_map(..).collect()`, which splits and joins per item).
-pub(crate) fn filter_map_range<T: Send>(n: usize, f: impl Fn(usize) -> Option<T> + Sync) -> Vec<T> {
-    let runs: Vec<Vec<T>> = (0..n.div_ceil(PASS_CHUNK))
-        .into_par_iter()
-        .map(|c| (c * PASS_CHUNK..((c + 1) * PASS_CHUNK).min(n)).filter_map(&f).collect())
-        .collect();
-    let mut out = Vec::with_capacity(runs.iter().map(Vec::len).sum());
-    for run in runs {
-        out.extend(run);
-    }
-    out
-}
 
 /// A batch of rays and their closest hits in a scene.
 struct Rays<'a> {
