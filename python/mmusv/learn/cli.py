@@ -138,29 +138,29 @@ def run(args: argparse.Namespace) -> int:
         "threads": threads,
         "progress": not args.no_progress and jobs == 1,
     }
+    # A model that fails side by side does not stop the others: each failure is reported, the summary holds the
+    # models that finished, and the first failure is raised after them (as training in turn would raise it).
+    finished: list[tuple[str, dict[str, Any]]] = []
+    failures: list[BaseException] = []
     if jobs == 1:
-        results = [_train_one({**task, "mode": mode, "out": str(out / mode)}) for mode in modes]
+        finished = [(mode, _train_one({**task, "mode": mode, "out": str(out / mode)})) for mode in modes]
     else:
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor, as_completed
 
         print(f"training {', '.join(modes)} side by side: {jobs} processes, {threads} torch thread(s) each", flush=True)
         ctx = multiprocessing.get_context("spawn")  # a fresh interpreter per model: no forked torch thread pools
-        # A model that fails does not stop the others: each is reported, the summary holds those that finished,
-        # and the first failure is raised after them (as training in turn would raise it).
-        failures: list[tuple[str, BaseException]] = []
         done: dict[str, dict[str, Any]] = {}
         with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
             futures = {pool.submit(_train_one, {**task, "mode": mode, "out": str(out / mode)}): mode for mode in modes}
             for f in as_completed(futures):
                 try:
                     done[futures[f]] = f.result()
-                except Exception as e:  # reported below, the first one raised after the others
-                    failures.append((futures[f], e))
+                except Exception as e:  # reported here, the first one raised after the others
+                    failures.append(e)
                     print(f"{futures[f]}: failed: {e}", file=sys.stderr, flush=True)
-        results = [done[m] for m in modes if m in done]
-        modes = [m for m in modes if m in done]
-    for mode, r in zip(modes, results, strict=True):
+        finished = [(mode, done[mode]) for mode in modes if mode in done]
+    for mode, r in finished:
         summary["models"][mode] = {k: r[k] for k in ("epochs", "steps", "seconds", "finished")}
         print(
             f"{mode}: {r['epochs']} epochs, {r['steps']} steps, {r['seconds']:.1f} s of training -> {r['out']} "
@@ -168,8 +168,8 @@ def run(args: argparse.Namespace) -> int:
             flush=True,
         )
     (out / "train_summary.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
-    if jobs > 1 and failures:
-        raise failures[0][1]
+    if failures:
+        raise failures[0]
     print(f"total {time.perf_counter() - t0:.1f} s; score with: mmusv study detection --model {out} ...", flush=True)
     return 0
 
@@ -177,14 +177,9 @@ def run(args: argparse.Namespace) -> int:
 def _jobs(value: str, models: int, device: str | None) -> int:
     """``--jobs``: a positive count (at most ``models``), or ``auto`` (on a CPU ``models``; 1 on a GPU)."""
     if value == "auto":
-        if device is not None and device != "cpu":
-            return 1
-        if device is None:
-            import torch
+        from mmusv.learn.model import torch_device
 
-            if torch.cuda.is_available():
-                return 1
-        return max(1, models)
+        return 1 if torch_device(device).type != "cpu" else max(1, models)
     try:
         n = int(value)
     except ValueError:

@@ -23,7 +23,7 @@ from mmusv.learn._errors import input_error
 from mmusv.learn.cache import Cache
 from mmusv.learn.decode import peaks
 from mmusv.learn.example import MODES, collate, make_example, message_bytes
-from mmusv.learn.model import PillarNet
+from mmusv.learn.model import PillarNet, torch_device
 from mmusv.learn.presets import Preset
 
 __all__ = ["infer_cache", "main", "merge_main", "merge_peaks"]
@@ -52,7 +52,7 @@ def infer_cache(
     unknown = sorted(set(modes) - set(MODES))
     if unknown:
         raise input_error(f"--modes {','.join(unknown)}: allowed: {', '.join(MODES)}")
-    dev = torch.device(device or ("cuda" if torch.cuda.is_available() else "cpu"))
+    dev = torch_device(device)
     root = Path(models)
     arrays: dict[str, np.ndarray] = {}
     n_clouds = len(cache.arrays["cloud_offsets"]) - 1

@@ -21,6 +21,12 @@ from mmusv.learn.presets import Preset
 __all__ = ["PillarNet"]
 
 
+def torch_device(device: str | None) -> torch.device:
+    """The torch device named ``device`` (``cpu``, ``cuda``, ``cuda:1``, ...) or, when ``None``, CUDA where it is
+    available, else the CPU: the one rule of training, inference and ``mmusv train --jobs``."""
+    return torch.device(device or ("cuda" if torch.cuda.is_available() else "cpu"))
+
+
 class PillarNet(nn.Module):
     """PointPillars + CenterPoint of preset ``p`` for training ``mode`` (``single``, ``early``,
     ``intermediate``)."""

@@ -42,7 +42,7 @@ from mmusv.learn.augment import apply, draw
 from mmusv.learn.cache import Cache
 from mmusv.learn.example import MODES, Example, collate, early_cloud, make_example
 from mmusv.learn.loss import centerpoint_loss
-from mmusv.learn.model import PillarNet
+from mmusv.learn.model import PillarNet, torch_device
 from mmusv.learn.presets import PRESETS, Preset, parse_overrides, preset
 from mmusv.learn.targets import points_in_boxes
 
@@ -134,7 +134,7 @@ def train(
     c = Cache(cache) if isinstance(cache, (str, Path)) else cache
     out_p = Path(out)
     out_p.mkdir(parents=True, exist_ok=True)
-    dev = torch.device(device or ("cuda" if torch.cuda.is_available() else "cpu"))
+    dev = torch_device(device)
     if dev.type == "cpu":
         torch.use_deterministic_algorithms(True)
     else:
