@@ -74,7 +74,12 @@ def test_ctrl_c_while_closing_still_writes_every_item_and_is_reported() -> None:
 
     def write(i: int) -> None:
         if i == 1:
-            time.sleep(0.3)  # the main thread is in close() by now
+            # Wait until the main thread is in close() (on a loaded machine a fixed sleep may not be enough), then
+            # give it a moment to be waiting there.
+            deadline = time.monotonic() + 30.0
+            while not w._closed and time.monotonic() < deadline:
+                time.sleep(0.01)
+            time.sleep(0.1)
             _thread.interrupt_main()  # what Ctrl-C does
             time.sleep(0.3)
         written.append(i)
