@@ -59,10 +59,32 @@ struct Tile {
     n: usize,
     zmin: f32,
     zmax: f32,
-    /// `(n+1)²` heights, world z.
+    /// `(n+1)²` heights, world z (every component).
     h: Vec<f32>,
-    /// `(n+1)²` slopes `(∂η/∂x, ∂η/∂y)`.
+    /// `(n+1)²` slopes `(∂η/∂x, ∂η/∂y)` of the components the cell resolves ([`resolved`]).
     g: Vec<[f32; 2]>,
+    /// Mean square slope `Σ a²k²/2` (both axes) of the components it does not resolve, tapered as the waves are.
+    mss: f32,
+}
+
+/// Whether a wave of wavenumber `k_rad_m` is resolved by samples `cell_m` apart: at least two cells to its
+/// wavelength (the Nyquist limit, `k ≤ π / cell_m`). Shorter waves sampled at the nodes would alias into
+/// spurious longer slope patterns, so the shading slopes leave them out and take their slope variance as
+/// roughness instead ([`WaveSurface::shading`]).
+#[inline]
+pub(crate) fn resolved(k_rad_m: f64, cell_m: f32) -> bool {
+    k_rad_m * f64::from(cell_m) <= std::f64::consts::PI
+}
+
+/// The water's shading at a point: the resolved waves' normal and the unresolved ones' slope variance.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfaceShading {
+    /// Unit normal (up-facing) of the sampled slopes `∇η` of the resolved waves, interpolated bilinearly.
+    pub normal: [f32; 3],
+    /// Mean square slope (both axes, `σx² + σy²`) of the waves too short for the level's cells: a roughness
+    /// to add to the capillaries' (the filtered-normal-map rule, LEAN/Toksvig), so every level shows the same
+    /// total slope variance.
+    pub unresolved_mss: f32,
 }
 
 /// The displaced sea surface of one frame (see the module docs).
@@ -211,10 +233,24 @@ impl WaveSurface {
         unit([-p[1] / s, -p[2] / s, 1.0])
     }
 
-    /// Smooth unit normal at world `(x, y)`: the sampled slopes `∇η` interpolated bilinearly (up-facing); `None`
-    /// over still water (outside the sampled tiles), where the caller's own small-scale normals serve.
+    /// Smooth unit normal at world `(x, y)`: the sampled slopes `∇η` of the resolved waves interpolated
+    /// bilinearly (up-facing); `None` over still water (outside the sampled tiles), where the caller's own
+    /// small-scale normals serve.
     #[inline]
     pub fn shading_normal(&self, x: f32, y: f32) -> Option<[f32; 3]> {
+        self.shading(x, y).map(|s| s.normal)
+    }
+
+    /// The water's shading at world `(x, y)` ([`SurfaceShading`]); `None` over still water.
+    ///
+    /// Model: a wave shorter than two cells of the tile's level ([`resolved`]) cannot be drawn from its nodes
+    /// (sampled there, it aliases into a false pattern of longer slopes, and the level's edge shows as a change
+    /// of texture), so its slopes are treated statistically, as filtered normal maps treat detail finer than a
+    /// texel: M. Olano & D. Baker, "LEAN Mapping", I3D 2010; M. Toksvig, "Mipmapping Normal Maps", J. Graphics
+    /// Tools 10(3), 2005. Each level's normals carry the waves it resolves and its roughness the variance of
+    /// the rest, `Σ a²k²/2` over those components.
+    #[inline]
+    pub fn shading(&self, x: f32, y: f32) -> Option<SurfaceShading> {
         let (ix, iy) = self.tile_at(x, y)?;
         let t = &self.tiles[iy * self.ntx + ix];
         if t.n == 0 {
@@ -226,7 +262,7 @@ impl WaveSurface {
         let (g00, g10, g01, g11) = (g(ci, cj), g(ci + 1, cj), g(ci, cj + 1), g(ci + 1, cj + 1));
         let mix =
             |a: usize| (g00[a] * (1.0 - fu) + g10[a] * fu) * (1.0 - fv) + (g01[a] * (1.0 - fu) + g11[a] * fu) * fv;
-        Some(unit([-mix(0), -mix(1), 1.0]))
+        Some(SurfaceShading { normal: unit([-mix(0), -mix(1), 1.0]), unresolved_mss: t.mss })
     }
 
     /// The first crossing of the ray `o + t·d` (`d` unit, `0 <= t < t_max`) with the surface, from either side,
@@ -358,7 +394,13 @@ pub(crate) mod tests {
                     }
                     let e = eta(&c, x, y, 12.5);
                     assert!((f64::from(tile.h[j * w + i]) - e).abs() < 2e-4, "tile {k} node {i},{j}");
-                    let gx: f64 = c.iter().map(|w| -w.amplitude_m * w.kx * w.phase_at(x, y, 12.5).sin()).sum();
+                    // The slopes: those of the waves at least two cells long only.
+                    let cell = f64::from(s.tile_m) / tile.n as f64;
+                    let gx: f64 = c
+                        .iter()
+                        .filter(|w| std::f64::consts::TAU / w.k_rad_m >= 2.0 * cell)
+                        .map(|w| -w.amplitude_m * w.kx * w.phase_at(x, y, 12.5).sin())
+                        .sum();
                     assert!((f64::from(tile.g[j * w + i][0]) - gx).abs() < 2e-4);
                     checked += 1;
                 }
@@ -366,6 +408,38 @@ pub(crate) mod tests {
         }
         assert!(checked > 500);
         assert!(s.zmax() > 0.5 && s.zmax() <= 1.6 && s.zmin() < -0.5);
+    }
+
+    /// A wave shorter than two cells leaves the level's shading slopes and becomes its roughness: its slope
+    /// variance `a²k²/2` exactly, at every level too coarse for it, so resolved and unresolved slopes together
+    /// keep the sea's whole mean square slope at every level; the heights keep it at every level.
+    #[test]
+    fn short_waves_become_roughness_not_aliased_slopes() {
+        // 1.5 m and 12 m waves: the first is resolved nowhere (finest cell 1 m), the second up to 4 m cells.
+        let (k1, k2) = (std::f64::consts::TAU / 1.5, std::f64::consts::TAU / 12.0);
+        let sea = [comp(0.02, k1 * 0.6, k1 * 0.8, 0.0, 0.3), comp(0.3, k2, 0.0, 0.0, 1.1)];
+        let spec = SurfaceSpec { radius_m: 2000.0, ..SurfaceSpec::default() };
+        let s = surface(&sea, 0.0, &[[0.0, 0.0]], spec);
+        let (m1, m2) = ((0.02 * k1).powi(2) / 2.0, (0.3 * k2).powi(2) / 2.0);
+        let mut seen = [false; 4];
+        for (k, tile) in s.tiles.iter().enumerate().filter(|(_, t)| t.n > 0) {
+            let centre = [s.x0 + ((k % s.ntx) as f32 + 0.5) * s.tile_m, s.y0 + ((k / s.ntx) as f32 + 0.5) * s.tile_m];
+            if nearest(&[[0.0, 0.0]], centre[0], centre[1]) > spec.radius_m - spec.taper_m {
+                continue; // tapered
+            }
+            let cell = f64::from(s.tile_m) / tile.n as f64;
+            let want = if cell * 2.0 > 12.0 { m1 + m2 } else { m1 };
+            assert!((f64::from(tile.mss) - want).abs() < 1e-6 * want.max(1e-3), "cell {cell}: {} vs {want}", tile.mss);
+            // The shading slopes are the long wave's alone where it is resolved (no 1.5 m aliasing), none else.
+            for (q, g) in tile.g.iter().enumerate().step_by(7) {
+                let long = if cell * 2.0 > 12.0 { 0.0 } else { 0.3 * k2 };
+                assert!(g[0].abs() <= long as f32 + 1e-5 && g[1].abs() < 1e-5, "cell {cell} node {q}: {g:?}");
+            }
+            seen[(TILE_CELLS / tile.n).trailing_zeros().min(3) as usize] = true;
+        }
+        assert!(seen.iter().all(|&v| v), "levels: {seen:?}");
+        let sh = s.shading(3.0, 4.0).unwrap_or_else(|| unreachable!("inside the sampled tiles"));
+        assert!((f64::from(sh.unresolved_mss) - m1).abs() < 1e-9 && sh.normal[2] > 0.9);
     }
 
     /// Brute force: march the ray in tiny steps against [`WaveSurface::height`] (the same triangulated surface,
@@ -421,7 +495,15 @@ pub(crate) mod tests {
                     continue; // still water beyond the radius
                 }
                 assert!((tile.h[q] - h[q]).abs() < 1e-4, "tile {k} node {q}: {} vs {}", tile.h[q], h[q]);
-                assert!((tile.g[q][0] - gx[q]).abs() < 1e-4 && (tile.g[q][1] - gy[q]).abs() < 1e-4);
+                // The tile's slopes leave out the waves its cells cannot resolve: add theirs back, point by point.
+                let (mut ux, mut uy) = (0.0f64, 0.0f64);
+                for w in f.components().iter().filter(|w| !resolved(w.k_rad_m, dx as f32)) {
+                    let sn = w.phase_at(xq, yq, 41.3).sin();
+                    ux -= w.amplitude_m * w.kx * sn;
+                    uy -= w.amplitude_m * w.ky * sn;
+                }
+                let (ax, ay) = (f64::from(tile.g[q][0]) + ux, f64::from(tile.g[q][1]) + uy);
+                assert!((ax - f64::from(gx[q])).abs() < 2e-4 && (ay - f64::from(gy[q])).abs() < 2e-4, "tile {k} {q}");
             }
         }
         assert!(levels[..5].iter().all(|&c| c > 0), "every level sampled: {levels:?}");

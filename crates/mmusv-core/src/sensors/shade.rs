@@ -114,6 +114,9 @@ pub struct SurfaceHit {
     pub lights_on: bool,
     /// The shading normal: the geometric one, or for water the swell's ([`Shader::with_swell`]).
     pub shading_normal: Vec3,
+    /// For water on the displaced sea, the mean square slope of the waves too short for the surface's sampling
+    /// there ([`crate::sea::SurfaceShading`]), added to the glint's roughness; 0 elsewhere.
+    pub unresolved_mss: f32,
 }
 
 impl SurfaceHit {
@@ -365,9 +368,13 @@ impl Shader {
     #[inline(always)]
     pub fn with_swell(&self, d: Vec3, mut hit: SurfaceHit) -> SurfaceHit {
         hit.shading_normal = hit.normal;
+        hit.unresolved_mss = 0.0;
         if hit.is_water() {
-            let n = match self.waves.as_ref().and_then(|w| w.shading_normal(hit.point.x, hit.point.y)) {
-                Some(n) => Vec3::from_array(n),
+            let n = match self.waves.as_ref().and_then(|w| w.shading(hit.point.x, hit.point.y)) {
+                Some(s) => {
+                    hit.unresolved_mss = s.unresolved_mss;
+                    Vec3::from_array(s.normal)
+                }
                 None => self.water_normal(hit.point),
             };
             if n.dot(d) <= 0.0 {
@@ -441,10 +448,17 @@ impl Shader {
         if sunlit {
             let ns = n.dot(self.sun);
             if ns > 0.0 {
-                // The glint: GGX with the Cox–Munk roughness, weighted by the exact Fresnel at the half vector.
+                // The glint: GGX with the Cox–Munk roughness (and the slope variance of the waves too short for
+                // the surface's sampling there: α² adds as mean square slopes do), weighted by the exact Fresnel
+                // at the half vector.
                 let h = (v + self.sun).normalize_or_zero();
                 let f = water_fresnel(v.dot(h));
-                c += self.sun_e * (brdf::microfacet_cos(n, v, self.sun, self.water_alpha) * f);
+                let alpha = if hit.unresolved_mss > 0.0 {
+                    (self.water_alpha * self.water_alpha + hit.unresolved_mss).sqrt()
+                } else {
+                    self.water_alpha
+                };
+                c += self.sun_e * (brdf::microfacet_cos(n, v, self.sun, alpha) * f);
                 entering += self.sun_e * (ns * (1.0 - water_fresnel(ns)));
             }
         }
@@ -522,6 +536,7 @@ mod tests {
             material,
             lights_on: false,
             shading_normal: Vec3::Z,
+            unresolved_mss: 0.0,
         }
     }
 

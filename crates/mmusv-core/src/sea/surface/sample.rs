@@ -7,8 +7,12 @@
 //! component and frame, and the inner loop is a vectorisable multiply-add over a row of nodes (the same values as
 //! [`crate::ocean::WaveField::elevation_slope_grid`] to rounding, tested in the parent module). Beyond
 //! `radius_m − taper_m` from the nearest focus the waves taper linearly to the still level.
+//!
+//! The heights sum every component; the slopes (which only shading reads) sum only the components the level's
+//! cell resolves ([`resolved`]), and the tile keeps the others' mean square slope for the shading to treat
+//! statistically (see [`super::WaveSurface::shading`]).
 
-use super::{nearest, SurfaceSpec, Tile, MAX_LEVEL, TILE_CELLS};
+use super::{nearest, resolved, SurfaceSpec, Tile, MAX_LEVEL, TILE_CELLS};
 use crate::ocean::WaveComponent;
 
 /// Nodes summed together by [`accumulate`] (one AVX2 register of `f32`).
@@ -112,6 +116,9 @@ impl<'a> Phasors<'a> {
         let (mut ar, mut ai) = (vec![0f32; groups * nc * LANES], vec![0f32; groups * nc * LANES]);
         let (mut fr, mut fi) = (vec![0f32; w * nc], vec![0f32; w * nc]);
         let mut k = vec![[0f32; 2]; nc];
+        // Mean square slope (both axes) of the components this level's cell cannot resolve.
+        let cell_m = tile_m / n as f32;
+        let mut mss = 0f64;
         let table = &self.powers[lvl as usize];
         for (c, comp) in self.comps.iter().enumerate() {
             let pw = &table[c * w..(c + 1) * w];
@@ -124,7 +131,11 @@ impl<'a> Phasors<'a> {
                 fr[i * nc + c] = q.1 .0 as f32;
                 fi[i * nc + c] = q.1 .1 as f32;
             }
-            k[c] = [comp.kx as f32, comp.ky as f32];
+            if resolved(comp.k_rad_m, cell_m) {
+                k[c] = [comp.kx as f32, comp.ky as f32];
+            } else {
+                mss += 0.5 * (comp.amplitude_m * comp.k_rad_m).powi(2);
+            }
         }
         let mut eta = vec![0f32; stride * w];
         let mut sx = vec![0f32; stride * w];
@@ -160,7 +171,10 @@ impl<'a> Phasors<'a> {
                 zmax = zmax.max(z);
             }
         }
-        Tile { n, zmin, zmax, h, g }
+        // The unresolved slopes taper with the waves: their share at the tile's centre.
+        let centre_taper = ((spec.radius_m - dc) / (spec.radius_m - inner).max(1e-6)).clamp(0.0, 1.0);
+        let mss = mss as f32 * centre_taper * centre_taper;
+        Tile { n, zmin, zmax, h, g, mss }
     }
 }
 
@@ -243,7 +257,8 @@ mod tests {
                 for (c, comp) in comps.iter().enumerate() {
                     let pw = &table[c * w..(c + 1) * w];
                     let p = cmul(ph.col[ix * nc + c], ph.row[iy * nc + c]);
-                    let (kx, ky) = (comp.kx as f32, comp.ky as f32);
+                    let keep = resolved(comp.k_rad_m, tile_m / tile.n as f32);
+                    let (kx, ky) = if keep { (comp.kx as f32, comp.ky as f32) } else { (0.0, 0.0) };
                     for j in 0..w {
                         let (fr, fi) = (pw[j].1 .0 as f32, pw[j].1 .1 as f32);
                         for i in 0..w {

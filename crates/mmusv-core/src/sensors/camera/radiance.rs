@@ -49,6 +49,7 @@ pub(crate) fn surface_at(
         material: scene.material_index(instance, triangle),
         lights_on: scene.instances().get(instance as usize).is_some_and(|i| i.lights_on()),
         shading_normal: normal,
+        unresolved_mss: 0.0,
     };
     Some(shader.with_swell(d, hit))
 }
