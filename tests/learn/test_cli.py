@@ -78,3 +78,18 @@ def test_bad_jobs_is_a_clear_error(
     assert _train(recording, tmp_path / "bad", "--jobs", value) != 0
     err = capsys.readouterr().err
     assert f"--jobs {value}" in err and "Traceback" not in err
+
+
+def test_scorer_options_are_checked(recording: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert _train(recording, tmp_path / "none", "--scorers-only") != 0
+    assert "--scorers-only: no" in capsys.readouterr().err
+    assert _train(recording, tmp_path / "both", "--scorers-only", "--no-scorers") != 0
+    assert "give one" in capsys.readouterr().err
+
+
+def test_a_model_that_finds_nothing_trains_without_a_scorer(recording: Path, tmp_path: Path) -> None:
+    # two epochs of the tiny preset find no box: the model is kept, without a scorer, and the summary says why
+    assert _train(recording, tmp_path, "--modes", "single", "--threads", "1") == 0
+    summary = json.loads((tmp_path / "train_summary.json").read_text(encoding="utf-8"))
+    assert "boxes" in summary["scorers"]["single"]["skipped"]
+    assert (tmp_path / "single" / "model.pt").is_file() and not (tmp_path / "single" / "scorer.pt").exists()

@@ -1,6 +1,8 @@
 """``mmusv train``: builds the tensor cache of a detection dataset's training split (:mod:`mmusv.learn.cache`)
 and trains the single-agent, early- and intermediate-fusion models of a preset (:mod:`mmusv.learn.train`), each
-into ``OUT/<mode>/`` with its checkpoint, log and loss plot (``loss.png``); started again, it resumes.
+into ``OUT/<mode>/`` with its checkpoint, log and loss plot (``loss.png``); started again, it resumes. Then it
+fits each model's IoU scorer (:mod:`mmusv.learn.scorer`) on the same training cache, into ``OUT/<mode>/scorer.pt``
+(``--no-scorers`` leaves them out, ``--scorers-only`` fits them for models already trained).
 ``mmusv study detection|robustness --model OUT`` then scores them (:func:`load_for_study`).
 
 On a CPU the models train side by side, each in a process of its own (``--jobs``, by default one per model), with
@@ -38,13 +40,14 @@ def _torch() -> None:
         raise InputError(f"mmusv.learn {_INSTALL}") from None
 
 
-def load_for_study(path: str, *, refine: bool | None = None) -> Any:
+def load_for_study(path: str, *, refine: bool | None = None, rescore: bool | None = None) -> Any:
     """The :class:`~mmusv.learn.detector.LearnedDetector` at ``path`` (``--model``); ``refine``: the geometric
-    second stage on or off (``None``: the default of :func:`~mmusv.learn.detector.load_models`)."""
+    second stage on or off, ``rescore``: the IoU scorers on or off (``None``: the defaults of
+    :func:`~mmusv.learn.detector.load_models`)."""
     _torch()
     from mmusv.learn.detector import load_models
 
-    return load_models(path, refine=refine)
+    return load_models(path, refine=refine, rescore=rescore)
 
 
 def add_parser(sub: Any) -> None:
@@ -83,6 +86,16 @@ def add_parser(sub: Any) -> None:
         "30x slower than a 1-thread one on the shared 2-core machine",
     )
     p.add_argument("--cache-only", action="store_true", help="build OUT/cache_<split>.npz and stop")
+    p.add_argument(
+        "--no-scorers",
+        action="store_true",
+        help="do not fit the IoU scorers (mmusv.learn.scorer) of the trained models after training",
+    )
+    p.add_argument(
+        "--scorers-only",
+        action="store_true",
+        help="fit the IoU scorers of the models already trained in OUT (and nothing else)",
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("-o", "--output", default="out/train", help="output folder (default out/train)")
 
@@ -104,6 +117,14 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(f"--threads {args.threads}: must be >= 1")
     jobs = _jobs(args.jobs, len(modes), args.device)
     out = Path(args.output)
+    if args.scorers_only and args.no_scorers:
+        raise InputError("--scorers-only and --no-scorers: give one")
+    if args.scorers_only:
+        cache_file = out / f"cache_{args.split}.npz"
+        if not cache_file.is_file():
+            raise InputError(f"--scorers-only: no {cache_file}; train first (mmusv train ... -o {out})")
+        _fit_scorers(out, cache_file, modes, seed=args.seed, threads=args.threads)
+        return 0
     inputs: list[Any] = list(args.inputs)
     if args.generate is not None:
         if inputs or args.opv2v:
@@ -167,6 +188,8 @@ def run(args: argparse.Namespace) -> int:
             f"({r['plot']})",
             flush=True,
         )
+    if not args.no_scorers and not failures:
+        summary["scorers"] = _fit_scorers(out, cache, [m for m, _ in finished], seed=args.seed, threads=args.threads)
     (out / "train_summary.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
     if failures:
         raise failures[0]
@@ -187,6 +210,64 @@ def _jobs(value: str, models: int, device: str | None) -> int:
     if n < 1:
         raise InputError(f"--jobs {value}: must be >= 1 (or auto)")
     return min(n, models)
+
+
+def _fit_scorers(
+    out: Path, cache_path: Path, modes: list[str], *, seed: int, threads: int | None
+) -> dict[str, dict[str, Any]]:
+    """Fits the IoU scorer (:func:`mmusv.learn.scorer.fit_scorer`) of each trained model in ``modes`` on the
+    training cache, each into ``OUT/<mode>/scorer.pt``; returns what each fit measured."""
+    import torch
+
+    from mmusv.learn.cache import Cache
+    from mmusv.learn.detector import load_models
+    from mmusv.learn.example import early_cloud
+    from mmusv.learn.refine import RefineParams
+    from mmusv.learn.scorer import SCORER_FILE, fit_scorer
+
+    if threads is not None:
+        torch.set_num_threads(threads)
+    cache = Cache(cache_path)
+    done: dict[str, dict[str, Any]] = {}
+    for mode in modes:
+        if not (out / mode / "model.pt").is_file():
+            raise InputError(f"--scorers-only: no {out / mode / 'model.pt'}; train the {mode} model first")
+        det = load_models(out / mode / "model.pt", refine=True, rescore=False)
+        model = det.models[mode]
+
+        def sample(k: int, mode: str = mode, det: Any = det) -> tuple[Any, Any, Any, Any]:
+            ego, nbs, gt = cache.sample(k)
+            points = early_cloud(ego, nbs) if mode == "early" else ego
+            boxes, scores = det._infer(mode, points, nbs if mode == "intermediate" else [])
+            return points, boxes, scores, gt
+
+        ks = list(range(len(cache)))
+        groups = [cache.key(int(cache.arrays["sample_cloud"][k]))[0] for k in ks]
+        t0 = time.perf_counter()
+        try:
+            scorer, fit = fit_scorer(sample, ks, groups, refine=RefineParams(), nms_iou=model.preset.nms_iou, seed=seed)
+        except InputError as e:  # a model that finds (almost) nothing: it is used as it is, and this is said
+            done[mode] = {"skipped": str(e)}
+            print(f"{mode}: no IoU scorer ({e}); the model's boxes keep the network's scores", flush=True)
+            continue
+        info = {
+            "boxes": fit.boxes,
+            "frames": fit.frames,
+            "beta": fit.beta,
+            "held_out": [{"beta": b, "ap50": round(a5, 4), "ap70": round(a7, 4)} for b, a5, a7 in fit.held_out],
+            "seconds": round(time.perf_counter() - t0, 1),
+        }
+        path = scorer.save(out / mode / SCORER_FILE, info)
+        done[mode] = info
+        base = next(x for x in fit.held_out if x[0] == 0.0)
+        chosen = next(x for x in fit.held_out if x[0] == fit.beta)
+        print(
+            f"{mode}: IoU scorer on {fit.boxes} boxes of {fit.frames} ego-frames, β = {fit.beta:g} (held-out "
+            f"AP@0.5 {base[1]:.3f} -> {chosen[1]:.3f}, AP@0.7 {base[2]:.3f} -> {chosen[2]:.3f}), "
+            f"{info['seconds']:.0f} s -> {path}",
+            flush=True,
+        )
+    return done
 
 
 def _train_one(task: dict[str, Any]) -> dict[str, Any]:

@@ -8,7 +8,8 @@ fusion code (:func:`mmusv.studies.detection.fusion.fuse`) calls :meth:`LearnedDe
 cloud and :meth:`LearnedDetector.intermediate` with the ego and its neighbours (as delayed or noisy as the
 robustness setting makes them). :attr:`LearnedDetector.shared_bytes` records, per intermediate-fusion call, the
 bytes the neighbours sent (:func:`mmusv.learn.example.message_bytes`). By default the boxes of ``cpu``-preset
-models are tightened on the points by the geometric second stage of :mod:`mmusv.learn.refine` (``refine``).
+models are tightened on the points by the geometric second stage of :mod:`mmusv.learn.refine` (``refine``), and
+rescored by a model's IoU scorer (:mod:`mmusv.learn.scorer`, ``scorer.pt`` beside its ``model.pt``) where it has one.
 """
 
 from __future__ import annotations
@@ -25,8 +26,8 @@ from mmusv.learn.decode import decode
 from mmusv.learn.example import MODES, collate, make_example, message_bytes
 from mmusv.learn.model import PillarNet
 from mmusv.learn.presets import Preset
-from mmusv.learn.refine import RefineParams, refine_boxes
-from mmusv.studies.detection.fusion import rotated_nms
+from mmusv.learn.refine import RefineParams
+from mmusv.learn.scorer import SCORER_FILE, IoUScorer, load_scorer, second_stage
 
 __all__ = ["LearnedDetector", "load_models"]
 
@@ -45,11 +46,15 @@ def _load(path: Path, device: torch.device) -> tuple[PillarNet, dict[str, Any]]:
     return model, ck
 
 
-def load_models(path: str | Path, *, device: str = "cpu", refine: bool | None = None) -> LearnedDetector:
+def load_models(
+    path: str | Path, *, device: str = "cpu", refine: bool | None = None, rescore: bool | None = None
+) -> LearnedDetector:
     """The models at ``path`` (module docstring) as one detector; raises ``InputError`` naming the path when
     there is none or one is unreadable. ``refine``: apply the geometric second stage
     (:mod:`mmusv.learn.refine`) to every model's boxes; ``None`` (default): only when every model is of the
-    ``cpu`` preset, the one it was measured on."""
+    ``cpu`` preset, the one it was measured on. ``rescore``: rank the refined boxes by each model's IoU scorer
+    (:mod:`mmusv.learn.scorer`); ``None`` (default): where a model has one and the boxes are refined; ``True``:
+    every model must have one (an ``InputError`` names the one without)."""
     p = Path(path)
     dev = torch.device(device)
     files: dict[str, Path] = {}
@@ -72,20 +77,38 @@ def load_models(path: str | Path, *, device: str = "cpu", refine: bool | None = 
         }
     if refine is None:
         refine = all(v["preset"] == "cpu" for v in info.values())
-    return LearnedDetector(models, info, refine=RefineParams() if refine else None)
+    scorers: dict[str, IoUScorer] = {}
+    if rescore is not False:
+        if not refine and rescore:
+            raise input_error("--rescore on needs the refined boxes (--refine on): the scorer reads the refinement")
+        for mode, f in files.items():
+            sf = f.parent / SCORER_FILE
+            if refine and sf.is_file():
+                scorers[mode] = load_scorer(sf)
+                info[mode]["scorer"] = str(sf)
+            elif rescore:
+                raise input_error(f"--rescore on: {mode} has no {sf} (fit it with mmusv train --scorers-only)")
+    return LearnedDetector(models, info, refine=RefineParams() if refine else None, scorers=scorers)
 
 
 class LearnedDetector:
     """Trained models by training mode (``single``, ``early``, ``intermediate``; module docstring). With
     ``refine``, every model's decoded boxes go through :func:`mmusv.learn.refine.refine_boxes` on the points the
     model was given (the aggregate for early fusion; the ego's own cloud for intermediate fusion, whose
-    neighbours send features, not points) and the preset's rotated NMS again (two proposals on one hull can grow
-    into the same box); the scores stay the network's."""
+    neighbours send features, not points), then, for a model with a scorer in ``scorers``, the IoU-aware
+    rescoring, and the preset's rotated NMS again (two proposals on one hull can grow into the same box):
+    :func:`mmusv.learn.scorer.second_stage`."""
 
     def __init__(
-        self, models: dict[str, PillarNet], info: dict[str, dict[str, Any]], *, refine: RefineParams | None = None
+        self,
+        models: dict[str, PillarNet],
+        info: dict[str, dict[str, Any]],
+        *,
+        refine: RefineParams | None = None,
+        scorers: dict[str, IoUScorer] | None = None,
     ) -> None:
         self.models, self.info, self.refine = models, info, refine
+        self.scorers: dict[str, IoUScorer] = dict(scorers or {})
         self.shared_bytes: list[int] = []
 
     @property
@@ -103,17 +126,26 @@ class LearnedDetector:
             for m, v in self.info.items()
         )
         second = self.refine.describe() if self.refine is not None else "no box refinement (network boxes as decoded)"
+        if self.scorers:
+            second += (
+                "; IoU-aware rescoring ("
+                + ", ".join(f"{m} β={s.beta:g}" for m, s in sorted(self.scorers.items()))
+                + ")"
+            )
         return f"{models}; {second}"
 
     def _run(
         self, mode: str, ego: np.ndarray, neighbours: Sequence[tuple[np.ndarray, np.ndarray]]
     ) -> tuple[np.ndarray, np.ndarray]:
         boxes, scores = self._infer(mode, ego, neighbours)
-        if self.refine is None or len(boxes) == 0:
-            return boxes, scores
-        boxes = refine_boxes(ego, boxes, params=self.refine)
-        keep = rotated_nms(boxes, scores, iou_threshold=self.models[mode].preset.nms_iou)
-        return boxes[keep], scores[keep]
+        return second_stage(
+            ego,
+            boxes,
+            scores,
+            refine=self.refine,
+            scorer=self.scorers.get(mode),
+            nms_iou=self.models[mode].preset.nms_iou,
+        )
 
     def _infer(
         self, mode: str, ego: np.ndarray, neighbours: Sequence[tuple[np.ndarray, np.ndarray]]

@@ -13,8 +13,11 @@ detections of the ego and its current neighbours, merged by rotated NMS or WBF (
 would. Clean setting only (the robustness settings re-run early and intermediate fusion on delayed or noisy
 inputs: use ``--model``).
 
-``python -m mmusv.learn.replay PEAKS.npz CACHE.npz RECORDINGS... [--split test] [--refine] [--late-merge wbf]
--o PREDICTIONS.parquet``
+With ``--scorers DIR`` (and ``--refine``) the refined boxes are rescored by the IoU scorers of
+:mod:`mmusv.learn.scorer` as the detector does (:func:`mmusv.learn.scorer.second_stage`).
+
+``python -m mmusv.learn.replay PEAKS.npz CACHE.npz RECORDINGS... [--split test] [--refine [--scorers DIR]]
+[--late-merge wbf] -o PREDICTIONS.parquet``
 """
 
 from __future__ import annotations
@@ -29,11 +32,15 @@ import numpy as np
 from mmusv.learn._errors import input_error
 from mmusv.learn.cache import Cache
 from mmusv.learn.example import early_cloud
-from mmusv.learn.refine import RefineParams, refine_boxes
+from mmusv.learn.refine import RefineParams
+from mmusv.learn.scorer import SCORER_FILE, IoUScorer, load_scorer, second_stage
 
 __all__ = ["main", "write_predictions"]
 
 Key = tuple[str, int, str]
+
+MODELS = ("single", "early", "intermediate")
+"""The models whose peaks a run may hold (``single`` serves ``none`` and ``late``)."""
 
 
 def _no_detector(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -66,10 +73,12 @@ def write_predictions(
     nms_iou: float = 0.1,
     refine: RefineParams | None = None,
     late_merge: str = "nms",
+    scorers: dict[str, IoUScorer] | None = None,
 ) -> Path:
     """Writes the predictions Parquet (module docstring) of ``peaks`` on ``cache`` (built from the same
     ``inputs`` and split) to ``out``; returns ``out``. ``refine``: the second stage's parameters, or ``None`` for
-    the network's boxes; ``late_merge``: one of :data:`mmusv.studies.detection.fusion.LATE_MERGES`."""
+    the network's boxes; ``late_merge``: one of :data:`mmusv.studies.detection.fusion.LATE_MERGES`; ``scorers``:
+    the IoU scorers by model (``single``, ``early``, ``intermediate``) for the refined boxes."""
     import polars as pl
 
     from mmusv.studies.detection.data import AgentFrame
@@ -87,25 +96,30 @@ def write_predictions(
         keep = rotated_nms(b, s, iou_threshold=nms_iou)
         return b[keep], s[keep]
 
-    def stage(b: np.ndarray, s: np.ndarray, points: Callable[[], np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    def stage(
+        b: np.ndarray, s: np.ndarray, points: Callable[[], np.ndarray], model: str
+    ) -> tuple[np.ndarray, np.ndarray]:
         b, s = nms(b, s)
         if refine is None or len(s) == 0:
             return b, s
-        return nms(refine_boxes(points(), b, params=refine), s)
+        scorer = (scorers or {}).get(model)
+        return second_stage(points(), b, s, refine=refine, scorer=scorer, nms_iou=nms_iou)
 
     own: dict[Key, tuple[np.ndarray, np.ndarray]] = {}
     fused: dict[tuple[Key, str], tuple[np.ndarray, np.ndarray]] = {}
     n_clouds = len(cache.arrays["cloud_offsets"]) - 1
     for c in range(n_clouds):
         if "single_offsets" in z:
-            own[cache.key(c)] = stage(*_rows(z, "single", c), partial(cache.cloud, c))
+            own[cache.key(c)] = stage(*_rows(z, "single", c), partial(cache.cloud, c), "single")
     for k in range(len(cache)):
         ego_cloud = int(cache.arrays["sample_cloud"][k])
         key = cache.key(ego_cloud)
         if "early_offsets" in z:
-            fused[(key, "early")] = stage(*_rows(z, "early", k), partial(_aggregate, cache, k))
+            fused[(key, "early")] = stage(*_rows(z, "early", k), partial(_aggregate, cache, k), "early")
         if "intermediate_offsets" in z:
-            fused[(key, "intermediate")] = stage(*_rows(z, "intermediate", k), partial(cache.cloud, ego_cloud))
+            fused[(key, "intermediate")] = stage(
+                *_rows(z, "intermediate", k), partial(cache.cloud, ego_cloud), "intermediate"
+            )
     ds = resolve_dataset(list(inputs), opv2v=None, split=split, ratios=tuple(ratios), seed=seed)
     cols: dict[str, list[object]] = {
         c: [] for c in ("sequence", "frame", "ego", "mode", "x", "y", "z", "l", "w", "h", "yaw", "score")
@@ -160,11 +174,34 @@ def main(argv: Sequence[str] | None = None) -> int:
         "--refine", action="store_true", help="the geometric second stage on every box (mmusv.learn.refine)"
     )
     ap.add_argument("--late-merge", default="nms", help="late fusion's merge: nms (default) or wbf")
+    ap.add_argument(
+        "--scorers",
+        default=None,
+        metavar="DIR",
+        help="with --refine: rescore by the IoU scorers DIR/<single|early|intermediate>/scorer.pt (mmusv train's "
+        "output folder)",
+    )
     ap.add_argument("-o", "--out", required=True)
     a = ap.parse_args(argv)
     refine = RefineParams() if a.refine else None
+    scorers = None
+    if a.scorers is not None:
+        if refine is None:
+            raise input_error("--scorers needs --refine (the scorers read the refined boxes)")
+        root = Path(a.scorers)
+        scorers = {m: load_scorer(root / m / SCORER_FILE) for m in MODELS if (root / m / SCORER_FILE).is_file()}
+        if not scorers:
+            raise input_error(f"--scorers {root}: no <{'|'.join(MODELS)}>/{SCORER_FILE} there")
     path = write_predictions(
-        a.peaks, Cache(a.cache), a.inputs, a.out, split=a.split, seed=a.seed, refine=refine, late_merge=a.late_merge
+        a.peaks,
+        Cache(a.cache),
+        a.inputs,
+        a.out,
+        split=a.split,
+        seed=a.seed,
+        refine=refine,
+        late_merge=a.late_merge,
+        scorers=scorers,
     )
     print(path)
     return 0

@@ -78,6 +78,13 @@ def _common(p: argparse.ArgumentParser, default_out: str) -> None:
         "auto (default) = on for cpu-preset models, where it was measured",
     )
     p.add_argument(
+        "--rescore",
+        choices=("auto", "on", "off"),
+        default="auto",
+        help="with --model: rank the refined boxes by each model's IoU scorer (mmusv.learn.scorer, scorer.pt "
+        "beside model.pt, fitted by mmusv train); auto (default) = where a model has one and boxes are refined",
+    )
+    p.add_argument(
         "--late-merge",
         choices=("nms", "wbf"),
         default="nms",
@@ -138,9 +145,11 @@ def run(args: argparse.Namespace) -> int:
             raise InputError("give one of --model, --detector or --predictions")
         from mmusv.learn.cli import load_for_study
 
-        learned = load_for_study(args.model, refine={"auto": None, "on": True, "off": False}[args.refine])
-    if args.model is None and args.refine != "auto":
-        raise InputError(f"--refine {args.refine}: only with --model (the learned detector's second stage)")
+        tri = {"auto": None, "on": True, "off": False}
+        learned = load_for_study(args.model, refine=tri[args.refine], rescore=tri[args.rescore])
+    if args.model is None and (args.refine != "auto" or args.rescore != "auto"):
+        flag = f"--refine {args.refine}" if args.refine != "auto" else f"--rescore {args.rescore}"
+        raise InputError(f"{flag}: only with --model (the learned detector's second stage)")
     modes = parse_modes(args.modes or (",".join(learned.fusion_modes) if learned is not None else "none,late,early"))
     settings = parse_settings(args.settings) if robust else (Setting(),)
     if robust and not any(m != "none" for m in modes):
