@@ -9,10 +9,11 @@
 //!
 //! Rays go through 8-wide nodes (see [`crate::bvh`]) one at a time or as packets of coherent rays, with AVX2
 //! where the CPU has it ([`crate::simd`]); batches are cast in parallel over rayon (`scene/batch.rs`). The sea
-//! shortcuts (rays settled from a height map of the scene, see [`crate::sea`]) live in `scene/sea_routes.rs`.
+//! shortcuts (rays settled from a height map of the scene, see [`crate::sea`]) live in `scene/sea_routes.rs`,
+//! and the top-level leaf visitors (each instance traced in its own frame) in `scene/visit.rs`.
 //! Distances are metres along the normalised direction.
 
-use crate::bvh::{box_entry, Box3, Bvh, Packet, PacketStack, PacketVisit, Stack, Visit, PACKET};
+use crate::bvh::{Box3, Bvh, Packet, PacketStack, Stack, PACKET};
 use crate::error::{MmusvError, Result};
 use crate::geometry::RigidPose;
 use crate::material::Material;
@@ -27,7 +28,10 @@ use std::sync::Arc;
 
 mod batch;
 mod sea_routes;
+mod visit;
 mod waves;
+
+use visit::{AnyInstance, Instances, PacketInstances};
 
 /// Value of `instance`, `triangle` for a ray that hit nothing.
 pub const NO_HIT: i32 = -1;
@@ -494,188 +498,6 @@ impl Scene {
             w.triangles.extend(0..mesh.num_triangles() as u32);
         }
         w
-    }
-}
-
-/// The top-level leaf visitor of [`Scene::cast_ray_with`]: each instance's mesh, cheapest first, in its local
-/// frame (instances at the identity pose use the world ray as it is).
-struct Instances<'a, L> {
-    lv: L,
-    scene: &'a Scene,
-    ray: &'a RayPrep,
-    stack: &'a mut Stack,
-    instance: u32,
-    triangle: u32,
-    /// An instance left out (the flat sea mesh while the wave surface stands in for it), or `u32::MAX`.
-    hidden: u32,
-}
-
-impl<L: Level> Visit for Instances<'_, L> {
-    #[inline(always)]
-    fn leaf(&mut self, leaf: u32, mut best: f32) -> f32 {
-        let sc = self.scene;
-        let lf = sc.tlas.leaves()[leaf as usize];
-        for k in lf.start as usize..(lf.start + lf.count) as usize {
-            let id = sc.tlas_order[k];
-            if id == self.hidden || !box_entry(&sc.tlas_boxes[k], self.ray, best) {
-                continue;
-            }
-            let inst = &sc.instances[id as usize];
-            let mesh = &sc.meshes[inst.mesh as usize];
-            let local = local_ray(self.ray, &inst.pose);
-            if let Some(h) = mesh.closest(self.lv, local.as_ref().unwrap_or(self.ray), best, self.stack) {
-                best = h.t;
-                self.instance = id;
-                self.triangle = h.triangle;
-            }
-        }
-        best
-    }
-}
-
-/// The top-level leaf visitor of [`Scene::occluded_with`].
-struct AnyInstance<'a, L> {
-    lv: L,
-    scene: &'a Scene,
-    ray: &'a RayPrep,
-    stack: &'a mut Stack,
-    hidden: u32,
-}
-
-impl<L: Level> Visit for AnyInstance<'_, L> {
-    #[inline(always)]
-    fn leaf(&mut self, leaf: u32, best: f32) -> f32 {
-        let sc = self.scene;
-        let lf = sc.tlas.leaves()[leaf as usize];
-        for k in lf.start as usize..(lf.start + lf.count) as usize {
-            let id = sc.tlas_order[k];
-            if id == self.hidden || !box_entry(&sc.tlas_boxes[k], self.ray, best) {
-                continue;
-            }
-            let inst = &sc.instances[id as usize];
-            let local = local_ray(self.ray, &inst.pose);
-            if sc.meshes[inst.mesh as usize].any(self.lv, local.as_ref().unwrap_or(self.ray), best, self.stack) {
-                return 0.0;
-            }
-        }
-        best
-    }
-}
-
-/// The ray in an instance's local frame, or `None` when the pose is the identity (the world ray then serves).
-#[inline(always)]
-fn local_ray(ray: &RayPrep, pose: &RigidPose) -> Option<RayPrep> {
-    if *pose == RigidPose::IDENTITY {
-        return None;
-    }
-    let rt = pose.rotation.transpose();
-    let o = rt * (Vec3::from_array(ray.o) - pose.translation);
-    let d = rt * Vec3::from_array(ray.d);
-    Some(RayPrep::new(o.to_array(), d.to_array()))
-}
-
-/// The top-level leaf visitor of packets: each instance whose box some ray enters, cheapest first; its mesh
-/// is traced with the rays that enter its box, as a packet in the instance's frame where their directions
-/// still share signs there, else ray by ray.
-struct PacketInstances<'a, L> {
-    lv: L,
-    scene: &'a Scene,
-    scratch_single: &'a mut Stack,
-    stack: &'a mut PacketStack,
-    /// The packet of a moved instance's rays in its frame (filled anew for each such instance).
-    sub: &'a mut Packet,
-    instance: [u32; PACKET],
-    triangle: [u32; PACKET],
-    any: bool,
-    hidden: u32,
-}
-
-impl<L: Level> PacketVisit for PacketInstances<'_, L> {
-    #[inline(always)]
-    fn leaf(&mut self, leaf: u32, rays: u32, p: &mut Packet) {
-        let sc = self.scene;
-        let lf = sc.tlas.leaves()[leaf as usize];
-        for k in lf.start as usize..(lf.start + lf.count) as usize {
-            let id = sc.tlas_order[k];
-            if id == self.hidden {
-                continue;
-            }
-            let mask = p.rays_entering_box(&sc.tlas_boxes[k]) & rays;
-            if mask == 0 {
-                continue;
-            }
-            let inst = &sc.instances[id as usize];
-            let mesh = &sc.meshes[inst.mesh as usize];
-            if inst.pose == RigidPose::IDENTITY {
-                // Trace the world packet, with the rays outside `mask` switched off for this instance.
-                let saved = p.best;
-                for r in 0..PACKET {
-                    if mask & (1 << r) == 0 {
-                        p.best[r] = -1.0;
-                    }
-                }
-                let mut tri = [u32::MAX; PACKET];
-                if self.any {
-                    mesh.any_packet(self.lv, p, self.stack);
-                } else {
-                    mesh.closest_packet(self.lv, p, self.stack, &mut tri);
-                }
-                for r in 0..PACKET {
-                    if mask & (1 << r) == 0 {
-                        p.best[r] = saved[r];
-                    } else if !self.any && p.best[r] < saved[r] {
-                        self.instance[r] = id;
-                        self.triangle[r] = tri[r];
-                    }
-                }
-                continue;
-            }
-            // Moved instance: the rays in its frame.
-            let mut local = [p.ray[0]; PACKET];
-            let mut lane = [0usize; PACKET];
-            let mut n = 0;
-            let mut m = mask;
-            while m != 0 {
-                let r = m.trailing_zeros() as usize;
-                m &= m - 1;
-                local[n] = local_ray(&p.ray[r], &inst.pose).unwrap_or(p.ray[r]);
-                lane[n] = r;
-                n += 1;
-            }
-            let q = &mut *self.sub;
-            if n > 1 && q.fill(&local[..n], 0.0) {
-                for j in 0..n {
-                    q.best[j] = p.best[lane[j]];
-                }
-                let mut tri = [u32::MAX; PACKET];
-                if self.any {
-                    mesh.any_packet(self.lv, q, self.stack);
-                } else {
-                    mesh.closest_packet(self.lv, q, self.stack, &mut tri);
-                }
-                for j in 0..n {
-                    let r = lane[j];
-                    if q.best[j] < p.best[r] {
-                        p.best[r] = q.best[j];
-                        self.instance[r] = id;
-                        self.triangle[r] = tri[j];
-                    }
-                }
-            } else {
-                for j in 0..n {
-                    let r = lane[j];
-                    if self.any {
-                        if mesh.any(self.lv, &local[j], p.best[r], self.scratch_single) {
-                            p.best[r] = -1.0;
-                        }
-                    } else if let Some(h) = mesh.closest(self.lv, &local[j], p.best[r], self.scratch_single) {
-                        p.best[r] = h.t;
-                        self.instance[r] = id;
-                        self.triangle[r] = h.triangle;
-                    }
-                }
-            }
-        }
     }
 }
 
