@@ -295,6 +295,7 @@ class Scene:
         time_s: float,
         foci: npt.ArrayLike,
         radius_m: float = 320.0,
+        detail: bool = True,
     ) -> None:
         """Sets the displaced sea surface of one frame time (``mmusv_core::sea::WaveSurface``), which replaces the
         sea instance's flat mesh for every ray: crests occlude, beams meet wave faces. The scene must have a sea
@@ -308,6 +309,10 @@ class Scene:
             foci: ``(F, 2)`` float world x, y (metres) the sampling is finest around (the USVs); the same foci for
                 every sensor of a frame give every sensor the same surface.
             radius_m: the waves taper to still water this far from the nearest focus (metres, > 0).
+            detail: the finest tiles (1 m cells, within 40 m of a focus) also carry the slopes of the waves 1–2 m
+                long on a 0.5 m grid, so the cameras shade them as normals rather than roughness; the geometry,
+                and so every ray's hit, is the same either way. Costs sampling time; without cameras, leave it
+                off (:meth:`~mmusv.simulation.Simulation.capture` does).
         """
         if sea is None:
             self._native.set_wave_surface(None)
@@ -324,6 +329,7 @@ class Scene:
             foci=f,
             radius_m=float(radius_m),
             taper_m=min(60.0, float(radius_m)),
+            detail=bool(detail),
         )
 
     def wave_heights(self, xy: npt.ArrayLike) -> npt.NDArray[np.float32]:

@@ -309,10 +309,11 @@ class Simulation:
             self.ws.scene.set_wave_surface(None, scenario_seed=self.scenario.seed, time_s=0.0, foci=np.zeros((0, 2)))
         self._frame = None
 
-    def set_frame(self, frame: int, *, sea_radius_m: float = 320.0) -> WorldState:
+    def set_frame(self, frame: int, *, sea_radius_m: float = 320.0, shading_detail: bool = True) -> WorldState:
         """Moves every vessel to its pose at ``frame`` (and, over a physical sea, the water to its surface at the
         frame time, displaced out to ``sea_radius_m`` around every USV: :meth:`set_sea_surface`) and returns the
-        world state."""
+        world state. ``shading_detail``: sample the short waves' slopes the cameras shade with
+        (:meth:`mmusv.scene.Scene.set_wave_surface`'s ``detail``); only rendering reads them."""
         if not 0 <= frame < self.frames:
             raise ConfigError(f"frame {frame} is outside the acquisition (0..{self.frames - 1})")
         state = self.world_state(frame)
@@ -321,7 +322,12 @@ class Simulation:
         if self.sea is not None and "water" in self.ws.static_instances:
             foci = np.array([state.poses[a.index, :2] for a in self.agents], dtype=np.float32).reshape(-1, 2)
             self.ws.scene.set_wave_surface(
-                self.sea, scenario_seed=self.scenario.seed, time_s=state.time_s, foci=foci, radius_m=sea_radius_m
+                self.sea,
+                scenario_seed=self.scenario.seed,
+                time_s=state.time_s,
+                foci=foci,
+                radius_m=sea_radius_m,
+                detail=shading_detail,
             )
         self._frame = frame
         return state
@@ -394,7 +400,13 @@ class Simulation:
             raise ConfigError(
                 f"unknown sensor kind(s) {sorted(kinds - set(SENSOR_KINDS))}; allowed: {', '.join(SENSOR_KINDS)}"
             )
-        state = self.set_frame(frame)
+        # The short waves' shading slopes only for frames that render.
+        renders = any(
+            (("cameras" in kinds and a.cameras) or ("top_view" in kinds and a.top_view is not None))
+            for a in self.agents
+            if agents is None or a.id in agents
+        )
+        state = self.set_frame(frame, shading_detail=renders)
         sc = self.scenario
         out: dict[str, AgentCapture] = {}
         tasks: list[core._CaptureTask] = []

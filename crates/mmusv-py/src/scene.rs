@@ -201,8 +201,9 @@ impl Scene {
     /// Sets the displaced sea surface of the current frame (see mmusv_core::sea::WaveSurface): the wave field
     /// of the directional JONSWAP sea `hs_m`, `tp_s`, `gamma`, `direction_rad`, `spread_s` drawn from the scenario's
     /// sea seed (mmusv_core::ocean::WaveField, `sea_seed(scenario_seed)`: the field the hulls ride), sampled at `time_s` around `foci` (F, 2) float32 world x, y; `hs_m=None`
-    /// clears it. Samples with the GIL released.
-    #[pyo3(signature = (hs_m, *, tp_s=8.0, gamma=3.3, direction_rad=0.0, spread_s=10.0, scenario_seed=0, time_s=0.0, foci=None, level=0.0, tile_m=32.0, near_m=40.0, radius_m=320.0, taper_m=60.0))]
+    /// clears it; `detail`: the finest tiles also carry the short waves' slopes for the cameras' shading
+    /// (mmusv_core::sea::SurfaceSpec::detail). Samples with the GIL released.
+    #[pyo3(signature = (hs_m, *, tp_s=8.0, gamma=3.3, direction_rad=0.0, spread_s=10.0, scenario_seed=0, time_s=0.0, foci=None, level=0.0, tile_m=32.0, near_m=40.0, radius_m=320.0, taper_m=60.0, detail=false))]
     #[allow(clippy::too_many_arguments)]
     fn set_wave_surface(
         &self,
@@ -220,6 +221,7 @@ impl Scene {
         near_m: f32,
         radius_m: f32,
         taper_m: f32,
+        detail: bool,
     ) -> PyResult<()> {
         let Some(hs) = hs_m else {
             return self.write(|s| s.set_wave_surface(None))?.map_err(crate::errors::to_py);
@@ -241,7 +243,7 @@ impl Scene {
         }
         let sea = SeaSpec { hs, tp: tp_s, gamma, direction_rad, spread_s };
         let seed = sea_seed(scenario_seed);
-        let spec = SurfaceSpec { tile_m, near_m, radius_m, taper_m };
+        let spec = SurfaceSpec { tile_m, near_m, radius_m, taper_m, detail };
         let cached = self
             .wave_field
             .lock()

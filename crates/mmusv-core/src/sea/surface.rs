@@ -43,13 +43,18 @@ pub struct SurfaceSpec {
     pub radius_m: f32,
     /// Width of that taper, metres.
     pub taper_m: f32,
+    /// Whether the finest-level tiles also carry the slopes of the waves shorter than two of their cells on a
+    /// grid of half their cell ([`DETAIL_CELLS`]), for shading only: cameras near the foci see waves down to one
+    /// cell long as normals rather than roughness. The geometry, and so every hit, is the same either way; the
+    /// sampling costs more (the scene sets it only when cameras render).
+    pub detail: bool,
 }
 
 impl Default for SurfaceSpec {
     /// 1 m cells within ~40 m, 2 m to ~80 m, 4 m to ~160 m, 8 m to ~320 m, waves out to 320 m around every
     /// focus (tapered over the last 60 m).
     fn default() -> Self {
-        Self { tile_m: 32.0, near_m: 40.0, radius_m: 320.0, taper_m: 60.0 }
+        Self { tile_m: 32.0, near_m: 40.0, radius_m: 320.0, taper_m: 60.0, detail: false }
     }
 }
 
@@ -63,9 +68,22 @@ struct Tile {
     h: Vec<f32>,
     /// `(n+1)²` slopes `(∂η/∂x, ∂η/∂y)` of the components the cell resolves ([`resolved`]).
     g: Vec<[f32; 2]>,
-    /// Mean square slope `Σ a²k²/2` (both axes) of the components it does not resolve, tapered as the waves are.
+    /// Mean square slope `Σ a²k²/2` (both axes) of the components its slopes leave out (the detail bands'
+    /// apart), tapered as the waves are.
     mss: f32,
+    /// With [`SurfaceSpec::detail`], on a finest-level tile: at `(DETAIL_CELLS + 1)²` nodes, the slopes
+    /// `(∂η/∂x, ∂η/∂y)` of the two detail bands' waves ([`DETAIL_BANDS`]), `[a_x, a_y, b_x, b_y]`; empty
+    /// otherwise.
+    detail: Vec<[f32; 4]>,
+    /// The mean square slopes of the two detail bands' waves.
+    band_mss: [f32; 2],
 }
+
+/// Cells along a side of a tile's detail grid ([`SurfaceSpec::detail`]): a quarter of the finest cell.
+pub const DETAIL_CELLS: usize = 4 * TILE_CELLS;
+/// The detail bands' resolution, as fractions of a tile: band 0 holds the waves the finest cells (`1/32`)
+/// cannot resolve but cells of `1/64` can, band 1 those that need cells of `1/128` (the detail grid's).
+pub const DETAIL_BANDS: [f32; 2] = [1.0 / 64.0, 1.0 / 128.0];
 
 /// Whether a wave of wavenumber `k_rad_m` is resolved by samples `cell_m` apart: at least two cells to its
 /// wavelength (the Nyquist limit, `k ≤ π / cell_m`). Shorter waves sampled at the nodes would alias into
@@ -238,19 +256,24 @@ impl WaveSurface {
     /// small-scale normals serve.
     #[inline]
     pub fn shading_normal(&self, x: f32, y: f32) -> Option<[f32; 3]> {
-        self.shading(x, y).map(|s| s.normal)
+        self.shading(x, y, 0.0).map(|s| s.normal)
     }
 
-    /// The water's shading at world `(x, y)` ([`SurfaceShading`]); `None` over still water.
+    /// The water's shading at world `(x, y)` seen with a pixel footprint of `footprint_m` metres on the water
+    /// ([`SurfaceShading`]); `None` over still water.
     ///
     /// Model: a wave shorter than two cells of the tile's level ([`resolved`]) cannot be drawn from its nodes
     /// (sampled there, it aliases into a false pattern of longer slopes, and the level's edge shows as a change
     /// of texture), so its slopes are treated statistically, as filtered normal maps treat detail finer than a
     /// texel: M. Olano & D. Baker, "LEAN Mapping", I3D 2010; M. Toksvig, "Mipmapping Normal Maps", J. Graphics
     /// Tools 10(3), 2005. Each level's normals carry the waves it resolves and its roughness the variance of
-    /// the rest, `Σ a²k²/2` over those components.
+    /// the rest, `Σ a²k²/2` over those components. With [`SurfaceSpec::detail`] the finest level's short waves
+    /// come in two bands of their own, each drawn as normals where the footprint resolves it (a footprint no
+    /// wider than the band's cell) and as roughness where it is twice as wide or more, with a linear crossfade
+    /// of the slopes in between (`w`, the roughness taking `(1 − w²)` of the band's variance): the texture
+    /// filtering rule of a mipmap's level selection, so a top view's 0.5 m pixels never alias waves of 0.5 m.
     #[inline]
-    pub fn shading(&self, x: f32, y: f32) -> Option<SurfaceShading> {
+    pub fn shading(&self, x: f32, y: f32, footprint_m: f32) -> Option<SurfaceShading> {
         let (ix, iy) = self.tile_at(x, y)?;
         let t = &self.tiles[iy * self.ntx + ix];
         if t.n == 0 {
@@ -262,7 +285,35 @@ impl WaveSurface {
         let (g00, g10, g01, g11) = (g(ci, cj), g(ci + 1, cj), g(ci, cj + 1), g(ci + 1, cj + 1));
         let mix =
             |a: usize| (g00[a] * (1.0 - fu) + g10[a] * fu) * (1.0 - fv) + (g01[a] * (1.0 - fu) + g11[a] * fu) * fv;
-        Some(SurfaceShading { normal: unit([-mix(0), -mix(1), 1.0]), unresolved_mss: t.mss })
+        let (mut gx, mut gy) = (mix(0), mix(1));
+        let mut mss = t.mss;
+        if !t.detail.is_empty() {
+            let w = DETAIL_BANDS.map(|c| (2.0 - footprint_m / (c * self.tile_m)).clamp(0.0, 1.0));
+            if w[0] > 0.0 || w[1] > 0.0 {
+                let d = self.detail_slope(t, ix, iy, x, y);
+                gx += w[0] * d[0] + w[1] * d[2];
+                gy += w[0] * d[1] + w[1] * d[3];
+            }
+            mss += (1.0 - w[0] * w[0]) * t.band_mss[0] + (1.0 - w[1] * w[1]) * t.band_mss[1];
+        }
+        Some(SurfaceShading { normal: unit([-gx, -gy, 1.0]), unresolved_mss: mss })
+    }
+
+    /// The detail slopes of tile `t` (at `(ix, iy)`, with a detail grid) at world `(x, y)`, bilinearly.
+    #[inline]
+    fn detail_slope(&self, t: &Tile, ix: usize, iy: usize, x: f32, y: f32) -> [f32; 4] {
+        let n = DETAIL_CELLS;
+        let inv = n as f32 * self.inv_tile_m;
+        let u = ((x - (self.x0 + ix as f32 * self.tile_m)) * inv).clamp(0.0, n as f32);
+        let v = ((y - (self.y0 + iy as f32 * self.tile_m)) * inv).clamp(0.0, n as f32);
+        let (ci, cj) = ((u as usize).min(n - 1), (v as usize).min(n - 1));
+        let (fu, fv) = (u - ci as f32, v - cj as f32);
+        let w = n + 1;
+        let g = |i: usize, j: usize| t.detail[j * w + i];
+        let (g00, g10, g01, g11) = (g(ci, cj), g(ci + 1, cj), g(ci, cj + 1), g(ci + 1, cj + 1));
+        let mix =
+            |a: usize| (g00[a] * (1.0 - fu) + g10[a] * fu) * (1.0 - fv) + (g01[a] * (1.0 - fu) + g11[a] * fu) * fv;
+        [mix(0), mix(1), mix(2), mix(3)]
     }
 
     /// The first crossing of the ray `o + t·d` (`d` unit, `0 <= t < t_max`) with the surface, from either side,
@@ -338,6 +389,7 @@ fn nearest(foci: &[[f32; 2]], x: f32, y: f32) -> f32 {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use std::f64::consts::TAU;
 
     /// A wave component `a cos(kx x + ky y − ω t + φ)` (the derived fields filled in).
     pub(crate) fn comp(a: f64, kx: f64, ky: f64, omega: f64, phase: f64) -> WaveComponent {
@@ -438,8 +490,65 @@ pub(crate) mod tests {
             seen[(TILE_CELLS / tile.n).trailing_zeros().min(3) as usize] = true;
         }
         assert!(seen.iter().all(|&v| v), "levels: {seen:?}");
-        let sh = s.shading(3.0, 4.0).unwrap_or_else(|| unreachable!("inside the sampled tiles"));
+        let sh = s.shading(3.0, 4.0, 0.0).unwrap_or_else(|| unreachable!("inside the sampled tiles"));
         assert!((f64::from(sh.unresolved_mss) - m1).abs() < 1e-9 && sh.normal[2] > 0.9);
+    }
+
+    /// With `detail`, a finest-level tile carries, on its quarter-cell grid, the slopes of the waves too short
+    /// for its cells in two bands (here a 1.5 m wave in band 0 and a 0.8 m wave in band 1: their analytic slopes
+    /// at every detail node); the shading draws each band as normals or roughness by the pixel's footprint;
+    /// coarser tiles and the geometry do not change.
+    #[test]
+    fn detail_bands_hold_the_short_waves_and_follow_the_footprint() {
+        let (k1, k2, k3) = (TAU / 1.5, TAU / 12.0, TAU / 0.8);
+        let sea =
+            [comp(0.02, k1 * 0.6, k1 * 0.8, 0.0, 0.3), comp(0.3, k2, 0.0, 0.0, 1.1), comp(0.004, 0.0, k3, 0.0, 2.0)];
+        let base = SurfaceSpec { radius_m: 2000.0, ..SurfaceSpec::default() };
+        let plain = surface(&sea, 0.0, &[[0.0, 0.0]], base);
+        let s = surface(&sea, 0.0, &[[0.0, 0.0]], SurfaceSpec { detail: true, ..base });
+        let (m1, m3) = ((0.02 * k1).powi(2) / 2.0, (0.004 * k3).powi(2) / 2.0);
+        let w = DETAIL_CELLS + 1;
+        let step = 32.0 / DETAIL_CELLS as f64;
+        let slope = |c: &WaveComponent, x: f64, y: f64| {
+            let sn = c.phase_at(x, y, 0.0).sin();
+            [-c.amplitude_m * c.kx * sn, -c.amplitude_m * c.ky * sn]
+        };
+        let mut checked = 0;
+        for (k, (t, p)) in s.tiles.iter().zip(&plain.tiles).enumerate() {
+            assert_eq!(t.h, p.h, "tile {k}: the geometry is the same");
+            assert_eq!(t.g, p.g);
+            if t.n != TILE_CELLS {
+                assert!(t.detail.is_empty() && t.mss == p.mss);
+                continue;
+            }
+            assert_eq!(t.detail.len(), w * w, "tile {k}");
+            assert!(t.mss.abs() < 1e-9, "every short wave is in a band: {}", t.mss);
+            assert!((f64::from(t.band_mss[0]) - m1).abs() < 1e-9 && (f64::from(t.band_mss[1]) - m3).abs() < 1e-9);
+            let (x0, y0) = (f64::from(s.x0) + (k % s.ntx) as f64 * 32.0, f64::from(s.y0) + (k / s.ntx) as f64 * 32.0);
+            for (q, g) in t.detail.iter().enumerate().step_by(37) {
+                let (x, y) = (x0 + (q % w) as f64 * step, y0 + (q / w) as f64 * step);
+                let (a, b) = (slope(&sea[0], x, y), slope(&sea[2], x, y));
+                let got = g.map(f64::from);
+                assert!((got[0] - a[0]).abs() < 1e-4 && (got[1] - a[1]).abs() < 1e-4, "band 0 node {q}");
+                assert!((got[2] - b[0]).abs() < 1e-5 && (got[3] - b[1]).abs() < 1e-5, "band 1 node {q}");
+                checked += 1;
+            }
+        }
+        assert!(checked > 100);
+        // At a detail node near the focus: a fine footprint adds both bands' slopes; 0.5 m (a top view's pixel)
+        // only the 1.5 m wave's, the 0.8 m wave as roughness; 1 m neither, both as roughness.
+        let (x, y) = (3.5f64, 7.0f64); // a detail node: the tiles' corners are multiples of 32 m
+        let n0 = plain.shading(x as f32, y as f32, 0.0).unwrap_or_else(|| unreachable!("sampled"));
+        let gs = |n: [f32; 3], a: usize| -f64::from(n[a] / n[2]);
+        let (a, b) = (slope(&sea[0], x, y), slope(&sea[2], x, y));
+        for (footprint, wa, wb, mss) in [(0.1f32, 1.0, 1.0, 0.0), (0.5, 1.0, 0.0, m3), (1.0, 0.0, 0.0, m1 + m3)] {
+            let sh = s.shading(x as f32, y as f32, footprint).unwrap_or_else(|| unreachable!("sampled"));
+            for ax in 0..2 {
+                let want = gs(n0.normal, ax) + wa * a[ax] + wb * b[ax];
+                assert!((gs(sh.normal, ax) - want).abs() < 2e-3, "footprint {footprint} axis {ax}");
+            }
+            assert!((f64::from(sh.unresolved_mss) - mss).abs() < 1e-7, "footprint {footprint}: {}", sh.unresolved_mss);
+        }
     }
 
     /// Brute force: march the ray in tiny steps against [`WaveSurface::height`] (the same triangulated surface,

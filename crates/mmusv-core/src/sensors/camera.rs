@@ -373,10 +373,16 @@ impl Camera {
             return Ok(frame);
         }
         let q = self.cfg.image.quality;
+        // A pixel's footprint for the sea's detail bands: its angle (at the image centre) or its width.
+        let (pixel_rad, pixel_m) = match self.cfg.projection {
+            Projection::Pinhole { hfov } => ((2.0 * (0.5 * hfov).tan() / f64::from(self.cfg.width)) as f32, 0.0),
+            Projection::Orthographic { metres_per_pixel } => (0.0, metres_per_pixel as f32),
+        };
         let shader = Shader::new(env, options.seed, options.wakes)
             .with_materials(scene.material_table())
             .with_seabed(scene.seabed())
-            .with_waves(scene.wave_surface());
+            .with_waves(scene.wave_surface())
+            .with_footprint(pixel_rad, pixel_m);
         // Standard quality shares one traced reflection per 2 × 2 block of water pixels; high traces each. Below
         // `high`, open water and sky share their shading over the pixels between even rows and columns wherever
         // the even pixels around agree (radiance::radiance).

@@ -221,6 +221,9 @@ pub struct Shader {
     seabed: Option<Arc<Seabed>>,
     /// The displaced sea surface, whose slopes replace the swell's normals ([`Shader::with_waves`]).
     waves: Option<Arc<WaveSurface>>,
+    /// A pinhole pixel's angle (radians) and an orthographic pixel's width (metres): [`Shader::with_footprint`].
+    pixel_rad: f32,
+    pixel_m: f32,
 }
 
 /// Intervals of the water's Fresnel table over `cos θ` in `[0, 1]`.
@@ -278,6 +281,8 @@ impl Shader {
             materials: Arc::new(Vec::new()),
             seabed: None,
             waves: None,
+            pixel_rad: 0.0,
+            pixel_m: 0.0,
         }
     }
 
@@ -291,6 +296,16 @@ impl Shader {
     /// [`crate::Scene::wave_surface`]) instead of the swell.
     pub fn with_waves(mut self, waves: Option<Arc<WaveSurface>>) -> Self {
         self.waves = waves;
+        self
+    }
+
+    /// This shader seeing the water with pixels of `pixel_rad` radians (a pinhole camera's) or `pixel_m` metres
+    /// (an orthographic one's): a hit's footprint on the water, `(pixel_m + t · pixel_rad) / |d_z|`, chooses
+    /// which of the sea's detail bands it draws as normals ([`WaveSurface::shading`]). Both 0 (the default):
+    /// every band.
+    pub fn with_footprint(mut self, pixel_rad: f32, pixel_m: f32) -> Self {
+        self.pixel_rad = pixel_rad.max(0.0);
+        self.pixel_m = pixel_m.max(0.0);
         self
     }
 
@@ -370,7 +385,8 @@ impl Shader {
         hit.shading_normal = hit.normal;
         hit.unresolved_mss = 0.0;
         if hit.is_water() {
-            let n = match self.waves.as_ref().and_then(|w| w.shading(hit.point.x, hit.point.y)) {
+            let footprint = (self.pixel_m + hit.t * self.pixel_rad) / d.z.abs().max(0.05);
+            let n = match self.waves.as_ref().and_then(|w| w.shading(hit.point.x, hit.point.y, footprint)) {
                 Some(s) => {
                     hit.unresolved_mss = s.unresolved_mss;
                     Vec3::from_array(s.normal)

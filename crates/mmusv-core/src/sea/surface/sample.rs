@@ -12,7 +12,7 @@
 //! cell resolves ([`resolved`]), and the tile keeps the others' mean square slope for the shading to treat
 //! statistically (see [`super::WaveSurface::shading`]).
 
-use super::{nearest, resolved, SurfaceSpec, Tile, MAX_LEVEL, TILE_CELLS};
+use super::{nearest, resolved, SurfaceSpec, Tile, DETAIL_BANDS, DETAIL_CELLS, MAX_LEVEL, TILE_CELLS};
 use crate::ocean::WaveComponent;
 
 /// Nodes summed together by [`accumulate`] (one AVX2 register of `f32`).
@@ -63,8 +63,10 @@ impl<'a> Phasors<'a> {
         let tm = f64::from(tile_m);
         let mut col = vec![(0.0, 0.0); ntx * nc];
         let mut row = vec![(0.0, 0.0); nty * nc];
+        // One table per level, and a last one for the detail grid ([`DETAIL_CELLS`] cells a side).
+        let cells = |l: usize| if l as u32 > MAX_LEVEL { DETAIL_CELLS } else { TILE_CELLS >> l };
         let mut powers: Vec<Vec<(C64, C64)>> =
-            (0..=MAX_LEVEL).map(|l| vec![((1.0, 0.0), (1.0, 0.0)); nc * ((TILE_CELLS >> l) + 1)]).collect();
+            (0..=MAX_LEVEL as usize + 1).map(|l| vec![((1.0, 0.0), (1.0, 0.0)); nc * (cells(l) + 1)]).collect();
         for (c, w) in comps.iter().enumerate() {
             let base = cis(w.phase_at(f64::from(x0), f64::from(y0), t));
             let (ex, ey) = (cis(w.kx * tm), cis(w.ky * tm));
@@ -79,7 +81,7 @@ impl<'a> Phasors<'a> {
                 q = cmul(q, ey);
             }
             for (lvl, table) in powers.iter_mut().enumerate() {
-                let n = TILE_CELLS >> lvl;
+                let n = cells(lvl);
                 let d = tm / n as f64;
                 let (sx, sy) = (cis(w.kx * d), cis(w.ky * d));
                 let (mut px, mut py) = ((1.0, 0.0), (1.0, 0.0));
@@ -171,10 +173,80 @@ impl<'a> Phasors<'a> {
                 zmax = zmax.max(z);
             }
         }
+        // The detail grid of a finest-level tile wholly inside the untapered sea: the slopes of the waves its
+        // cells leave out, in two bands by the grid's resolution ([`DETAIL_BANDS`]); what even the finest band
+        // leaves out stays roughness.
+        let mut detail = Vec::new();
+        let mut band_mss = [0f32; 2];
+        if spec.detail && lvl == 0 && all_inner {
+            let [a_m, b_m] = DETAIL_BANDS.map(|c| tile_m * c);
+            let band = |k: f64| {
+                if resolved(k, cell_m) {
+                    None
+                } else if resolved(k, a_m) {
+                    Some(0)
+                } else if resolved(k, b_m) {
+                    Some(1)
+                } else {
+                    None
+                }
+            };
+            let subs: [Vec<usize>; 2] =
+                [0, 1].map(|b| (0..nc).filter(|&c| band(self.comps[c].k_rad_m) == Some(b)).collect());
+            if subs.iter().any(|v| !v.is_empty()) {
+                let [a, b] = [&subs[0], &subs[1]].map(|sub| self.detail_slopes(ix, iy, sub));
+                detail = a.iter().zip(&b).map(|(a, b)| [a[0], a[1], b[0], b[1]]).collect();
+                for (m, sub) in band_mss.iter_mut().zip(&subs) {
+                    *m = sub
+                        .iter()
+                        .map(|&c| 0.5 * (self.comps[c].amplitude_m * self.comps[c].k_rad_m).powi(2))
+                        .sum::<f64>() as f32;
+                }
+                mss -= band_mss.iter().map(|&m| f64::from(m)).sum::<f64>();
+                mss = mss.max(0.0);
+            }
+        }
         // The unresolved slopes taper with the waves: their share at the tile's centre.
         let centre_taper = ((spec.radius_m - dc) / (spec.radius_m - inner).max(1e-6)).clamp(0.0, 1.0);
         let mss = mss as f32 * centre_taper * centre_taper;
-        Tile { n, zmin, zmax, h, g, mss }
+        Tile { n, zmin, zmax, h, g, mss, detail, band_mss }
+    }
+
+    /// The slopes `(∂η/∂x, ∂η/∂y)` of components `sub` alone at the `(DETAIL_CELLS + 1)²` nodes of tile
+    /// `(ix, iy)`'s detail grid, row-major (the same phasor sums as [`Phasors::tile`], heights discarded).
+    fn detail_slopes(&self, ix: usize, iy: usize, sub: &[usize]) -> Vec<[f32; 2]> {
+        let n = DETAIL_CELLS;
+        let w = n + 1;
+        let nc = self.comps.len();
+        let ns = sub.len();
+        let groups = w.div_ceil(LANES);
+        let stride = groups * LANES;
+        let (mut ar, mut ai) = (vec![0f32; groups * ns * LANES], vec![0f32; groups * ns * LANES]);
+        let (mut fr, mut fi) = (vec![0f32; w * ns], vec![0f32; w * ns]);
+        let mut k = vec![[0f32; 2]; ns];
+        if ns == 0 {
+            return vec![[0.0; 2]; w * w];
+        }
+        let table = &self.powers[MAX_LEVEL as usize + 1];
+        for (s, &c) in sub.iter().enumerate() {
+            let comp = &self.comps[c];
+            let pw = &table[c * w..(c + 1) * w];
+            let p = cmul(self.col[ix * nc + c], self.row[iy * nc + c]);
+            for (i, q) in pw.iter().enumerate() {
+                let v = cmul(p, q.0);
+                let at = ((i / LANES) * ns + s) * LANES + i % LANES;
+                ar[at] = v.0 as f32;
+                ai[at] = v.1 as f32;
+                fr[i * ns + s] = q.1 .0 as f32;
+                fi[i * ns + s] = q.1 .1 as f32;
+            }
+            k[s] = [comp.kx as f32, comp.ky as f32];
+        }
+        let mut eta = vec![0f32; stride * w];
+        let mut sx = vec![0f32; stride * w];
+        let mut sy = vec![0f32; stride * w];
+        accumulate((&ar, &ai), (&fr, &fi), &k, (&mut eta, &mut sx, &mut sy));
+        (0..w * w).map(|q| [sx[(q / w) * stride + q % w], sy[(q / w) * stride + q % w]]).collect()
     }
 }
 
