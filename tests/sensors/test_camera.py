@@ -418,3 +418,29 @@ def test_native_camera_misconfig_names_the_field() -> None:
         core.Camera(rgb=False, width=8, height=8, metres_per_pixel=0.0)
     with pytest.raises(mmusv.errors.ConfigError, match="hfov"):
         core.Camera(rgb=False, width=8, height=8, hfov=1.0, metres_per_pixel=1.0)
+
+
+def test_sea_detail_bands_change_only_the_water_colours_near_the_camera() -> None:
+    """The sea surface's detail bands (``set_wave_surface(detail=...)``) are shading only: depth, labels and the
+    far water's colours are the same with and without; the near water's colours change (its short waves drawn as
+    normals rather than roughness)."""
+    from mmusv.world.sea_state import sea_spec_for_preset
+
+    s = plane_scene(2000.0)
+    s.set_sea(0)
+    cam = core.Camera(width=160, height=96, rgb=True, hfov=math.radians(90))
+    pose = pose_matrices(np.array([0.0, 0.0, 2.5, 0.0, 0.12, 0.0]))
+    images = []
+    for detail in (False, True):
+        s.set_wave_surface(sea_spec_for_preset("W1"), scenario_seed=3, time_s=5.0, foci=np.zeros((1, 2)), detail=detail)
+        images.append(render(cam, s, pose=pose, env=sensor_env(), seed=1))
+    plain, fine = images
+    for name in ("depth", "semantic", "instance"):
+        assert np.array_equal(getattr(plain, name), getattr(fine, name)), name
+    assert plain.rgb is not None and fine.rgb is not None
+    near = np.isfinite(plain.depth) & (plain.depth < 15.0)
+    far = np.isfinite(plain.depth) & (plain.depth > 70.0)  # the finest tiles end within 40 + 16√2 m
+    assert near.sum() > 1000 and far.sum() > 400
+    diff = np.abs(plain.rgb.astype(int) - fine.rgb.astype(int)).max(axis=2)
+    assert (diff[near] > 0).mean() > 0.5, "the near water shows its short waves"
+    assert (diff[far] == 0).all(), "beyond the finest tiles nothing changes"
