@@ -44,8 +44,8 @@ pub struct SurfaceSpec {
     /// Width of that taper, metres.
     pub taper_m: f32,
     /// Whether the finest-level tiles also carry the slopes of the waves shorter than two of their cells on a
-    /// grid of half their cell ([`DETAIL_CELLS`]), for shading only: cameras near the foci see waves down to one
-    /// cell long as normals rather than roughness. The geometry, and so every hit, is the same either way; the
+    /// grid of a quarter of their cell, in two bands ([`DETAIL_BANDS`]), for shading only: cameras near the foci
+    /// see waves down to half a cell long as normals rather than roughness. The geometry, and so every hit, is the same either way; the
     /// sampling costs more (the scene sets it only when cameras render).
     pub detail: bool,
 }
@@ -71,19 +71,19 @@ struct Tile {
     /// Mean square slope `Σ a²k²/2` (both axes) of the components its slopes leave out (the detail bands'
     /// apart), tapered as the waves are.
     mss: f32,
-    /// With [`SurfaceSpec::detail`], on a finest-level tile: at `(DETAIL_CELLS + 1)²` nodes, the slopes
-    /// `(∂η/∂x, ∂η/∂y)` of the two detail bands' waves ([`DETAIL_BANDS`]), `[a_x, a_y, b_x, b_y]`; empty
-    /// otherwise.
-    detail: Vec<[f32; 4]>,
+    /// With [`SurfaceSpec::detail`], on a finest-level tile: per detail band ([`DETAIL_BANDS`]), the slopes
+    /// `(∂η/∂x, ∂η/∂y)` of its waves at the `(DETAIL_CELLS + 1)²` nodes of the detail grid; empty otherwise.
+    detail: [Vec<[f32; 2]>; 2],
     /// The mean square slopes of the two detail bands' waves.
     band_mss: [f32; 2],
 }
 
-/// Cells along a side of a tile's detail grid ([`SurfaceSpec::detail`]): a quarter of the finest cell.
+/// The detail bands ([`SurfaceSpec::detail`]) by the cells per tile side that resolve them: band 0 holds the
+/// waves the finest cells (a 32nd of a tile) cannot resolve but a 64th can, band 1 those that need a 128th.
+pub const DETAIL_BANDS: [usize; 2] = [2 * TILE_CELLS, 4 * TILE_CELLS];
+/// Cells along a side of the grid both detail bands are sampled on: the finer band's, so the coarser band has
+/// four nodes or more to its shortest wave (bilinear interpolation keeps its amplitude).
 pub const DETAIL_CELLS: usize = 4 * TILE_CELLS;
-/// The detail bands' resolution, as fractions of a tile: band 0 holds the waves the finest cells (`1/32`)
-/// cannot resolve but cells of `1/64` can, band 1 those that need cells of `1/128` (the detail grid's).
-pub const DETAIL_BANDS: [f32; 2] = [1.0 / 64.0, 1.0 / 128.0];
 
 /// Whether a wave of wavenumber `k_rad_m` is resolved by samples `cell_m` apart: at least two cells to its
 /// wavelength (the Nyquist limit, `k ≤ π / cell_m`). Shorter waves sampled at the nodes would alias into
@@ -287,21 +287,25 @@ impl WaveSurface {
             |a: usize| (g00[a] * (1.0 - fu) + g10[a] * fu) * (1.0 - fv) + (g01[a] * (1.0 - fu) + g11[a] * fu) * fv;
         let (mut gx, mut gy) = (mix(0), mix(1));
         let mut mss = t.mss;
-        if !t.detail.is_empty() {
-            let w = DETAIL_BANDS.map(|c| (2.0 - footprint_m / (c * self.tile_m)).clamp(0.0, 1.0));
-            if w[0] > 0.0 || w[1] > 0.0 {
-                let d = self.detail_slope(t, ix, iy, x, y);
-                gx += w[0] * d[0] + w[1] * d[2];
-                gy += w[0] * d[1] + w[1] * d[3];
+        for b in 0..2 {
+            if t.detail[b].is_empty() {
+                continue;
             }
-            mss += (1.0 - w[0] * w[0]) * t.band_mss[0] + (1.0 - w[1] * w[1]) * t.band_mss[1];
+            let cell = self.tile_m / DETAIL_BANDS[b] as f32;
+            let w = (2.0 - footprint_m / cell).clamp(0.0, 1.0);
+            if w > 0.0 {
+                let [dx, dy] = self.detail_slope(t, b, ix, iy, x, y);
+                gx += w * dx;
+                gy += w * dy;
+            }
+            mss += (1.0 - w * w) * t.band_mss[b];
         }
         Some(SurfaceShading { normal: unit([-gx, -gy, 1.0]), unresolved_mss: mss })
     }
 
-    /// The detail slopes of tile `t` (at `(ix, iy)`, with a detail grid) at world `(x, y)`, bilinearly.
+    /// The slopes of detail band `b` of tile `t` (at `(ix, iy)`, with that band) at world `(x, y)`, bilinearly.
     #[inline]
-    fn detail_slope(&self, t: &Tile, ix: usize, iy: usize, x: f32, y: f32) -> [f32; 4] {
+    fn detail_slope(&self, t: &Tile, b: usize, ix: usize, iy: usize, x: f32, y: f32) -> [f32; 2] {
         let n = DETAIL_CELLS;
         let inv = n as f32 * self.inv_tile_m;
         let u = ((x - (self.x0 + ix as f32 * self.tile_m)) * inv).clamp(0.0, n as f32);
@@ -309,11 +313,11 @@ impl WaveSurface {
         let (ci, cj) = ((u as usize).min(n - 1), (v as usize).min(n - 1));
         let (fu, fv) = (u - ci as f32, v - cj as f32);
         let w = n + 1;
-        let g = |i: usize, j: usize| t.detail[j * w + i];
+        let g = |i: usize, j: usize| t.detail[b][j * w + i];
         let (g00, g10, g01, g11) = (g(ci, cj), g(ci + 1, cj), g(ci, cj + 1), g(ci + 1, cj + 1));
         let mix =
             |a: usize| (g00[a] * (1.0 - fu) + g10[a] * fu) * (1.0 - fv) + (g01[a] * (1.0 - fu) + g11[a] * fu) * fv;
-        [mix(0), mix(1), mix(2), mix(3)]
+        [mix(0), mix(1)]
     }
 
     /// The first crossing of the ray `o + t·d` (`d` unit, `0 <= t < t_max`) with the surface, from either side,
@@ -494,8 +498,8 @@ pub(crate) mod tests {
         assert!((f64::from(sh.unresolved_mss) - m1).abs() < 1e-9 && sh.normal[2] > 0.9);
     }
 
-    /// With `detail`, a finest-level tile carries, on its quarter-cell grid, the slopes of the waves too short
-    /// for its cells in two bands (here a 1.5 m wave in band 0 and a 0.8 m wave in band 1: their analytic slopes
+    /// With `detail`, a finest-level tile carries, on a grid of a quarter of its cell, the slopes of the waves
+    /// too short for its cells in two bands (here a 1.5 m wave in band 0 and a 0.8 m wave in band 1: their analytic slopes
     /// at every detail node); the shading draws each band as normals or roughness by the pixel's footprint;
     /// coarser tiles and the geometry do not change.
     #[test]
@@ -507,8 +511,7 @@ pub(crate) mod tests {
         let plain = surface(&sea, 0.0, &[[0.0, 0.0]], base);
         let s = surface(&sea, 0.0, &[[0.0, 0.0]], SurfaceSpec { detail: true, ..base });
         let (m1, m3) = ((0.02 * k1).powi(2) / 2.0, (0.004 * k3).powi(2) / 2.0);
-        let w = DETAIL_CELLS + 1;
-        let step = 32.0 / DETAIL_CELLS as f64;
+
         let slope = |c: &WaveComponent, x: f64, y: f64| {
             let sn = c.phase_at(x, y, 0.0).sin();
             [-c.amplitude_m * c.kx * sn, -c.amplitude_m * c.ky * sn]
@@ -518,20 +521,23 @@ pub(crate) mod tests {
             assert_eq!(t.h, p.h, "tile {k}: the geometry is the same");
             assert_eq!(t.g, p.g);
             if t.n != TILE_CELLS {
-                assert!(t.detail.is_empty() && t.mss == p.mss);
+                assert!(t.detail.iter().all(Vec::is_empty) && t.mss == p.mss);
                 continue;
             }
-            assert_eq!(t.detail.len(), w * w, "tile {k}");
             assert!(t.mss.abs() < 1e-9, "every short wave is in a band: {}", t.mss);
             assert!((f64::from(t.band_mss[0]) - m1).abs() < 1e-9 && (f64::from(t.band_mss[1]) - m3).abs() < 1e-9);
             let (x0, y0) = (f64::from(s.x0) + (k % s.ntx) as f64 * 32.0, f64::from(s.y0) + (k / s.ntx) as f64 * 32.0);
-            for (q, g) in t.detail.iter().enumerate().step_by(37) {
-                let (x, y) = (x0 + (q % w) as f64 * step, y0 + (q / w) as f64 * step);
-                let (a, b) = (slope(&sea[0], x, y), slope(&sea[2], x, y));
-                let got = g.map(f64::from);
-                assert!((got[0] - a[0]).abs() < 1e-4 && (got[1] - a[1]).abs() < 1e-4, "band 0 node {q}");
-                assert!((got[2] - b[0]).abs() < 1e-5 && (got[3] - b[1]).abs() < 1e-5, "band 1 node {q}");
-                checked += 1;
+            for (band, wave, tol) in [(0, &sea[0], 1e-4), (1, &sea[2], 1e-5)] {
+                let w = DETAIL_CELLS + 1;
+                assert_eq!(t.detail[band].len(), w * w, "tile {k} band {band}");
+                let step = 32.0 / DETAIL_CELLS as f64;
+                for (q, g) in t.detail[band].iter().enumerate().step_by(37) {
+                    let (x, y) = (x0 + (q % w) as f64 * step, y0 + (q / w) as f64 * step);
+                    let want = slope(wave, x, y);
+                    let got = g.map(f64::from);
+                    assert!((got[0] - want[0]).abs() < tol && (got[1] - want[1]).abs() < tol, "band {band} node {q}");
+                    checked += 1;
+                }
             }
         }
         assert!(checked > 100);

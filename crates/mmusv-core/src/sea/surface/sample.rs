@@ -63,10 +63,11 @@ impl<'a> Phasors<'a> {
         let tm = f64::from(tile_m);
         let mut col = vec![(0.0, 0.0); ntx * nc];
         let mut row = vec![(0.0, 0.0); nty * nc];
-        // One table per level, and a last one for the detail grid ([`DETAIL_CELLS`] cells a side).
-        let cells = |l: usize| if l as u32 > MAX_LEVEL { DETAIL_CELLS } else { TILE_CELLS >> l };
+        // One table per level, and one for the detail grid ([`DETAIL_CELLS`] cells a side) after them.
+        let levels = MAX_LEVEL as usize + 1;
+        let cells = |l: usize| if l >= levels { DETAIL_CELLS } else { TILE_CELLS >> l };
         let mut powers: Vec<Vec<(C64, C64)>> =
-            (0..=MAX_LEVEL as usize + 1).map(|l| vec![((1.0, 0.0), (1.0, 0.0)); nc * (cells(l) + 1)]).collect();
+            (0..=levels).map(|l| vec![((1.0, 0.0), (1.0, 0.0)); nc * (cells(l) + 1)]).collect();
         for (c, w) in comps.iter().enumerate() {
             let base = cis(w.phase_at(f64::from(x0), f64::from(y0), t));
             let (ex, ey) = (cis(w.kx * tm), cis(w.ky * tm));
@@ -174,12 +175,12 @@ impl<'a> Phasors<'a> {
             }
         }
         // The detail grid of a finest-level tile wholly inside the untapered sea: the slopes of the waves its
-        // cells leave out, in two bands by the grid's resolution ([`DETAIL_BANDS`]); what even the finest band
+        // cells leave out, in two bands by the cell that resolves them ([`DETAIL_BANDS`]); what even the finest band
         // leaves out stays roughness.
-        let mut detail = Vec::new();
+        let mut detail: [Vec<[f32; 2]>; 2] = [Vec::new(), Vec::new()];
         let mut band_mss = [0f32; 2];
         if spec.detail && lvl == 0 && all_inner {
-            let [a_m, b_m] = DETAIL_BANDS.map(|c| tile_m * c);
+            let [a_m, b_m] = DETAIL_BANDS.map(|c| tile_m / c as f32);
             let band = |k: f64| {
                 if resolved(k, cell_m) {
                     None
@@ -191,19 +192,16 @@ impl<'a> Phasors<'a> {
                     None
                 }
             };
-            let subs: [Vec<usize>; 2] =
-                [0, 1].map(|b| (0..nc).filter(|&c| band(self.comps[c].k_rad_m) == Some(b)).collect());
-            if subs.iter().any(|v| !v.is_empty()) {
-                let [a, b] = [&subs[0], &subs[1]].map(|sub| self.detail_slopes(ix, iy, sub));
-                detail = a.iter().zip(&b).map(|(a, b)| [a[0], a[1], b[0], b[1]]).collect();
-                for (m, sub) in band_mss.iter_mut().zip(&subs) {
-                    *m = sub
-                        .iter()
-                        .map(|&c| 0.5 * (self.comps[c].amplitude_m * self.comps[c].k_rad_m).powi(2))
-                        .sum::<f64>() as f32;
+            for b in 0..2 {
+                let sub: Vec<usize> = (0..nc).filter(|&c| band(self.comps[c].k_rad_m) == Some(b)).collect();
+                if sub.is_empty() {
+                    continue;
                 }
-                mss -= band_mss.iter().map(|&m| f64::from(m)).sum::<f64>();
-                mss = mss.max(0.0);
+                detail[b] = self.detail_slopes(ix, iy, &sub);
+                let m: f64 =
+                    sub.iter().map(|&c| 0.5 * (self.comps[c].amplitude_m * self.comps[c].k_rad_m).powi(2)).sum();
+                band_mss[b] = m as f32;
+                mss = (mss - m).max(0.0);
             }
         }
         // The unresolved slopes taper with the waves: their share at the tile's centre.
@@ -224,9 +222,6 @@ impl<'a> Phasors<'a> {
         let (mut ar, mut ai) = (vec![0f32; groups * ns * LANES], vec![0f32; groups * ns * LANES]);
         let (mut fr, mut fi) = (vec![0f32; w * ns], vec![0f32; w * ns]);
         let mut k = vec![[0f32; 2]; ns];
-        if ns == 0 {
-            return vec![[0.0; 2]; w * w];
-        }
         let table = &self.powers[MAX_LEVEL as usize + 1];
         for (s, &c) in sub.iter().enumerate() {
             let comp = &self.comps[c];
