@@ -127,3 +127,47 @@ def test_train_command_line_applies_set(trained: tuple[Path, Cache, Path], tmp_p
     assert ck["preset"]["pillar_m"] == preset("tiny").pillar_m
     with pytest.raises(InputError, match="--set 'min_point=1'"):
         train_main([*args, "--set", "min_point=1"])
+
+
+def test_replay_with_scorers_equals_the_rescoring_detector(trained: tuple[Path, Cache, Path], tmp_path: Path) -> None:
+    """The IoU scorers (here seeded random ones, β = ½, beside a copy of each model) rescore the replay as they
+    rescore the detector: the same boxes and scores, and scores other than the network's."""
+    import shutil
+
+    from mmusv.learn.scorer import FEATURES, SCORER_FILE, IoUScorer, load_scorer
+
+    rec, cache, root = trained
+    models = tmp_path / "models"
+    shutil.copytree(root / "models", models)
+    torch.manual_seed(7)
+    for mode in MODES:
+        n = len(FEATURES)
+        IoUScorer(np.zeros(n), np.ones(n), beta=0.5).save(models / mode / SCORER_FILE, {"test": True})
+    peaks = infer_cache(cache, models, tmp_path / "peaks.npz")
+    scorers = {m: load_scorer(models / m / SCORER_FILE) for m in MODES}
+    out = write_predictions(
+        peaks, cache, [rec], tmp_path / "pred.parquet", split="all", refine=RefineParams(), scorers=scorers
+    )
+    df = pl.read_parquet(out)
+    det = load_models(models, refine=True)  # rescored: the scorers are found beside the models
+    plain = load_models(models, refine=True, rescore=False)
+    assert sorted(det.scorers) == sorted(MODES) and not plain.scorers
+    changed = 0
+    for k in range(len(cache)):
+        key = cache.key(int(cache.arrays["sample_cloud"][k]))
+        ego, nbs, _ = cache.sample(k)
+        expect = {
+            "none": det(ego),
+            "early": det.early(early_cloud(ego, nbs)),
+            "intermediate": det.intermediate(ego, nbs),
+        }
+        for mode, (b, s) in expect.items():
+            got_b, got_s = _rows(df, key, mode)
+            assert got_b.shape == b.shape, (key, mode)
+            np.testing.assert_allclose(got_s, s, rtol=1e-6)
+            np.testing.assert_allclose(got_b, b, atol=1e-3)
+        _, s0 = plain(ego)
+        changed += int(s0.shape != expect["none"][1].shape or not np.allclose(np.sort(s0), np.sort(expect["none"][1])))
+    assert changed > 0
+    with pytest.raises(InputError, match="--rescore on: single has no"):
+        load_models(root / "models", refine=True, rescore=True)
