@@ -171,3 +171,25 @@ def test_replay_with_scorers_equals_the_rescoring_detector(trained: tuple[Path, 
     assert changed > 0
     with pytest.raises(InputError, match="--rescore on: single has no"):
         load_models(root / "models", refine=True, rescore=True)
+
+
+def test_mmusv_train_scorers_only_fits_every_model(trained: tuple[Path, Cache, Path], tmp_path: Path) -> None:
+    """``mmusv train --scorers-only``'s fit (the model's own input per mode: the ego cloud, the aggregate, the ego
+    and its neighbours) writes a scorer beside each model that the detector then loads."""
+    import shutil
+
+    from mmusv.learn.cli import _fit_scorers
+    from mmusv.learn.scorer import SCORER_FILE
+
+    _, cache, root = trained
+    out = tmp_path / "out"
+    shutil.copytree(root / "models", out)
+    done = _fit_scorers(out, cache.path, list(MODES), seed=0, threads=1)
+    fitted = [m for m in MODES if "beta" in done[m]]
+    assert fitted, done  # the tiny models find boxes at their low threshold
+    for m in MODES:
+        assert (out / m / SCORER_FILE).is_file() == (m in fitted)
+        if m in fitted:
+            assert done[m]["boxes"] >= 20 and done[m]["frames"] == len(cache)
+    det = load_models(out, refine=True)
+    assert sorted(det.scorers) == sorted(fitted)
