@@ -58,7 +58,8 @@ pub enum Projection {
 pub enum Quality {
     /// One sample per pixel; water reflects the sky only.
     Draft,
-    /// Traced water reflections, one per 2 × 2 block of water pixels; 4 stratified samples on edge pixels.
+    /// Traced water reflections, one per 2 × 2 block of water pixels (the others the mean of the block corners
+    /// around them); 4 stratified samples on edge pixels.
     #[default]
     Standard,
     /// Traced water reflections for every pixel; 16 stratified samples on edge pixels.

@@ -150,8 +150,9 @@ pub enum Reflections<'a> {
     Sky,
     /// For every water ray.
     Every,
-    /// Once per 2 × 2 block of a camera's pixels: ray `k` takes the reflected radiance of its block's
-    /// ([`PixelGrid::block`]) when that one is water too (its own otherwise).
+    /// Once per 2 × 2 block of a camera's pixels (at its even corner, [`PixelGrid::block`], when that one is
+    /// water; else at the ray itself): every other water ray takes the mean of those traced at its anchors
+    /// ([`PixelGrid::anchors`], the block corners around it), else its block's.
     Shared(PixelGrid<'a>),
 }
 
@@ -269,6 +270,8 @@ pub fn radiance(
     // `slot[k]` is the index into `values` of ray k's reflected radiance.
     let mut slot: Vec<u32> = Vec::new();
     let mut values: Vec<Vec3> = Vec::new();
+    // `index[k]`: ray k's own traced reflection in `values`, `u32::MAX` where it has none.
+    let mut index: Vec<u32> = Vec::new();
     if !matches!(reflections, Reflections::Sky) {
         let owner = |k: usize| match reflections {
             Reflections::Shared(grid) => {
@@ -311,16 +314,39 @@ pub fn radiance(
                 shader.reflected(Vec3::from_array(rd[j]), h.as_ref(), rlit[j])
             })
             .collect();
-        let mut index = vec![u32::MAX; n];
+        index = vec![u32::MAX; n];
         for (j, &k) in traced.iter().enumerate() {
             index[k as usize] = j as u32;
         }
         slot = (0..n).into_par_iter().map(|k| if is_water(k) { index[owner(k)] } else { u32::MAX }).collect();
     }
+    // The reflected radiance ray k reads: its own traced one; sharing its block's (standard quality), the mean of
+    // those traced at the block corners around it, its anchors (a bilinear reconstruction of the half-resolution
+    // reflections rather than the nearest corner's, so a reflected outline has no 2 × 2 steps); `None`: the sky.
+    let reflected_of = |k: usize| -> Option<Vec3> {
+        let own = index.get(k).copied().filter(|&i| i != u32::MAX);
+        if let Some(i) = own {
+            return values.get(i as usize).copied();
+        }
+        if let Reflections::Shared(grid) = reflections {
+            let (ids, m) = grid.anchors(k);
+            let (mut sum, mut count) = (Vec3::ZERO, 0u32);
+            for &a in &ids[..m] {
+                if let Some(&i) = index.get(a as usize).filter(|&&i| i != u32::MAX) {
+                    sum += values[i as usize];
+                    count += 1;
+                }
+            }
+            if count > 0 {
+                return Some(sum / count as f32);
+            }
+        }
+        slot.get(k).and_then(|&i| values.get(i as usize)).copied()
+    };
     let mut out = vec![Vec3::ZERO; n];
     let rays = Rays { scene, hits, origins, dirs };
     out.par_chunks_mut(SHADE_CHUNK).enumerate().for_each(|(c, chunk)| {
-        shade_chunk(shader, &rays, (&lit, &slot, &values), (c * SHADE_CHUNK, &|k| !is_candidate(k)), chunk);
+        shade_chunk(shader, &rays, (&lit, &reflected_of), (c * SHADE_CHUNK, &|k| !is_candidate(k)), chunk);
     });
     if let Some(grid) = shared {
         // The candidates: the anchors' mean where they look alike; the others (`redo`) need their own shading.
@@ -377,7 +403,7 @@ pub fn radiance(
             .zip(redo_lit.par_iter())
             .map(|(&k, &lit)| {
                 let k = k as usize;
-                let refl = slot.get(k).and_then(|&i| values.get(i as usize)).copied();
+                let refl = if is_water(k) { reflected_of(k) } else { None };
                 shader.shade(Vec3::from_array(dirs[k]), surface(k).as_ref(), lit, refl)
             })
             .collect();
@@ -403,16 +429,16 @@ struct Rays<'a> {
 
 crate::dispatch! {
     /// Shades the rays `start..start + out.len()` that `which` accepts into `out` (the others are left as they
-    /// are), with their sun visibility `lit` and, for water, the reflected radiance `values[slot[k]]` (none:
+    /// are), with their sun visibility `lit` and, for water, the reflected radiance `reflected_of(k)` (none:
     /// the sky's).
     fn shade_chunk(
         shader: &Shader,
         rays: &Rays<'_>,
-        reflected: (&[bool], &[u32], &[Vec3]),
+        reflected: (&[bool], &(dyn Fn(usize) -> Option<Vec3> + Sync)),
         range: (usize, &(dyn Fn(usize) -> bool + Sync)),
         out: &mut [Vec3],
     ) {
-        let (lit, slot, values) = reflected;
+        let (lit, reflected_of) = reflected;
         let (start, which) = range;
         for (j, c) in out.iter_mut().enumerate() {
             let k = start + j;
@@ -420,7 +446,10 @@ crate::dispatch! {
                 continue;
             }
             let h = surface_at(shader, rays.scene, rays.hits, rays.origins, rays.dirs, k);
-            let refl = slot.get(k).and_then(|&i| values.get(i as usize)).copied();
+            let refl = match &h {
+                Some(h) if h.is_water() => reflected_of(k),
+                _ => None,
+            };
             *c = shader.shade(Vec3::from_array(rays.dirs[k]), h.as_ref(), lit[k], refl);
         }
     }

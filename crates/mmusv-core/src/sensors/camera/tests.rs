@@ -215,3 +215,47 @@ fn bad_configs_name_the_field() {
     assert!(bad(CameraConfig { projection: Projection::Orthographic { metres_per_pixel: 0.0 }, ..ok })
         .contains("metres_per_pixel"));
 }
+
+/// Standard quality traces one water reflection per 2 × 2 block and reconstructs the others from the block
+/// corners around each pixel: a cube's mirror image in calm water then stays close to high quality's (every
+/// pixel traced), without the 2 × 2 steps that taking the nearest corner's value left along the reflected
+/// outline (measured here on calm water's interior pixels against high: mean 0.520 sRGB levels, worst 92 with
+/// the nearest corner's value; 0.292 and 55 with the corners' mean).
+#[test]
+fn shared_reflections_are_reconstructed_from_the_corners_around() {
+    let scene = ground_with_box();
+    let (w, h) = (128usize, 96usize);
+    let render = |quality: Quality| {
+        let cfg = CameraConfig {
+            width: w as u32,
+            height: h as u32,
+            projection: Projection::Pinhole { hfov: 1.0 },
+            range_max: 1e4,
+            image: ImageOptions { quality, ..Default::default() },
+        };
+        let cam = Camera::new(cfg).ok()?;
+        let pose = RigidPose::from_xyz_rpy([0.0, 0.3, 1.5], [0.0, 0.08, 0.0]);
+        let env = ShadeEnv { wave_height_m: 0.0, wind_speed_m_s: 0.0, ..ShadeEnv::default() };
+        let opts = RenderOptions { rgb: true, radiance: false, seed: 3, wakes: &[] };
+        cam.render_with(&scene, &pose, &env, &opts).ok()
+    };
+    let (Some(std), Some(high)) = (render(Quality::Standard), render(Quality::High)) else { panic!("render failed") };
+    let (mut compared, mut worst, mut sum) = (0usize, 0u8, 0u64);
+    for y in 1..h - 1 {
+        for x in 1..w - 1 {
+            let i = y * w + x;
+            if [i, i - 1, i + 1, i - w, i + w].iter().any(|&j| high.semantic[j] != 1) {
+                continue; // water away from any silhouette
+            }
+            compared += 1;
+            for c in 0..3 {
+                let d = std.rgb[3 * i + c].abs_diff(high.rgb[3 * i + c]);
+                worst = worst.max(d);
+                sum += d as u64;
+            }
+        }
+    }
+    let mean = sum as f64 / (3 * compared) as f64;
+    assert!(compared > 3000, "{compared} pixels compared");
+    assert!(mean < 0.4 && worst <= 75, "mean {mean:.3}, worst {worst} levels");
+}
