@@ -109,41 +109,25 @@ impl<'a> Phasors<'a> {
         let lvl = if dc <= spec.near_m { 0 } else { ((dc / spec.near_m).log2().ceil() as u32).min(MAX_LEVEL) };
         let n = TILE_CELLS >> lvl;
         let w = n + 1;
-        let nc = self.comps.len();
-        // Node rows padded to whole groups of LANES (the padding lanes are summed and never read).
-        let groups = w.div_ceil(LANES);
-        let stride = groups * LANES;
-        // Per component: its phasor along the bottom row, `[(g · nc + c) · LANES + l]` for node column
-        // `g · LANES + l` (group-major, so the sum over components reads memory in order), and the rotation to
-        // each node row `[j · nc + c]`.
-        let (mut ar, mut ai) = (vec![0f32; groups * nc * LANES], vec![0f32; groups * nc * LANES]);
-        let (mut fr, mut fi) = (vec![0f32; w * nc], vec![0f32; w * nc]);
-        let mut k = vec![[0f32; 2]; nc];
-        // Mean square slope (both axes) of the components this level's cell cannot resolve.
+        // Mean square slope (both axes) of the components this level's cell cannot resolve: their slopes are
+        // left out of the sums (a zero wavenumber), their heights kept.
         let cell_m = tile_m / n as f32;
         let mut mss = 0f64;
-        let table = &self.powers[lvl as usize];
-        for (c, comp) in self.comps.iter().enumerate() {
-            let pw = &table[c * w..(c + 1) * w];
-            let p = cmul(self.col[ix * nc + c], self.row[iy * nc + c]);
-            for (i, q) in pw.iter().enumerate() {
-                let v = cmul(p, q.0);
-                let at = ((i / LANES) * nc + c) * LANES + i % LANES;
-                ar[at] = v.0 as f32;
-                ai[at] = v.1 as f32;
-                fr[i * nc + c] = q.1 .0 as f32;
-                fi[i * nc + c] = q.1 .1 as f32;
-            }
-            if resolved(comp.k_rad_m, cell_m) {
-                k[c] = [comp.kx as f32, comp.ky as f32];
-            } else {
-                mss += 0.5 * (comp.amplitude_m * comp.k_rad_m).powi(2);
-            }
-        }
-        let mut eta = vec![0f32; stride * w];
-        let mut sx = vec![0f32; stride * w];
-        let mut sy = vec![0f32; stride * w];
-        accumulate((&ar, &ai), (&fr, &fi), &k, (&mut eta, &mut sx, &mut sy));
+        let terms: Vec<(usize, [f32; 2])> = self
+            .comps
+            .iter()
+            .enumerate()
+            .map(|(c, comp)| {
+                if resolved(comp.k_rad_m, cell_m) {
+                    (c, [comp.kx as f32, comp.ky as f32])
+                } else {
+                    mss += 0.5 * (comp.amplitude_m * comp.k_rad_m).powi(2);
+                    (c, [0.0; 2])
+                }
+            })
+            .collect();
+        let nc = self.comps.len();
+        let (eta, sx, sy, stride) = self.node_sums(ix, iy, lvl as usize, w, &terms);
         let mut h = vec![0f32; w * w];
         let mut g = vec![[0f32; 2]; w * w];
         let (mut zmin, mut zmax) = (f32::INFINITY, f32::NEG_INFINITY);
@@ -213,35 +197,54 @@ impl<'a> Phasors<'a> {
     /// The slopes `(∂η/∂x, ∂η/∂y)` of components `sub` alone at the `(DETAIL_CELLS + 1)²` nodes of tile
     /// `(ix, iy)`'s detail grid, row-major (the same phasor sums as [`Phasors::tile`], heights discarded).
     fn detail_slopes(&self, ix: usize, iy: usize, sub: &[usize]) -> Vec<[f32; 2]> {
-        let n = DETAIL_CELLS;
-        let w = n + 1;
+        let w = DETAIL_CELLS + 1;
+        let terms: Vec<(usize, [f32; 2])> =
+            sub.iter().map(|&c| (c, [self.comps[c].kx as f32, self.comps[c].ky as f32])).collect();
+        let (_, sx, sy, stride) = self.node_sums(ix, iy, MAX_LEVEL as usize + 1, w, &terms);
+        (0..w * w).map(|q| [sx[(q / w) * stride + q % w], sy[(q / w) * stride + q % w]]).collect()
+    }
+
+    /// The sums of [`accumulate`] over the `w × w` nodes of tile `(ix, iy)` with power table `table` (a level's,
+    /// or the detail grid's after them, for `w` nodes a side): per term, a component's index and the wavenumber its slopes are summed with
+    /// (zero: its height only). Returns `eta`, `sx`, `sy` row-major with rows padded to `stride` nodes.
+    fn node_sums(
+        &self,
+        ix: usize,
+        iy: usize,
+        table: usize,
+        w: usize,
+        terms: &[(usize, [f32; 2])],
+    ) -> (Vec<f32>, Vec<f32>, Vec<f32>, usize) {
         let nc = self.comps.len();
-        let ns = sub.len();
+        let table = &self.powers[table];
+        let nt = terms.len();
+        // Node rows padded to whole groups of LANES (the padding lanes are summed and never read).
         let groups = w.div_ceil(LANES);
         let stride = groups * LANES;
-        let (mut ar, mut ai) = (vec![0f32; groups * ns * LANES], vec![0f32; groups * ns * LANES]);
-        let (mut fr, mut fi) = (vec![0f32; w * ns], vec![0f32; w * ns]);
-        let mut k = vec![[0f32; 2]; ns];
-        let table = &self.powers[MAX_LEVEL as usize + 1];
-        for (s, &c) in sub.iter().enumerate() {
-            let comp = &self.comps[c];
+        // Per term: its phasor along the bottom row, `[(g · nt + t) · LANES + l]` for node column `g · LANES + l`
+        // (group-major, so the sum over terms reads memory in order), and the rotation to each node row
+        // `[j · nt + t]`.
+        let (mut ar, mut ai) = (vec![0f32; groups * nt * LANES], vec![0f32; groups * nt * LANES]);
+        let (mut fr, mut fi) = (vec![0f32; w * nt], vec![0f32; w * nt]);
+        let mut k = vec![[0f32; 2]; nt];
+        for (t, &(c, kc)) in terms.iter().enumerate() {
             let pw = &table[c * w..(c + 1) * w];
             let p = cmul(self.col[ix * nc + c], self.row[iy * nc + c]);
             for (i, q) in pw.iter().enumerate() {
                 let v = cmul(p, q.0);
-                let at = ((i / LANES) * ns + s) * LANES + i % LANES;
+                let at = ((i / LANES) * nt + t) * LANES + i % LANES;
                 ar[at] = v.0 as f32;
                 ai[at] = v.1 as f32;
-                fr[i * ns + s] = q.1 .0 as f32;
-                fi[i * ns + s] = q.1 .1 as f32;
+                fr[i * nt + t] = q.1 .0 as f32;
+                fi[i * nt + t] = q.1 .1 as f32;
             }
-            k[s] = [comp.kx as f32, comp.ky as f32];
+            k[t] = kc;
         }
         let mut eta = vec![0f32; stride * w];
         let mut sx = vec![0f32; stride * w];
         let mut sy = vec![0f32; stride * w];
         accumulate((&ar, &ai), (&fr, &fi), &k, (&mut eta, &mut sx, &mut sy));
-        (0..w * w).map(|q| [sx[(q / w) * stride + q % w], sy[(q / w) * stride + q % w]]).collect()
+        (eta, sx, sy, stride)
     }
 }
 
