@@ -267,23 +267,22 @@ pub fn radiance(
     let is_candidate = |k: usize| candidate.get(k).copied().unwrap_or(false);
     let lit = sunlit(scene, shader, shadows, (hits, origins, dirs), |k| !is_candidate(k))?;
     // Reflected rays of the water hits (their representatives'), traced, and the radiance they bring back:
-    // `slot[k]` is the index into `values` of ray k's reflected radiance.
-    let mut slot: Vec<u32> = Vec::new();
+    // `index[k]` is ray k's own traced reflection in `values`, `u32::MAX` where it has none.
     let mut values: Vec<Vec3> = Vec::new();
-    // `index[k]`: ray k's own traced reflection in `values`, `u32::MAX` where it has none.
     let mut index: Vec<u32> = Vec::new();
-    if !matches!(reflections, Reflections::Sky) {
-        let owner = |k: usize| match reflections {
-            Reflections::Shared(grid) => {
-                let r = grid.block(k);
-                if r < n && is_water(r) {
-                    r
-                } else {
-                    k
-                }
+    // The ray whose reflection stands for ray k's: its block's corner where that is water too, else itself.
+    let owner = |k: usize| match reflections {
+        Reflections::Shared(grid) => {
+            let r = grid.block(k);
+            if r < n && is_water(r) {
+                r
+            } else {
+                k
             }
-            _ => k,
-        };
+        }
+        _ => k,
+    };
+    if !matches!(reflections, Reflections::Sky) {
         // A candidate's own reflection is traced only if it is its own representative (its shading may fall
         // back to its own); with a shared one, the representative's serves.
         let traced: Vec<u32> = (0..n)
@@ -318,7 +317,6 @@ pub fn radiance(
         for (j, &k) in traced.iter().enumerate() {
             index[k as usize] = j as u32;
         }
-        slot = (0..n).into_par_iter().map(|k| if is_water(k) { index[owner(k)] } else { u32::MAX }).collect();
     }
     // The reflected radiance ray k reads: its own traced one; sharing its block's (standard quality), the mean of
     // those traced at the block corners around it, its anchors (a bilinear reconstruction of the half-resolution
@@ -341,7 +339,7 @@ pub fn radiance(
                 return Some(sum / count as f32);
             }
         }
-        slot.get(k).and_then(|&i| values.get(i as usize)).copied()
+        index.get(owner(k)).and_then(|&i| values.get(i as usize)).copied()
     };
     let mut out = vec![Vec3::ZERO; n];
     let rays = Rays { scene, hits, origins, dirs };
