@@ -11,15 +11,19 @@
 //! Each cell is two triangles (split along the `(0,0)–(1,1)` diagonal). A ray meets that piecewise-planar surface
 //! exactly ([`WaveSurface::intersect`], the sign march of [`march`]); tiles and cells whose sampled maximum lies
 //! below the ray are skipped whole. Heights and slopes `∇η` (for smooth shading normals,
-//! [`WaveSurface::shading_normal`]) are summed per tile by the phasor recurrence of [`sample`].
+//! [`WaveSurface::shading`], whose filtering of the waves a level cannot resolve lives in [`shading`]) are summed
+//! per tile by the phasor recurrence of [`sample`].
 
 mod march;
 mod sample;
+mod shading;
 
 use crate::ocean::WaveComponent;
 use march::intersect_with;
 use rayon::prelude::*;
 use sample::Phasors;
+use shading::resolved;
+pub use shading::{SurfaceShading, DETAIL_BANDS, DETAIL_CELLS};
 
 /// Cells along a side of a finest-level tile (a tile at level `L` has `TILE_CELLS >> L`).
 pub const TILE_CELLS: usize = 32;
@@ -76,33 +80,6 @@ struct Tile {
     detail: [Vec<[f32; 2]>; 2],
     /// The mean square slopes of the two detail bands' waves.
     band_mss: [f32; 2],
-}
-
-/// The detail bands ([`SurfaceSpec::detail`]) by the cells per tile side that resolve them: band 0 holds the
-/// waves the finest cells (a 32nd of a tile) cannot resolve but a 64th can, band 1 those that need a 128th.
-pub const DETAIL_BANDS: [usize; 2] = [2 * TILE_CELLS, 4 * TILE_CELLS];
-/// Cells along a side of the grid both detail bands are sampled on: the finer band's, so the coarser band has
-/// four nodes or more to its shortest wave (bilinear interpolation keeps its amplitude).
-pub const DETAIL_CELLS: usize = 4 * TILE_CELLS;
-
-/// Whether a wave of wavenumber `k_rad_m` is resolved by samples `cell_m` apart: at least two cells to its
-/// wavelength (the Nyquist limit, `k ≤ π / cell_m`). Shorter waves sampled at the nodes would alias into
-/// spurious longer slope patterns, so the shading slopes leave them out and take their slope variance as
-/// roughness instead ([`WaveSurface::shading`]).
-#[inline]
-pub(crate) fn resolved(k_rad_m: f64, cell_m: f32) -> bool {
-    k_rad_m * f64::from(cell_m) <= std::f64::consts::PI
-}
-
-/// The water's shading at a point: the resolved waves' normal and the unresolved ones' slope variance.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SurfaceShading {
-    /// Unit normal (up-facing) of the sampled slopes `∇η` of the resolved waves, interpolated bilinearly.
-    pub normal: [f32; 3],
-    /// Mean square slope (both axes, `σx² + σy²`) of the waves too short for the level's cells: a roughness
-    /// to add to the capillaries' (the filtered-normal-map rule, LEAN/Toksvig), so every level shows the same
-    /// total slope variance.
-    pub unresolved_mss: f32,
 }
 
 /// The displaced sea surface of one frame (see the module docs).
@@ -205,13 +182,14 @@ impl WaveSurface {
         Some(((u as usize).min(self.ntx - 1), (v as usize).min(self.nty - 1)))
     }
 
-    /// Tile `(ix, iy)`'s cell holding world `(x, y)` and the local `(fu, fv)` in it (clamped into the tile).
+    /// The cell holding world `(x, y)` of tile `(ix, iy)` cut into `n` cells a side, and the local `(fu, fv)` in
+    /// it (clamped into the tile).
     #[inline(always)]
-    fn cell_at(&self, t: &Tile, ix: usize, iy: usize, x: f32, y: f32) -> ([usize; 2], [f32; 2]) {
-        let inv = t.n as f32 * self.inv_tile_m;
-        let u = ((x - (self.x0 + ix as f32 * self.tile_m)) * inv).clamp(0.0, t.n as f32);
-        let v = ((y - (self.y0 + iy as f32 * self.tile_m)) * inv).clamp(0.0, t.n as f32);
-        let (ci, cj) = ((u as usize).min(t.n - 1), (v as usize).min(t.n - 1));
+    fn cell_at(&self, n: usize, ix: usize, iy: usize, x: f32, y: f32) -> ([usize; 2], [f32; 2]) {
+        let inv = n as f32 * self.inv_tile_m;
+        let u = ((x - (self.x0 + ix as f32 * self.tile_m)) * inv).clamp(0.0, n as f32);
+        let v = ((y - (self.y0 + iy as f32 * self.tile_m)) * inv).clamp(0.0, n as f32);
+        let (ci, cj) = ((u as usize).min(n - 1), (v as usize).min(n - 1));
         ([ci, cj], [u - ci as f32, v - cj as f32])
     }
 
@@ -224,7 +202,7 @@ impl WaveSurface {
         if t.n == 0 {
             return self.level;
         }
-        let ([ci, cj], [fu, fv]) = self.cell_at(t, ix, iy, x, y);
+        let ([ci, cj], [fu, fv]) = self.cell_at(t.n, ix, iy, x, y);
         let (plane, _) = cell_planes(t, ci, cj);
         let p = if fu >= fv { plane[0] } else { plane[1] };
         p[0] + p[1] * fu + p[2] * fv
@@ -249,75 +227,6 @@ impl WaveSurface {
         let (plane, _) = cell_planes(t, ci, cj);
         let p = plane[tri];
         unit([-p[1] / s, -p[2] / s, 1.0])
-    }
-
-    /// Smooth unit normal at world `(x, y)`: the sampled slopes `∇η` of the resolved waves interpolated
-    /// bilinearly (up-facing); `None` over still water (outside the sampled tiles), where the caller's own
-    /// small-scale normals serve.
-    #[inline]
-    pub fn shading_normal(&self, x: f32, y: f32) -> Option<[f32; 3]> {
-        self.shading(x, y, 0.0).map(|s| s.normal)
-    }
-
-    /// The water's shading at world `(x, y)` seen with a pixel footprint of `footprint_m` metres on the water
-    /// ([`SurfaceShading`]); `None` over still water.
-    ///
-    /// Model: a wave shorter than two cells of the tile's level ([`resolved`]) cannot be drawn from its nodes
-    /// (sampled there, it aliases into a false pattern of longer slopes, and the level's edge shows as a change
-    /// of texture), so its slopes are treated statistically, as filtered normal maps treat detail finer than a
-    /// texel: M. Olano & D. Baker, "LEAN Mapping", I3D 2010; M. Toksvig, "Mipmapping Normal Maps", J. Graphics
-    /// Tools 10(3), 2005. Each level's normals carry the waves it resolves and its roughness the variance of
-    /// the rest, `Σ a²k²/2` over those components. With [`SurfaceSpec::detail`] the finest level's short waves
-    /// come in two bands of their own, each drawn as normals where the footprint resolves it (a footprint no
-    /// wider than the band's cell) and as roughness where it is twice as wide or more, with a linear crossfade
-    /// of the slopes in between (`w`, the roughness taking `(1 − w²)` of the band's variance): the texture
-    /// filtering rule of a mipmap's level selection, so a top view's 0.5 m pixels never alias waves of 0.5 m.
-    #[inline]
-    pub fn shading(&self, x: f32, y: f32, footprint_m: f32) -> Option<SurfaceShading> {
-        let (ix, iy) = self.tile_at(x, y)?;
-        let t = &self.tiles[iy * self.ntx + ix];
-        if t.n == 0 {
-            return None;
-        }
-        let ([ci, cj], [fu, fv]) = self.cell_at(t, ix, iy, x, y);
-        let w = t.n + 1;
-        let g = |i: usize, j: usize| t.g[j * w + i];
-        let (g00, g10, g01, g11) = (g(ci, cj), g(ci + 1, cj), g(ci, cj + 1), g(ci + 1, cj + 1));
-        let mix =
-            |a: usize| (g00[a] * (1.0 - fu) + g10[a] * fu) * (1.0 - fv) + (g01[a] * (1.0 - fu) + g11[a] * fu) * fv;
-        let (mut gx, mut gy) = (mix(0), mix(1));
-        let mut mss = t.mss;
-        for b in 0..2 {
-            if t.detail[b].is_empty() {
-                continue;
-            }
-            let cell = self.tile_m / DETAIL_BANDS[b] as f32;
-            let w = (2.0 - footprint_m / cell).clamp(0.0, 1.0);
-            if w > 0.0 {
-                let [dx, dy] = self.detail_slope(t, b, ix, iy, x, y);
-                gx += w * dx;
-                gy += w * dy;
-            }
-            mss += (1.0 - w * w) * t.band_mss[b];
-        }
-        Some(SurfaceShading { normal: unit([-gx, -gy, 1.0]), unresolved_mss: mss })
-    }
-
-    /// The slopes of detail band `b` of tile `t` (at `(ix, iy)`, with that band) at world `(x, y)`, bilinearly.
-    #[inline]
-    fn detail_slope(&self, t: &Tile, b: usize, ix: usize, iy: usize, x: f32, y: f32) -> [f32; 2] {
-        let n = DETAIL_CELLS;
-        let inv = n as f32 * self.inv_tile_m;
-        let u = ((x - (self.x0 + ix as f32 * self.tile_m)) * inv).clamp(0.0, n as f32);
-        let v = ((y - (self.y0 + iy as f32 * self.tile_m)) * inv).clamp(0.0, n as f32);
-        let (ci, cj) = ((u as usize).min(n - 1), (v as usize).min(n - 1));
-        let (fu, fv) = (u - ci as f32, v - cj as f32);
-        let w = n + 1;
-        let g = |i: usize, j: usize| t.detail[b][j * w + i];
-        let (g00, g10, g01, g11) = (g(ci, cj), g(ci + 1, cj), g(ci, cj + 1), g(ci + 1, cj + 1));
-        let mix =
-            |a: usize| (g00[a] * (1.0 - fu) + g10[a] * fu) * (1.0 - fv) + (g01[a] * (1.0 - fu) + g11[a] * fu) * fv;
-        [mix(0), mix(1)]
     }
 
     /// The first crossing of the ray `o + t·d` (`d` unit, `0 <= t < t_max`) with the surface, from either side,

@@ -1,0 +1,99 @@
+//! The water's shading from the sampled surface: each level's slopes of the waves it resolves, the rest as
+//! roughness, and near the foci two detail bands chosen by the pixel's footprint ([`WaveSurface::shading`]).
+//!
+//! Model: a wave shorter than two cells of a level ([`resolved`], the Nyquist limit) cannot be drawn from its
+//! nodes (sampled there, it aliases into a false pattern of longer slopes), so its slopes are treated
+//! statistically, as filtered normal maps treat detail finer than a texel: M. Olano & D. Baker, "LEAN Mapping",
+//! I3D 2010; M. Toksvig, "Mipmapping Normal Maps", J. Graphics Tools 10(3), 2005. The detail bands are chosen as a
+//! mipmap's level is, by the footprint of the pixel that sees the water. Checked in the parent's tests against
+//! the waves' analytic slopes and variances.
+
+use super::{unit, WaveSurface, TILE_CELLS};
+
+/// The detail bands ([`SurfaceSpec::detail`](super::SurfaceSpec::detail)) by the cells per tile side that resolve them: band 0 holds the
+/// waves the finest cells (a 32nd of a tile) cannot resolve but a 64th can, band 1 those that need a 128th.
+pub const DETAIL_BANDS: [usize; 2] = [2 * TILE_CELLS, 4 * TILE_CELLS];
+/// Cells along a side of the grid both detail bands are sampled on: the finer band's, so the coarser band has
+/// four nodes or more to its shortest wave (bilinear interpolation keeps its amplitude).
+pub const DETAIL_CELLS: usize = 4 * TILE_CELLS;
+
+/// Whether a wave of wavenumber `k_rad_m` is resolved by samples `cell_m` apart: at least two cells to its
+/// wavelength (the Nyquist limit, `k ≤ π / cell_m`). Shorter waves sampled at the nodes would alias into
+/// spurious longer slope patterns, so the shading slopes leave them out and take their slope variance as
+/// roughness instead ([`WaveSurface::shading`]).
+#[inline]
+pub(crate) fn resolved(k_rad_m: f64, cell_m: f32) -> bool {
+    k_rad_m * f64::from(cell_m) <= std::f64::consts::PI
+}
+
+/// The water's shading at a point: the resolved waves' normal and the unresolved ones' slope variance.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfaceShading {
+    /// Unit normal (up-facing) of the sampled slopes `∇η` of the resolved waves, interpolated bilinearly.
+    pub normal: [f32; 3],
+    /// Mean square slope (both axes, `σx² + σy²`) of the waves too short for the level's cells: a roughness
+    /// to add to the capillaries' (the filtered-normal-map rule, LEAN/Toksvig), so every level shows the same
+    /// total slope variance.
+    pub unresolved_mss: f32,
+}
+
+impl WaveSurface {
+    /// Smooth unit normal at world `(x, y)`: the sampled slopes `∇η` of the resolved waves interpolated
+    /// bilinearly (up-facing); `None` over still water (outside the sampled tiles), where the caller's own
+    /// small-scale normals serve.
+    #[inline]
+    pub fn shading_normal(&self, x: f32, y: f32) -> Option<[f32; 3]> {
+        self.shading(x, y, 0.0).map(|s| s.normal)
+    }
+
+    /// The water's shading at world `(x, y)` seen with a pixel footprint of `footprint_m` metres on the water
+    /// ([`SurfaceShading`]); `None` over still water.
+    ///
+    /// Model: a wave shorter than two cells of the tile's level ([`resolved`]) cannot be drawn from its nodes
+    /// (sampled there, it aliases into a false pattern of longer slopes, and the level's edge shows as a change
+    /// of texture), so its slopes are treated statistically, as filtered normal maps treat detail finer than a
+    /// texel: M. Olano & D. Baker, "LEAN Mapping", I3D 2010; M. Toksvig, "Mipmapping Normal Maps", J. Graphics
+    /// Tools 10(3), 2005. Each level's normals carry the waves it resolves and its roughness the variance of
+    /// the rest, `Σ a²k²/2` over those components. With [`SurfaceSpec::detail`](super::SurfaceSpec::detail) the finest level's short waves
+    /// come in two bands of their own, each drawn as normals where the footprint resolves it (a footprint no
+    /// wider than the band's cell) and as roughness where it is twice as wide or more, with a linear crossfade
+    /// of the slopes in between (`w`, the roughness taking `(1 − w²)` of the band's variance): the texture
+    /// filtering rule of a mipmap's level selection, so a top view's 0.5 m pixels never alias waves of 0.5 m.
+    #[inline]
+    pub fn shading(&self, x: f32, y: f32, footprint_m: f32) -> Option<SurfaceShading> {
+        let (ix, iy) = self.tile_at(x, y)?;
+        let t = &self.tiles[iy * self.ntx + ix];
+        if t.n == 0 {
+            return None;
+        }
+        let [mut gx, mut gy] = self.slope_at(&t.g, t.n, ix, iy, x, y);
+        let mut mss = t.mss;
+        for b in 0..2 {
+            if t.detail[b].is_empty() {
+                continue;
+            }
+            let cell = self.tile_m / DETAIL_BANDS[b] as f32;
+            let w = (2.0 - footprint_m / cell).clamp(0.0, 1.0);
+            if w > 0.0 {
+                let [dx, dy] = self.slope_at(&t.detail[b], DETAIL_CELLS, ix, iy, x, y);
+                gx += w * dx;
+                gy += w * dy;
+            }
+            mss += (1.0 - w * w) * t.band_mss[b];
+        }
+        Some(SurfaceShading { normal: unit([-gx, -gy, 1.0]), unresolved_mss: mss })
+    }
+
+    /// The slopes `grid` (`(n + 1)²` nodes of tile `(ix, iy)` cut into `n` cells a side, row-major) at world
+    /// `(x, y)`, bilinearly.
+    #[inline]
+    fn slope_at(&self, grid: &[[f32; 2]], n: usize, ix: usize, iy: usize, x: f32, y: f32) -> [f32; 2] {
+        let ([ci, cj], [fu, fv]) = self.cell_at(n, ix, iy, x, y);
+        let w = n + 1;
+        let g = |i: usize, j: usize| grid[j * w + i];
+        let (g00, g10, g01, g11) = (g(ci, cj), g(ci + 1, cj), g(ci, cj + 1), g(ci + 1, cj + 1));
+        let mix =
+            |a: usize| (g00[a] * (1.0 - fu) + g10[a] * fu) * (1.0 - fv) + (g01[a] * (1.0 - fu) + g11[a] * fu) * fv;
+        [mix(0), mix(1)]
+    }
+}
