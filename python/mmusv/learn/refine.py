@@ -44,7 +44,7 @@ import numpy as np
 
 from mmusv.studies.detection.detector import BaselineParams, above_water, fit_box
 
-__all__ = ["RefineParams", "refine_box", "refine_boxes", "surface_points"]
+__all__ = ["RefineParams", "refine_box", "refine_boxes", "refine_on", "surface_points"]
 
 
 @dataclass(frozen=True)
@@ -138,13 +138,15 @@ def refine_box(xy: np.ndarray, box: np.ndarray, p: RefineParams) -> np.ndarray:
     return out
 
 
+def refine_on(xy: np.ndarray, boxes: np.ndarray, p: RefineParams) -> np.ndarray:
+    """``(M, 7)`` float64 ``boxes`` ``(M, 7)`` refined on a cloud's :func:`surface_points` ``xy``, row for row."""
+    b = np.asarray(boxes, dtype=np.float64).reshape(-1, 7)
+    return np.array([refine_box(xy, row, p) for row in b]).reshape(-1, 7)
+
+
 def refine_boxes(points: np.ndarray, boxes: np.ndarray, *, params: RefineParams | None = None) -> np.ndarray:
     """``(M, 7)`` float64 ``boxes`` refined on the cloud ``points`` ``(N, ≥3)`` (same frame, the sensor at the
     origin; module docstring), row for row."""
     p = params or RefineParams()
     b = np.asarray(boxes, dtype=np.float64).reshape(-1, 7)
-    out: np.ndarray = b.copy()
-    if b.shape[0]:
-        xy = surface_points(points, p)
-        out = np.array([refine_box(xy, row, p) for row in b]).reshape(-1, 7)
-    return out
+    return refine_on(surface_points(points, p), b, p) if b.shape[0] else b.copy()

@@ -32,7 +32,7 @@ import torch
 from torch import nn
 
 from mmusv.learn._errors import input_error
-from mmusv.learn.refine import RefineParams, refine_box, surface_points
+from mmusv.learn.refine import RefineParams, refine_on, surface_points
 from mmusv.studies.detection.evaluate import average_precision, bev_iou, match_frame
 from mmusv.studies.detection.fusion import rotated_nms
 
@@ -196,7 +196,7 @@ def second_stage(
     if refine is None or len(b) == 0:
         return b, s
     xy = surface_points(points, refine)
-    ref = np.array([refine_box(xy, row, refine) for row in b]).reshape(-1, 7)
+    ref = refine_on(xy, b, refine)
     if scorer is not None:
         s = scorer.rescore(box_features(xy, b, ref, s, refine), s)
     keep = rotated_nms(ref, s, iou_threshold=nms_iou)
@@ -232,7 +232,7 @@ def _frames(
         s = np.asarray(scores, dtype=np.float64).reshape(-1)
         if len(b):
             xy = surface_points(points, refine)
-            ref = np.array([refine_box(xy, row, refine) for row in b]).reshape(-1, 7)
+            ref = refine_on(xy, b, refine)
             f = box_features(xy, b, ref, s, refine)
             # The boxes the rescored detector would keep whatever the new scores: the NMS of the refined boxes by
             # the network's scores (the final NMS removes only boxes that grew onto one hull).
