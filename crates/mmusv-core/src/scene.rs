@@ -378,6 +378,19 @@ impl Scene {
     pub fn cast_prepared<L: Level>(&self, lv: L, ray: &RayPrep, max_range: f32, scratch: &mut Scratch) -> Option<Hit> {
         // The wave surface first (it shortens the ray before the tree is walked).
         let water = self.wave_hit(ray, max_range);
+        self.cast_prepared_over(lv, ray, water, max_range, scratch)
+    }
+
+    /// [`Scene::cast_prepared`] with the ray's wave-surface hit below `max_range` already known (`water`).
+    #[inline(always)]
+    pub(crate) fn cast_prepared_over<L: Level>(
+        &self,
+        lv: L,
+        ray: &RayPrep,
+        water: Option<Hit>,
+        max_range: f32,
+        scratch: &mut Scratch,
+    ) -> Option<Hit> {
         let limit = water.map_or(max_range, |h| h.distance);
         let hidden = self.hidden_instance();
         let mut v = Instances {
@@ -409,6 +422,19 @@ impl Scene {
         scratch: &mut Scratch,
     ) -> ([u32; PACKET], [u32; PACKET]) {
         let water = self.wave_hits_packet(p);
+        self.cast_packet_over(lv, p, water, scratch)
+    }
+
+    /// [`Scene::cast_packet_with`] with the packet's wave-surface hits already applied to `p.best` and given as
+    /// `water` (see [`Scene::wave_hits_packet`]).
+    #[inline(always)]
+    pub(crate) fn cast_packet_over<L: Level>(
+        &self,
+        lv: L,
+        p: &mut Packet,
+        water: Option<(u32, [u32; PACKET])>,
+        scratch: &mut Scratch,
+    ) -> ([u32; PACKET], [u32; PACKET]) {
         let mut v = PacketInstances {
             lv,
             scene: self,

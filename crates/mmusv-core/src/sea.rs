@@ -33,7 +33,10 @@ pub(crate) mod surface;
 pub use horizon::Horizon;
 #[cfg(test)]
 pub(crate) use surface::tests::comp as test_component;
-pub use surface::{SurfaceHit, SurfaceShading, SurfaceSpec, WaveSurface, DETAIL_CELLS, FLAT_PIECE, SKIN_M, TILE_CELLS};
+pub use surface::{
+    PinholeView, Raster, SurfaceHit, SurfaceShading, SurfaceSpec, WaterHit, WaveSurface, DETAIL_CELLS, FLAT_PIECE,
+    SKIN_M, TILE_CELLS,
+};
 
 /// Most cells per side of the height grid.
 const MAX_CELLS: usize = 512;

@@ -10,7 +10,7 @@ use super::{Hit, RayHits, Scene, Scratch, NO_HIT};
 use crate::bvh::{Packet, PACKET};
 use crate::error::{MmusvError, Result};
 use crate::ray::{prepare_lanes, RayPrep};
-use crate::sea::{Horizon, SunMask};
+use crate::sea::{Horizon, SunMask, WaterHit};
 use crate::simd::Level;
 use parry3d::math::Vec3;
 use rayon::prelude::*;
@@ -23,7 +23,31 @@ impl Scene {
     ///
     /// Errors name the first offending ray.
     pub fn cast_rays(&self, origins: &[[f32; 3]], dirs: &[[f32; 3]], max_range: f32) -> Result<RayHits> {
+        self.cast_rays_over(origins, dirs, max_range, None)
+    }
+
+    /// [`Scene::cast_rays`] with each ray's wave-surface hit already known where `water` says so (one entry per
+    /// ray, from [`crate::sea::Raster::resolve`] with the same `max_range`; [`WaterHit::Unknown`] marches): the
+    /// same hits, without marching the known rays through the waves. Ignored without a wave surface.
+    pub fn cast_rays_over(
+        &self,
+        origins: &[[f32; 3]],
+        dirs: &[[f32; 3]],
+        max_range: f32,
+        water: Option<&[WaterHit]>,
+    ) -> Result<RayHits> {
         check_batch(origins, dirs, max_range)?;
+        if water.is_some_and(|w| w.len() != origins.len()) {
+            return Err(MmusvError::input(
+                "water",
+                format!(
+                    "{} known water hits for {} rays; give one per ray",
+                    water.map_or(0, <[_]>::len),
+                    origins.len()
+                ),
+            ));
+        }
+        let water = water.filter(|_| self.waves.is_some());
         let mut out = RayHits::zeroed(origins.len());
         let limit = if max_range.is_finite() { max_range } else { f32::MAX };
         // Rays that all leave one point (a camera's pixels): its horizon settles those rising over everything.
@@ -43,7 +67,8 @@ impl Scene {
             .enumerate()
             .map(|(k, (dist, inst, tri, nrm, cls, back, o, d))| {
                 let out = ChunkOut { dist, inst, tri, nrm, cls, back };
-                BadRays::offset(trace_chunk(self, o, d, limit, horizon, out), k * CHUNK)
+                let water = water.map(|w| &w[k * CHUNK..(k * CHUNK + o.len())]);
+                BadRays::offset(trace_chunk(self, o, d, limit, horizon, water, out), k * CHUNK)
             })
             .reduce(BadRays::default, BadRays::min);
         bad.check(origins, dirs)?;
@@ -149,6 +174,7 @@ crate::dispatch! {
         d: &[[f32; 3]],
         limit: f32,
         horizon: Option<&Horizon>,
+        water: Option<&[WaterHit]>,
         out: ChunkOut<'_>,
     ) -> BadRays {
         let mut scratch = Scratch::default();
@@ -173,7 +199,7 @@ crate::dispatch! {
             }
             if !any_sky {
                 // Nothing for the sea shortcut: trace the rays in place.
-                trace_rest(lv, scene, rays, |j| start + j, limit, &mut scratch, &mut packet, &mut out);
+                trace_rest(lv, scene, rays, |j| start + j, (limit, water), &mut scratch, &mut packet, &mut out);
                 continue;
             }
             // Rays the sea shortcut settles are misses; the others are traced (as a packet when coherent).
@@ -187,7 +213,8 @@ crate::dispatch! {
                     n += 1;
                 }
             }
-            trace_rest(lv, scene, &rest[..n], |j| start + lane[j], limit, &mut scratch, &mut packet, &mut out);
+            let at = |j: usize| start + lane[j];
+            trace_rest(lv, scene, &rest[..n], at, (limit, water), &mut scratch, &mut packet, &mut out);
         }
         bad
     }
@@ -202,13 +229,19 @@ fn trace_rest<L: Level>(
     scene: &Scene,
     rays: &[RayPrep],
     at: impl Fn(usize) -> usize,
-    limit: f32,
+    (limit, water): (f32, Option<&[WaterHit]>),
     scratch: &mut Scratch,
     p: &mut Packet,
     out: &mut ChunkOut<'_>,
 ) {
     if coherent(rays) && p.fill(rays, limit) {
-        let (inst, tri) = scene.cast_packet_with(lv, p, scratch);
+        let (inst, tri) = match water {
+            None => scene.cast_packet_with(lv, p, scratch),
+            Some(w) => {
+                let water = scene.known_wave_hits_packet(p, |j| w[at(j)]);
+                scene.cast_packet_over(lv, p, water, scratch)
+            }
+        };
         for (j, ray) in rays.iter().enumerate() {
             if inst[j] != u32::MAX {
                 let hit = Hit { distance: p.best[j], instance: inst[j], triangle: tri[j] };
@@ -217,7 +250,14 @@ fn trace_rest<L: Level>(
         }
     } else {
         for (j, ray) in rays.iter().enumerate() {
-            if let Some(hit) = scene.cast_prepared(lv, ray, limit, scratch) {
+            let hit = match water {
+                None => scene.cast_prepared(lv, ray, limit, scratch),
+                Some(w) => {
+                    let water = scene.known_wave_hit(ray, w[at(j)], limit);
+                    scene.cast_prepared_over(lv, ray, water, limit, scratch)
+                }
+            };
+            if let Some(hit) = hit {
                 out.hit(scene, at(j), Vec3::from_array(ray.d), &hit);
             }
         }

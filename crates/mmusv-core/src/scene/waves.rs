@@ -7,7 +7,7 @@ use super::{Hit, Scene};
 use crate::bvh::{Packet, PACKET};
 use crate::error::{MmusvError, Result};
 use crate::ray::{RayPrep, LEAVES_NO, LEAVES_UNKNOWN, LEAVES_YES};
-use crate::sea::WaveSurface;
+use crate::sea::{WaterHit, WaveSurface};
 use parry3d::math::Vec3;
 use std::sync::Arc;
 
@@ -92,6 +92,50 @@ impl Scene {
                 continue;
             }
             if let Some(h) = w.intersect(p.ray[r].o, p.ray[r].d, p.best[r]) {
+                p.best[r] = h.t;
+                pieces[r] = h.piece;
+            }
+        }
+        Some((self.hidden_instance(), pieces))
+    }
+
+    /// [`Scene::wave_hit`] where the raster may already know the answer (`known`; [`WaterHit::Unknown`]
+    /// marches).
+    #[inline(always)]
+    pub(super) fn known_wave_hit(&self, ray: &RayPrep, known: WaterHit, limit: f32) -> Option<Hit> {
+        match known {
+            WaterHit::Hit(h) if h.t < limit => {
+                Some(Hit { distance: h.t, instance: self.hidden_instance(), triangle: h.piece })
+            }
+            WaterHit::Hit(_) | WaterHit::Miss => None,
+            WaterHit::Unknown => self.wave_hit(ray, limit),
+        }
+    }
+
+    /// [`Scene::wave_hits_packet`] where the raster may already know the answers (`known(r)` for ray `r`).
+    #[inline(always)]
+    pub(super) fn known_wave_hits_packet(
+        &self,
+        p: &mut Packet,
+        known: impl Fn(usize) -> WaterHit,
+    ) -> Option<(u32, [u32; PACKET])> {
+        let w = self.waves.as_ref()?;
+        let mut pieces = [u32::MAX; PACKET];
+        for r in 0..p.n {
+            if p.best[r] < 0.0 {
+                continue;
+            }
+            let hit = match known(r) {
+                WaterHit::Hit(h) => Some(h),
+                WaterHit::Miss => None,
+                WaterHit::Unknown => {
+                    if self.ray_leaves(&p.ray[r]) {
+                        continue;
+                    }
+                    w.intersect(p.ray[r].o, p.ray[r].d, p.best[r])
+                }
+            };
+            if let Some(h) = hit.filter(|h| h.t < p.best[r]) {
                 p.best[r] = h.t;
                 pieces[r] = h.piece;
             }

@@ -15,11 +15,13 @@
 //! per tile by the phasor recurrence of [`sample`].
 
 mod march;
+mod raster;
 mod sample;
 mod shading;
 
 use crate::ocean::WaveComponent;
 use march::intersect_with;
+pub use raster::{PinholeView, Raster, WaterHit};
 use rayon::prelude::*;
 use sample::Phasors;
 use shading::resolved;
