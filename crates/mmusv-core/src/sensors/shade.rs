@@ -295,6 +295,9 @@ impl Shader {
     /// This shader taking water normals from the displaced sea surface `waves` (a scene's,
     /// [`crate::Scene::wave_surface`]) instead of the swell.
     pub fn with_waves(mut self, waves: Option<Arc<WaveSurface>>) -> Self {
+        if waves.is_some() && self.env.wave_height_m > 0.0 {
+            self.foam = self.foam.clone().on_crests();
+        }
         self.waves = waves;
         self
     }
@@ -484,7 +487,12 @@ impl Shader {
         };
         c += water::body_factor(rho, self.water_fdr, f_o, WATER_IOR) * entering;
         if !self.foam.is_empty() {
-            let cover = self.foam.cover(hit.point.x, hit.point.y);
+            // The normalised elevation η/σ_η (σ_η = H_s/4) that gathers the whitecaps on the crests.
+            let crest = match &self.waves {
+                Some(w) if self.env.wave_height_m > 0.0 => (hit.point.z - w.level()) * 4.0 / self.env.wave_height_m,
+                _ => 0.0,
+            };
+            let cover = self.foam.cover(hit.point.x, hit.point.y, crest);
             if cover > 0.0 {
                 let mut e = self.light.irradiance(n);
                 if sunlit {

@@ -7,8 +7,14 @@
 //! * **Whitecap coverage**: E. C. Monahan & I. O'Muircheartaigh, "Optimal Power-Law Description of Oceanic
 //!   Whitecap Coverage Dependence on Wind Speed", J. Phys. Oceanogr. 10, 1980: `W = 3.84·10⁻⁶ U^3.41`
 //!   (fraction of the surface). The foam is placed by a seeded fractal noise thresholded at its own
-//!   `(1 − W)` quantile, so the covered fraction is `W`. Foam is Lambertian with albedo 0.55, the reflectance of
-//!   fresh dense foam (P. Koepke, "Effective reflectance of oceanic whitecaps", Appl. Opt. 23(11), 1984).
+//!   `(1 − W)` quantile, so the covered fraction is `W`. Over a wave surface whitecaps form where waves break,
+//!   on and just behind the crests (E. C. Monahan, "Oceanic whitecaps", J. Phys. Oceanogr. 1(2), 1971): the
+//!   noise is then biased by the local elevation `η/σ_η` (`σ_η = H_s/4`, the elevation of a linear random sea
+//!   being Gaussian: M. S. Longuet-Higgins, "On the statistical distribution of the heights of sea waves",
+//!   J. Mar. Res. 11, 1952), thresholded at the `(1 − W)` quantile of that sum (noise and a standard normal),
+//!   so the coverage stays `W` while the foam gathers on the crests. Foam is Lambertian with albedo 0.55, the
+//!   reflectance of fresh dense foam (P. Koepke, "Effective reflectance of oceanic whitecaps", Appl. Opt.
+//!   23(11), 1984).
 //! * **Wind from the sea state** when the scenario gives none: a fully developed Pierson–Moskowitz sea,
 //!   `H_s = 0.21 U² / g` (W. J. Pierson & L. Moskowitz, JGR 69(24), 1964), so `U = √(H_s g / 0.21)`.
 //! * **Wakes**: behind every vessel under way, turbulent foam along its track (as wide as its beam, widening
@@ -202,12 +208,19 @@ pub fn foam_noise(seed: u64, x: f32, y: f32) -> f32 {
     s / 0.875
 }
 
-/// The `(1 − coverage)` quantile of the foam noise, from a fixed sample of it (cached per coverage and seed:
+/// Weight of the normalised elevation `η/σ_η` added to the foam noise (range `[0, 1]`, standard deviation
+/// about 0.1) over a wave surface: enough to gather the whitecaps on the crests, not to paint every crest.
+pub const CREST_WEIGHT: f32 = 0.12;
+
+/// The `(1 − coverage)` quantile of the foam noise (plus [`CREST_WEIGHT`] times a standard normal, the
+/// normalised elevation, with `crests`), from a fixed sample of it (cached per coverage, seed and `crests`:
 /// every render of a run asks for the same one).
-fn foam_threshold(coverage: f32, seed: u64) -> f32 {
-    static CACHE: std::sync::Mutex<Vec<(u32, u64, f32)>> = std::sync::Mutex::new(Vec::new());
+fn foam_threshold(coverage: f32, seed: u64, crests: bool) -> f32 {
+    type Key = (u32, u64, bool);
+    static CACHE: std::sync::Mutex<Vec<(Key, f32)>> = std::sync::Mutex::new(Vec::new());
+    let key = (coverage.to_bits(), seed, crests);
     if let Ok(c) = CACHE.lock() {
-        if let Some(&(_, _, t)) = c.iter().find(|(k, s, _)| *k == coverage.to_bits() && *s == seed) {
+        if let Some(&(_, t)) = c.iter().find(|(k, _)| *k == key) {
             return t;
         }
     }
@@ -215,7 +228,8 @@ fn foam_threshold(coverage: f32, seed: u64) -> f32 {
         .map(|i| {
             let x = noise::uniform(seed, FOAM_STREAM + 1, 2 * i) as f32 * 4000.0;
             let y = noise::uniform(seed, FOAM_STREAM + 1, 2 * i + 1) as f32 * 4000.0;
-            foam_noise(seed, x, y)
+            let crest = if crests { CREST_WEIGHT * standard_normal(seed, i) } else { 0.0 };
+            foam_noise(seed, x, y) + crest
         })
         .collect();
     v.sort_by(f32::total_cmp);
@@ -224,16 +238,30 @@ fn foam_threshold(coverage: f32, seed: u64) -> f32 {
         if c.len() >= 16 {
             c.remove(0);
         }
-        c.push((coverage.to_bits(), seed, t));
+        c.push((key, t));
     }
     t
 }
 
+/// A seeded standard normal deviate (Box–Muller), the `i`-th of the foam's threshold sample.
+fn standard_normal(seed: u64, i: u64) -> f32 {
+    let u1 = noise::uniform(seed, FOAM_STREAM + 2, 2 * i).max(1e-12);
+    let u2 = noise::uniform(seed, FOAM_STREAM + 2, 2 * i + 1);
+    ((-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()) as f32
+}
+
+/// The threshold that no noise value reaches, crests included: no whitecaps.
+const NO_WHITECAPS: f32 = 1e6;
+
 /// The foam of one render: whitecaps at a coverage and the wakes of the vessels under way.
 #[derive(Debug, Clone, Default)]
 pub struct Foam {
-    /// Noise level above which the surface is a whitecap (`> 1`: none).
+    /// Noise level above which the surface is a whitecap (`> 1 + CREST_WEIGHT·8`: none).
     threshold: f32,
+    /// The whitecap coverage asked for.
+    coverage: f32,
+    /// Whether the threshold is that of the noise biased by the crests ([`Foam::on_crests`]).
+    crests: bool,
     seed: u64,
     wakes: Vec<WakeShape>,
 }
@@ -253,7 +281,7 @@ struct WakeShape {
 impl Foam {
     /// Foam for whitecap `coverage` in `[0, 1]` and `wakes`, placed by `seed`.
     pub fn new(coverage: f32, wakes: &[Wake], seed: u64) -> Self {
-        let threshold = if coverage <= 0.0 { 2.0 } else { foam_threshold(coverage.min(1.0), seed) };
+        let threshold = if coverage <= 0.0 { NO_WHITECAPS } else { foam_threshold(coverage.min(1.0), seed, false) };
         let wakes = wakes
             .iter()
             .filter(|w| w.speed > 0.05)
@@ -269,25 +297,37 @@ impl Foam {
                 }
             })
             .collect();
-        Self { threshold, seed, wakes }
+        Self { threshold, coverage, crests: false, seed, wakes }
+    }
+
+    /// This foam with its whitecaps gathered on the wave crests (see the module docs): [`Foam::cover`] is then
+    /// given each point's normalised elevation `η/σ_η`.
+    pub fn on_crests(mut self) -> Self {
+        if self.threshold < NO_WHITECAPS {
+            self.threshold = foam_threshold(self.coverage.min(1.0), self.seed, true);
+        }
+        self.crests = true;
+        self
     }
 
     /// Whether there is any foam at all.
     pub fn is_empty(&self) -> bool {
-        self.threshold > 1.0 && self.wakes.is_empty()
+        self.threshold >= NO_WHITECAPS && self.wakes.is_empty()
     }
 
-    /// Foam cover in `[0, 1]` at world point `(x, y)`.
+    /// Foam cover in `[0, 1]` at world point `(x, y)`, whose normalised elevation is `crest` (`η/σ_η`; read
+    /// only [`Foam::on_crests`]).
     #[inline(always)]
-    pub fn cover(&self, x: f32, y: f32) -> f32 {
+    pub fn cover(&self, x: f32, y: f32, crest: f32) -> f32 {
         let mut c = 0.0f32;
         let mut nz = None;
         let mut noise_at = || *nz.get_or_insert_with(|| foam_noise(self.seed, x, y));
+        let lift = if self.crests { CREST_WEIGHT * crest } else { 0.0 };
         // The first octave bounds the sum: skip the rest where it cannot reach the threshold.
-        if self.threshold <= 1.0
-            && (0.5 * value_noise(self.seed, x / 6.0, y / 6.0) + 0.375) / 0.875 > self.threshold - 0.015
+        if self.threshold < NO_WHITECAPS
+            && (0.5 * value_noise(self.seed, x / 6.0, y / 6.0) + 0.375) / 0.875 + lift > self.threshold - 0.015
         {
-            let n = noise_at();
+            let n = noise_at() + lift;
             // A soft edge over 0.03 of the noise range.
             c = ((n - self.threshold) / 0.03 + 0.5).clamp(0.0, 1.0);
         }
@@ -377,12 +417,48 @@ mod tests {
             for i in 0..n {
                 let x = noise::uniform(99, 1, 2 * i) as f32 * 3000.0 - 1500.0;
                 let y = noise::uniform(99, 1, 2 * i + 1) as f32 * 3000.0 - 1500.0;
-                s += foam.cover(x, y) as f64;
+                s += foam.cover(x, y, 0.0) as f64;
             }
             let got = s / n as f64;
             assert!((got - cov as f64).abs() < 0.2 * cov as f64 + 0.002, "coverage {cov}: {got}");
         }
         assert!(Foam::new(0.0, &[], 1).is_empty());
+        assert!(Foam::new(0.0, &[], 1).on_crests().is_empty());
+    }
+
+    /// On a wave surface the whitecaps keep Monahan's coverage over a Gaussian sea (the normalised elevation a
+    /// standard normal, independent of the noise) and gather on the crests: the covered points' mean elevation
+    /// is well above the mean, and troughs below −1 σ carry almost none.
+    #[test]
+    fn whitecaps_keep_their_coverage_and_gather_on_the_crests() {
+        for cov in [0.01f32, 0.05, 0.2] {
+            let foam = Foam::new(cov, &[], 7).on_crests();
+            let n = 200_000u64;
+            let (mut s, mut crest_sum, mut troughs, mut trough_n) = (0.0f64, 0.0f64, 0.0f64, 0u64);
+            for i in 0..n {
+                let x = noise::uniform(99, 1, 2 * i) as f32 * 3000.0 - 1500.0;
+                let y = noise::uniform(99, 1, 2 * i + 1) as f32 * 3000.0 - 1500.0;
+                let g = standard_normal(1234, i);
+                let c = foam.cover(x, y, g) as f64;
+                s += c;
+                crest_sum += c * g as f64;
+                if g < -1.0 {
+                    troughs += c;
+                    trough_n += 1;
+                }
+            }
+            let got = s / n as f64;
+            assert!((got - cov as f64).abs() < 0.2 * cov as f64 + 0.002, "coverage {cov}: {got}");
+            let mean_crest = crest_sum / s;
+            assert!(mean_crest > 0.7, "coverage {cov}: foam at a mean elevation of {mean_crest} σ");
+            let trough_cover = troughs / trough_n as f64;
+            assert!(trough_cover < 0.25 * cov as f64, "coverage {cov}: {trough_cover} in the troughs");
+        }
+        // The normal deviates are normal: mean 0, variance 1.
+        let g: Vec<f64> = (0..50_000).map(|i| f64::from(standard_normal(5, i))).collect();
+        let mean = g.iter().sum::<f64>() / g.len() as f64;
+        let var = g.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / g.len() as f64;
+        assert!(mean.abs() < 0.02 && (var - 1.0).abs() < 0.03, "{mean} {var}");
     }
 
     #[test]
@@ -394,7 +470,7 @@ mod tests {
             let mut s = 0.0;
             for i in 0..21 {
                 for j in 0..21 {
-                    s += f.cover(x + (i as f32 - 10.0) * 0.5, y + (j as f32 - 10.0) * 0.05);
+                    s += f.cover(x + (i as f32 - 10.0) * 0.5, y + (j as f32 - 10.0) * 0.05, 0.0);
                 }
             }
             s / 441.0
