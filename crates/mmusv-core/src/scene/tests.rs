@@ -511,7 +511,7 @@ fn wave_surface_batches_give_exactly_the_ray_by_ray_reference() {
 
 /// A pinhole camera over the waves rasterises its water hits ([`crate::sea::WaveSurface::first_hits`]): its depth
 /// and instances are those of the same pixel rays cast ray by ray (marched through the waves), vessels in front
-/// of the water included, but for the few pixels whose ray skims a crest (where rounding picks the side).
+/// of the water included.
 #[test]
 fn a_camera_over_the_waves_sees_the_marched_hits() {
     use crate::sea::{SurfaceSpec, WaveSurface};
@@ -532,7 +532,7 @@ fn a_camera_over_the_waves_sees_the_marched_hits() {
         image: Default::default(),
     };
     let cam = Camera::new(cfg).unwrap_or_else(|e| unreachable!("{e}"));
-    let (mut water, mut skims, mut vessel_px) = (0, 0, 0);
+    let (mut water, mut differ, mut vessel_px) = (0, 0, 0);
     for (k, pose) in [
         RigidPose::from_xyz_rpy([2.0, 1.0, 3.5], [0.02, 0.05, 0.4]),
         RigidPose::from_xyz_rpy([110.0, -70.0, 8.0], [0.0, 0.3, 2.6]),
@@ -551,7 +551,7 @@ fn a_camera_over_the_waves_sees_the_marched_hits() {
             let same = frame.instance[i] == marched.instance[i]
                 && (depth == frame.depth[i] || (depth - frame.depth[i]).abs() <= 1e-4 * depth);
             if !same {
-                skims += 1;
+                differ += 1;
                 assert!(
                     marched.instance[i] == 1 && frame.instance[i] == 1,
                     "view {k} pixel {i}: marched {} at {depth}, rasterised {} at {}",
@@ -565,5 +565,5 @@ fn a_camera_over_the_waves_sees_the_marched_hits() {
         }
     }
     assert!(water > 30_000 && vessel_px > 500, "{water} water pixels, {vessel_px} vessel pixels");
-    assert!(skims * 5000 <= water, "{skims} of {water} water pixels differ");
+    assert_eq!(differ, 0, "{differ} of {water} water pixels differ");
 }

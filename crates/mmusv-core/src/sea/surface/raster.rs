@@ -22,7 +22,10 @@
 //!
 //! The raster picks the piece; its distance along the camera's own world ray (and so the hit a march would give,
 //! to rounding) is then solved on that piece's plane ([`Raster::resolve`]), and the still level is checked
-//! analytically. A pixel the plane solve cannot settle (a ray in the piece's plane) is left to the march.
+//! analytically. The depth that picks the nearest piece is `r·N / v0·N` from the triangle's normal `N`; a
+//! triangle whose plane passes within `10⁻⁴` rad of the camera (seen edge-on) is left out, as its depth there
+//! would be rounding noise (the pieces beside it meet those rays at the same distance). A pixel the plane solve
+//! cannot settle (a ray in the piece's plane, or a hit off the piece) is left to the march.
 
 use super::{cell_planes, SurfaceHit, WaveSurface, FLAT_PIECE, SKIN_M, TILE_CELLS};
 use rayon::prelude::*;
@@ -109,8 +112,14 @@ pub struct Raster<'a> {
     first: Vec<u32>,
 }
 
+/// How far (in cells) outside its piece a resolved hit may fall before the march is asked instead.
+const ON_PIECE: f32 = 1e-3;
 /// Pixels along a band of rows that one task rasterises.
 const BAND_ROWS: usize = 32;
+/// Sine of the angle under which a triangle's plane passes the camera below which it counts as seen edge-on.
+const EDGE_ON: f32 = 1e-4;
+/// Pixels by which a triangle's projected bounds are widened before taking the pixel centres inside them.
+const BOUNDS_SLACK: f32 = 0.01;
 /// The near plane that bounds the pixels a triangle crossing the camera's plane can cover, metres.
 const NEAR_M: f32 = 1e-3;
 
@@ -386,13 +395,22 @@ impl<'a> Frame<'a> {
     /// The rasterised form of triangle `v` (camera space), or `None` when it covers no pixel centre for sure
     /// (behind the camera, outside the image, or seen edge-on). `ab`, when given, holds the vertices'
     /// projections `(x/z, y/z)`, all in front of the near plane.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // a NaN depth must leave the triangle out
     fn setup(&self, v: [[f32; 3]; 3], ab: Option<[[f32; 2]; 3]>, piece: u32) -> Option<Tri> {
         let cross = |p: [f32; 3], q: [f32; 3]| {
             [p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2], p[0] * q[1] - p[1] * q[0]]
         };
         let mut e = [cross(v[1], v[2]), cross(v[2], v[0]), cross(v[0], v[1])];
-        let det = v[0][0] * e[0][0] + v[0][1] * e[0][1] + v[0][2] * e[0][2];
-        if det == 0.0 || !det.is_finite() {
+        // The depth from the normal `N = (v1 − v0) × (v2 − v0)` (= e0 + e1 + e2, without the cancellation of
+        // summing three large cross products): `1/z = r·N / v0·N`.
+        let sub = |p: [f32; 3], q: [f32; 3]| [p[0] - q[0], p[1] - q[1], p[2] - q[2]];
+        let n = cross(sub(v[1], v[0]), sub(v[2], v[0]));
+        let det = v[0][0] * n[0] + v[0][1] * n[1] + v[0][2] * n[2];
+        let scale = (v[0][0] * v[0][0] + v[0][1] * v[0][1] + v[0][2] * v[0][2]).sqrt()
+            * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        // Seen (almost) edge-on, its plane through the camera: it covers no pixel centre but by rounding, where
+        // its depth would be noise (the pieces beside it are met at the same distance).
+        if !(det.abs() > EDGE_ON * scale) {
             return None;
         }
         if det < 0.0 {
@@ -400,8 +418,7 @@ impl<'a> Frame<'a> {
                 *ei = ei.map(|x| -x);
             }
         }
-        let ad = 1.0 / det.abs();
-        let inv = [0, 1, 2].map(|i| (e[0][i] + e[1][i] + e[2][i]) * ad);
+        let inv = n.map(|x| x / det);
         // Pixel bounds from the part of the triangle in front of the near plane.
         let (mut lo, mut hi) = ([f32::INFINITY; 2], [f32::NEG_INFINITY; 2]);
         let mut add = |x: [f32; 2]| {
@@ -429,11 +446,13 @@ impl<'a> Frame<'a> {
         }
         let f = self.view.focal as f32;
         let (w, h) = (self.view.width as f32, self.view.height as f32);
-        // Pixel u's centre is at a = (u + ½ − W/2) / f: u = a·f + W/2 − ½ (one pixel of margin each side).
+        // Pixel u's centre is at a = (u + ½ − W/2) / f: u = a·f + W/2 − ½. The pixel centres within the bounds,
+        // widened by a hundredth of a pixel (far more than the projection's rounding): a triangle between two
+        // pixel centres covers none.
         let px = |a: f32, size: f32| a * f + size / 2.0 - 0.5;
-        let (u0, u1) = (px(lo[0], w).floor() - 1.0, px(hi[0], w).ceil() + 1.0);
-        let (v0, v1) = (px(lo[1], h).floor() - 1.0, px(hi[1], h).ceil() + 1.0);
-        if u1 < 0.0 || v1 < 0.0 || u0 > w - 1.0 || v0 > h - 1.0 {
+        let (u0, u1) = ((px(lo[0], w) - BOUNDS_SLACK).ceil(), (px(hi[0], w) + BOUNDS_SLACK).floor());
+        let (v0, v1) = ((px(lo[1], h) - BOUNDS_SLACK).ceil(), (px(hi[1], h) + BOUNDS_SLACK).floor());
+        if u1 < u0 || v1 < v0 || u1 < 0.0 || v1 < 0.0 || u0 > w - 1.0 || v0 > h - 1.0 {
             return None;
         }
         let clamp = |x: f32, size: f32| x.clamp(0.0, size - 1.0) as u32;
@@ -445,6 +464,7 @@ impl Raster<'_> {
     /// The first hit of the ray `o + t·d` (`d` unit, `0 <= t < t_max`) through the centre of pixel `pixel`
     /// (row-major) of the rasterised view, `o` its origin: solved on the piece the raster found there, or on the
     /// still level where the ray meets it over still water first.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // a NaN must send the ray to the march
     pub fn resolve(&self, pixel: usize, o: [f32; 3], d: [f32; 3], t_max: f32) -> WaterHit {
         let s = self.surface;
         let mut best: Option<SurfaceHit> = None;
@@ -455,8 +475,22 @@ impl Raster<'_> {
                     let fu0 = (o[0] - corner[0]) * inv_cs - cell[0];
                     let fv0 = (o[1] - corner[1]) * inv_cs - cell[1];
                     let f0 = o[2] - (q[0] + q[1] * fu0 + q[2] * fv0);
-                    let f1 = d[2] - (q[1] * d[0] * inv_cs + q[2] * d[1] * inv_cs);
-                    (-f0 / f1, id)
+                    let (du, dv) = (d[0] * inv_cs, d[1] * inv_cs);
+                    let f1 = d[2] - (q[1] * du + q[2] * dv);
+                    let t = -f0 / f1;
+                    // The hit must lie on the piece (to a thousandth of a cell): else the raster was misled
+                    // (rounding at a silhouette) and the march decides.
+                    let (fu, fv) = (fu0 + du * t, fv0 + dv * t);
+                    let side = if id % 2 == 0 { fu - fv } else { fv - fu };
+                    if !(fu > -ON_PIECE
+                        && fu < 1.0 + ON_PIECE
+                        && fv > -ON_PIECE
+                        && fv < 1.0 + ON_PIECE
+                        && side > -ON_PIECE)
+                    {
+                        return WaterHit::Unknown;
+                    }
+                    (t, id)
                 }
                 Piece::Wall { axis, at, lo, hi } => {
                     let a = axis as usize;
