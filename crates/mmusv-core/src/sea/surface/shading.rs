@@ -1,8 +1,9 @@
 //! The water's shading from the sampled surface: each level's slopes of the waves it resolves, the rest as
 //! roughness, and near the foci two detail bands chosen by the pixel's footprint ([`WaveSurface::shading`]).
 //!
-//! Model: a wave shorter than two cells of a level ([`resolved`], the Nyquist limit) cannot be drawn from its
-//! nodes (sampled there, it aliases into a false pattern of longer slopes), so its slopes are treated
+//! Model: a wave shorter than four cells of a level ([`resolved`]: twice the Nyquist limit) cannot be drawn from
+//! its nodes (sampled there, it aliases into a false pattern of longer slopes, or, between two and four cells,
+//! bilinear interpolation draws the cells' lattice), so its slopes are treated
 //! statistically, as filtered normal maps treat detail finer than a texel: M. Olano & D. Baker, "LEAN Mapping",
 //! I3D 2010; M. Toksvig, "Mipmapping Normal Maps", J. Graphics Tools 10(3), 2005. The detail bands are chosen as a
 //! mipmap's level is, by the footprint of the pixel that sees the water. Checked in the parent's tests against
@@ -11,19 +12,23 @@
 use super::{unit, WaveSurface, TILE_CELLS};
 
 /// The detail bands ([`SurfaceSpec::detail`](super::SurfaceSpec::detail)) by the cells per tile side that resolve them: band 0 holds the
-/// waves the finest cells (a 32nd of a tile) cannot resolve but a 64th can, band 1 those that need a 128th.
+/// waves the finest cells (a 32nd of a tile) cannot resolve but a 64th can (2–4 m long with 32 m tiles), band 1
+/// those that need a 128th (1–2 m).
 pub const DETAIL_BANDS: [usize; 2] = [2 * TILE_CELLS, 4 * TILE_CELLS];
-/// Cells along a side of the grid both detail bands are sampled on: the finer band's, so the coarser band has
-/// four nodes or more to its shortest wave (bilinear interpolation keeps its amplitude).
+/// Cells along a side of the grid both detail bands are sampled on: the finer band's, so each band has four
+/// nodes or more to its shortest wave (bilinear interpolation keeps its amplitude).
 pub const DETAIL_CELLS: usize = 4 * TILE_CELLS;
 
-/// Whether a wave of wavenumber `k_rad_m` is resolved by samples `cell_m` apart: at least two cells to its
-/// wavelength (the Nyquist limit, `k ≤ π / cell_m`). Shorter waves sampled at the nodes would alias into
-/// spurious longer slope patterns, so the shading slopes leave them out and take their slope variance as
-/// roughness instead ([`WaveSurface::shading`]).
+/// Whether a wave of wavenumber `k_rad_m` is resolved by samples `cell_m` apart: at least four cells to its
+/// wavelength (`k ≤ π / (2 cell_m)`, twice the Nyquist limit). Shorter waves sampled at the nodes either alias
+/// into spurious longer slope patterns (under two cells) or, interpolated bilinearly between nodes two to four
+/// cells apart along the wave, draw the grid itself: a lattice of highlights aligned with the cells, its amplitude
+/// set by where the nodes fall on the wave (at W3 the shortest waves, 2.1 m, have just over two of the finest 1 m
+/// cells). So the shading slopes leave them out and take their slope variance as roughness instead
+/// ([`WaveSurface::shading`]).
 #[inline]
 pub(crate) fn resolved(k_rad_m: f64, cell_m: f32) -> bool {
-    k_rad_m * f64::from(cell_m) <= std::f64::consts::PI
+    k_rad_m * f64::from(cell_m) <= std::f64::consts::FRAC_PI_2
 }
 
 /// The water's shading at a point: the resolved waves' normal and the unresolved ones' slope variance.
@@ -49,7 +54,7 @@ impl WaveSurface {
     /// The water's shading at world `(x, y)` seen with a pixel footprint of `footprint_m` metres on the water
     /// ([`SurfaceShading`]); `None` over still water.
     ///
-    /// Model: a wave shorter than two cells of the tile's level ([`resolved`]) cannot be drawn from its nodes
+    /// Model: a wave shorter than four cells of the tile's level ([`resolved`]) cannot be drawn from its nodes
     /// (sampled there, it aliases into a false pattern of longer slopes, and the level's edge shows as a change
     /// of texture), so its slopes are treated statistically, as filtered normal maps treat detail finer than a
     /// texel: M. Olano & D. Baker, "LEAN Mapping", I3D 2010; M. Toksvig, "Mipmapping Normal Maps", J. Graphics
