@@ -234,14 +234,11 @@ fn trace_rest<L: Level>(
     p: &mut Packet,
     out: &mut ChunkOut<'_>,
 ) {
+    // The rays' wave-surface hits where the raster knows them, else marched.
+    let known = |j: usize| water.map_or(WaterHit::Unknown, |w| w[at(j)]);
     if coherent(rays) && p.fill(rays, limit) {
-        let (inst, tri) = match water {
-            None => scene.cast_packet_with(lv, p, scratch),
-            Some(w) => {
-                let water = scene.known_wave_hits_packet(p, |j| w[at(j)]);
-                scene.cast_packet_over(lv, p, water, scratch)
-            }
-        };
+        let water = scene.known_wave_hits_packet(p, known);
+        let (inst, tri) = scene.cast_packet_over(lv, p, water, scratch);
         for (j, ray) in rays.iter().enumerate() {
             if inst[j] != u32::MAX {
                 let hit = Hit { distance: p.best[j], instance: inst[j], triangle: tri[j] };
@@ -250,13 +247,8 @@ fn trace_rest<L: Level>(
         }
     } else {
         for (j, ray) in rays.iter().enumerate() {
-            let hit = match water {
-                None => scene.cast_prepared(lv, ray, limit, scratch),
-                Some(w) => {
-                    let water = scene.known_wave_hit(ray, w[at(j)], limit);
-                    scene.cast_prepared_over(lv, ray, water, limit, scratch)
-                }
-            };
+            let water = scene.known_wave_hit(ray, known(j), limit);
+            let hit = scene.cast_prepared_over(lv, ray, water, limit, scratch);
             if let Some(hit) = hit {
                 out.hit(scene, at(j), Vec3::from_array(ray.d), &hit);
             }

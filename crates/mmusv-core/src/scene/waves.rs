@@ -85,18 +85,7 @@ impl Scene {
     /// sea instance and the piece per ray (`u32::MAX` where none), or `None` without a wave surface.
     #[inline(always)]
     pub(super) fn wave_hits_packet(&self, p: &mut Packet) -> Option<(u32, [u32; PACKET])> {
-        let w = self.waves.as_ref()?;
-        let mut pieces = [u32::MAX; PACKET];
-        for r in 0..p.n {
-            if p.best[r] < 0.0 || self.ray_leaves(&p.ray[r]) {
-                continue;
-            }
-            if let Some(h) = w.intersect(p.ray[r].o, p.ray[r].d, p.best[r]) {
-                p.best[r] = h.t;
-                pieces[r] = h.piece;
-            }
-        }
-        Some((self.hidden_instance(), pieces))
+        self.known_wave_hits_packet(p, |_| WaterHit::Unknown)
     }
 
     /// [`Scene::wave_hit`] where the raster may already know the answer (`known`; [`WaterHit::Unknown`]
@@ -112,7 +101,8 @@ impl Scene {
         }
     }
 
-    /// [`Scene::wave_hits_packet`] where the raster may already know the answers (`known(r)` for ray `r`).
+    /// [`Scene::wave_hits_packet`] where the raster may already know the answers (`known(r)` for ray `r`;
+    /// [`WaterHit::Unknown`] marches).
     #[inline(always)]
     pub(super) fn known_wave_hits_packet(
         &self,
@@ -126,16 +116,12 @@ impl Scene {
                 continue;
             }
             let hit = match known(r) {
-                WaterHit::Hit(h) => Some(h),
-                WaterHit::Miss => None,
-                WaterHit::Unknown => {
-                    if self.ray_leaves(&p.ray[r]) {
-                        continue;
-                    }
-                    w.intersect(p.ray[r].o, p.ray[r].d, p.best[r])
-                }
+                WaterHit::Hit(h) if h.t < p.best[r] => Some(h),
+                WaterHit::Hit(_) | WaterHit::Miss => None,
+                WaterHit::Unknown if self.ray_leaves(&p.ray[r]) => None,
+                WaterHit::Unknown => w.intersect(p.ray[r].o, p.ray[r].d, p.best[r]),
             };
-            if let Some(h) = hit.filter(|h| h.t < p.best[r]) {
+            if let Some(h) = hit {
                 p.best[r] = h.t;
                 pieces[r] = h.piece;
             }

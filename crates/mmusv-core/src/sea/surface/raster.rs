@@ -144,7 +144,7 @@ impl WaveSurface {
         let mut tris = Vec::new();
         for mut p in per_tile {
             let offset = pieces.len() as u32;
-            tris.extend(p.tris.iter_mut().map(|t| Tri { piece: t.piece + offset, ..*t }));
+            tris.extend(p.tris.iter().map(|t| Tri { piece: t.piece + offset, ..*t }));
             pieces.append(&mut p.pieces);
         }
         // Pixel u's centre is at a = (u + ½ − W/2) / f: u = a·f + W/2 − ½.
