@@ -19,6 +19,14 @@ pub fn scene() -> Result<DemoScene> {
     maritime_demo(DemoParams::default())
 }
 
+/// [`scene`] with the sea declared as `mmusv` worlds declare it (instance 1 the water plane, the vessels moving),
+/// so the sea shortcuts apply.
+pub fn sea_scene() -> Result<DemoScene> {
+    let mut demo = scene()?;
+    demo.scene.set_sea(1, &demo.vessel_instances)?;
+    Ok(demo)
+}
+
 /// One 64-channel × 2048-azimuth LiDAR sweep.
 pub fn lidar() -> Result<Rays> {
     lidar_rays([0.0, 0.0, LIDAR_HEIGHT], 64, 2048)

@@ -5,10 +5,9 @@
 //! [`Scene::cast_rays_over`]). Throughput per pixel.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use mmusv_core::demo::surround_camera_rays;
 use mmusv_core::ocean::{SeaSpec, WaveField};
 use mmusv_core::sea::{PinholeView, Raster, SurfaceSpec, WaterHit, WaveSurface};
-use mmusv_core::RigidPose;
-use parry3d::math::Vec3;
 use rayon::prelude::*;
 use std::hint::black_box;
 use std::time::Duration;
@@ -16,14 +15,13 @@ use std::time::Duration;
 const RANGE: f32 = 5000.0;
 
 fn bench_seacam(c: &mut Criterion) {
-    let Ok(mut demo) = mmusv_benches::scene() else {
-        eprintln!("could not build the benchmark scene");
-        return;
+    let mut demo = match mmusv_benches::sea_scene() {
+        Ok(d) => d,
+        Err(e) => {
+            eprintln!("could not build the benchmark scene with its sea: {e}");
+            return;
+        }
     };
-    if let Err(e) = demo.scene.set_sea(1, &demo.vessel_instances) {
-        eprintln!("could not declare the sea: {e}");
-        return;
-    }
     let sea = SeaSpec { hs: 1.5, tp: 6.1, gamma: 3.3, direction_rad: 0.4, spread_s: 10.0 };
     let Ok(field) = WaveField::new(&sea, 7) else {
         eprintln!("could not build the wave field");
@@ -37,33 +35,23 @@ fn bench_seacam(c: &mut Criterion) {
     }
     let scene = &demo.scene;
     let Some(waves) = scene.wave_surface() else { return };
-    // Level along +x from 2 m, as a small USV's surround camera looks: water to the horizon, vessels ahead.
-    let pose = RigidPose::from_xyz_rpy([0.0, 0.0, f64::from(eye[2])], [0.0, 0.0, 0.0]);
+    // One camera level along +x from 2 m, as a small USV's surround camera looks: water to the horizon, vessels
+    // ahead; its pixel rays row by row (`surround_camera_rays` with one camera: image right is −y, down −z).
     let (w, h) = (640u32, 480u32);
-    let focal = f64::from(w) / 2.0; // 90° horizontal field of view
-    let axis = |v: Vec3| pose.transform_vector(v).to_array();
+    let hfov = std::f64::consts::FRAC_PI_2;
+    let Ok((o, d)) = surround_camera_rays(eye, 1, w, h, hfov) else {
+        eprintln!("could not build the camera rays");
+        return;
+    };
     let view = PinholeView {
         origin: eye,
-        forward: axis(Vec3::X),
-        right: axis(-Vec3::Y),
-        down: axis(-Vec3::Z),
+        forward: [1.0, 0.0, 0.0],
+        right: [0.0, -1.0, 0.0],
+        down: [0.0, 0.0, -1.0],
         width: w,
         height: h,
-        focal,
+        focal: f64::from(w) / (2.0 * (hfov / 2.0).tan()),
     };
-    let (mut o, mut d) = (Vec::new(), Vec::new());
-    for v in 0..h {
-        for u in 0..w {
-            let (a, b) =
-                ((f64::from(u) + 0.5 - f64::from(w) / 2.0) / focal, (f64::from(v) + 0.5 - f64::from(h) / 2.0) / focal);
-            let dir: Vec<f64> = (0..3)
-                .map(|i| f64::from(view.forward[i]) + a * f64::from(view.right[i]) + b * f64::from(view.down[i]))
-                .collect();
-            let n = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
-            o.push(eye);
-            d.push([(dir[0] / n) as f32, (dir[1] / n) as f32, (dir[2] / n) as f32]);
-        }
-    }
     let rasterised = |waves: &WaveSurface| {
         let raster: Option<Raster<'_>> = waves.first_hits(&view);
         let known: Option<Vec<WaterHit>> =

@@ -5,12 +5,13 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let which = args.get(1).map_or("top", String::as_str).to_string();
     let reps: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(20);
-    let Ok(mut demo) = mmusv_benches::scene() else { return };
-    let moving = demo.vessel_instances.clone();
-    if demo.scene.set_sea(1, &moving).is_err() {
-        eprintln!("set_sea failed");
-        return;
-    }
+    let demo = match mmusv_benches::sea_scene() {
+        Ok(d) => d,
+        Err(e) => {
+            eprintln!("could not build the scene with its sea: {e}");
+            return;
+        }
+    };
     let (o, d) = if which == "top" {
         let mut o = Vec::new();
         let mut d = Vec::new();

@@ -12,15 +12,13 @@ use std::hint::black_box;
 use std::time::Duration;
 
 fn bench_sensors(c: &mut Criterion) {
-    let Ok(mut demo) = mmusv_benches::scene() else {
-        eprintln!("could not build the benchmark scene");
-        return;
+    let demo = match mmusv_benches::sea_scene() {
+        Ok(d) => d,
+        Err(e) => {
+            eprintln!("could not build the benchmark scene with its sea: {e}");
+            return;
+        }
     };
-    // The sea shortcuts, as `mmusv` worlds declare them: instance 1 is the water plane, the vessels move.
-    if let Err(e) = demo.scene.set_sea(1, &demo.vessel_instances) {
-        eprintln!("could not declare the sea: {e}");
-        return;
-    }
     let scene = &demo.scene;
     let lidar_pose = RigidPose::from_xyz_rpy([0.0, 0.0, f64::from(mmusv_benches::LIDAR_HEIGHT)], [0.0, 0.0, 0.0]);
     let cam_pose = RigidPose::from_xyz_rpy([0.0, 0.0, f64::from(mmusv_benches::CAMERA_HEIGHT)], [0.0, 0.0, 0.0]);
