@@ -1,0 +1,307 @@
+//! Unit tests of the parent module (`surface.rs`): sampling, shading bands, the march.
+
+use super::*;
+use std::f64::consts::TAU;
+
+/// A wave component `a cos(kx x + ky y − ω t + φ)` (the derived fields filled in).
+pub(crate) fn comp(a: f64, kx: f64, ky: f64, omega: f64, phase: f64) -> WaveComponent {
+    WaveComponent {
+        amplitude_m: a,
+        omega_rad_s: omega,
+        k_rad_m: kx.hypot(ky),
+        direction_rad: ky.atan2(kx),
+        phase_rad: phase,
+        kx,
+        ky,
+    }
+}
+
+/// A small irregular sea: eight components over directions and wavelengths 12..80 m, amplitudes summing
+/// to 1.6 m.
+pub(crate) fn test_sea() -> Vec<WaveComponent> {
+    (0..8)
+        .map(|i| {
+            let k = std::f64::consts::TAU / (12.0 + 9.5 * i as f64);
+            let dir = 0.4 + 0.37 * i as f64;
+            comp(0.2, k * dir.cos(), k * dir.sin(), (9.81 * k).sqrt(), 1.3 * i as f64)
+        })
+        .collect()
+}
+
+/// The elevation summed point by point (the independent reference).
+fn eta(c: &[WaveComponent], x: f64, y: f64, t: f64) -> f64 {
+    c.iter().map(|w| w.amplitude_m * (w.kx * x + w.ky * y - w.omega_rad_s * t + w.phase_rad).cos()).sum()
+}
+
+fn surface(sea: &[WaveComponent], t: f64, foci: &[[f32; 2]], spec: SurfaceSpec) -> WaveSurface {
+    WaveSurface::new(sea, t, 0.0, foci, spec)
+}
+
+#[test]
+fn nodes_hold_the_analytic_elevation_and_slope() {
+    let c = test_sea();
+    let spec = SurfaceSpec { radius_m: 2000.0, ..SurfaceSpec::default() };
+    let s = surface(&c, 12.5, &[[130.0, -40.0]], spec);
+    let mut checked = 0;
+    for (k, tile) in s.tiles.iter().enumerate() {
+        if tile.n == 0 || k % 7 != 0 {
+            continue;
+        }
+        let (ix, iy) = (k % s.ntx, k / s.ntx);
+        let w = tile.n + 1;
+        for j in (0..w).step_by(3) {
+            for i in (0..w).step_by(5) {
+                let x = f64::from(s.x0 + ix as f32 * s.tile_m) + i as f64 * f64::from(s.tile_m) / tile.n as f64;
+                let y = f64::from(s.y0 + iy as f32 * s.tile_m) + j as f64 * f64::from(s.tile_m) / tile.n as f64;
+                if nearest(&[[130.0, -40.0]], x as f32, y as f32) > spec.radius_m - spec.taper_m {
+                    continue; // tapered
+                }
+                let e = eta(&c, x, y, 12.5);
+                assert!((f64::from(tile.h[j * w + i]) - e).abs() < 2e-4, "tile {k} node {i},{j}");
+                // The slopes: those of the waves at least four cells long only.
+                let cell = f64::from(s.tile_m) / tile.n as f64;
+                let gx: f64 = c
+                    .iter()
+                    .filter(|w| std::f64::consts::TAU / w.k_rad_m >= 4.0 * cell)
+                    .map(|w| -w.amplitude_m * w.kx * w.phase_at(x, y, 12.5).sin())
+                    .sum();
+                assert!((f64::from(tile.g[j * w + i][0]) - gx).abs() < 2e-4);
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 500);
+    assert!(s.zmax() > 0.5 && s.zmax() <= 1.6 && s.zmin() < -0.5);
+}
+
+/// A wave shorter than four cells leaves the level's shading slopes and becomes its roughness: its slope
+/// variance `a²k²/2` exactly, at every level too coarse for it, so resolved and unresolved slopes together
+/// keep the sea's whole mean square slope at every level; the heights keep it at every level.
+#[test]
+fn short_waves_become_roughness_not_aliased_slopes() {
+    // 1.5 m and 12 m waves: the first is resolved nowhere (finest cell 1 m), the second up to 2 m cells.
+    let (k1, k2) = (std::f64::consts::TAU / 1.5, std::f64::consts::TAU / 12.0);
+    let sea = [comp(0.02, k1 * 0.6, k1 * 0.8, 0.0, 0.3), comp(0.3, k2, 0.0, 0.0, 1.1)];
+    let spec = SurfaceSpec { radius_m: 2000.0, ..SurfaceSpec::default() };
+    let s = surface(&sea, 0.0, &[[0.0, 0.0]], spec);
+    let (m1, m2) = ((0.02 * k1).powi(2) / 2.0, (0.3 * k2).powi(2) / 2.0);
+    let mut seen = [false; 4];
+    for (k, tile) in s.tiles.iter().enumerate().filter(|(_, t)| t.n > 0) {
+        let centre = [s.x0 + ((k % s.ntx) as f32 + 0.5) * s.tile_m, s.y0 + ((k / s.ntx) as f32 + 0.5) * s.tile_m];
+        if nearest(&[[0.0, 0.0]], centre[0], centre[1]) > spec.radius_m - spec.taper_m {
+            continue; // tapered
+        }
+        let cell = f64::from(s.tile_m) / tile.n as f64;
+        let want = if cell * 4.0 > 12.0 { m1 + m2 } else { m1 };
+        assert!((f64::from(tile.mss) - want).abs() < 1e-6 * want.max(1e-3), "cell {cell}: {} vs {want}", tile.mss);
+        // The shading slopes are the long wave's alone where it is resolved (no 1.5 m aliasing), none else.
+        for (q, g) in tile.g.iter().enumerate().step_by(7) {
+            let long = if cell * 4.0 > 12.0 { 0.0 } else { 0.3 * k2 };
+            assert!(g[0].abs() <= long as f32 + 1e-5 && g[1].abs() < 1e-5, "cell {cell} node {q}: {g:?}");
+        }
+        seen[(TILE_CELLS / tile.n).trailing_zeros().min(3) as usize] = true;
+    }
+    assert!(seen.iter().all(|&v| v), "levels: {seen:?}");
+    let sh = s.shading(3.0, 4.0, 0.0).unwrap_or_else(|| unreachable!("inside the sampled tiles"));
+    assert!((f64::from(sh.unresolved_mss) - m1).abs() < 1e-9 && sh.normal[2] > 0.9);
+}
+
+/// With `detail`, a finest-level tile carries, on a grid of a quarter of its cell, the slopes of the waves
+/// too short for its cells in two bands (here a 3 m wave in band 0 and a 1.5 m wave in band 1: their analytic slopes
+/// at every detail node); the shading draws each band as normals or roughness by the pixel's footprint;
+/// coarser tiles and the geometry do not change.
+#[test]
+fn detail_bands_hold_the_short_waves_and_follow_the_footprint() {
+    let (k1, k2, k3) = (TAU / 3.0, TAU / 12.0, TAU / 1.5);
+    let sea = [comp(0.04, k1 * 0.6, k1 * 0.8, 0.0, 0.3), comp(0.3, k2, 0.0, 0.0, 1.1), comp(0.01, 0.0, k3, 0.0, 2.0)];
+    let base = SurfaceSpec { radius_m: 2000.0, ..SurfaceSpec::default() };
+    let plain = surface(&sea, 0.0, &[[0.0, 0.0]], base);
+    let s = surface(&sea, 0.0, &[[0.0, 0.0]], SurfaceSpec { detail: true, ..base });
+    let (m1, m3) = ((0.04 * k1).powi(2) / 2.0, (0.01 * k3).powi(2) / 2.0);
+
+    let slope = |c: &WaveComponent, x: f64, y: f64| {
+        let sn = c.phase_at(x, y, 0.0).sin();
+        [-c.amplitude_m * c.kx * sn, -c.amplitude_m * c.ky * sn]
+    };
+    let mut checked = 0;
+    for (k, (t, p)) in s.tiles.iter().zip(&plain.tiles).enumerate() {
+        assert_eq!(t.h, p.h, "tile {k}: the geometry is the same");
+        assert_eq!(t.g, p.g);
+        if t.n != TILE_CELLS {
+            assert!(t.detail.iter().all(Vec::is_empty) && t.mss == p.mss);
+            continue;
+        }
+        assert!(t.mss.abs() < 1e-9, "every short wave is in a band: {}", t.mss);
+        assert!((f64::from(t.band_mss[0]) - m1).abs() < 1e-9 && (f64::from(t.band_mss[1]) - m3).abs() < 1e-9);
+        let (x0, y0) = (f64::from(s.x0) + (k % s.ntx) as f64 * 32.0, f64::from(s.y0) + (k / s.ntx) as f64 * 32.0);
+        for (band, wave, tol) in [(0, &sea[0], 2e-4), (1, &sea[2], 1e-4)] {
+            let w = DETAIL_CELLS + 1;
+            assert_eq!(t.detail[band].len(), w * w, "tile {k} band {band}");
+            let step = 32.0 / DETAIL_CELLS as f64;
+            for (q, g) in t.detail[band].iter().enumerate().step_by(37) {
+                let (x, y) = (x0 + (q % w) as f64 * step, y0 + (q / w) as f64 * step);
+                let want = slope(wave, x, y);
+                let got = g.map(f64::from);
+                assert!((got[0] - want[0]).abs() < tol && (got[1] - want[1]).abs() < tol, "band {band} node {q}");
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 100);
+    // At a detail node near the focus: a fine footprint adds both bands' slopes; 0.5 m (a top view's pixel)
+    // only the 3 m wave's, the 1.5 m wave as roughness; 1 m neither, both as roughness.
+    let (x, y) = (3.5f64, 7.0f64); // a detail node: the tiles' corners are multiples of 32 m
+    let n0 = plain.shading(x as f32, y as f32, 0.0).unwrap_or_else(|| unreachable!("sampled"));
+    let gs = |n: [f32; 3], a: usize| -f64::from(n[a] / n[2]);
+    let (a, b) = (slope(&sea[0], x, y), slope(&sea[2], x, y));
+    for (footprint, wa, wb, mss) in [(0.1f32, 1.0, 1.0, 0.0), (0.5, 1.0, 0.0, m3), (1.0, 0.0, 0.0, m1 + m3)] {
+        let sh = s.shading(x as f32, y as f32, footprint).unwrap_or_else(|| unreachable!("sampled"));
+        for ax in 0..2 {
+            let want = gs(n0.normal, ax) + wa * a[ax] + wb * b[ax];
+            assert!((gs(sh.normal, ax) - want).abs() < 2e-3, "footprint {footprint} axis {ax}");
+        }
+        assert!((f64::from(sh.unresolved_mss) - mss).abs() < 1e-7, "footprint {footprint}: {}", sh.unresolved_mss);
+    }
+}
+
+/// Brute force: march the ray in tiny steps against [`WaveSurface::height`] (the same triangulated surface,
+/// read point by point) and bisect the first sign change.
+fn brute(s: &WaveSurface, o: [f32; 3], d: [f32; 3], t_max: f32, step: f32) -> Option<f32> {
+    let f = |t: f32| o[2] + d[2] * t - s.height(o[0] + d[0] * t, o[1] + d[1] * t);
+    let mut t = 0.0;
+    let mut fa = f(0.0);
+    while t < t_max {
+        let tb = (t + step).min(t_max);
+        let fb = f(tb);
+        if (fa > 0.0) != (fb > 0.0) {
+            let (mut lo, mut hi) = (t, tb);
+            for _ in 0..40 {
+                let m = 0.5 * (lo + hi);
+                if (f(m) > 0.0) == (fa > 0.0) {
+                    lo = m
+                } else {
+                    hi = m
+                }
+            }
+            return Some(0.5 * (lo + hi));
+        }
+        t = tb;
+        fa = fb;
+    }
+    None
+}
+
+/// The tiles of a real wave field against the field's own row-recurrence grid over each tile.
+#[test]
+fn field_tiles_match_the_fields_own_grids() {
+    use crate::ocean::{SeaSpec, WaveField};
+    let spec = SeaSpec { hs: 3.5, tp: 9.0, gamma: 3.3, direction_rad: 0.7, spread_s: 8.0 };
+    let f = WaveField::new(&spec, 77).unwrap_or_else(|e| unreachable!("{e}"));
+    let foci = [[-1234.5f32, 877.25]];
+    let spec = SurfaceSpec { radius_m: 500.0, taper_m: 0.0, ..SurfaceSpec::default() };
+    let s = WaveSurface::new(f.components(), 41.3, 0.0, &foci, spec);
+    let mut levels = [0usize; 6];
+    for (k, tile) in s.tiles.iter().enumerate() {
+        if tile.n == 0 {
+            continue;
+        }
+        levels[(TILE_CELLS / tile.n).trailing_zeros() as usize] += 1;
+        let (ix, iy) = (k % s.ntx, k / s.ntx);
+        let (x0, y0) = (f64::from(s.x0 + ix as f32 * s.tile_m), f64::from(s.y0 + iy as f32 * s.tile_m));
+        let w = tile.n + 1;
+        let dx = f64::from(s.tile_m) / tile.n as f64;
+        let (h, gx, gy) = f.elevation_slope_grid(x0, y0, dx, w, w, 41.3).unwrap_or_else(|e| unreachable!("{e}"));
+        for q in 0..w * w {
+            let (xq, yq) = (x0 + (q % w) as f64 * dx, y0 + (q / w) as f64 * dx);
+            if nearest(&foci, xq as f32, yq as f32) >= spec.radius_m {
+                continue; // still water beyond the radius
+            }
+            assert!((tile.h[q] - h[q]).abs() < 1e-4, "tile {k} node {q}: {} vs {}", tile.h[q], h[q]);
+            // The tile's slopes leave out the waves its cells cannot resolve: add theirs back, point by point.
+            let (mut ux, mut uy) = (0.0f64, 0.0f64);
+            for w in f.components().iter().filter(|w| !resolved(w.k_rad_m, dx as f32)) {
+                let sn = w.phase_at(xq, yq, 41.3).sin();
+                ux -= w.amplitude_m * w.kx * sn;
+                uy -= w.amplitude_m * w.ky * sn;
+            }
+            let (ax, ay) = (f64::from(tile.g[q][0]) + ux, f64::from(tile.g[q][1]) + uy);
+            assert!((ax - f64::from(gx[q])).abs() < 2e-4 && (ay - f64::from(gy[q])).abs() < 2e-4, "tile {k} {q}");
+        }
+    }
+    assert!(levels[..5].iter().all(|&c| c > 0), "every level sampled: {levels:?}");
+}
+
+#[test]
+fn intersect_matches_a_dense_march_of_the_surface() {
+    let c = test_sea();
+    let spec = SurfaceSpec { radius_m: 300.0, taper_m: 60.0, ..SurfaceSpec::default() };
+    let s = surface(&c, 3.0, &[[0.0, 0.0], [90.0, 40.0]], spec);
+    let mut state = 11u64;
+    let mut rand = |lo: f32, hi: f32| {
+        state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+        lo + (hi - lo) * ((state >> 40) as f32 / (1u64 << 24) as f32)
+    };
+    let (mut hits, mut grazing, mut agree) = (0, 0, 0);
+    let n = 1500;
+    for i in 0..n {
+        let o = [rand(-60.0, 60.0), rand(-60.0, 60.0), rand(1.0, 6.0)];
+        // Mostly grazing rays (crests occlude), some steep, some up.
+        let el = if i % 10 == 0 { rand(0.0, 0.3) } else { -rand(0.002, if i % 3 == 0 { 1.2 } else { 0.08 }) };
+        let az = rand(0.0, std::f32::consts::TAU);
+        let d = [el.cos() * az.cos(), el.cos() * az.sin(), el.sin()];
+        let t_max = 400.0;
+        let fast = s.intersect(o, d, t_max).map(|h| h.t);
+        let slow = brute(&s, o, d, t_max, 0.01);
+        match (fast, slow) {
+            (Some(a), Some(b)) => {
+                assert!((a - b).abs() < 0.02 + 1e-4 * b, "ray {i}: {a} vs brute {b} ({o:?} {d:?})");
+                hits += 1;
+                grazing += usize::from(d[2] > -0.08);
+                agree += 1;
+            }
+            (None, None) => agree += 1,
+            // A crossing thinner than the brute force's step can be missed by it, never by the march.
+            (Some(a), None) => {
+                let h = s.height(o[0] + d[0] * a, o[1] + d[1] * a);
+                assert!((o[2] + d[2] * a - h).abs() < 1e-3, "ray {i}: a hit at {a} off the surface");
+            }
+            (None, Some(b)) => panic!("ray {i}: brute force hits at {b}, the march misses ({o:?} {d:?})"),
+        }
+    }
+    assert!(agree > n * 99 / 100, "{agree} of {n} agree");
+    assert!(hits > 1000 && grazing > 500, "{hits} hits, {grazing} grazing");
+}
+
+#[test]
+fn crests_hide_what_lies_behind_them() {
+    // One long-crested swell along x, 1 m amplitude, 60 m long (crests at x = 0, 60, 120 m): from 1.2 m
+    // above the still level looking along x at a point 0.3 m above it 150 m away, the crest at 60 m hides it.
+    let k = std::f64::consts::TAU / 60.0;
+    let s = surface(&[comp(1.0, k, 0.0, 0.0, 0.0)], 0.0, &[[0.0, 0.0]], SurfaceSpec::default());
+    let o = [0.0, 0.0, 1.2];
+    let target = [150.0f32, 0.0, 0.3];
+    let dv = [target[0] - o[0], target[1] - o[1], target[2] - o[2]];
+    let len = (dv[0] * dv[0] + dv[2] * dv[2]).sqrt();
+    let d = [dv[0] / len, 0.0, dv[2] / len];
+    let Some(h) = s.intersect(o, d, len) else { panic!("the crest at x = 60 m hides the target") };
+    let x = o[0] + d[0] * h.t;
+    assert!((45.0..=60.0).contains(&x), "hit at x = {x}");
+    // A ray above every crest meets nothing, whatever its length.
+    assert!(s.intersect([0.0, 0.0, 1.2], [1.0, 0.0, 0.0], 1e6).is_none());
+    // The flat beyond the radius: a ray down far away meets the still level.
+    let Some(far) = s.intersect([5000.0, 0.0, 10.0], [0.0, 0.0, -1.0], 100.0) else { panic!("still water") };
+    assert!((far.t - 10.0).abs() < 1e-4 && far.piece == FLAT_PIECE);
+}
+
+#[test]
+fn normals_face_up_and_follow_the_slope() {
+    let k = std::f64::consts::TAU / 40.0;
+    let s = surface(&[comp(0.8, k, 0.0, 0.0, 0.0)], 0.0, &[[0.0, 0.0]], SurfaceSpec::default());
+    // At x = 10 m (a quarter wave) the slope is −a k: the normal leans towards +x.
+    let n = s.shading_normal(10.0, 3.0).unwrap_or_default();
+    let want = (0.8 * k) as f32;
+    assert!((n[0] / n[2] - want).abs() < 1e-3, "{n:?}");
+    let Some(h) = s.intersect([10.0, 3.0, 5.0], [0.0, 0.0, -1.0], 10.0) else { panic!("a ray straight down") };
+    let g = s.piece_normal(h.piece);
+    assert!(g[2] > 0.0 && (g[0] / g[2] - want).abs() < 0.01, "{g:?}");
+}
