@@ -26,6 +26,17 @@ impl Scene {
         self.cast_rays_over(origins, dirs, max_range, None)
     }
 
+    /// [`Scene::cast_rays`] for sensors to which the water is no target (a radar, whose sea echo is clutter drawn
+    /// per cell): each ray's closest hit on anything but the sea, where the sea does not stop the ray first; a ray
+    /// that meets the sea first, or nothing, is a miss. The same as [`Scene::cast_rays`] with its hits on the sea
+    /// turned into misses (to a tie between the two distances), but over a wave surface the surface is only asked
+    /// whether it stops a ray before the thing it hit, not where it meets every ray: a ray that hits nothing else
+    /// (most of a radar's, over open water) is never marched through the waves, and a descending ray from above
+    /// the crests is walked through the tree only down to the lowest trough.
+    pub fn cast_rays_to_targets(&self, origins: &[[f32; 3]], dirs: &[[f32; 3]], max_range: f32) -> Result<RayHits> {
+        self.cast(origins, dirs, max_range, None, true)
+    }
+
     /// [`Scene::cast_rays`] with each ray's wave-surface hit already known where `water` says so (one entry per
     /// ray, from [`crate::sea::Raster::resolve`] with the same `max_range`; [`WaterHit::Unknown`] marches): the
     /// same hits, without marching the known rays through the waves. Ignored without a wave surface.
@@ -35,6 +46,18 @@ impl Scene {
         dirs: &[[f32; 3]],
         max_range: f32,
         water: Option<&[WaterHit]>,
+    ) -> Result<RayHits> {
+        self.cast(origins, dirs, max_range, water, false)
+    }
+
+    /// [`Scene::cast_rays_over`], or with `targets` [`Scene::cast_rays_to_targets`].
+    fn cast(
+        &self,
+        origins: &[[f32; 3]],
+        dirs: &[[f32; 3]],
+        max_range: f32,
+        water: Option<&[WaterHit]>,
+        targets: bool,
     ) -> Result<RayHits> {
         check_batch(origins, dirs, max_range)?;
         if water.is_some_and(|w| w.len() != origins.len()) {
@@ -68,7 +91,7 @@ impl Scene {
             .map(|(k, (dist, inst, tri, nrm, cls, back, o, d))| {
                 let out = ChunkOut { dist, inst, tri, nrm, cls, back };
                 let water = water.map(|w| &w[k * CHUNK..(k * CHUNK + o.len())]);
-                BadRays::offset(trace_chunk(self, o, d, limit, horizon, water, out), k * CHUNK)
+                BadRays::offset(trace_chunk(self, o, d, (limit, targets), horizon, water, out), k * CHUNK)
             })
             .reduce(BadRays::default, BadRays::min);
         bad.check(origins, dirs)?;
@@ -140,9 +163,12 @@ impl ChunkOut<'_> {
         self.tri[i] = NO_HIT;
     }
 
-    /// Ray `i` (unit direction `dir`) hit `hit`.
+    /// Ray `i` (unit direction `dir`) hit `hit`; with `targets`, a hit on the sea is left a miss.
     #[inline(always)]
-    fn hit(&mut self, scene: &Scene, i: usize, dir: Vec3, hit: &Hit) {
+    fn hit(&mut self, scene: &Scene, i: usize, dir: Vec3, hit: &Hit, targets: bool) {
+        if targets && scene.sea.as_ref().is_some_and(|s| s.instance == hit.instance) {
+            return;
+        }
         let (n, c) = scene.hit_normal_class(hit);
         self.dist[i] = hit.distance;
         self.inst[i] = hit.instance as i32;
@@ -167,16 +193,18 @@ fn coherent(rays: &[RayPrep]) -> bool {
 
 crate::dispatch! {
     /// Traces one chunk of rays (normalising each direction) and stores the hits: coherent groups of
-    /// [`PACKET`] consecutive rays as packets, the others one by one; both give each ray the same hit.
+    /// [`PACKET`] consecutive rays as packets, the others one by one; both give each ray the same hit. With
+    /// `targets`, the hits of [`Scene::cast_rays_to_targets`].
     fn trace_chunk[lv](
         scene: &Scene,
         o: &[[f32; 3]],
         d: &[[f32; 3]],
-        limit: f32,
+        limit_targets: (f32, bool),
         horizon: Option<&Horizon>,
         water: Option<&[WaterHit]>,
         out: ChunkOut<'_>,
     ) -> BadRays {
+        let (limit, targets) = limit_targets;
         let mut scratch = Scratch::default();
         let mut packet = Packet::default();
         let mut bad = BadRays::default();
@@ -199,7 +227,7 @@ crate::dispatch! {
             }
             if !any_sky {
                 // Nothing for the sea shortcut: trace the rays in place.
-                trace_rest(lv, scene, rays, |j| start + j, (limit, water), &mut scratch, &mut packet, &mut out);
+                trace_rest(lv, scene, rays, |j| start + j, (limit, water, targets), &mut scratch, &mut packet, &mut out);
                 continue;
             }
             // Rays the sea shortcut settles are misses; the others are traced (as a packet when coherent).
@@ -214,14 +242,14 @@ crate::dispatch! {
                 }
             }
             let at = |j: usize| start + lane[j];
-            trace_rest(lv, scene, &rest[..n], at, (limit, water), &mut scratch, &mut packet, &mut out);
+            trace_rest(lv, scene, &rest[..n], at, (limit, water, targets), &mut scratch, &mut packet, &mut out);
         }
         bad
     }
 }
 
 /// Traces `rays` fully (as one packet when coherent, else one by one) and stores each hit at chunk index
-/// `at(j)` for ray `j`.
+/// `at(j)` for ray `j`; with `targets`, the hits of [`Scene::cast_rays_to_targets`].
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn trace_rest<L: Level>(
@@ -229,11 +257,14 @@ fn trace_rest<L: Level>(
     scene: &Scene,
     rays: &[RayPrep],
     at: impl Fn(usize) -> usize,
-    (limit, water): (f32, Option<&[WaterHit]>),
+    (limit, water, targets): (f32, Option<&[WaterHit]>, bool),
     scratch: &mut Scratch,
     p: &mut Packet,
     out: &mut ChunkOut<'_>,
 ) {
+    if targets && scene.waves.is_some() {
+        return trace_targets(lv, scene, rays, at, limit, scratch, p, out);
+    }
     // The rays' wave-surface hits where the raster knows them, else marched.
     let known = |j: usize| water.map_or(WaterHit::Unknown, |w| w[at(j)]);
     if coherent(rays) && p.fill(rays, limit) {
@@ -242,7 +273,7 @@ fn trace_rest<L: Level>(
         for (j, ray) in rays.iter().enumerate() {
             if inst[j] != u32::MAX {
                 let hit = Hit { distance: p.best[j], instance: inst[j], triangle: tri[j] };
-                out.hit(scene, at(j), Vec3::from_array(ray.d), &hit);
+                out.hit(scene, at(j), Vec3::from_array(ray.d), &hit, targets);
             }
         }
     } else {
@@ -250,7 +281,57 @@ fn trace_rest<L: Level>(
             let water = scene.known_wave_hit(ray, known(j), limit);
             let hit = scene.cast_prepared_over(lv, ray, water, limit, scratch);
             if let Some(hit) = hit {
-                out.hit(scene, at(j), Vec3::from_array(ray.d), &hit);
+                out.hit(scene, at(j), Vec3::from_array(ray.d), &hit, targets);
+            }
+        }
+    }
+}
+
+/// [`trace_rest`] of [`Scene::cast_rays_to_targets`] over a wave surface: each ray's closest hit among the
+/// instances (the sea's stands aside for the surface), kept unless the surface stops the ray before it. A ray that
+/// descends from above the crests crosses the surface before it sinks below the lowest trough, so its walk ends
+/// there (with a margin against rounding: what lies beyond is behind the water either way, and anything found
+/// short of it is checked against the surface).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn trace_targets<L: Level>(
+    lv: L,
+    scene: &Scene,
+    rays: &[RayPrep],
+    at: impl Fn(usize) -> usize,
+    limit: f32,
+    scratch: &mut Scratch,
+    p: &mut Packet,
+    out: &mut ChunkOut<'_>,
+) {
+    let Some(w) = scene.waves.as_deref() else { return };
+    let (zmin, zmax) = (w.zmin(), w.zmax());
+    let reach = |ray: &RayPrep| {
+        if ray.d[2] < 0.0 && ray.o[2] > zmax {
+            let t = (zmin - ray.o[2]) / ray.d[2];
+            limit.min(t + 1e-3 * (1.0 + t))
+        } else {
+            limit
+        }
+    };
+    // The water stops ray `j` before `t`: then it has no target.
+    let water_first = |ray: &RayPrep, t: f32| scene.wave_hit(ray, t).is_some();
+    if coherent(rays) && p.fill(rays, limit) {
+        for (j, ray) in rays.iter().enumerate() {
+            p.best[j] = reach(ray);
+        }
+        let (inst, tri) = scene.cast_packet_over(lv, p, None, scratch);
+        for (j, ray) in rays.iter().enumerate() {
+            if inst[j] != u32::MAX && !water_first(ray, p.best[j]) {
+                let hit = Hit { distance: p.best[j], instance: inst[j], triangle: tri[j] };
+                out.hit(scene, at(j), Vec3::from_array(ray.d), &hit, true);
+            }
+        }
+    } else {
+        for (j, ray) in rays.iter().enumerate() {
+            let hit = scene.cast_prepared_over(lv, ray, None, reach(ray), scratch);
+            if let Some(hit) = hit.filter(|h| !water_first(ray, h.distance)) {
+                out.hit(scene, at(j), Vec3::from_array(ray.d), &hit, true);
             }
         }
     }

@@ -509,6 +509,81 @@ fn wave_surface_batches_give_exactly_the_ray_by_ray_reference() {
     assert!(s.set_wave_surface(Some(w)).is_err());
 }
 
+/// [`Scene::cast_rays_to_targets`] gives [`Scene::cast_rays`]'s hits with those on the sea turned into misses, bit
+/// for bit, over the waves (the surface asked only whether it stops a ray first) and over the flat sea: rays of
+/// every kind, grazing rays among the crests, and a radar-like fan from one point (with its horizon); some
+/// rays must meet a target, and some a target the crests hide.
+#[test]
+fn target_casts_are_the_closest_hits_with_the_sea_left_out() {
+    use crate::sea::{SurfaceSpec, WaveSurface};
+    let (mut s, vessels) = sea_world();
+    let mut rng = ChaCha8Rng::seed_from_u64(34);
+    scatter(&mut s, &vessels, &mut rng, [0.3, 0.02, -0.03]);
+    s.set_sea(1, &vessels).unwrap_or_else(|e| unreachable!("{e}"));
+    let (mut o, mut d) = sensor_rays(&mut rng, 8_000);
+    for k in 0..4000 {
+        let az: f32 = rng.random_range(0.0..std::f32::consts::TAU);
+        let el: f32 = rng.random_range(-0.08..0.03);
+        o.push([rng.random_range(-200.0..200.0), rng.random_range(-200.0..200.0), 1.7 + 0.001 * k as f32]);
+        d.push([az.cos() * el.cos(), az.sin() * el.cos(), el.sin()]);
+    }
+    // A radar's fan: one origin 6 m up, every azimuth, elevations crowded about the horizon.
+    for k in 0..8192u32 {
+        let az = std::f32::consts::TAU * k as f32 / 8192.0;
+        let el = -0.17 + 0.2 * (((k * 37) % 64) as f32 / 64.0).powi(2);
+        o.push([10.0, -15.0, 6.0]);
+        d.push([az.cos() * el.cos(), az.sin() * el.cos(), el.sin()]);
+    }
+    let limit = 3000.0;
+    let amp = |c: &mut crate::ocean::WaveComponent| c.amplitude_m *= 4.0;
+    let mut components = wave_components();
+    components.iter_mut().for_each(amp);
+    for waves in [true, false] {
+        if waves {
+            let spec = SurfaceSpec { radius_m: 400.0, taper_m: 80.0, ..SurfaceSpec::default() };
+            let surface = WaveSurface::new(&components, 7.0, 0.0, &[[0.0, 0.0], [120.0, -80.0]], spec);
+            s.set_wave_surface(Some(surface)).unwrap_or_else(|e| unreachable!("{e}"));
+        } else {
+            s.set_wave_surface(None).unwrap_or_else(|e| unreachable!("{e}"));
+        }
+        let all = s.cast_rays(&o, &d, limit).unwrap_or_default();
+        let targets = s.cast_rays_to_targets(&o, &d, limit).unwrap_or_default();
+        let (mut seen, mut sea) = (0, 0);
+        for i in 0..o.len() {
+            if all.instance[i] == 1 {
+                sea += 1;
+                assert_eq!(
+                    (targets.instance[i], targets.distance[i]),
+                    (NO_HIT, f32::INFINITY),
+                    "ray {i} (waves {waves})"
+                );
+                continue;
+            }
+            seen += usize::from(all.instance[i] != NO_HIT);
+            let at = |h: &RayHits| {
+                (
+                    h.distance[i],
+                    h.instance[i],
+                    h.triangle[i],
+                    h.class[i],
+                    h.backface[i],
+                    h.normal[3 * i..3 * i + 3].to_vec(),
+                )
+            };
+            assert_eq!(at(&targets), at(&all), "ray {i} (waves {waves}): {:?} {:?}", o[i], d[i]);
+        }
+        assert!(seen > 1000 && sea > 5000, "waves {waves}: {seen} rays on targets, {sea} on the sea");
+    }
+    // Targets the crests hide: rays whose target the flat sea would leave in view.
+    let spec = SurfaceSpec { radius_m: 400.0, taper_m: 80.0, ..SurfaceSpec::default() };
+    let flat = s.cast_rays_to_targets(&o, &d, limit).unwrap_or_default();
+    s.set_wave_surface(Some(WaveSurface::new(&components, 7.0, 0.0, &[[0.0, 0.0], [120.0, -80.0]], spec)))
+        .unwrap_or_else(|e| unreachable!("{e}"));
+    let wavy = s.cast_rays_to_targets(&o, &d, limit).unwrap_or_default();
+    let hidden = (0..o.len()).filter(|&i| flat.instance[i] > 1 && wavy.instance[i] == NO_HIT).count();
+    assert!(hidden > 50, "only {hidden} targets hidden by the crests");
+}
+
 /// A pinhole camera over the waves rasterises its water hits ([`crate::sea::WaveSurface::first_hits`]): its depth
 /// and instances are those of the same pixel rays cast ray by ray (marched through the waves), vessels in front
 /// of the water included.

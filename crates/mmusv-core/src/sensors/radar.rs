@@ -107,7 +107,8 @@ pub fn radar_sweep(
     // Ray directions (world) and per-ray (elevation, fan-height weight), both in trace order.
     let (dirs, meta) = pattern::sweep_rays(cfg, sensor_to_world);
     let origins = vec![sensor_to_world.translation.to_array(); dirs.len()];
-    let hits = scene.cast_rays(&origins, &dirs, cfg.range_max_m as f32)?;
+    // Water is no target (its echo is the clutter drawn per cell): the surface is only asked whether it stops a ray.
+    let hits = scene.cast_rays_to_targets(&origins, &dirs, cfg.range_max_m as f32)?;
     drop(origins);
 
     let (first, end) = cfg.range_bins();
