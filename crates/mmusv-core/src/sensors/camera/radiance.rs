@@ -4,7 +4,8 @@
 //! Every stage is one batch over the scene (parallel, coherent packets in the order given), so a camera's
 //! pixels, its anti-aliasing samples and any other ray set go through the same code. Hits are turned into
 //! [`SurfaceHit`]s on the fly in each pass rather than stored (a stored hit per pixel costs more in memory
-//! traffic than recomputing it).
+//! traffic than recomputing it), except those of the water rays whose reflections are traced: their shading
+//! normals sample the wave surface, which costs more than keeping them (−3 % of `port_entry`'s camera CPU).
 
 use crate::error::Result;
 use crate::scene::{RayHits, Scene};
@@ -270,6 +271,9 @@ pub fn radiance(
     // `index[k]` is ray k's own traced reflection in `values`, `u32::MAX` where it has none.
     let mut values: Vec<Vec3> = Vec::new();
     let mut index: Vec<u32> = Vec::new();
+    // The surfaces of the rays whose reflections are traced, kept in `values`' order for their own shading (a
+    // water hit's shading normal samples the waves: worked out once, not again in the final pass).
+    let mut traced_hits: Vec<SurfaceHit> = Vec::new();
     // The ray whose reflection stands for ray k's: its block's corner where that is water too, else itself.
     let owner = |k: usize| match reflections {
         Reflections::Shared(grid) => {
@@ -292,16 +296,18 @@ pub fn radiance(
             })
             .map(|k| k as u32)
             .collect();
-        let rays: Vec<([f32; 3], [f32; 3])> = traced
+        traced_hits = traced
             .par_iter()
-            .map(|&k| {
-                let k = k as usize;
-                let h = surface(k).unwrap_or_else(|| unreachable!("ray {k} was a water hit"));
-                let (o, r) = shader.reflection_ray(Vec3::from_array(dirs[k]), &h);
+            .map(|&k| surface(k as usize).unwrap_or_else(|| unreachable!("ray {k} was a water hit")))
+            .collect();
+        let (ro, rd): (Vec<[f32; 3]>, Vec<[f32; 3]>) = traced
+            .par_iter()
+            .zip(&traced_hits)
+            .map(|(&k, h)| {
+                let (o, r) = shader.reflection_ray(Vec3::from_array(dirs[k as usize]), h);
                 (o.to_array(), r.to_array())
             })
-            .collect();
-        let (ro, rd): (Vec<[f32; 3]>, Vec<[f32; 3]>) = rays.into_iter().unzip();
+            .unzip();
         let rhits = scene.cast_rays(&ro, &rd, REFLECTION_RANGE)?;
         let rsurface = |j: usize| surface_at(shader, scene, &rhits, &ro, &rd, j).filter(|h| !h.is_water());
         let rlit = sunlit(scene, shader, shadows, (&rhits, &ro, &rd), |j| rhits.class[j] != 1)?;
@@ -341,10 +347,14 @@ pub fn radiance(
         }
         index.get(owner(k)).and_then(|&i| values.get(i as usize)).copied()
     };
+    // Ray k's surface: the one kept when its reflection was traced, else worked out.
+    let hit_of = |k: usize| match index.get(k).filter(|&&i| i != u32::MAX) {
+        Some(&i) => Some(traced_hits[i as usize]),
+        None => surface(k),
+    };
     let mut out = vec![Vec3::ZERO; n];
-    let rays = Rays { scene, hits, origins, dirs };
     out.par_chunks_mut(SHADE_CHUNK).enumerate().for_each(|(c, chunk)| {
-        shade_chunk(shader, &rays, (&lit, &reflected_of), (c * SHADE_CHUNK, &|k| !is_candidate(k)), chunk);
+        shade_chunk(shader, dirs, (&lit, &reflected_of), (c * SHADE_CHUNK, &|k| !is_candidate(k), &hit_of), chunk);
     });
     if let Some(grid) = shared {
         // The candidates: the anchors' mean where they look alike; the others (`redo`) need their own shading.
@@ -402,7 +412,7 @@ pub fn radiance(
             .map(|(&k, &lit)| {
                 let k = k as usize;
                 let refl = if is_water(k) { reflected_of(k) } else { None };
-                shader.shade(Vec3::from_array(dirs[k]), surface(k).as_ref(), lit, refl)
+                shader.shade(Vec3::from_array(dirs[k]), hit_of(k).as_ref(), lit, refl)
             })
             .collect();
         for (&k, c) in redo.iter().zip(shaded) {
@@ -412,43 +422,38 @@ pub fn radiance(
     Ok(out)
 }
 
+/// The surface a ray of the batch hit (`None`: a miss).
+type SurfaceOf<'a> = dyn Fn(usize) -> Option<SurfaceHit> + Sync + 'a;
+
 /// Rays shaded together per task of the final pass.
 const SHADE_CHUNK: usize = 4096;
 /// Least rays per task of the cheap per-ray passes (kinds, candidates, means).
 const PASS_CHUNK: usize = 4096;
 
-/// A batch of rays and their closest hits in a scene.
-struct Rays<'a> {
-    scene: &'a Scene,
-    hits: &'a RayHits,
-    origins: &'a [[f32; 3]],
-    dirs: &'a [[f32; 3]],
-}
-
 crate::dispatch! {
     /// Shades the rays `start..start + out.len()` that `which` accepts into `out` (the others are left as they
-    /// are), with their sun visibility `lit` and, for water, the reflected radiance `reflected_of(k)` (none:
-    /// the sky's).
+    /// are), with their surfaces `hit_of(k)`, sun visibility `lit` and, for water, the reflected radiance
+    /// `reflected_of(k)` (none: the sky's).
     fn shade_chunk(
         shader: &Shader,
-        rays: &Rays<'_>,
+        dirs: &[[f32; 3]],
         reflected: (&[bool], &(dyn Fn(usize) -> Option<Vec3> + Sync)),
-        range: (usize, &(dyn Fn(usize) -> bool + Sync)),
+        range: (usize, &(dyn Fn(usize) -> bool + Sync), &SurfaceOf<'_>),
         out: &mut [Vec3],
     ) {
         let (lit, reflected_of) = reflected;
-        let (start, which) = range;
+        let (start, which, hit_of) = range;
         for (j, c) in out.iter_mut().enumerate() {
             let k = start + j;
             if !which(k) {
                 continue;
             }
-            let h = surface_at(shader, rays.scene, rays.hits, rays.origins, rays.dirs, k);
+            let h = hit_of(k);
             let refl = match &h {
                 Some(h) if h.is_water() => reflected_of(k),
                 _ => None,
             };
-            *c = shader.shade(Vec3::from_array(rays.dirs[k]), h.as_ref(), lit[k], refl);
+            *c = shader.shade(Vec3::from_array(dirs[k]), h.as_ref(), lit[k], refl);
         }
     }
 }
