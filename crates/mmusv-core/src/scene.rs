@@ -27,6 +27,7 @@ use parry3d::math::Vec3;
 use std::sync::Arc;
 
 mod batch;
+pub use batch::KnownWater;
 mod sea_routes;
 mod visit;
 mod waves;

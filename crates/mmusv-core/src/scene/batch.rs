@@ -37,15 +37,16 @@ impl Scene {
         self.cast(origins, dirs, max_range, None, true)
     }
 
-    /// [`Scene::cast_rays`] with each ray's wave-surface hit already known where `water` says so (one entry per
-    /// ray, from [`crate::sea::Raster::resolve`] with the same `max_range`; [`WaterHit::Unknown`] marches): the
-    /// same hits, without marching the known rays through the waves. Ignored without a wave surface.
+    /// [`Scene::cast_rays`] with each ray's wave-surface hit already known where `water(k)` says so for ray `k`
+    /// (from [`crate::sea::Raster::resolve`] with the same `max_range`, asked as each ray is traced, so the
+    /// answers need no pass and no array of their own; [`WaterHit::Unknown`] marches): the same hits, without
+    /// marching the known rays through the waves. Ignored without a wave surface.
     pub fn cast_rays_over(
         &self,
         origins: &[[f32; 3]],
         dirs: &[[f32; 3]],
         max_range: f32,
-        water: Option<&[WaterHit]>,
+        water: Option<&KnownWater<'_>>,
     ) -> Result<RayHits> {
         self.cast(origins, dirs, max_range, water, false)
     }
@@ -56,20 +57,10 @@ impl Scene {
         origins: &[[f32; 3]],
         dirs: &[[f32; 3]],
         max_range: f32,
-        water: Option<&[WaterHit]>,
+        water: Option<&KnownWater<'_>>,
         targets: bool,
     ) -> Result<RayHits> {
         check_batch(origins, dirs, max_range)?;
-        if water.is_some_and(|w| w.len() != origins.len()) {
-            return Err(MmusvError::input(
-                "water",
-                format!(
-                    "{} known water hits for {} rays; give one per ray",
-                    water.map_or(0, <[_]>::len),
-                    origins.len()
-                ),
-            ));
-        }
         let water = water.filter(|_| self.waves.is_some());
         let mut out = RayHits::zeroed(origins.len());
         let limit = if max_range.is_finite() { max_range } else { f32::MAX };
@@ -90,7 +81,7 @@ impl Scene {
             .enumerate()
             .map(|(k, (dist, inst, tri, nrm, cls, back, o, d))| {
                 let out = ChunkOut { dist, inst, tri, nrm, cls, back };
-                let water = water.map(|w| &w[k * CHUNK..(k * CHUNK + o.len())]);
+                let water = water.map(|w| (w, k * CHUNK));
                 BadRays::offset(trace_chunk(self, o, d, (limit, targets), horizon, water, out), k * CHUNK)
             })
             .reduce(BadRays::default, BadRays::min);
@@ -131,6 +122,9 @@ impl Scene {
         Ok(out)
     }
 }
+
+/// The wave-surface hit of batch ray `k` where it is known ([`Scene::cast_rays_over`]).
+pub type KnownWater<'a> = dyn Fn(usize) -> WaterHit + Sync + 'a;
 
 /// Fewest rays from one point for which [`Scene::cast_rays`] builds that point's [`Horizon`] (about a millisecond).
 const HORIZON_MIN_RAYS: usize = 4096;
@@ -201,7 +195,7 @@ crate::dispatch! {
         d: &[[f32; 3]],
         limit_targets: (f32, bool),
         horizon: Option<&Horizon>,
-        water: Option<&[WaterHit]>,
+        water: Option<(&KnownWater<'_>, usize)>,
         out: ChunkOut<'_>,
     ) -> BadRays {
         let (limit, targets) = limit_targets;
@@ -257,7 +251,7 @@ fn trace_rest<L: Level>(
     scene: &Scene,
     rays: &[RayPrep],
     at: impl Fn(usize) -> usize,
-    (limit, water, targets): (f32, Option<&[WaterHit]>, bool),
+    (limit, water, targets): (f32, Option<(&KnownWater<'_>, usize)>, bool),
     scratch: &mut Scratch,
     p: &mut Packet,
     out: &mut ChunkOut<'_>,
@@ -266,7 +260,7 @@ fn trace_rest<L: Level>(
         return trace_targets(lv, scene, rays, at, limit, scratch, p, out);
     }
     // The rays' wave-surface hits where the raster knows them, else marched.
-    let known = |j: usize| water.map_or(WaterHit::Unknown, |w| w[at(j)]);
+    let known = |j: usize| water.map_or(WaterHit::Unknown, |(w, base)| w(base + at(j)));
     if coherent(rays) && p.fill(rays, limit) {
         let water = scene.known_wave_hits_packet(p, known);
         let (inst, tri) = scene.cast_packet_over(lv, p, water, scratch);

@@ -22,8 +22,8 @@ use super::shade::water::Wake;
 use super::shade::{ShadeEnv, Shader};
 use crate::error::{MmusvError, Result};
 use crate::geometry::RigidPose;
-use crate::scene::Scene;
-use crate::sea::{PinholeView, WaterHit};
+use crate::scene::{KnownWater, Scene};
+use crate::sea::{PinholeView, Raster, WaterHit, WaveSurface};
 use parry3d::math::Vec3;
 use rayon::prelude::*;
 
@@ -343,8 +343,14 @@ impl Camera {
         options: &RenderOptions<'_>,
     ) -> Result<CameraFrame> {
         let (origins, dirs) = self.traced_rays(pose);
-        let water = self.water_hits(scene, pose, &origins, &dirs);
-        let hits = scene.cast_rays_over(&origins, &dirs, self.cfg.range_max, water.as_deref())?;
+        let waves = scene.wave_surface();
+        let raster = waves.as_deref().and_then(|w| self.water_raster(w, pose));
+        let range = self.cfg.range_max;
+        let water = |k: usize| match &raster {
+            Some(r) => r.resolve(self.order[k] as usize, origins[k], dirs[k], range),
+            None => WaterHit::Unknown,
+        };
+        let hits = scene.cast_rays_over(&origins, &dirs, range, raster.as_ref().map(|_| &water as &KnownWater<'_>))?;
         let n = origins.len();
         let axis = pose.transform_vector(Vec3::X);
         let mut frame = CameraFrame {
@@ -439,21 +445,15 @@ impl Camera {
         Ok(frame)
     }
 
-    /// Every traced ray's first hit with the scene's wave surface, rasterised ([`crate::sea::WaveSurface::first_hits`]) instead
-    /// of marched ray by ray: for an undistorted pinhole camera over a wave surface, when its origin stands clear
-    /// above the water; `None` otherwise (the rays march).
-    fn water_hits(
-        &self,
-        scene: &Scene,
-        pose: &RigidPose,
-        origins: &[[f32; 3]],
-        dirs: &[[f32; 3]],
-    ) -> Option<Vec<WaterHit>> {
+    /// The scene's wave surface `waves` rasterised for this camera at `pose` ([`crate::sea::WaveSurface::first_hits`]),
+    /// so that its traced rays' first water hits are solved from it ([`crate::sea::Raster::resolve`]) instead of
+    /// marched ray by ray: for an undistorted pinhole camera whose origin stands clear above the water; `None`
+    /// otherwise (the rays march).
+    fn water_raster<'w>(&self, waves: &'w WaveSurface, pose: &RigidPose) -> Option<Raster<'w>> {
         let Projection::Pinhole { hfov } = self.cfg.projection else { return None };
         if self.cfg.image.distortion.is_some() {
             return None;
         }
-        let waves = scene.wave_surface()?;
         let axis = |v: Vec3| pose.transform_vector(v).to_array();
         let view = PinholeView {
             origin: pose.translation.to_array(),
@@ -464,13 +464,7 @@ impl Camera {
             height: self.cfg.height,
             focal: f64::from(self.cfg.width) / (2.0 * (hfov / 2.0).tan()),
         };
-        let raster = waves.first_hits(&view)?;
-        let range = self.cfg.range_max;
-        let mut out = vec![WaterHit::Unknown; origins.len()];
-        out.par_iter_mut().enumerate().for_each(|(k, w)| {
-            *w = raster.resolve(self.order[k] as usize, origins[k], dirs[k], range);
-        });
-        Some(out)
+        waves.first_hits(&view)
     }
 
     /// The traced rays as a pixel grid (what the shading shared between neighbouring pixels reads).
