@@ -52,7 +52,7 @@ pub fn backscatter(cos_theta: f32, u: f32) -> f32 {
     let c = cos_theta.clamp(1e-6, 1.0);
     let s2 = mean_square_slope(u);
     let tan2 = (1.0 - c * c) / (c * c);
-    let qs = FRESNEL_NORMAL * (-tan2 / s2).exp() / (4.0 * std::f32::consts::PI * s2 * c.powi(4));
+    let qs = FRESNEL_NORMAL * exp_or_zero(-tan2 / s2) / (4.0 * std::f32::consts::PI * s2 * c.powi(4));
     let wc = whitecap_fraction(u) * WHITECAP_REFLECTANCE * c / std::f32::consts::PI;
     qs + wc
 }
@@ -68,9 +68,21 @@ pub fn mean_intensity(cos_theta: f32, u: f32, r: f32, tau: f32) -> f32 {
 #[inline]
 pub fn detection_probability(mean: f32) -> f32 {
     if mean > 0.0 {
-        (-DETECTION_THRESHOLD / mean).exp()
+        exp_or_zero(-DETECTION_THRESHOLD / mean)
     } else {
         0.0
+    }
+}
+
+/// `x.exp()`, with the 0 it rounds to below −104 given at once: `expf` reaches that 0 through its underflow
+/// path (the error and the floating-point exception it raises), which grazing beams and far returns take every
+/// time. The same bits either way (the smallest subnormal `f32` is `e^−103.28`; `e^−104` rounds to 0).
+#[inline(always)]
+fn exp_or_zero(x: f32) -> f32 {
+    if x < -104.0 {
+        0.0
+    } else {
+        x.exp()
     }
 }
 
@@ -122,5 +134,18 @@ mod tests {
         assert!((p((80f32).to_radians().cos(), 8.4) - 0.2).abs() < 0.03, "{}", p((80f32).to_radians().cos(), 8.4));
         // Near normal incidence the glint dominates.
         assert!(p(0.999, 8.4) > 0.99);
+    }
+
+    /// The shortcut to 0 gives `exp`'s own bits everywhere: across the underflow and far below it.
+    #[test]
+    fn exp_or_zero_is_exp() {
+        let mut x = -200.0f32;
+        while x < 5.0 {
+            assert_eq!(exp_or_zero(x).to_bits(), x.exp().to_bits(), "x = {x}");
+            x += 0.013;
+        }
+        for x in [-104.0f32, -103.98, -103.97, -103.28, f32::MIN, -1e30] {
+            assert_eq!(exp_or_zero(x).to_bits(), x.exp().to_bits(), "x = {x}");
+        }
     }
 }
