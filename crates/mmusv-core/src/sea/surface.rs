@@ -77,9 +77,12 @@ struct Tile {
     /// Mean square slope `Σ a²k²/2` (both axes) of the components its slopes leave out (the detail bands'
     /// apart), tapered as the waves are.
     mss: f32,
-    /// With [`SurfaceSpec::detail`], on a finest-level tile: per detail band ([`DETAIL_BANDS`]), the slopes
-    /// `(∂η/∂x, ∂η/∂y)` of its waves at the `(DETAIL_CELLS + 1)²` nodes of the detail grid; empty otherwise.
-    detail: [Vec<[f32; 2]>; 2],
+    /// With [`SurfaceSpec::detail`], on a finest-level tile: at each of the `(DETAIL_CELLS + 1)²` nodes of the
+    /// detail grid, the slopes `(∂η/∂x, ∂η/∂y)` of band 0's waves then band 1's ([`DETAIL_BANDS`]; a band
+    /// without waves holds zeros and is not read), together so one lookup serves both; empty otherwise.
+    detail: Vec<[f32; 4]>,
+    /// Which detail bands hold waves.
+    bands: [bool; 2],
     /// The mean square slopes of the two detail bands' waves.
     band_mss: [f32; 2],
 }

@@ -161,7 +161,8 @@ impl<'a> Phasors<'a> {
         // The detail grid of a finest-level tile wholly inside the untapered sea: the slopes of the waves its
         // cells leave out, in two bands by the cell that resolves them ([`DETAIL_BANDS`]); what even the finest band
         // leaves out stays roughness.
-        let mut detail: [Vec<[f32; 2]>; 2] = [Vec::new(), Vec::new()];
+        let mut detail: Vec<[f32; 4]> = Vec::new();
+        let mut bands = [false; 2];
         let mut band_mss = [0f32; 2];
         if spec.detail && lvl == 0 && all_inner {
             let [a_m, b_m] = DETAIL_BANDS.map(|c| tile_m / c as f32);
@@ -181,7 +182,15 @@ impl<'a> Phasors<'a> {
                 if sub.is_empty() {
                     continue;
                 }
-                detail[b] = self.detail_slopes(ix, iy, &sub);
+                let slopes = self.detail_slopes(ix, iy, &sub);
+                if detail.is_empty() {
+                    detail = vec![[0.0; 4]; slopes.len()];
+                }
+                for (node, g) in detail.iter_mut().zip(&slopes) {
+                    node[2 * b] = g[0];
+                    node[2 * b + 1] = g[1];
+                }
+                bands[b] = true;
                 let m: f64 =
                     sub.iter().map(|&c| 0.5 * (self.comps[c].amplitude_m * self.comps[c].k_rad_m).powi(2)).sum();
                 band_mss[b] = m as f32;
@@ -191,7 +200,7 @@ impl<'a> Phasors<'a> {
         // The unresolved slopes taper with the waves: their share at the tile's centre.
         let centre_taper = ((spec.radius_m - dc) / (spec.radius_m - inner).max(1e-6)).clamp(0.0, 1.0);
         let mss = mss as f32 * centre_taper * centre_taper;
-        Tile { n, zmin, zmax, h, g, mss, detail, band_mss }
+        Tile { n, zmin, zmax, h, g, mss, detail, bands, band_mss }
     }
 
     /// The slopes `(∂η/∂x, ∂η/∂y)` of components `sub` alone at the `(DETAIL_CELLS + 1)²` nodes of tile

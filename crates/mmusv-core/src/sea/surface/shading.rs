@@ -73,14 +73,22 @@ impl WaveSurface {
         }
         let [mut gx, mut gy] = self.slope_at(&t.g, t.n, ix, iy, x, y);
         let mut mss = t.mss;
+        // The detail grid's cell and its four nodes, read once for both bands.
+        let mut nodes: Option<([f32; 2], [[f32; 4]; 4])> = None;
         for b in 0..2 {
-            if t.detail[b].is_empty() {
+            if !t.bands[b] {
                 continue;
             }
             let cell = self.tile_m / DETAIL_BANDS[b] as f32;
             let w = (2.0 - footprint_m / cell).clamp(0.0, 1.0);
             if w > 0.0 {
-                let [dx, dy] = self.slope_at(&t.detail[b], DETAIL_CELLS, ix, iy, x, y);
+                let (f, g) = *nodes.get_or_insert_with(|| {
+                    let ([ci, cj], f) = self.cell_at(DETAIL_CELLS, ix, iy, x, y);
+                    let at = |i: usize, j: usize| t.detail[j * (DETAIL_CELLS + 1) + i];
+                    (f, [at(ci, cj), at(ci + 1, cj), at(ci, cj + 1), at(ci + 1, cj + 1)])
+                });
+                let dx = bilinear([g[0][2 * b], g[1][2 * b], g[2][2 * b], g[3][2 * b]], f);
+                let dy = bilinear([g[0][2 * b + 1], g[1][2 * b + 1], g[2][2 * b + 1], g[3][2 * b + 1]], f);
                 gx += w * dx;
                 gy += w * dy;
             }
@@ -93,12 +101,16 @@ impl WaveSurface {
     /// `(x, y)`, bilinearly.
     #[inline]
     fn slope_at(&self, grid: &[[f32; 2]], n: usize, ix: usize, iy: usize, x: f32, y: f32) -> [f32; 2] {
-        let ([ci, cj], [fu, fv]) = self.cell_at(n, ix, iy, x, y);
+        let ([ci, cj], f) = self.cell_at(n, ix, iy, x, y);
         let w = n + 1;
         let g = |i: usize, j: usize| grid[j * w + i];
         let (g00, g10, g01, g11) = (g(ci, cj), g(ci + 1, cj), g(ci, cj + 1), g(ci + 1, cj + 1));
-        let mix =
-            |a: usize| (g00[a] * (1.0 - fu) + g10[a] * fu) * (1.0 - fv) + (g01[a] * (1.0 - fu) + g11[a] * fu) * fv;
-        [mix(0), mix(1)]
+        [0, 1].map(|a| bilinear([g00[a], g10[a], g01[a], g11[a]], f))
     }
+}
+
+/// The bilinear mix of a cell's corner values `[v00, v10, v01, v11]` at local `(fu, fv)`.
+#[inline(always)]
+fn bilinear([v00, v10, v01, v11]: [f32; 4], [fu, fv]: [f32; 2]) -> f32 {
+    (v00 * (1.0 - fu) + v10 * fu) * (1.0 - fv) + (v01 * (1.0 - fu) + v11 * fu) * fv
 }
