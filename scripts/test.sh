@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Installs everything the tests need on a fresh machine and runs them all:
 # rustfmt, Rust unit tests (mmusv-core alone, no Python), benches compile check, the Python package with its test
-# extras, clippy, ruff, the type-stub check, mypy and pytest (warnings are errors). Exits non-zero on any failure
-# (pytest's "no tests" included).
+# extras, clippy, the core's API docs, ruff, the type-stub check, mypy and pytest (warnings are errors). Exits
+# non-zero on any failure (pytest's "no tests" included).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -46,6 +46,9 @@ python3 -m pip install --quiet --disable-pip-version-check -e ".[test,learn]"
 
 echo "== cargo clippy, warnings are errors (release: reuses the build scripts and proc macros built above)"
 cargo clippy -p mmusv-core -p mmusv-benches -p mmusv-py --release --all-targets --quiet -- -D warnings
+
+echo "== cargo doc (mmusv-core's API docs: no broken or private intra-doc links, warnings are errors)"
+RUSTDOCFLAGS="-D warnings" cargo doc -p mmusv-core --no-deps --quiet
 
 echo "== ruff: lint and format check of the Python sources"
 python3 -m ruff check python tests benches

@@ -204,7 +204,7 @@ impl Sea {
     }
 
     /// The [`Horizon`] of viewpoint `origin` over the static geometry and the moving instances' boxes, with the
-    /// moving instances whose boxes stand over it (the caller adds their triangles: [`Horizon::add_triangle`]).
+    /// moving instances whose boxes stand over it (the caller adds their triangles: `Horizon::add_triangle`).
     /// `None` when `origin` is not above the surface or a moving box lies outside the grid.
     #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > b)` on purpose: a NaN must answer "no"
     pub fn horizon(&self, origin: [f32; 3]) -> Option<(Horizon, Vec<u32>)> {

@@ -3,9 +3,9 @@
 //! Hot loops are written once as `#[inline(always)]` generic code over plain arrays. Two macros compile them
 //! for each instruction-set level:
 //!
-//! * [`dispatch!`] defines an entry point: its body is compiled twice, once inside a function with
+//! * `dispatch!` defines an entry point: its body is compiled twice, once inside a function with
 //!   `#[target_feature(enable = "avx2,fma")]` and once for the baseline, and one is picked at run time.
-//! * [`kernel!`] defines a kernel called from inside such bodies (a mesh's BVH walk, say): one out-of-line copy
+//! * `kernel!` defines a kernel called from inside such bodies (a mesh's BVH walk, say): one out-of-line copy
 //!   per level, chosen at compile time by the caller's [`Level`] token. Kernels keep every caller's code small —
 //!   a walk inlined into each of its call sites is compiled (and cached) once per site — without giving up the
 //!   caller's level.

@@ -227,7 +227,7 @@ impl Fleet {
     }
 
     /// The same fleet moved physically by `sea`: heave, roll and pitch from each hull's RAOs
-    /// ([`crate::ocean::response`]) instead of the paper's perturbation.
+    /// ([`crate::ocean::response`](mod@crate::ocean::response)) instead of the paper's perturbation.
     pub fn with_sea(mut self, sea: Arc<WaveField>) -> Self {
         self.sea = Some(sea);
         self

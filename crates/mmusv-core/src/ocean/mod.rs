@@ -4,7 +4,7 @@
 //! - [`field`]: [`WaveField`], a seeded sum of linear deep-water waves realising a [`SeaSpec`]: elevation, slope
 //!   and orbital velocity anywhere, at any time, and a hard crest bound.
 //! - [`presets`]: WMO sea state codes 0–9 and the paper's W0–W3 as (Hs, Tp, γ, wind), fully developed seas.
-//! - [`response`]: [`Hull`] particulars and closed-form RAOs (Jensen, Mansour & Olsen 2004 heave and pitch, a
+//! - [`response`](mod@response): [`Hull`] particulars and closed-form RAOs (Jensen, Mansour & Olsen 2004 heave and pitch, a
 //!   1-DOF roll oscillator), hull responses in the field, and their spectral prediction.
 //!
 //! Conventions: metres, seconds, radians; world frame x east, y north, z up, mean water level z = 0; wave

@@ -2,7 +2,7 @@
 //! numbers, metadata and attachments, and the rename into place on [`Recorder::finish`].
 //!
 //! Deterministic: no wall clock is read; log and publish times are the simulation times the caller gives;
-//! zstd runs single-threaded with a fixed level ([`ZSTD_LEVEL`]), so the same calls give the same bytes.
+//! zstd runs single-threaded with a fixed level (`ZSTD_LEVEL`), so the same calls give the same bytes.
 
 use crate::error::{MmusvError, Result};
 use foxglove::Encode;

@@ -50,7 +50,7 @@ pub struct SurfaceSpec {
     /// Width of that taper, metres.
     pub taper_m: f32,
     /// Whether the finest-level tiles also carry the slopes of the waves shorter than four of their cells on a
-    /// grid of a quarter of their cell, in two bands ([`DETAIL_BANDS`]), for shading only: cameras near the foci
+    /// grid of a quarter of their cell, in two bands (`DETAIL_BANDS`), for shading only: cameras near the foci
     /// see waves down to one cell long as normals rather than roughness. The geometry, and so every hit, is the same either way; the
     /// sampling costs more (the scene sets it only when cameras render).
     pub detail: bool,

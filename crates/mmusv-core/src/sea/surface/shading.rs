@@ -54,7 +54,7 @@ impl WaveSurface {
     /// The water's shading at world `(x, y)` seen with a pixel footprint of `footprint_m` metres on the water
     /// ([`SurfaceShading`]); `None` over still water.
     ///
-    /// Model: a wave shorter than four cells of the tile's level ([`resolved`]) cannot be drawn from its nodes
+    /// Model: a wave shorter than four cells of the tile's level (`resolved`) cannot be drawn from its nodes
     /// (sampled there, it aliases into a false pattern of longer slopes, and the level's edge shows as a change
     /// of texture), so its slopes are treated statistically, as filtered normal maps treat detail finer than a
     /// texel: M. Olano & D. Baker, "LEAN Mapping", I3D 2010; M. Toksvig, "Mipmapping Normal Maps", J. Graphics
