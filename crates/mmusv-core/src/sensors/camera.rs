@@ -23,7 +23,7 @@ use super::shade::{ShadeEnv, Shader};
 use crate::error::{MmusvError, Result};
 use crate::geometry::RigidPose;
 use crate::scene::{KnownWater, Scene};
-use crate::sea::{PinholeView, Raster, WaterHit, WaveSurface};
+use crate::sea::{PinholeView, Raster, WaveSurface};
 use parry3d::math::Vec3;
 use rayon::prelude::*;
 
@@ -346,11 +346,9 @@ impl Camera {
         let waves = scene.wave_surface();
         let raster = waves.as_deref().and_then(|w| self.water_raster(w, pose));
         let range = self.cfg.range_max;
-        let water = |k: usize| match &raster {
-            Some(r) => r.resolve(self.order[k] as usize, origins[k], dirs[k], range),
-            None => WaterHit::Unknown,
-        };
-        let hits = scene.cast_rays_over(&origins, &dirs, range, raster.as_ref().map(|_| &water as &KnownWater<'_>))?;
+        let (o, d) = (&origins, &dirs);
+        let water = raster.as_ref().map(|r| move |k: usize| r.resolve(self.order[k] as usize, o[k], d[k], range));
+        let hits = scene.cast_rays_over(&origins, &dirs, range, water.as_ref().map(|w| w as &KnownWater<'_>))?;
         let n = origins.len();
         let axis = pose.transform_vector(Vec3::X);
         let mut frame = CameraFrame {
