@@ -183,6 +183,17 @@ fn sensor_rays(rng: &mut ChaCha8Rng, n: usize) -> (Vec<[f32; 3]>, Vec<[f32; 3]>)
     (o, d)
 }
 
+/// Appends 4,000 grazing rays from among the crests (1.7–5.7 m up, −0.08 to 0.03 rad), as a low USV's sensors
+/// cast them.
+fn grazing_rays(rng: &mut ChaCha8Rng, o: &mut Vec<[f32; 3]>, d: &mut Vec<[f32; 3]>) {
+    for k in 0..4000 {
+        let az: f32 = rng.random_range(0.0..std::f32::consts::TAU);
+        let el: f32 = rng.random_range(-0.08..0.03);
+        o.push([rng.random_range(-200.0..200.0), rng.random_range(-200.0..200.0), 1.7 + 0.001 * k as f32]);
+        d.push([az.cos() * el.cos(), az.sin() * el.cos(), el.sin()]);
+    }
+}
+
 /// Moves the vessels to random places within 200 m of the origin, random headings, at height, roll and pitch
 /// `[z, roll, pitch]`.
 fn scatter(s: &mut Scene, vessels: &[u32], rng: &mut ChaCha8Rng, [z, roll, pitch]: [f64; 3]) {
@@ -426,13 +437,7 @@ fn wave_surface_batches_give_exactly_the_ray_by_ray_reference() {
     let w = surface.clone();
     s.set_wave_surface(Some(surface)).unwrap_or_else(|e| unreachable!("{e}"));
     let (mut o, mut d) = sensor_rays(&mut rng, 12_000);
-    // Grazing rays from among the crests, as a low USV's sensors cast them.
-    for k in 0..4000 {
-        let az: f32 = rng.random_range(0.0..std::f32::consts::TAU);
-        let el: f32 = rng.random_range(-0.08..0.03);
-        o.push([rng.random_range(-200.0..200.0), rng.random_range(-200.0..200.0), 1.7 + 0.001 * k as f32]);
-        d.push([az.cos() * el.cos(), az.sin() * el.cos(), el.sin()]);
-    }
+    grazing_rays(&mut rng, &mut o, &mut d);
     let limit = 800.0;
     let fast = s.cast_rays(&o, &d, limit).unwrap_or_default();
     let mut water = 0;
@@ -521,12 +526,7 @@ fn target_casts_are_the_closest_hits_with_the_sea_left_out() {
     scatter(&mut s, &vessels, &mut rng, [0.3, 0.02, -0.03]);
     s.set_sea(1, &vessels).unwrap_or_else(|e| unreachable!("{e}"));
     let (mut o, mut d) = sensor_rays(&mut rng, 8_000);
-    for k in 0..4000 {
-        let az: f32 = rng.random_range(0.0..std::f32::consts::TAU);
-        let el: f32 = rng.random_range(-0.08..0.03);
-        o.push([rng.random_range(-200.0..200.0), rng.random_range(-200.0..200.0), 1.7 + 0.001 * k as f32]);
-        d.push([az.cos() * el.cos(), az.sin() * el.cos(), el.sin()]);
-    }
+    grazing_rays(&mut rng, &mut o, &mut d);
     // A radar's fan: one origin 6 m up, every azimuth, elevations crowded about the horizon.
     for k in 0..8192u32 {
         let az = std::f32::consts::TAU * k as f32 / 8192.0;
@@ -535,17 +535,14 @@ fn target_casts_are_the_closest_hits_with_the_sea_left_out() {
         d.push([az.cos() * el.cos(), az.sin() * el.cos(), el.sin()]);
     }
     let limit = 3000.0;
-    let amp = |c: &mut crate::ocean::WaveComponent| c.amplitude_m *= 4.0;
     let mut components = wave_components();
-    components.iter_mut().for_each(amp);
-    for waves in [true, false] {
-        if waves {
-            let spec = SurfaceSpec { radius_m: 400.0, taper_m: 80.0, ..SurfaceSpec::default() };
-            let surface = WaveSurface::new(&components, 7.0, 0.0, &[[0.0, 0.0], [120.0, -80.0]], spec);
-            s.set_wave_surface(Some(surface)).unwrap_or_else(|e| unreachable!("{e}"));
-        } else {
-            s.set_wave_surface(None).unwrap_or_else(|e| unreachable!("{e}"));
-        }
+    components.iter_mut().for_each(|c| c.amplitude_m *= 4.0);
+    let spec = SurfaceSpec { radius_m: 400.0, taper_m: 80.0, ..SurfaceSpec::default() };
+    let surface = WaveSurface::new(&components, 7.0, 0.0, &[[0.0, 0.0], [120.0, -80.0]], spec);
+    let mut cast = Vec::new();
+    for surface in [Some(surface), None] {
+        let waves = surface.is_some();
+        s.set_wave_surface(surface).unwrap_or_else(|e| unreachable!("{e}"));
         let all = s.cast_rays(&o, &d, limit).unwrap_or_default();
         let targets = s.cast_rays_to_targets(&o, &d, limit).unwrap_or_default();
         let (mut seen, mut sea) = (0, 0);
@@ -573,13 +570,10 @@ fn target_casts_are_the_closest_hits_with_the_sea_left_out() {
             assert_eq!(at(&targets), at(&all), "ray {i} (waves {waves}): {:?} {:?}", o[i], d[i]);
         }
         assert!(seen > 1000 && sea > 5000, "waves {waves}: {seen} rays on targets, {sea} on the sea");
+        cast.push(targets);
     }
     // Targets the crests hide: rays whose target the flat sea would leave in view.
-    let spec = SurfaceSpec { radius_m: 400.0, taper_m: 80.0, ..SurfaceSpec::default() };
-    let flat = s.cast_rays_to_targets(&o, &d, limit).unwrap_or_default();
-    s.set_wave_surface(Some(WaveSurface::new(&components, 7.0, 0.0, &[[0.0, 0.0], [120.0, -80.0]], spec)))
-        .unwrap_or_else(|e| unreachable!("{e}"));
-    let wavy = s.cast_rays_to_targets(&o, &d, limit).unwrap_or_default();
+    let (wavy, flat) = (&cast[0], &cast[1]);
     let hidden = (0..o.len()).filter(|&i| flat.instance[i] > 1 && wavy.instance[i] == NO_HIT).count();
     assert!(hidden > 50, "only {hidden} targets hidden by the crests");
 }
