@@ -15,7 +15,12 @@
 //! * a batch of shadow rays all towards one sun direction asks the [`SunMask`] instead: the cells from which a
 //!   ray in that direction can pass over some cell at or below that cell's bound, found once per sun direction
 //!   and height map by sweeping every occupied cell against the sun. A ray from above the surface whose cell is
-//!   not in the mask hits nothing, however far it goes, in one lookup.
+//!   not in the mask hits nothing, however far it goes, in one lookup. Where only moving boxes put a cell in
+//!   the mask, the ray is tested against those boxes (a slab test each): a box is a coarse stand-in for a
+//!   vessel, and the water round a USV, which its own cameras see most of, lies in its box's sweep.
+//!
+//! Both walks and masks keep the static bound and the moving boxes apart in this way: a cell raised by a box
+//! alone does not stop a ray that passes over its static bound and misses the box itself.
 //!
 //! * a batch of rays that all leave one point (a camera's pixels) asks that point's [`Horizon`]: per azimuth,
 //!   the slope above which a ray from there passes over everything (`sea/horizon.rs`).
@@ -84,16 +89,27 @@ pub struct Sea {
 }
 
 /// The cells of a [`Sea`] grid from which a ray towards one sun direction may meet something (see the module
-/// docs): a ray from above the surface starting in any other cell of the grid hits nothing.
+/// docs): a ray from above the surface starting in any other cell of the grid hits nothing. In a cell only the
+/// moving instances' boxes may shade, the ray is tested against those boxes themselves.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SunMask {
     /// The unit direction the mask was built for.
     dir: [f32; 3],
     /// The height map's generation it was built from.
     generation: u64,
-    /// Per cell, row-major like the height map: whether a ray from there may meet something.
-    blocked: Vec<bool>,
+    /// Per cell, row-major like the height map: [`OPEN`], [`BOXES`] or [`FIXED`].
+    cells: Vec<u8>,
+    /// The moving instances' boxes, grown by [`MARGIN_M`], each with the horizontal rectangle
+    /// `[x_lo, y_lo, x_hi, y_hi]` holding every start above the surface from which a ray in `dir` may meet it.
+    boxes: Vec<(Box3, [f32; 4])>,
 }
+
+/// A [`SunMask`] cell from which a ray towards the sun meets nothing.
+const OPEN: u8 = 0;
+/// A [`SunMask`] cell over which only moving boxes may stand in the sun's way: the ray is tested against them.
+const BOXES: u8 = 1;
+/// A [`SunMask`] cell from which a ray towards the sun may meet the static geometry: it is traced.
+const FIXED: u8 = 2;
 
 /// The last [`SunMask`] built; a copy of a [`Sea`] starts with an empty cache.
 #[derive(Debug, Default)]
@@ -254,7 +270,7 @@ impl Sea {
                 }
             }
         };
-        let mut blocked = fixed.blocked.clone();
+        let mut cells = fixed.cells.clone();
         let (nx, ny) = (self.nx, self.ny);
         for b in &self.boxes {
             let h = b.hi[2] + MARGIN_M;
@@ -263,13 +279,16 @@ impl Sea {
                 for ix in x_lo..=x_hi {
                     self.sweep(ix, iy, h, dir, |gx, gy| {
                         for y in gy.saturating_sub(1)..=(gy + 1).min(ny - 1) {
-                            blocked[y * nx + gx.saturating_sub(1)..=y * nx + (gx + 1).min(nx - 1)].fill(true);
+                            for c in &mut cells[y * nx + gx.saturating_sub(1)..=y * nx + (gx + 1).min(nx - 1)] {
+                                *c = (*c).max(BOXES);
+                            }
                         }
                     });
                 }
             }
         }
-        let mask = Arc::new(SunMask { dir, generation: self.generation, blocked });
+        let boxes = self.boxes.iter().map(|b| self.sun_shadow(b, dir)).collect();
+        let mask = Arc::new(SunMask { dir, generation: self.generation, cells, boxes });
         *cache = Some(Arc::clone(&mask));
         Some(mask)
     }
@@ -291,13 +310,31 @@ impl Sea {
                 rows[iy * nx + ix] = r[ix.saturating_sub(1)..=(ix + 1).min(nx - 1)].iter().any(|&b| b);
             }
         }
-        let mut blocked = vec![false; nx * ny];
+        let mut cells = vec![OPEN; nx * ny];
         for iy in 0..ny {
             for ix in 0..nx {
-                blocked[iy * nx + ix] = (iy.saturating_sub(1)..=(iy + 1).min(ny - 1)).any(|y| rows[y * nx + ix]);
+                if (iy.saturating_sub(1)..=(iy + 1).min(ny - 1)).any(|y| rows[y * nx + ix]) {
+                    cells[iy * nx + ix] = FIXED;
+                }
             }
         }
-        SunMask { dir, generation: 0, blocked }
+        SunMask { dir, generation: 0, cells, boxes: Vec::new() }
+    }
+
+    /// Moving box `b` grown by [`MARGIN_M`], and the horizontal rectangle of the starts above the surface from
+    /// which a ray in unit direction `dir` (rising) may meet it: the box's own, swept back against the sun as far
+    /// as a ray rising from the surface to the box's top runs, padded by the margin.
+    fn sun_shadow(&self, b: &Box3, dir: [f32; 3]) -> (Box3, [f32; 4]) {
+        let g = Box3 { lo: b.lo.map(|v| v - MARGIN_M), hi: b.hi.map(|v| v + MARGIN_M) };
+        let run = ((g.hi[2] - self.level).max(0.0) / dir[2]) * 1.001 + MARGIN_M;
+        let (bx, by) = (-dir[0] * run, -dir[1] * run);
+        let rect = [
+            g.lo[0] + bx.min(0.0) - MARGIN_M,
+            g.lo[1] + by.min(0.0) - MARGIN_M,
+            g.hi[0] + bx.max(0.0) + MARGIN_M,
+            g.hi[1] + by.max(0.0) + MARGIN_M,
+        ];
+        (g, rect)
     }
 
     /// Sweeps cell `(ix, iy)` with height bound `h` against the sun `dir`, calling `mark(gx, gy)` for the cell
@@ -355,7 +392,13 @@ impl Sea {
         };
         let gx = ((px - self.x0) / self.cell).floor().clamp(0.0, (self.nx - 1) as f32);
         let gy = ((py - self.y0) / self.cell).floor().clamp(0.0, (self.ny - 1) as f32);
-        !mask.blocked[gy as usize * self.nx + gx as usize]
+        match mask.cells[gy as usize * self.nx + gx as usize] {
+            OPEN => true,
+            BOXES => mask.boxes.iter().all(|(b, r)| {
+                o[0] < r[0] || o[1] < r[1] || o[0] > r[2] || o[1] > r[3] || !segment_meets(b, o, d, f32::INFINITY)
+            }),
+            _ => false,
+        }
     }
 
     /// Raises the cells under `b` (widened by one cell) to `b`'s top plus the margin.
@@ -414,18 +457,13 @@ impl Sea {
         self.top
     }
 
-    /// Whether the ray `o + t·d`, `t ∈ [0, t_end]`, stays strictly above the height bound of every cell it
-    /// crosses. `false` also when the path is longer than `max_cells` cells (tracing it is then cheaper) or
-    /// leaves a grid that does not hold everything.
-    #[inline(always)]
-    pub fn path_clear(&self, o: [f32; 3], d: [f32; 3], t_end: f32, max_cells: usize) -> bool {
-        self.walk(&self.heights, o, d, t_end, max_cells)
-    }
-
-    /// [`Sea::path_clear`] over the height map `heights` (this grid's shape).
+    /// Whether the ray `o + t·d`, `t ∈ [0, t_end]`, meets nothing but the sea surface: it stays strictly above
+    /// the height bound of every cell it crosses, or where a cell's bound is raised by the moving boxes alone
+    /// and the ray is above the static bound there, it misses those boxes. `false` also when the path is longer
+    /// than `max_cells` cells (tracing it is then cheaper) or leaves a grid that does not hold everything.
     #[inline(always)]
     #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a < b)` on purpose: a NaN must answer "not clear"
-    fn walk(&self, heights: &[f32], o: [f32; 3], d: [f32; 3], t_end: f32, max_cells: usize) -> bool {
+    pub fn path_clear(&self, o: [f32; 3], d: [f32; 3], t_end: f32, max_cells: usize) -> bool {
         if !(t_end.is_finite() && t_end >= 0.0) {
             return false;
         }
@@ -462,28 +500,34 @@ impl Sea {
         let mut tx = next(ix, d[0], o[0], self.x0);
         let mut ty = next(iy, d[1], o[1], self.y0);
         let mut t = t0;
+        // Whether some cell was passed over only above its static bound: the moving boxes decide then.
+        let mut boxes = false;
         for _ in 0..=2 * max_cells + 2 {
             let t_exit = tx.min(ty).min(t1);
             let low_t = if d[2] < 0.0 { t_exit } else { t };
             let z_low = o[2] + d[2] * low_t;
-            if !(z_low > heights[iy * self.nx + ix]) {
-                return false;
+            let cell = iy * self.nx + ix;
+            if !(z_low > self.heights[cell]) {
+                if !(z_low > self.fixed[cell]) {
+                    return false;
+                }
+                boxes = true;
             }
             if t_exit >= t1 {
-                return true;
+                return !boxes || self.misses_boxes(o, d, t_end);
             }
             t = t_exit;
             if tx <= ty {
                 let n = ix as isize + sx;
                 if n < 0 || n >= self.nx as isize {
-                    return self.contained;
+                    return self.contained && (!boxes || self.misses_boxes(o, d, t_end));
                 }
                 ix = n as usize;
                 tx += dtx;
             } else {
                 let n = iy as isize + sy;
                 if n < 0 || n >= self.ny as isize {
-                    return self.contained;
+                    return self.contained && (!boxes || self.misses_boxes(o, d, t_end));
                 }
                 iy = n as usize;
                 ty += dty;
@@ -491,6 +535,42 @@ impl Sea {
         }
         false
     }
+
+    /// Whether the segment `o + t·d`, `t ∈ [0, t_end]`, misses every moving box grown by [`MARGIN_M`].
+    #[inline]
+    fn misses_boxes(&self, o: [f32; 3], d: [f32; 3], t_end: f32) -> bool {
+        let (ex, ey) = (o[0] + d[0] * t_end, o[1] + d[1] * t_end);
+        let (x_lo, x_hi) = (o[0].min(ex) - MARGIN_M, o[0].max(ex) + MARGIN_M);
+        let (y_lo, y_hi) = (o[1].min(ey) - MARGIN_M, o[1].max(ey) + MARGIN_M);
+        self.boxes.iter().all(|b| {
+            // Away from the segment's own footprint, or missed by it.
+            b.hi[0] < x_lo || b.lo[0] > x_hi || b.hi[1] < y_lo || b.lo[1] > y_hi || {
+                let g = Box3 { lo: b.lo.map(|v| v - MARGIN_M), hi: b.hi.map(|v| v + MARGIN_M) };
+                !segment_meets(&g, o, d, t_end)
+            }
+        })
+    }
+}
+
+/// Whether the segment `o + t·d`, `t ∈ [0, t_end]`, meets the closed box `b` (the slab test; an axis the
+/// direction does not move along is met only where `o` lies within the slab). `true` when not sure (a NaN).
+#[inline(always)]
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a <= b)` on purpose: a NaN must answer "meets"
+fn segment_meets(b: &Box3, o: [f32; 3], d: [f32; 3], t_end: f32) -> bool {
+    let (mut t0, mut t1) = (0f32, t_end);
+    for a in 0..3 {
+        if d[a] == 0.0 {
+            if o[a] < b.lo[a] || o[a] > b.hi[a] {
+                return false;
+            }
+        } else {
+            let (p, q) = ((b.lo[a] - o[a]) / d[a], (b.hi[a] - o[a]) / d[a]);
+            let (p, q) = if p < q { (p, q) } else { (q, p) };
+            t0 = t0.max(p);
+            t1 = t1.min(q);
+        }
+    }
+    !(t0 > t1)
 }
 
 #[cfg(test)]
@@ -528,14 +608,33 @@ mod tests {
         assert!(!sea.path_clear([45.0, 0.5, 1.0], [0.98, 0.0, 0.2], 60.0, 512));
     }
 
+    /// Whether the rising ray `o + t·d` meets one of the horizontal triangles `tris` or the inside of box `b`:
+    /// by brute force (each triangle's plane crossing, and the ray sampled every centimetre up to `b`'s top).
+    fn meets_by_brute_force(tris: &[[Vec3; 3]], b: &Box3, o: [f32; 3], d: [f32; 3]) -> bool {
+        let (o64, d64) = (o.map(f64::from), d.map(f64::from));
+        let on_tri = tris.iter().any(|t| {
+            let t_hit = (f64::from(t[0].z) - o64[2]) / d64[2];
+            let (x, y) = (o64[0] + d64[0] * t_hit, o64[1] + d64[1] * t_hit);
+            let (u, v) = (x - f64::from(t[0].x), y - f64::from(t[0].y));
+            t_hit > 0.0 && u >= 0.0 && v >= 0.0 && u + v <= 1.0
+        });
+        let t_top = (f64::from(b.hi[2]) - o64[2]) / d64[2];
+        let in_box = (0..=(t_top.max(0.0) * 100.0) as usize).any(|k| {
+            let p = [0, 1, 2].map(|a| o64[a] + d64[a] * k as f64 * 0.01);
+            (0..3).all(|a| p[a] >= f64::from(b.lo[a]) && p[a] <= f64::from(b.hi[a]))
+        });
+        on_tri || in_box
+    }
+
     #[test]
-    fn sun_mask_clears_only_rays_the_unlimited_walk_clears() {
+    fn sun_mask_clears_only_rays_that_meet_nothing() {
         // A tower and a low quay on a 200 m grid, a moving boat; suns from steep to low, one straight up.
         let bounds = Box3 { lo: [-100.0, -100.0, -20.0], hi: [100.0, 100.0, 30.0] };
         let mut fixed = vec![tri(50.0, 0.0, 30.0), tri(-80.0, -80.0, -20.0)];
         fixed.extend((0..40).map(|i| tri(-60.0 + i as f32, 40.0, 2.0)));
         let mut sea = Sea::new(0, 0.0, bounds, vec![1], &fixed);
-        sea.update([Box3 { lo: [0.0, -30.0, -1.0], hi: [12.0, -26.0, 6.0] }].into_iter());
+        let boat = Box3 { lo: [0.0, -30.0, -1.0], hi: [12.0, -26.0, 6.0] };
+        sea.update([boat].into_iter());
         let mut state = 7u64;
         let mut rand = |lo: f32, hi: f32| {
             state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
@@ -546,21 +645,35 @@ mod tests {
             let d = [sun[0] / n, sun[1] / n, sun[2] / n];
             let Some(mask) = sea.sun_mask(d) else { panic!("no mask for {d:?}") };
             let (mut cleared, mut shaded, mut outside) = (0, 0, 0);
-            for _ in 0..20_000 {
-                let o = [rand(-170.0, 170.0), rand(-170.0, 170.0), rand(0.001, 3.0)];
-                let t_top = (sea.top() - o[2]) / d[2];
-                let walk = sea.path_clear(o, d, t_top, 100_000);
+            let cell_of = |o: [f32; 3]| {
+                let g = |v: f32, v0: f32, n: usize| (((v - v0) / sea.cell).floor().max(0.0) as usize).min(n - 1);
+                mask.cells[g(o[1], sea.y0, sea.ny) * sea.nx + g(o[0], sea.x0, sea.nx)]
+            };
+            let (mut by_box, mut shaded_by_box) = (0, 0);
+            for k in 0..24_000 {
+                // Every sixth start lies in the water round the boat, where the boxes decide.
+                let o = if k % 6 == 0 {
+                    [rand(-20.0, 32.0), rand(-50.0, -6.0), rand(0.001, 3.0)]
+                } else {
+                    [rand(-170.0, 170.0), rand(-170.0, 170.0), rand(0.001, 3.0)]
+                };
+                let meets = meets_by_brute_force(&fixed, &boat, o, d);
                 if sea.sun_clear(&mask, o) {
-                    assert!(walk, "mask clears {o:?} towards {d:?}, the walk does not");
+                    assert!(!meets, "mask clears {o:?} towards {d:?}, yet the ray meets something");
                     outside += usize::from(o[0].abs() > 105.0 || o[1].abs() > 105.0);
                     cleared += 1;
+                    by_box += usize::from(cell_of(o) == BOXES);
                 }
-                shaded += usize::from(!walk);
+                shaded += usize::from(meets);
+                shaded_by_box += usize::from(meets && cell_of(o) == BOXES);
             }
             // The mask settles most of the open water, and the shade is real.
             assert!(cleared > 15_000, "only {cleared} cleared towards {d:?}");
             assert!(shaded > 50, "only {shaded} shaded towards {d:?}");
             assert!(outside > 5_000, "only {outside} cleared from outside the grid towards {d:?}");
+            // Round the boat, the box itself decides: most starts there are cleared, some are in its shade.
+            assert!(by_box > 300, "only {by_box} cleared where the boat's box is tested towards {d:?}");
+            assert!(shaded_by_box > 20, "only {shaded_by_box} in the boat's shade towards {d:?}");
             // Cached: the same mask again, until the map changes.
             assert!(sea.sun_mask(d).is_some_and(|m| Arc::ptr_eq(&m, &mask)));
         }
@@ -582,6 +695,14 @@ mod tests {
         sea.update([boat].into_iter());
         assert!(!sea.path_clear([0.0, 0.0, 3.0], [1.0, 0.0, 0.0], 30.0, 512));
         assert!(sea.path_clear([0.0, 0.0, 3.0], [-1.0, 0.0, 0.0], 30.0, 512));
+        // Beside the boat (within the cells its box raises) and over it: the box itself is missed, so clear;
+        // just inside its margin, or under its top, not.
+        assert!(sea.path_clear([0.0, 2.5, 3.0], [1.0, 0.0, 0.0], 30.0, 512));
+        assert!(sea.path_clear([0.0, 0.0, 4.1], [1.0, 0.0, 0.0], 30.0, 512));
+        assert!(!sea.path_clear([0.0, 2.04, 3.0], [1.0, 0.0, 0.0], 30.0, 512));
+        assert!(!sea.path_clear([0.0, 0.0, 4.04], [1.0, 0.0, 0.0], 30.0, 512));
+        // Past the boat, the segment's end short of it: clear.
+        assert!(sea.path_clear([0.0, 0.0, 3.0], [1.0, 0.0, 0.0], 9.9, 512));
         // The boat sails out of the grid: leaving the grid no longer proves anything.
         let away = Box3 { lo: [60.0, -2.0, -1.0], hi: [70.0, 2.0, 4.0] };
         sea.update([away].into_iter());
