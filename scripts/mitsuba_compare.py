@@ -190,12 +190,15 @@ def write_table(args: Any, results: list[Result], mi_version: str) -> None:
         "= `roughconductor` with `ggx` (dielectric: `eta` 1.5, `k` 0, the exact Fresnel whose normal incidence "
         "value is mmusv's F0 = 0.04; metal: Mitsuba's `Al` `eta`/`k`, mmusv getting their normal incidence "
         "reflectance as base colour); their sum as a `blendbsdf` of weight 0.5 of both with doubled "
-        "reflectances. Water = smooth `plastic` (`int_ior` 1.33, `ext_ior` 1, water albedo, `nonlinear` false), "
-        "the sun glint = `roughconductor` (`eta` 1.33, `k` 0, α = the Cox–Munk slope) under the sun alone. "
+        "reflectances. Water = the body of a smooth `plastic` (`int_ior` 1.33, `ext_ior` 1, water albedo, "
+        "`nonlinear` false) plus its rough interface, the sun's glint and the glossy reflections alike: "
+        "`roughconductor` (`beckmann`, `eta` 1.33, `k` 0, α = the Cox–Munk slope). "
         "mmusv's Schlick Fresnel is compared against the exact one.",
         "- **Same light transport.** mmusv lights surfaces directly: the sun with a shadow ray, the sky and "
-        "ground as image-based light without occlusion, water adding its traced mirror reflection. Mitsuba "
-        "renders exactly that as layers composited by mmusv's instance image:",
+        "ground as image-based light without occlusion, water adding its traced reflections spread over the "
+        "roughness lobe in screen space (`sensors/camera/glossy.rs`) and weighted by the rough surface's "
+        "directional reflectance (`sensors/shade/rough_water.rs`). Mitsuba path-traces that rough reflection; "
+        "it renders the rest as layers composited by mmusv's instance image:",
         "",
         "\n\n".join(f"  {r[0].scene.name}:\n\n{layer_table(r[0].scene, args.spp)}" for r in results),
         "",

@@ -15,9 +15,10 @@ Materials (mmusv's metallic workflow, ``crates/mmusv-core/src/sensors/shade/brdf
 * mmusv sums the two; Mitsuba has no additive BSDF, so a ``blendbsdf`` of weight 0.5 mixes the two with every
   reflectance doubled (raw bitmap textures): ``0.5·(2 f_d) + 0.5·(2 f_s) = f_d + f_s``;
 * water (class 1, ``shade/water.rs``) is Mitsuba's smooth ``plastic`` (``int_ior = 1.33``, ``ext_ior = 1``,
-  ``diffuse_reflectance`` = the water albedo, ``nonlinear = false``): the exact-Fresnel mirror plus the water
-  body; mmusv's Cox–Munk sun glint is a ``roughconductor`` (``eta = 1.33, k = 0``: the exact dielectric
-  Fresnel at the half vector, GGX ``α`` = the Cox–Munk slope) lit by the sun alone.
+  ``diffuse_reflectance`` = the water albedo, ``nonlinear = false``) without its mirror: the water body; the
+  interface's reflection — mmusv's Cox–Munk sun glint and its glossy reflections alike — is a ``roughconductor``
+  (``eta = 1.33, k = 0``: the exact dielectric Fresnel at the half vector; ``beckmann``, ``α`` = the Cox–Munk
+  slope, the Gaussian slopes of ``shade/rough_water.rs``).
 
 Light transport. mmusv shades direct light only: the sun with a shadow ray, and the environment as image-based
 light *without* occlusion (an irradiance map and split-sum prefiltered maps; every surface sees the whole sky and
@@ -26,13 +27,13 @@ ray (a surface hit there is shaded the same way). Mitsuba's ``path`` integrator 
 layers, each composited on the pixels whose instance (mmusv's instance image) it stands for:
 
 * ``sun``: the full scene lit by the sun alone, ``max_depth = 2`` (direct light, shadows): every surface and
-  the water body; plus, where there is water, a ``glint`` layer (water as the glint BSDF);
+  the water body;
 * ``env:<object>``: one object alone in the scene lit by the environment alone, ``max_depth = 2``: its
   image-based light without occlusion, as mmusv's (for water, the body term alone: plastic without its mirror);
   the sky pixels come from one of these (the camera sees the envmap);
-* ``mirror``: the full scene under sun and environment with the water a pure Fresnel mirror (a smooth
-  ``conductor`` with ``eta = 1.33, k = 0``: the exact dielectric Fresnel), ``max_depth = 3``: the water's
-  reflection of the sky and of the objects, lit directly (sun with shadows, environment). An object seen in
+* ``mirror``: the full scene under sun and environment with the water its rough interface alone (the
+  ``roughconductor`` above), ``max_depth = 3``: the sun's glint, and the water's glossy reflection of the sky
+  and of the objects, lit directly (sun with shadows, environment). An object seen in
   the mirror has the water, not the envmap, below its horizon, and the water (no emission) is black at that
   depth: the water scenes therefore set ``ground_albedo = 0``, so that mmusv's lower hemisphere is black too.
 
@@ -409,16 +410,15 @@ def surface_bsdf(mi: Any, m: Material) -> dict[str, Any]:
 
 def water_bsdf(mi: Any, env: Env, part: str) -> dict[str, Any]:
     """The water as Mitsuba sees it in one layer: ``body`` (the plastic without its mirror), ``mirror`` (the
-    Fresnel mirror alone), ``glint`` (the sun's GGX lobe of mmusv's Cox–Munk ``α = √(0.003 + 5.12·10⁻³ U)``),
-    ``smooth`` (the whole smooth plastic, mirror and body; no glint: for full path tracing)."""
-    if part not in ("body", "mirror", "glint", "smooth"):
+    rough interface alone: Beckmann of mmusv's Cox–Munk ``α = √(0.003 + 5.12·10⁻³ U)``, exact Fresnel; under the
+    sun, the glint), ``smooth`` (the whole smooth plastic, mirror and body; no glint: for full path tracing)."""
+    if part not in ("body", "mirror", "smooth"):
         raise ValueError(f"unknown water part {part!r}")
-    if part == "glint":
-        alpha = math.sqrt(0.003 + 5.12e-3 * max(env.wind_speed_m_s, 0.0))
-        return {"type": "roughconductor", "distribution": "ggx", "alpha": alpha, "eta": WATER_IOR, "k": 0.0}
     if part == "mirror":
-        # The Fresnel mirror alone: a smooth conductor with k = 0 has the exact dielectric Fresnel.
-        return {"type": "conductor", "eta": WATER_IOR, "k": 0.0}
+        # The rough interface's reflection alone (a rough conductor with k = 0 has the exact dielectric Fresnel):
+        # under the sun, the glint; under the sky and of the other objects, the glossy reflection.
+        alpha = math.sqrt(0.003 + 5.12e-3 * max(env.wind_speed_m_s, 0.0))
+        return {"type": "roughconductor", "distribution": "beckmann", "alpha": alpha, "eta": WATER_IOR, "k": 0.0}
     d: dict[str, Any] = {
         "type": "plastic",
         "int_ior": WATER_IOR,
@@ -454,7 +454,6 @@ def layers(scene: RefScene, spp: int) -> list[Layer]:
     water = [i for i, o in enumerate(scene.objects) if o.is_water]
     out = [Layer("sun", everything, True, False, "body", 2, max(16, spp // 4), everything)]
     if water:
-        out.append(Layer("glint", everything, True, False, "glint", 2, max(16, spp // 4), tuple(water)))
         out.append(Layer("mirror", everything, True, True, "mirror", 3, spp, tuple(water)))
     for i, o in enumerate(scene.objects):
         sky = (-1,) if i == 0 else ()

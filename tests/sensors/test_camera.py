@@ -421,9 +421,9 @@ def test_native_camera_misconfig_names_the_field() -> None:
 
 
 def test_sea_detail_bands_change_only_the_water_colours_near_the_camera() -> None:
-    """The sea surface's detail bands (``set_wave_surface(detail=...)``) are shading only: depth, labels and the
-    far water's colours are the same with and without; the near water's colours change (its short waves drawn as
-    normals rather than roughness)."""
+    """The sea surface's detail bands (``set_wave_surface(detail=...)``) are shading only: depth and labels are the
+    same with and without, and the far water's colours within a level; the near water's colours change (its short
+    waves drawn as normals rather than roughness)."""
     from mmusv.world.sea_state import sea_spec_for_preset
 
     s = plane_scene(2000.0)
@@ -443,4 +443,6 @@ def test_sea_detail_bands_change_only_the_water_colours_near_the_camera() -> Non
     assert near.sum() > 1000 and far.sum() > 400
     diff = np.abs(plain.rgb.astype(int) - fine.rgb.astype(int)).max(axis=2)
     assert (diff[near] > 0).mean() > 0.5, "the near water shows its short waves"
-    assert (diff[far] == 0).all(), "beyond the finest tiles nothing changes"
+    # Beyond the finest tiles the water itself is the same; its colours move by a level at most, through the
+    # glossy reflections, whose lobe there reaches down the image into the near water (glossy.rs).
+    assert diff[far].max() <= 1, "beyond the finest tiles the colours stay"

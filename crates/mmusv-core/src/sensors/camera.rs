@@ -29,6 +29,7 @@ use rayon::prelude::*;
 
 mod antialias;
 mod distortion;
+mod glossy;
 pub mod radiance;
 
 use antialias::surface_key;
@@ -400,13 +401,19 @@ impl Camera {
             Quality::High => Reflections::Every,
         };
         let shared = if q == Quality::High { None } else { Some(grid) };
-        let traced = radiance::radiance(scene, &shader, env.shadows, refl, shared, (&origins, &dirs, &hits))?;
+        // Reflections spread over the water's roughness (pinhole cameras; the top view looks straight down).
+        let glossy = match self.cfg.projection {
+            Projection::Pinhole { .. } if pixel_rad > 0.0 => Some((grid, 1.0 / pixel_rad)),
+            _ => None,
+        };
+        let shaded = radiance::radiance(scene, &shader, env.shadows, refl, shared, glossy, (&origins, &dirs, &hits))?;
         let mut linear = vec![Vec3::ZERO; n];
         for (k, &i) in self.order.iter().enumerate() {
-            linear[i as usize] = traced[k];
+            linear[i as usize] = shaded.radiance[k];
         }
         if q.edge_samples() > 1 {
-            let centres = antialias::Centres { frame: &frame, surface: &surface, hits: &hits };
+            let reflected = shaded.reflected.as_ref();
+            let centres = antialias::Centres { frame: &frame, surface: &surface, hits: &hits, reflected };
             self.antialias(scene, pose, (&shader, env.shadows, options.seed), centres, &mut linear)?;
         }
         let w = self.cfg.width as usize;

@@ -28,6 +28,7 @@ use std::sync::Arc;
 
 pub mod brdf;
 pub mod envlight;
+pub mod rough_water;
 pub mod sky;
 pub mod tonemap;
 pub mod water;
@@ -449,6 +450,14 @@ impl Shader {
         c
     }
 
+    /// Mean square slope `α²` (both axes) of the water's roughness where the sampled surface leaves
+    /// `unresolved_mss` out: the Cox–Munk slopes of the wind plus those. The sun's glint and the glossy
+    /// reflections (`sensors/camera/glossy.rs`) both take it.
+    #[inline]
+    pub fn water_mss(&self, unresolved_mss: f32) -> f32 {
+        self.water_alpha * self.water_alpha + unresolved_mss.max(0.0)
+    }
+
     /// Radiance (before aerial perspective) of the water seen along `d`: Fresnel-weighted `reflected` radiance
     /// (along [`Shader::reflection_ray`]; `None` reads the sky there), the sun's Cox–Munk glint when `sunlit`,
     /// the water body, and foam.
@@ -462,22 +471,20 @@ impl Shader {
             Some(l) => l,
             None => self.sky_no_sun(self.reflection_ray(d, hit).1),
         };
-        let mut c = l_r * f_o;
+        // The reflection over the roughness lobe (its radiance spread over the lobe by the camera, `reflected`):
+        // weighted by the rough surface's directional reflectance, not the mirror's Fresnel.
+        let alpha_r = self.water_mss(hit.unresolved_mss).sqrt();
+        let mut c = l_r * rough_water::reflectance(cos_o, alpha_r);
         let mut entering = self.light.water_entering;
         if sunlit {
             let ns = n.dot(self.sun);
             if ns > 0.0 {
-                // The glint: GGX with the Cox–Munk roughness (and the slope variance of the waves too short for
-                // the surface's sampling there: α² adds as mean square slopes do), weighted by the exact Fresnel
-                // at the half vector.
+                // The glint: Cox–Munk's Gaussian slopes (Beckmann, `rough_water.rs`) with the wind's roughness and
+                // the slope variance of the waves too short for the surface's sampling there (α² adds as mean
+                // square slopes do), weighted by the exact Fresnel at the half vector: the reflections' lobe too.
                 let h = (v + self.sun).normalize_or_zero();
                 let f = water_fresnel(v.dot(h));
-                let alpha = if hit.unresolved_mss > 0.0 {
-                    (self.water_alpha * self.water_alpha + hit.unresolved_mss).sqrt()
-                } else {
-                    self.water_alpha
-                };
-                c += self.sun_e * (brdf::microfacet_cos(n, v, self.sun, alpha) * f);
+                c += self.sun_e * (rough_water::specular_cos(n, v, self.sun, alpha_r) * f);
                 entering += self.sun_e * (ns * (1.0 - water_fresnel(ns)));
             }
         }

@@ -6,6 +6,7 @@
 //! takes the mean of its samples' radiance, each shaded like a pixel at `high` quality (traced reflections above
 //! `draft`). Depth, class and instance stay those of the centre.
 
+use super::glossy::Blurred;
 use super::radiance::{self, Reflections};
 use super::{Camera, CameraFrame, WorldRays};
 use crate::error::Result;
@@ -15,12 +16,13 @@ use crate::sensors::shade::Shader;
 use parry3d::math::Vec3;
 use rayon::prelude::*;
 
-/// What the pixel centres saw: the frame (row-major depth, class, instance), each pixel's [`surface_key`], and
-/// the centre rays' hits (in trace order).
+/// What the pixel centres saw: the frame (row-major depth, class, instance), each pixel's [`surface_key`], the
+/// centre rays' hits (in trace order) and, with glossy reflections, the blurred reflections.
 pub(super) struct Centres<'a> {
     pub frame: &'a CameraFrame,
     pub surface: &'a [u64],
     pub hits: &'a RayHits,
+    pub reflected: Option<&'a Blurred>,
 }
 
 impl Camera {
@@ -35,7 +37,7 @@ impl Camera {
         linear: &mut [Vec3],
     ) -> Result<()> {
         let (shader, shadows, seed) = shading;
-        let Centres { frame, surface, hits } = centres;
+        let Centres { frame, surface, hits, reflected } = centres;
         let q = self.cfg.image.quality;
         let s = q.edge_samples();
         let exposure = shader.exposure();
@@ -68,8 +70,20 @@ impl Camera {
             mixed.iter().flat_map(|&e| (e as usize * per..(e as usize + 1) * per).map(|j| j as u32)).collect();
         let (mo, md): (Vec<[f32; 3]>, Vec<[f32; 3]>) = rays.iter().map(|&j| (so[j as usize], sd[j as usize])).unzip();
         let mhits = shits.select(&rays);
-        let refl = if q.reflections() { Reflections::Every } else { Reflections::Sky };
-        let samples = radiance::radiance(scene, shader, shadows, refl, None, (&mo, &md, &mhits))?;
+        // A water sample reflects the blurred reflections at its own position in the image (the lobe is far wider
+        // than a pixel; no water within reach: the sky along its mirror direction); without the blur, its own
+        // traced reflection.
+        let given = |j: usize| {
+            let (i, sub) = (edges[mixed[j / per] as usize], (j % per) as u32);
+            let [u, v] = self.sample_point(i, sub, s, seed);
+            reflected.and_then(|b| b.at(u as f32, v as f32))
+        };
+        let refl = match (q.reflections(), reflected) {
+            (false, _) => Reflections::Sky,
+            (true, None) => Reflections::Every,
+            (true, Some(_)) => Reflections::Given(&given),
+        };
+        let samples = radiance::radiance(scene, shader, shadows, refl, None, None, (&mo, &md, &mhits))?.radiance;
         for (m, &e) in mixed.iter().enumerate() {
             let sum: Vec3 = samples[m * per..(m + 1) * per].iter().copied().sum();
             linear[edges[e as usize] as usize] = sum / s as f32;
@@ -81,25 +95,30 @@ impl Camera {
     /// pixel of `pixels` (row-major indices), pixel by pixel.
     fn sample_rays(&self, pose: &RigidPose, pixels: &[u32], samples: u32, seed: u64) -> WorldRays {
         let g = (samples as f64).sqrt().round().max(1.0) as u32;
-        let w = self.cfg.width;
         let cap = pixels.len() * (g * g) as usize;
         let (mut o, mut d) = (Vec::with_capacity(cap), Vec::with_capacity(cap));
         for &i in pixels {
-            let (u, v) = ((i % w) as f64, (i / w) as f64);
-            for a in 0..g {
-                for b in 0..g {
-                    let key = (i as u64) << 8 | (a * g + b) as u64;
-                    let ju = crate::sensors::noise::uniform(seed, 0xAA, 2 * key);
-                    let jv = crate::sensors::noise::uniform(seed, 0xAA, 2 * key + 1);
-                    let su = u + (b as f64 + ju) / g as f64;
-                    let sv = v + (a as f64 + jv) / g as f64;
-                    let (bo, bd) = self.body_ray(su, sv);
-                    o.push(pose.transform_point(Vec3::from_array(bo)).to_array());
-                    d.push(pose.transform_vector(Vec3::from_array(bd)).normalize().to_array());
-                }
+            for k in 0..g * g {
+                let [su, sv] = self.sample_point(i, k, samples, seed);
+                let (bo, bd) = self.body_ray(su, sv);
+                o.push(pose.transform_point(Vec3::from_array(bo)).to_array());
+                d.push(pose.transform_vector(Vec3::from_array(bd)).normalize().to_array());
             }
         }
         (o, d)
+    }
+
+    /// Image point (pixels) of sub-pixel sample `k` (row `k / √s`, column `k % √s` of the `√s × √s` grid,
+    /// jittered by `seed`) of row-major pixel `i`.
+    fn sample_point(&self, i: u32, k: u32, samples: u32, seed: u64) -> [f64; 2] {
+        let g = (samples as f64).sqrt().round().max(1.0) as u32;
+        let w = self.cfg.width;
+        let (u, v) = ((i % w) as f64, (i / w) as f64);
+        let (a, b) = (k / g, k % g);
+        let key = (i as u64) << 8 | (a * g + b) as u64;
+        let ju = crate::sensors::noise::uniform(seed, 0xAA, 2 * key);
+        let jv = crate::sensors::noise::uniform(seed, 0xAA, 2 * key + 1);
+        [u + (b as f64 + ju) / g as f64, v + (a as f64 + jv) / g as f64]
     }
 }
 

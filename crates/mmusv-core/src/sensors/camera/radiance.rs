@@ -7,6 +7,7 @@
 //! traffic than recomputing it), except those of the water rays whose reflections are traced: their shading
 //! normals sample the wave surface, which costs more than keeping them (−3 % of `port_entry`'s camera CPU).
 
+use super::glossy;
 use crate::error::Result;
 use crate::scene::{RayHits, Scene};
 use crate::sensors::shade::tonemap;
@@ -151,9 +152,13 @@ pub enum Reflections<'a> {
     Sky,
     /// For every water ray.
     Every,
+    /// None traced: water ray `k` reflects `given(k)` (`None`: the sky along its mirror direction), e.g. the
+    /// blurred reflection of the pixel an anti-aliasing sample lies in.
+    Given(&'a (dyn Fn(usize) -> Option<Vec3> + Sync)),
     /// Once per 2 × 2 block of a camera's pixels (at its even corner, [`PixelGrid::block`], when that one is
     /// water; else at the ray itself): every other water ray takes the mean of those traced at its anchors
-    /// ([`PixelGrid::anchors`], the block corners around it), else its block's.
+    /// ([`PixelGrid::anchors`], the block corners around it), else its block's. With the glossy blur, once per
+    /// 4 × 4 block where even the calmest water's lobe spans many of them, and every water ray reads the blur.
     Shared(PixelGrid<'a>),
 }
 
@@ -175,8 +180,15 @@ impl PixelGrid<'_> {
     /// The ray at the even corner of ray `k`'s 2 × 2 block of pixels.
     #[inline(always)]
     pub fn block(&self, k: usize) -> usize {
+        self.block_of(k, 2)
+    }
+
+    /// The ray at the corner of ray `k`'s `side × side` block of pixels (`side` a power of two).
+    #[inline(always)]
+    pub fn block_of(&self, k: usize, side: u32) -> usize {
         let [x, y] = self.pos[k].map(u32::from);
-        self.rank[((y & !1) * self.width + (x & !1)) as usize] as usize
+        let m = !(side.max(1) - 1);
+        self.rank[((y & m) * self.width + (x & m)) as usize] as usize
     }
 
     /// The anchors of ray `k` (up to four rays, and how many) whose mean it may take instead of being shaded:
@@ -227,9 +239,20 @@ fn kind(hits: &RayHits, k: usize) -> u8 {
     }
 }
 
+/// What [`radiance`] returns: per ray, the radiance and, with a glossy blur, the blurred reflections the water
+/// rays' shading read.
+pub struct Shaded {
+    /// Radiance per ray (linear RGB, cd/m²).
+    pub radiance: Vec<Vec3>,
+    /// The blurred reflections (`glossy.rs`), read at a pixel's centre; `None` without the blur.
+    pub reflected: Option<glossy::Blurred>,
+}
+
 /// Radiance (linear RGB, cd/m², aerial perspective included) along every ray `origins[k] + t dirs[k]` whose
 /// closest hits are `hits`, with water `reflections` traced as asked; `shadows` casts shadow rays (else every
-/// surface facing the sun is lit).
+/// surface facing the sun is lit). With `glossy` (the rays are a pinhole camera's pixels, its focal length in
+/// pixels per radian), the traced reflections are spread over the water's roughness lobe (`glossy.rs`) before
+/// the water is shaded.
 ///
 /// With `shared` (the rays are a camera's pixels), a ray that sees the open water or the sky, as all its anchors
 /// ([`PixelGrid::anchors`]) do, takes their mean when their colours are alike ([`alike`] under the shader's
@@ -243,8 +266,9 @@ pub fn radiance(
     shadows: bool,
     reflections: Reflections<'_>,
     shared: Option<PixelGrid<'_>>,
+    glossy: Option<(PixelGrid<'_>, f32)>,
     (origins, dirs, hits): (&[[f32; 3]], &[[f32; 3]], &RayHits),
-) -> Result<Vec<Vec3>> {
+) -> Result<Shaded> {
     let n = origins.len();
     let surface = |k: usize| surface_at(shader, scene, hits, origins, dirs, k);
     let is_water = |k: usize| hits.distance[k].is_finite() && hits.class[k] == 1;
@@ -274,10 +298,20 @@ pub fn radiance(
     // The surfaces of the rays whose reflections are traced, kept in `values`' order for their own shading (a
     // water hit's shading normal samples the waves: worked out once, not again in the final pass).
     let mut traced_hits: Vec<SurfaceHit> = Vec::new();
+    // Traced reflections per block side: standard quality traces one per 2 × 2 block, or per 4 × 4 where the
+    // glossy lobe of the calmest water here spans many such blocks (the blur then reads them on cells at least
+    // that coarse, `glossy::decimation`).
+    let spacing = match (reflections, glossy) {
+        (Reflections::Shared(_), Some((_, f_px))) => {
+            glossy::decimation(glossy::narrowest_lobe_px(shader.water_mss(0.0), f_px), 2)[0] as u32
+        }
+        (Reflections::Shared(_), None) => 2,
+        _ => 1,
+    };
     // The ray whose reflection stands for ray k's: its block's corner where that is water too, else itself.
     let owner = |k: usize| match reflections {
         Reflections::Shared(grid) => {
-            let r = grid.block(k);
+            let r = grid.block_of(k, spacing);
             if r < n && is_water(r) {
                 r
             } else {
@@ -286,7 +320,7 @@ pub fn radiance(
         }
         _ => k,
     };
-    if !matches!(reflections, Reflections::Sky) {
+    if !matches!(reflections, Reflections::Sky | Reflections::Given(_)) {
         // A candidate's own reflection is traced only if it is its own representative (its shading may fall
         // back to its own); with a shared one, the representative's serves.
         let traced: Vec<u32> = (0..n)
@@ -327,7 +361,10 @@ pub fn radiance(
     // The reflected radiance ray k reads: its own traced one; sharing its block's (standard quality), the mean of
     // those traced at the block corners around it, its anchors (a bilinear reconstruction of the half-resolution
     // reflections rather than the nearest corner's, so a reflected outline has no 2 × 2 steps); `None`: the sky.
-    let reflected_of = |k: usize| -> Option<Vec3> {
+    let traced_of = |k: usize| -> Option<Vec3> {
+        if let Reflections::Given(given) = reflections {
+            return given(k);
+        }
         let own = index.get(k).copied().filter(|&i| i != u32::MAX);
         if let Some(i) = own {
             return values.get(i as usize).copied();
@@ -346,6 +383,34 @@ pub fn radiance(
             }
         }
         index.get(owner(k)).and_then(|&i| values.get(i as usize)).copied()
+    };
+    // The traced reflections spread over the water's roughness lobe, read back at each water pixel.
+    let blurred = match glossy {
+        Some((grid, f_px)) if !matches!(reflections, Reflections::Sky | Reflections::Given(_)) => {
+            let samples: Vec<glossy::Sample> = index
+                .iter()
+                .enumerate()
+                .filter(|(_, &i)| i != u32::MAX)
+                .map(|(k, &i)| {
+                    let [x, y] = grid.pos[k];
+                    let d = dirs[k];
+                    let sin_grazing = (-d[2] / (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()).max(0.0);
+                    let mss = shader.water_mss(traced_hits[i as usize].unresolved_mss);
+                    glossy::Sample { x: u32::from(x), y: u32::from(y), value: values[i as usize], mss, sin_grazing }
+                })
+                .collect();
+            glossy::blur(grid.width as usize, grid.height as usize, f_px, spacing as usize, &samples).map(|b| (b, grid))
+        }
+        _ => None,
+    };
+    let reflected_of = |k: usize| -> Option<Vec3> {
+        match &blurred {
+            Some((b, grid)) => {
+                let [x, y] = grid.pos[k];
+                b.at(f32::from(x) + 0.5, f32::from(y) + 0.5).or_else(|| traced_of(k))
+            }
+            None => traced_of(k),
+        }
     };
     // Ray k's surface: the one kept when its reflection was traced, else worked out.
     let hit_of = |k: usize| match index.get(k).filter(|&&i| i != u32::MAX) {
@@ -419,7 +484,7 @@ pub fn radiance(
             out[k as usize] = c;
         }
     }
-    Ok(out)
+    Ok(Shaded { radiance: out, reflected: blurred.map(|(b, _)| b) })
 }
 
 /// The surface a ray of the batch hit (`None`: a miss).

@@ -2,8 +2,9 @@
 //!
 //! * **Capillary roughness** (waves too small to be geometry): C. Cox & W. Munk, "Measurement of the Roughness of
 //!   the Sea Surface from Photographs of the Sun's Glitter", JOSA 44(11), 1954: mean square slope
-//!   `σ² = 0.003 + 5.12·10⁻³ U` (U the wind speed at 12.5 m, m/s); used as a GGX roughness `α = σ` for the sun's
-//!   glitter, so the glint is the Cox–Munk glitter pattern rather than a disc.
+//!   `σ² = 0.003 + 5.12·10⁻³ U` (U the wind speed at 12.5 m, m/s); their slopes are Gaussian, so the roughness is
+//!   a Beckmann one of `α = σ` (`rough_water.rs`), for the sun's glitter (the Cox–Munk glitter pattern rather than
+//!   a disc) and for the glossy reflections alike.
 //! * **Whitecap coverage**: E. C. Monahan & I. O'Muircheartaigh, "Optimal Power-Law Description of Oceanic
 //!   Whitecap Coverage Dependence on Wind Speed", J. Phys. Oceanogr. 10, 1980: `W = 3.84·10⁻⁶ U^3.41`
 //!   (fraction of the surface). The foam is placed by a seeded fractal noise thresholded at its own
@@ -114,7 +115,7 @@ const KELVIN_TAN: f32 = 0.353_553_4;
 /// Stream of the foam noise.
 const FOAM_STREAM: u64 = 0xF0A;
 
-/// Cox–Munk GGX roughness `α` of the capillary waves under wind `u` (m/s).
+/// Cox–Munk (Beckmann) roughness `α` of the capillary waves under wind `u` (m/s).
 pub fn cox_munk_alpha(u: f32) -> f32 {
     (0.003 + 5.12e-3 * u.max(0.0)).sqrt()
 }

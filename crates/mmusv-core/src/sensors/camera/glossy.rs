@@ -1,0 +1,308 @@
+//! Glossy water reflections: a camera's traced mirror reflections spread over the reflection lobe of the
+//! water's unresolved roughness, in screen space.
+//!
+//! **Model.** The water's roughness below the surface's sampling is a Gaussian slope distribution of mean square
+//! slope `σ² = α²` (both axes; C. Cox & W. Munk, "Measurement of the Roughness of the Sea Surface from
+//! Photographs of the Sun's Glitter", JOSA 44(11), 1954: `α² = 0.003 + 5.12·10⁻³ U`, plus the slopes of the waves
+//! too short for the sampled surface there), the same `α` that shapes the sun's glitter (`sensors/shade.rs`). A
+//! facet tilted by slopes `(s_u, s_c)` (along and across the line of sight) turns the mirror direction of a view
+//! ray that meets the water at grazing angle `γ` by `2 s_u` in elevation and `2 s_c tan γ` in azimuth (first
+//! order; Cox & Munk's glitter geometry, their section 3), so the reflected radiance is the mirror image
+//! convolved with a Gaussian of standard deviations `2 σ_1` vertically and `2 σ_1 sin γ` horizontally
+//! (`σ_1 = α/√2` per axis; radians of view, the azimuth's at the mirror direction's elevation `γ`). That is why
+//! reflections on a breezy sea stretch into vertical streaks and lose their outlines.
+//!
+//! **Screen space.** A pinhole camera turns those angles into pixels (`f` pixels per radian at the image centre):
+//! each water pixel's reflected radiance becomes the mean of the traced reflections around it under that lobe,
+//! the screen-space filtering of glossy reflections real-time renderers use (T. Stachowiak, "Stochastic
+//! Screen-Space Reflections", SIGGRAPH 2015 Advances in Real-Time Rendering; here deterministic). Only water
+//! takes part. The lobe is a tent of two box filters per axis (P. S. Heckbert, "Filtering by repeated
+//! integration", SIGGRAPH 1986), each box read from prefix sums, so any width costs the same; the boxes' widths
+//! and shift follow each place's own lobe. The sums run on a grid of cells of several pixels, as coarse as the
+//! narrowest lobe allows (four cells to its standard deviation, [`decimation`]), and each pixel reads them back
+//! bilinearly. Approximations: the lobe is taken at the image's focal length everywhere, the mirror image is
+//! taken as smooth between the traced reflections, and the lobe is cut where the water ends in the image (at a
+//! hull's waterline: there the mean is over the water that remains).
+
+use crate::sensors::shade::rough_water;
+use parry3d::math::Vec3;
+
+/// One traced water reflection: its pixel (`x`, `y`, the pixel's index), the reflected radiance (linear RGB),
+/// the roughness's mean square slope `α²` (both axes) there, and `sin γ`, the sine of its view ray's angle below
+/// the horizontal.
+#[derive(Debug, Clone, Copy)]
+pub struct Sample {
+    /// Pixel column.
+    pub x: u32,
+    /// Pixel row.
+    pub y: u32,
+    /// Reflected radiance, linear RGB.
+    pub value: Vec3,
+    /// Mean square slope `α²`.
+    pub mss: f32,
+    /// Sine of the view ray's angle below the horizontal.
+    pub sin_grazing: f32,
+}
+
+/// The lobe in pixels, `[σ_x, σ_y, Δy]` (standard deviations across and down the image, and how far below the
+/// pixel its centre lies), for mean square slope `mss`, grazing sine `sin_grazing` and focal length `f_px`: the
+/// microfacet lobe's moments ([`rough_water::lobe`]) at `f_px` pixels per radian (an azimuth's at the view's
+/// elevation).
+#[inline]
+pub fn lobe_px(mss: f32, sin_grazing: f32, f_px: f32) -> [f32; 3] {
+    let sin_g = sin_grazing.clamp(0.0, 1.0);
+    let [de, se, sa] = rough_water::lobe(sin_g, mss.max(0.0).sqrt());
+    let cos_g = (1.0 - sin_g * sin_g).sqrt();
+    [sa * f_px * cos_g, se * f_px, de * f_px]
+}
+
+/// The narrowest lobe down the image (pixels) of water whose mean square slope is at least `mss_min`: at the
+/// grazing views where it is narrowest, about 0.6 of the first-order spread `2σ₁ f` (`rough_water.rs`).
+#[inline]
+pub fn narrowest_lobe_px(mss_min: f32, f_px: f32) -> f32 {
+    0.6 * 2.0 * (0.5 * mss_min.max(0.0)).sqrt() * f_px
+}
+
+/// Pixels per coarse-grid cell `[x, y]`: the largest power of two up to 8 down the image such that the narrowest
+/// lobe (`sigma_min_vertical`, pixels) still spans four cells, and half that across (the lobe of water near the
+/// horizon is narrow across the image, so fewer pixels are merged that way); at least `spacing` both ways (the
+/// traced reflections' spacing, so that every cell holds one).
+pub fn decimation(sigma_min_vertical: f32, spacing: usize) -> [usize; 2] {
+    let mut d = 1;
+    while d < 8 && sigma_min_vertical / (2 * d) as f32 >= 4.0 {
+        d *= 2;
+    }
+    [(d / 2).max(spacing.max(1)), d.max(spacing.max(1))]
+}
+
+/// The blurred reflections of one image: the lobe-weighted means on a coarse grid of `dx × dy`-pixel cells,
+/// read back bilinearly ([`Blurred::at`]).
+#[derive(Debug, Clone)]
+pub struct Blurred {
+    dx: usize,
+    dy: usize,
+    /// Where a cell's samples lie on average, in pixels from its centre (the traced reflections sit at the
+    /// corner of each `spacing × spacing` block: `0.5 − spacing / 2`).
+    shift: f32,
+    cw: usize,
+    ch: usize,
+    /// Per cell, the mean reflected radiance over its lobe; `None` where no water lies within reach.
+    mean: Vec<Option<Vec3>>,
+}
+
+impl Blurred {
+    /// The blurred reflected radiance at image point `(u, v)` (pixels; a pixel's centre is `x + 0.5, y + 0.5`):
+    /// bilinear between the four nearest cells that hold water, else the point's own cell's; `None` when
+    /// neither does.
+    #[inline]
+    pub fn at(&self, u: f32, v: f32) -> Option<Vec3> {
+        let fx = ((u - self.shift) / self.dx as f32 - 0.5).clamp(0.0, (self.cw - 1) as f32);
+        let fy = ((v - self.shift) / self.dy as f32 - 0.5).clamp(0.0, (self.ch - 1) as f32);
+        let (x0, y0) = (fx as usize, fy as usize);
+        let (x1, y1) = ((x0 + 1).min(self.cw - 1), (y0 + 1).min(self.ch - 1));
+        let (tx, ty) = (fx - x0 as f32, fy - y0 as f32);
+        let mut acc = Vec3::ZERO;
+        let mut wsum = 0.0;
+        for (cx, cy, wt) in
+            [(x0, y0, (1.0 - tx) * (1.0 - ty)), (x1, y0, tx * (1.0 - ty)), (x0, y1, (1.0 - tx) * ty), (x1, y1, tx * ty)]
+        {
+            if let Some(m) = self.mean[cy * self.cw + cx] {
+                acc += m * wt;
+                wsum += wt;
+            }
+        }
+        if wsum > 0.0 {
+            return Some(acc / wsum);
+        }
+        let (cx, cy) =
+            (((u.max(0.0) as usize) / self.dx).min(self.cw - 1), ((v.max(0.0) as usize) / self.dy).min(self.ch - 1));
+        self.mean[cy * self.cw + cx]
+    }
+}
+
+/// Spreads the traced reflections `samples` of a `width × height` image (focal length `f_px` pixels per radian;
+/// traced every `spacing` pixels, or closer) over their lobes (see the module docs); `None` without samples.
+pub fn blur(width: usize, height: usize, f_px: f32, spacing: usize, samples: &[Sample]) -> Option<Blurred> {
+    if samples.is_empty() || width == 0 || height == 0 {
+        return None;
+    }
+    // The narrowest lobe: the calmest water's, at grazing views.
+    let mss_min = samples.iter().map(|s| s.mss).fold(f32::INFINITY, f32::min);
+    let [dx, dy] = decimation(narrowest_lobe_px(mss_min, f_px), spacing);
+    let (cw, ch) = (width.div_ceil(dx), height.div_ceil(dy));
+    // The coarse grid: sums of radiance and of samples; of the grazing sine and the roughness.
+    let mut sum = vec![[0f32; 4]; cw * ch];
+    let mut geo = vec![[0f32; 2]; cw * ch];
+    for s in samples {
+        let (x, y) = ((s.x as usize).min(width - 1), (s.y as usize).min(height - 1));
+        let c = (y / dy) * cw + x / dx;
+        let acc = &mut sum[c];
+        acc[0] += s.value.x;
+        acc[1] += s.value.y;
+        acc[2] += s.value.z;
+        acc[3] += 1.0;
+        geo[c][0] += s.sin_grazing;
+        geo[c][1] += s.mss;
+    }
+    // Per cell, its lobe (in cells): the half-widths of each box of the tent (a box of width 2r has variance
+    // r²/3; two of σ/√2 make σ), and each vertical box's shift (half the lobe's).
+    let radius: Vec<[f32; 3]> = sum
+        .iter()
+        .zip(&geo)
+        .map(|(s, g)| {
+            if s[3] <= 0.0 {
+                return [0.0; 3];
+            }
+            let [lx, ly, off] = lobe_px(g[1] / s[3], g[0] / s[3], f_px);
+            let k = 1.5f32.sqrt();
+            [lx / dx as f32 * k, ly / dy as f32 * k, 0.5 * off / dy as f32]
+        })
+        .collect();
+    let mut cur = sum;
+    for axis in [1usize, 1, 0, 0] {
+        cur = box_pass(&cur, &radius, cw, ch, axis);
+    }
+    let mean = cur.iter().map(|s| (s[3] > 1e-6).then(|| Vec3::new(s[0], s[1], s[2]) / s[3])).collect();
+    Some(Blurred { dx, dy, shift: 0.5 - 0.5 * spacing.max(1) as f32, cw, ch, mean })
+}
+
+/// One box pass along `axis` (0: along rows, 1: along columns) over the `cw × ch` grid of sums: each cell takes
+/// the sum over the box of half-width `radius[c][axis]` cells centred on it (down the columns, `radius[c][2]`
+/// cells below it), fractional ends read linearly from prefix sums; at least a cell's width.
+fn box_pass(src: &[[f32; 4]], radius: &[[f32; 3]], cw: usize, ch: usize, axis: usize) -> Vec<[f32; 4]> {
+    let (lines, len) = if axis == 0 { (ch, cw) } else { (cw, ch) };
+    let at = move |line: usize, k: usize| if axis == 0 { line * cw + k } else { k * cw + line };
+    let mut out = vec![[0f32; 4]; cw * ch];
+    let mut prefix = vec![[0f64; 4]; len + 1];
+    for line in 0..lines {
+        for k in 0..len {
+            let s = src[at(line, k)];
+            prefix[k + 1] = std::array::from_fn(|c| prefix[k][c] + f64::from(s[c]));
+        }
+        // The sums of the cells over the continuous interval [0, x) (x ≥ 0: truncation is the floor).
+        let cum = |x: f32| -> [f64; 4] {
+            let x = x.clamp(0.0, len as f32);
+            let i = (x as usize).min(len);
+            if i == len {
+                return prefix[len];
+            }
+            let f = f64::from(x - i as f32);
+            let (a, b) = (prefix[i], prefix[i + 1]);
+            std::array::from_fn(|c| a[c] + f * (b[c] - a[c]))
+        };
+        for k in 0..len {
+            let rc = radius[at(line, k)];
+            let r = rc[axis].max(0.5);
+            let centre = k as f32 + 0.5 + if axis == 1 { rc[2] } else { 0.0 };
+            let (hi, lo) = (cum(centre + r), cum(centre - r));
+            out[at(line, k)] = std::array::from_fn(|c| (hi[c] - lo[c]) as f32);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every pixel of a `w × h` image a sample of roughness `mss` and grazing sine `sin_g`, radiance from `value`.
+    fn samples(w: usize, h: usize, mss: f32, sin_g: f32, value: impl Fn(usize, usize) -> Vec3) -> Vec<Sample> {
+        (0..w * h)
+            .map(|i| Sample {
+                x: (i % w) as u32,
+                y: (i / w) as u32,
+                value: value(i % w, i / w),
+                mss,
+                sin_grazing: sin_g,
+            })
+            .collect()
+    }
+
+    /// The blurred image at every pixel centre.
+    fn image(b: &Blurred, w: usize, h: usize) -> Vec<Vec3> {
+        (0..w * h).map(|i| b.at((i % w) as f32 + 0.5, (i / w) as f32 + 0.5).unwrap_or(Vec3::ZERO)).collect()
+    }
+
+    /// Mean and standard deviation of the image's first channel along x and y, as a distribution.
+    fn moments(img: &[Vec3], w: usize) -> ([f64; 2], [f64; 2]) {
+        let total: f64 = img.iter().map(|c| f64::from(c.x)).sum();
+        let mut m = [0f64; 2];
+        for (i, c) in img.iter().enumerate() {
+            m[0] += (i % w) as f64 * f64::from(c.x) / total;
+            m[1] += (i / w) as f64 * f64::from(c.x) / total;
+        }
+        let mut v = [0f64; 2];
+        for (i, c) in img.iter().enumerate() {
+            v[0] += ((i % w) as f64 - m[0]).powi(2) * f64::from(c.x) / total;
+            v[1] += ((i / w) as f64 - m[1]).powi(2) * f64::from(c.x) / total;
+        }
+        (m, [v[0].sqrt(), v[1].sqrt()])
+    }
+
+    #[test]
+    fn a_point_spreads_into_the_lobe_of_its_slopes() {
+        // mss 0.02 at 500 px/rad, sin γ = 0.3: about 2σ₁ f = 100 px down and 2σ₁ f sin γ ≈ 30 px across (the
+        // first-order lobe); the lobe's own moments below.
+        // (Tall enough that the image's edges, where each pixel's mean is over fewer neighbours, are 6 σ away.)
+        let (w, h) = (400, 1200);
+        let s =
+            samples(w, h, 0.02, 0.3, |x, y| if (x, y) == (200, 600) { Vec3::new(1.0, 2.0, 3.0) } else { Vec3::ZERO });
+        let [lx, ly, off] = lobe_px(0.02, 0.3, 500.0);
+        // (Down the image the lobe is narrower than the first-order 100 px: at 17° below the horizontal, part of it
+        // would leave under the horizon and is masked.)
+        assert!((lx - 30.0).abs() < 3.0 && ly > 70.0 && ly < 100.0 && off.abs() < 10.0, "{lx} {ly} {off}");
+        let Some(b) = blur(w, h, 500.0, 1, &s) else { panic!("no blur") };
+        let out = image(&b, w, h);
+        let (m, sd) = moments(&out, w);
+        // Each pixel is a normalised mean over the lobe around it: a unit point spreads into the kernel mirrored
+        // (every pixel whose lobe reaches it), with the kernel's spread (within the discretisation of the boxes
+        // and the coarse grid).
+        assert!((m[0] - 200.0).abs() < 2.0 && (m[1] - (600.0 - f64::from(off))).abs() < 4.0, "centre {m:?}");
+        assert!((sd[0] - f64::from(lx)).abs() < 2.0, "horizontal σ {} px, want {lx}", sd[0]);
+        assert!((sd[1] - f64::from(ly)).abs() < 5.0, "vertical σ {} px, want {ly}", sd[1]);
+        // The channels stay in proportion, and what is spread is what was there (a sum over the pixels).
+        let total: Vec3 = out.iter().copied().sum();
+        assert!((total.y / total.x - 2.0).abs() < 1e-3 && (total.z / total.x - 3.0).abs() < 1e-3);
+        assert!((total.x - 1.0).abs() < 0.03, "total {}", total.x);
+    }
+
+    #[test]
+    fn a_flat_layer_stays_flat_and_other_pixels_neither_give_nor_take() {
+        let (w, h) = (64, 48);
+        // A hull in the middle: not water, so no samples there (whatever it looks like, it must not leak in).
+        let hull = |x: usize, y: usize| (20..40).contains(&x) && (10..20).contains(&y);
+        let s: Vec<Sample> = samples(w, h, 0.01, 0.2, |_, _| Vec3::new(5.0, 6.0, 7.0))
+            .into_iter()
+            .filter(|s| !hull(s.x as usize, s.y as usize))
+            .collect();
+        let Some(b) = blur(w, h, 200.0, 1, &s) else { panic!("no blur") };
+        for (i, c) in image(&b, w, h).iter().enumerate() {
+            if !hull(i % w, i / w) {
+                assert!((*c - Vec3::new(5.0, 6.0, 7.0)).abs().max_element() < 1e-3, "pixel {i}: {c:?}");
+            }
+        }
+        // Traced every other pixel (as at standard quality): the same.
+        let sparse: Vec<Sample> = s.iter().filter(|p| p.x % 2 == 0 && p.y % 2 == 0).copied().collect();
+        let Some(b) = blur(w, h, 200.0, 2, &sparse) else { panic!("no blur") };
+        for (i, c) in image(&b, w, h).iter().enumerate() {
+            if !hull(i % w, i / w) {
+                assert!((*c - Vec3::new(5.0, 6.0, 7.0)).abs().max_element() < 1e-3, "pixel {i}: {c:?}");
+            }
+        }
+        assert!(blur(w, h, 200.0, 1, &[]).is_none());
+    }
+
+    #[test]
+    fn calmer_water_and_a_wider_view_spread_less() {
+        assert!(lobe_px(0.003, 0.5, 320.0)[1] < lobe_px(0.046, 0.5, 320.0)[1]);
+        assert!(lobe_px(0.01, 0.5, 100.0)[1] < lobe_px(0.01, 0.5, 320.0)[1]);
+        // Near the horizon the horizontal spread narrows, and the lobe's centre drops below the pixel.
+        assert!(lobe_px(0.01, 0.02, 320.0)[0] < 0.3 * lobe_px(0.01, 0.5, 320.0)[0]);
+        assert!(lobe_px(0.01, 0.02, 320.0)[2] > 10.0);
+        assert_eq!(decimation(1.0, 1), [1, 1]);
+        assert_eq!(decimation(1.0, 2), [2, 2]);
+        assert_eq!(decimation(10.0, 1), [1, 2]);
+        assert_eq!(decimation(20.0, 1), [2, 4]);
+        assert_eq!(decimation(100.0, 2), [4, 8]);
+    }
+}
