@@ -615,7 +615,8 @@ def render_mitsuba(
         img = render_layer(scene, layer, width, height, seed=seed + 101 * k, workdir=workdir, envmap=envmap, only=mask)
         seconds[layer.name] = time.perf_counter() - t0
         images[layer.name] = img
-        total += img * mask[..., None]
+        # (np.where, not a product: a NaN sample outside the layer's pixels must not reach the composite.)
+        total += np.where(mask[..., None], img, 0.0)
     return MitsubaImage(radiance=total.astype(np.float32), layers=images, seconds=seconds)
 
 
