@@ -40,11 +40,11 @@ RIG_PRESETS: dict[str, dict[str, object]] = {
 
 CameraOutput = Literal["rgb", "depth", "semantic", "instance"]
 Quality = Literal["draft", "standard", "high"]
-"""Work spent on a camera's RGB: ``draft`` one sample per pixel and water reflecting the sky; ``standard`` water
-reflections traced once per 2 × 2 block of water pixels (each other pixel takes the mean of the block corners around
-it) and 4 stratified samples on edge pixels (a change of
-instance, class or material, or a depth step off the water); ``high`` reflections traced for every pixel and 16
-samples on edges."""
+"""Work spent on a camera's RGB: ``draft`` one sample per pixel and water reflecting the sky along each pixel's
+mirror direction; ``standard`` water reflections traced once per 2 × 2 block of water pixels (4 × 4 where the
+water's glossy lobe spans many such blocks) and spread over that lobe, and 4 stratified samples on edge pixels (a
+change of instance, class or material, or a depth step off the water); ``high`` reflections traced for every pixel
+(then spread over the lobe) and 16 samples on edges."""
 _ALL_OUTPUTS: tuple[CameraOutput, ...] = ("rgb", "depth", "semantic", "instance")
 _TOP_OUTPUTS: tuple[CameraOutput, ...] = ("rgb", "semantic", "instance")
 

@@ -60,8 +60,8 @@ pub enum Projection {
 pub enum Quality {
     /// One sample per pixel; water reflects the sky only.
     Draft,
-    /// Traced water reflections, one per 2 × 2 block of water pixels (the others the mean of the block corners
-    /// around them); 4 stratified samples on edge pixels.
+    /// Traced water reflections, one per 2 × 2 block of water pixels (4 × 4 where the water's glossy lobe spans
+    /// many such blocks), spread over that lobe; 4 stratified samples on edge pixels.
     #[default]
     Standard,
     /// Traced water reflections for every pixel; 16 stratified samples on edge pixels.
@@ -391,7 +391,8 @@ impl Camera {
             .with_seabed(scene.seabed())
             .with_waves(scene.wave_surface())
             .with_footprint(pixel_rad, pixel_m);
-        // Standard quality shares one traced reflection per 2 × 2 block of water pixels; high traces each. Below
+        // Standard quality shares one traced reflection per 2 × 2 (or 4 × 4) block of water pixels; high traces
+        // each; both spread them over the water's glossy lobe. Below
         // `high`, open water and sky share their shading over the pixels between even rows and columns wherever
         // the even pixels around agree (radiance::radiance).
         let grid = self.pixel_grid();

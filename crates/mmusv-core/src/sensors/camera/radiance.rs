@@ -387,14 +387,15 @@ pub fn radiance(
     // The traced reflections spread over the water's roughness lobe, read back at each water pixel.
     let blurred = match glossy {
         Some((grid, f_px)) if !matches!(reflections, Reflections::Sky | Reflections::Given(_)) => {
+            // (A camera's ray directions are unit vectors: `−d.z` is the grazing sine.)
             let samples: Vec<glossy::Sample> = index
-                .iter()
+                .par_iter()
+                .with_min_len(PASS_CHUNK)
                 .enumerate()
                 .filter(|(_, &i)| i != u32::MAX)
                 .map(|(k, &i)| {
                     let [x, y] = grid.pos[k];
-                    let d = dirs[k];
-                    let sin_grazing = (-d[2] / (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()).max(0.0);
+                    let sin_grazing = (-dirs[k][2]).max(0.0);
                     let mss = shader.water_mss(traced_hits[i as usize].unresolved_mss);
                     glossy::Sample { x: u32::from(x), y: u32::from(y), value: values[i as usize], mss, sin_grazing }
                 })

@@ -50,7 +50,11 @@ pub fn smith_g1(cos_theta: f64, alpha: f64) -> f64 {
     }
 }
 
-/// The Beckmann distribution `D` at `cos θ_h = n_dot_h` for roughness `alpha`.
+/// Beyond this `tan²θ_h / α²` the Beckmann `D` is taken as 0: `e^−60 ≈ 10⁻²⁶`, so even the sun's glint there is
+/// below 10⁻¹⁸ cd/m² (and the exponential, most pixels' case, is skipped).
+const D_CUTOFF: f32 = 60.0;
+
+/// The Beckmann distribution `D` at `cos θ_h = n_dot_h` for roughness `alpha` (0 past [`D_CUTOFF`]).
 #[inline(always)]
 pub fn beckmann_d(n_dot_h: f32, alpha: f32) -> f32 {
     if n_dot_h <= 0.0 || alpha <= 0.0 {
@@ -59,7 +63,11 @@ pub fn beckmann_d(n_dot_h: f32, alpha: f32) -> f32 {
     let c2 = n_dot_h * n_dot_h;
     let tan2 = (1.0 - c2).max(0.0) / c2;
     let a2 = alpha * alpha;
-    (-tan2 / a2).exp() / (std::f32::consts::PI * a2 * c2 * c2)
+    let x = tan2 / a2;
+    if x > D_CUTOFF {
+        return 0.0;
+    }
+    (-x).exp() / (std::f32::consts::PI * a2 * c2 * c2)
 }
 
 /// The specular reflection of light from unit direction `l` seen from `v` on water of normal `n` and roughness
@@ -72,9 +80,13 @@ pub fn specular_cos(n: Vec3, v: Vec3, l: Vec3, alpha: f32) -> f32 {
         return 0.0;
     }
     let h = (v + l).normalize_or_zero();
+    let d = beckmann_d(n.dot(h), alpha);
+    if d == 0.0 {
+        return 0.0;
+    }
     let a = f64::from(alpha);
     let g = (smith_g1(f64::from(nl), a) * smith_g1(f64::from(nv), a)) as f32;
-    beckmann_d(n.dot(h), alpha) * g / (4.0 * nv)
+    d * g / (4.0 * nv)
 }
 
 /// `E(μ_o, α)` by quadrature (see the module docs): facet normals drawn from the Beckmann distribution on a
