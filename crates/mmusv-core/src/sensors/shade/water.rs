@@ -15,7 +15,11 @@
 //!   J. Mar. Res. 11, 1952), thresholded at the `(1 − W)` quantile of that sum (noise and a standard normal),
 //!   so the coverage stays `W` while the foam gathers on the crests. Foam is Lambertian with albedo 0.55, the
 //!   reflectance of fresh dense foam (P. Koepke, "Effective reflectance of oceanic whitecaps", Appl. Opt.
-//!   23(11), 1984).
+//!   23(11), 1984). A whitecap is not all fresh foam: its foam thins as it ages, and Koepke finds the
+//!   *effective* reflectance of whitecaps, over their area and lifetime, to be 0.22 — 0.4 of fresh foam's. So
+//!   within the covered area the foam's density rises from 0 at a patch's edge with the noise's excess over the
+//!   threshold, linearly up to full over a band chosen (from the same sample as the threshold) so that the mean
+//!   density over the covered area is 0.4: bright cores fading into thin foam, not flat white patches.
 //! * **Wind from the sea state** when the scenario gives none: a fully developed Pierson–Moskowitz sea,
 //!   `H_s = 0.21 U² / g` (W. J. Pierson & L. Moskowitz, JGR 69(24), 1964), so `U = √(H_s g / 0.21)`.
 //! * **Wakes**: behind every vessel under way, turbulent foam along its track (as wide as its beam, widening
@@ -108,6 +112,9 @@ impl ShallowWater {
 
 /// Albedo of dense foam.
 pub const FOAM_ALBEDO: f32 = 0.55;
+/// Koepke's effective reflectance of whitecaps (0.22) over fresh foam's: the mean foam density over the whitecaps'
+/// area.
+pub const WHITECAP_MEAN_DENSITY: f32 = 0.22 / 0.55;
 /// e-folding age of wake foam, seconds.
 const WAKE_FADE_S: f32 = 30.0;
 /// `tan` of the Kelvin half-angle.
@@ -214,11 +221,13 @@ pub fn foam_noise(seed: u64, x: f32, y: f32) -> f32 {
 pub const CREST_WEIGHT: f32 = 0.12;
 
 /// The `(1 − coverage)` quantile of the foam noise (plus [`CREST_WEIGHT`] times a standard normal, the
-/// normalised elevation, with `crests`), from a fixed sample of it (cached per coverage, seed and `crests`:
-/// every render of a run asks for the same one).
-fn foam_threshold(coverage: f32, seed: u64, crests: bool) -> f32 {
+/// normalised elevation, with `crests`), from a fixed sample of it, and the band of noise over which the foam's
+/// density rises from 0 to full so that its mean over the covered part of the sample is
+/// [`WHITECAP_MEAN_DENSITY`] (cached per coverage, seed and `crests`: every render of a run asks for the same
+/// ones).
+fn foam_threshold(coverage: f32, seed: u64, crests: bool) -> (f32, f32) {
     type Key = (u32, u64, bool);
-    static CACHE: std::sync::Mutex<Vec<(Key, f32)>> = std::sync::Mutex::new(Vec::new());
+    static CACHE: std::sync::Mutex<Vec<(Key, (f32, f32))>> = std::sync::Mutex::new(Vec::new());
     let key = (coverage.to_bits(), seed, crests);
     if let Ok(c) = CACHE.lock() {
         if let Some(&(_, t)) = c.iter().find(|(k, _)| *k == key) {
@@ -234,7 +243,9 @@ fn foam_threshold(coverage: f32, seed: u64, crests: bool) -> f32 {
         })
         .collect();
     v.sort_by(f32::total_cmp);
-    let t = v[((1.0 - coverage) * (v.len() - 1) as f32).round() as usize];
+    let th = v[((1.0 - coverage) * (v.len() - 1) as f32).round() as usize];
+    let excess: Vec<f32> = v.iter().filter(|&&n| n > th).map(|&n| n - th).collect();
+    let t = (th, density_band(&excess, WHITECAP_MEAN_DENSITY));
     if let Ok(mut c) = CACHE.lock() {
         if c.len() >= 16 {
             c.remove(0);
@@ -242,6 +253,27 @@ fn foam_threshold(coverage: f32, seed: u64, crests: bool) -> f32 {
         c.push((key, t));
     }
     t
+}
+
+/// The band `b` for which the mean of `min(1, e / b)` over the excesses `e > 0` is `mean` (past the widest
+/// excess the mean is `mean(e) / b`, in closed form; below it, bisection; a tiny band without excesses).
+fn density_band(excess: &[f32], mean: f32) -> f32 {
+    let Some(&widest) = excess.iter().max_by(|a, b| a.total_cmp(b)) else { return 1e-3 };
+    let mean_at = |b: f32| excess.iter().map(|&e| (e / b).min(1.0)).sum::<f32>() / excess.len() as f32;
+    let (mut lo, mut hi) = (1e-6f32, widest.max(1e-6));
+    if mean_at(hi) >= mean {
+        return excess.iter().sum::<f32>() / excess.len() as f32 / mean;
+    }
+    // The mean falls as the band widens.
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if mean_at(mid) > mean {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
 }
 
 /// A seeded standard normal deviate (Box–Muller), the `i`-th of the foam's threshold sample.
@@ -259,6 +291,8 @@ const NO_WHITECAPS: f32 = 1e6;
 pub struct Foam {
     /// Noise level above which the surface is a whitecap (`> 1 + CREST_WEIGHT·8`: none).
     threshold: f32,
+    /// Noise band over which a whitecap's foam density rises from 0 to full.
+    band: f32,
     /// The whitecap coverage asked for.
     coverage: f32,
     /// Whether the threshold is that of the noise biased by the crests ([`Foam::on_crests`]).
@@ -282,7 +316,8 @@ struct WakeShape {
 impl Foam {
     /// Foam for whitecap `coverage` in `[0, 1]` and `wakes`, placed by `seed`.
     pub fn new(coverage: f32, wakes: &[Wake], seed: u64) -> Self {
-        let threshold = if coverage <= 0.0 { NO_WHITECAPS } else { foam_threshold(coverage.min(1.0), seed, false) };
+        let (threshold, band) =
+            if coverage <= 0.0 { (NO_WHITECAPS, 1.0) } else { foam_threshold(coverage.min(1.0), seed, false) };
         let wakes = wakes
             .iter()
             .filter(|w| w.speed > 0.05)
@@ -298,14 +333,14 @@ impl Foam {
                 }
             })
             .collect();
-        Self { threshold, coverage, crests: false, seed, wakes }
+        Self { threshold, band, coverage, crests: false, seed, wakes }
     }
 
     /// This foam with its whitecaps gathered on the wave crests (see the module docs): [`Foam::cover`] is then
     /// given each point's normalised elevation `η/σ_η`.
     pub fn on_crests(mut self) -> Self {
         if self.threshold < NO_WHITECAPS {
-            self.threshold = foam_threshold(self.coverage.min(1.0), self.seed, true);
+            (self.threshold, self.band) = foam_threshold(self.coverage.min(1.0), self.seed, true);
         }
         self.crests = true;
         self
@@ -316,7 +351,7 @@ impl Foam {
         self.threshold >= NO_WHITECAPS && self.wakes.is_empty()
     }
 
-    /// Foam cover in `[0, 1]` at world point `(x, y)`, whose normalised elevation is `crest` (`η/σ_η`; read
+    /// Foam cover (density) in `[0, 1]` at world point `(x, y)`, whose normalised elevation is `crest` (`η/σ_η`; read
     /// only [`Foam::on_crests`]).
     #[inline(always)]
     pub fn cover(&self, x: f32, y: f32, crest: f32) -> f32 {
@@ -329,8 +364,8 @@ impl Foam {
             && (0.5 * value_noise(self.seed, x / 6.0, y / 6.0) + 0.375) / 0.875 + lift > self.threshold - 0.015
         {
             let n = noise_at() + lift;
-            // A soft edge over 0.03 of the noise range.
-            c = ((n - self.threshold) / 0.03 + 0.5).clamp(0.0, 1.0);
+            // Thin at the edge, dense in the core (see the module docs).
+            c = ((n - self.threshold) / self.band).clamp(0.0, 1.0);
         }
         for w in &self.wakes {
             let [co, s] = w.dir;
@@ -409,20 +444,31 @@ mod tests {
         assert!((b - (0.03 + (0.22 - 0.03) * (-0.72f32).exp())).abs() < 1e-5);
     }
 
+    /// Monahan's coverage is the area with foam; over it the foam's mean density is Koepke's effective
+    /// reflectance over fresh foam's, and it rises from thin edges to dense cores.
     #[test]
     fn whitecap_cover_matches_coverage() {
         for cov in [0.01f32, 0.05, 0.2] {
             let foam = Foam::new(cov, &[], 7);
             let n = 200_000u64;
-            let mut s = 0.0f64;
+            let (mut s, mut covered, mut dense) = (0.0f64, 0u64, 0u64);
             for i in 0..n {
                 let x = noise::uniform(99, 1, 2 * i) as f32 * 3000.0 - 1500.0;
                 let y = noise::uniform(99, 1, 2 * i + 1) as f32 * 3000.0 - 1500.0;
-                s += foam.cover(x, y, 0.0) as f64;
+                let c = foam.cover(x, y, 0.0);
+                s += c as f64;
+                covered += u64::from(c > 0.0);
+                dense += u64::from(c >= 1.0);
             }
-            let got = s / n as f64;
+            let got = covered as f64 / n as f64;
             assert!((got - cov as f64).abs() < 0.2 * cov as f64 + 0.002, "coverage {cov}: {got}");
+            let density = s / covered as f64;
+            assert!((density - 0.4).abs() < 0.04, "coverage {cov}: mean density {density}");
+            // Some of it is full foam (the cores), most of it thinner.
+            let core = dense as f64 / covered as f64;
+            assert!(core > 0.02 && core < 0.4, "coverage {cov}: cores {core}");
         }
+        assert!((density_band(&[0.1, 0.2, 0.3, 0.4], 0.5) - 0.5).abs() < 1e-4);
         assert!(Foam::new(0.0, &[], 1).is_empty());
         assert!(Foam::new(0.0, &[], 1).on_crests().is_empty());
     }
@@ -448,7 +494,7 @@ mod tests {
                     trough_n += 1;
                 }
             }
-            let got = s / n as f64;
+            let got = s / n as f64 / f64::from(WHITECAP_MEAN_DENSITY);
             assert!((got - cov as f64).abs() < 0.2 * cov as f64 + 0.002, "coverage {cov}: {got}");
             let mean_crest = crest_sum / s;
             assert!(mean_crest > 0.7, "coverage {cov}: foam at a mean elevation of {mean_crest} σ");
