@@ -54,7 +54,7 @@ pub fn smith_g1(cos_theta: f64, alpha: f64) -> f64 {
 /// below 10⁻¹⁸ cd/m² (and the exponential, most pixels' case, is skipped).
 const D_CUTOFF: f32 = 60.0;
 
-/// The Beckmann distribution `D` at `cos θ_h = n_dot_h` for roughness `alpha` (0 past [`D_CUTOFF`]).
+/// The Beckmann distribution `D` at `cos θ_h = n_dot_h` for roughness `alpha` (0 where `tan²θ_h / α² > 60`).
 #[inline(always)]
 pub fn beckmann_d(n_dot_h: f32, alpha: f32) -> f32 {
     if n_dot_h <= 0.0 || alpha <= 0.0 {
