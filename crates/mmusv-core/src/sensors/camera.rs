@@ -404,7 +404,7 @@ impl Camera {
         let shared = if q == Quality::High { None } else { Some(grid) };
         // Reflections spread over the water's roughness (pinhole cameras; the top view looks straight down).
         let glossy = match self.cfg.projection {
-            Projection::Pinhole { .. } if pixel_rad > 0.0 => Some((grid, 1.0 / pixel_rad)),
+            Projection::Pinhole { .. } if pixel_rad > 0.0 => Some((grid, 1.0 / pixel_rad, image_roll(pose))),
             _ => None,
         };
         let shaded = radiance::radiance(scene, &shader, env.shadows, refl, shared, glossy, (&origins, &dirs, &hits))?;
@@ -498,6 +498,19 @@ impl Camera {
             }
         }
     }
+}
+
+/// How far the world's vertical shows turned in a pinhole image taken from `pose` (radians; 0 for a level camera,
+/// `−θ` for one rolled by `θ` about its axis): the image's "down" (`−z` of the camera body, as `+v`) against the
+/// world's down there. 0 when the camera looks straight up or down.
+fn image_roll(pose: &RigidPose) -> f32 {
+    let r = pose.rotation;
+    // The world's up in the camera body: the third row of the rotation.
+    let (up_y, up_z) = (r.y_axis.z, r.z_axis.z);
+    if up_y == 0.0 && up_z == 0.0 {
+        return 0.0;
+    }
+    (-up_y).atan2(up_z)
 }
 
 #[cfg(test)]

@@ -20,9 +20,10 @@
 //! integration", SIGGRAPH 1986), each box read from prefix sums, so any width costs the same; the boxes' widths
 //! and shift follow each place's own lobe. The sums run on a grid of cells of several pixels, as coarse as the
 //! narrowest lobe allows (four cells to its standard deviation, [`decimation`]), and each pixel reads them back
-//! bilinearly. Approximations: the lobe is taken at the image's focal length everywhere, the mirror image is
-//! taken as smooth between the traced reflections, and the lobe is cut where the water ends in the image (at a
-//! hull's waterline: there the mean is over the water that remains).
+//! bilinearly. The grid is laid along the world's vertical as the image shows it (turned by the camera's roll),
+//! so a rolling USV's streaks stay vertical in the world. Approximations: the lobe is taken at the image's focal
+//! length everywhere, the mirror image is taken as smooth between the traced reflections, and the lobe is cut
+//! where the water ends in the image (at a hull's waterline: there the mean is over the water that remains).
 
 use crate::sensors::shade::rough_water;
 use parry3d::math::Vec3;
@@ -79,6 +80,9 @@ pub fn decimation(sigma_min_vertical: f32, spacing: usize) -> [usize; 2] {
 /// read back bilinearly ([`Blurred::at`]).
 #[derive(Debug, Clone)]
 pub struct Blurred {
+    /// The frame the grid is laid in: image points turned by the camera's roll about `centre`, so that the grid's
+    /// columns run along the world's vertical as the image shows it, then moved by `origin`.
+    frame: Frame,
     dx: usize,
     dy: usize,
     /// Where a cell's samples lie on average, in pixels from its centre (the traced reflections sit at the
@@ -96,6 +100,7 @@ impl Blurred {
     /// neither does.
     #[inline]
     pub fn at(&self, u: f32, v: f32) -> Option<Vec3> {
+        let [u, v] = self.frame.grid_point(u, v);
         let fx = ((u - self.shift) / self.dx as f32 - 0.5).clamp(0.0, (self.cw - 1) as f32);
         let fy = ((v - self.shift) / self.dy as f32 - 0.5).clamp(0.0, (self.ch - 1) as f32);
         let (x0, y0) = (fx as usize, fy as usize);
@@ -116,25 +121,76 @@ impl Blurred {
         }
         let (cx, cy) =
             (((u.max(0.0) as usize) / self.dx).min(self.cw - 1), ((v.max(0.0) as usize) / self.dy).min(self.ch - 1));
+        // (u, v) are in the grid's frame here.
         self.mean[cy * self.cw + cx]
     }
 }
 
+/// Image points (pixels) to the grid's frame: turned by `-roll` about `centre`, then moved by `-origin`. Without
+/// roll it is the identity (exactly: the centre and origin are zero then).
+#[derive(Debug, Clone, Copy)]
+struct Frame {
+    cos: f32,
+    sin: f32,
+    centre: [f32; 2],
+    origin: [f32; 2],
+}
+
+impl Frame {
+    /// The frame of a `width × height` image whose world vertical shows turned by `roll` radians (clockwise
+    /// positive: the image's "down" lies at `roll` from its columns), holding the whole image.
+    fn new(width: usize, height: usize, roll: f32) -> Self {
+        if roll == 0.0 || !roll.is_finite() {
+            return Self { cos: 1.0, sin: 0.0, centre: [0.0; 2], origin: [0.0; 2] };
+        }
+        let (sin, cos) = roll.sin_cos();
+        let centre = [0.5 * width as f32, 0.5 * height as f32];
+        let mut f = Self { cos, sin, centre, origin: [0.0; 2] };
+        let corners = [[0.0, 0.0], [width as f32, 0.0], [0.0, height as f32], [width as f32, height as f32]];
+        let g = corners.map(|[u, v]| f.grid_point(u, v));
+        f.origin = [
+            g.iter().map(|p| p[0]).fold(f32::INFINITY, f32::min),
+            g.iter().map(|p| p[1]).fold(f32::INFINITY, f32::min),
+        ];
+        f
+    }
+
+    /// The grid frame's extent, pixels `[across, down]`, for a `width × height` image.
+    fn extent(&self, width: usize, height: usize) -> [f32; 2] {
+        let corners = [[0.0, 0.0], [width as f32, 0.0], [0.0, height as f32], [width as f32, height as f32]];
+        let g = corners.map(|[u, v]| self.grid_point(u, v));
+        [g.iter().map(|p| p[0]).fold(0.0, f32::max), g.iter().map(|p| p[1]).fold(0.0, f32::max)]
+    }
+
+    #[inline(always)]
+    fn grid_point(&self, u: f32, v: f32) -> [f32; 2] {
+        let (x, y) = (u - self.centre[0], v - self.centre[1]);
+        [
+            self.cos * x + self.sin * y + self.centre[0] - self.origin[0],
+            -self.sin * x + self.cos * y + self.centre[1] - self.origin[1],
+        ]
+    }
+}
+
 /// Spreads the traced reflections `samples` of a `width × height` image (focal length `f_px` pixels per radian;
-/// traced every `spacing` pixels, or closer) over their lobes (see the module docs); `None` without samples.
-pub fn blur(width: usize, height: usize, f_px: f32, spacing: usize, samples: &[Sample]) -> Option<Blurred> {
+/// traced every `spacing` pixels, or closer; the world's vertical turned by `roll` radians in the image, the
+/// camera's roll) over their lobes (see the module docs); `None` without samples.
+pub fn blur(width: usize, height: usize, f_px: f32, spacing: usize, roll: f32, samples: &[Sample]) -> Option<Blurred> {
     if samples.is_empty() || width == 0 || height == 0 {
         return None;
     }
     // The narrowest lobe: the calmest water's, at grazing views.
     let mss_min = samples.iter().map(|s| s.mss).fold(f32::INFINITY, f32::min);
     let [dx, dy] = decimation(narrowest_lobe_px(mss_min, f_px), spacing);
-    let (cw, ch) = (width.div_ceil(dx), height.div_ceil(dy));
+    let frame = Frame::new(width, height, roll);
+    let [ew, eh] = frame.extent(width, height);
+    let (cw, ch) = ((ew.ceil() as usize).div_ceil(dx).max(1), (eh.ceil() as usize).div_ceil(dy).max(1));
     // The coarse grid: sums of radiance and of samples; of the grazing sine and the roughness.
     let mut sum = vec![[0f32; 4]; cw * ch];
     let mut geo = vec![[0f32; 2]; cw * ch];
     for s in samples {
-        let (x, y) = ((s.x as usize).min(width - 1), (s.y as usize).min(height - 1));
+        let [gx, gy] = frame.grid_point(s.x as f32 + 0.5, s.y as f32 + 0.5);
+        let (x, y) = ((gx.max(0.0) as usize).min(cw * dx - 1), (gy.max(0.0) as usize).min(ch * dy - 1));
         let c = (y / dy) * cw + x / dx;
         let acc = &mut sum[c];
         acc[0] += s.value.x;
@@ -163,7 +219,9 @@ pub fn blur(width: usize, height: usize, f_px: f32, spacing: usize, samples: &[S
         cur = box_pass(&cur, &radius, cw, ch, axis);
     }
     let mean = cur.iter().map(|s| (s[3] > 1e-6).then(|| Vec3::new(s[0], s[1], s[2]) / s[3])).collect();
-    Some(Blurred { dx, dy, shift: 0.5 - 0.5 * spacing.max(1) as f32, cw, ch, mean })
+    // (Turned, the traced corners no longer sit at a fixed place in their cells.)
+    let shift = if frame.sin == 0.0 { 0.5 - 0.5 * spacing.max(1) as f32 } else { 0.0 };
+    Some(Blurred { frame, dx, dy, shift, cw, ch, mean })
 }
 
 /// One box pass along `axis` (0: along rows, 1: along columns) over the `cw × ch` grid of sums: each cell takes
@@ -251,7 +309,7 @@ mod tests {
         // (Down the image the lobe is narrower than the first-order 100 px: at 17° below the horizontal, part of it
         // would leave under the horizon and is masked.)
         assert!((lx - 30.0).abs() < 3.0 && ly > 70.0 && ly < 100.0 && off.abs() < 10.0, "{lx} {ly} {off}");
-        let Some(b) = blur(w, h, 500.0, 1, &s) else { panic!("no blur") };
+        let Some(b) = blur(w, h, 500.0, 1, 0.0, &s) else { panic!("no blur") };
         let out = image(&b, w, h);
         let (m, sd) = moments(&out, w);
         // Each pixel is a normalised mean over the lobe around it: a unit point spreads into the kernel mirrored
@@ -267,6 +325,34 @@ mod tests {
     }
 
     #[test]
+    fn a_rolled_camera_spreads_along_the_world_vertical_it_shows() {
+        // The same point as above, the world's vertical turned by 0.3 rad in the image: the spread's long axis is
+        // the image's (−sin 0.3, cos 0.3), and its two spreads are the lobe's.
+        let (w, h, roll) = (900usize, 900usize, 0.3f32);
+        let s = samples(w, h, 0.02, 0.3, |x, y| if (x, y) == (450, 450) { Vec3::ONE } else { Vec3::ZERO });
+        let Some(b) = blur(w, h, 500.0, 1, roll, &s) else { panic!("no blur") };
+        let out = image(&b, w, h);
+        let total: f64 = out.iter().map(|c| f64::from(c.x)).sum();
+        let mean = |f: &dyn Fn(f64, f64) -> f64| {
+            out.iter().enumerate().map(|(i, c)| f((i % w) as f64, (i / w) as f64) * f64::from(c.x)).sum::<f64>() / total
+        };
+        let (mx, my) = (mean(&|x, _| x), mean(&|_, y| y));
+        let sxx = mean(&|x, _| (x - mx).powi(2));
+        let syy = mean(&|_, y| (y - my).powi(2));
+        let sxy = mean(&|x, y| (x - mx) * (y - my));
+        // Principal axis of the covariance, and the spreads along and across it.
+        let angle = 0.5 * (2.0 * sxy).atan2(syy - sxx);
+        let want = f64::from(-roll);
+        assert!((angle - want).abs() < 0.03, "long axis at {angle} rad from the columns, want {want}");
+        let [lx, ly, _] = lobe_px(0.02, 0.3, 500.0);
+        let (c, sn) = (angle.cos(), angle.sin());
+        let along = (syy * c * c + sxx * sn * sn + 2.0 * sxy * sn * c).sqrt();
+        let across = (sxx * c * c + syy * sn * sn - 2.0 * sxy * sn * c).sqrt();
+        assert!((along - f64::from(ly)).abs() < 6.0, "along {along}, want {ly}");
+        assert!((across - f64::from(lx)).abs() < 3.0, "across {across}, want {lx}");
+    }
+
+    #[test]
     fn a_flat_layer_stays_flat_and_other_pixels_neither_give_nor_take() {
         let (w, h) = (64, 48);
         // A hull in the middle: not water, so no samples there (whatever it looks like, it must not leak in).
@@ -275,7 +361,7 @@ mod tests {
             .into_iter()
             .filter(|s| !hull(s.x as usize, s.y as usize))
             .collect();
-        let Some(b) = blur(w, h, 200.0, 1, &s) else { panic!("no blur") };
+        let Some(b) = blur(w, h, 200.0, 1, 0.0, &s) else { panic!("no blur") };
         for (i, c) in image(&b, w, h).iter().enumerate() {
             if !hull(i % w, i / w) {
                 assert!((*c - Vec3::new(5.0, 6.0, 7.0)).abs().max_element() < 1e-3, "pixel {i}: {c:?}");
@@ -283,13 +369,13 @@ mod tests {
         }
         // Traced every other pixel (as at standard quality): the same.
         let sparse: Vec<Sample> = s.iter().filter(|p| p.x % 2 == 0 && p.y % 2 == 0).copied().collect();
-        let Some(b) = blur(w, h, 200.0, 2, &sparse) else { panic!("no blur") };
+        let Some(b) = blur(w, h, 200.0, 2, 0.0, &sparse) else { panic!("no blur") };
         for (i, c) in image(&b, w, h).iter().enumerate() {
             if !hull(i % w, i / w) {
                 assert!((*c - Vec3::new(5.0, 6.0, 7.0)).abs().max_element() < 1e-3, "pixel {i}: {c:?}");
             }
         }
-        assert!(blur(w, h, 200.0, 1, &[]).is_none());
+        assert!(blur(w, h, 200.0, 1, 0.0, &[]).is_none());
     }
 
     #[test]

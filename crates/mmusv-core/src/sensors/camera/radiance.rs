@@ -251,8 +251,8 @@ pub struct Shaded {
 /// Radiance (linear RGB, cd/m², aerial perspective included) along every ray `origins[k] + t dirs[k]` whose
 /// closest hits are `hits`, with water `reflections` traced as asked; `shadows` casts shadow rays (else every
 /// surface facing the sun is lit). With `glossy` (the rays are a pinhole camera's pixels, its focal length in
-/// pixels per radian), the traced reflections are spread over the water's roughness lobe (`glossy.rs`) before
-/// the water is shaded.
+/// pixels per radian and its roll: how far the world's vertical shows turned in the image, radians), the traced
+/// reflections are spread over the water's roughness lobe (`glossy.rs`) before the water is shaded.
 ///
 /// With `shared` (the rays are a camera's pixels), a ray that sees the open water or the sky, as all its anchors
 /// ([`PixelGrid::anchors`]) do, takes their mean when their colours are alike ([`alike`] under the shader's
@@ -266,7 +266,7 @@ pub fn radiance(
     shadows: bool,
     reflections: Reflections<'_>,
     shared: Option<PixelGrid<'_>>,
-    glossy: Option<(PixelGrid<'_>, f32)>,
+    glossy: Option<(PixelGrid<'_>, f32, f32)>,
     (origins, dirs, hits): (&[[f32; 3]], &[[f32; 3]], &RayHits),
 ) -> Result<Shaded> {
     let n = origins.len();
@@ -302,7 +302,7 @@ pub fn radiance(
     // glossy lobe of the calmest water here spans many such blocks (the blur then reads them on cells at least
     // that coarse, `glossy::decimation`).
     let spacing = match (reflections, glossy) {
-        (Reflections::Shared(_), Some((_, f_px))) => {
+        (Reflections::Shared(_), Some((_, f_px, _))) => {
             glossy::decimation(glossy::narrowest_lobe_px(shader.water_mss(0.0), f_px), 2)[0] as u32
         }
         (Reflections::Shared(_), None) => 2,
@@ -386,7 +386,7 @@ pub fn radiance(
     };
     // The traced reflections spread over the water's roughness lobe, read back at each water pixel.
     let blurred = match glossy {
-        Some((grid, f_px)) if !matches!(reflections, Reflections::Sky | Reflections::Given(_)) => {
+        Some((grid, f_px, roll)) if !matches!(reflections, Reflections::Sky | Reflections::Given(_)) => {
             // (A camera's ray directions are unit vectors: `−d.z` is the grazing sine.)
             let samples: Vec<glossy::Sample> = index
                 .par_iter()
@@ -400,7 +400,8 @@ pub fn radiance(
                     glossy::Sample { x: u32::from(x), y: u32::from(y), value: values[i as usize], mss, sin_grazing }
                 })
                 .collect();
-            glossy::blur(grid.width as usize, grid.height as usize, f_px, spacing as usize, &samples).map(|b| (b, grid))
+            let (w, h) = (grid.width as usize, grid.height as usize);
+            glossy::blur(w, h, f_px, spacing as usize, roll, &samples).map(|b| (b, grid))
         }
         _ => None,
     };

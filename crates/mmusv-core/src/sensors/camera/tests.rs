@@ -263,3 +263,13 @@ fn shared_reflections_are_reconstructed_from_the_corners_around() {
     assert!(compared > 3000, "{compared} pixels compared");
     assert!(mean < 0.4 && worst <= 75, "mean {mean:.3}, worst {worst} levels");
 }
+
+#[test]
+fn the_image_roll_is_the_cameras_roll_about_its_axis() {
+    assert_eq!(super::image_roll(&RigidPose::from_xyz_rpy([1.0, 2.0, 3.0], [0.0, 0.0, 0.7])), 0.0);
+    let rolled = super::image_roll(&RigidPose::from_xyz_rpy([0.0; 3], [0.2, 0.0, 0.4]));
+    assert!((rolled + 0.2).abs() < 1e-5, "{rolled}");
+    // Pitched down, the roll still reads as the roll.
+    let pitched = super::image_roll(&RigidPose::from_xyz_rpy([0.0; 3], [0.1, 0.3, 0.0]));
+    assert!((pitched + 0.1).abs() < 0.02, "{pitched}");
+}
