@@ -145,21 +145,19 @@ impl Frame {
         }
         let (sin, cos) = roll.sin_cos();
         let centre = [0.5 * width as f32, 0.5 * height as f32];
-        let mut f = Self { cos, sin, centre, origin: [0.0; 2] };
-        let corners = [[0.0, 0.0], [width as f32, 0.0], [0.0, height as f32], [width as f32, height as f32]];
-        let g = corners.map(|[u, v]| f.grid_point(u, v));
-        f.origin = [
-            g.iter().map(|p| p[0]).fold(f32::INFINITY, f32::min),
-            g.iter().map(|p| p[1]).fold(f32::INFINITY, f32::min),
-        ];
-        f
+        let turned = Self { cos, sin, centre, origin: [0.0; 2] };
+        Self { origin: turned.bounds(width, height)[0], ..turned }
     }
 
-    /// The grid frame's extent, pixels `[across, down]`, for a `width × height` image.
-    fn extent(&self, width: usize, height: usize) -> [f32; 2] {
-        let corners = [[0.0, 0.0], [width as f32, 0.0], [0.0, height as f32], [width as f32, height as f32]];
-        let g = corners.map(|[u, v]| self.grid_point(u, v));
-        [g.iter().map(|p| p[0]).fold(0.0, f32::max), g.iter().map(|p| p[1]).fold(0.0, f32::max)]
+    /// The lowest and highest grid-frame coordinates `[[x, y], [x, y]]` of a `width × height` image's corners.
+    fn bounds(&self, width: usize, height: usize) -> [[f32; 2]; 2] {
+        let (w, h) = (width as f32, height as f32);
+        let g = [[0.0, 0.0], [w, 0.0], [0.0, h], [w, h]].map(|[u, v]| self.grid_point(u, v));
+        let fold = |a: usize, init: f32, f: fn(f32, f32) -> f32| g.iter().map(|p| p[a]).fold(init, f);
+        [
+            [fold(0, f32::INFINITY, f32::min), fold(1, f32::INFINITY, f32::min)],
+            [fold(0, 0.0, f32::max), fold(1, 0.0, f32::max)],
+        ]
     }
 
     #[inline(always)]
@@ -183,7 +181,7 @@ pub fn blur(width: usize, height: usize, f_px: f32, spacing: usize, roll: f32, s
     let mss_min = samples.iter().map(|s| s.mss).fold(f32::INFINITY, f32::min);
     let [dx, dy] = decimation(narrowest_lobe_px(mss_min, f_px), spacing);
     let frame = Frame::new(width, height, roll);
-    let [ew, eh] = frame.extent(width, height);
+    let [ew, eh] = frame.bounds(width, height)[1];
     let (cw, ch) = ((ew.ceil() as usize).div_ceil(dx).max(1), (eh.ceil() as usize).div_ceil(dy).max(1));
     // The coarse grid: sums of radiance and of samples; of the grazing sine and the roughness.
     let mut sum = vec![[0f32; 4]; cw * ch];
