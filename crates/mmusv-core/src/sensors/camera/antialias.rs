@@ -136,25 +136,31 @@ fn edge_pixels(frame: &CameraFrame, surface: &[u64], contrast: impl Fn(usize, us
     let (w, h) = (frame.width as usize, frame.height as usize);
     // Each pair of 4-neighbours once: bit 0 (1) of pixel `a` when `a` sees an edge towards `b`, bit 1 (2) when
     // `b` sees one towards `a` (the depth step counts from a pixel off the water only), for its right neighbour
-    // in the low two bits and the one below in the next two. The colours are compared only at a geometric edge.
-    let pair = |a: usize, b: usize| -> u8 {
-        let same = surface[a] == surface[b];
-        let (da, db) = (frame.depth[a], frame.depth[b]);
-        let step = da.is_finite() && db.is_finite() && (da - db).abs() > 0.05 * da.min(db);
-        let from_a = !same || step && frame.semantic[a] != 1;
-        let from_b = !same || step && frame.semantic[b] != 1;
-        if !(from_a || from_b) || !contrast(a, b) {
-            return 0;
-        }
-        u8::from(from_a) | u8::from(from_b) << 1
-    };
+    // in the low two bits and the one below in the next two. The geometric test runs over whole rows without
+    // branches (so it runs in vector lanes); the colours are compared only where it finds an edge.
     let mut flags = vec![0u8; w * h];
     flags.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        let i = y * w;
+        let (s0, d0, c0) = (&surface[i..i + w], &frame.depth[i..i + w], &frame.semantic[i..i + w]);
+        let right = s0.iter().zip(&s0[1..]).zip(d0.iter().zip(&d0[1..])).zip(c0.iter().zip(&c0[1..]));
+        for (f, ((s, d), c)) in row.iter_mut().zip(right) {
+            *f = geometric_pair((*s.0, *s.1), (*d.0, *d.1), (*c.0, *c.1));
+        }
+        if y + 1 < h {
+            let j = i + w;
+            let (s1, d1, c1) = (&surface[j..j + w], &frame.depth[j..j + w], &frame.semantic[j..j + w]);
+            let down = s0.iter().zip(s1).zip(d0.iter().zip(d1)).zip(c0.iter().zip(c1));
+            for (f, ((s, d), c)) in row.iter_mut().zip(down) {
+                *f |= geometric_pair((*s.0, *s.1), (*d.0, *d.1), (*c.0, *c.1)) << 2;
+            }
+        }
         for (x, f) in row.iter_mut().enumerate() {
-            let i = y * w + x;
-            let right = if x + 1 < w { pair(i, i + 1) } else { 0 };
-            let down = if y + 1 < h { pair(i, i + w) } else { 0 };
-            *f = right | down << 2;
+            if *f & 3 != 0 && !contrast(i + x, i + x + 1) {
+                *f &= !3;
+            }
+            if *f & 12 != 0 && !contrast(i + x, i + x + w) {
+                *f &= !12;
+            }
         }
     });
     let flags = &flags;
@@ -169,4 +175,90 @@ fn edge_pixels(frame: &CameraFrame, surface: &[u64], contrast: impl Fn(usize, us
             })
         })
         .collect()
+}
+
+/// The geometric half of [`edge_pixels`]' test for neighbours `a` and `b` (their surface keys, depths and
+/// classes): bit 0 when `a` sees an edge towards `b` (another surface, or a depth step of more than 5 % from `a`
+/// off the water), bit 1 when `b` sees one towards `a`. Branch-free.
+#[inline(always)]
+fn geometric_pair((sa, sb): (u64, u64), (da, db): (f32, f32), (ca, cb): (u16, u16)) -> u8 {
+    let other = sa != sb;
+    let step = da.is_finite() & db.is_finite() & ((da - db).abs() > 0.05 * da.min(db));
+    let from_a = other | (step & (ca != 1));
+    let from_b = other | (step & (cb != 1));
+    u8::from(from_a) | u8::from(from_b) << 1
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The edge test written pixel by pixel, as the module docs state it.
+    fn edges_by_definition(frame: &CameraFrame, surface: &[u64], contrast: impl Fn(usize, usize) -> bool) -> Vec<u32> {
+        let (w, h) = (frame.width as usize, frame.height as usize);
+        let sees_edge = |a: usize, b: usize| {
+            let (da, db) = (frame.depth[a], frame.depth[b]);
+            let step = da.is_finite() && db.is_finite() && (da - db).abs() > 0.05 * da.min(db);
+            // (the contrast of a pair is asked with its left or upper pixel first)
+            (surface[a] != surface[b] || step && frame.semantic[a] != 1) && contrast(a.min(b), a.max(b))
+        };
+        let mut out = Vec::new();
+        for y in 0..h {
+            for x in 0..w {
+                let i = y * w + x;
+                let mut nb = Vec::new();
+                if x > 0 {
+                    nb.push(i - 1);
+                }
+                if x + 1 < w {
+                    nb.push(i + 1);
+                }
+                if y > 0 {
+                    nb.push(i - w);
+                }
+                if y + 1 < h {
+                    nb.push(i + w);
+                }
+                if nb.iter().any(|&j| sees_edge(i, j)) {
+                    out.push(i as u32);
+                }
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn edge_pixels_follow_their_definition() {
+        // Random frames with few surfaces, water (class 1), sky (infinite depth) and depth steps around 5 %, and
+        // a contrast that refuses some pairs: every pixel as the definition says.
+        for (seed, (w, h)) in [(1u64, (37usize, 23usize)), (2, (1, 9)), (3, (9, 1)), (4, (64, 48))] {
+            let n = w * h;
+            let u = |k: u64| crate::sensors::noise::uniform(seed, 7, k);
+            let surface: Vec<u64> = (0..n).map(|i| (u(4 * i as u64) * 3.0) as u64).collect();
+            let semantic: Vec<u16> = (0..n).map(|i| if u(4 * i as u64 + 1) < 0.4 { 1 } else { 3 }).collect();
+            let depth: Vec<f32> = (0..n)
+                .map(|i| {
+                    if u(4 * i as u64 + 2) < 0.1 {
+                        f32::INFINITY
+                    } else {
+                        100.0 * (1.0 + 0.1 * u(4 * i as u64 + 3) as f32)
+                    }
+                })
+                .collect();
+            let frame = CameraFrame {
+                width: w as u32,
+                height: h as u32,
+                depth,
+                semantic,
+                instance: vec![0; n],
+                rgb: Vec::new(),
+                radiance: Vec::new(),
+            };
+            let contrast = |a: usize, b: usize| (a * 31 + b * 17) % 5 != 0;
+            let fast = edge_pixels(&frame, &surface, contrast);
+            let slow = edges_by_definition(&frame, &surface, contrast);
+            assert!(slow.len() > n / 10 || n < 20, "a frame with edges ({} of {n})", slow.len());
+            assert_eq!(fast, slow, "{w} x {h}");
+        }
+    }
 }
