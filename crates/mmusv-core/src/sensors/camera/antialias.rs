@@ -254,7 +254,7 @@ mod tests {
                 rgb: Vec::new(),
                 radiance: Vec::new(),
             };
-            let contrast = |a: usize, b: usize| (a * 31 + b * 17) % 5 != 0;
+            let contrast = |a: usize, b: usize| !(a * 31 + b * 17).is_multiple_of(5);
             let fast = edge_pixels(&frame, &surface, contrast);
             let slow = edges_by_definition(&frame, &surface, contrast);
             assert!(slow.len() > n / 10 || n < 20, "a frame with edges ({} of {n})", slow.len());
