@@ -31,6 +31,7 @@ pub mod envlight;
 pub mod rough_water;
 pub mod sky;
 pub mod tonemap;
+pub mod twilight;
 pub mod water;
 
 use brdf::{dfg, fresnel_dielectric, specular_cos};

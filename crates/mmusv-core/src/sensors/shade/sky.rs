@@ -13,15 +13,22 @@
 //!   The optical depth is scaled per channel by `(λ_G / λ)²` (a Rayleigh–aerosol compromise between the
 //!   exponents 4 and ~1.3), which reddens the low sun. The disc has its true angular radius 0.2665°, and its
 //!   radiance is `E_b / Ω_sun`.
-//! * **Twilight and night**: Preetham is defined for the sun above the horizon. Below it the sky is the
-//!   model's horizon-sun sky scaled by `exp(h / 0.9°)` (`h` the sun's elevation in degrees: about 10⁻³ at the
-//!   end of civil twilight, −6°, the fall the zenith luminance shows from sunset), over a night floor of
-//!   0.002 cd/m² (a moonless clear night sky). An approximation, not a twilight model.
+//! * **Twilight and night**: Preetham is defined for the sun above the horizon. Below it the sky's zenith
+//!   luminance is the model's horizon-sun zenith scaled by `exp(h / 0.9°)` (`h` the sun's elevation in degrees:
+//!   about 10⁻³ at the end of civil twilight, −6°, the fall the zenith luminance shows from sunset), over a
+//!   night floor of 0.002 cd/m² (a moonless clear night sky). The sky's shape and colour there are those of
+//!   single scattering in a spherical atmosphere with the Earth's shadow and the ozone layer
+//!   ([`super::twilight`]): the blue zenith, the yellow-to-orange band over the sunward horizon. Between the
+//!   horizon and 1° below it the two skies are blended; beyond 6° of depression the shape of 6° is kept (single
+//!   scattering there comes from ever higher, thinner air, where light scattered more than once dominates) and
+//!   only the level falls.
 //!
 //! Checked in the tests against the closed forms: the overcast sky's horizontal illuminance, Preetham's zenith
 //! value equal to its zenith formula, the air mass at zenith, and the disc's solid angle.
 
+use super::twilight::TwilightTable;
 use parry3d::math::Vec3;
+use std::sync::Arc;
 
 /// Extraterrestrial solar illuminance `E_0`, lux.
 pub const SOLAR_CONSTANT_LUX: f32 = 128_000.0;
@@ -31,6 +38,10 @@ pub const SUN_RADIUS_RAD: f32 = 0.004_651;
 const NIGHT_FLOOR: f32 = 0.002;
 /// Centre wavelengths of the R, G, B channels, µm.
 const LAMBDA: [f32; 3] = [0.61, 0.55, 0.465];
+/// Depression below which the twilight sky keeps its shape (only its level falls), radians (6°).
+const TWILIGHT_SHAPE_LIMIT: f32 = 0.104_72;
+/// Depression over which Preetham's horizon-sun sky gives way to the twilight sky, radians (1°).
+const TWILIGHT_BLEND: f32 = 0.017_453;
 
 /// Linear sRGB (D65) from CIE XYZ.
 #[inline]
@@ -76,7 +87,7 @@ pub fn rayleigh_thickness(m: f32) -> f32 {
 }
 
 /// The sky and the sun of one environment (see the module docs).
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct Sky {
     /// Unit vector towards the sun (world frame; may point below the horizon).
     pub sun: Vec3,
@@ -95,6 +106,9 @@ pub struct Sky {
     sun_radiance: Vec3,
     /// `cos` of the disc's angular radius.
     cos_sun_radius: f32,
+    /// With the sun below the horizon: the twilight sky's table, its weight against Preetham's horizon-sun sky,
+    /// and the scale that gives its zenith Preetham's twilight zenith luminance.
+    twilight: Option<(Arc<TwilightTable>, f32, f32)>,
 }
 
 impl Sky {
@@ -152,6 +166,14 @@ impl Sky {
         };
         let sun_irradiance = if h > 0.0 { Vec3::new(beam(0), beam(1), beam(2)) * (1.0 - cloud) } else { Vec3::ZERO };
         let omega = std::f32::consts::TAU * (1.0 - SUN_RADIUS_RAD.cos());
+        // The twilight sky, scaled to Preetham's zenith luminance (the clear sky's `Y` at the zenith is
+        // `zenith_over_f0[0] · F(0, θ_s)`, before the twilight factor).
+        let dusk_sky = (h < 0.0).then(|| {
+            let table = TwilightTable::new(h.max(-TWILIGHT_SHAPE_LIMIT), t);
+            let y_zenith = zenith_over_f0[0] * perez[0].f(1.0, theta_s, theta_s.cos());
+            let scale = y_zenith / luminance(table.zenith()).max(f32::MIN_POSITIVE);
+            (Arc::new(table), (-h / TWILIGHT_BLEND).min(1.0), scale)
+        });
         // Overcast horizontal illuminance: ~20 klux under a high sun, less as it sinks.
         let e_overcast = 20_000.0 * up.sin().max(0.0).powf(1.2) + 400.0 * twilight * (h > -0.2) as i32 as f32;
         Self {
@@ -164,6 +186,7 @@ impl Sky {
             sun_irradiance,
             sun_radiance: sun_irradiance / omega,
             cos_sun_radius: SUN_RADIUS_RAD.cos(),
+            twilight: dusk_sky,
         }
     }
 
@@ -179,7 +202,11 @@ impl Sky {
             let y = self.zenith_over_f0[0] * self.perez[0].f(cos_theta, gamma, cos_gamma);
             let x = self.zenith_over_f0[1] * self.perez[1].f(cos_theta, gamma, cos_gamma);
             let yc = (self.zenith_over_f0[2] * self.perez[2].f(cos_theta, gamma, cos_gamma)).max(1e-4);
-            let rgb = xyz_to_rgb(x * y / yc, y, (1.0 - x - yc) * y / yc).max(Vec3::ZERO);
+            let mut rgb = xyz_to_rgb(x * y / yc, y, (1.0 - x - yc) * y / yc).max(Vec3::ZERO);
+            if let Some((table, w, scale)) = &self.twilight {
+                let dusk = table.radiance(d, self.sun.y.atan2(self.sun.x)) * *scale;
+                rgb = rgb * (1.0 - w) + dusk * *w;
+            }
             c += rgb * self.clear_weight;
         }
         if self.overcast_lz > 0.0 {
@@ -276,5 +303,41 @@ mod tests {
         let night = Sky::new(Vec3::new(0.0, 0.9, -0.3).normalize(), 3.0, 0.0);
         assert_eq!(night.sun_irradiance(), Vec3::ZERO);
         assert!(luminance(night.radiance(Vec3::Z)) < 1.0);
+    }
+    #[test]
+    fn twilight_sky_keeps_the_zenith_level_and_takes_the_twilight_colours() {
+        // The sun on the horizon: Preetham's sky, which the twilight sky continues.
+        let dawn = Sky::new(Vec3::X, 3.0, 0.0);
+        let level = |s: &Sky, d: Vec3| luminance(s.radiance(d)) - NIGHT_FLOOR;
+        for deg in [-0.5f32, -2.0, -4.0, -8.0] {
+            let h = deg.to_radians();
+            let sky = Sky::new(Vec3::new(h.cos(), 0.0, h.sin()), 3.0, 0.0);
+            // The zenith's luminance falls as exp(h / 0.9°) from the horizon sun's.
+            let want = level(&dawn, Vec3::Z) * (deg / 0.9).exp();
+            let got = level(&sky, Vec3::Z);
+            assert!((got - want).abs() / want < 5e-3, "{deg}°: {got} vs {want}");
+            if deg <= -2.0 {
+                // Blue overhead (Preetham's horizon-sun zenith is blue too, but its sunward sky stays yellow):
+                // the sunward sky at 10° is bluer than the horizon sun's at the same place, and the band over
+                // the sunward horizon redder than the zenith.
+                let z = sky.radiance(Vec3::Z);
+                assert!(z.z > 1.3 * z.x, "{deg}°: zenith {z}");
+                let up10 = Vec3::new(1.0, 0.0, 0.176).normalize();
+                let (a, b) = (sky.radiance(up10), dawn.radiance(up10));
+                assert!(a.z / a.x > 1.5 * (b.z / b.x), "{deg}°: {a} vs {b}");
+                let band = sky.radiance(Vec3::new(1.0, 0.0, 0.052).normalize());
+                assert!(band.x / band.z > z.x / z.z, "{deg}°: band {band}");
+            }
+        }
+        // Just below the horizon the sky is still the horizon sun's.
+        let h = -0.01f32.to_radians();
+        let just = Sky::new(Vec3::new(h.cos(), 0.0, h.sin()), 3.0, 0.0);
+        let fall = (-0.01f32 / 0.9).exp();
+        for d in [Vec3::Z, Vec3::new(1.0, 0.0, 0.2), Vec3::new(-0.5, 0.7, 0.3), Vec3::new(0.9, 0.1, 0.05)] {
+            let d = d.normalize();
+            let (a, b) =
+                (just.radiance(d) - Vec3::splat(NIGHT_FLOOR), (dawn.radiance(d) - Vec3::splat(NIGHT_FLOOR)) * fall);
+            assert!((a - b).length() < 0.02 * b.length(), "{d}: {a} vs {b}");
+        }
     }
 }
