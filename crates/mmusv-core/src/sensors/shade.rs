@@ -17,7 +17,8 @@
 //! is the radiance along the reflected ray (traced by the camera, so ships mirror in it; the sky's otherwise),
 //! the glint is the sun through a Cox–Munk GGX lobe, and `L_body` the smooth-plastic water body; foam (whitecaps
 //! and wakes) is Lambertian on top. Aerial perspective: `L·T + L_air (1 − T)`, `T = e^{−σ t}` (Koschmieder),
-//! `L_air` the horizon sky's radiance along the view's azimuth.
+//! `L_air` the horizon sky's radiance along the view's azimuth (in twilight, the haze in the Earth's shadow,
+//! `twilight::shadowed_haze`).
 
 use super::noise::{self, stream};
 use crate::material::Material;

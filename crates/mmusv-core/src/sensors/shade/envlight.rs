@@ -21,6 +21,7 @@
 
 use super::brdf::{fresnel_dielectric, ggx_d};
 use super::sky::{luminance, Sky};
+use super::twilight;
 use parry3d::math::Vec3;
 use std::sync::{Arc, Mutex};
 
@@ -278,10 +279,24 @@ impl Lighting {
                 sky_table[j * kw + i] = sky.radiance(Vec3::new(s * x, s * y, z));
             }
         }
+        // What distant things fade into: the horizon sky at their azimuth, or in twilight the haze in the Earth's
+        // shadow, lit by the sky alone (`twilight::shadowed_haze`).
+        let shade_w = twilight::shadowed_haze_weight(sky.sun.z.clamp(-1.0, 1.0).asin());
+        let haze = if shade_w > 0.0 {
+            let mean = src.iter().map(|(_, l)| *l).sum::<Vec3>() * d_omega / std::f32::consts::TAU;
+            twilight::shadowed_haze(mean)
+        } else {
+            Vec3::ZERO
+        };
         let horizon = (0..kw)
             .map(|i| {
                 let (x, y) = diamond_dir((i as f32 + 0.5) / kw as f32 * 4.0);
-                sky.radiance(Vec3::new(x, y, 0.02).normalize())
+                let lit = sky.radiance(Vec3::new(x, y, 0.02).normalize());
+                if shade_w > 0.0 {
+                    lit * (1.0 - shade_w) + haze * shade_w
+                } else {
+                    lit
+                }
             })
             .collect();
         Self {
@@ -464,5 +479,47 @@ mod tests {
         let a = Lighting::shared(&key(0.3));
         let b = Lighting::shared(&key(0.3));
         assert!(Arc::ptr_eq(&a, &b));
+    }
+
+    #[test]
+    fn distant_things_fade_into_the_horizon_by_day_and_into_shadowed_haze_in_twilight() {
+        let at = |deg: f32| {
+            let h = deg.to_radians();
+            LightingKey {
+                sun: [h.cos() * 0.6, h.cos() * 0.8, h.sin()],
+                turbidity: 3.0,
+                cloud: 0.0,
+                ground_albedo: 0.06,
+            }
+        };
+        // By day: the sky just over the horizon at the view's azimuth.
+        let day = Lighting::new(&at(10.0));
+        for d in [Vec3::new(0.6, 0.8, 0.0), Vec3::new(-1.0, 0.2, 0.0).normalize()] {
+            let want = day.sky.radiance(Vec3::new(d.x, d.y, 0.02).normalize());
+            assert!((day.horizon_radiance(d) - want).length() < 0.02 * want.length());
+        }
+        // Sun 3° down: the same for every azimuth, 0.9 / 2 of the sky's mean radiance over the upper hemisphere
+        // (integrated here on its own grid, uniform in zenith angle).
+        let dusk = Lighting::new(&at(-3.0));
+        let (n_t, n_p) = (200, 96);
+        let mut sum = Vec3::ZERO;
+        for i in 0..n_t {
+            let th = (i as f32 + 0.5) / n_t as f32 * std::f32::consts::FRAC_PI_2;
+            for j in 0..n_p {
+                let ph = (j as f32 + 0.5) / n_p as f32 * std::f32::consts::TAU;
+                let d = Vec3::new(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos());
+                sum += dusk.sky.radiance(d) * th.sin();
+            }
+        }
+        let mean = sum * (std::f32::consts::FRAC_PI_2 / n_t as f32 * std::f32::consts::TAU / n_p as f32)
+            / std::f32::consts::TAU;
+        let want = mean * 0.45;
+        for d in [Vec3::new(0.6, 0.8, 0.0), Vec3::new(-1.0, 0.2, 0.0).normalize(), Vec3::new(0.0, -1.0, 0.0)] {
+            let got = dusk.horizon_radiance(d);
+            assert!((got - want).length() < 0.02 * want.length(), "{d}: {got} vs {want}");
+        }
+        // The glow over the sunward horizon is far brighter than the haze in the shadow.
+        let glow = dusk.sky.radiance(Vec3::new(0.6, 0.8, 0.03).normalize());
+        assert!(luminance(glow) > 3.0 * luminance(want), "{glow} vs {want}");
     }
 }

@@ -13,18 +13,19 @@
 //!   The optical depth is scaled per channel by `(λ_G / λ)²` (a Rayleigh–aerosol compromise between the
 //!   exponents 4 and ~1.3), which reddens the low sun. The disc has its true angular radius 0.2665°, and its
 //!   radiance is `E_b / Ω_sun`.
-//! * **Twilight and night**: Preetham is defined for the sun above the horizon. Below it the sky's zenith
-//!   luminance is the model's horizon-sun zenith scaled by `exp(h / 0.9°)` (`h` the sun's elevation in degrees:
-//!   about 10⁻³ at the end of civil twilight, −6°, the fall the zenith luminance shows from sunset), over a
-//!   night floor of 0.002 cd/m² (a moonless clear night sky). The sky's shape and colour there are those of
-//!   single scattering in a spherical atmosphere with the Earth's shadow and the ozone layer
-//!   ([`super::twilight`]): the blue zenith, the yellow-to-orange band over the sunward horizon. Between the
-//!   horizon and 1° below it the two skies are blended; beyond 6° of depression the shape of 6° is kept (single
-//!   scattering there comes from ever higher, thinner air, where light scattered more than once dominates) and
-//!   only the level falls.
+//! * **Twilight and night**: Preetham is defined for the sun above the horizon. Below it the sky is the
+//!   model's horizon-sun sky scaled by `exp(h / 0.9°)` (`h` the sun's elevation in degrees: about 10⁻³ at the
+//!   end of civil twilight, −6°, the fall the zenith luminance shows from sunset), over a night floor of
+//!   0.002 cd/m² (a moonless clear night sky) — in level: its shape and colour are those of single scattering
+//!   in a spherical atmosphere of pure air with the Earth's shadow and the ozone layer ([`super::twilight`]),
+//!   the blue zenith over the orange band of the sunward horizon, scaled to the same horizontal illuminance (so
+//!   what lights the scene and sets the metered exposure keeps its level). Between the horizon and 1° below it
+//!   the two skies are blended; beyond 6° of depression the shape of 6° is kept (single scattering there comes
+//!   from ever higher, thinner air, where light scattered more than once dominates) and only the level falls.
 //!
 //! Checked in the tests against the closed forms: the overcast sky's horizontal illuminance, Preetham's zenith
-//! value equal to its zenith formula, the air mass at zenith, and the disc's solid angle.
+//! value equal to its zenith formula, the air mass at zenith, and the disc's solid angle; the twilight sky's
+//! horizontal illuminance against Preetham's twilight sky's, integrated on a grid of its own.
 
 use super::twilight::TwilightTable;
 use parry3d::math::Vec3;
@@ -86,6 +87,22 @@ pub fn rayleigh_thickness(m: f32) -> f32 {
     }
 }
 
+/// `∫ L(d) cos θ dω` over the upper hemisphere (lux for a radiance in cd/m²), by the midpoint rule on 256 rings
+/// (uniform in `cos θ`, fine enough for the afterglow's band, a degree or two over the horizon) of 64 directions.
+fn horizontal_illuminance(radiance: impl Fn(Vec3) -> Vec3) -> f32 {
+    let (rings, n) = (256, 64);
+    let mut e = 0.0f64;
+    for i in 0..rings {
+        let mu = (i as f32 + 0.5) / rings as f32;
+        let s = (1.0 - mu * mu).sqrt();
+        for j in 0..n {
+            let phi = std::f32::consts::TAU * (j as f32 + 0.5) / n as f32;
+            e += f64::from(luminance(radiance(Vec3::new(s * phi.cos(), s * phi.sin(), mu))) * mu);
+        }
+    }
+    (e * std::f64::consts::TAU / (rings * n) as f64) as f32
+}
+
 /// The sky and the sun of one environment (see the module docs).
 #[derive(Debug, Clone)]
 pub struct Sky {
@@ -107,7 +124,7 @@ pub struct Sky {
     /// `cos` of the disc's angular radius.
     cos_sun_radius: f32,
     /// With the sun below the horizon: the twilight sky's table, its weight against Preetham's horizon-sun sky,
-    /// and the scale that gives its zenith Preetham's twilight zenith luminance.
+    /// and the scale that gives it that sky's horizontal illuminance.
     twilight: Option<(Arc<TwilightTable>, f32, f32)>,
 }
 
@@ -166,17 +183,9 @@ impl Sky {
         };
         let sun_irradiance = if h > 0.0 { Vec3::new(beam(0), beam(1), beam(2)) * (1.0 - cloud) } else { Vec3::ZERO };
         let omega = std::f32::consts::TAU * (1.0 - SUN_RADIUS_RAD.cos());
-        // The twilight sky, scaled to Preetham's zenith luminance (the clear sky's `Y` at the zenith is
-        // `zenith_over_f0[0] · F(0, θ_s)`, before the twilight factor).
-        let dusk_sky = (h < 0.0).then(|| {
-            let table = TwilightTable::new(h.max(-TWILIGHT_SHAPE_LIMIT), t);
-            let y_zenith = zenith_over_f0[0] * perez[0].f(1.0, theta_s, theta_s.cos());
-            let scale = y_zenith / luminance(table.zenith()).max(f32::MIN_POSITIVE);
-            (Arc::new(table), (-h / TWILIGHT_BLEND).min(1.0), scale)
-        });
         // Overcast horizontal illuminance: ~20 klux under a high sun, less as it sinks.
         let e_overcast = 20_000.0 * up.sin().max(0.0).powf(1.2) + 400.0 * twilight * (h > -0.2) as i32 as f32;
-        Self {
+        let mut sky = Self {
             sun,
             theta_s,
             perez,
@@ -186,23 +195,27 @@ impl Sky {
             sun_irradiance,
             sun_radiance: sun_irradiance / omega,
             cos_sun_radius: SUN_RADIUS_RAD.cos(),
-            twilight: dusk_sky,
+            twilight: None,
+        };
+        if h < 0.0 {
+            // The twilight sky, scaled to the horizontal illuminance of Preetham's horizon-sun sky (what lights
+            // the scene and sets the metered exposure stays as it was; the light's distribution and colour change).
+            let table = TwilightTable::new(h.max(-TWILIGHT_SHAPE_LIMIT));
+            let sun_azimuth = sky.sun.y.atan2(sky.sun.x);
+            let scale = horizontal_illuminance(|d| sky.preetham(d))
+                / horizontal_illuminance(|d| table.radiance(d, sun_azimuth)).max(f32::MIN_POSITIVE);
+            sky.twilight = Some((Arc::new(table), (-h / TWILIGHT_BLEND).min(1.0), scale));
         }
+        sky
     }
 
     /// Sky radiance (linear RGB, cd/m²) towards unit direction `d`, without the sun's disc. Directions below the
     /// horizon get the horizon's value.
     #[inline]
     pub fn radiance(&self, d: Vec3) -> Vec3 {
-        let cos_theta = d.z.max(0.01);
-        let cos_gamma = d.dot(self.sun).clamp(-1.0, 1.0);
-        let gamma = cos_gamma.acos();
         let mut c = Vec3::splat(NIGHT_FLOOR);
         if self.clear_weight > 0.0 {
-            let y = self.zenith_over_f0[0] * self.perez[0].f(cos_theta, gamma, cos_gamma);
-            let x = self.zenith_over_f0[1] * self.perez[1].f(cos_theta, gamma, cos_gamma);
-            let yc = (self.zenith_over_f0[2] * self.perez[2].f(cos_theta, gamma, cos_gamma)).max(1e-4);
-            let mut rgb = xyz_to_rgb(x * y / yc, y, (1.0 - x - yc) * y / yc).max(Vec3::ZERO);
+            let mut rgb = self.preetham(d);
             if let Some((table, w, scale)) = &self.twilight {
                 let dusk = table.radiance(d, self.sun.y.atan2(self.sun.x)) * *scale;
                 rgb = rgb * (1.0 - w) + dusk * *w;
@@ -213,6 +226,18 @@ impl Sky {
             c += Vec3::splat(self.overcast_lz * (1.0 + 2.0 * d.z.max(0.0)) / 3.0);
         }
         c
+    }
+
+    /// Preetham's clear sky towards unit `d` (linear RGB, cd/m², before the cloud cover and the twilight factor).
+    #[inline]
+    fn preetham(&self, d: Vec3) -> Vec3 {
+        let cos_theta = d.z.max(0.01);
+        let cos_gamma = d.dot(self.sun).clamp(-1.0, 1.0);
+        let gamma = cos_gamma.acos();
+        let y = self.zenith_over_f0[0] * self.perez[0].f(cos_theta, gamma, cos_gamma);
+        let x = self.zenith_over_f0[1] * self.perez[1].f(cos_theta, gamma, cos_gamma);
+        let yc = (self.zenith_over_f0[2] * self.perez[2].f(cos_theta, gamma, cos_gamma)).max(1e-4);
+        xyz_to_rgb(x * y / yc, y, (1.0 - x - yc) * y / yc).max(Vec3::ZERO)
     }
 
     /// Radiance of the sun's disc (linear RGB, cd/m²) if `d` points into it, else zero.
@@ -305,28 +330,49 @@ mod tests {
         assert!(luminance(night.radiance(Vec3::Z)) < 1.0);
     }
     #[test]
-    fn twilight_sky_keeps_the_zenith_level_and_takes_the_twilight_colours() {
+    fn twilight_sky_keeps_the_horizontal_illuminance_and_takes_the_twilight_colours() {
         // The sun on the horizon: Preetham's sky, which the twilight sky continues.
         let dawn = Sky::new(Vec3::X, 3.0, 0.0);
-        let level = |s: &Sky, d: Vec3| luminance(s.radiance(d)) - NIGHT_FLOOR;
+        // ∫ L cos θ dω over the hemisphere, numerically (uniform in θ, unlike the model's own rings).
+        let e_h = |s: &Sky| {
+            let (n_t, n_p) = (300, 128);
+            let mut e = 0.0f64;
+            for i in 0..n_t {
+                let th = (i as f64 + 0.5) / n_t as f64 * std::f64::consts::FRAC_PI_2;
+                for j in 0..n_p {
+                    let ph = (j as f64 + 0.5) / n_p as f64 * std::f64::consts::TAU;
+                    let d = Vec3::new((th.sin() * ph.cos()) as f32, (th.sin() * ph.sin()) as f32, th.cos() as f32);
+                    let l = (luminance(s.radiance(d)) - NIGHT_FLOOR) as f64;
+                    e += l * th.cos() * th.sin() * std::f64::consts::FRAC_PI_2 / n_t as f64 * std::f64::consts::TAU
+                        / n_p as f64;
+                }
+            }
+            e
+        };
+        let e_dawn = e_h(&dawn);
         for deg in [-0.5f32, -2.0, -4.0, -8.0] {
             let h = deg.to_radians();
             let sky = Sky::new(Vec3::new(h.cos(), 0.0, h.sin()), 3.0, 0.0);
-            // The zenith's luminance falls as exp(h / 0.9°) from the horizon sun's.
-            let want = level(&dawn, Vec3::Z) * (deg / 0.9).exp();
-            let got = level(&sky, Vec3::Z);
-            assert!((got - want).abs() / want < 5e-3, "{deg}°: {got} vs {want}");
+            // The horizontal illuminance is that of Preetham's horizon-sun sky (with the sun where it is) dimmed
+            // by exp(h / 0.9°), which the twilight sky replaces; that one is within 6 % of the horizon sun's (its
+            // circumsolar brightening follows the sun down).
+            let mut preetham = sky.clone();
+            preetham.twilight = None;
+            let (got, want) = (e_h(&sky), e_h(&preetham));
+            assert!((got - want).abs() / want < 0.01, "{deg}°: {got} vs {want}");
+            let dimmed = e_dawn * f64::from((deg / 0.9).exp());
+            assert!((want - dimmed).abs() / dimmed < 0.06, "{deg}°: {want} vs {dimmed}");
             if deg <= -2.0 {
-                // Blue overhead (Preetham's horizon-sun zenith is blue too, but its sunward sky stays yellow):
-                // the sunward sky at 10° is bluer than the horizon sun's at the same place, and the band over
-                // the sunward horizon redder than the zenith.
+                // Blue overhead, the sunward sky at 10° bluer than the horizon sun's at the same place (Preetham's
+                // stays yellow there), and the band over the sunward horizon redder than the zenith.
                 let z = sky.radiance(Vec3::Z);
                 assert!(z.z > 1.3 * z.x, "{deg}°: zenith {z}");
                 let up10 = Vec3::new(1.0, 0.0, 0.176).normalize();
                 let (a, b) = (sky.radiance(up10), dawn.radiance(up10));
-                assert!(a.z / a.x > 1.5 * (b.z / b.x), "{deg}°: {a} vs {b}");
-                let band = sky.radiance(Vec3::new(1.0, 0.0, 0.052).normalize());
-                assert!(band.x / band.z > z.x / z.z, "{deg}°: band {band}");
+                assert!(a.z / a.x > 1.3 * (b.z / b.x), "{deg}°: {a} vs {b}");
+                let band = sky.radiance(Vec3::new(1.0, 0.0, 0.035).normalize());
+                assert!(band.x > 1.3 * band.y && band.y > 2.0 * band.z, "{deg}°: band {band}");
+                assert!(luminance(band) > luminance(z), "{deg}°: the afterglow outshines the zenith");
             }
         }
         // Just below the horizon the sky is still the horizon sun's.

@@ -18,11 +18,20 @@
 //! * **What it gives the sky**: the distribution and colour of the twilight sky, tabulated once per sun
 //!   elevation over view elevation and azimuth from the sun. Single scattering underestimates the deep
 //!   twilight's level (multiple scattering dominates beyond ~6° of depression), so `sky.rs` scales the table to
-//!   its own zenith luminance and keeps only its shape and colours.
+//!   the horizontal illuminance of its own twilight sky and keeps only the shape and colours. The table is that
+//!   of pure air with its ozone, without aerosols: in single scattering, haze darkens the band over the sunward
+//!   horizon a thousandfold at turbidity 3 (the long, low view path through haze still in the Earth's shadow),
+//!   where the light it scatters forward, more than once, keeps real afterglows brightest at the horizon;
+//!   without it the band is the orange afterglow under a blue zenith.
+//! * **Haze in the Earth's shadow** ([`shadowed_haze`]): once the sun is a degree below the horizon the low air
+//!   is in the shadow, lit by the sky alone; what distant things fade into (the aerial perspective's `L_air`,
+//!   by day the horizon sky at the view's azimuth) is then that air's isotropic single scattering of the sky's
+//!   mean radiance, `ω M / 2`, the same in every direction — not the afterglow behind it.
 //!
 //! Checked in the tests against closed forms: the vertical optical depths (Rayleigh and aerosol `β H`, the ozone
 //! column `σ N`), and the zenith radiance of a high sun in a Rayleigh-only atmosphere, whose plane-parallel
-//! single scattering integrates exactly.
+//! single scattering integrates exactly; the shadowed haze against the sky's mean integrated on its own grid
+//! (`envlight.rs`).
 
 use parry3d::math::Vec3;
 
@@ -141,9 +150,10 @@ pub struct TwilightTable {
 }
 
 impl TwilightTable {
-    /// The table for a sun at elevation `h` (radians) and turbidity `turbidity`.
-    pub fn new(h: f32, turbidity: f32) -> Self {
-        let atm = Atmosphere::new(f64::from(turbidity), true);
+    /// The table for a sun at elevation `h` (radians): pure air and ozone, without aerosols (see the module
+    /// docs).
+    pub fn new(h: f32) -> Self {
+        let atm = Atmosphere::new(1.0, true);
         let hs = f64::from(h);
         let s = [hs.cos(), 0.0, hs.sin()];
         let mut values = Vec::with_capacity(ROWS * COLS);
@@ -176,11 +186,20 @@ impl TwilightTable {
         let bottom = at(r0 + 1, c0) * (1.0 - wc) + at(r0 + 1, c0 + 1) * wc;
         top * (1.0 - wr) + bottom * wr
     }
+}
 
-    /// Radiance at the zenith.
-    pub fn zenith(&self) -> Vec3 {
-        self.values[(ROWS - 1) * COLS]
-    }
+/// Radiance of haze in the Earth's shadow, lit by the twilight sky alone: isotropic single scattering of the
+/// mean radiance `mean_sky` of the upper hemisphere (the dark ground adds nothing), `ω M / 2` with the aerosols'
+/// single-scattering albedo `ω`. What distant things fade into once the sun has left the low air.
+pub fn shadowed_haze(mean_sky: Vec3) -> Vec3 {
+    mean_sky * (0.5 * MIE_ALBEDO as f32)
+}
+
+/// Weight of [`shadowed_haze`] against the sunlit horizon's radiance in the aerial perspective, for a sun at
+/// elevation `h` (radians): 0 with the sun up, 1 from 1° below the horizon (where the Earth's shadow covers the
+/// first hundred metres of air over the observer), linear between.
+pub fn shadowed_haze_weight(h: f32) -> f32 {
+    (-h / 1f32.to_radians()).clamp(0.0, 1.0)
 }
 
 /// View elevation of table row `i`, radians (rows uniform in √elevation: denser near the horizon).
@@ -289,8 +308,8 @@ mod tests {
 
     #[test]
     fn table_reads_back_its_nodes_and_is_symmetric() {
-        let t = TwilightTable::new(-4f32.to_radians(), 3.0);
-        let atm = Atmosphere::new(3.0, true);
+        let t = TwilightTable::new(-4f32.to_radians());
+        let atm = Atmosphere::new(1.0, true);
         let s = [(-4f64).to_radians().cos(), 0.0, (-4f64).to_radians().sin()];
         let (i, j) = (10usize, 6usize);
         let e = row_elevation(i);
@@ -303,6 +322,5 @@ mod tests {
         assert!((f64::from(got.y) - want[1]).abs() / want[1] < 1e-3, "{got} vs {want:?}");
         let mirrored = t.radiance(Vec3::new(d.x, -d.y, d.z), -0.3);
         assert!((mirrored - got).length() < 1e-4 * got.length());
-        assert_eq!(t.zenith(), t.values[(ROWS - 1) * COLS]);
     }
 }
