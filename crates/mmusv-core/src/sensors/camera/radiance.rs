@@ -272,20 +272,20 @@ pub fn radiance(
     let n = origins.len();
     let surface = |k: usize| surface_at(shader, scene, hits, origins, dirs, k);
     let is_water = |k: usize| hits.distance[k].is_finite() && hits.class[k] == 1;
-    // Candidates for a shared shading: the ray and its anchors all see water, or all the sky.
-    let kinds: Vec<u8> = match shared {
-        None => Vec::new(),
-        Some(_) => (0..n).into_par_iter().with_min_len(PASS_CHUNK).map(|k| kind(hits, k)).collect(),
-    };
+    // Candidates for a shared shading: the ray and its anchors all see water, or all the sky (each ray's kind
+    // read where it is needed: a pass of its own cost more than reading the anchors' twice).
     let candidate: Vec<bool> = match shared {
         None => Vec::new(),
         Some(grid) => (0..n)
             .into_par_iter()
             .with_min_len(PASS_CHUNK)
             .map(|k| {
-                let kk = kinds[k];
+                let kk = kind(hits, k);
+                if kk == 0 {
+                    return false;
+                }
                 let (ids, m) = grid.anchors(k);
-                kk != 0 && m > 0 && ids[..m].iter().all(|&j| kinds[j as usize] == kk)
+                m > 0 && ids[..m].iter().all(|&j| kind(hits, j as usize) == kk)
             })
             .collect(),
     };
@@ -430,34 +430,38 @@ pub fn radiance(
         let shown: Vec<[u8; 3]> = (0..n)
             .into_par_iter()
             .with_min_len(PASS_CHUNK)
-            .map(|k| if is_candidate(k) || kinds[k] == 0 { [0; 3] } else { tonemap::to_srgb8(out[k], k_exp) })
+            .map(|k| if is_candidate(k) || kind(hits, k) == 0 { [0; 3] } else { tonemap::to_srgb8(out[k], k_exp) })
             .collect();
-        // Each candidate with its anchors' mean, or `None` where they differ (or the mean is not a number), written
-        // in place per ray (as a filtered and collected list of pairs this pass took 8 ms on one camera, 3.3 ms
-        // so).
-        let mut means: Vec<Option<Vec3>> = vec![None; n];
-        means.par_chunks_mut(PASS_CHUNK).enumerate().for_each(|(c, chunk)| {
-            for (j, slot) in chunk.iter_mut().enumerate() {
-                let k = c * PASS_CHUNK + j;
-                if !is_candidate(k) {
-                    continue;
+        // Each candidate with its anchors' mean, or, where they differ (or the mean is not a number), on the list
+        // to shade: per task of `PASS_CHUNK` rays, the means (ray, value) and the rays to shade, in order, then
+        // applied (a slot per ray and a pass over all of them to apply it took 10 ms more a frame of
+        // `port_entry`, one thread; one filtered list of pairs for the whole camera, more still).
+        let parts: Vec<MeansAndRedo> = (0..n.div_ceil(PASS_CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let (mut means, mut redo) = (Vec::new(), Vec::new());
+                for k in c * PASS_CHUNK..((c + 1) * PASS_CHUNK).min(n) {
+                    if !is_candidate(k) {
+                        continue;
+                    }
+                    let (ids, m) = grid.anchors(k);
+                    let first = shown[ids[0] as usize];
+                    let alike = ids[1..m].iter().all(|&j| alike_shown(first, shown[j as usize]));
+                    let mean = alike.then(|| ids[..m].iter().map(|&j| out[j as usize]).sum::<Vec3>() / m as f32);
+                    match mean.filter(|c| !c.x.is_nan()) {
+                        Some(v) => means.push((k as u32, v)),
+                        None => redo.push(k as u32),
+                    }
                 }
-                let (ids, m) = grid.anchors(k);
-                let first = shown[ids[0] as usize];
-                let alike = ids[1..m].iter().all(|&j| alike_shown(first, shown[j as usize]));
-                let mean = alike.then(|| ids[..m].iter().map(|&j| out[j as usize]).sum::<Vec3>() / m as f32);
-                *slot = mean.filter(|c| !c.x.is_nan());
-            }
-        });
+                (means, redo)
+            })
+            .collect();
         let mut redo: Vec<u32> = Vec::new();
-        for (k, mean) in means.into_iter().enumerate() {
-            if !is_candidate(k) {
-                continue;
+        for (means, r) in parts {
+            for (k, v) in means {
+                out[k as usize] = v;
             }
-            match mean {
-                Some(c) => out[k] = c,
-                None => redo.push(k as u32),
-            }
+            redo.extend(r);
         }
         // The rays whose anchors differ: shaded themselves. Their sun visibility is their anchors' where those
         // agree (as a shadow map at half the resolution gives it), a shadow ray of their own where they do not.
@@ -491,6 +495,9 @@ pub fn radiance(
 
 /// The surface a ray of the batch hit (`None`: a miss).
 type SurfaceOf<'a> = dyn Fn(usize) -> Option<SurfaceHit> + Sync + 'a;
+
+/// One task's shared shadings: (ray, its anchors' mean) pairs, and the rays whose anchors differ.
+type MeansAndRedo = (Vec<(u32, Vec3)>, Vec<u32>);
 
 /// Rays shaded together per task of the final pass.
 const SHADE_CHUNK: usize = 4096;
