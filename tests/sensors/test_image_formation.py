@@ -69,6 +69,31 @@ def test_sun_disc_has_its_true_angular_size() -> None:
     assert lum.max() / np.median(lum) > 1e4
 
 
+@pytest.mark.parametrize("time_of_day", ["20:15", "21:00"])
+def test_twilight_sky_is_blue_over_an_orange_afterglow(time_of_day: str) -> None:
+    """Sun 4.5° and 10° below the horizon (21 June, 45° N): towards it, the band just over the horizon is orange
+    and outshines the sky above, which is blue; at 4.5° the sky opposite is blue too (at 10° it is near the night
+    floor, where single scattering leaves it a dim reddish grey). The twilight model's colours reach the cameras'
+    sky through the bindings; its physics is tested in the core."""
+    env_cfg = Environment.make(time_of_day=time_of_day)
+    assert env_cfg.sun.elevation_deg < -4.0
+    d = np.asarray(env_cfg.sun.direction)
+    az = math.atan2(d[1], d[0])
+
+    def towards(elev_deg: float, azimuth: float) -> list[float]:
+        e = math.radians(elev_deg)
+        return [math.cos(e) * math.cos(azimuth), math.cos(e) * math.sin(azimuth), math.sin(e)]
+
+    dirs = np.array([towards(1.5, az), towards(35.0, az), towards(35.0, az + math.pi)], dtype=np.float32)
+    band, above, opposite = np.asarray(sensor_env(env_cfg).sky_radiance(dirs))
+    assert band[0] > 1.3 * band[1] > 2.0 * band[2], band
+    assert above[2] > above[0], above
+    if env_cfg.sun.elevation_deg > -6.0:
+        assert opposite[2] > opposite[0], opposite
+    lum = np.array([0.2126, 0.7152, 0.0722])
+    assert band @ lum > 2.0 * (above @ lum)
+
+
 def test_edge_pixels_are_averaged_and_labels_stay_exact() -> None:
     """A dark box on a bright sky: at standard quality its silhouette pixels take intermediate values equal to
     the covered fraction (checked against an analytic edge), while depth, class and instance stay the centre's."""
