@@ -329,6 +329,7 @@ mod tests {
         assert_eq!(night.sun_irradiance(), Vec3::ZERO);
         assert!(luminance(night.radiance(Vec3::Z)) < 1.0);
     }
+
     #[test]
     fn twilight_sky_keeps_the_horizontal_illuminance_and_takes_the_twilight_colours() {
         // The sun on the horizon: Preetham's sky, which the twilight sky continues.
