@@ -68,7 +68,8 @@ pub struct Lighting {
     prefiltered: Vec<Vec<Vec3>>,
     /// The sky's radiance (no sun disc) on the `SKY` grid.
     sky_table: Vec<Vec3>,
-    /// The sky's radiance just above the horizon (elevation ~1.1°), per column of the `SKY` grid.
+    /// What distant things fade into, per column of the `SKY` grid: the sky's radiance just above the horizon
+    /// (elevation ~1.1°), in twilight blended into the haze in the Earth's shadow (`twilight::shadowed_haze`).
     horizon: Vec<Vec3>,
 }
 
@@ -318,7 +319,8 @@ impl Lighting {
         sky_read(&self.sky_table, d)
     }
 
-    /// The sky's radiance just above the horizon at `d`'s azimuth (what distant things fade into).
+    /// What distant things fade into along `d`'s azimuth: the sky's radiance just above the horizon there, or, with
+    /// the sun a degree or more below the horizon, the haze in the Earth's shadow (the same at every azimuth).
     #[inline(always)]
     pub fn horizon_radiance(&self, d: Vec3) -> Vec3 {
         let (w, _) = SKY;
