@@ -283,21 +283,15 @@ impl Lighting {
         // What distant things fade into: the horizon sky at their azimuth, or in twilight the haze in the Earth's
         // shadow, lit by the sky alone (`twilight::shadowed_haze`).
         let shade_w = twilight::shadowed_haze_weight(sky.sun.z.clamp(-1.0, 1.0).asin());
-        let haze = if shade_w > 0.0 {
+        let haze = (shade_w > 0.0).then(|| {
             let mean = src.iter().map(|(_, l)| *l).sum::<Vec3>() * d_omega / std::f32::consts::TAU;
             twilight::shadowed_haze(mean)
-        } else {
-            Vec3::ZERO
-        };
+        });
         let horizon = (0..kw)
             .map(|i| {
                 let (x, y) = diamond_dir((i as f32 + 0.5) / kw as f32 * 4.0);
                 let lit = sky.radiance(Vec3::new(x, y, 0.02).normalize());
-                if shade_w > 0.0 {
-                    lit * (1.0 - shade_w) + haze * shade_w
-                } else {
-                    lit
-                }
+                haze.map_or(lit, |air| lit * (1.0 - shade_w) + air * shade_w)
             })
             .collect();
         Self {

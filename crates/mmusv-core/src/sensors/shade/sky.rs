@@ -37,7 +37,7 @@ pub const SOLAR_CONSTANT_LUX: f32 = 128_000.0;
 pub const SUN_RADIUS_RAD: f32 = 0.004_651;
 /// Night-sky floor, cd/m².
 const NIGHT_FLOOR: f32 = 0.002;
-/// Centre wavelengths of the R, G, B channels, µm.
+/// Centre wavelengths of the R, G, B channels, µm (`twilight.rs` holds them in double precision).
 const LAMBDA: [f32; 3] = [0.61, 0.55, 0.465];
 /// Depression below which the twilight sky keeps its shape (only its level falls), radians (6°).
 const TWILIGHT_SHAPE_LIMIT: f32 = 0.104_72;
@@ -123,9 +123,20 @@ pub struct Sky {
     sun_radiance: Vec3,
     /// `cos` of the disc's angular radius.
     cos_sun_radius: f32,
-    /// With the sun below the horizon: the twilight sky's table, its weight against Preetham's horizon-sun sky,
-    /// and the scale that gives it that sky's horizontal illuminance.
-    twilight: Option<(Arc<TwilightTable>, f32, f32)>,
+    /// With the sun below the horizon, the twilight sky.
+    twilight: Option<Twilight>,
+}
+
+/// The twilight sky of a [`Sky`] whose sun is below the horizon.
+#[derive(Debug, Clone)]
+struct Twilight {
+    table: Arc<TwilightTable>,
+    /// The sun's azimuth (radians, from +x towards +y), which the table is read around.
+    sun_azimuth: f32,
+    /// Weight against Preetham's horizon-sun sky.
+    weight: f32,
+    /// Scale giving the table that sky's horizontal illuminance.
+    scale: f32,
 }
 
 impl Sky {
@@ -204,7 +215,8 @@ impl Sky {
             let sun_azimuth = sky.sun.y.atan2(sky.sun.x);
             let scale = horizontal_illuminance(|d| sky.preetham(d))
                 / horizontal_illuminance(|d| table.radiance(d, sun_azimuth)).max(f32::MIN_POSITIVE);
-            sky.twilight = Some((Arc::new(table), (-h / TWILIGHT_BLEND).min(1.0), scale));
+            let weight = (-h / TWILIGHT_BLEND).min(1.0);
+            sky.twilight = Some(Twilight { table: Arc::new(table), sun_azimuth, weight, scale });
         }
         sky
     }
@@ -216,9 +228,9 @@ impl Sky {
         let mut c = Vec3::splat(NIGHT_FLOOR);
         if self.clear_weight > 0.0 {
             let mut rgb = self.preetham(d);
-            if let Some((table, w, scale)) = &self.twilight {
-                let dusk = table.radiance(d, self.sun.y.atan2(self.sun.x)) * *scale;
-                rgb = rgb * (1.0 - w) + dusk * *w;
+            if let Some(t) = &self.twilight {
+                let dusk = t.table.radiance(d, t.sun_azimuth) * t.scale;
+                rgb = rgb * (1.0 - t.weight) + dusk * t.weight;
             }
             c += rgb * self.clear_weight;
         }
@@ -266,6 +278,22 @@ impl Sky {
 mod tests {
     use super::*;
 
+    /// `∫ (L − night floor) cos θ dω` of `sky` over the upper hemisphere, by the midpoint rule on `n_t` rings
+    /// uniform in the zenith angle θ, `n_p` directions each (a grid of its own, not the model's).
+    fn horizontal_illuminance_theta(sky: &Sky, n_t: usize, n_p: usize) -> f64 {
+        let mut e = 0.0f64;
+        for i in 0..n_t {
+            let th = (i as f64 + 0.5) / n_t as f64 * std::f64::consts::FRAC_PI_2;
+            for j in 0..n_p {
+                let ph = (j as f64 + 0.5) / n_p as f64 * std::f64::consts::TAU;
+                let d = Vec3::new((th.sin() * ph.cos()) as f32, (th.sin() * ph.sin()) as f32, th.cos() as f32);
+                let l = luminance(sky.radiance(d)) as f64 - NIGHT_FLOOR as f64;
+                e += l * th.cos() * th.sin();
+            }
+        }
+        e * (std::f64::consts::FRAC_PI_2 / n_t as f64) * (std::f64::consts::TAU / n_p as f64)
+    }
+
     #[test]
     fn zenith_value_is_the_zenith_formula() {
         // At the zenith θ = 0, γ = θ_s: F(0, θ_s) / F(0, θ_s) = 1, so Y is the zenith luminance itself.
@@ -288,22 +316,7 @@ mod tests {
     #[test]
     fn overcast_sky_gives_its_horizontal_illuminance() {
         let sky = Sky::new(Vec3::new(0.0, 0.0, 1.0), 3.0, 1.0);
-        // ∫ L cos θ dω over the hemisphere, numerically.
-        let (n_t, n_p) = (400, 64);
-        let mut e = 0.0f64;
-        for i in 0..n_t {
-            let th = (i as f64 + 0.5) / n_t as f64 * std::f64::consts::FRAC_PI_2;
-            for j in 0..n_p {
-                let ph = (j as f64 + 0.5) / n_p as f64 * std::f64::consts::TAU;
-                let d = Vec3::new((th.sin() * ph.cos()) as f32, (th.sin() * ph.sin()) as f32, th.cos() as f32);
-                let l = luminance(sky.radiance(d)) as f64 - NIGHT_FLOOR as f64;
-                e += l
-                    * th.cos()
-                    * th.sin()
-                    * (std::f64::consts::FRAC_PI_2 / n_t as f64)
-                    * (std::f64::consts::TAU / n_p as f64);
-            }
-        }
+        let e = horizontal_illuminance_theta(&sky, 400, 64);
         let want = 20_000.0 + 400.0;
         assert!((e - want).abs() / want < 0.01, "{e} vs {want}");
     }
@@ -334,22 +347,8 @@ mod tests {
     fn twilight_sky_keeps_the_horizontal_illuminance_and_takes_the_twilight_colours() {
         // The sun on the horizon: Preetham's sky, which the twilight sky continues.
         let dawn = Sky::new(Vec3::X, 3.0, 0.0);
-        // ∫ L cos θ dω over the hemisphere, numerically (uniform in θ, unlike the model's own rings).
-        let e_h = |s: &Sky| {
-            let (n_t, n_p) = (300, 128);
-            let mut e = 0.0f64;
-            for i in 0..n_t {
-                let th = (i as f64 + 0.5) / n_t as f64 * std::f64::consts::FRAC_PI_2;
-                for j in 0..n_p {
-                    let ph = (j as f64 + 0.5) / n_p as f64 * std::f64::consts::TAU;
-                    let d = Vec3::new((th.sin() * ph.cos()) as f32, (th.sin() * ph.sin()) as f32, th.cos() as f32);
-                    let l = (luminance(s.radiance(d)) - NIGHT_FLOOR) as f64;
-                    e += l * th.cos() * th.sin() * std::f64::consts::FRAC_PI_2 / n_t as f64 * std::f64::consts::TAU
-                        / n_p as f64;
-                }
-            }
-            e
-        };
+        // (integrated uniformly in θ, unlike the model's own rings)
+        let e_h = |s: &Sky| horizontal_illuminance_theta(s, 300, 128);
         let e_dawn = e_h(&dawn);
         for deg in [-0.5f32, -2.0, -4.0, -8.0] {
             let h = deg.to_radians();

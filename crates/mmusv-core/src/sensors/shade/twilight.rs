@@ -53,7 +53,8 @@ const MIE_G: f64 = 0.8;
 const OZONE_CROSS_SECTION: [f64; 3] = [4.66e-25, 3.30e-25, 3.67e-26];
 /// Ozone column: 300 Dobson units, molecules per m².
 const OZONE_COLUMN: f64 = 300.0 * 2.687e20;
-/// Centre wavelengths of the R, G, B channels, µm (those of the sun's beam in `sky.rs`).
+/// Centre wavelengths of the R, G, B channels, µm: `sky::LAMBDA` in double precision (the table is integrated
+/// in f64; widening the f32 values would move its last bits).
 const LAMBDA: [f64; 3] = [0.61, 0.55, 0.465];
 /// Steps along a view ray and along a ray towards the sun.
 const VIEW_STEPS: usize = 96;
