@@ -183,10 +183,12 @@ impl Sea {
 
     /// The [`Horizon`] of viewpoint `origin` over the static geometry and the moving instances' boxes, with the
     /// moving instances whose boxes stand over it (the caller adds their triangles: `Horizon::add_triangle`).
-    /// `None` when `origin` is not above the surface or a moving box lies outside the grid.
+    /// `None` when `origin` is not above the still level or a moving box lies outside the grid. The water is not
+    /// part of it: from a viewpoint below the crest bound of the waves ([`Sea::set_wave_top`]), a ray the horizon
+    /// clears must also clear the waves.
     #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > b)` on purpose: a NaN must answer "no"
     pub fn horizon(&self, origin: [f32; 3]) -> Option<(Horizon, Vec<u32>)> {
-        if !(self.contained && origin[2] > self.surface_top() && origin.iter().all(|v| v.is_finite())) {
+        if !(self.contained && origin[2] > self.level && origin.iter().all(|v| v.is_finite())) {
             return None;
         }
         let mut h = Horizon::new(origin);

@@ -89,6 +89,37 @@ fn wave_surface_batches_give_exactly_the_ray_by_ray_reference() {
             assert_eq!(fast.distance[i], t_w.min(t_m), "eye {z}: ray {i}");
         }
     }
+    // Viewpoints among the crests (over the still level, under the crest bound: a low USV's camera or LiDAR at
+    // sea) have horizons too; the rays they clear must still clear the waves, which some of these rising rays meet.
+    let (mut rising, mut blocked, mut cleared) = (0, 0, 0);
+    for (k, z) in [0.45f32, 0.8, 1.1].into_iter().enumerate() {
+        let eye = [-40.0 + 35.0 * k as f32, 25.0 - 20.0 * k as f32, z];
+        let Some(h) = s.horizon(eye) else { panic!("a viewpoint {z} m up among the crests has no horizon") };
+        let (mut co, mut cd) = (Vec::new(), Vec::new());
+        for j in 0..6144u32 {
+            let (az, el) = (0.00103 * j as f32, -0.02 + 0.17 * ((j * 53) % 6144) as f32 / 6144.0);
+            co.push(eye);
+            cd.push([az.cos() * el.cos(), az.sin() * el.cos(), el.sin()]);
+        }
+        let fast = s.cast_rays(&co, &cd, limit).unwrap_or_default();
+        for i in 0..co.len() {
+            let u = unit_direction(&cd[i]);
+            let t_w = if w.leaves(co[i], u) { None } else { w.intersect(co[i], u, limit) };
+            let t_w = t_w.map_or(f32::INFINITY, |h| h.t);
+            let t_m = reference
+                .cast_ray(Vec3::from_array(co[i]), Vec3::from_array(u), limit)
+                .map_or(f32::INFINITY, |h| h.distance);
+            assert_eq!(fast.distance[i], t_w.min(t_m), "eye {z}: ray {i} {u:?}");
+            if u[2] > 0.0 {
+                rising += 1;
+                blocked += usize::from(t_w < t_m);
+                // Rays the horizon clears of everything but the water, which the waves stop.
+                cleared += usize::from(h.clear(u) && t_w.is_finite());
+            }
+        }
+    }
+    assert!(blocked > 1000 && rising - blocked > 5000, "{blocked} of {rising} rising rays met the waves first");
+    assert!(cleared > 500, "only {cleared} rays cleared by the horizons met the waves");
     // Shadow rays towards the sun from the wave surface (leaving the water: the waves do not shade them), from
     // just over the skin above it (the sun mask, lifted over the crests that shade them) and from above everything.
     let sun = [0.8f32, 0.3, 0.05];
