@@ -62,9 +62,19 @@ impl Scene {
     #[inline(always)]
     pub(super) fn mark_leaves(&self, rays: &mut [RayPrep]) {
         let Some(w) = &self.waves else { return };
+        // Rays from one point (a camera's pixels) share the height of the surface under it.
+        let mut under: Option<([f32; 2], f32)> = None;
         for r in rays {
             if r.leaves == LEAVES_UNKNOWN {
-                r.leaves = if w.leaves(r.o, r.d) { LEAVES_YES } else { LEAVES_NO };
+                let h = |x: f32, y: f32| match under {
+                    Some((p, h)) if p == [x, y] => h,
+                    _ => {
+                        let h = w.height(x, y);
+                        under = Some(([x, y], h));
+                        h
+                    }
+                };
+                r.leaves = if w.leaves_over(r.o, r.d, h) { LEAVES_YES } else { LEAVES_NO };
             }
         }
     }

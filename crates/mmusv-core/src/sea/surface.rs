@@ -247,10 +247,18 @@ impl WaveSurface {
     #[inline]
     #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > b)` on purpose: a NaN must answer "no"
     pub fn leaves(&self, o: [f32; 3], d: [f32; 3]) -> bool {
+        self.leaves_over(o, d, |x, y| self.height(x, y))
+    }
+
+    /// [`WaveSurface::leaves`] with the surface's height under the origin from `height(x, y)` (called only
+    /// when needed; a caller with many rays from one point keeps it).
+    #[inline(always)]
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > b)` on purpose: a NaN must answer "no"
+    pub fn leaves_over(&self, o: [f32; 3], d: [f32; 3], mut height: impl FnMut(f32, f32) -> f32) -> bool {
         if !(d[2] > 0.0) || o[2] > self.zmax + SKIN_M || o[2] < self.zmin {
             return false;
         }
-        let h = self.height(o[0], o[1]);
+        let h = height(o[0], o[1]);
         o[2] >= h && o[2] <= h + SKIN_M
     }
 
