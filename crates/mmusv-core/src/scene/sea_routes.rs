@@ -84,7 +84,7 @@ impl Scene {
     pub fn sea_sky(&self, ray: &RayPrep, limit: f32, horizon: Option<&Horizon>) -> bool {
         if let Some(h) = horizon {
             debug_assert_eq!(h.origin(), ray.o, "a horizon answers only for rays from its viewpoint");
-            if h.clear(ray.d) && self.clears_waves(ray, limit) {
+            if h.clear(ray.d) {
                 return true;
             }
             return self.sea_clear_within(ray, limit, SEA_WALK_SKY);
@@ -92,32 +92,10 @@ impl Scene {
         self.sea_clear_within(ray, limit, SEA_WALK_SKY_NO_HORIZON)
     }
 
-    /// Whether `ray` meets no wave: it starts above the crest bound, or it rises from above the still level and
-    /// crosses no wave before it is over that bound (a ray leaving the water, [`crate::sea::WaveSurface::leaves`],
-    /// crosses none). What a [`Horizon`] answers for a viewpoint among the waves (a camera or LiDAR lower than the
-    /// highest crest around the USVs) needs this as well.
-    #[inline(always)]
-    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > b)` on purpose: a NaN must answer "not clear"
-    fn clears_waves(&self, ray: &RayPrep, limit: f32) -> bool {
-        let Some(sea) = &self.sea else { return false };
-        let top = sea.surface_top();
-        if ray.o[2] > top {
-            return true;
-        }
-        let Some(w) = &self.waves else { return false };
-        if !(ray.d[2] > 0.0 && ray.o[2] > sea.level) {
-            return false;
-        }
-        if self.ray_leaves(ray) {
-            return true;
-        }
-        // As far as just over the bound (the margin as in `lift_over_waves`).
-        let t = ((top - ray.o[2]) / ray.d[2]) * 1.0001 + 1e-3 / ray.d[2];
-        !w.occludes(ray.o, ray.d, t.min(limit))
-    }
-
     /// The [`Horizon`] of viewpoint `origin` (see [`crate::sea`]): the static height map, the moving instances'
-    /// boxes, and the triangles of those whose boxes stand over it. `None` when the sea shortcuts do not apply.
+    /// boxes, the triangles of those whose boxes stand over it, and, from among the waves, their crests
+    /// ([`crate::sea::WaveSurface::add_crests`]). `None` when the sea shortcuts do not apply.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > b)` on purpose: a NaN origin takes the crests
     pub(super) fn horizon(&self, origin: [f32; 3]) -> Option<Horizon> {
         let (mut h, near) = self.sea.as_ref()?.horizon(origin)?;
         for id in near {
@@ -125,6 +103,12 @@ impl Scene {
             let mesh = &self.meshes[inst.mesh as usize];
             for f in mesh.faces() {
                 h.add_triangle(f.map(|k| inst.pose.transform_point(mesh.vertices()[k as usize]).to_array()));
+            }
+        }
+        // A viewpoint among the waves (not over their crest bound): the crests are columns too.
+        if let (Some(w), Some(sea)) = (&self.waves, &self.sea) {
+            if !(origin[2] > sea.surface_top()) {
+                w.add_crests(&mut h);
             }
         }
         Some(h)

@@ -34,6 +34,9 @@ const MAX_LEVEL: u32 = 5;
 /// Rays that rise from within this height (metres) above the surface under their origin leave the water: the
 /// surface does not occlude them ([`WaveSurface::leaves`]).
 pub const SKIN_M: f32 = 0.25;
+/// Crest columns given to a [`crate::sea::Horizon`] ([`WaveSurface::add_crests`]) stand this much (metres) above
+/// the highest node under them: far more than the rounding of the surface's planes.
+const CREST_MARGIN_M: f64 = 1e-3;
 /// Piece id of the still, flat water (outside the sampled tiles or in a flat tile).
 pub const FLAT_PIECE: u32 = u32::MAX - 1;
 
@@ -260,6 +263,41 @@ impl WaveSurface {
         }
         let h = height(o[0], o[1]);
         o[2] >= h && o[2] <= h + SKIN_M
+    }
+
+    /// Adds the crests to `horizon` as columns (see [`crate::sea::Horizon`]): every sampled tile rising to its
+    /// viewpoint's height or above, as one column up to its highest node, and, for the tiles within a tile of the
+    /// viewpoint, each such cell as its own column up to its highest corner (so the water just round a sensor
+    /// among the waves hides only the directions its crests stand in; a cell under the viewpoint rising above it
+    /// covers the horizon). A ray the horizon then clears crosses no wave.
+    pub(crate) fn add_crests(&self, horizon: &mut crate::sea::Horizon) {
+        let o = horizon.origin();
+        let pz = f64::from(o[2]);
+        let (ox, oy) = (f64::from(o[0]), f64::from(o[1]));
+        let tm = f64::from(self.tile_m);
+        for (k, t) in self.tiles.iter().enumerate() {
+            if t.n == 0 || f64::from(t.zmax) + CREST_MARGIN_M < pz {
+                continue;
+            }
+            let lo = [f64::from(self.x0) + (k % self.ntx) as f64 * tm, f64::from(self.y0) + (k / self.ntx) as f64 * tm];
+            let hi = [lo[0] + tm, lo[1] + tm];
+            let near = (lo[0] - ox).max(ox - hi[0]) < tm && (lo[1] - oy).max(oy - hi[1]) < tm;
+            if !near {
+                horizon.add_rect(lo, hi, f64::from(t.zmax) + CREST_MARGIN_M);
+                continue;
+            }
+            let cs = tm / t.n as f64;
+            for cj in 0..t.n {
+                for ci in 0..t.n {
+                    let (_, cmax) = cell_planes(t, ci, cj);
+                    let top = f64::from(cmax) + CREST_MARGIN_M;
+                    if top >= pz {
+                        let c = [lo[0] + ci as f64 * cs, lo[1] + cj as f64 * cs];
+                        horizon.add_rect(c, [c[0] + cs, c[1] + cs], top);
+                    }
+                }
+            }
+        }
     }
 
     /// Whether the ray `o + t·d` crosses the surface with `0 <= t < t_max`.
