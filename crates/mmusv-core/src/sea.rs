@@ -23,7 +23,8 @@
 //! alone does not stop a ray that passes over its static bound and misses the box itself.
 //!
 //! * a batch of rays that all leave one point (a camera's pixels) asks that point's [`Horizon`]: per azimuth,
-//!   the slope above which a ray from there passes over everything (`sea/horizon.rs`).
+//!   the slope above which a ray from there passes over everything (`sea/horizon.rs`); from a point among the
+//!   waves (under their crest bound), the crests are among its columns (`WaveSurface::add_crests`).
 //!
 //! So the shortcuts give exactly the full trace's answers; a ray the bound cannot settle is traced fully.
 
