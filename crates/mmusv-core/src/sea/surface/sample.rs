@@ -47,6 +47,10 @@ pub(super) struct Phasors<'a> {
     /// level's `w` nodes a side (the powers tabulated once per frame, so a tile's nodes need no chain of
     /// rotations: every node's phasor is one product, independent of the others).
     powers: Vec<Vec<(C64, C64)>>,
+    /// Per level (not the detail grid), the rotations to each node row as [`accumulate`] reads them for a tile
+    /// summing every component, `([j · nc + c] re, im)` in `f32`: the same for every tile of the level, so made
+    /// once per frame.
+    rows_f32: Vec<(Vec<f32>, Vec<f32>)>,
 }
 
 impl<'a> Phasors<'a> {
@@ -93,7 +97,21 @@ impl<'a> Phasors<'a> {
                 }
             }
         }
-        Self { comps, x0, y0, tile_m, col, row, powers }
+        let rows_f32 = (0..levels)
+            .map(|l| {
+                let w = cells(l) + 1;
+                let (mut fr, mut fi) = (vec![0f32; w * nc], vec![0f32; w * nc]);
+                for c in 0..nc {
+                    for i in 0..w {
+                        let q = powers[l][c * w + i].1;
+                        fr[i * nc + c] = q.0 as f32;
+                        fi[i * nc + c] = q.1 as f32;
+                    }
+                }
+                (fr, fi)
+            })
+            .collect();
+        Self { comps, x0, y0, tile_m, col, row, powers, rows_f32 }
     }
 
     /// Samples tile `(ix, iy)`: its level from the distance of its centre to the nearest focus, flat when wholly
@@ -225,7 +243,8 @@ impl<'a> Phasors<'a> {
         terms: &[(usize, [f32; 2])],
     ) -> (Vec<f32>, Vec<f32>, Vec<f32>, usize) {
         let nc = self.comps.len();
-        let table = &self.powers[table];
+        let level = table;
+        let table = &self.powers[level];
         let nt = terms.len();
         // Node rows padded to whole groups of LANES (the padding lanes are summed and never read).
         let groups = w.div_ceil(LANES);
@@ -234,7 +253,11 @@ impl<'a> Phasors<'a> {
         // (group-major, so the sum over terms reads memory in order), and the rotation to each node row
         // `[j · nt + t]`.
         let (mut ar, mut ai) = (vec![0f32; groups * nt * LANES], vec![0f32; groups * nt * LANES]);
-        let (mut fr, mut fi) = (vec![0f32; w * nt], vec![0f32; w * nt]);
+        // Every component in order (a tile's own sums): the level's row rotations are made once per frame.
+        let shared =
+            self.rows_f32.get(level).filter(|_| nt == nc && terms.iter().enumerate().all(|(t, &(c, _))| c == t));
+        let (mut fr, mut fi) =
+            if shared.is_some() { (Vec::new(), Vec::new()) } else { (vec![0f32; w * nt], vec![0f32; w * nt]) };
         let mut k = vec![[0f32; 2]; nt];
         for (t, &(c, kc)) in terms.iter().enumerate() {
             let pw = &table[c * w..(c + 1) * w];
@@ -244,15 +267,20 @@ impl<'a> Phasors<'a> {
                 let at = ((i / LANES) * nt + t) * LANES + i % LANES;
                 ar[at] = v.0 as f32;
                 ai[at] = v.1 as f32;
-                fr[i * nt + t] = q.1 .0 as f32;
-                fi[i * nt + t] = q.1 .1 as f32;
+            }
+            if shared.is_none() {
+                for (i, q) in pw.iter().enumerate() {
+                    fr[i * nt + t] = q.1 .0 as f32;
+                    fi[i * nt + t] = q.1 .1 as f32;
+                }
             }
             k[t] = kc;
         }
+        let (fr, fi) = shared.map_or((&fr[..], &fi[..]), |(r, i)| (&r[..], &i[..]));
         let mut eta = vec![0f32; stride * w];
         let mut sx = vec![0f32; stride * w];
         let mut sy = vec![0f32; stride * w];
-        accumulate((&ar, &ai), (&fr, &fi), &k, (&mut eta, &mut sx, &mut sy));
+        accumulate((&ar, &ai), (fr, fi), &k, (&mut eta, &mut sx, &mut sy));
         (eta, sx, sy, stride)
     }
 }
