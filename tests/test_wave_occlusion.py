@@ -277,3 +277,24 @@ def test_pattern_angles_trust_identity_only_for_frozen_arrays() -> None:
     first = pattern_angles(view).az.copy()
     base[:, :2] *= -1.0
     assert not np.allclose(first, pattern_angles(view).az)
+
+
+def test_a_surface_sampled_without_its_shading_slopes_is_the_same_geometry() -> None:
+    """``slopes=False`` (what a frame nothing renders samples) gives every ray the same hit, bit for bit, and the
+    same heights: the slopes only ever reach the cameras' shading."""
+    sea = Sea(3.5, 9.3)
+    s, _, _, _ = _world(None)
+    rng = np.random.default_rng(4)
+    n = 4000
+    o = np.column_stack([rng.uniform(-80, 80, n), rng.uniform(-80, 80, n), rng.uniform(1.5, 4.0, n)]).astype(np.float32)
+    el, az = rng.uniform(-0.5, 0.1, n), rng.uniform(0, 2 * np.pi, n)
+    d = np.column_stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)]).astype(np.float32)
+    out = {}
+    for slopes in (True, False):
+        s.set_wave_surface(sea, scenario_seed=3, time_s=12.0, foci=np.array([[0.0, 0.0]]), slopes=slopes)
+        hits = s.cast_rays(o, d, max_range=300.0)
+        out[slopes] = (hits.distance, hits.instance_id, hits.triangle_id, hits.normal, s.wave_heights(o[:, :2]))
+    water_hits = int(np.count_nonzero(np.isfinite(out[True][0])))
+    assert water_hits > n // 2
+    for a, b in zip(out[True], out[False], strict=True):
+        np.testing.assert_array_equal(a, b)

@@ -130,11 +130,13 @@ class Scene:
         radius_m: float = 320.0,
         taper_m: float = 60.0,
         detail: bool = False,
+        slopes: bool = True,
     ) -> None:
         """Sets the displaced sea surface of the frame: the JONSWAP wave field of (hs_m, tp_s, gamma,
         direction_rad, spread_s) drawn from the scenario's sea seed, sampled at ``time_s`` around ``foci`` (F, 2)
         float32; ``hs_m=None`` clears it. ``detail``: the finest tiles also carry the short waves' slopes on a
-        half-cell grid, for the cameras' shading (the geometry is the same either way)."""
+        half-cell grid, for the cameras' shading; ``slopes``: the tiles carry the slopes the cameras shade with
+        at all (off: heights alone, for frames nothing renders). The geometry is the same either way."""
 
     def wave_heights(self, xy: npt.NDArray[np.float32]) -> npt.NDArray[np.float32]:
         """Heights (N,) float32 of the displaced sea surface at ``xy`` (N, 2) float32 world x, y."""

@@ -296,6 +296,7 @@ class Scene:
         foci: npt.ArrayLike,
         radius_m: float = 320.0,
         detail: bool = True,
+        slopes: bool = True,
     ) -> None:
         """Sets the displaced sea surface of one frame time (``mmusv_core::sea::WaveSurface``), which replaces the
         sea instance's flat mesh for every ray: crests occlude, beams meet wave faces. The scene must have a sea
@@ -313,6 +314,9 @@ class Scene:
                 long on a 0.5 m grid, so the cameras shade them as normals rather than roughness; the geometry,
                 and so every ray's hit, is the same either way. Costs sampling time; without cameras, leave it
                 off (:meth:`~mmusv.simulation.Simulation.capture` does).
+            slopes: the tiles carry the slopes of the waves they resolve, which only the cameras' shading reads;
+                off, the heights alone are sampled (cheaper; ``detail`` is then off too, and every ray's hit is the
+                same). :meth:`~mmusv.simulation.Simulation.capture` leaves them out for frames nothing renders.
         """
         if sea is None:
             self._native.set_wave_surface(None)
@@ -330,6 +334,7 @@ class Scene:
             radius_m=float(radius_m),
             taper_m=min(60.0, float(radius_m)),
             detail=bool(detail),
+            slopes=bool(slopes),
         )
 
     def wave_heights(self, xy: npt.ArrayLike) -> npt.NDArray[np.float32]:

@@ -312,8 +312,8 @@ class Simulation:
     def set_frame(self, frame: int, *, sea_radius_m: float = 320.0, shading_detail: bool = True) -> WorldState:
         """Moves every vessel to its pose at ``frame`` (and, over a physical sea, the water to its surface at the
         frame time, displaced out to ``sea_radius_m`` around every USV: :meth:`set_sea_surface`) and returns the
-        world state. ``shading_detail``: sample the short waves' slopes the cameras shade with
-        (:meth:`mmusv.scene.Scene.set_wave_surface`'s ``detail``); only rendering reads them."""
+        world state. ``shading_detail``: sample the waves' slopes the cameras shade with, the short waves' too
+        (:meth:`mmusv.scene.Scene.set_wave_surface`'s ``slopes`` and ``detail``); only rendering reads them."""
         if not 0 <= frame < self.frames:
             raise ConfigError(f"frame {frame} is outside the acquisition (0..{self.frames - 1})")
         state = self.world_state(frame)
@@ -328,6 +328,7 @@ class Simulation:
                 foci=foci,
                 radius_m=sea_radius_m,
                 detail=shading_detail,
+                slopes=shading_detail,
             )
         self._frame = frame
         return state

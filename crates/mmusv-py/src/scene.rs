@@ -202,8 +202,10 @@ impl Scene {
     /// of the directional JONSWAP sea `hs_m`, `tp_s`, `gamma`, `direction_rad`, `spread_s` drawn from the scenario's
     /// sea seed (mmusv_core::ocean::WaveField, `sea_seed(scenario_seed)`: the field the hulls ride), sampled at `time_s` around `foci` (F, 2) float32 world x, y; `hs_m=None`
     /// clears it; `detail`: the finest tiles also carry the short waves' slopes for the cameras' shading
-    /// (mmusv_core::sea::SurfaceSpec::detail). Samples with the GIL released.
-    #[pyo3(signature = (hs_m, *, tp_s=8.0, gamma=3.3, direction_rad=0.0, spread_s=10.0, scenario_seed=0, time_s=0.0, foci=None, level=0.0, tile_m=32.0, near_m=40.0, radius_m=320.0, taper_m=60.0, detail=false))]
+    /// (mmusv_core::sea::SurfaceSpec::detail); `slopes`: the tiles carry the slopes the cameras shade with at all
+    /// (mmusv_core::sea::SurfaceSpec::slopes; off: heights alone, for scenes nothing renders). Samples with the
+    /// GIL released.
+    #[pyo3(signature = (hs_m, *, tp_s=8.0, gamma=3.3, direction_rad=0.0, spread_s=10.0, scenario_seed=0, time_s=0.0, foci=None, level=0.0, tile_m=32.0, near_m=40.0, radius_m=320.0, taper_m=60.0, detail=false, slopes=true))]
     #[allow(clippy::too_many_arguments)]
     fn set_wave_surface(
         &self,
@@ -222,6 +224,7 @@ impl Scene {
         radius_m: f32,
         taper_m: f32,
         detail: bool,
+        slopes: bool,
     ) -> PyResult<()> {
         let Some(hs) = hs_m else {
             return self.write(|s| s.set_wave_surface(None))?.map_err(crate::errors::to_py);
@@ -243,7 +246,7 @@ impl Scene {
         }
         let sea = SeaSpec { hs, tp: tp_s, gamma, direction_rad, spread_s };
         let seed = sea_seed(scenario_seed);
-        let spec = SurfaceSpec { tile_m, near_m, radius_m, taper_m, detail };
+        let spec = SurfaceSpec { tile_m, near_m, radius_m, taper_m, detail, slopes };
         let cached = self
             .wave_field
             .lock()

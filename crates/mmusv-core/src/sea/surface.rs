@@ -57,13 +57,17 @@ pub struct SurfaceSpec {
     /// see waves down to one cell long as normals rather than roughness. The geometry, and so every hit, is the same either way; the
     /// sampling costs more (the scene sets it only when cameras render).
     pub detail: bool,
+    /// Whether the tiles carry the slopes the cameras shade with ([`WaveSurface::shading`], which answers `None`
+    /// without them; `detail` needs them too). The geometry, and so every hit, is the same either way; the
+    /// sampling costs less without (the scene leaves them out when nothing renders).
+    pub slopes: bool,
 }
 
 impl Default for SurfaceSpec {
     /// 1 m cells within ~40 m, 2 m to ~80 m, 4 m to ~160 m, 8 m to ~320 m, waves out to 320 m around every
     /// focus (tapered over the last 60 m).
     fn default() -> Self {
-        Self { tile_m: 32.0, near_m: 40.0, radius_m: 320.0, taper_m: 60.0, detail: false }
+        Self { tile_m: 32.0, near_m: 40.0, radius_m: 320.0, taper_m: 60.0, detail: false, slopes: true }
     }
 }
 
@@ -75,7 +79,8 @@ struct Tile {
     zmax: f32,
     /// `(n+1)²` heights, world z (every component).
     h: Vec<f32>,
-    /// `(n+1)²` slopes `(∂η/∂x, ∂η/∂y)` of the components the cell resolves ([`resolved`]).
+    /// `(n+1)²` slopes `(∂η/∂x, ∂η/∂y)` of the components the cell resolves ([`resolved`]); empty without
+    /// [`SurfaceSpec::slopes`].
     g: Vec<[f32; 2]>,
     /// Mean square slope `Σ a²k²/2` (both axes) of the components its slopes leave out (the detail bands'
     /// apart), tapered as the waves are.

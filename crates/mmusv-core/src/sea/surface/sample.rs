@@ -145,9 +145,9 @@ impl<'a> Phasors<'a> {
             })
             .collect();
         let nc = self.comps.len();
-        let (eta, sx, sy, stride) = self.node_sums(ix, iy, lvl as usize, w, &terms);
+        let (eta, sx, sy, stride) = self.node_sums(ix, iy, lvl as usize, w, &terms, spec.slopes);
         let mut h = vec![0f32; w * w];
-        let mut g = vec![[0f32; 2]; w * w];
+        let mut g = if spec.slopes { vec![[0f32; 2]; w * w] } else { Vec::new() };
         let (mut zmin, mut zmax) = (f32::INFINITY, f32::NEG_INFINITY);
         let inner = spec.radius_m - spec.taper_m.max(0.0);
         // Every node within `inner` of a focus is untapered: no distances when the whole tile is.
@@ -171,7 +171,9 @@ impl<'a> Phasors<'a> {
                 let ks = j * stride + i;
                 let z = level + eta[ks] * taper;
                 h[k] = z;
-                g[k] = [sx[ks] * taper, sy[ks] * taper];
+                if let Some(g) = g.get_mut(k) {
+                    *g = [sx[ks] * taper, sy[ks] * taper];
+                }
                 zmin = zmin.min(z);
                 zmax = zmax.max(z);
             }
@@ -182,7 +184,7 @@ impl<'a> Phasors<'a> {
         let mut detail: Vec<[f32; 4]> = Vec::new();
         let mut bands = [false; 2];
         let mut band_mss = [0f32; 2];
-        if spec.detail && lvl == 0 && all_inner {
+        if spec.detail && spec.slopes && lvl == 0 && all_inner {
             let [a_m, b_m] = DETAIL_BANDS.map(|c| tile_m / c as f32);
             let band = |k: f64| {
                 if resolved(k, cell_m) {
@@ -227,13 +229,14 @@ impl<'a> Phasors<'a> {
         let w = DETAIL_CELLS + 1;
         let terms: Vec<(usize, [f32; 2])> =
             sub.iter().map(|&c| (c, [self.comps[c].kx as f32, self.comps[c].ky as f32])).collect();
-        let (_, sx, sy, stride) = self.node_sums(ix, iy, MAX_LEVEL as usize + 1, w, &terms);
+        let (_, sx, sy, stride) = self.node_sums(ix, iy, MAX_LEVEL as usize + 1, w, &terms, true);
         (0..w * w).map(|q| [sx[(q / w) * stride + q % w], sy[(q / w) * stride + q % w]]).collect()
     }
 
     /// The sums of [`accumulate`] over the `w × w` nodes of tile `(ix, iy)` with power table `table` (a level's,
     /// or the detail grid's after them, for `w` nodes a side): per term, a component's index and the wavenumber its slopes are summed with
-    /// (zero: its height only). Returns `eta`, `sx`, `sy` row-major with rows padded to `stride` nodes.
+    /// (zero: its height only). Returns `eta`, `sx`, `sy` row-major with rows padded to `stride` nodes; without
+    /// `slopes`, `sx` and `sy` empty (the heights alone summed, the same bits).
     fn node_sums(
         &self,
         ix: usize,
@@ -241,6 +244,7 @@ impl<'a> Phasors<'a> {
         table: usize,
         w: usize,
         terms: &[(usize, [f32; 2])],
+        slopes: bool,
     ) -> (Vec<f32>, Vec<f32>, Vec<f32>, usize) {
         let nc = self.comps.len();
         let level = table;
@@ -278,6 +282,10 @@ impl<'a> Phasors<'a> {
         }
         let (fr, fi) = shared.map_or((&fr[..], &fi[..]), |(r, i)| (&r[..], &i[..]));
         let mut eta = vec![0f32; stride * w];
+        if !slopes {
+            accumulate_heights((&ar, &ai), (fr, fi), nt, &mut eta);
+            return (eta, Vec::new(), Vec::new(), stride);
+        }
         let mut sx = vec![0f32; stride * w];
         let mut sy = vec![0f32; stride * w];
         accumulate((&ar, &ai), (fr, fi), &k, (&mut eta, &mut sx, &mut sy));
@@ -326,6 +334,33 @@ crate::dispatch! {
                 e_row[at.clone()].copy_from_slice(&e);
                 x_row[at.clone()].copy_from_slice(&gx);
                 y_row[at].copy_from_slice(&gy);
+            }
+        }
+    }
+}
+
+crate::dispatch! {
+    /// [`accumulate`]'s heights alone, `eta = Σ re` over `nc` components (the same operations in the same order:
+    /// the same bits), for a surface nothing shades ([`SurfaceSpec::slopes`] off).
+    fn accumulate_heights(row: (&[f32], &[f32]), rot: (&[f32], &[f32]), nc: usize, eta: &mut [f32]) {
+        let ((ar, ai), (fr, fi)) = (row, rot);
+        if nc == 0 {
+            return;
+        }
+        let groups = ar.len() / (nc * LANES);
+        let stride = groups * LANES;
+        for (j, e_row) in eta.chunks_exact_mut(stride).enumerate() {
+            let (fr, fi) = (&fr[j * nc..(j + 1) * nc], &fi[j * nc..(j + 1) * nc]);
+            for g in 0..groups {
+                let span = g * nc * LANES..(g + 1) * nc * LANES;
+                let mut e = [0f32; LANES];
+                let comps = ar[span.clone()].chunks_exact(LANES).zip(ai[span].chunks_exact(LANES));
+                for ((a, b), (&r, &i)) in comps.zip(fr.iter().zip(fi)) {
+                    for l in 0..LANES {
+                        e[l] += a[l] * r - b[l] * i;
+                    }
+                }
+                e_row[g * LANES..(g + 1) * LANES].copy_from_slice(&e);
             }
         }
     }

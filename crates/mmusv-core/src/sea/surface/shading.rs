@@ -52,7 +52,8 @@ impl WaveSurface {
     }
 
     /// The water's shading at world `(x, y)` seen with a pixel footprint of `footprint_m` metres on the water
-    /// ([`SurfaceShading`]); `None` over still water.
+    /// ([`SurfaceShading`]); `None` over still water, and on a surface sampled without its slopes
+    /// ([`SurfaceSpec::slopes`](super::SurfaceSpec::slopes) off).
     ///
     /// Model: a wave shorter than four cells of the tile's level (`resolved`) cannot be drawn from its nodes
     /// (sampled there, it aliases into a false pattern of longer slopes, and the level's edge shows as a change
@@ -68,7 +69,7 @@ impl WaveSurface {
     pub fn shading(&self, x: f32, y: f32, footprint_m: f32) -> Option<SurfaceShading> {
         let (ix, iy) = self.tile_at(x, y)?;
         let t = &self.tiles[iy * self.ntx + ix];
-        if t.n == 0 {
+        if t.n == 0 || t.g.is_empty() {
             return None;
         }
         let [mut gx, mut gy] = self.slope_at(&t.g, t.n, ix, iy, x, y);

@@ -305,3 +305,27 @@ fn normals_face_up_and_follow_the_slope() {
     let g = s.piece_normal(h.piece);
     assert!(g[2] > 0.0 && (g[0] / g[2] - want).abs() < 0.01, "{g:?}");
 }
+
+/// Sampled without its slopes (nothing renders), the surface is the same geometry bit for bit — the same heights,
+/// bounds and hits — and has no shading to give.
+#[test]
+fn a_surface_without_slopes_has_the_same_geometry_and_no_shading() {
+    let c = test_sea();
+    let foci = [[0.0f32, 0.0], [150.0, 60.0]];
+    let with = surface(&c, 4.0, &foci, SurfaceSpec { detail: true, ..SurfaceSpec::default() });
+    let without = surface(&c, 4.0, &foci, SurfaceSpec { detail: true, slopes: false, ..SurfaceSpec::default() });
+    assert_eq!((with.zmin(), with.zmax()), (without.zmin(), without.zmax()));
+    let (mut shaded, mut hits) = (0, 0);
+    for k in 0..4000u32 {
+        let (x, y) = (-300.0 + 0.151 * k as f32, -250.0 + 0.137 * ((k * 37) % 4000) as f32);
+        assert_eq!(with.height(x, y).to_bits(), without.height(x, y).to_bits(), "height at {x}, {y}");
+        shaded += usize::from(with.shading(x, y, 0.1).is_some());
+        assert!(without.shading(x, y, 0.1).is_none(), "shading at {x}, {y} without slopes");
+        let (o, el) = ([x, y, 2.5], -0.02 - 0.3 * (k % 7) as f32 / 7.0);
+        let d = [el.cos() * (0.7 * k as f32).cos(), el.cos() * (0.7 * k as f32).sin(), el.sin()];
+        let (a, b) = (with.intersect(o, d, 300.0), without.intersect(o, d, 300.0));
+        assert_eq!(a, b, "ray {k}");
+        hits += usize::from(a.is_some());
+    }
+    assert!(shaded > 2000 && hits > 2000, "{shaded} shaded points, {hits} hits");
+}
