@@ -69,25 +69,34 @@ fn wave_surface_batches_give_exactly_the_ray_by_ray_reference() {
         }
     }
     assert!(water > 5000, "only {water} rays met the waves");
+    // A fan of `n` rays from `eye` (azimuth step `az_step`, elevations spread over `el0 .. el0 + span` in the order
+    // `k · mul mod n`), cast as one batch and checked ray by ray against the reference; each ray's unit direction,
+    // wave distance and distance to the rest of the scene (infinite for none).
+    let fan = |eye: [f32; 3], n: u32, az_step: f32, (el0, span, mul): (f32, f32, u32)| {
+        let co = vec![eye; n as usize];
+        let cd: Vec<[f32; 3]> = (0..n)
+            .map(|k| {
+                let (az, el) = (az_step * k as f32, el0 + span * ((k * mul) % n) as f32 / n as f32);
+                [az.cos() * el.cos(), az.sin() * el.cos(), el.sin()]
+            })
+            .collect();
+        let fast = s.cast_rays(&co, &cd, limit).unwrap_or_default();
+        (0..co.len())
+            .map(|i| {
+                let u = unit_direction(&cd[i]);
+                let t_w = if w.leaves(eye, u) { None } else { w.intersect(eye, u, limit) };
+                let t_w = t_w.map_or(f32::INFINITY, |h| h.t);
+                let t_m = reference
+                    .cast_ray(Vec3::from_array(eye), Vec3::from_array(u), limit)
+                    .map_or(f32::INFINITY, |h| h.distance);
+                assert_eq!(fast.distance[i], t_w.min(t_m), "eye {eye:?}: ray {i} {u:?}");
+                (u, t_w, t_m)
+            })
+            .collect::<Vec<_>>()
+    };
     // One viewpoint (a camera above the crests, with its horizon) and one among them.
     for z in [6.0f32, 1.2] {
-        let eye = [30.0f32, -20.0, z];
-        let (mut co, mut cd) = (Vec::new(), Vec::new());
-        for k in 0..8192u32 {
-            let (az, el) = (0.0008 * k as f32, -0.3 + 0.4 * ((k * 37) % 8192) as f32 / 8192.0);
-            co.push(eye);
-            cd.push([az.cos() * el.cos(), az.sin() * el.cos(), el.sin()]);
-        }
-        let fast = s.cast_rays(&co, &cd, limit).unwrap_or_default();
-        for i in 0..co.len() {
-            let u = unit_direction(&cd[i]);
-            let t_w = if w.leaves(co[i], u) { None } else { w.intersect(co[i], u, limit) };
-            let t_w = t_w.map_or(f32::INFINITY, |h| h.t);
-            let t_m = reference
-                .cast_ray(Vec3::from_array(co[i]), Vec3::from_array(u), limit)
-                .map_or(f32::INFINITY, |h| h.distance);
-            assert_eq!(fast.distance[i], t_w.min(t_m), "eye {z}: ray {i}");
-        }
+        fan([30.0f32, -20.0, z], 8192, 0.0008, (-0.3, 0.4, 37));
     }
     // Viewpoints among the crests (over the still level, under the crest bound: a low USV's camera or LiDAR at
     // sea) have horizons too, the crests among their columns; some of these rising rays meet the waves.
@@ -112,21 +121,7 @@ fn wave_surface_batches_give_exactly_the_ray_by_ray_reference() {
     for eye in eyes {
         let z = eye[2];
         let Some(h) = s.horizon(eye) else { panic!("a viewpoint {z} m up among the crests has no horizon") };
-        let (mut co, mut cd) = (Vec::new(), Vec::new());
-        for j in 0..6144u32 {
-            let (az, el) = (0.00103 * j as f32, -0.02 + 0.17 * ((j * 53) % 6144) as f32 / 6144.0);
-            co.push(eye);
-            cd.push([az.cos() * el.cos(), az.sin() * el.cos(), el.sin()]);
-        }
-        let fast = s.cast_rays(&co, &cd, limit).unwrap_or_default();
-        for i in 0..co.len() {
-            let u = unit_direction(&cd[i]);
-            let t_w = if w.leaves(co[i], u) { None } else { w.intersect(co[i], u, limit) };
-            let t_w = t_w.map_or(f32::INFINITY, |h| h.t);
-            let t_m = reference
-                .cast_ray(Vec3::from_array(co[i]), Vec3::from_array(u), limit)
-                .map_or(f32::INFINITY, |h| h.distance);
-            assert_eq!(fast.distance[i], t_w.min(t_m), "eye {z}: ray {i} {u:?}");
+        for (u, t_w, t_m) in fan(eye, 6144, 0.00103, (-0.02, 0.17, 53)) {
             if u[2] > 0.0 {
                 rising += 1;
                 blocked += usize::from(t_w < t_m);
