@@ -282,12 +282,8 @@ impl<'a> Phasors<'a> {
         }
         let (fr, fi) = shared.map_or((&fr[..], &fi[..]), |(r, i)| (&r[..], &i[..]));
         let mut eta = vec![0f32; stride * w];
-        if !slopes {
-            accumulate_heights((&ar, &ai), (fr, fi), nt, &mut eta);
-            return (eta, Vec::new(), Vec::new(), stride);
-        }
-        let mut sx = vec![0f32; stride * w];
-        let mut sy = vec![0f32; stride * w];
+        let slope_len = if slopes { stride * w } else { 0 };
+        let (mut sx, mut sy) = (vec![0f32; slope_len], vec![0f32; slope_len]);
         accumulate((&ar, &ai), (fr, fi), &k, (&mut eta, &mut sx, &mut sy));
         (eta, sx, sy, stride)
     }
@@ -297,70 +293,62 @@ crate::dispatch! {
     /// Sums the components at every node of a tile: `row` holds each component's phasor `(re, im)` along the
     /// tile's bottom row (group-major, see [`Phasors::tile`]), `rot` its rotation `(re, im)` to each node row
     /// (`[j · nc + c]`), `k` its wavenumber; `eta = Σ re`, `(sx, sy) = −Σ (kx, ky) im`, row-major, rows padded to
-    /// whole groups of [`LANES`]. Each group of nodes keeps its sums in registers over all components (one store
+    /// whole groups of [`LANES`] (`sx` and `sy` empty: the heights alone, for a surface nothing shades,
+    /// [`SurfaceSpec::slopes`] off). Each group of nodes keeps its sums in registers over all components (one store
     /// per node, not one per component), and every node adds the components in order, as a loop per component
-    /// would: the same bits. Compiled for AVX2 where the CPU has it (no fused multiply-adds).
+    /// would: the same bits, with or without the slopes. Compiled for AVX2 where the CPU has it (no fused
+    /// multiply-adds).
     fn accumulate(
         row: (&[f32], &[f32]),
         rot: (&[f32], &[f32]),
         k: &[[f32; 2]],
         out: (&mut [f32], &mut [f32], &mut [f32]),
     ) {
-        let nc = k.len();
-        let ((ar, ai), (fr, fi), (eta, sx, sy)) = (row, rot, out);
-        if nc == 0 {
-            return;
-        }
-        let groups = ar.len() / (nc * LANES);
-        let stride = groups * LANES;
-        for (j, ((e_row, x_row), y_row)) in
-            eta.chunks_exact_mut(stride).zip(sx.chunks_exact_mut(stride)).zip(sy.chunks_exact_mut(stride)).enumerate()
-        {
-            let (fr, fi) = (&fr[j * nc..(j + 1) * nc], &fi[j * nc..(j + 1) * nc]);
-            for g in 0..groups {
-                let span = g * nc * LANES..(g + 1) * nc * LANES;
-                let (mut e, mut gx, mut gy) = ([0f32; LANES], [0f32; LANES], [0f32; LANES]);
-                let comps = ar[span.clone()].chunks_exact(LANES).zip(ai[span].chunks_exact(LANES));
-                for ((a, b), ((&r, &i), kc)) in comps.zip(fr.iter().zip(fi).zip(k)) {
-                    for l in 0..LANES {
-                        let re = a[l] * r - b[l] * i;
-                        let im = a[l] * i + b[l] * r;
-                        e[l] += re;
-                        gx[l] -= kc[0] * im;
-                        gy[l] -= kc[1] * im;
-                    }
-                }
-                let at = g * LANES..(g + 1) * LANES;
-                e_row[at.clone()].copy_from_slice(&e);
-                x_row[at.clone()].copy_from_slice(&gx);
-                y_row[at].copy_from_slice(&gy);
-            }
+        if out.1.is_empty() {
+            sum_nodes::<false>(row, rot, k, out);
+        } else {
+            sum_nodes::<true>(row, rot, k, out);
         }
     }
 }
 
-crate::dispatch! {
-    /// [`accumulate`]'s heights alone, `eta = Σ re` over `nc` components (the same operations in the same order:
-    /// the same bits), for a surface nothing shades ([`SurfaceSpec::slopes`] off).
-    fn accumulate_heights(row: (&[f32], &[f32]), rot: (&[f32], &[f32]), nc: usize, eta: &mut [f32]) {
-        let ((ar, ai), (fr, fi)) = (row, rot);
-        if nc == 0 {
-            return;
-        }
-        let groups = ar.len() / (nc * LANES);
-        let stride = groups * LANES;
-        for (j, e_row) in eta.chunks_exact_mut(stride).enumerate() {
-            let (fr, fi) = (&fr[j * nc..(j + 1) * nc], &fi[j * nc..(j + 1) * nc]);
-            for g in 0..groups {
-                let span = g * nc * LANES..(g + 1) * nc * LANES;
-                let mut e = [0f32; LANES];
-                let comps = ar[span.clone()].chunks_exact(LANES).zip(ai[span].chunks_exact(LANES));
-                for ((a, b), (&r, &i)) in comps.zip(fr.iter().zip(fi)) {
-                    for l in 0..LANES {
-                        e[l] += a[l] * r - b[l] * i;
+/// [`accumulate`]'s body, with or without the slopes (inlined into each instruction-set copy).
+#[inline(always)]
+fn sum_nodes<const SLOPES: bool>(
+    row: (&[f32], &[f32]),
+    rot: (&[f32], &[f32]),
+    k: &[[f32; 2]],
+    out: (&mut [f32], &mut [f32], &mut [f32]),
+) {
+    let nc = k.len();
+    let ((ar, ai), (fr, fi), (eta, sx, sy)) = (row, rot, out);
+    if nc == 0 {
+        return;
+    }
+    let groups = ar.len() / (nc * LANES);
+    let stride = groups * LANES;
+    for (j, e_row) in eta.chunks_exact_mut(stride).enumerate() {
+        let (fr, fi) = (&fr[j * nc..(j + 1) * nc], &fi[j * nc..(j + 1) * nc]);
+        for g in 0..groups {
+            let span = g * nc * LANES..(g + 1) * nc * LANES;
+            let (mut e, mut gx, mut gy) = ([0f32; LANES], [0f32; LANES], [0f32; LANES]);
+            let comps = ar[span.clone()].chunks_exact(LANES).zip(ai[span].chunks_exact(LANES));
+            for ((a, b), ((&r, &i), kc)) in comps.zip(fr.iter().zip(fi).zip(k)) {
+                for l in 0..LANES {
+                    e[l] += a[l] * r - b[l] * i;
+                    if SLOPES {
+                        let im = a[l] * i + b[l] * r;
+                        gx[l] -= kc[0] * im;
+                        gy[l] -= kc[1] * im;
                     }
                 }
-                e_row[g * LANES..(g + 1) * LANES].copy_from_slice(&e);
+            }
+            let at = g * LANES..(g + 1) * LANES;
+            e_row[at.clone()].copy_from_slice(&e);
+            if SLOPES {
+                let at = j * stride + at.start..j * stride + at.end;
+                sx[at.clone()].copy_from_slice(&gx);
+                sy[at].copy_from_slice(&gy);
             }
         }
     }
