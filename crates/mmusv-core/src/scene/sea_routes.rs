@@ -95,7 +95,6 @@ impl Scene {
     /// The [`Horizon`] of viewpoint `origin` (see [`crate::sea`]): the static height map, the moving instances'
     /// boxes, the triangles of those whose boxes stand over it, and, from among the waves, their crests
     /// ([`crate::sea::WaveSurface::add_crests`]). `None` when the sea shortcuts do not apply.
-    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > b)` on purpose: a NaN origin takes the crests
     pub(super) fn horizon(&self, origin: [f32; 3]) -> Option<Horizon> {
         let (mut h, near) = self.sea.as_ref()?.horizon(origin)?;
         for id in near {
@@ -105,9 +104,10 @@ impl Scene {
                 h.add_triangle(f.map(|k| inst.pose.transform_point(mesh.vertices()[k as usize]).to_array()));
             }
         }
-        // A viewpoint among the waves (not over their crest bound): the crests are columns too.
+        // A viewpoint among the waves (not over their crest bound; finite, as `Sea::horizon` checked): the crests
+        // are columns too.
         if let (Some(w), Some(sea)) = (&self.waves, &self.sea) {
-            if !(origin[2] > sea.surface_top()) {
+            if origin[2] <= sea.surface_top() {
                 w.add_crests(&mut h);
             }
         }
