@@ -209,16 +209,25 @@ impl WaveSurface {
     /// Height of the surface at world `(x, y)` (the triangulated surface; the still level outside).
     #[inline]
     pub fn height(&self, x: f32, y: f32) -> f32 {
-        let Some((ix, iy)) = self.tile_at(x, y) else { return self.level };
+        self.height_piece(x, y).0
+    }
+
+    /// [`WaveSurface::height`] at world `(x, y)` and the piece there ([`FLAT_PIECE`] over still water), as a
+    /// [`SurfaceHit::piece`].
+    #[inline(always)]
+    fn height_piece(&self, x: f32, y: f32) -> (f32, u32) {
+        let Some((ix, iy)) = self.tile_at(x, y) else { return (self.level, FLAT_PIECE) };
         let k = iy * self.ntx + ix;
         let t = &self.tiles[k];
         if t.n == 0 {
-            return self.level;
+            return (self.level, FLAT_PIECE);
         }
         let ([ci, cj], [fu, fv]) = self.cell_at(t.n, ix, iy, x, y);
         let (plane, _) = cell_planes(t, ci, cj);
-        let p = if fu >= fv { plane[0] } else { plane[1] };
-        p[0] + p[1] * fu + p[2] * fv
+        let tri = usize::from(fu < fv);
+        let p = plane[tri];
+        let piece = (k * 2 * TILE_CELLS * TILE_CELLS + 2 * (cj * t.n + ci) + tri) as u32;
+        (p[0] + p[1] * fu + p[2] * fv, piece)
     }
 
     /// Unit geometric normal (up-facing) of piece `piece` (a [`SurfaceHit::piece`]).

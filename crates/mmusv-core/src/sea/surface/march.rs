@@ -30,6 +30,19 @@ impl WaveSurface {
         if !(t0 <= t1) {
             return None;
         }
+        // A ray that stays over one point while in the band (a top view's, looking straight down: its horizontal
+        // drift there rounds away) meets only the piece under that point, solved on its plane without a walk.
+        let (xa, ya) = (o[0] + d[0] * t0, o[1] + d[1] * t0);
+        if xa == o[0] + d[0] * t1 && ya == o[1] + d[1] * t1 {
+            let (h, piece) = self.height_piece(xa, ya);
+            let (fa, fb) = (oz + dz * t0 - h, oz + dz * t1 - h);
+            if (fa > 0.0) == (fb > 0.0) {
+                return None;
+            }
+            let f = fa / (fa - fb);
+            let t = if f.is_finite() { t0 + (t1 - t0) * f.clamp(0.0, 1.0) } else { t0 };
+            return Some(SurfaceHit { t, piece });
+        }
         let inv = [0, 1, 2].map(|a| if d[a] == 0.0 { f32::INFINITY } else { 1.0 / d[a] });
         let mut m = March { s: self, o, d, inv, above: None };
         // A steep ray crosses the band within one tile: straight to it.

@@ -272,6 +272,37 @@ fn intersect_matches_a_dense_march_of_the_surface() {
     assert!(hits > 1000 && grazing > 500, "{hits} hits, {grazing} grazing");
 }
 
+/// Rays looking straight down (a top view's, whose direction keeps a horizontal drift of `1e-17` from its
+/// rotation), solved on the piece under their point: the surface's height there and its piece, and the same hit as
+/// a ray tilted just enough (`1e-5`) to take the walk.
+#[test]
+fn straight_down_rays_meet_the_piece_under_them() {
+    let c = test_sea();
+    let s = surface(&c, 7.0, &[[0.0, 0.0]], SurfaceSpec::default());
+    let mut n = 0;
+    for j in 0..40 {
+        for i in 0..40 {
+            // Over fine, coarse, tapered and still water (the rectangle reaches about ±352 m).
+            let (x, y) = (-390.0 + 19.7 * i as f32, -388.0 + 19.3 * j as f32);
+            let o = [x, y, 120.0];
+            for d in [[0.0, 0.0, -1.0], [-6.6e-19, 6.1e-17, -1.0]] {
+                let Some(h) = s.intersect(o, d, 500.0) else { panic!("({x}, {y}): no hit straight down") };
+                let z = s.height(x, y);
+                assert!((120.0 - h.t - z).abs() < 1e-4, "({x}, {y}): hit at z {} over a surface at {z}", 120.0 - h.t);
+                let tilted = [1e-5, 0.0, -1.0f32];
+                let w = s.intersect(o, tilted, 500.0).map(|w| w.t);
+                assert!(w.is_some_and(|w| (w - h.t).abs() < 5e-4), "({x}, {y}): {} vs the walk's {w:?}", h.t);
+                assert_eq!(s.piece_normal(h.piece), s.piece_normal(s.height_piece(x, y).1));
+                n += 1;
+            }
+            // Beyond its range, or from under the surface going down: no hit.
+            assert!(s.intersect(o, [0.0, 0.0, -1.0], 100.0).is_none());
+            assert!(s.intersect([x, y, s.height(x, y) - 0.5], [0.0, 0.0, -1.0], 500.0).is_none());
+        }
+    }
+    assert_eq!(n, 3200);
+}
+
 #[test]
 fn crests_hide_what_lies_behind_them() {
     // One long-crested swell along x, 1 m amplitude, 60 m long (crests at x = 0, 60, 120 m): from 1.2 m
