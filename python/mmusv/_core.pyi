@@ -138,6 +138,29 @@ class Scene:
         half-cell grid, for the cameras' shading; ``slopes``: the tiles carry the slopes the cameras shade with
         at all (off: heights alone, for frames nothing renders). The geometry is the same either way."""
 
+    def prefetch_wave_surface(
+        self,
+        hs_m: float | None,
+        *,
+        tp_s: float = 8.0,
+        gamma: float = 3.3,
+        direction_rad: float = 0.0,
+        spread_s: float = 10.0,
+        scenario_seed: int = 0,
+        time_s: float = 0.0,
+        foci: npt.NDArray[np.float32] | None = None,
+        level: float = 0.0,
+        tile_m: float = 32.0,
+        near_m: float = 40.0,
+        radius_m: float = 320.0,
+        taper_m: float = 60.0,
+        detail: bool = False,
+        slopes: bool = True,
+    ) -> None:
+        """Starts sampling, on a thread of its own, the surface a later ``set_wave_surface`` with the same
+        arguments will set; that call takes it instead of sampling it again (the same surface bit for bit), any
+        other leaves it unused. Arguments checked as ``set_wave_surface`` checks them; ``hs_m=None`` drops it."""
+
     def wave_heights(self, xy: npt.NDArray[np.float32]) -> npt.NDArray[np.float32]:
         """Heights (N,) float32 of the displaced sea surface at ``xy`` (N, 2) float32 world x, y."""
 

@@ -252,6 +252,7 @@ def _record(
             prof.add("writer:tables", time.perf_counter() - tw)
 
     writer = BackgroundWriter(write, depth=1)
+    renders = sim.renders()
     if prof is not None:
         prof.start()
     failure: BaseException | None = None
@@ -259,6 +260,9 @@ def _record(
         for k in range(first, total):
             tf = time.perf_counter()
             cap = sim.capture(k)
+            # The next frame's sea surface is sampled on its own thread while this one is annotated and written.
+            if k + 1 < total:
+                sim.prefetch_frame(k + 1, shading_detail=renders)
             t1 = time.perf_counter()
             anns = annotations_for(sim, cap, silhouettes)
             frame = _Frame(cap, {agent: (a, a.columns()) for agent, a in anns.items()})

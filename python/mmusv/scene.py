@@ -90,6 +90,35 @@ class RayHits:
         return p.astype(np.float32, copy=False)
 
 
+def _surface_args(
+    sea: SeaState | None,
+    scenario_seed: int,
+    time_s: float,
+    foci: npt.ArrayLike,
+    radius_m: float,
+    detail: bool,
+    slopes: bool,
+) -> tuple[float | None, dict[str, Any]]:
+    """The native ``set_wave_surface`` / ``prefetch_wave_surface`` arguments of :meth:`Scene.set_wave_surface`'s:
+    ``hs_m`` (``None`` without a sea) and the keywords."""
+    if sea is None:
+        return None, {}
+    f = _array(foci, name="foci", dtype=np.float32, shape_tail=(2,))
+    return float(sea.hs_m), {
+        "tp_s": float(sea.tp_s),
+        "gamma": float(sea.gamma),
+        "direction_rad": float(sea.direction_rad),
+        "spread_s": float(sea.spread_s),
+        "scenario_seed": int(scenario_seed),
+        "time_s": float(time_s),
+        "foci": f,
+        "radius_m": float(radius_m),
+        "taper_m": min(60.0, float(radius_m)),
+        "detail": bool(detail),
+        "slopes": bool(slopes),
+    }
+
+
 def _array(value: Any, *, name: str, dtype: Any, shape_tail: tuple[int, ...]) -> np.ndarray:
     """Coerces ``value`` to a C-contiguous array of ``dtype`` with trailing shape ``shape_tail``."""
     try:
@@ -318,24 +347,27 @@ class Scene:
                 off, the heights alone are sampled (cheaper; ``detail`` is then off too, and every ray's hit is the
                 same). :meth:`~mmusv.simulation.Simulation.capture` leaves them out for frames nothing renders.
         """
-        if sea is None:
-            self._native.set_wave_surface(None)
-            return
-        f = _array(foci, name="foci", dtype=np.float32, shape_tail=(2,))
-        self._native.set_wave_surface(
-            float(sea.hs_m),
-            tp_s=float(sea.tp_s),
-            gamma=float(sea.gamma),
-            direction_rad=float(sea.direction_rad),
-            spread_s=float(sea.spread_s),
-            scenario_seed=int(scenario_seed),
-            time_s=float(time_s),
-            foci=f,
-            radius_m=float(radius_m),
-            taper_m=min(60.0, float(radius_m)),
-            detail=bool(detail),
-            slopes=bool(slopes),
-        )
+        hs, kw = _surface_args(sea, scenario_seed, time_s, foci, radius_m, detail, slopes)
+        self._native.set_wave_surface(hs, **kw)
+
+    def prefetch_wave_surface(
+        self,
+        sea: SeaState | None,
+        *,
+        scenario_seed: int,
+        time_s: float,
+        foci: npt.ArrayLike,
+        radius_m: float = 320.0,
+        detail: bool = True,
+        slopes: bool = True,
+    ) -> None:
+        """Starts sampling, on a thread of its own, the surface a later :meth:`set_wave_surface` with the same
+        arguments will set (the next frame's, while this one is annotated and written: what
+        :meth:`~mmusv.simulation.Simulation.prefetch_frame` does); that call then takes it instead of sampling it
+        again, and any other call leaves it unused. The same surface bit for bit. Arguments as for
+        :meth:`set_wave_surface`, checked now; ``sea=None`` drops a surface being sampled ahead."""
+        hs, kw = _surface_args(sea, scenario_seed, time_s, foci, radius_m, detail, slopes)
+        self._native.prefetch_wave_surface(hs, **kw)
 
     def wave_heights(self, xy: npt.ArrayLike) -> npt.NDArray[np.float32]:
         """``(N,)`` float32 world z of the sea surface at ``xy`` ``(N, 2)`` world x, y (metres): the displaced

@@ -320,18 +320,41 @@ class Simulation:
         n = len(self.scenario.vessels)
         self.ws.scene.set_poses(self.ws.vessel_instances, state.matrices[:n])
         if self.sea is not None and "water" in self.ws.static_instances:
-            foci = np.array([state.poses[a.index, :2] for a in self.agents], dtype=np.float32).reshape(-1, 2)
-            self.ws.scene.set_wave_surface(
-                self.sea,
-                scenario_seed=self.scenario.seed,
-                time_s=state.time_s,
-                foci=foci,
-                radius_m=sea_radius_m,
-                detail=shading_detail,
-                slopes=shading_detail,
-            )
+            self.ws.scene.set_wave_surface(self.sea, **self._surface_of(state, sea_radius_m, shading_detail))
         self._frame = frame
         return state
+
+    def prefetch_frame(self, frame: int, *, sea_radius_m: float = 320.0, shading_detail: bool = True) -> None:
+        """Starts sampling the sea surface :meth:`set_frame` will set for ``frame`` with the same arguments, on a
+        thread of its own (:meth:`mmusv.scene.Scene.prefetch_wave_surface`), so that it is ready when the frame
+        is set: a recording asks for the next frame's while it annotates and writes this one. The same surface
+        bit for bit; nothing to do without a physical sea, or for a frame outside the acquisition."""
+        if self.sea is None or "water" not in self.ws.static_instances or not 0 <= frame < self.frames:
+            return
+        state = self.world_state(frame)
+        self.ws.scene.prefetch_wave_surface(self.sea, **self._surface_of(state, sea_radius_m, shading_detail))
+
+    def _surface_of(self, state: WorldState, radius_m: float, detail: bool) -> dict[str, Any]:
+        """The wave surface arguments of ``state`` (after the sea): finest around the USVs."""
+        foci = np.array([state.poses[a.index, :2] for a in self.agents], dtype=np.float32).reshape(-1, 2)
+        return {
+            "scenario_seed": self.scenario.seed,
+            "time_s": state.time_s,
+            "foci": foci,
+            "radius_m": radius_m,
+            "detail": detail,
+            "slopes": detail,
+        }
+
+    def renders(self, *, agents: Collection[str] | None = None, sensors: Collection[str] | None = None) -> bool:
+        """Whether a :meth:`capture` with these ``agents`` and ``sensors`` renders (a camera or a top view): only
+        then are the short waves' shading slopes sampled."""
+        kinds = set(SENSOR_KINDS if sensors is None else sensors)
+        return any(
+            (("cameras" in kinds and a.cameras) or ("top_view" in kinds and a.top_view is not None))
+            for a in self.agents
+            if agents is None or a.id in agents
+        )
 
     def wakes(self, state: WorldState) -> np.ndarray:
         """``(K, 6)`` float32 rows ``x, y, heading, speed, length, beam`` (world metres, radians, m/s) of the
@@ -402,12 +425,7 @@ class Simulation:
                 f"unknown sensor kind(s) {sorted(kinds - set(SENSOR_KINDS))}; allowed: {', '.join(SENSOR_KINDS)}"
             )
         # The short waves' shading slopes only for frames that render.
-        renders = any(
-            (("cameras" in kinds and a.cameras) or ("top_view" in kinds and a.top_view is not None))
-            for a in self.agents
-            if agents is None or a.id in agents
-        )
-        state = self.set_frame(frame, shading_detail=renders)
+        state = self.set_frame(frame, shading_detail=self.renders(agents=agents, sensors=kinds))
         sc = self.scenario
         out: dict[str, AgentCapture] = {}
         tasks: list[core._CaptureTask] = []

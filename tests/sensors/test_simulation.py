@@ -525,6 +525,55 @@ def test_frame_outside_acquisition(sim: Simulation) -> None:
         sim.agent("tgt")
 
 
+# ------------------------------------------------------------------------------------------ sampling ahead
+
+
+def _surface_bits(sim: Simulation) -> tuple[bytes, float | None]:
+    """The heights of the scene's wave surface on a 2 m grid over its USVs' water, and its crest bound."""
+    g = np.arange(-300.0, 300.0, 2.0)
+    xy = np.stack(np.meshgrid(g, g), axis=-1).reshape(-1, 2).astype(np.float32)
+    return sim.ws.scene.wave_heights(xy).tobytes(), sim.ws.scene.wave_top
+
+
+def test_a_frame_sampled_ahead_sets_the_same_surface(make_scenario: Any) -> None:
+    """``prefetch_frame`` samples the next frame's surface on a thread of its own: the frame then set has the
+    surface it would have had without (every height bit for bit), a prefetch of another frame or with other
+    arguments is left unused, and the captures are the same."""
+    plain, ahead = Simulation(make_scenario()), Simulation(make_scenario())
+    assert plain.sea is not None and plain.sea.hs_m > 0
+    for frame, detail in ((3, True), (4, False)):
+        plain.set_frame(frame, shading_detail=detail)
+        ahead.prefetch_frame(frame, shading_detail=detail)
+        ahead.set_frame(frame, shading_detail=detail)
+        assert _surface_bits(ahead) == _surface_bits(plain), frame
+        assert plain.ws.scene.wave_top is not None
+    # Sampled ahead for frame 6 (or frame 5 without the slopes): frame 5 is sampled afresh, the same.
+    plain.set_frame(5)
+    for other in ({"frame": 6}, {"frame": 5, "shading_detail": False}):
+        ahead.prefetch_frame(**other)
+        ahead.set_frame(5)
+        assert _surface_bits(ahead) == _surface_bits(plain)
+    # What a recording does: capture, sample the next frame ahead, capture it.
+    ahead.capture(1)
+    ahead.prefetch_frame(2, shading_detail=ahead.renders())
+    assert_same_capture(ahead.capture(2), plain.capture(2))
+
+
+def test_sampling_ahead_checks_its_arguments_and_skips_what_needs_none(make_scenario: Any) -> None:
+    sim = Simulation(make_scenario())
+    assert sim.sea is not None
+    with pytest.raises(mmusv.InputError, match="radius_m"):
+        sim.ws.scene.prefetch_wave_surface(sim.sea, scenario_seed=1, time_s=0.0, foci=[[0.0, 0.0]], radius_m=-1.0)
+    with pytest.raises(mmusv.InputError, match="foci"):
+        sim.ws.scene.prefetch_wave_surface(sim.sea, scenario_seed=1, time_s=0.0, foci=[[0.0, np.nan]])
+    sim.prefetch_frame(sim.frames)  # past the acquisition: nothing to sample
+    sim.prefetch_frame(-1)
+    sim.set_sea_surface(None)
+    sim.prefetch_frame(1)  # a flat sea: nothing to sample
+    sim.set_frame(1)
+    assert sim.ws.scene.wave_top is None
+
+
 def test_pose_matrices_convention() -> None:
     """R = Rz(yaw)·Ry(pitch)·Rx(roll): positive pitch points the nose (x) down, positive yaw turns x to +y."""
     m = pose_matrices(np.array([0, 0, 0, 0.0, math.radians(30), 0.0]))

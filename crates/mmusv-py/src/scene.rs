@@ -45,6 +45,81 @@ pub struct Scene {
     inner: RwLock<Arc<CoreScene>>,
     /// The last wave field drawn by `set_wave_surface`, with its sea and seed (reused while they stay).
     wave_field: Mutex<Option<(SeaSpec, u64, Arc<WaveField>)>>,
+    /// A wave surface being sampled ahead by `prefetch_wave_surface`, taken by the `set_wave_surface` that asks
+    /// for the same one.
+    prefetched: Mutex<Option<Prefetch>>,
+}
+
+/// What a wave surface is sampled from: `set_wave_surface`'s arguments, checked. The same key gives the same
+/// surface bit for bit, whichever thread samples it.
+#[derive(Debug, Clone, PartialEq)]
+struct SurfaceKey {
+    sea: SeaSpec,
+    seed: u64,
+    time_s: f64,
+    level: f32,
+    foci: Vec<[f32; 2]>,
+    spec: SurfaceSpec,
+}
+
+/// The wave field and the surface of `key`, the field reused from `cached` when it is that sea's.
+type Sampled = mmusv_core::Result<(Arc<WaveField>, WaveSurface)>;
+
+/// A surface being sampled on a thread of its own.
+struct Prefetch {
+    key: SurfaceKey,
+    handle: std::thread::JoinHandle<Sampled>,
+}
+
+/// Samples the surface of `key` (drawing its wave field unless `cached` holds it).
+fn sample(key: &SurfaceKey, cached: Option<Arc<WaveField>>) -> Sampled {
+    let field = match cached {
+        Some(f) => f,
+        None => {
+            key.sea.validate()?;
+            Arc::new(WaveField::new(&key.sea, key.seed)?)
+        }
+    };
+    let surface = WaveSurface::new(field.components(), key.time_s, key.level, &key.foci, key.spec);
+    Ok((field, surface))
+}
+
+/// Checks `set_wave_surface`'s arguments (errors name the argument); `None` for `hs_m = None` (no surface).
+#[allow(clippy::too_many_arguments)]
+fn surface_key(
+    hs_m: Option<f64>,
+    (tp_s, gamma, direction_rad, spread_s): (f64, f64, f64, f64),
+    scenario_seed: u64,
+    time_s: f64,
+    foci: Option<&PyReadonlyArray2<'_, f32>>,
+    level: f32,
+    (tile_m, near_m, radius_m, taper_m): (f32, f32, f32, f32),
+    (detail, slopes): (bool, bool),
+) -> PyResult<Option<SurfaceKey>> {
+    let Some(hs) = hs_m else { return Ok(None) };
+    let foci: Vec<[f32; 2]> = match foci {
+        Some(f) => rows::<f32, 2>(f, "foci")?.to_vec(),
+        None => Vec::new(),
+    };
+    for (name, v) in [("tile_m", tile_m), ("near_m", near_m), ("radius_m", radius_m)] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(InputError::new_err(format!("{name} = {v} is not allowed; give a distance > 0 metres")));
+        }
+    }
+    if !(taper_m.is_finite() && (0.0..=radius_m).contains(&taper_m)) {
+        return Err(InputError::new_err(format!("taper_m = {taper_m} must be in [0, radius_m]")));
+    }
+    if !(time_s.is_finite() && level.is_finite()) || foci.iter().any(|f| !(f[0].is_finite() && f[1].is_finite())) {
+        return Err(InputError::new_err("wave surface: time_s, level and foci must be finite"));
+    }
+    Ok(Some(SurfaceKey {
+        sea: SeaSpec { hs, tp: tp_s, gamma, direction_rad, spread_s },
+        seed: sea_seed(scenario_seed),
+        time_s,
+        level,
+        foci,
+        spec: SurfaceSpec { tile_m, near_m, radius_m, taper_m, detail, slopes },
+    }))
 }
 
 fn poisoned() -> PyErr {
@@ -54,7 +129,18 @@ fn poisoned() -> PyErr {
 impl Scene {
     /// Wraps a core scene built in Rust.
     pub fn from_core(scene: CoreScene) -> Self {
-        Self { inner: RwLock::new(Arc::new(scene)), wave_field: Mutex::new(None) }
+        Self { inner: RwLock::new(Arc::new(scene)), wave_field: Mutex::new(None), prefetched: Mutex::new(None) }
+    }
+
+    /// The wave field last drawn, when it is `key`'s sea's.
+    fn cached_field(&self, key: &SurfaceKey) -> PyResult<Option<Arc<WaveField>>> {
+        Ok(self
+            .wave_field
+            .lock()
+            .map_err(|_| poisoned())?
+            .as_ref()
+            .filter(|(s, k, _)| *s == key.sea && *k == key.seed)
+            .map(|(_, _, f)| Arc::clone(f)))
     }
 
     /// Runs `f` on a snapshot of the scene (the lock is released before `f` runs).
@@ -226,47 +312,82 @@ impl Scene {
         detail: bool,
         slopes: bool,
     ) -> PyResult<()> {
-        let Some(hs) = hs_m else {
+        let key = surface_key(
+            hs_m,
+            (tp_s, gamma, direction_rad, spread_s),
+            scenario_seed,
+            time_s,
+            foci.as_ref(),
+            level,
+            (tile_m, near_m, radius_m, taper_m),
+            (detail, slopes),
+        )?;
+        let ahead = self.prefetched.lock().map_err(|_| poisoned())?.take();
+        let Some(key) = key else {
             return self.write(|s| s.set_wave_surface(None))?.map_err(crate::errors::to_py);
         };
-        let foci: Vec<[f32; 2]> = match &foci {
-            Some(f) => rows::<f32, 2>(f, "foci")?.to_vec(),
-            None => Vec::new(),
-        };
-        for (name, v) in [("tile_m", tile_m), ("near_m", near_m), ("radius_m", radius_m)] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(InputError::new_err(format!("{name} = {v} is not allowed; give a distance > 0 metres")));
+        let (field, surface) = match ahead {
+            // Sampled ahead from the same arguments: the same surface, waited for (a panic there is re-raised
+            // here, and reported as one).
+            Some(p) if p.key == key => {
+                detached(py, || p.handle.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)))?
             }
-        }
-        if !(taper_m.is_finite() && (0.0..=radius_m).contains(&taper_m)) {
-            return Err(InputError::new_err(format!("taper_m = {taper_m} must be in [0, radius_m]")));
-        }
-        if !(time_s.is_finite() && level.is_finite()) || foci.iter().any(|f| !(f[0].is_finite() && f[1].is_finite())) {
-            return Err(InputError::new_err("wave surface: time_s, level and foci must be finite"));
-        }
-        let sea = SeaSpec { hs, tp: tp_s, gamma, direction_rad, spread_s };
-        let seed = sea_seed(scenario_seed);
-        let spec = SurfaceSpec { tile_m, near_m, radius_m, taper_m, detail, slopes };
-        let cached = self
-            .wave_field
-            .lock()
-            .map_err(|_| poisoned())?
-            .as_ref()
-            .filter(|(s, k, _)| *s == sea && *k == seed)
-            .map(|(_, _, f)| Arc::clone(f));
-        let (field, surface) = detached(py, || {
-            let field = match cached {
-                Some(f) => f,
-                None => {
-                    sea.validate()?;
-                    Arc::new(WaveField::new(&sea, seed)?)
-                }
-            };
-            let surface = WaveSurface::new(field.components(), time_s, level, &foci, spec);
-            Ok((field, surface))
-        })?;
-        *self.wave_field.lock().map_err(|_| poisoned())? = Some((sea, seed, field));
+            _ => {
+                let cached = self.cached_field(&key)?;
+                detached(py, || sample(&key, cached))?
+            }
+        };
+        *self.wave_field.lock().map_err(|_| poisoned())? = Some((key.sea, key.seed, field));
         self.write(|s| s.set_wave_surface(Some(surface)))?.map_err(crate::errors::to_py)
+    }
+
+    /// Starts sampling, on a thread of its own, the wave surface that `set_wave_surface` with the same arguments
+    /// will set (a later frame's, while the current one is annotated and written); that call then takes it
+    /// instead of sampling it again, and any other call leaves it unused. The same surface bit for bit: the
+    /// sampling depends on the arguments alone. Arguments are checked as `set_wave_surface` checks them;
+    /// `hs_m=None` drops a surface being sampled ahead.
+    #[pyo3(signature = (hs_m, *, tp_s=8.0, gamma=3.3, direction_rad=0.0, spread_s=10.0, scenario_seed=0, time_s=0.0, foci=None, level=0.0, tile_m=32.0, near_m=40.0, radius_m=320.0, taper_m=60.0, detail=false, slopes=true))]
+    #[allow(clippy::too_many_arguments)]
+    fn prefetch_wave_surface(
+        &self,
+        hs_m: Option<f64>,
+        tp_s: f64,
+        gamma: f64,
+        direction_rad: f64,
+        spread_s: f64,
+        scenario_seed: u64,
+        time_s: f64,
+        foci: Option<PyReadonlyArray2<'_, f32>>,
+        level: f32,
+        tile_m: f32,
+        near_m: f32,
+        radius_m: f32,
+        taper_m: f32,
+        detail: bool,
+        slopes: bool,
+    ) -> PyResult<()> {
+        let key = surface_key(
+            hs_m,
+            (tp_s, gamma, direction_rad, spread_s),
+            scenario_seed,
+            time_s,
+            foci.as_ref(),
+            level,
+            (tile_m, near_m, radius_m, taper_m),
+            (detail, slopes),
+        )?;
+        let Some(key) = key else {
+            *self.prefetched.lock().map_err(|_| poisoned())? = None;
+            return Ok(());
+        };
+        let cached = self.cached_field(&key)?;
+        let job = key.clone();
+        let handle =
+            std::thread::Builder::new().name("mmusv-wave-surface".into()).spawn(move || sample(&job, cached)).map_err(
+                |e| crate::errors::InternalError::new_err(format!("cannot start a thread to sample the waves: {e}")),
+            )?;
+        *self.prefetched.lock().map_err(|_| poisoned())? = Some(Prefetch { key, handle });
+        Ok(())
     }
 
     /// Heights (N,) float32 of the displaced sea surface at `xy` (N, 2) float32 world x, y (the still level
