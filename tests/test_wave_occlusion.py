@@ -201,6 +201,46 @@ def test_recordings_carry_the_shares_as_annotated(tmp_path: Path) -> None:
     assert msg3 == want3 and msg2 == want2
 
 
+def test_shares_read_from_the_capture_equal_the_beams_cast_again() -> None:
+    """A capture keeps the instance each LiDAR beam met first (``AgentCapture.lidar_beams``): every returned point
+    is its beam's hit, the beams agree with casting the pattern again from the LiDAR pose, and the boxes'
+    wave-occlusion shares read from them are those of casting each box's beams again (both within the LiDAR's
+    range)."""
+    import sys
+
+    from mmusv.acquire import annotations_for
+    from mmusv.annotate import SilhouetteCache
+    from mmusv.simulation import Simulation
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from test_acquire import small_scenario
+
+    sc = small_scenario(frames=3)
+    sc["environment"]["wave"] = "W3"
+    sim, sil = Simulation(sc), SilhouetteCache()
+    shares = 0
+    for k in range(3):
+        cap = sim.capture(k)
+        for agent in sim.agents:
+            ac = cap.agents[agent.id]
+            assert ac.lidar is not None and ac.lidar_beams is not None and ac.lidar_pose is not None
+            beams = ac.lidar_beams
+            assert beams.dtype == np.int32 and beams.shape == (agent.lidar_pattern.shape[0],)
+            assert np.array_equal(beams[ac.lidar.ray_index], ac.lidar.instance)
+            dirs = agent.lidar_pattern.astype(np.float64) @ ac.lidar_pose[:3, :3].T
+            origins = np.broadcast_to(ac.lidar_pose[:3, 3], dirs.shape)
+            again = sim.ws.scene.cast_rays(origins, dirs, max_range=agent.rig.lidar.range_m).instance_id
+            assert np.mean(again == beams) > 0.999
+        read = annotations_for(sim, cap, sil)
+        for ac in cap.agents.values():
+            ac.lidar_beams = None  # the annotations cast the beams again
+        cast = annotations_for(sim, cap, sil)
+        for agent_id, ann in read.items():
+            assert ann.lidar_wave_occlusion == cast[agent_id].lidar_wave_occlusion
+            shares += sum(w > 0 for w in ann.lidar_wave_occlusion)
+    assert shares > 0  # W3 crests hide part of some box
+
+
 def _box_beams_by_testing_every_beam(pattern: np.ndarray, pose: np.ndarray, corners: np.ndarray) -> np.ndarray:
     """Indices of the beams within the box's azimuth and elevation extent, every beam tested (the definition)."""
     p = np.asarray(pattern, dtype=np.float64)

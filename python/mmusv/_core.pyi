@@ -323,7 +323,8 @@ class Lidar:
     def scan(
         self, scene: Scene, *, pose: npt.NDArray[np.float64], env: SensorEnv, seed: int
     ) -> dict[str, npt.NDArray[Any]]:
-        """One sweep: xyz (N,3) f32 LiDAR frame, range, intensity, ring, azimuth, class, instance, ray_index."""
+        """One sweep: xyz (N,3) f32 LiDAR frame, range, intensity, ring, azimuth, class, instance, ray_index; and
+        beam_instance (M,) i32, per ray of the full pattern the instance its cast met first (-1: none)."""
 
 @final
 class Camera:

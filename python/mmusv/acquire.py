@@ -97,6 +97,7 @@ def annotations_for(sim: Simulation, cap: FrameCapture, silhouettes: SilhouetteC
             max_range_m=rng,
             scene=sim.ws.scene,
             lidar_pattern=agent.lidar_pattern,
+            lidar_beams=ac.lidar_beams,
         )
     return out
 

@@ -27,7 +27,7 @@ from scipy.spatial.transform import Rotation
 
 from mmusv.frames import BODY_TO_OPTICAL, translation
 from mmusv.scene import Scene
-from mmusv.wave_occlusion import exposed_hidden, lidar_box_rays, pattern_angles, share
+from mmusv.wave_occlusion import exposed_hidden, lidar_beam_rays, lidar_box_beams, pattern_angles, share
 from mmusv.world.vessels import get_asset
 
 __all__ = ["Annotations", "SilhouetteCache", "annotate_agent", "box_corners", "in_target_range"]
@@ -196,6 +196,7 @@ def annotate_agent(
     max_range_m: float,
     scene: Scene | None = None,
     lidar_pattern: np.ndarray | None = None,
+    lidar_beams: np.ndarray | None = None,
 ) -> Annotations:
     """Annotations of one agent (see the module docstring).
 
@@ -208,6 +209,9 @@ def annotate_agent(
         max_range_m: vessels outside this range of the LiDAR (:func:`in_target_range`) get no 3D/BEV box.
         scene: the full scene; where it has a wave surface, the boxes' ``wave_occlusion`` is computed (else 0).
         lidar_pattern: ``(M, 3)`` float32 unit beam directions in the LiDAR frame (for the 3D boxes' share).
+        lidar_beams: ``(M,)`` int32 instance each beam of the pattern met first in the capture (-1: none;
+            :attr:`~mmusv.simulation.AgentCapture.lidar_beams`): the full scene's answer for the 3D boxes' share,
+            read instead of casting the beams again.
     """
     waves = scene is not None and scene.wave_top is not None
     angles = pattern_angles(lidar_pattern) if waves and lidar_pattern is not None else None
@@ -245,9 +249,12 @@ def annotate_agent(
             ann.lidar_static.append(bool(info.static))
             wave = 0.0
             if scene is not None and lidar_pose is not None and lidar_pattern is not None and angles is not None:
-                o, d = lidar_box_rays(lidar_pattern, angles, lidar_pose, box_corners(box_world, info.box_size))
+                corners = box_corners(box_world, info.box_size)
+                beams = lidar_box_beams(angles, lidar_pose, corners)
+                o, d = lidar_beam_rays(lidar_pattern, lidar_pose, beams)
                 t = silhouettes.distances(info.asset, state.matrices[vi], o, d)
-                wave = share(*exposed_hidden(scene, o, d, t))
+                first = None if lidar_beams is None else np.asarray(lidar_beams)[beams]
+                wave = share(*exposed_hidden(scene, o, d, t, scene_instance=first, max_range_m=max_range_m))
             ann.lidar_wave_occlusion.append(wave)
         corners_world = box_corners(box_world, info.box_size)
         for name, (cam, k, inv, pose, inst_img) in views.items():

@@ -182,6 +182,10 @@ class AgentCapture:
     radar_pose: np.ndarray | None = None
     body: np.ndarray | None = None
     sensors: dict[str, SensorMount] = field(default_factory=dict)
+    lidar_beams: np.ndarray | None = field(default=None, repr=False, compare=False)
+    """``(M,)`` int32: per ray of the LiDAR's full pattern (pattern order, returned or not), the scene instance
+    its cast met first within the range, -1 for none; what the annotations read to know which beams the water
+    stopped. Not recorded."""
 
 
 @dataclass
@@ -478,6 +482,7 @@ class Simulation:
             secs[f"{agent.id}/{key}"] = seconds
             if key == "lidar":
                 cap.lidar = LidarPoints.from_native(d)
+                cap.lidar_beams = d["beam_instance"]
             elif key == "top_view":
                 cap.top_view = CameraImages.from_native(d)
             elif key == "radar" and agent.radar is not None and cap.radar_pose is not None:

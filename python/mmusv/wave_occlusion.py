@@ -10,7 +10,9 @@ flat sea the share is 0 by construction; it is only computed where the scene has
 * Cameras: the rays of the box's pixels; "stopped at the water" reads the captured instance image (the water
   instance there).
 * LiDAR: the LiDAR's own beams within the box's angular extent (azimuth and elevation of its corners seen from
-  the LiDAR), cast against the vessel alone and then against the full scene.
+  the LiDAR), cast against the vessel alone and then against the full scene; in a capture the full scene's
+  answer is the one the LiDAR's own cast found (:attr:`~mmusv.simulation.AgentCapture.lidar_beams`), read
+  rather than cast again. Only the part of the vessel within the LiDAR's range counts.
 
 Frames: world x east, y north, z up, metres; directions need not be unit length.
 """
@@ -24,7 +26,15 @@ import numpy.typing as npt
 
 from mmusv.scene import Scene
 
-__all__ = ["BeamAngles", "exposed_hidden", "lidar_box_rays", "pattern_angles", "share"]
+__all__ = [
+    "BeamAngles",
+    "exposed_hidden",
+    "lidar_beam_rays",
+    "lidar_box_beams",
+    "lidar_box_rays",
+    "pattern_angles",
+    "share",
+]
 
 
 def share(exposed: int, hidden: int) -> float:
@@ -39,6 +49,7 @@ def exposed_hidden(
     vessel_t: npt.NDArray[np.float32],
     *,
     scene_instance: npt.NDArray[np.int32] | None = None,
+    max_range_m: float = float("inf"),
 ) -> tuple[int, int]:
     """``(exposed, hidden)`` ray counts of one target (see the module docstring).
 
@@ -48,7 +59,9 @@ def exposed_hidden(
         vessel_t: ``(N,)`` float32 distance (in units of each direction's length) at which each ray meets the
             vessel alone, ``inf`` where it misses it.
         scene_instance: ``(N,)`` int32 instance each ray meets first in the full scene, when already known (a
-            camera's instance image); else the rays are cast here.
+            camera's instance image, a LiDAR's beams); else the rays are cast here.
+        max_range_m: only the part of the vessel within this distance (metres) of the origins counts (a LiDAR's
+            range: what lies beyond it is neither seen nor hidden).
     """
     o = np.asarray(origins, dtype=np.float64)
     d = np.asarray(directions, dtype=np.float64)
@@ -56,6 +69,8 @@ def exposed_hidden(
     hit = np.isfinite(t)
     z = o[:, 2] + d[:, 2] * np.where(hit, t, 0.0)
     exposed = hit & (z > 0.0)
+    if np.isfinite(max_range_m):
+        exposed &= np.where(hit, t, 0.0) * np.linalg.norm(d, axis=1) <= max_range_m
     n = int(np.count_nonzero(exposed))
     water = scene.sea_instance
     if n == 0 or water is None or scene.wave_top is None:
@@ -131,7 +146,18 @@ def lidar_box_rays(
     """The LiDAR's world rays ``(origins, directions)`` (each ``(K, 3)`` float32, in pattern order) whose
     direction lies within the azimuth and elevation extent of the box ``corners_world`` ``(8, 3)`` seen from the
     LiDAR at ``lidar_pose`` ``(4, 4)`` LiDAR → world; ``pattern`` ``(M, 3)`` unit directions in the LiDAR frame,
-    ``angles`` their :func:`pattern_angles`."""
+    ``angles`` their :func:`pattern_angles`. The rays of :func:`lidar_box_beams`' beams."""
+    return lidar_beam_rays(pattern, lidar_pose, lidar_box_beams(angles, lidar_pose, corners_world))
+
+
+def lidar_box_beams(
+    angles: BeamAngles,
+    lidar_pose: npt.NDArray[np.float64],
+    corners_world: npt.NDArray[np.float64],
+) -> npt.NDArray[np.int64]:
+    """``(K,)`` pattern indices (ascending) of the beams whose direction lies within the azimuth and elevation
+    extent of the box ``corners_world`` ``(8, 3)`` seen from the LiDAR at ``lidar_pose`` ``(4, 4)`` LiDAR →
+    world; ``angles`` the pattern's :func:`pattern_angles`."""
     inv = np.linalg.inv(lidar_pose)
     c = corners_world @ inv[:3, :3].T + inv[:3, 3]
     az = np.arctan2(c[:, 1], c[:, 0])
@@ -146,9 +172,17 @@ def lidar_box_rays(
     paz, pel = angles.az[cand], angles.el[cand]
     near = (pel >= el.min()) & (pel <= el.max())
     prel = np.angle(np.exp(1j * (paz[near] - mid)))
-    idx = cand[near][(prel >= rel.min()) & (prel <= rel.max())]
+    idx: npt.NDArray[np.int64] = cand[near][(prel >= rel.min()) & (prel <= rel.max())]
+    return idx
+
+
+def lidar_beam_rays(
+    pattern: npt.NDArray[np.float32], lidar_pose: npt.NDArray[np.float64], beams: npt.NDArray[np.int64]
+) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
+    """The world rays ``(origins, directions)`` (each ``(K, 3)`` float32) of the pattern's ``beams`` (indices)
+    from the LiDAR at ``lidar_pose`` ``(4, 4)`` LiDAR → world."""
     # Only the selected beams are widened to float64 (the same values as widening the whole pattern first).
-    dirs = (np.asarray(pattern)[idx].astype(np.float64) @ lidar_pose[:3, :3].T).astype(np.float32)
+    dirs = (np.asarray(pattern)[beams].astype(np.float64) @ lidar_pose[:3, :3].T).astype(np.float32)
     origins = np.tile(lidar_pose[:3, 3].astype(np.float32), (dirs.shape[0], 1))
     return origins, dirs
 

@@ -281,7 +281,8 @@ impl Lidar {
     /// One sweep on the current state of `scene` from the LiDAR at `pose` (4×4 LiDAR → world) in `env` (fog, rain
     /// and waves are used). Returns a dict
     /// of equal-length columns: xyz (N,3) f32 LiDAR frame, range, intensity (f32), ring (u16), azimuth (f32
-    /// rad), class (u16), instance (i32), ray_index (u32).
+    /// rad), class (u16), instance (i32), ray_index (u32); and beam_instance (M,) i32: per ray of the full
+    /// pattern, the instance its cast met first within the range (-1: none).
     #[pyo3(signature = (scene, *, pose, env, seed))]
     fn scan<'py>(
         &self,
@@ -445,6 +446,7 @@ pub(crate) fn scan_dict(py: Python<'_>, s: lidar::LidarScan) -> PyResult<Bound<'
     d.set_item("class", s.class.into_pyarray(py))?;
     d.set_item("instance", s.instance.into_pyarray(py))?;
     d.set_item("ray_index", s.ray_index.into_pyarray(py))?;
+    d.set_item("beam_instance", s.beam_instance.into_pyarray(py))?;
     Ok(d)
 }
 

@@ -157,6 +157,10 @@ pub struct LidarScan {
     pub instance: Vec<i32>,
     /// Index of the ray in the full pattern (`column · channels + ring`).
     pub ray_index: Vec<u32>,
+    /// Per ray of the full pattern (pattern order, every ray, returned or not): the scene instance its cast met
+    /// first within the range, or [`crate::scene::NO_HIT`]. What the annotations read to know which beams the
+    /// water stopped (a box's wave-occlusion share) without casting them again.
+    pub beam_instance: Vec<i32>,
 }
 
 impl LidarScan {
@@ -237,7 +241,10 @@ impl Lidar {
         let water_range = cfg.water_range_m + cfg.water_range_per_wave_m * h;
         let sigma = env.fog_extinction_per_m.max(0.0) + 1e-5 * env.rain_mm_per_h.max(0.0).powf(0.6);
         let waves = scene.wave_surface().is_some();
-        let mut out = LidarScan::default();
+        let mut out = LidarScan {
+            beam_instance: slot.iter().map(|&k| hits.instance[k as usize]).collect(),
+            ..LidarScan::default()
+        };
         for (i, &k) in slot.iter().enumerate() {
             let k = k as usize;
             let r = hits.distance[k];
