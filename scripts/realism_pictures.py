@@ -12,6 +12,8 @@ with the new one, draws the same frames from the same poses. Each view is writte
 * ``tug_30m``: a 32 m tug under way, its centre 30 m from the camera;
 * ``ferry_dusk``: a 90 m ro-pax ferry under way at 21:00 (sun 10° below the horizon), 120 m off;
 * ``ferry_dusk_zoom``: its mast and bridge enlarged 4× (the lights are a few pixels each);
+* ``dusk_series``: the same ferry and view through the hour of dusk (19:45, 20:15, 20:30 above; 20:45, 21:00,
+  21:15 below; 480 × 270 each);
 * ``whitecaps_w3``: open water at wave level W3, from 8 m above the sea;
 * ``wake_chase``: a 35 m patrol boat at 14 m/s, seen from 20 m above a vessel following 100 m behind;
 * ``wake_top``: the same boat in its own top view (orthographic, heading up, 0.6 m per pixel);
@@ -143,6 +145,26 @@ def ferry_dusk_zoom(path: Path) -> None:
             im.crop((330, 150, 530, 270)).resize((800, 480), Image.Resampling.NEAREST).save(path)
 
 
+def dusk_series(path: Path) -> None:
+    """``ferry_dusk``'s ferry and view at six times through the hour of dusk (19:45, 20:15, 20:30 above; 20:45,
+    21:00, 21:15 below), 480 × 270 each, side by side."""
+    from PIL import Image
+
+    bearing = 140.0
+    x, y = _at(bearing, 120.0)
+    ferry = {"id": "ferry", "asset": "ropax_ferry_90m", "speed_mps": 6.0, "route": _route(x, y, 265.0)}
+    rig = _camera_rig(resolution=(480, 270), hfov_deg=60.0, xyz=(0.0, 0.0, 3.0), yaw_deg=bearing, pitch_deg=-5.0)
+    sheet = Image.new("RGB", (3 * 480, 2 * 270))
+    with tempfile.TemporaryDirectory(prefix="realism_") as tmp:
+        for i, t in enumerate(["19:45", "20:15", "20:30", "20:45", "21:00", "21:15"]):
+            env = {"time_of_day": t, "weather": "clear", "wave": "W1"}
+            one = Path(tmp) / f"{i}.png"
+            _save_rgb(_scenario("dusk_series", rig=rig, vessels=[ferry], environment=env), one)
+            with Image.open(one) as im:
+                sheet.paste(im, ((i % 3) * 480, (i // 3) * 270))
+    sheet.save(path)
+
+
 def whitecaps_w3(path: Path) -> None:
     """Open water at W3 (clear, 11:00), looking north-west (down-sun) from 8 m above the sea."""
     rig = _camera_rig(resolution=(960, 540), hfov_deg=90.0, xyz=(0.0, 0.0, 8.0), yaw_deg=120.0, pitch_deg=8.0)
@@ -254,6 +276,7 @@ VIEWS: dict[str, Callable[[Path], None]] = {
     "tug_30m": tug_30m,
     "ferry_dusk": ferry_dusk,
     "ferry_dusk_zoom": ferry_dusk_zoom,
+    "dusk_series": dusk_series,
     "whitecaps_w3": whitecaps_w3,
     "wake_chase": wake_chase,
     "wake_top": wake_top,

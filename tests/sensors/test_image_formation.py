@@ -47,6 +47,52 @@ def test_metered_exposure_puts_a_grey_card_at_0_18() -> None:
     assert fixed.exposure[1] == pytest.approx(1.0 / (1.2 * 2.0**14), rel=1e-6)
 
 
+def _metered_key(radiance: np.ndarray, width: int) -> float:
+    """The highlight limit's reading: the log-average luminance of every 4th pixel of every 4th row (black as
+    10⁻⁶ cd/m²), computed here independently of the core."""
+    lum = (radiance.reshape(-1, width, 3)[::4, ::4] @ np.array([0.2126, 0.7152, 0.0722])).astype(np.float32)
+    return float(np.exp(np.mean(np.log(np.maximum(lum, 1e-6).astype(np.float64)))))
+
+
+@pytest.mark.parametrize(("time_of_day", "limited"), [("10:30", False), ("16:30", False), ("20:15", True)])
+def test_exposure_holds_a_view_brighter_than_its_light_at_the_key(time_of_day: str, limited: bool) -> None:
+    """The automatic exposure is the incident reading unless the view, so exposed, would average (log-average
+    luminance, read on every 4th pixel of every 4th row) brighter than 0.5 before the tone curve; then it holds
+    it at 0.5. By day, looking over the water towards the sun's side, the incident exposure stands; at 20:15
+    (sun 4.5° below the horizon), looking into the afterglow, it is lowered and most of the picture is no longer
+    white. Each image is compared with the same view at the fixed exposure the rule gives."""
+    cfg = Environment.make(time_of_day=time_of_day)
+    d = np.asarray(cfg.sun.direction)
+    yaw = math.atan2(d[1], d[0])
+    s = Scene()
+    _water(s)
+
+    w, h = 96, 54
+    cam = core.Camera(width=w, height=h, rgb=True, hfov=math.radians(60.0), quality="draft")
+    pose = pose_matrices(np.array([0, 0, 3.0, 0, math.radians(5.0), yaw]))
+    env = sensor_env(cfg, wave_height_m=0.5)
+    img = render(cam, s, pose=pose, env=env, seed=1, radiance=True)
+    assert img.radiance is not None and img.rgb is not None
+    k_incident = env.exposure[1]
+    key = _metered_key(np.asarray(img.radiance), w)
+    assert (key * k_incident > 0.5) == limited, key * k_incident
+    k = min(k_incident, 0.5 / key)
+
+    def at(k_fixed: float) -> np.ndarray:
+        ev = math.log2(1.0 / (1.2 * k_fixed))  # the saturation-based scale 1 / (1.2 · 2^EV) = k_fixed
+        fixed = render(cam, s, pose=pose, env=sensor_env(cfg, wave_height_m=0.5, exposure_ev100=ev), seed=1)
+        assert fixed.rgb is not None
+        return np.asarray(fixed.rgb).astype(np.int16)
+
+    got = np.asarray(img.rgb).astype(np.int16)
+    assert np.abs(got - at(k)).max() <= 1  # the same exposure, to the rounding of EV
+    white = np.mean(got.max(axis=-1) >= 250)
+    if limited:
+        assert white < 0.3 and np.mean(at(k_incident).max(axis=-1) >= 250) > 0.5, white
+    else:
+        assert white < 0.05
+
+
 def test_sun_disc_has_its_true_angular_size() -> None:
     """Looking at the sun with a narrow camera: the pixels inside the disc cover a 0.533° circle."""
     env = sensor_env(Environment.make(time_of_day="15:00"))

@@ -412,12 +412,14 @@ impl Camera {
         for (k, &i) in self.order.iter().enumerate() {
             linear[i as usize] = shaded.radiance[k];
         }
+        // The exposure: metered on the centre rays (before anti-aliasing), as the shared shading showed them.
+        let (w, h) = (self.cfg.width as usize, self.cfg.height as usize);
+        let k = shaded.exposure.unwrap_or_else(|| shader.metered_exposure(w, h, |p| linear[p]));
         if q.edge_samples() > 1 {
             let reflected = shaded.reflected.as_ref();
             let centres = antialias::Centres { frame: &frame, surface: &surface, hits: &hits, reflected };
-            self.antialias(scene, pose, (&shader, env.shadows, options.seed), centres, &mut linear)?;
+            self.antialias(scene, pose, (&shader, env.shadows, options.seed, k), centres, &mut linear)?;
         }
-        let w = self.cfg.width as usize;
         if self.cfg.image.noise.is_some() || env.rain_mm_per_h > 0.0 {
             linear.par_iter_mut().enumerate().for_each(|(i, c)| {
                 *c = shader.rain(*c, (i % w) as u32, (i / w) as u32, options.seed);
@@ -427,7 +429,6 @@ impl Camera {
             frame.radiance = linear.iter().flat_map(|c| c.to_array()).collect();
         }
         if options.rgb {
-            let k = shader.exposure();
             let noise = self.cfg.image.noise;
             let mut out = vec![0u8; 3 * n];
             out.par_chunks_mut(3 * w).zip(linear.par_chunks(w)).enumerate().for_each(|(row, (px, cs))| {

@@ -326,9 +326,19 @@ impl Shader {
         &self.light
     }
 
-    /// Multiplier from radiance (cd/m²) to the tone curve's input.
+    /// Multiplier from radiance (cd/m²) to the tone curve's input: the incident reading (or the fixed EV100).
     pub fn exposure(&self) -> f32 {
         self.exposure
+    }
+
+    /// The exposure of a `width × height` view whose pixel `p` (row-major) has the centre-ray radiance
+    /// `radiance(p)`: the automatic one with its highlight limit ([`tonemap::highlight_limited`], reading
+    /// [`tonemap::metered_pixels`]), or the fixed EV100's.
+    pub fn metered_exposure(&self, width: usize, height: usize, radiance: impl Fn(usize) -> Vec3) -> f32 {
+        if self.env.exposure_ev100.is_finite() {
+            return self.exposure;
+        }
+        tonemap::highlight_limited(self.exposure, tonemap::metered_pixels(width, height).map(radiance))
     }
 
     /// Unit vector towards the sun.

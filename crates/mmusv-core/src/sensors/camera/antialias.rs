@@ -27,20 +27,20 @@ pub(super) struct Centres<'a> {
 
 impl Camera {
     /// Replaces the radiance of the edge pixels of `linear` (row-major, linear RGB) by the mean of their
-    /// sub-pixel samples (see the module docs); `shading` is the shader, whether shadows are cast, and the seed.
+    /// sub-pixel samples (see the module docs); `shading` is the shader, whether shadows are cast, the seed and the
+    /// view's exposure (the edge test compares pixels as shown).
     pub(super) fn antialias(
         &self,
         scene: &Scene,
         pose: &RigidPose,
-        shading: (&Shader, bool, u64),
+        shading: (&Shader, bool, u64, f32),
         centres: Centres<'_>,
         linear: &mut [Vec3],
     ) -> Result<()> {
-        let (shader, shadows, seed) = shading;
+        let (shader, shadows, seed, exposure) = shading;
         let Centres { frame, surface, hits, reflected } = centres;
         let q = self.cfg.image.quality;
         let s = q.edge_samples();
-        let exposure = shader.exposure();
         let edges = edge_pixels(frame, surface, |a, b| !radiance::alike(linear[a], linear[b], exposure));
         if edges.is_empty() {
             return Ok(());

@@ -246,6 +246,9 @@ pub struct Shaded {
     pub radiance: Vec<Vec3>,
     /// The blurred reflections (`glossy.rs`), read at a pixel's centre; `None` without the blur.
     pub reflected: Option<glossy::Blurred>,
+    /// The view's exposure ([`Shader::metered_exposure`] of the rays' radiance), where the shared shading
+    /// needed it (it compares the pixels as shown); `None` otherwise.
+    pub exposure: Option<f32>,
 }
 
 /// Radiance (linear RGB, cd/m², aerial perspective included) along every ray `origins[k] + t dirs[k]` whose
@@ -419,13 +422,16 @@ pub fn radiance(
         Some(&i) => Some(traced_hits[i as usize]),
         None => surface(k),
     };
+    let mut exposure = None;
     let mut out = vec![Vec3::ZERO; n];
     out.par_chunks_mut(SHADE_CHUNK).enumerate().for_each(|(c, chunk)| {
         shade_chunk(shader, dirs, (&lit, &reflected_of), (c * SHADE_CHUNK, &|k| !is_candidate(k), &hit_of), chunk);
     });
     if let Some(grid) = shared {
         // The candidates: the anchors' mean where they look alike; the others (`redo`) need their own shading.
-        let k_exp = shader.exposure();
+        // The exposure the view is shown with (the metered pixels are anchors: shaded themselves, above).
+        let k_exp = shader.metered_exposure(grid.width as usize, grid.height as usize, |p| out[grid.rank[p] as usize]);
+        exposure = Some(k_exp);
         // The anchors' colours as shown (each tone-mapped once; only water and sky can be anchors).
         let shown: Vec<[u8; 3]> = (0..n)
             .into_par_iter()
@@ -490,7 +496,7 @@ pub fn radiance(
             out[k as usize] = c;
         }
     }
-    Ok(Shaded { radiance: out, reflected: blurred.map(|(b, _)| b) })
+    Ok(Shaded { radiance: out, reflected: blurred.map(|(b, _)| b), exposure })
 }
 
 /// The surface a ray of the batch hit (`None`: a miss).

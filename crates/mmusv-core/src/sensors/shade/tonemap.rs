@@ -6,6 +6,14 @@
 //!   highest gain), so nights stay dark and lights stand out. A fixed `EV100` instead gives the
 //!   saturation-based scale `k = 1 / (1.2 · 2^EV100)` (ISO 12232; S. Lagarde & C. de Rousiers, "Moving
 //!   Frostbite to Physically Based Rendering", SIGGRAPH 2014 course notes).
+//! * **Highlight limit** of the automatic exposure: a reflected-light reading of what the camera sees (the
+//!   log-average luminance of the image, as an averaging meter reads it: ISO 2720:1974, and the "key" of
+//!   E. Reinhard et al., "Photographic Tone Reproduction for Digital Images", SIGGRAPH 2002) caps the incident
+//!   reading: where the view would average brighter than [`MAX_METERED_KEY`] (1.5 stops over middle grey)
+//!   before the tone curve, the exposure is lowered to hold it there. By day a view of sea and sky averages
+//!   0.1–0.4 and keeps the incident exposure; looking into an afterglow that outshines the sky light falling on
+//!   the water (the sun a few degrees below the horizon), the incident reading alone would leave most of the
+//!   picture white.
 //! * **Tone curve**: K. Narkowicz's fit of the ACES filmic reference rendering transform (2016),
 //!   `f(x) = x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14)`, clamped to `[0, 1]`, per channel.
 //! * **sRGB**: the IEC 61966-2-1 transfer function, rounded to 8 bits.
@@ -25,6 +33,41 @@ pub fn exposure_scale(ev100: f32, horizontal_lux: f32) -> f32 {
         1.0 / (1.2 * 2f32.powf(ev100))
     } else {
         std::f32::consts::PI / horizontal_lux.max(MIN_METERED_LUX)
+    }
+}
+
+/// Brightest log-average an automatically exposed view keeps before the tone curve (middle grey is 0.18).
+pub const MAX_METERED_KEY: f32 = 0.5;
+/// Pixels the reflected-light reading takes along each image axis: every `METER_STEP`-th of every
+/// `METER_STEP`-th row (a camera meters on a grid of zones, not every pixel).
+const METER_STEP: usize = 4;
+
+/// The pixels the highlight limit reads in a `width × height` image, row-major indices: every
+/// `METER_STEP`-th pixel of every `METER_STEP`-th row, from the top-left one (even pixels all: shaded each
+/// for itself, never shared).
+pub fn metered_pixels(width: usize, height: usize) -> impl Iterator<Item = usize> {
+    (0..height).step_by(METER_STEP).flat_map(move |y| (0..width).step_by(METER_STEP).map(move |x| y * width + x))
+}
+
+/// The automatic exposure `k` (the incident reading, [`exposure_scale`]) with the highlight limit of a view
+/// whose metered pixels ([`metered_pixels`], in that order) have the radiances `metered`: `k` lowered so that
+/// their log-average luminance, exposed, is at most [`MAX_METERED_KEY`] (see the module docs). Black pixels
+/// count as `10⁻⁶` cd/m².
+pub fn highlight_limited(k: f32, metered: impl IntoIterator<Item = Vec3>) -> f32 {
+    let (mut sum, mut n) = (0f64, 0u32);
+    for c in metered {
+        let l = 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
+        sum += f64::from(l.max(1e-6)).ln();
+        n += 1;
+    }
+    if n == 0 {
+        return k;
+    }
+    let key = (sum / f64::from(n)).exp() as f32;
+    if key * k > MAX_METERED_KEY {
+        MAX_METERED_KEY / key
+    } else {
+        k
     }
 }
 
@@ -110,6 +153,33 @@ impl SensorNoise {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The highlight limit: a uniform view keeps the incident exposure up to the key and is held at the key
+    /// above it; the reading is the log-average of every fourth pixel of every fourth row, the others unread.
+    #[test]
+    fn highlight_limit_holds_bright_views_at_the_key() {
+        let k = 2e-4; // π / E_h at about 16 klux
+        for l in [10.0f32, 500.0, 2000.0, 2500.0, 1e4, 1e5] {
+            let img = vec![Vec3::splat(l); 64 * 48];
+            let got = highlight_limited(k, metered_pixels(64, 48).map(|p| img[p]));
+            let want = if l * k <= MAX_METERED_KEY { k } else { MAX_METERED_KEY / l };
+            assert!((got - want).abs() <= 1e-6 * want, "L = {l}: {got} vs {want}");
+        }
+        // An 8 × 8 view: the metered pixels (0, 0), (0, 4), (4, 0), (4, 4) hold 1, 10, 100 and 1000 cd/m², the
+        // rest a glare that would dominate a mean of every pixel.
+        let mut img = vec![Vec3::splat(1e7); 64];
+        for (q, l) in [(0usize, 1.0f32), (4, 10.0), (32, 100.0), (36, 1000.0)] {
+            img[q] = Vec3::splat(l);
+        }
+        let key = (1.0f64 * 10.0 * 100.0 * 1000.0).powf(0.25) as f32; // 31.6
+        let read = || metered_pixels(8, 8).map(|p| img[p]);
+        assert_eq!(metered_pixels(8, 8).collect::<Vec<_>>(), [0, 4, 32, 36]);
+        assert!((highlight_limited(1.0, read()) - MAX_METERED_KEY / key).abs() < 1e-6);
+        assert_eq!(highlight_limited(0.01, read()), 0.01); // 0.316 exposed: under the key, kept
+        assert_eq!(highlight_limited(0.01, []), 0.01);
+        // Black pixels count as 10⁻⁶ cd/m² (no logarithm of zero): a night view keeps its exposure.
+        assert_eq!(highlight_limited(0.3, [Vec3::ZERO; 4]), 0.3);
+    }
 
     #[test]
     fn grey_card_meters_to_0_18_and_curve_is_monotone() {
