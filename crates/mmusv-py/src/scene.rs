@@ -382,11 +382,10 @@ impl Scene {
         };
         let cached = self.cached_field(&key)?;
         let job = key.clone();
-        let handle =
-            std::thread::Builder::new().name("mmusv-wave-surface".into()).spawn(move || sample(&job, cached)).map_err(
-                |e| crate::errors::InternalError::new_err(format!("cannot start a thread to sample the waves: {e}")),
-            )?;
-        *self.prefetched.lock().map_err(|_| poisoned())? = Some(Prefetch { key, handle });
+        // Where no thread can be started (a process at its limit), nothing is sampled ahead: the frame's own
+        // `set_wave_surface` samples it, the same surface.
+        let handle = std::thread::Builder::new().name("mmusv-wave-surface".into()).spawn(move || sample(&job, cached));
+        *self.prefetched.lock().map_err(|_| poisoned())? = handle.ok().map(|handle| Prefetch { key, handle });
         Ok(())
     }
 
