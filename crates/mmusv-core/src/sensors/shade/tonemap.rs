@@ -7,9 +7,9 @@
 //!   saturation-based scale `k = 1 / (1.2 · 2^EV100)` (ISO 12232; S. Lagarde & C. de Rousiers, "Moving
 //!   Frostbite to Physically Based Rendering", SIGGRAPH 2014 course notes).
 //! * **Highlight limit** of the automatic exposure: a reflected-light reading of what the camera sees (the
-//!   log-average luminance of the image, as an averaging meter reads it: ISO 2720:1974, and the "key" of
-//!   E. Reinhard et al., "Photographic Tone Reproduction for Digital Images", SIGGRAPH 2002) caps the incident
-//!   reading: where the view would average brighter than [`MAX_METERED_KEY`] (1.5 stops over middle grey)
+//!   quantity a reflected-light meter reads, ISO 2720:1974, taken as the log-average luminance of the view, the
+//!   "key" of E. Reinhard et al., "Photographic Tone Reproduction for Digital Images", SIGGRAPH 2002) caps the
+//!   incident reading: where the view would average brighter than [`MAX_METERED_KEY`] (1.5 stops over middle grey)
 //!   before the tone curve, the exposure is lowered to hold it there. By day a view of sea and sky averages
 //!   0.1–0.4 and keeps the incident exposure; looking into an afterglow that outshines the sky light falling on
 //!   the water (the sun a few degrees below the horizon), the incident reading alone would leave most of the
