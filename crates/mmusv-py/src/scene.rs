@@ -290,7 +290,7 @@ impl Scene {
     /// clears it; `detail`: the finest tiles also carry the short waves' slopes for the cameras' shading
     /// (mmusv_core::sea::SurfaceSpec::detail); `slopes`: the tiles carry the slopes the cameras shade with at all
     /// (mmusv_core::sea::SurfaceSpec::slopes; off: heights alone, for scenes nothing renders). Samples with the
-    /// GIL released.
+    /// GIL released, or takes the surface `prefetch_wave_surface` sampled ahead with the same arguments.
     #[pyo3(signature = (hs_m, *, tp_s=8.0, gamma=3.3, direction_rad=0.0, spread_s=10.0, scenario_seed=0, time_s=0.0, foci=None, level=0.0, tile_m=32.0, near_m=40.0, radius_m=320.0, taper_m=60.0, detail=false, slopes=true))]
     #[allow(clippy::too_many_arguments)]
     fn set_wave_surface(
