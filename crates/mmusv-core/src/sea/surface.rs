@@ -226,8 +226,7 @@ impl WaveSurface {
         let (plane, _) = cell_planes(t, ci, cj);
         let tri = usize::from(fu < fv);
         let p = plane[tri];
-        let piece = (k * 2 * TILE_CELLS * TILE_CELLS + 2 * (cj * t.n + ci) + tri) as u32;
-        (p[0] + p[1] * fu + p[2] * fv, piece)
+        (p[0] + p[1] * fu + p[2] * fv, cell_piece(k, t.n, ci, cj, tri))
     }
 
     /// Unit geometric normal (up-facing) of piece `piece` (a [`SurfaceHit::piece`]).
@@ -319,6 +318,13 @@ impl WaveSurface {
     pub fn occludes(&self, o: [f32; 3], d: [f32; 3], t_max: f32) -> bool {
         self.intersect(o, d, t_max).is_some()
     }
+}
+
+/// The piece id ([`SurfaceHit::piece`]) of triangle `tri` (as [`cell_planes`] numbers them) of cell `(ci, cj)` of
+/// tile `k` cut into `n` cells a side: what [`WaveSurface::piece_normal`] takes apart.
+#[inline(always)]
+fn cell_piece(k: usize, n: usize, ci: usize, cj: usize, tri: usize) -> u32 {
+    (k * 2 * TILE_CELLS * TILE_CELLS + 2 * (cj * n + ci) + tri) as u32
 }
 
 /// The two triangle planes of cell `(ci, cj)` as `[h0, ∂h/∂fu, ∂h/∂fv]` over the cell's local `(fu, fv) ∈ [0,1]²`:

@@ -8,7 +8,7 @@
 //! boundary). Tiles and cells whose sampled maximum lies below the ray are skipped whole; a ray that crosses the
 //! band within one tile goes straight to it.
 
-use super::{cell_planes, fmax, fmin, SurfaceHit, WaveSurface, FLAT_PIECE, TILE_CELLS};
+use super::{cell_piece, cell_planes, fmax, fmin, SurfaceHit, WaveSurface, FLAT_PIECE};
 
 impl WaveSurface {
     /// [`WaveSurface::intersect`]'s body, inlined into each instruction-set copy of [`intersect_with`].
@@ -287,7 +287,6 @@ impl March<'_> {
         let (u0, v0) = ((o[0] - corner[0]) * inv_cs, (o[1] - corner[1]) * inv_cs);
         let (du, dv) = (d[0] * inv_cs, d[1] * inv_cs);
         let mut g = Dda::new(self, ta, corner, cs, inv_cs, lo, hi);
-        let base = (k * 2 * TILE_CELLS * TILE_CELLS) as u32;
         let mut t = ta;
         loop {
             let t_exit = fmin(g.exit(), tb);
@@ -298,7 +297,7 @@ impl March<'_> {
                 if fmin(zt, ze) > cmax && self.above != Some(false) {
                     self.above = Some(true);
                 } else {
-                    let id = base + 2 * (cj * n + ci) as u32;
+                    let id = cell_piece(k, n, ci, cj, 0);
                     // Local (fu, fv) at t: u(t) - ci.
                     let fu = |t: f32| u0 + du * t - ci as f32;
                     let fv = |t: f32| v0 + dv * t - cj as f32;

@@ -27,7 +27,7 @@
 //! would be rounding noise (the pieces beside it meet those rays at the same distance). A pixel the plane solve
 //! cannot settle (a ray in the piece's plane, or a hit off the piece) is left to the march.
 
-use super::{cell_planes, SurfaceHit, WaveSurface, FLAT_PIECE, SKIN_M, TILE_CELLS};
+use super::{cell_piece, cell_planes, SurfaceHit, WaveSurface, FLAT_PIECE, SKIN_M, TILE_CELLS};
 use rayon::prelude::*;
 
 /// A pinhole view for [`WaveSurface::first_hits`]: the camera's origin and axes in the world, its image and
@@ -277,7 +277,6 @@ impl<'a> Frame<'a> {
                 nodes.iter().map(|c| if c[2] >= NEAR_M { [c[0] / c[2], c[1] / c[2]] } else { [f32::NAN; 2] }).collect();
             let corner = [s.x0 + ix as f32 * s.tile_m, s.y0 + iy as f32 * s.tile_m];
             let inv_cs = n as f32 * s.inv_tile_m;
-            let base = (k * 2 * TILE_CELLS * TILE_CELLS) as u32;
             for cj in 0..n {
                 for ci in 0..n {
                     let q = [cj * w + ci, cj * w + ci + 1, (cj + 1) * w + ci + 1, (cj + 1) * w + ci];
@@ -287,7 +286,7 @@ impl<'a> Frame<'a> {
                             continue;
                         }
                         let plane = cell_planes(t, ci, cj).0[usize::from(tri)];
-                        let id = base + 2 * (cj * n + ci) as u32 + u32::from(tri);
+                        let id = cell_piece(k, n, ci, cj, usize::from(tri));
                         let piece = Piece::Cell { corner, cell: [ci as f32, cj as f32], inv_cs, plane, id };
                         let proj = c.map(|i| ab[i]);
                         let known = proj.iter().all(|p| !p[0].is_nan());
