@@ -228,6 +228,8 @@ class Simulation:
         under_way = [int(inst) for v, inst in zip(sc.vessels, self.ws.vessel_instances, strict=True) if not v.static]
         self.ws.scene.set_lights(under_way, on=True)
         self._frame: int | None = None
+        # The world state `prefetch_frame` worked out, for the `set_frame` of that frame to take (once).
+        self._ahead: tuple[int, WorldState] | None = None
         # The physical sea (``environment.motion: physical``, the default) displaces the water every sensor sees;
         # with ``motion: paper`` the water stays the flat plane of the paper.
         self.sea: SeaState | None = None
@@ -320,7 +322,8 @@ class Simulation:
         (:meth:`mmusv.scene.Scene.set_wave_surface`'s ``slopes`` and ``detail``); only rendering reads them."""
         if not 0 <= frame < self.frames:
             raise ConfigError(f"frame {frame} is outside the acquisition (0..{self.frames - 1})")
-        state = self.world_state(frame)
+        ahead, self._ahead = self._ahead, None
+        state = ahead[1] if ahead is not None and ahead[0] == frame else self.world_state(frame)
         n = len(self.scenario.vessels)
         self.ws.scene.set_poses(self.ws.vessel_instances, state.matrices[:n])
         if self.sea is not None and "water" in self.ws.static_instances:
@@ -336,6 +339,7 @@ class Simulation:
         if self.sea is None or "water" not in self.ws.static_instances or not 0 <= frame < self.frames:
             return
         state = self.world_state(frame)
+        self._ahead = (frame, state)  # a function of the frame alone: set_frame(frame) takes it
         self.ws.scene.prefetch_wave_surface(self.sea, **self._surface_of(state, sea_radius_m, shading_detail))
 
     def _surface_of(self, state: WorldState, radius_m: float, detail: bool) -> dict[str, Any]:

@@ -551,8 +551,9 @@ def test_a_frame_sampled_ahead_sets_the_same_surface(make_scenario: Any) -> None
     plain.set_frame(5)
     for other in ({"frame": 6}, {"frame": 5, "shading_detail": False}):
         ahead.prefetch_frame(**other)
-        ahead.set_frame(5)
+        state = ahead.set_frame(5)
         assert _surface_bits(ahead) == _surface_bits(plain)
+        assert state.frame == 5 and np.array_equal(state.matrices, plain.world_state(5).matrices)
     # What a recording does: capture, sample the next frame ahead, capture it.
     ahead.capture(1)
     ahead.prefetch_frame(2, shading_detail=ahead.renders())
