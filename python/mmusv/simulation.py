@@ -13,10 +13,10 @@ from __future__ import annotations
 
 import hashlib
 import math
-from collections.abc import Collection
+from collections.abc import Callable, Collection
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 import numpy.typing as npt
@@ -79,6 +79,23 @@ def mount_matrix(asset: VesselAsset, mount: Mount, *, where: str) -> np.ndarray:
     if not np.all(np.isfinite(m)):
         raise ConfigError(f"invalid config {where}: the mount is not a finite pose")
     return m
+
+
+_T = TypeVar("_T")
+
+
+def _built(where: str, kind: str, build: Callable[[], _T]) -> _T:
+    """``build()`` (a sensor made from its configuration by the core), its configuration errors naming the field
+    by its path in the scenario (``where``, e.g. ``rigs.usv_standard.cameras[front]``) instead of the core's own
+    ``kind.`` prefix (``camera.distortion``), so that a rig of several cameras says which one is at fault."""
+    try:
+        return build()
+    except ConfigError as exc:
+        prefix = f"invalid config {kind}."
+        msg = str(exc)
+        if not msg.startswith(prefix):
+            raise
+        raise ConfigError(f"invalid config {where}.{msg[len(prefix) :]}") from None
 
 
 @dataclass(frozen=True)
@@ -252,16 +269,20 @@ class Simulation:
         asset = get_asset(v.asset)
         agent = Agent(index=index, vessel=v, asset=asset, rig=rig, lidar=None, lidar_mount=None, radar_mount=None)
         if rig.lidar is not None:
-            agent.lidar = lidar_from_config(rig.lidar)
+            lidar_cfg = rig.lidar
+            agent.lidar = _built(f"{where}.lidar", "lidar", lambda: lidar_from_config(lidar_cfg))
             agent.lidar_mount = mount_matrix(asset, rig.lidar.mount, where=f"{where}.lidar.mount")
         if rig.radar is not None:
             agent.radar_mount = mount_matrix(asset, rig.radar.mount, where=f"{where}.radar.mount")
-            agent.radar = radar_from_config(rig.radar)
+            radar_cfg = rig.radar
+            agent.radar = _built(f"{where}.radar", "radar", lambda: radar_from_config(radar_cfg))
         for c in rig.cameras:
             m = mount_matrix(asset, c.mount, where=f"{where}.cameras[{c.name}].mount")
-            agent.cameras[c.name] = (camera_from_config(c), c, m)
+            camera = _built(f"{where}.cameras[{c.name}]", "camera", lambda c=c: camera_from_config(c))
+            agent.cameras[c.name] = (camera, c, m)
         if rig.top_view is not None:
-            agent.top_view = top_view_from_config(rig.top_view)
+            top_cfg = rig.top_view
+            agent.top_view = _built(f"{where}.top_view", "camera", lambda: top_view_from_config(top_cfg))
         self._check_mounts(agent, where)
         return agent
 

@@ -169,6 +169,24 @@ def test_an_unknown_mount_point_lists_the_assets_points() -> None:
         load_scenario(d)
 
 
+def test_a_sensor_the_core_refuses_names_the_rig_and_the_sensor(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # Two cameras, the second's distortion folding over within its image: only the core can tell (it inverts the
+    # distortion at every pixel), and its error must name which camera of which rig, not just `camera.distortion`.
+    d = tiny()
+    cam = {"resolution": [32, 24], "outputs": ["depth"]}
+    d["rigs"]["r"]["cameras"] = [
+        {**cam, "name": "bow", "mount": {"point": "camera_front"}},
+        {**cam, "name": "aft", "mount": {"point": "camera_rear"}, "distortion": [-5.0, 3.0, 0.0, 0.0, 0.0]},
+    ]
+    path = write(tmp_path / "folded.yaml", d)
+    err = cli_error(capsys, ["run", str(path), "-o", str(tmp_path / "out")])
+    assert "folded.yaml: invalid config rigs.r.cameras[aft].distortion = [-5.0, 3.0" in err, err
+    assert "the distortion folds over" in err
+    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").rglob("*.mcap"))
+
+
 def test_a_mount_kilometres_away_is_a_warning_naming_it(tmp_path: Path) -> None:
     d = tiny()
     d["rigs"]["r"]["lidar"]["mount"] = {"xyz": [0.0, 0.0, 2300.0]}  # millimetres typed as metres
