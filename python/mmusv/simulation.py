@@ -11,6 +11,7 @@ are ``(4, 4)`` float64 sensor → world matrices.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import math
 from collections.abc import Callable, Collection
@@ -278,7 +279,7 @@ class Simulation:
             agent.radar = _built(f"{where}.radar", "radar", lambda: radar_from_config(radar_cfg))
         for c in rig.cameras:
             m = mount_matrix(asset, c.mount, where=f"{where}.cameras[{c.name}].mount")
-            camera = _built(f"{where}.cameras[{c.name}]", "camera", lambda c=c: camera_from_config(c))
+            camera = _built(f"{where}.cameras[{c.name}]", "camera", functools.partial(camera_from_config, c))
             agent.cameras[c.name] = (camera, c, m)
         if rig.top_view is not None:
             top_cfg = rig.top_view
