@@ -111,6 +111,9 @@ pub struct WaveSurface {
     tiles: Vec<Tile>,
     zmin: f32,
     zmax: f32,
+    /// The mean square slope of every wave, the roughness the still water beyond the sampled sea is shaded with
+    /// (`None` without waves, or without slopes: [`SurfaceSpec::slopes`]).
+    far_mss: Option<f32>,
 }
 
 /// A hit of a ray with the surface: distance and the piece (tile, cell, triangle) hit.
@@ -159,7 +162,8 @@ impl WaveSurface {
                 zmax = zmax.max(t.zmax);
             }
         }
-        Self { level, time_s, x0, y0, tile_m, inv_tile_m: 1.0 / tile_m, ntx, nty, tiles, zmin, zmax }
+        let far_mss = (spec.slopes && !components.is_empty()).then(|| sample::total_mss(components) as f32);
+        Self { level, time_s, x0, y0, tile_m, inv_tile_m: 1.0 / tile_m, ntx, nty, tiles, zmin, zmax, far_mss }
     }
 
     /// The still water level (world z).
@@ -181,6 +185,13 @@ impl WaveSurface {
     /// Number of sampled (non-flat) tiles.
     pub fn sampled_tiles(&self) -> usize {
         self.tiles.iter().filter(|t| t.n > 0).count()
+    }
+
+    /// Whether world `(x, y)` lies on the sampled part of the surface (a sampled tile; else the still level, where
+    /// the sea goes on unsampled).
+    #[inline]
+    pub fn sampled_at(&self, x: f32, y: f32) -> bool {
+        self.tile_at(x, y).is_some_and(|(ix, iy)| self.tiles[iy * self.ntx + ix].n > 0)
     }
 
     /// The tile holding world `(x, y)`, if inside the rectangle.

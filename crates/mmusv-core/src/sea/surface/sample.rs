@@ -15,6 +15,11 @@
 use super::{nearest, resolved, SurfaceSpec, Tile, DETAIL_BANDS, DETAIL_CELLS, MAX_LEVEL, TILE_CELLS};
 use crate::ocean::WaveComponent;
 
+/// The mean square slope (both axes) of all the `comps`: `Σ a²k²/2`.
+pub(super) fn total_mss(comps: &[WaveComponent]) -> f64 {
+    comps.iter().map(|c| 0.5 * (c.amplitude_m * c.k_rad_m).powi(2)).sum()
+}
+
 /// Nodes summed together by [`accumulate`] (one AVX2 register of `f32`).
 const LANES: usize = 8;
 
@@ -144,6 +149,7 @@ impl<'a> Phasors<'a> {
                 }
             })
             .collect();
+        let unresolved_mss = mss;
         let nc = self.comps.len();
         let (eta, sx, sy, stride) = self.node_sums(ix, iy, lvl as usize, w, &terms, spec.slopes);
         let mut h = vec![0f32; w * w];
@@ -217,9 +223,13 @@ impl<'a> Phasors<'a> {
                 mss = (mss - m).max(0.0);
             }
         }
-        // The unresolved slopes taper with the waves: their share at the tile's centre.
+        // Where the waves taper (a level-of-detail device: the sea goes on), the slopes the taper takes from the
+        // sampled ones are handed to the roughness, so the total slope variance stays the sea's: the resolved
+        // waves' `R` drawn at `s²R` (`s` the taper at the tile's centre) and `(1 − s²) R` as roughness; beyond the
+        // taper the still level is shaded with all of it ([`super::WaveSurface::shading`]).
         let centre_taper = ((spec.radius_m - dc) / (spec.radius_m - inner).max(1e-6)).clamp(0.0, 1.0);
-        let mss = mss as f32 * centre_taper * centre_taper;
+        let resolved_mss = (total_mss(self.comps) - unresolved_mss).max(0.0);
+        let mss = (mss + (1.0 - f64::from(centre_taper * centre_taper)) * resolved_mss) as f32;
         Tile { n, zmin, zmax, h, g, mss, detail, bands, band_mss }
     }
 

@@ -6,8 +6,9 @@
 //! bilinear interpolation draws the cells' lattice), so its slopes are treated
 //! statistically, as filtered normal maps treat detail finer than a texel: M. Olano & D. Baker, "LEAN Mapping",
 //! I3D 2010; M. Toksvig, "Mipmapping Normal Maps", J. Graphics Tools 10(3), 2005. The detail bands are chosen as a
-//! mipmap's level is, by the footprint of the pixel that sees the water. Checked in the parent's tests against
-//! the waves' analytic slopes and variances.
+//! mipmap's level is, by the footprint of the pixel that sees the water. Past the sampled sea (where the waves
+//! taper, and the still level beyond) the slopes not drawn are roughness too, so the total slope variance is the
+//! sea's everywhere. Checked in the parent's tests against the waves' analytic slopes and variances.
 
 use super::{unit, WaveSurface, TILE_CELLS};
 
@@ -44,15 +45,15 @@ pub struct SurfaceShading {
 
 impl WaveSurface {
     /// Smooth unit normal at world `(x, y)`: the sampled slopes `∇η` of the resolved waves interpolated
-    /// bilinearly (up-facing); `None` over still water (outside the sampled tiles), where the caller's own
-    /// small-scale normals serve.
+    /// bilinearly (up-facing); straight up over the still water beyond the sampled sea (see
+    /// [`WaveSurface::shading`]); `None` without waves or slopes.
     #[inline]
     pub fn shading_normal(&self, x: f32, y: f32) -> Option<[f32; 3]> {
         self.shading(x, y, 0.0).map(|s| s.normal)
     }
 
     /// The water's shading at world `(x, y)` seen with a pixel footprint of `footprint_m` metres on the water
-    /// ([`SurfaceShading`]); `None` over still water, and on a surface sampled without its slopes
+    /// ([`SurfaceShading`]); `None` on a surface without waves or sampled without its slopes
     /// ([`SurfaceSpec::slopes`](super::SurfaceSpec::slopes) off).
     ///
     /// Model: a wave shorter than four cells of the tile's level (`resolved`) cannot be drawn from its nodes
@@ -65,11 +66,22 @@ impl WaveSurface {
     /// wider than the band's cell) and as roughness where it is twice as wide or more, with a linear crossfade
     /// of the slopes in between (`w`, the roughness taking `(1 − w²)` of the band's variance): the texture
     /// filtering rule of a mipmap's level selection, so a top view's 0.5 m pixels never alias waves of 0.5 m.
+    ///
+    /// The same rule carries the sea past its sampled part, which is a level of detail and not the sea's end:
+    /// where the waves taper to the still level, the slopes the taper takes away are handed to the roughness,
+    /// and the still water beyond (outside the tiles, or a flat tile) is the coarsest level of all, every wave
+    /// too short for it: a level normal with the whole `Σ a²k²/2` as roughness. So the total slope variance
+    /// (drawn plus rough) is the sea's everywhere, and the far sea reads as the near one does from afar instead
+    /// of changing texture where the sampling ends.
     #[inline]
     pub fn shading(&self, x: f32, y: f32, footprint_m: f32) -> Option<SurfaceShading> {
-        let (ix, iy) = self.tile_at(x, y)?;
+        let far = |mss: f32| SurfaceShading { normal: [0.0, 0.0, 1.0], unresolved_mss: mss };
+        let Some((ix, iy)) = self.tile_at(x, y) else { return self.far_mss.map(far) };
         let t = &self.tiles[iy * self.ntx + ix];
-        if t.n == 0 || t.g.is_empty() {
+        if t.n == 0 {
+            return self.far_mss.map(far);
+        }
+        if t.g.is_empty() {
             return None;
         }
         let [mut gx, mut gy] = self.slope_at(&t.g, t.n, ix, iy, x, y);

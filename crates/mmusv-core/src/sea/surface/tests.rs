@@ -360,3 +360,46 @@ fn a_surface_without_slopes_has_the_same_geometry_and_no_shading() {
     }
     assert!(shaded > 2000 && hits > 2000, "{shaded} shaded points, {hits} hits");
 }
+
+/// The sampled sea is a level of detail, not the sea's end: the total slope variance a pixel shades with (the
+/// drawn normals' `|∇η|²` plus the roughness) is the waves' `Σ a²k²/2` where every wave is drawn, where the taper
+/// takes the drawn slopes away, and beyond, where the still level is shaded with all of it as roughness.
+#[test]
+fn the_total_slope_variance_is_the_seas_through_the_taper_and_beyond() {
+    let c = test_sea();
+    let total: f64 = c.iter().map(|w| 0.5 * (w.amplitude_m * w.k_rad_m).powi(2)).sum();
+    let spec = SurfaceSpec::default(); // waves taper between 260 and 320 m
+    let s = surface(&c, 3.0, &[[0.0, 0.0]], spec);
+    // The spatial mean over an annulus of the drawn slopes' square plus the roughness, and the mean roughness.
+    let mean = |r0: f32, r1: f32| {
+        let (mut sum, mut rough, n) = (0f64, 0f64, 20_000u32);
+        for k in 0..n {
+            // A low-discrepancy cover of the annulus (golden-angle turns, radii uniform in area).
+            let f = (k as f32 + 0.5) / n as f32;
+            let r = (r0 * r0 + f * (r1 * r1 - r0 * r0)).sqrt();
+            let a = k as f32 * 2.399_963;
+            let sh = s.shading(r * a.cos(), r * a.sin(), 0.0).unwrap_or_else(|| unreachable!("a wavy sea"));
+            let [nx, ny, nz] = sh.normal.map(f64::from);
+            sum += (nx * nx + ny * ny) / (nz * nz) + f64::from(sh.unresolved_mss);
+            rough += f64::from(sh.unresolved_mss);
+        }
+        (sum / f64::from(n), rough / f64::from(n))
+    };
+    for (r0, r1) in [(5.0, 60.0), (270.0, 300.0), (330.0, 600.0)] {
+        let (got, rough) = mean(r0, r1);
+        assert!((got - total).abs() < 0.12 * total, "{r0}..{r1} m: {got} against the sea's {total}");
+        match r0 {
+            // Near the focus (1 and 2 m cells) every wave is drawn: no roughness.
+            5.0 => assert!(rough < 1e-9, "{r0}..{r1} m: roughness {rough}"),
+            // In the taper (8 m cells, half the slopes tapered away) most of it is roughness.
+            270.0 => assert!(rough > 0.5 * total && rough < got, "{r0}..{r1} m: roughness {rough} of {got}"),
+            // Beyond, all of it.
+            _ => assert!((rough - total).abs() < 1e-6 * total, "{r0}..{r1} m: {rough}"),
+        }
+    }
+    let far = s.shading(5000.0, -7000.0, 1.0).unwrap_or_else(|| unreachable!("the sea goes on"));
+    assert_eq!(far.normal, [0.0, 0.0, 1.0]);
+    assert!((f64::from(far.unresolved_mss) - total).abs() < 1e-6 * total);
+    // Without waves there is nothing to shade with.
+    assert!(surface(&[], 3.0, &[[0.0, 0.0]], spec).shading(0.0, 0.0, 0.0).is_none());
+}
