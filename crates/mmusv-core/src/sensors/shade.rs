@@ -506,10 +506,13 @@ impl Shader {
         };
         c += water::body_factor(rho, self.water_fdr, f_o, WATER_IOR) * entering;
         if !self.foam.is_empty() {
-            // The normalised elevation η/σ_η (σ_η = H_s/4) that gathers the whitecaps on the crests.
+            // The normalised elevation η/σ_η (σ_η = H_s/4) that gathers the whitecaps on the crests, where the
+            // surface is sampled (beyond, the sea goes on at an elevation not known: the foam's own coverage).
             let crest = match &self.waves {
-                Some(w) if self.env.wave_height_m > 0.0 => (hit.point.z - w.level()) * 4.0 / self.env.wave_height_m,
-                _ => 0.0,
+                Some(w) if self.env.wave_height_m > 0.0 && w.sampled_at(hit.point.x, hit.point.y) => {
+                    Some((hit.point.z - w.level()) * 4.0 / self.env.wave_height_m)
+                }
+                _ => None,
             };
             let cover = self.foam.cover(hit.point.x, hit.point.y, crest);
             if cover > 0.0 {

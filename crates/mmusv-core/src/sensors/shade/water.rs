@@ -297,6 +297,8 @@ pub struct Foam {
     coverage: f32,
     /// Whether the threshold is that of the noise biased by the crests ([`Foam::on_crests`]).
     crests: bool,
+    /// The threshold and band of the noise alone: where the elevation is not known (see [`Foam::cover`]).
+    plain: (f32, f32),
     seed: u64,
     wakes: Vec<WakeShape>,
 }
@@ -333,7 +335,7 @@ impl Foam {
                 }
             })
             .collect();
-        Self { threshold, band, coverage, crests: false, seed, wakes }
+        Self { threshold, band, coverage, crests: false, plain: (threshold, band), seed, wakes }
     }
 
     /// This foam with its whitecaps gathered on the wave crests (see the module docs): [`Foam::cover`] is then
@@ -352,20 +354,26 @@ impl Foam {
     }
 
     /// Foam cover (density) in `[0, 1]` at world point `(x, y)`, whose normalised elevation is `crest` (`η/σ_η`; read
-    /// only [`Foam::on_crests`]).
+    /// only [`Foam::on_crests`]). `None`: the elevation is not known there (the still level beyond a wave
+    /// surface's sampled part, where the sea goes on unsampled): the noise alone against its own threshold, so
+    /// the whitecaps keep Monahan's coverage there too (the crest-biased threshold, met by the noise alone,
+    /// would cover less).
     #[inline(always)]
-    pub fn cover(&self, x: f32, y: f32, crest: f32) -> f32 {
+    pub fn cover(&self, x: f32, y: f32, crest: Option<f32>) -> f32 {
         let mut c = 0.0f32;
         let mut nz = None;
         let mut noise_at = || *nz.get_or_insert_with(|| foam_noise(self.seed, x, y));
-        let lift = if self.crests { CREST_WEIGHT * crest } else { 0.0 };
+        let (threshold, band, lift) = match crest {
+            Some(e) if self.crests => (self.threshold, self.band, CREST_WEIGHT * e),
+            _ => (self.plain.0, self.plain.1, 0.0),
+        };
         // The first octave bounds the sum: skip the rest where it cannot reach the threshold.
-        if self.threshold < NO_WHITECAPS
-            && (0.5 * value_noise(self.seed, x / 6.0, y / 6.0) + 0.375) / 0.875 + lift > self.threshold - 0.015
+        if threshold < NO_WHITECAPS
+            && (0.5 * value_noise(self.seed, x / 6.0, y / 6.0) + 0.375) / 0.875 + lift > threshold - 0.015
         {
             let n = noise_at() + lift;
             // Thin at the edge, dense in the core (see the module docs).
-            c = ((n - self.threshold) / self.band).clamp(0.0, 1.0);
+            c = ((n - threshold) / band).clamp(0.0, 1.0);
         }
         for w in &self.wakes {
             let [co, s] = w.dir;
@@ -455,7 +463,7 @@ mod tests {
             for i in 0..n {
                 let x = noise::uniform(99, 1, 2 * i) as f32 * 3000.0 - 1500.0;
                 let y = noise::uniform(99, 1, 2 * i + 1) as f32 * 3000.0 - 1500.0;
-                let c = foam.cover(x, y, 0.0);
+                let c = foam.cover(x, y, None);
                 s += c as f64;
                 covered += u64::from(c > 0.0);
                 dense += u64::from(c >= 1.0);
@@ -486,7 +494,7 @@ mod tests {
                 let x = noise::uniform(99, 1, 2 * i) as f32 * 3000.0 - 1500.0;
                 let y = noise::uniform(99, 1, 2 * i + 1) as f32 * 3000.0 - 1500.0;
                 let g = standard_normal(1234, i);
-                let c = foam.cover(x, y, g) as f64;
+                let c = foam.cover(x, y, Some(g)) as f64;
                 s += c;
                 crest_sum += c * g as f64;
                 if g < -1.0 {
@@ -500,6 +508,19 @@ mod tests {
             assert!(mean_crest > 0.7, "coverage {cov}: foam at a mean elevation of {mean_crest} σ");
             let trough_cover = troughs / trough_n as f64;
             assert!(trough_cover < 0.25 * cov as f64, "coverage {cov}: {trough_cover} in the troughs");
+            // Where the elevation is not known (beyond the sampled sea) the noise alone keeps the coverage: met by
+            // the crests' threshold it would cover far less.
+            let (mut plain, mut biased) = (0.0f64, 0.0f64);
+            for i in 0..n {
+                let x = noise::uniform(98, 1, 2 * i) as f32 * 3000.0 - 1500.0;
+                let y = noise::uniform(98, 1, 2 * i + 1) as f32 * 3000.0 - 1500.0;
+                plain += f64::from(foam.cover(x, y, None));
+                biased += f64::from(foam.cover(x, y, Some(0.0)));
+            }
+            let area = |v: f64| v / n as f64 / f64::from(WHITECAP_MEAN_DENSITY);
+            let (plain, biased) = (area(plain), area(biased));
+            assert!((plain - cov as f64).abs() < 0.2 * cov as f64 + 0.002, "coverage {cov}: {plain} unsampled");
+            assert!(biased < 0.8 * cov as f64, "coverage {cov}: {biased} at the mean level");
         }
         // The normal deviates are normal: mean 0, variance 1.
         let g: Vec<f64> = (0..50_000).map(|i| f64::from(standard_normal(5, i))).collect();
@@ -517,7 +538,7 @@ mod tests {
             let mut s = 0.0;
             for i in 0..21 {
                 for j in 0..21 {
-                    s += f.cover(x + (i as f32 - 10.0) * 0.5, y + (j as f32 - 10.0) * 0.05, 0.0);
+                    s += f.cover(x + (i as f32 - 10.0) * 0.5, y + (j as f32 - 10.0) * 0.05, None);
                 }
             }
             s / 441.0
