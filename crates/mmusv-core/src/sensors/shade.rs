@@ -13,7 +13,9 @@
 //! camera's shadow ray finds it unoccluded) and by the environment:
 //! `L = L_e + (f_d + f_s(v, s)) E_s (n·s) + f_d E_env(n) + P(r', roughness) (F0 A + B)`, with `f_d = (1 − metallic)
 //! base / π` and `r'` the rough lobe's dominant direction (Lagarde & de Rousiers 2014). The environment light is
-//! not occluded (no ambient occlusion): every surface sees the whole sky and the sea, a known limit of the model. Water is a dielectric (IOR 1.33) with swell normals: `L = F(θ_o) L_r + glint + L_body`, where `L_r`
+//! not occluded (no ambient occlusion): every surface sees the whole sky and the sea, a known limit of the model. Water is a dielectric (IOR 1.33) whose normals and roughness come from the wave surface where the scene has one
+//! (`WaveSurface::shading`, the far sea beyond its sampled part included), else from a fixed four-component swell:
+//! `L = F(θ_o) L_r + glint + L_body`, where `L_r`
 //! is the radiance along the reflected ray (traced by the camera, so ships mirror in it; the sky's otherwise),
 //! the glint is the sun through a Cox–Munk GGX lobe, and `L_body` the smooth-plastic water body; foam (whitecaps
 //! and wakes) is Lambertian on top. Aerial perspective: `L·T + L_air (1 − T)`, `T = e^{−σ t}` (Koschmieder),
@@ -394,8 +396,9 @@ impl Shader {
         Vec3::new(-gx, -gy, 1.0).normalize_or_zero()
     }
 
-    /// `hit` with its shading normal set: for water seen along `d`, the swell's (or the geometric one where the
-    /// swell would face away); for anything else, the geometric normal.
+    /// `hit` with its shading normal set: for water seen along `d`, the wave surface's (with the roughness of the
+    /// waves it does not draw), or without one the swell's (the geometric one where either would face away); for
+    /// anything else, the geometric normal.
     #[inline(always)]
     pub fn with_swell(&self, d: Vec3, mut hit: SurfaceHit) -> SurfaceHit {
         hit.shading_normal = hit.normal;
