@@ -14,6 +14,7 @@
 //! [`WaveSurface::shading`], whose filtering of the waves a level cannot resolve lives in [`shading`]) are summed
 //! per tile by the phasor recurrence of [`sample`].
 
+mod crests;
 mod march;
 mod raster;
 mod sample;
@@ -114,6 +115,8 @@ pub struct WaveSurface {
     /// The mean square slope of every wave, the roughness the still water beyond the sampled sea is shaded with
     /// (`None` without waves, or without slopes: [`SurfaceSpec::slopes`]).
     far_mss: Option<f32>,
+    /// The wave components the surface was sampled from (for the statistics of [`crests`]).
+    components: Vec<WaveComponent>,
 }
 
 /// A hit of a ray with the surface: distance and the piece (tile, cell, triangle) hit.
@@ -163,7 +166,21 @@ impl WaveSurface {
             }
         }
         let far_mss = (spec.slopes && !components.is_empty()).then(|| sample::total_mss(components) as f32);
-        Self { level, time_s, x0, y0, tile_m, inv_tile_m: 1.0 / tile_m, ntx, nty, tiles, zmin, zmax, far_mss }
+        Self {
+            level,
+            time_s,
+            x0,
+            y0,
+            tile_m,
+            inv_tile_m: 1.0 / tile_m,
+            ntx,
+            nty,
+            tiles,
+            zmin,
+            zmax,
+            far_mss,
+            components: components.to_vec(),
+        }
     }
 
     /// The still water level (world z).
