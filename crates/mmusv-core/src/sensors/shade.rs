@@ -31,6 +31,7 @@ use std::sync::Arc;
 
 pub mod brdf;
 pub mod envlight;
+pub mod foam_trail;
 pub mod rough_water;
 pub mod sky;
 pub mod tonemap;
@@ -300,8 +301,13 @@ impl Shader {
     /// This shader taking water normals from the displaced sea surface `waves` (a scene's,
     /// [`crate::Scene::wave_surface`]) instead of the swell.
     pub fn with_waves(mut self, waves: Option<Arc<WaveSurface>>) -> Self {
-        if waves.is_some() && self.env.wave_height_m > 0.0 {
-            self.foam = self.foam.clone().on_crests();
+        if let Some(w) = waves.as_ref().filter(|_| self.env.wave_height_m > 0.0) {
+            // The whitecaps gather on the crests and leave foam behind them as the crests move on.
+            let max_crest = (w.zmax() - w.level()) * 4.0 / self.env.wave_height_m;
+            self.foam = match foam_trail::CrestTrail::of(w) {
+                Some(trail) => self.foam.clone().with_trail(trail, max_crest),
+                None => self.foam.clone().on_crests(),
+            };
         }
         self.waves = waves;
         self
@@ -511,13 +517,20 @@ impl Shader {
         if !self.foam.is_empty() {
             // The normalised elevation η/σ_η (σ_η = H_s/4) that gathers the whitecaps on the crests, where the
             // surface is sampled (beyond, the sea goes on at an elevation not known: the foam's own coverage).
+            let (x, y) = (hit.point.x, hit.point.y);
             let crest = match &self.waves {
-                Some(w) if self.env.wave_height_m > 0.0 && w.sampled_at(hit.point.x, hit.point.y) => {
+                Some(w) if self.env.wave_height_m > 0.0 && w.sampled_at(x, y) => {
                     Some((hit.point.z - w.level()) * 4.0 / self.env.wave_height_m)
                 }
                 _ => None,
             };
-            let cover = self.foam.cover(hit.point.x, hit.point.y, crest);
+            // Where the crests that left foam here were: the elevation that far ahead now (`foam_trail.rs`).
+            let past = |dx: f32, dy: f32| {
+                let w = self.waves.as_ref()?;
+                let (px, py) = (x + dx, y + dy);
+                w.sampled_at(px, py).then(|| (w.height(px, py) - w.level()) * 4.0 / self.env.wave_height_m)
+            };
+            let cover = self.foam.cover(x, y, crest, past);
             if cover > 0.0 {
                 let mut e = self.light.irradiance(n);
                 if sunlit {
