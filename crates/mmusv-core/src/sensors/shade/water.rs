@@ -19,7 +19,10 @@
 //!   *effective* reflectance of whitecaps, over their area and lifetime, to be 0.22 — 0.4 of fresh foam's. So
 //!   within the covered area the foam's density rises from 0 at a patch's edge with the noise's excess over the
 //!   threshold, linearly up to full over a band chosen (from the same sample as the threshold) so that the mean
-//!   density over the covered area is 0.4: bright cores fading into thin foam, not flat white patches.
+//!   density over the covered area is 0.4: bright cores fading into thin foam, not flat white patches. A crest
+//!   also leaves its foam behind as it travels on, thinning for seconds (`foam_trail.rs`), so part of the
+//!   coverage lies on the backs of the waves and in the troughs; where the elevation is not known (beyond the
+//!   sampled sea) the noise meets its own threshold.
 //! * **Wind from the sea state** when the scenario gives none: a fully developed Pierson–Moskowitz sea,
 //!   `H_s = 0.21 U² / g` (W. J. Pierson & L. Moskowitz, JGR 69(24), 1964), so `U = √(H_s g / 0.21)`.
 //! * **Wakes**: behind every vessel under way, turbulent foam along its track (as wide as its beam, widening
