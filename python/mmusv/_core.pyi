@@ -131,6 +131,7 @@ class Scene:
         taper_m: float = 60.0,
         detail: bool = False,
         slopes: bool = True,
+        fine_m: float = 0.0,
     ) -> None:
         """Sets the displaced sea surface of the frame: the JONSWAP wave field of (hs_m, tp_s, gamma,
         direction_rad, spread_s) drawn from the scenario's sea seed, sampled at ``time_s`` around ``foci`` (F, 2)
@@ -156,6 +157,7 @@ class Scene:
         taper_m: float = 60.0,
         detail: bool = False,
         slopes: bool = True,
+        fine_m: float = 0.0,
     ) -> None:
         """Starts sampling, on a thread of its own, the surface a later ``set_wave_surface`` with the same
         arguments will set; that call takes it instead of sampling it again (the same surface bit for bit), any

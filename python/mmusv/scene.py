@@ -98,6 +98,7 @@ def _surface_args(
     radius_m: float,
     detail: bool,
     slopes: bool,
+    fine_m: float,
 ) -> tuple[float | None, dict[str, Any]]:
     """The native ``set_wave_surface`` / ``prefetch_wave_surface`` arguments of :meth:`Scene.set_wave_surface`'s:
     ``hs_m`` (``None`` without a sea) and the keywords."""
@@ -116,6 +117,7 @@ def _surface_args(
         "taper_m": min(60.0, float(radius_m)),
         "detail": bool(detail),
         "slopes": bool(slopes),
+        "fine_m": float(fine_m),
     }
 
 
@@ -326,6 +328,7 @@ class Scene:
         radius_m: float = 320.0,
         detail: bool = True,
         slopes: bool = True,
+        fine_m: float = 0.0,
     ) -> None:
         """Sets the displaced sea surface of one frame time (``mmusv_core::sea::WaveSurface``), which replaces the
         sea instance's flat mesh for every ray: crests occlude, beams meet wave faces. The scene must have a sea
@@ -346,8 +349,13 @@ class Scene:
             slopes: the tiles carry the slopes of the waves they resolve, which only the cameras' shading reads;
                 off, the heights alone are sampled (cheaper; ``detail`` is then off too, and every ray's hit is the
                 same). :meth:`~mmusv.simulation.Simulation.capture` leaves them out for frames nothing renders.
+            fine_m: with ``detail``, the coarser tiles within this distance of a focus (metres, >= 0; 0: none) also
+                carry the slopes of the waves a 1 m grid resolves, drawn where a pixel's footprint resolves them:
+                an orthographic top view, one footprint everywhere, then shades every level alike instead of
+                showing the levels' edges as squares around its USV. The simulation sets it to its top views'
+                reach; the geometry is the same either way.
         """
-        hs, kw = _surface_args(sea, scenario_seed, time_s, foci, radius_m, detail, slopes)
+        hs, kw = _surface_args(sea, scenario_seed, time_s, foci, radius_m, detail, slopes, fine_m)
         self._native.set_wave_surface(hs, **kw)
 
     def prefetch_wave_surface(
@@ -360,13 +368,14 @@ class Scene:
         radius_m: float = 320.0,
         detail: bool = True,
         slopes: bool = True,
+        fine_m: float = 0.0,
     ) -> None:
         """Starts sampling, on a thread of its own, the surface a later :meth:`set_wave_surface` with the same
         arguments will set (the next frame's, while this one is annotated and written: what
         :meth:`~mmusv.simulation.Simulation.prefetch_frame` does); that call then takes it instead of sampling it
         again, and any other call leaves it unused. The same surface bit for bit. Arguments as for
         :meth:`set_wave_surface`, checked now; ``sea=None`` drops a surface being sampled ahead."""
-        hs, kw = _surface_args(sea, scenario_seed, time_s, foci, radius_m, detail, slopes)
+        hs, kw = _surface_args(sea, scenario_seed, time_s, foci, radius_m, detail, slopes, fine_m)
         self._native.prefetch_wave_surface(hs, **kw)
 
     def wave_heights(self, xy: npt.ArrayLike) -> npt.NDArray[np.float32]:

@@ -254,6 +254,7 @@ class Simulation:
         if sc.environment.motion == "physical":
             spec = sc.environment.sea_spec()
             self.sea = spec if spec.hs_m > 0.0 else None
+        self._sense_sea()
 
     # ------------------------------------------------------------------------------------------ building
 
@@ -333,9 +334,18 @@ class Simulation:
         sea state and grazing angle, and the annotations carry each box's ``wave_occlusion``.
         """
         self.sea = sea if sea is None or sea.hs_m > 0.0 else None
+        self._sense_sea()
         if self.sea is None:
             self.ws.scene.set_wave_surface(None, scenario_seed=self.scenario.seed, time_s=0.0, foci=np.zeros((0, 2)))
         self._frame = None
+
+    def _sense_sea(self) -> None:
+        """The sensors' sea state (their wind, whitecaps, water returns and clutter) is the physical sea's
+        significant height where there is one (``environment.sea``, or the sea of ``environment.wave``), else the
+        ``wave`` setting's: a scenario giving ``sea: {state: 6}`` alone is a rough sea to every sensor, not the
+        default W0's calm one."""
+        waves = self.sea.hs_m if self.sea is not None else None
+        self.sensor_env = sensor_env(self.environment, wave_height_m=waves)
 
     def set_frame(self, frame: int, *, sea_radius_m: float = 320.0, shading_detail: bool = True) -> WorldState:
         """Moves every vessel to its pose at ``frame`` (and, over a physical sea, the water to its surface at the
@@ -374,7 +384,20 @@ class Simulation:
             "radius_m": radius_m,
             "detail": detail,
             "slopes": detail,
+            "fine_m": self._top_view_reach_m if detail else 0.0,
         }
+
+    @cached_property
+    def _top_view_reach_m(self) -> float:
+        """How far from its USV the farthest RGB top view sees (half its diagonal, metres; 0 without one): the
+        sea's coarser tiles that near carry the finest grid's shading slopes, so a top view's one footprint sees
+        every level alike (``Scene.set_wave_surface``'s ``fine_m``)."""
+        reach = [
+            0.5 * a.rig.top_view.metres_per_pixel * math.hypot(*a.rig.top_view.resolution)
+            for a in self.agents
+            if a.rig.top_view is not None and "rgb" in a.rig.top_view.outputs
+        ]
+        return max(reach, default=0.0)
 
     def renders(self, *, agents: Collection[str] | None = None, sensors: Collection[str] | None = None) -> bool:
         """Whether a :meth:`capture` with these ``agents`` and ``sensors`` renders (a camera or a top view): only

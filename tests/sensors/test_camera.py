@@ -446,3 +446,36 @@ def test_sea_detail_bands_change_only_the_water_colours_near_the_camera() -> Non
     # Beyond the finest tiles the water itself is the same; its colours move by a level at most, through the
     # glossy reflections, whose lobe there reaches down the image into the near water (glossy.rs).
     assert diff[far].max() <= 1, "beyond the finest tiles the colours stay"
+
+
+@pytest.mark.parametrize("preset", ["W1", "W3"])
+def test_a_top_view_shades_every_level_of_the_sea_alike(preset: str) -> None:
+    """An orthographic top view sees the water with one footprint (0.5 m) across its whole image, while the sea
+    is sampled at 1 m within about 40 m of its USV and coarser beyond. With ``fine_m`` (what the simulation sets
+    to its top views' reach) the texture the image shows — the pixel-scale contrast left after a 5-pixel box blur
+    — is the same near the USV and 50–64 m out (0.89 and 1.13 times); without, the finest tiles stand out as a
+    square of other texture (2.4 and 4.2 times the contrast at W1 and W3)."""
+    from mmusv.world.sea_state import sea_spec_for_preset
+    from scipy.ndimage import uniform_filter
+
+    s = plane_scene(2000.0)
+    s.set_sea(0)
+    top = core.Camera(width=256, height=256, rgb=True, metres_per_pixel=0.5, range_max=500.0)
+    pose = pose_matrices(np.array([0.0, 0.0, 120.0, 0.0, math.pi / 2, 0.0]))
+    ratios = []
+    for fine_m in (0.0, 91.0):
+        sea = sea_spec_for_preset(preset)
+        s.set_wave_surface(sea, scenario_seed=3, time_s=5.0, foci=np.zeros((1, 2)), fine_m=fine_m)
+        rgb = render(top, s, pose=pose, env=sensor_env(), seed=1).rgb
+        assert rgb is not None
+        lum = rgb.astype(float).mean(axis=2)
+        texture = lum - uniform_filter(lum, 5)
+        v, u = np.mgrid[0:256, 0:256]
+        r = np.hypot(v - 127.5, u - 127.5) * 0.5  # metres from the USV
+        calm = np.abs(texture) < 20  # whitecaps' edges left out
+        near = np.sqrt((texture[(r > 4) & (r < 28) & calm] ** 2).mean())
+        ring = np.sqrt((texture[(r > 50) & (r < 64) & calm] ** 2).mean())
+        ratios.append(near / ring)
+    without, with_fine = ratios
+    assert 0.75 < with_fine < 1.33, ratios
+    assert without > 1.6, ratios

@@ -582,3 +582,23 @@ def test_pose_matrices_convention() -> None:
     m = pose_matrices(np.array([1, 2, 3, 0.0, 0.0, math.pi / 2]))
     np.testing.assert_allclose(m[:3, 0], [0, 1, 0], atol=1e-12)
     np.testing.assert_allclose(m[:3, 3], [1, 2, 3])
+
+
+def test_the_sensors_sea_state_is_the_physical_seas() -> None:
+    """A scenario that sets the physical sea alone (``environment.sea``) is that sea to every sensor — wind,
+    whitecaps, water returns, clutter — not the default ``wave: W0`` (0.5 m); ``motion: paper`` keeps the ``wave``
+    setting's height, and :meth:`Simulation.set_sea_surface` moves the sensors' sea with the water."""
+    from mmusv.bundled import resolve_scenario
+    from mmusv.config import load_scenario
+    from mmusv.world.sea_state import sea_spec_for_preset
+
+    sc = load_scenario(resolve_scenario("open_sea_convoy")).model_dump()
+    sc["environment"] = {"sea": {"state": 6}}
+    sim = Simulation(sc)
+    assert sim.sea is not None and sim.sensor_env.wave_height_m == pytest.approx(sim.sea.hs_m) and sim.sea.hs_m > 4
+    sim.set_sea_surface(sea_spec_for_preset("W2"))
+    assert sim.sensor_env.wave_height_m == pytest.approx(2.5)
+    sim.set_sea_surface(None)
+    assert sim.sensor_env.wave_height_m == pytest.approx(0.5)  # the `wave` setting's (W0)
+    sc["environment"] = {"wave": "W3", "motion": "paper"}
+    assert Simulation(sc).sensor_env.wave_height_m == pytest.approx(3.5)

@@ -94,7 +94,7 @@ fn surface_key(
     foci: Option<&PyReadonlyArray2<'_, f32>>,
     level: f32,
     (tile_m, near_m, radius_m, taper_m): (f32, f32, f32, f32),
-    (detail, slopes): (bool, bool),
+    (detail, slopes, fine_m): (bool, bool, f32),
 ) -> PyResult<Option<SurfaceKey>> {
     let Some(hs) = hs_m else { return Ok(None) };
     let foci: Vec<[f32; 2]> = match foci {
@@ -105,6 +105,9 @@ fn surface_key(
         if !(v.is_finite() && v > 0.0) {
             return Err(InputError::new_err(format!("{name} = {v} is not allowed; give a distance > 0 metres")));
         }
+    }
+    if !(fine_m.is_finite() && fine_m >= 0.0) {
+        return Err(InputError::new_err(format!("fine_m = {fine_m} is not allowed; give a distance >= 0 metres")));
     }
     if !(taper_m.is_finite() && (0.0..=radius_m).contains(&taper_m)) {
         return Err(InputError::new_err(format!("taper_m = {taper_m} must be in [0, radius_m]")));
@@ -118,7 +121,7 @@ fn surface_key(
         time_s,
         level,
         foci,
-        spec: SurfaceSpec { tile_m, near_m, radius_m, taper_m, detail, slopes },
+        spec: SurfaceSpec { tile_m, near_m, radius_m, taper_m, detail, slopes, fine_m },
     }))
 }
 
@@ -289,9 +292,11 @@ impl Scene {
     /// sea seed (mmusv_core::ocean::WaveField, `sea_seed(scenario_seed)`: the field the hulls ride), sampled at `time_s` around `foci` (F, 2) float32 world x, y; `hs_m=None`
     /// clears it; `detail`: the finest tiles also carry the short waves' slopes for the cameras' shading
     /// (mmusv_core::sea::SurfaceSpec::detail); `slopes`: the tiles carry the slopes the cameras shade with at all
-    /// (mmusv_core::sea::SurfaceSpec::slopes; off: heights alone, for scenes nothing renders). Samples with the
+    /// (mmusv_core::sea::SurfaceSpec::slopes; off: heights alone, for scenes nothing renders); `fine_m`: with
+    /// `detail`, the coarser tiles within this distance of a focus also carry the finest grid's slopes, so a top
+    /// view shades every level alike (mmusv_core::sea::SurfaceSpec::fine_m; 0: none). Samples with the
     /// GIL released, or takes the surface `prefetch_wave_surface` sampled ahead with the same arguments.
-    #[pyo3(signature = (hs_m, *, tp_s=8.0, gamma=3.3, direction_rad=0.0, spread_s=10.0, scenario_seed=0, time_s=0.0, foci=None, level=0.0, tile_m=32.0, near_m=40.0, radius_m=320.0, taper_m=60.0, detail=false, slopes=true))]
+    #[pyo3(signature = (hs_m, *, tp_s=8.0, gamma=3.3, direction_rad=0.0, spread_s=10.0, scenario_seed=0, time_s=0.0, foci=None, level=0.0, tile_m=32.0, near_m=40.0, radius_m=320.0, taper_m=60.0, detail=false, slopes=true, fine_m=0.0))]
     #[allow(clippy::too_many_arguments)]
     fn set_wave_surface(
         &self,
@@ -311,6 +316,7 @@ impl Scene {
         taper_m: f32,
         detail: bool,
         slopes: bool,
+        fine_m: f32,
     ) -> PyResult<()> {
         let key = surface_key(
             hs_m,
@@ -320,7 +326,7 @@ impl Scene {
             foci.as_ref(),
             level,
             (tile_m, near_m, radius_m, taper_m),
-            (detail, slopes),
+            (detail, slopes, fine_m),
         )?;
         let ahead = self.prefetched.lock().map_err(|_| poisoned())?.take();
         let Some(key) = key else {
@@ -346,7 +352,7 @@ impl Scene {
     /// instead of sampling it again, and any other call leaves it unused. The same surface bit for bit: the
     /// sampling depends on the arguments alone. Arguments are checked as `set_wave_surface` checks them;
     /// `hs_m=None` drops a surface being sampled ahead.
-    #[pyo3(signature = (hs_m, *, tp_s=8.0, gamma=3.3, direction_rad=0.0, spread_s=10.0, scenario_seed=0, time_s=0.0, foci=None, level=0.0, tile_m=32.0, near_m=40.0, radius_m=320.0, taper_m=60.0, detail=false, slopes=true))]
+    #[pyo3(signature = (hs_m, *, tp_s=8.0, gamma=3.3, direction_rad=0.0, spread_s=10.0, scenario_seed=0, time_s=0.0, foci=None, level=0.0, tile_m=32.0, near_m=40.0, radius_m=320.0, taper_m=60.0, detail=false, slopes=true, fine_m=0.0))]
     #[allow(clippy::too_many_arguments)]
     fn prefetch_wave_surface(
         &self,
@@ -365,6 +371,7 @@ impl Scene {
         taper_m: f32,
         detail: bool,
         slopes: bool,
+        fine_m: f32,
     ) -> PyResult<()> {
         let key = surface_key(
             hs_m,
@@ -374,7 +381,7 @@ impl Scene {
             foci.as_ref(),
             level,
             (tile_m, near_m, radius_m, taper_m),
-            (detail, slopes),
+            (detail, slopes, fine_m),
         )?;
         let Some(key) = key else {
             *self.prefetched.lock().map_err(|_| poisoned())? = None;

@@ -62,13 +62,20 @@ pub struct SurfaceSpec {
     /// without them; `detail` needs them too). The geometry, and so every hit, is the same either way; the
     /// sampling costs less without (the scene leaves them out when nothing renders).
     pub slopes: bool,
+    /// With [`SurfaceSpec::detail`]: tiles coarser than the finest level whose nearest point lies within this
+    /// distance of a focus also carry, on a grid of the finest cell, the slopes of the waves that cell resolves
+    /// and theirs does not, drawn where a pixel's footprint resolves them (0: none). An orthographic top view sees
+    /// the water with one footprint everywhere: without them its shading would change texture at every level's
+    /// edge (the finest tiles drawing 4–8 m waves as normals, the next as roughness), concentric squares around
+    /// its USV. The geometry is the same either way (the scene sets it to its top views' reach).
+    pub fine_m: f32,
 }
 
 impl Default for SurfaceSpec {
     /// 1 m cells within ~40 m, 2 m to ~80 m, 4 m to ~160 m, 8 m to ~320 m, waves out to 320 m around every
     /// focus (tapered over the last 60 m).
     fn default() -> Self {
-        Self { tile_m: 32.0, near_m: 40.0, radius_m: 320.0, taper_m: 60.0, detail: false, slopes: true }
+        Self { tile_m: 32.0, near_m: 40.0, radius_m: 320.0, taper_m: 60.0, detail: false, slopes: true, fine_m: 0.0 }
     }
 }
 
@@ -94,6 +101,12 @@ struct Tile {
     bands: [bool; 2],
     /// The mean square slopes of the two detail bands' waves.
     band_mss: [f32; 2],
+    /// With [`SurfaceSpec::fine_m`], on a coarser tile near a focus: the slopes `(∂η/∂x, ∂η/∂y)` of the waves the
+    /// finest cell resolves and this tile's does not, at the `(TILE_CELLS + 1)²` nodes of the finest grid; empty
+    /// otherwise.
+    fine: Vec<[f32; 2]>,
+    /// The mean square slope of those waves.
+    fine_mss: f32,
 }
 
 /// The displaced sea surface of one frame (see the module docs).
@@ -117,6 +130,8 @@ pub struct WaveSurface {
     far_mss: Option<f32>,
     /// The wave components the surface was sampled from (for the statistics of [`crests`]).
     components: Vec<WaveComponent>,
+    /// Their elevation's standard deviation `√(Σ a²/2)`, metres.
+    elevation_std: f32,
 }
 
 /// A hit of a ray with the surface: distance and the piece (tile, cell, triangle) hit.
@@ -180,6 +195,7 @@ impl WaveSurface {
             zmax,
             far_mss,
             components: components.to_vec(),
+            elevation_std: components.iter().map(|c| 0.5 * c.amplitude_m * c.amplitude_m).sum::<f64>().sqrt() as f32,
         }
     }
 
@@ -198,6 +214,10 @@ impl WaveSurface {
     /// Lowest point of the surface (world z).
     pub fn zmin(&self) -> f32 {
         self.zmin
+    }
+    /// Side of the finest cells, metres (`tile_m / TILE_CELLS`).
+    pub fn finest_cell_m(&self) -> f32 {
+        self.tile_m / TILE_CELLS as f32
     }
     /// Number of sampled (non-flat) tiles.
     pub fn sampled_tiles(&self) -> usize {

@@ -301,9 +301,9 @@ impl Shader {
     /// This shader taking water normals from the displaced sea surface `waves` (a scene's,
     /// [`crate::Scene::wave_surface`]) instead of the swell.
     pub fn with_waves(mut self, waves: Option<Arc<WaveSurface>>) -> Self {
-        if let Some(w) = waves.as_ref().filter(|_| self.env.wave_height_m > 0.0) {
+        if let Some(w) = waves.as_ref().filter(|w| w.elevation_std() > 0.0) {
             // The whitecaps gather on the crests and leave foam behind them as the crests move on.
-            let max_crest = (w.zmax() - w.level()) * 4.0 / self.env.wave_height_m;
+            let max_crest = (w.zmax() - w.level()) / w.elevation_std();
             self.foam = match foam_trail::CrestTrail::of(w) {
                 Some(trail) => self.foam.clone().with_trail(trail, max_crest),
                 None => self.foam.clone().on_crests(),
@@ -316,7 +316,10 @@ impl Shader {
     /// This shader seeing the water with pixels of `pixel_rad` radians (a pinhole camera's) or `pixel_m` metres
     /// (an orthographic one's): a hit's footprint on the water, `(pixel_m + t · pixel_rad) / |d_z|`, chooses
     /// which of the sea's detail bands it draws as normals ([`WaveSurface::shading`]). Both 0 (the default):
-    /// every band.
+    /// every band. An orthographic view (`pixel_rad` 0, `pixel_m` > 0: a top view) sees the water with one
+    /// footprint across an image much wider than the finest tiles, so its footprint is taken as at least the
+    /// finest cell: every tile then draws the same waves (the finest grid's, `SurfaceSpec::fine_m`), the shorter
+    /// ones as roughness, instead of the finest tiles alone drawing 2–4 m waves as a square of other texture.
     pub fn with_footprint(mut self, pixel_rad: f32, pixel_m: f32) -> Self {
         self.pixel_rad = pixel_rad.max(0.0);
         self.pixel_m = pixel_m.max(0.0);
@@ -410,7 +413,10 @@ impl Shader {
         hit.shading_normal = hit.normal;
         hit.unresolved_mss = 0.0;
         if hit.is_water() {
-            let footprint = (self.pixel_m + hit.t * self.pixel_rad) / d.z.abs().max(0.05);
+            let mut footprint = (self.pixel_m + hit.t * self.pixel_rad) / d.z.abs().max(0.05);
+            if let Some(w) = self.waves.as_ref().filter(|_| self.pixel_rad == 0.0 && self.pixel_m > 0.0) {
+                footprint = footprint.max(w.finest_cell_m());
+            }
             let n = match self.waves.as_ref().and_then(|w| w.shading(hit.point.x, hit.point.y, footprint)) {
                 Some(s) => {
                     hit.unresolved_mss = s.unresolved_mss;
@@ -515,20 +521,20 @@ impl Shader {
         };
         c += water::body_factor(rho, self.water_fdr, f_o, WATER_IOR) * entering;
         if !self.foam.is_empty() {
-            // The normalised elevation η/σ_η (σ_η = H_s/4) that gathers the whitecaps on the crests, where the
-            // surface is sampled (beyond, the sea goes on at an elevation not known: the foam's own coverage).
+            // The normalised elevation η/σ_η (σ_η the sampled sea's own, H_s/4) that gathers the whitecaps on the
+            // crests, where the surface is sampled (beyond, the sea goes on at an elevation not known: the foam's
+            // own coverage).
             let (x, y) = (hit.point.x, hit.point.y);
+            let sigma = self.waves.as_ref().map_or(0.0, |w| w.elevation_std());
             let crest = match &self.waves {
-                Some(w) if self.env.wave_height_m > 0.0 && w.sampled_at(x, y) => {
-                    Some((hit.point.z - w.level()) * 4.0 / self.env.wave_height_m)
-                }
+                Some(w) if sigma > 0.0 && w.sampled_at(x, y) => Some((hit.point.z - w.level()) / sigma),
                 _ => None,
             };
             // Where the crests that left foam here were: the elevation that far ahead now (`foam_trail.rs`).
             let past = |dx: f32, dy: f32| {
                 let w = self.waves.as_ref()?;
                 let (px, py) = (x + dx, y + dy);
-                w.sampled_at(px, py).then(|| (w.height(px, py) - w.level()) * 4.0 / self.env.wave_height_m)
+                w.sampled_at(px, py).then(|| (w.height(px, py) - w.level()) / sigma)
             };
             let cover = self.foam.cover(x, y, crest, past);
             if cover > 0.0 {

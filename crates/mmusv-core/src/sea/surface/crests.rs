@@ -30,6 +30,13 @@ impl WaveSurface {
         Some([vx, vy])
     }
 
+    /// The standard deviation of the elevation, metres: `√(Σ a²/2)`, `H_s / 4` of the sea the components realise
+    /// (0 without waves).
+    #[inline]
+    pub fn elevation_std(&self) -> f32 {
+        self.elevation_std
+    }
+
     /// The correlation of the elevation between two points `r` (metres, world `x, y`) apart at one time (see the
     /// module docs): 1 at `r = 0`; `None` without waves.
     pub fn elevation_correlation(&self, r: [f32; 2]) -> Option<f32> {

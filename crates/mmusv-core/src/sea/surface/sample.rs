@@ -223,6 +223,25 @@ impl<'a> Phasors<'a> {
                 mss = (mss - m).max(0.0);
             }
         }
+        // The finest grid's slopes of the waves this coarser tile leaves out (SurfaceSpec::fine_m), for a top
+        // view's uniform footprint.
+        let (mut fine, mut fine_mss) = (Vec::new(), 0f32);
+        let fine_cell = tile_m / TILE_CELLS as f32;
+        if spec.detail && spec.slopes && lvl > 0 && all_inner && dc - std::f32::consts::SQRT_2 * half <= spec.fine_m {
+            let terms: Vec<(usize, [f32; 2])> = (0..nc)
+                .filter(|&c| resolved(self.comps[c].k_rad_m, fine_cell) && !resolved(self.comps[c].k_rad_m, cell_m))
+                .map(|c| (c, [self.comps[c].kx as f32, self.comps[c].ky as f32]))
+                .collect();
+            if !terms.is_empty() {
+                let w = TILE_CELLS + 1;
+                let (_, sx, sy, stride) = self.node_sums(ix, iy, 0, w, &terms, true);
+                fine = (0..w * w).map(|q| [sx[(q / w) * stride + q % w], sy[(q / w) * stride + q % w]]).collect();
+                let m: f64 =
+                    terms.iter().map(|&(c, _)| 0.5 * (self.comps[c].amplitude_m * self.comps[c].k_rad_m).powi(2)).sum();
+                fine_mss = m as f32;
+                mss = (mss - m).max(0.0);
+            }
+        }
         // Where the waves taper (a level-of-detail device: the sea goes on), the slopes the taper takes from the
         // sampled ones are handed to the roughness, so the total slope variance stays the sea's: the resolved
         // waves' `R` drawn at `s²R` (`s` the taper at the tile's centre) and `(1 − s²) R` as roughness; beyond the
@@ -230,7 +249,7 @@ impl<'a> Phasors<'a> {
         let centre_taper = ((spec.radius_m - dc) / (spec.radius_m - inner).max(1e-6)).clamp(0.0, 1.0);
         let resolved_mss = (total_mss(self.comps) - unresolved_mss).max(0.0);
         let mss = (mss + (1.0 - f64::from(centre_taper * centre_taper)) * resolved_mss) as f32;
-        Tile { n, zmin, zmax, h, g, mss, detail, bands, band_mss }
+        Tile { n, zmin, zmax, h, g, mss, detail, bands, band_mss, fine, fine_mss }
     }
 
     /// The slopes `(∂η/∂x, ∂η/∂y)` of components `sub` alone at the `(DETAIL_CELLS + 1)²` nodes of tile

@@ -107,6 +107,16 @@ impl WaveSurface {
             }
             mss += (1.0 - w * w) * t.band_mss[b];
         }
+        if !t.fine.is_empty() {
+            // The finest grid's waves on a coarser tile (SurfaceSpec::fine_m), by the same footprint rule.
+            let w = (2.0 - footprint_m * TILE_CELLS as f32 * self.inv_tile_m).clamp(0.0, 1.0);
+            if w > 0.0 {
+                let [dx, dy] = self.slope_at(&t.fine, TILE_CELLS, ix, iy, x, y);
+                gx += w * dx;
+                gy += w * dy;
+            }
+            mss += (1.0 - w * w) * t.fine_mss;
+        }
         Some(SurfaceShading { normal: unit([-gx, -gy, 1.0]), unresolved_mss: mss })
     }
 

@@ -424,6 +424,7 @@ fn a_single_waves_crests_move_at_its_phase_velocity() {
         assert!((f64::from(got) - want).abs() < 1e-5, "{r:?}: {got} vs {want}");
     }
     assert!((s.crest_recall(3.0).unwrap_or_default() - 1.0).abs() < 1e-4);
+    assert!((f64::from(s.elevation_std()) - a / 2f64.sqrt()).abs() < 1e-6);
     let flat = surface(&[], 2.0, &[[0.0, 0.0]], SurfaceSpec::default());
     assert!(flat.crest_velocity().is_none() && flat.elevation_correlation([1.0, 0.0]).is_none());
 }
@@ -436,6 +437,8 @@ fn crest_statistics_match_the_fields_sample_statistics() {
     let f = WaveField::new(&paper_sea_states()[3].spec(0.8, 10.0), 11).unwrap_or_else(|e| unreachable!("{e}"));
     let s = WaveSurface::new(f.components(), 0.0, 0.0, &[[0.0, 0.0]], SurfaceSpec::default());
     let v = s.crest_velocity().unwrap_or_else(|| unreachable!("waves"));
+    // Hs = 4 σ: the field realises its 3.5 m.
+    assert!((f64::from(s.elevation_std()) * 4.0 - 3.5).abs() < 0.02 * 3.5, "{}", s.elevation_std());
     let speed = f64::from(v[0].hypot(v[1]));
     // Near the peak's phase speed (Tp 7.9 s: g Tp / 2π = 12.3 m/s), along the mean direction.
     assert!(speed > 8.0 && speed < 14.0, "{v:?}");
@@ -467,5 +470,65 @@ fn crest_statistics_match_the_fields_sample_statistics() {
         if lag >= 2.0 {
             assert!(want > sample(at(0.7), f64::from(lag)) && want > sample(at(1.3), f64::from(lag)), "lag {lag}");
         }
+    }
+}
+
+/// With `fine_m`, the coarser tiles near a focus carry the finest grid's waves (here a 6 m wave, which 1 m
+/// cells resolve and 2 m cells do not) at their analytic slopes, and a pixel footprint that resolves them draws
+/// them: a top view (one footprint everywhere) sees the same waves on every level, no squares at the levels'
+/// edges; a wide footprint takes them as roughness; beyond `fine_m` and in the geometry nothing changes.
+#[test]
+fn fine_slopes_make_every_level_alike_for_a_fine_footprint() {
+    let (k6, k40, k15) = (TAU / 6.0, TAU / 40.0, TAU / 1.5);
+    let sea = [comp(0.05, k6 * 0.6, k6 * 0.8, 0.0, 0.3), comp(0.5, k40, 0.0, 0.0, 1.1), comp(0.01, 0.0, k15, 0.0, 2.0)];
+    let (m6, m40, m15) = ((0.05 * k6).powi(2) / 2.0, (0.5 * k40).powi(2) / 2.0, (0.01 * k15).powi(2) / 2.0);
+    let base = SurfaceSpec { radius_m: 2000.0, detail: true, ..SurfaceSpec::default() };
+    let plain = surface(&sea, 0.0, &[[0.0, 0.0]], base);
+    let s = surface(&sea, 0.0, &[[0.0, 0.0]], SurfaceSpec { fine_m: 150.0, ..base });
+    let mut checked = 0;
+    for (k, (t, p)) in s.tiles.iter().zip(&plain.tiles).enumerate() {
+        assert!(t.h == p.h && t.g == p.g, "tile {k}: the geometry and the level's slopes are the same");
+        let (ix, iy) = (k % s.ntx, k / s.ntx);
+        let (x0, y0) = (s.x0 + ix as f32 * 32.0, s.y0 + iy as f32 * 32.0);
+        let near = nearest(&[[0.0, 0.0]], x0 + 16.0, y0 + 16.0) - std::f32::consts::SQRT_2 * 16.0 <= 150.0;
+        if t.n == TILE_CELLS || !near {
+            assert!(t.fine.is_empty() && t.mss == p.mss, "tile {k}");
+            continue;
+        }
+        assert!((f64::from(t.fine_mss) - m6).abs() < 1e-9 && (f64::from(t.mss) - m15).abs() < 1e-9, "tile {k}");
+        for (q, g) in t.fine.iter().enumerate().step_by(41) {
+            let (x, y) = (f64::from(x0) + (q % 33) as f64, f64::from(y0) + (q / 33) as f64);
+            let sn = sea[0].phase_at(x, y, 0.0).sin();
+            let want = [-0.05 * sea[0].kx * sn, -0.05 * sea[0].ky * sn];
+            assert!((f64::from(g[0]) - want[0]).abs() < 2e-4 && (f64::from(g[1]) - want[1]).abs() < 2e-4, "{k} {q}");
+            checked += 1;
+        }
+    }
+    assert!(checked > 100);
+    // The drawn slope variance over an annulus at a 0.5 m footprint, and the roughness.
+    let drawn = |surf: &WaveSurface, r0: f32, r1: f32, footprint: f32| {
+        let (mut g2, mut rough, n) = (0f64, 0f64, 20_000u32);
+        for k in 0..n {
+            let f = (k as f32 + 0.5) / n as f32;
+            let r = (r0 * r0 + f * (r1 * r1 - r0 * r0)).sqrt();
+            let a = k as f32 * 2.399_963;
+            let sh = surf.shading(r * a.cos(), r * a.sin(), footprint).unwrap_or_else(|| unreachable!("waves"));
+            let [nx, ny, nz] = sh.normal.map(f64::from);
+            g2 += (nx * nx + ny * ny) / (nz * nz);
+            rough += f64::from(sh.unresolved_mss);
+        }
+        (g2 / f64::from(n), rough / f64::from(n))
+    };
+    // The finest tiles (within 40 m), the 2 m and the 4 m ones: the same waves drawn with `fine_m`, not without.
+    let (inner, _) = drawn(&s, 5.0, 25.0, 0.5);
+    for (r0, r1) in [(60.0, 75.0), (100.0, 140.0)] {
+        let (got, rough) = drawn(&s, r0, r1, 0.5);
+        assert!((got - inner).abs() < 0.1 * inner && (got - (m6 + m40)).abs() < 0.1 * (m6 + m40), "{r0}: {got}");
+        assert!((rough - m15).abs() < 1e-6, "{r0}: roughness {rough}");
+        let (without, _) = drawn(&plain, r0, r1, 0.5);
+        assert!(without < inner - 0.5 * m6, "{r0}: {without} drawn without fine slopes against {inner}");
+        // A footprint of 2 m or more takes them as roughness.
+        let (wide, rough) = drawn(&s, r0, r1, 2.5);
+        assert!((wide - without).abs() < 1e-3 * without && (rough - m6 - m15).abs() < 1e-6, "{r0}");
     }
 }

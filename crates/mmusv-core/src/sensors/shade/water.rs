@@ -10,7 +10,7 @@
 //!   (fraction of the surface). The foam is placed by a seeded fractal noise thresholded at its own
 //!   `(1 − W)` quantile, so the covered fraction is `W`. Over a wave surface whitecaps form where waves break,
 //!   on and just behind the crests (E. C. Monahan, "Oceanic whitecaps", J. Phys. Oceanogr. 1(2), 1971): the
-//!   noise is then biased by the local elevation `η/σ_η` (`σ_η = H_s/4`, the elevation of a linear random sea
+//!   noise is then biased by the local elevation `η/σ_η` (`σ_η` the sampled sea's own, `H_s/4`; the elevation of a linear random sea
 //!   being Gaussian: M. S. Longuet-Higgins, "On the statistical distribution of the heights of sea waves",
 //!   J. Mar. Res. 11, 1952), thresholded at the `(1 − W)` quantile of that sum (noise and a standard normal),
 //!   so the coverage stays `W` while the foam gathers on the crests. Foam is Lambertian with albedo 0.55, the
