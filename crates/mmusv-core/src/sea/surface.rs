@@ -14,7 +14,6 @@
 //! [`WaveSurface::shading`], whose filtering of the waves a level cannot resolve lives in [`shading`]) are summed
 //! per tile by the phasor recurrence of [`sample`].
 
-mod crests;
 mod march;
 mod raster;
 mod sample;
@@ -128,9 +127,7 @@ pub struct WaveSurface {
     /// The mean square slope of every wave, the roughness the still water beyond the sampled sea is shaded with
     /// (`None` without waves, or without slopes: [`SurfaceSpec::slopes`]).
     far_mss: Option<f32>,
-    /// The wave components the surface was sampled from (for the statistics of [`crests`]).
-    components: Vec<WaveComponent>,
-    /// Their elevation's standard deviation `√(Σ a²/2)`, metres.
+    /// The elevation's standard deviation `√(Σ a²/2)` of the components sampled, metres.
     elevation_std: f32,
 }
 
@@ -194,7 +191,6 @@ impl WaveSurface {
             zmin,
             zmax,
             far_mss,
-            components: components.to_vec(),
             elevation_std: components.iter().map(|c| 0.5 * c.amplitude_m * c.amplitude_m).sum::<f64>().sqrt() as f32,
         }
     }
@@ -214,6 +210,12 @@ impl WaveSurface {
     /// Lowest point of the surface (world z).
     pub fn zmin(&self) -> f32 {
         self.zmin
+    }
+    /// The standard deviation of the elevation of the waves sampled, metres: `√(Σ a²/2)`, `H_s / 4` of the sea
+    /// they realise (0 without waves).
+    #[inline]
+    pub fn elevation_std(&self) -> f32 {
+        self.elevation_std
     }
     /// Side of the finest cells, metres (`tile_m / TILE_CELLS`).
     pub fn finest_cell_m(&self) -> f32 {

@@ -31,7 +31,6 @@ use std::sync::Arc;
 
 pub mod brdf;
 pub mod envlight;
-pub mod foam_trail;
 pub mod rough_water;
 pub mod sky;
 pub mod tonemap;
@@ -301,13 +300,9 @@ impl Shader {
     /// This shader taking water normals from the displaced sea surface `waves` (a scene's,
     /// [`crate::Scene::wave_surface`]) instead of the swell.
     pub fn with_waves(mut self, waves: Option<Arc<WaveSurface>>) -> Self {
-        if let Some(w) = waves.as_ref().filter(|w| w.elevation_std() > 0.0) {
-            // The whitecaps gather on the crests and leave foam behind them as the crests move on.
-            let max_crest = (w.zmax() - w.level()) / w.elevation_std();
-            self.foam = match foam_trail::CrestTrail::of(w) {
-                Some(trail) => self.foam.clone().with_trail(trail, max_crest),
-                None => self.foam.clone().on_crests(),
-            };
+        if waves.as_ref().is_some_and(|w| w.elevation_std() > 0.0) {
+            // The whitecaps gather on the crests.
+            self.foam = self.foam.clone().on_crests();
         }
         self.waves = waves;
         self
@@ -530,13 +525,7 @@ impl Shader {
                 Some(w) if sigma > 0.0 && w.sampled_at(x, y) => Some((hit.point.z - w.level()) / sigma),
                 _ => None,
             };
-            // Where the crests that left foam here were: the elevation that far ahead now (`foam_trail.rs`).
-            let past = |dx: f32, dy: f32| {
-                let w = self.waves.as_ref()?;
-                let (px, py) = (x + dx, y + dy);
-                w.sampled_at(px, py).then(|| (w.height(px, py) - w.level()) / sigma)
-            };
-            let cover = self.foam.cover(x, y, crest, past);
+            let cover = self.foam.cover(x, y, crest);
             if cover > 0.0 {
                 let mut e = self.light.irradiance(n);
                 if sunlit {

@@ -19,10 +19,8 @@
 //!   *effective* reflectance of whitecaps, over their area and lifetime, to be 0.22 — 0.4 of fresh foam's. So
 //!   within the covered area the foam's density rises from 0 at a patch's edge with the noise's excess over the
 //!   threshold, linearly up to full over a band chosen (from the same sample as the threshold) so that the mean
-//!   density over the covered area is 0.4: bright cores fading into thin foam, not flat white patches. A crest
-//!   also leaves its foam behind as it travels on, thinning for seconds (`foam_trail.rs`), so part of the
-//!   coverage lies on the backs of the waves and in the troughs; where the elevation is not known (beyond the
-//!   sampled sea) the noise meets its own threshold.
+//!   density over the covered area is 0.4: bright cores fading into thin foam, not flat white patches. Where
+//!   the elevation is not known (the still level beyond the sampled sea) the noise meets its own threshold.
 //! * **Wind from the sea state** when the scenario gives none: a fully developed Pierson–Moskowitz sea,
 //!   `H_s = 0.21 U² / g` (W. J. Pierson & L. Moskowitz, JGR 69(24), 1964), so `U = √(H_s g / 0.21)`.
 //! * **Wakes**: behind every vessel under way, turbulent foam along its track (as wide as its beam, widening
@@ -42,7 +40,6 @@
 //!   diffuse reflectance (here integrated exactly, with total internal reflection).
 
 use super::super::noise;
-use super::foam_trail::{self, CrestTrail, READS};
 use parry3d::math::Vec3;
 
 /// Albedo of a sand bottom, linear RGB.
@@ -220,57 +217,56 @@ pub fn foam_noise(seed: u64, x: f32, y: f32) -> f32 {
     s / 0.875
 }
 
+/// [`foam_noise`] (the same bits) where it may exceed `need`, octave by octave: `None` as soon as the octaves
+/// still to come cannot lift it above `need` (each is in `[0, 1]` times its weight).
+#[inline(always)]
+fn foam_noise_over(seed: u64, x: f32, y: f32, need: f32) -> Option<f32> {
+    let mut s = 0.0;
+    let mut w = 0.5;
+    let mut f = 1.0 / 6.0;
+    let mut rest = 0.375f32;
+    for o in 0..3u64 {
+        s += w * value_noise(seed ^ o, x * f + o as f32 * 17.3, y * f - o as f32 * 9.1);
+        w *= 0.5;
+        f *= 2.3;
+        if (s + rest) / 0.875 <= need {
+            return None;
+        }
+        rest -= w;
+    }
+    Some(s / 0.875)
+}
+
 /// Weight of the normalised elevation `η/σ_η` added to the foam noise (range `[0, 1]`, standard deviation
 /// about 0.1) over a wave surface: enough to gather the whitecaps on the crests, not to paint every crest.
 pub const CREST_WEIGHT: f32 = 0.12;
 
 /// The `(1 − coverage)` quantile of the foam noise (plus [`CREST_WEIGHT`] times a standard normal, the
-/// normalised elevation, with `crests`; or the largest of the correlated reads of a crest `trail`,
-/// [`foam_trail`]), from a fixed sample of it, and the band of noise over which the foam's density rises from 0
-/// to full so that its mean over the covered part of the sample is [`WHITECAP_MEAN_DENSITY`] (cached per
-/// coverage, seed, `crests` and trail: every render of a run asks for the same ones).
-fn foam_threshold(coverage: f32, seed: u64, crests: bool, trail: Option<&CrestTrail>) -> (f32, f32) {
-    type Key = (u32, u64, bool, Vec<u32>);
+/// normalised elevation, with `crests`), from a fixed sample of it, and the band of noise over which the foam's
+/// density rises from 0 to full so that its mean over the covered part of the sample is
+/// [`WHITECAP_MEAN_DENSITY`] (cached per coverage, seed and `crests`: every render of a run asks for the same
+/// ones).
+fn foam_threshold(coverage: f32, seed: u64, crests: bool) -> (f32, f32) {
+    type Key = (u32, u64, bool);
     static CACHE: std::sync::Mutex<Vec<(Key, (f32, f32))>> = std::sync::Mutex::new(Vec::new());
-    let trail_bits =
-        trail.map_or(Vec::new(), |t| t.velocity.iter().chain(t.corr.iter().flatten()).map(|v| v.to_bits()).collect());
-    let key = (coverage.to_bits(), seed, crests, trail_bits);
+    let key = (coverage.to_bits(), seed, crests);
     if let Ok(c) = CACHE.lock() {
-        if let Some((_, t)) = c.iter().find(|(k, _)| *k == key) {
-            return *t;
+        if let Some(&(_, t)) = c.iter().find(|(k, _)| *k == key) {
+            return t;
         }
     }
-    let point = |i: u64| {
-        let x = noise::uniform(seed, FOAM_STREAM + 1, 2 * i) as f32 * 4000.0;
-        let y = noise::uniform(seed, FOAM_STREAM + 1, 2 * i + 1) as f32 * 4000.0;
-        foam_noise(seed, x, y)
-    };
-    let t = match trail {
-        Some(trail) => {
-            let correlate = trail.correlator();
-            let sample: Vec<(f32, [f32; READS])> = (0..16_384u64)
-                .map(|i| {
-                    let z = std::array::from_fn(|k| standard_normal(seed, READS as u64 * i + k as u64));
-                    (point(i), correlate(z))
-                })
-                .collect();
-            let reach = |(n, e): &(f32, [f32; READS])| n + CREST_WEIGHT * e.iter().copied().fold(f32::MIN, f32::max);
-            let mut v: Vec<f32> = sample.iter().map(reach).collect();
-            v.sort_by(f32::total_cmp);
-            let th = v[((1.0 - coverage) * (v.len() - 1) as f32).round() as usize];
-            let covered: Vec<(f32, [f32; READS])> = sample.into_iter().filter(|s| reach(s) > th).collect();
-            (th, foam_trail::trail_band(&covered, th, WHITECAP_MEAN_DENSITY))
-        }
-        None => {
-            let mut v: Vec<f32> = (0..16_384u64)
-                .map(|i| point(i) + if crests { CREST_WEIGHT * standard_normal(seed, i) } else { 0.0 })
-                .collect();
-            v.sort_by(f32::total_cmp);
-            let th = v[((1.0 - coverage) * (v.len() - 1) as f32).round() as usize];
-            let excess: Vec<f32> = v.iter().filter(|&&n| n > th).map(|&n| n - th).collect();
-            (th, density_band(&excess, WHITECAP_MEAN_DENSITY))
-        }
-    };
+    let mut v: Vec<f32> = (0..16_384u64)
+        .map(|i| {
+            let x = noise::uniform(seed, FOAM_STREAM + 1, 2 * i) as f32 * 4000.0;
+            let y = noise::uniform(seed, FOAM_STREAM + 1, 2 * i + 1) as f32 * 4000.0;
+            let crest = if crests { CREST_WEIGHT * standard_normal(seed, i) } else { 0.0 };
+            foam_noise(seed, x, y) + crest
+        })
+        .collect();
+    v.sort_by(f32::total_cmp);
+    let th = v[((1.0 - coverage) * (v.len() - 1) as f32).round() as usize];
+    let excess: Vec<f32> = v.iter().filter(|&&n| n > th).map(|&n| n - th).collect();
+    let t = (th, density_band(&excess, WHITECAP_MEAN_DENSITY));
     if let Ok(mut c) = CACHE.lock() {
         if c.len() >= 16 {
             c.remove(0);
@@ -302,7 +298,7 @@ fn density_band(excess: &[f32], mean: f32) -> f32 {
 }
 
 /// A seeded standard normal deviate (Box–Muller), the `i`-th of the foam's threshold sample.
-pub(super) fn standard_normal(seed: u64, i: u64) -> f32 {
+fn standard_normal(seed: u64, i: u64) -> f32 {
     let u1 = noise::uniform(seed, FOAM_STREAM + 2, 2 * i).max(1e-12);
     let u2 = noise::uniform(seed, FOAM_STREAM + 2, 2 * i + 1);
     ((-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()) as f32
@@ -324,10 +320,6 @@ pub struct Foam {
     crests: bool,
     /// The threshold and band of the noise alone: where the elevation is not known (see [`Foam::cover`]).
     plain: (f32, f32),
-    /// Where the crests were, for the foam they left behind ([`Foam::with_trail`]).
-    trail: Option<CrestTrail>,
-    /// The highest normalised elevation the surface reaches (bounds what the trail's reads can add).
-    max_crest: f32,
     seed: u64,
     wakes: Vec<WakeShape>,
 }
@@ -348,7 +340,7 @@ impl Foam {
     /// Foam for whitecap `coverage` in `[0, 1]` and `wakes`, placed by `seed`.
     pub fn new(coverage: f32, wakes: &[Wake], seed: u64) -> Self {
         let (threshold, band) =
-            if coverage <= 0.0 { (NO_WHITECAPS, 1.0) } else { foam_threshold(coverage.min(1.0), seed, false, None) };
+            if coverage <= 0.0 { (NO_WHITECAPS, 1.0) } else { foam_threshold(coverage.min(1.0), seed, false) };
         let wakes = wakes
             .iter()
             .filter(|w| w.speed > 0.05)
@@ -364,40 +356,16 @@ impl Foam {
                 }
             })
             .collect();
-        Self {
-            threshold,
-            band,
-            coverage,
-            crests: false,
-            plain: (threshold, band),
-            trail: None,
-            max_crest: 0.0,
-            seed,
-            wakes,
-        }
+        Self { threshold, band, coverage, crests: false, plain: (threshold, band), seed, wakes }
     }
 
     /// This foam with its whitecaps gathered on the wave crests (see the module docs): [`Foam::cover`] is then
     /// given each point's normalised elevation `η/σ_η`.
     pub fn on_crests(mut self) -> Self {
         if self.threshold < NO_WHITECAPS {
-            (self.threshold, self.band) = foam_threshold(self.coverage.min(1.0), self.seed, true, None);
+            (self.threshold, self.band) = foam_threshold(self.coverage.min(1.0), self.seed, true);
         }
         self.crests = true;
-        self.trail = None;
-        self
-    }
-
-    /// This foam on the crests ([`Foam::on_crests`]) with the foam the crests left behind as they moved on
-    /// ([`foam_trail`]): [`Foam::cover`] then also reads, through its `past` argument, the normalised elevation
-    /// at the points `trail` says the crests of each age were, none higher than `max_crest`.
-    pub fn with_trail(mut self, trail: CrestTrail, max_crest: f32) -> Self {
-        if self.threshold < NO_WHITECAPS {
-            (self.threshold, self.band) = foam_threshold(self.coverage.min(1.0), self.seed, true, Some(&trail));
-        }
-        self.crests = true;
-        self.trail = Some(trail);
-        self.max_crest = max_crest;
         self
     }
 
@@ -410,43 +378,25 @@ impl Foam {
     /// only [`Foam::on_crests`]). `None`: the elevation is not known there (the still level beyond a wave
     /// surface's sampled part, where the sea goes on unsampled): the noise alone against its own threshold, so
     /// the whitecaps keep Monahan's coverage there too (the crest-biased threshold, met by the noise alone,
-    /// would cover less). With a trail ([`Foam::with_trail`]), `past(dx, dy)` gives the normalised elevation at
-    /// `(x + dx, y + dy)` (`None` where not known), asked only where the noise can reach the threshold.
+    /// would cover less).
     #[inline(always)]
-    pub fn cover(&self, x: f32, y: f32, crest: Option<f32>, past: impl Fn(f32, f32) -> Option<f32>) -> f32 {
+    pub fn cover(&self, x: f32, y: f32, crest: Option<f32>) -> f32 {
         let mut c = 0.0f32;
         let mut nz = None;
-        let mut noise_at = || *nz.get_or_insert_with(|| foam_noise(self.seed, x, y));
-        let (threshold, band, lift, trail) = match crest {
-            Some(e) if self.crests => (self.threshold, self.band, CREST_WEIGHT * e, self.trail.as_ref()),
-            _ => (self.plain.0, self.plain.1, 0.0, None),
+        let (threshold, band, lift) = match crest {
+            Some(e) if self.crests => (self.threshold, self.band, CREST_WEIGHT * e),
+            _ => (self.plain.0, self.plain.1, 0.0),
         };
-        // The most the elevations read can lift the noise.
-        let reach = match trail {
-            Some(_) => lift.max(CREST_WEIGHT * self.max_crest),
-            None => lift,
-        };
-        // The first octave bounds the sum: skip the rest where it cannot reach the threshold.
-        if threshold < NO_WHITECAPS
-            && (0.5 * value_noise(self.seed, x / 6.0, y / 6.0) + 0.375) / 0.875 + reach > threshold - 0.015
-        {
-            let n = noise_at();
-            c = match (trail, crest) {
-                (Some(t), Some(e)) if n + reach > threshold => {
-                    let v = t.velocity;
-                    foam_trail::trail_density(n, threshold, band, |k| {
-                        if k == 0 {
-                            Some(e)
-                        } else {
-                            let a = foam_trail::FOAM_AGES_S[k - 1];
-                            past(v[0] * a, v[1] * a)
-                        }
-                    })
-                }
+        // The noise octave by octave, while it can still reach the threshold (a hundredth and a half of slack for
+        // the bound's rounding).
+        if threshold < NO_WHITECAPS {
+            if let Some(n) = foam_noise_over(self.seed, x, y, threshold - 0.015 - lift) {
+                nz = Some(n);
                 // Thin at the edge, dense in the core (see the module docs).
-                _ => ((n + lift - threshold) / band).clamp(0.0, 1.0),
-            };
+                c = ((n + lift - threshold) / band).clamp(0.0, 1.0);
+            }
         }
+        let mut noise_at = || *nz.get_or_insert_with(|| foam_noise(self.seed, x, y));
         for w in &self.wakes {
             let [co, s] = w.dir;
             let (dx, dy) = (x - w.stern[0], y - w.stern[1]);
@@ -535,7 +485,7 @@ mod tests {
             for i in 0..n {
                 let x = noise::uniform(99, 1, 2 * i) as f32 * 3000.0 - 1500.0;
                 let y = noise::uniform(99, 1, 2 * i + 1) as f32 * 3000.0 - 1500.0;
-                let c = foam.cover(x, y, None, |_, _| None);
+                let c = foam.cover(x, y, None);
                 s += c as f64;
                 covered += u64::from(c > 0.0);
                 dense += u64::from(c >= 1.0);
@@ -566,7 +516,7 @@ mod tests {
                 let x = noise::uniform(99, 1, 2 * i) as f32 * 3000.0 - 1500.0;
                 let y = noise::uniform(99, 1, 2 * i + 1) as f32 * 3000.0 - 1500.0;
                 let g = standard_normal(1234, i);
-                let c = foam.cover(x, y, Some(g), |_, _| None) as f64;
+                let c = foam.cover(x, y, Some(g)) as f64;
                 s += c;
                 crest_sum += c * g as f64;
                 if g < -1.0 {
@@ -586,8 +536,8 @@ mod tests {
             for i in 0..n {
                 let x = noise::uniform(98, 1, 2 * i) as f32 * 3000.0 - 1500.0;
                 let y = noise::uniform(98, 1, 2 * i + 1) as f32 * 3000.0 - 1500.0;
-                plain += f64::from(foam.cover(x, y, None, |_, _| None));
-                biased += f64::from(foam.cover(x, y, Some(0.0), |_, _| None));
+                plain += f64::from(foam.cover(x, y, None));
+                biased += f64::from(foam.cover(x, y, Some(0.0)));
             }
             let area = |v: f64| v / n as f64 / f64::from(WHITECAP_MEAN_DENSITY);
             let (plain, biased) = (area(plain), area(biased));
@@ -601,6 +551,28 @@ mod tests {
         assert!(mean.abs() < 0.02 && (var - 1.0).abs() < 0.03, "{mean} {var}");
     }
 
+    /// The noise read octave by octave is the noise's own bits where it may exceed the bar, and gives up only on
+    /// points the full noise leaves at or below it.
+    #[test]
+    fn noise_over_a_bar_is_the_noise() {
+        let mut refused = 0;
+        for i in 0..20_000u64 {
+            let x = noise::uniform(5, 1, 2 * i) as f32 * 500.0 - 250.0;
+            let y = noise::uniform(5, 1, 2 * i + 1) as f32 * 500.0 - 250.0;
+            let n = foam_noise(9, x, y);
+            for need in [0.3f32, 0.5, 0.6, 0.7, 0.8] {
+                match foam_noise_over(9, x, y, need) {
+                    Some(m) => assert_eq!(m.to_bits(), n.to_bits(), "{x}, {y}"),
+                    None => {
+                        assert!(n <= need + 1e-6, "{x}, {y}: {n} refused at {need}");
+                        refused += 1;
+                    }
+                }
+            }
+        }
+        assert!(refused > 20_000, "{refused}");
+    }
+
     #[test]
     fn wake_lies_behind_and_on_the_kelvin_arms() {
         let w = Wake { x: 0.0, y: 0.0, heading: 0.0, speed: 12.0, length: 10.0, beam: 3.0 };
@@ -610,7 +582,7 @@ mod tests {
             let mut s = 0.0;
             for i in 0..21 {
                 for j in 0..21 {
-                    s += f.cover(x + (i as f32 - 10.0) * 0.5, y + (j as f32 - 10.0) * 0.05, None, |_, _| None);
+                    s += f.cover(x + (i as f32 - 10.0) * 0.5, y + (j as f32 - 10.0) * 0.05, None);
                 }
             }
             s / 441.0
