@@ -205,6 +205,22 @@ def wake_top(path: Path) -> None:
     Image.fromarray(np.asarray(top.rgb)).save(path)
 
 
+def top_views(path: Path) -> None:
+    """The observer's default top view (512 × 512 at 0.5 m, heading up) over open water at W1 and W3, 11:00, side
+    by side."""
+    from PIL import Image
+
+    rig = {"lidar": None, "radar": None, "cameras": [], "top_view": {"outputs": ["rgb"]}}
+    sheet = Image.new("RGB", (1034, 512), "white")
+    for i, wave in enumerate(("W1", "W3")):
+        env = {"time_of_day": "11:00", "weather": "clear", "wave": wave}
+        sim = mmusv.Simulation(_scenario("top_views", rig=rig, vessels=[], environment=env))
+        top = sim.capture(0, sensors=["top_view"]).agents["observer"].top_view
+        assert top is not None and top.rgb is not None
+        sheet.paste(Image.fromarray(np.asarray(top.rgb)), (i * 522, 0))
+    sheet.save(path)
+
+
 _DENSE_LIDAR = {
     "channels": 128,
     "vertical_fov_deg": [-5.0, 20.0],
@@ -280,6 +296,7 @@ VIEWS: dict[str, Callable[[Path], None]] = {
     "whitecaps_w3": whitecaps_w3,
     "wake_chase": wake_chase,
     "wake_top": wake_top,
+    "top_views": top_views,
 }
 
 
