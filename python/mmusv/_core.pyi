@@ -137,7 +137,9 @@ class Scene:
         direction_rad, spread_s) drawn from the scenario's sea seed, sampled at ``time_s`` around ``foci`` (F, 2)
         float32; ``hs_m=None`` clears it. ``detail``: the finest tiles also carry the short waves' slopes on a
         half-cell grid, for the cameras' shading; ``slopes``: the tiles carry the slopes the cameras shade with
-        at all (off: heights alone, for frames nothing renders). The geometry is the same either way."""
+        at all (off: heights alone, for frames nothing renders); ``fine_m`` (metres, >= 0): with ``detail``, the
+        coarser tiles within this distance of a focus also carry the finest grid's slopes, so a top view shades
+        every level alike. The geometry is the same either way."""
 
     def prefetch_wave_surface(
         self,
