@@ -567,6 +567,9 @@ def test_sampling_ahead_checks_its_arguments_and_skips_what_needs_none(make_scen
         sim.ws.scene.prefetch_wave_surface(sim.sea, scenario_seed=1, time_s=0.0, foci=[[0.0, 0.0]], radius_m=-1.0)
     with pytest.raises(mmusv.InputError, match="foci"):
         sim.ws.scene.prefetch_wave_surface(sim.sea, scenario_seed=1, time_s=0.0, foci=[[0.0, np.nan]])
+    for fine_m in (-1.0, np.inf, np.nan):
+        with pytest.raises(mmusv.InputError, match="fine_m"):
+            sim.ws.scene.set_wave_surface(sim.sea, scenario_seed=1, time_s=0.0, foci=[[0.0, 0.0]], fine_m=fine_m)
     sim.prefetch_frame(sim.frames)  # past the acquisition: nothing to sample
     sim.prefetch_frame(-1)
     sim.set_sea_surface(None)
