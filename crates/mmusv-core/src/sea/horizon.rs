@@ -183,7 +183,7 @@ impl Horizon {
         let (a, b) = (f64::from(zlo - TRIANGLE_MARGIN_M) - p[2], f64::from(zhi + TRIANGLE_MARGIN_M) - p[2]);
         let xy = tri.map(|v| [f64::from(v[0]) - p[0], f64::from(v[1]) - p[1]]);
         let r_min = triangle_distance(&xy) - DISTANCE_SLACK_M;
-        let r_max = xy.iter().map(|v| v[0].hypot(v[1])).fold(0.0, f64::max) + DISTANCE_SLACK_M;
+        let r_max = xy.iter().map(|v| norm(v[0], v[1])).fold(0.0, f64::max) + DISTANCE_SLACK_M;
         let (bins, s_lo, s_hi) = if r_min > 0.0 {
             let corners = tri.map(|v| [f64::from(v[0]), f64::from(v[1])]);
             (self.bins_of(&corners), (a / r_min).min(a / r_max), (b / r_min).max(b / r_max))
@@ -231,7 +231,7 @@ impl Horizon {
         let (px, py) = (f64::from(self.origin[0]), f64::from(self.origin[1]));
         let dx = (lo[0] - px).max(px - hi[0]).max(0.0);
         let dy = (lo[1] - py).max(py - hi[1]).max(0.0);
-        dx.hypot(dy)
+        norm(dx, dy)
     }
 
     /// The azimuth bins `b0..=b1` (to be taken modulo [`BINS`]) of the convex footprint with these corners
@@ -320,6 +320,15 @@ fn pseudo_angle_f32(x: f32, y: f32) -> f32 {
     diamond!(x, y)
 }
 
+/// The length of `(x, y)`, metres: `√(x² + y²)` without `hypot`'s guard against overflow and underflow, which no
+/// distance in a scene (metres to kilometres, in `f64`) comes near, and which costs several times the square root
+/// (the horizon computes six per triangle). Within an ulp of `hypot`; the horizon's distances carry a slack of
+/// [`DISTANCE_SLACK_M`] far beyond that.
+#[inline(always)]
+fn norm(x: f64, y: f64) -> f64 {
+    (x * x + y * y).sqrt()
+}
+
 /// Horizontal distance from the origin to a triangle given relative to it (x, y), 0 when it lies over the
 /// origin (or the triangle is degenerate through it).
 fn triangle_distance(t: &[[f64; 2]; 3]) -> f64 {
@@ -332,7 +341,7 @@ fn triangle_distance(t: &[[f64; 2]; 3]) -> f64 {
         let ab = [b[0] - a[0], b[1] - a[1]];
         let len2 = ab[0] * ab[0] + ab[1] * ab[1];
         let t = if len2 > 0.0 { (-(a[0] * ab[0] + a[1] * ab[1]) / len2).clamp(0.0, 1.0) } else { 0.0 };
-        (a[0] + t * ab[0]).hypot(a[1] + t * ab[1])
+        norm(a[0] + t * ab[0], a[1] + t * ab[1])
     };
     seg(t[0], t[1]).min(seg(t[1], t[2])).min(seg(t[2], t[0]))
 }
