@@ -137,6 +137,18 @@ impl WaveComponent {
     pub fn phase_at(&self, x: f64, y: f64, t: f64) -> f64 {
         self.kx * x + self.ky * y - self.omega_rad_s * t + self.phase_rad
     }
+
+    /// Its elevation's variance `a²/2` (m²).
+    #[inline]
+    pub fn elevation_variance(&self) -> f64 {
+        0.5 * self.amplitude_m * self.amplitude_m
+    }
+
+    /// Its mean square slope, both axes together: `a²k²/2`.
+    #[inline]
+    pub fn slope_variance(&self) -> f64 {
+        0.5 * (self.amplitude_m * self.k_rad_m).powi(2)
+    }
 }
 
 /// A realised sea: elevation, slope and orbital velocity anywhere, at any time.

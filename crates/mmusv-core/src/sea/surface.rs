@@ -191,7 +191,7 @@ impl WaveSurface {
             zmin,
             zmax,
             far_mss,
-            elevation_std: components.iter().map(|c| 0.5 * c.amplitude_m * c.amplitude_m).sum::<f64>().sqrt() as f32,
+            elevation_std: components.iter().map(WaveComponent::elevation_variance).sum::<f64>().sqrt() as f32,
         }
     }
 

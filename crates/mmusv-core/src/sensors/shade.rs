@@ -520,11 +520,9 @@ impl Shader {
             // crests, where the surface is sampled (beyond, the sea goes on at an elevation not known: the foam's
             // own coverage).
             let (x, y) = (hit.point.x, hit.point.y);
-            let sigma = self.waves.as_ref().map_or(0.0, |w| w.elevation_std());
-            let crest = match &self.waves {
-                Some(w) if sigma > 0.0 && w.sampled_at(x, y) => Some((hit.point.z - w.level()) / sigma),
-                _ => None,
-            };
+            let crest = (self.waves.as_ref())
+                .filter(|w| w.elevation_std() > 0.0 && w.sampled_at(x, y))
+                .map(|w| (hit.point.z - w.level()) / w.elevation_std());
             let cover = self.foam.cover(x, y, crest);
             if cover > 0.0 {
                 let mut e = self.light.irradiance(n);

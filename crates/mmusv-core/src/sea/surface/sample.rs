@@ -17,7 +17,7 @@ use crate::ocean::WaveComponent;
 
 /// The mean square slope (both axes) of all the `comps`: `Σ a²k²/2`.
 pub(super) fn total_mss(comps: &[WaveComponent]) -> f64 {
-    comps.iter().map(|c| 0.5 * (c.amplitude_m * c.k_rad_m).powi(2)).sum()
+    comps.iter().map(WaveComponent::slope_variance).sum()
 }
 
 /// Nodes summed together by [`accumulate`] (one AVX2 register of `f32`).
@@ -144,7 +144,7 @@ impl<'a> Phasors<'a> {
                 if resolved(comp.k_rad_m, cell_m) {
                     (c, [comp.kx as f32, comp.ky as f32])
                 } else {
-                    mss += 0.5 * (comp.amplitude_m * comp.k_rad_m).powi(2);
+                    mss += comp.slope_variance();
                     (c, [0.0; 2])
                 }
             })
@@ -217,8 +217,7 @@ impl<'a> Phasors<'a> {
                     node[2 * b + 1] = g[1];
                 }
                 bands[b] = true;
-                let m: f64 =
-                    sub.iter().map(|&c| 0.5 * (self.comps[c].amplitude_m * self.comps[c].k_rad_m).powi(2)).sum();
+                let m: f64 = sub.iter().map(|&c| self.comps[c].slope_variance()).sum();
                 band_mss[b] = m as f32;
                 mss = (mss - m).max(0.0);
             }
@@ -236,8 +235,7 @@ impl<'a> Phasors<'a> {
                 let w = TILE_CELLS + 1;
                 let (_, sx, sy, stride) = self.node_sums(ix, iy, 0, w, &terms, true);
                 fine = (0..w * w).map(|q| [sx[(q / w) * stride + q % w], sy[(q / w) * stride + q % w]]).collect();
-                let m: f64 =
-                    terms.iter().map(|&(c, _)| 0.5 * (self.comps[c].amplitude_m * self.comps[c].k_rad_m).powi(2)).sum();
+                let m: f64 = terms.iter().map(|&(c, _)| self.comps[c].slope_variance()).sum();
                 fine_mss = m as f32;
                 mss = (mss - m).max(0.0);
             }

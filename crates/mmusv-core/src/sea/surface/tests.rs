@@ -361,32 +361,34 @@ fn a_surface_without_slopes_has_the_same_geometry_and_no_shading() {
     assert!(shaded > 2000 && hits > 2000, "{shaded} shaded points, {hits} hits");
 }
 
+/// The spatial means over the annulus `r0..r1` m around the origin (20,000 points: golden-angle turns, radii
+/// uniform in area) of the drawn slopes' square `|∇η|²` and of the roughness, at pixel footprint `footprint` (m).
+fn annulus_means(s: &WaveSurface, r0: f32, r1: f32, footprint: f32) -> (f64, f64) {
+    let (mut g2, mut rough, n) = (0f64, 0f64, 20_000u32);
+    for k in 0..n {
+        let f = (k as f32 + 0.5) / n as f32;
+        let r = (r0 * r0 + f * (r1 * r1 - r0 * r0)).sqrt();
+        let a = k as f32 * 2.399_963;
+        let sh = s.shading(r * a.cos(), r * a.sin(), footprint).unwrap_or_else(|| unreachable!("a wavy sea"));
+        let [nx, ny, nz] = sh.normal.map(f64::from);
+        g2 += (nx * nx + ny * ny) / (nz * nz);
+        rough += f64::from(sh.unresolved_mss);
+    }
+    (g2 / f64::from(n), rough / f64::from(n))
+}
+
 /// The sampled sea is a level of detail, not the sea's end: the total slope variance a pixel shades with (the
 /// drawn normals' `|∇η|²` plus the roughness) is the waves' `Σ a²k²/2` where every wave is drawn, where the taper
 /// takes the drawn slopes away, and beyond, where the still level is shaded with all of it as roughness.
 #[test]
 fn the_total_slope_variance_is_the_seas_through_the_taper_and_beyond() {
     let c = test_sea();
-    let total: f64 = c.iter().map(|w| 0.5 * (w.amplitude_m * w.k_rad_m).powi(2)).sum();
+    let total: f64 = c.iter().map(WaveComponent::slope_variance).sum();
     let spec = SurfaceSpec::default(); // waves taper between 260 and 320 m
     let s = surface(&c, 3.0, &[[0.0, 0.0]], spec);
-    // The spatial mean over an annulus of the drawn slopes' square plus the roughness, and the mean roughness.
-    let mean = |r0: f32, r1: f32| {
-        let (mut sum, mut rough, n) = (0f64, 0f64, 20_000u32);
-        for k in 0..n {
-            // A low-discrepancy cover of the annulus (golden-angle turns, radii uniform in area).
-            let f = (k as f32 + 0.5) / n as f32;
-            let r = (r0 * r0 + f * (r1 * r1 - r0 * r0)).sqrt();
-            let a = k as f32 * 2.399_963;
-            let sh = s.shading(r * a.cos(), r * a.sin(), 0.0).unwrap_or_else(|| unreachable!("a wavy sea"));
-            let [nx, ny, nz] = sh.normal.map(f64::from);
-            sum += (nx * nx + ny * ny) / (nz * nz) + f64::from(sh.unresolved_mss);
-            rough += f64::from(sh.unresolved_mss);
-        }
-        (sum / f64::from(n), rough / f64::from(n))
-    };
     for (r0, r1) in [(5.0, 60.0), (270.0, 300.0), (330.0, 600.0)] {
-        let (got, rough) = mean(r0, r1);
+        let (drawn, rough) = annulus_means(&s, r0, r1, 0.0);
+        let got = drawn + rough;
         assert!((got - total).abs() < 0.12 * total, "{r0}..{r1} m: {got} against the sea's {total}");
         match r0 {
             // Near the focus (1 and 2 m cells) every wave is drawn: no roughness.
@@ -450,30 +452,16 @@ fn fine_slopes_make_every_level_alike_for_a_fine_footprint() {
         }
     }
     assert!(checked > 100);
-    // The drawn slope variance over an annulus at a 0.5 m footprint, and the roughness.
-    let drawn = |surf: &WaveSurface, r0: f32, r1: f32, footprint: f32| {
-        let (mut g2, mut rough, n) = (0f64, 0f64, 20_000u32);
-        for k in 0..n {
-            let f = (k as f32 + 0.5) / n as f32;
-            let r = (r0 * r0 + f * (r1 * r1 - r0 * r0)).sqrt();
-            let a = k as f32 * 2.399_963;
-            let sh = surf.shading(r * a.cos(), r * a.sin(), footprint).unwrap_or_else(|| unreachable!("waves"));
-            let [nx, ny, nz] = sh.normal.map(f64::from);
-            g2 += (nx * nx + ny * ny) / (nz * nz);
-            rough += f64::from(sh.unresolved_mss);
-        }
-        (g2 / f64::from(n), rough / f64::from(n))
-    };
     // The finest tiles (within 40 m), the 2 m and the 4 m ones: the same waves drawn with `fine_m`, not without.
-    let (inner, _) = drawn(&s, 5.0, 25.0, 0.5);
+    let (inner, _) = annulus_means(&s, 5.0, 25.0, 0.5);
     for (r0, r1) in [(60.0, 75.0), (100.0, 140.0)] {
-        let (got, rough) = drawn(&s, r0, r1, 0.5);
+        let (got, rough) = annulus_means(&s, r0, r1, 0.5);
         assert!((got - inner).abs() < 0.1 * inner && (got - (m6 + m40)).abs() < 0.1 * (m6 + m40), "{r0}: {got}");
         assert!((rough - m15).abs() < 1e-6, "{r0}: roughness {rough}");
-        let (without, _) = drawn(&plain, r0, r1, 0.5);
+        let (without, _) = annulus_means(&plain, r0, r1, 0.5);
         assert!(without < inner - 0.5 * m6, "{r0}: {without} drawn without fine slopes against {inner}");
         // A footprint of 2 m or more takes them as roughness.
-        let (wide, rough) = drawn(&s, r0, r1, 2.5);
+        let (wide, rough) = annulus_means(&s, r0, r1, 2.5);
         assert!((wide - without).abs() < 1e-3 * without && (rough - m6 - m15).abs() < 1e-6, "{r0}");
     }
 }
