@@ -228,7 +228,13 @@ class Simulation:
         self.environment: Environment = sc.environment.resolve()
         self.world: MapWorld = world if world is not None else generate_map_from(sc.map.params, seed=sc.map.seed)
         self.fleet = build_fleet(sc)
-        self.sensor_env: core.SensorEnv = sensor_env(self.environment)
+        # The physical sea (``environment.motion: physical``, the default) displaces the water every sensor sees;
+        # with ``motion: paper`` the water stays the flat plane of the paper.
+        self.sea: SeaState | None = None
+        if sc.environment.motion == "physical":
+            spec = sc.environment.sea_spec()
+            self.sea = spec if spec.hs_m > 0.0 else None
+        self.sensor_env: core.SensorEnv = self._sensor_env()
         poses0 = np.asarray(self.fleet.poses_at_times(np.zeros(1)))[0]
         self.ws: WorldScene = build_world_scene(self.world, [(v.asset, v.role) for v in sc.vessels], poses0)
         self.vessels: list[VesselInfo] = []
@@ -248,13 +254,6 @@ class Simulation:
         self._frame: int | None = None
         # The world state `prefetch_frame` worked out, for the `set_frame` of that frame to take (once).
         self._ahead: tuple[int, WorldState] | None = None
-        # The physical sea (``environment.motion: physical``, the default) displaces the water every sensor sees;
-        # with ``motion: paper`` the water stays the flat plane of the paper.
-        self.sea: SeaState | None = None
-        if sc.environment.motion == "physical":
-            spec = sc.environment.sea_spec()
-            self.sea = spec if spec.hs_m > 0.0 else None
-        self._sense_sea()
 
     # ------------------------------------------------------------------------------------------ building
 
@@ -271,20 +270,18 @@ class Simulation:
         asset = get_asset(v.asset)
         agent = Agent(index=index, vessel=v, asset=asset, rig=rig, lidar=None, lidar_mount=None, radar_mount=None)
         if rig.lidar is not None:
-            lidar_cfg = rig.lidar
-            agent.lidar = _built(f"{where}.lidar", "lidar", lambda: lidar_from_config(lidar_cfg))
+            agent.lidar = _built(f"{where}.lidar", "lidar", functools.partial(lidar_from_config, rig.lidar))
             agent.lidar_mount = mount_matrix(asset, rig.lidar.mount, where=f"{where}.lidar.mount")
         if rig.radar is not None:
             agent.radar_mount = mount_matrix(asset, rig.radar.mount, where=f"{where}.radar.mount")
-            radar_cfg = rig.radar
-            agent.radar = _built(f"{where}.radar", "radar", lambda: radar_from_config(radar_cfg))
+            agent.radar = _built(f"{where}.radar", "radar", functools.partial(radar_from_config, rig.radar))
         for c in rig.cameras:
             m = mount_matrix(asset, c.mount, where=f"{where}.cameras[{c.name}].mount")
             camera = _built(f"{where}.cameras[{c.name}]", "camera", functools.partial(camera_from_config, c))
             agent.cameras[c.name] = (camera, c, m)
         if rig.top_view is not None:
-            top_cfg = rig.top_view
-            agent.top_view = _built(f"{where}.top_view", "camera", lambda: top_view_from_config(top_cfg))
+            top = functools.partial(top_view_from_config, rig.top_view)
+            agent.top_view = _built(f"{where}.top_view", "camera", top)
         self._check_mounts(agent, where)
         return agent
 
@@ -334,18 +331,17 @@ class Simulation:
         sea state and grazing angle, and the annotations carry each box's ``wave_occlusion``.
         """
         self.sea = sea if sea is None or sea.hs_m > 0.0 else None
-        self._sense_sea()
+        self.sensor_env = self._sensor_env()
         if self.sea is None:
             self.ws.scene.set_wave_surface(None, scenario_seed=self.scenario.seed, time_s=0.0, foci=np.zeros((0, 2)))
         self._frame = None
 
-    def _sense_sea(self) -> None:
-        """The sensors' sea state (their wind, whitecaps, water returns and clutter) is the physical sea's
-        significant height where there is one (``environment.sea``, or the sea of ``environment.wave``), else the
-        ``wave`` setting's: a scenario giving ``sea: {state: 6}`` alone is a rough sea to every sensor, not the
-        default W0's calm one."""
-        waves = self.sea.hs_m if self.sea is not None else None
-        self.sensor_env = sensor_env(self.environment, wave_height_m=waves)
+    def _sensor_env(self) -> core.SensorEnv:
+        """The sensors' view of the environment, whose sea state (their wind, whitecaps, water returns and
+        clutter) is the physical sea's significant height where there is one (``environment.sea``, or the sea of
+        ``environment.wave``), else the ``wave`` setting's: a scenario giving ``sea: {state: 6}`` alone is a rough
+        sea to every sensor, not the default W0's calm one."""
+        return sensor_env(self.environment, wave_height_m=self.sea.hs_m if self.sea is not None else None)
 
     def set_frame(self, frame: int, *, sea_radius_m: float = 320.0, shading_detail: bool = True) -> WorldState:
         """Moves every vessel to its pose at ``frame`` (and, over a physical sea, the water to its surface at the
