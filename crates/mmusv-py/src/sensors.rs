@@ -1,7 +1,7 @@
 //! Bindings for `mmusv_core::sensors`: ray patterns, the spinning LiDAR and the cameras.
 
 use crate::native::{detached, flat, pose_arg, rows_to_array, RayArrays};
-use mmusv_core::sensors::shade::water::Wake;
+use mmusv_core::sensors::shade::foam::Wake;
 use mmusv_core::sensors::shade::ShadeEnv;
 use mmusv_core::sensors::{camera, capture, lidar, rays};
 use numpy::ndarray::{Array2, Array3};

@@ -31,6 +31,7 @@ use std::sync::Arc;
 
 pub mod brdf;
 pub mod envlight;
+pub mod foam;
 pub mod rough_water;
 pub mod sky;
 pub mod tonemap;
@@ -39,7 +40,8 @@ pub mod water;
 
 use brdf::{dfg, fresnel_dielectric, specular_cos};
 use envlight::{Lighting, LightingKey, WATER_IOR};
-use water::{Foam, ShallowWater, Wake, FOAM_ALBEDO};
+use foam::{Foam, Wake, FOAM_ALBEDO};
+use water::ShallowWater;
 
 /// The environment as the cameras see it (and, for fog, rain and waves, the LiDAR and the radar).
 #[derive(Debug, Clone, Copy, PartialEq)]
