@@ -4,9 +4,12 @@
 * a small craft 150 m ahead of a USV at W3, partly hidden by crests, in the camera and the LiDAR, with its
   wave-occlusion share (the annotations' ``wave_occlusion``);
 * the LiDAR's water returns within 60 m at W0 and W3 (on wave faces after; on the flat plane before);
-* the radar PPI at W0 and W3.
+* the radar PPI at W0 and W3;
+* the LiDAR's returns from a fast boat's wake passing a USV at W1 (after: the capture, whose LiDAR sees the
+  wakes' foam; before: the same sweep without the wakes).
 
-Usage: ``python scripts/sea_pictures.py [-o docs/sea]``; prints the counts of docs/sea/README.md.
+Usage: ``python scripts/sea_pictures.py [-o docs/sea] [--only craft,faces,radar,wake]``; prints the counts of
+docs/sea/README.md.
 """
 
 from __future__ import annotations
@@ -201,25 +204,84 @@ def radar_ppi(out: Path, lines: list[str]) -> None:
     plt.close(fig)
 
 
+def lidar_wake(out: Path, lines: list[str]) -> None:
+    """A patrol boat at 14 m/s passes 15 m beside a USV at W1: the USV's LiDAR returns in plan view, before (the
+    same sweep without the wakes) and after (the capture, the wakes' foam seen), coloured by class."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from mmusv.sensors.lidar import scan
+    from mmusv.simulation import sensor_seed
+
+    scenario = _scenario("W1")
+    scenario["rigs"]["view"] = {"cameras": [], "top_view": None, "radar": None}  # the default 64-channel LiDAR
+    scenario["acquisition"]["frames"] = 60
+    scenario["vessels"] = [
+        {"id": "usv", "role": "usv", "asset": "usv_wamv", "rig": "view", "speed_mps": 2.0,
+         "route": [[0.0, 0.0], [400.0, 0.0]]},
+        {"id": "patrol", "role": "target", "asset": "patrol_boat_35m", "speed_mps": 14.0,
+         "route": [[-60.0, 15.0], [600.0, 15.0]]},
+    ]  # fmt: skip
+    sim = Simulation(scenario)
+    frame = 46  # the patrol boat's bow about 60 m ahead of the USV: its track and arms reach past it
+    cap = sim.capture(frame, sensors=["lidar"], radar=False)
+    ac = cap.agents["usv"]
+    assert ac.lidar is not None and ac.lidar_pose is not None
+    agent = sim.agents[0]
+    assert agent.lidar is not None
+    seed = sensor_seed(sim.scenario.seed, frame, agent.index, "lidar")
+    without = scan(agent.lidar, sim.ws.scene, pose=ac.lidar_pose, env=sim.sensor_env, seed=seed)
+    fig, axes = plt.subplots(1, 2, figsize=(12, 5.4), sharex=True, sharey=True)
+    for ax, (name, pts) in zip(axes, (("before (no wake foam)", without), ("after", ac.lidar)), strict=True):
+        p = pts.xyz.astype(np.float64) @ ac.lidar_pose[:3, :3].T + ac.lidar_pose[:3, 3]
+        water = pts.semantic_class == 1
+        ax.scatter(p[water, 0], p[water, 1], s=1, c="tab:blue", label=f"water ({int(water.sum())})")
+        ax.scatter(p[~water, 0], p[~water, 1], s=1, c="tab:red", label=f"vessels ({int((~water).sum())})")
+        ax.set_aspect("equal")
+        ax.set_xlim(-80, 170)
+        ax.set_ylim(-70, 80)
+        ax.set_title(f"{name}: {len(pts)} returns", fontsize=9)
+        ax.legend(loc="lower left", fontsize=8, markerscale=6)
+        lines.append(f"| {name} | {int(water.sum())} | {int((~water).sum())} |")
+    axes[0].set_ylabel("world y (m)")
+    for ax in axes:
+        ax.set_xlabel("world x (m)")
+    title = "LiDAR returns, W1: the USV at x ≈ 18 m heading +x at 2 m/s; a patrol boat at y = 15 m, 14 m/s"
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(out / "lidar_wake.png", dpi=90)
+    plt.close(fig)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("-o", "--out", default=str(ROOT / "docs/sea"))
+    ap.add_argument("--only", default="craft,faces,radar,wake", help="comma-separated: craft, faces, radar, wake")
     args = ap.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    lines = [
-        "| sea | frame | wave occlusion, camera | wave occlusion, LiDAR | LiDAR points on the craft |",
-        "|---|---|---|---|---|",
-    ]
-    craft_views(out, lines)
-    lines += [
-        "",
-        "| sea state | sea | water returns within 60 m (4 sweeps) | world-z std (m) | std / (Hs/4) |",
-        "|---|---|---|---|---|",
-    ]
-    lidar_faces(out, lines)
-    lines += ["", "| sea state | sea | clutter returns | 95th percentile clutter range (m) |", "|---|---|---|---|"]
-    radar_ppi(out, lines)
+    parts = {
+        "craft": (
+            "| sea | frame | wave occlusion, camera | wave occlusion, LiDAR | LiDAR points on the craft |",
+            craft_views,
+        ),
+        "faces": (
+            "| sea state | sea | water returns within 60 m (4 sweeps) | world-z std (m) | std / (Hs/4) |",
+            lidar_faces,
+        ),
+        "radar": ("| sea state | sea | clutter returns | 95th percentile clutter range (m) |", radar_ppi),
+        "wake": ("| sweep | water returns | vessel returns |", lidar_wake),
+    }
+    only = [p.strip() for p in args.only.split(",") if p.strip()]
+    unknown = sorted(set(only) - set(parts))
+    if unknown:
+        ap.error(f"--only: unknown part(s) {', '.join(unknown)}; allowed: {', '.join(parts)}")
+    lines: list[str] = []
+    for name in only:
+        header, make = parts[name]
+        lines += ["", header, "|" + "---|" * header.count(" | ") + "---|"]
+        make(out, lines)
     print("\n".join(lines))
 
 

@@ -153,6 +153,49 @@ def test_lidar_water_returns_follow_the_waves(sea: Sea, lo: float, hi: float) ->
     assert lo < ratio < hi, ratio
 
 
+def test_lidar_returns_from_wake_foam_along_the_track_and_the_kelvin_arms() -> None:
+    """A boat at 14 m/s passes 10 m beside a LiDAR 2.5 m up over a W1-like sea. With its wake, the beams that meet
+    the wake's foam return from it (the model's Lambertian foam, detected through speckle) and every other beam
+    is as it was: the returns the wake adds lie behind the boat, on its track or on two arms at the Kelvin angle
+    asin(1/3) = 19.47° from the bow, measured here from the points themselves."""
+    lidar = lidar_from_config(LidarConfig())
+    sea = Sea(1.25, 5.5)
+    length, beam = 20.0, 5.0
+    bow = np.array([40.0 + length / 2, 10.0])
+    wake = np.array([[40.0, 10.0, 0.0, 14.0, length, beam]], np.float32)
+    from_bow, lateral = [], []
+    for seed, t in ((1, 5.0), (2, 9.0)):
+        scene, _, _, _ = _world(None, target_x=900.0)
+        scene.set_wave_surface(sea, scenario_seed=3, time_s=t, foci=np.array([[0.0, 0.0]]))
+        env = sensor_env(wave_height_m=sea.hs_m)
+        open_sea = scan(lidar, scene, pose=_pose(0.0, 0.0, 2.5), env=env, seed=seed)
+        waked = scan(lidar, scene, pose=_pose(0.0, 0.0, 2.5), env=env, seed=seed, wakes=wake)
+        kept = np.isin(waked.ray_index, open_sea.ray_index)
+        # Every return of the open sea is still there at the same point; the wake adds water returns, and those of
+        # the open sea's that fall on its foam return brighter (foam against the glints' nothing at grazing).
+        assert np.isin(open_sea.ray_index, waked.ray_index).all()
+        np.testing.assert_array_equal(waked.xyz[kept], open_sea.xyz)
+        brighter = waked.intensity[kept] != open_sea.intensity
+        assert (waked.intensity[kept][brighter] > open_sea.intensity[brighter]).all()
+        changed = ~kept
+        changed[np.nonzero(kept)[0][brighter]] = True
+        assert (waked.semantic_class[changed] == 1).all()
+        assert (~kept).sum() > 1500, (~kept).sum()
+        added = waked.xyz[changed]
+        from_bow.append(bow[0] - added[:, 0])
+        lateral.append(np.abs(added[:, 1] - bow[1]))
+    fb, lat = np.concatenate(from_bow), np.concatenate(lateral)
+    # Behind the stern (from the bow's 0.9 boat lengths back) and within the arms' wedge.
+    assert fb.min() > 0.85 * length, fb.min()
+    assert (lat <= fb * np.tan(np.radians(19.47)) + 0.6 * beam + 0.08 * fb + 0.5).all()
+    track = lat < 0.5 * beam
+    arms = (fb > 40.0) & (lat > 0.6 * beam + 0.1 * fb)
+    assert track.sum() > 300 and arms.sum() > 300, (track.sum(), arms.sum())
+    angle = float(np.median(np.degrees(np.arctan2(lat[arms], fb[arms]))))
+    print(f"{len(fb)} returns from the wake: {track.sum()} on the track, {arms.sum()} on the arms at {angle:.2f} deg")
+    assert abs(angle - 19.47) < 1.0, angle
+
+
 def test_recordings_carry_the_shares_as_annotated(tmp_path: Path) -> None:
     """A W3 run writes each box's wave-occlusion share to the Parquet tables and to the MCAP annotation messages,
     equal to the annotations of the same frames computed afresh."""

@@ -325,10 +325,18 @@ class Lidar:
     def pattern(self) -> npt.NDArray[np.float32]:
         """(channels·azimuth_steps, 3) float32 unit directions, LiDAR frame, azimuth-major."""
     def scan(
-        self, scene: Scene, *, pose: npt.NDArray[np.float64], env: SensorEnv, seed: int
+        self,
+        scene: Scene,
+        *,
+        pose: npt.NDArray[np.float64],
+        env: SensorEnv,
+        seed: int,
+        wakes: npt.NDArray[np.float32] | None = None,
     ) -> dict[str, npt.NDArray[Any]]:
         """One sweep: xyz (N,3) f32 LiDAR frame, range, intensity, ring, azimuth, class, instance, ray_index; and
-        beam_instance (M,) i32, per ray of the full pattern the instance its cast met first (-1: none)."""
+        beam_instance (M,) i32, per ray of the full pattern the instance its cast met first (-1: none). ``wakes``
+        (K, 6) float32 ``x, y, heading, speed, length, beam`` rows: vessels under way, whose wake foam returns
+        over a wave surface."""
 
 @final
 class Camera:

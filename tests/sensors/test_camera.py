@@ -347,7 +347,10 @@ def test_depth_agrees_with_lidar(sim: Simulation, agent_id: str, frame: int) -> 
     # Pixels whose footprint holds an edge (silhouette, step, crease, a mast thinner than a pixel) are left out.
     edge, centre_normal = footprint_edges(sim.ws.scene, cam.intrinsics, cp, ui, vi)
     inner = ~edge
-    assert inner.mean() > 0.5
+    # Most points are water returns over the W1 waves (the target's wake foam among them since the LiDAR sees it:
+    # 857 points in view of usv_a's frame 7 before, 1,254 after), and half of those footprints hold a facet's
+    # crease: at least 40 % of the points are left to judge.
+    assert inner.mean() > 0.4
 
     # Tolerance: the pixel-centre ray is δ away from the point's ray. Along a surface at incidence θ the range
     # changes by about r·δ·tan θ over that angle, and the off-axis angle α by δ, so the depth r·cos α changes by

@@ -45,12 +45,13 @@ def _check_frame(sim: Simulation, frame: int) -> None:
     cap = sim.capture(frame)  # the batch
     seed = sim.scenario.seed
     env, scene = sim.sensor_env, sim.ws.scene  # the scene is at `frame` after the capture
-    wakes = sim.wakes(sim.world_state(frame))  # the vessels under way, whose wakes the cameras draw
+    wakes = sim.wakes(sim.world_state(frame))  # the vessels under way, whose wakes the cameras and LiDARs see
     checked = 0
     for agent in sim.agents:
         ac = cap.agents[agent.id]
         assert agent.lidar is not None and ac.lidar is not None and ac.lidar_pose is not None
-        one = scan(agent.lidar, scene, pose=ac.lidar_pose, env=env, seed=sensor_seed(seed, frame, agent.index, "lidar"))
+        lidar_seed = sensor_seed(seed, frame, agent.index, "lidar")
+        one = scan(agent.lidar, scene, pose=ac.lidar_pose, env=env, seed=lidar_seed, wakes=wakes)
         assert len(one) > 0
         for name in ("xyz", "range", "intensity", "ring", "azimuth", "semantic_class", "instance", "ray_index"):
             assert _same(getattr(ac.lidar, name), getattr(one, name)), name

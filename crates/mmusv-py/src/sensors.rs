@@ -282,8 +282,10 @@ impl Lidar {
     /// and waves are used). Returns a dict
     /// of equal-length columns: xyz (N,3) f32 LiDAR frame, range, intensity (f32), ring (u16), azimuth (f32
     /// rad), class (u16), instance (i32), ray_index (u32); and beam_instance (M,) i32: per ray of the full
-    /// pattern, the instance its cast met first within the range (-1: none).
-    #[pyo3(signature = (scene, *, pose, env, seed))]
+    /// pattern, the instance its cast met first within the range (-1: none). `wakes` (K, 6) float32 rows `x, y,
+    /// heading, speed, length, beam` (world metres, radians, m/s): the vessels under way, whose wake foam returns
+    /// over a wave surface.
+    #[pyo3(signature = (scene, *, pose, env, seed, wakes=None))]
     fn scan<'py>(
         &self,
         py: Python<'py>,
@@ -291,10 +293,12 @@ impl Lidar {
         pose: PyReadonlyArray2<'py, f64>,
         env: &SensorEnv,
         seed: u64,
+        wakes: Option<PyReadonlyArray2<'py, f32>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let pose = pose_arg(&pose, "pose")?;
+        let wakes = wakes_arg(wakes.as_ref())?;
         let env = env.lidar();
-        let s = scene.read(|s| detached(py, || self.inner.scan(s, &pose, &env, seed)))?;
+        let s = scene.read(|s| detached(py, || self.inner.scan_with_wakes(s, &pose, &env, seed, &wakes)))?;
         scan_dict(py, s)
     }
 }

@@ -78,9 +78,20 @@ def lidar_from_config(cfg: LidarConfig) -> core.Lidar:
     )
 
 
-def scan(lidar: core.Lidar, scene: Scene, *, pose: npt.ArrayLike, env: core.SensorEnv, seed: int) -> LidarPoints:
+def scan(
+    lidar: core.Lidar,
+    scene: Scene,
+    *,
+    pose: npt.ArrayLike,
+    env: core.SensorEnv,
+    seed: int,
+    wakes: npt.ArrayLike | None = None,
+) -> LidarPoints:
     """One sweep of ``lidar`` (from :func:`lidar_from_config`) at ``pose`` (``(4, 4)`` LiDAR → world) on the
     current state of ``scene`` in ``env`` (:func:`mmusv.sensors.env.sensor_env`: fog, rain and waves are used).
-    ``seed`` drives noise, dropout and water returns."""
+    ``seed`` drives noise, dropout and water returns. ``wakes``: ``(K, 6)`` rows ``x, y, heading, speed, length,
+    beam`` (world metres, radians, m/s; :meth:`mmusv.simulation.Simulation.wakes`) of the vessels under way: over
+    a wave surface, beams that meet their foam return from it (the foam the cameras draw)."""
     p = np.ascontiguousarray(pose, dtype=np.float64).reshape(4, 4)
-    return LidarPoints.from_native(lidar.scan(scene.native, pose=p, env=env, seed=int(seed)))
+    w = None if wakes is None else np.ascontiguousarray(wakes, dtype=np.float32).reshape(-1, 6)
+    return LidarPoints.from_native(lidar.scan(scene.native, pose=p, env=env, seed=int(seed), wakes=w))

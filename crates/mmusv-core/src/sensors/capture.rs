@@ -109,12 +109,12 @@ pub struct TaskResult {
     pub ppi_seconds: f64,
 }
 
-/// Runs one task on the frozen `scene`, with `wakes` behind the vessels under way (cameras).
+/// Runs one task on the frozen `scene`, with `wakes` behind the vessels under way (cameras and LiDARs).
 pub fn run_task(scene: &Scene, env: &ShadeEnv, wakes: &[Wake], task: &SensorTask<'_>) -> Result<TaskResult> {
     let start = Instant::now();
     let (output, ppi_seconds) = match *task {
         SensorTask::Lidar { lidar, ref pose, seed } => {
-            (SensorOutput::Lidar(lidar.scan(scene, pose, &lidar_env(env), seed)?), 0.0)
+            (SensorOutput::Lidar(lidar.scan_with_wakes(scene, pose, &lidar_env(env), seed, wakes)?), 0.0)
         }
         SensorTask::Camera { camera, rgb, ref pose, seed } => {
             let options = RenderOptions { rgb, radiance: false, seed, wakes };
@@ -137,7 +137,7 @@ pub fn run_task(scene: &Scene, env: &ShadeEnv, wakes: &[Wake], task: &SensorTask
 
 /// Runs every task of a frame concurrently on the current rayon pool (each sensor's own rays in parallel
 /// inside its task) and returns the results in task order. The first error (in task order) is returned.
-/// `wakes` are the vessels under way at this frame (their wakes in the cameras).
+/// `wakes` are the vessels under way at this frame (their wakes in the cameras and the LiDARs' water returns).
 pub fn capture_frame(
     scene: &Scene,
     env: &ShadeEnv,
@@ -208,7 +208,7 @@ mod tests {
         let one = |t: &SensorTask<'_>| -> Result<SensorOutput> {
             Ok(match *t {
                 SensorTask::Lidar { lidar, ref pose, seed } => {
-                    SensorOutput::Lidar(lidar.scan(&scene, pose, &lidar_env(&env), seed)?)
+                    SensorOutput::Lidar(lidar.scan_with_wakes(&scene, pose, &lidar_env(&env), seed, &wakes)?)
                 }
                 SensorTask::Camera { camera, rgb, ref pose, seed } => {
                     let options = RenderOptions { rgb, radiance: false, seed, wakes: &wakes };

@@ -10,7 +10,8 @@
 //! 2. `r < range_min` or `r > range_max`: no return;
 //! 3. open water (class 1): on a scene with a displaced wave surface ([`crate::Scene::wave_surface`]), a return
 //!    with the probability of the physical model in [`super::lidar_water`] (quasi-specular glints off the wave
-//!    facet met, at its incidence angle, and whitecaps, detected through speckle), with that model's intensity;
+//!    facet met, at its incidence angle, whitecaps, and the foam of the wakes where the beam meets it — the
+//!    cameras' wake foam at that point — detected through speckle), with that model's intensity;
 //!    on a flat sea, the empirical rule: a return only with probability
 //!    `p_w = water_probability + water_probability_per_wave_m · H` (clamped to 1) and only within
 //!    `water_range_m + water_range_per_wave_m · H` — calm water is a mirror at 905 nm, waves give the beam facets
@@ -27,6 +28,7 @@
 use super::lidar_water;
 use super::noise::{self, stream};
 use super::rays;
+use super::shade::foam::{Foam, Wake, FOAM_SEED};
 use crate::error::{MmusvError, Result};
 use crate::geometry::RigidPose;
 use crate::scene::Scene;
@@ -219,8 +221,22 @@ impl Lidar {
         &self.pattern
     }
 
-    /// One sweep from the LiDAR at `sensor_to_world` on the frozen `scene`.
+    /// One sweep from the LiDAR at `sensor_to_world` on the frozen `scene`, no vessel under way leaving a wake.
     pub fn scan(&self, scene: &Scene, sensor_to_world: &RigidPose, env: &LidarEnv, seed: u64) -> Result<LidarScan> {
+        self.scan_with_wakes(scene, sensor_to_world, env, seed, &[])
+    }
+
+    /// One sweep from the LiDAR at `sensor_to_world` on the frozen `scene`, with `wakes` behind the vessels under
+    /// way: over a displaced wave surface, beams that meet their foam return from it ([`super::lidar_water`];
+    /// the same foam the cameras draw). On a flat sea the empirical water rule stands and wakes change nothing.
+    pub fn scan_with_wakes(
+        &self,
+        scene: &Scene,
+        sensor_to_world: &RigidPose,
+        env: &LidarEnv,
+        seed: u64,
+        wakes: &[Wake],
+    ) -> Result<LidarScan> {
         let cfg = &self.cfg;
         let channels = cfg.elevations.len();
         let origin = sensor_to_world.translation.to_array();
@@ -241,6 +257,10 @@ impl Lidar {
         let water_range = cfg.water_range_m + cfg.water_range_per_wave_m * h;
         let sigma = env.fog_extinction_per_m.max(0.0) + 1e-5 * env.rain_mm_per_h.max(0.0).powf(0.6);
         let waves = scene.wave_surface().is_some();
+        // The wakes' foam (no whitecaps: those are the model's area mean), only over a wave surface.
+        let wake_foam = Some(Foam::new(0.0, wakes, FOAM_SEED))
+            .filter(|f| waves && !f.is_empty())
+            .map(|f| f.around([origin[0], origin[1]], cfg.range_max));
         let mut out = LidarScan {
             beam_instance: slot.iter().map(|&k| hits.instance[k as usize]).collect(),
             ..LidarScan::default()
@@ -259,7 +279,11 @@ impl Lidar {
             let mut water_intensity = None;
             if class == CLASS_WATER {
                 if waves {
-                    let mean = lidar_water::mean_intensity(cos, env.wind_speed_m_s, r, tau);
+                    let foam = wake_foam.as_ref().map_or(0.0, |f| {
+                        let p = Vec3::from_array(origin) + Vec3::from_array(dirs[k]) * r;
+                        f.cover(p.x, p.y, None)
+                    });
+                    let mean = lidar_water::mean_intensity_with_foam(cos, env.wind_speed_m_s, r, tau, foam);
                     if noise::uniform(seed, stream::WATER, idx) >= f64::from(lidar_water::detection_probability(mean)) {
                         continue;
                     }

@@ -17,14 +17,24 @@
 //!   O'Muircheartaigh, I. (1980), J. Phys. Oceanogr. 10; the cameras' foam uses the same law):
 //!   `β_wc(θ) = W ρ_wc cos θ / π`.
 //!
+//! * **Wake foam** where the beam meets it (the foam of [`super::shade::foam`], the cameras' own at the same
+//!   point: the turbulent track and Kelvin arms behind every vessel under way, broken up by the same noise):
+//!   foam of density `c` covers that fraction of the footprint with Lambertian foam of the fresh foam's albedo
+//!   `ρ_f = 0.55` (Koepke 1984), so `β = (1 − c)(β_qs + β_wc) + c ρ_f cos θ / π`. Where a beam meets no wake
+//!   foam (`c = 0`), `β` is the open sea's above, to the bit. Whitecaps stay the area mean `β_wc` of the
+//!   calibration below; wakes are foam the sensor resolves (metres wide, tens to hundreds long), whitecaps at
+//!   their coverage a fraction of every footprint's chance (`docs/sea/README.md`).
+//!
 //! The expected intensity of the return is the LiDAR's intensity law with the Lambertian-equivalent
-//! reflectivity of `β = β_qs + β_wc` (a Lambertian target of reflectance ρ has `β = ρ cos θ / π`):
+//! reflectivity of `β` (a Lambertian target of reflectance ρ has `β = ρ cos θ / π`):
 //! `⟨I⟩ = π β τ / (1 + (r / 100 m)²)`. The surface is rough on the scale of the wavelength, so the received
 //! power is fully developed speckle, exponentially distributed about `⟨I⟩`; the return is detected when it
 //! exceeds the threshold `I_d`, with probability `P_d = exp(−I_d / ⟨I⟩)` (Goodman, J. W. (1976), "Some
 //! fundamental properties of speckle", J. Opt. Soc. Am. 66(11)). `I_d` ([`DETECTION_THRESHOLD`]) is set so
 //! that a beam 20 m out over a W1 sea (U ≈ 8.4 m/s, grazing at 80°) returns with the probability 0.2 of the
 //! empirical rule this model replaces; calm water (W0) then returns almost nothing, as at 905 nm it should.
+
+use super::shade::foam::FOAM_ALBEDO;
 
 /// Fresnel reflectance of water at normal incidence at 905 nm (n ≈ 1.328): `((n − 1)/(n + 1))²`.
 pub const FRESNEL_NORMAL: f32 = 0.0199;
@@ -39,10 +49,11 @@ pub fn mean_square_slope(u: f32) -> f32 {
     0.003 + 5.12e-3 * u.max(0.0)
 }
 
-/// Monahan & O'Muircheartaigh whitecap fraction under wind `u` (m/s), in `[0, 1]`.
+/// Monahan & O'Muircheartaigh whitecap fraction under wind `u` (m/s), in `[0, 1]` (the cameras' coverage,
+/// [`super::shade::water::monahan_coverage`]).
 #[inline]
 pub fn whitecap_fraction(u: f32) -> f32 {
-    (3.84e-6 * u.max(0.0).powf(3.41)).min(1.0)
+    super::shade::water::monahan_coverage(u)
 }
 
 /// Backscatter coefficient `β = β_qs + β_wc` (sr⁻¹) of the sea surface at incidence `cos θ` (against the facet
@@ -57,11 +68,30 @@ pub fn backscatter(cos_theta: f32, u: f32) -> f32 {
     qs + wc
 }
 
+/// Backscatter coefficient (sr⁻¹) where the beam meets foam of density `foam` in `[0, 1]` (a wake's; see the
+/// module docs): `(1 − c) β + c ρ_f cos θ / π`, with `β` the open sea's [`backscatter`]; `foam ≤ 0` gives
+/// [`backscatter`] itself, to the bit.
+#[inline]
+pub fn backscatter_with_foam(cos_theta: f32, u: f32, foam: f32) -> f32 {
+    let b = backscatter(cos_theta, u);
+    if foam <= 0.0 {
+        return b;
+    }
+    let (c, f) = (cos_theta.clamp(1e-6, 1.0), foam.min(1.0));
+    (1.0 - f) * b + f * FOAM_ALBEDO * c / std::f32::consts::PI
+}
+
 /// Expected intensity `⟨I⟩ = π β τ / (1 + (r/100)²)` of a water return at range `r` (m), two-way transmission
 /// `tau`.
 #[inline]
 pub fn mean_intensity(cos_theta: f32, u: f32, r: f32, tau: f32) -> f32 {
-    std::f32::consts::PI * backscatter(cos_theta, u) * tau / (1.0 + (r / 100.0) * (r / 100.0))
+    mean_intensity_with_foam(cos_theta, u, r, tau, 0.0)
+}
+
+/// [`mean_intensity`] where the beam meets foam of density `foam` ([`backscatter_with_foam`]).
+#[inline]
+pub fn mean_intensity_with_foam(cos_theta: f32, u: f32, r: f32, tau: f32, foam: f32) -> f32 {
+    std::f32::consts::PI * backscatter_with_foam(cos_theta, u, foam) * tau / (1.0 + (r / 100.0) * (r / 100.0))
 }
 
 /// Probability `exp(−I_d / ⟨I⟩)` that a water return is detected (0 for `⟨I⟩ = 0`).
@@ -134,6 +164,31 @@ mod tests {
         assert!((p((80f32).to_radians().cos(), 8.4) - 0.2).abs() < 0.03, "{}", p((80f32).to_radians().cos(), 8.4));
         // Near normal incidence the glint dominates.
         assert!(p(0.999, 8.4) > 0.99);
+    }
+
+    /// Wake foam: none is the open sea's backscatter to the bit; full foam is a Lambertian target of the fresh
+    /// foam's albedo; between, the footprint's mix. At grazing, where the open sea returns almost nothing, a beam
+    /// on a wake's foam returns almost always (the foam is what a LiDAR sees of a wake).
+    #[test]
+    fn wake_foam_is_a_lambertian_share_of_the_footprint() {
+        for (cos, u) in [(0.999f32, 8.4f32), (0.5, 12.8), (0.17, 8.4), (0.02, 4.8)] {
+            assert_eq!(backscatter_with_foam(cos, u, 0.0).to_bits(), backscatter(cos, u).to_bits());
+            assert_eq!(
+                mean_intensity_with_foam(cos, u, 37.0, 0.9, 0.0).to_bits(),
+                mean_intensity(cos, u, 37.0, 0.9).to_bits()
+            );
+            let lambert = FOAM_ALBEDO * cos / std::f32::consts::PI;
+            assert!((backscatter_with_foam(cos, u, 1.0) / lambert - 1.0).abs() < 1e-5);
+            let half = 0.5 * backscatter(cos, u) + 0.5 * lambert;
+            assert!((backscatter_with_foam(cos, u, 0.5) / half - 1.0).abs() < 1e-5);
+            assert_eq!(
+                backscatter_with_foam(cos, u, 3.0),
+                backscatter_with_foam(cos, u, 1.0),
+                "density is capped at 1"
+            );
+        }
+        let p = |foam: f32| detection_probability(mean_intensity_with_foam(0.17, 4.8, 20.0, 1.0, foam));
+        assert!(p(0.0) < 1e-3 && p(0.5) > 0.95, "open water {} against foam {}", p(0.0), p(0.5));
     }
 
     /// The shortcut to 0 gives `exp`'s own bits everywhere: across the underflow and far below it.

@@ -282,7 +282,7 @@ impl Shader {
             water_fdr: water::internal_diffuse_reflectance(WATER_IOR),
             water_rho: Vec3::from_array(env.water_albedo),
             shallow: ShallowWater::shared(Vec3::from_array(env.water_albedo)),
-            foam: Foam::new(water::monahan_coverage(env.wind_speed_m_s), wakes, 0x5EA),
+            foam: Foam::new(water::monahan_coverage(env.wind_speed_m_s), wakes, foam::FOAM_SEED),
             exposure,
             sky_keep: (-env.fog_extinction_per_m * 3000.0).exp(),
             materials: Arc::new(Vec::new()),

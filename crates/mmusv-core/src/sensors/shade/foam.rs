@@ -25,6 +25,9 @@ use super::super::noise;
 
 /// Albedo of dense foam.
 pub const FOAM_ALBEDO: f32 = 0.55;
+/// The seed that places the foam every sensor sees: the cameras' whitecaps and wakes and the LiDAR's wake returns
+/// are the same foam at the same point.
+pub const FOAM_SEED: u64 = 0x5EA;
 /// Koepke's effective reflectance of whitecaps (0.22) over fresh foam's: the mean foam density over the whitecaps'
 /// area.
 pub const WHITECAP_MEAN_DENSITY: f32 = 0.22 / 0.55;
@@ -188,6 +191,35 @@ pub struct Foam {
     plain: (f32, f32),
     seed: u64,
     wakes: Vec<WakeShape>,
+    /// Which wakes may lay foam where, around a sensor ([`Foam::around`]); `None`: every wake is tried everywhere.
+    grid: Option<WakeGrid>,
+}
+
+/// Which wakes may lay foam in each cell of a square grid: a bit per wake (at most 64), set wherever the wake's
+/// track or arms may reach into the cell. The test is conservative (a cell's every point within its half-diagonal,
+/// plus a centimetre for rounding, of its centre), so a wake whose bit is clear gives no foam there.
+#[derive(Debug, Clone, Default)]
+struct WakeGrid {
+    origin: [f32; 2],
+    inv_cell: f32,
+    n: usize,
+    bits: Vec<u64>,
+}
+
+impl WakeGrid {
+    /// Cells per side.
+    const N: usize = 32;
+
+    /// The wakes that may lay foam at `(x, y)`; `None` outside the grid (every wake then).
+    #[inline(always)]
+    fn mask(&self, x: f32, y: f32) -> Option<u64> {
+        let (u, v) = ((x - self.origin[0]) * self.inv_cell, (y - self.origin[1]) * self.inv_cell);
+        if !(u >= 0.0 && v >= 0.0) {
+            return None;
+        }
+        let (i, j) = (u as usize, v as usize);
+        (i < self.n && j < self.n).then(|| self.bits[j * self.n + i])
+    }
 }
 
 /// A wake prepared for lookups: its stern, unit heading, reach and sizes.
@@ -200,6 +232,71 @@ struct WakeShape {
     speed: f32,
     length: f32,
     beam: f32,
+}
+
+impl WakeShape {
+    /// Whether any point within `r` of `c` may lie on this wake's track or arms (see [`WakeShape::foam_at`]):
+    /// along the wake and across it such a point is at most `r` from `c`'s distances, and the track's half-width
+    /// and the arms' width grow with the distance behind.
+    fn may_reach(&self, c: [f32; 2], r: f32) -> bool {
+        let [co, s] = self.dir;
+        let (dx, dy) = (c[0] - self.stern[0], c[1] - self.stern[1]);
+        let behind = -(dx * co + dy * s);
+        let lateral = (-dx * s + dy * co).abs();
+        if behind + r <= -0.1 * self.length || behind - r > self.reach {
+            return false;
+        }
+        let far = (behind + r).max(0.0);
+        let half = 0.5 * self.beam * (1.0 + (far / self.beam.max(1.0)).sqrt() * 0.25);
+        if lateral - r < half {
+            return true;
+        }
+        if behind + r <= 0.0 {
+            return false;
+        }
+        let width = 0.3 + 0.02 * (far + self.length) + 0.1 * self.beam;
+        (lateral - (behind + self.length) * KELVIN_TAN).abs() - r * (1.0 + KELVIN_TAN) < width
+    }
+
+    /// The foam density this wake lays at `(x, y)` (0 where none), `noise_at` the foam noise there.
+    #[inline(always)]
+    fn foam_at(&self, x: f32, y: f32, noise_at: &mut impl FnMut() -> f32) -> f32 {
+        let w = self;
+        let [co, s] = w.dir;
+        let (dx, dy) = (x - w.stern[0], y - w.stern[1]);
+        let behind = -(dx * co + dy * s);
+        if behind <= -0.1 * w.length || behind > w.reach {
+            return 0.0;
+        }
+        let lateral = (-dx * s + dy * co).abs();
+        if lateral > 0.6 * w.beam + (behind.max(0.0) + w.length) * (KELVIN_TAN + 0.07) + 0.3 {
+            return 0.0;
+        }
+        // Turbulent track behind the stern, and the Kelvin arms from the bow: whether the point is on either
+        // before the fade is worked out (most of the wedge is between them).
+        let half = 0.5 * w.beam * (1.0 + (behind.max(0.0) / w.beam.max(1.0)).sqrt() * 0.25);
+        let on_track = lateral < half;
+        let from_bow = behind + w.length;
+        let width = 0.3 + 0.02 * from_bow + 0.1 * w.beam;
+        let off = (lateral - from_bow * KELVIN_TAN).abs();
+        let on_arm = behind > 0.0 && off < width;
+        if !on_track && !on_arm {
+            return 0.0;
+        }
+        let fade = (-behind.max(0.0) / (w.speed * WAKE_FADE_S)).exp();
+        let track = (w.speed / 6.0).powi(2).min(1.0);
+        let mut f = if on_track { (1.0 - lateral / half).sqrt() * fade * track } else { 0.0 };
+        if on_arm {
+            let strength = (w.speed / 8.0).powi(2).min(1.0);
+            f = f.max((1.0 - off / width) * fade * strength * 0.45);
+        }
+        if f > 0.0 {
+            // Broken up by the noise, as real foam is.
+            (f * (1.6 * noise_at() - 0.3)).clamp(0.0, 1.0)
+        } else {
+            0.0
+        }
+    }
 }
 
 impl Foam {
@@ -222,7 +319,33 @@ impl Foam {
                 }
             })
             .collect();
-        Self { threshold, band, coverage, crests: false, plain: (threshold, band), seed, wakes }
+        Self { threshold, band, coverage, crests: false, plain: (threshold, band), seed, wakes, grid: None }
+    }
+
+    /// This foam with its wakes indexed on a grid over the square of half-side `radius` metres around `centre`
+    /// (a sensor's position, `radius` the reach of its water hits): a point there tries only the wakes that may
+    /// lay foam in its cell (the same cover, to the bit: a wake left out gives none); points outside try every
+    /// wake. Nothing changes with no wakes, more than 64, or a radius that is not a positive number.
+    pub fn around(mut self, centre: [f32; 2], radius: f32) -> Self {
+        if self.wakes.is_empty() || self.wakes.len() > 64 || !(radius > 0.0 && radius.is_finite()) {
+            return self;
+        }
+        let n = WakeGrid::N;
+        let cell = 2.0 * radius / n as f32;
+        let origin = [centre[0] - radius, centre[1] - radius];
+        let reach = cell * std::f32::consts::FRAC_1_SQRT_2 * 1.001 + 0.01;
+        let mut bits = Vec::with_capacity(n * n);
+        for j in 0..n {
+            for i in 0..n {
+                let c = [origin[0] + (i as f32 + 0.5) * cell, origin[1] + (j as f32 + 0.5) * cell];
+                let m = (self.wakes.iter().enumerate())
+                    .filter(|(_, w)| w.may_reach(c, reach))
+                    .fold(0u64, |m, (k, _)| m | (1u64 << k));
+                bits.push(m);
+            }
+        }
+        self.grid = Some(WakeGrid { origin, inv_cell: 1.0 / cell, n, bits });
+        self
     }
 
     /// This foam with its whitecaps gathered on the wave crests (see the module docs): [`Foam::cover`] is then
@@ -263,36 +386,18 @@ impl Foam {
             }
         }
         let mut noise_at = || *nz.get_or_insert_with(|| foam_noise(self.seed, x, y));
-        for w in &self.wakes {
-            let [co, s] = w.dir;
-            let (dx, dy) = (x - w.stern[0], y - w.stern[1]);
-            let behind = -(dx * co + dy * s);
-            if behind <= -0.1 * w.length || behind > w.reach {
-                continue;
-            }
-            let lateral = (-dx * s + dy * co).abs();
-            if lateral > 0.6 * w.beam + (behind.max(0.0) + w.length) * (KELVIN_TAN + 0.07) + 0.3 {
-                continue;
-            }
-            let fade = (-behind.max(0.0) / (w.speed * WAKE_FADE_S)).exp();
-            // Turbulent track behind the stern.
-            let half = 0.5 * w.beam * (1.0 + (behind.max(0.0) / w.beam.max(1.0)).sqrt() * 0.25);
-            let track = (w.speed / 6.0).powi(2).min(1.0);
-            let mut f = if lateral < half { (1.0 - lateral / half).sqrt() * fade * track } else { 0.0 };
-            // Kelvin arms, from the bow.
-            let from_bow = behind + w.length;
-            if behind > 0.0 {
-                let width = 0.3 + 0.02 * from_bow + 0.1 * w.beam;
-                let off = (lateral - from_bow * KELVIN_TAN).abs();
-                if off < width {
-                    let strength = (w.speed / 8.0).powi(2).min(1.0);
-                    f = f.max((1.0 - off / width) * fade * strength * 0.45);
+        match self.grid.as_ref().and_then(|g| g.mask(x, y)) {
+            Some(mut m) => {
+                while m != 0 {
+                    let k = m.trailing_zeros() as usize;
+                    m &= m - 1;
+                    c = c.max(self.wakes[k].foam_at(x, y, &mut noise_at));
                 }
             }
-            if f > 0.0 {
-                // Broken up by the noise, as real foam is.
-                let n = noise_at();
-                c = c.max((f * (1.6 * n - 0.3)).clamp(0.0, 1.0));
+            None => {
+                for w in &self.wakes {
+                    c = c.max(w.foam_at(x, y, &mut noise_at));
+                }
             }
         }
         c
@@ -400,6 +505,44 @@ mod tests {
             }
         }
         assert!(refused > 20_000, "{refused}");
+    }
+
+    /// Wakes indexed around a sensor give every point the cover of every wake tried, to the bit, and most
+    /// points there try none.
+    #[test]
+    fn wakes_indexed_around_a_sensor_give_the_same_cover() {
+        let wakes: Vec<Wake> = (0..7)
+            .map(|i| {
+                let f = i as f32;
+                Wake {
+                    x: 40.0 * f - 120.0,
+                    y: 25.0 * (f * 1.7).sin() * f,
+                    heading: 0.9 * f - 2.0,
+                    speed: 1.0 + 2.3 * f,
+                    length: 4.0 + 30.0 * f,
+                    beam: 2.0 + 3.0 * f,
+                }
+            })
+            .collect();
+        let plain = Foam::new(0.02, &wakes, 11).on_crests();
+        let indexed = plain.clone().around([10.0, -20.0], 200.0);
+        let (mut foamy, mut tried_none) = (0, 0);
+        for i in 0..300_000u64 {
+            // Inside the grid and a margin beyond it (where every wake is tried).
+            let x = noise::uniform(3, 1, 2 * i) as f32 * 520.0 - 250.0;
+            let y = noise::uniform(3, 1, 2 * i + 1) as f32 * 520.0 - 280.0;
+            let crest = Some(standard_normal(8, i));
+            let (a, b) = (plain.cover(x, y, crest), indexed.cover(x, y, crest));
+            assert_eq!(a.to_bits(), b.to_bits(), "({x}, {y})");
+            foamy += usize::from(a > 0.0);
+            let g = indexed.grid.as_ref().unwrap_or_else(|| unreachable!());
+            tried_none += usize::from(g.mask(x, y) == Some(0));
+        }
+        assert!(foamy > 10_000, "{foamy}");
+        assert!(tried_none > 75_000, "{tried_none}");
+        // No grid without wakes, or with a radius that is not a positive number.
+        assert!(Foam::new(0.02, &[], 1).around([0.0, 0.0], 100.0).grid.is_none());
+        assert!(Foam::new(0.0, &wakes, 1).around([0.0, 0.0], f32::NAN).grid.is_none());
     }
 
     #[test]
