@@ -406,9 +406,15 @@ class Simulation:
         )
 
     def wakes(self, state: WorldState) -> np.ndarray:
-        """``(K, 6)`` float32 rows ``x, y, heading, speed, length, beam`` (world metres, radians, m/s) of the
-        scenario vessels under way (horizontal speed above 0.3 m/s) in ``state``: the wakes the cameras draw."""
+        """``(K, 7)`` float32 rows ``x, y, heading, speed, length, beam, reach_m`` (world metres, radians, m/s) of
+        the scenario vessels under way (horizontal speed above 0.3 m/s) in ``state``: the wakes the cameras draw
+        and the LiDARs see. A wake is drawn straight back along the heading, so ``reach_m`` is how far behind the
+        stern the vessel's own path ran straight, within one beam of that line (``inf``: as far as the foam lasts;
+        a turn or a reversal of a ping-pong route ends it, the foam thinning out before): no foam where the vessel
+        never went."""
         n = len(self.scenario.vessels)
+        beams = np.array([float(v.box_size[1]) for v in self.vessels[:n]], dtype=np.float64)
+        reach = self.fleet.straight_behind(state.time_s, beams) if n else beams
         rows = []
         for i in range(n):
             vx, vy = float(state.velocities[i, 0]), float(state.velocities[i, 1])
@@ -416,8 +422,8 @@ class Simulation:
             if speed > 0.3:
                 size = self.vessels[i].box_size
                 x, y, yaw = (float(state.poses[i, k]) for k in (0, 1, 5))
-                rows.append((x, y, yaw, speed, float(size[0]), float(size[1])))
-        return np.asarray(rows, dtype=np.float32).reshape(-1, 6)
+                rows.append((x, y, yaw, speed, float(size[0]), float(size[1]), float(reach[i])))
+        return np.asarray(rows, dtype=np.float32).reshape(-1, 7)
 
     def agent(self, agent_id: str) -> Agent:
         """The agent (USV) named ``agent_id``."""

@@ -605,3 +605,65 @@ def test_the_sensors_sea_state_is_the_physical_seas() -> None:
     assert sim.sensor_env.wave_height_m == pytest.approx(0.5)  # the `wave` setting's (W0)
     sc["environment"] = {"wave": "W3", "motion": "paper"}
     assert Simulation(sc).sensor_env.wave_height_m == pytest.approx(3.5)
+
+
+def test_wakes_reach_only_as_far_as_the_path_ran_straight(make_scenario: Any) -> None:
+    """A wake is drawn straight back along the heading: ``Simulation.wakes`` gives how far the vessel's own path
+    ran straight (within a beam of that line). On a straight route, as far as the foam lasts; on a 100 m ping-pong
+    leg at 5 m/s, 24 s in, back to where it turned 20 m ago (the route's ends are worked out independently here:
+    the leg runs from x = 100 to x = 200)."""
+    sc = make_scenario()
+    sc["acquisition"] = {"frequency_hz": 5, "frames": 130}
+    sc["vessels"].append(
+        {"id": "shuttle", "role": "target", "asset": "tug_32m", "speed_mps": 5.0, "end": "ping_pong",
+         "route": [[100.0, 300.0], [200.0, 300.0]]}
+    )  # fmt: skip
+    sim = Simulation(sc)
+    names = [v.id for v in sim.scenario.vessels]
+    for frame in (60, 120):
+        st = sim.world_state(frame)
+        w = sim.wakes(st)
+        rows = {names[i]: w[k] for k, i in enumerate(np.flatnonzero(np.hypot(*st.velocities[:, :2].T) > 0.3))}
+        x = float(st.poses[names.index("shuttle"), 0])
+        reach = float(rows["shuttle"][6])
+        if frame == 60:  # 60 m out from x = 100, heading +x: straight all the way back (and before the start)
+            assert reach == np.inf and abs(x - 160.0) < 0.5
+        else:  # 120 m travelled: turned at x = 200 20 m ago, heading -x at x = 180
+            assert abs(x - 180.0) < 0.5 and abs(reach - 20.0) <= 2.0, (x, reach)
+        assert rows["usv_a"][6] == np.inf  # a straight route
+        assert w.shape[1] == 7 and w.dtype == np.float32
+
+
+def test_a_wake_reach_cuts_the_foam_every_sensor_sees() -> None:
+    """The core draws no wake foam farther behind the stern than the row's ``reach_m``: a LiDAR beside a 14 m/s
+    boat whose path turned 30 m behind its stern returns from its foam only that far back; with the same row and
+    no reach (six columns), far beyond. Bad rows are refused, naming the row."""
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    from mmusv.errors import InputError
+    from mmusv.sensors.config import LidarConfig
+    from mmusv.sensors.env import sensor_env
+    from mmusv.sensors.lidar import lidar_from_config, scan
+    from test_wave_occlusion import Sea, _pose, _world
+
+    lidar = lidar_from_config(LidarConfig())
+    scene, _, _, _ = _world(None, target_x=900.0)
+    sea = Sea(0.5, 3.5)
+    scene.set_wave_surface(sea, scenario_seed=3, time_s=5.0, foci=np.array([[0.0, 0.0]]))
+    env = sensor_env(wave_height_m=sea.hs_m)
+    row = [40.0, 8.0, 0.0, 14.0, 20.0, 5.0]  # stern at x = 30, track along y = 8 back past the LiDAR
+    behind = {}
+    for name, wakes in (("open", None), ("full", [row]), ("cut", [[*row, 30.0]])):
+        pts = scan(lidar, scene, pose=_pose(0.0, 0.0, 2.5), env=env, seed=4, wakes=wakes)
+        track = (pts.semantic_class == 1) & (np.abs(pts.xyz[:, 1] - 8.0) < 2.5)
+        behind[name] = 30.0 - pts.xyz[track, 0]
+    assert (behind["cut"] > 30.0).sum() <= (behind["open"] > 30.0).sum()  # no more than the open sea gives
+    assert (behind["full"] > 30.0).sum() > 200, (behind["full"] > 30.0).sum()
+    near = {k: int(((v > 5.0) & (v < 20.0)).sum()) for k, v in behind.items()}
+    print(near, {k: int((v > 30.0).sum()) for k, v in behind.items()})
+    assert near["cut"] == near["full"] and near["cut"] > near["open"] + 20, near  # the foam before the cut stays
+    with pytest.raises(InputError, match=r"wakes\[0\]"):
+        scan(lidar, scene, pose=_pose(0.0, 0.0, 2.5), env=env, seed=4, wakes=[[*row, -1.0]])
+    with pytest.raises(InputError, match=r"\(K, 6\) or \(K, 7\)"):
+        scan(lidar, scene, pose=_pose(0.0, 0.0, 2.5), env=env, seed=4, wakes=[row[:5]])

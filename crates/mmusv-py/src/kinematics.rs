@@ -158,6 +158,39 @@ impl Fleet {
         rows_to_array(py, self.inner.velocities_at(t).map_err(to_py)?)
     }
 
+    /// `(V,)` float64: how far behind each vessel at time `t` (s) its path ran straight along its heading, within
+    /// `tolerances_m` (V,) metres of that line, checked every 2 m out to its wake's reach (`speed ·
+    /// WAKE_REACH_S`); inf when straight that far, 0 at rest (`VesselMotion::straight_behind_m`).
+    fn straight_behind<'py>(
+        &self,
+        py: Python<'py>,
+        t: f64,
+        tolerances_m: PyReadonlyArray1<'py, f64>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let tol = flat(&tolerances_m, "tolerances_m")?;
+        let vessels = self.inner.vessels();
+        if tol.len() != vessels.len() {
+            return Err(InputError::new_err(format!(
+                "tolerances_m must hold one tolerance per vessel ({}), got {}",
+                vessels.len(),
+                tol.len()
+            )));
+        }
+        let reach_s = f64::from(mmusv_core::sensors::shade::foam::WAKE_REACH_S);
+        let out = vessels
+            .iter()
+            .zip(tol)
+            .map(|(v, &tol)| {
+                let max_m = v.params().speed_mps * reach_s;
+                if max_m <= 0.0 {
+                    return Ok(0.0);
+                }
+                v.straight_behind_m(t, max_m, 2.0, tol).map_err(to_py)
+            })
+            .collect::<PyResult<Vec<f64>>>()?;
+        Ok(out.into_pyarray(py))
+    }
+
     /// `(T, V, 6)` float64 poses at every time in `times` (s), computed in parallel with the GIL released.
     fn poses_at_times<'py>(
         &self,

@@ -282,9 +282,9 @@ impl Lidar {
     /// and waves are used). Returns a dict
     /// of equal-length columns: xyz (N,3) f32 LiDAR frame, range, intensity (f32), ring (u16), azimuth (f32
     /// rad), class (u16), instance (i32), ray_index (u32); and beam_instance (M,) i32: per ray of the full
-    /// pattern, the instance its cast met first within the range (-1: none). `wakes` (K, 6) float32 rows `x, y,
-    /// heading, speed, length, beam` (world metres, radians, m/s): the vessels under way, whose wake foam returns
-    /// over a wave surface.
+    /// pattern, the instance its cast met first within the range (-1: none). `wakes` (K, 6) or (K, 7) float32 rows
+    /// `x, y, heading, speed, length, beam[, reach_m]` (world metres, radians, m/s): the vessels under way, whose
+    /// wake foam returns over a wave surface.
     #[pyo3(signature = (scene, *, pose, env, seed, wakes=None))]
     fn scan<'py>(
         &self,
@@ -416,8 +416,9 @@ impl Camera {
     /// Renders the current state of `scene` from `pose` (4×4 camera body → world) in `env`. Returns a dict:
     /// depth (H,W) f32 metres along the axis (inf = sky), semantic (H,W) u16, instance (H,W) i32 (−1 = sky) and,
     /// for a camera built with `rgb=True`, rgb (H,W,3) u8 sRGB; with `radiance=True`, radiance (H,W,3) f32
-    /// linear cd/m² (before noise and exposure). `wakes` (K, 6) float32 rows `x, y, heading, speed, length,
-    /// beam` (world metres, radians, m/s) are the vessels under way whose wakes the water shows.
+    /// linear cd/m² (before noise and exposure). `wakes` (K, 6) or (K, 7) float32 rows `x, y, heading, speed,
+    /// length, beam[, reach_m]` (world metres, radians, m/s; `reach_m` how far behind the stern the path ran
+    /// straight, inf when not given) are the vessels under way whose wakes the water shows.
     #[pyo3(signature = (scene, *, pose, env, seed, wakes=None, radiance=false))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
@@ -474,16 +475,29 @@ pub(crate) fn frame_dict(py: Python<'_>, f: camera::CameraFrame, rgb: bool) -> P
 /// Wakes from a `(K, 6)` float32 array (`x, y, heading, speed, length, beam`), checked finite.
 pub(crate) fn wakes_arg(wakes: Option<&PyReadonlyArray2<'_, f32>>) -> PyResult<Vec<Wake>> {
     let Some(w) = wakes else { return Ok(Vec::new()) };
-    let rows = crate::native::rows::<f32, 6>(w, "wakes")?;
+    // Six columns, or seven with how far behind the stern the path ran straight (inf: as far as the foam lasts).
+    let rows: Vec<[f32; 7]> = if numpy::PyUntypedArrayMethods::shape(&**w)[1] == 6 {
+        let six = crate::native::rows::<f32, 6>(w, "wakes")?;
+        six.iter().map(|r| [r[0], r[1], r[2], r[3], r[4], r[5], f32::INFINITY]).collect()
+    } else {
+        crate::native::rows::<f32, 7>(w, "wakes")?.to_vec()
+    };
     rows.iter()
         .enumerate()
         .map(|(i, r)| {
-            if r.iter().any(|x| !x.is_finite()) || r[3] < 0.0 || r[4] <= 0.0 || r[5] <= 0.0 {
+            if r[..6].iter().any(|x| !x.is_finite())
+                || r[3] < 0.0
+                || r[4] <= 0.0
+                || r[5] <= 0.0
+                || r[6].is_nan()
+                || r[6] < 0.0
+            {
                 return Err(crate::errors::InputError::new_err(format!(
-                    "wakes[{i}] = {r:?}: must be finite, with speed >= 0 and length, beam > 0"
+                    "wakes[{i}] = {r:?}: x, y, heading, speed, length, beam must be finite, with speed >= 0 and \
+                     length, beam > 0; reach_m >= 0 (inf: unlimited)"
                 )));
             }
-            Ok(Wake { x: r[0], y: r[1], heading: r[2], speed: r[3], length: r[4], beam: r[5] })
+            Ok(Wake { x: r[0], y: r[1], heading: r[2], speed: r[3], length: r[4], beam: r[5], reach_m: r[6] })
         })
         .collect()
 }

@@ -19,6 +19,7 @@ from mmusv._native import core
 from mmusv.frames import BODY_TO_OPTICAL
 from mmusv.scene import Scene
 from mmusv.sensors.config import CameraConfig, TopViewConfig
+from mmusv.sensors.env import wake_rows
 
 __all__ = ["BODY_TO_OPTICAL", "CameraImages", "camera_from_config", "render", "top_view_from_config"]
 
@@ -81,10 +82,11 @@ def render(
     radiance: bool = False,
 ) -> CameraImages:
     """Renders ``scene`` (current state) with ``camera`` at ``pose`` (``(4, 4)`` camera body → world) in ``env``
-    (:func:`mmusv.sensors.env.sensor_env`). ``wakes``: ``(K, 6)`` rows ``x, y, heading, speed, length, beam``
-    (world metres, radians, m/s) of the vessels under way; ``radiance`` also returns the linear radiance
+    (:func:`mmusv.sensors.env.sensor_env`). ``wakes``: ``(K, 6)`` or ``(K, 7)`` rows ``x, y, heading, speed,
+    length, beam[, reach_m]`` (world metres, radians, m/s; :func:`mmusv.sensors.env.wake_rows`) of the vessels
+    under way; ``radiance`` also returns the linear radiance
     ``(H, W, 3)`` float32 in cd/m² (linear sRGB primaries, before sensor noise and exposure)."""
     p = np.ascontiguousarray(pose, dtype=np.float64).reshape(4, 4)
-    w = None if wakes is None else np.ascontiguousarray(wakes, dtype=np.float32).reshape(-1, 6)
+    w = wake_rows(wakes)
     out = camera.render(scene.native, pose=p, env=env, seed=int(seed), wakes=w, radiance=radiance)
     return CameraImages.from_native(out)

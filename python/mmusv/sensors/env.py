@@ -21,16 +21,44 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+import numpy.typing as npt
+
 from mmusv._native import core
+from mmusv.errors import InputError
 from mmusv.world.environment import Environment
 
-__all__ = ["SEA_ALBEDO", "WATER_ALBEDO", "sensor_env", "turbidity_from_visibility", "wind_from_wave_height"]
+__all__ = [
+    "SEA_ALBEDO",
+    "WATER_ALBEDO",
+    "sensor_env",
+    "turbidity_from_visibility",
+    "wake_rows",
+    "wind_from_wave_height",
+]
 
 SEA_ALBEDO = 0.06
 """Albedo of the sea surface under a high sun (Payne 1972): the lower hemisphere of the cameras' sky light."""
 
 WATER_ALBEDO = (0.004, 0.018, 0.03)
 """Diffuse reflectance of the water body, linear RGB."""
+
+
+def wake_rows(wakes: npt.ArrayLike | None) -> npt.NDArray[np.float32] | None:
+    """The vessels under way as the core takes them: ``(K, 6)`` or ``(K, 7)`` float32 C-contiguous rows ``x, y,
+    heading, speed, length, beam[, reach_m]`` (world metres, radians, m/s; ``reach_m`` how far behind the stern the
+    path ran straight, :meth:`mmusv.simulation.Simulation.wakes`; unlimited when left out). One row may be given
+    flat; ``None`` stays ``None``."""
+    if wakes is None:
+        return None
+    w = np.ascontiguousarray(wakes, dtype=np.float32)
+    if w.ndim == 1 and w.size in (6, 7):
+        w = w.reshape(1, -1)
+    if w.ndim != 2 or w.shape[1] not in (6, 7):
+        raise InputError(
+            f"wakes must have shape (K, 6) or (K, 7): x, y, heading, speed, length, beam[, reach_m]; got {w.shape}"
+        )
+    return w
 
 
 def turbidity_from_visibility(visibility_m: float) -> float:

@@ -16,6 +16,7 @@ import numpy.typing as npt
 from mmusv._native import core
 from mmusv.scene import Scene
 from mmusv.sensors.config import LidarConfig
+from mmusv.sensors.env import wake_rows
 
 __all__ = ["LidarPoints", "lidar_from_config", "scan"]
 
@@ -89,9 +90,10 @@ def scan(
 ) -> LidarPoints:
     """One sweep of ``lidar`` (from :func:`lidar_from_config`) at ``pose`` (``(4, 4)`` LiDAR → world) on the
     current state of ``scene`` in ``env`` (:func:`mmusv.sensors.env.sensor_env`: fog, rain and waves are used).
-    ``seed`` drives noise, dropout and water returns. ``wakes``: ``(K, 6)`` rows ``x, y, heading, speed, length,
-    beam`` (world metres, radians, m/s; :meth:`mmusv.simulation.Simulation.wakes`) of the vessels under way: over
-    a wave surface, beams that meet their foam return from it (the foam the cameras draw)."""
+    ``seed`` drives noise, dropout and water returns. ``wakes``: ``(K, 6)`` or ``(K, 7)`` rows ``x, y, heading,
+    speed, length, beam[, reach_m]`` (world metres, radians, m/s; :meth:`mmusv.simulation.Simulation.wakes`,
+    :func:`mmusv.sensors.env.wake_rows`) of the vessels under way: over a wave surface, beams that meet their foam
+    return from it (the foam the cameras draw)."""
     p = np.ascontiguousarray(pose, dtype=np.float64).reshape(4, 4)
-    w = None if wakes is None else np.ascontiguousarray(wakes, dtype=np.float32).reshape(-1, 6)
+    w = wake_rows(wakes)
     return LidarPoints.from_native(lidar.scan(scene.native, pose=p, env=env, seed=int(seed), wakes=w))

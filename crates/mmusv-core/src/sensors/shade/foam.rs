@@ -19,7 +19,10 @@
 //!   slowly) and two arms at the Kelvin angle `asin(1/3) = 19.47°` (Lord Kelvin, 1887) from the bow, both fading
 //!   with their age `distance / speed` (e-folding 30 s); the foam grows with speed (track `min(1, (V / 6 m/s)²)`,
 //!   arms `min(1, (V / 8 m/s)²)`), so a slow craft leaves a faint trace. The wake follows the vessel's current
-//!   heading (a straight track): an approximation where the route bends.
+//!   heading (a straight track), so it is drawn only as far back as the vessel's own path ran straight
+//!   ([`Wake::reach_m`]: within a beam of that line; a turn or the reversal of a ping-pong route ends it), thinning
+//!   to nothing over the last quarter of that stretch (at most four beams): no foam where the vessel never went,
+//!   none of its older foam round the bend either.
 
 use super::super::noise;
 
@@ -33,6 +36,9 @@ pub const FOAM_SEED: u64 = 0x5EA;
 pub const WHITECAP_MEAN_DENSITY: f32 = 0.22 / 0.55;
 /// e-folding age of wake foam, seconds.
 const WAKE_FADE_S: f32 = 30.0;
+/// The oldest wake foam drawn, seconds (four e-folding ages: 2 % of its fresh density); a wake reaches this
+/// long times the speed behind the stern, less where the path bent ([`Wake::reach_m`]).
+pub const WAKE_REACH_S: f32 = 4.0 * WAKE_FADE_S;
 /// `tan` of the Kelvin half-angle.
 const KELVIN_TAN: f32 = 0.353_553_4;
 /// Stream of the foam noise.
@@ -53,6 +59,10 @@ pub struct Wake {
     pub length: f32,
     /// Beam, metres.
     pub beam: f32,
+    /// How far behind the stern the vessel's path ran straight along `heading` (metres, ≥ 0; `f32::INFINITY`:
+    /// as far as the foam lasts): the wake is drawn straight behind the vessel, so no farther than its path was
+    /// (a turn or a reversal ends it; `mmusv.Simulation.wakes` works it out from the route).
+    pub reach_m: f32,
 }
 
 /// Smooth value noise in `[0, 1]` at `(x, y)` on a unit lattice (hashed corners, smoothstep blend).
@@ -229,6 +239,9 @@ struct WakeShape {
     dir: [f32; 2],
     /// Farthest distance behind the stern with foam.
     reach: f32,
+    /// Where the vessel's path bent ([`Wake::reach_m`] short of the foam's own reach): the foam thins linearly to
+    /// nothing over this last stretch before `reach` (0: no such end).
+    taper: f32,
     speed: f32,
     length: f32,
     beam: f32,
@@ -283,7 +296,10 @@ impl WakeShape {
         if !on_track && !on_arm {
             return 0.0;
         }
-        let fade = (-behind.max(0.0) / (w.speed * WAKE_FADE_S)).exp();
+        let mut fade = (-behind.max(0.0) / (w.speed * WAKE_FADE_S)).exp();
+        if w.taper > 0.0 && behind > w.reach - w.taper {
+            fade *= (w.reach - behind) / w.taper;
+        }
         let track = (w.speed / 6.0).powi(2).min(1.0);
         let mut f = if on_track { (1.0 - lateral / half).sqrt() * fade * track } else { 0.0 };
         if on_arm {
@@ -312,7 +328,8 @@ impl Foam {
                 WakeShape {
                     stern: [w.x - c * w.length * 0.5, w.y - s * w.length * 0.5],
                     dir: [c, s],
-                    reach: w.speed * WAKE_FADE_S * 4.0,
+                    reach: (w.speed * WAKE_REACH_S).min(w.reach_m),
+                    taper: if w.reach_m < w.speed * WAKE_REACH_S { (0.25 * w.reach_m).min(4.0 * w.beam) } else { 0.0 },
                     speed: w.speed,
                     length: w.length,
                     beam: w.beam,
@@ -521,6 +538,7 @@ mod tests {
                     speed: 1.0 + 2.3 * f,
                     length: 4.0 + 30.0 * f,
                     beam: 2.0 + 3.0 * f,
+                    reach_m: if i == 3 { 40.0 } else { f32::INFINITY },
                 }
             })
             .collect();
@@ -547,7 +565,7 @@ mod tests {
 
     #[test]
     fn wake_lies_behind_and_on_the_kelvin_arms() {
-        let w = Wake { x: 0.0, y: 0.0, heading: 0.0, speed: 12.0, length: 10.0, beam: 3.0 };
+        let w = Wake { x: 0.0, y: 0.0, heading: 0.0, speed: 12.0, length: 10.0, beam: 3.0, reach_m: f32::INFINITY };
         let foam = Foam::new(0.0, &[w], 3);
         // The mean cover over a patch (the foam is broken up by noise, so single points may be clear).
         let patch = |f: &Foam, x: f32, y: f32| {
@@ -571,5 +589,12 @@ mod tests {
         // A slow craft leaves a faint track.
         let slow = Foam::new(0.0, &[Wake { speed: 1.5, ..w }], 3);
         assert!(patch(&slow, -12.0, 0.0) < 0.1 * patch(&foam, -12.0, 0.0));
+        // A path that ran straight only 30 m behind the stern (it turned there): foam no farther, on the track
+        // or the arms.
+        let turned = Foam::new(0.0, &[Wake { reach_m: 30.0, ..w }], 3);
+        assert!(patch(&turned, -12.0, 0.0) > 0.2);
+        assert_eq!(patch(&turned, behind, 38.89), 0.0);
+        assert_eq!(patch(&turned, -5.0 - 40.0, 0.0), 0.0);
+        assert!(patch(&foam, -5.0 - 40.0, 0.0) > 0.1);
     }
 }
