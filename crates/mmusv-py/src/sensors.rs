@@ -472,7 +472,7 @@ pub(crate) fn frame_dict(py: Python<'_>, f: camera::CameraFrame, rgb: bool) -> P
     Ok(d)
 }
 
-/// Wakes from a `(K, 6)` float32 array (`x, y, heading, speed, length, beam`), checked finite.
+/// Wakes from a `(K, 6)` or `(K, 7)` float32 array (`x, y, heading, speed, length, beam[, reach_m]`), checked.
 pub(crate) fn wakes_arg(wakes: Option<&PyReadonlyArray2<'_, f32>>) -> PyResult<Vec<Wake>> {
     let Some(w) = wakes else { return Ok(Vec::new()) };
     // Six columns, or seven with how far behind the stern the path ran straight (inf: as far as the foam lasts).
