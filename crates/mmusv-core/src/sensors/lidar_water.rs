@@ -43,10 +43,11 @@ pub const WHITECAP_REFLECTANCE: f32 = 0.22;
 /// Detection threshold `I_d` of a water return, in the LiDAR's intensity units (see the module docs).
 pub const DETECTION_THRESHOLD: f32 = 3.2e-4;
 
-/// Cox–Munk total mean square slope of the capillary waves under wind `u` (m/s).
+/// Cox–Munk total mean square slope of the capillary waves under wind `u` (m/s) (the cameras' roughness,
+/// [`super::shade::water::cox_munk_mss`]).
 #[inline]
 pub fn mean_square_slope(u: f32) -> f32 {
-    0.003 + 5.12e-3 * u.max(0.0)
+    super::shade::water::cox_munk_mss(u)
 }
 
 /// Monahan & O'Muircheartaigh whitecap fraction under wind `u` (m/s), in `[0, 1]` (the cameras' coverage,

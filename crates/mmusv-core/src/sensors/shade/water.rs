@@ -93,9 +93,15 @@ impl ShallowWater {
     }
 }
 
-/// Cox–Munk (Beckmann) roughness `α` of the capillary waves under wind `u` (m/s).
+/// Cox–Munk total mean square slope `σ² = 0.003 + 5.12·10⁻³ U` of the capillary waves under wind `u` (m/s, at
+/// 12.5 m in their paper, 10 m here).
+pub fn cox_munk_mss(u: f32) -> f32 {
+    0.003 + 5.12e-3 * u.max(0.0)
+}
+
+/// Cox–Munk (Beckmann) roughness `α` of the capillary waves under wind `u` (m/s): `√σ²`.
 pub fn cox_munk_alpha(u: f32) -> f32 {
-    (0.003 + 5.12e-3 * u.max(0.0)).sqrt()
+    cox_munk_mss(u).sqrt()
 }
 
 /// Monahan's whitecap coverage (fraction in `[0, 1]`) under wind `u` (m/s).
