@@ -107,6 +107,35 @@ def test_yaml_syntax_errors_name_line_and_column(tmp_path: Path) -> None:
 # ---------------------------------------------------------------------------------------------- numbers
 
 
+def test_deep_nesting_is_refused_without_a_crash(tmp_path: Path) -> None:
+    """A scenario nested 100,000 deep (a hostile or corrupted file) is a ConfigError naming the file, in this
+    process: user inputs go through the pure-Python parser, whose recursion is bounded (libyaml's C composer,
+    used for mmusv's own catalogue, would overflow the C stack and kill the process)."""
+    for text in ("[" * 100_000 + "]" * 100_000, "- " * 20_000 + "1", "a: " + "{b: " * 5_000 + "1" + "}" * 5_000):
+        bad = tmp_path / "deep.yaml"
+        bad.write_text(text)
+        with pytest.raises(ConfigError, match=r"deep\.yaml: not valid YAML: nested too deeply"):
+            load_scenario(bad)
+
+
+def test_the_built_in_catalogue_parses_alike_with_either_parser() -> None:
+    """The vessel catalogue, read by libyaml's C parser (trusted: mmusv's own file), is the document the
+    pure-Python parser reads, and a refused document gets the pure-Python parser's message either way."""
+    from importlib import resources
+
+    from mmusv.yamlio import parse_yaml
+
+    text = resources.files("mmusv.world").joinpath("vessel_catalog.yaml").read_text(encoding="utf-8")
+    assert parse_yaml(text, "c", trusted=True) == parse_yaml(text, "c")
+    for bad in ("a:\n\t- 1", "a: &x 1\nb: *y"):
+        messages = []
+        for trusted in (True, False):
+            with pytest.raises(ConfigError) as err:
+                parse_yaml(bad, "f.yaml", trusted=trusted)
+            messages.append(str(err.value))
+        assert messages[0] == messages[1] and "line 2" in messages[0], messages
+
+
 @pytest.mark.parametrize("value", [float("inf"), float("-inf"), float("nan")])
 def test_non_finite_numbers_are_refused_with_the_field(value: float) -> None:
     d = tiny()

@@ -238,7 +238,8 @@ def _builtin_entries() -> dict[str, Mapping[str, Any]]:
     with _lock:
         if _entries is None:
             text = resources.files("mmusv.world").joinpath("vessel_catalog.yaml").read_text(encoding="utf-8")
-            _entries = _index_entries(parse_yaml(text, "vessel_catalog.yaml"), source="vessel_catalog.yaml")
+            data = parse_yaml(text, "vessel_catalog.yaml", trusted=True)
+            _entries = _index_entries(data, source="vessel_catalog.yaml")
         return _entries
 
 
