@@ -420,9 +420,9 @@ class Simulation:
             vx, vy = float(state.velocities[i, 0]), float(state.velocities[i, 1])
             speed = math.hypot(vx, vy)
             if speed > 0.3:
-                size = self.vessels[i].box_size
                 x, y, yaw = (float(state.poses[i, k]) for k in (0, 1, 5))
-                rows.append((x, y, yaw, speed, float(size[0]), float(size[1]), float(reach[i])))
+                length = float(self.vessels[i].box_size[0])
+                rows.append((x, y, yaw, speed, length, float(beams[i]), float(reach[i])))
         return np.asarray(rows, dtype=np.float32).reshape(-1, 7)
 
     def agent(self, agent_id: str) -> Agent:

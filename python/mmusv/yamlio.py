@@ -47,9 +47,9 @@ class _UniqueKeyLoader(yaml.SafeLoader):
 # deeply"). A document it refuses is parsed again by the pure-Python parser, whose messages say more.
 _CSafeLoader: Any = getattr(yaml, "CSafeLoader", None)
 _FastUniqueKeyLoader: Any = (
-    type("_FastUniqueKeyLoader", (_CSafeLoader,), {"__doc__": _UniqueKeyLoader.__doc__})
-    if _CSafeLoader is not None
-    else _UniqueKeyLoader
+    None
+    if _CSafeLoader is None
+    else type("_FastUniqueKeyLoader", (_CSafeLoader,), {"__doc__": _UniqueKeyLoader.__doc__})
 )
 
 
@@ -76,8 +76,9 @@ class _DuplicateKey(Exception):
     pass
 
 
-for _loader in {_UniqueKeyLoader, _FastUniqueKeyLoader}:
-    _loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
+for _loader in (_UniqueKeyLoader, _FastUniqueKeyLoader):
+    if _loader is not None:
+        _loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
 
 
 def _decode(raw: bytes, where: str) -> str:
@@ -103,7 +104,7 @@ def parse_yaml(text: str, where: str, *, trusted: bool = False) -> Any:
     own files (the built-in catalogues), parsed by libyaml's C parser where PyYAML has it; every input a user
     gives goes through the pure-Python parser, which refuses any nesting depth without crashing."""
     try:
-        if trusted and _FastUniqueKeyLoader is not _UniqueKeyLoader:
+        if trusted and _FastUniqueKeyLoader is not None:
             try:
                 return yaml.load(text, Loader=_FastUniqueKeyLoader)
             except yaml.YAMLError:

@@ -248,50 +248,62 @@ struct WakeShape {
 }
 
 impl WakeShape {
+    /// World `(x, y)` in the wake's frame: how far behind the stern along the heading, and how far from the track's
+    /// centre line (either side).
+    #[inline(always)]
+    fn frame(&self, x: f32, y: f32) -> (f32, f32) {
+        let [co, s] = self.dir;
+        let (dx, dy) = (x - self.stern[0], y - self.stern[1]);
+        (-(dx * co + dy * s), (-dx * s + dy * co).abs())
+    }
+
+    /// Half-width of the turbulent track `behind` metres behind the stern (widening slowly).
+    #[inline(always)]
+    fn track_half_width(&self, behind: f32) -> f32 {
+        0.5 * self.beam * (1.0 + (behind.max(0.0) / self.beam.max(1.0)).sqrt() * 0.25)
+    }
+
+    /// Width of a Kelvin arm `behind` metres behind the stern.
+    #[inline(always)]
+    fn arm_width(&self, behind: f32) -> f32 {
+        0.3 + 0.02 * (behind + self.length) + 0.1 * self.beam
+    }
+
     /// Whether any point within `r` of `c` may lie on this wake's track or arms (see [`WakeShape::foam_at`]):
     /// along the wake and across it such a point is at most `r` from `c`'s distances, and the track's half-width
     /// and the arms' width grow with the distance behind.
     fn may_reach(&self, c: [f32; 2], r: f32) -> bool {
-        let [co, s] = self.dir;
-        let (dx, dy) = (c[0] - self.stern[0], c[1] - self.stern[1]);
-        let behind = -(dx * co + dy * s);
-        let lateral = (-dx * s + dy * co).abs();
+        let (behind, lateral) = self.frame(c[0], c[1]);
         if behind + r <= -0.1 * self.length || behind - r > self.reach {
             return false;
         }
         let far = (behind + r).max(0.0);
-        let half = 0.5 * self.beam * (1.0 + (far / self.beam.max(1.0)).sqrt() * 0.25);
-        if lateral - r < half {
+        if lateral - r < self.track_half_width(far) {
             return true;
         }
         if behind + r <= 0.0 {
             return false;
         }
-        let width = 0.3 + 0.02 * (far + self.length) + 0.1 * self.beam;
-        (lateral - (behind + self.length) * KELVIN_TAN).abs() - r * (1.0 + KELVIN_TAN) < width
+        (lateral - (behind + self.length) * KELVIN_TAN).abs() - r * (1.0 + KELVIN_TAN) < self.arm_width(far)
     }
 
     /// The foam density this wake lays at `(x, y)` (0 where none), `noise_at` the foam noise there.
     #[inline(always)]
     fn foam_at(&self, x: f32, y: f32, noise_at: &mut impl FnMut() -> f32) -> f32 {
         let w = self;
-        let [co, s] = w.dir;
-        let (dx, dy) = (x - w.stern[0], y - w.stern[1]);
-        let behind = -(dx * co + dy * s);
+        let (behind, lateral) = w.frame(x, y);
         if behind <= -0.1 * w.length || behind > w.reach {
             return 0.0;
         }
-        let lateral = (-dx * s + dy * co).abs();
         if lateral > 0.6 * w.beam + (behind.max(0.0) + w.length) * (KELVIN_TAN + 0.07) + 0.3 {
             return 0.0;
         }
         // Turbulent track behind the stern, and the Kelvin arms from the bow: whether the point is on either
         // before the fade is worked out (most of the wedge is between them).
-        let half = 0.5 * w.beam * (1.0 + (behind.max(0.0) / w.beam.max(1.0)).sqrt() * 0.25);
+        let half = w.track_half_width(behind);
         let on_track = lateral < half;
-        let from_bow = behind + w.length;
-        let width = 0.3 + 0.02 * from_bow + 0.1 * w.beam;
-        let off = (lateral - from_bow * KELVIN_TAN).abs();
+        let width = w.arm_width(behind);
+        let off = (lateral - (behind + w.length) * KELVIN_TAN).abs();
         let on_arm = behind > 0.0 && off < width;
         if !on_track && !on_arm {
             return 0.0;
