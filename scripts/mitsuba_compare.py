@@ -198,7 +198,9 @@ def write_table(args: Any, results: list[Result], mi_version: str) -> None:
         "ground as image-based light without occlusion, water adding its traced reflections spread over the "
         "roughness lobe in screen space (`sensors/camera/glossy.rs`) and weighted by the rough surface's "
         "directional reflectance (`sensors/shade/rough_water.rs`). Mitsuba path-traces that rough reflection; "
-        "it renders the rest as layers composited by mmusv's instance image:",
+        "it renders the rest as layers composited by mmusv's instance image. Mitsuba's rough BSDFs reflect "
+        "once, so mmusv's water is rendered with its single scattering alone (`water_multiple_scattering=False`;"
+        " the light reflected between the wave facets, `sensors/shade/sea_ms.rs`, is checked on its own):",
         "",
         "\n\n".join(f"  {r[0].scene.name}:\n\n{layer_table(r[0].scene, args.spp)}" for r in results),
         "",

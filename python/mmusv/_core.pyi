@@ -265,7 +265,9 @@ class SensorEnv:
     """The physical environment every sensor sees: sun direction (world unit vector towards it), Preetham
     turbidity (1.7..10), cloud cover and ground albedo in [0, 1], fog extinction 1/m, rain mm/h, significant wave
     height m, wind m/s, the water body's linear RGB albedo, a fixed exposure (EV100) or None for metered, and
-    whether cameras cast shadow rays. A value out of range raises ``ConfigError`` naming ``env.<field>``."""
+    whether cameras cast shadow rays, and whether the water keeps the light reflected more than once between its
+    wave facets (off: single-scattering microfacet reflection alone, as a renderer's rough BSDF). A value out of
+    range raises ``ConfigError`` naming ``env.<field>``."""
 
     def __new__(
         cls,
@@ -281,6 +283,7 @@ class SensorEnv:
         water_albedo: Sequence[float],
         exposure_ev100: float | None = None,
         shadows: bool = True,
+        water_multiple_scattering: bool = True,
     ) -> SensorEnv: ...
     @property
     def exposure(self) -> tuple[float, float]:

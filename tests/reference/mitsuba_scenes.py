@@ -116,7 +116,9 @@ class Env:
     water_albedo: tuple[float, float, float] = (0.004, 0.018, 0.03)
 
     def sensor_env(self) -> Any:
-        """The mmusv ``SensorEnv``: no cloud, fog, rain or waves, shadows on."""
+        """The mmusv ``SensorEnv``: no cloud, fog, rain or waves, shadows on; the water's single scattering
+        alone (Mitsuba's ``roughconductor`` reflects once; the multiple scattering is checked against its own
+        reference, ``sensors/shade/sea_ms.rs``)."""
         s = np.asarray(self.sun, dtype=np.float64)
         s = s / np.linalg.norm(s)
         return _core.SensorEnv(
@@ -130,6 +132,7 @@ class Env:
             wind_speed_m_s=self.wind_speed_m_s,
             water_albedo=list(self.water_albedo),
             shadows=True,
+            water_multiple_scattering=False,
         )
 
 

@@ -345,3 +345,33 @@ def test_shallow_water_shows_the_bottom() -> None:
     gain3, gain30 = d3 - deep, d30 - deep
     # At 30 m little red survives the round trip (exp(-2·0.324·30) ~ 4e-9), blue still does (exp(-4.3) ~ 1 %).
     assert gain30[0] < 1e-3 * gain3[0] and gain30[2] > 1e-3 * gain3[2]
+
+
+def test_light_scattered_between_wave_facets_brightens_grazing_water_only() -> None:
+    """Rough water (12 m/s) seen from 3 m towards the horizon, with and without the light reflected more than
+    once between the wave facets (``sensors/shade/sea_ms.rs``): near the horizon, where single scattering loses
+    most, the water is a few per cent brighter; looking down steeply it is the same to 1 %; the sky is
+    untouched. (The walk itself and its table are checked in Rust: energy conserved with mirror facets, its
+    first order against a quadrature.)"""
+    s = Scene()
+    _water(s)
+    cam = core.Camera(width=64, height=96, rgb=True, hfov=math.radians(60.0), quality="draft", range_max=6000.0)
+    # Looking along +x, pitched 30° down: the horizon near the top, 60° below it at the bottom.
+    pose = pose_matrices(np.array([0.0, 0.0, 3.0, 0.0, math.radians(30.0), 0.0]))
+    out = {}
+    for ms in (True, False):
+        env = _env(wind_speed_m_s=12.0, exposure_ev100=12.0, water_multiple_scattering=ms)
+        frame = render(cam, s, pose=pose, env=env, seed=3, radiance=True)
+        assert frame.radiance is not None
+        out[ms] = (frame.radiance @ np.array([0.2126, 0.7152, 0.0722])).reshape(96, 64)
+        sem = np.asarray(frame.semantic).reshape(96, 64)
+    water = sem == 1
+    assert water.any() and (~water).any()
+    assert np.array_equal(out[True][~water], out[False][~water])
+    ratio = out[True][water] / out[False][water]
+    assert ratio.min() >= 1.0 - 1e-6 and ratio.max() < 1.15
+    full = np.flatnonzero(water.all(axis=1))  # rows of water only, from just below the horizon down
+    near = np.median(out[True][full[0]] / out[False][full[0]])
+    steep = np.median(out[True][full[-1]] / out[False][full[-1]])
+    assert 1.02 < near < 1.12, near
+    assert abs(steep - 1.0) < 0.01, steep

@@ -123,10 +123,13 @@ impl SensorEnv {
     /// below the horizon for sky light), `fog_extinction_per_m` (1/m, 3 / visibility), `rain_mm_per_h`,
     /// `wave_height_m` (significant height H), `wind_speed_m_s` (capillary roughness, whitecaps),
     /// `water_albedo` (linear RGB diffuse reflectance of the water body), `exposure_ev100` (None: metered from
-    /// the scene's light), and whether cameras cast shadow rays. Every value must be finite and in range.
+    /// the scene's light), whether cameras cast shadow rays, and whether the water keeps the light reflected
+    /// more than once between its wave facets (`water_multiple_scattering`; off: the single-scattering
+    /// microfacet model alone, as a renderer's rough BSDF). Every value must be finite and in range.
     #[new]
     #[pyo3(signature = (*, sun_direction, turbidity, cloud_cover, ground_albedo, fog_extinction_per_m,
-        rain_mm_per_h, wave_height_m, wind_speed_m_s, water_albedo, exposure_ev100=None, shadows=true))]
+        rain_mm_per_h, wave_height_m, wind_speed_m_s, water_albedo, exposure_ev100=None, shadows=true,
+        water_multiple_scattering=true))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         sun_direction: Vec<f32>,
@@ -140,6 +143,7 @@ impl SensorEnv {
         water_albedo: Vec<f32>,
         exposure_ev100: Option<f32>,
         shadows: bool,
+        water_multiple_scattering: bool,
     ) -> PyResult<Self> {
         for &x in sun_direction.iter() {
             env_value("sun_direction", x, false)?;
@@ -174,6 +178,7 @@ impl SensorEnv {
             water_albedo: triple(water_albedo, "water_albedo")?,
             exposure_ev100,
             shadows,
+            water_multiple_scattering,
         };
         Ok(Self { shade })
     }

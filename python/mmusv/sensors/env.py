@@ -80,12 +80,14 @@ def sensor_env(
     wind_speed_m_s: float | None = None,
     exposure_ev100: float | None = None,
     shadows: bool = True,
+    water_multiple_scattering: bool = True,
 ) -> core.SensorEnv:
     """The sensors' view of ``environment`` (default: clear noon, ``Environment.make()``). The keyword values,
     when given, replace its fog extinction (1/m), rain (mm/h), wave height (m) and wind (m/s; default from the
     wave height), and fix the cameras' exposure (EV at ISO 100; default metered from the scene's light): for
-    driving one sensor by hand. Raises :class:`mmusv.ConfigError` naming ``env.<field>`` for a value out of
-    range."""
+    driving one sensor by hand. ``water_multiple_scattering=False`` leaves out the light reflected more than once
+    between the sea's wave facets (single-scattering microfacet reflection alone, as renderers' rough BSDFs).
+    Raises :class:`mmusv.ConfigError` naming ``env.<field>`` for a value out of range."""
     env = environment if environment is not None else Environment.make()
     fog = env.weather.extinction_per_m if fog_extinction_per_m is None else fog_extinction_per_m
     rain = env.weather.rain_mm_per_h if rain_mm_per_h is None else rain_mm_per_h
@@ -103,4 +105,5 @@ def sensor_env(
         water_albedo=list(WATER_ALBEDO),
         exposure_ev100=exposure_ev100,
         shadows=shadows,
+        water_multiple_scattering=water_multiple_scattering,
     )

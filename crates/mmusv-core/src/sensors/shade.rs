@@ -7,6 +7,9 @@
 //! * [`envlight`]: the sky (and the sea below the horizon) as image-based light, irradiance and split-sum
 //!   prefiltered maps;
 //! * [`water`]: Cox–Munk capillary roughness, Monahan whitecaps, Kelvin wakes and the water body;
+//! * [`rough_water`]: the rough sea's single-scattering microfacet reflection (Beckmann, Smith, Fresnel);
+//! * [`sea_ms`]: the light reflected more than once between the wave facets (Heitz et al.'s random walk),
+//!   restored over that lobe (Turquin's energy compensation);
 //! * [`tonemap`]: physical exposure from the scene's illuminance and the ACES filmic curve.
 //!
 //! A surface of material `m` seen along `d` (`v = −d`) is lit by the sun (irradiance `E_s` along `s`, when the
@@ -33,6 +36,8 @@ pub mod brdf;
 pub mod envlight;
 pub mod foam;
 pub mod rough_water;
+pub mod sea_ms;
+mod sea_ms_table;
 pub mod sky;
 pub mod tonemap;
 pub mod twilight;
@@ -68,6 +73,9 @@ pub struct ShadeEnv {
     pub exposure_ev100: f32,
     /// Whether to cast shadow rays.
     pub shadows: bool,
+    /// Whether light reflecting more than once between the sea's wave facets is kept ([`sea_ms`]); `false`
+    /// is the single-scattering microfacet model alone (as renderers' rough BSDFs, for comparisons).
+    pub water_multiple_scattering: bool,
 }
 
 impl Default for ShadeEnv {
@@ -85,6 +93,7 @@ impl Default for ShadeEnv {
             water_albedo: [0.004, 0.018, 0.03],
             exposure_ev100: f32::NAN,
             shadows: true,
+            water_multiple_scattering: true,
         }
     }
 }
@@ -498,7 +507,16 @@ impl Shader {
         // The reflection over the roughness lobe (its radiance spread over the lobe by the camera, `reflected`):
         // weighted by the rough surface's directional reflectance, not the mirror's Fresnel.
         let alpha_r = self.water_mss(hit.unresolved_mss).sqrt();
-        let mut c = l_r * rough_water::reflectance(cos_o, alpha_r);
+        // Light scattered more than once between the facets is spent over the same lobe (`sea_ms.rs`): the
+        // reflection weighted by the reflectance of every order, the glitter scaled by its share over the first.
+        let e_single = rough_water::reflectance(cos_o, alpha_r);
+        let (e_r, ms_gain) = if self.env.water_multiple_scattering {
+            let e = sea_ms::reflectance(cos_o, alpha_r);
+            (e, if e_single > 0.0 { e / e_single } else { 1.0 })
+        } else {
+            (e_single, 1.0)
+        };
+        let mut c = l_r * e_r;
         let mut entering = self.light.water_entering;
         if sunlit {
             let ns = n.dot(self.sun);
@@ -508,7 +526,7 @@ impl Shader {
                 // square slopes do), weighted by the exact Fresnel at the half vector: the reflections' lobe too.
                 let h = (v + self.sun).normalize_or_zero();
                 let f = water_fresnel(v.dot(h));
-                c += self.sun_e * (rough_water::specular_cos(n, v, self.sun, alpha_r) * f);
+                c += self.sun_e * (rough_water::specular_cos(n, v, self.sun, alpha_r) * f * ms_gain);
                 entering += self.sun_e * (ns * (1.0 - water_fresnel(ns)));
             }
         }
