@@ -17,6 +17,7 @@ with the new one, draws the same frames from the same poses. Each view is writte
 * ``whitecaps_w3``: open water at wave level W3, from 8 m above the sea;
 * ``wake_chase``: a 35 m patrol boat at 14 m/s, seen from 20 m above a vessel following 100 m behind;
 * ``wake_top``: the same boat in its own top view (orthographic, heading up, 0.6 m per pixel);
+* ``wake_bend``: a pilot boat at 10 m/s 100 m past a right-angle turn, in a still USV's top view (north up);
 * ``lidar_bulk_100m``: the points of the default 64-channel LiDAR and of a dense 128-channel one on a 190 m bulk
   carrier whose centre line is 100 m off, in the ship's frame (side and plan views, coloured by intensity).
 """
@@ -205,6 +206,30 @@ def wake_top(path: Path) -> None:
     Image.fromarray(np.asarray(top.rgb)).save(path)
 
 
+def wake_bend(path: Path) -> None:
+    """A pilot boat at 10 m/s that went east, then turned north (a route with a right-angle corner, which the
+    route's spline rounds), 100 m past the corner: the top view (north up, 0.5 m per pixel, 800 × 800, 400 m square)
+    of a USV lying still 60 m west and 60 m south of the boat's corner, at 12:00, clear, W1."""
+    from PIL import Image
+
+    rig = {
+        "lidar": None,
+        "radar": None,
+        "cameras": [],
+        "top_view": {"resolution": [800, 800], "metres_per_pixel": 0.5, "orientation": "north_up", "outputs": ["rgb"]},
+    }
+    observer = {**_OBSERVER, "speed_mps": 0.1, "route": [[-60.0, -160.0], [-60.0, -150.0]]}
+    boat = {"id": "pilot", "role": "target", "asset": "pilot_boat_16m", "speed_mps": 10.0,
+            "route": [[-300.0, -100.0], [0.0, -100.0], [0.0, 400.0]]}  # fmt: skip
+    env = {"time_of_day": "12:00", "weather": "clear", "wave": "W1"}
+    sc = _scenario("wake_bend", rig=rig, vessels=[boat], environment=env, observer=observer)
+    sc["acquisition"] = {"frequency_hz": 5, "frames": 201}
+    sim = mmusv.Simulation(sc)
+    top = sim.capture(200, sensors=["top_view"]).agents["observer"].top_view
+    assert top is not None and top.rgb is not None
+    Image.fromarray(np.asarray(top.rgb)).save(path)
+
+
 def top_views(path: Path) -> None:
     """The observer's default top view (512 × 512 at 0.5 m, heading up) over open water at W1 and W3, 11:00, side
     by side."""
@@ -296,6 +321,7 @@ VIEWS: dict[str, Callable[[Path], None]] = {
     "whitecaps_w3": whitecaps_w3,
     "wake_chase": wake_chase,
     "wake_top": wake_top,
+    "wake_bend": wake_bend,
     "top_views": top_views,
 }
 

@@ -338,8 +338,8 @@ class Lidar:
     ) -> dict[str, npt.NDArray[Any]]:
         """One sweep: xyz (N,3) f32 LiDAR frame, range, intensity, ring, azimuth, class, instance, ray_index; and
         beam_instance (M,) i32, per ray of the full pattern the instance its cast met first (-1: none). ``wakes``
-        (K, 6) or (K, 7) float32 ``x, y, heading, speed, length, beam[, reach_m]`` rows: vessels under way, whose
-        wake foam returns over a wave surface."""
+        (K, 6), (K, 7) or (K, 8) float32 ``x, y, heading, speed, length, beam[, reach_m[, age_s]]`` rows (see
+        ``Camera.render``): vessels under way, whose wake foam returns over a wave surface."""
 
 @final
 class Camera:
@@ -389,8 +389,10 @@ class Camera:
         radiance: bool = False,
     ) -> dict[str, npt.NDArray[Any]]:
         """depth (H,W) f32, semantic (H,W) u16, instance (H,W) i32 and, for an rgb camera, rgb (H,W,3) u8; with
-        ``radiance``, radiance (H,W,3) f32 cd/m². ``wakes`` (K, 6) or (K, 7) f32: x, y, heading, speed, length,
-        beam[, reach_m] (how far behind the stern the path ran straight; inf when not given)."""
+        ``radiance``, radiance (H,W,3) f32 cd/m². ``wakes`` (K, 6), (K, 7) or (K, 8) f32: x, y, heading, speed,
+        length, beam[, reach_m[, age_s]] (how far behind the stern the path ran straight, inf when not given; with
+        age_s, pieces of wakes that follow their vessels' bends: the foam age_s old at the piece's start, ending
+        at reach_m where the next piece goes on)."""
 
 # --- radar ---
 
@@ -530,9 +532,11 @@ class Fleet:
         """(V, 6) float64 poses at time t seconds."""
     def velocities_at(self, t: float) -> npt.NDArray[np.float64]:
         """(V, 3) float64 world-frame velocities (m/s) at time t seconds."""
-    def straight_behind(self, t: float, tolerances_m: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
-        """(V,) float64 metres: how far behind each vessel at time t its path ran straight along its heading, within
-        ``tolerances_m`` (V,) of that line, out to its wake's reach; inf when straight that far, 0 at rest."""
+    def wake_pieces(self, t: float, tolerances_m: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+        """(M, 6) float64 rows ``vessel, x, y, heading, reach_m, age_s``: the path behind each vessel at time t (s)
+        as straight pieces, newest first: where each starts (metres, radians), how far back from there the path ran
+        straight within ``tolerances_m`` (V,) of that line (inf: on to the wake's end), how long ago the vessel
+        passed there (s); out to its wake's reach, at most 32 pieces a vessel; none for a vessel at rest."""
     def poses_at_times(self, times: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
         """(T, V, 6) float64 poses at each time (seconds); GIL released."""
 

@@ -406,24 +406,46 @@ class Simulation:
         )
 
     def wakes(self, state: WorldState) -> np.ndarray:
-        """``(K, 7)`` float32 rows ``x, y, heading, speed, length, beam, reach_m`` (world metres, radians, m/s) of
-        the scenario vessels under way (horizontal speed above 0.3 m/s) in ``state``: the wakes the cameras draw
-        and the LiDARs see. A wake is drawn straight back along the heading, so ``reach_m`` is how far behind the
-        stern the vessel's own path ran straight, within one beam of that line (``inf``: as far as the foam lasts;
-        a turn or a reversal of a ping-pong route ends it, the foam thinning out before): no foam where the vessel
-        never went."""
+        """``(K, 8)`` float32 rows ``x, y, heading, speed, length, beam, reach_m, age_s`` (world metres, radians,
+        m/s, s) of the scenario vessels under way (horizontal speed above 0.3 m/s) in ``state``: the wakes the
+        cameras draw and the LiDARs see. A wake follows its vessel's path round the bends, as straight pieces,
+        newest first. The first row is the vessel itself (its pose), its foam drawn straight back from the stern
+        along its heading for ``reach_m`` metres (until its path leaves that line by half a beam; ``inf``: as far
+        as the foam lasts). Each further row of the same vessel is a piece of the path from there: its stern on the
+        path where the piece starts (the row's ``x, y`` half a length ahead of it, ``heading`` along the piece's
+        chord to the next one's start), ``reach_m`` the chord's length, ``age_s`` how long ago the vessel's stern
+        passed the piece's start (at least 1 ms: rows older than 0 draw no Kelvin arms). No foam where the vessel
+        never went, nor under its hull; its older foam round the bends too."""
         n = len(self.scenario.vessels)
         beams = np.array([float(v.box_size[1]) for v in self.vessels[:n]], dtype=np.float64)
-        reach = self.fleet.straight_behind(state.time_s, beams) if n else beams
+        pieces = self.fleet.wake_pieces(state.time_s, 0.5 * beams) if n else np.zeros((0, 6))
         rows = []
         for i in range(n):
             vx, vy = float(state.velocities[i, 0]), float(state.velocities[i, 1])
             speed = math.hypot(vx, vy)
-            if speed > 0.3:
-                x, y, yaw = (float(state.poses[i, k]) for k in (0, 1, 5))
-                length = float(self.vessels[i].box_size[0])
-                rows.append((x, y, yaw, speed, length, float(beams[i]), float(reach[i])))
-        return np.asarray(rows, dtype=np.float32).reshape(-1, 7)
+            mine = pieces[pieces[:, 0] == i]
+            if speed <= 0.3 or len(mine) == 0:
+                continue
+            length, beam = float(self.vessels[i].box_size[0]), float(beams[i])
+            half = 0.5 * length
+            # The vessel's own piece where it is now (its pose), its foam from the stern back to where its path left
+            # the line (the core's reach runs from the vessel's centre).
+            x, y, yaw = (float(state.poses[i, k]) for k in (0, 1, 5))
+            rows.append((x, y, yaw, speed, length, beam, max(float(mine[0, 4]) - half, 0.0), 0.0))
+            # The older pieces: each row's stern on the path where the piece starts (the row's "vessel" half a length
+            # ahead of it along the piece), its foam as old as the time since the stern passed there; a piece the
+            # stern has not yet passed all of starts where it is.
+            for _, px, py, heading, reach, age in mine[1:]:
+                c, s = math.cos(heading), math.sin(heading)
+                lag = age * speed - half  # how far the stern is past the piece's start, along the path
+                cut = max(-lag, 0.0)
+                if reach <= cut:
+                    continue
+                px, py, reach = px - cut * c, py - cut * s, reach - cut
+                # (At least a millisecond old: a row older than 0 is a piece further back, without Kelvin arms.)
+                old = max(lag / speed, 1e-3)
+                rows.append((px + half * c, py + half * s, heading, speed, length, beam, reach, old))
+        return np.asarray(rows, dtype=np.float32).reshape(-1, 8)
 
     def agent(self, agent_id: str) -> Agent:
         """The agent (USV) named ``agent_id``."""

@@ -607,11 +607,24 @@ def test_the_sensors_sea_state_is_the_physical_seas() -> None:
     assert Simulation(sc).sensor_env.wave_height_m == pytest.approx(3.5)
 
 
+def _rows_of(w: np.ndarray, st: Any, index: int) -> np.ndarray:
+    """The rows of ``Simulation.wakes`` that are vessel ``index``'s: its own (at its pose), then its older pieces."""
+    x, y = (float(st.poses[index, k]) for k in (0, 1))
+    start = [k for k in range(len(w)) if w[k, 7] == 0.0 and abs(w[k, 0] - x) < 1e-3 and abs(w[k, 1] - y) < 1e-3]
+    assert len(start) == 1
+    k = start[0] + 1
+    while k < len(w) and w[k, 7] > 0.0:
+        k += 1
+    return w[start[0] : k]
+
+
 def test_wakes_reach_only_as_far_as_the_path_ran_straight(make_scenario: Any) -> None:
-    """A wake is drawn straight back along the heading: ``Simulation.wakes`` gives how far the vessel's own path
-    ran straight (within a beam of that line). On a straight route, as far as the foam lasts; on a 100 m ping-pong
-    leg at 5 m/s, 24 s in, back to where it turned 20 m ago (the route's ends are worked out independently here:
-    the leg runs from x = 100 to x = 200)."""
+    """A wake is drawn as straight pieces of the path behind its vessel: ``Simulation.wakes`` gives the vessel's own
+    piece (from its stern as far back as its path ran straight, within half a beam of the line back along its
+    heading) and the older ones from where each left the line. On a straight route, one piece as far as the foam
+    lasts; on a 100 m ping-pong leg at 5 m/s, 24 s in, back to where it turned 20 m ago (4 m behind the 32 m tug's
+    stern), then the outbound leg from there, which its stern passed 0.8 s ago (the route's ends are worked out
+    independently here: the leg runs from x = 100 to x = 200)."""
     sc = make_scenario()
     sc["acquisition"] = {"frequency_hz": 5, "frames": 130}
     sc["vessels"].append(
@@ -623,15 +636,83 @@ def test_wakes_reach_only_as_far_as_the_path_ran_straight(make_scenario: Any) ->
     for frame in (60, 120):
         st = sim.world_state(frame)
         w = sim.wakes(st)
-        rows = {names[i]: w[k] for k, i in enumerate(np.flatnonzero(np.hypot(*st.velocities[:, :2].T) > 0.3))}
+        assert w.shape[1] == 8 and w.dtype == np.float32
+        shuttle = _rows_of(w, st, names.index("shuttle"))
         x = float(st.poses[names.index("shuttle"), 0])
-        reach = float(rows["shuttle"][6])
         if frame == 60:  # 60 m out from x = 100, heading +x: straight all the way back (and before the start)
-            assert reach == np.inf and abs(x - 160.0) < 0.5
-        else:  # 120 m travelled: turned at x = 200 20 m ago, heading -x at x = 180
-            assert abs(x - 180.0) < 0.5 and abs(reach - 20.0) <= 2.0, (x, reach)
-        assert rows["usv_a"][6] == np.inf  # a straight route
-        assert w.shape[1] == 7 and w.dtype == np.float32
+            assert abs(x - 160.0) < 0.5 and len(shuttle) == 1 and shuttle[0, 6] == np.inf
+        else:  # 120 m travelled: turned at x = 200 20 m ago, heading -x at x = 180, its stern (16 m aft) at x = 196
+            assert abs(x - 180.0) < 0.5 and abs(shuttle[0, 6] - 4.0) <= 2.0, (x, shuttle)
+            # Then the outbound leg, heading +x from the turn, the stern there 0.8 s ago (the row's "vessel" at x = 216)
+            assert len(shuttle) == 2 and shuttle[1, 6] == np.inf, shuttle
+            assert abs(shuttle[1, 0] - 216.0) <= 2.0 and abs(shuttle[1, 2]) < 1e-3, shuttle
+            assert abs(shuttle[1, 7] - 0.8) <= 0.4, shuttle
+        usv_a = _rows_of(w, st, names.index("usv_a"))
+        assert len(usv_a) == 1 and usv_a[0, 6] == np.inf  # a straight route
+
+
+def test_a_wake_follows_its_vessel_round_the_bend(make_scenario: Any) -> None:
+    """A boat at 8 m/s went east 300 m, then turned north; 400 m on, its top-view foam (flat water, the wakes of
+    ``Simulation.wakes``) lies along the path it took round the bend (the path from its own poses, frame by frame):
+    most of the path behind its own first piece has foam within 1.5 m, where the first piece alone (the wake drawn
+    straight back from the vessel, as before) has none; and every foam pixel lies within the wake's width of the path
+    or is that first piece's (its Kelvin arms)."""
+    from mmusv._native import core
+    from mmusv.scene import Scene
+    from mmusv.sensors.camera import render
+    from mmusv.sensors.env import sensor_env
+    from mmusv.world.build import pose_matrices
+
+    sc = make_scenario()
+    sc["acquisition"] = {"frequency_hz": 5, "frames": 300}
+    sc["vessels"].append(
+        {"id": "runner", "role": "target", "asset": "pilot_boat_16m", "speed_mps": 8.0,
+         "route": [[0.0, 500.0], [300.0, 500.0], [300.0, 900.0]]}
+    )  # fmt: skip
+    sim = Simulation(sc)
+    i = [v.id for v in sim.scenario.vessels].index("runner")
+    frame = 250
+    st = sim.world_state(frame)
+    mine = _rows_of(sim.wakes(st), st, i)
+    assert len(mine) > 4 and np.all(np.diff(mine[:, 7]) > 0), mine
+    path = np.array([sim.world_state(k).poses[i, :2] for k in range(frame + 1)])
+    s = Scene()
+    v = np.array([[-5000.0, -5000.0, 0.0], [5000.0, -5000.0, 0.0], [5000.0, 5000.0, 0.0], [-5000.0, 5000.0, 0.0]])
+    s.add_instance(s.add_mesh(v, np.array([[0, 1, 2], [0, 2, 3]]), classes=1, name="water"))
+    env = sensor_env(fog_extinction_per_m=0.0, rain_mm_per_h=0.0, wave_height_m=0.0, wind_speed_m_s=0.0)
+    top = core.Camera(width=300, height=300, rgb=True, metres_per_pixel=1.0, quality="draft", range_max=500.0)
+    pose = pose_matrices(np.array([250.0, 550.0, 300.0, 0.0, math.pi / 2, 0.0]))  # +x at the image top
+    lum = np.array([0.2126, 0.7152, 0.0722])
+
+    def foam(wakes: np.ndarray | None) -> np.ndarray:
+        img = render(top, s, pose=pose, env=env, seed=1, wakes=wakes, radiance=True).radiance
+        assert img is not None
+        return img @ lum
+
+    water = foam(None)
+    chain = foam(mine) - water > 0.05 * np.median(water)
+    first = foam(mine[:1]) - water > 0.05 * np.median(water)
+    # Pixel (v, u) is world x = 399.5 - v, y = 699.5 - u.
+    vv, uu = np.nonzero(chain)
+    pts = np.stack([399.5 - vv, 699.5 - uu], axis=1)
+    # The path behind the boat's own piece (and inside the picture): foam along it with the chain, none without.
+    back = float(mine[0, 6]) + 20.0
+    travelled = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(path, axis=0).T))])
+    old = path[(travelled[-1] - travelled > back) & (path[:, 0] > 255.0) & (path[:, 1] < 695.0)]
+    assert len(old) > 50
+
+    def near(mask: np.ndarray, q: np.ndarray) -> bool:
+        v, u = int(np.rint(399.5 - q[0])), int(np.rint(699.5 - q[1]))
+        return bool(mask[max(v - 1, 0) : v + 2, max(u - 1, 0) : u + 2].any())
+
+    with_chain = np.mean([near(chain, q) for q in old])
+    alone = np.mean([near(first, q) for q in old])
+    assert with_chain > 0.8 and alone < 0.05, (with_chain, alone)
+    # Every foam pixel: within the widest track (half-width 9 m here, plus the noise and the pixel) of the path,
+    # or foam the first piece alone lays too (its Kelvin arms).
+    d = np.min(np.hypot(pts[:, None, 0] - path[None, ::2, 0], pts[:, None, 1] - path[None, ::2, 1]), axis=1)
+    own = first[vv, uu]
+    assert np.all((d < 12.0) | own), np.max(d[~own])
 
 
 def test_a_wake_reach_cuts_the_foam_every_sensor_sees() -> None:
@@ -665,5 +746,5 @@ def test_a_wake_reach_cuts_the_foam_every_sensor_sees() -> None:
     assert near["cut"] == near["full"] and near["cut"] > near["open"] + 20, near  # the foam before the cut stays
     with pytest.raises(InputError, match=r"wakes\[0\]"):
         scan(lidar, scene, pose=_pose(0.0, 0.0, 2.5), env=env, seed=4, wakes=[[*row, -1.0]])
-    with pytest.raises(InputError, match=r"\(K, 6\) or \(K, 7\)"):
+    with pytest.raises(InputError, match=r"\(K, 6\), \(K, 7\) or \(K, 8\)"):
         scan(lidar, scene, pose=_pose(0.0, 0.0, 2.5), env=env, seed=4, wakes=[row[:5]])

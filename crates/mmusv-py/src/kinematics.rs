@@ -158,15 +158,18 @@ impl Fleet {
         rows_to_array(py, self.inner.velocities_at(t).map_err(to_py)?)
     }
 
-    /// `(V,)` float64: how far behind each vessel at time `t` (s) its path ran straight along its heading, within
-    /// `tolerances_m` (V,) metres of that line, checked every 2 m out to its wake's reach (`speed ·
-    /// WAKE_REACH_S`); inf when straight that far, 0 at rest (`VesselMotion::straight_behind_m`).
-    fn straight_behind<'py>(
+    /// `(M, 6)` float64 rows `vessel, x, y, heading, reach_m, age_s`: the path behind each vessel at time `t`
+    /// (s) as straight pieces, newest first (`VesselMotion::wake_pieces`): where each starts (metres, radians: the
+    /// vessel's centre and direction of travel when it passed there), how far back from there the path ran straight
+    /// within `tolerances_m` (V,) metres of that line (checked every 2 m; inf: on to the wake's end), and how long
+    /// ago the vessel passed there (s); out to its wake's reach (`speed · WAKE_REACH_S` of path), at most
+    /// `WAKE_MAX_PIECES` pieces a vessel. No rows for a vessel at rest.
+    fn wake_pieces<'py>(
         &self,
         py: Python<'py>,
         t: f64,
         tolerances_m: PyReadonlyArray1<'py, f64>,
-    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let tol = flat(&tolerances_m, "tolerances_m")?;
         let vessels = self.inner.vessels();
         if tol.len() != vessels.len() {
@@ -177,18 +180,18 @@ impl Fleet {
             )));
         }
         let reach_s = f64::from(mmusv_core::sensors::shade::foam::WAKE_REACH_S);
-        let out = vessels
-            .iter()
-            .zip(tol)
-            .map(|(v, &tol)| {
-                let max_m = v.params().speed_mps * reach_s;
-                if max_m <= 0.0 {
-                    return Ok(0.0);
-                }
-                v.straight_behind_m(t, max_m, 2.0, tol).map_err(to_py)
-            })
-            .collect::<PyResult<Vec<f64>>>()?;
-        Ok(out.into_pyarray(py))
+        let most = mmusv_core::sensors::shade::foam::WAKE_MAX_PIECES;
+        let mut rows: Vec<[f64; 6]> = Vec::new();
+        for (i, (v, &tol)) in vessels.iter().zip(tol).enumerate() {
+            let max_m = v.params().speed_mps * reach_s;
+            if max_m <= 0.0 {
+                continue;
+            }
+            for p in v.wake_pieces(t, max_m, 2.0, tol, most).map_err(to_py)? {
+                rows.push([i as f64, p.x, p.y, p.heading, p.reach_m, p.age_s]);
+            }
+        }
+        rows_to_array(py, rows)
     }
 
     /// `(T, V, 6)` float64 poses at every time in `times` (s), computed in parallel with the GIL released.

@@ -287,9 +287,9 @@ impl Lidar {
     /// and waves are used). Returns a dict
     /// of equal-length columns: xyz (N,3) f32 LiDAR frame, range, intensity (f32), ring (u16), azimuth (f32
     /// rad), class (u16), instance (i32), ray_index (u32); and beam_instance (M,) i32: per ray of the full
-    /// pattern, the instance its cast met first within the range (-1: none). `wakes` (K, 6) or (K, 7) float32 rows
-    /// `x, y, heading, speed, length, beam[, reach_m]` (world metres, radians, m/s): the vessels under way, whose
-    /// wake foam returns over a wave surface.
+    /// pattern, the instance its cast met first within the range (-1: none). `wakes` (K, 6), (K, 7) or (K, 8)
+    /// float32 rows `x, y, heading, speed, length, beam[, reach_m[, age_s]]` (world metres, radians, m/s, s; see
+    /// `Camera.render`): the vessels under way, whose wake foam returns over a wave surface.
     #[pyo3(signature = (scene, *, pose, env, seed, wakes=None))]
     fn scan<'py>(
         &self,
@@ -421,9 +421,11 @@ impl Camera {
     /// Renders the current state of `scene` from `pose` (4×4 camera body → world) in `env`. Returns a dict:
     /// depth (H,W) f32 metres along the axis (inf = sky), semantic (H,W) u16, instance (H,W) i32 (−1 = sky) and,
     /// for a camera built with `rgb=True`, rgb (H,W,3) u8 sRGB; with `radiance=True`, radiance (H,W,3) f32
-    /// linear cd/m² (before noise and exposure). `wakes` (K, 6) or (K, 7) float32 rows `x, y, heading, speed,
-    /// length, beam[, reach_m]` (world metres, radians, m/s; `reach_m` how far behind the stern the path ran
-    /// straight, inf when not given) are the vessels under way whose wakes the water shows.
+    /// linear cd/m² (before noise and exposure). `wakes` (K, 6), (K, 7) or (K, 8) float32 rows `x, y, heading,
+    /// speed, length, beam[, reach_m[, age_s]]` (world metres, radians, m/s; `reach_m` how far behind the stern
+    /// the path ran straight, inf when not given; with `age_s`, the rows are pieces of wakes that follow their
+    /// vessels' bends, `Simulation.wakes`: the foam is `age_s` old at the piece's start and ends at `reach_m`,
+    /// where the next piece goes on) are the vessels under way whose wakes the water shows.
     #[pyo3(signature = (scene, *, pose, env, seed, wakes=None, radiance=false))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
@@ -477,15 +479,30 @@ pub(crate) fn frame_dict(py: Python<'_>, f: camera::CameraFrame, rgb: bool) -> P
     Ok(d)
 }
 
-/// Wakes from a `(K, 6)` or `(K, 7)` float32 array (`x, y, heading, speed, length, beam[, reach_m]`), checked.
+/// Wakes from a `(K, 6)`, `(K, 7)` or `(K, 8)` float32 array (`x, y, heading, speed, length, beam[, reach_m[,
+/// age_s]]`), checked. Eight columns are the pieces of wakes that follow their vessels' bends
+/// (`mmusv.Simulation.wakes`): each piece's foam is `age_s` old at its start and ends at `reach_m` at full
+/// strength, where the next piece goes on.
 pub(crate) fn wakes_arg(wakes: Option<&PyReadonlyArray2<'_, f32>>) -> PyResult<Vec<Wake>> {
     let Some(w) = wakes else { return Ok(Vec::new()) };
-    // Six columns, or seven with how far behind the stern the path ran straight (inf: as far as the foam lasts).
-    let rows: Vec<[f32; 7]> = if numpy::PyUntypedArrayMethods::shape(&**w)[1] == 6 {
-        let six = crate::native::rows::<f32, 6>(w, "wakes")?;
-        six.iter().map(|r| [r[0], r[1], r[2], r[3], r[4], r[5], f32::INFINITY]).collect()
-    } else {
-        crate::native::rows::<f32, 7>(w, "wakes")?.to_vec()
+    let columns = numpy::PyUntypedArrayMethods::shape(&**w)[1];
+    let rows: Vec<[f32; 8]> = match columns {
+        6 => crate::native::rows::<f32, 6>(w, "wakes")?
+            .iter()
+            .map(|r| [r[0], r[1], r[2], r[3], r[4], r[5], f32::INFINITY, 0.0])
+            .collect(),
+        7 => crate::native::rows::<f32, 7>(w, "wakes")?
+            .iter()
+            .map(|r| [r[0], r[1], r[2], r[3], r[4], r[5], r[6], 0.0])
+            .collect(),
+        8 => crate::native::rows::<f32, 8>(w, "wakes")?.to_vec(),
+        _ => {
+            return Err(crate::errors::InputError::new_err(format!(
+                "wakes must have shape (K, 6), (K, 7) or (K, 8): x, y, heading, speed, length, beam[, reach_m[, \
+                 age_s]]; got {:?}",
+                numpy::PyUntypedArrayMethods::shape(&**w)
+            )))
+        }
     };
     rows.iter()
         .enumerate()
@@ -496,13 +513,25 @@ pub(crate) fn wakes_arg(wakes: Option<&PyReadonlyArray2<'_, f32>>) -> PyResult<V
                 || r[5] <= 0.0
                 || r[6].is_nan()
                 || r[6] < 0.0
+                || !(r[7].is_finite() && r[7] >= 0.0)
             {
                 return Err(crate::errors::InputError::new_err(format!(
-                    "wakes[{i}] = {r:?}: x, y, heading, speed, length, beam must be finite, with speed >= 0 and \
-                     length, beam > 0; reach_m >= 0 (inf: unlimited)"
+                    "wakes[{i}] = {:?}: x, y, heading, speed, length, beam must be finite, with speed >= 0 and \
+                     length, beam > 0; reach_m >= 0 (inf: unlimited); age_s finite and >= 0",
+                    &r[..columns.min(8)]
                 )));
             }
-            Ok(Wake { x: r[0], y: r[1], heading: r[2], speed: r[3], length: r[4], beam: r[5], reach_m: r[6] })
+            Ok(Wake {
+                x: r[0],
+                y: r[1],
+                heading: r[2],
+                speed: r[3],
+                length: r[4],
+                beam: r[5],
+                reach_m: r[6],
+                age_s: r[7],
+                goes_on: columns == 8,
+            })
         })
         .collect()
 }

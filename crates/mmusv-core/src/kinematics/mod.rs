@@ -14,9 +14,14 @@
 //!
 //! - [`spline`]: [`Route`] and [`EndBehaviour`].
 //! - [`waves`]: [`WaveSetting`], size factor, base amplitudes and the seeded periodic functions `g(t)`.
+//! - [`path_behind`]: how far back a vessel's path ran straight, and its straight pieces round the bends
+//!   ([`WakePiece`]).
 
+pub mod path_behind;
 pub mod spline;
 pub mod waves;
+
+pub use path_behind::WakePiece;
 
 pub use spline::{wrap_angle, EndBehaviour, Route};
 pub use waves::{mix_seed, BaseAmplitudes, PeriodicSignal, VesselDims, WaveSetting, WaveSignals};
@@ -169,51 +174,6 @@ impl VesselMotion {
         Ok(self.velocity_unchecked(t, wave, None))
     }
 
-    /// How far behind the vessel its own path at time `t` (finite, ≥ 0) runs straight back along its heading:
-    /// the largest distance `b ≤ max_m` (metres, along the heading, checked every `step_m`) such that every
-    /// point of its route within it lies within `tolerance_m` of the line back from its position along its
-    /// heading, ever farther behind (a reversal or a turn ends it); `f64::INFINITY` when straight to `max_m`, 0 at
-    /// rest. Before `t = 0` the vessel is taken to have come straight along its heading at the start (a
-    /// scenario starts with its vessels under way). A wake drawn straight behind a vessel is right this far.
-    pub fn straight_behind_m(&self, t: f64, max_m: f64, step_m: f64, tolerance_m: f64) -> Result<f64> {
-        check_time(t, "t")?;
-        for (name, v) in [("max_m", max_m), ("step_m", step_m), ("tolerance_m", tolerance_m)] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(MmusvError::input(name, format!("must be a finite distance > 0 m, got {v}")));
-            }
-        }
-        let heading = |d: f64| {
-            let (s, sign) = self.route.distance_to_arc(d);
-            let [tx, ty] = self.route.tangent(s);
-            (self.route.position(s), [tx * sign, ty * sign], sign)
-        };
-        let d_now = self.travelled_m(t);
-        let (p0, u, sign) = heading(d_now);
-        if sign == 0.0 || self.params.speed_mps == 0.0 {
-            return Ok(0.0);
-        }
-        let d_start = self.params.start_offset_m;
-        let (p_start, u_start, _) = heading(d_start);
-        let mut reach = 0.0;
-        let steps = (max_m / step_m).ceil() as usize;
-        for k in 1..=steps {
-            let d = d_now - (k as f64 * step_m).min(max_m);
-            let p = if d >= d_start {
-                self.route.position(self.route.distance_to_arc(d).0)
-            } else {
-                [p_start[0] - (d_start - d) * u_start[0], p_start[1] - (d_start - d) * u_start[1]]
-            };
-            let (rx, ry) = (p0[0] - p[0], p0[1] - p[1]);
-            let along = rx * u[0] + ry * u[1];
-            let across = (rx * u[1] - ry * u[0]).abs();
-            if across > tolerance_m || along <= reach {
-                return Ok(reach);
-            }
-            reach = along;
-        }
-        Ok(f64::INFINITY)
-    }
-
     fn pose_unchecked(&self, t: f64, wave: &WaveSetting, sea: Option<&WaveField>) -> [f64; 6] {
         let (s, sign) = self.route.distance_to_arc(self.travelled_m(t));
         let [x, y] = self.route.position(s);
@@ -344,7 +304,7 @@ impl Fleet {
 mod tests {
     use super::*;
 
-    fn straight_test_vessel(waypoints: &[[f64; 2]], end: EndBehaviour, speed: f64) -> VesselMotion {
+    pub(super) fn straight_test_vessel(waypoints: &[[f64; 2]], end: EndBehaviour, speed: f64) -> VesselMotion {
         let route = Route::new(waypoints, end).unwrap_or_else(|e| unreachable!("{e}"));
         let params = VesselParams {
             speed_mps: speed,
@@ -355,37 +315,6 @@ mod tests {
             hull: REFERENCE_HULL,
         };
         VesselMotion::new(route, params, WaveSignals::from_seed(1, 0)).unwrap_or_else(|e| unreachable!("{e}"))
-    }
-
-    /// A straight route is straight behind as far as asked (also back before the start); a ping-pong route is
-    /// straight only back to where it turned; a circle only as far as its arc stays within the tolerance of the
-    /// tangent, `√(2 R tol)` for a radius R.
-    #[test]
-    fn straight_behind_follows_the_path_travelled() {
-        let ok = |r: Result<f64>| r.unwrap_or_else(|e| unreachable!("{e}"));
-        let line = straight_test_vessel(&[[0.0, 0.0], [1000.0, 0.0]], EndBehaviour::Stop, 5.0);
-        assert_eq!(ok(line.straight_behind_m(10.0, 600.0, 2.0, 1.0)), f64::INFINITY);
-        assert_eq!(ok(line.straight_behind_m(0.0, 600.0, 2.0, 1.0)), f64::INFINITY);
-        assert_eq!(ok(line.straight_behind_m(300.0, 600.0, 2.0, 1.0)), 0.0, "at rest at the end");
-        // Ping-pong on a 100 m leg at 5 m/s: at t = 24 s it turned 20 m ago (d = 120 m).
-        let pp = straight_test_vessel(&[[0.0, 0.0], [100.0, 0.0]], EndBehaviour::PingPong, 5.0);
-        let b = ok(pp.straight_behind_m(24.0, 600.0, 1.0, 1.0));
-        assert!((b - 20.0).abs() <= 1.0 + 1e-9, "{b}");
-        // A loop on a circle of radius 100 m (a 64-gon through the spline).
-        let r = 100.0;
-        let ring: Vec<[f64; 2]> = (0..=64)
-            .map(|k| {
-                let a = std::f64::consts::TAU * k as f64 / 64.0;
-                [r * a.cos(), r * a.sin()]
-            })
-            .collect();
-        let circle = straight_test_vessel(&ring, EndBehaviour::Loop, 5.0);
-        let tol = 2.0;
-        let b = ok(circle.straight_behind_m(30.0, 600.0, 0.5, tol));
-        let want = (2.0 * r * tol).sqrt();
-        assert!((b - want).abs() < 0.1 * want, "{b} against {want}");
-        assert!(line.straight_behind_m(1.0, 0.0, 2.0, 1.0).is_err());
-        assert!(line.straight_behind_m(f64::NAN, 10.0, 2.0, 1.0).is_err());
     }
 
     const CURVY: [[f64; 2]; 5] = [[0.0, 0.0], [60.0, 20.0], [80.0, 90.0], [10.0, 120.0], [-50.0, 60.0]];

@@ -144,6 +144,9 @@ pub struct CameraFrame {
 /// Side of the square pixel tiles rays are traced in: a tile's 16 rays form one packet (see
 /// [`crate::bvh::packet`]), much tighter than 16 pixels of a row.
 const TILE: u32 = 4;
+/// Half-side of the square around a camera over which its wakes are indexed (metres): most of its water pixels
+/// lie within it; farther ones try every wake.
+const FOAM_INDEX_M: f32 = 1_000.0;
 
 /// World-frame ray origins and unit directions, one row per ray.
 pub type WorldRays = (Vec<[f32; 3]>, Vec<[f32; 3]>);
@@ -390,7 +393,8 @@ impl Camera {
             .with_materials(scene.material_table())
             .with_seabed(scene.seabed())
             .with_waves(scene.wave_surface())
-            .with_footprint(pixel_rad, pixel_m);
+            .with_footprint(pixel_rad, pixel_m)
+            .with_foam_around([pose.translation.x, pose.translation.y], self.cfg.range_max.min(FOAM_INDEX_M));
         // Standard quality shares one traced reflection per 2 × 2 (or 4 × 4) block of water pixels; high traces
         // each; both spread them over the water's glossy lobe. Below
         // `high`, open water and sky share their shading over the pixels between even rows and columns wherever

@@ -202,8 +202,17 @@ mod tests {
             SensorTask::Radar { radar: &radar, pose: a, seed: 16, ppi: None },
             SensorTask::Lidar { lidar: &lidar, pose: b, seed: 17 },
         ];
-        let wakes =
-            [Wake { x: 0.0, y: 0.0, heading: 0.3, speed: 9.0, length: 20.0, beam: 5.0, reach_m: f32::INFINITY }];
+        let wakes = [Wake {
+            x: 0.0,
+            y: 0.0,
+            heading: 0.3,
+            speed: 9.0,
+            length: 20.0,
+            beam: 5.0,
+            reach_m: f32::INFINITY,
+            age_s: 0.0,
+            goes_on: false,
+        }];
         let batch = capture_frame(&scene, &env, &wakes, &tasks)?;
         assert_eq!(batch.len(), tasks.len());
         let one = |t: &SensorTask<'_>| -> Result<SensorOutput> {

@@ -319,6 +319,13 @@ impl Shader {
         self
     }
 
+    /// This shader's wakes indexed around a camera at `centre` (world x, y) out to `radius` metres
+    /// ([`Foam::around`]): the same foam to the bit, each water point trying only the wakes that may reach it.
+    pub fn with_foam_around(mut self, centre: [f32; 2], radius: f32) -> Self {
+        self.foam = std::mem::take(&mut self.foam).around(centre, radius);
+        self
+    }
+
     /// This shader seeing the water with pixels of `pixel_rad` radians (a pinhole camera's) or `pixel_m` metres
     /// (an orthographic one's): a hit's footprint on the water, `(pixel_m + t · pixel_rad) / |d_z|`, chooses
     /// which of the sea's detail bands it draws as normals ([`WaveSurface::shading`]). Both 0 (the default):

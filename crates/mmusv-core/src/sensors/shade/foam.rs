@@ -18,11 +18,15 @@
 //! * **Wakes**: behind every vessel under way, turbulent foam along its track (as wide as its beam, widening
 //!   slowly) and two arms at the Kelvin angle `asin(1/3) = 19.47°` (Lord Kelvin, 1887) from the bow, both fading
 //!   with their age `distance / speed` (e-folding 30 s); the foam grows with speed (track `min(1, (V / 6 m/s)²)`,
-//!   arms `min(1, (V / 8 m/s)²)`), so a slow craft leaves a faint trace. The wake follows the vessel's current
-//!   heading (a straight track), so it is drawn only as far back as the vessel's own path ran straight
-//!   ([`Wake::reach_m`]: within a beam of that line; a turn or the reversal of a ping-pong route ends it), thinning
-//!   to nothing over the last quarter of that stretch (at most four beams): no foam where the vessel never went,
-//!   none of its older foam round the bend either.
+//!   arms `min(1, (V / 8 m/s)²)`), so a slow craft leaves a faint trace. A wake is drawn as straight pieces of
+//!   the path behind its vessel ([`Wake`] rows; `mmusv.Simulation.wakes` works them out from the route,
+//!   `VesselMotion::wake_pieces`): the vessel's own, straight back along its heading as far as its path ran
+//!   straight ([`Wake::reach_m`]), then, round each bend, a piece from where the vessel was [`Wake::age_s`] ago,
+//!   whose foam is as faded and as widened as that age makes it and ends where the next piece goes on (reaching
+//!   past its end by the track's half-width, to fill the bend's outer corner). Only the vessel's own piece draws
+//!   the Kelvin arms: the arms of the path before a bend, which bend with it, are left out. A wake row without a
+//!   piece after it whose path bent (`reach_m` short of the foam's own reach) thins to nothing over the last
+//!   quarter of that stretch (at most four beams). No foam where the vessel never went.
 
 use super::super::noise;
 
@@ -39,6 +43,9 @@ const WAKE_FADE_S: f32 = 30.0;
 /// The oldest wake foam drawn, seconds (four e-folding ages: 2 % of its fresh density); a wake reaches this
 /// long times the speed behind the stern, less where the path bent ([`Wake::reach_m`]).
 pub const WAKE_REACH_S: f32 = 4.0 * WAKE_FADE_S;
+/// Most straight pieces a wake is drawn in (`mmusv.Simulation.wakes`: the path behind a vessel, piece by piece
+/// round its bends; the last one goes on straight).
+pub const WAKE_MAX_PIECES: usize = 32;
 /// `tan` of the Kelvin half-angle.
 const KELVIN_TAN: f32 = 0.353_553_4;
 /// Stream of the foam noise.
@@ -63,6 +70,13 @@ pub struct Wake {
     /// as far as the foam lasts): the wake is drawn straight behind the vessel, so no farther than its path was
     /// (a turn or a reversal ends it; `mmusv.Simulation.wakes` works it out from the route).
     pub reach_m: f32,
+    /// How old the foam at the stern point is, seconds (0 for a vessel's own position; a piece of its path further
+    /// back, `mmusv.Simulation.wakes`, passed that long ago): the foam fades and its track widens from that age on,
+    /// and a row older than 0 draws no Kelvin arms (the vessel's own piece draws them).
+    pub age_s: f32,
+    /// Whether the vessel's older foam goes on past `reach_m` in another row (a piece of a wake that follows the
+    /// path's bends): the foam then ends there at full strength instead of thinning out before it.
+    pub goes_on: bool,
 }
 
 /// Smooth value noise in `[0, 1]` at `(x, y)` on a unit lattice (hashed corners, smoothstep blend).
@@ -205,14 +219,16 @@ pub struct Foam {
     grid: Option<WakeGrid>,
 }
 
-/// Which wakes may lay foam in each cell of a square grid: a bit per wake (at most 64), set wherever the wake's
-/// track or arms may reach into the cell. The test is conservative (a cell's every point within its half-diagonal,
-/// plus a centimetre for rounding, of its centre), so a wake whose bit is clear gives no foam there.
+/// Which wakes may lay foam in each cell of a square grid: a bit per wake (`words` 64-bit words a cell), set
+/// wherever the wake's track or arms may reach into the cell. The test is conservative (a cell's every point within
+/// its half-diagonal, plus a centimetre for rounding, of its centre), so a wake whose bit is clear gives no foam
+/// there.
 #[derive(Debug, Clone, Default)]
 struct WakeGrid {
     origin: [f32; 2],
     inv_cell: f32,
     n: usize,
+    words: usize,
     bits: Vec<u64>,
 }
 
@@ -220,15 +236,16 @@ impl WakeGrid {
     /// Cells per side.
     const N: usize = 32;
 
-    /// The wakes that may lay foam at `(x, y)`; `None` outside the grid (every wake then).
+    /// The wakes that may lay foam at `(x, y)` (a bit per wake); `None` outside the grid (every wake then).
     #[inline(always)]
-    fn mask(&self, x: f32, y: f32) -> Option<u64> {
+    fn mask(&self, x: f32, y: f32) -> Option<&[u64]> {
         let (u, v) = ((x - self.origin[0]) * self.inv_cell, (y - self.origin[1]) * self.inv_cell);
         if !(u >= 0.0 && v >= 0.0) {
             return None;
         }
         let (i, j) = (u as usize, v as usize);
-        (i < self.n && j < self.n).then(|| self.bits[j * self.n + i])
+        let at = (j * self.n + i) * self.words;
+        (i < self.n && j < self.n).then(|| &self.bits[at..at + self.words])
     }
 }
 
@@ -242,6 +259,15 @@ struct WakeShape {
     /// Where the vessel's path bent ([`Wake::reach_m`] short of the foam's own reach): the foam thins linearly to
     /// nothing over this last stretch before `reach` (0: no such end).
     taper: f32,
+    /// The fade of the foam at the stern point, for its age there ([`Wake::age_s`]; 1 for a fresh one).
+    fade0: f32,
+    /// How far along the path the vessel has gone since it passed the stern point (`age_s · speed`, metres): the
+    /// track has widened over that much more.
+    back: f32,
+    /// Whether the Kelvin arms are drawn (from the vessel itself, not from a piece of its path further back).
+    arms: bool,
+    /// The track's half-width at its reach (its widest), metres.
+    widest: f32,
     speed: f32,
     length: f32,
     beam: f32,
@@ -260,7 +286,18 @@ impl WakeShape {
     /// Half-width of the turbulent track `behind` metres behind the stern (widening slowly).
     #[inline(always)]
     fn track_half_width(&self, behind: f32) -> f32 {
-        0.5 * self.beam * (1.0 + (behind.max(0.0) / self.beam.max(1.0)).sqrt() * 0.25)
+        0.5 * self.beam * (1.0 + ((behind.max(0.0) + self.back) / self.beam.max(1.0)).sqrt() * 0.25)
+    }
+
+    /// Farther from the centre line than this, `behind` metres behind the stern, no foam: outside the Kelvin arms
+    /// and the track (with arms), or the track at its widest (a piece without them).
+    #[inline(always)]
+    fn wedge(&self, behind: f32) -> f32 {
+        if self.arms {
+            0.6 * self.beam + (behind.max(0.0) + self.length) * (KELVIN_TAN + 0.07) + 0.3
+        } else {
+            self.widest
+        }
     }
 
     /// Width of a Kelvin arm `behind` metres behind the stern.
@@ -281,7 +318,7 @@ impl WakeShape {
         if lateral - r < self.track_half_width(far) {
             return true;
         }
-        if behind + r <= 0.0 {
+        if behind + r <= 0.0 || !self.arms {
             return false;
         }
         (lateral - (behind + self.length) * KELVIN_TAN).abs() - r * (1.0 + KELVIN_TAN) < self.arm_width(far)
@@ -295,7 +332,8 @@ impl WakeShape {
         if behind <= -0.1 * w.length || behind > w.reach {
             return 0.0;
         }
-        if lateral > 0.6 * w.beam + (behind.max(0.0) + w.length) * (KELVIN_TAN + 0.07) + 0.3 {
+        // Beyond the arms (or, for a piece further back, without them, beyond its track at its widest).
+        if lateral > w.wedge(behind) {
             return 0.0;
         }
         // Turbulent track behind the stern, and the Kelvin arms from the bow: whether the point is on either
@@ -304,11 +342,11 @@ impl WakeShape {
         let on_track = lateral < half;
         let width = w.arm_width(behind);
         let off = (lateral - (behind + w.length) * KELVIN_TAN).abs();
-        let on_arm = behind > 0.0 && off < width;
+        let on_arm = w.arms && behind > 0.0 && off < width;
         if !on_track && !on_arm {
             return 0.0;
         }
-        let mut fade = (-behind.max(0.0) / (w.speed * WAKE_FADE_S)).exp();
+        let mut fade = (-behind.max(0.0) / (w.speed * WAKE_FADE_S)).exp() * w.fade0;
         if w.taper > 0.0 && behind > w.reach - w.taper {
             fade *= (w.reach - behind) / w.taper;
         }
@@ -337,15 +375,30 @@ impl Foam {
             .filter(|w| w.speed > 0.05)
             .map(|w| {
                 let (s, c) = w.heading.sin_cos();
-                WakeShape {
+                // The foam's own reach: as far back as it is at most `WAKE_REACH_S` old.
+                let age = w.age_s.max(0.0);
+                let lasts = w.speed * (WAKE_REACH_S - age).max(0.0);
+                let bent = w.reach_m < lasts && !w.goes_on;
+                let mut shape = WakeShape {
                     stern: [w.x - c * w.length * 0.5, w.y - s * w.length * 0.5],
                     dir: [c, s],
-                    reach: (w.speed * WAKE_REACH_S).min(w.reach_m),
-                    taper: if w.reach_m < w.speed * WAKE_REACH_S { (0.25 * w.reach_m).min(4.0 * w.beam) } else { 0.0 },
+                    reach: lasts.min(w.reach_m),
+                    taper: if bent { (0.25 * w.reach_m).min(4.0 * w.beam) } else { 0.0 },
+                    fade0: (-age / WAKE_FADE_S).exp(),
+                    back: age * w.speed,
+                    arms: age <= 0.0,
+                    widest: 0.0,
                     speed: w.speed,
                     length: w.length,
                     beam: w.beam,
+                };
+                // A piece whose older foam goes on in the next one reaches on past its end by its track's
+                // half-width there, to fill the corner on the outer side of the bend between the two.
+                if w.goes_on && w.reach_m < lasts {
+                    shape.reach = lasts.min(w.reach_m + shape.track_half_width(w.reach_m));
                 }
+                shape.widest = shape.track_half_width(shape.reach);
+                shape
             })
             .collect();
         Self { threshold, band, coverage, crests: false, plain: (threshold, band), seed, wakes, grid: None }
@@ -354,26 +407,29 @@ impl Foam {
     /// This foam with its wakes indexed on a grid over the square of half-side `radius` metres around `centre`
     /// (a sensor's position, `radius` the reach of its water hits): a point there tries only the wakes that may
     /// lay foam in its cell (the same cover, to the bit: a wake left out gives none); points outside try every
-    /// wake. Nothing changes with no wakes, more than 64, or a radius that is not a positive number.
+    /// wake. Nothing changes with no wakes or a radius that is not a positive number.
     pub fn around(mut self, centre: [f32; 2], radius: f32) -> Self {
-        if self.wakes.is_empty() || self.wakes.len() > 64 || !(radius > 0.0 && radius.is_finite()) {
+        if self.wakes.is_empty() || !(radius > 0.0 && radius.is_finite()) {
             return self;
         }
         let n = WakeGrid::N;
+        let words = self.wakes.len().div_ceil(64);
         let cell = 2.0 * radius / n as f32;
         let origin = [centre[0] - radius, centre[1] - radius];
         let reach = cell * std::f32::consts::FRAC_1_SQRT_2 * 1.001 + 0.01;
-        let mut bits = Vec::with_capacity(n * n);
+        let mut bits = vec![0u64; n * n * words];
         for j in 0..n {
             for i in 0..n {
                 let c = [origin[0] + (i as f32 + 0.5) * cell, origin[1] + (j as f32 + 0.5) * cell];
-                let m = (self.wakes.iter().enumerate())
-                    .filter(|(_, w)| w.may_reach(c, reach))
-                    .fold(0u64, |m, (k, _)| m | (1u64 << k));
-                bits.push(m);
+                let cell_bits = &mut bits[(j * n + i) * words..(j * n + i + 1) * words];
+                for (k, w) in self.wakes.iter().enumerate() {
+                    if w.may_reach(c, reach) {
+                        cell_bits[k / 64] |= 1u64 << (k % 64);
+                    }
+                }
             }
         }
-        self.grid = Some(WakeGrid { origin, inv_cell: 1.0 / cell, n, bits });
+        self.grid = Some(WakeGrid { origin, inv_cell: 1.0 / cell, n, words, bits });
         self
     }
 
@@ -416,11 +472,14 @@ impl Foam {
         }
         let mut noise_at = || *nz.get_or_insert_with(|| foam_noise(self.seed, x, y));
         match self.grid.as_ref().and_then(|g| g.mask(x, y)) {
-            Some(mut m) => {
-                while m != 0 {
-                    let k = m.trailing_zeros() as usize;
-                    m &= m - 1;
-                    c = c.max(self.wakes[k].foam_at(x, y, &mut noise_at));
+            Some(words) => {
+                for (base, &word) in words.iter().enumerate() {
+                    let mut m = word;
+                    while m != 0 {
+                        let k = base * 64 + m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        c = c.max(self.wakes[k].foam_at(x, y, &mut noise_at));
+                    }
                 }
             }
             None => {
@@ -550,7 +609,9 @@ mod tests {
                     speed: 1.0 + 2.3 * f,
                     length: 4.0 + 30.0 * f,
                     beam: 2.0 + 3.0 * f,
-                    reach_m: if i == 3 { 40.0 } else { f32::INFINITY },
+                    reach_m: if i == 3 || i == 5 { 40.0 } else { f32::INFINITY },
+                    age_s: if i == 5 { 25.0 } else { 0.0 },
+                    goes_on: i == 5,
                 }
             })
             .collect();
@@ -566,10 +627,38 @@ mod tests {
             assert_eq!(a.to_bits(), b.to_bits(), "({x}, {y})");
             foamy += usize::from(a > 0.0);
             let g = indexed.grid.as_ref().unwrap_or_else(|| unreachable!());
-            tried_none += usize::from(g.mask(x, y) == Some(0));
+            tried_none += usize::from(g.mask(x, y).is_some_and(|m| m.iter().all(|&w| w == 0)));
         }
         assert!(foamy > 10_000, "{foamy}");
         assert!(tried_none > 75_000, "{tried_none}");
+        // More wakes than one word holds (the pieces of wakes round their vessels' bends, many vessels).
+        let many: Vec<Wake> = (0..150)
+            .map(|i| {
+                let f = i as f32;
+                Wake {
+                    x: 7.0 * f - 500.0,
+                    y: 30.0 * (f * 0.37).sin(),
+                    heading: 0.41 * f,
+                    speed: 2.0 + (i % 9) as f32,
+                    length: 5.0 + (i % 5) as f32 * 8.0,
+                    beam: 2.0 + (i % 4) as f32,
+                    reach_m: 20.0 + 3.0 * (i % 11) as f32,
+                    age_s: (i % 7) as f32 * 6.0,
+                    goes_on: i % 2 == 0,
+                }
+            })
+            .collect();
+        let plain = Foam::new(0.0, &many, 5);
+        let indexed = plain.clone().around([-100.0, 0.0], 300.0);
+        let mut foamy = 0;
+        for i in 0..100_000u64 {
+            let x = noise::uniform(4, 1, 2 * i) as f32 * 700.0 - 450.0;
+            let y = noise::uniform(4, 1, 2 * i + 1) as f32 * 700.0 - 350.0;
+            let (a, b) = (plain.cover(x, y, None), indexed.cover(x, y, None));
+            assert_eq!(a.to_bits(), b.to_bits(), "({x}, {y})");
+            foamy += usize::from(a > 0.0);
+        }
+        assert!(foamy > 5_000, "{foamy}");
         // No grid without wakes, or with a radius that is not a positive number.
         assert!(Foam::new(0.02, &[], 1).around([0.0, 0.0], 100.0).grid.is_none());
         assert!(Foam::new(0.0, &wakes, 1).around([0.0, 0.0], f32::NAN).grid.is_none());
@@ -577,7 +666,17 @@ mod tests {
 
     #[test]
     fn wake_lies_behind_and_on_the_kelvin_arms() {
-        let w = Wake { x: 0.0, y: 0.0, heading: 0.0, speed: 12.0, length: 10.0, beam: 3.0, reach_m: f32::INFINITY };
+        let w = Wake {
+            x: 0.0,
+            y: 0.0,
+            heading: 0.0,
+            speed: 12.0,
+            length: 10.0,
+            beam: 3.0,
+            reach_m: f32::INFINITY,
+            age_s: 0.0,
+            goes_on: false,
+        };
         let foam = Foam::new(0.0, &[w], 3);
         // The mean cover over a patch (the foam is broken up by noise, so single points may be clear).
         let patch = |f: &Foam, x: f32, y: f32| {
@@ -608,5 +707,28 @@ mod tests {
         assert_eq!(patch(&turned, behind, 38.89), 0.0);
         assert_eq!(patch(&turned, -5.0 - 40.0, 0.0), 0.0);
         assert!(patch(&foam, -5.0 - 40.0, 0.0) > 0.1);
+        // An older piece of a wake (its vessel passed its start 30 s, 360 m, ago): on its track, the foam of a
+        // vessel 360 m further on along the same line, as faded and widened since; without the Kelvin arms.
+        let aged = Foam::new(0.0, &[Wake { age_s: 30.0, goes_on: true, ..w }], 3);
+        let ahead = Foam::new(0.0, &[Wake { x: 360.0, ..w }], 3);
+        for (x, y) in [(-5.0 - 200.0, 0.0), (-5.0 - 100.0, 4.0), (-5.0 - 300.0, -5.5)] {
+            let (a, b) = (patch(&aged, x, y), patch(&ahead, x, y));
+            assert!(a > 0.02 && (a - b).abs() <= 1e-5 * b, "({x}, {y}): {a} against {b}");
+        }
+        assert_eq!(patch(&aged, behind, 38.89), 0.0);
+        // Its foam lasts only what is left of its life: 120 s − 100 s at 12 m/s, 240 m.
+        let old = Foam::new(0.0, &[Wake { age_s: 100.0, goes_on: true, ..w }], 3);
+        assert!(patch(&old, -5.0 - 200.0, 0.0) > 0.0);
+        assert_eq!(patch(&old, -5.0 - 250.0, 0.0), 0.0);
+        // A piece whose older foam goes on in the next one ends at its reach at full strength (past it by its
+        // track's half-width, 3.2 m here, to fill the bend's outer corner); a wake whose path bent with nothing after
+        // it thins out before.
+        let piece = Foam::new(0.0, &[Wake { reach_m: 60.0, goes_on: true, ..w }], 3);
+        let ended = Foam::new(0.0, &[Wake { reach_m: 60.0, ..w }], 3);
+        let near_end = -5.0 - 52.0;
+        assert_eq!(patch(&piece, near_end, 0.0), patch(&foam, near_end, 0.0));
+        assert!(patch(&ended, near_end, 0.0) < 0.7 * patch(&piece, near_end, 0.0));
+        assert_eq!(patch(&piece, -5.0 - 69.0, 0.0), 0.0);
+        assert!(patch(&piece, -5.0 - 63.0, 0.0) > 0.0);
     }
 }
