@@ -35,24 +35,11 @@ fn check_distances(max_m: f64, step_m: f64, tolerance_m: f64) -> Result<()> {
 }
 
 impl VesselMotion {
-    /// How far behind the vessel its own path at time `t` (finite, ≥ 0) runs straight back along its heading:
-    /// the largest distance `b ≤ max_m` (metres, along the heading, checked every `step_m`) such that every
-    /// point of its route within it lies within `tolerance_m` of the line back from its position along its
-    /// heading, ever farther behind (a reversal or a turn ends it); `f64::INFINITY` when straight to `max_m`, 0 at
-    /// rest. Before `t = 0` the vessel is taken to have come straight along its heading at the start (a
-    /// scenario starts with its vessels under way). A wake drawn straight behind a vessel is right this far.
-    pub fn straight_behind_m(&self, t: f64, max_m: f64, step_m: f64, tolerance_m: f64) -> Result<f64> {
-        check_time(t, "t")?;
-        check_distances(max_m, step_m, tolerance_m)?;
-        if self.route_heading(self.travelled_m(t)).2 == 0.0 || self.params.speed_mps == 0.0 {
-            return Ok(0.0);
-        }
-        Ok(self.straight_run(self.travelled_m(t), max_m, step_m, tolerance_m).0)
-    }
-
-    /// The vessel's path behind it at time `t` as straight pieces, newest first, for a wake that follows the
-    /// bends: the first is [`VesselMotion::straight_behind_m`]'s stretch from the vessel itself, along its
-    /// heading; each next one starts where the path stopped running straight within `tolerance_m` of the one
+    /// The vessel's path behind it at time `t` (finite, ≥ 0) as straight pieces, newest first, for a wake that
+    /// follows the bends. The first is the vessel's own, back along its heading from its position: as far as
+    /// every point of the route behind (checked every `step_m`) lies within `tolerance_m` of that line, ever
+    /// farther behind (a reversal or a turn ends it); before `t = 0` the vessel is taken to have come straight
+    /// along its heading at the start (a scenario starts with its vessels under way). Each next one starts where the path stopped running straight within `tolerance_m` of the one
     /// before (the vessel's centre there, and how long ago it passed there, `age_s`) and runs along the chord to
     /// the next one's start (`heading` the direction of travel, `reach_m` the chord's length), until `max_m` of
     /// path or `max_pieces` pieces; the last reaches on straight along the vessel's heading there (`reach_m`
@@ -150,35 +137,41 @@ mod tests {
     use crate::kinematics::{EndBehaviour, WaveSetting};
     use std::f64::consts::PI;
 
-    /// A straight route is straight behind as far as asked (also back before the start); a ping-pong route is
-    /// straight only back to where it turned; a circle only as far as its arc stays within the tolerance of the
-    /// tangent, `√(2 R tol)` for a radius R.
-    #[test]
-    fn straight_behind_follows_the_path_travelled() {
-        let ok = |r: Result<f64>| r.unwrap_or_else(|e| unreachable!("{e}"));
-        let line = straight_test_vessel(&[[0.0, 0.0], [1000.0, 0.0]], EndBehaviour::Stop, 5.0);
-        assert_eq!(ok(line.straight_behind_m(10.0, 600.0, 2.0, 1.0)), f64::INFINITY);
-        assert_eq!(ok(line.straight_behind_m(0.0, 600.0, 2.0, 1.0)), f64::INFINITY);
-        assert_eq!(ok(line.straight_behind_m(300.0, 600.0, 2.0, 1.0)), 0.0, "at rest at the end");
-        // Ping-pong on a 100 m leg at 5 m/s: at t = 24 s it turned 20 m ago (d = 120 m).
-        let pp = straight_test_vessel(&[[0.0, 0.0], [100.0, 0.0]], EndBehaviour::PingPong, 5.0);
-        let b = ok(pp.straight_behind_m(24.0, 600.0, 1.0, 1.0));
-        assert!((b - 20.0).abs() <= 1.0 + 1e-9, "{b}");
-        // A loop on a circle of radius 100 m (a 64-gon through the spline).
-        let r = 100.0;
-        let ring: Vec<[f64; 2]> = (0..=64)
+    /// A ring of radius `r` metres round the origin (a 64-gon through the spline).
+    fn ring(r: f64) -> Vec<[f64; 2]> {
+        (0..=64)
             .map(|k| {
                 let a = std::f64::consts::TAU * k as f64 / 64.0;
                 [r * a.cos(), r * a.sin()]
             })
-            .collect();
-        let circle = straight_test_vessel(&ring, EndBehaviour::Loop, 5.0);
-        let tol = 2.0;
-        let b = ok(circle.straight_behind_m(30.0, 600.0, 0.5, tol));
+            .collect()
+    }
+
+    /// The vessel's own piece: on a straight route, straight behind as far as asked (also back before the start);
+    /// on a ping-pong route only back to where it turned; on a circle only as far as its arc stays within the
+    /// tolerance of the tangent, `√(2 R tol)` for a radius R. None at rest.
+    #[test]
+    fn the_vessels_own_piece_runs_as_far_as_the_path_ran_straight() {
+        let own = |v: &VesselMotion, t: f64, step: f64, tol: f64| {
+            let pieces = v.wake_pieces(t, 600.0, step, tol, 32).unwrap_or_else(|e| unreachable!("{e}"));
+            pieces.first().map(|p| p.reach_m)
+        };
+        let line = straight_test_vessel(&[[0.0, 0.0], [1000.0, 0.0]], EndBehaviour::Stop, 5.0);
+        assert_eq!(own(&line, 10.0, 2.0, 1.0), Some(f64::INFINITY));
+        assert_eq!(own(&line, 0.0, 2.0, 1.0), Some(f64::INFINITY));
+        assert_eq!(own(&line, 300.0, 2.0, 1.0), None, "at rest at the end");
+        // Ping-pong on a 100 m leg at 5 m/s: at t = 24 s it turned 20 m ago (d = 120 m).
+        let pp = straight_test_vessel(&[[0.0, 0.0], [100.0, 0.0]], EndBehaviour::PingPong, 5.0);
+        let b = own(&pp, 24.0, 1.0, 1.0).unwrap_or(f64::NAN);
+        assert!((b - 20.0).abs() <= 1.0 + 1e-9, "{b}");
+        // A loop on a circle of radius 100 m.
+        let (r, tol) = (100.0, 2.0);
+        let circle = straight_test_vessel(&ring(r), EndBehaviour::Loop, 5.0);
+        let b = own(&circle, 30.0, 0.5, tol).unwrap_or(f64::NAN);
         let want = (2.0 * r * tol).sqrt();
         assert!((b - want).abs() < 0.1 * want, "{b} against {want}");
-        assert!(line.straight_behind_m(1.0, 0.0, 2.0, 1.0).is_err());
-        assert!(line.straight_behind_m(f64::NAN, 10.0, 2.0, 1.0).is_err());
+        assert!(line.wake_pieces(1.0, 0.0, 2.0, 1.0, 32).is_err());
+        assert!(line.wake_pieces(f64::NAN, 10.0, 2.0, 1.0, 32).is_err());
     }
 
     /// The pieces of the path behind a vessel follow it round its bends: on a route with a right-angle corner
@@ -242,13 +235,7 @@ mod tests {
         assert!((pieces[1].age_s - 4.0).abs() <= 0.2 && (pieces[1].x - 100.0).abs() <= 1.0, "{:?}", pieces[1]);
         // A circle of radius 100 m: pieces of about √(2 R tol), all on the circle, the last going on straight.
         let r = 100.0;
-        let ring: Vec<[f64; 2]> = (0..=64)
-            .map(|k| {
-                let a = std::f64::consts::TAU * k as f64 / 64.0;
-                [r * a.cos(), r * a.sin()]
-            })
-            .collect();
-        let circle = straight_test_vessel(&ring, EndBehaviour::Loop, 5.0);
+        let circle = straight_test_vessel(&ring(r), EndBehaviour::Loop, 5.0);
         let pieces = ok(circle.wake_pieces(60.0, 300.0, 0.5, 2.0, 32));
         let want = (2.0 * r * 2.0_f64).sqrt();
         for p in &pieces[..pieces.len() - 1] {

@@ -89,6 +89,25 @@ pub fn specular_cos(n: Vec3, v: Vec3, l: Vec3, alpha: f32) -> f32 {
     d * g / (4.0 * nv)
 }
 
+/// A facet normal of the Beckmann distribution of roughness `alpha`, drawn from `D(m) cos θ_m` by the uniform
+/// numbers `u1` (the slope's size) and `u2` (its azimuth): `tan²θ_m = −α² ln(1 − u1)`, `φ = 2π u2`.
+#[inline]
+pub fn beckmann_facet(alpha: f64, u1: f64, u2: f64) -> [f64; 3] {
+    let tan2 = -alpha * alpha * (1.0 - u1).ln();
+    let cos_m = 1.0 / (1.0 + tan2).sqrt();
+    let sin_m = (1.0 - cos_m * cos_m).max(0.0).sqrt();
+    let phi = std::f64::consts::TAU * u2;
+    [sin_m * phi.cos(), sin_m * phi.sin(), cos_m]
+}
+
+/// The facet normals ([`beckmann_facet`]) at the midpoints of a `strata × strata` stratified grid of `(u1, u2)`:
+/// the quadratures' sample of the facets, each standing for `1 / strata²` of `D(m) cos θ_m`.
+pub fn stratified_facets(alpha: f64, strata: usize) -> impl Iterator<Item = [f64; 3]> {
+    let n = strata as f64;
+    (0..strata)
+        .flat_map(move |a| (0..strata).map(move |b| beckmann_facet(alpha, (a as f64 + 0.5) / n, (b as f64 + 0.5) / n)))
+}
+
 /// `E(μ_o, α)` by quadrature (see the module docs): facet normals drawn from the Beckmann distribution on a
 /// `strata × strata` stratified grid, each weighted by `F G₁(ω_o) G₁(ω_i) (ω_o·h) / (μ_o cos θ_h)`.
 pub fn reflectance_quadrature(mu_o: f64, alpha: f64, strata: usize) -> f64 {
@@ -107,34 +126,25 @@ pub fn lobe_quadrature(mu_o: f64, alpha: f64, strata: usize) -> [f64; 4] {
     let wo = [(1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu];
     let g_o = smith_g1(mu, alpha);
     let (mut sum, mut s_el, mut s_el2, mut s_az2) = (0.0, 0.0, 0.0, 0.0);
-    for a in 0..strata {
-        for b in 0..strata {
-            let u1 = (a as f64 + 0.5) / strata as f64;
-            let u2 = (b as f64 + 0.5) / strata as f64;
-            let tan2 = -alpha * alpha * (1.0 - u1).ln();
-            let cos_h = 1.0 / (1.0 + tan2).sqrt();
-            let sin_h = (1.0 - cos_h * cos_h).max(0.0).sqrt();
-            let phi = std::f64::consts::TAU * u2;
-            let h = [sin_h * phi.cos(), sin_h * phi.sin(), cos_h];
-            let c = wo[0] * h[0] + wo[2] * h[2];
-            if c <= 0.0 {
-                continue;
-            }
-            let wi = [2.0 * c * h[0] - wo[0], 2.0 * c * h[1], 2.0 * c * h[2] - wo[2]];
-            if wi[2] <= 0.0 {
-                continue;
-            }
-            let f = f64::from(fresnel_dielectric(c as f32, IOR));
-            let w = f * g_o * smith_g1(wi[2], alpha) * c / (mu * cos_h);
-            // The reflected direction's elevation, and its azimuth about the mirror direction's (which is 0: the
-            // mirror of ω_o lies in the x–z plane, leaving along −x).
-            let el = wi[2].clamp(-1.0, 1.0).asin() - mirror_el;
-            let az = wi[1].atan2(-wi[0]);
-            sum += w;
-            s_el += w * el;
-            s_el2 += w * el * el;
-            s_az2 += w * az * az;
+    for h in stratified_facets(alpha, strata) {
+        let c = wo[0] * h[0] + wo[2] * h[2];
+        if c <= 0.0 {
+            continue;
         }
+        let wi = [2.0 * c * h[0] - wo[0], 2.0 * c * h[1], 2.0 * c * h[2] - wo[2]];
+        if wi[2] <= 0.0 {
+            continue;
+        }
+        let f = f64::from(fresnel_dielectric(c as f32, IOR));
+        let w = f * g_o * smith_g1(wi[2], alpha) * c / (mu * h[2]);
+        // The reflected direction's elevation, and its azimuth about the mirror direction's (which is 0: the
+        // mirror of ω_o lies in the x–z plane, leaving along −x).
+        let el = wi[2].clamp(-1.0, 1.0).asin() - mirror_el;
+        let az = wi[1].atan2(-wi[0]);
+        sum += w;
+        s_el += w * el;
+        s_el2 += w * el * el;
+        s_az2 += w * az * az;
     }
     if sum <= 0.0 {
         return [0.0; 4];

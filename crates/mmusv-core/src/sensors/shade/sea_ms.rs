@@ -30,6 +30,7 @@
 //! at nodes drawn afresh.
 
 use super::brdf::fresnel_dielectric;
+use super::rough_water::beckmann_facet;
 use rand::{Rng, SeedableRng};
 
 /// Refractive index of sea water (the same as the shader's).
@@ -140,18 +141,14 @@ pub fn walk(mu_o: f64, alpha: f64, walks: usize, seed: u64, mirror_facets: bool)
             // The facet it meets: drawn from D(m) cos θ_m, weighted to the visible normals of ω = −wr.
             let wi = [-wr[0], -wr[1], -wr[2]];
             let (u1, u2): (f64, f64) = (rng.random(), rng.random());
-            let tan2 = -alpha * alpha * (1.0 - u1).ln();
-            let cos_m = 1.0 / (1.0 + tan2).sqrt();
-            let sin_m = (1.0 - cos_m * cos_m).max(0.0).sqrt();
-            let phi = std::f64::consts::TAU * u2;
-            let m = [sin_m * phi.cos(), sin_m * phi.sin(), cos_m];
+            let m = beckmann_facet(alpha, u1, u2);
             let c = wi[0] * m[0] + wi[1] * m[1] + wi[2] * m[2];
             let projected = (1.0 + lambda(wi[2], alpha)) * wi[2];
             if c <= 0.0 || projected <= 0.0 {
                 weight = 0.0;
                 break;
             }
-            weight *= c / (cos_m * projected) * fresnel(c);
+            weight *= c / (m[2] * projected) * fresnel(c);
             wr = [2.0 * c * m[0] - wi[0], 2.0 * c * m[1] - wi[1], 2.0 * c * m[2] - wi[2]];
         }
         let _ = weight;
@@ -195,33 +192,24 @@ mod tests {
     use crate::sensors::shade::rough_water;
 
     /// The first order by quadrature, independent of the walk: facet normals from `D(m) cos θ_m` on a
-    /// stratified grid, each weighted by `F (ω_o·m) G₂ / (μ_o cos θ_m)` with the height-correlated `G₂ = 1 / (1 +
+    /// stratified grid (`rough_water::stratified_facets`), each weighted by `F (ω_o·m) G₂ / (μ_o cos θ_m)` with the height-correlated `G₂ = 1 / (1 +
     /// Λ(ω_o) + Λ(ω_i))` (Heitz, "Understanding the Masking-Shadowing Function in Microfacet-Based BRDFs", JCGT
     /// 3(2), 2014, eq. 99), which a microsurface of random heights has.
     fn single_correlated(mu: f64, alpha: f64, strata: usize) -> f64 {
         let wo = [(1.0 - mu * mu).sqrt(), 0.0, mu];
         let lo = lambda(mu, alpha);
         let mut sum = 0.0;
-        for a in 0..strata {
-            for b in 0..strata {
-                let u1 = (a as f64 + 0.5) / strata as f64;
-                let u2 = (b as f64 + 0.5) / strata as f64;
-                let tan2 = -alpha * alpha * (1.0 - u1).ln();
-                let cos_h = 1.0 / (1.0 + tan2).sqrt();
-                let sin_h = (1.0 - cos_h * cos_h).max(0.0).sqrt();
-                let phi = std::f64::consts::TAU * u2;
-                let h = [sin_h * phi.cos(), sin_h * phi.sin(), cos_h];
-                let c = wo[0] * h[0] + wo[2] * h[2];
-                if c <= 0.0 {
-                    continue;
-                }
-                let wi_z = 2.0 * c * h[2] - wo[2];
-                if wi_z <= 0.0 {
-                    continue;
-                }
-                let f = f64::from(fresnel_dielectric(c as f32, IOR as f32));
-                sum += f * c / (mu * cos_h) / (1.0 + lo + lambda(wi_z, alpha));
+        for h in rough_water::stratified_facets(alpha, strata) {
+            let c = wo[0] * h[0] + wo[2] * h[2];
+            if c <= 0.0 {
+                continue;
             }
+            let wi_z = 2.0 * c * h[2] - wo[2];
+            if wi_z <= 0.0 {
+                continue;
+            }
+            let f = f64::from(fresnel_dielectric(c as f32, IOR as f32));
+            sum += f * c / (mu * h[2]) / (1.0 + lo + lambda(wi_z, alpha));
         }
         sum / (strata * strata) as f64
     }
