@@ -179,8 +179,8 @@ impl Fleet {
                 tol.len()
             )));
         }
-        let reach_s = f64::from(mmusv_core::sensors::shade::foam::WAKE_REACH_S);
-        let most = mmusv_core::sensors::shade::foam::WAKE_MAX_PIECES;
+        let reach_s = f64::from(mmusv_core::sensors::shade::wake::WAKE_REACH_S);
+        let most = mmusv_core::sensors::shade::wake::WAKE_MAX_PIECES;
         let mut rows: Vec<[f64; 6]> = Vec::new();
         for (i, (v, &tol)) in vessels.iter().zip(tol).enumerate() {
             let max_m = v.params().speed_mps * reach_s;

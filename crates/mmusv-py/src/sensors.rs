@@ -1,7 +1,7 @@
 //! Bindings for `mmusv_core::sensors`: ray patterns, the spinning LiDAR and the cameras.
 
 use crate::native::{detached, flat, pose_arg, rows_to_array, RayArrays};
-use mmusv_core::sensors::shade::foam::Wake;
+use mmusv_core::sensors::shade::wake::Wake;
 use mmusv_core::sensors::shade::ShadeEnv;
 use mmusv_core::sensors::{camera, capture, lidar, rays};
 use numpy::ndarray::{Array2, Array3};
@@ -485,25 +485,26 @@ pub(crate) fn frame_dict(py: Python<'_>, f: camera::CameraFrame, rgb: bool) -> P
 /// strength, where the next piece goes on.
 pub(crate) fn wakes_arg(wakes: Option<&PyReadonlyArray2<'_, f32>>) -> PyResult<Vec<Wake>> {
     let Some(w) = wakes else { return Ok(Vec::new()) };
-    let columns = numpy::PyUntypedArrayMethods::shape(&**w)[1];
-    let rows: Vec<[f32; 8]> = match columns {
-        6 => crate::native::rows::<f32, 6>(w, "wakes")?
-            .iter()
-            .map(|r| [r[0], r[1], r[2], r[3], r[4], r[5], f32::INFINITY, 0.0])
-            .collect(),
-        7 => crate::native::rows::<f32, 7>(w, "wakes")?
-            .iter()
-            .map(|r| [r[0], r[1], r[2], r[3], r[4], r[5], r[6], 0.0])
-            .collect(),
-        8 => crate::native::rows::<f32, 8>(w, "wakes")?.to_vec(),
-        _ => {
-            return Err(crate::errors::InputError::new_err(format!(
-                "wakes must have shape (K, 6), (K, 7) or (K, 8): x, y, heading, speed, length, beam[, reach_m[, \
-                 age_s]]; got {:?}",
-                numpy::PyUntypedArrayMethods::shape(&**w)
-            )))
-        }
-    };
+    let shape = numpy::PyUntypedArrayMethods::shape(&**w);
+    let columns = shape[1];
+    if !(6..=8).contains(&columns) {
+        return Err(crate::errors::InputError::new_err(format!(
+            "wakes must have shape (K, 6), (K, 7) or (K, 8): x, y, heading, speed, length, beam[, reach_m[, \
+             age_s]]; got {shape:?}"
+        )));
+    }
+    let flat = w
+        .as_slice()
+        .map_err(|_| crate::errors::InputError::new_err("wakes must be C-contiguous (use numpy.ascontiguousarray)"))?;
+    // The columns given, then the defaults of those left out: reach_m unlimited, age_s 0.
+    let rows: Vec<[f32; 8]> = flat
+        .chunks_exact(columns)
+        .map(|given| {
+            let mut r = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, f32::INFINITY, 0.0];
+            r[..columns].copy_from_slice(given);
+            r
+        })
+        .collect();
     rows.iter()
         .enumerate()
         .map(|(i, r)| {

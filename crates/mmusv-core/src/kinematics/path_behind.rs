@@ -1,5 +1,5 @@
 //! The path behind a vessel: how far back it ran straight, and the straight pieces it runs in round its bends
-//! (what a wake is drawn along: `sensors/shade/foam.rs`, `mmusv.Simulation.wakes`).
+//! (what a wake is drawn along: `sensors/shade/wake.rs`, `mmusv.Simulation.wakes`).
 //!
 //! Worked out from the route spline itself, sampled back along the distance travelled (before the scenario's
 //! start the vessel is taken to have come straight along its heading there): a piece runs straight while every

@@ -17,8 +17,8 @@
 //! and optionally sRGB (uint8 × 3) and linear radiance (float32 × 3, cd/m²).
 
 use super::rays;
-use super::shade::foam::Wake;
 use super::shade::tonemap::{self, SensorNoise};
+use super::shade::wake::Wake;
 use super::shade::{ShadeEnv, Shader};
 use crate::error::{MmusvError, Result};
 use crate::geometry::RigidPose;

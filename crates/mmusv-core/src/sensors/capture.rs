@@ -13,7 +13,7 @@ use super::camera::{Camera, CameraFrame, RenderOptions};
 use super::lidar::{Lidar, LidarEnv, LidarScan};
 use super::ppi::{ppi_image, PpiConfig};
 use super::radar::{radar_sweep, RadarConfig, RadarEnv, RadarReturns};
-use super::shade::foam::Wake;
+use super::shade::wake::Wake;
 use super::shade::ShadeEnv;
 use crate::error::Result;
 use crate::geometry::RigidPose;

@@ -28,7 +28,8 @@
 use super::lidar_water;
 use super::noise::{self, stream};
 use super::rays;
-use super::shade::foam::{Foam, Wake, FOAM_SEED};
+use super::shade::foam::{Foam, FOAM_SEED};
+use super::shade::wake::Wake;
 use crate::error::{MmusvError, Result};
 use crate::geometry::RigidPose;
 use crate::scene::Scene;

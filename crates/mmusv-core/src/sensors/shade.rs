@@ -41,11 +41,13 @@ mod sea_ms_table;
 pub mod sky;
 pub mod tonemap;
 pub mod twilight;
+pub mod wake;
 pub mod water;
 
 use brdf::{dfg, fresnel_dielectric, specular_cos};
 use envlight::{Lighting, LightingKey, WATER_IOR};
-use foam::{Foam, Wake, FOAM_ALBEDO};
+use foam::{Foam, FOAM_ALBEDO};
+use wake::Wake;
 use water::ShallowWater;
 
 /// The environment as the cameras see it (and, for fog, rain and waves, the LiDAR and the radar).
