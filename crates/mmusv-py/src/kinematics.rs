@@ -92,15 +92,9 @@ impl Fleet {
         let mut vessels = Vec::with_capacity(n);
         for i in 0..n {
             let prefix = format!("vessels[{i}]");
+            let wps = rows::<f64, 2>(&routes[i], &format!("{prefix}.route"))?;
             let build = || -> Result<VesselMotion, MmusvError> {
                 let end = EndBehaviour::parse(&end_behaviours[i])?;
-                let pts = routes[i]
-                    .as_slice()
-                    .map_err(|_| MmusvError::input("route", "must be a C-contiguous (K, 2) float64 array"))?;
-                if pts.len() % 2 != 0 {
-                    return Err(MmusvError::input("route", "must have shape (K, 2)"));
-                }
-                let (wps, _) = pts.as_chunks::<2>();
                 let route = Route::new(wps, end)?;
                 let params = VesselParams {
                     speed_mps: speeds[i],

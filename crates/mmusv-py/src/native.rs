@@ -3,7 +3,8 @@
 use crate::errors::{to_py, InputError, InternalError};
 use mmusv_core::RigidPose;
 use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::ndarray::Dimension;
+use numpy::{IntoPyArray, PyArray2, PyReadonlyArray, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
@@ -38,9 +39,7 @@ pub fn rows<'a, T: numpy::Element, const K: usize>(
     if shape[1] != K {
         return Err(InputError::new_err(format!("{name} must have shape (N, {K}), got {shape:?}")));
     }
-    let flat = arr
-        .as_slice()
-        .map_err(|_| InputError::new_err(format!("{name} must be C-contiguous (use numpy.ascontiguousarray)")))?;
+    let flat = c_order(arr, name)?;
     let (chunks, rest) = flat.as_chunks::<K>();
     debug_assert!(rest.is_empty());
     Ok(chunks)
@@ -48,8 +47,29 @@ pub fn rows<'a, T: numpy::Element, const K: usize>(
 
 /// Borrows a C-contiguous 1-D array; `name` is used in the error.
 pub fn flat<'a, T: numpy::Element>(arr: &'a PyReadonlyArray1<'_, T>, name: &str) -> PyResult<&'a [T]> {
-    arr.as_slice()
-        .map_err(|_| InputError::new_err(format!("{name} must be C-contiguous (use numpy.ascontiguousarray)")))
+    c_order(arr, name)
+}
+
+/// Borrows the elements of a C-contiguous array of any dimension, in row-major order; `name` is used in the
+/// error. The one check every borrowed array goes through: numpy's own `as_slice` also accepts a Fortran-ordered
+/// array, whose elements would then be read transposed (a `(4, 4)` pose as its transpose, `(N, K)` rows as
+/// columns) without an error.
+pub fn c_order<'a, T: numpy::Element, D: Dimension>(
+    arr: &'a PyReadonlyArray<'_, T, D>,
+    name: &str,
+) -> PyResult<&'a [T]> {
+    let refused = || {
+        InputError::new_err(format!(
+            "{name} must be a C-contiguous (row-major) array, got shape {:?} with strides {:?} (use \
+             numpy.ascontiguousarray)",
+            arr.shape(),
+            arr.strides()
+        ))
+    };
+    if !arr.is_c_contiguous() {
+        return Err(refused());
+    }
+    arr.as_slice().map_err(|_| refused())
 }
 
 /// A rigid pose from 16 row-major numbers of a 4×4 matrix; `field` names the argument in errors.
@@ -63,9 +83,7 @@ pub fn pose_arg(pose: &PyReadonlyArray2<'_, f64>, field: &str) -> PyResult<Rigid
     if pose.shape() != [4, 4] {
         return Err(InputError::new_err(format!("{field} must have shape (4, 4), got {:?}", pose.shape())));
     }
-    let m = pose
-        .as_slice()
-        .map_err(|_| InputError::new_err(format!("{field} must be a C-contiguous (4, 4) float64 array")))?;
+    let m = c_order(pose, field)?;
     pose_from(m, field)
 }
 

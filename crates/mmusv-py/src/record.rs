@@ -5,7 +5,7 @@
 //! `images` encodes before it takes the lock: the lock is held only to append the finished messages.
 
 use crate::errors::InputError;
-use crate::native::{detached, flat, rows};
+use crate::native::{c_order, detached, flat, rows};
 use mmusv_core::record::{
     encode_images, AgentAnnotations, BevBox, Box2D, Box3D, BoxMarker, Column, ImageFormat, ImageJob, PackedType,
     Pixels, Recorder as CoreRecorder, Transform, VesselState, WorldState,
@@ -98,17 +98,16 @@ impl<'py> ImageArray<'py> {
 
     /// `(width, height, pixels)`.
     fn pixels(&self) -> PyResult<(u32, u32, Pixels<'_>)> {
-        let contiguous = || InputError::new_err("image must be C-contiguous (use numpy.ascontiguousarray)");
         let (shape, px) = match self {
-            Self::Mono8(a) => (a.shape(), Pixels::Mono8(a.as_slice().map_err(|_| contiguous())?)),
+            Self::Mono8(a) => (a.shape(), Pixels::Mono8(c_order(a, "image")?)),
             Self::Rgb8(a) => {
                 if a.shape()[2] != 3 {
                     return Err(InputError::new_err(format!("image must be {IMAGE_KINDS}, got {:?}", a.shape())));
                 }
-                (a.shape(), Pixels::Rgb8(a.as_slice().map_err(|_| contiguous())?))
+                (a.shape(), Pixels::Rgb8(c_order(a, "image")?))
             }
-            Self::Mono16(a) => (a.shape(), Pixels::Mono16(a.as_slice().map_err(|_| contiguous())?)),
-            Self::Float32(a) => (a.shape(), Pixels::Float32(a.as_slice().map_err(|_| contiguous())?)),
+            Self::Mono16(a) => (a.shape(), Pixels::Mono16(c_order(a, "image")?)),
+            Self::Float32(a) => (a.shape(), Pixels::Float32(c_order(a, "image")?)),
         };
         let dim = |v: usize| u32::try_from(v).map_err(|_| InputError::new_err("image is too large"));
         Ok((dim(shape[1])?, dim(shape[0])?, px))

@@ -2,7 +2,7 @@
 //! instances, cast rays, export the world triangles.
 
 use crate::errors::InputError;
-use crate::native::{detached, flat, pose_from, rows, rows_to_array};
+use crate::native::{c_order, detached, flat, pose_from, rows, rows_to_array};
 use mmusv_core::export::{write_world_mesh, MeshFormat};
 use mmusv_core::ocean::{sea_seed, SeaSpec, WaveField};
 use mmusv_core::sea::{SurfaceSpec, WaveSurface};
@@ -219,7 +219,7 @@ impl Scene {
             Some(z) => {
                 let shape = z.shape();
                 let (ny, nx) = (shape[0], shape[1]);
-                let data = z.as_slice().map_err(|_| InputError::new_err("seabed heights must be C-contiguous"))?;
+                let data = c_order(&z, "seabed heights")?;
                 Some(
                     mmusv_core::seabed::Seabed::new(x0, y0, spacing, nx, ny, data.to_vec())
                         .map_err(crate::errors::to_py)?,
@@ -267,7 +267,7 @@ impl Scene {
                 ids.len()
             )));
         }
-        let data = poses.as_slice().map_err(|_| InputError::new_err("poses must be C-contiguous"))?;
+        let data = c_order(&poses, "poses")?;
         let parsed = data
             .chunks_exact(16)
             .enumerate()
@@ -536,7 +536,7 @@ impl Scene {
 }
 
 fn flat_2d<'a>(arr: &'a PyReadonlyArray2<'_, f64>) -> PyResult<&'a [f64]> {
-    arr.as_slice().map_err(|_| InputError::new_err("pose must be C-contiguous"))
+    c_order(arr, "pose")
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -1,6 +1,6 @@
 //! Bindings for `mmusv_core::sensors`: ray patterns, the spinning LiDAR and the cameras.
 
-use crate::native::{detached, flat, pose_arg, rows_to_array, RayArrays};
+use crate::native::{c_order, detached, flat, pose_arg, rows_to_array, RayArrays};
 use mmusv_core::sensors::shade::wake::Wake;
 use mmusv_core::sensors::shade::ShadeEnv;
 use mmusv_core::sensors::{camera, capture, lidar, rays};
@@ -493,9 +493,7 @@ pub(crate) fn wakes_arg(wakes: Option<&PyReadonlyArray2<'_, f32>>) -> PyResult<V
              age_s]]; got {shape:?}"
         )));
     }
-    let flat = w
-        .as_slice()
-        .map_err(|_| crate::errors::InputError::new_err("wakes must be C-contiguous (use numpy.ascontiguousarray)"))?;
+    let flat = c_order(w, "wakes")?;
     // The columns given, then the defaults of those left out: reach_m unlimited, age_s 0.
     let rows: Vec<[f32; 8]> = flat
         .chunks_exact(columns)
