@@ -392,7 +392,8 @@ class Camera:
         ``radiance``, radiance (H,W,3) f32 cd/m². ``wakes`` (K, 6), (K, 7) or (K, 8) f32: x, y, heading, speed,
         length, beam[, reach_m[, age_s]] (how far behind the stern the path ran straight, inf when not given; with
         age_s, pieces of wakes that follow their vessels' bends: the foam age_s old at the piece's start, ending
-        at reach_m where the next piece goes on)."""
+        at reach_m where the next piece goes on; a vessel's pieces one after another, newest first, the Kelvin arms
+        bent along them)."""
 
 # --- radar ---
 

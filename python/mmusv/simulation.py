@@ -414,8 +414,9 @@ class Simulation:
         as the foam lasts). Each further row of the same vessel is a piece of the path from there: its stern on the
         path where the piece starts (the row's ``x, y`` half a length ahead of it, ``heading`` along the piece's
         chord to the next one's start), ``reach_m`` the chord's length, ``age_s`` how long ago the vessel's stern
-        passed the piece's start (at least 1 ms: rows older than 0 draw no Kelvin arms). No foam where the vessel
-        never went, nor under its hull; its older foam round the bends too."""
+        passed the piece's start (at least 1 ms: a row older than 0 is a piece further back). A vessel's rows come
+        together, newest first: the core bends the Kelvin arms along them. No foam where the vessel never went, nor
+        under its hull; its older foam and arms round the bends too."""
         n = len(self.scenario.vessels)
         beams = np.array([float(v.box_size[1]) for v in self.vessels[:n]], dtype=np.float64)
         pieces = self.fleet.wake_pieces(state.time_s, 0.5 * beams) if n else np.zeros((0, 6))
@@ -442,7 +443,7 @@ class Simulation:
                 if reach <= cut:
                     continue
                 px, py, reach = px - cut * c, py - cut * s, reach - cut
-                # (At least a millisecond old: a row older than 0 is a piece further back, without Kelvin arms.)
+                # (At least a millisecond old: a row older than 0 is a piece further back, its arms bent by the core.)
                 old = max(lag / speed, 1e-3)
                 rows.append((px + half * c, py + half * s, heading, speed, length, beam, reach, old))
         return np.asarray(rows, dtype=np.float32).reshape(-1, 8)

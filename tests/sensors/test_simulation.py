@@ -655,8 +655,11 @@ def test_a_wake_follows_its_vessel_round_the_bend(make_scenario: Any) -> None:
     """A boat at 8 m/s went east 300 m, then turned north; 400 m on, its top-view foam (flat water, the wakes of
     ``Simulation.wakes``) lies along the path it took round the bend (the path from its own poses, frame by frame):
     most of the path behind its own first piece has foam within 1.5 m, where the first piece alone (the wake drawn
-    straight back from the vessel, as before) has none; and every foam pixel lies within the wake's width of the path
-    or is that first piece's (its Kelvin arms)."""
+    straight back from the vessel, as before) has none. Its Kelvin arms bend round the turn: they follow the
+    envelope of the waves' energy circles along the path (``sensors/shade/wake.rs``), worked out here from the
+    poses alone (each frame's bow position, heading and turn rate); most of that envelope beyond the first piece's
+    arms has foam, where the first piece alone has none; and every foam pixel lies within the wake's width of the
+    path, on the first piece's arms, or within an arm's width of that envelope."""
     from mmusv._native import core
     from mmusv.scene import Scene
     from mmusv.sensors.camera import render
@@ -708,11 +711,45 @@ def test_a_wake_follows_its_vessel_round_the_bend(make_scenario: Any) -> None:
     with_chain = np.mean([near(chain, q) for q in old])
     alone = np.mean([near(first, q) for q in old])
     assert with_chain > 0.8 and alone < 0.05, (with_chain, alone)
+    # The envelope of the energy circles (Lighthill 1978, as wake.rs): waves sent out from the bow's position E
+    # metres of travel ago, heading h, path curvature kappa there: k = E kappa, normal at psi = atan2(k, 3) +/-
+    # acos(1 / sqrt(9 + k^2)) from the heading, the arm point at P + (E/4)(h + n).
+    # Before the scenario's start the boat is taken to have come straight (as the core's wake pieces do).
+    length, beam = float(mine[0, 4]), float(mine[0, 5])
+    yaw = np.unwrap([float(sim.world_state(k).poses[i, 5]) for k in range(frame + 1)])
+    pre = np.arange(1000.0, 0.0, -2.0)
+    centre = np.concatenate([path[0] - pre[:, None] * [math.cos(yaw[0]), math.sin(yaw[0])], path])
+    yaw = np.concatenate([np.full(len(pre), yaw[0]), yaw])
+    along = np.concatenate([-pre, travelled])
+    bow = centre + 0.5 * length * np.stack([np.cos(yaw), np.sin(yaw)], axis=1)
+    kappa = np.gradient(yaw) / np.maximum(np.gradient(along), 1e-6)
+    e = along[-1] - along
+    k = e * kappa
+    arms = []
+    for sign in (1.0, -1.0):
+        psi = np.arctan2(k, 3.0) + sign * np.arccos(1.0 / np.sqrt(9.0 + k**2))
+        n = np.stack([np.cos(yaw + psi), np.sin(yaw + psi)], axis=1)
+        arms.append(bow + 0.25 * e[:, None] * (np.stack([np.cos(yaw), np.sin(yaw)], axis=1) + n))
+    env_pts, env_e = np.concatenate(arms), np.concatenate([e, e])
+    in_view = (np.abs(env_pts[:, 0] - 250.0) < 145.0) & (np.abs(env_pts[:, 1] - 550.0) < 145.0)
+    # Beyond the first piece's arms (sent out before its straight stretch) and fresh enough to show.
+    bent = in_view & (env_e > length + float(mine[0, 6]) + 30.0) & (env_e < 500.0)
+    assert bent.sum() > 50, bent.sum()
+    on_chain = np.mean([near(chain, q) for q in env_pts[bent]])
+    on_first = np.mean([near(first, q) for q in env_pts[bent]])
+    assert on_chain > 0.6 and on_first < 0.05, (on_chain, on_first)
     # Every foam pixel: within the widest track (half-width 9 m here, plus the noise and the pixel) of the path,
-    # or foam the first piece alone lays too (its Kelvin arms).
+    # foam the first piece alone lays too (its straight arms), or within an arm's width of the envelope, plus 10 m:
+    # the core works the arms out along the wake's pieces (chords within half a beam of the path, the heading
+    # turning between them), and on the inside of the turn the envelope moves with the curvature times the
+    # distance gone (k = E kappa): the farthest foam pixel here lies 8.4 m beyond an arm's width.
     d = np.min(np.hypot(pts[:, None, 0] - path[None, ::2, 0], pts[:, None, 1] - path[None, ::2, 1]), axis=1)
     own = first[vv, uu]
-    assert np.all((d < 12.0) | own), np.max(d[~own])
+    to_env = np.hypot(pts[:, None, 0] - env_pts[None, :, 0], pts[:, None, 1] - env_pts[None, :, 1])
+    width = 0.3 + 0.02 * (2.0 / 3.0) * env_e + 0.1 * beam + 10.0
+    on_arm = np.any(to_env < width[None, :], axis=1)
+    stray = ~((d < 12.0) | own | on_arm)
+    assert not np.any(stray), pts[stray][:10]
 
 
 def test_a_wake_reach_cuts_the_foam_every_sensor_sees() -> None:

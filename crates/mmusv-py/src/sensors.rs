@@ -482,7 +482,8 @@ pub(crate) fn frame_dict(py: Python<'_>, f: camera::CameraFrame, rgb: bool) -> P
 /// Wakes from a `(K, 6)`, `(K, 7)` or `(K, 8)` float32 array (`x, y, heading, speed, length, beam[, reach_m[,
 /// age_s]]`), checked. Eight columns are the pieces of wakes that follow their vessels' bends
 /// (`mmusv.Simulation.wakes`): each piece's foam is `age_s` old at its start and ends at `reach_m` at full
-/// strength, where the next piece goes on.
+/// strength, where the next piece goes on; a vessel's pieces come one after another, newest first, and the Kelvin
+/// arms bend along them.
 pub(crate) fn wakes_arg(wakes: Option<&PyReadonlyArray2<'_, f32>>) -> PyResult<Vec<Wake>> {
     let Some(w) = wakes else { return Ok(Vec::new()) };
     let shape = numpy::PyUntypedArrayMethods::shape(&**w);
