@@ -419,13 +419,30 @@ fn bent_arms(chain: &[Wake]) -> Vec<ArmSegment> {
             sides[side].push(([p[0] + 0.25 * e * (ch + n[0]), p[1] + 0.25 * e * (sh + n[1])], e));
         }
     }
+    // Runs of points within 5 cm of the straight stretch between their ends are drawn as that one stretch (the
+    // straight legs of a path give long runs).
     let mut out = Vec::new();
     for pts in &sides {
-        for pair in pts.windows(2) {
-            out.push(ArmSegment::new(pair[0].0, pair[1].0, [pair[0].1, pair[1].1], own));
+        let mut from = 0;
+        while from + 1 < pts.len() {
+            let mut to = from + 1;
+            while to + 1 < pts.len() && (from + 1..=to).all(|m| off_line(pts[m].0, pts[from].0, pts[to + 1].0) <= 0.05)
+            {
+                to += 1;
+            }
+            out.push(ArmSegment::new(pts[from].0, pts[to].0, [pts[from].1, pts[to].1], own));
+            from = to;
         }
     }
     out
+}
+
+/// How far `p` lies from the straight stretch from `a` to `b` (metres).
+fn off_line(p: [f32; 2], a: [f32; 2], b: [f32; 2]) -> f32 {
+    let (ab, ap) = ([b[0] - a[0], b[1] - a[1]], [p[0] - a[0], p[1] - a[1]]);
+    let len2 = ab[0] * ab[0] + ab[1] * ab[1];
+    let t = if len2 > 0.0 { ((ap[0] * ab[0] + ap[1] * ab[1]) / len2).clamp(0.0, 1.0) } else { 0.0 };
+    (ap[0] - t * ab[0]).hypot(ap[1] - t * ab[1])
 }
 
 /// The wakes of one render, prepared for lookups ([`Wakes::cover`]), optionally indexed around a sensor.
@@ -787,7 +804,7 @@ mod tests {
             }
         }
         assert!(beyond >= 10, "{beyond}");
-        assert!(wakes.arms.len() > 100, "{}", wakes.arms.len());
+        assert!(wakes.arms.len() > 20, "{}", wakes.arms.len());
         // Between the outer arm and the track before the turn, inside the envelope: no foam.
         for x0 in [-200.0, -300.0] {
             let arm = exit([x0, 0.0], [0.0, -1.0])[1];
