@@ -336,8 +336,7 @@ fn bent_arms(chain: &[Wake]) -> Vec<ArmSegment> {
     }
     let (u, length) = (own.speed, own.length);
     // The path back from the vessel's stern: piece k from `q = back_k` (metres of path) to the next piece's
-    // start; the heading piecewise linear through each piece's own at its middle (the own piece's at its end:
-    // it is straight), unwrapped.
+    // start (the last one as far as it reaches, at most 100 km); the pieces' headings unwrapped.
     let starts: Vec<f32> = shapes.iter().map(|s| s.back).collect();
     let ends: Vec<f32> = (0..chain.len())
         .map(|k| if k + 1 < chain.len() { starts[k + 1] } else { starts[k] + chain[k].reach_m.min(1e5) })
