@@ -1,6 +1,6 @@
 """``mmusv train``: the models trained side by side in processes of their own (``--jobs``) are the models trained
-in turn in this process, weight for weight; one that fails does not stop the others; bad ``--jobs`` values get a
-clear error."""
+in turn in this process, weight for weight, each job fitting its own model's scorer; one that fails does not stop
+the others; bad ``--jobs`` values get a clear error."""
 
 from __future__ import annotations
 
@@ -47,6 +47,13 @@ def test_side_by_side_models_equal_models_trained_in_turn(recording: Path, tmp_p
     summary = json.loads((tmp_path / "side" / "train_summary.json").read_text(encoding="utf-8"))
     assert summary["jobs"] == 3 and sorted(summary["models"]) == ["early", "intermediate", "single"]
     assert all(m["epochs"] == 2 and m["finished"] for m in summary["models"].values())
+    # each job fits its own model's scorer after training it, with the outcome of the fit in turn
+    turn = json.loads((tmp_path / "turn" / "train_summary.json").read_text(encoding="utf-8"))
+    assert sorted(summary["scorers"]) == ["early", "intermediate", "single"]
+    for mode, fit in summary["scorers"].items():
+        assert {k: v for k, v in fit.items() if k != "seconds"} == {
+            k: v for k, v in turn["scorers"][mode].items() if k != "seconds"
+        }, mode
 
 
 def test_a_failing_model_does_not_stop_the_others(
@@ -60,6 +67,7 @@ def test_a_failing_model_does_not_stop_the_others(
     assert "early: failed" in err and "a checkpoint of another run" in err and "Traceback" not in err
     summary = json.loads((tmp_path / "train_summary.json").read_text(encoding="utf-8"))
     assert sorted(summary["models"]) == ["intermediate", "single"]
+    assert sorted(summary["scorers"]) == ["intermediate", "single"]  # fitted in the jobs that trained
     assert (tmp_path / "single" / "model.pt").is_file() and (tmp_path / "intermediate" / "model.pt").is_file()
     assert not (tmp_path / "early" / "model.pt").exists()
 

@@ -88,8 +88,9 @@ def test_min_points_drops_the_targets_of_unseen_boxes() -> None:
 
 
 def test_channels_last_model_is_the_same_function() -> None:
-    """The layout training and inference use on CUDA (PillarNet.channels_last) changes no output: the same weights
-    in NCHW and NHWC give the same maps on the same batch (here on CPU), in training mode and after a step."""
+    """The layout training uses on every device and inference on CUDA (PillarNet.channels_last) changes no output:
+    the same weights in NCHW and NHWC give the same maps on the same batch (here on CPU), in training mode and after
+    a step."""
     from mmusv.learn.example import collate, make_example
     from mmusv.learn.loss import centerpoint_loss
     from mmusv.learn.model import PillarNet

@@ -45,7 +45,9 @@ class PillarNet(nn.Module):
         the same function (a test compares the outputs), but cuDNN then runs the convolutions and batch norms
         without converting between layouts around every layer. Measured on one H200 (bf16 autocast, the `paper`
         preset, batch 4, model step alone): 11.8 → 24.3 steps/s; batch-norm kernels and NCHW↔NHWC conversions were
-        70 % of the step's GPU time before. Used on CUDA by training and inference."""
+        70 % of the step's GPU time before. On a CPU (oneDNN) a training step of the `cpu` preset, one thread, batch
+        4, took 0.175 s against 0.225 s in NCHW (2-core Xeon, 2026-11-29); inference gains little there (0.014 against
+        0.015 s a frame). Used by training on every device and by inference on CUDA."""
         self.backbone.to(memory_format=torch.channels_last)
         self.head.to(memory_format=torch.channels_last)
         return self
