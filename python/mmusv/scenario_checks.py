@@ -189,7 +189,7 @@ def map_findings(
 def check_mounts(scenario: Scenario, *, source: str) -> list[str]:
     """Warns (and returns the warnings) for every sensor mount farther than :data:`MOUNT_WARN_FACTOR` hull
     lengths (at least 10 m) from its vessel's box."""
-    from mmusv.simulation import mount_matrix
+    from mmusv.sensors.mounts import mount_matrix
     from mmusv.world.vessels import get_asset
 
     found: list[str] = []

@@ -28,9 +28,10 @@ from mmusv.errors import ConfigError
 from mmusv.motion import build_fleet
 from mmusv.scene import SeaState
 from mmusv.sensors.camera import CameraImages, camera_from_config, top_view_from_config
-from mmusv.sensors.config import CameraConfig, Mount, RigConfig
+from mmusv.sensors.config import CameraConfig, RigConfig
 from mmusv.sensors.env import sensor_env
 from mmusv.sensors.lidar import LidarPoints, lidar_from_config
+from mmusv.sensors.mounts import inside_mesh, mount_matrix, rpy_matrix
 from mmusv.sensors.radar import RadarReturns, ppi_request, radar_from_config
 from mmusv.world.build import WorldScene, build_world_scene, pose_matrices
 from mmusv.world.environment import Environment
@@ -56,30 +57,6 @@ def sensor_seed(scenario_seed: int, frame: int, agent: int, sensor: str, index: 
     """The 64-bit seed of one sensor capture: a hash of (scenario seed, frame, agent index, sensor, index)."""
     key = f"{scenario_seed}/{frame}/{agent}/{_SENSOR_CODES.get(sensor, 9)}/{index}".encode()
     return int.from_bytes(hashlib.blake2b(key, digest_size=8).digest(), "little")
-
-
-def _rpy_matrix(xyz: tuple[float, float, float], rpy_deg: tuple[float, float, float]) -> np.ndarray:
-    r, p, y = (math.radians(a) for a in rpy_deg)
-    return pose_matrices(np.array([*xyz, r, p, y], dtype=np.float64))
-
-
-def mount_matrix(asset: VesselAsset, mount: Mount, *, where: str) -> np.ndarray:
-    """``(4, 4)`` sensor → vessel body transform of ``mount`` on ``asset``
-    (see :class:`~mmusv.sensors.config.Mount`)."""
-    base = np.eye(4)
-    if mount.point is not None:
-        if mount.point in asset.mounts:
-            mp = asset.mounts[mount.point]
-            base = _rpy_matrix(mp.xyz, mp.rpy_deg)
-        else:
-            # Fall back to the top of the hull: above the deck, looking where the mount name says.
-            yaw = {"camera_left": 90.0, "camera_rear": 180.0, "camera_right": -90.0}.get(mount.point, 0.0)
-            top = float(asset.bbox[1, 2]) + 0.5
-            base = _rpy_matrix((0.0, 0.0, top), (0.0, 0.0, yaw))
-    m: np.ndarray = base @ _rpy_matrix(mount.xyz, mount.rpy_deg)
-    if not np.all(np.isfinite(m)):
-        raise ConfigError(f"invalid config {where}: the mount is not a finite pose")
-    return m
 
 
 _T = TypeVar("_T")
@@ -464,7 +441,7 @@ class Simulation:
             tv = agent.rig.top_view
             x, y, _, _, _, yaw = state.poses[agent.index]
             heading = yaw if tv.orientation == "heading_up" else math.pi / 2
-            out["top_view"] = pose_matrices(np.array([x, y, tv.altitude_m, 0.0, 0.0, heading])) @ _rpy_matrix(
+            out["top_view"] = pose_matrices(np.array([x, y, tv.altitude_m, 0.0, 0.0, heading])) @ rpy_matrix(
                 (0.0, 0.0, 0.0), (0.0, 90.0, 0.0)
             )
         return out
@@ -571,39 +548,3 @@ class Simulation:
 def _pose(m: np.ndarray) -> npt.NDArray[np.float64]:
     """A ``(4, 4)`` pose as the core takes it: C-contiguous float64."""
     return np.ascontiguousarray(m, dtype=np.float64)
-
-
-def inside_mesh(vertices: np.ndarray, faces: np.ndarray, point: np.ndarray, *, rays: int = 9) -> bool:
-    """Whether ``point`` lies inside the closed (union of) mesh(es) ``vertices``/``faces`` (same frame).
-
-    Along each of ``rays`` directions every crossing is found by re-casting past the previous hit; the winding
-    number is (back-face exits − front-face entries). The point is inside when most rays give a positive one.
-    """
-    from mmusv.scene import Scene
-
-    scene = Scene()
-    scene.add_instance(scene.add_mesh(vertices, faces, classes=0))
-    dirs = _sphere_directions(rays)
-    origin = np.tile(np.asarray(point, dtype=np.float64), (rays, 1))
-    winding = np.zeros(rays, dtype=np.int64)
-    active = np.ones(rays, dtype=bool)
-    for _ in range(64):
-        if not active.any():
-            break
-        hits = scene.cast_rays(origin[active], dirs[active])
-        idx = np.nonzero(active)[0]
-        hit = hits.hit
-        winding[idx[hit]] += np.where(hits.backface[hit], 1, -1)
-        active[idx[~hit]] = False
-        step = hits.distance[hit].astype(np.float64) + 1e-4
-        origin[idx[hit]] += dirs[idx[hit]] * step[:, None]
-    return bool(np.count_nonzero(winding > 0) * 2 > rays)
-
-
-def _sphere_directions(n: int) -> npt.NDArray[np.float64]:
-    """``n`` unit vectors spread over the sphere (Fibonacci lattice)."""
-    i = np.arange(n) + 0.5
-    z = 1 - 2 * i / n
-    r = np.sqrt(1 - z * z)
-    phi = i * math.pi * (3 - math.sqrt(5))
-    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)

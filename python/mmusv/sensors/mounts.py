@@ -1,0 +1,82 @@
+"""Where a sensor sits on a vessel: the ``(4, 4)`` sensor → body transform of a :class:`~mmusv.sensors.config.Mount`
+on a vessel asset (:func:`mount_matrix`), and the test that a sensor's origin is not inside the hull
+(:func:`inside_mesh`: a sensor there would see nothing but the hull's inside).
+
+Frames: vessel body x forward, y left, z up (metres); angles roll, pitch, yaw in degrees (applied as in
+:func:`mmusv.world.build.pose_matrices`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import numpy.typing as npt
+
+from mmusv.errors import ConfigError
+from mmusv.sensors.config import Mount
+from mmusv.world.build import pose_matrices
+from mmusv.world.vessels import VesselAsset
+
+__all__ = ["inside_mesh", "mount_matrix", "rpy_matrix"]
+
+
+def rpy_matrix(xyz: tuple[float, float, float], rpy_deg: tuple[float, float, float]) -> np.ndarray:
+    """``(4, 4)`` float64 transform translating by ``xyz`` (m) and rotating by roll, pitch, yaw ``rpy_deg`` (°)."""
+    r, p, y = (math.radians(a) for a in rpy_deg)
+    return pose_matrices(np.array([*xyz, r, p, y], dtype=np.float64))
+
+
+def mount_matrix(asset: VesselAsset, mount: Mount, *, where: str) -> np.ndarray:
+    """``(4, 4)`` sensor → vessel body transform of ``mount`` on ``asset``
+    (see :class:`~mmusv.sensors.config.Mount`)."""
+    base = np.eye(4)
+    if mount.point is not None:
+        if mount.point in asset.mounts:
+            mp = asset.mounts[mount.point]
+            base = rpy_matrix(mp.xyz, mp.rpy_deg)
+        else:
+            # Fall back to the top of the hull: above the deck, looking where the mount name says.
+            yaw = {"camera_left": 90.0, "camera_rear": 180.0, "camera_right": -90.0}.get(mount.point, 0.0)
+            top = float(asset.bbox[1, 2]) + 0.5
+            base = rpy_matrix((0.0, 0.0, top), (0.0, 0.0, yaw))
+    m: np.ndarray = base @ rpy_matrix(mount.xyz, mount.rpy_deg)
+    if not np.all(np.isfinite(m)):
+        raise ConfigError(f"invalid config {where}: the mount is not a finite pose")
+    return m
+
+
+def inside_mesh(vertices: np.ndarray, faces: np.ndarray, point: np.ndarray, *, rays: int = 9) -> bool:
+    """Whether ``point`` lies inside the closed (union of) mesh(es) ``vertices``/``faces`` (same frame).
+
+    Along each of ``rays`` directions every crossing is found by re-casting past the previous hit; the winding
+    number is (back-face exits − front-face entries). The point is inside when most rays give a positive one.
+    """
+    from mmusv.scene import Scene
+
+    scene = Scene()
+    scene.add_instance(scene.add_mesh(vertices, faces, classes=0))
+    dirs = _sphere_directions(rays)
+    origin = np.tile(np.asarray(point, dtype=np.float64), (rays, 1))
+    winding = np.zeros(rays, dtype=np.int64)
+    active = np.ones(rays, dtype=bool)
+    for _ in range(64):
+        if not active.any():
+            break
+        hits = scene.cast_rays(origin[active], dirs[active])
+        idx = np.nonzero(active)[0]
+        hit = hits.hit
+        winding[idx[hit]] += np.where(hits.backface[hit], 1, -1)
+        active[idx[~hit]] = False
+        step = hits.distance[hit].astype(np.float64) + 1e-4
+        origin[idx[hit]] += dirs[idx[hit]] * step[:, None]
+    return bool(np.count_nonzero(winding > 0) * 2 > rays)
+
+
+def _sphere_directions(n: int) -> npt.NDArray[np.float64]:
+    """``n`` unit vectors spread over the sphere (Fibonacci lattice)."""
+    i = np.arange(n) + 0.5
+    z = 1 - 2 * i / n
+    r = np.sqrt(1 - z * z)
+    phi = i * math.pi * (3 - math.sqrt(5))
+    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
