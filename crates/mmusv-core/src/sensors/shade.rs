@@ -33,20 +33,24 @@ use parry3d::math::Vec3;
 use std::sync::Arc;
 
 pub mod brdf;
+mod class_material;
 pub mod envlight;
 pub mod foam;
 pub mod rough_water;
 pub mod sea_ms;
 mod sea_ms_table;
 pub mod sky;
+mod tables;
 pub mod tonemap;
 pub mod twilight;
 pub mod wake;
 pub mod water;
 
-use brdf::{dfg, fresnel_dielectric, specular_cos};
+use brdf::{dfg, specular_cos};
+pub use class_material::class_material;
 use envlight::{Lighting, LightingKey, WATER_IOR};
 use foam::{Foam, FOAM_ALBEDO};
+use tables::{fast_cos, water_fresnel};
 use wake::Wake;
 use water::ShallowWater;
 
@@ -145,69 +149,6 @@ impl SurfaceHit {
     }
 }
 
-#[inline]
-fn hash_tint(id: u64, seed: u64) -> Vec3 {
-    let h = noise::hash3(seed, 0xC0105, id);
-    let f = |s: u32| 0.55 + 0.45 * ((h >> s) & 0xFF) as f32 / 255.0;
-    Vec3::new(f(0), f(8), f(16))
-}
-
-/// The material a face without one gets from its class: base colour (containers varied per container-sized
-/// cell of space, vessels per instance), roughness, metallic.
-#[inline]
-pub fn class_material(hit: &SurfaceHit) -> Material {
-    let (base, roughness, metallic) = match hit.class {
-        2 => (Vec3::new(0.33, 0.27, 0.18), 0.9, 0.0),
-        3 => (Vec3::new(0.07, 0.18, 0.05), 0.85, 0.0),
-        4 => (Vec3::new(0.38, 0.38, 0.37), 0.8, 0.0),
-        5 => {
-            let p = hit.point;
-            let cell = ((p.x / 6.1).floor() as i64 as u64).wrapping_mul(73_856_093)
-                ^ ((p.y / 2.5).floor() as i64 as u64).wrapping_mul(19_349_663)
-                ^ ((p.z / 2.6).floor() as i64 as u64).wrapping_mul(83_492_791);
-            const PALETTE: [[f32; 3]; 6] = [
-                [0.5, 0.08, 0.05],
-                [0.05, 0.2, 0.45],
-                [0.1, 0.35, 0.12],
-                [0.6, 0.45, 0.05],
-                [0.45, 0.45, 0.45],
-                [0.5, 0.22, 0.05],
-            ];
-            (Vec3::from_array(PALETTE[(noise::hash3(5, 5, cell) % 6) as usize]), 0.5, 0.0)
-        }
-        6 => (Vec3::new(0.6, 0.42, 0.04), 0.45, 0.0),
-        7 => (Vec3::new(0.75, 0.15, 0.08), 0.4, 0.0),
-        8 => (Vec3::new(0.42, 0.4, 0.38), 0.8, 0.0),
-        10 => (Vec3::new(0.62, 0.62, 0.62) * hash_tint(hit.instance.max(0) as u64, 10), 0.5, 0.0),
-        11 => (Vec3::new(0.15, 0.45, 0.45), 0.4, 0.0),
-        _ => (Vec3::splat(0.3), 0.7, 0.0),
-    };
-    Material { base_color: base.to_array(), roughness, metallic, emissive: [0.0; 3], nav_light: false }
-}
-
-/// Intervals per turn of [`fast_cos`]'s table.
-const COS_STEPS: usize = 4096;
-
-/// `cos` at `COS_STEPS + 1` evenly spaced points of one turn (built once).
-fn cos_table() -> &'static [f32] {
-    static TABLE: std::sync::OnceLock<Vec<f32>> = std::sync::OnceLock::new();
-    TABLE.get_or_init(|| {
-        (0..=COS_STEPS).map(|i| (i as f64 / COS_STEPS as f64 * std::f64::consts::TAU).cos() as f32).collect()
-    })
-}
-
-/// `cos x` to within 10⁻⁶ without a library call (for `|x| < 10⁹`): the argument reduced to turns in `f64`,
-/// then a table of [`COS_STEPS`] intervals per turn read linearly (error below `(2π/4096)² / 8 ≈ 3·10⁻⁷`).
-#[inline(always)]
-fn fast_cos(x: f32) -> f32 {
-    let t = x as f64 * (COS_STEPS as f64 / std::f64::consts::TAU);
-    let f = t.floor();
-    let i = (f as i64).rem_euclid(COS_STEPS as i64) as usize;
-    let w = (t - f) as f32;
-    let table = cos_table();
-    table[i] + (table[i + 1] - table[i]) * w
-}
-
 /// One swell component of the water surface: direction `(cos, sin)`, wave number, phase and slope amplitude.
 #[derive(Debug, Clone, Copy)]
 struct Swell {
@@ -242,27 +183,6 @@ pub struct Shader {
     /// A pinhole pixel's angle (radians) and an orthographic pixel's width (metres): [`Shader::with_footprint`].
     pixel_rad: f32,
     pixel_m: f32,
-}
-
-/// Intervals of the water's Fresnel table over `cos θ` in `[0, 1]`.
-const FRESNEL_STEPS: usize = 1024;
-
-/// The exact Fresnel reflectance of water at `FRESNEL_STEPS + 1` evenly spaced `cos θ` (built once).
-fn water_fresnel_table() -> &'static [f32] {
-    static TABLE: std::sync::OnceLock<Vec<f32>> = std::sync::OnceLock::new();
-    TABLE.get_or_init(|| {
-        (0..=FRESNEL_STEPS).map(|i| fresnel_dielectric(i as f32 / FRESNEL_STEPS as f32, WATER_IOR)).collect()
-    })
-}
-
-/// [`fresnel_dielectric`] of water at `cos θ`, linearly interpolated in its table (within 2·10⁻⁴ of it, tested).
-#[inline]
-fn water_fresnel(cos: f32) -> f32 {
-    let t = water_fresnel_table();
-    let x = cos.clamp(0.0, 1.0) * FRESNEL_STEPS as f32;
-    let i = (x as usize).min(FRESNEL_STEPS - 1);
-    let f = x - i as f32;
-    t[i] + (t[i + 1] - t[i]) * f
 }
 
 impl Shader {

@@ -1,5 +1,6 @@
 //! Unit tests of the parent module (`shade.rs`).
 
+use super::brdf::fresnel_dielectric;
 use super::*;
 
 fn hit(class: u16, material: u16) -> SurfaceHit {
@@ -13,23 +14,6 @@ fn hit(class: u16, material: u16) -> SurfaceHit {
         lights_on: false,
         shading_normal: Vec3::Z,
         unresolved_mss: 0.0,
-    }
-}
-
-#[test]
-fn water_fresnel_table_is_the_formula() {
-    for i in 0..=100_000 {
-        let c = i as f32 / 100_000.0;
-        let (a, b) = (water_fresnel(c), fresnel_dielectric(c, WATER_IOR));
-        assert!((a - b).abs() < 2e-4, "{c}: {a} vs {b}");
-    }
-}
-
-#[test]
-fn fast_cos_is_cos() {
-    for i in -200_000..200_000 {
-        let x = i as f32 * 0.001_37;
-        assert!((fast_cos(x) - (x as f64).cos() as f32).abs() < 2e-6, "{x}");
     }
 }
 
