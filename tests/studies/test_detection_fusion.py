@@ -232,6 +232,56 @@ def test_closeness_axis_follows_the_legs_of_an_l() -> None:
     assert line is None or abs(abs(float(line @ u)) - 1.0) < 1e-6
 
 
+def test_point_sets_give_the_multipoints_hull_and_rectangle_to_the_bit() -> None:
+    """The detector hands shapely its points as one line string (fast to build); the convex hull and the oriented
+    envelope are those of the multipoint of the same points, coordinate for coordinate, scattered, duplicated,
+    collinear, coincident and on a grid, and for one and two points."""
+    import shapely
+    from mmusv.studies.detection.detector import _coordinates
+
+    rng = np.random.default_rng(5)
+    cases = [np.array([[1.0, 2.0]]), np.array([[1.0, 2.0], [3.0, 5.0]]), np.array([[1.0, 2.0], [1.0, 2.0]])]
+    for i in range(250):
+        n = int(rng.integers(3, 300))
+        t = rng.uniform(0, 10, n)
+        cases.append(
+            [
+                rng.normal(size=(n, 2)) * [20, 3],
+                np.round(rng.normal(size=(n, 2)) * 5, 1),
+                np.c_[t, 2 * t + 1],
+                np.repeat(rng.normal(size=(1, 2)), n, 0),
+                np.round(rng.uniform(0, 3, (n, 2))),
+            ][i % 5]
+        )
+    for pts in cases:
+        for f in (shapely.convex_hull, shapely.minimum_rotated_rectangle):
+            a, b = f(shapely.multipoints(pts)), f(_coordinates(pts))
+            assert a.geom_type == b.geom_type
+            np.testing.assert_array_equal(shapely.get_coordinates(a), shapely.get_coordinates(b))
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_linked_pairs_are_every_pair_within_the_smaller_gap(seed: int) -> None:
+    """The baseline's cell links, searched level by level, against every pair checked by brute force: a dense
+    near cluster (the least gap), far sparse cells (range-adaptive gaps up to 15 m) and exact ties at the gaps."""
+    from mmusv.studies.detection.detector import linked_pairs
+
+    rng = np.random.default_rng(seed)
+    near = (np.floor(rng.normal(size=(300, 2)) * 8 / 0.5) + 0.5) * 0.5
+    r, a = rng.uniform(20, 300, 300), rng.uniform(0, 2 * np.pi, 300)
+    far = (np.floor(np.c_[r * np.cos(a), r * np.sin(a)] / 0.5) + 0.5) * 0.5
+    tie = np.array([[100.25, 0.25], [100.25 + 5.0125, 0.25]])  # 5.0125 m apart, both gaps 5.0125 m
+    c = np.unique(np.concatenate([near, far, tie]), axis=0)
+    gap = np.maximum(1.5, 0.05 * np.hypot(c[:, 0], c[:, 1]))
+    gap[np.all(np.isin(c, tie), axis=1)] = 5.0125
+    i, j = np.triu_indices(len(c), k=1)
+    d = np.hypot(*(c[i] - c[j]).T)
+    want = {(int(x), int(y)) for x, y, ok in zip(i, j, d <= np.minimum(gap[i], gap[j]), strict=True) if ok}
+    got = linked_pairs(c, gap)
+    assert len(got) == len(want) and {(int(x), int(y)) for x, y in got} == want  # each pair once, i < j
+    assert linked_pairs(c[:1], gap[:1]).shape == (0, 2)
+
+
 def test_rotated_nms_threshold() -> None:
     a = np.array([[0, 0, 0, 4, 2, 1, 0]], float)
     near = np.array([[1.0, 0, 0, 4, 2, 1, 0]])  # IoU 0.6: suppressed

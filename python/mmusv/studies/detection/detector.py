@@ -125,6 +125,15 @@ def above_water(points: np.ndarray, params: BaselineParams | None = None) -> tup
     return keep, height, plane
 
 
+def _coordinates(pts: np.ndarray) -> shapely.Geometry:
+    """The ``(K, 2)`` points ``pts`` as one shapely geometry whose convex hull (and oriented envelope) is theirs:
+    a line string through them (one coordinate sequence, built in one step) rather than a multipoint, which builds
+    a point geometry per point (GEOS takes the same coordinates from either, in the same order: the same hull and
+    rectangle to the bit, tested). The multipoint built so was 57 % of a robustness study with the learned model's
+    box refinement (3 ms a cluster). A single point stays a point."""
+    return shapely.linestrings(pts) if len(pts) >= 2 else shapely.multipoints(pts)
+
+
 def closeness_axis(xy: np.ndarray, *, d0_m: float = 0.1) -> np.ndarray | None:
     """``(2,)`` unit direction of one side of the rectangle that best fits the BEV points ``xy`` ``(K, 2)`` as
     seen from one place, by the closeness criterion of L-shape fitting (Zhang et al., "Efficient L-shape fitting
@@ -138,23 +147,25 @@ def closeness_axis(xy: np.ndarray, *, d0_m: float = 0.1) -> np.ndarray | None:
     pts = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
     if pts.shape[0] < 3:
         return None
-    hull = shapely.convex_hull(shapely.multipoints(pts))
+    hull = shapely.convex_hull(_coordinates(pts))
     if hull.geom_type != "Polygon":
         return None
     ring = np.asarray(hull.exterior.coords)
     edges = np.diff(ring, axis=0)
     edges = edges[np.hypot(edges[:, 0], edges[:, 1]) > 1e-9]
+    # every hull edge at once: rows are edges, columns points
+    u = edges / np.hypot(edges[:, 0], edges[:, 1])[:, None]
+    d = np.full((len(u), len(pts)), np.inf)
+    for ax in (u, np.column_stack([-u[:, 1], u[:, 0]])):
+        c = ax @ pts.T
+        lo, hi = c - c.min(axis=1, keepdims=True), c.max(axis=1, keepdims=True) - c
+        near_lo = np.sqrt(np.einsum("ek,ek->e", lo, lo)) <= np.sqrt(np.einsum("ek,ek->e", hi, hi))
+        d = np.minimum(d, np.where(near_lo[:, None], lo, hi))
+    scores = np.sum(1.0 / np.maximum(d, d0_m), axis=1)
     best, best_score = None, -1.0
-    for e in edges:
-        u = e / np.hypot(*e)
-        d = np.full(len(pts), np.inf)
-        for ax in (u, np.array([-u[1], u[0]])):
-            c = pts @ ax
-            lo, hi = c - c.min(), c.max() - c
-            d = np.minimum(d, lo if np.linalg.norm(lo) <= np.linalg.norm(hi) else hi)
-        score = float(np.sum(1.0 / np.maximum(d, d0_m)))
+    for e, score in enumerate(scores.tolist()):  # the first of (near-)equal scores, edge by edge along the ring
         if score > best_score + 1e-9:
-            best, best_score = u, score
+            best, best_score = u[e], score
     return best
 
 
@@ -183,7 +194,7 @@ def fit_box(
         e1, e2 = axis * float(np.ptp(pu)), across * float(np.ptp(pv))
         centre = axis * (pu.min() + pu.max()) / 2.0 + across * (pv.min() + pv.max()) / 2.0
     else:
-        rect = shapely.minimum_rotated_rectangle(shapely.multipoints(pts))
+        rect = shapely.minimum_rotated_rectangle(_coordinates(pts))
         if rect.geom_type == "Polygon":
             c = np.asarray(rect.exterior.coords)[:4]
             e1, e2 = c[1] - c[0], c[2] - c[1]
@@ -217,6 +228,34 @@ def fit_box(
     return np.array([centre[0], centre[1], (z_low + z_high) / 2.0, length, width, h, yaw])
 
 
+def linked_pairs(centres: np.ndarray, gap: np.ndarray, *, growth: float = 2.0) -> np.ndarray:
+    """``(P, 2)`` int64 index pairs ``i < j`` of the BEV cells ``centres`` ``(n, 2)`` (metres) no farther apart
+    than the smaller of their gaps ``gap`` ``(n,)`` (metres), each pair once: step 3's links. Searched level by level
+    rather than within the largest gap everywhere: the pairs whose smaller gap is the least gap ``t_0`` (every
+    near cell's) among all cells within ``t_0``; then, for ``t_l = t_0 · growth^l`` up to the largest gap, those
+    whose smaller gap lies in ``(t_(l−1), t_l]`` among only the cells with gaps above ``t_(l−1)`` (the far, sparse
+    ones) within ``t_l``. One search within the largest gap (11 m at 220 m range) met about 200 near cells around
+    every near cell: 1.7 M candidate pairs for 0.14 M links in an early-fusion cloud of a port, most of the
+    baseline's time in the robustness study."""
+    gap = np.asarray(gap, dtype=np.float64)
+    if len(gap) < 2:
+        return np.zeros((0, 2), dtype=np.int64)
+    top = float(gap.max())
+    levels = [(-np.inf, float(gap.min()))]
+    while levels[-1][1] < top:
+        levels.append((levels[-1][1], min(levels[-1][1] * growth, top)))
+    found = []
+    for above, r in levels:
+        idx = np.flatnonzero(gap > above)
+        if len(idx) < 2:
+            continue
+        sub = idx[cKDTree(centres[idx]).query_pairs(r=r, output_type="ndarray")].reshape(-1, 2)
+        d = np.hypot(*(centres[sub[:, 0]] - centres[sub[:, 1]]).T)
+        least = np.minimum(gap[sub[:, 0]], gap[sub[:, 1]])
+        found.append(sub[(d <= least) & (least > above) & (least <= r)])  # each pair at its smaller gap's level
+    return np.concatenate(found).astype(np.int64) if found else np.zeros((0, 2), dtype=np.int64)
+
+
 def baseline_detect(points: np.ndarray, params: BaselineParams | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The baseline detector (see the module docstring): ``points`` ``(N, 4)`` float32 in the ego LiDAR frame →
     boxes ``(M, 7)`` float64 and scores ``(M,)`` float64, sorted by descending score then position."""
@@ -234,11 +273,7 @@ def baseline_detect(points: np.ndarray, params: BaselineParams | None = None) ->
     centres = (uniq + 0.5) * prm.cell_m
     rng = np.hypot(centres[:, 0], centres[:, 1])
     gap = np.maximum(prm.gap_m, prm.gap_per_m * rng)
-    pairs = cKDTree(centres).query_pairs(r=float(gap.max()), output_type="ndarray")
-    if pairs.size:
-        d = np.hypot(*(centres[pairs[:, 0]] - centres[pairs[:, 1]]).T)
-        ok = d <= np.minimum(gap[pairs[:, 0]], gap[pairs[:, 1]])
-        pairs = pairs[ok]
+    pairs = linked_pairs(centres, gap)
     n = uniq.shape[0]
     graph = coo_matrix(
         (np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])) if len(pairs) else ([], ([], [])), shape=(n, n)
