@@ -191,3 +191,27 @@ def test_mmusv_train_scorers_only_fits_every_model(trained: tuple[Path, Cache, P
             assert done[m]["boxes"] >= 20 and done[m]["frames"] == len(cache)
     det = load_models(out, refine=True)
     assert sorted(det.scorers) == sorted(fitted)
+
+
+def test_the_study_scores_the_models_on_the_threads_asked(
+    trained: tuple[Path, Cache, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``mmusv study detection --model DIR --threads 1``: the four modes scored beside the baseline, with torch on
+    one thread; ``--threads`` below 1 is refused by name."""
+    from mmusv.cli import main
+
+    rec, _, root = trained
+    before = torch.get_num_threads()
+    try:
+        argv = ["study", "detection", str(rec), "--split", "all", "--model", str(root / "models"), "--no-progress"]
+        assert main([*argv, "--threads", "1", "-o", str(tmp_path / "t3")]) == 0
+        assert torch.get_num_threads() == 1
+        out = capsys.readouterr().out
+        assert "learned models:" in out and "intermediate" in out
+        table = pl.read_csv(tmp_path / "t3" / "detection_table.csv")
+        assert sorted(table["mode"].to_list()) == ["early", "intermediate", "late", "none"]
+        assert (tmp_path / "t3" / "baseline" / "detection_table.csv").is_file()
+        assert main([*argv, "--threads", "0", "-o", str(tmp_path / "bad")]) == 2
+        assert "--threads 0: must be >= 1" in capsys.readouterr().err
+    finally:
+        torch.set_num_threads(before)

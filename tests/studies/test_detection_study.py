@@ -165,6 +165,7 @@ def test_bad_input_errors(two_usv: Path, tmp_path: Path, capsys: pytest.CaptureF
     assert "needs at least 2" in err(["study", "detection", str(one)])
     assert "only with --model" in err(["study", "detection", str(two_usv), "--refine", "off"])
     assert "--rescore on: only with --model" in err(["study", "detection", str(two_usv), "--rescore", "on"])
+    assert "--threads 1: only with --model" in err(["study", "detection", str(two_usv), "--threads", "1"])
     assert main(["study", "detection", str(one), "--modes", "none", "-o", str(tmp_path / "o1"), "--no-progress"]) == 0
     capsys.readouterr()
     assert "unknown mode" in err(["study", "detection", str(two_usv), "--modes", "none,mid"])

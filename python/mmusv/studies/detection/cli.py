@@ -85,6 +85,14 @@ def _common(p: argparse.ArgumentParser, default_out: str) -> None:
         "beside model.pt, fitted by mmusv train); auto (default) = where a model has one and boxes are refined",
     )
     p.add_argument(
+        "--threads",
+        type=int,
+        default=None,
+        help="with --model: torch's CPU threads for the learned models (default: torch's own, one per core). 1 "
+        "where other work shares the cores: torch's waiting threads spin, and two studies side by side with the "
+        "default had not finished Table III after 28 minutes, which one thread each did in 3",
+    )
+    p.add_argument(
         "--late-merge",
         choices=("nms", "wbf"),
         default="nms",
@@ -150,6 +158,14 @@ def run(args: argparse.Namespace) -> int:
     if args.model is None and (args.refine != "auto" or args.rescore != "auto"):
         flag = f"--refine {args.refine}" if args.refine != "auto" else f"--rescore {args.rescore}"
         raise InputError(f"{flag}: only with --model (the learned detector's second stage)")
+    if args.threads is not None:
+        if args.model is None:
+            raise InputError(f"--threads {args.threads}: only with --model (torch's threads of the learned models)")
+        if args.threads < 1:
+            raise InputError(f"--threads {args.threads}: must be >= 1")
+        import torch
+
+        torch.set_num_threads(args.threads)
     modes = parse_modes(args.modes or (",".join(learned.fusion_modes) if learned is not None else "none,late,early"))
     settings = parse_settings(args.settings) if robust else (Setting(),)
     if robust and not any(m != "none" for m in modes):
