@@ -152,9 +152,10 @@ def closeness_axis(xy: np.ndarray, *, d0_m: float = 0.1) -> np.ndarray | None:
         return None
     ring = np.asarray(hull.exterior.coords)
     edges = np.diff(ring, axis=0)
-    edges = edges[np.hypot(edges[:, 0], edges[:, 1]) > 1e-9]
+    length = np.hypot(edges[:, 0], edges[:, 1])
+    keep = length > 1e-9
     # every hull edge at once: rows are edges, columns points
-    u = edges / np.hypot(edges[:, 0], edges[:, 1])[:, None]
+    u = edges[keep] / length[keep, None]
     d = np.full((len(u), len(pts)), np.inf)
     for ax in (u, np.column_stack([-u[:, 1], u[:, 0]])):
         c = ax @ pts.T
