@@ -69,7 +69,7 @@ def test_bundled_specs_resolve_from_another_directory(tmp_path: Path) -> None:
         for arg in ("coop_detection", "scenarios/specs/coop_detection.yaml", "specs/coop_detection.yaml"):
             p = resolve_spec(arg)
             assert p == bundled_dir() / "specs" / "coop_detection.yaml" and p.is_file()
-        bundled = "coop_detection, coop_detection_shift, impossible_port"
+        bundled = "coop_detection, coop_detection_shift, coop_detection_w1, coop_detection_w3, impossible_port"
         with pytest.raises(NotFoundError, match=f"not a bundled spec; bundled: {bundled}"):
             resolve_spec("no_such_spec")
     finally:

@@ -67,3 +67,42 @@ def test_target_density_rejects_a_lonely_usv(tmp_path: Path) -> None:
     report = generate(spec, tmp_path)
     assert report.accepted == 0
     assert report.combos[0].rejected.get("target_density", 0) > 0
+
+
+def test_w1_and_w3_specs_make_the_same_traffic_over_another_sea(tmp_path: Path) -> None:
+    """coop_detection_w1 and _w3 (the detection study at two sea states, docs/studies/detection.md) differ in name
+    and wave alone, and generate the same scenarios but for the wave: a fixed wave draws nothing and the
+    generator's checks run on a calm sea. A spec whose wave is a list draws it and the traffic moves."""
+    import yaml
+
+    w1, w3 = (load_spec(ROOT / f"scenarios/specs/coop_detection_{w}.yaml").model_dump() for w in ("w1", "w3"))
+    assert (w1["environment"]["wave"], w3["environment"]["wave"]) == ("W1", "W3")
+    strip = lambda s: {k: v for k, v in s.items() if k not in ("name", "environment")}  # noqa: E731
+    assert strip(w1) == strip(w3)
+    assert {k: v for k, v in w1["environment"].items() if k != "wave"} == {
+        k: v for k, v in w3["environment"].items() if k != "wave"
+    }
+    keep = {"sea_head_on", "port_crossing"}  # two quick combinations, two maps
+    made = {}
+    for name, spec in (
+        ("w1", w1),
+        ("w3", w3),
+        ("list", dict(w3, environment=dict(w3["environment"], wave=["W1", "W3"]))),
+    ):
+        spec = dict(spec, combinations=[dict(c, quota=1) for c in spec["combinations"] if c["name"] in keep])
+        generate(spec, tmp_path / name)
+        made[name] = {f.name: yaml.safe_load(f.read_text()) for f in sorted((tmp_path / name).glob("*.yaml"))}
+    assert sorted(made["w1"]) == sorted(made["w3"]) and len(made["w1"]) == 2
+    for f, a in made["w1"].items():
+        b = made["w3"][f]
+        assert (a["environment"]["wave"], b["environment"]["wave"]) == ("W1", "W3")
+        a["environment"].pop("wave"), b["environment"].pop("wave")
+        a.pop("name"), b.pop("name")
+        assert a == b, f
+    # the control: drawing the wave from a list moves the other draws, so the test above would see it
+    assert any(
+        {k: v for k, v in made["list"][f].items() if k not in ("name", "environment")}
+        != {k: v for k, v in made["w3"][f].items() if k not in ("name", "environment")}
+        for f in made["w3"]
+        if f in made["list"]
+    )

@@ -68,6 +68,7 @@ def test_detection_study_end_to_end(two_usv: Path, tmp_path: Path, capsys: pytes
         "matched",
         "ego_points",
         "neighbour_points",
+        "wave_occlusion",
     ]
     assert table["gt_visible"][0] + table["gt_hidden"][0] + table["gt_unseen"][0] == table["gt"][0]
     gt = boxes.filter(pl.col("kind") == "gt")
@@ -95,6 +96,35 @@ def test_detection_study_end_to_end(two_usv: Path, tmp_path: Path, capsys: pytes
         a, b = table[col].to_list(), again[col].to_list()
         assert all((math.isnan(x) and math.isnan(y)) or x == pytest.approx(y) for x, y in zip(a, b, strict=True)), col
     assert (out / "detection_ap.png").stat().st_size > 0
+
+
+def test_wave_occlusion_of_every_ground_truth_is_the_recordings_own(two_usv: Path, tmp_path: Path) -> None:
+    """Each ground truth's wave-occlusion share is the one the recording's table gives that vessel from that ego
+    (boxes_3d, written by the run; matched by position in the LiDAR frame, so a share given to the wrong box fails),
+    and the wave-hidden count and recall are those of the boxes at or over WAVE_HIDDEN_SHARE."""
+    from mmusv.studies.detection.study import WAVE_HIDDEN_SHARE
+
+    out = tmp_path / "det"
+    assert main(["study", "detection", str(two_usv), "--modes", "none", "-o", str(out), "--no-progress"]) == 0
+    gt = pl.read_parquet(out / "detection_boxes.parquet").filter(pl.col("kind") == "gt")
+    table = pl.read_parquet(sorted((two_usv.parent / "tables" / "boxes_3d").glob("*.parquet")))
+    assert (table["wave_occlusion"] > 0).any()  # a W2 sea: some targets are partly behind waves
+    checked = 0
+    for r in gt.iter_rows(named=True):
+        rows = table.filter((pl.col("frame") == r["frame"]) & (pl.col("agent") == r["ego"]))
+        d = np.hypot(rows["x"].to_numpy() - r["x"], rows["y"].to_numpy() - r["y"])
+        k = int(np.argmin(d))
+        if d[k] < 1e-3:
+            assert r["wave_occlusion"] == pytest.approx(rows["wave_occlusion"][k], abs=1e-12)
+            checked += 1
+        else:
+            assert math.isnan(r["wave_occlusion"])  # not among the ego's annotated boxes
+    assert checked >= 0.9 * len(gt) and checked > 0
+    t = pl.read_csv(out / "detection_table.csv")
+    hidden = gt.filter(pl.col("wave_occlusion") >= WAVE_HIDDEN_SHARE)
+    assert int(t["gt_wave_hidden"][0]) == len(hidden)
+    if len(hidden):
+        assert t["recall50_wave_hidden"][0] == pytest.approx(hidden["matched"].mean())
 
 
 def test_robustness_study_end_to_end(two_usv: Path, tmp_path: Path) -> None:

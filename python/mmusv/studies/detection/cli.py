@@ -19,7 +19,8 @@ __all__ = ["add_dataset_arguments", "add_parsers", "run"]
 _BOXES_HELP = (
     "Parquet columns: sequence, frame, ego, [setting], mode, kind (det|gt), x, y, z, l, w, h, yaw "
     "(ego LiDAR frame, m, rad), score, range_bin, matched (at IoU 0.5), ego_points, neighbour_points (gt: "
-    "LiDAR points inside from the ego / the other USVs)"
+    "LiDAR points inside from the ego / the other USVs), wave_occlusion (gt: the share of it the waves hide "
+    "from the ego's LiDAR, from the recording's annotations; NaN where unknown)"
 )
 
 
@@ -324,7 +325,8 @@ def _print_detection(console: Any, res: Any) -> None:
     console.print(
         f"ground truth: {int(r0['gt'])} boxes: {int(r0['gt_visible'])} visible to the ego, "
         f"{int(r0['gt_hidden'])} hidden from it but seen by neighbours, {int(r0['gt_unseen'])} seen by "
-        "neither (seen = at least 5 LiDAR points inside)",
+        "neither (seen = at least 5 LiDAR points inside); "
+        f"{int(r0['gt_wave_hidden'])} at least half hidden from the ego by the waves",
         highlight=False,
     )
 

@@ -14,8 +14,8 @@ are returned separately: detections centred on them are ignored in evaluation.
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
-from dataclasses import dataclass
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -32,11 +32,13 @@ __all__ = [
     "SequenceData",
     "boxes_in_frame",
     "gt_in_ego",
+    "gt_with_ids",
     "opv2v_scenarios",
     "read_opv2v",
     "read_recording",
     "split_sequences",
     "usv_boxes_in_ego",
+    "wave_shares",
 ]
 
 OPV2V_USV_RADIUS_M = 8.0
@@ -47,12 +49,15 @@ about the body origin."""
 @dataclass(frozen=True)
 class AgentFrame:
     """One instrumented USV at one frame: ``points`` ``(N, 4)`` float32 ``x, y, z, intensity`` in its LiDAR
-    frame, ``body`` ``(4, 4)`` body → world and ``mount`` ``(4, 4)`` LiDAR → body."""
+    frame, ``body`` ``(4, 4)`` body → world and ``mount`` ``(4, 4)`` LiDAR → body; ``wave_occlusion``: the share
+    (0..1) of each target (by vessel id) that the waves hide from this USV's LiDAR, from its annotations (a
+    recording's ``boxes_lidar``; empty where the source has none, e.g. OPV2V)."""
 
     id: str
     points: np.ndarray
     body: np.ndarray
     mount: np.ndarray
+    wave_occlusion: Mapping[str, float] = field(default_factory=dict)
 
     @property
     def lidar(self) -> np.ndarray:
@@ -103,9 +108,23 @@ def boxes_in_frame(to_frame: np.ndarray, boxes: np.ndarray, sizes: np.ndarray) -
 def gt_in_ego(frame: SceneFrame, ego: AgentFrame, *, range_m: float = 200.0) -> np.ndarray:
     """``(G, 7)`` ground-truth target boxes in ``ego``'s LiDAR frame within ``range_m`` by the one target rule,
     :func:`mmusv.annotate.in_target_range` (BEV distance ``<= range_m``)."""
+    return gt_with_ids(frame, ego, range_m=range_m)[0]
+
+
+def gt_with_ids(frame: SceneFrame, ego: AgentFrame, *, range_m: float = 200.0) -> tuple[np.ndarray, list[str]]:
+    """:func:`gt_in_ego` and the vessel id of each of its boxes."""
     b = boxes_in_frame(invert(ego.lidar), frame.targets, frame.target_sizes)
-    out: np.ndarray = b[in_target_range(b[:, :3], range_m)] if len(b) else b
-    return out
+    if not len(b):
+        return b, []
+    keep = in_target_range(b[:, :3], range_m)
+    return b[keep], [i for i, k in zip(frame.target_ids, keep, strict=True) if k]
+
+
+def wave_shares(ego: AgentFrame, ids: Sequence[str]) -> np.ndarray:
+    """``(len(ids),)`` float64: the share of each target that the waves hide from ``ego``'s LiDAR (its
+    annotations); NaN where the source gives none (no annotation of that target, an OPV2V folder, a recording
+    made before the shares existed)."""
+    return np.array([ego.wave_occlusion.get(i, np.nan) for i in ids], dtype=np.float64)
 
 
 def usv_boxes_in_ego(frame: SceneFrame, ego: AgentFrame) -> np.ndarray:
@@ -164,8 +183,9 @@ def read_recording(path: str | Path) -> SequenceData:
     from mmusv.recording import topics as names
 
     topics = {names.lidar(a.id) for a in agents}
+    notes = {names.agent_annotations(a.id) for a in agents}
     frames: list[SceneFrame] = []
-    stream = FrameStream(info, want=topics.__contains__)
+    stream = FrameStream(info, want=lambda t: t in topics or t in notes)
     for fr in stream:
         w = fr.world
         if w is None or not all(t in fr.messages for t in topics):
@@ -175,7 +195,9 @@ def read_recording(path: str | Path) -> SequenceData:
             c = decode_point_cloud(fr.messages[names.lidar(a.id)])
             pts = np.column_stack([c["x"], c["y"], c["z"], c.get("intensity", np.zeros(len(c["x"])))])
             assert a.lidar_mount is not None
-            afs.append(AgentFrame(a.id, pts.astype(np.float32), pose_matrices(w.poses[a.index]), a.lidar_mount))
+            body = pose_matrices(w.poses[a.index])
+            waves = _wave_occlusion(fr.messages.get(names.agent_annotations(a.id)))
+            afs.append(AgentFrame(a.id, pts.astype(np.float32), body, a.lidar_mount, waves))
         is_usv = np.array([r == "usv" for r in w.roles], dtype=bool)
         boxes = _box_mats(w.poses, w.box_centers)
         frames.append(
@@ -192,6 +214,17 @@ def read_recording(path: str | Path) -> SequenceData:
     warn_missing(stream, reader="the detection study")  # frames missing or damaged: said, not dropped silently
     frames.sort(key=lambda f: f.frame)
     return SequenceData(recording_name(info.path), tuple(frames))
+
+
+def _wave_occlusion(annotations: object) -> dict[str, float]:
+    """Target id → wave-occlusion share of an agent's annotations message (``boxes_lidar``); no entry for a box
+    without one (a recording made before the field existed)."""
+    out: dict[str, float] = {}
+    for b in getattr(annotations, "boxes_lidar", ()):
+        share = getattr(b, "wave_occlusion", None)
+        if share is not None:
+            out[str(b.target_id)] = float(share)
+    return out
 
 
 def opv2v_scenarios(root: str | Path) -> list[Path]:

@@ -29,6 +29,8 @@ DETECTION_METRICS: tuple[tuple[str, str | None], ...] = (
     ("recall30_visible", None),
     ("recall30_hidden", "R@0.3 hidden"),
     ("recall30_unseen", None),
+    ("recall50_wave_hidden", "R@0.5 wave-hidden"),
+    ("recall30_wave_hidden", None),
 )
 """Table III's metric columns in CSV order, each with its heading in the printed table (``None``: CSV only)."""
 
@@ -41,7 +43,8 @@ def fmt(v: float) -> str:
 def detection_table(res: StudyResult) -> pl.DataFrame:
     """Table III: one row per fusion mode (clean setting)."""
     t = res.table().filter(pl.col("setting") == "clean")
-    cols = ["mode", *(c for c, _ in DETECTION_METRICS), "gt_visible", "gt_hidden", "gt_unseen", "gt", "det", "frames"]
+    cols = ["mode", *(c for c, _ in DETECTION_METRICS), "gt_visible", "gt_hidden", "gt_unseen"]
+    cols += ["gt_wave_hidden", "gt", "det", "frames"]
     return t.select(cols)
 
 

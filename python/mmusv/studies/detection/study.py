@@ -11,7 +11,11 @@ height within ±0.5 m), and ``neighbour_points``, the same summed over the other
 ``SEEN_POINTS`` = 5 (about the fewest points a box can be put on), a target is *visible* (ego_points ≥ 5),
 *hidden* (fewer from the ego but ≥ 5 from the neighbours: behind an island or another hull, or too small for the
 ego's beams at that range, but seen by cooperating USVs: the case cooperation exists for) or *unseen* (neither).
-Recall at IoU 0.5 and 0.3 is reported for each class.
+Recall at IoU 0.5 and 0.3 is reported for each class. Over waves, each ground truth also records
+``wave_occlusion``, the share of it the waves hide from the ego's LiDAR (the recording's annotations; NaN where the
+source has none), and the targets the waves hide at least :data:`WAVE_HIDDEN_SHARE` of from the ego are a class
+of their own, *wave-hidden*, with its recall (``recall50_wave_hidden``, ...; a target may be wave-hidden and
+visible, hidden or unseen as well).
 
 **Predictions file** (``--predictions``, instead of a detector): a Parquet file with one row per detection and
 columns ``sequence`` (recording stem or OPV2V scenario folder name), ``frame`` (acquisition index), ``ego``
@@ -41,8 +45,9 @@ from mmusv.studies.detection.data import (
     AgentFrame,
     SceneFrame,
     SequenceData,
-    gt_in_ego,
+    gt_with_ids,
     usv_boxes_in_ego,
+    wave_shares,
 )
 from mmusv.studies.detection.detector import Detector
 from mmusv.studies.detection.evaluate import (
@@ -62,6 +67,9 @@ __all__ = ["StudyOptions", "StudyResult", "gt_visibility", "load_predictions", "
 Key = tuple[str, str]  # (setting name, mode)
 SEEN_POINTS = 5
 """LiDAR points inside a target for it to count as seen by a USV (module docstring)."""
+WAVE_HIDDEN_SHARE = 0.5
+"""The share of a target the waves hide from the ego's LiDAR from which it counts as wave-hidden (module
+docstring)."""
 
 
 @dataclass(frozen=True)
@@ -86,9 +94,9 @@ class StudyResult:
 
     options: StudyOptions
     matches: dict[Key, list[FrameMatch]] = field(default_factory=dict)
-    visibility: dict[Key, list[tuple[np.ndarray, np.ndarray, np.ndarray]]] = field(default_factory=dict)
+    visibility: dict[Key, list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]] = field(default_factory=dict)
     """Per key and ego-frame: visibility class of each ground truth (0 visible, 1 hidden, 2 unseen), matched at
-    0.5, matched at 0.3."""
+    0.5, matched at 0.3, and its wave-occlusion share from the ego (NaN where unknown)."""
     rows: dict[str, list[Any]] = field(default_factory=dict)
     sequences: list[str] = field(default_factory=list)
     frames: int = 0
@@ -98,14 +106,22 @@ class StudyResult:
 
     def metrics(self, key: Key) -> dict[str, float]:
         """:func:`~mmusv.studies.detection.evaluate.summarize` of ``key`` plus the recall at IoU 0.5 and 0.3
-        of the visible, hidden and unseen ground truths (``recall50_hidden``, ``recall30_hidden``, ...; module
-        docstring) and their counts ``gt_visible``, ``gt_hidden``, ``gt_unseen``."""
+        of the visible, hidden, unseen and wave-hidden ground truths (``recall50_hidden``, ``recall30_hidden``,
+        ...; module docstring) and their counts ``gt_visible``, ``gt_hidden``, ``gt_unseen``, ``gt_wave_hidden``."""
         out = summarize(self.matches.get(key, []))
         vis = self.visibility.get(key, [])
         cls = np.concatenate([v[0] for v in vis]) if vis else np.zeros(0)
         hit50 = np.concatenate([v[1] for v in vis]) if vis else np.zeros(0, dtype=bool)
         hit30 = np.concatenate([v[2] for v in vis]) if vis else np.zeros(0, dtype=bool)
-        for name, sel in (("visible", cls == 0), ("hidden", cls == 1), ("unseen", cls == 2)):
+        wave = np.concatenate([v[3] for v in vis]) if vis else np.zeros(0)
+        with np.errstate(invalid="ignore"):
+            wave_hidden = wave >= WAVE_HIDDEN_SHARE  # NaN (unknown) is not
+        for name, sel in (
+            ("visible", cls == 0),
+            ("hidden", cls == 1),
+            ("unseen", cls == 2),
+            ("wave_hidden", wave_hidden),
+        ):
             n = int(sel.sum())
             out[f"recall50_{name}"] = float(hit50[sel].sum()) / n if n else math.nan
             out[f"recall30_{name}"] = float(hit30[sel].sum()) / n if n else math.nan
@@ -153,6 +169,7 @@ _ROW_SCHEMA: dict[str, Any] = {
     "matched": pl.Boolean,
     "ego_points": pl.Int64,
     "neighbour_points": pl.Int64,
+    "wave_occlusion": pl.Float64,
 }
 
 
@@ -236,6 +253,7 @@ def run_study(
         "matched",
         "ego_points",
         "neighbour_points",
+        "wave_occlusion",
     ):
         res.rows[k] = []
     start = max(s.delay_frames for s in o.settings)
@@ -294,7 +312,8 @@ def _score_ego(
 ) -> None:
     o = res.options
     res.ego_frames += 1
-    gt = gt_in_ego(frame, ego, range_m=o.range_m)
+    gt, gt_ids = gt_with_ids(frame, ego, range_m=o.range_m)
+    wave = wave_shares(ego, gt_ids)
     res.gt_boxes += len(gt)
     usv = usv_boxes_in_ego(frame, ego)
     vis = gt_visibility(gt, ego.points)
@@ -330,8 +349,8 @@ def _score_ego(
             key = (s.name, mode)
             res.matches.setdefault(key, []).append(fm)
             gm = fm.gt_matched(0.5)
-            res.visibility.setdefault(key, []).append((cls, gm, fm.gt_matched(0.3)))
-            _add_rows(res, seq.name, frame.frame, ego.id, s.name, mode, fm, gm, gbin, vis, nb_vis)
+            res.visibility.setdefault(key, []).append((cls, gm, fm.gt_matched(0.3), wave))
+            _add_rows(res, seq.name, frame.frame, ego.id, s.name, mode, fm, gm, gbin, (vis, nb_vis, wave))
 
 
 def _add_rows(
@@ -344,16 +363,16 @@ def _add_rows(
     fm: FrameMatch,
     gm: np.ndarray,
     gbin: np.ndarray,
-    vis: np.ndarray,
-    nb_vis: np.ndarray,
+    seen: tuple[np.ndarray, np.ndarray, np.ndarray],
 ) -> None:
+    vis, nb_vis, wave = seen
     r = res.rows
     dbin = fm.det_bins(0.5)
     tp = fm.matches[0.5] >= 0
-    none: list[int | None] = [None] * len(fm.det_boxes)
-    for kind, boxes, scores, bins, matched, pts, nb_pts in (
-        ("det", fm.det_boxes, fm.det_scores, dbin, tp, none, none),
-        ("gt", fm.gt_boxes, [math.nan] * len(fm.gt_boxes), gbin, gm, vis.tolist(), nb_vis.tolist()),
+    none: list[Any] = [None] * len(fm.det_boxes)
+    for kind, boxes, scores, bins, matched, pts, nb_pts, waves in (
+        ("det", fm.det_boxes, fm.det_scores, dbin, tp, none, none, none),
+        ("gt", fm.gt_boxes, [math.nan] * len(fm.gt_boxes), gbin, gm, vis.tolist(), nb_vis.tolist(), wave.tolist()),
     ):
         n = len(boxes)
         r["sequence"] += [seq] * n
@@ -369,6 +388,7 @@ def _add_rows(
         r["matched"] += [bool(v) for v in matched]
         r["ego_points"] += list(pts)
         r["neighbour_points"] += list(nb_pts)
+        r["wave_occlusion"] += list(waves)
 
 
 def range_bin_labels() -> list[str]:
