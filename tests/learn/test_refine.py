@@ -127,3 +127,51 @@ def test_a_blob_keeps_the_network_heading() -> None:
     out = refine_boxes(cloud, loose[None])[0]
     assert out[6] == loose[6]
     assert iou(out, squat) > iou(loose, squat)
+
+
+def rough_sea(rng: np.random.Generator, crest_m: float, n: int = 30_000) -> np.ndarray:
+    """A rough sea's returns round the sensor: a carpet over the 50 m disc, each return at a height drawn uniformly
+    between the trough (the water plane the lowest returns give) and ``crest_m`` above it."""
+    r = 50.0 * np.sqrt(rng.uniform(0.0, 1.0, n))
+    a = rng.uniform(0.0, 2.0 * np.pi, n)
+    z = WATER_Z + rng.uniform(0.0, crest_m, n)
+    return np.column_stack([r * np.cos(a), r * np.sin(a), z, np.full(n, 0.1)])
+
+
+def tall_faces(box: np.ndarray, *, spacing: float) -> np.ndarray:
+    """Points on the two faces of ``box`` the sensor sees, from the waterline to 6 m above it."""
+    pts = faces(box, spacing=spacing)
+    return np.vstack([pts + np.array([0.0, 0.0, dz, 0.0]) for dz in (0.0, 1.5, 3.0)])
+
+
+def test_the_sea_height_is_the_quantile_of_the_near_returns() -> None:
+    from mmusv.learn.refine import sea_height
+    from mmusv.studies.detection.detector import above_water
+
+    rng = np.random.default_rng(4)
+    p = RefineParams()
+    sea = rough_sea(rng, crest_m=2.5)
+    _, height, _ = above_water(sea[:, :3], p.water)
+    r = np.hypot(sea[:, 0], sea[:, 1])
+    want = np.quantile(height[(r > p.water.self_radius_m) & (r < p.near_m) & (height < p.sea_cap_m)], 0.95)
+    assert sea_height(sea, height, r, p) == want + p.sea_margin_m
+    assert 2.2 < want < 2.5  # the carpet's crests, above the trough plane
+    # A calm sea returns from a few patches of water only: no sea height, the fixed rule as before.
+    calm = sea[:300]
+    _, h2, _ = above_water(calm[:, :3], p.water)
+    assert sea_height(calm, h2, np.hypot(calm[:, 0], calm[:, 1]), p) == 0.0
+
+
+def test_a_rough_seas_returns_do_not_carry_the_box_away() -> None:
+    """Round a 20 m hull in a carpet of wave returns up to 2.5 m over the troughs, the refined box stays on the hull
+    (its crests are not points of it); with the sea's height not learnt (the 1 m rule alone) the rounds follow the
+    carpet across the sea, the failure this guards against."""
+    rng = np.random.default_rng(5)
+    true = np.array([30.0, 12.0, WATER_Z + 2.0, 20.0, 6.0, 4.0, 0.4])
+    cloud = np.vstack([rough_sea(rng, crest_m=2.5), tall_faces(true, spacing=0.25)])
+    net = true + np.array([1.0, -0.8, 0.0, -4.0, -1.5, 0.0, 0.05])
+    got = refine_boxes(cloud, net[None])[0]
+    assert iou(got, true) > 0.7, got
+    fixed = RefineParams(sea_cells=10**9)  # never learns the sea
+    away = refine_boxes(cloud, net[None], params=fixed)[0]
+    assert iou(away, true) < 0.3 and away[3] * away[4] > 4 * true[3] * true[4], away

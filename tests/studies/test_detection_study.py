@@ -151,7 +151,9 @@ def test_robustness_study_end_to_end(two_usv: Path, tmp_path: Path) -> None:
         assert (out / name).read_bytes() == (again / name).read_bytes()
 
 
-def test_opv2v_input_gives_the_same_ground_truth(two_usv: Path, tmp_path: Path) -> None:
+def test_opv2v_input_gives_the_same_ground_truth(
+    two_usv: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     from mmusv.export.convert import convert
 
     convert([two_usv], to="opv2v", out_dir=tmp_path / "opv2v", splits=None, extras="")
@@ -173,8 +175,12 @@ def test_opv2v_input_gives_the_same_ground_truth(two_usv: Path, tmp_path: Path) 
         )
         == 0
     )
+    out = " ".join(capsys.readouterr().out.split())  # rich wraps its lines
+    assert "at least half hidden from the ego by the waves" in out  # the recording has the shares
+    assert "the source gives no wave-occlusion shares" in out  # OPV2V has none: said, not counted as 0
     a, b = pl.read_csv(rec_out / "detection_table.csv"), pl.read_csv(opv_out / "detection_table.csv")
     assert a["gt"].to_list() == b["gt"].to_list()
+    assert int(b["gt_wave_hidden"][0]) == 0 and math.isnan(b["recall50_wave_hidden"][0])
     ga = pl.read_parquet(rec_out / "detection_boxes.parquet").filter(pl.col("kind") == "gt").sort(["frame", "x"])
     gb = pl.read_parquet(opv_out / "detection_boxes.parquet").filter(pl.col("kind") == "gt").sort(["frame", "x"])
     assert np.allclose(

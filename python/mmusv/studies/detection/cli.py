@@ -325,10 +325,20 @@ def _print_detection(console: Any, res: Any) -> None:
     console.print(
         f"ground truth: {int(r0['gt'])} boxes: {int(r0['gt_visible'])} visible to the ego, "
         f"{int(r0['gt_hidden'])} hidden from it but seen by neighbours, {int(r0['gt_unseen'])} seen by "
-        "neither (seen = at least 5 LiDAR points inside); "
-        f"{int(r0['gt_wave_hidden'])} at least half hidden from the ego by the waves",
+        "neither (seen = at least 5 LiDAR points inside); " + _wave_line(res, int(r0["gt_wave_hidden"])),
         highlight=False,
     )
+
+
+def _wave_line(res: Any, hidden: int) -> str:
+    """How many ground truths the waves hide at least half of from the ego, or that the source does not say (an
+    OPV2V folder, a recording made before the shares were recorded)."""
+    import math
+
+    shares = [w for w, k in zip(res.rows["wave_occlusion"], res.rows["kind"], strict=True) if k == "gt"]
+    if shares and all(w is None or math.isnan(w) for w in shares):
+        return "the source gives no wave-occlusion shares"
+    return f"{hidden} at least half hidden from the ego by the waves"
 
 
 def _print_robustness(console: Any, res: Any) -> None:
