@@ -282,6 +282,21 @@ def test_linked_pairs_are_every_pair_within_the_smaller_gap(seed: int) -> None:
     assert linked_pairs(c[:1], gap[:1]).shape == (0, 2)
 
 
+def test_cell_keys_order_and_group_cells_as_the_rows_do() -> None:
+    """np.unique on cell_keys gives np.unique(cell, axis=0)'s cells, order and grouping (negative indices, the
+    extremes of the range the keys are for, duplicates)."""
+    from mmusv.studies.detection.detector import cell_keys
+
+    rng = np.random.default_rng(3)
+    cell = rng.integers(-600, 600, size=(5000, 2))
+    cell[:40] = cell[40:80]  # duplicates
+    cell[80:84] = [[-(2**31), 2**31 - 1], [2**31 - 1, -(2**31)], [0, -(2**31)], [-1, 2**31 - 1]]
+    want, want_inv = np.unique(cell, axis=0, return_inverse=True)
+    _, first, inv = np.unique(cell_keys(cell), return_index=True, return_inverse=True)
+    np.testing.assert_array_equal(cell[first], want)
+    np.testing.assert_array_equal(inv.reshape(-1), want_inv.reshape(-1))
+
+
 def test_rotated_nms_threshold() -> None:
     a = np.array([[0, 0, 0, 4, 2, 1, 0]], float)
     near = np.array([[1.0, 0, 0, 4, 2, 1, 0]])  # IoU 0.6: suppressed

@@ -48,7 +48,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from mmusv.studies.detection.detector import BaselineParams, above_water, fit_box
+from mmusv.studies.detection.detector import BaselineParams, above_water, cell_keys, fit_box
 
 __all__ = ["SEA_CELL_M", "RefineParams", "refine_box", "refine_boxes", "refine_on", "sea_height", "surface_points"]
 
@@ -114,8 +114,8 @@ def sea_height(points: np.ndarray, height: np.ndarray, r: np.ndarray, p: RefineP
     sel = (r < p.near_m) & (r > p.water.self_radius_m) & (height < p.sea_cap_m)
     if int(sel.sum()) < p.sea_cells:
         return 0.0
-    keys = np.floor(points[sel, :2] / SEA_CELL_M).astype(np.int64)
-    if len(np.unique(keys, axis=0)) < p.sea_cells:
+    cell = np.floor(points[sel, :2] / SEA_CELL_M).astype(np.int64)
+    if len(np.unique(cell_keys(cell))) < p.sea_cells:
         return 0.0
     return float(np.quantile(height[sel], p.sea_quantile)) + p.sea_margin_m
 

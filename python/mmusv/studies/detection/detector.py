@@ -49,6 +49,7 @@ __all__ = [
     "Detector",
     "above_water",
     "baseline_detect",
+    "cell_keys",
     "closeness_axis",
     "fit_box",
     "load_detector",
@@ -123,6 +124,15 @@ def above_water(points: np.ndarray, params: BaselineParams | None = None) -> tup
     height = p[:, 2] - (plane[0] * p[:, 0] + plane[1] * p[:, 1] + plane[2])
     keep: np.ndarray = (height > prm.min_height_m) & (np.hypot(p[:, 0], p[:, 1]) > prm.self_radius_m)
     return keep, height, plane
+
+
+def cell_keys(cell: np.ndarray) -> np.ndarray:
+    """``(N,)`` int64, one key per row of the integer BEV cell indices ``cell`` ``(N, 2)`` (|index| < 2³¹), ordered
+    as the rows are lexicographically: ``np.unique`` on the keys is ``np.unique(cell, axis=0)`` without its row-wise
+    sort, an order of magnitude slower (4 of a W3 cloud's 18 ms in the baseline)."""
+    c = np.asarray(cell, dtype=np.int64)
+    out: np.ndarray = c[:, 0] * (1 << 32) + c[:, 1]
+    return out
 
 
 def _coordinates(pts: np.ndarray) -> shapely.Geometry:
@@ -269,7 +279,8 @@ def baseline_detect(points: np.ndarray, params: BaselineParams | None = None) ->
     if q.shape[0] < prm.min_points:
         return np.zeros((0, 7)), np.zeros(0)
     cell = np.floor(q[:, :2] / prm.cell_m).astype(np.int64)
-    uniq, inv = np.unique(cell, axis=0, return_inverse=True)
+    _, first, inv = np.unique(cell_keys(cell), return_index=True, return_inverse=True)
+    uniq = cell[first]
     inv = inv.reshape(-1)
     centres = (uniq + 0.5) * prm.cell_m
     rng = np.hypot(centres[:, 0], centres[:, 1])
