@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import shapely
 from mmusv.learn.refine import RefineParams, refine_boxes
+from mmusv.studies.detection.detector import BaselineParams
 
 WATER_Z = -2.3  # the water 2.3 m below the sensor
 
@@ -130,12 +131,15 @@ def test_a_blob_keeps_the_network_heading() -> None:
 
 
 def rough_sea(rng: np.random.Generator, crest_m: float, n: int = 30_000) -> np.ndarray:
-    """A rough sea's returns round the sensor: a carpet over the 50 m disc, each return at a height drawn uniformly
-    between the trough (the water plane the lowest returns give) and ``crest_m`` above it."""
+    """A rough sea's returns round the sensor: a carpet over the 50 m disc on a smooth surface of two crossing
+    waves (31 m and 23 m long) between the trough (the water plane the lowest returns give) and ``crest_m`` above
+    it. Smooth as the sea is: its returns in a 1 m column span well under the 1 m of a hull's side."""
     r = 50.0 * np.sqrt(rng.uniform(0.0, 1.0, n))
     a = rng.uniform(0.0, 2.0 * np.pi, n)
-    z = WATER_Z + rng.uniform(0.0, crest_m, n)
-    return np.column_stack([r * np.cos(a), r * np.sin(a), z, np.full(n, 0.1)])
+    x, y = r * np.cos(a), r * np.sin(a)
+    wave = np.sin(2 * np.pi * (0.8 * x + 0.6 * y) / 31.0) + np.sin(2 * np.pi * (-0.3 * x + 0.95 * y) / 23.0 + 1.0)
+    z = WATER_Z + crest_m * (0.5 + 0.25 * wave)
+    return np.column_stack([x, y, z, np.full(n, 0.1)])
 
 
 def tall_faces(box: np.ndarray, *, spacing: float) -> np.ndarray:
@@ -145,21 +149,61 @@ def tall_faces(box: np.ndarray, *, spacing: float) -> np.ndarray:
 
 
 def test_the_sea_height_is_the_quantile_of_the_near_returns() -> None:
-    from mmusv.learn.refine import sea_height
-    from mmusv.studies.detection.detector import above_water
+    from mmusv.studies.detection.detector import above_water, sea_height
 
     rng = np.random.default_rng(4)
-    p = RefineParams()
+    w = RefineParams().water
     sea = rough_sea(rng, crest_m=2.5)
-    _, height, _ = above_water(sea[:, :3], p.water)
+    keep, height, _, got = above_water(sea[:, :3], w)
     r = np.hypot(sea[:, 0], sea[:, 1])
-    want = np.quantile(height[(r > p.water.self_radius_m) & (r < p.near_m) & (height < p.sea_cap_m)], 0.95)
-    assert sea_height(sea, height, r, p) == want + p.sea_margin_m
-    assert 2.2 < want < 2.5  # the carpet's crests, above the trough plane
+    want = np.quantile(height[(r > w.self_radius_m) & (r < w.sea_near_m) & (height < w.sea_cap_m)], 0.95)
+    assert sea_height(sea, height, r, w) == got == want + w.sea_margin_m
+    assert 0.7 * 2.5 < want < 2.5  # the carpet's crests, above the trough plane
+    assert np.array_equal(keep, (height > got) & (r > w.self_radius_m))
     # A calm sea returns from a few patches of water only: no sea height, the fixed rule as before.
     calm = sea[:300]
-    _, h2, _ = above_water(calm[:, :3], p.water)
-    assert sea_height(calm, h2, np.hypot(calm[:, 0], calm[:, 1]), p) == 0.0
+    keep2, h2, _, got2 = above_water(calm[:, :3], w)
+    assert sea_height(calm, h2, np.hypot(calm[:, 0], calm[:, 1]), w) == got2 == 0.0
+    assert np.array_equal(keep2, (h2 > w.min_height_m) & (np.hypot(calm[:, 0], calm[:, 1]) > w.self_radius_m))
+
+
+def test_a_hulls_side_near_the_sensor_does_not_raise_the_sea_height() -> None:
+    """A 60 m hull 20 m off, its side's returns stacked from the waterline to 5.6 m in 0.25 m steps: they are as many
+    as a tenth of the sea's below the 4 m cap, and without the column test they raised the height by over 0.5 m."""
+    from mmusv.studies.detection.detector import sea_height
+
+    rng = np.random.default_rng(6)
+    w = RefineParams().water
+    sea = rough_sea(rng, crest_m=2.0)
+    hull = np.array([0.0, 20.0, WATER_Z + 3.0, 60.0, 10.0, 6.0, 0.0])
+    side = tall_faces(hull, spacing=0.1)
+    cloud = np.vstack([sea, side])
+
+    def height_of(pts: np.ndarray, prm: BaselineParams) -> float:
+        h = pts[:, 2] - WATER_Z
+        return sea_height(pts, h, np.hypot(pts[:, 0], pts[:, 1]), prm)
+
+    alone = height_of(sea, w)
+    assert alone > 0.0
+    assert abs(height_of(cloud, w) - alone) < 0.05
+    from dataclasses import replace
+
+    no_columns = replace(w, sea_stack_m=np.inf)
+    assert height_of(cloud, no_columns) > alone + 0.5  # the control: the side does raise the plain quantile
+
+
+def test_the_baseline_sees_the_hull_not_the_crests() -> None:
+    """The baseline detector over the same rough sea: one box, on the hull; with its water height fixed at 0.5 m
+    the crests' returns join the hull in one cluster wider than any vessel, and the hull is lost."""
+    from mmusv.studies.detection.detector import baseline_detect
+
+    rng = np.random.default_rng(7)
+    true = np.array([30.0, 12.0, WATER_Z + 3.0, 20.0, 6.0, 6.0, 0.4])
+    cloud = np.vstack([rough_sea(rng, crest_m=2.5), tall_faces(true, spacing=0.25)]).astype(np.float32)
+    boxes, _ = baseline_detect(cloud)
+    assert len(boxes) == 1 and np.hypot(*(boxes[0, :2] - true[:2])) < 3.0, boxes  # its rectangle: the L's own
+    fixed, _ = baseline_detect(cloud, BaselineParams(sea_cells=10**9))
+    assert not any(np.hypot(*(b[:2] - true[:2])) < 3.0 for b in fixed)  # hull and crests: one land-sized cluster
 
 
 def test_a_rough_seas_returns_do_not_carry_the_box_away() -> None:
@@ -172,6 +216,6 @@ def test_a_rough_seas_returns_do_not_carry_the_box_away() -> None:
     net = true + np.array([1.0, -0.8, 0.0, -4.0, -1.5, 0.0, 0.05])
     got = refine_boxes(cloud, net[None])[0]
     assert iou(got, true) > 0.7, got
-    fixed = RefineParams(sea_cells=10**9)  # never learns the sea
+    fixed = RefineParams(water=BaselineParams(sea_cells=10**9))  # never learns the sea
     away = refine_boxes(cloud, net[None], params=fixed)[0]
     assert iou(away, true) < 0.3 and away[3] * away[4] > 4 * true[3] * true[4], away

@@ -45,14 +45,14 @@ def water(rng: np.random.Generator, *, z: float = -2.3, n: int = 3000, r: float 
 
 
 def box_surface(b: np.ndarray, rng: np.random.Generator, *, n: int = 1500) -> np.ndarray:
-    """Points on the four sides and the top of box ``b`` (x, y, z, l, w, h, yaw)."""
+    """Points on the four sides of box ``b`` (x, y, z, l, w, h, yaw); not on its top, which the boxes of these
+    tests raise above the LiDAR that would see it."""
     u = rng.uniform(-0.5, 0.5, (n, 3))
-    face = rng.integers(0, 5, n)
+    face = rng.integers(0, 4, n)
     u[face == 0, 0] = 0.5
     u[face == 1, 0] = -0.5
     u[face == 2, 1] = 0.5
     u[face == 3, 1] = -0.5
-    u[face == 4, 2] = 0.5
     local = u * b[3:6]
     c, s = math.cos(b[6]), math.sin(b[6])
     x = b[0] + c * local[:, 0] - s * local[:, 1]

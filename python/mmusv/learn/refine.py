@@ -12,12 +12,13 @@ docs/studies/detection.md gives the measurements):
 
 1. **Points.** The cloud's points above the water: the baseline's plane and ``water.min_height_m`` (0.5 m), and
    within ``near_m`` (50 m) of the sensor ``near_min_height_m`` (1 m), where the wave faces' returns stand above
-   0.5 m. In a rough sea the crests rise higher still, so both heights rise to the sea the cloud shows
-   (:func:`sea_height`): the ``sea_quantile`` (0.95) of the heights (below ``sea_cap_m``, 4 m) of the returns
-   within ``near_m``, plus ``sea_margin_m`` (0.5 m) for the crests above it, where those returns cover at least
-   ``sea_cells`` (400) cells of 2 m. (Without it, the water's returns round a hull at W3 carry the rounds of step
-   4 on across the sea: boxes 150 m × 80 m round a 27 m ship. The three constants were chosen on every third
-   sequence of the W1 and W3 sets of docs/studies/detection.md, *Sea state*.)
+   0.5 m. In a rough sea the crests rise higher still, so both heights rise to the sea the cloud shows (the
+   baseline's :func:`~mmusv.studies.detection.detector.sea_height`, with ``water``'s ``sea_*`` fields): the
+   ``sea_quantile`` (0.95) of the heights (below ``sea_cap_m``, 4 m) of the returns within ``sea_near_m`` (50 m),
+   plus ``sea_margin_m`` (0.5 m) for the crests above it, where those returns cover at least ``sea_cells`` (400)
+   cells of 2 m. (Without it, the water's returns round a hull at W3 carry the rounds of step 4 on across the sea:
+   boxes 150 m × 80 m round a 27 m ship. The three constants were chosen on every third sequence of the W1 and W3
+   sets of docs/studies/detection.md, *Sea state*.)
    Of those, the ones whose BEV position lies in the box grown by ``margin_length_m`` (10 m) at each end
    and ``margin_m`` (3 m) at each side. Fewer than ``min_points`` (3): the box is left as it is.
 2. **Heading.** The rectangle ``fit_box`` fits to those points (without its widening; the side directions by the
@@ -48,16 +49,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from mmusv.studies.detection.detector import BaselineParams, above_water, cell_keys, fit_box
+from mmusv.studies.detection.detector import BaselineParams, above_water, fit_box
 
-__all__ = ["SEA_CELL_M", "RefineParams", "refine_box", "refine_boxes", "refine_on", "sea_height", "surface_points"]
+__all__ = ["RefineParams", "refine_box", "refine_boxes", "refine_on", "surface_points"]
 
 
 @dataclass(frozen=True)
 class RefineParams:
     """The constants of the rule (module docstring; metres unless said otherwise). ``criterion``: ``fit_box``'s
     (``"closeness"`` or ``"area"``). ``water``: the baseline's parameters, of which the water plane,
-    ``min_height_m`` and ``self_radius_m`` are used."""
+    ``min_height_m``, ``self_radius_m`` and the sea's height (``sea_*``) are used."""
 
     margin_m: float = 3.0
     margin_length_m: float = 10.0
@@ -71,10 +72,6 @@ class RefineParams:
     rounds: int = 20
     near_m: float = 50.0
     near_min_height_m: float = 1.0
-    sea_quantile: float = 0.95
-    sea_margin_m: float = 0.5
-    sea_cap_m: float = 4.0
-    sea_cells: int = 400
     criterion: str = "closeness"
     water: BaselineParams = field(default_factory=BaselineParams)
 
@@ -92,32 +89,11 @@ def surface_points(points: np.ndarray, p: RefineParams) -> np.ndarray:
     pts = np.asarray(points, dtype=np.float64)
     if pts.shape[0] == 0:
         return np.zeros((0, 2))
-    keep, height, _ = above_water(pts[:, :3], p.water)
+    keep, height, _, sea = above_water(pts[:, :3], p.water)
     if p.near_m > 0:
         r = np.hypot(pts[:, 0], pts[:, 1])
-        sea = sea_height(pts, height, r, p)
-        near_min, far_min = max(p.near_min_height_m, sea), max(p.water.min_height_m, sea)
-        keep &= np.where(r > p.near_m, height > far_min, height > near_min)
+        keep &= (r > p.near_m) | (height > max(p.near_min_height_m, sea))
     return pts[keep, :2]
-
-
-SEA_CELL_M = 2.0
-"""BEV cell (metres) in which :func:`sea_height` counts how much of the water round the sensor returns."""
-
-
-def sea_height(points: np.ndarray, height: np.ndarray, r: np.ndarray, p: RefineParams) -> float:
-    """How high the sea's own returns stand above the fitted water plane (metres; step 1 of the module docstring):
-    the ``p.sea_quantile`` of the ``height`` of the ``points`` ``(N, ≥2)`` within ``p.near_m`` (``r``: their BEV
-    range; the sensor's own ``p.water.self_radius_m`` left out) that lie below ``p.sea_cap_m``, plus
-    ``p.sea_margin_m``, where those cover at least ``p.sea_cells`` cells of :data:`SEA_CELL_M`; else 0 (a calm sea
-    returns from too little water to tell its crests from the hulls near the sensor)."""
-    sel = (r < p.near_m) & (r > p.water.self_radius_m) & (height < p.sea_cap_m)
-    if int(sel.sum()) < p.sea_cells:
-        return 0.0
-    cell = np.floor(points[sel, :2] / SEA_CELL_M).astype(np.int64)
-    if len(np.unique(cell_keys(cell))) < p.sea_cells:
-        return 0.0
-    return float(np.quantile(height[sel], p.sea_quantile)) + p.sea_margin_m
 
 
 def _axis(

@@ -18,7 +18,13 @@ model of the paper (a PointPillars-style network), so its absolute numbers are n
    cell (least squares, trimmed to the cells within 1 m of the plane, three rounds): this follows the ego's roll,
    pitch and heave without knowing its pose;
 2. points more than ``min_height_m`` above that plane are kept; points within ``self_radius_m`` of the sensor
-   (the own platform) are dropped;
+   (the own platform) are dropped. In a rough sea the crests' returns stand higher than that, so the height rises
+   to the sea the cloud shows (:func:`sea_height`): the ``sea_quantile`` (0.95) of the heights (below
+   ``sea_cap_m``, 4 m) of the returns within ``sea_near_m`` (50 m), plus ``sea_margin_m`` (0.5 m) for the crests
+   above it, where those returns cover at least ``sea_cells`` (400) cells of 2 m (a calm sea returns from too
+   little water to tell: the fixed height stands; returns stacked more than ``sea_stack_m``, 1 m, high in
+   a 1 m column, a hull's side, are not water and are left out). Without it, a W3 sea's crests leave clusters
+   of water all round the ego (docs/studies/detection.md, *A baseline that sees the sea*);
 3. the kept points are binned into 0.5 m BEV cells and the cells are clustered by single linkage with a
    range-adaptive gap (``max(gap_m, gap_per_m · range)``: the LiDAR's point spacing grows with range);
 4. each cluster gets the minimum-area rectangle of its points (shapely), with length along the longer side;
@@ -45,6 +51,8 @@ from mmusv.errors import ConfigError
 
 __all__ = [
     "BASELINE_NOTE",
+    "SEA_CELL_M",
+    "SEA_COLUMN_M",
     "BaselineParams",
     "Detector",
     "above_water",
@@ -53,6 +61,7 @@ __all__ = [
     "closeness_axis",
     "fit_box",
     "load_detector",
+    "sea_height",
     "water_plane",
 ]
 
@@ -67,11 +76,18 @@ BASELINE_NOTE = (
 
 @dataclass(frozen=True)
 class BaselineParams:
-    """Tuning of :func:`baseline_detect` (metres unless said otherwise)."""
+    """Tuning of :func:`baseline_detect` (metres unless said otherwise). The ``sea_*`` fields: the water height
+    learnt from the cloud (:func:`sea_height`; ``sea_cells`` above the cloud's size turns it off)."""
 
     plane_cell_m: float = 10.0
     min_height_m: float = 0.5
     self_radius_m: float = 2.0
+    sea_near_m: float = 50.0
+    sea_quantile: float = 0.95
+    sea_margin_m: float = 0.5
+    sea_cap_m: float = 4.0
+    sea_cells: int = 400
+    sea_stack_m: float = 1.0
     cell_m: float = 0.5
     gap_m: float = 1.5
     gap_per_m: float = 0.05
@@ -111,19 +127,62 @@ def water_plane(points: np.ndarray, *, cell_m: float = 10.0, rounds: int = 3, to
     return np.asarray(coef, dtype=np.float64)
 
 
-def above_water(points: np.ndarray, params: BaselineParams | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+SEA_CELL_M = 2.0
+"""BEV cell (metres) in which :func:`sea_height` counts how much of the water round the sensor returns."""
+
+SEA_COLUMN_M = 1.0
+"""BEV column (metres) whose returns :func:`sea_height` leaves out when they stack higher than ``sea_stack_m``."""
+
+
+def sea_height(points: np.ndarray, height: np.ndarray, r: np.ndarray, params: BaselineParams) -> float:
+    """How high the sea's own returns stand above the fitted water plane (metres; step 2 of the module docstring):
+    the ``params.sea_quantile`` of the ``height`` of the ``points`` ``(N, ≥2)`` within ``params.sea_near_m``
+    (``r``: their BEV range; the sensor's own ``params.self_radius_m`` left out) that lie below
+    ``params.sea_cap_m``, plus ``params.sea_margin_m``, where those cover at least ``params.sea_cells`` cells of
+    :data:`SEA_CELL_M`; else 0 (a calm sea returns from too little water to tell its crests from the hulls near the
+    sensor). Returns in a :data:`SEA_COLUMN_M` column that spans more than ``params.sea_stack_m`` from its lowest to
+    its highest are a hull's side, not water, and are left out: a hull within the near range otherwise raised the
+    height by up to 2.6 m at W1 (docs/studies/detection.md, *A baseline that sees the sea*)."""
+    prm = params
+    sel = (r < prm.sea_near_m) & (r > prm.self_radius_m) & (height < prm.sea_cap_m)
+    if int(sel.sum()) < prm.sea_cells:
+        return 0.0
+    h = height[sel]
+    xy = points[sel, :2]
+    col = cell_keys(np.floor(xy / SEA_COLUMN_M).astype(np.int64))
+    order = np.lexsort((h, col))
+    c = col[order]
+    starts = np.flatnonzero(np.r_[True, c[1:] != c[:-1]])
+    ends = np.r_[starts[1:], len(c)]
+    flat = h[order][ends - 1] - h[order][starts] <= prm.sea_stack_m
+    water = np.empty(len(h), dtype=bool)
+    water[order] = np.repeat(flat, ends - starts)
+    if int(water.sum()) < prm.sea_cells:
+        return 0.0
+    cell = np.floor(xy[water] / SEA_CELL_M).astype(np.int64)
+    if len(np.unique(cell_keys(cell))) < prm.sea_cells:
+        return 0.0
+    return float(np.quantile(h[water], prm.sea_quantile)) + prm.sea_margin_m
+
+
+def above_water(
+    points: np.ndarray, params: BaselineParams | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     """Steps 1–2 of the module docstring, for the ``points`` ``(N, ≥3)`` (ego LiDAR frame, metres): the
-    ``(N,)`` bool mask of those more than ``params.min_height_m`` above the fitted water plane and farther than
-    ``params.self_radius_m`` from the sensor, every point's ``(N,)`` float64 height above that plane (metres),
-    and the plane ``(a, b, c)`` (:func:`water_plane`)."""
+    ``(N,)`` bool mask of those higher above the fitted water plane than ``params.min_height_m`` and the sea's
+    height (:func:`sea_height`) and farther than ``params.self_radius_m`` from the sensor, every point's ``(N,)``
+    float64 height above that plane (metres), the plane ``(a, b, c)`` (:func:`water_plane`) and the sea's height
+    (metres; 0 where the cloud shows no rough sea)."""
     prm = params or BaselineParams()
     p = np.asarray(points, dtype=np.float64)
     if p.shape[0] == 0:
-        return np.zeros(0, dtype=bool), np.zeros(0), np.zeros(3)
+        return np.zeros(0, dtype=bool), np.zeros(0), np.zeros(3), 0.0
     plane = water_plane(p, cell_m=prm.plane_cell_m)
     height = p[:, 2] - (plane[0] * p[:, 0] + plane[1] * p[:, 1] + plane[2])
-    keep: np.ndarray = (height > prm.min_height_m) & (np.hypot(p[:, 0], p[:, 1]) > prm.self_radius_m)
-    return keep, height, plane
+    r = np.hypot(p[:, 0], p[:, 1])
+    sea = sea_height(p, height, r, prm)
+    keep: np.ndarray = (height > max(prm.min_height_m, sea)) & (r > prm.self_radius_m)
+    return keep, height, plane, sea
 
 
 def cell_keys(cell: np.ndarray) -> np.ndarray:
@@ -274,7 +333,7 @@ def baseline_detect(points: np.ndarray, params: BaselineParams | None = None) ->
     p = np.asarray(points, dtype=np.float64).reshape(-1, 4) if np.size(points) else np.zeros((0, 4))
     if p.shape[0] == 0:
         return np.zeros((0, 7)), np.zeros(0)
-    keep, _, (a, b, c) = above_water(p, prm)
+    keep, _, (a, b, c), _ = above_water(p, prm)
     q = p[keep]
     if q.shape[0] < prm.min_points:
         return np.zeros((0, 7)), np.zeros(0)
