@@ -109,6 +109,13 @@ def _common(p: argparse.ArgumentParser, default_out: str) -> None:
     p.add_argument(
         "--range", dest="range_m", type=float, default=200.0, help="evaluation range in metres (default 200)"
     )
+    p.add_argument(
+        "--jobs",
+        type=int,
+        default=1,
+        help="processes, one sequence each (default 1); the tables and boxes are the same with any number "
+        "(mmusv.studies.detection.parallel). With --model each runs torch on --threads threads (default 1)",
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("-o", "--output", default=default_out, help=f"output folder (default {default_out})")
 
@@ -149,12 +156,14 @@ def run(args: argparse.Namespace) -> int:
     robust = args.study == "robustness"
     console = Console(width=None if sys.stdout.isatty() else 160)
     learned = None
+    tri = {"auto": None, "on": True, "off": False}
+    if args.jobs < 1:
+        raise InputError(f"--jobs {args.jobs}: must be >= 1")
     if args.model is not None:
         if args.predictions is not None or args.detector != "baseline":
             raise InputError("give one of --model, --detector or --predictions")
         from mmusv.learn.cli import load_for_study
 
-        tri = {"auto": None, "on": True, "off": False}
         learned = load_for_study(args.model, refine=tri[args.refine], rescore=tri[args.rescore])
     if args.model is None and (args.refine != "auto" or args.rescore != "auto"):
         flag = f"--refine {args.refine}" if args.refine != "auto" else f"--rescore {args.rescore}"
@@ -228,12 +237,24 @@ def run(args: argparse.Namespace) -> int:
         total = dataset.count_frames()
         t1 = time.perf_counter()
         with _bar(console, f"{args.study} study ({name})", args.no_progress) as (bar, task):
-            res = run_study(
-                dataset.sequences(),
-                options=options,
-                total_frames=total,
-                progress=lambda done, tot: bar.update(task, completed=done, total=tot) if bar is not None else None,
-            )
+            show = (lambda done, tot: bar.update(task, completed=done, total=tot)) if bar is not None else None
+            if args.jobs > 1:
+                from mmusv.studies.detection.parallel import DetectorSpec, run_study_jobs
+
+                spec = (
+                    DetectorSpec(
+                        model=args.model, refine=tri[args.refine], rescore=tri[args.rescore], threads=args.threads or 1
+                    )
+                    if det is learned and learned is not None
+                    else DetectorSpec(predictions=args.predictions)
+                    if det is None
+                    else DetectorSpec(detector="baseline" if name == "baseline" else args.detector)
+                )
+                res, nbytes = run_study_jobs(dataset, options=options, spec=spec, jobs=args.jobs, progress=show)
+                if det is learned and learned is not None:
+                    learned.shared_bytes.extend(nbytes)
+            else:
+                res = run_study(dataset.sequences(), options=options, total_frames=total, progress=show)
         if res.ego_frames == 0:
             raise InputError(
                 f"empty dataset: the {len(dataset.sources)} sequence(s) of split {split!r} hold no frame to evaluate"

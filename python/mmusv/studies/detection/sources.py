@@ -46,17 +46,26 @@ class Dataset:
     def sequences(self) -> Iterator[SequenceData]:
         """Each chosen sequence, loaded when reached (sorted by name)."""
         for name in sorted(self.sources):
-            p = self.sources[name]
-            seq = read_recording(p) if self.kind == "recording" else read_opv2v(p)
-            yield SequenceData(name, seq.frames)
+            yield self.load(name)
+
+    def load(self, name: str) -> SequenceData:
+        """The sequence ``name`` (a key of :attr:`sources`)."""
+        p = self.sources[name]
+        seq = read_recording(p) if self.kind == "recording" else read_opv2v(p)
+        return SequenceData(name, seq.frames)
+
+    def frames_by_sequence(self) -> dict[str, int]:
+        """Frames of each sequence (cheap for recordings: from their metadata)."""
+        if self.kind == "recording":
+            return {n: recording_summary(p).frames_configured for n, p in self.sources.items()}
+        return {
+            n: len({f.stem for c in p.iterdir() if c.is_dir() for f in c.glob("*.pcd")})
+            for n, p in self.sources.items()
+        }
 
     def count_frames(self) -> int:
-        """Frames over all sequences (cheap for recordings: from their metadata)."""
-        if self.kind == "recording":
-            return sum(recording_summary(p).frames_configured for p in self.sources.values())
-        return sum(
-            len({f.stem for c in p.iterdir() if c.is_dir() for f in c.glob("*.pcd")}) for p in self.sources.values()
-        )
+        """Frames over all sequences (:meth:`frames_by_sequence`)."""
+        return sum(self.frames_by_sequence().values())
 
 
 def _recordings(inputs: Sequence[str | Path]) -> list[Path]:

@@ -104,6 +104,25 @@ class StudyResult:
     gt_boxes: int = 0
     predictions_used: int = 0
 
+    @classmethod
+    def merge(cls, options: StudyOptions, parts: Sequence[StudyResult]) -> StudyResult:
+        """One result of ``parts`` (studies of disjoint sequences, in the order one study would have met them),
+        equal to that study's: lists concatenated in order, counts summed."""
+        out = cls(options=options)
+        for part in parts:
+            for key, fms in part.matches.items():
+                out.matches.setdefault(key, []).extend(fms)
+            for key, vis in part.visibility.items():
+                out.visibility.setdefault(key, []).extend(vis)
+            for col, values in part.rows.items():
+                out.rows.setdefault(col, []).extend(values)
+            out.sequences.extend(part.sequences)
+            out.frames += part.frames
+            out.ego_frames += part.ego_frames
+            out.gt_boxes += part.gt_boxes
+            out.predictions_used += part.predictions_used
+        return out
+
     def metrics(self, key: Key) -> dict[str, float]:
         """:func:`~mmusv.studies.detection.evaluate.summarize` of ``key`` plus the recall at IoU 0.5 and 0.3
         of the visible, hidden, unseen and wave-hidden ground truths (``recall50_hidden``, ``recall30_hidden``,
@@ -233,9 +252,12 @@ def run_study(
     options: StudyOptions,
     total_frames: int | None = None,
     progress: Callable[[int, int], None] | None = None,
+    check_predictions: bool = True,
 ) -> StudyResult:
     """Evaluates ``sequences`` (see the module docstring). With delays, the first ``max delay`` frames of every
-    sequence are skipped for every setting, so all settings are scored on the same frames."""
+    sequence are skipped for every setting, so all settings are scored on the same frames. ``check_predictions``:
+    raise when a predictions file matched nothing evaluated (:func:`check_predictions_used`; off for one
+    sequence of many, :mod:`~mmusv.studies.detection.parallel`)."""
     o = options
     if o.detector is None and o.predictions is None:
         raise InputError("no detector and no predictions given")
@@ -277,12 +299,19 @@ def run_study(
             done += 1
             if progress is not None:
                 progress(done, total_frames or done)
-    if o.predictions is not None and res.predictions_used == 0 and res.ego_frames:
+    if check_predictions:
+        check_predictions_used(res)
+    return res
+
+
+def check_predictions_used(res: StudyResult) -> None:
+    """Raises :class:`~mmusv.errors.InputError` when ``res`` was scored from predictions of which no row matched
+    any (sequence, frame, ego, mode) evaluated: a misnamed file, not a detector that found nothing."""
+    if res.options.predictions is not None and res.predictions_used == 0 and res.ego_frames:
         raise InputError(
             "--predictions: no row matches any (sequence, frame, ego, mode) evaluated; check the "
             f"sequence names ({', '.join(res.sequences[:3])}, ...) and the ego ids"
         )
-    return res
 
 
 class _OwnDetections:

@@ -1,0 +1,115 @@
+"""The detection and robustness studies over several processes (``--jobs N``): one task per sequence.
+
+Each task loads its sequence, builds the detector from a :class:`DetectorSpec` (the baseline, a
+``package.module:function``, a learned model's folder, or a predictions Parquet: what can be named, so nothing large
+is pickled) and runs :func:`~mmusv.studies.detection.study.run_study` on it alone; the parent merges the results in
+sequence order (:meth:`~mmusv.studies.detection.study.StudyResult.merge`). Every sequence is scored exactly as
+in one process: the detections of a cloud depend on that cloud only, the pose noise is drawn per (seed, sequence,
+frame, ego, neighbour, setting), and AP sorts all detections of the merged result once. So the tables and the boxes
+Parquet are the same, byte for byte, with any number of jobs (tested).
+
+Workers are started with ``spawn`` (a clean interpreter: safe after torch has started its threads, and the same on
+every platform); with a learned model each sets torch to ``threads`` CPU threads (1 by default: ``jobs`` processes
+share the cores).
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+from collections.abc import Callable
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from dataclasses import dataclass, replace
+from typing import Any
+
+from mmusv.errors import InputError, MmusvError
+from mmusv.studies.detection.sources import Dataset
+from mmusv.studies.detection.study import StudyOptions, StudyResult, check_predictions_used, run_study
+
+__all__ = ["DetectorSpec", "run_study_jobs"]
+
+
+@dataclass(frozen=True)
+class DetectorSpec:
+    """What a task builds its detector from: ``detector`` (``"baseline"`` or ``package.module:function``), or
+    ``model`` (a learned model's path, with its ``refine`` / ``rescore`` switches and torch ``threads``), or
+    ``predictions`` (a predictions Parquet)."""
+
+    detector: str = "baseline"
+    model: str | None = None
+    refine: bool | None = None
+    rescore: bool | None = None
+    threads: int = 1
+    predictions: str | None = None
+
+    def build(self) -> tuple[Any, Any]:
+        """``(detector, predictions)`` for :class:`~mmusv.studies.detection.study.StudyOptions`."""
+        if self.predictions is not None:
+            from mmusv.studies.detection.study import load_predictions
+
+            return None, load_predictions(self.predictions)
+        if self.model is not None:
+            import torch
+
+            from mmusv.learn.cli import load_for_study
+
+            torch.set_num_threads(self.threads)
+            return load_for_study(self.model, refine=self.refine, rescore=self.rescore), None
+        from mmusv.studies.detection.detector import load_detector
+
+        return load_detector(self.detector), None
+
+
+def _task(dataset: Dataset, name: str, options: StudyOptions, spec: DetectorSpec) -> tuple[str, Any, list[int]]:
+    """One sequence's study: ``("ok", StudyResult, shared bytes)`` or ``("error", message, [])`` for bad input
+    (re-raised in the parent as :class:`~mmusv.errors.InputError`, whose own class need not pickle)."""
+    try:
+        detector, predictions = spec.build()
+        opts = replace(options, detector=detector, predictions=predictions)
+        res = run_study([dataset.load(name)], options=opts, check_predictions=False)
+        return "ok", res, list(getattr(detector, "shared_bytes", []) or [])
+    except MmusvError as exc:
+        return "error", str(exc), []
+
+
+def run_study_jobs(
+    dataset: Dataset,
+    *,
+    options: StudyOptions,
+    spec: DetectorSpec,
+    jobs: int,
+    progress: Callable[[int, int], None] | None = None,
+) -> tuple[StudyResult, list[int]]:
+    """The study of every sequence of ``dataset`` on ``jobs`` processes (module docstring): the merged
+    :class:`~mmusv.studies.detection.study.StudyResult` and, for a learned model, the bytes its intermediate
+    fusion shared per call (in sequence order). ``options``' detector and predictions are ignored: each task
+    builds them from ``spec``. ``progress(done, total)`` counts frames, a sequence at a time."""
+    if jobs < 1:
+        raise InputError(f"--jobs {jobs}: must be >= 1")
+    names = sorted(dataset.sources)
+    frames = dataset.frames_by_sequence()
+    total = sum(frames.values())
+    bare = replace(options, detector=None, predictions=None)
+    parts: dict[str, StudyResult] = {}
+    shared: dict[str, list[int]] = {}
+    done = 0
+    ctx = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(max_workers=min(jobs, max(1, len(names))), mp_context=ctx) as pool:
+        pending: dict[Future[tuple[str, Any, list[int]]], str] = {
+            pool.submit(_task, dataset, n, bare, spec): n for n in names
+        }
+        while pending:
+            finished, _ = wait(pending, return_when=FIRST_COMPLETED)
+            for fut in finished:
+                name = pending.pop(fut)
+                status, value, nbytes = fut.result()
+                if status == "error":
+                    for other in pending:
+                        other.cancel()
+                    raise InputError(value)
+                parts[name], shared[name] = value, nbytes
+                done += frames.get(name, 0)
+                if progress is not None:
+                    progress(done, total)
+    res = StudyResult.merge(options, [parts[n] for n in names])
+    check_predictions_used(res)
+    return res, [b for n in names for b in shared[n]]

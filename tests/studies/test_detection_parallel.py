@@ -1,0 +1,61 @@
+"""``--jobs``: the detection and robustness studies over several processes give the same files, byte for byte,
+as one process; a worker's bad input is the same one-line error."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+from mmusv.cli import main
+from test_detection_study import record
+
+
+@pytest.fixture(scope="module")
+def two_sequences(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A folder of two recordings (2 and 3 USVs; 4 and 3 frames)."""
+    root = tmp_path_factory.mktemp("seqs")
+    folder = root / "recordings"
+    folder.mkdir()
+    for usvs, frames in ((("usv_1", "usv_3"), 4), (("usv_1", "usv_2", "usv_3"), 3)):
+        rec = record(root / f"r{len(usvs)}", usvs, frames=frames)
+        shutil.copy(rec, folder / rec.name)
+    return folder
+
+
+def study(args: list[str], out: Path) -> Path:
+    assert main([*args, "-o", str(out), "--no-progress"]) == 0
+    return out
+
+
+def test_detection_jobs_give_the_same_bytes(two_sequences: Path, tmp_path: Path) -> None:
+    args = ["study", "detection", str(two_sequences)]
+    one = study(args, tmp_path / "one")
+    two = study([*args, "--jobs", "2"], tmp_path / "two")
+    for name in ("detection_table.csv", "detection_boxes.parquet"):
+        assert (one / name).read_bytes() == (two / name).read_bytes(), name
+    # A predictions file scored over two processes: the same table again.
+    again = study([*args, "--predictions", str(one / "detection_boxes.parquet"), "--jobs", "2"], tmp_path / "pred")
+    assert (again / "detection_table.csv").read_bytes() == (one / "detection_table.csv").read_bytes()
+
+
+def test_robustness_jobs_give_the_same_bytes(two_sequences: Path, tmp_path: Path) -> None:
+    args = ["study", "robustness", str(two_sequences), "--settings", "delay:1,noise:1/1"]
+    one = study(args, tmp_path / "one")
+    three = study([*args, "--jobs", "3"], tmp_path / "three")  # more jobs than sequences
+    for name in ("robustness_table.csv", "robustness_boxes.parquet"):
+        assert (one / name).read_bytes() == (three / name).read_bytes(), name
+
+
+def test_a_workers_bad_input_is_one_line(
+    two_sequences: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    mixed = tmp_path / "mixed"
+    shutil.copytree(two_sequences, mixed)
+    lone = record(tmp_path / "lone", ("usv_1",), frames=2)
+    shutil.copy(lone, mixed / lone.name)
+    assert main(["study", "detection", str(mixed), "--jobs", "2", "-o", str(tmp_path / "o"), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert "sequence tiny_1usv" in err and "needs at least 2" in err and "Traceback" not in err
+    assert main(["study", "detection", str(two_sequences), "--jobs", "0", "-o", str(tmp_path / "o")]) == 2
+    assert "--jobs 0: must be >= 1" in capsys.readouterr().err
