@@ -173,7 +173,7 @@ def test_a_hulls_side_near_the_sensor_does_not_raise_the_sea_height() -> None:
     from mmusv.studies.detection.detector import sea_height
 
     rng = np.random.default_rng(6)
-    w = RefineParams().water
+    w = BaselineParams()
     sea = rough_sea(rng, crest_m=2.0)
     hull = np.array([0.0, 20.0, WATER_Z + 3.0, 60.0, 10.0, 6.0, 0.0])
     side = tall_faces(hull, spacing=0.1)
@@ -190,6 +190,7 @@ def test_a_hulls_side_near_the_sensor_does_not_raise_the_sea_height() -> None:
 
     no_columns = replace(w, sea_stack_m=np.inf)
     assert height_of(cloud, no_columns) > alone + 0.5  # the control: the side does raise the plain quantile
+    assert height_of(cloud, RefineParams().water) == height_of(cloud, no_columns)  # the refinement's, as chosen
 
 
 def test_the_baseline_sees_the_hull_not_the_crests() -> None:

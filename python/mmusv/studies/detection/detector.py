@@ -149,16 +149,17 @@ def sea_height(points: np.ndarray, height: np.ndarray, r: np.ndarray, params: Ba
         return 0.0
     h = height[sel]
     xy = points[sel, :2]
-    col = cell_keys(np.floor(xy / SEA_COLUMN_M).astype(np.int64))
-    order = np.lexsort((h, col))
-    c = col[order]
-    starts = np.flatnonzero(np.r_[True, c[1:] != c[:-1]])
-    ends = np.r_[starts[1:], len(c)]
-    flat = h[order][ends - 1] - h[order][starts] <= prm.sea_stack_m
-    water = np.empty(len(h), dtype=bool)
-    water[order] = np.repeat(flat, ends - starts)
-    if int(water.sum()) < prm.sea_cells:
-        return 0.0
+    water = np.ones(len(h), dtype=bool)
+    if np.isfinite(prm.sea_stack_m):
+        col = cell_keys(np.floor(xy / SEA_COLUMN_M).astype(np.int64))
+        order = np.lexsort((h, col))
+        c = col[order]
+        starts = np.flatnonzero(np.r_[True, c[1:] != c[:-1]])
+        ends = np.r_[starts[1:], len(c)]
+        flat = h[order][ends - 1] - h[order][starts] <= prm.sea_stack_m
+        water[order] = np.repeat(flat, ends - starts)
+        if int(water.sum()) < prm.sea_cells:
+            return 0.0
     cell = np.floor(xy[water] / SEA_CELL_M).astype(np.int64)
     if len(np.unique(cell_keys(cell))) < prm.sea_cells:
         return 0.0
