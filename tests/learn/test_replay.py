@@ -211,6 +211,13 @@ def test_the_study_scores_the_models_on_the_threads_asked(
         table = pl.read_csv(tmp_path / "t3" / "detection_table.csv")
         assert sorted(table["mode"].to_list()) == ["early", "intermediate", "late", "none"]
         assert (tmp_path / "t3" / "baseline" / "detection_table.csv").is_file()
+        # The same study in a worker process (--jobs): its own models, one torch thread, the same bytes.
+        assert main([*argv, "--threads", "1", "--jobs", "2", "-o", str(tmp_path / "j2")]) == 0
+        shared = [line for line in out.splitlines() if "shared per ego-frame" in line]
+        assert shared and shared == [ln for ln in capsys.readouterr().out.splitlines() if "shared per ego-frame" in ln]
+        for sub in ("", "baseline/"):
+            for name in ("detection_table.csv", "detection_boxes.parquet"):
+                assert (tmp_path / "t3" / sub / name).read_bytes() == (tmp_path / "j2" / sub / name).read_bytes()
         assert main([*argv, "--threads", "0", "-o", str(tmp_path / "bad")]) == 2
         assert "--threads 0: must be >= 1" in capsys.readouterr().err
     finally:

@@ -143,27 +143,26 @@ def sea_height(points: np.ndarray, height: np.ndarray, r: np.ndarray, params: Ba
     sensor). Returns in a :data:`SEA_COLUMN_M` column that spans more than ``params.sea_stack_m`` from its lowest to
     its highest are a hull's side, not water, and are left out: a hull within the near range otherwise raised the
     height by up to 2.6 m at W1 (docs/studies/detection.md, *A baseline that sees the sea*)."""
-    prm = params
-    sel = (r < prm.sea_near_m) & (r > prm.self_radius_m) & (height < prm.sea_cap_m)
-    if int(sel.sum()) < prm.sea_cells:
+    sel = (r < params.sea_near_m) & (r > params.self_radius_m) & (height < params.sea_cap_m)
+    if int(sel.sum()) < params.sea_cells:
         return 0.0
     h = height[sel]
     xy = points[sel, :2]
     water = np.ones(len(h), dtype=bool)
-    if np.isfinite(prm.sea_stack_m):
+    if np.isfinite(params.sea_stack_m):
         col = cell_keys(np.floor(xy / SEA_COLUMN_M).astype(np.int64))
         order = np.lexsort((h, col))
         c = col[order]
         starts = np.flatnonzero(np.r_[True, c[1:] != c[:-1]])
         ends = np.r_[starts[1:], len(c)]
-        flat = h[order][ends - 1] - h[order][starts] <= prm.sea_stack_m
+        flat = h[order][ends - 1] - h[order][starts] <= params.sea_stack_m
         water[order] = np.repeat(flat, ends - starts)
-        if int(water.sum()) < prm.sea_cells:
+        if int(water.sum()) < params.sea_cells:
             return 0.0
     cell = np.floor(xy[water] / SEA_CELL_M).astype(np.int64)
-    if len(np.unique(cell_keys(cell))) < prm.sea_cells:
+    if len(np.unique(cell_keys(cell))) < params.sea_cells:
         return 0.0
-    return float(np.quantile(h[water], prm.sea_quantile)) + prm.sea_margin_m
+    return float(np.quantile(h[water], params.sea_quantile)) + params.sea_margin_m
 
 
 def above_water(
