@@ -189,6 +189,12 @@ def test_opv2v_input_gives_the_same_ground_truth(
     # Same clouds (to 0.1 mm): the baseline finds the same boxes, up to a few of the clusters it forms in the
     # physical sea's water returns, which the 0.1 mm rounding of the export can split or merge.
     assert np.allclose(a["det"].to_numpy(), b["det"].to_numpy(), rtol=0.03, atol=0)
+    # An OPV2V tree on two processes: the same bytes as on one.
+    jobs = tmp_path / "j"
+    argv = ["study", "detection", "--opv2v", str(tmp_path / "opv2v"), "--modes", "none,early", "--no-progress"]
+    assert main([*argv, "--jobs", "2", "-o", str(jobs)]) == 0
+    for name in ("detection_table.csv", "detection_boxes.parquet"):
+        assert (opv_out / name).read_bytes() == (jobs / name).read_bytes(), name
 
 
 def test_bad_input_errors(two_usv: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
