@@ -241,17 +241,16 @@ def run(args: argparse.Namespace) -> int:
             if args.jobs > 1:
                 from mmusv.studies.detection.parallel import DetectorSpec, run_study_jobs
 
-                spec = (
-                    DetectorSpec(
+                if learned is not None and det is learned:
+                    spec = DetectorSpec(
                         model=args.model, refine=tri[args.refine], rescore=tri[args.rescore], threads=args.threads or 1
                     )
-                    if det is learned and learned is not None
-                    else DetectorSpec(predictions=args.predictions)
-                    if det is None
-                    else DetectorSpec(detector="baseline" if name == "baseline" else args.detector)
-                )
+                elif det is None:
+                    spec = DetectorSpec(predictions=args.predictions)
+                else:
+                    spec = DetectorSpec(detector=name)  # the run's detector name: --detector, or the baseline beside
                 res, nbytes = run_study_jobs(dataset, options=options, spec=spec, jobs=args.jobs, progress=show)
-                if det is learned and learned is not None:
+                if learned is not None and det is learned:
                     learned.shared_bytes.extend(nbytes)
             else:
                 res = run_study(dataset.sequences(), options=options, total_frames=total, progress=show)

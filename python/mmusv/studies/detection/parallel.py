@@ -1,12 +1,12 @@
 """The detection and robustness studies over several processes (``--jobs N``): one task per sequence.
 
-Each task loads its sequence, builds the detector from a :class:`DetectorSpec` (the baseline, a
+Each task loads its sequence, takes the detector its process built from a :class:`DetectorSpec` (the baseline, a
 ``package.module:function``, a learned model's folder, or a predictions Parquet: what can be named, so nothing large
-is pickled) and runs :func:`~mmusv.studies.detection.study.run_study` on it alone; the parent merges the results in
-sequence order (:meth:`~mmusv.studies.detection.study.StudyResult.merge`). Every sequence is scored exactly as
-in one process: the detections of a cloud depend on that cloud only, the pose noise is drawn per (seed, sequence,
-frame, ego, neighbour, setting), and AP sorts all detections of the merged result once. So the tables and the boxes
-Parquet are the same, byte for byte, with any number of jobs (tested).
+is pickled; built at the process's first task) and runs :func:`~mmusv.studies.detection.study.run_study` on it
+alone; the parent merges the results in sequence order (:meth:`~mmusv.studies.detection.study.StudyResult.merge`).
+Every sequence is scored exactly as in one process: the detections of a cloud depend on that cloud only, the pose
+noise is drawn per (seed, sequence, frame, ego, neighbour, setting), and AP sorts all detections of the merged result
+once. So the tables and the boxes Parquet are the same, byte for byte, with any number of jobs (tested).
 
 Workers are started with ``spawn`` (a clean interpreter: safe after torch has started its threads, and the same on
 every platform); with a learned model each sets torch to ``threads`` CPU threads (1 by default: ``jobs`` processes
@@ -59,14 +59,23 @@ class DetectorSpec:
         return load_detector(self.detector), None
 
 
+_BUILT: dict[DetectorSpec, tuple[Any, Any]] = {}
+"""In a worker process: the detector and predictions each spec built, once per process (a model loaded, a Parquet
+read), for every sequence the process is given, as the one process of ``--jobs 1`` does."""
+
+
 def _task(dataset: Dataset, name: str, options: StudyOptions, spec: DetectorSpec) -> tuple[str, Any, list[int]]:
     """One sequence's study: ``("ok", StudyResult, shared bytes)`` or ``("error", message, [])`` for bad input
     (re-raised in the parent as :class:`~mmusv.errors.InputError`, whose own class need not pickle)."""
     try:
-        detector, predictions = spec.build()
+        if spec not in _BUILT:
+            _BUILT[spec] = spec.build()
+        detector, predictions = _BUILT[spec]
+        shared = getattr(detector, "shared_bytes", None)
+        before = len(shared) if shared is not None else 0
         opts = replace(options, detector=detector, predictions=predictions)
         res = run_study([dataset.load(name)], options=opts, check_predictions=False)
-        return "ok", res, list(getattr(detector, "shared_bytes", []) or [])
+        return "ok", res, list(shared[before:]) if shared is not None else []
     except MmusvError as exc:
         return "error", str(exc), []
 
