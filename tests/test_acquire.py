@@ -232,7 +232,7 @@ def test_profiled_run_writes_the_same_bytes_and_times_every_stage(recorded: tupl
     stages = {r.stage: r for r in p.rows()}
     for sensor in ("lidar", "camera/front", "camera/rear", "top_view", "radar", "ppi"):
         assert stages[f"main:capture/{sensor}"].overlapping
-    for stage in ("main:capture", "main:annotate", "main:wait", "main:python", "writer:write", "writer:tables"):
+    for stage in ("main:capture", "main:wait", "main:python", "writer:annotate", "writer:write", "writer:tables"):
         assert not stages[stage].overlapping
     assert stages["writer:write/encode"].seconds > 0
     assert p.frames == 3 and p.wall_s > 0 and p.cpu_s > 0 and p.peak_rss_mb > 0
@@ -341,7 +341,7 @@ def test_cli_profile_prints_the_table(tmp_path: Path, capsys: pytest.CaptureFixt
     path.write_text(yaml.safe_dump(small_scenario(frames=2)))
     assert main(["run", str(path), "-o", str(tmp_path / "out"), "--profile"]) == 0
     text = capsys.readouterr().out
-    for row in ("main:capture", "main:capture/lidar", "main:capture/radar", "main:annotate", "writer:write/encode"):
+    for row in ("main:capture", "main:capture/lidar", "main:capture/radar", "writer:annotate", "writer:write/encode"):
         assert row in text
     assert "2 frames in" in text and "frames/s" in text and "CPU" in text
     assert main(["run", str(tmp_path), "-o", str(tmp_path / "o2"), "--profile"]) == 2  # a folder: one line
