@@ -17,6 +17,7 @@ with the new one, draws the same frames from the same poses. Each view is writte
 * ``whitecaps_w3``: open water at wave level W3, from 8 m above the sea;
 * ``wake_chase``: a 35 m patrol boat at 14 m/s, seen from 20 m above a vessel following 100 m behind;
 * ``wake_top``: the same boat in its own top view (orthographic, heading up, 0.6 m per pixel);
+* ``wake_kelvin``: a 20 m motor yacht at 7 m/s on calm water (W0), from 25 m up, 130 m off its wake;
 * ``wake_bend``: a pilot boat at 10 m/s 100 m past a right-angle turn, in a still USV's top view (north up);
 * ``lidar_bulk_100m``: the points of the default 64-channel LiDAR and of a dense 128-channel one on a 190 m bulk
   carrier whose centre line is 100 m off, in the ship's frame (side and plan views, coloured by intensity).
@@ -206,6 +207,21 @@ def wake_top(path: Path) -> None:
     Image.fromarray(np.asarray(top.rgb)).save(path)
 
 
+def wake_kelvin(path: Path) -> None:
+    """A 20 m motor yacht at 7 m/s (Froude number 0.5) heading north on calm water (W0), 12:00, clear: the camera
+    25 m above a still USV 120 m west of the yacht's track and 150 m south of it, looking at the wake 100 m behind
+    the yacht."""
+    yacht = {"id": "yacht", "asset": "motor_yacht_20m", "speed_mps": 7.0, "route": _route(0.0, 0.0, 90.0, 2000.0)}
+    observer = {**_OBSERVER, "route": [[-120.0, -150.0], [-110.0, -150.0]]}
+    target = (0.0, -70.0)
+    dx, dy = target[0] + 120.0, target[1] + 150.0
+    yaw = math.degrees(math.atan2(dy, dx))
+    pitch = math.degrees(math.atan2(25.0, math.hypot(dx, dy)))
+    rig = _camera_rig(resolution=(960, 540), hfov_deg=60.0, xyz=(0.0, 0.0, 25.0), yaw_deg=yaw, pitch_deg=pitch)
+    env = {"time_of_day": "12:00", "weather": "clear", "wave": "W0"}
+    _save_rgb(_scenario("wake_kelvin", rig=rig, vessels=[yacht], environment=env, observer=observer), path)
+
+
 def wake_bend(path: Path) -> None:
     """A pilot boat at 10 m/s that went east, then turned north (a route with a right-angle corner, which the
     route's spline rounds), 100 m past the corner: the top view (north up, 0.5 m per pixel, 800 × 800, 400 m square)
@@ -321,6 +337,7 @@ VIEWS: dict[str, Callable[[Path], None]] = {
     "whitecaps_w3": whitecaps_w3,
     "wake_chase": wake_chase,
     "wake_top": wake_top,
+    "wake_kelvin": wake_kelvin,
     "wake_bend": wake_bend,
     "top_views": top_views,
 }

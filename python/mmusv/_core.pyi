@@ -338,7 +338,7 @@ class Lidar:
     ) -> dict[str, npt.NDArray[Any]]:
         """One sweep: xyz (N,3) f32 LiDAR frame, range, intensity, ring, azimuth, class, instance, ray_index; and
         beam_instance (M,) i32, per ray of the full pattern the instance its cast met first (-1: none). ``wakes``
-        (K, 6), (K, 7) or (K, 8) float32 ``x, y, heading, speed, length, beam[, reach_m[, age_s]]`` rows (see
+        (K, 6) to (K, 9) float32 ``x, y, heading, speed, length, beam[, reach_m[, age_s[, displacement_m3]]]`` rows (see
         ``Camera.render``): vessels under way, whose wake foam returns over a wave surface."""
 
 @final
@@ -389,11 +389,11 @@ class Camera:
         radiance: bool = False,
     ) -> dict[str, npt.NDArray[Any]]:
         """depth (H,W) f32, semantic (H,W) u16, instance (H,W) i32 and, for an rgb camera, rgb (H,W,3) u8; with
-        ``radiance``, radiance (H,W,3) f32 cd/m². ``wakes`` (K, 6), (K, 7) or (K, 8) f32: x, y, heading, speed,
-        length, beam[, reach_m[, age_s]] (how far behind the stern the path ran straight, inf when not given; with
-        age_s, pieces of wakes that follow their vessels' bends: the foam age_s old at the piece's start, ending
-        at reach_m where the next piece goes on; a vessel's pieces one after another, newest first, the Kelvin arms
-        bent along them)."""
+        ``radiance``, radiance (H,W,3) f32 cd/m². ``wakes`` (K, 6) to (K, 9) f32: x, y, heading, speed, length, beam[,
+        reach_m[, age_s[, displacement_m3]]] (how far behind the stern the path ran straight, inf when not given; with
+        age_s, pieces of wakes that follow their vessels' bends: the foam age_s old at the piece's start, ending at
+        reach_m where the next piece goes on; a vessel's pieces one after another, newest first, the Kelvin arms bent
+        along them; displacement_m3, m³, sets the vessel's Kelvin waves, none without it)."""
 
 # --- radar ---
 

@@ -383,17 +383,18 @@ class Simulation:
         )
 
     def wakes(self, state: WorldState) -> np.ndarray:
-        """``(K, 8)`` float32 rows ``x, y, heading, speed, length, beam, reach_m, age_s`` (world metres, radians,
-        m/s, s) of the scenario vessels under way (horizontal speed above 0.3 m/s) in ``state``: the wakes the
-        cameras draw and the LiDARs see. A wake follows its vessel's path round the bends, as straight pieces,
-        newest first. The first row is the vessel itself (its pose), its foam drawn straight back from the stern
-        along its heading for ``reach_m`` metres (until its path leaves that line by half a beam; ``inf``: as far
-        as the foam lasts). Each further row of the same vessel is a piece of the path from there: its stern on the
-        path where the piece starts (the row's ``x, y`` half a length ahead of it, ``heading`` along the piece's
-        chord to the next one's start), ``reach_m`` the chord's length, ``age_s`` how long ago the vessel's stern
-        passed the piece's start (at least 1 ms: a row older than 0 is a piece further back). A vessel's rows come
-        together, newest first: the core bends the Kelvin arms along them. No foam where the vessel never went, nor
-        under its hull; its older foam and arms round the bends too."""
+        """``(K, 9)`` float32 rows ``x, y, heading, speed, length, beam, reach_m, age_s, displacement_m3`` (world
+        metres, radians, m/s, s, m³) of the scenario vessels under way (horizontal speed above 0.3 m/s) in ``state``:
+        the wakes the cameras draw and the LiDARs see. A wake follows its vessel's path round the bends, as straight
+        pieces, newest first. The first row is the vessel itself (its pose), its foam drawn straight back from the stern
+        along its heading for ``reach_m`` metres (until its path leaves that line by half a beam; ``inf``: as far as the
+        foam lasts). Each further row of the same vessel is a piece of the path from there: its stern on the path where
+        the piece starts (the row's ``x, y`` half a length ahead of it, ``heading`` along the piece's chord to the next
+        one's start), ``reach_m`` the chord's length, ``age_s`` how long ago the vessel's stern passed the piece's start
+        (at least 1 ms: a row older than 0 is a piece further back). A vessel's rows come together, newest first: the
+        core bends the Kelvin arms along them. No foam where the vessel never went, nor under its hull; its older foam
+        and arms round the bends too. ``displacement_m3`` (the hull's ``Cb·L·B·T``,
+        :func:`~mmusv.world.hydrostatics.hull_particulars`) sets the Kelvin waves the cameras draw behind it."""
         n = len(self.scenario.vessels)
         beams = np.array([float(v.box_size[1]) for v in self.vessels[:n]], dtype=np.float64)
         pieces = self.fleet.wake_pieces(state.time_s, 0.5 * beams) if n else np.zeros((0, 6))
@@ -405,11 +406,12 @@ class Simulation:
             if speed <= 0.3 or len(mine) == 0:
                 continue
             length, beam = float(self.vessels[i].box_size[0]), float(beams[i])
+            volume = self._displacements[i]
             half = 0.5 * length
             # The vessel's own piece where it is now (its pose), its foam from the stern back to where its path left
             # the line (the core's reach runs from the vessel's centre).
             x, y, yaw = (float(state.poses[i, k]) for k in (0, 1, 5))
-            rows.append((x, y, yaw, speed, length, beam, max(float(mine[0, 4]) - half, 0.0), 0.0))
+            rows.append((x, y, yaw, speed, length, beam, max(float(mine[0, 4]) - half, 0.0), 0.0, volume))
             # The older pieces: each row's stern on the path where the piece starts (the row's "vessel" half a length
             # ahead of it along the piece), its foam as old as the time since the stern passed there; a piece the
             # stern has not yet passed all of starts where it is.
@@ -422,8 +424,19 @@ class Simulation:
                 px, py, reach = px - cut * c, py - cut * s, reach - cut
                 # (At least a millisecond old: a row older than 0 is a piece further back, its arms bent by the core.)
                 old = max(lag / speed, 1e-3)
-                rows.append((px + half * c, py + half * s, heading, speed, length, beam, reach, old))
-        return np.asarray(rows, dtype=np.float32).reshape(-1, 8)
+                rows.append((px + half * c, py + half * s, heading, speed, length, beam, reach, old, volume))
+        return np.asarray(rows, dtype=np.float32).reshape(-1, 9)
+
+    @cached_property
+    def _displacements(self) -> list[float]:
+        """Each scenario vessel's displaced volume ``Cb·L·B·T``, m³ (its hull particulars)."""
+        from mmusv.world.hydrostatics import hull_particulars
+
+        out = []
+        for v in self.scenario.vessels:
+            length, beam, draft, cb, _gm = hull_particulars(get_asset(v.asset))
+            out.append(cb * length * beam * draft)
+        return out
 
     def agent(self, agent_id: str) -> Agent:
         """The agent (USV) named ``agent_id``."""

@@ -636,7 +636,13 @@ def test_wakes_reach_only_as_far_as_the_path_ran_straight(make_scenario: Any) ->
     for frame in (60, 120):
         st = sim.world_state(frame)
         w = sim.wakes(st)
-        assert w.shape[1] == 8 and w.dtype == np.float32
+        assert w.shape[1] == 9 and w.dtype == np.float32
+        # The ninth column is each vessel's displaced volume, Cb·L·B·T of its hull (its Kelvin waves' strength).
+        from mmusv.world.hydrostatics import hull_particulars
+        from mmusv.world.vessels import get_asset
+
+        length, beam, draft, cb, _ = hull_particulars(get_asset("tug_32m"))
+        assert np.allclose(_rows_of(w, st, names.index("shuttle"))[:, 8], cb * length * beam * draft, rtol=1e-6)
         shuttle = _rows_of(w, st, names.index("shuttle"))
         x = float(st.poses[names.index("shuttle"), 0])
         if frame == 60:  # 60 m out from x = 100, heading +x: straight all the way back (and before the start)
@@ -783,5 +789,5 @@ def test_a_wake_reach_cuts_the_foam_every_sensor_sees() -> None:
     assert near["cut"] == near["full"] and near["cut"] > near["open"] + 20, near  # the foam before the cut stays
     with pytest.raises(InputError, match=r"wakes\[0\]"):
         scan(lidar, scene, pose=_pose(0.0, 0.0, 2.5), env=env, seed=4, wakes=[[*row, -1.0]])
-    with pytest.raises(InputError, match=r"\(K, 6\), \(K, 7\) or \(K, 8\)"):
+    with pytest.raises(InputError, match=r"\(K, 6\) to \(K, 9\)"):
         scan(lidar, scene, pose=_pose(0.0, 0.0, 2.5), env=env, seed=4, wakes=[row[:5]])

@@ -77,8 +77,8 @@ fn task<'a>(i: usize, item: &'a Item<'_>) -> PyResult<SensorTask<'a>> {
 /// `Lidar`, `Camera` or `Radar`, pose `(4, 4)` float64 sensor → world, or `(radar, pose, seed, ppi)` with
 /// `ppi = (size_px, metres_per_pixel, orientation, sensor_yaw)` or None. Returns, in task order,
 /// `(outputs, seconds, ppi_seconds)`: the dict `scan` / `render` / `sweep` return (a radar's with `ppi`
-/// `(size_px, size_px)` float32 when asked), and the task's wall seconds (profiling only). `wakes` (K, 6) or
-/// (K, 7) float32 are the vessels under way (see `Camera.render`), whose wakes the cameras and LiDARs see.
+/// `(size_px, size_px)` float32 when asked), and the task's wall seconds (profiling only). `wakes` (K, 6) to
+/// (K, 9) float32 are the vessels under way (see `Camera.render`), whose wakes the cameras and LiDARs see.
 #[pyfunction]
 #[pyo3(signature = (scene, *, env, tasks, wakes=None))]
 fn capture_frame<'py>(

@@ -287,8 +287,8 @@ impl Lidar {
     /// and waves are used). Returns a dict
     /// of equal-length columns: xyz (N,3) f32 LiDAR frame, range, intensity (f32), ring (u16), azimuth (f32
     /// rad), class (u16), instance (i32), ray_index (u32); and beam_instance (M,) i32: per ray of the full
-    /// pattern, the instance its cast met first within the range (-1: none). `wakes` (K, 6), (K, 7) or (K, 8)
-    /// float32 rows `x, y, heading, speed, length, beam[, reach_m[, age_s]]` (world metres, radians, m/s, s; see
+    /// pattern, the instance its cast met first within the range (-1: none). `wakes` (K, 6) to (K, 9) float32
+    /// rows `x, y, heading, speed, length, beam[, reach_m[, age_s[, displacement_m3]]]` (world metres, radians, m/s, s, m³; see
     /// `Camera.render`): the vessels under way, whose wake foam returns over a wave surface.
     #[pyo3(signature = (scene, *, pose, env, seed, wakes=None))]
     fn scan<'py>(
@@ -421,11 +421,12 @@ impl Camera {
     /// Renders the current state of `scene` from `pose` (4×4 camera body → world) in `env`. Returns a dict:
     /// depth (H,W) f32 metres along the axis (inf = sky), semantic (H,W) u16, instance (H,W) i32 (−1 = sky) and,
     /// for a camera built with `rgb=True`, rgb (H,W,3) u8 sRGB; with `radiance=True`, radiance (H,W,3) f32
-    /// linear cd/m² (before noise and exposure). `wakes` (K, 6), (K, 7) or (K, 8) float32 rows `x, y, heading,
-    /// speed, length, beam[, reach_m[, age_s]]` (world metres, radians, m/s; `reach_m` how far behind the stern
+    /// linear cd/m² (before noise and exposure). `wakes` (K, 6) to (K, 9) float32 rows `x, y, heading,
+    /// speed, length, beam[, reach_m[, age_s[, displacement_m3]]]` (world metres, radians, m/s, s, m³; `reach_m` how far behind the stern
     /// the path ran straight, inf when not given; with `age_s`, the rows are pieces of wakes that follow their
     /// vessels' bends, `Simulation.wakes`: the foam is `age_s` old at the piece's start and ends at `reach_m`,
-    /// where the next piece goes on) are the vessels under way whose wakes the water shows.
+    /// where the next piece goes on; `displacement_m3` the vessel's displaced volume, which sets its Kelvin waves,
+    /// none without it) are the vessels under way whose wakes the water shows.
     #[pyo3(signature = (scene, *, pose, env, seed, wakes=None, radiance=false))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
@@ -479,27 +480,27 @@ pub(crate) fn frame_dict(py: Python<'_>, f: camera::CameraFrame, rgb: bool) -> P
     Ok(d)
 }
 
-/// Wakes from a `(K, 6)`, `(K, 7)` or `(K, 8)` float32 array (`x, y, heading, speed, length, beam[, reach_m[,
-/// age_s]]`), checked. Eight columns are the pieces of wakes that follow their vessels' bends
+/// Wakes from a `(K, 6)` to `(K, 9)` float32 array (`x, y, heading, speed, length, beam[, reach_m[, age_s[,
+/// displacement_m3]]]`), checked. Eight columns or more are the pieces of wakes that follow their vessels' bends
 /// (`mmusv.Simulation.wakes`): each piece's foam is `age_s` old at its start and ends at `reach_m` at full
 /// strength, where the next piece goes on; a vessel's pieces come one after another, newest first, and the Kelvin
-/// arms bend along them.
+/// arms bend along them. The ninth, the vessel's displaced volume, sets its Kelvin waves (none without it).
 pub(crate) fn wakes_arg(wakes: Option<&PyReadonlyArray2<'_, f32>>) -> PyResult<Vec<Wake>> {
     let Some(w) = wakes else { return Ok(Vec::new()) };
     let shape = numpy::PyUntypedArrayMethods::shape(&**w);
     let columns = shape[1];
-    if !(6..=8).contains(&columns) {
+    if !(6..=9).contains(&columns) {
         return Err(crate::errors::InputError::new_err(format!(
-            "wakes must have shape (K, 6), (K, 7) or (K, 8): x, y, heading, speed, length, beam[, reach_m[, \
-             age_s]]; got {shape:?}"
+            "wakes must have shape (K, 6) to (K, 9): x, y, heading, speed, length, beam[, reach_m[, age_s[, \
+             displacement_m3]]]; got {shape:?}"
         )));
     }
     let flat = c_order(w, "wakes")?;
-    // The columns given, then the defaults of those left out: reach_m unlimited, age_s 0.
-    let rows: Vec<[f32; 8]> = flat
+    // The columns given, then the defaults of those left out: reach_m unlimited, age_s 0, no displacement.
+    let rows: Vec<[f32; 9]> = flat
         .chunks_exact(columns)
         .map(|given| {
-            let mut r = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, f32::INFINITY, 0.0];
+            let mut r = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, f32::INFINITY, 0.0, 0.0];
             r[..columns].copy_from_slice(given);
             r
         })
@@ -514,11 +515,13 @@ pub(crate) fn wakes_arg(wakes: Option<&PyReadonlyArray2<'_, f32>>) -> PyResult<V
                 || r[6].is_nan()
                 || r[6] < 0.0
                 || !(r[7].is_finite() && r[7] >= 0.0)
+                || !(r[8].is_finite() && r[8] >= 0.0)
             {
                 return Err(crate::errors::InputError::new_err(format!(
                     "wakes[{i}] = {:?}: x, y, heading, speed, length, beam must be finite, with speed >= 0 and \
-                     length, beam > 0; reach_m >= 0 (inf: unlimited); age_s finite and >= 0",
-                    &r[..columns.min(8)]
+                     length, beam > 0; reach_m >= 0 (inf: unlimited); age_s finite and >= 0; displacement_m3 \
+                     finite and >= 0",
+                    &r[..columns]
                 )));
             }
             Ok(Wake {
@@ -530,7 +533,8 @@ pub(crate) fn wakes_arg(wakes: Option<&PyReadonlyArray2<'_, f32>>) -> PyResult<V
                 beam: r[5],
                 reach_m: r[6],
                 age_s: r[7],
-                goes_on: columns == 8,
+                displacement_m3: r[8],
+                goes_on: columns >= 8,
             })
         })
         .collect()

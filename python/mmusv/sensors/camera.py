@@ -82,8 +82,8 @@ def render(
     radiance: bool = False,
 ) -> CameraImages:
     """Renders ``scene`` (current state) with ``camera`` at ``pose`` (``(4, 4)`` camera body → world) in ``env``
-    (:func:`mmusv.sensors.env.sensor_env`). ``wakes``: ``(K, 6)``, ``(K, 7)`` or ``(K, 8)`` rows ``x, y,
-    heading, speed, length, beam[, reach_m[, age_s]]`` (world metres, radians, m/s, s;
+    (:func:`mmusv.sensors.env.sensor_env`). ``wakes``: ``(K, 6)`` to ``(K, 9)`` rows ``x, y,
+    heading, speed, length, beam[, reach_m[, age_s[, displacement_m3]]]`` (world metres, radians, m/s, s, m³;
     :func:`mmusv.sensors.env.wake_rows`) of the vessels under way; ``radiance`` also returns the linear radiance
     ``(H, W, 3)`` float32 in cd/m² (linear sRGB primaries, before sensor noise and exposure)."""
     p = np.ascontiguousarray(pose, dtype=np.float64).reshape(4, 4)

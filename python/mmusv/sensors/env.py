@@ -45,21 +45,22 @@ WATER_ALBEDO = (0.004, 0.018, 0.03)
 
 
 def wake_rows(wakes: npt.ArrayLike | None) -> npt.NDArray[np.float32] | None:
-    """The vessels under way as the core takes them: ``(K, 6)``, ``(K, 7)`` or ``(K, 8)`` float32 C-contiguous rows
-    ``x, y, heading, speed, length, beam[, reach_m[, age_s]]`` (world metres, radians, m/s, s; ``reach_m`` how far
-    behind the stern the path ran straight, unlimited when left out; with ``age_s``, the rows are the pieces of
-    wakes that follow their vessels' bends, :meth:`mmusv.simulation.Simulation.wakes`: a piece's foam is ``age_s``
-    old at its start and ends at ``reach_m``, where the next piece goes on). One row may be given flat; ``None``
-    stays ``None``."""
+    """The vessels under way as the core takes them: ``(K, 6)`` to ``(K, 9)`` float32 C-contiguous rows
+    ``x, y, heading, speed, length, beam[, reach_m[, age_s[, displacement_m3]]]`` (world metres, radians, m/s, s,
+    m³; ``reach_m`` how far behind the stern the path ran straight, unlimited when left out; with ``age_s``, the
+    rows are the pieces of wakes that follow their vessels' bends, :meth:`mmusv.simulation.Simulation.wakes`: a
+    piece's foam is ``age_s`` old at its start and ends at ``reach_m``, where the next piece goes on;
+    ``displacement_m3``, the vessel's displaced volume, sets the Kelvin waves the cameras draw, none when left
+    out). One row may be given flat; ``None`` stays ``None``."""
     if wakes is None:
         return None
     w = np.ascontiguousarray(wakes, dtype=np.float32)
-    if w.ndim == 1 and w.size in (6, 7, 8):
+    if w.ndim == 1 and w.size in (6, 7, 8, 9):
         w = w.reshape(1, -1)
-    if w.ndim != 2 or w.shape[1] not in (6, 7, 8):
+    if w.ndim != 2 or w.shape[1] not in (6, 7, 8, 9):
         raise InputError(
-            "wakes must have shape (K, 6), (K, 7) or (K, 8): x, y, heading, speed, length, beam[, reach_m[, age_s]];"
-            f" got {w.shape}"
+            "wakes must have shape (K, 6) to (K, 9): x, y, heading, speed, length, beam[, reach_m[, age_s[, "
+            f"displacement_m3]]]; got {w.shape}"
         )
     return w
 

@@ -90,7 +90,7 @@ def scan(
 ) -> LidarPoints:
     """One sweep of ``lidar`` (from :func:`lidar_from_config`) at ``pose`` (``(4, 4)`` LiDAR → world) on the
     current state of ``scene`` in ``env`` (:func:`mmusv.sensors.env.sensor_env`: fog, rain and waves are used).
-    ``seed`` drives noise, dropout and water returns. ``wakes``: ``(K, 6)``, ``(K, 7)`` or ``(K, 8)`` rows ``x, y,
+    ``seed`` drives noise, dropout and water returns. ``wakes``: ``(K, 6)`` to ``(K, 9)`` rows ``x, y,
     heading, speed, length, beam[, reach_m[, age_s]]`` (world metres, radians, m/s, s;
     :meth:`mmusv.simulation.Simulation.wakes`, :func:`mmusv.sensors.env.wake_rows`) of the vessels under way: over
     a wave surface, beams that meet their foam return from it (the foam the cameras draw)."""

@@ -58,7 +58,7 @@ pub enum Projection {
 /// How much work the RGB image gets.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Quality {
-    /// One sample per pixel; water reflects the sky only.
+    /// One sample per pixel; water reflects the sky only; wakes are foam without their Kelvin waves.
     Draft,
     /// Traced water reflections, one per 2 × 2 block of water pixels (4 × 4 where the water's glossy lobe spans
     /// many such blocks), spread over that lobe; 4 stratified samples on edge pixels.
@@ -79,6 +79,10 @@ impl Quality {
     }
     /// Whether water reflections are traced.
     pub fn reflections(self) -> bool {
+        !matches!(self, Quality::Draft)
+    }
+    /// Whether the water shows the vessels' Kelvin waves (`shade/kelvin.rs`; `draft` draws their foam only).
+    pub fn kelvin_waves(self) -> bool {
         !matches!(self, Quality::Draft)
     }
 }
@@ -390,6 +394,7 @@ impl Camera {
             Projection::Orthographic { metres_per_pixel } => (0.0, metres_per_pixel as f32),
         };
         let shader = Shader::new(env, options.seed, options.wakes)
+            .with_kelvin_waves(q.kelvin_waves())
             .with_materials(scene.material_table())
             .with_seabed(scene.seabed())
             .with_waves(scene.wave_surface())

@@ -212,6 +212,7 @@ mod tests {
             reach_m: f32::INFINITY,
             age_s: 0.0,
             goes_on: false,
+            displacement_m3: 0.0,
         }];
         let batch = capture_frame(&scene, &env, &wakes, &tasks)?;
         assert_eq!(batch.len(), tasks.len());

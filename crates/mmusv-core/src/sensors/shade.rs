@@ -36,6 +36,7 @@ pub mod brdf;
 mod class_material;
 pub mod envlight;
 pub mod foam;
+pub mod kelvin;
 pub mod rough_water;
 pub mod sea_ms;
 mod sea_ms_table;
@@ -173,6 +174,8 @@ pub struct Shader {
     water_rho: Vec3,
     shallow: Arc<ShallowWater>,
     foam: Foam,
+    /// The Kelvin waves of the vessels under way, added to the water's slopes ([`Shader::with_swell`]).
+    kelvin: kelvin::KelvinWaves,
     exposure: f32,
     /// Share of the sky's own radiance that reaches the camera through the fog (3 km of it).
     sky_keep: f32,
@@ -214,6 +217,7 @@ impl Shader {
             water_rho: Vec3::from_array(env.water_albedo),
             shallow: ShallowWater::shared(Vec3::from_array(env.water_albedo)),
             foam: Foam::new(water::monahan_coverage(env.wind_speed_m_s), wakes, foam::FOAM_SEED),
+            kelvin: kelvin::KelvinWaves::new(wakes),
             exposure,
             sky_keep: (-env.fog_extinction_per_m * 3000.0).exp(),
             materials: Arc::new(Vec::new()),
@@ -222,6 +226,14 @@ impl Shader {
             pixel_rad: 0.0,
             pixel_m: 0.0,
         }
+    }
+
+    /// This shader with (the default) or without the vessels' Kelvin waves on the water.
+    pub fn with_kelvin_waves(mut self, on: bool) -> Self {
+        if !on {
+            self.kelvin = kelvin::KelvinWaves::default();
+        }
+        self
     }
 
     /// This shader showing the bottom through shallow water over `seabed` (a scene's, [`crate::Scene::seabed`]).
@@ -341,7 +353,8 @@ impl Shader {
     }
 
     /// `hit` with its shading normal set: for water seen along `d`, the wave surface's (with the roughness of the
-    /// waves it does not draw), or without one the swell's (the geometric one where either would face away); for
+    /// waves it does not draw), or without one the swell's, with the slopes of the vessels' Kelvin waves added
+    /// (those the pixel cannot resolve as roughness; the geometric normal where the result would face away); for
     /// anything else, the geometric normal.
     #[inline(always)]
     pub fn with_swell(&self, d: Vec3, mut hit: SurfaceHit) -> SurfaceHit {
@@ -358,6 +371,18 @@ impl Shader {
                     Vec3::from_array(s.normal)
                 }
                 None => self.water_normal(hit.point),
+            };
+            let n = if self.kelvin.is_empty() {
+                n
+            } else {
+                // The vessels' Kelvin waves add their slopes (those the footprint cannot resolve, roughness).
+                let k = self.kelvin.slope(hit.point.x, hit.point.y, footprint);
+                hit.unresolved_mss += k.unresolved_mss;
+                if k.slope == [0.0, 0.0] || n.z <= 0.0 {
+                    n
+                } else {
+                    Vec3::new(n.x / n.z - k.slope[0], n.y / n.z - k.slope[1], 1.0).normalize_or(n)
+                }
             };
             if n.dot(d) <= 0.0 {
                 hit.shading_normal = n;

@@ -53,6 +53,8 @@ pub struct Wake {
     /// back, `mmusv.Simulation.wakes`, passed that long ago): the foam fades and its track widens from that age on,
     /// and a row older than 0 draws no Kelvin arms (the vessel's own piece draws them).
     pub age_s: f32,
+    /// The vessel's displaced volume, m³: the strength of its Kelvin waves (`kelvin.rs`; 0: none drawn).
+    pub displacement_m3: f32,
     /// Whether the vessel's older foam goes on past `reach_m` in another row (a piece of a wake that follows the
     /// path's bends): the foam then ends there at full strength instead of thinning out before it.
     pub goes_on: bool,
@@ -406,6 +408,7 @@ mod tests {
                     reach_m: if i == 3 || i == 5 { 40.0 } else { f32::INFINITY },
                     age_s: if i == 5 { 25.0 } else { 0.0 },
                     goes_on: i == 5,
+                    displacement_m3: 0.0,
                 }
             })
             .collect();
@@ -441,6 +444,7 @@ mod tests {
                     reach_m: 20.0 + 3.0 * (i % 11) as f32,
                     age_s: (i % 7) as f32 * 6.0,
                     goes_on: i % 2 == 0,
+                    displacement_m3: 0.0,
                 }
             })
             .collect();
@@ -465,6 +469,7 @@ mod tests {
             reach_m: f32::INFINITY,
             age_s: 0.0,
             goes_on: false,
+            displacement_m3: 0.0,
         };
         let foam = Foam::new(0.0, &[w], 3);
         // The mean cover over a patch (the foam is broken up by noise, so single points may be clear).

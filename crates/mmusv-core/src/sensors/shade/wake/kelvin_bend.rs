@@ -229,6 +229,7 @@ mod tests {
             reach_m: reach as f32,
             age_s: (back / u) as f32,
             goes_on: true,
+            displacement_m3: 0.0,
         };
         let mut rows = vec![row([60.0, 120.0], FRAC_PI_2, 60.0, 0.0)];
         let step = 15f64.to_radians();
