@@ -198,13 +198,13 @@ def test_info_and_preview_commands(
 # ------------------------------------------------------------------ the overlapped pipeline (issue #12)
 
 
-def _sequential(tmp_path: Path, frames: int) -> bytes:
+def _sequential(tmp_path: Path, frames: int, scenario: dict[str, Any] | None = None) -> bytes:
     """The recording written the plain way: capture, annotate, write, one frame after the other, one thread."""
     from mmusv.acquire import annotations_for
     from mmusv.annotate import SilhouetteCache
     from mmusv.recording.frames import FrameRecorder
 
-    sim = mmusv.Simulation(small_scenario(frames))
+    sim = mmusv.Simulation(scenario or small_scenario(frames))
     path = tmp_path / "sequential.mcap"
     rec = FrameRecorder(path, sim)
     silhouettes = SilhouetteCache()
@@ -220,6 +220,19 @@ def test_overlapped_run_writes_the_bytes_of_the_sequential_loop(recorded: tuple[
     assert res.recording.read_bytes() == _sequential(tmp_path, 3)
 
 
+def test_a_run_without_cameras_annotates_behind_the_capture_with_the_same_bytes(tmp_path: Path) -> None:
+    """Without cameras each frame is annotated on the writer thread while the next is captured (the LiDAR's
+    wave-occlusion shares over the physical sea included): the recording is the plain loop's, byte for byte, and the
+    profile times the annotations on the writer's side."""
+    sc = small_scenario(3)
+    sc["rigs"]["usv_standard"] = {"preset": "lidar_only", "lidar": {"channels": 16, "points_per_second": 16 * 360 * 5}}
+    res = run(sc, out_dir=tmp_path / "run", profile=True)
+    assert res.recording.read_bytes() == _sequential(tmp_path, 3, sc)
+    assert res.profile is not None
+    stages = {r.stage for r in res.profile.rows()}
+    assert "writer:annotate" in stages and "main:annotate" not in stages
+
+
 def test_profiled_run_writes_the_same_bytes_and_times_every_stage(recorded: tuple[Path, Any], tmp_path: Path) -> None:
     out, res = recorded
     prof = run(small_scenario(), out_dir=tmp_path, profile=True)
@@ -232,7 +245,7 @@ def test_profiled_run_writes_the_same_bytes_and_times_every_stage(recorded: tupl
     stages = {r.stage: r for r in p.rows()}
     for sensor in ("lidar", "camera/front", "camera/rear", "top_view", "radar", "ppi"):
         assert stages[f"main:capture/{sensor}"].overlapping
-    for stage in ("main:capture", "main:wait", "main:python", "writer:annotate", "writer:write", "writer:tables"):
+    for stage in ("main:capture", "main:annotate", "main:wait", "main:python", "writer:write", "writer:tables"):
         assert not stages[stage].overlapping
     assert stages["writer:write/encode"].seconds > 0
     assert p.frames == 3 and p.wall_s > 0 and p.cpu_s > 0 and p.peak_rss_mb > 0
@@ -341,7 +354,7 @@ def test_cli_profile_prints_the_table(tmp_path: Path, capsys: pytest.CaptureFixt
     path.write_text(yaml.safe_dump(small_scenario(frames=2)))
     assert main(["run", str(path), "-o", str(tmp_path / "out"), "--profile"]) == 0
     text = capsys.readouterr().out
-    for row in ("main:capture", "main:capture/lidar", "main:capture/radar", "writer:annotate", "writer:write/encode"):
+    for row in ("main:capture", "main:capture/lidar", "main:capture/radar", "main:annotate", "writer:write/encode"):
         assert row in text
     assert "2 frames in" in text and "frames/s" in text and "CPU" in text
     assert main(["run", str(tmp_path), "-o", str(tmp_path / "o2"), "--profile"]) == 2  # a folder: one line

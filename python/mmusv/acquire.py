@@ -7,11 +7,11 @@ captures every sensor of every USV on the frozen state of t_k = k / f, derives t
 run; tables are flushed to Parquet parts every ``TABLE_PART_FRAMES`` frames.
 
 No core waits: all sensors of a frame run in one native call (:meth:`~mmusv.simulation.Simulation.capture`),
-and frame k is annotated and written (images encoded in parallel, MCAP, tables) on a writer thread while frame
-k+1 is captured (:mod:`mmusv.recording.background`; at most one frame waits between the two, so memory stays
-flat). One thread annotates and writes every frame in order, so the files are byte-identical to doing it all one
-frame after another (the annotations of a capture read the scene only for what a run never changes: its sea
-instance and whether waves are set; everything else comes from the capture itself).
+and frame k is written (images encoded in parallel, MCAP, tables) on a writer thread while frame k+1 is
+captured (:mod:`mmusv.recording.background`; at most one frame waits between the two, so memory stays flat); a run
+without cameras annotates it there too (the annotations of a capture read the scene only for what a run never
+changes: its sea instance and whether waves are set; everything else comes from the capture itself). One thread
+writes every frame in order, so the files are byte-identical to doing it all one frame after another.
 
 Output in ``out_dir``: ``<name>.mcap`` (see ``docs/recording.md``), ``tables/{world_state,boxes_3d,boxes_2d}/
 part-NNNNN.parquet`` (polars), ``scenario.yaml`` (the resolved scenario) and ``manifest.json``. A run stopped by
@@ -244,10 +244,13 @@ def _record(
             raise
         raise IoError(_write_failure(out, rec_path, [("starting the recording", exc)])[0]) from None
 
-    def write(cap: FrameCapture) -> None:  # on the writer thread, in frame order, while the next frame is captured
-        ta = time.perf_counter()
+    def annotate(cap: FrameCapture) -> _Frame:
         anns = annotations_for(sim, cap, silhouettes)
-        frame = _Frame(cap, {agent: (a, a.columns()) for agent, a in anns.items()})
+        return _Frame(cap, {agent: (a, a.columns()) for agent, a in anns.items()})
+
+    def write(item: _Frame | FrameCapture) -> None:  # on the writer thread, in frame order
+        ta = time.perf_counter()
+        frame = annotate(item) if isinstance(item, FrameCapture) else item
         t = time.perf_counter()
         encoded = recorder.encode_seconds
         recorder.write_frame(frame.capture, {agent: cols for agent, (_, cols) in frame.annotations.items()})
@@ -256,13 +259,18 @@ def _record(
         if (frame.capture.frame + 1) % TABLE_PART_FRAMES == 0:  # parts end at the same indices in every run
             tables.flush()
         if prof is not None:
-            prof.add("writer:annotate", t - ta)
+            if frame is not item:
+                prof.add("writer:annotate", t - ta)
             prof.add("writer:write", tw - t)
             prof.add("writer:write/encode", recorder.encode_seconds - encoded)
             prof.add("writer:tables", time.perf_counter() - tw)
 
-    writer = BackgroundWriter(write, depth=1)
+    writer: BackgroundWriter[_Frame | FrameCapture] = BackgroundWriter(write, depth=1)
     renders = sim.renders()
+    # Without cameras a frame is annotated on the writer thread while the next is captured. With them the
+    # annotations' native calls (each box's pixel rays and silhouette) would queue on the thread pool behind the
+    # cameras' work, stalling the writer (port_entry: 50 -> 930 ms a frame), so they run between captures.
+    annotate_behind = not renders
     if prof is not None:
         prof.start()
     failure: BaseException | None = None
@@ -274,14 +282,18 @@ def _record(
             if k + 1 < total:
                 sim.prefetch_frame(k + 1, shading_detail=renders)
             t1 = time.perf_counter()
+            item: _Frame | FrameCapture = cap if annotate_behind else annotate(cap)
+            t2 = time.perf_counter()
             waited = writer.wait_seconds
-            writer.submit(cap)  # annotated and written while the next frame is captured
+            writer.submit(item)  # (annotated and) written while the next frame is captured
             if prof is not None:
                 prof.add("main:capture", t1 - tf)
                 for key, sec in cap.sensor_seconds.items():  # keyed <agent>/<sensor>: summed over the agents
                     prof.add("main:capture/" + key.split("/", 1)[1], sec)
+                if not annotate_behind:
+                    prof.add("main:annotate", t2 - t1)
                 prof.add("main:wait", writer.wait_seconds - waited)
-            del cap
+            del cap, item
             result.frame_seconds.append(time.perf_counter() - tf)
             if progress is not None:
                 progress(k + 1 - first, total - first)

@@ -56,7 +56,7 @@ class RunProfile:
     _cpu0: float = field(default=0.0, repr=False)
 
     def add(self, stage: str, seconds: float) -> None:
-        """Adds ``seconds`` to ``stage`` (``thread:name``, e.g. ``writer:annotate``)."""
+        """Adds ``seconds`` to ``stage`` (``thread:name``, e.g. ``main:annotate``)."""
         with self._lock:
             self.seconds[stage] = self.seconds.get(stage, 0.0) + seconds
 

@@ -35,7 +35,7 @@
 //! `a` its stationary-phase amplitude. Within a length of the vessel's centre the far field does not hold (the hull
 //! covers most of it): the waves grow in as `1 − exp(−(r/L)²)`. They are drawn only where the vessel's path ran
 //! straight behind it (the wake row's `reach_m`, thinning over its last quarter), no farther than
-//! [`super::wake::WAKE_REACH_S`] of its travel nor than where their steepest slope falls below `10⁻³`; a wake row
+//! [`super::wake::WAKE_REACH_S`] of its travel nor than where their steepest slope falls below `4·10⁻³`; a wake row
 //! of an older piece of a bent path draws none (its foam does). The waves are the cameras' only: the sea's
 //! geometry, and so the LiDAR and the radar, do not see them.
 
@@ -53,10 +53,13 @@ const TAN_KELVIN: f64 = 0.353_553_390_593_273_8;
 const MAX_EXPONENT: f64 = 30.0;
 /// Beyond `tan α` of this (25°) the Airy tail is left out (below 1 % of the cusp's amplitude at `k₀ r ≥ 20`).
 const WEDGE_TAN: f64 = 0.466_307_658_154_998_6;
+/// Where the Airy tail is left out: `Ai(4) = 9.5·10⁻⁴`.
+const TAIL_Z_MAX: f64 = 4.0;
 /// The step of the tail's differences, metres.
 const TAIL_DIFF_M: f64 = 0.01;
-/// Slopes below this are not drawn: a wake's waves end where their steepest falls below it.
-const MIN_SLOPE: f64 = 1e-3;
+/// Slopes below this are not drawn: a wake's waves end where their steepest falls below it (0.23°, a twentieth of
+/// the capillary slopes' r.m.s. per axis under a 2 m/s breeze, Cox–Munk).
+const MIN_SLOPE: f64 = 4e-3;
 /// Below this speed a vessel draws no wake waves, m/s (its waves are shorter than the capillaries' roughness).
 const MIN_SPEED: f64 = 0.5;
 
@@ -336,8 +339,14 @@ fn local(s: &Source, behind: f64, port: f64) -> Local {
     } else {
         // Beyond the cusp line: the pair's Airy tail at the cusp angle (tan θ = −1/(4 tan α)).
         let (c, d) = stat(s, -1.0 / (4.0 * tau), kr, ca, sa);
-        let c3 = ((kr * d[3]).abs().max(1e-300) / 2.0).cbrt(); // (|ψ'''|/2)^{1/3}
-        let z = (kr * d[1]).abs() / c3;
+        let half_p3 = (kr * d[3]).abs().max(1e-300) / 2.0;
+        let p1 = (kr * d[1]).abs();
+        // Past z = 4 the tail is below 0.3 % of the caustic's Ai(0) (tested without the cube root: z³ = |ψ'|³/(|ψ'''|/2)).
+        if p1 * p1 * p1 > TAIL_Z_MAX.powi(3) * half_p3 {
+            return Local::None;
+        }
+        let c3 = half_p3.cbrt(); // (|ψ'''|/2)^{1/3}
+        let z = p1 / c3;
         let m = 2.0 * std::f64::consts::PI / c3 * airy::airy(z).0;
         Local::Tail(c, m)
     }
