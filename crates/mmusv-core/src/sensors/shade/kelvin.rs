@@ -209,8 +209,8 @@ fn source(w: &Wake) -> Option<Source> {
     let thin_from = if f64::from(w.reach_m) < u * f64::from(WAKE_REACH_S) { 0.75 * reach } else { reach };
     let scale = volume * k0 * k0 / std::f64::consts::PI;
     let (sx2, sy2) = ((length / 4.0).powi(2), (beam / 4.0).powi(2));
-    // The Gaussian factor is largest for the transverse wave on the track, exp(−k₀²σx²/2): a long, slow hull
-    // (Froude number below about 0.2 for 20 m, 0.13 for 300 m) makes no wave above e^{-30} of its scale.
+    // The Gaussian factor is largest for the transverse wave on the track, exp(−k₀²σx²/2) = exp(−1/(32 Fr⁴)): a
+    // hull below a Froude number of 0.18 makes no wave above e^{-30} of its scale.
     if !(reach > 0.0) || k0 * k0 * sx2 / 2.0 > MAX_EXPONENT {
         return None;
     }
