@@ -137,11 +137,9 @@ impl KelvinWaves {
             if px < b[0] || py < b[1] || px > b[2] || py > b[3] {
                 continue;
             }
-            let (dx, dy) = (px - s.centre[0], py - s.centre[1]);
-            let behind = -(dx * s.h[0] + dy * s.h[1]);
-            let port = -dx * s.h[1] + dy * s.h[0];
+            let (behind, port) = s.frame(px, py);
             let f = fade(s, behind);
-            if f == 0.0 || port.abs() > behind * WEDGE_TAN + s.length {
+            if f == 0.0 || !s.in_wedge(behind, port) {
                 continue;
             }
             let here = local(s, behind, port);
@@ -157,7 +155,7 @@ impl KelvinWaves {
                     mss += 0.5 * ak * ak;
                 }
             }
-            let (_, [gb, gp]) = match here {
+            let (_, g) = match here {
                 // Beyond the cusp line the Airy factor falls off across a wavelength: its gradient by differences.
                 Local::Tail(..) => {
                     let at = |b: f64, p: f64| local(s, b, p).elevation(s, k_max).0;
@@ -166,7 +164,7 @@ impl KelvinWaves {
                 }
                 _ => here.elevation(s, k_max),
             };
-            let (gx, gy) = (f * (-s.h[0] * gb - s.h[1] * gp), f * (-s.h[1] * gb + s.h[0] * gp));
+            let [gx, gy] = s.world_gradient(g).map(|v| f * v);
             let g = gx.hypot(gy);
             let cap = if g > MAX_STEEPNESS { MAX_STEEPNESS / g } else { 1.0 };
             out[0] += gx * cap;
@@ -452,16 +450,35 @@ impl Local {
 /// world gradient.
 #[inline(always)]
 fn source_elevation(s: &Source, x: f64, y: f64, k_max: f64) -> (f64, [f64; 2]) {
-    let (dx, dy) = (x - s.centre[0], y - s.centre[1]);
-    let behind = -(dx * s.h[0] + dy * s.h[1]);
-    let port = -dx * s.h[1] + dy * s.h[0];
+    let (behind, port) = s.frame(x, y);
     let f = fade(s, behind);
-    if f == 0.0 || port.abs() > behind * WEDGE_TAN + s.length {
+    if f == 0.0 || !s.in_wedge(behind, port) {
         return (0.0, [0.0; 2]);
     }
-    let (z, [gb, gp]) = local(s, behind, port).elevation(s, k_max);
-    // behind = −(d·h), port = d·h⊥: ∂/∂x = −h.x ∂/∂behind − h.y ∂/∂port, ∂/∂y = −h.y ∂/∂behind + h.x ∂/∂port.
-    (f * z, [f * (-s.h[0] * gb - s.h[1] * gp), f * (-s.h[1] * gb + s.h[0] * gp)])
+    let (z, g) = local(s, behind, port).elevation(s, k_max);
+    (f * z, s.world_gradient(g).map(|v| f * v))
+}
+
+impl Source {
+    /// World `(x, y)` in the vessel's frame: metres `behind` its centre and to `port`.
+    #[inline(always)]
+    fn frame(&self, x: f64, y: f64) -> (f64, f64) {
+        let (dx, dy) = (x - self.centre[0], y - self.centre[1]);
+        (-(dx * self.h[0] + dy * self.h[1]), -dx * self.h[1] + dy * self.h[0])
+    }
+
+    /// Whether a point of the vessel's frame lies within the wedge drawn (the Airy tail's and the hull's margin).
+    #[inline(always)]
+    fn in_wedge(&self, behind: f64, port: f64) -> bool {
+        port.abs() <= behind * WEDGE_TAN + self.length
+    }
+
+    /// A gradient `(∂/∂behind, ∂/∂port)` in world axes: behind = −(d·h), port = d·h⊥, so
+    /// `∂/∂x = −h.x ∂/∂behind − h.y ∂/∂port` and `∂/∂y = −h.y ∂/∂behind + h.x ∂/∂port`.
+    #[inline(always)]
+    fn world_gradient(&self, [gb, gp]: [f64; 2]) -> [f64; 2] {
+        [-self.h[0] * gb - self.h[1] * gp, -self.h[1] * gb + self.h[0] * gp]
+    }
 }
 
 mod airy;
