@@ -35,6 +35,7 @@ from mmusv.sensors.mounts import inside_mesh, mount_matrix, rpy_matrix
 from mmusv.sensors.radar import RadarReturns, ppi_request, radar_from_config
 from mmusv.world.build import WorldScene, build_world_scene, pose_matrices
 from mmusv.world.environment import Environment
+from mmusv.world.hydrostatics import hull_particulars
 from mmusv.world.maps import MapWorld, generate_map_from
 from mmusv.world.vessels import VesselAsset, get_asset
 
@@ -430,8 +431,6 @@ class Simulation:
     @cached_property
     def _displacements(self) -> list[float]:
         """Each scenario vessel's displaced volume ``Cb·L·B·T``, m³ (its hull particulars)."""
-        from mmusv.world.hydrostatics import hull_particulars
-
         out = []
         for v in self.scenario.vessels:
             length, beam, draft, cb, _gm = hull_particulars(get_asset(v.asset))

@@ -288,8 +288,8 @@ impl Lidar {
     /// of equal-length columns: xyz (N,3) f32 LiDAR frame, range, intensity (f32), ring (u16), azimuth (f32
     /// rad), class (u16), instance (i32), ray_index (u32); and beam_instance (M,) i32: per ray of the full
     /// pattern, the instance its cast met first within the range (-1: none). `wakes` (K, 6) to (K, 9) float32
-    /// rows `x, y, heading, speed, length, beam[, reach_m[, age_s[, displacement_m3]]]` (world metres, radians, m/s, s, m³; see
-    /// `Camera.render`): the vessels under way, whose wake foam returns over a wave surface.
+    /// rows `x, y, heading, speed, length, beam[, reach_m[, age_s[, displacement_m3]]]` (world metres, radians,
+    /// m/s, s, m³; see `Camera.render`): the vessels under way, whose wake foam returns over a wave surface.
     #[pyo3(signature = (scene, *, pose, env, seed, wakes=None))]
     fn scan<'py>(
         &self,
@@ -422,8 +422,8 @@ impl Camera {
     /// depth (H,W) f32 metres along the axis (inf = sky), semantic (H,W) u16, instance (H,W) i32 (−1 = sky) and,
     /// for a camera built with `rgb=True`, rgb (H,W,3) u8 sRGB; with `radiance=True`, radiance (H,W,3) f32
     /// linear cd/m² (before noise and exposure). `wakes` (K, 6) to (K, 9) float32 rows `x, y, heading,
-    /// speed, length, beam[, reach_m[, age_s[, displacement_m3]]]` (world metres, radians, m/s, s, m³; `reach_m` how far behind the stern
-    /// the path ran straight, inf when not given; with `age_s`, the rows are pieces of wakes that follow their
+    /// speed, length, beam[, reach_m[, age_s[, displacement_m3]]]` (world metres, radians, m/s, s, m³; `reach_m`
+    /// how far behind the stern the path ran straight, inf when not given; with `age_s`, the rows are pieces of wakes that follow their
     /// vessels' bends, `Simulation.wakes`: the foam is `age_s` old at the piece's start and ends at `reach_m`,
     /// where the next piece goes on; `displacement_m3` the vessel's displaced volume, which sets its Kelvin waves,
     /// none without it) are the vessels under way whose wakes the water shows.

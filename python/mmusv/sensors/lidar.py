@@ -91,7 +91,7 @@ def scan(
     """One sweep of ``lidar`` (from :func:`lidar_from_config`) at ``pose`` (``(4, 4)`` LiDAR → world) on the
     current state of ``scene`` in ``env`` (:func:`mmusv.sensors.env.sensor_env`: fog, rain and waves are used).
     ``seed`` drives noise, dropout and water returns. ``wakes``: ``(K, 6)`` to ``(K, 9)`` rows ``x, y,
-    heading, speed, length, beam[, reach_m[, age_s]]`` (world metres, radians, m/s, s;
+    heading, speed, length, beam[, reach_m[, age_s[, displacement_m3]]]`` (world metres, radians, m/s, s, m³;
     :meth:`mmusv.simulation.Simulation.wakes`, :func:`mmusv.sensors.env.wake_rows`) of the vessels under way: over
     a wave surface, beams that meet their foam return from it (the foam the cameras draw)."""
     p = np.ascontiguousarray(pose, dtype=np.float64).reshape(4, 4)
