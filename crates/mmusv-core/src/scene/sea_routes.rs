@@ -100,9 +100,10 @@ impl Scene {
         for id in near {
             let inst = &self.instances[id as usize];
             let mesh = &self.meshes[inst.mesh as usize];
-            for f in mesh.faces() {
-                h.add_triangle(f.map(|k| inst.pose.transform_point(mesh.vertices()[k as usize]).to_array()));
-            }
+            // Each vertex moved into the world once, not once per face that holds it.
+            let world: Vec<[f32; 3]> =
+                mesh.vertices().iter().map(|&v| inst.pose.transform_point(v).to_array()).collect();
+            h.add_mesh(&world, mesh.faces());
         }
         // A viewpoint among the waves (not over their crest bound; finite, as `Sea::horizon` checked): the crests
         // are columns too.

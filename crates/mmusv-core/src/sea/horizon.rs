@@ -182,8 +182,13 @@ impl Horizon {
         let (zlo, zhi) = tri.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), v| (a.min(v[2]), b.max(v[2])));
         let (a, b) = (f64::from(zlo - TRIANGLE_MARGIN_M) - p[2], f64::from(zhi + TRIANGLE_MARGIN_M) - p[2]);
         let xy = tri.map(|v| [f64::from(v[0]) - p[0], f64::from(v[1]) - p[1]]);
-        let r_min = triangle_distance(&xy) - DISTANCE_SLACK_M;
         let r_max = xy.iter().map(|v| norm(v[0], v[1])).fold(0.0, f64::max) + DISTANCE_SLACK_M;
+        // Wholly below the viewpoint, the steepest slope is `b / r_max` whatever the footprint's nearest point:
+        // a triangle that marks nothing is known before the footprint's distance and azimuths are worked out.
+        if b < 0.0 && marks_nothing(b / r_max) {
+            return;
+        }
+        let r_min = triangle_distance(&xy) - DISTANCE_SLACK_M;
         let (bins, s_lo, s_hi) = if r_min > 0.0 {
             let corners = tri.map(|v| [f64::from(v[0]), f64::from(v[1])]);
             (self.bins_of(&corners), (a / r_min).min(a / r_max), (b / r_min).max(b / r_max))
@@ -192,17 +197,12 @@ impl Horizon {
             let hi = if b < 0.0 { b / r_max } else { f64::INFINITY };
             ((0, BINS as i64 - 1), lo, hi)
         };
-        // Slope bins, widened by one on each side (q is ±1 for infinite slopes).
-        let e = |s: f64, widen: i64| {
-            let q = if s.is_finite() { s / (1.0 + s.abs()) } else { s.signum() };
-            ((q + 1.0) * (SLOPE_BINS / 2) as f64).floor() as i64 + widen
-        };
         // Only the rising half is ever read ([`Horizon::clear`]): a triangle wholly below it marks nothing.
-        let e1 = e(s_hi, 1).min(SLOPE_BINS as i64 - 1);
-        if e1 < (SLOPE_BINS / 2) as i64 {
+        if marks_nothing(s_hi) {
             return;
         }
-        let e0 = e(s_lo, -1).clamp((SLOPE_BINS / 2) as i64, e1) as usize;
+        let e1 = slope_bin(s_hi, 1).min(SLOPE_BINS as i64 - 1);
+        let e0 = slope_bin(s_lo, -1).clamp((SLOPE_BINS / 2) as i64, e1) as usize;
         let e1 = e1 as usize;
         let mut mask = [0u64; SLOPE_WORDS];
         for (w, m) in mask.iter_mut().enumerate() {
@@ -219,6 +219,29 @@ impl Horizon {
             }
         }
         self.any_bands = true;
+    }
+
+    /// Adds every face of a near instance's mesh ([`Horizon::add_triangle`] each): `vertices` in the world
+    /// frame, `faces` index triples into them. The same horizon as adding the faces one by one; a face wholly
+    /// below the viewpoint, under the slope the farthest vertex would give it, is passed over on its heights
+    /// alone (most of a hull under a mast-top sensor).
+    pub(crate) fn add_mesh(&mut self, vertices: &[[f32; 3]], faces: &[[u32; 3]]) {
+        let p = self.origin.map(f64::from);
+        // The farthest vertex bounds every face's `r_max` (each is the largest of its own vertices' distances,
+        // computed alike).
+        let r_far = vertices.iter().map(|v| norm(f64::from(v[0]) - p[0], f64::from(v[1]) - p[1])).fold(0.0, f64::max)
+            + DISTANCE_SLACK_M;
+        for f in faces {
+            let tri = f.map(|k| vertices[k as usize]);
+            let zhi = tri[0][2].max(tri[1][2]).max(tri[2][2]);
+            let b = f64::from(zhi + TRIANGLE_MARGIN_M) - p[2];
+            // `b < 0`: its steepest slope `b / r_max` is at most `b / r_far`; one bin more than
+            // [`marks_nothing`] asks keeps the test on the safe side of any rounding between the two slopes.
+            if b < 0.0 && slope_bin(b / r_far, 2) < (SLOPE_BINS / 2) as i64 {
+                continue;
+            }
+            self.add_triangle(tri);
+        }
     }
 
     /// Whether the rectangle `lo..hi` (world x, y) stands over the viewpoint, or within the distance slack of it.
@@ -329,6 +352,20 @@ fn norm(x: f64, y: f64) -> f64 {
     (x * x + y * y).sqrt()
 }
 
+/// The slope bin of slope `s` ([`Horizon::bands`]), moved by `widen` bins (`q` is ±1 for infinite slopes).
+#[inline(always)]
+fn slope_bin(s: f64, widen: i64) -> i64 {
+    let q = if s.is_finite() { s / (1.0 + s.abs()) } else { s.signum() };
+    ((q + 1.0) * (SLOPE_BINS / 2) as f64).floor() as i64 + widen
+}
+
+/// Whether a triangle whose steepest slope from the viewpoint is `s_hi` marks no rising direction cell (its
+/// highest cell, widened by one, lies in the falling half, which is never read).
+#[inline(always)]
+fn marks_nothing(s_hi: f64) -> bool {
+    slope_bin(s_hi, 1).min(SLOPE_BINS as i64 - 1) < (SLOPE_BINS / 2) as i64
+}
+
 /// Horizontal distance from the origin to a triangle given relative to it (x, y), 0 when it lies over the
 /// origin (or the triangle is degenerate through it).
 fn triangle_distance(t: &[[f64; 2]; 3]) -> f64 {
@@ -411,6 +448,47 @@ mod tests {
         let before = h.slope.clone();
         h.add_rect([-50.0, -50.0], [50.0, 50.0], 1.9);
         assert_eq!(before, h.slope);
+    }
+
+    #[test]
+    fn a_mesh_marks_what_its_faces_mark_one_by_one() {
+        // A hull-like cloud of faces around a mast-top viewpoint, most of them below it (and so passed over on
+        // their heights by `add_mesh`), some beside and over it, and slivers just under its height: the bands
+        // must be the same bits as adding every face with `add_triangle`.
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f32 / (1u64 << 53) as f32
+        };
+        let mut vertices = Vec::new();
+        for _ in 0..1500 {
+            let z = if next() < 0.9 { 4.0 * next() } else { 4.7 + 0.6 * next() };
+            vertices.push([12.0 * next() - 6.0, 5.0 * next() - 2.5, z]);
+        }
+        // Slivers within millimetres of the viewpoint's height, where the first rising bin begins.
+        for k in 0..200 {
+            vertices.push([1.0 + 0.01 * k as f32, 0.3, 4.99 - 0.0001 * k as f32]);
+        }
+        let n = vertices.len() as u32;
+        let faces: Vec<[u32; 3]> = (0..n - 2).map(|k| [k, (k * 7 + 1) % n, (k * 13 + 2) % n]).collect();
+        let eye = [0.2f32, -0.1, 5.0];
+        let mut marking = 0;
+        for f in &faces {
+            // Face by face, so that no other face's bits can cover one that a wrong early exit left out.
+            let mut one = Horizon::new(eye);
+            one.add_triangle(f.map(|k| vertices[k as usize]));
+            let mut mesh = Horizon::new(eye);
+            mesh.add_mesh(&vertices, std::slice::from_ref(f));
+            assert!(one.bands == mesh.bands && one.any_bands == mesh.any_bands, "face {f:?}");
+            assert_eq!(one.covered, mesh.covered);
+            marking += usize::from(one.any_bands);
+        }
+        assert!(marking * 10 > faces.len(), "only {marking} of {} faces mark directions", faces.len());
+        // And most faces were below: the test exercises the early exit, not only the full path.
+        let below = faces.iter().filter(|f| f.iter().all(|&k| vertices[k as usize][2] < 4.9)).count();
+        assert!(below * 2 > faces.len(), "only {below} of {} faces below the viewpoint", faces.len());
     }
 
     #[test]
