@@ -2,8 +2,11 @@
 //!
 //! * **Exposure** like an incident-light meter: the scene's horizontal illuminance `E_h` (sun and sky) sets the
 //!   scale so that an 18 % grey Lambert card lying flat under that light, of radiance `0.18 E_h / π`, reaches
-//!   0.18 before the tone curve: `k = π / E_h`. `E_h` is floored at 10 lux (the camera's longest exposure and
-//!   highest gain), so nights stay dark and lights stand out. A fixed `EV100` instead gives the
+//!   0.18 before the tone curve: `k = π / E_h`. `E_h` is floored at [`MIN_METERED_LUX`], 3.46 lux: the
+//!   camera's longest exposure and highest gain, f/1.4, 1/30 s (its frame time) and ISO 6 400 (EV100 −0.12),
+//!   which is the light at the end of civil twilight (about 3.4 lux, sun 6° below the horizon): through civil
+//!   twilight the camera opens up as the light falls, then holds, so nautical twilight darkens and nights stay
+//!   dark with their lights standing out. A fixed `EV100` instead gives the
 //!   saturation-based scale `k = 1 / (1.2 · 2^EV100)` (ISO 12232; S. Lagarde & C. de Rousiers, "Moving
 //!   Frostbite to Physically Based Rendering", SIGGRAPH 2014 course notes).
 //! * **Highlight limit** of the automatic exposure: a reflected-light reading of what the camera sees (the
@@ -23,8 +26,12 @@
 use super::super::noise;
 use parry3d::math::Vec3;
 
-/// Darkest horizontal illuminance the automatic exposure adapts to, lux.
-pub const MIN_METERED_LUX: f32 = 10.0;
+/// Darkest horizontal illuminance the automatic exposure adapts to, lux: the incident exposure `π / E` equals the
+/// saturation-based scale `1 / (1.2 · 2^EV100)` of the camera's limit, f/1.4 at 1/30 s and ISO 6 400
+/// (`EV100 = log2(N² / t) − log2(S / 100)`, −0.12), at `E = 1.2 π · 2^EV100` = 3.46 lux. Until 2026-11-30 the
+/// floor was 10 lux (ISO 2 200 at the same aperture and time), held from 20:25 on (45° N in June), and the views
+/// of the next fifty minutes darkened with the light itself, 550-fold by 21:15.
+pub const MIN_METERED_LUX: f32 = 3.46;
 
 /// Multiplier from radiance (cd/m²) to the tone curve's input: metered from `horizontal_lux` when `ev100` is
 /// `NaN`, else the saturation-based scale of `ev100`.
@@ -201,6 +208,21 @@ mod tests {
         assert_eq!(srgb8(1.0), 255);
         // 0.5 display-linear is sRGB 188.
         assert_eq!(srgb8(0.5), 188);
+    }
+
+    /// Below the floor the automatic exposure is the camera's limit, f/1.4, 1/30 s, ISO 6 400, given as a fixed
+    /// EV100 (within the floor's rounding to three figures, 0.2 %); above it the incident reading still governs.
+    #[test]
+    fn the_exposure_floor_is_the_low_light_cameras_limit() {
+        let ev100 = (1.4f32 * 1.4 * 30.0).log2() - (6_400.0f32 / 100.0).log2();
+        assert!((ev100 + 0.12).abs() < 0.01, "{ev100}");
+        let limit = exposure_scale(ev100, 0.0);
+        for lux in [0.0, 1e-3, 0.08, 0.5, 3.0, MIN_METERED_LUX] {
+            let k = exposure_scale(f32::NAN, lux);
+            assert!((k / limit - 1.0).abs() < 0.002, "{lux} lux: {k} against the camera's limit {limit}");
+        }
+        // Brighter light is exposed from its own reading: a grey card under 20 lux still meters to 0.18.
+        assert!((exposure_scale(f32::NAN, 20.0) * 20.0 - std::f32::consts::PI).abs() < 1e-5);
     }
 
     /// The blockwise tone mapping gives [`to_srgb8`]'s bytes for every colour, odd lengths, out-of-range and
