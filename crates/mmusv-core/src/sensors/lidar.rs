@@ -274,7 +274,8 @@ impl Lidar {
                 continue;
             }
             let idx = i as u64;
-            let tau = (-2.0 * sigma * r).exp();
+            // Clear air (no fog, no rain) transmits all: `exp(-0)` is 1 to the bit, without the call per beam.
+            let tau = if sigma > 0.0 { (-2.0 * sigma * r).exp() } else { 1.0 };
             let n = Vec3::new(hits.normal[3 * k], hits.normal[3 * k + 1], hits.normal[3 * k + 2]);
             let cos = n.dot(Vec3::from_array(dirs[k])).abs().min(1.0);
             let mut water_intensity = None;
