@@ -23,12 +23,12 @@ import hashlib
 import json
 import math
 import os
+import reprlib
 from dataclasses import replace
 from typing import Any, Literal
 
 from pydantic import (
     BaseModel,
-    ConfigDict,
     Field,
     SerializationInfo,
     ValidationError,
@@ -40,6 +40,7 @@ from pydantic import (
 
 from mmusv.errors import ConfigError, MmusvError, located
 from mmusv.sensors.config import RigConfig
+from mmusv.strict import StrictModel
 from mmusv.world.environment import Environment, wave_height_m
 from mmusv.world.map_params import PARAM_MODELS, IslandParams, MapParams
 from mmusv.world.sea_state import SeaSpec
@@ -60,8 +61,16 @@ __all__ = [
 ]
 
 
-class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, str_strip_whitespace=True, allow_inf_nan=False)
+MAX_SPEED_MPS = 100.0
+"""Fastest vessel speed a scenario may give, m/s (about 194 knots: past every craft afloat)."""
+MAX_COORDINATE_M = 1.0e6
+"""Farthest a waypoint (and a route's start offset) may lie from the world origin, metres (1,000 km: far
+beyond any map)."""
+
+
+class _Model(StrictModel):
+    """A scenario's models: :class:`~mmusv.strict.StrictModel` (no unknown keys, NaN, infinity or booleans for
+    numbers)."""
 
 
 class MapConfig(_Model):
@@ -143,13 +152,21 @@ class EnvironmentConfig(_Model):
 
     time_of_day: str = "12:00"
     weather: Literal["clear", "overcast", "fog", "rain"] = "clear"
-    visibility_m: float | None = Field(default=None, gt=0)
-    rain_mm_per_h: float | None = Field(default=None, ge=0)
+    visibility_m: float | None = Field(default=None, ge=1, le=1e7)
+    rain_mm_per_h: float | None = Field(default=None, ge=0, le=500)
     wave: str | float = "W0"
     latitude_deg: float = Field(default=45.0, ge=-90, le=90)
     day_of_year: int = Field(default=172, ge=1, le=366)
     sea: SeaConfig | None = None
     motion: Literal["physical", "paper"] = "physical"
+
+    @field_validator("time_of_day", mode="before")
+    @classmethod
+    def _time_quoted(cls, v: Any) -> Any:
+        # YAML 1.1 reads an unquoted 13:00 as the sexagesimal integer 780.
+        if isinstance(v, int) and not isinstance(v, bool):
+            raise ValueError(f'use 24-hour "HH:MM" in quotes, e.g. "16:30" (unquoted, YAML reads it as the number {v})')
+        return v
 
     @field_validator("time_of_day")
     @classmethod
@@ -187,7 +204,7 @@ class EnvironmentConfig(_Model):
 class AcquisitionConfig(_Model):
     """Acquisition: ``frequency_hz`` (Δt = 1/f) and the number of ``frames`` (indices 0..frames-1)."""
 
-    frequency_hz: float = Field(default=5.0, gt=0, le=1000)
+    frequency_hz: float = Field(default=5.0, ge=0.01, le=1000)
     frames: int = Field(default=100, ge=1, le=10_000_000)
 
     def times(self) -> list[float]:
@@ -203,11 +220,11 @@ class VesselConfig(_Model):
     role: Literal["usv", "target"] = "target"
     asset: str
     rig: str | None = None
-    speed_mps: float = Field(default=0.0, ge=0, allow_inf_nan=False)
+    speed_mps: float = Field(default=0.0, ge=0, le=MAX_SPEED_MPS, allow_inf_nan=False)
     route: list[tuple[float, float]] = Field(min_length=2)
     end: Literal["stop", "loop", "ping_pong"] = "stop"
-    start_offset_m: float = Field(default=0.0, ge=0, allow_inf_nan=False)
-    z_base_m: float = Field(default=0.0, allow_inf_nan=False)
+    start_offset_m: float = Field(default=0.0, ge=0, le=MAX_COORDINATE_M, allow_inf_nan=False)
+    z_base_m: float = Field(default=0.0, ge=-30, le=30, allow_inf_nan=False)
 
     @field_validator("asset")
     @classmethod
@@ -226,13 +243,15 @@ class VesselConfig(_Model):
         for i, (x, y) in enumerate(v):
             if not (math.isfinite(x) and math.isfinite(y)):
                 raise ValueError(f"waypoint {i} is not finite")
+            if max(abs(x), abs(y)) > MAX_COORDINATE_M:
+                raise ValueError(f"waypoint {i} lies beyond {MAX_COORDINATE_M:,.0f} m of the origin (world metres)")
         return v
 
 
 class Scenario(_Model):
     """A whole scenario: map, environment, acquisition, sensor rigs and vessels."""
 
-    name: str = Field(default="scenario", pattern=r"^[A-Za-z0-9_\-.]+$")
+    name: str = Field(default="scenario", pattern=r"^[A-Za-z0-9_\-][A-Za-z0-9_\-.]*$", max_length=200)
     seed: int = Field(default=0, ge=0, lt=2**63)
     map: MapConfig = Field(default_factory=MapConfig)
     environment: EnvironmentConfig = Field(default_factory=EnvironmentConfig)
@@ -305,6 +324,18 @@ def _field_path(loc: tuple[int | str, ...], root: str) -> str:
     return out or root
 
 
+_VALIDATOR_STEPS = frozenset(
+    {"str", "float", "int", "bool", "function-after", "function-before", "function-wrap", "function-plain"}
+    | {"constrained-str", "constrained-float", "constrained-int", "literal", "nullable"}
+)
+"""What pydantic adds to an error's location besides the fields (the union member or validator it tried)."""
+
+_REPR = reprlib.Repr()
+_REPR.maxstring, _REPR.maxother, _REPR.maxlong = 80, 80, 40
+"""How a value shows in messages: strings and numbers shortened to 80 characters, containers to a few items, so
+a 3 MB name or a document of aliases is never printed (or walked) whole."""
+
+
 def validation_problems(err: ValidationError, *, root: str = "scenario") -> list[tuple[str, str, str]]:
     """A pydantic ``ValidationError`` as ``(field path, value shown, what is allowed)`` per problem, the field path
     as in messages (``vessels[2].speed_mps``); a check across fields has the empty path and names the fields in its
@@ -312,13 +343,11 @@ def validation_problems(err: ValidationError, *, root: str = "scenario") -> list
     out = []
     for e in err.errors():
         # Pydantic adds the union member or validator name to `loc`; drop the non-field parts.
-        loc = tuple(
-            p for p in e["loc"] if not (isinstance(p, str) and ("[" in p or p in {"str", "float", "function-after"}))
-        )
+        loc = tuple(p for p in e["loc"] if not (isinstance(p, str) and ("[" in p or p in _VALIDATOR_STEPS)))
         value = e.get("input")
-        shown = (
-            repr(value) if not isinstance(value, (dict, list)) or len(repr(value)) < 80 else f"<{type(value).__name__}>"
-        )
+        shown = _REPR.repr(value)
+        if isinstance(value, (dict, list)) and len(shown) >= 80:
+            shown = f"<{type(value).__name__}>"
         msg = str(e["msg"]).removeprefix("Value error, ")
         if not loc and isinstance(value, dict):  # a check across fields: its message names the fields itself
             out.append(("", shown, msg))

@@ -28,6 +28,10 @@ __all__ = ["MAX_YAML_BYTES", "mapping_source", "parse_yaml", "read_yaml"]
 MAX_YAML_BYTES = 64 * 1024 * 1024
 """Largest YAML input read (64 MiB): larger files are refused before they are read."""
 
+MAX_YAML_VALUES = 1_000_000
+"""Most values (scalars, lists and mappings, each time an alias repeats them) a YAML document may expand to: a few
+hundred bytes of nested aliases can stand for billions of values, which no scenario needs."""
+
 _BOMS = {
     b"\xff\xfe\x00\x00": "UTF-32 (little-endian)",
     b"\x00\x00\xfe\xff": "UTF-32 (big-endian)",
@@ -54,9 +58,12 @@ _FastUniqueKeyLoader: Any = (
 
 
 def _construct_mapping(loader: Any, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
+    # Only the keys written in this mapping must be unique: a merge key (`<<: *base`) brings in keys that the
+    # mapping's own may override, as YAML's merge type says.
+    explicit = [(k, v) for k, v in node.value if k.tag != "tag:yaml.org,2002:merge"]
     loader.flatten_mapping(node)
     seen: dict[Any, int] = {}
-    for key_node, _ in node.value:
+    for key_node, _ in explicit:
         key = loader.construct_object(key_node, deep=True)
         try:
             hash(key)
@@ -109,7 +116,9 @@ def parse_yaml(text: str, where: str, *, trusted: bool = False) -> Any:
                 return yaml.load(text, Loader=_FastUniqueKeyLoader)
             except yaml.YAMLError:
                 pass  # refused: again below, for the pure-Python parser's message
-        return yaml.load(text, Loader=_UniqueKeyLoader)
+        data = yaml.load(text, Loader=_UniqueKeyLoader)
+        _check_expansion(data, where)
+        return data
     except _DuplicateKey as exc:
         raise ConfigError(f"{where}: {exc}; each key may appear once") from None
     except yaml.MarkedYAMLError as exc:
@@ -121,6 +130,29 @@ def parse_yaml(text: str, where: str, *, trusted: bool = False) -> Any:
         raise ConfigError(f"{where}: not valid YAML: {' '.join(str(exc).split())}") from None
     except RecursionError:
         raise ConfigError(f"{where}: not valid YAML: nested too deeply") from None
+    except ValueError as exc:  # an integer of more digits than Python converts (4300)
+        what = "an integer of more than 4,300 digits" if "digits" in str(exc) else str(exc)
+        raise ConfigError(f"{where}: not valid YAML: {what}; no value of a scenario needs one") from None
+
+
+def _check_expansion(data: Any, where: str) -> None:
+    """Refuses a document that expands to more than :data:`MAX_YAML_VALUES` values, counting a value as often as
+    aliases repeat it (PyYAML shares one object per anchor, so the document is small in memory, but everything
+    that reads it walks every repetition). Stops counting at the limit."""
+    count, stack = 0, [data]
+    while stack:
+        v = stack.pop()
+        count += 1
+        if count > MAX_YAML_VALUES:
+            raise ConfigError(
+                f"{where}: the document expands to more than {MAX_YAML_VALUES:,} values (aliases repeating "
+                "anchors within anchors); write the values out or use fewer repetitions"
+            )
+        if isinstance(v, dict):
+            stack.extend(v.keys())
+            stack.extend(v.values())
+        elif isinstance(v, list):
+            stack.extend(v)
 
 
 def read_yaml(path: str | os.PathLike[str], *, kind: str = "YAML") -> Any:

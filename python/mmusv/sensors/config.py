@@ -18,7 +18,9 @@ from __future__ import annotations
 import math
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import Field, field_validator, model_validator
+
+from mmusv.strict import StrictModel
 
 __all__ = [
     "RIG_PRESETS",
@@ -49,8 +51,9 @@ _ALL_OUTPUTS: tuple[CameraOutput, ...] = ("rgb", "depth", "semantic", "instance"
 _TOP_OUTPUTS: tuple[CameraOutput, ...] = ("rgb", "semantic", "instance")
 
 
-class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, str_strip_whitespace=True, allow_inf_nan=False)
+class _Model(StrictModel):
+    """The sensor configs' models: :class:`~mmusv.strict.StrictModel` (no unknown keys, NaN, infinity or booleans
+    for numbers)."""
 
 
 MAX_IMAGE_PIXELS = 4096 * 4096
@@ -99,16 +102,16 @@ class LidarConfig(_Model):
     channels: int = Field(default=64, ge=1, le=1024)
     vertical_fov_deg: tuple[float, float] = (-25.0, 15.0)
     elevations_deg: list[float] | None = None
-    points_per_second: float = Field(default=131_072.0, gt=0)
-    rotation_hz: float = Field(default=5.0, gt=0)
-    range_m: float = Field(default=200.0, gt=0)
+    points_per_second: float = Field(default=131_072.0, gt=0, le=1e10)
+    rotation_hz: float = Field(default=5.0, ge=0.1, le=100)
+    range_m: float = Field(default=200.0, gt=0, le=100_000)
     range_min_m: float = Field(default=0.5, ge=0)
-    range_noise_std_m: float = Field(default=0.02, ge=0)
+    range_noise_std_m: float = Field(default=0.02, ge=0, le=100)
     dropout: float = Field(default=0.0, ge=0, le=1)
     water_probability: float = Field(default=0.05, ge=0, le=1)
-    water_probability_per_wave_m: float = Field(default=0.1, ge=0)
-    water_range_m: float = Field(default=20.0, ge=0)
-    water_range_per_wave_m: float = Field(default=10.0, ge=0)
+    water_probability_per_wave_m: float = Field(default=0.1, ge=0, le=100)
+    water_range_m: float = Field(default=20.0, ge=0, le=100_000)
+    water_range_per_wave_m: float = Field(default=10.0, ge=0, le=100_000)
     mount: Mount = Mount(point="lidar")
 
     @field_validator("vertical_fov_deg")
@@ -143,8 +146,8 @@ class LidarConfig(_Model):
 
     @property
     def azimuth_steps(self) -> int:
-        """Columns per sweep."""
-        return max(1, round(self.points_per_second / (self.rotation_hz * self.channels)))
+        """Columns per sweep (validated to 1..65536)."""
+        return round(self.points_per_second / (self.rotation_hz * self.channels))
 
     def elevations_rad(self) -> list[float]:
         """Elevation of each ring, radians (ring ``i`` = entry ``i``)."""
@@ -198,7 +201,7 @@ class RadarConfig(_Model):
 
     range_m: float = Field(default=3000.0, gt=0, le=100_000)
     min_range_m: float = Field(default=10.0, ge=0)
-    range_resolution_m: float = Field(default=3.0, gt=0)
+    range_resolution_m: float = Field(default=3.0, ge=1e-6, le=100_000)
     azimuth_bins: int = Field(default=2048, ge=1, le=65536)
     beamwidth_deg: float = Field(default=1.2, gt=0, le=90)
     elevation_fan_deg: tuple[float, float] = (-10.0, 10.0)
@@ -213,7 +216,7 @@ class RadarConfig(_Model):
     sea_clutter_max_range_m: float = Field(default=2500.0, ge=0, le=100_000)
     rain_clutter_eta: float = Field(default=5.0e-9, ge=0, le=1)
     ppi_size_px: int = Field(default=512, ge=16, le=8192)
-    ppi_metres_per_pixel: float | None = Field(default=None, gt=0)
+    ppi_metres_per_pixel: float | None = Field(default=None, ge=0.01, le=1000)
     ppi_orientation: Literal["north_up", "head_up"] = "north_up"
     mount: Mount = Mount(point="radar")
 
@@ -243,8 +246,8 @@ class SensorNoiseConfig(_Model):
     """Shot and read noise of an image sensor: ``full_well_e`` electrons at full scale (before the tone curve)
     and ``read_noise_e`` electrons RMS."""
 
-    full_well_e: float = Field(default=10000.0, gt=0)
-    read_noise_e: float = Field(default=3.0, ge=0)
+    full_well_e: float = Field(default=10000.0, ge=1, le=1e7)
+    read_noise_e: float = Field(default=3.0, ge=0, le=1e5)
 
 
 class CameraConfig(_Model):
@@ -256,9 +259,9 @@ class CameraConfig(_Model):
 
     name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$")
     resolution: tuple[int, int] = (640, 480)
-    hfov_deg: float = Field(default=90.0, gt=0, lt=180)
+    hfov_deg: float = Field(default=90.0, ge=0.1, lt=180)
     outputs: list[CameraOutput] = Field(default_factory=lambda: list(_ALL_OUTPUTS))
-    range_m: float = Field(default=5000.0, gt=0)
+    range_m: float = Field(default=5000.0, gt=0, le=1e6)
     mount: Mount = Mount()
     quality: Quality = "standard"
     distortion: tuple[float, float, float, float, float] | None = None
@@ -281,9 +284,9 @@ class TopViewConfig(_Model):
     ``resolution`` pixels at ``metres_per_pixel``; ``heading_up`` puts the USV's bow at the top of the image,
     ``north_up`` puts north there."""
 
-    altitude_m: float = Field(default=120.0, gt=0)
+    altitude_m: float = Field(default=120.0, gt=0, le=20_000)
     resolution: tuple[int, int] = (512, 512)
-    metres_per_pixel: float = Field(default=0.5, gt=0)
+    metres_per_pixel: float = Field(default=0.5, ge=0.001, le=1000)
     orientation: Literal["heading_up", "north_up"] = "heading_up"
     outputs: list[CameraOutput] = Field(default_factory=lambda: list(_TOP_OUTPUTS))
     quality: Quality = "standard"

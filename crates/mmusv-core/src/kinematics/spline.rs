@@ -211,6 +211,14 @@ impl Route {
             total += acc;
         }
         seg_start.push(total);
+        // Finite waypoints can still be too far apart for an arc length (beyond ~1e154 m the squares overflow).
+        if !total.is_finite() {
+            return Err(MmusvError::config(
+                "route",
+                format!("{} waypoints", pts.len()),
+                "the route's length is not finite: waypoints must lie within reach of one another in metres",
+            ));
+        }
         Ok(Self { waypoints: pts, end, cubics, seg_start, sub })
     }
 
@@ -479,5 +487,12 @@ mod tests {
         assert!((t[0].hypot(t[1]) - 1.0).abs() < 1e-9);
         assert!(r.position(f64::NAN).iter().all(|v| v.is_finite()));
         assert_eq!(r.distance_to_arc(f64::NAN), (0.0, 0.0));
+    }
+
+    #[test]
+    fn a_route_too_long_to_measure_is_refused() {
+        let far = Route::new(&[[-1e308, 100.0], [1e308, 100.0]], EndBehaviour::Stop);
+        assert!(matches!(far, Err(MmusvError::Config { ref field, .. }) if field == "route"), "{far:?}");
+        assert!(Route::new(&[[-1e6, 100.0], [1e6, 100.0]], EndBehaviour::Stop).is_ok());
     }
 }
