@@ -83,12 +83,29 @@ def scenario_samples(scenario: Scenario, ctx: MapContext, spec: GenerationSpec |
 
 def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[str]:
     """Runs the generator's ``in_water`` check (an error) and clearance/separation checks (warnings, also
-    returned) on ``scenario`` sailing on ``world``; ``source`` names the file in messages."""
-    from mmusv.generate.checks import InWater, Separation, ShoreClearance, StructureClearance
+    returned) on ``scenario`` sailing on ``world``; ``source`` names the file in messages.
+
+    The checks sample the whole acquisition (every frame, whatever a run records); a scenario whose checks would
+    take more than :data:`~mmusv.generate.checks.MAX_CHECK_SAMPLES` samples is refused (a ``ConfigError`` that
+    says how many and how to skip them) before anything is sampled."""
+    from mmusv.generate.checks import (
+        InWater,
+        Separation,
+        ShoreClearance,
+        StructureClearance,
+        budget_problem,
+        sample_counts,
+    )
     from mmusv.generate.mapctx import MapContext
     from mmusv.generate.spec import GenerationSpec
 
     spec = GenerationSpec.model_validate({"combinations": [{"family": "crossing"}]})
+    problem = budget_problem(scenario, *sample_counts(scenario, spec))
+    if problem is not None:
+        raise ConfigError(
+            f"{source}: {problem} (they cover the whole acquisition, however few frames are run): skip them with "
+            "--no-checks (checks=False), or lower acquisition.frames or acquisition.frequency_hz"
+        )
     samples = scenario_samples(scenario, MapContext(world), spec)
     cons = spec.constraints
     fail = InWater().check(samples)

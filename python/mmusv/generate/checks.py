@@ -33,6 +33,7 @@ import numpy as np
 
 from mmusv._native import core
 from mmusv.config import Scenario
+from mmusv.errors import ConfigError
 from mmusv.generate.hulls import axis_points, capsule, segment_distance
 from mmusv.generate.mapctx import MapContext
 from mmusv.generate.sampler import CandidateMeta
@@ -51,7 +52,25 @@ from mmusv.generate.spec_constraints import TargetDensityCheck
 from mmusv.motion import build_fleet
 from mmusv.world.vessels import get_asset
 
-__all__ = ["Constraint", "Finding", "Samples", "build_constraints", "first_failure", "sample_counts", "take_samples"]
+__all__ = [
+    "MAX_CHECK_SAMPLES",
+    "Constraint",
+    "Finding",
+    "Samples",
+    "budget_problem",
+    "build_constraints",
+    "first_failure",
+    "sample_counts",
+    "take_samples",
+]
+
+MAX_CHECK_SAMPLES = 5_000_000
+"""The most samples (per-vessel samples, in time or along the routes, whichever is more, times the vessels) the
+checks of one scenario take: about three minutes and a few GiB. :func:`take_samples` refuses more (a
+:class:`~mmusv.errors.ConfigError`) instead of allocating them; the scenario editor checks at most as many."""
+
+_SATURATE = 2**62
+"""A sample count past every budget, for counts that overflow (a non-finite time or route length)."""
 
 
 @dataclass(frozen=True)
@@ -136,12 +155,39 @@ def _half_turn(yaw: np.ndarray) -> np.ndarray:
     return out
 
 
+def _ceil_count(x: float) -> int:
+    """``ceil(x) + 1`` samples, at least 2, saturated at :data:`_SATURATE` (``x`` infinite, NaN or huge)."""
+    if not x < _SATURATE:  # also NaN
+        return _SATURATE
+    return max(math.ceil(x) + 1, 2)
+
+
 def _counts(scenario: Scenario, lengths: np.ndarray, step: float) -> tuple[int, int]:
-    """``(motion samples, route samples)`` per vessel for route ``lengths`` (metres) at spacing ``step``."""
+    """``(motion samples, route samples)`` per vessel for route ``lengths`` (metres) at spacing ``step``; counts too
+    large for any budget (or from non-finite inputs) saturate instead of overflowing."""
     acq = scenario.acquisition
     t_last = (acq.frames - 1) / acq.frequency_hz
     dt = min(1.0 / acq.frequency_hz, step / max(max(v.speed_mps for v in scenario.vessels), 1e-9))
-    return max(math.ceil(t_last / dt) + 1, 2), max(math.ceil(float(lengths.max()) / step) + 1, 2)
+    return _ceil_count(t_last / dt), _ceil_count(float(lengths.max()) / step)
+
+
+def _fmt(n: int) -> str:
+    return f"{n:,}" if n < _SATURATE else f"over {_SATURATE:.1e}"
+
+
+def budget_problem(scenario: Scenario, n_motion: int, n_route: int) -> str | None:
+    """None when ``n_motion``/``n_route`` samples per vessel (:func:`sample_counts`) fit :data:`MAX_CHECK_SAMPLES`,
+    else why not: the sample count, split into time and route samples (callers add what to do about it)."""
+    n_v = len(scenario.vessels)
+    total = max(n_motion, n_route) * n_v
+    if total <= MAX_CHECK_SAMPLES:
+        return None
+    acq = scenario.acquisition
+    return (
+        f"the route checks would take {_fmt(total)} samples ({_fmt(n_motion)} in time over {acq.frames:,} frames at "
+        f"{acq.frequency_hz:g} Hz, {_fmt(n_route)} along the longest route, x {n_v} vessel{'s' if n_v != 1 else ''}),"
+        f" more than the {MAX_CHECK_SAMPLES:,} they take at most"
+    )
 
 
 def sample_counts(scenario: Scenario, spec: GenerationSpec) -> tuple[int, int]:
@@ -151,7 +197,12 @@ def sample_counts(scenario: Scenario, spec: GenerationSpec) -> tuple[int, int]:
 
 
 def take_samples(scenario: Scenario, meta: CandidateMeta, ctx: MapContext, spec: GenerationSpec) -> Samples:
-    """Samples a candidate's routes, motion and frames (two fleet evaluations in Rust)."""
+    """Samples a candidate's routes, motion and frames (two fleet evaluations in Rust).
+
+    Raises:
+        ConfigError: the samples would exceed :data:`MAX_CHECK_SAMPLES` (:func:`budget_problem`); nothing is
+            allocated.
+    """
     step = spec.check_step_m
     vessels = scenario.vessels
     fleet = build_fleet(scenario)
@@ -160,6 +211,11 @@ def take_samples(scenario: Scenario, meta: CandidateMeta, ctx: MapContext, spec:
     acq = scenario.acquisition
     t_last = (acq.frames - 1) / acq.frequency_hz
     n_t, n_g = _counts(scenario, lengths, step)
+    problem = budget_problem(scenario, n_t, n_g)
+    if problem is not None:
+        raise ConfigError(
+            f"{problem}: lower acquisition.frames or acquisition.frequency_hz, shorten the routes or lower the speeds"
+        )
     times = np.linspace(0.0, t_last, n_t)
     frame_times = np.arange(acq.frames, dtype=np.float64) / acq.frequency_hz
     poses = np.asarray(fleet.poses_at_times(np.concatenate([times, frame_times])))

@@ -112,14 +112,24 @@ class MapContext:
         )
 
     def _eligible(self, need: float) -> np.ndarray:
+        """Water cells of the priors at least ``need`` metres from shore, ``need`` halved (down to the priors'
+        ``clearance``) while none qualifies; a loop, so any finite ``need`` ends quickly."""
         key = f"eligible:{need:.3f}"
         if key not in self.cache:
             pri = self.priors
-            cells = np.flatnonzero(pri.water_mask & (pri.shore_distance >= need) & pri.valid_zones)
-            if cells.size == 0:
-                if need <= pri.clearance:
+            ok = pri.water_mask & pri.valid_zones
+            if not ok.any():
+                raise ValueError(f"the map has no valid water cell (clearance {pri.clearance:g} m)")
+            need_now, top = float(need), float(pri.shore_distance[ok].max())
+            while need_now > top and need_now > pri.clearance:  # no cell qualifies: halve without looking
+                need_now = max(need_now / 2.0, pri.clearance)
+            while True:
+                cells = np.flatnonzero(ok & (pri.shore_distance >= need_now))
+                if cells.size > 0:
+                    break
+                if need_now <= pri.clearance:
                     raise ValueError(f"the map has no valid water cell (clearance {pri.clearance:g} m)")
-                cells = self._eligible(max(need / 2.0, pri.clearance))
+                need_now = max(need_now / 2.0, pri.clearance)
             self.cache[key] = cells
         out: np.ndarray = self.cache[key]
         return out

@@ -23,12 +23,12 @@ import yaml
 
 from mmusv.config import load_scenario
 from mmusv.errors import ConfigError, IoError, MmusvError
-from mmusv.generate.checks import build_constraints, first_failure, take_samples
+from mmusv.generate.checks import Constraint, build_constraints, first_failure, take_samples
 from mmusv.generate.hulls import capsule
 from mmusv.generate.layout import SamplingError
 from mmusv.generate.mapctx import MapContext, map_context
 from mmusv.generate.report import ComboReport, RunReport
-from mmusv.generate.sampler import sample_candidate
+from mmusv.generate.sampler import Candidate, sample_candidate
 from mmusv.generate.spec import GenerationSpec, class_assets, load_spec
 
 __all__ = ["Progress", "dump_scenario", "generate"]
@@ -122,6 +122,18 @@ def _infeasible(spec: GenerationSpec, ctx: MapContext, idx: int) -> str | None:
     return None
 
 
+def _first_failure(
+    constraints: list[Constraint], cand: Candidate, ctx: MapContext, spec: GenerationSpec
+) -> tuple[str, str] | None:
+    """The first failing constraint of a candidate, ``("sampling", why)`` when it has too many samples to check
+    (:data:`~mmusv.generate.checks.MAX_CHECK_SAMPLES`), None when it passes."""
+    try:
+        samples = take_samples(cand.scenario, cand.meta, ctx, spec)
+    except ConfigError as exc:
+        return "sampling", str(exc)
+    return first_failure(constraints, samples)
+
+
 def generate(
     spec_source: GenerationSpec | str | os.PathLike[str] | dict[str, Any],
     out_dir: str | os.PathLike[str],
@@ -161,7 +173,7 @@ def generate(
             except ConfigError as exc:
                 rep.reject("schema", str(exc))
             else:
-                fail = first_failure(constraints, take_samples(cand.scenario, cand.meta, ctx, spec))
+                fail = _first_failure(constraints, cand, ctx, spec)
                 if fail is not None:
                     rep.reject(*fail)
                 else:

@@ -39,13 +39,17 @@ the value given and what is allowed, in the style of :func:`mmusv.config.load_sc
 from __future__ import annotations
 
 import difflib
+import math
 import os
+import re
+from collections.abc import Callable
 from functools import lru_cache
 from typing import Any
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from mmusv.config import (
+    MAX_SPEED_MPS,
     AcquisitionConfig,
     EnvironmentConfig,
     MapConfig,
@@ -93,6 +97,15 @@ __all__ = [
 
 Pair = tuple[float, float]
 
+_NAME = re.compile(r"[A-Za-z0-9_\-][A-Za-z0-9_\-.]*")
+"""A spec name (as a scenario name): no path separators, and no leading dot (``.``, ``..``, hidden files)."""
+
+MAX_RANGE_M = 100_000.0
+"""Farthest closest-approach ``range_m`` of a difficulty, metres (100 km: far beyond any sensor)."""
+MAX_ENCOUNTER_CLEARANCE_M = 10_000.0
+"""Largest ``encounter_clearance_m`` (shore distance of an encounter centre), metres; maps are a few km across and
+the clearance is halved down to the map's own while no water cell has it."""
+
 
 class _Model(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, str_strip_whitespace=True, allow_inf_nan=False)
@@ -118,6 +131,13 @@ class SizeClass(_Model):
         if v[0] < 0:
             raise ValueError("must be >= 0")
         return _ordered(v, "range")
+
+    @field_validator("speed_mps")
+    @classmethod
+    def _speed(cls, v: Pair) -> Pair:
+        if v[1] > MAX_SPEED_MPS:
+            raise ValueError(f"speeds must be <= {MAX_SPEED_MPS:g} m/s")
+        return v
 
     @field_validator("assets")
     @classmethod
@@ -172,6 +192,8 @@ class UsvRoles(_Model):
     def _speed(cls, v: Pair) -> Pair:
         if v[0] <= 0:
             raise ValueError("USV speeds must be > 0")
+        if v[1] > MAX_SPEED_MPS:
+            raise ValueError(f"USV speeds must be <= {MAX_SPEED_MPS:g} m/s")
         return _ordered(v, "speed_mps")
 
 
@@ -194,6 +216,8 @@ class Difficulty(_Model):
     def _range(cls, v: Pair) -> Pair:
         if v[0] < 0:
             raise ValueError("must be >= 0")
+        if v[1] > MAX_RANGE_M:
+            raise ValueError(f"must be <= {MAX_RANGE_M:,.0f} m")
         return _ordered(v, "range_m")
 
     @field_validator("extra_targets", mode="before")
@@ -265,7 +289,7 @@ def _default_rigs() -> dict[str, dict[str, Any]]:
 class GenerationSpec(_Model):
     """A whole generation spec (see the module docstring)."""
 
-    name: str = Field(default="generated", pattern=r"^[A-Za-z0-9_\-.]+$")
+    name: str = Field(default="generated", min_length=1, max_length=200)
     seed: int = Field(default=0, ge=0, lt=2**63)
     map: MapConfig = Field(default_factory=MapConfig)
     environment: dict[str, Any] = Field(default_factory=dict)
@@ -280,8 +304,17 @@ class GenerationSpec(_Model):
     max_attempts_per_scenario: int = Field(default=40, ge=1, le=100_000)
     check_step_m: float = Field(default=2.0, ge=0.25, le=50.0)
     sensor_height_m: float = Field(default=2.5, gt=0.0, le=100.0)
-    encounter_clearance_m: float = Field(default=100.0, ge=0.0)
+    encounter_clearance_m: float = Field(default=100.0, ge=0.0, le=MAX_ENCOUNTER_CLEARANCE_M)
     proposals: int = Field(default=6, ge=1, le=100)
+
+    @field_validator("name")
+    @classmethod
+    def _name(cls, v: str) -> str:
+        if not _NAME.fullmatch(v):
+            raise ValueError(
+                "use letters, digits, '_', '-' and '.', not starting with '.' (it names files and folders)"
+            )
+        return v
 
     @field_validator("environment")
     @classmethod
@@ -334,6 +367,7 @@ def _cross_checks(spec: GenerationSpec, source: str) -> None:
         for c in d.extra_classes or []:
             if c not in spec.size_classes:
                 fail(f"difficulties.{name}.extra_classes", c, f"not a size class ({', '.join(spec.size_classes)})")
+    _check_budget(spec, fail)
     labels: set[str] = set()
     for i, combo in enumerate(spec.combinations):
         where = f"combinations[{i}]"
@@ -362,6 +396,29 @@ def _cross_checks(spec: GenerationSpec, source: str) -> None:
         if label in labels:
             fail(f"{where}.name", label, "two combinations have this name; give them distinct `name:`s")
         labels.add(label)
+
+
+def _check_budget(spec: GenerationSpec, fail: Callable[[str, object, str], None]) -> None:
+    """Refuses a spec whose every candidate would take more samples in time than the checks take at most
+    (:data:`~mmusv.generate.checks.MAX_CHECK_SAMPLES`): a long window at the fastest speeds, many vessels."""
+    from mmusv.generate.checks import MAX_CHECK_SAMPLES
+
+    acq = spec.acquisition
+    speeds = [spec.usv.speed_mps[1], *(c.speed_mps[1] for c in spec.size_classes.values())]
+    dt = min(1.0 / acq.frequency_hz, spec.check_step_m / max(max(speeds), 1e-9))
+    n_t = max(math.ceil((acq.frames - 1) / acq.frequency_hz / dt) + 1, 2)
+    for i, combo in enumerate(spec.combinations):
+        diff = spec.difficulties.get(combo.difficulty)
+        n_v = 1 + combo.cooperating + len(combo.targets) + (diff.extra_targets[1] if diff is not None else 0)
+        if n_t * n_v > MAX_CHECK_SAMPLES:
+            fail(
+                "acquisition",
+                {"frequency_hz": acq.frequency_hz, "frames": acq.frames},
+                f"the checks of a combinations[{i}] candidate could take {n_t * n_v:,} samples ({n_t:,} in time at "
+                f"up to {max(speeds):g} m/s, x {n_v} vessels), more than the {MAX_CHECK_SAMPLES:,} they take at most: "
+                "lower frames or frequency_hz, the speeds (usv.speed_mps, size_classes.*.speed_mps) or raise "
+                "check_step_m",
+            )
 
 
 def load_spec(source: str | os.PathLike[str] | dict[str, Any] | GenerationSpec) -> GenerationSpec:

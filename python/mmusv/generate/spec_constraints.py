@@ -28,6 +28,9 @@ __all__ = [
 
 PairKind = Literal["usv-usv", "usv-target", "target-target"]
 
+MAX_DISTANCE_M = 100_000.0
+"""The largest distance threshold (clearance, separation, range, cooperation band) a constraint takes, metres."""
+
 
 class _Model(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
@@ -45,27 +48,27 @@ class ShoreClearanceCheck(_Check):
     """Hull at least ``min_m`` from non-navigable cells (land, shallows, structures, map edge). The hull is the
     capsule covering its rectangle at the vessel's yaw (:mod:`mmusv.generate.hulls`)."""
 
-    min_m: float = Field(default=10.0, ge=0.0)
+    min_m: float = Field(default=10.0, ge=0.0, le=MAX_DISTANCE_M)
 
 
 class StructureClearanceCheck(_Check):
     """Hull (the capsule covering its rectangle at the vessel's yaw, :mod:`mmusv.generate.hulls`) at least
     ``min_m`` from port structures, buoys and moored ships."""
 
-    min_m: float = Field(default=15.0, ge=0.0)
+    min_m: float = Field(default=15.0, ge=0.0, le=MAX_DISTANCE_M)
 
 
 class SeparationCheck(_Check):
     """Hull-to-hull distance at least ``min_m`` between every two vessels at every time, each hull the capsule
     covering its rectangle at the vessel's yaw (:mod:`mmusv.generate.hulls`)."""
 
-    min_m: float = Field(default=15.0, ge=0.0)
+    min_m: float = Field(default=15.0, ge=0.0, le=MAX_DISTANCE_M)
 
 
 class RouteSeparationCheck(_Check):
     """Route centre lines of the vessel pairs of kinds ``pairs`` at least ``min_m`` apart everywhere."""
 
-    min_m: float = Field(default=20.0, ge=0.0)
+    min_m: float = Field(default=20.0, ge=0.0, le=MAX_DISTANCE_M)
     pairs: list[PairKind] = Field(default_factory=lambda: list[PairKind](["usv-usv"]))
 
 
@@ -76,7 +79,7 @@ class TargetRangeCheck(_Check):
 class SensingRangeCheck(_Check):
     """Each target within ``range_m`` of at least one USV for at least ``min_share`` of the frames."""
 
-    range_m: float = Field(default=1000.0, gt=0.0)
+    range_m: float = Field(default=1000.0, gt=0.0, le=MAX_DISTANCE_M)
     min_share: float = Field(default=0.8, ge=0.0, le=1.0)
     targets: Literal["all", "role"] = "all"
 
@@ -87,7 +90,7 @@ class TargetDensityCheck(_Check):
     to learn detection from. Off unless a spec sets it."""
 
     enabled: bool = False
-    range_m: float = Field(default=200.0, gt=0.0, le=100_000.0)
+    range_m: float = Field(default=200.0, gt=0.0, le=MAX_DISTANCE_M)
     min_targets: int = Field(default=1, ge=1, le=64)
     min_share: float = Field(default=0.8, ge=0.0, le=1.0)
 
@@ -96,8 +99,8 @@ class CooperationCheck(_Check):
     """Each USV's nearest other USV between ``min_m`` and ``max_m`` for at least ``min_share`` of the frames
     (vacuous with one USV)."""
 
-    min_m: float = Field(default=20.0, ge=0.0)
-    max_m: float = Field(default=800.0, gt=0.0)
+    min_m: float = Field(default=20.0, ge=0.0, le=MAX_DISTANCE_M)
+    max_m: float = Field(default=800.0, gt=0.0, le=MAX_DISTANCE_M)
     min_share: float = Field(default=1.0, ge=0.0, le=1.0)
 
     @model_validator(mode="after")
