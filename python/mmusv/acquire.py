@@ -176,7 +176,9 @@ def run(
         raise located(exc, source) from None
     if checks:
         check_mounts(scenario, source=source)
-        check_routes(scenario, sim.world, source=source)
+        # The routes as far as this run sails them: frames 0 .. total - 1 (the stop of a frame range).
+        upto = scenario.acquisition.model_copy(update={"frames": total})
+        check_routes(scenario.model_copy(update={"acquisition": upto}), sim.world, source=source)
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:

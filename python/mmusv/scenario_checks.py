@@ -85,9 +85,9 @@ def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[st
     """Runs the generator's ``in_water`` check (an error) and clearance/separation checks (warnings, also
     returned) on ``scenario`` sailing on ``world``; ``source`` names the file in messages.
 
-    The checks sample the whole acquisition (every frame, whatever a run records); a scenario whose checks would
-    take more than :data:`~mmusv.generate.checks.MAX_CHECK_SAMPLES` samples is refused (a ``ConfigError`` that
-    says how many and how to skip them) before anything is sampled."""
+    The checks sample the scenario's whole acquisition (:func:`mmusv.run` passes it cut to the frames it runs); a
+    scenario whose checks would take more than :data:`~mmusv.generate.checks.MAX_CHECK_SAMPLES` samples is refused
+    (a ``ConfigError`` that says how many and how to skip them) before anything is sampled."""
     from mmusv.generate.checks import (
         InWater,
         Separation,
@@ -103,8 +103,8 @@ def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[st
     problem = budget_problem(scenario, *sample_counts(scenario, spec))
     if problem is not None:
         raise ConfigError(
-            f"{source}: {problem} (they cover the whole acquisition, however few frames are run): skip them with "
-            "--no-checks (checks=False), or lower acquisition.frames or acquisition.frequency_hz"
+            f"{source}: {problem} (they cover every frame that is run): skip them with --no-checks "
+            "(checks=False), run fewer frames (--frames), or lower acquisition.frames or acquisition.frequency_hz"
         )
     samples = scenario_samples(scenario, MapContext(world), spec)
     cons = spec.constraints

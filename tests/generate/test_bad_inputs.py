@@ -73,15 +73,34 @@ def _spec_error(tmp_path: Path, extra: dict[str, Any]) -> str:
 
 @pytest.mark.usefixtures("no_sampling")
 def test_run_refuses_checks_past_the_sample_budget(tmp_path: Path) -> None:
-    # 1000 Hz x 10,000,000 frames is a valid acquisition, but the checks sample all of it even for --frames 1
+    # 1000 Hz x 10,000,000 frames is a valid acquisition, but its checks would sample all of it (it hung)
     path = tmp_path / "long.yaml"
     path.write_text(yaml.safe_dump({**BASE, "acquisition": {"frequency_hz": 1000, "frames": 10_000_000}}))
     with pytest.raises(ConfigError) as info:
-        mmusv.run(path, out_dir=tmp_path / "out", frames=1)
+        mmusv.run(path, out_dir=tmp_path / "out")
     msg = str(info.value)
     assert "long.yaml" in msg and "10,000,000 samples" in msg
-    assert "--no-checks" in msg and "acquisition.frames" in msg
+    assert "--no-checks" in msg and "acquisition.frames" in msg and "--frames" in msg
     assert not (tmp_path / "out").exists()
+
+
+def test_run_checks_only_the_frames_it_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    # `--frames 1` of that acquisition checks the routes over its one frame (then stops here: nothing recorded).
+    import mmusv.acquire
+
+    seen: list[int] = []
+
+    def checked(scenario: Any, world: Any, *, source: str) -> list[str]:
+        seen.append(scenario.acquisition.frames)
+        raise ConfigError("stop")
+
+    monkeypatch.setattr(mmusv.acquire, "check_routes", checked)
+    path = tmp_path / "long.yaml"
+    path.write_text(yaml.safe_dump({**BASE, "acquisition": {"frequency_hz": 1000, "frames": 10_000_000}}))
+    for kwargs, frames in (({"frames": 1}, 1), ({"frame_range": (3, 7)}, 7)):
+        with pytest.raises(ConfigError, match="stop"):
+            mmusv.run(path, out_dir=tmp_path / "out", **kwargs)
+        assert seen[-1] == frames
 
 
 @pytest.mark.usefixtures("no_sampling")
