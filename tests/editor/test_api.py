@@ -303,7 +303,12 @@ def test_evaluate_names_the_field_of_schema_and_route_errors(client: TestClient)
     ev = client.post("/api/evaluate", json={"document": doc}).json()
     assert not ev["valid"] and ev["errors"][0]["field"] == "vessels[2].route[1]"
     doc = bundled_doc(client)
-    doc["vessels"][0]["speed_mps"] = 1e9
+    doc["vessels"][0]["speed_mps"] = 1e9  # beyond any vessel: refused by the schema, naming the field
+    ev = client.post("/api/evaluate", json={"document": doc}).json()
+    assert not ev["valid"] and ev["errors"][0]["field"] == "vessels[0].speed_mps"
+    assert "less than or equal to 100" in ev["errors"][0]["message"]
+    doc = bundled_doc(client)
+    doc["acquisition"] = {"frequency_hz": 1000, "frames": 10_000_000}  # valid, but too long to sample
     ev = client.post("/api/evaluate", json={"document": doc}).json()
     assert not ev["valid"] and "at most" in ev["errors"][0]["message"]
 
