@@ -185,6 +185,21 @@ class EnvironmentConfig(_Model):
         wave_height_m(v)
         return v.strip().upper() if isinstance(v, str) else float(v)
 
+    @model_validator(mode="after")
+    def _one_sea(self) -> EnvironmentConfig:
+        # Either setting alone decides the sea; given both, one would be dropped without a word.
+        if self.sea is not None and "wave" in self.model_fields_set:
+            raise ValueError(
+                "environment: give `wave` (W0..W3 or metres) or `sea`, not both: `sea` sets the waves every sensor "
+                "and every hull meets"
+            )
+        if self.sea is not None and self.motion == "paper":
+            raise ValueError(
+                "environment: `sea` is the physical sea, which `motion: paper` leaves out (the paper's formula, "
+                "driven by `wave`, over flat water): drop `sea`, or use `motion: physical`"
+            )
+        return self
+
     def resolve(self) -> Environment:
         """The resolved :class:`~mmusv.world.environment.Environment` (sun, weather, wave height)."""
         return Environment.make(**self.model_dump(exclude={"sea", "motion"}))

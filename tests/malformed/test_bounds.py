@@ -151,3 +151,17 @@ def test_a_merge_key_may_be_overridden(tmp_path: Path) -> None:
     f.write_text(textwrap.dedent(text).replace("id: u2,", "id: u2, id: u3,"), encoding="utf-8")
     with pytest.raises(ConfigError, match="duplicate key 'id'"):
         load_scenario(f)
+
+
+@pytest.mark.parametrize(
+    ("environment", "said"),
+    [
+        ({"wave": "W3", "sea": {"hs_m": 1.0}}, "not both"),  # the sea's 1 m decided; W3 was dropped silently
+        ({"motion": "paper", "sea": {"state": 5}}, "motion: physical"),  # the flat sea of the paper; `sea` unused
+    ],
+)
+def test_a_sea_given_twice_is_refused(environment: dict[str, Any], said: str, tmp_path: Path) -> None:
+    msg = _refused(_with("environment", environment), tmp_path)
+    assert "environment" in msg and said in msg, msg
+    load_scenario(_with("environment", {"sea": {"hs_m": 1.0}}))  # either alone loads
+    load_scenario(_with("environment", {"wave": "W3", "motion": "paper"}))
