@@ -225,3 +225,16 @@ def test_spec_name_refuses_dots_and_separators(tmp_path: Path, name: str) -> Non
 
 def test_spec_name_with_inner_dots_is_accepted() -> None:
     assert load_spec({**SPEC, "name": "v1.2_run-3"}).name == "v1.2_run-3"
+
+
+@pytest.mark.parametrize(
+    ("environment", "said"),
+    [
+        ({"wave": ["W1", "W2"], "sea": {"hs_m": 1.0}}, "not both"),
+        ({"motion": ["physical", "paper"], "sea": {"state": 4}}, "motion: paper"),
+    ],
+)
+def test_spec_environment_refuses_a_sea_given_twice(tmp_path: Path, environment: dict[str, Any], said: str) -> None:
+    # Each key is valid alone, but every candidate drawn with both would be refused by the scenario schema.
+    msg = _spec_error(tmp_path, {"environment": environment})
+    assert "environment" in msg and said in msg, msg

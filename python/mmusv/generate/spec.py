@@ -332,6 +332,16 @@ class GenerationSpec(_Model):
                 except ValidationError as exc:
                     msg = str(exc.errors()[0]["msg"]).removeprefix("Value error, ")
                     raise ValueError(f"environment.{key} = {c!r}: {msg}") from None
+        # What a scenario refuses across keys (EnvironmentConfig's checks), for any choice the sampler can draw.
+        motions = v.get("motion", [])
+        if "sea" in v and "wave" in v:
+            raise ValueError(
+                "environment: give `wave` or `sea`, not both: `sea` sets the waves every sensor and hull meet"
+            )
+        if "sea" in v and "paper" in (motions if isinstance(motions, list) else [motions]):
+            raise ValueError(
+                "environment: `sea` is the physical sea, which `motion: paper` leaves out: drop one of them"
+            )
         return v
 
     def map_of(self, combo: Combination) -> MapConfig:
