@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import hashlib
+import shutil
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -98,6 +99,19 @@ def test_existing_output_refused_without_overwrite(coop_rec: Path, tmp_path: Pat
     with pytest.raises(IoError, match="refusing to delete"):
         convert(coop_rec, out_dir=foreign, overwrite=True)
     assert (foreign / "precious.txt").read_text() == "keep me"
+
+
+def test_overwrite_never_deletes_the_recording_being_converted(coop_rec: Path, tmp_path: Path) -> None:
+    # A recording copied into an earlier conversion's folder, converted into that folder with --overwrite: the
+    # folder used to be emptied first, the input with it.
+    out = tmp_path / "conv"
+    convert(coop_rec, out_dir=out, splits=None, extras=())
+    inside = out / "in.mcap"
+    shutil.copyfile(coop_rec, inside)
+    for target in (out, out / "deeper" / ".."):
+        with pytest.raises(IoError, match="being converted"):
+            convert(inside, out_dir=target, splits=None, extras=(), overwrite=True)
+        assert inside.stat().st_size == coop_rec.stat().st_size
 
 
 @pytest.mark.parametrize("to", ["opv2v", "kitti"])

@@ -238,3 +238,29 @@ def test_spec_environment_refuses_a_sea_given_twice(tmp_path: Path, environment:
     # Each key is valid alone, but every candidate drawn with both would be refused by the scenario schema.
     msg = _spec_error(tmp_path, {"environment": environment})
     assert "environment" in msg and said in msg, msg
+
+
+def test_force_replaces_only_what_a_generate_run_wrote(tmp_path: Path) -> None:
+    # `generate spec.yaml -o DIR --force` used to delete every *.yaml in DIR: the spec itself, hand-written files.
+    from mmusv.errors import IoError
+    from mmusv.generate.runner import _prepare_dir
+
+    out = tmp_path / "gen"
+    out.mkdir()
+    (out / "a_0000.yaml").write_text("name: a\n")
+    (out / "report.json").write_text(json.dumps({"combinations": [{"files": ["a_0000.yaml"]}]}))
+    spec = out / "spec.yaml"
+    spec.write_text("name: s\n")
+    with pytest.raises(IoError, match="spec itself"):
+        _prepare_dir(out, True, spec)
+    assert spec.is_file() and (out / "a_0000.yaml").is_file()
+    spec.unlink()
+    (out / "mine.yaml").write_text("name: m\n")
+    with pytest.raises(IoError, match=r"mine\.yaml"):
+        _prepare_dir(out, True)
+    (out / "mine.yaml").unlink()
+    _prepare_dir(out, True)  # only the listed scenario and the report: removed
+    assert not any(out.iterdir())
+    with pytest.raises(IoError, match="--force"):
+        (out / "b.yaml").write_text("name: b\n")
+        _prepare_dir(out, False)

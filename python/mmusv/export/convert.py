@@ -165,9 +165,17 @@ def _as_list(recordings: str | Path | Iterable[str | Path]) -> list[Path]:
     return out
 
 
-def _prepare_out(out: Path, overwrite: bool) -> None:
+def _prepare_out(out: Path, overwrite: bool, inputs: list[Path]) -> None:
     if out.exists() and not out.is_dir():
         raise IoError(f"output {out} exists and is not a folder")
+    # The output folder is emptied on --overwrite: it may not hold a recording being converted.
+    home = out.resolve()
+    for p in inputs:
+        where = p.resolve()
+        if where == home or home in where.parents:
+            raise IoError(
+                f"output folder {out} holds {p}, which is being converted; write the conversion to another folder"
+            )
     if out.exists() and any(out.iterdir()):
         if not overwrite:
             raise IoError(
@@ -291,7 +299,7 @@ def convert(
     if ratios is not None:
         split_of = dict(assign_splits(folders, ratios, seed))
     out = Path(out_dir)
-    _prepare_out(out, overwrite)
+    _prepare_out(out, overwrite, [Path(i.path) for i in infos])
     reports = [
         RecordingReport(path=i.path, scenario=i.scenario_name, folder=f, split=split_of[f])
         for i, f in zip(infos, folders, strict=True)

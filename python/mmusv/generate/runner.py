@@ -86,19 +86,55 @@ def dump_scenario(data: dict[str, Any]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _prepare_dir(out: Path, force: bool) -> None:
+def _prepare_dir(out: Path, force: bool, spec_path: Path | None = None) -> None:
+    """Readies ``out``: with ``force``, removes the scenario files a previous run generated there (those its
+    ``report.json`` lists) and that report; any other YAML file there (a hand-written scenario, the spec itself)
+    is never deleted: the run refuses instead."""
     if out.exists() and not out.is_dir():
         raise IoError(f"output {str(out)!r} exists and is not a directory")
-    old: list[Path] = []
-    if out.is_dir():
-        old = sorted(out.glob("*.yaml"))
-        if (out / "report.json").is_file():
-            old.append(out / "report.json")
-    if old and not force:
+    if not out.is_dir():
+        out.mkdir(parents=True, exist_ok=True)
+        return
+    yamls = sorted(out.glob("*.yaml"))
+    report = out / "report.json"
+    if not yamls and not report.is_file():
+        return
+    if not force:
         raise IoError(f"output directory {str(out)!r} already holds scenario files; pass --force to replace them")
-    for p in old:
+    ours = _generated_here(report)
+    foreign = [p for p in yamls if p.name not in ours or (spec_path is not None and _same_file(p, spec_path))]
+    if foreign:
+        names = ", ".join(p.name for p in foreign[:3]) + (" ..." if len(foreign) > 3 else "")
+        raise IoError(
+            f"output directory {str(out)!r} holds YAML files that no earlier generate run there wrote ({names}; "
+            f"{'the spec itself, ' if spec_path is not None and any(_same_file(p, spec_path) for p in foreign) else ''}"
+            "report.json lists what a run wrote); --force replaces only those: choose another folder or move them"
+        )
+    for p in yamls:
         p.unlink()
-    out.mkdir(parents=True, exist_ok=True)
+    report.unlink(missing_ok=True)
+
+
+def _generated_here(report: Path) -> set[str]:
+    """The scenario file names an earlier run's ``report.json`` lists (empty when there is none or it is not
+    readable as one)."""
+    try:
+        data = json.loads(report.read_text(encoding="utf-8"))
+        return {
+            f
+            for c in data.get("combinations", [])
+            for f in c.get("files", [])
+            if isinstance(f, str) and Path(f).name == f
+        }
+    except (OSError, ValueError, AttributeError, TypeError):
+        return set()
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        return a.resolve() == b.resolve()
+    except OSError:
+        return False
 
 
 def _infeasible(spec: GenerationSpec, ctx: MapContext, idx: int) -> str | None:
@@ -147,7 +183,8 @@ def generate(
     out = Path(out_dir)
     contexts = [map_context(m.type, m.seed, m.param_values()) for m in (spec.map_of(c) for c in spec.combinations)]
     constraints = build_constraints(spec)
-    _prepare_dir(out, force)
+    spec_path = Path(spec_source) if isinstance(spec_source, (str, os.PathLike)) else None
+    _prepare_dir(out, force, spec_path)
     report = RunReport(
         spec_name=spec.name,
         seed=spec.seed,
