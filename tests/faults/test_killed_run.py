@@ -120,3 +120,20 @@ def test_run_on_a_killed_run_redoes_it_cleanly_and_says_so(killed: tuple[Path, P
         assert pl.read_parquet(folder / "tables" / table / "*.parquet").equals(
             pl.read_parquet(ref / "tables" / table / "*.parquet")
         )
+
+
+def test_recover_leaves_a_partial_without_a_complete_frame_as_it_was(
+    killed: tuple[Path, Path, int], tmp_path: Path
+) -> None:
+    # The first 64 KiB of the killed run's file: its header and metadata, no whole chunk. Recovering it used to write
+    # a recording of no frame, report success and delete the .partial (and the tables there).
+    _src, ref, _k = killed
+    folder = tmp_path / "early"
+    shutil.copytree(ref.parent / "killed", folder)
+    partial = folder / "dense.mcap.partial"
+    partial.write_bytes(partial.read_bytes()[:65536])
+    tables = sorted(p.relative_to(folder) for p in (folder / "tables").rglob("*.parquet"))
+    code, _out, err = cli_main("recover", str(folder))
+    assert code != 0 and "no complete frame" in err and "left as it was" in err, err
+    assert partial.stat().st_size == 65536 and not (folder / "dense.mcap").exists()
+    assert sorted(p.relative_to(folder) for p in (folder / "tables").rglob("*.parquet")) == tables

@@ -184,11 +184,14 @@ def _want(topic: str) -> bool:
     return topic.endswith("/annotations")
 
 
-def rebuild_tables(recording: str | os.PathLike[str], tables_dir: str | os.PathLike[str]) -> FrameStream:
+def rebuild_tables(
+    recording: str | os.PathLike[str], tables_dir: str | os.PathLike[str], *, keep_if_empty: bool = False
+) -> FrameStream:
     """Writes the Parquet tables of every complete frame of ``recording`` into ``tables_dir`` (replacing the parts
     there): ``world_state`` from ``/world/state``, ``boxes_3d`` and ``boxes_2d`` from each agent's
     ``/<agent>/annotations``, roles from the world state and static flags from the recorded scenario; parts end
-    at the frames where a run flushes them. Returns the stream that read it (its damage and missing frames)."""
+    at the frames where a run flushes them. With ``keep_if_empty``, a recording without one complete frame leaves
+    ``tables_dir`` as it was. Returns the stream that read it (its damage and missing frames)."""
     from mmusv.acquire import TABLE_PART_FRAMES
 
     info = read_info(Path(recording))
@@ -213,6 +216,8 @@ def rebuild_tables(recording: str | os.PathLike[str], tables_dir: str | os.PathL
             if (fr.index + 1) % TABLE_PART_FRAMES == 0:
                 tables.flush()
         tables.flush()
+        if keep_if_empty and not stream.yielded:
+            return stream
         for old in sorted(root.glob("*/part-*.parquet")):
             old.unlink()
         for new in sorted(tmp.glob("*/part-*.parquet")):
@@ -243,8 +248,14 @@ def recover(target: str | os.PathLike[str], *, overwrite: bool = False) -> Recov
     folder = src.parent
     # pass 1: which frames are complete (and their tables)
     tables_dir = folder / "tables"
-    stream = rebuild_tables(src, tables_dir)
+    stream = rebuild_tables(src, tables_dir, keep_if_empty=True)
     keep = set(stream.yielded)
+    if not keep:
+        # Nothing to finish: a recording of no frame would replace the .partial (and its chance of a better tool).
+        raise IoError(
+            f"{src} holds no complete frame (the run stopped before its first frame was written, or the file is "
+            "damaged there): nothing to recover; it is left as it was"
+        )
     times = {round(k / info.frequency_hz * 1e9) for k in keep} if info.frequency_hz > 0 else set()
     # pass 2: copy their messages into a finished MCAP
     tmp = final.with_name(final.name + ".recovering")
