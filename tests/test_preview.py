@@ -132,3 +132,20 @@ def test_unknown_agent_is_a_clear_error(recording: Path) -> None:
 
     with pytest.raises(ConfigError, match=r"no agent 'nobody'.*usv_1"):
         compose_preview(recording, frame=0, agent="nobody")
+    with pytest.raises(ConfigError, match=r"no agent ''"):  # an empty name is not "the first agent"
+        compose_preview(recording, frame=0, agent="")
+
+
+def test_the_output_is_a_picture_path_or_a_folder(recording: Path, tmp_path: Path) -> None:
+    from mmusv.errors import ConfigError
+    from mmusv.preview import write_preview
+
+    # A folder takes the picture under its default name; a path without a picture suffix is refused before the
+    # frame is read (it was a bare Pillow "unknown file extension" traceback).
+    out = write_preview(recording, frame=0, output=tmp_path)
+    assert out.parent == tmp_path and out.suffix == ".png" and out.stat().st_size > 0
+    for bad in (tmp_path / "p.txt", tmp_path / "noext"):
+        with pytest.raises(ConfigError, match=r"\.png, \.jpg, \.jpeg, or a folder"):
+            write_preview(recording, frame=0, output=bad)
+        assert not bad.exists()
+    assert write_preview(recording, frame=0, output=tmp_path / "p.JPG").stat().st_size > 0

@@ -19,7 +19,7 @@ import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
 from mmusv.classes import palette_array
-from mmusv.errors import ConfigError
+from mmusv.errors import ConfigError, IoError
 from mmusv.recording import topics
 from mmusv.recording.decode import decode_image, decode_point_cloud
 from mmusv.recording.info import AgentInfo, read_info, recording_name
@@ -166,7 +166,7 @@ def compose_preview(path: str | Path, *, frame: int = 0, agent: str | None = Non
     agents = {a.id: a for a in info.agents if any(topics.agent_of(t) == a.id for t in msgs)}
     if not agents:
         raise ConfigError(f"frame {frame} of {path} has no agent topics")
-    a_id = agent or next(iter(agents))
+    a_id = next(iter(agents)) if agent is None else agent
     if a_id not in agents:
         raise ConfigError(f"no agent {a_id!r} in {path}; agents: {', '.join(agents)}")
     a: AgentInfo = agents[a_id]
@@ -248,11 +248,24 @@ def compose_preview(path: str | Path, *, frame: int = 0, agent: str | None = Non
 def write_preview(
     path: str | Path, *, frame: int = 0, agent: str | None = None, output: str | Path | None = None
 ) -> Path:
-    """Writes the preview PNG of ``frame`` for ``agent`` (default: the first agent); returns its path."""
+    """Writes the preview PNG of ``frame`` for ``agent`` (default: the first agent); returns its path. ``output``:
+    the picture's path (``.png``, ``.jpg`` or ``.jpeg``), or an existing folder to write it into under its
+    default name; anything else is a :class:`~mmusv.errors.ConfigError`, checked before the frame is read."""
+    target = Path(output) if output is not None else None
+    if target is not None and not target.is_dir() and target.suffix.lower() not in _PICTURE_SUFFIXES:
+        raise ConfigError(
+            f"output {str(target)!r}: give a picture path ending in {', '.join(_PICTURE_SUFFIXES)}, or a folder"
+        )
     canvas, panels = compose_preview(path, frame=frame, agent=agent)
     a = panels[0].title.split(" · ")[0]
-    out = (
-        Path(output) if output is not None else Path(path).with_name(f"{recording_name(path)}_frame{frame:06d}_{a}.png")
-    )
-    canvas.save(out)
+    name = f"{recording_name(path)}_frame{frame:06d}_{a}.png"
+    out = Path(path).with_name(name) if target is None else target / name if target.is_dir() else target
+    try:
+        canvas.save(out)
+    except OSError as exc:
+        raise IoError(f"cannot write the preview {out}: {exc.strerror or exc}") from None
     return out
+
+
+_PICTURE_SUFFIXES = (".png", ".jpg", ".jpeg")
+"""What :func:`write_preview` writes (Pillow picks the format from the suffix)."""
