@@ -33,3 +33,17 @@ def test_bad_scenario_is_one_line_not_a_traceback(tmp_path: Path) -> None:
     r = run("study", "waves", "--scenario", str(bad), "-o", str(tmp_path))
     assert r.returncode == 2
     assert "Traceback" not in r.stderr and "vessels[0].asset" in r.stderr
+
+
+def test_run_checks_its_options_for_one_file_as_for_a_folder(tmp_path: Path) -> None:
+    # A single scenario file took --jobs 0 and -o "" (the current folder) without a word.
+    scenario = str(ROOT / "scenarios/open_sea_convoy.yaml")
+    for args, said in (
+        (["--jobs", "0"], "--jobs 0: must be at least 1"),
+        (["--frames", "-1"], "--frames -1: must be at least 1"),
+        (["-o", ""], "-o/--output is empty"),
+    ):
+        out = [] if "-o" in args else ["-o", str(tmp_path / "out")]
+        r = run("run", scenario, *out, *args)
+        assert r.returncode == 2 and said in r.stderr and "Traceback" not in r.stderr, r.stderr
+    assert not (tmp_path / "out").exists()

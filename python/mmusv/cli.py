@@ -21,7 +21,7 @@ if TYPE_CHECKING:
 
     from mmusv.config import Scenario
 
-from mmusv.errors import MmusvError
+from mmusv.errors import ConfigError, MmusvError
 
 BUNDLED_WAVE_SCENARIO = "scenarios/island_port_waves.yaml"
 
@@ -217,6 +217,13 @@ def _cmd_run(args: argparse.Namespace) -> int:
     from mmusv.bundled import resolve_scenario
 
     src = resolve_scenario(args.scenario)
+    # Checked for one file as for a folder (a single file used to take --jobs 0 without a word).
+    if args.jobs < 1:
+        raise ConfigError(f"--jobs {args.jobs}: must be at least 1")
+    if args.frames is not None and args.frames < 1:
+        raise ConfigError(f"--frames {args.frames}: must be at least 1")
+    if not str(args.output).strip():
+        raise ConfigError("-o/--output is empty: give the output folder (default out/)")
     if src.is_dir():
         if args.profile:
             raise MmusvError("--profile times one scenario; give a scenario file, not a folder")
