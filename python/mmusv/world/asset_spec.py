@@ -95,6 +95,8 @@ from mmusv.world.part_spec import MaterialName, PartSpec
 
 __all__ = [
     "AXES",
+    "DIMENSION_RANGES",
+    "MOUNT_REACH",
     "NAME_PATTERN",
     "AssetSpec",
     "AssetSpecError",
@@ -102,6 +104,8 @@ __all__ = [
     "MeshAssetSpec",
     "MountSpec",
     "ProceduralAssetSpec",
+    "dimension_problem",
+    "mount_reach",
     "parse_asset",
     "spec_error",
 ]
@@ -127,6 +131,35 @@ NAME_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.\-]*$")
 
 AXES: dict[str, tuple[float, float, float]] = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
 """The axis letters of a mesh file's ``up_axis`` / ``forward_axis`` (optionally with a sign) as unit vectors."""
+
+
+DIMENSION_RANGES: dict[str, tuple[float, float]] = {
+    "length": (0.5, 500.0),
+    "beam": (0.1, 500.0),
+    "height": (0.1, 500.0),
+}
+"""The allowed bounding-box size of an asset in metres, ``(min, max)`` per dimension (the built-in catalogue spans
+3-330 m in length, 0.65-60 m in beam and 1.1-73 m in height)."""
+
+MOUNT_REACH: tuple[float, float] = (2.0, 50.0)
+"""A mount may lie at most ``max(MOUNT_REACH[0] * length, MOUNT_REACH[1])`` metres outside the asset's bounding box."""
+
+
+def dimension_problem(length: float, beam: float, height: float) -> str | None:
+    """What is wrong with an asset of this bounding-box size (metres), or ``None`` when every dimension lies in
+    :data:`DIMENSION_RANGES`; non-finite sizes are always wrong."""
+    size = {"length": length, "beam": beam, "height": height}
+    bad = [k for k, v in size.items() if not DIMENSION_RANGES[k][0] <= v <= DIMENSION_RANGES[k][1]]
+    if not bad:
+        return None
+    got = " x ".join(f"{size[k]:.6g}" for k in size)
+    allowed = ", ".join(f"{k} {lo:g}..{hi:g} m" for k, (lo, hi) in DIMENSION_RANGES.items())
+    return f"gives {', '.join(bad)} out of range: length x beam x height = {got} m; allowed: {allowed}"
+
+
+def mount_reach(length: float) -> float:
+    """How far (metres) a mount may lie outside the bounding box of an asset ``length`` metres long."""
+    return max(MOUNT_REACH[0] * length, MOUNT_REACH[1])
 
 
 def _axis_name(value: object) -> str:
@@ -169,8 +202,8 @@ class HullSpec(Spec):
     """The hull of a procedural asset (module docstring); lengths in metres, the rest dimensionless."""
 
     type: Literal["mono", "twin"] = "mono"
-    length: Positive
-    beam: Positive
+    length: Annotated[Number, Field(ge=DIMENSION_RANGES["length"][0], le=DIMENSION_RANGES["length"][1])]
+    beam: Annotated[Number, Field(ge=DIMENSION_RANGES["beam"][0], le=DIMENSION_RANGES["beam"][1])]
     draft: Positive
     depth: Positive
     """Keel-to-deck depth at midship; more than ``draft``."""

@@ -40,10 +40,13 @@ from mmusv.errors import ConfigError, NotFoundError
 from mmusv.validation import join
 from mmusv.world.asset_spec import (
     AXES,
+    MOUNT_REACH,
     NAME_PATTERN,
     AssetSpecError,
     MeshAssetSpec,
     ProceduralAssetSpec,
+    dimension_problem,
+    mount_reach,
     parse_asset,
 )
 from mmusv.world.materials import NAV_LAMP_RADIANCE, Material, register_material
@@ -143,7 +146,9 @@ class VesselAsset:
     ``mounts``/``description``/``source``; ``length``, ``beam``, ``height``, ``draft`` (metres, floats) and
     ``bbox`` (``(2, 3)`` float64, min/max corner, metres, body frame) are computed from the mesh. The mesh
     arrays are copied and made read-only. The mesh must be centred in x/y (|centre| <= 1e-6 of its size)
-    and must cross the waterline (``min z < 0 < max z``); otherwise ``ValueError``.
+    and must cross the waterline (``min z < 0 < max z``), its size must lie in
+    :data:`mmusv.world.asset_spec.DIMENSION_RANGES` and every mount within
+    :func:`mmusv.world.asset_spec.mount_reach` of its bounding box; otherwise ``ValueError``.
     """
 
     name: str
@@ -192,9 +197,23 @@ class VesselAsset:
             raise AssetSpecError(
                 f"{self.name}.mesh", f"mesh spans z [{lo[2]:g}, {hi[2]:g}] m; it must cross the waterline z = 0"
             )
+        problem = dimension_problem(float(ext[0]), float(ext[1]), float(ext[2]))
+        if problem is not None:
+            raise AssetSpecError(f"{self.name}.mesh", f"the mesh's bounding box {problem}")
         bbox = np.stack([lo, hi])
         bbox.setflags(write=False)
         mounts = {str(k): _as_mount(m, f"{self.name}.mounts.{k}") for k, m in dict(self.mounts).items()}
+        reach = mount_reach(float(ext[0]))
+        for k, m in mounts.items():
+            p = np.asarray(m.xyz, dtype=np.float64)
+            off = float(np.linalg.norm(p - np.clip(p, lo, hi)))
+            if off > reach:
+                box = ", ".join(f"[{a:.6g}, {b:.6g}]" for a, b in zip(lo, hi, strict=True))
+                raise AssetSpecError(
+                    f"{self.name}.mounts.{k}.xyz",
+                    f"{list(m.xyz)} lies {off:.6g} m outside the hull's bounding box (x, y, z: {box} m); a mount "
+                    f"must lie within max({MOUNT_REACH[0]:g} x length, {MOUNT_REACH[1]:g} m) = {reach:g} m of it",
+                )
         object.__setattr__(self, "mesh", mesh)
         object.__setattr__(self, "mounts", MappingProxyType(mounts))
         object.__setattr__(self, "bbox", bbox)
@@ -430,7 +449,26 @@ def _load_mesh_file(path: Path, where: str) -> tuple[np.ndarray, np.ndarray, np.
         raise AssetSpecError(where, "loading mesh files needs the 'trimesh' package (pip install trimesh)") from exc
     gltf = path.suffix.lower() in (".glb", ".gltf")
     try:
-        loaded = trimesh.load(str(path), force="scene" if gltf else "mesh")
+        # Read unprocessed: trimesh's processing silently drops every face touching a NaN/inf vertex, so the raw
+        # arrays are checked first; each piece is then processed exactly as ``trimesh.load(process=True)`` would.
+        scene = trimesh.load(str(path), force="scene", process=False)
+    except Exception as exc:  # trimesh raises many types for unreadable files
+        raise AssetSpecError(where, f"cannot read {str(path)!r}: {exc}") from exc
+    if not isinstance(scene, trimesh.Scene):
+        raise AssetSpecError(where, f"{str(path)!r} does not hold a triangle mesh")
+    geoms = [g for g in scene.geometry.values() if isinstance(g, trimesh.Trimesh)]
+    for g in geoms:
+        bad = ~np.isfinite(np.asarray(g.vertices, dtype=np.float64))
+        if bad.any():
+            raise AssetSpecError(
+                where,
+                f"{str(path)!r} has non-finite (NaN/inf) coordinates at {int(bad.any(axis=-1).sum())} of its "
+                f"{len(g.vertices)} vertices; every vertex coordinate must be a finite number",
+            )
+    try:
+        for g in geoms:
+            g.process()
+        loaded = scene if gltf else scene.to_mesh()
     except Exception as exc:  # trimesh raises many types for unreadable files
         raise AssetSpecError(where, f"cannot read {str(path)!r}: {exc}") from exc
     if gltf and isinstance(loaded, trimesh.Scene):
@@ -515,7 +553,18 @@ def _mesh_entry(spec: MeshAssetSpec, *, path: str, base_dir: Path | None, cls: i
     up, fwd = _axis(spec.up_axis), _axis(spec.forward_axis)
     v, fc, fm = _load_mesh_file(mesh_path, join(path, "mesh"))
     rot = np.stack([fwd, np.cross(up, fwd), up])  # rows: body x, y, z in file coordinates
-    body = (v @ rot.T) * spec.scale
+    body = v @ rot.T  # a signed axis permutation: exact, no overflow
+    # Python floats: an overflowing product is inf (no numpy warning), which the range check then refuses.
+    lo3, hi3 = body.min(axis=0), body.max(axis=0)
+    ext = [float(hi) * spec.scale - float(lo) * spec.scale for lo, hi in zip(lo3, hi3, strict=True)]
+    problem = dimension_problem(*ext)
+    if problem is not None:
+        raise AssetSpecError(
+            join(path, "scale"),
+            f"{spec.scale:g} (file units -> metres) applied to {str(mesh_path)!r} {problem}; "
+            "check the mesh's units and scale",
+        )
+    body = body * spec.scale
     zmin, zmax = float(body[:, 2].min()), float(body[:, 2].max())
     if spec.draft is not None:
         if spec.draft >= zmax - zmin:
