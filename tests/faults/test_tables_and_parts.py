@@ -99,3 +99,26 @@ def test_a_parts_manifest_naming_a_missing_part(tmp_path: Path) -> None:
             call()
     code, _out, err = cli_main("info", str(manifest))
     assert code == 2 and err.startswith("mmusv: error: ") and "tiny.parts.json" in err and err.count("\n") == 1
+
+
+def test_a_part_swapped_for_another_recording_is_named(tmp_path: Path) -> None:
+    # A whole 12-frame recording of the same scenario put where the part of frames 4..7 was: `mmusv info` said
+    # "complete, 12 frames" and convert wrote frames twice. And a part's file swapped for another part's.
+    from mmusv.acquire import run
+    from mmusv.batch import run_many
+
+    src = tmp_path / "src"
+    write_yaml(src / "tiny.yaml", scenario("tiny", frames=12))
+    assert run_many(src, out_dir=tmp_path / "out", split_frames=4).ok
+    whole = run(src / "tiny.yaml", out_dir=tmp_path / "whole").recording
+    manifest = tmp_path / "out/tiny/tiny.parts.json"
+    part = tmp_path / "out/tiny/parts/000004-000007/tiny.mcap"
+    kept = part.read_bytes()
+    shutil.copyfile(whole, part)
+    code, _out, err = cli_main("info", str(manifest))
+    assert code == 2 and "is a whole recording, not a part" in err and "4..7" in err, err
+    part.write_bytes((tmp_path / "out/tiny/parts/000008-000011/tiny.mcap").read_bytes())
+    code, _out, err = cli_main("info", str(manifest))
+    assert code == 2 and "starts at frame 8, the manifest says 4" in err, err
+    part.write_bytes(kept)
+    assert cli_main("info", str(manifest))[0] == 0

@@ -188,6 +188,7 @@ def _read_parts_info(p: Path) -> RecordingInfo:
     m = read_parts_manifest(p)
     files = part_files(p)
     infos = [(first, read_info(f)) for first, _stop, f in files if f is not None]
+    stops = {first: stop for first, stop, _f in files}
     if not infos:
         raise IoError(
             f"{p}: none of its {len(files)} parts is recorded yet (the first is {p.parent / m.parts[0].recording})"
@@ -201,6 +202,18 @@ def _read_parts_info(p: Path) -> RecordingInfo:
         got = i.run.get("first_frame")
         if got is not None and int(got) != first:
             raise IoError(f"{p}: part {i.path} starts at frame {got}, the manifest says {first}")
+        # A finished part says which frames it was asked for: a whole recording put in its place says nothing.
+        if i.run.get("status") is not None and got is None:
+            raise IoError(
+                f"{p}: {i.path} is a whole recording, not a part (no first_frame); the manifest puts frames "
+                f"{first}..{stops[first] - 1} there"
+            )
+        asked = i.run.get("frames_requested")
+        if got is not None and asked is not None and int(asked) != stops[first] - first:
+            raise IoError(
+                f"{p}: part {i.path} holds frames {first}..{first + int(asked) - 1}, the manifest says "
+                f"{first}..{stops[first] - 1}"
+            )
     base = infos[0][1]
     done = sum(1 for _f, i in infos if i.run.get("status") == "complete")
     status = "complete" if done == len(files) else f"incomplete ({done} of {len(files)} parts complete)"
