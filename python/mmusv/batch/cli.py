@@ -22,7 +22,15 @@ if TYPE_CHECKING:
 
     from mmusv.batch.runner import BatchReport
 
-__all__ = ["add_dataset_parser", "add_run_options", "print_report", "run_batch", "run_dataset", "uses_batch"]
+__all__ = [
+    "add_dataset_parser",
+    "add_run_options",
+    "check_batch_options",
+    "print_report",
+    "run_batch",
+    "run_dataset",
+    "uses_batch",
+]
 
 
 def _batch_options(p: argparse.ArgumentParser) -> None:
@@ -149,9 +157,22 @@ def print_report(report: BatchReport, console: Console) -> None:
     console.print(f"{report.summary()} in {report.seconds:.1f} s; index {report.index}")
 
 
+def check_batch_options(args: argparse.Namespace) -> None:
+    """The batch options (``--retries``, ``--split-frames``, ``--cpus-per-task``) checked before anything is
+    generated or recorded: ``mmusv dataset`` refused them only after writing the scenario set."""
+    if args.retries < 0:
+        raise ConfigError(f"--retries {args.retries}: must be 0 or more")
+    if args.split_frames is not None and args.split_frames < 1:
+        raise ConfigError(f"--split-frames {args.split_frames}: must be at least 1 frame per part")
+    if args.cpus_per_task is not None and args.cpus_per_task < 1:
+        raise ConfigError(f"--cpus-per-task {args.cpus_per_task}: must be at least 1")
+
+
 def run_batch(args: argparse.Namespace, source: Path | list[Path]) -> int:
     """``mmusv run DIR`` (or a file with batch options): runs the batch, prints the table; 1 if a scenario failed."""
     from mmusv.batch.runner import run_many
+
+    check_batch_options(args)
 
     console = _console()
     with _bar(console, "mmusv run") as update, _resume_hint(args):
@@ -196,6 +217,7 @@ def run_dataset(args: argparse.Namespace) -> int:
 
     if args.jobs < 1:
         raise ConfigError(f"--jobs {args.jobs}: must be at least 1")
+    check_batch_options(args)
     console = _console()
     with _bar(console, "mmusv dataset") as update, _resume_hint(args):
         rep = build_dataset(

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import sys
 import time
@@ -74,10 +75,10 @@ def add_parser(sub: Any) -> None:
         help="models trained at once, each in a process of its own (default auto: on a CPU one per model, sharing "
         "the cores; on a GPU 1, in turn)",
     )
-    p.add_argument("--epochs", type=int, default=None, help="epochs per model (default: the preset's)")
-    p.add_argument("--time-limit", type=float, default=None, help="seconds per model at most")
-    p.add_argument("--workers", type=int, default=0, help="data-loader worker processes (default 0)")
-    p.add_argument("--device", default=None, help="cpu or cuda (default: cuda when available)")
+    p.add_argument("--epochs", type=int, default=None, help="epochs per model, at least 1 (default: the preset's)")
+    p.add_argument("--time-limit", type=float, default=None, help="seconds per model at most, > 0 (default: no limit)")
+    p.add_argument("--workers", type=int, default=0, help="data-loader worker processes, 0 or more (default 0)")
+    p.add_argument("--device", default=None, help="cpu, cuda, cuda:N or mps (default: cuda when available, else cpu)")
     p.add_argument(
         "--threads",
         type=int,
@@ -105,7 +106,9 @@ def run(args: argparse.Namespace) -> int:
     """Runs ``mmusv train``; returns the exit status."""
     from mmusv.export.splits import parse_ratios
 
+    _check_numbers(args)
     _torch()
+    _check_device(args.device)
     from mmusv.learn.cache import build_cache
     from mmusv.learn.example import MODES
     from mmusv.learn.presets import preset
@@ -197,6 +200,48 @@ def run(args: argparse.Namespace) -> int:
         raise failures[0]
     print(f"total {time.perf_counter() - t0:.1f} s; score with: mmusv study detection --model {out} ...", flush=True)
     return 0
+
+
+def _check_numbers(args: argparse.Namespace) -> None:
+    """``--epochs``, ``--time-limit`` and ``--workers`` checked before anything is built or written: a negative
+    or NaN time limit stopped training after one step with a model that looked complete."""
+    if args.epochs is not None and args.epochs < 1:
+        raise InputError(f"--epochs {args.epochs}: must be >= 1 (or left out for the preset's)")
+    if args.time_limit is not None and not (math.isfinite(args.time_limit) and args.time_limit > 0):
+        raise InputError(f"--time-limit {args.time_limit}: seconds, a finite number > 0 (or left out for no limit)")
+    if args.workers < 0:
+        raise InputError(f"--workers {args.workers}: must be >= 0 (0: load data in the training process)")
+
+
+_DEVICES = "cpu, cuda, cuda:N or mps"
+
+
+def _check_device(value: str | None) -> None:
+    """``--device``: a torch device of this machine (``None``: the default of
+    :func:`mmusv.learn.model.torch_device`)."""
+    if value is None:
+        return
+    import torch
+
+    try:
+        dev = torch.device(value)
+    except (RuntimeError, ValueError, TypeError):
+        raise InputError(f"--device {value!r}: not a device; allowed: {_DEVICES}") from None
+    if dev.type == "cpu":
+        return
+    if dev.type == "cuda":
+        if not torch.cuda.is_available():
+            raise InputError(f"--device {value!r}: CUDA is not available on this machine; use --device cpu")
+        count = torch.cuda.device_count()
+        if dev.index is not None and dev.index >= count:
+            raise InputError(f"--device {value!r}: this machine has {count} CUDA device(s), cuda:0 to cuda:{count - 1}")
+        return
+    if dev.type == "mps":
+        mps = getattr(torch.backends, "mps", None)
+        if mps is None or not mps.is_available():
+            raise InputError(f"--device {value!r}: MPS is not available on this machine; use --device cpu")
+        return
+    raise InputError(f"--device {value!r}: allowed: {_DEVICES}")
 
 
 def _jobs(value: str, models: int, device: str | None) -> int:

@@ -21,6 +21,7 @@ occupancy.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from numbers import Integral
 from pathlib import Path
 
 import numpy as np
@@ -31,6 +32,7 @@ from scipy import ndimage
 from mmusv.annotate import box_corners
 from mmusv.bundled import resolve_scenario
 from mmusv.config import load_scenario
+from mmusv.errors import ConfigError
 from mmusv.frames import translation
 from mmusv.simulation import Simulation
 
@@ -128,7 +130,13 @@ def run_agreement_study(
     scenarios: list[str] | tuple[str, ...] = BUNDLED_SCENARIOS, *, frames: int | None = None, stride: int = 1
 ) -> AgreementStudy:
     """Runs the top-view cameras of every USV over ``frames`` frames (default: the scenario's) of each scenario
-    and evaluates every other vessel (see the module docstring)."""
+    and evaluates every other vessel (see the module docstring); every ``stride``-th frame. ``frames`` and
+    ``stride`` below 1 raise :class:`~mmusv.errors.ConfigError` (before any scenario is loaded): they evaluated
+    nothing and wrote an empty table."""
+    if frames is not None and (isinstance(frames, bool) or not isinstance(frames, Integral) or frames < 1):
+        raise ConfigError(f"frames (--frames) = {frames!r}: must be a whole number >= 1 (or left out for all frames)")
+    if isinstance(stride, bool) or not isinstance(stride, Integral) or stride < 1:
+        raise ConfigError(f"stride = {stride!r}: must be a whole number >= 1")
     rows: list[dict[str, object]] = []
     for path in scenarios:
         sc = load_scenario(resolve_scenario(path))

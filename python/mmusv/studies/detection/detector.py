@@ -47,7 +47,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-from mmusv.errors import ConfigError
+from mmusv.errors import ConfigError, MmusvError
 
 __all__ = [
     "BASELINE_NOTE",
@@ -55,6 +55,7 @@ __all__ = [
     "SEA_COLUMN_M",
     "BaselineParams",
     "Detector",
+    "UserDetector",
     "above_water",
     "baseline_detect",
     "cell_keys",
@@ -382,8 +383,8 @@ def baseline_detect(points: np.ndarray, params: BaselineParams | None = None) ->
 
 
 def load_detector(spec: str) -> Detector:
-    """The callable named by ``spec`` = ``"package.module:function"`` (``"baseline"`` is
-    :func:`baseline_detect`)."""
+    """The callable named by ``spec`` = ``"package.module:function"``, as a :class:`UserDetector` whose failures
+    name ``spec`` (``"baseline"`` is :func:`baseline_detect`)."""
     if spec == "baseline":
         return baseline_detect
     mod_name, sep, attr = spec.partition(":")
@@ -396,4 +397,41 @@ def load_detector(spec: str) -> Detector:
     fn = getattr(mod, attr, None)
     if not callable(fn):
         raise ConfigError(f"--detector {spec!r}: module {mod_name!r} has no callable {attr!r}")
-    return fn  # type: ignore[no-any-return]
+    return baseline_detect if fn is baseline_detect else UserDetector(spec, fn)
+
+
+_SIGNATURE = (
+    "expected detect(points (N, 4) float32 x, y, z, intensity in the ego LiDAR frame) -> "
+    "(boxes (M, 7) x, y, z, l, w, h, yaw, scores (M,))"
+)
+
+
+class UserDetector:
+    """The user's detector ``fn`` named by ``--detector spec``, called as itself: an exception it raises (a
+    function of another signature, a bug in it) becomes a :class:`~mmusv.errors.ConfigError` naming ``spec``,
+    what failed and the signature expected. Its other attributes (``early``, a detector's own early-fusion
+    entry) are its own, ``early`` checked the same way."""
+
+    def __init__(self, spec: str, fn: Callable[..., object], name: str | None = None) -> None:
+        self.spec, self.fn, self.name = spec, fn, name
+
+    def __call__(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        what = f"its {self.name!r}" if self.name else "calling it"
+        try:
+            out = self.fn(points)
+        except MmusvError:
+            raise
+        except Exception as exc:
+            raise ConfigError(
+                f"--detector {self.spec!r}: {what} on a ({len(points)}, 4) point cloud failed: "
+                f"{type(exc).__name__}: {exc}; {_SIGNATURE}"
+            ) from exc
+        if not isinstance(out, (tuple, list)) or len(out) != 2:
+            raise ConfigError(f"--detector {self.spec!r}: {what} returned {type(out).__name__}; {_SIGNATURE}")
+        return out[0], out[1]
+
+    def __getattr__(self, name: str) -> object:
+        if name.startswith("__") or "fn" not in self.__dict__:
+            raise AttributeError(name)
+        value = getattr(self.fn, name)
+        return UserDetector(self.spec, value, name) if name == "early" and callable(value) else value

@@ -1,0 +1,89 @@
+"""Bad arguments of the studies: ``study agreement --frames`` below 1 (was an empty table and exit status 0), and a
+``--detector`` callable that fails when called (was the callable's own traceback)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+import yaml
+from mmusv.cli import main
+from mmusv.errors import ConfigError
+from mmusv.studies.agreement import run_agreement_study
+from mmusv.studies.detection.detector import load_detector
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.mark.parametrize("frames", [0, -1])
+def test_agreement_refuses_frames_below_one(frames: int, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(ConfigError, match="--frames"):
+        run_agreement_study([str(ROOT / "scenarios/open_sea_convoy.yaml")], frames=frames)
+    out = tmp_path / "agree"
+    scenario = str(ROOT / "scenarios/open_sea_convoy.yaml")
+    assert main(["study", "agreement", scenario, "-o", str(out), "--frames", str(frames)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("mmusv: error: ") and f"--frames) = {frames}" in err and ">= 1" in err, err
+    assert not out.exists()
+
+
+def test_agreement_refuses_a_stride_below_one() -> None:
+    with pytest.raises(ConfigError, match="stride"):
+        run_agreement_study([str(ROOT / "scenarios/open_sea_convoy.yaml")], frames=1, stride=0)
+
+
+POINTS = np.zeros((5, 4), dtype=np.float32)
+
+
+def test_a_detector_of_another_signature_names_the_detector() -> None:
+    det = load_detector("os:getcwd")
+    with pytest.raises(ConfigError, match=r"--detector 'os:getcwd'.*TypeError.*expected detect\(points \(N, 4\)"):
+        det(POINTS)
+
+
+def test_a_detector_returning_no_pair_names_the_detector() -> None:
+    with pytest.raises(ConfigError, match=r"--detector 'builtins:len'.*returned int"):
+        load_detector("builtins:len")(POINTS)
+
+
+def test_a_working_user_detector_and_its_early_entry_run_as_they_are(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    (tmp_path / "my_bad_args_detector.py").write_text(
+        "import numpy as np\n"
+        "def detect(points):\n"
+        "    return np.ones((1, 7)), np.ones(1)\n"
+        "def _early(points):\n"
+        "    raise ValueError('broken early')\n"
+        "detect.early = _early\n"
+        "detect.tag = 'mine'\n",
+        encoding="utf-8",
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.delitem(sys.modules, "my_bad_args_detector", raising=False)
+    det: Any = load_detector("my_bad_args_detector:detect")
+    boxes, scores = det(POINTS)
+    assert boxes.shape == (1, 7) and scores.shape == (1,)
+    assert det.tag == "mine"
+    with pytest.raises(ConfigError, match=r"--detector 'my_bad_args_detector:detect': its 'early'.*broken early"):
+        det.early(POINTS)
+
+
+def test_study_detection_with_a_failing_detector_is_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from mmusv.acquire import run
+    from mmusv.studies.detection.sources import lidar_only
+
+    data = lidar_only(yaml.safe_load((ROOT / "scenarios/island_occlusion.yaml").read_text(encoding="utf-8")))
+    data["vessels"] = [v for v in data["vessels"] if v["role"] != "usv" or v["id"] in ("usv_1", "usv_3")]
+    data["name"] = "tiny_bad_detector"
+    data["acquisition"]["frames"] = 1
+    rec = run(data, out_dir=tmp_path / "rec").recording
+    code = main(["study", "detection", str(rec), "--detector", "os:getcwd", "-o", str(tmp_path / "o"), "--no-progress"])
+    assert code == 2
+    err = capsys.readouterr().err
+    assert err.startswith("mmusv: error: --detector 'os:getcwd'") and "TypeError" in err and "Traceback" not in err
