@@ -188,7 +188,8 @@ class EnvironmentConfig(_Model):
     @model_validator(mode="after")
     def _one_sea(self) -> EnvironmentConfig:
         # Either setting alone decides the sea; given both, one would be dropped without a word.
-        if self.sea is not None and "wave" in self.model_fields_set:
+        # (`wave: W0`, the default, goes with a `sea`: a resolved scenario written out, scenario.yaml, holds both.)
+        if self.sea is not None and "wave" in self.model_fields_set and self.wave != "W0":
             raise ValueError(
                 "environment: give `wave` (W0..W3 or metres) or `sea`, not both: `sea` sets the waves every sensor "
                 "and every hull meets"

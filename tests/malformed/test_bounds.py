@@ -163,5 +163,7 @@ def test_a_merge_key_may_be_overridden(tmp_path: Path) -> None:
 def test_a_sea_given_twice_is_refused(environment: dict[str, Any], said: str, tmp_path: Path) -> None:
     msg = _refused(_with("environment", environment), tmp_path)
     assert "environment" in msg and said in msg, msg
-    load_scenario(_with("environment", {"sea": {"hs_m": 1.0}}))  # either alone loads
+    alone = load_scenario(_with("environment", {"sea": {"hs_m": 1.0}}))  # either alone loads
+    # A resolved scenario written out (a run folder's scenario.yaml) holds the default `wave: W0` beside its sea.
+    assert load_scenario(yaml.safe_load(yaml.safe_dump(alone.model_dump(mode="json")))) == alone
     load_scenario(_with("environment", {"wave": "W3", "motion": "paper"}))
