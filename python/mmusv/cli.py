@@ -61,6 +61,17 @@ def _cmd_assets(args: argparse.Namespace) -> int:
     return 0
 
 
+def _ready_output(output: str) -> None:
+    """Creates a study's output folder before the study runs, so that a folder that cannot be written is named
+    (as ``-o``) at once, not after the computing."""
+    from mmusv.errors import IoError
+
+    try:
+        Path(output).mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise IoError(f"-o/--output {output}: cannot create the folder: {exc.strerror or exc}") from None
+
+
 def _cmd_study_waves(args: argparse.Namespace) -> int:
     from rich.table import Table
 
@@ -69,6 +80,7 @@ def _cmd_study_waves(args: argparse.Namespace) -> int:
     from mmusv.studies.waves import run_wave_study
 
     scenario = load_scenario(resolve_scenario(args.scenario))
+    _ready_output(args.output)
     if args.frames is not None:
         if args.frames < 2:
             raise MmusvError("--frames must be at least 2")
@@ -357,6 +369,9 @@ def _cmd_study_agreement(args: argparse.Namespace) -> int:
 
     from mmusv.studies.agreement import BUNDLED_SCENARIOS, run_agreement_study
 
+    if args.frames is not None and args.frames < 1:  # before the output folder is made (the study says it too)
+        raise ConfigError(f"frames (--frames) = {args.frames!r}: must be a whole number >= 1 (or left out for all)")
+    _ready_output(args.output)
     study = run_agreement_study(args.scenarios or BUNDLED_SCENARIOS, frames=args.frames)
     table = Table(title="Annotation vs top-view rendering (Table II)")
     for col in (

@@ -99,3 +99,11 @@ def test_catalogue_within_bounds() -> None:
         a = get_asset(name)
         for dim, (lo, hi) in DIMENSION_RANGES.items():
             assert lo <= getattr(a, dim) <= hi, (name, dim)
+
+
+def test_a_folder_given_as_a_mesh_is_named_as_a_folder(tmp_path: Path) -> None:
+    (tmp_path / "boat.obj").mkdir()
+    with pytest.raises(AssetSpecError, match="is a folder, not a mesh file"):
+        load_asset_file({"name": "userboat", "mesh": str(tmp_path / "boat.obj")})
+    with pytest.raises(AssetSpecError, match="does not exist"):
+        load_asset_file({"name": "userboat", "mesh": str(tmp_path / "missing.obj")})

@@ -442,7 +442,8 @@ def _load_mesh_file(path: Path, where: str) -> tuple[np.ndarray, np.ndarray, np.
     """Vertices ``(V, 3)``, faces ``(F, 3)`` and material ids ``(F,)`` of a mesh file (glTF/GLB: its PBR
     materials, registered; other formats: material 0)."""
     if not path.is_file():
-        raise AssetSpecError(where, f"mesh file {str(path)!r} does not exist")
+        what = "is a folder, not a mesh file" if path.is_dir() else "does not exist"
+        raise AssetSpecError(where, f"mesh file {str(path)!r} {what}")
     try:
         import trimesh
     except ImportError as exc:  # pragma: no cover - depends on the install
@@ -637,7 +638,8 @@ def load_asset_catalog(path: str | os.PathLike[str], *, register: bool = False) 
 
 def _read_yaml(path: Path) -> object:
     if not path.is_file():
-        raise AssetSpecError("file", f"asset file {str(path)!r} does not exist")
+        what = "is a folder, not an asset file" if path.is_dir() else "does not exist"
+        raise AssetSpecError("file", f"asset file {str(path)!r} {what}")
     try:
         return read_yaml(path, kind="asset")
     except ConfigError as exc:
