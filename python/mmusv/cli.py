@@ -367,10 +367,9 @@ def _cmd_preview(args: argparse.Namespace) -> int:
 def _cmd_study_agreement(args: argparse.Namespace) -> int:
     from rich.table import Table
 
-    from mmusv.studies.agreement import BUNDLED_SCENARIOS, run_agreement_study
+    from mmusv.studies.agreement import BUNDLED_SCENARIOS, check_counts, run_agreement_study
 
-    if args.frames is not None and args.frames < 1:  # before the output folder is made (the study says it too)
-        raise ConfigError(f"frames (--frames) = {args.frames!r}: must be a whole number >= 1 (or left out for all)")
+    check_counts(args.frames)  # before the output folder is made
     _ready_output(args.output)
     study = run_agreement_study(args.scenarios or BUNDLED_SCENARIOS, frames=args.frames)
     table = Table(title="Annotation vs top-view rendering (Table II)")

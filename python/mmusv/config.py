@@ -48,6 +48,9 @@ from mmusv.world.vessels import get_asset, known_asset
 from mmusv.yamlio import mapping_source
 
 __all__ = [
+    "MAX_COORDINATE_M",
+    "MAX_SPEED_MPS",
+    "SCENARIO_NAME",
     "AcquisitionConfig",
     "EnvironmentConfig",
     "MapConfig",
@@ -63,6 +66,9 @@ __all__ = [
 
 MAX_SPEED_MPS = 100.0
 """Fastest vessel speed a scenario may give, m/s (about 194 knots: past every craft afloat)."""
+SCENARIO_NAME = r"[A-Za-z0-9_\-][A-Za-z0-9_\-.]*"
+"""A scenario's (and a generation spec's) name, which names files and folders: letters, digits, ``_``, ``-``
+and ``.``, not starting with ``.`` (``.``, ``..``, hidden files)."""
 MAX_COORDINATE_M = 1.0e6
 """Farthest a waypoint (and a route's start offset) may lie from the world origin, metres (1,000 km: far
 beyond any map)."""
@@ -267,7 +273,7 @@ class VesselConfig(_Model):
 class Scenario(_Model):
     """A whole scenario: map, environment, acquisition, sensor rigs and vessels."""
 
-    name: str = Field(default="scenario", pattern=r"^[A-Za-z0-9_\-][A-Za-z0-9_\-.]*$", max_length=200)
+    name: str = Field(default="scenario", pattern=f"^{SCENARIO_NAME}$", max_length=200)
     seed: int = Field(default=0, ge=0, lt=2**63)
     map: MapConfig = Field(default_factory=MapConfig)
     environment: EnvironmentConfig = Field(default_factory=EnvironmentConfig)

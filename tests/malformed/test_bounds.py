@@ -39,13 +39,7 @@ def _with(path: str, value: Any) -> dict[str, Any]:
 
 
 def _refused(doc: dict[str, Any], tmp_path: Path) -> str:
-    f = tmp_path / "case.yaml"
-    f.write_text(yaml.safe_dump(doc), encoding="utf-8")
-    with pytest.raises(ConfigError) as err:
-        load_scenario(f)
-    msg = str(err.value)
-    assert msg.startswith(f"{f}:"), msg
-    return msg
+    return _yaml_refused(yaml.safe_dump(doc), tmp_path)
 
 
 @pytest.mark.parametrize(

@@ -62,6 +62,7 @@ __all__ = [
     "first_failure",
     "sample_counts",
     "take_samples",
+    "time_samples",
 ]
 
 MAX_CHECK_SAMPLES = 5_000_000
@@ -162,13 +163,20 @@ def _ceil_count(x: float) -> int:
     return max(math.ceil(x) + 1, 2)
 
 
+def time_samples(frames: int, frequency_hz: float, step: float, max_speed_mps: float) -> int:
+    """Motion samples per vessel over ``frames`` frames at ``frequency_hz``: at least one a frame, and one each
+    ``step`` metres at ``max_speed_mps`` (saturated like every count here)."""
+    t_last = (frames - 1) / frequency_hz
+    dt = min(1.0 / frequency_hz, step / max(max_speed_mps, 1e-9))
+    return _ceil_count(t_last / dt)
+
+
 def _counts(scenario: Scenario, lengths: np.ndarray, step: float) -> tuple[int, int]:
     """``(motion samples, route samples)`` per vessel for route ``lengths`` (metres) at spacing ``step``; counts too
     large for any budget (or from non-finite inputs) saturate instead of overflowing."""
     acq = scenario.acquisition
-    t_last = (acq.frames - 1) / acq.frequency_hz
-    dt = min(1.0 / acq.frequency_hz, step / max(max(v.speed_mps for v in scenario.vessels), 1e-9))
-    return _ceil_count(t_last / dt), _ceil_count(float(lengths.max()) / step)
+    fastest = max(v.speed_mps for v in scenario.vessels)
+    return time_samples(acq.frames, acq.frequency_hz, step, fastest), _ceil_count(float(lengths.max()) / step)
 
 
 def _fmt(n: int) -> str:

@@ -39,7 +39,6 @@ the value given and what is allowed, in the style of :func:`mmusv.config.load_sc
 from __future__ import annotations
 
 import difflib
-import math
 import os
 import re
 from collections.abc import Callable
@@ -50,6 +49,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 
 from mmusv.config import (
     MAX_SPEED_MPS,
+    SCENARIO_NAME,
     AcquisitionConfig,
     EnvironmentConfig,
     MapConfig,
@@ -97,7 +97,7 @@ __all__ = [
 
 Pair = tuple[float, float]
 
-_NAME = re.compile(r"[A-Za-z0-9_\-][A-Za-z0-9_\-.]*")
+_NAME = re.compile(SCENARIO_NAME)
 """A spec name (as a scenario name): no path separators, and no leading dot (``.``, ``..``, hidden files)."""
 
 MAX_RANGE_M = 100_000.0
@@ -411,12 +411,11 @@ def _cross_checks(spec: GenerationSpec, source: str) -> None:
 def _check_budget(spec: GenerationSpec, fail: Callable[[str, object, str], None]) -> None:
     """Refuses a spec whose every candidate would take more samples in time than the checks take at most
     (:data:`~mmusv.generate.checks.MAX_CHECK_SAMPLES`): a long window at the fastest speeds, many vessels."""
-    from mmusv.generate.checks import MAX_CHECK_SAMPLES
+    from mmusv.generate.checks import MAX_CHECK_SAMPLES, time_samples
 
     acq = spec.acquisition
     speeds = [spec.usv.speed_mps[1], *(c.speed_mps[1] for c in spec.size_classes.values())]
-    dt = min(1.0 / acq.frequency_hz, spec.check_step_m / max(max(speeds), 1e-9))
-    n_t = max(math.ceil((acq.frames - 1) / acq.frequency_hz / dt) + 1, 2)
+    n_t = time_samples(acq.frames, acq.frequency_hz, spec.check_step_m, max(speeds))
     for i, combo in enumerate(spec.combinations):
         diff = spec.difficulties.get(combo.difficulty)
         n_v = 1 + combo.cooperating + len(combo.targets) + (diff.extra_targets[1] if diff is not None else 0)

@@ -36,7 +36,7 @@ from mmusv.errors import ConfigError
 from mmusv.frames import translation
 from mmusv.simulation import Simulation
 
-__all__ = ["BUNDLED_SCENARIOS", "AgreementStudy", "run_agreement_study", "sample_agreement"]
+__all__ = ["BUNDLED_SCENARIOS", "AgreementStudy", "check_counts", "run_agreement_study", "sample_agreement"]
 
 BUNDLED_SCENARIOS = ("scenarios/island_occlusion.yaml", "scenarios/open_sea_convoy.yaml", "scenarios/port_entry.yaml")
 _VESSEL_CLASSES = (10, 11)
@@ -126,6 +126,16 @@ class AgreementStudy:
         return paths
 
 
+def check_counts(frames: int | None, stride: int = 1) -> None:
+    """Raises :class:`~mmusv.errors.ConfigError` for ``frames`` (``None``: all) or ``stride`` below 1, which
+    evaluated nothing and wrote an empty table: :func:`run_agreement_study`'s check, for a caller to make before
+    it prepares anything."""
+    if frames is not None and (isinstance(frames, bool) or not isinstance(frames, Integral) or frames < 1):
+        raise ConfigError(f"frames (--frames) = {frames!r}: must be a whole number >= 1 (or left out for all frames)")
+    if isinstance(stride, bool) or not isinstance(stride, Integral) or stride < 1:
+        raise ConfigError(f"stride = {stride!r}: must be a whole number >= 1")
+
+
 def run_agreement_study(
     scenarios: list[str] | tuple[str, ...] = BUNDLED_SCENARIOS, *, frames: int | None = None, stride: int = 1
 ) -> AgreementStudy:
@@ -133,10 +143,7 @@ def run_agreement_study(
     and evaluates every other vessel (see the module docstring); every ``stride``-th frame. ``frames`` and
     ``stride`` below 1 raise :class:`~mmusv.errors.ConfigError` (before any scenario is loaded): they evaluated
     nothing and wrote an empty table."""
-    if frames is not None and (isinstance(frames, bool) or not isinstance(frames, Integral) or frames < 1):
-        raise ConfigError(f"frames (--frames) = {frames!r}: must be a whole number >= 1 (or left out for all frames)")
-    if isinstance(stride, bool) or not isinstance(stride, Integral) or stride < 1:
-        raise ConfigError(f"stride = {stride!r}: must be a whole number >= 1")
+    check_counts(frames, stride)
     rows: list[dict[str, object]] = []
     for path in scenarios:
         sc = load_scenario(resolve_scenario(path))
