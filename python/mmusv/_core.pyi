@@ -344,7 +344,9 @@ class Lidar:
 @final
 class Camera:
     """A pinhole (``hfov``) or orthographic (``metres_per_pixel``) camera with its rays computed once; ``rgb``:
-    whether it shades colour (depth, semantic and instance images always come)."""
+    whether it shades colour (depth, semantic and instance images always come). ``exposure``: ``(ev100,
+    compensation_ev, max_iso)``, a fixed EV at ISO 100 (``None``: automatic), the stops added to the automatic
+    exposure, and the highest ISO it reaches (default ``(None, 0.0, 6400.0)``)."""
 
     def __new__(
         cls,
@@ -358,6 +360,7 @@ class Camera:
         quality: str = "standard",
         distortion: Sequence[float] | None = None,
         noise: tuple[float, float] | None = None,
+        exposure: tuple[float | None, float, float] | None = None,
     ) -> Camera: ...
     @property
     def rgb(self) -> bool:

@@ -93,6 +93,108 @@ def test_exposure_holds_a_view_brighter_than_its_light_at_the_key(time_of_day: s
         assert white < 0.05
 
 
+@pytest.mark.parametrize(
+    ("time_of_day", "exposure"),
+    [
+        ("10:30", (None, 1.0, 6400.0)),
+        ("10:30", (None, -1.5, 6400.0)),
+        ("20:15", (None, 1.0, 6400.0)),  # held by the highlight limit: the compensation shifts the held value
+        ("21:45", (None, 0.0, 6400.0)),  # below the floor: the camera's limit at ISO 6 400
+        ("21:45", (None, 0.0, 25600.0)),  # two stops more gain: a quarter of the light
+        ("21:45", (None, 0.5, 1600.0)),
+    ],
+)
+def test_camera_exposure_settings_follow_the_metering_rule(
+    time_of_day: str, exposure: tuple[float | None, float, float]
+) -> None:
+    """A camera's own exposure settings: the incident reading floored at the light its highest ISO reaches
+    (3.46 lux at ISO 6 400, scaled by 6 400 / ISO), the highlight limit, then ``2^compensation``; each image is
+    compared with the same view at the fixed exposure this rule, computed here, gives."""
+    _, comp, max_iso = exposure
+    cfg = Environment.make(time_of_day=time_of_day)
+    d = np.asarray(cfg.sun.direction)
+    yaw = math.atan2(d[1], d[0])
+    s = Scene()
+    _water(s)
+    _box(s, (60.0, -10.0, 0.0), (80.0, 10.0, 12.0), cls=3)
+    w, h = 96, 54
+    cam = core.Camera(width=w, height=h, rgb=True, hfov=math.radians(60.0), quality="draft", exposure=exposure)
+    pose = pose_matrices(np.array([0, 0, 3.0, 0, math.radians(5.0), yaw]))
+    env = sensor_env(cfg, wave_height_m=0.5)
+    img = render(cam, s, pose=pose, env=env, seed=1, radiance=True)
+    assert img.radiance is not None and img.rgb is not None
+    lux = env.exposure[0]
+    k_incident = math.pi / max(lux, 3.46 * 6400.0 / max_iso)
+    key = _metered_key(np.asarray(img.radiance), w)
+    k = min(k_incident, 0.5 / key) * 2.0**comp
+    ev = math.log2(1.0 / (1.2 * k))
+    fixed = render(
+        cam_fixed := core.Camera(width=w, height=h, rgb=True, hfov=math.radians(60.0), quality="draft"),
+        s,
+        pose=pose,
+        env=sensor_env(cfg, wave_height_m=0.5, exposure_ev100=ev),
+        seed=1,
+    )
+    assert cam_fixed.resolution == (w, h) and fixed.rgb is not None
+    got = np.asarray(img.rgb).astype(np.int16)
+    assert np.abs(got - np.asarray(fixed.rgb).astype(np.int16)).max() <= 1
+    # And the same camera at its default settings shows another picture wherever the settings differ from them.
+    default = render(
+        core.Camera(width=w, height=h, rgb=True, hfov=math.radians(60.0), quality="draft"),
+        s,
+        pose=pose,
+        env=env,
+        seed=1,
+    )
+    assert default.rgb is not None
+    changed = not (comp == 0.0 and (max_iso == 6400.0 or lux >= 3.46 * 6400.0 / max_iso))
+    assert np.array_equal(np.asarray(default.rgb), np.asarray(img.rgb)) != changed
+
+
+def test_a_fixed_camera_exposure_is_the_environments_fixed_exposure() -> None:
+    """``exposure=(ev100, 0, iso)`` on the camera gives the bytes of the same EV100 fixed for the whole
+    environment, at noon and at dusk alike (no metering, no highlight limit)."""
+    s = Scene()
+    _water(s)
+    _box(s, (60.0, -10.0, 0.0), (80.0, 10.0, 12.0), cls=3)
+    pose = pose_matrices(np.array([0, 0, 3.0, 0, math.radians(3.0), 0.3]))
+    for tod in ("12:00", "20:30"):
+        cfg = Environment.make(time_of_day=tod)
+        mine = core.Camera(width=64, height=48, rgb=True, hfov=1.2, exposure=(11.0, 0.0, 6400.0))
+        plain = core.Camera(width=64, height=48, rgb=True, hfov=1.2)
+        a = render(mine, s, pose=pose, env=sensor_env(cfg), seed=4)
+        b = render(plain, s, pose=pose, env=sensor_env(cfg, exposure_ev100=11.0), seed=4)
+        assert a.rgb is not None and b.rgb is not None
+        assert np.array_equal(np.asarray(a.rgb), np.asarray(b.rgb)), tod
+
+
+@pytest.mark.parametrize(
+    ("exposure", "field"),
+    [
+        ({"ev100": 30}, "exposure.ev100"),
+        ({"compensation_ev": -9}, "exposure.compensation_ev"),
+        ({"max_iso": 50}, "exposure.max_iso"),
+        ({"ev100": 12, "compensation_ev": 1}, "exposure"),
+        ({"iso": 800}, "exposure.iso"),
+    ],
+)
+def test_camera_exposure_misconfig_names_the_field(exposure: dict[str, float], field: str) -> None:
+    from mmusv.sensors.config import CameraConfig, TopViewConfig
+
+    with pytest.raises(ValueError, match=field.replace(".", r"\.")):
+        CameraConfig(name="front", exposure=exposure)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match=field.replace(".", r"\.")):
+        TopViewConfig(exposure=exposure)  # type: ignore[arg-type]
+    for bad, name in [
+        ((40.0, 0.0, 6400.0), "ev100"),
+        ((None, 7.0, 6400.0), "compensation_ev"),
+        ((None, 0.0, 1e7), "max_iso"),
+        ((12.0, 1.0, 6400.0), "compensation_ev"),
+    ]:
+        with pytest.raises(mmusv.ConfigError, match=rf"camera\.exposure\.{name}"):
+            core.Camera(width=8, height=8, rgb=True, hfov=1.0, exposure=bad)
+
+
 def test_sun_disc_has_its_true_angular_size() -> None:
     """Looking at the sun with a narrow camera: the pixels inside the disc cover a 0.533° circle."""
     env = sensor_env(Environment.make(time_of_day="15:00"))

@@ -320,7 +320,7 @@ pub struct Camera {
 impl Camera {
     #[new]
     #[pyo3(signature = (*, width, height, rgb, hfov=None, metres_per_pixel=None, range_max=f32::INFINITY,
-        quality="standard", distortion=None, noise=None))]
+        quality="standard", distortion=None, noise=None, exposure=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         width: u32,
@@ -332,6 +332,7 @@ impl Camera {
         quality: &str,
         distortion: Option<[f64; 5]>,
         noise: Option<(f32, f32)>,
+        exposure: Option<(Option<f32>, f32, f32)>,
     ) -> PyResult<Self> {
         let quality = match quality {
             "draft" => camera::Quality::Draft,
@@ -359,6 +360,9 @@ impl Camera {
             quality,
             distortion: distortion.map(|coefficients| camera::Distortion { coefficients }),
             noise,
+            exposure: exposure.map_or_else(Default::default, |(ev100, compensation_ev, max_iso)| {
+                mmusv_core::sensors::shade::tonemap::Exposure { ev100, compensation_ev, max_iso }
+            }),
         };
         let projection = match (hfov, metres_per_pixel) {
             (Some(hfov), None) => camera::Projection::Pinhole { hfov },

@@ -60,6 +60,7 @@ def camera_from_config(cfg: CameraConfig) -> core.Camera:
         quality=cfg.quality,
         distortion=None if cfg.distortion is None else list(cfg.distortion),
         noise=noise,
+        exposure=cfg.exposure.native(),
     )
 
 
@@ -68,7 +69,15 @@ def top_view_from_config(cfg: TopViewConfig) -> core.Camera:
     w, h = cfg.resolution
     rgb = "rgb" in cfg.outputs
     mpp, range_max = cfg.metres_per_pixel, cfg.altitude_m + 500.0
-    return core.Camera(width=w, height=h, rgb=rgb, metres_per_pixel=mpp, range_max=range_max, quality=cfg.quality)
+    return core.Camera(
+        width=w,
+        height=h,
+        rgb=rgb,
+        metres_per_pixel=mpp,
+        range_max=range_max,
+        quality=cfg.quality,
+        exposure=cfg.exposure.native(),
+    )
 
 
 def render(

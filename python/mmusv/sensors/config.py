@@ -25,6 +25,7 @@ from mmusv.strict import StrictModel
 __all__ = [
     "RIG_PRESETS",
     "CameraConfig",
+    "ExposureConfig",
     "LidarConfig",
     "Mount",
     "RadarConfig",
@@ -250,12 +251,38 @@ class SensorNoiseConfig(_Model):
     read_noise_e: float = Field(default=3.0, ge=0, le=1e5)
 
 
+class ExposureConfig(_Model):
+    """How a camera exposes its RGB (``crates/mmusv-core/src/sensors/shade/tonemap.rs``). Automatic by default:
+    an incident reading of the scene's light with a highlight limit, ``compensation_ev`` stops brighter (+) or
+    darker (−), adapting down to the light at which the camera reaches ``max_iso`` at f/1.4 and 1/30 s (ISO 6 400:
+    3.46 lux, the end of civil twilight; each doubling of ``max_iso`` halves it). Or fixed at ``ev100`` (manual
+    exposure at ISO 100, e.g. 15 for full sun, 12 for an overcast day): every frame shows the light as it is,
+    without the automatic exposure's adaptation."""
+
+    ev100: float | None = Field(default=None, ge=-6, le=20)
+    compensation_ev: float = Field(default=0.0, ge=-5, le=5)
+    max_iso: float = Field(default=6400.0, ge=100, le=409_600)
+
+    @model_validator(mode="after")
+    def _one_mode(self) -> ExposureConfig:
+        if self.ev100 is not None and self.compensation_ev != 0.0:
+            raise ValueError(
+                "compensation_ev applies to the automatic exposure only; give ev100 (fixed) or compensation_ev"
+            )
+        return self
+
+    def native(self) -> tuple[float | None, float, float]:
+        """``(ev100, compensation_ev, max_iso)`` for :class:`mmusv._core.Camera`."""
+        return (self.ev100, self.compensation_ev, self.max_iso)
+
+
 class CameraConfig(_Model):
     """A pinhole camera: ``resolution`` ``[width, height]`` pixels, horizontal field of view ``hfov_deg`` (< 180),
     the images to produce, and its mount (optical axis = the mount's x axis). ``quality`` (:data:`Quality`) sets
     the RGB's anti-aliasing and reflections; ``distortion`` is Brown–Conrady ``[k1, k2, p1, p2, k3]`` in OpenCV's
-    order (none by default); ``noise`` adds seeded shot and read noise (none by default). Depth, semantic and
-    instance images always come from the pixel centres."""
+    order (none by default); ``noise`` adds seeded shot and read noise (none by default); ``exposure``
+    (:class:`ExposureConfig`) is automatic unless fixed. Depth, semantic and instance images always come from the
+    pixel centres."""
 
     name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$")
     resolution: tuple[int, int] = (640, 480)
@@ -266,6 +293,7 @@ class CameraConfig(_Model):
     quality: Quality = "standard"
     distortion: tuple[float, float, float, float, float] | None = None
     noise: SensorNoiseConfig | None = None
+    exposure: ExposureConfig = ExposureConfig()
 
     _res = field_validator("resolution")(_check_resolution)
 
@@ -282,7 +310,7 @@ class CameraConfig(_Model):
 class TopViewConfig(_Model):
     """A level orthographic camera ``altitude_m`` above the water over the USV, looking straight down:
     ``resolution`` pixels at ``metres_per_pixel``; ``heading_up`` puts the USV's bow at the top of the image,
-    ``north_up`` puts north there."""
+    ``north_up`` puts north there; ``exposure`` as a camera's (:class:`ExposureConfig`)."""
 
     altitude_m: float = Field(default=120.0, gt=0, le=20_000)
     resolution: tuple[int, int] = (512, 512)
@@ -290,6 +318,7 @@ class TopViewConfig(_Model):
     orientation: Literal["heading_up", "north_up"] = "heading_up"
     outputs: list[CameraOutput] = Field(default_factory=lambda: list(_TOP_OUTPUTS))
     quality: Quality = "standard"
+    exposure: ExposureConfig = ExposureConfig()
 
     _res = field_validator("resolution")(_check_resolution)
 

@@ -96,6 +96,8 @@ pub struct ImageOptions {
     pub distortion: Option<Distortion>,
     /// Shot and read noise added before the tone curve.
     pub noise: Option<SensorNoise>,
+    /// Automatic (compensated, up to a highest ISO) or fixed exposure ([`tonemap::Exposure`]).
+    pub exposure: tonemap::Exposure,
 }
 
 /// Configuration of a camera.
@@ -189,7 +191,7 @@ fn tile_order(w: u32, h: u32) -> Vec<u32> {
 
 impl Camera {
     /// Validates `cfg` and precomputes the rays. Errors name the field (`camera.resolution`, `camera.hfov_deg`,
-    /// `camera.metres_per_pixel`, `camera.range_m`).
+    /// `camera.metres_per_pixel`, `camera.range_m`, `camera.exposure.<field>`).
     pub fn new(cfg: CameraConfig) -> Result<Self> {
         if cfg.width == 0 || cfg.height == 0 || cfg.width > MAX_SIDE || cfg.height > MAX_SIDE {
             return Err(MmusvError::config(
@@ -201,6 +203,7 @@ impl Camera {
         if !(cfg.range_max > 0.0) {
             return Err(MmusvError::config("camera.range_m", cfg.range_max, "must be > 0 metres"));
         }
+        cfg.image.exposure.validate()?;
         let (w, h) = (cfg.width, cfg.height);
         let (dirs, origins) = match cfg.projection {
             Projection::Pinhole { hfov } => {
@@ -399,6 +402,7 @@ impl Camera {
             .with_seabed(scene.seabed())
             .with_waves(scene.wave_surface())
             .with_footprint(pixel_rad, pixel_m)
+            .with_exposure(&self.cfg.image.exposure)
             .with_foam_around([pose.translation.x, pose.translation.y], self.cfg.range_max.min(FOAM_INDEX_M));
         // Standard quality shares one traced reflection per 2 × 2 (or 4 × 4) block of water pixels; high traces
         // each; both spread them over the water's glossy lobe. Below

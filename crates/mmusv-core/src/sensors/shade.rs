@@ -176,7 +176,12 @@ pub struct Shader {
     foam: Foam,
     /// The Kelvin waves of the vessels under way, added to the water's slopes ([`Shader::with_swell`]).
     kelvin: kelvin::KelvinWaves,
+    /// The incident reading (or the fixed EV100's scale), before the compensation `exposure_gain`.
     exposure: f32,
+    /// `2^compensation` of an automatic exposure ([`Shader::with_exposure`]); 1 otherwise.
+    exposure_gain: f32,
+    /// Whether the exposure is fixed (the environment's or the camera's EV100): no highlight limit.
+    exposure_fixed: bool,
     /// Share of the sky's own radiance that reaches the camera through the fog (3 km of it).
     sky_keep: f32,
     materials: Arc<Vec<Material>>,
@@ -219,6 +224,8 @@ impl Shader {
             foam: Foam::new(water::monahan_coverage(env.wind_speed_m_s), wakes, foam::FOAM_SEED),
             kelvin: kelvin::KelvinWaves::new(wakes),
             exposure,
+            exposure_gain: 1.0,
+            exposure_fixed: env.exposure_ev100.is_finite(),
             sky_keep: (-env.fog_extinction_per_m * 3000.0).exp(),
             materials: Arc::new(Vec::new()),
             seabed: None,
@@ -284,19 +291,37 @@ impl Shader {
         &self.light
     }
 
-    /// Multiplier from radiance (cd/m²) to the tone curve's input: the incident reading (or the fixed EV100).
+    /// This shader exposing as a camera set to `exposure`: its fixed EV100 replaces the environment's and the
+    /// metered one; otherwise, unless the environment fixes the exposure, the incident reading is floored at the
+    /// camera's limit ([`tonemap::min_metered_lux`] of its highest ISO) and the compensation applies.
+    pub fn with_exposure(mut self, exposure: &tonemap::Exposure) -> Self {
+        if let Some(ev100) = exposure.ev100 {
+            self.exposure = tonemap::fixed_exposure_scale(ev100);
+            self.exposure_fixed = true;
+            self.exposure_gain = 1.0;
+        } else if !self.env.exposure_ev100.is_finite() {
+            let floor = tonemap::min_metered_lux(exposure.max_iso);
+            self.exposure = tonemap::incident_exposure_scale(self.light.horizontal_lux, floor);
+            self.exposure_gain = 2f32.powf(exposure.compensation_ev);
+        }
+        self
+    }
+
+    /// Multiplier from radiance (cd/m²) to the tone curve's input: the incident reading, compensated (or the
+    /// fixed EV100's scale).
     pub fn exposure(&self) -> f32 {
-        self.exposure
+        self.exposure * self.exposure_gain
     }
 
     /// The exposure of a `width × height` view whose pixel `p` (row-major) has the centre-ray radiance
     /// `radiance(p)`: the automatic one with its highlight limit ([`tonemap::highlight_limited`], reading
     /// [`tonemap::metered_pixels`]), or the fixed EV100's.
     pub fn metered_exposure(&self, width: usize, height: usize, radiance: impl Fn(usize) -> Vec3) -> f32 {
-        if self.env.exposure_ev100.is_finite() {
+        if self.exposure_fixed {
             return self.exposure;
         }
-        tonemap::highlight_limited(self.exposure, tonemap::metered_pixels(width, height).map(radiance))
+        let limited = tonemap::highlight_limited(self.exposure, tonemap::metered_pixels(width, height).map(radiance));
+        limited * self.exposure_gain
     }
 
     /// Unit vector towards the sun.
@@ -545,7 +570,7 @@ impl Shader {
         let key = ((u as u64) << 32) | segment as u64;
         if noise::uniform(seed, stream::RAIN, key) < 0.03 * strength as f64 {
             // A streak adds 12 % of full scale.
-            out += Vec3::splat(0.12 / self.exposure);
+            out += Vec3::splat(0.12 / self.exposure());
         }
         out
     }

@@ -6,7 +6,9 @@
 //!   camera's longest exposure and highest gain, f/1.4, 1/30 s (its frame time) and ISO 6 400 (EV100 −0.12),
 //!   which is the light at the end of civil twilight (about 3.4 lux, sun 6° below the horizon): through civil
 //!   twilight the camera opens up as the light falls, then holds, so nautical twilight darkens and nights stay
-//!   dark with their lights standing out. A fixed `EV100` instead gives the
+//!   dark with their lights standing out. A camera reaching another ISO has its floor scaled by `6 400 / ISO`
+//!   ([`min_metered_lux`]), and its exposure compensation multiplies the result by `2^EV` ([`Exposure`]).
+//!   A fixed `EV100` instead gives the
 //!   saturation-based scale `k = 1 / (1.2 · 2^EV100)` (ISO 12232; S. Lagarde & C. de Rousiers, "Moving
 //!   Frostbite to Physically Based Rendering", SIGGRAPH 2014 course notes).
 //! * **Highlight limit** of the automatic exposure: a reflected-light reading of what the camera sees (the
@@ -33,13 +35,88 @@ use parry3d::math::Vec3;
 /// of the next fifty minutes darkened with the light itself, 550-fold by 21:15.
 pub const MIN_METERED_LUX: f32 = 3.46;
 
+/// The highest ISO of the default camera's automatic exposure, whose limit is [`MIN_METERED_LUX`].
+pub const DEFAULT_MAX_ISO: f32 = 6_400.0;
+
 /// Multiplier from radiance (cd/m²) to the tone curve's input: metered from `horizontal_lux` when `ev100` is
 /// `NaN`, else the saturation-based scale of `ev100`.
 pub fn exposure_scale(ev100: f32, horizontal_lux: f32) -> f32 {
     if ev100.is_finite() {
-        1.0 / (1.2 * 2f32.powf(ev100))
+        fixed_exposure_scale(ev100)
     } else {
-        std::f32::consts::PI / horizontal_lux.max(MIN_METERED_LUX)
+        incident_exposure_scale(horizontal_lux, MIN_METERED_LUX)
+    }
+}
+
+/// The saturation-based scale of a fixed exposure value at ISO 100: `1 / (1.2 · 2^EV100)` (ISO 12232).
+pub fn fixed_exposure_scale(ev100: f32) -> f32 {
+    1.0 / (1.2 * 2f32.powf(ev100))
+}
+
+/// The incident reading `π / E_h`, `E_h` floored at `min_lux` (the camera's limit, [`min_metered_lux`]).
+pub fn incident_exposure_scale(horizontal_lux: f32, min_lux: f32) -> f32 {
+    std::f32::consts::PI / horizontal_lux.max(min_lux)
+}
+
+/// The darkest light (lux) the automatic exposure of a camera reaching `max_iso` at f/1.4 and 1/30 s adapts
+/// to: [`MIN_METERED_LUX`] at [`DEFAULT_MAX_ISO`], inversely proportional to the ISO (one stop of gain, one stop
+/// of light: `E = 1.2 π · 2^EV100` with `EV100 = log2(N² / t) − log2(S / 100)`).
+pub fn min_metered_lux(max_iso: f32) -> f32 {
+    MIN_METERED_LUX * (DEFAULT_MAX_ISO / max_iso)
+}
+
+/// How a camera sets its exposure.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Exposure {
+    /// A fixed (manual) exposure value at ISO 100; `None` meters it automatically from the scene's light.
+    pub ev100: Option<f32>,
+    /// Stops added to the automatic exposure (+1 doubles it; the highlight limit shifts with it); ignored with a
+    /// fixed `ev100`.
+    pub compensation_ev: f32,
+    /// The highest ISO the automatic exposure reaches at f/1.4 and 1/30 s: sets the darkest light it adapts to
+    /// ([`min_metered_lux`]); below it pictures darken with the light.
+    pub max_iso: f32,
+}
+
+impl Default for Exposure {
+    /// Automatic, uncompensated, the ISO 6 400 camera of [`MIN_METERED_LUX`].
+    fn default() -> Self {
+        Self { ev100: None, compensation_ev: 0.0, max_iso: DEFAULT_MAX_ISO }
+    }
+}
+
+/// Allowed fixed exposure values: EV100 −6 (a starlit scene at long exposure) to 20 (beyond snow in full sun).
+pub const EV100_RANGE: (f32, f32) = (-6.0, 20.0);
+/// Allowed exposure compensation, stops.
+pub const COMPENSATION_RANGE_EV: (f32, f32) = (-5.0, 5.0);
+/// Allowed highest ISO of the automatic exposure.
+pub const MAX_ISO_RANGE: (f32, f32) = (100.0, 409_600.0);
+
+impl Exposure {
+    /// Checks the settings; errors name `camera.exposure.<field>` and the range allowed.
+    pub fn validate(&self) -> crate::Result<()> {
+        use crate::MmusvError;
+        let within = |v: f32, (lo, hi): (f32, f32)| v.is_finite() && (lo..=hi).contains(&v);
+        if let Some(ev) = self.ev100 {
+            if !within(ev, EV100_RANGE) {
+                let allowed = format!("must be a finite EV100 in [{}, {}]", EV100_RANGE.0, EV100_RANGE.1);
+                return Err(MmusvError::config("camera.exposure.ev100", ev, allowed));
+            }
+            if self.compensation_ev != 0.0 {
+                let why = "applies to the automatic exposure only; give ev100 or compensation_ev, not both";
+                return Err(MmusvError::config("camera.exposure.compensation_ev", self.compensation_ev, why));
+            }
+        }
+        if !within(self.compensation_ev, COMPENSATION_RANGE_EV) {
+            let (lo, hi) = COMPENSATION_RANGE_EV;
+            let allowed = format!("must be a finite number of stops in [{lo}, {hi}]");
+            return Err(MmusvError::config("camera.exposure.compensation_ev", self.compensation_ev, allowed));
+        }
+        if !within(self.max_iso, MAX_ISO_RANGE) {
+            let allowed = format!("must be an ISO in [{}, {}]", MAX_ISO_RANGE.0, MAX_ISO_RANGE.1);
+            return Err(MmusvError::config("camera.exposure.max_iso", self.max_iso, allowed));
+        }
+        Ok(())
     }
 }
 
@@ -223,6 +300,34 @@ mod tests {
         }
         // Brighter light is exposed from its own reading: a grey card under 20 lux still meters to 0.18.
         assert!((exposure_scale(f32::NAN, 20.0) * 20.0 - std::f32::consts::PI).abs() < 1e-5);
+    }
+
+    /// A camera's highest ISO sets its floor as the same f/1.4, 1/30 s limit at that ISO (one stop of gain, one
+    /// stop of light), the default camera's exactly [`MIN_METERED_LUX`]; settings out of range are refused,
+    /// naming the field.
+    #[test]
+    fn the_floor_follows_the_highest_iso_and_settings_are_checked() {
+        assert_eq!(min_metered_lux(DEFAULT_MAX_ISO), MIN_METERED_LUX);
+        for iso in [400.0f32, 1_600.0, 25_600.0, 102_400.0] {
+            let ev100 = (1.4f32 * 1.4 * 30.0).log2() - (iso / 100.0).log2();
+            let limit = fixed_exposure_scale(ev100);
+            let k = incident_exposure_scale(0.0, min_metered_lux(iso));
+            assert!((k / limit - 1.0).abs() < 0.002, "ISO {iso}: {k} against {limit}");
+        }
+        assert!(Exposure::default().validate().is_ok());
+        let bad = [
+            (Exposure { ev100: Some(25.0), ..Default::default() }, "camera.exposure.ev100"),
+            (Exposure { ev100: Some(f32::NAN), ..Default::default() }, "camera.exposure.ev100"),
+            (Exposure { ev100: Some(10.0), compensation_ev: 1.0, ..Default::default() }, "compensation_ev"),
+            (Exposure { compensation_ev: 6.0, ..Default::default() }, "camera.exposure.compensation_ev"),
+            (Exposure { max_iso: 50.0, ..Default::default() }, "camera.exposure.max_iso"),
+            (Exposure { max_iso: f32::INFINITY, ..Default::default() }, "camera.exposure.max_iso"),
+        ];
+        for (e, field) in bad {
+            let Err(err) = e.validate() else { panic!("{e:?} was accepted") };
+            let msg = err.to_string();
+            assert!(msg.contains(field), "{e:?}: {msg}");
+        }
     }
 
     /// The blockwise tone mapping gives [`to_srgb8`]'s bytes for every colour, odd lengths, out-of-range and
