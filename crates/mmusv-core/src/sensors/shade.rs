@@ -403,11 +403,7 @@ impl Shader {
                 // The vessels' Kelvin waves add their slopes (those the footprint cannot resolve, roughness).
                 let k = self.kelvin.slope(hit.point.x, hit.point.y, footprint);
                 hit.unresolved_mss += k.unresolved_mss;
-                if k.slope == [0.0, 0.0] || n.z <= 0.0 {
-                    n
-                } else {
-                    Vec3::new(n.x / n.z - k.slope[0], n.y / n.z - k.slope[1], 1.0).normalize_or(n)
-                }
+                kelvin::tilted(n, k.slope)
             };
             if n.dot(d) <= 0.0 {
                 hit.shading_normal = n;

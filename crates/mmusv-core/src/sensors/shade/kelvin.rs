@@ -36,8 +36,11 @@
 //! covers most of it): the waves grow in as `1 − exp(−(r/L)²)`. They are drawn only where the vessel's path ran
 //! straight behind it (the wake row's `reach_m`, thinning over its last quarter), no farther than
 //! [`super::wake::WAKE_REACH_S`] of its travel nor than where their steepest slope falls below `4·10⁻³`; a wake row
-//! of an older piece of a bent path draws none (its foam does). The waves are the cameras' only: the sea's
-//! geometry, and so the LiDAR and the radar, do not see them.
+//! of an older piece of a bent path draws none (its foam does). The waves are slopes, not geometry: the sea's
+//! surface, and so every ray's hit point, does not move with them (their heights, centimetres to decimetres, stay
+//! out of the wave surface). The cameras shade with them, and the LiDAR's water model ([`super::super::lidar`])
+//! tilts the facets its beams meet by them ([`tilted`]); the radar's sea clutter, a statistical model of the
+//! whole sea state, does not see them.
 
 #![allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x > 0.0)` on purpose: a NaN must answer "no waves"
 
@@ -109,6 +112,17 @@ pub struct KelvinSlope {
     pub slope: [f32; 2],
     /// Mean square slope (both axes) of the waves the footprint does not resolve.
     pub unresolved_mss: f32,
+}
+
+/// The unit normal `n` of a water facet tilted by the surface slopes `slope` (`∂ζ/∂x, ∂ζ/∂y`) laid over it: the
+/// facet's own slopes `(−n_x/n_z, −n_y/n_z)` plus `slope`. `n` itself where `slope` is zero or `n` does not face up.
+#[inline]
+pub fn tilted(n: parry3d::math::Vec3, slope: [f32; 2]) -> parry3d::math::Vec3 {
+    if slope == [0.0, 0.0] || n.z <= 0.0 {
+        n
+    } else {
+        parry3d::math::Vec3::new(n.x / n.z - slope[0], n.y / n.z - slope[1], 1.0).normalize_or(n)
+    }
 }
 
 impl KelvinWaves {

@@ -247,3 +247,27 @@ fn steepness_never_passes_michells_limit() {
         }
     }
 }
+
+/// A facet of slopes `(sx, sy)` has the normal `∝ (−sx, −sy, 1)`; tilted by waves of slopes `(kx, ky)` laid over
+/// it, the normal of the summed slopes. A facet that does not face up, or no slope, is kept as it is.
+#[test]
+fn tilting_a_facet_adds_the_slopes() {
+    use parry3d::math::Vec3;
+    let mut state = 0x2545_F491_4F6C_DD1Du64;
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 40) as f32 / (1u64 << 24) as f32 - 0.5
+    };
+    for _ in 0..1000 {
+        let (sx, sy, kx, ky) = (next(), next(), 0.6 * next(), 0.6 * next());
+        let n = Vec3::new(-sx, -sy, 1.0).normalize();
+        let want = Vec3::new(-(sx + kx), -(sy + ky), 1.0).normalize();
+        let got = tilted(n, [kx, ky]);
+        assert!((got - want).length() < 1e-5, "{got:?} vs {want:?}");
+        assert_eq!(tilted(n, [0.0, 0.0]), n);
+    }
+    let down = Vec3::new(0.1, 0.0, -1.0).normalize();
+    assert_eq!(tilted(down, [0.2, 0.1]), down);
+}
