@@ -10,7 +10,8 @@ Endpoints (JSON in and out unless said otherwise; errors are ``{"error": "..."}`
 ``GET /api/files``        the scenario files in the folder; ``GET /api/files/{name}`` one as a document, with
                           its ``etag`` (also the ``ETag`` header)
 ``PUT /api/files/{name}`` saves ``{document, comment, overwrite}`` as YAML into the folder (409 if it exists);
-                          with ``If-Match: ETAG`` only if the file is still that version (412 if it changed)
+                          with ``If-Match: ETAG`` only if the file is still that version (412 if it changed;
+                          a list of ETags and ``*``, any version, are understood)
 ``POST /api/map``         ``{map}`` -> the map's layers (:mod:`mmusv.editor.maplayers`)
 ``POST /api/evaluate``    ``{document}`` -> validation, checks and motion (:mod:`mmusv.editor.evaluate`)
 ``POST /api/poses``       ``{document, frame}`` -> every vessel's ``[x, y, yaw]`` at that index
@@ -19,37 +20,44 @@ Endpoints (JSON in and out unless said otherwise; errors are ``{"error": "..."}`
                           progress; ``DELETE /api/runs/{id}`` stops one
 ========================  =====================================================================================
 
-Status codes: 400 bad input (a file name, a request the server cannot serve), 404 nothing of that name, 409 the
-file exists, 412 the file changed since the client read it (If-Match), 413 the request is too large, 422 the
-request body or the scenario does not validate (the message names the field). Nothing outside the folder is read
-or written (:mod:`mmusv.editor.files`); the page loads nothing from elsewhere (a Content-Security-Policy says so
-to the browser).
+Status codes: 400 bad input (a file name, a request the server cannot serve, a body that cannot be read as JSON:
+the message says why), 404 nothing of that name, 409 the file exists (or the name is a folder; or a run of the
+same scenario is going on), 412 the file changed since the client read it (If-Match), 413 the request is larger
+than :data:`MAX_BODY_BYTES`, 422 the request body or the scenario does not validate (the message names the
+field). Request bodies are JSON objects sent as ``application/json``; their fields are strict (``frame: true`` or
+``"3"`` is refused, not read as 1 or 3), and a text must be valid Unicode (an unpaired ``\\ud800`` escape is
+refused). Nothing outside the folder is read or written (:mod:`mmusv.editor.files`); the page loads nothing from
+elsewhere (a Content-Security-Policy says so to the browser).
 """
 
 from __future__ import annotations
 
 import json
+import math
+import re
 import sys
 import threading
 import traceback
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any, get_args
+from typing import Annotated, Any, get_args
 
 from fastapi import FastAPI, Request
+from fastapi import Path as PathParam
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import FileResponse, JSONResponse, Response
 from fastapi.staticfiles import StaticFiles
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.middleware.trustedhost import TrustedHostMiddleware
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
+from mmusv import yamlio
 from mmusv.config import EnvironmentConfig, MapConfig, Scenario, VesselConfig, load_scenario, validation_problems
 from mmusv.editor.document import leading_comment, scenario_yaml, to_document
 from mmusv.editor.evaluate import MAX_BULK_FRAMES, evaluate, poses_at, validate
 from mmusv.editor.files import ChangedInFolder, FileExistsInFolder, ScenarioFolder, check_name, etag
-from mmusv.editor.jobs import Jobs
+from mmusv.editor.jobs import Jobs, RunGoingOn
 from mmusv.editor.maplayers import map_layers
 from mmusv.errors import ConfigError, InputError, MmusvError, NotFoundError
 from mmusv.yamlio import parse_yaml
@@ -79,8 +87,47 @@ class InitialScenario:
     """The ETag of the file when ``in_folder`` (the page saves it with ``If-Match``)."""
 
 
+_NOT_YAML = re.compile("[^\x09\x0a\x0d\x20-\x7e\x85\xa0-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
+"""A character a YAML file may not hold anywhere, comments included (control characters but tab and line breaks,
+unpaired surrogates, U+FFFE/U+FFFF): a file with one does not load again."""
+_SURROGATE = re.compile("[\ud800-\udfff]")
+_JOB_ID = r"^(0|[1-9][0-9]{0,17})$"
+"""A run id as the API gives it: a whole number in decimal digits (no sign, spaces, ``_`` or leading zeros)."""
+
+
+def _path(parts: list[str | int]) -> str:
+    """``vessels[0].route`` from the keys and indices ``parts``."""
+    out = ""
+    for p in parts:
+        out += f"[{p}]" if isinstance(p, int) else (f".{p}" if out else p)
+    return out
+
+
+def _unjsonable(value: Any, root: str) -> str | None:
+    """Where ``value`` (plain JSON-like data) holds what JSON cannot carry back to the page, and what it is:
+    a number that is not finite (``.nan``, ``.inf`` in YAML, ``NaN`` in lenient JSON) or a text with an unpaired
+    UTF-16 surrogate (``"\\ud800"``); None when there is nothing."""
+    stack: list[tuple[Any, list[str | int]]] = [(value, [root] if root else [])]
+    while stack:
+        v, parts = stack.pop()
+        if isinstance(v, float) and not math.isfinite(v):
+            return f"{_path(parts) or 'the value'} = {v}: not a finite number"
+        if isinstance(v, str) and _SURROGATE.search(v) is not None:
+            return f"{_path(parts) or 'the value'} = {v!r}: an unpaired UTF-16 surrogate is not text"
+        if isinstance(v, dict):
+            for k, item in v.items():
+                if isinstance(k, str) and _SURROGATE.search(k) is not None:
+                    return (
+                        f"{_path(parts) or 'the mapping'} has the key {k!r}: an unpaired UTF-16 surrogate is not text"
+                    )
+                stack.append((item, [*parts, str(k)]))
+        elif isinstance(v, list):
+            stack.extend((item, [*parts, i]) for i, item in enumerate(v))
+    return None
+
+
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", strict=True)
 
 
 class DocumentBody(_Strict):
@@ -88,10 +135,29 @@ class DocumentBody(_Strict):
 
     document: dict[str, Any]
 
+    @field_validator("document")
+    @classmethod
+    def _text_is_unicode(cls, document: dict[str, Any]) -> dict[str, Any]:
+        problem = _unjsonable(document, "document")
+        if problem is not None:
+            raise ValueError(problem)
+        return document
+
 
 class SaveBody(DocumentBody):
     comment: str = Field(default="", max_length=20_000)
     overwrite: bool = False
+
+    @field_validator("comment")
+    @classmethod
+    def _comment_fits_yaml(cls, comment: str) -> str:
+        bad = _NOT_YAML.search(comment)
+        if bad is not None:
+            raise ValueError(
+                f"character U+{ord(bad.group()):04X} at position {bad.start()} cannot be written into a YAML file "
+                "(the file would not load again): control characters other than tab and line breaks are not allowed"
+            )
+        return comment
 
 
 class FrameBody(DocumentBody):
@@ -105,6 +171,14 @@ class PreviewBody(FrameBody):
 class MapBody(_Strict):
     map: dict[str, Any]
 
+    @field_validator("map")
+    @classmethod
+    def _text_is_unicode(cls, value: dict[str, Any]) -> dict[str, Any]:
+        problem = _unjsonable(value, "map")
+        if problem is not None:
+            raise ValueError(problem)
+        return value
+
 
 class RunBody(_Strict):
     name: str = Field(max_length=1000)
@@ -116,7 +190,7 @@ def _error(status: int, message: str) -> JSONResponse:
 
 
 def _status(exc: MmusvError) -> int:
-    if isinstance(exc, FileExistsInFolder):
+    if isinstance(exc, (FileExistsInFolder, RunGoingOn)):
         return 409
     if isinstance(exc, ChangedInFolder):
         return 412
@@ -130,7 +204,9 @@ def _status(exc: MmusvError) -> int:
 
 
 class _BodyLimit:
-    """Refuses request bodies over ``limit`` bytes with 413, whether or not they say their length up front."""
+    """Refuses request bodies over ``limit`` bytes with 413, whether or not they say their length up front: the body
+    is read here (at most ``limit`` bytes are kept) before the app sees the request, so a body streamed without a
+    Content-Length (chunked) gets the same 413, not an error from whatever reads it."""
 
     def __init__(self, app: ASGIApp, limit: int) -> None:
         self.app, self.limit = app, limit
@@ -139,43 +215,92 @@ class _BodyLimit:
         if scope["type"] != "http":
             await self.app(scope, receive, send)
             return
+        too_large = f"the request body is larger than {self.limit} bytes, the most the editor takes"
         length = dict(scope.get("headers") or []).get(b"content-length")
-        if length is not None and (not length.isdigit() or int(length) > self.limit):
-            await _error(413, f"the request body is larger than {self.limit} bytes")(scope, receive, send)
+        if length is not None and not length.isdigit():
+            shown = length.decode("latin-1")[:40]
+            await _error(400, f"the Content-Length header {shown!r} is not a number of bytes")(scope, receive, send)
             return
+        if length is not None and int(length) > self.limit:
+            await _error(413, too_large)(scope, receive, send)
+            return
+        chunks: list[bytes] = []
         seen = 0
-
-        async def counted() -> Message:
-            nonlocal seen
+        while True:
             msg = await receive()
-            seen += len(msg.get("body", b""))
+            if msg["type"] != "http.request":  # the client went away
+                return
+            chunk = msg.get("body", b"")
+            seen += len(chunk)
             if seen > self.limit:
-                raise _TooLarge
-            return msg
+                await _error(413, too_large)(scope, receive, send)
+                return
+            chunks.append(chunk)
+            if not msg.get("more_body", False):
+                break
+        body: list[Message] = [{"type": "http.request", "body": b"".join(chunks), "more_body": False}]
 
-        try:
-            await self.app(scope, counted, send)
-        except _TooLarge:
-            await _error(413, f"the request body is larger than {self.limit} bytes")(scope, receive, send)
+        async def replay() -> Message:
+            return body.pop() if body else await receive()
 
-
-class _TooLarge(Exception):
-    pass
+        await self.app(scope, replay, send)
 
 
 def _choices(model: type[BaseModel], name: str) -> list[str]:
     return list(get_args(model.model_fields[name].annotation))
 
 
-def _request_error(exc: RequestValidationError) -> str:
+def _request_error(exc: RequestValidationError, content_type: str | None) -> str:
     parts = []
     for e in exc.errors():
         loc = ".".join(str(p) for p in e.get("loc", ()) if p != "body") or "body"
         if e.get("type") == "json_invalid":
             parts.append(f"the request body is not valid JSON ({e.get('ctx', {}).get('error', 'unreadable')})")
+        elif loc == "body" and not _is_json(content_type):
+            got = f"Content-Type {content_type!r}" if content_type else "no Content-Type"
+            parts.append(f"body: the request body must be a JSON object sent as application/json (got {got})")
         else:
             parts.append(f"{loc}: {e.get('msg', 'invalid')}")
     return "malformed request: " + "; ".join(parts)
+
+
+def _is_json(content_type: str | None) -> bool:
+    kind = (content_type or "").split(";", 1)[0].strip().lower()
+    return kind == "application/json" or (kind.startswith("application/") and kind.endswith("+json"))
+
+
+def _unreadable_body(cause: BaseException | None) -> str:
+    """Why FastAPI could not read a JSON body (it says only "There was an error parsing the body")."""
+    if isinstance(cause, RecursionError):
+        return "the request body is not valid JSON: nested too deeply"
+    if isinstance(cause, UnicodeDecodeError):
+        bad = cause.object[cause.start : cause.start + 1].hex()
+        return f"the request body is not valid JSON: not UTF-8 text (byte 0x{bad} at offset {cause.start})"
+    if isinstance(cause, ValueError) and "digits" in str(cause):
+        return "the request body is not valid JSON: an integer of more than 4,300 digits"
+    return "the request body cannot be read" + (f" ({type(cause).__name__})" if cause is not None else "")
+
+
+def _if_match(header: str | None) -> list[str] | None:
+    """The ETags of an ``If-Match`` header (quotes and ``W/`` dropped; ``*`` kept), or None without one."""
+    if header is None:
+        return None
+    return [t.strip().removeprefix("W/").strip('"') for t in header.split(",") if t.strip()]
+
+
+def _value_count(document: Any, limit: int) -> int:
+    """How many values (mappings, lists, keys and scalars) ``document`` holds, as :mod:`mmusv.yamlio` counts them
+    when the file is read again; stops counting above ``limit``."""
+    count, stack = 0, [document]
+    while stack and count <= limit:
+        v = stack.pop()
+        count += 1
+        if isinstance(v, dict):
+            stack.extend(v.keys())
+            stack.extend(v.values())
+        elif isinstance(v, list):
+            stack.extend(v)
+    return count
 
 
 def _load_document(text: str, where: str) -> tuple[dict[str, Any], bool]:
@@ -191,7 +316,11 @@ def _load_document(text: str, where: str) -> tuple[dict[str, Any], bool]:
             raise ConfigError(
                 f"{exc}; the editor opens files whose vessels and routes are lists (fix it as text)"
             ) from None
-        return json.loads(json.dumps(data, default=str)), False
+        raw = json.loads(json.dumps(data, default=str))
+        problem = _unjsonable(raw, "")
+        if problem is not None:  # JSON cannot carry it to the page
+            raise ConfigError(f"{where}: {problem}; the editor cannot show this value (fix it as text)") from None
+        return raw, False
 
 
 def _editable(data: dict[str, Any]) -> bool:
@@ -233,10 +362,12 @@ def create_app(
 
     @app.exception_handler(RequestValidationError)
     async def _bad_request(request: Request, exc: RequestValidationError) -> JSONResponse:
-        return _error(422, _request_error(exc))
+        return _error(422, _request_error(exc, request.headers.get("content-type")))
 
     @app.exception_handler(StarletteHTTPException)
     async def _http_error(request: Request, exc: StarletteHTTPException) -> JSONResponse:
+        if exc.status_code == 400 and exc.detail == "There was an error parsing the body":  # FastAPI's words
+            return _error(400, _unreadable_body(exc.__cause__))
         return _error(exc.status_code, str(exc.detail))
 
     @app.exception_handler(Exception)
@@ -331,11 +462,18 @@ def create_app(
     def files() -> list[dict[str, Any]]:
         return [{"name": f.name, "size": f.size} for f in store.files()]
 
+    def _sent_name(request: Request, name: str) -> str:
+        """``name`` as the request sent it: Starlette's route drops a trailing newline (``x.yaml%0A`` matches as
+        ``x.yaml``), which must not reach another file."""
+        sent = str(request.scope.get("path", "")).partition("/api/files/")[2]
+        return check_name(sent) if sent != name else name
+
     @app.get("/api/files/{name:path}")
-    def read_file(name: str) -> JSONResponse:
-        path, text = store.read_text(name)
+    def read_file(name: str, request: Request) -> JSONResponse:
+        name = _sent_name(request, name)
+        got = store.read_text(name)  # the text and the ETag of the same bytes, read once
+        text, tag = got.text, got.etag
         doc, valid = _load_document(text, name)
-        tag = etag(path.read_bytes())
         return JSONResponse(
             {"name": name, "document": doc, "valid": valid, "comment": leading_comment(text), "etag": tag},
             headers={"ETag": f'"{tag}"'},
@@ -343,16 +481,23 @@ def create_app(
 
     @app.put("/api/files/{name:path}")
     def write_file(name: str, body: SaveBody, request: Request) -> JSONResponse:
-        check_name(name)
+        name = check_name(_sent_name(request, name))
         scenario, errors = validate(body.document)
         if scenario is None:
             raise ConfigError(
                 f"{name}: not saved, the scenario does not validate: " + "; ".join(e["message"] for e in errors)
             )
-        match = request.headers.get("if-match")
-        if_match = None if match is None else match.strip().removeprefix("W/").strip('"')
+        limit = yamlio.MAX_YAML_VALUES
+        if _value_count(to_document(scenario), limit) > limit:  # the file would not load again
+            raise ConfigError(
+                f"{name}: not saved, the scenario holds more than {limit:,} values (a waypoint counts three: its list "
+                "and two numbers), the most a scenario file may hold (mmusv.yamlio.MAX_YAML_VALUES), so the file "
+                "would not load again: use fewer waypoints or vessels"
+            )
         text = scenario_yaml(scenario, comment=body.comment)
-        path = store.write_text(name, text, overwrite=body.overwrite, if_match=if_match)
+        path = store.write_text(
+            name, text, overwrite=body.overwrite, if_match=_if_match(request.headers.get("if-match"))
+        )
         tag = etag(text.encode("utf-8"))
         return JSONResponse(
             {"name": name, "path": str(path), "bytes": path.stat().st_size, "etag": tag}, headers={"ETag": f'"{tag}"'}
@@ -412,12 +557,12 @@ def create_app(
         return [j.as_dict() for j in jobs.all()]
 
     @app.get("/api/runs/{job_id}")
-    def run_status(job_id: int) -> dict[str, Any]:
-        return jobs.get(job_id).as_dict()
+    def run_status(job_id: Annotated[str, PathParam(pattern=_JOB_ID)]) -> dict[str, Any]:
+        return jobs.get(int(job_id)).as_dict()
 
     @app.delete("/api/runs/{job_id}")
-    def run_cancel(job_id: int) -> dict[str, Any]:
-        return jobs.cancel(job_id).as_dict()
+    def run_cancel(job_id: Annotated[str, PathParam(pattern=_JOB_ID)]) -> dict[str, Any]:
+        return jobs.cancel(int(job_id)).as_dict()
 
     @app.api_route("/api/{rest:path}", methods=["GET", "POST", "PUT"], include_in_schema=False)
     def unknown(rest: str) -> Response:

@@ -5,11 +5,14 @@ keys a person writes by hand (name, seed, map, environment, acquisition, rigs, v
 speed and route) always, everything else only where it differs from its default, and each rig only where it
 differs from its ``preset``. Validating the document again gives a scenario equal to the original, which is why
 "load, save unchanged" gives an equal scenario. :func:`scenario_yaml` writes it the way the bundled scenarios are
-written (top-level blocks, one flow line per vessel), with the file's leading comment kept.
+written (top-level blocks, one flow line per vessel), with the file's leading comment kept. A text holding a line
+break, a tab or a character outside printable Unicode (a rig named ``"a\\x85b"``) is written double-quoted with
+escapes, so it reads back as written (PyYAML's default style would fold such a break into a space).
 """
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 import yaml
@@ -92,6 +95,18 @@ def _float(dumper: yaml.SafeDumper, data: float) -> yaml.Node:
     return dumper.represent_float(data)
 
 
+_ESCAPE = re.compile("[^\x20-\x7e\xa0-\u2027\u202a-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
+"""A character that only a double-quoted YAML scalar keeps as it is: controls, line breaks (``\\x85``,
+``\\u2028``, ``\\u2029`` included), tab, surrogates."""
+
+
+def _str(dumper: yaml.SafeDumper, data: str) -> yaml.Node:
+    """Texts as PyYAML writes them, but double-quoted (escaped) when they hold a character of :data:`_ESCAPE`."""
+    style = '"' if _ESCAPE.search(data) else None
+    return dumper.represent_scalar("tag:yaml.org,2002:str", data, style=style)
+
+
+_Dumper.add_representer(str, _str)
 _Dumper.add_representer(_FlowMap, _flow)
 _Dumper.add_representer(_FlowList, _flow)
 _Dumper.add_representer(float, _float)

@@ -16,6 +16,12 @@ returns, JSON-ready:
   ``rings`` the LiDAR and radar ranges of a USV's rig (metres);
 * ``valid`` (the schema and the routes are fine; problems may remain), ``frames``, ``frequency_hz``, ``map``.
 
+Bounds: the checks take at most :data:`MAX_CHECK_SAMPLES` samples x vessels and :data:`MAX_CHECK_PAIR_SAMPLES`
+time samples x pairs of vessels (the separation check compares every pair at every time: without this bound a
+fleet of a few thousand vessels, a body of a few hundred kB, would take the server's memory); above either the
+document is not valid and ``errors`` says why. At most :data:`MAX_PROBLEMS` problems are listed; one more entry
+(check ``more``) then says how many were left out.
+
 World frame, metres, radians (yaw from +x, counter-clockwise); coordinates rounded to millimetres.
 """
 
@@ -37,12 +43,24 @@ from mmusv.scenario_checks import check_mounts, map_check_spec, map_findings
 from mmusv.sensors.config import RigConfig
 from mmusv.world.vessels import get_asset
 
-__all__ = ["MAX_BULK_FRAMES", "MAX_CHECK_SAMPLES", "evaluate", "poses_at", "validate"]
+__all__ = [
+    "MAX_BULK_FRAMES",
+    "MAX_CHECK_PAIR_SAMPLES",
+    "MAX_CHECK_SAMPLES",
+    "MAX_PROBLEMS",
+    "evaluate",
+    "poses_at",
+    "validate",
+]
 
 MAX_BULK_FRAMES = 3000
 """Above this many frames the evaluation leaves the per-frame poses out; the page asks for one index at a time."""
 MAX_CHECK_SAMPLES = 5_000_000
 """Most samples x vessels the live checks take (route or motion samples); above, the editor says so instead."""
+MAX_CHECK_PAIR_SAMPLES = 2_000_000
+"""Most motion samples x pairs of vessels the live checks take (about 0.5 GB and a few seconds at the limit)."""
+MAX_PROBLEMS = 1000
+"""Most problems listed; the rest are counted in one last entry."""
 
 _FIELD = re.compile(r"invalid config (\S+) = ")
 _VESSEL_FIELD = re.compile(r"^vessels\[(\d+)\]")
@@ -142,6 +160,19 @@ def evaluate(document: dict[str, Any]) -> dict[str, Any]:
             )
         ]
         return out
+    pairs = n_v * (n_v - 1) // 2
+    if n_motion * pairs > MAX_CHECK_PAIR_SAMPLES:
+        out["valid"] = False
+        out["errors"] = [
+            _error(
+                "vessels",
+                f"the checks would compare {pairs:,} pairs of vessels ({n_v} vessels) at {n_motion:,} times, "
+                f"{n_motion * pairs:,} pair samples; the editor checks at most {MAX_CHECK_PAIR_SAMPLES:,}: use fewer "
+                "vessels or a shorter acquisition",
+                document,
+            )
+        ]
+        return out
     ctx = map_context(scenario.map.type, scenario.map.seed, scenario.map.param_values())
     samples, findings = map_findings(scenario, ctx, spec)
     index = {v.id: i for i, v in enumerate(scenario.vessels)}
@@ -173,6 +204,22 @@ def evaluate(document: dict[str, Any]) -> dict[str, Any]:
                 "severity": "warning",
                 "message": text,
                 "field": text.split(" ", 1)[0],
+                "vessels": [],
+                "point": None,
+                "segments": {},
+            }
+        )
+    if len(out["problems"]) > MAX_PROBLEMS:
+        left = out["problems"][MAX_PROBLEMS:]
+        n_err = sum(1 for p in left if p["severity"] == "error")
+        out["problems"] = out["problems"][:MAX_PROBLEMS]
+        out["problems"].append(
+            {
+                "check": "more",
+                "severity": "error" if n_err else "warning",
+                "message": f"{len(left):,} more problems ({n_err:,} errors, {len(left) - n_err:,} warnings) are "
+                f"not listed; the editor lists at most {MAX_PROBLEMS:,}",
+                "field": "",
                 "vessels": [],
                 "point": None,
                 "segments": {},

@@ -4,8 +4,14 @@ A file is named by a bare file name (``harbour.yaml``): letters, digits, ``_``, 
 letter or digit, ending in ``.yaml`` or ``.yml``, at most 128 characters. Anything else (a path with ``/`` or
 ``\\``, ``..``, an absolute path, another suffix) is an :class:`~mmusv.errors.InputError`; a name whose file
 resolves outside the folder (a symbolic link pointing out) is refused the same way, so nothing outside the folder
-can be read or overwritten through the server. Writes go to a temporary file in the folder first and replace the
-target in one rename, so a file is never left half-written.
+can be read or overwritten through the server. Writes go to a temporary file in the folder first (flushed to disk)
+and replace the target in one rename, so a file is never left half-written and a failed write leaves neither the
+temporary file nor a changed target behind; a new file gets the permissions of any file the user creates (the
+umask applies), a replaced one keeps its own. A name that is a folder or another non-file is never replaced.
+
+Reading: a file must be UTF-8 text (a byte-order mark is accepted) of at most :data:`MAX_FILE_BYTES`; anything else
+is refused naming the file and the first bad byte, never opened with replacement characters (saving it back would
+lose the characters that did not decode).
 
 Lost updates: every read gives the file's ETag (:func:`etag`, a hash of its bytes). A write that names the ETag
 it started from (``if_match``) is refused with :class:`ChangedInFolder` when the file has changed since (another
@@ -18,16 +24,38 @@ from __future__ import annotations
 import hashlib
 import os
 import re
-import tempfile
+import secrets
+import stat
 import threading
 from dataclasses import dataclass
 from pathlib import Path
 
-from mmusv.errors import InputError, IoError, NotFoundError
+from mmusv.errors import ConfigError, InputError, IoError, NotFoundError
 
-__all__ = ["ChangedInFolder", "FileExistsInFolder", "ScenarioFile", "ScenarioFolder", "check_name", "etag"]
+__all__ = [
+    "MAX_FILE_BYTES",
+    "ChangedInFolder",
+    "FileExistsInFolder",
+    "ScenarioFile",
+    "ScenarioFolder",
+    "ScenarioText",
+    "check_name",
+    "decode_text",
+    "etag",
+]
 
 _NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.\-]{0,122}\.ya?ml")
+
+MAX_FILE_BYTES = 16 * 1024 * 1024
+"""Largest scenario file the editor opens (16 MiB, as large as the largest request it takes); larger files are
+refused before they are read whole."""
+
+_BOMS = {
+    b"\xff\xfe\x00\x00": "UTF-32 (little-endian)",
+    b"\x00\x00\xfe\xff": "UTF-32 (big-endian)",
+    b"\xff\xfe": "UTF-16 (little-endian)",
+    b"\xfe\xff": "UTF-16 (big-endian)",
+}
 
 
 class FileExistsInFolder(IoError):
@@ -52,6 +80,35 @@ def check_name(name: str) -> str:
             ".yml (letters, digits, _ - and ., no folders, no leading dot)"
         )
     return name
+
+
+def decode_text(data: bytes, *, name: str) -> str:
+    """The text of a scenario file's bytes ``data`` (UTF-8, a leading byte-order mark dropped);
+    :class:`~mmusv.errors.ConfigError` naming ``name`` and the first bad byte for UTF-16/32, binary or other
+    non-UTF-8 files."""
+    for bom, encoding in _BOMS.items():
+        if data.startswith(bom):
+            raise ConfigError(f"{name}: the file is encoded as {encoding}; save it as UTF-8")
+    data = data.removeprefix(b"\xef\xbb\xbf")
+    nul = data.find(b"\x00")
+    if nul >= 0:
+        raise ConfigError(f"{name}: not a text file (a NUL byte at offset {nul}); expected UTF-8 YAML")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ConfigError(
+            f"{name}: not UTF-8 text (byte 0x{data[exc.start : exc.start + 1].hex()} at offset {exc.start}); "
+            "save the file as UTF-8"
+        ) from None
+
+
+@dataclass(frozen=True)
+class ScenarioText:
+    """A scenario file as read once: its ``path``, ``text`` and the ``etag`` of exactly those bytes."""
+
+    path: Path
+    text: str
+    etag: str
 
 
 @dataclass(frozen=True)
@@ -89,15 +146,23 @@ class ScenarioFolder:
             out.append(ScenarioFile(p.name, p.stat().st_size))
         return out
 
-    def read_text(self, name: str) -> tuple[Path, str]:
-        """``(path, text)`` of the file ``name``; :class:`NotFoundError` when it does not exist."""
+    def read_text(self, name: str) -> ScenarioText:
+        """The file ``name`` read once (its text and the ETag of the same bytes, so a save that names that ETag
+        replaces exactly what the client was shown); :class:`NotFoundError` when it does not exist,
+        :class:`ConfigError` when it is larger than :data:`MAX_FILE_BYTES` or not UTF-8 text."""
         p = self.path(name)
         if not p.is_file():
             raise NotFoundError(f"no scenario file {name!r} in the editor's folder")
         try:
-            return p, p.read_text(encoding="utf-8", errors="replace")
+            with p.open("rb") as f:
+                data = f.read(MAX_FILE_BYTES + 1)
         except OSError as exc:
             raise IoError(f"{name}: cannot be read: {exc.strerror or exc}") from None
+        if len(data) > MAX_FILE_BYTES:
+            raise ConfigError(
+                f"{name}: larger than {MAX_FILE_BYTES:,} bytes, the most the editor opens; edit it as text"
+            )
+        return ScenarioText(p, decode_text(data, name=name), etag(data))
 
     def etag_of(self, name: str) -> str | None:
         """The ETag of the file ``name`` now, or ``None`` when it does not exist."""
@@ -109,30 +174,57 @@ class ScenarioFolder:
         except OSError as exc:
             raise IoError(f"{name}: cannot be read: {exc.strerror or exc}") from None
 
-    def write_text(self, name: str, text: str, *, overwrite: bool, if_match: str | None = None) -> Path:
+    def write_text(self, name: str, text: str, *, overwrite: bool, if_match: list[str] | None = None) -> Path:
         """Writes ``text`` to the file ``name`` (atomically); :class:`FileExistsInFolder` when it exists and
-        ``overwrite`` is false; :class:`ChangedInFolder` when ``if_match`` is given, the file exists and its ETag
-        is another (it changed since the client read it)."""
+        ``overwrite`` is false, or when the name is a folder or another non-file; :class:`ChangedInFolder` when
+        ``if_match`` (the ETags of an ``If-Match`` header, ``"*"`` for any version) is given, the file exists and
+        its ETag is none of them, or it is ``"*"`` and the file does not exist."""
         p = self.path(name)
         with self._write_lock:
+            if p.exists() and not p.is_file():
+                raise FileExistsInFolder(
+                    f"{name} is a folder or another non-file in the editor's folder, not a scenario file; it is "
+                    "never replaced: save under another name"
+                )
             if p.exists() and not overwrite:
                 raise FileExistsInFolder(
                     f"{name} already exists in the editor's folder; save with overwrite to replace it"
                 )
             if if_match is not None:
                 now = self.etag_of(name)
-                if now is not None and now != if_match:
+                if now is None and "*" in if_match:
+                    raise ChangedInFolder(
+                        f"{name} does not exist in the editor's folder (If-Match names a version of an existing "
+                        "file; was it deleted or renamed?): save it again without If-Match"
+                    )
+                if now is not None and "*" not in if_match and now not in if_match:
                     raise ChangedInFolder(
                         f"{name} was changed since you opened it (another tab or program saved it), so neither "
                         "edit is lost: open it again to see the other version, save under another name, or "
                         "overwrite it"
                     )
-            fd, tmp = tempfile.mkstemp(dir=self.root, prefix=".mmusv-editor-", suffix=".tmp")
-            try:
-                with os.fdopen(fd, "w", encoding="utf-8") as f:
-                    f.write(text)
-                os.replace(tmp, p)
-            except OSError as exc:
-                Path(tmp).unlink(missing_ok=True)
-                raise IoError(f"{name}: cannot be written: {exc.strerror or exc}") from None
+            self._replace(p, text.encode("utf-8"), name=name)
         return p
+
+    def _replace(self, p: Path, data: bytes, *, name: str) -> None:
+        """Writes ``data`` to a new temporary file in the folder, flushes it to disk and renames it over ``p``;
+        on any failure the temporary file is removed and ``p`` is left as it was."""
+        tmp = self.root / f".mmusv-editor-{secrets.token_hex(8)}.tmp"
+        try:
+            # created like any new file (mode 0666 less the umask), refusing to follow or reuse anything there
+            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0), 0o666)
+        except OSError as exc:
+            raise IoError(f"{name}: cannot be written: {exc.strerror or exc}") from None
+        try:
+            with os.fdopen(fd, "wb") as f:
+                f.write(data)
+                f.flush()
+                os.fsync(f.fileno())
+            if p.is_file():  # a replaced file keeps its permissions
+                os.chmod(tmp, stat.S_IMODE(p.stat().st_mode))
+            os.replace(tmp, p)
+        except BaseException as exc:
+            tmp.unlink(missing_ok=True)
+            if isinstance(exc, OSError):
+                raise IoError(f"{name}: cannot be written: {exc.strerror or exc}") from None
+            raise

@@ -4,6 +4,11 @@ the JSON lines it prints.
 A run of ``NAME.yaml`` in the editor's folder writes into ``<folder>/out/<NAME>/`` (replacing an earlier run of
 the same file), like ``mmusv run NAME.yaml -o out/NAME --overwrite``. :meth:`Jobs.cancel` sends SIGINT, so the
 recording is finished with every completed frame, exactly as Ctrl-C on the command line.
+
+At most :data:`MAX_RUNNING` runs go on at a time, and one output folder has one run at a time (``a.yaml`` and
+``a.yml`` share ``out/a``): a second is refused with :class:`RunGoingOn` instead of starting and failing on the
+folder's lock. A run never writes outside the folder: ``out/NAME`` reached through a link pointing elsewhere is
+refused.
 """
 
 from __future__ import annotations
@@ -21,10 +26,14 @@ from typing import Any
 
 from mmusv.errors import InputError, NotFoundError
 
-__all__ = ["MAX_RUNNING", "Job", "Jobs"]
+__all__ = ["MAX_RUNNING", "Job", "Jobs", "RunGoingOn"]
 
 MAX_RUNNING = 2
 """Runs at a time; a further start is refused until one ends."""
+
+
+class RunGoingOn(InputError):
+    """A run of the same output folder is going on already."""
 
 
 @dataclass
@@ -64,12 +73,25 @@ class Jobs:
 
     def start(self, path: Path, *, frames: int | None = None) -> Job:
         """Starts ``mmusv run`` of the scenario file ``path`` (in the folder) into ``out/<stem>``."""
+        out = self.root / "out" / path.stem
+        rel_out = out.relative_to(self.root)
+        if not out.resolve().is_relative_to(self.root.resolve()):
+            raise InputError(
+                f"{rel_out} is a link (or inside one) that points outside the editor's folder; a run writes only "
+                "inside the folder: remove the link"
+            )
         with self._lock:
-            running = sum(1 for j in self._jobs.values() if j.status == "running")
-            if running >= MAX_RUNNING:
-                raise InputError(f"{running} runs are going on already; wait for one to end or stop it")
-            out = self.root / "out" / path.stem
-            rel_out = out.relative_to(self.root)
+            running = [j for j in self._jobs.values() if j.status == "running"]
+            same = [j for j in running if j.output == str(rel_out)]
+            if same:
+                raise RunGoingOn(
+                    f"run {same[0].id} ({same[0].scenario}) is writing {rel_out} already; wait for it to end or stop it"
+                )
+            if len(running) >= MAX_RUNNING:
+                raise InputError(
+                    f"{len(running)} runs are going on already, the most the editor runs at a time; wait for one to "
+                    "end or stop it"
+                )
             cmd = [sys.executable, "-m", "mmusv.editor.job", str(path), str(out)]
             shown = f"mmusv run {path.name} -o {rel_out} --overwrite"
             if frames is not None:

@@ -4,7 +4,8 @@ The frame goes through the same path as a run: :class:`~mmusv.simulation.Simulat
 scenario's real sensors (only the chosen USV), :func:`mmusv.acquire.annotations_for` annotates it, a
 :class:`~mmusv.recording.frames.FrameRecorder` writes it into a one-frame recording in a temporary folder, and
 :func:`mmusv.preview.compose_preview` draws the sheet from that recording, so the picture is what ``mmusv run`` then
-``mmusv preview --frame K`` would show. Nothing is written into the editor's folder.
+``mmusv preview --frame K`` would show. Nothing is written into the editor's folder. A scenario of more than
+:data:`MAX_PREVIEW_VESSELS` vessels is refused (the picture of one frame of thousands takes minutes).
 """
 
 from __future__ import annotations
@@ -22,12 +23,20 @@ from mmusv.recording.frames import FrameRecorder
 from mmusv.simulation import Simulation
 from mmusv.world.maps import MapWorld
 
-__all__ = ["preview_png"]
+__all__ = ["MAX_PREVIEW_VESSELS", "preview_png"]
+
+MAX_PREVIEW_VESSELS = 1000
+"""Most vessels a preview draws (a few seconds at the limit)."""
 
 
 def preview_png(scenario: Scenario, *, frame: int, agent: str | None = None, world: MapWorld | None = None) -> bytes:
     """PNG bytes of the preview sheet of ``frame`` for the USV ``agent`` (default: the first USV); ``world`` is the
     scenario's map when the caller has it already (it is generated otherwise)."""
+    if len(scenario.vessels) > MAX_PREVIEW_VESSELS:
+        raise ConfigError(
+            f"the scenario has {len(scenario.vessels):,} vessels; the editor previews scenarios of at most "
+            f"{MAX_PREVIEW_VESSELS:,} (`mmusv run` then `mmusv preview` draws any)"
+        )
     usvs = [v.id for v in scenario.usvs]
     if not usvs:
         raise ConfigError("the scenario has no USV (role: usv): there is no sensor to preview")
