@@ -58,3 +58,75 @@ def test_map_findings_of_the_bundled_scenarios_are_clean_or_warnings() -> None:
         _, found = map_findings(sc, map_context(sc.map.type, sc.map.seed, sc.map.param_values()))
         assert all(f.severity == "warning" for f in found), name
         assert np.all([f.check != "in_water" for f in found])
+
+
+def _crowded() -> object:
+    """port_entry with every target sent across the same stretch of the entrance: many close pairs."""
+    data = load_scenario(resolve_scenario("port_entry")).model_dump(mode="json")
+    for k, v in enumerate(data["vessels"][3:]):
+        v["route"] = [[-150.0 + 3.0 * k, -200.0], [-150.0 + 3.0 * k, -100.0]]
+    return load_scenario(data)
+
+
+def test_separation_in_blocks_is_the_whole_array(monkeypatch: object) -> None:
+    """The separation check compares pairs x times in blocks (bounded memory); with blocks of 7 pair samples (so
+    both the pairs and the times are split) its findings are those of one (times, pairs) array, computed here the
+    plain way."""
+    import mmusv.generate.checks as checks
+    from mmusv.generate.hulls import segment_distance
+
+    sc = _crowded()
+    ctx = map_context("port", 3, {})
+    spec = map_check_spec(sc)
+    s = scenario_samples(sc, ctx, spec)
+    sep = Separation(spec.constraints.separation)
+    iu, ju = np.triu_indices(len(s.ids), 1)
+    d = np.stack([np.cos(s.motion_yaw), np.sin(s.motion_yaw)], axis=-1) * s.half[None, :, None]
+    p, q = s.motion - d, s.motion + d
+    hull = segment_distance(p[:, iu], q[:, iu], p[:, ju], q[:, ju]) - (s.radius[iu] + s.radius[ju])[None, :]
+    slack = s.motion_slack + s.motion_turn
+    gap = hull - (slack[iu] + slack[ju])[None, :] - sep.min_m
+    worst = gap.min(axis=0)
+    want = []
+    for j in sorted(np.flatnonzero(worst < 0.0), key=lambda j: (float(worst[j]), int(j))):
+        k = int(np.argmin(gap[:, j]))
+        want.append((s.ids[int(iu[j])], s.ids[int(ju[j])], f"{hull[k, j]:.1f}", f"{s.times[k]:.1f}"))
+    assert len(want) >= 3
+    for block in (7, 10**6):
+        monkeypatch.setattr(checks, "_PAIR_BLOCK", block)  # type: ignore[attr-defined]
+        got = sep.findings(s)
+        assert [f.vessels for f in got] == [w[:2] for w in want]
+        assert all(
+            f"{w[2]} m apart" in f.message and f"t={w[3]} s" in f.message for f, w in zip(got, want, strict=True)
+        )
+
+
+def test_route_separation_is_the_closest_pair_of_route_samples() -> None:
+    """RouteSeparation's k-d tree finds the closest pair of route samples of every USV-target pair: the distance
+    it reports is the brute-force minimum over all pairs of samples."""
+    from mmusv.generate.checks import RouteSeparation
+    from mmusv.generate.spec import RouteSeparationCheck
+
+    sc = _crowded()
+    s = scenario_samples(sc, map_context("port", 3, {}), map_check_spec(sc))
+    usv, target = s.index("usv_3"), s.index("pilot")
+    brute = float(np.linalg.norm(s.geo[:, usv, None, :] - s.geo[None, :, target, :], axis=-1).min())
+    gap = brute - s.geo_slack[usv] - s.geo_slack[target]
+    near = RouteSeparation(RouteSeparationCheck(min_m=gap + 0.05, pairs=["usv-target"])).check(s)
+    far = RouteSeparation(RouteSeparationCheck(min_m=gap - 0.05, pairs=["usv-target"])).check(s)
+    assert near is not None and "come within" in near
+    assert far is None or "usv_3 and pilot" not in far
+
+
+def test_a_fleet_too_large_to_compare_pairwise_is_refused_before_sampling() -> None:
+    """Thousands of vessels: the pairs at every time exceed MAX_CHECK_PAIR_SAMPLES, so the checks refuse (naming
+    the pairs) instead of taking minutes."""
+    from mmusv.generate.checks import MAX_CHECK_PAIR_SAMPLES, budget_problem
+
+    data = load_scenario(resolve_scenario("port_entry")).model_dump(mode="json")
+    base = data["vessels"][3]
+    data["vessels"] += [{**base, "id": f"extra_{k}"} for k in range(1500)]
+    sc = load_scenario(data)
+    problem = budget_problem(sc, 100, 100)
+    assert problem is not None and "pairs of vessels" in problem and f"{MAX_CHECK_PAIR_SAMPLES:,}" in problem
+    assert budget_problem(load_scenario(resolve_scenario("port_entry")), 100, 100) is None

@@ -16,11 +16,11 @@ returns, JSON-ready:
   ``rings`` the LiDAR and radar ranges of a USV's rig (metres);
 * ``valid`` (the schema and the routes are fine; problems may remain), ``frames``, ``frequency_hz``, ``map``.
 
-Bounds: the checks take at most :data:`MAX_CHECK_SAMPLES` samples x vessels and :data:`MAX_CHECK_PAIR_SAMPLES`
-time samples x pairs of vessels (the separation check compares every pair at every time: without this bound a
-fleet of a few thousand vessels, a body of a few hundred kB, would take the server's memory); above either the
-document is not valid and ``errors`` says why. At most :data:`MAX_PROBLEMS` problems are listed; one more entry
-(check ``more``) then says how many were left out.
+Bounds (:mod:`mmusv.generate.checks`' own, re-exported): the checks take at most :data:`MAX_CHECK_SAMPLES`
+samples x vessels and :data:`MAX_CHECK_PAIR_SAMPLES` time samples x pairs of vessels (the separation check
+compares every pair at every time: without this bound a fleet of a few thousand vessels, a body of a few hundred
+kB, would take minutes); above either the document is not valid and ``errors`` says why. At most
+:data:`MAX_PROBLEMS` problems are listed; one more entry (check ``more``) then says how many were left out.
 
 World frame, metres, radians (yaw from +x, counter-clockwise); coordinates rounded to millimetres.
 """
@@ -36,7 +36,7 @@ from pydantic import ValidationError
 
 from mmusv.config import Scenario, validation_problems
 from mmusv.errors import ConfigError, MmusvError
-from mmusv.generate.checks import sample_counts
+from mmusv.generate.checks import MAX_CHECK_PAIR_SAMPLES, MAX_CHECK_SAMPLES, sample_counts
 from mmusv.generate.mapctx import map_context
 from mmusv.motion import build_fleet
 from mmusv.scenario_checks import check_mounts, map_check_spec, map_findings
@@ -55,10 +55,6 @@ __all__ = [
 
 MAX_BULK_FRAMES = 3000
 """Above this many frames the evaluation leaves the per-frame poses out; the page asks for one index at a time."""
-MAX_CHECK_SAMPLES = 5_000_000
-"""Most samples x vessels the live checks take (route or motion samples); above, the editor says so instead."""
-MAX_CHECK_PAIR_SAMPLES = 2_000_000
-"""Most motion samples x pairs of vessels the live checks take (about 0.5 GB and a few seconds at the limit)."""
 MAX_PROBLEMS = 1000
 """Most problems listed; the rest are counted in one last entry."""
 

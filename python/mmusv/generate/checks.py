@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from mmusv._native import core
 from mmusv.config import Scenario
@@ -53,6 +54,7 @@ from mmusv.motion import build_fleet
 from mmusv.world.vessels import get_asset
 
 __all__ = [
+    "MAX_CHECK_PAIR_SAMPLES",
     "MAX_CHECK_SAMPLES",
     "Constraint",
     "Finding",
@@ -69,6 +71,14 @@ MAX_CHECK_SAMPLES = 5_000_000
 """The most samples (per-vessel samples, in time or along the routes, whichever is more, times the vessels) the
 checks of one scenario take: about three minutes and a few GiB. :func:`take_samples` refuses more (a
 :class:`~mmusv.errors.ConfigError`) instead of allocating them; the scenario editor checks at most as many."""
+
+MAX_CHECK_PAIR_SAMPLES = 5_000_000
+"""The most motion samples x pairs of vessels the separation check compares (every pair at every time): a few
+seconds. Above, :func:`budget_problem` refuses, as a fleet of thousands of vessels would otherwise take minutes.
+The comparison itself runs in blocks of :data:`_PAIR_BLOCK` pair samples, so its memory stays small at any size."""
+
+_PAIR_BLOCK = 262_144
+"""Pair samples (times x pairs) the separation check holds at once (a few tens of MB of temporaries)."""
 
 _SATURATE = 2**62
 """A sample count past every budget, for counts that overflow (a non-finite time or route length)."""
@@ -184,18 +194,25 @@ def _fmt(n: int) -> str:
 
 
 def budget_problem(scenario: Scenario, n_motion: int, n_route: int) -> str | None:
-    """None when ``n_motion``/``n_route`` samples per vessel (:func:`sample_counts`) fit :data:`MAX_CHECK_SAMPLES`,
-    else why not: the sample count, split into time and route samples (callers add what to do about it)."""
+    """None when ``n_motion``/``n_route`` samples per vessel (:func:`sample_counts`) fit :data:`MAX_CHECK_SAMPLES`
+    and the pairs of vessels at every motion sample fit :data:`MAX_CHECK_PAIR_SAMPLES`, else why not: the sample
+    count, split into time and route samples, or the pair count (callers add what to do about it)."""
     n_v = len(scenario.vessels)
     total = max(n_motion, n_route) * n_v
-    if total <= MAX_CHECK_SAMPLES:
-        return None
     acq = scenario.acquisition
-    return (
-        f"the route checks would take {_fmt(total)} samples ({_fmt(n_motion)} in time over {acq.frames:,} frames at "
-        f"{acq.frequency_hz:g} Hz, {_fmt(n_route)} along the longest route, x {n_v} vessel{'s' if n_v != 1 else ''}),"
-        f" more than the {MAX_CHECK_SAMPLES:,} they take at most"
-    )
+    if total > MAX_CHECK_SAMPLES:
+        return (
+            f"the route checks would take {_fmt(total)} samples ({_fmt(n_motion)} in time over {acq.frames:,} frames "
+            f"at {acq.frequency_hz:g} Hz, {_fmt(n_route)} along the longest route, x {n_v} "
+            f"vessel{'s' if n_v != 1 else ''}), more than the {MAX_CHECK_SAMPLES:,} they take at most"
+        )
+    pairs = n_v * (n_v - 1) // 2
+    if n_motion * pairs > MAX_CHECK_PAIR_SAMPLES:
+        return (
+            f"the route checks would compare {pairs:,} pairs of vessels ({n_v} vessels) at {_fmt(n_motion)} times "
+            f"({_fmt(n_motion * pairs)} pair samples), more than the {MAX_CHECK_PAIR_SAMPLES:,} they compare at most"
+        )
+    return None
 
 
 def sample_counts(scenario: Scenario, spec: GenerationSpec) -> tuple[int, int]:
@@ -366,19 +383,35 @@ class Separation:
         iu, ju = np.triu_indices(n, 1)
         d = np.stack([np.cos(s.motion_yaw), np.sin(s.motion_yaw)], axis=-1) * s.half[None, :, None]
         p, q = s.motion - d, s.motion + d  # capsule axes (T, V, 2)
-        dist = segment_distance(p[:, iu], q[:, iu], p[:, ju], q[:, ju])  # (T, pairs)
-        hull = dist - (s.radius[iu] + s.radius[ju])[None, :]
         slack = s.motion_slack + s.motion_turn
-        gap = hull - (slack[iu] + slack[ju])[None, :] - self.min_m
-        worst = gap.min(axis=0)
+        reach = s.radius[iu] + s.radius[ju]
+        pair_slack = slack[iu] + slack[ju]
+        # Each pair's tightest moment (the first, on a tie), over blocks of times x pairs: the same values as one
+        # (T, pairs) array, in bounded memory.
+        worst = np.full(len(iu), np.inf)
+        at = np.zeros(len(iu), dtype=np.int64)
+        hull_at = np.zeros(len(iu))
+        for c0 in range(0, len(iu), _PAIR_BLOCK):
+            c = slice(c0, min(c0 + _PAIR_BLOCK, len(iu)))
+            a_, b_, cols = iu[c], ju[c], np.arange(c.stop - c0)
+            t_step = max(1, _PAIR_BLOCK // len(cols))
+            for t0 in range(0, len(s.times), t_step):
+                t = slice(t0, t0 + t_step)
+                hull = segment_distance(p[t, a_], q[t, a_], p[t, b_], q[t, b_]) - reach[None, c]
+                gap = hull - pair_slack[None, c] - self.min_m
+                k = np.argmin(gap, axis=0)
+                better = gap[k, cols] < worst[c]  # strictly: an earlier block keeps a tie, as argmin would
+                worst[c] = np.where(better, gap[k, cols], worst[c])
+                at[c] = np.where(better, t0 + k, at[c])
+                hull_at[c] = np.where(better, hull[k, cols], hull_at[c])
         out = []
         for j in sorted(np.flatnonzero(worst < 0.0), key=lambda j: (float(worst[j]), int(j))):
-            k = int(np.argmin(gap[:, j]))
+            k = int(at[j])
             a, b = int(iu[j]), int(ju[j])
             mid = (s.motion[k, a] + s.motion[k, b]) / 2.0
             out.append(
                 Finding(
-                    f"{s.ids[a]} and {s.ids[b]} come {hull[k, j]:.1f} m apart (hulls) at t={s.times[k]:.1f} s; "
+                    f"{s.ids[a]} and {s.ids[b]} come {hull_at[j]:.1f} m apart (hulls) at t={s.times[k]:.1f} s; "
                     f"need {self.min_m:g} m",
                     (s.ids[a], s.ids[b]),
                     (float(mid[0]), float(mid[1])),
@@ -401,7 +434,8 @@ class RouteSeparation:
                 pair = "-".join(sorted((kind[i], kind[j]), key=("usv", "target").index))
                 if pair not in self.pairs:
                     continue
-                d = np.linalg.norm(s.geo[:, i, None, :] - s.geo[None, :, j, :], axis=-1)
+                # The closest pair of route samples, through a k-d tree of one route's: O(G log G), not G x G.
+                d, _ = cKDTree(s.geo[:, j, :]).query(s.geo[:, i, :])
                 gap = float(d.min()) - s.geo_slack[i] - s.geo_slack[j]
                 if gap < self.min_m:
                     return (
