@@ -23,7 +23,7 @@ import yaml
 
 from mmusv.errors import ConfigError
 
-__all__ = ["MAX_YAML_BYTES", "mapping_source", "parse_yaml", "read_yaml"]
+__all__ = ["MAX_YAML_BYTES", "MAX_YAML_VALUES", "decode_text", "mapping_source", "parse_yaml", "read_yaml"]
 
 MAX_YAML_BYTES = 64 * 1024 * 1024
 """Largest YAML input read (64 MiB): larger files are refused before they are read."""
@@ -88,7 +88,10 @@ for _loader in (_UniqueKeyLoader, _FastUniqueKeyLoader):
         _loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
 
 
-def _decode(raw: bytes, where: str) -> str:
+def decode_text(raw: bytes, where: str) -> str:
+    """The text of a YAML file's bytes ``raw`` (UTF-8, a leading byte-order mark dropped);
+    :class:`~mmusv.errors.ConfigError` naming ``where`` for UTF-16/32 (by their byte-order marks), binary (a NUL
+    byte) or other non-UTF-8 files, with the offset of the first bad byte."""
     for bom, name in _BOMS.items():
         if raw.startswith(bom):
             raise ConfigError(f"{where}: the file is encoded as {name}; save it as UTF-8")
@@ -139,15 +142,24 @@ def _check_expansion(data: Any, where: str) -> None:
     """Refuses a document that expands to more than :data:`MAX_YAML_VALUES` values, counting a value as often as
     aliases repeat it (PyYAML shares one object per anchor, so the document is small in memory, but everything
     that reads it walks every repetition). Stops counting at the limit."""
-    count, stack = 0, [data]
+    count, stack, seen, aliased = 0, [data], set(), False
     while stack:
         v = stack.pop()
         count += 1
         if count > MAX_YAML_VALUES:
+            if aliased:
+                raise ConfigError(
+                    f"{where}: the document expands to more than {MAX_YAML_VALUES:,} values (aliases repeating "
+                    "anchors within anchors); write the values out or use fewer repetitions"
+                )
             raise ConfigError(
-                f"{where}: the document expands to more than {MAX_YAML_VALUES:,} values (aliases repeating "
-                "anchors within anchors); write the values out or use fewer repetitions"
+                f"{where}: the document holds more than {MAX_YAML_VALUES:,} values, more than a YAML file of mmusv "
+                "may; split it (fewer vessels or waypoints per scenario)"
             )
+        if isinstance(v, (dict, list)):
+            if id(v) in seen:  # the same container met again: an alias repeats an anchor
+                aliased = True
+            seen.add(id(v))
         if isinstance(v, dict):
             stack.extend(v.keys())
             stack.extend(v.values())
@@ -169,7 +181,7 @@ def read_yaml(path: str | os.PathLike[str], *, kind: str = "YAML") -> Any:
         raw = p.read_bytes()
     except OSError as exc:
         raise ConfigError(f"{kind} file {str(p)!r} cannot be read: {exc.strerror or exc}") from None
-    return parse_yaml(_decode(raw, str(p)), str(p))
+    return parse_yaml(decode_text(raw, str(p)), str(p))
 
 
 def mapping_source(source: Any, *, kind: str, root_hint: str) -> tuple[dict[str, Any], str]:

@@ -124,7 +124,18 @@ def test_an_alias_bomb_is_refused_before_it_is_walked(tmp_path: Path) -> None:
         lines.append(f"{name}: &{name} [" + ", ".join([f"*{prev}"] * 9) + "]")
     lines.append("vessels: *i")
     msg = _yaml_refused("\n".join(lines) + "\n", tmp_path)
-    assert f"{MAX_YAML_VALUES:,} values" in msg, msg
+    assert f"{MAX_YAML_VALUES:,} values" in msg and "aliases" in msg, msg
+
+
+def test_a_plain_document_past_the_value_limit_is_not_blamed_on_aliases(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import mmusv.yamlio
+
+    monkeypatch.setattr(mmusv.yamlio, "MAX_YAML_VALUES", 2000)  # the real limit takes seconds to reach
+    route = "[" + ", ".join(f"[{k}, 0]" for k in range(1200)) + "]"
+    msg = _yaml_refused(f"name: t\nvessels: [{{id: a, route: {route}}}]\n", tmp_path)
+    assert "more than 2,000 values" in msg and "aliases" not in msg and "split it" in msg, msg
 
 
 def test_a_merge_key_may_be_overridden(tmp_path: Path) -> None:

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from mmusv.errors import ConfigError, InputError, IoError, NotFoundError
+from mmusv.yamlio import decode_text
 
 __all__ = [
     "MAX_FILE_BYTES",
@@ -40,7 +41,6 @@ __all__ = [
     "ScenarioFolder",
     "ScenarioText",
     "check_name",
-    "decode_text",
     "etag",
 ]
 
@@ -49,13 +49,6 @@ _NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.\-]{0,122}\.ya?ml")
 MAX_FILE_BYTES = 16 * 1024 * 1024
 """Largest scenario file the editor opens (16 MiB, as large as the largest request it takes); larger files are
 refused before they are read whole."""
-
-_BOMS = {
-    b"\xff\xfe\x00\x00": "UTF-32 (little-endian)",
-    b"\x00\x00\xfe\xff": "UTF-32 (big-endian)",
-    b"\xff\xfe": "UTF-16 (little-endian)",
-    b"\xfe\xff": "UTF-16 (big-endian)",
-}
 
 
 class FileExistsInFolder(IoError):
@@ -80,26 +73,6 @@ def check_name(name: str) -> str:
             ".yml (letters, digits, _ - and ., no folders, no leading dot)"
         )
     return name
-
-
-def decode_text(data: bytes, *, name: str) -> str:
-    """The text of a scenario file's bytes ``data`` (UTF-8, a leading byte-order mark dropped);
-    :class:`~mmusv.errors.ConfigError` naming ``name`` and the first bad byte for UTF-16/32, binary or other
-    non-UTF-8 files."""
-    for bom, encoding in _BOMS.items():
-        if data.startswith(bom):
-            raise ConfigError(f"{name}: the file is encoded as {encoding}; save it as UTF-8")
-    data = data.removeprefix(b"\xef\xbb\xbf")
-    nul = data.find(b"\x00")
-    if nul >= 0:
-        raise ConfigError(f"{name}: not a text file (a NUL byte at offset {nul}); expected UTF-8 YAML")
-    try:
-        return data.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise ConfigError(
-            f"{name}: not UTF-8 text (byte 0x{data[exc.start : exc.start + 1].hex()} at offset {exc.start}); "
-            "save the file as UTF-8"
-        ) from None
 
 
 @dataclass(frozen=True)
@@ -162,7 +135,7 @@ class ScenarioFolder:
             raise ConfigError(
                 f"{name}: larger than {MAX_FILE_BYTES:,} bytes, the most the editor opens; edit it as text"
             )
-        return ScenarioText(p, decode_text(data, name=name), etag(data))
+        return ScenarioText(p, decode_text(data, name), etag(data))
 
     def etag_of(self, name: str) -> str | None:
         """The ETag of the file ``name`` now, or ``None`` when it does not exist."""
