@@ -206,7 +206,8 @@ def radar_ppi(out: Path, lines: list[str]) -> None:
 
 def lidar_wake(out: Path, lines: list[str]) -> None:
     """A patrol boat at 14 m/s passes 15 m beside a USV at W1: the USV's LiDAR returns in plan view, before (the
-    same sweep without the wakes) and after (the capture, the wakes' foam seen), coloured by class."""
+    same sweep without the wakes) and after (the capture: the wakes' foam, and their Kelvin waves tilting the facets),
+    coloured by class."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -233,7 +234,7 @@ def lidar_wake(out: Path, lines: list[str]) -> None:
     seed = sensor_seed(sim.scenario.seed, frame, agent.index, "lidar")
     without = scan(agent.lidar, sim.ws.scene, pose=ac.lidar_pose, env=sim.sensor_env, seed=seed)
     fig, axes = plt.subplots(1, 2, figsize=(12, 5.4), sharex=True, sharey=True)
-    for ax, (name, pts) in zip(axes, (("before (no wake foam)", without), ("after", ac.lidar)), strict=True):
+    for ax, (name, pts) in zip(axes, (("before (no wakes)", without), ("after", ac.lidar)), strict=True):
         p = pts.xyz.astype(np.float64) @ ac.lidar_pose[:3, :3].T + ac.lidar_pose[:3, 3]
         water = pts.semantic_class == 1
         ax.scatter(p[water, 0], p[water, 1], s=1, c="tab:blue", label=f"water ({int(water.sum())})")
