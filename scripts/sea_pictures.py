@@ -206,8 +206,7 @@ def radar_ppi(out: Path, lines: list[str]) -> None:
 
 def lidar_wake(out: Path, lines: list[str]) -> None:
     """A patrol boat at 14 m/s passes 15 m beside a USV at W1: the USV's LiDAR returns in plan view, before (the
-    same sweep without the wakes) and after (the capture: the wakes' foam, and their Kelvin waves tilting the facets),
-    coloured by class."""
+    same sweep without the wakes) and after (the capture, the wakes' foam seen), coloured by class."""
     import matplotlib
 
     matplotlib.use("Agg")

@@ -11,10 +11,9 @@
 //! 3. open water (class 1): on a scene with a displaced wave surface ([`crate::Scene::wave_surface`]), a return
 //!    with the probability of the physical model in [`super::lidar_water`] (quasi-specular glints off the wave
 //!    facet met, at its incidence angle, whitecaps, and the foam of the wakes where the beam meets it — the
-//!    cameras' wake foam at that point — detected through speckle), with that model's intensity; the facet is
-//!    tilted by the slopes of the vessels' Kelvin waves there (the cameras' [`super::shade::kelvin`], those the
-//!    beam's footprint resolves), so a wake's waves turn its glints towards or away from the sensor as they do
-//!    the cameras' reflections;
+//!    cameras' wake foam at that point — detected through speckle), with that model's intensity (the vessels'
+//!    Kelvin waves, the cameras' slopes, do not tilt the facet: `docs/sea/README.md`, *LiDAR returns from
+//!    wakes*, says what that cost);
 //!    on a flat sea, the empirical rule: a return only with probability
 //!    `p_w = water_probability + water_probability_per_wave_m · H` (clamped to 1) and only within
 //!    `water_range_m + water_range_per_wave_m · H` — calm water is a mirror at 905 nm, waves give the beam facets
@@ -32,7 +31,6 @@ use super::lidar_water;
 use super::noise::{self, stream};
 use super::rays;
 use super::shade::foam::{Foam, FOAM_SEED};
-use super::shade::kelvin::{self, KelvinWaves};
 use super::shade::wake::Wake;
 use crate::error::{MmusvError, Result};
 use crate::geometry::RigidPose;
@@ -41,11 +39,6 @@ use parry3d::math::Vec3;
 
 /// Semantic class of open water (see `mmusv.classes`).
 pub const CLASS_WATER: u16 = 1;
-
-/// Full-angle divergence of a beam, radians (3 mrad: 0.18°, the Ouster OS1's datasheet figure, of the order of
-/// every 64-channel spinning LiDAR's): its footprint on the water, `r · divergence / |d_z|`, decides which Kelvin
-/// waves it resolves ([`KelvinWaves::slope`]).
-pub const BEAM_DIVERGENCE_RAD: f32 = 3e-3;
 
 /// Configuration of a spinning LiDAR. Angles in radians, distances in metres.
 #[derive(Debug, Clone, PartialEq)]
@@ -271,8 +264,6 @@ impl Lidar {
         let wake_foam = Some(Foam::new(0.0, wakes, FOAM_SEED))
             .filter(|f| waves && !f.is_empty())
             .map(|f| f.around([origin[0], origin[1]], cfg.range_max));
-        // The vessels' Kelvin waves, tilting the facets their beams meet (only over a wave surface too).
-        let kelvin = Some(KelvinWaves::new(wakes)).filter(|k| waves && !k.is_empty());
         let mut out = LidarScan {
             beam_instance: slot.iter().map(|&k| hits.instance[k as usize]).collect(),
             ..LidarScan::default()
@@ -292,10 +283,10 @@ impl Lidar {
             let mut water_intensity = None;
             if class == CLASS_WATER {
                 if waves {
-                    let d = Vec3::from_array(dirs[k]);
-                    let p = Vec3::from_array(origin) + d * r;
-                    let foam = wake_foam.as_ref().map_or(0.0, |f| f.cover(p.x, p.y, None));
-                    let cos = kelvin.as_ref().map_or(cos, |kw| kelvin_tilted_cos(kw, n, d, p, r));
+                    let foam = wake_foam.as_ref().map_or(0.0, |f| {
+                        let p = Vec3::from_array(origin) + Vec3::from_array(dirs[k]) * r;
+                        f.cover(p.x, p.y, None)
+                    });
                     let mean = lidar_water::mean_intensity_with_foam(cos, env.wind_speed_m_s, r, tau, foam);
                     if noise::uniform(seed, stream::WATER, idx) >= f64::from(lidar_water::detection_probability(mean)) {
                         continue;
@@ -332,16 +323,6 @@ impl Lidar {
         }
         Ok(out)
     }
-}
-
-/// `|cos θ|` of a beam along unit `d` meeting the water at `p`, `r` metres out, whose resolved facet has the
-/// normal `n`, once the vessels' Kelvin waves tilt that facet: their slopes at `p` that the beam's footprint
-/// (`r ·` [`BEAM_DIVERGENCE_RAD`] `/ |d_z|`) resolves are added to the facet's, as the cameras add them to their
-/// shading normals ([`kelvin::tilted`]). Where no wave reaches `p`, `n`'s own cosine.
-#[inline]
-fn kelvin_tilted_cos(kelvin: &KelvinWaves, n: Vec3, d: Vec3, p: Vec3, r: f32) -> f32 {
-    let footprint = r * BEAM_DIVERGENCE_RAD / d.z.abs().max(0.05);
-    kelvin::tilted(n, kelvin.slope(p.x, p.y, footprint).slope).dot(d).abs().min(1.0)
 }
 
 #[cfg(test)]

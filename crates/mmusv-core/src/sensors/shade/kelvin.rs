@@ -38,9 +38,9 @@
 //! [`super::wake::WAKE_REACH_S`] of its travel nor than where their steepest slope falls below `4·10⁻³`; a wake row
 //! of an older piece of a bent path draws none (its foam does). The waves are slopes, not geometry: the sea's
 //! surface, and so every ray's hit point, does not move with them (their heights, centimetres to decimetres, stay
-//! out of the wave surface). The cameras shade with them, and the LiDAR's water model ([`super::super::lidar`])
-//! tilts the facets its beams meet by them ([`tilted`]); the radar's sea clutter, a statistical model of the
-//! whole sea state, does not see them.
+//! out of the wave surface). The cameras shade with them ([`tilted`]); the LiDAR's water model and the radar's
+//! sea clutter do not see them (tilting the LiDAR's facets by them was tried and cost 15 % of a LiDAR-only W3
+//! recording's speed: `docs/sea/README.md`, *LiDAR returns from wakes*).
 
 #![allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x > 0.0)` on purpose: a NaN must answer "no waves"
 
