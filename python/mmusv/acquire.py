@@ -31,6 +31,7 @@ from typing import Any
 
 import yaml
 
+from mmusv import arguments
 from mmusv.annotate import Annotations, SilhouetteCache, annotate_agent
 from mmusv.config import Scenario, load_scenario, scenario_hash
 from mmusv.errors import ConfigError, IoError, MmusvError, located
@@ -122,14 +123,15 @@ def run(
     """Runs a scenario (a YAML path, a dict or a :class:`~mmusv.config.Scenario`) into ``out_dir``.
 
     Args:
-        out_dir: output folder (created).
+        out_dir: output folder (a ``str`` or ``os.PathLike``, not empty; created).
         overwrite: replace an existing recording of the same scenario name; otherwise that is an error.
-        frames: run only the first ``frames`` indices (default: the scenario's ``acquisition.frames``).
+        frames: run only the first ``frames`` indices, a whole number (``int`` or numpy integer) in
+            ``1..acquisition.frames`` (default: the scenario's ``acquisition.frames``).
         progress: called (on the calling thread) with (frames done, frames total) after every frame has been
-            captured, annotated and handed to the writer.
-        frame_range: ``(first, stop)``: run only acquisition indices ``first .. stop - 1`` (one part of a
-            recording split into frame ranges, :mod:`mmusv.batch`); every frame is the same as in a whole run
-            (each frame is captured from its own frozen state and seeds). Not together with ``frames``.
+            captured, annotated and handed to the writer; a callable taking two arguments, checked before the run.
+        frame_range: ``(first, stop)``, two whole numbers: run only acquisition indices ``first .. stop - 1`` (one
+            part of a recording split into frame ranges, :mod:`mmusv.batch`); every frame is the same as in a whole
+            run (each frame is captured from its own frozen state and seeds). Not together with ``frames``.
         checks: run the generator's route checks on the map (:mod:`mmusv.scenario_checks`): a route over land
             is an error, clearance and separation problems and far-away mounts are warnings.
         profile: time every stage (each sensor, annotation, encoding, writing, the rest) into
@@ -141,32 +143,44 @@ def run(
     (a clean redo; ``notes`` says so), and table parts of an earlier run are removed first.
 
     Raises:
-        ConfigError: the scenario is invalid (nothing is written).
+        ConfigError: the scenario or an argument is invalid (nothing is written); flags (``overwrite``,
+            ``checks``, ``profile``) must be ``bool``.
         IoError: the output exists and ``overwrite`` is false, another run writes the folder, or it cannot be
             written (the message names the cause, e.g. ``No space left on device``, and the frames that are safe).
         KeyboardInterrupt: re-raised after the recording was finished with every completed frame.
     """
 
+    # The arguments' types first (cheap, and before anything is built or written), their ranges once the scenario
+    # says how many frames it has.
+    out = arguments.path(out_dir, name="out_dir")
+    overwrite = arguments.flag(overwrite, name="overwrite")
+    checks = arguments.flag(checks, name="checks")
+    profile = arguments.flag(profile, name="profile")
+    progress = arguments.callback(progress, name="progress", nargs=2)
+    if notes is not None and not isinstance(notes, list):
+        raise ConfigError(f"notes = {arguments.shown(notes)}: must be a list (lines are appended to it), or None")
+    count = None if frames is None else arguments.whole(frames, name="frames")
+    span = None if frame_range is None else _frame_range(frame_range)
     if isinstance(cfg, (str, os.PathLike)) and Path(cfg).is_dir():
         raise ConfigError(
             f"{cfg} is a directory; mmusv.run takes one scenario file (run a folder with `mmusv run {cfg} -o OUT`)"
         )
     source = str(cfg) if isinstance(cfg, (str, os.PathLike)) else "scenario"
     scenario = load_scenario(cfg)
-    total = scenario.acquisition.frames if frames is None else int(frames)
+    total = scenario.acquisition.frames if count is None else count
     if not 1 <= total <= scenario.acquisition.frames:
         raise ConfigError(f"frames = {frames}: must be in 1..{scenario.acquisition.frames} (acquisition.frames)")
     first = 0
-    if frame_range is not None:
+    if span is not None:
         if frames is not None:
             raise ConfigError("give frames or frame_range, not both")
-        first, total = int(frame_range[0]), int(frame_range[1])
+        first, total = span
         if not 0 <= first < total <= scenario.acquisition.frames:
             raise ConfigError(
-                f"frame_range = {tuple(frame_range)}: must be (first, stop) with 0 <= first < stop <= "
+                f"frame_range = {span}: must be (first, stop) with 0 <= first < stop <= "
                 f"{scenario.acquisition.frames} (acquisition.frames)"
             )
-    out = Path(out_dir)
+        frame_range = span
     rec_path = recording_path(out, scenario)
     if rec_path.exists() and not overwrite:
         raise IoError(f"{rec_path} already exists; pass overwrite=True (mmusv run --overwrite) to replace it")
@@ -190,6 +204,19 @@ def run(
         )
     finally:
         lock.release()
+
+
+def _frame_range(value: Any) -> tuple[int, int]:
+    """``run``'s ``frame_range`` as ``(first, stop)``: a tuple or list of exactly two whole numbers."""
+    if not isinstance(value, (tuple, list)) or len(value) != 2:
+        raise ConfigError(
+            f"frame_range = {arguments.shown(value)}: must be (first, stop), two whole numbers (acquisition indices "
+            "first .. stop - 1)"
+        )
+    return (
+        arguments.whole(value[0], name="frame_range[0] (first)"),
+        arguments.whole(value[1], name="frame_range[1] (stop)"),
+    )
 
 
 def _record(

@@ -137,18 +137,16 @@ class SeaConfig(_Model):
         """The resolved sea."""
         from mmusv.world.sea_state import sea_spec_for_height, sea_spec_for_preset
 
-        if self.state is not None:
-            p = sea_spec_for_preset(str(self.state), direction_deg=self.direction_deg, spread_s=self.spread_s)
-            return p if self.gamma is None else replace(p, gamma=self.gamma)
-        assert self.hs_m is not None
-        spec = sea_spec_for_height(
-            self.hs_m, tp_s=self.tp_s, gamma=self.gamma, direction_deg=self.direction_deg, spread_s=self.spread_s
-        )
-        try:
-            spec.field(scenario_seed=0)
+        try:  # the core checks the ranges together (errors name the field)
+            if self.state is not None:
+                p = sea_spec_for_preset(str(self.state), direction_deg=self.direction_deg, spread_s=self.spread_s)
+                return p if self.gamma is None else replace(p, gamma=self.gamma)
+            assert self.hs_m is not None
+            return sea_spec_for_height(
+                self.hs_m, tp_s=self.tp_s, gamma=self.gamma, direction_deg=self.direction_deg, spread_s=self.spread_s
+            )
         except MmusvError as exc:
             raise ValueError(f"environment.sea: {exc}") from None
-        return spec
 
 
 class EnvironmentConfig(_Model):

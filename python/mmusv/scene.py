@@ -14,6 +14,7 @@ Example::
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass
 from typing import Any, Protocol
@@ -21,13 +22,24 @@ from typing import Any, Protocol
 import numpy as np
 import numpy.typing as npt
 
+from mmusv import arguments
 from mmusv._native import core
 from mmusv.errors import GeometryError, InputError, NotFoundError
 
-__all__ = ["NO_HIT", "RayHits", "Scene", "demo_scene"]
+__all__ = ["MAX_SURFACE_TILES", "NO_HIT", "SURFACE_TILE_M", "RayHits", "Scene", "demo_scene", "surface_tiles"]
 
 NO_HIT = -1
 """Value of ``RayHits.instance_id`` and ``triangle_id`` where the ray hit nothing."""
+
+SURFACE_TILE_M = 32.0
+"""Side of a tile of the displaced sea surface, metres (the core's ``SurfaceSpec::tile_m``, which
+:meth:`Scene.set_wave_surface` leaves at its default)."""
+MAX_SURFACE_TILES = 2**22
+"""Most tiles one displaced sea surface may hold. The core samples the rectangle around every focus (out to
+``radius_m``) as one grid of :data:`SURFACE_TILE_M` tiles, so foci far apart (or a huge radius) would ask it for
+more memory than any machine has: 2²² tiles is a square of about 65 km a side, beyond any map."""
+MAX_DEMO_CELLS = 4096
+"""Largest ``terrain_cells`` and ``vessels`` of :func:`demo_scene` (4096² cells: 33 million terrain triangles)."""
 
 
 class SeaState(Protocol):
@@ -80,14 +92,56 @@ class RayHits:
         return self.instance_id >= 0
 
     def points(self, origins: npt.ArrayLike, directions: npt.ArrayLike) -> npt.NDArray[np.float32]:
-        """``(N, 3)`` float32 world hit points (``nan`` rows for misses)."""
-        o = np.asarray(origins, dtype=np.float32)
-        d = np.asarray(directions, dtype=np.float32)
-        d = d / np.linalg.norm(d, axis=1, keepdims=True)
+        """``(N, 3)`` float32 world hit points (``nan`` rows for misses) of the ``(N, 3)`` ``origins`` and
+        non-zero ``directions`` the rays were cast with."""
+        n = self.distance.shape[0]
+        o = _array(origins, name="origins", dtype=np.float32, shape_tail=(3,))
+        d = _array(directions, name="directions", dtype=np.float32, shape_tail=(3,))
+        if o.shape[0] != n or d.shape[0] != n:
+            raise InputError(
+                f"points: got {o.shape[0]} origins and {d.shape[0]} directions for {n} rays; give the arrays the rays "
+                "were cast with"
+            )
+        norm = np.linalg.norm(d, axis=1, keepdims=True)
+        if n and not (np.isfinite(norm).all() and (norm > 0).all()):
+            raise InputError("points: every direction must be finite and non-zero")
+        d = d / norm
         with np.errstate(invalid="ignore"):
             p: npt.NDArray[np.float32] = o + d * self.distance[:, None]
         p[~self.hit] = np.nan
         return p.astype(np.float32, copy=False)
+
+
+def surface_tiles(foci: npt.ArrayLike, radius_m: float) -> int:
+    """How many tiles the displaced sea surface around ``foci`` ``(F, 2)`` (world x, y, metres) out to
+    ``radius_m`` holds: the core samples their bounding rectangle, grown by ``radius_m``, as one grid of
+    :data:`SURFACE_TILE_M` tiles (0 without foci)."""
+    f = np.asarray(foci, dtype=np.float64).reshape(-1, 2)
+    if f.shape[0] == 0:
+        return 0
+    lo, hi = f.min(axis=0) - radius_m, f.max(axis=0) + radius_m
+    x0 = np.floor(lo / SURFACE_TILE_M) * SURFACE_TILE_M
+    n = np.ceil((hi - x0) / SURFACE_TILE_M)
+    return int(n[0]) * int(n[1])
+
+
+_SEA_FIELDS = ("hs_m", "tp_s", "gamma", "direction_rad", "spread_s")
+
+
+def check_sea(sea: Any, *, name: str, error: type[Exception] = InputError) -> None:
+    """``sea`` must be ``None`` or a :class:`SeaState` (e.g. :class:`~mmusv.world.sea_state.SeaSpec`): an object
+    with the real numbers ``hs_m``, ``tp_s``, ``gamma``, ``direction_rad`` and ``spread_s``."""
+    if sea is None:
+        return
+    missing = [k for k in _SEA_FIELDS if not hasattr(sea, k)]
+    if missing:
+        raise error(
+            f"{name} = {arguments.shown(sea)}: must be a sea state such as mmusv.world.sea_state.SeaSpec "
+            f"(sea_spec_for_preset('4'), sea_spec_for_height(2.0)) with {', '.join(_SEA_FIELDS)}, or None; "
+            f"{type(sea).__name__} has no {', '.join(missing)}"
+        )
+    for k in _SEA_FIELDS:
+        arguments.real(getattr(sea, k), name=f"{name}.{k}", error=error)
 
 
 def _surface_args(
@@ -102,22 +156,37 @@ def _surface_args(
 ) -> tuple[float | None, dict[str, Any]]:
     """The native ``set_wave_surface`` / ``prefetch_wave_surface`` arguments of :meth:`Scene.set_wave_surface`'s:
     ``hs_m`` (``None`` without a sea) and the keywords."""
+    check_sea(sea, name="sea")
     if sea is None:
         return None, {}
     f = _array(foci, name="foci", dtype=np.float32, shape_tail=(2,))
+    seed = arguments.whole(scenario_seed, name="scenario_seed", lo=0, hi=2**64 - 1, error=InputError)
+    t = arguments.real(time_s, name="time_s", unit="seconds", error=InputError)
+    radius = arguments.real(radius_m, name="radius_m", unit="metres", above=0.0, error=InputError)
+    fine = arguments.real(fine_m, name="fine_m", unit="metres", lo=0.0, error=InputError)
+    flags = {k: arguments.flag(v, name=k, error=InputError) for k, v in (("detail", detail), ("slopes", slopes))}
+    if np.isfinite(f).all():  # (non-finite foci: the core names them)
+        tiles = surface_tiles(f, radius)
+        if tiles > MAX_SURFACE_TILES:
+            span = f.max(axis=0) - f.min(axis=0)
+            raise InputError(
+                f"the sea surface around foci spanning {span[0]:.0f} m x {span[1]:.0f} m out to radius_m = {radius:g} "
+                f"would hold {float(tiles):.3g} tiles of {SURFACE_TILE_M:g} m; at most {MAX_SURFACE_TILES} (a square "
+                f"of about {math.sqrt(MAX_SURFACE_TILES) * SURFACE_TILE_M / 1000.0:.0f} km): bring the foci closer "
+                "together or lower radius_m"
+            )
     return float(sea.hs_m), {
         "tp_s": float(sea.tp_s),
         "gamma": float(sea.gamma),
         "direction_rad": float(sea.direction_rad),
         "spread_s": float(sea.spread_s),
-        "scenario_seed": int(scenario_seed),
-        "time_s": float(time_s),
+        "scenario_seed": seed,
+        "time_s": t,
         "foci": f,
-        "radius_m": float(radius_m),
-        "taper_m": min(60.0, float(radius_m)),
-        "detail": bool(detail),
-        "slopes": bool(slopes),
-        "fine_m": float(fine_m),
+        "radius_m": radius,
+        "taper_m": min(60.0, radius),
+        "fine_m": fine,
+        **flags,
     }
 
 
@@ -127,7 +196,7 @@ def _array(value: Any, *, name: str, dtype: Any, shape_tail: tuple[int, ...]) ->
         arr = np.asarray(value)
     except Exception as exc:
         raise InputError(f"{name} could not be converted to an array: {exc}") from None
-    if arr.dtype == object or not (np.issubdtype(arr.dtype, np.number) or arr.dtype == np.bool_):
+    if arr.dtype == object or not np.issubdtype(arr.dtype, np.number):
         raise InputError(f"{name} must be numeric, got dtype {arr.dtype}")
     if np.iscomplexobj(arr):
         raise InputError(f"{name} must be real, got complex dtype {arr.dtype}")
@@ -137,7 +206,8 @@ def _array(value: Any, *, name: str, dtype: Any, shape_tail: tuple[int, ...]) ->
         raise InputError(f"{name} must have shape (N, {tail}), got {arr.shape}")
     if np.issubdtype(dtype, np.integer) and not np.issubdtype(arr.dtype, np.integer):
         raise InputError(f"{name} must be an integer array, got dtype {arr.dtype}")
-    return np.ascontiguousarray(arr, dtype=dtype)
+    with np.errstate(over="ignore", invalid="ignore"):  # values past float32 become inf, which the checks name
+        return np.ascontiguousarray(arr, dtype=dtype)
 
 
 def _floats(value: Any, *, name: str) -> np.ndarray:
@@ -208,8 +278,16 @@ class Scene:
             materials: one material id or ``(F,)`` ids into the table of :meth:`set_materials` (0: the class's
                 default look; the cameras' shading only). ``None``: no materials.
         """
+        if not isinstance(name, str):
+            raise InputError(f"name = {arguments.shown(name)}: must be a str (free text), not {type(name).__name__}")
         v = _array(vertices, name="vertices", dtype=np.float32, shape_tail=(3,))
-        f = _array(faces, name="faces", dtype=np.int64, shape_tail=(3,))
+        raw_faces = np.asarray(faces)
+        if raw_faces.dtype.kind == "u" and raw_faces.size and int(raw_faces.max()) >= 2**63:
+            raise GeometryError(
+                f"invalid geometry in faces: index {int(raw_faces.max())} lies outside the {v.shape[0]} vertices; "
+                f"indices must be in 0..{v.shape[0] - 1}"
+            )
+        f = _array(raw_faces, name="faces", dtype=np.int64, shape_tail=(3,))
         c = np.atleast_1d(np.asarray(classes))
         if c.ndim != 1 or not np.issubdtype(c.dtype, np.integer):
             raise InputError(f"classes must be an int or a 1-D integer array, got {c.dtype} with shape {c.shape}")
@@ -233,7 +311,7 @@ class Scene:
         (linear base colour and roughness, metallic in [0, 1]; emitted radiance in cd/m²; nav_light 0 or 1, a
         light that glows only on instances whose lights are on). Row 0 is never read (material id 0 means none).
         :func:`mmusv.world.materials.material_table` gives the library's."""
-        t = np.ascontiguousarray(np.asarray(table, dtype=np.float32))
+        t = np.ascontiguousarray(_floats(table, name="materials"), dtype=np.float32)
         if t.ndim != 2 or t.shape[1] != 9:
             raise InputError(f"materials must have shape (M, 9), got {t.shape}")
         self._native.set_materials(t)
@@ -252,13 +330,17 @@ class Scene:
         if heights is None:
             self._native.set_seabed(None)
             return
-        z = np.ascontiguousarray(np.asarray(heights, dtype=np.float32))
+        z = np.ascontiguousarray(_floats(heights, name="seabed heights"), dtype=np.float32)
         if z.ndim != 2:
             raise InputError(f"seabed heights must have shape (ny, nx), got {z.shape}")
-        self._native.set_seabed(z, x0=float(x0), y0=float(y0), spacing=float(spacing))
+        xy0 = [arguments.real(v, name=k, unit="metres", error=InputError) for k, v in (("x0", x0), ("y0", y0))]
+        step = arguments.real(spacing, name="spacing", unit="metres", above=0.0, error=InputError)
+        self._native.set_seabed(z, x0=xy0[0], y0=xy0[1], spacing=step)
 
     def set_lights(self, instance_ids: npt.ArrayLike, *, on: bool) -> None:
-        """Turns the navigation lights (materials with ``nav_light``) of ``instance_ids`` on or off."""
+        """Turns the navigation lights (materials with ``nav_light``) of ``instance_ids`` on or off (``on``: a
+        ``bool``)."""
+        on = arguments.flag(on, name="on", error=InputError)
         ids = np.atleast_1d(np.asarray(instance_ids))
         if ids.size == 0:
             return
@@ -313,7 +395,10 @@ class Scene:
         node visits. Moving another instance later is allowed (it is treated as moving from then on); moving
         the surface itself switches the shortcuts off.
         """
-        ids = np.atleast_1d(np.asarray(moving, dtype=np.int64))
+        ids = np.atleast_1d(np.asarray(moving))
+        if ids.size and (ids.ndim != 1 or not np.issubdtype(ids.dtype, np.integer)):
+            raise InputError(f"moving must be a 1-D list of integer instance ids, got {ids.dtype} of shape {ids.shape}")
+        ids = ids.astype(np.int64)
         if ids.size and (ids.min() < 0 or ids.max() >= 2**32):
             raise NotFoundError(f"unknown instance id in moving: {ids.tolist()}")
         self._native.set_sea(_id(surface, name="surface", kind="instance"), np.ascontiguousarray(ids, np.uint32))
@@ -379,9 +464,13 @@ class Scene:
         self._native.prefetch_wave_surface(hs, **kw)
 
     def wave_heights(self, xy: npt.ArrayLike) -> npt.NDArray[np.float32]:
-        """``(N,)`` float32 world z of the sea surface at ``xy`` ``(N, 2)`` world x, y (metres): the displaced
-        surface of :meth:`set_wave_surface`, or the still level 0 where there is none."""
-        return self._native.wave_heights(_array(xy, name="xy", dtype=np.float32, shape_tail=(2,)))
+        """``(N,)`` float32 world z of the sea surface at ``xy`` ``(N, 2)`` finite world x, y (metres): the
+        displaced surface of :meth:`set_wave_surface`, or the still level 0 where there is none."""
+        p = _array(xy, name="xy", dtype=np.float32, shape_tail=(2,))
+        bad = np.flatnonzero(~np.isfinite(p).all(axis=1))
+        if bad.size:
+            raise InputError(f"invalid xy[{int(bad[0])}]: {p[bad[0]].tolist()} is not finite; give world x, y, metres")
+        return self._native.wave_heights(p)
 
     @property
     def wave_top(self) -> float | None:
@@ -411,10 +500,7 @@ class Scene:
         """
         o = _array(origins, name="origins", dtype=np.float32, shape_tail=(3,))
         d = _array(directions, name="directions", dtype=np.float32, shape_tail=(3,))
-        try:
-            limit = float(max_range)
-        except (TypeError, ValueError):
-            raise InputError(f"max_range must be a number of metres > 0, got {max_range!r}") from None
+        limit = arguments.real(max_range, name="max_range", unit="metres", above=0.0, finite=False, error=InputError)
         dist, inst, tri, normal, cls, back = self._native.cast_rays(o, d, limit)
         return RayHits(dist, inst, tri, normal, cls, back)
 
@@ -425,9 +511,9 @@ class Scene:
         return {"vertices": v, "faces": f, "classes": c, "instance_ids": i, "triangle_ids": t}
 
     def export(self, path: str | os.PathLike[str]) -> None:
-        """Writes the world triangles at the current poses to ``path`` (``.ply`` with per-face class and
-        instance, or ``.obj``); written atomically."""
-        self._native.export(os.fspath(path))
+        """Writes the world triangles at the current poses to ``path`` (a ``str`` or ``os.PathLike``: ``.ply``
+        with per-face class and instance, or ``.obj``); written atomically."""
+        self._native.export(os.fspath(arguments.path(path, name="path", error=InputError)))
 
     def instance_aabb(self, instance_id: int) -> np.ndarray:
         """``(2, 3)`` float32 world AABB (min row, max row) of an instance at its current pose."""
@@ -462,7 +548,13 @@ def demo_scene(
     """The synthetic maritime benchmark scene: seabed/islands heightfield (``2·terrain_cells²`` triangles,
     instance 0), water plane at z = 0 (instance 1) and ``vessels`` hull instances around the origin.
 
+    ``seed``: a whole number in ``0..2**64 - 1``; ``extent``: metres (>= 100); ``terrain_cells`` in
+    ``1..MAX_DEMO_CELLS`` and ``vessels`` in ``0..MAX_DEMO_CELLS`` (whole numbers).
     Returns ``(scene, vessel_instance_ids)``. Deterministic from ``seed``.
     """
+    seed = arguments.whole(seed, name="seed", lo=0, hi=2**64 - 1, error=InputError)
+    extent = arguments.real(extent, name="extent", unit="metres", error=InputError)
+    terrain_cells = arguments.whole(terrain_cells, name="terrain_cells", lo=1, hi=MAX_DEMO_CELLS, error=InputError)
+    vessels = arguments.whole(vessels, name="vessels", lo=0, hi=MAX_DEMO_CELLS, error=InputError)
     native, ids = core.demo_scene(seed=seed, extent=extent, terrain_cells=terrain_cells, vessels=vessels)
     return Scene._from_native(native), [int(i) for i in ids]

@@ -22,11 +22,12 @@ from typing import Any, TypeVar
 import numpy as np
 import numpy.typing as npt
 
+from mmusv import arguments
 from mmusv._native import core
 from mmusv.config import Scenario, VesselConfig, load_scenario
 from mmusv.errors import ConfigError
 from mmusv.motion import build_fleet
-from mmusv.scene import SeaState
+from mmusv.scene import MAX_SURFACE_TILES, SURFACE_TILE_M, SeaState, check_sea, surface_tiles
 from mmusv.sensors.camera import CameraImages, camera_from_config, top_view_from_config
 from mmusv.sensors.config import CameraConfig, RigConfig
 from mmusv.sensors.env import sensor_env
@@ -201,6 +202,11 @@ class Simulation:
     """A runnable scenario (see the module docstring). ``source``: a path, a dict or a :class:`Scenario`."""
 
     def __init__(self, source: Any, *, world: MapWorld | None = None) -> None:
+        if world is not None and not isinstance(world, MapWorld):
+            raise ConfigError(
+                f"world = {arguments.shown(world)}: must be a MapWorld (mmusv.world.maps.generate_map) or None (the "
+                "scenario's map)"
+            )
         self.scenario: Scenario = load_scenario(source)
         sc = self.scenario
         self.environment: Environment = sc.environment.resolve()
@@ -282,12 +288,21 @@ class Simulation:
         """Number of acquisition indices."""
         return self.scenario.acquisition.frames
 
+    def _frame_index(self, frame: Any) -> int:
+        """``frame`` as an acquisition index: a whole number (``int`` or numpy integer) in ``0..frames - 1``."""
+        k = arguments.whole(frame, name="frame")
+        if not 0 <= k < self.frames:
+            raise ConfigError(f"frame {k} is outside the acquisition (0..{self.frames - 1})")
+        return k
+
     def time_of(self, frame: int) -> float:
-        """``t_k = k / f`` in seconds."""
-        return frame / self.scenario.acquisition.frequency_hz
+        """``t_k = k / f`` in seconds of acquisition index ``frame`` (a whole number in ``0..frames - 1``)."""
+        return self._frame_index(frame) / self.scenario.acquisition.frequency_hz
 
     def world_state(self, frame: int) -> WorldState:
-        """Poses, velocities and boxes of every vessel at ``frame`` (does not move the scene)."""
+        """Poses, velocities and boxes of every vessel at acquisition index ``frame`` (a whole number in
+        ``0..frames - 1``; does not move the scene)."""
+        frame = self._frame_index(frame)
         t = self.time_of(frame)
         eta = np.asarray(self.fleet.poses_at_times(np.array([t])))[0]
         vel = np.asarray(self.fleet.velocities_at(t))
@@ -308,6 +323,7 @@ class Simulation:
         every sensor of every agent): crests occlude, LiDAR beams meet wave faces, the radar's sea clutter follows
         sea state and grazing angle, and the annotations carry each box's ``wave_occlusion``.
         """
+        check_sea(sea, name="sea", error=ConfigError)
         self.sea = sea if sea is None or sea.hs_m > 0.0 else None
         self.sensor_env = self._sensor_env()
         if self.sea is None:
@@ -326,8 +342,9 @@ class Simulation:
         frame time, displaced out to ``sea_radius_m`` around every USV: :meth:`set_sea_surface`) and returns the
         world state. ``shading_detail``: sample the waves' slopes the cameras shade with, the short waves' too
         (:meth:`mmusv.scene.Scene.set_wave_surface`'s ``slopes`` and ``detail``); only rendering reads them."""
-        if not 0 <= frame < self.frames:
-            raise ConfigError(f"frame {frame} is outside the acquisition (0..{self.frames - 1})")
+        frame = self._frame_index(frame)
+        sea_radius_m = arguments.real(sea_radius_m, name="sea_radius_m", unit="metres", above=0.0)
+        shading_detail = arguments.flag(shading_detail, name="shading_detail")
         ahead, self._ahead = self._ahead, None
         state = ahead[1] if ahead is not None and ahead[0] == frame else self.world_state(frame)
         n = len(self.scenario.vessels)
@@ -341,7 +358,11 @@ class Simulation:
         """Starts sampling the sea surface :meth:`set_frame` will set for ``frame`` with the same arguments, on a
         thread of its own (:meth:`mmusv.scene.Scene.prefetch_wave_surface`), so that it is ready when the frame
         is set: a recording asks for the next frame's while it annotates and writes this one. The same surface
-        bit for bit; nothing to do without a physical sea, or for a frame outside the acquisition."""
+        bit for bit; nothing to do without a physical sea, or for a frame outside the acquisition (``frame`` must
+        still be a whole number)."""
+        frame = arguments.whole(frame, name="frame")
+        sea_radius_m = arguments.real(sea_radius_m, name="sea_radius_m", unit="metres", above=0.0)
+        shading_detail = arguments.flag(shading_detail, name="shading_detail")
         if self.sea is None or "water" not in self.ws.static_instances or not 0 <= frame < self.frames:
             return
         state = self.world_state(frame)
@@ -349,8 +370,25 @@ class Simulation:
         self.ws.scene.prefetch_wave_surface(self.sea, **self._surface_of(state, sea_radius_m, shading_detail))
 
     def _surface_of(self, state: WorldState, radius_m: float, detail: bool) -> dict[str, Any]:
-        """The wave surface arguments of ``state`` (after the sea): finest around the USVs."""
+        """The wave surface arguments of ``state`` (after the sea): finest around the USVs, which must lie close
+        enough together for one sampled surface to span them (:data:`~mmusv.scene.MAX_SURFACE_TILES`)."""
         foci = np.array([state.poses[a.index, :2] for a in self.agents], dtype=np.float32).reshape(-1, 2)
+        if surface_tiles(foci, radius_m) > MAX_SURFACE_TILES:
+            lo, hi = foci.min(axis=0), foci.max(axis=0)
+            # The side of the largest square surface, less the tile the rounding may add.
+            side = (math.sqrt(MAX_SURFACE_TILES) - 1.0) * SURFACE_TILE_M
+            what = (
+                f"the sea's surface around one USV with sea_radius_m = {radius_m:g} would exceed it: give at most "
+                f"{side / 2.0:.0f} m"
+                if 2.0 * radius_m > side
+                else f"keep the USVs within about {(side - 2.0 * radius_m) / 1000.0:.0f} km of each other, or use "
+                "`environment.motion: paper` (flat water)"
+            )
+            raise ConfigError(
+                f"frame {state.frame}: the USVs {[a.id for a in self.agents]} span {hi[0] - lo[0]:.0f} m x "
+                f"{hi[1] - lo[1]:.0f} m; the physical sea's surface around them is sampled as one rectangle of at "
+                f"most {MAX_SURFACE_TILES} tiles of {SURFACE_TILE_M:g} m: {what}"
+            )
         return {
             "scenario_seed": self.scenario.seed,
             "time_s": state.time_s,
@@ -375,13 +413,31 @@ class Simulation:
 
     def renders(self, *, agents: Collection[str] | None = None, sensors: Collection[str] | None = None) -> bool:
         """Whether a :meth:`capture` with these ``agents`` and ``sensors`` renders (a camera or a top view): only
-        then are the short waves' shading slopes sampled."""
-        kinds = set(SENSOR_KINDS if sensors is None else sensors)
+        then are the short waves' shading slopes sampled. Arguments as for :meth:`capture`."""
+        agents, kinds = self._selection(agents, sensors)
         return any(
             (("cameras" in kinds and a.cameras) or ("top_view" in kinds and a.top_view is not None))
             for a in self.agents
             if agents is None or a.id in agents
         )
+
+    def _selection(self, agents: Any, sensors: Any) -> tuple[frozenset[str] | None, set[str]]:
+        """:meth:`capture`'s ``agents`` (``None``: all) and sensor kinds, checked: lists of names, every agent a
+        USV of the scenario and every kind one of :data:`SENSOR_KINDS`."""
+        ids = arguments.names(agents, name="agents", example="['usv_1']")
+        if ids is not None:
+            unknown = sorted(ids - {a.id for a in self.agents})
+            if unknown:
+                raise ConfigError(
+                    f"no USV named {', '.join(map(repr, unknown))}; the USVs are {[a.id for a in self.agents]}"
+                )
+        given = arguments.names(sensors, name="sensors", example="['lidar', 'cameras']")
+        kinds = set(SENSOR_KINDS if given is None else given)
+        if kinds - set(SENSOR_KINDS):
+            raise ConfigError(
+                f"unknown sensor kind(s) {sorted(kinds - set(SENSOR_KINDS))}; allowed: {', '.join(SENSOR_KINDS)}"
+            )
+        return ids, kinds
 
     def wakes(self, state: WorldState) -> np.ndarray:
         """``(K, 9)`` float32 rows ``x, y, heading, speed, length, beam, reach_m, age_s, displacement_m3`` (world
@@ -396,6 +452,7 @@ class Simulation:
         core bends the Kelvin arms along them. No foam where the vessel never went, nor under its hull; its older foam
         and arms round the bends too. ``displacement_m3`` (the hull's ``Cb·L·B·T``,
         :func:`~mmusv.world.hydrostatics.hull_particulars`) sets the Kelvin waves the cameras draw behind it."""
+        _check_state(state)
         n = len(self.scenario.vessels)
         beams = np.array([float(v.box_size[1]) for v in self.vessels[:n]], dtype=np.float64)
         pieces = self.fleet.wake_pieces(state.time_s, 0.5 * beams) if n else np.zeros((0, 6))
@@ -447,6 +504,12 @@ class Simulation:
     def sensor_poses(self, agent: Agent, state: WorldState) -> dict[str, np.ndarray]:
         """Sensor → world matrices of every sensor of ``agent`` in ``state``: keys ``lidar``, ``radar``,
         ``camera/<name>``, ``top_view``."""
+        if not isinstance(agent, Agent):
+            raise ConfigError(
+                f"agent = {arguments.shown(agent)}: must be an Agent (Simulation.agent(id) or Simulation.agents), "
+                f"not {type(agent).__name__}"
+            )
+        _check_state(state)
         body = state.matrices[agent.index]
         out = {key: body @ m for key, m in agent.mounts().items()}
         if agent.top_view is not None and agent.rig.top_view is not None:
@@ -470,27 +533,20 @@ class Simulation:
     ) -> FrameCapture:
         """Moves the world to ``frame`` and runs every sensor of every USV on that state.
 
-        ``agents`` limits the USVs (ids), ``sensors`` the sensor kinds (``lidar``, ``cameras``, ``top_view``,
-        ``radar``); ``None`` means all. ``radar=False`` leaves the radar out whatever ``sensors`` says.
+        ``frame`` is an acquisition index, a whole number (``int`` or numpy integer) in ``0..frames - 1``.
+        ``agents`` limits the USVs (a list of ids, e.g. ``['usv_1']``), ``sensors`` the sensor kinds (a list of
+        ``lidar``, ``cameras``, ``top_view``, ``radar``); ``None`` means all. ``radar=False`` leaves the radar out
+        whatever ``sensors`` says. Anything else (a single string, an unknown id or kind) is a ``ConfigError``.
 
         Every selected sensor of every selected USV runs in one native call (``core.capture_frame``: concurrent
         tasks over all cores, GIL released), with the outputs bit-identical to calling :func:`~mmusv.sensors.
         lidar.scan`, :func:`~mmusv.sensors.camera.render`, :func:`~mmusv.sensors.radar.radar_sweep` and
         :func:`~mmusv.sensors.radar.ppi_image` one by one with the same poses and :func:`sensor_seed` seeds.
         """
-        if agents is not None:
-            unknown = sorted(set(agents) - {a.id for a in self.agents})
-            if unknown:
-                raise ConfigError(
-                    f"no USV named {', '.join(map(repr, unknown))}; the USVs are {[a.id for a in self.agents]}"
-                )
-        kinds = set(SENSOR_KINDS if sensors is None else sensors)
-        if not radar:
+        frame = self._frame_index(frame)
+        agents, kinds = self._selection(agents, sensors)
+        if not arguments.flag(radar, name="radar"):
             kinds.discard("radar")
-        if kinds - set(SENSOR_KINDS):
-            raise ConfigError(
-                f"unknown sensor kind(s) {sorted(kinds - set(SENSOR_KINDS))}; allowed: {', '.join(SENSOR_KINDS)}"
-            )
         # The short waves' shading slopes only for frames that render.
         state = self.set_frame(frame, shading_detail=self.renders(agents=agents, sensors=kinds))
         sc = self.scenario
@@ -555,6 +611,15 @@ class Simulation:
             else:
                 cap.cameras[key.removeprefix("camera/")] = CameraImages.from_native(d)
         return FrameCapture(frame, state.time_s, state, out, secs)
+
+
+def _check_state(state: Any) -> None:
+    """A :class:`WorldState`, else a ``ConfigError`` saying where one comes from."""
+    if not isinstance(state, WorldState):
+        raise ConfigError(
+            f"state = {arguments.shown(state)}: must be a WorldState (Simulation.world_state(frame)), "
+            f"not {type(state).__name__}"
+        )
 
 
 def _pose(m: np.ndarray) -> npt.NDArray[np.float64]:

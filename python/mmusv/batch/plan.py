@@ -19,11 +19,12 @@ from __future__ import annotations
 import os
 import re
 import shutil
-from collections.abc import Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from mmusv import arguments
 from mmusv.errors import ConfigError, MmusvError
 from mmusv.recording.parts import (
     PARTS_SUFFIX,
@@ -95,7 +96,7 @@ def scenario_files(source: str | os.PathLike[str] | Sequence[str | os.PathLike[s
     Raises :class:`~mmusv.errors.ConfigError` for an empty folder or two files with the same stem (their output
     folders would clash)."""
     if isinstance(source, (str, os.PathLike)):
-        src = Path(source)
+        src = arguments.path(source, name="source")
         if src.is_dir():
             files = sorted(p for p in src.glob("*.yaml") if p.name != "report.yaml")
             if not files:
@@ -103,7 +104,12 @@ def scenario_files(source: str | os.PathLike[str] | Sequence[str | os.PathLike[s
             return [f.resolve() for f in files]
         files = [src]
     else:
-        files = [Path(s) for s in source]
+        if isinstance(source, (bytes, Mapping)) or not isinstance(source, Iterable):
+            raise ConfigError(
+                f"source = {arguments.shown(source)}: must be a folder of scenarios or a list of scenario files "
+                "(str or pathlib.Path)"
+            )
+        files = [arguments.path(s, name=f"source[{i}]") for i, s in enumerate(source)]
         if not files:
             raise ConfigError("no scenario files given")
     for f in files:

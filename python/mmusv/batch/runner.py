@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from mmusv import arguments
 from mmusv.batch.executors import Executor, PoolExecutor, SerialExecutor, available_cpus
 from mmusv.batch.index import INDEX_NAME, Entry, folder_bytes, write_index
 from mmusv.batch.plan import ScenarioPlan, plan_scenarios, prepare, scenario_files
@@ -181,15 +182,25 @@ def run_many(
         KeyboardInterrupt: after the executor stopped and the index says what is done.
     """
     t0 = time.perf_counter()
-    if int(jobs) < 1:
-        raise ConfigError(f"jobs = {jobs}: must be at least 1")
-    if int(retries) < 0 or int(lost_worker_retries) < 0:
-        raise ConfigError("retries and lost_worker_retries must be 0 or more")
-    if cpus_per_task is not None and int(cpus_per_task) < 1:
-        raise ConfigError(f"cpus_per_task = {cpus_per_task}: must be at least 1")
+    jobs = arguments.whole(jobs, name="jobs", lo=1)
+    retries = arguments.whole(retries, name="retries", lo=0)
+    lost_worker_retries = arguments.whole(lost_worker_retries, name="lost_worker_retries", lo=0)
+    if cpus_per_task is not None:
+        cpus_per_task = arguments.whole(cpus_per_task, name="cpus_per_task", lo=1)
+    if split_frames is not None:
+        split_frames = arguments.whole(split_frames, name="split_frames", lo=1)
+    if frames is not None:
+        frames = arguments.whole(frames, name="frames", lo=1)
+    overwrite = arguments.flag(overwrite, name="overwrite")
+    checks = arguments.flag(checks, name="checks")
+    stop_on_full_disk = arguments.flag(stop_on_full_disk, name="stop_on_full_disk")
+    progress = arguments.callback(progress, name="progress", nargs=2)
+    index_extra = arguments.mapping(index_extra, name="index_extra")
+    if not isinstance(ray, (bool, str)):
+        raise ConfigError(f"ray = {arguments.shown(ray)}: must be False, True, 'local', 'auto' or a Ray address")
     files = scenario_files(source)
-    out = Path(out_dir).resolve()
-    index_path = Path(index).resolve() if index is not None else out / INDEX_NAME
+    out = arguments.path(out_dir, name="out_dir").resolve()
+    index_path = arguments.path(index, name="index").resolve() if index is not None else out / INDEX_NAME
     root = index_path.parent
     plans = plan_scenarios(
         files,

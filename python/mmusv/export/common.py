@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from mmusv import arguments
 from mmusv.errors import ConfigError
 
 __all__ = [
@@ -48,7 +49,11 @@ def parse_extras(extras: Iterable[str] | str | None) -> tuple[str, ...]:
     """Validated extras (order of :data:`EXTRAS`) from a sequence or a comma-separated string."""
     if extras is None:
         return ()
-    items = [e.strip() for e in extras.split(",")] if isinstance(extras, str) else [str(e).strip() for e in extras]
+    if isinstance(extras, str):
+        items = [e.strip() for e in extras.split(",")]
+    else:
+        given = arguments.names(extras, name="extras", example="['depth', 'radar'] or 'depth,radar'")
+        items = [e.strip() for e in given or ()]
     items = [e for e in items if e]
     bad = sorted(set(items) - set(EXTRAS))
     if bad:

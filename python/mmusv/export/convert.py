@@ -17,15 +17,17 @@ existing ``out_dir`` is replaced only with ``overwrite`` and only when it is emp
 from __future__ import annotations
 
 import math
+import os
 import shutil
 import time
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import yaml
 
+from mmusv import arguments
 from mmusv.errors import ConfigError, IoError
 from mmusv.export.common import DEFAULT_EXTRAS, TARGETS, Options, Sink, dump_yaml, parse_extras
 from mmusv.export.splits import DEFAULT_RATIOS, SPLIT_NAMES, assign_splits, parse_ratios
@@ -144,7 +146,14 @@ def _as_list(recordings: str | Path | Iterable[str | Path]) -> list[Path]:
     (a batch run's output) as its complete recordings."""
     from mmusv.batch.index import dataset_recordings, find_index
 
-    given = [Path(recordings)] if isinstance(recordings, (str, Path)) else [Path(r) for r in recordings]
+    if isinstance(recordings, (str, os.PathLike)):
+        given = [arguments.path(recordings, name="recordings")]
+    elif isinstance(recordings, (bytes, Mapping)) or not isinstance(recordings, Iterable):
+        raise ConfigError(
+            f"recordings = {arguments.shown(recordings)}: must be a path (str or pathlib.Path) or a list of paths"
+        )
+    else:
+        given = [arguments.path(r, name=f"recordings[{i}]") for i, r in enumerate(recordings)]
     out: list[Path] = []
     for p in given:
         if p.is_dir():
@@ -215,12 +224,8 @@ def _folders(infos: list[RecordingInfo]) -> list[str]:
 
 
 def _box_filter(min_box_px: Any, max_occlusion: Any) -> tuple[float, float]:
-    try:
-        px, occ = float(min_box_px), float(max_occlusion)
-    except (TypeError, ValueError):
-        raise ConfigError(
-            f"min_box_px = {min_box_px!r}, max_occlusion = {max_occlusion!r}: must be numbers (pixels, fraction)"
-        ) from None
+    px = arguments.real(min_box_px, name="min_box_px", unit="pixels", finite=False)
+    occ = arguments.real(max_occlusion, name="max_occlusion", finite=False)
     if not (math.isfinite(px) and px >= 0):
         raise ConfigError(f"min_box_px = {min_box_px!r}: must be a finite number of pixels >= 0")
     if not (math.isfinite(occ) and 0 <= occ <= 1):
@@ -252,7 +257,8 @@ def convert(
             recordings).
         to: one of :data:`~mmusv.export.common.TARGETS`: ``"opv2v"``, ``"kitti"``, ``"ros2"`` (a rosbag2 folder
             per recording), ``"coco"``, ``"yolo"``, ``"mastr"``, ``"semantickitti"`` (``docs/exports.md``).
-        splits: ``(train, validate, test)`` fractions (split per recording, shuffled with ``seed``) or ``None``
+        splits: ``(train, validate, test)`` fractions (split per recording, shuffled with ``seed``, a whole number
+            >= 0) or ``None``
             for one folder of scenarios. ROS 2 bags are never split: with ``to="ros2"`` only the default or
             ``None`` is accepted.
         eval_range_m: targets are vessels whose box centre lies within ``eval_range_m`` of the agent's LiDAR in
@@ -262,20 +268,20 @@ def convert(
             files stock loaders skip).
         min_box_px: COCO and YOLO: leave out 2D boxes whose shorter side is under this many pixels.
         max_occlusion: COCO and YOLO: leave out 2D boxes hidden by more than this fraction (0..1).
-        overwrite: replace a previous conversion in ``out_dir``.
-        progress: called with (frames done, frames expected) after every frame.
+        overwrite: replace a previous conversion in ``out_dir`` (``include_usvs`` and ``overwrite`` are ``bool``).
+        progress: called with (frames done, frames expected) after every frame (a callable of two arguments).
 
     Raises:
         ConfigError: bad options. IoError: missing, unreadable or non-MCAP recordings; an existing output.
     """
     t0 = time.perf_counter()
     cls = writer_class(to)
-    try:
-        rng = float(eval_range_m)
-    except (TypeError, ValueError):
-        raise ConfigError(f"eval_range_m = {eval_range_m!r}: must be a number of metres") from None
-    if not math.isfinite(rng) or rng <= 0:
-        raise ConfigError(f"eval_range_m = {eval_range_m!r}: must be a positive, finite number of metres")
+    rng = arguments.real(eval_range_m, name="eval_range_m", unit="metres", above=0.0)
+    seed = arguments.whole(seed, name="seed", lo=0)
+    include_usvs = arguments.flag(include_usvs, name="include_usvs")
+    overwrite = arguments.flag(overwrite, name="overwrite")
+    progress = arguments.callback(progress, name="progress", nargs=2)
+    out = arguments.path(out_dir, name="out_dir")
     ratios = None if splits is None else parse_ratios(splits)
     if not cls.splits and ratios is not None:
         if ratios != parse_ratios(DEFAULT_RATIOS):
@@ -285,7 +291,7 @@ def convert(
     options = Options(
         to=to,
         eval_range_m=rng,
-        include_usvs=bool(include_usvs),
+        include_usvs=include_usvs,
         extras=parse_extras(extras),
         min_box_px=box_px,
         max_occlusion=max_occ,
@@ -298,7 +304,6 @@ def convert(
     split_of: dict[str, str | None] = dict.fromkeys(folders)
     if ratios is not None:
         split_of = dict(assign_splits(folders, ratios, seed))
-    out = Path(out_dir)
     _prepare_out(out, overwrite, [Path(i.path) for i in infos])
     reports = [
         RecordingReport(path=i.path, scenario=i.scenario_name, folder=f, split=split_of[f])

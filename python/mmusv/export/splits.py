@@ -12,6 +12,7 @@ import math
 import random
 from collections.abc import Sequence
 
+from mmusv import arguments
 from mmusv.errors import ConfigError
 
 __all__ = ["DEFAULT_RATIOS", "SPLIT_NAMES", "assign_splits", "parse_ratios", "split_counts"]
@@ -32,7 +33,12 @@ def parse_ratios(ratios: Sequence[float] | str) -> tuple[float, float, float]:
                 f"split {ratios!r}: expected three comma-separated fractions, e.g. 0.7,0.15,0.15"
             ) from None
     else:
-        vals = [float(x) for x in ratios]
+        if not isinstance(ratios, (list, tuple)):
+            raise ConfigError(
+                f"split {arguments.shown(ratios)}: expected three fractions (train, validate, test), e.g. "
+                "(0.7, 0.15, 0.15) or '0.7,0.15,0.15'"
+            )
+        vals = [arguments.real(x, name=f"split[{i}]", finite=False) for i, x in enumerate(ratios)]
     if len(vals) != 3:
         raise ConfigError(
             f"split {list(ratios) if not isinstance(ratios, str) else ratios!r}: "

@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from mmusv.errors import IoError
-from mmusv.recording.info import RecordingInfo, check_mcap, read_info
+from mmusv.recording.info import RecordingInfo, check_mcap, read_info, recording_arg
 from mmusv.recording.parts import is_parts_manifest
 from mmusv.recording.scan import Scan
 from mmusv.recording.stream import FrameStream
@@ -30,7 +30,7 @@ def summary(path: str | os.PathLike[str]) -> dict[str, Any]:
     :meth:`~mmusv.recording.stream.FrameStream.report` (``None`` when all is well). A parts manifest gives the
     sums over its recorded parts, the metadata of the first with the merged ``run`` of
     :func:`~mmusv.recording.info.read_info`, and ``parts`` (how many there are)."""
-    p = Path(path)
+    p = recording_arg(path)
     if is_parts_manifest(p):
         return _parts_summary(p)
     check_mcap(p)

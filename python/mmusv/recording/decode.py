@@ -12,17 +12,36 @@ from typing import Any
 import numpy as np
 from PIL import Image
 
-from mmusv.errors import IoError
+from mmusv.errors import InputError, IoError
 
 __all__ = ["WorldFrame", "decode_image", "decode_point_cloud"]
 
 _NUMPY = {1: np.uint8, 2: np.int8, 3: np.uint16, 4: np.int16, 5: np.uint32, 6: np.int32, 7: np.float32, 8: np.float64}
 
 
+def _need(msg: Any, fields: tuple[str, ...], what: str, caller: str) -> None:
+    """``msg`` must have ``fields`` (a decoded message of kind ``what``), else an :class:`InputError` naming
+    ``caller`` and the message given."""
+    missing = [f for f in fields if not hasattr(msg, f)]
+    if missing:
+        kind = getattr(getattr(msg, "DESCRIPTOR", None), "full_name", None) or type(msg).__name__
+        raise InputError(
+            f"{caller} takes a decoded {what} message (from mmusv.recording.read_messages / frame_messages), got "
+            f"{kind} without {', '.join(missing)}"
+        )
+
+
 def decode_image(msg: Any) -> np.ndarray:
-    """A ``foxglove.RawImage`` or ``foxglove.CompressedImage`` (PNG) as a numpy array (``(H, W)`` or ``(H, W, 3)``)."""
+    """A ``foxglove.RawImage`` or ``foxglove.CompressedImage`` (PNG) as a numpy array (``(H, W)`` or ``(H, W, 3)``).
+    Another message is an :class:`~mmusv.errors.InputError`; image bytes that do not decode an
+    :class:`~mmusv.errors.IoError`."""
     if hasattr(msg, "format"):
-        return np.asarray(Image.open(io.BytesIO(msg.data)))
+        _need(msg, ("data",), "foxglove.CompressedImage", "decode_image")
+        try:
+            return np.asarray(Image.open(io.BytesIO(msg.data)))
+        except (OSError, ValueError, SyntaxError) as exc:
+            raise IoError(f"a compressed image does not decode ({type(exc).__name__}: {exc})") from None
+    _need(msg, ("encoding", "width", "height", "step", "data"), "foxglove.RawImage or CompressedImage", "decode_image")
     enc = msg.encoding
     dtype = {
         "rgb8": np.uint8,
@@ -35,15 +54,23 @@ def decode_image(msg: Any) -> np.ndarray:
     }.get(enc)
     if dtype is None:
         raise IoError(f"unsupported image encoding {enc!r}")
-    data = np.frombuffer(msg.data, dtype=np.dtype(dtype).newbyteorder("<"))
     ch = 3 if enc == "rgb8" else 1
-    rows = data.reshape(msg.height, msg.step // np.dtype(dtype).itemsize)
-    img = rows[:, : msg.width * ch]
-    return img.reshape(msg.height, msg.width, 3) if ch == 3 else img
+    try:
+        data = np.frombuffer(msg.data, dtype=np.dtype(dtype).newbyteorder("<"))
+        rows = data.reshape(msg.height, msg.step // np.dtype(dtype).itemsize)
+        img = rows[:, : msg.width * ch]
+        return img.reshape(msg.height, msg.width, 3) if ch == 3 else img
+    except ValueError as exc:
+        raise IoError(
+            f"a {enc} image of {msg.width} x {msg.height} (step {msg.step}) does not match its {len(msg.data)} bytes "
+            f"({exc})"
+        ) from None
 
 
 def decode_point_cloud(msg: Any) -> dict[str, np.ndarray]:
-    """A ``foxglove.PointCloud`` as ``{field name: (N,) array}`` using the packed field offsets."""
+    """A ``foxglove.PointCloud`` as ``{field name: (N,) array}`` using the packed field offsets (another message is
+    an :class:`~mmusv.errors.InputError`)."""
+    _need(msg, ("point_stride", "data", "fields"), "foxglove.PointCloud", "decode_point_cloud")
     stride = msg.point_stride
     raw = np.frombuffer(msg.data, dtype=np.uint8)
     n = raw.size // stride if stride else 0
@@ -75,7 +102,8 @@ class WorldFrame:
 
     @staticmethod
     def from_message(msg: Any) -> WorldFrame:
-        """From a decoded ``mmusv.WorldState``."""
+        """From a decoded ``mmusv.WorldState`` (another message is an :class:`~mmusv.errors.InputError`)."""
+        _need(msg, ("vessels", "frame", "time_s"), "mmusv.WorldState", "WorldFrame.from_message")
         vs = list(msg.vessels)
 
         def rows(attr: str, k: int) -> np.ndarray:

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import yaml
 
+from mmusv import arguments
 from mmusv.errors import IoError
 from mmusv.recording.parts import is_parts_manifest, part_files, read_parts_manifest
 from mmusv.recording.scan import MAGIC, Scan
@@ -240,8 +241,15 @@ def _read_parts_info(p: Path) -> RecordingInfo:
     )
 
 
+def recording_arg(path: object) -> Path:
+    """The ``path`` argument of the readers as a :class:`~pathlib.Path`: a ``str`` or ``os.PathLike`` naming a
+    recording, else a :class:`~mmusv.errors.ConfigError` (``bytes``, numbers and ``None`` are not paths)."""
+    return arguments.path(path, name="recording path")
+
+
 def read_info(path: str | Path) -> RecordingInfo:
     """The metadata of the recording at ``path`` (an ``.mcap`` or a parts manifest; see the module docstring)."""
+    path = recording_arg(path)
     if is_parts_manifest(path):
         return _read_parts_info(Path(path))
     p = check_mcap(path)

@@ -13,8 +13,9 @@ from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
+from mmusv import arguments
 from mmusv.errors import ConfigError, IoError
-from mmusv.recording.info import check_mcap, read_info
+from mmusv.recording.info import check_mcap, read_info, recording_arg
 from mmusv.recording.parts import is_parts_manifest, part_files
 from mmusv.recording.scan import Scan
 from mmusv.recording.stream import FrameStream
@@ -28,18 +29,26 @@ def read_messages(
     """Yields ``(topic, log_time_ns, decoded_protobuf_message)`` in file order (= log-time order for files of
     mmusv), optionally only ``topics``. Works on finished files, on ``.partial`` files and on parts manifests (the
     recorded parts in order); damaged chunks are skipped (:mod:`mmusv.recording.scan`) and described in
-    ``damage`` when a list is given."""
+    ``damage`` when a list is given.
+
+    ``topics`` is a list of topic names (``["/world/state"]``; a single string is refused, not read as its
+    characters). A topic the recording does not have is a :class:`~mmusv.errors.ConfigError` listing the ones it
+    has, raised once the file has been read (after the messages of the topics it has) unless the file is damaged.
+    The arguments are checked when iteration starts."""
     from mcap_protobuf.decoder import DecoderFactory
 
+    path = recording_arg(path)
+    wanted = arguments.names(topics, name="topics", example="['/world/state']")
+    if damage is not None and not isinstance(damage, list):
+        raise ConfigError(f"damage = {arguments.shown(damage)}: must be a list (lines are appended to it), or None")
     if is_parts_manifest(path):
-        for _first, _stop, part in part_files(Path(path)):
+        for _first, _stop, part in part_files(path):
             if part is not None:
                 yield from read_messages(part, topics, damage=damage)
             elif damage is not None:
                 damage.append(f"{path}: part {_first}..{_stop - 1} is not recorded")
         return
-    p = check_mcap(Path(path))
-    wanted = None if topics is None else set(topics)
+    p = check_mcap(path)
     factory = DecoderFactory()
     decoders: dict[int, Callable[[bytes], Any] | None] = {}
     scan = Scan(p)
@@ -69,13 +78,19 @@ def read_messages(
             yield ch.topic, msg.log_time, decoded
     except OSError as exc:
         raise IoError(f"{p} cannot be read: {exc.strerror or exc}") from None
+    have = {ch.topic for ch in scan.channels.values()}
+    if wanted is not None and not scan.damage and wanted - have:
+        raise ConfigError(
+            f"{p} has no topic {', '.join(map(repr, sorted(wanted - have)))}; its topics: {', '.join(sorted(have))}"
+        )
 
 
 def frame_messages(path: str | Path, frame: int) -> dict[str, Any]:
     """Every decoded message of acquisition index ``frame``, by topic; for a parts manifest, from the part
     holding ``frame``. Raises :class:`~mmusv.errors.IoError` when the frame is damaged (naming the damage) and
-    :class:`~mmusv.errors.ConfigError` when the recording does not hold it."""
-    p = Path(path)
+    :class:`~mmusv.errors.ConfigError` when the recording does not hold it (``frame`` must be a whole number)."""
+    p = recording_arg(path)
+    frame = arguments.whole(frame, name="frame")
     if is_parts_manifest(p):
         for first, stop, part in part_files(p):
             if first <= frame < stop:

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from mmusv.errors import IoError
+from mmusv.errors import ConfigError, IoError
 from mmusv.recording.decode import WorldFrame
 from mmusv.recording.info import RecordingInfo
 from mmusv.recording.parts import is_parts_manifest, part_files
@@ -82,6 +82,13 @@ class FrameStream:
     """
 
     def __init__(self, info: RecordingInfo, want: Callable[[str], bool]) -> None:
+        if not isinstance(info, RecordingInfo):
+            raise ConfigError(
+                f"info = {info!r:.80}: must be a RecordingInfo (mmusv.recording.read_info(path)), "
+                f"not {type(info).__name__}"
+            )
+        if not callable(want):
+            raise ConfigError(f"want = {want!r:.80}: must be a function of a topic name returning True or False")
         self.info = info
         self.want = want
         self.truncated: str | None = None

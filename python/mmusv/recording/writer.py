@@ -21,6 +21,7 @@ Frames: world x east, y north, z up, metres; sensor frames x forward, y left, z 
 
 from __future__ import annotations
 
+import numbers
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -43,10 +44,16 @@ POINT_DTYPES: tuple[str, ...] = ("uint8", "int8", "uint16", "int16", "uint32", "
 
 
 def to_ns(time_s: float) -> int:
-    """Simulation time in seconds → integer nanoseconds (rounded), the time unit of every record call."""
+    """Simulation time in seconds (a real number, ``0 <= time_s < 2**64 ns``, about 584 years) → integer
+    nanoseconds (rounded), the time unit of every record call (an MCAP log time is an unsigned 64-bit count)."""
+    if isinstance(time_s, (bool, np.bool_)) or not isinstance(time_s, numbers.Real):
+        raise InputError(f"invalid time_s: {time_s!r:.60} must be a number of seconds, not {type(time_s).__name__}")
     if not np.isfinite(time_s) or time_s < 0:
         raise InputError(f"invalid time_s: {time_s} must be finite and >= 0")
-    return round(time_s * 1e9)
+    ns = round(float(time_s) * 1e9)
+    if ns >= 2**64:
+        raise InputError(f"invalid time_s: {time_s} s is past the largest MCAP log time (2**64 ns, about 584 years)")
+    return ns
 
 
 def _f64(a: npt.ArrayLike, name: str, cols: int) -> npt.NDArray[np.float64]:

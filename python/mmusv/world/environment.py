@@ -16,10 +16,14 @@ sun.
 from __future__ import annotations
 
 import math
+import numbers
 import re
 from dataclasses import dataclass
 from typing import Literal
 
+import numpy as np
+
+from mmusv import arguments
 from mmusv._native import core
 from mmusv.errors import ConfigError
 
@@ -35,7 +39,8 @@ _TIME_RE = re.compile(r"^(\d{1,2}):(\d{2})$")
 
 
 def wave_height_m(wave: str | float) -> float:
-    """Wave height H (m) of a preset name (``"W0"``..``"W3"``, any case) or a height in metres (≥ 0)."""
+    """Wave height H (m) of a preset name (``"W0"``..``"W3"``, any case) or a height in metres (a real number ≥ 0;
+    not ``True``/``False``)."""
     if isinstance(wave, str):
         key = wave.strip().upper()
         if key not in WAVE_PRESETS:
@@ -44,6 +49,11 @@ def wave_height_m(wave: str | float) -> float:
                 f"{', '.join(WAVE_PRESETS)} or a wave height in metres (>= 0)"
             )
         return WAVE_PRESETS[key]
+    if isinstance(wave, (bool, np.bool_)) or not isinstance(wave, numbers.Real):
+        raise ConfigError(
+            f"invalid config environment.wave = {wave!r:.60}: allowed presets are {', '.join(WAVE_PRESETS)} or a wave "
+            f"height in metres (>= 0), not {type(wave).__name__}"
+        )
     h = float(wave)
     if not math.isfinite(h) or h < 0:
         raise ConfigError(f"invalid config environment.wave = {wave!r}: a wave height must be finite and >= 0 metres")
@@ -65,6 +75,10 @@ class Sun:
 
 
 def _parse_time(text: str) -> float:
+    if not isinstance(text, str):
+        raise ConfigError(
+            f'invalid config environment.time_of_day = {text!r:.60}: use 24-hour "HH:MM" as a string, e.g. "16:30"'
+        )
     m = _TIME_RE.match(text.strip())
     if not m or int(m.group(1)) > 23 or int(m.group(2)) > 59:
         raise ConfigError(f'invalid config environment.time_of_day = {text!r}: use 24-hour "HH:MM", e.g. "16:30"')
@@ -72,7 +86,10 @@ def _parse_time(text: str) -> float:
 
 
 def sun_at(time_of_day: str, *, latitude_deg: float = 45.0, day_of_year: int = 172) -> Sun:
-    """Sun direction, colour and light level at local solar time ``time_of_day`` (``"HH:MM"``)."""
+    """Sun direction, colour and light level at local solar time ``time_of_day`` (``"HH:MM"``), ``latitude_deg``
+    (degrees, -90..90) and ``day_of_year`` (a whole number, 1..366)."""
+    latitude_deg = arguments.real(latitude_deg, name="invalid config environment.latitude_deg", unit="degrees")
+    day_of_year = arguments.whole(day_of_year, name="invalid config environment.day_of_year")
     if not -90.0 <= latitude_deg <= 90.0:
         raise ConfigError(f"invalid config environment.latitude_deg = {latitude_deg}: must be in [-90, 90]")
     if not 1 <= day_of_year <= 366:
@@ -129,8 +146,10 @@ class Weather:
             "rain": (5000.0, 4.0, 1.0),
         }
         vis, rain, cloud = defaults[kind]
-        vis = vis if visibility_m is None else float(visibility_m)
-        rain = rain if rain_mm_per_h is None else float(rain_mm_per_h)
+        if visibility_m is not None:
+            vis = arguments.real(visibility_m, name="invalid config environment.visibility_m", unit="metres")
+        if rain_mm_per_h is not None:
+            rain = arguments.real(rain_mm_per_h, name="invalid config environment.rain_mm_per_h", unit="mm/h")
         if not (math.isfinite(vis) and vis > 0):
             raise ConfigError(f"invalid config environment.visibility_m = {visibility_m}: must be > 0 metres")
         if not (math.isfinite(rain) and rain >= 0):

@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 import shapely
+from pydantic import BaseModel
 from shapely.geometry import Polygon
 from shapely.geometry.base import BaseGeometry
 
@@ -202,6 +203,21 @@ def _assemble(
     )
 
 
+def _check_params(params: object, model: type[Any], kind: str) -> Any:
+    """``params`` when it is ``None`` (the defaults) or an instance of ``model`` (the parameters of a ``kind`` map),
+    else a :class:`MapConfigError` saying how to make one."""
+    if params is None:
+        return model()
+    if not isinstance(params, model):
+        raise MapConfigError(
+            "params",
+            params if not isinstance(params, BaseModel) else type(params).__name__,
+            f"{model.__name__}, the parameters of the {kind!r} map (make_params({kind!r}, ...)), or None; "
+            f"generate_map({kind!r}, seed=..., **values) takes plain values",
+        )
+    return params
+
+
 def _check_seed(seed: object) -> int:
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise MapConfigError("seed", seed, "a non-negative integer")
@@ -269,7 +285,7 @@ def _island_terrain(
 def generate_island(*, seed: int, params: IslandParams | None = None) -> MapWorld:
     """``island`` map: ``n_islands`` islands (sizes from ``island_radius_m``) at least ``min_gap_m`` apart."""
     seed = _check_seed(seed)
-    p = params if params is not None else IslandParams()
+    p: IslandParams = _check_params(params, IslandParams, "island")
     rng = np.random.default_rng(seed)
     spacing, xs = _grid(p.extent_m, p.grid_m)
     islands = _place_islands(p, rng)
@@ -285,7 +301,7 @@ def generate_open_sea(*, seed: int, params: OpenSeaParams | None = None) -> MapW
     """``open_sea`` map: open water with up to ``n_buoys`` buoys near the centre and, with probability
     ``islet_probability``, one small islet far from the centre."""
     seed = _check_seed(seed)
-    p = params if params is not None else OpenSeaParams()
+    p: OpenSeaParams = _check_params(params, OpenSeaParams, "open_sea")
     rng = np.random.default_rng(seed)
     spacing, xs = _grid(p.extent_m, p.grid_m)
     half = p.extent_m / 2.0
@@ -325,7 +341,7 @@ def _wrap(a: float) -> float:
 def generate_port(*, seed: int, params: PortParams | None = None) -> MapWorld:
     """``port`` map (see :class:`PortParams`), land on the ``coast_side`` of the map."""
     seed = _check_seed(seed)
-    p = params if params is not None else PortParams()
+    p: PortParams = _check_params(params, PortParams, "port")
     rng = np.random.default_rng(seed)
     spacing, xs = _grid(p.extent_m, p.grid_m)
     r0, r1, dyaw = _COAST_ROT[p.coast_side]
@@ -386,9 +402,16 @@ def generate_map(kind: str, *, seed: int, **params: Any) -> MapWorld:
 
 def generate_map_from(params: MapParams, *, seed: int) -> MapWorld:
     """Generates the map that validated ``params`` describe (their type says the kind), e.g. a scenario's
-    ``map.params`` (:class:`mmusv.config.MapConfig`)."""
+    ``map.params`` (:class:`mmusv.config.MapConfig`); anything else is a :class:`MapConfigError`."""
     if isinstance(params, IslandParams):
         return generate_island(seed=seed, params=params)
     if isinstance(params, OpenSeaParams):
         return generate_open_sea(seed=seed, params=params)
-    return generate_port(seed=seed, params=params)
+    if isinstance(params, PortParams):
+        return generate_port(seed=seed, params=params)
+    raise MapConfigError(
+        "params",
+        params if not isinstance(params, BaseModel) else type(params).__name__,
+        "IslandParams, OpenSeaParams or PortParams (make_params(kind, ...)); "
+        "generate_map(kind, seed=..., **values) takes plain values",
+    )

@@ -22,7 +22,9 @@ import math
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
+from mmusv import arguments
 from mmusv._native import core
+from mmusv.errors import ConfigError
 
 __all__ = ["SEA_PRESETS", "SeaPreset", "SeaSpec", "sea_spec_for_height", "sea_spec_for_preset"]
 
@@ -72,9 +74,16 @@ class SeaSpec:
 
 
 def sea_spec_for_preset(name: str, *, direction_deg: float = 0.0, spread_s: float = DEFAULT_SPREAD_S) -> SeaSpec:
-    """The sea of a preset name ("0".."9" or "W0".."W3"); ``KeyError`` for an unknown name."""
+    """The sea of a preset name (the strings "0".."9" or "W0".."W3"), travelling towards ``direction_deg``
+    (degrees counter-clockwise from east) with spreading ``spread_s``; a :class:`~mmusv.errors.ConfigError`
+    (also a ``KeyError``, as before) names the presets for an unknown name."""
+    if not isinstance(name, str) or name not in SEA_PRESETS:
+        raise UnknownSeaPresetError(
+            f"sea preset {name!r:.60} is unknown; the presets are {', '.join(SEA_PRESETS)} (strings: WMO sea state "
+            "codes and the paper's W0..W3)"
+        )
     p = SEA_PRESETS[name]
-    return SeaSpec(p.hs_m, p.tp_s, p.gamma, math.radians(direction_deg), spread_s)
+    return _checked(SeaSpec(p.hs_m, p.tp_s, p.gamma, _radians(direction_deg), _spread(spread_s)))
 
 
 def sea_spec_for_height(
@@ -87,11 +96,39 @@ def sea_spec_for_height(
 ) -> SeaSpec:
     """The sea of a significant height ``hs_m``: fully developed (Pierson–Moskowitz) unless ``tp_s`` is given;
     ``gamma`` defaults to 1 for a fully developed sea and to DNV-RP-C205's ``exp(5.75 − 1.15 Tp/√Hs)`` (in [1, 5])
-    for a given period."""
+    for a given period. Every value is a real number; a sea outside the core's ranges is a
+    :class:`~mmusv.errors.ConfigError` naming the field (checked here, not first when the sea is used)."""
+    hs_m = arguments.real(hs_m, name="invalid config hs_m", unit="metres")
+    if tp_s is not None:
+        tp_s = arguments.real(tp_s, name="invalid config tp_s", unit="seconds")
+    if gamma is not None:
+        gamma = arguments.real(gamma, name="invalid config gamma")
     if tp_s is None:
         tp, _ = core.fully_developed(hs_m)
         g = 1.0 if gamma is None else gamma
     else:
         tp = tp_s
         g = core.dnv_gamma(hs_m, tp_s) if gamma is None else gamma
-    return SeaSpec(float(hs_m), float(tp), float(g), math.radians(direction_deg), float(spread_s))
+    return _checked(SeaSpec(float(hs_m), float(tp), float(g), _radians(direction_deg), _spread(spread_s)))
+
+
+class UnknownSeaPresetError(ConfigError, KeyError):  # type: ignore[misc,unused-ignore]
+    """No sea preset has this name (a :class:`~mmusv.errors.ConfigError`, and a ``KeyError`` as before)."""
+
+    def __str__(self) -> str:
+        return str(self.args[0]) if self.args else ""
+
+
+def _radians(direction_deg: float) -> float:
+    return math.radians(arguments.real(direction_deg, name="invalid config direction_deg", unit="degrees"))
+
+
+def _spread(spread_s: float) -> float:
+    return arguments.real(spread_s, name="invalid config spread_s")
+
+
+def _checked(spec: SeaSpec) -> SeaSpec:
+    """``spec`` after the core checked its ranges (it draws the sea's field once, about 2 ms; errors name the
+    field: ``hs_m``, ``tp_s``, ``gamma``, ``spread_s``)."""
+    spec.field(scenario_seed=0)
+    return spec

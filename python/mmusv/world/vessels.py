@@ -55,6 +55,7 @@ from mmusv.world.vessel_shapes import build_procedural
 from mmusv.yamlio import parse_yaml, read_yaml
 
 __all__ = [
+    "AssetNameError",
     "AssetSpecError",
     "MountPoint",
     "UnknownAssetError",
@@ -285,24 +286,36 @@ def asset_names() -> list[str]:
         return sorted(set(_builtin_entries()) | set(_user))
 
 
+class AssetNameError(ConfigError, ValueError):  # type: ignore[misc,unused-ignore]
+    """:func:`known_asset` refused a name: a :class:`mmusv.ConfigError`, and the ``ValueError`` schema validators
+    take."""
+
+
 def known_asset(name: str) -> str:
-    """``name`` when the library has an asset of that name; else a ``ValueError`` (for schema validators) naming
-    up to three close matches and the command that lists them all. Builds nothing."""
+    """``name`` when the library has an asset of that name; else an :class:`AssetNameError` (a ``ConfigError`` and,
+    for schema validators, a ``ValueError``) naming up to three close matches and the command that lists them all.
+    Builds nothing."""
+    if not isinstance(name, str):
+        raise AssetNameError(f"an asset name is a string, not {type(name).__name__} (`mmusv assets` lists them)")
     names = asset_names()
     if name not in names:
         close = difflib.get_close_matches(name, names, n=3, cutoff=0.5)
         hint = f"; did you mean {', '.join(close)}?" if close else ""
-        raise ValueError(f"unknown asset{hint} (`mmusv assets` lists all {len(names)})")
+        raise AssetNameError(f"unknown asset{hint} (`mmusv assets` lists all {len(names)})")
     return name
 
 
 def get_asset(name: str) -> VesselAsset:
     """The asset called ``name`` (built on first use, then cached).
 
-    Raises :class:`UnknownAssetError` (a ``KeyError``) listing close matches when no asset has that name.
+    Raises :class:`UnknownAssetError` (a ``KeyError``) listing close matches when no asset has that name, and
+    :class:`~mmusv.errors.ConfigError` when ``name`` is not a string.
     """
     if not isinstance(name, str):
-        raise TypeError(f"asset name must be a string, got {type(name).__name__}")
+        raise ConfigError(
+            f"asset name = {name!r:.60}: must be a string, not {type(name).__name__} "
+            "(mmusv.world.vessels.asset_names() lists the assets)"
+        )
     with _lock:
         if name in _user:
             return _user[name]
@@ -317,7 +330,21 @@ def get_asset(name: str) -> VesselAsset:
 
 
 def library(*, category: str | None = None, semantic_class: SemanticClass | int | None = None) -> list[VesselAsset]:
-    """All assets sorted by name, optionally only one ``category`` and/or ``semantic_class``. Builds them all."""
+    """All assets sorted by name, optionally only one ``category`` (one of :func:`categories`) and/or
+    ``semantic_class`` (a :class:`~mmusv.classes.SemanticClass` or its id). Builds them all. An unknown category or
+    class is a :class:`~mmusv.errors.ConfigError` naming the valid ones (not an empty list)."""
+    if category is not None and category not in categories():
+        raise ConfigError(f"category = {category!r:.60}: unknown; the categories are {', '.join(categories())}")
+    if semantic_class is not None:
+        try:
+            if isinstance(semantic_class, (bool, np.bool_)):
+                raise ValueError(semantic_class)
+            semantic_class = SemanticClass(semantic_class)
+        except ValueError:
+            known = ", ".join(f"{c.value} ({c.name.lower()})" for c in SemanticClass)
+            raise ConfigError(
+                f"semantic_class = {semantic_class!r:.60}: not a semantic class; the classes are {known}"
+            ) from None
     assets = [get_asset(n) for n in asset_names()]
     if category is not None:
         assets = [a for a in assets if a.category == category]
@@ -336,7 +363,9 @@ def categories() -> list[str]:
 def register_asset(asset: VesselAsset) -> VesselAsset:
     """Adds ``asset`` to this process's library and returns it; a name already taken raises :class:`AssetSpecError`."""
     if not isinstance(asset, VesselAsset):
-        raise TypeError(f"register_asset() takes a VesselAsset, got {type(asset).__name__}")
+        raise ConfigError(
+            f"register_asset() takes a VesselAsset (load_asset_file(...) builds one), got {type(asset).__name__}"
+        )
     with _lock:
         if asset.name in _builtin_entries():
             raise AssetSpecError("name", f"{asset.name!r} is a built-in asset; choose another name")
@@ -348,6 +377,8 @@ def register_asset(asset: VesselAsset) -> VesselAsset:
 
 def unregister_asset(name: str) -> None:
     """Removes a registered user asset (built-ins cannot be removed)."""
+    if not isinstance(name, str):
+        raise ConfigError(f"asset name = {name!r:.60}: must be a string, not {type(name).__name__}")
     with _lock:
         if name in _user:
             del _user[name]
@@ -610,7 +641,7 @@ def load_asset_file(
         base = Path(base_dir) if base_dir is not None else None
         source = "<mapping>"
     else:
-        path = Path(os.fspath(entry)).expanduser()
+        path = _asset_path(entry, "entry")
         data = _read_yaml(path)
         if not isinstance(data, Mapping) or "vessels" in data:
             raise AssetSpecError(
@@ -627,13 +658,22 @@ def load_asset_catalog(path: str | os.PathLike[str], *, register: bool = False) 
 
     Entries are those of :func:`load_asset_file`; relative mesh paths are relative to the file's folder.
     """
-    p = Path(os.fspath(path)).expanduser()
+    p = _asset_path(path, "path")
     entries = _index_entries(_read_yaml(p), source=str(p))
     assets = [_build_entry(e, base_dir=p.parent, source=str(p)) for e in entries.values()]
     if register:
         for a in assets:
             register_asset(a)
     return assets
+
+
+def _asset_path(value: object, name: str) -> Path:
+    """An asset file argument as a path (``~`` expanded), else an :class:`AssetSpecError` naming ``name``."""
+    if isinstance(value, bytes) or not isinstance(value, (str, os.PathLike)) or not os.fspath(value):
+        raise AssetSpecError(
+            name, f"must be a YAML file path (str or pathlib.Path) or an asset mapping, got {value!r:.60}"
+        )
+    return Path(os.fspath(value)).expanduser()
 
 
 def _read_yaml(path: Path) -> object:
