@@ -13,6 +13,7 @@ import numpy as np
 import numpy.typing as npt
 
 __all__ = [
+    "MAX_SURFACE_TILES",
     "Camera",
     "ConfigError",
     "Fleet",
@@ -42,6 +43,7 @@ __all__ = [
     "response_variance",
     "sea_presets",
     "sea_seed",
+    "surface_tiles",
     "uniform_elevations",
     "wave_height",
     "wave_presets",
@@ -486,13 +488,21 @@ def capture_frame(
     ``(outputs, seconds, ppi_seconds)``: the dict ``scan``/``render``/``sweep`` return (bit-identical to those
     calls; a radar's has ``ppi`` (size_px, size_px) f32 when asked for) and the task's wall seconds (profiling)."""
 
+MAX_SURFACE_TILES: int
+"""Most tiles one displaced sea surface may hold (2**22; mmusv_core::sea::MAX_TILES)."""
+
+def surface_tiles(foci: npt.NDArray[np.float32], *, radius_m: float = 320.0, tile_m: float = 32.0) -> int:
+    """Tiles the displaced sea surface around ``foci`` (F, 2) float32 (world x, y, metres) out to ``radius_m`` holds, in
+    tiles of ``tile_m`` (saturated; 0 without foci): ``Scene.set_wave_surface`` refuses more than
+    ``MAX_SURFACE_TILES``."""
+
 # --- demo ---
 
 def demo_scene(
     *, seed: int = 1, extent: float = 2000.0, terrain_cells: int = 512, vessels: int = 48
 ) -> tuple[Scene, list[int]]:
-    """The synthetic maritime scene (terrain instance 0, water plane instance 1, vessels; ``extent`` metres); returns
-    ``(scene, vessel_instance_ids)``."""
+    """The synthetic maritime scene (terrain instance 0, water plane instance 1, vessels; ``extent`` metres, at least
+    100; ``terrain_cells`` 1..4096 a side, ``vessels`` at most 4096); returns ``(scene, vessel_instance_ids)``."""
 
 # --- kinematics ---
 

@@ -34,10 +34,11 @@ NO_HIT = -1
 SURFACE_TILE_M = 32.0
 """Side of a tile of the displaced sea surface, metres (the core's ``SurfaceSpec::tile_m``, which
 :meth:`Scene.set_wave_surface` leaves at its default)."""
-MAX_SURFACE_TILES = 2**22
-"""Most tiles one displaced sea surface may hold. The core samples the rectangle around every focus (out to
-``radius_m``) as one grid of :data:`SURFACE_TILE_M` tiles, so foci far apart (or a huge radius) would ask it for
-more memory than any machine has: 2²² tiles is a square of about 65 km a side, beyond any map."""
+MAX_SURFACE_TILES: int = core.MAX_SURFACE_TILES
+"""Most tiles one displaced sea surface may hold (the core's ``sea::MAX_TILES``, which it refuses past itself).
+The core samples the rectangle around every focus (out to ``radius_m``) as one grid of :data:`SURFACE_TILE_M`
+tiles, so foci far apart (or a huge radius) would ask for more memory than any machine has: 2²² tiles is a square
+of about 65 km a side, beyond any map."""
 MAX_DEMO_CELLS = 4096
 """Largest ``terrain_cells`` and ``vessels`` of :func:`demo_scene` (4096² cells: 33 million terrain triangles)."""
 
@@ -116,13 +117,8 @@ def surface_tiles(foci: npt.ArrayLike, radius_m: float) -> int:
     """How many tiles the displaced sea surface around ``foci`` ``(F, 2)`` (world x, y, metres) out to
     ``radius_m`` holds: the core samples their bounding rectangle, grown by ``radius_m``, as one grid of
     :data:`SURFACE_TILE_M` tiles (0 without foci)."""
-    f = np.asarray(foci, dtype=np.float64).reshape(-1, 2)
-    if f.shape[0] == 0:
-        return 0
-    lo, hi = f.min(axis=0) - radius_m, f.max(axis=0) + radius_m
-    x0 = np.floor(lo / SURFACE_TILE_M) * SURFACE_TILE_M
-    n = np.ceil((hi - x0) / SURFACE_TILE_M)
-    return int(n[0]) * int(n[1])
+    f = np.ascontiguousarray(np.asarray(foci, dtype=np.float32).reshape(-1, 2))
+    return int(core.surface_tiles(f, radius_m=float(radius_m), tile_m=SURFACE_TILE_M))  # the core's own count
 
 
 _SEA_FIELDS = ("hs_m", "tp_s", "gamma", "direction_rad", "spread_s")

@@ -189,6 +189,19 @@ try:
     demo_scene(terrain_cells=10**6)
 except MmusvError as exc:
     print("demo:", type(exc).__name__, exc)
+# The native calls themselves, past the Python checks: the core refuses them too.
+from mmusv._native import core
+far = np.array([[-2e5, -2e5], [2e5, 2e5]], np.float32)
+for foci, radius in ((far, 320.0), (np.zeros((1, 2), np.float32), 1e30)):
+    try:
+        s.native.set_wave_surface(2.0, tp_s=7.0, gamma=1.0, foci=foci, radius_m=radius)
+    except MmusvError as exc:
+        print("native scene:", type(exc).__name__, exc)
+for cells, vessels in ((10**6, 1), (64, 10**9)):
+    try:
+        core.demo_scene(seed=1, extent=2000.0, terrain_cells=cells, vessels=vessels)
+    except MmusvError as exc:
+        print("native demo:", type(exc).__name__, exc)
 """
 
 
@@ -212,6 +225,10 @@ def test_requests_that_aborted_the_process_are_refused() -> None:
     assert any(ln.startswith("simulation: ConfigError") and "keep the USVs within" in ln for ln in lines), r.stdout
     assert any(ln.startswith("scene: InputError") and "bring the foci closer" in ln for ln in lines), r.stdout
     assert any(ln.startswith("demo: InputError") and "terrain_cells" in ln for ln in lines), r.stdout
+    native = [ln for ln in lines if ln.startswith("native scene: InputError") and "foci" in ln]
+    assert len(native) == 2, r.stdout  # foci 400 km apart; a radius of 1e30 m (a capacity-overflow panic)
+    assert any(ln.startswith("native demo: InputError") and "terrain_cells" in ln for ln in lines), r.stdout
+    assert any(ln.startswith("native demo: InputError") and "vessels" in ln for ln in lines), r.stdout
 
 
 # ------------------------------------------------------------------------------------------------ Scene

@@ -119,10 +119,18 @@ pub fn hull_mesh(
     Mesh::new(name, &v, &f, &[VESSEL])
 }
 
-/// Builds the demo scene.
+/// Largest `terrain_cells` (a side: 4096² cells, 33 million terrain triangles) and `vessels` of the demo scene.
+pub const MAX_DEMO_SIZE: u32 = 4096;
+
+/// Builds the demo scene. Errors name `terrain_cells` (1..=[`MAX_DEMO_SIZE`]), `vessels` (at most
+/// [`MAX_DEMO_SIZE`]) or `extent` (at least 100 m).
 pub fn maritime_demo(p: DemoParams) -> Result<DemoScene> {
-    if p.terrain_cells == 0 {
-        return Err(MmusvError::input("terrain_cells", "need at least 1 terrain cell per side"));
+    if p.terrain_cells == 0 || p.terrain_cells > MAX_DEMO_SIZE {
+        let why = format!("{} cells a side; give 1..={MAX_DEMO_SIZE}", p.terrain_cells);
+        return Err(MmusvError::input("terrain_cells", why));
+    }
+    if p.vessels > MAX_DEMO_SIZE {
+        return Err(MmusvError::input("vessels", format!("{} vessels; give 0..={MAX_DEMO_SIZE}", p.vessels)));
     }
     if !(p.extent >= 100.0 && p.extent.is_finite()) {
         return Err(MmusvError::input(
@@ -254,5 +262,19 @@ mod tests {
         let full = DemoParams::default();
         let cells = full.terrain_cells as usize;
         assert!(2 * cells * cells > 500_000);
+    }
+
+    /// Sizes past the bounds are refused before anything is allocated, naming the parameter.
+    #[test]
+    fn oversized_demos_are_refused() {
+        for (p, field) in [
+            (DemoParams { terrain_cells: 0, ..DemoParams::default() }, "terrain_cells"),
+            (DemoParams { terrain_cells: 1_000_000, ..DemoParams::default() }, "terrain_cells"),
+            (DemoParams { vessels: 1_000_000_000, ..DemoParams::default() }, "vessels"),
+            (DemoParams { extent: f32::NAN, ..DemoParams::default() }, "extent"),
+        ] {
+            let Err(e) = maritime_demo(p) else { panic!("{p:?} was accepted") };
+            assert!(e.to_string().contains(field), "{p:?}: {e}");
+        }
     }
 }

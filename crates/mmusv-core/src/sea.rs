@@ -43,7 +43,7 @@ pub use sun_mask::SunMask;
 pub(crate) use surface::tests::comp as test_component;
 pub use surface::{
     PinholeView, Raster, SurfaceHit, SurfaceShading, SurfaceSpec, WaterHit, WaveSurface, DETAIL_CELLS, FLAT_PIECE,
-    SKIN_M, TILE_CELLS,
+    MAX_TILES, SKIN_M, TILE_CELLS,
 };
 
 /// Most cells per side of the height grid.

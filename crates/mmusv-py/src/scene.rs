@@ -115,13 +115,15 @@ fn surface_key(
     if !(time_s.is_finite() && level.is_finite()) || foci.iter().any(|f| !(f[0].is_finite() && f[1].is_finite())) {
         return Err(InputError::new_err("wave surface: time_s, level and foci must be finite"));
     }
+    let spec = SurfaceSpec { tile_m, near_m, radius_m, taper_m, detail, slopes, fine_m };
+    spec.check_extent(&foci).map_err(crate::errors::to_py)?; // before any tile is allocated
     Ok(Some(SurfaceKey {
         sea: SeaSpec { hs, tp: tp_s, gamma, direction_rad, spread_s },
         seed: sea_seed(scenario_seed),
         time_s,
         level,
         foci,
-        spec: SurfaceSpec { tile_m, near_m, radius_m, taper_m, detail, slopes, fine_m },
+        spec,
     }))
 }
 
@@ -539,6 +541,18 @@ fn flat_2d<'a>(arr: &'a PyReadonlyArray2<'_, f64>) -> PyResult<&'a [f64]> {
     c_order(arr, "pose")
 }
 
+/// How many tiles the displaced sea surface around `foci` (F, 2) float32 (world x, y, metres) out to `radius_m`
+/// holds, in tiles of `tile_m` (mmusv_core::sea::SurfaceSpec::tiles_for; saturated, 0 without foci): what
+/// `Scene.set_wave_surface` refuses above `MAX_SURFACE_TILES`.
+#[pyfunction]
+#[pyo3(signature = (foci, *, radius_m=320.0, tile_m=32.0))]
+fn surface_tiles(foci: PyReadonlyArray2<'_, f32>, radius_m: f32, tile_m: f32) -> PyResult<u64> {
+    let foci = rows::<f32, 2>(&foci, "foci")?;
+    Ok(SurfaceSpec { tile_m, radius_m, ..SurfaceSpec::default() }.tiles_for(foci))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("MAX_SURFACE_TILES", mmusv_core::sea::MAX_TILES)?;
+    m.add_function(wrap_pyfunction!(surface_tiles, m)?)?;
     m.add_class::<Scene>()
 }

@@ -78,6 +78,54 @@ impl Default for SurfaceSpec {
     }
 }
 
+/// Most tiles one surface may hold: 2²² (a square of about 65 km a side at the default 32 m tiles, beyond any
+/// map). [`WaveSurface::new`] samples the rectangle around every focus as one grid, so foci far apart or a huge
+/// radius would ask for more memory than a machine has; [`SurfaceSpec::check_extent`] refuses them first.
+pub const MAX_TILES: u64 = 1 << 22;
+
+impl SurfaceSpec {
+    /// How many tiles [`WaveSurface::new`] samples for `foci` (world x, y, metres): the foci's bounding rectangle
+    /// grown by `radius_m`, in tiles of `tile_m` (0 without foci). Counted in `f64` and saturated, never
+    /// overflowing.
+    pub fn tiles_for(&self, foci: &[[f32; 2]]) -> u64 {
+        let tile_m = f64::from(self.tile_m.max(1e-3));
+        let reach = f64::from(self.radius_m.max(0.0));
+        if foci.is_empty() || reach == 0.0 {
+            return 0;
+        }
+        let side = |a: usize| {
+            let lo = foci.iter().map(|f| f64::from(f[a])).fold(f64::INFINITY, f64::min) - reach;
+            let hi = foci.iter().map(|f| f64::from(f[a])).fold(f64::NEG_INFINITY, f64::max) + reach;
+            let x0 = (lo / tile_m).floor() * tile_m;
+            ((hi - x0) / tile_m).ceil()
+        };
+        let n = side(0) * side(1);
+        if n.is_finite() && n < 1.8e19 {
+            n as u64
+        } else {
+            u64::MAX
+        }
+    }
+
+    /// Refuses foci and a radius whose surface would hold more than [`MAX_TILES`] tiles (an input error naming
+    /// `foci`, the count and the limit).
+    pub fn check_extent(&self, foci: &[[f32; 2]]) -> crate::Result<()> {
+        let n = self.tiles_for(foci);
+        if n > MAX_TILES {
+            return Err(crate::MmusvError::input(
+                "foci",
+                format!(
+                    "the wave surface around these foci out to radius_m = {} m would hold {n} tiles of {} m, more \
+                     than the {MAX_TILES} one surface may (a square of about 65 km); bring the foci closer together \
+                     or lower radius_m",
+                    self.radius_m, self.tile_m
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// One sampled tile: `n` cells a side (0: flat at the still level), node heights and slopes row-major.
 #[derive(Debug, Clone, Default)]
 struct Tile {

@@ -465,3 +465,27 @@ fn fine_slopes_make_every_level_alike_for_a_fine_footprint() {
         assert!((wide - without).abs() < 1e-3 * without && (rough - m6 - m15).abs() < 1e-6, "{r0}");
     }
 }
+
+/// `tiles_for` counts the grid `new` samples (checked on surfaces built here), and `check_extent` refuses foci far
+/// apart or a huge radius before anything is allocated, naming `foci`.
+#[test]
+fn the_tile_count_is_the_grids_and_huge_extents_are_refused() {
+    let sea = test_sea();
+    for (foci, radius) in [
+        (vec![[0.0f32, 0.0]], 320.0f32),
+        (vec![[-17.5, 3.0], [250.0, -90.0]], 100.0),
+        (vec![[1000.0, 1000.0], [1010.0, 990.0], [960.0, 1100.0]], 64.0),
+        (vec![], 320.0),
+    ] {
+        let spec = SurfaceSpec { radius_m: radius, ..SurfaceSpec::default() };
+        let s = surface(&sea, 0.0, &foci, spec);
+        assert_eq!(spec.tiles_for(&foci), (s.ntx * s.nty) as u64, "{foci:?}");
+        assert!(spec.check_extent(&foci).is_ok());
+    }
+    let far = [[-2e5f32, -2e5], [2e5, 2e5]];
+    let Err(e) = SurfaceSpec::default().check_extent(&far) else { panic!("400 km apart accepted") };
+    assert!(e.to_string().contains("foci"), "{e}");
+    let huge = SurfaceSpec { radius_m: 1e30, ..SurfaceSpec::default() };
+    assert_eq!(huge.tiles_for(&[[0.0, 0.0]]), u64::MAX);
+    assert!(huge.check_extent(&[[0.0, 0.0]]).is_err());
+}
