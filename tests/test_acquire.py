@@ -162,6 +162,30 @@ def test_malformed_scenario_fails_before_anything_is_written(
     assert not (tmp_path / "out").exists()
 
 
+def test_a_capture_that_fails_at_the_first_frame_writes_and_replaces_nothing(tmp_path: Path) -> None:
+    """The first frame is captured before the recording is opened: a scenario the schema takes but the capture
+    refuses (two USVs 200 km apart over a physical sea: too far for one sampled sea surface; the route checks,
+    which would catch it earlier, are off) fails with a ConfigError naming the USVs, and an earlier complete run
+    in the folder, with ``overwrite``, is left byte for byte as it was (recording, manifest, tables)."""
+    sc = small_scenario(frames=2)
+    first = run(sc, out_dir=tmp_path)
+    before = {p.relative_to(tmp_path): p.read_bytes() for p in sorted(tmp_path.rglob("*")) if p.is_file()}
+    far = small_scenario(frames=2)
+    far["environment"]["wave"] = "W2"
+    usvs = [v for v in far["vessels"] if v["role"] == "usv"]
+    usvs[0]["route"] = [[-1e5, -1e5], [-99_900, -1e5]]
+    usvs[1]["route"] = [[1e5, 1e5], [99_900, 1e5]]
+    with pytest.raises(mmusv.ConfigError, match="USVs") as err:
+        run(far, out_dir=tmp_path, overwrite=True, checks=False)
+    assert usvs[0]["id"] in str(err.value)
+    after = {p.relative_to(tmp_path): p.read_bytes() for p in sorted(tmp_path.rglob("*")) if p.is_file()}
+    assert after == before and first.recording.name in {p.name for p in before}
+    fresh = tmp_path / "fresh"
+    with pytest.raises(mmusv.ConfigError):
+        run(far, out_dir=fresh, checks=False)
+    assert not fresh.exists()
+
+
 def test_interrupted_run_leaves_a_readable_recording(tmp_path: Path) -> None:
     def stop(done: int, total: int) -> None:
         if done == 2:

@@ -35,7 +35,7 @@ from mmusv import arguments
 from mmusv.annotate import Annotations, SilhouetteCache, annotate_agent
 from mmusv.config import Scenario, load_scenario, scenario_hash
 from mmusv.errors import ConfigError, IoError, MmusvError, located
-from mmusv.profiling import RunProfile
+from mmusv.profiling import RunProfile, clocks
 from mmusv.recording.background import BackgroundWriter
 from mmusv.recording.guard import FolderLock, write_cause
 from mmusv.recording.tables import TableWriter
@@ -142,9 +142,12 @@ def run(
     the same folder fails at once. A ``.partial`` recording left by a killed run is recorded again from scratch
     (a clean redo; ``notes`` says so), and table parts of an earlier run are removed first.
 
+    The first frame is captured before anything is written: a failure there (a setting a sensor refuses only when
+    it captures, a capture that cannot be made) leaves the folder as it was, an earlier run in it included.
+
     Raises:
-        ConfigError: the scenario or an argument is invalid (nothing is written); flags (``overwrite``,
-            ``checks``, ``profile``) must be ``bool``.
+        ConfigError: the scenario or an argument is invalid, or the first frame cannot be captured (nothing is
+            written); flags (``overwrite``, ``checks``, ``profile``) must be ``bool``.
         IoError: the output exists and ``overwrite`` is false, another run writes the folder, or it cannot be
             written (the message names the cause, e.g. ``No space left on device``, and the frames that are safe).
         KeyboardInterrupt: re-raised after the recording was finished with every completed frame.
@@ -193,6 +196,15 @@ def run(
         # The routes as far as this run sails them: frames 0 .. total - 1 (the stop of a frame range).
         upto = scenario.acquisition.model_copy(update={"frames": total})
         check_routes(scenario.model_copy(update={"acquisition": upto}), sim.world, source=source)
+    # The first frame is captured before anything is written or replaced: whatever a sensor refuses only when it
+    # captures (or any other failure of a capture) fails the run here, with the folder as it was.
+    started = clocks()  # the run's clocks start with its first frame
+    try:
+        first_capture = sim.capture(first)
+    except MmusvError as exc:
+        raise located(exc, source) from None
+    captured = [(first_capture, time.perf_counter() - started[0])]
+    del first_capture
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
@@ -200,7 +212,19 @@ def run(
     lock = FolderLock(out, what="mmusv run").acquire()  # a second run into `out` refuses at once
     try:
         return _record(
-            scenario, sim, out, rec_path, overwrite, first, total, frame_range, progress, profile, notes=notes
+            scenario,
+            sim,
+            out,
+            rec_path,
+            overwrite,
+            first,
+            total,
+            frame_range,
+            progress,
+            profile,
+            notes=notes,
+            captured=captured,
+            started=started,
         )
     finally:
         lock.release()
@@ -232,8 +256,13 @@ def _record(
     profile: bool,
     *,
     notes: list[str] | None,
+    captured: list[tuple[FrameCapture, float]],
+    started: tuple[float, float],
 ) -> RunResult:
-    """The recording part of :func:`run`, with the folder locked."""
+    """The recording part of :func:`run`, with the folder locked; ``captured`` holds frame ``first``, captured
+    before anything was written, and the seconds it took (taken from the list, so it is freed once written);
+    ``started``: the clocks (:func:`~mmusv.profiling.clocks`) read when that capture began, from which the run's
+    seconds and its profile count."""
     from mmusv.recording.frames import FrameRecorder  # the MCAP side, kept apart from the loop
 
     if rec_path.exists() and not overwrite:  # again, now that no other run can be writing it
@@ -263,7 +292,7 @@ def _record(
         raise IoError(f"cannot write into {out}: {write_cause(out, exc)}") from None
     silhouettes = SilhouetteCache()
     result = RunResult(recording=rec_path, tables=tables_dir, frames_written=0, status="complete", seconds=0.0)
-    t0 = time.perf_counter()
+    t0 = started[0]  # the first frame's capture, before the recording was opened
     prof = RunProfile() if profile else None
     result.profile = prof
     try:
@@ -301,12 +330,15 @@ def _record(
     # cameras' work, stalling the writer (port_entry: 50 -> 930 ms a frame), so they run between captures.
     annotate_behind = not renders
     if prof is not None:
-        prof.start()
+        prof.start(since=started)
     failure: BaseException | None = None
     try:
         for k in range(first, total):
             tf = time.perf_counter()
-            cap = sim.capture(k)
+            if captured:  # frame `first`, captured before the recording was opened
+                cap, earlier = captured.pop()
+            else:
+                cap, earlier = sim.capture(k), 0.0
             # The next frame's sea surface is sampled on its own thread while this one is annotated and written.
             if k + 1 < total:
                 sim.prefetch_frame(k + 1, shading_detail=renders)
@@ -316,14 +348,14 @@ def _record(
             waited = writer.wait_seconds
             writer.submit(item)  # (annotated and) written while the next frame is captured
             if prof is not None:
-                prof.add("main:capture", t1 - tf)
+                prof.add("main:capture", t1 - tf + earlier)
                 for key, sec in cap.sensor_seconds.items():  # keyed <agent>/<sensor>: summed over the agents
                     prof.add("main:capture/" + key.split("/", 1)[1], sec)
                 if not annotate_behind:
                     prof.add("main:annotate", t2 - t1)
                 prof.add("main:wait", writer.wait_seconds - waited)
             del cap, item
-            result.frame_seconds.append(time.perf_counter() - tf)
+            result.frame_seconds.append(time.perf_counter() - tf + earlier)
             if progress is not None:
                 progress(k + 1 - first, total - first)
         writer.close()

@@ -69,10 +69,10 @@ class RunProfile:
         finally:
             self.add(stage, time.perf_counter() - t)
 
-    def start(self) -> None:
-        """Starts the wall and CPU clocks (at the first frame)."""
-        self._t0 = time.perf_counter()
-        self._cpu0 = _cpu_seconds()
+    def start(self, *, since: tuple[float, float] | None = None) -> None:
+        """Starts the wall and CPU clocks (at the first frame); ``since``: clocks read earlier (:func:`clocks`),
+        when the first frame was captured before the rest was set up."""
+        self._t0, self._cpu0 = since if since is not None else clocks()
 
     def stop(self, frames: int) -> None:
         """Stops the clocks after ``frames`` frames and reads the peak RSS and the load average."""
@@ -129,6 +129,11 @@ class RunProfile:
         lines.append("indented rows: task times inside the stage above them (sensors of one frame run concurrently,")
         lines.append("so they can add up to more than that stage)")
         return "\n".join(lines)
+
+
+def clocks() -> tuple[float, float]:
+    """``(time.perf_counter(), process CPU seconds)`` now: what :meth:`RunProfile.start` reads."""
+    return time.perf_counter(), _cpu_seconds()
 
 
 def _cpu_seconds() -> float:
