@@ -23,6 +23,7 @@ import hashlib
 import json
 import math
 import os
+import re
 import reprlib
 from dataclasses import replace
 from typing import Any, Literal
@@ -50,6 +51,7 @@ from mmusv.yamlio import mapping_source
 __all__ = [
     "MAX_COORDINATE_M",
     "MAX_SPEED_MPS",
+    "RIG_NAME",
     "SCENARIO_NAME",
     "AcquisitionConfig",
     "EnvironmentConfig",
@@ -69,6 +71,8 @@ MAX_SPEED_MPS = 100.0
 SCENARIO_NAME = r"[A-Za-z0-9_\-][A-Za-z0-9_\-.]*"
 """A scenario's (and a generation spec's) name, which names files and folders: letters, digits, ``_``, ``-``
 and ``.``, not starting with ``.`` (``.``, ``..``, hidden files)."""
+RIG_NAME = re.compile(r"[A-Za-z0-9_\-]{1,64}")
+"""A rig's name under ``rigs`` (what the vessels' ``rig`` names): letters, digits, ``_`` and ``-``."""
 MAX_COORDINATE_M = 1.0e6
 """Farthest a waypoint (and a route's start offset) may lie from the world origin, metres (1,000 km: far
 beyond any map)."""
@@ -278,6 +282,19 @@ class Scenario(_Model):
     acquisition: AcquisitionConfig = Field(default_factory=AcquisitionConfig)
     rigs: dict[str, RigConfig] = Field(default_factory=dict)
     vessels: list[VesselConfig] = Field(min_length=1)
+
+    @field_validator("rigs", mode="before")
+    @classmethod
+    def _rig_names(cls, v: Any) -> Any:
+        # Checked as written, before whitespace is stripped (" " and "" would become one rig named '').
+        if isinstance(v, dict):
+            for name in v:
+                if not (isinstance(name, str) and RIG_NAME.fullmatch(name)):
+                    raise ValueError(
+                        f"rig name {reprlib.repr(name)}: letters, digits, _ and - only (1..64 characters), as the "
+                        "vessels' `rig` names it"
+                    )
+        return v
 
     @model_validator(mode="after")
     def _cross_checks(self) -> Scenario:

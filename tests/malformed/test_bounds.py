@@ -172,3 +172,12 @@ def test_a_sea_given_twice_is_refused(environment: dict[str, Any], said: str, tm
     # A resolved scenario written out (a run folder's scenario.yaml) holds the default `wave: W0` beside its sea.
     assert load_scenario(yaml.safe_load(yaml.safe_dump(alone.model_dump(mode="json")))) == alone
     load_scenario(_with("environment", {"wave": "W3", "motion": "paper"}))
+
+
+@pytest.mark.parametrize("name", [" ", "", "a b", "usv\nrig", "x" * 65, "rig.1"])
+def test_rig_names_are_refused_unless_plain(name: str, tmp_path: Path) -> None:
+    """A rig name is checked as written: " " and "" used to become one rig named '' (two rigs merged, silently)."""
+    doc = _with("name", "t")
+    doc["rigs"] = {name: {}, "r": doc["rigs"]["r"]}
+    msg = _refused(doc, tmp_path)
+    assert "rig name" in msg and "letters, digits" in msg, msg
