@@ -42,7 +42,7 @@ from pydantic import (
 from mmusv.errors import ConfigError, MmusvError, located
 from mmusv.sensors.config import RigConfig
 from mmusv.strict import StrictModel
-from mmusv.world.environment import Environment, wave_height_m
+from mmusv.world.environment import MAX_WAVE_HEIGHT_M, Environment, wave_height_m
 from mmusv.world.map_params import PARAM_MODELS, IslandParams, MapParams
 from mmusv.world.sea_state import SeaSpec
 from mmusv.world.vessels import get_asset, known_asset
@@ -122,7 +122,7 @@ class SeaConfig(_Model):
     cos-2s spreading ``spread_s`` (10: a wind sea; larger is longer-crested)."""
 
     state: int | None = Field(default=None, ge=0, le=9)
-    hs_m: float | None = Field(default=None, ge=0, le=25)
+    hs_m: float | None = Field(default=None, ge=0, le=MAX_WAVE_HEIGHT_M)
     tp_s: float | None = Field(default=None, ge=0.5, le=30)
     gamma: float | None = Field(default=None, ge=1, le=7)
     direction_deg: float = 0.0

@@ -62,6 +62,7 @@ def _refused(doc: dict[str, Any], tmp_path: Path) -> str:
         ("acquisition.frames", True, "acquisition.frames"),  # read as 1 frame
         ("vessels.1.speed_mps", True, "vessels[1].speed_mps"),  # read as 1 m/s
         ("environment.wave", True, "environment.wave"),  # read as a 1 m sea
+        ("environment.wave", 1e9, "environment.wave"),  # the paper's formula took a 1e9 m sea; physical: named hs_m
         ("name", "..", "name"),  # wrote `...mcap`; exports then failed
         ("name", ".hidden", "name"),
     ],

@@ -27,7 +27,7 @@ from mmusv import arguments
 from mmusv._native import core
 from mmusv.errors import ConfigError
 
-__all__ = ["WAVE_PRESETS", "Environment", "Sun", "Weather", "sun_at", "wave_height_m"]
+__all__ = ["MAX_WAVE_HEIGHT_M", "WAVE_PRESETS", "Environment", "Sun", "Weather", "sun_at", "wave_height_m"]
 
 WAVE_PRESETS: dict[str, float] = dict(core.wave_presets())
 """Significant wave height H in metres of each preset (paper, Table I), in order W0..W3: read from the core
@@ -38,6 +38,10 @@ _WEATHER: tuple[str, ...] = ("clear", "overcast", "fog", "rain")
 _TIME_RE = re.compile(r"^(\d{1,2}):(\d{2})$")
 
 
+MAX_WAVE_HEIGHT_M = 25.0
+"""Highest wave height a scenario may give, metres (the physical sea's ``hs_m`` bound too)."""
+
+
 def wave_height_m(wave: str | float) -> float:
     """Wave height H (m) of a preset name (``"W0"``..``"W3"``, any case) or a height in metres (a real number ≥ 0;
     not ``True``/``False``)."""
@@ -46,17 +50,20 @@ def wave_height_m(wave: str | float) -> float:
         if key not in WAVE_PRESETS:
             raise ConfigError(
                 f"invalid config environment.wave = {wave!r}: allowed presets are "
-                f"{', '.join(WAVE_PRESETS)} or a wave height in metres (>= 0)"
+                f"{', '.join(WAVE_PRESETS)} or a wave height in metres (0..{MAX_WAVE_HEIGHT_M:g})"
             )
         return WAVE_PRESETS[key]
     if isinstance(wave, (bool, np.bool_)) or not isinstance(wave, numbers.Real):
         raise ConfigError(
             f"invalid config environment.wave = {wave!r:.60}: allowed presets are {', '.join(WAVE_PRESETS)} or a wave "
-            f"height in metres (>= 0), not {type(wave).__name__}"
+            f"height in metres (0..{MAX_WAVE_HEIGHT_M:g}), not {type(wave).__name__}"
         )
     h = float(wave)
-    if not math.isfinite(h) or h < 0:
-        raise ConfigError(f"invalid config environment.wave = {wave!r}: a wave height must be finite and >= 0 metres")
+    if not (math.isfinite(h) and 0 <= h <= MAX_WAVE_HEIGHT_M):
+        raise ConfigError(
+            f"invalid config environment.wave = {wave!r}: a wave height must be in 0..{MAX_WAVE_HEIGHT_M:g} metres "
+            "(the significant height of the highest seas measured is about 19 m)"
+        )
     return h
 
 
