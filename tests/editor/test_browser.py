@@ -277,6 +277,22 @@ def test_run_in_the_background(browser: Any, live_server: LiveServer) -> None:
     assert [a.id for a in info.agents] == ["usv_1", "usv_2", "usv_3"]
 
 
+@pytest.mark.parametrize("typed", ["1e", "-", "0", "2.5"])
+def test_a_frames_box_it_cannot_read_starts_no_run(browser: Any, live_server: LiveServer, typed: str) -> None:
+    """A number box the browser cannot parse ("1e", "-") reads as empty, which means every frame: the page says so
+    and starts nothing (it started a full run); 0 and 2.5 are refused the same way before the server is asked."""
+    open_editor(browser, live_server)
+    frames = browser.find_element(By.ID, "run-frames")
+    frames.clear()
+    frames.send_keys(typed)
+    before = sorted(p.name for p in live_server.folder.rglob("*"))
+    browser.find_element(By.ID, "run").click()
+    _wait(browser, "return document.getElementById('status').classList.contains('error')", "the error")
+    assert "whole number of frames" in browser.find_element(By.ID, "status").text
+    assert sorted(p.name for p in live_server.folder.rglob("*")) == before  # nothing saved, nothing run
+    assert browser.execute_script("return document.getElementById('run-status').dataset.status") in (None, "")
+
+
 @pytest.mark.parametrize(
     ("method", "path", "body", "status"),
     [

@@ -200,10 +200,17 @@ function showRun(job) {
 }
 
 async function run() {
+  // A number box the browser cannot read (e.g. "1e") reports "" — which would mean every frame: say so instead.
+  const box = $("run-frames");
+  const framesText = box.value.trim();
+  const frames = framesText ? Number(framesText) : null;
+  if (box.validity.badInput || (frames !== null && !(Number.isInteger(frames) && frames >= 1))) {
+    status("frames: type a whole number of frames (1 or more), or leave the box empty to run every frame", true);
+    return;
+  }
   if (!(await save(false))) return;
-  const framesText = $("run-frames").value.trim();
   try {
-    const job = await api.startRun(state.savedName, framesText ? Number(framesText) : null);
+    const job = await api.startRun(state.savedName, frames);
     showRun(job);
     clearInterval(runTimer);
     runTimer = setInterval(async () => {
