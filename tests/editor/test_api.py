@@ -450,3 +450,25 @@ def test_other_hosts_are_refused(folder: Path) -> None:
     assert c.get("/api/files").status_code == 400
     c = TestClient(create_app(folder, allowed_hosts=["127.0.0.1", "localhost"]), base_url="http://127.0.0.1:8765")
     assert c.get("/api/files").status_code == 200
+
+
+def test_a_server_remembers_only_its_newest_finished_runs(
+    client: TestClient, folder: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The runs list of a long-lived server does not grow without end: past KEEP_FINISHED finished runs, the
+    oldest are forgotten when another starts (asking for one says why it is gone)."""
+    import mmusv.editor.jobs as jobs
+
+    monkeypatch.setattr(jobs, "KEEP_FINISHED", 1)
+    doc = small(bundled_doc(client))
+    doc["vessels"][0]["route"][2] = [-120, 600]  # over land: each run fails at once
+    assert client.put("/api/files/land.yaml", json={"document": doc}).status_code == 200
+    ids = []
+    for _ in range(3):
+        job = client.post("/api/runs", json={"name": "land.yaml", "frames": 1}).json()
+        _wait_run(client, job["id"])
+        ids.append(job["id"])
+    listed = [j["id"] for j in client.get("/api/runs").json()]
+    assert listed == [ids[2], ids[1]]  # the newest run and the one finished run kept when it started
+    gone = client.get(f"/api/runs/{ids[0]}")
+    assert gone.status_code == 404 and "newest 1 finished" in gone.text

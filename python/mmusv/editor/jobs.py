@@ -26,10 +26,12 @@ from typing import Any
 
 from mmusv.errors import InputError, NotFoundError
 
-__all__ = ["MAX_RUNNING", "Job", "Jobs", "RunGoingOn"]
+__all__ = ["KEEP_FINISHED", "MAX_RUNNING", "Job", "Jobs", "RunGoingOn"]
 
 MAX_RUNNING = 2
 """Runs at a time; a further start is refused until one ends."""
+KEEP_FINISHED = 100
+"""Finished runs a server remembers (the newest); older ones are forgotten when another starts."""
 
 
 class RunGoingOn(InputError):
@@ -107,6 +109,12 @@ class Jobs:
                 env={**os.environ, "PYTHONUNBUFFERED": "1"},
             )
             self._jobs[job.id] = job
+            # A long-lived server keeps the newest KEEP_FINISHED finished runs (their records, and the threads that
+            # followed them), not every run it ever started.
+            finished = sorted((j.id for j in self._jobs.values() if j.status != "running"), reverse=True)
+            for old in finished[KEEP_FINISHED:]:
+                del self._jobs[old]
+            self._followers = [t for t in self._followers if t.is_alive()]
         follower = threading.Thread(target=self._follow, args=(job,), daemon=True)
         self._followers.append(follower)
         follower.start()
@@ -132,6 +140,8 @@ class Jobs:
                     final = msg
         err = proc.stderr.read()
         code = proc.wait()
+        proc.stdout.close()  # read to the end: the pipes are done with (a forgotten run leaves none open)
+        proc.stderr.close()
         with self._lock:
             if final is None and job.stop_requested:  # stopped while Python was still starting
                 job.status = "interrupted"
@@ -152,7 +162,7 @@ class Jobs:
         """The run ``job_id``; :class:`NotFoundError` when there is none."""
         with self._lock:
             if job_id not in self._jobs:
-                raise NotFoundError(f"no run {job_id}")
+                raise NotFoundError(f"no run {job_id} (the editor keeps its newest {KEEP_FINISHED} finished runs)")
             return self._jobs[job_id]
 
     def all(self) -> list[Job]:
