@@ -60,3 +60,11 @@ def browser() -> Iterator[Any]:
         yield driver
     finally:
         driver.quit()
+
+
+@pytest.fixture
+def folder(tmp_path: Path) -> Path:
+    """The editor's scenario folder (empty)."""
+    d = tmp_path / "scenarios"
+    d.mkdir()
+    return d

@@ -28,14 +28,8 @@ from mmusv.preview import compose_preview
 
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")
 
+
 SMALL_RIG = {"preset": "lidar_only", "lidar": {"channels": 16, "points_per_second": 20000}}
-
-
-@pytest.fixture
-def folder(tmp_path: Path) -> Path:
-    d = tmp_path / "scenarios"
-    d.mkdir()
-    return d
 
 
 @pytest.fixture

@@ -22,15 +22,9 @@ from mmusv.editor.app import MAX_BODY_BYTES, create_app
 
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")
 
-SMALL_RIG = {"preset": "lidar_only", "lidar": {"channels": 16, "points_per_second": 20000}}
 JSON = {"content-type": "application/json"}
 
-
-@pytest.fixture
-def folder(tmp_path: Path) -> Path:
-    d = tmp_path / "scenarios"
-    d.mkdir()
-    return d
+SMALL_RIG = {"preset": "lidar_only", "lidar": {"channels": 16, "points_per_second": 20000}}
 
 
 @pytest.fixture

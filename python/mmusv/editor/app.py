@@ -130,6 +130,15 @@ class _Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", strict=True)
 
 
+def _jsonable(value: dict[str, Any], name: str) -> dict[str, Any]:
+    """``value`` (a request field ``name``) when JSON can carry all of it back (:func:`_unjsonable`); else the
+    ``ValueError`` pydantic reports as a 422 naming the path."""
+    problem = _unjsonable(value, name)
+    if problem is not None:
+        raise ValueError(problem)
+    return value
+
+
 class DocumentBody(_Strict):
     """A scenario document (the JSON form of a scenario file)."""
 
@@ -138,10 +147,7 @@ class DocumentBody(_Strict):
     @field_validator("document")
     @classmethod
     def _text_is_unicode(cls, document: dict[str, Any]) -> dict[str, Any]:
-        problem = _unjsonable(document, "document")
-        if problem is not None:
-            raise ValueError(problem)
-        return document
+        return _jsonable(document, "document")
 
 
 class SaveBody(DocumentBody):
@@ -174,10 +180,7 @@ class MapBody(_Strict):
     @field_validator("map")
     @classmethod
     def _text_is_unicode(cls, value: dict[str, Any]) -> dict[str, Any]:
-        problem = _unjsonable(value, "map")
-        if problem is not None:
-            raise ValueError(problem)
-        return value
+        return _jsonable(value, "map")
 
 
 class RunBody(_Strict):
