@@ -14,6 +14,8 @@ with the new one, draws the same frames from the same poses. Each view is writte
 * ``ferry_dusk_zoom``: its mast and bridge enlarged 4× (the lights are a few pixels each);
 * ``dusk_series``: the same ferry and view through the hour of dusk (19:45, 20:15, 20:30 above; 20:45, 21:00,
   21:15 below; 480 × 270 each);
+* ``exposure_settings``: that view at 21:15 through four cameras differing only in their ``exposure`` (the
+  default, −1 EV, +1 EV, ISO 25 600; *after* only);
 * ``whitecaps_w3``: open water at wave level W3, from 8 m above the sea;
 * ``wake_chase``: a 35 m patrol boat at 14 m/s, seen from 20 m above a vessel following 100 m behind;
 * ``wake_top``: the same boat in its own top view (orthographic, heading up, 0.6 m per pixel);
@@ -164,6 +166,30 @@ def dusk_series(path: Path) -> None:
             _save_rgb(_scenario("dusk_series", rig=rig, vessels=[ferry], environment=env), one)
             with Image.open(one) as im:
                 sheet.paste(im, ((i % 3) * 480, (i // 3) * 270))
+    sheet.save(path)
+
+
+def exposure_settings(path: Path) -> None:
+    """``ferry_dusk``'s ferry and view at 21:15 (below the default camera's floor) through four cameras on the same mount that differ only in their
+    ``exposure`` (after issue #28 only: the setting is newer than the *before* package): the default automatic
+    exposure (ISO 6 400 at most), −1 EV and +1 EV of compensation, and a camera reaching ISO 25 600; 480 × 270
+    each, in that order left to right, top to bottom."""
+    from PIL import Image
+
+    bearing = 140.0
+    x, y = _at(bearing, 120.0)
+    ferry = {"id": "ferry", "asset": "ropax_ferry_90m", "speed_mps": 6.0, "route": _route(x, y, 265.0)}
+    rig = _camera_rig(resolution=(480, 270), hfov_deg=60.0, xyz=(0.0, 0.0, 3.0), yaw_deg=bearing, pitch_deg=-5.0)
+    settings = [{}, {"compensation_ev": -1.0}, {"compensation_ev": 1.0}, {"max_iso": 25600.0}]
+    rig["cameras"] = [{**rig["cameras"][0], "name": f"view{i}", "exposure": e} for i, e in enumerate(settings)]
+    env = {"time_of_day": "21:15", "weather": "clear", "wave": "W1"}
+    sim = mmusv.Simulation(_scenario("exposure_settings", rig=rig, vessels=[ferry], environment=env))
+    cams = sim.capture(0, sensors=["cameras"]).agents[sim.agents[0].id].cameras
+    sheet = Image.new("RGB", (2 * 480, 2 * 270))
+    for i in range(len(settings)):
+        rgb = cams[f"view{i}"].rgb
+        assert rgb is not None
+        sheet.paste(Image.fromarray(np.asarray(rgb)), ((i % 2) * 480, (i // 2) * 270))
     sheet.save(path)
 
 
@@ -334,6 +360,7 @@ VIEWS: dict[str, Callable[[Path], None]] = {
     "ferry_dusk": ferry_dusk,
     "ferry_dusk_zoom": ferry_dusk_zoom,
     "dusk_series": dusk_series,
+    "exposure_settings": exposure_settings,
     "whitecaps_w3": whitecaps_w3,
     "wake_chase": wake_chase,
     "wake_top": wake_top,
