@@ -154,7 +154,8 @@ class SeaConfig(_Model):
 
 
 class EnvironmentConfig(_Model):
-    """Time of day (``"HH:MM"``), weather, visibility, rain, the wave setting (``W0``..``W3`` or metres), the
+    """Time of day (``"HH:MM"``), weather, visibility, rain (a rate above 0 needs a sky that rains: ``weather`` other
+    than ``clear``), the wave setting (``W0``..``W3`` or metres), the
     physical ``sea`` (optional; else it follows ``wave``) and the vessels' ``motion``: ``physical`` (default: each
     hull's response to the sea through its RAOs) or ``paper`` (the paper's formula, driven by ``wave``)."""
 
@@ -201,6 +202,11 @@ class EnvironmentConfig(_Model):
             raise ValueError(
                 "environment: give `wave` (W0..W3 or metres) or `sea`, not both: `sea` sets the waves every sensor "
                 "and every hull meets"
+            )
+        if self.weather == "clear" and self.rain_mm_per_h:
+            raise ValueError(
+                f"environment: rain_mm_per_h = {self.rain_mm_per_h:g} with weather: clear: a clear sky does not rain; "
+                "give weather: rain (or overcast or fog, for the rain falling from them)"
             )
         if self.sea is not None and self.motion == "paper":
             raise ValueError(

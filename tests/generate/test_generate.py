@@ -226,3 +226,22 @@ def test_cli_generates_and_exit_status_reflects_quotas(tmp_path: Path, capsys: p
     assert "quota not met" in capsys.readouterr().out
     with pytest.raises(ConfigError, match="does not exist"):
         _cli(["generate", str(tmp_path / "missing.yaml"), "-o", str(tmp_path / "x")])
+
+
+def test_a_rain_rate_is_drawn_for_the_skies_that_rain(tmp_path: Path) -> None:
+    """The spec's rain rates go with the weathers that rain: a scenario drawn with a clear sky carries none (a clear
+    sky with rain is refused by the scenario), one drawn with rain carries the rate drawn."""
+    spec = {
+        **SMALL,
+        "environment": {**SMALL["environment"], "rain_mm_per_h": [6.0]},
+        "combinations": [
+            {"family": "head_on", "difficulty": "easy", "cooperating": 1, "targets": ["small"], "quota": 6},
+        ],
+    }
+    generate(spec, tmp_path)
+    weathers = []
+    for f in sorted(tmp_path.glob("*.yaml")):
+        env = yaml.safe_load(f.read_text())["environment"]
+        weathers.append(env["weather"])
+        assert env.get("rain_mm_per_h") == (6.0 if env["weather"] == "rain" else None), (f.name, env)
+    assert set(weathers) == {"clear", "rain"}, weathers

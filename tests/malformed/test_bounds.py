@@ -83,7 +83,7 @@ def test_camera_settings_out_of_range_are_refused(tmp_path: Path) -> None:
 def test_the_values_at_the_bounds_still_load() -> None:
     doc = _with("vessels.1.speed_mps", 100.0)
     doc["vessels"][1]["route"] = [[-1e6, 100], [1e6, 100]]
-    doc["environment"] = {"rain_mm_per_h": 500, "visibility_m": 1, "time_of_day": "13:00"}
+    doc["environment"] = {"weather": "rain", "rain_mm_per_h": 500, "visibility_m": 1, "time_of_day": "13:00"}
     doc["acquisition"]["frequency_hz"] = 0.01
     load_scenario(doc)
 
@@ -182,3 +182,18 @@ def test_rig_names_are_refused_unless_plain(name: str, tmp_path: Path) -> None:
     doc["rigs"] = {name: {}, "r": doc["rigs"]["r"]}
     msg = _refused(doc, tmp_path)
     assert "rig name" in msg and "letters, digits" in msg, msg
+
+
+@pytest.mark.parametrize(
+    ("weather", "refused"), [("clear", True), ("rain", False), ("overcast", False), ("fog", False)]
+)
+def test_rain_needs_a_sky_that_rains(weather: str, refused: bool, tmp_path: Path) -> None:
+    """A rain rate under a clear sky was taken as given (rain falling from a cloudless sky); 0 mm/h is fine."""
+    doc = _with("name", "t")
+    doc["environment"] = {"weather": weather, "rain_mm_per_h": 4.0}
+    if refused:
+        msg = _refused(doc, tmp_path)
+        assert "rain_mm_per_h = 4 with weather: clear" in msg, msg
+    else:
+        load_scenario(doc)
+    load_scenario({**doc, "environment": {"weather": weather, "rain_mm_per_h": 0.0}})

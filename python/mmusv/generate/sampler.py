@@ -109,10 +109,14 @@ def _choice(rng: np.random.Generator, items: list[str]) -> str:
 
 
 def _environment(spec: GenerationSpec, rng: np.random.Generator) -> dict[str, Any]:
+    """One draw of the spec's environment choices. A rain rate drawn beside a clear sky is left out (a clear sky
+    does not rain, and the scenario refuses the pair): the rates are for the draws of the other weathers."""
     env: dict[str, Any] = {}
     for key in sorted(spec.environment):
         value = spec.environment[key]
         env[key] = value[int(rng.integers(len(value)))] if isinstance(value, list) else value
+    if env.get("weather", "clear") == "clear":
+        env.pop("rain_mm_per_h", None)
     return env
 
 

@@ -4,7 +4,8 @@ Units: metres, seconds, metres per second; shares are fractions of the frames in
 
 - ``name``, ``seed`` (every random draw derives from it), ``map`` (``type``/``seed``/``params`` as in a scenario);
 - ``acquisition`` (``frequency_hz``, ``frames``: the window every scenario covers) and ``environment`` (scenario
-  environment keys; a list means one value drawn per scenario);
+  environment keys; a list means one value drawn per scenario; a ``rain_mm_per_h`` drawn with a clear sky is left
+  out, as a clear sky does not rain);
 - ``rig``/``rigs``: the sensor rig every USV carries (``{usv_standard: {}}`` = the default rig);
 - ``usv``: USV ``assets`` and ``speed_mps``; ``size_classes``: target classes by hull ``length_m`` (default
   small < 15 m <= medium < 80 m <= large) with their ``speed_mps``;
@@ -326,9 +327,11 @@ class GenerationSpec(_Model):
             choices = value if isinstance(value, list) else [value]
             if not choices:
                 raise ValueError(f"environment.{key}: an empty list has nothing to choose from")
+            # A rain rate alone is checked under a sky that rains (the sampler leaves it out of clear-sky draws).
+            with_key = {"weather": "rain"} if key == "rain_mm_per_h" else {}
             for c in choices:
                 try:
-                    EnvironmentConfig.model_validate({key: c})
+                    EnvironmentConfig.model_validate({**with_key, key: c})
                 except ValidationError as exc:
                     msg = str(exc.errors()[0]["msg"]).removeprefix("Value error, ")
                     raise ValueError(f"environment.{key} = {c!r}: {msg}") from None
