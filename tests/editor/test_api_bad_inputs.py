@@ -430,3 +430,10 @@ def test_a_run_never_writes_through_a_link_out_of_the_folder(
     assert "outside the editor's folder" in error_of(r, 400)  # was: the recording written into elsewhere/q
     assert client.get("/api/runs").json() == []
     assert list(elsewhere.iterdir()) == []
+
+
+def test_a_bundled_name_with_a_trailing_newline_is_not_another_scenario(client: TestClient) -> None:
+    # Starlette's route drops the newline: `port_entry%0A` was served as `port_entry`.
+    assert client.get("/api/bundled/port_entry").status_code == 200
+    r = client.get("/api/bundled/port_entry%0A")
+    assert r.status_code == 404 and "no bundled scenario" in r.text

@@ -450,10 +450,12 @@ def create_app(
         ]
 
     @app.get("/api/bundled/{name:path}")
-    def bundled_one(name: str) -> dict[str, Any]:
+    def bundled_one(name: str, request: Request) -> dict[str, Any]:
         from mmusv.bundled import bundled_dir
 
         files = {p.stem: p for p in bundled_dir().glob("*.yaml")}
+        # As sent: the route drops a trailing newline (`port_entry%0A` would match `port_entry`).
+        name = str(request.scope.get("path", "")).partition("/api/bundled/")[2] or name
         stem = name.removesuffix(".yaml")
         if stem not in files:
             raise NotFoundError(f"no bundled scenario {name!r}; bundled: {', '.join(sorted(files))}")
