@@ -10,6 +10,7 @@ keys that are known there.
 
 from __future__ import annotations
 
+import reprlib
 import types
 import typing
 from collections.abc import Mapping
@@ -52,8 +53,10 @@ def sequence(n_min: int, n_max: int | None, what: str) -> BeforeValidator:
     """Accepts a list (or tuple) of ``n_min`` to ``n_max`` items (no upper bound for ``None``); ``what`` names it."""
 
     def check(value: object) -> object:
-        if not isinstance(value, (list, tuple)) or not n_min <= len(value) <= (n_max or len(value)):
-            raise invalid(f"must be {what}, got {value!r}")
+        if not isinstance(value, (list, tuple)):
+            raise invalid(f"must be {what}, got {reprlib.repr(value)}")
+        if not n_min <= len(value) <= (n_max or len(value)):
+            raise invalid(f"must be {what}, got {len(value):,} items: {reprlib.repr(value)}")
         return value
 
     return BeforeValidator(check)

@@ -66,6 +66,10 @@ Mesh asset keys: ``mesh`` (file path), ``scale=1``, ``up_axis=z``, ``forward_axi
 
 :func:`parse_asset` validates an entry; errors are one :class:`AssetSpecError` whose ``field`` is the dotted path
 of the first problem (``tug_32m.hull.beam``, ``tug_32m.parts[3].top``) and whose message says what is allowed.
+Bounds (so that every accepted entry builds real faces in seconds): hull ``draft``, freeboard and ``demi_beam`` at
+least :data:`HULL_MIN_SIZE`, a non-zero ``bow``/``stern`` taper at least :data:`MIN_TAPER`, at most
+:data:`MAX_PARTS` parts; part sizes at least 1 mm and coordinates within ±500 m, lists of at most 200 items and
+counts of at most 20,000 pieces (:mod:`mmusv.world.part_spec`); the built vessel at most 500 m tall.
 """
 
 from __future__ import annotations
@@ -80,7 +84,6 @@ from mmusv.classes import SemanticClass
 from mmusv.errors import ConfigError
 from mmusv.validation import (
     Fraction,
-    NonNegative,
     Number,
     Positive,
     Spec,
@@ -90,12 +93,16 @@ from mmusv.validation import (
     invalid,
     invalid_field,
     join,
+    sequence,
 )
 from mmusv.world.part_spec import MaterialName, PartSpec
 
 __all__ = [
     "AXES",
     "DIMENSION_RANGES",
+    "HULL_MIN_SIZE",
+    "MAX_PARTS",
+    "MIN_TAPER",
     "MOUNT_REACH",
     "NAME_PATTERN",
     "AssetSpec",
@@ -140,6 +147,16 @@ DIMENSION_RANGES: dict[str, tuple[float, float]] = {
 }
 """The allowed bounding-box size of an asset in metres, ``(min, max)`` per dimension (the built-in catalogue spans
 3-330 m in length, 0.65-60 m in beam and 1.1-73 m in height)."""
+
+HULL_MIN_SIZE = 0.01
+"""The smallest ``draft``, freeboard (``depth - draft``) and ``demi_beam`` of a hull, metres (thinner would give
+near-zero-area faces)."""
+
+MIN_TAPER = 0.01
+"""The smallest non-zero ``bow`` / ``stern`` taper fraction of a hull."""
+
+MAX_PARTS = 1000
+"""The most parts a procedural asset may have (the built-in catalogue uses at most a few dozen)."""
 
 MOUNT_REACH: tuple[float, float] = (2.0, 50.0)
 """A mount may lie at most ``max(MOUNT_REACH[0] * length, MOUNT_REACH[1])`` metres outside the asset's bounding box."""
@@ -204,10 +221,10 @@ class HullSpec(Spec):
     type: Literal["mono", "twin"] = "mono"
     length: Annotated[Number, Field(ge=DIMENSION_RANGES["length"][0], le=DIMENSION_RANGES["length"][1])]
     beam: Annotated[Number, Field(ge=DIMENSION_RANGES["beam"][0], le=DIMENSION_RANGES["beam"][1])]
-    draft: Positive
-    depth: Positive
-    """Keel-to-deck depth at midship; more than ``draft``."""
-    demi_beam: Positive | None = None
+    draft: Annotated[Number, Field(ge=HULL_MIN_SIZE, le=DIMENSION_RANGES["height"][1])]
+    depth: Annotated[Number, Field(ge=HULL_MIN_SIZE, le=DIMENSION_RANGES["height"][1])]
+    """Keel-to-deck depth at midship; at least ``draft + HULL_MIN_SIZE``."""
+    demi_beam: Annotated[Number, Field(ge=HULL_MIN_SIZE, le=DIMENSION_RANGES["beam"][1])] | None = None
     """Twin hulls only (required there): beam of each demihull, less than ``beam / 2``."""
     bow: Annotated[Number, Field(ge=0.0, le=0.95)] = 0.2
     stern: Annotated[Number, Field(ge=0.0, le=0.95)] = 0.1
@@ -220,7 +237,7 @@ class HullSpec(Spec):
     overhang: Annotated[Number, Field(ge=0.0, le=0.45)] = 0.0
     bow_power: Annotated[Number, Field(ge=1.0, le=8.0)] = 2.0
     bow_shape: Literal["pointed", "round"] = "pointed"
-    sheer: NonNegative = 0.0
+    sheer: Annotated[Number, Field(ge=0.0, le=DIMENSION_RANGES["height"][1])] = 0.0
     bottom: Annotated[Number, Field(ge=0.02, le=1.0)] = 0.8
     flare: Annotated[Number, Field(ge=0.02, le=1.0)] = 1.0
     bulb: Annotated[Number, Field(ge=0.0, le=0.5)] = 0.0
@@ -230,8 +247,13 @@ class HullSpec(Spec):
 
     @model_validator(mode="after")
     def _consistent(self) -> HullSpec:
-        if self.depth <= self.draft:
-            raise invalid_field("depth", f"must be > draft ({self.draft}), got {self.depth}")
+        if self.depth < self.draft + HULL_MIN_SIZE:
+            raise invalid_field(
+                "depth", f"must be >= draft + {HULL_MIN_SIZE:g} ({self.draft + HULL_MIN_SIZE:g}), got {self.depth}"
+            )
+        for key in ("bow", "stern"):
+            if 0.0 < getattr(self, key) < MIN_TAPER:
+                raise invalid_field(key, f"must be 0 (no taper) or {MIN_TAPER:g} to 0.95, got {getattr(self, key)}")
         if self.type == "twin" and self.demi_beam is None:
             raise invalid_field("demi_beam", "is required for a twin hull")
         if self.type == "mono" and self.demi_beam is not None:
@@ -321,7 +343,7 @@ class ProceduralAssetSpec(_AssetSpec):
     """An asset built from a hull and superstructure parts (module docstring)."""
 
     hull: HullSpec
-    parts: tuple[PartSpec, ...] = ()
+    parts: Annotated[tuple[PartSpec, ...], sequence(0, MAX_PARTS, f"a list of at most {MAX_PARTS} parts")] = ()
 
 
 AssetSpec = MeshAssetSpec | ProceduralAssetSpec

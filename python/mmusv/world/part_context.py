@@ -14,13 +14,10 @@ import numpy as np
 from mmusv.world.asset_spec import AssetSpecError, HullSpec
 from mmusv.world.hull_form import deck_z, half_width
 from mmusv.world.materials import material_id
-from mmusv.world.part_spec import DEFAULT_MATERIALS, PartSpec
+from mmusv.world.part_spec import DEFAULT_MATERIALS, MAX_PIECES, PartSpec
 from mmusv.world.primitives import TriMesh, box, prism
 
 __all__ = ["MAX_PIECES", "Ctx", "block", "material_of"]
-
-MAX_PIECES = 20000
-"""The most repeated pieces (stanchions, windows, containers, supports, ...) one part may make."""
 
 
 def material_of(part: PartSpec, hull: HullSpec) -> int:

@@ -20,11 +20,8 @@ from pydantic import BeforeValidator, Field, model_validator
 from mmusv.errors import ConfigError
 from mmusv.validation import (
     Fraction,
-    NonNegative,
     Number,
-    Positive,
     Spec,
-    Vec2,
     Vec3,
     Whole,
     invalid,
@@ -35,7 +32,12 @@ from mmusv.world.materials import material_id
 
 __all__ = [
     "DEFAULT_MATERIALS",
+    "MAX_EXTENT",
+    "MAX_ITEMS",
+    "MAX_PIECES",
+    "MIN_SIZE",
     "PART_MODELS",
+    "TAPER_RANGE",
     "AntennasPart",
     "BollardsPart",
     "BoxPart",
@@ -85,7 +87,43 @@ MaterialName = Annotated[str, BeforeValidator(_material_name)]
 Side = Literal["both", "port", "starboard"]
 """Which side of the vessel a sided part goes on (port = +y)."""
 
-WindowBand = Annotated[tuple[Positive, ...], sequence(3, 3, "a list of 3 numbers > 0: [width, height, pitch]")]
+MIN_SIZE = 0.001
+"""The smallest size (metres) of a part: a radius, width, height, thickness, ... (1 mm; smaller pieces would have
+near-zero-area faces)."""
+
+MAX_EXTENT = 500.0
+"""The largest coordinate or size (metres, either sign) of a part: the largest asset is 500 m
+(:data:`mmusv.world.asset_spec.DIMENSION_RANGES`), so nothing beyond this can lie on a valid asset."""
+
+TAPER_RANGE = (0.05, 2.0)
+"""The allowed ``taper`` of a part (top size over base size)."""
+
+MAX_PIECES = 20000
+"""The most repeated pieces (boxes of a row, hatch covers, stanchions, windows, containers, supports, ...) one part
+may make."""
+
+MAX_ITEMS = 200
+"""The most items of a part's list (``tiers``, ``heights``, ``points``, ``at``, ``masthead``, ``ys``): each item
+is a piece (or a vertex), so an unbounded list would be an unbounded mesh."""
+
+Coord = Annotated[Number, Field(ge=-MAX_EXTENT, le=MAX_EXTENT)]
+"""A body-frame coordinate in metres, within :data:`MAX_EXTENT` of the origin."""
+Size = Annotated[Number, Field(ge=MIN_SIZE, le=MAX_EXTENT)]
+"""A length of a part in metres, :data:`MIN_SIZE` to :data:`MAX_EXTENT`."""
+Gap = Annotated[Number, Field(ge=0.0, le=MAX_EXTENT)]
+"""A clearance or inset in metres, 0 to :data:`MAX_EXTENT`."""
+Angle = Annotated[Number, Field(ge=-360.0, le=360.0)]
+"""An angle in degrees, -360 to 360."""
+Taper = Annotated[Number, Field(ge=TAPER_RANGE[0], le=TAPER_RANGE[1])]
+"""A part's taper (top over base size), within :data:`TAPER_RANGE`."""
+Size2 = Annotated[tuple[Size, ...], sequence(2, 2, "a list of 2 sizes")]
+"""Two sizes (a YAML list)."""
+Point2 = Annotated[tuple[Coord, ...], sequence(2, 2, "a list of 2 numbers")]
+"""A point ``[x, z]`` (a YAML list)."""
+Point3 = Annotated[tuple[Coord, ...], sequence(3, 3, "a list of 3 numbers")]
+"""A body-frame point ``[x, y, z]`` (a YAML list)."""
+
+WindowBand = Annotated[tuple[Size, ...], sequence(3, 3, "a list of 3 numbers > 0: [width, height, pitch]")]
 """``[width, height, pitch]`` of a window band, metres."""
 
 
@@ -105,9 +143,9 @@ class _Part(Spec):
 class _Span(_Part):
     """A part standing from ``base`` (default: the deck at the part's x) up to ``top`` or ``base + height``."""
 
-    base: Number | None = None
-    top: Number | None = None
-    height: Positive | None = None
+    base: Coord | None = None
+    top: Coord | None = None
+    height: Size | None = None
 
     @model_validator(mode="after")
     def _one_top(self) -> _Span:
@@ -121,8 +159,8 @@ class _Span(_Part):
 class _Along(_Part):
     """A part spanning ``x0`` to ``x1`` along the hull (``x1 > x0``)."""
 
-    x0: Number
-    x1: Number
+    x0: Coord
+    x1: Coord
 
     @model_validator(mode="after")
     def _ordered(self) -> _Along:
@@ -134,18 +172,18 @@ class _Along(_Part):
 class _Placed(_Part):
     """A part standing at ``(x, y)`` in the body frame (metres)."""
 
-    x: Number
-    y: Number = 0.0
+    x: Coord
+    y: Coord = 0.0
 
 
 class BoxPart(_Placed, _Span):
     """A box, optionally tapered towards the top and turned by ``yaw_deg``."""
 
     type: Literal["box"]
-    size: Vec2
-    fit: NonNegative | None = None
-    taper: Positive = 1.0
-    yaw_deg: Number = 0.0
+    size: Size2
+    fit: Gap | None = None
+    taper: Taper = 1.0
+    yaw_deg: Angle = 0.0
     windows: WindowBand | None = None
     """``[width, height, pitch]`` of a window band round the box (not with ``yaw_deg``)."""
 
@@ -157,35 +195,45 @@ class HousePart(_Placed):
     align: Literal["center", "aft", "fore"] = "center"
     windows: WindowBand | None = None
     """``[width, height, pitch]`` of the window bands on every tier (the top tier's front gets a bridge band)."""
-    taper: Positive = 1.0
+    taper: Taper = 1.0
     tiers: Annotated[
-        tuple[Annotated[tuple[Number, ...], sequence(3, 4, "a list of 3 to 4 numbers")], ...],
-        sequence(1, None, "a non-empty list of lists"),
+        tuple[Annotated[tuple[Coord, ...], sequence(3, 4, "a list of 3 to 4 numbers")], ...],
+        sequence(1, MAX_ITEMS, f"a list of 1 to {MAX_ITEMS} lists"),
     ]
-    base: Number | None = None
-    fit: NonNegative | None = None
-    wings: Vec2 | None = None
+    base: Coord | None = None
+    fit: Gap | None = None
+    wings: Size2 | None = None
+
+    @model_validator(mode="after")
+    def _tier_sizes(self) -> HousePart:
+        for i, tier in enumerate(self.tiers):
+            for j, what in enumerate(("lx", "ly", "h")):
+                if not MIN_SIZE <= tier[j] <= MAX_EXTENT:
+                    raise invalid_field(
+                        f"tiers[{i}][{j}]", f"{what} must be {MIN_SIZE:g} to {MAX_EXTENT:g} m, got {tier[j]:g}"
+                    )
+        return self
 
 
 class HullBlockPart(_Along, _Span):
     """A block following the deck outline between ``x0`` and ``x1``, ``inset`` metres inside it (mono hulls)."""
 
     type: Literal["hull_block"]
-    inset: NonNegative = 0.0
-    taper: Positive = 1.0
+    inset: Gap = 0.0
+    taper: Taper = 1.0
 
 
 class RowPart(_Along):
     """``count`` boxes in a row from ``x0`` to ``x1`` with ``gap`` between them, heights cycled from ``heights``."""
 
     type: Literal["row"]
-    count: Annotated[Whole, Field(ge=1)]
-    gap: NonNegative = 0.0
-    y: Number = 0.0
-    width: Positive
-    heights: Annotated[tuple[Positive, ...], sequence(1, None, "a non-empty list of numbers")]
-    base: Number | None = None
-    fit: NonNegative | None = None
+    count: Annotated[Whole, Field(ge=1, le=MAX_PIECES)]
+    gap: Gap = 0.0
+    y: Coord = 0.0
+    width: Size
+    heights: Annotated[tuple[Size, ...], sequence(1, MAX_ITEMS, f"a list of 1 to {MAX_ITEMS} numbers")]
+    base: Coord | None = None
+    fit: Gap | None = None
 
     @model_validator(mode="after")
     def _fits(self) -> RowPart:
@@ -198,8 +246,8 @@ class FunnelPart(_Placed, _Span):
     """A funnel, square (``shape: box``) or elliptic (``shape: round``) in plan, narrowing by ``taper``."""
 
     type: Literal["funnel"]
-    size: Vec2
-    taper: Positive = 0.9
+    size: Size2
+    taper: Taper = 0.9
     shape: Literal["box", "round"] = "box"
     band: MaterialName | None = None
     """A company colour band around the upper funnel (below the black top)."""
@@ -211,9 +259,15 @@ class MastPart(_Placed, _Span):
     """A square mast of side ``width``, with a crosswise ``yard`` at fraction ``yard_at`` of its height."""
 
     type: Literal["mast"]
-    width: Positive = 0.3
-    yard: NonNegative = 0.0
+    width: Size = 0.3
+    yard: Gap = 0.0
     yard_at: Fraction = 0.8
+
+    @model_validator(mode="after")
+    def _yard(self) -> MastPart:
+        if 0.0 < self.yard < MIN_SIZE:
+            raise invalid_field("yard", f"must be 0 (no yard) or {MIN_SIZE:g} to {MAX_EXTENT:g} m, got {self.yard:g}")
+        return self
 
 
 Segments = Annotated[Whole, Field(ge=3, le=64)]
@@ -224,8 +278,8 @@ class CylinderPart(_Placed, _Span):
     """A vertical cylinder (a cone frustum with ``top_radius``)."""
 
     type: Literal["cylinder"]
-    radius: Positive
-    top_radius: Positive | None = None
+    radius: Size
+    top_radius: Size | None = None
     segments: Segments = 12
 
 
@@ -233,9 +287,9 @@ class HcylinderPart(_Along):
     """A horizontal cylinder along x from ``x0`` to ``x1``, axis at ``(y, z)``."""
 
     type: Literal["hcylinder"]
-    y: Number = 0.0
-    z: Number
-    radius: Positive
+    y: Coord = 0.0
+    z: Coord
+    radius: Size
     segments: Segments = 12
 
 
@@ -243,9 +297,9 @@ class DomePart(_Placed):
     """A sphere cap of ``radius`` with its top at ``top``, on a skirt down to ``base``."""
 
     type: Literal["dome"]
-    radius: Positive
-    top: Number
-    base: Number | None = None
+    radius: Size
+    top: Coord
+    base: Coord | None = None
     segments: Segments = 16
 
     @model_validator(mode="after")
@@ -259,10 +313,10 @@ class StrutPart(_Part):
     """A beam of ``width`` x ``thickness`` from ``from`` to ``to`` (absolute body-frame points)."""
 
     type: Literal["strut"]
-    start: Vec3 = Field(alias="from")
-    end: Vec3 = Field(alias="to")
-    width: Positive
-    thickness: Positive | None = None
+    start: Point3 = Field(alias="from")
+    end: Point3 = Field(alias="to")
+    width: Size
+    thickness: Size | None = None
     """Default: ``width``."""
 
     @model_validator(mode="after")
@@ -276,9 +330,9 @@ class PlatePart(_Part):
     """A convex ``[x, z]`` profile ``points`` extruded ``thickness`` across y, centred at ``y``."""
 
     type: Literal["plate"]
-    y: Number = 0.0
-    thickness: Positive
-    points: Annotated[tuple[Vec2, ...], sequence(3, None, "a list of at least 3 [x, z] points")]
+    y: Coord = 0.0
+    thickness: Size
+    points: Annotated[tuple[Point2, ...], sequence(3, MAX_ITEMS, f"a list of 3 to {MAX_ITEMS} [x, z] points")]
 
     @model_validator(mode="after")
     def _area(self) -> PlatePart:
@@ -291,25 +345,27 @@ class GantryPart(_Span):
     """An A-frame or portal of two legs ``span`` apart, leaning ``lean`` metres forward, and a crossbeam."""
 
     type: Literal["gantry"]
-    x: Number
-    span: Positive
-    leg: Positive = 0.5
-    lean: Number = 0.0
+    x: Coord
+    span: Size
+    leg: Size = 0.5
+    lean: Coord = 0.0
 
 
 class CranePart(_Placed):
     """A deck crane: ``pedestal [radius, height]``, a cab, and a ``jib [length, elevation_deg, yaw_deg]``."""
 
     type: Literal["crane"]
-    base: Number | None = None
-    pedestal: Vec2
+    base: Coord | None = None
+    pedestal: Size2
     jib: Vec3
-    width: Positive = 0.6
+    width: Size = 0.6
 
     @model_validator(mode="after")
-    def _positive(self) -> CranePart:
-        if self.pedestal[0] <= 0 or self.pedestal[1] <= 0 or self.jib[0] <= 0:
-            raise invalid_field("pedestal", "pedestal radius/height and jib length must be > 0")
+    def _jib(self) -> CranePart:
+        if not MIN_SIZE <= self.jib[0] <= MAX_EXTENT:
+            raise invalid_field("jib", f"jib length must be {MIN_SIZE:g} to {MAX_EXTENT:g} m, got {self.jib[0]:g}")
+        if not all(-360.0 <= a <= 360.0 for a in self.jib[1:]):
+            raise invalid_field("jib", f"jib elevation_deg and yaw_deg must be -360 to 360, got {list(self.jib[1:])}")
         return self
 
 
@@ -317,12 +373,12 @@ class GunPart(_Placed):
     """A gun turret of ``radius`` and ``height`` with a ``barrel`` pointing along ``yaw_deg``/``elevation_deg``."""
 
     type: Literal["gun"]
-    base: Number | None = None
-    radius: Positive
-    height: Positive
-    barrel: Positive
-    yaw_deg: Number = 0.0
-    elevation_deg: Number = 5.0
+    base: Coord | None = None
+    radius: Size
+    height: Size
+    barrel: Size
+    yaw_deg: Angle = 0.0
+    elevation_deg: Angle = 5.0
 
 
 class RailingPart(_Part):
@@ -331,23 +387,23 @@ class RailingPart(_Part):
     when asked; or, with ``width``, round a rectangle ``x0..x1`` by ``width`` centred at ``y`` on ``base``."""
 
     type: Literal["railing"]
-    x0: Number | None = None
-    x1: Number | None = None
+    x0: Coord | None = None
+    x1: Coord | None = None
     side: Side = "both"
-    inset: NonNegative = 0.1
-    height: Positive = 1.0
-    spacing: Positive = 1.5
+    inset: Gap = 0.1
+    height: Size = 1.0
+    spacing: Size = 1.5
     rails: Annotated[Whole, Field(ge=1, le=5)] = 2
-    base: Number | None = None
-    width: Positive | None = None
-    y: Number = 0.0
+    base: Coord | None = None
+    width: Size | None = None
+    y: Coord = 0.0
     bow: bool = False
     stern: bool = False
-    radius: Positive | None = None
+    radius: Size | None = None
     """Tube radius (default ``0.02 + 0.01 * height``)."""
     posts: bool = True
     """False: rails alone (a rubbing strake or fender band along the sheer, with ``lift`` below the deck edge)."""
-    lift: Number = 0.0
+    lift: Coord = 0.0
     """Metres the whole railing is raised above (negative: lowered below) its deck line or ``base``."""
 
     @model_validator(mode="after")
@@ -366,15 +422,15 @@ class WindowsPart(_Along):
     (``wall: hull``); ``shape: round`` makes portholes."""
 
     type: Literal["windows"]
-    z: Number
-    width: Positive
-    height: Positive
-    pitch: Positive
+    z: Coord
+    width: Size
+    height: Size
+    pitch: Size
     rows: Annotated[Whole, Field(ge=1, le=40)] = 1
-    row_pitch: Positive = 2.8
+    row_pitch: Size = 2.8
     side: Side = "both"
-    y: Positive | None = None
-    inset: NonNegative = 0.0
+    y: Size | None = None
+    inset: Gap = 0.0
     wall: Literal["outline", "hull"] = "outline"
     shape: Literal["rect", "round"] = "rect"
 
@@ -393,13 +449,16 @@ class ContainersPart(_Along):
     type: Literal["containers"]
     bays: Annotated[Whole, Field(ge=1, le=60)]
     rows: Annotated[Whole, Field(ge=1, le=30)]
-    tiers: Annotated[tuple[Annotated[Whole, Field(ge=1, le=12)], ...], sequence(1, None, "a list of whole numbers")]
-    width: Positive
-    base: Number | None = None
-    gap: NonNegative = 0.6
-    height: Positive = 2.59
-    seed: Annotated[Whole, Field(ge=0)] = 0
-    fit: NonNegative | None = None
+    tiers: Annotated[
+        tuple[Annotated[Whole, Field(ge=1, le=12)], ...],
+        sequence(1, MAX_ITEMS, f"a list of 1 to {MAX_ITEMS} whole numbers"),
+    ]
+    width: Size
+    base: Coord | None = None
+    gap: Gap = 0.6
+    height: Size = 2.59
+    seed: Annotated[Whole, Field(ge=0, le=2**32 - 1)] = 0
+    fit: Gap | None = None
     """Drop outer rows of a bay (keeping it centred) until it stays ``fit`` metres inside the deck outline."""
 
 
@@ -408,12 +467,12 @@ class HatchesPart(_Along):
     ``fit``), ``height`` from ``base`` to the cover top, each cover with ``ribs`` transverse stiffeners."""
 
     type: Literal["hatches"]
-    count: Annotated[Whole, Field(ge=1)]
-    gap: NonNegative = 0.0
-    width: Positive
-    height: Positive
-    base: Number | None = None
-    fit: NonNegative | None = None
+    count: Annotated[Whole, Field(ge=1, le=MAX_PIECES)]
+    gap: Gap = 0.0
+    width: Size
+    height: Size
+    base: Coord | None = None
+    fit: Gap | None = None
     ribs: Annotated[Whole, Field(ge=0, le=40)] = 6
 
 
@@ -423,10 +482,10 @@ class LifeboatsPart(_Placed):
     (``kind: freefall``, on the centreline)."""
 
     type: Literal["lifeboats"]
-    z: Number
-    length: Positive
+    z: Coord
+    length: Size
     count: Annotated[Whole, Field(ge=1, le=12)] = 1
-    pitch: NonNegative = 0.0
+    pitch: Gap = 0.0
     side: Side = "both"
     kind: Literal["davit", "freefall"] = "davit"
 
@@ -437,8 +496,8 @@ class FendersPart(_Along):
 
     type: Literal["fenders"]
     count: Annotated[Whole, Field(ge=1, le=80)]
-    z: Number
-    radius: Positive
+    z: Coord
+    radius: Size
     side: Side = "both"
     kind: Literal["tyre", "cylinder"] = "tyre"
 
@@ -450,10 +509,10 @@ class NavLightsPart(_Part):
     lantern's height."""
 
     type: Literal["nav_lights"]
-    masthead: tuple[Vec3, ...] | None = None
-    sides: Vec3 | None = None
-    stern: Vec3 | None = None
-    size: Positive = 0.3
+    masthead: Annotated[tuple[Point3, ...], sequence(1, MAX_ITEMS, f"a list of 1 to {MAX_ITEMS} points")] | None = None
+    sides: Point3 | None = None
+    stern: Point3 | None = None
+    size: Size = 0.3
 
 
 class RadarPart(_Placed):
@@ -461,9 +520,9 @@ class RadarPart(_Placed):
     ``yaw_deg``."""
 
     type: Literal["radar"]
-    base: Number
-    length: Positive = 2.0
-    yaw_deg: Number = 0.0
+    base: Coord
+    length: Size = 2.0
+    yaw_deg: Angle = 0.0
 
 
 class AntennasPart(_Part):
@@ -471,9 +530,17 @@ class AntennasPart(_Part):
 
     type: Literal["antennas"]
     at: Annotated[
-        tuple[Annotated[tuple[Number, ...], sequence(4, 4, "[x, y, z, height]")], ...], sequence(1, None, "a list")
+        tuple[Annotated[tuple[Coord, ...], sequence(4, 4, "[x, y, z, height]")], ...],
+        sequence(1, MAX_ITEMS, f"a list of 1 to {MAX_ITEMS} items"),
     ]
-    radius: Positive = 0.03
+    radius: Size = 0.03
+
+    @model_validator(mode="after")
+    def _heights(self) -> AntennasPart:
+        for i, a in enumerate(self.at):
+            if not MIN_SIZE <= a[3] <= MAX_EXTENT:
+                raise invalid_field(f"at[{i}][3]", f"height must be {MIN_SIZE:g} to {MAX_EXTENT:g} m, got {a[3]:g}")
+        return self
 
 
 class BollardsPart(_Along):
@@ -481,8 +548,8 @@ class BollardsPart(_Along):
 
     type: Literal["bollards"]
     count: Annotated[Whole, Field(ge=1, le=40)]
-    inset: NonNegative = 0.8
-    radius: Positive = 0.2
+    inset: Gap = 0.8
+    radius: Size = 0.2
     side: Side = "both"
 
 
@@ -491,10 +558,10 @@ class TubePart(_Part):
     booms, derricks, pipes, bow fenders."""
 
     type: Literal["tube"]
-    start: Vec3 = Field(alias="from")
-    end: Vec3 = Field(alias="to")
-    radius: Positive
-    end_radius: Positive | None = None
+    start: Point3 = Field(alias="from")
+    end: Point3 = Field(alias="to")
+    radius: Size
+    end_radius: Size | None = None
     segments: Segments = 12
 
     @model_validator(mode="after")
@@ -508,20 +575,20 @@ class PipesPart(_Along):
     """A pipe rack: pipes along x at each of ``ys`` at height ``z`` on supports every ``support`` metres."""
 
     type: Literal["pipes"]
-    ys: Annotated[tuple[Number, ...], sequence(1, None, "a list of numbers")]
-    z: Number
-    radius: Positive = 0.2
-    support: Positive = 6.0
-    base: Number | None = None
+    ys: Annotated[tuple[Coord, ...], sequence(1, MAX_ITEMS, f"a list of 1 to {MAX_ITEMS} numbers")]
+    z: Coord
+    radius: Size = 0.2
+    support: Size = 6.0
+    base: Coord | None = None
 
 
 class WinchPart(_Placed):
     """A winch: a drum of ``radius`` and ``width`` (across y) between two cheek plates on ``base``."""
 
     type: Literal["winch"]
-    base: Number | None = None
-    radius: Positive
-    width: Positive
+    base: Coord | None = None
+    radius: Size
+    width: Size
 
 
 PartSpec = Annotated[

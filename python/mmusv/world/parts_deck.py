@@ -155,6 +155,11 @@ def containers_mesh(p: ContainersPart, ctx: Ctx) -> TriMesh:
     )
     cl = (lb - 0.25 * (n_long - 1)) / n_long
     cw = (p.width - 0.08 * (p.rows - 1)) / p.rows
+    if cw < 0.1:
+        raise ctx.error(
+            "width",
+            f"{p.rows} rows 0.08 m apart leave {cw:.3g} m per container; width must be >= {0.18 * p.rows - 0.08:g} m",
+        )
     ch = p.height
     bay, lon, row, tier, base = [], [], [], [], []
     for b in range(p.bays):
@@ -204,6 +209,11 @@ def hatches_mesh(p: HatchesPart, ctx: Ctx) -> TriMesh:
     out = []
     for x in xc:
         w = ctx.fit_width(p.fit, x0=x - lx / 2, x1=x + lx / 2, y=0.0, width=p.width)
+        if w < 0.4:
+            key = "width" if w == p.width else "fit"
+            raise ctx.error(
+                key, f"leaves a hatch cover {w:.3g} m wide at x={x:g}; it must be >= 0.4 m (coaming inside)"
+            )
         z0 = ctx.base(p.base, x)
         rib = min(0.25, 0.15 * p.height)
         hc = 0.55 * p.height

@@ -20,7 +20,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from mmusv.world.asset_spec import AssetSpecError, HullSpec
+from mmusv.world.asset_spec import DIMENSION_RANGES, AssetSpecError, HullSpec
 from mmusv.world.hull_form import deck_z, half_width, hull_mesh, profile, stations
 from mmusv.world.part_context import Ctx, block, material_of
 from mmusv.world.part_spec import (
@@ -289,6 +289,14 @@ def build_parts(*, hull: HullSpec, parts: Sequence[PartSpec], path: str, cls: in
     meshes = [hull_mesh(hull, cls)]
     lim = np.array([hull.length / 2.0, hull.beam / 2.0])
     tol = 1e-9 * max(1.0, hull.length)
+    max_height = DIMENSION_RANGES["height"][1]
+    z_lo, z_hi = (float(z) for z in meshes[0].bounds[:, 2])
+    if z_hi - z_lo > max_height:
+        raise AssetSpecError(
+            f"{path}.hull" if path else "hull",
+            f"spans z [{z_lo:.6g}, {z_hi:.6g}] m (keel to deck at the stem, with sheer): {z_hi - z_lo:.6g} m is more "
+            f"than the largest asset height, {max_height:g} m",
+        )
     all_parts = tuple(parts)
     for i, part in enumerate(parts):
         where = f"{path}.parts[{i}]" if path else f"parts[{i}]"
@@ -302,6 +310,13 @@ def build_parts(*, hull: HullSpec, parts: Sequence[PartSpec], path: str, cls: in
                 where,
                 f"{part.type} spans x [{b[0, 0]:.3f}, {b[1, 0]:.3f}] y [{b[0, 1]:.3f}, {b[1, 1]:.3f}] m, outside the "
                 f"hull footprint x [{-lim[0]:g}, {lim[0]:g}] y [{-lim[1]:g}, {lim[1]:g}] m",
+            )
+        z_lo, z_hi = min(z_lo, float(b[0, 2])), max(z_hi, float(b[1, 2]))
+        if z_hi - z_lo > max_height:
+            raise AssetSpecError(
+                where,
+                f"{part.type} spans z [{b[0, 2]:.6g}, {b[1, 2]:.6g}] m, making the vessel {z_hi - z_lo:.6g} m tall; "
+                f"the largest asset height is {max_height:g} m",
             )
         meshes.append(m)
     origin = np.concatenate([np.full(m.num_triangles, i - 1, dtype=np.int32) for i, m in enumerate(meshes)])
