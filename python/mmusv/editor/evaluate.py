@@ -16,10 +16,10 @@ returns, JSON-ready:
   ``rings`` the LiDAR and radar ranges of a USV's rig (metres);
 * ``valid`` (the schema and the routes are fine; problems may remain), ``frames``, ``frequency_hz``, ``map``.
 
-Bounds (:mod:`mmusv.generate.checks`' own, re-exported): the checks take at most :data:`MAX_CHECK_SAMPLES`
-samples x vessels and :data:`MAX_CHECK_PAIR_SAMPLES` time samples x pairs of vessels (the separation check
-compares every pair at every time: without this bound a fleet of a few thousand vessels, a body of a few hundred
-kB, would take minutes); above either the document is not valid and ``errors`` says why. At most
+Bounds (:func:`mmusv.generate.checks.budget_problem`, the ones ``mmusv run`` checks): the checks take at most
+``MAX_CHECK_SAMPLES`` samples x vessels and ``MAX_CHECK_PAIR_SAMPLES`` time samples x pairs of vessels (the
+separation check compares every pair at every time: without this bound a fleet of a few thousand vessels, a body
+of a few hundred kB, would take minutes); above either the document is not valid and ``errors`` says why. At most
 :data:`MAX_PROBLEMS` problems are listed; one more entry (check ``more``) then says how many were left out.
 
 World frame, metres, radians (yaw from +x, counter-clockwise); coordinates rounded to millimetres.
@@ -36,7 +36,7 @@ from pydantic import ValidationError
 
 from mmusv.config import Scenario, validation_problems
 from mmusv.errors import ConfigError, MmusvError
-from mmusv.generate.checks import MAX_CHECK_PAIR_SAMPLES, MAX_CHECK_SAMPLES, sample_counts
+from mmusv.generate.checks import budget_problem, sample_counts
 from mmusv.generate.mapctx import map_context
 from mmusv.motion import build_fleet
 from mmusv.scenario_checks import check_mounts, map_check_spec, map_findings
@@ -45,8 +45,6 @@ from mmusv.world.vessels import get_asset
 
 __all__ = [
     "MAX_BULK_FRAMES",
-    "MAX_CHECK_PAIR_SAMPLES",
-    "MAX_CHECK_SAMPLES",
     "MAX_PROBLEMS",
     "evaluate",
     "poses_at",
@@ -142,32 +140,11 @@ def evaluate(document: dict[str, Any]) -> dict[str, Any]:
     out.update(frames=acq.frames, frequency_hz=acq.frequency_hz, valid=True)
     out["map"] = {"type": scenario.map.type, "seed": scenario.map.seed, "params": scenario.map.param_values()}
     spec = map_check_spec(scenario)
-    n_motion, n_route = sample_counts(scenario, spec)
-    n_v = len(scenario.vessels)
-    if max(n_motion, n_route) * n_v > MAX_CHECK_SAMPLES:
+    problem = budget_problem(scenario, *sample_counts(scenario, spec))  # the bounds `mmusv run` checks
+    if problem is not None:
         out["valid"] = False
-        out["errors"] = [
-            _error(
-                "vessels",
-                f"the checks would take {max(n_motion, n_route) * n_v:,} samples ({n_motion:,} in time, {n_route:,} "
-                f"along the routes, x {n_v} vessels); the editor checks at most {MAX_CHECK_SAMPLES:,}: shorten the "
-                "routes or the acquisition or lower the speeds",
-                document,
-            )
-        ]
-        return out
-    pairs = n_v * (n_v - 1) // 2
-    if n_motion * pairs > MAX_CHECK_PAIR_SAMPLES:
-        out["valid"] = False
-        out["errors"] = [
-            _error(
-                "vessels",
-                f"the checks would compare {pairs:,} pairs of vessels ({n_v} vessels) at {n_motion:,} times, "
-                f"{n_motion * pairs:,} pair samples; the editor checks at most {MAX_CHECK_PAIR_SAMPLES:,}: use fewer "
-                "vessels or a shorter acquisition",
-                document,
-            )
-        ]
+        advice = "shorten the routes or the acquisition, lower the speeds or use fewer vessels"
+        out["errors"] = [_error("vessels", f"{problem}: {advice}", document)]
         return out
     ctx = map_context(scenario.map.type, scenario.map.seed, scenario.map.param_values())
     samples, findings = map_findings(scenario, ctx, spec)

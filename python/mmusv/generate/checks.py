@@ -204,13 +204,13 @@ def budget_problem(scenario: Scenario, n_motion: int, n_route: int) -> str | Non
         return (
             f"the route checks would take {_fmt(total)} samples ({_fmt(n_motion)} in time over {acq.frames:,} frames "
             f"at {acq.frequency_hz:g} Hz, {_fmt(n_route)} along the longest route, x {n_v} "
-            f"vessel{'s' if n_v != 1 else ''}), more than the {MAX_CHECK_SAMPLES:,} they take at most"
+            f"vessel{'s' if n_v != 1 else ''}); they take at most {MAX_CHECK_SAMPLES:,}"
         )
     pairs = n_v * (n_v - 1) // 2
     if n_motion * pairs > MAX_CHECK_PAIR_SAMPLES:
         return (
             f"the route checks would compare {pairs:,} pairs of vessels ({n_v} vessels) at {_fmt(n_motion)} times "
-            f"({_fmt(n_motion * pairs)} pair samples), more than the {MAX_CHECK_PAIR_SAMPLES:,} they compare at most"
+            f"({_fmt(n_motion * pairs)} pair samples); they compare at most {MAX_CHECK_PAIR_SAMPLES:,}"
         )
     return None
 
