@@ -36,6 +36,7 @@ __all__ = [
     "default_amplitudes",
     "demo_scene",
     "dnv_gamma",
+    "exposure_limits",
     "fully_developed",
     "hull_rao",
     "lidar_trace_order",
@@ -559,6 +560,10 @@ def default_amplitudes() -> tuple[float, float, float]:
 
 def wave_height(wave: str | float) -> float:
     """Wave height H in metres of a preset "W0".."W3" or a height in metres (validated)."""
+
+def exposure_limits() -> dict[str, Any]:
+    """The camera exposure settings' ranges: ``ev100``, ``compensation_ev``, ``max_iso`` as ``(lo, hi)`` and
+    ``default_max_iso`` (the core's tonemap constants, their one definition)."""
 
 def wave_presets() -> list[tuple[str, float]]:
     """``[(name, H metres), ...]`` of the presets W0..W3 in order (the one definition of the presets)."""

@@ -66,7 +66,22 @@ fn lidar_trace_order<'py>(
     Ok(order.into_pyarray(py))
 }
 
+/// The camera exposure settings' ranges, `{"ev100": (lo, hi), "compensation_ev": (lo, hi), "max_iso": (lo, hi),
+/// "default_max_iso": iso}` (mmusv_core::sensors::shade::tonemap: their one definition, which the scenario schema
+/// reads).
+#[pyfunction]
+fn exposure_limits(py: Python<'_>) -> PyResult<Bound<'_, pyo3::types::PyDict>> {
+    use mmusv_core::sensors::shade::tonemap::{COMPENSATION_RANGE_EV, DEFAULT_MAX_ISO, EV100_RANGE, MAX_ISO_RANGE};
+    let d = pyo3::types::PyDict::new(py);
+    d.set_item("ev100", EV100_RANGE)?;
+    d.set_item("compensation_ev", COMPENSATION_RANGE_EV)?;
+    d.set_item("max_iso", MAX_ISO_RANGE)?;
+    d.set_item("default_max_iso", DEFAULT_MAX_ISO)?;
+    Ok(d)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(exposure_limits, m)?)?;
     m.add_function(wrap_pyfunction!(pinhole_intrinsics, m)?)?;
     m.add_function(wrap_pyfunction!(pinhole_directions, m)?)?;
     m.add_function(wrap_pyfunction!(lidar_directions, m)?)?;

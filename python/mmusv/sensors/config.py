@@ -20,6 +20,7 @@ from typing import Literal
 
 from pydantic import Field, field_validator, model_validator
 
+from mmusv._native import core
 from mmusv.strict import StrictModel
 
 __all__ = [
@@ -251,6 +252,10 @@ class SensorNoiseConfig(_Model):
     read_noise_e: float = Field(default=3.0, ge=0, le=1e5)
 
 
+_EXPOSURE = core.exposure_limits()
+"""The exposure settings' ranges, as the core defines and checks them (``tonemap::Exposure``)."""
+
+
 class ExposureConfig(_Model):
     """How a camera exposes its RGB (``crates/mmusv-core/src/sensors/shade/tonemap.rs``). Automatic by default:
     an incident reading of the scene's light with a highlight limit, ``compensation_ev`` stops brighter (+) or
@@ -259,9 +264,9 @@ class ExposureConfig(_Model):
     exposure at ISO 100, e.g. 15 for full sun, 12 for an overcast day): every frame shows the light as it is,
     without the automatic exposure's adaptation."""
 
-    ev100: float | None = Field(default=None, ge=-6, le=20)
-    compensation_ev: float = Field(default=0.0, ge=-5, le=5)
-    max_iso: float = Field(default=6400.0, ge=100, le=409_600)
+    ev100: float | None = Field(default=None, ge=_EXPOSURE["ev100"][0], le=_EXPOSURE["ev100"][1])
+    compensation_ev: float = Field(default=0.0, ge=_EXPOSURE["compensation_ev"][0], le=_EXPOSURE["compensation_ev"][1])
+    max_iso: float = Field(default=_EXPOSURE["default_max_iso"], ge=_EXPOSURE["max_iso"][0], le=_EXPOSURE["max_iso"][1])
 
     @model_validator(mode="after")
     def _one_mode(self) -> ExposureConfig:
