@@ -13,6 +13,7 @@ import numpy as np
 import numpy.typing as npt
 
 __all__ = [
+    "MAX_DEMO_SIZE",
     "MAX_SURFACE_TILES",
     "Camera",
     "ConfigError",
@@ -488,6 +489,9 @@ def capture_frame(
     ``ppi = (size_px, metres_per_pixel, orientation, sensor_yaw)`` or None. Returns, in task order,
     ``(outputs, seconds, ppi_seconds)``: the dict ``scan``/``render``/``sweep`` return (bit-identical to those
     calls; a radar's has ``ppi`` (size_px, size_px) f32 when asked for) and the task's wall seconds (profiling)."""
+
+MAX_DEMO_SIZE: int
+"""Largest ``terrain_cells`` (a side) and ``vessels`` of ``demo_scene`` (mmusv_core::demo::MAX_DEMO_SIZE)."""
 
 MAX_SURFACE_TILES: int
 """Most tiles one displaced sea surface may hold (2**22; mmusv_core::sea::MAX_TILES)."""

@@ -39,8 +39,9 @@ MAX_SURFACE_TILES: int = core.MAX_SURFACE_TILES
 The core samples the rectangle around every focus (out to ``radius_m``) as one grid of :data:`SURFACE_TILE_M`
 tiles, so foci far apart (or a huge radius) would ask for more memory than any machine has: 2²² tiles is a square
 of about 65 km a side, beyond any map."""
-MAX_DEMO_CELLS = 4096
-"""Largest ``terrain_cells`` and ``vessels`` of :func:`demo_scene` (4096² cells: 33 million terrain triangles)."""
+MAX_DEMO_CELLS: int = core.MAX_DEMO_SIZE
+"""Largest ``terrain_cells`` and ``vessels`` of :func:`demo_scene` (4096² cells: 33 million terrain triangles; the
+core's bound, which it checks itself)."""
 
 
 class SeaState(Protocol):

@@ -15,5 +15,6 @@ fn demo_scene(py: Python<'_>, seed: u64, extent: f32, terrain_cells: u32, vessel
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("MAX_DEMO_SIZE", mmusv_core::demo::MAX_DEMO_SIZE)?;
     m.add_function(wrap_pyfunction!(demo_scene, m)?)
 }
