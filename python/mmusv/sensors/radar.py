@@ -35,6 +35,7 @@ from typing import Any, Literal
 import numpy as np
 import numpy.typing as npt
 
+from mmusv import arguments
 from mmusv._native import core
 from mmusv.errors import InputError
 from mmusv.scene import Scene, _pose
@@ -162,10 +163,9 @@ def radar_sweep(
     """
     if not isinstance(scene, Scene):
         raise InputError(f"scene must be an mmusv.Scene, got {type(scene).__name__}")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) < 2**64:
-        raise InputError(f"seed must be an integer in 0..2**64, got {seed!r}")
+    seed = arguments.whole(seed, name="seed", lo=0, hi=2**64 - 1, error=InputError)
     p = _pose(pose, name="pose")
-    return RadarReturns.from_native(radar.sweep(scene.native, pose=p, env=env, seed=int(seed)), pose=p, radar=radar)
+    return RadarReturns.from_native(radar.sweep(scene.native, pose=p, env=env, seed=seed), pose=p, radar=radar)
 
 
 def ppi_image(
@@ -218,9 +218,7 @@ def ppi_request(
     """``(size_px, metres_per_pixel, orientation, sensor_yaw)`` of the PPI :func:`ppi_image` draws for a sweep of
     ``radar`` at ``pose`` (``(4, 4)`` sensor → world), with its defaults filled in; the same tuple is the ``ppi``
     of a radar task of ``core.capture_frame``."""
-    if isinstance(size_px, bool) or not isinstance(size_px, (int, np.integer)) or not 0 <= int(size_px) < 2**32:
-        raise InputError(f"size_px must be a non-negative integer below 2**32, got {size_px!r}")
-    size = int(size_px)
+    size = arguments.whole(size_px, name="size_px", lo=0, hi=2**32 - 1, error=InputError)
     mpp = radar.range_max_m / max(size // 2, 1) if metres_per_pixel is None else float(metres_per_pixel)
     yaw = _yaw(pose) if sensor_yaw is None else float(sensor_yaw)
     return size, mpp, str(orientation), yaw
