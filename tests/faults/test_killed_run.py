@@ -48,6 +48,12 @@ def killed(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path, int]:
     return src, base / "reference", k
 
 
+def _copy_of_killed(ref: Path, to: Path) -> Path:
+    """A copy, at ``to``, of the killed run's folder (beside the reference run ``ref``): each test changes its own."""
+    shutil.copytree(ref.parent / "killed", to)
+    return to
+
+
 def test_every_reader_recovers_the_complete_frames_of_a_killed_run(killed: tuple[Path, Path, int]) -> None:
     _src, ref, k = killed
     folder = ref.parent / "killed"
@@ -79,8 +85,7 @@ def test_recover_finishes_the_partial_file_and_rebuilds_its_tables(
     from mcap.reader import make_reader
 
     _src, ref, _k = killed
-    folder = tmp_path / "killed"
-    shutil.copytree(ref.parent / "killed", folder)
+    folder = _copy_of_killed(ref, tmp_path / "killed")
     partial = folder / "dense.mcap.partial"
     kept, _ = frames_of(partial)
     code, out, err = cli_main("recover", str(folder))
@@ -109,8 +114,7 @@ def test_recover_finishes_the_partial_file_and_rebuilds_its_tables(
 
 def test_run_on_a_killed_run_redoes_it_cleanly_and_says_so(killed: tuple[Path, Path, int], tmp_path: Path) -> None:
     src, ref, _k = killed
-    folder = tmp_path / "killed"
-    shutil.copytree(ref.parent / "killed", folder)
+    folder = _copy_of_killed(ref, tmp_path / "killed")
     code, _out, err = cli_main("run", str(src), "-o", str(folder))
     assert code == 0, err
     assert "was left by an interrupted run" in err and "clean redo" in err
@@ -128,8 +132,7 @@ def test_recover_leaves_a_partial_without_a_complete_frame_as_it_was(
     # The first 64 KiB of the killed run's file: its header and metadata, no whole chunk. Recovering it used to write
     # a recording of no frame, report success and delete the .partial (and the tables there).
     _src, ref, _k = killed
-    folder = tmp_path / "early"
-    shutil.copytree(ref.parent / "killed", folder)
+    folder = _copy_of_killed(ref, tmp_path / "early")
     partial = folder / "dense.mcap.partial"
     partial.write_bytes(partial.read_bytes()[:65536])
     tables = sorted(p.relative_to(folder) for p in (folder / "tables").rglob("*.parquet"))
