@@ -414,7 +414,10 @@ class Simulation:
     def renders(self, *, agents: Collection[str] | None = None, sensors: Collection[str] | None = None) -> bool:
         """Whether a :meth:`capture` with these ``agents`` and ``sensors`` renders (a camera or a top view): only
         then are the short waves' shading slopes sampled. Arguments as for :meth:`capture`."""
-        agents, kinds = self._selection(agents, sensors)
+        return self._renders(*self._selection(agents, sensors))
+
+    def _renders(self, agents: frozenset[str] | None, kinds: set[str]) -> bool:
+        """:meth:`renders` of a selection already checked (:meth:`_selection`)."""
         return any(
             (("cameras" in kinds and a.cameras) or ("top_view" in kinds and a.top_view is not None))
             for a in self.agents
@@ -548,7 +551,7 @@ class Simulation:
         if not arguments.flag(radar, name="radar"):
             kinds.discard("radar")
         # The short waves' shading slopes only for frames that render.
-        state = self.set_frame(frame, shading_detail=self.renders(agents=agents, sensors=kinds))
+        state = self.set_frame(frame, shading_detail=self._renders(agents, kinds))
         sc = self.scenario
         out: dict[str, AgentCapture] = {}
         tasks: list[core._CaptureTask] = []
