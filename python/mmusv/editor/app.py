@@ -449,13 +449,17 @@ def create_app(
             for b in bundled_scenarios()
         ]
 
+    def _as_sent(request: Request, prefix: str, name: str) -> str:
+        """The path parameter after ``prefix`` as the request sent it: Starlette's route drops a trailing newline
+        (``x.yaml%0A`` matches as ``x.yaml``), which must not reach another file or scenario."""
+        return str(request.scope.get("path", "")).partition(prefix)[2] or name
+
     @app.get("/api/bundled/{name:path}")
     def bundled_one(name: str, request: Request) -> dict[str, Any]:
         from mmusv.bundled import bundled_dir
 
         files = {p.stem: p for p in bundled_dir().glob("*.yaml")}
-        # As sent: the route drops a trailing newline (`port_entry%0A` would match `port_entry`).
-        name = str(request.scope.get("path", "")).partition("/api/bundled/")[2] or name
+        name = _as_sent(request, "/api/bundled/", name)
         stem = name.removesuffix(".yaml")
         if stem not in files:
             raise NotFoundError(f"no bundled scenario {name!r}; bundled: {', '.join(sorted(files))}")
@@ -468,9 +472,8 @@ def create_app(
         return [{"name": f.name, "size": f.size} for f in store.files()]
 
     def _sent_name(request: Request, name: str) -> str:
-        """``name`` as the request sent it: Starlette's route drops a trailing newline (``x.yaml%0A`` matches as
-        ``x.yaml``), which must not reach another file."""
-        sent = str(request.scope.get("path", "")).partition("/api/files/")[2]
+        """A file ``name`` as the request sent it (:func:`_as_sent`), checked when it differs from the route's."""
+        sent = _as_sent(request, "/api/files/", name)
         return check_name(sent) if sent != name else name
 
     @app.get("/api/files/{name:path}")
