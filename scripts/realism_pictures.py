@@ -170,10 +170,10 @@ def dusk_series(path: Path) -> None:
 
 
 def exposure_settings(path: Path) -> None:
-    """``ferry_dusk``'s ferry and view at 21:15 (below the default camera's floor) through four cameras on the same mount that differ only in their
-    ``exposure`` (after issue #28 only: the setting is newer than the *before* package): the default automatic
-    exposure (ISO 6 400 at most), −1 EV and +1 EV of compensation, and a camera reaching ISO 25 600; 480 × 270
-    each, in that order left to right, top to bottom."""
+    """``ferry_dusk``'s ferry and view at 21:15 (below the default camera's floor) through four cameras on the
+    same mount that differ only in their ``exposure`` (after issue #28 only: the setting is newer than the *before*
+    package): the default automatic exposure (ISO 6 400 at most), −1 EV and +1 EV of compensation, and a camera
+    reaching ISO 25 600; 480 × 270 each, in that order left to right, top to bottom."""
     from PIL import Image
 
     bearing = 140.0
