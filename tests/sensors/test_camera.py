@@ -215,6 +215,27 @@ def test_range_max_cuts_far_surfaces() -> None:
     assert np.all(np.isposinf(img.depth)) and np.all(img.instance == -1) and np.all(img.semantic == 0)
 
 
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"seed": 1.7}, r"seed = 1\.7: must be a whole number"),
+        ({"seed": -1}, r"seed = -1: must be a whole number in 0\.\."),
+        ({"seed": "3"}, r"seed = '3'.*not str"),
+        ({"pose": np.eye(3)}, r"pose must be a \(4, 4\)"),
+        ({"pose": np.eye(4).ravel()}, r"pose must be a \(4, 4\)"),
+        ({"scene": "scene"}, r"scene must be an mmusv\.Scene, got str"),
+    ],
+)
+def test_bad_render_arguments_are_named(kwargs: dict[str, Any], match: str) -> None:
+    """A float seed used to be truncated (1.7 rendered as seed 1) and a flat 16-vector pose reshaped without a
+    word; both are refused now, naming the argument, as the radar's sweep does."""
+    cam = core.Camera(rgb=False, width=8, height=6, hfov=math.radians(60))
+    args: dict[str, Any] = {"scene": plane_scene(10.0), "pose": np.eye(4), "seed": 1, **kwargs}
+    scene = args.pop("scene")
+    with pytest.raises(mmusv.InputError, match=match):
+        render(cam, scene, env=sensor_env(), **args)
+
+
 def test_rgb_only_when_asked() -> None:
     s = plane_scene(1000.0)
     colour = core.Camera(width=16, height=12, rgb=True, hfov=math.radians(90))

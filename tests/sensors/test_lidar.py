@@ -15,6 +15,7 @@ import itertools
 import math
 from typing import Any
 
+import mmusv
 import numpy as np
 import pytest
 from mmusv._native import core
@@ -246,6 +247,26 @@ def test_explicit_elevation_table_is_honoured() -> None:
 
 
 # ------------------------------------------------------------------------------------------ noise, dropout, weather
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"seed": 2.9}, r"seed = 2\.9: must be a whole number"),
+        ({"seed": 2**64}, r"seed = .*: must be a whole number in 0\.\."),
+        ({"seed": True}, r"seed = True: must be a whole number"),
+        ({"pose": np.eye(4)[:3]}, r"pose must be a \(4, 4\)"),
+        ({"pose": np.eye(4).ravel()}, r"pose must be a \(4, 4\)"),
+        ({"scene": None}, r"scene must be an mmusv\.Scene, got NoneType"),
+    ],
+)
+def test_bad_scan_arguments_are_named(kwargs: dict[str, Any], match: str) -> None:
+    """A float seed used to be truncated (2.9 scanned as seed 2) and a flat 16-vector pose reshaped without a
+    word; both are refused now, naming the argument, as the radar's sweep does."""
+    args: dict[str, Any] = {"scene": plane_scene(10.0, z=-2.0), "pose": np.eye(4), "seed": 1, **kwargs}
+    scene = args.pop("scene")
+    with pytest.raises(mmusv.InputError, match=match):
+        scan(exact_lidar(channels=4, steps=8), scene, env=sensor_env(), **args)
 
 
 def test_same_seed_same_sweep_other_seed_other_noise() -> None:

@@ -15,9 +15,11 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from mmusv import arguments
 from mmusv._native import core
+from mmusv.errors import InputError
 from mmusv.frames import BODY_TO_OPTICAL
-from mmusv.scene import Scene
+from mmusv.scene import Scene, _pose
 from mmusv.sensors.config import CameraConfig, TopViewConfig
 from mmusv.sensors.env import wake_rows
 
@@ -94,8 +96,12 @@ def render(
     (:func:`mmusv.sensors.env.sensor_env`). ``wakes``: ``(K, 6)`` to ``(K, 9)`` rows ``x, y,
     heading, speed, length, beam[, reach_m[, age_s[, displacement_m3]]]`` (world metres, radians, m/s, s, m³;
     :func:`mmusv.sensors.env.wake_rows`) of the vessels under way; ``radiance`` also returns the linear radiance
-    ``(H, W, 3)`` float32 in cd/m² (linear sRGB primaries, before sensor noise and exposure)."""
-    p = np.ascontiguousarray(pose, dtype=np.float64).reshape(4, 4)
+    ``(H, W, 3)`` float32 in cd/m² (linear sRGB primaries, before sensor noise and exposure). ``seed`` is a whole
+    number in ``0..2⁶⁴−1``; a bad seed, pose or scene raises :class:`mmusv.InputError` naming it."""
+    if not isinstance(scene, Scene):
+        raise InputError(f"scene must be an mmusv.Scene, got {type(scene).__name__}")
+    seed = arguments.whole(seed, name="seed", lo=0, hi=2**64 - 1, error=InputError)
+    p = _pose(pose, name="pose")
     w = wake_rows(wakes)
-    out = camera.render(scene.native, pose=p, env=env, seed=int(seed), wakes=w, radiance=radiance)
+    out = camera.render(scene.native, pose=p, env=env, seed=seed, wakes=w, radiance=radiance)
     return CameraImages.from_native(out)

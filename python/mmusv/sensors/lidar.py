@@ -13,8 +13,10 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from mmusv import arguments
 from mmusv._native import core
-from mmusv.scene import Scene
+from mmusv.errors import InputError
+from mmusv.scene import Scene, _pose
 from mmusv.sensors.config import LidarConfig
 from mmusv.sensors.env import wake_rows
 
@@ -93,7 +95,11 @@ def scan(
     ``seed`` drives noise, dropout and water returns. ``wakes``: ``(K, 6)`` to ``(K, 9)`` rows ``x, y,
     heading, speed, length, beam[, reach_m[, age_s[, displacement_m3]]]`` (world metres, radians, m/s, s, m³;
     :meth:`mmusv.simulation.Simulation.wakes`, :func:`mmusv.sensors.env.wake_rows`) of the vessels under way: over
-    a wave surface, beams that meet their foam return from it (the foam the cameras draw)."""
-    p = np.ascontiguousarray(pose, dtype=np.float64).reshape(4, 4)
+    a wave surface, beams that meet their foam return from it (the foam the cameras draw). ``seed`` is a whole
+    number in ``0..2⁶⁴−1``; a bad seed, pose or scene raises :class:`mmusv.InputError` naming it."""
+    if not isinstance(scene, Scene):
+        raise InputError(f"scene must be an mmusv.Scene, got {type(scene).__name__}")
+    seed = arguments.whole(seed, name="seed", lo=0, hi=2**64 - 1, error=InputError)
+    p = _pose(pose, name="pose")
     w = wake_rows(wakes)
-    return LidarPoints.from_native(lidar.scan(scene.native, pose=p, env=env, seed=int(seed), wakes=w))
+    return LidarPoints.from_native(lidar.scan(scene.native, pose=p, env=env, seed=seed, wakes=w))
