@@ -27,8 +27,9 @@ from mmusv.config import Scenario
 from mmusv.errors import ConfigError
 
 if TYPE_CHECKING:
-    from mmusv.generate.checks import Finding, Samples
+    from mmusv.generate.checks import Finding
     from mmusv.generate.mapctx import MapContext
+    from mmusv.generate.samples import Samples
     from mmusv.generate.spec import GenerationSpec
     from mmusv.world.maps import MapWorld
 
@@ -53,10 +54,10 @@ class MmusvWarning(UserWarning):
 
 
 def scenario_samples(scenario: Scenario, ctx: MapContext, spec: GenerationSpec | None = None) -> Samples:
-    """The generator's samples (:func:`~mmusv.generate.checks.take_samples`) of a hand-written scenario: the first
+    """The generator's samples (:func:`~mmusv.generate.samples.take_samples`) of a hand-written scenario: the first
     USV is the ego, every other vessel a role target; ``spec`` gives the thresholds (default: the generator's)."""
-    from mmusv.generate.checks import take_samples
     from mmusv.generate.sampler import CandidateMeta
+    from mmusv.generate.samples import take_samples
     from mmusv.generate.spec import GenerationSpec
 
     usvs = [v.id for v in scenario.vessels if v.role == "usv"]
@@ -86,17 +87,16 @@ def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[st
     returned) on ``scenario`` sailing on ``world``; ``source`` names the file in messages.
 
     The checks sample the scenario's whole acquisition (:func:`mmusv.run` passes it cut to the frames it runs); a
-    scenario whose checks would take more than :data:`~mmusv.generate.checks.MAX_CHECK_SAMPLES` samples is refused
+    scenario whose checks would take more than :data:`~mmusv.generate.samples.MAX_CHECK_SAMPLES` samples is refused
     (a ``ConfigError`` that says how many and how to skip them) before anything is sampled."""
     from mmusv.generate.checks import (
         InWater,
         Separation,
         ShoreClearance,
         StructureClearance,
-        budget_problem,
-        sample_counts,
     )
     from mmusv.generate.mapctx import MapContext
+    from mmusv.generate.samples import budget_problem, sample_counts
     from mmusv.generate.spec import GenerationSpec
 
     spec = GenerationSpec.model_validate({"combinations": [{"family": "crossing"}]})

@@ -370,7 +370,7 @@ def test_non_finite_numbers_in_a_document_are_refused_naming_the_field(client: T
 def test_a_fleet_too_large_to_check_pairwise_is_refused_before_the_checks(
     client: TestClient, doc: dict[str, Any]
 ) -> None:
-    from mmusv.generate.checks import MAX_CHECK_PAIR_SAMPLES
+    from mmusv.generate.samples import MAX_CHECK_PAIR_SAMPLES
 
     r = client.post("/api/evaluate", json={"document": fleet(doc, 1000)})  # a body of 170 kB
     assert r.status_code == 200, r.text[:300]

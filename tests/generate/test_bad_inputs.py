@@ -14,7 +14,7 @@ import pytest
 import yaml
 from mmusv.config import Scenario, load_scenario
 from mmusv.errors import ConfigError
-from mmusv.generate import checks, generate, load_spec
+from mmusv.generate import generate, load_spec, samples
 from mmusv.generate.mapctx import map_context
 
 BASE: dict[str, Any] = {
@@ -54,8 +54,8 @@ class _NoPoses:
 
 @pytest.fixture
 def no_sampling(monkeypatch: pytest.MonkeyPatch) -> None:
-    real = checks.build_fleet
-    monkeypatch.setattr(checks, "build_fleet", lambda sc: _NoPoses(real(sc)))
+    real = samples.build_fleet
+    monkeypatch.setattr(samples, "build_fleet", lambda sc: _NoPoses(real(sc)))
 
 
 def _spec_error(tmp_path: Path, extra: dict[str, Any]) -> str:
@@ -114,16 +114,16 @@ def test_take_samples_refuses_instead_of_allocating() -> None:
 
 def test_sample_counts_saturate_instead_of_overflowing() -> None:
     sc = _scenario(frequency_hz=5, frames=10)
-    n_t, n_g = checks._counts(sc, np.array([math.inf]), 2.0)  # was an OverflowError
-    assert n_t == 10 and n_g > checks.MAX_CHECK_SAMPLES
-    problem = checks.budget_problem(sc, n_t, n_g)
+    n_t, n_g = samples._counts(sc, np.array([math.inf]), 2.0)  # was an OverflowError
+    assert n_t == 10 and n_g > samples.MAX_CHECK_SAMPLES
+    problem = samples.budget_problem(sc, n_t, n_g)
     assert problem is not None and "along the longest route" in problem
-    assert checks.budget_problem(sc, *checks._counts(sc, np.array([600.0]), 2.0)) is None
+    assert samples.budget_problem(sc, *samples._counts(sc, np.array([600.0]), 2.0)) is None
 
 
 def test_generator_rejects_a_candidate_past_the_budget(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     spec = load_spec({**SPEC, "max_attempts_per_scenario": 2})
-    monkeypatch.setattr(checks, "MAX_CHECK_SAMPLES", 10)
+    monkeypatch.setattr(samples, "MAX_CHECK_SAMPLES", 10)
     report = generate(spec, tmp_path / "out")
     assert report.accepted == 0
     rep = json.loads((tmp_path / "out" / "report.json").read_text())

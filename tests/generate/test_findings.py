@@ -121,7 +121,7 @@ def test_route_separation_is_the_closest_pair_of_route_samples() -> None:
 def test_a_fleet_too_large_to_compare_pairwise_is_refused_before_sampling() -> None:
     """Thousands of vessels: the pairs at every time exceed MAX_CHECK_PAIR_SAMPLES, so the checks refuse (naming
     the pairs) instead of taking minutes."""
-    from mmusv.generate.checks import MAX_CHECK_PAIR_SAMPLES, budget_problem
+    from mmusv.generate.samples import MAX_CHECK_PAIR_SAMPLES, budget_problem
 
     data = load_scenario(resolve_scenario("port_entry")).model_dump(mode="json")
     base = data["vessels"][3]

@@ -16,7 +16,7 @@ returns, JSON-ready:
   ``rings`` the LiDAR and radar ranges of a USV's rig (metres);
 * ``valid`` (the schema and the routes are fine; problems may remain), ``frames``, ``frequency_hz``, ``map``.
 
-Bounds (:func:`mmusv.generate.checks.budget_problem`, the ones ``mmusv run`` checks): the checks take at most
+Bounds (:func:`mmusv.generate.samples.budget_problem`, the ones ``mmusv run`` checks): the checks take at most
 ``MAX_CHECK_SAMPLES`` samples x vessels and ``MAX_CHECK_PAIR_SAMPLES`` time samples x pairs of vessels (the
 separation check compares every pair at every time: without this bound a fleet of a few thousand vessels, a body
 of a few hundred kB, would take minutes); above either the document is not valid and ``errors`` says why. At most
@@ -36,8 +36,8 @@ from pydantic import ValidationError
 
 from mmusv.config import Scenario, validation_problems
 from mmusv.errors import ConfigError, MmusvError
-from mmusv.generate.checks import budget_problem, sample_counts
 from mmusv.generate.mapctx import map_context
+from mmusv.generate.samples import budget_problem, sample_counts
 from mmusv.motion import build_fleet
 from mmusv.scenario_checks import check_mounts, map_check_spec, map_findings
 from mmusv.sensors.config import RigConfig

@@ -23,12 +23,13 @@ import yaml
 
 from mmusv.config import load_scenario
 from mmusv.errors import ConfigError, IoError, MmusvError
-from mmusv.generate.checks import Constraint, build_constraints, first_failure, take_samples
+from mmusv.generate.checks import Constraint, build_constraints, first_failure
 from mmusv.generate.hulls import capsule
 from mmusv.generate.layout import SamplingError
 from mmusv.generate.mapctx import MapContext, map_context
 from mmusv.generate.report import ComboReport, RunReport
 from mmusv.generate.sampler import Candidate, sample_candidate
+from mmusv.generate.samples import take_samples
 from mmusv.generate.spec import GenerationSpec, class_assets, load_spec
 
 __all__ = ["Progress", "dump_scenario", "generate"]
@@ -162,7 +163,7 @@ def _first_failure(
     constraints: list[Constraint], cand: Candidate, ctx: MapContext, spec: GenerationSpec
 ) -> tuple[str, str] | None:
     """The first failing constraint of a candidate, ``("sampling", why)`` when it has too many samples to check
-    (:data:`~mmusv.generate.checks.MAX_CHECK_SAMPLES`), None when it passes."""
+    (:data:`~mmusv.generate.samples.MAX_CHECK_SAMPLES`), None when it passes."""
     try:
         samples = take_samples(cand.scenario, cand.meta, ctx, spec)
     except ConfigError as exc:

@@ -413,8 +413,8 @@ def _cross_checks(spec: GenerationSpec, source: str) -> None:
 
 def _check_budget(spec: GenerationSpec, fail: Callable[[str, object, str], None]) -> None:
     """Refuses a spec whose every candidate would take more samples in time than the checks take at most
-    (:data:`~mmusv.generate.checks.MAX_CHECK_SAMPLES`): a long window at the fastest speeds, many vessels."""
-    from mmusv.generate.checks import MAX_CHECK_SAMPLES, time_samples
+    (:data:`~mmusv.generate.samples.MAX_CHECK_SAMPLES`): a long window at the fastest speeds, many vessels."""
+    from mmusv.generate.samples import MAX_CHECK_SAMPLES, time_samples
 
     acq = spec.acquisition
     speeds = [spec.usv.speed_mps[1], *(c.speed_mps[1] for c in spec.size_classes.values())]
