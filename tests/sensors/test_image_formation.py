@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import mmusv
 import numpy as np
@@ -477,3 +478,46 @@ def test_light_scattered_between_wave_facets_brightens_grazing_water_only() -> N
     steep = np.median(out[True][full[-1]] / out[False][full[-1]])
     assert 1.02 < near < 1.12, near
     assert abs(steep - 1.0) < 0.01, steep
+
+
+def test_rig_quality_is_every_camera_s_unless_it_sets_its_own(make_scenario: Any) -> None:
+    """``quality`` on a rig reaches every camera and the top view that do not set their own: the captures equal
+    those of the same rig with the quality written on each sensor, and differ from the default's (so the test can
+    tell the rig's quality was not ignored). A camera's own quality wins; a LiDAR-only rig has nothing to set; a
+    bad value names the rig's field."""
+    from mmusv.config import Scenario
+    from mmusv.editor.document import to_document
+    from mmusv.simulation import Simulation
+
+    def capture(rig: dict[str, Any]) -> dict[str, np.ndarray]:
+        sc = make_scenario()
+        sc["rigs"] = {"r": rig, "rn": {"preset": "lidar_only", "quality": "draft"}}
+        sim = Simulation(sc)
+        agent = sim.capture(2, agents=["usv_a"]).agents["usv_a"]
+        return {"front": agent.cameras["front"].rgb, "top": agent.top_view.rgb}
+
+    cams = [{"name": "front", "resolution": [64, 48], "mount": {"point": "camera_front"}}]
+    top = {"resolution": [48, 48], "metres_per_pixel": 1.0}
+    by_rig = capture({"quality": "draft", "cameras": cams, "top_view": top, "radar": None})
+    each = capture(
+        {"cameras": [{**cams[0], "quality": "draft"}], "top_view": {**top, "quality": "draft"}, "radar": None}
+    )
+    default = capture({"cameras": cams, "top_view": top, "radar": None})
+    for name in ("front", "top"):
+        assert np.array_equal(by_rig[name], each[name]), name
+    assert not np.array_equal(by_rig["front"], default["front"])
+    sc = make_scenario()
+    sc["rigs"]["r"] = {"quality": "high", "cameras": [{**cams[0], "quality": "draft"}, {"name": "b"}]}
+    rig = Scenario.model_validate(sc).rigs["r"]
+    assert [c.quality for c in rig.cameras] == ["draft", "high"] and rig.top_view is not None
+    assert rig.top_view.quality == "high"
+    assert Scenario.model_validate(sc).rigs["rn"].cameras[0].quality == "standard"
+    # The editor's document keeps the rig's quality, not a copy on every camera, and loads back equal.
+    sc["rigs"]["r"] = {"quality": "draft"}
+    scenario = Scenario.model_validate(sc)
+    doc = to_document(scenario)
+    assert doc["rigs"]["r"] == {"quality": "draft"}
+    assert Scenario.model_validate(doc) == scenario
+    sc["rigs"]["r"] = {"quality": "best"}
+    with pytest.raises(mmusv.ConfigError, match=r"rigs\.r\.quality"):
+        Simulation(sc)

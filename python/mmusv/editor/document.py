@@ -18,7 +18,7 @@ from typing import Any
 import yaml
 
 from mmusv.config import Scenario, VesselConfig
-from mmusv.sensors.config import RIG_PRESETS, RigConfig
+from mmusv.sensors.config import RigConfig
 
 __all__ = ["leading_comment", "scenario_yaml", "to_document"]
 
@@ -26,20 +26,19 @@ _ALWAYS_VESSEL = ("id", "role", "asset", "speed_mps", "route")
 
 
 def _rig_document(rig: RigConfig) -> dict[str, Any]:
-    """The keys of ``rig`` that differ from what its preset gives (``{}`` for the paper's full suite); nested
-    models (a LiDAR, each camera) only with their non-default keys."""
-    preset = RIG_PRESETS[rig.preset]
+    """The keys of ``rig`` that differ from what its preset and its quality give (``{}`` for the paper's full
+    suite); nested models (a LiDAR, each camera) only with their non-default keys."""
+    base = RigConfig.model_validate({"preset": rig.preset, "quality": rig.quality}).model_dump(mode="json")
     given = rig.model_dump(mode="json", exclude_defaults=True)
     full = rig.model_dump(mode="json")
     out: dict[str, Any] = {"preset": rig.preset} if rig.preset != "full" else {}
+    if rig.quality is not None:
+        out["quality"] = rig.quality
     for key, value in full.items():
-        if key == "preset":
+        if key in ("preset", "quality"):
             continue
-        if key in preset:
-            if value != preset[key]:  # e.g. a radar added back to a LiDAR-only rig, maybe with all defaults
-                out[key] = given.get(key, {} if isinstance(value, dict) else value)
-        elif key in given:
-            out[key] = given[key]
+        if value != base[key]:  # e.g. a radar added back to a LiDAR-only rig, maybe with all defaults
+            out[key] = given.get(key, {} if isinstance(value, dict) else value)
     return out
 
 

@@ -6,6 +6,7 @@ four 640×480 surround cameras with a 90° field of view, a top-view camera 120 
 is a complete rig. ``null`` switches a sensor off (``radar: null``); ``cameras: []`` removes the cameras.
 ``preset: lidar_only`` starts from the LiDAR alone (no radar, cameras or top view; any of them can still be
 added explicitly): the rig for detection datasets, where cameras would cost most of the time.
+``quality: draft`` (or ``high``) on a rig sets the quality of every camera and top view that does not set its own.
 
 Mounts: ``point`` names a mount point of the vessel asset (``lidar``, ``radar``, ``camera_front``, ...; see
 ``mmusv assets``); ``xyz`` (metres) and ``rpy_deg`` (degrees) are then relative to that point, in the vessel
@@ -16,7 +17,7 @@ the waterline). Assets without the named point fall back to the top of the hull'
 from __future__ import annotations
 
 import math
-from typing import Literal
+from typing import Literal, get_args
 
 from pydantic import Field, field_validator, model_validator
 
@@ -328,6 +329,28 @@ class TopViewConfig(_Model):
     _res = field_validator("resolution")(_check_resolution)
 
 
+_QUALITIES: tuple[str, ...] = get_args(Quality)
+
+
+def _with_quality(rig: dict[str, object], quality: str) -> dict[str, object]:
+    """``rig`` (a rig's fields, before validation) with ``quality`` given to every camera and to the top view that
+    do not set their own; the default cameras and top view when the rig leaves them out. Entries of another kind
+    are left as they are, for the rig's validation to name."""
+
+    def given(item: object) -> object:
+        if isinstance(item, dict) and "quality" not in item:
+            return {**item, "quality": quality}
+        if isinstance(item, (CameraConfig, TopViewConfig)) and "quality" not in item.model_fields_set:
+            return item.model_copy(update={"quality": quality})
+        return item
+
+    out = dict(rig)
+    cameras = rig.get("cameras", default_cameras())
+    out["cameras"] = [given(c) for c in cameras] if isinstance(cameras, list) else cameras
+    out["top_view"] = given(rig.get("top_view", {}))
+    return out
+
+
 def default_cameras(resolution: tuple[int, int] = (640, 480)) -> list[CameraConfig]:
     """The surround rig: front, left, rear, right, 90° each, on the asset's ``camera_*`` mount points."""
     return [
@@ -338,9 +361,12 @@ def default_cameras(resolution: tuple[int, int] = (640, 480)) -> list[CameraConf
 
 class RigConfig(_Model):
     """The sensors of one instrumented USV; every part defaults to the paper's suite, or to ``preset``'s
-    (:data:`RIG_PRESETS`): ``full`` (the default) or ``lidar_only``."""
+    (:data:`RIG_PRESETS`): ``full`` (the default) or ``lidar_only``. ``quality`` (:data:`Quality`), when given,
+    is the quality of every camera and of the top view that does not set its own (``quality: draft`` on the rig
+    renders the whole suite at ``draft`` without listing its cameras)."""
 
     preset: RigPreset = "full"
+    quality: Quality | None = None
     lidar: LidarConfig | None = Field(default_factory=LidarConfig)
     radar: RadarConfig | None = Field(default_factory=RadarConfig)
     cameras: list[CameraConfig] = Field(default_factory=default_cameras)
@@ -352,7 +378,10 @@ class RigConfig(_Model):
         if isinstance(data, dict):
             preset = data.get("preset", "full")
             if isinstance(preset, str) and preset in RIG_PRESETS:
-                return {**RIG_PRESETS[preset], **data}
+                data = {**RIG_PRESETS[preset], **data}
+            quality = data.get("quality")
+            if isinstance(quality, str) and quality in _QUALITIES:
+                data = _with_quality(data, quality)
         return data
 
     def mounts(self) -> list[tuple[str, Mount]]:
