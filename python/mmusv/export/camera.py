@@ -94,6 +94,10 @@ class CameraWriter(DatasetWriter):
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self.extra_counts = {}
+        self.visible_boxes = 0
+        """2D boxes with a visible pixel in the converted images (before ``min_box_px`` and ``max_occlusion``)."""
+        self.kept_boxes = 0
+        """Of those, the boxes :meth:`boxes_of` kept."""
         self.cams: dict[str, list[str]] = {}
         for a in self.agents:
             self.cams[a.id] = [n for n, c in sorted(a.cameras.items()) if self.camera_ok(c)]
@@ -181,12 +185,29 @@ class CameraWriter(DatasetWriter):
                 occlusion=float(b.occlusion),
                 visible_pixels=int(b.visible_pixels),
             )
-            if box.visible_pixels == 0 or box.occlusion > self.options.max_occlusion:
+            if box.visible_pixels == 0:
                 continue
-            if min(box.width, box.height) < self.options.min_box_px:
+            self.visible_boxes += 1
+            if box.occlusion > self.options.max_occlusion or min(box.width, box.height) < self.options.min_box_px:
                 continue
             out.append(box)
+        self.kept_boxes += len(out)
         return out
+
+    def finish(self, frames: list[int], skipped: list[dict[str, Any]]) -> None:
+        """Says so when a format with boxes kept none of this recording's (no vessel in view, or every box left
+        out by the filters), as its label files are then all empty."""
+        super().finish(frames, skipped)
+        if not (self.boxes and frames) or self.kept_boxes:
+            return
+        o = self.options
+        if self.visible_boxes == 0:
+            self.notes.append("no vessel is visible in any converted image: no 2D box, every image is background")
+        else:
+            self.notes.append(
+                f"all {self.visible_boxes} visible 2D boxes were left out by min_box_px = {o.min_box_px:g} and "
+                f"max_occlusion = {o.max_occlusion:g}: no 2D box, every image is background"
+            )
 
 
 def category_names() -> dict[int, str]:

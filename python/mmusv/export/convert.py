@@ -195,7 +195,12 @@ def _prepare_out(out: Path, overwrite: bool, inputs: list[Path]) -> None:
                 f"output folder {out} is not empty and holds no {REPORT_NAME} from a previous conversion; "
                 "refusing to delete it, choose another folder"
             )
-        shutil.rmtree(out)
+        # Empties the folder rather than removing it: it may be the working directory (``-o .``) or a link.
+        for child in sorted(out.iterdir()):
+            if child.is_dir() and not child.is_symlink():
+                shutil.rmtree(child)
+            else:
+                child.unlink()
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:

@@ -8,6 +8,10 @@ z up — KITTI's Velodyne axes, so no mirror), ``image_2/<ts>.png`` (front camer
 OPV2V): ``type truncated occluded alpha x1 y1 x2 y2 h w l x y z rotation_y`` in the front camera frame
 (location = bottom centre of the box); the 2D box, truncation and occlusion come from the recording's camera
 annotations (occluded 0: < 25 % hidden, 1: < 60 %, 2: more, 3: not in the front image, with box ``0 0 0 0``).
+An agent without a front camera has no ``image_2``, zero ``P0..P3`` and, as camera, the LiDAR's own optical axes
+(``Tr_velo_to_cam`` = the rotation x right, y down, z forward): its labels keep KITTI's camera conventions, so
+KITTI's readers turn them into LiDAR boxes with the right heading. A front camera's lens distortion (KITTI's
+images are rectified; ``P2`` is a pinhole) is in ``mmusv_kitti.yaml`` and the conversion's notes.
 Extras: ``depth_2`` (uint16 cm), ``semantic_2``, ``instance_2``, ``radar_ppi``, ``top_view_rgb``,
 ``top_view_semantic``.
 """
@@ -30,7 +34,13 @@ from mmusv.recording.decode import WorldFrame
 from mmusv.recording.info import AgentInfo
 from mmusv.recording.stream import Frame
 
-__all__ = ["KittiWriter", "front_calib", "kitti_label", "kitti_numbers", "occlusion_level"]
+__all__ = ["LIDAR_OPTICAL", "KittiWriter", "front_calib", "kitti_label", "kitti_numbers", "occlusion_level"]
+
+
+LIDAR_OPTICAL = np.eye(4)
+LIDAR_OPTICAL[:3, :3] = BODY_TO_OPTICAL
+"""``(4, 4)`` ``Tr_velo_to_cam`` of an agent without a front camera: the LiDAR frame (x forward, y left, z up) in
+optical axes (x right, y down, z forward), no translation."""
 
 
 def occlusion_level(occlusion: float | None) -> int:
@@ -82,6 +92,25 @@ class KittiWriter(DatasetWriter):
     """Writes one recording as KITTI-style per-agent folders (see the module docstring)."""
 
     cameras: ClassVar[dict[str, int]] = {"front": 2}
+    needs_agent: ClassVar[bool] = True
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        for a in self.agents:
+            cam = a.cameras.get("front")
+            if cam is None:
+                self.notes.append(
+                    f"agent {a.id} has no front camera: no image_2, P0..P3 are zeros and Tr_velo_to_cam is the "
+                    "LiDAR's own optical axes (labels without 2D boxes, occluded 3)"
+                )
+                continue
+            if "rgb" not in cam.outputs:
+                self.notes.append(f"agent {a.id}: front camera records no rgb images: no image_2")
+            if cam.distortion is not None and any(cam.distortion):
+                self.notes.append(
+                    f"agent {a.id}: front camera has lens distortion {list(cam.distortion)} [k1, k2, p1, p2, k3]: "
+                    "image_2 is not rectified (P2 is its pinhole K; coefficients in mmusv_kitti.yaml)"
+                )
 
     def optional_topics(self) -> list[str]:
         return super().optional_topics() + [topics.agent_annotations(a.id) for a in self.agents]
@@ -103,6 +132,8 @@ class KittiWriter(DatasetWriter):
         self.put(self._dir(a, "pose") / f"{ts}.txt", (kitti_numbers(view.lidar[:3, :]) + "\n").encode())
         cam = a.cameras.get("front")
         k, velo_to_cam = front_calib(a, view)
+        if cam is None:
+            velo_to_cam = LIDAR_OPTICAL  # labels in KITTI's camera axes (y down, rotation_y about y) at the LiDAR
         calib = [f"P{i}: {kitti_numbers(k)}" for i in range(4)]
         calib += [
             f"R0_rect: {kitti_numbers(np.eye(3))}",
@@ -114,10 +145,7 @@ class KittiWriter(DatasetWriter):
         ann = msgs.get(topics.agent_annotations(a.id))
         if ann is not None:
             boxes = {b.target_id: b for b in ann.boxes_camera if b.camera == "front"}
-        lines = [
-            kitti_label(t, velo_to_cam, boxes.get(t.id)) if cam is not None else kitti_label(t, velo_to_cam, None)
-            for t in targets
-        ]
+        lines = [kitti_label(t, velo_to_cam, boxes.get(t.id) if cam is not None else None) for t in targets]
         self.put(self._dir(a, "label_2") / f"{ts}.txt", "".join(line + "\n" for line in lines).encode())
         if cam is not None:
             base = topics.camera(a.id, "front") + "/"
@@ -149,6 +177,15 @@ class KittiWriter(DatasetWriter):
                     "scenario": self.info.scenario_name,
                     "config_hash": self.info.config_hash,
                     "agents": {cav_id(a.index): a.id for a in self.agents},
+                    # Brown–Conrady [k1, k2, p1, p2, k3] of image_2 (OpenCV's order); null: no front camera
+                    "front_camera_distortion": {
+                        cav_id(a.index): (
+                            None
+                            if "front" not in a.cameras
+                            else [float(v) for v in (a.cameras["front"].distortion or (0.0,) * 5)]
+                        )
+                        for a in self.agents
+                    },
                     "eval_range_m": o.eval_range_m,
                     "include_usvs": o.include_usvs,
                     "extras": list(o.extras),

@@ -57,12 +57,15 @@ class Opv2vWriter(DatasetWriter):
     """Writes one recording as one OPV2V scenario folder (see the module docstring)."""
 
     cameras: ClassVar[dict[str, int]] = {k: v for k, v in OPV2V_CAMERAS.items() if k != "back"}
+    needs_agent: ClassVar[bool] = True
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         speeds = {str(v["id"]): float(v.get("speed_mps", 0.0)) * 3.6 for v in self.info.scenario.get("vessels", [])}
         self.static_ids = {vid for vid, kmh in speeds.items() if kmh == 0.0}  # VesselConfig.static: speed 0
         self.plans: dict[str, list[list[float]]] = {}
+        self.empty_scans: dict[str, list[int]] = {}
+        """Per agent, the frames whose LiDAR scan has no point (their ``.pcd`` has ``POINTS 0``)."""
         for v in self.info.scenario.get("vessels", []):
             route = np.asarray(v.get("route", []), dtype=np.float64).reshape(-1, 2)
             self.plans[str(v["id"])] = [rounded([x, -y, speeds[str(v["id"])]]) for x, y in route]
@@ -114,6 +117,8 @@ class Opv2vWriter(DatasetWriter):
         msgs = frame.messages
         cloud = decode_point_cloud(msgs[topics.lidar(a.id)])
         xyz = np.column_stack([cloud["x"], cloud["y"], cloud["z"]]).astype(np.float64)
+        if not len(xyz):
+            self.empty_scans.setdefault(a.id, []).append(frame.index)
         self.put(d / f"{ts}.pcd", pcd_bytes(mirror_points(xyz), cloud.get("intensity", np.zeros(len(xyz)))))
         lidar_pose = rounded(carla_pose(view.lidar))
         lidar_m = carla_matrix(np.array(lidar_pose))
@@ -209,6 +214,12 @@ class Opv2vWriter(DatasetWriter):
 
     def finish(self, frames: list[int], skipped: list[dict[str, Any]]) -> None:
         super().finish(frames, skipped)
+        for agent, empty in sorted(self.empty_scans.items()):
+            shown = ", ".join(map(str, empty[:8])) + (f" and {len(empty) - 8} more" if len(empty) > 8 else "")
+            self.notes.append(
+                f"agent {agent}: the LiDAR has no point in frames {shown}: their .pcd files hold 0 points, which "
+                "Open3D reads as an empty cloud after a warning ('PCD has no data')"
+            )
         if not frames:
             return
         info, o = self.info, self.options
