@@ -293,6 +293,9 @@ def test_two_different_rigs_read_back_in_every_format(mixed_rec: Path, tmp_path:
     assert found["mastr"] == 2  # usv_b's front camera; the rear one records no semantic image
     assert len(list((tmp_path / "yolo" / "images").rglob("*.png"))) == 4  # usv_b's front and rear, 2 frames
     assert "agent usv_a has no camera recording rgb images and is left out" in notes(tmp_path / "yolo")
+    # data_protocol.yaml names the OPV2V cameras some agent writes (it said four whatever the rigs).
+    protocol = yaml.safe_load((tmp_path / "opv2v" / "edge_mixed" / "data_protocol.yaml").read_text())
+    assert protocol["vehicle_base"]["sensing"]["perception"]["camera"] == {"num": 2, "order": ["front", "rear"]}
 
 
 def test_empty_scans_and_no_vessel_are_said_and_read_back(lonely_rec: Path, tmp_path: Path) -> None:

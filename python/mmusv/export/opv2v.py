@@ -225,6 +225,9 @@ class Opv2vWriter(DatasetWriter):
         info, o = self.info, self.options
         lidar = next((a.rig.get("lidar") for a in self.agents if a.rig.get("lidar")), None) or {}
         acq = info.scenario.get("acquisition", {})
+        # The OPV2V cameras (camera0..3) some agent writes, by index: none for a LiDAR-only rig.
+        indices = {i: n for a in self.agents for n, i in self.agent_cameras(a)}
+        written = [indices[i] for i in sorted(indices)]
         protocol: dict[str, Any] = {
             "description": f"mmusv scenario {info.scenario_name} converted to the OPV2V layout",
             "world": {
@@ -247,7 +250,7 @@ class Opv2vWriter(DatasetWriter):
                             "noise_stddev": lidar.get("range_noise_std_m"),
                             "dropoff_general_rate": lidar.get("dropout"),
                         },
-                        "camera": {"num": 4, "order": ["front", "right", "left", "rear"]},
+                        "camera": {"num": len(written), "order": written},
                     }
                 }
             },
