@@ -24,6 +24,8 @@ if TYPE_CHECKING:
 from mmusv.errors import ConfigError, MmusvError
 
 BUNDLED_WAVE_SCENARIO = "scenarios/island_port_waves.yaml"
+MAX_FRAMES = 10_000_000
+"""The most frames a scenario may have (``AcquisitionConfig.frames``): ``study waves --frames`` at most."""
 
 
 def _console() -> Console:
@@ -38,6 +40,8 @@ def _cmd_assets(args: argparse.Namespace) -> int:
 
     from mmusv.world.vessels import library
 
+    if args.render is not None:  # its folder made first: one that cannot be was named after the table
+        _ready_output(args.render, flag="--render")
     table = Table(title="mmusv vessel library")
     for col in ("name", "category", "class", "length m", "beam m", "height m", "draft m", "triangles", "parts"):
         table.add_column(col, justify="right" if col.endswith(("m", "triangles", "parts")) else "left")
@@ -61,29 +65,73 @@ def _cmd_assets(args: argparse.Namespace) -> int:
     return 0
 
 
-def _ready_output(output: str) -> None:
+def path_arg(value: str, *, flag: str, empty: str = "give a path") -> str:
+    """``value``, the path given to ``flag``, as it is; :class:`~mmusv.errors.ConfigError` naming ``flag`` (and
+    ending in ``empty``) when it is empty: an empty path quietly meant the current folder (``mmusv info ""`` read
+    ``.``, ``-o ""`` wrote there)."""
+    from mmusv import arguments
+
+    if value == "":
+        raise ConfigError(f"{flag} is empty: {empty}")
+    arguments.path(value, name=flag)  # a NUL character, from a caller in Python
+    return value
+
+
+def output_arg(value: str, *, flag: str = "-o/--output") -> str:
+    """``value``, the output path given to ``flag``, as it is: not empty (:func:`path_arg`) and valid UTF-8. A
+    name with bytes that are not UTF-8 was written halfway (the recording, the table) before the Parquet or CSV
+    writer failed with a traceback."""
+    from mmusv import arguments
+
+    path_arg(value, flag=flag, empty='give a path ("." for the current folder)')
+    try:
+        value.encode("utf-8")
+    except UnicodeEncodeError:
+        raise ConfigError(
+            f"{flag} {arguments.shown(value)}: the path holds bytes that are not UTF-8; give a UTF-8 path"
+        ) from None
+    return value
+
+
+def check_output_folder(value: str, *, flag: str = "-o/--output") -> Path:
+    """``value`` (:func:`output_arg`) as the output folder of ``flag``, checked without creating anything: it, or
+    the nearest of its parents that exists, is a folder. A file there was named only after the computing."""
+    out = Path(output_arg(value, flag=flag))
+    for q in (out, *out.parents):
+        if q.exists():
+            if not q.is_dir():
+                raise ConfigError(f"{flag} {value}: {q} is a file, not a folder")
+            break
+    return out
+
+
+def _ready_output(output: str, *, flag: str = "-o/--output") -> None:
     """Creates a study's output folder before the study runs, so that a folder that cannot be written is named
-    (as ``-o``) at once, not after the computing."""
+    (as ``flag``) at once, not after the computing."""
     from mmusv.errors import IoError
 
+    output_arg(output, flag=flag)
     try:
         Path(output).mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise IoError(f"-o/--output {output}: cannot create the folder: {exc.strerror or exc}") from None
+        raise IoError(f"{flag} {output}: cannot create the folder: {exc.strerror or exc}") from None
 
 
 def _cmd_study_waves(args: argparse.Namespace) -> int:
     from rich.table import Table
 
+    from mmusv import arguments
     from mmusv.bundled import resolve_scenario
     from mmusv.config import load_scenario
     from mmusv.studies.waves import run_wave_study
 
-    scenario = load_scenario(resolve_scenario(args.scenario))
+    # --frames first, within a scenario's own bound: a bad count made the output folder before it was refused,
+    # and 10**30 was a numpy traceback (the copy of the scenario below is not validated).
+    if args.frames is not None:
+        arguments.whole(args.frames, name="--frames", lo=2, hi=MAX_FRAMES)
+    scenario = load_scenario(resolve_scenario(path_arg(args.scenario, flag="--scenario")))
     _ready_output(args.output)
     if args.frames is not None:
-        if args.frames < 2:
-            raise MmusvError("--frames must be at least 2")
         scenario = scenario.model_copy(
             update={"acquisition": scenario.acquisition.model_copy(update={"frames": args.frames})}
         )
@@ -225,10 +273,10 @@ def _run_one(
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from mmusv.batch.cli import run_batch, uses_batch
+    from mmusv.batch.cli import check_batch_options, run_batch, uses_batch
     from mmusv.bundled import resolve_scenario
 
-    src = resolve_scenario(args.scenario)
+    src = resolve_scenario(path_arg(args.scenario, flag="scenario"))
     # Checked for one file as for a folder (a single file used to take --jobs 0 without a word).
     if args.jobs < 1:
         raise ConfigError(f"--jobs {args.jobs}: must be at least 1")
@@ -236,6 +284,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
         raise ConfigError(f"--frames {args.frames}: must be at least 1")
     if not str(args.output).strip():
         raise ConfigError("-o/--output is empty: give the output folder (default out/)")
+    output_arg(args.output)
+    check_batch_options(args)
     if src.is_dir():
         if args.profile:
             raise MmusvError("--profile times one scenario; give a scenario file, not a folder")
@@ -272,7 +322,7 @@ def _cmd_info(args: argparse.Namespace) -> int:
     from mmusv.recording import summary
     from mmusv.recording.info import recording_name
 
-    target = Path(args.recording)
+    target = Path(path_arg(args.recording, flag="recording"))
     folder: Path | None = None
     if target.is_dir():  # a run folder: its recording (finished, else the .partial) and its tables
         folder = target
@@ -350,15 +400,20 @@ def _table_problems(folder: Path, frames: dict[str, object]) -> list[str]:
 def _cmd_recover(args: argparse.Namespace) -> int:
     from mmusv.recording.recover import recover
 
-    res = recover(args.target, overwrite=args.overwrite)
+    res = recover(path_arg(args.target, flag="target"), overwrite=args.overwrite)
     for line in res.lines():
         print(line)
     return 0
 
 
 def _cmd_preview(args: argparse.Namespace) -> int:
+    from mmusv import arguments
     from mmusv.preview import write_preview
 
+    path_arg(args.recording, flag="recording")
+    if args.output is not None:
+        output_arg(args.output)
+    arguments.whole(args.frame, name="--frame", lo=0)  # -1 was "frame -1 is not in ...", not what is allowed
     out = write_preview(args.recording, frame=args.frame, agent=args.agent, output=args.output)
     print(f"wrote {out}")
     return 0
@@ -370,6 +425,8 @@ def _cmd_study_agreement(args: argparse.Namespace) -> int:
     from mmusv.studies.agreement import BUNDLED_SCENARIOS, check_counts, run_agreement_study
 
     check_counts(args.frames)  # before the output folder is made
+    for scenario in args.scenarios:
+        path_arg(scenario, flag="scenario")
     _ready_output(args.output)
     study = run_agreement_study(args.scenarios or BUNDLED_SCENARIOS, frames=args.frames)
     table = Table(title="Annotation vs top-view rendering (Table II)")

@@ -173,6 +173,8 @@ def read_yaml(path: str | os.PathLike[str], *, kind: str = "YAML") -> Any:
     if p.is_dir():
         raise ConfigError(f"{kind} {str(p)!r} is a directory, not a file")
     if not p.is_file():
+        if p.exists():  # a FIFO, a socket, a device: "does not exist" was wrong, and reading one may never end
+            raise ConfigError(f"{kind} {str(p)!r} is not a regular file (a pipe, socket or device); give a YAML file")
         raise ConfigError(f"{kind} file {str(p)!r} does not exist")
     try:
         size = p.stat().st_size

@@ -157,15 +157,58 @@ def print_report(report: BatchReport, console: Console) -> None:
     console.print(f"{report.summary()} in {report.seconds:.1f} s; index {report.index}")
 
 
+JOBS_PER_CPU = 4
+"""``--jobs`` of a local pool at most: this many processes per CPU of the machine."""
+
+
 def check_batch_options(args: argparse.Namespace) -> None:
-    """The batch options (``--retries``, ``--split-frames``, ``--cpus-per-task``) checked before anything is
-    generated or recorded: ``mmusv dataset`` refused them only after writing the scenario set."""
+    """The batch options (``--jobs``, ``--retries``, ``--split-frames``, ``--cpus-per-task``, ``--ray``) checked
+    before anything is generated or recorded: ``mmusv dataset`` refused them only after writing the scenario set.
+    On a local pool ``--jobs`` and ``--cpus-per-task`` are bounded by this machine's CPUs: ``--jobs 10**11`` was
+    a multiprocessing traceback, ``--cpus-per-task 100000`` as many core threads per process, a hang."""
+    from mmusv.batch.executors import available_cpus
+
     if args.retries < 0:
         raise ConfigError(f"--retries {args.retries}: must be 0 or more")
     if args.split_frames is not None and args.split_frames < 1:
         raise ConfigError(f"--split-frames {args.split_frames}: must be at least 1 frame per part")
     if args.cpus_per_task is not None and args.cpus_per_task < 1:
         raise ConfigError(f"--cpus-per-task {args.cpus_per_task}: must be at least 1")
+    if args.ray is not None:  # the cluster's CPUs: the Ray executor checks --cpus-per-task against them
+        _check_ray_address(args.ray)
+        return
+    cpus = available_cpus()
+    if args.jobs > JOBS_PER_CPU * cpus:
+        raise ConfigError(
+            f"--jobs {args.jobs}: must be in 1..{JOBS_PER_CPU * cpus} ({JOBS_PER_CPU} processes per CPU at most; "
+            f"this machine has {cpus})"
+        )
+    if args.cpus_per_task is not None and args.cpus_per_task > cpus:
+        raise ConfigError(
+            f"--cpus-per-task {args.cpus_per_task}: must be in 1..{cpus} (the CPUs of this machine; --ray for more)"
+        )
+
+
+def _check_ray_address(address: str) -> None:
+    """``--ray HOST:PORT`` (or ``ray://HOST:PORT``) reachable: Ray itself retried an address where nothing listens
+    for minutes, without a word on the console. Other forms (``local``, ``auto``) are left to Ray."""
+    import socket
+
+    from mmusv.errors import IoError
+
+    hostport = address.removeprefix("ray://")
+    host, sep, port = hostport.rpartition(":")
+    if not sep or not host or not port.isdigit():
+        return
+    try:
+        with socket.create_connection((host.strip("[]"), int(port)), timeout=5):
+            pass
+    except (OSError, OverflowError, UnicodeError) as exc:
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc) or type(exc).__name__
+        raise IoError(
+            f"--ray {address}: nothing answers at {host} port {port} ({reason}); give the address of a running Ray "
+            "head (HOST:PORT), 'auto' for the cluster this machine is part of, or no ADDRESS for a local instance"
+        ) from None
 
 
 def run_batch(args: argparse.Namespace, source: Path | list[Path]) -> int:
@@ -214,7 +257,10 @@ def add_dataset_parser(subparsers: Any) -> argparse.ArgumentParser:
 def run_dataset(args: argparse.Namespace) -> int:
     """Runs ``mmusv dataset``; 0 when every scenario was recorded and converted, 1 otherwise."""
     from mmusv.batch.dataset import build_dataset
+    from mmusv.cli import check_output_folder, path_arg
 
+    path_arg(args.spec, flag="spec")
+    check_output_folder(args.output)  # an empty -o wrote the dataset into the current folder
     if args.jobs < 1:
         raise ConfigError(f"--jobs {args.jobs}: must be at least 1")
     check_batch_options(args)

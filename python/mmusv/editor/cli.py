@@ -41,6 +41,8 @@ def _bind(host: str, port: int) -> socket.socket:
         infos = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)
     except socket.gaierror as exc:
         raise ConfigError(f"--host {host!r}: not an address of this machine ({exc.strerror})") from None
+    except UnicodeError:  # bytes that are not UTF-8 (or a label IDNA refuses): was a traceback
+        raise ConfigError(f"--host {host!r}: not a host name or address (it holds characters a name cannot)") from None
     family, _, _, _, addr = infos[0]
     sock = socket.socket(family, socket.SOCK_STREAM)
     sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
@@ -77,15 +79,17 @@ def serve(app: Any, *, host: str, port: int, announce: bool = True) -> None:
 def run(args: argparse.Namespace) -> int:
     """Runs ``mmusv editor`` with parsed ``args``; returns the exit status."""
     from mmusv.bundled import resolve_scenario
+    from mmusv.cli import path_arg
     from mmusv.config import load_scenario
     from mmusv.editor.app import InitialScenario, create_app
     from mmusv.editor.document import leading_comment, to_document
     from mmusv.editor.files import check_name
 
     initial = None
-    folder = Path(args.dir) if args.dir is not None else Path.cwd()
+    # an empty --dir served the current folder, an empty SCENARIO read "." (a folder): both named now
+    folder = Path(path_arg(args.dir, flag="--dir")) if args.dir is not None else Path.cwd()
     if args.scenario is not None:
-        path = resolve_scenario(args.scenario)
+        path = resolve_scenario(path_arg(args.scenario, flag="scenario"))
         if args.dir is None and Path(args.scenario).is_file():
             folder = path.parent
         scenario = load_scenario(path)

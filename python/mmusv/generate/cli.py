@@ -39,13 +39,17 @@ def run(args: argparse.Namespace) -> int:
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
+    from mmusv.cli import check_output_folder, output_arg, path_arg
     from mmusv.generate.mapctx import map_context
     from mmusv.generate.runner import generate
     from mmusv.generate.spec import load_spec
 
     console = Console(width=None if sys.stdout.isatty() else 160)
-    spec = load_spec(args.spec)
-    out = Path(args.output) if args.output else Path("scenarios/generated") / spec.name
+    if args.output is not None:  # an empty -o took the default folder without a word
+        output_arg(args.output)
+    spec = load_spec(path_arg(args.spec, flag="spec"))
+    out = Path(args.output) if args.output is not None else Path("scenarios/generated") / spec.name
+    check_output_folder(str(out))  # before the map is built: a file there was named after it
     total = sum(c.quota for c in spec.combinations)
     t0 = time.perf_counter()
     maps = {(m.type, m.seed): m for m in (spec.map_of(c) for c in spec.combinations)}

@@ -104,9 +104,15 @@ def add_parser(sub: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Runs ``mmusv train``; returns the exit status."""
-    from mmusv.export.splits import parse_ratios
+    from mmusv.cli import check_output_folder, path_arg
 
     _check_numbers(args)
+    check_output_folder(args.output)  # an empty -o wrote the cache and the models into the current folder
+    for item in args.inputs:
+        path_arg(item, flag="recording")
+    if args.opv2v is not None:
+        path_arg(args.opv2v, flag="--opv2v")
+    ratios = split_ratios(args.split_ratios)
     _torch()
     _check_device(args.device)
     from mmusv.learn.cache import build_cache
@@ -117,8 +123,6 @@ def run(args: argparse.Namespace) -> int:
     bad = [m for m in modes if m not in MODES]
     if bad or not modes:
         raise InputError(f"--modes {args.modes}: unknown {bad}; allowed: {', '.join(MODES)}")
-    if args.threads is not None and args.threads < 1:
-        raise InputError(f"--threads {args.threads}: must be >= 1")
     jobs = _jobs(args.jobs, len(modes), args.device)
     out = Path(args.output)
     if args.scorers_only and args.no_scorers:
@@ -141,9 +145,7 @@ def run(args: argparse.Namespace) -> int:
     cache = out / f"cache_{args.split}.npz"
     t0 = time.perf_counter()
     if not cache.is_file():
-        build_cache(
-            inputs, cache, opv2v=args.opv2v, split=args.split, ratios=parse_ratios(args.split_ratios), seed=args.seed
-        )
+        build_cache(inputs, cache, opv2v=args.opv2v, split=args.split, ratios=ratios, seed=args.seed)
         print(f"cache: {cache} ({cache.stat().st_size / 2**20:.1f} MiB, {time.perf_counter() - t0:.1f} s)", flush=True)
     if args.cache_only:
         return 0
@@ -211,6 +213,37 @@ def _check_numbers(args: argparse.Namespace) -> None:
         raise InputError(f"--time-limit {args.time_limit}: seconds, a finite number > 0 (or left out for no limit)")
     if args.workers < 0:
         raise InputError(f"--workers {args.workers}: must be >= 0 (0: load data in the training process)")
+    from mmusv.batch.executors import available_cpus
+
+    check_threads(args.threads)
+    cpus = available_cpus()
+    if args.workers > cpus:  # each a process: 10**11 of them froze the data loader
+        raise InputError(f"--workers {args.workers}: must be in 0..{cpus} (the CPUs of this machine)")
+
+
+def check_threads(threads: int | None) -> None:
+    """``--threads`` (``None``: the default) in 1..the CPUs of this machine: ``10**11`` was a torch traceback and
+    ``100000`` as many threads started (a crash on exit)."""
+    from mmusv.batch.executors import available_cpus
+
+    if threads is None:
+        return
+    cpus = available_cpus()
+    if threads < 1:
+        raise InputError(f"--threads {threads}: must be >= 1")
+    if threads > cpus:
+        raise InputError(f"--threads {threads}: must be at most {cpus} (the CPUs of this machine)")
+
+
+def split_ratios(text: str) -> tuple[float, float, float]:
+    """``--split-ratios`` as three fractions; its errors name the option (they said only "split")."""
+    from mmusv.errors import MmusvError, located
+    from mmusv.export.splits import parse_ratios
+
+    try:
+        return parse_ratios(text)
+    except MmusvError as exc:
+        raise located(exc, "--split-ratios") from None
 
 
 _DEVICES = "cpu, cuda, cuda:N or mps"

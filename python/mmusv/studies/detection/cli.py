@@ -145,8 +145,10 @@ def run(args: argparse.Namespace) -> int:
     """Runs ``mmusv study detection|robustness``; returns the exit status."""
     from rich.console import Console
 
+    from mmusv import arguments
+    from mmusv.cli import check_output_folder, path_arg
     from mmusv.errors import InputError
-    from mmusv.export.splits import parse_ratios
+    from mmusv.learn.cli import check_threads, split_ratios
     from mmusv.studies.detection.detector import BASELINE_NOTE, load_detector
     from mmusv.studies.detection.fusion import parse_modes
     from mmusv.studies.detection.robustness import Setting, parse_settings
@@ -159,7 +161,19 @@ def run(args: argparse.Namespace) -> int:
     tri = {"auto": None, "on": True, "off": False}
     if args.jobs < 1:
         raise InputError(f"--jobs {args.jobs}: must be >= 1")
+    # Paths before anything is read: an empty one meant the current folder (-o "" wrote the tables there), and an
+    # -o that is a file was named only after the evaluation.
+    for item in args.inputs:
+        path_arg(item, flag="recording")
+    for flag, value in (("--opv2v", args.opv2v), ("--predictions", args.predictions), ("--model", args.model)):
+        if value is not None:
+            path_arg(value, flag=flag)
+    out = check_output_folder(args.output)
+    ratios = split_ratios(args.split_ratios)
+    # --range: a finite distance (inf was taken, and cropped the clouds at inf metres)
+    range_m = arguments.real(args.range_m, name="--range", unit="metres", above=0.0, error=InputError)
     if args.model is not None:
+        check_threads(args.threads)  # before the models load: 10**11 was a torch traceback
         if args.predictions is not None or args.detector != "baseline":
             raise InputError("give one of --model, --detector or --predictions")
         from mmusv.learn.cli import load_for_study
@@ -171,12 +185,11 @@ def run(args: argparse.Namespace) -> int:
     if args.threads is not None:
         if args.model is None:
             raise InputError(f"--threads {args.threads}: only with --model (torch's threads of the learned models)")
-        if args.threads < 1:
-            raise InputError(f"--threads {args.threads}: must be >= 1")
         import torch
 
         torch.set_num_threads(args.threads)
-    modes = parse_modes(args.modes or (",".join(learned.fusion_modes) if learned is not None else "none,late,early"))
+    default_modes = ",".join(learned.fusion_modes) if learned is not None else "none,late,early"
+    modes = parse_modes(default_modes if args.modes is None else args.modes)  # "" was taken as the default
     settings = parse_settings(args.settings) if robust else (Setting(),)
     if robust and not any(m != "none" for m in modes):
         raise InputError("--modes: the robustness study needs late and/or early fusion")
@@ -187,9 +200,6 @@ def run(args: argparse.Namespace) -> int:
     )
     detector_name = f"learned model {args.model}" if learned is not None else args.detector
     predictions = load_predictions(args.predictions) if args.predictions is not None else None
-    if not (args.range_m > 0):
-        raise InputError(f"--range {args.range_m}: must be > 0 metres")
-    out = Path(args.output)
     t0 = time.perf_counter()
     inputs: list[Any] = list(args.inputs)
     if args.generate is not None:
@@ -215,9 +225,7 @@ def run(args: argparse.Namespace) -> int:
             highlight=False,
         )
     split = args.split or ("test" if args.generate is not None else "all")
-    dataset = resolve_dataset(
-        inputs, opv2v=args.opv2v, split=split, ratios=parse_ratios(args.split_ratios), seed=args.seed
-    )
+    dataset = resolve_dataset(inputs, opv2v=args.opv2v, split=split, ratios=ratios, seed=args.seed)
     runs: list[tuple[Any, str, tuple[str, ...], Path]] = [(detector, detector_name, modes, out)]
     if learned is not None:  # the learned model beside the baseline, on the same frames
         base_modes = tuple(m for m in modes if m != "intermediate")
@@ -230,7 +238,7 @@ def run(args: argparse.Namespace) -> int:
             settings=settings,
             detector=det,
             predictions=predictions,
-            range_m=args.range_m,
+            range_m=range_m,
             seed=args.seed,
             late_merge=args.late_merge,
         )
@@ -255,8 +263,16 @@ def run(args: argparse.Namespace) -> int:
             else:
                 res = run_study(dataset.sequences(), options=options, total_frames=total, progress=show)
         if res.ego_frames == 0:
+            delay = max(s.delay_frames for s in settings)
+            why = (
+                f" (the robustness study leaves out the first {delay} frames of every sequence: --settings holds "
+                f"delay:{delay})"
+                if delay > 0
+                else ""
+            )
             raise InputError(
-                f"empty dataset: the {len(dataset.sources)} sequence(s) of split {split!r} hold no frame to evaluate"
+                f"empty dataset: the {len(dataset.sources)} sequence(s) of split {split!r} hold no frame to "
+                f"evaluate{why}"
             )
         eval_s = time.perf_counter() - t1
         from mmusv.studies.detection import report

@@ -1,0 +1,228 @@
+"""The command line misused as a new user would: empty paths, outputs that are files or not UTF-8, counts past
+what the machine has, unreachable addresses. Each is one ``mmusv: error:`` line naming the option (exit status 2)
+before anything is computed or written, never a traceback, a hang, or a silent fallback to the current folder or a
+default. The options are checked first, so most cases name a recording or spec that does not exist: the code before
+these checks failed on that instead, without naming the option."""
+
+from __future__ import annotations
+
+import os
+import socket
+from collections.abc import Sequence
+from pathlib import Path
+
+import pytest
+import yaml
+from mmusv.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENARIO = str(ROOT / "scenarios/open_sea_convoy.yaml")
+SPEC = str(ROOT / "scenarios/specs/island_demo.yaml")
+
+
+def _refused(argv: Sequence[str], capsys: pytest.CaptureFixture[str]) -> tuple[str, str]:
+    """Runs ``mmusv argv`` in this process; asserts exit status 2 and one error line; returns (stdout, stderr)."""
+    assert main(list(argv)) == 2
+    out, err = capsys.readouterr()
+    assert err.startswith("mmusv: error: ") and "Traceback" not in err, err
+    return out, err
+
+
+@pytest.fixture
+def cwd(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """An empty current folder, to see that nothing lands there."""
+    here = tmp_path / "cwd"
+    here.mkdir()
+    monkeypatch.chdir(here)
+    return here
+
+
+@pytest.mark.parametrize(
+    ("argv", "said"),
+    [
+        (["assets", "--render", ""], "--render is empty"),
+        (["study", "waves", "--frames", "2", "-o", ""], "-o/--output is empty"),
+        (["study", "waves", "--scenario", ""], "--scenario is empty"),
+        (["study", "agreement", "", "--frames", "1", "-o", "agree"], "scenario is empty"),
+        (["study", "agreement", "missing.yaml", "--frames", "1", "-o", ""], "-o/--output is empty"),
+        (["run", "", "-o", "out"], "scenario is empty"),
+        (["info", ""], "recording is empty"),
+        (["recover", ""], "target is empty"),
+        (["preview", ""], "recording is empty"),
+        (["preview", "missing.mcap", "-o", ""], "-o/--output is empty"),
+        (["generate", ""], "spec is empty"),
+        (["generate", "missing.yaml", "-o", ""], "-o/--output is empty"),
+        (["dataset", "", "-o", "ds"], "spec is empty"),
+        (["dataset", "missing.yaml", "-o", ""], "-o/--output is empty"),
+        (["study", "detection", "", "-o", "det"], "recording is empty"),
+        (["study", "detection", "missing.mcap", "-o", ""], "-o/--output is empty"),
+        (["study", "detection", "--opv2v", "", "-o", "det"], "--opv2v is empty"),
+        (["train", "", "-o", "tr"], "recording is empty"),
+        (["train", "missing.mcap", "-o", ""], "-o/--output is empty"),
+        (["editor", "", "--port", "-1"], "scenario is empty"),
+        (["editor", "--dir", "", "--port", "-1"], "--dir is empty"),
+    ],
+)
+def test_an_empty_path_is_refused_by_name_not_taken_as_the_current_folder(
+    argv: list[str], said: str, cwd: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    _, err = _refused(argv, capsys)
+    assert said in err, err
+    assert list(cwd.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["run", SCENARIO, "--frames", "1", "-o"],
+        ["study", "waves", "--frames", "2", "-o"],
+    ],
+)
+def test_an_output_path_that_is_not_utf8_is_refused_before_anything_is_written(
+    argv: list[str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bad = os.fsdecode(os.fsencode(tmp_path) + b"/out\xff")  # as Python hands such an argument over
+    _, err = _refused([*argv, bad], capsys)
+    assert "-o/--output" in err and "not UTF-8" in err, err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_output_folders_under_a_file_are_named_as_the_option_before_any_work(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    afile = tmp_path / "afile"
+    afile.write_text("not a folder\n", encoding="utf-8")
+    out, err = _refused(["assets", "--render", str(afile / "sheet")], capsys)
+    assert err.startswith(f"mmusv: error: --render {afile / 'sheet'}: cannot create the folder"), err
+    assert out == ""  # the table was printed before the folder was refused
+    for argv in (
+        ["generate", SPEC, "-o", str(afile)],
+        ["dataset", SPEC, "-o", str(afile / "ds")],
+        ["study", "detection", str(tmp_path / "missing.mcap"), "-o", str(afile)],
+        ["train", str(tmp_path / "missing.mcap"), "-o", str(afile)],
+    ):
+        _, err = _refused(argv, capsys)
+        assert f"-o/--output {argv[-1]}: {afile} is a file, not a folder" in err, (argv, err)
+    assert afile.read_text(encoding="utf-8") == "not a folder\n"
+
+
+@pytest.mark.parametrize(("frames", "said"), [("0", "--frames = 0"), (str(10**30), f"--frames = {10**30}")])
+def test_wave_study_frames_are_bounded_and_checked_before_the_output_folder(
+    frames: str, said: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "waves"
+    _, err = _refused(["study", "waves", "--frames", frames, "-o", str(out)], capsys)
+    assert said in err and "2..10000000" in err, err
+    assert not out.exists()
+
+
+def _empty_folder(tmp_path: Path) -> str:
+    folder = tmp_path / "no_scenarios"
+    folder.mkdir()
+    return str(folder)
+
+
+@pytest.mark.parametrize(
+    ("option", "said"),
+    [
+        (["--jobs", str(10**11)], f"--jobs {10**11}: must be in 1.."),
+        (["--cpus-per-task", str(10**11)], f"--cpus-per-task {10**11}: must be in 1.."),
+    ],
+)
+def test_a_local_pool_is_bounded_by_the_cpus_of_the_machine(
+    option: list[str], said: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--jobs 10**11`` was a multiprocessing traceback, ``--cpus-per-task 10**11`` as many core threads (a hang);
+    an empty folder of scenarios made the code before the check fail at once, on something else."""
+    out = tmp_path / "out"
+    _, err = _refused(["run", _empty_folder(tmp_path), "-o", str(out), *option], capsys)
+    assert said in err and "this machine" in err, err
+    _, err = _refused(["dataset", str(tmp_path / "missing.yaml"), "-o", str(tmp_path / "ds"), *option], capsys)
+    assert said in err, err
+    assert not out.exists() and not (tmp_path / "ds").exists()
+
+
+def _closed_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind(("127.0.0.1", 0))
+        port: int = s.getsockname()[1]
+    return port
+
+
+def test_a_ray_address_where_nothing_listens_is_named_not_retried_for_minutes(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    address = f"127.0.0.1:{_closed_port()}"
+    _, err = _refused(["run", _empty_folder(tmp_path), "-o", str(tmp_path / "out"), "--ray", address], capsys)
+    assert f"--ray {address}: nothing answers" in err, err
+
+
+@pytest.mark.parametrize(
+    ("option", "said"),
+    [
+        (["--workers", str(10**11)], f"--workers {10**11}: must be in 0.."),
+        (["--threads", str(10**11)], f"--threads {10**11}: must be at most"),
+    ],
+)
+def test_train_threads_and_workers_are_bounded_by_the_cpus(
+    option: list[str], said: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    argv = ["train", str(tmp_path / "missing.mcap"), "--no-progress", "-o", str(tmp_path / "tr"), *option]
+    _, err = _refused(argv, capsys)
+    assert said in err and "CPUs of this machine" in err, err
+    assert not (tmp_path / "tr").exists()
+
+
+@pytest.mark.parametrize(
+    ("option", "said"),
+    [
+        (["--range", "inf"], "--range = inf: must be a finite number of metres > 0"),
+        (["--modes", ""], "--modes '': unknown mode(s) []; allowed: none, late, early, intermediate"),
+        (["--split-ratios", "1,2"], "--split-ratios: split '1,2': expected three fractions"),
+        (["--model", "missing", "--threads", str(10**11)], f"--threads {10**11}: must be at most"),
+    ],
+)
+def test_detection_study_options_are_refused_by_name_before_the_data_is_read(
+    option: list[str], said: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--range inf`` and ``--modes ""`` (the default modes) were taken without a word, ``--threads 10**11`` was
+    a torch traceback, and a bad ``--split-ratios`` was called "split"."""
+    argv = ["study", "detection", str(tmp_path / "missing.mcap"), "--no-progress", "-o", str(tmp_path / "det")]
+    _, err = _refused([*argv, *option], capsys)
+    assert said in err, err
+
+
+def test_robustness_says_why_a_dataset_shorter_than_the_delay_is_empty(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from mmusv.acquire import run
+    from mmusv.studies.detection.sources import lidar_only
+
+    data = lidar_only(yaml.safe_load(Path(SCENARIO).read_text(encoding="utf-8")))
+    data["name"] = "one_frame"
+    data["acquisition"]["frames"] = 1
+    rec = run(data, out_dir=tmp_path / "rec").recording
+    argv = ["study", "robustness", str(rec), "--settings", "delay:1", "--no-progress", "-o", str(tmp_path / "rob")]
+    _, err = _refused(argv, capsys)
+    assert "empty dataset" in err and "leaves out the first 1 frames" in err and "--settings holds delay:1" in err
+
+
+def test_a_fifo_given_as_a_scenario_is_not_said_to_be_missing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    fifo = tmp_path / "scenario.yaml"
+    os.mkfifo(fifo)
+    _, err = _refused(["run", str(fifo), "-o", str(tmp_path / "out")], capsys)
+    assert f"scenario {str(fifo)!r} is not a regular file" in err, err
+
+
+def test_preview_refuses_a_negative_frame_by_name(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    _, err = _refused(["preview", str(tmp_path / "missing.mcap"), "--frame", "-1"], capsys)
+    assert "--frame = -1: must be a whole number >= 0" in err, err
+
+
+def test_editor_host_that_is_not_utf8_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Was a UnicodeError traceback from the name lookup."""
+    host = os.fsdecode(b"\xff")
+    _, err = _refused(["editor", "--dir", str(tmp_path), "--host", host, "--port", "0"], capsys)
+    assert err.startswith(f"mmusv: error: --host {host!r}: not a host name or address"), err
