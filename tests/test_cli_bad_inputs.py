@@ -226,3 +226,45 @@ def test_editor_host_that_is_not_utf8_is_one_line(tmp_path: Path, capsys: pytest
     host = os.fsdecode(b"\xff")
     _, err = _refused(["editor", "--dir", str(tmp_path), "--host", host, "--port", "0"], capsys)
     assert err.startswith(f"mmusv: error: --host {host!r}: not a host name or address"), err
+
+
+def test_retries_are_bounded(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``--retries 10**20`` was taken: a task that always fails would have been run again practically forever."""
+    _, err = _refused(["run", _empty_folder(tmp_path), "-o", str(tmp_path / "out"), "--retries", str(10**20)], capsys)
+    assert "--retries" in err and "0..100" in err, err
+    assert not (tmp_path / "out").exists()
+
+
+def test_generate_takes_a_bundled_spec_by_name(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``mmusv dataset coop_detection`` found the bundled spec, ``mmusv generate island_demo`` said it did not exist.
+    With an output under a file, the run goes past the spec (resolved, loaded) and stops at ``-o`` before any map."""
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    _, err = _refused(["generate", "island_demo", "-o", str(blocker / "out")], capsys)
+    assert "-o/--output" in err and "is a file" in err, err
+    _, err = _refused(["generate", "no_such_spec"], capsys)
+    assert "not a bundled spec" in err and "island_demo" in err, err
+
+
+def test_recover_names_a_path_that_does_not_exist(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    _, err = _refused(["recover", str(tmp_path / "missing")], capsys)
+    assert "does not exist" in err, err
+
+
+def test_robustness_settings_may_not_be_empty(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``--settings ""`` ran the clean setting alone: a robustness study of nothing."""
+    argv = ["study", "robustness", str(tmp_path / "missing.mcap"), "--settings", "", "-o", str(tmp_path / "rob")]
+    _, err = _refused(argv, capsys)
+    assert "--settings is empty" in err, err
+
+
+def test_jobs_for_one_scenario_is_said_to_do_nothing(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``--jobs 3`` with one scenario file was ignored without a word (it runs the files of a folder side by side)."""
+    scenario = yaml.safe_load(Path(SCENARIO).read_text())
+    scenario["rigs"] = {"r": {"preset": "lidar_only", "lidar": {"channels": 4, "points_per_second": 2000}}}
+    scenario["vessels"] = [{**v, "rig": "r"} if v.get("role") == "usv" else v for v in scenario["vessels"]]
+    path = tmp_path / "one.yaml"
+    path.write_text(yaml.safe_dump(scenario))
+    assert main(["run", str(path), "-o", str(tmp_path / "out"), "--frames", "1", "--jobs", "3", "--no-checks"]) == 0
+    _, err = capsys.readouterr()
+    assert "mmusv: note: --jobs 3 runs the scenarios of a folder side by side" in err, err

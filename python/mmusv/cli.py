@@ -294,6 +294,12 @@ def _cmd_run(args: argparse.Namespace) -> int:
         if args.profile:
             raise MmusvError("--profile times one run in this process; leave out --ray, --retries and --split-frames")
         return run_batch(args, [src])
+    if args.jobs > 1:  # taken without a word: one scenario runs in this process, on every core
+        print(
+            f"mmusv: note: --jobs {args.jobs} runs the scenarios of a folder side by side; one scenario runs in "
+            "this process (its sensors use every core)",
+            file=sys.stderr,
+        )
     print(
         _run_one(
             str(src), args.output, args.overwrite, args.frames, sys.stdout.isatty(), not args.no_checks, args.profile

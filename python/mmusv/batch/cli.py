@@ -157,6 +157,9 @@ def print_report(report: BatchReport, console: Console) -> None:
     console.print(f"{report.summary()} in {report.seconds:.1f} s; index {report.index}")
 
 
+MAX_RETRIES = 100
+"""``--retries`` at most: a task that keeps failing is run at most this many more times (10**20 was accepted)."""
+
 JOBS_PER_CPU = 4
 """``--jobs`` of a local pool at most: this many processes per CPU of the machine."""
 
@@ -168,8 +171,8 @@ def check_batch_options(args: argparse.Namespace) -> None:
     a multiprocessing traceback, ``--cpus-per-task 100000`` as many core threads per process, a hang."""
     from mmusv.batch.executors import available_cpus
 
-    if args.retries < 0:
-        raise ConfigError(f"--retries {args.retries}: must be 0 or more")
+    if not 0 <= args.retries <= MAX_RETRIES:
+        raise ConfigError(f"--retries {args.retries}: must be in 0..{MAX_RETRIES} (more runs of a task per failure)")
     if args.split_frames is not None and args.split_frames < 1:
         raise ConfigError(f"--split-frames {args.split_frames}: must be at least 1 frame per part")
     if args.cpus_per_task is not None and args.cpus_per_task < 1:

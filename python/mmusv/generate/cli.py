@@ -25,7 +25,9 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         description="Samples scenarios from a generation spec, rejects those that break a constraint, writes one "
         "scenario YAML per accepted sample and report.json into the output directory.",
     )
-    p.add_argument("spec", help="generation spec YAML (e.g. scenarios/specs/island_demo.yaml)")
+    p.add_argument(
+        "spec", help="generation spec YAML, or a bundled spec by name (island_demo, scenarios/specs/island_demo.yaml)"
+    )
     p.add_argument("-o", "--output", default=None, help="output directory (default scenarios/generated/<spec name>)")
     p.add_argument(
         "--force", action="store_true", help="replace scenario files and report.json already in the directory"
@@ -47,7 +49,10 @@ def run(args: argparse.Namespace) -> int:
     console = Console(width=None if sys.stdout.isatty() else 160)
     if args.output is not None:  # an empty -o took the default folder without a word
         output_arg(args.output)
-    spec = load_spec(path_arg(args.spec, flag="spec"))
+    from mmusv.bundled import resolve_spec
+
+    # A bundled spec by name from any folder (island_demo, coop_detection), as mmusv dataset takes it.
+    spec = load_spec(resolve_spec(path_arg(args.spec, flag="spec")))
     out = Path(args.output) if args.output is not None else Path("scenarios/generated") / spec.name
     check_output_folder(str(out))  # before the map is built: a file there was named after it
     total = sum(c.quota for c in spec.combinations)

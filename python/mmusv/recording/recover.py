@@ -70,6 +70,8 @@ class Recovered:
 def find_partial(target: str | os.PathLike[str]) -> Path:
     """The ``.partial`` recording ``target`` names: the file itself, or the one ``.mcap.partial`` in the folder."""
     p = Path(target)
+    if not p.exists():
+        raise IoError(f"{p} does not exist; recover takes a run folder or a .mcap.partial file left by a killed run")
     if p.is_dir():
         found = sorted(p.glob("*.mcap.partial"))
         if not found:

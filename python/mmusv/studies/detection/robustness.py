@@ -61,6 +61,8 @@ def parse_settings(text: str | Sequence[str]) -> tuple[Setting, ...]:
     """Settings from ``"clean,delay:1,delay:2,noise:0.5/0.5"`` (or a list of such items); ``clean`` is always
     included first."""
     items = [s.strip() for s in (text.split(",") if isinstance(text, str) else text) if s.strip()]
+    if not items:  # "" ran the clean setting alone, a robustness study of nothing
+        raise InputError("--settings is empty: give clean, delay:K or noise:SIGMA_XYZ_M/SIGMA_RPY_DEG items")
     out: list[Setting] = [Setting()]
     for it in items:
         kind, _, val = it.partition(":")
