@@ -365,3 +365,35 @@ def test_recovered_recording_reads_back_with_rosbags_and_pycocotools(mixed_rec: 
         ], to
     assert read_bag(tmp_path / "ros2" / "edge_mixed") > 10
     check_coco(tmp_path / "coco")
+
+
+def _tree(folder: Path) -> dict[str, bytes]:
+    return {str(f.relative_to(folder)): f.read_bytes() for f in sorted(folder.rglob("*")) if f.is_file()}
+
+
+def test_overwrite_keeps_the_previous_conversion_until_the_new_one_is_complete(
+    lonely_rec: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``--overwrite`` deleted the previous conversion first: a new one failing halfway (here a full disk while a
+    frame is written) left neither. The new one is now written beside it and swapped in when complete."""
+    from mmusv.export.kitti import KittiWriter
+
+    out = tmp_path / "ds"
+    convert(lonely_rec, to="opv2v", out_dir=out, splits=None)
+    before = _tree(out)
+
+    def full_disk(self: Any, frame: Any) -> None:
+        raise OSError(28, "No space left on device")
+
+    with monkeypatch.context() as m:
+        m.setattr(KittiWriter, "write_frame", full_disk)
+        with pytest.raises(OSError, match="No space left"):
+            convert(lonely_rec, to="kitti", out_dir=out, splits=None, overwrite=True)
+    assert _tree(out) == before and load_report(out)["status"] == "complete"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ds"]  # no staging folder left beside it
+    # A staging folder of a killed conversion (its process gone) is cleared by the next one; a success swaps in.
+    stale = tmp_path / ".ds.converting-999999999"
+    stale.mkdir()
+    rep = convert(lonely_rec, to="kitti", out_dir=out, splits=None, overwrite=True)
+    assert rep.out_dir == out and load_report(out)["format"] == "kitti" and not (out / "opencood").exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ds"]

@@ -11,16 +11,17 @@ YOLO, SemanticKITTI: see their modules), plus ``conversion.yaml`` (options, sour
 frames converted and skipped; no times or absolute paths, so two conversions of the same input are
 byte-identical). ``conversion.yaml`` is written first with ``status: in_progress`` and rewritten at the end; an
 existing ``out_dir`` is replaced only with ``overwrite`` and only when it is empty or holds a previous conversion
-(its ``conversion.yaml``).
+(its ``conversion.yaml``), and then only once the new one is complete (written beside it, then swapped in).
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import shutil
 import time
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -174,10 +175,15 @@ def _as_list(recordings: str | Path | Iterable[str | Path]) -> list[Path]:
     return out
 
 
-def _prepare_out(out: Path, overwrite: bool, inputs: list[Path]) -> None:
+def _prepare_out(out: Path, overwrite: bool, inputs: list[Path]) -> Path:
+    """Checks ``out`` and returns the folder to write into: ``out`` itself (created), or, when ``overwrite``
+    replaces a previous conversion there, a staging folder beside it that :func:`_staged` swaps in once the new
+    conversion is complete, so that one failing halfway (a full disk) leaves the previous one as it was. Where
+    ``out`` cannot be swapped (it is, or holds, the working folder, e.g. ``-o .``; it is a link; its parent takes no
+    new folder) the previous conversion is emptied in place instead."""
     if out.exists() and not out.is_dir():
         raise IoError(f"output {out} exists and is not a folder")
-    # The output folder is emptied on --overwrite: it may not hold a recording being converted.
+    # The output folder is replaced on --overwrite: it may not hold a recording being converted.
     home = out.resolve()
     for p in inputs:
         where = p.resolve()
@@ -195,7 +201,17 @@ def _prepare_out(out: Path, overwrite: bool, inputs: list[Path]) -> None:
                 f"output folder {out} is not empty and holds no {REPORT_NAME} from a previous conversion; "
                 "refusing to delete it, choose another folder"
             )
-        # Empties the folder rather than removing it: it may be the working directory (``-o .``) or a link.
+        here = Path.cwd().resolve()
+        if not out.is_symlink() and home != here and home not in here.parents:
+            _remove_stale_stages(out)
+            stage = out.parent / f".{out.name}.converting-{os.getpid()}"
+            try:
+                if stage.exists():
+                    shutil.rmtree(stage)
+                stage.mkdir()
+                return stage
+            except OSError:
+                pass  # the parent takes no new folder: replaced in place
         for child in sorted(out.iterdir()):
             if child.is_dir() and not child.is_symlink():
                 shutil.rmtree(child)
@@ -205,6 +221,50 @@ def _prepare_out(out: Path, overwrite: bool, inputs: list[Path]) -> None:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise IoError(f"cannot create output folder {out}: {exc.strerror}") from None
+    return out
+
+
+def _remove_stale_stages(out: Path) -> None:
+    """Removes the staging and replaced folders beside ``out`` left by conversions that were killed (their process
+    no longer runs): ``.<name>.converting-<pid>`` and ``.<name>.replaced-<pid>``."""
+    for kind in ("converting", "replaced"):
+        for left in out.parent.glob(f".{out.name}.{kind}-*"):
+            pid = left.name.rpartition("-")[2]
+            if not pid.isdigit() or not left.is_dir() or left.is_symlink():
+                continue
+            try:
+                os.kill(int(pid), 0)
+            except ProcessLookupError:
+                shutil.rmtree(left, ignore_errors=True)
+            except (PermissionError, OverflowError, ValueError):
+                continue
+
+
+@contextlib.contextmanager
+def _staged(work: Path, out: Path) -> Iterator[None]:
+    """Around a conversion written into ``work`` (:func:`_prepare_out`): when that is a staging folder, swaps it in
+    for ``out`` on success (the previous conversion is removed only then) and removes it on failure (the previous
+    conversion stays)."""
+    if work == out:
+        yield
+        return
+    try:
+        yield
+    except BaseException:
+        shutil.rmtree(work, ignore_errors=True)
+        raise
+    old = out.parent / f".{out.name}.replaced-{os.getpid()}"
+    try:
+        os.replace(out, old)
+        try:
+            os.replace(work, out)
+        except OSError:
+            os.replace(old, out)
+            raise
+    except OSError as exc:
+        shutil.rmtree(work, ignore_errors=True)
+        raise IoError(f"cannot replace {out} with the new conversion: {exc.strerror or exc}") from None
+    shutil.rmtree(old, ignore_errors=True)
 
 
 def _ranges(frames: list[int]) -> list[tuple[int, int]]:
@@ -309,7 +369,7 @@ def convert(
     split_of: dict[str, str | None] = dict.fromkeys(folders)
     if ratios is not None:
         split_of = dict(assign_splits(folders, ratios, seed))
-    _prepare_out(out, overwrite, [Path(i.path) for i in infos])
+    work = _prepare_out(out, overwrite, [Path(i.path) for i in infos])
     reports = [
         RecordingReport(path=i.path, scenario=i.scenario_name, folder=f, split=split_of[f])
         for i, f in zip(infos, folders, strict=True)
@@ -325,88 +385,91 @@ def convert(
             "seed": seed,
         },
     }
-    (out / REPORT_NAME).write_bytes(dump_yaml({**header, "status": "in_progress"}))
-    sink = Sink()
-    shared = cls.start(out, options, sink)
-    report = ConvertReport(out_dir=out, target=to, recordings=reports)
-    expected = sum(int(i.run.get("frames_written", i.frames_configured) or 0) for i in infos)
-    done = 0
-    order = sorted(
-        range(len(infos)), key=lambda j: (SPLIT_NAMES.index(reports[j].split) if reports[j].split else 0, folders[j])
-    )
-    for j in order:
-        info, rep = infos[j], reports[j]
-        folder = out / rep.split / rep.folder if rep.split else out / rep.folder
-        if cls.owns_folder:
-            sink.mkdir(folder)
-        writer = cls(info, folder, options, sink, split=rep.split, shared=shared)
-        wanted = writer.topic_filter()
-        stream = FrameStream(info, wanted.__contains__)
-        converted: list[int] = []
-        incomplete: list[tuple[int, str]] = []
-        for fr in stream:
-            missing = writer.missing(fr)
-            if fr.world is None or missing or not writer.agents:
-                why = (
-                    writer.no_agent_reason
-                    if not writer.agents
-                    else f"incomplete: missing {', '.join(missing[:4])}"
-                    + (f" and {len(missing) - 4} more" if len(missing) > 4 else "")
-                )
-                incomplete.append((fr.index, why))
-            else:
-                writer.write_frame(fr)
-                converted.append(fr.index)
-                report.agent_frames += len(writer.agents)
-            done += 1
-            if progress is not None:
-                progress(done, max(expected, done))
-        rep.status = stream.run.get("status", "unfinished (no run metadata)")
-        for k, why in incomplete:
-            rep.skipped.append({"frames": [k, k], "reason": why})
-        seen = set(converted) | {k for k, _ in incomplete}
-        # the frames the run set out to write: --frames N cuts a run short on purpose, those after N are not missing
-        configured = int(
-            stream.run.get("frames_requested", stream.run.get("frames_configured", info.frames_configured)) or 0
+    with _staged(work, out):
+        (work / REPORT_NAME).write_bytes(dump_yaml({**header, "status": "in_progress"}))
+        sink = Sink()
+        shared = cls.start(work, options, sink)
+        report = ConvertReport(out_dir=out, target=to, recordings=reports)
+        expected = sum(int(i.run.get("frames_written", i.frames_configured) or 0) for i in infos)
+        done = 0
+        order = sorted(
+            range(len(infos)),
+            key=lambda j: (SPLIT_NAMES.index(reports[j].split) if reports[j].split else 0, folders[j]),
         )
-        first = int(stream.run.get("first_frame", 0) or 0)  # one part of a split recording given alone
-        absent = [k for k in range(first, first + configured) if k not in seen]
-        if absent:
-            written = stream.run.get("frames_written")
-            why = (
-                f"not in the recording (run {rep.status}: {written} of {configured} frames written)"
-                if written is not None
-                else f"not in the recording (the run did not finish; {configured} frames configured)"
-            )
-            if stream.truncated:
-                why += "; " + stream.truncated
-            rep.skipped += [{"frames": [a, b], "reason": why} for a, b in _ranges(absent)]
-        elif stream.truncated:
-            rep.notes.append(stream.truncated)
-        if stream.out_of_order:
-            rep.notes.append(f"frames {sorted(set(stream.out_of_order))} appear more than once; the last copy was kept")
-        rep.skipped.sort(key=lambda s: s["frames"][0])
-        writer.finish(sorted(converted), rep.skipped)
-        rep.notes += writer.notes
-        rep.frames_converted = len(converted)
-        if converted:
-            rep.first_frame, rep.last_frame = min(converted), max(converted)
-        else:
-            rep.notes.append("no complete frame: nothing written for this recording")
+        for j in order:
+            info, rep = infos[j], reports[j]
+            folder = work / rep.split / rep.folder if rep.split else work / rep.folder
             if cls.owns_folder:
-                shutil.rmtree(folder, ignore_errors=True)
-    cls.finish_all(shared, out, sink)
-    doc = {
-        **header,
-        "status": "complete",
-        "frames_converted": report.frames,
-        "agent_frames": report.agent_frames,
-        "recordings": [r.as_dict() for r in sorted(reports, key=lambda r: (r.split or "", r.folder))],
-    }
-    data = dump_yaml(doc)
-    (out / REPORT_NAME).write_bytes(data)
-    report.files = sink.files + 1
-    report.bytes = sink.bytes + len(data)
+                sink.mkdir(folder)
+            writer = cls(info, folder, options, sink, split=rep.split, shared=shared)
+            wanted = writer.topic_filter()
+            stream = FrameStream(info, wanted.__contains__)
+            converted: list[int] = []
+            incomplete: list[tuple[int, str]] = []
+            for fr in stream:
+                missing = writer.missing(fr)
+                if fr.world is None or missing or not writer.agents:
+                    why = (
+                        writer.no_agent_reason
+                        if not writer.agents
+                        else f"incomplete: missing {', '.join(missing[:4])}"
+                        + (f" and {len(missing) - 4} more" if len(missing) > 4 else "")
+                    )
+                    incomplete.append((fr.index, why))
+                else:
+                    writer.write_frame(fr)
+                    converted.append(fr.index)
+                    report.agent_frames += len(writer.agents)
+                done += 1
+                if progress is not None:
+                    progress(done, max(expected, done))
+            rep.status = stream.run.get("status", "unfinished (no run metadata)")
+            for k, why in incomplete:
+                rep.skipped.append({"frames": [k, k], "reason": why})
+            seen = set(converted) | {k for k, _ in incomplete}
+            # the frames the run set out to write: --frames N cuts a run short on purpose, those after N are not missing
+            configured = int(
+                stream.run.get("frames_requested", stream.run.get("frames_configured", info.frames_configured)) or 0
+            )
+            first = int(stream.run.get("first_frame", 0) or 0)  # one part of a split recording given alone
+            absent = [k for k in range(first, first + configured) if k not in seen]
+            if absent:
+                written = stream.run.get("frames_written")
+                why = (
+                    f"not in the recording (run {rep.status}: {written} of {configured} frames written)"
+                    if written is not None
+                    else f"not in the recording (the run did not finish; {configured} frames configured)"
+                )
+                if stream.truncated:
+                    why += "; " + stream.truncated
+                rep.skipped += [{"frames": [a, b], "reason": why} for a, b in _ranges(absent)]
+            elif stream.truncated:
+                rep.notes.append(stream.truncated)
+            if stream.out_of_order:
+                again = sorted(set(stream.out_of_order))
+                rep.notes.append(f"frames {again} appear more than once; the last copy was kept")
+            rep.skipped.sort(key=lambda s: s["frames"][0])
+            writer.finish(sorted(converted), rep.skipped)
+            rep.notes += writer.notes
+            rep.frames_converted = len(converted)
+            if converted:
+                rep.first_frame, rep.last_frame = min(converted), max(converted)
+            else:
+                rep.notes.append("no complete frame: nothing written for this recording")
+                if cls.owns_folder:
+                    shutil.rmtree(folder, ignore_errors=True)
+        cls.finish_all(shared, work, sink)
+        doc = {
+            **header,
+            "status": "complete",
+            "frames_converted": report.frames,
+            "agent_frames": report.agent_frames,
+            "recordings": [r.as_dict() for r in sorted(reports, key=lambda r: (r.split or "", r.folder))],
+        }
+        data = dump_yaml(doc)
+        (work / REPORT_NAME).write_bytes(data)
+        report.files = sink.files + 1
+        report.bytes = sink.bytes + len(data)
     report.seconds = time.perf_counter() - t0
     return report
 
