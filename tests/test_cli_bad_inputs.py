@@ -93,7 +93,7 @@ def test_output_folders_under_a_file_are_named_as_the_option_before_any_work(
     afile = tmp_path / "afile"
     afile.write_text("not a folder\n", encoding="utf-8")
     out, err = _refused(["assets", "--render", str(afile / "sheet")], capsys)
-    assert err.startswith(f"mmusv: error: --render {afile / 'sheet'}: cannot create the folder"), err
+    assert err.startswith(f"mmusv: error: --render {afile / 'sheet'}: {afile} is a file, not a folder"), err
     assert out == ""  # the table was printed before the folder was refused
     for argv in (
         ["generate", SPEC, "-o", str(afile)],

@@ -110,7 +110,7 @@ def _ready_output(output: str, *, flag: str = "-o/--output") -> None:
     (as ``flag``) at once, not after the computing."""
     from mmusv.errors import IoError
 
-    output_arg(output, flag=flag)
+    check_output_folder(output, flag=flag)  # a file there (or above) is named as such, not as "File exists"
     try:
         Path(output).mkdir(parents=True, exist_ok=True)
     except OSError as exc:
