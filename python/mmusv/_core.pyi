@@ -43,6 +43,7 @@ __all__ = [
     "lidar_trace_order",
     "pinhole_intrinsics",
     "response_variance",
+    "sea_limits",
     "sea_presets",
     "sea_seed",
     "surface_tiles",
@@ -621,6 +622,9 @@ def sea_seed(scenario_seed: int) -> int:
 
 def sea_presets() -> list[tuple[str, str, float, float, float, float]]:
     """[(name, description, hs_m, tp_s, gamma, wind_mps), ...]: WMO codes "0".."9", then "W0".."W3"."""
+
+def sea_limits() -> dict[str, tuple[float, float]]:
+    """``{"hs_m": (lo, hi), "tp_s": (lo, hi)}``: the significant heights (m) and peak periods (s) a sea takes."""
 
 def fully_developed(hs_m: float) -> tuple[float, float]:
     """(tp_s, wind_mps) of a fully developed Pierson–Moskowitz sea."""

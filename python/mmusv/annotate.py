@@ -6,10 +6,11 @@ For every agent (USV) and frame, for every other vessel (the agent's own hull is
 * the vessel's ``role`` (``target``, ``usv`` — another instrumented USV, never a detection target — or
   ``moored``) and ``static`` flag (moored ships, and scenario vessels that never move), so users can filter;
 * an ego-centric BEV box: the 3D box's footprint in the LiDAR frame's xy plane (x, y, length, width, yaw);
-* per pinhole camera, a 2D box: the projected 3D-box corners (edges clipped at the near plane), clipped to the
-  image, with ``truncation`` = 1 − clipped area / unclipped area, ``visible_pixels`` (pixels whose instance is
-  the vessel), ``box_pixels`` (the clipped box area) and ``occlusion`` = 1 − visible / silhouette, where the
-  silhouette is the vessel's pixels with everything else removed (its rays cast against the vessel alone).
+* per pinhole camera, a 2D box: the projected 3D-box corners (edges clipped at the near plane; through a camera's
+  lens distortion, the projected edges), clipped to the image, with ``truncation`` = 1 − clipped area / unclipped
+  area, ``visible_pixels`` (pixels whose instance is the vessel), ``box_pixels`` (the clipped box area) and
+  ``occlusion`` = 1 − visible / silhouette, where the silhouette is the vessel's pixels with everything else
+  removed (its rays cast against the vessel alone).
 * over a displaced sea (a scene with a wave surface), per 3D box and per 2D box, ``wave_occlusion``: the share of
   the vessel's part above the still water level that the water hides from that sensor (:mod:`mmusv.wave_occlusion`);
   0 over a flat sea.
@@ -163,22 +164,72 @@ class SilhouetteCache:
         return scene.cast_rays(origins, directions).distance
 
 
-def _project_box(corners_opt: np.ndarray, k: tuple[float, float, float, float]) -> np.ndarray | None:
+EDGE_STEPS = 32
+"""Pieces each box edge is cut into for a camera with lens distortion, which bends the edges' images."""
+
+
+def _project_box(
+    corners_opt: np.ndarray, k: tuple[float, float, float, float], lens: tuple[np.ndarray, float] | None = None
+) -> np.ndarray | None:
     """Pixel bounding box ``[x0, y0, x1, y1]`` of a box given by its corners in the optical frame, with edges
-    clipped at the near plane; ``None`` when the box is entirely behind the camera."""
+    clipped at the near plane; ``None`` when the box is entirely behind the camera. ``lens``: the camera's
+    Brown–Conrady coefficients and reach (:func:`_lens`), or ``None`` for an ideal pinhole, where the corners
+    alone bound the image; through a lens the box's edges are sampled (their images are curves)."""
     fx, fy, cx, cy = k
     pts = [c for c in corners_opt if c[2] >= NEAR_M]
+    ends = []
     for a, b in _EDGES:
-        za, zb = corners_opt[a, 2], corners_opt[b, 2]
+        pa, pb = corners_opt[a], corners_opt[b]
+        za, zb = pa[2], pb[2]
         if (za - NEAR_M) * (zb - NEAR_M) < 0:
-            t = (NEAR_M - za) / (zb - za)
-            pts.append(corners_opt[a] + t * (corners_opt[b] - corners_opt[a]))
+            cut = pa + (NEAR_M - za) / (zb - za) * (pb - pa)
+            pts.append(cut)
+            ends.append((pa, cut) if za >= NEAR_M else (cut, pb))
+        elif za >= NEAR_M and zb >= NEAR_M:
+            ends.append((pa, pb))
     if not pts:
         return None
-    p = np.array(pts)
-    u = fx * p[:, 0] / p[:, 2] + cx
-    v = fy * p[:, 1] / p[:, 2] + cy
+    if lens is None:
+        p = np.array(pts)
+        u = fx * p[:, 0] / p[:, 2] + cx
+        v = fy * p[:, 1] / p[:, 2] + cy
+    else:
+        t = np.linspace(0.0, 1.0, EDGE_STEPS + 1)[:, None]
+        p = np.concatenate([pa + t * (pb - pa) for pa, pb in ends])
+        x, y = _distort(p[:, 0] / p[:, 2], p[:, 1] / p[:, 2], *lens)
+        u = fx * x + cx
+        v = fy * y + cy
     return np.array([u.min(), v.min(), u.max(), v.max()])
+
+
+def _lens(cam: Any, pose: np.ndarray, world_to_body: np.ndarray) -> tuple[np.ndarray, float] | None:
+    """A pinhole camera's Brown–Conrady coefficients ``[k1, k2, p1, p2, k3]`` and reach (the largest undistorted
+    normalised radius its image corners see, from the camera's own corner rays), or ``None`` without distortion.
+    Within the reach the camera's distortion maps every point to the pixel whose ray meets it; beyond it, where the
+    polynomial may fold back into the image, points are carried radially outwards, outside the image."""
+    if cam.distortion is None:
+        return None
+    w, h = cam.resolution
+    corners = np.array([0, w - 1, (h - 1) * w, h * w - 1], dtype=np.int64)
+    _, d = cam.pixel_rays(pose, corners)
+    opt = np.asarray(d, dtype=np.float64) @ world_to_body[:3, :3].T @ BODY_TO_OPTICAL.T
+    reach = float(np.max(np.hypot(opt[:, 0], opt[:, 1]) / opt[:, 2]))
+    # A single pixel's centre is the image centre: nothing to fold past, the polynomial alone.
+    return np.asarray(cam.distortion, dtype=np.float64), reach if reach > 0.0 else np.inf
+
+
+def _distort(x: np.ndarray, y: np.ndarray, coefficients: np.ndarray, reach: float) -> tuple[np.ndarray, np.ndarray]:
+    """Distorted normalised coordinates of undistorted ``(x, y)`` (OpenCV's Brown–Conrady, as the core's
+    ``Distortion::distort``); a point beyond ``reach`` is distorted at the reach and scaled back out radially."""
+    k1, k2, p1, p2, k3 = coefficients
+    r = np.hypot(x, y)
+    s = np.where(r > reach, reach / np.maximum(r, 1e-300), 1.0)
+    x, y = x * s, y * s
+    r2 = x * x + y * y
+    radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))
+    xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x)
+    yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y
+    return xd / s, yd / s
 
 
 def annotate_agent(
@@ -223,11 +274,11 @@ def annotate_agent(
         ids, cnt = np.unique(lidar_instances, return_counts=True)
         counts = {int(i): int(c) for i, c in zip(ids, cnt, strict=True)}
     # Per pinhole camera, once: intrinsics, the world → camera-body transform and the pose as the binding takes it.
-    views = {
-        name: (cam, cam.intrinsics, np.linalg.inv(pose), np.ascontiguousarray(pose, dtype=np.float64), inst_img)
-        for name, (cam, pose, inst_img) in cameras.items()
-        if cam.intrinsics is not None
-    }
+    views = {}
+    for name, (cam, pose, inst_img) in cameras.items():
+        if cam.intrinsics is not None:
+            inv, p = np.linalg.inv(pose), np.ascontiguousarray(pose, dtype=np.float64)
+            views[name] = (cam, cam.intrinsics, inv, p, inst_img, _lens(cam, p, inv))
     rotations: list[np.ndarray] = []  # the 3D boxes' rotation matrices, turned into quaternions in one call
     for vi, info in enumerate(vessels):
         if vi == agent_index:
@@ -257,10 +308,10 @@ def annotate_agent(
                 wave = share(*exposed_hidden(scene, o, d, t, scene_instance=first, max_range_m=max_range_m))
             ann.lidar_wave_occlusion.append(wave)
         corners_world = box_corners(box_world, info.box_size)
-        for name, (cam, k, inv, pose, inst_img) in views.items():
+        for name, (cam, k, inv, pose, inst_img, lens) in views.items():
             h, w = inst_img.shape
             body = corners_world @ inv[:3, :3].T + inv[:3, 3]
-            box = _project_box(body @ BODY_TO_OPTICAL.T, k)
+            box = _project_box(body @ BODY_TO_OPTICAL.T, k, lens)
             if box is None:
                 continue
             area = max(box[2] - box[0], 0.0) * max(box[3] - box[1], 0.0)

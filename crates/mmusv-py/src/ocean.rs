@@ -197,6 +197,17 @@ fn fully_developed(hs_m: f64) -> PyResult<(f64, f64)> {
     Ok(presets::fully_developed(hs_m))
 }
 
+/// `{"hs_m": (lo, hi), "tp_s": (lo, hi)}`: the significant heights (m) and peak periods (s) a sea takes
+/// (mmusv_core::ocean::field: their one definition, which the scenario schema reads).
+#[pyfunction]
+fn sea_limits(py: Python<'_>) -> PyResult<Bound<'_, pyo3::types::PyDict>> {
+    use mmusv_core::ocean::field::{HS_RANGE_M, TP_RANGE_S};
+    let d = pyo3::types::PyDict::new(py);
+    d.set_item("hs_m", HS_RANGE_M)?;
+    d.set_item("tp_s", TP_RANGE_S)?;
+    Ok(d)
+}
+
 /// DNV-RP-C205 peak enhancement γ for `hs_m`, `tp_s`.
 #[pyfunction]
 fn dnv_gamma(hs_m: f64, tp_s: f64) -> f64 {
@@ -258,6 +269,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sea_seed, m)?)?;
     m.add_function(wrap_pyfunction!(sea_presets, m)?)?;
     m.add_function(wrap_pyfunction!(fully_developed, m)?)?;
+    m.add_function(wrap_pyfunction!(sea_limits, m)?)?;
     m.add_function(wrap_pyfunction!(dnv_gamma, m)?)?;
     m.add_function(wrap_pyfunction!(hull_rao, m)?)?;
     m.add_function(wrap_pyfunction!(response_variance, m)?)?;

@@ -38,8 +38,9 @@ _WEATHER: tuple[str, ...] = ("clear", "overcast", "fog", "rain")
 _TIME_RE = re.compile(r"^(\d{1,2}):(\d{2})$")
 
 
-MAX_WAVE_HEIGHT_M = 25.0
-"""Highest wave height a scenario may give, metres (the physical sea's ``hs_m`` bound too)."""
+MAX_WAVE_HEIGHT_M: float = core.sea_limits()["hs_m"][1]
+"""Highest wave height a scenario may give, metres: the physical sea's ``hs_m`` bound (``ocean::field::HS_RANGE_M``,
+25 m)."""
 
 
 def wave_height_m(wave: str | float) -> float:

@@ -26,10 +26,13 @@ from mmusv import arguments
 from mmusv._native import core
 from mmusv.errors import ConfigError
 
-__all__ = ["SEA_PRESETS", "SeaPreset", "SeaSpec", "sea_spec_for_height", "sea_spec_for_preset"]
+__all__ = ["MIN_TP_S", "SEA_PRESETS", "SeaPreset", "SeaSpec", "sea_spec_for_height", "sea_spec_for_preset"]
 
 DEFAULT_SPREAD_S = 10.0
 """cos-2s exponent of the presets (wind sea, Goda 1985)."""
+MIN_TP_S: float = core.sea_limits()["tp_s"][0]
+"""Shortest peak period the core's sea takes, seconds (``ocean::field::TP_RANGE_S``, 0.5 s): the fully developed
+period of a sea below about 1 cm (Tp = 4.99 √Hs) is raised to it."""
 
 
 class SeaPreset(NamedTuple):
@@ -94,10 +97,11 @@ def sea_spec_for_height(
     direction_deg: float = 0.0,
     spread_s: float = DEFAULT_SPREAD_S,
 ) -> SeaSpec:
-    """The sea of a significant height ``hs_m``: fully developed (Pierson–Moskowitz) unless ``tp_s`` is given;
-    ``gamma`` defaults to 1 for a fully developed sea and to DNV-RP-C205's ``exp(5.75 − 1.15 Tp/√Hs)`` (in [1, 5])
-    for a given period. Every value is a real number; a sea outside the core's ranges is a
-    :class:`~mmusv.errors.ConfigError` naming the field (checked here, not first when the sea is used)."""
+    """The sea of a significant height ``hs_m``: fully developed (Pierson–Moskowitz; at least :data:`MIN_TP_S`, for
+    ripples below about 1 cm) unless ``tp_s`` is given; ``gamma`` defaults to 1 for a fully developed sea and to
+    DNV-RP-C205's ``exp(5.75 − 1.15 Tp/√Hs)`` (in [1, 5]) for a given period. Every value is a real number; a sea
+    outside the core's ranges is a :class:`~mmusv.errors.ConfigError` naming the field (checked here, not first when
+    the sea is used)."""
     hs_m = arguments.real(hs_m, name="invalid config hs_m", unit="metres")
     if tp_s is not None:
         tp_s = arguments.real(tp_s, name="invalid config tp_s", unit="seconds")
@@ -105,6 +109,7 @@ def sea_spec_for_height(
         gamma = arguments.real(gamma, name="invalid config gamma")
     if tp_s is None:
         tp, _ = core.fully_developed(hs_m)
+        tp = max(tp, MIN_TP_S)  # every height in 0..25 m has a sea (Hs = 1 cm alone would give 0.499 s)
         g = 1.0 if gamma is None else gamma
     else:
         tp = tp_s

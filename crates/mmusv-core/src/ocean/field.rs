@@ -54,6 +54,11 @@ pub const COMPONENTS_RANGE: [usize; 2] = [8, 4096];
 /// 1/15 as the upper end of observed average seas).
 pub const MAX_STEEPNESS: f64 = 1.0 / 7.0;
 
+/// Significant wave heights a [`SeaSpec`] takes, metres (0: a flat sea).
+pub const HS_RANGE_M: (f64, f64) = (0.0, 25.0);
+/// Peak periods a [`SeaSpec`] takes, seconds.
+pub const TP_RANGE_S: (f64, f64) = (0.5, 30.0);
+
 /// The sea state: a directional JONSWAP spectrum.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SeaSpec {
@@ -74,11 +79,20 @@ impl SeaSpec {
     /// Checks every field; errors are [`MmusvError::Config`] naming `hs_m`, `tp_s`, `gamma`, `direction_rad`
     /// or `spread_s` and the allowed range.
     pub fn validate(&self) -> Result<()> {
-        if !self.hs.is_finite() || !(0.0..=25.0).contains(&self.hs) {
-            return Err(MmusvError::config("hs_m", self.hs, "must be a significant wave height in [0, 25] m"));
+        let (hs, tp) = (HS_RANGE_M, TP_RANGE_S);
+        if !self.hs.is_finite() || !(hs.0..=hs.1).contains(&self.hs) {
+            return Err(MmusvError::config(
+                "hs_m",
+                self.hs,
+                format!("must be a significant wave height in [{}, {}] m", hs.0, hs.1),
+            ));
         }
-        if !self.tp.is_finite() || !(0.5..=30.0).contains(&self.tp) {
-            return Err(MmusvError::config("tp_s", self.tp, "must be a peak period in [0.5, 30] s"));
+        if !self.tp.is_finite() || !(tp.0..=tp.1).contains(&self.tp) {
+            return Err(MmusvError::config(
+                "tp_s",
+                self.tp,
+                format!("must be a peak period in [{}, {}] s", tp.0, tp.1),
+            ));
         }
         if !self.direction_rad.is_finite() {
             return Err(MmusvError::config("direction_rad", self.direction_rad, "must be a finite angle in radians"));
