@@ -47,6 +47,7 @@ __all__ = [
     "Finding",
     "build_constraints",
     "first_failure",
+    "separation_words",
 ]
 
 _PAIR_BLOCK = 262_144
@@ -194,13 +195,21 @@ class Separation:
             mid = (s.motion[k, a] + s.motion[k, b]) / 2.0
             out.append(
                 Finding(
-                    f"{s.ids[a]} and {s.ids[b]} come {hull_at[j]:.1f} m apart (hulls) at t={s.times[k]:.1f} s; "
+                    f"{s.ids[a]} and {s.ids[b]} {separation_words(float(hull_at[j]))} at t={s.times[k]:.1f} s; "
                     f"need {self.min_m:g} m",
                     (s.ids[a], s.ids[b]),
                     (float(mid[0]), float(mid[1])),
                 )
             )
         return out
+
+
+def separation_words(hull_m: float) -> str:
+    """How two hulls ``hull_m`` metres apart are said: "come 3.2 m apart (hulls)", or, below 0, "overlap by 33.7 m
+    (hulls)" (a negative distance read as "come -33.7 m apart")."""
+    if hull_m < 0.0:
+        return f"overlap by {-hull_m:.1f} m (hulls)"
+    return f"come {hull_m:.1f} m apart (hulls)"
 
 
 class RouteSeparation:
