@@ -450,6 +450,24 @@ def test_bad_parameters_are_rejected_naming_the_field(kind: str, params: dict[st
     assert field in str(err.value) and "allowed" in str(err.value)
 
 
+@pytest.mark.parametrize(
+    ("kind", "params", "field", "said"),
+    [
+        ("port", {"draft_margin_m": 12.0}, "basin_depth_m", "lower bound is draft_margin_m + 3"),
+        ("island", {"extent_m": 200.0}, "island_radius_m", "upper bound is extent_m / 2"),
+        ("open_sea", {"extent_m": 200.0, "islet_radius_m": (30.0, 60.0)}, "islet_radius_m", "extent_m / 4"),
+    ],
+)
+def test_a_default_out_of_a_range_set_by_another_knob_says_which(
+    kind: str, params: dict[str, Any], field: str, said: str
+) -> None:
+    """A knob left at its default whose range another knob moved was blamed alone ("basin_depth_m = 14: must be in
+    [15, 40]" for draft_margin_m = 12, which the user did set): the message now says where the bound comes from."""
+    with pytest.raises(MapConfigError) as err:
+        generate_map(kind, seed=0, **params)
+    assert err.value.field == field and said in str(err.value), str(err.value)
+
+
 def test_unknown_kind_lists_the_kinds_and_bad_seed_is_rejected() -> None:
     with pytest.raises(MapConfigError, match=r"island \| open_sea \| port"):
         make_params("volcano")

@@ -55,20 +55,27 @@ class MapConfigError(ConfigError, ValueError):  # type: ignore[misc,unused-ignor
         self.allowed = allowed
 
 
-def _within(value: float, lo: float, hi: float, *, integer: bool = False) -> float:
-    """``value`` if ``lo <= value <= hi``, else a ``ValueError`` saying the range."""
+def _within(value: float, lo: float, hi: float, *, integer: bool = False, bounds: str = "") -> float:
+    """``value`` if ``lo <= value <= hi``, else a ``ValueError`` saying the range; ``bounds`` says where a range
+    that depends on other knobs comes from (``"the upper bound is extent_m / 4"``), so that a value the user never
+    set (a default) is not blamed alone."""
     if not lo <= value <= hi:
         kind = "an integer" if integer else "a number"
-        raise ValueError(f"must be {kind} in [{lo:g}, {hi:g}]")
+        raise ValueError(f"must be {kind} in [{lo:g}, {hi:g}]" + (f" ({bounds})" if bounds else ""))
     return value
 
 
-def _pair(value: tuple[float, float], lo: float, hi: float) -> tuple[float, float]:
-    """``(a, b)`` if ``lo <= a <= b <= hi``, else a ``ValueError`` saying so."""
+def _pair(value: tuple[float, float], lo: float, hi: float, *, bounds: str = "") -> tuple[float, float]:
+    """``(a, b)`` if ``lo <= a <= b <= hi``, else a ``ValueError`` saying so (``bounds`` as for :func:`_within`)."""
     a, b = value
     if not lo <= a <= b <= hi:
-        raise ValueError(f"must be two numbers [a, b] with {lo:g} <= a <= b <= {hi:g}")
+        raise ValueError(
+            f"must be two numbers [a, b] with {lo:g} <= a <= b <= {hi:g}" + (f" ({bounds})" if bounds else "")
+        )
     return value
+
+
+_EXTENT = "the upper bound is extent_m / {}: set this knob too, or raise extent_m"
 
 
 def _known(info: ValidationInfo, *names: str) -> bool:
@@ -113,7 +120,9 @@ class _CommonParams(BaseModel):
     @field_validator("clearance_m")
     @classmethod
     def _clearance(cls, v: float, info: ValidationInfo) -> float:
-        return _within(v, 0.0, info.data["extent_m"] / 4.0) if _known(info, "extent_m") else v
+        if not _known(info, "extent_m"):
+            return v
+        return _within(v, 0.0, info.data["extent_m"] / 4.0, bounds=_EXTENT.format(4))
 
 
 class IslandParams(_CommonParams):
@@ -135,7 +144,7 @@ class IslandParams(_CommonParams):
     @field_validator("island_radius_m")
     @classmethod
     def _radius(cls, v: tuple[float, float], info: ValidationInfo) -> tuple[float, float]:
-        return _pair(v, 15.0, info.data["extent_m"] / 2.0) if _known(info, "extent_m") else v
+        return _pair(v, 15.0, info.data["extent_m"] / 2.0, bounds=_EXTENT.format(2)) if _known(info, "extent_m") else v
 
     @field_validator("island_height_m")
     @classmethod
@@ -145,7 +154,9 @@ class IslandParams(_CommonParams):
     @field_validator("min_gap_m")
     @classmethod
     def _gap(cls, v: float, info: ValidationInfo) -> float:
-        return _within(v, 0.0, info.data["extent_m"] / 2.0) if _known(info, "extent_m") else v
+        if not _known(info, "extent_m"):
+            return v
+        return _within(v, 0.0, info.data["extent_m"] / 2.0, bounds=_EXTENT.format(2))
 
 
 class OpenSeaParams(_CommonParams):
@@ -162,7 +173,7 @@ class OpenSeaParams(_CommonParams):
     @field_validator("islet_radius_m")
     @classmethod
     def _radius(cls, v: tuple[float, float], info: ValidationInfo) -> tuple[float, float]:
-        return _pair(v, 10.0, info.data["extent_m"] / 4.0) if _known(info, "extent_m") else v
+        return _pair(v, 10.0, info.data["extent_m"] / 4.0, bounds=_EXTENT.format(4)) if _known(info, "extent_m") else v
 
     @field_validator("islet_height_m")
     @classmethod
@@ -255,7 +266,10 @@ class PortParams(_CommonParams):
     @field_validator("basin_depth_m")
     @classmethod
     def _basin(cls, v: float, info: ValidationInfo) -> float:
-        return _within(v, info.data["draft_margin_m"] + 3.0, 40.0) if _known(info, "draft_margin_m") else v
+        if not _known(info, "draft_margin_m"):
+            return v
+        why = "the lower bound is draft_margin_m + 3: set basin_depth_m too, or lower draft_margin_m"
+        return _within(v, info.data["draft_margin_m"] + 3.0, 40.0, bounds=why)
 
     @field_validator("n_piers")
     @classmethod
