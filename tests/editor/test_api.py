@@ -83,6 +83,7 @@ def test_info_gives_the_choices_of_the_schema(client: TestClient) -> None:
     assert info["version"] == mmusv.__version__
     assert info["choices"]["map_type"] == ["island", "open_sea", "port"]
     assert info["choices"]["end"] == ["stop", "loop", "ping_pong"]
+    assert info["choices"]["camera_quality"] == ["draft", "standard", "high"]
     assert [w["name"] for w in info["choices"]["wave"]] == ["W0", "W1", "W2", "W3"]
     assert info["initial"] is None and info["limits"]["bulk_frames"] == MAX_BULK_FRAMES
 

@@ -254,6 +254,21 @@ def test_preview_frame(browser: Any, live_server: LiveServer) -> None:
     browser.find_element(By.ID, "preview-close").click()
 
 
+def test_rig_camera_quality_is_set_and_cleared(browser: Any, live_server: LiveServer) -> None:
+    """The rig panel's camera quality writes the rig's ``quality`` (every camera and top view of the rig that sets
+    none of its own) and "default" takes it out again."""
+    from selenium.webdriver.support.select import Select
+
+    open_editor(browser, live_server)
+    css = '#rigs [data-rig="usv_standard"] select[data-key="quality"]'
+    Select(browser.find_element(By.CSS_SELECTOR, css)).select_by_value("draft")
+    settled(browser)
+    assert document_of(browser)["rigs"]["usv_standard"] == {"quality": "draft"}
+    Select(browser.find_element(By.CSS_SELECTOR, css)).select_by_value("default")
+    settled(browser)
+    assert document_of(browser)["rigs"]["usv_standard"] == {}
+
+
 def test_run_in_the_background(browser: Any, live_server: LiveServer) -> None:
     open_editor(browser, live_server)
     preset = browser.find_element(By.CSS_SELECTOR, '#rigs [data-rig="usv_standard"] select[data-key="preset"]')

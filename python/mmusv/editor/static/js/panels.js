@@ -355,8 +355,9 @@ export class Panels {
         ["LiDAR channels", "number", lidar?.channels ?? "", null, "default"],
         ["LiDAR range m", "number", lidar?.range_m ?? "", null, "default"],
         ["radar", "select", radarOn ? "on" : "off", ["on", "off"]],
+        ["camera quality", "select", rig.quality || "default", ["default", ...this.state.choices.camera_quality]],
       ];
-      const keys = ["preset", "lidar.channels", "lidar.range_m", "radar"];
+      const keys = ["preset", "lidar.channels", "lidar.range_m", "radar", "quality"];
       fields.forEach(([label, kind, value, options, placeholder], i) => {
         const l = document.createElement("label");
         l.textContent = label;
@@ -391,6 +392,10 @@ export class Panels {
       if (key === "preset") {
         if (input.value === "full") delete rig.preset;
         else rig.preset = input.value;
+      } else if (key === "quality") {
+        // every camera and top view of the rig that does not set its own (default: each camera's, standard)
+        if (input.value === "default") delete rig.quality;
+        else rig.quality = input.value;
       } else if (key === "radar") {
         const full = (rig.preset || "full") === "full";
         if (input.value === "off") {
