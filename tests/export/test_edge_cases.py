@@ -397,3 +397,41 @@ def test_overwrite_keeps_the_previous_conversion_until_the_new_one_is_complete(
     rep = convert(lonely_rec, to="kitti", out_dir=out, splits=None, overwrite=True)
     assert rep.out_dir == out and load_report(out)["format"] == "kitti" and not (out / "opencood").exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["ds"]
+
+
+def test_agents_and_frames_select_what_is_converted(mixed_rec: Path, tmp_path: Path) -> None:
+    """``agents`` and ``frames`` (``--agents``, ``--frames``) convert a part of a recording: the other agents'
+    folders are not written, the frames outside the range are neither converted nor reported missing, and the
+    selection is in ``conversion.yaml``; a selection the recordings cannot honour is refused up front."""
+    from mmusv.cli import main
+
+    rep = convert(mixed_rec, to="kitti", out_dir=tmp_path / "b", splits=None, agents=["usv_b"], frames="1:")
+    assert rep.frames == 1 and rep.agent_frames == 1
+    scen = tmp_path / "b" / "edge_mixed"
+    # usv_b (vessel index 2), not usv_a (1000)
+    assert sorted(p.name for p in scen.iterdir()) == ["1002", "mmusv_kitti.yaml"]
+    assert yaml.safe_load((scen / "mmusv_kitti.yaml").read_text())["agents"] == {1002: "usv_b"}
+    assert sorted(p.name for p in (scen / "1002" / "label_2").iterdir()) == ["000001.txt"]
+    doc = load_report(tmp_path / "b")
+    assert doc["options"]["agents"] == ["usv_b"] and doc["options"]["frames"] == [1, None]
+    assert doc["recordings"][0]["skipped"] == []
+    rep = convert(mixed_rec, to="opv2v", out_dir=tmp_path / "o", splits=None, frames=(0, 1))
+    assert rep.frames == 1 and rep.agent_frames == 2
+    # Without an agent selection: both agents (of frame 0), and no agents in the options.
+    assert "agents" not in load_report(tmp_path / "o")["options"]
+    for agents, frames, said in (
+        ("usv_9", None, "usv_9 is not an agent of the recordings (their agents: usv_a, usv_b)"),
+        ("usv_a", None, "no selected agent (usv_a) to convert to coco: usv_a has no camera"),
+        ("", None, "agents = '': must be one or more agent ids"),
+        (None, "2:1", "frames stop = 1: must be a whole number >= 3"),
+        (None, "x", "frames = 'x': must be START:STOP"),
+        (None, (-1, 2), "frames start = -1: must be a whole number >= 0"),
+    ):
+        with pytest.raises(ConfigError) as err:
+            convert(mixed_rec, to="coco", out_dir=tmp_path / "bad", agents=agents, frames=frames)
+        assert said in str(err.value), str(err.value)
+    assert not (tmp_path / "bad").exists()
+    out = tmp_path / "cli"
+    argv = ["convert", str(mixed_rec), "--to", "semantickitti", "--agents", "usv_a", "--frames", "0:1", "-o", str(out)]
+    assert main([*argv, "--no-progress"]) == 0
+    assert load_report(out)["frames_converted"] == 1

@@ -78,6 +78,17 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         default=1.0,
         help="coco, yolo: leave out 2D boxes hidden by more than this fraction, 0..1 (default 1: keep all)",
     )
+    p.add_argument(
+        "--agents",
+        default=None,
+        help="convert only these agents (USV ids, comma-separated, e.g. usv_1,usv_2); every recording must hold one",
+    )
+    p.add_argument(
+        "--frames",
+        default=None,
+        metavar="START:STOP",
+        help="convert only the acquisition indices START..STOP-1 (STOP may be left out: to the end)",
+    )
     p.add_argument("--overwrite", action="store_true", help="replace a previous conversion in the output folder")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     return p
@@ -105,6 +116,8 @@ def run(args: argparse.Namespace) -> int:
         "min_box_px": args.min_box_px,
         "max_occlusion": args.max_occlusion,
         "overwrite": args.overwrite,
+        "agents": args.agents,
+        "frames": args.frames,
     }
     if args.no_progress:
         report = convert(args.recordings, **kwargs)

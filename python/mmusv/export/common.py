@@ -73,6 +73,17 @@ class Options:
     """COCO/YOLO: 2D boxes whose shorter side is under this many pixels are left out."""
     max_occlusion: float = 1.0
     """COCO/YOLO: 2D boxes whose occlusion (fraction hidden, 0..1) is above this are left out."""
+    agents: tuple[str, ...] | None = None
+    """The agents (USV ids) to convert; ``None``: every agent the format uses."""
+    frames: tuple[int, int | None] | None = None
+    """The acquisition indices to convert, ``[start, stop)`` (``stop`` ``None``: to the end); ``None``: all."""
+
+    def wants_frame(self, index: int) -> bool:
+        """Whether acquisition index ``index`` lies in :attr:`frames`."""
+        if self.frames is None:
+            return True
+        start, stop = self.frames
+        return index >= start and (stop is None or index < stop)
 
 
 @dataclass

@@ -298,6 +298,63 @@ def _box_filter(min_box_px: Any, max_occlusion: Any) -> tuple[float, float]:
     return px, occ
 
 
+def _agent_selection(agents: Iterable[str] | str | None) -> tuple[str, ...] | None:
+    """``agents`` (a list of ids or ``"usv_1,usv_2"``) as sorted unique ids, or ``None``; an empty selection or an
+    id that is not a string is a :class:`~mmusv.errors.ConfigError` naming ``agents``."""
+    if agents is None:
+        return None
+    if isinstance(agents, str):
+        items = [a.strip() for a in agents.split(",")]
+    elif isinstance(agents, Iterable):
+        items = list(agents)
+    else:
+        raise ConfigError(f"agents = {arguments.shown(agents)}: must be agent ids (a list or 'usv_1,usv_2')")
+    if not all(isinstance(a, str) and a for a in items) or not items:
+        raise ConfigError(
+            f"agents = {arguments.shown(agents)}: must be one or more agent ids (non-empty strings, comma-separated)"
+        )
+    return tuple(sorted(set(items)))
+
+
+def _frame_selection(frames: Sequence[int | None] | str | None) -> tuple[int, int | None] | None:
+    """``frames`` (``(start, stop)`` or ``"start:stop"``, ``stop`` excluded and optional) as ``(start, stop)``, or
+    ``None``; :class:`~mmusv.errors.ConfigError` naming ``frames`` unless ``0 <= start < stop``."""
+    if frames is None:
+        return None
+    shown = arguments.shown(frames)
+    if isinstance(frames, str):
+        head, sep, tail = frames.partition(":")
+        if not sep or not head.strip().isdigit() or not (tail.strip().isdigit() or tail.strip() == ""):
+            raise ConfigError(f"frames = {shown}: must be START:STOP (acquisition indices, STOP excluded or empty)")
+        pair: list[Any] = [int(head), int(tail) if tail.strip() else None]
+    elif isinstance(frames, Sequence) and len(frames) == 2:
+        pair = [frames[0], frames[1]]
+    else:
+        raise ConfigError(f"frames = {shown}: must be (start, stop) or 'START:STOP'")
+    start = arguments.whole(pair[0], name="frames start", lo=0)
+    stop = None if pair[1] is None else arguments.whole(pair[1], name="frames stop", lo=start + 1)
+    return start, stop
+
+
+def _check_agents(cls: type[DatasetWriter], infos: list[RecordingInfo], agents: tuple[str, ...]) -> None:
+    """Every selected agent is an agent of some recording, and every recording holds a selected agent the format
+    uses (:class:`~mmusv.errors.ConfigError` naming the ids or the recording otherwise)."""
+    known = sorted({a.id for i in infos for a in i.agents})
+    unknown = [a for a in agents if a not in known]
+    if unknown:
+        raise ConfigError(
+            f"agents: {', '.join(unknown)} {'is not an agent' if len(unknown) == 1 else 'are not agents'} of the "
+            f"recordings (their agents: {', '.join(known)})"
+        )
+    for i in infos:
+        if not any(a.id in agents and cls.uses_agent(a) is None for a in i.agents):
+            unusable = [f"{a.id} {cls.uses_agent(a)}" for a in i.agents if a.id in agents]
+            raise ConfigError(
+                f"{i.path}: no selected agent ({', '.join(agents)}) to convert to {cls.format_name()}: "
+                + (f"{'; '.join(unusable)}" if unusable else f"its agents are {', '.join(a.id for a in i.agents)}")
+            )
+
+
 def convert(
     recordings: str | Path | Iterable[str | Path],
     *,
@@ -311,6 +368,8 @@ def convert(
     min_box_px: float = 0.0,
     max_occlusion: float = 1.0,
     overwrite: bool = False,
+    agents: Iterable[str] | str | None = None,
+    frames: Sequence[int | None] | str | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> ConvertReport:
     """Converts one or many recordings into a dataset folder (see the module docstring).
@@ -334,6 +393,10 @@ def convert(
         min_box_px: COCO and YOLO: leave out 2D boxes whose shorter side is under this many pixels.
         max_occlusion: COCO and YOLO: leave out 2D boxes hidden by more than this fraction (0..1).
         overwrite: replace a previous conversion in ``out_dir`` (``include_usvs`` and ``overwrite`` are ``bool``).
+        agents: the agents (USV ids, a list or ``"usv_1,usv_2"``) to convert; every recording must hold one of
+            them. ``None``: all.
+        frames: the acquisition indices to convert, ``(start, stop)`` or ``"start:stop"`` (``stop`` excluded; left
+            out or ``None``: to the end). The others are neither converted nor reported missing. ``None``: all.
         progress: called with (frames done, frames expected) after every frame (a callable of two arguments).
 
     Raises:
@@ -360,11 +423,15 @@ def convert(
         extras=parse_extras(extras),
         min_box_px=box_px,
         max_occlusion=max_occ,
+        agents=_agent_selection(agents),
+        frames=_frame_selection(frames),
     )
     paths = _as_list(recordings)
     infos = [read_info(p) for p in paths]  # validates every input before anything is written
     for i in infos:
         cls.check(i)
+    if options.agents is not None:
+        _check_agents(cls, infos, options.agents)
     folders = _folders(infos)
     split_of: dict[str, str | None] = dict.fromkeys(folders)
     if ratios is not None:
@@ -383,6 +450,8 @@ def convert(
             **({"min_box_px": box_px, "max_occlusion": max_occ} if to in ("coco", "yolo") else {}),
             "splits": None if ratios is None else dict(zip(SPLIT_NAMES, [round(r, 9) for r in ratios], strict=True)),
             "seed": seed,
+            **({"agents": list(options.agents)} if options.agents is not None else {}),
+            **({"frames": list(options.frames)} if options.frames is not None else {}),
         },
     }
     with _staged(work, out):
@@ -407,6 +476,11 @@ def convert(
             converted: list[int] = []
             incomplete: list[tuple[int, str]] = []
             for fr in stream:
+                if not options.wants_frame(fr.index):  # outside --frames: neither converted nor missing
+                    done += 1
+                    if progress is not None:
+                        progress(done, max(expected, done))
+                    continue
                 missing = writer.missing(fr)
                 if fr.world is None or missing or not writer.agents:
                     why = (
@@ -432,7 +506,7 @@ def convert(
                 stream.run.get("frames_requested", stream.run.get("frames_configured", info.frames_configured)) or 0
             )
             first = int(stream.run.get("first_frame", 0) or 0)  # one part of a split recording given alone
-            absent = [k for k in range(first, first + configured) if k not in seen]
+            absent = [k for k in range(first, first + configured) if k not in seen and options.wants_frame(k)]
             if absent:
                 written = stream.run.get("frames_written")
                 why = (

@@ -60,6 +60,8 @@ class DatasetWriter:
         self.notes: list[str] = []
         self.agents: list[AgentInfo] = []
         for a in info.agents:
+            if options.agents is not None and a.id not in options.agents:
+                continue  # not selected (convert checked that the recording holds a selected agent)
             why = self.uses_agent(a)
             if why is None:
                 self.agents.append(a)
