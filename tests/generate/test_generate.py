@@ -12,7 +12,7 @@ from typing import Any
 import pytest
 import yaml
 from mmusv.config import load_scenario
-from mmusv.errors import ConfigError, IoError
+from mmusv.errors import ConfigError, IoError, NotFoundError
 from mmusv.generate import FAMILIES, generate, load_spec
 from mmusv.generate.cli import add_parser, run
 
@@ -224,7 +224,7 @@ def test_cli_generates_and_exit_status_reflects_quotas(tmp_path: Path, capsys: p
     rc = _cli(["generate", str(SPECS / "impossible_port.yaml"), "-o", str(tmp_path / "imp"), "--no-progress"])
     assert rc == 1
     assert "quota not met" in capsys.readouterr().out
-    with pytest.raises(ConfigError, match="does not exist"):
+    with pytest.raises(NotFoundError, match="does not exist and is not a bundled spec"):
         _cli(["generate", str(tmp_path / "missing.yaml"), "-o", str(tmp_path / "x")])
 
 
