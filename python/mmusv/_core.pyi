@@ -379,6 +379,9 @@ class Camera:
     @property
     def resolution(self) -> tuple[int, int]:
         """(width, height) pixels."""
+    def distort(self, points: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+        """Distorted normalised image coordinates (N, 2) float64 of undistorted ones (N, 2) float64 (Brown–Conrady,
+        the render's own model); the points themselves without distortion."""
     def world_rays(self, pose: npt.NDArray[np.float64]) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
         """World ray origins and unit directions (H·W, 3) float32, row-major."""
     def pixel_rays(

@@ -169,11 +169,11 @@ EDGE_STEPS = 32
 
 
 def _project_box(
-    corners_opt: np.ndarray, k: tuple[float, float, float, float], lens: tuple[np.ndarray, float] | None = None
+    corners_opt: np.ndarray, k: tuple[float, float, float, float], lens: tuple[Any, float] | None = None
 ) -> np.ndarray | None:
     """Pixel bounding box ``[x0, y0, x1, y1]`` of a box given by its corners in the optical frame, with edges
-    clipped at the near plane; ``None`` when the box is entirely behind the camera. ``lens``: the camera's
-    Brown–Conrady coefficients and reach (:func:`_lens`), or ``None`` for an ideal pinhole, where the corners
+    clipped at the near plane; ``None`` when the box is entirely behind the camera. ``lens``: the camera with
+    lens distortion and its reach (:func:`_lens`), or ``None`` for an ideal pinhole, where the corners
     alone bound the image; through a lens the box's edges are sampled (their images are curves)."""
     fx, fy, cx, cy = k
     pts = [c for c in corners_opt if c[2] >= NEAR_M]
@@ -202,8 +202,8 @@ def _project_box(
     return np.array([u.min(), v.min(), u.max(), v.max()])
 
 
-def _lens(cam: Any, pose: np.ndarray, world_to_body: np.ndarray) -> tuple[np.ndarray, float] | None:
-    """A pinhole camera's Brown–Conrady coefficients ``[k1, k2, p1, p2, k3]`` and reach (the largest undistorted
+def _lens(cam: Any, pose: np.ndarray, world_to_body: np.ndarray) -> tuple[Any, float] | None:
+    """A pinhole camera with lens distortion (``mmusv._core.Camera``) and its reach (the largest undistorted
     normalised radius its image corners see, from the camera's own corner rays), or ``None`` without distortion.
     Within the reach the camera's distortion maps every point to the pixel whose ray meets it; beyond it, where the
     polynomial may fold back into the image, points are carried radially outwards, outside the image."""
@@ -215,21 +215,17 @@ def _lens(cam: Any, pose: np.ndarray, world_to_body: np.ndarray) -> tuple[np.nda
     opt = np.asarray(d, dtype=np.float64) @ world_to_body[:3, :3].T @ BODY_TO_OPTICAL.T
     reach = float(np.max(np.hypot(opt[:, 0], opt[:, 1]) / opt[:, 2]))
     # A single pixel's centre is the image centre: nothing to fold past, the polynomial alone.
-    return np.asarray(cam.distortion, dtype=np.float64), reach if reach > 0.0 else np.inf
+    return cam, reach if reach > 0.0 else np.inf
 
 
-def _distort(x: np.ndarray, y: np.ndarray, coefficients: np.ndarray, reach: float) -> tuple[np.ndarray, np.ndarray]:
-    """Distorted normalised coordinates of undistorted ``(x, y)`` (OpenCV's Brown–Conrady, as the core's
-    ``Distortion::distort``); a point beyond ``reach`` is distorted at the reach and scaled back out radially."""
-    k1, k2, p1, p2, k3 = coefficients
+def _distort(x: np.ndarray, y: np.ndarray, cam: Any, reach: float) -> tuple[np.ndarray, np.ndarray]:
+    """Distorted normalised coordinates of undistorted ``(x, y)`` through ``cam``'s own Brown–Conrady model (the
+    core's ``Distortion::distort``, which the render uses); a point beyond ``reach`` is distorted at the reach and
+    scaled back out radially."""
     r = np.hypot(x, y)
     s = np.where(r > reach, reach / np.maximum(r, 1e-300), 1.0)
-    x, y = x * s, y * s
-    r2 = x * x + y * y
-    radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))
-    xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x)
-    yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y
-    return xd / s, yd / s
+    d = cam.distort(np.column_stack([x * s, y * s]).astype(np.float64))
+    return d[:, 0] / s, d[:, 1] / s
 
 
 def annotate_agent(

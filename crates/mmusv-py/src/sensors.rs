@@ -1,6 +1,6 @@
 //! Bindings for `mmusv_core::sensors`: ray patterns, the spinning LiDAR and the cameras.
 
-use crate::native::{c_order, detached, flat, pose_arg, rows_to_array, RayArrays};
+use crate::native::{c_order, detached, flat, pose_arg, rows, rows_to_array, RayArrays};
 use mmusv_core::sensors::shade::wake::Wake;
 use mmusv_core::sensors::shade::ShadeEnv;
 use mmusv_core::sensors::{camera, capture, lidar, rays};
@@ -408,6 +408,18 @@ impl Camera {
     #[getter]
     fn distortion(&self) -> Option<[f64; 5]> {
         self.inner.config().image.distortion.map(|d| d.coefficients)
+    }
+
+    /// Distorted normalised image coordinates `(N, 2)` float64 of undistorted ones `points` `(N, 2)` float64
+    /// (`x / z`, `y / z` in the optical frame): the camera's Brown–Conrady model (mmusv_core's
+    /// `Distortion::distort`, the one the render uses); the points themselves without distortion.
+    fn distort<'py>(&self, py: Python<'py>, points: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let pts = rows::<f64, 2>(&points, "points")?;
+        let out = match &self.inner.config().image.distortion {
+            Some(d) => pts.iter().map(|&[x, y]| d.distort(x, y).into()).collect(),
+            None => pts.to_vec(),
+        };
+        rows_to_array(py, out)
     }
 
     /// `(width, height)` in pixels.
