@@ -44,7 +44,7 @@ from mmusv.sensors.config import RigConfig
 from mmusv.strict import StrictModel
 from mmusv.world.environment import MAX_WAVE_HEIGHT_M, Environment, wave_height_m
 from mmusv.world.map_params import PARAM_MODELS, IslandParams, MapParams
-from mmusv.world.sea_state import SeaSpec
+from mmusv.world.sea_state import TP_RANGE_S, SeaSpec
 from mmusv.world.vessels import get_asset, known_asset
 from mmusv.yamlio import mapping_source
 
@@ -123,7 +123,7 @@ class SeaConfig(_Model):
 
     state: int | None = Field(default=None, ge=0, le=9)
     hs_m: float | None = Field(default=None, ge=0, le=MAX_WAVE_HEIGHT_M)
-    tp_s: float | None = Field(default=None, ge=0.5, le=30)
+    tp_s: float | None = Field(default=None, ge=TP_RANGE_S[0], le=TP_RANGE_S[1])
     gamma: float | None = Field(default=None, ge=1, le=7)
     direction_deg: float = 0.0
     spread_s: float = Field(default=10.0, ge=0.5, le=100)

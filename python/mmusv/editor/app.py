@@ -395,7 +395,7 @@ def create_app(
     @app.get("/api/info")
     def info() -> dict[str, Any]:
         from mmusv import __version__
-        from mmusv.sensors.config import RIG_PRESETS, Quality
+        from mmusv.sensors.config import RIG_PRESETS, CameraConfig
         from mmusv.world.environment import WAVE_PRESETS
 
         return {
@@ -409,7 +409,7 @@ def create_app(
                 "role": _choices(VesselConfig, "role"),
                 "end": _choices(VesselConfig, "end"),
                 "rig_preset": sorted(RIG_PRESETS),
-                "camera_quality": list(get_args(Quality)),
+                "camera_quality": _choices(CameraConfig, "quality"),
             },
             "limits": {"bulk_frames": MAX_BULK_FRAMES, "body_bytes": MAX_BODY_BYTES},
         }

@@ -476,13 +476,10 @@ def convert(
             converted: list[int] = []
             incomplete: list[tuple[int, str]] = []
             for fr in stream:
-                if not options.wants_frame(fr.index):  # outside --frames: neither converted nor missing
-                    done += 1
-                    if progress is not None:
-                        progress(done, max(expected, done))
-                    continue
                 missing = writer.missing(fr)
-                if fr.world is None or missing or not writer.agents:
+                if not options.wants_frame(fr.index):
+                    pass  # outside --frames: neither converted nor missing
+                elif fr.world is None or missing or not writer.agents:
                     why = (
                         writer.no_agent_reason
                         if not writer.agents

@@ -39,8 +39,8 @@ __all__ = ["LIDAR_OPTICAL", "KittiWriter", "front_calib", "kitti_label", "kitti_
 
 LIDAR_OPTICAL = np.eye(4)
 LIDAR_OPTICAL[:3, :3] = BODY_TO_OPTICAL
-"""``(4, 4)`` ``Tr_velo_to_cam`` of an agent without a front camera: the LiDAR frame (x forward, y left, z up) in
-optical axes (x right, y down, z forward), no translation."""
+"""``(4, 4)``: a body frame (x forward, y left, z up) in optical axes (x right, y down, z forward), no
+translation: the ``Tr_velo_to_cam`` of an agent without a front camera, and the last step of every other's."""
 
 
 def occlusion_level(occlusion: float | None) -> int:
@@ -62,9 +62,7 @@ def front_calib(agent: AgentInfo, view: AgentView) -> tuple[np.ndarray, np.ndarr
     cam = agent.cameras.get("front")
     if cam is None:
         return np.zeros((3, 4)), np.eye(4)
-    opt = np.eye(4)
-    opt[:3, :3] = BODY_TO_OPTICAL
-    velo_to_cam = opt @ invert(view.cameras["front"]) @ view.lidar
+    velo_to_cam = LIDAR_OPTICAL @ invert(view.cameras["front"]) @ view.lidar
     fx, fy, cx, cy = cam.intrinsics
     return np.array([[fx, 0.0, cx, 0.0], [0.0, fy, cy, 0.0], [0.0, 0.0, 1.0, 0.0]]), velo_to_cam
 

@@ -26,13 +26,23 @@ from mmusv import arguments
 from mmusv._native import core
 from mmusv.errors import ConfigError
 
-__all__ = ["MIN_TP_S", "SEA_PRESETS", "SeaPreset", "SeaSpec", "sea_spec_for_height", "sea_spec_for_preset"]
+__all__ = [
+    "MIN_TP_S",
+    "SEA_PRESETS",
+    "TP_RANGE_S",
+    "SeaPreset",
+    "SeaSpec",
+    "sea_spec_for_height",
+    "sea_spec_for_preset",
+]
 
 DEFAULT_SPREAD_S = 10.0
 """cos-2s exponent of the presets (wind sea, Goda 1985)."""
-MIN_TP_S: float = core.sea_limits()["tp_s"][0]
-"""Shortest peak period the core's sea takes, seconds (``ocean::field::TP_RANGE_S``, 0.5 s): the fully developed
-period of a sea below about 1 cm (Tp = 4.99 √Hs) is raised to it."""
+TP_RANGE_S: tuple[float, float] = core.sea_limits()["tp_s"]
+"""Peak periods the core's sea takes, seconds (``ocean::field::TP_RANGE_S``, 0.5..30 s)."""
+MIN_TP_S: float = TP_RANGE_S[0]
+"""Shortest peak period, seconds: the fully developed period of a sea below about 1 cm (Tp = 4.99 √Hs) is raised
+to it."""
 
 
 class SeaPreset(NamedTuple):
