@@ -21,6 +21,7 @@ if TYPE_CHECKING:
 
     from mmusv.config import Scenario
 
+from mmusv.cli_paths import check_output_folder, output_arg, path_arg
 from mmusv.errors import ConfigError, MmusvError
 
 BUNDLED_WAVE_SCENARIO = "scenarios/island_port_waves.yaml"
@@ -63,46 +64,6 @@ def _cmd_assets(args: argparse.Namespace) -> int:
 
         _console().print(f"wrote {write_contact_sheet(args.render)}")
     return 0
-
-
-def path_arg(value: str, *, flag: str, empty: str = "give a path") -> str:
-    """``value``, the path given to ``flag``, as it is; :class:`~mmusv.errors.ConfigError` naming ``flag`` (and
-    ending in ``empty``) when it is empty: an empty path quietly meant the current folder (``mmusv info ""`` read
-    ``.``, ``-o ""`` wrote there)."""
-    from mmusv import arguments
-
-    if value == "":
-        raise ConfigError(f"{flag} is empty: {empty}")
-    arguments.path(value, name=flag)  # a NUL character, from a caller in Python
-    return value
-
-
-def output_arg(value: str, *, flag: str = "-o/--output") -> str:
-    """``value``, the output path given to ``flag``, as it is: not empty (:func:`path_arg`) and valid UTF-8. A
-    name with bytes that are not UTF-8 was written halfway (the recording, the table) before the Parquet or CSV
-    writer failed with a traceback."""
-    from mmusv import arguments
-
-    path_arg(value, flag=flag, empty='give a path ("." for the current folder)')
-    try:
-        value.encode("utf-8")
-    except UnicodeEncodeError:
-        raise ConfigError(
-            f"{flag} {arguments.shown(value)}: the path holds bytes that are not UTF-8; give a UTF-8 path"
-        ) from None
-    return value
-
-
-def check_output_folder(value: str, *, flag: str = "-o/--output") -> Path:
-    """``value`` (:func:`output_arg`) as the output folder of ``flag``, checked without creating anything: it, or
-    the nearest of its parents that exists, is a folder. A file there was named only after the computing."""
-    out = Path(output_arg(value, flag=flag))
-    for q in (out, *out.parents):
-        if q.exists():
-            if not q.is_dir():
-                raise ConfigError(f"{flag} {value}: {q} is a file, not a folder")
-            break
-    return out
 
 
 def _ready_output(output: str, *, flag: str = "-o/--output") -> None:

@@ -260,7 +260,7 @@ def add_dataset_parser(subparsers: Any) -> argparse.ArgumentParser:
 def run_dataset(args: argparse.Namespace) -> int:
     """Runs ``mmusv dataset``; 0 when every scenario was recorded and converted, 1 otherwise."""
     from mmusv.batch.dataset import build_dataset
-    from mmusv.cli import check_output_folder, path_arg
+    from mmusv.cli_paths import check_output_folder, path_arg
 
     path_arg(args.spec, flag="spec")
     check_output_folder(args.output)  # an empty -o wrote the dataset into the current folder

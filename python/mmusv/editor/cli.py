@@ -79,7 +79,7 @@ def serve(app: Any, *, host: str, port: int, announce: bool = True) -> None:
 def run(args: argparse.Namespace) -> int:
     """Runs ``mmusv editor`` with parsed ``args``; returns the exit status."""
     from mmusv.bundled import resolve_scenario
-    from mmusv.cli import path_arg
+    from mmusv.cli_paths import path_arg
     from mmusv.config import load_scenario
     from mmusv.editor.app import InitialScenario, create_app
     from mmusv.editor.document import leading_comment, to_document

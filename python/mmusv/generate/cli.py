@@ -41,7 +41,7 @@ def run(args: argparse.Namespace) -> int:
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-    from mmusv.cli import check_output_folder, output_arg, path_arg
+    from mmusv.cli_paths import check_output_folder, output_arg, path_arg
     from mmusv.generate.mapctx import map_context
     from mmusv.generate.runner import generate
     from mmusv.generate.spec import load_spec

@@ -104,7 +104,7 @@ def add_parser(sub: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Runs ``mmusv train``; returns the exit status."""
-    from mmusv.cli import check_output_folder, path_arg
+    from mmusv.cli_paths import check_output_folder, path_arg
 
     _check_numbers(args)
     check_output_folder(args.output)  # an empty -o wrote the cache and the models into the current folder

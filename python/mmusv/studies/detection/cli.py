@@ -146,7 +146,7 @@ def run(args: argparse.Namespace) -> int:
     from rich.console import Console
 
     from mmusv import arguments
-    from mmusv.cli import check_output_folder, path_arg
+    from mmusv.cli_paths import check_output_folder, path_arg
     from mmusv.errors import InputError
     from mmusv.learn.cli import check_threads, split_ratios
     from mmusv.studies.detection.detector import BASELINE_NOTE, load_detector
