@@ -316,6 +316,15 @@ def _agent_selection(agents: Iterable[str] | str | None) -> tuple[str, ...] | No
     return tuple(sorted(set(items)))
 
 
+def _frames_to_read(info: RecordingInfo, options: Options) -> int:
+    """How many frames of ``info`` the conversion reads (for its progress): those written, in ``options.frames``."""
+    first = int(info.run.get("first_frame", 0) or 0)
+    written = int(info.run.get("frames_written", info.frames_configured) or 0)
+    start, stop = options.frames if options.frames is not None else (first, None)
+    end = first + written if stop is None else min(first + written, stop)
+    return max(0, end - max(first, start))
+
+
 def _frame_selection(frames: Sequence[int | None] | str | None) -> tuple[int, int | None] | None:
     """``frames`` (``(start, stop)`` or ``"start:stop"``, ``stop`` excluded and optional) as ``(start, stop)``, or
     ``None``; :class:`~mmusv.errors.ConfigError` naming ``frames`` unless ``0 <= start < stop``."""
@@ -459,7 +468,7 @@ def convert(
         sink = Sink()
         shared = cls.start(work, options, sink)
         report = ConvertReport(out_dir=out, target=to, recordings=reports)
-        expected = sum(int(i.run.get("frames_written", i.frames_configured) or 0) for i in infos)
+        expected = sum(_frames_to_read(i, options) for i in infos)
         done = 0
         order = sorted(
             range(len(infos)),
@@ -472,7 +481,7 @@ def convert(
                 sink.mkdir(folder)
             writer = cls(info, folder, options, sink, split=rep.split, shared=shared)
             wanted = writer.topic_filter()
-            stream = FrameStream(info, wanted.__contains__)
+            stream = FrameStream(info, wanted.__contains__, frames=options.frames)
             converted: list[int] = []
             incomplete: list[tuple[int, str]] = []
             for fr in stream:

@@ -99,7 +99,8 @@ def frame_messages(path: str | Path, frame: int) -> dict[str, Any]:
                 return frame_messages(part, frame)
         raise ConfigError(f"frame {frame} is not in {p}")
     info = read_info(p)
-    stream = FrameStream(info, want=lambda _t: True)
+    # only the chunks around the frame are decompressed (a negative frame is in no recording: read to say so)
+    stream = FrameStream(info, want=lambda _t: True, frames=(frame, frame + 1) if frame >= 0 else None)
     for fr in stream:
         if fr.index == frame:
             return dict(fr.messages)

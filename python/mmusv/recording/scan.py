@@ -18,6 +18,12 @@ shrinks under a reader must not crash it) and never trusts a length it has not c
 - the data section's CRC (in the data end record) is checked as well, so damage outside the chunks (metadata,
   message indexes) is reported too.
 
+A reader that wants only some log times (one frame for a preview, ``convert --frames``) gives ``keep``: a chunk
+whose messages all lie outside it is hopped over unread, when the file's summary (its CRC checked) holds every
+schema and channel and indexes that chunk with the times its header gives (a file without a summary, e.g. a
+``.partial`` file, is read in full; a chunk whose header disagrees with the index is read and checked). A chunk
+hopped over is not checked, nor is the data section's CRC then; the chunks read are, each against its own CRC.
+
 Schemas and channels come from the chunks as they appear and, when the file has a readable summary, from the
 summary up front (so the messages of a channel whose defining chunk is damaged still decode).
 """
@@ -27,7 +33,7 @@ from __future__ import annotations
 import io
 import struct
 import zlib
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any
@@ -246,13 +252,17 @@ class Scan:
     """One walk over the MCAP file at ``path`` (see the module docstring).
 
     ``chunks``: decompress and check the chunks and yield their messages; without it the chunks are hopped over
-    (for the metadata alone). After :meth:`messages` ran: ``damage`` (every damaged region, in file order),
+    (for the metadata alone). ``keep``: called with a chunk's first and last message log times (ns), whether to
+    read it (``None``: every chunk); with a readable summary the others are hopped over, see the module docstring,
+    and counted in ``skipped_chunks``. After :meth:`messages` ran: ``damage`` (every damaged region, in file order),
     ``complete`` (the file ends with its data end, summary and footer), ``metadata`` by name, ``attachments``
     (names), ``schemas`` and ``channels`` by id.
     """
 
     path: Path
     chunks: bool = True
+    keep: Callable[[int, int], bool] | None = None
+    skipped_chunks: int = 0
     size: int = 0
     damage: list[Damage] = field(default_factory=list)
     complete: bool = False
@@ -263,6 +273,8 @@ class Scan:
     channels: dict[int, Any] = field(default_factory=dict)
     has_summary: bool = False
     _summary_bad: bool = False
+    _chunk_index: dict[int, tuple[int, int, int]] = field(default_factory=dict)
+    """The summary's chunk indexes: file offset → (first and last log time, record length)."""
 
     def messages(self) -> Iterator[tuple[Any, Damage | None]]:
         """Yields ``(message, None)`` for every message of every intact chunk in file order, and ``(None,
@@ -297,6 +309,7 @@ class Scan:
             return
         at = 0
         found: list[tuple[int, Any]] = []
+        chunks: dict[int, tuple[int, int, int]] = {}
         try:
             while at < len(data):
                 if at + 9 > len(data):
@@ -306,11 +319,15 @@ class Scan:
                     return
                 if op in (_SCHEMA, _CHANNEL):
                     found.append((op, _read_record(op, data[at + 9 : at + 9 + n])))
+                elif op == _CHUNK_INDEX and n >= 32:  # first and last log times, offset, record length
+                    t0, t1, offset, length = struct.unpack_from("<QQQQ", data, at + 9)
+                    chunks[int(offset)] = (int(t0), int(t1), int(length))
                 at += 9 + n
         except _Bad:
             return
         for op, rec in found:
             (self.schemas if op == _SCHEMA else self.channels)[rec.id] = rec
+        self._chunk_index = chunks
         self.has_summary = True
 
     # ------------------------------------------------------------------------------------------ data section
@@ -385,6 +402,14 @@ class Scan:
                 f.seek(end)
                 pos, crc_valid = end, False
                 continue
+            if op == _CHUNK and self.keep is not None and pos in self._chunk_index and n >= 40:
+                t0, t1 = struct.unpack("<QQ", f.read(16))
+                # the chunk's own times agree with the summary's index (whose CRC was checked): hop over it unread
+                if self._chunk_index[pos] == (t0, t1, 9 + n) and t0 <= t1 and not self.keep(int(t0), int(t1)):
+                    self.skipped_chunks += 1
+                    pos, crc_valid = end, False
+                    continue
+                f.seek(pos + 9)
             body = f.read(n)
             if op == _DATA_END:
                 stored = _u32(body, 0) if len(body) >= 4 else 0

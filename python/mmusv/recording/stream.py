@@ -70,6 +70,10 @@ class FrameStream:
     Args:
         info: from :func:`~mmusv.recording.info.read_info`.
         want: which topics to decode (``/world/state`` always is); others are skipped undecoded.
+        frames: only the acquisition indices ``start <= k < stop`` (``stop`` ``None``: to the end), found by their
+            log times (``k / frequency``); the other frames are neither read nor yielded, chunks holding none of
+            these frames are not even decompressed, and :meth:`expected` is limited to the range. ``None``: every
+            frame.
 
     Damaged input (:mod:`mmusv.recording.scan`): a damaged chunk is skipped and the walk goes on after it; a file
     that ends inside a record yields what came before. Only complete frames are yielded: a frame whose messages
@@ -81,7 +85,9 @@ class FrameStream:
     :attr:`attachments` describe what was read (every message, decoded or not).
     """
 
-    def __init__(self, info: RecordingInfo, want: Callable[[str], bool]) -> None:
+    def __init__(
+        self, info: RecordingInfo, want: Callable[[str], bool], *, frames: tuple[int, int | None] | None = None
+    ) -> None:
         if not isinstance(info, RecordingInfo):
             raise ConfigError(
                 f"info = {info!r:.80}: must be a RecordingInfo (mmusv.recording.read_info(path)), "
@@ -89,8 +95,20 @@ class FrameStream:
             )
         if not callable(want):
             raise ConfigError(f"want = {want!r:.80}: must be a function of a topic name returning True or False")
+        if frames is not None and not (
+            isinstance(frames, tuple)
+            and len(frames) == 2
+            and all(isinstance(k, int) and not isinstance(k, bool) for k in frames if k is not None)
+            and frames[0] is not None
+            and frames[0] >= 0
+            and (frames[1] is None or frames[0] < frames[1])
+        ):
+            raise ConfigError(
+                f"frames = {frames!r:.80}: must be (start, stop) with 0 <= start < stop, or (start, None)"
+            )
         self.info = info
         self.want = want
+        self.frames = frames
         self.truncated: str | None = None
         self.damage: list[str] = []
         self.incomplete: list[tuple[int, str]] = []
@@ -106,6 +124,8 @@ class FrameStream:
         self.attachments: list[str] = []
         self.complete = True
         """Every file read ends with its data end, summary and footer, without damage."""
+        self.chunks_skipped = 0
+        """Chunks hopped over unread because they hold no frame of :attr:`frames`."""
         self._missing_parts: list[tuple[int, int, str]] = []
         self._ended = False
 
@@ -114,18 +134,39 @@ class FrameStream:
             return world.frame
         return round(log_time_ns * self.info.frequency_hz / 1e9)
 
+    def _in_range(self, first: int, last: int) -> bool:
+        """Whether acquisition indices ``first..last`` (inclusive) meet :attr:`frames`."""
+        if self.frames is None:
+            return True
+        start, stop = self.frames
+        return last >= start and (stop is None or first < stop)
+
+    def _wanted_times(self) -> Callable[[int, int], bool] | None:
+        """Whether a span of log times (ns, inclusive) may hold a frame of :attr:`frames` (``None``: all may).
+        The frame of log time ``t`` is ``round(t · frequency)``, monotonic in ``t``."""
+        if self.frames is None or not self.info.frequency_hz > 0:
+            return None
+        f = self.info.frequency_hz
+        return lambda t0, t1: self._in_range(round(t0 * f / 1e9), round(t1 * f / 1e9))
+
     def __iter__(self) -> Iterator[Frame]:
         seen: set[int] = set()
         if is_parts_manifest(self.info.path):
             for first, stop, f in part_files(self.info.path):
+                if not self._in_range(first, stop - 1):
+                    continue
                 if f is None:
                     self._missing_parts.append((first, stop, f"part {first}..{stop - 1}"))
                     self.complete = False
                     continue
-                yield from self._file(f, seen)
+                yield from self._ranged(self._file(f, seen))
         else:
-            yield from self._file(self.info.path, seen)
+            yield from self._ranged(self._file(self.info.path, seen))
         self._ended = True
+
+    def _ranged(self, frames: Iterator[Frame]) -> Iterator[Frame]:
+        """The frames of :attr:`frames` (the log times leave out the others unless the frequency is unknown)."""
+        return (fr for fr in frames if self._in_range(fr.index, fr.index))
 
     def _note(self, line: str) -> None:
         self.damage.append(line)
@@ -137,7 +178,8 @@ class FrameStream:
         factory = DecoderFactory()
         decoders: dict[int, Callable[[bytes], Any] | None] = {}
         where = f"part {path.name} of {self.info.path.name}" if self.info.parts else "the file"
-        scan = Scan(path)
+        times = self._wanted_times()
+        scan = Scan(path, keep=times)
         lost: list[tuple[int, int]] = []  # log times of damaged chunks
         reference: set[str] = set()  # topics of the intact frames so far
         pending: list[_Open] = []  # frames next to damage, waiting for an intact frame to compare with
@@ -154,6 +196,9 @@ class FrameStream:
                         cur.suspect = True
                     after_damage = True
                     continue
+                if times is not None and not times(msg.log_time, msg.log_time):
+                    after_damage = False  # damage before it borders this frame, not one asked for
+                    continue  # a frame outside the range asked for
                 if cur is None or msg.log_time != cur.frame.log_time_ns:
                     if cur is not None:
                         yield from self._close(cur, pending, lost, reference, scan, seen, final=False)
@@ -199,6 +244,7 @@ class FrameStream:
                 yield from self._flush(pending, lost, reference, scan, seen)
         except OSError as exc:
             raise IoError(f"{path} cannot be read: {exc.strerror or exc}") from None
+        self.chunks_skipped += scan.skipped_chunks
         if scan.damage or not scan.complete:
             self.complete = False
         if not self.info.parts:
@@ -277,8 +323,15 @@ class FrameStream:
         return fr
 
     def expected(self) -> tuple[range, bool]:
-        """The frames the run set out to write and whether the run said so itself (``False``: it did not finish,
-        so this is the scenario's configured range)."""
+        """The frames the run set out to write (those in :attr:`frames` when given) and whether the run said so
+        itself (``False``: it did not finish, so this is the scenario's configured range)."""
+        span, said = self._expected_all()
+        if self.frames is not None:
+            start, stop = self.frames
+            span = range(max(span.start, start), span.stop if stop is None else min(span.stop, stop))
+        return span, said
+
+    def _expected_all(self) -> tuple[range, bool]:
         run = self.run
         if is_parts_manifest(self.info.path):
             return range(int(run.get("frames_requested", self.info.frames_configured) or 0)), True
