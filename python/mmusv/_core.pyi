@@ -297,8 +297,8 @@ class SensorEnv:
         """Sky radiance (N, 3) float32 cd/m² along unit world directions ``dirs`` (N, 3) (ground below the
         horizon), with the sun's disc when ``sun_disc``."""
     @property
-    def sun_irradiance(self) -> tuple[float, float, float]:
-        """Direct-normal irradiance of the sun, lux (linear RGB); zero at night."""
+    def sun_irradiance(self) -> list[float]:
+        """Direct-normal irradiance of the sun, lux (linear RGB, a list of 3); zero at night."""
     @property
     def fog_extinction_per_m(self) -> float:
         """Atmospheric extinction, 1/m."""
@@ -371,11 +371,11 @@ class Camera:
     def rgb(self) -> bool:
         """Whether render shades an RGB image."""
     @property
-    def distortion(self) -> tuple[float, float, float, float, float] | None:
-        """Brown–Conrady [k1, k2, p1, p2, k3] (OpenCV order) or None."""
+    def distortion(self) -> list[float] | None:
+        """Brown–Conrady ``[k1, k2, p1, p2, k3]`` (OpenCV order; a list of 5) or None."""
     @property
-    def intrinsics(self) -> tuple[float, float, float, float] | None:
-        """[fx, fy, cx, cy] pixels (pinhole) or None (orthographic)."""
+    def intrinsics(self) -> list[float] | None:
+        """``[fx, fy, cx, cy]`` pixels (pinhole; a list of 4) or None (orthographic)."""
     @property
     def resolution(self) -> tuple[int, int]:
         """(width, height) pixels."""

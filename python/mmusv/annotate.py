@@ -92,7 +92,20 @@ class Annotations:
     cam_wave_occlusion: list[float] = field(default_factory=list)
 
     def columns(self) -> dict[str, Any]:
-        """Numpy columns: ``lidar`` and ``bev`` and ``camera`` dicts of arrays (shapes in the docstrings above)."""
+        """Numpy columns, the ``Recording.annotations`` groups: ``{"lidar", "bev", "camera"}``, each a dict of
+        columns in the order the vessels are in the world state (``n3d`` rows for ``lidar``/``bev``, ``n2d`` for
+        ``camera``, which goes vessel by vessel, camera by camera):
+
+        - ``lidar`` (the agent's LiDAR frame, metres, radians): ``target_id``, ``role`` lists of str;
+          ``instance_id``, ``semantic_class``, ``lidar_points`` ``(n3d,)`` uint32; ``center`` ``(n3d, 3)``,
+          ``size`` ``(n3d, 3)`` length, beam, height, ``rotation`` ``(n3d, 4)`` quaternion x, y, z, w, ``yaw``,
+          ``range_m`` (``|center|``), ``wave_occlusion`` ``(n3d,)`` float64; ``static`` ``(n3d,)`` bool;
+        - ``bev``: ``target_id``; ``x``, ``y``, ``length``, ``width``, ``yaw`` ``(n3d,)`` float64 (the 3D box's
+          footprint in the LiDAR frame's xy plane);
+        - ``camera`` (pixels, origin top-left, clipped to the image): ``target_id``, ``camera``, ``role`` lists of
+          str; ``x_min``, ``y_min``, ``x_max``, ``y_max``, ``truncation``, ``occlusion``, ``wave_occlusion``
+          ``(n2d,)`` float64; ``visible_pixels``, ``box_pixels`` ``(n2d,)`` uint32; ``static`` ``(n2d,)`` bool.
+        """
         n = len(self.lidar_ids)
         centre = np.array(self.lidar_center, dtype=np.float64).reshape(n, 3)
         size = np.array(self.lidar_size, dtype=np.float64).reshape(n, 3)

@@ -114,10 +114,11 @@ class RayHits:
         return p.astype(np.float32, copy=False)
 
 
-def surface_tiles(foci: npt.ArrayLike, radius_m: float) -> int:
+def surface_tiles(foci: npt.ArrayLike, *, radius_m: float) -> int:
     """How many tiles the displaced sea surface around ``foci`` ``(F, 2)`` (world x, y, metres) out to
-    ``radius_m`` holds: the core samples their bounding rectangle, grown by ``radius_m``, as one grid of
-    :data:`SURFACE_TILE_M` tiles (0 without foci)."""
+    ``radius_m`` (metres) holds: the core samples their bounding rectangle, grown by ``radius_m``, as one grid of
+    :data:`SURFACE_TILE_M` tiles aligned on multiples of :data:`SURFACE_TILE_M` (so a side may take one tile more
+    than its length over the tile's); 0 without foci."""
     f = np.ascontiguousarray(np.asarray(foci, dtype=np.float32).reshape(-1, 2))
     return int(core.surface_tiles(f, radius_m=float(radius_m), tile_m=SURFACE_TILE_M))  # the core's own count
 
@@ -163,7 +164,7 @@ def _surface_args(
     fine = arguments.real(fine_m, name="fine_m", unit="metres", lo=0.0, error=InputError)
     flags = {k: arguments.flag(v, name=k, error=InputError) for k, v in (("detail", detail), ("slopes", slopes))}
     if np.isfinite(f).all():  # (non-finite foci: the core names them)
-        tiles = surface_tiles(f, radius)
+        tiles = surface_tiles(f, radius_m=radius)
         if tiles > MAX_SURFACE_TILES:
             span = f.max(axis=0) - f.min(axis=0)
             raise InputError(

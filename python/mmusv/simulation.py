@@ -373,7 +373,7 @@ class Simulation:
         """The wave surface arguments of ``state`` (after the sea): finest around the USVs, which must lie close
         enough together for one sampled surface to span them (:data:`~mmusv.scene.MAX_SURFACE_TILES`)."""
         foci = np.array([state.poses[a.index, :2] for a in self.agents], dtype=np.float32).reshape(-1, 2)
-        if surface_tiles(foci, radius_m) > MAX_SURFACE_TILES:
+        if surface_tiles(foci, radius_m=radius_m) > MAX_SURFACE_TILES:
             lo, hi = foci.min(axis=0), foci.max(axis=0)
             # The side of the largest square surface, less the tile the rounding may add.
             side = (math.sqrt(MAX_SURFACE_TILES) - 1.0) * SURFACE_TILE_M
