@@ -189,3 +189,13 @@ def test_parts_written_before_wave_occlusion_read_with_it_null(tmp_path: Path) -
         assert got.rows["wave_occlusion"].null_count() == new.height
         assert got.rows.drop("wave_occlusion").equals(new.drop("wave_occlusion"))
         assert len(got.damaged) == 1 and "part-00001" in got.damaged[0]
+
+
+def test_an_unknown_table_name_is_a_config_error_listing_the_tables(tmp_path: Path) -> None:
+    import pytest
+    from mmusv.errors import ConfigError
+    from mmusv.recording.tables import read_table
+
+    for bad in ("worldstate", ["world_state"], None):
+        with pytest.raises(ConfigError, match=r"table = .*tables: world_state"):
+            read_table(tmp_path, bad)  # type: ignore[arg-type]

@@ -19,6 +19,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import polars as pl
 
+from mmusv.errors import ConfigError
+
 if TYPE_CHECKING:
     from mmusv.annotate import Annotations
     from mmusv.simulation import FrameCapture, VesselInfo
@@ -254,8 +256,8 @@ def read_table(root: str | os.PathLike[str], table: str, *, expected: range | No
     reads and has the table's columns; a damaged part is left out and named. ``expected``: the frames the run
     wrote (their absence from the rows is reported in ``missing``; only meaningful for ``world_state``, which
     has rows in every frame)."""
-    if table not in SCHEMAS:
-        raise ValueError(f"unknown table {table!r}; tables: {', '.join(SCHEMAS)}")
+    if not isinstance(table, str) or table not in SCHEMAS:
+        raise ConfigError(f"table = {table!r:.60}: not a table of a recording; tables: {', '.join(SCHEMAS)}")
     schema = SCHEMAS[table]
     frames: list[pl.DataFrame] = []
     damaged: list[str] = []
