@@ -70,7 +70,7 @@ for m in ("single", "early", "intermediate"):
     if not os.path.isfile(f):
         print(m, "no model.pt")
         continue
-    ck = torch.load(f, map_location="cpu", weights_only=False)
+    ck = torch.load(f, map_location="cpu", weights_only=True)
     ck["model"] = {k: (v.half() if v.is_floating_point() else v) for k, v in ck["model"].items()}
     ck["fp16_copy"] = True
     torch.save(ck, os.path.join(OUT, f"{m}_model_fp16.pt"))

@@ -15,7 +15,7 @@ if __name__ == "__main__":
     src, dst = Path(sys.argv[1]), Path(sys.argv[2])
     dst.mkdir(parents=True, exist_ok=True)
     for d in sorted(x for x in src.iterdir() if (x / "model.pt").is_file()):
-        ck = torch.load(d / "model.pt", map_location="cpu", weights_only=False)
+        ck = torch.load(d / "model.pt", map_location="cpu", weights_only=True)
         ck["model"] = {k: (v.half() if v.is_floating_point() else v) for k, v in ck["model"].items()}
         torch.save(ck, dst / f"{d.name}.pt")
         shutil.copy(d / "log.jsonl", dst / f"{d.name}.jsonl")

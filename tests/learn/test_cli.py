@@ -39,8 +39,8 @@ def test_side_by_side_models_equal_models_trained_in_turn(recording: Path, tmp_p
     assert _train(recording, tmp_path / "turn", "--jobs", "1", "--threads", "1") == 0
     assert _train(recording, tmp_path / "side", "--jobs", "3", "--threads", "1") == 0
     for mode in ("single", "early", "intermediate"):
-        a = torch.load(tmp_path / "turn" / mode / "model.pt", weights_only=False)
-        b = torch.load(tmp_path / "side" / mode / "model.pt", weights_only=False)
+        a = torch.load(tmp_path / "turn" / mode / "model.pt", weights_only=True)
+        b = torch.load(tmp_path / "side" / mode / "model.pt", weights_only=True)
         assert a["step"] == b["step"] > 0
         assert all(torch.equal(a["model"][k], b["model"][k]) for k in a["model"]), mode
         assert (tmp_path / "side" / mode / "loss.png").stat().st_size > 0

@@ -130,7 +130,7 @@ def test_train_command_line_applies_set(trained: tuple[Path, Cache, Path], tmp_p
     args = ["--cache", str(root / "cache.npz"), "--preset", "tiny", "--modes", "single", "-o", str(tmp_path)]
     args += ["--max-steps", "1", "--no-progress", "--threads", "1"]
     assert train_main([*args, "--set", "min_points=1", "--set", "code_weights=[1,1,0.1,1,1,1,1,1]"]) == 0
-    ck = torch.load(tmp_path / "single" / "model.pt", weights_only=False)
+    ck = torch.load(tmp_path / "single" / "model.pt", weights_only=True)
     assert ck["preset"]["min_points"] == 1 and ck["preset"]["code_weights"][2] == 0.1
     assert ck["preset"]["pillar_m"] == preset("tiny").pillar_m
     with pytest.raises(InputError, match="--set 'min_point=1'"):

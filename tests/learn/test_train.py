@@ -61,14 +61,14 @@ def test_same_seed_same_weights_and_resume(tmp_path: Path) -> None:
     runs = []
     for name, seed in (("a", 4), ("b", 4), ("c", 5)):
         train(src, p=p, mode="intermediate", out=tmp_path / name, seed=seed, epochs=3, progress=False)
-        runs.append(torch.load(tmp_path / name / "model.pt", weights_only=False)["model"])
+        runs.append(torch.load(tmp_path / name / "model.pt", weights_only=True)["model"])
     assert all(torch.equal(runs[0][k], runs[1][k]) for k in runs[0])
     assert any(not torch.equal(runs[0][k], runs[2][k]) for k in runs[0] if runs[0][k].is_floating_point())
     # interrupted after one epoch, then started again: the same weights as the run that went through
     train(src, p=p, mode="intermediate", out=tmp_path / "d", seed=4, epochs=1, progress=False)
     r = train(src, p=p, mode="intermediate", out=tmp_path / "d", seed=4, epochs=3, progress=False)
     assert r.epochs == 3
-    resumed = torch.load(tmp_path / "d" / "model.pt", weights_only=False)["model"]
+    resumed = torch.load(tmp_path / "d" / "model.pt", weights_only=True)["model"]
     assert all(torch.equal(runs[0][k], resumed[k]) for k in runs[0])
 
 

@@ -22,6 +22,7 @@ import numpy as np
 import torch
 
 from mmusv.learn._errors import input_error
+from mmusv.learn.checkpoint import load_checkpoint
 from mmusv.learn.decode import decode
 from mmusv.learn.example import MODES, collate, make_example, message_bytes
 from mmusv.learn.model import PillarNet
@@ -33,13 +34,14 @@ __all__ = ["LearnedDetector", "load_models"]
 
 
 def _load(path: Path, device: torch.device) -> tuple[PillarNet, dict[str, Any]]:
+    what = f"--model {path}: not an mmusv.learn model.pt"
+    ck = load_checkpoint(path, what=what, device=device)
     try:
-        ck = torch.load(path, map_location=device, weights_only=False)
         p = Preset.from_dict(ck["preset"])
         model = PillarNet(p, ck["mode"])
         model.load_state_dict(ck["model"])
     except (OSError, KeyError, TypeError, RuntimeError, ValueError) as exc:
-        raise input_error(f"--model {path}: not an mmusv.learn model.pt ({type(exc).__name__}: {exc})") from None
+        raise input_error(f"{what} ({type(exc).__name__}: {exc})") from None
     model.to(device).eval()
     if device.type == "cuda":
         model.channels_last()

@@ -21,6 +21,7 @@ import torch
 
 from mmusv.learn._errors import input_error
 from mmusv.learn.cache import Cache
+from mmusv.learn.checkpoint import load_checkpoint
 from mmusv.learn.decode import peaks
 from mmusv.learn.example import MODES, collate, make_example, message_bytes
 from mmusv.learn.model import PillarNet, torch_device
@@ -30,9 +31,13 @@ __all__ = ["infer_cache", "main", "merge_main", "merge_peaks"]
 
 
 def _model(path: Path, dev: torch.device) -> PillarNet:
-    ck = torch.load(path, map_location=dev, weights_only=False)
-    m = PillarNet(Preset.from_dict(ck["preset"]), ck["mode"])
-    m.load_state_dict(ck["model"])
+    what = f"{path}: not an mmusv.learn model.pt"
+    ck = load_checkpoint(path, what=what, device=dev)
+    try:
+        m = PillarNet(Preset.from_dict(ck["preset"]), ck["mode"])
+        m.load_state_dict(ck["model"])
+    except (KeyError, TypeError, RuntimeError, ValueError) as exc:
+        raise input_error(f"{what} ({type(exc).__name__}: {exc})") from None
     m = m.to(dev)
     return (m.channels_last() if dev.type == "cuda" else m).eval()
 

@@ -32,6 +32,7 @@ import torch
 from torch import nn
 
 from mmusv.learn._errors import input_error
+from mmusv.learn.checkpoint import load_checkpoint
 from mmusv.learn.refine import RefineParams, refine_on, surface_points
 from mmusv.studies.detection.evaluate import average_precision, bev_iou, match_frame
 from mmusv.studies.detection.fusion import rotated_nms
@@ -165,8 +166,8 @@ def blend(scores: np.ndarray, iou: np.ndarray, beta: float) -> np.ndarray:
 def load_scorer(path: str | Path) -> IoUScorer:
     """The :class:`IoUScorer` saved at ``path``; raises ``InputError`` naming the file when it is not one."""
     p = Path(path)
+    ck = load_checkpoint(p, what=f"{p}: not an mmusv.learn scorer")
     try:
-        ck = torch.load(p, map_location="cpu", weights_only=False)
         if list(ck["features"]) != list(FEATURES):
             raise ValueError(f"features {ck['features']} are not this version's {list(FEATURES)}")
         n = len(FEATURES)

@@ -41,6 +41,7 @@ import torch
 from mmusv.learn._errors import input_error
 from mmusv.learn.augment import apply, draw
 from mmusv.learn.cache import Cache
+from mmusv.learn.checkpoint import load_checkpoint
 from mmusv.learn.example import MODES, Example, collate, early_cloud, make_example
 from mmusv.learn.loss import centerpoint_loss
 from mmusv.learn.model import PillarNet, torch_device
@@ -156,12 +157,16 @@ def train(
     start_epoch, step, log, spent = 0, 0, [], 0.0
     last = out_p / "last.pt"
     if last.is_file():
-        ck = torch.load(last, map_location=dev, weights_only=False)
-        if ck["preset"] != p.to_dict() or ck["mode"] != mode or ck["seed"] != seed:
+        what = f"{last}: not a checkpoint of mmusv train (remove it to start again, or use another --out)"
+        ck = load_checkpoint(last, what=what, device=dev)
+        if ck.get("preset") != p.to_dict() or ck.get("mode") != mode or ck.get("seed") != seed:
             raise input_error(f"{last}: a checkpoint of another run (preset/mode/seed differ); use another --out")
-        model.load_state_dict(ck["model"])
-        opt.load_state_dict(ck["optimizer"])
-        start_epoch, step, log, spent = ck["epoch"], ck["step"], ck["log"], ck["seconds"]
+        try:
+            model.load_state_dict(ck["model"])
+            opt.load_state_dict(ck["optimizer"])
+            start_epoch, step, log, spent = int(ck["epoch"]), int(ck["step"]), list(ck["log"]), float(ck["seconds"])
+        except (KeyError, TypeError, RuntimeError, ValueError) as exc:
+            raise input_error(f"{what} ({type(exc).__name__}: {exc})") from None
     log_path = out_p / "log.jsonl"
     t0 = time.perf_counter() - spent
     finished = True
