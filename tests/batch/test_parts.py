@@ -90,6 +90,25 @@ def test_parts_read_as_one_sequence(
     assert find_recordings(split) == [split / n / f"{n}.parts.json" for n in GOOD]
 
 
+def test_a_frame_range_of_parts_reads_only_the_parts_it_needs(
+    split: Path, reference: tuple[Path, dict[str, str]], tmp_path: Path
+) -> None:
+    manifest = split / "b_sea/b_sea.parts.json"
+    full = frames_of(whole(reference, "b_sea"))
+    for rng in ((20, 30), (30, 31), (49, None)):
+        stream = FrameStream(read_info(manifest), lambda t: True, frames=rng)
+        got = [(f.index, {t: m.SerializeToString() for t, m in sorted(f.messages.items())}) for f in stream]
+        assert got == full[rng[0] : rng[1]] and stream.report() is None, rng
+    # the first part is not even opened for frames of the second: its absence goes unnoticed
+    moved = tmp_path / "b_sea"
+    shutil.copytree(split / "b_sea", moved)
+    shutil.rmtree(moved / "parts" / "000000-000024")
+    stream = FrameStream(read_info(moved / "b_sea.parts.json"), lambda t: True, frames=(30, 33))
+    assert [f.index for f in stream] == [30, 31, 32] and stream.report() is None
+    rep = convert(moved / "b_sea.parts.json", out_dir=tmp_path / "conv", splits=None, frames=(30, 33))
+    assert rep.frames == 3 and not rep.recordings[0].skipped
+
+
 def test_conversion_and_the_study_read_parts_like_the_whole_recording(
     split: Path, reference: tuple[Path, dict[str, str]], tmp_path: Path
 ) -> None:
