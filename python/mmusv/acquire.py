@@ -153,6 +153,9 @@ def run(
         KeyboardInterrupt: re-raised after the recording was finished with every completed frame.
     """
 
+    from mmusv.batch.executors import refuse_in_worker_import
+
+    refuse_in_worker_import("mmusv.run")  # the top level of a script a batch's worker imports: said at once
     # The arguments' types first (cheap, and before anything is built or written), their ranges once the scenario
     # says how many frames it has.
     out = arguments.path(out_dir, name="out_dir")

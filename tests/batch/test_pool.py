@@ -242,3 +242,40 @@ def test_pool_workers_get_their_share_of_the_cpus(tmp_path: Path) -> None:
     assert report.backend == "pool" and [o.threads for o in report.outcomes] == [["1"], ["1"]]
     again = run_many(src, out_dir=tmp_path / "out", jobs=2)
     assert again.count("skipped") == 2 and again.backend == "serial"  # nothing to run: no pool is started
+
+
+def test_a_script_without_the_main_guard_is_told_so(tmp_path: Path) -> None:
+    """The pool's workers import the script that starts them: a call to run or run_many at its top level runs
+    again in each of them. Said where it happens (the worker refuses, naming the guard) and in the driver's lost
+    tasks; the guarded script runs. Before, each worker ran the script's own mmusv.run again (a whole recording
+    into the same folder), then died on the folder lock, and the batch said only 'worker lost ... out of
+    memory'."""
+    import subprocess
+    import sys
+
+    from .conftest import ROOT
+
+    src = tmp_path / "src"
+    src.mkdir()
+    for name in ("a", "b"):
+        write(src / f"{name}.yaml", scenario(name, frames=1))
+    body = (
+        "import mmusv\n"
+        "r = mmusv.run_many('src', out_dir='out', jobs=2, lost_worker_retries=0)\n"
+        "print('STATUS', sorted({o.status for o in r.outcomes}), r.outcomes[0].error)\n"
+    )
+    guarded = "if __name__ == '__main__':\n" + "".join(f"    {line}\n" for line in body.splitlines())
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "python") + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    for name, text in (("unguarded.py", body), ("guarded.py", guarded)):
+        (tmp_path / name).write_text(text, encoding="utf-8")
+        shutil.rmtree(tmp_path / "out", ignore_errors=True)
+        proc = subprocess.run(
+            [sys.executable, name], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=240
+        )
+        status = [line for line in proc.stdout.splitlines() if line.startswith("STATUS")]
+        assert proc.returncode == 0 and status, (name, proc.stdout[-2000:], proc.stderr[-2000:])
+        if name == "guarded.py":
+            assert status[0].startswith("STATUS ['done'] None"), status
+        else:
+            assert "STATUS ['failed'] worker lost" in status[0] and '__name__ == "__main__"' in status[0], status
+            assert "mmusv.run_many was called while a worker process imported the script" in proc.stderr

@@ -19,7 +19,12 @@ from typing import Any, Protocol
 from mmusv.batch.plan import Task
 from mmusv.batch.task import TaskResult, execute, lost
 
-__all__ = ["Executor", "PoolExecutor", "SerialExecutor", "available_cpus"]
+__all__ = ["Executor", "PoolExecutor", "SerialExecutor", "available_cpus", "refuse_in_worker_import"]
+
+UNGUARDED = (
+    'in a script, put the call under  if __name__ == "__main__":  (the pool\'s worker processes import the script '
+    "that starts them, and run what its top level runs)"
+)
 
 _REAP_S = 15.0
 """How long a stopped pool worker may take to finish its recording before it is killed."""
@@ -31,6 +36,34 @@ def available_cpus() -> int:
         return len(os.sched_getaffinity(0))
     except AttributeError:  # not Linux
         return os.cpu_count() or 1
+
+
+def _started_from_a_script() -> bool:
+    """Whether this process runs a script file of the user's (which spawned workers import), not ``mmusv``'s own
+    command line or an interactive session."""
+    import sys
+
+    main = sys.modules.get("__main__")
+    spec = getattr(main, "__spec__", None)
+    name = getattr(spec, "name", "") or ""
+    path = getattr(main, "__file__", None)
+    return path is not None and not name.startswith("mmusv") and os.path.basename(path) not in ("mmusv", "mmusv.exe")
+
+
+def refuse_in_worker_import(what: str) -> None:
+    """Raises :class:`~mmusv.errors.ConfigError` when ``what`` (``"mmusv.run_many"``) is called while a pool
+    worker imports the script that started the pool (Python's spawn runs the script's top level again, as module
+    ``__mp_main__``): the call is not under ``if __name__ == "__main__":`` and would run the batch again inside
+    every worker. The worker then dies saying so, and the driver's lost task says it too (:data:`UNGUARDED`)."""
+    import sys
+
+    frame = sys._getframe(1)
+    while frame is not None:
+        if frame.f_code.co_name == "<module>" and frame.f_globals.get("__name__") == "__mp_main__":
+            from mmusv.errors import ConfigError
+
+            raise ConfigError(f"{what} was called while a worker process imported the script: {UNGUARDED}")
+        frame = frame.f_back  # type: ignore[assignment]
 
 
 class Executor(Protocol):
@@ -167,6 +200,7 @@ class PoolExecutor:
         self.threads = threads
         self._pool: ProcessPoolExecutor | None = None
         self._futures: dict[Future[TaskResult], Task] = {}
+        self._finished = 0  # tasks the pool answered (a pool that never answers may be an unguarded script)
 
     def _ensure(self) -> None:
         import multiprocessing
@@ -203,12 +237,17 @@ class PoolExecutor:
         fut = min(done, key=lambda f: self._futures[f].key)
         task = self._futures.pop(fut)
         try:
-            return task, fut.result()
+            result = fut.result()
         except BrokenProcessPool:
             if self._pool is not None:
                 self._pool.shutdown(wait=False, cancel_futures=True)
                 self._pool = None
-            return task, lost(task, "a process of the local pool died (killed, or out of memory)")
+            why = "a process of the local pool died (killed, or out of memory)"
+            if self._finished == 0 and _started_from_a_script():
+                why = f"{why}; if no task ever finishes: {UNGUARDED}"
+            return task, lost(task, why)
+        self._finished += 1
+        return task, result
 
     def in_flight(self) -> int:
         return len(self._futures)

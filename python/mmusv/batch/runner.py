@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from mmusv import arguments
-from mmusv.batch.executors import Executor, PoolExecutor, SerialExecutor, available_cpus
+from mmusv.batch.executors import Executor, PoolExecutor, SerialExecutor, available_cpus, refuse_in_worker_import
 from mmusv.batch.index import INDEX_NAME, Entry, folder_bytes, write_index
 from mmusv.batch.plan import ScenarioPlan, plan_scenarios, prepare, scenario_files
 from mmusv.batch.task import TaskResult
@@ -181,6 +181,7 @@ def run_many(
         reported as failed while the others run.
         KeyboardInterrupt: after the executor stopped and the index says what is done.
     """
+    refuse_in_worker_import("mmusv.run_many")
     t0 = time.perf_counter()
     jobs = arguments.whole(jobs, name="jobs", lo=1)
     retries = arguments.whole(retries, name="retries", lo=0)
