@@ -47,6 +47,7 @@ export const api = {
   poses: (document, frame) => call("POST", "/api/poses", { document, frame }),
   preview: (document, frame, agent) => call("POST", "/api/preview", { document, frame, agent }),
   startRun: (name, frames) => call("POST", "/api/runs", { name, frames }),
+  runs: () => call("GET", "/api/runs"),
   run: (id) => call("GET", `/api/runs/${id}`),
   stopRun: (id) => call("DELETE", `/api/runs/${id}`),
 };

@@ -14,6 +14,7 @@ const panels = new Panels(state, map);
 let bundled = [];
 let runTimer = null;
 let currentRun = null;
+let runAfterSave = null; // {frames}: the run to start once the file is saved over (Run, then Overwrite)
 
 function status(text, error = false) {
   const s = $("status");
@@ -70,6 +71,12 @@ function togglePlay() {
   $("play").textContent = "Pause";
   const t0 = performance.now(), k0 = state.frame >= ev.frames - 1 ? 0 : state.frame;
   const step = () => {
+    // an edit of the acquisition (frames, frequency) while playing: stop at a frame the scenario has
+    const now = state.evaluation;
+    if (now && (!now.valid || now.frames !== ev.frames || now.frequency_hz !== ev.frequency_hz)) {
+      if (now.valid && state.frame > now.frames - 1) state.setFrame(now.frames - 1);
+      return togglePlay();
+    }
     const k = Math.min(ev.frames - 1, k0 + Math.floor(((performance.now() - t0) / 1000) * ev.frequency_hz));
     if (k !== state.frame) state.setFrame(k);
     if (k >= ev.frames - 1) return togglePlay();
@@ -107,7 +114,10 @@ async function refreshOpen() {
 
 async function open(value) {
   if (!value) return;
-  if (state.dirty && !window.confirm("Discard the unsaved changes?")) return;
+  if (state.dirty && !window.confirm("Discard the unsaved changes?")) {
+    $("open").value = ""; // the scenario shown is still the one edited, not the one picked
+    return;
+  }
   const [kind, name] = [value.slice(0, value.indexOf(":")), value.slice(value.indexOf(":") + 1)];
   try {
     const res = kind === "file" ? await api.readFile(name) : await api.bundledOne(name);
@@ -127,6 +137,7 @@ let savedEtag = null;
 async function save(overwrite = false) {
   const name = $("file-name").value.trim();
   $("save-confirm").hidden = true;
+  $("save-overwrite").textContent = "Overwrite";
   if (!name) {
     status("give the file a name ending in .yaml", true);
     return false;
@@ -139,6 +150,7 @@ async function save(overwrite = false) {
     state.savedName = name;
     state.fileName = name;
     state.dirty = false;
+    renderAll(); // the title's unsaved mark and file name
     status(`saved ${res.name} (${res.bytes} bytes)`);
     document.body.dataset.saved = name;
     await refreshOpen();
@@ -208,24 +220,41 @@ async function run() {
     status("frames: type a whole number of frames (1 or more), or leave the box empty to run every frame", true);
     return;
   }
-  if (!(await save(false))) return;
+  runAfterSave = null;
+  if (!(await save(false))) {
+    // the file exists or changed: the Overwrite button saves it and then starts the run asked for
+    if (!$("save-confirm").hidden) {
+      runAfterSave = { frames };
+      $("save-overwrite").textContent = "Overwrite and run";
+    }
+    return;
+  }
+  await startRun(frames);
+}
+
+async function startRun(frames) {
   try {
-    const job = await api.startRun(state.savedName, frames);
-    showRun(job);
-    clearInterval(runTimer);
-    runTimer = setInterval(async () => {
-      try {
-        const j = await api.run(job.id);
-        showRun(j);
-        if (j.status !== "running") clearInterval(runTimer);
-      } catch (err) {
-        clearInterval(runTimer);
-        status(err.message, true);
-      }
-    }, 400);
+    follow(await api.startRun(state.savedName, frames));
   } catch (err) {
     status(`run: ${err.message}`, true);
   }
+}
+
+/** Shows the run `job` and its progress until it ends. */
+function follow(job) {
+  showRun(job);
+  clearInterval(runTimer);
+  if (job.status !== "running") return;
+  runTimer = setInterval(async () => {
+    try {
+      const j = await api.run(job.id);
+      showRun(j);
+      if (j.status !== "running") clearInterval(runTimer);
+    } catch (err) {
+      clearInterval(runTimer);
+      status(err.message, true);
+    }
+  }, 400);
 }
 
 // ------------------------------------------------------------------------------------- wiring
@@ -235,6 +264,7 @@ function renderAll() {
   panels.renderVessel();
   panels.renderProblems();
   panels.renderScenario();
+  panels.renderNotes();
   map.renderScenario();
   renderTimeline();
   $("undo").disabled = !state.undoStack.length;
@@ -263,6 +293,7 @@ state.on("evaluated", () => {
 state.on("selection", () => {
   panels.renderFleet();
   panels.renderVessel();
+  panels.renderNotes();
   map.renderScenario();
 });
 state.on("frame", () => {
@@ -285,9 +316,17 @@ $("open").addEventListener("change", (ev) => open(ev.target.value));
 $("file-name").addEventListener("change", (ev) => {
   state.fileName = ev.target.value.trim();
 });
-$("save").addEventListener("click", () => save(false));
-$("save-overwrite").addEventListener("click", () => save(true));
+$("save").addEventListener("click", () => {
+  runAfterSave = null;
+  save(false);
+});
+$("save-overwrite").addEventListener("click", async () => {
+  const then = runAfterSave;
+  runAfterSave = null;
+  if ((await save(true)) && then) await startRun(then.frames);
+});
 $("save-cancel").addEventListener("click", () => {
+  runAfterSave = null;
   $("save-confirm").hidden = true;
 });
 $("undo").addEventListener("click", () => state.undo());
@@ -311,6 +350,7 @@ window.addEventListener("keydown", (ev) => {
   const typing = ["INPUT", "TEXTAREA", "SELECT"].includes(document.activeElement?.tagName);
   if ((ev.ctrlKey || ev.metaKey) && ev.key.toLowerCase() === "s") {
     ev.preventDefault();
+    runAfterSave = null;
     save(false);
   } else if (!typing && (ev.ctrlKey || ev.metaKey) && ev.key.toLowerCase() === "z") {
     ev.preventDefault();
@@ -344,6 +384,9 @@ async function boot() {
       state.load({ document: res.document, comment: res.comment, name: res.name });
     }
     map.applyView();
+    // a run started before the page was loaded again (or from another tab) is still followed
+    const running = (await api.runs()).find((j) => j.status === "running");
+    if (running) follow(running);
     document.body.dataset.ready = "1";
   } catch (err) {
     status(`cannot start: ${err.message}`, true);

@@ -411,8 +411,10 @@ export class MapView {
   }
 
   deleteWaypoint(id, index) {
-    this.state.edit((doc) => doc.vessels[this.state.vesselIndex(id)].route.splice(index, 1));
     this.activeWaypoint = null;
+    const v = this.state.vessel(id);
+    if (!v || !Array.isArray(v.route) || !(index >= 0 && index < v.route.length)) return; // gone meanwhile
+    this.state.edit((doc) => doc.vessels[this.state.vesselIndex(id)].route.splice(index, 1));
   }
 
   // ----------------------------------------------------------------------------------------- events
@@ -508,7 +510,8 @@ export class MapView {
     });
 
     svg.addEventListener("keydown", (ev) => {
-      if ((ev.key === "Delete" || ev.key === "Backspace") && this.activeWaypoint) {
+      // only a handle of the vessel selected now: the vessel of an earlier handle may be deselected or deleted
+      if ((ev.key === "Delete" || ev.key === "Backspace") && this.activeWaypoint?.vessel === this.state.selected) {
         ev.preventDefault();
         this.deleteWaypoint(this.activeWaypoint.vessel, this.activeWaypoint.index);
       } else if (ev.key === "Enter" || ev.key === "Escape") {

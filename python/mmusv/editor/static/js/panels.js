@@ -17,6 +17,8 @@ function fillSelect(select, values) {
 
 function setValue(input, value) {
   if (document.activeElement === input) return; // do not fight the person typing
+  // an entry the page refused stays as typed, beside its note, until the person changes it
+  if (input.tagName === "INPUT" && input.dataset.refused === "1") return;
   input.value = value ?? "";
 }
 
@@ -26,10 +28,114 @@ function numberOrNull(input) {
   return Number.isFinite(n) ? n : input.value;
 }
 
+/** Enter or Space on an item matching `selector` inside `list` clicks it (items that act on a click are buttons to
+ * a keyboard too). */
+function clickOnEnter(list, selector) {
+  list.addEventListener("keydown", (ev) => {
+    const item = ev.target.closest(selector);
+    if (!item || ev.target !== item || (ev.key !== "Enter" && ev.key !== " ")) return;
+    ev.preventDefault();
+    ev.stopPropagation(); // not also the page's Enter (which ends placing and drawing)
+    item.click();
+  });
+}
+
+/** The form fields that can carry a note (the Checks list's items have a data-field too). */
+const FIELDS = ["input", "select", "textarea", "table"].map((t) => `#left ${t}[data-field], #right ${t}[data-field]`).join(", ");
+
+const RIG_NAME = /^[A-Za-z0-9_-]{1,64}$/;
+
+/** Whether the scenario's schema error at `field` (its message `message`) concerns the form field `path`: the same
+ * field or one inside it, or a check across a section's fields (`environment`) that names this field's key. */
+function concerns(field, message, path) {
+  if (!field) return false;
+  if (field === path || field.startsWith(`${path}.`) || field.startsWith(`${path}[`)) return true;
+  const key = path.slice(path.lastIndexOf(".") + 1);
+  return path.startsWith(`${field}.`) && /^[a-z_]+$/.test(key) && message.includes(key);
+}
+
 export class Panels {
   constructor(state, mapView) {
     this.state = state;
     this.map = mapView;
+    // Entries the page did not write into the scenario (a number box the browser cannot read, an id another
+    // vessel has, map parameters that are not JSON): field path -> the note shown next to the field. The scenario
+    // keeps its value, every other edit stays; the note goes when the field is changed again or the scenario is
+    // replaced (open, undo, redo).
+    this.refused = new Map();
+    this.lastErrors = [];
+    state.on("jump", () => this.forgetRefused(""));
+  }
+
+  // ------------------------------------------------------------------------------------- notes next to fields
+
+  /** Refuses what was typed into `input` (its `data-field` path): the scenario is left as it is, `message` says
+   * why and what is allowed, next to the field. */
+  refuse(input, message) {
+    this.refused.set(input.dataset.field, message);
+    if (input.tagName === "INPUT") input.dataset.refused = "1";
+    this.renderNotes();
+  }
+
+  /** Clears the refusal of `input`'s field (it was changed again and is being applied). */
+  accept(input) {
+    this.refused.delete(input.dataset.field);
+    delete input.dataset.refused;
+  }
+
+  /** Forgets the refusals of the fields under `prefix` ("" for all), and shows the scenario's values there again. */
+  forgetRefused(prefix) {
+    for (const key of [...this.refused.keys()]) if (key.startsWith(prefix)) this.refused.delete(key);
+    for (const input of document.querySelectorAll("[data-refused]")) {
+      if (input.dataset.field.startsWith(prefix)) delete input.dataset.refused;
+    }
+  }
+
+  /** A number typed into `input`, null when it is empty; undefined when the browser cannot read it as a number
+   * ("1e", "1e400", "--1"), which is refused with a note saying what `allowed`. With `required`, empty is refused
+   * too. */
+  readNumber(input, label, allowed, { required = false } = {}) {
+    if (input.validity?.badInput || (required && input.value.trim() === "")) {
+      const what = input.validity?.badInput ? "not a number" : "empty";
+      this.refuse(input, `${label}: ${what}; type ${allowed}. The scenario keeps its value.`);
+      return undefined;
+    }
+    this.accept(input);
+    return numberOrNull(input);
+  }
+
+  /** Shows next to every form field the refusal of what was typed there, or the scenario's schema error about it
+   * (from the last check: the Checks list has them all), and marks the field invalid for assistive technology. */
+  renderNotes() {
+    const ev = this.state.evaluation;
+    if (ev) this.lastErrors = ev.errors || [];
+    else if (this.state.evalError) this.lastErrors = [];
+    let n = 0;
+    for (const el of document.querySelectorAll(FIELDS)) {
+      const path = el.dataset.field;
+      let text = this.refused.get(path) || null;
+      if (!text) {
+        const errs = this.lastErrors.filter((e) => concerns(e.field, e.message, path));
+        if (errs.length) text = errs.map((e) => e.message).join("; ");
+      }
+      let note = el.nextElementSibling?.classList.contains("field-note") ? el.nextElementSibling : null;
+      if (!text) {
+        note?.remove();
+        el.removeAttribute("aria-invalid");
+        if (el.getAttribute("aria-describedby")?.startsWith("note-")) el.removeAttribute("aria-describedby");
+        continue;
+      }
+      if (!note) {
+        note = document.createElement("span");
+        note.className = "field-note";
+        el.insertAdjacentElement("afterend", note);
+      }
+      note.id = `note-${++n}`;
+      note.dataset.for = path;
+      note.textContent = text;
+      el.setAttribute("aria-invalid", "true");
+      el.setAttribute("aria-describedby", note.id);
+    }
   }
 
   init(choices, assets) {
@@ -44,6 +150,7 @@ export class Panels {
     fillSelect($("e-wave"), [...choices.wave.map((w) => [w.name, `${w.name} (H ${w.height_m} m)`]), ["custom", "custom height…"]]);
     this.renderLibrary();
     this.bindLibrary();
+    clickOnEnter($("problems"), "li.problem");
     this.bindVesselForm();
     this.bindScenarioForm();
   }
@@ -53,6 +160,7 @@ export class Panels {
   renderLibrary() {
     const q = $("library-search").value.trim().toLowerCase();
     const ul = $("library");
+    const focused = document.activeElement?.closest?.("#library li")?.dataset.asset;
     ul.replaceChildren();
     const armed = this.map.placing?.asset?.name;
     for (const a of this.state.assets) {
@@ -60,6 +168,9 @@ export class Panels {
       if (q && !q.split(/\s+/).every((w) => hay.includes(w))) continue;
       const li = document.createElement("li");
       li.dataset.asset = a.name;
+      li.tabIndex = 0;
+      li.setAttribute("role", "button");
+      li.setAttribute("aria-pressed", String(a.name === armed));
       li.title = `${a.description}\n${a.length} m long, ${a.beam} m beam, ${a.height} m high, ${a.draft} m draft`;
       if (a.name === armed) li.classList.add("armed");
       const name = document.createElement("span");
@@ -75,11 +186,13 @@ export class Panels {
       size.textContent = `${a.length} × ${a.beam} m`;
       li.append(name, size);
       ul.appendChild(li);
+      if (a.name === focused) li.focus();
     }
   }
 
   bindLibrary() {
     $("library-search").addEventListener("input", () => this.renderLibrary());
+    clickOnEnter($("library"), "li[data-asset]");
     $("library").addEventListener("click", (ev) => {
       const li = ev.target.closest("li[data-asset]");
       if (!li) return;
@@ -90,6 +203,7 @@ export class Panels {
         this.map.setMode("place", { asset, role: $("library-role").value });
       }
       this.renderLibrary();
+      $("library").querySelector(`li[data-asset="${CSS.escape(asset.name)}"]`)?.focus();
     });
     $("library-role").addEventListener("change", () => {
       if (this.map.mode === "place") this.map.setMode("place", { asset: this.map.placing.asset, role: $("library-role").value });
@@ -100,6 +214,7 @@ export class Panels {
 
   renderFleet() {
     const ul = $("fleet");
+    const focused = document.activeElement?.closest?.("#fleet li")?.dataset.id;
     ul.replaceChildren();
     const vessels = this.state.doc?.vessels || [];
     $("vessel-count").textContent = String(vessels.length);
@@ -110,6 +225,9 @@ export class Panels {
     for (const v of vessels) {
       const li = document.createElement("li");
       li.dataset.id = v.id;
+      li.tabIndex = 0;
+      li.setAttribute("role", "button");
+      li.setAttribute("aria-pressed", String(v.id === this.state.selected));
       if (v.id === this.state.selected) li.classList.add("selected");
       const dot = document.createElement("span");
       dot.className = `dot ${v.role === "usv" ? "usv" : "target"}`;
@@ -128,13 +246,20 @@ export class Panels {
       asset.textContent = v.asset;
       li.appendChild(asset);
       ul.appendChild(li);
+      if (v.id === focused) li.focus();
     }
   }
 
   renderVessel() {
     const v = this.state.vessel();
     $("vessel-panel").hidden = !v;
+    if ((v?.id ?? null) !== this.shownVessel) this.forgetRefused("vessels["); // another vessel: its own values
+    this.shownVessel = v?.id ?? null;
     if (!v) return;
+    const at = `vessels[${this.state.vesselIndex(v.id)}]`;
+    const keys = { "v-id": "id", "v-role": "role", "v-asset": "asset", "v-rig": "rig", "v-speed": "speed_mps", "v-end": "end", "v-offset": "start_offset_m" };
+    for (const [id, key] of Object.entries(keys)) $(id).dataset.field = `${at}.${key}`;
+    $("v-route").dataset.field = `${at}.route`;
     setValue($("v-id"), v.id);
     setValue($("v-role"), v.role || "target");
     setValue($("v-asset"), v.asset);
@@ -161,7 +286,11 @@ export class Panels {
         input.step = "1";
         input.value = String(val);
         input.dataset.axis = String(j);
+        input.dataset.field = `${at}.route[${i}][${j}]`;
+        const refused = this.refused.get(input.dataset.field);
+        if (refused) input.dataset.refused = "1";
         input.title = j === 0 ? "x east, metres" : "y north, metres";
+        input.setAttribute("aria-label", `waypoint ${i} ${j === 0 ? "x east" : "y north"}, metres`);
         td.appendChild(input);
         return td;
       });
@@ -169,6 +298,7 @@ export class Panels {
       const b = document.createElement("button");
       b.textContent = "×";
       b.title = "delete this waypoint";
+      b.setAttribute("aria-label", `delete waypoint ${i}`);
       b.dataset.delete = String(i);
       del.appendChild(b);
       tr.append(idx, ...cells, del);
@@ -184,6 +314,7 @@ export class Panels {
   }
 
   bindVesselForm() {
+    clickOnEnter($("fleet"), "li[data-id]");
     $("fleet").addEventListener("click", (ev) => {
       const li = ev.target.closest("li[data-id]");
       if (li) this.state.select(li.dataset.id);
@@ -194,6 +325,13 @@ export class Panels {
     });
     $("v-id").addEventListener("change", (ev) => {
       const id = ev.target.value.trim();
+      const others = (this.state.doc.vessels || []).filter((v) => v.id !== this.state.selected).map((v) => v.id);
+      if (others.includes(id)) {
+        // written, the panel would show the other vessel of that id and the next edit would go to it
+        this.refuse(ev.target, `id: ${JSON.stringify(id)} is the id of another vessel; give this vessel an id of its own (ids must be unique). It keeps ${JSON.stringify(this.state.selected)}.`);
+        return;
+      }
+      this.accept(ev.target);
       this.editVessel((v) => {
         v.id = id;
       });
@@ -211,25 +349,32 @@ export class Panels {
       if (ev.target.value) v.rig = ev.target.value;
       else delete v.rig;
     }));
-    $("v-speed").addEventListener("change", (ev) => this.editVessel((v) => {
-      v.speed_mps = numberOrNull(ev.target) ?? 0;
-    }));
+    $("v-speed").addEventListener("change", (ev) => {
+      const n = this.readNumber(ev.target, "speed", "a speed in m/s, 0 or more", { required: true });
+      if (n !== undefined) this.editVessel((v) => {
+        v.speed_mps = n;
+      });
+    });
     $("v-end").addEventListener("change", (ev) => this.editVessel((v) => {
       if (ev.target.value === "stop") delete v.end;
       else v.end = ev.target.value;
     }));
-    $("v-offset").addEventListener("change", (ev) => this.editVessel((v) => {
-      const n = numberOrNull(ev.target);
-      if (n === null || n === 0) delete v.start_offset_m;
-      else v.start_offset_m = n;
-    }));
+    $("v-offset").addEventListener("change", (ev) => {
+      const n = this.readNumber(ev.target, "start offset", "metres along the route, 0 or more (empty: 0)");
+      if (n !== undefined) this.editVessel((v) => {
+        if (n === null || n === 0) delete v.start_offset_m;
+        else v.start_offset_m = n;
+      });
+    });
     $("v-route").addEventListener("change", (ev) => {
       const input = ev.target;
       const row = input.closest("tr");
       if (!row || input.dataset.axis === undefined) return;
       const i = Number(row.dataset.index), j = Number(input.dataset.axis);
-      this.editVessel((v) => {
-        v.route[i][j] = numberOrNull(input) ?? 0;
+      const axis = j === 0 ? "x (east)" : "y (north)";
+      const n = this.readNumber(input, `waypoint ${i} ${axis}`, "a position in metres", { required: true });
+      if (n !== undefined) this.editVessel((v) => {
+        v.route[i][j] = n;
       });
     });
     $("v-route").addEventListener("click", (ev) => {
@@ -242,6 +387,7 @@ export class Panels {
     $("v-zoom").addEventListener("click", () => this.map.zoomTo(this.state.selected));
     $("v-delete").addEventListener("click", () => {
       const id = this.state.selected;
+      this.forgetRefused("vessels[");
       this.state.edit((doc) => {
         doc.vessels = doc.vessels.filter((v) => v.id !== id);
       });
@@ -292,6 +438,10 @@ export class Panels {
       msg.className = "msg";
       msg.textContent = p.message;
       li.append(check, field, msg);
+      if (p.vessels?.length || p.point) {
+        li.tabIndex = 0; // Enter shows it, like a click
+        li.setAttribute("role", "button");
+      }
       li.addEventListener("click", () => {
         if (p.vessels?.length) this.state.select(p.vessels[0]);
         if (p.point) {
@@ -319,15 +469,23 @@ export class Panels {
     const env = d.environment || {};
     setValue($("e-time"), env.time_of_day || "12:00");
     setValue($("e-weather"), env.weather || "clear");
-    const presets = this.state.choices.wave.map((w) => w.name);
-    const wave = env.wave ?? "W0";
-    setValue($("e-wave"), typeof wave === "string" && presets.includes(wave) ? wave : "custom");
+    setValue($("e-wave"), this.waveChoice());
     setValue($("e-visibility"), env.visibility_m);
     setValue($("e-rain"), env.rain_mm_per_h);
     const acq = d.acquisition || {};
     setValue($("a-frequency"), acq.frequency_hz ?? 5);
     setValue($("a-frames"), acq.frames ?? 100);
     this.renderRigs();
+  }
+
+  /** The wave select's value for the scenario's wave (a preset's name, or "custom" for a height, whose option then
+   * shows it). */
+  waveChoice() {
+    const presets = this.state.choices.wave.map((w) => w.name);
+    const wave = this.state.doc.environment?.wave ?? "W0";
+    const custom = $("e-wave").querySelector('option[value="custom"]');
+    custom.textContent = typeof wave === "number" ? `custom: H ${wave} m` : "custom height…";
+    return typeof wave === "string" && presets.includes(wave) ? wave : "custom";
   }
 
   renderRigs() {
@@ -373,6 +531,8 @@ export class Panels {
         }
         input.value = String(value);
         input.dataset.key = keys[i];
+        input.dataset.field = `rigs.${name}.${keys[i]}`;
+        if (kind !== "select" && this.refused.has(input.dataset.field)) input.dataset.refused = "1";
         l.appendChild(input);
         grid.appendChild(l);
       });
@@ -405,7 +565,7 @@ export class Panels {
         else rig.radar = {};
       } else {
         const [part, field] = key.split(".");
-        const n = numberOrNull(input);
+        const n = input.dataset.number === "" ? null : Number(input.dataset.number);
         if (rig[part] === null) rig[part] = {};
         rig[part] ||= {};
         if (n === null) delete rig[part][field];
@@ -417,12 +577,16 @@ export class Panels {
 
   bindScenarioForm() {
     const edit = (fn) => this.state.edit(fn);
+    const WHOLE = "a whole number, 0 or more (empty: 0)";
     $("s-name").addEventListener("change", (ev) => edit((d) => {
       d.name = ev.target.value.trim();
     }));
-    $("s-seed").addEventListener("change", (ev) => edit((d) => {
-      d.seed = numberOrNull(ev.target) ?? 0;
-    }));
+    $("s-seed").addEventListener("change", (ev) => {
+      const n = this.readNumber(ev.target, "seed", WHOLE);
+      if (n !== undefined) edit((d) => {
+        d.seed = n ?? 0;
+      });
+    });
     $("s-comment").addEventListener("change", (ev) => {
       this.state.comment = ev.target.value;
       this.state.dirty = true;
@@ -432,18 +596,26 @@ export class Panels {
       d.map = { ...d.map, type: ev.target.value };
       delete d.map.params; // parameters belong to one map type
     }));
-    $("m-seed").addEventListener("change", (ev) => edit((d) => {
-      d.map = { ...d.map, seed: numberOrNull(ev.target) ?? 0 };
-    }));
+    $("m-seed").addEventListener("change", (ev) => {
+      const n = this.readNumber(ev.target, "map seed", WHOLE);
+      if (n !== undefined) edit((d) => {
+        d.map = { ...d.map, seed: n ?? 0 };
+      });
+    });
     $("m-params").addEventListener("change", (ev) => {
       const text = ev.target.value.trim();
       let params;
       try {
         params = text ? JSON.parse(text) : null;
       } catch (err) {
-        this.state.emit("status", { text: `map parameters: not JSON (${err.message})`, error: true });
+        this.refuse(ev.target, `map parameters: not JSON (${err.message}); type a JSON object such as {"name": value}, or leave it empty for the map's defaults. The map keeps its parameters.`);
         return;
       }
+      if (params !== null && (typeof params !== "object" || Array.isArray(params))) {
+        this.refuse(ev.target, `map parameters: ${text} is not a JSON object; type one such as {"name": value}, or leave it empty for the map's defaults. The map keeps its parameters.`);
+        return;
+      }
+      this.accept(ev.target);
       edit((d) => {
         if (params === null || (typeof params === "object" && !Object.keys(params).length)) delete d.map.params;
         else d.map.params = params;
@@ -457,42 +629,86 @@ export class Panels {
     $("e-time").addEventListener("change", (ev) => env("time_of_day", ev.target.value));
     $("e-weather").addEventListener("change", (ev) => env("weather", ev.target.value));
     $("e-wave").addEventListener("change", (ev) => {
-      if (ev.target.value !== "custom") return env("wave", ev.target.value);
-      const h = window.prompt("Wave height in metres", "1.0");
-      if (h !== null && h.trim() !== "") env("wave", Number(h));
-      else this.renderScenario();
+      const select = ev.target;
+      if (select.value !== "custom") {
+        this.refused.delete(select.dataset.field);
+        return env("wave", select.value);
+      }
+      const now = this.state.doc.environment?.wave;
+      const h = window.prompt("Wave height in metres (0 to 25)", typeof now === "number" ? String(now) : "1.0");
+      const n = h === null || h.trim() === "" ? NaN : Number(h.trim());
+      if (Number.isFinite(n)) {
+        this.refused.delete(select.dataset.field);
+        env("wave", n);
+      } else {
+        if (h !== null && h.trim() !== "") {
+          this.refused.set(select.dataset.field, `wave: ${JSON.stringify(h.trim())} is not a number; type a wave height in metres (0 to 25) or pick a preset. The wave stays as it was.`);
+        }
+        select.value = this.waveChoice(); // back to the wave the scenario has (the select keeps the focus)
+        this.renderNotes();
+      }
     });
-    $("e-visibility").addEventListener("change", (ev) => env("visibility_m", numberOrNull(ev.target)));
-    $("e-rain").addEventListener("change", (ev) => env("rain_mm_per_h", numberOrNull(ev.target)));
-    const acq = (key, input) => edit((d) => {
-      d.acquisition ||= {};
-      const n = numberOrNull(input);
-      if (n === null) delete d.acquisition[key];
-      else d.acquisition[key] = n;
-    });
-    $("a-frequency").addEventListener("change", (ev) => acq("frequency_hz", ev.target));
-    $("a-frames").addEventListener("change", (ev) => acq("frames", ev.target));
+    const envNumber = (key, label, allowed) => (ev) => {
+      const n = this.readNumber(ev.target, label, allowed);
+      if (n !== undefined) env(key, n);
+    };
+    $("e-visibility").addEventListener("change", envNumber("visibility_m", "visibility", "metres, 1 or more (empty: the weather's own)"));
+    $("e-rain").addEventListener("change", envNumber("rain_mm_per_h", "rain", "mm/h, 0 to 500 (empty: the weather's own)"));
+    const acq = (key, label, allowed) => (ev) => {
+      const n = this.readNumber(ev.target, label, allowed);
+      if (n !== undefined) edit((d) => {
+        d.acquisition ||= {};
+        if (n === null) delete d.acquisition[key];
+        else d.acquisition[key] = n;
+      });
+    };
+    $("a-frequency").addEventListener("change", acq("frequency_hz", "frequency", "Hz, 0.01 to 1000 (empty: 5)"));
+    $("a-frames").addEventListener("change", acq("frames", "frames", "a whole number of frames, 1 or more (empty: 100)"));
     $("rigs").addEventListener("change", (ev) => {
-      const key = ev.target.dataset.key;
-      const rig = ev.target.closest("[data-rig]")?.dataset.rig;
-      if (key && rig) this.editRig(rig, key, ev.target);
+      const input = ev.target;
+      const key = input.dataset.key;
+      const rig = input.closest("[data-rig]")?.dataset.rig;
+      if (!key || !rig) return;
+      if (input.tagName === "INPUT") {
+        const [label, allowed] = key === "lidar.channels"
+          ? ["LiDAR channels", "a whole number of channels, 1 or more (empty: the preset's)"]
+          : ["LiDAR range", "metres, more than 0 (empty: the preset's)"];
+        const n = this.readNumber(input, `${rig} ${label}`, allowed);
+        if (n === undefined) return;
+        input.dataset.number = n === null ? "" : String(n);
+      }
+      this.editRig(rig, key, input);
     });
     $("rigs").addEventListener("click", (ev) => {
       const b = ev.target.closest("button[data-action=remove]");
       if (!b) return;
       const name = b.closest("[data-rig]").dataset.rig;
+      this.forgetRefused(`rigs.${name}.`);
       edit((d) => {
         delete d.rigs[name];
         for (const v of d.vessels || []) if (v.rig === name) delete v.rig;
       });
     });
     $("rig-add").addEventListener("click", () => {
-      const name = $("rig-new-name").value.trim() || `rig_${Object.keys(this.state.doc.rigs || {}).length + 1}`;
+      const box = $("rig-new-name");
+      const rigs = Object.keys(this.state.doc.rigs || {});
+      let name = box.value.trim();
+      if (!name) for (let k = rigs.length + 1; !name || rigs.includes(name); k++) name = `rig_${k}`;
+      if (!RIG_NAME.test(name)) {
+        this.refuse(box, `rig name ${JSON.stringify(name)}: letters, digits, _ and - only (1 to 64 characters); no rig added.`);
+        return;
+      }
+      if (rigs.includes(name)) {
+        this.refuse(box, `rig name ${JSON.stringify(name)}: this scenario has a rig of that name; give the new rig another. No rig added.`);
+        return;
+      }
+      this.accept(box);
       edit((d) => {
         d.rigs ||= {};
-        if (!(name in d.rigs)) d.rigs[name] = {};
+        d.rigs[name] = {};
       });
-      $("rig-new-name").value = "";
+      box.value = "";
+      this.renderNotes();
     });
   }
 }

@@ -60,6 +60,7 @@ export class EditorState {
     this.evaluation = null;
     this.lastGood = null;
     this.emit("loaded");
+    this.emit("jump");
     this.changed();
   }
 
@@ -84,6 +85,7 @@ export class EditorState {
     this.lastGesture = null;
     this.dirty = true;
     if (this.selected && !this.vessel()) this.selected = null;
+    this.emit("jump");
     this.changed();
   }
 
@@ -94,6 +96,7 @@ export class EditorState {
     this.lastGesture = null;
     this.dirty = true;
     if (this.selected && !this.vessel()) this.selected = null;
+    this.emit("jump");
     this.changed();
   }
 
