@@ -115,3 +115,20 @@ def test_map_params_are_typed_by_map_type_and_dump_as_given() -> None:
     assert isinstance(sea.map.params, OpenSeaParams) and sea.map.params.extent_m == 4000.0
     assert sea.model_dump()["map"]["params"] == {}
     assert isinstance(load_scenario(minimal()).map.params, IslandParams)
+
+
+def test_a_bad_wave_is_reported_with_the_other_errors() -> None:
+    """The wave's check raised the core's ConfigError inside pydantic, which stopped the validation there: a
+    scenario with a bad wave and a bad frame count said only the wave."""
+    import yaml
+    from mmusv.errors import ConfigError
+
+    sc = yaml.safe_load((Path(__file__).resolve().parents[1] / "scenarios/port_entry.yaml").read_text())
+    sc["acquisition"]["frames"] = -3
+    for wave in ("W9", 30, True):
+        sc["environment"]["wave"] = wave
+        with pytest.raises(ConfigError) as info:
+            load_scenario(sc)
+        msg = str(info.value)
+        assert "environment.wave = " in msg and "acquisition.frames = -3" in msg, msg
+        assert msg.count("environment.wave") == 1, msg

@@ -42,7 +42,7 @@ from pydantic import (
 from mmusv.errors import ConfigError, MmusvError, located
 from mmusv.sensors.config import RigConfig
 from mmusv.strict import StrictModel
-from mmusv.world.environment import MAX_WAVE_HEIGHT_M, Environment, wave_height_m
+from mmusv.world.environment import MAX_WAVE_HEIGHT_M, Environment, wave_problem
 from mmusv.world.map_params import PARAM_MODELS, IslandParams, MapParams
 from mmusv.world.sea_state import TP_RANGE_S, SeaSpec
 from mmusv.world.vessels import get_asset, known_asset
@@ -191,7 +191,10 @@ class EnvironmentConfig(_Model):
     @field_validator("wave")
     @classmethod
     def _wave(cls, v: str | float) -> str | float:
-        wave_height_m(v)
+        # a ValueError (not the ConfigError of wave_height_m): pydantic then reports the other fields' errors too
+        problem = wave_problem(v)
+        if problem is not None:
+            raise ValueError(problem)
         return v.strip().upper() if isinstance(v, str) else float(v)
 
     @model_validator(mode="after")

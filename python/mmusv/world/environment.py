@@ -27,7 +27,16 @@ from mmusv import arguments
 from mmusv._native import core
 from mmusv.errors import ConfigError
 
-__all__ = ["MAX_WAVE_HEIGHT_M", "WAVE_PRESETS", "Environment", "Sun", "Weather", "sun_at", "wave_height_m"]
+__all__ = [
+    "MAX_WAVE_HEIGHT_M",
+    "WAVE_PRESETS",
+    "Environment",
+    "Sun",
+    "Weather",
+    "sun_at",
+    "wave_height_m",
+    "wave_problem",
+]
 
 WAVE_PRESETS: dict[str, float] = dict(core.wave_presets())
 """Significant wave height H in metres of each preset (paper, Table I), in order W0..W3: read from the core
@@ -43,29 +52,33 @@ MAX_WAVE_HEIGHT_M: float = core.sea_limits()["hs_m"][1]
 25 m)."""
 
 
-def wave_height_m(wave: str | float) -> float:
-    """Wave height H (m) of a preset name (``"W0"``..``"W3"``, any case) or a height in metres (a real number ≥ 0;
-    not ``True``/``False``)."""
+def wave_problem(wave: object) -> str | None:
+    """What is wrong with ``wave`` as ``environment.wave`` (what is allowed, for an error message), or ``None``
+    when it is a preset name (``"W0"``..``"W3"``, any case) or a height in metres (a real number in
+    ``0..MAX_WAVE_HEIGHT_M``; not ``True``/``False``)."""
+    allowed = f"allowed presets are {', '.join(WAVE_PRESETS)} or a wave height in metres (0..{MAX_WAVE_HEIGHT_M:g})"
     if isinstance(wave, str):
-        key = wave.strip().upper()
-        if key not in WAVE_PRESETS:
-            raise ConfigError(
-                f"invalid config environment.wave = {wave!r}: allowed presets are "
-                f"{', '.join(WAVE_PRESETS)} or a wave height in metres (0..{MAX_WAVE_HEIGHT_M:g})"
-            )
-        return WAVE_PRESETS[key]
+        return None if wave.strip().upper() in WAVE_PRESETS else allowed
     if isinstance(wave, (bool, np.bool_)) or not isinstance(wave, numbers.Real):
-        raise ConfigError(
-            f"invalid config environment.wave = {wave!r:.60}: allowed presets are {', '.join(WAVE_PRESETS)} or a wave "
-            f"height in metres (0..{MAX_WAVE_HEIGHT_M:g}), not {type(wave).__name__}"
-        )
+        return f"{allowed}, not {type(wave).__name__}"
     h = float(wave)
     if not (math.isfinite(h) and 0 <= h <= MAX_WAVE_HEIGHT_M):
-        raise ConfigError(
-            f"invalid config environment.wave = {wave!r}: a wave height must be in 0..{MAX_WAVE_HEIGHT_M:g} metres "
-            "(the significant height of the highest seas measured is about 19 m)"
+        return (
+            f"a wave height must be in 0..{MAX_WAVE_HEIGHT_M:g} metres (the significant height of the highest seas "
+            "measured is about 19 m)"
         )
-    return h
+    return None
+
+
+def wave_height_m(wave: str | float) -> float:
+    """Wave height H (m) of a preset name (``"W0"``..``"W3"``, any case) or a height in metres (a real number ≥ 0;
+    not ``True``/``False``); :class:`~mmusv.errors.ConfigError` naming ``environment.wave`` otherwise."""
+    problem = wave_problem(wave)
+    if problem is not None:
+        raise ConfigError(f"invalid config environment.wave = {wave!r:.60}: {problem}")
+    if isinstance(wave, str):
+        return WAVE_PRESETS[wave.strip().upper()]
+    return float(wave)
 
 
 @dataclass(frozen=True)
