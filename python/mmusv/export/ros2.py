@@ -55,6 +55,11 @@ OPTICAL_IN_BODY = np.eye(4)
 OPTICAL_IN_BODY[:3, :3] = BODY_TO_OPTICAL.T
 """``(4, 4)`` optical frame → camera body frame."""
 
+PIXEL_CENTRE = 0.5
+"""Where mmusv's pixel coordinates put a pixel's centre (pixel ``(i, j)`` covers ``[i, i + 1) × [j, j + 1)``: its
+intrinsics, 2D boxes); ROS, like OpenCV (``image_geometry``, ``depth_image_proc``, ``cv2.projectPoints``), puts it
+at ``(i, j)``, so ``CameraInfo``'s principal point and the ``Detection2D`` centres are mmusv's less this."""
+
 ROLE_COLOURS = {"usv": (0.2, 0.9, 0.9, 0.5), "target": (1.0, 0.3, 0.2, 0.5), "moored": (1.0, 0.8, 0.2, 0.5)}
 """RViz box colour (r, g, b, a) per vessel role."""
 
@@ -416,10 +421,13 @@ class Ros2Writer(DatasetWriter):
                 self._put(f"{base}/{kind}", "sensor_msgs/msg/Image", m.image(t, frame_id, img, "16UC1"), t)
 
     def _camera_info(self, t: int, a: AgentInfo, name: str) -> Any:
-        """Pinhole intrinsics; ``plumb_bob`` distortion = the camera's Brown–Conrady ``[k1, k2, p1, p2, k3]`` as
-        recorded in its rig (:func:`camera_distortion`), zeros without; R = I, P = [K | 0]."""
+        """Pinhole intrinsics in ROS's (OpenCV's) pixel coordinates, where pixel centres are whole numbers: the
+        recorded principal point (mmusv's, centres at +0.5) less half a pixel (:data:`PIXEL_CENTRE`); ``plumb_bob``
+        distortion = the camera's Brown–Conrady ``[k1, k2, p1, p2, k3]`` as recorded in its rig
+        (:func:`camera_distortion`), zeros without; R = I, P = [K | 0]."""
         cam = a.cameras[name]
         fx, fy, cx, cy = cam.intrinsics
+        cx, cy = cx - PIXEL_CENTRE, cy - PIXEL_CENTRE
         k = np.array([fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0])
         p = np.array([fx, 0.0, cx, 0.0, 0.0, fy, cy, 0.0, 0.0, 0.0, 1.0, 0.0])
         roi = self.T("sensor_msgs/msg/RegionOfInterest")(x_offset=0, y_offset=0, height=0, width=0, do_rectify=False)
@@ -489,7 +497,9 @@ class Ros2Writer(DatasetWriter):
             j = row.get(b.target_id)
             name = class_name(int(world.classes[j])) if j is not None else "unknown"
             centre = self.T("vision_msgs/msg/Pose2D")(
-                position=self.T("vision_msgs/msg/Point2D")(x=(b.x_min + b.x_max) / 2.0, y=(b.y_min + b.y_max) / 2.0),
+                position=self.T("vision_msgs/msg/Point2D")(
+                    x=(b.x_min + b.x_max) / 2.0 - PIXEL_CENTRE, y=(b.y_min + b.y_max) / 2.0 - PIXEL_CENTRE
+                ),
                 theta=0.0,
             )
             by_cam[b.camera].append(
