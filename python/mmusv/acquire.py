@@ -35,6 +35,7 @@ from mmusv import arguments
 from mmusv.annotate import Annotations, SilhouetteCache, annotate_agent
 from mmusv.config import Scenario, load_scenario, scenario_hash
 from mmusv.errors import ConfigError, IoError, MmusvError, located
+from mmusv.forking import check_polars
 from mmusv.profiling import RunProfile, clocks
 from mmusv.recording.background import BackgroundWriter
 from mmusv.recording.guard import FolderLock, write_cause
@@ -156,6 +157,7 @@ def run(
     from mmusv.batch.executors import refuse_in_worker_import
 
     refuse_in_worker_import("mmusv.run")  # the top level of a script a batch's worker imports: said at once
+    check_polars("mmusv.run")  # a process forked after Polars started (it writes the tables): said at once
     # The arguments' types first (cheap, and before anything is built or written), their ranges once the scenario
     # says how many frames it has.
     out = arguments.path(out_dir, name="out_dir")

@@ -10,6 +10,7 @@
 //! - [`ray`]: a ray prepared once for its box and triangle tests.
 //! - [`bvh`]: binned-SAH BVHs collapsed to 8-wide nodes, traversed nearest child first.
 //! - [`simd`]: run-time CPU feature dispatch (AVX2 where available, portable otherwise).
+//! - [`threads`]: thread pools that survive `fork()` (a forked child runs its parallel work on a pool of its own).
 //! - [`seabed`]: the seabed's heights under the water, for the cameras' shallow-water optics.
 //! - [`sea`]: exact shortcuts for rays that can only meet the sea surface or the sky (a height bound map).
 //! - [`mesh`]: triangle meshes with per-face semantic classes and a bottom-level BVH built once.
@@ -44,6 +45,7 @@ pub mod sea;
 pub mod seabed;
 pub mod sensors;
 pub mod simd;
+pub mod threads;
 
 pub use error::{MmusvError, Result};
 pub use geometry::RigidPose;

@@ -21,6 +21,9 @@ mod sensors;
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    // This process runs the core's parallel work on rayon's global pool; a child forked from it, on its own
+    // (`mmusv_core::threads`: the parent's pool has no threads in the child).
+    mmusv_core::threads::set_owner();
     errors::register(m)?;
     scene::register(m)?;
     kinematics::register(m)?;

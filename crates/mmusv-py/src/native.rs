@@ -8,13 +8,15 @@ use numpy::{IntoPyArray, PyArray2, PyReadonlyArray, PyReadonlyArray1, PyReadonly
 use pyo3::prelude::*;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-/// Runs `f` with the GIL released; a core error becomes its Python exception, a panic an `InternalError`.
+/// Runs `f` with the GIL released; a core error becomes its Python exception, a panic an `InternalError`. In a
+/// process forked from the one that imported mmusv, `f` runs on that process's own thread pool
+/// ([`mmusv_core::threads::run`]: the parent's has no threads there).
 pub fn detached<T, F>(py: Python<'_>, f: F) -> PyResult<T>
 where
     F: FnOnce() -> mmusv_core::Result<T> + Send,
     T: Send,
 {
-    let outcome = py.detach(|| catch_unwind(AssertUnwindSafe(f)));
+    let outcome = py.detach(|| catch_unwind(AssertUnwindSafe(|| mmusv_core::threads::run(f))));
     match outcome {
         Ok(result) => result.map_err(to_py),
         Err(payload) => {

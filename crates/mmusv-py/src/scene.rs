@@ -65,10 +65,11 @@ struct SurfaceKey {
 /// The wave field and the surface of `key`, the field reused from `cached` when it is that sea's.
 type Sampled = mmusv_core::Result<(Arc<WaveField>, WaveSurface)>;
 
-/// A surface being sampled on a thread of its own.
+/// A surface being sampled on a thread of its own, by process `pid` (a child forked since has no such thread).
 struct Prefetch {
     key: SurfaceKey,
     handle: std::thread::JoinHandle<Sampled>,
+    pid: u32,
 }
 
 /// Samples the surface of `key` (drawing its wave field unless `cached` holds it).
@@ -330,7 +331,12 @@ impl Scene {
             (tile_m, near_m, radius_m, taper_m),
             (detail, slopes, fine_m),
         )?;
-        let ahead = self.prefetched.lock().map_err(|_| poisoned())?.take();
+        let mut ahead = self.prefetched.lock().map_err(|_| poisoned())?.take();
+        if ahead.as_ref().is_some_and(|p| p.pid != std::process::id()) {
+            // Started by the process this one was forked from: its thread is not here, so it is neither joined
+            // nor detached, just forgotten (and the surface is sampled again).
+            std::mem::forget(ahead.take());
+        }
         let Some(key) = key else {
             return self.write(|s| s.set_wave_surface(None))?.map_err(crate::errors::to_py);
         };
@@ -393,8 +399,11 @@ impl Scene {
         let job = key.clone();
         // Where no thread can be started (a process at its limit), nothing is sampled ahead: the frame's own
         // `set_wave_surface` samples it, the same surface.
-        let handle = std::thread::Builder::new().name("mmusv-wave-surface".into()).spawn(move || sample(&job, cached));
-        *self.prefetched.lock().map_err(|_| poisoned())? = handle.ok().map(|handle| Prefetch { key, handle });
+        let handle = std::thread::Builder::new()
+            .name("mmusv-wave-surface".into())
+            .spawn(move || mmusv_core::threads::run(|| sample(&job, cached)));
+        let pid = std::process::id();
+        *self.prefetched.lock().map_err(|_| poisoned())? = handle.ok().map(|handle| Prefetch { key, handle, pid });
         Ok(())
     }
 

@@ -20,6 +20,7 @@ import numpy as np
 import polars as pl
 
 from mmusv.errors import ConfigError
+from mmusv.forking import check_polars
 
 if TYPE_CHECKING:
     from mmusv.annotate import Annotations
@@ -87,6 +88,7 @@ class TableWriter:
     """Collects table rows column-wise and flushes them as numbered Parquet parts under ``root``."""
 
     def __init__(self, root: Path) -> None:
+        check_polars("writing the tables")
         self.root = root
         self.part = 0
         self.frames = 0
@@ -256,6 +258,7 @@ def read_table(root: str | os.PathLike[str], table: str, *, expected: range | No
     reads and has the table's columns; a damaged part is left out and named. ``expected``: the frames the run
     wrote (their absence from the rows is reported in ``missing``; only meaningful for ``world_state``, which
     has rows in every frame)."""
+    check_polars("reading the tables")
     if not isinstance(table, str) or table not in SCHEMAS:
         raise ConfigError(f"table = {table!r:.60}: not a table of a recording; tables: {', '.join(SCHEMAS)}")
     schema = SCHEMAS[table]

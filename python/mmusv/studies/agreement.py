@@ -33,6 +33,7 @@ from mmusv.annotate import box_corners
 from mmusv.bundled import resolve_scenario
 from mmusv.config import load_scenario
 from mmusv.errors import ConfigError
+from mmusv.forking import check_polars
 from mmusv.frames import translation
 from mmusv.simulation import Simulation
 
@@ -143,6 +144,7 @@ def run_agreement_study(
     and evaluates every other vessel (see the module docstring); every ``stride``-th frame. ``frames`` and
     ``stride`` below 1 raise :class:`~mmusv.errors.ConfigError` (before any scenario is loaded): they evaluated
     nothing and wrote an empty table."""
+    check_polars("mmusv study agreement")
     check_counts(frames, stride)
     rows: list[dict[str, object]] = []
     for path in scenarios:

@@ -21,6 +21,7 @@ import numpy as np
 import polars as pl
 
 from mmusv.config import Scenario
+from mmusv.forking import check_polars
 from mmusv.motion import scenario_poses
 from mmusv.world.environment import WAVE_PRESETS, wave_height_m
 
@@ -90,6 +91,7 @@ def run_wave_study(
 ) -> WaveStudy:
     """Runs the study on ``scenario``'s USVs for each wave setting (names ``W0``.. or heights in metres), with the
     paper's motion formula (default) or the physical response to the fully developed sea of each setting."""
+    check_polars("mmusv study waves")
     usv_idx = _usv_indices(scenario)
     scenario = scenario.with_sea(None, motion=motion)
     rows = []
@@ -170,6 +172,7 @@ def run_physical_wave_study(
     preset in ``waves`` (``W0``..``W3``), beside the paper's Table I and the paper mode (USVs pooled). The record
     lasts ``record_s`` seconds at the scenario's frequency, or the scenario's own frames when longer or when
     ``record_s`` is ``None``."""
+    check_polars("mmusv study waves")
     from mmusv.world.sea_state import SEA_PRESETS
 
     usv_idx = _usv_indices(scenario)

@@ -16,7 +16,7 @@ use super::writer::{EncodedMessage, Recorder};
 use crate::error::{MmusvError, Result};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
-use std::sync::OnceLock;
+use std::sync::{Arc, Mutex};
 
 /// How one image is stored.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -44,17 +44,15 @@ pub struct ImageJob<'a> {
     pub format: ImageFormat,
 }
 
-/// The recorder's encoding pool: as many threads as rayon's global pool, made once.
-fn encode_pool() -> Option<&'static rayon::ThreadPool> {
-    static POOL: OnceLock<Option<rayon::ThreadPool>> = OnceLock::new();
-    POOL.get_or_init(|| {
+/// The recorder's encoding pool: as many threads as the pool of the work around it, made once per process
+/// ([`crate::threads::per_process`]: a forked child makes its own).
+fn encode_pool() -> Option<Arc<rayon::ThreadPool>> {
+    static POOL: Mutex<Option<(u32, Arc<rayon::ThreadPool>)>> = Mutex::new(None);
+    crate::threads::per_process(&POOL, || {
         rayon::ThreadPoolBuilder::new()
             .num_threads(rayon::current_num_threads())
             .thread_name(|i| format!("mmusv-encode-{i}"))
-            .build()
-            .ok()
     })
-    .as_ref()
 }
 
 fn encode_one(log_time_ns: u64, job: &ImageJob<'_>) -> Result<EncodedMessage> {

@@ -40,6 +40,7 @@ import shapely
 
 from mmusv.annotate import in_target_range
 from mmusv.errors import InputError
+from mmusv.forking import check_polars
 from mmusv.frames import transform_points
 from mmusv.studies.detection.data import (
     AgentFrame,
@@ -258,6 +259,7 @@ def run_study(
     sequence are skipped for every setting, so all settings are scored on the same frames. ``check_predictions``:
     raise when a predictions file matched nothing evaluated (:func:`check_predictions_used`; off for one
     sequence of many, :mod:`~mmusv.studies.detection.parallel`)."""
+    check_polars("the detection study")
     o = options
     if o.detector is None and o.predictions is None:
         raise InputError("no detector and no predictions given")

@@ -1,0 +1,164 @@
+"""A process forked after mmusv ran (a PyTorch DataLoader's workers, Linux's default start method) captures and
+records like its parent, byte for byte: its parallel work runs on a thread pool of its own
+(``mmusv_core::threads``). Before, the parent's pool had no threads in the child and the first capture there
+waited forever. Each case runs in a child process with a time limit, so a hang fails the test."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+
+COMMON = """
+import hashlib, os, sys
+import numpy as np
+import yaml
+import mmusv
+from mmusv.simulation import Simulation
+
+def scenario():
+    sc = yaml.safe_load(open(os.path.join(sys.argv[1], "scenarios/port_entry.yaml")))
+    sc["acquisition"]["frames"] = 4
+    sc["vessels"] = [v for v in sc["vessels"] if v["id"] != "usv_3"]
+    sc["rigs"] = {"usv_standard": {
+        "lidar": {"channels": 8, "points_per_second": 8 * 360 * 5},
+        "radar": {"range_m": 600, "azimuth_bins": 128, "rays_el": 4, "ppi_size_px": 64},
+        "cameras": [{"name": "front", "resolution": [64, 48], "mount": {"point": "camera_front"}}],
+        "top_view": {"resolution": [48, 48]},
+    }}
+    return sc
+
+def digest(cap):
+    h = hashlib.sha256()
+    for aid in sorted(cap.agents):
+        a = cap.agents[aid]
+        h.update(np.ascontiguousarray(a.lidar.xyz).tobytes())
+        for name in sorted(a.cameras):
+            c = a.cameras[name]
+            for arr in (c.rgb, c.depth, c.semantic, c.instance):
+                h.update(np.ascontiguousarray(arr).tobytes())
+        h.update(np.ascontiguousarray(a.top_view.rgb).tobytes())
+        h.update(np.ascontiguousarray(a.radar_ppi).tobytes())
+    return h.hexdigest()
+"""
+
+
+def _run(body: str, tmp_path: Path, *, timeout: float = 240) -> str:
+    script = tmp_path / "case.py"
+    script.write_text(COMMON + textwrap.dedent(body), encoding="utf-8")
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "python") + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    try:
+        proc = subprocess.run(
+            [sys.executable, str(script), str(ROOT), str(tmp_path)],
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=timeout,
+        )
+    except subprocess.TimeoutExpired as exc:
+        raise AssertionError(f"hung (killed after {timeout} s): {exc.stdout!r:.2000} {exc.stderr!r:.2000}") from None
+    assert proc.returncode == 0, (proc.stdout[-3000:], proc.stderr[-3000:])
+    return proc.stdout
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="no fork() on this platform")
+def test_a_forked_child_captures_what_its_parent_captures(tmp_path: Path) -> None:
+    out = _run(
+        """
+        sim = Simulation(scenario())
+        sim.capture(0)                 # the parent's pools exist now
+        sim.prefetch_frame(1)          # and a surface is being sampled on a thread of the parent's
+        r, w = os.pipe()
+        pid = os.fork()
+        if pid == 0:
+            os.close(r)
+            got = " ".join(digest(sim.capture(k)) for k in (1, 2))
+            os.write(w, got.encode())
+            os._exit(0)
+        os.close(w)
+        child = b""
+        while chunk := os.read(r, 65536):
+            child += chunk
+        _, status = os.waitpid(pid, 0)
+        assert status == 0, status
+        parent = " ".join(digest(sim.capture(k)) for k in (1, 2))
+        fresh = Simulation(scenario())
+        again = " ".join(digest(fresh.capture(k)) for k in (1, 2))
+        print("SAME", child.decode() == parent == again)
+        """,
+        tmp_path,
+    )
+    assert "SAME True" in out, out
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="no fork() on this platform")
+def test_a_forked_child_records_the_parent_s_bytes_until_polars_has_started(tmp_path: Path) -> None:
+    """Recording in a forked child works while the parent has not started Polars' threads (the tables' writer);
+    once it has, Polars would hang in the child, and mmusv.run says so at once instead."""
+    out = _run(
+        """
+        from mmusv.errors import ConfigError
+        out = sys.argv[2]
+        Simulation(scenario()).capture(0)   # the core's pools exist now, Polars' not
+        pid = os.fork()
+        if pid == 0:
+            mmusv.run(scenario(), out_dir=os.path.join(out, "child"), frames=2)
+            os._exit(0)
+        _, status = os.waitpid(pid, 0)
+        mmusv.run(scenario(), out_dir=os.path.join(out, "parent"), frames=2)   # Polars' threads run now
+        a = open(os.path.join(out, "parent", "port_entry.mcap"), "rb").read()
+        b = open(os.path.join(out, "child", "port_entry.mcap"), "rb").read()
+        print("STATUS", status, "SAME", a == b, len(a))
+        r, w = os.pipe()
+        pid = os.fork()
+        if pid == 0:
+            os.close(r)
+            try:
+                mmusv.run(scenario(), out_dir=os.path.join(out, "late"), frames=2)
+                os.write(w, b"recorded")
+            except ConfigError as exc:
+                os.write(w, str(exc).encode())
+            os._exit(0)
+        os.close(w)
+        said = b""
+        while chunk := os.read(r, 65536):
+            said += chunk
+        os.waitpid(pid, 0)
+        print("LATE", said.decode(), "WROTE", os.path.exists(os.path.join(out, "late")))
+        """,
+        tmp_path,
+    )
+    assert "STATUS 0 SAME True" in out, out
+    assert "LATE mmusv.run cannot run in this process: it was forked" in out and "'spawn'" in out, out
+    assert "WROTE False" in out, out
+
+
+def test_a_dataloader_with_forked_workers_gives_the_captures(tmp_path: Path) -> None:
+    pytest.importorskip("torch")
+    out = _run(
+        """
+        import torch
+        from torch.utils.data import DataLoader, Dataset
+
+        class Frames(Dataset):
+            def __init__(self):
+                self.sim = Simulation(scenario())
+            def __len__(self):
+                return 4
+            def __getitem__(self, k):
+                return digest(self.sim.capture(k))
+
+        ds = Frames()
+        direct = [ds[k] for k in range(4)]
+        loader = DataLoader(ds, batch_size=None, num_workers=2, multiprocessing_context="fork")
+        print("SAME", list(loader) == direct)
+        """,
+        tmp_path,
+    )
+    assert "SAME True" in out, out
