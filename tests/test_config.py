@@ -132,3 +132,25 @@ def test_a_bad_wave_is_reported_with_the_other_errors() -> None:
         msg = str(info.value)
         assert "environment.wave = " in msg and "acquisition.frames = -3" in msg, msg
         assert msg.count("environment.wave") == 1, msg
+
+
+def test_the_cross_checks_report_every_problem_at_once() -> None:
+    """The scenario's and the environment's cross-checks stopped at their first problem: a user fixing a file met
+    them one per round (noted by the editor round)."""
+    import yaml
+    from mmusv.errors import ConfigError
+
+    sc = yaml.safe_load((Path(__file__).resolve().parents[1] / "scenarios/port_entry.yaml").read_text())
+    sc["vessels"][1]["id"] = sc["vessels"][0]["id"]  # a duplicate id
+    sc["vessels"][2]["rig"] = "nope"  # an unknown rig
+    sc["vessels"][3]["rig"] = "usv_standard"  # a rig on a target
+    with pytest.raises(ConfigError) as info:
+        load_scenario(sc)
+    msg = str(info.value)
+    assert "is used twice" in msg and "names rig 'nope'" in msg and "only instrumented vessels" in msg, msg
+    sc = yaml.safe_load((Path(__file__).resolve().parents[1] / "scenarios/port_entry.yaml").read_text())
+    sc["environment"] = {"weather": "clear", "rain_mm_per_h": 2, "sea": {"state": 4}, "motion": "paper"}
+    with pytest.raises(ConfigError) as info:
+        load_scenario(sc)
+    msg = str(info.value)
+    assert "a clear sky does not rain" in msg and "which `motion: paper` leaves out" in msg, msg

@@ -201,21 +201,25 @@ class EnvironmentConfig(_Model):
     def _one_sea(self) -> EnvironmentConfig:
         # Either setting alone decides the sea; given both, one would be dropped without a word.
         # (`wave: W0`, the default, goes with a `sea`: a resolved scenario written out, scenario.yaml, holds both.)
+        # Every problem at once (a user fixes them in one go).
+        problems = []
         if self.sea is not None and "wave" in self.model_fields_set and self.wave != "W0":
-            raise ValueError(
+            problems.append(
                 "environment: give `wave` (W0..W3 or metres) or `sea`, not both: `sea` sets the waves every sensor "
                 "and every hull meets"
             )
         if self.weather == "clear" and self.rain_mm_per_h:
-            raise ValueError(
+            problems.append(
                 f"environment: rain_mm_per_h = {self.rain_mm_per_h:g} with weather: clear: a clear sky does not rain; "
                 "give weather: rain (or overcast or fog, for the rain falling from them)"
             )
         if self.sea is not None and self.motion == "paper":
-            raise ValueError(
+            problems.append(
                 "environment: `sea` is the physical sea, which `motion: paper` leaves out (the paper's formula, "
                 "driven by `wave`, over flat water): drop `sea`, or use `motion: physical`"
             )
+        if problems:
+            raise ValueError("; ".join(problems))
         return self
 
     def resolve(self) -> Environment:
@@ -307,23 +311,29 @@ class Scenario(_Model):
 
     @model_validator(mode="after")
     def _cross_checks(self) -> Scenario:
+        problems: list[str] = []  # every problem at once (a user fixes them in one go)
         seen: set[str] = set()
         for v in self.vessels:
             if v.id in seen:
-                raise ValueError(f"vessel id {v.id!r} is used twice; ids must be unique")
+                problems.append(f"vessel id {v.id!r} is used twice; ids must be unique")
             seen.add(v.id)
             if v.rig is not None and v.rig not in self.rigs:
-                raise ValueError(
+                problems.append(
                     f"vessel {v.id!r} names rig {v.rig!r}, which is not defined under rigs: ({sorted(self.rigs)})"
                 )
         for i, v in enumerate(self.vessels):
             if v.rig is not None and v.role != "usv":
-                raise ValueError(
+                problems.append(
                     f"vessels[{i}].rig = {v.rig!r}: only instrumented vessels (role: usv) carry a rig; "
                     f"vessel {v.id!r} has role {v.role!r} (add `role: usv` or remove `rig`)"
                 )
-            if v.role == "usv" and v.rig is not None:
-                _check_mount_points(v, i, v.rig, self.rigs[v.rig])
+            if v.role == "usv" and v.rig is not None and v.rig in self.rigs:
+                try:
+                    _check_mount_points(v, i, v.rig, self.rigs[v.rig])
+                except ValueError as exc:
+                    problems.append(str(exc))
+        if problems:
+            raise ValueError("; ".join(dict.fromkeys(problems)))
         return self
 
     @property
