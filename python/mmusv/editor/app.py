@@ -396,7 +396,7 @@ def create_app(
     def info() -> dict[str, Any]:
         from mmusv import __version__
         from mmusv.sensors.config import RIG_PRESETS, CameraConfig
-        from mmusv.world.environment import WAVE_PRESETS
+        from mmusv.world.environment import MAX_WAVE_HEIGHT_M, WAVE_PRESETS
 
         return {
             "version": __version__,
@@ -406,6 +406,7 @@ def create_app(
                 "map_type": _choices(MapConfig, "type"),
                 "weather": _choices(EnvironmentConfig, "weather"),
                 "wave": [{"name": k, "height_m": v} for k, v in WAVE_PRESETS.items()],
+                "wave_height_m": [0.0, MAX_WAVE_HEIGHT_M],  # a custom wave's height: lowest, highest
                 "role": _choices(VesselConfig, "role"),
                 "end": _choices(VesselConfig, "end"),
                 "rig_preset": sorted(RIG_PRESETS),

@@ -112,22 +112,46 @@ async function refreshOpen() {
   sel.value = keep && [...sel.options].some((o) => o.value === keep) ? keep : "";
 }
 
+/** Loads `value` (`file:NAME` or `bundled:NAME`, as the Open box names them); rejects when it cannot. */
+async function load(value) {
+  const [kind, name] = [value.slice(0, value.indexOf(":")), value.slice(value.indexOf(":") + 1)];
+  const res = kind === "file" ? await api.readFile(name) : await api.bundledOne(name);
+  state.load({ document: res.document, comment: res.comment, name: res.name, savedName: kind === "file" ? res.name : null });
+  savedEtag = kind === "file" ? res.etag : null;
+  openedBundled = kind === "bundled" ? name : null;
+  remember();
+  status(`opened ${kind === "file" ? name : `bundled ${name}`}${res.valid ? "" : " (it does not validate: see Checks)"}`);
+}
+
+/** Names the scenario open in the page's address (#file:NAME or #bundled:NAME), so a reload opens it again. */
+function remember() {
+  const [kind, name] = state.savedName ? ["file", state.savedName] : ["bundled", openedBundled];
+  const hash = name ? `#${kind}:${encodeURIComponent(name)}` : "";
+  history.replaceState(null, "", `${location.pathname}${location.search}${hash}`);
+}
+let openedBundled = null; // the bundled scenario last opened, while no folder file holds the scenario
+
 async function open(value) {
   if (!value) return;
   if (state.dirty && !window.confirm("Discard the unsaved changes?")) {
     $("open").value = ""; // the scenario shown is still the one edited, not the one picked
     return;
   }
-  const [kind, name] = [value.slice(0, value.indexOf(":")), value.slice(value.indexOf(":") + 1)];
   try {
-    const res = kind === "file" ? await api.readFile(name) : await api.bundledOne(name);
-    state.load({ document: res.document, comment: res.comment, name: res.name, savedName: kind === "file" ? res.name : null });
-    savedEtag = kind === "file" ? res.etag : null;
-    status(`opened ${kind === "file" ? name : `bundled ${name}`}${res.valid ? "" : " (it does not validate: see Checks)"}`);
+    await load(value);
+    if (state.savedName && currentRun?.status !== "running") await showLastRun();
   } catch (err) {
     status(err.message, true);
   }
   $("open").value = "";
+}
+
+/** Shows the latest run of the file open (one that ended too, as a run that just ended shows); else a run going
+ * on, of any file (started before the page was loaded again, or from another tab). */
+async function showLastRun() {
+  const runs = await api.runs(); // newest first
+  const run = (state.savedName && runs.find((j) => j.scenario === state.savedName)) || runs.find((j) => j.status === "running");
+  if (run) follow(run);
 }
 
 // The ETag of the folder file this page last read or saved (state.savedName): a save of that file sends it, so a
@@ -144,12 +168,14 @@ async function save(overwrite = false) {
   }
   try {
     const same = name === state.savedName;
+    const key = state.key(); // what is sent: edits made while it is on its way are not saved
     const body = { document: state.doc, comment: state.comment, overwrite: overwrite || same };
     const res = await api.writeFile(name, body, same && !overwrite ? savedEtag : null);
     savedEtag = res.etag;
     state.savedName = name;
     state.fileName = name;
-    state.dirty = false;
+    state.markSaved(key);
+    remember();
     renderAll(); // the title's unsaved mark and file name
     status(`saved ${res.name} (${res.bytes} bytes)`);
     document.body.dataset.saved = name;
@@ -172,10 +198,29 @@ async function save(overwrite = false) {
 
 // ------------------------------------------------------------------------------------- preview and run
 
+// The element that had the focus when the preview opened (the Preview button): it gets it back when it closes.
+let previewOpener = null;
+
+/** The controls of the preview window a Tab reaches, in order. */
+function previewStops() {
+  const sel = 'button, [href], input, select, textarea, [tabindex]:not([tabindex="-1"])';
+  return [...$("preview-modal").querySelectorAll(sel)].filter((el) => !el.disabled && !el.closest("[hidden]"));
+}
+
+function closePreview() {
+  if ($("preview-modal").hidden) return;
+  $("preview-modal").hidden = true;
+  const back = previewOpener?.isConnected ? previewOpener : $("preview");
+  previewOpener = null;
+  back.focus();
+}
+
 async function preview() {
   const usvs = (state.doc?.vessels || []).filter((v) => v.role === "usv").map((v) => v.id);
   const agent = usvs.includes(state.selected) ? state.selected : usvs[0];
+  if ($("preview-modal").hidden) previewOpener = document.activeElement;
   $("preview-modal").hidden = false;
+  $("preview-close").focus(); // the keyboard is in the window (Escape or Close leaves it)
   $("preview-img").hidden = true;
   $("preview-wait").hidden = false;
   $("preview-wait").textContent = "Rendering with the real sensors…";
@@ -332,8 +377,30 @@ $("save-cancel").addEventListener("click", () => {
 $("undo").addEventListener("click", () => state.undo());
 $("redo").addEventListener("click", () => state.redo());
 $("preview").addEventListener("click", preview);
-$("preview-close").addEventListener("click", () => {
-  $("preview-modal").hidden = true;
+$("preview-close").addEventListener("click", closePreview);
+// While the preview is open it has the keyboard: Escape closes it, Tab and Shift+Tab go round its own controls.
+// (on the window, first: the focus may be on the page's body after a click on the image)
+window.addEventListener("keydown", (ev) => {
+  if ($("preview-modal").hidden) return;
+  if (ev.key === "Escape") {
+    ev.preventDefault();
+    ev.stopPropagation();
+    closePreview();
+  } else if (ev.key === "Tab") {
+    const stops = previewStops();
+    if (!stops.length) return;
+    const at = stops.indexOf(document.activeElement);
+    const next = ev.shiftKey ? (at <= 0 ? stops.length - 1 : at - 1) : (at + 1) % stops.length;
+    ev.preventDefault();
+    stops[next].focus();
+  }
+}, { capture: true });
+// a focus that lands outside while it is open (a click on the dimmed page) goes back in
+document.addEventListener("focusin", (ev) => {
+  if (!$("preview-modal").hidden && !$("preview-modal").contains(ev.target)) previewStops()[0]?.focus();
+});
+$("preview-modal").addEventListener("click", (ev) => {
+  if (ev.target === $("preview-modal")) closePreview(); // a click on the dimmed page around the window
 });
 $("run").addEventListener("click", run);
 $("run-stop").addEventListener("click", async () => {
@@ -370,7 +437,23 @@ async function boot() {
     bundled = bundledList;
     panels.init(info.choices, assets);
     await refreshOpen();
-    if (info.initial) {
+    // a page loaded again opens the scenario it had open (the address names it), else the one of the command line
+    let asked = "";
+    try {
+      asked = decodeURIComponent(location.hash.slice(1));
+    } catch {
+      // an address typed by hand that is not percent-encoded text: open what the command line says
+    }
+    let opened = false;
+    if (/^(file|bundled):./.test(asked)) {
+      try {
+        await load(asked);
+        opened = true;
+      } catch (err) {
+        status(`cannot open ${asked.slice(asked.indexOf(":") + 1)} again: ${err.message}`, true);
+      }
+    }
+    if (!opened && info.initial) {
       state.load({
         document: info.initial.document,
         comment: info.initial.comment,
@@ -378,15 +461,14 @@ async function boot() {
         savedName: info.initial.in_folder ? info.initial.name : null,
       });
       savedEtag = info.initial.in_folder ? info.initial.etag : null;
-    } else {
+    } else if (!opened) {
       const first = bundled.find((b) => b.name === "port_entry") || bundled[0];
       const res = await api.bundledOne(first.name);
       state.load({ document: res.document, comment: res.comment, name: res.name });
     }
+    if (!opened) remember();
     map.applyView();
-    // a run started before the page was loaded again (or from another tab) is still followed
-    const running = (await api.runs()).find((j) => j.status === "running");
-    if (running) follow(running);
+    await showLastRun();
     document.body.dataset.ready = "1";
   } catch (err) {
     status(`cannot start: ${err.message}`, true);

@@ -148,6 +148,7 @@ export class Panels {
     fillSelect($("m-type"), choices.map_type.map((t) => [t, t.replace("_", " ")]));
     fillSelect($("e-weather"), choices.weather);
     fillSelect($("e-wave"), [...choices.wave.map((w) => [w.name, `${w.name} (H ${w.height_m} m)`]), ["custom", "custom height…"]]);
+    [$("e-wave-height").min, $("e-wave-height").max] = this.waveRange().map(String);
     this.renderLibrary();
     this.bindLibrary();
     clickOnEnter($("problems"), "li.problem");
@@ -253,13 +254,18 @@ export class Panels {
   renderVessel() {
     const v = this.state.vessel();
     $("vessel-panel").hidden = !v;
-    if ((v?.id ?? null) !== this.shownVessel) this.forgetRefused("vessels["); // another vessel: its own values
+    if ((v?.id ?? null) !== this.shownVessel) {
+      this.forgetRefused("vessels["); // another vessel: its own values, and an empty row to add a waypoint
+      $("v-add-x").value = $("v-add-y").value = "";
+    }
     this.shownVessel = v?.id ?? null;
     if (!v) return;
     const at = `vessels[${this.state.vesselIndex(v.id)}]`;
     const keys = { "v-id": "id", "v-role": "role", "v-asset": "asset", "v-rig": "rig", "v-speed": "speed_mps", "v-end": "end", "v-offset": "start_offset_m" };
     for (const [id, key] of Object.entries(keys)) $(id).dataset.field = `${at}.${key}`;
     $("v-route").dataset.field = `${at}.route`;
+    $("v-add-x").dataset.field = `${at}.route.(new)[0]`;
+    $("v-add-y").dataset.field = `${at}.route.(new)[1]`;
     setValue($("v-id"), v.id);
     setValue($("v-role"), v.role || "target");
     setValue($("v-asset"), v.asset);
@@ -270,7 +276,7 @@ export class Panels {
     setValue($("v-speed"), v.speed_mps ?? 0);
     setValue($("v-end"), v.end || "stop");
     setValue($("v-offset"), v.start_offset_m ?? 0);
-    const table = $("v-route");
+    const table = $("v-route-rows");
     if (table.contains(document.activeElement)) return;
     table.replaceChildren();
     (v.route || []).forEach(([x, y], i) => {
@@ -304,6 +310,26 @@ export class Panels {
       tr.append(idx, ...cells, del);
       table.appendChild(tr);
     });
+  }
+
+  /** Adds the waypoint typed into the route's last row at the end of the selected vessel's route; an empty or
+   * unreadable x or y is refused next to its box (the route stays as it was). */
+  addWaypoint() {
+    const [bx, by] = [$("v-add-x"), $("v-add-y")];
+    const allowed = "a position in metres";
+    const x = this.readNumber(bx, "new waypoint x (east)", allowed, { required: true });
+    const y = this.readNumber(by, "new waypoint y (north)", allowed, { required: true });
+    if (x === undefined || y === undefined) {
+      (x === undefined ? bx : by).focus();
+      return;
+    }
+    this.renderNotes();
+    this.editVessel((v) => {
+      v.route ||= [];
+      v.route.push([x, y]);
+    });
+    bx.value = by.value = "";
+    bx.focus(); // ready for the next one
   }
 
   editVessel(fn) {
@@ -381,6 +407,26 @@ export class Panels {
       const b = ev.target.closest("button[data-delete]");
       if (b) this.map.deleteWaypoint(this.state.selected, Number(b.dataset.delete));
     });
+    // the route's last row adds a waypoint from the keyboard: x and y, then Enter (or its + button)
+    for (const [id, axis] of [["v-add-x", "x (east)"], ["v-add-y", "y (north)"]]) {
+      $(id).addEventListener("blur", (ev) => {
+        // what the browser cannot read is refused on leaving the box (a change event does not come: the value of
+        // "1e" is "", as it was); an empty box is refused only when adding, a number takes the note away
+        const box = ev.target;
+        if (box.validity.badInput) this.readNumber(box, `new waypoint ${axis}`, "a position in metres");
+        else if (box.value.trim() !== "" && this.refused.has(box.dataset.field)) {
+          this.accept(box);
+          this.renderNotes();
+        }
+      });
+      $(id).addEventListener("keydown", (ev) => {
+        if (ev.key !== "Enter") return;
+        ev.preventDefault();
+        ev.stopPropagation();
+        this.addWaypoint();
+      });
+    }
+    $("v-add-waypoint").addEventListener("click", () => this.addWaypoint());
     $("v-extend").addEventListener("click", () => {
       if (this.state.selected) this.map.setMode("draw", { vessel: this.state.selected });
     });
@@ -469,13 +515,35 @@ export class Panels {
     const env = d.environment || {};
     setValue($("e-time"), env.time_of_day || "12:00");
     setValue($("e-weather"), env.weather || "clear");
-    setValue($("e-wave"), this.waveChoice());
+    const wave = this.waveChoice();
+    setValue($("e-wave"), wave);
+    // a custom wave's height has its own box; one field at a time carries the wave's notes: the box while the wave
+    // is custom, the select otherwise
+    const custom = wave === "custom";
+    $("e-wave-height-label").hidden = !custom;
+    for (const [el, on] of [[$("e-wave"), !custom], [$("e-wave-height"), custom]]) {
+      if (on) {
+        el.dataset.field = "environment.wave";
+      } else if (el.dataset.field !== undefined) {
+        el.removeAttribute("data-field"); // and its note and refusal, which the notes no longer see
+        delete el.dataset.refused;
+        if (el.nextElementSibling?.classList.contains("field-note")) el.nextElementSibling.remove();
+        el.removeAttribute("aria-invalid");
+        el.removeAttribute("aria-describedby");
+      }
+    }
+    if (custom) setValue($("e-wave-height"), env.wave);
     setValue($("e-visibility"), env.visibility_m);
     setValue($("e-rain"), env.rain_mm_per_h);
     const acq = d.acquisition || {};
     setValue($("a-frequency"), acq.frequency_hz ?? 5);
     setValue($("a-frames"), acq.frames ?? 100);
     this.renderRigs();
+  }
+
+  /** The wave heights a scenario may give, metres: [lowest, highest] (the schema's bounds, from the server). */
+  waveRange() {
+    return this.state.choices.wave_height_m || [0, 25];
   }
 
   /** The wave select's value for the scenario's wave (a preset's name, or "custom" for a height, whose option then
@@ -588,8 +656,7 @@ export class Panels {
       });
     });
     $("s-comment").addEventListener("change", (ev) => {
-      this.state.comment = ev.target.value;
-      this.state.dirty = true;
+      this.state.comment = ev.target.value; // the unsaved mark follows it (state.dirty compares the scenario)
       this.state.emit("doc");
     });
     $("m-type").addEventListener("change", (ev) => edit((d) => {
@@ -628,25 +695,43 @@ export class Panels {
     });
     $("e-time").addEventListener("change", (ev) => env("time_of_day", ev.target.value));
     $("e-weather").addEventListener("change", (ev) => env("weather", ev.target.value));
+    const waveAllowed = () => {
+      const [lo, hi] = this.waveRange();
+      return `a wave height in metres, ${lo} to ${hi}, or pick a preset`;
+    };
+    const inRange = (n) => n >= this.waveRange()[0] && n <= this.waveRange()[1];
     $("e-wave").addEventListener("change", (ev) => {
       const select = ev.target;
       if (select.value !== "custom") {
-        this.refused.delete(select.dataset.field);
+        this.forgetRefused("environment.wave");
         return env("wave", select.value);
       }
-      const now = this.state.doc.environment?.wave;
-      const h = window.prompt("Wave height in metres (0 to 25)", typeof now === "number" ? String(now) : "1.0");
+      // from a preset to a custom wave: its height is asked for here, then changed in the box beside the select
+      const now = this.state.doc.environment?.wave ?? "W0";
+      const preset = this.state.choices.wave.find((w) => w.name === now);
+      const [lo, hi] = this.waveRange();
+      const h = window.prompt(`Wave height in metres (${lo} to ${hi})`, String(preset ? preset.height_m : typeof now === "number" ? now : 1));
       const n = h === null || h.trim() === "" ? NaN : Number(h.trim());
-      if (Number.isFinite(n)) {
-        this.refused.delete(select.dataset.field);
+      if (Number.isFinite(n) && inRange(n)) {
+        this.forgetRefused("environment.wave");
         env("wave", n);
       } else {
         if (h !== null && h.trim() !== "") {
-          this.refused.set(select.dataset.field, `wave: ${JSON.stringify(h.trim())} is not a number; type a wave height in metres (0 to 25) or pick a preset. The wave stays as it was.`);
+          const what = Number.isFinite(n) ? `${n} m is out of range` : `${JSON.stringify(h.trim())} is not a number`;
+          this.refused.set("environment.wave", `wave: ${what}; type ${waveAllowed()}. The wave stays as it was.`);
         }
         select.value = this.waveChoice(); // back to the wave the scenario has (the select keeps the focus)
         this.renderNotes();
       }
+    });
+    $("e-wave-height").addEventListener("change", (ev) => {
+      const n = this.readNumber(ev.target, "wave height", waveAllowed(), { required: true });
+      if (n === undefined) return;
+      if (!inRange(n)) {
+        this.refuse(ev.target, `wave height: ${n} m is out of range; type ${waveAllowed()}. The wave stays as it was.`);
+        return;
+      }
+      env("wave", n);
     });
     const envNumber = (key, label, allowed) => (ev) => {
       const n = this.readNumber(ev.target, label, allowed);

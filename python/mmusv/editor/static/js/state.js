@@ -5,13 +5,21 @@ import { api } from "./api.js";
 
 const HISTORY = 100;
 
+/** A canonical text of a value: JSON with the keys of every object in sorted order, so two documents that hold the
+ * same scenario give the same text whatever order their keys were written in. */
+export function canonical(value) {
+  return JSON.stringify(value, (key, v) =>
+    v && typeof v === "object" && !Array.isArray(v) ? Object.fromEntries(Object.keys(v).sort().map((k) => [k, v[k]])) : v,
+  );
+}
+
 export class EditorState {
   constructor() {
     this.doc = null; // scenario document, as /api/evaluate and the YAML file know it
     this.comment = "";
     this.fileName = "";
     this.savedName = null; // the folder file this document was loaded from or saved to
-    this.dirty = false;
+    this.savedKey = null; // canonical text of the scenario (document and comment) last opened or saved
     this.evaluation = null; // last answer of /api/evaluate for the current document (null while pending)
     this.lastGood = null; // last evaluation that had motion (valid schema), for drawing while one is pending
     this.selected = null; // vessel id
@@ -28,6 +36,21 @@ export class EditorState {
     this.inFlight = false;
     this.queued = false;
     this.evalError = null;
+  }
+
+  /** Canonical text of the scenario as it is now (its document and its comment, which the file holds too). */
+  key() {
+    return canonical({ document: this.doc, comment: this.comment });
+  }
+
+  /** Whether the scenario differs from the one last opened or saved (undoing back to it makes it clean again). */
+  get dirty() {
+    return this.doc !== null && this.key() !== this.savedKey;
+  }
+
+  /** Marks `key` (the scenario's key() when it was sent to be saved) as the scenario the file now holds. */
+  markSaved(key) {
+    this.savedKey = key;
   }
 
   on(event, fn) {
@@ -52,7 +75,7 @@ export class EditorState {
     this.comment = comment || "";
     this.fileName = name || "";
     this.savedName = savedName || null;
-    this.dirty = false;
+    this.savedKey = this.key();
     this.undoStack = [];
     this.redoStack = [];
     this.selected = null;
@@ -74,7 +97,6 @@ export class EditorState {
     }
     this.lastGesture = gesture;
     fn(this.doc);
-    this.dirty = true;
     this.changed();
   }
 
@@ -83,7 +105,6 @@ export class EditorState {
     this.redoStack.push(JSON.stringify(this.doc));
     this.doc = JSON.parse(this.undoStack.pop());
     this.lastGesture = null;
-    this.dirty = true;
     if (this.selected && !this.vessel()) this.selected = null;
     this.emit("jump");
     this.changed();
@@ -94,7 +115,6 @@ export class EditorState {
     this.undoStack.push(JSON.stringify(this.doc));
     this.doc = JSON.parse(this.redoStack.pop());
     this.lastGesture = null;
-    this.dirty = true;
     if (this.selected && !this.vessel()) this.selected = null;
     this.emit("jump");
     this.changed();
