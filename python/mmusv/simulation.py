@@ -7,6 +7,10 @@ no skew between sensors or agents. The state at frame ``k`` is a pure function o
 
 Frames: world x east, y north, z up (metres); vessel/sensor body frames x forward, y left, z up. Sensor poses
 are ``(4, 4)`` float64 sensor → world matrices.
+
+One simulation moves one scene: its calls that move it (``capture``, ``set_frame``, ``prefetch_frame``,
+``set_sea_surface``) take turns, so threads sharing a simulation each get the frame they asked for (the core
+already runs each capture on every CPU).
 """
 
 from __future__ import annotations
@@ -14,6 +18,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import math
+import threading
 from collections.abc import Callable, Collection
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -62,6 +67,19 @@ def sensor_seed(scenario_seed: int, frame: int, agent: int, sensor: str, index: 
 
 
 _T = TypeVar("_T")
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+
+def _one_at_a_time(method: _F) -> _F:
+    """``method`` of :class:`Simulation` holding the simulation's lock: calls that move its scene take turns (two
+    threads capturing frames 1 and 2 at once got each other's state)."""
+
+    @functools.wraps(method)
+    def locked(self: Simulation, *args: Any, **kwargs: Any) -> Any:
+        with self._lock:
+            return method(self, *args, **kwargs)
+
+    return locked  # type: ignore[return-value]
 
 
 def _built(where: str, kind: str, build: Callable[[], _T]) -> _T:
@@ -207,6 +225,7 @@ class Simulation:
                 f"world = {arguments.shown(world)}: must be a MapWorld (mmusv.world.maps.generate_map) or None (the "
                 "scenario's map)"
             )
+        self._lock = threading.RLock()
         self.scenario: Scenario = load_scenario(source)
         sc = self.scenario
         self.environment: Environment = sc.environment.resolve()
@@ -314,6 +333,7 @@ class Simulation:
         centres = np.einsum("vij,vj->vi", mats[:, :3, :3], centres_body) + mats[:, :3, 3]
         return WorldState(frame, t, eta_all, vel_all, centres, mats)
 
+    @_one_at_a_time
     def set_sea_surface(self, sea: SeaState | None) -> None:
         """Makes the water the displaced surface of the physical sea ``sea`` (its wave field drawn from the
         scenario's sea seed) from the next :meth:`set_frame` on, or flat again with ``None``.
@@ -337,6 +357,7 @@ class Simulation:
         sea to every sensor, not the default W0's calm one."""
         return sensor_env(self.environment, wave_height_m=self.sea.hs_m if self.sea is not None else None)
 
+    @_one_at_a_time
     def set_frame(self, frame: int, *, sea_radius_m: float = 320.0, shading_detail: bool = True) -> WorldState:
         """Moves every vessel to its pose at ``frame`` (and, over a physical sea, the water to its surface at the
         frame time, displaced out to ``sea_radius_m`` around every USV: :meth:`set_sea_surface`) and returns the
@@ -354,6 +375,7 @@ class Simulation:
         self._frame = frame
         return state
 
+    @_one_at_a_time
     def prefetch_frame(self, frame: int, *, sea_radius_m: float = 320.0, shading_detail: bool = True) -> None:
         """Starts sampling the sea surface :meth:`set_frame` will set for ``frame`` with the same arguments, on a
         thread of its own (:meth:`mmusv.scene.Scene.prefetch_wave_surface`), so that it is ready when the frame
@@ -526,6 +548,7 @@ class Simulation:
 
     # ------------------------------------------------------------------------------------------ capture
 
+    @_one_at_a_time
     def capture(
         self,
         frame: int,

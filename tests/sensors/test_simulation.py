@@ -108,6 +108,31 @@ def test_capture_does_not_depend_on_history(bundled_pair: tuple[Simulation, Simu
         assert np.array_equal(getattr(lp_a, f), getattr(lp_o, f)), f
 
 
+def test_threads_sharing_a_simulation_each_get_their_frame() -> None:
+    """Two threads capturing different frames from one simulation: each capture is its own frame's (before, a
+    thread could capture on the scene the other had just moved to its frame, silently)."""
+    import threading
+
+    d = bundled()
+    ref = Simulation(d)
+    want = {k: ref.capture(k) for k in range(1, 5)}
+    shared = Simulation(d)
+    got: dict[int, FrameCapture] = {}
+
+    def work(frames: list[int]) -> None:
+        for k in frames:
+            got[k] = shared.capture(k)
+            shared.prefetch_frame(min(k + 3, shared.frames - 1))
+
+    threads = [threading.Thread(target=work, args=(list(range(start, 5, 2)),)) for start in (1, 2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for k, cap in want.items():
+        assert_same_capture(got[k], cap)
+
+
 def test_scenario_seed_drives_the_noise() -> None:
     d = bundled()
     d["seed"] = 12
