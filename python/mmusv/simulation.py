@@ -10,7 +10,10 @@ are ``(4, 4)`` float64 sensor → world matrices.
 
 One simulation moves one scene: its calls that move it (``capture``, ``set_frame``, ``prefetch_frame``,
 ``set_sea_surface``) take turns, so threads sharing a simulation each get the frame they asked for (the core
-already runs each capture on every CPU).
+already runs each capture on every CPU). A simulation pickles as what rebuilds it (its scenario, the map it was
+given, the sea it was set to), so it can be handed to spawned processes (``multiprocessing``, a PyTorch
+``DataLoader`` with ``multiprocessing_context="spawn"``): each rebuilds the world once and captures the same
+bytes.
 """
 
 from __future__ import annotations
@@ -226,6 +229,8 @@ class Simulation:
                 "scenario's map)"
             )
         self._lock = threading.RLock()
+        self._given_world = world
+        self._sea_set: tuple[SeaState | None] | None = None  # the sea of set_sea_surface, when it was called
         self.scenario: Scenario = load_scenario(source)
         sc = self.scenario
         self.environment: Environment = sc.environment.resolve()
@@ -257,6 +262,11 @@ class Simulation:
         self._frame: int | None = None
         # The world state `prefetch_frame` worked out, for the `set_frame` of that frame to take (once).
         self._ahead: tuple[int, WorldState] | None = None
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        """Pickled as what rebuilds it (see the module docstring): its scenario, the map it was given (``None``:
+        the scenario's, made again from its seed) and the sea :meth:`set_sea_surface` set, if it was called."""
+        return (_rebuilt, (self.scenario, self._given_world, self._sea_set))
 
     # ------------------------------------------------------------------------------------------ building
 
@@ -344,6 +354,7 @@ class Simulation:
         sea state and grazing angle, and the annotations carry each box's ``wave_occlusion``.
         """
         check_sea(sea, name="sea", error=ConfigError)
+        self._sea_set = (sea,)
         self.sea = sea if sea is None or sea.hs_m > 0.0 else None
         self.sensor_env = self._sensor_env()
         if self.sea is None:
@@ -637,6 +648,14 @@ class Simulation:
             else:
                 cap.cameras[key.removeprefix("camera/")] = CameraImages.from_native(d)
         return FrameCapture(frame, state.time_s, state, out, secs)
+
+
+def _rebuilt(scenario: Scenario, world: MapWorld | None, sea: tuple[SeaState | None] | None) -> Simulation:
+    """The simulation a pickled :class:`Simulation` stands for (:meth:`Simulation.__reduce__`)."""
+    sim = Simulation(scenario, world=world)
+    if sea is not None:
+        sim.set_sea_surface(sea[0])
+    return sim
 
 
 def _check_state(state: Any) -> None:

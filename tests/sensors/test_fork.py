@@ -162,3 +162,50 @@ def test_a_dataloader_with_forked_workers_gives_the_captures(tmp_path: Path) -> 
         tmp_path,
     )
     assert "SAME True" in out, out
+
+
+def test_a_simulation_pickles_as_what_rebuilds_it() -> None:
+    import pickle
+
+    import yaml
+    from mmusv.simulation import Simulation
+    from mmusv.world.sea_state import SeaSpec
+
+    sc = yaml.safe_load((ROOT / "scenarios/open_sea_convoy.yaml").read_text())
+    sc["acquisition"]["frames"] = 3
+    sc["rigs"] = {k: {"preset": "lidar_only", "lidar": {"channels": 8}} for k in sc["rigs"]}
+    sim = Simulation(sc)
+    sim.set_sea_surface(SeaSpec(hs_m=2.5, tp_s=7.0, gamma=3.3, direction_rad=0.5, spread_s=10.0))  # travels too
+    again = pickle.loads(pickle.dumps(sim))
+    assert again is not sim and again.sea == sim.sea
+    for k in (0, 2):
+        a, b = sim.capture(k), again.capture(k)
+        for aid in a.agents:
+            la, lb = a.agents[aid].lidar, b.agents[aid].lidar
+            assert la is not None and lb is not None and la.xyz.size
+            assert la.xyz.tobytes() == lb.xyz.tobytes() and la.instance.tobytes() == lb.instance.tobytes()
+
+
+def test_a_dataloader_with_spawned_workers_gives_the_captures(tmp_path: Path) -> None:
+    pytest.importorskip("torch")
+    out = _run(
+        """
+        from torch.utils.data import DataLoader, Dataset
+
+        class Frames(Dataset):
+            def __init__(self):
+                self.sim = Simulation(scenario())
+            def __len__(self):
+                return 3
+            def __getitem__(self, k):
+                return digest(self.sim.capture(k))
+
+        if __name__ == "__main__":
+            ds = Frames()
+            direct = [ds[k] for k in range(3)]
+            loader = DataLoader(ds, batch_size=None, num_workers=2, multiprocessing_context="spawn")
+            print("SAME", list(loader) == direct)
+        """,
+        tmp_path,
+    )
+    assert "SAME True" in out, out
