@@ -42,7 +42,7 @@ from pydantic import (
 from mmusv.errors import ConfigError, MmusvError, located
 from mmusv.sensors.config import RigConfig
 from mmusv.strict import StrictModel
-from mmusv.world.environment import MAX_WAVE_HEIGHT_M, Environment, wave_problem
+from mmusv.world.environment import MAX_WAVE_HEIGHT_M, Environment, wave_height_m, wave_problem
 from mmusv.world.map_params import PARAM_MODELS, IslandParams, MapParams
 from mmusv.world.sea_state import TP_RANGE_S, SeaSpec
 from mmusv.world.vessels import get_asset, known_asset
@@ -342,7 +342,9 @@ class Scenario(_Model):
         return [v for v in self.vessels if v.role == "usv"]
 
     def with_wave(self, wave: str | float) -> Scenario:
-        """A copy with another wave setting (everything else unchanged)."""
+        """A copy with another wave setting (everything else unchanged); a bad ``wave`` is a
+        :class:`~mmusv.errors.ConfigError` naming ``environment.wave``."""
+        wave_height_m(wave)  # the ConfigError, not the schema's ValueError
         env = self.environment.model_copy(update={"wave": EnvironmentConfig._wave(wave)})
         return self.model_copy(update={"environment": env})
 
