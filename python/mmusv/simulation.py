@@ -9,11 +9,12 @@ Frames: world x east, y north, z up (metres); vessel/sensor body frames x forwar
 are ``(4, 4)`` float64 sensor → world matrices.
 
 One simulation moves one scene: its calls that move it (``capture``, ``set_frame``, ``prefetch_frame``,
-``set_sea_surface``) take turns, so threads sharing a simulation each get the frame they asked for (the core
-already runs each capture on every CPU). A simulation pickles as what rebuilds it (its scenario, the map it was
-given, the sea it was set to), so it can be handed to spawned processes (``multiprocessing``, a PyTorch
-``DataLoader`` with ``multiprocessing_context="spawn"``): each rebuilds the world once and captures the same
-bytes.
+``set_sea_surface``) take turns, so threads sharing a simulation each get the frame they asked for (the core already
+runs each capture on every CPU). A process forked while another thread held that turn (a DataLoader's workers
+started while a thread captures) gets every simulation's turn free again: the thread holding it is not there to give
+it back, and the next capture sets the whole frame anew. A simulation pickles as what rebuilds it (its scenario, the
+map it was given, the sea it was set to), so it can be handed to spawned processes (``multiprocessing``, a PyTorch
+``DataLoader`` with ``multiprocessing_context="spawn"``): each rebuilds the world once and captures the same bytes.
 """
 
 from __future__ import annotations
@@ -21,7 +22,9 @@ from __future__ import annotations
 import functools
 import hashlib
 import math
+import os
 import threading
+import weakref
 from collections.abc import Callable, Collection
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -83,6 +86,23 @@ def _one_at_a_time(method: _F) -> _F:
             return method(self, *args, **kwargs)
 
     return locked  # type: ignore[return-value]
+
+
+_LIVE: weakref.WeakSet[Simulation] = weakref.WeakSet()
+"""Every simulation of this process, for :func:`_free_turns_after_fork`."""
+
+
+def _free_turns_after_fork() -> None:
+    """In a forked child: a fresh lock for every simulation (see the module docstring). A thread of the parent
+    that held one when the process forked does not exist in the child, so its lock would never be released and
+    the child's first capture would wait forever."""
+    for sim in list(_LIVE):
+        sim._lock = threading.RLock()
+        sim._frame = None
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_free_turns_after_fork)
 
 
 def _built(where: str, kind: str, build: Callable[[], _T]) -> _T:
@@ -229,6 +249,7 @@ class Simulation:
                 "scenario's map)"
             )
         self._lock = threading.RLock()
+        _LIVE.add(self)
         self._given_world = world
         self._sea_set: tuple[SeaState | None] | None = None  # the sea of set_sea_surface, when it was called
         self.scenario: Scenario = load_scenario(source)

@@ -4,22 +4,33 @@
 :class:`~mmusv.batch.task.TaskResult`) and :meth:`~Executor.close`.
 
 The pool spawns its workers (not fork: the driver already runs the core's thread pool, and a forked copy of a
-process with threads can deadlock on a lock another thread held). Each worker sets ``RAYON_NUM_THREADS`` to the
-task's CPU share before the core starts its thread pool, and exits when the driver is gone (a killed driver
-leaves no worker writing on). A worker that dies breaks the pool: every task in flight comes back ``lost``, and
-the pool is started afresh for the next submission.
+process with threads can deadlock on a lock another thread held). A spawned worker imports the driver's script when
+it has one (Python's spawn); a script read from standard input (``python -``, whose ``__file__`` is ``<stdin>``) is
+no file to import, and every worker died of it, so the pool starts its workers without it (as from a notebook). A
+daemonic process (a ``multiprocessing.Pool`` or DataLoader worker) may not start one: :func:`refuse_in_daemon` says
+so before any work. Each worker sets ``RAYON_NUM_THREADS`` to the task's CPU share before the core starts its thread
+pool, and exits when the driver is gone (a killed driver leaves no worker writing on). A worker that dies breaks the
+pool: every task in flight comes back ``lost``, and the pool is started afresh for the next submission.
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import Any, Protocol
 
 from mmusv.batch.plan import Task
 from mmusv.batch.task import TaskResult, execute, lost
 
-__all__ = ["Executor", "PoolExecutor", "SerialExecutor", "available_cpus", "refuse_in_worker_import"]
+__all__ = [
+    "Executor",
+    "PoolExecutor",
+    "SerialExecutor",
+    "available_cpus",
+    "refuse_in_daemon",
+    "refuse_in_worker_import",
+]
 
 UNGUARDED = (
     'in a script, put the call under  if __name__ == "__main__":  (the pool\'s worker processes import the script '
@@ -47,7 +58,63 @@ def _started_from_a_script() -> bool:
     spec = getattr(main, "__spec__", None)
     name = getattr(spec, "name", "") or ""
     path = getattr(main, "__file__", None)
-    return path is not None and not name.startswith("mmusv") and os.path.basename(path) not in ("mmusv", "mmusv.exe")
+    return (
+        path is not None
+        and not name.startswith("mmusv")
+        and os.path.basename(path) not in ("mmusv", "mmusv.exe")
+        and _unimportable_main() is None
+    )
+
+
+def _unimportable_main() -> tuple[Any, str] | None:
+    """``(module, __file__)`` of ``__main__`` when spawned workers would fail to import it by its path: a script
+    that is no file (``python -`` reads it from standard input: ``<stdin>``; a script deleted since), else None.
+    A main module run by name (``python -m``) is imported by name, and one without a file (``python -c``, a
+    notebook) is not imported at all."""
+    import sys
+    from multiprocessing import process
+
+    main = sys.modules.get("__main__")
+    if main is None or getattr(getattr(main, "__spec__", None), "name", None):
+        return None
+    path = getattr(main, "__file__", None)
+    if not isinstance(path, str):
+        return None
+    start = getattr(process, "ORIGINAL_DIR", None)  # where spawn looks for a relative script path
+    full = path if os.path.isabs(path) or not isinstance(start, str) else os.path.join(start, path)
+    return None if os.path.isfile(full) else (main, path)
+
+
+@contextlib.contextmanager
+def _workers_skip_unimportable_main() -> Iterator[None]:
+    """Around starting spawned workers: hides an ``__main__.__file__`` they could not import
+    (:func:`_unimportable_main`), so that they start as from a notebook instead of dying of it."""
+    found = _unimportable_main()
+    if found is None:
+        yield
+        return
+    main, path = found
+    del main.__file__
+    try:
+        yield
+    finally:
+        main.__file__ = path
+
+
+def refuse_in_daemon(what: str) -> None:
+    """Raises :class:`~mmusv.errors.ConfigError` when ``what`` (``"mmusv.run_many(jobs=2)"``) would start a
+    process pool in a daemonic process (a ``multiprocessing.Pool`` worker, a PyTorch DataLoader worker), which
+    Python does not let have child processes (it failed on the first task with a bare ``AssertionError``)."""
+    import multiprocessing
+
+    if multiprocessing.current_process().daemon:
+        from mmusv.errors import ConfigError
+
+        raise ConfigError(
+            f"{what} cannot start its pool of processes here: this process is a daemonic worker (of a "
+            "multiprocessing.Pool, a DataLoader), and those may not have child processes; give jobs=1 to record "
+            "in this process, or call it from a concurrent.futures.ProcessPoolExecutor worker, which may have them"
+        )
 
 
 def refuse_in_worker_import(what: str) -> None:
@@ -219,14 +286,15 @@ class PoolExecutor:
 
         self._ensure()
         assert self._pool is not None
-        try:
-            fut = self._pool.submit(_execute, task)
-        except BrokenProcessPool:  # broken since the last answer: start afresh
-            self._pool.shutdown(wait=False, cancel_futures=True)
-            self._pool = None
-            self._ensure()
-            assert self._pool is not None
-            fut = self._pool.submit(_execute, task)
+        with _workers_skip_unimportable_main():  # a submission may start workers
+            try:
+                fut = self._pool.submit(_execute, task)
+            except BrokenProcessPool:  # broken since the last answer: start afresh
+                self._pool.shutdown(wait=False, cancel_futures=True)
+                self._pool = None
+                self._ensure()
+                assert self._pool is not None
+                fut = self._pool.submit(_execute, task)
         self._futures[fut] = task
 
     def next_done(self) -> tuple[Task, TaskResult]:

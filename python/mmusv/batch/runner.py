@@ -24,7 +24,14 @@ from pathlib import Path
 from typing import Any
 
 from mmusv import arguments
-from mmusv.batch.executors import Executor, PoolExecutor, SerialExecutor, available_cpus, refuse_in_worker_import
+from mmusv.batch.executors import (
+    Executor,
+    PoolExecutor,
+    SerialExecutor,
+    available_cpus,
+    refuse_in_daemon,
+    refuse_in_worker_import,
+)
 from mmusv.batch.index import INDEX_NAME, Entry, folder_bytes, write_index
 from mmusv.batch.plan import ScenarioPlan, plan_scenarios, prepare, scenario_files
 from mmusv.batch.task import TaskResult
@@ -199,6 +206,8 @@ def run_many(
     index_extra = arguments.mapping(index_extra, name="index_extra")
     if not isinstance(ray, (bool, str)):
         raise ConfigError(f"ray = {arguments.shown(ray)}: must be False, True, 'local', 'auto' or a Ray address")
+    if ray is False and (jobs > 1 or cpus_per_task is not None):  # the local pool (see _executor)
+        refuse_in_daemon(f"mmusv.run_many(jobs={jobs})")
     files = scenario_files(source)
     out = arguments.path(out_dir, name="out_dir").resolve()
     index_path = arguments.path(index, name="index").resolve() if index is not None else out / INDEX_NAME

@@ -21,6 +21,7 @@ Metadata records: ``scenario`` (the resolved YAML), ``manifest`` (mmusv version,
 from __future__ import annotations
 
 import json
+import threading
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -70,10 +71,16 @@ def pose7(m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 class FrameRecorder:
-    """Streams :class:`~mmusv.simulation.FrameCapture` frames of ``sim`` into ``path``."""
+    """Streams :class:`~mmusv.simulation.FrameCapture` frames of ``sim`` into ``path``.
+
+    Threads may share one: each :meth:`write_frame` writes its frame's messages together, as the readers need
+    (:class:`~mmusv.recording.stream.FrameStream` reads a frame from its messages in a row; two threads writing
+    frames at once interleaved them, and each frame was read back with a few of its topics).
+    """
 
     def __init__(self, path: Path, sim: Simulation, *, overwrite: bool = False) -> None:
         self.sim = sim
+        self._lock = threading.Lock()
         self.encode_seconds = 0.0
         """Wall seconds spent encoding images so far (for profiling)."""
         self.roles = {v.id: v.role for v in sim.vessels}
@@ -110,7 +117,13 @@ class FrameRecorder:
     # ------------------------------------------------------------------------------------------ per frame
 
     def write_frame(self, cap: FrameCapture, annotations: dict[str, dict[str, Any]]) -> None:
-        """Writes every message of one frame; ``annotations`` maps an agent to its ``Annotations.columns()``."""
+        """Writes every message of one frame, together (one thread at a time); ``annotations`` maps an agent to its
+        ``Annotations.columns()``."""
+        with self._lock:
+            self._write_frame(cap, annotations)
+
+    def _write_frame(self, cap: FrameCapture, annotations: dict[str, dict[str, Any]]) -> None:
+        """:meth:`write_frame` under the lock."""
         t = round(cap.time_s * 1e9)
         sim, st, rec = self.sim, cap.world, self.rec
         tfs: list[tuple[str, str, np.ndarray, np.ndarray]] = []
@@ -262,6 +275,7 @@ class FrameRecorder:
             meta["first_frame"] = first_frame
         if error:
             meta["error"] = error
-        self.rec.metadata("run", meta)
-        summary: dict[str, Any] = self.rec.finish()
+        with self._lock:  # after a frame being written by another thread
+            self.rec.metadata("run", meta)
+            summary: dict[str, Any] = self.rec.finish()
         return summary
