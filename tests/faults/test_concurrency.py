@@ -118,3 +118,30 @@ def test_two_editor_tabs_saving_one_file_never_lose_an_edit(tmp_path: Path) -> N
         headers={"If-Match": f'"{again["etag"]}"'},
     )
     assert r3.status_code == 200 and "seed: 202" in (folder / "tabs.yaml").read_text()
+
+
+def test_a_process_forked_during_a_run_does_not_keep_the_folder_locked(tmp_path: Path) -> None:
+    """A process forked while the folder lock was held (a DataLoader's worker started during a run) shares the
+    lock through its copy of the descriptor: the lock is released when the run ends, not when that process does
+    (closing our descriptor alone left the folder locked)."""
+    import os
+
+    from mmusv.recording.guard import FolderLock
+
+    folder = tmp_path / "out"
+    folder.mkdir()
+    lock = FolderLock(folder, what="test").acquire()
+    r, w = os.pipe()
+    pid = os.fork()
+    if pid == 0:  # the child sleeps, holding its copy of the descriptor
+        os.close(w)
+        os.read(r, 1)
+        os._exit(0)
+    try:
+        os.close(r)
+        lock.release()
+        FolderLock(folder, what="again").acquire().release()  # free at once, the child still alive
+    finally:
+        os.write(w, b"x")
+        os.close(w)
+        os.waitpid(pid, 0)

@@ -70,8 +70,14 @@ class FolderLock:
         return self
 
     def release(self) -> None:
-        """Releases the lock."""
+        """Releases the lock: unlocked first, then closed (a process forked while it was held, a DataLoader's
+        worker, shares the lock through its copy of the descriptor; closing ours alone left the folder locked
+        until that process ended)."""
         if self._fd >= 0:
+            import fcntl  # (a descriptor is only kept where fcntl exists)
+
+            with contextlib.suppress(OSError):
+                fcntl.flock(self._fd, fcntl.LOCK_UN)
             os.close(self._fd)
             self._fd = -1
 
