@@ -217,3 +217,35 @@ def test_splits_by_sequence(many_recs: list[Path], tmp_path: Path) -> None:
     doc = yaml.safe_load((tmp_path / "a" / "conversion.yaml").read_text())
     assert {r["folder"]: r["split"] for r in doc["recordings"]} == where
     assert doc["options"]["seed"] == 3
+
+
+def test_two_conversions_into_one_folder_at_once(coop_rec: Path, tmp_path: Path) -> None:
+    """Two conversions into the same folder at once (threads here; processes alike): the second is refused, naming
+    the folder, and the folder holds the first's conversion whole. Before, both wrote into one staging folder:
+    one came back 'complete' with files missing, the other with a bare FileNotFoundError (found by the
+    concurrency round)."""
+    import threading
+
+    convert(coop_rec, to="kitti", out_dir=tmp_path / "ref")
+    out = tmp_path / "out"
+    convert(coop_rec, to="kitti", out_dir=out)  # a previous conversion, replaced by both below
+    results: list[object] = []
+    start = threading.Barrier(2)
+
+    def again() -> None:
+        start.wait()
+        try:
+            results.append(convert(coop_rec, to="kitti", out_dir=out, overwrite=True))
+        except IoError as exc:
+            results.append(exc)
+
+    threads = [threading.Thread(target=again) for _ in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    refused = [r for r in results if isinstance(r, IoError)]
+    assert len(results) == 2 and len(refused) <= 1, results
+    for r in refused:
+        assert "is being written by another mmusv convert" in str(r), r
+    assert tree(out) == tree(tmp_path / "ref")

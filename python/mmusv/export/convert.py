@@ -33,6 +33,7 @@ from mmusv.errors import ConfigError, IoError
 from mmusv.export.common import DEFAULT_EXTRAS, TARGETS, Options, Sink, dump_yaml, parse_extras
 from mmusv.export.splits import DEFAULT_RATIOS, SPLIT_NAMES, assign_splits, parse_ratios
 from mmusv.export.writer import DatasetWriter
+from mmusv.recording.guard import FolderLock
 from mmusv.recording.info import RecordingInfo, read_info
 from mmusv.recording.stream import FrameStream
 
@@ -175,12 +176,14 @@ def _as_list(recordings: str | Path | Iterable[str | Path]) -> list[Path]:
     return out
 
 
-def _prepare_out(out: Path, overwrite: bool, inputs: list[Path]) -> Path:
-    """Checks ``out`` and returns the folder to write into: ``out`` itself (created), or, when ``overwrite``
-    replaces a previous conversion there, a staging folder beside it that :func:`_staged` swaps in once the new
-    conversion is complete, so that one failing halfway (a full disk) leaves the previous one as it was. Where
-    ``out`` cannot be swapped (it is, or holds, the working folder, e.g. ``-o .``; it is a link; its parent takes no
-    new folder) the previous conversion is emptied in place instead."""
+def _prepare_out(out: Path, overwrite: bool, inputs: list[Path]) -> tuple[Path, FolderLock]:
+    """Checks ``out``, locks it (:class:`~mmusv.recording.guard.FolderLock`: a second conversion into it, from
+    another process or thread, is refused instead of mixing its files with this one's) and returns the folder to
+    write into, with the lock to release when done: ``out`` itself (created), or, when ``overwrite`` replaces a
+    previous conversion there, a staging folder beside it that :func:`_staged` swaps in once the new conversion is
+    complete, so that one failing halfway (a full disk) leaves the previous one as it was. Where ``out`` cannot be
+    swapped (it is, or holds, the working folder, e.g. ``-o .``; it is a link; its parent takes no new folder) the
+    previous conversion is emptied in place instead."""
     if out.exists() and not out.is_dir():
         raise IoError(f"output {out} exists and is not a folder")
     # The output folder is replaced on --overwrite: it may not hold a recording being converted.
@@ -191,7 +194,21 @@ def _prepare_out(out: Path, overwrite: bool, inputs: list[Path]) -> Path:
             raise IoError(
                 f"output folder {out} holds {p}, which is being converted; write the conversion to another folder"
             )
-    if out.exists() and any(out.iterdir()):
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise IoError(f"cannot create output folder {out}: {exc.strerror}") from None
+    lock = FolderLock(out, what="mmusv convert").acquire()
+    try:
+        return _prepare_locked(out, home, overwrite), lock
+    except BaseException:
+        lock.release()
+        raise
+
+
+def _prepare_locked(out: Path, home: Path, overwrite: bool) -> Path:
+    """:func:`_prepare_out` once ``out`` exists and is locked."""
+    if any(out.iterdir()):
         if not overwrite:
             raise IoError(
                 f"output folder {out} already exists and is not empty; pass overwrite=True (--overwrite) to replace it"
@@ -217,10 +234,6 @@ def _prepare_out(out: Path, overwrite: bool, inputs: list[Path]) -> Path:
                 shutil.rmtree(child)
             else:
                 child.unlink()
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise IoError(f"cannot create output folder {out}: {exc.strerror}") from None
     return out
 
 
@@ -445,111 +458,117 @@ def convert(
     split_of: dict[str, str | None] = dict.fromkeys(folders)
     if ratios is not None:
         split_of = dict(assign_splits(folders, ratios, seed))
-    work = _prepare_out(out, overwrite, [Path(i.path) for i in infos])
-    reports = [
-        RecordingReport(path=i.path, scenario=i.scenario_name, folder=f, split=split_of[f])
-        for i, f in zip(infos, folders, strict=True)
-    ]
-    header = {
-        "format": to,
-        "options": {
-            "eval_range_m": rng,
-            "include_usvs": options.include_usvs,
-            "extras": list(options.extras),
-            **({"min_box_px": box_px, "max_occlusion": max_occ} if to in ("coco", "yolo") else {}),
-            "splits": None if ratios is None else dict(zip(SPLIT_NAMES, [round(r, 9) for r in ratios], strict=True)),
-            "seed": seed,
-            **({"agents": list(options.agents)} if options.agents is not None else {}),
-            **({"frames": list(options.frames)} if options.frames is not None else {}),
-        },
-    }
-    with _staged(work, out):
-        (work / REPORT_NAME).write_bytes(dump_yaml({**header, "status": "in_progress"}))
-        sink = Sink()
-        shared = cls.start(work, options, sink)
-        report = ConvertReport(out_dir=out, target=to, recordings=reports)
-        expected = sum(_frames_to_read(i, options) for i in infos)
-        done = 0
-        order = sorted(
-            range(len(infos)),
-            key=lambda j: (SPLIT_NAMES.index(reports[j].split) if reports[j].split else 0, folders[j]),
-        )
-        for j in order:
-            info, rep = infos[j], reports[j]
-            folder = work / rep.split / rep.folder if rep.split else work / rep.folder
-            if cls.owns_folder:
-                sink.mkdir(folder)
-            writer = cls(info, folder, options, sink, split=rep.split, shared=shared)
-            wanted = writer.topic_filter()
-            stream = FrameStream(info, wanted.__contains__, frames=options.frames)
-            converted: list[int] = []
-            incomplete: list[tuple[int, str]] = []
-            for fr in stream:
-                missing = writer.missing(fr)
-                if not options.wants_frame(fr.index):
-                    pass  # outside --frames: neither converted nor missing
-                elif fr.world is None or missing or not writer.agents:
-                    why = (
-                        writer.no_agent_reason
-                        if not writer.agents
-                        else f"incomplete: missing {', '.join(missing[:4])}"
-                        + (f" and {len(missing) - 4} more" if len(missing) > 4 else "")
-                    )
-                    incomplete.append((fr.index, why))
-                else:
-                    writer.write_frame(fr)
-                    converted.append(fr.index)
-                    report.agent_frames += len(writer.agents)
-                done += 1
-                if progress is not None:
-                    progress(done, max(expected, done))
-            rep.status = stream.run.get("status", "unfinished (no run metadata)")
-            for k, why in incomplete:
-                rep.skipped.append({"frames": [k, k], "reason": why})
-            seen = set(converted) | {k for k, _ in incomplete}
-            # the frames the run set out to write: --frames N cuts a run short on purpose, those after N are not missing
-            configured = int(
-                stream.run.get("frames_requested", stream.run.get("frames_configured", info.frames_configured)) or 0
-            )
-            first = int(stream.run.get("first_frame", 0) or 0)  # one part of a split recording given alone
-            absent = [k for k in range(first, first + configured) if k not in seen and options.wants_frame(k)]
-            if absent:
-                written = stream.run.get("frames_written")
-                why = (
-                    f"not in the recording (run {rep.status}: {written} of {configured} frames written)"
-                    if written is not None
-                    else f"not in the recording (the run did not finish; {configured} frames configured)"
-                )
-                if stream.truncated:
-                    why += "; " + stream.truncated
-                rep.skipped += [{"frames": [a, b], "reason": why} for a, b in _ranges(absent)]
-            elif stream.truncated:
-                rep.notes.append(stream.truncated)
-            if stream.out_of_order:
-                again = sorted(set(stream.out_of_order))
-                rep.notes.append(f"frames {again} appear more than once; the last copy was kept")
-            rep.skipped.sort(key=lambda s: s["frames"][0])
-            writer.finish(sorted(converted), rep.skipped)
-            rep.notes += writer.notes
-            rep.frames_converted = len(converted)
-            if converted:
-                rep.first_frame, rep.last_frame = min(converted), max(converted)
-            else:
-                rep.notes.append("no complete frame: nothing written for this recording")
-                if cls.owns_folder:
-                    shutil.rmtree(folder, ignore_errors=True)
-        cls.finish_all(shared, work, sink)
-        doc = {
-            **header,
-            "status": "complete",
-            "frames_converted": report.frames,
-            "agent_frames": report.agent_frames,
-            "recordings": [r.as_dict() for r in sorted(reports, key=lambda r: (r.split or "", r.folder))],
+    work, lock = _prepare_out(out, overwrite, [Path(i.path) for i in infos])
+    try:
+        reports = [
+            RecordingReport(path=i.path, scenario=i.scenario_name, folder=f, split=split_of[f])
+            for i, f in zip(infos, folders, strict=True)
+        ]
+        header = {
+            "format": to,
+            "options": {
+                "eval_range_m": rng,
+                "include_usvs": options.include_usvs,
+                "extras": list(options.extras),
+                **({"min_box_px": box_px, "max_occlusion": max_occ} if to in ("coco", "yolo") else {}),
+                "splits": None
+                if ratios is None
+                else dict(zip(SPLIT_NAMES, [round(r, 9) for r in ratios], strict=True)),
+                "seed": seed,
+                **({"agents": list(options.agents)} if options.agents is not None else {}),
+                **({"frames": list(options.frames)} if options.frames is not None else {}),
+            },
         }
-        data = dump_yaml(doc)
-        (work / REPORT_NAME).write_bytes(data)
-        report.files = sink.files + 1
-        report.bytes = sink.bytes + len(data)
+        with _staged(work, out):
+            (work / REPORT_NAME).write_bytes(dump_yaml({**header, "status": "in_progress"}))
+            sink = Sink()
+            shared = cls.start(work, options, sink)
+            report = ConvertReport(out_dir=out, target=to, recordings=reports)
+            expected = sum(_frames_to_read(i, options) for i in infos)
+            done = 0
+            order = sorted(
+                range(len(infos)),
+                key=lambda j: (SPLIT_NAMES.index(reports[j].split) if reports[j].split else 0, folders[j]),
+            )
+            for j in order:
+                info, rep = infos[j], reports[j]
+                folder = work / rep.split / rep.folder if rep.split else work / rep.folder
+                if cls.owns_folder:
+                    sink.mkdir(folder)
+                writer = cls(info, folder, options, sink, split=rep.split, shared=shared)
+                wanted = writer.topic_filter()
+                stream = FrameStream(info, wanted.__contains__, frames=options.frames)
+                converted: list[int] = []
+                incomplete: list[tuple[int, str]] = []
+                for fr in stream:
+                    missing = writer.missing(fr)
+                    if not options.wants_frame(fr.index):
+                        pass  # outside --frames: neither converted nor missing
+                    elif fr.world is None or missing or not writer.agents:
+                        why = (
+                            writer.no_agent_reason
+                            if not writer.agents
+                            else f"incomplete: missing {', '.join(missing[:4])}"
+                            + (f" and {len(missing) - 4} more" if len(missing) > 4 else "")
+                        )
+                        incomplete.append((fr.index, why))
+                    else:
+                        writer.write_frame(fr)
+                        converted.append(fr.index)
+                        report.agent_frames += len(writer.agents)
+                    done += 1
+                    if progress is not None:
+                        progress(done, max(expected, done))
+                rep.status = stream.run.get("status", "unfinished (no run metadata)")
+                for k, why in incomplete:
+                    rep.skipped.append({"frames": [k, k], "reason": why})
+                seen = set(converted) | {k for k, _ in incomplete}
+                # the frames the run set out to write: --frames N cuts a run short on purpose, those after N are
+                # not missing
+                configured = int(
+                    stream.run.get("frames_requested", stream.run.get("frames_configured", info.frames_configured)) or 0
+                )
+                first = int(stream.run.get("first_frame", 0) or 0)  # one part of a split recording given alone
+                absent = [k for k in range(first, first + configured) if k not in seen and options.wants_frame(k)]
+                if absent:
+                    written = stream.run.get("frames_written")
+                    why = (
+                        f"not in the recording (run {rep.status}: {written} of {configured} frames written)"
+                        if written is not None
+                        else f"not in the recording (the run did not finish; {configured} frames configured)"
+                    )
+                    if stream.truncated:
+                        why += "; " + stream.truncated
+                    rep.skipped += [{"frames": [a, b], "reason": why} for a, b in _ranges(absent)]
+                elif stream.truncated:
+                    rep.notes.append(stream.truncated)
+                if stream.out_of_order:
+                    again = sorted(set(stream.out_of_order))
+                    rep.notes.append(f"frames {again} appear more than once; the last copy was kept")
+                rep.skipped.sort(key=lambda s: s["frames"][0])
+                writer.finish(sorted(converted), rep.skipped)
+                rep.notes += writer.notes
+                rep.frames_converted = len(converted)
+                if converted:
+                    rep.first_frame, rep.last_frame = min(converted), max(converted)
+                else:
+                    rep.notes.append("no complete frame: nothing written for this recording")
+                    if cls.owns_folder:
+                        shutil.rmtree(folder, ignore_errors=True)
+            cls.finish_all(shared, work, sink)
+            doc = {
+                **header,
+                "status": "complete",
+                "frames_converted": report.frames,
+                "agent_frames": report.agent_frames,
+                "recordings": [r.as_dict() for r in sorted(reports, key=lambda r: (r.split or "", r.folder))],
+            }
+            data = dump_yaml(doc)
+            (work / REPORT_NAME).write_bytes(data)
+            report.files = sink.files + 1
+            report.bytes = sink.bytes + len(data)
+    finally:
+        lock.release()
     report.seconds = time.perf_counter() - t0
     return report
 
