@@ -240,3 +240,26 @@ def test_run_many_with_a_pool_from_a_script_on_standard_input(tmp_path: Path) ->
     out = _python(["-"], cwd=tmp_path, timeout=150, stdin=script)
     assert "OK True pool" in out, out
     assert (tmp_path / "out" / "a" / "a.mcap").is_file() and (tmp_path / "out" / "b" / "b.mcap").is_file()
+
+
+def test_the_detection_study_s_pool_in_a_daemonic_worker_is_refused() -> None:
+    """The detection study's own pool of spawned workers follows the batch's rule: a daemonic process (a
+    multiprocessing.Pool worker) may not start one, said up front instead of a bare AssertionError."""
+    import multiprocessing
+
+    with multiprocessing.get_context("spawn").Pool(1) as pool:
+        said = pool.apply(_study_pool_in_worker)
+    assert "cannot start its pool of processes here: this process is a daemonic worker" in said, said
+
+
+def _study_pool_in_worker() -> str:
+    from mmusv.errors import ConfigError
+    from mmusv.studies.detection.parallel import run_study_jobs
+
+    try:
+        run_study_jobs(None, options=None, spec=None, jobs=2)  # type: ignore[arg-type]
+    except ConfigError as exc:
+        return str(exc)
+    except Exception as exc:  # what it raised instead, for the assertion message
+        return f"{type(exc).__name__}: {exc}"
+    return "no error"

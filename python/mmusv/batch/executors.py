@@ -30,6 +30,7 @@ __all__ = [
     "available_cpus",
     "refuse_in_daemon",
     "refuse_in_worker_import",
+    "workers_skip_unimportable_main",
 ]
 
 UNGUARDED = (
@@ -86,7 +87,7 @@ def _unimportable_main() -> tuple[Any, str] | None:
 
 
 @contextlib.contextmanager
-def _workers_skip_unimportable_main() -> Iterator[None]:
+def workers_skip_unimportable_main() -> Iterator[None]:
     """Around starting spawned workers: hides an ``__main__.__file__`` they could not import
     (:func:`_unimportable_main`), so that they start as from a notebook instead of dying of it."""
     found = _unimportable_main()
@@ -286,7 +287,7 @@ class PoolExecutor:
 
         self._ensure()
         assert self._pool is not None
-        with _workers_skip_unimportable_main():  # a submission may start workers
+        with workers_skip_unimportable_main():  # a submission may start workers
             try:
                 fut = self._pool.submit(_execute, task)
             except BrokenProcessPool:  # broken since the last answer: start afresh

@@ -21,6 +21,7 @@ from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wai
 from dataclasses import dataclass, replace
 from typing import Any
 
+from mmusv.batch.executors import refuse_in_daemon, workers_skip_unimportable_main
 from mmusv.errors import InputError, MmusvError
 from mmusv.studies.detection.sources import Dataset
 from mmusv.studies.detection.study import StudyOptions, StudyResult, check_predictions_used, run_study
@@ -94,6 +95,7 @@ def run_study_jobs(
     builds them from ``spec``. ``progress(done, total)`` counts frames, a sequence at a time."""
     if jobs < 1:
         raise InputError(f"--jobs {jobs}: must be >= 1")
+    refuse_in_daemon(f"the detection study with --jobs {jobs}")  # the batch's rules for a pool of spawned workers
     names = sorted(dataset.sources)
     frames = dataset.frames_by_sequence()
     total = sum(frames.values())
@@ -103,9 +105,10 @@ def run_study_jobs(
     done = 0
     ctx = multiprocessing.get_context("spawn")
     with ProcessPoolExecutor(max_workers=min(jobs, max(1, len(names))), mp_context=ctx) as pool:
-        pending: dict[Future[tuple[str, Any, list[int]]], str] = {
-            pool.submit(_task, dataset, n, bare, spec): n for n in names
-        }
+        with workers_skip_unimportable_main():  # the submissions start the workers
+            pending: dict[Future[tuple[str, Any, list[int]]], str] = {
+                pool.submit(_task, dataset, n, bare, spec): n for n in names
+            }
         while pending:
             finished, _ = wait(pending, return_when=FIRST_COMPLETED)
             for fut in finished:
