@@ -21,6 +21,7 @@ if TYPE_CHECKING:
 
     from mmusv.config import Scenario
 
+from mmusv import cli_console
 from mmusv.cli_paths import check_output_folder, output_arg, path_arg
 from mmusv.errors import ConfigError, MmusvError
 
@@ -542,6 +543,19 @@ class _Signals:
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``mmusv`` command; returns the exit status."""
+    cli_console.open_missing_streams()  # a closed stdout (``mmusv run ... >&-``) was an AttributeError traceback
+    with cli_console.lenient_output():
+        try:
+            code = _main(argv)
+        except SystemExit as exc:  # argparse: --help, usage errors (its own message, its own status)
+            failed = cli_console.flush_stdout(0) if exc.code in (0, None) else 0
+            if failed:
+                raise SystemExit(failed) from None
+            raise
+        return cli_console.flush_stdout(code)
+
+
+def _main(argv: list[str] | None) -> int:
     args = _parser().parse_args(sys.argv[1:] if argv is None else argv)
     import warnings
 
@@ -549,22 +563,39 @@ def main(argv: list[str] | None = None) -> int:
 
     def _show(message: Warning | str, category: type[Warning], *rest: object, **kw: object) -> None:
         prefix = "mmusv: warning: " if issubclass(category, MmusvWarning) else f"{category.__name__}: "
-        print(prefix + str(message), file=sys.stderr)
+        cli_console.say(prefix + str(message))
 
     warnings.showwarning = _show  # one line per warning, never a source excerpt
     with _Signals() as signals:
         try:
+            cli_console.check_thread_environment()  # before the core's or Polars' thread pools exist
             code = _dispatch(args)
         except MmusvError as exc:
-            print(f"mmusv: error: {exc}", file=sys.stderr)
+            cli_console.say(f"mmusv: error: {exc}{cli_console.cwd_hint()}")
             code = 2
+        except BrokenPipeError as exc:  # the reader of stdout went away (``mmusv info X | head -1``): quietly
+            if not cli_console.stdout_broken():
+                cli_console.say(f"mmusv: error: {exc.filename + ': ' if exc.filename else ''}{exc.strerror or exc}")
+                return signals.status(2)
+            cli_console.drop(sys.stdout)
+            code = 1
         except OSError as exc:  # a file the command reads or writes (a full disk, a read-only folder): one line
             where = f"{exc.filename}: " if exc.filename else ""
-            print(f"mmusv: error: {where}{exc.strerror or exc}", file=sys.stderr)
+            if not exc.filename and cli_console.stdout_fails():  # ``> /dev/full``: the console's write, not a file's
+                where = "cannot write to the standard output: "
+                cli_console.drop(sys.stdout)
+            cli_console.say(
+                f"mmusv: error: {where}{exc.strerror or exc}{cli_console.os_hint(exc)}{cli_console.cwd_hint()}"
+            )
+            code = 2
+        except MemoryError as exc:  # Python's or numpy's allocation (the core's own aborts: see the report)
+            cli_console.say(
+                f"mmusv: error: out of memory{': ' + str(exc) if str(exc) else ''}{cli_console.memory_hint()}"
+            )
             code = 2
         except KeyboardInterrupt:
             name = "terminated (SIGTERM)" if signals.received not in (None, 2) else "interrupted"
-            print(f"mmusv: {name}", file=sys.stderr)
+            cli_console.say(f"mmusv: {name}")
             return signals.status(130)
         return signals.status(code)
 

@@ -5,6 +5,8 @@ subcommand's module (``batch``, ``editor``, ``generate``, ``learn``, ``studies.d
 
 from __future__ import annotations
 
+import os
+import sys
 from pathlib import Path
 
 from mmusv import arguments
@@ -20,14 +22,37 @@ def path_arg(value: str, *, flag: str, empty: str = "give a path") -> str:
     if value == "":
         raise ConfigError(f"{flag} is empty: {empty}")
     arguments.path(value, name=flag)  # a NUL character, from a caller in Python
+    _check_locale(value, flag=flag)
     return value
+
+
+def _check_locale(value: str, *, flag: str) -> None:
+    """A path that is not ASCII under a locale whose encoding is not UTF-8 (``LC_ALL=en_US.ISO-8859-1``, or
+    ``LC_ALL=C`` with ``PYTHONUTF8=0``): Python names the file with the locale's bytes, the core and Polars with
+    UTF-8's, so they meet different files. ``mmusv run X -o "out é"`` wrote the recording, then failed writing
+    its tables (``No such file or directory``); ``mmusv info`` called intact tables unreadable, ``recover``
+    failed. :class:`~mmusv.errors.ConfigError` naming ``flag``, the locale and the two ways out."""
+    encoding = sys.getfilesystemencoding()
+    if value.isascii() or encoding.lower().replace("-", "").replace("_", "") in ("utf8", "utf8mb4"):
+        return
+    raise ConfigError(
+        f"{flag} {arguments.shown(value)}: a path that is not ASCII needs a UTF-8 locale, and this one names files "
+        f"in {encoding} (LC_ALL/LC_CTYPE/LANG = {_locale_name()!r}); run with PYTHONUTF8=1 or LC_ALL=C.UTF-8"
+    )
+
+
+def _locale_name() -> str:
+    for name in ("LC_ALL", "LC_CTYPE", "LANG"):
+        if os.environ.get(name):
+            return os.environ[name]
+    return ""
 
 
 def output_arg(value: str, *, flag: str = "-o/--output") -> str:
     """``value``, the output path given to ``flag``, as it is: not empty (:func:`path_arg`) and valid UTF-8. A
     name with bytes that are not UTF-8 was written halfway (the recording, the table) before the Parquet or CSV
     writer failed with a traceback."""
-    path_arg(value, flag=flag, empty='give a path ("." for the current folder)')
+    path_arg(value, flag=flag, empty='give a path ("." for the current folder)')  # and the locale's encoding
     try:
         value.encode("utf-8")
     except UnicodeEncodeError:

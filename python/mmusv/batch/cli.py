@@ -219,6 +219,7 @@ def run_batch(args: argparse.Namespace, source: Path | list[Path]) -> int:
     from mmusv.batch.runner import run_many
 
     check_batch_options(args)
+    _check_file_names(source)
 
     console = _console()
     with _bar(console, "mmusv run") as update, _resume_hint(args):
@@ -238,6 +239,24 @@ def run_batch(args: argparse.Namespace, source: Path | list[Path]) -> int:
         )
     print_report(report, console)
     return 0 if report.ok else 1
+
+
+def _check_file_names(source: Path | list[Path]) -> None:
+    """Every scenario file of a folder named in UTF-8, checked before any recording: a file whose name holds
+    other bytes (``x\\xe9.yaml``, from a Latin-1 system) was recorded, then the batch ended in a
+    UnicodeEncodeError traceback writing ``dataset.json``, whose names must be UTF-8."""
+    if not isinstance(source, Path) or not source.is_dir():
+        return
+    from mmusv.arguments import shown
+
+    for f in sorted(source.glob("*.yaml")):
+        try:
+            f.name.encode("utf-8")
+        except UnicodeEncodeError:
+            raise ConfigError(
+                f"{source}: the scenario file {shown(f.name)} has a name that is not UTF-8 (the batch index "
+                "dataset.json names every file); rename it"
+            ) from None
 
 
 def add_dataset_parser(subparsers: Any) -> argparse.ArgumentParser:
