@@ -219,8 +219,8 @@ def test_invalid_thread_counts_are_named(name: str, value: str) -> None:
 
 
 def test_check_thread_environment_bounds() -> None:
-    from mmusv.cli_console import THREADS_PER_CPU, check_thread_environment
     from mmusv.errors import ConfigError
+    from mmusv.thread_env import THREADS_PER_CPU, check_thread_environment
 
     hi = THREADS_PER_CPU * (os.cpu_count() or 1)
     check_thread_environment({"RAYON_NUM_THREADS": "0", "POLARS_MAX_THREADS": "1"})
@@ -371,3 +371,14 @@ def test_out_of_memory_and_open_files_are_one_line(monkeypatch: pytest.MonkeyPat
     assert cli.main(["version"]) == 2
     err = capsys.readouterr().err
     assert err.startswith("mmusv: error: Too many open files (the limit on open files is ") and "ulimit -n" in err
+
+
+def test_the_api_checks_the_thread_counts_too(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A Simulation (and so mmusv.run) checks RAYON_NUM_THREADS before its first thread pool starts: through the
+    API, 99999 started thousands of core threads as the command line did."""
+    from mmusv.errors import ConfigError
+    from mmusv.simulation import Simulation
+
+    monkeypatch.setenv("RAYON_NUM_THREADS", "99999")
+    with pytest.raises(ConfigError, match=r"RAYON_NUM_THREADS='99999' in the environment: must be a whole number"):
+        Simulation(Path(__file__).resolve().parents[1] / "scenarios/port_entry.yaml")

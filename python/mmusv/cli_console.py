@@ -12,7 +12,7 @@ import sys
 from collections.abc import Iterator
 from typing import Any
 
-from mmusv.errors import ConfigError
+from mmusv.thread_env import check_thread_environment
 
 __all__ = [
     "check_thread_environment",
@@ -225,38 +225,3 @@ def memory_hint() -> str:
     if soft == resource.RLIM_INFINITY:
         return " (use fewer frames, sensors or --jobs, or a machine with more memory)"
     return f" (the address-space limit, ulimit -v, is {soft // 1024} kB: raise it, or use fewer frames or --jobs)"
-
-
-THREAD_VARIABLES = {
-    "RAYON_NUM_THREADS": (0, "the core's threads; 0: one per CPU"),
-    "POLARS_MAX_THREADS": (1, "the Parquet tables' threads"),
-}
-"""Thread-count variables of the environment read by the libraries ``mmusv`` runs on, each with its least
-allowed value and what it sets; :func:`check_thread_environment`."""
-
-THREADS_PER_CPU = 4
-"""A thread-count variable's value at most: this many threads per CPU of the machine."""
-
-
-def check_thread_environment(environ: dict[str, str] | None = None) -> None:
-    """The thread counts of the environment (``RAYON_NUM_THREADS``, ``POLARS_MAX_THREADS``) checked before a
-    thread pool reads them: ``RAYON_NUM_THREADS=99999`` started tens of thousands of core threads (the run did
-    not finish in 15 minutes and the machine's load went past 2,000), ``POLARS_MAX_THREADS=0`` was a Rust panic
-    with a traceback once the tables were written, and ``abc`` or ``-3`` were quietly taken as the default.
-    :class:`~mmusv.errors.ConfigError` naming the variable and what is allowed. Unset or empty: not checked."""
-    import os
-
-    env = os.environ if environ is None else environ
-    cpus = os.cpu_count() or 1  # the machine's, not this process's affinity: a job may oversubscribe its share
-    hi = THREADS_PER_CPU * cpus
-    for name, (lo, what) in THREAD_VARIABLES.items():
-        raw = env.get(name)
-        if raw is None or not raw.strip():
-            continue
-        text = raw.strip()
-        if not (text.isascii() and text.isdigit()) or not lo <= int(text) <= hi:
-            raise ConfigError(
-                f"{name}={raw!r} in the environment: must be a whole number in {lo}..{hi} ({what}; at most "
-                f"{THREADS_PER_CPU} per CPU, this machine has {cpus}); unset it for the "
-                "default"
-            )

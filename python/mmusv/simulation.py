@@ -45,6 +45,7 @@ from mmusv.sensors.env import sensor_env
 from mmusv.sensors.lidar import LidarPoints, lidar_from_config
 from mmusv.sensors.mounts import inside_mesh, mount_matrix, rpy_matrix
 from mmusv.sensors.radar import RadarReturns, ppi_request, radar_from_config
+from mmusv.thread_env import check_thread_environment
 from mmusv.world.build import WorldScene, build_world_scene, pose_matrices
 from mmusv.world.environment import Environment
 from mmusv.world.hydrostatics import hull_particulars
@@ -248,6 +249,7 @@ class Simulation:
                 f"world = {arguments.shown(world)}: must be a MapWorld (mmusv.world.maps.generate_map) or None (the "
                 "scenario's map)"
             )
+        check_thread_environment()  # RAYON_NUM_THREADS / POLARS_MAX_THREADS, before the first thread pool starts
         self._lock = threading.RLock()
         _LIVE.add(self)
         self._given_world = world
