@@ -5,6 +5,7 @@ waited forever. Each case runs in a child process with a time limit, so a hang f
 
 from __future__ import annotations
 
+import contextlib
 import os
 import subprocess
 import sys
@@ -50,21 +51,32 @@ def digest(cap):
 
 
 def _run(body: str, tmp_path: Path, *, timeout: float = 240) -> str:
+    """Runs ``body`` after :data:`COMMON` as a script in a session of its own; on a hang the whole session (the
+    script and every process it forked) is killed, and the test fails."""
+    import signal
+
     script = tmp_path / "case.py"
     script.write_text(COMMON + textwrap.dedent(body), encoding="utf-8")
     env = {**os.environ, "PYTHONPATH": str(ROOT / "python") + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    proc = subprocess.Popen(
+        [sys.executable, str(script), str(ROOT), str(tmp_path)],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
     try:
-        proc = subprocess.run(
-            [sys.executable, str(script), str(ROOT), str(tmp_path)],
-            env=env,
-            capture_output=True,
-            text=True,
-            timeout=timeout,
-        )
-    except subprocess.TimeoutExpired as exc:
-        raise AssertionError(f"hung (killed after {timeout} s): {exc.stdout!r:.2000} {exc.stderr!r:.2000}") from None
-    assert proc.returncode == 0, (proc.stdout[-3000:], proc.stderr[-3000:])
-    return proc.stdout
+        out, err = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        out, err = proc.communicate()
+        raise AssertionError(f"hung (killed after {timeout} s): {out[-2000:]!r} {err[-2000:]!r}") from None
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, signal.SIGKILL)  # forked children left behind by a failed case
+    assert proc.returncode == 0, (out[-3000:], err[-3000:])
+    return out
 
 
 @pytest.mark.skipif(not hasattr(os, "fork"), reason="no fork() on this platform")
