@@ -210,11 +210,7 @@ def run(
         raise located(exc, source) from None
     captured = [(first_capture, time.perf_counter() - started[0])]
     del first_capture
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise IoError(f"cannot create output folder {out}: {write_cause(out, exc)}") from None
-    lock = FolderLock(out, what="mmusv run").acquire()  # a second run into `out` refuses at once
+    lock = FolderLock.create(out, what="mmusv run")  # a second run into `out` refuses at once
     try:
         return _record(
             scenario,

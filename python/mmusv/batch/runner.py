@@ -36,7 +36,7 @@ from mmusv.batch.index import INDEX_NAME, Entry, folder_bytes, write_index
 from mmusv.batch.plan import ScenarioPlan, plan_scenarios, prepare, scenario_files
 from mmusv.batch.task import TaskResult
 from mmusv.errors import ConfigError, IoError, MmusvError
-from mmusv.recording.guard import FolderLock, write_cause
+from mmusv.recording.guard import FolderLock
 
 __all__ = ["BatchReport", "ScenarioOutcome", "run_many"]
 
@@ -224,11 +224,7 @@ def run_many(
     for p in plans:
         if p.recording is not None and not p.recording.is_relative_to(root):
             raise ConfigError(f"index {index_path} must be in a folder above the output {out}")
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise IoError(f"cannot create output folder {out}: {write_cause(out, exc)}") from None
-    lock = FolderLock(out, what="mmusv run (batch)").acquire()
+    lock = FolderLock.create(out, what="mmusv run (batch)")
     try:
         return _run(
             plans,

@@ -194,11 +194,7 @@ def _prepare_out(out: Path, overwrite: bool, inputs: list[Path]) -> tuple[Path, 
             raise IoError(
                 f"output folder {out} holds {p}, which is being converted; write the conversion to another folder"
             )
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise IoError(f"cannot create output folder {out}: {exc.strerror}") from None
-    lock = FolderLock(out, what="mmusv convert").acquire()
+    lock = FolderLock.create(out, what="mmusv convert")
     try:
         return _prepare_locked(out, home, overwrite), lock
     except BaseException:

@@ -41,6 +41,18 @@ class FolderLock:
         self.what = what
         self._fd = -1
 
+    @classmethod
+    def create(cls, folder: str | os.PathLike[str], *, what: str) -> FolderLock:
+        """Creates ``folder`` (with its parents) where it is missing and takes its lock (:meth:`acquire`): how every
+        writer of an output folder starts. :class:`~mmusv.errors.IoError` naming the folder and the cause
+        (:func:`write_cause`) when it cannot be created."""
+        path = Path(folder)
+        try:
+            path.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise IoError(f"cannot create output folder {path}: {write_cause(path, exc)}") from None
+        return cls(path, what=what).acquire()
+
     def acquire(self) -> FolderLock:
         """Takes the lock at once; :class:`~mmusv.errors.IoError` naming the holder when another process has it.
         Where the file system cannot lock folders (some network file systems) this is a no-op."""
