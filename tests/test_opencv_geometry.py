@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
+from kitti_files import read_calib
 
 cv2 = pytest.importorskip("cv2")
 
@@ -331,14 +332,6 @@ def truth_uv(sim: Any, agent_id: str, camera: str, lidar_xyz: np.ndarray) -> np.
 
 def in_view(uv: np.ndarray, z: np.ndarray) -> np.ndarray:
     return (z > 1.0) & (uv[:, 0] > -0.5) & (uv[:, 0] < W - 0.5) & (uv[:, 1] > -0.5) & (uv[:, 1] < H - 0.5)
-
-
-def read_calib(path: Path) -> dict[str, np.ndarray]:
-    out = {}
-    for line in path.read_text().splitlines():
-        key, vals = line.split(":", 1)
-        out[key] = np.array([float(v) for v in vals.split()])
-    return out
 
 
 def test_kitti_calibration_projects_lidar_onto_the_image(sim: Any, exports: dict[str, Path]) -> None:

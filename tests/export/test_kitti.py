@@ -9,16 +9,9 @@ from typing import Any
 
 import numpy as np
 import pytest
+from kitti_files import read_calib
 from mmusv.export import convert
 from mmusv.recording import decode_point_cloud, read_messages
-
-
-def read_calib(path: Path) -> dict[str, np.ndarray]:
-    out = {}
-    for line in path.read_text().splitlines():
-        key, vals = line.split(":", 1)
-        out[key] = np.array([float(v) for v in vals.split()])
-    return out
 
 
 def parse_labels(path: Path) -> list[dict[str, Any]]:
