@@ -6,15 +6,14 @@ the native sensors with their ray patterns). ``capture(frame)`` sets every vesse
 no skew between sensors or agents. The state at frame ``k`` is a pure function of (scenario, seed, k).
 
 Frames: world x east, y north, z up (metres); vessel/sensor body frames x forward, y left, z up. Sensor poses
-are ``(4, 4)`` float64 sensor → world matrices.
+are ``(4, 4)`` float64 sensor → world matrices. What a capture gives (world state, agent captures) is defined in
+:mod:`mmusv.captures` and re-exported here.
 
 One simulation moves one scene: its calls that move it (``capture``, ``set_frame``, ``prefetch_frame``,
-``set_sea_surface``) take turns, so threads sharing a simulation each get the frame they asked for (the core already
-runs each capture on every CPU). A process forked while another thread held that turn (a DataLoader's workers
-started while a thread captures) gets every simulation's turn free again: the thread holding it is not there to give
-it back, and the next capture sets the whole frame anew. A simulation pickles as what rebuilds it (its scenario, the
-map it was given, the sea it was set to), so it can be handed to spawned processes (``multiprocessing``, a PyTorch
-``DataLoader`` with ``multiprocessing_context="spawn"``): each rebuilds the world once and captures the same bytes.
+``set_sea_surface``) take turns, also across a fork (:mod:`mmusv.turns`), so threads sharing a simulation each get
+the frame they asked for. A simulation pickles as what rebuilds it (its scenario, the map it was given, the sea it
+was set to), so it can be handed to spawned processes (``multiprocessing``, a PyTorch ``DataLoader`` with
+``multiprocessing_context="spawn"``): each rebuilds the world once and captures the same bytes.
 """
 
 from __future__ import annotations
@@ -22,9 +21,6 @@ from __future__ import annotations
 import functools
 import hashlib
 import math
-import os
-import threading
-import weakref
 from collections.abc import Callable, Collection
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -35,6 +31,7 @@ import numpy.typing as npt
 
 from mmusv import arguments
 from mmusv._native import core
+from mmusv.captures import AgentCapture, FrameCapture, SensorMount, VesselInfo, WorldState
 from mmusv.config import Scenario, VesselConfig, load_scenario
 from mmusv.errors import ConfigError
 from mmusv.motion import build_fleet
@@ -46,6 +43,7 @@ from mmusv.sensors.lidar import LidarPoints, lidar_from_config
 from mmusv.sensors.mounts import inside_mesh, mount_matrix, rpy_matrix
 from mmusv.sensors.radar import RadarReturns, ppi_request, radar_from_config
 from mmusv.thread_env import check_thread_environment
+from mmusv.turns import one_at_a_time, take_turns
 from mmusv.world.build import WorldScene, build_world_scene, pose_matrices
 from mmusv.world.environment import Environment
 from mmusv.world.hydrostatics import hull_particulars
@@ -74,36 +72,6 @@ def sensor_seed(scenario_seed: int, frame: int, agent: int, sensor: str, index: 
 
 
 _T = TypeVar("_T")
-_F = TypeVar("_F", bound=Callable[..., Any])
-
-
-def _one_at_a_time(method: _F) -> _F:
-    """``method`` of :class:`Simulation` holding the simulation's lock: calls that move its scene take turns (two
-    threads capturing frames 1 and 2 at once got each other's state)."""
-
-    @functools.wraps(method)
-    def locked(self: Simulation, *args: Any, **kwargs: Any) -> Any:
-        with self._lock:
-            return method(self, *args, **kwargs)
-
-    return locked  # type: ignore[return-value]
-
-
-_LIVE: weakref.WeakSet[Simulation] = weakref.WeakSet()
-"""Every simulation of this process, for :func:`_free_turns_after_fork`."""
-
-
-def _free_turns_after_fork() -> None:
-    """In a forked child: a fresh lock for every simulation (see the module docstring). A thread of the parent
-    that held one when the process forked does not exist in the child, so its lock would never be released and
-    the child's first capture would wait forever."""
-    for sim in list(_LIVE):
-        sim._lock = threading.RLock()
-        sim._frame = None
-
-
-if hasattr(os, "register_at_fork"):
-    os.register_at_fork(after_in_child=_free_turns_after_fork)
 
 
 def _built(where: str, kind: str, build: Callable[[], _T]) -> _T:
@@ -118,33 +86,6 @@ def _built(where: str, kind: str, build: Callable[[], _T]) -> _T:
         if not msg.startswith(prefix):
             raise
         raise ConfigError(f"invalid config {where}.{msg[len(prefix) :]}") from None
-
-
-@dataclass(frozen=True)
-class VesselInfo:
-    """A vessel of the world state: scenario vessels first (file order), then moored ships (port maps)."""
-
-    id: str
-    asset: str
-    role: str  # "usv", "target" or "moored"
-    semantic_class: int
-    instance_id: int
-    box_center_body: np.ndarray  # (3,) box centre in the vessel body frame, metres
-    box_size: np.ndarray  # (3,) length, beam, height, metres
-    static: bool = False  # never moves: moored ships, and scenario vessels at speed 0 (VesselConfig.static)
-
-
-@dataclass(frozen=True)
-class WorldState:
-    """Every vessel at one frame: ``poses`` ``(V, 6)`` [x, y, z, roll, pitch, yaw] (m, rad, world),
-    ``velocities`` ``(V, 3)`` m/s world, ``box_centers`` ``(V, 3)`` world, ``matrices`` ``(V, 4, 4)`` body → world."""
-
-    frame: int
-    time_s: float
-    poses: np.ndarray
-    velocities: np.ndarray
-    box_centers: np.ndarray
-    matrices: np.ndarray
 
 
 @dataclass
@@ -190,56 +131,6 @@ class Agent:
         return out
 
 
-@dataclass(frozen=True, eq=False)
-class SensorMount:
-    """Where one sensor is at a frame: ``mount`` ``(4, 4)`` float64 sensor → vessel body, ``pose`` ``(4, 4)``
-    float64 sensor → world (``body · mount``). Fixed for body-mounted sensors; for the level top view the mount
-    is ``body⁻¹ · pose`` and changes with the vessel's attitude."""
-
-    mount: np.ndarray
-    pose: np.ndarray
-
-
-@dataclass
-class AgentCapture:
-    """Everything one USV's sensors produced at one frame, with the sensor poses (sensor → world).
-
-    ``body`` is the USV's ``(4, 4)`` body → world matrix and ``sensors`` every sensor of the USV (captured or
-    not) as a :class:`SensorMount`, keyed ``lidar``, ``radar``, ``camera/<name>``, ``top_view``: read the mounts
-    and poses there rather than recomputing ``body · mount``.
-    """
-
-    agent: str
-    lidar: LidarPoints | None
-    lidar_pose: np.ndarray | None
-    cameras: dict[str, CameraImages]
-    camera_poses: dict[str, np.ndarray]
-    top_view: CameraImages | None
-    top_view_pose: np.ndarray | None
-    radar: RadarReturns | None = None
-    radar_ppi: np.ndarray | None = None
-    radar_pose: np.ndarray | None = None
-    body: np.ndarray | None = None
-    sensors: dict[str, SensorMount] = field(default_factory=dict)
-    lidar_beams: np.ndarray | None = field(default=None, repr=False, compare=False)
-    """``(M,)`` int32: per ray of the LiDAR's full pattern (pattern order, returned or not), the scene instance
-    its cast met first within the range, -1 for none; what the annotations read to know which beams the water
-    stopped. Not recorded."""
-
-
-@dataclass
-class FrameCapture:
-    """One acquisition index: the world state and every agent's capture."""
-
-    frame: int
-    time_s: float
-    world: WorldState
-    agents: dict[str, AgentCapture]
-    sensor_seconds: dict[str, float] = field(default_factory=dict, compare=False)
-    """Wall seconds each sensor's work took, keyed ``<agent>/<sensor>`` (``lidar``, ``camera/<name>``,
-    ``top_view``, ``radar``, ``ppi``): for profiling only, never recorded."""
-
-
 class Simulation:
     """A runnable scenario (see the module docstring). ``source``: a path, a dict or a :class:`Scenario`."""
 
@@ -250,8 +141,7 @@ class Simulation:
                 "scenario's map)"
             )
         check_thread_environment()  # RAYON_NUM_THREADS / POLARS_MAX_THREADS, before the first thread pool starts
-        self._lock = threading.RLock()
-        _LIVE.add(self)
+        self._lock = take_turns(self)
         self._given_world = world
         self._sea_set: tuple[SeaState | None] | None = None  # the sea of set_sea_surface, when it was called
         self.scenario: Scenario = load_scenario(source)
@@ -285,6 +175,11 @@ class Simulation:
         self._frame: int | None = None
         # The world state `prefetch_frame` worked out, for the `set_frame` of that frame to take (once).
         self._ahead: tuple[int, WorldState] | None = None
+
+    def _after_fork_in_child(self) -> None:
+        """In a forked child (:mod:`mmusv.turns`): the scene may be half-way to another frame; the next capture
+        sets it anew."""
+        self._frame = None
 
     def __reduce__(self) -> tuple[Any, ...]:
         """Pickled as what rebuilds it (see the module docstring): its scenario, the map it was given (``None``:
@@ -366,7 +261,7 @@ class Simulation:
         centres = np.einsum("vij,vj->vi", mats[:, :3, :3], centres_body) + mats[:, :3, 3]
         return WorldState(frame, t, eta_all, vel_all, centres, mats)
 
-    @_one_at_a_time
+    @one_at_a_time
     def set_sea_surface(self, sea: SeaState | None) -> None:
         """Makes the water the displaced surface of the physical sea ``sea`` (its wave field drawn from the
         scenario's sea seed) from the next :meth:`set_frame` on, or flat again with ``None``.
@@ -391,7 +286,7 @@ class Simulation:
         sea to every sensor, not the default W0's calm one."""
         return sensor_env(self.environment, wave_height_m=self.sea.hs_m if self.sea is not None else None)
 
-    @_one_at_a_time
+    @one_at_a_time
     def set_frame(self, frame: int, *, sea_radius_m: float = 320.0, shading_detail: bool = True) -> WorldState:
         """Moves every vessel to its pose at ``frame`` (and, over a physical sea, the water to its surface at the
         frame time, displaced out to ``sea_radius_m`` around every USV: :meth:`set_sea_surface`) and returns the
@@ -409,7 +304,7 @@ class Simulation:
         self._frame = frame
         return state
 
-    @_one_at_a_time
+    @one_at_a_time
     def prefetch_frame(self, frame: int, *, sea_radius_m: float = 320.0, shading_detail: bool = True) -> None:
         """Starts sampling the sea surface :meth:`set_frame` will set for ``frame`` with the same arguments, on a
         thread of its own (:meth:`mmusv.scene.Scene.prefetch_wave_surface`), so that it is ready when the frame
@@ -582,7 +477,7 @@ class Simulation:
 
     # ------------------------------------------------------------------------------------------ capture
 
-    @_one_at_a_time
+    @one_at_a_time
     def capture(
         self,
         frame: int,

@@ -1,0 +1,94 @@
+"""What a :class:`~mmusv.simulation.Simulation` gives: the world state of one frame and every agent's capture.
+
+Frames: world x east, y north, z up (metres); vessel/sensor body frames x forward, y left, z up. Poses are
+``(4, 4)`` float64 sensor → world matrices. These types are re-exported by :mod:`mmusv.simulation`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from mmusv.sensors.camera import CameraImages
+from mmusv.sensors.lidar import LidarPoints
+from mmusv.sensors.radar import RadarReturns
+
+__all__ = ["AgentCapture", "FrameCapture", "SensorMount", "VesselInfo", "WorldState"]
+
+
+@dataclass(frozen=True)
+class VesselInfo:
+    """A vessel of the world state: scenario vessels first (file order), then moored ships (port maps)."""
+
+    id: str
+    asset: str
+    role: str  # "usv", "target" or "moored"
+    semantic_class: int
+    instance_id: int
+    box_center_body: np.ndarray  # (3,) box centre in the vessel body frame, metres
+    box_size: np.ndarray  # (3,) length, beam, height, metres
+    static: bool = False  # never moves: moored ships, and scenario vessels at speed 0 (VesselConfig.static)
+
+
+@dataclass(frozen=True)
+class WorldState:
+    """Every vessel at one frame: ``poses`` ``(V, 6)`` [x, y, z, roll, pitch, yaw] (m, rad, world),
+    ``velocities`` ``(V, 3)`` m/s world, ``box_centers`` ``(V, 3)`` world, ``matrices`` ``(V, 4, 4)`` body → world."""
+
+    frame: int
+    time_s: float
+    poses: np.ndarray
+    velocities: np.ndarray
+    box_centers: np.ndarray
+    matrices: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class SensorMount:
+    """Where one sensor is at a frame: ``mount`` ``(4, 4)`` float64 sensor → vessel body, ``pose`` ``(4, 4)``
+    float64 sensor → world (``body · mount``). Fixed for body-mounted sensors; for the level top view the mount
+    is ``body⁻¹ · pose`` and changes with the vessel's attitude."""
+
+    mount: np.ndarray
+    pose: np.ndarray
+
+
+@dataclass
+class AgentCapture:
+    """Everything one USV's sensors produced at one frame, with the sensor poses (sensor → world).
+
+    ``body`` is the USV's ``(4, 4)`` body → world matrix and ``sensors`` every sensor of the USV (captured or
+    not) as a :class:`SensorMount`, keyed ``lidar``, ``radar``, ``camera/<name>``, ``top_view``: read the mounts
+    and poses there rather than recomputing ``body · mount``.
+    """
+
+    agent: str
+    lidar: LidarPoints | None
+    lidar_pose: np.ndarray | None
+    cameras: dict[str, CameraImages]
+    camera_poses: dict[str, np.ndarray]
+    top_view: CameraImages | None
+    top_view_pose: np.ndarray | None
+    radar: RadarReturns | None = None
+    radar_ppi: np.ndarray | None = None
+    radar_pose: np.ndarray | None = None
+    body: np.ndarray | None = None
+    sensors: dict[str, SensorMount] = field(default_factory=dict)
+    lidar_beams: np.ndarray | None = field(default=None, repr=False, compare=False)
+    """``(M,)`` int32: per ray of the LiDAR's full pattern (pattern order, returned or not), the scene instance
+    its cast met first within the range, -1 for none; what the annotations read to know which beams the water
+    stopped. Not recorded."""
+
+
+@dataclass
+class FrameCapture:
+    """One acquisition index: the world state and every agent's capture."""
+
+    frame: int
+    time_s: float
+    world: WorldState
+    agents: dict[str, AgentCapture]
+    sensor_seconds: dict[str, float] = field(default_factory=dict, compare=False)
+    """Wall seconds each sensor's work took, keyed ``<agent>/<sensor>`` (``lidar``, ``camera/<name>``,
+    ``top_view``, ``radar``, ``ppi``): for profiling only, never recorded."""
