@@ -4,43 +4,22 @@ driven by Selenium (Debian's ``chromium`` and ``chromium-driver``, which ``scrip
 from __future__ import annotations
 
 import shutil
-import threading
 from collections.abc import Iterator
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import pytest
+from editor_server import LiveServer, serve
 
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
 CHROMEDRIVER = shutil.which("chromedriver") or "/usr/bin/chromedriver"
 WAIT_S = 60
 
 
-@dataclass
-class LiveServer:
-    url: str
-    folder: Path
-    app: Any
-
-
 @pytest.fixture(scope="module")
 def live_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[LiveServer]:
-    import uvicorn
-    from mmusv.editor.app import create_app
-    from mmusv.editor.cli import _bind
-
-    folder = tmp_path_factory.mktemp("editor")
-    app = create_app(folder, allowed_hosts=["127.0.0.1", "localhost"])
-    sock = _bind("127.0.0.1", 0)
-    server = uvicorn.Server(uvicorn.Config(app, log_level="warning", lifespan="off"))
-    thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
-    thread.start()
-    yield LiveServer(f"http://127.0.0.1:{sock.getsockname()[1]}", folder, app)
-    server.should_exit = True
-    thread.join(timeout=10)
-    app.state.jobs.shutdown()
-    sock.close()
+    with serve(tmp_path_factory.mktemp("editor")) as server:
+        yield server
 
 
 @pytest.fixture(scope="module")

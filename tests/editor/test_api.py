@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import json
 import os
 import re
 import time
@@ -467,3 +468,37 @@ def test_a_server_remembers_only_its_newest_finished_runs(
     assert listed == [ids[2], ids[1]]  # the newest run and the one finished run kept when it started
     gone = client.get(f"/api/runs/{ids[0]}")
     assert gone.status_code == 404 and "newest 1 finished" in gone.text
+
+
+def test_a_restarted_server_shows_the_runs_already_in_its_folder(client: TestClient, folder: Path) -> None:
+    """A server starts knowing the finished runs in ``out/`` (one per manifest of a scenario file in the folder), so a
+    file reopened after a restart shows its last run; a folder with no manifest (a run going on or killed), a broken
+    manifest or no scenario file is not listed."""
+    doc = small(bundled_doc(client))
+    assert client.put("/api/files/quick.yaml", json={"document": doc}).status_code == 200
+    job = client.post("/api/runs", json={"name": "quick.yaml", "frames": 2}).json()
+    done = _wait_run(client, job["id"])
+    assert done["status"] == "complete" and done["earlier"] is False
+    # a run from the command line into the folder of another file, stopped after its first frame
+    assert client.put("/api/files/cli.yml", json={"document": doc}).status_code == 200
+    mmusv.run(folder / "cli.yml", out_dir=folder / "out" / "cli", frames=1)
+    manifest = folder / "out" / "cli" / "manifest.json"
+    meta = json.loads(manifest.read_text())
+    manifest.write_text(json.dumps({**meta, "status": "interrupted", "frames_requested": 5}))
+    os.utime(manifest, (time.time() + 5, time.time() + 5))  # written after quick's
+    for name, text in [("orphan", json.dumps(meta)), ("broken", "{not json"), ("going_on", None)]:
+        (folder / "out" / name).mkdir()
+        if name != "orphan":
+            (folder / f"{name}.yaml").write_text((folder / "quick.yaml").read_text())
+        if text is not None:
+            (folder / "out" / name / "manifest.json").write_text(text)
+    restarted = TestClient(create_app(folder)).get("/api/runs").json()
+    assert [(j["scenario"], j["status"], j["done"], j["total"], j["earlier"]) for j in restarted] == [
+        ("cli.yml", "interrupted", 1, 5, True),
+        ("quick.yaml", "complete", 2, 2, True),
+    ], restarted
+    cli, quick = restarted
+    assert quick["output"] == "out/quick" and quick["command"] == "mmusv run quick.yaml -o out/quick --overwrite"
+    assert quick["recording"] == done["recording"] and Path(quick["recording"]).is_file()
+    assert quick["error"] is None and cli["error"] == "stopped before the end; the recording holds 1 frame"
+    assert cli["id"] > quick["id"]  # newest first, as the page looks for a file's last run

@@ -1,7 +1,7 @@
 """A second round through the editor in a real headless Chromium: a custom wave has a number box of its own, the
 preview window keeps the keyboard until Escape gives it back, the unsaved mark follows undo and redo back to the
-saved scenario, a page loaded again shows the last run of its file (one that ended too), the vessel library fits a
-narrow window, and a waypoint can be added from the keyboard.
+saved scenario, a page loaded again shows the last run of its file (one that ended too, and after a restart of the
+server), the vessel library fits a narrow window, and a waypoint can be added from the keyboard.
 
 Each test checks the browser's console for JavaScript errors (failed requests the page explains are not errors).
 """
@@ -14,6 +14,7 @@ import urllib.request
 from typing import Any
 
 import yaml
+from editor_server import serve
 from mmusv.world.environment import MAX_WAVE_HEIGHT_M
 from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
@@ -205,6 +206,27 @@ def test_a_page_loaded_again_shows_the_last_run_of_its_file(browser: Any, live_s
     text = browser.find_element(By.ID, "run-text").text
     assert text.startswith("failed: ") and failed["error"][:40] in text, text
     assert js_errors(browser) == []
+
+
+def test_a_restarted_server_shows_the_last_run_of_a_file(browser: Any, live_server: LiveServer) -> None:
+    """A server started again on the folder (a second server on it here) knew no run: a file reopened there showed
+    none, though its recording was in ``out/``. Now the runs there are read from their manifests."""
+    open_editor(browser, live_server)
+    js_errors(browser)
+    preset = '#rigs [data-rig="usv_standard"] select[data-key="preset"]'
+    Select(browser.find_element(By.CSS_SELECTOR, preset)).select_by_value("lidar_only")
+    settled(browser)
+    save_as(browser, "before.yaml")
+    done = run_to_end(live_server, "before.yaml", 2)
+    assert done["status"] == "complete", done
+    with serve(live_server.folder) as restarted:
+        open_editor(browser, restarted)
+        Select(browser.find_element(By.ID, "open")).select_by_value("file:before.yaml")
+        _wait(browser, "return document.getElementById('run-status').dataset.status === 'complete'", "the last run")
+        text = browser.find_element(By.ID, "run-text").text
+        assert text == "done: 2 frames → out/before/ (recorded before this editor started)", text
+        assert not browser.find_element(By.ID, "run-stop").is_displayed()
+        assert js_errors(browser) == []
 
 
 def test_the_library_fits_a_narrow_window(browser: Any, live_server: LiveServer) -> None:

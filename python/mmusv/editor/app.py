@@ -17,7 +17,8 @@ Endpoints (JSON in and out unless said otherwise; errors are ``{"error": "..."}`
 ``POST /api/poses``       ``{document, frame}`` -> every vessel's ``[x, y, yaw]`` at that index
 ``POST /api/preview``     ``{document, frame, agent}`` -> PNG of the ``mmusv preview`` sheet of that frame
 ``POST /api/runs``        ``{name, frames}`` starts ``mmusv run`` of a saved file; ``GET /api/runs[/{id}]``
-                          progress; ``DELETE /api/runs/{id}`` stops one
+                          progress (and the runs already in ``out/`` at start, ``earlier``); ``DELETE
+                          /api/runs/{id}`` stops one
 ========================  =====================================================================================
 
 Status codes: 400 bad input (a file name, a request the server cannot serve, a body that cannot be read as JSON:

@@ -9,6 +9,10 @@ At most :data:`MAX_RUNNING` runs go on at a time, and one output folder has one 
 ``a.yml`` share ``out/a``): a second is refused with :class:`RunGoingOn` instead of starting and failing on the
 folder's lock. A run never writes outside the folder: ``out/NAME`` reached through a link pointing elsewhere is
 refused.
+
+A server starts knowing the runs already in its folder: each ``out/NAME/manifest.json`` (written last by every run
+that ended, ``mmusv run`` on the command line included) of a scenario file ``NAME.yaml`` (or ``.yml``) is one finished
+run, marked ``earlier``, so a file reopened after a restart shows its last run as before.
 """
 
 from __future__ import annotations
@@ -54,12 +58,26 @@ class Job:
     recording: str | None = None
     seconds: float | None = None
     warnings: list[str] = field(default_factory=list)
+    earlier: bool = False
+    """Run before this server started (read from the output folder's manifest; no timing, no warnings)."""
     process: subprocess.Popen[str] | None = field(default=None, repr=False)
     stop_requested: bool = field(default=False, repr=False)
 
     def as_dict(self) -> dict[str, Any]:
         """The job as JSON (without the process)."""
-        keys = ("id", "scenario", "output", "command", "status", "done", "total", "error", "recording", "seconds")
+        keys = (
+            "id",
+            "scenario",
+            "output",
+            "command",
+            "status",
+            "done",
+            "total",
+            "error",
+            "recording",
+            "seconds",
+            "earlier",
+        )
         return {**{k: getattr(self, k) for k in keys}, "warnings": list(self.warnings)}
 
 
@@ -72,6 +90,9 @@ class Jobs:
         self._ids = itertools.count(1)
         self._lock = threading.Lock()
         self._followers: list[threading.Thread] = []
+        for job in _earlier_runs(root):
+            job.id = next(self._ids)
+            self._jobs[job.id] = job
 
     def start(self, path: Path, *, frames: int | None = None) -> Job:
         """Starts ``mmusv run`` of the scenario file ``path`` (in the folder) into ``out/<stem>``."""
@@ -199,3 +220,53 @@ class Jobs:
                 job.process.wait()
         for follower in self._followers:
             follower.join(timeout=max(0.1, deadline - time.monotonic()))
+
+
+_MANIFEST_STATUSES = ("complete", "interrupted", "failed")
+
+
+def _earlier_runs(root: Path) -> list[Job]:
+    """The finished runs in ``root/out`` (see the module docstring), oldest first (by their manifest's time, then
+    name); ids are given by the caller. A folder without a readable manifest of a known status (a run going on or
+    killed, or not a run) or without its scenario file in ``root`` is not a run the editor shows."""
+    found: list[tuple[float, str, Job]] = []
+    out = root / "out"
+    try:
+        folders = sorted(p for p in out.iterdir() if p.is_dir() and not p.is_symlink())
+    except OSError:
+        return []
+    for folder in folders:
+        files = [root / f"{folder.name}{ext}" for ext in (".yaml", ".yml")]
+        scenario = next((f for f in files if f.is_file()), None)
+        manifest = folder / "manifest.json"
+        try:
+            meta = json.loads(manifest.read_text(encoding="utf-8"))
+            when = manifest.stat().st_mtime
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError):
+            continue
+        if scenario is None or not isinstance(meta, dict) or meta.get("status") not in _MANIFEST_STATUSES:
+            continue
+        written, requested, recording = meta.get("frames_written"), meta.get("frames_requested"), meta.get("recording")
+        if not isinstance(written, int) or not isinstance(recording, str):
+            continue
+        rel = f"out/{folder.name}"
+        status = str(meta["status"])
+        error, frames = None, f"{written} frame{'' if written == 1 else 's'}"
+        if status == "interrupted":
+            error = f"stopped before the end; the recording holds {frames}"
+        elif status == "failed":
+            error = f"the run failed; the recording holds its first {frames} (mmusv info {rel})"
+        job = Job(
+            id=0,
+            scenario=scenario.name,
+            output=rel,
+            command=f"mmusv run {scenario.name} -o {rel} --overwrite",
+            status=status,
+            done=written,
+            total=requested if isinstance(requested, int) else None,
+            error=error,
+            recording=str(folder / recording),
+            earlier=True,
+        )
+        found.append((when, folder.name, job))
+    return [job for _, _, job in sorted(found, key=lambda t: (t[0], t[1]))]

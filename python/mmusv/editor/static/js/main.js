@@ -250,7 +250,11 @@ function showRun(job) {
   p.value = job.done;
   $("run-stop").hidden = job.status !== "running";
   let text = `${job.status} · frame ${job.done}${job.total ? ` / ${job.total}` : ""}`;
-  if (job.status === "complete") text = `done: ${job.done} frames in ${job.seconds} s → ${job.output}/`;
+  if (job.status === "complete") {
+    text = job.earlier
+      ? `done: ${job.done} frames → ${job.output}/ (recorded before this editor started)`
+      : `done: ${job.done} frames in ${job.seconds} s → ${job.output}/`;
+  }
   if (job.status === "failed" || job.status === "interrupted") text = `${job.status}: ${job.error}`;
   $("run-text").textContent = text;
   $("run-text").title = `${job.command}${job.warnings.length ? "\n" + job.warnings.join("\n") : ""}`;
