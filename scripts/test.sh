@@ -44,6 +44,11 @@ echo "== pip install the package with test and learn extras (builds the extensio
 echo "   tests; torch for the learned detector's tests in tests/learn)"
 python3 -m pip install --quiet --disable-pip-version-check -e ".[test,learn]"
 
+echo "== Ultralytics, the YOLO peer of tests/export/test_peer_readers.py, without its dependencies: it asks for OpenCV's"
+echo "   GUI build (opencv-python, needing libGL), which would overwrite the headless OpenCV of the test extra; what it"
+echo "   imports besides is installed above"
+python3 -m pip install --quiet --disable-pip-version-check --no-deps "ultralytics>=8.4,<9" "ultralytics-thop>=2"
+
 echo "== cargo clippy, warnings are errors (release: reuses the build scripts and proc macros built above)"
 cargo clippy -p mmusv-core -p mmusv-benches -p mmusv-py --release --all-targets --quiet -- -D warnings
 

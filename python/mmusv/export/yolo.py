@@ -8,6 +8,11 @@ which Ultralytics takes as the dataset root when ``path`` is absent; ``names``: 
 made by recording (:mod:`mmusv.export.splits`); without a split, ``images/all`` is both ``train`` and ``val``, and
 ``val`` is the ``train`` folder when no recording went to ``validate`` (Ultralytics requires both keys).
 
+Ultralytics finds an image's label file by replacing the *last* ``images`` folder of the image's path with
+``labels``, so a scenario, agent or camera named ``images`` would send it to a label file that does not exist
+(its boxes silently read as none): :func:`yolo_key` writes such a folder, and any ``images_``, ``images__``, …,
+with one more ``_`` (``images`` → ``images_``), which keeps distinct names distinct.
+
 Class index = the position of the vessel's semantic class in :data:`mmusv.export.camera.CATEGORIES` (every mmusv
 class but ``none``, by id), so ``names`` lists the classes in id order. Boxes are those of
 :meth:`mmusv.export.camera.CameraWriter.boxes_of` (the COCO export's).
@@ -15,6 +20,7 @@ class but ``none``, by id), so ``names`` lists the classes in id order. Boxes ar
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -22,14 +28,21 @@ from mmusv.export.camera import CATEGORIES, CameraWriter, Sample, Shared, catego
 from mmusv.export.common import Options, Sink, dump_yaml, png_bytes
 from mmusv.export.splits import SPLIT_NAMES
 
-__all__ = ["YoloWriter", "yolo_class"]
+__all__ = ["YoloWriter", "yolo_class", "yolo_key"]
 
 _YOLO_SPLIT = {"train": "train", "validate": "val", "test": "test"}
+_IMAGES_FOLDER = re.compile(r"images_*")
 
 
 def yolo_class(semantic_class: int) -> int:
     """The YOLO class index of an mmusv semantic class (its position in ``CATEGORIES``)."""
     return CATEGORIES.index(int(semantic_class))
+
+
+def yolo_key(key: str) -> str:
+    """A sample key (``<scenario>/<agent>/<camera>/<frame>``) as a path under ``images/<split>/`` and
+    ``labels/<split>/``: a folder named ``images``, ``images_``, … gets one more ``_`` (see the module docstring)."""
+    return "/".join(p + "_" if _IMAGES_FOLDER.fullmatch(p) else p for p in key.split("/"))
 
 
 class _YoloShared(Shared):
@@ -52,13 +65,14 @@ class YoloWriter(CameraWriter):
     def write_sample(self, sample: Sample) -> None:
         self.shared.splits.add(sample.split)
         cam = sample.camera
-        self.put(self.file("images", sample.split, f"{sample.key}.png"), png_bytes(sample.message("rgb")))
+        key = yolo_key(sample.key)
+        self.put(self.file("images", sample.split, f"{key}.png"), png_bytes(sample.message("rgb")))
         lines = []
         for b in self.boxes_of(sample):
             cx, cy = (b.x_min + b.x_max) / 2.0 / cam.width, (b.y_min + b.y_max) / 2.0 / cam.height
             w, h = b.width / cam.width, b.height / cam.height
             lines.append(f"{yolo_class(b.semantic_class)} {cx:.6f} {cy:.6f} {w:.6f} {h:.6f}\n")
-        self.put(self.file("labels", sample.split, f"{sample.key}.txt"), "".join(lines).encode())
+        self.put(self.file("labels", sample.split, f"{key}.txt"), "".join(lines).encode())
 
     @classmethod
     def finish_all(cls, shared: Any, out: Path, sink: Sink) -> None:
