@@ -57,13 +57,21 @@ def test_generated_scenarios_have_the_density_they_promise(generated: Path) -> N
 
 
 def test_target_density_rejects_a_lonely_usv(tmp_path: Path) -> None:
-    """The same combination with distractors removed and density asking for 3 targets can never pass."""
+    """The same combination with distractors removed and density asking for 3 targets can never pass: refused
+    when the spec is read (it spent its every attempt before). A density the combination can meet in principle
+    but its ranges never give (one target within 16 m while difficulty mid keeps it 70 m or more from the ego)
+    is left to the check, which rejects every candidate."""
+    from mmusv.errors import ConfigError
+
     spec = load_spec(SPEC).model_dump()
     spec["combinations"] = [
         dict(c, quota=1, max_attempts=20) for c in spec["combinations"] if c["name"] == "sea_crossing"
     ]
     spec["difficulties"]["mid"]["extra_targets"] = 0
     spec["constraints"]["target_density"]["min_targets"] = 3
+    with pytest.raises(ConfigError, match=r"constraints\.target_density\.min_targets = 3: .*sea_crossing"):
+        generate(spec, tmp_path)
+    spec["constraints"]["target_density"].update(min_targets=1, range_m=16.0)
     report = generate(spec, tmp_path)
     assert report.accepted == 0
     assert report.combos[0].rejected.get("target_density", 0) > 0

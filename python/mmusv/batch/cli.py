@@ -277,7 +277,8 @@ def add_dataset_parser(subparsers: Any) -> argparse.ArgumentParser:
 
 
 def run_dataset(args: argparse.Namespace) -> int:
-    """Runs ``mmusv dataset``; 0 when every scenario was recorded and converted, 1 otherwise."""
+    """Runs ``mmusv dataset``; 0 when every quota of the spec was met and every scenario was recorded and converted,
+    1 otherwise (a quota not met: as ``mmusv generate``, which exits 1 then)."""
     from mmusv.batch.dataset import build_dataset
     from mmusv.cli_paths import check_output_folder, path_arg
 
@@ -310,4 +311,4 @@ def run_dataset(args: argparse.Namespace) -> int:
         if rep.converted is not None
         else f"opv2v: {rep.opv2v} is up to date"
     )
-    return 0 if rep.ok else 1
+    return 0 if rep.ok and not rep.shortfall else 1

@@ -3,7 +3,8 @@
 Steps, each skipped on a re-run when its result is already there:
 
 1. generate the spec (:func:`mmusv.generate.generate`) into ``DIR/scenarios`` (skipped when ``DIR/dataset.json``
-   names the same spec hash and ``DIR/scenarios/report.json`` exists);
+   names the same spec hash and ``DIR/scenarios/report.json`` exists with every file it lists; a generation stopped
+   before its report is done again, replacing what it wrote); the quotas it did not meet are reported on every run;
 2. record every scenario into ``DIR/recordings/<stem>/`` with the batch runner (:func:`mmusv.batch.run_many`: the
    local pool or Ray, complete recordings skipped);
 3. convert the complete recordings to OPV2V (:func:`mmusv.export.convert`) into ``DIR/opv2v`` (skipped when the
@@ -24,7 +25,7 @@ from typing import Any
 
 from mmusv.batch.index import INDEX_NAME, read_index, write_index
 from mmusv.batch.runner import BatchReport, run_many
-from mmusv.errors import MmusvError
+from mmusv.errors import IoError, MmusvError
 
 __all__ = ["DatasetReport", "build_dataset"]
 
@@ -53,6 +54,23 @@ class DatasetReport:
 def _spec_hash(spec: Any) -> str:
     text = json.dumps(spec.model_dump(mode="json"), sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _generated_set(scen_dir: Path) -> list[str] | None:
+    """The quota shortfalls of the scenario set an earlier run generated into ``scen_dir`` (``[]`` when every quota
+    was met), or None when that set is not whole (no readable ``report.json``, or a file it lists is gone) and must
+    be generated again. A re-run used to say only "kept (same spec)", forgetting the shortfall the first run
+    printed, and kept a set whose files had been deleted, recording fewer scenarios than the spec makes."""
+    try:
+        data = json.loads((scen_dir / "report.json").read_text(encoding="utf-8"))
+        combos = data["combinations"]
+        files = [f for c in combos for f in c["files"]]
+        shortfall = [f"{c['name']}: {c['accepted']} of {c['quota']}" for c in combos if not c["quota_met"]]
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    if not all(isinstance(f, str) and (scen_dir / f).is_file() for f in files):
+        return None
+    return shortfall
 
 
 def build_dataset(
@@ -85,8 +103,9 @@ def build_dataset(
     except MmusvError:
         old = {}
     spec_section = {"file": Path(sp).name, "name": loaded.name, "hash": _spec_hash(loaded)}
-    generated = not (old.get("spec") == spec_section and (scen_dir / "report.json").is_file())
-    shortfall: list[str] = []
+    kept = _generated_set(scen_dir) if old.get("spec") == spec_section else None
+    generated = kept is None
+    shortfall: list[str] = [] if kept is None else kept
     quota = sum(c.quota for c in loaded.combinations)
     if generated:
 
@@ -121,13 +140,21 @@ def build_dataset(
     )
     if sources and not up_to_date:
         recs = [out / r["recording"] for r in doc["recordings"] if r["name"] in sources]
-        conv = convert(
-            recs,
-            to="opv2v",
-            out_dir=opv2v,
-            overwrite=True,
-            progress=None if progress is None else (lambda d, t: progress("convert", d, t)),
-        )
+        try:
+            conv = convert(
+                recs,
+                to="opv2v",
+                out_dir=opv2v,
+                overwrite=True,
+                progress=None if progress is None else (lambda d, t: progress("convert", d, t)),
+            )
+        except OSError as exc:  # a full disk: "No space left on device" alone, naming no folder and no way on
+            where = f"{exc.filename}: " if exc.filename else ""
+            raise IoError(
+                f"{opv2v}: converting the recordings to OPV2V failed: {where}{exc.strerror or exc}; the "
+                f"{len(recs)} complete recording(s) are kept and indexed in {index_path}: free space and run the "
+                "same command again to convert them"
+            ) from None
         converted = conv.frames
         section = {"folder": opv2v.name, "status": "complete", "frames": conv.frames, "sources": sources}
     elif not sources:

@@ -11,6 +11,8 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -43,7 +45,7 @@ def run(args: argparse.Namespace) -> int:
 
     from mmusv.cli_paths import check_output_folder, output_arg, path_arg
     from mmusv.generate.mapctx import map_context
-    from mmusv.generate.runner import generate
+    from mmusv.generate.runner import check_output, generate
     from mmusv.generate.spec import load_spec
 
     console = Console(width=None if sys.stdout.isatty() else 160)
@@ -52,9 +54,11 @@ def run(args: argparse.Namespace) -> int:
     from mmusv.bundled import resolve_spec
 
     # A bundled spec by name from any folder (island_demo, coop_detection), as mmusv dataset takes it.
-    spec = load_spec(resolve_spec(path_arg(args.spec, flag="spec")))
+    spec_path = resolve_spec(path_arg(args.spec, flag="spec"))
+    spec = load_spec(spec_path)
     out = Path(args.output) if args.output is not None else Path("scenarios/generated") / spec.name
     check_output_folder(str(out))  # before the map is built: a file there was named after it
+    check_output(out, args.force, spec_path)  # an earlier run's files, without --force: refused before the maps
     total = sum(c.quota for c in spec.combinations)
     t0 = time.perf_counter()
     maps = {(m.type, m.seed): m for m in (spec.map_of(c) for c in spec.combinations)}
@@ -64,7 +68,8 @@ def run(args: argparse.Namespace) -> int:
     t_map = time.perf_counter() - t0
     t0 = time.perf_counter()
     if args.no_progress:
-        report = generate(spec, out, force=args.force)
+        with _resume_hint(out):
+            report = generate(spec, out, force=args.force)
     else:
         columns = (
             TextColumn("[bold]{task.description}"),
@@ -79,7 +84,8 @@ def run(args: argparse.Namespace) -> int:
             def tick(name: str, accepted: int, attempts: int) -> None:
                 bar.update(task, completed=accepted, attempts=attempts, description=name)
 
-            report = generate(spec, out, force=args.force, progress=tick)
+            with _resume_hint(out):
+                report = generate(spec, out, force=args.force, progress=tick)
             bar.update(task, completed=total, description="done")
     elapsed = time.perf_counter() - t0
     report.print(console)
@@ -89,3 +95,17 @@ def run(args: argparse.Namespace) -> int:
         f"generated in {elapsed:.1f} s ({rate:.1f} scenarios/s, {report.attempts} attempts)"
     )
     return 0 if report.all_met else 1
+
+
+@contextmanager
+def _resume_hint(out: Path) -> Iterator[None]:
+    """On Ctrl-C (or SIGTERM): one line saying what is left in ``out`` and how to start again."""
+    try:
+        yield
+    except KeyboardInterrupt:
+        print(
+            f"mmusv: generation stopped; the scenario files written so far stay in {out} (listed in its "
+            ".generate.partial): run the same command with --force to generate the set from the start",
+            file=sys.stderr,
+        )
+        raise

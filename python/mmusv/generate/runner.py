@@ -3,7 +3,8 @@ scenarios and ``report.json``.
 
 Per combination ``i`` (in spec order) attempts ``0, 1, ...`` are drawn by :func:`sample_candidate` from
 ``(spec.seed, i, attempt)`` and checked by the enabled constraints; an accepted candidate is written as
-``<combination>_<NNN>.yaml`` (``NNN`` = its rank among the combination's accepted scenarios), read back (YAML
+``<combination>_<NNN>.yaml`` (``NNN`` = its rank among the combination's accepted scenarios; its name goes into
+the hidden ``.generate.partial`` first, so a run stopped before its report is known by ``--force``), read back (YAML
 safe loader, libyaml's when installed: the same resolver as ``yaml.safe_load``), validated with
 :func:`mmusv.config.load_scenario` and compared with the checked scenario before it counts. The loop stops at the
 quota or at ``max_attempts``, so it always ends; the same spec gives the same files byte for byte.
@@ -11,6 +12,7 @@ quota or at ``max_attempts``, so it always ends; the same spec gives the same fi
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
@@ -32,7 +34,7 @@ from mmusv.generate.sampler import Candidate, sample_candidate
 from mmusv.generate.samples import take_samples
 from mmusv.generate.spec import GenerationSpec, class_assets, load_spec
 
-__all__ = ["Progress", "dump_scenario", "generate"]
+__all__ = ["JOURNAL", "Progress", "check_output", "dump_scenario", "generate"]
 
 Progress = Callable[[str, int, int], None]
 """Called after every attempt with (combination name, accepted so far in total, attempts so far in total)."""
@@ -87,33 +89,93 @@ def dump_scenario(data: dict[str, Any]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _prepare_dir(out: Path, force: bool, spec_path: Path | None = None) -> None:
-    """Readies ``out``: with ``force``, removes the scenario files a previous run generated there (those its
-    ``report.json`` lists) and that report; any other YAML file there (a hand-written scenario, the spec itself)
-    is never deleted: the run refuses instead."""
+JOURNAL = ".generate.partial"
+"""The file in the output folder that names every scenario file a run is about to write, one per line, before the
+file appears; removed once ``report.json`` is in place. A run stopped before its report (Ctrl-C, a kill, a full
+disk) leaves it, so ``--force`` (and ``mmusv dataset`` run again) knows those files are a generate run's own."""
+
+
+def check_output(out: str | os.PathLike[str], force: bool, spec_path: str | os.PathLike[str] | None = None) -> None:
+    """Raises the :class:`~mmusv.errors.IoError` that generating into ``out`` would end in (a file there, YAML
+    files no generate run wrote, or, without ``force``, an earlier run's files), changing nothing: ``mmusv generate``
+    calls it before building the maps, which took seconds before such a refusal."""
+    _existing(Path(out), force, Path(spec_path) if spec_path is not None else None)
+
+
+def _existing(out: Path, force: bool, spec_path: Path | None) -> tuple[list[Path], set[str]] | None:
+    """The YAML files in ``out`` and the names an earlier run there wrote (its ``report.json`` or, for a run
+    stopped before its report, its :data:`JOURNAL`), or None when ``out`` holds nothing of a run; raises when the
+    run must refuse (see :func:`_prepare_dir`)."""
     if out.exists() and not out.is_dir():
         raise IoError(f"output {str(out)!r} exists and is not a directory")
     if not out.is_dir():
-        out.mkdir(parents=True, exist_ok=True)
-        return
+        return None
     yamls = sorted(out.glob("*.yaml"))
-    report = out / "report.json"
-    if not yamls and not report.is_file():
-        return
-    if not force:
-        raise IoError(f"output directory {str(out)!r} already holds scenario files; pass --force to replace them")
-    ours = _generated_here(report)
-    foreign = [p for p in yamls if p.name not in ours or (spec_path is not None and _same_file(p, spec_path))]
-    if foreign:
+    report, journal = out / "report.json", out / JOURNAL
+    if not yamls and not report.is_file():  # a journal alone: a run stopped before its first file
+        return None
+    ours = _generated_here(report) | _journal_names(journal)
+    is_spec = [p for p in yamls if spec_path is not None and _same_file(p, spec_path)]
+    foreign = [p for p in yamls if p.name not in ours or p in is_spec]
+    if foreign:  # --force would not replace them either: say so at once, not after a first refusal
         names = ", ".join(p.name for p in foreign[:3]) + (" ..." if len(foreign) > 3 else "")
         raise IoError(
             f"output directory {str(out)!r} holds YAML files that no earlier generate run there wrote ({names}; "
-            f"{'the spec itself, ' if spec_path is not None and any(_same_file(p, spec_path) for p in foreign) else ''}"
+            f"{'the spec itself, ' if is_spec else ''}"
             "report.json lists what a run wrote); --force replaces only those: choose another folder or move them"
         )
-    for p in yamls:
-        p.unlink()
-    report.unlink(missing_ok=True)
+    if not force:
+        what = (
+            f"the {len(yamls)} scenario files of a generate run stopped before its report.json"
+            if not report.is_file()
+            else f"{len(yamls)} scenario files and the report.json of an earlier generate run"
+        )
+        raise IoError(f"output directory {str(out)!r} already holds {what}; pass --force to replace them")
+    return yamls, ours
+
+
+def _prepare_dir(out: Path, force: bool, spec_path: Path | None = None) -> None:
+    """Readies ``out``: with ``force``, removes the scenario files a previous run generated there (those its
+    ``report.json`` lists, or, for a run stopped before its report, its :data:`JOURNAL`) and that report; any other
+    YAML file there (a hand-written scenario, the spec itself) is never deleted: the run refuses instead, with or
+    without ``force``."""
+    found = _existing(out, force, spec_path)
+    if found is None:
+        out.mkdir(parents=True, exist_ok=True)
+        for name in _journal_names(out / JOURNAL):  # a temporary a stopped run left (the journal is rewritten)
+            (out / f".{name}.tmp").unlink(missing_ok=True)
+        return
+    yamls, ours = found
+    journal = out / JOURNAL
+    # The journal names every file about to go, so a run stopped while removing them still knows them as its own.
+    try:
+        _write_journal(journal, sorted(ours | {p.name for p in yamls}))
+        (out / "report.json").unlink(missing_ok=True)
+        for p in yamls:
+            p.unlink()
+        for name in ours:
+            (out / f".{name}.tmp").unlink(missing_ok=True)
+        (out / ".report.json.tmp").unlink(missing_ok=True)
+        journal.unlink()
+    except OSError as exc:
+        raise IoError(
+            f"output directory {str(out)!r}: cannot replace the earlier run's files: {exc.strerror or exc}"
+        ) from None
+
+
+def _write_journal(journal: Path, names: list[str]) -> None:
+    tmp = journal.with_name(journal.name + ".tmp")
+    tmp.write_text("".join(f"{n}\n" for n in names), encoding="utf-8")
+    os.replace(tmp, journal)
+
+
+def _journal_names(journal: Path) -> set[str]:
+    """The scenario file names a run's :data:`JOURNAL` lists (empty when there is none or it is unreadable)."""
+    try:
+        lines = journal.read_text(encoding="utf-8").splitlines()
+    except (OSError, ValueError):
+        return set()
+    return {n for n in lines if n.endswith(".yaml") and Path(n).name == n}
 
 
 def _generated_here(report: Path) -> set[str]:
@@ -129,6 +191,19 @@ def _generated_here(report: Path) -> set[str]:
         }
     except (OSError, ValueError, AttributeError, TypeError):
         return set()
+
+
+def _write_failed(path: Path, exc: OSError, written: int) -> IoError:
+    """The one-line error of a write that failed (a full disk, a read-only folder): the file, the cause, what is
+    kept and how to go on. The OSError of a write to an open file names no file, so the CLI said only "No space
+    left on device"."""
+    cause = f"{path}: cannot write it: {exc.strerror or exc}"
+    if not written:
+        return IoError(f"{cause}; free space or choose a folder that can be written")
+    return IoError(
+        f"{cause}; the {written} scenario file(s) written before it are kept: free space and run again (generate "
+        "--force, or the same mmusv dataset command), which replaces what this run wrote"
+    )
 
 
 def _same_file(a: Path, b: Path) -> bool:
@@ -182,10 +257,16 @@ def generate(
     unless ``force``) and writes ``report.json`` there; returns the report."""
     spec = load_spec(spec_source)
     out = Path(out_dir)
+    spec_path = Path(spec_source) if isinstance(spec_source, (str, os.PathLike)) else None
+    check_output(out, force, spec_path)  # before the maps are built: a refusal took their seconds first
     contexts = [map_context(m.type, m.seed, m.param_values()) for m in (spec.map_of(c) for c in spec.combinations)]
     constraints = build_constraints(spec)
-    spec_path = Path(spec_source) if isinstance(spec_source, (str, os.PathLike)) else None
     _prepare_dir(out, force, spec_path)
+    journal = out / JOURNAL
+    try:  # also the first write into the folder: a read-only one is named before any sampling
+        journal.write_text("", encoding="utf-8")
+    except OSError as exc:
+        raise _write_failed(journal, exc, 0) from None
     report = RunReport(
         spec_name=spec.name,
         seed=spec.seed,
@@ -216,9 +297,7 @@ def generate(
                     rep.reject(*fail)
                 else:
                     path = out / f"{name}.yaml"
-                    tmp = path.with_name(f".{path.name}.tmp")  # renamed into place: a stop never leaves half a file
-                    tmp.write_text(dump_scenario(cand.data), encoding="utf-8")
-                    os.replace(tmp, path)
+                    _write_scenario(path, dump_scenario(cand.data), journal, report.accepted)
                     if load_scenario(yaml.load(path.read_text(encoding="utf-8"), Loader=_LOADER)) != cand.scenario:
                         raise MmusvError(f"internal: {path} does not read back as the scenario that was checked")
                     rep.accept(path.name)
@@ -236,7 +315,29 @@ def generate(
                     )
             if progress is not None:
                 progress(rep.name, report.accepted, total_attempts)
-    tmp = out / ".report.json.tmp"
-    tmp.write_text(report.to_json(), encoding="utf-8")
-    os.replace(tmp, out / "report.json")
+    _write_atomic(out / "report.json", report.to_json(), report.accepted)
+    journal.unlink(missing_ok=True)  # the report lists every file now
     return report
+
+
+def _write_atomic(path: Path, text: str, written: int) -> None:
+    """``text`` into ``path`` through a hidden temporary renamed into place (a stop never leaves half a file); on
+    an OSError the temporary is removed and the error names ``path`` (:func:`_write_failed`)."""
+    tmp = path.with_name(f".{path.name}.tmp")
+    try:
+        tmp.write_text(text, encoding="utf-8")
+        os.replace(tmp, path)
+    except OSError as exc:
+        with contextlib.suppress(OSError):
+            tmp.unlink(missing_ok=True)
+        raise _write_failed(path, exc, written) from None
+
+
+def _write_scenario(path: Path, text: str, journal: Path, written: int) -> None:
+    """Writes one accepted scenario: its name into the journal first (flushed), then the file itself."""
+    try:
+        with journal.open("a", encoding="utf-8") as f:
+            f.write(f"{path.name}\n")
+    except OSError as exc:
+        raise _write_failed(journal, exc, written) from None
+    _write_atomic(path, text, written)

@@ -8,7 +8,7 @@ Units: metres, seconds, metres per second; shares are fractions of the frames in
   out, as a clear sky does not rain);
 - ``rig``/``rigs``: the sensor rig every USV carries (``{usv_standard: {}}`` = the default rig);
 - ``usv``: USV ``assets`` and ``speed_mps``; ``size_classes``: target classes by hull ``length_m`` (default
-  small < 15 m <= medium < 80 m <= large) with their ``speed_mps``;
+  small < 15 m <= medium < 80 m <= large) or an explicit ``assets`` list, with their ``speed_mps``;
 - ``difficulties``: ``range_m`` (ego to target closest approach), ``extra_targets`` (distractors, n or
   [lo, hi]) from ``extra_classes``, ``occluded_share`` (ask for occlusion of the primary target);
 - ``combinations``: ``family`` (:data:`mmusv.generate.families.FAMILIES`), ``difficulty``, ``ego`` asset,
@@ -16,6 +16,7 @@ Units: metres, seconds, metres per second; shares are fractions of the frames in
   optional ``max_attempts`` (default ``quota x max_attempts_per_scenario``), ``name`` and ``map`` (this
   combination's own map instead of the spec's, so one spec can cover several maps);
 - ``constraints``: the named checks and thresholds (:mod:`mmusv.generate.spec_constraints`);
+- ``max_attempts_per_scenario`` (default 40: a combination's attempt cap is its quota times this);
 - tuning: ``check_step_m`` (sample spacing of the checks), ``sensor_height_m``, ``encounter_clearance_m``,
   ``proposals`` (prior-guided proposals per placed vessel).
 
@@ -34,7 +35,12 @@ Example (``scenarios/specs/island_demo.yaml`` is a commented one)::
       occlusion: {min_occluded_share: 0.3}
 
 Every error is a :class:`mmusv.ConfigError` whose message names the field (``combinations[1].difficulty``),
-the value given and what is allowed, in the style of :func:`mmusv.config.load_scenario`.
+the value given and what is allowed, in the style of :func:`mmusv.config.load_scenario`. As in a scenario,
+``true``/``false`` is never read as a number (``quota: true``, ``speed_mps: [true, 5]``). Constraints that no
+candidate of a combination could meet together are refused here, naming the constraint, the combination and the
+other bound (``separation.min_m`` above the difficulty's ``range_m`` or ``cooperation.max_m``, a sensing or
+density range inside the separation, ``target_density.min_targets`` above the targets a combination has, a lone
+ego whose target is kept beyond its sensing range), rather than spending every attempt on them.
 """
 
 from __future__ import annotations
@@ -46,7 +52,7 @@ from collections.abc import Callable
 from functools import lru_cache
 from typing import Any
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic import Field, ValidationError, field_validator
 
 from mmusv.config import (
     MAX_SPEED_MPS,
@@ -69,6 +75,7 @@ from mmusv.generate.spec_constraints import (
     SensingRangeCheck,
     SeparationCheck,
     ShoreClearanceCheck,
+    SpecModel,
     StructureClearanceCheck,
     TargetRangeCheck,
 )
@@ -108,8 +115,8 @@ MAX_ENCOUNTER_CLEARANCE_M = 10_000.0
 the clearance is halved down to the map's own while no water cell has it."""
 
 
-class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, str_strip_whitespace=True, allow_inf_nan=False)
+_Model = SpecModel
+"""No unknown keys, NaN, infinity or booleans for numbers (:class:`~mmusv.generate.spec_constraints.SpecModel`)."""
 
 
 def _ordered(v: Pair, what: str) -> Pair:
@@ -409,6 +416,74 @@ def _cross_checks(spec: GenerationSpec, source: str) -> None:
         if label in labels:
             fail(f"{where}.name", label, "two combinations have this name; give them distinct `name:`s")
         labels.add(label)
+        bad = _contradiction(spec, combo)
+        if bad is not None:
+            fail(f"constraints.{bad[0]}", bad[1], f"{where} ({label}) could never pass: {bad[2]}")
+
+
+def _contradiction(spec: GenerationSpec, combo: Combination) -> tuple[str, float, str] | None:
+    """Two enabled constraints (or a constraint and the combination) that no candidate can meet together, as
+    ``(constraint field, its value, why)``; None when none is found. Without this, such a combination spent its
+    every attempt (quota x max_attempts_per_scenario) and its report named only the constraint that rejected most,
+    not that it never could pass. The arguments are exact: hulls at least ``separation.min_m`` apart put their
+    centres farther apart still, and a vessel's centre is always on its route."""
+    c = spec.constraints
+    diff = spec.difficulties[combo.difficulty]
+    lo, hi = diff.range_m
+    sep = c.separation.min_m if c.separation.enabled else 0.0
+    route_uu = c.route_separation.min_m if c.route_separation.enabled and "usv-usv" in c.route_separation.pairs else 0
+    route_ut = (
+        c.route_separation.min_m if c.route_separation.enabled and "usv-target" in c.route_separation.pairs else 0
+    )
+    coop = c.cooperation.enabled and c.cooperation.min_share > 0 and combo.cooperating >= 1
+    density = c.target_density
+    sensing = c.sensing_range
+    most = len(combo.targets) + diff.extra_targets[1]
+    if density.enabled and density.min_share > 0 and density.min_targets > most:
+        return (
+            "target_density.min_targets",
+            density.min_targets,
+            f"the combination has at most {most} target(s) ({len(combo.targets)} role target(s) + at most "
+            f"{diff.extra_targets[1]} extra of difficulty {combo.difficulty}): lower min_targets or add targets",
+        )
+    if c.target_range.enabled and hi < max(sep, route_ut):
+        what = "separation.min_m" if sep >= route_ut else "route_separation.min_m"
+        return (
+            what,
+            max(sep, route_ut),
+            f"difficulty {combo.difficulty} asks the ego and its target to come within {hi:g} m (range_m) and "
+            f"target_range checks it, but {what} keeps them farther apart: lower {what} or raise range_m",
+        )
+    if coop and c.cooperation.max_m < max(sep, route_uu):
+        what = "separation.min_m" if sep >= route_uu else "route_separation.min_m"
+        return (
+            what,
+            max(sep, route_uu),
+            f"cooperation asks every USV's nearest USV to be within {c.cooperation.max_m:g} m (max_m), but {what} "
+            f"keeps the USVs farther apart: lower {what} or raise cooperation.max_m",
+        )
+    for name, check, rng in (("sensing_range", sensing, sensing.range_m), ("target_density", density, density.range_m)):
+        if check.enabled and check.min_share > 0 and rng < sep:
+            return (
+                f"{name}.range_m",
+                rng,
+                f"separation keeps every target more than {sep:g} m (min_m) from every USV, so none is ever within "
+                f"{rng:g} m: raise {name}.range_m or lower separation.min_m",
+            )
+    if (
+        combo.cooperating == 0
+        and c.target_range.enabled
+        and sensing.enabled
+        and sensing.min_share > 0
+        and lo > (sensing.range_m)
+    ):
+        return (
+            "sensing_range.range_m",
+            sensing.range_m,
+            f"with no cooperating USV the ego must sense its target, which difficulty {combo.difficulty} keeps at "
+            f"least {lo:g} m away (range_m): raise sensing_range.range_m, lower range_m or add a cooperating USV",
+        )
+    return None
 
 
 def _check_budget(spec: GenerationSpec, fail: Callable[[str, object, str], None]) -> None:

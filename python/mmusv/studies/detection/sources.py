@@ -1,6 +1,7 @@
 """Where the sequences of a detection study come from: recordings given on the command line (files, folders
-holding a batch run's ``dataset.json`` (its complete recordings), or other folders searched for ``*.mcap`` and
-parts manifests of split recordings), an OPV2V folder, or the bundled detection spec generated and recorded LiDAR-only.
+holding a batch run's ``dataset.json`` (its complete recordings), the ``recordings`` folder of a ``mmusv dataset``
+folder (the complete recordings its ``dataset.json`` lists), or other folders searched for ``*.mcap`` and parts
+manifests of split recordings), an OPV2V folder, or the bundled detection spec generated and recorded LiDAR-only.
 
 Sequences are split by sequence before any agent-as-ego expansion: recordings and OPV2V scenario folders without
 split folders by :func:`~mmusv.studies.detection.data.split_sequences`; an OPV2V tree that already has
@@ -68,6 +69,29 @@ class Dataset:
         return sum(self.frames_by_sequence().values())
 
 
+def _indexed_below(folder: Path) -> list[Path] | None:
+    """The complete recordings below ``folder`` that the index of the folder above it lists, when that index
+    (``mmusv dataset``'s ``DIR/dataset.json``) lists recordings there: ``mmusv study detection DIR/recordings``
+    searched the folder instead and also read what the dataset no longer holds (a scenario the spec dropped, whose
+    recording stays on disk) and recordings the index marks failed. None when there is no such index."""
+    from mmusv.batch.index import INDEX_NAME, dataset_recordings, read_index
+    from mmusv.errors import MmusvError
+
+    here = folder.resolve()
+    index = here.parent / INDEX_NAME
+    if not index.is_file():
+        return None
+    try:
+        doc = read_index(index)
+    except MmusvError:
+        return None
+    prefix = f"{here.name}/"
+    paths = [str(r.get("recording") or "") for r in doc["recordings"]]
+    if not paths or not all(r.startswith(prefix) for r in paths if r):
+        return None
+    return [folder / r.relative_to(here) for r in dataset_recordings(index) if r.is_relative_to(here)]
+
+
 def _recordings(inputs: Sequence[str | Path]) -> list[Path]:
     from mmusv.batch.index import dataset_recordings, find_index
 
@@ -76,7 +100,17 @@ def _recordings(inputs: Sequence[str | Path]) -> list[Path]:
         p = Path(x)
         if p.is_dir():
             index = find_index(p)
-            found = dataset_recordings(index) if index is not None else find_recordings(p)
+            indexed = _indexed_below(p) if index is None else None
+            if index is not None:
+                found = dataset_recordings(index)
+            elif indexed is not None:
+                found = indexed
+            else:
+                found = find_recordings(p)
+            if not found and indexed is not None:
+                raise InputError(
+                    f"{p}: {p.resolve().parent / 'dataset.json'} lists no complete recording in this folder"
+                )
             if not found:
                 raise InputError(f"{p}: folder holds no .mcap recording")
             out.extend(found)
