@@ -37,6 +37,7 @@ import pytest
 from mmusv._native import core
 from mmusv.scene import Scene
 from mmusv.sensors.camera import render
+from mmusv.sensors.env import wind_from_wave_height
 from mmusv.world.build import pose_matrices
 from mmusv.world.hydrostatics import hull_particulars
 from mmusv.world.primitives import box
@@ -227,8 +228,9 @@ def test_cos2s_spreading_is_sampled_quantile_by_quantile(spread: float) -> None:
 
 
 def test_sea_state_presets_are_fully_developed_douglas_seas() -> None:
-    """WMO codes 0..9: Hs in (the middle of) its Douglas band; Tp and U of a fully developed Pierson–Moskowitz sea
-    (Hs = 0.21 U²/g, ωp = 0.877 g/U, so Tp = 2πU/(0.877 g) ≈ 4.99 √Hs) to 1e-9; γ = 1, which DNV's
+    """WMO codes 0..9: Hs in (the middle of) its Douglas band; Tp and U (at 19.5 m; the cameras' default wind is the
+    same at 10 m) of a fully developed Pierson–Moskowitz sea (Hs = 0.21 U²/g, ωp = 0.877 g/U, so
+    Tp = 2πU/(0.877 g) ≈ 4.99 √Hs) to 1e-9; γ = 1, which DNV's
     γ = exp(5.75 − 1.15 Tp/√Hs) (1 from Tp/√Hs ≥ 5) gives within 2 %; mmusv's ``dnv_gamma`` is that formula."""
     presets = {p[0]: p for p in core.sea_presets()}
     for code, (lo, hi) in enumerate(DOUGLAS_BANDS):
@@ -240,6 +242,9 @@ def test_sea_state_presets_are_fully_developed_douglas_seas() -> None:
             continue
         u = math.sqrt(G * hs / PM_HS_COEF)
         assert wind == pytest.approx(u, rel=1e-9)
+        # PM's wind is at 19.5 m; the cameras' whitecaps and facet slopes take the 10 m wind (Monahan, Cox & Munk):
+        # U19.5 ≈ 1.026 U10 (Stewart 2008, §16.4). It was passed on at 19.5 m: whitecaps 9 % too many.
+        assert wind_from_wave_height(hs) == pytest.approx(u / 1.026, rel=1e-12)  # what sensor_env passes on
         assert tp == pytest.approx(2 * math.pi * u / (PM_PEAK * G), rel=1e-9)
         assert gamma == 1.0
         r = tp / math.sqrt(hs)

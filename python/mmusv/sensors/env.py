@@ -12,7 +12,10 @@ and waves.
   monotone mapping chosen so that a clear 20 km day is T ≈ 3.4 and a 5 km haze T ≈ 7.9 (the range over which
   Preetham et al. 1999 fitted their model); fog and rain, whose skies are overcast, saturate it.
 * **Wind** (m/s at 10 m), when the scenario does not give one: the wind of a fully developed Pierson–Moskowitz
-  sea of the scenario's significant height, ``U = √(H g / 0.21)``.
+  sea of the scenario's significant height. Pierson & Moskowitz (1964) give it at 19.5 m (their weather ships'
+  anemometers), ``U₁₉.₅ = √(H g / 0.21)``; the whitecaps (Monahan) and the water's slopes (Cox & Munk) take the
+  10 m wind, ``U₁₀ = U₁₉.₅ / 1.026`` (Stewart, R. H. (2008), *Introduction to Physical Oceanography*, §16.4, for a
+  drag coefficient of 1.3·10⁻³).
 * **Water body**: diffuse reflectance (linear RGB) of clear open-ocean water, blue (Morel 1988's case-1 water:
   a few per cent in the blue, well under one in the red).
 """
@@ -70,9 +73,16 @@ def turbidity_from_visibility(visibility_m: float) -> float:
     return float(min(10.0, max(1.9, 1.9 + 30.0 / max(visibility_m / 1000.0, 1e-3))))
 
 
+STANDARD_GRAVITY = 9.80665
+"""g, m/s² (the core's wave field and sea-state presets use the same)."""
+U19_5_PER_U10 = 1.026
+"""Wind at 19.5 m over wind at 10 m above the sea (Stewart 2008, §16.4; see the module docstring)."""
+
+
 def wind_from_wave_height(wave_height_m: float) -> float:
-    """Wind speed (m/s) of a fully developed Pierson–Moskowitz sea of significant height ``wave_height_m``."""
-    return math.sqrt(max(0.0, wave_height_m) * 9.81 / 0.21)
+    """Wind speed (m/s) at 10 m of a fully developed Pierson–Moskowitz sea of significant height ``wave_height_m``
+    (the module docstring: PM's 19.5 m wind divided by :data:`U19_5_PER_U10`)."""
+    return math.sqrt(max(0.0, wave_height_m) * STANDARD_GRAVITY / 0.21) / U19_5_PER_U10
 
 
 def sensor_env(
