@@ -14,27 +14,13 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:
-    from rich.console import Console
-
-    from mmusv.config import Scenario
 
 from mmusv import cli_console
-from mmusv.cli_paths import check_output_folder, output_arg, path_arg
+from mmusv.cli_console import rich_console
+from mmusv.cli_paths import output_arg, path_arg, ready_output_folder
 from mmusv.errors import ConfigError, MmusvError
 
 BUNDLED_WAVE_SCENARIO = "scenarios/island_port_waves.yaml"
-MAX_FRAMES = 10_000_000
-"""The most frames a scenario may have (``AcquisitionConfig.frames``): ``study waves --frames`` at most."""
-
-
-def _console() -> Console:
-    """A rich console; wide when not writing to a terminal so piped tables are not wrapped."""
-    from rich.console import Console
-
-    return Console(width=None if sys.stdout.isatty() else 160)
 
 
 def _cmd_assets(args: argparse.Namespace) -> int:
@@ -43,7 +29,7 @@ def _cmd_assets(args: argparse.Namespace) -> int:
     from mmusv.world.vessels import library
 
     if args.render is not None:  # its folder made first: one that cannot be was named after the table
-        _ready_output(args.render, flag="--render")
+        ready_output_folder(args.render, flag="--render")
     table = Table(title="mmusv vessel library")
     for col in ("name", "category", "class", "length m", "beam m", "height m", "draft m", "triangles", "parts"):
         table.add_column(col, justify="right" if col.endswith(("m", "triangles", "parts")) else "left")
@@ -59,120 +45,11 @@ def _cmd_assets(args: argparse.Namespace) -> int:
             str(a.num_triangles),
             str(a.num_parts),
         )
-    _console().print(table)
+    rich_console().print(table)
     if args.render is not None:  # one close-up per asset and a contact sheet of them all
         from mmusv.world.contact_sheet import write_contact_sheet
 
-        _console().print(f"wrote {write_contact_sheet(args.render)}")
-    return 0
-
-
-def _ready_output(output: str, *, flag: str = "-o/--output") -> None:
-    """Creates a study's output folder before the study runs, so that a folder that cannot be written is named
-    (as ``flag``) at once, not after the computing."""
-    from mmusv.errors import IoError
-
-    check_output_folder(output, flag=flag)  # a file there (or above) is named as such, not as "File exists"
-    try:
-        Path(output).mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise IoError(f"{flag} {output}: cannot create the folder: {exc.strerror or exc}") from None
-
-
-def _cmd_study_waves(args: argparse.Namespace) -> int:
-    from rich.table import Table
-
-    from mmusv import arguments
-    from mmusv.bundled import resolve_scenario
-    from mmusv.config import load_scenario
-    from mmusv.studies.waves import run_wave_study
-
-    # --frames first, within a scenario's own bound: a bad count made the output folder before it was refused,
-    # and 10**30 was a numpy traceback (the copy of the scenario below is not validated).
-    if args.frames is not None:
-        arguments.whole(args.frames, name="--frames", lo=2, hi=MAX_FRAMES)
-    scenario = load_scenario(resolve_scenario(path_arg(args.scenario, flag="--scenario")))
-    _ready_output(args.output)
-    if args.frames is not None:
-        scenario = scenario.model_copy(
-            update={"acquisition": scenario.acquisition.model_copy(update={"frames": args.frames})}
-        )
-    if args.motion == "physical":
-        return _print_physical_wave_study(scenario, args)
-    study = run_wave_study(scenario)
-    table = Table(
-        title=f"Wave study on {scenario.name} ({study.table['usvs'][0]} USVs × {study.table['frames'][0]} frames)"
-    )
-    for col in ("wave", "H (m)", "heave RMS (m)", "roll RMS (°)", "pitch RMS (°)"):
-        table.add_column(col, justify="right")
-    for r in study.table.iter_rows(named=True):
-        table.add_row(
-            str(r["wave"]),
-            f"{r['H_m']:.1f}",
-            f"{r['heave_rms_m']:.4f}",
-            f"{r['roll_rms_deg']:.4f}",
-            f"{r['pitch_rms_deg']:.4f}",
-        )
-    console = _console()
-    console.print(table)
-    console.print("R² of a linear fit in H: " + ", ".join(f"{k} {v:.4f}" for k, v in study.r2.items()))
-    paths = study.write(Path(args.output))
-    console.print(f"wrote {paths['csv']} and {paths['png']}")
-    return 0
-
-
-def _print_physical_wave_study(scenario: Scenario, args: argparse.Namespace) -> int:
-    from rich.table import Table
-
-    from mmusv.studies.waves import run_physical_wave_study
-
-    study = run_physical_wave_study(scenario, record_s=None if args.frames is not None else 1200.0)
-    s = study.summary
-    frames, hz = int(s["frames"][0]), scenario.acquisition.frequency_hz
-    table = Table(
-        title=f"Wave study, physical motion, on {scenario.name}: USVs pooled, {frames} frames ({frames / hz:.0f} s) "
-        "per sea state; heave m / roll ° / pitch ° RMS"
-    )
-    for col in ("wave", "Hs (m)", "Tp (s)", "paper Table I", "paper mode", "physical (USVs)", "physical (fleet)"):
-        table.add_column(col, justify="right")
-
-    def trio(r: dict[str, object], prefix: str) -> str:
-        return (
-            f"{r[prefix + '_heave_rms_m']:.3f} / {r[prefix + '_roll_rms_deg']:.2f} / {r[prefix + '_pitch_rms_deg']:.2f}"
-        )
-
-    for r in s.iter_rows(named=True):
-        table.add_row(
-            str(r["wave"]),
-            f"{r['Hs_m']:.1f}",
-            f"{r['Tp_s']:.1f}",
-            trio(r, "table1"),
-            trio(r, "paper"),
-            trio(r, "physical"),
-            trio(r, "fleet"),
-        )
-    console = _console()
-    console.print(table)
-    per = Table(title="Physical motion per vessel: heave m / roll ° / pitch ° RMS")
-    per.add_column("vessel")
-    per.add_column("asset")
-    waves = s["wave"].to_list()
-    for w in waves:
-        per.add_column(str(w), justify="right")
-    v = study.vessels
-    for vid in v["id"].unique(maintain_order=True).to_list():
-        rows = v.filter(v["id"] == vid)
-        cells = [
-            f"{r['heave_rms_m']:.3f} / {r['roll_rms_deg']:.2f} / {r['pitch_rms_deg']:.2f}"
-            for r in rows.iter_rows(named=True)
-        ]
-        per.add_row(str(vid), str(rows["asset"][0]), *cells)
-    console.print(per)
-    mono = study.monotonic()
-    rising = sorted(k for k, ok in mono.items() if ok)
-    console.print(f"all three RMS rise with the sea state for {len(rising)} of {len(mono)} vessels")
-    paths = study.write(Path(args.output))
-    console.print(f"wrote {paths['summary']} and {paths['vessels']}")
+        rich_console().print(f"wrote {write_contact_sheet(args.render)}")
     return 0
 
 
@@ -280,7 +157,7 @@ def _cmd_scenarios(args: argparse.Namespace) -> int:
         table.add_column(col, justify="right" if col in ("USVs", "targets", "frames") else "left")
     for b in bundled_scenarios():
         table.add_row(b.name, b.map, str(b.usvs), str(b.targets), str(b.frames), b.description)
-    _console().print(table)
+    rich_console().print(table)
     return 0
 
 
@@ -302,7 +179,7 @@ def _cmd_info(args: argparse.Namespace) -> int:
             raise MmusvError(f"{target} holds {len(found)} recordings ({', '.join(f.name for f in found)}); name one")
         target = found[0]
     info = summary(target)
-    console = _console()
+    console = rich_console()
     meta = info.get("metadata", {})
     run_meta = meta.get("run", {})
     frames = info.get("frames") or {}
@@ -384,42 +261,6 @@ def _cmd_preview(args: argparse.Namespace) -> int:
     arguments.whole(args.frame, name="--frame", lo=0)  # -1 was "frame -1 is not in ...", not what is allowed
     out = write_preview(args.recording, frame=args.frame, agent=args.agent, output=args.output)
     print(f"wrote {out}")
-    return 0
-
-
-def _cmd_study_agreement(args: argparse.Namespace) -> int:
-    from rich.table import Table
-
-    from mmusv.studies.agreement import BUNDLED_SCENARIOS, check_counts, run_agreement_study
-
-    check_counts(args.frames)  # before the output folder is made
-    for scenario in args.scenarios:
-        path_arg(scenario, flag="scenario")
-    _ready_output(args.output)
-    study = run_agreement_study(args.scenarios or BUNDLED_SCENARIOS, frames=args.frames)
-    table = Table(title="Annotation vs top-view rendering (Table II)")
-    for col in (
-        "map",
-        "valid samples",
-        "median centre error (px)",
-        "median centroid error (px)",
-        "mean containment",
-        "mean hull occupancy",
-    ):
-        table.add_column(col, justify="right")
-    for r in study.summary.iter_rows(named=True):
-        table.add_row(
-            str(r["map"]),
-            str(r["valid_samples"]),
-            f"{r['median_centre_error_px']:.3f}",
-            f"{r['median_centroid_error_px']:.3f}",
-            f"{r['mean_containment']:.4f}",
-            f"{r['mean_hull_occupancy']:.3f}",
-        )
-    console = _console()
-    console.print(table)
-    paths = study.write(Path(args.output))
-    console.print(f"wrote {paths['samples']} and {paths['summary']}")
     return 0
 
 
@@ -612,9 +453,13 @@ def _dispatch(args: argparse.Namespace) -> int:
     if args.command == "scenarios":
         return _cmd_scenarios(args)
     if args.command == "study" and args.study == "waves":
-        return _cmd_study_waves(args)
+        from mmusv.studies.cli import study_waves
+
+        return study_waves(args)
     if args.command == "study" and args.study == "agreement":
-        return _cmd_study_agreement(args)
+        from mmusv.studies.cli import study_agreement
+
+        return study_agreement(args)
     if args.command == "study" and args.study in ("detection", "robustness"):
         from mmusv.studies.detection.cli import run as _run_detection
 

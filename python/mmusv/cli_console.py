@@ -10,7 +10,10 @@ from __future__ import annotations
 import contextlib
 import sys
 from collections.abc import Iterator
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from rich.console import Console
 
 from mmusv.thread_env import check_thread_environment
 
@@ -23,6 +26,7 @@ __all__ = [
     "memory_hint",
     "open_missing_streams",
     "os_hint",
+    "rich_console",
     "say",
     "stdout_broken",
     "stdout_fails",
@@ -225,3 +229,11 @@ def memory_hint() -> str:
     if soft == resource.RLIM_INFINITY:
         return " (use fewer frames, sensors or --jobs, or a machine with more memory)"
     return f" (the address-space limit, ulimit -v, is {soft // 1024} kB: raise it, or use fewer frames or --jobs)"
+
+
+def rich_console() -> Console:
+    """A rich console for a command's tables; wide when not writing to a terminal, so piped tables are not
+    wrapped."""
+    from rich.console import Console
+
+    return Console(width=None if sys.stdout.isatty() else 160)

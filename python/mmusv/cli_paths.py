@@ -12,7 +12,7 @@ from pathlib import Path
 from mmusv import arguments
 from mmusv.errors import ConfigError
 
-__all__ = ["check_output_folder", "output_arg", "path_arg"]
+__all__ = ["check_output_folder", "output_arg", "path_arg", "ready_output_folder"]
 
 
 def path_arg(value: str, *, flag: str, empty: str = "give a path") -> str:
@@ -72,3 +72,15 @@ def check_output_folder(value: str, *, flag: str = "-o/--output") -> Path:
                 raise ConfigError(f"{flag} {value}: {q} is a file, not a folder")
             break
     return out
+
+
+def ready_output_folder(output: str, *, flag: str = "-o/--output") -> None:
+    """Creates a command's output folder before its work, so that a folder that cannot be written is named (as
+    ``flag``) at once, not after the computing."""
+    from mmusv.errors import IoError
+
+    check_output_folder(output, flag=flag)  # a file there (or above) is named as such, not as "File exists"
+    try:
+        Path(output).mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise IoError(f"{flag} {output}: cannot create the folder: {exc.strerror or exc}") from None
