@@ -175,16 +175,22 @@ def test_the_unsaved_mark_follows_undo_and_redo(browser: Any, live_server: LiveS
     assert js_errors(browser) == []
 
 
+def saved_and_run(driver: Any, server: LiveServer, name: str) -> None:
+    """``port_entry`` opened with a LiDAR-only rig (quick to run), saved as ``name`` and run for 2 frames to the
+    end."""
+    open_editor(driver, server)
+    js_errors(driver)
+    preset = '#rigs [data-rig="usv_standard"] select[data-key="preset"]'
+    Select(driver.find_element(By.CSS_SELECTOR, preset)).select_by_value("lidar_only")
+    settled(driver)
+    save_as(driver, name)
+    done = run_to_end(server, name, 2)
+    assert done["status"] == "complete", done
+
+
 def test_a_page_loaded_again_shows_the_last_run_of_its_file(browser: Any, live_server: LiveServer) -> None:
     """A run that had ended was not shown after a reload (only one still going on was)."""
-    open_editor(browser, live_server)
-    js_errors(browser)
-    preset = '#rigs [data-rig="usv_standard"] select[data-key="preset"]'
-    Select(browser.find_element(By.CSS_SELECTOR, preset)).select_by_value("lidar_only")
-    settled(browser)
-    save_as(browser, "ran.yaml")
-    done = run_to_end(live_server, "ran.yaml", 2)
-    assert done["status"] == "complete", done
+    saved_and_run(browser, live_server, "ran.yaml")
     # a failing run of another file: its scenario names a vessel the library does not have
     doc = yaml.safe_load((live_server.folder / "ran.yaml").read_text(encoding="utf-8"))
     doc["vessels"][0]["asset"] = "no_such_boat"
@@ -211,14 +217,7 @@ def test_a_page_loaded_again_shows_the_last_run_of_its_file(browser: Any, live_s
 def test_a_restarted_server_shows_the_last_run_of_a_file(browser: Any, live_server: LiveServer) -> None:
     """A server started again on the folder (a second server on it here) knew no run: a file reopened there showed
     none, though its recording was in ``out/``. Now the runs there are read from their manifests."""
-    open_editor(browser, live_server)
-    js_errors(browser)
-    preset = '#rigs [data-rig="usv_standard"] select[data-key="preset"]'
-    Select(browser.find_element(By.CSS_SELECTOR, preset)).select_by_value("lidar_only")
-    settled(browser)
-    save_as(browser, "before.yaml")
-    done = run_to_end(live_server, "before.yaml", 2)
-    assert done["status"] == "complete", done
+    saved_and_run(browser, live_server, "before.yaml")
     with serve(live_server.folder) as restarted:
         open_editor(browser, restarted)
         Select(browser.find_element(By.ID, "open")).select_by_value("file:before.yaml")
