@@ -5,7 +5,8 @@ on a local pool or Ray), ``dataset`` (spec → recordings → OPV2V, :mod:`mmusv
 ``preview`` (inspect a recording), ``convert`` (to OPV2V, KITTI, ROS 2, COCO, YOLO, MaSTr1325, SemanticKITTI),
 ``generate`` (batch scenario generation), ``recover`` (finish a killed run), ``assets`` (the vessel library),
 ``study waves`` (Table I) and ``study agreement`` (Table II), ``study detection`` / ``study robustness``
-(Tables III, IV), ``editor`` (the scenario editor in the browser), ``version``.
+(Tables III, IV), ``editor`` (the scenario editor in the browser), ``schema`` (the JSON Schema of scenario and
+spec files, for editors), ``version``.
 Errors in the input end with a one-line message naming the problem and exit status 2, never a traceback.
 """
 
@@ -264,6 +265,32 @@ def _cmd_preview(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_schema(args: argparse.Namespace) -> int:
+    import contextlib
+    import os
+
+    from mmusv.errors import IoError
+    from mmusv.schema import schema_text
+
+    text = schema_text(args.kind)
+    if args.output is None:
+        sys.stdout.write(text)
+        return 0
+    out = Path(output_arg(args.output, flag="-o/--output"))
+    tmp = out.with_name(f".{out.name}.{os.getpid()}.tmp")
+    try:  # through a temporary beside it and a rename: an editor never reads half a schema
+        if out.is_dir():
+            raise IsADirectoryError(21, "is a folder, not a file")
+        tmp.write_text(text, encoding="utf-8")
+        os.replace(tmp, out)
+    except OSError as exc:
+        with contextlib.suppress(OSError):
+            tmp.unlink(missing_ok=True)
+        raise IoError(f"-o/--output {args.output}: cannot write the schema: {exc.strerror or exc}") from None
+    print(f"wrote {out}")
+    return 0
+
+
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="mmusv", description="Headless maritime multi-USV simulator and dataset generator."
@@ -331,6 +358,11 @@ def _parser() -> argparse.ArgumentParser:
     prev.add_argument("--frame", type=int, default=0, help="acquisition index (default 0)")
     prev.add_argument("--agent", default=None, help="USV id (default: the first)")
     prev.add_argument("-o", "--output", default=None, help="PNG path (default: next to the recording)")
+    schema = sub.add_parser(
+        "schema", help="print the JSON Schema of scenario or spec files (for editors: yaml-language-server)"
+    )
+    schema.add_argument("kind", choices=("scenario", "spec"), help="scenario files or generation specs")
+    schema.add_argument("-o", "--output", default=None, help="write it to this file (default: the standard output)")
     from mmusv.editor.cli import add_parser as add_editor_parser
     from mmusv.export.cli import add_parser as add_convert_parser
     from mmusv.generate.cli import add_parser as add_generate_parser
@@ -488,6 +520,8 @@ def _dispatch(args: argparse.Namespace) -> int:
         from mmusv.editor.cli import run as _run_editor
 
         return _run_editor(args)
+    if args.command == "schema":
+        return _cmd_schema(args)
     if args.command == "dataset":
         from mmusv.batch.cli import run_dataset
 

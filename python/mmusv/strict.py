@@ -2,18 +2,21 @@
 refused, strings stripped, instances frozen, and no boolean taken for a number.
 
 Pydantic's lax mode reads ``true`` as 1 for an int or float field: ``frames: true`` would record one frame and
-``speed_mps: true`` sail at 1 m/s without a word. Here a boolean is refused wherever the field does not take one.
+``speed_mps: true`` sail at 1 m/s without a word. Here a boolean is refused wherever the field does not take one,
+also inside a field's lists, tuples and mappings (a waypoint ``[true, 0]`` sailed to x = 1): :class:`StrictModel`
+for the models, :func:`bool_for_a_number` for a model that needs other settings.
 """
 
 from __future__ import annotations
 
 import types
 import typing
+from collections import abc
 from typing import Any
 
 from pydantic import BaseModel, ConfigDict, ValidationInfo, field_validator
 
-__all__ = ["StrictModel"]
+__all__ = ["StrictModel", "bool_for_a_number"]
 
 
 class StrictModel(BaseModel):
@@ -24,17 +27,48 @@ class StrictModel(BaseModel):
     @field_validator("*", mode="before")
     @classmethod
     def _no_bool_for_a_number(cls, v: Any, info: ValidationInfo) -> Any:
-        if isinstance(v, bool) and info.field_name is not None:
-            field = cls.model_fields.get(info.field_name)
-            if field is not None and _numeric(field.annotation) and not _takes_bool(field.annotation):
-                raise ValueError("a number is expected, not true/false")
+        return bool_for_a_number(cls, v, info)
+
+
+def bool_for_a_number(model: type[BaseModel], v: Any, info: ValidationInfo) -> Any:
+    """``v`` unchanged, or ``ValueError`` when it is, or holds where a number goes (in a list, tuple or mapping of
+    the field's type), ``true``/``false``: the body of a ``field_validator("*", mode="before")`` of ``model``."""
+    if info.field_name is None:
         return v
+    field = model.model_fields.get(info.field_name)
+    if field is not None and _bool_for_number(field.annotation, v):
+        raise ValueError("a number is expected, not true/false")
+    return v
+
+
+def _bool_for_number(annotation: Any, v: Any) -> bool:
+    """Whether ``v`` (or an item of it, at any depth) is a boolean where ``annotation`` takes a number only."""
+    if typing.get_origin(annotation) is typing.Annotated:
+        return _bool_for_number(typing.get_args(annotation)[0], v)
+    if isinstance(v, bool):
+        return _numeric(annotation) and not _takes_bool(annotation)
+    if not isinstance(v, (list, tuple, dict)):
+        return False
+    for member in _members(annotation):
+        origin, args = typing.get_origin(member), typing.get_args(member)
+        if isinstance(v, dict) and origin in (dict, abc.Mapping) and len(args) == 2:
+            if any(_bool_for_number(args[1], x) for x in v.values()):
+                return True
+        elif isinstance(v, (list, tuple)) and origin in (list, tuple, abc.Sequence) and args:
+            if origin is tuple and args[-1] is not Ellipsis:
+                if any(_bool_for_number(a, x) for a, x in zip(args, v, strict=False)):
+                    return True
+            elif any(_bool_for_number(args[0], x) for x in v):
+                return True
+    return False
 
 
 def _members(annotation: Any) -> tuple[Any, ...]:
-    """The members of a union annotation (``int | None``), or the annotation itself."""
+    """The members of a union annotation (``int | None``), or the annotation itself; ``Annotated`` unwrapped."""
+    if typing.get_origin(annotation) is typing.Annotated:
+        return _members(typing.get_args(annotation)[0])
     if typing.get_origin(annotation) in (typing.Union, types.UnionType):
-        return typing.get_args(annotation)
+        return tuple(m for a in typing.get_args(annotation) for m in _members(a))
     return (annotation,)
 
 

@@ -7,11 +7,9 @@ Units: metres; shares are fractions of the acquisition frames in [0, 1]. Every c
 
 from __future__ import annotations
 
-import types
-import typing
-from typing import Any, Literal
+from typing import Literal
 
-from pydantic import Field, ValidationInfo, field_validator, model_validator
+from pydantic import Field, model_validator
 
 from mmusv.strict import StrictModel
 
@@ -39,24 +37,8 @@ MAX_DISTANCE_M = 100_000.0
 
 class SpecModel(StrictModel):
     """The base of the spec's models: :class:`~mmusv.strict.StrictModel` (no unknown keys, NaN, infinity or
-    booleans for numbers), and no boolean inside a pair of numbers either (``speed_mps: [true, 5]``): Pydantic's
-    lax mode read ``quota: true`` as 1 and ``[true, 5]`` as ``(1.0, 5.0)`` without a word."""
-
-    @field_validator("*", mode="before")
-    @classmethod
-    def _no_bool_in_a_pair(cls, v: Any, info: ValidationInfo) -> Any:
-        if isinstance(v, (list, tuple)) and any(isinstance(x, bool) for x in v) and info.field_name is not None:
-            field = cls.model_fields.get(info.field_name)
-            if field is not None and _numeric_tuple(field.annotation):
-                raise ValueError("numbers are expected, not true/false")
-        return v
-
-
-def _numeric_tuple(annotation: Any) -> bool:
-    members = typing.get_args(annotation) if typing.get_origin(annotation) in (typing.Union, types.UnionType) else ()
-    return any(_numeric_tuple(m) for m in members) or (
-        typing.get_origin(annotation) is tuple and all(a in (int, float) for a in typing.get_args(annotation))
-    )
+    booleans for numbers, also inside a pair of numbers: Pydantic's lax mode read ``quota: true`` as 1 and
+    ``speed_mps: [true, 5]`` as ``(1.0, 5.0)`` without a word)."""
 
 
 _Model = SpecModel

@@ -16,6 +16,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, StrictBool, ValidationError, ValidationInfo, field_validator
 
 from mmusv.errors import ConfigError
+from mmusv.strict import bool_for_a_number
 
 __all__ = [
     "COAST_SIDES",
@@ -102,6 +103,11 @@ class _CommonParams(BaseModel):
     """Terrain and structures higher than this block line of sight in the priors."""
     n_buoys: int = Field(default=0, ge=0, le=500)
     """Extra free-standing buoys placed at random in open water (at most this many)."""
+
+    @field_validator("*", mode="before")
+    @classmethod
+    def _no_bool_for_a_number(cls, v: Any, info: ValidationInfo) -> Any:
+        return bool_for_a_number(cls, v, info)  # as in a scenario's other models (mmusv.strict)
 
     @field_validator("grid_m")
     @classmethod
