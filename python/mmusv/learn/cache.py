@@ -15,12 +15,18 @@ Layout (all arrays of one ``np.savez_compressed`` file):
 - ``frame_seq`` ``(F,)`` int64 sequence slot, ``frame_index`` ``(F,)`` acquisition index, ``sequences`` ``(S,)``;
 - ``sample_cloud`` ``(K,)`` int64 the ego's cloud of each sample; ``gt`` ``(G, 7)`` float32 ego-frame boxes
   ``x, y, z, l, w, h, yaw``; ``gt_offsets`` ``(K + 1,)`` int64;
-- ``meta`` a JSON string: the split, ratios, seed and sources.
+- ``meta`` a JSON string: the split, ratios, seed, sources and their ``fingerprints``
+  (:func:`dataset_fingerprints`; caches written before they were added lack them).
+
+:meth:`Cache.identity` is what the cache was built from (the sequences, each with its fingerprint, the range and
+the frame stride): ``mmusv train`` reuses ``OUT/cache_<split>.npz`` only for the same data, and a checkpoint records
+it, so a run is resumed, and a model evaluated, knowing which sequences it was trained on.
 """
 
 from __future__ import annotations
 
 import json
+import zipfile
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -29,13 +35,53 @@ import numpy as np
 
 from mmusv.learn._errors import input_error
 
-__all__ = ["Cache", "Sample", "build_cache"]
+__all__ = ["Cache", "Sample", "build_cache", "dataset_fingerprints", "same_data"]
 
 Sample = tuple[np.ndarray, list[tuple[np.ndarray, np.ndarray]], np.ndarray]
 """``(ego points (N, 4) float32, [(neighbour points (N_i, 4) float32 own frame, rel (4, 4) neighbour → ego)],
 ground truth (G, 7) float64)``."""
 
 _LIMIT_CM = 32767
+_IDENTITY = ("sources", "fingerprints", "range_m", "frame_stride")
+
+
+def dataset_fingerprints(ds: Any) -> dict[str, str]:
+    """``{sequence name: fingerprint}`` of a detection dataset (:class:`mmusv.studies.detection.sources.Dataset`),
+    without reading its frames: a recording's config hash and frame count (what it says of itself); an OPV2V
+    scenario folder's first frame's YAML (the poses and boxes) and its frame count. A sequence whose fingerprint
+    cannot be read is left out. Two sequences with the same name and fingerprint hold the same data (the names
+    alone repeat across datasets: every generated spec has its ``island_crossing_000``)."""
+    import hashlib
+
+    out: dict[str, str] = {}
+    for name, path in sorted(ds.sources.items()):
+        try:
+            if ds.kind == "recording":
+                from mmusv.studies.detection.data import recording_summary
+
+                s = recording_summary(path)
+                out[name] = f"recording:{s.config_hash}:{s.frames_configured}"
+            else:
+                cavs = sorted(c for c in Path(path).iterdir() if c.is_dir())
+                yamls = sorted(f for f in cavs[0].glob("*.yaml") if not f.stem.endswith("_additional"))
+                digest = hashlib.sha256(yamls[0].read_bytes()).hexdigest()[:32]
+                out[name] = f"opv2v:{digest}:{len(yamls)}"
+        except Exception:  # a fingerprint is a check's input: reading the sequence reports a bad file
+            continue
+    return out
+
+
+def same_data(a: dict[str, Any] | None, b: dict[str, Any] | None) -> bool:
+    """Whether two :meth:`Cache.identity` values name the same data: the same sequences, range and stride, and,
+    where both give fingerprints, the same fingerprints (``None``: unknown, taken as the same)."""
+    if not isinstance(a, dict) or not isinstance(b, dict):
+        return True
+    if any(a[k] != b[k] for k in _IDENTITY if k != "fingerprints" and k in a and k in b):
+        return False
+    fa, fb = a.get("fingerprints"), b.get("fingerprints")
+    if isinstance(fa, dict) and isinstance(fb, dict):  # a sequence whose fingerprint could not be read is not compared
+        return all(fa[n] == fb[n] for n in fa.keys() & fb.keys())
+    return True
 
 
 def build_cache(
@@ -56,6 +102,7 @@ def build_cache(
     from mmusv.studies.detection.sources import resolve_dataset
 
     ds = resolve_dataset(list(inputs), opv2v=opv2v, split=split, ratios=tuple(ratios), seed=seed)
+    fingerprints = dataset_fingerprints(ds)
     xyz: list[np.ndarray] = []
     inten: list[np.ndarray] = []
     counts: list[int] = []
@@ -98,6 +145,7 @@ def build_cache(
         "seed": seed,
         "range_m": range_m,
         "sources": sorted(ds.sources),
+        "fingerprints": fingerprints,
     }
     np.savez_compressed(
         tmp,
@@ -140,14 +188,15 @@ class Cache:
     def __init__(self, path: str | Path) -> None:
         p = Path(path)
         try:
-            with np.load(p, allow_pickle=False) as z:
+            # numpy leaves the file it opened open when it is not a zip: the file is ours to close
+            with open(p, "rb") as fh, np.load(fh, allow_pickle=False) as z:
                 missing = [k for k in self.KEYS if k not in z.files]
                 if missing:
                     raise input_error(f"--cache {p}: not an mmusv.learn cache (missing {missing})")
                 self.arrays: dict[str, np.ndarray] = {k: z[k] for k in self.KEYS}
                 if "cloud_agent" in z.files:  # caches written before it was added lack it
                     self.arrays["cloud_agent"] = z["cloud_agent"]
-        except (OSError, ValueError) as exc:
+        except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:  # a cut copy was a BadZipFile traceback
             raise input_error(f"--cache {p}: not a readable .npz cache ({type(exc).__name__}: {exc})") from None
         self.path = p
         self.meta: dict[str, Any] = json.loads(str(self.arrays["meta"]))
@@ -159,6 +208,12 @@ class Cache:
 
     def __len__(self) -> int:
         return len(self.arrays["sample_cloud"])
+
+    def identity(self) -> dict[str, Any]:
+        """What the cache was built from (module docstring): ``sources``, ``fingerprints`` (when recorded),
+        ``range_m``, ``frame_stride``, and the ``split``, ``ratios`` and ``seed`` that chose the sequences."""
+        keys = (*_IDENTITY, "split", "ratios", "seed")
+        return {k: self.meta[k] for k in keys if k in self.meta}
 
     def cloud(self, c: int) -> np.ndarray:
         """``(N, 4)`` float32 points of cloud ``c`` (LiDAR frame, metres; intensity in [0, 1])."""

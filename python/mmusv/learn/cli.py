@@ -122,7 +122,11 @@ def run(args: argparse.Namespace) -> int:
     modes = [m.strip() for m in args.modes.split(",") if m.strip()]
     bad = [m for m in modes if m not in MODES]
     if bad or not modes:
-        raise InputError(f"--modes {args.modes}: unknown {bad}; allowed: {', '.join(MODES)}")
+        what = f"unknown {', '.join(bad)}" if bad else "no model named"
+        raise InputError(f"--modes {args.modes!r}: {what}; allowed: {', '.join(MODES)}")
+    twice = sorted({m for m in modes if modes.count(m) > 1})
+    if twice:  # side by side, two processes trained the same model into the same folder at once
+        raise InputError(f"--modes {args.modes!r}: {', '.join(twice)} given twice; each model once")
     jobs = _jobs(args.jobs, len(modes), args.device)
     out = Path(args.output)
     if args.scorers_only and args.no_scorers:
@@ -139,12 +143,19 @@ def run(args: argparse.Namespace) -> int:
             raise InputError("--generate makes its own recordings: give no recordings and no --opv2v with it")
         from mmusv.studies.detection.sources import generate_dataset
 
-        inputs = generate_dataset(out / "dataset", spec=args.generate)
+        shortfalls: list[str] = []
+        inputs = generate_dataset(out / "dataset", spec=args.generate, shortfall=shortfalls.append)
+        if shortfalls:  # said by mmusv study detection --generate; training went on without a word
+            print(f"generate: quotas not met: {shortfalls[0]}", file=sys.stderr, flush=True)
+            for line in shortfalls[1:]:
+                print(f"generate: {line}", file=sys.stderr, flush=True)
     if not inputs and args.opv2v is None:
         raise InputError("no dataset: give recordings, --opv2v or --generate")
     cache = out / f"cache_{args.split}.npz"
     t0 = time.perf_counter()
-    if not cache.is_file():
+    if cache.is_file():
+        _check_cache(cache, inputs, opv2v=args.opv2v, split=args.split, ratios=ratios, seed=args.seed)
+    else:
         build_cache(inputs, cache, opv2v=args.opv2v, split=args.split, ratios=ratios, seed=args.seed)
         print(f"cache: {cache} ({cache.stat().st_size / 2**20:.1f} MiB, {time.perf_counter() - t0:.1f} s)", flush=True)
     if args.cache_only:
@@ -189,10 +200,16 @@ def run(args: argparse.Namespace) -> int:
                     print(f"{futures[f]}: failed: {e}", file=sys.stderr, flush=True)
         finished = [(mode, done[mode]) for mode in modes if mode in done]
     for mode, r in finished:
-        summary["models"][mode] = {k: r[k] for k in ("epochs", "steps", "seconds", "finished")}
+        summary["models"][mode] = {k: r[k] for k in ("epochs", "steps", "seconds", "finished", "stopped")}
+        short = ""
+        if r["stopped"] == "time limit":  # the line read as a run that went through
+            short = (
+                f" (stopped at --time-limit {args.time_limit:g} s, {r['epochs']} of {r['planned']} epochs done; "
+                "started again with a higher limit, it goes on)"
+            )
         print(
             f"{mode}: {r['epochs']} epochs, {r['steps']} steps, {r['seconds']:.1f} s of training -> {r['out']} "
-            f"({r['plot']})",
+            f"({r['plot']}){short}",
             flush=True,
         )
         if "scorer" in r:
@@ -202,6 +219,43 @@ def run(args: argparse.Namespace) -> int:
         raise failures[0]
     print(f"total {time.perf_counter() - t0:.1f} s; score with: mmusv study detection --model {out} ...", flush=True)
     return 0
+
+
+def _check_cache(
+    cache: Path, inputs: list[Any], *, opv2v: str | None, split: str, ratios: tuple[float, float, float], seed: int
+) -> None:
+    """Refuses ``cache`` (``OUT/cache_<split>.npz`` of an earlier run) when it was built from other data than
+    ``inputs`` / ``opv2v`` give for ``split``: it was reused without a word, so the models trained again on the
+    sequences of the first run (and a resumed model went on with them)."""
+    import json
+    import zipfile
+
+    import numpy as np
+
+    from mmusv.learn.cache import dataset_fingerprints, same_data
+    from mmusv.studies.detection.sources import resolve_dataset
+
+    try:
+        with open(cache, "rb") as fh, np.load(fh, allow_pickle=False) as z:
+            meta = json.loads(str(z["meta"]))
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:
+        raise InputError(
+            f"{cache}: not a readable mmusv.learn cache ({type(exc).__name__}); remove it to build it again"
+        ) from None
+    ds = resolve_dataset(inputs, opv2v=opv2v, split=split, ratios=ratios, seed=seed)
+    asked = {"sources": sorted(ds.sources), "fingerprints": dataset_fingerprints(ds)}
+    if same_data(meta, asked):
+        return
+    old = meta.get("sources", [])
+    what = (
+        f"sequences {', '.join(old)}; asked for {', '.join(asked['sources'])}"
+        if old != asked["sources"]
+        else f"sequences of the same names recorded differently: {', '.join(old)}"
+    )
+    raise InputError(
+        f"{cache}: built from other data (split {meta.get('split', split)!r}: {what}); use another -o, or remove "
+        f"{cache} and the models beside it to start again"
+    )
 
 
 def _check_numbers(args: argparse.Namespace) -> None:
@@ -301,6 +355,7 @@ def _fit_scorers(
     import torch
 
     from mmusv.learn.cache import Cache
+    from mmusv.learn.checkpoint import weights_digest
     from mmusv.learn.detector import load_models
     from mmusv.learn.example import early_cloud
     from mmusv.learn.refine import RefineParams
@@ -332,6 +387,7 @@ def _fit_scorers(
             print(f"{mode}: no IoU scorer ({e}); the model's boxes keep the network's scores", flush=True)
             continue
         info = {
+            "model": weights_digest(model.state_dict()),  # the weights it was fitted for (load_models checks)
             "boxes": fit.boxes,
             "frames": fit.frames,
             "beta": fit.beta,
@@ -380,9 +436,11 @@ def _train_one(task: dict[str, Any]) -> dict[str, Any]:
     png = plot_losses(out / "log.jsonl", out / "loss.png")
     done = {
         "epochs": r.epochs,
+        "planned": task["epochs"] if task["epochs"] is not None else preset(task["preset"]).epochs,
         "steps": r.steps,
         "seconds": round(r.seconds, 1),
         "finished": r.finished,
+        "stopped": r.stopped,
         "out": str(r.out),
         "plot": png.name,
     }

@@ -1,7 +1,8 @@
 """A trained model as the detection study's detector (:mod:`mmusv.studies.detection.detector`'s interface).
 
-:func:`load_models` reads ``model.pt`` files written by :mod:`mmusv.learn.train`: one file, or a folder
-holding ``single/``, ``early/`` and ``intermediate/`` sub-folders (what ``mmusv train`` writes). The
+:func:`load_models` reads ``model.pt`` files written by :mod:`mmusv.learn.train`: one file, a model's own folder
+(``OUT/single``), or a folder holding ``single/``, ``early/`` and ``intermediate/`` sub-folders (what ``mmusv
+train`` writes). The
 :class:`LearnedDetector` it returns is called like any detector (``points (N, 4)`` float32 ego LiDAR frame →
 ``boxes (M, 7)``, ``scores (M,)``) with the single-agent model, which serves no and late fusion; the study's
 fusion code (:func:`mmusv.studies.detection.fusion.fuse`) calls :meth:`LearnedDetector.early` on the aggregated
@@ -9,7 +10,10 @@ cloud and :meth:`LearnedDetector.intermediate` with the ego and its neighbours (
 robustness setting makes them). :attr:`LearnedDetector.shared_bytes` records, per intermediate-fusion call, the
 bytes the neighbours sent (:func:`mmusv.learn.example.message_bytes`). By default the boxes of ``cpu``-preset
 models are tightened on the points by the geometric second stage of :mod:`mmusv.learn.refine` (``refine``), and
-rescored by a model's IoU scorer (:mod:`mmusv.learn.scorer`, ``scorer.pt`` beside its ``model.pt``) where it has one.
+rescored by a model's IoU scorer (:mod:`mmusv.learn.scorer`, ``scorer.pt`` beside its ``model.pt``) where it has one
+and it was fitted for these weights (a scorer of a model trained on after it is left out, and said so).
+:meth:`LearnedDetector.describe` says how far each model trained (``3 of 12 epochs`` for a run that stopped
+short); :meth:`LearnedDetector.trained_on` which sequences it learnt from.
 """
 
 from __future__ import annotations
@@ -22,7 +26,7 @@ import numpy as np
 import torch
 
 from mmusv.learn._errors import input_error
-from mmusv.learn.checkpoint import load_checkpoint
+from mmusv.learn.checkpoint import load_checkpoint, weights_digest
 from mmusv.learn.decode import decode
 from mmusv.learn.example import MODES, collate, make_example, message_bytes
 from mmusv.learn.model import PillarNet
@@ -60,13 +64,18 @@ def load_models(
     p = Path(path)
     dev = torch.device(device)
     files: dict[str, Path] = {}
+    if p.is_dir() and (p / "model.pt").is_file():  # a model's own folder (OUT/single): it was "no model.pt there"
+        p = p / "model.pt"
     if p.is_file():
         _, ck = _load(p, dev)
         files[str(ck["mode"])] = p
     elif p.is_dir():
         files = {m: p / m / "model.pt" for m in MODES if (p / m / "model.pt").is_file()}
     if not files:
-        raise input_error(f"--model {p}: no model.pt there (a file, or a folder with {'/'.join(MODES)}/model.pt)")
+        raise input_error(
+            f"--model {p}: no model.pt there (a model.pt, a folder holding one, or a folder with "
+            f"{'/'.join(MODES)}/model.pt)"
+        )
     models: dict[str, PillarNet] = {}
     info: dict[str, dict[str, Any]] = {}
     for mode, f in files.items():
@@ -76,6 +85,10 @@ def load_models(
             "epoch": int(ck["epoch"]),
             "step": int(ck["step"]),
             "preset": ck["preset"]["name"],
+            "epochs": ck.get("epochs"),  # asked for (checkpoints from before it was recorded lack it)
+            "stopped": ck.get("stopped"),
+            "seed": ck.get("seed"),
+            "data": ck.get("data") if isinstance(ck.get("data"), dict) else None,
         }
     if refine is None:
         refine = all(v["preset"] == "cpu" for v in info.values())
@@ -86,11 +99,31 @@ def load_models(
         for mode, f in files.items():
             sf = f.parent / SCORER_FILE
             if refine and sf.is_file():
-                scorers[mode] = load_scorer(sf)
+                scorer = load_scorer(sf)
+                fitted_for = scorer.info.get("model")
+                if fitted_for is not None and fitted_for != weights_digest(models[mode].state_dict()):
+                    # the model trained on after its scorer was fitted (mmusv train --no-scorers, or a resumed run):
+                    # the scorer ranks boxes it never saw, so it is left out, and the line of describe() says so
+                    why = f"{sf} was fitted for other weights of this model; refit it: mmusv train --scorers-only"
+                    if rescore:
+                        raise input_error(f"--rescore on: {why}")
+                    info[mode]["stale_scorer"] = str(sf)
+                    continue
+                scorers[mode] = scorer
                 info[mode]["scorer"] = str(sf)
             elif rescore:
                 raise input_error(f"--rescore on: {mode} has no {sf} (fit it with mmusv train --scorers-only)")
     return LearnedDetector(models, info, refine=RefineParams() if refine else None, scorers=scorers)
+
+
+def _progress(v: dict[str, Any]) -> str:
+    """``12 epochs, 5340 steps``; ``3 of 12 epochs, unfinished, 1335 steps`` for a run that stopped short (``stopped
+    at its time limit`` when that is why)."""
+    planned = v.get("epochs")
+    if not isinstance(planned, int) or v["epoch"] >= planned:
+        return f"{v['epoch']} epochs, {v['step']} steps"
+    why = "stopped at its time limit" if v.get("stopped") == "time limit" else "unfinished"
+    return f"{v['epoch']} of {planned} epochs, {why}, {v['step']} steps"
 
 
 class LearnedDetector:
@@ -122,11 +155,9 @@ class LearnedDetector:
         return tuple(out)
 
     def describe(self) -> str:
-        """One line: each model's file, preset and the epochs it was trained for."""
-        models = "; ".join(
-            f"{m}: {v['file']} (preset {v['preset']}, {v['epoch']} epochs, {v['step']} steps)"
-            for m, v in self.info.items()
-        )
+        """One line: each model's file, preset and the epochs it was trained for (``3 of 12 epochs, unfinished``
+        for a model whose run stopped short: a ``model.pt`` is written after every epoch), and the second stage."""
+        models = "; ".join(f"{m}: {v['file']} (preset {v['preset']}, {_progress(v)})" for m, v in self.info.items())
         second = self.refine.describe() if self.refine is not None else "no box refinement (network boxes as decoded)"
         if self.scorers:
             second += (
@@ -134,7 +165,25 @@ class LearnedDetector:
                 + ", ".join(f"{m} β={s.beta:g}" for m, s in sorted(self.scorers.items()))
                 + ")"
             )
+        stale = [v["stale_scorer"] for v in self.info.values() if "stale_scorer" in v]
+        if stale:
+            second += (
+                f"; not used, fitted for other weights of the model (refit: mmusv train --scorers-only): "
+                f"{', '.join(stale)}"
+            )
         return f"{models}; {second}"
+
+    def trained_on(self, fingerprints: dict[str, str]) -> dict[str, list[str]]:
+        """``{model: sequences}``: which of the sequences ``fingerprints`` (``{name: fingerprint}``,
+        :func:`mmusv.learn.cache.dataset_fingerprints`) each model was trained on (the same name and fingerprint
+        in its checkpoint's data; none for a checkpoint that does not record it)."""
+        out: dict[str, list[str]] = {}
+        for mode, v in self.info.items():
+            seen = (v.get("data") or {}).get("fingerprints") or {}
+            both = sorted(n for n, fp in fingerprints.items() if isinstance(seen, dict) and seen.get(n) == fp)
+            if both:
+                out[mode] = both
+        return out
 
     def _run(
         self, mode: str, ego: np.ndarray, neighbours: Sequence[tuple[np.ndarray, np.ndarray]]

@@ -125,6 +125,9 @@ class IoUScorer(nn.Module):
         self.register_buffer("std", torch.as_tensor(np.maximum(np.asarray(std, dtype=np.float32).reshape(n), 1e-3)))
         self.net = nn.Sequential(nn.Linear(n, 32), nn.ReLU(), nn.Linear(32, 32), nn.ReLU(), nn.Linear(32, 1))
         self.beta = float(beta)
+        self.info: dict[str, Any] = {}
+        """What the fit saved beside the weights (``mmusv train``: the digest of the model it was fitted for
+        under ``"model"``, :func:`mmusv.learn.checkpoint.weights_digest`); empty for a scorer not loaded."""
 
     def forward(self, x: torch.Tensor) -> torch.Tensor:
         """Logits ``(M,)`` of the IoU for features ``x`` ``(M, len(FEATURES))``."""
@@ -173,6 +176,8 @@ def load_scorer(path: str | Path) -> IoUScorer:
         n = len(FEATURES)
         m = IoUScorer(np.zeros(n), np.ones(n), beta=float(ck["beta"]))
         m.load_state_dict(ck["state"])
+        info = ck.get("info", {})
+        m.info = dict(info) if isinstance(info, dict) else {}
     except (OSError, KeyError, TypeError, RuntimeError, ValueError) as exc:
         raise input_error(f"{p}: not an mmusv.learn scorer ({type(exc).__name__}: {exc})") from None
     m.eval()

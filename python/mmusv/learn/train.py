@@ -11,7 +11,11 @@ or through ``mmusv train`` (which builds the cache first). Files in the output f
   renamed, so an interruption leaves the previous one whole); training resumes from it when started again (a run
   stopped inside an epoch, by ``time_limit_s`` or ``max_steps``, resumes at that epoch's start with the weights
   it had reached);
-- ``model.pt``: the weights, preset and mode for inference (:mod:`mmusv.learn.detector`), after every epoch;
+- ``model.pt``: the weights, preset and mode for inference (:mod:`mmusv.learn.detector`), after every epoch, with
+  the epochs asked for (``epochs``), why the run stopped short of them (``stopped``: ``"time limit"``, ``"max
+  steps"``, or ``None`` while it is still going or was interrupted) and the data it was trained on (``data``:
+  :meth:`mmusv.learn.cache.Cache.identity`), so an unfinished model, and a model evaluated on its own training
+  sequences, can be told;
 - ``log.jsonl``: one line per logged step (``epoch, step, loss, heatmap, regression, lr, seconds``) and one per
   epoch (``"epoch_end": true``); :func:`plot_losses` draws it.
 
@@ -19,8 +23,13 @@ Determinism: weights are initialised after ``torch.manual_seed(seed)``; the orde
 drawn from ``(seed, epoch)``; each sample's augmentation from ``(seed, epoch, index)``, so it does not depend on
 the number of loader workers. On CPU with ``torch.use_deterministic_algorithms`` (and a given thread count), the
 same seed gives the same weights. The model trains channels-last (:meth:`PillarNet.channels_last`) on every
-device. With ``time_limit_s`` the run stops at the first epoch end past the limit (or mid-epoch, checkpointed, when
-an epoch would overrun), and the learning-rate schedule runs on elapsed time instead of steps.
+device. With ``time_limit_s`` the run stops at the first step past the limit (mid-epoch, checkpointed), and the
+learning-rate schedule runs on elapsed time instead of steps; started again with the same limit, a run that
+reached it does nothing (it took one more step and rewrote its model every time).
+
+A ``last.pt`` is resumed only by the same run: the same preset, mode and seed, and the same data (a cache built from
+other sequences is refused; the first cache was trained on again without a word when the recordings given
+changed).
 """
 
 from __future__ import annotations
@@ -40,7 +49,7 @@ import torch
 
 from mmusv.learn._errors import input_error
 from mmusv.learn.augment import apply, draw
-from mmusv.learn.cache import Cache
+from mmusv.learn.cache import Cache, same_data
 from mmusv.learn.checkpoint import load_checkpoint
 from mmusv.learn.example import MODES, Example, collate, early_cloud, make_example
 from mmusv.learn.loss import centerpoint_loss
@@ -100,6 +109,8 @@ class TrainResult:
     steps: int
     seconds: float
     finished: bool
+    stopped: str | None = None
+    """Why the run stopped before its epochs: ``"time limit"``, ``"max steps"`` (``None``: it did not)."""
 
 
 def _lr(p: Preset, step: int, progress: float) -> float:
@@ -153,6 +164,7 @@ def train(
     data = TrainingSet(c, p, mode, seed=seed, augment=augment, indices=indices)
     if len(data) == 0:
         raise input_error(f"--cache {getattr(c, 'path', c)}: no training sample")
+    identity = c.identity() if isinstance(c, Cache) else None
     steps_per_epoch = math.ceil(len(data) / p.batch)
     start_epoch, step, log, spent = 0, 0, [], 0.0
     last = out_p / "last.pt"
@@ -161,6 +173,12 @@ def train(
         ck = load_checkpoint(last, what=what, device=dev)
         if ck.get("preset") != p.to_dict() or ck.get("mode") != mode or ck.get("seed") != seed:
             raise input_error(f"{last}: a checkpoint of another run (preset/mode/seed differ); use another --out")
+        if not same_data(ck.get("data"), identity):
+            before = ", ".join(str(x) for x in ck["data"].get("sources", [])) or "?"
+            raise input_error(
+                f"{last}: a checkpoint of a run on other data (trained on {before}); use another --out, or remove "
+                f"{out_p} to start again"
+            )
         try:
             model.load_state_dict(ck["model"])
             opt.load_state_dict(ck["optimizer"])
@@ -170,6 +188,17 @@ def train(
     log_path = out_p / "log.jsonl"
     t0 = time.perf_counter() - spent
     finished = True
+    stop: str | None = None
+    # A run that stopped at its time limit or step budget, started again with the same one, stops there: it took one
+    # more step (and rewrote its model) every time it was started.
+    if start_epoch < n_epochs and time_limit_s and spent > time_limit_s:
+        stop = "time limit"
+    elif start_epoch < n_epochs and max_steps is not None and step >= max_steps:
+        stop = "max steps"
+    if start_epoch < n_epochs and stop is None:
+        if step:
+            print(f"{mode}: resuming {last} at epoch {start_epoch + 1}/{n_epochs}, step {step}", flush=True)
+        _warn_without_targets(c, p, mode, data.indices)
     amp = dev.type == "cuda"
     bar: Any = None
     if progress:
@@ -177,7 +206,7 @@ def train(
 
         bar = tqdm(total=n_epochs * steps_per_epoch, initial=step, desc=f"train {mode} ({p.name})", unit="step")
     epoch = start_epoch
-    while epoch < n_epochs:
+    while epoch < n_epochs and stop is None:
         data.epoch = epoch
         order = np.random.default_rng([seed, epoch, 7]).permutation(len(data))
         sampler = [int(i) for i in order]
@@ -216,10 +245,11 @@ def train(
             if step % LOG_EVERY == 0 or step == 1:
                 rec = {k: round(float(v.item()), 6) for k, v in losses.items()}
                 log.append({"epoch": epoch, "step": step, **rec, "lr": lr, "seconds": round(elapsed, 2)})
-            if (max_steps is not None and step >= max_steps) or (
-                time_limit_s and time.perf_counter() - t0 > time_limit_s
-            ):
-                stopped = True
+            if max_steps is not None and step >= max_steps:
+                stopped, stop = True, "max steps"
+                break
+            if time_limit_s and time.perf_counter() - t0 > time_limit_s:
+                stopped, stop = True, "time limit"
                 break
         epoch_done = not stopped
         if epoch_done:
@@ -236,9 +266,12 @@ def train(
             "mode": mode,
             "seed": seed,
             "epoch": epoch,
+            "epochs": n_epochs,
+            "stopped": stop,
             "step": step,
             "log": log,
             "seconds": time.perf_counter() - t0,
+            "data": identity,
         }
         _save({**state, "model": model.state_dict(), "optimizer": opt.state_dict()}, last)
         _save({**state, "model": model.state_dict(), "log": []}, out_p / "model.pt")
@@ -248,7 +281,43 @@ def train(
             break
     if bar is not None:
         bar.close()
-    return TrainResult(out_p, epoch, step, time.perf_counter() - t0, finished and epoch >= n_epochs)
+    if stop is not None:
+        finished = stop == "max steps"
+    return TrainResult(out_p, epoch, step, time.perf_counter() - t0, finished and epoch >= n_epochs, stop)
+
+
+def _warn_without_targets(cache: Any, p: Preset, mode: str, indices: Sequence[int]) -> None:
+    """Says on stderr when no training sample has a ground-truth box centred in the preset's grid: the model is
+    then taught empty water alone (recordings without targets, or a ``tiny`` grid of ±32 m around USVs whose
+    targets are farther), which trained without a word and scored AP 0."""
+    import sys
+
+    n_in, n_all = 0, 0
+    arrays = getattr(cache, "arrays", None)
+    for k in indices:
+        if arrays is not None:
+            gt = arrays["gt"][arrays["gt_offsets"][k] : arrays["gt_offsets"][k + 1]]
+        else:
+            gt = cache.sample(k)[2]
+        n_all += len(gt)
+        if len(gt):
+            x, y = gt[:, 0], gt[:, 1]
+            inside = (x >= p.x_range[0]) & (x < p.x_range[1]) & (y >= p.y_range[0]) & (y < p.y_range[1])
+            n_in += int(inside.sum())
+    if n_in:
+        return
+    where = (
+        f"the {n_all} ground-truth boxes lie outside the {p.name} preset's grid (x {p.x_range[0]:g}..{p.x_range[1]:g} "
+        f"m, y {p.y_range[0]:g}..{p.y_range[1]:g} m)"
+        if n_all
+        else "they hold no ground-truth box (no vessel other than the USVs)"
+    )
+    print(
+        f"{mode}: warning: none of the {len(indices)} training samples has a target to learn: {where}; the model "
+        "learns empty water only",
+        file=sys.stderr,
+        flush=True,
+    )
 
 
 def plot_losses(log_path: str | Path, png: str | Path) -> Path:

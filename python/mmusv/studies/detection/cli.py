@@ -190,6 +190,8 @@ def run(args: argparse.Namespace) -> int:
         torch.set_num_threads(args.threads)
     default_modes = ",".join(learned.fusion_modes) if learned is not None else "none,late,early"
     modes = parse_modes(default_modes if args.modes is None else args.modes)  # "" was taken as the default
+    if learned is not None:
+        _check_model_modes(args.model, learned, modes)
     settings = parse_settings(args.settings) if robust else (Setting(),)
     if robust and not any(m != "none" for m in modes):
         raise InputError("--modes: the robustness study needs late and/or early fusion")
@@ -226,6 +228,15 @@ def run(args: argparse.Namespace) -> int:
         )
     split = args.split or ("test" if args.generate is not None else "all")
     dataset = resolve_dataset(inputs, opv2v=args.opv2v, split=split, ratios=ratios, seed=args.seed)
+    learned_notes: list[str] = []
+    if learned is not None:
+        from rich.markup import escape
+
+        learned_notes.append(f"learned models: {learned.describe()}")
+        leak = _training_overlap(learned, dataset)
+        if leak:
+            console.print(f"[yellow]{escape(leak)}[/]", highlight=False)
+            learned_notes.append(leak)
     runs: list[tuple[Any, str, tuple[str, ...], Path]] = [(detector, detector_name, modes, out)]
     if learned is not None:  # the learned model beside the baseline, on the same frames
         base_modes = tuple(m for m in modes if m != "intermediate")
@@ -279,12 +290,14 @@ def run(args: argparse.Namespace) -> int:
 
         if len(runs) > 1:
             console.print(f"[bold]{name}[/]", highlight=False)
+        notes = learned_notes if det is learned and learned is not None else []
         if robust:
-            paths.update({f"{name}:{k}": v for k, v in report.write_robustness(res, run_out, detector=name).items()})
+            written = report.write_robustness(res, run_out, detector=name, notes=notes)
             _print_robustness(console, res)
         else:
-            paths.update({f"{name}:{k}": v for k, v in report.write_detection(res, run_out, detector=name).items()})
+            written = report.write_detection(res, run_out, detector=name, notes=notes)
             _print_detection(console, res)
+        paths.update({f"{name}:{k}": v for k, v in written.items()})
         if det is learned and learned is not None:
             console.print(f"learned models: {learned.describe()}", highlight=False)
             if learned.shared_bytes:
@@ -306,6 +319,52 @@ def run(args: argparse.Namespace) -> int:
         )
     console.print("wrote " + ", ".join(str(p) for p in paths.values()), highlight=False)
     return 0
+
+
+_NEEDS = {"none": "single", "late": "single", "early": "early", "intermediate": "intermediate"}
+"""The learned model each fusion mode runs (:class:`mmusv.learn.detector.LearnedDetector`)."""
+
+
+def _check_model_modes(model: str, learned: Any, modes: tuple[str, ...]) -> None:
+    """Refuses fusion ``modes`` the models at ``--model`` cannot run, before any frame is read (the error came
+    from the first frame, naming the missing model but not the mode asked for)."""
+    from mmusv.errors import InputError
+
+    missing = [m for m in modes if _NEEDS[m] not in learned.models]
+    if missing:
+        needs = sorted({_NEEDS[m] for m in missing})
+        raise InputError(
+            f"--modes {','.join(missing)}: needs the {' and '.join(needs)} model, which --model {model} does not "
+            f"hold (it has {', '.join(learned.models)}: modes {','.join(learned.fusion_modes)}; train it with "
+            "mmusv train --modes)"
+        )
+
+
+def _training_overlap(learned: Any, dataset: Any) -> str | None:
+    """A warning line when sequences evaluated were in a model's training data (the same name and fingerprint:
+    :meth:`mmusv.learn.detector.LearnedDetector.trained_on`): a model trained with another ``--seed`` or
+    ``--split-ratios`` than the study's, or on ``--split all``, was scored on what it learnt from without a word."""
+    from mmusv.learn.cache import dataset_fingerprints
+
+    seen = learned.trained_on(dataset_fingerprints(dataset))
+    if not seen:
+        return None
+    names = sorted({n for v in seen.values() for n in v})
+    shown = ", ".join(names[:6]) + (f" and {len(names) - 6} more" if len(names) > 6 else "")
+    how: dict[str, list[str]] = {}
+    for mode in seen:
+        data = learned.info[mode].get("data") or {}
+        seed = data.get("seed", learned.info[mode].get("seed"))
+        ratios = ",".join(f"{r:g}" for r in data.get("ratios", []))
+        how.setdefault(f"split {data.get('split', '?')!r} made with --seed {seed} --split-ratios {ratios}", []).append(
+            mode
+        )
+    trained = "; ".join(f"{' and '.join(m)}: {h}" for h, m in how.items())
+    return (
+        f"warning: {len(names)} of the {len(dataset.sources)} sequences evaluated ({shown}) are in the training data "
+        f"of the learned models ({trained}): their scores are not held-out; evaluate a split made with the same "
+        "--seed and --split-ratios"
+    )
 
 
 class _bar:

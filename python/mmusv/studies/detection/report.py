@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -61,9 +62,10 @@ def _detector_name(res: StudyResult, detector: str) -> str:
     return "predictions file" if res.options.predictions is not None else detector
 
 
-def write_detection(res: StudyResult, out: Path, *, detector: str) -> dict[str, Path]:
+def write_detection(res: StudyResult, out: Path, *, detector: str, notes: Sequence[str] = ()) -> dict[str, Path]:
     """Writes ``detection_table.csv``, ``detection_boxes.parquet``, ``detection_ap.png`` and
-    ``detection_note.txt`` into ``out``; returns the paths."""
+    ``detection_note.txt`` (with the lines ``notes``: a learned detector's models and second stage) into ``out``;
+    returns the paths."""
     out.mkdir(parents=True, exist_ok=True)
     table = detection_table(res)
     paths = {
@@ -75,13 +77,14 @@ def write_detection(res: StudyResult, out: Path, *, detector: str) -> dict[str, 
     table.write_csv(paths["csv"])
     res.boxes_frame(with_setting=False).write_parquet(paths["parquet"])
     _plot_detection(table, paths["png"])
-    paths["note"].write_text(_note(res, detector), encoding="utf-8")
+    paths["note"].write_text(_note(res, detector, notes), encoding="utf-8")
     return paths
 
 
-def write_robustness(res: StudyResult, out: Path, *, detector: str) -> dict[str, Path]:
+def write_robustness(res: StudyResult, out: Path, *, detector: str, notes: Sequence[str] = ()) -> dict[str, Path]:
     """Writes ``robustness_table.csv`` (AP@0.5 per setting and mode), ``robustness_metrics.csv`` (every metric),
-    ``robustness_boxes.parquet``, ``robustness_ap.png`` and ``robustness_note.txt`` into ``out``."""
+    ``robustness_boxes.parquet``, ``robustness_ap.png`` and ``robustness_note.txt`` (with the lines ``notes``)
+    into ``out``."""
     out.mkdir(parents=True, exist_ok=True)
     paths = {
         "csv": out / "robustness_table.csv",
@@ -95,12 +98,12 @@ def write_robustness(res: StudyResult, out: Path, *, detector: str) -> dict[str,
     res.table().write_csv(paths["metrics"])
     res.boxes_frame(with_setting=True).write_parquet(paths["parquet"])
     _plot_robustness(res, paths["png"])
-    paths["note"].write_text(_note(res, detector), encoding="utf-8")
+    paths["note"].write_text(_note(res, detector, notes), encoding="utf-8")
     return paths
 
 
-def _note(res: StudyResult, detector: str) -> str:
-    lines = [f"detector: {_detector_name(res, detector)}"]
+def _note(res: StudyResult, detector: str, notes: Sequence[str] = ()) -> str:
+    lines = [f"detector: {_detector_name(res, detector)}", *notes]
     if detector == "baseline" and res.options.predictions is None:
         lines.append(BASELINE_NOTE)
     lines += [
