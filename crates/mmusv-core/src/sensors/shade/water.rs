@@ -1,5 +1,5 @@
-//! The sea surface's optics for cameras: capillary roughness, whitecap coverage, the wind of a sea state, shallow
-//! water and the water body (the foam itself, whitecaps and wakes, in [`super::foam`]).
+//! The sea surface's optics for cameras: capillary roughness, whitecap coverage, shallow water and the water body
+//! (the foam itself, whitecaps and wakes, in [`super::foam`]).
 //!
 //! * **Capillary roughness** (waves too small to be geometry): C. Cox & W. Munk, "Measurement of the Roughness of
 //!   the Sea Surface from Photographs of the Sun's Glitter", JOSA 44(11), 1954: mean square slope
@@ -9,8 +9,9 @@
 //! * **Whitecap coverage**: E. C. Monahan & I. O'Muircheartaigh, "Optimal Power-Law Description of Oceanic
 //!   Whitecap Coverage Dependence on Wind Speed", J. Phys. Oceanogr. 10, 1980: `W = 3.84·10⁻⁶ U^3.41`
 //!   (fraction of the surface; [`super::foam`] places it).
-//! * **Wind from the sea state** when the scenario gives none: a fully developed Pierson–Moskowitz sea,
-//!   `H_s = 0.21 U² / g` (W. J. Pierson & L. Moskowitz, JGR 69(24), 1964), so `U = √(H_s g / 0.21)`.
+//! * **Wind**: the environment's (m/s at 10 m); when the scenario gives none, the Python layer derives it from the
+//!   sea state (`mmusv.sensors.env.wind_from_wave_height`: a fully developed Pierson–Moskowitz sea, whose 19.5 m
+//!   wind `√(H_s g / 0.21)` (W. J. Pierson & L. Moskowitz, JGR 69(24), 1964) is brought to 10 m).
 //! * **Shallow water**: over a seabed `d` metres down, the water body's diffuse reflectance is
 //!   `ρ(d) = ρ∞ + (A_b − ρ∞) exp(−2 K_d d)` (S. Maritorena, A. Morel & B. Gentili, "Diffuse reflectance of
 //!   oceanic shallow waters: influence of water depth and bottom albedo", Limnol. Oceanogr. 39(7), 1994), with a
@@ -109,11 +110,6 @@ pub fn monahan_coverage(u: f32) -> f32 {
     (3.84e-6 * u.max(0.0).powf(3.41)).min(1.0)
 }
 
-/// Wind speed (m/s) of a fully developed Pierson–Moskowitz sea of significant height `hs` (m).
-pub fn wind_from_wave_height(hs: f32) -> f32 {
-    (hs.max(0.0) * 9.81 / 0.21).sqrt()
-}
-
 /// Internal diffuse reflectance of a dielectric interface of relative index `eta` seen from inside
 /// (`∫ F(θ) 2 cos θ sin θ dθ` with the inside-to-outside Fresnel, total internal reflection included).
 pub fn internal_diffuse_reflectance(eta: f32) -> f32 {
@@ -154,8 +150,6 @@ mod tests {
         assert!((cox_munk_alpha(10.0) - (0.003f32 + 0.0512).sqrt()).abs() < 1e-6);
         // Monahan at 10 m/s: 3.84e-6 · 10^3.41 = 0.00987.
         assert!((monahan_coverage(10.0) - 0.009_87).abs() < 1e-4);
-        // PM: U = 10 m/s gives Hs = 0.21 · 100 / 9.81 = 2.14 m.
-        assert!((wind_from_wave_height(0.21 * 100.0 / 9.81) - 10.0).abs() < 1e-3);
         // Internal diffuse reflectance of water: total internal reflection beyond the critical angle alone
         // gives 1 − (1/1.33)² = 0.435; the Fresnel inside the cone adds a little.
         let f = internal_diffuse_reflectance(1.33);
