@@ -315,3 +315,46 @@ def test_a_cut_cache_is_one_line(
         err = capsys.readouterr().err
         assert err.startswith("mmusv: error: ") and "cache_all.npz: not a readable" in err, err
         assert err.count("\n") == 1 and "Traceback" not in err, err
+
+
+def test_a_npy_file_for_a_cache_is_one_line(
+    recordings: tuple[Path, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # a plain .npy under the cache's name: numpy gives an array, not an archive, and `with` on it was a TypeError
+    # traceback (found by the review of this round)
+    (tmp_path / "out").mkdir()
+    with (tmp_path / "out" / "cache_all.npz").open("wb") as f:
+        np.save(f, np.arange(4))
+    with pytest.raises(InputError, match=r"cache_all\.npz: not a readable \.npz cache \(TypeError"):
+        Cache(tmp_path / "out" / "cache_all.npz")
+    for extra in (["--split", "all", "--scorers-only"], [str(recordings[0]), "--split", "all", "--cache-only"]):
+        assert main(["train", *extra, "--preset", "tiny", "--no-progress", "-o", str(tmp_path / "out")]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("mmusv: error: ") and "cache_all.npz: not a readable" in err, err
+        assert err.count("\n") == 1 and "Traceback" not in err, err
+
+
+def test_a_rerun_of_a_finished_training_keeps_its_scorer(
+    recordings: tuple[Path, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # a rerun of a finished training did no training but fitted the scorer again: minutes for the same file (found
+    # by the review of this round). A scorer.pt fitted for the weights as they are is kept; one for other weights
+    # is fitted again.
+    from mmusv.learn.checkpoint import weights_digest
+    from mmusv.learn.cli import _fit_scorers
+
+    out = tmp_path / "out"
+    train(MemorySource(SCENES), p=preset("tiny"), mode="single", out=out / "single", epochs=1, progress=False)
+    cache = build_cache([recordings[0]], out / "cache_all.npz", split="all")
+    digest = weights_digest(load_models(out / "single" / "model.pt").models["single"].state_dict())
+    scorer = out / "single" / SCORER_FILE
+    IoUScorer(np.zeros(len(FEATURES)), np.ones(len(FEATURES))).save(scorer, {"model": digest, "boxes": 7})
+    first = scorer.read_bytes()
+    kept = _fit_scorers(out, cache, ["single"], seed=0, keep_current=True)
+    assert kept["single"]["model"] == digest and kept["single"]["boxes"] == 7
+    assert f"single: {scorer} was fitted for these weights; kept" in capsys.readouterr().out
+    assert scorer.read_bytes() == first
+    IoUScorer(np.zeros(len(FEATURES)), np.ones(len(FEATURES))).save(scorer, {"model": "other weights", "boxes": 7})
+    again = _fit_scorers(out, cache, ["single"], seed=0, keep_current=True)
+    assert "was fitted for these weights; kept" not in capsys.readouterr().out
+    assert again["single"].get("boxes") != 7  # fitted again (or skipped, for a model that finds too little)

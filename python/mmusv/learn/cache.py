@@ -196,7 +196,7 @@ class Cache:
                 self.arrays: dict[str, np.ndarray] = {k: z[k] for k in self.KEYS}
                 if "cloud_agent" in z.files:  # caches written before it was added lack it
                     self.arrays["cloud_agent"] = z["cloud_agent"]
-        except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:  # a cut copy was a BadZipFile traceback
+        except (OSError, ValueError, EOFError, TypeError, zipfile.BadZipFile) as exc:  # a cut copy; a .npy (TypeError)
             raise input_error(f"--cache {p}: not a readable .npz cache ({type(exc).__name__}: {exc})") from None
         self.path = p
         self.meta: dict[str, Any] = json.loads(str(self.arrays["meta"]))

@@ -27,7 +27,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from mmusv.errors import InputError
+from mmusv.errors import InputError, MmusvError
 
 __all__ = ["add_parser", "load_for_study", "run"]
 
@@ -238,7 +238,7 @@ def _check_cache(
     try:
         with open(cache, "rb") as fh, np.load(fh, allow_pickle=False) as z:
             meta = json.loads(str(z["meta"]))
-    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:
+    except (OSError, ValueError, KeyError, EOFError, TypeError, zipfile.BadZipFile) as exc:  # TypeError: a .npy
         raise InputError(
             f"{cache}: not a readable mmusv.learn cache ({type(exc).__name__}); remove it to build it again"
         ) from None
@@ -291,7 +291,7 @@ def check_threads(threads: int | None) -> None:
 
 def split_ratios(text: str) -> tuple[float, float, float]:
     """``--split-ratios`` as three fractions; its errors name the option (they said only "split")."""
-    from mmusv.errors import MmusvError, located
+    from mmusv.errors import located
     from mmusv.export.splits import parse_ratios
 
     try:
@@ -347,11 +347,18 @@ def _jobs(value: str, models: int, device: str | None) -> int:
 
 
 def _fit_scorers(
-    out: Path, cache_path: Path, modes: list[str], *, seed: int, threads: int | None = None
+    out: Path,
+    cache_path: Path,
+    modes: list[str],
+    *,
+    seed: int,
+    threads: int | None = None,
+    keep_current: bool = False,
 ) -> dict[str, dict[str, Any]]:
     """Fits the IoU scorer (:func:`mmusv.learn.scorer.fit_scorer`) of each trained model in ``modes`` on the
     training cache, each into ``OUT/<mode>/scorer.pt``; returns what each fit measured. ``threads``: torch's
-    threads (``None``: as they are)."""
+    threads (``None``: as they are). ``keep_current``: a ``scorer.pt`` already fitted for the model's weights as they
+    are is kept, not fitted again (a rerun of a finished training: minutes of work for the same scorer)."""
     import torch
 
     from mmusv.learn.cache import Cache
@@ -359,7 +366,7 @@ def _fit_scorers(
     from mmusv.learn.detector import load_models
     from mmusv.learn.example import early_cloud
     from mmusv.learn.refine import RefineParams
-    from mmusv.learn.scorer import SCORER_FILE, fit_scorer
+    from mmusv.learn.scorer import SCORER_FILE, fit_scorer, load_scorer
 
     if threads is not None:
         torch.set_num_threads(threads)
@@ -370,6 +377,16 @@ def _fit_scorers(
             raise InputError(f"--scorers-only: no {out / mode / 'model.pt'}; train the {mode} model first")
         det = load_models(out / mode / "model.pt", refine=True, rescore=False)
         model = det.models[mode]
+        current = out / mode / SCORER_FILE
+        if keep_current and current.is_file():
+            try:
+                kept = load_scorer(current).info
+            except MmusvError:
+                kept = {}
+            if kept.get("model") == weights_digest(model.state_dict()):
+                done[mode] = kept
+                print(f"{mode}: {current} was fitted for these weights; kept", flush=True)
+                continue
 
         def sample(k: int, mode: str = mode, det: Any = det) -> tuple[Any, Any, Any, Any]:
             ego, nbs, gt = cache.sample(k)
@@ -445,5 +462,6 @@ def _train_one(task: dict[str, Any]) -> dict[str, Any]:
         "plot": png.name,
     }
     if task["scorer"]:
-        done["scorer"] = _fit_scorers(out.parent, Path(task["cache"]), [task["mode"]], seed=task["seed"])[task["mode"]]
+        fits = _fit_scorers(out.parent, Path(task["cache"]), [task["mode"]], seed=task["seed"], keep_current=True)
+        done["scorer"] = fits[task["mode"]]
     return done
