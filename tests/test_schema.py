@@ -359,3 +359,19 @@ def test_cli_bad_output_is_one_line_naming_the_flag(
     lines = cap.err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("mmusv: error: -o/--output"), cap.err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["f"]
+
+
+def test_cli_replaces_only_a_schema_it_wrote(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``-o`` over an existing schema of mmusv's (an older one) replaces it; over any other file (``-o
+    my_scenario.yaml``: the scenario was replaced by JSON, for good) it refuses in one line and leaves it."""
+    old = tmp_path / "scenario.schema.json"
+    old.write_text('{"$schema": "https://json-schema.org/draft/2020-12/schema", "title": "mmusv scenario"}')
+    assert cli.main(["schema", "scenario", "-o", str(old)]) == 0
+    assert old.read_text(encoding="utf-8") == schema_text("scenario")
+    capsys.readouterr()
+    mine = tmp_path / "my_scenario.yaml"
+    mine.write_text("name: mine\n")
+    assert cli.main(["schema", "scenario", "-o", str(mine)]) == 2
+    err = capsys.readouterr().err
+    assert "the file exists and is not a schema mmusv wrote" in err and err.count("\n") == 1, err
+    assert mine.read_text() == "name: mine\n"

@@ -277,6 +277,11 @@ def _cmd_schema(args: argparse.Namespace) -> int:
         sys.stdout.write(text)
         return 0
     out = Path(output_arg(args.output, flag="-o/--output"))
+    if out.is_file() and not _is_our_schema(out):  # `-o my_scenario.yaml` replaced the scenario, for good
+        raise IoError(
+            f"-o/--output {args.output}: the file exists and is not a schema mmusv wrote; choose another name or "
+            "remove it first"
+        )
     tmp = out.with_name(f".{out.name}.{os.getpid()}.tmp")
     try:  # through a temporary beside it and a rename: an editor never reads half a schema
         if out.is_dir():
@@ -289,6 +294,17 @@ def _cmd_schema(args: argparse.Namespace) -> int:
         raise IoError(f"-o/--output {args.output}: cannot write the schema: {exc.strerror or exc}") from None
     print(f"wrote {out}")
     return 0
+
+
+def _is_our_schema(path: Path) -> bool:
+    """Whether ``path`` holds a JSON Schema ``mmusv schema`` wrote (one it may replace with a newer one)."""
+    import json
+
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError):
+        return False
+    return isinstance(doc, dict) and "$schema" in doc and str(doc.get("title", "")).startswith("mmusv ")
 
 
 def _parser() -> argparse.ArgumentParser:
