@@ -502,3 +502,10 @@ def test_a_restarted_server_shows_the_runs_already_in_its_folder(client: TestCli
     assert quick["recording"] == done["recording"] and Path(quick["recording"]).is_file()
     assert quick["error"] is None and cli["error"] == "stopped before the end; the recording holds 1 frame"
     assert cli["id"] > quick["id"]  # newest first, as the page looks for a file's last run
+    import mmusv.editor.jobs as jobs
+
+    keep, jobs.KEEP_FINISHED = jobs.KEEP_FINISHED, 1
+    try:  # a folder of many runs: the newest KEEP_FINISHED, as a long-lived server keeps
+        assert [j["scenario"] for j in TestClient(create_app(folder)).get("/api/runs").json()] == ["cli.yml"]
+    finally:
+        jobs.KEEP_FINISHED = keep

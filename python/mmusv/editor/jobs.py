@@ -90,7 +90,7 @@ class Jobs:
         self._ids = itertools.count(1)
         self._lock = threading.Lock()
         self._followers: list[threading.Thread] = []
-        for job in _earlier_runs(root):
+        for job in _earlier_runs(root)[-KEEP_FINISHED:]:  # the newest, as a long-lived server keeps them
             job.id = next(self._ids)
             self._jobs[job.id] = job
 
