@@ -301,32 +301,22 @@ def test_generate_short_of_its_quotas_is_said(
     assert "generate: quota not met sea_convoy" in err, err
 
 
-def test_a_cut_cache_is_one_line(
-    recordings: tuple[Path, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+@pytest.mark.parametrize("damage", ["BadZipFile", "TypeError"])
+def test_a_damaged_cache_is_one_line(
+    damage: str, recordings: tuple[Path, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    # a cache copied from another machine and cut short was a zipfile.BadZipFile traceback
-    whole = build_cache([recordings[0]], tmp_path / "whole.npz", split="all").read_bytes()
-    (tmp_path / "out").mkdir()
-    (tmp_path / "out" / "cache_all.npz").write_bytes(whole[:1000])
-    with pytest.raises(InputError, match=r"cache_all\.npz: not a readable \.npz cache \(BadZipFile"):
-        Cache(tmp_path / "out" / "cache_all.npz")
-    for extra in (["--split", "all", "--scorers-only"], [str(recordings[0]), "--split", "all", "--cache-only"]):
-        assert main(["train", *extra, "--preset", "tiny", "--no-progress", "-o", str(tmp_path / "out")]) == 2
-        err = capsys.readouterr().err
-        assert err.startswith("mmusv: error: ") and "cache_all.npz: not a readable" in err, err
-        assert err.count("\n") == 1 and "Traceback" not in err, err
-
-
-def test_a_npy_file_for_a_cache_is_one_line(
-    recordings: tuple[Path, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
-    # a plain .npy under the cache's name: numpy gives an array, not an archive, and `with` on it was a TypeError
-    # traceback (found by the review of this round)
-    (tmp_path / "out").mkdir()
-    with (tmp_path / "out" / "cache_all.npz").open("wb") as f:
-        np.save(f, np.arange(4))
-    with pytest.raises(InputError, match=r"cache_all\.npz: not a readable \.npz cache \(TypeError"):
-        Cache(tmp_path / "out" / "cache_all.npz")
+    # BadZipFile: a cache copied from another machine and cut short was a zipfile.BadZipFile traceback. TypeError: a
+    # plain .npy under the cache's name (numpy gives an array, not an archive, and `with` on it was a TypeError
+    # traceback; found by the review of this round).
+    cache = tmp_path / "out" / "cache_all.npz"
+    cache.parent.mkdir()
+    if damage == "BadZipFile":
+        cache.write_bytes(build_cache([recordings[0]], tmp_path / "whole.npz", split="all").read_bytes()[:1000])
+    else:
+        with cache.open("wb") as f:
+            np.save(f, np.arange(4))
+    with pytest.raises(InputError, match=rf"cache_all\.npz: not a readable \.npz cache \({damage}"):
+        Cache(cache)
     for extra in (["--split", "all", "--scorers-only"], [str(recordings[0]), "--split", "all", "--cache-only"]):
         assert main(["train", *extra, "--preset", "tiny", "--no-progress", "-o", str(tmp_path / "out")]) == 2
         err = capsys.readouterr().err
