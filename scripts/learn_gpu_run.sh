@@ -1,19 +1,20 @@
 #!/bin/bash
-# One call on a GPU machine without mmusv installed (torch + numpy only): train the single, early and
-# intermediate models side by side on the one GPU (three processes, T seconds each, the loader workers split
-# between them), then run the three models on the test cache side by side, and leave under $OUT what comes back
+# One call on a GPU machine without mmusv installed (torch + numpy only): train the models (MODES; by default
+# single, early and intermediate) side by side on the one GPU (a process each, T seconds each, the loader workers
+# split between them), then run them on the test cache side by side, and leave under $OUT what comes back
 # from such a call: run.log (every process's output, prefixed, and the GPU's load every 15 s), fp16 copies of
 # the models (<mode>_model_fp16.pt, under the 16 MiB file limit), their loss logs (<mode>_log.jsonl) and the
-# heatmap peaks of all three (peaks.npz, for `python -m mmusv.learn.replay` back on a machine with mmusv).
+# heatmap peaks of all of them (peaks.npz, for `python -m mmusv.learn.replay` back on a machine with mmusv).
 # A training process that dies or hangs does not stop the rest: each writes model.pt at every epoch end and at
 # the time limit, the script goes on with the models that exist, and every step has a timeout so that the call
 # ends inside about T + 180 s.
 #
 # Run from the repository root, with C a folder holding train.npz and test.npz (`mmusv train --cache-only`):
 #   C=.learncache/gpu3 T=360 OUT=$OUT bash scripts/learn_gpu_run.sh
-# Knobs (environment): PRESET (paper), SETS (preset overrides, space-separated KEY=VALUE, passed as --set),
-# WORKERS ("single early intermediate" loader workers), THREADS (torch threads per process), DEVICE (cuda when
-# available), INFER_LIMIT (first N items per model: dry runs), INFER_TIMEOUT (s), W (where models are written).
+# Knobs (environment): MODES (the models, space-separated; default "single early intermediate"), PRESET
+# (paper), SETS (preset overrides, space-separated KEY=VALUE, passed as --set), WORKERS (loader workers, one number
+# per mode), THREADS (torch threads per process), DEVICE (cuda when available), INFER_LIMIT (first N items per
+# model: dry runs), INFER_TIMEOUT (s), W (where models are written).
 set -u
 export PYTHONUNBUFFERED=1
 C=${C:-.learncache/gpu3}
@@ -27,7 +28,7 @@ INFER_LIMIT=${INFER_LIMIT:-}
 INFER_TIMEOUT=${INFER_TIMEOUT:-100}
 OUT=${OUT:-/tmp/out}
 W=${W:-/tmp/models}
-MODES=(single early intermediate)
+read -ra MODES <<<"${MODES:-single early intermediate}"
 read -ra sets <<<"$SETS"
 read -ra workers <<<"$WORKERS"
 set_args=()
@@ -51,7 +52,7 @@ fi
 python3 -c "import torch, numpy; print('torch', torch.__version__, 'numpy', numpy.__version__, 'cuda', torch.cuda.is_available())" 2>&1 | tee -a "$LOG"
 
 pids=()
-for i in 0 1 2; do
+for i in "${!MODES[@]}"; do
   m=${MODES[$i]}
   timeout -k 10 $((T + 45)) python3 scripts/learn_train.py --cache "$C/train.npz" --preset "$PRESET" "${set_args[@]}" \
     --modes "$m" -o "$W" --time-limit "$T" --workers "${workers[$i]}" --threads "$THREADS" --no-progress "${dev_args[@]}" \
@@ -62,10 +63,10 @@ for p in "${pids[@]}"; do wait "$p"; done
 say "training done"
 
 # fp16 copies and logs first, so that they come back even if inference fails
-W=$W OUT=$OUT python3 - <<'PY' 2>&1 | sed -u 's/^/[copy] /' | tee -a "$LOG"
+W=$W OUT=$OUT MODES="${MODES[*]}" python3 - <<'PY' 2>&1 | sed -u 's/^/[copy] /' | tee -a "$LOG"
 import os, shutil, torch
 W, OUT = os.environ["W"], os.environ["OUT"]
-for m in ("single", "early", "intermediate"):
+for m in os.environ["MODES"].split():
     f = os.path.join(W, m, "model.pt")
     if not os.path.isfile(f):
         print(m, "no model.pt")
