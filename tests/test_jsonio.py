@@ -26,3 +26,32 @@ def test_a_killed_writers_temporary_file_is_removed_by_the_next_write(tmp_path: 
     assert not stale.exists()
     assert live.exists() and other.exists()
     assert not (tmp_path / f".dataset.json.{os.getpid()}.tmp").exists()
+
+
+def test_a_failed_write_keeps_the_old_file_and_leaves_no_temporary(tmp_path: Path, monkeypatch) -> None:
+    """A full disk during the write: the file keeps its old bytes, no temporary stays, the OSError reaches the
+    caller (who names the file in its own words)."""
+    import errno
+    import pathlib
+
+    from mmusv.jsonio import write_bytes_atomic
+
+    target = tmp_path / "manifest.json"
+    target.write_bytes(b"old\n")
+    real = pathlib.Path.write_bytes
+
+    def full(self: Path, data: bytes) -> int:
+        real(self, data[:3])  # what a full disk leaves: the start of the file
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(pathlib.Path, "write_bytes", full)
+    try:
+        write_bytes_atomic(target, b"new contents\n")
+    except OSError as exc:
+        assert exc.errno == errno.ENOSPC
+    else:
+        raise AssertionError("the OSError was swallowed")
+    monkeypatch.undo()
+    assert target.read_bytes() == b"old\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["manifest.json"]
+    assert write_bytes_atomic(target, b"new\n") == target and target.read_bytes() == b"new\n"

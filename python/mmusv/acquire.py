@@ -21,7 +21,6 @@ Ctrl-C or an error still finishes the MCAP (every completed frame is in it, its 
 
 from __future__ import annotations
 
-import json
 import os
 import time
 from collections.abc import Callable
@@ -36,6 +35,7 @@ from mmusv.annotate import Annotations, SilhouetteCache, annotate_agent
 from mmusv.config import Scenario, load_scenario, scenario_hash
 from mmusv.errors import ConfigError, IoError, MmusvError, located
 from mmusv.forking import check_polars
+from mmusv.jsonio import dump_json, write_bytes_atomic
 from mmusv.profiling import RunProfile, clocks
 from mmusv.recording.background import BackgroundWriter
 from mmusv.recording.guard import FolderLock, write_cause
@@ -414,12 +414,9 @@ def _record(
     }
     if frame_range is not None:
         manifest["first_frame"] = first
-    tmp = out / ".manifest.json.tmp"  # renamed into place: never half-written
-    try:
-        tmp.write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")
-        os.replace(tmp, out / "manifest.json")
+    try:  # renamed into place: never half-written
+        write_bytes_atomic(out / "manifest.json", dump_json(manifest))
     except OSError as exc:
-        tmp.unlink(missing_ok=True)
         if message is None:
             message, _safe = _write_failure(out, rec_path, [("writing manifest.json", exc)])
     if message is not None:

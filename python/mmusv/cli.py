@@ -266,10 +266,8 @@ def _cmd_preview(args: argparse.Namespace) -> int:
 
 
 def _cmd_schema(args: argparse.Namespace) -> int:
-    import contextlib
-    import os
-
     from mmusv.errors import IoError
+    from mmusv.jsonio import write_bytes_atomic
     from mmusv.schema import schema_text
 
     text = schema_text(args.kind)
@@ -282,15 +280,11 @@ def _cmd_schema(args: argparse.Namespace) -> int:
             f"-o/--output {args.output}: the file exists and is not a schema mmusv wrote; choose another name or "
             "remove it first"
         )
-    tmp = out.with_name(f".{out.name}.{os.getpid()}.tmp")
     try:  # through a temporary beside it and a rename: an editor never reads half a schema
         if out.is_dir():
             raise IsADirectoryError(21, "is a folder, not a file")
-        tmp.write_text(text, encoding="utf-8")
-        os.replace(tmp, out)
+        write_bytes_atomic(out, text.encode("utf-8"))
     except OSError as exc:
-        with contextlib.suppress(OSError):
-            tmp.unlink(missing_ok=True)
         raise IoError(f"-o/--output {args.output}: cannot write the schema: {exc.strerror or exc}") from None
     print(f"wrote {out}")
     return 0

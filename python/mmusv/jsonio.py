@@ -2,12 +2,14 @@
 
 :func:`dump_json` gives the bytes (2-space indent, keys in the order given, a final newline, no NaN), so two
 writes of the same document are byte-identical; :func:`write_json` replaces a file atomically (a reader or a
-killed writer never leaves half a file behind); :func:`read_json` reads one object and names the file in every
-error (:class:`~mmusv.errors.IoError`).
+killed writer never leaves half a file behind) through :func:`write_bytes_atomic`, which other small files the
+project writes whole (a run's ``manifest.json``, a JSON Schema) use too; :func:`read_json` reads one object and
+names the file in every error (:class:`~mmusv.errors.IoError`).
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 from pathlib import Path
@@ -15,7 +17,7 @@ from typing import Any
 
 from mmusv.errors import IoError
 
-__all__ = ["dump_json", "read_json", "remove_stale_temps", "write_json"]
+__all__ = ["dump_json", "read_json", "remove_stale_temps", "write_bytes_atomic", "write_json"]
 
 
 def dump_json(doc: Any) -> bytes:
@@ -43,20 +45,34 @@ def remove_stale_temps(path: Path) -> None:
             tmp.unlink(missing_ok=True)
 
 
-def write_json(path: str | os.PathLike[str], doc: Any) -> Path:
-    """Writes ``doc`` to ``path`` through a temporary file in the same folder and an atomic rename; temporary
-    files left beside it by a killed writer are removed."""
+def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
+    """Writes ``data`` to ``path`` through a temporary file beside it (``.NAME.PID.tmp``) and an atomic rename, so
+    a reader or a writer killed on the way never leaves half a file; temporary files of earlier writers that no
+    longer run are removed first. The folder must exist. An :class:`OSError` is raised as it came, after the
+    temporary is removed: the caller words it (it names no file)."""
     p = Path(path)
     tmp = p.with_name(f".{p.name}.{os.getpid()}.tmp")
     try:
-        p.parent.mkdir(parents=True, exist_ok=True)
         remove_stale_temps(p)
-        tmp.write_bytes(dump_json(doc))
+        tmp.write_bytes(data)
         os.replace(tmp, p)
-    except OSError as exc:
-        tmp.unlink(missing_ok=True)
-        raise IoError(f"cannot write {p}: {exc.strerror or exc}") from None
+    except BaseException:
+        with contextlib.suppress(OSError):
+            tmp.unlink(missing_ok=True)
+        raise
     return p
+
+
+def write_json(path: str | os.PathLike[str], doc: Any) -> Path:
+    """Writes ``doc`` (:func:`dump_json`) to ``path`` with :func:`write_bytes_atomic`, creating its folder;
+    :class:`~mmusv.errors.IoError` naming the file when it cannot be written."""
+    p = Path(path)
+    data = dump_json(doc)
+    try:
+        p.parent.mkdir(parents=True, exist_ok=True)
+        return write_bytes_atomic(p, data)
+    except OSError as exc:
+        raise IoError(f"cannot write {p}: {exc.strerror or exc}") from None
 
 
 def read_json(path: str | os.PathLike[str]) -> dict[str, Any]:

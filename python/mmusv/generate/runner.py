@@ -322,7 +322,9 @@ def generate(
 
 def _write_atomic(path: Path, text: str, written: int) -> None:
     """``text`` into ``path`` through a hidden temporary renamed into place (a stop never leaves half a file); on
-    an OSError the temporary is removed and the error names ``path`` (:func:`_write_failed`)."""
+    an OSError the temporary is removed and the error names ``path`` (:func:`_write_failed`). The temporary's
+    name is fixed (not :func:`mmusv.jsonio.write_bytes_atomic`'s per process): :func:`_prepare_dir` finds a
+    stopped run's temporaries by the names its journal lists."""
     tmp = path.with_name(f".{path.name}.tmp")
     try:
         tmp.write_text(text, encoding="utf-8")
