@@ -630,7 +630,9 @@ def sea_limits() -> dict[str, tuple[float, float]]:
     """``{"hs_m": (lo, hi), "tp_s": (lo, hi)}``: the significant heights (m) and peak periods (s) a sea takes."""
 
 def fully_developed(hs_m: float) -> tuple[float, float]:
-    """(tp_s, wind_mps) of a fully developed Pierson–Moskowitz sea."""
+    """(tp_s, wind_mps) of a fully developed Pierson–Moskowitz sea of significant height ``hs_m`` (m): the peak
+    period (s) and the wind at 19.5 m, ``√(g·hs_m/0.21)`` (m/s); the 10 m wind mmusv's sensors take is that /
+    1.026."""
 
 def dnv_gamma(hs_m: float, tp_s: float) -> float:
     """DNV-RP-C205 peak enhancement for Hs, Tp."""
@@ -642,7 +644,9 @@ def hull_rao(
     beta: npt.NDArray[np.float64],
     omega_e: npt.NDArray[np.float64],
 ) -> npt.NDArray[np.complex128]:
-    """(N, 3) complex128 RAOs (heave m/m, roll rad/m, pitch rad/m)."""
+    """(N, 3) complex128 RAOs (heave m/m, roll rad/m, pitch rad/m) of a hull ``[length, beam, draft,
+    block_coefficient, gm]`` (m, m, m, 1, m) for waves of frequency ``omega`` (rad/s), heading ``beta`` relative to
+    the hull (rad: 0 following, π/2 beam, π head) and encounter frequency ``omega_e`` (rad/s), all ``(N,)``."""
 
 def response_variance(
     *,

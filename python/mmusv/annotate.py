@@ -54,7 +54,10 @@ def in_target_range(centres: np.ndarray, range_m: float) -> np.ndarray:
 
 
 def box_corners(matrix: np.ndarray, size: np.ndarray) -> np.ndarray:
-    """``(8, 3)`` corners of a box with pose ``matrix`` (``(4, 4)`` box → frame, centred) and full ``size``."""
+    """``(8, 3)`` corners of a box with pose ``matrix`` (``(4, 4)`` box → frame, centred) and full ``size``
+    (length, beam, height along the box's x, y, z), in the frame ``matrix`` maps to. Corner ``i`` lies at
+    ``±size / 2`` in the box frame, the sign of x from bit 0 of ``i``, of y from bit 1 and of z from bit 2 (set:
+    +; corner 0 is (−x, −y, −z), corner 7 (+x, +y, +z))."""
     local = _SIGNS * (np.asarray(size, dtype=np.float64) / 2.0)
     out: np.ndarray = local @ matrix[:3, :3].T + matrix[:3, 3]
     return out

@@ -188,7 +188,8 @@ fn sea_presets() -> Vec<(&'static str, &'static str, f64, f64, f64, f64)> {
         .collect()
 }
 
-/// `(tp_s, wind_mps)` of a fully developed Pierson–Moskowitz sea of significant height `hs_m`.
+/// `(tp_s, wind_mps)` of a fully developed Pierson–Moskowitz sea of significant height `hs_m` (m): the peak
+/// period (s) and the wind at 19.5 m, `√(g·hs_m/0.21)` (m/s); the 10 m wind mmusv's sensors take is that / 1.026.
 #[pyfunction]
 fn fully_developed(hs_m: f64) -> PyResult<(f64, f64)> {
     if !hs_m.is_finite() || hs_m < 0.0 {

@@ -89,7 +89,9 @@ class RadarReturns:
         azimuth: ``(N,)`` float32, radians in ``[0, 2π)``, sensor frame, 0 = forward, counter-clockwise (the
             beam's centre azimuth).
         elevation: ``(N,)`` float32, radians, sensor frame: echo-weighted elevation of the rays in the cell
-            (clutter: the sea surface's elevation at that range, for a level sensor).
+            (clutter: where the still sea level, world z = 0, lies at that range and azimuth seen from the sensor's
+            height: the sea horizon's elevation in the sensor frame, tilted as the sensor is, less
+            ``atan(height / range)``; the waves are not in it).
         intensity: ``(N,)`` float32, linear, relative to a 1 m² target at 1 km; ``>= detection_threshold``.
         instance_id: ``(N,)`` int32, scene instance of the strongest echo in the cell; ``-1`` for clutter.
         semantic_class: ``(N,)`` uint16, class of that echo (:mod:`mmusv.classes`); WATER (1) for sea

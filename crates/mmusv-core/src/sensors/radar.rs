@@ -66,7 +66,9 @@ pub struct RadarReturns {
     /// Beam azimuth in the sensor frame, radians in `[0, 2π)`, 0 = forward, counter-clockwise.
     pub azimuth: Vec<f32>,
     /// Elevation in the sensor frame, radians: echo-weighted mean of the rays hitting the cell, or for
-    /// clutter the elevation of the sea surface at that range seen from the sensor height (level sensor).
+    /// clutter where the still sea level (world z = 0) lies at that range and azimuth seen from the sensor's
+    /// height: the sea horizon's elevation in the (tilted) sensor frame less `atan(height / range)`, without
+    /// the waves.
     pub elevation: Vec<f32>,
     /// Intensity, linear, relative to a 1 m² target at 1 km (see [`radar_model`]).
     pub intensity: Vec<f32>,
