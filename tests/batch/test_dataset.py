@@ -151,3 +151,21 @@ def test_detection_generate_records_through_the_batch_runner(tmp_path: Path) -> 
     before = stamps(tmp_path / "d/recordings", names)
     assert generate_dataset(tmp_path / "d", spec=spec) == recs  # a second call records nothing again
     assert stamps(tmp_path / "d/recordings", names) == before
+
+
+def test_a_spec_no_candidate_meets_is_a_quota_shortfall_not_a_crash(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """No scenario met the spec: `mmusv dataset` exited 2 with "…/scenarios holds no *.yaml scenarios" (the batch
+    runner's refusal of an empty folder), where the README promises exit 1 and the quota not met, as generate."""
+    spec = Path(__file__).resolve().parents[2] / "scenarios/specs/impossible_port.yaml"
+    out = tmp_path / "ds"
+    for rerun in (False, True):
+        assert main(["dataset", str(spec), "-o", str(out)]) == 1
+        text = capsys.readouterr().out
+        assert "quota not met: port_entry_close_2usv_huge: 0 of 5" in text, text
+        assert ("kept (same spec)" in text) == rerun
+        assert "nothing to convert" in text and "up to date" not in text
+        doc = read_index(out / "dataset.json")
+        assert doc["recordings"] == [] and doc["opv2v"]["status"] == "nothing to convert"
+        assert doc["spec"]["name"] == "impossible_port"

@@ -306,9 +306,12 @@ def run_dataset(args: argparse.Namespace) -> int:
         + (f"; quota not met: {', '.join(rep.shortfall)}" if rep.shortfall else "")
     )
     print_report(rep.batch, console)
-    console.print(
-        f"opv2v: {rep.converted} frames converted into {rep.opv2v}"
-        if rep.converted is not None
-        else f"opv2v: {rep.opv2v} is up to date"
-    )
+    if rep.converted == 0:
+        console.print("opv2v: nothing to convert (no complete recording)")
+    else:
+        console.print(
+            f"opv2v: {rep.converted} frames converted into {rep.opv2v}"
+            if rep.converted is not None
+            else f"opv2v: {rep.opv2v} is up to date"
+        )
     return 0 if rep.ok and not rep.shortfall else 1

@@ -117,6 +117,13 @@ def build_dataset(
         shortfall = [f"{c.name}: {c.accepted} of {c.quota}" for c in report.combos if not c.met]
     if progress is not None:
         progress("generate", quota, quota)
+    if not any(scen_dir.glob("*.yaml")):  # no candidate met the spec: nothing to record (the shortfall says so)
+        nothing = {"folder": opv2v.name, "status": "nothing to convert", "frames": 0, "sources": {}}
+        write_index(index_path, [], {"spec": spec_section, "opv2v": nothing})
+        empty = BatchReport(out_dir=rec_dir, backend="serial", outcomes=[], index=index_path)
+        return DatasetReport(
+            out_dir=out, generated=generated, shortfall=shortfall, batch=empty, converted=0, opv2v=opv2v
+        )
     batch = run_many(
         scen_dir,
         out_dir=rec_dir,
@@ -159,6 +166,7 @@ def build_dataset(
         section = {"folder": opv2v.name, "status": "complete", "frames": conv.frames, "sources": sources}
     elif not sources:
         section = {"folder": opv2v.name, "status": "nothing to convert", "frames": 0, "sources": {}}
+        converted = 0  # not "up to date": no recording is complete
     from mmusv.batch.index import Entry
 
     entries = [Entry(**{k: r[k] for k in Entry.__dataclass_fields__}) for r in doc["recordings"]]
