@@ -30,7 +30,12 @@ def add_parser(sub: Any) -> None:
     )
     p.add_argument("scenario", nargs="?", default=None, help="scenario to open (a YAML file or a bundled name)")
     p.add_argument("--port", type=int, default=DEFAULT_PORT, help=f"port (default {DEFAULT_PORT}; 0 picks a free one)")
-    p.add_argument("--dir", default=None, help="folder the editor reads and saves scenarios in (see above)")
+    p.add_argument(
+        "--dir",
+        default=None,
+        help="the only folder the editor reads and saves scenarios in (default: SCENARIO's folder when SCENARIO "
+        "is a file, else the current folder)",
+    )
     p.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1: this machine only)")
 
 
