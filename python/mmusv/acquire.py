@@ -297,7 +297,7 @@ def _record(
     prof = RunProfile() if profile else None
     result.profile = prof
     try:
-        recorder = FrameRecorder(rec_path, sim, overwrite=overwrite)
+        recorder = FrameRecorder(rec_path, sim, overwrite=overwrite, frames=(first, total - first))
     except MmusvError as exc:  # the metadata could not be written (a full disk): say why
         if not _writes_into(exc, out):
             raise

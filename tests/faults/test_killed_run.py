@@ -140,3 +140,29 @@ def test_recover_leaves_a_partial_without_a_complete_frame_as_it_was(
     assert code != 0 and "no complete frame" in err and "left as it was" in err, err
     assert partial.stat().st_size == 65536 and not (folder / "dense.mcap").exists()
     assert sorted(p.relative_to(folder) for p in (folder / "tables").rglob("*.parquet")) == tables
+
+
+def test_a_killed_run_of_its_first_n_frames_is_reported_against_n(tmp_path: Path) -> None:
+    """`mmusv run --frames N` killed: `mmusv info` and `mmusv recover` counted its frames against the scenario's
+    acquisition.frames ("4 of 50 frames" for a run of 30), since only the run metadata written at the end said N;
+    the recording now says what it set out to write from its start."""
+    src = write_yaml(tmp_path / "dense.yaml", scenario("dense", frames=FRAMES, dense=True))
+    asked, k = FRAMES - 20, 85
+    killer = _KILLER.replace("progress=progress)", f"progress=progress, frames={asked})")
+    proc = subprocess.run(
+        [sys.executable, "-c", killer, str(src), str(tmp_path / "killed"), str(k)],
+        cwd=ROOT,
+        env=child_env(),
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert proc.returncode == -9, proc.stderr
+    frames, stream = frames_of(tmp_path / "killed" / "dense.mcap.partial")
+    assert 30 <= len(frames) < k and stream.missing() == list(range(len(frames), asked))
+    code, out, _err = cli_main("info", str(tmp_path / "killed"))
+    assert code == 0 and f"{len(frames)} of {asked} frames" in out, out
+    code, out, err = cli_main("recover", str(tmp_path / "killed"))
+    assert code == 0 and f"recovered {len(frames)} of {asked} frames" in out, (out, err)
+    manifest = (tmp_path / "killed" / "manifest.json").read_text(encoding="utf-8")
+    assert f'"frames_requested": {asked}' in manifest and f'"frames_written": {len(frames)}' in manifest

@@ -78,7 +78,12 @@ class FrameRecorder:
     frames at once interleaved them, and each frame was read back with a few of its topics).
     """
 
-    def __init__(self, path: Path, sim: Simulation, *, overwrite: bool = False) -> None:
+    def __init__(
+        self, path: Path, sim: Simulation, *, overwrite: bool = False, frames: tuple[int, int] | None = None
+    ) -> None:
+        """``frames``: ``(first, count)``, the acquisition indices the run sets out to write, kept in the
+        ``manifest`` metadata from the start, so that a run killed before :meth:`finish` still says what it
+        meant to record (``None``: the scenario's ``acquisition.frames`` from index 0)."""
         self.sim = sim
         self._lock = threading.Lock()
         self.encode_seconds = 0.0
@@ -91,7 +96,17 @@ class FrameRecorder:
         )
         from mmusv import __version__
 
-        self.rec.metadata("manifest", {"mmusv_version": __version__, "seed": sc.seed, "config_hash": scenario_hash(sc)})
+        first, count = (0, sc.acquisition.frames) if frames is None else frames
+        self.rec.metadata(
+            "manifest",
+            {
+                "mmusv_version": __version__,
+                "seed": sc.seed,
+                "config_hash": scenario_hash(sc),
+                "first_frame": first,
+                "frames_requested": count,
+            },
+        )
         sensors: dict[str, Any] = {}
         for a in sim.agents:
             cams = {}

@@ -119,6 +119,9 @@ class RecordingInfo:
     has_summary: bool
     parts: tuple[Path, ...] = ()
     """For a parts manifest: the recorded part files in frame order (``path`` is the manifest); else empty."""
+    planned: tuple[int, int] | None = None
+    """``(first, count)``: the acquisition indices the run set out to write, as its ``manifest`` metadata said
+    from the start (also in a ``.partial`` of a killed run); ``None`` for recordings that predate it."""
 
     @property
     def vessel_ids(self) -> list[str]:
@@ -327,4 +330,14 @@ def _info(p: Path, meta: dict[str, dict[str, str]], has_summary: bool) -> Record
         agents=agents,
         run=dict(run),
         has_summary=has_summary,
+        planned=_planned(manifest),
     )
+
+
+def _planned(manifest: dict[str, str]) -> tuple[int, int] | None:
+    """``(first, count)`` from the ``manifest`` metadata, or ``None`` when it does not say (or says nonsense)."""
+    try:
+        first, count = int(manifest["first_frame"]), int(manifest["frames_requested"])
+    except (KeyError, ValueError):
+        return None
+    return (first, count) if first >= 0 and count > 0 else None

@@ -41,7 +41,8 @@ _CHUNK_BYTES = 4 << 20
 @dataclass
 class Recovered:
     """What :func:`recover` did: the recording written, the ``.partial`` it came from, the frames kept (of those
-    the scenario configures), frames left out as incomplete (with why), the damage met and the tables folder."""
+    the scenario configures, and of those the run set out to write), frames left out as incomplete (with why), the
+    damage met and the tables folder."""
 
     recording: Path
     source: Path
@@ -50,6 +51,8 @@ class Recovered:
     incomplete: list[tuple[int, str]] = field(default_factory=list)
     damage: list[str] = field(default_factory=list)
     tables: Path | None = None
+    frames_requested: int | None = None
+    """The frames the run set out to write (``mmusv run --frames N``), when the recording says so."""
 
     def lines(self) -> list[str]:
         """What to tell the user, one line each."""
@@ -57,7 +60,8 @@ class Recovered:
 
         got = f"frames {frame_ranges(self.frames)}" if self.frames else "no complete frame"
         out = [
-            f"recovered {len(self.frames)} of {self.frames_configured} frames ({got}) from {self.source} "
+            f"recovered {len(self.frames)} of {self.frames_requested or self.frames_configured} frames ({got}) from "
+            f"{self.source} "
             f"into {self.recording}"
         ]
         out += [f"left out frame {k}: {why}" for k, why in self.incomplete]
@@ -247,6 +251,7 @@ def recover(target: str | os.PathLike[str], *, overwrite: bool = False) -> Recov
     if final.exists() and not overwrite:
         raise IoError(f"{final} already exists; pass --overwrite to replace it with the recovery of {src.name}")
     info = read_info(src)
+    planned = info.planned[1] if info.planned is not None else info.frames_configured
     folder = src.parent
     # pass 1: which frames are complete (and their tables)
     tables_dir = folder / "tables"
@@ -319,7 +324,7 @@ def recover(target: str | os.PathLike[str], *, overwrite: bool = False) -> Recov
             "config_hash": info.config_hash,
             "status": "interrupted",
             "frames_written": len(keep),
-            "frames_requested": int(run.get("frames_requested", info.frames_configured)),
+            "frames_requested": int(run.get("frames_requested", planned)),
             "frequency_hz": info.frequency_hz,
             "agents": [a.id for a in info.agents],
             "recording": final.name,
@@ -335,6 +340,7 @@ def recover(target: str | os.PathLike[str], *, overwrite: bool = False) -> Recov
         source=src,
         frames=sorted(keep),
         frames_configured=info.frames_configured,
+        frames_requested=planned,
         incomplete=list(stream.incomplete),
         damage=list(stream.damage),
         tables=tables_dir,

@@ -323,8 +323,9 @@ class FrameStream:
         return fr
 
     def expected(self) -> tuple[range, bool]:
-        """The frames the run set out to write (those in :attr:`frames` when given) and whether the run said so
-        itself (``False``: it did not finish, so this is the scenario's configured range)."""
+        """The frames the run set out to write (those in :attr:`frames` when given) and whether its ``run``
+        metadata says so (``False``: it did not finish; the range is then the one its ``manifest`` metadata gave
+        at the start, or for recordings that predate it the scenario's configured range)."""
         span, said = self._expected_all()
         if self.frames is not None:
             start, stop = self.frames
@@ -339,6 +340,9 @@ class FrameStream:
         if "frames_requested" in run or "frames_written" in run:
             n = int(run.get("frames_requested", run.get("frames_written", 0)) or 0)
             return range(first, first + n), True
+        if self.info.planned is not None:  # a run that did not finish: what it set out to write
+            start, count = self.info.planned
+            return range(start, start + count), False
         return range(first, first + self.info.frames_configured), False
 
     def missing(self) -> list[int]:
