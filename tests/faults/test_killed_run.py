@@ -36,8 +36,17 @@ def killed(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path, int]:
     src = write_yaml(base / "dense.yaml", scenario("dense", frames=FRAMES, dense=True))
     run(src, out_dir=base / "reference")
     k = random.Random(13).randrange(80, 105)  # the first 4 MiB chunk (about 70 frames) is on disk by then
+    _run_killed(src, base / "killed", k)
+    return src, base / "reference", k
+
+
+def _run_killed(src: Path, out: Path, k: int, *, frames: int | None = None) -> None:
+    """``mmusv.run(src, out_dir=out[, frames=frames])`` in a child killed with SIGKILL once frame ``k`` is done."""
+    killer = (
+        _KILLER if frames is None else _KILLER.replace("progress=progress)", f"progress=progress, frames={frames})")
+    )
     proc = subprocess.run(
-        [sys.executable, "-c", _KILLER, str(src), str(base / "killed"), str(k)],
+        [sys.executable, "-c", killer, str(src), str(out), str(k)],
         cwd=ROOT,
         env=child_env(),
         capture_output=True,
@@ -45,7 +54,6 @@ def killed(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path, int]:
         timeout=300,
     )
     assert proc.returncode == -9, proc.stderr
-    return src, base / "reference", k
 
 
 def _copy_of_killed(ref: Path, to: Path) -> Path:
@@ -148,16 +156,7 @@ def test_a_killed_run_of_its_first_n_frames_is_reported_against_n(tmp_path: Path
     the recording now says what it set out to write from its start."""
     src = write_yaml(tmp_path / "dense.yaml", scenario("dense", frames=FRAMES, dense=True))
     asked, k = FRAMES - 20, 85
-    killer = _KILLER.replace("progress=progress)", f"progress=progress, frames={asked})")
-    proc = subprocess.run(
-        [sys.executable, "-c", killer, str(src), str(tmp_path / "killed"), str(k)],
-        cwd=ROOT,
-        env=child_env(),
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
-    assert proc.returncode == -9, proc.stderr
+    _run_killed(src, tmp_path / "killed", k, frames=asked)
     frames, stream = frames_of(tmp_path / "killed" / "dense.mcap.partial")
     assert 30 <= len(frames) < k and stream.missing() == list(range(len(frames), asked))
     code, out, _err = cli_main("info", str(tmp_path / "killed"))
