@@ -3,7 +3,8 @@
 :func:`dump_json` gives the bytes (2-space indent, keys in the order given, a final newline, no NaN), so two
 writes of the same document are byte-identical; :func:`write_json` replaces a file atomically (a reader or a
 killed writer never leaves half a file behind) through :func:`write_bytes_atomic`, which other small files the
-project writes whole (a run's ``manifest.json``, a JSON Schema) use too; :func:`read_json` reads one object and
+project writes whole (a run's ``manifest.json``, a JSON Schema, a study's tables and plots:
+:func:`write_files_atomic`) use too; :func:`read_json` reads one object and
 names the file in every error (:class:`~mmusv.errors.IoError`).
 """
 
@@ -12,12 +13,13 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 from mmusv.errors import IoError
 
-__all__ = ["dump_json", "read_json", "remove_stale_temps", "write_bytes_atomic", "write_json"]
+__all__ = ["dump_json", "read_json", "remove_stale_temps", "write_bytes_atomic", "write_files_atomic", "write_json"]
 
 
 def dump_json(doc: Any) -> bytes:
@@ -61,6 +63,22 @@ def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
             tmp.unlink(missing_ok=True)
         raise
     return p
+
+
+def write_files_atomic(files: Mapping[Path, bytes]) -> None:
+    """Writes several files made in memory (a study's table and plot), creating their folders, each with
+    :func:`write_bytes_atomic`, after checking that no name is taken by a folder: a failure half-way never leaves
+    a new table beside the old plot of an earlier run, nor half a file. :class:`~mmusv.errors.IoError` naming
+    the file."""
+    for path in files:
+        if path.exists() and not path.is_file():
+            raise IoError(f"cannot write {path}: a folder (or another non-file) has that name; remove it")
+    for path, data in files.items():
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            write_bytes_atomic(path, data)
+        except OSError as exc:
+            raise IoError(f"cannot write {path}: {exc.strerror or exc}") from None
 
 
 def write_json(path: str | os.PathLike[str], doc: Any) -> Path:

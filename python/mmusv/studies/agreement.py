@@ -9,17 +9,20 @@ to this vessel alone (per the instance image). Per sample:
 * ``centre error`` (px): distance between the projected box centre and the centre of the component's extent
   measured along the box's own axes (mid-point of the farthest mask pixels forward/aft and port/starboard) —
   the quantity a box fitted to the mask would have;
-* ``centroid error`` (px): distance between the projected box centre and the component's pixel centroid (what
-  the paper reports; it also measures how asymmetric a hull is about its box centre);
-* ``containment``: share of component pixel centres inside the hull;
-* ``hull occupancy``: component pixels / hull area.
+* ``centroid error`` (px): distance between the projected box centre and the centroid of the component's pixels
+  inside the hull, M_local ∩ H_proj (what the paper reports; it also measures how asymmetric a hull is about its
+  box centre);
+* ``containment``: share of component pixel centres inside the hull (on its edge counts as inside);
+* ``hull occupancy``: component pixels inside the hull / hull area, |M_local ∩ H_proj| / |H_proj| (the paper's).
 
 Per map the study reports the number of valid samples, the medians of both errors, mean containment and mean
-occupancy.
+occupancy (a map without valid samples has no row; the tables keep their columns).
 """
 
 from __future__ import annotations
 
+import io
+from collections.abc import Sequence
 from dataclasses import dataclass
 from numbers import Integral
 from pathlib import Path
@@ -31,13 +34,22 @@ from scipy import ndimage
 
 from mmusv.annotate import box_corners
 from mmusv.bundled import resolve_scenario
-from mmusv.config import load_scenario
-from mmusv.errors import ConfigError
+from mmusv.config import Scenario, load_scenario
+from mmusv.errors import ConfigError, located
 from mmusv.forking import check_polars
 from mmusv.frames import translation
+from mmusv.jsonio import write_files_atomic
+from mmusv.sensors.config import RigConfig
 from mmusv.simulation import Simulation
 
-__all__ = ["BUNDLED_SCENARIOS", "AgreementStudy", "check_counts", "run_agreement_study", "sample_agreement"]
+__all__ = [
+    "BUNDLED_SCENARIOS",
+    "AgreementStudy",
+    "check_counts",
+    "load_scenarios",
+    "run_agreement_study",
+    "sample_agreement",
+]
 
 BUNDLED_SCENARIOS = ("scenarios/island_occlusion.yaml", "scenarios/open_sea_convoy.yaml", "scenarios/port_entry.yaml")
 _VESSEL_CLASSES = (10, 11)
@@ -83,11 +95,8 @@ def sample_agreement(
     if np.count_nonzero(owners == instance_id) < owners.size:
         return None  # merged with another vessel, or not this vessel at all
     px = np.stack([cols + 0.5, rows + 0.5], axis=1)
-    contained = float(
-        np.mean(
-            shapely.contains_xy(hull, px[:, 0], px[:, 1]) | shapely.intersects_xy(hull.boundary, px[:, 0], px[:, 1])
-        )
-    )
+    in_hull = shapely.contains_xy(hull, px[:, 0], px[:, 1]) | shapely.intersects_xy(hull.boundary, px[:, 0], px[:, 1])
+    contained = float(np.mean(in_hull))
     centre_body = inv[:3, :3] @ box_matrix[:3, 3] + inv[:3, 3]
     centre_uv = np.array([w / 2.0 - centre_body[1] / metres_per_pixel, h / 2.0 - centre_body[2] / metres_per_pixel])
     # The box's forward and port axes in the image plane.
@@ -104,9 +113,10 @@ def sample_agreement(
         extent_centre += a * (proj.min() + proj.max()) / 2.0
     return {
         "centre_error_px": float(np.linalg.norm(extent_centre - centre_uv)),
-        "centroid_error_px": float(np.linalg.norm(px.mean(axis=0) - centre_uv)),
+        # M_local ∩ H_proj, as the paper (the whole component's centroid moved with the pixels outside the hull).
+        "centroid_error_px": float(np.linalg.norm(px[in_hull].mean(axis=0) - centre_uv)),
         "containment": contained,
-        "hull_occupancy": float(px.shape[0] / hull.area),
+        "hull_occupancy": float(np.count_nonzero(in_hull) / hull.area),
         "pixels": float(px.shape[0]),
     }
 
@@ -119,11 +129,14 @@ class AgreementStudy:
     summary: pl.DataFrame
 
     def write(self, out_dir: Path) -> dict[str, Path]:
-        """Writes ``agreement_samples.parquet`` and ``agreement_summary.csv`` under ``out_dir``."""
-        out_dir.mkdir(parents=True, exist_ok=True)
+        """Writes ``agreement_samples.parquet`` and ``agreement_summary.csv`` under ``out_dir`` (created) with
+        :func:`mmusv.jsonio.write_files_atomic`; returns their paths."""
         paths = {"samples": out_dir / "agreement_samples.parquet", "summary": out_dir / "agreement_summary.csv"}
-        self.samples.write_parquet(paths["samples"])
-        self.summary.write_csv(paths["summary"])
+        samples = io.BytesIO()
+        self.samples.write_parquet(samples)
+        write_files_atomic(
+            {paths["samples"]: samples.getvalue(), paths["summary"]: self.summary.write_csv().encode("utf-8")}
+        )
         return paths
 
 
@@ -137,18 +150,49 @@ def check_counts(frames: int | None, stride: int = 1) -> None:
         raise ConfigError(f"stride = {stride!r}: must be a whole number >= 1")
 
 
+def load_scenarios(scenarios: Sequence[str | Path | Scenario]) -> list[Scenario]:
+    """The scenarios (paths, names of bundled ones, or loaded ones), each loaded and checked: at least one USV
+    whose rig has a top-view camera (:class:`~mmusv.errors.ConfigError` naming the scenario otherwise; such a
+    scenario was an empty table and exit status 0). :func:`run_agreement_study`'s check, for a caller to make
+    before it prepares anything (a missing second scenario was named only after the first had run)."""
+    out = []
+    for path in scenarios:
+        sc = path if isinstance(path, Scenario) else load_scenario(resolve_scenario(path))
+        usvs = [v for v in sc.vessels if v.role == "usv"]
+        if not any((sc.rigs[v.rig] if v.rig is not None else RigConfig()).top_view is not None for v in usvs):
+            why = "no vessel with role: usv" if not usvs else "no USV whose rig has a top_view (rigs.NAME.top_view)"
+            where = f"scenario {sc.name!r}" if isinstance(path, Scenario) else str(path)
+            raise located(ConfigError(f"the agreement study needs a USV's top-view camera; it has {why}"), where)
+        out.append(sc)
+    return out
+
+
+_SAMPLE_SCHEMA = {
+    "map": pl.String,
+    "scenario": pl.String,
+    "frame": pl.Int64,
+    "agent": pl.String,
+    "target": pl.String,
+    "centre_error_px": pl.Float64,
+    "centroid_error_px": pl.Float64,
+    "containment": pl.Float64,
+    "hull_occupancy": pl.Float64,
+    "pixels": pl.Float64,
+}
+
+
 def run_agreement_study(
-    scenarios: list[str] | tuple[str, ...] = BUNDLED_SCENARIOS, *, frames: int | None = None, stride: int = 1
+    scenarios: Sequence[str | Path | Scenario] = BUNDLED_SCENARIOS, *, frames: int | None = None, stride: int = 1
 ) -> AgreementStudy:
     """Runs the top-view cameras of every USV over ``frames`` frames (default: the scenario's) of each scenario
     and evaluates every other vessel (see the module docstring); every ``stride``-th frame. ``frames`` and
     ``stride`` below 1 raise :class:`~mmusv.errors.ConfigError` (before any scenario is loaded): they evaluated
-    nothing and wrote an empty table."""
+    nothing and wrote an empty table; every scenario is loaded and checked (:func:`load_scenarios`) before the
+    first is run."""
     check_polars("mmusv study agreement")
     check_counts(frames, stride)
     rows: list[dict[str, object]] = []
-    for path in scenarios:
-        sc = load_scenario(resolve_scenario(path))
+    for sc in load_scenarios(scenarios):
         sim = Simulation(sc)
         n = sc.acquisition.frames if frames is None else min(frames, sc.acquisition.frames)
         for k in range(0, n, stride):
@@ -183,19 +227,17 @@ def run_agreement_study(
                                 **r,
                             }
                         )
-    samples = pl.DataFrame(rows) if rows else pl.DataFrame(schema={"map": pl.String, "centre_error_px": pl.Float64})
-    if samples.height == 0:
-        summary = pl.DataFrame(schema={"map": pl.String, "valid_samples": pl.UInt32})
-    else:
-        summary = (
-            samples.group_by("map", maintain_order=True)
-            .agg(
-                pl.len().alias("valid_samples"),
-                pl.col("centre_error_px").median().alias("median_centre_error_px"),
-                pl.col("centroid_error_px").median().alias("median_centroid_error_px"),
-                pl.col("containment").mean().alias("mean_containment"),
-                pl.col("hull_occupancy").mean().alias("mean_hull_occupancy"),
-            )
-            .sort("map")
+    # The same columns with or without samples (an empty table had two columns, its CSV a two-column header).
+    samples = pl.DataFrame(rows, schema=_SAMPLE_SCHEMA)
+    summary = (
+        samples.group_by("map", maintain_order=True)
+        .agg(
+            pl.len().alias("valid_samples"),
+            pl.col("centre_error_px").median().alias("median_centre_error_px"),
+            pl.col("centroid_error_px").median().alias("median_centroid_error_px"),
+            pl.col("containment").mean().alias("mean_containment"),
+            pl.col("hull_occupancy").mean().alias("mean_hull_occupancy"),
         )
+        .sort("map")
+    )
     return AgreementStudy(samples, summary)

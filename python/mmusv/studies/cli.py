@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from mmusv.cli_console import rich_console
-from mmusv.cli_paths import path_arg, ready_output_folder
+from mmusv.cli_paths import check_output_folder, path_arg, ready_output_folder
 
 if TYPE_CHECKING:
     from mmusv.config import Scenario
@@ -29,18 +29,21 @@ def study_waves(args: argparse.Namespace) -> int:
     from mmusv import arguments
     from mmusv.bundled import resolve_scenario
     from mmusv.config import load_scenario
-    from mmusv.studies.waves import run_wave_study
+    from mmusv.studies.waves import PHYSICAL_RECORD_S, check_scenario, run_wave_study
 
     # --frames first, within a scenario's own bound: a bad count made the output folder before it was refused,
     # and 10**30 was a numpy traceback (the copy of the scenario below is not validated).
     if args.frames is not None:
         arguments.whole(args.frames, name="--frames", lo=2, hi=MAX_FRAMES)
     scenario = load_scenario(resolve_scenario(path_arg(args.scenario, flag="--scenario")))
-    ready_output_folder(args.output)
     if args.frames is not None:
         scenario = scenario.model_copy(
             update={"acquisition": scenario.acquisition.model_copy(update={"frames": args.frames})}
         )
+    # The scenario's own checks (a USV, 2 frames) before the output folder: a scenario without USVs left an empty
+    # folder behind, and one of a single frame a table of zeros.
+    check_scenario(scenario, record_s=PHYSICAL_RECORD_S if args.motion == "physical" and args.frames is None else None)
+    ready_output_folder(args.output)
     if args.motion == "physical":
         return _physical_wave_study(scenario, args)
     study = run_wave_study(scenario)
@@ -69,9 +72,9 @@ def _physical_wave_study(scenario: Scenario, args: argparse.Namespace) -> int:
     """``study waves --motion physical``: the table per sea state, then per vessel."""
     from rich.table import Table
 
-    from mmusv.studies.waves import run_physical_wave_study
+    from mmusv.studies.waves import PHYSICAL_RECORD_S, run_physical_wave_study
 
-    study = run_physical_wave_study(scenario, record_s=None if args.frames is not None else 1200.0)
+    study = run_physical_wave_study(scenario, record_s=None if args.frames is not None else PHYSICAL_RECORD_S)
     s = study.summary
     frames, hz = int(s["frames"][0]), scenario.acquisition.frequency_hz
     table = Table(
@@ -126,13 +129,17 @@ def study_agreement(args: argparse.Namespace) -> int:
     writes its files into ``-o``; exit status 0."""
     from rich.table import Table
 
-    from mmusv.studies.agreement import BUNDLED_SCENARIOS, check_counts, run_agreement_study
+    from mmusv.studies.agreement import BUNDLED_SCENARIOS, check_counts, load_scenarios, run_agreement_study
 
     check_counts(args.frames)  # before the output folder is made
     for scenario in args.scenarios:
         path_arg(scenario, flag="scenario")
+    check_output_folder(args.output)
+    # Every scenario loaded and checked (a top-view camera) before the output folder and the first run: a missing
+    # or broken one left an empty folder behind, after the scenarios before it had run.
+    scenarios = load_scenarios(args.scenarios or BUNDLED_SCENARIOS)
     ready_output_folder(args.output)
-    study = run_agreement_study(args.scenarios or BUNDLED_SCENARIOS, frames=args.frames)
+    study = run_agreement_study(scenarios, frames=args.frames)
     table = Table(title="Annotation vs top-view rendering (Table II)")
     for col in (
         "map",

@@ -13,6 +13,7 @@ mixed fleet, one row per vessel and sea state.
 
 from __future__ import annotations
 
+import io
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
@@ -20,12 +21,21 @@ from typing import Literal
 import numpy as np
 import polars as pl
 
-from mmusv.config import Scenario
+from mmusv.config import AcquisitionConfig, Scenario
+from mmusv.errors import ConfigError
 from mmusv.forking import check_polars
+from mmusv.jsonio import write_files_atomic
 from mmusv.motion import scenario_poses
 from mmusv.world.environment import WAVE_PRESETS, wave_height_m
 
-__all__ = ["PAPER_TABLE_I", "PhysicalWaveStudy", "WaveStudy", "run_physical_wave_study", "run_wave_study"]
+__all__ = [
+    "PAPER_TABLE_I",
+    "PhysicalWaveStudy",
+    "WaveStudy",
+    "check_scenario",
+    "run_physical_wave_study",
+    "run_wave_study",
+]
 
 PAPER_TABLE_I: dict[str, tuple[float, float, float]] = {
     "W0": (0.0274, 0.2054, 0.0684),
@@ -39,19 +49,19 @@ PAPER_TABLE_I: dict[str, tuple[float, float, float]] = {
 @dataclass(frozen=True)
 class WaveStudy:
     """Result: ``table`` (one row per wave setting: wave, H_m, heave_rms_m, roll_rms_deg, pitch_rms_deg, usvs,
-    frames) and ``r2`` (R² of a linear fit against H per statistic)."""
+    frames) and ``r2`` (R² of a linear fit against H per statistic; NaN with fewer than 3 settings)."""
 
     table: pl.DataFrame
     r2: dict[str, float]
 
     def write(self, out_dir: Path) -> dict[str, Path]:
-        """Writes ``wave_study.csv`` and ``wave_study.png`` into ``out_dir`` (created); returns their paths."""
-        out_dir.mkdir(parents=True, exist_ok=True)
-        csv = out_dir / "wave_study.csv"
-        self.table.write_csv(csv)
-        png = out_dir / "wave_study.png"
+        """Writes ``wave_study.csv`` and ``wave_study.png`` into ``out_dir`` (created) with
+        :func:`~mmusv.jsonio.write_files_atomic`; returns their paths."""
+        paths = {"csv": out_dir / "wave_study.csv", "png": out_dir / "wave_study.png"}
+        png = io.BytesIO()
         _plot(self, png)
-        return {"csv": csv, "png": png}
+        write_files_atomic({paths["csv"]: self.table.write_csv().encode("utf-8"), paths["png"]: png.getvalue()})
+        return paths
 
 
 def _rms_stats(poses: np.ndarray) -> tuple[float, float, float]:
@@ -68,19 +78,42 @@ def _rms(a: np.ndarray) -> float:
 
 
 def _r2(x: np.ndarray, y: np.ndarray) -> float:
+    """R² of a straight-line fit of ``y`` against ``x``; NaN with fewer than 3 distinct ``x`` (one setting was
+    numpy's RankWarning, two a line through both points, R² = 1 whatever the data)."""
+    if np.unique(x).size < 3:
+        return float("nan")
     slope, intercept = np.polyfit(x, y, 1)
     resid = y - (slope * x + intercept)
     ss_tot = float(np.sum((y - y.mean()) ** 2))
     return 1.0 - float(np.sum(resid**2)) / ss_tot if ss_tot > 0 else 1.0
 
 
-def _usv_indices(scenario: Scenario) -> list[int]:
+def check_scenario(scenario: Scenario, *, record_s: float | None = None) -> list[int]:
+    """The indices of ``scenario``'s USVs; :class:`~mmusv.errors.ConfigError` naming the scenario when it has none,
+    or when the study would record fewer than 2 frames (the scenario's, or ``record_s`` seconds when longer, as
+    :func:`run_physical_wave_study`): heave about each USV's mean over one frame is 0 at every wave setting, and a
+    one-frame scenario gave a table of zeros with R² = 1. The studies' checks, for a caller to make before it
+    prepares anything."""
     usv_idx = [i for i, v in enumerate(scenario.vessels) if v.role == "usv"]
     if not usv_idx:
-        from mmusv.errors import ConfigError
-
-        raise ConfigError("invalid config vessels: the wave study needs at least one vessel with role: usv")
+        raise ConfigError(
+            f"invalid config vessels: scenario {scenario.name!r}: the wave study needs at least one vessel with "
+            "role: usv"
+        )
+    frames = _record_frames(scenario.acquisition, record_s)
+    if frames < 2:
+        raise ConfigError(
+            f"acquisition.frames = {frames}: scenario {scenario.name!r}: the wave study needs at least 2 frames "
+            "(heave is taken about each USV's mean over the sequence); give more frames (--frames N)"
+        )
     return usv_idx
+
+
+def _record_frames(acq: AcquisitionConfig, record_s: float | None) -> int:
+    """The frames a study records: the scenario's, or ``record_s`` seconds at its frequency when longer."""
+    if record_s is not None and record_s * acq.frequency_hz > acq.frames:
+        return round(record_s * acq.frequency_hz)
+    return acq.frames
 
 
 def run_wave_study(
@@ -92,7 +125,7 @@ def run_wave_study(
     """Runs the study on ``scenario``'s USVs for each wave setting (names ``W0``.. or heights in metres), with the
     paper's motion formula (default) or the physical response to the fully developed sea of each setting."""
     check_polars("mmusv study waves")
-    usv_idx = _usv_indices(scenario)
+    usv_idx = check_scenario(scenario)
     scenario = scenario.with_sea(None, motion=motion)
     rows = []
     for w in waves:
@@ -136,11 +169,15 @@ class PhysicalWaveStudy:
         return out
 
     def write(self, out_dir: Path) -> dict[str, Path]:
-        """Writes ``wave_study_physical.csv`` (summary) and ``wave_study_vessels.csv`` into ``out_dir``."""
-        out_dir.mkdir(parents=True, exist_ok=True)
+        """Writes ``wave_study_physical.csv`` (summary) and ``wave_study_vessels.csv`` into ``out_dir`` (created)
+        with :func:`~mmusv.jsonio.write_files_atomic`; returns their paths."""
         paths = {"summary": out_dir / "wave_study_physical.csv", "vessels": out_dir / "wave_study_vessels.csv"}
-        self.summary.write_csv(paths["summary"])
-        self.vessels.write_csv(paths["vessels"])
+        write_files_atomic(
+            {
+                paths["summary"]: self.summary.write_csv().encode("utf-8"),
+                paths["vessels"]: self.vessels.write_csv().encode("utf-8"),
+            }
+        )
         return paths
 
 
@@ -175,10 +212,9 @@ def run_physical_wave_study(
     check_polars("mmusv study waves")
     from mmusv.world.sea_state import SEA_PRESETS
 
-    usv_idx = _usv_indices(scenario)
+    usv_idx = check_scenario(scenario, record_s=record_s)
     acq = scenario.acquisition
-    if record_s is not None and record_s * acq.frequency_hz > acq.frames:
-        frames = round(record_s * acq.frequency_hz)
+    if (frames := _record_frames(acq, record_s)) != acq.frames:
         scenario = scenario.model_copy(update={"acquisition": acq.model_copy(update={"frames": frames})})
     physical = scenario.with_sea(None, motion="physical")
     paper = scenario.with_sea(None, motion="paper")
@@ -220,7 +256,7 @@ def run_physical_wave_study(
 _COLS = ("heave_rms_m", "roll_rms_deg", "pitch_rms_deg")
 
 
-def _plot(study: WaveStudy, path: Path) -> None:
+def _plot(study: WaveStudy, path: Path | io.BytesIO) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -241,5 +277,5 @@ def _plot(study: WaveStudy, path: Path) -> None:
         ax.set_title(f"R² = {study.r2[col]:.4f}", fontsize=9)
         ax.grid(alpha=0.3)
     fig.suptitle("mmusv wave study: USV pose perturbation vs wave setting")
-    fig.savefig(path, dpi=110)
+    fig.savefig(path, dpi=110, format="png")
     plt.close(fig)
