@@ -316,7 +316,9 @@ def _parser() -> argparse.ArgumentParser:
     waves.add_argument(
         "--scenario", default=BUNDLED_WAVE_SCENARIO, help=f"scenario YAML (default {BUNDLED_WAVE_SCENARIO})"
     )
-    waves.add_argument("-o", "--output", default="out/wave_study", help="output folder for CSV and plot")
+    waves.add_argument(
+        "-o", "--output", default="out/wave_study", help="output folder for CSV and plot (default out/wave_study)"
+    )
     waves.add_argument("--frames", type=int, default=None, help="override the scenario's frame count")
     waves.add_argument(
         "--motion",
@@ -326,7 +328,9 @@ def _parser() -> argparse.ArgumentParser:
     )
     agree = studies.add_parser("agreement", help="Table II: 3D-box annotations vs top-view semantic rendering")
     agree.add_argument("scenarios", nargs="*", help="scenario YAMLs (default: the three bundled map scenarios)")
-    agree.add_argument("-o", "--output", default="out/agreement_study", help="output folder")
+    agree.add_argument(
+        "-o", "--output", default="out/agreement_study", help="output folder (default out/agreement_study)"
+    )
     agree.add_argument("--frames", type=int, default=None, help="frames per scenario (default: all)")
     from mmusv.studies.detection.cli import add_parsers as add_detection_parsers
 
