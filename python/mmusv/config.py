@@ -50,6 +50,7 @@ from mmusv.yamlio import mapping_source
 
 __all__ = [
     "MAX_COORDINATE_M",
+    "MAX_FRAMES",
     "MAX_SPEED_MPS",
     "RIG_NAME",
     "SCENARIO_NAME",
@@ -65,6 +66,9 @@ __all__ = [
     "validation_problems",
 ]
 
+
+MAX_FRAMES = 10_000_000
+"""Most frames a scenario may configure (``acquisition.frames``): 23 days at 5 Hz."""
 
 MAX_SPEED_MPS = 100.0
 """Fastest vessel speed a scenario may give, m/s (about 194 knots: past every craft afloat)."""
@@ -242,7 +246,7 @@ class AcquisitionConfig(_Model):
     """Acquisition: ``frequency_hz`` (Δt = 1/f) and the number of ``frames`` (indices 0..frames-1)."""
 
     frequency_hz: float = Field(default=5.0, ge=0.01, le=1000)
-    frames: int = Field(default=100, ge=1, le=10_000_000)
+    frames: int = Field(default=100, ge=1, le=MAX_FRAMES)
 
     def times(self) -> list[float]:
         """Acquisition times t_k = k / f in seconds."""

@@ -165,3 +165,14 @@ def test_a_killed_run_of_its_first_n_frames_is_reported_against_n(tmp_path: Path
     assert code == 0 and f"recovered {len(frames)} of {asked} frames" in out, (out, err)
     manifest = (tmp_path / "killed" / "manifest.json").read_text(encoding="utf-8")
     assert f'"frames_requested": {asked}' in manifest and f'"frames_written": {len(frames)}' in manifest
+
+
+def test_a_plan_out_of_bounds_is_not_believed() -> None:
+    """A damaged manifest record's frame plan (10**18 frames, negative, not a number) is ignored, not iterated:
+    the readers then count against the scenario's acquisition.frames, as for recordings that predate the plan."""
+    from mmusv.recording.info import _planned
+
+    assert _planned({"first_frame": "40", "frames_requested": "30"}) == (40, 30)
+    for first, count in (("0", str(10**18)), ("-1", "5"), ("0", "0"), ("x", "5"), (None, "5")):
+        meta = {"frames_requested": count} if first is None else {"first_frame": first, "frames_requested": count}
+        assert _planned(meta) is None, meta

@@ -340,4 +340,7 @@ def _planned(manifest: dict[str, str]) -> tuple[int, int] | None:
         first, count = int(manifest["first_frame"]), int(manifest["frames_requested"])
     except (KeyError, ValueError):
         return None
-    return (first, count) if first >= 0 and count > 0 else None
+    from mmusv.config import MAX_FRAMES
+
+    ok = 0 <= first <= MAX_FRAMES and 0 < count <= MAX_FRAMES  # a damaged file's 10**18 would be iterated
+    return (first, count) if ok else None

@@ -10,14 +10,12 @@ from typing import TYPE_CHECKING
 
 from mmusv.cli_console import rich_console
 from mmusv.cli_paths import check_output_folder, path_arg, ready_output_folder
+from mmusv.config import MAX_FRAMES  # also the bound of `study waves --frames`
 
 if TYPE_CHECKING:
     from mmusv.config import Scenario
 
 __all__ = ["MAX_FRAMES", "study_agreement", "study_waves"]
-
-MAX_FRAMES = 10_000_000
-"""The most frames a scenario may have (``AcquisitionConfig.frames``): ``study waves --frames`` at most."""
 
 
 def study_waves(args: argparse.Namespace) -> int:
