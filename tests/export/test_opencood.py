@@ -51,6 +51,16 @@ def test_anchors_heights_and_constants_come_from_the_data() -> None:
     c = constants(st)
     assert c["COM_RANGE"] == 510  # the USVs 500 m apart, rounded up to 10 m, plus 10 m
     assert c["GT_RANGE"] == r
+    # OpenCOOD's remove_large_pred_bbx drops a box whose corners span more than the limit in x or y: no listed
+    # vessel may be dropped at any yaw (the 40 x 8 m hull reaches 40.8 m; its length alone, 40 m, dropped it).
+    limit = int(c["remove_large_pred_bbx"].split()[4])
+    spans = []
+    for length, width, _h in st.sizes:
+        for yaw in np.linspace(0.0, np.pi, 721):
+            rot = np.array([[np.cos(yaw), -np.sin(yaw)], [np.sin(yaw), np.cos(yaw)]])
+            xy = np.array([[sx * length / 2, sy * width / 2] for sx in (-1, 1) for sy in (-1, 1)]) @ rot.T
+            spans.append(max(np.ptp(xy[:, 0]), np.ptp(xy[:, 1])))
+    assert max(spans) <= limit < max(spans) + 1
     assert doc["optimizer"]["lr"] == 0.002 and doc["train_params"]["batch_size"] == 4
 
 
