@@ -177,7 +177,10 @@ def run(
     scenario = load_scenario(cfg)
     total = scenario.acquisition.frames if count is None else count
     if not 1 <= total <= scenario.acquisition.frames:
-        raise ConfigError(f"frames = {frames}: must be in 1..{scenario.acquisition.frames} (acquisition.frames)")
+        raise ConfigError(
+            f"frames = {frames} (mmusv run --frames): must be in 1..{scenario.acquisition.frames}, the "
+            f"acquisition.frames of {source}"
+        )
     first = 0
     if span is not None:
         if frames is not None:
@@ -186,7 +189,7 @@ def run(
         if not 0 <= first < total <= scenario.acquisition.frames:
             raise ConfigError(
                 f"frame_range = {span}: must be (first, stop) with 0 <= first < stop <= "
-                f"{scenario.acquisition.frames} (acquisition.frames)"
+                f"{scenario.acquisition.frames}, the acquisition.frames of {source}"
             )
         frame_range = span
     rec_path = recording_path(out, scenario)

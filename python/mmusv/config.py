@@ -25,6 +25,8 @@ import math
 import os
 import re
 import reprlib
+import types
+import typing
 from dataclasses import replace
 from typing import Any, Literal
 
@@ -179,6 +181,8 @@ class EnvironmentConfig(_Model):
         # YAML 1.1 reads an unquoted 13:00 as the sexagesimal integer 780.
         if isinstance(v, int) and not isinstance(v, bool):
             raise ValueError(f'use 24-hour "HH:MM" in quotes, e.g. "16:30" (unquoted, YAML reads it as the number {v})')
+        if not isinstance(v, str):  # 13.5, 13.00 (YAML's float), true, null, a list: not a time either
+            raise ValueError(f'use 24-hour "HH:MM" in quotes, e.g. "16:30", not {_REPR.repr(v)}')
         return v
 
     @field_validator("time_of_day")
@@ -317,6 +321,15 @@ class Scenario(_Model):
     def _cross_checks(self) -> Scenario:
         problems: list[str] = []  # every problem at once (a user fixes them in one go)
         seen: set[str] = set()
+        # A port map's moored ships are labelled moored_00, moored_01, ... beside the scenario's vessels.
+        n_moored = getattr(self.map.params, "n_moored", 0)
+        moored = {f"moored_{k:02d}" for k in range(n_moored)}
+        for i, v in enumerate(self.vessels):
+            if v.id in moored:
+                problems.append(
+                    f"vessels[{i}].id = {v.id!r}: the port map labels its moored ships moored_00..moored_"
+                    f"{n_moored - 1:02d} (map.params.n_moored = {n_moored}); ids must be unique: choose another id"
+                )
         for v in self.vessels:
             if v.id in seen:
                 problems.append(f"vessel id {v.id!r} is used twice; ids must be unique")
@@ -398,10 +411,72 @@ _REPR.maxstring, _REPR.maxother, _REPR.maxlong = 80, 80, 40
 a 3 MB name or a document of aliases is never printed (or walked) whole."""
 
 
-def validation_problems(err: ValidationError, *, root: str = "scenario") -> list[tuple[str, str, str]]:
+def _strip_optional(tp: Any) -> Any:
+    """``tp`` without ``Annotated`` and without ``None`` in a union (``LidarConfig | None`` is ``LidarConfig``)."""
+    while True:
+        if typing.get_origin(tp) is typing.Annotated:
+            tp = typing.get_args(tp)[0]
+        elif typing.get_origin(tp) in (typing.Union, types.UnionType):
+            members = [a for a in typing.get_args(tp) if a is not type(None)]
+            if len(members) != 1:
+                return tp
+            tp = members[0]
+        else:
+            return tp
+
+
+def _model_at(model: type[BaseModel], loc: tuple[int | str, ...], data: Any) -> type[BaseModel] | None:
+    """The model that reads the mapping at ``loc`` (a field path inside ``model``, as in errors), or ``None`` when
+    the path leaves the models; ``data`` (the document, or ``None``) picks the parameters of the map's ``type``."""
+    tp: Any = model
+    for part in loc:
+        tp = _strip_optional(tp)
+        origin, args = typing.get_origin(tp), typing.get_args(tp)
+        if isinstance(tp, type) and issubclass(tp, BaseModel) and isinstance(part, str) and part in tp.model_fields:
+            if tp is MapConfig and part == "params":  # a union of the kinds' models: the map's type picks one
+                kind = data.get("type", "island") if isinstance(data, dict) else None
+                tp = PARAM_MODELS.get(kind) if isinstance(kind, str) else None
+            else:
+                tp = tp.model_fields[part].annotation
+        elif origin is dict and isinstance(part, str) and len(args) == 2:
+            tp = args[1]
+        elif origin is list and isinstance(part, int) and args:
+            tp = args[0]
+        else:
+            return None
+        if isinstance(data, dict):
+            data = data.get(part)
+        elif isinstance(data, list) and isinstance(part, int) and 0 <= part < len(data):
+            data = data[part]
+        else:
+            data = None
+    tp = _strip_optional(tp)
+    return tp if isinstance(tp, type) and issubclass(tp, BaseModel) else None
+
+
+def _unknown_key_hint(model: type[BaseModel], loc: tuple[int | str, ...], data: Any) -> str:
+    """For the unknown key at the end of ``loc``: the closest allowed key and every allowed key, or ``""``."""
+    if not loc or not isinstance(loc[-1], str):
+        return ""
+    where = _model_at(model, loc[:-1], data)
+    if where is None:
+        return ""
+    keys = list(where.model_fields)
+    close = difflib.get_close_matches(loc[-1], keys, n=1, cutoff=0.75)
+    hint = f"did you mean {close[0]!r}? " if close else ""
+    return f"; {hint}allowed keys: {', '.join(keys)}"
+
+
+def validation_problems(
+    err: ValidationError, *, root: str = "scenario", model: type[BaseModel] | None = None, data: Any = None
+) -> list[tuple[str, str, str]]:
     """A pydantic ``ValidationError`` as ``(field path, value shown, what is allowed)`` per problem, the field path
     as in messages (``vessels[2].speed_mps``); a check across fields has the empty path and names the fields in its
-    message; ``root`` names the whole document when a problem has no field but is not such a check."""
+    message; ``root`` names the whole document when a problem has no field but is not such a check. An unknown key
+    of ``model`` (default: :class:`Scenario` for its errors) says the keys allowed there and the closest one;
+    ``data``, the document validated, tells which map ``type``'s parameters ``map.params`` holds."""
+    if model is None and err.title == Scenario.__name__:
+        model = Scenario
     out = []
     for e in err.errors():
         # Pydantic adds the union member or validator name to `loc`; drop the non-field parts.
@@ -411,6 +486,8 @@ def validation_problems(err: ValidationError, *, root: str = "scenario") -> list
         if isinstance(value, (dict, list)) and len(shown) >= 80:
             shown = f"<{type(value).__name__}>"
         msg = str(e["msg"]).removeprefix("Value error, ")
+        if e["type"] == "extra_forbidden" and model is not None:
+            msg += _unknown_key_hint(model, loc, data)
         if not loc and isinstance(value, dict):  # a check across fields: its message names the fields itself
             out.append(("", shown, msg))
             continue
@@ -418,12 +495,15 @@ def validation_problems(err: ValidationError, *, root: str = "scenario") -> list
     return out
 
 
-def validation_error(err: ValidationError, source: str, *, noun: str = "config", root: str = "scenario") -> ConfigError:
+def validation_error(
+    err: ValidationError, source: str, *, noun: str = "config", root: str = "scenario", data: Any = None
+) -> ConfigError:
     """A pydantic ``ValidationError`` as one :class:`ConfigError` line per problem: ``invalid <noun> <field
-    path> = <value>: <what is allowed>``; ``root`` names the whole document when the problem has no field."""
+    path> = <value>: <what is allowed>``; ``root`` names the whole document when the problem has no field; ``data``
+    is the document validated (see :func:`validation_problems`)."""
     lines = [
         f"invalid {noun}: {msg}" if not field else f"invalid {noun} {field} = {shown}: {msg}"
-        for field, shown, msg in validation_problems(err, root=root)
+        for field, shown, msg in validation_problems(err, root=root, data=data)
     ]
     return ConfigError(f"{source}: " + "; ".join(lines))
 
@@ -444,7 +524,7 @@ def load_scenario(source: str | os.PathLike[str] | dict[str, Any] | Scenario) ->
     try:
         return Scenario.model_validate(data)
     except ValidationError as exc:
-        raise validation_error(exc, where) from None
+        raise validation_error(exc, where, data=data) from None
     except MmusvError as exc:  # a validator that checks through the core (wave presets, ...)
         raise located(exc, where) from None
 
