@@ -16,6 +16,15 @@ from mmusv.errors import InputError, IoError
 
 __all__ = ["WorldFrame", "decode_image", "decode_point_cloud"]
 
+_RAW = {
+    "rgb8": np.uint8,
+    "mono8": np.uint8,
+    "8UC1": np.uint8,
+    "16UC1": np.uint16,
+    "mono16": np.uint16,
+    "32FC1": np.float32,
+    "32SC1": np.int32,
+}
 _NUMPY = {1: np.uint8, 2: np.int8, 3: np.uint16, 4: np.int16, 5: np.uint32, 6: np.int32, 7: np.float32, 8: np.float64}
 
 
@@ -32,52 +41,60 @@ def _need(msg: Any, fields: tuple[str, ...], what: str, caller: str) -> None:
 
 
 def decode_image(msg: Any) -> np.ndarray:
-    """A ``foxglove.RawImage`` or ``foxglove.CompressedImage`` (PNG) as a numpy array (``(H, W)`` or ``(H, W, 3)``).
-    Another message is an :class:`~mmusv.errors.InputError`; image bytes that do not decode an
+    """A ``foxglove.RawImage`` or ``foxglove.CompressedImage`` (PNG) as a new, writable numpy array (``(H, W)`` or
+    ``(H, W, 3)``). Another message is an :class:`~mmusv.errors.InputError`; image bytes that do not decode an
     :class:`~mmusv.errors.IoError`."""
     if hasattr(msg, "format"):
         _need(msg, ("data",), "foxglove.CompressedImage", "decode_image")
         try:
-            return np.asarray(Image.open(io.BytesIO(msg.data)))
+            return np.array(Image.open(io.BytesIO(msg.data)))
         except (OSError, ValueError, SyntaxError) as exc:
             raise IoError(f"a compressed image does not decode ({type(exc).__name__}: {exc})") from None
     _need(msg, ("encoding", "width", "height", "step", "data"), "foxglove.RawImage or CompressedImage", "decode_image")
     enc = msg.encoding
-    dtype = {
-        "rgb8": np.uint8,
-        "mono8": np.uint8,
-        "8UC1": np.uint8,
-        "16UC1": np.uint16,
-        "mono16": np.uint16,
-        "32FC1": np.float32,
-        "32SC1": np.int32,
-    }.get(enc)
+    dtype = _RAW.get(enc)
     if dtype is None:
-        raise IoError(f"unsupported image encoding {enc!r}")
+        raise IoError(f"unsupported image encoding {enc!r}; encodings: {', '.join(_RAW)}")
     ch = 3 if enc == "rgb8" else 1
-    try:
-        data = np.frombuffer(msg.data, dtype=np.dtype(dtype).newbyteorder("<"))
-        rows = data.reshape(msg.height, msg.step // np.dtype(dtype).itemsize)
-        img = rows[:, : msg.width * ch]
-        return img.reshape(msg.height, msg.width, 3) if ch == 3 else img
-    except ValueError as exc:
+    size = np.dtype(dtype).itemsize
+    w, h, step = int(msg.width), int(msg.height), int(msg.step)
+    if step < w * ch * size or step % size or len(msg.data) != step * h:
         raise IoError(
-            f"a {enc} image of {msg.width} x {msg.height} (step {msg.step}) does not match its {len(msg.data)} bytes "
-            f"({exc})"
-        ) from None
+            f"a {enc} image of {w} x {h} (step {step}) does not match its {len(msg.data)} bytes (needs step >= "
+            f"{w * ch * size}, a multiple of {size}, and step x height bytes)"
+        )
+    rows = np.frombuffer(msg.data, dtype=np.dtype(dtype).newbyteorder("<")).reshape(h, step // size)
+    img: np.ndarray = rows[:, : w * ch].copy()  # a writable array of its own, not a view of the message's bytes
+    return img.reshape(h, w, 3) if ch == 3 else img
 
 
 def decode_point_cloud(msg: Any) -> dict[str, np.ndarray]:
     """A ``foxglove.PointCloud`` as ``{field name: (N,) array}`` using the packed field offsets (another message is
-    an :class:`~mmusv.errors.InputError`)."""
+    an :class:`~mmusv.errors.InputError`; bytes that are not whole points, or fields that do not fit in a point, an
+    :class:`~mmusv.errors.IoError`)."""
     _need(msg, ("point_stride", "data", "fields"), "foxglove.PointCloud", "decode_point_cloud")
-    stride = msg.point_stride
+    stride = int(msg.point_stride)
     raw = np.frombuffer(msg.data, dtype=np.uint8)
+    if (stride == 0 and raw.size) or (stride and raw.size % stride):
+        raise IoError(
+            f"a point cloud of {raw.size} bytes is not a whole number of points of {stride} bytes (its stride)"
+        )
     n = raw.size // stride if stride else 0
-    rows = raw[: n * stride].reshape(n, stride)
+    rows = raw.reshape(n, stride)
     out: dict[str, np.ndarray] = {}
     for f in msg.fields:
-        dt = np.dtype(_NUMPY[int(f.type)]).newbyteorder("<")
+        kind = _NUMPY.get(int(f.type))
+        if kind is None:
+            raise IoError(
+                f"point cloud field {f.name!r} has type {int(f.type)}; types: {', '.join(map(str, _NUMPY))} "
+                "(UINT8 .. FLOAT64)"
+            )
+        dt = np.dtype(kind).newbyteorder("<")
+        if f.offset + dt.itemsize > stride:
+            raise IoError(
+                f"point cloud field {f.name!r} ({dt.itemsize} bytes at offset {f.offset}) does not fit in its "
+                f"{stride}-byte points"
+            )
         out[f.name] = rows[:, f.offset : f.offset + dt.itemsize].copy().view(dt).reshape(n)
     return out
 

@@ -178,8 +178,11 @@ def recording_name(path: str | os.PathLike[str]) -> str:
 
 def find_recordings(folder: str | os.PathLike[str]) -> list[Path]:
     """The recordings below ``folder``, sorted: every parts manifest and every ``.mcap`` that is not one of a
-    manifest's parts."""
-    root = Path(folder)
+    manifest's parts. ``folder`` must be an existing folder (:class:`~mmusv.errors.IoError` otherwise)."""
+    root = arguments.path(folder, name="folder")
+    if not root.is_dir():
+        what = "does not exist" if not root.exists() else "is not a folder"
+        raise IoError(f"folder = {root} {what}: give a folder holding recordings (.mcap or .parts.json)")
     manifests = sorted(root.rglob("*.parts.json"))
     parts = set()
     for m in manifests:

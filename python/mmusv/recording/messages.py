@@ -87,17 +87,20 @@ def read_messages(
 
 def frame_messages(path: str | Path, frame: int) -> dict[str, Any]:
     """Every decoded message of acquisition index ``frame``, by topic; for a parts manifest, from the part
-    holding ``frame``. Raises :class:`~mmusv.errors.IoError` when the frame is damaged (naming the damage) and
-    :class:`~mmusv.errors.ConfigError` when the recording does not hold it (``frame`` must be a whole number)."""
+    holding ``frame``. Raises :class:`~mmusv.errors.IoError` when the frame is damaged or lost with damaged or
+    missing bytes (naming the damage) and :class:`~mmusv.errors.ConfigError` when the recording does not hold it
+    (``frame`` must be a whole number)."""
     p = recording_arg(path)
     frame = arguments.whole(frame, name="frame")
     if is_parts_manifest(p):
-        for first, stop, part in part_files(p):
+        files = part_files(p)
+        for first, stop, part in files:
             if first <= frame < stop:
                 if part is None:
                     raise ConfigError(f"frame {frame} is not in {p}: its part is not recorded yet")
                 return frame_messages(part, frame)
-        raise ConfigError(f"frame {frame} is not in {p}")
+        held = f"frames {files[0][0]}..{files[-1][1] - 1}" if files else "no frames"
+        raise ConfigError(f"frame = {frame}: not in {p}, which holds {held}")
     info = read_info(p)
     # only the chunks around the frame are decompressed (a negative frame is in no recording: read to say so)
     stream = FrameStream(info, want=lambda _t: True, frames=(frame, frame + 1) if frame >= 0 else None)
@@ -109,5 +112,11 @@ def frame_messages(path: str | Path, frame: int) -> dict[str, Any]:
     bad = [why for k, why in stream.incomplete if k == frame]
     if bad:
         raise IoError(f"frame {frame} of {p} is damaged: {bad[0]}; {stream.truncated}")
+    span, said = FrameStream(info, want=lambda _t: False).expected()  # the frames the run wrote (or set out to)
+    if stream.truncated and frame in span:  # a frame of the run, lost with a damaged chunk or a cut-off end
+        raise IoError(f"frame {frame} of {p} is lost to damage ({stream.truncated})")
     where = f" ({stream.truncated})" if stream.truncated else ""
-    raise ConfigError(f"frame {frame} is not in {p}{where}")
+    held = f"frames {span.start}..{span.stop - 1}" if len(span) else "no frames"
+    raise ConfigError(
+        f"frame = {frame}: not in {p}, {'which holds' if said else 'whose run set out to write'} {held}{where}"
+    )

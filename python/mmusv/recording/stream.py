@@ -17,6 +17,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from mmusv.errors import ConfigError, IoError
 from mmusv.recording.decode import WorldFrame
 from mmusv.recording.info import RecordingInfo
@@ -95,6 +97,8 @@ class FrameStream:
             )
         if not callable(want):
             raise ConfigError(f"want = {want!r:.80}: must be a function of a topic name returning True or False")
+        if isinstance(frames, tuple):  # numpy integers (an index taken from an array) count as ints
+            frames = tuple(int(k) if isinstance(k, np.integer) else k for k in frames)  # type: ignore[assignment]
         if frames is not None and not (
             isinstance(frames, tuple)
             and len(frames) == 2

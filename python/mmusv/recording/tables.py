@@ -12,6 +12,7 @@ qz, qw``), ``boxes_2d`` in pixels (origin top-left). See ``docs/recording.md``.
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -19,7 +20,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import polars as pl
 
-from mmusv.errors import ConfigError
+from mmusv import arguments
+from mmusv.errors import ConfigError, IoError
 from mmusv.forking import check_polars
 
 if TYPE_CHECKING:
@@ -253,18 +255,41 @@ class TableRead:
         return f"table {self.table}: " + "; ".join(parts)
 
 
-def read_table(root: str | os.PathLike[str], table: str, *, expected: range | None = None) -> TableRead:
+def read_table(root: str | os.PathLike[str], table: str, *, expected: range | Sequence[int] | None = None) -> TableRead:
     """The table ``table`` of the tables folder ``root`` (``<root>/<table>/part-*.parquet``), every part that
     reads and has the table's columns; a damaged part is left out and named. ``expected``: the frames the run
     wrote (their absence from the rows is reported in ``missing``; only meaningful for ``world_state``, which
-    has rows in every frame)."""
+    has rows in every frame: a ``range`` or a list of frame numbers). A ``root`` that is not a folder holding
+    tables (a missing path, a file, a run folder instead of its ``tables``) is an :class:`~mmusv.errors.IoError`,
+    not an empty table."""
     check_polars("reading the tables")
+    root = arguments.path(root, name="root")
     if not isinstance(table, str) or table not in SCHEMAS:
         raise ConfigError(f"table = {table!r:.60}: not a table of a recording; tables: {', '.join(SCHEMAS)}")
+    if expected is not None and not (
+        isinstance(expected, range)
+        or (
+            isinstance(expected, (list, tuple))
+            and all(isinstance(k, (int, np.integer)) and not isinstance(k, bool) for k in expected)
+        )
+    ):
+        raise ConfigError(
+            f"expected = {arguments.shown(expected)}: must be the frames the run wrote, a range (range(0, 50)) or a "
+            "list of frame numbers, or None"
+        )
+    if not root.is_dir():
+        what = "does not exist" if not root.exists() else "is not a folder"
+        raise IoError(f"root = {root} {what}: give the tables folder of a run (<run folder>/tables)")
+    # an empty folder is the tables folder of a run that wrote no rows yet; a folder of other things is a mistake
+    if not any((root / t).is_dir() for t in SCHEMAS) and any(root.iterdir()):
+        hint = f"; it holds {root / 'tables'}: give that" if (root / "tables").is_dir() else ""
+        raise IoError(
+            f"root = {root} is not the tables folder of a run: it has none of the folders {', '.join(SCHEMAS)}{hint}"
+        )
     schema = SCHEMAS[table]
     frames: list[pl.DataFrame] = []
     damaged: list[str] = []
-    for part in sorted((Path(root) / table).glob("part-*.parquet")):
+    for part in sorted((root / table).glob("part-*.parquet")):
         try:
             df = pl.read_parquet(part)
         except Exception as exc:  # polars raises several kinds for a damaged file; any means unreadable
