@@ -202,8 +202,8 @@ class FrameRecorder:
                 outputs = a.cameras[name][1].outputs
                 images += _images(topics.camera(a.id, name), topics.camera_frame(a.id, name), img, outputs)
             if ac.top_view is not None and a.rig.top_view is not None:
-                outputs = a.rig.top_view.outputs
-                images += _images(topics.top_view(a.id), topics.top_view_frame(a.id), ac.top_view, outputs)
+                top = a.rig.top_view.outputs
+                images += _images(topics.top_view(a.id), topics.top_view_frame(a.id), ac.top_view, top)
             if images:  # one call per agent: encoded in parallel, written in this order
                 self.encode_seconds += rec.images(log_time_ns=t, images=images)[0]
             if ac.radar is not None:

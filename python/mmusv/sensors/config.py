@@ -9,14 +9,17 @@ added explicitly): the rig for detection datasets, where cameras would cost most
 ``quality: draft`` (or ``high``) on a rig sets the quality of every camera and top view that does not set its own.
 
 Mounts: ``point`` names a mount point of the vessel asset (``lidar``, ``radar``, ``camera_front``, ...; see
-``mmusv assets``); ``xyz`` (metres) and ``rpy_deg`` (degrees) are then relative to that point, in the vessel
-body frame (x forward, y left, z up). Without ``point``, they are relative to the vessel origin (midship, at
-the waterline). Assets without the named point fall back to the top of the hull's bounding box.
+``mmusv assets``); ``xyz`` (metres) and ``rpy_deg`` (degrees) are then relative to that point, in the point's own
+frame (axes of the vessel body frame, x forward, y left, z up, turned by the point's rpy: on ``camera_left``, which
+looks left, ``xyz: [1, 0, 0]`` moves the sensor 1 m to the left). Without ``point``, they are relative to the vessel
+origin (midship, at the waterline), in the vessel body frame. Assets without any mount point fall back to the top
+of the hull's bounding box (a point an asset with mount points lacks is refused).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from typing import Literal, get_args
 
 from pydantic import Field, field_validator, model_validator
@@ -44,6 +47,8 @@ RIG_PRESETS: dict[str, dict[str, object]] = {
 """Defaults each preset puts in place of the paper's full suite (keys given explicitly in the rig win)."""
 
 CameraOutput = Literal["rgb", "depth", "semantic", "instance"]
+TopViewOutput = Literal["rgb", "semantic", "instance"]
+"""A top view's images: a camera's less ``depth`` (the recording has no top-view depth topic)."""
 Quality = Literal["draft", "standard", "high"]
 """Work spent on a camera's RGB: ``draft`` one sample per pixel and water reflecting the sky along each pixel's
 mirror direction; ``standard`` water reflections traced once per 2 × 2 block of water pixels (4 × 4 where the
@@ -51,7 +56,7 @@ water's glossy lobe spans many such blocks) and spread over that lobe, and 4 str
 change of instance, class or material, or a depth step off the water); ``high`` reflections traced for every pixel
 (then spread over the lobe) and 16 samples on edges."""
 _ALL_OUTPUTS: tuple[CameraOutput, ...] = ("rgb", "depth", "semantic", "instance")
-_TOP_OUTPUTS: tuple[CameraOutput, ...] = ("rgb", "semantic", "instance")
+_TOP_OUTPUTS: tuple[TopViewOutput, ...] = get_args(TopViewOutput)
 
 
 class _Model(StrictModel):
@@ -77,6 +82,13 @@ def _check_resolution(v: tuple[int, int]) -> tuple[int, int]:
             f"at most {MAX_IMAGE_PIXELS:,} pixels are allowed"
         )
     return v
+
+
+def _check_outputs(v: Sequence[str], allowed: tuple[str, ...], drop: str) -> None:
+    """``outputs`` of a camera or top view: at least one image (a sensor without any would be rendered for nothing
+    and recorded nowhere)."""
+    if not v:
+        raise ValueError(f"must list at least one of {', '.join(allowed)}; {drop}")
 
 
 class Mount(_Model):
@@ -303,6 +315,12 @@ class CameraConfig(_Model):
 
     _res = field_validator("resolution")(_check_resolution)
 
+    @field_validator("outputs")
+    @classmethod
+    def _outputs(cls, v: list[CameraOutput]) -> list[CameraOutput]:
+        _check_outputs(v, _ALL_OUTPUTS, "to drop the camera, leave it out of cameras (cameras: [] for none)")
+        return v
+
     @field_validator("distortion")
     @classmethod
     def _finite_distortion(
@@ -316,17 +334,24 @@ class CameraConfig(_Model):
 class TopViewConfig(_Model):
     """A level orthographic camera ``altitude_m`` above the water over the USV, looking straight down:
     ``resolution`` pixels at ``metres_per_pixel``; ``heading_up`` puts the USV's bow at the top of the image,
-    ``north_up`` puts north there; ``exposure`` as a camera's (:class:`ExposureConfig`)."""
+    ``north_up`` puts north there; ``outputs`` any of ``rgb``, ``semantic``, ``instance`` (no ``depth``);
+    ``exposure`` as a camera's (:class:`ExposureConfig`)."""
 
     altitude_m: float = Field(default=120.0, gt=0, le=20_000)
     resolution: tuple[int, int] = (512, 512)
     metres_per_pixel: float = Field(default=0.5, ge=0.001, le=1000)
     orientation: Literal["heading_up", "north_up"] = "heading_up"
-    outputs: list[CameraOutput] = Field(default_factory=lambda: list(_TOP_OUTPUTS))
+    outputs: list[TopViewOutput] = Field(default_factory=lambda: list(_TOP_OUTPUTS))
     quality: Quality = "standard"
     exposure: ExposureConfig = ExposureConfig()
 
     _res = field_validator("resolution")(_check_resolution)
+
+    @field_validator("outputs")
+    @classmethod
+    def _outputs(cls, v: list[TopViewOutput]) -> list[TopViewOutput]:
+        _check_outputs(v, _TOP_OUTPUTS, "to drop the top view, set top_view: null")
+        return v
 
 
 _QUALITIES: tuple[str, ...] = get_args(Quality)
