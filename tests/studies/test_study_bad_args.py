@@ -87,3 +87,13 @@ def test_study_detection_with_a_failing_detector_is_one_line(
     assert code == 2
     err = capsys.readouterr().err
     assert err.startswith("mmusv: error: --detector 'os:getcwd'") and "TypeError" in err and "Traceback" not in err
+
+
+def test_waves_names_the_scenario_flag(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """`study waves --scenario /some/folder` said "scenario '...' is a directory, not a file", naming no flag."""
+    from mmusv.cli import main
+
+    rc = main(["study", "waves", "--scenario", str(tmp_path), "-o", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "--scenario: " in err and "is a directory" in err, err
+    assert not (tmp_path / "out").exists()

@@ -27,13 +27,17 @@ def study_waves(args: argparse.Namespace) -> int:
     from mmusv import arguments
     from mmusv.bundled import resolve_scenario
     from mmusv.config import load_scenario
+    from mmusv.errors import MmusvError, located
     from mmusv.studies.waves import PHYSICAL_RECORD_S, check_scenario, run_wave_study
 
     # --frames first, within a scenario's own bound: a bad count made the output folder before it was refused,
     # and 10**30 was a numpy traceback (the copy of the scenario below is not validated).
     if args.frames is not None:
         arguments.whole(args.frames, name="--frames", lo=2, hi=MAX_FRAMES)
-    scenario = load_scenario(resolve_scenario(path_arg(args.scenario, flag="--scenario")))
+    try:  # "scenario '/tmp' is a directory, not a file" did not say which flag gave it
+        scenario = load_scenario(resolve_scenario(path_arg(args.scenario, flag="--scenario")))
+    except MmusvError as exc:
+        raise located(exc, "--scenario") from None
     if args.frames is not None:
         scenario = scenario.model_copy(
             update={"acquisition": scenario.acquisition.model_copy(update={"frames": args.frames})}
