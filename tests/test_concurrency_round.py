@@ -17,24 +17,14 @@ from typing import Any
 
 import pytest
 import yaml
+from tiny_scenario import lidar_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def _lidar(name: str, frames: int = 2) -> dict[str, Any]:
-    """A tiny open-sea scenario: one USV with an 8-channel LiDAR, one target, flat water."""
-    return {
-        "name": name,
-        "seed": 1,
-        "map": {"type": "open_sea", "seed": 0},
-        "acquisition": {"frames": frames},
-        "environment": {"motion": "paper"},
-        "rigs": {"r": {"preset": "lidar_only", "lidar": {"channels": 8, "points_per_second": 20480}}},
-        "vessels": [
-            {"id": "u", "role": "usv", "asset": "usv_wamv", "rig": "r", "speed_mps": 2, "route": [[0, 0], [50, 0]]},
-            {"id": "t", "asset": "fishing_boat_12m", "speed_mps": 3, "route": [[0, 60], [60, 60]]},
-        ],
-    }
+    """The tiny scenario (:func:`tiny_scenario.lidar_scenario`) of ``frames`` frames."""
+    return lidar_scenario(name, frames=frames)
 
 
 def _camera(name: str, frames: int) -> dict[str, Any]:

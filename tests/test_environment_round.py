@@ -17,26 +17,15 @@ from typing import Any
 import mmusv
 import pytest
 import yaml
+from tiny_scenario import lidar_scenario
 
 PYTHONPATH = str(Path(mmusv.__file__).resolve().parents[1])
 TIMEOUT_S = 60
 
 
 def tiny_scenario(name: str = "tiny") -> dict[str, Any]:
-    """One LiDAR-only USV (8 channels) and one target on the open sea, 3 frames: a run takes a fraction of a
-    second after the imports."""
-    return {
-        "name": name,
-        "seed": 1,
-        "map": {"type": "open_sea", "seed": 0},
-        "acquisition": {"frames": 3},
-        "environment": {"motion": "paper"},
-        "rigs": {"r": {"preset": "lidar_only", "lidar": {"channels": 8, "points_per_second": 20480}}},
-        "vessels": [
-            {"id": "u", "role": "usv", "asset": "usv_wamv", "rig": "r", "speed_mps": 2, "route": [[0, 0], [50, 0]]},
-            {"id": "t", "asset": "fishing_boat_12m", "speed_mps": 3, "route": [[0, 60], [60, 60]]},
-        ],
-    }
+    """The tiny scenario of 3 frames: a run takes a fraction of a second after the imports."""
+    return lidar_scenario(name, frames=3)
 
 
 def write_scenario(path: Path, name: str = "tiny") -> Path:

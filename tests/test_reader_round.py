@@ -18,22 +18,12 @@ import numpy as np
 import pytest
 from mmusv.errors import ConfigError, IoError
 from PIL import Image
+from tiny_scenario import lidar_scenario
 
 
 def _tiny(name: str, frames: int = 3) -> dict[str, Any]:
-    """One USV with an 8-channel LiDAR and one target over flat water."""
-    return {
-        "name": name,
-        "seed": 1,
-        "map": {"type": "open_sea", "seed": 0},
-        "acquisition": {"frames": frames},
-        "environment": {"motion": "paper"},
-        "rigs": {"r": {"preset": "lidar_only", "lidar": {"channels": 8, "points_per_second": 20480}}},
-        "vessels": [
-            {"id": "u", "role": "usv", "asset": "usv_wamv", "rig": "r", "speed_mps": 2, "route": [[0, 0], [50, 0]]},
-            {"id": "t", "asset": "fishing_boat_12m", "speed_mps": 3, "route": [[0, 60], [60, 60]]},
-        ],
-    }
+    """The tiny scenario (:func:`tiny_scenario.lidar_scenario`): one USV with an 8-channel LiDAR, one target."""
+    return lidar_scenario(name, frames=frames)
 
 
 @pytest.fixture(scope="module")

@@ -19,28 +19,13 @@ from typing import Any
 import pytest
 import yaml
 from mcap_rechunk import rechunk
+from tiny_scenario import lidar_scenario
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def scenario(name: str, *, frames: int, dense: bool = False, seed: int = 1) -> dict[str, Any]:
-    """An open-sea scenario with one LiDAR-only USV and one target. ``dense``: a 32-channel LiDAR (about 60 kB a
-    frame, so a run of ~100 frames fills the recorder's 4 MiB chunks); else 8 channels (about 7 kB a frame). The
-    paper's motion over flat water keeps these frame sizes (the physical sea's water returns would change them),
-    which the chunk counts and kill timings of the fault tests rely on."""
-    lidar = {"channels": 32, "points_per_second": 327680} if dense else {"channels": 8, "points_per_second": 20480}
-    return {
-        "name": name,
-        "seed": seed,
-        "map": {"type": "open_sea", "seed": 0},
-        "acquisition": {"frames": frames},
-        "environment": {"motion": "paper"},
-        "rigs": {"r": {"preset": "lidar_only", "lidar": lidar}},
-        "vessels": [
-            {"id": "u", "role": "usv", "asset": "usv_wamv", "rig": "r", "speed_mps": 2, "route": [[0, 0], [50, 0]]},
-            {"id": "t", "asset": "fishing_boat_12m", "speed_mps": 3, "route": [[0, 60], [60, 60]]},
-        ],
-    }
+scenario = lidar_scenario
+"""The fault tests' scenario (:func:`tiny_scenario.lidar_scenario`)."""
 
 
 def write_yaml(path: Path, data: dict[str, Any]) -> Path:
