@@ -64,6 +64,20 @@ def test_duplicate_ids_and_missing_rig() -> None:
         load_scenario(minimal(rig="nope"))
 
 
+def test_ids_must_differ_beyond_case() -> None:
+    """Exports name folders after ids: ``usv_1`` and ``USV_1`` would be one folder on macOS and Windows."""
+    data = minimal()
+    data["vessels"].append({**data["vessels"][0], "id": "USV_1", "route": [[0, 50], [100, 50]]})  # type: ignore[attr-defined]
+    with pytest.raises(mmusv.ConfigError) as info:
+        load_scenario(data)
+    msg = str(info.value)
+    assert "vessels[1].id = 'USV_1' differs from vessels[0].id = 'usv_1' only in case" in msg, msg
+    data = minimal()
+    data["vessels"] = [data["vessels"][0], data["vessels"][0]]  # type: ignore[index]
+    with pytest.raises(mmusv.ConfigError, match=r"vessels\[1\]\.id = 'usv_1' is used twice \(vessels\[0\]\)"):
+        load_scenario(data)
+
+
 def test_missing_file_and_bad_yaml(tmp_path: Path) -> None:
     with pytest.raises(mmusv.ConfigError, match="does not exist"):
         load_scenario(tmp_path / "nope.yaml")

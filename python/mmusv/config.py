@@ -320,20 +320,26 @@ class Scenario(_Model):
     @model_validator(mode="after")
     def _cross_checks(self) -> Scenario:
         problems: list[str] = []  # every problem at once (a user fixes them in one go)
-        seen: set[str] = set()
         # A port map's moored ships are labelled moored_00, moored_01, ... beside the scenario's vessels.
         n_moored = getattr(self.map.params, "n_moored", 0)
         moored = {f"moored_{k:02d}" for k in range(n_moored)}
         for i, v in enumerate(self.vessels):
-            if v.id in moored:
+            if v.id.casefold() in moored:
                 problems.append(
                     f"vessels[{i}].id = {v.id!r}: the port map labels its moored ships moored_00..moored_"
                     f"{n_moored - 1:02d} (map.params.n_moored = {n_moored}); ids must be unique: choose another id"
                 )
-        for v in self.vessels:
-            if v.id in seen:
-                problems.append(f"vessel id {v.id!r} is used twice; ids must be unique")
-            seen.add(v.id)
+        first: dict[str, int] = {}  # case-folded id -> index of its first vessel
+        for i, v in enumerate(self.vessels):
+            j = first.setdefault(v.id.casefold(), i)
+            if j != i and self.vessels[j].id == v.id:
+                problems.append(f"vessels[{i}].id = {v.id!r} is used twice (vessels[{j}]); ids must be unique")
+            elif j != i:
+                # Exports name folders and files after ids: on macOS and Windows the two would be one folder.
+                problems.append(
+                    f"vessels[{i}].id = {v.id!r} differs from vessels[{j}].id = {self.vessels[j].id!r} only in "
+                    "case; ids must be unique ignoring case (exports name files and folders after them)"
+                )
             if v.rig is not None and v.rig not in self.rigs:
                 problems.append(
                     f"vessel {v.id!r} names rig {v.rig!r}, which is not defined under rigs: ({sorted(self.rigs)})"

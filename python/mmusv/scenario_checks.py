@@ -108,9 +108,12 @@ def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[st
         )
     samples = scenario_samples(scenario, MapContext(world), spec)
     cons = spec.constraints
-    fail = InWater().check(samples)
-    if fail is not None:
-        raise ConfigError(f"{source}: in_water: {fail}; routes must stay on navigable water (--no-checks skips this)")
+    stranded = InWater().findings(samples)
+    if stranded:
+        # Every vessel that leaves the water, each named by the field to edit.
+        index = {v.id: i for i, v in enumerate(scenario.vessels)}
+        fails = "; ".join(f"{f.message} (vessels[{index[f.vessels[0]]}].route)" for f in stranded)
+        raise ConfigError(f"{source}: in_water: {fails}; routes must stay on navigable water (--no-checks skips this)")
     found: list[str] = []
     for check in (
         ShoreClearance(cons.shore_clearance),

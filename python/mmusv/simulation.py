@@ -76,7 +76,7 @@ _T = TypeVar("_T")
 
 def _built(where: str, kind: str, build: Callable[[], _T]) -> _T:
     """``build()`` (a sensor made from its configuration by the core), its configuration errors naming the field
-    by its path in the scenario (``where``, e.g. ``rigs.usv_standard.cameras[front]``) instead of the core's own
+    by its path in the scenario (``where``, e.g. ``rigs.usv_standard.cameras[1]``) instead of the core's own
     ``kind.`` prefix (``camera.distortion``), so that a rig of several cameras says which one is at fault."""
     try:
         return build()
@@ -206,9 +206,10 @@ class Simulation:
         if rig.radar is not None:
             agent.radar_mount = mount_matrix(asset, rig.radar.mount, where=f"{where}.radar.mount")
             agent.radar = _built(f"{where}.radar", "radar", functools.partial(radar_from_config, rig.radar))
-        for c in rig.cameras:
-            m = mount_matrix(asset, c.mount, where=f"{where}.cameras[{c.name}].mount")
-            camera = _built(f"{where}.cameras[{c.name}]", "camera", functools.partial(camera_from_config, c))
+        for i, c in enumerate(rig.cameras):
+            # The path as the YAML spells it (cameras is a list), as the schema's own errors say it.
+            m = mount_matrix(asset, c.mount, where=f"{where}.cameras[{i}].mount")
+            camera = _built(f"{where}.cameras[{i}]", "camera", functools.partial(camera_from_config, c))
             agent.cameras[c.name] = (camera, c, m)
         if rig.top_view is not None:
             top = functools.partial(top_view_from_config, rig.top_view)
@@ -218,8 +219,9 @@ class Simulation:
 
     def _check_mounts(self, agent: Agent, where: str) -> None:
         """A sensor whose origin lies inside its own hull would see only the hull's inside: refuse it."""
+        index = {f"camera/{c.name}": i for i, c in enumerate(agent.rig.cameras)}
         for key, m in agent.mounts().items():
-            name = f"{where}.cameras[{key[7:]}].mount" if key.startswith("camera/") else f"{where}.{key}.mount"
+            name = f"{where}.cameras[{index[key]}].mount" if key in index else f"{where}.{key}.mount"
             if inside_mesh(agent.asset.mesh.vertices, agent.asset.mesh.faces, m[:3, 3]):
                 xyz = np.round(m[:3, 3], 3).tolist()
                 raise ConfigError(

@@ -211,7 +211,8 @@ def test_a_sensor_the_core_refuses_names_the_rig_and_the_sensor(
     ]
     path = write(tmp_path / "folded.yaml", d)
     err = cli_error(capsys, ["run", str(path), "-o", str(tmp_path / "out")])
-    assert "folded.yaml: invalid config rigs.r.cameras[aft].distortion = [-5.0, 3.0" in err, err
+    # cameras is a list: the path is its index, as the schema's own errors and the YAML spell it
+    assert "folded.yaml: invalid config rigs.r.cameras[1].distortion = [-5.0, 3.0" in err, err
     assert "the distortion folds over" in err
     assert not (tmp_path / "out").exists() or not any((tmp_path / "out").rglob("*.mcap"))
 
@@ -233,6 +234,30 @@ def test_a_route_over_land_is_an_error_unless_checks_are_off(tmp_path: Path) -> 
         warnings.simplefilter("ignore")
         res = mmusv.run(d, out_dir=tmp_path / "o2", checks=False)
     assert res.frames_written == 2
+
+
+def test_every_stranded_route_is_named_by_its_field(tmp_path: Path) -> None:
+    d = tiny(map={"type": "island", "seed": 4})
+    d["vessels"][0]["route"] = [[460, -330], [500, -200]]  # across the islet of island map 4
+    d["vessels"].append({"id": "w", "asset": "fishing_boat_12m", "speed_mps": 3, "route": [[470, -330], [510, -200]]})
+    with pytest.raises(ConfigError) as info:
+        mmusv.run(d, out_dir=tmp_path / "o")
+    msg = str(info.value)
+    assert "u leaves navigable water" in msg and "(vessels[0].route)" in msg, msg
+    assert "w leaves navigable water" in msg and "(vessels[2].route)" in msg, msg
+    assert "t leaves" not in msg, msg
+
+
+def test_a_camera_inside_the_hull_is_named_by_its_index(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    d = tiny()
+    cam = {"resolution": [32, 24], "outputs": ["depth"]}
+    d["rigs"]["r"]["cameras"] = [
+        {**cam, "name": "bow", "mount": {"point": "camera_front"}},
+        {**cam, "name": "aft", "mount": {"xyz": [0.0, 1.0, 0.0]}},  # inside the WAM-V's port pontoon
+    ]
+    path = write(tmp_path / "inside.yaml", d)
+    err = cli_error(capsys, ["run", str(path), "-o", str(tmp_path / "out")])
+    assert "invalid config rigs.r.cameras[1].mount = " in err and "inside the hull" in err, err
 
 
 def test_close_passes_are_warnings(tmp_path: Path) -> None:
