@@ -4,7 +4,8 @@ Decoded images are arrays of their own (writable, like the point clouds); a poin
 not match its layout is an ``IoError`` (not a bare ``KeyError``/``ValueError`` or a silently shortened array);
 ``read_table`` and ``find_recordings`` refuse a path that is not what they read (not an empty result); a frame lost
 to damage is an ``IoError`` from ``frame_messages`` (as its docstring says) and a frame outside the recording names
-the frames it holds; ``FrameStream(frames=...)`` takes numpy integers as ``frame_messages`` does.
+the frames it holds; ``FrameStream(frames=...)`` takes numpy integers as ``frame_messages`` does and refuses a
+range that holds none of the recording's frames.
 """
 
 from __future__ import annotations
@@ -139,3 +140,18 @@ def test_frame_stream_takes_numpy_integers_as_frame_messages_does(run_dir: Path)
     assert [fr.index for fr in FrameStream(info, want=lambda _t: False, frames=(np.int32(2), None))] == [2]
     with pytest.raises(ConfigError, match="frames = "):
         FrameStream(info, want=lambda _t: False, frames=(np.float64(1.0), 2))
+
+
+def test_a_frame_range_outside_the_recording_is_refused_not_an_empty_stream(run_dir: Path) -> None:
+    from mmusv.recording import frame_messages, read_info
+    from mmusv.recording.stream import FrameStream
+
+    info = read_info(run_dir / "tiny.mcap")
+    with pytest.raises(ConfigError, match=r"frames = \(5, 9\): none is in .*tiny\.mcap, which holds frames 0\.\.2"):
+        FrameStream(info, want=lambda _t: False, frames=(5, 9))  # was: no frame, no missing frame, no report
+    with pytest.raises(ConfigError, match=r"frames = \(3, None\): none is in"):
+        FrameStream(info, want=lambda _t: False, frames=(3, None))
+    overlap = FrameStream(info, want=lambda _t: False, frames=(2, 9))  # a range that overlaps is cut to it
+    assert [fr.index for fr in overlap] == [2] and overlap.missing() == [] and overlap.report() is None
+    with pytest.raises(ConfigError, match=r"frame = 4: not in .*tiny\.mcap, which holds frames 0\.\.2"):
+        frame_messages(run_dir / "tiny.mcap", 4)

@@ -139,6 +139,21 @@ def test_run_cut_by_frames_converts_what_it_asked_for(short_rec: Path, tmp_path:
     assert doc["recordings"][0]["skipped"] == []
 
 
+def test_a_frame_range_beyond_every_recording_is_refused_before_writing(
+    coop_rec: Path, short_rec: Path, tmp_path: Path
+) -> None:
+    """``--frames 5:9`` of a 3-frame recording was a 'complete' conversion of nothing ("no complete frame"); it is a
+    ConfigError naming what the recording holds, and no output folder is made."""
+    with pytest.raises(ConfigError, match=r"frames = 5:9: none is in .*export_coop\.mcap, which holds frames 0\.\.2"):
+        convert(coop_rec, out_dir=tmp_path / "o", to="kitti", frames="5:9")
+    assert not (tmp_path / "o").exists()
+    # beside a recording that holds some of the range, the other is noted and left out
+    rep = convert([coop_rec, short_rec], out_dir=tmp_path / "two", to="kitti", frames="2:3", splits=None)
+    notes = {r.folder: " ".join(r.notes) for r in rep.recordings}
+    assert rep.frames == 1 and "which holds frames 0..1: nothing converted" in notes["export_short"], notes
+    assert not (tmp_path / "two" / "export_short").exists()
+
+
 def test_interrupted_run(tmp_path: Path, make_coop: Callable[..., dict[str, Any]]) -> None:
     from mmusv.acquire import recording_path, run
 

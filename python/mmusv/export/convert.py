@@ -325,6 +325,23 @@ def _agent_selection(agents: Iterable[str] | str | None) -> tuple[str, ...] | No
     return tuple(sorted(set(items)))
 
 
+def _outside_frames(infos: list[RecordingInfo], frames: tuple[int, int | None] | None) -> dict[int, str]:
+    """Per recording (index in ``infos``) that holds none of ``frames`` by its run's own account, why; a
+    :class:`~mmusv.errors.ConfigError` before anything is written when no recording holds one."""
+    if frames is None:
+        return {}
+    out: dict[int, str] = {}
+    for j, info in enumerate(infos):
+        try:
+            FrameStream(info, lambda _t: False, frames=frames)  # refuses a range outside what the run wrote
+        except ConfigError as exc:
+            out[j] = str(exc).split(": ", 1)[1]
+    if out and len(out) == len(infos):
+        stop = "" if frames[1] is None else frames[1]
+        raise ConfigError(f"frames = {frames[0]}:{stop}: " + "; ".join(out[j] for j in sorted(out)))
+    return out
+
+
 def _frames_to_read(info: RecordingInfo, options: Options) -> int:
     """How many frames of ``info`` the conversion reads (for its progress): those written, in ``options.frames``."""
     first = int(info.run.get("first_frame", 0) or 0)
@@ -450,6 +467,7 @@ def convert(
         cls.check(i)
     if options.agents is not None:
         _check_agents(cls, infos, options.agents)
+    outside = _outside_frames(infos, options.frames)
     folders = _folders(infos)
     split_of: dict[str, str | None] = dict.fromkeys(folders)
     if ratios is not None:
@@ -488,6 +506,10 @@ def convert(
             )
             for j in order:
                 info, rep = infos[j], reports[j]
+                if j in outside:  # none of its frames is in --frames (another recording's are)
+                    rep.status = info.run.get("status", "unfinished (no run metadata)")
+                    rep.notes.append(f"{outside[j]}: nothing converted")
+                    continue
                 folder = work / rep.split / rep.folder if rep.split else work / rep.folder
                 if cls.owns_folder:
                     sink.mkdir(folder)

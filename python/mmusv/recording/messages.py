@@ -102,6 +102,10 @@ def frame_messages(path: str | Path, frame: int) -> dict[str, Any]:
         held = f"frames {files[0][0]}..{files[-1][1] - 1}" if files else "no frames"
         raise ConfigError(f"frame = {frame}: not in {p}, which holds {held}")
     info = read_info(p)
+    span, said = FrameStream(info, want=lambda _t: False).expected()  # the frames the run wrote (or set out to)
+    if said and frame not in span:
+        held = f"frames {span.start}..{span.stop - 1}" if len(span) else "no frames"
+        raise ConfigError(f"frame = {frame}: not in {p}, which holds {held}")
     # only the chunks around the frame are decompressed (a negative frame is in no recording: read to say so)
     stream = FrameStream(info, want=lambda _t: True, frames=(frame, frame + 1) if frame >= 0 else None)
     for fr in stream:
@@ -112,7 +116,6 @@ def frame_messages(path: str | Path, frame: int) -> dict[str, Any]:
     bad = [why for k, why in stream.incomplete if k == frame]
     if bad:
         raise IoError(f"frame {frame} of {p} is damaged: {bad[0]}; {stream.truncated}")
-    span, said = FrameStream(info, want=lambda _t: False).expected()  # the frames the run wrote (or set out to)
     if stream.truncated and frame in span:  # a frame of the run, lost with a damaged chunk or a cut-off end
         raise IoError(f"frame {frame} of {p} is lost to damage ({stream.truncated})")
     where = f" ({stream.truncated})" if stream.truncated else ""

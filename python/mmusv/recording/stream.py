@@ -132,6 +132,12 @@ class FrameStream:
         """Chunks hopped over unread because they hold no frame of :attr:`frames`."""
         self._missing_parts: list[tuple[int, int, str]] = []
         self._ended = False
+        span, said = self._expected_all()
+        if frames is not None and said and not self._in_range(span.start, span.stop - 1):
+            # The run said which frames it wrote and none is in the range: an empty stream would look like a
+            # recording without frames.
+            held = f"frames {span.start}..{span.stop - 1}" if len(span) else "no frames"
+            raise ConfigError(f"frames = {frames!r}: none is in {info.path}, which holds {held}")
 
     def _index(self, log_time_ns: int, world: WorldFrame | None) -> int:
         if world is not None:
