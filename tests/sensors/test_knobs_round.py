@@ -1,6 +1,6 @@
 """Rig knobs a researcher sets by mistake are refused by name: a top view asked for ``depth`` (it has no depth
-topic; it used to be recorded under an undocumented ``/{agent}/top_view/depth``), and a camera or top view with
-no ``outputs`` at all (it used to be rendered every frame and recorded nowhere)."""
+topic; it used to be recorded under an undocumented ``/{agent}/top_view/depth``), a camera or top view with
+no ``outputs`` at all (it used to be rendered every frame and recorded nowhere) or with one listed twice."""
 
 from __future__ import annotations
 
@@ -54,6 +54,16 @@ def test_no_outputs_is_refused(model: type[CameraConfig] | type[TopViewConfig]) 
             {"cameras": [{"name": "a", "mount": {"point": "camera_front"}, "outputs": []}]},
             "rigs.usv_standard.cameras[0].outputs = []: must list at least one of rgb, depth, semantic, instance; "
             "to drop the camera, leave it out of cameras (cameras: [] for none)",
+        ),
+        (  # was accepted, and the sensors metadata listed the image twice
+            {"cameras": [{"name": "a", "mount": {"point": "camera_front"}, "outputs": ["depth", "semantic", "depth"]}]},
+            "rigs.usv_standard.cameras[0].outputs = ['depth', 'semantic', 'depth']: lists depth more than once; list "
+            "each output once (of rgb, depth, semantic, instance)",
+        ),
+        (
+            {"top_view": {"outputs": ["semantic", "semantic"]}},
+            "rigs.usv_standard.top_view.outputs = ['semantic', 'semantic']: lists semantic more than once; list each "
+            "output once (of rgb, semantic, instance)",
         ),
     ],
 )

@@ -430,7 +430,7 @@ def test_mount_inside_hull_is_refused(make_scenario: Any) -> None:
     )
     sc = make_scenario()
     sc["rigs"]["rn"]["cameras"][0]["mount"] = {"xyz": [0.0, 0.0, 1.0]}
-    with pytest.raises(mmusv.ConfigError, match=r"rigs\.rn\.cameras\[front\]\.mount"):
+    with pytest.raises(mmusv.ConfigError, match=r"rigs\.rn\.cameras\[0\]\.mount"):
         Simulation(sc)
     sc = make_scenario()
     sc["rigs"]["rn"]["lidar"]["mount"] = {"xyz": [0.0, 0.0, 1.0]}
@@ -449,7 +449,7 @@ def test_mount_inside_monohull_is_refused(make_scenario: Any, z: float) -> None:
     sc = make_scenario()
     assert sc["vessels"][0]["asset"] == "usv_patrol_12m" and sc["vessels"][0]["rig"] == "r"
     sc["rigs"]["r"]["cameras"][0]["mount"] = {"xyz": [0.0, 0.0, z]}
-    with pytest.raises(mmusv.ConfigError, match=r"rigs\.r\.cameras\[front\]\.mount"):
+    with pytest.raises(mmusv.ConfigError, match=r"rigs\.r\.cameras\[0\]\.mount"):
         Simulation(sc)
 
 

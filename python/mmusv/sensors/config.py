@@ -86,9 +86,13 @@ def _check_resolution(v: tuple[int, int]) -> tuple[int, int]:
 
 def _check_outputs(v: Sequence[str], allowed: tuple[str, ...], drop: str) -> None:
     """``outputs`` of a camera or top view: at least one image (a sensor without any would be rendered for nothing
-    and recorded nowhere)."""
+    and recorded nowhere), each once."""
     if not v:
         raise ValueError(f"must list at least one of {', '.join(allowed)}; {drop}")
+    twice = sorted({o for o in v if v.count(o) > 1})
+    if twice:
+        # Each image is rendered and recorded once: a repeat would be a second topic of the same name.
+        raise ValueError(f"lists {', '.join(twice)} more than once; list each output once (of {', '.join(allowed)})")
 
 
 class Mount(_Model):
@@ -305,7 +309,9 @@ class CameraConfig(_Model):
     name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$")
     resolution: tuple[int, int] = (640, 480)
     hfov_deg: float = Field(default=90.0, ge=0.1, lt=180)
-    outputs: list[CameraOutput] = Field(default_factory=lambda: list(_ALL_OUTPUTS))
+    outputs: list[CameraOutput] = Field(
+        default_factory=lambda: list(_ALL_OUTPUTS), json_schema_extra={"uniqueItems": True}
+    )
     range_m: float = Field(default=5000.0, gt=0, le=1e6)
     mount: Mount = Mount()
     quality: Quality = "standard"
@@ -341,7 +347,9 @@ class TopViewConfig(_Model):
     resolution: tuple[int, int] = (512, 512)
     metres_per_pixel: float = Field(default=0.5, ge=0.001, le=1000)
     orientation: Literal["heading_up", "north_up"] = "heading_up"
-    outputs: list[TopViewOutput] = Field(default_factory=lambda: list(_TOP_OUTPUTS))
+    outputs: list[TopViewOutput] = Field(
+        default_factory=lambda: list(_TOP_OUTPUTS), json_schema_extra={"uniqueItems": True}
+    )
     quality: Quality = "standard"
     exposure: ExposureConfig = ExposureConfig()
 
