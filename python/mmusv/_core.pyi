@@ -99,7 +99,8 @@ class Scene:
         ``classes`` (1,) or (F,) uint16, ``materials`` None, (1,) or (F,) uint16 ids into the material table;
         returns the mesh id."""
     def set_materials(self, table: npt.NDArray[np.float32]) -> None:
-        """Sets the material table (M, 9) float32: r, g, b, roughness, metallic, er, eg, eb, nav_light."""
+        """Sets the material table (M, 11) float32: r, g, b, roughness, metallic, er, eg, eb, nav_light, arc centre
+        and half-width (degrees, body frame: 0 right ahead, +90 to port; 180 all round)."""
     @property
     def num_materials(self) -> int:
         """Rows of the material table."""

@@ -305,13 +305,18 @@ class Scene:
         return int(self._native.add_mesh(v, f, np.ascontiguousarray(c, dtype=np.uint16), name, m))
 
     def set_materials(self, table: npt.ArrayLike) -> None:
-        """Sets the material table: ``(M, 9)`` float rows ``r, g, b, roughness, metallic, er, eg, eb, nav_light``
-        (linear base colour and roughness, metallic in [0, 1]; emitted radiance in cd/m²; nav_light 0 or 1, a
-        light that glows only on instances whose lights are on). Row 0 is never read (material id 0 means none).
-        :func:`mmusv.world.materials.material_table` gives the library's."""
+        """Sets the material table: ``(M, 11)`` float rows ``r, g, b, roughness, metallic, er, eg, eb, nav_light,
+        arc_centre, arc_half`` (linear base colour and roughness, metallic in [0, 1]; emitted radiance in cd/m²;
+        nav_light 0 or 1, a light that glows only on instances whose lights are on and only towards bearings
+        within its arc: centre in [-180, 180] and half-width in (0, 180] degrees in the instance's body frame, 0
+        right ahead and +90 to port, 180 all round). ``(M, 9)`` rows (without the arc) light all round. Row 0 is
+        never read (material id 0 means none). :func:`mmusv.world.materials.material_table` gives the library's."""
         t = np.ascontiguousarray(_floats(table, name="materials"), dtype=np.float32)
-        if t.ndim != 2 or t.shape[1] != 9:
-            raise InputError(f"materials must have shape (M, 9), got {t.shape}")
+        if t.ndim != 2 or t.shape[1] not in (9, 11):
+            raise InputError(f"materials must have shape (M, 11) or (M, 9) (lights all round), got {t.shape}")
+        if t.shape[1] == 9:
+            arcs = np.tile(np.array([0.0, 180.0], dtype=np.float32), (t.shape[0], 1))
+            t = np.ascontiguousarray(np.hstack([t, arcs]))
         self._native.set_materials(t)
 
     @property

@@ -77,9 +77,9 @@ def test_table_has_the_named_materials_and_id_zero_is_the_class_default() -> Non
 
 def test_table_rows_are_the_materials() -> None:
     t = material_table()
-    assert t.dtype == np.float32 and t.shape == (len(all_materials()), 9) and len(all_materials()) >= BUILTIN_COUNT
+    assert t.dtype == np.float32 and t.shape == (len(all_materials()), 11) and len(all_materials()) >= BUILTIN_COUNT
     for i, m in enumerate(MATERIALS):
-        want = [*m.base_color, m.roughness, m.metallic, *m.emissive, float(m.nav_light)]
+        want = [*m.base_color, m.roughness, m.metallic, *m.emissive, float(m.nav_light), *m.arc_deg]
         np.testing.assert_allclose(t[i], want, rtol=1e-6)
     assert np.all((t[:, :3] >= 0) & (t[:, :3] <= 1)) and np.all((t[:, 3] >= 0.02) & (t[:, 3] <= 1))
 
@@ -111,6 +111,9 @@ def test_unknown_name_lists_the_known_ones() -> None:
         ({"metallic": 1.5}, "metallic"),
         ({"emissive": (-1.0, 0.0, 0.0)}, "emissive"),
         ({"roughness": float("nan")}, "roughness"),
+        ({"arc_deg": (0.0, 0.0)}, "arc_deg"),
+        ({"arc_deg": (270.0, 45.0)}, "arc_deg"),
+        ({"arc_deg": (0.0,)}, "arc_deg"),
     ],
 )
 def test_material_checks_its_fields(kwargs: dict[str, object], field: str) -> None:
@@ -125,7 +128,7 @@ def test_register_same_material_twice_gives_the_same_id() -> None:
     i = register_material(m)
     assert i >= BUILTIN_COUNT and register_material(Material("test_reg:paint", (0.1, 0.2, 0.3), 0.4, 0.0)) == i
     assert material_id("test_reg:paint") == i and all_materials()[i] == m
-    np.testing.assert_allclose(material_table()[i], [0.1, 0.2, 0.3, 0.4, 0, 0, 0, 0, 0], rtol=1e-6)
+    np.testing.assert_allclose(material_table()[i], [0.1, 0.2, 0.3, 0.4, 0, 0, 0, 0, 0, 0, 180], rtol=1e-6)
     with pytest.raises(ConfigError, match="already registered"):
         register_material(Material("test_reg:paint", (0.9, 0.2, 0.3), 0.4, 0.0))
     assert register_material(MATERIALS[3]) == 3

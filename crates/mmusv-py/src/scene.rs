@@ -199,8 +199,9 @@ impl Scene {
         self.write(|s| s.add_mesh(mesh))
     }
 
-    /// Sets the material table `(M, 9)` float32, one row per material: r, g, b (linear base colour),
-    /// roughness, metallic, er, eg, eb (emitted radiance, cd/m²), nav_light (0 or 1). Row 0 is never read.
+    /// Sets the material table `(M, 11)` float32, one row per material: r, g, b (linear base colour),
+    /// roughness, metallic, er, eg, eb (emitted radiance, cd/m²), nav_light (0 or 1), the light's arc centre and
+    /// half-width (degrees, body frame: 0 right ahead, +90 to port; 180 all round). Row 0 is never read.
     fn set_materials(&self, table: PyReadonlyArray2<'_, f32>) -> PyResult<()> {
         let rows = rows::<f32, { mmusv_core::material::COLUMNS }>(&table, "materials")?;
         let mats = rows

@@ -15,7 +15,10 @@ and waves.
   sea of the scenario's significant height. Pierson & Moskowitz (1964) give it at 19.5 m (their weather ships'
   anemometers), ``U₁₉.₅ = √(H g / 0.21)``; the whitecaps (Monahan) and the water's slopes (Cox & Munk) take the
   10 m wind, ``U₁₀ = U₁₉.₅ / 1.026`` (Stewart, R. H. (2008), *Introduction to Physical Oceanography*, §16.4, for a
-  drag coefficient of 1.3·10⁻³).
+  drag coefficient of 1.3·10⁻³; a neutral log profile of that drag coefficient would give 1.060 instead, 3 % less
+  wind at 10 m: the published ratio is kept, as the oceanographic references quote it). Cox & Munk's fit was to
+  the wind at 12.5 m (their anemometer), 1–2 % above the 10 m wind; taking it at 10 m makes their mean square
+  slope about 1 % smaller.
 * **Water body**: diffuse reflectance (linear RGB) of clear open-ocean water, blue (Morel 1988's case-1 water:
   a few per cent in the blue, well under one in the red).
 """

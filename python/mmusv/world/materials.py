@@ -2,9 +2,12 @@
 
 A :class:`Material` is a metallic-roughness PBR description (the glTF 2.0 model): linear-RGB albedo
 ``base_color`` in [0, 1], perceptual ``roughness`` in [0.02, 1] (the GGX alpha is ``roughness**2``), ``metallic``
-in [0, 1], ``emissive`` radiance (linear RGB, cd/m² scale; a lit navigation lamp is about 2e4) and ``nav_light``
-(the lamp emits only on vessels under way, COLREG lights). A material's id is its index in the table; id 0 is
-``class_default``: the shading falls back to the semantic class colour (maps, user meshes without materials).
+in [0, 1], ``emissive`` radiance (linear RGB, cd/m² scale; a lit navigation lamp is about 2e4), ``nav_light``
+(the lamp emits only on vessels under way, COLREG lights) and a lamp's horizontal ``arc_deg`` (centre bearing and
+half-width in the vessel's body frame, 0 right ahead and +90 to port; COLREG 1972 Rule 21: masthead 225°,
+sidelights 112.5° each from right ahead to 22.5° abaft the beam, sternlight 135° about right astern). A
+material's id is its index in the table; id 0 is ``class_default``: the shading falls back to the semantic class
+colour (maps, user meshes without materials).
 
 The built-in values are typical PBR values from common PBR charts (the Physically Based database,
 physicallybased.info; the Substance/Allegorithmic PBR guide's albedo chart; glTF sample materials) converted to
@@ -12,7 +15,7 @@ linear RGB, rounded: dielectric paints and plastics have albedo 0.02-0.85 and me
 measured specular colour with metallic 1. They are plausible, not measured on a particular ship.
 
 User meshes (glTF/GLB through trimesh, :mod:`mmusv.world.vessels`) add theirs with :func:`register_material`;
-:func:`material_table` is the ``(M, 9)`` float32 array the renderer takes (:meth:`mmusv.Scene.set_materials`).
+:func:`material_table` is the ``(M, 11)`` float32 array the renderer takes (:meth:`mmusv.Scene.set_materials`).
 """
 
 from __future__ import annotations
@@ -55,6 +58,9 @@ class Material:
     """Emitted radiance, linear RGB, cd/m² scale (a lit navigation lamp is about 2e4)."""
     nav_light: bool = False
     """True: emits only on vessels under way (COLREG lights)."""
+    arc_deg: tuple[float, float] = (0.0, 180.0)
+    """A lamp's horizontal arc: centre bearing in [-180, 180] and half-width in (0, 180] degrees, body frame (0
+    right ahead, +90 to port); (0, 180) is all round. Read for ``nav_light`` materials only."""
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name.strip():
@@ -77,10 +83,21 @@ class Material:
         object.__setattr__(self, "roughness", rough)
         object.__setattr__(self, "metallic", metal)
         object.__setattr__(self, "nav_light", bool(self.nav_light))
+        try:
+            centre, half = (_number(v, f"{where}.arc_deg") for v in self.arc_deg)
+        except (TypeError, ValueError):
+            raise ConfigError(f"{where}.arc_deg: must be [centre, half-width] degrees, got {self.arc_deg!r}") from None
+        if not (-180.0 <= centre <= 180.0 and 0.0 < half <= 180.0):
+            raise ConfigError(
+                f"{where}.arc_deg: centre must be in [-180, 180] and half-width in (0, 180] degrees, got "
+                f"{[centre, half]}"
+            )
+        object.__setattr__(self, "arc_deg", (centre, half))
 
     def row(self) -> tuple[float, ...]:
-        """The material as the 9 numbers of a :func:`material_table` row."""
-        return (*self.base_color, self.roughness, self.metallic, *self.emissive, 1.0 if self.nav_light else 0.0)
+        """The material as the 11 numbers of a :func:`material_table` row."""
+        nav = 1.0 if self.nav_light else 0.0
+        return (*self.base_color, self.roughness, self.metallic, *self.emissive, nav, *self.arc_deg)
 
 
 def _number(value: object, where: str) -> float:
@@ -110,8 +127,9 @@ def _m(
     metallic: float = 0.0,
     emissive: tuple[float, float, float] = (0.0, 0.0, 0.0),
     nav: bool = False,
+    arc_deg: tuple[float, float] = (0.0, 180.0),
 ) -> Material:
-    return Material(name, rgb, roughness, metallic, emissive, nav)
+    return Material(name, rgb, roughness, metallic, emissive, nav, arc_deg)
 
 
 _L = NAV_LAMP_RADIANCE
@@ -172,13 +190,14 @@ MATERIALS: tuple[Material, ...] = (
     _m("rope_canvas", (0.50, 0.45, 0.35), 0.9),
     # sensors
     _m("sensor_housing", (0.06, 0.06, 0.065), 0.35),  # dark plastic radome / LiDAR housing
-    # COLREG navigation lights: emissive only on vessels under way
-    _m("nav_masthead_white", (0.80, 0.80, 0.80), 0.1, 0.0, (_L, _L, 0.92 * _L), True),
-    # COLREG sidelights: red, and a bluish green, with no light at all in the other channels (a faint share there
-    # would still saturate under a night exposure and draw the lamp white).
-    _m("nav_port_red", (0.60, 0.02, 0.02), 0.1, 0.0, (_L, 0.0, 0.0), True),
-    _m("nav_starboard_green", (0.02, 0.50, 0.20), 0.1, 0.0, (0.0, _L, 0.45 * _L), True),
-    _m("nav_stern_white", (0.80, 0.80, 0.80), 0.1, 0.0, (_L, _L, 0.92 * _L), True),
+    # COLREG navigation lights: emissive only on vessels under way, across their Rule 21 arcs
+    _m("nav_masthead_white", (0.80, 0.80, 0.80), 0.1, 0.0, (_L, _L, 0.92 * _L), True, (0.0, 112.5)),
+    # COLREG sidelights: red, and a bluish green inside Annex I §7's green area (CIE x, y = 0.265, 0.475), with no
+    # light at all in the other channels (a faint share there would still saturate under a night exposure and draw
+    # the lamp white).
+    _m("nav_port_red", (0.60, 0.02, 0.02), 0.1, 0.0, (_L, 0.0, 0.0), True, (56.25, 56.25)),
+    _m("nav_starboard_green", (0.02, 0.50, 0.20), 0.1, 0.0, (0.0, _L, 0.3 * _L), True, (-56.25, 56.25)),
+    _m("nav_stern_white", (0.80, 0.80, 0.80), 0.1, 0.0, (_L, _L, 0.92 * _L), True, (180.0, 67.5)),
 )
 """The built-in materials; a material's id is its index (:func:`all_materials` adds the registered ones)."""
 
@@ -225,8 +244,8 @@ def register_material(m: Material) -> int:
 
 
 def material_table() -> np.ndarray:
-    """``(M, 9)`` float32, one row per material id: r, g, b (linear albedo), roughness, metallic, er, eg, eb
-    (emitted radiance, cd/m² scale), nav_light (0/1)."""
+    """``(M, 11)`` float32, one row per material id: r, g, b (linear albedo), roughness, metallic, er, eg, eb
+    (emitted radiance, cd/m² scale), nav_light (0/1), arc centre and half-width (degrees, body frame)."""
     with _lock:
         rows = [m.row() for m in _all]
-    return np.asarray(rows, dtype=np.float32).reshape(-1, 9)
+    return np.asarray(rows, dtype=np.float32).reshape(-1, 11)

@@ -49,11 +49,25 @@ pub(crate) fn surface_at(
         class: hits.class[k],
         instance,
         material: scene.material_index(instance, triangle),
-        lights_on: scene.instances().get(instance as usize).is_some_and(|i| i.lights_on()),
+        lights_on: lamp_lit(scene, instance, triangle, d),
         shading_normal: normal,
         unresolved_mss: 0.0,
     };
     Some(shader.with_swell(d, hit))
+}
+
+/// Whether a navigation lamp hit along `d` shines towards the viewer: its instance's lights are on and the
+/// direction back to the viewer lies in the lamp's arc ([`crate::material::Material::emits_towards`], COLREG Rule
+/// 21). Other materials emit whenever the instance's lights are on.
+#[inline]
+fn lamp_lit(scene: &Scene, instance: i32, triangle: i32, d: Vec3) -> bool {
+    let Some(inst) = usize::try_from(instance).ok().and_then(|i| scene.instances().get(i)) else {
+        return false;
+    };
+    inst.lights_on()
+        && scene
+            .material_of(instance, triangle)
+            .is_none_or(|m| !m.nav_light || m.emits_towards(inst.pose().inverse_transform_vector(-d)))
 }
 
 /// Where a shadow ray from the hit of ray `k` starts (just off the surface, on the camera's side), if that hit

@@ -45,5 +45,12 @@ pub fn class_material(hit: &SurfaceHit) -> Material {
         11 => (Vec3::new(0.15, 0.45, 0.45), 0.4, 0.0),
         _ => (Vec3::splat(0.3), 0.7, 0.0),
     };
-    Material { base_color: base.to_array(), roughness, metallic, emissive: [0.0; 3], nav_light: false }
+    Material {
+        base_color: base.to_array(),
+        roughness,
+        metallic,
+        emissive: [0.0; 3],
+        nav_light: false,
+        arc_deg: [0.0, 180.0],
+    }
 }

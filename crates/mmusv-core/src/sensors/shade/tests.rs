@@ -25,7 +25,14 @@ fn table(m: Material) -> Arc<Vec<Material>> {
 #[test]
 fn lambert_plane_under_the_sun_is_albedo_times_irradiance_over_pi() {
     let env = ShadeEnv { fog_extinction_per_m: 0.0, ..ShadeEnv::default() };
-    let m = Material { base_color: [0.5; 3], roughness: 1.0, metallic: 0.0, emissive: [0.0; 3], nav_light: false };
+    let m = Material {
+        base_color: [0.5; 3],
+        roughness: 1.0,
+        metallic: 0.0,
+        emissive: [0.0; 3],
+        nav_light: false,
+        arc_deg: [0.0, 180.0],
+    };
     let sh = Shader::new(&env, 1, &[]).with_materials(table(m));
     // The specular part of a rough dielectric is small; compare the diffuse share in closed form.
     let lit = sh.surface(-Vec3::Z, &hit(2, 1), true);
@@ -49,6 +56,7 @@ fn nav_lights_glow_only_when_on_and_fog_veils() {
         metallic: 0.0,
         emissive: [2e4, 0.0, 0.0],
         nav_light: true,
+        arc_deg: [56.25, 56.25],
     };
     let sh = Shader::new(&env, 1, &[]).with_materials(table(lamp));
     let off = sh.surface(-Vec3::X, &SurfaceHit { normal: Vec3::X, ..hit(10, 1) }, false);
