@@ -212,6 +212,13 @@ def test_cut_before_any_frame(coop_rec: Path, tmp_path: Path) -> None:
     assert rep.frames == 0 and rep.skipped and "nothing written" in " ".join(rep.recordings[0].notes)
     assert not (tmp_path / "o" / "export_coop").exists()
     assert export_cli.run(parse([str(cut), "-o", str(tmp_path / "o2"), "--no-progress"])) == 1
+    # over a good conversion, --overwrite that converts nothing keeps it (it used to replace it with an empty one)
+    good = convert(coop_rec, out_dir=tmp_path / "good", splits=None)
+    before = tree(tmp_path / "good")
+    with pytest.raises(IoError, match=r"nothing converted: no complete frame in .*x\.mcap\.partial; .*good keeps"):
+        convert(cut, out_dir=tmp_path / "good", splits=None, overwrite=True)
+    assert good.frames == 3 and tree(tmp_path / "good") == before
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith(".")) == []  # no staging folder left
 
 
 # ---------------------------------------------------------------------------------------------- splits

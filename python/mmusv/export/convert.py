@@ -573,6 +573,12 @@ def convert(
                     rep.notes.append("no complete frame: nothing written for this recording")
                     if cls.owns_folder:
                         shutil.rmtree(folder, ignore_errors=True)
+            if report.frames == 0 and work != out:
+                # --overwrite with nothing to show for it: the previous conversion stays (the staging folder goes)
+                raise IoError(
+                    f"nothing converted: no complete frame in {', '.join(str(r.path) for r in reports)}; "
+                    f"{out} keeps its previous conversion"
+                )
             cls.finish_all(shared, work, sink)
             doc = {
                 **header,

@@ -63,14 +63,16 @@ class MastrWriter(CameraWriter):
 
     @classmethod
     def finish_all(cls, shared: Any, out: Path, sink: Sink) -> None:
+        # the layout as written: without a split the images and masks folders are at the root
+        root = "" if (out / "images").is_dir() else "<split>/"
         doc = {
             "labels": MASTR_LABELS,
             "from_mmusv_class": {
                 class_name(int(c)): int(v) for c, v in ((c, mastr_lut()[int(c)]) for c in SemanticClass)
             },
             "other_class_ids": OBSTACLE,
-            "images": "<split>/images/<scenario>/<agent>/<camera>/<frame>.png",
-            "masks": "<split>/masks/<scenario>/<agent>/<camera>/<frame>m.png",
+            "images": f"{root}images/<scenario>/<agent>/<camera>/<frame>.png",
+            "masks": f"{root}masks/<scenario>/<agent>/<camera>/<frame>m.png",
         }
         if any(out.glob("*/images")) or (out / "images").is_dir():
             sink.write(out / "mastr.yaml", dump_yaml(doc))

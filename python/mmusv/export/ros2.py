@@ -10,11 +10,13 @@ mmusv world: x east, y north, z up); per instrumented USV ``<usv>/odom`` (= ``ma
 (x forward, y left, z up; ``/tf`` every frame) → ``<usv>/lidar``, ``<usv>/radar``, ``<usv>/camera_<name>`` (x
 forward) → ``<usv>/camera_<name>_optical`` (x right, y down, z forward) on ``/tf_static`` (transient local);
 every other vessel ``map`` → ``<vessel>/base_link`` on ``/tf``; the top-view camera ``map`` →
-``<usv>/top_view_optical`` on ``/tf``.
+``<usv>/top_view_optical`` on ``/tf``. Topic names spell vessel ids and camera names as ROS 2 name tokens
+(:func:`ros_token`: ``usv-1`` → ``usv_1``, ``2b`` → ``_2b``); frame ids keep them as they are.
 """
 
 from __future__ import annotations
 
+import re
 from typing import Any, ClassVar, Literal
 
 import numpy as np
@@ -41,6 +43,8 @@ __all__ = [
     "odom_frame",
     "odom_topic",
     "optical_frame",
+    "ros_token",
+    "ros_topic",
     "top_view_frame",
 ]
 
@@ -89,24 +93,42 @@ def top_view_frame(agent: str) -> str:
     return f"{agent}/top_view_optical"
 
 
+_NOT_IN_ROS_NAMES = re.compile(r"[^A-Za-z0-9_]")
+
+
+def ros_token(name: str) -> str:
+    """``name`` (a vessel id, a camera name) as a ROS 2 name token: letters, digits and ``_``, not starting with a
+    digit (``rcl_validate_topic_name``). mmusv's names may hold ``-`` and start with a digit: each other character
+    becomes ``_`` and a leading digit gets a ``_`` before it (``usv-1`` → ``usv_1``, ``2b`` → ``_2b``); a valid token
+    is kept as it is."""
+    token = _NOT_IN_ROS_NAMES.sub("_", name)
+    return f"_{token}" if token[:1].isdigit() else token
+
+
+def ros_topic(topic: str) -> str:
+    """The bag's name for a topic spelled from mmusv names (``/usv-1/camera/front-wide/rgb`` →
+    ``/usv_1/camera/front_wide/rgb``): every token through :func:`ros_token`, so ``ros2 bag play`` can publish it."""
+    return "/".join(ros_token(t) if t else t for t in topic.split("/"))
+
+
 def odom_topic(agent: str) -> str:
     """``/<usv>/odom``: ``nav_msgs/Odometry``."""
-    return f"/{agent}/odom"
+    return ros_topic(f"/{agent}/odom")
 
 
 def camera_info_topic(agent: str, name: str) -> str:
     """``/<usv>/camera/<name>/camera_info``."""
-    return f"{topics.camera(agent, name)}/camera_info"
+    return ros_topic(f"{topics.camera(agent, name)}/camera_info")
 
 
 def detections_2d_topic(agent: str, name: str) -> str:
     """``/<usv>/camera/<name>/detections``: ``vision_msgs/Detection2DArray``."""
-    return f"{topics.camera(agent, name)}/detections"
+    return ros_topic(f"{topics.camera(agent, name)}/detections")
 
 
 def detections_3d_topic(agent: str) -> str:
     """``/<usv>/detections``: ``vision_msgs/Detection3DArray`` in the LiDAR frame."""
-    return f"/{agent}/detections"
+    return ros_topic(f"/{agent}/detections")
 
 
 def camera_distortion(agent: AgentInfo, name: str) -> np.ndarray:
@@ -234,6 +256,13 @@ class Ros2Writer(DatasetWriter):
         self.m = _Msgs(self.ts)
         self.bag: Any = None
         self.connections: dict[str, Any] = {}
+        for a in self.agents:
+            renamed = [n for n in (a.id, *sorted(a.cameras)) if ros_token(n) != n]
+            if renamed:
+                self.notes.append(
+                    f"agent {a.id}: {', '.join(f'{n} is {ros_token(n)}' for n in renamed)} in the topic names (ROS 2 "
+                    "names: letters, digits and '_', not starting with a digit); the frame ids keep the mmusv names"
+                )
 
     @classmethod
     def check(cls, info: RecordingInfo) -> None:
@@ -242,6 +271,19 @@ class Ros2Writer(DatasetWriter):
         except ImportError:
             raise ConfigError("--to ros2 needs the Python package rosbags: pip install 'mmusv[export]'") from None
         super().check(info)
+        # names that ros_token makes equal would share topics: refused before anything is written
+        groups = [("USVs", [a.id for a in info.agents])]
+        groups += [(f"cameras of {a.id}", list(a.cameras)) for a in info.agents]
+        for what, names in groups:
+            seen: dict[str, str] = {}
+            for n in names:
+                other = seen.setdefault(ros_token(n), n)
+                if other != n:
+                    raise ConfigError(
+                        f"{info.path}: cannot convert to ros2: the {what} {other!r} and {n!r} would both be "
+                        f"{ros_token(n)!r} in the bag's topic names (ROS 2 names: letters, digits and '_', not "
+                        "starting with a digit); rename one in the scenario"
+                    )
 
     @classmethod
     def uses_agent(cls, agent: AgentInfo) -> str | None:
@@ -285,6 +327,7 @@ class Ros2Writer(DatasetWriter):
         )
 
     def _put(self, topic: str, msgtype: str, msg: Any, t_ns: int, *, latched: bool = False) -> None:
+        topic = ros_topic(topic)  # mmusv's names as ROS 2 names (usv-1 → usv_1)
         conn = self.connections.get(topic)
         if conn is None:
             qos = (self.latched,) if latched else ()
@@ -446,12 +489,13 @@ class Ros2Writer(DatasetWriter):
         )
 
     def _annotations(self, t: int, world: WorldFrame, a: AgentInfo, ann: Any) -> None:
-        """``Detection3DArray`` and a ``MarkerArray`` of boxes in the LiDAR frame; a ``Detection2DArray`` per
-        camera in its optical frame. Class ids are mmusv class names (``vessel``, ``usv``), score 1 (ground
-        truth), detection ids the vessel ids."""
+        """``Detection3DArray`` and a ``MarkerArray`` of boxes in the LiDAR frame (the hull's ``base_link`` for a
+        USV without a LiDAR: the recorded boxes are then in its body frame, :mod:`mmusv.annotate`); a
+        ``Detection2DArray`` per camera in its optical frame. Class ids are mmusv class names (``vessel``,
+        ``usv``), score 1 (ground truth), detection ids the vessel ids."""
         m = self.m
         row = {vid: i for i, vid in enumerate(world.ids)}
-        lidar = topics.lidar_frame(a.id)
+        lidar = topics.lidar_frame(a.id) if a.lidar_mount is not None else base_link(a.id)
         hyp = self.T("vision_msgs/msg/ObjectHypothesis")
         hyp_pose = self.T("vision_msgs/msg/ObjectHypothesisWithPose")
         pwc = self.T("geometry_msgs/msg/PoseWithCovariance")

@@ -3,7 +3,8 @@
 One sequence per (recording, agent with a LiDAR), numbered ``00``, ``01``, ... in conversion order (split, then
 scenario folder, then agent): ``sequences/NN/velodyne/<scan>.bin`` (float32 x, y, z, intensity per point, the
 LiDAR frame: x forward, y left, z up), ``labels/<scan>.label`` (uint32 per point: the instance id in the upper 16
-bits, the semantic class id of :mod:`mmusv.classes` in the lower 16; instance 0 = no instance), ``poses.txt``
+bits, the semantic class id of :mod:`mmusv.classes` in the lower 16; the instance is the vessel's world-state
+``instance_id`` for points on a vessel, 0 for the rest: water, land, structures, buoys), ``poses.txt``
 (per scan, the 3×4 row-major pose of camera 0 in camera 0's frame at the first scan), ``calib.txt`` (``P0``..``P3``:
 the front camera's ``K·[I|0]``; ``Tr``: LiDAR → front optical frame; all zeros and the identity without a front
 camera, so camera 0 is the LiDAR) and ``times.txt`` (sim time of each scan, s). Scans are numbered ``000000``
@@ -33,9 +34,10 @@ from mmusv.export.kitti import front_calib, kitti_numbers
 from mmusv.export.writer import DatasetWriter
 from mmusv.frames import invert
 from mmusv.recording import topics
+from mmusv.recording.decode import WorldFrame
 from mmusv.recording.stream import Frame
 
-__all__ = ["LABEL_MAP_NAME", "SemanticKittiWriter", "label_words"]
+__all__ = ["LABEL_MAP_NAME", "SemanticKittiWriter", "label_words", "vessel_instances"]
 
 LABEL_MAP_NAME = "semantic-kitti.yaml"
 _YAML_SPLIT = {"train": "train", "validate": "valid", "test": "test"}
@@ -51,6 +53,17 @@ def label_words(semantic_class: np.ndarray, instance: np.ndarray) -> np.ndarray:
     if inst.size and inst.max() > 0xFFFF:
         raise ConfigError(f"instance id {int(inst.max())} does not fit in the 16 bits of a SemanticKITTI label")
     return ((inst << 16) | cls).astype(np.uint32)
+
+
+def vessel_instances(instance: np.ndarray, world: WorldFrame) -> np.ndarray:
+    """``(N,)`` int64: the points' instance ids where they hit a vessel of the world state (scenario vessels, USVs,
+    moored ships: their ``instance_id``, the one COCO's masks use), 0 elsewhere. The recorded ``instance`` is the
+    scene instance of the surface hit, and water, land, structures and buoys are scene instances too (the sea is
+    typically 1, the first static mesh 0), so without this the sea would read as one SemanticKITTI instance and a
+    buoy as none."""
+    inst = np.asarray(instance).astype(np.int64)
+    ids = np.asarray(world.instance_ids, dtype=np.int64)
+    return np.where(np.isin(inst, ids), inst, 0)
 
 
 @dataclass
@@ -123,7 +136,7 @@ class SemanticKittiWriter(DatasetWriter):
             n = len(cloud["x"])
             pts = np.column_stack([cloud["x"], cloud["y"], cloud["z"], cloud.get("intensity", np.zeros(n))])
             cls = cloud.get("class", np.zeros(n, dtype=np.uint16))
-            labels = label_words(cls, cloud.get("instance", np.zeros(n, dtype=np.int32)))
+            labels = label_words(cls, vessel_instances(cloud.get("instance", np.zeros(n, dtype=np.int32)), world))
             self.put(self.sink.mkdir(seq.folder / "velodyne") / f"{name}.bin", pts.astype("<f4").tobytes())
             self.put(self.sink.mkdir(seq.folder / "labels") / f"{name}.label", labels.astype("<u4").tobytes())
             st.counts += np.bincount(labels & 0xFFFF, minlength=65536)[:65536]
