@@ -168,3 +168,11 @@ def test_the_cross_checks_report_every_problem_at_once() -> None:
         load_scenario(sc)
     msg = str(info.value)
     assert "a clear sky does not rain" in msg and "which `motion: paper` leaves out" in msg, msg
+
+
+def test_time_of_day_takes_ascii_digits_only() -> None:
+    """The loader read "١٢:٠٠" (Arabic-Indic digits, which ``\\d`` matches) as noon; the schema's pattern refuses it."""
+    data = minimal()
+    data["environment"] = {"time_of_day": "١٢:٠٠"}
+    with pytest.raises(mmusv.ConfigError, match=r"environment\.time_of_day = .*HH:MM"):
+        load_scenario(data)

@@ -175,7 +175,10 @@ def _cmd_info(args: argparse.Namespace) -> int:
         found = sorted(target.glob("*.parts.json")) or sorted(target.glob("*.mcap"))
         found = found or sorted(target.glob("*.mcap.partial"))
         if not found:
-            raise MmusvError(f"{target} is a folder without a recording (*.mcap, *.mcap.partial or *.parts.json)")
+            raise MmusvError(
+                f"{target} is a folder without a recording (*.mcap, *.mcap.partial or *.parts.json)"
+                + _recordings_below(target)
+            )
         if len(found) > 1:
             raise MmusvError(f"{target} holds {len(found)} recordings ({', '.join(f.name for f in found)}); name one")
         target = found[0]
@@ -189,16 +192,24 @@ def _cmd_info(args: argparse.Namespace) -> int:
             "[yellow]incomplete recording (.partial, no summary or damaged): counts come from reading every "
             "chunk[/yellow]"
         )
-    written = run_meta.get("frames_written", "?")
-    if frames:
-        written = f"{frames['read']} of {frames['expected']}" if frames["read"] != frames["expected"] else written
-    console.print(
-        f"[bold]{target}[/bold]: scenario {run_meta.get('scenario', recording_name(target))}, "
-        f"status {run_meta.get('status', 'unfinished (no run metadata: the run was killed or is still going)')}, "
-        f"{written} frames, agents {run_meta.get('agents', '?')}",
-        markup=True,
-        highlight=False,
-    )
+    if info.get("frames") is None:  # an MCAP file, but not a recording of mmusv run: its messages only
+        console.print(
+            f"[bold]{target}[/bold]: an MCAP file not written by mmusv run (no scenario/sensors metadata): its "
+            "messages only",
+            markup=True,
+            highlight=False,
+        )
+    else:
+        written = run_meta.get("frames_written", "?")
+        if frames:
+            written = f"{frames['read']} of {frames['expected']}" if frames["read"] != frames["expected"] else written
+        console.print(
+            f"[bold]{target}[/bold]: scenario {run_meta.get('scenario') or _scenario_of(meta, target)}, "
+            f"status {run_meta.get('status', 'unfinished (no run metadata: the run was killed or is still going)')}, "
+            f"{written} frames, agents {run_meta.get('agents') or _agents_of(meta)}",
+            markup=True,
+            highlight=False,
+        )
     start, end = info.get("start_ns", 0), info.get("end_ns", 0)
     console.print(
         f"time {start / 1e9:.3f} .. {end / 1e9:.3f} s (duration {(end - start) / 1e9:.3f} s), "
@@ -211,31 +222,86 @@ def _cmd_info(args: argparse.Namespace) -> int:
         table.add_row(topic, t["schema"], str(t["messages"]))
     console.print(table)
     problems = [frames["report"]] if frames and frames.get("report") else list(info.get("damage", []))
-    if folder is not None:
-        problems += _table_problems(folder, frames)
+    if folder is not None and frames:
+        problems += _table_problems(target, frames)
     for line in problems:
         console.print(f"mmusv: warning: {line}", markup=False, highlight=False, style="yellow")
     if target.name.endswith(".mcap.partial"):
-        console.print(f"`mmusv recover {target.parent}` finishes it into {recording_name(target)}.mcap with its tables")
+        if frames and frames.get("read"):
+            console.print(
+                f"`mmusv recover {target.parent}` finishes it into {recording_name(target)}.mcap with its tables"
+            )
+        else:  # recover refuses a .partial without a complete frame: nothing to finish
+            console.print(
+                f"it holds no complete frame: nothing to recover (`mmusv run` on {target.parent} records it again)"
+            )
     return 0
 
 
-def _table_problems(folder: Path, frames: dict[str, object]) -> list[str]:
-    """What is wrong with the Parquet tables of a run folder (damaged parts, frames without rows)."""
+def _scenario_of(meta: dict[str, dict[str, str]], target: Path) -> str:
+    """The scenario's name as its ``scenario`` metadata says (a killed run has no ``run`` metadata), else the
+    recording's name."""
+    from mmusv.recording.info import recording_name
+
+    name = (meta.get("scenario") or {}).get("name")
+    return str(name) if name else recording_name(target)
+
+
+def _agents_of(meta: dict[str, dict[str, str]]) -> str:
+    """The agents the ``sensors`` metadata names (a killed run has no ``run`` metadata saying them), else ``?``."""
+    import json
+
+    try:
+        sensors = json.loads(meta["sensors"]["json"])
+    except (KeyError, TypeError, ValueError):
+        return "?"
+    return ",".join(map(str, sensors)) if isinstance(sensors, dict) and sensors else "?"
+
+
+def _recordings_below(folder: Path) -> str:
+    """``"; below it: a, b (name one)"``: the recordings in the folders below ``folder`` (a batch's output
+    folder), or ``""``."""
+    from mmusv.recording.info import find_recordings
+
+    try:
+        found = find_recordings(folder)
+    except MmusvError:
+        return ""
+    if not found:
+        return ""
+    names = [str(f.relative_to(folder)) for f in found[:5]]
+    more = f" and {len(found) - 5} more" if len(found) > 5 else ""
+    return f"; below it: {', '.join(names)}{more} (name one)"
+
+
+def _table_problems(recording: Path, frames: dict[str, object]) -> list[str]:
+    """What is wrong with the Parquet tables beside ``recording`` (damaged parts, frames without rows): those of
+    its run folder, or for a parts manifest those of each recorded part's folder."""
+    from mmusv.recording.parts import is_parts_manifest, part_files
+
+    missing = set(frames.get("missing", []))  # type: ignore[call-overload]
+    if not is_parts_manifest(recording):
+        first = frames.get("first", 0)
+        expected = frames.get("expected")
+        span = range(first, first + expected) if isinstance(first, int) and isinstance(expected, int) else None
+        return _tables_of(recording.parent / "tables", span, missing)
+    out = []
+    for first, stop, f in part_files(recording):
+        if f is not None:  # a part not recorded yet: its frames are said missing above
+            out += _tables_of(f.parent / "tables", range(first, stop), missing)
+    return out
+
+
+def _tables_of(tables: Path, span: range | None, missing: set[int]) -> list[str]:
     from mmusv.recording.tables import SCHEMAS, read_table
 
-    tables = folder / "tables"
     if not tables.is_dir():
+        if span is not None and all(k in missing for k in span):  # no frame recorded, so no table either
+            return []
         return [f"{tables} does not exist (a run killed before its first table flush; `mmusv recover` rebuilds it)"]
     out = []
-    read = frames.get("read") if frames else None
-    missing = set(frames.get("missing", [])) if frames else set()  # type: ignore[call-overload]
-    expected = frames.get("expected") if frames else None
     for name in SCHEMAS:
-        span = None
-        if name == "world_state" and isinstance(expected, int) and isinstance(read, int):
-            span = range(expected)
-        got = read_table(tables, name, expected=span)
+        got = read_table(tables, name, expected=span if name == "world_state" else None)
         got.missing = [k for k in got.missing if k not in missing]  # frames the recording lacks too: said above
         line = got.report()
         if line is not None:
@@ -305,6 +371,9 @@ def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="mmusv", description="Headless maritime multi-USV simulator and dataset generator."
     )
+    from mmusv import __version__
+
+    p.add_argument("--version", action="version", version=f"mmusv {__version__}", help="print the version and exit")
     sub = p.add_subparsers(dest="command", required=True)
     sub.add_parser("version", help="print the version")
     p_assets = sub.add_parser("assets", help="list the vessel library")
@@ -368,10 +437,16 @@ def _parser() -> argparse.ArgumentParser:
     rec.add_argument("target", help="the run folder (holding NAME.mcap.partial) or the .partial file")
     rec.add_argument("--overwrite", action="store_true", help="replace an existing NAME.mcap")
     prev = sub.add_parser("preview", help="one picture of a recorded frame (surround RGB, depth, semantic, PPI, BEV)")
-    prev.add_argument("recording", help="an .mcap written by mmusv run")
+    prev.add_argument("recording", help="an .mcap (or .mcap.partial, .parts.json) written by mmusv run")
     prev.add_argument("--frame", type=int, default=0, help="acquisition index (default 0)")
-    prev.add_argument("--agent", default=None, help="USV id (default: the first)")
-    prev.add_argument("-o", "--output", default=None, help="PNG path (default: next to the recording)")
+    prev.add_argument("--agent", default=None, help="USV id (default: the first that recorded a picture)")
+    prev.add_argument(
+        "-o",
+        "--output",
+        default=None,
+        help="picture path (.png, .jpg) or an existing folder (default: next to the recording, "
+        "NAME_frameNNNNNN_AGENT.png)",
+    )
     schema = sub.add_parser(
         "schema", help="print the JSON Schema of scenario or spec files (for editors: yaml-language-server)"
     )

@@ -11,6 +11,7 @@ shows what a user of the file gets.
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -141,6 +142,18 @@ def _bev_panel(points: dict[str, np.ndarray], boxes: list[Any], px: int, half_m:
     return pil
 
 
+def _pictured(topic: str, agent: str) -> bool:
+    """Whether ``topic`` is one of ``agent``'s that the sheet draws a panel of."""
+    if topics.agent_of(topic) != agent:
+        return False
+    kind = topic.rsplit("/", 1)[1]
+    return (
+        ("/camera/" in topic and kind in ("rgb", "depth", "semantic"))
+        or (topic.startswith(topics.top_view(agent)) and kind in ("rgb", "semantic"))
+        or topic in (topics.radar_ppi(agent), topics.lidar(agent))
+    )
+
+
 def _bev_half_extent(boxes: list[Any]) -> float:
     """Half side (m) of the BEV square: ``_BEV_HALF_M``, widened to a 1-2-5 value that holds every box centre."""
     reach = max([max(abs(b.center[0]), abs(b.center[1])) * 1.1 for b in boxes] + [_BEV_HALF_M])
@@ -166,9 +179,15 @@ def compose_preview(path: str | Path, *, frame: int = 0, agent: str | None = Non
     agents = {a.id: a for a in info.agents if any(topics.agent_of(t) == a.id for t in msgs)}
     if not agents:
         raise ConfigError(f"frame {frame} of {path} has no agent topics")
-    a_id = next(iter(agents)) if agent is None else agent
+    drawn = [i for i in agents if any(_pictured(t, i) for t in msgs)]  # agents with something to draw
+    a_id = (drawn or list(agents))[0] if agent is None else agent
     if a_id not in agents:
         raise ConfigError(f"no agent {a_id!r} in {path}; agents: {', '.join(agents)}")
+    if a_id not in drawn:  # a rig without cameras, radar, top view and LiDAR: an empty sheet, no panel to name
+        raise ConfigError(
+            f"agent {a_id!r} recorded no picture in frame {frame} of {path} (no camera, radar PPI, top view or "
+            "LiDAR)" + (f"; agents with pictures: {', '.join(drawn)}" if drawn else "")
+        )
     a: AgentInfo = agents[a_id]
     ann = msgs.get(topics.agent_annotations(a_id))
     boxes2d = list(ann.boxes_camera) if ann is not None else []
@@ -252,6 +271,11 @@ def write_preview(
     the picture's path (``.png``, ``.jpg`` or ``.jpeg``), or an existing folder to write it into under its
     default name; anything else is a :class:`~mmusv.errors.ConfigError`, checked before the frame is read."""
     target = Path(output) if output is not None else None
+    said_folder = output is not None and str(output).endswith(("/", os.sep))  # `-o previews/`: a folder
+    if target is not None and said_folder and not target.is_dir():
+        if target.exists():
+            raise ConfigError(f"output {str(output)!r}: {target} is a file, not a folder")
+        raise ConfigError(f"output {str(output)!r}: the folder {target} does not exist; create it first")
     if target is not None and not target.is_dir() and target.suffix.lower() not in _PICTURE_SUFFIXES:
         raise ConfigError(
             f"output {str(target)!r}: give a picture path ending in {', '.join(_PICTURE_SUFFIXES)}, or a folder"

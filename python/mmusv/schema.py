@@ -17,7 +17,11 @@ keys and values of the wrong type are still marked:
 - a difficulty's ``extra_targets`` is ``n`` or ``[lo, hi]``; a combination's ``family`` one of the families;
 - a spec's ``environment`` takes each scenario environment key, with one value or a list to draw from, and its
   default rig ``usv_standard`` is checked as a scenario's rig;
-- a scenario's rig names (``rigs:`` keys) follow :data:`mmusv.config.RIG_NAME`.
+- a scenario's rig names (``rigs:`` keys) follow :data:`mmusv.config.RIG_NAME`;
+- the bounds the loader's validators check on single fields are added: ``time_of_day`` as ``"HH:MM"``, ``wave`` a
+  preset or 0..25 m, waypoints within :data:`mmusv.config.MAX_COORDINATE_M`, image sizes in 1..16384, the
+  vertical fans within (-90, 90) degrees, a difficulty's ``range_m``; and a scenario environment's rules among
+  its own keys (a ``sea`` with ``wave: W0`` and ``motion: physical`` only, rain under a sky that rains).
 
 The loader stays the authority: checks across fields (a vessel's ``rig`` defined under ``rigs``, unique ids, mount
 points of the asset, the sea's steepness, asset names, ...) are not in the schema.
@@ -46,6 +50,8 @@ _INTEGER_TEXT = r"^\s*[+-]?[0-9](_?[0-9])*(\.0*)?\s*$"
 """An integer as pydantic's lax mode reads it from a string: ``"100"``, ``" +3 "``, ``"1_000"``, ``"10.0"``."""
 _NUMBER_TEXT = r"^\s*[+-]?([0-9](_?[0-9])*(\.([0-9](_?[0-9])*)?)?|\.[0-9](_?[0-9])*)([eE][+-]?[0-9]+)?\s*$"
 """A finite number as pydantic's lax mode reads it from a string: ``"5"``, ``"2.5"``, ``".5"``, ``"1e3"``."""
+_TIME_TEXT = r"^\s*(?:[01]?[0-9]|2[0-3]):[0-5][0-9]\s*$"
+"""A time of day as the loader reads it: 24-hour ``"H:MM"`` or ``"HH:MM"``, surrounding spaces stripped."""
 _BOOLEAN_TEXT = r"^(?i:true|false|yes|no|on|off|t|f|y|n|1|0)$"
 """A boolean as pydantic's lax mode reads it from a string (any case)."""
 
@@ -92,6 +98,8 @@ def _scenario() -> dict[str, Any]:
     doc = _widened(Scenario)
     doc["properties"]["rigs"]["propertyNames"] = {"pattern": f"^{RIG_NAME.pattern}$"}  # checked before stripping
     _map_params_by_type(doc)
+    _field_bounds(doc)
+    _environment_rules(doc["$defs"]["EnvironmentConfig"])
     return _finished(
         doc,
         title="mmusv scenario",
@@ -120,6 +128,11 @@ def _spec() -> dict[str, Any]:
         for name, d in defs.items():
             assert doc["$defs"].setdefault(name, d) == d, name  # the same model, the same schema
     _map_params_by_type(doc)
+    _field_bounds(doc)
+    from mmusv.generate.spec import MAX_RANGE_M
+
+    for item in doc["$defs"]["Difficulty"]["properties"]["range_m"]["prefixItems"]:
+        _bound(item, minimum=0, maximum=MAX_RANGE_M)
 
     family = doc["$defs"]["Combination"]["properties"]["family"]
     names = sorted(FAMILIES)
@@ -264,6 +277,81 @@ def _models(root: type[BaseModel]) -> dict[str, type[BaseModel]]:
         elif typing.get_origin(tp) is not None or isinstance(tp, types.UnionType):
             todo.extend(typing.get_args(tp))
     return out
+
+
+# ------------------------------------------------------------------------------------------------ field bounds
+
+
+def _bound(node: dict[str, Any], **limits: float) -> None:
+    """``limits`` (``minimum``, ``exclusiveMaximum``, ...) on the number of ``node``: the node itself, or its
+    number branch beside the quoted text the loader also reads (a quoted number stays unchecked: never marked)."""
+    if node.get("type") in ("number", "integer"):
+        node.update(limits)
+    for branch in node.get("anyOf", []):
+        _bound(branch, **limits)
+
+
+def _field_bounds(doc: dict[str, Any]) -> None:
+    """The bounds of single fields that the loader checks in its validators (the models' own schema leaves them
+    out): the time of day and the wave setting, waypoints within ``MAX_COORDINATE_M`` of the origin, image sizes
+    in 1..16384 pixels and the LiDAR's and radar's vertical fans strictly within (-90, 90) degrees."""
+    from mmusv.config import MAX_COORDINATE_M
+    from mmusv.world.environment import MAX_WAVE_HEIGHT_M, WAVE_PRESETS
+
+    defs = doc["$defs"]
+    env = defs["EnvironmentConfig"]["properties"]
+    env["time_of_day"] = {
+        **{k: v for k, v in env["time_of_day"].items() if k in _META},
+        "type": "string",
+        "pattern": _TIME_TEXT,
+        "description": 'Local solar time, 24-hour "HH:MM" in quotes (unquoted, YAML reads 13:00 as a number).',
+    }
+    presets = "|".join(
+        "".join(f"[{c.lower()}{c.upper()}]" if c.isalpha() else re.escape(c) for c in name) for name in WAVE_PRESETS
+    )
+    env["wave"] = {
+        **{k: v for k, v in env["wave"].items() if k in _META},
+        "anyOf": [
+            {"type": "string", "pattern": rf"^\s*(?:{presets})\s*$"},
+            {"type": "number", "minimum": 0, "maximum": MAX_WAVE_HEIGHT_M},
+        ],
+        "description": (
+            f"A wave preset ({', '.join(WAVE_PRESETS)}) or the significant wave height in metres "
+            f"(0..{MAX_WAVE_HEIGHT_M:g})."
+        ),
+    }
+    if "VesselConfig" in defs:
+        for item in defs["VesselConfig"]["properties"]["route"]["items"]["prefixItems"]:
+            _bound(item, minimum=-MAX_COORDINATE_M, maximum=MAX_COORDINATE_M)
+    for name in ("CameraConfig", "TopViewConfig"):
+        for item in defs[name]["properties"]["resolution"]["prefixItems"]:
+            _bound(item, minimum=1, maximum=16384)
+    for name, key in (("LidarConfig", "vertical_fov_deg"), ("RadarConfig", "elevation_fan_deg")):
+        for item in defs[name]["properties"][key]["prefixItems"]:
+            _bound(item, exclusiveMinimum=-90, exclusiveMaximum=90)
+
+
+def _environment_rules(env: dict[str, Any]) -> None:
+    """A scenario environment's rules across its own keys, as :class:`mmusv.config.EnvironmentConfig` checks
+    them: a ``sea`` goes with ``wave: W0`` (or none) and ``motion: physical``; rain needs a sky that rains."""
+    env["allOf"] = [
+        {
+            "if": {"properties": {"sea": {"type": "object"}}, "required": ["sea"]},
+            "then": {
+                "properties": {
+                    "wave": {"type": "string", "pattern": r"^\s*[wW]0\s*$"},
+                    "motion": {"not": {"const": "paper"}},
+                }
+            },
+        },
+        {
+            "if": {
+                "properties": {"rain_mm_per_h": {"type": "number", "exclusiveMinimum": 0}},
+                "required": ["rain_mm_per_h"],
+            },
+            "then": {"required": ["weather"], "properties": {"weather": {"not": {"const": "clear"}}}},
+        },
+    ]
 
 
 # ------------------------------------------------------------------------------------------------ map params

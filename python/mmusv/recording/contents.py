@@ -25,8 +25,9 @@ def summary(path: str | os.PathLike[str]) -> dict[str, Any]:
     "topics": {topic: {"schema", "encoding", "messages"}}, "metadata": {name: {key: value}},
     "attachments": [name, ...], "damage": [line, ...], "frames": {...} or None}``, counted by reading every
     chunk (checking its CRC). ``complete`` is False for a ``.partial`` file, one without a summary section or one
-    with damage. ``frames`` (for a recording of mmusv): ``{"read", "expected", "missing", "incomplete",
-    "report"}``, the complete frames read, how many the run set out to write, the missing ones (sorted), those
+    with damage. ``frames`` (for a recording of mmusv): ``{"read", "expected", "first", "missing", "incomplete",
+    "report"}``, the complete frames read, how many the run set out to write (from acquisition index ``first``:
+    0, or where one part of a split recording starts), the missing ones (sorted), those
     left out because some of their messages are damaged, and the one-line report of
     :meth:`~mmusv.recording.stream.FrameStream.report` (``None`` when all is well). A parts manifest gives the
     sums over its recorded parts, the metadata of the first with the merged ``run`` of
@@ -69,6 +70,7 @@ def _summary_dict(p: Path, stream: FrameStream, *, complete: bool) -> dict[str, 
         "frames": {
             "read": len(set(stream.yielded)),
             "expected": len(span),
+            "first": span.start,
             "missing": missing,
             "incomplete": [k for k, _ in stream.incomplete],
             "report": stream.report(),

@@ -90,6 +90,27 @@ def find_partial(target: str | os.PathLike[str]) -> Path:
     return check_mcap(p)
 
 
+def _part_of(recording: Path) -> tuple[int, int] | None:
+    """``(first_frame, frames)`` when ``recording`` is one part of a split recording (a parts manifest in a folder
+    above it lists it), else ``None``. A killed part's ``.partial`` has no ``run`` metadata, so without this its
+    recovery said nothing of where it starts, and the manifest then refused it as "a whole recording, not a
+    part" (every reader of the manifest failed)."""
+    from mmusv.errors import MmusvError
+    from mmusv.recording.parts import PARTS_SUFFIX, read_parts_manifest
+
+    want = recording.resolve()
+    for folder in list(recording.resolve().parents)[:4]:
+        for manifest in sorted(folder.glob(f"*{PARTS_SUFFIX}")):
+            try:
+                parts = read_parts_manifest(manifest).parts
+            except MmusvError:
+                continue
+            for p in parts:
+                if (manifest.parent / p.recording).resolve() == want:
+                    return p.first_frame, p.frames
+    return None
+
+
 def _static_flags(info: RecordingInfo) -> dict[str, bool]:
     """Vessel id -> static (moored ships, scenario vessels at speed 0), as the run's tables say."""
     vessels = info.scenario.get("vessels", [])
@@ -302,7 +323,10 @@ def recover(target: str | os.PathLike[str], *, overwrite: bool = False) -> Recov
                 + (f", {len(stream.incomplete)} incomplete left out" if stream.incomplete else ""),
             )
             run.pop("frames_requested", None)
-            if "first_frame" in run and keep:
+            part = _part_of(final)
+            if part is not None:  # one part of a split recording: its manifest checks where it starts
+                run["first_frame"] = str(part[0])
+            elif "first_frame" in run and keep:
                 run["frames_requested"] = str(len(keep))
             w.add_metadata("run", run)
             w.finish()  # type: ignore[no-untyped-call]

@@ -44,7 +44,7 @@ WAVE_PRESETS: dict[str, float] = dict(core.wave_presets())
 
 WeatherKind = Literal["clear", "overcast", "fog", "rain"]
 _WEATHER: tuple[str, ...] = ("clear", "overcast", "fog", "rain")
-_TIME_RE = re.compile(r"^(\d{1,2}):(\d{2})$")
+_TIME_RE = re.compile(r"^([0-9]{1,2}):([0-9]{2})$")  # ASCII digits (\d would take "١٢:٠٠")
 
 
 MAX_WAVE_HEIGHT_M: float = core.sea_limits()["hs_m"][1]

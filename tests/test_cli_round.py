@@ -1,0 +1,286 @@
+"""The inspection commands used as a new user would (``info``, ``recover``, ``preview``, ``schema``, ``--version``),
+each finding of that round a test that failed before its fix: a killed part of a split run recovered into a file
+its parts manifest refused, ``info`` warning about tables that are fine (a split run's, one part's), suggesting a
+recovery that refuses, calling a foreign MCAP a killed run and not naming a killed run's agents or scenario,
+``preview`` of a USV without picture sensors ending in a traceback, and the JSON Schema passing values the loader
+refuses on their own (a time of day, a wave, a waypoint, an image size)."""
+
+from __future__ import annotations
+
+import copy
+import json
+from pathlib import Path
+from typing import Any
+
+import jsonschema
+import pytest
+import yaml
+from mcap.reader import make_reader
+from mcap.writer import CompressionType, Writer
+from mmusv.cli import main
+from tiny_scenario import lidar_scenario
+
+
+def _cli(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
+    """``mmusv argv`` in this process: ``(exit status, stdout, stderr)``, with rich's line breaks joined."""
+    code = main(argv)
+    out, err = capsys.readouterr()
+    assert "Traceback" not in out + err, out + err
+    return code, out.replace("\n", " "), err
+
+
+def _killed_copy(src: Path, dst: Path, *, messages: int) -> Path:
+    """``dst``: what a run killed after the first ``messages`` messages of ``src`` leaves, as the recorder writes
+    it (the header, the scenario, manifest and sensors metadata, complete chunks, no ``run`` metadata, no summary
+    or footer)."""
+    with src.open("rb") as f:
+        reader = make_reader(f)
+        meta = [(m.name, dict(m.metadata)) for m in reader.iter_metadata() if m.name != "run"]
+        msgs = list(reader.iter_messages())[:messages]
+    with dst.open("wb") as out:
+        w = Writer(out, chunk_size=1, compression=CompressionType.NONE)  # every message in a chunk of its own
+        w.start(profile="", library="mmusv test")
+        for name, md in meta:
+            w.add_metadata(name, md)
+        schemas: dict[int, int] = {}
+        channels: dict[int, int] = {}
+        for schema, ch, m in msgs:
+            assert schema is not None
+            if schema.id not in schemas:
+                schemas[schema.id] = w.register_schema(schema.name, schema.encoding, schema.data)
+            if ch.id not in channels:
+                channels[ch.id] = w.register_channel(ch.topic, ch.message_encoding, schemas[schema.id], ch.metadata)
+            w.add_message(channels[ch.id], m.log_time, m.data, m.publish_time, m.sequence)
+        # no w.finish(): the process was killed
+    return dst
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """``tiny/`` (3 frames, one LiDAR-only USV), ``split/tiny/`` (4 frames recorded as 2 parts of 2) and
+    ``blind/`` (1 frame: USV ``a`` carries no sensor, USV ``u`` a LiDAR)."""
+    from mmusv.acquire import run
+
+    base = tmp_path_factory.mktemp("cli_round")
+    run(lidar_scenario("tiny", frames=3), out_dir=base / "tiny")
+    src = base / "tiny4.yaml"
+    src.write_text(yaml.safe_dump(lidar_scenario("tiny", frames=4)), encoding="utf-8")
+    assert main(["run", str(src), "-o", str(base / "split"), "--split-frames", "2"]) == 0
+    blind = lidar_scenario("blind", frames=1)
+    blind["rigs"]["none"] = {"preset": "lidar_only", "lidar": None}
+    blind["vessels"].insert(
+        0,
+        {"id": "a", "role": "usv", "asset": "usv_wamv", "rig": "none", "speed_mps": 2, "route": [[0, -40], [50, -40]]},
+    )
+    run(blind, out_dir=base / "blind")
+    return base
+
+
+# ------------------------------------------------------------------------------------------------ info
+
+
+def test_info_of_a_split_run_reads_the_tables_of_its_parts(runs: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """`mmusv info` on a split run's folder warned "tables does not exist (a run killed before its first table
+    flush...)": a split run's tables are in its parts' folders; and on one part's folder it called the frames
+    before the part ("frames 0..1 have no world_state rows") missing."""
+    folder = runs / "split" / "tiny4"
+    assert (folder / "tiny4.parts.json").is_file() or (folder / "tiny.parts.json").is_file(), sorted(folder.iterdir())
+    code, out, err = _cli(["info", str(folder)], capsys)
+    assert code == 0 and "status complete, 4 frames" in out and "warning" not in out + err, out
+    part = folder / "parts" / "000002-000003"
+    code, out, err = _cli(["info", str(part)], capsys)
+    assert code == 0 and "2 frames" in out and "warning" not in out + err, out
+    # a part's tables that really lack rows are still named (frames 2..3 of that part's own range)
+    for p in (part / "tables" / "world_state").glob("part-*.parquet"):
+        p.unlink()
+    code, out, _ = _cli(["info", str(part)], capsys)
+    assert code == 0 and "frames 2..3 have no world_state rows" in out, out
+
+
+def test_info_of_a_killed_run_names_its_scenario_and_agents(
+    runs: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A killed run has no `run` metadata: `info` said "agents ?" and the file's name for the scenario, though the
+    `sensors` and `scenario` metadata name them."""
+    partial = _killed_copy(runs / "tiny" / "tiny.mcap", tmp_path / "renamed.mcap.partial", messages=12)
+    code, out, _ = _cli(["info", str(partial)], capsys)
+    assert code == 0 and "scenario tiny," in out and "agents u" in out and "2 of 3 frames" in out, out
+    assert f"mmusv recover {tmp_path}" in out
+
+
+def test_info_of_a_killed_run_without_a_frame_does_not_suggest_recover(
+    runs: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Killed before its first frame reached the disk: `info` suggested `mmusv recover`, which then refuses ("holds
+    no complete frame"); and warned that the (never written) tables are missing."""
+    folder = tmp_path / "killed"
+    folder.mkdir()
+    _killed_copy(runs / "tiny" / "tiny.mcap", folder / "tiny.mcap.partial", messages=0)
+    code, out, _ = _cli(["info", str(folder)], capsys)
+    assert code == 0 and "0 of 3 frames" in out and "nothing to recover" in out, out
+    assert "mmusv recover" not in out and "tables does not exist" not in out, out
+    code, _, err = _cli(["recover", str(folder)], capsys)
+    assert code == 2 and "no complete frame" in err  # what the hint no longer promises
+
+
+def test_info_of_an_mcap_not_written_by_mmusv(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A complete MCAP of another tool was "status unfinished (no run metadata: the run was killed or is still
+    going), ? frames, agents ?"."""
+    path = tmp_path / "other.mcap"
+    with path.open("wb") as f:
+        w = Writer(f)
+        w.start()
+        ch = w.register_channel("/a", "json", w.register_schema("s", "jsonschema", b"{}"))
+        for k in range(3):
+            w.add_message(ch, k * 10**9, b"{}", k * 10**9)
+        w.finish()  # type: ignore[no-untyped-call]
+    code, out, _ = _cli(["info", str(path)], capsys)
+    assert code == 0 and "not written by mmusv run" in out and "3 messages" in out, out
+    assert "killed" not in out and "agents" not in out, out
+
+
+def test_info_of_a_batch_folder_names_the_recordings_below(runs: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """`mmusv info OUT` on a batch's output folder said only "a folder without a recording"."""
+    code, _, err = _cli(["info", str(runs / "split")], capsys)
+    assert code == 2 and "below it: tiny4/tiny.parts.json (name one)" in err, err
+
+
+# ------------------------------------------------------------------------------------------------ recover
+
+
+def test_recover_of_a_killed_part_keeps_its_parts_manifest_readable(
+    runs: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A part of a split run killed, then `mmusv recover PART_FOLDER`: the recovered part lacked `first_frame`, so
+    every reader of the manifest failed ("... is a whole recording, not a part (no first_frame)")."""
+    import shutil
+
+    folder = tmp_path / "tiny4"
+    shutil.copytree(runs / "split" / "tiny4", folder)
+    part = folder / "parts" / "000002-000003"
+    done = part / "tiny.mcap"
+    _killed_copy(done, part / "tiny.mcap.partial", messages=7)  # frame 2 whole, frame 3 cut short
+    done.unlink()
+    shutil.rmtree(part / "tables")
+    code, out, err = _cli(["recover", str(part)], capsys)
+    assert code == 0 and "recovered 1 of 2 frames (frames 2)" in out, (out, err)
+    code, out, err = _cli(["info", str(folder)], capsys)
+    assert code == 0 and "3 of 4 frames" in out and "frames 3 missing" in out, (out, err)
+    assert json.loads((part / "manifest.json").read_text())["first_frame"] == 2
+    code, out, err = _cli(["preview", str(folder / "tiny.parts.json"), "--frame", "2", "-o", str(tmp_path)], capsys)
+    assert code == 0 and (tmp_path / "tiny_frame000002_u.png").is_file(), err
+
+
+# ------------------------------------------------------------------------------------------------ preview
+
+
+def test_preview_skips_a_usv_without_picture_sensors(
+    runs: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A USV whose rig records no camera, radar, top view or LiDAR: `preview` ended in an IndexError traceback
+    (by default too, when it was the first agent)."""
+    rec = runs / "blind" / "blind.mcap"
+    code, out, err = _cli(["preview", str(rec), "-o", str(tmp_path)], capsys)
+    assert code == 0 and (tmp_path / "blind_frame000000_u.png").is_file(), (out, err)  # the first with pictures
+    code, _, err = _cli(["preview", str(rec), "--agent", "a", "-o", str(tmp_path)], capsys)
+    assert code == 2 and "agent 'a' recorded no picture" in err and "agents with pictures: u" in err, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["blind_frame000000_u.png"]
+
+
+def test_preview_into_a_folder_that_does_not_exist(
+    runs: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`-o previews/` (a folder, by its slash) that does not exist was "give a picture path ..., or a folder"."""
+    rec = str(runs / "tiny" / "tiny.mcap")
+    code, _, err = _cli(["preview", rec, "-o", f"{tmp_path / 'previews'}/"], capsys)
+    assert code == 2 and "does not exist" in err and not (tmp_path / "previews").exists(), err
+    (tmp_path / "previews").mkdir()
+    code, out, _ = _cli(["preview", rec, "-o", f"{tmp_path / 'previews'}/"], capsys)
+    assert code == 0 and (tmp_path / "previews" / "tiny_frame000000_u.png").is_file(), out
+
+
+# ------------------------------------------------------------------------------------------------ the rest
+
+
+def test_version_flag(capsys: pytest.CaptureFixture[str]) -> None:
+    """`mmusv --version` was "the following arguments are required: command" (exit status 2)."""
+    from mmusv import __version__
+
+    with pytest.raises(SystemExit) as exc:
+        main(["--version"])
+    assert exc.value.code in (0, None)
+    assert capsys.readouterr().out.strip() == f"mmusv {__version__}"
+
+
+_BASE: dict[str, Any] = {
+    "rigs": {"r": {}},
+    "vessels": [{"id": "u", "role": "usv", "asset": "usv_wamv", "rig": "r", "route": [[0, 0], [100, 0]]}],
+}
+_SPEC: dict[str, Any] = {
+    "map": {"type": "island", "seed": 4},
+    "acquisition": {"frequency_hz": 2, "frames": 10},
+    "combinations": [{"family": "crossing", "targets": ["small"]}],
+}
+
+
+def _doc(kind: str, path: str, value: Any) -> dict[str, Any]:
+    doc = copy.deepcopy(_BASE if kind == "scenario" else _SPEC)
+    *parents, last = [int(p) if p.isdigit() else p for p in path.split(".")]
+    node: Any = doc
+    for p in parents:
+        node = node.setdefault(p, {}) if isinstance(node, dict) else node[p]
+    node[last] = value
+    return doc
+
+
+def _loads(kind: str, doc: dict[str, Any]) -> bool:
+    from mmusv.config import load_scenario
+    from mmusv.errors import ConfigError
+    from mmusv.generate import load_spec
+
+    try:
+        (load_scenario if kind == "scenario" else load_spec)(copy.deepcopy(doc))
+    except ConfigError:
+        return False
+    return True
+
+
+@pytest.mark.parametrize(
+    ("kind", "path", "value", "good"),
+    [
+        ("scenario", "environment.time_of_day", "25:00", False),
+        ("scenario", "environment.time_of_day", "noon", False),
+        ("scenario", "environment.time_of_day", "0700", False),
+        ("scenario", "environment.time_of_day", " 7:05 ", True),
+        ("scenario", "environment.wave", "W9", False),
+        ("scenario", "environment.wave", "2.5", False),  # a quoted height is not a preset
+        ("scenario", "environment.wave", 26, False),
+        ("scenario", "environment.wave", -1, False),
+        ("scenario", "environment.wave", " w2 ", True),
+        ("scenario", "environment.wave", 2.5, True),
+        ("scenario", "environment", {"sea": {"state": 3}, "wave": "W2"}, False),
+        ("scenario", "environment", {"sea": {"state": 3}, "motion": "paper"}, False),
+        ("scenario", "environment", {"sea": {"state": 3}, "wave": "W0"}, True),
+        ("scenario", "environment", {"rain_mm_per_h": 5}, False),  # under the default clear sky
+        ("scenario", "environment", {"rain_mm_per_h": 5, "weather": "fog"}, True),
+        ("scenario", "vessels.0.route", [[-2e6, 0], [100, 0]], False),
+        ("scenario", "rigs.r", {"cameras": [{"name": "a", "resolution": [0, 480]}]}, False),
+        ("scenario", "rigs.r", {"top_view": {"resolution": [20000, 64]}}, False),
+        ("scenario", "rigs.r", {"lidar": {"vertical_fov_deg": [-90, 10]}}, False),
+        ("scenario", "rigs.r", {"radar": {"elevation_fan_deg": [-10, 90]}}, False),
+        ("spec", "environment.time_of_day", ["07:00", "7 pm"], False),
+        ("spec", "environment.wave", ["W0", "W7"], False),
+        ("spec", "environment.wave", ["w1", 3], True),
+        ("spec", "difficulties", {"near": {"range_m": [-5, 100]}}, False),
+        ("spec", "difficulties", {"near": {"range_m": [5, 1e6]}}, False),
+    ],
+    ids=lambda v: str(v)[:40],
+)
+def test_schema_marks_what_the_loader_refuses_on_its_own(kind: str, path: str, value: Any, good: bool) -> None:
+    """Values the loader refuses by the field alone passed the emitted JSON Schema (an editor marked nothing)."""
+    from mmusv.schema import json_schema
+
+    doc = _doc(kind, path, value)
+    assert _loads(kind, doc) is good, "the premise: what the loader does"
+    errors = list(jsonschema.Draft202012Validator(json_schema(kind)).iter_errors(doc))  # type: ignore[arg-type]
+    assert (not errors) is good, [e.message for e in errors]
