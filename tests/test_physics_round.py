@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from clear_env import clear_env
 from mmusv._native import core
 from mmusv.config import load_scenario
 from mmusv.frames import pose_matrices
@@ -54,22 +55,6 @@ SIDELIGHT_ARC, STERN_ARC = 112.5, 135.0
 225° (both sides' sidelight arcs); the sternlight over 135° centred right astern."""
 CUTOFF_DEG = 5.0
 """Annex I §9(a)(i): a sidelight's intensity must reach its cut-off 1–3° outside its sector; 5° allowed here."""
-
-
-def _env(sun: np.ndarray, **kw: object) -> core.SensorEnv:
-    args: dict[str, object] = {
-        "sun_direction": [float(x) for x in sun],
-        "turbidity": 3.0,
-        "cloud_cover": 0.0,
-        "ground_albedo": 0.06,
-        "fog_extinction_per_m": 0.0,
-        "rain_mm_per_h": 0.0,
-        "wave_height_m": 0.0,
-        "wind_speed_m_s": 0.0,
-        "water_albedo": [0.0, 0.0, 0.0],
-    }
-    args.update(kw)
-    return core.SensorEnv(**args)  # type: ignore[arg-type]
 
 
 def _sun(elevation_deg: float, azimuth_deg: float) -> np.ndarray:
@@ -126,7 +111,7 @@ def _lobe_radiance(env: core.SensorEnv, o: np.ndarray, a: float) -> np.ndarray:
 def _centre_ratio(fov_deg: float, pitch_deg: float, wind: float, sun: np.ndarray) -> np.ndarray:
     """(3,) rendered radiance of the central 2 × 2 water pixels over the lobe integral of each pixel's ray."""
     s = _sea_scene()
-    env = _env(sun, wind_speed_m_s=wind, water_multiple_scattering=False)
+    env = clear_env(sun, wind_speed_m_s=wind, water_multiple_scattering=False)
     w = 32
     cam = core.Camera(width=w, height=w, rgb=True, hfov=math.radians(fov_deg), quality="high", range_max=20000.0)
     pose = pose_matrices(np.array([0.0, 0.0, 10.0, 0.0, math.radians(pitch_deg), 0.0]))
@@ -149,7 +134,7 @@ def test_rendered_sun_disc_is_0533_degrees_and_carries_the_esra_beam() -> None:
     pixels make a circle 0.533° across within 1 % (the mean solar diameter, 31.99')."""
     el, az = 35.0, 40.0
     sun = _sun(el, az)
-    env = _env(sun)
+    env = clear_env(sun)
     w = 96
     cam = core.Camera(width=w, height=w, rgb=True, hfov=math.radians(1.2), quality="standard", range_max=1000.0)
     pose = pose_matrices(np.array([0.0, 0.0, 10.0, 0.0, -math.radians(el), math.radians(az)]))
@@ -173,7 +158,7 @@ def test_calm_water_seen_straight_down_reflects_fresnels_r0() -> None:
     about 1 %)."""
     r0 = ((WATER_IOR - 1) / (WATER_IOR + 1)) ** 2
     assert r0 == pytest.approx(0.02006, abs=1e-5) and float(_fresnel(1.0)) == pytest.approx(r0, rel=1e-12)
-    env = _env(_sun(30.0, 180.0), water_multiple_scattering=False)
+    env = clear_env(_sun(30.0, 180.0), water_multiple_scattering=False)
     cam = core.Camera(width=16, height=16, rgb=True, hfov=math.radians(2), quality="high", range_max=1000.0)
     pose = pose_matrices(np.array([0.0, 0.0, 20.0, 0.0, math.pi / 2, 0.0]))
     img = render(cam, _sea_scene(), pose=pose, env=env, seed=1, radiance=True)
@@ -349,7 +334,7 @@ def test_sensor_noise_is_shot_plus_read_noise_in_the_exposed_signal() -> None:
     v = np.array([[10.0, -50.0, -50.0], [10.0, 50.0, -50.0], [10.0, 50.0, 50.0], [10.0, -50.0, 50.0]])
     s.add_instance(s.add_mesh(v, np.array([[0, 1, 2], [0, 2, 3]]), classes=4, name="wall"))
     ev, full_well, read = 15.0, 400.0, 12.0
-    env = _env(_sun(30.0, 180.0), exposure_ev100=ev)
+    env = clear_env(_sun(30.0, 180.0), exposure_ev100=ev)
     cam = core.Camera(width=64, height=48, rgb=True, hfov=math.radians(30), quality="draft", noise=(full_well, read))
     img = render(cam, s, pose=np.eye(4), env=env, seed=3, radiance=True)
     assert img.radiance is not None and img.rgb is not None
@@ -427,7 +412,7 @@ def _lamp_glow(asset: str, bearing: np.ndarray) -> list[tuple[str, np.ndarray, n
     s.set_materials(material_table())
     inst = s.add_instance(s.add_mesh(m.vertices, m.faces, classes=10, name=asset, materials=m.materials))
     s.set_lights([inst], on=True)
-    env = _env(_sun(-20.0, 0.0))
+    env = clear_env(_sun(-20.0, 0.0))
     cam = core.Camera(width=1, height=1, rgb=True, hfov=math.radians(0.01), quality="draft", range_max=400.0)
     centroids = m.vertices[m.faces].mean(axis=1)
     rad = np.radians(bearing)

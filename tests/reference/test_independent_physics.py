@@ -34,6 +34,7 @@ import math
 
 import numpy as np
 import pytest
+from clear_env import clear_env
 from mmusv._native import core
 from mmusv.scene import Scene
 from mmusv.sensors.camera import render
@@ -115,23 +116,6 @@ KELVIN_HALF_ANGLE_DEG = math.degrees(math.asin(1.0 / 3.0))
 
 
 # --- helpers ---
-
-
-def _env(sun: np.ndarray | tuple[float, float, float] = (0.3, 0.2, 0.93), **kw: object) -> core.SensorEnv:
-    """A clear, fog-free environment, every field explicit (the keywords replace them)."""
-    args: dict[str, object] = {
-        "sun_direction": [float(x) for x in sun],
-        "turbidity": 3.0,
-        "cloud_cover": 0.0,
-        "ground_albedo": 0.06,
-        "fog_extinction_per_m": 0.0,
-        "rain_mm_per_h": 0.0,
-        "wave_height_m": 0.0,
-        "wind_speed_m_s": 0.0,
-        "water_albedo": [0.0, 0.0, 0.0],
-    }
-    args.update(kw)
-    return core.SensorEnv(**args)  # type: ignore[arg-type]
 
 
 def _quad(scene: Scene, z: float, half: float, cls: int, mat: int = 0) -> int:
@@ -380,7 +364,7 @@ def test_whitecap_coverage_follows_monahan() -> None:
     cover = []
     for u in winds:
         img = render(
-            top, s, pose=pose, env=_env(wind_speed_m_s=u, water_albedo=[0.004, 0.018, 0.03]), seed=2, radiance=True
+            top, s, pose=pose, env=clear_env(wind_speed_m_s=u, water_albedo=[0.004, 0.018, 0.03]), seed=2, radiance=True
         )
         assert img.radiance is not None
         lum = img.radiance @ LUMINANCE
@@ -448,12 +432,12 @@ def test_preetham_sky_overcast_sky_and_the_sun() -> None:
     for elev in (60.0, 30.0, 10.0):
         sun = _sun(elev, 20.0)
         for turbidity in (2.0, 3.0, 6.0, 9.0):
-            env = _env(sun, turbidity=turbidity)
+            env = clear_env(sun, turbidity=turbidity)
             got = env.sky_radiance(d.astype(np.float32)).astype(float)
             want = _preetham_rgb(turbidity, sun, d) + 0.002
             np.testing.assert_allclose(got, want, rtol=3e-3)
             np.testing.assert_allclose(env.sun_irradiance, _esra_beam(math.radians(elev), turbidity), rtol=1e-5)
-        overcast = _env(sun, cloud_cover=1.0).sky_radiance(d.astype(np.float32)).astype(float) - 0.002
+        overcast = clear_env(sun, cloud_cover=1.0).sky_radiance(d.astype(np.float32)).astype(float) - 0.002
         level = overcast / ((1 + 2 * d[:, 2]) / 3)[:, None]  # L_z, the same in every direction and channel
         np.testing.assert_allclose(level, np.median(level), rtol=2e-4)
 
@@ -461,7 +445,7 @@ def test_preetham_sky_overcast_sky_and_the_sun() -> None:
     disc_sr = 2 * math.pi * (1 - math.cos(radius))
     for elev, az in [(70.0, 53.0), (30.0, 11.0), (10.0, 143.0)]:
         sun = _sun(elev, az)
-        env = _env(sun)
+        env = clear_env(sun)
         beam = np.asarray(env.sun_irradiance, dtype=float)
         u = np.cross(sun, [0.0, 0.0, 1.0])
         u /= np.linalg.norm(u)
@@ -527,7 +511,7 @@ def test_ggx_smith_schlick_and_the_split_sum() -> None:
     h = v + sun
     h /= np.linalg.norm(h, axis=1)[:, None]
     nv, nl, nh, vh = v[:, 2], sun[2], h[:, 2], (v * h).sum(axis=1)
-    e_sun = np.asarray(_env(sun).sun_irradiance, dtype=float)
+    e_sun = np.asarray(clear_env(sun).sun_irradiance, dtype=float)
 
     def plane(base: tuple[float, float, float], rough: float, metal: float) -> Scene:
         s = Scene()
@@ -540,8 +524,8 @@ def test_ggx_smith_schlick_and_the_split_sum() -> None:
 
     for base, rough, metal in [((0.5, 0.4, 0.3), 0.3, 0.0), ((0.9, 0.6, 0.3), 0.6, 1.0), ((0.2, 0.2, 0.2), 0.15, 0.0)]:
         s = plane(base, rough, metal)
-        lit = render(cam, s, pose=pose, env=_env(sun, shadows=False), seed=1, radiance=True).radiance
-        dark = render(cam, s, pose=pose, env=_env(sun), seed=1, radiance=True).radiance
+        lit = render(cam, s, pose=pose, env=clear_env(sun, shadows=False), seed=1, radiance=True).radiance
+        dark = render(cam, s, pose=pose, env=clear_env(sun), seed=1, radiance=True).radiance
         assert lit is not None and dark is not None
         a = max(rough * rough, 1e-3)
         f0 = np.full(3, DIELECTRIC_F0) * (1 - metal) + np.array(base) * metal
@@ -562,7 +546,7 @@ def test_ggx_smith_schlick_and_the_split_sum() -> None:
     for rough in (0.25, 0.5, 0.8):
         a = rough * rough
         black, white = (
-            render(cam, plane((b, b, b), rough, 1.0), pose=pose, env=_env(sun), seed=1, radiance=True).radiance
+            render(cam, plane((b, b, b), rough, 1.0), pose=pose, env=clear_env(sun), seed=1, radiance=True).radiance
             for b in (0.0, 1.0)
         )
         assert black is not None and white is not None
@@ -602,7 +586,7 @@ def test_water_reflectance_is_fresnel_over_cox_munk_facets() -> None:
     sun = _sun(50.0, 180.0)  # behind the camera: no glint in view
     for wind in (0.0, 6.0):
         a = math.sqrt(COX_MUNK[0] + COX_MUNK[1] * wind)
-        env = _env(sun, wind_speed_m_s=wind, water_multiple_scattering=False)
+        env = clear_env(sun, wind_speed_m_s=wind, water_multiple_scattering=False)
         img = render(cam, s, pose=pose, env=env, seed=1, radiance=True)
         assert img.radiance is not None and np.all(img.semantic[h // 2 :] == 1) and np.all(img.semantic[: h // 2] == 0)
         th = (np.arange(600) + 0.5) / 600 * min(math.atan(8 * a), 1.5)
@@ -634,8 +618,8 @@ def test_water_reflectance_is_fresnel_over_cox_munk_facets() -> None:
     cam = core.Camera(width=32, height=48, rgb=True, hfov=math.radians(16), quality="high", range_max=50_000.0)
     pose = pose_matrices(np.array([0.0, 0.0, 20.0, 0.0, math.radians(12), 0.0]))
     single = {"water_multiple_scattering": False}
-    lit = render(cam, s, pose=pose, env=_env(sun, shadows=False, **single), seed=1, radiance=True).radiance
-    dark = render(cam, s, pose=pose, env=_env(sun, **single), seed=1, radiance=True).radiance
+    lit = render(cam, s, pose=pose, env=clear_env(sun, shadows=False, **single), seed=1, radiance=True).radiance
+    dark = render(cam, s, pose=pose, env=clear_env(sun, **single), seed=1, radiance=True).radiance
     assert lit is not None and dark is not None
     v = -cam.world_rays(pose)[1].astype(float)
     hh = v + sun
@@ -644,7 +628,7 @@ def test_water_reflectance_is_fresnel_over_cox_munk_facets() -> None:
     nh = hh[:, 2]
     dbeck = np.exp(-((1 - nh**2) / nh**2) / a**2) / (math.pi * a * a * nh**4)
     glint = dbeck * _beckmann_g1(v[:, 2], a) * _beckmann_g1(sun[2], a) * _fresnel((v * hh).sum(axis=1)) / (4 * v[:, 2])
-    want = glint[:, None] * np.asarray(_env(sun).sun_irradiance, dtype=float)
+    want = glint[:, None] * np.asarray(clear_env(sun).sun_irradiance, dtype=float)
     seen = want[:, 1] > 1e-3 * want[:, 1].max()
     assert seen.sum() > 300
     np.testing.assert_allclose(_sun_term(lit, dark)[seen], want[seen], rtol=0.01)
@@ -702,7 +686,7 @@ def test_radar_sea_clutter_is_the_nrl_model() -> None:
     earth = 6_371_000.0 * 4 / 3
     for hs in (0.3, 1.0, 3.0, 5.0):
         s.set_wave_surface(None, scenario_seed=1, time_s=0.0, foci=[[0.0, 0.0]])
-        fixed = radar.sweep(s.native, pose=pose, env=_env(wave_height_m=hs), seed=5)
+        fixed = radar.sweep(s.native, pose=pose, env=clear_env(wave_height_m=hs), seed=5)
         s.set_wave_surface(
             sea_spec_for_height(1.0),
             scenario_seed=1,
@@ -712,7 +696,7 @@ def test_radar_sea_clutter_is_the_nrl_model() -> None:
             detail=False,
             slopes=False,
         )
-        phys = radar.sweep(s.native, pose=pose, env=_env(wave_height_m=hs), seed=5)
+        phys = radar.sweep(s.native, pose=pose, env=clear_env(wave_height_m=hs), seed=5)
         assert np.array_equal(fixed["range"], phys["range"]) and np.array_equal(fixed["azimuth"], phys["azimuth"])
         r = phys["range"].astype(float)
         psi = np.clip(np.degrees(np.arcsin(height / r - r / (2 * earth))), 0.1, 60.0)
@@ -741,7 +725,7 @@ def test_exposure_aces_and_srgb() -> None:
     hemi = np.stack([np.sin(tt) * np.cos(pp), np.sin(tt) * np.sin(pp), np.cos(tt)], -1).reshape(-1, 3)
     for elev in (60.0, 25.0, 8.0):
         sun = _sun(elev)
-        env = _env(sun)
+        env = clear_env(sun)
         lum = env.sky_radiance(hemi.astype(np.float32)) @ LUMINANCE
         e_h = (lum.reshape(nt, npp) * np.cos(tt) * np.sin(tt)).sum() * (math.pi / 2 / nt) * (2 * math.pi / npp)
         e_h += np.asarray(env.sun_irradiance) @ LUMINANCE * sun[2]
@@ -761,7 +745,7 @@ def test_exposure_aces_and_srgb() -> None:
             cam,
             s,
             pose=pose,
-            env=_env((0.5, 0.3, 0.81), exposure_ev100=ev, wind_speed_m_s=3.0, water_albedo=[0.004, 0.018, 0.03]),
+            env=clear_env((0.5, 0.3, 0.81), exposure_ev100=ev, wind_speed_m_s=3.0, water_albedo=[0.004, 0.018, 0.03]),
             seed=1,
             radiance=True,
         )
@@ -786,7 +770,7 @@ def test_kelvin_wake_half_angle() -> None:
     (the Airy tail)."""
     s = Scene()
     _quad(s, 0.0, 9000.0, 1)
-    env = _env(wind_speed_m_s=0.0, water_albedo=[0.004, 0.018, 0.03])
+    env = clear_env(wind_speed_m_s=0.0, water_albedo=[0.004, 0.018, 0.03])
     heading, length, beam = 0.7, 20.0, 5.0
     ch, sh = math.cos(heading), math.sin(heading)
 

@@ -1,0 +1,24 @@
+"""One clear, fog-free, windless sensor environment for the physics tests, every field explicit."""
+
+from __future__ import annotations
+
+import numpy as np
+from mmusv._native import core
+
+
+def clear_env(sun: np.ndarray | tuple[float, float, float] = (0.3, 0.2, 0.93), **kw: object) -> core.SensorEnv:
+    """A clear sky of turbidity 3, no fog, rain, waves or wind, black water; ``sun`` the unit direction towards the
+    sun (world, z up); the keywords replace fields of :class:`mmusv._core.SensorEnv`."""
+    args: dict[str, object] = {
+        "sun_direction": [float(x) for x in sun],
+        "turbidity": 3.0,
+        "cloud_cover": 0.0,
+        "ground_albedo": 0.06,
+        "fog_extinction_per_m": 0.0,
+        "rain_mm_per_h": 0.0,
+        "wave_height_m": 0.0,
+        "wind_speed_m_s": 0.0,
+        "water_albedo": [0.0, 0.0, 0.0],
+    }
+    args.update(kw)
+    return core.SensorEnv(**args)  # type: ignore[arg-type]
