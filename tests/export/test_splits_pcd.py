@@ -36,6 +36,9 @@ def test_assign_splits_deterministic_and_order_independent() -> None:
     assert c != a
     with pytest.raises(ConfigError):
         assign_splits(["x", "x"], (1.0, 0.0, 0.0), seed=0)
+    # random.Random(-1) shuffles as random.Random(1): a negative seed is refused, not a copy of another
+    with pytest.raises(ConfigError, match=r"seed = -1: the split's seed must be a whole number >= 0"):
+        assign_splits(keys, parse_ratios((0.7, 0.15, 0.15)), seed=-1)
 
 
 @pytest.mark.parametrize("bad", ["0.7,0.3", "a,b,c", "-1,1,1", "0,0,0", (0.5, float("nan"), 0.5)])

@@ -72,6 +72,9 @@ def assign_splits(keys: Sequence[str], ratios: Sequence[float], seed: int) -> di
     seed), independent of the order of ``keys``."""
     if len(set(keys)) != len(keys):
         raise ConfigError("the same recording is given twice")
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        # random.Random takes |seed|: -1 would split as 1 does
+        raise ConfigError(f"seed = {seed!r}: the split's seed must be a whole number >= 0")
     ordered = sorted(keys)
     random.Random(seed).shuffle(ordered)
     counts = split_counts(len(ordered), ratios)

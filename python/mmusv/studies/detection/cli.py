@@ -137,7 +137,8 @@ def add_parsers(studies: Any) -> None:
     rob.add_argument(
         "--settings",
         default="delay:1,delay:2,delay:3,noise:0.5/0.5,noise:1/1,noise:2/2",
-        help="delay:K (frames) and noise:SIGMA_XYZ_M/SIGMA_RPY_DEG items (clean is always included)",
+        help="delay:K (frames) and noise:SIGMA_XYZ_M/SIGMA_RPY_DEG items (noise:S = noise:S/S; clean is always "
+        "included). A frame k is scored where the frame k-K of every delay was recorded",
     )
 
 
@@ -153,7 +154,7 @@ def run(args: argparse.Namespace) -> int:
     from mmusv.studies.detection.fusion import parse_modes
     from mmusv.studies.detection.robustness import Setting, parse_settings
     from mmusv.studies.detection.sources import generate_dataset, resolve_dataset
-    from mmusv.studies.detection.study import StudyOptions, load_predictions, run_study
+    from mmusv.studies.detection.study import StudyOptions, check_prediction_coverage, load_predictions, run_study
 
     robust = args.study == "robustness"
     console = Console(width=None if sys.stdout.isatty() else 160)
@@ -202,6 +203,8 @@ def run(args: argparse.Namespace) -> int:
     )
     detector_name = f"learned model {args.model}" if learned is not None else args.detector
     predictions = load_predictions(args.predictions) if args.predictions is not None else None
+    if predictions is not None:
+        check_prediction_coverage(args.predictions, predictions, modes=modes, settings=settings)
     t0 = time.perf_counter()
     inputs: list[Any] = list(args.inputs)
     if args.generate is not None:

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -92,6 +93,16 @@ class SequenceData:
     def agent_ids(self) -> tuple[str, ...]:
         """The instrumented USVs (those present in the first frame)."""
         return tuple(a.id for a in self.frames[0].agents) if self.frames else ()
+
+    @cached_property
+    def _positions(self) -> dict[int, int]:
+        return {f.frame: k for k, f in enumerate(self.frames)}
+
+    def frame_at(self, index: int) -> SceneFrame | None:
+        """The frame of acquisition index ``index`` (``None`` when the sequence has none: before its start, or
+        missing from a damaged or partly recorded recording)."""
+        k = self._positions.get(index)
+        return None if k is None else self.frames[k]
 
 
 def boxes_in_frame(to_frame: np.ndarray, boxes: np.ndarray, sizes: np.ndarray) -> np.ndarray:

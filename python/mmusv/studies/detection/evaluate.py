@@ -200,8 +200,8 @@ class FrameMatch:
 
 def summarize(frames: Sequence[FrameMatch]) -> dict[str, float]:
     """Metrics over ``frames``: ``ap30, ap50, ap70`` (AP at IoU 0.3/0.5/0.7), ``precision50, recall50``,
-    ``ap50_<bin>`` per range bin, and the counts ``frames, gt, det``. NaN where undefined (no ground truth, or no
-    detection for precision)."""
+    ``ap50_<bin>`` per range bin, and the counts ``ego_frames`` (one per element of ``frames``: an ego USV at a
+    frame), ``gt``, ``det``. NaN where undefined (no ground truth, or no detection for precision)."""
     out: dict[str, float] = {}
     scores = np.concatenate([f.det_scores for f in frames]) if frames else np.zeros(0)
     n_gt = int(sum(f.gt_boxes.shape[0] for f in frames))
@@ -222,7 +222,7 @@ def summarize(frames: Sequence[FrameMatch]) -> dict[str, float]:
     for k in range(len(RANGE_BINS)):
         sel = dbin == k
         out[f"ap50_{bin_label(k)}"] = average_precision(scores[sel], tp50[sel], int((gbin == k).sum()))
-    out["frames"] = float(len(frames))
+    out["ego_frames"] = float(len(frames))
     out["gt"] = float(n_gt)
     out["det"] = float(len(scores))
     return out

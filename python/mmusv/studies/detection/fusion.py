@@ -36,6 +36,7 @@ __all__ = [
     "MODES",
     "NMS_IOU",
     "WBF_IOU",
+    "detector_name",
     "fuse",
     "fuse_boxes",
     "parse_modes",
@@ -171,7 +172,8 @@ def fuse(
     """Boxes ``(M, 7)`` and scores ``(M,)`` in ``ego``'s LiDAR frame for fusion ``mode`` (module docstring).
     ``own_detections(agent)`` returns the detector's output on an agent's own cloud (a cache may back it);
     ``late_merge``: one of :data:`LATE_MERGES`."""
-    own = own_detections or (lambda a: _as_boxes(detector(a.points)))
+    who = detector_name(detector)
+    own = own_detections or (lambda a: _as_boxes(detector(a.points), who))
     if mode == "none":
         return own(ego)
     if mode == "late":
@@ -191,23 +193,40 @@ def fuse(
         return boxes[keep], scores[keep]
     if mode == "early":
         early = getattr(detector, "early", detector)
-        return _as_boxes(early(early_points(ego, neighbours, crop_m=crop_m)))
+        return _as_boxes(early(early_points(ego, neighbours, crop_m=crop_m)), who)
     if mode == "intermediate":
         inter = getattr(detector, "intermediate", None)
         if inter is None:
             raise InputError("intermediate fusion needs a learned model (--model), not a points -> boxes detector")
-        return _as_boxes(inter(ego.points, [(nb.points, relative(ego, nb)) for nb in neighbours]))
+        return _as_boxes(inter(ego.points, [(nb.points, relative(ego, nb)) for nb in neighbours]), who)
     raise InputError(f"fusion mode {mode!r}: allowed: {', '.join(MODES)}")
 
 
-def _as_boxes(out: tuple[np.ndarray, np.ndarray]) -> Boxes:
-    """A detector's output checked and as float64 ``(M, 7)``, ``(M,)``."""
+def detector_name(detector: object) -> str:
+    """How errors name ``detector``: ``--detector 'pkg.mod:fn'`` for a user's detector, else "the detector"."""
+    spec = getattr(detector, "spec", None)
+    return f"--detector {spec!r}" if isinstance(spec, str) else "the detector"
+
+
+def _as_boxes(out: tuple[np.ndarray, np.ndarray], who: str = "the detector") -> Boxes:
+    """A detector's output checked and as float64 ``(M, 7)``, ``(M,)``: finite boxes and scores (a NaN box was a
+    shapely traceback, a NaN score ranked anyhow), ``who`` naming the detector in the error."""
+    expected = "expected boxes (M, 7) x, y, z, l, w, h, yaw and scores (M,), finite numbers"
     try:
         b, s = out
+        boxes = np.asarray(b, dtype=np.float64)
+        scores = np.asarray(s, dtype=np.float64).reshape(-1)
     except (TypeError, ValueError):
-        raise InputError("the detector must return (boxes (M, 7), scores (M,))") from None
-    boxes = np.asarray(b, dtype=np.float64).reshape(-1, 7) if np.size(b) else np.zeros((0, 7))
-    scores = np.asarray(s, dtype=np.float64).reshape(-1)
+        raise InputError(f"{who} must return (boxes (M, 7), scores (M,)); {expected}") from None
+    if boxes.size == 0:
+        boxes = np.zeros((0, 7))
+    elif boxes.shape == (7,):  # one box, as a row
+        boxes = boxes.reshape(1, 7)
+    elif boxes.ndim != 2 or boxes.shape[1] != 7:
+        raise InputError(f"{who} returned boxes of shape {boxes.shape}; {expected}")
     if boxes.shape[0] != scores.shape[0]:
-        raise InputError(f"the detector returned {boxes.shape[0]} boxes but {scores.shape[0]} scores")
+        raise InputError(f"{who} returned {boxes.shape[0]} boxes but {scores.shape[0]} scores")
+    if not (np.isfinite(boxes).all() and np.isfinite(scores).all()):
+        bad = "boxes" if not np.isfinite(boxes).all() else "scores"
+        raise InputError(f"{who} returned {bad} that are not finite (NaN or inf); {expected}")
     return boxes, scores

@@ -45,7 +45,7 @@ def detection_table(res: StudyResult) -> pl.DataFrame:
     """Table III: one row per fusion mode (clean setting)."""
     t = res.table().filter(pl.col("setting") == "clean")
     cols = ["mode", *(c for c, _ in DETECTION_METRICS), "gt_visible", "gt_hidden", "gt_unseen"]
-    cols += ["gt_wave_hidden", "gt", "det", "frames"]
+    cols += ["gt_wave_hidden", "gt", "det", "frames", "ego_frames"]
     return t.select(cols)
 
 

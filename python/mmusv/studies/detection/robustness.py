@@ -2,7 +2,8 @@
 
 - ``clean``: the neighbours' current points and poses.
 - ``delay:k``: each non-ego USV's points *and* pose from ``k`` frames earlier (``k / f`` seconds: 200–600 ms at
-  5 Hz for k = 1..3); the ego and the ground truth stay current.
+  5 Hz for k = 1..3), the frame whose acquisition index is ``k`` less (not the ``k``-th frame read before: a
+  recording with missing frames has none there); the ego and the ground truth stay current.
 - ``noise:σ_xyz/σ_rpy``: zero-mean Gaussian noise, σ_xyz metres on each of x, y, z and σ_rpy degrees on each of
   roll, pitch, yaw, added to every non-ego USV's body pose (so to its LiDAR pose). The draws are seeded by
   (seed, sequence, frame, ego, neighbour, setting): late and early fusion see the same draws.
@@ -16,11 +17,24 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from mmusv.config import MAX_COORDINATE_M
 from mmusv.errors import InputError
 from mmusv.frames import matrix_to_pose, pose_matrices
 from mmusv.studies.detection.data import AgentFrame, SequenceData
 
-__all__ = ["DEFAULT_SETTINGS", "Setting", "neighbours_for", "parse_settings"]
+__all__ = ["DEFAULT_SETTINGS", "MAX_SIGMA_RPY_DEG", "MAX_SIGMA_XYZ_M", "Setting", "neighbours_for", "parse_settings"]
+
+MAX_SIGMA_XYZ_M = MAX_COORDINATE_M
+"""The largest position noise σ (metres): the extent of a scenario's world (σ = 1e308 overflowed the pose)."""
+MAX_SIGMA_RPY_DEG = 360.0
+"""The largest attitude noise σ (degrees): a full turn."""
+
+
+def _num(x: float) -> str:
+    """``x`` as ``%g`` writes it where that reads back as ``x`` (``0.5``, ``1``), else in full (``1.0000001``): two
+    settings that differ never share a name (the key of their results and of their noise draws)."""
+    short = f"{x:g}"
+    return short if float(short) == x else repr(float(x))
 
 
 @dataclass(frozen=True)
@@ -37,7 +51,7 @@ class Setting:
         if self.delay_frames:
             return f"delay:{self.delay_frames}"
         if self.sigma_xyz_m or self.sigma_rpy_deg:
-            return f"noise:{self.sigma_xyz_m:g}/{self.sigma_rpy_deg:g}"
+            return f"noise:{_num(self.sigma_xyz_m)}/{_num(self.sigma_rpy_deg)}"
         return "clean"
 
     @property
@@ -58,8 +72,8 @@ DEFAULT_SETTINGS = (
 
 
 def parse_settings(text: str | Sequence[str]) -> tuple[Setting, ...]:
-    """Settings from ``"clean,delay:1,delay:2,noise:0.5/0.5"`` (or a list of such items); ``clean`` is always
-    included first."""
+    """Settings from ``"clean,delay:1,delay:2,noise:0.5/0.5"`` (or a list of such items; ``noise:S`` is
+    ``noise:S/S``); ``clean`` is always included first, each setting once."""
     items = [s.strip() for s in (text.split(",") if isinstance(text, str) else text) if s.strip()]
     if not items:  # "" ran the clean setting alone, a robustness study of nothing
         raise InputError("--settings is empty: give clean, delay:K or noise:SIGMA_XYZ_M/SIGMA_RPY_DEG items")
@@ -77,7 +91,7 @@ def parse_settings(text: str | Sequence[str]) -> tuple[Setting, ...]:
             elif kind == "noise":
                 a, _, b = val.partition("/")
                 sx, sr = float(a), float(b if b else a)
-                if not (sx >= 0 and sr >= 0) or (sx == 0 and sr == 0) or not np.isfinite([sx, sr]).all():
+                if not (0 <= sx <= MAX_SIGMA_XYZ_M and 0 <= sr <= MAX_SIGMA_RPY_DEG) or (sx == 0 and sr == 0):
                     raise ValueError
                 st = Setting(sigma_xyz_m=sx, sigma_rpy_deg=sr)
             else:
@@ -85,7 +99,8 @@ def parse_settings(text: str | Sequence[str]) -> tuple[Setting, ...]:
         except ValueError:
             raise InputError(
                 f"--settings item {it!r}: expected clean, delay:K (K ≥ 1 frames) or "
-                "noise:SIGMA_XYZ_M/SIGMA_RPY_DEG (non-negative, not both 0)"
+                f"noise:SIGMA_XYZ_M/SIGMA_RPY_DEG (0 ≤ SIGMA_XYZ_M ≤ {MAX_SIGMA_XYZ_M:g} m, 0 ≤ SIGMA_RPY_DEG ≤ "
+                f"{MAX_SIGMA_RPY_DEG:g}°, not both 0)"
             ) from None
         if st not in out:
             out.append(st)
@@ -93,7 +108,7 @@ def parse_settings(text: str | Sequence[str]) -> tuple[Setting, ...]:
 
 
 def _seed_words(seed: int, seq: str, frame: int, ego: str, nb: str, setting: Setting) -> list[int]:
-    return [
+    words = [
         seed & 0xFFFFFFFF,
         zlib.crc32(seq.encode()),
         frame,
@@ -101,15 +116,25 @@ def _seed_words(seed: int, seq: str, frame: int, ego: str, nb: str, setting: Set
         zlib.crc32(nb.encode()),
         zlib.crc32(setting.name.encode()),
     ]
+    if not 0 <= seed <= 0xFFFFFFFF:  # the sign and the rest of the seed: 2**32 drew seed 0's noise, -1 2**32 - 1's
+        words.append(int(seed < 0))
+        high = abs(seed) >> 32
+        while high:
+            words.append(high & 0xFFFFFFFF)
+            high >>= 32
+    return words
 
 
 def neighbours_for(seq: SequenceData, index: int, ego_id: str, setting: Setting, *, seed: int) -> list[AgentFrame]:
-    """The non-ego USVs of ``seq.frames[index]`` as ``ego_id`` receives them under ``setting``. ``index`` must be
-    ≥ ``setting.delay_frames``."""
-    if index < setting.delay_frames:
-        raise InputError(f"frame index {index} has no data {setting.delay_frames} frames earlier")
+    """The non-ego USVs of ``seq.frames[index]`` as ``ego_id`` receives them under ``setting``. With a delay of
+    ``k`` frames, the sequence must hold the frame of acquisition index ``seq.frames[index].frame - k``."""
     now = seq.frames[index]
-    past = seq.frames[index - setting.delay_frames]
+    past = seq.frame_at(now.frame - setting.delay_frames)
+    if past is None:
+        raise InputError(
+            f"sequence {seq.name}: frame {now.frame} has no data {setting.delay_frames} frames earlier "
+            f"(frame {now.frame - setting.delay_frames} is not in the sequence)"
+        )
     by_id = {a.id: a for a in past.agents}
     out: list[AgentFrame] = []
     for a in now.agents:

@@ -60,10 +60,17 @@ from mmusv.studies.detection.evaluate import (
     range_bin,
     summarize,
 )
-from mmusv.studies.detection.fusion import DEFAULT_MODES, MODES, _as_boxes, fuse, relative
+from mmusv.studies.detection.fusion import DEFAULT_MODES, MODES, _as_boxes, detector_name, fuse, relative
 from mmusv.studies.detection.robustness import Setting, neighbours_for
 
-__all__ = ["StudyOptions", "StudyResult", "gt_visibility", "load_predictions", "run_study"]
+__all__ = [
+    "StudyOptions",
+    "StudyResult",
+    "check_prediction_coverage",
+    "gt_visibility",
+    "load_predictions",
+    "run_study",
+]
 
 Key = tuple[str, str]  # (setting name, mode)
 SEEN_POINTS = 5
@@ -127,8 +134,10 @@ class StudyResult:
     def metrics(self, key: Key) -> dict[str, float]:
         """:func:`~mmusv.studies.detection.evaluate.summarize` of ``key`` plus the recall at IoU 0.5 and 0.3
         of the visible, hidden, unseen and wave-hidden ground truths (``recall50_hidden``, ``recall30_hidden``,
-        ...; module docstring) and their counts ``gt_visible``, ``gt_hidden``, ``gt_unseen``, ``gt_wave_hidden``."""
+        ...; module docstring) and their counts ``gt_visible``, ``gt_hidden``, ``gt_unseen``, ``gt_wave_hidden``;
+        ``frames`` is the number of frames scored, ``ego_frames`` that of (frame, ego USV) pairs."""
         out = summarize(self.matches.get(key, []))
+        out["frames"] = float(self.frames)  # summarize counts the ego-frames (one per USV of a frame)
         vis = self.visibility.get(key, [])
         cls = np.concatenate([v[0] for v in vis]) if vis else np.zeros(0)
         hit50 = np.concatenate([v[1] for v in vis]) if vis else np.zeros(0, dtype=bool)
@@ -207,10 +216,12 @@ def load_predictions(path: str | Path) -> dict[tuple[str, int, str, str, str], t
     missing = [c for c in need if c not in df.columns]
     if missing:
         raise InputError(f"--predictions {p}: missing column(s) {missing}; required: {need}")
+    df = df.with_row_index("_row")
     if "kind" in df.columns:
         df = df.filter(pl.col("kind") == "det")
     if "setting" not in df.columns:
         df = df.with_columns(pl.lit("clean").alias("setting"))
+    _check_prediction_values(p, df)
     bad = sorted(set(df["mode"].to_list()) - set(MODES))
     if bad:
         raise InputError(f"--predictions {p}: column mode has unknown value(s) {bad}; allowed: {', '.join(MODES)}")
@@ -220,6 +231,73 @@ def load_predictions(path: str | Path) -> dict[tuple[str, int, str, str, str], t
         k = (str(key[0]), int(key[1]), str(key[2]), str(key[3]), str(key[4]))
         out[k] = (g.select(list(BOX_COLUMNS)).to_numpy().astype(np.float64), g["score"].to_numpy().astype(np.float64))
     return out
+
+
+def _check_prediction_values(path: Path, df: pl.DataFrame) -> None:
+    """Refuses a predictions table (its ``det`` rows, ``_row`` = the row in the file) with a null key, a frame that
+    is not a whole number, or a box or score that is not a finite number: a null frame was a TypeError traceback,
+    1.5 was read as frame 1, a NaN box was dropped and a NaN score ranked anyhow, each without a word."""
+
+    def first(mask: pl.Series) -> str:
+        return f"row {int(df['_row'].filter(mask)[0])}"
+
+    for c in ("sequence", "frame", "ego", "mode", "setting", *BOX_COLUMNS, "score"):
+        nulls = df[c].is_null()
+        if nulls.any():
+            raise InputError(
+                f"--predictions {path}: column {c} has {int(nulls.sum())} null value(s) (first: {first(nulls)}); "
+                "every det row needs one"
+            )
+    frame = df["frame"]
+    if not frame.dtype.is_numeric():
+        raise InputError(f"--predictions {path}: column frame must hold integer acquisition indices, not {frame.dtype}")
+    if frame.dtype.is_float():
+        values = frame.to_numpy()
+        bad = pl.Series(~np.isfinite(values) | (values != np.round(values)) | (np.abs(values) > 2**62))
+        if bad.any():
+            raise InputError(
+                f"--predictions {path}: column frame must hold integer acquisition indices; {first(bad)} has "
+                f"{float(values[bad.to_numpy()][0])!r}"
+            )
+    for c in (*BOX_COLUMNS, "score"):
+        col = df[c]
+        if not col.dtype.is_numeric():
+            unit = "" if c == "score" else " (metres, radians)"
+            raise InputError(f"--predictions {path}: column {c} must hold finite numbers{unit}, not {col.dtype}")
+        bad = pl.Series(~np.isfinite(col.to_numpy().astype(np.float64)))
+        if bad.any():
+            raise InputError(
+                f"--predictions {path}: column {c} must hold finite numbers; {first(bad)} has "
+                f"{float(col.filter(bad)[0])!r}"
+            )
+
+
+def check_prediction_coverage(
+    path: str | Path,
+    predictions: dict[tuple[str, int, str, str, str], tuple[np.ndarray, np.ndarray]],
+    *,
+    modes: Sequence[str],
+    settings: Sequence[Setting],
+) -> None:
+    """Refuses predictions without a single row of a (setting, mode) the study scores: Table III's boxes (setting
+    ``clean`` only) scored as Table IV gave AP 0 for every delay and noise setting, as if measured."""
+    held = {(k[4], k[3]) for k in predictions}
+    wanted = [(s.name, m) for s in settings for m in modes if m != "none" or s.name == "clean"]
+    missing = [w for w in wanted if w not in held]
+    if not missing:
+        return
+
+    def listed(pairs: Sequence[tuple[str, str]]) -> str:
+        by: dict[str, list[str]] = {}
+        for setting, mode in pairs:
+            by.setdefault(setting, []).append(mode)
+        return "; ".join(f"{setting} (modes {', '.join(m)})" for setting, m in by.items())
+
+    raise InputError(
+        f"--predictions {path}: no row of setting {listed(missing)}; the file holds setting "
+        f"{listed(sorted(held)) or 'none'}. Give the detections of every setting (--settings) and mode (--modes) "
+        "scored, or leave those out"
+    )
 
 
 def gt_visibility(gt: np.ndarray, points: np.ndarray, *, z_margin_m: float = 0.5) -> np.ndarray:
@@ -255,8 +333,10 @@ def run_study(
     progress: Callable[[int, int], None] | None = None,
     check_predictions: bool = True,
 ) -> StudyResult:
-    """Evaluates ``sequences`` (see the module docstring). With delays, the first ``max delay`` frames of every
-    sequence are skipped for every setting, so all settings are scored on the same frames. ``check_predictions``:
+    """Evaluates ``sequences`` (see the module docstring). With delays, a frame ``k`` is scored only where the
+    sequence holds the frame ``k - d`` of every delay ``d`` (so the first ``max delay`` frames of every sequence, and
+    those just after missing frames, are left out), for every setting: all settings are scored on the same frames.
+    ``check_predictions``:
     raise when a predictions file matched nothing evaluated (:func:`check_predictions_used`; off for one
     sequence of many, :mod:`~mmusv.studies.detection.parallel`)."""
     check_polars("the detection study")
@@ -280,12 +360,17 @@ def run_study(
         "wave_occlusion",
     ):
         res.rows[k] = []
-    start = max(s.delay_frames for s in o.settings)
+    delays = sorted({s.delay_frames for s in o.settings if s.delay_frames})
     fusion = [m for m in o.modes if m != "none"]
     done = 0
     for seq in sequences:
         if not seq.frames:
             continue
+        if not seq.agent_ids:  # was "use --modes none", which then found no frame to evaluate
+            raise InputError(
+                f"sequence {seq.name}: no LiDAR: none of its instrumented USVs carries one (a rig with lidar: null), "
+                "and the study detects in LiDAR clouds"
+            )
         if fusion and len(seq.agent_ids) < 2:
             raise InputError(
                 f"sequence {seq.name}: {len(seq.agent_ids)} instrumented USV(s) with a LiDAR; "
@@ -293,8 +378,9 @@ def run_study(
             )
         res.sequences.append(seq.name)
         own = _OwnDetections(o.detector)
-        for t in range(start, len(seq.frames)):
-            frame = seq.frames[t]
+        for t, frame in enumerate(seq.frames):
+            if any(seq.frame_at(frame.frame - d) is None for d in delays):
+                continue  # a delay has no frame k - d here: left out for every setting
             res.frames += 1
             for ego in frame.agents:
                 _score_ego(res, seq, t, frame, ego, own)
@@ -329,7 +415,7 @@ class _OwnDetections:
         if key not in self.cache:
             if self.detector is None:
                 raise InputError("no detector given")
-            self.cache[key] = _as_boxes(self.detector(a.points))
+            self.cache[key] = _as_boxes(self.detector(a.points), detector_name(self.detector))
         return self.cache[key]
 
 
