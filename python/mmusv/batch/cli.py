@@ -272,6 +272,12 @@ def add_dataset_parser(subparsers: Any) -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", required=True, help="dataset folder")
     p.add_argument("--jobs", type=int, default=1, help="local pool processes (default 1); ignored with --ray")
     p.add_argument("--no-checks", action="store_true", help="skip the route checks when recording")
+    p.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="record every scenario again, replacing what DIR/recordings holds for it (a re-run without it "
+        "records only what is missing, and again what a changed spec changed)",
+    )
     _batch_options(p)
     return p
 
@@ -300,6 +306,7 @@ def run_dataset(args: argparse.Namespace) -> int:
             checks=not args.no_checks,
             progress=update,
             stop_on_full_disk=args.stop_on_full_disk,
+            overwrite=getattr(args, "overwrite", False),
         )
     console.print(
         f"scenarios: {'generated' if rep.generated else 'kept (same spec)'} in {rep.out_dir / 'scenarios'}"

@@ -6,7 +6,10 @@ Steps, each skipped on a re-run when its result is already there:
    names the same spec hash and ``DIR/scenarios/report.json`` exists with every file it lists; a generation stopped
    before its report is done again, replacing what it wrote); the quotas it did not meet are reported on every run;
 2. record every scenario into ``DIR/recordings/<stem>/`` with the batch runner (:func:`mmusv.batch.run_many`: the
-   local pool or Ray, complete recordings skipped);
+   local pool or Ray, complete recordings skipped). The recordings an earlier run indexed are this dataset's own:
+   when the spec changed, one of a scenario that changed is recorded again (it used to fail, telling to pass an
+   ``--overwrite`` that ``mmusv dataset`` did not take) and one of a scenario the spec no longer makes is removed,
+   so ``DIR/recordings`` holds what ``dataset.json`` lists;
 3. convert the complete recordings to OPV2V (:func:`mmusv.export.convert`) into ``DIR/opv2v`` (skipped when the
    last conversion was of the same recordings and configurations);
 4. ``DIR/dataset.json`` (:mod:`mmusv.batch.index`) lists every recording, with sections ``spec`` (file name,
@@ -18,6 +21,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import shutil
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -73,6 +77,39 @@ def _generated_set(scen_dir: Path) -> list[str] | None:
     return shortfall
 
 
+def _own_recordings(old: dict[str, Any]) -> set[str]:
+    """The scenarios whose recording folder ``DIR/recordings/<name>/`` an earlier ``mmusv dataset`` run into this
+    folder indexed (its ``dataset.json``, with the ``spec`` section only that command writes)."""
+    if not isinstance(old.get("spec"), dict):
+        return set()
+    out = set()
+    for r in old.get("recordings", []):
+        name, rec = r.get("name"), r.get("recording")
+        if (
+            isinstance(name, str)
+            and isinstance(rec, str)
+            and name == Path(name).name
+            and not name.startswith(".")
+            and rec.startswith(f"recordings/{name}/")
+        ):
+            out.add(name)
+    return out
+
+
+def _remove_stale(rec_dir: Path, own: set[str], stems: set[str]) -> None:
+    """Removes the recording folders of this dataset's own scenarios that the spec no longer makes."""
+    for name in sorted(own - stems):
+        folder = rec_dir / name
+        if folder.is_dir() and not folder.is_symlink():
+            try:
+                shutil.rmtree(folder)
+            except OSError as exc:
+                raise IoError(
+                    f"{folder}: cannot remove the recording of {name}, which the spec no longer makes: "
+                    f"{exc.strerror or exc}"
+                ) from None
+
+
 def build_dataset(
     spec: str | os.PathLike[str],
     *,
@@ -85,9 +122,11 @@ def build_dataset(
     checks: bool = True,
     progress: Progress | None = None,
     stop_on_full_disk: bool = False,
+    overwrite: bool = False,
 ) -> DatasetReport:
     """Generates, records, converts and indexes the dataset of ``spec`` into ``out_dir`` (see the module
-    docstring); the batch options are those of :func:`mmusv.batch.run_many`."""
+    docstring); the batch options are those of :func:`mmusv.batch.run_many` (``overwrite``: record every scenario
+    again, replacing whatever ``DIR/recordings`` holds for it)."""
     from mmusv.bundled import resolve_spec
     from mmusv.export.convert import REPORT_NAME, convert
     from mmusv.generate.runner import generate
@@ -117,6 +156,8 @@ def build_dataset(
         shortfall = [f"{c.name}: {c.accepted} of {c.quota}" for c in report.combos if not c.met]
     if progress is not None:
         progress("generate", quota, quota)
+    own = _own_recordings(old)
+    _remove_stale(rec_dir, own, {p.stem for p in scen_dir.glob("*.yaml")})
     if not any(scen_dir.glob("*.yaml")):  # no candidate met the spec: nothing to record (the shortfall says so)
         nothing = {"folder": opv2v.name, "status": "nothing to convert", "frames": 0, "sources": {}}
         write_index(index_path, [], {"spec": spec_section, "opv2v": nothing})
@@ -137,6 +178,8 @@ def build_dataset(
         index_extra={"spec": spec_section, "opv2v": old.get("opv2v")},
         progress=None if progress is None else (lambda d, t: progress("record", d, t)),
         stop_on_full_disk=stop_on_full_disk,
+        overwrite=overwrite,
+        replace=own,
     )
     doc = read_index(index_path)
     sources = {r["name"]: r["config_hash"] for r in doc["recordings"] if r["status"] == "complete"}

@@ -224,11 +224,19 @@ def _execute(task: Task) -> TaskResult:
 
 def _stop(signum: int, frame: object) -> None:
     """SIGTERM or SIGINT in a pool worker: a running task finishes its recording as interrupted (raised as
-    ``KeyboardInterrupt`` inside it) and no further task starts; an idle worker just exits (no traceback)."""
+    ``KeyboardInterrupt`` inside it, once) and no further task starts; an idle worker just exits (no traceback).
+
+    A further signal while that task finishes its recording is ignored: a Ctrl-C reaches the driver and every
+    worker at once, and the driver's :func:`_reap` sends SIGTERM right after, so a second ``KeyboardInterrupt``
+    raised inside the first one's clean-up left the recording a ``.partial`` without its manifest (and, in a
+    finaliser, printed a traceback)."""
     global _STOPPING
+    first = not _STOPPING
     _STOPPING = True
     if _IN_TASK:
-        raise KeyboardInterrupt
+        if first:
+            raise KeyboardInterrupt
+        return
     os._exit(128 + signum)
 
 
@@ -269,6 +277,19 @@ class PoolExecutor:
         self._pool: ProcessPoolExecutor | None = None
         self._futures: dict[Future[TaskResult], Task] = {}
         self._finished = 0  # tasks the pool answered (a pool that never answers may be an unguarded script)
+        self._dropped: list[Any] = []  # manager threads of the broken pools shut down without waiting
+
+    def _drop(self) -> None:
+        """Shuts down a broken pool without waiting (its workers are gone or going), keeping its manager thread
+        for :meth:`close` to wait for: still closing the pool's wake-up pipe when the interpreter's exit hook
+        wrote to it, it printed "Exception ignored ... OSError: [Errno 9] Bad file descriptor" after a stop."""
+        if self._pool is None:
+            return
+        manager = getattr(self._pool, "_executor_manager_thread", None)
+        if manager is not None:
+            self._dropped.append(manager)
+        self._pool.shutdown(wait=False, cancel_futures=True)
+        self._pool = None
 
     def _ensure(self) -> None:
         import multiprocessing
@@ -291,8 +312,7 @@ class PoolExecutor:
             try:
                 fut = self._pool.submit(_execute, task)
             except BrokenProcessPool:  # broken since the last answer: start afresh
-                self._pool.shutdown(wait=False, cancel_futures=True)
-                self._pool = None
+                self._drop()
                 self._ensure()
                 assert self._pool is not None
                 fut = self._pool.submit(_execute, task)
@@ -308,9 +328,7 @@ class PoolExecutor:
         try:
             result = fut.result()
         except BrokenProcessPool:
-            if self._pool is not None:
-                self._pool.shutdown(wait=False, cancel_futures=True)
-                self._pool = None
+            self._drop()
             why = "a process of the local pool died (killed, or out of memory)"
             if self._finished == 0 and _started_from_a_script():
                 why = f"{why}; if no task ever finishes: {UNGUARDED}"
@@ -330,9 +348,12 @@ class PoolExecutor:
         if self._pool is not None:
             if cancel:  # stop now: each worker finishes its recording as interrupted (SIGTERM), then is reaped
                 procs = list(getattr(self._pool, "_processes", {}).values())
-                self._pool.shutdown(wait=False, cancel_futures=True)
+                self._drop()
                 _reap(procs)
             else:
                 self._pool.shutdown(wait=True)
             self._pool = None
+        for manager in self._dropped:  # see _drop
+            manager.join(timeout=_REAP_S)
+        self._dropped.clear()
         self._futures.clear()

@@ -19,7 +19,7 @@ from __future__ import annotations
 import os
 import re
 import shutil
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Collection, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -170,19 +170,36 @@ def _complete_parts(path: Path, *, config_hash: str, frames: int) -> bool:
     )
 
 
-def _conflict(folder: Path, scenario: str, config_hash: str) -> str | None:
-    """A message when ``folder`` holds a recording of ``scenario`` made from another configuration."""
+def _conflict(folder: Path, scenario: str, config_hash: str, frames: int, file: str) -> str | None:
+    """Why ``folder`` holds a complete recording of ``scenario`` that this run would replace (made from another
+    configuration, or of other frames than the ``frames`` asked for: a ``--frames 2`` run replaced complete
+    recordings of every frame, which the run of one file refuses), or None."""
     m = _manifest(folder)
-    if m is not None and m.get("status") == "complete" and m.get("config_hash") != config_hash:
-        return f"{folder / str(m.get('recording'))} is a complete recording of another configuration"
+    if m is not None and m.get("status") == "complete":
+        rec = folder / str(m.get("recording"))
+        if m.get("config_hash") != config_hash:
+            return f"{rec} is a complete recording of another configuration (config hash differs from {file}'s)"
+        n, first = m.get("frames_written"), m.get("first_frame", 0)
+        if (n, first) != (frames, 0) and isinstance(n, int) and isinstance(first, int) and rec.is_file():
+            return (
+                f"{rec} is a complete recording of frames {first}..{first + n - 1}, and this run asks for frames "
+                f"0..{frames - 1} (frames = {frames})"
+            )
     pm_path = folder / f"{scenario}{PARTS_SUFFIX}"
     if pm_path.is_file():
         try:
-            other = read_parts_manifest(pm_path).config_hash != config_hash
+            pm = read_parts_manifest(pm_path)
         except MmusvError:
-            other = False
-        if other:
-            return f"{pm_path} lists the parts of a recording of another configuration"
+            return None
+        if pm.config_hash != config_hash:
+            return (
+                f"{pm_path} lists the parts of a recording of another configuration (config hash differs from {file}'s)"
+            )
+        if pm.frames != frames and _complete_parts(pm_path, config_hash=config_hash, frames=pm.frames):
+            return (
+                f"{pm_path} lists the complete parts of a recording of frames 0..{pm.frames - 1}, and this run asks "
+                f"for frames 0..{frames - 1} (frames = {frames})"
+            )
     return None
 
 
@@ -195,9 +212,11 @@ def plan_scenarios(
     overwrite: bool,
     checks: bool,
     run_id: str,
+    replace: Collection[str] = (),
 ) -> list[ScenarioPlan]:
     """The plan of every file (see the module docstring); loading a file validates it (a failure becomes the
-    plan's ``error``, never an exception)."""
+    plan's ``error``, never an exception). ``replace``: file stems whose complete recording of another
+    configuration (or other frames) is replaced as with ``overwrite``, while one of the same is still skipped."""
     from mmusv.config import load_scenario, scenario_hash
 
     if split_frames is not None and split_frames < 1:
@@ -244,11 +263,9 @@ def plan_scenarios(
                     for p in pm.parts
                 ]
                 continue
-            conflict = _conflict(folder, name, h)
-            if conflict is not None:
-                plan.error = (
-                    f"{conflict} (config hash differs from {f.name}'s); pass --overwrite (overwrite=True) to replace it"
-                )
+            conflict = _conflict(folder, name, h, total, f.name)
+            if conflict is not None and plan.name not in replace:
+                plan.error = f"{conflict}; pass --overwrite (overwrite=True) to replace it"
                 continue
         if split_frames is not None and total > split_frames:
             ranges = split_ranges(total, split_frames)

@@ -62,7 +62,15 @@ class RayExecutor:
                     configure_logging=True,
                 )
             except (ConnectionError, RuntimeError, ValueError) as exc:
-                raise IoError(f"--ray {where}: cannot start or join Ray: {exc}") from None
+                why = str(exc)
+                if where == "auto" and "Please specify" in why:
+                    # Ray's own advice names its `--address` flag and RAY_ADDRESS, which mmusv does not take
+                    why = (
+                        why.split("Please specify", 1)[0].strip().rstrip(".")
+                        + " (`ray start --head` starts one on this machine); give --ray HOST:PORT for a cluster's "
+                        "head, or --ray without an address for a local instance of this run only"
+                    )
+                raise IoError(f"--ray {where}: cannot start or join Ray: {why}") from None
             self.owned = True
         total = ray.cluster_resources().get("CPU", 0)
         if total < num_cpus:

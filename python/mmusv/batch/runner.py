@@ -18,7 +18,7 @@ from __future__ import annotations
 import os
 import time
 import uuid
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -33,7 +33,7 @@ from mmusv.batch.executors import (
     refuse_in_worker_import,
 )
 from mmusv.batch.index import INDEX_NAME, Entry, folder_bytes, write_index
-from mmusv.batch.plan import ScenarioPlan, plan_scenarios, prepare, scenario_files
+from mmusv.batch.plan import ScenarioPlan, plan_scenarios, prepare, scenario_files, task_complete
 from mmusv.batch.task import TaskResult
 from mmusv.errors import ConfigError, IoError, MmusvError
 from mmusv.recording.guard import FolderLock
@@ -155,6 +155,7 @@ def run_many(
     index_extra: Mapping[str, Any] | None = None,
     progress: Callable[[int, int], None] | None = None,
     stop_on_full_disk: bool = False,
+    replace: Collection[str] = (),
 ) -> BatchReport:
     """Runs every scenario of ``source`` (a folder of ``*.yaml``, or a list of files) into ``out_dir/<stem>/``.
 
@@ -176,6 +177,9 @@ def run_many(
         stop_on_full_disk: when a task fails because the disk is full (``No space left on device``), stop: the
             tasks not started are cancelled and reported as failed with that cause (the default goes on, marking
             each recording that cannot be written failed).
+        replace: file stems whose complete recording of another configuration (or of other frames) is replaced
+            as ``overwrite`` does, while a complete recording of the same one is still skipped (``mmusv dataset``
+            passes the recordings its earlier run indexed, so a changed spec records its changed scenarios again).
 
     The output folder is locked while the batch runs (:class:`~mmusv.recording.guard.FolderLock`): a second batch
     (or ``mmusv run``) into it fails at once.
@@ -204,6 +208,11 @@ def run_many(
     stop_on_full_disk = arguments.flag(stop_on_full_disk, name="stop_on_full_disk")
     progress = arguments.callback(progress, name="progress", nargs=2)
     index_extra = arguments.mapping(index_extra, name="index_extra")
+    if isinstance(replace, (str, bytes)) or not isinstance(replace, Iterable):
+        raise ConfigError(f"replace = {arguments.shown(replace)}: must be a collection of scenario file stems")
+    stems = frozenset(replace)
+    if not all(isinstance(n, str) for n in stems):
+        raise ConfigError(f"replace = {arguments.shown(replace)}: must be a collection of scenario file stems")
     if not isinstance(ray, (bool, str)):
         raise ConfigError(f"ray = {arguments.shown(ray)}: must be False, True, 'local', 'auto' or a Ray address")
     if ray is False and (jobs > 1 or cpus_per_task is not None):  # the local pool (see _executor)
@@ -220,6 +229,7 @@ def run_many(
         overwrite=overwrite,
         checks=checks,
         run_id=uuid.uuid4().hex,
+        replace=stems,
     )
     for p in plans:
         if p.recording is not None and not p.recording.is_relative_to(root):
@@ -261,6 +271,8 @@ def _run(
     t0: float,
 ) -> BatchReport:
     """The batch of :func:`run_many` once planned, with the output folder locked."""
+    for p in plans:
+        _prepare(p)
     status: dict[str, str] = {}
     errors: dict[str, str | None] = {}
     retried: dict[str, int] = {}
@@ -292,8 +304,6 @@ def _run(
     interrupted = False
     full_disk: str | None = None
     try:
-        for p in plans:
-            prepare(p)
         for t in todo:
             executor.submit(t)
         tries = dict.fromkeys(by_key, 1)
@@ -346,6 +356,12 @@ def _run(
     finally:
         executor.close(cancel=interrupted)
         if interrupted:
+            # a task that ended while the stop came (its worker wrote the recording, the driver never heard of
+            # it) is complete on disk: the index says so, not "pending"
+            for p in plans:
+                if status[p.name] == "pending" and _complete_on_disk(p):
+                    status[p.name] = "complete"
+                    entries[p.name] = _entry(p, "complete", None, root)
             write()
     outcomes = [_outcome(p, status[p.name], errors[p.name], retried, results) for p in plans]
     if index_error:
@@ -357,6 +373,38 @@ def _run(
         index=index_path,
         seconds=time.perf_counter() - t0,
         index_error=index_error[0] if index_error else None,
+    )
+
+
+def _prepare(plan: ScenarioPlan) -> None:
+    """:func:`~mmusv.batch.plan.prepare` of one scenario; a folder that cannot be readied (``OUT/<stem>`` is a
+    file, ...) fails that scenario alone (the batch ended at once in one line naming a ``.parts.json`` no one
+    asked for, running none of the others)."""
+    try:
+        prepare(plan)
+    except OSError as exc:
+        if plan.folder.exists() and not plan.folder.is_dir():
+            why = f"its output folder {plan.folder} is a file: move it away (the recording goes into OUT/<stem>/)"
+        else:
+            where = f" ({exc.filename})" if exc.filename else ""
+            why = f"cannot prepare its output folder {plan.folder}{where}: {exc.strerror or exc}"
+        plan.error = f"{plan.file}: {why}"
+        plan.tasks, plan.to_run = [], []
+
+
+def _complete_on_disk(plan: ScenarioPlan) -> bool:
+    """Whether every task of ``plan`` is complete in its folder (:func:`~mmusv.batch.plan.task_complete`)."""
+    if plan.error is not None or plan.scenario is None or plan.config_hash is None or not plan.tasks:
+        return False
+    return all(
+        task_complete(
+            Path(t.out_dir),
+            scenario=plan.scenario,
+            config_hash=plan.config_hash,
+            frames=t.expected_frames,
+            first_frame=t.first_frame,
+        )
+        for t in plan.tasks
     )
 
 

@@ -62,6 +62,7 @@ from mmusv.config import (
     MapConfig,
     load_scenario,
     validation_error,
+    validation_problems,
 )
 from mmusv.errors import ConfigError, MmusvError, located
 from mmusv.generate.families import FAMILIES
@@ -340,8 +341,12 @@ class GenerationSpec(_Model):
                 try:
                     EnvironmentConfig.model_validate({**with_key, key: c})
                 except ValidationError as exc:
-                    msg = str(exc.errors()[0]["msg"]).removeprefix("Value error, ")
-                    raise ValueError(f"environment.{key} = {c!r}: {msg}") from None
+                    # the field inside the value too (environment.sea.preset, with the keys allowed there), as a
+                    # scenario names it: "environment.sea = {...}: Extra inputs are not permitted" named neither
+                    field, shown, msg = validation_problems(exc, root=key, model=EnvironmentConfig)[0]
+                    if not field.startswith(key):  # a check across the fields: the value as the spec gives it
+                        field, shown = key, repr(c)
+                    raise ValueError(f"environment.{field} = {shown}: {msg}") from None
         # What a scenario refuses across keys (EnvironmentConfig's checks), for any choice the sampler can draw.
         motions = v.get("motion", [])
         if "sea" in v and "wave" in v:
