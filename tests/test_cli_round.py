@@ -284,3 +284,14 @@ def test_schema_marks_what_the_loader_refuses_on_its_own(kind: str, path: str, v
     assert _loads(kind, doc) is good, "the premise: what the loader does"
     errors = list(jsonschema.Draft202012Validator(json_schema(kind)).iter_errors(doc))  # type: ignore[arg-type]
     assert (not errors) is good, [e.message for e in errors]
+
+
+def test_main_leaves_the_warning_display_as_it_was(capsys: pytest.CaptureFixture[str]) -> None:
+    """``main()`` shows warnings as one line while it runs; it used to leave that display in place, so a notebook
+    or a test calling it in-process lost Python's own warning display (``pytest.warns`` saw nothing after)."""
+    import warnings
+
+    before = warnings.showwarning
+    assert main(["scenarios"]) == 0
+    capsys.readouterr()
+    assert warnings.showwarning is before

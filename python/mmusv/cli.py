@@ -527,7 +527,17 @@ def _main(argv: list[str] | None) -> int:
         prefix = "mmusv: warning: " if issubclass(category, MmusvWarning) else f"{category.__name__}: "
         cli_console.say(prefix + str(message))
 
+    before = warnings.showwarning
     warnings.showwarning = _show  # one line per warning, never a source excerpt
+    try:
+        return _run_command(args)
+    finally:  # main() called in a process that goes on (a notebook, a test) leaves its warnings as they were
+        if warnings.showwarning is _show:
+            warnings.showwarning = before
+
+
+def _run_command(args: argparse.Namespace) -> int:
+    """:func:`_dispatch` of ``args`` with the command line's signal handling and one-line errors."""
     with _Signals() as signals:
         try:
             cli_console.check_thread_environment()  # before the core's or Polars' thread pools exist

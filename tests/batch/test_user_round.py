@@ -315,3 +315,20 @@ def test_a_broken_pool_leaves_no_thread_to_race_the_exit(tmp_path: Path) -> None
     assert res.lost
     pool.close(cancel=True)
     assert manager is not None and not manager.is_alive()
+
+
+def test_a_folders_yml_scenarios_are_run_too(tmp_path: Path) -> None:
+    """A folder's ``*.yml`` scenarios were skipped without a word (the run of one file takes them); a ``.yaml``
+    and a ``.yml`` of one stem still clash by name."""
+    from mmusv.batch.plan import scenario_files
+
+    src = tmp_path / "src"
+    src.mkdir()
+    write(src / "a.yaml", scenario("a", frames=1))
+    write(src / "b.yml", scenario("b", frames=1))
+    assert [f.name for f in scenario_files(src)] == ["a.yaml", "b.yml"]
+    rep = run_many(src, out_dir=tmp_path / "out")
+    assert rep.summary() == "2 done, 0 failed, 0 skipped, 0 retried"
+    write(src / "a.yml", scenario("a", frames=1))
+    with pytest.raises(ConfigError, match=r"\['a'\] share a file stem"):
+        scenario_files(src)

@@ -248,8 +248,9 @@ def _check_file_names(source: Path | list[Path]) -> None:
     if not isinstance(source, Path) or not source.is_dir():
         return
     from mmusv.arguments import shown
+    from mmusv.batch.plan import scenario_files
 
-    for f in sorted(source.glob("*.yaml")):
+    for f in scenario_files(source):  # the files the batch runs
         try:
             f.name.encode("utf-8")
         except UnicodeEncodeError:

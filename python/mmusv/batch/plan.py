@@ -92,15 +92,18 @@ class ScenarioPlan:
 
 
 def scenario_files(source: str | os.PathLike[str] | Sequence[str | os.PathLike[str]]) -> list[Path]:
-    """The scenario files of ``source``: a folder's ``*.yaml`` (not ``report.yaml``), sorted, or the files given.
-    Raises :class:`~mmusv.errors.ConfigError` for an empty folder or two files with the same stem (their output
-    folders would clash)."""
+    """The scenario files of ``source``: a folder's ``*.yaml`` and ``*.yml`` (not ``report.yaml``), sorted, or the
+    files given. Raises :class:`~mmusv.errors.ConfigError` for an empty folder or two files with the same stem
+    (their output folders would clash)."""
     if isinstance(source, (str, os.PathLike)):
         src = arguments.path(source, name="source")
         if src.is_dir():
-            files = sorted(p for p in src.glob("*.yaml") if p.name != "report.yaml")
+            # .yml too: the run of one file takes either, and a folder's .yml scenarios were skipped without a word
+            found = [*src.glob("*.yaml"), *src.glob("*.yml")]
+            files = sorted(p for p in found if p.name != "report.yaml" and p.is_file())
             if not files:
-                raise ConfigError(f"{src} holds no *.yaml scenarios")
+                raise ConfigError(f"{src} holds no *.yaml or *.yml scenarios")
+            _check_stems(files)
             return [f.resolve() for f in files]
         files = [src]
     else:
@@ -115,13 +118,19 @@ def scenario_files(source: str | os.PathLike[str] | Sequence[str | os.PathLike[s
     for f in files:
         if not f.is_file():
             raise ConfigError(f"{f}: no such scenario file")
+    _check_stems(files)
+    return sorted((f.resolve() for f in files), key=lambda f: f.stem)
+
+
+def _check_stems(files: Sequence[Path]) -> None:
+    """Two scenario files of one stem (``a.yaml`` and ``a.yml``, or the same name in two folders) would share the
+    output folder ``OUT/<stem>``: a :class:`~mmusv.errors.ConfigError`."""
     stems = [f.stem for f in files]
     dup = sorted({s for s in stems if stems.count(s) > 1})
     if dup:
         raise ConfigError(
             f"scenario files {dup} share a file stem; each gets the output folder OUT/<stem>, rename them"
         )
-    return sorted((f.resolve() for f in files), key=lambda f: f.stem)
 
 
 def _manifest(folder: Path) -> dict[str, Any] | None:

@@ -157,7 +157,8 @@ def run_many(
     stop_on_full_disk: bool = False,
     replace: Collection[str] = (),
 ) -> BatchReport:
-    """Runs every scenario of ``source`` (a folder of ``*.yaml``, or a list of files) into ``out_dir/<stem>/``.
+    """Runs every scenario of ``source`` (a folder of ``*.yaml`` and ``*.yml``, or a list of files) into
+    ``out_dir/<stem>/``.
 
     Args:
         jobs: processes of the local pool (1: in this process); ignored with ``ray``.
