@@ -332,3 +332,17 @@ def test_a_folders_yml_scenarios_are_run_too(tmp_path: Path) -> None:
     write(src / "a.yml", scenario("a", frames=1))
     with pytest.raises(ConfigError, match=r"\['a'\] share a file stem"):
         scenario_files(src)
+
+
+def test_the_detection_studys_generate_records_a_changed_spec_again(tmp_path: Path) -> None:
+    """`study detection --generate SPEC -o OUT` after editing the spec: every scenario failed ("a complete
+    recording of another configuration; pass --overwrite", which the study does not take). Now the changed ones
+    are recorded again and the study reads the new recordings."""
+    from mmusv.recording import read_info
+    from mmusv.studies.detection.sources import generate_dataset
+
+    out = tmp_path / "det"
+    first = generate_dataset(out, spec=_spec(tmp_path / "roundset.yaml"))
+    hashes = {read_info(p).config_hash for p in first}
+    again = generate_dataset(out, spec=_spec(tmp_path / "roundset.yaml", seed=8))
+    assert len(again) == 3 and not hashes & {read_info(p).config_hash for p in again}

@@ -195,9 +195,10 @@ def generate_dataset(
     """Generates ``spec`` into ``out_dir/scenarios``, writes their LiDAR-only versions into ``out_dir/lidar_only``
     and records those with the batch runner (:func:`mmusv.batch.run_many`) into ``out_dir/recordings/<name>/``;
     returns the recordings. A complete recording of the same configuration is kept (delete ``out_dir`` to redo
-    it). ``progress``: ``("recording", frames done, frames in all)``. When a quota was not met, ``shortfall`` is
-    called with how many scenarios were generated of how many asked for, then with one line per role combination
-    whose quota the generator did not meet, with the generator's reason
+    it); one of a scenario the spec now makes otherwise is recorded again. ``progress``: ``("recording", frames
+    done, frames in all)``. When a quota was not met, ``shortfall`` is called with how many scenarios were
+    generated of how many asked for, then with one line per role combination whose quota the generator did not
+    meet, with the generator's reason
     (:meth:`mmusv.generate.report.ComboReport.why`). Raises :class:`~mmusv.InputError` when a scenario could not
     be recorded."""
     from mmusv.batch import dataset_recordings, run_many
@@ -226,6 +227,9 @@ def generate_dataset(
         lidar_dir,
         out_dir=out / "recordings",
         progress=None if progress is None else (lambda done, total: progress("recording", done, total)),
+        # out_dir/recordings is this command's own: a scenario that a changed spec changed is recorded again (it
+        # failed as "a complete recording of another configuration", with no --overwrite to pass)
+        replace={f.stem for f in files},
     )
     failed = [o for o in report.outcomes if o.status == "failed"]
     if failed:
