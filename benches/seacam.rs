@@ -27,7 +27,8 @@ fn bench_seacam(c: &mut Criterion) {
         return;
     };
     let eye = [0.0f32, 0.0, mmusv_benches::CAMERA_HEIGHT];
-    let surface = WaveSurface::new(field.components(), 12.0, 0.0, &[[eye[0], eye[1]]], SurfaceSpec::default());
+    let surface = WaveSurface::new(field.components(), 12.0, 0.0, &[[eye[0], eye[1]]], SurfaceSpec::default())
+        .unwrap_or_else(|e| unreachable!("{e}"));
     if let Err(e) = demo.scene.set_wave_surface(Some(surface)) {
         eprintln!("could not set the waves: {e}");
         return;

@@ -13,11 +13,13 @@ fn main() {
     let mut best = f64::INFINITY;
     for k in 0..8 {
         let t0 = std::time::Instant::now();
-        let s = WaveSurface::new(field.components(), 12.0 + k as f64, 0.0, &[[0.0, 0.0]], SurfaceSpec::default());
+        let s = WaveSurface::new(field.components(), 12.0 + k as f64, 0.0, &[[0.0, 0.0]], SurfaceSpec::default())
+            .unwrap_or_else(|e| unreachable!("{e}"));
         best = best.min(t0.elapsed().as_secs_f64());
         std::hint::black_box(s);
     }
-    let s = WaveSurface::new(field.components(), 12.0, 0.0, &[[0.0, 0.0]], SurfaceSpec::default());
+    let s = WaveSurface::new(field.components(), 12.0, 0.0, &[[0.0, 0.0]], SurfaceSpec::default())
+        .unwrap_or_else(|e| unreachable!("{e}"));
     println!("build (one focus, least of 8): {:.2} ms, {} sampled tiles", best * 1e3, s.sampled_tiles());
     let ks: Vec<f64> = field.components().iter().map(|c| c.kx.hypot(c.ky)).collect();
     let kmax = ks.iter().copied().fold(0.0, f64::max);
@@ -76,7 +78,8 @@ fn main() {
     }
     let w3 = paper_sea_states()[3];
     let Ok(field3) = WaveField::new(&w3.spec(0.3, 10.0), 7) else { return };
-    let s3 = WaveSurface::new(field3.components(), 12.0, 0.0, &[[0.0, 0.0]], SurfaceSpec::default());
+    let s3 = WaveSurface::new(field3.components(), 12.0, 0.0, &[[0.0, 0.0]], SurfaceSpec::default())
+        .unwrap_or_else(|e| unreachable!("{e}"));
     let oz = s3.height(0.0, 0.0) + 2.0;
     let mut lidar = Vec::new();
     for c in 0..64 {

@@ -64,6 +64,12 @@ impl RigidPose {
                 "the rotation block has determinant -1 (a reflection); give a proper rotation",
             ));
         }
+        if let Some(t) = [m[3], m[7], m[11]].into_iter().find(|t| t.abs() > f64::from(f32::MAX)) {
+            return Err(MmusvError::input(
+                field,
+                format!("translation {t} m is beyond the f32 range of the scene (|t| <= {:e} m)", f32::MAX),
+            ));
+        }
         let col = |j: usize| Vec3::new(r(0, j) as f32, r(1, j) as f32, r(2, j) as f32);
         Ok(Self {
             rotation: Mat3::from_cols(col(0), col(1), col(2)),
@@ -71,7 +77,17 @@ impl RigidPose {
         })
     }
 
+    /// Checks that the pose is one [`RigidPose::from_matrix_row_major`] would give: every entry finite and the
+    /// rotation proper (orthonormal within [`ROTATION_TOLERANCE`], determinant +1). The fields are public and
+    /// [`RigidPose::from_xyz_rpy`] takes any number, so the scene and the sensors check the poses they are given;
+    /// `field` names the pose in the error.
+    pub fn validate(&self, field: &str) -> Result<()> {
+        let m = self.to_matrix_row_major();
+        Self::from_matrix_row_major(&m, field).map(|_| ())
+    }
+
     /// Builds a pose from a translation and roll, pitch, yaw in radians, with `R = Rz(yaw)·Ry(pitch)·Rx(roll)`.
+    /// Unchecked (a NaN gives a NaN pose): the scene and the sensors refuse such poses ([`RigidPose::validate`]).
     pub fn from_xyz_rpy(xyz: [f64; 3], rpy: [f64; 3]) -> Self {
         let (sr, cr) = rpy[0].sin_cos();
         let (sp, cp) = rpy[1].sin_cos();

@@ -50,6 +50,15 @@ impl Mesh {
         if vertices.is_empty() {
             return Err(MmusvError::geometry("vertices", "mesh has no vertices; give a (V, 3) array with V >= 3"));
         }
+        if vertices.len() < 3 {
+            return Err(MmusvError::geometry(
+                "vertices",
+                format!(
+                    "mesh has {} vertices; a triangle needs three, give a (V, 3) array with V >= 3",
+                    vertices.len()
+                ),
+            ));
+        }
         if faces.is_empty() {
             return Err(MmusvError::geometry("faces", "mesh has no faces; give a (F, 3) integer array with F >= 1"));
         }

@@ -180,9 +180,11 @@ impl Scene {
 
     /// Places mesh `mesh` at `pose`; returns the new instance id (instance ids count up from 0).
     ///
-    /// `class_override`, when given, replaces the mesh's per-face classes for this instance.
+    /// `class_override`, when given, replaces the mesh's per-face classes for this instance. The pose must be
+    /// finite and rigid ([`RigidPose::validate`]; the error names `pose`).
     pub fn add_instance(&mut self, mesh: u32, pose: RigidPose, class_override: Option<u16>) -> Result<u32> {
         self.check_mesh(mesh)?;
+        pose.validate("pose")?;
         self.instances.push(Instance { mesh, pose, class_override, lights_on: false });
         self.world_aabbs.push(Aabb::new_invalid());
         let id = (self.instances.len() - 1) as u32;
@@ -267,7 +269,8 @@ impl Scene {
 
     /// Moves instances; `ids` and `poses` have the same length. Only the top-level BVH is rebuilt.
     ///
-    /// Validates every id before changing anything, so a bad id leaves the scene as it was.
+    /// Validates every id and pose (finite and rigid, [`RigidPose::validate`]; errors name `poses[i]`) before
+    /// changing anything, so a bad id or pose leaves the scene as it was.
     pub fn set_poses(&mut self, ids: &[u32], poses: &[RigidPose]) -> Result<()> {
         if ids.len() != poses.len() {
             return Err(MmusvError::input(
@@ -277,6 +280,9 @@ impl Scene {
         }
         for &id in ids {
             self.check_instance(id)?;
+        }
+        for (i, pose) in poses.iter().enumerate() {
+            pose.validate(&format!("poses[{i}]"))?;
         }
         for (&id, pose) in ids.iter().zip(poses) {
             self.instances[id as usize].pose = *pose;

@@ -30,7 +30,7 @@ impl Seabed {
         if !(spacing.is_finite() && spacing > 0.0) {
             return Err(MmusvError::input("seabed.spacing", format!("{spacing} must be a finite distance > 0")));
         }
-        if nx < 2 || ny < 2 || z.len() != nx * ny {
+        if nx < 2 || ny < 2 || nx.checked_mul(ny) != Some(z.len()) {
             return Err(MmusvError::input(
                 "seabed.heights",
                 format!("need at least 2 x 2 heights, nx·ny of them; got {} for {ny} x {nx}", z.len()),

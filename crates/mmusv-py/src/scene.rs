@@ -81,7 +81,7 @@ fn sample(key: &SurfaceKey, cached: Option<Arc<WaveField>>) -> Sampled {
             Arc::new(WaveField::new(&key.sea, key.seed)?)
         }
     };
-    let surface = WaveSurface::new(field.components(), key.time_s, key.level, &key.foci, key.spec);
+    let surface = WaveSurface::new(field.components(), key.time_s, key.level, &key.foci, key.spec)?;
     Ok((field, surface))
 }
 

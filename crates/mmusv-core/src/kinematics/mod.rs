@@ -145,6 +145,23 @@ impl VesselMotion {
         self.params.start_offset_m + self.params.speed_mps * t
     }
 
+    /// Checks `t` ([`check_time`]) and that the distance travelled by then is finite (`offset + u·t` overflows
+    /// for a huge speed and time, and the route has no place for an infinite distance); `field` names `t`.
+    fn check_travel(&self, t: f64, field: &str) -> Result<()> {
+        check_time(t, field)?;
+        if self.travelled_m(t).is_finite() {
+            Ok(())
+        } else {
+            Err(MmusvError::input(
+                field,
+                format!(
+                    "at {t} s the distance travelled, start_offset_m + speed_mps · t = {} + {} · {t} m, overflows",
+                    self.params.start_offset_m, self.params.speed_mps
+                ),
+            ))
+        }
+    }
+
     /// `[Δz (m), Δφ (rad), Δθ (rad)] = S_wave · α_v · [r_z g_z(t), r_φ g_φ(t), r_θ g_θ(t)]` (eq. 3).
     pub fn perturbation_at(&self, t: f64, wave: &WaveSetting) -> [f64; 3] {
         let k = wave.scale() * self.alpha;
@@ -152,17 +169,18 @@ impl VesselMotion {
         [k * a.heave_m * g.heave.value(t), k * a.roll_rad * g.roll.value(t), k * a.pitch_rad * g.pitch.value(t)]
     }
 
-    /// The pose `η = [x, y, z_base + Δz, Δφ, Δθ, θ]` at time `t` (eq. 4); `t` must be finite and ≥ 0.
+    /// The pose `η = [x, y, z_base + Δz, Δφ, Δθ, θ]` at time `t` (eq. 4); `t` must be finite and ≥ 0, and the
+    /// distance travelled by then, `offset + u·t`, finite (errors name `t`).
     /// Yaw `θ` is in `[-π, π]`; travelling backwards on a ping-pong route it is the route heading + π.
     pub fn pose_at(&self, t: f64, wave: &WaveSetting) -> Result<[f64; 6]> {
-        check_time(t, "t")?;
+        self.check_travel(t, "t")?;
         Ok(self.pose_unchecked(t, wave, None))
     }
 
     /// The pose with the physical response to `sea` (heave, roll, pitch through the hull's RAOs at the vessel's
     /// position, heading and velocity) instead of the paper's perturbation.
     pub fn pose_in_sea(&self, t: f64, sea: &WaveField) -> Result<[f64; 6]> {
-        check_time(t, "t")?;
+        self.check_travel(t, "t")?;
         Ok(self.pose_unchecked(t, &WaveSetting::W0, Some(sea)))
     }
 
@@ -170,7 +188,7 @@ impl VesselMotion {
     /// rest at the end of a `Stop` route) and `dΔz/dt` vertically (in a sea: the heave rate at the current heading
     /// and velocity, exact on straight legs).
     pub fn velocity_at(&self, t: f64, wave: &WaveSetting) -> Result<[f64; 3]> {
-        check_time(t, "t")?;
+        self.check_travel(t, "t")?;
         Ok(self.velocity_unchecked(t, wave, None))
     }
 
@@ -258,6 +276,12 @@ impl Fleet {
         self.vessels.is_empty()
     }
 
+    /// `VesselMotion::check_travel` of every vessel at `t`.
+    fn check_travel(&self, t: f64, field: &str) -> Result<()> {
+        check_time(t, field)?;
+        self.vessels.iter().try_for_each(|v| v.check_travel(t, field))
+    }
+
     /// The scene wave setting.
     pub fn wave(&self) -> WaveSetting {
         self.wave
@@ -270,13 +294,13 @@ impl Fleet {
 
     /// Poses `η = [x, y, z, roll, pitch, yaw]` of every vessel at time `t` (finite, ≥ 0), in vessel order.
     pub fn poses_at(&self, t: f64) -> Result<Vec<[f64; 6]>> {
-        check_time(t, "t")?;
+        self.check_travel(t, "t")?;
         Ok(self.vessels.iter().map(|v| v.pose_unchecked(t, &self.wave, self.sea())).collect())
     }
 
     /// World-frame linear velocities `[vx, vy, vz]` (m/s) of every vessel at time `t`, in vessel order.
     pub fn velocities_at(&self, t: f64) -> Result<Vec<[f64; 3]>> {
-        check_time(t, "t")?;
+        self.check_travel(t, "t")?;
         Ok(self.vessels.iter().map(|v| v.velocity_unchecked(t, &self.wave, self.sea())).collect())
     }
 
@@ -284,7 +308,7 @@ impl Fleet {
     /// (a T×V×6 array). Every time must be finite and ≥ 0 (errors name `times[k]`). Runs over rayon.
     pub fn poses_at_times(&self, times: &[f64]) -> Result<Vec<[f64; 6]>> {
         for (k, &t) in times.iter().enumerate() {
-            check_time(t, &format!("times[{k}]"))?;
+            self.check_travel(t, &format!("times[{k}]"))?;
         }
         let nv = self.vessels.len();
         let mut out = vec![[0.0; 6]; times.len() * nv];

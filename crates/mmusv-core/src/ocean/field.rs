@@ -54,6 +54,9 @@ pub const COMPONENTS_RANGE: [usize; 2] = [8, 4096];
 /// 1/15 as the upper end of observed average seas).
 pub const MAX_STEEPNESS: f64 = 1.0 / 7.0;
 
+/// Most points of one [`WaveField::elevation_grid`] (2²⁸: 1 GiB of f32 per array).
+pub const MAX_GRID_POINTS: usize = 1 << 28;
+
 /// Significant wave heights a [`SeaSpec`] takes, metres (0: a flat sea).
 pub const HS_RANGE_M: (f64, f64) = (0.0, 25.0);
 /// Peak periods a [`SeaSpec`] takes, seconds.
@@ -294,9 +297,10 @@ impl WaveField {
     }
 
     /// Orbital velocity `[u, v, w]` (m/s, world frame) of the water at `(x, y, z)` (z up, m; values above the
-    /// mean level are those at z = 0), deep-water linear theory.
+    /// mean level are those at z = 0), deep-water linear theory. A NaN coordinate gives NaN.
     pub fn orbital_velocity(&self, x: f64, y: f64, z: f64, t: f64) -> [f64; 3] {
-        let z = z.min(0.0);
+        // Not `z.min(0.0)`: that reads a NaN depth as the surface.
+        let z = if z > 0.0 { 0.0 } else { z };
         let mut v = [0.0; 3];
         for c in &self.components {
             let decay = c.amplitude_m * c.omega_rad_s * (c.k_rad_m * z).exp();
@@ -311,7 +315,8 @@ impl WaveField {
 
     /// Elevations on a regular grid, row-major `ny × nx`: entry `j·nx + i` is `η(x0 + i·dx, y0 + j·dx, t)` (m,
     /// f32). Each row advances every component's phasor by one complex multiplication per point; rows run over
-    /// rayon. `dx` must be finite and > 0 (errors name `dx`).
+    /// rayon. `dx` must be finite and > 0 (errors name `dx`), and the grid at most [`MAX_GRID_POINTS`] points
+    /// (errors name `nx·ny`).
     pub fn elevation_grid(&self, x0: f64, y0: f64, dx: f64, nx: usize, ny: usize, t: f64) -> Result<Vec<f32>> {
         Ok(self.surface_grid(x0, y0, dx, nx, ny, t, false)?.0)
     }
@@ -349,7 +354,15 @@ impl WaveField {
                 return Err(MmusvError::input(name, format!("must be finite, got {v}")));
             }
         }
-        let n = nx * ny;
+        let n = match nx.checked_mul(ny) {
+            Some(n) if n <= MAX_GRID_POINTS => n,
+            _ => {
+                return Err(MmusvError::input(
+                    "nx·ny",
+                    format!("a grid of {nx} × {ny} points is more than the {MAX_GRID_POINTS} allowed"),
+                ))
+            }
+        };
         let mut eta = vec![0f32; n];
         let (mut sx, mut sy) = if slopes { (vec![0f32; n], vec![0f32; n]) } else { (Vec::new(), Vec::new()) };
         if n == 0 || self.components.is_empty() {

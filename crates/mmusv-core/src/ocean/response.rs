@@ -55,13 +55,13 @@ pub struct Hull {
     pub beam_m: f64,
     /// Draft `T` (m).
     pub draft_m: f64,
-    /// Block coefficient `Cb` in (0, 1].
+    /// Block coefficient `Cb` in [0.2, 1].
     pub block_coefficient: f64,
     /// Transverse metacentric height `GM` (m), > 0.
     pub gm_m: f64,
     /// Roll radius of gyration `k_xx` (m), including added inertia.
     pub roll_gyradius_m: f64,
-    /// Equivalent linear roll damping ratio ζ in (0, 1).
+    /// Equivalent linear roll damping ratio ζ in [0.005, 1].
     pub roll_damping_ratio: f64,
 }
 

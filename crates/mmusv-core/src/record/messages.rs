@@ -34,7 +34,7 @@ pub struct BoxMarker {
     pub center: [f64; 3],
     /// Box orientation, quaternion `x, y, z, w` (unit).
     pub quaternion: [f64; 4],
-    /// Edge lengths along the box's x, y, z axes, metres.
+    /// Edge lengths along the box's x, y, z axes, metres (finite, `>= 0`).
     pub size: [f64; 3],
     /// RGBA, each 0..1.
     pub color: [f32; 4],
@@ -93,6 +93,9 @@ fn raw_message(
     data: Bytes,
 ) -> Result<RawImage> {
     let bpp = raw_bytes_per_pixel(encoding)?;
+    if width == 0 || height == 0 {
+        return Err(MmusvError::input("image", format!("{width}x{height}: width and height must be > 0")));
+    }
     if (step as u64) < width as u64 * bpp as u64 || data.len() as u64 != step as u64 * height as u64 {
         return Err(MmusvError::input(
             "image",
@@ -198,7 +201,7 @@ impl Recorder {
 
     /// Writes a `foxglove.RawImage`; `encoding` is one of `rgb8`, `rgba8`, `bgr8`, `bgra8`, `mono8`, `8UC1`,
     /// `8UC3`, `mono16`, `16UC1`, `32FC1`; `data` is `height` rows of `step` bytes, multi-byte values
-    /// little-endian.
+    /// little-endian; width and height > 0 (errors name `image`).
     #[allow(clippy::too_many_arguments)]
     pub fn raw_image(
         &mut self,
@@ -265,7 +268,8 @@ impl Recorder {
 
     /// Writes a `foxglove.SceneUpdate` with one entity `entity_id` in `frame_id` (frame-locked, no lifetime)
     /// holding one cube per box and one billboard text per non-empty label; it replaces the previous entity
-    /// with the same id on the topic.
+    /// with the same id on the topic. A box with an empty or repeated id, a non-finite pose or size, a negative
+    /// edge or a colour outside `[0, 1]` is an error naming `boxes[i]`.
     pub fn boxes(
         &mut self,
         topic: &str,
@@ -287,6 +291,12 @@ impl Recorder {
                 ));
             }
             finite(&b.size, &field)?;
+            if b.size.iter().any(|&v| v < 0.0) {
+                return Err(MmusvError::input(field, format!("size {:?} has a negative edge length", b.size)));
+            }
+            if !b.color.iter().all(|c| (0.0..=1.0).contains(c)) {
+                return Err(MmusvError::input(field, format!("color {:?} must be RGBA, each in [0, 1]", b.color)));
+            }
             let color =
                 Color { r: b.color[0] as f64, g: b.color[1] as f64, b: b.color[2] as f64, a: b.color[3] as f64 };
             cubes.push(CubePrimitive {

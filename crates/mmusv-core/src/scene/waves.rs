@@ -15,6 +15,8 @@ impl Scene {
     /// Sets (or with `None` clears) the displaced sea surface of the current frame. The scene must have a sea
     /// ([`Scene::set_sea`]): the surface replaces that instance's flat mesh for every ray, and the sea shortcuts
     /// learn its crest bound ([`WaveSurface::zmax`]). [`Scene::set_sea`] and [`Scene::clear_sea`] clear it.
+    /// A surface sampled from a non-finite time, level, focus or component (one no ray would meet) is an input
+    /// error naming `surface`.
     pub fn set_wave_surface(&mut self, surface: Option<WaveSurface>) -> Result<()> {
         let Some(sea) = &mut self.sea else {
             if surface.is_none() {
@@ -26,6 +28,13 @@ impl Scene {
                 "the scene has no sea surface; declare it with set_sea before setting a wave surface",
             ));
         };
+        if surface.as_ref().is_some_and(|w| !w.is_finite()) {
+            return Err(MmusvError::input(
+                "surface",
+                "the wave surface was sampled from a time, level, focus or wave component that is not finite; \
+                 give finite values",
+            ));
+        }
         sea.set_wave_top(surface.as_ref().map(WaveSurface::zmax));
         self.waves = surface.map(Arc::new);
         Ok(())

@@ -190,8 +190,17 @@ pub struct SurfaceHit {
 
 impl WaveSurface {
     /// Samples `components` at time `time_s` around the `foci` (world x, y), with still level `level`.
-    /// Deterministic: the same inputs give the same surface, whatever the thread count.
-    pub fn new(components: &[WaveComponent], time_s: f64, level: f32, foci: &[[f32; 2]], spec: SurfaceSpec) -> Self {
+    /// Deterministic: the same inputs give the same surface, whatever the thread count. Foci and a radius whose
+    /// surface would hold more than [`MAX_TILES`] tiles are an error naming `foci` ([`SurfaceSpec::check_extent`]:
+    /// far-apart foci asked for more memory than a machine has, or overflowed the tile count).
+    pub fn new(
+        components: &[WaveComponent],
+        time_s: f64,
+        level: f32,
+        foci: &[[f32; 2]],
+        spec: SurfaceSpec,
+    ) -> crate::Result<Self> {
+        spec.check_extent(foci)?;
         let tile_m = spec.tile_m.max(1e-3);
         let reach = spec.radius_m.max(0.0);
         let (mut lo, mut hi) = ([f32::INFINITY; 2], [f32::NEG_INFINITY; 2]);
@@ -226,7 +235,7 @@ impl WaveSurface {
             }
         }
         let far_mss = (spec.slopes && !components.is_empty()).then(|| sample::total_mss(components) as f32);
-        Self {
+        Ok(Self {
             level,
             time_s,
             x0,
@@ -240,7 +249,7 @@ impl WaveSurface {
             zmax,
             far_mss,
             elevation_std: components.iter().map(WaveComponent::elevation_variance).sum::<f64>().sqrt() as f32,
-        }
+        })
     }
 
     /// The still water level (world z).
@@ -269,6 +278,19 @@ impl WaveSurface {
     pub fn finest_cell_m(&self) -> f32 {
         self.tile_m / TILE_CELLS as f32
     }
+    /// Whether every number that places the surface is finite: its level, time, lattice origin, height bounds and
+    /// elevation spread. A NaN time, level, focus or component samples a surface no ray meets (the sea would
+    /// vanish), which [`crate::Scene::set_wave_surface`] refuses.
+    pub(crate) fn is_finite(&self) -> bool {
+        self.level.is_finite()
+            && self.time_s.is_finite()
+            && self.x0.is_finite()
+            && self.y0.is_finite()
+            && self.zmin.is_finite()
+            && self.zmax.is_finite()
+            && self.elevation_std.is_finite()
+    }
+
     /// Number of sampled (non-flat) tiles.
     pub fn sampled_tiles(&self) -> usize {
         self.tiles.iter().filter(|t| t.n > 0).count()

@@ -250,8 +250,14 @@ impl Camera {
                         "lens distortion applies to pinhole cameras only",
                     ));
                 }
-                if !(m.is_finite() && m > 0.0) {
-                    return Err(MmusvError::config("camera.metres_per_pixel", m, "must be a finite distance > 0"));
+                // The pixels' offsets from the centre, up to half the larger side, must be finite in the f32 scene.
+                let reach = m * f64::from(w.max(h)) / 2.0;
+                if !(m.is_finite() && m > 0.0 && reach <= f64::from(f32::MAX)) {
+                    return Err(MmusvError::config(
+                        "camera.metres_per_pixel",
+                        m,
+                        "must be a finite distance > 0 (the image's half-width in metres within the f32 range)",
+                    ));
                 }
                 let origins = tile_order(w, h)
                     .iter()
@@ -339,7 +345,8 @@ impl Camera {
         self.render_with(scene, pose, env, &RenderOptions { rgb, radiance: false, seed, wakes: &[] })
     }
 
-    /// Renders the frozen `scene` from `pose` (camera body → world) with `options`.
+    /// Renders the frozen `scene` from `pose` (camera body → world) with `options`. A pose that is not finite or
+    /// not rigid is an error naming `pose`.
     ///
     /// Depth, semantic class and instance come from each pixel's centre ray. The RGB image (and the linear
     /// radiance, when asked) is shaded by [`radiance::radiance`]: shadow rays towards the sun, traced water
@@ -353,6 +360,7 @@ impl Camera {
         env: &ShadeEnv,
         options: &RenderOptions<'_>,
     ) -> Result<CameraFrame> {
+        pose.validate("pose")?;
         let (origins, dirs) = self.traced_rays(pose);
         let waves = scene.wave_surface();
         let raster = waves.as_deref().and_then(|w| self.water_raster(w, pose));

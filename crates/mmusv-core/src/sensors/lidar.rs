@@ -92,6 +92,14 @@ impl LidarConfig {
         if c == 0 || c > rays::MAX_CHANNELS as usize {
             return Err(MmusvError::config("lidar.channels", c, format!("must be in 1..={}", rays::MAX_CHANNELS)));
         }
+        if let Some(i) = self.elevations.iter().position(|e| !(e.is_finite() && e.abs() < std::f64::consts::FRAC_PI_2))
+        {
+            return Err(MmusvError::config(
+                format!("lidar.elevations[{i}]"),
+                self.elevations[i],
+                "must be a finite angle strictly between -π/2 and π/2 radians",
+            ));
+        }
         if self.azimuth_steps == 0 || self.azimuth_steps > rays::MAX_AZIMUTH_STEPS {
             return Err(MmusvError::config(
                 "lidar.azimuth_steps",
@@ -129,7 +137,7 @@ impl LidarConfig {
     }
 }
 
-/// Conditions that change what a LiDAR sees.
+/// Conditions that change what a LiDAR sees. Every field finite and `>= 0` ([`LidarEnv::validate`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct LidarEnv {
     /// Atmospheric extinction coefficient (1/m), 3 / visibility.
@@ -140,6 +148,23 @@ pub struct LidarEnv {
     pub wave_height_m: f32,
     /// Wind speed at 10 m (m/s): capillary roughness and whitecaps of the physical water returns.
     pub wind_speed_m_s: f32,
+}
+
+impl LidarEnv {
+    /// Checks that every field is finite and `>= 0`; errors name `lidar.<field>`.
+    pub fn validate(&self) -> Result<()> {
+        for (name, v) in [
+            ("lidar.fog_extinction_per_m", self.fog_extinction_per_m),
+            ("lidar.rain_mm_per_h", self.rain_mm_per_h),
+            ("lidar.wave_height_m", self.wave_height_m),
+            ("lidar.wind_speed_m_s", self.wind_speed_m_s),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(MmusvError::config(name, v, "must be finite and >= 0"));
+            }
+        }
+        Ok(())
+    }
 }
 
 /// The points of one sweep, in pattern order (azimuth column, then ring) with the rays that gave no return
@@ -232,6 +257,7 @@ impl Lidar {
     /// One sweep from the LiDAR at `sensor_to_world` on the frozen `scene`, with `wakes` behind the vessels under
     /// way: over a displaced wave surface, beams that meet their foam return from it ([`super::lidar_water`];
     /// the same foam the cameras draw). On a flat sea the empirical water rule stands and wakes change nothing.
+    /// Errors name `pose` (not finite or not rigid, [`RigidPose::validate`]) or the `lidar.<field>` of `env`.
     pub fn scan_with_wakes(
         &self,
         scene: &Scene,
@@ -240,6 +266,8 @@ impl Lidar {
         seed: u64,
         wakes: &[Wake],
     ) -> Result<LidarScan> {
+        sensor_to_world.validate("pose")?;
+        env.validate()?;
         let cfg = &self.cfg;
         let channels = cfg.elevations.len();
         let origin = sensor_to_world.translation.to_array();

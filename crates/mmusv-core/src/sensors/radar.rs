@@ -94,7 +94,7 @@ impl RadarReturns {
 /// Casts `cfg.num_rays()` rays in one batch, aggregates them per (azimuth bin, range bin) cell, adds seeded
 /// sea / rain clutter and returns the detections sorted by (azimuth bin, range bin). See the module
 /// documentation for the ray pattern and [`radar_model`] for the intensity model. Deterministic for a given
-/// scene, pose, configuration and seed.
+/// scene, pose, configuration and seed. A pose that is not finite or not rigid is an error naming `pose`.
 pub fn radar_sweep(
     scene: &Scene,
     sensor_to_world: &RigidPose,
@@ -104,6 +104,7 @@ pub fn radar_sweep(
 ) -> Result<RadarReturns> {
     cfg.validate()?;
     env.validate()?;
+    sensor_to_world.validate("pose")?;
     let samples = (cfg.azimuth_bins * cfg.rays_az) as usize;
     let rows = cfg.rays_el as usize;
     // Ray directions (world) and per-ray (elevation, fan-height weight), both in trace order.

@@ -233,7 +233,8 @@ fn physical_sea_clutter_follows_the_nrl_model() {
         s.set_sea(0, &[]).unwrap_or_else(|e| unreachable!("{e}"));
         let spec = SeaSpec { hs, tp, gamma: 3.3, direction_rad: 0.3, spread_s: 10.0 };
         let field = WaveField::new(&spec, sea_seed(5)).unwrap_or_else(|e| unreachable!("{e}"));
-        let w = WaveSurface::new(field.components(), 0.0, 0.0, &[[0.0, 0.0]], SurfaceSpec::default());
+        let w = WaveSurface::new(field.components(), 0.0, 0.0, &[[0.0, 0.0]], SurfaceSpec::default())
+            .unwrap_or_else(|e| unreachable!("{e}"));
         s.set_wave_surface(Some(w)).unwrap_or_else(|e| unreachable!("{e}"));
         let r = sweep(&s, &cfg, hs as f32, 11);
         (0..r.len()).filter(|&i| r.instance[i] == NO_HIT).map(|i| r.range[i] as f64).collect::<Vec<f64>>()

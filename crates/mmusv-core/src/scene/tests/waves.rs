@@ -42,7 +42,7 @@ fn wave_surface_batches_give_exactly_the_ray_by_ray_reference() {
     s.set_sea(1, &vessels).unwrap_or_else(|e| unreachable!("{e}"));
     let foci = [[0.0f32, 0.0], [120.0, -80.0]];
     let spec = SurfaceSpec { radius_m: 400.0, taper_m: 80.0, ..SurfaceSpec::default() };
-    let surface = WaveSurface::new(&wave_components(), 7.0, 0.0, &foci, spec);
+    let surface = WaveSurface::new(&wave_components(), 7.0, 0.0, &foci, spec).unwrap_or_else(|e| unreachable!("{e}"));
     let w = surface.clone();
     s.set_wave_surface(Some(surface)).unwrap_or_else(|e| unreachable!("{e}"));
     let (mut o, mut d) = sensor_rays(&mut rng, 12_000);
@@ -190,7 +190,8 @@ fn target_casts_are_the_closest_hits_with_the_sea_left_out() {
     let mut components = wave_components();
     components.iter_mut().for_each(|c| c.amplitude_m *= 4.0);
     let spec = SurfaceSpec { radius_m: 400.0, taper_m: 80.0, ..SurfaceSpec::default() };
-    let surface = WaveSurface::new(&components, 7.0, 0.0, &[[0.0, 0.0], [120.0, -80.0]], spec);
+    let surface = WaveSurface::new(&components, 7.0, 0.0, &[[0.0, 0.0], [120.0, -80.0]], spec)
+        .unwrap_or_else(|e| unreachable!("{e}"));
     let mut cast = Vec::new();
     for surface in [Some(surface), None] {
         let waves = surface.is_some();
@@ -243,8 +244,10 @@ fn a_camera_over_the_waves_sees_the_marched_hits() {
     s.set_sea(1, &vessels).unwrap_or_else(|e| unreachable!("{e}"));
     let foci = [[0.0f32, 0.0], [120.0, -80.0]];
     let spec = SurfaceSpec { radius_m: 400.0, taper_m: 80.0, ..SurfaceSpec::default() };
-    s.set_wave_surface(Some(WaveSurface::new(&wave_components(), 7.0, 0.0, &foci, spec)))
-        .unwrap_or_else(|e| unreachable!("{e}"));
+    s.set_wave_surface(Some(
+        WaveSurface::new(&wave_components(), 7.0, 0.0, &foci, spec).unwrap_or_else(|e| unreachable!("{e}")),
+    ))
+    .unwrap_or_else(|e| unreachable!("{e}"));
     let cfg = CameraConfig {
         width: 200,
         height: 150,

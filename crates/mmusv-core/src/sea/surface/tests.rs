@@ -34,7 +34,7 @@ fn eta(c: &[WaveComponent], x: f64, y: f64, t: f64) -> f64 {
 }
 
 fn surface(sea: &[WaveComponent], t: f64, foci: &[[f32; 2]], spec: SurfaceSpec) -> WaveSurface {
-    WaveSurface::new(sea, t, 0.0, foci, spec)
+    WaveSurface::new(sea, t, 0.0, foci, spec).unwrap_or_else(|e| unreachable!("{e}"))
 }
 
 #[test]
@@ -199,7 +199,7 @@ fn field_tiles_match_the_fields_own_grids() {
     let f = WaveField::new(&spec, 77).unwrap_or_else(|e| unreachable!("{e}"));
     let foci = [[-1234.5f32, 877.25]];
     let spec = SurfaceSpec { radius_m: 500.0, taper_m: 0.0, ..SurfaceSpec::default() };
-    let s = WaveSurface::new(f.components(), 41.3, 0.0, &foci, spec);
+    let s = WaveSurface::new(f.components(), 41.3, 0.0, &foci, spec).unwrap_or_else(|e| unreachable!("{e}"));
     let mut levels = [0usize; 6];
     for (k, tile) in s.tiles.iter().enumerate() {
         if tile.n == 0 {
@@ -415,7 +415,8 @@ fn elevation_std_is_the_seas() {
     assert!((f64::from(s.elevation_std()) - 1.2 / 2f64.sqrt()).abs() < 1e-6);
     use crate::ocean::{paper_sea_states, WaveField};
     let f = WaveField::new(&paper_sea_states()[3].spec(0.8, 10.0), 11).unwrap_or_else(|e| unreachable!("{e}"));
-    let w3 = WaveSurface::new(f.components(), 0.0, 0.0, &[[0.0, 0.0]], SurfaceSpec::default());
+    let w3 = WaveSurface::new(f.components(), 0.0, 0.0, &[[0.0, 0.0]], SurfaceSpec::default())
+        .unwrap_or_else(|e| unreachable!("{e}"));
     assert!((f64::from(w3.elevation_std()) * 4.0 - 3.5).abs() < 0.02 * 3.5, "{}", w3.elevation_std());
     assert_eq!(surface(&[], 2.0, &[[0.0, 0.0]], SurfaceSpec::default()).elevation_std(), 0.0);
 }

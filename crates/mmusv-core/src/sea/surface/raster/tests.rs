@@ -72,7 +72,7 @@ fn raster_hits_are_the_march_hits_at_every_pixel() {
     // Two foci 90 m apart: every level of detail, steps between them, the taper and the flat beyond.
     let c = test_sea();
     let spec = SurfaceSpec { radius_m: 300.0, taper_m: 60.0, ..SurfaceSpec::default() };
-    let s = WaveSurface::new(&c, 3.0, 0.0, &[[0.0, 0.0], [90.0, 40.0]], spec);
+    let s = WaveSurface::new(&c, 3.0, 0.0, &[[0.0, 0.0], [90.0, 40.0]], spec).unwrap_or_else(|e| unreachable!("{e}"));
     let mut walls_seen = 0;
     let views = [
         view([0.5, 0.3, 3.0], 0.3, -0.05, 1.6, 160, 120),
@@ -96,7 +96,8 @@ fn raster_hits_are_the_march_hits_at_every_pixel() {
 
 #[test]
 fn a_view_within_the_skin_is_left_to_the_march() {
-    let s = WaveSurface::new(&[comp(0.5, 0.1, 0.0, 0.0, 0.0)], 0.0, 0.0, &[[0.0, 0.0]], SurfaceSpec::default());
+    let s = WaveSurface::new(&[comp(0.5, 0.1, 0.0, 0.0, 0.0)], 0.0, 0.0, &[[0.0, 0.0]], SurfaceSpec::default())
+        .unwrap_or_else(|e| unreachable!("{e}"));
     let h = s.height(2.0, 3.0);
     assert!(s.first_hits(&view([2.0, 3.0, h + 0.1], 0.0, 0.0, 1.0, 8, 8)).is_none());
     assert!(s.first_hits(&view([2.0, 3.0, h - 1.0], 0.0, 0.0, 1.0, 8, 8)).is_none());
