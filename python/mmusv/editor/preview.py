@@ -50,11 +50,11 @@ def preview_png(scenario: Scenario, *, frame: int, agent: str | None = None, wor
     anns = annotations_for(sim, cap, SilhouetteCache())
     with tempfile.TemporaryDirectory(prefix="mmusv-editor-preview-") as tmp:
         path = Path(tmp) / "preview.mcap"
-        rec = FrameRecorder(path, sim)
+        rec = FrameRecorder(path, sim, frames=(frame, 1))  # a recording of this one frame, saying so
         try:
             rec.write_frame(cap, {a: ann.columns() for a, ann in anns.items()})
         finally:
-            rec.finish(status="complete", frames=1, requested=1)
+            rec.finish(status="complete", frames=1, requested=1, first_frame=frame)
         canvas, _ = compose_preview(path, frame=frame, agent=agent)
     buf = io.BytesIO()
     canvas.save(buf, format="PNG")
