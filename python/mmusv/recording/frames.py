@@ -12,10 +12,12 @@ Per frame k (log time = t_k in ns, the same for every message of the frame):
   ids), ``.../instance`` (PNG uint16 instance ids, 65535 = sky), ``/<agent>/top_view/{rgb,semantic,instance}``,
   ``/<agent>/radar/returns`` (PointCloud: x, y, z, range, azimuth, elevation, intensity float32, instance int32;
   radar frame), ``/<agent>/radar/ppi`` (PNG, colour-mapped PPI), ``/<agent>/boxes`` (``foxglove.SceneUpdate`` in
-  the LiDAR frame) and ``/<agent>/annotations`` (``mmusv.AgentAnnotations``).
+  the LiDAR frame, or in the vessel's body frame ``<agent>`` when the rig has no LiDAR) and
+  ``/<agent>/annotations`` (``mmusv.AgentAnnotations``, boxes in the same frame).
 
-Metadata records: ``scenario`` (the resolved YAML), ``manifest`` (mmusv version, seed, config hash), ``sensors``
-(JSON: per agent, mounts and camera intrinsics), ``run`` (status, frames written, frequency, agents; written last).
+Metadata records: ``scenario`` (the resolved YAML), ``manifest`` (mmusv version, seed, config hash, and the
+frames the run sets out to write: ``first_frame``, ``frames_requested``), ``sensors`` (JSON: per agent, mounts and
+camera intrinsics), ``run`` (status, frames written, frequency, agents; written last).
 """
 
 from __future__ import annotations
@@ -224,10 +226,13 @@ class FrameRecorder:
                 colours = np.array(
                     [_ROLE_COLOURS.get(self.roles.get(i, "target"), (1, 1, 1, 0.5)) for i in lid["target_id"]]
                 ).reshape(-1, 4)
+                # The boxes are in the LiDAR frame, or in the vessel's body frame when the rig has no LiDAR
+                # (mmusv.annotate): name the frame /tf defines for them, or Foxglove cannot place them.
+                box_frame = topics.lidar_frame(a.id) if ac.lidar_pose is not None else a.id
                 rec.boxes(
                     topics.boxes(a.id),
                     log_time_ns=t,
-                    frame_id=topics.lidar_frame(a.id),
+                    frame_id=box_frame,
                     entity_id=f"{a.id}/targets",
                     ids=lid["target_id"],
                     centers=lid["center"],

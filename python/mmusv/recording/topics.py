@@ -53,7 +53,9 @@ def _per_agent(pattern: str, doc: str) -> Callable[[str], str]:
 lidar = _per_agent("/{agent}/lidar", "foxglove.PointCloud in the LiDAR frame.")
 radar_returns = _per_agent("/{agent}/radar/returns", "foxglove.PointCloud in the radar frame.")
 radar_ppi = _per_agent("/{agent}/radar/ppi", "colour-mapped PPI, PNG foxglove.CompressedImage.")
-boxes = _per_agent("/{agent}/boxes", "foxglove.SceneUpdate in the LiDAR frame.")
+boxes = _per_agent(
+    "/{agent}/boxes", "foxglove.SceneUpdate in the LiDAR frame (the vessel body frame when the rig has no LiDAR)."
+)
 agent_annotations = _per_agent("/{agent}/annotations", "mmusv.AgentAnnotations.")
 lidar_frame = _per_agent("{agent}/lidar", "frame id of the agent's LiDAR.")
 radar_frame = _per_agent("{agent}/radar", "frame id of the agent's radar.")
