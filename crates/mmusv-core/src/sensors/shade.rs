@@ -280,6 +280,17 @@ impl Shader {
         self
     }
 
+    /// Whether face material `material` emits towards the viewer as far as its arc goes: a navigation lamp only
+    /// towards bearings inside it (`body_dir`: the direction to the viewer in the instance's body frame, worked
+    /// out only for a lamp; [`Material::emits_towards`]), every other material always.
+    #[inline]
+    pub fn lamp_shines(&self, material: u16, body_dir: impl FnOnce() -> Vec3) -> bool {
+        match self.materials.get(material as usize) {
+            Some(m) if material != 0 && m.nav_light => m.emits_towards(body_dir()),
+            _ => true,
+        }
+    }
+
     /// This shader reading face materials from `table` (a scene's, [`crate::Scene::material_table`]).
     pub fn with_materials(mut self, table: Arc<Vec<Material>>) -> Self {
         self.materials = table;

@@ -42,32 +42,31 @@ pub(crate) fn surface_at(
     }
     let point = Vec3::from_array(origins[k]) + d * t;
     let (instance, triangle) = (hits.instance[k], hits.triangle[k]);
+    let material = scene.material_index(instance, triangle);
     let hit = SurfaceHit {
         t,
         point,
         normal,
         class: hits.class[k],
         instance,
-        material: scene.material_index(instance, triangle),
-        lights_on: lamp_lit(scene, instance, triangle, d),
+        material,
+        lights_on: lamp_lit(scene, shader, instance, material, d),
         shading_normal: normal,
         unresolved_mss: 0.0,
     };
     Some(shader.with_swell(d, hit))
 }
 
-/// Whether a navigation lamp hit along `d` shines towards the viewer: its instance's lights are on and the
-/// direction back to the viewer lies in the lamp's arc ([`crate::material::Material::emits_towards`], COLREG Rule
-/// 21). Other materials emit whenever the instance's lights are on.
+/// Whether a navigation lamp of face material `material` hit along `d` shines towards the viewer: its instance's
+/// lights are on and the direction back to the viewer lies in the lamp's arc
+/// ([`crate::material::Material::emits_towards`], COLREG Rule 21). Other materials emit whenever the instance's
+/// lights are on.
 #[inline]
-fn lamp_lit(scene: &Scene, instance: i32, triangle: i32, d: Vec3) -> bool {
+fn lamp_lit(scene: &Scene, shader: &Shader, instance: i32, material: u16, d: Vec3) -> bool {
     let Some(inst) = usize::try_from(instance).ok().and_then(|i| scene.instances().get(i)) else {
         return false;
     };
-    inst.lights_on()
-        && scene
-            .material_of(instance, triangle)
-            .is_none_or(|m| !m.nav_light || m.emits_towards(inst.pose().inverse_transform_vector(-d)))
+    inst.lights_on() && shader.lamp_shines(material, || inst.pose().inverse_transform_vector(-d))
 }
 
 /// Where a shadow ray from the hit of ray `k` starts (just off the surface, on the camera's side), if that hit
