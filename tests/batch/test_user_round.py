@@ -25,22 +25,10 @@ from mmusv.cli import main
 from mmusv.errors import ConfigError, IoError
 from mmusv.generate import load_spec
 
+from .conftest import SPEC as BATCH_SPEC
 from .conftest import cli, complete, scenario, stamps, tree, wait_for, write
 
-SPEC: dict[str, Any] = {
-    "name": "roundset",
-    "seed": 7,
-    "map": {"type": "open_sea", "seed": 2},
-    "acquisition": {"frequency_hz": 5, "frames": 2},
-    "rig": "usv_lidar",
-    "rigs": {"usv_lidar": {"preset": "lidar_only", "lidar": {"channels": 8, "points_per_second": 20480}}},
-    "usv": {"assets": ["usv_wamv"], "speed_mps": [2, 3]},
-    "difficulties": {"near": {"range_m": [40, 120]}},
-    "combinations": [
-        {"family": "crossing", "difficulty": "near", "cooperating": 1, "targets": ["small"], "quota": 2},
-        {"family": "head_on", "difficulty": "near", "cooperating": 1, "targets": ["medium"], "quota": 1},
-    ],
-}
+SPEC: dict[str, Any] = {**BATCH_SPEC, "name": "roundset", "acquisition": {"frequency_hz": 5, "frames": 2}}
 """Three tiny LiDAR-only scenarios of two frames on the open sea: a dataset in a few seconds."""
 
 
