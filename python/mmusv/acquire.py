@@ -38,7 +38,7 @@ from mmusv.forking import check_polars
 from mmusv.jsonio import dump_json, write_bytes_atomic
 from mmusv.profiling import RunProfile, clocks
 from mmusv.recording.background import BackgroundWriter
-from mmusv.recording.guard import FolderLock, write_cause
+from mmusv.recording.guard import FolderLock, HeldSignals, write_cause
 from mmusv.recording.tables import TableWriter
 from mmusv.scenario_checks import check_mounts, check_routes
 from mmusv.simulation import FrameCapture, Simulation
@@ -299,12 +299,6 @@ def _record(
     t0 = started[0]  # the first frame's capture, before the recording was opened
     prof = RunProfile() if profile else None
     result.profile = prof
-    try:
-        recorder = FrameRecorder(rec_path, sim, overwrite=overwrite, frames=(first, total - first))
-    except MmusvError as exc:  # the metadata could not be written (a full disk): say why
-        if not _writes_into(exc, out):
-            raise
-        raise IoError(_write_failure(out, rec_path, [("starting the recording", exc)])[0]) from None
 
     def annotate(cap: FrameCapture) -> _Frame:
         anns = annotations_for(sim, cap, silhouettes)
@@ -327,16 +321,31 @@ def _record(
             prof.add("writer:write/encode", recorder.encode_seconds - encoded)
             prof.add("writer:tables", time.perf_counter() - tw)
 
-    writer: BackgroundWriter[_Frame | FrameCapture] = BackgroundWriter(write, depth=1)
-    renders = sim.renders()
-    # Without cameras a frame is annotated on the writer thread while the next is captured. With them the
-    # annotations' native calls (each box's pixel rays and silhouette) would queue on the thread pool behind the
-    # cameras' work, stalling the writer (port_entry: 50 -> 930 ms a frame), so they run between captures.
-    annotate_behind = not renders
-    if prof is not None:
-        prof.start(since=started)
+    # A stop (SIGINT, SIGTERM) from the opening of the recording to the frame loop is held and raised in the loop
+    # (below): the run then ends as one stopped during a frame does, its recording finished as interrupted and its
+    # manifest.json written. Unheld, a stop there left the recording's .partial without a manifest.
+    held = HeldSignals().hold()
+    try:
+        try:
+            recorder = FrameRecorder(rec_path, sim, overwrite=overwrite, frames=(first, total - first))
+        except MmusvError as exc:  # the metadata could not be written (a full disk): say why
+            if not _writes_into(exc, out):
+                raise
+            raise IoError(_write_failure(out, rec_path, [("starting the recording", exc)])[0]) from None
+        writer: BackgroundWriter[_Frame | FrameCapture] = BackgroundWriter(write, depth=1)
+        renders = sim.renders()
+        # Without cameras a frame is annotated on the writer thread while the next is captured. With them the
+        # annotations' native calls (each box's pixel rays and silhouette) would queue on the thread pool behind
+        # the cameras' work, stalling the writer (port_entry: 50 -> 930 ms a frame), so they run between captures.
+        annotate_behind = not renders
+        if prof is not None:
+            prof.start(since=started)
+    except BaseException:
+        held.release()
+        raise
     failure: BaseException | None = None
     try:
+        held.release()  # a stop held since the recording opened: KeyboardInterrupt here, inside the loop's handling
         for k in range(first, total):
             tf = time.perf_counter()
             if captured:  # frame `first`, captured before the recording was opened

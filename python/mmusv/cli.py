@@ -201,8 +201,9 @@ def _cmd_info(args: argparse.Namespace) -> int:
         )
     else:
         written = run_meta.get("frames_written", "?")
-        if frames:
-            written = f"{frames['read']} of {frames['expected']}" if frames["read"] != frames["expected"] else written
+        if frames:  # the complete frames read: a killed run's .partial has no run metadata saying it ("? frames")
+            read, expected = frames["read"], frames["expected"]
+            written = str(read) if read == expected else f"{read} of {expected}"
         console.print(
             f"[bold]{target}[/bold]: scenario {run_meta.get('scenario') or _scenario_of(meta, target)}, "
             f"status {run_meta.get('status', 'unfinished (no run metadata: the run was killed or is still going)')}, "

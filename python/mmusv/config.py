@@ -40,6 +40,7 @@ from pydantic import (
     field_validator,
     model_validator,
 )
+from pydantic_core import InitErrorDetails, PydanticCustomError
 
 from mmusv.errors import ConfigError, MmusvError, located
 from mmusv.sensors.config import RigConfig
@@ -110,6 +111,24 @@ class MapConfig(_Model):
         if isinstance(v, BaseModel):
             return v if type(v) is model else model.model_validate(v.model_dump(exclude_unset=True))
         return model.model_validate(v)
+
+    @field_validator("params")
+    @classmethod
+    def _islands_fit(cls, v: MapParams, info: ValidationInfo) -> MapParams:
+        """An island map whose islands cannot all be placed is refused here, naming ``map.params.n_islands``: it
+        was found only when a run built the world (or a generator its map)."""
+        seed = info.data.get("seed")
+        if not isinstance(v, IslandParams) or not isinstance(seed, int):
+            return v
+        from mmusv.world.maps import island_fit_problem
+
+        why = island_fit_problem(seed, v)
+        if why is None:
+            return v
+        detail = InitErrorDetails(
+            type=PydanticCustomError("value_error", "{why}", {"why": why}), loc=("n_islands",), input=v.n_islands
+        )
+        raise ValidationError.from_exception_data(type(v).__name__, [detail])
 
     @field_serializer("params")
     def _given_params(self, params: MapParams, info: SerializationInfo) -> dict[str, Any]:

@@ -7,14 +7,17 @@ One entry per scenario, sorted by name::
      "recordings": [{"name": "a", "scenario_file": "a.yaml", "scenario": "a", "config_hash": SHA256, "seed": 1,
                      "recording": "a/a.mcap", "status": "complete", "frames": 20, "frames_requested": 20,
                      "parts": 1, "bytes": 123456, "error": null}, ...],
-     "totals": {"recordings": 3, "complete": 3, "failed": 0, "pending": 0, "frames": 60, "bytes": ...},
+     "totals": {"recordings": 3, "complete": 3, "failed": 0, "pending": 0, "frames": 60, "frames_incomplete": 0,
+                "bytes": ...},
      ...}
 
 ``status`` is ``complete``, ``failed`` (``error`` says why) or ``pending`` (not run yet, or interrupted);
 ``recording`` (relative to the index's folder) is an ``.mcap`` or a parts manifest (:mod:`mmusv.recording.parts`);
-``bytes`` is the size of every file of the recording's folder. The file holds no times or absolute paths, so a
-finished dataset's index is the same bytes however many runs it took. ``mmusv dataset`` adds ``spec`` and
-``opv2v`` sections. Conversion (:func:`mmusv.export.convert`) and the studies take a folder holding a
+``bytes`` is the size of every file of the recording's folder. ``totals.frames`` counts the frames of the complete
+recordings only, the dataset's; the frames a failed or pending recording wrote (its entry's ``frames``) are in
+``totals.frames_incomplete``, and ``totals.failed`` says how many recordings failed. The file holds no times or
+absolute paths, so a finished dataset's index is the same bytes however many runs it took. ``mmusv dataset`` adds
+``spec`` and ``opv2v`` sections. Conversion (:func:`mmusv.export.convert`) and the studies take a folder holding a
 ``dataset.json`` and read its complete recordings (:func:`dataset_recordings`).
 """
 
@@ -108,7 +111,9 @@ def write_index(path: str | os.PathLike[str], entries: Iterable[Entry], extra: M
         "totals": {
             "recordings": len(rows),
             **{s: sum(1 for e in rows if e.status == s) for s in STATUSES},
-            "frames": sum(e.frames for e in rows),
+            # the dataset's frames: a failed or pending recording's are not part of it (they were counted in)
+            "frames": sum(e.frames for e in rows if e.status == "complete"),
+            "frames_incomplete": sum(e.frames for e in rows if e.status != "complete"),
             "bytes": sum(e.bytes for e in rows),
         },
     }

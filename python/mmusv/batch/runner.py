@@ -191,6 +191,8 @@ def run_many(
     Raises:
         ConfigError: bad options, an empty folder, Ray asked for but missing. A bad scenario is not raised: it is
         reported as failed while the others run.
+        IoError: Ray cannot be started or joined (raised before anything is written: an earlier index stays as it
+        was), or another batch writes the output folder.
         KeyboardInterrupt: after the executor stopped and the index says what is done.
     """
     refuse_in_worker_import("mmusv.run_many")
@@ -235,7 +237,15 @@ def run_many(
     for p in plans:
         if p.recording is not None and not p.recording.is_relative_to(root):
             raise ConfigError(f"index {index_path} must be in a folder above the output {out}")
-    lock = FolderLock.create(out, what="mmusv run (batch)")
+    # The executor first: Ray that cannot be imported or joined fails the batch here, before anything is written
+    # (it wrote an index calling every scenario pending, and readied their folders, as if work had been scheduled).
+    executor = _executor(jobs, ray, cpus_per_task, lost_worker_retries) if any(p.to_run for p in plans) else None
+    try:
+        lock = FolderLock.create(out, what="mmusv run (batch)")
+    except BaseException:
+        if executor is not None:
+            executor.close(cancel=True)
+        raise
     try:
         return _run(
             plans,
@@ -243,9 +253,7 @@ def run_many(
             root,
             index_path,
             index_extra,
-            jobs,
-            ray,
-            cpus_per_task,
+            executor,
             retries,
             lost_worker_retries,
             progress,
@@ -262,26 +270,30 @@ def _run(
     root: Path,
     index_path: Path,
     index_extra: Mapping[str, Any] | None,
-    jobs: int,
-    ray: bool | str,
-    cpus_per_task: int | None,
+    started: Executor | None,
     retries: int,
     lost_worker_retries: int,
     progress: Callable[[int, int], None] | None,
     stop_on_full_disk: bool,
     t0: float,
 ) -> BatchReport:
-    """The batch of :func:`run_many` once planned, with the output folder locked."""
-    for p in plans:
-        _prepare(p)
+    """The batch of :func:`run_many` once planned, with the output folder locked, on the executor ``started``
+    (``None`` when nothing was to run; closed here)."""
     status: dict[str, str] = {}
     errors: dict[str, str | None] = {}
     retried: dict[str, int] = {}
     results: dict[str, TaskResult] = {}
-    for p in plans:
-        status[p.name] = "failed" if p.error else "pending" if p.to_run else "complete"
-        errors[p.name] = p.error
-    entries = {p.name: _entry(p, status[p.name], errors[p.name], root) for p in plans}
+    try:
+        for p in plans:
+            _prepare(p)
+        for p in plans:
+            status[p.name] = "failed" if p.error else "pending" if p.to_run else "complete"
+            errors[p.name] = p.error
+        entries = {p.name: _entry(p, status[p.name], errors[p.name], root) for p in plans}
+    except BaseException:
+        if started is not None:
+            started.close(cancel=True)
+        raise
 
     index_error: list[str] = []
 
@@ -293,18 +305,20 @@ def _run(
             index_error[:] = [str(exc)]
 
     todo = [t for p in plans for t in p.to_run]
+    if started is not None and not todo:  # every scenario that was to run failed to ready its folder
+        started.close(cancel=False)
+    executor: Executor = started if started is not None and todo else SerialExecutor()
     total_frames = sum(p.frames for p in plans if not p.error)
     done_frames = total_frames - sum(t.expected_frames for t in todo)
-    write()
-    if progress is not None:
-        progress(done_frames, total_frames)
     by_key = {t.key: t for t in todo}
     plan_of = {t.key: p for p in plans for t in p.to_run}
     left = {p.name: len(p.to_run) for p in plans}
-    executor = _executor(int(jobs), ray, cpus_per_task, int(lost_worker_retries)) if todo else SerialExecutor()
     interrupted = False
     full_disk: str | None = None
     try:
+        write()
+        if progress is not None:
+            progress(done_frames, total_frames)
         for t in todo:
             executor.submit(t)
         tries = dict.fromkeys(by_key, 1)

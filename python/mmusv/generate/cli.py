@@ -16,7 +16,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-__all__ = ["add_parser", "run"]
+__all__ = ["add_parser", "run", "seed_arg"]
 
 
 def add_parser(subparsers: Any) -> argparse.ArgumentParser:
@@ -34,8 +34,31 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     p.add_argument(
         "--force", action="store_true", help="replace scenario files and report.json already in the directory"
     )
+    p.add_argument(
+        "--seed",
+        default=None,
+        metavar="N",
+        help="replaces the spec's seed, from which every random draw derives: a whole number in 0..2**63-1; the "
+        "same spec and seed give the same files byte for byte (default: the spec's own seed)",
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     return p
+
+
+def seed_arg(text: str, *, flag: str = "--seed") -> int:
+    """The value of ``--seed`` as a whole number in ``0 .. 2**63 - 1`` (the range of a spec's ``seed``), else a
+    :class:`~mmusv.errors.ConfigError` naming the flag and that range."""
+    import re
+
+    from mmusv.errors import ConfigError
+    from mmusv.generate.spec import SEED_LIMIT
+
+    t = text.strip()
+    if not re.fullmatch(r"[+-]?[0-9]+", t) or not 0 <= int(t) < SEED_LIMIT:
+        raise ConfigError(
+            f"{flag} {text!r}: must be a whole number in 0..{SEED_LIMIT - 1} (it replaces the spec's seed)"
+        )
+    return int(t)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -46,16 +69,19 @@ def run(args: argparse.Namespace) -> int:
     from mmusv.cli_paths import check_output_folder, output_arg, path_arg
     from mmusv.generate.mapctx import map_context
     from mmusv.generate.runner import check_output, generate
-    from mmusv.generate.spec import load_spec
+    from mmusv.generate.spec import load_spec, with_seed
 
     console = Console(width=None if sys.stdout.isatty() else 160)
     if args.output is not None:  # an empty -o took the default folder without a word
         output_arg(args.output)
     from mmusv.bundled import resolve_spec
 
+    seed = None if args.seed is None else seed_arg(args.seed)  # before the spec is read: a bad flag is said first
     # A bundled spec by name from any folder (island_demo, coop_detection), as mmusv dataset takes it.
     spec_path = resolve_spec(path_arg(args.spec, flag="spec"))
     spec = load_spec(spec_path)
+    if seed is not None:
+        spec = with_seed(spec, seed, name="--seed")
     out = Path(args.output) if args.output is not None else Path("scenarios/generated") / spec.name
     check_output_folder(str(out))  # before the map is built: a file there was named after it
     check_output(out, args.force, spec_path)  # an earlier run's files, without --force: refused before the maps

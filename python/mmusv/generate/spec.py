@@ -102,12 +102,16 @@ __all__ = [
     "UsvRoles",
     "class_assets",
     "load_spec",
+    "with_seed",
 ]
 
 Pair = tuple[float, float]
 
 _NAME = re.compile(SCENARIO_NAME)
 """A spec name (as a scenario name): no path separators, and no leading dot (``.``, ``..``, hidden files)."""
+
+SEED_LIMIT = 2**63
+"""A spec's ``seed`` is a whole number in ``0 .. SEED_LIMIT - 1`` (the range of a signed 64-bit integer)."""
 
 MAX_RANGE_M = 100_000.0
 """Farthest closest-approach ``range_m`` of a difficulty, metres (100 km: far beyond any sensor)."""
@@ -299,7 +303,7 @@ class GenerationSpec(_Model):
     """A whole generation spec (see the module docstring)."""
 
     name: str = Field(default="generated", min_length=1, max_length=200)
-    seed: int = Field(default=0, ge=0, lt=2**63)
+    seed: int = Field(default=0, ge=0, lt=SEED_LIMIT)
     map: MapConfig = Field(default_factory=MapConfig)
     environment: dict[str, Any] = Field(default_factory=dict)
     acquisition: AcquisitionConfig = Field(default_factory=AcquisitionConfig)
@@ -526,3 +530,14 @@ def load_spec(source: str | os.PathLike[str] | dict[str, Any] | GenerationSpec) 
         raise located(exc, where) from None
     _cross_checks(spec, where)
     return spec
+
+
+def with_seed(spec: GenerationSpec, seed: Any, *, name: str = "seed") -> GenerationSpec:
+    """``spec`` with ``seed`` in place of its own ``seed`` (``mmusv generate --seed N``): checked as that field is,
+    a whole number in ``0 .. 2**63 - 1`` (:class:`~mmusv.errors.ConfigError` naming ``name`` otherwise). Every random
+    draw of the set derives from it, so the result generates the same files, byte for byte, as the spec file with
+    ``seed: N`` written in it."""
+    from mmusv import arguments
+
+    value = arguments.whole(seed, name=name, lo=0, hi=SEED_LIMIT - 1)
+    return spec.model_copy(update={"seed": value})

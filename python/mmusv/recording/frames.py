@@ -22,6 +22,7 @@ camera intrinsics), ``run`` (status, frames written, frequency, agents; written 
 
 from __future__ import annotations
 
+import contextlib
 import json
 import threading
 from collections.abc import Sequence
@@ -33,8 +34,10 @@ import yaml
 from scipy.spatial.transform import Rotation
 
 from mmusv.config import scenario_hash
+from mmusv.errors import MmusvError
 from mmusv.frames import BODY_TO_OPTICAL
 from mmusv.recording import topics
+from mmusv.recording.guard import HeldSignals
 from mmusv.recording.writer import ImageFormat, Recording
 from mmusv.sensors.camera import CameraImages
 from mmusv.simulation import FrameCapture, Simulation
@@ -72,6 +75,31 @@ def pose7(m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return m[:3, 3].copy(), Rotation.from_matrix(m[:3, :3]).as_quat()
 
 
+def _sensors(sim: Simulation) -> dict[str, Any]:
+    """The ``sensors`` metadata of ``sim``: per agent, its asset, mounts, cameras and rig."""
+    sensors: dict[str, Any] = {}
+    for a in sim.agents:
+        cams = {}
+        for name, (cam, cfg, mount) in a.cameras.items():
+            cams[name] = {
+                "resolution": list(cfg.resolution),
+                "hfov_deg": cfg.hfov_deg,
+                "intrinsics": list(cam.intrinsics or ()),
+                "distortion": None if cfg.distortion is None else list(cfg.distortion),
+                "quality": cfg.quality,
+                "mount_in_body": np.round(mount, 9).tolist(),
+                "outputs": list(cfg.outputs),
+            }
+        sensors[a.id] = {
+            "asset": a.asset.name,
+            "lidar_mount_in_body": None if a.lidar_mount is None else np.round(a.lidar_mount, 9).tolist(),
+            "radar_mount_in_body": None if a.radar_mount is None else np.round(a.radar_mount, 9).tolist(),
+            "cameras": cams,
+            "rig": a.rig.model_dump(mode="json"),
+        }
+    return sensors
+
+
 class FrameRecorder:
     """Streams :class:`~mmusv.simulation.FrameCapture` frames of ``sim`` into ``path``.
 
@@ -91,45 +119,40 @@ class FrameRecorder:
         self.encode_seconds = 0.0
         """Wall seconds spent encoding images so far (for profiling)."""
         self.roles = {v.id: v.role for v in sim.vessels}
-        self.rec = Recording(path, overwrite=overwrite)
         sc = sim.scenario
-        self.rec.metadata(
-            "scenario", {"name": sc.name, "yaml": yaml.safe_dump(sc.model_dump(mode="json"), sort_keys=False)}
-        )
         from mmusv import __version__
 
         first, count = (0, sc.acquisition.frames) if frames is None else frames
-        self.rec.metadata(
-            "manifest",
-            {
+        metadata: dict[str, dict[str, Any]] = {
+            "scenario": {"name": sc.name, "yaml": yaml.safe_dump(sc.model_dump(mode="json"), sort_keys=False)},
+            "manifest": {
                 "mmusv_version": __version__,
                 "seed": sc.seed,
                 "config_hash": scenario_hash(sc),
                 "first_frame": first,
                 "frames_requested": count,
             },
-        )
-        sensors: dict[str, Any] = {}
-        for a in sim.agents:
-            cams = {}
-            for name, (cam, cfg, mount) in a.cameras.items():
-                cams[name] = {
-                    "resolution": list(cfg.resolution),
-                    "hfov_deg": cfg.hfov_deg,
-                    "intrinsics": list(cam.intrinsics or ()),
-                    "distortion": None if cfg.distortion is None else list(cfg.distortion),
-                    "quality": cfg.quality,
-                    "mount_in_body": np.round(mount, 9).tolist(),
-                    "outputs": list(cfg.outputs),
-                }
-            sensors[a.id] = {
-                "asset": a.asset.name,
-                "lidar_mount_in_body": None if a.lidar_mount is None else np.round(a.lidar_mount, 9).tolist(),
-                "radar_mount_in_body": None if a.radar_mount is None else np.round(a.radar_mount, 9).tolist(),
-                "cameras": cams,
-                "rig": a.rig.model_dump(mode="json"),
-            }
-        self.rec.metadata("sensors", {"json": json.dumps(sensors, sort_keys=True)})
+            "sensors": {"json": json.dumps(_sensors(sim), sort_keys=True)},
+        }
+        # The file and every metadata record together: a stop (SIGINT, SIGTERM) that comes meanwhile is held until
+        # they are written, and a failure removes the file, so a .partial always says what it is (a stop here left
+        # one without its manifest and sensors, which `mmusv info` and `mmusv recover` could not read).
+        with HeldSignals():
+            self.rec = Recording(path, overwrite=overwrite)
+            try:
+                for name, values in metadata.items():
+                    self.rec.metadata(name, values)
+            except BaseException:
+                self._discard()
+                raise
+
+    def _discard(self) -> None:
+        """Closes and removes the ``.partial`` of a recording that could not be opened (no frame is in it)."""
+        partial = self.rec.partial_path
+        with contextlib.suppress(MmusvError):
+            self.rec.abandon()
+        with contextlib.suppress(OSError):
+            partial.unlink()
 
     # ------------------------------------------------------------------------------------------ per frame
 

@@ -4,9 +4,10 @@ itself (:class:`RecordingInfo`: scenario, config hash, seed, rate, frames, its i
 :func:`read_info` reads the metadata records (``scenario``, ``manifest``, ``sensors``, ``run``) from the summary
 section when the file has one, otherwise from the records before the first chunk (a truncated or ``.partial``
 file; :mod:`mmusv.recording.scan` hops over the chunks). Given a parts manifest (:mod:`mmusv.recording.parts`) it
-merges the recorded parts' metadata (``run.status`` is ``complete`` only when every part is). Mounts are
-``(4, 4)`` sensor → vessel body matrices (metres; body frame x forward, y left, z up); camera intrinsics are
-pixels. :func:`check_mcap` says whether a path is an MCAP file at all, :func:`recording_name` and
+merges the recorded parts' metadata (``run.status`` is ``complete`` only when every part is; ``run.frames_written``
+sums what each part says, and for a part killed before its ``run`` metadata, the complete frames read from it).
+Mounts are ``(4, 4)`` sensor → vessel body matrices (metres; body frame x forward, y left, z up); camera
+intrinsics are pixels. :func:`check_mcap` says whether a path is an MCAP file at all, :func:`recording_name` and
 :func:`find_recordings` name and find recordings (an ``.mcap`` or a parts manifest, which stands for its parts).
 The frames themselves: :mod:`mmusv.recording.stream`.
 """
@@ -227,7 +228,7 @@ def _read_parts_info(p: Path) -> RecordingInfo:
     run = {k: v for k, v in base.run.items() if k not in ("status", "error", "first_frame")}
     run.update(
         status=status,
-        frames_written=str(sum(int(i.run.get("frames_written", 0) or 0) for _f, i in infos)),
+        frames_written=str(sum(_part_frames(i) for _f, i in infos)),
         frames_requested=str(m.frames),
         parts=str(len(files)),
     )
@@ -245,6 +246,21 @@ def _read_parts_info(p: Path) -> RecordingInfo:
         has_summary=status == "complete" and all(i.has_summary for _f, i in infos),
         parts=tuple(i.path for _f, i in infos),
     )
+
+
+def _part_frames(part: RecordingInfo) -> int:
+    """The frames one part of a split recording holds: as its ``run`` metadata says, or, for a part killed before it
+    could say (a ``.partial`` without ``run`` metadata), the complete frames read from it. Counted as 0, a killed
+    split run's parts made ``mmusv info`` say 0 frames written where they held every frame."""
+    said = part.run.get("frames_written")
+    if said is not None:
+        return int(said or 0)
+    from mmusv.recording.stream import FrameStream
+
+    stream = FrameStream(part, want=lambda _t: False)
+    for _ in stream:
+        pass
+    return len(set(stream.yielded))
 
 
 def recording_arg(path: object) -> Path:

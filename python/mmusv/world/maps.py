@@ -53,6 +53,7 @@ __all__ = [
     "generate_map_from",
     "generate_open_sea",
     "generate_port",
+    "island_fit_problem",
     "make_params",
 ]
 
@@ -244,8 +245,13 @@ def _place_islands(p: IslandParams, rng: np.random.Generator) -> list[IslandSpec
             if all(np.hypot(*(c - c2)) >= (r + r2) * grow + p.min_gap_m for c2, r2 in placed):
                 break
         else:
+            lo, hi = p.island_radius_m
             raise MapConfigError(
-                "n_islands", p.n_islands, "fewer or smaller islands (they do not fit in extent_m with min_gap_m)"
+                "n_islands",
+                p.n_islands,
+                f"fewer or smaller islands: with this map seed only {len(placed)} of the {p.n_islands} islands of "
+                f"island_radius_m [{lo:g}, {hi:g}] fit in extent_m = {p.extent_m:g} at least min_gap_m = "
+                f"{p.min_gap_m:g} apart (lower n_islands or island_radius_m, lower min_gap_m, or raise extent_m)",
             )
         placed.append((c, r))
         peak = min(float(rng.uniform(*p.island_height_m)), 0.35 * r)
@@ -267,6 +273,19 @@ def _place_islands(p: IslandParams, rng: np.random.Generator) -> list[IslandSpec
                 )
             )
     return specs
+
+
+def island_fit_problem(seed: int, params: IslandParams) -> str | None:
+    """Why the islands of an ``island`` map of ``seed`` and ``params`` cannot be placed (what is allowed instead),
+    or None when they fit. It runs the placement of :func:`generate_island` itself, the first draws of the map's
+    random stream, so the answer is the build's for this seed; it builds no terrain (milliseconds), so
+    :class:`mmusv.config.MapConfig` refuses such a map when the scenario or spec loads (``map.params.n_islands``)
+    rather than when a run builds its world."""
+    try:
+        _place_islands(params, np.random.default_rng(_check_seed(seed)))
+    except MapConfigError as exc:
+        return exc.allowed
+    return None
 
 
 def _island_terrain(
