@@ -20,14 +20,16 @@ if __name__ == "__main__":
         bare = types.ModuleType("mmusv")
         bare.__path__ = [str(pkg)]
         sys.modules["mmusv"] = bare
+    from mmusv.learn._errors import command  # a bad input is one line and exit status 2, not a traceback
+
     if sys.argv[1:2] == ["infer"]:
         from mmusv.learn.infer import main
 
-        raise SystemExit(main(sys.argv[2:]))
+        raise SystemExit(command(main, sys.argv[2:]))
     if sys.argv[1:2] == ["merge"]:
         from mmusv.learn.infer import merge_main
 
-        raise SystemExit(merge_main(sys.argv[2:]))
+        raise SystemExit(command(merge_main, sys.argv[2:]))
     from mmusv.learn.train import main
 
-    raise SystemExit(main())
+    raise SystemExit(command(main, sys.argv[1:]))

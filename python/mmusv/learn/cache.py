@@ -115,6 +115,11 @@ def build_cache(
     sample_cloud: list[int] = []
     gts: list[np.ndarray] = []
     for s, seq in enumerate(ds.sequences()):
+        if seq.frames and not seq.agent_ids:  # it left no sample, and the cache was built (or "no frame to cache")
+            raise input_error(
+                f"sequence {seq.name}: no LiDAR: none of its instrumented USVs carries one (a rig with lidar: null), "
+                "and the models learn from LiDAR clouds; leave it out of the training data"
+            )
         names.append(seq.name)
         for fr in seq.frames[:: max(1, frame_stride)]:
             f = len(frame_seq)
@@ -167,6 +172,43 @@ def build_cache(
     return out_p
 
 
+def _check_arrays(path: Path, a: dict[str, np.ndarray]) -> None:
+    """Refuses a cache whose arrays do not fit together or hold values that are not finite, naming the array: a NaN
+    ground-truth box was a ``ValueError`` traceback in training (``cannot convert float NaN to integer``), and offsets
+    past the points an ``IndexError`` at some sample."""
+
+    def bad(what: str) -> Exception:
+        return input_error(f"--cache {path}: {what} (a damaged or edited cache: build it again)")
+
+    n_clouds, n_frames = len(a["cloud_lidar"]), len(a["frame_seq"])
+    shapes = {
+        "xyz_cm": (a["xyz_cm"].ndim == 2 and a["xyz_cm"].shape[1] == 3, "(N, 3)"),
+        "gt": (a["gt"].ndim == 2 and a["gt"].shape[1] == 7, "(G, 7) x, y, z, l, w, h, yaw"),
+        "cloud_lidar": (a["cloud_lidar"].ndim == 3 and a["cloud_lidar"].shape[1:] == (4, 4), "(C, 4, 4)"),
+        "cloud_offsets": (a["cloud_offsets"].shape == (n_clouds + 1,), f"({n_clouds + 1},), one more than the clouds"),
+        "cloud_frame": (a["cloud_frame"].shape == (n_clouds,), f"({n_clouds},), one per cloud"),
+        "intensity": (a["intensity"].shape == (len(a["xyz_cm"]),), f"({len(a['xyz_cm'])},), one per point"),
+        "gt_offsets": (a["gt_offsets"].shape == (len(a["sample_cloud"]) + 1,), "one more than the samples"),
+    }
+    for name, (ok, want) in shapes.items():
+        if not ok:
+            raise bad(f"{name}: shape {a[name].shape}, expected {want}")
+    for name, total in (("cloud_offsets", len(a["xyz_cm"])), ("gt_offsets", len(a["gt"]))):
+        o = a[name]
+        if o[0] != 0 or o[-1] != total or (np.diff(o) < 0).any():
+            raise bad(f"{name}: not a rising run from 0 to {total}")
+    for name, top in (("sample_cloud", n_clouds), ("cloud_frame", n_frames), ("frame_seq", len(a["sequences"]))):
+        if len(a[name]) and (a[name].min() < 0 or a[name].max() >= top):
+            raise bad(f"{name}: indices outside 0..{top - 1}")
+    for name in ("gt", "cloud_lidar"):
+        finite = np.isfinite(a[name]).reshape(len(a[name]), -1).all(axis=1)
+        if not finite.all():
+            rows = np.flatnonzero(~finite)
+            raise bad(
+                f"{name}: {len(rows)} row(s) with values that are not finite (NaN or inf), the first row {rows[0]}"
+            )
+
+
 class Cache:
     """A tensor cache read back (module docstring): :meth:`sample` gives one ego's inputs and ground truth."""
 
@@ -199,8 +241,12 @@ class Cache:
         except (OSError, ValueError, EOFError, TypeError, zipfile.BadZipFile) as exc:  # a cut copy; a .npy (TypeError)
             raise input_error(f"--cache {p}: not a readable .npz cache ({type(exc).__name__}: {exc})") from None
         self.path = p
-        self.meta: dict[str, Any] = json.loads(str(self.arrays["meta"]))
+        try:
+            self.meta: dict[str, Any] = json.loads(str(self.arrays["meta"]))
+        except ValueError:
+            raise input_error(f"--cache {p}: meta: not JSON (not an mmusv.learn cache)") from None
         a = self.arrays
+        _check_arrays(p, a)
         self.frame_clouds: list[np.ndarray] = [np.zeros(0, np.int64)] * len(a["frame_seq"])
         order = np.argsort(a["cloud_frame"], kind="stable")
         bounds = np.searchsorted(a["cloud_frame"][order], np.arange(len(a["frame_seq"]) + 1))

@@ -411,7 +411,8 @@ def _fit_scorers(
             "held_out": [{"beta": b, "ap50": round(a5, 4), "ap70": round(a7, 4)} for b, a5, a7 in fit.held_out],
             "seconds": round(time.perf_counter() - t0, 1),
         }
-        path = scorer.save(out / mode / SCORER_FILE, info)
+        # the file without the fit's wall-clock time (the summary has it): the same seed, the same bytes
+        path = scorer.save(out / mode / SCORER_FILE, {k: v for k, v in info.items() if k != "seconds"})
         done[mode] = info
         base = next(x for x in fit.held_out if x[0] == 0.0)
         chosen = next(x for x in fit.held_out if x[0] == fit.beta)

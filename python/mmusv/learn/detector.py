@@ -29,23 +29,17 @@ from mmusv.learn._errors import input_error
 from mmusv.learn.checkpoint import load_checkpoint, weights_digest
 from mmusv.learn.decode import decode
 from mmusv.learn.example import MODES, collate, make_example, message_bytes
-from mmusv.learn.model import PillarNet
-from mmusv.learn.presets import Preset
+from mmusv.learn.model import PillarNet, from_checkpoint
 from mmusv.learn.refine import RefineParams
 from mmusv.learn.scorer import SCORER_FILE, IoUScorer, load_scorer, second_stage
 
 __all__ = ["LearnedDetector", "load_models"]
 
 
-def _load(path: Path, device: torch.device) -> tuple[PillarNet, dict[str, Any]]:
+def _load(path: Path, device: torch.device, mode: str | None = None) -> tuple[PillarNet, dict[str, Any]]:
     what = f"--model {path}: not an mmusv.learn model.pt"
     ck = load_checkpoint(path, what=what, device=device)
-    try:
-        p = Preset.from_dict(ck["preset"])
-        model = PillarNet(p, ck["mode"])
-        model.load_state_dict(ck["model"])
-    except (OSError, KeyError, TypeError, RuntimeError, ValueError) as exc:
-        raise input_error(f"{what} ({type(exc).__name__}: {exc})") from None
+    model = from_checkpoint(ck, what, mode=mode)
     model.to(device).eval()
     if device.type == "cuda":
         model.channels_last()
@@ -79,7 +73,7 @@ def load_models(
     models: dict[str, PillarNet] = {}
     info: dict[str, dict[str, Any]] = {}
     for mode, f in files.items():
-        models[mode], ck = _load(f, dev)
+        models[mode], ck = _load(f, dev, mode if p.is_dir() else None)
         info[mode] = {
             "file": str(f),
             "epoch": int(ck["epoch"]),

@@ -6,7 +6,12 @@ Output ``.npz``: for each of ``single`` (per cloud), ``early`` and ``intermediat
 ``(M, 7)`` float32 ego-frame ``x, y, z, l, w, h, yaw``, ``<m>_scores`` ``(M,)``, ``<m>_offsets`` (rows of item
 ``i`` are ``offsets[i]:offsets[i+1]``); and ``intermediate_bytes`` ``(K,)`` the bytes the neighbours sent.
 :mod:`mmusv.learn.replay` turns it into the detection study's predictions Parquet (rotated NMS and late fusion
-done there by the study's own code).
+done there by the study's own code). A ``--models`` folder without a model of the ``--modes`` asked for is refused
+(an empty peaks file was written). The file is written under the very name given (``-o peaks`` wrote
+``peaks.npz``).
+
+Run as a command (``scripts/learn_train.py infer|merge``), a bad input is one line, ``mmusv: error: ...``, and exit
+status 2.
 """
 
 from __future__ import annotations
@@ -24,8 +29,7 @@ from mmusv.learn.cache import Cache
 from mmusv.learn.checkpoint import load_checkpoint
 from mmusv.learn.decode import peaks
 from mmusv.learn.example import MODES, collate, make_example, message_bytes
-from mmusv.learn.model import PillarNet, torch_device
-from mmusv.learn.presets import Preset
+from mmusv.learn.model import PillarNet, from_checkpoint, torch_device
 
 __all__ = ["infer_cache", "main", "merge_main", "merge_peaks"]
 
@@ -33,12 +37,7 @@ __all__ = ["infer_cache", "main", "merge_main", "merge_peaks"]
 def _model(path: Path, dev: torch.device) -> PillarNet:
     what = f"{path}: not an mmusv.learn model.pt"
     ck = load_checkpoint(path, what=what, device=dev)
-    try:
-        m = PillarNet(Preset.from_dict(ck["preset"]), ck["mode"])
-        m.load_state_dict(ck["model"])
-    except (KeyError, TypeError, RuntimeError, ValueError) as exc:
-        raise input_error(f"{what} ({type(exc).__name__}: {exc})") from None
-    m = m.to(dev)
+    m = from_checkpoint(ck, what, mode=path.parent.name if path.parent.name in MODES else None).to(dev)
     return (m.channels_last() if dev.type == "cuda" else m).eval()
 
 
@@ -91,8 +90,23 @@ def infer_cache(
         if mode == "intermediate":
             arrays["intermediate_bytes"] = np.array(sent, dtype=np.int64)
         print(f"{mode}: {len(counts)} inferences, {time.perf_counter() - t0:.1f} s", flush=True)
+    if not arrays:  # an empty peaks file was written, and replayed into predictions without a box
+        raise input_error(
+            f"--models {root}: no {'|'.join(m for m in MODES if m in modes)}/model.pt there (mmusv train's output "
+            "folder holds one per model)"
+        )
+    return _write(arrays, out)
+
+
+def _write(arrays: dict[str, np.ndarray], out: str | Path) -> Path:
+    """``arrays`` into the ``.npz`` file ``out``, by that very name (numpy's own writer appended ``.npz`` to a name
+    without it, and the path returned was not the file written), through a temporary file: an interrupted run leaves
+    no file that looks complete."""
     out_p = Path(out)
-    np.savez_compressed(out_p, **arrays)  # type: ignore[arg-type]
+    tmp = out_p.with_name(f".{out_p.name}.partial")
+    with open(tmp, "wb") as fh:
+        np.savez_compressed(fh, **arrays)  # type: ignore[arg-type]
+    tmp.replace(out_p)
     return out_p
 
 
@@ -108,8 +122,9 @@ def merge_peaks(parts: Sequence[str | Path], out: str | Path) -> Path:
                 if k in arrays:
                     raise input_error(f"{part}: {k} is in two of the peak files")
                 arrays[k] = f[k]
-    np.savez_compressed(Path(out), **arrays)  # type: ignore[arg-type]
-    return Path(out)
+    if not arrays:
+        raise input_error(f"{', '.join(str(x) for x in parts)}: none of the peak files is there")
+    return _write(arrays, out)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

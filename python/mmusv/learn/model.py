@@ -8,17 +8,20 @@ Chen et al., SEC 2019). Output: the head's maps, each ``(B, C, ny / out_stride, 
 
 from __future__ import annotations
 
+from dataclasses import MISSING
+from typing import Any
+
 import torch
 from torch import nn
 
-from mmusv.learn._errors import input_error
+from mmusv.learn._errors import input_error, input_error_types
 from mmusv.learn.backbone import Backbone
 from mmusv.learn.example import MODES, Batch
 from mmusv.learn.head import CenterHead
 from mmusv.learn.pillars import PillarEncoder, scatter, scatter_max
 from mmusv.learn.presets import Preset
 
-__all__ = ["PillarNet"]
+__all__ = ["PillarNet", "from_checkpoint"]
 
 
 def torch_device(device: str | None) -> torch.device:
@@ -64,3 +67,59 @@ class PillarNet(nn.Module):
     def forward(self, b: Batch) -> dict[str, torch.Tensor]:
         out: dict[str, torch.Tensor] = self.head(self.backbone(self.canvas(b)))
         return out
+
+
+def from_checkpoint(ck: dict[str, Any], what: str, *, mode: str | None = None) -> PillarNet:
+    """The model a checkpoint dict of :mod:`mmusv.learn.train` holds (``model.pt``), its weights loaded, on the CPU;
+    ``what`` names the file for the errors (``"--model OUT/single/model.pt: not an mmusv.learn model.pt"``),
+    ``mode``: the model the file must be (the folder it lies in: ``OUT/single/model.pt`` holding the early model
+    served no and late fusion without a word). Raises the training core's input error naming the file and the field:
+    a preset of another mmusv version (fields it does not know or lacks; it was a ``TypeError`` of
+    ``Preset.__init__``), an unknown or other ``mode``, ``epoch``/``step`` that are not counts (a ``KeyError``
+    traceback in the study), weights of another shape, or weights that are not finite (a training that diverged:
+    such a model finds nothing)."""
+    from dataclasses import fields
+
+    preset = ck.get("preset")
+    if not isinstance(preset, dict):
+        raise input_error(f"{what} (preset: {type(preset).__name__}, not the preset's fields)")
+    known = {f.name for f in fields(Preset)}
+    required = {f.name for f in fields(Preset) if f.default is MISSING and f.default_factory is MISSING}
+    unknown = sorted(set(preset) - known)
+    missing = sorted(required - set(preset))
+    if unknown or missing:
+        parts = ([f"unknown field(s) {', '.join(unknown)}"] if unknown else []) + (
+            [f"missing field(s) {', '.join(missing)}"] if missing else []
+        )
+        raise input_error(
+            f"{what} (preset: {'; '.join(parts)}: written by another version of mmusv; train it again with this one)"
+        )
+    m = ck.get("mode")
+    if m not in MODES:
+        raise input_error(f"{what} (mode: {m!r}; allowed: {', '.join(MODES)})")
+    if mode is not None and m != mode:
+        raise input_error(f"{what} (mode: it holds the {m} model, where the {mode} model belongs; put it in {m}/)")
+    for key in ("epoch", "step"):
+        v = ck.get(key)
+        if type(v) is not int or v < 0:
+            raise input_error(f"{what} ({key}: {v!r}; a count, 0 or more)")
+    state = ck.get("model")
+    if not isinstance(state, dict):
+        raise input_error(f"{what} (model: {type(state).__name__}, not the model's weights)")
+    try:
+        net = PillarNet(Preset.from_dict(preset), m)
+        net.load_state_dict(state)
+    except input_error_types() as exc:  # the preset's own checks (a grid the backbone cannot divide)
+        raise input_error(f"{what} (preset: {exc})") from None
+    except (KeyError, TypeError, RuntimeError, ValueError) as exc:
+        raise input_error(f"{what} ({type(exc).__name__}: {exc})") from None
+    bad = [
+        k for k, t in state.items() if isinstance(t, torch.Tensor) and t.is_floating_point() and not t.isfinite().all()
+    ]
+    if bad:
+        raise input_error(
+            f"{what} (model: weights that are not finite (NaN or inf) in {', '.join(bad[:3])}"
+            f"{f' and {len(bad) - 3} more' if len(bad) > 3 else ''}: its training diverged; train it again, e.g. with "
+            "a lower lr)"
+        )
+    return net

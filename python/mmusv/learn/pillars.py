@@ -49,11 +49,12 @@ def pillarize(points: np.ndarray, p: Preset) -> Pillars:
     pts = pts[:, :4]
     (x0, _), (y0, _), (z0, z1) = p.x_range, p.y_range, p.z_range
     nx, ny = p.grid
-    ix = np.floor((pts[:, 0] - x0) / p.pillar_m).astype(np.int64)
-    iy = np.floor((pts[:, 1] - y0) / p.pillar_m).astype(np.int64)
-    ok = (ix >= 0) & (ix < nx) & (iy >= 0) & (iy < ny) & (pts[:, 2] >= z0) & (pts[:, 2] < z1)
-    ok &= np.isfinite(pts).all(axis=1)
-    pts, ix, iy = pts[ok], ix[ok], iy[ok]
+    fx = np.floor((pts[:, 0] - x0) / p.pillar_m)
+    fy = np.floor((pts[:, 1] - y0) / p.pillar_m)
+    # the grid's points chosen before the cast to cells: a NaN (or a point far off the grid) cast to int64 warned
+    ok = (fx >= 0) & (fx < nx) & (fy >= 0) & (fy < ny) & (pts[:, 2] >= z0) & (pts[:, 2] < z1)
+    ok &= np.isfinite(pts[:, 3])
+    pts, ix, iy = pts[ok], fx[ok].astype(np.int64), fy[ok].astype(np.int64)
     m = p.max_points
     if len(pts) == 0:
         return Pillars(np.zeros((0, m, FEATURES), np.float32), np.zeros((0, m), bool), np.zeros((0, 2), np.int64))

@@ -16,6 +16,11 @@ inputs: use ``--model``).
 With ``--scorers DIR`` (and ``--refine``) the refined boxes are rescored by the IoU scorers of
 :mod:`mmusv.learn.scorer` as the detector does (:func:`mmusv.learn.scorer.second_stage`).
 
+The peaks must be those of this cache (one item per cloud or sample: the peaks of another cache, or of an ``infer
+--limit`` run, are refused), and the cache must hold every sequence of ``split`` of the recordings given, recorded
+the same (a cache of another split wrote a predictions file without a row). Run as a command, a bad input is one
+line, ``mmusv: error: ...``, and exit status 2.
+
 ``python -m mmusv.learn.replay PEAKS.npz CACHE.npz RECORDINGS... [--split test] [--refine [--scorers DIR]]
 [--late-merge wbf] -o PREDICTIONS.parquet``
 """
@@ -61,6 +66,54 @@ def _aggregate(cache: Cache, k: int) -> np.ndarray:
     return early_cloud(ego, nbs)
 
 
+def _read_peaks(peaks: str | Path, cache: Cache) -> dict[str, np.ndarray]:
+    """The arrays of the peaks file ``peaks`` (:mod:`mmusv.learn.infer`), checked against ``cache``: one item per
+    cloud (``single``) or sample (``early``, ``intermediate``) of the cache. The peaks of another cache, or of a run
+    with ``--limit``, were an ``IndexError`` traceback, or boxes put on the clouds of other frames."""
+    import zipfile
+
+    try:
+        with open(peaks, "rb") as fh, np.load(fh, allow_pickle=False) as f:
+            z = {k: f[k] for k in f.files}
+    except (ValueError, EOFError, TypeError, zipfile.BadZipFile) as exc:
+        raise input_error(f"{peaks}: not a peaks .npz of mmusv.learn.infer ({type(exc).__name__})") from None
+    found = [m for m in MODELS if f"{m}_offsets" in z]
+    if not found:
+        raise input_error(f"{peaks}: holds no peaks ({', '.join(f'{m}_offsets' for m in MODELS)} missing)")
+    n_clouds = len(cache.arrays["cloud_offsets"]) - 1
+    for m in found:
+        n, what = (n_clouds, "clouds") if m == "single" else (len(cache), "samples")
+        o, b, sc = z[f"{m}_offsets"], z.get(f"{m}_boxes"), z.get(f"{m}_scores")
+        if len(o) != n + 1:
+            raise input_error(
+                f"{peaks}: {m}_offsets: peaks of {len(o) - 1} items, where the cache {cache.path} has {n} {what}: the "
+                "peaks of another cache, or of a run with --limit; infer them on this cache"
+            )
+        if b is None or sc is None or b.ndim != 2 or b.shape[1] != 7 or len(b) != len(sc) or o[-1] != len(sc):
+            raise input_error(f"{peaks}: {m}_boxes/{m}_scores: not (M, 7) boxes and (M,) scores as {m}_offsets says")
+    return z
+
+
+def _check_same_sequences(ds: object, cache: Cache, split: str) -> None:
+    """Refuses a cache that lacks a sequence of the dataset's split, or holds one of the same name recorded otherwise:
+    its peaks were never matched to a frame, and the predictions file was written without a row."""
+    from mmusv.learn.cache import dataset_fingerprints
+
+    held = {str(x) for x in cache.arrays["sequences"]}
+    recorded = cache.meta.get("fingerprints")
+    theirs: dict[str, str] = recorded if isinstance(recorded, dict) else {}
+    asked = dataset_fingerprints(ds)
+    names = sorted(getattr(ds, "sources", {}))
+    missing = [n for n in names if n not in held]
+    other = [n for n in names if n in held and n in asked and n in theirs and asked[n] != theirs[n]]
+    if missing or other:
+        why = f"holds no sequence {', '.join(missing)}" if missing else f"holds {', '.join(other)} recorded differently"
+        raise input_error(
+            f"--cache {cache.path}: {why} of split {split!r} of the recordings given (it holds "
+            f"{', '.join(sorted(held))}); give the recordings, --split and --seed the cache was built from"
+        )
+
+
 def write_predictions(
     peaks: str | Path,
     cache: Cache,
@@ -86,11 +139,11 @@ def write_predictions(
     from mmusv.studies.detection.robustness import Setting, neighbours_for
     from mmusv.studies.detection.sources import resolve_dataset
 
-    with np.load(peaks) as f:
-        z = {k: f[k] for k in f.files}
-
     if late_merge not in LATE_MERGES:
         raise input_error(f"--late-merge {late_merge!r}: allowed: {', '.join(LATE_MERGES)}")
+    z = _read_peaks(peaks, cache)
+    ds = resolve_dataset(list(inputs), opv2v=None, split=split, ratios=tuple(ratios), seed=seed)
+    _check_same_sequences(ds, cache, split)
 
     def nms(b: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         keep = rotated_nms(b, s, iou_threshold=nms_iou)
@@ -120,7 +173,6 @@ def write_predictions(
             fused[(key, "intermediate")] = stage(
                 *_rows(z, "intermediate", k), partial(cache.cloud, ego_cloud), "intermediate"
             )
-    ds = resolve_dataset(list(inputs), opv2v=None, split=split, ratios=tuple(ratios), seed=seed)
     cols: dict[str, list[object]] = {
         c: [] for c in ("sequence", "frame", "ego", "mode", "x", "y", "z", "l", "w", "h", "yaw", "score")
     }
@@ -208,4 +260,6 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    from mmusv.learn._errors import command
+
+    raise SystemExit(command(main))

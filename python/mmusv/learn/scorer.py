@@ -152,10 +152,8 @@ class IoUScorer(nn.Module):
         renamed: a killed save leaves no file that looks complete)."""
         p = Path(path)
         tmp = p.with_name(p.name + ".part")
-        torch.save(
-            {"features": list(FEATURES), "state": self.state_dict(), "beta": self.beta, "info": info},
-            tmp,
-        )
+        with open(tmp, "wb") as fh:  # through an open file: the archive inside is named "archive", not after tmp
+            torch.save({"features": list(FEATURES), "state": self.state_dict(), "beta": self.beta, "info": info}, fh)
         tmp.replace(p)
         return p
 

@@ -15,7 +15,8 @@ or through ``mmusv train`` (which builds the cache first). Files in the output f
   the epochs asked for (``epochs``), why the run stopped short of them (``stopped``: ``"time limit"``, ``"max
   steps"``, or ``None`` while it is still going or was interrupted) and the data it was trained on (``data``:
   :meth:`mmusv.learn.cache.Cache.identity`), so an unfinished model, and a model evaluated on its own training
-  sequences, can be told;
+  sequences, can be told; without the wall-clock time (``last.pt`` has it), so two runs of the same seed on a CPU
+  write the same bytes;
 - ``log.jsonl``: one line per logged step (``epoch, step, loss, heatmap, regression, lr, seconds``) and one per
   epoch (``"epoch_end": true``); :func:`plot_losses` draws it.
 
@@ -27,10 +28,13 @@ device. With ``time_limit_s`` the run stops at the first step past the limit (mi
 learning-rate schedule runs on elapsed time instead of steps; started again with the same limit, a run that
 reached it does nothing (it took one more step and rewrote its model every time).
 
+A training whose loss or gradient becomes NaN or infinite (a learning rate too high for the data) stops there with an
+input error naming the step, before that step changes the weights: it went on and saved NaN weights as a finished
+model, which finds nothing.
+
 A ``last.pt`` is resumed only by the same run: the same preset, mode and seed, and the same data (a cache built from
 other sequences is refused; the first cache was trained on again without a word when the recordings given
-changed).
-"""
+changed); the refusal names what differs (``preset 'tiny', this run 'cpu'``, ``seed 0, this run 1``)."""
 
 from __future__ import annotations
 
@@ -119,9 +123,32 @@ def _lr(p: Preset, step: int, progress: float) -> float:
 
 
 def _save(obj: dict[str, Any], path: Path) -> None:
+    """``obj`` saved to ``path`` through a temporary file (an interruption leaves the previous file whole). Saved
+    through an open file, so the archive inside is named ``archive`` whatever the file is called: saved by its path,
+    it was named after the temporary file, whose name holds the process id, and two runs of the same seed wrote
+    ``model.pt`` files of different bytes."""
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    torch.save(obj, tmp)
+    with open(tmp, "wb") as fh:
+        torch.save(obj, fh)
     tmp.replace(path)
+
+
+def _differs(ck: dict[str, Any], p: Preset, mode: str, seed: int) -> str | None:
+    """What of ``preset``, ``mode`` and ``seed`` a ``last.pt`` holds other than this run (``None``: the same run)."""
+    out = []
+    old = ck.get("preset")
+    if old != p.to_dict():
+        if isinstance(old, dict) and old.get("name") == p.name:
+            changed = sorted(k for k, v in p.to_dict().items() if old.get(k, object()) != v)
+            out.append(f"preset {p.name} with other {', '.join(changed) or 'fields'}")
+        else:
+            name = old.get("name") if isinstance(old, dict) else None
+            out.append(f"preset {name!r}, this run {p.name!r}")
+    if ck.get("mode") != mode:
+        out.append(f"mode {ck.get('mode')!r}, this run {mode!r}")
+    if ck.get("seed") != seed:
+        out.append(f"seed {ck.get('seed')!r}, this run {seed!r}")
+    return "; ".join(out) or None
 
 
 def train(
@@ -171,8 +198,9 @@ def train(
     if last.is_file():
         what = f"{last}: not a checkpoint of mmusv train (remove it to start again, or use another --out)"
         ck = load_checkpoint(last, what=what, device=dev)
-        if ck.get("preset") != p.to_dict() or ck.get("mode") != mode or ck.get("seed") != seed:
-            raise input_error(f"{last}: a checkpoint of another run (preset/mode/seed differ); use another --out")
+        other = _differs(ck, p, mode, seed)
+        if other is not None:  # it said "preset/mode/seed differ", not which
+            raise input_error(f"{last}: a checkpoint of another run ({other}); use another --out")
         if not same_data(ck.get("data"), identity):
             before = ", ".join(str(x) for x in ck["data"].get("sources", [])) or "?"
             raise input_error(
@@ -236,7 +264,21 @@ def train(
             losses = centerpoint_loss(outs, b.heatmap, b.index, b.reg_mask, b.reg, b.reg_weight, p.code_weights)
             opt.zero_grad(set_to_none=True)
             losses["loss"].backward()  # type: ignore[no-untyped-call]
-            torch.nn.utils.clip_grad_norm_(model.parameters(), 35.0)
+            norm = torch.nn.utils.clip_grad_norm_(model.parameters(), 35.0)
+            if not bool(torch.isfinite(losses["loss"]) & torch.isfinite(norm)):
+                # it stepped on, and saved NaN weights as a finished model that finds nothing
+                if bar is not None:
+                    bar.close()
+                what = f"the loss is {float(losses['loss'].item())}, the gradient norm {float(norm.item())}"
+                kept = (
+                    f"{last} and model.pt are as the last save before it left them"
+                    if last.is_file()
+                    else "no model.pt was written"
+                )
+                raise input_error(
+                    f"{mode}: the training diverged: {what} at step {step + 1} (epoch {epoch + 1}, learning rate "
+                    f"{lr:.3g}); {kept}. Train it again with a lower lr (preset {p.name}: {p.lr:g}) or other data"
+                )
             opt.step()
             step += 1
             if bar is not None:
@@ -274,7 +316,11 @@ def train(
             "data": identity,
         }
         _save({**state, "model": model.state_dict(), "optimizer": opt.state_dict()}, last)
-        _save({**state, "model": model.state_dict(), "log": []}, out_p / "model.pt")
+        # model.pt without the wall-clock time (last.pt and train_summary.json have it): the same seed, the same bytes
+        _save(
+            {**{k: v for k, v in state.items() if k != "seconds"}, "model": model.state_dict(), "log": []},
+            out_p / "model.pt",
+        )
         log_path.write_text("".join(json.dumps(r) + "\n" for r in log), encoding="utf-8")
         if stopped:
             finished = max_steps is not None and step >= max_steps
@@ -424,4 +470,6 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    from mmusv.learn._errors import command
+
+    raise SystemExit(command(main))
