@@ -8,6 +8,7 @@
 //!   prefiltered maps;
 //! * [`water`]: Cox–Munk capillary roughness, Monahan whitecaps, Kelvin wakes and the water body;
 //! * [`rough_water`]: the rough sea's single-scattering microfacet reflection (Beckmann, Smith, Fresnel);
+//! * [`sky_lobe`]: the sky's mean over the rough water's reflection lobe, tabulated per environment;
 //! * [`sea_ms`]: the light reflected more than once between the wave facets (Heitz et al.'s random walk),
 //!   restored over that lobe (Turquin's energy compensation);
 //! * [`tonemap`]: physical exposure from the scene's illuminance and the ACES filmic curve.
@@ -41,6 +42,7 @@ pub mod rough_water;
 pub mod sea_ms;
 mod sea_ms_table;
 pub mod sky;
+pub mod sky_lobe;
 mod tables;
 pub mod tonemap;
 pub mod twilight;
@@ -359,6 +361,23 @@ impl Shader {
     fn sky_no_sun(&self, d: Vec3) -> Vec3 {
         let (sky, air) = self.light.sky_and_horizon(d);
         sky * self.sky_keep + air * (1.0 - self.sky_keep)
+    }
+
+    /// Radiance a reflected ray `d` that meets nothing brings back: the sky without the sun's disc, blended into
+    /// the air light by visibility ([`Shader::reflected`] without a hit).
+    #[inline(always)]
+    pub fn sky_reflected(&self, d: Vec3) -> Vec3 {
+        self.sky_no_sun(d)
+    }
+
+    /// The sky as water of roughness `alpha` reflects it around unit mirror direction `r`: the mean of
+    /// [`Shader::sky_reflected`] over the single-scattering lobe (`sky_lobe.rs`; `r` read as level water's mirror
+    /// direction).
+    #[inline]
+    pub fn sky_lobe_mean(&self, r: Vec3, alpha: f32) -> Vec3 {
+        let (sky, air) = self.light.sky_and_horizon(r);
+        let (dsky, dair) = self.light.sky_lobe_correction(r, alpha);
+        (sky + dsky) * self.sky_keep + (air + dair) * (1.0 - self.sky_keep)
     }
 
     /// Radiance distant objects fade into along `d`: the horizon sky's, at `d`'s azimuth.

@@ -314,6 +314,9 @@ pub fn radiance(
     // The surfaces of the rays whose reflections are traced, kept in `values`' order for their own shading (a
     // water hit's shading normal samples the waves: worked out once, not again in the final pass).
     let mut traced_hits: Vec<SurfaceHit> = Vec::new();
+    // With the glossy blur, per traced reflection: the sky along it (what it brings back meeting nothing) and the
+    // sky's mean over the water's lobe around it (`shade/sky_lobe.rs`), in `values`' order.
+    let mut skies: Vec<(Vec3, Vec3)> = Vec::new();
     // Traced reflections per block side: standard quality traces one per 2 × 2 block, or per 4 × 4 where the
     // glossy lobe of the calmest water here spans many such blocks (the blur then reads them on cells at least
     // that coarse, `glossy::decimation`).
@@ -369,6 +372,16 @@ pub fn radiance(
                 shader.reflected(Vec3::from_array(rd[j]), h.as_ref(), rlit[j])
             })
             .collect();
+        if glossy.is_some() {
+            skies = (0..ro.len())
+                .into_par_iter()
+                .map(|j| {
+                    let r = Vec3::from_array(rd[j]);
+                    let alpha = shader.water_mss(traced_hits[j].unresolved_mss).sqrt();
+                    (shader.sky_reflected(r), shader.sky_lobe_mean(r, alpha))
+                })
+                .collect();
+        }
         index = vec![u32::MAX; n];
         for (j, &k) in traced.iter().enumerate() {
             index[k as usize] = j as u32;
@@ -413,7 +426,9 @@ pub fn radiance(
                     let [x, y] = grid.pos[k];
                     let sin_grazing = (-dirs[k][2]).max(0.0);
                     let mss = shader.water_mss(traced_hits[i as usize].unresolved_mss);
-                    glossy::Sample { x: u32::from(x), y: u32::from(y), value: values[i as usize], mss, sin_grazing }
+                    let (sky, lobe_sky) = skies[i as usize];
+                    let (x, y) = (u32::from(x), u32::from(y));
+                    glossy::Sample { x, y, value: values[i as usize], sky, lobe_sky, mss, sin_grazing }
                 })
                 .collect();
             let (w, h) = (grid.width as usize, grid.height as usize);

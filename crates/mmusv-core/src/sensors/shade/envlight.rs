@@ -21,6 +21,7 @@
 
 use super::brdf::{fresnel_dielectric, ggx_d};
 use super::sky::{luminance, Sky};
+use super::sky_lobe::SkyLobe;
 use super::twilight;
 use parry3d::math::Vec3;
 use std::sync::{Arc, Mutex};
@@ -71,6 +72,8 @@ pub struct Lighting {
     /// What distant things fade into, per column of the `SKY` grid: the sky's radiance just above the horizon
     /// (elevation ~1.1°), in twilight blended into the haze in the Earth's shadow (`twilight::shadowed_haze`).
     horizon: Vec<Vec3>,
+    /// The sky's means over the rough water's reflection lobes (`sky_lobe.rs`), built as they are first read.
+    sky_lobe: SkyLobe,
 }
 
 /// Unit direction of the centre of texel `(i, j)` of a `w × h` equal-area grid.
@@ -84,7 +87,7 @@ fn texel_dir(i: usize, j: usize, w: usize, h: usize) -> Vec3 {
 /// The "diamond angle" of `(x, y)` in `[0, 4)`: a monotone stand-in for the azimuth (1 per quarter turn)
 /// without trigonometry.
 #[inline(always)]
-fn diamond(x: f32, y: f32) -> f32 {
+pub(super) fn diamond(x: f32, y: f32) -> f32 {
     let s = x.abs() + y.abs();
     if s == 0.0 {
         return 0.0;
@@ -108,7 +111,7 @@ fn diamond(x: f32, y: f32) -> f32 {
 }
 
 /// Unit horizontal `(x, y)` of diamond angle `p` in `[0, 4)`.
-fn diamond_dir(p: f32) -> (f32, f32) {
+pub(super) fn diamond_dir(p: f32) -> (f32, f32) {
     let q = p.floor();
     let f = p - q;
     let (x, y) = match q as i32 {
@@ -303,6 +306,7 @@ impl Lighting {
             prefiltered,
             sky_table,
             horizon,
+            sky_lobe: SkyLobe::default(),
         }
     }
 
@@ -348,6 +352,14 @@ impl Lighting {
             cache.push((*key, Arc::clone(&l)));
         }
         l
+    }
+
+    /// `(sky, air)`: the means of [`Lighting::sky_radiance`] and [`Lighting::horizon_radiance`] over the
+    /// single-scattering reflection lobe of level water of roughness `alpha` whose mirror direction is unit `r`,
+    /// minus their values along `r` (`sky_lobe.rs`).
+    #[inline]
+    pub fn sky_lobe_correction(&self, r: Vec3, alpha: f32) -> (Vec3, Vec3) {
+        self.sky_lobe.correction(self, r, alpha)
     }
 
     /// Radiance of the environment (sky above the horizon, ground below, no sun disc) along unit `d`.
