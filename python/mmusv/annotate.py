@@ -10,7 +10,10 @@ For every agent (USV) and frame, for every other vessel (the agent's own hull is
   lens distortion, the projected edges), clipped to the image, with ``truncation`` = 1 − clipped area / unclipped
   area, ``visible_pixels`` (pixels whose instance is the vessel), ``box_pixels`` (the clipped box area) and
   ``occlusion`` = 1 − visible / silhouette, where the silhouette is the vessel's pixels with everything else
-  removed (its rays cast against the vessel alone).
+  removed (its rays cast against the vessel alone). The whole hull is in the silhouette, its part below the
+  waterline too, so the water counts among what hides it: a vessel in plain view on flat water has an occlusion
+  above 0, the share of its silhouette's rays that meet its hull below the water level (the 2D box, the projected
+  3D box, reaches down to the keel).
 * over a displaced sea (a scene with a wave surface), per 3D box and per 2D box, ``wave_occlusion``: the share of
   the vessel's part above the still water level that the water hides from that sensor (:mod:`mmusv.wave_occlusion`);
   0 over a flat sea.
@@ -26,6 +29,8 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from mmusv._equality import same
+from mmusv.errors import InputError
 from mmusv.frames import BODY_TO_OPTICAL, translation
 from mmusv.scene import Scene
 from mmusv.wave_occlusion import exposed_hidden, lidar_beam_rays, lidar_box_beams, pattern_angles, share
@@ -50,6 +55,8 @@ def in_target_range(centres: np.ndarray, range_m: float) -> np.ndarray:
     labelled); it is the BEV distance the detection study evaluates within.
     """
     c = np.asarray(centres, dtype=np.float64)
+    if c.ndim == 0 or c.shape[-1] not in (2, 3):
+        raise InputError(f"centres must have shape (..., 3) or (..., 2) (x, y[, z] metres), got {c.shape}")
     return np.asarray(np.hypot(c[..., 0], c[..., 1]) <= range_m)
 
 
@@ -57,16 +64,20 @@ def box_corners(matrix: np.ndarray, size: np.ndarray) -> np.ndarray:
     """``(8, 3)`` corners of a box with pose ``matrix`` (``(4, 4)`` box → frame, centred) and full ``size``
     (length, beam, height along the box's x, y, z), in the frame ``matrix`` maps to. Corner ``i`` lies at
     ``±size / 2`` in the box frame, the sign of x from bit 0 of ``i``, of y from bit 1 and of z from bit 2 (set:
-    +; corner 0 is (−x, −y, −z), corner 7 (+x, +y, +z))."""
-    local = _SIGNS * (np.asarray(size, dtype=np.float64) / 2.0)
+    +; corner 0 is (−x, −y, −z), corner 7 (+x, +y, +z)). Other shapes raise :class:`mmusv.InputError`."""
+    matrix, size = np.asarray(matrix, dtype=np.float64), np.asarray(size, dtype=np.float64)
+    if matrix.shape != (4, 4) or size.shape != (3,):
+        raise InputError(f"box_corners takes a (4, 4) matrix and a (3,) size, got {matrix.shape} and {size.shape}")
+    local = _SIGNS * (size / 2.0)
     out: np.ndarray = local @ matrix[:3, :3].T + matrix[:3, 3]
     return out
 
 
-@dataclass
+@dataclass(eq=False)
 class Annotations:
     """Columns of one agent's annotations at one frame (see the module docstring). Lengths: ``n3d`` for
-    ``lidar_*``/``bev_*``, ``n2d`` for ``cam_*``."""
+    ``lidar_*``/``bev_*``, ``n2d`` for ``cam_*``. Two compare equal (``==``) when they hold the same values
+    (arrays by dtype, shape and value)."""
 
     agent: str
     frame: int
@@ -93,6 +104,12 @@ class Annotations:
     cam_role: list[str] = field(default_factory=list)
     cam_static: list[bool] = field(default_factory=list)
     cam_wave_occlusion: list[float] = field(default_factory=list)
+
+    def __eq__(self, other: object) -> bool:
+        """Field by field, arrays by dtype, shape and value (:mod:`mmusv._equality`)."""
+        return same(self, other) if type(other) is type(self) else NotImplemented
+
+    __hash__ = None  # type: ignore[assignment]
 
     def columns(self) -> dict[str, Any]:
         """Numpy columns, the ``Recording.annotations`` groups: ``{"lidar", "bev", "camera"}``, each a dict of

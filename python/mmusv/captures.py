@@ -2,6 +2,11 @@
 
 Frames: world x east, y north, z up (metres); vessel/sensor body frames x forward, y left, z up. Poses are
 ``(4, 4)`` float64 sensor → world matrices. These types are re-exported by :mod:`mmusv.simulation`.
+
+Two captures compare equal (``==``) when they hold the same values: arrays by dtype, shape and value, fields that
+are for profiling only (``sensor_seconds``) left out; they are not hashable. A capture's arrays are its own
+(writable: changing one changes neither the simulation nor its later captures), and a capture pickles (a
+``DataLoader`` worker can return one).
 """
 
 from __future__ import annotations
@@ -10,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from mmusv._equality import same
 from mmusv.sensors.camera import CameraImages
 from mmusv.sensors.lidar import LidarPoints
 from mmusv.sensors.radar import RadarReturns
@@ -17,7 +23,7 @@ from mmusv.sensors.radar import RadarReturns
 __all__ = ["AgentCapture", "FrameCapture", "SensorMount", "VesselInfo", "WorldState"]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class VesselInfo:
     """A vessel of the world state: scenario vessels first (file order), then moored ships (port maps)."""
 
@@ -30,8 +36,14 @@ class VesselInfo:
     box_size: np.ndarray  # (3,) length, beam, height, metres
     static: bool = False  # never moves: moored ships, and scenario vessels at speed 0 (VesselConfig.static)
 
+    def __eq__(self, other: object) -> bool:
+        """Field by field, arrays by dtype, shape and value (:mod:`mmusv._equality`)."""
+        return same(self, other) if type(other) is type(self) else NotImplemented
 
-@dataclass(frozen=True)
+    __hash__ = None  # type: ignore[assignment]
+
+
+@dataclass(frozen=True, eq=False)
 class WorldState:
     """Every vessel at one frame: ``poses`` ``(V, 6)`` [x, y, z, roll, pitch, yaw] (m, rad, world),
     ``velocities`` ``(V, 3)`` m/s world, ``box_centers`` ``(V, 3)`` world, ``matrices`` ``(V, 4, 4)`` body → world."""
@@ -43,6 +55,12 @@ class WorldState:
     box_centers: np.ndarray
     matrices: np.ndarray
 
+    def __eq__(self, other: object) -> bool:
+        """Field by field, arrays by dtype, shape and value (:mod:`mmusv._equality`)."""
+        return same(self, other) if type(other) is type(self) else NotImplemented
+
+    __hash__ = None  # type: ignore[assignment]
+
 
 @dataclass(frozen=True, eq=False)
 class SensorMount:
@@ -53,8 +71,14 @@ class SensorMount:
     mount: np.ndarray
     pose: np.ndarray
 
+    def __eq__(self, other: object) -> bool:
+        """Field by field, arrays by dtype, shape and value (:mod:`mmusv._equality`)."""
+        return same(self, other) if type(other) is type(self) else NotImplemented
 
-@dataclass
+    __hash__ = None  # type: ignore[assignment]
+
+
+@dataclass(eq=False)
 class AgentCapture:
     """Everything one USV's sensors produced at one frame, with the sensor poses (sensor → world).
 
@@ -80,8 +104,14 @@ class AgentCapture:
     its cast met first within the range, -1 for none; what the annotations read to know which beams the water
     stopped. Not recorded."""
 
+    def __eq__(self, other: object) -> bool:
+        """Field by field, arrays by dtype, shape and value (:mod:`mmusv._equality`)."""
+        return same(self, other) if type(other) is type(self) else NotImplemented
 
-@dataclass
+    __hash__ = None  # type: ignore[assignment]
+
+
+@dataclass(eq=False)
 class FrameCapture:
     """One acquisition index: the world state and every agent's capture."""
 
@@ -92,3 +122,9 @@ class FrameCapture:
     sensor_seconds: dict[str, float] = field(default_factory=dict, compare=False)
     """Wall seconds each sensor's work took, keyed ``<agent>/<sensor>`` (``lidar``, ``camera/<name>``,
     ``top_view``, ``radar``, ``ppi``): for profiling only, never recorded."""
+
+    def __eq__(self, other: object) -> bool:
+        """Field by field, arrays by dtype, shape and value (:mod:`mmusv._equality`)."""
+        return same(self, other) if type(other) is type(self) else NotImplemented
+
+    __hash__ = None  # type: ignore[assignment]

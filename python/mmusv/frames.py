@@ -14,14 +14,21 @@ body frames: a point becomes ``S·p`` and a transform ``S·T·S`` with ``S = dia
 
 (:func:`carla_pose_from_eta`); for an arbitrary rotation :func:`carla_pose` reads the angles off ``S·R·S``.
 Mirroring is its own inverse, so the same functions take CARLA data back.
+
+Every function checks the shapes it documents and raises :class:`mmusv.InputError` naming the argument for any
+other (or for values that are not numbers): ``(N, 4)`` homogeneous points, say, are refused, not read as
+``4N / 3`` points of three.
 """
 
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
+
+from mmusv.errors import InputError
 
 __all__ = [
     "BODY_TO_OPTICAL",
@@ -49,10 +56,35 @@ BODY_TO_OPTICAL = np.array([[0.0, -1.0, 0.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0]]
 """``(3, 3)`` camera body (x forward, y left, z up) → optical (x right, y down, z forward)."""
 
 
+def _floats(value: Any, *, name: str, tail: tuple[int, ...], what: str) -> np.ndarray:
+    """``value`` as a float64 array whose last axes are ``tail``, else an :class:`InputError` naming ``name``
+    and the shape ``what`` it must have."""
+    try:
+        a = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name} must be {what} of real numbers: {exc}") from None
+    if a.ndim < len(tail) or a.shape[a.ndim - len(tail) :] != tail:
+        raise InputError(f"{name} must be {what}, got shape {a.shape}")
+    return a
+
+
+def _points(value: Any, *, name: str) -> np.ndarray:
+    """``value`` as ``(N, 3)`` float64 points (one point ``(3,)`` becomes ``(1, 3)``), else an
+    :class:`InputError`."""
+    p = _floats(value, name=name, tail=(3,), what="(N, 3) points (or one (3,) point)")
+    if p.ndim > 2:
+        raise InputError(f"{name} must be (N, 3) points (or one (3,) point), got shape {p.shape}")
+    return p.reshape(-1, 3)
+
+
+def _transforms(value: Any, *, name: str) -> np.ndarray:
+    return _floats(value, name=name, tail=(4, 4), what="(..., 4, 4) transforms")
+
+
 def pose_matrices(eta: npt.ArrayLike) -> np.ndarray:
     """``(..., 4, 4)`` float64 body -> world matrices from poses ``η = [x, y, z, roll, pitch, yaw]`` ``(..., 6)``
     (metres, radians, R = Rz(yaw)·Ry(pitch)·Rx(roll))."""
-    eta = np.asarray(eta, dtype=np.float64)
+    eta = _floats(eta, name="eta", tail=(6,), what="(..., 6) poses [x, y, z, roll, pitch, yaw]")
     cr, sr = np.cos(eta[..., 3]), np.sin(eta[..., 3])
     cp, sp = np.cos(eta[..., 4]), np.sin(eta[..., 4])
     cy, sy = np.cos(eta[..., 5]), np.sin(eta[..., 5])
@@ -73,15 +105,18 @@ def pose_matrices(eta: npt.ArrayLike) -> np.ndarray:
 
 def translation(v: npt.ArrayLike) -> np.ndarray:
     """``(4, 4)`` float64 pure translation by ``v`` ``(3,)`` metres."""
+    t = _floats(v, name="v", tail=(), what="3 numbers (x, y, z)")
+    if t.size != 3:
+        raise InputError(f"v must be 3 numbers (x, y, z), got shape {t.shape}")
     m = np.eye(4)
-    m[:3, 3] = np.asarray(v, dtype=np.float64).reshape(3)
+    m[:3, 3] = t.reshape(3)
     return m
 
 
 def matrix_to_pose(m: npt.ArrayLike) -> np.ndarray:
     """``(..., 6)`` poses ``[x, y, z, roll, pitch, yaw]`` of ``(..., 4, 4)`` rigid transforms (the inverse of
     :func:`pose_matrices`; pitch in [-π/2, π/2], roll = 0 at gimbal lock)."""
-    m = np.asarray(m, dtype=np.float64)
+    m = _transforms(m, name="m")
     r = m[..., :3, :3]
     pitch = np.arcsin(np.clip(-r[..., 2, 0], -1.0, 1.0))
     lock = np.hypot(r[..., 0, 0], r[..., 1, 0]) < 1e-9
@@ -93,7 +128,7 @@ def matrix_to_pose(m: npt.ArrayLike) -> np.ndarray:
 
 def invert(m: npt.ArrayLike) -> np.ndarray:
     """The inverse of ``(..., 4, 4)`` rigid transforms (Rᵀ, −Rᵀt)."""
-    m = np.asarray(m, dtype=np.float64)
+    m = _transforms(m, name="m")
     out = np.zeros_like(m)
     rt = np.swapaxes(m[..., :3, :3], -1, -2)
     out[..., :3, :3] = rt
@@ -102,16 +137,21 @@ def invert(m: npt.ArrayLike) -> np.ndarray:
     return out
 
 
-def transform_points(m: np.ndarray, points: npt.ArrayLike) -> np.ndarray:
-    """``(N, 3)`` points moved by the ``(4, 4)`` transform ``m``."""
-    p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-    out: np.ndarray = p @ m[:3, :3].T + m[:3, 3]
+def transform_points(m: npt.ArrayLike, points: npt.ArrayLike) -> np.ndarray:
+    """``(N, 3)`` float64 points (``points``: ``(N, 3)``, or one ``(3,)`` point as ``(1, 3)``) moved by the
+    ``(4, 4)`` transform ``m``."""
+    t = _floats(m, name="m", tail=(4, 4), what="a (4, 4) transform")
+    if t.ndim != 2:
+        raise InputError(f"m must be a (4, 4) transform, got shape {t.shape}")
+    p = _points(points, name="points")
+    out: np.ndarray = p @ t[:3, :3].T + t[:3, 3]
     return out
 
 
 def mirror_points(points: npt.ArrayLike) -> np.ndarray:
-    """``(N, 3)`` points with y negated: mmusv frame ↔ CARLA frame (the same for world and body frames)."""
-    p = np.array(points, dtype=np.float64).reshape(-1, 3)
+    """``(N, 3)`` float64 points with y negated (``points``: ``(N, 3)``, or one ``(3,)`` point as ``(1, 3)``):
+    mmusv frame ↔ CARLA frame (the same for world and body frames)."""
+    p: np.ndarray = _points(points, name="points").copy()
     p[:, 1] *= -1.0
     return p
 
@@ -119,7 +159,7 @@ def mirror_points(points: npt.ArrayLike) -> np.ndarray:
 def mirror_transform(m: npt.ArrayLike) -> np.ndarray:
     """``S·m·S`` for ``(..., 4, 4)`` transforms: a right-handed body → world transform as the left-handed one
     (and back)."""
-    out: np.ndarray = MIRROR_Y @ np.asarray(m, dtype=np.float64) @ MIRROR_Y
+    out: np.ndarray = MIRROR_Y @ _transforms(m, name="m") @ MIRROR_Y
     return out
 
 
@@ -138,7 +178,7 @@ def carla_rotation(roll_deg: npt.ArrayLike, yaw_deg: npt.ArrayLike, pitch_deg: n
 
 def carla_matrix(pose: npt.ArrayLike) -> np.ndarray:
     """``(..., 4, 4)`` the CARLA transform of ``[x, y, z, roll, yaw, pitch]`` poses ``(..., 6)`` (left-handed)."""
-    pose = np.asarray(pose, dtype=np.float64)
+    pose = _floats(pose, name="pose", tail=(6,), what="(..., 6) CARLA poses [x, y, z, roll, yaw, pitch]")
     m = np.zeros((*pose.shape[:-1], 4, 4), dtype=np.float64)
     m[..., :3, :3] = carla_rotation(pose[..., 3], pose[..., 4], pose[..., 5])
     m[..., :3, 3] = pose[..., :3]
@@ -163,7 +203,7 @@ def carla_pose(m: npt.ArrayLike) -> np.ndarray:
 def carla_pose_from_eta(eta: npt.ArrayLike) -> np.ndarray:
     """``(..., 6)`` CARLA pose of mmusv poses ``[x, y, z, roll, pitch, yaw]``: ``[x, -y, z, deg(roll),
     -deg(yaw), -deg(pitch)]`` (closed form of :func:`carla_pose` for Euler poses)."""
-    eta = np.asarray(eta, dtype=np.float64)
+    eta = _floats(eta, name="eta", tail=(6,), what="(..., 6) poses [x, y, z, roll, pitch, yaw]")
     out: np.ndarray = np.stack(
         [
             eta[..., 0],

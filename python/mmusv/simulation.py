@@ -119,8 +119,9 @@ class Agent:
         return p
 
     def mounts(self) -> dict[str, np.ndarray]:
-        """``(4, 4)`` sensor → vessel body matrices of the body-mounted sensors: keys ``lidar``, ``radar``,
-        ``camera/<name>`` (camera body frame: x forward, y left, z up). The top view is not body-mounted."""
+        """``(4, 4)`` float64 sensor → vessel body matrices of the body-mounted sensors, read-only (the rig never
+        changes; copy one to change it): keys ``lidar``, ``radar``, ``camera/<name>`` (camera body frame: x forward,
+        y left, z up). The top view is not body-mounted."""
         out: dict[str, np.ndarray] = {}
         if self.lidar_mount is not None:
             out["lidar"] = self.lidar_mount
@@ -193,22 +194,24 @@ class Simulation:
         a = get_asset(asset_name)
         lo, hi = a.bbox[0], a.bbox[1]
         cls = 11 if role == "usv" else int(a.semantic_class)
-        return VesselInfo(vid, asset_name, role, cls, instance, (lo + hi) / 2.0, hi - lo, static)
+        # Read-only: every frame's annotations read these boxes, so they must not change under them.
+        return VesselInfo(vid, asset_name, role, cls, instance, _frozen((lo + hi) / 2.0), _frozen(hi - lo), static)
 
     def _agent(self, index: int, v: VesselConfig) -> Agent:
         rig = self.scenario.rigs[v.rig] if v.rig is not None else RigConfig()
         where = f"rigs.{v.rig or '<default>'}"
         asset = get_asset(v.asset)
         agent = Agent(index=index, vessel=v, asset=asset, rig=rig, lidar=None, lidar_mount=None, radar_mount=None)
+        # The mounts are read-only: every frame's poses are made from them (a capture gets copies).
         if rig.lidar is not None:
             agent.lidar = _built(f"{where}.lidar", "lidar", functools.partial(lidar_from_config, rig.lidar))
-            agent.lidar_mount = mount_matrix(asset, rig.lidar.mount, where=f"{where}.lidar.mount")
+            agent.lidar_mount = _frozen(mount_matrix(asset, rig.lidar.mount, where=f"{where}.lidar.mount"))
         if rig.radar is not None:
-            agent.radar_mount = mount_matrix(asset, rig.radar.mount, where=f"{where}.radar.mount")
+            agent.radar_mount = _frozen(mount_matrix(asset, rig.radar.mount, where=f"{where}.radar.mount"))
             agent.radar = _built(f"{where}.radar", "radar", functools.partial(radar_from_config, rig.radar))
         for i, c in enumerate(rig.cameras):
             # The path as the YAML spells it (cameras is a list), as the schema's own errors say it.
-            m = mount_matrix(asset, c.mount, where=f"{where}.cameras[{i}].mount")
+            m = _frozen(mount_matrix(asset, c.mount, where=f"{where}.cameras[{i}].mount"))
             camera = _built(f"{where}.cameras[{i}]", "camera", functools.partial(camera_from_config, c))
             agent.cameras[c.name] = (camera, c, m)
         if rig.top_view is not None:
@@ -518,7 +521,8 @@ class Simulation:
             mounts = agent.mounts()
             cap = AgentCapture(agent.id, None, None, {}, {}, None, None, body=body)
             for key, p in poses.items():
-                m = mounts[key] if key in mounts else np.linalg.inv(body) @ p
+                # A copy of the agent's (read-only) mount: the capture's arrays are its own.
+                m = mounts[key].copy() if key in mounts else np.linalg.inv(body) @ p
                 cap.sensors[key] = SensorMount(mount=m, pose=p)
             if agent.lidar is not None and "lidar" in kinds:
                 cap.lidar_pose = poses["lidar"]
@@ -562,7 +566,7 @@ class Simulation:
             elif key == "top_view":
                 cap.top_view = CameraImages.from_native(d)
             elif key == "radar" and agent.radar is not None and cap.radar_pose is not None:
-                cap.radar = RadarReturns.from_native(d, pose=cap.radar_pose, radar=agent.radar)
+                cap.radar = RadarReturns.from_native(d, pose=cap.radar_pose, radar=agent.radar, config=agent.rig.radar)
                 cap.radar_ppi = d["ppi"]
                 secs[f"{agent.id}/ppi"] = ppi_seconds
             else:
@@ -585,6 +589,12 @@ def _check_state(state: Any) -> None:
             f"state = {arguments.shown(state)}: must be a WorldState (Simulation.world_state(frame)), "
             f"not {type(state).__name__}"
         )
+
+
+def _frozen(a: np.ndarray) -> np.ndarray:
+    """``a`` made read-only (in place) and returned."""
+    a.flags.writeable = False
+    return a
 
 
 def _pose(m: np.ndarray) -> npt.NDArray[np.float64]:

@@ -117,7 +117,7 @@ def test_box_return_at_its_range_bearing_and_id(near_range: float, bearing_deg: 
     assert ret.semantic_class[k] == SemanticClass.VESSEL
     # World positions of the target's returns lie at its near face (within a range bin and the beam).
     centre = box_pose(near_range, math.radians(bearing_deg))[:2, 3]
-    world = ret.points("world")[mine]
+    world = ret.points(frame="world")[mine]
     dist = np.linalg.norm(world[:, :2] - centre, axis=1)
     assert dist.min() < HALF + SMALL.range_resolution_m + near_range * math.radians(SMALL.beamwidth_deg)
     # Dtypes, shapes, sorted order, azimuth range.

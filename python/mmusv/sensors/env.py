@@ -26,17 +26,21 @@ and waves.
 from __future__ import annotations
 
 import math
+import numbers
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
+from mmusv import arguments
 from mmusv._native import core
-from mmusv.errors import InputError
+from mmusv.errors import ConfigError, InputError
 from mmusv.world.environment import Environment
 
 __all__ = [
     "SEA_ALBEDO",
     "WATER_ALBEDO",
+    "check_env",
     "sensor_env",
     "turbidity_from_visibility",
     "wake_rows",
@@ -60,7 +64,10 @@ def wake_rows(wakes: npt.ArrayLike | None) -> npt.NDArray[np.float32] | None:
     out). One row may be given flat; ``None`` stays ``None``."""
     if wakes is None:
         return None
-    w = np.ascontiguousarray(wakes, dtype=np.float32)
+    try:
+        w = np.ascontiguousarray(wakes, dtype=np.float32)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"wakes = {arguments.shown(wakes)}: must be numeric rows ({exc})") from None
     if w.ndim == 1 and w.size in (6, 7, 8, 9):
         w = w.reshape(1, -1)
     if w.ndim != 2 or w.shape[1] not in (6, 7, 8, 9):
@@ -69,6 +76,17 @@ def wake_rows(wakes: npt.ArrayLike | None) -> npt.NDArray[np.float32] | None:
             f"displacement_m3]]]; got {w.shape}"
         )
     return w
+
+
+def check_env(env: Any) -> core.SensorEnv:
+    """``env`` when it is the sensors' environment (a ``mmusv._core.SensorEnv``: :func:`sensor_env`), else an
+    :class:`mmusv.InputError` saying where one comes from."""
+    if not isinstance(env, core.SensorEnv):
+        raise InputError(
+            f"env = {arguments.shown(env)}: must be the sensors' environment, mmusv.sensors.env.sensor_env(...) (or "
+            f"Simulation.sensor_env), not {type(env).__name__}"
+        )
+    return env
 
 
 def turbidity_from_visibility(visibility_m: float) -> float:
@@ -104,7 +122,31 @@ def sensor_env(
     wave height), and fix the cameras' exposure (EV at ISO 100; default metered from the scene's light): for
     driving one sensor by hand. ``water_multiple_scattering=False`` leaves out the light reflected more than once
     between the sea's wave facets (single-scattering microfacet reflection alone, as renderers' rough BSDFs).
-    Raises :class:`mmusv.ConfigError` naming ``env.<field>`` for a value out of range."""
+    Raises :class:`mmusv.ConfigError` naming ``env.<field>`` for a value out of range or of the wrong kind (a
+    string or a boolean for a number, anything but ``True``/``False`` for a flag), or ``environment`` that is not
+    an :class:`~mmusv.world.environment.Environment`."""
+    if environment is not None and not isinstance(environment, Environment):
+        raise ConfigError(
+            f"environment = {arguments.shown(environment)}: must be an Environment (mmusv.world.environment."
+            f"Environment.make(...), or Simulation.environment) or None, not {type(environment).__name__}"
+        )
+    given = {
+        "fog_extinction_per_m": fog_extinction_per_m,
+        "rain_mm_per_h": rain_mm_per_h,
+        "wave_height_m": wave_height_m,
+        "wind_speed_m_s": wind_speed_m_s,
+        "exposure_ev100": exposure_ev100,
+    }
+    for name, value in given.items():
+        if value is not None and (isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real)):
+            raise ConfigError(
+                f"invalid config env.{name} = {arguments.shown(value)}: must be a number or None, "
+                f"not {type(value).__name__}"
+            )
+    shadows = arguments.flag(shadows, name="invalid config env.shadows")
+    water_multiple_scattering = arguments.flag(
+        water_multiple_scattering, name="invalid config env.water_multiple_scattering"
+    )
     env = environment if environment is not None else Environment.make()
     fog = env.weather.extinction_per_m if fog_extinction_per_m is None else fog_extinction_per_m
     rain = env.weather.rain_mm_per_h if rain_mm_per_h is None else rain_mm_per_h
@@ -120,7 +162,7 @@ def sensor_env(
         wave_height_m=float(waves),
         wind_speed_m_s=float(wind),
         water_albedo=list(WATER_ALBEDO),
-        exposure_ev100=exposure_ev100,
+        exposure_ev100=None if exposure_ev100 is None else float(exposure_ev100),
         shadows=shadows,
         water_multiple_scattering=water_multiple_scattering,
     )

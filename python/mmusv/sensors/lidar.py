@@ -14,18 +14,20 @@ import numpy as np
 import numpy.typing as npt
 
 from mmusv import arguments
+from mmusv._equality import same
 from mmusv._native import core
-from mmusv.errors import InputError
+from mmusv.errors import ConfigError, InputError
 from mmusv.scene import Scene, _pose
 from mmusv.sensors.config import LidarConfig
-from mmusv.sensors.env import wake_rows
+from mmusv.sensors.env import check_env, wake_rows
 
 __all__ = ["LidarPoints", "lidar_from_config", "scan"]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class LidarPoints:
-    """One sweep. All arrays have length N (points).
+    """One sweep. All arrays have length N (points). Two sweeps compare equal (``==``) when their arrays are
+    (dtype, shape and value).
 
     Attributes:
         xyz: ``(N, 3)`` float32, metres, LiDAR frame.
@@ -50,6 +52,12 @@ class LidarPoints:
     def __len__(self) -> int:
         return int(self.xyz.shape[0])
 
+    def __eq__(self, other: object) -> bool:
+        """Field by field, arrays by dtype, shape and value (:mod:`mmusv._equality`)."""
+        return same(self, other) if type(other) is type(self) else NotImplemented
+
+    __hash__ = None  # type: ignore[assignment]
+
     @classmethod
     def from_native(cls, d: dict[str, npt.NDArray[Any]]) -> LidarPoints:
         """The sweep from the dict of ``core.Lidar.scan`` (or of ``core.capture_frame``)."""
@@ -66,7 +74,13 @@ class LidarPoints:
 
 
 def lidar_from_config(cfg: LidarConfig) -> core.Lidar:
-    """The native LiDAR (pattern computed once) for ``cfg``."""
+    """The native LiDAR (pattern computed once) for ``cfg``, a :class:`LidarConfig` (``LidarConfig(**fields)``
+    validates a dict), else :class:`mmusv.ConfigError`."""
+    if not isinstance(cfg, LidarConfig):
+        raise ConfigError(
+            f"cfg = {arguments.shown(cfg)}: must be a LidarConfig (mmusv.sensors.config.LidarConfig(**fields)), "
+            f"not {type(cfg).__name__}"
+        )
     return core.Lidar(
         elevations=cfg.elevations_rad(),
         azimuth_steps=cfg.azimuth_steps,
@@ -97,8 +111,14 @@ def scan(
     :meth:`mmusv.simulation.Simulation.wakes`, :func:`mmusv.sensors.env.wake_rows`) of the vessels under way: over
     a wave surface, beams that meet their foam return from it (the foam the cameras draw). ``seed`` is a whole
     number in ``0..2⁶⁴−1``; a bad seed, pose or scene raises :class:`mmusv.InputError` naming it."""
+    if not isinstance(lidar, core.Lidar):
+        raise InputError(
+            f"lidar = {arguments.shown(lidar)}: must be a native lidar (lidar_from_config(LidarConfig(...)), or "
+            f"Simulation.agent(id).lidar), not {type(lidar).__name__}"
+        )
     if not isinstance(scene, Scene):
         raise InputError(f"scene must be an mmusv.Scene, got {type(scene).__name__}")
+    check_env(env)
     seed = arguments.whole(seed, name="seed", lo=0, hi=2**64 - 1, error=InputError)
     p = _pose(pose, name="pose")
     w = wake_rows(wakes)

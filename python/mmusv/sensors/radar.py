@@ -26,22 +26,27 @@ Example::
 
 from __future__ import annotations
 
+import copy
 import math
+import numbers
 import os
 import tempfile
-from dataclasses import dataclass
+from dataclasses import dataclass, field, fields
 from typing import Any, Literal
 
 import numpy as np
 import numpy.typing as npt
 
 from mmusv import arguments
+from mmusv._equality import same
 from mmusv._native import core
-from mmusv.errors import InputError
+from mmusv.errors import ConfigError, InputError
 from mmusv.scene import Scene, _pose
 from mmusv.sensors.config import RadarConfig
+from mmusv.sensors.env import check_env
 
 __all__ = [
+    "MAX_PPI_SIZE",
     "Orientation",
     "RadarReturns",
     "ppi_colormap",
@@ -58,7 +63,13 @@ Orientation = Literal["north_up", "head_up"]
 
 def radar_from_config(cfg: RadarConfig) -> core.Radar:
     """The native radar for ``cfg`` (degrees become radians; the core checks everything again as a last guard,
-    naming ``radar.<core field>``, which a validated ``cfg`` never trips)."""
+    naming ``radar.<core field>``, which a validated ``cfg`` never trips). ``cfg`` must be a :class:`RadarConfig`
+    (``RadarConfig(**fields)`` validates a dict), else :class:`mmusv.ConfigError`."""
+    if not isinstance(cfg, RadarConfig):
+        raise ConfigError(
+            f"cfg = {arguments.shown(cfg)}: must be a RadarConfig (mmusv.sensors.config.RadarConfig(**fields)), "
+            f"not {type(cfg).__name__}"
+        )
     lo, hi = cfg.elevation_fan_deg
     return core.Radar(
         range_min_m=cfg.min_range_m,
@@ -84,6 +95,10 @@ def radar_from_config(cfg: RadarConfig) -> core.Radar:
 class RadarReturns:
     """The returns of one sweep (N of them), sorted by (azimuth bin, range bin), at most one per cell.
 
+    Two sweeps compare equal (``==``) when their arrays and pose are (dtype, shape and value). A sweep pickles
+    when it knows the :class:`RadarConfig` its radar was made from (``config``: every sweep of
+    :meth:`mmusv.Simulation.capture`), its native radar rebuilt from it; copies share the native radar.
+
     Attributes:
         range: ``(N,)`` float32, metres: the range-bin centre plus the optional range noise.
         azimuth: ``(N,)`` float32, radians in ``[0, 2π)``, sensor frame, 0 = forward, counter-clockwise (the
@@ -98,6 +113,8 @@ class RadarReturns:
             clutter, NONE (0) for rain clutter.
         pose: ``(4, 4)`` float64 sensor → world pose of the sweep.
         radar: the radar that swept (its range and bins size the PPI).
+        config: the :class:`RadarConfig` ``radar`` was made from (:func:`radar_from_config`), when known
+            (``None`` for a sweep of :func:`radar_sweep`); what a pickled sweep rebuilds its radar from.
     """
 
     range: npt.NDArray[np.float32]
@@ -107,16 +124,49 @@ class RadarReturns:
     instance_id: npt.NDArray[np.int32]
     semantic_class: npt.NDArray[np.uint16]
     pose: npt.NDArray[np.float64]
-    radar: core.Radar
+    radar: core.Radar = field(compare=False)
+    config: RadarConfig | None = field(default=None, repr=False, compare=False)
 
     def __len__(self) -> int:
         return int(self.range.shape[0])
 
+    def __eq__(self, other: object) -> bool:
+        """Field by field, arrays by dtype, shape and value (:mod:`mmusv._equality`); not the native radar."""
+        return same(self, other) if type(other) is type(self) else NotImplemented
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        """Pickled as its arrays, pose and ``config``, from which the native radar (which does not pickle) is
+        rebuilt; a sweep without ``config`` is refused with :class:`mmusv.InputError`."""
+        if self.config is None:
+            raise InputError(
+                "this RadarReturns cannot be pickled: its radar is a native mmusv._core.Radar, which pickles only as "
+                "the RadarConfig it was made from, and this sweep does not know it (a sweep of "
+                "Simulation.capture does); give it one with dataclasses.replace(returns, config=cfg)"
+            )
+        values = {f.name: getattr(self, f.name) for f in fields(self) if f.name != "radar"}
+        return (_unpickled_returns, (values,))
+
+    def __copy__(self) -> RadarReturns:
+        return type(self)(**{f.name: getattr(self, f.name) for f in fields(self)})
+
+    def __deepcopy__(self, memo: dict[int, Any]) -> RadarReturns:
+        """The arrays copied; the native radar (configured once, never changed) shared."""
+        values = {f.name: getattr(self, f.name) for f in fields(self)}
+        return type(self)(**{k: v if k == "radar" else copy.deepcopy(v, memo) for k, v in values.items()})
+
     @classmethod
     def from_native(
-        cls, d: dict[str, npt.NDArray[Any]], *, pose: npt.NDArray[np.float64], radar: core.Radar
+        cls,
+        d: dict[str, npt.NDArray[Any]],
+        *,
+        pose: npt.NDArray[np.float64],
+        radar: core.Radar,
+        config: RadarConfig | None = None,
     ) -> RadarReturns:
-        """The returns from the dict of ``core.Radar.sweep`` (or of ``core.capture_frame``) swept at ``pose``."""
+        """The returns from the dict of ``core.Radar.sweep`` (or of ``core.capture_frame``) swept at ``pose`` by
+        ``radar`` (made from ``config``, when known: see the class docstring)."""
         return cls(
             range=d["range"],
             azimuth=d["azimuth"],
@@ -126,6 +176,7 @@ class RadarReturns:
             semantic_class=d["class"],
             pose=pose,
             radar=radar,
+            config=config,
         )
 
     @property
@@ -138,7 +189,7 @@ class RadarReturns:
         """World yaw of the sensor's forward axis, radians (counter-clockwise from east)."""
         return _yaw(self.pose)
 
-    def points(self, frame: Literal["sensor", "world"] = "sensor") -> npt.NDArray[np.float32]:
+    def points(self, *, frame: Literal["sensor", "world"] = "sensor") -> npt.NDArray[np.float32]:
         """``(N, 3)`` float32 positions of the returns (range, azimuth, elevation) in metres, in the sensor
         frame or the world frame."""
         r = self.range.astype(np.float64)
@@ -152,6 +203,11 @@ class RadarReturns:
         return p.astype(np.float32)
 
 
+def _unpickled_returns(values: dict[str, Any]) -> RadarReturns:
+    """A pickled :class:`RadarReturns` (:meth:`RadarReturns.__reduce__`), its radar rebuilt from its config."""
+    return RadarReturns(**values, radar=radar_from_config(values["config"]))
+
+
 def radar_sweep(
     radar: core.Radar, scene: Scene, *, pose: npt.ArrayLike, env: core.SensorEnv, seed: int
 ) -> RadarReturns:
@@ -160,11 +216,17 @@ def radar_sweep(
     (:func:`mmusv.sensors.env.sensor_env`; 0..30 m, e.g. W0 = 0.5, W3 = 3.5) and its rain (0..500 mm/h).
     Releases the GIL and uses every core.
 
-    Raises :class:`mmusv.ConfigError` for waves or rain out of range, :class:`mmusv.InputError` for a bad pose
-    or seed.
+    Raises :class:`mmusv.ConfigError` for waves or rain out of range, :class:`mmusv.InputError` for a bad radar,
+    scene, pose, environment or seed.
     """
+    if not isinstance(radar, core.Radar):
+        raise InputError(
+            f"radar = {arguments.shown(radar)}: must be a native radar (radar_from_config(RadarConfig(...)), or "
+            f"Simulation.agent(id).radar), not {type(radar).__name__}"
+        )
     if not isinstance(scene, Scene):
         raise InputError(f"scene must be an mmusv.Scene, got {type(scene).__name__}")
+    check_env(env)
     seed = arguments.whole(seed, name="seed", lo=0, hi=2**64 - 1, error=InputError)
     p = _pose(pose, name="pose")
     return RadarReturns.from_native(radar.sweep(scene.native, pose=p, env=env, seed=seed), pose=p, radar=radar)
@@ -185,8 +247,14 @@ def ppi_image(
     The scale is fixed: a return at range R lies ``R / metres_per_pixel`` pixels from the centre in every
     frame. ``metres_per_pixel`` defaults to the radar's range over ``size_px // 2`` (the full range fills the
     image); ``sensor_yaw`` (radians, for north-up) defaults to the sweep pose's yaw. Bad values raise
-    :class:`mmusv.ConfigError` naming ``ppi.<field>``.
+    :class:`mmusv.ConfigError` naming ``ppi.<field>``; ``returns`` that are not a :class:`RadarReturns`
+    :class:`mmusv.InputError`.
     """
+    if not isinstance(returns, RadarReturns):
+        raise InputError(
+            f"returns = {arguments.shown(returns)}: must be a RadarReturns (radar_sweep(...), or the radar of a "
+            f"Simulation.capture), not {type(returns).__name__}"
+        )
     size, mpp, orient, yaw = ppi_request(
         returns.radar,
         pose=returns.pose,
@@ -219,11 +287,32 @@ def ppi_request(
 ) -> tuple[int, float, str, float]:
     """``(size_px, metres_per_pixel, orientation, sensor_yaw)`` of the PPI :func:`ppi_image` draws for a sweep of
     ``radar`` at ``pose`` (``(4, 4)`` sensor → world), with its defaults filled in; the same tuple is the ``ppi``
-    of a radar task of ``core.capture_frame``."""
-    size = arguments.whole(size_px, name="size_px", lo=0, hi=2**32 - 1, error=InputError)
-    mpp = radar.range_max_m / max(size // 2, 1) if metres_per_pixel is None else float(metres_per_pixel)
-    yaw = _yaw(pose) if sensor_yaw is None else float(sensor_yaw)
-    return size, mpp, str(orientation), yaw
+    of a radar task of ``core.capture_frame``. ``size_px`` is a whole number in ``1..MAX_PPI_SIZE``,
+    ``metres_per_pixel`` and ``sensor_yaw`` numbers (not strings or booleans), else :class:`mmusv.ConfigError`
+    naming ``ppi.<field>`` (:class:`mmusv.InputError` for ``sensor_yaw``, as the core's own check)."""
+    size = arguments.whole(size_px, name="invalid config ppi.size_px", lo=1, hi=MAX_PPI_SIZE, error=ConfigError)
+    if metres_per_pixel is None:
+        mpp = radar.range_max_m / max(size // 2, 1)
+    else:
+        mpp = _number(metres_per_pixel, "invalid config ppi.metres_per_pixel", "a number of metres > 0", ConfigError)
+    if not isinstance(orientation, str):
+        raise ConfigError(
+            f'invalid config ppi.orientation = {arguments.shown(orientation)}: must be "north_up" or "head_up"'
+        )
+    yaw = _yaw(pose) if sensor_yaw is None else _number(sensor_yaw, "sensor_yaw", "an angle in radians", InputError)
+    return size, mpp, orientation, yaw
+
+
+MAX_PPI_SIZE = 8192
+"""Largest PPI side, pixels (the core's ``sensors::ppi::MAX_PPI_SIZE``, which it checks itself)."""
+
+
+def _number(value: Any, name: str, what: str, error: type[Exception]) -> float:
+    """``value`` as a float when it is a real number (not a string, not a boolean), else ``error`` naming
+    ``name``; its range is the core's to check (as it names it)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise error(f"{name} = {arguments.shown(value)}: must be {what}, not {type(value).__name__}")
+    return float(value)
 
 
 def _yaw(pose: npt.NDArray[np.float64]) -> float:
@@ -236,7 +325,12 @@ def ppi_colormap(img: npt.ArrayLike, *, vmin_db: float = -20.0, vmax_db: float =
     ``vmin_db`` (dark green) to ``vmax_db`` (near white); pixels ``<= 0`` are black. Fixed limits by default,
     so frames are comparable. Only the lit pixels are computed (a PPI is mostly empty): per pixel, the same
     operations as over the whole image."""
-    a = np.asarray(img, dtype=np.float64)
+    vmin_db = arguments.real(vmin_db, name="vmin_db", unit="dB", error=InputError)
+    vmax_db = arguments.real(vmax_db, name="vmax_db", unit="dB", error=InputError)
+    try:
+        a = np.asarray(img, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"img = {arguments.shown(img)}: must be a (H, W) array of intensities ({exc})") from None
     if a.ndim != 2:
         raise InputError(f"img must be a (H, W) intensity image, got shape {a.shape}")
     if not vmax_db > vmin_db:

@@ -1,0 +1,230 @@
+"""The in-memory API as a machine-learning researcher meets it (a user round of ``mmusv.Simulation`` driven from a
+training loop, never writing a recording): captures that pickle (a ``DataLoader`` worker returns them) and compare
+by value (the determinism checks a user writes: ``a == b``), a capture's arrays that are its own (an augmentation
+in place must not move the simulation's sensors), the sensors' Python wrappers refusing bad inputs with mmusv's
+errors (never a bare ``TypeError``/``AttributeError``/``ValueError``, nor a string or ``True`` read as a number),
+options keyword-only, and :mod:`mmusv.frames` refusing shapes it would misread."""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import pickle
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import pytest
+from mmusv import frames
+from mmusv.acquire import annotations_for
+from mmusv.annotate import SilhouetteCache, box_corners
+from mmusv.errors import ConfigError, InputError
+from mmusv.sensors.camera import camera_from_config, render, top_view_from_config
+from mmusv.sensors.config import LidarConfig
+from mmusv.sensors.env import sensor_env
+from mmusv.sensors.lidar import lidar_from_config, scan
+from mmusv.sensors.radar import RadarReturns, ppi_colormap, ppi_image, radar_from_config, radar_sweep
+from mmusv.simulation import FrameCapture, Simulation
+from tiny_scenario import lidar_scenario
+
+
+def _scenario(*, frames: int = 4) -> dict[str, Any]:
+    """The tests' tiny open sea, its USV carrying every kind of sensor, all small: an 8-channel LiDAR, a
+    90-bin radar, one 48 x 32 camera and a 24 x 24 top view."""
+    sc = lidar_scenario("sim_round", frames=frames)
+    sc["rigs"]["r"].update(
+        radar={"azimuth_bins": 90, "rays_el": 4, "range_m": 400, "ppi_size_px": 32},
+        cameras=[{"name": "front", "resolution": [48, 32], "quality": "draft", "mount": {"point": "camera_front"}}],
+        top_view={"resolution": [24, 24], "quality": "draft"},
+    )
+    return sc
+
+
+@pytest.fixture(scope="module")
+def sim() -> Simulation:
+    return Simulation(_scenario())
+
+
+@pytest.fixture(scope="module")
+def cap(sim: Simulation) -> FrameCapture:
+    return sim.capture(2)
+
+
+# ------------------------------------------------------------------------------------- captures as values
+
+
+def test_a_capture_pickles_with_its_radar(cap: FrameCapture) -> None:
+    """A ``DataLoader`` worker pickles what it returns: a capture with a radar sweep failed (``TypeError: cannot
+    pickle 'mmusv._core.Radar' object``). The sweep now pickles as its arrays and its ``RadarConfig``, its radar
+    rebuilt from it, so the PPI of the unpickled sweep is the original's; copies share the native radar."""
+    ac = cap.agents["u"]
+    assert ac.radar is not None and len(ac.radar) > 0
+    back = pickle.loads(pickle.dumps(cap))
+    assert back == cap
+    radar = back.agents["u"].radar
+    assert radar is not None and radar.config == ac.radar.config
+    np.testing.assert_array_equal(ppi_image(radar, size_px=32), ppi_image(ac.radar, size_px=32))
+    deep = copy.deepcopy(ac.radar)
+    assert deep == ac.radar and deep.radar is ac.radar.radar and deep.range is not ac.radar.range
+    # A sweep made by hand does not know its config: refused with an mmusv error saying how to give it one.
+    bare = dataclasses.replace(ac.radar, config=None)
+    with pytest.raises(InputError, match="config"):
+        pickle.dumps(bare)
+    assert pickle.loads(pickle.dumps(dataclasses.replace(bare, config=ac.radar.config))) == ac.radar
+
+
+def test_captures_compare_by_value_in_any_order(sim: Simulation, cap: FrameCapture) -> None:
+    """``a == b`` on two captures raised numpy's ``ValueError`` (the dataclasses' generated ``__eq__`` asked an
+    array for its truth value). Now equal captures compare equal: frame 2 of a second simulation, asked for after
+    frame 3 (random access) and twice, is the first simulation's frame 2, and frame 1 is not."""
+    other = Simulation(_scenario())
+    other.capture(3)
+    again = other.capture(2)
+    assert again == cap and other.capture(np.int64(2)) == cap
+    assert other.capture(1) != cap
+    ac, bc = cap.agents["u"], again.agents["u"]
+    assert ac.lidar == bc.lidar and ac.cameras["front"] == bc.cameras["front"] and ac.radar == bc.radar
+    assert cap.world == again.world and ac.sensors["lidar"] == bc.sensors["lidar"]
+    moved = dataclasses.replace(ac.lidar, xyz=ac.lidar.xyz + np.float32(0.01)) if ac.lidar is not None else None
+    assert moved is not None and moved != ac.lidar
+    with pytest.raises(TypeError, match="unhashable"):
+        hash(cap)
+    # The annotations of the two captures too (they held lists of arrays).
+    mine, theirs = annotations_for(sim, cap, SilhouetteCache()), annotations_for(other, again, SilhouetteCache())
+    assert mine == theirs and mine["u"].lidar_ids == ["t"]
+
+
+def test_editing_a_capture_in_place_changes_no_later_capture(sim: Simulation) -> None:
+    """A capture's ``sensors[...].mount`` was the agent's own mount matrix: an augmentation in place (jittering
+    the extrinsics of a capture) silently moved that sensor in every later capture. Captures now get copies, and
+    the simulation's mounts and vessel boxes are read-only."""
+    before = sim.capture(1)
+    cap = sim.capture(0)
+    for mounted in cap.agents["u"].sensors.values():
+        assert mounted.mount.flags.writeable
+        mounted.mount[:3, 3] += 5.0
+    cap.agents["u"].sensors["camera/front"].mount[:3, :3] = np.eye(3)[::-1]
+    assert sim.capture(1) == before
+    agent = sim.agent("u")
+    for key, m in agent.mounts().items():
+        with pytest.raises(ValueError, match="read-only"):
+            m[0, 3] = 1.0
+        assert key in cap.agents["u"].sensors
+    for v in sim.vessels:
+        assert not v.box_size.flags.writeable and not v.box_center_body.flags.writeable
+
+
+# ---------------------------------------------------------------------------- the sensors' Python wrappers
+
+
+def _calls(sim: Simulation) -> list[tuple[str, Callable[[], Any], type[Exception], str]]:
+    """(label, call, error class, words the message must hold) of bad calls that gave a bare error or were
+    quietly read as something else (the functions typed ``Any``: the calls are wrong on purpose)."""
+    state = sim.set_frame(0)
+    agent = sim.agent("u")
+    pose = sim.sensor_poses(agent, state)["lidar"]
+    scene, env = sim.ws.scene, sim.sensor_env
+    assert agent.lidar is not None and agent.radar is not None
+    lidar, radar, camera = agent.lidar, agent.radar, agent.cameras["front"][0]
+    ret = radar_sweep(radar, scene, pose=pose, env=env, seed=0)
+    sc: Any = scan
+    rd: Any = render
+    sw: Any = radar_sweep
+    ppi: Any = ppi_image
+    cmap: Any = ppi_colormap
+    senv: Any = sensor_env
+    lcfg: Any = lidar_from_config
+    ccfg: Any = camera_from_config
+    tcfg: Any = top_view_from_config
+    rcfg: Any = radar_from_config
+    at = {"pose": pose, "seed": 0}
+    return [
+        # bare TypeError / AttributeError
+        ("scan env=None", lambda: sc(lidar, scene, env=None, **at), InputError, "env = None"),
+        ("scan env=Environment", lambda: sc(lidar, scene, env=sim.environment, **at), InputError, "sensor_env"),
+        ("scan a config", lambda: sc(LidarConfig(), scene, env=env, **at), InputError, "lidar_from_config"),
+        ("scan wakes='x'", lambda: sc(lidar, scene, env=env, wakes="x", **at), InputError, "wakes"),
+        ("render a lidar", lambda: rd(lidar, scene, env=env, **at), InputError, "camera = "),
+        ("render radiance=1", lambda: rd(camera, scene, env=env, radiance=1, **at), InputError, "radiance = 1"),
+        ("sweep radar=None", lambda: sw(None, scene, env=env, **at), InputError, "radar = None"),
+        ("sweep env=None", lambda: sw(radar, scene, env=None, **at), InputError, "env = None"),
+        ("ppi of a dict", lambda: ppi({}, size_px=16), InputError, "RadarReturns"),
+        ("colormap vmin_db='a'", lambda: cmap(np.ones((2, 2)), vmin_db="a"), InputError, "vmin_db = 'a'"),
+        ("colormap of a str", lambda: cmap("abc"), InputError, "img = 'abc'"),
+        ("sensor_env fog='a'", lambda: senv(fog_extinction_per_m="a"), ConfigError, "env.fog_extinction_per_m"),
+        ("sensor_env of a dict", lambda: senv({}), ConfigError, "Environment"),
+        ("sensor_env shadows='no'", lambda: senv(shadows="no"), ConfigError, "env.shadows = 'no'"),
+        ("sensor_env ev100='12'", lambda: senv(exposure_ev100="12"), ConfigError, "env.exposure_ev100"),
+        ("lidar_from_config(dict)", lambda: lcfg({"channels": 4}), ConfigError, "LidarConfig"),
+        ("camera_from_config(dict)", lambda: ccfg({"name": "a"}), ConfigError, "CameraConfig"),
+        ("top_view_from_config(None)", lambda: tcfg(None), ConfigError, "TopViewConfig"),
+        ("radar_from_config(None)", lambda: rcfg(None), ConfigError, "RadarConfig"),
+        # quietly read as numbers
+        ("ppi metres_per_pixel='8'", lambda: ppi(ret, size_px=16, metres_per_pixel="8"), ConfigError, "'8'"),
+        ("ppi metres_per_pixel=True", lambda: ppi(ret, size_px=16, metres_per_pixel=True), ConfigError, "True"),
+        ("ppi sensor_yaw='1'", lambda: ppi(ret, size_px=16, sensor_yaw="1"), InputError, "sensor_yaw = '1'"),
+        ("sensor_env wave_height_m=True", lambda: senv(wave_height_m=True), ConfigError, "env.wave_height_m"),
+        # the allowed range named wrongly (0..4294967295; the core allows 1..8192)
+        ("ppi size_px=-1", lambda: ppi(ret, size_px=-1), ConfigError, "1..8192"),
+    ]
+
+
+def test_sensor_wrappers_refuse_bad_inputs_with_mmusv_errors(sim: Simulation) -> None:
+    wrong = []
+    for label, call, cls, words in _calls(sim):
+        try:
+            call()
+        except cls as exc:
+            if words not in str(exc):
+                wrong.append(f"{label}: {type(exc).__name__}: {exc} (want {words!r})")
+        except Exception as exc:
+            wrong.append(f"{label}: {type(exc).__name__}: {exc}")
+        else:
+            wrong.append(f"{label}: accepted")
+    assert not wrong, "\n".join(wrong)
+
+
+def test_radar_points_frame_is_keyword_only(cap: FrameCapture) -> None:
+    """The project's style: options are keyword-only (``points("world")`` read as the frame)."""
+    ret = cap.agents["u"].radar
+    assert isinstance(ret, RadarReturns)
+    with pytest.raises(TypeError):
+        ret.points("world")  # type: ignore[call-arg]
+    world = ret.points(frame="world")
+    expect = ret.points().astype(np.float64) @ ret.pose[:3, :3].T + ret.pose[:3, 3]
+    np.testing.assert_allclose(world, expect, atol=1e-3)
+
+
+# ---------------------------------------------------------------------------------------------- mmusv.frames
+
+
+def test_frames_refuse_shapes_they_would_misread() -> None:
+    """``transform_points`` and ``mirror_points`` reshaped anything to ``(-1, 3)``: ``(N, 4)`` homogeneous points
+    (or ``(N, 6)`` poses) came back as ``4N / 3`` (``2N``) garbage points; ``pose_matrices`` read a 7-vector's
+    first six values; the others raised bare ``IndexError``/``ValueError``."""
+    homogeneous = np.array([[1.0, 2.0, 3.0, 1.0], [4.0, 5.0, 6.0, 1.0], [7.0, 8.0, 9.0, 1.0]])
+    bad: list[tuple[Callable[[], Any], str]] = [
+        (lambda: frames.transform_points(np.eye(4), homogeneous), "points"),
+        (lambda: frames.transform_points(np.eye(4), np.zeros((1, 6))), "points"),
+        (lambda: frames.mirror_points(homogeneous), "points"),
+        (lambda: frames.transform_points(np.eye(3), np.zeros((1, 3))), "m must be a (4, 4)"),
+        (lambda: frames.pose_matrices(np.zeros(7)), "eta"),
+        (lambda: frames.pose_matrices([1.0, 2.0, 3.0]), "eta"),
+        (lambda: frames.pose_matrices("abc"), "eta"),
+        (lambda: frames.matrix_to_pose(np.eye(3)), "m must be"),
+        (lambda: frames.invert(np.eye(3)), "m must be"),
+        (lambda: frames.translation([1.0, 2.0]), "v must be 3 numbers"),
+        (lambda: frames.carla_matrix(np.zeros(5)), "pose"),
+        (lambda: frames.carla_pose_from_eta(np.zeros(7)), "eta"),
+        (lambda: box_corners(np.eye(4), np.array([1.0, 2.0])), "size"),
+    ]
+    for call, words in bad:
+        with pytest.raises(InputError, match=words.replace("(", r"\(").replace(")", r"\)")):
+            call()
+    # What they document still works: (N, 3) points, one (3,) point, a list for the transform, stacks of poses.
+    m = frames.pose_matrices(np.array([[1.0, 2.0, 3.0, 0.1, 0.2, 0.3], [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]]))
+    assert m.shape == (2, 4, 4)
+    np.testing.assert_allclose(frames.transform_points(m[0].tolist(), [0.0, 0.0, 0.0]), [[1.0, 2.0, 3.0]])
+    np.testing.assert_allclose(frames.mirror_points([1.0, 2.0, 3.0]), [[1.0, -2.0, 3.0]])
+    assert frames.transform_points(m[0], np.zeros((0, 3))).shape == (0, 3)
+    np.testing.assert_allclose(frames.pose_matrices(frames.matrix_to_pose(m)), m, atol=1e-12)
