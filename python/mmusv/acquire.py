@@ -141,7 +141,10 @@ def run(
 
     The folder is locked while the run writes it (:class:`~mmusv.recording.guard.FolderLock`): a second run into
     the same folder fails at once. A ``.partial`` recording left by a killed run is recorded again from scratch
-    (a clean redo; ``notes`` says so), and table parts of an earlier run are removed first.
+    (a clean redo; ``notes`` says so). An earlier run's ``manifest.json``, table parts and ``scenario.yaml`` are
+    replaced only once the new recording is open (a stop before it starts to open, or a recording that cannot be
+    opened, leaves that run whole; a stop while it opens ends the run as one during a frame does, ``interrupted``),
+    and its recording only when the new one is finished.
 
     The first frame is captured before anything is written: a failure there (a setting a sensor refuses only when
     it captures, a capture that cannot be made) leaves the folder as it was, an earlier run in it included.
@@ -284,16 +287,7 @@ def _record(
         )
         if notes is not None:
             notes.append(line)
-    try:
-        (out / "manifest.json").unlink(missing_ok=True)  # written last: a run in progress never has one
-        for old in stale:  # tables of another run (replaced, or killed before it finished) never mix with these
-            old.unlink()
-        tables = TableWriter(tables_dir)
-        (out / "scenario.yaml").write_text(
-            yaml.safe_dump(scenario.model_dump(mode="json"), sort_keys=False), encoding="utf-8"
-        )
-    except OSError as exc:
-        raise IoError(f"cannot write into {out}: {write_cause(out, exc)}") from None
+    tables = TableWriter(tables_dir)
     silhouettes = SilhouetteCache()
     result = RunResult(recording=rec_path, tables=tables_dir, frames_written=0, status="complete", seconds=0.0)
     t0 = started[0]  # the first frame's capture, before the recording was opened
@@ -323,7 +317,11 @@ def _record(
 
     # A stop (SIGINT, SIGTERM) from the opening of the recording to the frame loop is held and raised in the loop
     # (below): the run then ends as one stopped during a frame does, its recording finished as interrupted and its
-    # manifest.json written. Unheld, a stop there left the recording's .partial without a manifest.
+    # manifest.json written. Unheld, a stop there left the recording's .partial without a manifest. An earlier
+    # run's manifest.json, table parts and scenario.yaml are replaced only once the new recording is open, within
+    # the hold: a stop before the hold leaves that run whole (--overwrite removed them before the recording opened,
+    # and a stop in between left the earlier recording without its manifest and tables, and nothing new), and so
+    # does a recording that cannot be opened (a full disk).
     held = HeldSignals().hold()
     try:
         try:
@@ -331,7 +329,13 @@ def _record(
         except MmusvError as exc:  # the metadata could not be written (a full disk): say why
             if not _writes_into(exc, out):
                 raise
-            raise IoError(_write_failure(out, rec_path, [("starting the recording", exc)])[0]) from None
+            kept = f"; {rec_path.name} and the rest of the run there are left as they were" if rec_path.exists() else ""
+            raise IoError(f"cannot write into {out}: {write_cause(out, exc)}{kept}") from None
+        try:
+            _replace_outputs(out, scenario, stale)
+        except OSError as exc:
+            recorder.discard()
+            raise IoError(f"cannot write into {out}: {write_cause(out, exc)}") from None
         writer: BackgroundWriter[_Frame | FrameCapture] = BackgroundWriter(write, depth=1)
         renders = sim.renders()
         # Without cameras a frame is annotated on the writer thread while the next is captured. With them the
@@ -436,6 +440,18 @@ def _record(
     if failure is not None:
         raise failure
     return result
+
+
+def _replace_outputs(out: Path, scenario: Scenario, stale: list[Path]) -> None:
+    """Removes an earlier run's ``manifest.json`` (written last: a run in progress never has one) and table parts
+    ``stale`` (tables of another run, replaced or killed before it finished, never mix with these) and writes this
+    run's ``scenario.yaml``; the new recording is open by then (see :func:`_record`)."""
+    (out / "manifest.json").unlink(missing_ok=True)
+    for old in stale:
+        old.unlink(missing_ok=True)
+    (out / "scenario.yaml").write_text(
+        yaml.safe_dump(scenario.model_dump(mode="json"), sort_keys=False), encoding="utf-8"
+    )
 
 
 def _writes_into(exc: BaseException, out: Path) -> bool:

@@ -70,6 +70,7 @@ def _rows(df: pl.DataFrame, key: tuple[str, int, str], mode: str) -> tuple[np.nd
         & (pl.col("frame") == key[1])
         & (pl.col("ego") == key[2])
         & (pl.col("mode") == mode)
+        & (pl.col("kind") == "det")  # a row of kind frame says the frame is covered
     )
     return sel.select(["x", "y", "z", "l", "w", "h", "yaw"]).to_numpy(), sel["score"].to_numpy()
 

@@ -9,7 +9,9 @@ Steps, each skipped on a re-run when its result is already there:
    local pool or Ray, complete recordings skipped). The recordings an earlier run indexed are this dataset's own:
    when the spec changed, one of a scenario that changed is recorded again (it used to fail, telling to pass an
    ``--overwrite`` that ``mmusv dataset`` did not take) and one of a scenario the spec no longer makes is removed,
-   so ``DIR/recordings`` holds what ``dataset.json`` lists;
+   so ``DIR/recordings`` holds what ``dataset.json`` lists. With ``ray``, Ray is joined before step 1 changes
+   anything (when scenarios are to be generated or a stale recording removed): a cluster that cannot be joined
+   fails the command with nothing on disk changed (it generated the scenarios and removed recordings first);
 3. convert the complete recordings to OPV2V (:func:`mmusv.export.convert`) into ``DIR/opv2v`` (skipped when the
    last conversion was of the same recordings and configurations);
 4. ``DIR/dataset.json`` (:mod:`mmusv.batch.index`) lists every recording, with sections ``spec`` (file name,
@@ -28,7 +30,7 @@ from pathlib import Path
 from typing import Any
 
 from mmusv.batch.index import INDEX_NAME, read_index, write_index
-from mmusv.batch.runner import BatchReport, run_many
+from mmusv.batch.runner import BatchReport, join_ray, run_many
 from mmusv.errors import IoError, MmusvError
 
 __all__ = ["DatasetReport", "build_dataset"]
@@ -146,74 +148,89 @@ def build_dataset(
     generated = kept is None
     shortfall: list[str] = [] if kept is None else kept
     quota = sum(c.quota for c in loaded.combinations)
-    if generated:
-
-        def tick(_name: str, accepted: int, _attempts: int) -> None:
-            if progress is not None:
-                progress("generate", accepted, quota)
-
-        report = generate(loaded, scen_dir, force=True, progress=tick)
-        shortfall = [f"{c.name}: {c.accepted} of {c.quota}" for c in report.combos if not c.met]
-    if progress is not None:
-        progress("generate", quota, quota)
     own = _own_recordings(old)
-    _remove_stale(rec_dir, own, {p.stem for p in scen_dir.glob("*.yaml")})
-    if not any(scen_dir.glob("*.yaml")):  # no candidate met the spec: nothing to record (the shortfall says so)
-        nothing = {"folder": opv2v.name, "status": "nothing to convert", "frames": 0, "sources": {}}
-        write_index(index_path, [], {"spec": spec_section, "opv2v": nothing})
-        empty = BatchReport(out_dir=rec_dir, backend="serial", outcomes=[], index=index_path)
-        return DatasetReport(
-            out_dir=out, generated=generated, shortfall=shortfall, batch=empty, converted=0, opv2v=opv2v
-        )
-    batch = run_many(
-        scen_dir,
-        out_dir=rec_dir,
-        jobs=jobs,
-        ray=ray,
-        cpus_per_task=cpus_per_task,
-        retries=retries,
-        split_frames=split_frames,
-        checks=checks,
-        index=index_path,
-        index_extra={"spec": spec_section, "opv2v": old.get("opv2v")},
-        progress=None if progress is None else (lambda d, t: progress("record", d, t)),
-        stop_on_full_disk=stop_on_full_disk,
-        overwrite=overwrite,
-        replace=own,
-    )
-    doc = read_index(index_path)
-    sources = {r["name"]: r["config_hash"] for r in doc["recordings"] if r["status"] == "complete"}
-    section = old.get("opv2v") or {}
-    converted: int | None = None
-    up_to_date = (
-        section.get("sources") == sources and section.get("status") == "complete" and (opv2v / REPORT_NAME).is_file()
-    )
-    if sources and not up_to_date:
-        recs = [out / r["recording"] for r in doc["recordings"] if r["name"] in sources]
-        try:
-            conv = convert(
-                recs,
-                to="opv2v",
-                out_dir=opv2v,
-                overwrite=True,
-                progress=None if progress is None else (lambda d, t: progress("convert", d, t)),
-            )
-        except OSError as exc:  # a full disk: "No space left on device" alone, naming no folder and no way on
-            where = f"{exc.filename}: " if exc.filename else ""
-            raise IoError(
-                f"{opv2v}: converting the recordings to OPV2V failed: {where}{exc.strerror or exc}; the "
-                f"{len(recs)} complete recording(s) are kept and indexed in {index_path}: free space and run the "
-                "same command again to convert them"
-            ) from None
-        converted = conv.frames
-        section = {"folder": opv2v.name, "status": "complete", "frames": conv.frames, "sources": sources}
-    elif not sources:
-        section = {"folder": opv2v.name, "status": "nothing to convert", "frames": 0, "sources": {}}
-        converted = 0  # not "up to date": no recording is complete
-    from mmusv.batch.index import Entry
+    # Ray before anything changes on disk: a cluster that could not be joined failed the batch after the scenarios
+    # were generated and stale recordings removed. (With nothing to generate or remove, the batch joins it if it has
+    # something to record, before it writes anything, as `mmusv run DIR --ray` does.)
+    joined = None
+    if ray is not False and (generated or own - {p.stem for p in scen_dir.glob("*.yaml")}):
+        joined = join_ray(ray, cpus_per_task=cpus_per_task)
+    try:
+        if generated:
 
-    entries = [Entry(**{k: r[k] for k in Entry.__dataclass_fields__}) for r in doc["recordings"]]
-    write_index(index_path, entries, {"spec": spec_section, "opv2v": section})
-    return DatasetReport(
-        out_dir=out, generated=generated, shortfall=shortfall, batch=batch, converted=converted, opv2v=opv2v
-    )
+            def tick(_name: str, accepted: int, _attempts: int) -> None:
+                if progress is not None:
+                    progress("generate", accepted, quota)
+
+            report = generate(loaded, scen_dir, force=True, progress=tick)
+            shortfall = [f"{c.name}: {c.accepted} of {c.quota}" for c in report.combos if not c.met]
+        if progress is not None:
+            progress("generate", quota, quota)
+        _remove_stale(rec_dir, own, {p.stem for p in scen_dir.glob("*.yaml")})
+        if not any(scen_dir.glob("*.yaml")):  # no candidate met the spec: nothing to record (the shortfall says so)
+            nothing = {"folder": opv2v.name, "status": "nothing to convert", "frames": 0, "sources": {}}
+            write_index(index_path, [], {"spec": spec_section, "opv2v": nothing})
+            empty = BatchReport(out_dir=rec_dir, backend="serial", outcomes=[], index=index_path)
+            return DatasetReport(
+                out_dir=out, generated=generated, shortfall=shortfall, batch=empty, converted=0, opv2v=opv2v
+            )
+        batch = run_many(
+            scen_dir,
+            out_dir=rec_dir,
+            jobs=jobs,
+            ray=ray,
+            cpus_per_task=cpus_per_task,
+            retries=retries,
+            split_frames=split_frames,
+            checks=checks,
+            index=index_path,
+            index_extra={"spec": spec_section, "opv2v": old.get("opv2v")},
+            progress=None if progress is None else (lambda d, t: progress("record", d, t)),
+            stop_on_full_disk=stop_on_full_disk,
+            overwrite=overwrite,
+            replace=own,
+        )
+        if joined is not None:  # the batch ran on the Ray joined here: left now (shut down if started here)
+            joined.close(cancel=False)
+            joined = None
+        doc = read_index(index_path)
+        sources = {r["name"]: r["config_hash"] for r in doc["recordings"] if r["status"] == "complete"}
+        section = old.get("opv2v") or {}
+        converted: int | None = None
+        up_to_date = (
+            section.get("sources") == sources
+            and section.get("status") == "complete"
+            and (opv2v / REPORT_NAME).is_file()
+        )
+        if sources and not up_to_date:
+            recs = [out / r["recording"] for r in doc["recordings"] if r["name"] in sources]
+            try:
+                conv = convert(
+                    recs,
+                    to="opv2v",
+                    out_dir=opv2v,
+                    overwrite=True,
+                    progress=None if progress is None else (lambda d, t: progress("convert", d, t)),
+                )
+            except OSError as exc:  # a full disk: "No space left on device" alone, naming no folder and no way on
+                where = f"{exc.filename}: " if exc.filename else ""
+                raise IoError(
+                    f"{opv2v}: converting the recordings to OPV2V failed: {where}{exc.strerror or exc}; the "
+                    f"{len(recs)} complete recording(s) are kept and indexed in {index_path}: free space and run the "
+                    "same command again to convert them"
+                ) from None
+            converted = conv.frames
+            section = {"folder": opv2v.name, "status": "complete", "frames": conv.frames, "sources": sources}
+        elif not sources:
+            section = {"folder": opv2v.name, "status": "nothing to convert", "frames": 0, "sources": {}}
+            converted = 0  # not "up to date": no recording is complete
+        from mmusv.batch.index import Entry
+
+        entries = [Entry(**{k: r[k] for k in Entry.__dataclass_fields__}) for r in doc["recordings"]]
+        write_index(index_path, entries, {"spec": spec_section, "opv2v": section})
+        return DatasetReport(
+            out_dir=out, generated=generated, shortfall=shortfall, batch=batch, converted=converted, opv2v=opv2v
+        )
+    finally:
+        if joined is not None:
+            joined.close(cancel=True)

@@ -110,6 +110,23 @@ def _executor(jobs: int, ray: bool | str, cpus_per_task: int | None, lost_worker
     return PoolExecutor(jobs, threads)
 
 
+def join_ray(ray: bool | str, *, cpus_per_task: int | None = None, lost_worker_retries: int = 3) -> Executor:
+    """Ray started or joined as :func:`run_many` ``(ray=ray, cpus_per_task=..., lost_worker_retries=...)`` joins it,
+    its arguments checked as there: for a caller that must know Ray is there before it changes anything
+    (:func:`mmusv.batch.dataset.build_dataset` generates and removes before its batch). A :func:`run_many` called
+    meanwhile uses the Ray this joined; :meth:`~mmusv.batch.executors.Executor.close` leaves it.
+
+    Raises:
+        ConfigError: bad arguments, Ray asked for but missing, or a cluster without the CPUs of one task.
+        IoError: Ray cannot be started or joined."""
+    if ray is False or not isinstance(ray, (bool, str)):
+        raise ConfigError(f"ray = {arguments.shown(ray)}: must be True, 'local', 'auto' or a Ray address to join")
+    if cpus_per_task is not None:
+        cpus_per_task = arguments.whole(cpus_per_task, name="cpus_per_task", lo=1)
+    lost_worker_retries = arguments.whole(lost_worker_retries, name="lost_worker_retries", lo=0)
+    return _executor(1, ray, cpus_per_task, lost_worker_retries)
+
+
 def _entry(plan: ScenarioPlan, status: str, error: str | None, root: Path) -> Entry:
     from mmusv.jsonio import read_json
 

@@ -6,12 +6,19 @@ it and saying what it is not, never a traceback. What the files hold (dicts of t
 is all the safe unpickler needs.
 
 :func:`weights_digest` names a model's weights (a scorer records the digest of the model it was fitted for, so a
-model trained further after its scorer is not rescored by a scorer of other weights)."""
+model trained further after its scorer is not rescored by a scorer of other weights).
+
+:func:`save_checkpoint` writes them: through a temporary ``.<name>.<pid>.tmp`` beside the file, renamed into
+place (an interruption leaves the previous file whole) and removed when the save fails; a process killed while
+saving cannot remove it, so :func:`remove_stale_temporaries` removes those of processes that are gone, at the start
+of a training into the folder (files of that exact pattern only, never one the user put there)."""
 
 from __future__ import annotations
 
 import hashlib
+import os
 import pickle
+import re
 import zipfile
 from collections.abc import Mapping
 from pathlib import Path
@@ -21,7 +28,11 @@ import torch
 
 from mmusv.learn._errors import input_error
 
-__all__ = ["load_checkpoint", "weights_digest"]
+__all__ = ["load_checkpoint", "remove_stale_temporaries", "save_checkpoint", "weights_digest"]
+
+SAVED = ("model.pt", "last.pt", "scorer.pt")
+"""The files :func:`save_checkpoint` writes."""
+_TEMPORARY = re.compile(r"\.(" + "|".join(re.escape(n) for n in SAVED) + r")\.([0-9]+)\.tmp")
 
 
 def load_checkpoint(path: str | Path, *, what: str, device: torch.device | str = "cpu") -> dict[str, Any]:
@@ -53,3 +64,55 @@ def weights_digest(state: Mapping[str, Any]) -> str:
         h.update(f"{name}:{c.dtype}:{tuple(c.shape)};".encode())
         h.update(c.reshape(-1).view(torch.uint8).numpy().tobytes() if c.numel() else b"")
     return h.hexdigest()
+
+
+def save_checkpoint(obj: Mapping[str, Any], path: str | Path) -> Path:
+    """``obj`` saved to ``path`` through the temporary ``.<name>.<pid>.tmp`` (module docstring), removed if the
+    save fails. Saved through an open file, so the archive inside is named ``archive`` whatever the file is called:
+    saved by its path, it was named after the temporary file, whose name holds the process id, and two runs of the
+    same seed wrote ``model.pt`` files of different bytes."""
+    p = Path(path)
+    tmp = p.with_name(f".{p.name}.{os.getpid()}.tmp")
+    try:
+        with open(tmp, "wb") as fh:
+            torch.save(obj, fh)
+        tmp.replace(p)
+    except BaseException:  # a full disk, a Ctrl-C: no temporary file is left behind
+        tmp.unlink(missing_ok=True)
+        raise
+    return p
+
+
+def _alive(pid: int) -> bool:
+    """Whether process ``pid`` runs on this machine (where that cannot be told, it is taken to)."""
+    if pid == os.getpid():
+        return False  # this process saves nothing into the folder before the removal
+    if os.name != "posix":
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # another user's process, or no way to tell
+        return True
+    return True
+
+
+def remove_stale_temporaries(folder: str | Path) -> list[Path]:
+    """Removes from ``folder`` the temporaries of :func:`save_checkpoint` (``.model.pt.<pid>.tmp``,
+    ``.last.pt.<pid>.tmp``, ``.scorer.pt.<pid>.tmp``) left by processes that are gone (killed while saving);
+    returns them. A file of any other name, or of a process still running, is left alone."""
+    d = Path(folder)
+    gone: list[Path] = []
+    if not d.is_dir():
+        return gone
+    for f in sorted(d.glob(".*.tmp")):
+        m = _TEMPORARY.fullmatch(f.name)
+        if m is None or not f.is_file() or f.is_symlink() or _alive(int(m.group(2))):
+            continue
+        try:
+            f.unlink()
+        except FileNotFoundError:
+            continue
+        gone.append(f)
+    return gone

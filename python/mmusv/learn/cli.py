@@ -362,7 +362,7 @@ def _fit_scorers(
     import torch
 
     from mmusv.learn.cache import Cache
-    from mmusv.learn.checkpoint import weights_digest
+    from mmusv.learn.checkpoint import remove_stale_temporaries, weights_digest
     from mmusv.learn.detector import load_models
     from mmusv.learn.example import early_cloud
     from mmusv.learn.refine import RefineParams
@@ -375,6 +375,7 @@ def _fit_scorers(
     for mode in modes:
         if not (out / mode / "model.pt").is_file():
             raise InputError(f"--scorers-only: no {out / mode / 'model.pt'}; train the {mode} model first")
+        remove_stale_temporaries(out / mode)  # of a fit killed while it saved its scorer.pt
         det = load_models(out / mode / "model.pt", refine=True, rescore=False)
         model = det.models[mode]
         current = out / mode / SCORER_FILE

@@ -13,16 +13,23 @@ detections of the ego and its current neighbours, merged by rotated NMS or WBF (
 would. Clean setting only (the robustness settings re-run early and intermediate fusion on delayed or noisy
 inputs: use ``--model``).
 
+Beside the detections (rows of ``kind`` ``det``), the file holds one row of kind ``frame`` (box and score null)
+for every (sequence, frame, ego, mode) it covers, detections or not: a model that finds nothing writes a file that
+says which frames it looked at, and the study scores it as AP 0 (a file without a row said nothing, and was
+refused).
+
 With ``--scorers DIR`` (and ``--refine``) the refined boxes are rescored by the IoU scorers of
 :mod:`mmusv.learn.scorer` as the detector does (:func:`mmusv.learn.scorer.second_stage`).
 
 The peaks must be those of this cache (one item per cloud or sample: the peaks of another cache, or of an ``infer
 --limit`` run, are refused), and the cache must hold every sequence of ``split`` of the recordings given, recorded
-the same (a cache of another split wrote a predictions file without a row). Run as a command, a bad input is one
-line, ``mmusv: error: ...``, and exit status 2.
+the same (a cache of another split wrote a predictions file without a row): ``--split``, ``--split-ratios`` and
+``--seed`` must be those the cache was built with (``mmusv train``'s and ``mmusv study``'s options of the same
+names; defaults ``test``, ``0.7,0.15,0.15`` and 0). Run as a command, a bad input is one line,
+``mmusv: error: ...``, and exit status 2.
 
-``python -m mmusv.learn.replay PEAKS.npz CACHE.npz RECORDINGS... [--split test] [--refine [--scorers DIR]]
-[--late-merge wbf] -o PREDICTIONS.parquet``
+``python -m mmusv.learn.replay PEAKS.npz CACHE.npz RECORDINGS... [--split test] [--split-ratios 0.7,0.15,0.15]
+[--seed 0] [--refine [--scorers DIR]] [--late-merge wbf] -o PREDICTIONS.parquet``
 """
 
 from __future__ import annotations
@@ -34,7 +41,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mmusv.learn._errors import input_error
+from mmusv.learn._errors import input_error, input_error_types
 from mmusv.learn.cache import Cache
 from mmusv.learn.example import early_cloud
 from mmusv.learn.refine import RefineParams
@@ -110,8 +117,18 @@ def _check_same_sequences(ds: object, cache: Cache, split: str) -> None:
         why = f"holds no sequence {', '.join(missing)}" if missing else f"holds {', '.join(other)} recorded differently"
         raise input_error(
             f"--cache {cache.path}: {why} of split {split!r} of the recordings given (it holds "
-            f"{', '.join(sorted(held))}); give the recordings, --split and --seed the cache was built from"
+            f"{', '.join(sorted(held))}{_built_with(cache, '; it was built with ')}); give the recordings, --split, "
+            "--split-ratios and --seed the cache was built from"
         )
+
+
+def _built_with(cache: Cache, lead: str) -> str:
+    """``lead`` and the ``--split``, ``--split-ratios`` and ``--seed`` the cache records it was built with (``""``
+    where it does not)."""
+    split, ratios, seed = (cache.meta.get(k) for k in ("split", "ratios", "seed"))
+    if not isinstance(ratios, list) or not all(isinstance(r, (int, float)) for r in ratios):
+        return ""
+    return f"{lead}--split {split} --split-ratios {','.join(f'{float(r):g}' for r in ratios)} --seed {seed}"
 
 
 def write_predictions(
@@ -142,7 +159,13 @@ def write_predictions(
     if late_merge not in LATE_MERGES:
         raise input_error(f"--late-merge {late_merge!r}: allowed: {', '.join(LATE_MERGES)}")
     z = _read_peaks(peaks, cache)
-    ds = resolve_dataset(list(inputs), opv2v=None, split=split, ratios=tuple(ratios), seed=seed)
+    try:
+        ds = resolve_dataset(list(inputs), opv2v=None, split=split, ratios=tuple(ratios), seed=seed)
+    except input_error_types() as exc:  # an empty split: say how the cache was made
+        hint = _built_with(cache, f"; the cache {cache.path} was built with ")
+        if not hint:
+            raise
+        raise input_error(f"{exc}{hint}") from None
     _check_same_sequences(ds, cache, split)
 
     def nms(b: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -173,17 +196,20 @@ def write_predictions(
             fused[(key, "intermediate")] = stage(
                 *_rows(z, "intermediate", k), partial(cache.cloud, ego_cloud), "intermediate"
             )
-    cols: dict[str, list[object]] = {
-        c: [] for c in ("sequence", "frame", "ego", "mode", "x", "y", "z", "l", "w", "h", "yaw", "score")
-    }
+    box = ("x", "y", "z", "l", "w", "h", "yaw")
+    cols: dict[str, list[object]] = {c: [] for c in ("sequence", "frame", "ego", "mode", "kind", *box, "score")}
+
+    def row(key: Key, mode: str, kind: str, values: Sequence[float | None], score: float | None) -> None:
+        for name, v in zip(("sequence", "frame", "ego", "mode", "kind"), (*key, mode, kind), strict=True):
+            cols[name].append(v)
+        for name, x in zip(box, values, strict=True):
+            cols[name].append(x)
+        cols["score"].append(score)
 
     def add(key: Key, mode: str, b: np.ndarray, s: np.ndarray) -> None:
-        for row, sc in zip(b, s, strict=True):
-            for name, v in zip(("sequence", "frame", "ego", "mode"), (*key, mode), strict=True):
-                cols[name].append(v)
-            for name, v in zip(("x", "y", "z", "l", "w", "h", "yaw"), row, strict=True):
-                cols[name].append(float(v))
-            cols["score"].append(float(sc))
+        row(key, mode, "frame", [None] * len(box), None)  # covered, whether or not anything was found
+        for r, sc in zip(b, s, strict=True):
+            row(key, mode, "det", [float(v) for v in r], float(sc))
 
     for seq in ds.sequences():
         for t, frame in enumerate(seq.frames):
@@ -206,9 +232,9 @@ def write_predictions(
     pl.DataFrame(
         cols,
         schema={
-            **dict.fromkeys(("sequence", "ego", "mode"), pl.Utf8),
+            **dict.fromkeys(("sequence", "ego", "mode", "kind"), pl.Utf8),
             "frame": pl.Int64,
-            **dict.fromkeys(("x", "y", "z", "l", "w", "h", "yaw", "score"), pl.Float64),
+            **dict.fromkeys((*box, "score"), pl.Float64),
         },
     ).select(list(cols)).write_parquet(out_p)
     return out_p
@@ -220,8 +246,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("peaks")
     ap.add_argument("cache")
     ap.add_argument("inputs", nargs="+")
-    ap.add_argument("--split", default="test")
-    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--split", default="test", help="the split the cache holds (default test)")
+    ap.add_argument(
+        "--split-ratios",
+        default="0.7,0.15,0.15",
+        help="train,validate,test fractions the cache's split was made with (default 0.7,0.15,0.15)",
+    )
+    ap.add_argument("--seed", type=int, default=0, help="seed of the split the cache was made with (default 0)")
     ap.add_argument(
         "--refine", action="store_true", help="the geometric second stage on every box (mmusv.learn.refine)"
     )
@@ -235,6 +266,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     ap.add_argument("-o", "--out", required=True)
     a = ap.parse_args(argv)
+    from mmusv.learn.cli import split_ratios
+
+    ratios = split_ratios(a.split_ratios)  # as mmusv train and mmusv study take it
     refine = RefineParams() if a.refine else None
     scorers = None
     if a.scorers is not None:
@@ -250,6 +284,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         a.inputs,
         a.out,
         split=a.split,
+        ratios=ratios,
         seed=a.seed,
         refine=refine,
         late_merge=a.late_merge,

@@ -32,7 +32,7 @@ import torch
 from torch import nn
 
 from mmusv.learn._errors import input_error
-from mmusv.learn.checkpoint import load_checkpoint
+from mmusv.learn.checkpoint import load_checkpoint, save_checkpoint
 from mmusv.learn.refine import RefineParams, refine_on, surface_points
 from mmusv.studies.detection.evaluate import average_precision, bev_iou, match_frame
 from mmusv.studies.detection.fusion import rotated_nms
@@ -148,14 +148,11 @@ class IoUScorer(nn.Module):
         return blend(s, self.iou(features), self.beta)
 
     def save(self, path: str | Path, info: dict[str, Any]) -> Path:
-        """Writes the scorer (weights, standardisation, ``beta``) and ``info`` to ``path`` (a temporary name, then
-        renamed: a killed save leaves no file that looks complete)."""
-        p = Path(path)
-        tmp = p.with_name(p.name + ".part")
-        with open(tmp, "wb") as fh:  # through an open file: the archive inside is named "archive", not after tmp
-            torch.save({"features": list(FEATURES), "state": self.state_dict(), "beta": self.beta, "info": info}, fh)
-        tmp.replace(p)
-        return p
+        """Writes the scorer (weights, standardisation, ``beta``) and ``info`` to ``path``
+        (:func:`mmusv.learn.checkpoint.save_checkpoint`: a temporary name, then renamed, so a killed save leaves no
+        file that looks complete, and a failed one no temporary file)."""
+        obj = {"features": list(FEATURES), "state": self.state_dict(), "beta": self.beta, "info": info}
+        return save_checkpoint(obj, path)
 
 
 def blend(scores: np.ndarray, iou: np.ndarray, beta: float) -> np.ndarray:

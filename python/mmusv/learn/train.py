@@ -41,7 +41,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -54,7 +53,7 @@ import torch
 from mmusv.learn._errors import input_error
 from mmusv.learn.augment import apply, draw
 from mmusv.learn.cache import Cache, same_data
-from mmusv.learn.checkpoint import load_checkpoint
+from mmusv.learn.checkpoint import load_checkpoint, remove_stale_temporaries, save_checkpoint
 from mmusv.learn.example import MODES, Example, collate, early_cloud, make_example
 from mmusv.learn.loss import centerpoint_loss
 from mmusv.learn.model import PillarNet, torch_device
@@ -123,14 +122,9 @@ def _lr(p: Preset, step: int, progress: float) -> float:
 
 
 def _save(obj: dict[str, Any], path: Path) -> None:
-    """``obj`` saved to ``path`` through a temporary file (an interruption leaves the previous file whole). Saved
-    through an open file, so the archive inside is named ``archive`` whatever the file is called: saved by its path,
-    it was named after the temporary file, whose name holds the process id, and two runs of the same seed wrote
-    ``model.pt`` files of different bytes."""
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    with open(tmp, "wb") as fh:
-        torch.save(obj, fh)
-    tmp.replace(path)
+    """``obj`` saved to ``path`` (:func:`mmusv.learn.checkpoint.save_checkpoint`: through a temporary file, so an
+    interruption leaves the previous file whole and no temporary behind)."""
+    save_checkpoint(obj, path)
 
 
 def _differs(ck: dict[str, Any], p: Preset, mode: str, seed: int) -> str | None:
@@ -174,6 +168,7 @@ def train(
     c = Cache(cache) if isinstance(cache, (str, Path)) else cache
     out_p = Path(out)
     out_p.mkdir(parents=True, exist_ok=True)
+    remove_stale_temporaries(out_p)  # of a run killed while it saved (they were left in the folder for good)
     dev = torch_device(device)
     if dev.type == "cpu":
         torch.use_deterministic_algorithms(True)

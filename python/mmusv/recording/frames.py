@@ -143,11 +143,12 @@ class FrameRecorder:
                 for name, values in metadata.items():
                     self.rec.metadata(name, values)
             except BaseException:
-                self._discard()
+                self.discard()
                 raise
 
-    def _discard(self) -> None:
-        """Closes and removes the ``.partial`` of a recording that could not be opened (no frame is in it)."""
+    def discard(self) -> None:
+        """Closes and removes the ``.partial`` of a recording just opened, before any frame: one that could not be
+        opened whole, or that the run will not write after all."""
         partial = self.rec.partial_path
         with contextlib.suppress(MmusvError):
             self.rec.abandon()

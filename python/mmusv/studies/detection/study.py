@@ -21,9 +21,14 @@ visible, hidden or unseen as well).
 columns ``sequence`` (recording stem or OPV2V scenario folder name), ``frame`` (acquisition index), ``ego``
 (USV id, or CAV id for OPV2V), ``mode`` (``none``/``late``/``early``/``intermediate``), ``x, y, z, l, w, h,
 yaw`` (ego LiDAR frame, mmusv axes: x forward, y left, z up; metres, radians), ``score``; optionally
-``setting`` (robustness study, e.g. ``delay:2``; missing = ``clean``) and ``kind`` (rows with
-``kind != "det"`` are skipped). A frame with no row has no detection. The Parquet this study writes has that
-layout, so its output can be re-scored.
+``setting`` (robustness study, e.g. ``delay:2``; missing = ``clean``) and ``kind``: rows of kind ``det`` are the
+detections; a row of kind ``frame`` (its box and score null) says the file covers its (sequence, frame, ego,
+mode, setting), so that a covered frame without a ``det`` row is scored as one without a detection (a model that
+found nothing is AP 0, not a file that says nothing); ``gt`` rows, as this study writes, say the same; other
+kinds are skipped. Without a ``kind`` column every row is a detection. A frame with no row has no detection. The
+study refuses a file that covers no frame of a (setting, mode) it scores
+(:func:`check_prediction_coverage`). :mod:`mmusv.learn.replay` writes a ``frame`` row for every (sequence, frame,
+ego, mode) it covers, and the Parquet this study writes has that layout, so its output can be re-scored.
 """
 
 from __future__ import annotations
@@ -75,6 +80,9 @@ __all__ = [
 Key = tuple[str, str]  # (setting name, mode)
 SEEN_POINTS = 5
 """LiDAR points inside a target for it to count as seen by a USV (module docstring)."""
+COVERAGE_KINDS = ("frame", "gt")
+"""The ``kind`` values of a predictions file's rows that say which (sequence, frame, ego, mode, setting) it covers
+without being detections (module docstring)."""
 WAVE_HIDDEN_SHARE = 0.5
 """The share of a target the waves hide from the ego's LiDAR from which it counts as wave-hidden (module
 docstring)."""
@@ -204,7 +212,7 @@ _ROW_SCHEMA: dict[str, Any] = {
 
 def load_predictions(path: str | Path) -> dict[tuple[str, int, str, str, str], tuple[np.ndarray, np.ndarray]]:
     """The detections of a predictions Parquet (module docstring) keyed by (sequence, frame, ego, mode,
-    setting)."""
+    setting); a key the file covers (a ``frame`` or ``gt`` row) without a detection maps to no box."""
     p = Path(path)
     if not p.is_file():
         raise InputError(f"--predictions {p}: no such file")
@@ -217,36 +225,48 @@ def load_predictions(path: str | Path) -> dict[tuple[str, int, str, str, str], t
     if missing:
         raise InputError(f"--predictions {p}: missing column(s) {missing}; required: {need}")
     df = df.with_row_index("_row")
-    if "kind" in df.columns:
-        df = df.filter(pl.col("kind") == "det")
     if "setting" not in df.columns:
         df = df.with_columns(pl.lit("clean").alias("setting"))
+    if "kind" in df.columns:
+        kind = pl.col("kind").cast(pl.Utf8, strict=False)
+        covered = df.filter(kind.is_in(list(COVERAGE_KINDS)))
+        df = df.filter(kind == "det")
+    else:
+        covered = df.clear()
+    _check_prediction_keys(p, df, rows="det")
     _check_prediction_values(p, df)
-    bad = sorted(set(df["mode"].to_list()) - set(MODES))
-    if bad:
-        raise InputError(f"--predictions {p}: column mode has unknown value(s) {bad}; allowed: {', '.join(MODES)}")
+    _check_prediction_keys(p, covered, rows=" or ".join(COVERAGE_KINDS))
     out: dict[tuple[str, int, str, str, str], tuple[np.ndarray, np.ndarray]] = {}
-    df = df.with_columns(pl.col("frame").cast(pl.Int64), pl.col("ego").cast(pl.Utf8), pl.col("sequence").cast(pl.Utf8))
-    for key, g in df.group_by(["sequence", "frame", "ego", "mode", "setting"], maintain_order=True):
+    keys = ["sequence", "frame", "ego", "mode", "setting"]
+
+    def typed(d: pl.DataFrame) -> pl.DataFrame:
+        return d.with_columns(
+            pl.col("frame").cast(pl.Int64), pl.col("ego").cast(pl.Utf8), pl.col("sequence").cast(pl.Utf8)
+        )
+
+    for row in typed(covered).select(keys).unique(maintain_order=True).iter_rows():
+        k = (str(row[0]), int(row[1]), str(row[2]), str(row[3]), str(row[4]))
+        out[k] = (np.zeros((0, 7)), np.zeros(0))
+    for key, g in typed(df).group_by(keys, maintain_order=True):
         k = (str(key[0]), int(key[1]), str(key[2]), str(key[3]), str(key[4]))
         out[k] = (g.select(list(BOX_COLUMNS)).to_numpy().astype(np.float64), g["score"].to_numpy().astype(np.float64))
     return out
 
 
-def _check_prediction_values(path: Path, df: pl.DataFrame) -> None:
-    """Refuses a predictions table (its ``det`` rows, ``_row`` = the row in the file) with a null key, a frame that
-    is not a whole number, or a box or score that is not a finite number: a null frame was a TypeError traceback,
-    1.5 was read as frame 1, a NaN box was dropped and a NaN score ranked anyhow, each without a word."""
+def _check_prediction_keys(path: Path, df: pl.DataFrame, *, rows: str) -> None:
+    """Refuses rows (``_row`` = the row in the file) of a predictions table with a null key, a frame that is not a
+    whole number or a mode that is not one: a null frame was a TypeError traceback and 1.5 was read as frame 1.
+    ``rows``: the kind of the rows, for the message."""
 
     def first(mask: pl.Series) -> str:
         return f"row {int(df['_row'].filter(mask)[0])}"
 
-    for c in ("sequence", "frame", "ego", "mode", "setting", *BOX_COLUMNS, "score"):
+    for c in ("sequence", "frame", "ego", "mode", "setting"):
         nulls = df[c].is_null()
         if nulls.any():
             raise InputError(
                 f"--predictions {path}: column {c} has {int(nulls.sum())} null value(s) (first: {first(nulls)}); "
-                "every det row needs one"
+                f"every {rows} row needs one"
             )
     frame = df["frame"]
     if not frame.dtype.is_numeric():
@@ -258,6 +278,27 @@ def _check_prediction_values(path: Path, df: pl.DataFrame) -> None:
             raise InputError(
                 f"--predictions {path}: column frame must hold integer acquisition indices; {first(bad)} has "
                 f"{float(values[bad.to_numpy()][0])!r}"
+            )
+    unknown = sorted(set(df["mode"].cast(pl.Utf8).to_list()) - set(MODES))
+    if unknown:
+        raise InputError(
+            f"--predictions {path}: column mode has unknown value(s) {unknown}; allowed: {', '.join(MODES)}"
+        )
+
+
+def _check_prediction_values(path: Path, df: pl.DataFrame) -> None:
+    """Refuses a predictions table (its ``det`` rows, ``_row`` = the row in the file) with a box or score that is
+    null or not a finite number: a NaN box was dropped and a NaN score ranked anyhow, each without a word."""
+
+    def first(mask: pl.Series) -> str:
+        return f"row {int(df['_row'].filter(mask)[0])}"
+
+    for c in (*BOX_COLUMNS, "score"):
+        nulls = df[c].is_null()
+        if nulls.any():
+            raise InputError(
+                f"--predictions {path}: column {c} has {int(nulls.sum())} null value(s) (first: {first(nulls)}); "
+                "every det row needs one"
             )
     for c in (*BOX_COLUMNS, "score"):
         col = df[c]
@@ -279,8 +320,10 @@ def check_prediction_coverage(
     modes: Sequence[str],
     settings: Sequence[Setting],
 ) -> None:
-    """Refuses predictions without a single row of a (setting, mode) the study scores: Table III's boxes (setting
-    ``clean`` only) scored as Table IV gave AP 0 for every delay and noise setting, as if measured."""
+    """Refuses predictions that cover no frame of a (setting, mode) the study scores (no ``det`` row, nor a
+    ``frame`` or ``gt`` row saying it was covered): Table III's boxes (setting ``clean`` only) scored as Table IV
+    gave AP 0 for every delay and noise setting, as if measured. A covered (setting, mode) without a detection is a
+    model that found nothing: AP 0, as ``--model`` scores it."""
     held = {(k[4], k[3]) for k in predictions}
     wanted = [(s.name, m) for s in settings for m in modes if m != "none" or s.name == "clean"]
     missing = [w for w in wanted if w not in held]
@@ -291,12 +334,18 @@ def check_prediction_coverage(
         by: dict[str, list[str]] = {}
         for setting, mode in pairs:
             by.setdefault(setting, []).append(mode)
-        return "; ".join(f"{setting} (modes {', '.join(m)})" for setting, m in by.items())
+        return "; ".join(f"setting {setting} (modes {', '.join(m)})" for setting, m in by.items())
 
+    holds = (
+        f"the file covers {listed(sorted(held))}"
+        if held
+        else "the file holds no detection and covers no frame (no row of kind det, frame or gt; a file of a model "
+        "that found nothing needs a row of kind frame for each (sequence, frame, ego, mode) it covers, as "
+        "mmusv.learn.replay writes)"
+    )
     raise InputError(
-        f"--predictions {path}: no row of setting {listed(missing)}; the file holds setting "
-        f"{listed(sorted(held)) or 'none'}. Give the detections of every setting (--settings) and mode (--modes) "
-        "scored, or leave those out"
+        f"--predictions {path}: no row of {listed(missing)}; {holds}. Give the detections of every setting "
+        "(--settings) and mode (--modes) scored, or leave those out"
     )
 
 
