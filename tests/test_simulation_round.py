@@ -228,3 +228,26 @@ def test_frames_refuse_shapes_they_would_misread() -> None:
     np.testing.assert_allclose(frames.mirror_points([1.0, 2.0, 3.0]), [[1.0, -2.0, 3.0]])
     assert frames.transform_points(m[0], np.zeros((0, 3))).shape == (0, 3)
     np.testing.assert_allclose(frames.pose_matrices(frames.matrix_to_pose(m)), m, atol=1e-12)
+
+
+# ------------------------------------------------------------------------------------------- annotations
+
+
+def test_a_vessel_in_plain_view_on_flat_water_is_not_occluded() -> None:
+    """``occlusion`` is the share of the vessel's part above the still water level that the camera does not see
+    (``docs/recording.md``: hidden by other objects). The hull below the waterline, which a flat sea always hides,
+    counted as occluded: a fishing boat in plain view 60 m ahead read 0.34. Here it reads 0 (every pixel whose
+    ray meets the boat above the water level, cast against the boat alone, shows the boat), while the 2D box still
+    reaches below the waterline (the projected 3D box), so fewer pixels show the boat than the box's silhouette."""
+    sc = _scenario(frames=1)
+    sc["rigs"]["r"]["cameras"][0].update(resolution=[320, 240])
+    sc["vessels"] = [
+        {"id": "u", "role": "usv", "asset": "usv_wamv", "rig": "r", "speed_mps": 0.0, "route": [[0, 0], [10, 0]]},
+        {"id": "t", "asset": "fishing_boat_12m", "speed_mps": 0.0, "route": [[60, -8], [60, 8]]},
+    ]
+    s = Simulation(sc)
+    cap = s.capture(0)
+    ann = annotations_for(s, cap, SilhouetteCache())["u"].columns()["camera"]
+    (row,) = [i for i, v in enumerate(ann["target_id"]) if v == "t"]
+    assert ann["camera"][row] == "front" and ann["visible_pixels"][row] > 100
+    assert ann["occlusion"][row] == pytest.approx(0.0, abs=0.01)

@@ -9,11 +9,11 @@ For every agent (USV) and frame, for every other vessel (the agent's own hull is
 * per pinhole camera, a 2D box: the projected 3D-box corners (edges clipped at the near plane; through a camera's
   lens distortion, the projected edges), clipped to the image, with ``truncation`` = 1 − clipped area / unclipped
   area, ``visible_pixels`` (pixels whose instance is the vessel), ``box_pixels`` (the clipped box area) and
-  ``occlusion`` = 1 − visible / silhouette, where the silhouette is the vessel's pixels with everything else
-  removed (its rays cast against the vessel alone). The whole hull is in the silhouette, its part below the
-  waterline too, so the water counts among what hides it: a vessel in plain view on flat water has an occlusion
-  above 0, the share of its silhouette's rays that meet its hull below the water level (the 2D box, the projected
-  3D box, reaches down to the keel).
+  ``occlusion`` = 1 − visible / silhouette over the vessel's part above the still water level (world z > 0):
+  the silhouette is the pixels whose rays, cast against the vessel alone, meet it above that level (the part of
+  the hull a flat calm sea never hides), visible those of them whose pixel shows the vessel; so a vessel in plain
+  view on flat water has occlusion 0, and other objects and the waves' crests raise it (the waves' own share is
+  ``wave_occlusion``, below). The 2D box is the projected 3D box, which reaches down to the keel.
 * over a displaced sea (a scene with a wave surface), per 3D box and per 2D box, ``wave_occlusion``: the share of
   the vessel's part above the still water level that the water hides from that sensor (:mod:`mmusv.wave_occlusion`);
   0 over a flat sea.
@@ -356,21 +356,27 @@ def annotate_agent(
             pix = np.ascontiguousarray((vv * w + uu).reshape(-1), dtype=np.int64)
             o, d = cam.pixel_rays(pose, pix)
             t_alone = silhouettes.distances(info.asset, state.matrices[vi], o, d)
-            sil = int(np.count_nonzero(np.isfinite(t_alone)))
+            alone = np.isfinite(t_alone)
+            sil = int(np.count_nonzero(alone))
             if sil == 0 and visible == 0:
                 continue
+            # The silhouette above the still water level, and the part of it the camera sees (a flat sea hides the
+            # hull below the waterline: that is no occlusion).
+            dn = d / np.linalg.norm(d, axis=1, keepdims=True)
+            above = alone & (o[:, 2] + dn[:, 2] * np.where(alone, t_alone, 0.0) > 0.0)
+            exposed = int(np.count_nonzero(above))
+            seen = int(np.count_nonzero(above & (window.reshape(-1) == info.instance_id)))
             ann.cam_ids.append(info.id)
             ann.cam_camera.append(name)
             ann.cam_box.append(clipped)
             ann.cam_truncation.append(float(1.0 - carea / area))
             ann.cam_visible.append(visible)
             ann.cam_box_pixels.append(int((u1 - u0) * (v1 - v0)))
-            ann.cam_occlusion.append(float(1.0 - visible / sil) if sil else 0.0)
+            ann.cam_occlusion.append(float(1.0 - seen / exposed) if exposed else float(sil > 0 and visible == 0))
             ann.cam_role.append(info.role)
             ann.cam_static.append(bool(info.static))
             wave = 0.0
             if waves and scene is not None and sil:
-                dn = d / np.linalg.norm(d, axis=1, keepdims=True)
                 wave = share(*exposed_hidden(scene, o, dn, t_alone, scene_instance=window.reshape(-1)))
             ann.cam_wave_occlusion.append(wave)
     if rotations:
