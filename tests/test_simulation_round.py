@@ -251,3 +251,14 @@ def test_a_vessel_in_plain_view_on_flat_water_is_not_occluded() -> None:
     (row,) = [i for i, v in enumerate(ann["target_id"]) if v == "t"]
     assert ann["camera"][row] == "front" and ann["visible_pixels"][row] > 100
     assert ann["occlusion"][row] == pytest.approx(0.0, abs=0.01)
+
+
+def test_a_missing_field_is_named_and_not_shown_as_the_mapping_it_is_missing_from() -> None:
+    """``Simulation({"name": "x"})`` said ``invalid config vessels = {'name': 'x'}: Field required``, the whole
+    document shown as if it were the value of ``vessels``."""
+    with pytest.raises(ConfigError) as e:
+        Simulation({"name": "x"})
+    assert "vessels = <missing>: required" in str(e.value) and "'name'" not in str(e.value)
+    with pytest.raises(ConfigError) as e:
+        Simulation({"name": "x", "vessels": [{"id": "a"}]})
+    assert "vessels[0].asset = <missing>: required" in str(e.value)

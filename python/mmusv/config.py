@@ -511,6 +511,8 @@ def validation_problems(
         if isinstance(value, (dict, list)) and len(shown) >= 80:
             shown = f"<{type(value).__name__}>"
         msg = str(e["msg"]).removeprefix("Value error, ")
+        if e["type"] == "missing":  # pydantic's input is the mapping the field is missing from, not the field's
+            shown, msg = "<missing>", "required"
         if e["type"] == "extra_forbidden" and model is not None:
             msg += _unknown_key_hint(model, loc, data)
         if not loc and isinstance(value, dict):  # a check across fields: its message names the fields itself

@@ -24,7 +24,13 @@ impl MeshFormat {
         match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
             Some("ply") => Ok(Self::Ply),
             Some("obj") => Ok(Self::Obj),
-            other => Err(MmusvError::input("path", format!("extension {other:?} is not supported; use .ply or .obj"))),
+            other => Err(MmusvError::input(
+                "path",
+                match other {
+                    Some(ext) => format!("extension .{ext} is not supported; use .ply or .obj"),
+                    None => "a file name without extension is not supported; use .ply or .obj".to_string(),
+                },
+            )),
         }
     }
 }
@@ -115,7 +121,9 @@ mod tests {
         write_world_mesh(&m, &obj, MeshFormat::Obj).unwrap_or(());
         let text = std::fs::read_to_string(&obj).unwrap_or_default();
         assert!(text.contains("g instance_2") && text.contains("f 1 2 3"));
-        assert!(MeshFormat::from_path(Path::new("x.stl")).is_err());
+        let said = |p: &str| MeshFormat::from_path(Path::new(p)).err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(said("x.stl").contains("extension .stl is not supported"), "{}", said("x.stl"));
+        assert!(said("x").contains("without extension"), "{}", said("x"));
         let _ = std::fs::remove_dir_all(&dir);
     }
 }

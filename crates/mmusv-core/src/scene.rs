@@ -333,7 +333,7 @@ impl Scene {
             Err(MmusvError::UnknownId {
                 kind: "mesh",
                 id: mesh as i64,
-                hint: format!("the scene has {} meshes (ids 0..{})", self.meshes.len(), self.meshes.len()),
+                hint: id_range(("mesh", "meshes"), self.meshes.len()),
             })
         }
     }
@@ -345,7 +345,7 @@ impl Scene {
             Err(MmusvError::UnknownId {
                 kind: "instance",
                 id: id as i64,
-                hint: format!("the scene has {} instances (ids 0..{})", self.instances.len(), self.instances.len()),
+                hint: id_range(("instance", "instances"), self.instances.len()),
             })
         }
     }
@@ -547,6 +547,16 @@ pub struct WorldMesh {
     pub instances: Vec<u32>,
     /// Triangle index within its instance's mesh, per face.
     pub triangles: Vec<u32>,
+}
+
+/// How many `(one, many)` a scene holds and their ids, both ends included (`"the scene has 2 instances (ids 0
+/// to 1)"`; it said `ids 0..2`, which reads as including 2).
+fn id_range((one, many): (&str, &str), n: usize) -> String {
+    match n {
+        0 => format!("the scene has no {many}"),
+        1 => format!("the scene has 1 {one} (id 0)"),
+        _ => format!("the scene has {n} {many} (ids 0 to {})", n - 1),
+    }
 }
 
 #[cfg(test)]

@@ -93,6 +93,13 @@ fn bad_rays_and_ids_are_errors_not_panics() {
     // Empty scene / empty batch: misses, not errors.
     assert!(Scene::new().cast_rays(&[[0.0; 3]], &[[1.0, 0.0, 0.0]], 10.0).is_ok_and(|h| h.instance[0] == NO_HIT));
     assert!(s.cast_rays(&[], &[], 10.0).is_ok_and(|h| h.is_empty()));
+    // The ids a scene holds, both ends included ("ids 0..2" read as holding id 2).
+    let _ = s.add_instance(m, RigidPose::IDENTITY, None);
+    let _ = s.add_instance(m, RigidPose::IDENTITY, None);
+    let said = s.set_poses(&[3], &[RigidPose::IDENTITY]).err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(said.contains("the scene has 2 instances (ids 0 to 1)"), "{said}");
+    let said = s.add_instance(m + 1, RigidPose::IDENTITY, None).err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(said.contains("the scene has 1 mesh (id 0)"), "{said}");
 }
 
 #[test]
