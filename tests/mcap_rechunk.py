@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 
 def rechunk(src: Path, dst: Path, chunk_size: int) -> None:
@@ -29,3 +30,46 @@ def rechunk(src: Path, dst: Path, chunk_size: int) -> None:
             elif isinstance(rec, Metadata):
                 w.add_metadata(rec.name, rec.metadata)
         w.finish()  # type: ignore[no-untyped-call]
+
+
+def killed_copy(src: Path, dst: Path, *, messages: int | None = None) -> Path:
+    """``dst``: what a run killed after the first ``messages`` messages of ``src`` (all: ``None``) leaves, as the
+    recorder writes it (the header, the scenario, manifest and sensors metadata, complete chunks, no ``run``
+    metadata, no summary or footer)."""
+    from mcap.reader import make_reader
+    from mcap.writer import CompressionType, Writer
+
+    with src.open("rb") as f:
+        reader = make_reader(f)
+        meta = [(m.name, dict(m.metadata)) for m in reader.iter_metadata() if m.name != "run"]
+        msgs = list(reader.iter_messages())[:messages]
+    with dst.open("wb") as out:
+        w = Writer(out, chunk_size=1, compression=CompressionType.NONE)  # every message in a chunk of its own
+        w.start(profile="", library="mmusv test")
+        for name, md in meta:
+            w.add_metadata(name, md)
+        schemas: dict[int, int] = {}
+        channels: dict[int, int] = {}
+        for schema, ch, m in msgs:
+            assert schema is not None
+            if schema.id not in schemas:
+                schemas[schema.id] = w.register_schema(schema.name, schema.encoding, schema.data)
+            if ch.id not in channels:
+                channels[ch.id] = w.register_channel(ch.topic, ch.message_encoding, schemas[schema.id], ch.metadata)
+            w.add_message(channels[ch.id], m.log_time, m.data, m.publish_time, m.sequence)
+        # no w.finish(): the process was killed
+    return dst
+
+
+def no_ray_cluster(monkeypatch: Any) -> None:
+    """Ray "installed" (a stand-in module, through ``mmusv.batch.ray_backend.import_ray``) with no cluster to join:
+    ``ray.init`` raises Ray's own ``ConnectionError``."""
+    import types
+
+    from mmusv.batch import ray_backend
+
+    def init(**_kw: Any) -> None:
+        raise ConnectionError("Could not find any running Ray instance. Please specify the one to connect to.")
+
+    fake = types.SimpleNamespace(is_initialized=lambda: False, init=init)
+    monkeypatch.setattr(ray_backend, "import_ray", lambda: fake)

@@ -15,8 +15,8 @@ from typing import Any
 import jsonschema
 import pytest
 import yaml
-from mcap.reader import make_reader
-from mcap.writer import CompressionType, Writer
+from mcap.writer import Writer
+from mcap_rechunk import killed_copy
 from mmusv.cli import main
 from tiny_scenario import lidar_scenario
 
@@ -30,29 +30,8 @@ def _cli(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str,
 
 
 def _killed_copy(src: Path, dst: Path, *, messages: int) -> Path:
-    """``dst``: what a run killed after the first ``messages`` messages of ``src`` leaves, as the recorder writes
-    it (the header, the scenario, manifest and sensors metadata, complete chunks, no ``run`` metadata, no summary
-    or footer)."""
-    with src.open("rb") as f:
-        reader = make_reader(f)
-        meta = [(m.name, dict(m.metadata)) for m in reader.iter_metadata() if m.name != "run"]
-        msgs = list(reader.iter_messages())[:messages]
-    with dst.open("wb") as out:
-        w = Writer(out, chunk_size=1, compression=CompressionType.NONE)  # every message in a chunk of its own
-        w.start(profile="", library="mmusv test")
-        for name, md in meta:
-            w.add_metadata(name, md)
-        schemas: dict[int, int] = {}
-        channels: dict[int, int] = {}
-        for schema, ch, m in msgs:
-            assert schema is not None
-            if schema.id not in schemas:
-                schemas[schema.id] = w.register_schema(schema.name, schema.encoding, schema.data)
-            if ch.id not in channels:
-                channels[ch.id] = w.register_channel(ch.topic, ch.message_encoding, schemas[schema.id], ch.metadata)
-            w.add_message(channels[ch.id], m.log_time, m.data, m.publish_time, m.sequence)
-        # no w.finish(): the process was killed
-    return dst
+    """``dst``: what a run killed after the first ``messages`` messages of ``src`` leaves (``mcap_rechunk``)."""
+    return killed_copy(src, dst, messages=messages)
 
 
 @pytest.fixture(scope="module")

@@ -10,13 +10,11 @@ from __future__ import annotations
 import copy
 import json
 import signal
-import types
 from pathlib import Path
 from typing import Any
 
 import pytest
-from mcap.reader import make_reader
-from mcap.writer import CompressionType, Writer
+from mcap_rechunk import killed_copy, no_ray_cluster
 from mmusv.batch import build_dataset, read_index, run_many
 from mmusv.cli import main
 from mmusv.config import load_scenario
@@ -137,17 +135,6 @@ def test_dataset_json_counts_the_frames_of_complete_recordings_only(
 # ------------------------------------------------------------------------------------------------ Ray
 
 
-def _no_cluster(monkeypatch: pytest.MonkeyPatch) -> None:
-    """Ray "installed" (a stand-in module) with no cluster to join."""
-    from mmusv.batch import ray_backend
-
-    def init(**_kw: Any) -> None:
-        raise ConnectionError("Could not find any running Ray instance. Please specify the one to connect to.")
-
-    fake = types.SimpleNamespace(is_initialized=lambda: False, init=init)
-    monkeypatch.setattr(ray_backend, "import_ray", lambda: fake)
-
-
 def test_a_ray_batch_that_cannot_join_its_cluster_writes_nothing(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -161,7 +148,7 @@ def test_a_ray_batch_that_cannot_join_its_cluster_writes_nothing(
     assert run_many(src, out_dir=out).ok
     before = tree(out)
     write(src / "b.yaml", lidar_scenario("b", frames=1))  # something to run
-    _no_cluster(monkeypatch)
+    no_ray_cluster(monkeypatch)
     with pytest.raises(IoError, match=r"--ray auto: cannot start or join Ray: Could not find any running Ray"):
         run_many(src, out_dir=out, ray="auto")
     assert tree(out) == before and not (out / "b").exists()
@@ -201,25 +188,7 @@ def _killed(recording: Path) -> None:
     """``recording`` (a finished part) as a run killed after its last frame leaves it: ``NAME.mcap.partial`` with
     the header, the scenario, manifest and sensors metadata and every message, no ``run`` metadata, no summary;
     the part's manifest.json gone."""
-    with recording.open("rb") as f:
-        reader = make_reader(f)
-        meta = [(m.name, dict(m.metadata)) for m in reader.iter_metadata() if m.name != "run"]
-        msgs = list(reader.iter_messages())
-    with recording.with_name(recording.name + ".partial").open("wb") as out:
-        w = Writer(out, chunk_size=1, compression=CompressionType.NONE)
-        w.start(profile="", library="mmusv test")
-        for name, md in meta:
-            w.add_metadata(name, md)
-        schemas: dict[int, int] = {}
-        channels: dict[int, int] = {}
-        for schema, ch, m in msgs:
-            assert schema is not None
-            if schema.id not in schemas:
-                schemas[schema.id] = w.register_schema(schema.name, schema.encoding, schema.data)
-            if ch.id not in channels:
-                channels[ch.id] = w.register_channel(ch.topic, ch.message_encoding, schemas[schema.id], ch.metadata)
-            w.add_message(channels[ch.id], m.log_time, m.data, m.publish_time, m.sequence)
-        # no w.finish(): the process was killed
+    killed_copy(recording, recording.with_name(recording.name + ".partial"))
     recording.unlink()
     (recording.parent / "manifest.json").unlink()
 

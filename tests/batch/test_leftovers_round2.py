@@ -8,11 +8,11 @@ from __future__ import annotations
 
 import json
 import signal
-import types
 from pathlib import Path
 from typing import Any
 
 import pytest
+from mcap_rechunk import no_ray_cluster
 from mmusv.batch import build_dataset
 from mmusv.batch.index import Entry, write_index
 from mmusv.cli import main
@@ -36,17 +36,6 @@ def _cli(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str,
 
 
 # ------------------------------------------------------------------------------------------------ dataset --ray
-
-
-def _no_cluster(monkeypatch: pytest.MonkeyPatch) -> None:
-    """Ray "installed" (a stand-in module) with no cluster to join."""
-    from mmusv.batch import ray_backend
-
-    def init(**_kw: Any) -> None:
-        raise ConnectionError("Could not find any running Ray instance. Please specify the one to connect to.")
-
-    fake = types.SimpleNamespace(is_initialized=lambda: False, init=init)
-    monkeypatch.setattr(ray_backend, "import_ray", lambda: fake)
 
 
 def test_a_dataset_on_a_ray_cluster_it_cannot_join_changes_nothing(
@@ -75,7 +64,7 @@ def test_a_dataset_on_a_ray_cluster_it_cannot_join_changes_nothing(
     )
     write_index(out / "dataset.json", [entry], {"spec": {"file": "s.yaml", "name": "older", "hash": "0" * 64}})
     before = tree(out)
-    _no_cluster(monkeypatch)
+    no_ray_cluster(monkeypatch)
     with pytest.raises(IoError, match=r"--ray auto: cannot start or join Ray: Could not find any running Ray"):
         build_dataset(spec, out_dir=out, ray="auto")
     assert tree(out) == before and not (out / "scenarios").exists()
