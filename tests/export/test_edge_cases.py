@@ -291,8 +291,16 @@ def test_two_different_rigs_read_back_in_every_format(mixed_rec: Path, tmp_path:
         }[to](out)
     assert found["kitti"] == 4 and found["semantickitti"] == 4 and found["opv2v"] > 0 and found["ros2"] > 20
     assert found["mastr"] == 2  # usv_b's front camera; the rear one records no semantic image
-    assert len(list((tmp_path / "yolo" / "images").rglob("*.png"))) == 4  # usv_b's front and rear, 2 frames
-    assert "agent usv_a has no camera recording rgb images and is left out" in notes(tmp_path / "yolo")
+    # The default --box visible takes YOLO's boxes from the instance images, so usv_b's rear camera (RGB only) is left
+    # out, as in COCO; --box projected (the recorded boxes, the only ones before --box) converts it from RGB alone.
+    assert len(list((tmp_path / "yolo" / "images").rglob("*.png"))) == 2  # usv_b's front, 2 frames
+    yolo_notes = notes(tmp_path / "yolo")
+    assert "agent usv_a has no camera recording rgb and instance images and is left out" in yolo_notes
+    assert "agent usv_b: cameras ['rear'] do not record rgb and instance images and are left out (--box" in yolo_notes
+    convert(mixed_rec, to="yolo", out_dir=tmp_path / "yolo_projected", splits=None, box="projected")
+    assert check_yolo(tmp_path / "yolo_projected") >= found["yolo"]
+    assert len(list((tmp_path / "yolo_projected" / "images").rglob("*.png"))) == 4  # usv_b's front and rear, 2 frames
+    assert "agent usv_a has no camera recording rgb images and is left out" in notes(tmp_path / "yolo_projected")
     # data_protocol.yaml names the OPV2V cameras some agent writes (it said four whatever the rigs).
     protocol = yaml.safe_load((tmp_path / "opv2v" / "edge_mixed" / "data_protocol.yaml").read_text())
     assert protocol["vehicle_base"]["sensing"]["perception"]["camera"] == {"num": 2, "order": ["front", "rear"]}

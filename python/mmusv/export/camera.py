@@ -2,17 +2,26 @@
 and the box filter.
 
 A sample is one camera image of one agent at one frame; its key ``<scenario>/<agent>/<camera>/<frame:06d>`` names
-its files in every layout, so no two samples of a conversion share a name. Boxes are the recording's 2D camera
+its files in every layout, so no two samples of a conversion share a name. Boxes come from the recording's 2D camera
 annotations (``mmusv.AgentAnnotations.boxes_camera``: the vessel's projected 3D box clipped to the image, with
 truncation, visible pixels and occlusion; :mod:`mmusv.annotate`), with the vessel's class, instance and role from
-the frame's world state.
+the frame's world state. The box written is the option ``box`` (:data:`mmusv.export.common.BOXES`): ``visible``
+(the default), the tight box of the instance image's pixels equal to the vessel's instance id (:func:`mask_box`),
+or ``projected``, the recorded box; truncation, occlusion and visible pixels are the recording's either way.
+
+Pixel coordinates (every box): origin at the top-left corner of the image, x right, y down, pixel ``(i, j)`` over
+``[i, i + 1) × [j, j + 1)``, so the tight box of pixels ``x_min..x_max``, ``y_min..y_max`` (inclusive) is
+``[x_min, y_min, x_max + 1, y_max + 1]``, as pycocotools' ``toBbox`` gives it for the same mask.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from functools import cached_property
 from pathlib import Path
 from typing import Any, ClassVar
+
+import numpy as np
 
 from mmusv.classes import SemanticClass, class_name
 from mmusv.export.common import Options, Sink
@@ -22,7 +31,7 @@ from mmusv.recording.decode import WorldFrame
 from mmusv.recording.info import AgentInfo, CameraInfo
 from mmusv.recording.stream import Frame
 
-__all__ = ["CATEGORIES", "CameraWriter", "ImageBox", "Sample", "Shared"]
+__all__ = ["CATEGORIES", "CameraWriter", "ImageBox", "Sample", "Shared", "mask_box"]
 
 CATEGORIES: tuple[int, ...] = tuple(int(c) for c in SemanticClass if c != SemanticClass.NONE)
 """The detection categories: every semantic class of :mod:`mmusv.classes` but ``NONE`` (0, nothing hit), by id."""
@@ -71,6 +80,24 @@ class Sample:
         """The camera's ``kind`` image message (``rgb``, ``depth``, ``semantic``, ``instance``)."""
         return self.frame.messages[topics.camera(self.agent.id, self.camera.name, kind)]
 
+    @cached_property
+    def instance(self) -> np.ndarray:
+        """The camera's instance image, ``(H, W)`` (decoded once)."""
+        from mmusv.recording import decode_image
+
+        return np.asarray(decode_image(self.message("instance")))
+
+
+def mask_box(instance: np.ndarray, instance_id: int) -> tuple[int, int, int, int] | None:
+    """The tight box ``(x_min, y_min, x_max, y_max)`` of ``instance``'s pixels equal to ``instance_id`` in pixel-edge
+    coordinates (the last pixel's far edge: ``x_max`` = last column + 1), or ``None`` when there is none."""
+    mask = np.asarray(instance) == instance_id
+    cols = np.flatnonzero(mask.any(axis=0))
+    if cols.size == 0:
+        return None
+    rows = np.flatnonzero(mask.any(axis=1))
+    return int(cols[0]), int(rows[0]), int(cols[-1]) + 1, int(rows[-1]) + 1
+
 
 @dataclass
 class Shared:
@@ -90,6 +117,8 @@ class CameraWriter(DatasetWriter):
     needs_agent: ClassVar[bool] = True
     kinds: ClassVar[tuple[str, ...]] = ("rgb",)
     boxes: ClassVar[bool] = False
+    left_out_why: ClassVar[str] = ""
+    """Said after the cameras left out for lacking one of :attr:`kinds` (what would keep them)."""
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
@@ -105,6 +134,7 @@ class CameraWriter(DatasetWriter):
             if other:
                 self.notes.append(
                     f"agent {a.id}: cameras {other} do not record {' and '.join(self.kinds)} images and are left out"
+                    + self.left_out_why
                 )
 
     @classmethod
@@ -162,11 +192,14 @@ class CameraWriter(DatasetWriter):
         return p
 
     def boxes_of(self, sample: Sample) -> list[ImageBox]:
-        """The sample's 2D boxes kept by the options: a box with no visible pixel is always left out, and so are
-        boxes whose shorter side is under ``min_box_px`` or whose occlusion is above ``max_occlusion``."""
+        """The sample's 2D boxes kept by the options, each the box of option ``box``: ``visible``, the tight box of the
+        vessel's pixels in the instance image (:func:`mask_box`), or ``projected``, the recorded box. A box with no
+        visible pixel is always left out, and so are boxes whose shorter side (of the box written) is under
+        ``min_box_px`` or whose occlusion is above ``max_occlusion``."""
         ann = sample.frame.messages[topics.agent_annotations(sample.agent.id)]
         w = sample.world
         row = {vid: i for i, vid in enumerate(w.ids)}
+        visible = self.options.box == "visible"
         out = []
         for b in ann.boxes_camera:
             if b.camera != sample.camera.name or b.target_id not in row:
@@ -187,6 +220,12 @@ class CameraWriter(DatasetWriter):
             )
             if box.visible_pixels == 0:
                 continue
+            if visible:
+                tight = mask_box(sample.instance, box.instance_id)
+                if tight is None:  # no pixel of the vessel in the image
+                    continue
+                x0, y0, x1, y1 = (float(v) for v in tight)
+                box = replace(box, x_min=x0, y_min=y0, x_max=x1, y_max=y1)
             self.visible_boxes += 1
             if box.occlusion > self.options.max_occlusion or min(box.width, box.height) < self.options.min_box_px:
                 continue

@@ -79,6 +79,13 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         help="coco, yolo: leave out 2D boxes hidden by more than this fraction, 0..1 (default 1: keep all)",
     )
     p.add_argument(
+        "--box",
+        default="visible",
+        help="coco, yolo: the 2D box written: visible (default: the tight box of the vessel's pixels in the instance "
+        "image, COCO's bbox convention; yolo then needs instance images) or projected (the recording's box: the "
+        "projected 3D box clipped to the image, reaching down to the keel); kitti and ros2 keep the recorded box",
+    )
+    p.add_argument(
         "--agents",
         default=None,
         help="convert only these agents (USV ids, comma-separated, e.g. usv_1,usv_2); every recording must hold one",
@@ -99,11 +106,16 @@ def run(args: argparse.Namespace) -> int:
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
-    from mmusv.export.common import TARGETS
+    from mmusv.export.common import BOXES, TARGETS
     from mmusv.export.convert import convert
 
     if args.to not in TARGETS:
         raise ConfigError(f"unknown --to {args.to!r}; allowed: {', '.join(TARGETS)}")
+    if args.box not in BOXES:
+        raise ConfigError(
+            f"unknown --box {args.box!r}; allowed: visible (the tight box of the vessel's visible pixels, the default) "
+            "or projected (the recording's box: the projected 3D box clipped to the image)"
+        )
     console = Console(width=None if sys.stdout.isatty() else 160)
     kwargs: dict[str, Any] = {
         "to": args.to,
@@ -115,6 +127,7 @@ def run(args: argparse.Namespace) -> int:
         "extras": args.extras,
         "min_box_px": args.min_box_px,
         "max_occlusion": args.max_occlusion,
+        "box": args.box,
         "overwrite": args.overwrite,
         "agents": args.agents,
         "frames": args.frames,

@@ -2,17 +2,21 @@
 
 Layout: ``images/<split>/<scenario>/<agent>/<camera>/<frame>.png`` (the recorded RGB PNG, copied) and
 ``annotations/instances_<split>.json`` (``split`` = ``train``, ``validate``, ``test``, or ``all`` without a split;
-the split is made by recording, :mod:`mmusv.export.splits`). Each file: ``info``, ``licenses`` (empty),
+the split is made by recording, :mod:`mmusv.export.splits`). Each file: ``info`` (with ``mmusv_box``, the option
+``box`` the boxes were written with, and ``mmusv_box_definition``, what it means), ``licenses`` (empty),
 ``images`` (``id`` from 1, ``file_name`` relative to ``images/<split>``, ``width``, ``height``, and mmusv's
 ``scenario``, ``agent``, ``camera``, ``frame``, ``time_s``), ``annotations`` and ``categories`` (every mmusv
 semantic class but ``none``: ``id`` = the class id of :mod:`mmusv.classes`, ``name`` its name).
 
 An annotation per kept 2D box (:meth:`mmusv.export.camera.CameraWriter.boxes_of`): ``bbox`` ``[x, y, w, h]``
-pixels (the recording's box: the vessel's projected 3D box clipped to the image), ``category_id`` the vessel's
-semantic class, ``segmentation`` the run-length encoding (pycocotools, ``counts`` as a string) of the instance
-image's pixels equal to the vessel's instance id, ``area`` that mask's pixel count, ``iscrowd`` 0, and the extra
-fields ``truncation``, ``occlusion`` (fractions), ``role``, ``mmusv_id`` (vessel id), ``instance_id`` and
-``visible_pixels``.
+pixels (origin at the image's top-left corner, pixel ``(i, j)`` over ``[i, i + 1) × [j, j + 1)``), with
+``box="visible"`` (the default, COCO's convention) the tight box of the vessel's segmentation, what pycocotools'
+``toBbox`` gives for it, and with ``box="projected"`` the recording's box (the vessel's projected 3D box clipped to
+the image: it reaches down to the keel below the waterline and over what hides the vessel); ``category_id`` the
+vessel's semantic class, ``segmentation`` the run-length encoding (pycocotools, ``counts`` as a string) of the
+instance image's pixels equal to the vessel's instance id, ``area`` that mask's pixel count, ``iscrowd`` 0, and the
+extra fields ``truncation``, ``occlusion`` (fractions, as recorded: of the projected box), ``role``, ``mmusv_id``
+(vessel id), ``instance_id`` and ``visible_pixels``.
 """
 
 from __future__ import annotations
@@ -24,7 +28,7 @@ import numpy as np
 
 from mmusv.errors import ConfigError
 from mmusv.export.camera import CATEGORIES, CameraWriter, Sample, Shared, category_names
-from mmusv.export.common import Options, Sink, png_bytes
+from mmusv.export.common import BOX_DEFINITIONS, Options, Sink, png_bytes
 from mmusv.export.splits import SPLIT_NAMES
 from mmusv.jsonio import dump_json
 from mmusv.recording.info import RecordingInfo
@@ -38,8 +42,9 @@ def annotations_file(split: str) -> str:
 
 
 class _CocoShared(Shared):
-    def __init__(self, out: Path) -> None:
+    def __init__(self, out: Path, box: str) -> None:
         super().__init__(out=out)
+        self.box = box
         self.images: dict[str, list[dict[str, Any]]] = {}
         self.annotations: dict[str, list[dict[str, Any]]] = {}
 
@@ -61,19 +66,17 @@ class CocoWriter(CameraWriter):
 
     @classmethod
     def start(cls, out: Path, options: Options, sink: Sink) -> Any:
-        return _CocoShared(out)
+        return _CocoShared(out, options.box)
 
     def write_sample(self, sample: Sample) -> None:
         from pycocotools import mask as mask_util
-
-        from mmusv.recording import decode_image
 
         st: _CocoShared = self.shared
         images = st.images.setdefault(sample.split, [])
         anns = st.annotations.setdefault(sample.split, [])
         name = f"{sample.key}.png"
         self.put(self.file("images", sample.split, name), png_bytes(sample.message("rgb")))
-        inst = np.asarray(decode_image(sample.message("instance")))
+        inst = sample.instance
         h, w = inst.shape
         image_id = len(images) + 1
         images.append(
@@ -119,7 +122,12 @@ class CocoWriter(CameraWriter):
             if split not in st.images:
                 continue
             doc = {
-                "info": {"description": f"mmusv recordings, split {split}", "version": "1.0"},
+                "info": {
+                    "description": f"mmusv recordings, split {split}",
+                    "version": "1.0",
+                    "mmusv_box": st.box,
+                    "mmusv_box_definition": BOX_DEFINITIONS[st.box],
+                },
                 "licenses": [],
                 "images": st.images[split],
                 "annotations": st.annotations.get(split, []),

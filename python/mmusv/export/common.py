@@ -16,6 +16,8 @@ from mmusv import arguments
 from mmusv.errors import ConfigError
 
 __all__ = [
+    "BOXES",
+    "BOX_DEFINITIONS",
     "CAV_ID_BASE",
     "DEFAULT_EXTRAS",
     "DEPTH_UNIT_M",
@@ -26,6 +28,7 @@ __all__ = [
     "cav_id",
     "depth_png",
     "dump_yaml",
+    "parse_box",
     "parse_extras",
     "png_bytes",
     "rounded",
@@ -37,6 +40,16 @@ DEFAULT_EXTRAS = ("depth", "semantic", "radar", "top_view")
 CAV_ID_BASE = 1000
 DEPTH_UNIT_M = 0.01
 """Depth PNGs are uint16 centimetres along the optical axis: 0 = no hit (sky), 65535 = 655.35 m or farther."""
+BOXES = ("visible", "projected")
+"""The 2D boxes the COCO and YOLO exports can write (``--box``; the first is the default)."""
+BOX_DEFINITIONS = {
+    "visible": "the tight box of the vessel's visible pixels: the instance image's pixels equal to its instance id "
+    "(pixel edges: [x_min, y_min, x_max + 1, y_max + 1] of those pixels; COCO: pycocotools' toBbox of its "
+    "segmentation)",
+    "projected": "the recording's 2D box: the vessel's projected 3D box clipped to the image (amodal: it reaches down "
+    "to the keel below the waterline and covers parts hidden by other objects)",
+}
+"""What each of :data:`BOXES` is, as the COCO ``info`` and the YOLO ``data.yaml`` say it."""
 
 
 def cav_id(index: int) -> int:
@@ -61,6 +74,16 @@ def parse_extras(extras: Iterable[str] | str | None) -> tuple[str, ...]:
     return tuple(e for e in EXTRAS if e in items)
 
 
+def parse_box(box: Any) -> str:
+    """A validated ``box`` option (one of :data:`BOXES`); :class:`~mmusv.errors.ConfigError` in one line otherwise."""
+    if isinstance(box, str) and box in BOXES:
+        return box
+    raise ConfigError(
+        f"box = {arguments.shown(box)}: must be 'visible' (the tight box of the vessel's visible pixels, the default) "
+        "or 'projected' (the recording's box: the vessel's projected 3D box clipped to the image)"
+    )
+
+
 @dataclass(frozen=True)
 class Options:
     """Conversion options (see :func:`mmusv.export.convert`)."""
@@ -73,6 +96,9 @@ class Options:
     """COCO/YOLO: 2D boxes whose shorter side is under this many pixels are left out."""
     max_occlusion: float = 1.0
     """COCO/YOLO: 2D boxes whose occlusion (fraction hidden, 0..1) is above this are left out."""
+    box: str = "visible"
+    """COCO/YOLO: the 2D box written (one of :data:`BOXES`): ``visible``, the tight box of the vessel's pixels in the
+    instance image; ``projected``, the recording's box (the projected 3D box clipped to the image)."""
     agents: tuple[str, ...] | None = None
     """The agents (USV ids) to convert; ``None``: every agent the format uses."""
     frames: tuple[int, int | None] | None = None

@@ -30,7 +30,7 @@ import yaml
 
 from mmusv import arguments
 from mmusv.errors import ConfigError, IoError
-from mmusv.export.common import DEFAULT_EXTRAS, TARGETS, Options, Sink, dump_yaml, parse_extras
+from mmusv.export.common import DEFAULT_EXTRAS, TARGETS, Options, Sink, dump_yaml, parse_box, parse_extras
 from mmusv.export.splits import DEFAULT_RATIOS, SPLIT_NAMES, assign_splits, parse_ratios
 from mmusv.export.writer import DatasetWriter
 from mmusv.recording.guard import FolderLock
@@ -402,6 +402,7 @@ def convert(
     extras: Iterable[str] | str | None = DEFAULT_EXTRAS,
     min_box_px: float = 0.0,
     max_occlusion: float = 1.0,
+    box: str = "visible",
     overwrite: bool = False,
     agents: Iterable[str] | str | None = None,
     frames: Sequence[int | None] | str | None = None,
@@ -427,6 +428,11 @@ def convert(
             files stock loaders skip).
         min_box_px: COCO and YOLO: leave out 2D boxes whose shorter side is under this many pixels.
         max_occlusion: COCO and YOLO: leave out 2D boxes hidden by more than this fraction (0..1).
+        box: COCO and YOLO: the 2D box written, ``"visible"`` (the default: the tight box of the vessel's pixels in
+            the instance image, COCO's convention for ``bbox``; YOLO then needs cameras recording instance images)
+            or ``"projected"`` (the recording's box: the vessel's projected 3D box clipped to the image, reaching
+            down to the keel and over what hides it). ``min_box_px`` applies to the box written. Other formats
+            keep their boxes (KITTI and ROS 2: the recorded box).
         overwrite: replace a previous conversion in ``out_dir`` (``include_usvs`` and ``overwrite`` are ``bool``).
         agents: the agents (USV ids, a list or ``"usv_1,usv_2"``) to convert; every recording must hold one of
             them. ``None``: all.
@@ -451,6 +457,7 @@ def convert(
             raise ConfigError(f"split {splits!r}: --to {to} writes one folder per recording and is never split")
         ratios = None
     box_px, max_occ = _box_filter(min_box_px, max_occlusion)
+    box = parse_box(box)
     options = Options(
         to=to,
         eval_range_m=rng,
@@ -458,9 +465,11 @@ def convert(
         extras=parse_extras(extras),
         min_box_px=box_px,
         max_occlusion=max_occ,
+        box=box,
         agents=_agent_selection(agents),
         frames=_frame_selection(frames),
     )
+    cls = cls.for_options(options)
     paths = _as_list(recordings)
     infos = [read_info(p) for p in paths]  # validates every input before anything is written
     for i in infos:
@@ -484,7 +493,7 @@ def convert(
                 "eval_range_m": rng,
                 "include_usvs": options.include_usvs,
                 "extras": list(options.extras),
-                **({"min_box_px": box_px, "max_occlusion": max_occ} if to in ("coco", "yolo") else {}),
+                **({"min_box_px": box_px, "max_occlusion": max_occ, "box": box} if to in ("coco", "yolo") else {}),
                 "splits": None
                 if ratios is None
                 else dict(zip(SPLIT_NAMES, [round(r, 9) for r in ratios], strict=True)),

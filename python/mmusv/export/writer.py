@@ -22,9 +22,10 @@ class DatasetWriter:
     """Base of every format's writer: one instance per recording.
 
     :func:`mmusv.export.convert` reads, validates, splits and selects the frames of every recording, reports
-    progress, and calls, in this order: :meth:`check` (every recording, before anything is written), :meth:`start`
-    (once: state shared by the recordings of one conversion), the constructor, :meth:`write_frame` per complete
-    frame, :meth:`finish` per recording and :meth:`finish_all` (once). Subclasses set :attr:`cameras` (our camera
+    progress, and calls, in this order: :meth:`for_options` (the class to use), :meth:`check` (every recording,
+    before anything is written), :meth:`start` (once: state shared by the recordings of one conversion), the
+    constructor, :meth:`write_frame` per complete frame, :meth:`finish` per recording and :meth:`finish_all`
+    (once). Subclasses set :attr:`cameras` (our camera
     name → the dataset's index) and implement :meth:`write_agent` (or :meth:`write_frame`) and :meth:`finish`.
 
     By default an agent without a LiDAR is left out (with a note), as OPV2V and KITTI need one; a format that
@@ -79,6 +80,13 @@ class DatasetWriter:
         :attr:`no_agent_reason`)."""
         if cls.needs_agent and not any(cls.uses_agent(a) is None for a in info.agents):
             raise ConfigError(f"{info.path}: cannot convert to {cls.format_name()}: {cls.no_agent_reason}")
+
+    @classmethod
+    def for_options(cls, options: Options) -> type[DatasetWriter]:
+        """The writer class that converts with ``options`` (called by :func:`mmusv.export.convert` before
+        :meth:`check`): this class, unless the options change what the format needs from a recording (YOLO's
+        ``box="visible"`` needs instance images)."""
+        return cls
 
     @classmethod
     def format_name(cls) -> str:

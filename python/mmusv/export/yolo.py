@@ -4,9 +4,16 @@
 ``labels/<split>/<same path>.txt`` (one line per kept 2D box: ``class x_centre y_centre width height``, the box
 normalised by the image width and height, 6 decimals; an empty file for an image without boxes) and ``data.yaml``
 (``train``/``val``/``test``: the image folders of the splits that hold images, relative to the file's folder,
-which Ultralytics takes as the dataset root when ``path`` is absent; ``names``: class index → name). Splits are
-made by recording (:mod:`mmusv.export.splits`); without a split, ``images/all`` is both ``train`` and ``val``, and
-``val`` is the ``train`` folder when no recording went to ``validate`` (Ultralytics requires both keys).
+which Ultralytics takes as the dataset root when ``path`` is absent; ``names``: class index → name;
+``mmusv_box`` and ``mmusv_box_definition``: the option ``box`` the boxes were written with and what it means, keys
+Ultralytics does not read). Splits are made by recording (:mod:`mmusv.export.splits`); without a split,
+``images/all`` is both ``train`` and ``val``, and ``val`` is the ``train`` folder when no recording went to
+``validate`` (Ultralytics requires both keys).
+
+The box (option ``box``, :meth:`mmusv.export.camera.CameraWriter.boxes_of`, the COCO export's boxes and filters):
+``visible`` (the default) the tight box of the vessel's pixels in the camera's instance image, so only cameras that
+record ``rgb`` and ``instance`` images are converted (:class:`YoloVisibleWriter`); ``projected`` the recording's
+box (the vessel's projected 3D box clipped to the image, reaching down to the keel), from ``rgb`` cameras alone.
 
 Ultralytics finds an image's label file by replacing the *last* ``images`` folder of the image's path with
 ``labels``, so a scenario, agent or camera named ``images`` would send it to a label file that does not exist
@@ -14,8 +21,7 @@ Ultralytics finds an image's label file by replacing the *last* ``images`` folde
 with one more ``_`` (``images`` → ``images_``), which keeps distinct names distinct.
 
 Class index = the position of the vessel's semantic class in :data:`mmusv.export.camera.CATEGORIES` (every mmusv
-class but ``none``, by id), so ``names`` lists the classes in id order. Boxes are those of
-:meth:`mmusv.export.camera.CameraWriter.boxes_of` (the COCO export's).
+class but ``none``, by id), so ``names`` lists the classes in id order.
 """
 
 from __future__ import annotations
@@ -25,10 +31,10 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from mmusv.export.camera import CATEGORIES, CameraWriter, Sample, Shared, category_names
-from mmusv.export.common import Options, Sink, dump_yaml, png_bytes
+from mmusv.export.common import BOX_DEFINITIONS, Options, Sink, dump_yaml, png_bytes
 from mmusv.export.splits import SPLIT_NAMES
 
-__all__ = ["YoloWriter", "yolo_class", "yolo_key"]
+__all__ = ["YoloVisibleWriter", "YoloWriter", "yolo_class", "yolo_key"]
 
 _YOLO_SPLIT = {"train": "train", "validate": "val", "test": "test"}
 _IMAGES_FOLDER = re.compile(r"images_*")
@@ -46,21 +52,31 @@ def yolo_key(key: str) -> str:
 
 
 class _YoloShared(Shared):
-    def __init__(self, out: Path) -> None:
+    def __init__(self, out: Path, box: str) -> None:
         super().__init__(out=out)
+        self.box = box
         self.splits: set[str] = set()
 
 
 class YoloWriter(CameraWriter):
-    """Writes the Ultralytics layout (see the module docstring)."""
+    """Writes the Ultralytics layout (see the module docstring); this class with ``box="projected"``, which needs
+    only RGB images, :class:`YoloVisibleWriter` with ``box="visible"``."""
 
     kinds: ClassVar[tuple[str, ...]] = ("rgb",)
     boxes: ClassVar[bool] = True
     no_agent_reason: ClassVar[str] = "no camera recording rgb images"
 
     @classmethod
+    def for_options(cls, options: Options) -> type[YoloWriter]:
+        return YoloVisibleWriter if options.box == "visible" else YoloWriter
+
+    @classmethod
+    def format_name(cls) -> str:
+        return "yolo"
+
+    @classmethod
     def start(cls, out: Path, options: Options, sink: Sink) -> Any:
-        return _YoloShared(out)
+        return _YoloShared(out, options.box)
 
     def write_sample(self, sample: Sample) -> None:
         self.shared.splits.add(sample.split)
@@ -87,4 +103,18 @@ class YoloWriter(CameraWriter):
         doc.setdefault("val", doc["train"])  # Ultralytics requires both keys
         names = category_names()
         doc["names"] = {i: names[c] for i, c in enumerate(CATEGORIES)}
+        doc["mmusv_box"] = st.box
+        doc["mmusv_box_definition"] = BOX_DEFINITIONS[st.box]
         sink.write(out / "data.yaml", dump_yaml(doc))
+
+
+class YoloVisibleWriter(YoloWriter):
+    """:class:`YoloWriter` with ``box="visible"``: the boxes come from the instance images, so a camera must record
+    them too."""
+
+    kinds: ClassVar[tuple[str, ...]] = ("rgb", "instance")
+    no_agent_reason: ClassVar[str] = (
+        "no camera recording rgb and instance images (--box visible, the default, takes each box from the instance "
+        "image; --box projected writes the recorded boxes from rgb images alone)"
+    )
+    left_out_why: ClassVar[str] = " (--box visible takes the boxes from the instance images; --box projected does not)"
