@@ -30,10 +30,10 @@ lint: ## rustfmt + clippy + ruff + mypy + stubtest (as CI runs them)
 	python3 -m mypy
 	python3 -m mypy.stubtest mmusv._core
 
-bench: ## criterion ray-casting benchmarks (rays/s)
+bench: ## criterion benchmarks: ray casting, sensors, radar, sea camera (rays/s; minutes: see README, Speed)
 	cargo bench -p mmusv-benches
 
-bench-peers: ## mmusv vs Open3D/Embree on the same scene and rays
+bench-peers: ## mmusv vs Open3D/Embree: same scene, rays and threads, hits checked equal first (pip install '.[bench]')
 	python3 benches/compare_open3d.py
 
 profile: ## where the main job's time goes, per stage per frame (50 frames of scenarios/port_entry.yaml)

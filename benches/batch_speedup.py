@@ -29,12 +29,12 @@ import hashlib
 import logging
 import os
 import shutil
-import sys
 import tempfile
 import time
 from pathlib import Path
 from typing import Any
 
+import bench_env
 import yaml
 from mmusv.batch import run_many
 from mmusv.batch.executors import available_cpus
@@ -92,16 +92,33 @@ def _ray_round_trip(ray: Any, cpus: int, calls: int = 20) -> tuple[float, float]
 
 
 def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--scenarios", type=int, default=6)
-    ap.add_argument("--frames", type=int, default=40)
-    ap.add_argument("--cpus", type=int, default=available_cpus(), help="CPUs to use (default: all)")
-    ap.add_argument("--repeat", type=int, default=2, help="rounds over every mode; the fastest round counts")
+    ap = argparse.ArgumentParser(description=bench_env.description(__doc__))
+    ap.add_argument("--scenarios", type=bench_env.positive_int, default=6, help="scenarios in the folder (6)")
+    ap.add_argument("--frames", type=bench_env.positive_int, default=40, help="frames per scenario (40)")
+    ap.add_argument("--cpus", type=bench_env.positive_int, default=available_cpus(), help="CPUs to use (default: all)")
+    ap.add_argument(
+        "--repeat", type=bench_env.positive_int, default=2, help="rounds over every mode; the fastest round counts"
+    )
     ap.add_argument("--rig", choices=sorted(RIGS), default="lidar", help="sensor rig of the USVs (default lidar)")
-    ap.add_argument("--skip-ray", action="store_true")
+    ap.add_argument("--skip-ray", action="store_true", help="leave Ray out (it needs pip install '.[ray]')")
     args = ap.parse_args()
-    n, s = args.cpus, args.scenarios
+    # before any work: without Ray the run ended in a traceback after writing and warming up
+    ray = (
+        None
+        if args.skip_ray
+        else bench_env.require("ray", "pip install '.[ray]'  (or pass --skip-ray)", "the Ray modes")
+    )
+    print(bench_env.machine())
     work = Path(tempfile.mkdtemp(prefix="mmusv_batch_bench_"))
+    try:  # the folder goes whatever ends the run (it stayed behind a failure, each time one more)
+        return measure(args, ray, work)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+
+def measure(args: argparse.Namespace, ray: Any, work: Path) -> int:
+    """Writes the scenarios into ``work``, records them in every mode and prints the table."""
+    n, s = args.cpus, args.scenarios
     src = work / "src"
     src.mkdir()
     for i in range(s):
@@ -119,9 +136,7 @@ def main() -> int:
         (f"pool, {n} processes x 1 thread", {"jobs": n, "cpus_per_task": 1}),
     ]
     ray_init = float("nan")
-    if not args.skip_ray:
-        import ray
-
+    if ray is not None:
         t0 = time.perf_counter()
         ray.init(num_cpus=n, include_dashboard=False, log_to_driver=False, logging_level=logging.WARNING)
         ray_init = time.perf_counter() - t0
@@ -179,9 +194,8 @@ def main() -> int:
     print(f"  pool: {(best[modes[1][0]][0] - serial) / s:+.2f} s")
     if not args.skip_ray:
         print(f"  ray:  {(best[modes[3][0]][0] - serial) / s:+.2f} s   (plus ray.init {ray_init:.2f} s once)")
-    shutil.rmtree(work)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    bench_env.run(main)

@@ -14,7 +14,7 @@ pub const RADAR_HEIGHT: f32 = 3.0;
 /// Rays as parallel origin / direction arrays.
 pub type Rays = (Vec<[f32; 3]>, Vec<[f32; 3]>);
 
-/// The benchmark scene (defaults of [`DemoParams`]: ≈0.75 M triangles, 48 vessel instances).
+/// The benchmark scene (defaults of [`DemoParams`]: 775,170 triangles, 48 vessel instances).
 pub fn scene() -> Result<DemoScene> {
     maritime_demo(DemoParams::default())
 }

@@ -20,6 +20,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+import bench_env
 import yaml
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -63,10 +64,14 @@ def child(kind: str, frames: int, out: str) -> None:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--lidar-frames", type=int, default=10_000)
-    ap.add_argument("--full-frames", type=int, default=1_000)
-    ap.add_argument("--only", choices=("lidar", "full"), default=None)
+    ap = argparse.ArgumentParser(description=bench_env.description(__doc__))
+    ap.add_argument(
+        "--lidar-frames", type=bench_env.positive_int, default=10_000, help="frames of the LiDAR-only run (10000)"
+    )
+    ap.add_argument(
+        "--full-frames", type=bench_env.positive_int, default=1_000, help="frames of the full-suite run (1000)"
+    )
+    ap.add_argument("--only", choices=("lidar", "full"), default=None, help="run only one of the two")
     ap.add_argument("-o", "--output", default=None, help="output folder (default: a temporary one, removed)")
     ap.add_argument("--child", nargs=3, metavar=("KIND", "FRAMES", "OUT"), help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -74,6 +79,7 @@ def main() -> None:
         child(args.child[0], int(args.child[1]), args.child[2])
         return
     runs = [("lidar", args.lidar_frames), ("full", args.full_frames)]
+    print(bench_env.machine())
     with tempfile.TemporaryDirectory() as tmp:
         base = Path(args.output or tmp)
         for kind, frames in runs:
@@ -117,4 +123,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    bench_env.run(main)

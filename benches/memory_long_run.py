@@ -15,6 +15,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+import bench_env
 import yaml
 from mmusv.acquire import run
 
@@ -48,11 +49,12 @@ def rss_mb() -> float:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--frames", type=int, default=1000)
-    ap.add_argument("--every", type=int, default=100)
+    ap = argparse.ArgumentParser(description=bench_env.description(__doc__))
+    ap.add_argument("--frames", type=bench_env.positive_int, default=1000, help="frames to run (1000)")
+    ap.add_argument("--every", type=bench_env.positive_int, default=100, help="print a row every N frames (100)")
     ap.add_argument("-o", "--output", default=None, help="output folder (default: a temporary one, removed)")
     args = ap.parse_args()
+    print(bench_env.machine())
     t0 = time.perf_counter()
     print(f"{'frame':>6} {'RSS MB':>8} {'peak MB':>8} {'s':>7}")
 
@@ -67,4 +69,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    bench_env.run(main)

@@ -9,22 +9,24 @@ Usage: ``python benches/profile_run.py [SCENARIO] [--frames N] [-o OUT]`` (defau
 from __future__ import annotations
 
 import argparse
-import os
 import tempfile
 from pathlib import Path
 
+import bench_env
 from mmusv.acquire import run
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("scenario", nargs="?", default=str(ROOT / "scenarios/port_entry.yaml"))
-    ap.add_argument("--frames", type=int, default=None, help="only the first N frames")
+    ap = argparse.ArgumentParser(description=bench_env.description(__doc__))
+    ap.add_argument(
+        "scenario", nargs="?", default=str(ROOT / "scenarios/port_entry.yaml"), help="scenario file (port_entry)"
+    )
+    ap.add_argument("--frames", type=bench_env.positive_int, default=None, help="only the first N frames")
     ap.add_argument("-o", "--output", default=None, help="output folder (default: a temporary one, removed)")
     args = ap.parse_args()
-    print(f"load average before: {' '.join(f'{x:.2f}' for x in os.getloadavg())}, {os.cpu_count()} cores")
+    print(bench_env.machine())
     with tempfile.TemporaryDirectory() as tmp:
         res = run(args.scenario, out_dir=args.output or tmp, overwrite=True, frames=args.frames, profile=True)
         assert res.profile is not None
@@ -33,4 +35,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    bench_env.run(main)

@@ -1,5 +1,9 @@
 //! `cargo bench --bench radar`: marine radar sweep throughput (rays/s, returns per sweep) on the synthetic
 //! maritime scene, calm and with 3.5 m waves (W3 sea clutter), and PPI rasterisation (returns/s).
+//!
+//! The sampling settings are the group's defaults (`config` below), so criterion's command line
+//! (`-- --measurement-time 2 --warm-up-time 1 --sample-size 10`) overrides them; set on the group in code,
+//! they silently won over it.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use mmusv_core::sensors::ppi::{ppi_image, PpiConfig};
@@ -17,7 +21,6 @@ fn bench_radar(c: &mut Criterion) {
     // The configuration of the core's tests (as before; the user defaults live in the scenario schema).
     let cfg = RadarConfig::tuning();
     let mut g = c.benchmark_group("radar");
-    g.sample_size(10).measurement_time(Duration::from_secs(6)).warm_up_time(Duration::from_secs(1));
     for (name, waves) in [("sweep_calm", 0.0f32), ("sweep_w3", 3.5)] {
         let env = RadarEnv { wave_height_m: waves, rain_mm_per_h: 0.0 };
         let n = radar_sweep(&demo.scene, &pose, &cfg, &env, 1).map(|r| r.len()).unwrap_or(0);
@@ -34,5 +37,12 @@ fn bench_radar(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench_radar);
+criterion_group! {
+    name = benches;
+    config = Criterion::default()
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(6))
+        .warm_up_time(Duration::from_secs(1));
+    targets = bench_radar
+}
 criterion_main!(benches);

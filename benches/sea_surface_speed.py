@@ -20,6 +20,7 @@ import statistics
 import time
 from pathlib import Path
 
+import bench_env
 from mmusv.acquire import annotations_for
 from mmusv.annotate import SilhouetteCache
 from mmusv.simulation import Simulation
@@ -29,20 +30,24 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("scenario", nargs="?", default=str(ROOT / "scenarios/port_entry.yaml"))
+    ap = argparse.ArgumentParser(description=bench_env.description(__doc__))
+    ap.add_argument(
+        "scenario", nargs="?", default=str(ROOT / "scenarios/port_entry.yaml"), help="scenario file (port_entry)"
+    )
     ap.add_argument("--preset", default=None, help="sea preset (W0..W3, WMO 0..9); default: the scenario's sea")
     ap.add_argument("--lidar-only", action="store_true", help="capture the LiDARs only")
-    ap.add_argument("--frames", type=int, default=4)
-    ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--frames", type=bench_env.positive_int, default=4, help="frames per round (4)")
+    ap.add_argument("--rounds", type=bench_env.positive_int, default=3, help="rounds, the median counts (3)")
     args = ap.parse_args()
     sim = Simulation(args.scenario)
     sea = sim.scenario.environment.sea_spec() if args.preset is None else sea_spec_for_preset(args.preset)
     sensors = ["lidar"] if args.lidar_only else None
     sil = SilhouetteCache()
-    sim.capture(0, sensors=sensors)  # warm up: lighting tables, silhouettes
+    for s in (None, sea):  # warm up both: lighting tables, silhouettes, the wave field of --preset
+        sim.set_sea_surface(s)
+        annotations_for(sim, sim.capture(0, sensors=sensors), sil)
     times: dict[str, list[float]] = {"flat": [], "waves": []}
-    print(f"load average before: {' '.join(f'{x:.2f}' for x in os.getloadavg())}, {os.cpu_count()} cores")
+    print(bench_env.machine())
     for _ in range(args.rounds):
         for name, s in (("flat", None), ("waves", sea)):
             sim.set_sea_surface(s)
@@ -63,4 +68,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    bench_env.run(main)

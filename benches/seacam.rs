@@ -3,6 +3,10 @@
 //! same hits: marched through the crest band ray by ray ([`Scene::cast_rays`]), and with the water hits first
 //! rasterised for the whole image ([`WaveSurface::first_hits`], [`Raster::resolve`], then
 //! [`Scene::cast_rays_over`]). Throughput per pixel.
+//!
+//! The sampling settings are the group's defaults (`config` below), so criterion's command line
+//! (`-- --measurement-time 2 --warm-up-time 1 --sample-size 10`) overrides them; set on the group in code,
+//! they silently won over it.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use mmusv_core::demo::surround_camera_rays;
@@ -59,12 +63,18 @@ fn bench_seacam(c: &mut Criterion) {
         scene.cast_rays_over(&o, &d, RANGE, Some(&known))
     };
     let mut g = c.benchmark_group("sea_camera_w1");
-    g.sample_size(10).measurement_time(Duration::from_secs(5)).warm_up_time(Duration::from_secs(1));
     g.throughput(Throughput::Elements(u64::from(w * h)));
     g.bench_function("marched", |b| b.iter(|| black_box(scene.cast_rays(&o, &d, RANGE))));
     g.bench_function("rasterised", |b| b.iter(|| black_box(rasterised(&waves))));
     g.finish();
 }
 
-criterion_group!(benches, bench_seacam);
+criterion_group! {
+    name = benches;
+    config = Criterion::default()
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(5))
+        .warm_up_time(Duration::from_secs(1));
+    targets = bench_seacam
+}
 criterion_main!(benches);

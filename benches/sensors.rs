@@ -1,7 +1,12 @@
 //! `cargo bench --bench sensors`: per-sensor throughput on the synthetic maritime scene (≈0.78 M triangles,
 //! 48 vessels) from an ego USV at the origin — the paper's LiDAR sweep (64 × 410 columns, 131,072 points/s at
 //! 5 Hz), one 640×480 camera with depth + semantic + instance, the same with RGB shading (shadow rays
-//! included), and a 512×512 top view. Throughput is reported per ray (= per pixel for cameras).
+//! included), and a 512×512 top view. Throughput is reported per ray (= per pixel for cameras), criterion's
+//! `elem/s`.
+//!
+//! The sampling settings are the group's defaults (`config` below), so criterion's command line
+//! (`-- --measurement-time 2 --warm-up-time 1 --sample-size 10`) overrides them; set on the group in code,
+//! they silently won over it.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use mmusv_core::sensors::camera::{Camera, CameraConfig, ImageOptions, Projection, Quality};
@@ -46,7 +51,6 @@ fn bench_sensors(c: &mut Criterion) {
     let env = ShadeEnv::default();
     let lenv = LidarEnv { wave_height_m: 1.5, ..LidarEnv::default() };
     let mut g = c.benchmark_group("sensors");
-    g.sample_size(10).measurement_time(Duration::from_secs(5)).warm_up_time(Duration::from_secs(1));
     g.throughput(Throughput::Elements(lidar.pattern().len() as u64));
     g.bench_function("lidar_sweep_64x410", |b| b.iter(|| black_box(lidar.scan(scene, &lidar_pose, &lenv, 1))));
     g.throughput(Throughput::Elements(640 * 480));
@@ -66,5 +70,12 @@ fn bench_sensors(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench_sensors);
+criterion_group! {
+    name = benches;
+    config = Criterion::default()
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(5))
+        .warm_up_time(Duration::from_secs(1));
+    targets = bench_sensors
+}
 criterion_main!(benches);

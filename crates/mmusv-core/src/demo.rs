@@ -2,7 +2,7 @@
 //!
 //! A seabed-and-islands heightfield (`terrain_cells²·2` triangles), a water plane at z = 0, and vessel
 //! instances of three tessellated hull meshes (≈5 m, ≈40 m, ≈180 m) scattered on the water around an ego
-//! USV at the origin. Deterministic from the seed. With the defaults the world holds about 0.75 M triangles.
+//! USV at the origin. Deterministic from the seed. With the defaults the world holds 775,170 triangles.
 
 use crate::error::{MmusvError, Result};
 use crate::geometry::RigidPose;
