@@ -25,13 +25,15 @@
 //! length everywhere, the mirror image is taken as smooth between the traced reflections, and the lobe is cut
 //! where the water ends in the image (at a hull's waterline: there the mean is over the water that remains).
 //!
-//! **The sky's part.** What is spread is only what a traced reflection brings back beyond the sky it would have
-//! met (`value − sky`: a ship's, a quay's, an island's reflection; zero where the reflection leaves for the sky);
-//! the sky's own mean over the lobe is read at each place from a table of the same microfacet model
-//! (`shade/sky_lobe.rs`, `lobe_sky`). The screen space cannot look past the image's edge, so a lens narrower
-//! than the lobe, or a view steeply down, would otherwise read the sky of the mirror direction instead of the
-//! lobe's mean (a 4° lens over 8 m/s wind: 0.80 of it in red); now only a reflected object beyond the edge is
-//! missed.
+//! **The sky's part.** The screen space cannot look past the image's edge: a lens narrower than the lobe, or a
+//! view steeply down, would read the sky of the mirror directions around the pixel instead of the lobe's mean (a
+//! 4° lens over 8 m/s wind: 0.80 of it in red). So the sky is spread too, alongside: each traced reflection also
+//! carries the sky along its ray (`sky`, what it brings back when it meets nothing), and each place reads the
+//! spread reflections scaled by the sky's own mean over the lobe (`lobe_sky`, from a table of the same microfacet
+//! model, `shade/sky_lobe.rs`) over the spread sky: `L = blur(value) · lobe_sky / blur(sky)`, per channel. Where
+//! the lobe meets only sky this is the table's mean exactly, whatever the lens; where it meets a ship it is the
+//! screen-space spread, scaled by how much the sky's part is off there; and it is never negative (a sum
+//! `lobe_sky + blur(value − sky)` went below zero where a dark hull hid a much brighter sky, at dusk).
 
 use crate::sensors::shade::rough_water;
 use parry3d::math::Vec3;
@@ -89,7 +91,7 @@ pub fn decimation(sigma_min_vertical: f32, spacing: usize) -> [usize; 2] {
     [(d / 2).max(spacing.max(1)), d.max(spacing.max(1))]
 }
 
-/// The blurred reflections of one image: the lobe-weighted means of what the reflections bring beyond the sky,
+/// The blurred reflections of one image: the lobe-weighted means of the reflections and of the sky along them,
 /// and the sky's lobe means, on a coarse grid of `dx × dy`-pixel cells, read back bilinearly ([`Blurred::at`]).
 #[derive(Debug, Clone)]
 pub struct Blurred {
@@ -103,17 +105,15 @@ pub struct Blurred {
     shift: f32,
     cw: usize,
     ch: usize,
-    /// Per cell, the mean over its lobe of the reflected radiance beyond the sky's; `None` where no water lies
-    /// within reach.
+    /// Per cell, the reflected radiance over its lobe, scaled by the sky's lobe mean over the spread sky there;
+    /// `None` where no water lies within reach or the cell holds no sample of its own.
     mean: Vec<Option<Vec3>>,
-    /// Per cell, the mean of its own samples' sky lobe means; `None` where it holds none.
-    sky: Vec<Option<Vec3>>,
 }
 
 impl Blurred {
     /// The blurred reflected radiance at image point `(u, v)` (pixels; a pixel's centre is `x + 0.5, y + 0.5`):
-    /// the sky's lobe mean plus the spread of what the reflections bring beyond it, bilinear between the four
-    /// nearest cells that hold both, else the point's own cell's; `None` when neither does.
+    /// the spread reflections scaled by the sky's lobe mean over the spread sky (see the module docs), bilinear
+    /// between the four nearest cells that hold it, else the point's own cell's; `None` when neither does.
     #[inline]
     pub fn at(&self, u: f32, v: f32) -> Option<Vec3> {
         let [u, v] = self.frame.grid_point(u, v);
@@ -122,10 +122,7 @@ impl Blurred {
         let (x0, y0) = (fx as usize, fy as usize);
         let (x1, y1) = ((x0 + 1).min(self.cw - 1), (y0 + 1).min(self.ch - 1));
         let (tx, ty) = (fx - x0 as f32, fy - y0 as f32);
-        let cell = |c: usize| match (self.mean[c], self.sky[c]) {
-            (Some(m), Some(s)) => Some(m + s),
-            _ => None,
-        };
+        let cell = |c: usize| self.mean[c];
         let mut acc = Vec3::ZERO;
         let mut wsum = 0.0;
         for (cx, cy, wt) in
@@ -190,6 +187,11 @@ impl Frame {
     }
 }
 
+/// Sums per cell: radiance (3), the sky along the same rays (3), samples (1).
+const SUMS: usize = 7;
+/// Where the sample count is among the [`SUMS`].
+const COUNT: usize = 6;
+
 /// Spreads the traced reflections `samples` of a `width × height` image (focal length `f_px` pixels per radian;
 /// traced every `spacing` pixels, or closer; the world's vertical turned by `roll` radians in the image, the
 /// camera's roll) over their lobes (see the module docs); `None` without samples.
@@ -204,22 +206,22 @@ pub fn blur(width: usize, height: usize, f_px: f32, spacing: usize, roll: f32, s
     let [ew, eh] = frame.bounds(width, height)[1];
     let (cw, ch) = ((ew.ceil() as usize).div_ceil(dx).max(1), (eh.ceil() as usize).div_ceil(dy).max(1));
     // The coarse grid: sums of radiance and of samples; of the grazing sine and the roughness.
-    let mut sum = vec![[0f32; 4]; cw * ch];
+    // The coarse grid: sums of radiance, of the sky along the same rays and of samples; of the grazing sine and the
+    // roughness; of the sky's lobe means.
+    let mut sum = vec![[0f32; SUMS]; cw * ch];
     let mut geo = vec![[0f32; 2]; cw * ch];
-    let mut sky = vec![Vec3::ZERO; cw * ch];
+    let mut lobe_sky = vec![Vec3::ZERO; cw * ch];
     for s in samples {
         let [gx, gy] = frame.grid_point(s.x as f32 + 0.5, s.y as f32 + 0.5);
         let (x, y) = ((gx.max(0.0) as usize).min(cw * dx - 1), (gy.max(0.0) as usize).min(ch * dy - 1));
         let c = (y / dy) * cw + x / dx;
-        let beyond = s.value - s.sky;
         let acc = &mut sum[c];
-        acc[0] += beyond.x;
-        acc[1] += beyond.y;
-        acc[2] += beyond.z;
-        acc[3] += 1.0;
-        sky[c] += s.lobe_sky;
+        for (k, v) in [s.value.x, s.value.y, s.value.z, s.sky.x, s.sky.y, s.sky.z, 1.0].into_iter().enumerate() {
+            acc[k] += v;
+        }
         geo[c][0] += s.sin_grazing;
         geo[c][1] += s.mss;
+        lobe_sky[c] += s.lobe_sky;
     }
     // Per cell, its lobe (in cells): the half-widths of each box of the tent (a box of width 2r has variance
     // r²/3; two of σ/√2 make σ), and each vertical box's shift (half the lobe's).
@@ -227,40 +229,56 @@ pub fn blur(width: usize, height: usize, f_px: f32, spacing: usize, roll: f32, s
         .iter()
         .zip(&geo)
         .map(|(s, g)| {
-            if s[3] <= 0.0 {
+            if s[COUNT] <= 0.0 {
                 return [0.0; 3];
             }
-            let [lx, ly, off] = lobe_px(g[1] / s[3], g[0] / s[3], f_px);
+            let [lx, ly, off] = lobe_px(g[1] / s[COUNT], g[0] / s[COUNT], f_px);
             let k = 1.5f32.sqrt();
             [lx / dx as f32 * k, ly / dy as f32 * k, 0.5 * off / dy as f32]
         })
         .collect();
-    let sky = sum.iter().zip(sky).map(|(s, l)| (s[3] > 0.0).then(|| l / s[3])).collect();
+    // The sky's lobe mean of each cell's own samples (not spread: it is the lobe's already).
+    let own: Vec<Option<Vec3>> =
+        sum.iter().zip(lobe_sky).map(|(s, l)| (s[COUNT] > 0.0).then(|| l / s[COUNT])).collect();
     let mut cur = sum;
     for axis in [1usize, 1, 0, 0] {
         cur = box_pass(&cur, &radius, cw, ch, axis);
     }
-    let mean = cur.iter().map(|s| (s[3] > 1e-6).then(|| Vec3::new(s[0], s[1], s[2]) / s[3])).collect();
+    let mean = cur
+        .iter()
+        .zip(&own)
+        .map(|(s, own)| {
+            let lobe = (*own)?;
+            (s[COUNT] > 1e-6).then(|| {
+                let value = Vec3::new(s[0], s[1], s[2]) / s[COUNT];
+                let sky = Vec3::new(s[3], s[4], s[5]) / s[COUNT];
+                // Per channel: the spread reflections times the sky's lobe mean over the spread sky (1 where there
+                // is no sky to speak of: a black night sky).
+                let scale = |v: f32, l: f32, k: f32| if k > 1e-12 { v * (l / k) } else { v };
+                Vec3::new(scale(value.x, lobe.x, sky.x), scale(value.y, lobe.y, sky.y), scale(value.z, lobe.z, sky.z))
+            })
+        })
+        .collect();
     // (Turned, the traced corners no longer sit at a fixed place in their cells.)
     let shift = if frame.sin == 0.0 { 0.5 - 0.5 * spacing.max(1) as f32 } else { 0.0 };
-    Some(Blurred { frame, dx, dy, shift, cw, ch, mean, sky })
+    Some(Blurred { frame, dx, dy, shift, cw, ch, mean })
 }
 
 /// One box pass along `axis` (0: along rows, 1: along columns) over the `cw × ch` grid of sums: each cell takes
 /// the sum over the box of half-width `radius[c][axis]` cells centred on it (down the columns, `radius[c][2]`
 /// cells below it), fractional ends read linearly from prefix sums; at least a cell's width.
-fn box_pass(src: &[[f32; 4]], radius: &[[f32; 3]], cw: usize, ch: usize, axis: usize) -> Vec<[f32; 4]> {
+fn box_pass(src: &[[f32; SUMS]], radius: &[[f32; 3]], cw: usize, ch: usize, axis: usize) -> Vec<[f32; SUMS]> {
     let (lines, len) = if axis == 0 { (ch, cw) } else { (cw, ch) };
     let at = move |line: usize, k: usize| if axis == 0 { line * cw + k } else { k * cw + line };
-    let mut out = vec![[0f32; 4]; cw * ch];
-    let mut prefix = vec![[0f64; 4]; len + 1];
+    let mut out = vec![[0f32; SUMS]; cw * ch];
+    let mut prefix = vec![[0f64; SUMS]; len + 1];
     for line in 0..lines {
         for k in 0..len {
             let s = src[at(line, k)];
             prefix[k + 1] = std::array::from_fn(|c| prefix[k][c] + f64::from(s[c]));
         }
         // The sums of the cells over the continuous interval [0, x) (x ≥ 0: truncation is the floor).
-        let cum = |x: f32| -> [f64; 4] {
+        let cum = |x: f32| -> [f64; SUMS] {
             let x = x.clamp(0.0, len as f32);
             let i = (x as usize).min(len);
             if i == len {
@@ -423,25 +441,35 @@ mod tests {
             let want = lobe_sky(i / w);
             assert!((*c - want).abs().max_element() < 2.0 * b.dy as f32 + 1e-3, "pixel {i}: {c:?}, want {want:?}");
         }
-        // A reflected hull (brighter than the sky by 1000 in a block) is spread around it, over the sky's means.
+        // A reflected hull (brighter than an even sky by 1000 in a block) is spread around it.
         let hull = |x: usize, y: usize| (12..20).contains(&x) && (8..14).contains(&y);
-        let with_hull: Vec<Sample> = s
-            .iter()
-            .map(|p| {
-                let (x, y) = (p.x as usize, p.y as usize);
-                if hull(x, y) {
-                    Sample { value: p.sky + Vec3::splat(1000.0), ..*p }
-                } else {
-                    *p
-                }
-            })
-            .collect();
-        let Some(bh) = blur(w, h, 3000.0, 1, 0.0, &with_hull) else { panic!("no blur") };
-        let (plain, lit) = (image(&b, w, h), image(&bh, w, h));
-        let extra: f32 = plain.iter().zip(&lit).map(|(a, c)| (*c - *a).x).sum::<f32>() / (w * h) as f32;
+        let even = Vec3::new(200.0, 300.0, 400.0);
+        let with_hull = |hull_value: Vec3| -> Vec<Sample> {
+            s.iter()
+                .map(|p| {
+                    let (x, y) = (p.x as usize, p.y as usize);
+                    let value = if hull(x, y) { hull_value } else { even };
+                    Sample { value, sky: even, lobe_sky: even, ..*p }
+                })
+                .collect()
+        };
+        let Some(bh) = blur(w, h, 3000.0, 1, 0.0, &with_hull(even + Vec3::splat(1000.0))) else { panic!("no blur") };
+        let extra: f32 = image(&bh, w, h).iter().map(|c| c.x - even.x).sum::<f32>() / (w * h) as f32;
         // The spread is a normalised mean over the whole image here (the lobe reaches past it every way): every
         // pixel gets the hull's share, 48 of 768 pixels' 1000.
         assert!((extra - 1000.0 * 48.0 / 768.0).abs() < 1.0, "{extra}");
+        // A black hull hiding a sky far brighter than the lobe's mean there (dusk: the afterglow low in the mirror,
+        // the lobe reaching up into darker sky): the reflection darkens but never goes below zero (the sum of the
+        // lobe's mean and the spread difference did, and showed black and pure blue water).
+        let dusk: Vec<Sample> = with_hull(Vec3::ZERO)
+            .into_iter()
+            .map(|p| Sample { sky: Vec3::new(5000.0, 3000.0, 900.0), lobe_sky: Vec3::new(500.0, 400.0, 300.0), ..p })
+            .map(|p| if hull(p.x as usize, p.y as usize) { p } else { Sample { value: p.sky, ..p } })
+            .collect();
+        let Some(bd) = blur(w, h, 3000.0, 1, 0.0, &dusk) else { panic!("no blur") };
+        for (i, c) in image(&bd, w, h).iter().enumerate() {
+            assert!(c.min_element() >= 0.0 && c.max_element() <= 500.0 + 1e-3, "pixel {i}: {c:?}");
+        }
     }
 
     #[test]
