@@ -7,6 +7,7 @@ issue #28 (4,000 triangles under 15 m, 15,000 for 15-80 m, 40,000 from 80 m).
 
 from __future__ import annotations
 
+import argparse
 import statistics
 import sys
 from collections import Counter
@@ -64,7 +65,10 @@ def table() -> str:
 
 
 def main(argv: list[str]) -> int:
-    out = Path(argv[1]) if len(argv) > 1 else Path(__file__).resolve().parent.parent / "docs" / "assets.md"
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    default = Path(__file__).resolve().parent.parent / "docs" / "assets.md"
+    ap.add_argument("out", nargs="?", type=Path, default=default, help="the Markdown file (default: docs/assets.md)")
+    out = ap.parse_args(argv[1:]).out
     text = table()
     tmp = out.with_name(out.name + ".part")
     tmp.write_text(text, encoding="utf-8")
