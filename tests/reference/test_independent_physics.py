@@ -103,8 +103,9 @@ DIELECTRIC_F0 = 0.04
 """Schlick F0 of a dielectric in the metallic workflow (Burley 2012)."""
 NRL_HH = (-73.0, 20.78, 7.351, 25.65, 0.0054)
 """Gregers-Hansen & Mital (2012), horizontal polarisation, 0.1°–60°: c1..c5."""
-DOUGLAS_UPPER = (0.0, 0.1, 0.5, 1.25, 2.5, 4.0, 6.0)
-"""Upper Hs bound of Douglas states 0..6 (the sea state the clutter model reads, interpolated between them)."""
+DOUGLAS_MIDDLE = (0.0, 0.05, 0.3, 0.875, 1.875, 3.25, 5.0)
+"""Hs at the middle of the WMO/Douglas bands of states 0..6 (0–0.1, 0.1–0.5, 0.5–1.25, 1.25–2.5, 2.5–4, 4–6 m),
+where a sea of that state is the NRL model's state (the clutter model interpolates between them)."""
 X_BAND_GHZ = 9.41
 """The marine radar's carrier mmusv states."""
 ACES_FIT = (2.51, 0.03, 2.43, 0.59, 0.14)
@@ -656,7 +657,8 @@ def test_radar_sea_clutter_is_the_nrl_model() -> None:
     μ·(−ln u) with u the cell's own seeded draw. The same sweep over the same water without the wave surface
     draws the same u with μ = σ⁰_1m H² A (R_ref/r)⁴ (the fixed model, its fall-off pushed past the range), so the
     ratio of the two is exactly σ⁰_NRL / (σ⁰_1m H²): against the NRL formula at the 4/3-earth grazing angle
-    sin ψ = h/r − r/(2 k R_e), and the sea state of Hs by the Douglas bands, within 1 % over 20–1200 m and four
+    sin ψ = h/r − r/(2 k R_e), and the sea state of Hs by the Douglas bands (each state at its band's middle),
+    within 1 % over 20–1200 m and four
     wave heights (measured 0.04 %: mmusv's c2 = 20.781 against the 20.78 quoted here, 0.003 dB). And the mean of
     the physical sweep over its 2 048 azimuths is that μ = σ⁰ A (R_ref/r)⁴ within 10 % (exponential draws: a 2.2 %
     standard error)."""
@@ -700,7 +702,7 @@ def test_radar_sea_clutter_is_the_nrl_model() -> None:
         assert np.array_equal(fixed["range"], phys["range"]) and np.array_equal(fixed["azimuth"], phys["azimuth"])
         r = phys["range"].astype(float)
         psi = np.clip(np.degrees(np.arcsin(height / r - r / (2 * earth))), 0.1, 60.0)
-        ss = np.interp(hs, DOUGLAS_UPPER, np.arange(len(DOUGLAS_UPPER)))
+        ss = np.interp(hs, DOUGLAS_MIDDLE, np.arange(len(DOUGLAS_MIDDLE)))
         sigma0 = phys["intensity"].astype(float) / fixed["intensity"].astype(float) * sigma_1m * hs**2
         np.testing.assert_allclose(sigma0, _nrl_sigma0(X_BAND_GHZ, ss, psi), rtol=0.01)
         if hs == 1.0:

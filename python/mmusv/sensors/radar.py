@@ -5,8 +5,9 @@ spread over its beamwidth and the elevation fan (all rays of a sweep go to the R
 are gathered per (azimuth bin, range bin) cell; a cell's intensity is the radar equation summed over its rays
 (reflectivity by class × |cos incidence| × the ray's footprint, over range⁴, two-way rain attenuation), so
 bigger and nearer targets are brighter. Hits on the sea (class WATER) are not targets: sea clutter is drawn
-per cell instead, stronger and reaching farther for higher waves; rain adds a little clutter. The full model
-is documented in the Rust module ``mmusv_core::sensors::radar_model``.
+per cell instead, stronger and reaching farther for higher waves, from the water the beam sees (none over land
+or in the shadow of an island, a quay or a ship); rain adds a little clutter. The full model is documented in
+the Rust module ``mmusv_core::sensors::radar_model``.
 
 Intensity unit: linear, relative to the echo of a 1 m² target at 1 km in clear air (``0.01`` = −20 dB).
 Frames: the sensor frame is x forward, y left, z up; azimuth 0 is forward, counter-clockwise, in ``[0, 2π)``.

@@ -6,23 +6,31 @@
 //! packets) and put back in pattern order.
 //!
 //! Per ray, in this order (each random draw is a pure function of `(seed, ray index)`, see [`noise`]):
-//! 1. the exact hit (distance `r`, normal `n`, class, instance) or a miss;
-//! 2. `r < range_min` or `r > range_max`: no return;
+//! 1. the exact hit (distance `r`, normal `n`, class, instance) or a miss; the cast reaches `range_max + 6σ`
+//!    (`σ = range_noise_std`), so that step 6 meets the ranges that noise brings inside `range_max` too;
+//! 2. no hit: no return;
 //! 3. open water (class 1): on a scene with a displaced wave surface ([`crate::Scene::wave_surface`]), a return
 //!    with the probability of the physical model in [`super::lidar_water`] (quasi-specular glints off the wave
 //!    facet met, at its incidence angle, whitecaps, and the foam of the wakes where the beam meets it — the
-//!    cameras' wake foam at that point — detected through speckle), with that model's intensity (the vessels'
-//!    Kelvin waves, the cameras' slopes, do not tilt the facet: `docs/sea/README.md`, *LiDAR returns from
-//!    wakes*, says what that cost);
+//!    cameras' wake foam at that point — detected through speckle), its intensity the speckle draw that passed
+//!    the detection threshold ([`super::lidar_water::speckle_intensity`]: never below the threshold; until
+//!    2026-12-01 a detected return carried the model's mean, below the threshold for one in seven water returns
+//!    at W1) (the vessels' Kelvin waves, the cameras' slopes, do not tilt the facet: `docs/sea/README.md`,
+//!    *LiDAR returns from wakes*, says what that cost);
 //!    on a flat sea, the empirical rule: a return only with probability
 //!    `p_w = water_probability + water_probability_per_wave_m · H` (clamped to 1) and only within
 //!    `water_range_m + water_range_per_wave_m · H` — calm water is a mirror at 905 nm, waves give the beam facets
 //!    to return from;
 //! 4. weather: two-way transmission `τ = exp(−2 (σ_fog + σ_rain) r)` with `σ_fog` the visibility extinction
 //!    (Koschmieder, 3 / V) and `σ_rain = 1e-5 · R^0.6` per metre (R in mm/h); the return is lost with
-//!    probability `1 − τ`;
+//!    probability `1 − τ` — but for the physical water returns of step 3, whose speckle threshold already met the
+//!    attenuated mean `τ ⟨I⟩` (until 2026-12-01 they were lost with probability `1 − τ` as well, the fog counted
+//!    twice: at 600 m visibility a fifth fewer water returns 20 m out than the model gives, a third 40 m out);
 //! 5. random dropout with probability `dropout`;
-//! 6. range noise: `r + N(0, range_noise_std)`; the point is `origin + r' · d` in the LiDAR frame.
+//! 6. range noise: `r' = r + N(0, range_noise_std)` (not below 0); a measured range `r' < range_min` or
+//!    `r' > range_max` gives no return (the sensor gates on what it measures: no point's range lies outside
+//!    `[range_min, range_max]`; until 2026-12-01 the gate took the exact `r` and noise put points beyond both
+//!    limits); the point is `origin + r' · d` in the LiDAR frame.
 //!
 //! Intensity in `[0, 1]`: `ρ(class) · |cos θ| · τ / (1 + (r / 100 m)²)`, θ the incidence angle, ρ a per-class
 //! reflectivity ([`reflectivity`]).
@@ -34,7 +42,7 @@ use super::shade::foam::{Foam, FOAM_SEED};
 use super::shade::wake::Wake;
 use crate::error::{MmusvError, Result};
 use crate::geometry::RigidPose;
-use crate::scene::Scene;
+use crate::scene::{Scene, NO_HIT};
 use parry3d::math::Vec3;
 
 /// Semantic class of open water (see `mmusv.classes`).
@@ -47,9 +55,9 @@ pub struct LidarConfig {
     pub elevations: Vec<f64>,
     /// Columns per revolution (points per second / (rotation rate · channels)).
     pub azimuth_steps: u32,
-    /// Returns closer than this are discarded (metres, ≥ 0).
+    /// Returns whose measured range (noise included) is closer than this are discarded (metres, ≥ 0).
     pub range_min: f32,
-    /// Returns farther than this are discarded (metres, > range_min).
+    /// Returns whose measured range (noise included) is farther than this are discarded (metres, > range_min).
     pub range_max: f32,
     /// Standard deviation of the Gaussian range noise (metres, ≥ 0).
     pub range_noise_std: f32,
@@ -188,7 +196,7 @@ pub struct LidarScan {
     /// Index of the ray in the full pattern (`column · channels + ring`).
     pub ray_index: Vec<u32>,
     /// Per ray of the full pattern (pattern order, every ray, returned or not): the scene instance its cast met
-    /// first within the range, or [`crate::scene::NO_HIT`]. What the annotations read to know which beams the
+    /// first within `range_max`, or [`crate::scene::NO_HIT`]. What the annotations read to know which beams the
     /// water stopped (a box's wave-occlusion share) without casting them again.
     pub beam_instance: Vec<i32>,
 }
@@ -277,7 +285,9 @@ impl Lidar {
             .iter()
             .map(|&i| sensor_to_world.transform_vector(Vec3::from_array(self.pattern[i as usize])).to_array())
             .collect();
-        let hits = scene.cast_rays(&origins, &dirs, cfg.range_max)?;
+        // Hits a little beyond `range_max` may be measured within it (step 6); `range_max` itself without noise.
+        let reach = cfg.range_max + 6.0 * cfg.range_noise_std;
+        let hits = scene.cast_rays(&origins, &dirs, reach)?;
         // Back to pattern order.
         let mut slot = vec![u32::MAX; self.pattern.len()];
         for (k, &i) in self.order.iter().enumerate() {
@@ -291,16 +301,15 @@ impl Lidar {
         // The wakes' foam (no whitecaps: those are the model's area mean), only over a wave surface.
         let wake_foam = Some(Foam::new(0.0, wakes, FOAM_SEED))
             .filter(|f| waves && !f.is_empty())
-            .map(|f| f.around([origin[0], origin[1]], cfg.range_max));
-        let mut out = LidarScan {
-            beam_instance: slot.iter().map(|&k| hits.instance[k as usize]).collect(),
-            ..LidarScan::default()
-        };
+            .map(|f| f.around([origin[0], origin[1]], reach));
+        let within = |k: usize| if hits.distance[k] <= cfg.range_max { hits.instance[k] } else { NO_HIT };
+        let mut out =
+            LidarScan { beam_instance: slot.iter().map(|&k| within(k as usize)).collect(), ..LidarScan::default() };
         for (i, &k) in slot.iter().enumerate() {
             let k = k as usize;
             let r = hits.distance[k];
             let class = hits.class[k];
-            if !r.is_finite() || r < cfg.range_min || r > cfg.range_max {
+            if !r.is_finite() || hits.instance[k] == NO_HIT {
                 continue;
             }
             let idx = i as u64;
@@ -316,15 +325,17 @@ impl Lidar {
                         f.cover(p.x, p.y, None)
                     });
                     let mean = lidar_water::mean_intensity_with_foam(cos, env.wind_speed_m_s, r, tau, foam);
-                    if noise::uniform(seed, stream::WATER, idx) >= f64::from(lidar_water::detection_probability(mean)) {
+                    let u = noise::uniform(seed, stream::WATER, idx);
+                    if u >= f64::from(lidar_water::detection_probability(mean)) {
                         continue;
                     }
-                    water_intensity = Some(mean.clamp(0.0, 1.0));
+                    water_intensity = Some(lidar_water::speckle_intensity(mean, u).clamp(0.0, 1.0));
                 } else if r > water_range || noise::uniform(seed, stream::WATER, idx) >= p_water {
                     continue;
                 }
             }
-            if sigma > 0.0 && noise::uniform(seed, stream::WEATHER, idx) >= tau as f64 {
+            // The physical water returns' detection already took the attenuated mean (step 3).
+            if sigma > 0.0 && water_intensity.is_none() && noise::uniform(seed, stream::WEATHER, idx) >= tau as f64 {
                 continue;
             }
             if cfg.dropout > 0.0 && noise::uniform(seed, stream::DROPOUT, idx) < cfg.dropout as f64 {
@@ -335,6 +346,9 @@ impl Lidar {
             } else {
                 r
             };
+            if measured < cfg.range_min || measured > cfg.range_max {
+                continue;
+            }
             let d = self.pattern[i];
             let intensity = water_intensity.unwrap_or_else(|| {
                 (reflectivity(class) * cos * tau / (1.0 + (r / 100.0) * (r / 100.0))).clamp(0.0, 1.0)
@@ -421,6 +435,102 @@ mod tests {
             f.len(),
             a.len()
         );
+    }
+
+    /// The range gates take the measured range: with 5 cm of noise and a wall 29.5 m off, no point lies beyond a
+    /// 30 m `range_max` or before a 30 m `range_min`, and the beams that meet the wall just beyond 30 m return
+    /// where their noise brings them inside, as often as those just inside fall out (the gate unbiased; near the
+    /// axis as many beams meet the wall per centimetre of range on either side of the gate). Until
+    /// 2026-12-01 the gates took the exact range, and noise put points beyond both.
+    #[test]
+    fn range_gates_take_the_measured_range() {
+        let c = LidarConfig { range_noise_std: 0.05, ..cfg(16, 3600) };
+        let s = wall_scene(29.5);
+        let scan = |c: LidarConfig| {
+            Lidar::new(c).and_then(|l| l.scan(&s, &RigidPose::IDENTITY, &LidarEnv::default(), 3)).unwrap_or_default()
+        };
+        let pattern = rays::lidar_directions(&c.elevations, c.azimuth_steps).unwrap_or_default();
+        let truth = |i: u32| 29.5 / pattern[i as usize][0];
+        let far = scan(LidarConfig { range_max: 30.0, ..c.clone() });
+        assert!(far.range.iter().all(|&r| r <= 30.0), "a point beyond range_max");
+        let near_gate = |lo: f32, hi: f32| (0..pattern.len() as u32).filter(|&i| (lo..hi).contains(&truth(i))).count();
+        // Beams whose wall lies within 5 cm beyond the gate: about a fifth (P(N > 1σ) ≈ 0.16 over 0..1σ) return.
+        let beyond = far.ray_index.iter().filter(|&&i| truth(i) > 30.0).count();
+        let kept = far.ray_index.iter().filter(|&&i| (29.95..30.0).contains(&truth(i))).count();
+        let inside_lost = near_gate(29.95, 30.0) - kept;
+        assert!(beyond > 20 && near_gate(30.0, 30.05) > 100, "{beyond} of {}", near_gate(30.0, 30.05));
+        eprintln!("gate at 30 m: {beyond} beams beyond it return, {inside_lost} inside it are lost");
+        let n = (beyond + inside_lost) as f64;
+        assert!((beyond as f64 - inside_lost as f64).abs() < 4.0 * n.sqrt(), "{beyond} in, {inside_lost} out");
+        let near = scan(LidarConfig { range_min: 30.0, ..c });
+        assert!(!near.is_empty() && near.range.iter().all(|&r| r >= 30.0), "a point before range_min");
+        // The annotations' beams stop at range_max as before.
+        let l = Lidar::new(LidarConfig { range_max: 30.0, ..cfg(16, 3600) });
+        let exact = l.and_then(|l| l.scan(&s, &RigidPose::IDENTITY, &LidarEnv::default(), 3)).unwrap_or_default();
+        assert_eq!(far.beam_instance, exact.beam_instance);
+    }
+
+    /// Over a displaced sea in fog, each beam meeting the water returns with the physical model's probability
+    /// `exp(−I_d / ⟨I⟩)` of the attenuated mean `⟨I⟩ ∝ τ`, worked out here beam by beam from the cast's own facet
+    /// normals: the counts per band of range agree within 4.5 standard deviations. Until 2026-12-01 the weather's
+    /// random loss `1 − τ` came on top, a second time.
+    #[test]
+    fn water_returns_in_fog_count_the_attenuation_once() {
+        use crate::ocean::{sea_seed, SeaSpec, WaveField};
+        use crate::sea::{SurfaceSpec, WaveSurface};
+        let mut s = Scene::new();
+        let h = 5000.0f32;
+        let sea =
+            Mesh::new("sea", &[[-h, -h, 0.0], [h, -h, 0.0], [h, h, 0.0], [-h, h, 0.0]], &[[0, 1, 2], [0, 2, 3]], &[1])
+                .unwrap_or_else(|e| unreachable!("{e}"));
+        let sea = s.add_mesh(sea);
+        let id = s.add_instance(sea, RigidPose::IDENTITY, None).unwrap_or_else(|e| unreachable!("{e}"));
+        s.set_sea(id, &[]).unwrap_or_else(|e| unreachable!("{e}"));
+        let spec = SeaSpec { hs: 1.5, tp: 6.1, gamma: 1.0, direction_rad: 0.4, spread_s: 10.0 };
+        let field = WaveField::new(&spec, sea_seed(2)).unwrap_or_else(|e| unreachable!("{e}"));
+        let w = WaveSurface::new(field.components(), 0.0, 0.0, &[[0.0, 0.0]], SurfaceSpec::default())
+            .unwrap_or_else(|e| unreachable!("{e}"));
+        s.set_wave_surface(Some(w)).unwrap_or_else(|e| unreachable!("{e}"));
+        let c = LidarConfig {
+            elevations: rays::uniform_elevations(32, (-25f64).to_radians(), (-2f64).to_radians()).unwrap_or_default(),
+            azimuth_steps: 1024,
+            range_noise_std: 0.0,
+            ..LidarConfig::default()
+        };
+        let lidar = Lidar::new(c.clone()).unwrap_or_else(|e| unreachable!("{e}"));
+        let pose = RigidPose::from_xyz_rpy([0.0, 0.0, 3.0], [0.0; 3]);
+        let env = LidarEnv {
+            fog_extinction_per_m: 3.0 / 600.0,
+            wave_height_m: 1.5,
+            wind_speed_m_s: 9.0,
+            ..LidarEnv::default()
+        };
+        let scan = lidar.scan(&s, &pose, &env, 4).unwrap_or_else(|e| unreachable!("{e}"));
+        let dirs: Vec<[f32; 3]> =
+            lidar.pattern().iter().map(|d| pose.transform_vector(Vec3::from_array(*d)).to_array()).collect();
+        let hits = s
+            .cast_rays(&vec![pose.translation.to_array(); dirs.len()], &dirs, c.range_max)
+            .unwrap_or_else(|e| unreachable!("{e}"));
+        for (lo, hi) in [(5.0f32, 12.0f32), (12.0, 25.0), (25.0, 60.0)] {
+            let (mut want, mut var) = (0.0f64, 0.0f64);
+            for (k, d) in dirs.iter().enumerate() {
+                let r = hits.distance[k];
+                if hits.class[k] != CLASS_WATER || !(lo..hi).contains(&r) {
+                    continue;
+                }
+                let n = Vec3::new(hits.normal[3 * k], hits.normal[3 * k + 1], hits.normal[3 * k + 2]);
+                let cos = n.dot(Vec3::from_array(*d)).abs().min(1.0);
+                let tau = (-2.0 * env.fog_extinction_per_m * r).exp();
+                let p = f64::from(lidar_water::detection_probability(lidar_water::mean_intensity(cos, 9.0, r, tau)));
+                want += p;
+                var += p * (1.0 - p);
+            }
+            let got =
+                (0..scan.len()).filter(|&i| scan.class[i] == CLASS_WATER && (lo..hi).contains(&scan.range[i])).count();
+            eprintln!("fog, water {lo}-{hi} m: {got} returns, the model {want:.0} ± {:.0}", var.sqrt());
+            assert!(want > 200.0, "{want}");
+            assert!((got as f64 - want).abs() < 4.5 * var.sqrt() + 2.0, "{lo}-{hi} m: {got} returns, model {want:.0}");
+        }
     }
 
     #[test]

@@ -30,7 +30,10 @@
 //! `⟨I⟩ = π β τ / (1 + (r / 100 m)²)`. The surface is rough on the scale of the wavelength, so the received
 //! power is fully developed speckle, exponentially distributed about `⟨I⟩`; the return is detected when it
 //! exceeds the threshold `I_d`, with probability `P_d = exp(−I_d / ⟨I⟩)` (Goodman, J. W. (1976), "Some
-//! fundamental properties of speckle", J. Opt. Soc. Am. 66(11)). `I_d` ([`DETECTION_THRESHOLD`]) is set so
+//! fundamental properties of speckle", J. Opt. Soc. Am. 66(11)), and its intensity is that draw: with `u` the
+//! beam's uniform draw, `I = −⟨I⟩ ln u` is exponential about `⟨I⟩` and exceeds `I_d` exactly when `u < P_d`, so
+//! a detected return's intensity is `I_d` plus an exponential of mean `⟨I⟩`, never below the threshold
+//! ([`speckle_intensity`]). `I_d` ([`DETECTION_THRESHOLD`]) is set so
 //! that a beam 20 m out over a W1 sea (U ≈ 8.4 m/s, grazing at 80°) returns with the probability 0.2 of the
 //! empirical rule this model replaces; calm water (W0) then returns almost nothing, as at 905 nm it should.
 
@@ -93,6 +96,14 @@ pub fn mean_intensity(cos_theta: f32, u: f32, r: f32, tau: f32) -> f32 {
 #[inline]
 pub fn mean_intensity_with_foam(cos_theta: f32, u: f32, r: f32, tau: f32, foam: f32) -> f32 {
     std::f32::consts::PI * backscatter_with_foam(cos_theta, u, foam) * tau / (1.0 + (r / 100.0) * (r / 100.0))
+}
+
+/// The speckle intensity of a water return of mean `mean` (`⟨I⟩`) for the beam's uniform draw `u` in `[0, 1)`:
+/// `−⟨I⟩ ln u`, exponentially distributed about `⟨I⟩`, at least [`DETECTION_THRESHOLD`] whenever the draw detects
+/// the return (`u < `[`detection_probability`]`(mean)`; the bound held against the rounding of the two sides).
+#[inline]
+pub fn speckle_intensity(mean: f32, u: f64) -> f32 {
+    ((-f64::from(mean) * u.ln()) as f32).max(DETECTION_THRESHOLD)
 }
 
 /// Probability `exp(−I_d / ⟨I⟩)` that a water return is detected (0 for `⟨I⟩ = 0`).
@@ -190,6 +201,35 @@ mod tests {
         }
         let p = |foam: f32| detection_probability(mean_intensity_with_foam(0.17, 4.8, 20.0, 1.0, foam));
         assert!(p(0.0) < 1e-3 && p(0.5) > 0.95, "open water {} against foam {}", p(0.0), p(0.5));
+    }
+
+    /// A detected water return's intensity is the speckle draw that passed the threshold: never below `I_d`, and
+    /// `I − I_d` exponential of mean `⟨I⟩` (memoryless), its mean and its tail checked against the closed form over
+    /// a million draws at three means around the threshold. Until 2026-12-01 the return carried `⟨I⟩` itself,
+    /// below the threshold it had passed whenever `⟨I⟩ < I_d`.
+    #[test]
+    fn detected_water_returns_are_speckle_draws_above_the_threshold() {
+        for mean in [0.3 * DETECTION_THRESHOLD, DETECTION_THRESHOLD, 5.0 * DETECTION_THRESHOLD] {
+            let p = f64::from(detection_probability(mean));
+            let (mut n, mut excess, mut tail) = (0u64, 0.0f64, 0u64);
+            for i in 0..1_000_000u64 {
+                let u = crate::sensors::noise::uniform(9, 3, i);
+                if u >= p {
+                    continue;
+                }
+                let x = speckle_intensity(mean, u);
+                assert!(x >= DETECTION_THRESHOLD, "mean {mean}: {x} below the threshold");
+                n += 1;
+                let e = f64::from(x - DETECTION_THRESHOLD) / f64::from(mean);
+                excess += e;
+                tail += u64::from(e > 1.0);
+            }
+            let nf = n as f64;
+            assert!((nf / 1e6 - p).abs() < 5.0 * (p * (1.0 - p) / 1e6).sqrt(), "mean {mean}: rate {}", nf / 1e6);
+            assert!((excess / nf - 1.0).abs() < 5.0 / nf.sqrt(), "mean {mean}: mean excess {}", excess / nf);
+            let e1 = (-1.0f64).exp();
+            assert!((tail as f64 / nf - e1).abs() < 5.0 * (e1 * (1.0 - e1) / nf).sqrt(), "mean {mean}: tail");
+        }
     }
 
     /// The shortcut to 0 gives `exp`'s own bits everywhere: across the underflow and far below it.

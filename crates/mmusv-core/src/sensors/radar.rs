@@ -20,22 +20,26 @@
 //! the cell's clutter draw ([`radar_model::clutter_mean`]); a cell is reported when its intensity is positive
 //! and at least `detection_threshold`. Its instance and class are those of the object with the largest summed
 //! echo in the cell, or instance −1 and class WATER (sea clutter) / NONE (rain clutter) when clutter
-//! dominates. Rays that hit water end there and are not targets: the sea is seen only as clutter.
+//! dominates. Rays that hit water end there and are not targets: the sea is seen only as clutter. Sea clutter
+//! comes only from the water the beam sees: a cell's sea clutter mean is scaled by the share of the beam's azimuth
+//! samples whose rays show the water at that range in view, not under land or in the shadow of an island, a quay
+//! or a ship (`shadow`; until 2026-12-01 sea clutter was drawn at every range of every beam, over islands too).
 //!
 //! Determinism: clutter and range noise of cell `(b, k)` come from a ChaCha8 generator seeded with `seed`,
 //! stream `b`, at word offset `4k`, so they depend on nothing else (not on threads, other cells, or the
 //! range limits), and for a fixed seed clutter grows monotonically with the wave height and rain rate.
 //!
 //! One module a step: `config` (what the radar is and what it sees through, checked), `pattern` (where its
-//! rays go), this file (cast the sweep, collect each beam's echoes, assemble the returns), `cells` (echoes
-//! grouped per cell and merged with clutter into returns) and `clutter` (clutter means and the seeded per-cell
-//! draws).
+//! rays go), this file (cast the sweep, collect each beam's echoes, assemble the returns), `shadow` (where the
+//! beam sees the sea), `cells` (echoes grouped per cell and merged with clutter into returns) and `clutter`
+//! (clutter means and the seeded per-cell draws).
 
 mod cells;
 mod clutter;
 mod config;
 mod pattern;
 pub mod sea_clutter;
+mod shadow;
 
 use crate::error::Result;
 use crate::geometry::RigidPose;
@@ -45,6 +49,7 @@ use cells::{group_cells, BeamContext, Echo, Return};
 use clutter::clutter_table;
 use pattern::trace_index;
 use rayon::prelude::*;
+use shadow::Blockers;
 
 pub(crate) use config::{validate_azimuth_bins, validate_resolution};
 pub use config::{RadarConfig, RadarEnv, MAX_AZIMUTH_BINS, MAX_RANGE_BINS, MAX_RANGE_M, MAX_RAYS};
@@ -120,31 +125,34 @@ pub fn radar_sweep(
         sea_clutter::PhysicalSea::new(env.wave_height_m as f64, f64::from(sensor_to_world.translation.z - w.level()))
     });
     let table = clutter_table(cfg, env, physical.as_ref(), first, end);
-    // Solid angle of a ray = (beamwidth / rays_az) · its fan-height weight.
+    // Solid angle of a ray = (beamwidth / rays_az) · its fan-height weight · cos(its elevation).
     let az_width = cfg.beamwidth_az_rad / cfg.rays_az as f64;
     let rain = env.rain_mm_per_h as f64;
-    let ctx = BeamContext {
-        cfg,
-        env,
-        seed,
-        first,
-        end,
-        table: &table,
-        sensor_height: sensor_to_world.translation.z.max(0.0) as f64,
-        physical,
-        pose: sensor_to_world,
-    };
+    let sensor_height = sensor_to_world.translation.z.max(0.0) as f64;
+    // The clutter bins' ranges and the still water's depression there (`shadow`).
+    let clutter_ranges: Vec<f64> = (first..).take(table.len()).map(|k| cfg.bin_centre(k)).collect();
+    let depression: Vec<f64> = clutter_ranges.iter().map(|&r| sensor_height.atan2(r)).collect();
+    let ctx = BeamContext { cfg, env, seed, first, end, table: &table, sensor_height, physical, pose: sensor_to_world };
     let per_beam: Vec<Vec<Return>> = (0..cfg.azimuth_bins)
         .into_par_iter()
         .map(|b| {
             let mut echoes = Vec::new();
+            // Per clutter bin, the beam's azimuth samples that do not see the sea there (`shadow`; empty: none).
+            let mut shadowed = Vec::new();
+            let mut blockers = Blockers::default();
             for j in 0..cfg.rays_az {
                 let g = b * cfg.rays_az + j;
+                let horizon = horizon_elevation(sensor_to_world, cfg.sample_azimuth(g)).unwrap_or(0.0);
+                blockers.clear();
                 for k in 0..cfg.rays_el {
                     let i = trace_index(g as usize, k as usize, samples, rows);
                     let (instance, class, d) = (hits.instance[i], hits.class[i], hits.distance[i] as f64);
                     if instance == NO_HIT || class == CLASS_WATER || !d.is_finite() {
                         continue;
+                    }
+                    let [elevation, weight] = meta[i];
+                    if d >= cfg.range_min_m && f64::from(elevation) <= horizon {
+                        blockers.push(f64::from(elevation), d);
                     }
                     let bin = (d / cfg.range_resolution_m).floor() as u32;
                     if bin < first || bin >= end {
@@ -153,12 +161,13 @@ pub fn radar_sweep(
                     let n = &hits.normal[3 * i..3 * i + 3];
                     let dir = dirs[i];
                     let cos = (n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2]) as f64;
-                    let [elevation, weight] = meta[i];
-                    let power = radar_model::ray_power(class, cos, az_width * weight as f64, d, rain);
+                    let omega = az_width * weight as f64 * f64::from(elevation).cos();
+                    let power = radar_model::ray_power(class, cos, omega, d, rain);
                     echoes.push(Echo { bin, instance, class, power, elevation: elevation as f64 });
                 }
+                blockers.count_shadowed(horizon, &clutter_ranges, &depression, &mut shadowed);
             }
-            ctx.returns(b, &group_cells(echoes))
+            ctx.returns(b, &group_cells(echoes), &shadowed)
         })
         .collect();
 

@@ -4,10 +4,15 @@
 //! clear air, linear (so `0.01` is −20 dB, a 1 m² target at ≈3.2 km). Every term below is the radar equation
 //! `P ∝ σ / r⁴`, written as `σ · (R_ref / r)⁴ · L_rain(r)`.
 //!
-//! * **Targets** (every ray hit that is not water): a ray stands for a solid angle `Ω = θ_az · θ_el / n_rays`
-//!   of the beam, so at range `r` it covers `Ω r²` m² and returns, for a diffuse (Lambertian) surface of
-//!   reflectivity `ρ` hit at incidence `θ`, `σ = ρ · |cos θ| · Ω r²`. Summing rays over a cell makes the
-//!   echo grow with the target's visible size (more rays hit it). `ρ` per class: [`class_reflectivity`].
+//! * **Targets** (every ray hit that is not water): a ray at elevation `e` standing for `Δφ` of the beamwidth
+//!   and `Δe` of the fan stands for the solid angle `Ω = Δφ · Δe · cos e` (the `cos e` of the sphere's area
+//!   element: until 2026-12-01 it was left out, and a target 40° above the horizon came out 1/cos 40° = 1.3 times
+//!   too bright), so at range `r` it covers `Ω r²` m² of the plane facing the sensor and returns, for a surface
+//!   of radar reflectivity `ρ` hit at incidence `θ`, `σ = ρ · |cos θ| · Ω r²`: a diffuse surface whose
+//!   backscatter per unit of its own area is `σ⁰ = ρ cos²θ` (a quarter of a Lambertian reflector's
+//!   `4 ρ cos²θ`; `ρ` is a per-class radar reflectivity, not an albedo), so a face-on patch of `A` m² is a
+//!   target of `ρ A` m². Summing rays over a cell makes the echo grow with the target's visible size (more rays
+//!   hit it). `ρ` per class: [`class_reflectivity`].
 //! * **Rain attenuation** (two-way): specific attenuation `γ = k · R^α` dB/km with `k = 0.01217`,
 //!   `α = 1.2571` (ITU-R P.838-3, 10 GHz, horizontal polarisation, the X band of marine radars) for a
 //!   rain rate `R` in mm/h; `L_rain(r) = 10^(−2 γ r_km / 10)`.

@@ -268,3 +268,80 @@ fn physical_sea_clutter_follows_the_nrl_model() {
         }
     }
 }
+
+/// A ray stands for the solid angle `Δφ · Δe · cos e` of the beam: a 30 m plate facing the radar 300 m away
+/// gives the same total echo (summed over the beams that see it) 40° above the horizon as on it, the radar
+/// equation's `ρ A (R_ref/r)⁴` times the beams per point of it (beamwidth / bin width). Without the `cos e` the
+/// plate 40° up came out 1/cos 40° = 1.31 times as bright.
+#[test]
+fn a_target_above_the_horizon_is_as_bright_as_on_it() {
+    let cfg = RadarConfig {
+        azimuth_bins: 1024,
+        rays_az: 4,
+        rays_el: 512,
+        elevation_fan_rad: [(-45f64).to_radians(), 45f64.to_radians()],
+        horizon_fraction: 0.0,
+        detection_threshold: 1e-12,
+        clutter: ClutterModel { sea_sigma0_at_1m: 0.0, rain_eta_at_1mm_h: 0.0, ..ClutterModel::tuning() },
+        ..RadarConfig::tuning()
+    };
+    let (r, half) = (300.0f64, 15.0f32);
+    let total = |e_deg: f64| {
+        let mut s = Scene::new();
+        let plate = Mesh::new(
+            "plate",
+            &[[0.0, -half, -half], [0.0, half, -half], [0.0, half, half], [0.0, -half, half]],
+            &[[0, 2, 1], [0, 3, 2]],
+            &[10],
+        )
+        .unwrap_or_else(|e| unreachable!("{e}"));
+        let m = s.add_mesh(plate);
+        let e = e_deg.to_radians();
+        let _ = s.add_instance(m, RigidPose::from_xyz_rpy([r * e.cos(), 0.0, r * e.sin()], [0.0, -e, 0.0]), None);
+        let ret = radar_sweep(&s, &RigidPose::IDENTITY, &cfg, &RadarEnv::default(), 1)
+            .unwrap_or_else(|e| unreachable!("{e}"));
+        assert!(ret.instance.iter().all(|&i| i == 0) && !ret.is_empty());
+        ret.intensity.iter().map(|&x| f64::from(x)).sum::<f64>()
+    };
+    let (level, raised) = (total(0.0), total(40.0));
+    let want =
+        900.0 * (radar_model::REFERENCE_RANGE_M / r).powi(4) * cfg.beamwidth_az_rad / (std::f64::consts::TAU / 1024.0);
+    eprintln!("plate on the horizon {:.3}, 40° up {:.3} of the radar equation", level / want, raised / want);
+    assert!((level / want - 1.0).abs() < 0.08, "{}", level / want);
+    assert!((raised / level - 1.0).abs() < 0.05, "40° up {raised} vs level {level}");
+}
+
+/// Sea clutter comes from the water in view: an island 60–160 m off (a 30 m high block, 100 m wide) leaves no sea
+/// clutter over itself nor in its shadow behind it, while the sea in front of it and in the other directions
+/// keeps the clutter it had without the island, return for return (the same draws). Until 2026-12-01 sea
+/// clutter was drawn at every range of every beam, over the island and behind it too.
+#[test]
+fn no_sea_clutter_over_land_or_in_its_shadow() {
+    let cfg = RadarConfig { range_max_m: 900.0, ..small_cfg() };
+    let with_island = |island: bool| {
+        let mut s = sea_with_box(5000.0, 0.0);
+        if island {
+            let block = s.add_mesh(box_mesh([50.0, 50.0, 15.0], 2));
+            let _ = s.add_instance(block, RigidPose::from_xyz_rpy([110.0, 0.0, 10.0], [0.0; 3]), None);
+        }
+        sweep(&s, &cfg, 3.5, 4)
+    };
+    let (open, island) = (with_island(false), with_island(true));
+    let clutter = |r: &RadarReturns, keep: &dyn Fn(f64, f64) -> bool| -> Vec<(u32, u32, u32)> {
+        (0..r.len())
+            .filter(|&i| r.instance[i] == NO_HIT && keep(r.azimuth[i] as f64, r.range[i] as f64))
+            .map(|i| (r.azimuth[i].to_bits(), r.range[i].to_bits(), r.intensity[i].to_bits()))
+            .collect()
+    };
+    let bearing = |a: f64| if a > std::f64::consts::PI { a - std::f64::consts::TAU } else { a };
+    // The island spans bearings ±atan(50 / 60) = ±39.8°; beams well inside it, beyond its near shore (x = 60 m).
+    let behind = |a: f64, r: f64| bearing(a).abs() < 0.6 && r * a.cos() > 62.0;
+    assert!(clutter(&open, &behind).len() > 1000, "the open sea there has clutter");
+    assert_eq!(clutter(&island, &behind).len(), 0, "no sea clutter over the island or behind it");
+    // In front of the island and away from it, the same clutter as without the island.
+    let in_front = |a: f64, r: f64| bearing(a).abs() < 0.6 && r * a.cos() < 58.0;
+    let away = |a: f64, _r: f64| bearing(a).abs() > 1.0;
+    assert!(clutter(&open, &in_front).len() > 100);
+    assert_eq!(clutter(&island, &in_front), clutter(&open, &in_front));
+    assert_eq!(clutter(&island, &away), clutter(&open, &away));
+}

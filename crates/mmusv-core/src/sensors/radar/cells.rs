@@ -75,8 +75,10 @@ pub(super) struct Return {
 }
 
 impl BeamContext<'_> {
-    /// Merges the target cells of beam `b` with its clutter draws into returns, by range bin.
-    pub(super) fn returns(&self, b: u32, cells: &[Echo]) -> Vec<Return> {
+    /// Merges the target cells of beam `b` with its clutter draws into returns, by range bin; `shadowed[i]` of the
+    /// beam's `rays_az` azimuth samples do not see the sea in clutter bin `i` (its sea clutter scaled by the share
+    /// that does; `shadowed` empty: every sample sees it everywhere).
+    pub(super) fn returns(&self, b: u32, cells: &[Echo], shadowed: &[u32]) -> Vec<Return> {
         let mut draws = CellDraws::new(self.seed, b);
         let azimuth = self.cfg.beam_azimuth(b) as f32;
         let horizon = horizon_elevation(self.pose, azimuth as f64).unwrap_or(0.0);
@@ -84,7 +86,7 @@ impl BeamContext<'_> {
         let thr = self.cfg.detection_threshold;
         let mut emit = |bin: u32, target: Option<&Echo>, clutter: Option<ClutterBin>| {
             let (u, w) = draws.at(bin);
-            let ClutterBin { mean, sea, p_detect } =
+            let ClutterBin { mean, sea, p_detect, .. } =
                 clutter.unwrap_or_else(|| ClutterBin::at(self.cfg, self.env, self.physical.as_ref(), bin));
             // Clutter alone is detected iff mean · (−ln u) ≥ threshold, i.e. u ≤ exp(−threshold / mean).
             if target.is_none() && u > p_detect {
@@ -113,8 +115,13 @@ impl BeamContext<'_> {
             });
         };
         let mut t = 0;
+        let samples = self.cfg.rays_az;
         for (i, &c) in self.table.iter().enumerate() {
             let bin = self.first + i as u32;
+            let c = match shadowed.get(i) {
+                Some(&n) if n > 0 => c.in_view(self.cfg, f64::from(samples - n) / f64::from(samples)),
+                _ => c,
+            };
             let target = cells.get(t).filter(|cell| cell.bin == bin);
             if target.is_some() {
                 t += 1;

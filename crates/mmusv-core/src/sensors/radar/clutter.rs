@@ -46,12 +46,14 @@ impl CellDraws {
 }
 
 /// Clutter of one range bin: mean intensity, whether sea (not rain) dominates, and the probability that
-/// clutter alone passes the threshold.
+/// clutter alone passes the threshold; and the sea and rain parts of the mean.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct ClutterBin {
     pub(super) mean: f64,
     pub(super) sea: bool,
     pub(super) p_detect: f64,
+    sea_mean: f64,
+    rain_mean: f64,
 }
 
 impl ClutterBin {
@@ -75,9 +77,23 @@ impl ClutterBin {
                 r,
             ),
         };
+        Self::of(cfg, sea, rain)
+    }
+
+    fn of(cfg: &RadarConfig, sea: f64, rain: f64) -> Self {
         let mean = sea + rain;
         let p_detect = if mean > 0.0 { (-cfg.detection_threshold / mean).exp() } else { 0.0 };
-        Self { mean, sea: sea >= rain, p_detect }
+        Self { mean, sea: sea >= rain, p_detect, sea_mean: sea, rain_mean: rain }
+    }
+
+    /// This bin where the beam sees the sea over `share` (`0..=1`) of its width (the rest land or shadow): the
+    /// sea part scaled by it, the rain part as it is; `share = 1` is `self`, to the bit.
+    pub(super) fn in_view(self, cfg: &RadarConfig, share: f64) -> Self {
+        if share >= 1.0 {
+            self
+        } else {
+            Self::of(cfg, self.sea_mean * share, self.rain_mean)
+        }
     }
 }
 

@@ -18,8 +18,12 @@
 //!
 //! The grazing angle at range `r` of an antenna `h` above the still water is that of the 4/3-earth geometry,
 //! `sin ψ = h / r − r / (2 k R_e)` (Barton, D. K. (2013), "Radar Equations for Modern Radar", §8), clamped
-//! into the model's 0.1°–60°. The sea state follows the significant wave height by the WMO/Douglas code
-//! (upper bounds 0.1, 0.5, 1.25, 2.5, 4, 6 m for states 1–6), interpolated linearly between them.
+//! into the model's 0.1°–60°. The sea state follows the significant wave height by the WMO/Douglas code (WMO
+//! code table 3700: state `s` is a band of Hs, 0.1, 0.5, 1.25, 2.5, 4 and 6 m the upper bounds of states 1–6),
+//! each state at the middle of its band, where the project's WMO presets put it (`ocean::presets`: 0.05, 0.3,
+//! 0.875, 1.875, 3.25, 5 m), interpolated linearly between those middles and 6 from 5 m on: a sea configured as
+//! `state: 4` is the NRL model's sea state 4 (until 2026-12-01 the states sat at the bands' upper bounds, so a
+//! WMO state-4 sea, Hs 1.875 m, was the model's 3.5, 1.1–2.5 dB low between 18° and 0.6° grazing).
 
 /// Carrier frequency of an X-band marine radar, GHz.
 pub const MARINE_FREQUENCY_GHZ: f64 = 9.41;
@@ -29,8 +33,6 @@ const EARTH_K: f64 = 4.0 / 3.0;
 const EARTH_RADIUS_M: f64 = 6_371_000.0;
 /// The model's grazing-angle range, degrees.
 const GRAZING_RANGE_DEG: [f64; 2] = [0.1, 60.0];
-/// Significant wave heights (m) at the upper bounds of Douglas sea states 0..=6.
-const SEA_STATE_HS: [f64; 7] = [0.0, 0.1, 0.5, 1.25, 2.5, 4.0, 6.0];
 
 /// Antenna polarisation (transmit = receive).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -56,16 +58,21 @@ pub fn nrl_sigma0(f_ghz: f64, ss: f64, pol: Polarisation, psi_deg: f64) -> f64 {
     10f64.powf(db / 10.0)
 }
 
-/// The continuous Douglas sea state of significant wave height `hs` (m): 0 for flat water, 6 from 6 m on.
+/// Highest sea state of the model's fit (Nathanson's tables: 0–6).
+const MAX_SEA_STATE: usize = 6;
+
+/// The continuous Douglas sea state of significant wave height `hs` (m): 0 for flat water; state `s` at the
+/// middle of its WMO band (the WMO presets' Hs, [`crate::ocean::wmo_sea_states`]), linear between; 6 from 5 m on.
 pub fn sea_state(hs: f64) -> f64 {
     let hs = hs.max(0.0);
-    for s in 1..SEA_STATE_HS.len() {
-        let (lo, hi) = (SEA_STATE_HS[s - 1], SEA_STATE_HS[s]);
+    let presets = crate::ocean::wmo_sea_states();
+    for s in 1..=MAX_SEA_STATE {
+        let (lo, hi) = (presets[s - 1].hs_m, presets[s].hs_m);
         if hs <= hi {
             return (s - 1) as f64 + (hs - lo) / (hi - lo);
         }
     }
-    (SEA_STATE_HS.len() - 1) as f64
+    MAX_SEA_STATE as f64
 }
 
 /// Grazing angle (degrees, clamped into 0.1°–60°) at ground range `r` (m) of an antenna `h` (m) above the
@@ -126,6 +133,34 @@ mod tests {
         assert!((got - want_db).abs() < 1e-9, "{got} vs {want_db}");
     }
 
+    /// A sea configured as WMO state `s` (the preset's Hs, the middle of the band) is the NRL model's sea state
+    /// `s`: its σ⁰ is the published formula's at `SS = s`, written out here term by term, at grazing angles from
+    /// 0.2° to 30°. (The states used to sit at the bands' upper bounds: state 3, Hs 0.875 m, was the model's 2.5.)
+    #[test]
+    fn a_wmo_sea_state_is_the_models_sea_state() {
+        let nrl_hh_db = |ss: f64, psi: f64| {
+            -73.0
+                + 20.781 * psi.to_radians().sin().log10()
+                + (27.5 + 7.351 * psi) * 9.41f64.log10() / (1.0 + 0.95 * psi)
+                + 25.65 * (ss + 1.0).powf(1.0 / (2.0 + 0.085 * psi + 0.033 * ss))
+                + 0.0054 * psi * psi
+        };
+        for preset in crate::ocean::wmo_sea_states().iter().take(7).skip(1) {
+            let state: f64 = preset.name.parse().unwrap_or(f64::NAN);
+            assert_eq!(sea_state(preset.hs_m), state, "WMO state {}", preset.name);
+            let h = 6.0;
+            for psi in [0.2f64, 1.0, 5.0, 30.0] {
+                // The range at which an antenna 6 m up sees the still water at grazing ψ (4/3 earth).
+                let (s, k) = (psi.to_radians().sin(), 2.0 * EARTH_K * EARTH_RADIUS_M);
+                let r = (-s + (s * s + 4.0 * h / k).sqrt()) / (2.0 / k);
+                assert!((grazing_deg(h, r) - psi).abs() < 1e-6);
+                let got = 10.0 * PhysicalSea::new(preset.hs_m, h).sigma0(r).log10();
+                let want = nrl_hh_db(state, psi);
+                assert!((got - want).abs() < 1e-6, "state {state}, ψ {psi}°: {got} dB vs NRL {want} dB");
+            }
+        }
+    }
+
     #[test]
     fn clutter_follows_sea_state_and_grazing_angle() {
         let at = |hs: f64, r: f64| PhysicalSea::new(hs, 4.0).sigma0(r);
@@ -135,10 +170,11 @@ mod tests {
         }
         assert!(at(2.5, 100.0) > at(2.5, 400.0) && at(2.5, 400.0) > at(2.5, 1600.0));
         assert_eq!(at(0.0, 100.0), 0.0);
-        // Douglas sea states at their bounds, and between.
-        assert_eq!(sea_state(1.25), 3.0);
-        assert_eq!(sea_state(4.0), 5.0);
-        assert!((sea_state(3.25) - 4.5).abs() < 1e-12);
+        // Douglas sea states at the middles of their bands, and between.
+        assert_eq!(sea_state(1.875), 4.0);
+        assert_eq!(sea_state(3.25), 5.0);
+        assert!((sea_state(2.5625) - 4.5).abs() < 1e-12);
+        assert_eq!(sea_state(5.0), 6.0);
         assert_eq!(sea_state(9.0), 6.0);
         // Grazing: h / r close in, the earth's curvature far out, clamped into the model's range.
         assert!((grazing_deg(10.0, 100.0) - (0.1f64.asin().to_degrees())).abs() < 1e-3);
