@@ -215,7 +215,8 @@ class RadarConfig(_Model):
     with 0.3 / 4e-7, sea clutter reaches ≈40 m at W0 and ≈140 m at W3 (99th percentile of the clutter ranges;
     10,819 → 55,466 clutter cells, still growing with every sea state); with 0.01 / 4e-6 it reaches ≈180 m /
     ≈930 m with 92,871 → 404,373 cells (8.9 MB of return arrays at 22 bytes a return, per USV per frame at W3).
-    The box gives the same 7 cells with both.
+    The box gives the same 7 cells with both. (Measured before 2026-12-01, when the sea behind the box stopped
+    drawing clutter, `radar/shadow.rs`: the counts are a little lower now.)
     """
 
     range_m: float = Field(default=3000.0, gt=0, le=100_000)
