@@ -363,21 +363,16 @@ impl Shader {
         sky * self.sky_keep + air * (1.0 - self.sky_keep)
     }
 
-    /// Radiance a reflected ray `d` that meets nothing brings back: the sky without the sun's disc, blended into
-    /// the air light by visibility ([`Shader::reflected`] without a hit).
-    #[inline(always)]
-    pub fn sky_reflected(&self, d: Vec3) -> Vec3 {
-        self.sky_no_sun(d)
-    }
-
-    /// The sky as water of roughness `alpha` reflects it around unit mirror direction `r`: the mean of
-    /// [`Shader::sky_reflected`] over the single-scattering lobe (`sky_lobe.rs`; `r` read as level water's mirror
-    /// direction).
+    /// The sky as water of roughness `alpha` reflects it around unit mirror direction `r`: `(along r, over the
+    /// lobe)`, the radiance a reflected ray along `r` that meets nothing brings back ([`Shader::reflected`] without
+    /// a hit: the sky without the sun's disc, blended into the air light by visibility) and its mean over the
+    /// single-scattering lobe (`sky_lobe.rs`; `r` read as level water's mirror direction). One sky lookup for both.
     #[inline]
-    pub fn sky_lobe_mean(&self, r: Vec3, alpha: f32) -> Vec3 {
+    pub fn reflected_sky(&self, r: Vec3, alpha: f32) -> (Vec3, Vec3) {
         let (sky, air) = self.light.sky_and_horizon(r);
         let (dsky, dair) = self.light.sky_lobe_correction(r, alpha);
-        (sky + dsky) * self.sky_keep + (air + dair) * (1.0 - self.sky_keep)
+        let keep = |s: Vec3, a: Vec3| s * self.sky_keep + a * (1.0 - self.sky_keep);
+        (keep(sky, air), keep(sky + dsky, air + dair))
     }
 
     /// Radiance distant objects fade into along `d`: the horizon sky's, at `d`'s azimuth.

@@ -122,13 +122,12 @@ impl Blurred {
         let (x0, y0) = (fx as usize, fy as usize);
         let (x1, y1) = ((x0 + 1).min(self.cw - 1), (y0 + 1).min(self.ch - 1));
         let (tx, ty) = (fx - x0 as f32, fy - y0 as f32);
-        let cell = |c: usize| self.mean[c];
         let mut acc = Vec3::ZERO;
         let mut wsum = 0.0;
         for (cx, cy, wt) in
             [(x0, y0, (1.0 - tx) * (1.0 - ty)), (x1, y0, tx * (1.0 - ty)), (x0, y1, (1.0 - tx) * ty), (x1, y1, tx * ty)]
         {
-            if let Some(m) = cell(cy * self.cw + cx) {
+            if let Some(m) = self.mean[cy * self.cw + cx] {
                 acc += m * wt;
                 wsum += wt;
             }
@@ -139,7 +138,7 @@ impl Blurred {
         let (cx, cy) =
             (((u.max(0.0) as usize) / self.dx).min(self.cw - 1), ((v.max(0.0) as usize) / self.dy).min(self.ch - 1));
         // (u, v) are in the grid's frame here.
-        cell(cy * self.cw + cx)
+        self.mean[cy * self.cw + cx]
     }
 }
 

@@ -378,7 +378,7 @@ pub fn radiance(
                 .map(|j| {
                     let r = Vec3::from_array(rd[j]);
                     let alpha = shader.water_mss(traced_hits[j].unresolved_mss).sqrt();
-                    (shader.sky_reflected(r), shader.sky_lobe_mean(r, alpha))
+                    shader.reflected_sky(r, alpha)
                 })
                 .collect();
         }
