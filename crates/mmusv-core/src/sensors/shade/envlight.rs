@@ -144,7 +144,7 @@ fn node_dir(i: usize, j: usize, w: usize, h: usize) -> Vec3 {
 
 /// The two columns and the weight of the second for column coordinate `x` (wrapping) of a map `w` wide.
 #[inline(always)]
-fn columns(w: usize, x: f32) -> (usize, usize, f32) {
+pub(super) fn columns(w: usize, x: f32) -> (usize, usize, f32) {
     // floor without a call: x > -1 here (a column coordinate is at least -0.5); wrap without a modulo.
     let xi = (x + 1.0) as i32 - 1;
     let fx = x - xi as f32;

@@ -26,7 +26,7 @@
 //! blends the mirror direction's.
 
 use super::brdf::fresnel_dielectric;
-use super::envlight::{diamond, diamond_dir, Lighting, WATER_IOR};
+use super::envlight::{columns, diamond, diamond_dir, Lighting, WATER_IOR};
 use super::rough_water::{smith_g1, stratified_facets};
 use parry3d::math::Vec3;
 use std::sync::OnceLock;
@@ -115,11 +115,7 @@ impl SkyLobe {
         // level `l` is stored at `l - 1`).
         let l = (a as usize).min(LEVELS);
         let f = a - l as f32;
-        let x = diamond(r.x, r.y) / 4.0 * COLS as f32 - 0.5;
-        let xi = (x + 1.0) as i32 - 1;
-        let fx = x - xi as f32;
-        let i0 = if xi < 0 { COLS - 1 } else { (xi as usize).min(COLS - 1) };
-        let i1 = if i0 + 1 == COLS { 0 } else { i0 + 1 };
+        let (i0, i1, fx) = columns(COLS, diamond(r.x, r.y) / 4.0 * COLS as f32 - 0.5);
         let y = r.z.clamp(0.0, 1.0).sqrt() * (ROWS - 1) as f32;
         let j0 = (y as usize).min(ROWS - 2);
         let fy = y - j0 as f32;
