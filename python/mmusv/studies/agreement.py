@@ -9,6 +9,11 @@ to this vessel alone (per the instance image). Per sample:
 * ``centre error`` (px): distance between the projected box centre and the centre of the component's extent
   measured along the box's own axes (mid-point of the farthest mask pixels forward/aft and port/starboard) —
   the quantity a box fitted to the mask would have;
+* ``forward offset`` and ``port offset`` (px, signed): that extent centre's offset from the projected box centre
+  along the box's forward (bow) and port axes, the two components of the centre error. A pointed bow, whose tip
+  narrows below a pixel, loses its tip's pixels to the pixel-centre sampling of the semantic image while a transom
+  keeps its last row: on the bundled scenarios the forward offset is negative (aft) while the port offset is not
+  biased (``docs/studies/agreement.md``);
 * ``centroid error`` (px): distance between the projected box centre and the centroid of the component's pixels
   inside the hull, M_local ∩ H_proj (what the paper reports; it also measures how asymmetric a hull is about its
   box centre);
@@ -103,6 +108,7 @@ def sample_agreement(
     axes_body = inv[:3, :3] @ box_matrix[:3, :2]
     axes_uv = np.stack([-axes_body[1], -axes_body[2]], axis=0)  # columns: forward, port (in pixel units per metre·m)
     extent_centre = centre_uv.copy()
+    offsets = [0.0, 0.0]
     for k in range(2):
         a = axes_uv[:, k]
         n = np.linalg.norm(a)
@@ -110,9 +116,12 @@ def sample_agreement(
             continue
         a = a / n
         proj = (px - centre_uv) @ a
-        extent_centre += a * (proj.min() + proj.max()) / 2.0
+        offsets[k] = float((proj.min() + proj.max()) / 2.0)
+        extent_centre += a * offsets[k]
     return {
         "centre_error_px": float(np.linalg.norm(extent_centre - centre_uv)),
+        "forward_offset_px": offsets[0],
+        "port_offset_px": offsets[1],
         # M_local ∩ H_proj, as the paper (the whole component's centroid moved with the pixels outside the hull).
         "centroid_error_px": float(np.linalg.norm(px[in_hull].mean(axis=0) - centre_uv)),
         "containment": contained,
@@ -174,6 +183,8 @@ _SAMPLE_SCHEMA = {
     "agent": pl.String,
     "target": pl.String,
     "centre_error_px": pl.Float64,
+    "forward_offset_px": pl.Float64,
+    "port_offset_px": pl.Float64,
     "centroid_error_px": pl.Float64,
     "containment": pl.Float64,
     "hull_occupancy": pl.Float64,
