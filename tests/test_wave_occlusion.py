@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -14,7 +15,15 @@ from mmusv.scene import Scene
 from mmusv.sensors.config import LidarConfig
 from mmusv.sensors.env import sensor_env
 from mmusv.sensors.lidar import lidar_from_config, scan
-from mmusv.wave_occlusion import exposed_hidden, lidar_box_rays, pattern_angles, share
+from mmusv.wave_occlusion import (
+    exposed_hidden,
+    lidar_beam_rays,
+    lidar_box_beams,
+    lidar_box_rays,
+    pattern_angles,
+    share,
+)
+from refusals import unrefused
 
 
 @dataclass(frozen=True)
@@ -381,3 +390,138 @@ def test_a_surface_sampled_without_its_shading_slopes_is_the_same_geometry() -> 
     assert water_hits > n // 2
     for a, b in zip(out[True], out[False], strict=True):
         np.testing.assert_array_equal(a, b)
+
+
+def _bad_calls() -> list[tuple[str, Any, str]]:
+    """(label, call, words the ``InputError`` must hold) of calls that gave a bare ``IndexError``/``ValueError``/
+    ``AttributeError``/``LinAlgError`` or, worse, an answer: the functions typed ``Any`` (wrong on purpose)."""
+    scene, _, _, _ = _world(None)
+    o = np.zeros((4, 3), np.float32)
+    d = np.tile(np.array([1.0, 0.0, 0.0], np.float32), (4, 1))
+    t = np.full(4, 5.0, np.float32)
+    p = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [-1, 0, 0]], np.float32)
+    angles = pattern_angles(p)
+    pose = np.eye(4)
+    corners = np.array([[10.0 + sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+    scaled = np.diag([2.0, 2.0, 2.0, 1.0])
+    eh: Any = exposed_hidden
+    sh: Any = share
+    pa: Any = pattern_angles
+    lbb: Any = lidar_box_beams
+    lbr: Any = lidar_beam_rays
+    lbx: Any = lidar_box_rays
+    return [
+        # answers for counts that are not counts
+        ("share(3, 5)", lambda: sh(3, 5), "hidden = 5: must be <= exposed = 3"),
+        ("share(0, 5)", lambda: sh(0, 5), "hidden = 5: must be <= exposed = 0"),
+        ("share(-2, 1)", lambda: sh(-2, 1), "exposed = -2: must be a whole number >= 0"),
+        ("share(True, True)", lambda: sh(True, True), "exposed = True"),
+        ("share(2.5, 1)", lambda: sh(2.5, 1), "exposed = 2.5"),
+        # exposed_hidden: broadcast, NaN read as a miss, a range that is no range, bare errors
+        ("one origin for 4 rays", lambda: eh(scene, o[:1], d, t), "directions must be (N, 3)"),
+        ("origins (4, 2)", lambda: eh(scene, o[:, :2], d, t), "origins must be (N, 3)"),
+        ("3 distances for 4 rays", lambda: eh(scene, o, d, t[:3]), "vessel_t must be (N,)"),
+        ("a NaN distance", lambda: eh(scene, o, d, np.full(4, np.nan)), "vessel_t must be distances >= 0"),
+        ("a negative distance", lambda: eh(scene, o, d, -t), "row 0 is -5.0"),
+        ("NaN origins", lambda: eh(scene, o + np.nan, d, t), "origins must be finite"),
+        ("a zero direction", lambda: eh(scene, o, d * 0, t), "directions must be directions of any non-zero"),
+        ("origins 'abc'", lambda: eh(scene, "abc", d, t), "origins must be (N, 3)"),
+        ("bool directions", lambda: eh(scene, o, d > 0, t), "got dtype bool"),
+        ("scene None", lambda: eh(None, o, d, t), "scene = None: must be a mmusv.scene.Scene"),
+        ("max_range_m NaN", lambda: eh(scene, o, d, t, max_range_m=float("nan")), "max_range_m = nan"),
+        ("max_range_m -1", lambda: eh(scene, o, d, t, max_range_m=-1.0), "max_range_m = -1.0"),
+        ("float instances", lambda: eh(scene, o, d, t, scene_instance=t), "scene_instance must be (N,)"),
+        ("2 instances", lambda: eh(scene, o, d, t, scene_instance=np.zeros(2, np.int32)), "scene_instance"),
+        # pattern_angles: NaN and (0, 0, 0) beams got angles
+        ("pattern (4, 2)", lambda: pa(p[:, :2]), "pattern must be (M, 3)"),
+        ("NaN pattern", lambda: pa(np.full((3, 3), np.nan, np.float32)), "pattern must be finite"),
+        ("zero beam", lambda: pa(np.zeros((3, 3), np.float32)), "row 0 is (0, 0, 0)"),
+        ("pattern 'x'", lambda: pa("x"), "pattern must be (M, 3)"),
+        # lidar_box_beams: a NaN pose gave no beams, a singular one LinAlgError, a scaled one wrong angles
+        ("angles a tuple", lambda: lbb((1, 2), pose, corners), "angles = (1, 2): must be the BeamAngles"),
+        ("pose (3, 3)", lambda: lbb(angles, np.eye(3), corners), "lidar_pose must be a (4, 4) rigid"),
+        ("pose singular", lambda: lbb(angles, np.zeros((4, 4)), corners), "lidar_pose must be a (4, 4) rigid"),
+        ("pose NaN", lambda: lbb(angles, pose + np.nan, corners), "not finite"),
+        ("pose scaled", lambda: lbb(angles, scaled, corners), "lidar_pose must be a (4, 4) rigid"),
+        ("corners (8, 2)", lambda: lbb(angles, pose, corners[:, :2]), "corners_world must be the (8, 3)"),
+        ("corners NaN", lambda: lbb(angles, pose, corners + np.nan), "corners_world must be"),
+        # lidar_beam_rays: -1 gave the last beam's ray, a boolean mask was read as one
+        ("beam -1", lambda: lbr(p, pose, np.array([-1])), "beams must be indices of the pattern's beams, in 0..3"),
+        ("beam 9", lambda: lbr(p, pose, np.array([9])), "got 9"),
+        ("float beams", lambda: lbr(p, pose, np.array([0.0, 1.0])), "beams must be (K,) beam indices"),
+        ("a mask", lambda: lbr(p, pose, np.array([True, False, True, False])), "got dtype bool"),
+        ("NaN beam", lambda: lbr(p + np.nan, pose, np.array([2])), "row 2"),
+        # lidar_box_rays: the angles of another pattern gave another pattern's beams
+        ("angles of 4, pattern of 2", lambda: lbx(p[:2], angles, pose, corners), "angles are of a pattern of 4"),
+    ]
+
+
+def test_the_helpers_refuse_bad_input_with_input_errors() -> None:
+    """Wrong shapes, NaN, wrong dtypes and counts gave bare numpy errors or quietly wrong answers (a share above 1,
+    a NaN ray counted as a miss, ``-1`` read as the last beam); each is now an ``InputError`` naming the argument
+    and what it must be."""
+    wrong = unrefused((label, call, InputError, words) for label, call, words in _bad_calls())
+    assert not wrong, "\n".join(wrong)
+
+
+def test_the_helpers_still_take_what_they_document() -> None:
+    """The checks refuse nothing valid: counts as numpy integers, patterns as lists, a float32 pose, empty beams,
+    and the right answers for them (worked out here)."""
+    assert share(np.int64(4), np.int32(3)) == 0.75 and share(0, 0) == 0.0 and share(4, 1) == 0.25
+    p = [[1, 0, 0], [0, 1, 0], [0, 0, 1], [-1, 0, 0]]
+    angles = pattern_angles(p)
+    np.testing.assert_array_equal(angles.az, [0.0, np.pi / 2, 0.0, np.pi])
+    np.testing.assert_array_equal(angles.el, [0.0, 0.0, np.pi / 2, 0.0])
+    th = 0.3
+    pose = np.array([[np.cos(th), -np.sin(th), 0, 5], [np.sin(th), np.cos(th), 0, 6], [0, 0, 1, 2], [0, 0, 0, 1]])
+    o, d = lidar_beam_rays(np.asarray(p, np.float32), pose.astype(np.float32), np.array([3, 0], np.uint8))
+    np.testing.assert_allclose(o, [[5, 6, 2], [5, 6, 2]])
+    np.testing.assert_allclose(d, [[-np.cos(th), -np.sin(th), 0], [np.cos(th), np.sin(th), 0]], atol=1e-7)
+    o, d = lidar_beam_rays(np.asarray(p, np.float32), pose, [])
+    assert o.shape == d.shape == (0, 3)
+    # A box 10 m straight ahead of the LiDAR (in its frame): the forward beam only.
+    ahead = np.array([[10.0 + sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+    corners = ahead @ pose[:3, :3].T + pose[:3, 3]
+    np.testing.assert_array_equal(lidar_box_beams(angles, pose, corners), [0])
+    scene, _, alone, _ = _world(None)
+    origins, dirs = _fan(np.array([0.0, 0.0, 2.0]), np.array([150.0, 0.0, 0.8]), n=8)
+    t = alone.cast_rays(origins, dirs).distance
+    n = int(np.count_nonzero(np.isfinite(t) & (origins[:, 2] + dirs[:, 2] * t > 0)))
+    assert exposed_hidden(scene, origins, dirs, t, max_range_m=np.float32(1e4)) == (n, 0) and n > 0
+
+
+def test_a_user_round_on_a_real_capture_is_unchanged() -> None:
+    """The LiDAR helpers on an ``open_sea_convoy.yaml`` capture (W2 waves), as a user would call them: the rig's
+    pattern, the capture's LiDAR pose and each vessel's box pass the checks, the beams are those a test of every
+    beam selects, and each share is that of the beams the capture's own cast found."""
+    from mmusv.annotate import SilhouetteCache, box_corners
+    from mmusv.frames import translation
+    from mmusv.simulation import Simulation
+
+    root = Path(__file__).resolve().parents[1]
+    sim, sil = Simulation(root / "scenarios" / "open_sea_convoy.yaml"), SilhouetteCache()
+    cap = sim.capture(0, sensors=["lidar"])
+    agent = sim.agents[0]
+    ac = cap.agents[agent.id]
+    pattern, pose, beams_hit = agent.lidar_pattern, ac.lidar_pose, ac.lidar_beams
+    assert pattern is not None and pose is not None and beams_hit is not None and agent.rig.lidar is not None
+    angles = pattern_angles(pattern)
+    shares = []
+    for vi, info in enumerate(sim.vessels):
+        if vi == agent.index:
+            continue
+        corners = box_corners(cap.world.matrices[vi] @ translation(info.box_center_body), info.box_size)
+        beams = lidar_box_beams(angles, pose, corners)
+        np.testing.assert_array_equal(beams, _box_beams_by_testing_every_beam(pattern, pose, corners))
+        o, d = lidar_box_rays(pattern, angles, pose, corners)
+        assert o.dtype == d.dtype == np.float32 and o.shape == d.shape == (len(beams), 3)
+        t = sil.distances(info.asset, cap.world.matrices[vi], o, d)
+        exposed, hidden = exposed_hidden(
+            sim.ws.scene, o, d, t, scene_instance=beams_hit[beams], max_range_m=agent.rig.lidar.range_m
+        )
+        water = sim.ws.scene.sea_instance
+        reach = np.isfinite(t) & (t <= agent.rig.lidar.range_m)
+        above = reach & (o[:, 2].astype(np.float64) + d[:, 2].astype(np.float64) * np.where(reach, t, 0.0) > 0.0)
+        assert exposed == int(above.sum()) and hidden == int(np.count_nonzero(beams_hit[beams][above] == water))
+        shares.append(share(exposed, hidden))
+    assert any(s > 0 for s in shares)

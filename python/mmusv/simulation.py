@@ -30,6 +30,7 @@ import numpy as np
 import numpy.typing as npt
 
 from mmusv import arguments
+from mmusv._equality import same
 from mmusv._native import core
 from mmusv.captures import AgentCapture, FrameCapture, SensorMount, VesselInfo, WorldState
 from mmusv.config import Scenario, VesselConfig, load_scenario
@@ -66,8 +67,32 @@ _SENSOR_CODES = {"lidar": 1, "radar": 2, "camera": 3, "top_view": 4}
 
 
 def sensor_seed(scenario_seed: int, frame: int, agent: int, sensor: str, index: int = 0) -> int:
-    """The 64-bit seed of one sensor capture: a hash of (scenario seed, frame, agent index, sensor, index)."""
-    key = f"{scenario_seed}/{frame}/{agent}/{_SENSOR_CODES.get(sensor, 9)}/{index}".encode()
+    """The 64-bit seed (a whole number in ``0..2**64 - 1``) of one sensor capture: a hash of (scenario seed, frame,
+    agent index, sensor, index), as :meth:`Simulation.capture` seeds its sensors.
+
+    Args:
+        scenario_seed: the scenario's ``seed``, a whole number in ``0..2**63 - 1`` (as the scenario allows).
+        frame: the acquisition index, a whole number >= 0.
+        agent: the agent's index (:attr:`Agent.index`, its position in the scenario's vessels), a whole number >= 0.
+        sensor: one of ``lidar``, ``radar``, ``camera``, ``top_view`` (one camera of the rig: ``camera``, with
+            ``index`` its position in the rig's cameras).
+        index: the camera's position in the rig's cameras (0 for the other sensors), a whole number >= 0.
+
+    Whole numbers are ``int`` or numpy integers (floats and booleans are refused); anything else is a
+    ``ConfigError`` naming the argument.
+    """
+    scenario_seed = arguments.whole(scenario_seed, name="scenario_seed", lo=0, hi=2**63 - 1)
+    frame = arguments.whole(frame, name="frame", lo=0)
+    agent = arguments.whole(agent, name="agent", lo=0)
+    index = arguments.whole(index, name="index", lo=0)
+    code = _SENSOR_CODES.get(sensor) if isinstance(sensor, str) else None
+    if code is None:
+        cameras = isinstance(sensor, str) and sensor == "cameras"  # capture's kind, not one sensor
+        hint = " (one camera is 'camera', with index its position in the rig's cameras)" if cameras else ""
+        raise ConfigError(
+            f"sensor = {arguments.shown(sensor)}: must be one of {', '.join(map(repr, _SENSOR_CODES))}{hint}"
+        )
+    key = f"{scenario_seed}/{frame}/{agent}/{code}/{index}".encode()
     return int.from_bytes(hashlib.blake2b(key, digest_size=8).digest(), "little")
 
 
@@ -88,9 +113,15 @@ def _built(where: str, kind: str, build: Callable[[], _T]) -> _T:
         raise ConfigError(f"invalid config {where}.{msg[len(prefix) :]}") from None
 
 
-@dataclass
+@dataclass(eq=False)
 class Agent:
-    """An instrumented USV and its native sensors (each configured once from the rig)."""
+    """An instrumented USV and its native sensors (each configured once from the rig).
+
+    Two agents compare equal (``==``) when they hold the same values, as captures do (:mod:`mmusv.captures`): the
+    same index, vessel, asset, rig and mounts (arrays by dtype, shape and value), and the same sensors present.
+    The native sensors are built from the rig, so they are compared through it: the agents of two simulations of
+    the same scenario are equal. Agents are not hashable (their fields can change): key them by :attr:`id`.
+    """
 
     index: int  # position in Simulation.vessels
     vessel: VesselConfig
@@ -102,6 +133,20 @@ class Agent:
     cameras: dict[str, tuple[core.Camera, CameraConfig, np.ndarray]] = field(default_factory=dict)
     top_view: core.Camera | None = None
     radar: core.Radar | None = None
+
+    def __eq__(self, other: object) -> bool:
+        """Whether ``other`` is an agent holding the same values (see the class docstring)."""
+        if type(other) is not type(self):
+            return NotImplemented
+        assert isinstance(other, Agent)
+        return same(self._compared(), other._compared())
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def _compared(self) -> tuple[Any, ...]:
+        """What :meth:`__eq__` compares: the values the agent's sensors are built from, and which sensors it has."""
+        present = (self.lidar is not None, self.radar is not None, self.top_view is not None, tuple(self.cameras))
+        return (self.index, self.vessel, self.asset, self.rig, self.mounts(), present)
 
     @property
     def id(self) -> str:
@@ -462,13 +507,24 @@ class Simulation:
 
     def sensor_poses(self, agent: Agent, state: WorldState) -> dict[str, np.ndarray]:
         """Sensor → world matrices of every sensor of ``agent`` in ``state``: keys ``lidar``, ``radar``,
-        ``camera/<name>``, ``top_view``."""
+        ``camera/<name>``, ``top_view``. ``agent`` is one of this simulation's agents (or one equal to it: of a
+        simulation of the same scenario), ``state`` a world state of this simulation (:meth:`world_state`)."""
         if not isinstance(agent, Agent):
             raise ConfigError(
                 f"agent = {arguments.shown(agent)}: must be an Agent (Simulation.agent(id) or Simulation.agents), "
                 f"not {type(agent).__name__}"
             )
+        if agent not in self.agents:  # another scenario's: its index would pick another vessel's pose
+            raise ConfigError(
+                f"agent {agent.id!r} (vessel index {agent.index}) is not an agent of this simulation: give "
+                f"Simulation.agent(id) of this one (its USVs are {[a.id for a in self.agents]})"
+            )
         _check_state(state)
+        if state.matrices.shape[0] != len(self.vessels):
+            raise ConfigError(
+                f"state holds {state.matrices.shape[0]} vessels, this simulation {len(self.vessels)}: give a state "
+                "of this simulation (Simulation.world_state(frame))"
+            )
         body = state.matrices[agent.index]
         out = {key: body @ m for key, m in agent.mounts().items()}
         if agent.top_view is not None and agent.rig.top_view is not None:

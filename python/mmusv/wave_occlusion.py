@@ -14,16 +14,23 @@ flat sea the share is 0 by construction; it is only computed where the scene has
   answer is the one the LiDAR's own cast found (:attr:`~mmusv.simulation.AgentCapture.lidar_beams`), read
   rather than cast again. Only the part of the vessel within the LiDAR's range counts.
 
-Frames: world x east, y north, z up, metres; directions need not be unit length.
+Frames: world x east, y north, z up, metres; directions need not be unit length. The LiDAR frame is the LiDAR's
+body frame (x forward, y left, z up); a LiDAR pose is the ``(4, 4)`` rigid LiDAR → world transform.
+
+Every function checks its arguments: an array of the wrong shape or dtype, a value that is not finite (where one
+must be), a count or index out of range is an :class:`~mmusv.errors.InputError` naming the argument and what it must
+be.
 """
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 
+from mmusv import arguments
+from mmusv.errors import InputError
 from mmusv.scene import Scene
 
 __all__ = [
@@ -38,8 +45,61 @@ __all__ = [
 
 
 def share(exposed: int, hidden: int) -> float:
-    """``hidden / exposed``, 0 for an empty exposed silhouette."""
+    """``hidden / exposed`` (a float in ``[0, 1]``), 0 for an empty exposed silhouette: the counts of
+    :func:`exposed_hidden`, whole numbers (``int`` or numpy integers) with ``0 <= hidden <= exposed``."""
+    exposed = arguments.whole(exposed, name="exposed", lo=0, error=InputError)
+    hidden = arguments.whole(hidden, name="hidden", lo=0, error=InputError)
+    if hidden > exposed:
+        raise InputError(f"hidden = {hidden}: must be <= exposed = {exposed} (the hidden rays are exposed rays)")
     return float(hidden / exposed) if exposed else 0.0
+
+
+def _array(value: Any, *, name: str, shape: tuple[int | None, ...], what: str, integer: bool = False) -> np.ndarray:
+    """``value`` as an array (not copied when it is one) of real numbers (``integer``: of integers) whose shape is
+    ``shape`` (``None``: any length on that axis), else an :class:`InputError` naming ``name`` and ``what`` it must
+    be. Booleans, complex numbers, strings and objects are refused."""
+    try:
+        a = np.asarray(value)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name} must be {what}: {exc}") from None
+    kinds = "iu" if integer else "fiu"
+    if a.dtype.kind not in kinds and not (integer and a.size == 0 and a.dtype.kind == "f"):
+        kind = "integers" if integer else "real numbers"
+        raise InputError(f"{name} must be {what} ({kind}), got dtype {a.dtype}")
+    if a.ndim != len(shape) or any(n is not None and a.shape[i] != n for i, n in enumerate(shape)):
+        raise InputError(f"{name} must be {what}, got shape {a.shape}")
+    return a
+
+
+def _finite(a: np.ndarray, *, name: str, what: str) -> None:
+    """An :class:`InputError` naming ``name`` and the first row of ``a`` that is not finite."""
+    bad = ~np.isfinite(a)
+    if bad.any():
+        row = int(np.argwhere(bad)[0][0]) if a.ndim else 0
+        raise InputError(f"{name} must be {what}: row {row} ({a[row].tolist()}) is not finite")
+
+
+def _nonzero_rows(a: np.ndarray, *, name: str, what: str) -> None:
+    """An :class:`InputError` naming ``name`` and the first row of the ``(N, 3)`` ``a`` that is all zeros (no
+    direction)."""
+    zero = ~a.any(axis=1)
+    if zero.any():
+        raise InputError(f"{name} must be {what}: row {int(np.argmax(zero))} is (0, 0, 0), which has no direction")
+
+
+def _rigid(value: Any, *, name: str) -> np.ndarray:
+    """``value`` as a ``(4, 4)`` array (its own real dtype, so that the arithmetic on it is what it was without the
+    check) of a rigid transform (finite; rotation block orthonormal within 1e-5, last row ``0 0 0 1``), else an
+    :class:`InputError` naming ``name``."""
+    what = "a (4, 4) rigid LiDAR → world transform (metres; rotation, translation, last row 0 0 0 1)"
+    given = _array(value, name=name, shape=(4, 4), what=what)
+    m = np.asarray(given, dtype=np.float64)
+    if not np.isfinite(m).all():
+        raise InputError(f"{name} must be {what}: it holds values that are not finite")
+    r = m[:3, :3]
+    if np.abs(m[3] - (0.0, 0.0, 0.0, 1.0)).max() > 1e-9 or np.abs(r @ r.T - np.eye(3)).max() > 1e-5:
+        raise InputError(f"{name} must be {what}: got {np.round(m, 6).tolist()}")
+    return given
 
 
 def exposed_hidden(
@@ -51,18 +111,54 @@ def exposed_hidden(
     scene_instance: npt.NDArray[np.int32] | None = None,
     max_range_m: float = float("inf"),
 ) -> tuple[int, int]:
-    """``(exposed, hidden)`` ray counts of one target (see the module docstring).
+    """``(exposed, hidden)`` ray counts of one target (see the module docstring): ``int``, ``0 <= hidden <=
+    exposed <= N``.
 
     Args:
-        scene: the full scene, with its sea and wave surface set.
-        origins, directions: ``(N, 3)`` float32 world rays (any non-zero direction length).
-        vessel_t: ``(N,)`` float32 distance (in units of each direction's length) at which each ray meets the
-            vessel alone, ``inf`` where it misses it.
-        scene_instance: ``(N,)`` int32 instance each ray meets first in the full scene, when already known (a
-            camera's instance image, a LiDAR's beams); else the rays are cast here.
-        max_range_m: only the part of the vessel within this distance (metres) of the origins counts (a LiDAR's
-            range: what lies beyond it is neither seen nor hidden).
+        scene: the full scene (a :class:`~mmusv.scene.Scene`), with its sea and wave surface set.
+        origins: ``(N, 3)`` float32 (any real dtype) world ray origins, metres, finite.
+        directions: ``(N, 3)`` float32 (any real dtype) world ray directions, finite, any non-zero length.
+        vessel_t: ``(N,)`` float32 (any real dtype) distance, in units of each direction's length (metres for unit
+            directions), at which each ray meets the vessel alone, ``>= 0``, ``inf`` where it misses it (not NaN).
+            :meth:`Scene.cast_rays <mmusv.scene.Scene.cast_rays>` gives metres along the normalised direction: give
+            unit directions with its distances.
+        scene_instance: ``(N,)`` int32 (any integer dtype) instance each ray meets first in the full scene, when
+            already known (a camera's instance image, a LiDAR's beams); else the rays are cast here.
+        max_range_m: only the part of the vessel within this distance (metres, ``> 0``, ``inf``: all of it) of the
+            origins counts (a LiDAR's range: what lies beyond it is neither seen nor hidden).
     """
+    if not isinstance(scene, Scene):
+        raise InputError(
+            f"scene = {arguments.shown(scene)}: must be a mmusv.scene.Scene (the full scene, with its sea), not "
+            f"{type(scene).__name__}"
+        )
+    origins = _array(origins, name="origins", shape=(None, 3), what="(N, 3) world ray origins (float, metres)")
+    n_rays = origins.shape[0]
+    directions = _array(
+        directions, name="directions", shape=(n_rays, 3), what=f"(N, 3) world ray directions (float), N = {n_rays}"
+    )
+    vessel_t = _array(
+        vessel_t, name="vessel_t", shape=(n_rays,), what=f"(N,) float distances along the rays, N = {n_rays}"
+    )
+    _finite(origins, name="origins", what="finite world points (metres)")
+    _finite(directions, name="directions", what="finite directions")
+    _nonzero_rows(directions, name="directions", what="directions of any non-zero length")
+    if np.isnan(vessel_t).any() or (vessel_t < 0).any():
+        row = int(np.argmax(np.isnan(vessel_t) | (vessel_t < 0)))
+        raise InputError(
+            f"vessel_t must be distances >= 0 (inf where a ray misses the vessel): row {row} is {vessel_t[row]}"
+        )
+    if scene_instance is not None:
+        scene_instance = _array(
+            scene_instance,
+            name="scene_instance",
+            shape=(n_rays,),
+            what=f"(N,) instance ids, N = {n_rays}",
+            integer=True,
+        )
+    max_range_m = arguments.real(
+        max_range_m, name="max_range_m", unit="metres", above=0.0, finite=False, error=InputError
+    )
     o = np.asarray(origins, dtype=np.float64)
     d = np.asarray(directions, dtype=np.float64)
     t = np.asarray(vessel_t, dtype=np.float64)
@@ -98,13 +194,15 @@ _LAST: dict[int, tuple[npt.NDArray[np.float32], BeamAngles]] = {}
 
 
 def pattern_angles(pattern: npt.NDArray[np.float32]) -> BeamAngles:
-    """The :class:`BeamAngles` (azimuth, elevation, radians) of a LiDAR's unit beam directions ``pattern``
-    ``(M, 3)`` (LiDAR frame), to pass to :func:`lidar_box_rays`. Remembered by content: a rig's pattern is worked
-    out once, not per frame; a read-only array that owns its data (``Agent.lidar_pattern``), passed again, is
-    recognised by identity without hashing it."""
+    """The :class:`BeamAngles` (azimuth, elevation, radians, float64) of a LiDAR's unit beam directions ``pattern``
+    ``(M, 3)`` float32 (any real dtype, taken as float32; LiDAR frame; finite, none ``(0, 0, 0)``), to pass to
+    :func:`lidar_box_rays`. Remembered by content: a rig's pattern is worked out once, not per frame; a read-only
+    array that owns its data (``Agent.lidar_pattern``), passed again, is recognised by identity without hashing
+    it."""
     same = _LAST.get(id(pattern))
     if same is not None and same[0] is pattern and _frozen(pattern):
         return same[1]  # the very (read-only) array of the last call: a rig's pattern, passed every frame
+    _pattern(pattern)
     p = np.ascontiguousarray(pattern, dtype=np.float32)
     key = (p.shape, hash(p.tobytes()))
     hit = _ANGLES.get(key)
@@ -121,6 +219,37 @@ def pattern_angles(pattern: npt.NDArray[np.float32]) -> BeamAngles:
     _ANGLES[key] = (p.copy(), out)
     _remember(pattern, out)
     return out
+
+
+_PATTERN = "(M, 3) float32 unit beam directions in the LiDAR frame"
+
+
+def _pattern(value: Any) -> np.ndarray:
+    """``value`` checked as a LiDAR pattern (:data:`_PATTERN`: finite, no ``(0, 0, 0)`` row), else an
+    :class:`InputError`."""
+    p = _array(value, name="pattern", shape=(None, 3), what=_PATTERN)
+    _finite(p, name="pattern", what="finite directions")
+    _nonzero_rows(p, name="pattern", what=_PATTERN)
+    return p
+
+
+def _angles(value: Any) -> BeamAngles:
+    """``value`` when it is the :class:`BeamAngles` of a pattern (:func:`pattern_angles`), else an
+    :class:`InputError`."""
+    if not isinstance(value, BeamAngles):
+        raise InputError(
+            f"angles = {arguments.shown(value)}: must be the BeamAngles of the pattern (pattern_angles(pattern)), "
+            f"not {type(value).__name__}"
+        )
+    return value
+
+
+def _box(value: Any) -> np.ndarray:
+    """``value`` checked as ``(8, 3)`` finite world box corners, else an :class:`InputError`."""
+    what = "the (8, 3) world corners of a box (float, metres)"
+    c = _array(value, name="corners_world", shape=(8, 3), what=what)
+    _finite(c, name="corners_world", what=what)
+    return c
 
 
 def _frozen(a: object) -> bool:
@@ -143,10 +272,17 @@ def lidar_box_rays(
     lidar_pose: npt.NDArray[np.float64],
     corners_world: npt.NDArray[np.float64],
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
-    """The LiDAR's world rays ``(origins, directions)`` (each ``(K, 3)`` float32, in pattern order) whose
-    direction lies within the azimuth and elevation extent of the box ``corners_world`` ``(8, 3)`` seen from the
-    LiDAR at ``lidar_pose`` ``(4, 4)`` LiDAR → world; ``pattern`` ``(M, 3)`` unit directions in the LiDAR frame,
-    ``angles`` their :func:`pattern_angles`. The rays of :func:`lidar_box_beams`' beams."""
+    """The LiDAR's world rays ``(origins, directions)`` (each ``(K, 3)`` float32, world frame: origins in metres,
+    unit directions, in pattern order) whose direction lies within the azimuth and elevation extent of the box
+    ``corners_world`` ``(8, 3)`` float64 (world, metres) seen from the LiDAR at ``lidar_pose`` ``(4, 4)`` float64
+    rigid LiDAR → world; ``pattern`` ``(M, 3)`` float32 unit directions in the LiDAR frame, ``angles`` their
+    :func:`pattern_angles` (of the same ``M`` beams). The rays of :func:`lidar_box_beams`' beams."""
+    m = _pattern(pattern).shape[0]
+    n = _angles(angles).az.shape[0]
+    if n != m:
+        raise InputError(
+            f"angles are of a pattern of {n} beams, pattern has {m}: give pattern_angles(pattern) of this pattern"
+        )
     return lidar_beam_rays(pattern, lidar_pose, lidar_box_beams(angles, lidar_pose, corners_world))
 
 
@@ -155,9 +291,12 @@ def lidar_box_beams(
     lidar_pose: npt.NDArray[np.float64],
     corners_world: npt.NDArray[np.float64],
 ) -> npt.NDArray[np.int64]:
-    """``(K,)`` pattern indices (ascending) of the beams whose direction lies within the azimuth and elevation
-    extent of the box ``corners_world`` ``(8, 3)`` seen from the LiDAR at ``lidar_pose`` ``(4, 4)`` LiDAR →
-    world; ``angles`` the pattern's :func:`pattern_angles`."""
+    """``(K,)`` int64 pattern indices (ascending) of the beams whose direction lies within the azimuth and
+    elevation extent of the box ``corners_world`` ``(8, 3)`` float64 (world, metres) seen from the LiDAR at
+    ``lidar_pose`` ``(4, 4)`` float64 rigid LiDAR → world; ``angles`` the pattern's :func:`pattern_angles`."""
+    angles = _angles(angles)
+    lidar_pose = _rigid(lidar_pose, name="lidar_pose")
+    corners_world = _box(corners_world)
     inv = np.linalg.inv(lidar_pose)
     c = corners_world @ inv[:3, :3].T + inv[:3, 3]
     az = np.arctan2(c[:, 1], c[:, 0])
@@ -179,10 +318,26 @@ def lidar_box_beams(
 def lidar_beam_rays(
     pattern: npt.NDArray[np.float32], lidar_pose: npt.NDArray[np.float64], beams: npt.NDArray[np.int64]
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
-    """The world rays ``(origins, directions)`` (each ``(K, 3)`` float32) of the pattern's ``beams`` (indices)
-    from the LiDAR at ``lidar_pose`` ``(4, 4)`` LiDAR → world."""
-    # Only the selected beams are widened to float64 (the same values as widening the whole pattern first).
-    dirs = (np.asarray(pattern)[beams].astype(np.float64) @ lidar_pose[:3, :3].T).astype(np.float32)
+    """The world rays ``(origins, directions)`` (each ``(K, 3)`` float32, world frame: origins in metres,
+    directions the beams' turned by the pose) of the pattern's ``beams`` (``(K,)`` integer indices in ``0..M - 1``,
+    in the order given) from the LiDAR at ``lidar_pose`` ``(4, 4)`` float64 rigid LiDAR → world; ``pattern``
+    ``(M, 3)`` float32 unit directions in the LiDAR frame."""
+    p = _array(pattern, name="pattern", shape=(None, 3), what=_PATTERN)
+    lidar_pose = _rigid(lidar_pose, name="lidar_pose")
+    m = p.shape[0]
+    beams = _array(beams, name="beams", shape=(None,), what=f"(K,) beam indices in 0..{m - 1}", integer=True)
+    if beams.size == 0:
+        beams = beams.astype(np.int64)
+    elif beams.min() < 0 or beams.max() >= m:
+        bad = beams[(beams < 0) | (beams >= m)][0]
+        raise InputError(f"beams must be indices of the pattern's beams, in 0..{m - 1}: got {bad}")
+    # Only the selected beams are checked, and widened to float64 (the same values as widening the whole pattern).
+    chosen = p[beams]
+    bad = ~np.isfinite(chosen).all(axis=1) | ~chosen.any(axis=1)
+    if bad.any():
+        k = int(beams[np.argmax(bad)])
+        raise InputError(f"pattern must be {_PATTERN}: row {k} ({p[k].tolist()}) is not a finite non-zero direction")
+    dirs = (chosen.astype(np.float64) @ lidar_pose[:3, :3].T).astype(np.float32)
     origins = np.tile(lidar_pose[:3, 3].astype(np.float32), (dirs.shape[0], 1))
     return origins, dirs
 
