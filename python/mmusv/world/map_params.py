@@ -224,6 +224,8 @@ class PortParams(_CommonParams):
     n_buildings: int = Field(default=8, ge=0, le=200)
     n_channel_buoy_pairs: int = Field(default=3, ge=0, le=50)
     n_moored: int = Field(default=4, ge=0, le=50)
+    """Ships moored at the terminal quay and the piers (labelled ``moored_00``, ...); a port whose quay and piers
+    have fewer free berths for ``moored_assets`` is refused when it is built, naming the most that fit."""
     moored_assets: tuple[_Berth, ...] = DEFAULT_MOORED_ASSETS
     """Candidate moored ships: ``(asset_name, length_m, beam_m)``."""
     hill_height_m: float = Field(default=35.0, ge=0.0, le=200.0)

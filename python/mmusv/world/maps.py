@@ -383,6 +383,16 @@ def generate_port(*, seed: int, params: PortParams | None = None) -> MapWorld:
         return hf.sample(np.asarray(c, dtype=np.float64) @ m.T)
 
     built = port_structures(p, plan, ground=ground, rng=rng)
+    if len(built.berths) < p.n_moored:
+        # Refused, as islands that do not fit are: fewer ships than asked would be a map other than the one given
+        # (and `params` records what was built).
+        raise MapConfigError(
+            "n_moored",
+            p.n_moored,
+            f"at most {len(built.berths)} with this map seed and layout: the quay and piers of this port have free "
+            f"berths for only {len(built.berths)} of the {p.n_moored} moored ships (lower n_moored, add piers with "
+            "n_piers, or give shorter moored_assets)",
+        )
     structures = [transformed(s, rotation=rot3) for s in built.parts]
     buoys = [np.asarray(b, dtype=np.float64) @ m.T for b in built.buoys]
     moored: list[tuple[str, tuple[float, float, float]]] = []
