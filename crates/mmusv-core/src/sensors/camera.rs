@@ -425,7 +425,9 @@ impl Camera {
         let shared = if q == Quality::High { None } else { Some(grid) };
         // Reflections spread over the water's roughness (pinhole cameras; the top view looks straight down).
         let glossy = match self.cfg.projection {
-            Projection::Pinhole { .. } if pixel_rad > 0.0 => Some((grid, 1.0 / pixel_rad, image_roll(pose))),
+            Projection::Pinhole { .. } if pixel_rad > 0.0 => {
+                Some((grid, 1.0 / pixel_rad, image_roll(pose), options.seed))
+            }
             _ => None,
         };
         let shaded = radiance::radiance(scene, &shader, env.shadows, refl, shared, glossy, (&origins, &dirs, &hits))?;

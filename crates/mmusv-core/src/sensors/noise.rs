@@ -18,6 +18,8 @@ pub mod stream {
     pub const RAIN: u64 = 5;
     /// Water surface ripples in camera images.
     pub const RIPPLE: u64 = 6;
+    /// The directions of a camera's traced water reflections (`camera/glossy.rs`).
+    pub const GLOSSY: u64 = 7;
 }
 
 #[inline]

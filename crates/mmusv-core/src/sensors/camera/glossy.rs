@@ -1,5 +1,5 @@
-//! Glossy water reflections: a camera's traced mirror reflections spread over the reflection lobe of the
-//! water's unresolved roughness, in screen space.
+//! Glossy water reflections: a camera's reflections traced in directions drawn from the reflection lobe of the
+//! water's unresolved roughness, then spread over the rest of it in screen space.
 //!
 //! **Model.** The water's roughness below the surface's sampling is a Gaussian slope distribution of mean square
 //! slope `σ² = α²` (both axes; C. Cox & W. Munk, "Measurement of the Roughness of the Sea Surface from
@@ -12,18 +12,28 @@
 //! (`σ_1 = α/√2` per axis; radians of view, the azimuth's at the mirror direction's elevation `γ`). That is why
 //! reflections on a breezy sea stretch into vertical streaks and lose their outlines.
 //!
-//! **Screen space.** A pinhole camera turns those angles into pixels (`f` pixels per radian at the image centre):
-//! each water pixel's reflected radiance becomes the mean of the traced reflections around it under that lobe,
-//! the screen-space filtering of glossy reflections real-time renderers use (T. Stachowiak, "Stochastic
-//! Screen-Space Reflections", SIGGRAPH 2015 Advances in Real-Time Rendering; here deterministic). Only water
-//! takes part. The lobe is a tent of two box filters per axis (P. S. Heckbert, "Filtering by repeated
-//! integration", SIGGRAPH 1986), each box read from prefix sums, so any width costs the same; the boxes' widths
-//! and shift follow each place's own lobe. The sums run on a grid of cells of several pixels, as coarse as the
-//! narrowest lobe allows (four cells to its standard deviation, [`decimation`]), and each pixel reads them back
-//! bilinearly. The grid is laid along the world's vertical as the image shows it (turned by the camera's roll),
-//! so a rolling USV's streaks stay vertical in the world. Approximations: the lobe is taken at the image's focal
-//! length everywhere, the mirror image is taken as smooth between the traced reflections, and the lobe is cut
-//! where the water ends in the image (at a hull's waterline: there the mean is over the water that remains).
+//! **Traced, then spread in screen space.** Each traced reflection leaves in a direction drawn from the lobe at
+//! its own point ([`lobe_ray`]: the mirror direction turned by the lobe's mean offset and a Gaussian draw of
+//! `√(1 − κ²)` of its spreads, `κ` = [`SCREEN_SHARE`]; the draws stratified over each 4 × 4 block of traced
+//! reflections, [`stratum`]), and a pinhole camera then spreads the traced reflections over the remaining `κ` of
+//! the lobe in screen space (`f` pixels per radian at the image centre): each water pixel's reflected radiance
+//! becomes the mean of the traced reflections around it under that share of the lobe — the variances add up to
+//! the lobe's. This is the stochastic screen-space filtering of glossy reflections of real-time renderers (T.
+//! Stachowiak, "Stochastic Screen-Space Reflections", SIGGRAPH 2015 Advances in Real-Time Rendering: rays drawn
+//! from the BRDF, resolved by a spatial filter), with stratified rather than random draws. Drawing the directions
+//! at each point matters where what is reflected stands close behind the water: the mirror rays of the water
+//! farther below a hull pass over it, so a spread of mirror rays alone lost most of the hull's reflection seen
+//! near the horizon (Mitsuba's comparison scene `grazing`, 2.1 times the reference's radiance there). Only
+//! water takes part. The screen-space share is a tent of two box filters per axis (P. S. Heckbert, "Filtering by
+//! repeated integration", SIGGRAPH 1986), each box read from prefix sums, so any width costs the same; the boxes'
+//! widths follow each place's own lobe. The sums run on a grid of cells of several pixels, as coarse as the
+//! narrowest screen-space share allows (four cells to its standard deviation, [`decimation`]), and each pixel
+//! reads them back bilinearly. The grid is laid along the world's vertical as the image shows it (turned by the
+//! camera's roll), so a rolling USV's streaks stay vertical in the world. Approximations: the lobe is a Gaussian
+//! of the microfacet lobe's moments; its screen-space share is taken at the image's focal length everywhere; and
+//! where the water ends in the image, down the image the missing reflections are the nearest traced ones in the
+//! same column (a hull standing on the water: the reflections just below it, which show the hull) and past the
+//! image's top and bottom its edge rows, while across the image the mean is over the water that remains.
 //!
 //! **The sky's part.** The screen space cannot look past the image's edge: a lens narrower than the lobe, or a
 //! view steeply down, would read the sky of the mirror directions around the pixel instead of the lobe's mean (a
@@ -35,8 +45,46 @@
 //! screen-space spread, scaled by how much the sky's part is off there; and it is never negative (a sum
 //! `lobe_sky + blur(value − sky)` went below zero where a dark hull hid a much brighter sky, at dusk).
 
+use crate::sensors::noise;
 use crate::sensors::shade::rough_water;
 use parry3d::math::Vec3;
+
+/// The share `κ` of the lobe's spread (its standard deviations) left to the screen-space blur: each traced
+/// reflection leaves in a direction drawn from the lobe narrowed to `√(1 − κ²)` of its spread around its mean
+/// ([`lobe_ray`]), so that the two together spread as the lobe does (variances add).
+pub const SCREEN_SHARE: f32 = 0.5;
+
+/// The point in `[0, 1)²` that draws the direction of the reflection traced at pixel `(x, y)`, traced every
+/// `spacing` pixels: the 16 points of a Hammersley set laid over each 4 × 4 block of traced reflections in the
+/// order of a Bayer matrix (neighbours draw far-apart points, so that the blur averages the whole set over a few
+/// blocks), the set shifted by a draw of `seed` (Cranley–Patterson rotation: every seed its own, unbiased set).
+pub fn stratum(x: u32, y: u32, spacing: u32, seed: u64) -> [f32; 2] {
+    const BAYER: [[u32; 4]; 4] = [[0, 8, 2, 10], [12, 4, 14, 6], [3, 11, 1, 9], [15, 7, 13, 5]];
+    let s = spacing.max(1);
+    let i = BAYER[((y / s) % 4) as usize][((x / s) % 4) as usize];
+    let reversed = ((i & 1) << 3) | ((i & 2) << 1) | ((i & 4) >> 1) | ((i & 8) >> 3);
+    let shift =
+        [noise::uniform(seed, noise::stream::GLOSSY, 0) as f32, noise::uniform(seed, noise::stream::GLOSSY, 1) as f32];
+    let point = [(i as f32 + 0.5) / 16.0, (reversed as f32 + 0.5) / 16.0];
+    [(point[0] + shift[0]).fract(), (point[1] + shift[1]).fract()]
+}
+
+/// A direction drawn from the reflection lobe around the `mirror` direction (unit; the mirror image of the view
+/// ray about the shading normal) of water of mean square slope `mss` seen at grazing sine `sin_grazing`, by the
+/// point `u` of `[0, 1)²`: the mirror direction turned by the lobe's mean offset in elevation plus a Gaussian
+/// draw (Box–Muller) of `√(1 − κ²)` of its standard deviations in elevation and azimuth ([`rough_water::lobe`],
+/// [`SCREEN_SHARE`]), kept above the horizon as the mirror direction is (a draw below it is mirrored back up).
+pub fn lobe_ray(mirror: Vec3, mss: f32, sin_grazing: f32, u: [f32; 2]) -> Vec3 {
+    let [de, se, sa] = rough_water::lobe(sin_grazing.clamp(0.0, 1.0), mss.max(0.0).sqrt());
+    let q = (1.0 - SCREEN_SHARE * SCREEN_SHARE).sqrt();
+    let radius = (-2.0 * (1.0 - u[0]).max(1e-7).ln()).sqrt();
+    let (s, c) = (std::f32::consts::TAU * u[1]).sin_cos();
+    let e = mirror.z.clamp(-1.0, 1.0).asin() + de + q * se * radius * c;
+    let a = mirror.y.atan2(mirror.x) + q * sa * radius * s;
+    let (se_, ce) = e.sin_cos();
+    let (sa_, ca) = a.sin_cos();
+    Vec3::new(ce * ca, ce * sa_, se_.abs().max(1e-4)).normalize()
+}
 
 /// One traced water reflection: its pixel (`x`, `y`, the pixel's index), the reflected radiance (linear RGB),
 /// the sky's radiance along the same reflected ray (what it brings back when it meets nothing) and the sky's mean
@@ -74,6 +122,7 @@ pub fn lobe_px(mss: f32, sin_grazing: f32, f_px: f32) -> [f32; 3] {
 
 /// The narrowest lobe down the image (pixels) of water whose mean square slope is at least `mss_min`: at the
 /// grazing views where it is narrowest, about 0.6 of the first-order spread `2σ₁ f` (`rough_water.rs`).
+/// That is the lobe's; the screen-space blur spreads [`SCREEN_SHARE`] of it.
 #[inline]
 pub fn narrowest_lobe_px(mss_min: f32, f_px: f32) -> f32 {
     0.6 * 2.0 * (0.5 * mss_min.max(0.0)).sqrt() * f_px
@@ -200,7 +249,7 @@ pub fn blur(width: usize, height: usize, f_px: f32, spacing: usize, roll: f32, s
     }
     // The narrowest lobe: the calmest water's, at grazing views.
     let mss_min = samples.iter().map(|s| s.mss).fold(f32::INFINITY, f32::min);
-    let [dx, dy] = decimation(narrowest_lobe_px(mss_min, f_px), spacing);
+    let [dx, dy] = decimation(SCREEN_SHARE * narrowest_lobe_px(mss_min, f_px), spacing);
     let frame = Frame::new(width, height, roll);
     let [ew, eh] = frame.bounds(width, height)[1];
     let (cw, ch) = ((ew.ceil() as usize).div_ceil(dx).max(1), (eh.ceil() as usize).div_ceil(dy).max(1));
@@ -222,8 +271,8 @@ pub fn blur(width: usize, height: usize, f_px: f32, spacing: usize, roll: f32, s
         geo[c][1] += s.mss;
         lobe_sky[c] += s.lobe_sky;
     }
-    // Per cell, its lobe (in cells): the half-widths of each box of the tent (a box of width 2r has variance
-    // r²/3; two of σ/√2 make σ), and each vertical box's shift (half the lobe's).
+    // Per cell, its share of the lobe (in cells): the half-widths of each box of the tent (a box of width 2r has
+    // variance r²/3; two of σ/√2 make σ). No shift: the traced directions carry the lobe's mean offset.
     let radius: Vec<[f32; 3]> = sum
         .iter()
         .zip(&geo)
@@ -231,16 +280,31 @@ pub fn blur(width: usize, height: usize, f_px: f32, spacing: usize, roll: f32, s
             if s[COUNT] <= 0.0 {
                 return [0.0; 3];
             }
-            let [lx, ly, off] = lobe_px(g[1] / s[COUNT], g[0] / s[COUNT], f_px);
-            let k = 1.5f32.sqrt();
-            [lx / dx as f32 * k, ly / dy as f32 * k, 0.5 * off / dy as f32]
+            let [lx, ly, _] = lobe_px(g[1] / s[COUNT], g[0] / s[COUNT], f_px);
+            let k = 1.5f32.sqrt() * SCREEN_SHARE;
+            [lx / dx as f32 * k, ly / dy as f32 * k, 0.0]
         })
         .collect();
     // The sky's lobe mean of each cell's own samples (not spread: it is the lobe's already).
     let own: Vec<Option<Vec3>> =
         sum.iter().zip(lobe_sky).map(|(s, l)| (s[COUNT] > 0.0).then(|| l / s[COUNT])).collect();
-    let mut cur = sum;
-    for axis in [1usize, 1, 0, 0] {
+    // Down the image the lobe is cut by what is not water (a hull standing on it, the horizon, the image's top and
+    // bottom edges): there the missing reflections are taken as the nearest traced ones in the same column (and
+    // beyond the edges as the edge's), clamped rather than left out, so that a water pixel just below a hull still
+    // reads the hull's reflection over the part of its lobe the hull hides (left out, the mean leant to the water
+    // farther below, which reflects what is higher: the sky over a low hull). Across the image, where the lobe
+    // runs along the water and past a hull's sides, the mean stays over the water that remains.
+    let water: Vec<bool> = sum.iter().map(|s| s[COUNT] > 0.0).collect();
+    let mut cur = fill_columns(&sum, cw, ch);
+    for axis in [1usize, 1] {
+        cur = box_pass(&cur, &radius, cw, ch, axis);
+    }
+    for (c, w) in cur.iter_mut().zip(&water) {
+        if !w {
+            *c = [0.0; SUMS];
+        }
+    }
+    for axis in [0usize, 0] {
         cur = box_pass(&cur, &radius, cw, ch, axis);
     }
     let mean = cur
@@ -263,9 +327,48 @@ pub fn blur(width: usize, height: usize, f_px: f32, spacing: usize, roll: f32, s
     Some(Blurred { frame, dx, dy, shift, cw, ch, mean })
 }
 
+/// The `cw × ch` grid of sums with each empty cell (no sample) given the sums of the nearest cell with samples in
+/// its column (the one below on a tie); a column without samples stays empty.
+fn fill_columns(src: &[[f32; SUMS]], cw: usize, ch: usize) -> Vec<[f32; SUMS]> {
+    let mut out = src.to_vec();
+    for x in 0..cw {
+        let full: Vec<usize> = (0..ch).filter(|&y| src[y * cw + x][COUNT] > 0.0).collect();
+        if full.is_empty() {
+            continue;
+        }
+        let mut next = 0; // index into `full` of the first full row at or below y
+        for y in 0..ch {
+            while next < full.len() && full[next] < y {
+                next += 1;
+            }
+            if src[y * cw + x][COUNT] > 0.0 {
+                continue;
+            }
+            let below = full.get(next).copied();
+            let above = next.checked_sub(1).map(|i| full[i]);
+            let from = match (above, below) {
+                (Some(a), Some(b)) => {
+                    if y - a < b - y {
+                        a
+                    } else {
+                        b
+                    }
+                }
+                (Some(a), None) => a,
+                (None, Some(b)) => b,
+                (None, None) => continue,
+            };
+            out[y * cw + x] = src[from * cw + x];
+        }
+    }
+    out
+}
+
 /// One box pass along `axis` (0: along rows, 1: along columns) over the `cw × ch` grid of sums: each cell takes
 /// the sum over the box of half-width `radius[c][axis]` cells centred on it (down the columns, `radius[c][2]`
-/// cells below it), fractional ends read linearly from prefix sums; at least a cell's width.
+/// cells below it), fractional ends read linearly from prefix sums; at least a cell's width. Down the columns
+/// the grid is taken as continued past its ends by its end cells, as far again as it is tall (the image's top and
+/// bottom rows clamped); along the rows it ends there.
 fn box_pass(src: &[[f32; SUMS]], radius: &[[f32; 3]], cw: usize, ch: usize, axis: usize) -> Vec<[f32; SUMS]> {
     let (lines, len) = if axis == 0 { (ch, cw) } else { (cw, ch) };
     let at = move |line: usize, k: usize| if axis == 0 { line * cw + k } else { k * cw + line };
@@ -276,8 +379,18 @@ fn box_pass(src: &[[f32; SUMS]], radius: &[[f32; 3]], cw: usize, ch: usize, axis
             let s = src[at(line, k)];
             prefix[k + 1] = std::array::from_fn(|c| prefix[k][c] + f64::from(s[c]));
         }
-        // The sums of the cells over the continuous interval [0, x) (x ≥ 0: truncation is the floor).
+        let (first, last) = (src[at(line, 0)], src[at(line, len - 1)]);
+        // The sums of the cells over the continuous interval [0, x) (x ≥ 0: truncation is the floor); down the
+        // columns, past the ends, the end cells repeated (as far as the grid is tall: a lobe far taller than the
+        // image would otherwise read little but its edge rows).
         let cum = |x: f32| -> [f64; SUMS] {
+            if axis == 1 && x < 0.0 {
+                return std::array::from_fn(|c| f64::from(x.max(-(len as f32))) * f64::from(first[c]));
+            }
+            if axis == 1 && x > len as f32 {
+                let past = f64::from((x - len as f32).min(len as f32));
+                return std::array::from_fn(|c| prefix[len][c] + past * f64::from(last[c]));
+            }
             let x = x.clamp(0.0, len as f32);
             let i = (x as usize).min(len);
             if i == len {
@@ -353,12 +466,14 @@ mod tests {
         let Some(b) = blur(w, h, 500.0, 1, 0.0, &s) else { panic!("no blur") };
         let out = image(&b, w, h);
         let (m, sd) = moments(&out, w);
-        // Each pixel is a normalised mean over the lobe around it: a unit point spreads into the kernel mirrored
-        // (every pixel whose lobe reaches it), with the kernel's spread (within the discretisation of the boxes
-        // and the coarse grid).
-        assert!((m[0] - 200.0).abs() < 2.0 && (m[1] - (600.0 - f64::from(off))).abs() < 4.0, "centre {m:?}");
-        assert!((sd[0] - f64::from(lx)).abs() < 2.0, "horizontal σ {} px, want {lx}", sd[0]);
-        assert!((sd[1] - f64::from(ly)).abs() < 5.0, "vertical σ {} px, want {ly}", sd[1]);
+        // Each pixel is a normalised mean over its share of the lobe around it (SCREEN_SHARE of its spread; the
+        // traced directions carry the rest and the lobe's offset, `lobe_ray`): a unit point spreads into that
+        // kernel mirrored (every pixel whose kernel reaches it), with its spread (within the discretisation of
+        // the boxes and the coarse grid) and no offset.
+        let (kx, ky) = (f64::from(SCREEN_SHARE * lx), f64::from(SCREEN_SHARE * ly));
+        assert!((m[0] - 200.0).abs() < 2.0 && (m[1] - 600.0).abs() < 3.0, "centre {m:?}");
+        assert!((sd[0] - kx).abs() < 1.5, "horizontal σ {} px, want {kx}", sd[0]);
+        assert!((sd[1] - ky).abs() < 3.0, "vertical σ {} px, want {ky}", sd[1]);
         // The channels stay in proportion, and what is spread is what was there (a sum over the pixels).
         let total: Vec3 = out.iter().copied().sum();
         assert!((total.y / total.x - 2.0).abs() < 1e-3 && (total.z / total.x - 3.0).abs() < 1e-3);
@@ -389,8 +504,62 @@ mod tests {
         let (c, sn) = (angle.cos(), angle.sin());
         let along = (syy * c * c + sxx * sn * sn + 2.0 * sxy * sn * c).sqrt();
         let across = (sxx * c * c + syy * sn * sn - 2.0 * sxy * sn * c).sqrt();
-        assert!((along - f64::from(ly)).abs() < 6.0, "along {along}, want {ly}");
-        assert!((across - f64::from(lx)).abs() < 3.0, "across {across}, want {lx}");
+        let (kx, ky) = (f64::from(SCREEN_SHARE * lx), f64::from(SCREEN_SHARE * ly));
+        assert!((along - ky).abs() < 4.0, "along {along}, want {ky}");
+        assert!((across - kx).abs() < 2.0, "across {across}, want {kx}");
+    }
+
+    #[test]
+    fn the_traced_directions_and_the_blur_together_spread_as_the_lobe() {
+        // The directions `lobe_ray` draws over the unit square (a fine grid standing for the strata of many
+        // seeds): their mean offset is the lobe's, their spreads `√(1 − κ²)` of its; with the blur's `κ` of it,
+        // the variances add up to the lobe's.
+        let (mss, sin_g) = (0.02f32, 0.3f32);
+        let [de, se, sa] = rough_water::lobe(sin_g, mss.sqrt());
+        let e0 = sin_g.asin(); // a flat surface: the mirror direction rises as steeply as the view falls
+        let mirror = Vec3::new(e0.cos(), 0.0, e0.sin());
+        let n = 256;
+        let (mut sum, mut sq) = ([0f64; 2], [0f64; 2]);
+        for i in 0..n {
+            for j in 0..n {
+                let u = [(i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32];
+                let r = lobe_ray(mirror, mss, sin_g, u);
+                let off = [f64::from(r.z.asin() - e0), f64::from(r.y.atan2(r.x))];
+                for k in 0..2 {
+                    sum[k] += off[k];
+                    sq[k] += off[k] * off[k];
+                }
+            }
+        }
+        let count = (n * n) as f64;
+        let mean = [sum[0] / count, sum[1] / count];
+        let sd = [0, 1].map(|k| (sq[k] / count - mean[k] * mean[k]).sqrt());
+        let q = f64::from((1.0 - SCREEN_SHARE * SCREEN_SHARE).sqrt());
+        assert!((mean[0] - f64::from(de)).abs() < 2e-3 && mean[1].abs() < 1e-4, "mean {mean:?}, want {de}");
+        assert!((sd[0] / (q * f64::from(se)) - 1.0).abs() < 0.03, "elevation σ {}, want {}", sd[0], q * f64::from(se));
+        assert!((sd[1] / (q * f64::from(sa)) - 1.0).abs() < 0.03, "azimuth σ {}, want {}", sd[1], q * f64::from(sa));
+        let total = (sd[0].powi(2) + f64::from(SCREEN_SHARE * se).powi(2)).sqrt();
+        assert!((total / f64::from(se) - 1.0).abs() < 0.03, "drawn and blurred {total}, lobe {se}");
+    }
+
+    #[test]
+    fn each_four_by_four_blocks_draw_the_whole_set_of_strata() {
+        for (spacing, seed) in [(1u32, 0u64), (2, 7), (4, 123)] {
+            let points: Vec<[f32; 2]> = (0..4u32)
+                .flat_map(|by| (0..4u32).map(move |bx| (bx, by)))
+                .map(|(bx, by)| stratum(bx * spacing + 8 * spacing, by * spacing, spacing, seed))
+                .collect();
+            // One point in every sixteenth of each axis (a Latin square of strata, shifted by the seed's rotation).
+            for axis in 0..2 {
+                let mut cells: Vec<u32> = points.iter().map(|p| (p[axis] * 16.0) as u32).collect();
+                cells.sort_unstable();
+                cells.dedup();
+                assert_eq!(cells.len(), 16, "spacing {spacing}, seed {seed}, axis {axis}: {points:?}");
+            }
+            // Pixels of one block share their block's point.
+            assert_eq!(stratum(spacing - 1, spacing - 1, spacing, seed), stratum(0, 0, spacing, seed));
+        }
+        assert_ne!(stratum(0, 0, 2, 1), stratum(0, 0, 2, 2));
     }
 
     #[test]
@@ -454,9 +623,11 @@ mod tests {
         };
         let Some(bh) = blur(w, h, 3000.0, 1, 0.0, &with_hull(even + Vec3::splat(1000.0))) else { panic!("no blur") };
         let extra: f32 = image(&bh, w, h).iter().map(|c| c.x - even.x).sum::<f32>() / (w * h) as f32;
-        // The spread is a normalised mean over the whole image here (the lobe reaches past it every way): every
-        // pixel gets the hull's share, 48 of 768 pixels' 1000.
-        assert!((extra - 1000.0 * 48.0 / 768.0).abs() < 1.0, "{extra}");
+        // The spread is a normalised mean over the whole image here and, down it, over the edge rows read again
+        // past its top and bottom as far as it is tall (the lobe reaches past it every way): every pixel gets the
+        // hull's share, 8 of 32 columns and 6 of 24 + 2 × 24 rows of 1000.
+        let want = 1000.0 * (8.0 / 32.0) * (6.0 / 72.0);
+        assert!((extra - want).abs() < 0.05 * want, "{extra}, want {want}");
         // A black hull hiding a sky far brighter than the lobe's mean there (dusk: the afterglow low in the mirror,
         // the lobe reaching up into darker sky): the reflection darkens but never goes below zero (the sum of the
         // lobe's mean and the spread difference did, and showed black and pure blue water).

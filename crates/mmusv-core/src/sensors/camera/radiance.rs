@@ -282,7 +282,7 @@ pub fn radiance(
     shadows: bool,
     reflections: Reflections<'_>,
     shared: Option<PixelGrid<'_>>,
-    glossy: Option<(PixelGrid<'_>, f32, f32)>,
+    glossy: Option<(PixelGrid<'_>, f32, f32, u64)>,
     (origins, dirs, hits): (&[[f32; 3]], &[[f32; 3]], &RayHits),
 ) -> Result<Shaded> {
     let n = origins.len();
@@ -321,7 +321,11 @@ pub fn radiance(
     // glossy lobe of the calmest water here spans many such blocks (the blur then reads them on cells at least
     // that coarse, `glossy::decimation`).
     let spacing = match (reflections, glossy) {
-        (Reflections::Shared(_), Some((_, f_px, _))) => {
+        (Reflections::Shared(_), Some((_, f_px, _, _))) => {
+            // (By the whole lobe: 4 × 4 blocks where even the screen-space share of it spans four of them, so the
+            // blur still averages the strata of 4 × 4 blocks of drawn directions; by that share alone, blocks of
+            // 2 × 2 were chosen four times as often, for 11 % more CPU on `port_entry`, the Mitsuba scenes' errors
+            // the same.)
             glossy::decimation(glossy::narrowest_lobe_px(shader.water_mss(0.0), f_px), 2)[0] as u32
         }
         (Reflections::Shared(_), None) => 2,
@@ -353,14 +357,35 @@ pub fn radiance(
             .par_iter()
             .map(|&k| surface(k as usize).unwrap_or_else(|| unreachable!("ray {k} was a water hit")))
             .collect();
+        // With the glossy blur, each leaves in a direction drawn from the part of the lobe the blur does not
+        // spread (`glossy::lobe_ray`): at its own point, so that a hull close behind the water darkens the
+        // reflection over the whole lobe it fills (the screen-space spread alone read the mirror rays of the
+        // water farther below, which pass over it). `mirrors` keeps the mirror directions for the sky's lobe mean.
+        let mut mirrors: Vec<Vec3> = Vec::new();
         let (ro, rd): (Vec<[f32; 3]>, Vec<[f32; 3]>) = traced
             .par_iter()
             .zip(&traced_hits)
             .map(|(&k, h)| {
-                let (o, r) = shader.reflection_ray(Vec3::from_array(dirs[k as usize]), h);
+                let d = Vec3::from_array(dirs[k as usize]);
+                let (o, r) = shader.reflection_ray(d, h);
+                let r = match glossy {
+                    Some((grid, _, _, seed)) => {
+                        let [x, y] = grid.pos[k as usize];
+                        let u = glossy::stratum(u32::from(x), u32::from(y), spacing, seed);
+                        glossy::lobe_ray(r, shader.water_mss(h.unresolved_mss), (-d.z).max(0.0), u)
+                    }
+                    None => r,
+                };
                 (o.to_array(), r.to_array())
             })
             .unzip();
+        if glossy.is_some() {
+            mirrors = traced
+                .par_iter()
+                .zip(&traced_hits)
+                .map(|(&k, h)| shader.reflection_ray(Vec3::from_array(dirs[k as usize]), h).1)
+                .collect();
+        }
         let rhits = scene.cast_rays(&ro, &rd, REFLECTION_RANGE)?;
         let rsurface = |j: usize| surface_at(shader, scene, &rhits, &ro, &rd, j).filter(|h| !h.is_water());
         let rlit = sunlit(scene, shader, shadows, (&rhits, &ro, &rd), |j| rhits.class[j] != 1)?;
@@ -376,9 +401,12 @@ pub fn radiance(
             skies = (0..ro.len())
                 .into_par_iter()
                 .map(|j| {
-                    let r = Vec3::from_array(rd[j]);
                     let alpha = shader.water_mss(traced_hits[j].unresolved_mss).sqrt();
-                    shader.reflected_sky(r, alpha)
+                    // The sky along the drawn direction (what it brings back meeting nothing), the lobe's mean
+                    // around the mirror direction.
+                    let (sky, _) = shader.reflected_sky(Vec3::from_array(rd[j]), alpha);
+                    let (_, lobe) = shader.reflected_sky(mirrors[j], alpha);
+                    (sky, lobe)
                 })
                 .collect();
         }
@@ -415,7 +443,7 @@ pub fn radiance(
     };
     // The traced reflections spread over the water's roughness lobe, read back at each water pixel.
     let blurred = match glossy {
-        Some((grid, f_px, roll)) if !matches!(reflections, Reflections::Sky | Reflections::Given(_)) => {
+        Some((grid, f_px, roll, _)) if !matches!(reflections, Reflections::Sky | Reflections::Given(_)) => {
             // (A camera's ray directions are unit vectors: `−d.z` is the grazing sine.)
             let samples: Vec<glossy::Sample> = index
                 .par_iter()

