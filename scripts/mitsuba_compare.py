@@ -195,8 +195,9 @@ def write_table(args: Any, results: list[Result], mi_version: str) -> None:
         "`roughconductor` (`beckmann`, `eta` 1.33, `k` 0, α = the Cox–Munk slope). "
         "mmusv's Schlick Fresnel is compared against the exact one.",
         "- **Same light transport.** mmusv lights surfaces directly: the sun with a shadow ray, the sky and "
-        "ground as image-based light without occlusion, water adding its traced reflections spread over the "
-        "roughness lobe in screen space (`sensors/camera/glossy.rs`) and weighted by the rough surface's "
+        "ground as image-based light without occlusion, water adding its reflections traced in directions drawn "
+        "from the roughness lobe at each point and spread over the rest of it in screen space "
+        "(`sensors/camera/glossy.rs`), weighted by the rough surface's "
         "directional reflectance (`sensors/shade/rough_water.rs`). Mitsuba path-traces that rough reflection; "
         "it renders the rest as layers composited by mmusv's instance image. Mitsuba's rough BSDFs reflect "
         "once, so mmusv's water is rendered with its single scattering alone (`water_multiple_scattering=False`;"
