@@ -168,8 +168,15 @@ def test_35_vessels_every_vessel_labelled(tmp_path: Path) -> None:
             for vid, v in by_id.items():
                 if vid == agent:
                     continue
-                d = float(np.hypot(*(np.array(v.box_center[:2]) - me)))
-                # The one target rule: box centre within the LiDAR's 200 m (a margin for the sensor's offset).
+                # The recording's rule: the box's BEV footprint within the LiDAR's 200 m (a margin for the sensor's
+                # offset), its distance from the USV by shapely (a 330 m ship centred beyond 200 m may reach in).
+                yaw = float(v.pose[5])
+                ax = np.array([np.cos(yaw), np.sin(yaw)])
+                ay = np.array([-ax[1], ax[0]])
+                c = np.array(v.box_center[:2])
+                half = np.array(v.box_size[:2]) / 2.0
+                rect = [c + sx * half[0] * ax + sy * half[1] * ay for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
+                d = float(shapely.Polygon(rect).distance(shapely.Point(*me)))
                 if d < 195.0:
                     assert vid in boxed, (f, agent, vid, d)
                     assert np.allclose(boxed[vid].size, v.box_size)

@@ -1,6 +1,8 @@
 """Per-agent annotations derived from the world state and the agent's own captures.
 
-For every agent (USV) and frame, for every other vessel (the agent's own hull is never a target):
+For every agent (USV) and frame, for every other vessel whose bird's-eye-view footprint comes within the LiDAR's
+range (:func:`footprint_in_range`: a long ship whose centre lies beyond it but whose stern is near gets its box; the
+agent's own hull is never a target):
 * a 3D box in the agent's LiDAR frame (centre, size = length/beam/height, rotation quaternion xyzw, yaw) with the
   number of LiDAR points on the vessel (exact: points carry instance ids) and its range;
 * the vessel's ``role`` (``target``, ``usv`` — another instrumented USV, never a detection target — or
@@ -36,7 +38,14 @@ from mmusv.scene import Scene
 from mmusv.wave_occlusion import exposed_hidden, lidar_beam_rays, lidar_box_beams, pattern_angles, share
 from mmusv.world.vessels import get_asset
 
-__all__ = ["Annotations", "SilhouetteCache", "annotate_agent", "box_corners", "in_target_range"]
+__all__ = [
+    "Annotations",
+    "SilhouetteCache",
+    "annotate_agent",
+    "box_corners",
+    "footprint_in_range",
+    "in_target_range",
+]
 
 # Corner order of a box: bit 0 → +x, bit 1 → +y, bit 2 → +z.
 _SIGNS = np.array(
@@ -51,13 +60,33 @@ def in_target_range(centres: np.ndarray, range_m: float) -> np.ndarray:
     view, ``hypot(x, y) <= range_m`` (height ignored). ``centres``: ``(..., 3)`` (or ``(..., 2)``) in the ego's
     LiDAR frame (its body frame when it has none), metres; returns a bool array of shape ``centres.shape[:-1]``.
 
-    Used by the annotations (which vessels get a 3D/BEV box) and by the dataset export (which vessels are
-    labelled); it is the BEV distance the detection study evaluates within.
+    Used by the dataset exports (which vessels are labelled) and the detection study (the BEV distance it evaluates
+    within), as OpenCOOD selects its objects; the recording's own 3D/BEV boxes reach farther, to every vessel whose
+    footprint comes within range (:func:`footprint_in_range`).
     """
     c = np.asarray(centres, dtype=np.float64)
     if c.ndim == 0 or c.shape[-1] not in (2, 3):
         raise InputError(f"centres must have shape (..., 3) or (..., 2) (x, y[, z] metres), got {c.shape}")
     return np.asarray(np.hypot(c[..., 0], c[..., 1]) <= range_m)
+
+
+def footprint_in_range(box: np.ndarray, size: np.ndarray, range_m: float) -> bool:
+    """Whether a box's bird's-eye-view footprint comes within ``range_m`` metres of the ego LiDAR: the distance from
+    the origin to the rectangle of ``size[0]`` (length) by ``size[1]`` (beam) centred at the box's ``(x, y)`` and
+    turned by its yaw (the BEV box), 0 inside it. ``box``: ``(4, 4)`` box → ego LiDAR frame (centred), metres.
+
+    The annotations' rule (:func:`annotate_agent`): a 330 m ship whose stern lies 45 m from the USV has its centre
+    beyond a 200 m LiDAR's range, yet the LiDAR sees it; the centre rule of :func:`in_target_range` stays the
+    exports' and the detection study's (OpenCOOD's convention)."""
+    m = np.asarray(box, dtype=np.float64)
+    yaw = np.arctan2(m[1, 0], m[0, 0])
+    c, s = np.cos(yaw), np.sin(yaw)
+    # The origin in the box's yaw-only frame, then its distance to the rectangle (0 inside).
+    x, y = -m[0, 3], -m[1, 3]
+    u, v = c * x + s * y, -s * x + c * y
+    du = max(abs(u) - float(size[0]) / 2.0, 0.0)
+    dv = max(abs(v) - float(size[1]) / 2.0, 0.0)
+    return bool(np.hypot(du, dv) <= range_m)
 
 
 def box_corners(matrix: np.ndarray, size: np.ndarray) -> np.ndarray:
@@ -286,7 +315,8 @@ def annotate_agent(
         lidar_pose: ``(4, 4)`` LiDAR → world (boxes are expressed in this frame; the vessel body if ``None``).
         lidar_instances: ``(N,)`` instance id of each LiDAR point (for the point counts).
         cameras: name -> (native camera, ``(4, 4)`` camera body → world, ``(H, W)`` instance image).
-        max_range_m: vessels outside this range of the LiDAR (:func:`in_target_range`) get no 3D/BEV box.
+        max_range_m: vessels whose BEV footprint lies wholly beyond this range of the LiDAR
+            (:func:`footprint_in_range`) get no 3D/BEV box.
         scene: the full scene; where it has a wave surface, the boxes' ``wave_occlusion`` is computed (else 0).
         lidar_pattern: ``(M, 3)`` float32 unit beam directions in the LiDAR frame (for the 3D boxes' share).
         lidar_beams: ``(M,)`` int32 instance each beam of the pattern met first in the capture (-1: none;
@@ -315,7 +345,7 @@ def annotate_agent(
         box_world = state.matrices[vi] @ translation(info.box_center_body)
         box_ref = ref_inv @ box_world
         rng = float(np.linalg.norm(box_ref[:3, 3]))
-        if in_target_range(box_ref[:3, 3], max_range_m):
+        if footprint_in_range(box_ref, info.box_size, max_range_m):
             ann.lidar_ids.append(info.id)
             ann.lidar_instance.append(info.instance_id)
             ann.lidar_class.append(info.semantic_class)
