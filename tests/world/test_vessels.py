@@ -483,3 +483,30 @@ def test_mount_points_are_named_tuples() -> None:
     assert len(xyz) == 3 and len(rpy) == 3 and all(math.isfinite(x) for x in xyz + rpy)
     with pytest.raises(TypeError):
         get_asset("usv_wamv").mounts["new"] = m  # type: ignore[index]
+
+
+def test_meshes_compare_by_value_and_assets_pickle() -> None:
+    # `TriMesh ==` asked its arrays for a truth value (numpy's ValueError) and `hash` raised TypeError; an asset
+    # could not be pickled or deep-copied (its read-only mounts), so neither could anything holding one.
+    import copy
+    import pickle
+
+    import numpy as np
+    import pytest
+    from mmusv.world.primitives import TriMesh
+    from mmusv.world.vessels import get_asset
+
+    a = get_asset("tug_32m")
+    mesh = a.mesh
+    twin = TriMesh(mesh.vertices.copy(), mesh.faces.copy(), mesh.classes.copy(), mesh.materials.copy())
+    assert mesh == twin
+    moved = TriMesh(mesh.vertices + np.array([0.0, 0.0, 1e-9]), mesh.faces, mesh.classes, mesh.materials)
+    assert mesh != moved
+    assert mesh != "tug"
+    with pytest.raises(TypeError):
+        hash(mesh)
+    for b in (pickle.loads(pickle.dumps(a)), copy.deepcopy(a)):
+        assert b.mesh == a.mesh and dict(b.mounts) == dict(a.mounts) and b.name == a.name
+        assert np.array_equal(b.bbox, a.bbox) and b.length == a.length
+        with pytest.raises(TypeError):
+            b.mounts["extra"] = None  # type: ignore[index]  # still read-only

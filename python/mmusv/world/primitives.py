@@ -16,6 +16,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import numpy.typing as npt
 
+from mmusv._equality import same
+
 __all__ = [
     "TriMesh",
     "box",
@@ -38,15 +40,25 @@ def _no_materials() -> np.ndarray:
     return np.zeros(0, dtype=np.uint16)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class TriMesh:
-    """A labelled triangle mesh (see module docstring for shapes and dtypes)."""
+    """A labelled triangle mesh (see module docstring for shapes and dtypes). Two compare equal (``==``) when
+    their arrays hold the same dtypes, shapes and values; meshes are not hashable (key them by name)."""
 
     vertices: np.ndarray
     faces: np.ndarray
     classes: np.ndarray
     materials: np.ndarray = field(default_factory=_no_materials)
     """``(F,)`` uint16 material ids; given empty (the default) it is all 0, given one id it is broadcast."""
+
+    def __eq__(self, other: object) -> bool:
+        """Whether ``other`` is a mesh with the same arrays (the generated ``==`` asked arrays for a truth value
+        and raised numpy's ``ValueError``)."""
+        if type(other) is not type(self):
+            return NotImplemented
+        return same(self, other)
+
+    __hash__ = None  # type: ignore[assignment]
 
     def __post_init__(self) -> None:
         v = np.ascontiguousarray(self.vertices, dtype=np.float64).reshape(-1, 3)

@@ -222,6 +222,19 @@ class VesselAsset:
         object.__setattr__(self, "height", float(ext[2]))
         object.__setattr__(self, "draft", float(-lo[2]))
 
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickling (a ``DataLoader`` worker, ``copy.deepcopy``): the mounts as a plain dict (a read-only view
+        cannot be pickled)."""
+        state = dict(self.__dict__)
+        state["mounts"] = dict(self.mounts)
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        """Unpickling: the mounts read-only again."""
+        state = dict(state)
+        state["mounts"] = MappingProxyType(dict(state["mounts"]))
+        self.__dict__.update(state)
+
     @property
     def air_draft(self) -> float:
         """Height of the highest point above the waterline, metres (``height - draft``)."""
