@@ -683,6 +683,8 @@ def test_radar_sea_clutter_is_the_nrl_model() -> None:
         critical_range_per_m=100_000.0,
         sea_max_range_m=5000.0,
         rain_eta_at_1mm_h=0.0,
+        frequency_ghz=9.41,
+        polarisation="HH",
     )
     pose = pose_matrices(np.array([0.0, 0.0, height, 0.0, 0.0, 0.0]))
     earth = 6_371_000.0 * 4 / 3

@@ -205,7 +205,12 @@ class RadarConfig(_Model):
         clutter_critical_range_per_m: metres of critical range per metre of wave height (sea clutter falls as
             r⁻⁷ beyond it, r⁻³ before).
         sea_clutter_max_range_m: no sea clutter beyond this range, metres.
-        rain_clutter_eta: rain volume reflectivity (m²/m³) at 1 mm/h (scales with rate^1.6, ``0..1``); 0 disables.
+        rain_clutter_eta: rain volume reflectivity (m²/m³) at 1 mm/h for a 9.41 GHz radar (scales with rate^1.6
+            and, by Rayleigh scattering's λ⁻⁴, with ``(frequency_ghz / 9.41)⁴``; ``0..1``); 0 disables. Marshall–Palmer
+            rain (η = π⁵|K|²Z/λ⁴, Z = 200 R^1.6) is 5.5e-8 at 9.41 GHz; the default is 10.4 dB below it.
+        frequency_ghz: carrier frequency, GHz (``0.5..35``, the NRL sea-clutter model's range; 9.41 = X band,
+            3.05 = S band): sea clutter's σ⁰ (NRL model, over the physical sea) and rain clutter follow it.
+        polarisation: ``"HH"`` (marine radars) or ``"VV"``: sea clutter's σ⁰ (NRL model) follows it.
         ppi_size_px, ppi_metres_per_pixel, ppi_orientation: the PPI image; ``ppi_metres_per_pixel`` defaults to
             ``range_m / (ppi_size_px / 2)``.
 
@@ -235,6 +240,8 @@ class RadarConfig(_Model):
     clutter_critical_range_per_m: float = Field(default=300.0, ge=0, le=100_000)
     sea_clutter_max_range_m: float = Field(default=2500.0, ge=0, le=100_000)
     rain_clutter_eta: float = Field(default=5.0e-9, ge=0, le=1)
+    frequency_ghz: float = Field(default=9.41, ge=0.5, le=35)
+    polarisation: Literal["HH", "VV"] = "HH"
     ppi_size_px: int = Field(default=512, ge=16, le=8192)
     ppi_metres_per_pixel: float | None = Field(default=None, ge=0.01, le=1000)
     ppi_orientation: Literal["north_up", "head_up"] = "north_up"

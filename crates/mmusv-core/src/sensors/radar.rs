@@ -123,6 +123,7 @@ pub fn radar_sweep(
     // Over the physical sea (a displaced wave surface), sea clutter follows sea state and grazing angle.
     let physical = scene.wave_surface().map(|w| {
         sea_clutter::PhysicalSea::new(env.wave_height_m as f64, f64::from(sensor_to_world.translation.z - w.level()))
+            .with_band(cfg.frequency_ghz, cfg.polarisation)
     });
     let table = clutter_table(cfg, env, physical.as_ref(), first, end);
     // Solid angle of a ray = (beamwidth / rays_az) · its fan-height weight · cos(its elevation).
@@ -194,3 +195,7 @@ pub fn radar_sweep(
 #[cfg(test)]
 #[path = "radar_tests.rs"]
 mod tests;
+
+#[cfg(test)]
+#[path = "radar_band_tests.rs"]
+mod band_tests;

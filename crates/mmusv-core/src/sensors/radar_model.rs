@@ -24,11 +24,20 @@
 //!   Over the physical sea (a scene with a displaced wave surface) σ⁰ instead follows sea state and grazing
 //!   angle by the NRL model of Gregers-Hansen & Mital (2012), `sensors/radar/sea_clutter.rs`, and the sea part
 //!   is `σ⁰ · A(r) · (R_ref/r)⁴ · L_rain(r)` ([`clutter_mean_sigma0`]).
-//! * **Rain clutter**: volume reflectivity `η = rain_eta_at_1mm_h · R^1.6` (the Marshall–Palmer `Z ∝ R^1.6`)
-//!   times the cell volume `r² · θ_az · θ_el · Δr`, same `(R_ref/r)⁴ · L_rain(r)`.
+//! * **Rain clutter**: the volume reflectivity of rain is that of Rayleigh scattering by drops small against the
+//!   wavelength λ, `η = π⁵ |K|² Z / λ⁴` (m²/m³, `Z` in m⁶/m³, `|K|² ≈ 0.93` for water), with the reflectivity
+//!   factor of Marshall & Palmer (1948), `Z = 200 R^1.6` mm⁶/m³ for a rain rate `R` in mm/h (Skolnik, M. I.
+//!   (2001), "Introduction to Radar Systems", 3rd ed., §13.6 Weather Clutter; Nathanson (1991) §6); at 9.41 GHz
+//!   that is `5.5·10⁻⁸ R^1.6` m²/m³. Here `η = rain_eta_at_1mm_h · R^1.6 · (f / 9.41 GHz)⁴`: the knob is η at
+//!   1 mm/h for an X-band 9.41 GHz radar, and the `λ⁻⁴` of the formula carries it to the radar's frequency `f`
+//!   (`|K|²` of water changes by under 1 % between 3 and 10 GHz; until 2026-12-01 η did not depend on the
+//!   frequency, which was fixed). η times the cell volume `r² · θ_az · θ_el · Δr`, same `(R_ref/r)⁴ ·
+//!   L_rain(r)`. (The scenario default `rain_clutter_eta` 5·10⁻⁹ is 10.4 dB below Marshall–Palmer's 5.5·10⁻⁸.)
 //! * A cell's clutter intensity is exponentially distributed (Rayleigh amplitude) with mean `μ_sea + μ_rain`,
 //!   drawn from `−ln u` with `u` uniform; so for a fixed seed the clutter of a cell grows monotonically with
 //!   the wave height and rain rate, and a clutter-only cell is reported with probability `exp(−threshold/μ)`.
+
+use crate::sensors::radar::sea_clutter::{Polarisation, MARINE_FREQUENCY_GHZ};
 
 /// Range at which a 1 m² target has intensity 1, metres.
 pub const REFERENCE_RANGE_M: f64 = 1000.0;
@@ -39,6 +48,30 @@ pub const RAIN_ATTENUATION_ALPHA: f64 = 1.2571;
 
 /// Semantic class of the sea surface (`mmusv.classes.SemanticClass.WATER`).
 pub const CLASS_WATER: u16 = 1;
+
+/// The frequency (GHz) at which `ClutterModel::rain_eta_at_1mm_h` is given: an X-band marine radar.
+pub const RAIN_ETA_REFERENCE_GHZ: f64 = MARINE_FREQUENCY_GHZ;
+
+/// The radar's carrier: what its clutter depends on besides the geometry.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Band {
+    /// Carrier frequency, GHz.
+    pub frequency_ghz: f64,
+    /// Polarisation (transmit = receive).
+    pub polarisation: Polarisation,
+}
+
+impl Band {
+    /// An X-band marine radar, 9.41 GHz, HH.
+    pub const MARINE_X: Band = Band { frequency_ghz: MARINE_FREQUENCY_GHZ, polarisation: Polarisation::Horizontal };
+
+    /// The factor `(f / 9.41 GHz)⁴ = (λ_X / λ)⁴` that carries a rain reflectivity given at X band to this
+    /// frequency (Rayleigh scattering, `η ∝ λ⁻⁴`); exactly 1 at 9.41 GHz.
+    pub fn rain_eta_factor(&self) -> f64 {
+        let q = self.frequency_ghz / RAIN_ETA_REFERENCE_GHZ;
+        (q * q) * (q * q)
+    }
+}
 
 /// Sea and rain clutter knobs (see the module documentation for the formulas).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -115,10 +148,12 @@ pub struct CellShape {
     pub range_resolution: f64,
 }
 
-/// Mean clutter intensity `(sea, rain)` of the cell at range `r` metres (see the module documentation).
+/// Mean clutter intensity `(sea, rain)` of the cell at range `r` metres of a radar in `band` (see the module
+/// documentation).
 pub fn clutter_mean(
     model: &ClutterModel,
     cell: &CellShape,
+    band: &Band,
     wave_height_m: f64,
     rain_mm_per_h: f64,
     r: f64,
@@ -139,7 +174,7 @@ pub fn clutter_mean(
         0.0
     };
     let rain = if rain_mm_per_h > 0.0 {
-        let eta = model.rain_eta_at_1mm_h * rain_mm_per_h.powf(1.6);
+        let eta = model.rain_eta_at_1mm_h * rain_mm_per_h.powf(1.6) * band.rain_eta_factor();
         eta * r * r * cell.beamwidth_az * cell.fan_height * cell.range_resolution * common
     } else {
         0.0
@@ -154,11 +189,12 @@ pub fn clutter_mean(
 pub fn clutter_mean_sigma0(
     model: &ClutterModel,
     cell: &CellShape,
+    band: &Band,
     sigma0: f64,
     rain_mm_per_h: f64,
     r: f64,
 ) -> (f64, f64) {
-    let (_, rain) = clutter_mean(model, cell, 0.0, rain_mm_per_h, r);
+    let (_, rain) = clutter_mean(model, cell, band, 0.0, rain_mm_per_h, r);
     let sea = if sigma0 > 0.0 && r <= model.sea_max_range_m {
         sigma0 * r * cell.beamwidth_az * cell.range_resolution * range_term(r) * rain_loss(rain_mm_per_h, r)
     } else {
@@ -191,7 +227,7 @@ mod tests {
     #[test]
     fn sea_clutter_grows_with_waves_and_falls_with_range() {
         let m = ClutterModel::tuning();
-        let at = |h: f64, r: f64| clutter_mean(&m, &CELL, h, 0.0, r).0;
+        let at = |h: f64, r: f64| clutter_mean(&m, &CELL, &Band::MARINE_X, h, 0.0, r).0;
         assert_eq!(at(0.0, 100.0), 0.0);
         for r in [50.0, 200.0, 800.0, 2000.0] {
             assert!(at(3.5, r) > at(0.5, r), "r = {r}");
@@ -201,7 +237,7 @@ mod tests {
         }
         assert_eq!(at(3.5, m.sea_max_range_m + 1.0), 0.0);
         // Rain clutter exists only with rain.
-        assert_eq!(clutter_mean(&m, &CELL, 0.0, 0.0, 300.0).1, 0.0);
-        assert!(clutter_mean(&m, &CELL, 0.0, 5.0, 300.0).1 > 0.0);
+        assert_eq!(clutter_mean(&m, &CELL, &Band::MARINE_X, 0.0, 0.0, 300.0).1, 0.0);
+        assert!(clutter_mean(&m, &CELL, &Band::MARINE_X, 0.0, 5.0, 300.0).1 > 0.0);
     }
 }

@@ -249,7 +249,14 @@ fn physical_sea_clutter_follows_the_nrl_model() {
                 break;
             }
             if r >= lo {
-                let (mu, _) = radar_model::clutter_mean_sigma0(&cfg.clutter, &cfg.cell_shape(), sea.sigma0(r), 0.0, r);
+                let (mu, _) = radar_model::clutter_mean_sigma0(
+                    &cfg.clutter,
+                    &cfg.cell_shape(),
+                    &cfg.band(),
+                    sea.sigma0(r),
+                    0.0,
+                    r,
+                );
                 n += (-cfg.detection_threshold / mu).exp() * cfg.azimuth_bins as f64;
             }
         }

@@ -65,6 +65,7 @@ impl ClutterBin {
             None => radar_model::clutter_mean(
                 &cfg.clutter,
                 &cfg.cell_shape(),
+                &cfg.band(),
                 env.wave_height_m as f64,
                 env.rain_mm_per_h as f64,
                 r,
@@ -72,6 +73,7 @@ impl ClutterBin {
             Some(p) => radar_model::clutter_mean_sigma0(
                 &cfg.clutter,
                 &cfg.cell_shape(),
+                &cfg.band(),
                 p.sigma0(r),
                 env.rain_mm_per_h as f64,
                 r,
