@@ -128,7 +128,7 @@ pub fn radar_sweep(
     let table = clutter_table(cfg, env, physical.as_ref(), first, end);
     // Solid angle of a ray = (beamwidth / rays_az) · its fan-height weight · cos(its elevation).
     let az_width = cfg.beamwidth_az_rad / cfg.rays_az as f64;
-    let rain = env.rain_mm_per_h as f64;
+    let rain = radar_model::RainLoss::new(&cfg.band(), env.rain_mm_per_h as f64);
     let sensor_height = sensor_to_world.translation.z.max(0.0) as f64;
     // The clutter bins' ranges and the still water's depression there (`shadow`).
     let clutter_ranges: Vec<f64> = (first..).take(table.len()).map(|k| cfg.bin_centre(k)).collect();
@@ -163,7 +163,7 @@ pub fn radar_sweep(
                     let dir = dirs[i];
                     let cos = (n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2]) as f64;
                     let omega = az_width * weight as f64 * f64::from(elevation).cos();
-                    let power = radar_model::ray_power(class, cos, omega, d, rain);
+                    let power = radar_model::ray_power(class, cos, omega, d, &rain);
                     echoes.push(Echo { bin, instance, class, power, elevation: elevation as f64 });
                 }
                 blockers.count_shadowed(horizon, &clutter_ranges, &depression, &mut shadowed);
