@@ -128,7 +128,9 @@ def test_physical_sea_clutter_is_the_nrl_model_at_the_configured_sea_state() -> 
             for k in (k0 - 1, k0, k0 + 1):
                 r = (k + 0.5) * cfg.range_resolution_m
                 psi = math.degrees(math.asin(height / r - r / (2 * EARTH_K_RE)))
-                area = r * math.radians(cfg.beamwidth_deg) * cfg.range_resolution_m
+                # The pulse-limited cell, r θ_az Δr sec ψ (Skolnik §13.2).
+                sec_psi = 1.0 / math.cos(math.radians(psi))
+                area = r * math.radians(cfg.beamwidth_deg) * cfg.range_resolution_m * sec_psi
                 sigma0 = 10 ** (nrl_sigma0_db(9.41, int(state), psi) / 10)
                 want += sigma0 * area * (1000.0 / r) ** 4 * cfg.azimuth_bins
                 got += float(ret.intensity[np.abs(ret.range - r) < 1e-3].astype(np.float64).sum())

@@ -125,11 +125,11 @@ pub fn radar_sweep(
         sea_clutter::PhysicalSea::new(env.wave_height_m as f64, f64::from(sensor_to_world.translation.z - w.level()))
             .with_band(cfg.frequency_ghz, cfg.polarisation)
     });
-    let table = clutter_table(cfg, env, physical.as_ref(), first, end);
+    let sensor_height = sensor_to_world.translation.z.max(0.0) as f64;
+    let table = clutter_table(cfg, env, physical.as_ref(), sensor_height, first, end);
     // Solid angle of a ray = (beamwidth / rays_az) · its fan-height weight · cos(its elevation).
     let az_width = cfg.beamwidth_az_rad / cfg.rays_az as f64;
     let rain = radar_model::RainLoss::new(&cfg.band(), env.rain_mm_per_h as f64);
-    let sensor_height = sensor_to_world.translation.z.max(0.0) as f64;
     // The clutter bins' ranges and the still water's depression there (`shadow`).
     let clutter_ranges: Vec<f64> = (first..).take(table.len()).map(|k| cfg.bin_centre(k)).collect();
     let depression: Vec<f64> = clutter_ranges.iter().map(|&r| sensor_height.atan2(r)).collect();
@@ -197,5 +197,5 @@ pub fn radar_sweep(
 mod tests;
 
 #[cfg(test)]
-#[path = "radar_band_tests.rs"]
-mod band_tests;
+#[path = "radar_clutter_tests.rs"]
+mod clutter_tests;

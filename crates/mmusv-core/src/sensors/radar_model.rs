@@ -22,7 +22,8 @@
 //!   10 mm/h); until 2026-12-01 every radar used the 10 GHz HH table values `k = 0.01217`, `α = 1.2571`
 //!   (0.220 dB/km at 10 mm/h, 21 % too much for the 9.41 GHz radar).
 //! * **Sea clutter**: mean `μ_sea = σ⁰(H) · A(r) · g(r) · (R_ref/r)⁴ · L_rain(r)` with wave height `H` (m),
-//!   `σ⁰(H) = sea_sigma0_at_1m · H²`, cell area `A = r · θ_az · Δr`, and past the critical range
+//!   `σ⁰(H) = sea_sigma0_at_1m · H²`, the pulse-limited cell area `A = r · θ_az · Δr · sec ψ` at grazing ψ
+//!   (Skolnik §13.2, [`CellShape::sea_area`]; until 2026-12-01 without the `sec ψ`), and past the critical range
 //!   `R_c = critical_range_per_m · H` the interference fall-off `g = (R_c / r)⁴` (so clutter falls as `r⁻³`
 //!   close in and `r⁻⁷` beyond `R_c`: higher waves give stronger clutter reaching farther); zero beyond
 //!   `sea_max_range_m` and for `H = 0`.
@@ -217,7 +218,8 @@ pub fn ray_power(class: u16, cos_incidence: f64, omega_sr: f64, r: f64, rain: &R
     class_reflectivity(class) * cos_incidence.abs() * omega_sr * r * r * range_term(r) * rain.at(r)
 }
 
-/// Geometry of one radar cell: the beam's azimuth width and elevation height (radians), range bin size (m).
+/// Geometry of one radar cell: the beam's azimuth width and elevation height (radians), range bin size (m), and
+/// the antenna's height above the still water (m), which sets the grazing angle of the sea in the cell.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CellShape {
     /// Azimuth beamwidth, radians.
@@ -226,6 +228,27 @@ pub struct CellShape {
     pub fan_height: f64,
     /// Range bin size, metres.
     pub range_resolution: f64,
+    /// Antenna height above the still water, metres (`≤ 0`: grazing 0, `sec ψ = 1`).
+    pub antenna_height: f64,
+}
+
+impl CellShape {
+    /// The sea surface a range cell at (slant) range `r` metres illuminates, m²: the pulse-limited clutter cell
+    /// `A = r · θ_az · Δr · sec ψ` (Skolnik, "Introduction to Radar Systems", 3rd ed., §13.2; Barton (2013),
+    /// "Radar Equations for Modern Radar", §8: the beam's width `r θ_az` across, the slant-range bin `Δr`
+    /// stretched to `Δr / cos ψ` along the water) at the 4/3-earth grazing angle ψ of
+    /// [`crate::sensors::radar::sea_clutter::sin_grazing`], `ψ ≥ 0` (beyond the horizon the NRL model's own
+    /// clamp to 0.1° stands: `sec ψ = 1`); zero where no water lies at that slant range (`r ≤ h`). The cell is
+    /// pulse-limited while `Δr sec ψ < r θ_el / sin ψ`, i.e. `tan ψ < r θ_el / Δr`: everywhere beyond the blind
+    /// range for a fan of a few degrees and metre-sized bins (the beam-limited `r² θ_az θ_el csc ψ` is not used).
+    /// Until 2026-12-01 the `sec ψ` was left out (1.5 times too little clutter 20 m from an antenna 15 m up).
+    pub fn sea_area(&self, r: f64) -> f64 {
+        let s = crate::sensors::radar::sea_clutter::sin_grazing(self.antenna_height, r).max(0.0);
+        if s >= 1.0 {
+            return 0.0;
+        }
+        r * self.beamwidth_az * self.range_resolution / (1.0 - s * s).sqrt()
+    }
 }
 
 /// Mean clutter intensity `(sea, rain)` of the cell at range `r` metres of a radar in `band` (see the module
@@ -241,7 +264,7 @@ pub fn clutter_mean(
     let common = range_term(r) * RainLoss::new(band, rain_mm_per_h).at(r);
     let sea = if wave_height_m > 0.0 && r <= model.sea_max_range_m {
         let sigma0 = model.sea_sigma0_at_1m * wave_height_m * wave_height_m;
-        let area = r * cell.beamwidth_az * cell.range_resolution;
+        let area = cell.sea_area(r);
         let rc = model.critical_range_per_m * wave_height_m;
         let falloff = if r > rc {
             let q = rc / r;
@@ -276,12 +299,7 @@ pub fn clutter_mean_sigma0(
 ) -> (f64, f64) {
     let (_, rain) = clutter_mean(model, cell, band, 0.0, rain_mm_per_h, r);
     let sea = if sigma0 > 0.0 && r <= model.sea_max_range_m {
-        sigma0
-            * r
-            * cell.beamwidth_az
-            * cell.range_resolution
-            * range_term(r)
-            * RainLoss::new(band, rain_mm_per_h).at(r)
+        sigma0 * cell.sea_area(r) * range_term(r) * RainLoss::new(band, rain_mm_per_h).at(r)
     } else {
         0.0
     };
@@ -292,7 +310,8 @@ pub fn clutter_mean_sigma0(
 mod tests {
     use super::*;
 
-    const CELL: CellShape = CellShape { beamwidth_az: 0.0209, fan_height: 0.349, range_resolution: 3.0 };
+    const CELL: CellShape =
+        CellShape { beamwidth_az: 0.0209, fan_height: 0.349, range_resolution: 3.0, antenna_height: 4.0 };
 
     #[test]
     fn reference_target_has_unit_intensity_and_rain_attenuates() {

@@ -251,7 +251,7 @@ fn physical_sea_clutter_follows_the_nrl_model() {
             if r >= lo {
                 let (mu, _) = radar_model::clutter_mean_sigma0(
                     &cfg.clutter,
-                    &cfg.cell_shape(),
+                    &cfg.cell_shape(sea.antenna_height_m),
                     &cfg.band(),
                     sea.sigma0(r),
                     0.0,

@@ -86,8 +86,8 @@ impl BeamContext<'_> {
         let thr = self.cfg.detection_threshold;
         let mut emit = |bin: u32, target: Option<&Echo>, clutter: Option<ClutterBin>| {
             let (u, w) = draws.at(bin);
-            let ClutterBin { mean, sea, p_detect, .. } =
-                clutter.unwrap_or_else(|| ClutterBin::at(self.cfg, self.env, self.physical.as_ref(), bin));
+            let ClutterBin { mean, sea, p_detect, .. } = clutter
+                .unwrap_or_else(|| ClutterBin::at(self.cfg, self.env, self.physical.as_ref(), self.sensor_height, bin));
             // Clutter alone is detected iff mean · (−ln u) ≥ threshold, i.e. u ≤ exp(−threshold / mean).
             if target.is_none() && u > p_detect {
                 return;

@@ -69,18 +69,25 @@ impl RadarConfig {
                 (if t < below { lo + t } else { b1 + (t - below) }, rest / k_rest as f64)
             } else {
                 // A zero-height fan: every ray at the one elevation, sharing one beamwidth of height.
-                (lo, self.cell_shape().fan_height / k_all as f64)
+                (lo, self.fan_height() / k_all as f64)
             };
         }
     }
 
-    /// The beam's cell: azimuth beamwidth, fan height and range resolution (for the intensity model).
-    pub(super) fn cell_shape(&self) -> CellShape {
+    /// The fan's height, radians (at least one azimuth beamwidth).
+    fn fan_height(&self) -> f64 {
         let [lo, hi] = self.elevation_fan_rad;
+        (hi - lo).max(self.beamwidth_az_rad)
+    }
+
+    /// The beam's cell with the antenna `antenna_height` metres above the still water: azimuth beamwidth, fan
+    /// height, range resolution and that height (for the intensity model).
+    pub(super) fn cell_shape(&self, antenna_height: f64) -> CellShape {
         CellShape {
             beamwidth_az: self.beamwidth_az_rad,
-            fan_height: (hi - lo).max(self.beamwidth_az_rad),
+            fan_height: self.fan_height(),
             range_resolution: self.range_resolution_m,
+            antenna_height,
         }
     }
 }

@@ -102,11 +102,17 @@ pub fn sea_state(hs: f64) -> f64 {
     MAX_SEA_STATE as f64
 }
 
-/// Grazing angle (degrees, clamped into 0.1°–60°) at ground range `r` (m) of an antenna `h` (m) above the
+/// `sin ψ = h / r − r / (2 k R_e)`: the sine of the grazing angle at which an antenna `h` (m) above the still
+/// water sees it at range `r` (m), 4/3 earth, not clamped (`≥ 1`: no water at that range, `r ≤ h`; `< 0`: beyond
+/// the radar horizon).
+pub fn sin_grazing(h: f64, r: f64) -> f64 {
+    h.max(0.0) / r.max(1e-3) - r.max(1e-3) / (2.0 * EARTH_K * EARTH_RADIUS_M)
+}
+
+/// Grazing angle (degrees, clamped into 0.1°–60°) at range `r` (m) of an antenna `h` (m) above the
 /// still water, 4/3 earth.
 pub fn grazing_deg(h: f64, r: f64) -> f64 {
-    let r = r.max(1e-3);
-    let s = h.max(0.0) / r - r / (2.0 * EARTH_K * EARTH_RADIUS_M);
+    let s = sin_grazing(h, r);
     let psi = s.clamp(-1.0, 1.0).asin().to_degrees();
     psi.clamp(GRAZING_RANGE_DEG[0], GRAZING_RANGE_DEG[1])
 }

@@ -1,5 +1,6 @@
-//! Unit tests of the radar's frequency and polarisation (`RadarConfig::frequency_ghz`, `polarisation`): sea clutter
-//! of the NRL model at the radar's band, rain clutter's `λ⁻⁴`, and the checks of both fields.
+//! Unit tests of the radar's clutter: its frequency and polarisation (`RadarConfig::frequency_ghz`, `polarisation`:
+//! the NRL sea clutter of the radar's band, rain clutter's `λ⁻⁴`, the checks of both fields) and the sea clutter's
+//! cell (pulse-limited, `sec ψ`; independent of the rays cast).
 
 use super::*;
 use crate::mesh::Mesh;
@@ -157,4 +158,66 @@ fn bad_frequency_or_polarisation_is_refused_by_name() {
             other => unreachable!("{name:?}: {other:?}"),
         }
     }
+}
+
+/// The sea clutter's cell is pulse-limited, `A = r θ_az Δr sec ψ` (Skolnik §13.2): cell for cell (the same
+/// draws), the clutter of an antenna 15 m up over the flat sea's fixed `σ⁰ H²` rule is that of one 3 m up times
+/// `sec ψ₁₅(r) / sec ψ₃(r)`, with `sin ψ = h / r − r / (2 · 4/3 · R_e)` written out here (1.51 at 20 m); and no
+/// sea clutter lies closer than the antenna's height, where there is no water at that slant range. Until
+/// 2026-12-01 the area was `r θ_az Δr` whatever the grazing angle (the ratio was 1), and clutter was drawn there.
+#[test]
+fn the_sea_clutter_cell_is_pulse_limited() {
+    let cfg = RadarConfig {
+        range_min_m: 0.0,
+        range_max_m: 600.0,
+        clutter: ClutterModel { rain_eta_at_1mm_h: 0.0, ..cfg(9.41, Polarisation::Horizontal).clutter },
+        ..cfg(9.41, Polarisation::Horizontal)
+    };
+    let s = sea(false);
+    let env = RadarEnv { wave_height_m: 1.5, rain_mm_per_h: 0.0 };
+    let at = |h: f32| {
+        let pose = RigidPose { translation: Vec3::new(0.0, 0.0, h), ..MAST };
+        let r = radar_sweep(&s, &pose, &cfg, &env, 7).unwrap_or_else(|e| unreachable!("{e}"));
+        (0..r.len())
+            .filter(|&i| r.instance[i] == NO_HIT)
+            .map(|i| ((r.azimuth[i].to_bits(), r.range[i].to_bits()), f64::from(r.intensity[i])))
+            .collect::<std::collections::BTreeMap<_, _>>()
+    };
+    let (high, low) = (at(15.0), at(3.0));
+    let sec = |h: f64, r: f64| {
+        let s = (h / r - r / (2.0 * (4.0 / 3.0) * 6_371_000.0)).max(0.0);
+        1.0 / (1.0 - s * s).sqrt()
+    };
+    let mut checked = 0;
+    for (key, &base) in &low {
+        let r = f64::from(f32::from_bits(key.1));
+        match high.get(key) {
+            Some(&got) => {
+                assert!(r > 15.0, "sea clutter {r} m from an antenna 15 m up");
+                let want = sec(15.0, r) / sec(3.0, r);
+                assert!((got / base / want - 1.0).abs() < 1e-5, "r {r} m: {} vs sec ratio {want}", got / base);
+                checked += 1;
+            }
+            None => assert!(r <= 15.0, "r {r} m: no clutter from 15 m up"),
+        }
+    }
+    assert!(checked > 10_000 && low.keys().any(|k| f32::from_bits(k.1) < 15.0), "{checked} cells compared");
+    assert!((sec(15.0, 19.5) - 1.5650).abs() < 1e-3);
+}
+
+/// Clutter intensities do not depend on how many rays the sweep casts: over the open physical sea the clutter
+/// returns of 1 × 4, 3 × 16 and 2 × 9 rays a beam are the same, bit for bit (the clutter means come from the
+/// beam's widths, not its rays; only shadows, which need something to cast them, are seen through the rays).
+#[test]
+fn clutter_does_not_depend_on_the_rays_cast() {
+    let s = sea(true);
+    let env = RadarEnv { wave_height_m: 1.875, rain_mm_per_h: 3.0 };
+    let with = |rays_az: u32, rays_el: u32| {
+        let c = RadarConfig { rays_az, rays_el, azimuth_bins: 128, ..cfg(9.41, Polarisation::Horizontal) };
+        clutter(&s, &c, &env).into_iter().map(|(k, v)| (k, v.to_bits())).collect::<Vec<_>>()
+    };
+    let base = with(1, 4);
+    assert!(base.len() > 10_000);
+    assert_eq!(with(3, 16), base);
+    assert_eq!(with(2, 9), base);
 }
