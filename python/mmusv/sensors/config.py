@@ -191,7 +191,9 @@ class RadarConfig(_Model):
         range_resolution_m: range bin size, metres (``> 0``; at most 2²⁰ bins over ``range_m``).
         azimuth_bins: beams per revolution (``1..65536``).
         beamwidth_deg: horizontal beamwidth, degrees, in ``(0, 90]``.
-        elevation_fan_deg: vertical fan ``(lower, upper)``, degrees, strictly within ``(-90, 90)``.
+        elevation_fan_deg: vertical fan ``(lower, upper)``, degrees, strictly within ``(-90, 90)``: the rays span it,
+            and it is the half-power beamwidth of the beam's Gaussian elevation pattern centred on it (two-way gain
+            1 on its axis, ¼ at its edges), which weights targets, sea clutter and rain (``radar/pattern.rs``).
         rays_az: rays per beam across the beamwidth (``1..64``).
         rays_el: rays per beam over the elevation fan (``1..256``); ``azimuth_bins · rays_az · rays_el <= 2²³``.
             Far, low targets are hit by few rays; raise it for steadier detection of small boats at km range.
@@ -221,7 +223,8 @@ class RadarConfig(_Model):
     10,819 → 55,466 clutter cells, still growing with every sea state); with 0.01 / 4e-6 it reaches ≈180 m /
     ≈930 m with 92,871 → 404,373 cells (8.9 MB of return arrays at 22 bytes a return, per USV per frame at W3).
     The box gives the same 7 cells with both. (Measured before 2026-12-01, when the sea behind the box stopped
-    drawing clutter, `radar/shadow.rs`: the counts are a little lower now.)
+    drawing clutter, `radar/shadow.rs`, and the fan beam got its elevation pattern, `radar/pattern.rs`, which
+    weakens the clutter close in: the counts are lower now, not measured again here.)
     """
 
     range_m: float = Field(default=3000.0, gt=0, le=100_000)

@@ -16,9 +16,10 @@
 //!
 //! Range bin `k` covers `[k Δr, (k+1) Δr)` and is reported at its centre `(k + ½) Δr`; bins whose centre lies
 //! outside `[range_min_m, range_max_m)` are blind. Hits are aggregated per cell (azimuth bin, range bin):
-//! intensity is the sum of [`radar_model::ray_power`] over the rays hitting something other than water, plus
-//! the cell's clutter draw ([`radar_model::clutter_mean`]); a cell is reported when its intensity is positive
-//! and at least `detection_threshold`. Its instance and class are those of the object with the largest summed
+//! intensity is the sum of [`radar_model::ray_power`] over the rays hitting something other than water (each
+//! weighted by the fan's two-way elevation gain, [`RadarConfig::two_way_gain`]), plus the cell's clutter draw
+//! ([`radar_model::clutter_mean`]); a cell is reported when its intensity is positive and at least
+//! `detection_threshold`. Its instance and class are those of the object with the largest summed
 //! echo in the cell, or instance −1 and class WATER (sea clutter) / NONE (rain clutter) when clutter
 //! dominates. Rays that hit water end there and are not targets: the sea is seen only as clutter. Sea clutter
 //! comes only from the water the beam sees: a cell's sea clutter mean is scaled by the share of the beam's azimuth
@@ -162,7 +163,8 @@ pub fn radar_sweep(
                     let n = &hits.normal[3 * i..3 * i + 3];
                     let dir = dirs[i];
                     let cos = (n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2]) as f64;
-                    let omega = az_width * weight as f64 * f64::from(elevation).cos();
+                    let omega =
+                        az_width * weight as f64 * f64::from(elevation).cos() * cfg.two_way_gain(f64::from(elevation));
                     let power = radar_model::ray_power(class, cos, omega, d, &rain);
                     echoes.push(Echo { bin, instance, class, power, elevation: elevation as f64 });
                 }

@@ -162,7 +162,8 @@ fn bad_frequency_or_polarisation_is_refused_by_name() {
 
 /// The sea clutter's cell is pulse-limited, `A = r θ_az Δr sec ψ` (Skolnik §13.2): cell for cell (the same
 /// draws), the clutter of an antenna 15 m up over the flat sea's fixed `σ⁰ H²` rule is that of one 3 m up times
-/// `sec ψ₁₅(r) / sec ψ₃(r)`, with `sin ψ = h / r − r / (2 · 4/3 · R_e)` written out here (1.51 at 20 m); and no
+/// `sec ψ₁₅(r) / sec ψ₃(r)`, with `sin ψ = h / r − r / (2 · 4/3 · R_e)` written out here (1.51 at 20 m), and
+/// times the ratio of the fan's two-way gains where the water lies (the elevation pattern's test below); and no
 /// sea clutter lies closer than the antenna's height, where there is no water at that slant range. Until
 /// 2026-12-01 the area was `r θ_az Δr` whatever the grazing angle (the ratio was 1), and clutter was drawn there.
 #[test]
@@ -194,7 +195,9 @@ fn the_sea_clutter_cell_is_pulse_limited() {
         match high.get(key) {
             Some(&got) => {
                 assert!(r > 15.0, "sea clutter {r} m from an antenna 15 m up");
-                let want = sec(15.0, r) / sec(3.0, r);
+                // And the fan's two-way gain where the water lies (Gaussian, θ_el = 20°, axis level).
+                let g2 = |h: f64| (-8.0 * std::f64::consts::LN_2 * ((h / r).atan() / 20f64.to_radians()).powi(2)).exp();
+                let want = sec(15.0, r) / sec(3.0, r) * g2(15.0) / g2(3.0);
                 assert!((got / base / want - 1.0).abs() < 1e-5, "r {r} m: {} vs sec ratio {want}", got / base);
                 checked += 1;
             }
@@ -220,4 +223,48 @@ fn clutter_does_not_depend_on_the_rays_cast() {
     assert!(base.len() > 10_000);
     assert_eq!(with(3, 16), base);
     assert_eq!(with(2, 9), base);
+}
+
+/// The fan's elevation pattern weights the sea clutter where the water lies: cell for cell (the same draws), the
+/// clutter of a 20° fan (±10°) over that of a 60° fan from a 6 m mast is `G²₂₀(e) / G²₆₀(e)` at the water's
+/// elevation `e = −atan(h / r)`, with the Gaussian two-way gain `exp(−8 ln 2 e² / θ_el²)` written out here (0.032
+/// at 20 m, 0.98 at 300 m). And rain fills the beam: its mean is `η r² θ_az θ_el √(π / (8 ln 2)) Δr (R_ref/r)⁴`,
+/// the pattern integrated. Until 2026-12-01 the fan was uniform: the sea 17° below the axis, outside a ±10° fan,
+/// gave the same clutter as on it (the ratio was 1) and rain filled `θ_el` whole.
+#[test]
+fn the_fan_pattern_weights_sea_and_rain_clutter() {
+    let base = RadarConfig {
+        range_max_m: 600.0,
+        clutter: ClutterModel { rain_eta_at_1mm_h: 0.0, ..cfg(9.41, Polarisation::Horizontal).clutter },
+        ..cfg(9.41, Polarisation::Horizontal)
+    };
+    let fan = |deg: f64| RadarConfig { elevation_fan_rad: [(-deg).to_radians(), deg.to_radians()], ..base };
+    let (s, env) = (sea(false), RadarEnv { wave_height_m: 1.5, rain_mm_per_h: 0.0 });
+    let (narrow, wide) = (clutter(&s, &fan(10.0), &env), clutter(&s, &fan(30.0), &env));
+    assert!(narrow.len() > 10_000);
+    let g2 = |e: f64, width_deg: f64| (-8.0 * std::f64::consts::LN_2 * (e / width_deg.to_radians()).powi(2)).exp();
+    let h = f64::from(MAST.translation.z);
+    let mut checked = 0;
+    for (key, &got) in &narrow {
+        let Some(&w) = wide.get(key) else { continue };
+        let r = f64::from(f32::from_bits(key.1));
+        let e = -(h / r).atan();
+        let want = g2(e, 20.0) / g2(e, 60.0);
+        assert!((got / w / want - 1.0).abs() < 1e-5, "r {r} m: {} vs {want}", got / w);
+        checked += 1;
+    }
+    assert!(checked > 10_000, "{checked} cells compared");
+    assert!((g2(-(6f64 / 19.5).atan(), 20.0) / g2(-(6f64 / 19.5).atan(), 60.0) - 0.0272).abs() < 1e-3);
+    // Rain: the mean of the model, against the integrated pattern written out.
+    let c = RadarConfig { clutter: ClutterModel { rain_eta_at_1mm_h: 5e-9, ..base.clutter }, ..fan(10.0) };
+    let cell = c.cell_shape(6.0);
+    for r in [50.0, 400.0] {
+        let (_, rain) = radar_model::clutter_mean(&c.clutter, &cell, &c.band(), 0.0, 4.0, r);
+        let theta_el = 20f64.to_radians();
+        let volume = r * r * c.beamwidth_az_rad * theta_el * (std::f64::consts::PI / (8.0 * 2f64.ln())).sqrt() * 3.0;
+        // ITU-R P.838-3 at 9.41 GHz HH (radar_model's test): k = 0.009299, α = 1.28951.
+        let loss = 10f64.powf(-2.0 * 0.009299 * 4f64.powf(1.28951) * r / 1000.0 / 10.0);
+        let want = 5e-9 * 4f64.powf(1.6) * volume * (1000.0 / r).powi(4) * loss;
+        assert!((rain / want - 1.0).abs() < 1e-5, "r {r} m: {rain} vs {want}");
+    }
 }

@@ -12,7 +12,8 @@
 //!   backscatter per unit of its own area is `σ⁰ = ρ cos²θ` (a quarter of a Lambertian reflector's
 //!   `4 ρ cos²θ`; `ρ` is a per-class radar reflectivity, not an albedo), so a face-on patch of `A` m² is a
 //!   target of `ρ A` m². Summing rays over a cell makes the echo grow with the target's visible size (more rays
-//!   hit it). `ρ` per class: [`class_reflectivity`].
+//!   hit it). `ρ` per class: [`class_reflectivity`]. Each ray's echo is weighted by the fan's two-way elevation
+//!   gain `G²(e)` (Gaussian main lobe, `radar/pattern.rs`; 1 on the fan's axis).
 //! * **Rain attenuation** (two-way): specific attenuation `γ = k · R^α` dB/km for a rain rate `R` in mm/h, with
 //!   `k` and `α` of the radar's frequency `f` and polarisation from ITU-R P.838-3 (2005), "Specific attenuation
 //!   model for rain for use in prediction methods", eqs. (2)–(3) and Tables 1–4: `log10 k = Σⱼ aⱼ exp(−((log10 f −
@@ -29,7 +30,8 @@
 //!   `sea_max_range_m` and for `H = 0`.
 //!   Over the physical sea (a scene with a displaced wave surface) σ⁰ instead follows sea state and grazing
 //!   angle by the NRL model of Gregers-Hansen & Mital (2012), `sensors/radar/sea_clutter.rs`, and the sea part
-//!   is `σ⁰ · A(r) · (R_ref/r)⁴ · L_rain(r)` ([`clutter_mean_sigma0`]).
+//!   is `σ⁰ · A(r) · (R_ref/r)⁴ · L_rain(r)` ([`clutter_mean_sigma0`]). Either is weighted per beam by the fan's
+//!   two-way gain `G²` at the elevation where that water lies in the sensor frame (`radar/pattern.rs`).
 //! * **Rain clutter**: the volume reflectivity of rain is that of Rayleigh scattering by drops small against the
 //!   wavelength λ, `η = π⁵ |K|² Z / λ⁴` (m²/m³, `Z` in m⁶/m³, `|K|² ≈ 0.93` for water), with the reflectivity
 //!   factor of Marshall & Palmer (1948), `Z = 200 R^1.6` mm⁶/m³ for a rain rate `R` in mm/h (Skolnik, M. I.
@@ -37,8 +39,9 @@
 //!   that is `5.5·10⁻⁸ R^1.6` m²/m³. Here `η = rain_eta_at_1mm_h · R^1.6 · (f / 9.41 GHz)⁴`: the knob is η at
 //!   1 mm/h for an X-band 9.41 GHz radar, and the `λ⁻⁴` of the formula carries it to the radar's frequency `f`
 //!   (`|K|²` of water changes by under 1 % between 3 and 10 GHz; until 2026-12-01 η did not depend on the
-//!   frequency, which was fixed). η times the cell volume `r² · θ_az · θ_el · Δr`, same `(R_ref/r)⁴ ·
-//!   L_rain(r)`. (The scenario default `rain_clutter_eta` 5·10⁻⁹ is 10.4 dB below Marshall–Palmer's 5.5·10⁻⁸.)
+//!   frequency, which was fixed). η times the cell volume `r² · θ_az · θ_el √(π / (8 ln 2)) · Δr` (the fan's
+//!   Gaussian two-way elevation pattern integrated, `radar/pattern.rs`; until 2026-12-01 the full `θ_el`), same
+//!   `(R_ref/r)⁴ · L_rain(r)`. (The scenario default `rain_clutter_eta` 5·10⁻⁹ is 10.4 dB below Marshall–Palmer's 5.5·10⁻⁸.)
 //! * A cell's clutter intensity is exponentially distributed (Rayleigh amplitude) with mean `μ_sea + μ_rain`,
 //!   drawn from `−ln u` with `u` uniform; so for a fixed seed the clutter of a cell grows monotonically with
 //!   the wave height and rain rate, and a clutter-only cell is reported with probability `exp(−threshold/μ)`.
@@ -278,7 +281,9 @@ pub fn clutter_mean(
     };
     let rain = if rain_mm_per_h > 0.0 {
         let eta = model.rain_eta_at_1mm_h * rain_mm_per_h.powf(1.6) * band.rain_eta_factor();
-        eta * r * r * cell.beamwidth_az * cell.fan_height * cell.range_resolution * common
+        // The fan's Gaussian two-way pattern integrated over elevation: ∫G² de = θ_el √(π / (8 ln 2)).
+        let fan = cell.fan_height * (std::f64::consts::PI / (8.0 * std::f64::consts::LN_2)).sqrt();
+        eta * r * r * cell.beamwidth_az * fan * cell.range_resolution * common
     } else {
         0.0
     };

@@ -96,8 +96,9 @@ impl ClutterBin {
         Self { mean, sea: sea >= rain, p_detect, sea_mean: sea, rain_mean: rain }
     }
 
-    /// This bin where the beam sees the sea over `share` (`0..=1`) of its width (the rest land or shadow): the
-    /// sea part scaled by it, the rain part as it is; `share = 1` is `self`, to the bit.
+    /// This bin with its sea part scaled by `share` (`0..=1`: the share of the beam's width that sees the sea,
+    /// the rest land or shadow; or the fan's two-way gain where the water lies), the rain part as it is;
+    /// `share = 1` is `self`, to the bit.
     pub(super) fn in_view(self, cfg: &RadarConfig, share: f64) -> Self {
         if share >= 1.0 {
             self

@@ -25,7 +25,9 @@ pub struct RadarConfig {
     pub azimuth_bins: u32,
     /// Horizontal (azimuth) beamwidth, radians, in `(0, π/2]`.
     pub beamwidth_az_rad: f64,
-    /// Vertical fan `[lower, upper]` elevations, radians, `-π/2 < lower ≤ upper < π/2`.
+    /// Vertical fan `[lower, upper]` elevations, radians, `-π/2 < lower ≤ upper < π/2`: the rays span it, and its
+    /// height is the half-power beamwidth of the Gaussian elevation pattern centred on it
+    /// ([`RadarConfig::two_way_gain`]).
     pub elevation_fan_rad: [f64; 2],
     /// Rays per beam across the beamwidth (`≥ 1`).
     pub rays_az: u32,
