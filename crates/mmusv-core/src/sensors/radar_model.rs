@@ -35,13 +35,15 @@
 //! * **Rain clutter**: the volume reflectivity of rain is that of Rayleigh scattering by drops small against the
 //!   wavelength λ, `η = π⁵ |K|² Z / λ⁴` (m²/m³, `Z` in m⁶/m³, `|K|² ≈ 0.93` for water), with the reflectivity
 //!   factor of Marshall & Palmer (1948), `Z = 200 R^1.6` mm⁶/m³ for a rain rate `R` in mm/h (Skolnik, M. I.
-//!   (2001), "Introduction to Radar Systems", 3rd ed., §13.6 Weather Clutter; Nathanson (1991) §6); at 9.41 GHz
-//!   that is `5.5·10⁻⁸ R^1.6` m²/m³. Here `η = rain_eta_at_1mm_h · R^1.6 · (f / 9.41 GHz)⁴`: the knob is η at
-//!   1 mm/h for an X-band 9.41 GHz radar, and the `λ⁻⁴` of the formula carries it to the radar's frequency `f`
+//!   (2001), "Introduction to Radar Systems", 3rd ed., §13.6 Weather Clutter; Nathanson, F. E. (1991), "Radar
+//!   Design Principles", 2nd ed.); at 9.41 GHz that is `5.5·10⁻⁸ R^1.6` m²/m³. Here
+//!   `η = rain_eta_at_1mm_h · R^1.6 · (f / 9.41 GHz)⁴`: the knob is η at 1 mm/h for an X-band 9.41 GHz radar,
+//!   and the `λ⁻⁴` of the formula carries it to the radar's frequency `f`
 //!   (`|K|²` of water changes by under 1 % between 3 and 10 GHz; until 2026-12-01 η did not depend on the
 //!   frequency, which was fixed). η times the cell volume `r² · θ_az · θ_el √(π / (8 ln 2)) · Δr` (the fan's
 //!   Gaussian two-way elevation pattern integrated, `radar/pattern.rs`; until 2026-12-01 the full `θ_el`), same
-//!   `(R_ref/r)⁴ · L_rain(r)`. (The scenario default `rain_clutter_eta` 5·10⁻⁹ is 10.4 dB below Marshall–Palmer's 5.5·10⁻⁸.)
+//!   `(R_ref/r)⁴ · L_rain(r)`. (The scenario default `rain_clutter_eta` 5·10⁻⁹ is 10.4 dB below
+//!   Marshall–Palmer's 5.5·10⁻⁸.)
 //! * A cell's clutter intensity is exponentially distributed (Rayleigh amplitude) with mean `μ_sea + μ_rain`,
 //!   drawn from `−ln u` with `u` uniform; so for a fixed seed the clutter of a cell grows monotonically with
 //!   the wave height and rain rate, and a clutter-only cell is reported with probability `exp(−threshold/μ)`.
@@ -238,7 +240,7 @@ pub struct CellShape {
 impl CellShape {
     /// The sea surface a range cell at (slant) range `r` metres illuminates, m²: the pulse-limited clutter cell
     /// `A = r · θ_az · Δr · sec ψ` (Skolnik, "Introduction to Radar Systems", 3rd ed., §13.2; Barton (2013),
-    /// "Radar Equations for Modern Radar", §8: the beam's width `r θ_az` across, the slant-range bin `Δr`
+    /// "Radar Equations for Modern Radar": the beam's width `r θ_az` across, the slant-range bin `Δr`
     /// stretched to `Δr / cos ψ` along the water) at the 4/3-earth grazing angle ψ of
     /// [`crate::sensors::radar::sea_clutter::sin_grazing`], `ψ ≥ 0` (beyond the horizon the NRL model's own
     /// clamp to 0.1° stands: `sec ψ = 1`); zero where no water lies at that slant range (`r ≤ h`). The cell is

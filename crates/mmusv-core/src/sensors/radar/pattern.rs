@@ -5,7 +5,7 @@
 //! Elevation pattern: a marine radar's fan beam is some 20–25° tall between its half-power points and tapers,
 //! not a uniform slab. Its main lobe is taken Gaussian, the standard approximation of a radar beam's main lobe
 //! (Probert-Jones, J. R. (1962), "The radar equation in meteorology", Q. J. R. Meteorol. Soc. 88, 485–495;
-//! Doviak, R. J. & Zrnić, D. S. (1993), "Doppler Radar and Weather Observations", 2nd ed., §4.4): one-way power
+//! Doviak, R. J. & Zrnić, D. S. (1993), "Doppler Radar and Weather Observations", 2nd ed.): one-way power
 //! gain `G(e) = exp(−4 ln 2 (e − e₀)² / θ_el²)` with `θ_el` the fan's height (`elevation_fan_rad`'s span: the
 //! half-power beamwidth) and `e₀` its centre, so the two-way weight of an echo is `G² = exp(−8 ln 2 (e − e₀)² /
 //! θ_el²)`: 1 on the axis, ¼ at the fan's edges. It weights every target ray ([`RadarConfig::two_way_gain`]), the
