@@ -211,8 +211,10 @@ class RadarConfig(_Model):
             and, by Rayleigh scattering's λ⁻⁴, with ``(frequency_ghz / 9.41)⁴``; ``0..1``); 0 disables. Marshall–Palmer
             rain (η = π⁵|K|²Z/λ⁴, Z = 200 R^1.6) is 5.5e-8 at 9.41 GHz; the default is 10.4 dB below it.
         frequency_ghz: carrier frequency, GHz (``0.5..35``, the NRL sea-clutter model's range; 9.41 = X band,
-            3.05 = S band): sea clutter's σ⁰ (NRL model, over the physical sea) and rain clutter follow it.
-        polarisation: ``"HH"`` (marine radars) or ``"VV"``: sea clutter's σ⁰ (NRL model) follows it.
+            3.05 = S band): sea clutter's σ⁰ (NRL model, over the physical sea), rain clutter (λ⁻⁴) and rain
+            attenuation (ITU-R P.838-3) follow it.
+        polarisation: ``"HH"`` (marine radars) or ``"VV"``: sea clutter's σ⁰ (NRL model) and rain attenuation
+            (ITU-R P.838-3) follow it.
         ppi_size_px, ppi_metres_per_pixel, ppi_orientation: the PPI image; ``ppi_metres_per_pixel`` defaults to
             ``range_m / (ppi_size_px / 2)``.
 

@@ -43,10 +43,10 @@ pub struct RadarConfig {
     pub range_noise_std_m: f64,
     /// Sea and rain clutter.
     pub clutter: ClutterModel,
-    /// Carrier frequency, GHz (`0.5..=35`, the NRL sea-clutter model's range; 9.41 = X band): sea clutter's σ⁰
-    /// and rain clutter's reflectivity (`∝ f⁴`) follow it ([`crate::sensors::radar_model`]).
+    /// Carrier frequency, GHz (`0.5..=35`, the NRL sea-clutter model's range; 9.41 = X band): sea clutter's σ⁰,
+    /// rain clutter's reflectivity (`∝ f⁴`) and rain attenuation follow it ([`crate::sensors::radar_model`]).
     pub frequency_ghz: f64,
-    /// Polarisation (transmit = receive): sea clutter's σ⁰ follows it.
+    /// Polarisation (transmit = receive): sea clutter's σ⁰ and rain attenuation follow it.
     pub polarisation: Polarisation,
 }
 
