@@ -433,7 +433,15 @@ class Radar:
         critical_range_per_m: float,
         sea_max_range_m: float,
         rain_eta_at_1mm_h: float,
+        frequency_ghz: float,
+        polarisation: str,
     ) -> Radar: ...
+    @property
+    def frequency_ghz(self) -> float:
+        """Carrier frequency, GHz."""
+    @property
+    def polarisation(self) -> str:
+        """Polarisation, ``"HH"`` or ``"VV"``."""
     @property
     def range_max_m(self) -> float:
         """Instrumented range, metres."""

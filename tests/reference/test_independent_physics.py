@@ -660,8 +660,9 @@ def test_radar_sea_clutter_is_the_nrl_model() -> None:
     sin ψ = h/r − r/(2 k R_e), and the sea state of Hs by the Douglas bands (each state at its band's middle),
     within 1 % over 20–1200 m and four
     wave heights (measured 0.04 %: mmusv's c2 = 20.781 against the 20.78 quoted here, 0.003 dB). And the mean of
-    the physical sweep over its 2 048 azimuths is that μ = σ⁰ A (R_ref/r)⁴ within 10 % (exponential draws: a 2.2 %
-    standard error)."""
+    the physical sweep over its 2 048 azimuths is that μ = σ⁰ A G² (R_ref/r)⁴, with the pulse-limited cell
+    A = r θ_az Δr sec ψ and the fan's two-way gain G² where the water lies, within 10 % (exponential draws: a
+    2.2 % standard error)."""
     s = Scene()
     sea = _quad(s, 0.0, 5000.0, 1)
     s.set_sea(sea)
@@ -683,6 +684,8 @@ def test_radar_sea_clutter_is_the_nrl_model() -> None:
         critical_range_per_m=100_000.0,
         sea_max_range_m=5000.0,
         rain_eta_at_1mm_h=0.0,
+        frequency_ghz=9.41,
+        polarisation="HH",
     )
     pose = pose_matrices(np.array([0.0, 0.0, height, 0.0, 0.0, 0.0]))
     earth = 6_371_000.0 * 4 / 3
@@ -706,7 +709,13 @@ def test_radar_sea_clutter_is_the_nrl_model() -> None:
         sigma0 = phys["intensity"].astype(float) / fixed["intensity"].astype(float) * sigma_1m * hs**2
         np.testing.assert_allclose(sigma0, _nrl_sigma0(X_BAND_GHZ, ss, psi), rtol=0.01)
         if hs == 1.0:
-            mu = _nrl_sigma0(X_BAND_GHZ, ss, psi) * r * math.radians(1.2) * 10.0 * (1000.0 / r) ** 4
+            # The pulse-limited cell A = r θ_az Δr sec ψ (Skolnik, Introduction to Radar Systems, §13.2), ψ unclamped.
+            sec_psi = 1.0 / np.sqrt(1.0 - np.clip(height / r - r / (2 * earth), 0.0, None) ** 2)
+            area = r * math.radians(1.2) * 10.0 * sec_psi
+            # Times the fan's Gaussian two-way gain exp(−8 ln 2 e² / θ_el²) where the water lies, e = −atan(h / r),
+            # θ_el = 20° (Probert-Jones 1962).
+            g2 = np.exp(-8 * math.log(2) * (np.arctan(height / r) / math.radians(20.0)) ** 2)
+            mu = _nrl_sigma0(X_BAND_GHZ, ss, psi) * area * g2 * (1000.0 / r) ** 4
             for rr in np.unique(r)[::20]:
                 m = r == rr
                 assert np.mean(phys["intensity"][m] / mu[m]) == pytest.approx(1.0, rel=0.1)

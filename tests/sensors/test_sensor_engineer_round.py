@@ -106,9 +106,10 @@ def nrl_sigma0_db(f_ghz: float, sea_state: float, psi_deg: float) -> float:
 def test_physical_sea_clutter_is_the_nrl_model_at_the_configured_sea_state() -> None:
     """Over the physical sea of WMO state 3 and 5 (the bundled presets, ``sea: {state: s}``), every cell's clutter
     drawn (threshold 0), the mean clutter of 2048 beams × 3 range bins at 20, 60, 200 and 600 m (grazing 18° to
-    0.6° from a 6 m mast, 4/3 earth) over the radar equation's ``A (R_ref/r)⁴`` (``A = r θ_az Δr``) is the NRL
-    model's σ⁰ at X band (9.41 GHz), HH, at that sea state, within 0.4 dB (the sampling error is 0.06 dB).
-    Before: 0.9 to 3.0 dB low, the model evaluated at sea state 2.5 and 4.5."""
+    0.6° from a 6 m mast, 4/3 earth) over the radar equation's ``A G² (R_ref/r)⁴`` (``A = r θ_az Δr sec ψ``,
+    ``G²`` the fan's two-way gain where the water lies) is the NRL model's σ⁰ at X band (9.41 GHz), HH, at that
+    sea state, within 0.4 dB (the sampling error is 0.06 dB). Before: 0.9 to 3.0 dB low, the model evaluated at
+    sea state 2.5 and 4.5."""
     cfg = RadarConfig(
         range_m=700.0, min_range_m=10.0, rays_az=1, rays_el=1, detection_threshold=0.0, rain_clutter_eta=0.0
     )
@@ -128,9 +129,13 @@ def test_physical_sea_clutter_is_the_nrl_model_at_the_configured_sea_state() -> 
             for k in (k0 - 1, k0, k0 + 1):
                 r = (k + 0.5) * cfg.range_resolution_m
                 psi = math.degrees(math.asin(height / r - r / (2 * EARTH_K_RE)))
-                area = r * math.radians(cfg.beamwidth_deg) * cfg.range_resolution_m
+                # The pulse-limited cell, r θ_az Δr sec ψ (Skolnik §13.2).
+                sec_psi = 1.0 / math.cos(math.radians(psi))
+                area = r * math.radians(cfg.beamwidth_deg) * cfg.range_resolution_m * sec_psi
                 sigma0 = 10 ** (nrl_sigma0_db(9.41, int(state), psi) / 10)
-                want += sigma0 * area * (1000.0 / r) ** 4 * cfg.azimuth_bins
+                # The fan's Gaussian two-way gain where the water lies (θ_el = 20°, axis level): Probert-Jones 1962.
+                g2 = math.exp(-8 * math.log(2) * (math.atan(height / r) / math.radians(20.0)) ** 2)
+                want += sigma0 * area * g2 * (1000.0 / r) ** 4 * cfg.azimuth_bins
                 got += float(ret.intensity[np.abs(ret.range - r) < 1e-3].astype(np.float64).sum())
             db = 10 * math.log10(got / want)
             assert abs(db) < 0.4, f"state {state}, {r0:.0f} m: clutter {db:+.2f} dB from the NRL model"
@@ -177,8 +182,9 @@ def test_no_sea_clutter_over_an_island_or_in_its_shadow() -> None:
 def test_target_echo_is_the_radar_equation_at_any_elevation_and_range() -> None:
     """A plate of 30 m × 30 m facing the radar: its echo summed over the beams that see it is the radar equation's
     ``ρ A (R_ref / r)⁴`` times the beams per point of it (beamwidth / bin width), on the horizon and 25° and 40°
-    above it (within 6 %), and falls as r⁻⁴ from 300 to 600 m. Before, the plate 40° up was 1.31 times as bright
-    (a ray's solid angle without ``cos e``)."""
+    above it (within 6 %), times the fan's two-way gain there (Gaussian, 90° between half-power points here), and
+    falls as r⁻⁴ from 300 to 600 m. Before, the plate 40° up was 1.31 times as bright (a ray's solid angle without
+    ``cos e``), and until the elevation pattern (2026-12-01) as bright as on the horizon."""
     cfg = RadarConfig(
         range_m=1000.0,
         azimuth_bins=1024,
@@ -207,8 +213,13 @@ def test_target_echo_is_the_radar_equation_at_any_elevation_and_range() -> None:
         assert (ret.instance_id == inst).all() and len(ret) > 0
         return float(ret.intensity.astype(np.float64).sum())
 
+    def gain(r: float, e_deg: float) -> float:
+        """The fan's Gaussian two-way gain exp(−8 ln 2 e² / θ_el²), θ_el = 90°, averaged over the plate."""
+        e = np.radians(e_deg) + np.linspace(-1.0, 1.0, 101) * math.atan(half / r)
+        return float(np.mean(np.exp(-8 * math.log(2) * (e / math.radians(90.0)) ** 2)))
+
     for e_deg in (0.0, 25.0, 40.0):
-        want = rho * (2 * half) ** 2 * (1000.0 / 300.0) ** 4 * beams
+        want = rho * (2 * half) ** 2 * (1000.0 / 300.0) ** 4 * beams * gain(300.0, e_deg)
         got = total(300.0, e_deg)
         assert abs(got / want - 1) < 0.06, f"plate {e_deg}° up: {got / want:.3f} of the radar equation"
     assert abs(total(300.0, 0.0) / total(600.0, 0.0) / 16.0 - 1) < 0.06, "r⁻⁴"

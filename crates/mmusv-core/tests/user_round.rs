@@ -25,6 +25,7 @@ use mmusv_core::sensors::camera::{Camera, CameraConfig, Projection};
 use mmusv_core::sensors::capture::{capture_frame, SensorOutput, SensorTask};
 use mmusv_core::sensors::lidar::{reflectivity, Lidar, LidarConfig, LidarEnv};
 use mmusv_core::sensors::ppi::{ppi_image, PpiConfig, PpiOrientation};
+use mmusv_core::sensors::radar::sea_clutter::Polarisation;
 use mmusv_core::sensors::radar::{radar_sweep, RadarConfig, RadarEnv};
 use mmusv_core::sensors::radar_model::ClutterModel;
 use mmusv_core::sensors::rays;
@@ -1005,6 +1006,8 @@ fn quiet_radar() -> RadarConfig {
             sea_max_range_m: 0.0,
             rain_eta_at_1mm_h: 0.0,
         },
+        frequency_ghz: 9.41,
+        polarisation: Polarisation::Horizontal,
     }
 }
 

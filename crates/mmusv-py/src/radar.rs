@@ -7,6 +7,7 @@ use crate::scene::Scene;
 use crate::sensors::SensorEnv;
 use mmusv_core::sensors::capture;
 use mmusv_core::sensors::ppi::{self, PpiConfig, PpiOrientation};
+use mmusv_core::sensors::radar::sea_clutter::Polarisation;
 use mmusv_core::sensors::radar::{self, RadarConfig, RadarReturns};
 use mmusv_core::sensors::radar_model::ClutterModel;
 use numpy::ndarray::Array2;
@@ -28,7 +29,7 @@ impl Radar {
     #[pyo3(signature = (
         *, range_min_m, range_max_m, range_resolution_m, azimuth_bins, beamwidth_az_rad, elevation_fan_rad, rays_az,
         rays_el, horizon_fraction, horizon_band_rad, detection_threshold, range_noise_std_m, sea_sigma0_at_1m,
-        critical_range_per_m, sea_max_range_m, rain_eta_at_1mm_h
+        critical_range_per_m, sea_max_range_m, rain_eta_at_1mm_h, frequency_ghz, polarisation
     ))]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -48,6 +49,8 @@ impl Radar {
         critical_range_per_m: f64,
         sea_max_range_m: f64,
         rain_eta_at_1mm_h: f64,
+        frequency_ghz: f64,
+        polarisation: &str,
     ) -> PyResult<Self> {
         let cfg = RadarConfig {
             range_min_m,
@@ -63,6 +66,8 @@ impl Radar {
             detection_threshold,
             range_noise_std_m,
             clutter: ClutterModel { sea_sigma0_at_1m, critical_range_per_m, sea_max_range_m, rain_eta_at_1mm_h },
+            frequency_ghz,
+            polarisation: Polarisation::parse(polarisation).map_err(to_py)?,
         };
         cfg.validate().map_err(to_py)?;
         Ok(Self { cfg })
@@ -72,6 +77,18 @@ impl Radar {
     #[getter]
     fn range_max_m(&self) -> f64 {
         self.cfg.range_max_m
+    }
+
+    /// Carrier frequency, GHz.
+    #[getter]
+    fn frequency_ghz(&self) -> f64 {
+        self.cfg.frequency_ghz
+    }
+
+    /// Polarisation, `"HH"` or `"VV"`.
+    #[getter]
+    fn polarisation(&self) -> &'static str {
+        self.cfg.polarisation.name()
     }
 
     /// Range bin size, metres.

@@ -191,7 +191,9 @@ class RadarConfig(_Model):
         range_resolution_m: range bin size, metres (``> 0``; at most 2²⁰ bins over ``range_m``).
         azimuth_bins: beams per revolution (``1..65536``).
         beamwidth_deg: horizontal beamwidth, degrees, in ``(0, 90]``.
-        elevation_fan_deg: vertical fan ``(lower, upper)``, degrees, strictly within ``(-90, 90)``.
+        elevation_fan_deg: vertical fan ``(lower, upper)``, degrees, strictly within ``(-90, 90)``: the rays span it,
+            and it is the half-power beamwidth of the beam's Gaussian elevation pattern centred on it (two-way gain
+            1 on its axis, ¼ at its edges), which weights targets, sea clutter and rain (``radar/pattern.rs``).
         rays_az: rays per beam across the beamwidth (``1..64``).
         rays_el: rays per beam over the elevation fan (``1..256``); ``azimuth_bins · rays_az · rays_el <= 2²³``.
             Far, low targets are hit by few rays; raise it for steadier detection of small boats at km range.
@@ -205,7 +207,14 @@ class RadarConfig(_Model):
         clutter_critical_range_per_m: metres of critical range per metre of wave height (sea clutter falls as
             r⁻⁷ beyond it, r⁻³ before).
         sea_clutter_max_range_m: no sea clutter beyond this range, metres.
-        rain_clutter_eta: rain volume reflectivity (m²/m³) at 1 mm/h (scales with rate^1.6, ``0..1``); 0 disables.
+        rain_clutter_eta: rain volume reflectivity (m²/m³) at 1 mm/h for a 9.41 GHz radar (scales with rate^1.6
+            and, by Rayleigh scattering's λ⁻⁴, with ``(frequency_ghz / 9.41)⁴``; ``0..1``); 0 disables. Marshall–Palmer
+            rain (η = π⁵|K|²Z/λ⁴, Z = 200 R^1.6) is 5.5e-8 at 9.41 GHz; the default is 10.4 dB below it.
+        frequency_ghz: carrier frequency, GHz (``0.5..35``, the NRL sea-clutter model's range; 9.41 = X band,
+            3.05 = S band): sea clutter's σ⁰ (NRL model, over the physical sea), rain clutter (λ⁻⁴) and rain
+            attenuation (ITU-R P.838-3) follow it.
+        polarisation: ``"HH"`` (marine radars) or ``"VV"``: sea clutter's σ⁰ (NRL model) and rain attenuation
+            (ITU-R P.838-3) follow it.
         ppi_size_px, ppi_metres_per_pixel, ppi_orientation: the PPI image; ``ppi_metres_per_pixel`` defaults to
             ``range_m / (ppi_size_px / 2)``.
 
@@ -216,7 +225,8 @@ class RadarConfig(_Model):
     10,819 → 55,466 clutter cells, still growing with every sea state); with 0.01 / 4e-6 it reaches ≈180 m /
     ≈930 m with 92,871 → 404,373 cells (8.9 MB of return arrays at 22 bytes a return, per USV per frame at W3).
     The box gives the same 7 cells with both. (Measured before 2026-12-01, when the sea behind the box stopped
-    drawing clutter, `radar/shadow.rs`: the counts are a little lower now.)
+    drawing clutter, `radar/shadow.rs`, and the fan beam got its elevation pattern, `radar/pattern.rs`, which
+    weakens the clutter close in: the counts are lower now, not measured again here.)
     """
 
     range_m: float = Field(default=3000.0, gt=0, le=100_000)
@@ -235,6 +245,8 @@ class RadarConfig(_Model):
     clutter_critical_range_per_m: float = Field(default=300.0, ge=0, le=100_000)
     sea_clutter_max_range_m: float = Field(default=2500.0, ge=0, le=100_000)
     rain_clutter_eta: float = Field(default=5.0e-9, ge=0, le=1)
+    frequency_ghz: float = Field(default=9.41, ge=0.5, le=35)
+    polarisation: Literal["HH", "VV"] = "HH"
     ppi_size_px: int = Field(default=512, ge=16, le=8192)
     ppi_metres_per_pixel: float | None = Field(default=None, ge=0.01, le=1000)
     ppi_orientation: Literal["north_up", "head_up"] = "north_up"

@@ -89,6 +89,8 @@ def radar_from_config(cfg: RadarConfig) -> core.Radar:
         critical_range_per_m=cfg.clutter_critical_range_per_m,
         sea_max_range_m=cfg.sea_clutter_max_range_m,
         rain_eta_at_1mm_h=cfg.rain_clutter_eta,
+        frequency_ghz=cfg.frequency_ghz,
+        polarisation=cfg.polarisation,
     )
 
 

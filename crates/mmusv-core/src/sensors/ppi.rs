@@ -14,6 +14,17 @@
 //! (`N` azimuth bins): every pixel whose centre lies in the cell takes the return's intensity, with max
 //! compositing, so neighbouring cells tile the image without gaps and far cells are arcs. The pixel nearest
 //! the cell centre is always painted too, so a cell thinner than a pixel never vanishes.
+//!
+//! Roll and pitch: a marine radar's antenna is not stabilised. It turns in the deck plane of the hull it is bolted
+//! to (the sweep's rays follow the full sensor pose, `radar/pattern.rs`), and the radar knows only the slant range
+//! of an echo and the antenna's shaft angle against the bow; it draws them as if the deck were level. So the PPI
+//! plots each return at its slant range and its azimuth in the (tilted) sensor frame, head-up as it is and
+//! north-up turned by the gyro heading alone (the yaw of the sensor's forward axis projected on the horizontal,
+//! `sensor_yaw`), and does not correct roll or pitch: a target at bearing β off the bow seen with the hull rolled
+//! φ is drawn at `atan(tan β cos φ)` (1.8° short at β = 45°, φ = 20°), the tilt error of a real set (IMO's radar
+//! performance standards, MSC.192(79), ask only that detection not be substantially impaired in roll or pitch up
+//! to ±10°). Checked by `tests::a_rolled_radar_draws_its_targets_in_the_deck_plane`; the heading-only rotation is
+//! what `mmusv.sensors.radar` passes as `sensor_yaw`.
 
 use crate::error::{MmusvError, Result};
 use crate::sensors::radar::{validate_azimuth_bins, validate_resolution, RadarConfig, RadarReturns};
@@ -332,5 +343,56 @@ mod tests {
         );
         // Returns outside the image are clipped, not errors.
         assert!(ppi_image(&one(1e5, 1.0, 1.0), &p, 0.0, &r).is_ok_and(|v| v.iter().all(|&x| x == 0.0)));
+    }
+
+    /// The antenna is not stabilised: with the hull rolled 20° a buoy 45° off the bow (in the horizontal) is
+    /// swept at its azimuth in the deck plane, `atan(tan 45° cos 20°)` = 43.22°, written out here, not at 45°,
+    /// and the north-up PPI draws it there turned by the heading alone (the module documentation's choice).
+    #[test]
+    fn a_rolled_radar_draws_its_targets_in_the_deck_plane() {
+        use crate::geometry::RigidPose;
+        use crate::scene::Scene;
+        use crate::sensors::radar::{radar_sweep, RadarEnv};
+        use crate::sensors::radar_model::ClutterModel;
+        let (heading, roll, beta, dist) = (0.4f64, 20f64.to_radians(), 45f64.to_radians(), 300.0);
+        let mut s = Scene::new();
+        // A 2 m buoy level with the antenna (on the sea horizon: its bearing in the horizontal is β).
+        let buoy = s.add_mesh(crate::scene::tests::box_mesh([1.0, 1.0, 1.0], 10));
+        let bearing = heading + beta;
+        let _ = s.add_instance(
+            buoy,
+            RigidPose::from_xyz_rpy([dist * bearing.cos(), dist * bearing.sin(), 5.0], [0.0; 3]),
+            None,
+        );
+        let pose = RigidPose::from_xyz_rpy([0.0, 0.0, 5.0], [roll, 0.0, heading]);
+        let radar = RadarConfig {
+            azimuth_bins: 2048,
+            rays_az: 8,
+            elevation_fan_rad: [(-25f64).to_radians(), 25f64.to_radians()],
+            detection_threshold: 1e-6,
+            clutter: ClutterModel { sea_sigma0_at_1m: 0.0, rain_eta_at_1mm_h: 0.0, ..ClutterModel::tuning() },
+            ..RadarConfig::tuning()
+        };
+        let ret = radar_sweep(&s, &pose, &radar, &RadarEnv::default(), 1).unwrap_or_else(|e| unreachable!("{e}"));
+        assert!(!ret.is_empty());
+        // The echo-weighted azimuth of the buoy's returns.
+        let w: f64 = ret.intensity.iter().map(|&x| f64::from(x)).sum();
+        let az = ret.azimuth.iter().zip(&ret.intensity).map(|(&a, &x)| f64::from(a) * f64::from(x)).sum::<f64>() / w;
+        let deck = (beta.tan() * roll.cos()).atan();
+        let bin = TAU / 2048.0;
+        assert!(
+            (az - deck).abs() < 1.5 * bin,
+            "azimuth {:.3}° vs deck-plane {:.3}°",
+            az.to_degrees(),
+            deck.to_degrees()
+        );
+        assert!((az - beta).abs() > 4.0 * bin, "drawn at the levelled bearing {:.3}°", az.to_degrees());
+        // North-up: the strongest return's pixel is at screen angle azimuth + heading (east = right, north = up).
+        let i = (0..ret.len()).max_by(|&a, &b| ret.intensity[a].total_cmp(&ret.intensity[b])).unwrap_or(0);
+        let p = PpiConfig { size_px: 801, metres_per_pixel: 1.0, orientation: PpiOrientation::NorthUp };
+        let img = ppi_image(&ret, &p, heading as f32, &radar).unwrap_or_default();
+        let (r, a) = (f64::from(ret.range[i]), f64::from(ret.azimuth[i]));
+        let (row, col) = (400.0 - r * (a + heading).sin(), 400.0 + r * (a + heading).cos());
+        assert!(img[row.round() as usize * 801 + col.round() as usize] > 0.0, "pixel ({row:.1}, {col:.1})");
     }
 }

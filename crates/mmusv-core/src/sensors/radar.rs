@@ -16,9 +16,10 @@
 //!
 //! Range bin `k` covers `[k Δr, (k+1) Δr)` and is reported at its centre `(k + ½) Δr`; bins whose centre lies
 //! outside `[range_min_m, range_max_m)` are blind. Hits are aggregated per cell (azimuth bin, range bin):
-//! intensity is the sum of [`radar_model::ray_power`] over the rays hitting something other than water, plus
-//! the cell's clutter draw ([`radar_model::clutter_mean`]); a cell is reported when its intensity is positive
-//! and at least `detection_threshold`. Its instance and class are those of the object with the largest summed
+//! intensity is the sum of [`radar_model::ray_power`] over the rays hitting something other than water (each
+//! weighted by the fan's two-way elevation gain, [`RadarConfig::two_way_gain`]), plus the cell's clutter draw
+//! ([`radar_model::clutter_mean`]); a cell is reported when its intensity is positive and at least
+//! `detection_threshold`. Its instance and class are those of the object with the largest summed
 //! echo in the cell, or instance −1 and class WATER (sea clutter) / NONE (rain clutter) when clutter
 //! dominates. Rays that hit water end there and are not targets: the sea is seen only as clutter. Sea clutter
 //! comes only from the water the beam sees: a cell's sea clutter mean is scaled by the share of the beam's azimuth
@@ -123,12 +124,13 @@ pub fn radar_sweep(
     // Over the physical sea (a displaced wave surface), sea clutter follows sea state and grazing angle.
     let physical = scene.wave_surface().map(|w| {
         sea_clutter::PhysicalSea::new(env.wave_height_m as f64, f64::from(sensor_to_world.translation.z - w.level()))
+            .with_band(cfg.frequency_ghz, cfg.polarisation)
     });
-    let table = clutter_table(cfg, env, physical.as_ref(), first, end);
+    let sensor_height = sensor_to_world.translation.z.max(0.0) as f64;
+    let table = clutter_table(cfg, env, physical.as_ref(), sensor_height, first, end);
     // Solid angle of a ray = (beamwidth / rays_az) · its fan-height weight · cos(its elevation).
     let az_width = cfg.beamwidth_az_rad / cfg.rays_az as f64;
-    let rain = env.rain_mm_per_h as f64;
-    let sensor_height = sensor_to_world.translation.z.max(0.0) as f64;
+    let rain = radar_model::RainLoss::new(&cfg.band(), env.rain_mm_per_h as f64);
     // The clutter bins' ranges and the still water's depression there (`shadow`).
     let clutter_ranges: Vec<f64> = (first..).take(table.len()).map(|k| cfg.bin_centre(k)).collect();
     let depression: Vec<f64> = clutter_ranges.iter().map(|&r| sensor_height.atan2(r)).collect();
@@ -161,8 +163,9 @@ pub fn radar_sweep(
                     let n = &hits.normal[3 * i..3 * i + 3];
                     let dir = dirs[i];
                     let cos = (n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2]) as f64;
-                    let omega = az_width * weight as f64 * f64::from(elevation).cos();
-                    let power = radar_model::ray_power(class, cos, omega, d, rain);
+                    let omega =
+                        az_width * weight as f64 * f64::from(elevation).cos() * cfg.two_way_gain(f64::from(elevation));
+                    let power = radar_model::ray_power(class, cos, omega, d, &rain);
                     echoes.push(Echo { bin, instance, class, power, elevation: elevation as f64 });
                 }
                 blockers.count_shadowed(horizon, &clutter_ranges, &depression, &mut shadowed);
@@ -194,3 +197,7 @@ pub fn radar_sweep(
 #[cfg(test)]
 #[path = "radar_tests.rs"]
 mod tests;
+
+#[cfg(test)]
+#[path = "radar_clutter_tests.rs"]
+mod clutter_tests;

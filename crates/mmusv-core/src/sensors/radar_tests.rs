@@ -215,7 +215,8 @@ fn misconfiguration_names_the_field() {
 }
 
 /// Over the physical sea, the clutter-only detections of each range band occur at the rate the NRL model's mean
-/// gives (`exp(−threshold / μ)` per cell, `μ = σ⁰_NRL(SS, ψ) · A · (R_ref/r)⁴`), and grow with the sea state.
+/// gives (`exp(−threshold / μ)` per cell, `μ = σ⁰_NRL(SS, ψ) · A · (R_ref/r)⁴ · G²`, `G²` the fan's two-way gain
+/// where the water lies), and grow with the sea state.
 #[test]
 fn physical_sea_clutter_follows_the_nrl_model() {
     use crate::ocean::{sea_seed, SeaSpec, WaveField};
@@ -249,8 +250,18 @@ fn physical_sea_clutter_follows_the_nrl_model() {
                 break;
             }
             if r >= lo {
-                let (mu, _) = radar_model::clutter_mean_sigma0(&cfg.clutter, &cfg.cell_shape(), sea.sigma0(r), 0.0, r);
-                n += (-cfg.detection_threshold / mu).exp() * cfg.azimuth_bins as f64;
+                // Weighted by the fan's two-way gain where the water lies (Gaussian, θ_el = 20°, axis level).
+                let e = f64::from(MAST.translation.z).atan2(r) / 20f64.to_radians();
+                let g2 = (-8.0 * std::f64::consts::LN_2 * e * e).exp();
+                let (mu, _) = radar_model::clutter_mean_sigma0(
+                    &cfg.clutter,
+                    &cfg.cell_shape(sea.antenna_height_m),
+                    &cfg.band(),
+                    sea.sigma0(r),
+                    0.0,
+                    r,
+                );
+                n += (-cfg.detection_threshold / (mu * g2)).exp() * cfg.azimuth_bins as f64;
             }
         }
         n
@@ -270,11 +281,12 @@ fn physical_sea_clutter_follows_the_nrl_model() {
 }
 
 /// A ray stands for the solid angle `Δφ · Δe · cos e` of the beam: a 30 m plate facing the radar 300 m away
-/// gives the same total echo (summed over the beams that see it) 40° above the horizon as on it, the radar
-/// equation's `ρ A (R_ref/r)⁴` times the beams per point of it (beamwidth / bin width). Without the `cos e` the
-/// plate 40° up came out 1/cos 40° = 1.31 times as bright.
+/// gives (summed over the beams that see it) the radar equation's `ρ A (R_ref/r)⁴` times the beams per point of
+/// it (beamwidth / bin width) times the fan's two-way gain there (Gaussian, 90° between half-power points here:
+/// 0.335 at 40°), on the horizon and 40° above it. Without the `cos e` the plate 40° up came out 1/cos 40° = 1.31
+/// times as bright; without the elevation pattern (until 2026-12-01) as bright as on the horizon.
 #[test]
-fn a_target_above_the_horizon_is_as_bright_as_on_it() {
+fn a_target_above_the_horizon_follows_the_fan_pattern() {
     let cfg = RadarConfig {
         azimuth_bins: 1024,
         rays_az: 4,
@@ -304,11 +316,23 @@ fn a_target_above_the_horizon_is_as_bright_as_on_it() {
         ret.intensity.iter().map(|&x| f64::from(x)).sum::<f64>()
     };
     let (level, raised) = (total(0.0), total(40.0));
+    // The fan's Gaussian two-way gain exp(−8 ln 2 e² / θ_el²), θ_el = 90°, averaged over the plate's ±atan(15/300).
+    let gain = |e_deg: f64| {
+        let a = (f64::from(half) / r).atan();
+        (0..=100)
+            .map(|i| {
+                let e = e_deg.to_radians() - a + 2.0 * a * f64::from(i) / 100.0;
+                (-8.0 * std::f64::consts::LN_2 * (e / std::f64::consts::FRAC_PI_2).powi(2)).exp()
+            })
+            .sum::<f64>()
+            / 101.0
+    };
     let want =
         900.0 * (radar_model::REFERENCE_RANGE_M / r).powi(4) * cfg.beamwidth_az_rad / (std::f64::consts::TAU / 1024.0);
     eprintln!("plate on the horizon {:.3}, 40° up {:.3} of the radar equation", level / want, raised / want);
-    assert!((level / want - 1.0).abs() < 0.08, "{}", level / want);
-    assert!((raised / level - 1.0).abs() < 0.05, "40° up {raised} vs level {level}");
+    assert!((level / (want * gain(0.0)) - 1.0).abs() < 0.08, "{}", level / want);
+    let ratio = raised / level / (gain(40.0) / gain(0.0));
+    assert!((ratio - 1.0).abs() < 0.05, "40° up {raised} vs level {level}: {ratio} of the pattern's");
 }
 
 /// Sea clutter comes from the water in view: an island 60–160 m off (a 30 m high block, 100 m wide) leaves no sea

@@ -86,8 +86,13 @@ impl BeamContext<'_> {
         let thr = self.cfg.detection_threshold;
         let mut emit = |bin: u32, target: Option<&Echo>, clutter: Option<ClutterBin>| {
             let (u, w) = draws.at(bin);
-            let ClutterBin { mean, sea, p_detect, .. } =
-                clutter.unwrap_or_else(|| ClutterBin::at(self.cfg, self.env, self.physical.as_ref(), bin));
+            let centre = self.cfg.bin_centre(bin);
+            // The still water of this cell lies at elevation `water` in the sensor frame (the clutter's reported
+            // elevation): its sea clutter is weighted by the fan's two-way gain there (`pattern`).
+            let water = horizon - self.sensor_height.atan2(centre);
+            let ClutterBin { mean, sea, p_detect, .. } = clutter
+                .unwrap_or_else(|| ClutterBin::at(self.cfg, self.env, self.physical.as_ref(), self.sensor_height, bin))
+                .in_view(self.cfg, self.cfg.two_way_gain(water));
             // Clutter alone is detected iff mean · (−ln u) ≥ threshold, i.e. u ≤ exp(−threshold / mean).
             if target.is_none() && u > p_detect {
                 return;
@@ -98,12 +103,11 @@ impl BeamContext<'_> {
             if !(total > 0.0 && total >= thr) {
                 return;
             }
-            let centre = self.cfg.bin_centre(bin);
             let noise = self.cfg.range_noise_std_m;
             let range = if noise > 0.0 { (centre + noise * CellDraws::normal(w)).max(0.0) } else { centre };
             let (instance, class, elevation) = match target {
                 Some(t) if t.power >= clutter_power => (t.instance, t.class, t.elevation),
-                _ => (NO_HIT, if sea { CLASS_WATER } else { 0 }, horizon - self.sensor_height.atan2(centre)),
+                _ => (NO_HIT, if sea { CLASS_WATER } else { 0 }, water),
             };
             out.push(Return {
                 range: range as f32,

@@ -57,21 +57,31 @@ pub(super) struct ClutterBin {
 }
 
 impl ClutterBin {
-    /// The clutter of range bin `bin`.
-    /// Over the physical sea (`physical`), σ⁰ is the NRL model's ([`super::sea_clutter`]).
-    pub(super) fn at(cfg: &RadarConfig, env: &RadarEnv, physical: Option<&PhysicalSea>, bin: u32) -> Self {
+    /// The clutter of range bin `bin`, the antenna `flat_height` metres above the flat sea (z = 0).
+    /// Over the physical sea (`physical`), σ⁰ is the NRL model's ([`super::sea_clutter`]) and the antenna's height
+    /// is the one above its still level.
+    pub(super) fn at(
+        cfg: &RadarConfig,
+        env: &RadarEnv,
+        physical: Option<&PhysicalSea>,
+        flat_height: f64,
+        bin: u32,
+    ) -> Self {
         let r = cfg.bin_centre(bin);
+        let antenna_height = physical.map_or(flat_height, |p| p.antenna_height_m);
         let (sea, rain) = match physical {
             None => radar_model::clutter_mean(
                 &cfg.clutter,
-                &cfg.cell_shape(),
+                &cfg.cell_shape(antenna_height),
+                &cfg.band(),
                 env.wave_height_m as f64,
                 env.rain_mm_per_h as f64,
                 r,
             ),
             Some(p) => radar_model::clutter_mean_sigma0(
                 &cfg.clutter,
-                &cfg.cell_shape(),
+                &cfg.cell_shape(antenna_height),
+                &cfg.band(),
                 p.sigma0(r),
                 env.rain_mm_per_h as f64,
                 r,
@@ -86,8 +96,9 @@ impl ClutterBin {
         Self { mean, sea: sea >= rain, p_detect, sea_mean: sea, rain_mean: rain }
     }
 
-    /// This bin where the beam sees the sea over `share` (`0..=1`) of its width (the rest land or shadow): the
-    /// sea part scaled by it, the rain part as it is; `share = 1` is `self`, to the bit.
+    /// This bin with its sea part scaled by `share` (`0..=1`: the share of the beam's width that sees the sea,
+    /// the rest land or shadow; or the fan's two-way gain where the water lies), the rain part as it is;
+    /// `share = 1` is `self`, to the bit.
     pub(super) fn in_view(self, cfg: &RadarConfig, share: f64) -> Self {
         if share >= 1.0 {
             self
@@ -97,18 +108,27 @@ impl ClutterBin {
     }
 }
 
-/// Clutter of the range bins from `first` on, shared by every beam, up to the first bin where clutter alone
-/// cannot be detected (`mean < threshold / CLUTTER_CUTOFF`; the means fall monotonically with range).
+/// Clutter of the range bins from `first` on, shared by every beam, up to the first bin beyond the antenna's
+/// height where clutter alone cannot be detected (`mean < threshold / CLUTTER_CUTOFF`; from there on the means
+/// fall monotonically with range).
 pub(super) fn clutter_table(
     cfg: &RadarConfig,
     env: &RadarEnv,
     physical: Option<&PhysicalSea>,
+    flat_height: f64,
     first: u32,
     end: u32,
 ) -> Vec<ClutterBin> {
     let mut table = Vec::new();
+    // No water lies at a slant range below the antenna's height: those bins have no sea clutter, and do not end
+    // the table (the sea's clutter begins beyond them).
+    let water_from = physical.map_or(flat_height, |p| p.antenna_height_m);
     for k in first..end {
-        let c = ClutterBin::at(cfg, env, physical, k);
+        let c = ClutterBin::at(cfg, env, physical, flat_height, k);
+        if cfg.bin_centre(k) <= water_from {
+            table.push(c);
+            continue;
+        }
         let negligible = if cfg.detection_threshold > 0.0 {
             c.mean * CLUTTER_CUTOFF < cfg.detection_threshold
         } else {

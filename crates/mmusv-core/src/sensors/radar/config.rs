@@ -1,7 +1,8 @@
 //! What a radar is and what it sees through: [`RadarConfig`] and [`RadarEnv`], their limits and checks.
 
 use crate::error::{MmusvError, Result};
-use crate::sensors::radar_model::ClutterModel;
+use crate::sensors::radar::sea_clutter::{Polarisation, FREQUENCY_RANGE_GHZ, MARINE_FREQUENCY_GHZ};
+use crate::sensors::radar_model::{Band, ClutterModel};
 
 /// Most azimuth bins per revolution.
 pub const MAX_AZIMUTH_BINS: u32 = 1 << 16;
@@ -24,7 +25,9 @@ pub struct RadarConfig {
     pub azimuth_bins: u32,
     /// Horizontal (azimuth) beamwidth, radians, in `(0, π/2]`.
     pub beamwidth_az_rad: f64,
-    /// Vertical fan `[lower, upper]` elevations, radians, `-π/2 < lower ≤ upper < π/2`.
+    /// Vertical fan `[lower, upper]` elevations, radians, `-π/2 < lower ≤ upper < π/2`: the rays span it, and its
+    /// height is the half-power beamwidth of the Gaussian elevation pattern centred on it
+    /// ([`RadarConfig::two_way_gain`]).
     pub elevation_fan_rad: [f64; 2],
     /// Rays per beam across the beamwidth (`≥ 1`).
     pub rays_az: u32,
@@ -40,6 +43,11 @@ pub struct RadarConfig {
     pub range_noise_std_m: f64,
     /// Sea and rain clutter.
     pub clutter: ClutterModel,
+    /// Carrier frequency, GHz (`0.5..=35`, the NRL sea-clutter model's range; 9.41 = X band): sea clutter's σ⁰,
+    /// rain clutter's reflectivity (`∝ f⁴`) and rain attenuation follow it ([`crate::sensors::radar_model`]).
+    pub frequency_ghz: f64,
+    /// Polarisation (transmit = receive): sea clutter's σ⁰ and rain attenuation follow it.
+    pub polarisation: Polarisation,
 }
 
 /// No `Default`: the radar's defaults are defined once, in the scenario schema
@@ -62,7 +70,14 @@ impl RadarConfig {
             detection_threshold: 0.01,
             range_noise_std_m: 0.0,
             clutter: ClutterModel::tuning(),
+            frequency_ghz: MARINE_FREQUENCY_GHZ,
+            polarisation: Polarisation::Horizontal,
         }
+    }
+
+    /// The radar's frequency and polarisation.
+    pub fn band(&self) -> Band {
+        Band { frequency_ghz: self.frequency_ghz, polarisation: self.polarisation }
     }
 }
 
@@ -160,7 +175,16 @@ impl RadarConfig {
         nonneg("clutter.sea_sigma0_at_1m", self.clutter.sea_sigma0_at_1m, 1.0)?;
         nonneg("clutter.critical_range_per_m", self.clutter.critical_range_per_m, MAX_RANGE_M)?;
         nonneg("clutter.sea_max_range_m", self.clutter.sea_max_range_m, MAX_RANGE_M)?;
-        nonneg("clutter.rain_eta_at_1mm_h", self.clutter.rain_eta_at_1mm_h, 1.0)
+        nonneg("clutter.rain_eta_at_1mm_h", self.clutter.rain_eta_at_1mm_h, 1.0)?;
+        let [f_lo, f_hi] = FREQUENCY_RANGE_GHZ;
+        if !(self.frequency_ghz.is_finite() && (f_lo..=f_hi).contains(&self.frequency_ghz)) {
+            return Err(MmusvError::config(
+                "radar.frequency_ghz",
+                self.frequency_ghz,
+                format!("must be in [{f_lo}, {f_hi}] GHz (the NRL sea-clutter model's range; 9.41 = X band)"),
+            ));
+        }
+        Ok(())
     }
 
     /// Rays per sweep: `azimuth_bins · rays_az · rays_el`.

@@ -13,8 +13,10 @@
 //! with ψ the grazing angle in degrees, `f` in GHz, `SS` the (continuous) Douglas sea state, and for the 0–60°
 //! fit HH: `c = (−73.0, 20.781, 7.351, 25.65, 0.0054)`, VV: `c = (−50.796, 25.93, 0.7093, 21.588, 0.00211)`.
 //! It is an *apparent* reflectivity: the shadowing of the troughs by the crests and the propagation close to the
-//! surface at low grazing angles are in it (hence the steep fall with ψ). Marine radars are X-band, horizontally
-//! polarised: [`MARINE_FREQUENCY_GHZ`], HH.
+//! surface at low grazing angles are in it (hence the steep fall with ψ). Marine radars are mostly X-band,
+//! horizontally polarised ([`MARINE_FREQUENCY_GHZ`], HH, the radar's default); the radar's `frequency_ghz` (the
+//! model's 0.5–35 GHz, [`FREQUENCY_RANGE_GHZ`]) and `polarisation` (HH or VV) choose others, e.g. an S-band
+//! 3.05 GHz radar (until 2026-12-01 the frequency and polarisation were fixed at 9.41 GHz HH).
 //!
 //! The grazing angle at range `r` of an antenna `h` above the still water is that of the 4/3-earth geometry,
 //! `sin ψ = h / r − r / (2 k R_e)` (Barton, D. K. (2013), "Radar Equations for Modern Radar", §8), clamped
@@ -25,8 +27,10 @@
 //! `state: 4` is the NRL model's sea state 4 (until 2026-12-01 the states sat at the bands' upper bounds, so a
 //! WMO state-4 sea, Hs 1.875 m, was the model's 3.5, 1.1–2.5 dB low between 18° and 0.6° grazing).
 
-/// Carrier frequency of an X-band marine radar, GHz.
+/// Carrier frequency of an X-band marine radar, GHz (the radar's default).
 pub const MARINE_FREQUENCY_GHZ: f64 = 9.41;
+/// The frequencies the NRL model was fitted over (Nathanson's tables), GHz: the radar's `frequency_ghz` range.
+pub const FREQUENCY_RANGE_GHZ: [f64; 2] = [0.5, 35.0];
 /// Effective earth radius factor `k` of the standard atmosphere.
 const EARTH_K: f64 = 4.0 / 3.0;
 /// Earth radius, metres.
@@ -41,6 +45,29 @@ pub enum Polarisation {
     Horizontal,
     /// Vertical.
     Vertical,
+}
+
+impl Polarisation {
+    /// Parses `"HH"` or `"VV"`; the error names `radar.polarisation` and what is allowed.
+    pub fn parse(name: &str) -> crate::error::Result<Self> {
+        match name {
+            "HH" => Ok(Self::Horizontal),
+            "VV" => Ok(Self::Vertical),
+            other => Err(crate::error::MmusvError::config(
+                "radar.polarisation",
+                other,
+                "must be \"HH\" (horizontal) or \"VV\" (vertical)",
+            )),
+        }
+    }
+
+    /// `"HH"` or `"VV"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Horizontal => "HH",
+            Self::Vertical => "VV",
+        }
+    }
 }
 
 /// NRL σ⁰ (m²/m², linear) at `f_ghz`, sea state `ss`, polarisation `pol` and grazing angle `psi_deg` (degrees).
@@ -75,41 +102,58 @@ pub fn sea_state(hs: f64) -> f64 {
     MAX_SEA_STATE as f64
 }
 
-/// Grazing angle (degrees, clamped into 0.1°–60°) at ground range `r` (m) of an antenna `h` (m) above the
+/// `sin ψ = h / r − r / (2 k R_e)`: the sine of the grazing angle at which an antenna `h` (m) above the still
+/// water sees it at range `r` (m), 4/3 earth, not clamped (`≥ 1`: no water at that range, `r ≤ h`; `< 0`: beyond
+/// the radar horizon).
+pub fn sin_grazing(h: f64, r: f64) -> f64 {
+    h.max(0.0) / r.max(1e-3) - r.max(1e-3) / (2.0 * EARTH_K * EARTH_RADIUS_M)
+}
+
+/// Grazing angle (degrees, clamped into 0.1°–60°) at range `r` (m) of an antenna `h` (m) above the
 /// still water, 4/3 earth.
 pub fn grazing_deg(h: f64, r: f64) -> f64 {
-    let r = r.max(1e-3);
-    let s = h.max(0.0) / r - r / (2.0 * EARTH_K * EARTH_RADIUS_M);
+    let s = sin_grazing(h, r);
     let psi = s.clamp(-1.0, 1.0).asin().to_degrees();
     psi.clamp(GRAZING_RANGE_DEG[0], GRAZING_RANGE_DEG[1])
 }
 
-/// The sea clutter of one sweep over the physical sea: antenna height and sea state.
+/// The sea clutter of one sweep over the physical sea: antenna height, sea state, the radar's frequency and
+/// polarisation.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PhysicalSea {
     /// Antenna height above the still water, metres.
     pub antenna_height_m: f64,
     /// Continuous Douglas sea state.
     pub sea_state: f64,
+    /// Radar frequency, GHz.
+    pub frequency_ghz: f64,
+    /// Radar polarisation.
+    pub polarisation: Polarisation,
 }
 
 impl PhysicalSea {
-    /// The sea of significant wave height `hs` (m) seen by an antenna `h` (m) above the still water.
+    /// The sea of significant wave height `hs` (m) seen by an X-band HH antenna `h` (m) above the still water
+    /// ([`PhysicalSea::with_band`] sets another frequency and polarisation).
     pub fn new(hs: f64, h: f64) -> Self {
-        Self { antenna_height_m: h.max(0.0), sea_state: sea_state(hs) }
+        Self {
+            antenna_height_m: h.max(0.0),
+            sea_state: sea_state(hs),
+            frequency_ghz: MARINE_FREQUENCY_GHZ,
+            polarisation: Polarisation::Horizontal,
+        }
     }
 
-    /// σ⁰ (m²/m²) at range `r` (m): X band, HH.
+    /// This sea seen by a radar at `frequency_ghz` with `polarisation`.
+    pub fn with_band(self, frequency_ghz: f64, polarisation: Polarisation) -> Self {
+        Self { frequency_ghz, polarisation, ..self }
+    }
+
+    /// σ⁰ (m²/m²) at range `r` (m), at the radar's frequency and polarisation.
     pub fn sigma0(&self, r: f64) -> f64 {
         if self.sea_state <= 0.0 {
             return 0.0;
         }
-        nrl_sigma0(
-            MARINE_FREQUENCY_GHZ,
-            self.sea_state,
-            Polarisation::Horizontal,
-            grazing_deg(self.antenna_height_m, r),
-        )
+        nrl_sigma0(self.frequency_ghz, self.sea_state, self.polarisation, grazing_deg(self.antenna_height_m, r))
     }
 }
 
