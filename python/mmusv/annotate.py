@@ -56,13 +56,14 @@ NEAR_M = 0.05
 
 
 def in_target_range(centres: np.ndarray, range_m: float) -> np.ndarray:
-    """The one target-selection rule: which box centres lie within ``range_m`` metres of the ego LiDAR in bird's-eye
+    """The box-centre target rule: which box centres lie within ``range_m`` metres of the ego LiDAR in bird's-eye
     view, ``hypot(x, y) <= range_m`` (height ignored). ``centres``: ``(..., 3)`` (or ``(..., 2)``) in the ego's
     LiDAR frame (its body frame when it has none), metres; returns a bool array of shape ``centres.shape[:-1]``.
 
-    Used by the dataset exports (which vessels are labelled) and the detection study (the BEV distance it evaluates
-    within), as OpenCOOD selects its objects; the recording's own 3D/BEV boxes reach farther, to every vessel whose
-    footprint comes within range (:func:`footprint_in_range`).
+    Used by the OPV2V and KITTI exports (which vessels are labelled) and the detection study (the BEV distance it
+    evaluates within), as OpenCOOD selects its objects; the recording's own 3D/BEV boxes reach farther, to every
+    vessel whose footprint comes within range (:func:`footprint_in_range`), and the ROS 2 export's 3D detections are
+    those boxes.
     """
     c = np.asarray(centres, dtype=np.float64)
     if c.ndim == 0 or c.shape[-1] not in (2, 3):

@@ -308,7 +308,8 @@ def render_mmusv(
     scene: RefScene, width: int, height: int, *, ss: int = 4, seed: int = 0, quality: str = "standard"
 ) -> MmusvImage:
     """Renders ``scene`` with mmusv at ``ss`` times the resolution (``quality``: ``standard``, the default, traces
-    one water reflection per 2×2 block of pixels, ``high`` every pixel's) and box-averages ``ss × ss`` blocks."""
+    one water reflection per 2×2 block of water pixels, 4×4 where the water's glossy lobe spans many such blocks,
+    ``high`` every pixel's) and box-averages ``ss × ss`` blocks."""
     t0 = time.perf_counter()
     s = mmusv_scene(scene)
     env = scene.env.sensor_env()

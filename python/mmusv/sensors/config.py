@@ -52,9 +52,9 @@ TopViewOutput = Literal["rgb", "semantic", "instance"]
 Quality = Literal["draft", "standard", "high"]
 """Work spent on a camera's RGB: ``draft`` one sample per pixel and water reflecting the sky along each pixel's
 mirror direction; ``standard`` water reflections traced once per 2 × 2 block of water pixels (4 × 4 where the
-water's glossy lobe spans many such blocks) and spread over that lobe, and 4 stratified samples on edge pixels (a
-change of instance, class or material, or a depth step off the water); ``high`` reflections traced for every pixel
-(then spread over the lobe) and 16 samples on edges."""
+water's glossy lobe spans many such blocks), each in a direction drawn from that lobe at its point and spread over
+the rest of it, and 4 stratified samples on edge pixels (a change of instance, class or material, or a depth step off
+the water); ``high`` reflections traced for every pixel (drawn and spread alike) and 16 samples on edges."""
 _ALL_OUTPUTS: tuple[CameraOutput, ...] = ("rgb", "depth", "semantic", "instance")
 _TOP_OUTPUTS: tuple[TopViewOutput, ...] = get_args(TopViewOutput)
 

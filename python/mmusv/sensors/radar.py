@@ -3,11 +3,14 @@
 The radar turns through ``azimuth_bins`` beams per revolution; each beam casts ``rays_az × rays_el`` rays
 spread over its beamwidth and the elevation fan (all rays of a sweep go to the Rust core in one batch). Hits
 are gathered per (azimuth bin, range bin) cell; a cell's intensity is the radar equation summed over its rays
-(reflectivity by class × |cos incidence| × the ray's footprint, over range⁴, two-way rain attenuation), so
-bigger and nearer targets are brighter. Hits on the sea (class WATER) are not targets: sea clutter is drawn
-per cell instead, stronger and reaching farther for higher waves, from the water the beam sees (none over land
-or in the shadow of an island, a quay or a ship); rain adds a little clutter. The full model is documented in
-the Rust module ``mmusv_core::sensors::radar_model``.
+(reflectivity by class × |cos incidence| × the ray's footprint, over range⁴, weighted by the fan beam's two-way
+Gaussian elevation gain, 1 on the fan's axis and ¼ at its edges, and by the two-way rain attenuation of ITU-R
+P.838-3 at the radar's ``frequency_ghz`` and ``polarisation``), so bigger and nearer targets are brighter. Hits on
+the sea (class WATER) are not targets: sea clutter is drawn per cell instead (the pulse-limited cell
+``r θ_az Δr sec ψ``, weighted by the elevation gain where that water lies), stronger and reaching farther for
+higher waves, from the water the beam sees (none over land or in the shadow of an island, a quay or a ship); rain
+adds clutter of volume reflectivity ``rain_clutter_eta`` · R^1.6 (R in mm/h), scaled by λ⁻⁴ from 9.41 GHz to the
+radar's frequency. The full model is documented in the Rust module ``mmusv_core::sensors::radar_model``.
 
 Intensity unit: linear, relative to the echo of a 1 m² target at 1 km in clear air (``0.01`` = −20 dB).
 Frames: the sensor frame is x forward, y left, z up; azimuth 0 is forward, counter-clockwise, in ``[0, 2π)``.

@@ -358,7 +358,9 @@ def _wrap(a: float) -> float:
 
 
 def generate_port(*, seed: int, params: PortParams | None = None) -> MapWorld:
-    """``port`` map (see :class:`PortParams`), land on the ``coast_side`` of the map."""
+    """``port`` map (see :class:`PortParams`), land on the ``coast_side`` of the map. A port whose quay and piers
+    have fewer free berths than ``n_moored`` is refused (:class:`MapConfigError` on ``n_moored``, naming the most
+    that fit)."""
     seed = _check_seed(seed)
     p: PortParams = _check_params(params, PortParams, "port")
     rng = np.random.default_rng(seed)

@@ -368,7 +368,8 @@ def port_structures(p: PortParams, plan: PortPlan, *, ground: Ground, rng: np.ra
 
 
 def _berths(p: PortParams, plan: PortPlan, parts: list[TriMesh], *, rng: np.random.Generator) -> list[Berth]:
-    """Candidate berths along the terminal quay and both sides of every pier; ``n_moored`` of them chosen."""
+    """Candidate berths along the terminal quay and both sides of every pier; ``n_moored`` of them chosen, or every
+    free one when fewer fit (:func:`mmusv.world.maps.generate_port` then refuses the map)."""
     if p.n_moored == 0:
         return []
     assets = p.moored_assets

@@ -61,7 +61,8 @@ pub enum Quality {
     /// One sample per pixel; water reflects the sky only; wakes are foam without their Kelvin waves.
     Draft,
     /// Traced water reflections, one per 2 × 2 block of water pixels (4 × 4 where the water's glossy lobe spans
-    /// many such blocks), spread over that lobe; 4 stratified samples on edge pixels.
+    /// many such blocks), each in a direction drawn from that lobe and spread over the rest of it; 4 stratified
+    /// samples on edge pixels.
     #[default]
     Standard,
     /// Traced water reflections for every pixel; 16 stratified samples on edge pixels.
@@ -122,7 +123,7 @@ pub struct RenderOptions<'a> {
     pub rgb: bool,
     /// The linear radiance (cd/m²; rain included, before sensor noise and exposure).
     pub radiance: bool,
-    /// Swell, rain, jitter and noise seed.
+    /// Swell, rain, jitter, glossy reflection directions and noise seed.
     pub seed: u64,
     /// Vessels under way, for their wakes.
     pub wakes: &'a [Wake],
@@ -339,8 +340,8 @@ impl Camera {
     }
 
     /// Renders the frozen `scene` from `pose` (camera body → world). `rgb` asks for the shaded image; `seed`
-    /// drives the swell, rain streaks, anti-aliasing jitter and sensor noise. No vessel wakes: see
-    /// [`Camera::render_with`].
+    /// drives the swell, rain streaks, anti-aliasing jitter, the directions of the traced glossy reflections and
+    /// sensor noise. No vessel wakes: see [`Camera::render_with`].
     pub fn render(&self, scene: &Scene, pose: &RigidPose, env: &ShadeEnv, rgb: bool, seed: u64) -> Result<CameraFrame> {
         self.render_with(scene, pose, env, &RenderOptions { rgb, radiance: false, seed, wakes: &[] })
     }

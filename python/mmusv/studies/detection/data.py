@@ -8,8 +8,9 @@ agent-as-ego expansion (:func:`split_sequences`), so no scene is in two splits.
 
 Ground truth for an ego (:func:`gt_in_ego`): every target box (USVs excluded) moved into the ego LiDAR frame and
 kept when its BEV centre is within ``range_m`` (200 m) of the sensor (:func:`mmusv.annotate.in_target_range`, the
-rule of the annotations and the export). USV platforms (:func:`usv_boxes_in_ego`)
-are returned separately: detections centred on them are ignored in evaluation.
+box-centre rule of OpenCOOD and of the OPV2V and KITTI exports; the recording's own boxes reach farther, to every
+vessel whose footprint comes within range, :func:`mmusv.annotate.footprint_in_range`). USV platforms
+(:func:`usv_boxes_in_ego`) are returned separately: detections centred on them are ignored in evaluation.
 """
 
 from __future__ import annotations
@@ -117,7 +118,7 @@ def boxes_in_frame(to_frame: np.ndarray, boxes: np.ndarray, sizes: np.ndarray) -
 
 
 def gt_in_ego(frame: SceneFrame, ego: AgentFrame, *, range_m: float = 200.0) -> np.ndarray:
-    """``(G, 7)`` ground-truth target boxes in ``ego``'s LiDAR frame within ``range_m`` by the one target rule,
+    """``(G, 7)`` ground-truth target boxes in ``ego``'s LiDAR frame within ``range_m`` by the box-centre rule,
     :func:`mmusv.annotate.in_target_range` (BEV distance ``<= range_m``)."""
     return gt_with_ids(frame, ego, range_m=range_m)[0]
 

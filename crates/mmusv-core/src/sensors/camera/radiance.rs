@@ -267,8 +267,10 @@ pub struct Shaded {
 /// Radiance (linear RGB, cd/m², aerial perspective included) along every ray `origins[k] + t dirs[k]` whose
 /// closest hits are `hits`, with water `reflections` traced as asked; `shadows` casts shadow rays (else every
 /// surface facing the sun is lit). With `glossy` (the rays are a pinhole camera's pixels, its focal length in
-/// pixels per radian and its roll: how far the world's vertical shows turned in the image, radians), the traced
-/// reflections are spread over the water's roughness lobe (`glossy.rs`) before the water is shaded.
+/// pixels per radian, its roll: how far the world's vertical shows turned in the image, radians, and the seed of
+/// the reflections' directions), each traced reflection leaves in a direction drawn from the water's roughness
+/// lobe at its point and the traced reflections are spread over the rest of the lobe (`glossy.rs`) before the
+/// water is shaded.
 ///
 /// With `shared` (the rays are a camera's pixels), a ray that sees the open water or the sky, as all its anchors
 /// ([`PixelGrid::anchors`]) do, takes their mean when their colours are alike ([`alike`] under the shader's

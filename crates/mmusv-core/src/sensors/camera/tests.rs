@@ -228,8 +228,9 @@ fn bad_configs_name_the_field() {
 /// corners around each pixel: a cube's mirror image in calm water then stays close to high quality's (every
 /// pixel traced), without the 2 × 2 steps that taking the nearest corner's value left along the reflected
 /// outline (measured here on calm water's interior pixels against high: mean 0.520 sRGB levels, worst 92 with
-/// the nearest corner's value; 0.292 and 55 with the corners' mean; 0.290 and 17 since the reflections are spread
-/// over the glossy lobe, read back bilinearly from the corners' cells).
+/// the nearest corner's value; 0.292 and 55 with the corners' mean; 0.290 and 17 once the reflections were spread
+/// over the glossy lobe, read back bilinearly from the corners' cells; 0.462 and 31 since their directions are drawn
+/// from the lobe, on a grid of every pixel at high quality and every other one at standard).
 #[test]
 fn shared_reflections_are_reconstructed_from_the_corners_around() {
     let scene = ground_with_box();

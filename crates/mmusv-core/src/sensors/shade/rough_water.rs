@@ -1,6 +1,6 @@
 //! The rough sea surface's reflection: the sun's glitter from it, and how much of the light arriving over its
-//! reflection lobe the camera receives, for glossy reflections (`sensors/camera/glossy.rs` spreads the radiance
-//! over the lobe; this weighs it).
+//! reflection lobe the camera receives, for glossy reflections (`sensors/camera/glossy.rs` draws the traced
+//! reflections' directions from the lobe and spreads them over the rest of it; this weighs them).
 //!
 //! **Model.** Microfacet reflection (K. E. Torrance & E. M. Sparrow, JOSA 57(9), 1967; B. Walter, S. R. Marschner,
 //! H. Li & K. E. Torrance, "Microfacet Models for Refraction through Rough Surfaces", EGSR 2007) with

@@ -11,11 +11,13 @@
 //! Evaluated by the stratified quadrature of `rough_water.rs` over facet normals drawn from `D(h) cos θ_h`
 //! (`stratified_facets`), 20 × 20 facets per entry.
 //!
-//! **Why a table.** The cameras spread their traced reflections over the lobe in screen space
-//! (`camera/glossy.rs`), which cannot look past the image's edge: a lens narrower than the lobe, or a view
-//! steeply down, would read the sky of the mirror direction instead of the lobe's mean. The sky's part of the
-//! reflection comes from here instead, whatever the lens; the screen-space spread carries only what differs from
-//! the sky (the reflection of a ship, a quay, an island).
+//! **Why a table.** The cameras trace their reflections in directions drawn from the lobe and spread them over the
+//! rest of it in screen space (`camera/glossy.rs`), which cannot look past the image's edge: a lens narrower than
+//! the lobe, or a view steeply down, would read the sky of the mirror directions around the pixel instead of the
+//! lobe's mean. The sky's part of the reflection comes from here instead, whatever the lens: each place reads the
+//! spread reflections scaled, per channel, by this mean over the spread sky along the same rays
+//! (`blur(value) · lobe_sky / blur(sky)`): where the lobe meets only sky that is this table's mean, and where it
+//! meets a ship, a quay or an island it is the spread reflection of it, scaled by how far the sky's part is off.
 //!
 //! **Table.** Per roughness level `α = k/16`, `k = 1..8` (built on first use; `α` is read linearly between
 //! levels, 0 at `k = 0`, and at 1/2 beyond it), a grid over the mirror direction: 48 columns uniform in the
