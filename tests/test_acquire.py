@@ -383,3 +383,27 @@ def test_cli_profile_prints_the_table(tmp_path: Path, capsys: pytest.CaptureFixt
     assert "2 frames in" in text and "frames/s" in text and "CPU" in text
     assert main(["run", str(tmp_path), "-o", str(tmp_path / "o2"), "--profile"]) == 2  # a folder: one line
     assert "--profile times one scenario" in capsys.readouterr().err
+
+
+def test_numpys_blas_runs_on_one_thread_while_recording(tmp_path: Path) -> None:
+    # OpenBLAS spread the loop's skinny products over its threads (five times the CPU of one thread for an
+    # (N, 3) by (3, 3) product) and its idle workers spun on the sensors' cores; the run holds it to one thread
+    # and gives the user's setting back when it ends, finished or failed.
+    from threadpoolctl import threadpool_info
+    from tiny_scenario import lidar_scenario
+
+    def blas_threads() -> list[int]:
+        return [int(i["num_threads"]) for i in threadpool_info() if i["user_api"] == "blas"]
+
+    before = blas_threads()
+    seen: list[list[int]] = []
+    run(lidar_scenario("blas", frames=2), out_dir=tmp_path / "a", progress=lambda *_: seen.append(blas_threads()))
+    assert seen and all(t and all(n == 1 for n in t) for t in seen), seen
+    assert blas_threads() == before
+
+    def stop(*_: object) -> None:
+        raise RuntimeError("stopped")
+
+    with pytest.raises(RuntimeError):
+        run(lidar_scenario("blas", frames=2), out_dir=tmp_path / "b", progress=stop)
+    assert blas_threads() == before

@@ -29,6 +29,7 @@ from pathlib import Path
 from typing import Any
 
 import yaml
+from threadpoolctl import threadpool_limits
 
 from mmusv import arguments
 from mmusv.annotate import Annotations, SilhouetteCache, annotate_agent
@@ -218,21 +219,25 @@ def run(
     del first_capture
     lock = FolderLock.create(out, what="mmusv run")  # a second run into `out` refuses at once
     try:
-        return _record(
-            scenario,
-            sim,
-            out,
-            rec_path,
-            overwrite,
-            first,
-            total,
-            frame_range,
-            progress,
-            profile,
-            notes=notes,
-            captured=captured,
-            started=started,
-        )
+        # numpy's BLAS on one thread while recording (restored after): the loop's products are skinny, (N, 3) by
+        # (3, 3), which OpenBLAS spreads over its threads for five times the CPU, its idle workers then spinning on
+        # the cores the sensors use.
+        with threadpool_limits(limits=1, user_api="blas"):
+            return _record(
+                scenario,
+                sim,
+                out,
+                rec_path,
+                overwrite,
+                first,
+                total,
+                frame_range,
+                progress,
+                profile,
+                notes=notes,
+                captured=captured,
+                started=started,
+            )
     finally:
         lock.release()
 
