@@ -363,16 +363,14 @@ impl Shader {
         sky * self.sky_keep + air * (1.0 - self.sky_keep)
     }
 
-    /// The sky as water of roughness `alpha` reflects it around unit mirror direction `r`: `(along r, over the
-    /// lobe)`, the radiance a reflected ray along `r` that meets nothing brings back ([`Shader::reflected`] without
-    /// a hit: the sky without the sun's disc, blended into the air light by visibility) and its mean over the
-    /// single-scattering lobe (`sky_lobe.rs`; `r` read as level water's mirror direction). One sky lookup for both.
+    /// The sky as water of roughness `alpha` reflects it around unit mirror direction `r`: its mean over the
+    /// single-scattering lobe (`sky_lobe.rs`; `r` read as level water's mirror direction), blended into the air
+    /// light by visibility as [`Shader::reflected`] blends the sky along a ray that meets nothing.
     #[inline]
-    pub fn reflected_sky(&self, r: Vec3, alpha: f32) -> (Vec3, Vec3) {
+    pub fn sky_lobe(&self, r: Vec3, alpha: f32) -> Vec3 {
         let (sky, air) = self.light.sky_and_horizon(r);
         let (dsky, dair) = self.light.sky_lobe_correction(r, alpha);
-        let keep = |s: Vec3, a: Vec3| s * self.sky_keep + a * (1.0 - self.sky_keep);
-        (keep(sky, air), keep(sky + dsky, air + dair))
+        (sky + dsky) * self.sky_keep + (air + dair) * (1.0 - self.sky_keep)
     }
 
     /// Radiance distant objects fade into along `d`: the horizon sky's, at `d`'s azimuth.

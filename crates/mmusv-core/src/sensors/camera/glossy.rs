@@ -253,7 +253,6 @@ pub fn blur(width: usize, height: usize, f_px: f32, spacing: usize, roll: f32, s
     let frame = Frame::new(width, height, roll);
     let [ew, eh] = frame.bounds(width, height)[1];
     let (cw, ch) = ((ew.ceil() as usize).div_ceil(dx).max(1), (eh.ceil() as usize).div_ceil(dy).max(1));
-    // The coarse grid: sums of radiance and of samples; of the grazing sine and the roughness.
     // The coarse grid: sums of radiance, of the sky along the same rays and of samples; of the grazing sine and the
     // roughness; of the sky's lobe means.
     let mut sum = vec![[0f32; SUMS]; cw * ch];
@@ -272,17 +271,17 @@ pub fn blur(width: usize, height: usize, f_px: f32, spacing: usize, roll: f32, s
         lobe_sky[c] += s.lobe_sky;
     }
     // Per cell, its share of the lobe (in cells): the half-widths of each box of the tent (a box of width 2r has
-    // variance r²/3; two of σ/√2 make σ). No shift: the traced directions carry the lobe's mean offset.
-    let radius: Vec<[f32; 3]> = sum
+    // variance r²/3; two of σ/√2 make σ). Centred: the traced directions carry the lobe's mean offset.
+    let radius: Vec<[f32; 2]> = sum
         .iter()
         .zip(&geo)
         .map(|(s, g)| {
             if s[COUNT] <= 0.0 {
-                return [0.0; 3];
+                return [0.0; 2];
             }
             let [lx, ly, _] = lobe_px(g[1] / s[COUNT], g[0] / s[COUNT], f_px);
             let k = 1.5f32.sqrt() * SCREEN_SHARE;
-            [lx / dx as f32 * k, ly / dy as f32 * k, 0.0]
+            [lx / dx as f32 * k, ly / dy as f32 * k]
         })
         .collect();
     // The sky's lobe mean of each cell's own samples (not spread: it is the lobe's already).
@@ -294,14 +293,13 @@ pub fn blur(width: usize, height: usize, f_px: f32, spacing: usize, roll: f32, s
     // reads the hull's reflection over the part of its lobe the hull hides (left out, the mean leant to the water
     // farther below, which reflects what is higher: the sky over a low hull). Across the image, where the lobe
     // runs along the water and past a hull's sides, the mean stays over the water that remains.
-    let water: Vec<bool> = sum.iter().map(|s| s[COUNT] > 0.0).collect();
     let mut cur = fill_columns(&sum, cw, ch);
     for axis in [1usize, 1] {
         cur = box_pass(&cur, &radius, cw, ch, axis);
     }
-    for (c, w) in cur.iter_mut().zip(&water) {
-        if !w {
-            *c = [0.0; SUMS];
+    for (c, own) in cur.iter_mut().zip(&own) {
+        if own.is_none() {
+            *c = [0.0; SUMS]; // (a cell without samples of its own, filled down its column: not water)
         }
     }
     for axis in [0usize, 0] {
@@ -365,11 +363,10 @@ fn fill_columns(src: &[[f32; SUMS]], cw: usize, ch: usize) -> Vec<[f32; SUMS]> {
 }
 
 /// One box pass along `axis` (0: along rows, 1: along columns) over the `cw × ch` grid of sums: each cell takes
-/// the sum over the box of half-width `radius[c][axis]` cells centred on it (down the columns, `radius[c][2]`
-/// cells below it), fractional ends read linearly from prefix sums; at least a cell's width. Down the columns
-/// the grid is taken as continued past its ends by its end cells, as far again as it is tall (the image's top and
-/// bottom rows clamped); along the rows it ends there.
-fn box_pass(src: &[[f32; SUMS]], radius: &[[f32; 3]], cw: usize, ch: usize, axis: usize) -> Vec<[f32; SUMS]> {
+/// the sum over the box of half-width `radius[c][axis]` cells centred on it, fractional ends read linearly from
+/// prefix sums; at least a cell's width. Down the columns the grid is taken as continued past its ends by its end
+/// cells, as far again as it is tall (the image's top and bottom rows clamped); along the rows it ends there.
+fn box_pass(src: &[[f32; SUMS]], radius: &[[f32; 2]], cw: usize, ch: usize, axis: usize) -> Vec<[f32; SUMS]> {
     let (lines, len) = if axis == 0 { (ch, cw) } else { (cw, ch) };
     let at = move |line: usize, k: usize| if axis == 0 { line * cw + k } else { k * cw + line };
     let mut out = vec![[0f32; SUMS]; cw * ch];
@@ -401,9 +398,8 @@ fn box_pass(src: &[[f32; SUMS]], radius: &[[f32; 3]], cw: usize, ch: usize, axis
             std::array::from_fn(|c| a[c] + f * (b[c] - a[c]))
         };
         for k in 0..len {
-            let rc = radius[at(line, k)];
-            let r = rc[axis].max(0.5);
-            let centre = k as f32 + 0.5 + if axis == 1 { rc[2] } else { 0.0 };
+            let r = radius[at(line, k)][axis].max(0.5);
+            let centre = k as f32 + 0.5;
             let (hi, lo) = (cum(centre + r), cum(centre - r));
             out[at(line, k)] = std::array::from_fn(|c| (hi[c] - lo[c]) as f32);
         }

@@ -359,35 +359,31 @@ pub fn radiance(
             .par_iter()
             .map(|&k| surface(k as usize).unwrap_or_else(|| unreachable!("ray {k} was a water hit")))
             .collect();
-        // With the glossy blur, each leaves in a direction drawn from the part of the lobe the blur does not
-        // spread (`glossy::lobe_ray`): at its own point, so that a hull close behind the water darkens the
-        // reflection over the whole lobe it fills (the screen-space spread alone read the mirror rays of the
-        // water farther below, which pass over it). `mirrors` keeps the mirror directions for the sky's lobe mean.
-        let mut mirrors: Vec<Vec3> = Vec::new();
+        // The mirror rays; with the glossy blur each leaves instead in a direction drawn from the part of the lobe
+        // the blur does not spread (`glossy::lobe_ray`): at its own point, so that a hull close behind the water
+        // darkens the reflection over the whole lobe it fills (the screen-space spread alone read the mirror rays
+        // of the water farther below, which pass over it). The mirror directions stay for the sky's lobe mean.
+        let mirrors: Vec<(Vec3, Vec3)> = traced
+            .par_iter()
+            .zip(&traced_hits)
+            .map(|(&k, h)| shader.reflection_ray(Vec3::from_array(dirs[k as usize]), h))
+            .collect();
         let (ro, rd): (Vec<[f32; 3]>, Vec<[f32; 3]>) = traced
             .par_iter()
             .zip(&traced_hits)
-            .map(|(&k, h)| {
-                let d = Vec3::from_array(dirs[k as usize]);
-                let (o, r) = shader.reflection_ray(d, h);
+            .zip(&mirrors)
+            .map(|((&k, h), &(o, r))| {
                 let r = match glossy {
                     Some((grid, _, _, seed)) => {
                         let [x, y] = grid.pos[k as usize];
                         let u = glossy::stratum(u32::from(x), u32::from(y), spacing, seed);
-                        glossy::lobe_ray(r, shader.water_mss(h.unresolved_mss), (-d.z).max(0.0), u)
+                        glossy::lobe_ray(r, shader.water_mss(h.unresolved_mss), (-dirs[k as usize][2]).max(0.0), u)
                     }
                     None => r,
                 };
                 (o.to_array(), r.to_array())
             })
             .unzip();
-        if glossy.is_some() {
-            mirrors = traced
-                .par_iter()
-                .zip(&traced_hits)
-                .map(|(&k, h)| shader.reflection_ray(Vec3::from_array(dirs[k as usize]), h).1)
-                .collect();
-        }
         let rhits = scene.cast_rays(&ro, &rd, REFLECTION_RANGE)?;
         let rsurface = |j: usize| surface_at(shader, scene, &rhits, &ro, &rd, j).filter(|h| !h.is_water());
         let rlit = sunlit(scene, shader, shadows, (&rhits, &ro, &rd), |j| rhits.class[j] != 1)?;
@@ -406,9 +402,7 @@ pub fn radiance(
                     let alpha = shader.water_mss(traced_hits[j].unresolved_mss).sqrt();
                     // The sky along the drawn direction (what it brings back meeting nothing), the lobe's mean
                     // around the mirror direction.
-                    let (sky, _) = shader.reflected_sky(Vec3::from_array(rd[j]), alpha);
-                    let (_, lobe) = shader.reflected_sky(mirrors[j], alpha);
-                    (sky, lobe)
+                    (shader.reflected(Vec3::from_array(rd[j]), None, false), shader.sky_lobe(mirrors[j].1, alpha))
                 })
                 .collect();
         }
