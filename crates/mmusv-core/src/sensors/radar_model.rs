@@ -266,7 +266,8 @@ pub fn clutter_mean(
     rain_mm_per_h: f64,
     r: f64,
 ) -> (f64, f64) {
-    let common = range_term(r) * RainLoss::new(band, rain_mm_per_h).at(r);
+    let loss = RainLoss::new(band, rain_mm_per_h).at(r);
+    let common = range_term(r) * loss;
     let sea = if wave_height_m > 0.0 && r <= model.sea_max_range_m {
         let sigma0 = model.sea_sigma0_at_1m * wave_height_m * wave_height_m;
         let area = cell.sea_area(r);
@@ -281,15 +282,18 @@ pub fn clutter_mean(
     } else {
         0.0
     };
-    let rain = if rain_mm_per_h > 0.0 {
-        let eta = model.rain_eta_at_1mm_h * rain_mm_per_h.powf(1.6) * band.rain_eta_factor();
-        // The fan's Gaussian two-way pattern integrated over elevation: ∫G² de = θ_el √(π / (8 ln 2)).
-        let fan = cell.fan_height * (std::f64::consts::PI / (8.0 * std::f64::consts::LN_2)).sqrt();
-        eta * r * r * cell.beamwidth_az * fan * cell.range_resolution * common
-    } else {
-        0.0
-    };
-    (sea, rain)
+    (sea, rain_mean(model, cell, band, rain_mm_per_h, r, common))
+}
+
+/// The rain part of [`clutter_mean`] at range `r`, `common` its range term times the rain's two-way loss there.
+fn rain_mean(model: &ClutterModel, cell: &CellShape, band: &Band, rain_mm_per_h: f64, r: f64, common: f64) -> f64 {
+    if rain_mm_per_h <= 0.0 {
+        return 0.0;
+    }
+    let eta = model.rain_eta_at_1mm_h * rain_mm_per_h.powf(1.6) * band.rain_eta_factor();
+    // The fan's Gaussian two-way pattern integrated over elevation: ∫G² de = θ_el √(π / (8 ln 2)).
+    let fan = cell.fan_height * (std::f64::consts::PI / (8.0 * std::f64::consts::LN_2)).sqrt();
+    eta * r * r * cell.beamwidth_az * fan * cell.range_resolution * common
 }
 
 /// Mean clutter intensity `(sea, rain)` of the cell at range `r` metres over the physical sea, whose
@@ -304,13 +308,10 @@ pub fn clutter_mean_sigma0(
     rain_mm_per_h: f64,
     r: f64,
 ) -> (f64, f64) {
-    let (_, rain) = clutter_mean(model, cell, band, 0.0, rain_mm_per_h, r);
-    let sea = if sigma0 > 0.0 && r <= model.sea_max_range_m {
-        sigma0 * cell.sea_area(r) * range_term(r) * RainLoss::new(band, rain_mm_per_h).at(r)
-    } else {
-        0.0
-    };
-    (sea, rain)
+    let loss = RainLoss::new(band, rain_mm_per_h).at(r);
+    let sea =
+        if sigma0 > 0.0 && r <= model.sea_max_range_m { sigma0 * cell.sea_area(r) * range_term(r) * loss } else { 0.0 };
+    (sea, rain_mean(model, cell, band, rain_mm_per_h, r, range_term(r) * loss))
 }
 
 #[cfg(test)]
