@@ -525,6 +525,11 @@ class Simulation:
                 f"state holds {state.matrices.shape[0]} vessels, this simulation {len(self.vessels)}: give a state "
                 "of this simulation (Simulation.world_state(frame))"
             )
+        return self._sensor_poses(agent, state)
+
+    def _sensor_poses(self, agent: Agent, state: WorldState) -> dict[str, np.ndarray]:
+        """:meth:`sensor_poses` without its checks: for an agent and a state this simulation made (the capture's,
+        once per agent per frame)."""
         body = state.matrices[agent.index]
         out = {key: body @ m for key, m in agent.mounts().items()}
         if agent.top_view is not None and agent.rig.top_view is not None:
@@ -572,7 +577,7 @@ class Simulation:
         for agent in self.agents:
             if agents is not None and agent.id not in agents:
                 continue
-            poses = self.sensor_poses(agent, state)
+            poses = self._sensor_poses(agent, state)
             body = state.matrices[agent.index]
             mounts = agent.mounts()
             cap = AgentCapture(agent.id, None, None, {}, {}, None, None, body=body)
