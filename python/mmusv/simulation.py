@@ -18,38 +18,36 @@ was set to), so it can be handed to spawned processes (``multiprocessing``, a Py
 
 from __future__ import annotations
 
-import functools
-import hashlib
 import math
-from collections.abc import Callable, Collection
-from dataclasses import dataclass, field
+from collections.abc import Collection
 from functools import cached_property
-from typing import Any, TypeVar
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 from mmusv import arguments
-from mmusv._equality import same
 from mmusv._native import core
+from mmusv.agents import Agent, build_agent, frozen
 from mmusv.captures import AgentCapture, FrameCapture, SensorMount, VesselInfo, WorldState
 from mmusv.config import Scenario, VesselConfig, load_scenario
 from mmusv.errors import ConfigError
 from mmusv.motion import build_fleet
 from mmusv.scene import MAX_SURFACE_TILES, SURFACE_TILE_M, SeaState, check_sea, surface_tiles
-from mmusv.sensors.camera import CameraImages, camera_from_config, top_view_from_config
-from mmusv.sensors.config import CameraConfig, RigConfig
+from mmusv.seeds import sensor_seed
+from mmusv.sensors.camera import CameraImages
+from mmusv.sensors.config import RigConfig
 from mmusv.sensors.env import sensor_env
-from mmusv.sensors.lidar import LidarPoints, lidar_from_config
-from mmusv.sensors.mounts import inside_mesh, mount_matrix, rpy_matrix
-from mmusv.sensors.radar import RadarReturns, ppi_request, radar_from_config
+from mmusv.sensors.lidar import LidarPoints
+from mmusv.sensors.mounts import rpy_matrix
+from mmusv.sensors.radar import RadarReturns, ppi_request
 from mmusv.thread_env import check_thread_environment
 from mmusv.turns import one_at_a_time, take_turns
 from mmusv.world.build import WorldScene, build_world_scene, pose_matrices
 from mmusv.world.environment import Environment
 from mmusv.world.hydrostatics import hull_particulars
 from mmusv.world.maps import MapWorld, generate_map_from
-from mmusv.world.vessels import VesselAsset, get_asset
+from mmusv.world.vessels import get_asset
 
 __all__ = [
     "Agent",
@@ -63,118 +61,6 @@ __all__ = [
 ]
 
 SENSOR_KINDS = ("lidar", "cameras", "top_view", "radar")
-_SENSOR_CODES = {"lidar": 1, "radar": 2, "camera": 3, "top_view": 4}
-
-
-def sensor_seed(scenario_seed: int, frame: int, agent: int, sensor: str, index: int = 0) -> int:
-    """The 64-bit seed (a whole number in ``0..2**64 - 1``) of one sensor capture: a hash of (scenario seed, frame,
-    agent index, sensor, index), as :meth:`Simulation.capture` seeds its sensors.
-
-    Args:
-        scenario_seed: the scenario's ``seed``, a whole number in ``0..2**63 - 1`` (as the scenario allows).
-        frame: the acquisition index, a whole number >= 0.
-        agent: the agent's index (:attr:`Agent.index`, its position in the scenario's vessels), a whole number >= 0.
-        sensor: one of ``lidar``, ``radar``, ``camera``, ``top_view`` (one camera of the rig: ``camera``, with
-            ``index`` its position in the rig's cameras).
-        index: the camera's position in the rig's cameras (0 for the other sensors), a whole number >= 0.
-
-    Whole numbers are ``int`` or numpy integers (floats and booleans are refused); anything else is a
-    ``ConfigError`` naming the argument.
-    """
-    scenario_seed = arguments.whole(scenario_seed, name="scenario_seed", lo=0, hi=2**63 - 1)
-    frame = arguments.whole(frame, name="frame", lo=0)
-    agent = arguments.whole(agent, name="agent", lo=0)
-    index = arguments.whole(index, name="index", lo=0)
-    code = _SENSOR_CODES.get(sensor) if isinstance(sensor, str) else None
-    if code is None:
-        cameras = isinstance(sensor, str) and sensor == "cameras"  # capture's kind, not one sensor
-        hint = " (one camera is 'camera', with index its position in the rig's cameras)" if cameras else ""
-        raise ConfigError(
-            f"sensor = {arguments.shown(sensor)}: must be one of {', '.join(map(repr, _SENSOR_CODES))}{hint}"
-        )
-    key = f"{scenario_seed}/{frame}/{agent}/{code}/{index}".encode()
-    return int.from_bytes(hashlib.blake2b(key, digest_size=8).digest(), "little")
-
-
-_T = TypeVar("_T")
-
-
-def _built(where: str, kind: str, build: Callable[[], _T]) -> _T:
-    """``build()`` (a sensor made from its configuration by the core), its configuration errors naming the field
-    by its path in the scenario (``where``, e.g. ``rigs.usv_standard.cameras[1]``) instead of the core's own
-    ``kind.`` prefix (``camera.distortion``), so that a rig of several cameras says which one is at fault."""
-    try:
-        return build()
-    except ConfigError as exc:
-        prefix = f"invalid config {kind}."
-        msg = str(exc)
-        if not msg.startswith(prefix):
-            raise
-        raise ConfigError(f"invalid config {where}.{msg[len(prefix) :]}") from None
-
-
-@dataclass(eq=False)
-class Agent:
-    """An instrumented USV and its native sensors (each configured once from the rig).
-
-    Two agents compare equal (``==``) when they hold the same values, as captures do (:mod:`mmusv.captures`): the
-    same index, vessel, asset, rig and mounts (arrays by dtype, shape and value), and the same sensors present.
-    The native sensors are built from the rig, so they are compared through it: the agents of two simulations of
-    the same scenario are equal. Agents are not hashable (their fields can change): key them by :attr:`id`.
-    """
-
-    index: int  # position in Simulation.vessels
-    vessel: VesselConfig
-    asset: VesselAsset
-    rig: RigConfig
-    lidar: core.Lidar | None
-    lidar_mount: np.ndarray | None
-    radar_mount: np.ndarray | None
-    cameras: dict[str, tuple[core.Camera, CameraConfig, np.ndarray]] = field(default_factory=dict)
-    top_view: core.Camera | None = None
-    radar: core.Radar | None = None
-
-    def __eq__(self, other: object) -> bool:
-        """Whether ``other`` is an agent holding the same values (see the class docstring)."""
-        if type(other) is not type(self):
-            return NotImplemented
-        assert isinstance(other, Agent)
-        return same(self._compared(), other._compared())
-
-    __hash__ = None  # type: ignore[assignment]
-
-    def _compared(self) -> tuple[Any, ...]:
-        """What :meth:`__eq__` compares: the values the agent's sensors are built from, and which sensors it has."""
-        present = (self.lidar is not None, self.radar is not None, self.top_view is not None, tuple(self.cameras))
-        return (self.index, self.vessel, self.asset, self.rig, self.mounts(), present)
-
-    @property
-    def id(self) -> str:
-        """The vessel id."""
-        return self.vessel.id
-
-    @cached_property
-    def lidar_pattern(self) -> npt.NDArray[np.float32] | None:
-        """``(M, 3)`` float32 unit beam directions of the LiDAR, LiDAR frame, in pattern order (read-only; worked
-        out once: the rig never changes), or ``None`` without a LiDAR."""
-        if self.lidar is None:
-            return None
-        p = np.array(self.lidar.pattern(), dtype=np.float32, order="C", copy=True)
-        p.flags.writeable = False
-        return p
-
-    def mounts(self) -> dict[str, np.ndarray]:
-        """``(4, 4)`` float64 sensor → vessel body matrices of the body-mounted sensors, read-only (the rig never
-        changes; copy one to change it): keys ``lidar``, ``radar``, ``camera/<name>`` (camera body frame: x forward,
-        y left, z up). The top view is not body-mounted."""
-        out: dict[str, np.ndarray] = {}
-        if self.lidar_mount is not None:
-            out["lidar"] = self.lidar_mount
-        if self.radar_mount is not None:
-            out["radar"] = self.radar_mount
-        for name, (_, _, m) in self.cameras.items():
-            out[f"camera/{name}"] = m
-        return out
 
 
 class Simulation:
@@ -240,43 +126,11 @@ class Simulation:
         lo, hi = a.bbox[0], a.bbox[1]
         cls = 11 if role == "usv" else int(a.semantic_class)
         # Read-only: every frame's annotations read these boxes, so they must not change under them.
-        return VesselInfo(vid, asset_name, role, cls, instance, _frozen((lo + hi) / 2.0), _frozen(hi - lo), static)
+        return VesselInfo(vid, asset_name, role, cls, instance, frozen((lo + hi) / 2.0), frozen(hi - lo), static)
 
     def _agent(self, index: int, v: VesselConfig) -> Agent:
         rig = self.scenario.rigs[v.rig] if v.rig is not None else RigConfig()
-        where = f"rigs.{v.rig or '<default>'}"
-        asset = get_asset(v.asset)
-        agent = Agent(index=index, vessel=v, asset=asset, rig=rig, lidar=None, lidar_mount=None, radar_mount=None)
-        # The mounts are read-only: every frame's poses are made from them (a capture gets copies).
-        if rig.lidar is not None:
-            agent.lidar = _built(f"{where}.lidar", "lidar", functools.partial(lidar_from_config, rig.lidar))
-            agent.lidar_mount = _frozen(mount_matrix(asset, rig.lidar.mount, where=f"{where}.lidar.mount"))
-        if rig.radar is not None:
-            agent.radar_mount = _frozen(mount_matrix(asset, rig.radar.mount, where=f"{where}.radar.mount"))
-            agent.radar = _built(f"{where}.radar", "radar", functools.partial(radar_from_config, rig.radar))
-        for i, c in enumerate(rig.cameras):
-            # The path as the YAML spells it (cameras is a list), as the schema's own errors say it.
-            m = _frozen(mount_matrix(asset, c.mount, where=f"{where}.cameras[{i}].mount"))
-            camera = _built(f"{where}.cameras[{i}]", "camera", functools.partial(camera_from_config, c))
-            agent.cameras[c.name] = (camera, c, m)
-        if rig.top_view is not None:
-            top = functools.partial(top_view_from_config, rig.top_view)
-            agent.top_view = _built(f"{where}.top_view", "camera", top)
-        self._check_mounts(agent, where)
-        return agent
-
-    def _check_mounts(self, agent: Agent, where: str) -> None:
-        """A sensor whose origin lies inside its own hull would see only the hull's inside: refuse it."""
-        index = {f"camera/{c.name}": i for i, c in enumerate(agent.rig.cameras)}
-        for key, m in agent.mounts().items():
-            name = f"{where}.cameras[{index[key]}].mount" if key in index else f"{where}.{key}.mount"
-            if inside_mesh(agent.asset.mesh.vertices, agent.asset.mesh.faces, m[:3, 3]):
-                xyz = np.round(m[:3, 3], 3).tolist()
-                raise ConfigError(
-                    f"invalid config {name} = {xyz}: the sensor sits inside the hull of vessel {agent.id!r} "
-                    f"({agent.asset.name}, top at z = {agent.asset.bbox[1, 2]:.2f} m); move it outside the hull, "
-                    "e.g. onto a mount point (`mmusv assets` lists them) or above the deck"
-                )
+        return build_agent(index, v, rig, rig_name=v.rig)
 
     # ------------------------------------------------------------------------------------------ state
 
@@ -650,12 +504,6 @@ def _check_state(state: Any) -> None:
             f"state = {arguments.shown(state)}: must be a WorldState (Simulation.world_state(frame)), "
             f"not {type(state).__name__}"
         )
-
-
-def _frozen(a: np.ndarray) -> np.ndarray:
-    """``a`` made read-only (in place) and returned."""
-    a.flags.writeable = False
-    return a
 
 
 def _pose(m: np.ndarray) -> npt.NDArray[np.float64]:
