@@ -74,6 +74,32 @@ def test_a_capture_pickles_with_its_radar(cap: FrameCapture) -> None:
     assert pickle.loads(pickle.dumps(dataclasses.replace(bare, config=ac.radar.config))) == ac.radar
 
 
+def test_an_agent_pickles_as_its_rig_and_its_sensors_capture_the_same(sim: Simulation, cap: FrameCapture) -> None:
+    """An agent did not pickle (``TypeError: cannot pickle 'mmusv._core.Lidar' object``), so a worker could not be
+    handed one. It now pickles as its index, vessel, asset and rig; unpickled, its sensors are built again from the
+    rig: it equals the original, and its LiDAR, camera and top view give the capture's arrays for the same pose,
+    seed and scene."""
+    agent = sim.agents[0]
+    back = pickle.loads(pickle.dumps(agent))
+    assert back == agent and back is not agent
+    assert back.lidar is not None and back.lidar is not agent.lidar and back.top_view is not None
+    ac = cap.agents[agent.id]
+    sim.set_frame(cap.frame)
+    scene, env, seed = sim.ws.scene, sim.sensor_env, sim.scenario.seed
+    wakes = sim.wakes(cap.world)
+    assert ac.lidar is not None and ac.lidar_pose is not None
+    lidar_seed = sensor_seed(seed, cap.frame, agent.index, "lidar")
+    points = scan(back.lidar, scene, pose=ac.lidar_pose, env=env, seed=lidar_seed, wakes=wakes)
+    assert np.array_equal(points.xyz, ac.lidar.xyz) and np.array_equal(points.instance, ac.lidar.instance)
+    cam, _, _ = back.cameras["front"]
+    cam_seed = sensor_seed(seed, cap.frame, 0, "camera", 0)
+    img = render(cam, scene, pose=ac.camera_poses["front"], env=env, seed=cam_seed, wakes=wakes)
+    assert np.array_equal(img.rgb, ac.cameras["front"].rgb)
+    assert ac.top_view_pose is not None
+    top = render(back.top_view, scene, pose=ac.top_view_pose, env=env, seed=sensor_seed(seed, cap.frame, 0, "top_view"))
+    assert np.array_equal(top.semantic, ac.top_view.semantic)
+
+
 def test_captures_compare_by_value_in_any_order(sim: Simulation, cap: FrameCapture) -> None:
     """``a == b`` on two captures raised numpy's ``ValueError`` (the dataclasses' generated ``__eq__`` asked an
     array for its truth value). Now equal captures compare equal: frame 2 of a second simulation, asked for after

@@ -51,6 +51,9 @@ class Agent:
     same index, vessel, asset, rig and mounts (arrays by dtype, shape and value), and the same sensors present.
     The native sensors are built from the rig, so they are compared through it: the agents of two simulations of
     the same scenario are equal. Agents are not hashable (their fields can change): key them by :attr:`id`.
+
+    An agent pickles as what builds it (its index, vessel, asset and rig): unpickled, its sensors are built again from
+    the rig, so it equals the original and captures the same bytes.
     """
 
     index: int  # position in Simulation.vessels
@@ -72,6 +75,10 @@ class Agent:
         return same(self._compared(), other._compared())
 
     __hash__ = None  # type: ignore[assignment]
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        """Pickled as what builds it (see the class docstring): the native sensors do not pickle."""
+        return (_rebuilt, (self.index, self.vessel, self.asset, self.rig))
 
     def _compared(self) -> tuple[Any, ...]:
         """What :meth:`__eq__` compares: the values the agent's sensors are built from, and which sensors it has."""
@@ -107,12 +114,15 @@ class Agent:
         return out
 
 
-def build_agent(index: int, vessel: VesselConfig, rig: RigConfig, *, rig_name: str | None) -> Agent:
+def build_agent(
+    index: int, vessel: VesselConfig, rig: RigConfig, *, rig_name: str | None, asset: VesselAsset | None = None
+) -> Agent:
     """The agent of USV ``vessel`` (position ``index`` in the scenario's vessels) with ``rig`` (the scenario's rig
-    ``rig_name``; ``None``: the default rig), its sensors built by the core. Configuration errors name the field by
-    its path in the scenario (``rigs.<name>.cameras[1].distortion``); a sensor mounted inside the hull is refused."""
+    ``rig_name``; ``None``: the default rig), its sensors built by the core, on ``asset`` (default: the catalogue's
+    ``vessel.asset``). Configuration errors name the field by its path in the scenario
+    (``rigs.<name>.cameras[1].distortion``); a sensor mounted inside the hull is refused."""
     where = f"rigs.{rig_name or '<default>'}"
-    asset = get_asset(vessel.asset)
+    asset = get_asset(vessel.asset) if asset is None else asset
     agent = Agent(index=index, vessel=vessel, asset=asset, rig=rig, lidar=None, lidar_mount=None, radar_mount=None)
     # The mounts are read-only: every frame's poses are made from them (a capture gets copies).
     if rig.lidar is not None:
@@ -131,6 +141,11 @@ def build_agent(index: int, vessel: VesselConfig, rig: RigConfig, *, rig_name: s
         agent.top_view = _built(f"{where}.top_view", "camera", top)
     _check_mounts(agent, where)
     return agent
+
+
+def _rebuilt(index: int, vessel: VesselConfig, asset: VesselAsset, rig: RigConfig) -> Agent:
+    """The agent a pickled :class:`Agent` stands for (:meth:`Agent.__reduce__`)."""
+    return build_agent(index, vessel, rig, rig_name=vessel.rig, asset=asset)
 
 
 def _check_mounts(agent: Agent, where: str) -> None:
