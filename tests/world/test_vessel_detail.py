@@ -100,7 +100,9 @@ def test_every_face_has_a_valid_material_and_parts_theirs(name: str) -> None:
             colours = {material_id(c) for c in CONTAINER_COLOURS}
             assert mats <= colours and len(mats) >= min(3, int((origin == i).sum() // 12))
         elif part.type == "nav_lights":
-            assert {material_id(n) for n in NAV} <= mats and material_id(
+            # masthead: [] is a vessel without a masthead light (under sail, under oars or towed: COLREG Rules 24-25)
+            lamps = NAV[1:] if part.masthead == () else NAV
+            assert {material_id(n) for n in lamps} <= mats and material_id(
                 want if part.material else "paint_grey"
             ) in mats
         else:
@@ -144,7 +146,9 @@ def test_colreg_lights_port_red_starboard_green_stern_aft(name: str) -> None:
     m = get_asset(name).mesh
     c = m.vertices[m.faces].mean(axis=1)
     where = {k: c[m.materials == material_id(k)] for k in NAV}
-    assert all(v.shape[0] > 0 for v in where.values())
+    # masthead: [] (under sail, under oars or towed: COLREG Rules 24-25) leaves the masthead lamp out
+    lamps = NAV[1:] if any(p.type == "nav_lights" and p.masthead == () for p in _spec(name).parts) else NAV
+    assert all(where[k].shape[0] > 0 for k in lamps)
     assert np.all(where["nav_port_red"][:, 1] > 0.0) and np.all(where["nav_starboard_green"][:, 1] < 0.0)
     assert where["nav_stern_white"][:, 0].max() < where["nav_port_red"][:, 0].min()
     lamp = all_materials()[material_id("nav_port_red")]

@@ -31,6 +31,7 @@ from mmusv.generate.layout import (
     perp,
     pick_best,
     straight_track,
+    top_speed_mps,
     unit,
 )
 from mmusv.generate.planner import PlannerError, harbour_planner
@@ -121,7 +122,7 @@ def _encounter(kind: str) -> Callable[[FamilyInput], Layout]:
                 else:
                     psi = theta + float(rng.uniform(-0.14, 0.14))
                     if rng.uniform() < 0.5:
-                        speed = inp.ego.speed + float(rng.uniform(1.0, 3.0))
+                        speed = min(inp.ego.speed + float(rng.uniform(1.0, 3.0)), top_speed_mps(tgt.asset))
                     else:
                         speed = max(0.5, inp.ego.speed - float(rng.uniform(0.8, 1.5)))
                 v_t = speed * heading(psi)

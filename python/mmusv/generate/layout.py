@@ -13,8 +13,10 @@ import numpy as np
 
 from mmusv.errors import MmusvError
 from mmusv.generate.mapctx import MapContext
+from mmusv.world.vessels import get_asset
 
 __all__ = [
+    "TOP_SPEED_MPS",
     "FamilyInput",
     "Layout",
     "Role",
@@ -24,9 +26,28 @@ __all__ = [
     "perp",
     "pick_best",
     "straight_track",
+    "top_speed_mps",
     "track_clearance",
     "unit",
 ]
+
+
+TOP_SPEED_MPS: dict[str, float] = {
+    "kayak": 3.0,
+    "sailing_yacht": 4.4,
+    "barge": 4.0,
+}
+"""The most a vessel of these catalogue categories makes through the water (m/s): a target's speed is drawn from
+its size class's range cut to ``[min(low, top / 2), min(high, top)]`` (other categories: the class's range). A sea
+kayak is paddled at 1.5-2 m/s (3-4 kn) on a tour, 3 m/s is a strong sprint; a 12 m cruising sloop's displacement
+hull speed is 1.34 kn·√(LWL in ft) (Froude number 0.4: 4.1 m/s for its 10.7 m waterline); a deck barge is towed
+at 5-8 kn (2.5-4 m/s)."""
+
+
+def top_speed_mps(asset: str) -> float:
+    """The highest speed (m/s) a target of library asset ``asset`` is given (:data:`TOP_SPEED_MPS` of its category,
+    else infinity)."""
+    return TOP_SPEED_MPS.get(get_asset(asset).category, math.inf)
 
 
 class SamplingError(MmusvError):

@@ -19,7 +19,16 @@ import numpy as np
 from mmusv.config import Scenario, load_scenario
 from mmusv.generate.families import FAMILIES
 from mmusv.generate.hulls import capsule
-from mmusv.generate.layout import FamilyInput, Layout, Role, SamplingError, Track, pick_best, straight_track
+from mmusv.generate.layout import (
+    FamilyInput,
+    Layout,
+    Role,
+    SamplingError,
+    Track,
+    pick_best,
+    straight_track,
+    top_speed_mps,
+)
 from mmusv.generate.mapctx import MapContext
 from mmusv.generate.spec import Combination, GenerationSpec, class_assets
 from mmusv.world.vessels import get_asset
@@ -151,7 +160,10 @@ def sample_candidate(spec: GenerationSpec, combo_index: int, attempt: int, ctx: 
     def target(role_id: str, cls: str) -> Role:
         sc = spec.size_classes[cls]
         asset = _choice(rng, class_assets(sc))
-        return Role(role_id, "target", asset, float(rng.uniform(*sc.speed_mps)), hull_radius(asset), capsule(asset)[1])
+        # the class's range, kept below what the vessel type makes (from half its top speed; one draw either way)
+        top = top_speed_mps(asset)
+        speed = float(rng.uniform(min(sc.speed_mps[0], top / 2.0), min(sc.speed_mps[1], top)))
+        return Role(role_id, "target", asset, speed, hull_radius(asset), capsule(asset)[1])
 
     ego = usv("usv_ego", combo.ego or spec.usv.assets[0])
     coops = [usv(f"usv_coop_{k + 1}", _choice(rng, spec.usv.assets)) for k in range(combo.cooperating)]

@@ -51,8 +51,8 @@ stays ``m`` metres inside the deck outline; every part takes ``material`` (a nam
     hatches    x0, x1, count, gap=0, width, height, base, fit, ribs=6
     lifeboats  x, y, z (keel), length, count=1, pitch=0, side, kind=davit|freefall
     fenders    x0, x1, count, z, radius, side, kind=tyre|cylinder
-    nav_lights masthead [[x, y, z], ...], sides [x, |y|, z], stern [x, y, z] (each defaults from the masts,
-               bridge wings, bow and transom), size=0.3
+    nav_lights masthead [[x, y, z], ...] ([] for none), sides [x, |y|, z], stern [x, y, z] (each defaults from
+               the masts, bridge wings, bow and transom), size=0.3
     radar      x, y=0, base, length=2, yaw_deg=0
     antennas   at [[x, y, z, height], ...], radius=0.03
     bollards   x0, x1, count, inset=0.8, radius=0.2, side

@@ -504,12 +504,13 @@ class FendersPart(_Along):
 
 class NavLightsPart(_Part):
     """COLREG navigation lights as small lanterns: ``masthead`` white (a list of ``[x, y, z]``; default: below the
-    top of the tallest mast), ``sides`` red to port and green to starboard at ``[x, |y|, z]`` (default: on the
-    bridge wings, else at the bow), ``stern`` white at ``[x, y, z]`` (default: on the transom); ``size`` is the
-    lantern's height."""
+    top of the tallest mast, and of the second tallest too from 50 m of hull length, Rule 23(a)(ii); ``[]``: none,
+    as a sailing vessel under sail, a vessel under oars or a towed one shows, Rules 24(e) and 25), ``sides`` red to
+    port and green to starboard at ``[x, |y|, z]`` (default: on the bridge wings, else at the bow), ``stern`` white
+    at ``[x, y, z]`` (default: on the transom); ``size`` is the lantern's height."""
 
     type: Literal["nav_lights"]
-    masthead: Annotated[tuple[Point3, ...], sequence(1, MAX_ITEMS, f"a list of 1 to {MAX_ITEMS} points")] | None = None
+    masthead: Annotated[tuple[Point3, ...], sequence(0, MAX_ITEMS, f"a list of 0 to {MAX_ITEMS} points")] | None = None
     sides: Point3 | None = None
     stern: Point3 | None = None
     size: Size = 0.3
