@@ -408,6 +408,7 @@ def create_app(
                 "weather": _choices(EnvironmentConfig, "weather"),
                 "wave": [{"name": k, "height_m": v} for k, v in WAVE_PRESETS.items()],
                 "wave_height_m": [0.0, MAX_WAVE_HEIGHT_M],  # a custom wave's height: lowest, highest
+                "motion": _choices(EnvironmentConfig, "motion"),
                 "role": _choices(VesselConfig, "role"),
                 "end": _choices(VesselConfig, "end"),
                 "rig_preset": sorted(RIG_PRESETS),

@@ -39,7 +39,24 @@ def _rig_document(rig: RigConfig) -> dict[str, Any]:
             continue
         if value != base[key]:  # e.g. a radar added back to a LiDAR-only rig, maybe with all defaults
             out[key] = given.get(key, {} if isinstance(value, dict) else value)
+    if rig.quality is not None:
+        # Under a rig's quality a camera (or the top view) states its own exactly where it differs from the rig's:
+        # a camera's `standard`, the model's default, left out would read back as the rig's quality.
+        cameras = out.get("cameras")
+        if isinstance(cameras, list):
+            for cam, doc in zip(rig.cameras, cameras, strict=True):
+                _own_quality(doc, cam.quality, rig.quality)
+        if rig.top_view is not None and isinstance(out.get("top_view"), dict):
+            _own_quality(out["top_view"], rig.top_view.quality, rig.quality)
     return out
+
+
+def _own_quality(doc: dict[str, Any], quality: str, rig_quality: str) -> None:
+    """Writes ``quality`` into a camera's or top view's ``doc`` when it is not the rig's (else leaves it out)."""
+    if quality == rig_quality:
+        doc.pop("quality", None)
+    else:
+        doc["quality"] = quality
 
 
 def _vessel_document(v: VesselConfig) -> dict[str, Any]:

@@ -45,6 +45,17 @@ const FIELDS = ["input", "select", "textarea", "table"].map((t) => `#left ${t}[d
 
 const RIG_NAME = /^[A-Za-z0-9_-]{1,64}$/;
 
+function isMapping(value) {
+  return value !== null && typeof value === "object" && !Array.isArray(value);
+}
+
+/** A time of day as an <input type="time"> shows it ("HH:MM"): "6:05" and " 06:05 ", which the schema takes too,
+ * become "06:05"; anything else is left as it is (the box then shows it empty, beside the schema's note). */
+function hhmm(text) {
+  const m = typeof text === "string" ? /^\s*([0-9]{1,2}):([0-9]{2})\s*$/.exec(text) : null;
+  return m ? `${m[1].padStart(2, "0")}:${m[2]}` : text;
+}
+
 /** Whether the scenario's schema error at `field` (its message `message`) concerns the form field `path`: the same
  * field or one inside it, or a check across a section's fields (`environment`) that names this field's key. */
 function concerns(field, message, path) {
@@ -147,7 +158,8 @@ export class Panels {
     fillSelect($("v-asset"), assets.map((a) => [a.name, `${a.name} (${a.length} × ${a.beam} m)`]));
     fillSelect($("m-type"), choices.map_type.map((t) => [t, t.replace("_", " ")]));
     fillSelect($("e-weather"), choices.weather);
-    fillSelect($("e-wave"), [...choices.wave.map((w) => [w.name, `${w.name} (H ${w.height_m} m)`]), ["custom", "custom height…"]]);
+    fillSelect($("e-wave"), [...choices.wave.map((w) => [w.name, `${w.name} (H ${w.height_m} m)`]), ["custom", "custom height…"], ["sea", "by the sea"]]);
+    fillSelect($("e-motion"), choices.motion);
     [$("e-wave-height").min, $("e-wave-height").max] = this.waveRange().map(String);
     this.renderLibrary();
     this.bindLibrary();
@@ -513,7 +525,8 @@ export class Panels {
     setValue($("m-seed"), d.map?.seed ?? 0);
     setValue($("m-params"), d.map?.params ? JSON.stringify(d.map.params) : "");
     const env = d.environment || {};
-    setValue($("e-time"), env.time_of_day || "12:00");
+    // the time box shows "HH:MM" only: a time the schema takes as "6:05" or " 06:05" is shown as 06:05
+    setValue($("e-time"), hhmm(env.time_of_day || "12:00"));
     setValue($("e-weather"), env.weather || "clear");
     const wave = this.waveChoice();
     setValue($("e-wave"), wave);
@@ -533,8 +546,12 @@ export class Panels {
       }
     }
     if (custom) setValue($("e-wave-height"), env.wave);
+    setValue($("e-motion"), env.motion || "physical");
+    setValue($("e-sea"), env.sea == null ? "" : JSON.stringify(env.sea));
     setValue($("e-visibility"), env.visibility_m);
     setValue($("e-rain"), env.rain_mm_per_h);
+    setValue($("e-latitude"), env.latitude_deg);
+    setValue($("e-day"), env.day_of_year);
     const acq = d.acquisition || {};
     setValue($("a-frequency"), acq.frequency_hz ?? 5);
     setValue($("a-frames"), acq.frames ?? 100);
@@ -550,9 +567,15 @@ export class Panels {
    * shows it). */
   waveChoice() {
     const presets = this.state.choices.wave.map((w) => w.name);
-    const wave = this.state.doc.environment?.wave ?? "W0";
+    const env = this.state.doc.environment || {};
+    const wave = env.wave ?? "W0";
     const custom = $("e-wave").querySelector('option[value="custom"]');
     custom.textContent = typeof wave === "number" ? `custom: H ${wave} m` : "custom height…";
+    // a `sea` with the default wave: the sea sets the waves, not W0 (the select says so; picking a wave replaces it)
+    const bySea = isMapping(env.sea) && wave === "W0";
+    const sea = $("e-wave").querySelector('option[value="sea"]');
+    sea.hidden = sea.disabled = !bySea;
+    if (bySea) return "sea";
     return typeof wave === "string" && presets.includes(wave) ? wave : "custom";
   }
 
@@ -607,8 +630,14 @@ export class Panels {
       const summary = document.createElement("div");
       summary.className = "summary";
       const users = (this.state.doc.vessels || []).filter((v) => v.rig === name).map((v) => v.id);
-      const cams = Array.isArray(rig.cameras) ? `${rig.cameras.length} cameras` : (rig.preset || "full") === "full" ? "4 surround cameras" : "no cameras";
-      summary.textContent = `${cams}; carried by ${users.length ? users.join(", ") : "no vessel"}. Other sensor settings: edit the YAML.`;
+      const n = Array.isArray(rig.cameras) ? rig.cameras.length : null;
+      const cams = n !== null ? `${n} camera${n === 1 ? "" : "s"}` : (rig.preset || "full") === "full" ? "4 surround cameras" : "no cameras";
+      // a camera or the top view that sets a quality of its own renders at it, whatever the rig's select says
+      const own = [...(Array.isArray(rig.cameras) ? rig.cameras : []).map((c) => [c?.name, c?.quality]), ["top view", rig.top_view?.quality]]
+        .filter(([, q]) => typeof q === "string" && q !== (rig.quality || "standard"))
+        .map(([name, q]) => `${name} ${q}`);
+      const quality = own.length ? ` (own quality: ${own.join(", ")})` : "";
+      summary.textContent = `${cams}${quality}; carried by ${users.length ? users.join(", ") : "no vessel"}. Other sensor settings: edit the YAML.`;
       div.append(head, grid, summary);
       box.appendChild(div);
     }
@@ -700,11 +729,21 @@ export class Panels {
       return `a wave height in metres, ${lo} to ${hi}, or pick a preset`;
     };
     const inRange = (n) => n >= this.waveRange()[0] && n <= this.waveRange()[1];
+    // a wave picked replaces a `sea` (a scenario gives one or the other)
+    const setWave = (value) => {
+      this.forgetRefused("environment.sea");
+      edit((d) => {
+        d.environment ||= {};
+        d.environment.wave = value;
+        delete d.environment.sea;
+      });
+    };
     $("e-wave").addEventListener("change", (ev) => {
       const select = ev.target;
+      if (select.value === "sea") return; // shown only while the sea sets the waves
       if (select.value !== "custom") {
         this.forgetRefused("environment.wave");
-        return env("wave", select.value);
+        return setWave(select.value);
       }
       // from a preset to a custom wave: its height is asked for here, then changed in the box beside the select
       const now = this.state.doc.environment?.wave ?? "W0";
@@ -714,7 +753,7 @@ export class Panels {
       const n = h === null || h.trim() === "" ? NaN : Number(h.trim());
       if (Number.isFinite(n) && inRange(n)) {
         this.forgetRefused("environment.wave");
-        env("wave", n);
+        setWave(n);
       } else {
         if (h !== null && h.trim() !== "") {
           const what = Number.isFinite(n) ? `${n} m is out of range` : `${JSON.stringify(h.trim())} is not a number`;
@@ -733,12 +772,39 @@ export class Panels {
       }
       env("wave", n);
     });
+    $("e-motion").addEventListener("change", (ev) => env("motion", ev.target.value === "physical" ? null : ev.target.value));
+    $("e-sea").addEventListener("change", (ev) => {
+      const text = ev.target.value.trim();
+      const allowed = 'type a JSON object such as {"state": 5} (a WMO sea state, 0 to 9) or {"hs_m": 2, "tp_s": 7.5}, or leave it empty for the wave\'s sea. The sea stays as it was.';
+      let sea;
+      try {
+        sea = text ? JSON.parse(text) : null;
+      } catch (err) {
+        this.refuse(ev.target, `sea: not JSON (${err.message}); ${allowed}`);
+        return;
+      }
+      if (sea !== null && !isMapping(sea)) {
+        this.refuse(ev.target, `sea: ${text} is not a JSON object; ${allowed}`);
+        return;
+      }
+      this.accept(ev.target);
+      edit((d) => {
+        d.environment ||= {};
+        if (sea === null) delete d.environment.sea;
+        else {
+          d.environment.sea = sea;
+          d.environment.wave = "W0"; // the sea replaces the wave: W0, the default, is the one that goes with a sea
+        }
+      });
+    });
     const envNumber = (key, label, allowed) => (ev) => {
       const n = this.readNumber(ev.target, label, allowed);
       if (n !== undefined) env(key, n);
     };
     $("e-visibility").addEventListener("change", envNumber("visibility_m", "visibility", "metres, 1 or more (empty: the weather's own)"));
     $("e-rain").addEventListener("change", envNumber("rain_mm_per_h", "rain", "mm/h, 0 to 500 (empty: the weather's own)"));
+    $("e-latitude").addEventListener("change", envNumber("latitude_deg", "latitude", "degrees north, -90 to 90 (empty: 45)"));
+    $("e-day").addEventListener("change", envNumber("day_of_year", "day of year", "a whole number, 1 to 366 (empty: 172, 21 June)"));
     const acq = (key, label, allowed) => (ev) => {
       const n = this.readNumber(ev.target, label, allowed);
       if (n !== undefined) edit((d) => {
