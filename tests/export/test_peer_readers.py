@@ -327,7 +327,8 @@ def wrap(a: float) -> float:
 def kitti_objects(rec: Path, agent: str, k: int) -> list[dict[str, Any]]:
     """The KITTI objects of ``agent``'s frame ``k`` from the recording: every non-USV vessel of the LiDAR
     annotations within 200 m (the default range), in KITTI's camera conventions (docs/exports.md) with the camera
-    the front camera's optical frame of ``/tf``: bottom-centre location, ``rotation_y`` about the camera's y axis
+    the front camera's optical frame of ``/tf``: bottom-centre location of the upright box (the box centre h/2 down
+    the camera's y axis, where a reader adding h/2 back finds the centre), ``rotation_y`` about the camera's y axis
     (the box's x axis is ``(cos ry, 0, -sin ry)``), dimensions ``h w l``, the front camera's 2D box (``0 0 0 0``
     and occluded 3 when it has none)."""
     msgs = frame_messages(rec, k)
@@ -342,8 +343,7 @@ def kitti_objects(rec: Path, agent: str, k: int) -> list[dict[str, Any]]:
             continue
         length, width, height = b.size
         rot = Rotation.from_quat(list(b.rotation)).as_matrix()
-        bottom = np.asarray(b.center) + rot @ [0.0, 0.0, -height / 2]
-        loc = velo_to_cam[:3, :3] @ bottom + velo_to_cam[:3, 3]
+        loc = velo_to_cam[:3, :3] @ np.asarray(b.center) + velo_to_cam[:3, 3] + [0.0, height / 2, 0.0]
         x_axis = velo_to_cam[:3, :3] @ rot[:, 0]
         ry = math.atan2(-x_axis[2], x_axis[0])
         b2 = boxes2d.get(b.target_id)

@@ -4,10 +4,13 @@
 z up — KITTI's Velodyne axes, so no mirror), ``image_2/<ts>.png`` (front camera), ``calib/<ts>.txt`` (``P0..P3``
 = the front camera's ``K·[I|0]``, ``R0_rect`` = I, ``Tr_velo_to_cam`` LiDAR → front optical frame,
 ``Tr_imu_to_velo`` vessel body → LiDAR), ``label_2/<ts>.txt`` and ``pose/<ts>.txt`` (LiDAR → mmusv world,
-3×4 row-major, for cooperative use). Labels, one line per target within the evaluation range (same filter as
-OPV2V): ``type truncated occluded alpha x1 y1 x2 y2 h w l x y z rotation_y`` in the front camera frame
-(location = bottom centre of the box); the 2D box, truncation and occlusion come from the recording's camera
-annotations (occluded 0: < 25 % hidden, 1: < 60 %, 2: more, 3: not in the front image, with box ``0 0 0 0``).
+3×4 row-major, for cooperative use); ``<ts>`` is the 6-digit acquisition index k, the same in every agent folder,
+taken at sim time k / ``frequency_hz`` s (``mmusv_kitti.yaml``). Labels, one line per target within the evaluation
+range (same filter as OPV2V): ``type truncated occluded alpha x1 y1 x2 y2 h w l x y z rotation_y`` in the front
+camera frame (location = the box centre moved h/2 down the camera's y axis: KITTI's bottom centre of an upright
+box, so that readers adding h/2 back get the box centre, also when the hull or the USV rolls in waves); the 2D box,
+truncation and occlusion come from the recording's camera annotations (occluded 0: < 25 % hidden, 1: < 60 %,
+2: more, 3: not in the front image, with box ``0 0 0 0``).
 An agent without a front camera has no ``image_2``, zero ``P0..P3`` and, as camera, the LiDAR's own optical axes
 (``Tr_velo_to_cam`` = the rotation x right, y down, z forward): its labels keep KITTI's camera conventions, so
 KITTI's readers turn them into LiDAR boxes with the right heading. A front camera's lens distortion (KITTI's
@@ -28,7 +31,7 @@ from mmusv.classes import class_name
 from mmusv.export.common import cav_id, depth_png, dump_yaml, png_bytes
 from mmusv.export.geometry import AgentView, Target
 from mmusv.export.writer import DatasetWriter
-from mmusv.frames import BODY_TO_OPTICAL, invert, transform_points, wrap_rad
+from mmusv.frames import BODY_TO_OPTICAL, invert, wrap_rad
 from mmusv.recording import topics
 from mmusv.recording.decode import WorldFrame
 from mmusv.recording.info import AgentInfo
@@ -71,10 +74,13 @@ def kitti_label(target: Target, velo_to_cam: np.ndarray, box2d: Any | None) -> s
     """One ``label_2`` line of ``target`` (box in the LiDAR frame) for the camera ``velo_to_cam`` (4×4)."""
     length, beam, height = (float(x) for x in target.size)
     box_cam = velo_to_cam @ target.box_in_lidar
-    bottom = transform_points(box_cam, np.array([[0.0, 0.0, -height / 2.0]]))[0]
+    centre = box_cam[:3, 3]
+    # KITTI's box is upright in the camera frame (its height along the camera's y, down): the location is the box
+    # centre h/2 down that axis, so that readers adding h/2 back get the centre. The bottom of the box itself, of a
+    # hull rolling and pitching in waves, put that centre h/2 · tilt away (metres for a tall ship, every frame).
+    bottom = centre + np.array([0.0, height / 2.0, 0.0])
     d = box_cam[:3, 0]
     ry = float(wrap_rad(math.atan2(-d[2], d[0])))
-    centre = box_cam[:3, 3]
     alpha = float(wrap_rad(ry - math.atan2(centre[0], centre[2])))
     if box2d is None:
         trunc, occ, bb = 0.0, 3, (0.0, 0.0, 0.0, 0.0)
@@ -185,6 +191,8 @@ class KittiWriter(DatasetWriter):
                         for a in self.agents
                     },
                     "eval_range_m": o.eval_range_m,
+                    # the files' <ts> is the acquisition index k, taken at k / frequency_hz s (sim time)
+                    "frequency_hz": self.info.frequency_hz,
                     "include_usvs": o.include_usvs,
                     "extras": list(o.extras),
                     "frames_converted": len(frames),

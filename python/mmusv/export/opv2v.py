@@ -10,7 +10,11 @@ Per-frame yaml (keys sorted, as OpenCDA writes them): ``camera0..3`` (``cords`` 
 ``extrinsic`` LiDAR → camera), ``ego_speed`` (km/h), ``lidar_pose``, ``plan_trajectory`` (the scenario route:
 ``[x, y, speed km/h]``), ``predicted_ego_pos`` = ``true_ego_pos`` (the vessel pose), ``vehicles``
 (``{id: {angle: [roll, yaw, pitch], center, extent (half sizes), location, speed km/h}}``, box centre =
-location + center component-wise). Camera order: 0 front, 1 right, 2 left, 3 rear.
+location + center component-wise). Camera order: 0 front, 1 right, 2 left, 3 rear. Both speeds are the norm of
+the world-state velocity ``(vx, vy, vz)``, as CARLA's 3D velocity in OpenCDA's ``get_speed``: in waves the heave
+rate ``vz`` is part of it, so a vessel sailing at ``speed_mps`` shows a little more, changing from frame to frame
+(0.4 m/s for a 9 m/s speedboat at W2); the speed over ground is ``hypot(vx, vy)`` of the world state (=
+``speed_mps`` under way).
 
 Files beyond stock OPV2V, which stock loaders skip: ``<ts>_additional.yaml`` (our names, classes and LiDAR point
 counts of the listed vehicles), ``<ts>_depth{i}.png`` (uint16 cm), ``<ts>_semantic{i}.png``,
