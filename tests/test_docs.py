@@ -729,6 +729,7 @@ DEFAULTS: list[tuple[str, str, tuple[str, ...], str, Any]] = [
     ("docs/exports.md", "`--seed` (default 0)", ("convert",), "--seed", 0),
     ("docs/exports.md", "`--min-box-px` (default 0)", ("convert",), "--min-box-px", 0),
     ("docs/exports.md", "`--max-occlusion` (default 1)", ("convert",), "--max-occlusion", 1),
+    ("docs/exports.md", "`--min-contrast C` (default: none", ("convert",), "--min-contrast", None),
     ("docs/exports.md", "`--box visible` (the default)", ("convert",), "--box", "visible"),
     ("docs/opencood.md", "`mmusv convert --range`, 200 m", ("convert",), "--range", 200),
     ("README.md", "`http://127.0.0.1:8765/`", ("editor",), "--port", 8765),

@@ -7,7 +7,10 @@ annotations (``mmusv.AgentAnnotations.boxes_camera``: the vessel's projected 3D 
 truncation, visible pixels and occlusion; :mod:`mmusv.annotate`), with the vessel's class, instance and role from
 the frame's world state. The box written is the option ``box`` (:data:`mmusv.export.common.BOXES`): ``visible``
 (the default), the tight box of the instance image's pixels equal to the vessel's instance id (:func:`mask_box`),
-or ``projected``, the recorded box; truncation, occlusion and visible pixels are the recording's either way.
+or ``projected``, the recorded box; truncation, occlusion and visible pixels are the recording's either way. A box's
+``contrast`` is measured on the recorded RGB image (:func:`mmusv.export.contrast.apparent_contrast`: the vessel's
+Weber contrast, row by row, against the background beside its pixels), for the formats that write it (COCO) and for the
+option ``min_contrast``.
 
 Pixel coordinates (every box): origin at the top-left corner of the image, x right, y down, pixel ``(i, j)`` over
 ``[i, i + 1) × [j, j + 1)``, so the tight box of pixels ``x_min..x_max``, ``y_min..y_max`` (inclusive) is
@@ -25,6 +28,7 @@ import numpy as np
 
 from mmusv.classes import SemanticClass, class_name
 from mmusv.export.common import Options, Sink
+from mmusv.export.contrast import apparent_contrast
 from mmusv.export.writer import DatasetWriter
 from mmusv.recording import topics
 from mmusv.recording.decode import WorldFrame
@@ -41,7 +45,9 @@ CATEGORIES: tuple[int, ...] = tuple(int(c) for c in SemanticClass if c != Semant
 class ImageBox:
     """One vessel's 2D box in one image: pixels ``x_min, y_min, x_max, y_max`` (origin at the top-left corner of
     the image, x right, y down), its vessel id, semantic class, instance id and role (``target``, ``usv``,
-    ``moored``), truncation and occlusion (fractions, 0..1) and visible pixels."""
+    ``moored``), truncation and occlusion (fractions, 0..1), visible pixels and, where measured, ``contrast`` (the
+    vessel's Weber contrast in the RGB image, :func:`mmusv.export.contrast.apparent_contrast`; ``None`` when not
+    measured or undefined)."""
 
     target_id: str
     semantic_class: int
@@ -54,6 +60,7 @@ class ImageBox:
     truncation: float
     occlusion: float
     visible_pixels: int
+    contrast: float | None = None
 
     @property
     def width(self) -> float:
@@ -87,6 +94,13 @@ class Sample:
 
         return np.asarray(decode_image(self.message("instance")))
 
+    @cached_property
+    def rgb(self) -> np.ndarray:
+        """The camera's RGB image as recorded, ``(H, W, 3)`` uint8 sRGB (decoded once)."""
+        from mmusv.recording import decode_image
+
+        return np.asarray(decode_image(self.message("rgb")))
+
 
 def mask_box(instance: np.ndarray, instance_id: int) -> tuple[int, int, int, int] | None:
     """The tight box ``(x_min, y_min, x_max, y_max)`` of ``instance``'s pixels equal to ``instance_id`` in pixel-edge
@@ -117,6 +131,9 @@ class CameraWriter(DatasetWriter):
     needs_agent: ClassVar[bool] = True
     kinds: ClassVar[tuple[str, ...]] = ("rgb",)
     boxes: ClassVar[bool] = False
+    contrast: ClassVar[bool] = False
+    """Whether the format writes each box's ``contrast`` (then measured for every box; otherwise only for the option
+    ``min_contrast``, which needs the camera's instance images: see :attr:`kinds`)."""
     left_out_why: ClassVar[str] = ""
     """Said after the cameras left out for lacking one of :attr:`kinds` (what would keep them)."""
 
@@ -127,6 +144,9 @@ class CameraWriter(DatasetWriter):
         """2D boxes with a visible pixel in the converted images (before ``min_box_px`` and ``max_occlusion``)."""
         self.kept_boxes = 0
         """Of those, the boxes :meth:`boxes_of` kept."""
+        self.faint_boxes = 0
+        """Of the visible boxes, those whose contrast is under ``min_contrast`` (left out, whatever the other
+        filters say)."""
         self.cams: dict[str, list[str]] = {}
         for a in self.agents:
             self.cams[a.id] = [n for n, c in sorted(a.cameras.items()) if self.camera_ok(c)]
@@ -195,11 +215,17 @@ class CameraWriter(DatasetWriter):
         """The sample's 2D boxes kept by the options, each the box of option ``box``: ``visible``, the tight box of the
         vessel's pixels in the instance image (:func:`mask_box`), or ``projected``, the recorded box. A box with no
         visible pixel is always left out, and so are boxes whose shorter side (of the box written) is under
-        ``min_box_px`` or whose occlusion is above ``max_occlusion``."""
+        ``min_box_px``, whose occlusion is above ``max_occlusion`` or, with ``min_contrast`` set, whose contrast in the
+        RGB image is under it (a box whose contrast is undefined, :func:`~mmusv.export.contrast.apparent_contrast`
+        ``None``, is kept). ``contrast`` is measured when the format writes it (:attr:`contrast`) or
+        ``min_contrast`` is set, else left ``None``."""
         ann = sample.frame.messages[topics.agent_annotations(sample.agent.id)]
         w = sample.world
         row = {vid: i for i, vid in enumerate(w.ids)}
         visible = self.options.box == "visible"
+        min_contrast = self.options.min_contrast
+        measure = self.contrast or min_contrast is not None
+        vessel_ids = [int(i) for i in w.instance_ids]
         out = []
         for b in ann.boxes_camera:
             if b.camera != sample.camera.name or b.target_id not in row:
@@ -226,8 +252,19 @@ class CameraWriter(DatasetWriter):
                     continue
                 x0, y0, x1, y1 = (float(v) for v in tight)
                 box = replace(box, x_min=x0, y_min=y0, x_max=x1, y_max=y1)
+            if measure:
+                c = apparent_contrast(
+                    rgb=sample.rgb, instance=sample.instance, instance_id=box.instance_id, other_ids=vessel_ids
+                )
+                box = replace(box, contrast=c)
             self.visible_boxes += 1
-            if box.occlusion > self.options.max_occlusion or min(box.width, box.height) < self.options.min_box_px:
+            faint = min_contrast is not None and box.contrast is not None and box.contrast < min_contrast
+            self.faint_boxes += faint
+            if (
+                faint
+                or box.occlusion > self.options.max_occlusion
+                or min(box.width, box.height) < self.options.min_box_px
+            ):
                 continue
             out.append(box)
         self.kept_boxes += len(out)
@@ -235,17 +272,28 @@ class CameraWriter(DatasetWriter):
 
     def finish(self, frames: list[int], skipped: list[dict[str, Any]]) -> None:
         """Says so when a format with boxes kept none of this recording's (no vessel in view, or every box left
-        out by the filters), as its label files are then all empty."""
+        out by the filters), as its label files are then all empty; with ``min_contrast``, how many boxes it left
+        out."""
         super().finish(frames, skipped)
+        o = self.options
+        if self.boxes and frames and o.min_contrast is not None:
+            self.notes.append(
+                f"min_contrast = {o.min_contrast:g}: {self.faint_boxes} of {self.visible_boxes} visible 2D boxes have "
+                "a lower contrast in the RGB image and are left out"
+            )
         if not (self.boxes and frames) or self.kept_boxes:
             return
-        o = self.options
         if self.visible_boxes == 0:
             self.notes.append("no vessel is visible in any converted image: no 2D box, every image is background")
         else:
+            filters = f"min_box_px = {o.min_box_px:g}"
+            if o.min_contrast is None:
+                filters += f" and max_occlusion = {o.max_occlusion:g}"
+            else:
+                filters += f", max_occlusion = {o.max_occlusion:g} and min_contrast = {o.min_contrast:g}"
             self.notes.append(
-                f"all {self.visible_boxes} visible 2D boxes were left out by min_box_px = {o.min_box_px:g} and "
-                f"max_occlusion = {o.max_occlusion:g}: no 2D box, every image is background"
+                f"all {self.visible_boxes} visible 2D boxes were left out by {filters}: no 2D box, every image is "
+                "background"
             )
 
 

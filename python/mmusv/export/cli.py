@@ -79,6 +79,15 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         help="coco, yolo: leave out 2D boxes hidden by more than this fraction, 0..1 (default 1: keep all)",
     )
     p.add_argument(
+        "--min-contrast",
+        type=float,
+        default=None,
+        metavar="C",
+        help="coco, yolo: leave out 2D boxes whose apparent (Weber) contrast in the recorded RGB image is under C, "
+        "e.g. 0.05, the WMO's visibility threshold: vessels lost in fog, haze or the dark (default: keep all; needs "
+        "instance images, also with --box projected)",
+    )
+    p.add_argument(
         "--box",
         default="visible",
         help="coco, yolo: the 2D box written: visible (default: the tight box of the vessel's pixels in the instance "
@@ -127,6 +136,7 @@ def run(args: argparse.Namespace) -> int:
         "extras": args.extras,
         "min_box_px": args.min_box_px,
         "max_occlusion": args.max_occlusion,
+        "min_contrast": args.min_contrast,
         "box": args.box,
         "overwrite": args.overwrite,
         "agents": args.agents,

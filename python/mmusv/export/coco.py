@@ -16,7 +16,8 @@ the image: it reaches down to the keel below the waterline and over what hides t
 vessel's semantic class, ``segmentation`` the run-length encoding (pycocotools, ``counts`` as a string) of the
 instance image's pixels equal to the vessel's instance id, ``area`` that mask's pixel count, ``iscrowd`` 0, and the
 extra fields ``truncation``, ``occlusion`` (fractions, as recorded: of the projected box), ``role``, ``mmusv_id``
-(vessel id), ``instance_id`` and ``visible_pixels``.
+(vessel id), ``instance_id``, ``visible_pixels`` and ``contrast`` (the vessel's apparent Weber contrast in the RGB
+image, :func:`mmusv.export.contrast.apparent_contrast`, 6 decimals; ``null`` where undefined).
 """
 
 from __future__ import annotations
@@ -54,6 +55,7 @@ class CocoWriter(CameraWriter):
 
     kinds: ClassVar[tuple[str, ...]] = ("rgb", "instance")
     boxes: ClassVar[bool] = True
+    contrast: ClassVar[bool] = True
     no_agent_reason: ClassVar[str] = "no camera recording rgb and instance images (COCO masks need instance images)"
 
     @classmethod
@@ -110,6 +112,7 @@ class CocoWriter(CameraWriter):
                     "mmusv_id": b.target_id,
                     "instance_id": b.instance_id,
                     "visible_pixels": b.visible_pixels,
+                    "contrast": None if b.contrast is None else round(b.contrast, 6) + 0.0,
                 }
             )
 

@@ -96,6 +96,9 @@ class Options:
     """COCO/YOLO: 2D boxes whose shorter side is under this many pixels are left out."""
     max_occlusion: float = 1.0
     """COCO/YOLO: 2D boxes whose occlusion (fraction hidden, 0..1) is above this are left out."""
+    min_contrast: float | None = None
+    """COCO/YOLO: 2D boxes whose apparent contrast in the RGB image (:func:`mmusv.export.contrast.apparent_contrast`,
+    Weber, dimensionless) is under this are left out; ``None``: every box is kept."""
     box: str = "visible"
     """COCO/YOLO: the 2D box written (one of :data:`BOXES`): ``visible``, the tight box of the vessel's pixels in the
     instance image; ``projected``, the recording's box (the projected 3D box clipped to the image)."""

@@ -31,6 +31,7 @@ import yaml
 from mmusv import arguments
 from mmusv.errors import ConfigError, IoError
 from mmusv.export.common import DEFAULT_EXTRAS, TARGETS, Options, Sink, dump_yaml, parse_box, parse_extras
+from mmusv.export.contrast import MAX_CONTRAST
 from mmusv.export.splits import DEFAULT_RATIOS, SPLIT_NAMES, assign_splits, parse_ratios
 from mmusv.export.writer import DatasetWriter
 from mmusv.recording.guard import FolderLock
@@ -307,6 +308,21 @@ def _box_filter(min_box_px: Any, max_occlusion: Any) -> tuple[float, float]:
     return px, occ
 
 
+def _contrast_filter(min_contrast: Any) -> float | None:
+    """``min_contrast`` as a float in ``[0, MAX_CONTRAST]``, or ``None``; :class:`~mmusv.errors.ConfigError` naming it
+    otherwise."""
+    if min_contrast is None:
+        return None
+    allowed = (
+        f"must be a Weber contrast >= 0 and <= {MAX_CONTRAST:.0f} (the largest an 8-bit image holds; 0.05 is the "
+        "WMO's visibility threshold), or None to keep every box"
+    )
+    c = arguments.real(min_contrast, name="min_contrast", finite=False)
+    if not (math.isfinite(c) and 0 <= c <= MAX_CONTRAST):
+        raise ConfigError(f"min_contrast = {arguments.shown(min_contrast)}: {allowed}")
+    return c
+
+
 def _agent_selection(agents: Iterable[str] | str | None) -> tuple[str, ...] | None:
     """``agents`` (a list of ids or ``"usv_1,usv_2"``) as sorted unique ids, or ``None``; an empty selection or an
     id that is not a string is a :class:`~mmusv.errors.ConfigError` naming ``agents``."""
@@ -402,6 +418,7 @@ def convert(
     extras: Iterable[str] | str | None = DEFAULT_EXTRAS,
     min_box_px: float = 0.0,
     max_occlusion: float = 1.0,
+    min_contrast: float | None = None,
     box: str = "visible",
     overwrite: bool = False,
     agents: Iterable[str] | str | None = None,
@@ -428,6 +445,10 @@ def convert(
             files stock loaders skip).
         min_box_px: COCO and YOLO: leave out 2D boxes whose shorter side is under this many pixels.
         max_occlusion: COCO and YOLO: leave out 2D boxes hidden by more than this fraction (0..1).
+        min_contrast: COCO and YOLO: leave out 2D boxes whose apparent contrast in the recorded RGB image (the
+            vessel's Weber contrast against the background around it, :mod:`mmusv.export.contrast`; 0.05 is the
+            WMO's visibility threshold) is under this; ``None`` (the default) keeps every box. It needs the cameras'
+            instance images (also with ``box="projected"``).
         box: COCO and YOLO: the 2D box written, ``"visible"`` (the default: the tight box of the vessel's pixels in
             the instance image, COCO's convention for ``bbox``; YOLO then needs cameras recording instance images)
             or ``"projected"`` (the recording's box: the vessel's projected 3D box clipped to the image, reaching
@@ -457,6 +478,7 @@ def convert(
             raise ConfigError(f"split {splits!r}: --to {to} writes one folder per recording and is never split")
         ratios = None
     box_px, max_occ = _box_filter(min_box_px, max_occlusion)
+    min_c = _contrast_filter(min_contrast)
     box = parse_box(box)
     options = Options(
         to=to,
@@ -465,6 +487,7 @@ def convert(
         extras=parse_extras(extras),
         min_box_px=box_px,
         max_occlusion=max_occ,
+        min_contrast=min_c,
         box=box,
         agents=_agent_selection(agents),
         frames=_frame_selection(frames),
@@ -494,6 +517,7 @@ def convert(
                 "include_usvs": options.include_usvs,
                 "extras": list(options.extras),
                 **({"min_box_px": box_px, "max_occlusion": max_occ, "box": box} if to in ("coco", "yolo") else {}),
+                **({"min_contrast": min_c} if to in ("coco", "yolo") and min_c is not None else {}),
                 "splits": None
                 if ratios is None
                 else dict(zip(SPLIT_NAMES, [round(r, 9) for r in ratios], strict=True)),

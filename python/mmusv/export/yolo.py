@@ -13,7 +13,9 @@ Ultralytics does not read). Splits are made by recording (:mod:`mmusv.export.spl
 The box (option ``box``, :meth:`mmusv.export.camera.CameraWriter.boxes_of`, the COCO export's boxes and filters):
 ``visible`` (the default) the tight box of the vessel's pixels in the camera's instance image, so only cameras that
 record ``rgb`` and ``instance`` images are converted (:class:`YoloVisibleWriter`); ``projected`` the recording's
-box (the vessel's projected 3D box clipped to the image, reaching down to the keel), from ``rgb`` cameras alone.
+box (the vessel's projected 3D box clipped to the image, reaching down to the keel), from ``rgb`` cameras alone
+(with ``min_contrast``, which measures each vessel on its pixels, ``rgb`` and ``instance``:
+:class:`YoloContrastWriter`).
 
 Ultralytics finds an image's label file by replacing the *last* ``images`` folder of the image's path with
 ``labels``, so a scenario, agent or camera named ``images`` would send it to a label file that does not exist
@@ -34,7 +36,7 @@ from mmusv.export.camera import CATEGORIES, CameraWriter, Sample, Shared, catego
 from mmusv.export.common import BOX_DEFINITIONS, Options, Sink, dump_yaml, png_bytes
 from mmusv.export.splits import SPLIT_NAMES
 
-__all__ = ["YoloVisibleWriter", "YoloWriter", "yolo_class", "yolo_key"]
+__all__ = ["YoloContrastWriter", "YoloVisibleWriter", "YoloWriter", "yolo_class", "yolo_key"]
 
 _YOLO_SPLIT = {"train": "train", "validate": "val", "test": "test"}
 _IMAGES_FOLDER = re.compile(r"images_*")
@@ -68,7 +70,9 @@ class YoloWriter(CameraWriter):
 
     @classmethod
     def for_options(cls, options: Options) -> type[YoloWriter]:
-        return YoloVisibleWriter if options.box == "visible" else YoloWriter
+        if options.box == "visible":
+            return YoloVisibleWriter
+        return YoloWriter if options.min_contrast is None else YoloContrastWriter
 
     @classmethod
     def format_name(cls) -> str:
@@ -118,3 +122,15 @@ class YoloVisibleWriter(YoloWriter):
         "image; --box projected writes the recorded boxes from rgb images alone)"
     )
     left_out_why: ClassVar[str] = " (--box visible takes the boxes from the instance images; --box projected does not)"
+
+
+class YoloContrastWriter(YoloWriter):
+    """:class:`YoloWriter` with ``box="projected"`` and ``min_contrast``: the contrast is measured on the vessel's
+    pixels in the instance images, so a camera must record them too."""
+
+    kinds: ClassVar[tuple[str, ...]] = ("rgb", "instance")
+    no_agent_reason: ClassVar[str] = (
+        "no camera recording rgb and instance images (--min-contrast measures each vessel on its pixels in the "
+        "instance image)"
+    )
+    left_out_why: ClassVar[str] = " (--min-contrast measures each vessel on its pixels in the instance images)"
