@@ -526,7 +526,7 @@ def demo_scene(
 
 @final
 class Fleet:
-    """Vessels on arc-length spline routes with wave heave/roll/pitch (paper eq. 1–4). Poses are
+    """Vessels on arc-length spline routes with wave heave/roll/pitch (paper eq. 1–3). Poses are
     ``[x, y, z, roll, pitch, yaw]`` in the world frame (metres, radians)."""
 
     def __new__(

@@ -1,6 +1,7 @@
 """Vessel motion for a scenario: the Rust fleet (spline routes + wave motion) built from the config.
 
-Poses are ``η = [x, y, z, roll, pitch, yaw]`` in the world frame (metres, radians), equation 4 of the paper.
+Poses are ``η = [x, y, z, roll, pitch, yaw]`` in the world frame (metres, radians), equation (3) of the paper
+(Sec. II-C; equation (1) is the spline route, equation (2) the heave, roll and pitch perturbation).
 Heave, roll and pitch come, with ``environment.motion: physical`` (the default), from each hull's response to the
 scenario's wave field (closed-form RAOs from the asset's length, beam, draft, block coefficient and GM:
 :mod:`mmusv.world.hydrostatics`, :mod:`mmusv.world.sea_state`); with ``motion: paper``, from the paper's formula

@@ -22,6 +22,9 @@ to this vessel alone (per the instance image). Per sample:
 
 Per map the study reports the number of valid samples, the medians of both errors, mean containment and mean
 occupancy (a map without valid samples has no row; the tables keep their columns).
+
+Every vessel other than the observing USV is sampled, the other USVs included, where the paper samples "each
+visible target vessel" (``docs/studies/agreement.md`` gives the table over the targets alone).
 """
 
 from __future__ import annotations

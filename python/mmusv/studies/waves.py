@@ -4,7 +4,10 @@ A controlled scenario, routes and sensors fixed, only the wave setting varied. H
 each USV's mean height over the sequence; roll and pitch RMS are in degrees; all statistics pool every USV and
 every acquisition frame. A straight-line fit of each statistic against H gives R².
 
-``motion="paper"`` (the default, Table I as published) moves the vessels by the paper's formula. With
+``motion="paper"`` (the default) moves the vessels by the paper's formula, whose amplitudes are fitted to Table I
+for a USV of the reference size (a 5 × 2.5 × 1.5 m box, ``α_v = 1``): on the bundled ``island_port_waves``, whose
+USVs are three 4.88 m WAM-Vs and a 12 m patrol boat (``α_v`` 0.85 and 0.42), every statistic is 0.76–0.77 times
+Table I's, the shape (monotonic, linear in H) the paper's (``docs/sea.md``, *mmusv study waves against Table I*). With
 ``motion="physical"`` every vessel responds to the fully developed sea of each setting (Hs = H, Pierson–Moskowitz
 Tp; :mod:`mmusv.world.sea_state`) through its hull's RAOs; :func:`run_physical_wave_study` then reports, beside
 the paper's Table I (:data:`PAPER_TABLE_I`) and the paper mode, the RMS of the USVs and of every vessel of the

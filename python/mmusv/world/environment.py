@@ -39,8 +39,11 @@ __all__ = [
 ]
 
 WAVE_PRESETS: dict[str, float] = dict(core.wave_presets())
-"""Significant wave height H in metres of each preset (paper, Table I), in order W0..W3: read from the core
-(``mmusv_core::kinematics::waves::WaveSetting::PRESETS``), their one definition."""
+"""Wave height H in metres of each preset, in order W0..W3: the midpoint of the paper's interval (W0 0–1 m, W1
+1–2 m, W2 2–3 m, W3 3–4 m; Sec. III-A and Table I), where H is "the simulator's geometric wave-height control" with
+amplitude A = H/2, not a significant wave height. The paper's formula scales the motion by it; the physical sea
+(``environment.motion: physical``) takes it as its significant height Hs (``docs/sea.md``), mmusv's choice. Read
+from the core (``mmusv_core::kinematics::waves::WaveSetting::PRESETS``), their one definition."""
 
 WeatherKind = Literal["clear", "overcast", "fog", "rain"]
 _WEATHER: tuple[str, ...] = ("clear", "overcast", "fog", "rain")
