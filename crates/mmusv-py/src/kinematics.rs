@@ -24,7 +24,7 @@ fn wave_from(obj: &Bound<'_, PyAny>) -> PyResult<WaveSetting> {
     WaveSetting::from_height(h).map_err(to_py)
 }
 
-/// The vessels of a scenario moving along their routes (equations 1–4 of the MMUSV-Sim paper).
+/// The vessels of a scenario moving along their routes (equations 1–3 of the MMUSV-Sim paper).
 #[pyclass(frozen, module = "mmusv._core")]
 pub struct Fleet {
     inner: CoreFleet,

@@ -1,4 +1,4 @@
-//! Vessel motion (paper eq. 1–4): spline routes travelled at a nominal speed, with wave-driven heave, roll
+//! Vessel motion (paper eq. 1–3): spline routes travelled at a nominal speed, with wave-driven heave, roll
 //! and pitch superimposed.
 //!
 //! For vessel `v` at time `t ≥ 0` (seconds), with travelled distance `d = offset + u·t` mapped to an arc
@@ -162,14 +162,14 @@ impl VesselMotion {
         }
     }
 
-    /// `[Δz (m), Δφ (rad), Δθ (rad)] = S_wave · α_v · [r_z g_z(t), r_φ g_φ(t), r_θ g_θ(t)]` (eq. 3).
+    /// `[Δz (m), Δφ (rad), Δθ (rad)] = S_wave · α_v · [r_z g_z(t), r_φ g_φ(t), r_θ g_θ(t)]` (eq. 2).
     pub fn perturbation_at(&self, t: f64, wave: &WaveSetting) -> [f64; 3] {
         let k = wave.scale() * self.alpha;
         let (a, g) = (&self.params.amplitudes, &self.signals);
         [k * a.heave_m * g.heave.value(t), k * a.roll_rad * g.roll.value(t), k * a.pitch_rad * g.pitch.value(t)]
     }
 
-    /// The pose `η = [x, y, z_base + Δz, Δφ, Δθ, θ]` at time `t` (eq. 4); `t` must be finite and ≥ 0, and the
+    /// The pose `η = [x, y, z_base + Δz, Δφ, Δθ, θ]` at time `t` (eq. 3); `t` must be finite and ≥ 0, and the
     /// distance travelled by then, `offset + u·t`, finite (errors name `t`).
     /// Yaw `θ` is in `[-π, π]`; travelling backwards on a ping-pong route it is the route heading + π.
     pub fn pose_at(&self, t: f64, wave: &WaveSetting) -> Result<[f64; 6]> {

@@ -1,4 +1,4 @@
-//! Wave-driven heave, roll and pitch perturbations (paper eq. 2–3).
+//! Wave-driven heave, roll and pitch perturbations (paper eq. 2).
 //!
 //! For vessel `v` at time `t` (seconds):
 //!

@@ -74,8 +74,8 @@ pub struct LidarConfig {
 }
 
 impl Default for LidarConfig {
-    /// The paper's sensor: 64 channels over [−25°, 15°], 131,072 points/s at 5 Hz, i.e. 26,214 points per
-    /// sweep = 410 columns of 64, 0.5–200 m.
+    /// The paper's LiDAR (64 channels, 131,072 points/s at 5 Hz, 200 m) over mmusv's vertical field of
+    /// [−25°, 15°] (the paper gives none): 26,214.4 points per sweep, fired as 410 whole columns of 64, 0.5–200 m.
     fn default() -> Self {
         let elevations = rays::uniform_elevations(64, (-25f64).to_radians(), 15f64.to_radians()).unwrap_or_default();
         Self {
