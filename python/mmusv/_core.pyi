@@ -46,6 +46,7 @@ __all__ = [
     "sea_limits",
     "sea_presets",
     "sea_seed",
+    "simd_level",
     "surface_tiles",
     "uniform_elevations",
     "wave_height",
@@ -513,6 +514,13 @@ def surface_tiles(foci: npt.NDArray[np.float32], *, radius_m: float = 320.0, til
     """Tiles the displaced sea surface around ``foci`` (F, 2) float32 (world x, y, metres) out to ``radius_m`` holds, in
     tiles of ``tile_m`` (saturated; 0 without foci): ``Scene.set_wave_surface`` refuses more than
     ``MAX_SURFACE_TILES``."""
+
+# --- simd ---
+
+def simd_level() -> str:
+    """The core's code paths in this process: ``"avx2"`` (AVX2 + FMA, picked where the CPU has them) or
+    ``"portable"`` (any x86-64, or forced by ``MMUSV_SIMD=portable`` in the environment before the first call).
+    Every level gives the same bytes; benchmarks report it."""
 
 # --- demo ---
 

@@ -16,6 +16,7 @@ mod radar;
 mod record;
 mod scene;
 mod sensors;
+mod simd;
 
 /// The compiled core of mmusv. Use the `mmusv` package rather than this module directly.
 #[pymodule]
@@ -33,5 +34,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     capture::register(m)?;
     record::register(m)?;
     demo::register(m)?;
+    simd::register(m)?;
     Ok(())
 }
