@@ -314,7 +314,7 @@ def _contrast_filter(min_contrast: Any) -> float | None:
     if min_contrast is None:
         return None
     allowed = (
-        f"must be a Weber contrast >= 0 and <= {MAX_CONTRAST:.0f} (the largest an 8-bit image holds; 0.05 is the "
+        f"must be a Weber contrast >= 0 and <= {MAX_CONTRAST:.1f} (the largest an 8-bit image holds; 0.05 is the "
         "WMO's visibility threshold), or None to keep every box"
     )
     c = arguments.real(min_contrast, name="min_contrast", finite=False)

@@ -124,7 +124,8 @@ def _encounter(kind: str) -> Callable[[FamilyInput], Layout]:
                     if rng.uniform() < 0.5:
                         speed = min(inp.ego.speed + float(rng.uniform(1.0, 3.0)), top_speed_mps(tgt.asset))
                     else:
-                        speed = max(0.5, inp.ego.speed - float(rng.uniform(0.8, 1.5)))
+                        slower = max(0.5, inp.ego.speed - float(rng.uniform(0.8, 1.5)))
+                        speed = min(slower, top_speed_mps(tgt.asset))
                 v_t = speed * heading(psi)
                 ego_at = centre + v_e * (t_e - t0)
                 p = _cpa_point(ego_at, v_e, v_t, _range(inp), rng, ahead=kind == "crossing")
@@ -140,7 +141,8 @@ def _encounter(kind: str) -> Callable[[FamilyInput], Layout]:
 def _convoy(inp: FamilyInput) -> Layout:
     """The role targets sail in line on one shared route (start offsets), the ego abeam of the lead."""
     rng, big_t = inp.rng, inp.duration
-    u = float(rng.uniform(*inp.usv_speed))
+    # the convoy sails at its slowest member's top speed at most (a kayak is not towed along at the USV's speed)
+    u = min([float(rng.uniform(*inp.usv_speed)), *(top_speed_mps(t.asset) for t in inp.targets)])
     t_e = big_t * float(rng.uniform(0.35, 0.65))
     gaps = [
         a.radius + b.radius + inp.separation_m + float(rng.uniform(15.0, 60.0))
