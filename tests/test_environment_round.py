@@ -207,6 +207,20 @@ def test_invalid_thread_counts_are_named(name: str, value: str) -> None:
     assert err.endswith("unset it for the default")
 
 
+@pytest.mark.parametrize("value", ["bogus", "avx2", " portable", "portable2"])
+def test_an_unknown_simd_level_is_named(value: str) -> None:
+    """``MMUSV_SIMD`` takes ``portable`` (the core's portable paths); anything else (a typo, ``avx2``, a blank
+    around the word) was silently ignored and the run took the fastest paths the CPU has, as if unset. Refused
+    before any work, naming the variable; ``portable`` in any case, and empty, are taken."""
+    res = run_mmusv("version", env=child_env(MMUSV_SIMD=value))
+    no_traceback(res.stderr)
+    assert res.returncode == 2 and res.stdout == b""
+    err = res.stderr.decode().splitlines()[-1]
+    assert err.startswith(f"mmusv: error: MMUSV_SIMD={value!r} in the environment: must be 'portable'"), err
+    for ok in ("portable", "PORTABLE", ""):
+        assert run_mmusv("version", env=child_env(MMUSV_SIMD=ok)).returncode == 0, ok
+
+
 def test_check_thread_environment_bounds() -> None:
     from mmusv.errors import ConfigError
     from mmusv.thread_env import THREADS_PER_CPU, check_thread_environment
