@@ -60,13 +60,19 @@ def cpu_model() -> str:
 
 def machine() -> str:
     """One line: CPU model, the CPUs this process may use of the machine's, OS, Python, the load average (the
-    machine may be shared: compare figures taken at the same load) and the thread variables the environment
-    sets."""
+    machine may be shared: compare figures taken at the same load), the core's code paths
+    (:func:`mmusv._core.simd_level`) and the variables the environment sets for them and the threads."""
     load = " ".join(f"{x:.2f}" for x in os.getloadavg())
     env = [f"{k}={os.environ[k]}" for k in ("RAYON_NUM_THREADS", "MMUSV_SIMD") if os.environ.get(k)]
+    try:  # the code paths the core runs in this process (AVX2 + FMA or portable), as it chose them
+        from mmusv._native import core
+
+        paths = f"; core paths {core.simd_level()}"
+    except ImportError:
+        paths = ""
     return (
         f"machine: {cpu_model()}, {available_cpus()} of {os.cpu_count()} CPUs available, {platform.system()} "
-        f"{platform.machine()}, Python {platform.python_version()}; load average {load}"
+        f"{platform.machine()}, Python {platform.python_version()}; load average {load}{paths}"
         + (f"; {', '.join(env)}" if env else "")
     )
 
