@@ -27,7 +27,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from mmusv.classes import SemanticClass, class_name
-from mmusv.export.common import Options, Sink
+from mmusv.export.common import Options, Sink, mask_box
 from mmusv.export.contrast import apparent_contrast
 from mmusv.export.writer import DatasetWriter
 from mmusv.recording import topics
@@ -100,17 +100,6 @@ class Sample:
         from mmusv.recording import decode_image
 
         return np.asarray(decode_image(self.message("rgb")))
-
-
-def mask_box(instance: np.ndarray, instance_id: int) -> tuple[int, int, int, int] | None:
-    """The tight box ``(x_min, y_min, x_max, y_max)`` of ``instance``'s pixels equal to ``instance_id`` in pixel-edge
-    coordinates (the last pixel's far edge: ``x_max`` = last column + 1), or ``None`` when there is none."""
-    mask = np.asarray(instance) == instance_id
-    cols = np.flatnonzero(mask.any(axis=0))
-    if cols.size == 0:
-        return None
-    rows = np.flatnonzero(mask.any(axis=1))
-    return int(cols[0]), int(rows[0]), int(cols[-1]) + 1, int(rows[-1]) + 1
 
 
 @dataclass
@@ -246,6 +235,7 @@ class CameraWriter(DatasetWriter):
             )
             if box.visible_pixels == 0:
                 continue
+            tight = None  # the tight box of the vessel's pixels, where worked out (``visible``)
             if visible:
                 tight = mask_box(sample.instance, box.instance_id)
                 if tight is None:  # no pixel of the vessel in the image
@@ -254,7 +244,11 @@ class CameraWriter(DatasetWriter):
                 box = replace(box, x_min=x0, y_min=y0, x_max=x1, y_max=y1)
             if measure:
                 c = apparent_contrast(
-                    rgb=sample.rgb, instance=sample.instance, instance_id=box.instance_id, other_ids=vessel_ids
+                    rgb=sample.rgb,
+                    instance=sample.instance,
+                    instance_id=box.instance_id,
+                    other_ids=vessel_ids,
+                    box=tight,
                 )
                 box = replace(box, contrast=c)
             self.visible_boxes += 1

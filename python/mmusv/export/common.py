@@ -28,6 +28,7 @@ __all__ = [
     "cav_id",
     "depth_png",
     "dump_yaml",
+    "mask_box",
     "parse_box",
     "parse_extras",
     "png_bytes",
@@ -181,3 +182,14 @@ def dump_yaml(data: Any) -> bytes:
     """YAML bytes with sorted keys, block style (as OpenCDA writes its files)."""
     text: str = yaml.dump(data, Dumper=_Dumper, default_flow_style=False, sort_keys=True, allow_unicode=False)
     return text.encode("utf-8")
+
+
+def mask_box(instance: np.ndarray, instance_id: int) -> tuple[int, int, int, int] | None:
+    """The tight box ``(x_min, y_min, x_max, y_max)`` of ``instance``'s pixels equal to ``instance_id`` in pixel-edge
+    coordinates (the last pixel's far edge: ``x_max`` = last column + 1), or ``None`` when there is none."""
+    mask = np.asarray(instance) == instance_id
+    cols = np.flatnonzero(mask.any(axis=0))
+    if cols.size == 0:
+        return None
+    rows = np.flatnonzero(mask.any(axis=1))
+    return int(cols[0]), int(rows[0]), int(cols[-1]) + 1, int(rows[-1]) + 1

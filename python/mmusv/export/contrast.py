@@ -14,7 +14,7 @@ bands of their own), over the rows ``r`` holding ``n_r`` of the vessel's pixels:
   ``r``;
 * ``L_b(r)``: the mean relative luminance of the *background ring*'s pixels in row ``r`` (the whole ring's mean
   where that row has none, e.g. a vessel cut by the image's edge): the ring is the pixels of the vessel's tight
-  box (the box of its pixels, :func:`mmusv.export.camera.mask_box`) grown by :func:`ring_margin` on each side
+  box (the box of its pixels, :func:`mmusv.export.common.mask_box`) grown by :func:`ring_margin` on each side
   and clipped to the image, less the vessel's own pixels, the pixels of the other vessels (``other_ids``) and the
   pixels next to the vessel's (its 8-neighbours: with anti-aliasing, ``quality`` ``standard`` or ``high``, they
   blend the vessel into its background). Where that leaves no pixel, the neighbours are taken back, then the
@@ -60,6 +60,7 @@ from collections.abc import Collection
 import numpy as np
 
 from mmusv.errors import InputError
+from mmusv.export.common import mask_box
 
 __all__ = [
     "LUMA_709",
@@ -125,6 +126,7 @@ def apparent_contrast(
     instance: np.ndarray,
     instance_id: int,
     other_ids: Collection[int] = (),
+    box: tuple[int, int, int, int] | None = None,
 ) -> float | None:
     """The Weber contrast of the vessel ``instance_id`` in a recorded image (see the module docstring for the
     definition, the ring and the night guard).
@@ -135,6 +137,8 @@ def apparent_contrast(
         instance_id: the vessel's instance id.
         other_ids: the instance ids of the other vessels, whose pixels are kept out of the ring (the vessel's own
             id among them is ignored).
+        box: the vessel's tight box ``(x_min, y_min, x_max, y_max)`` in pixel-edge coordinates, as
+            :func:`~mmusv.export.common.mask_box` gives it, when the caller has it already; ``None``: worked out.
 
     Returns:
         The contrast (the module docstring's row-weighted Weber contrast, each row's background floored at
@@ -150,16 +154,14 @@ def apparent_contrast(
         raise InputError(f"rgb must be an (H, W, 3) uint8 sRGB image, got shape {img.shape} and dtype {img.dtype}")
     if inst.shape != img.shape[:2]:
         raise InputError(f"instance must be (H, W) = {img.shape[:2]} like rgb, got {inst.shape}")
-    mask = inst == instance_id
-    cols = np.flatnonzero(mask.any(axis=0))
-    if cols.size == 0:
+    tight = mask_box(inst, instance_id) if box is None else box
+    if tight is None:
         return None
-    rows = np.flatnonzero(mask.any(axis=1))
     h, w = inst.shape
-    x0, x1, y0, y1 = int(cols[0]), int(cols[-1]) + 1, int(rows[0]), int(rows[-1]) + 1
+    x0, y0, x1, y1 = tight
     mx, my = ring_margin(x1 - x0, y1 - y0)
     gx0, gx1, gy0, gy1 = max(0, x0 - mx), min(w, x1 + mx), max(0, y0 - my), min(h, y1 + my)
-    vessel = mask[gy0:gy1, gx0:gx1]
+    vessel = inst[gy0:gy1, gx0:gx1] == instance_id  # every pixel of the vessel lies in its tight box
     lum = relative_luminance(img[gy0:gy1, gx0:gx1])  # the window only: the whole image per box is slow
     others = np.isin(inst[gy0:gy1, gx0:gx1], np.array([i for i in other_ids if i != instance_id], dtype=np.int64))
     # The vessel's 8-neighbours and itself (its mask dilated by one pixel; the window reaches >= 2 beyond it).
