@@ -122,10 +122,10 @@ def _encounter(kind: str) -> Callable[[FamilyInput], Layout]:
                 else:
                     psi = theta + float(rng.uniform(-0.14, 0.14))
                     if rng.uniform() < 0.5:
-                        speed = min(inp.ego.speed + float(rng.uniform(1.0, 3.0)), top_speed_mps(tgt.asset))
+                        speed = inp.ego.speed + float(rng.uniform(1.0, 3.0))
                     else:
-                        slower = max(0.5, inp.ego.speed - float(rng.uniform(0.8, 1.5)))
-                        speed = min(slower, top_speed_mps(tgt.asset))
+                        speed = max(0.5, inp.ego.speed - float(rng.uniform(0.8, 1.5)))
+                    speed = min(speed, top_speed_mps(tgt.asset))
                 v_t = speed * heading(psi)
                 ego_at = centre + v_e * (t_e - t0)
                 p = _cpa_point(ego_at, v_e, v_t, _range(inp), rng, ahead=kind == "crossing")
