@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
+from kitti_files import read_calib
 from mcap.reader import make_reader
 from mcap_protobuf.decoder import DecoderFactory
 from mmusv.acquire import run
@@ -85,14 +86,6 @@ def read(rec: Path) -> tuple[float, dict[int, Any], dict[str, list[int]]]:
     return float(meta["run"]["frequency_hz"]), world, times
 
 
-def numbers(path: Path) -> dict[str, np.ndarray]:
-    out = {}
-    for line in path.read_text().splitlines():
-        key, vals = line.split(":", 1)
-        out[key] = np.array([float(v) for v in vals.split()])
-    return out
-
-
 def homogeneous(rows: np.ndarray) -> np.ndarray:
     m = np.eye(4)
     m[:3, :] = rows.reshape(3, 4)
@@ -119,7 +112,7 @@ def test_kitti_label_centres_are_the_vessels_box_centres_in_every_frame_and_agen
     for cav, agent in agents.items():
         for k, ws in world.items():
             ts = f"{k:06d}"
-            calib = numbers(kitti / str(cav) / "calib" / f"{ts}.txt")
+            calib = read_calib(kitti / str(cav) / "calib" / f"{ts}.txt")
             r0 = np.eye(4)
             r0[:3, :3] = calib["R0_rect"].reshape(3, 3)
             cam_to_lidar = np.linalg.inv(r0 @ homogeneous(calib["Tr_velo_to_cam"]))
