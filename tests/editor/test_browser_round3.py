@@ -224,6 +224,34 @@ def test_a_sea_is_shown_set_and_replaced_by_a_wave(browser: Any, live_server: Li
     assert js_errors(browser) == []
 
 
+def test_a_number_beyond_a_double_in_a_json_box_is_refused(browser: Any, live_server: LiveServer) -> None:
+    """JSON.parse reads 1e999 as Infinity, which JSON.stringify sent to the server as null: a sea of
+    {"state": 1e999} became a sea without a state, and map parameters of {"n_moored": 1e999} a null parameter, with
+    no word. Now refused beside the box, naming the key, the document unchanged."""
+    env = {"time_of_day": "16:30", "weather": "clear", "sea": {"state": 5}}
+    write_scenario(live_server.folder, "huge.yaml", environment=env)
+    open_file(browser, live_server, "huge.yaml")
+    js_errors(browser)
+    sea = browser.find_element(By.ID, "e-sea")
+    type_into(browser, sea, '{"state": 1e999}')
+    settled(browser)
+    assert document_of(browser)["environment"]["sea"] == {"state": 5}
+    text = note(browser, "environment.sea")
+    assert "sea: state is too large to be a number" in text, text
+    type_into(browser, sea, '{"hs_m": 2, "tp_s": -1e999}')
+    settled(browser)
+    assert "sea: tp_s is too large" in note(browser, "environment.sea")
+    assert document_of(browser)["environment"]["sea"] == {"state": 5}
+    params = browser.find_element(By.ID, "m-params")
+    before = document_of(browser)["map"]
+    type_into(browser, params, '{"quays": [1, 1e999]}')
+    settled(browser)
+    assert document_of(browser)["map"] == before
+    assert "map parameters: quays.1 is too large" in note(browser, "map.params")
+    assert not browser.execute_script("return window.mmusvEditor.state.dirty")
+    assert js_errors(browser) == []
+
+
 def test_a_sea_fits_a_small_window(browser: Any, live_server: LiveServer) -> None:
     """The environment's new boxes keep the right panel from scrolling sideways at 800 x 600."""
     env = {"sea": {"hs_m": 2.5, "tp_s": 8.25, "gamma": 3.3, "direction_deg": 135, "spread_s": 25}, "motion": "physical"}

@@ -49,6 +49,19 @@ function isMapping(value) {
   return value !== null && typeof value === "object" && !Array.isArray(value);
 }
 
+/** The key path (`state`, `quays.0`) of the first number in the parsed JSON `value` that is not finite, or null:
+ * JSON.parse reads 1e999 as Infinity, which JSON.stringify then sends as null (a sea state of 1e999 became "no
+ * state" without a word). */
+function nonFinite(value, path = "") {
+  if (typeof value === "number") return Number.isFinite(value) ? null : path;
+  if (value === null || typeof value !== "object") return null;
+  for (const [key, item] of Object.entries(value)) {
+    const found = nonFinite(item, path ? `${path}.${key}` : key);
+    if (found !== null) return found;
+  }
+  return null;
+}
+
 /** A time of day as an <input type="time"> shows it ("HH:MM"): "6:05" and " 06:05 ", which the schema takes too,
  * become "06:05"; anything else is left as it is (the box then shows it empty, beside the schema's note). */
 function hhmm(text) {
@@ -711,6 +724,11 @@ export class Panels {
         this.refuse(ev.target, `map parameters: ${text} is not a JSON object; type one such as {"name": value}, or leave it empty for the map's defaults. The map keeps its parameters.`);
         return;
       }
+      const huge = nonFinite(params);
+      if (huge !== null) {
+        this.refuse(ev.target, `map parameters: ${huge} is too large to be a number (beyond ±1.8e308); type a finite number. The map keeps its parameters.`);
+        return;
+      }
       this.accept(ev.target);
       edit((d) => {
         if (params === null || (typeof params === "object" && !Object.keys(params).length)) delete d.map.params;
@@ -785,6 +803,11 @@ export class Panels {
       }
       if (sea !== null && !isMapping(sea)) {
         this.refuse(ev.target, `sea: ${text} is not a JSON object; ${allowed}`);
+        return;
+      }
+      const huge = nonFinite(sea);
+      if (huge !== null) {
+        this.refuse(ev.target, `sea: ${huge} is too large to be a number (beyond ±1.8e308); ${allowed}`);
         return;
       }
       this.accept(ev.target);
