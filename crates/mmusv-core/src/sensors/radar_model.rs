@@ -308,10 +308,9 @@ pub fn clutter_mean_sigma0(
     rain_mm_per_h: f64,
     r: f64,
 ) -> (f64, f64) {
-    let loss = RainLoss::new(band, rain_mm_per_h).at(r);
-    let sea =
-        if sigma0 > 0.0 && r <= model.sea_max_range_m { sigma0 * cell.sea_area(r) * range_term(r) * loss } else { 0.0 };
-    (sea, rain_mean(model, cell, band, rain_mm_per_h, r, range_term(r) * loss))
+    let (loss, rt) = (RainLoss::new(band, rain_mm_per_h).at(r), range_term(r));
+    let sea = if sigma0 > 0.0 && r <= model.sea_max_range_m { sigma0 * cell.sea_area(r) * rt * loss } else { 0.0 };
+    (sea, rain_mean(model, cell, band, rain_mm_per_h, r, rt * loss))
 }
 
 #[cfg(test)]
