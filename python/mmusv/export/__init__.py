@@ -2,12 +2,14 @@
 KITTI-style per-agent folders, ROS 2 bags, COCO, YOLO, MaSTr1325-style masks and SemanticKITTI (``docs/exports.md``).
 
 Modules, one job each: :mod:`~mmusv.recording.stream` (recording → frames), :mod:`~mmusv.export.convert` (the one
-job every format shares: reading, validation, splitting, frame selection, progress and its report),
+job every format shares: reading, validation, splitting, frame selection, progress and its report; with
+:mod:`~mmusv.export.convert_checks`, :mod:`~mmusv.export.convert_output` and :mod:`~mmusv.export.convert_report`),
 :mod:`~mmusv.export.writer` (the writer base and its hooks), :mod:`~mmusv.export.geometry` (sensor poses and
 targets per agent, mmusv frames), :mod:`~mmusv.export.splits` (train/validate/test by sequence),
 :mod:`~mmusv.export.camera` (what the image datasets share: samples, 2D boxes, box filter), the layouts
 (:mod:`~mmusv.export.opv2v`, :mod:`~mmusv.export.kitti`, :mod:`~mmusv.export.ros2` with
-:mod:`~mmusv.export.ros2_types`, :mod:`~mmusv.export.coco`, :mod:`~mmusv.export.yolo`, :mod:`~mmusv.export.mastr`,
+:mod:`~mmusv.export.ros2_names`, :mod:`~mmusv.export.ros2_msgs` and :mod:`~mmusv.export.ros2_types`,
+:mod:`~mmusv.export.coco`, :mod:`~mmusv.export.yolo`, :mod:`~mmusv.export.mastr`,
 :mod:`~mmusv.export.semantickitti`; frame changes only through :mod:`mmusv.frames`), :mod:`~mmusv.export.pcd`
 (Open3D-style ASCII PCD) and :mod:`~mmusv.export.cli` (the command).
 """

@@ -12,11 +12,13 @@ forward) → ``<usv>/camera_<name>_optical`` (x right, y down, z forward) on ``/
 every other vessel ``map`` → ``<vessel>/base_link`` on ``/tf``; the top-view camera ``map`` →
 ``<usv>/top_view_optical`` on ``/tf``. Topic names spell vessel ids and camera names as ROS 2 name tokens
 (:func:`ros_token`: ``usv-1`` → ``usv_1``, ``2b`` → ``_2b``); frame ids keep them as they are.
+
+The frame ids and topic names are :mod:`mmusv.export.ros2_names`'s, the messages built by
+:mod:`mmusv.export.ros2_msgs`; this module writes them into the bag.
 """
 
 from __future__ import annotations
 
-import re
 from typing import Any, ClassVar, Literal
 
 import numpy as np
@@ -24,6 +26,21 @@ from scipy.spatial.transform import Rotation
 
 from mmusv.classes import class_name
 from mmusv.errors import ConfigError
+from mmusv.export.ros2_msgs import Msgs, stamp
+from mmusv.export.ros2_names import (
+    MAP_FRAME,
+    base_link,
+    camera_frame,
+    camera_info_topic,
+    detections_2d_topic,
+    detections_3d_topic,
+    odom_frame,
+    odom_topic,
+    optical_frame,
+    ros_token,
+    ros_topic,
+    top_view_frame,
+)
 from mmusv.export.writer import DatasetWriter
 from mmusv.frames import BODY_TO_OPTICAL, pose_matrices
 from mmusv.recording import topics
@@ -48,7 +65,6 @@ __all__ = [
     "top_view_frame",
 ]
 
-MAP_FRAME = "map"
 TF_TOPIC = "/tf"
 TF_STATIC_TOPIC = "/tf_static"
 CLOCK_TOPIC = "/clock"
@@ -68,69 +84,6 @@ ROLE_COLOURS = {"usv": (0.2, 0.9, 0.9, 0.5), "target": (1.0, 0.3, 0.2, 0.5), "mo
 """RViz box colour (r, g, b, a) per vessel role."""
 
 
-def base_link(vessel: str) -> str:
-    """``<vessel>/base_link``: the vessel body (x forward, y left, z up)."""
-    return f"{vessel}/base_link"
-
-
-def odom_frame(agent: str) -> str:
-    """``<usv>/odom``: the odometry frame of an instrumented USV (ground truth: the same as ``map``)."""
-    return f"{agent}/odom"
-
-
-def camera_frame(agent: str, name: str) -> str:
-    """``<usv>/camera_<name>``: camera body frame (x forward = optical axis, y left, z up)."""
-    return f"{agent}/camera_{name}"
-
-
-def optical_frame(agent: str, name: str) -> str:
-    """``<usv>/camera_<name>_optical``: the camera's optical frame (x right, y down, z forward; REP 103)."""
-    return f"{camera_frame(agent, name)}_optical"
-
-
-def top_view_frame(agent: str) -> str:
-    """``<usv>/top_view_optical``: optical frame of the agent's top-view camera."""
-    return f"{agent}/top_view_optical"
-
-
-_NOT_IN_ROS_NAMES = re.compile(r"[^A-Za-z0-9_]")
-
-
-def ros_token(name: str) -> str:
-    """``name`` (a vessel id, a camera name) as a ROS 2 name token: letters, digits and ``_``, not starting with a
-    digit (``rcl_validate_topic_name``). mmusv's names may hold ``-`` and start with a digit: each other character
-    becomes ``_`` and a leading digit gets a ``_`` before it (``usv-1`` → ``usv_1``, ``2b`` → ``_2b``); a valid token
-    is kept as it is."""
-    token = _NOT_IN_ROS_NAMES.sub("_", name)
-    return f"_{token}" if token[:1].isdigit() else token
-
-
-def ros_topic(topic: str) -> str:
-    """The bag's name for a topic spelled from mmusv names (``/usv-1/camera/front-wide/rgb`` →
-    ``/usv_1/camera/front_wide/rgb``): every token through :func:`ros_token`, so ``ros2 bag play`` can publish it."""
-    return "/".join(ros_token(t) if t else t for t in topic.split("/"))
-
-
-def odom_topic(agent: str) -> str:
-    """``/<usv>/odom``: ``nav_msgs/Odometry``."""
-    return ros_topic(f"/{agent}/odom")
-
-
-def camera_info_topic(agent: str, name: str) -> str:
-    """``/<usv>/camera/<name>/camera_info``."""
-    return ros_topic(f"{topics.camera(agent, name)}/camera_info")
-
-
-def detections_2d_topic(agent: str, name: str) -> str:
-    """``/<usv>/camera/<name>/detections``: ``vision_msgs/Detection2DArray``."""
-    return ros_topic(f"{topics.camera(agent, name)}/detections")
-
-
-def detections_3d_topic(agent: str) -> str:
-    """``/<usv>/detections``: ``vision_msgs/Detection3DArray`` in the LiDAR frame."""
-    return ros_topic(f"/{agent}/detections")
-
-
 def camera_distortion(agent: AgentInfo, name: str) -> np.ndarray:
     """``(5,)`` float64 ``[k1, k2, p1, p2, k3]`` of the agent's camera ``name`` as recorded beside its intrinsics
     (or, in older recordings, in its rig; OpenCV's order, which is ROS's ``plumb_bob``); zeros for a camera
@@ -142,101 +95,6 @@ def camera_distortion(agent: AgentInfo, name: str) -> np.ndarray:
         if isinstance(c, dict) and c.get("name") == name and c.get("distortion") is not None:
             return np.asarray(c["distortion"], dtype=np.float64).reshape(5)
     return np.zeros(5)
-
-
-def _stamp(ts: Any, t_ns: int) -> Any:
-    return ts.types["builtin_interfaces/msg/Time"](sec=int(t_ns // 1_000_000_000), nanosec=int(t_ns % 1_000_000_000))
-
-
-class _Msgs:
-    """Builds messages of the typestore ``ts`` from numpy values."""
-
-    def __init__(self, ts: Any) -> None:
-        self.ts = ts
-        self.T = ts.types
-
-    def header(self, t_ns: int, frame_id: str) -> Any:
-        return self.T["std_msgs/msg/Header"](stamp=_stamp(self.ts, t_ns), frame_id=frame_id)
-
-    def vector3(self, v: Any) -> Any:
-        return self.T["geometry_msgs/msg/Vector3"](x=float(v[0]), y=float(v[1]), z=float(v[2]))
-
-    def quaternion(self, q: Any) -> Any:
-        return self.T["geometry_msgs/msg/Quaternion"](x=float(q[0]), y=float(q[1]), z=float(q[2]), w=float(q[3]))
-
-    def pose(self, m: np.ndarray) -> Any:
-        t = m[:3, 3]
-        return self.T["geometry_msgs/msg/Pose"](
-            position=self.T["geometry_msgs/msg/Point"](x=float(t[0]), y=float(t[1]), z=float(t[2])),
-            orientation=self.quaternion(Rotation.from_matrix(m[:3, :3]).as_quat()),
-        )
-
-    def transform(self, t_ns: int, parent: str, child: str, m: np.ndarray) -> Any:
-        tr = self.T["geometry_msgs/msg/Transform"](
-            translation=self.vector3(m[:3, 3]), rotation=self.quaternion(Rotation.from_matrix(m[:3, :3]).as_quat())
-        )
-        return self.T["geometry_msgs/msg/TransformStamped"](
-            header=self.header(t_ns, parent), child_frame_id=child, transform=tr
-        )
-
-    def tf(self, transforms: list[Any]) -> Any:
-        return self.T["tf2_msgs/msg/TFMessage"](transforms=transforms)
-
-    def point_cloud(self, t_ns: int, frame_id: str, cloud: dict[str, np.ndarray], fields: list[str]) -> Any:
-        """A dense ``PointCloud2`` (height 1, little-endian, fields packed in the order given)."""
-        pf = self.T["sensor_msgs/msg/PointField"]
-        codes = {
-            np.dtype("int8"): pf.INT8,
-            np.dtype("uint8"): pf.UINT8,
-            np.dtype("int16"): pf.INT16,
-            np.dtype("uint16"): pf.UINT16,
-            np.dtype("int32"): pf.INT32,
-            np.dtype("uint32"): pf.UINT32,
-            np.dtype("float32"): pf.FLOAT32,
-            np.dtype("float64"): pf.FLOAT64,
-        }
-        names = [f for f in fields if f in cloud]
-        n = len(cloud[names[0]]) if names else 0
-        dtype = np.dtype([(f, cloud[f].dtype.newbyteorder("<")) for f in names])
-        packed = np.empty(n, dtype=dtype)
-        for f in names:
-            packed[f] = cloud[f]
-        out_fields = [
-            pf(name=f, offset=int(dtype.fields[f][1]), datatype=int(codes[np.dtype(cloud[f].dtype.name)]), count=1)
-            for f in names
-            if dtype.fields is not None
-        ]
-        return self.T["sensor_msgs/msg/PointCloud2"](
-            header=self.header(t_ns, frame_id),
-            height=1,
-            width=n,
-            fields=out_fields,
-            is_bigendian=False,
-            point_step=dtype.itemsize,
-            row_step=dtype.itemsize * n,
-            data=np.frombuffer(packed.tobytes(), dtype=np.uint8),
-            is_dense=True,
-        )
-
-    def image(self, t_ns: int, frame_id: str, img: np.ndarray, encoding: str) -> Any:
-        """A ``sensor_msgs/Image`` of ``img`` (``(H, W)`` or ``(H, W, 3)``, little-endian, rows top to bottom)."""
-        a = np.ascontiguousarray(img)
-        a = a.astype(a.dtype.newbyteorder("<"), copy=False)
-        h, w = a.shape[:2]
-        return self.T["sensor_msgs/msg/Image"](
-            header=self.header(t_ns, frame_id),
-            height=h,
-            width=w,
-            encoding=encoding,
-            is_bigendian=0,
-            step=int(a.strides[0]),
-            data=np.frombuffer(a.tobytes(), dtype=np.uint8),
-        )
-
-    def compressed(self, t_ns: int, frame_id: str, data: bytes, fmt: str) -> Any:
-        return self.T["sensor_msgs/msg/CompressedImage"](
-            header=self.header(t_ns, frame_id), format=fmt, data=np.frombuffer(data, dtype=np.uint8)
-        )
 
 
 class Ros2Writer(DatasetWriter):
@@ -253,7 +111,7 @@ class Ros2Writer(DatasetWriter):
 
         self.extra_counts = {}
         self.ts = typestore()
-        self.m = _Msgs(self.ts)
+        self.m = Msgs(self.ts)
         self.bag: Any = None
         self.connections: dict[str, Any] = {}
         for a in self.agents:
@@ -346,7 +204,7 @@ class Ros2Writer(DatasetWriter):
         self._put(
             CLOCK_TOPIC,
             "rosgraph_msgs/msg/Clock",
-            self.ts.types["rosgraph_msgs/msg/Clock"](clock=_stamp(self.ts, t)),
+            self.ts.types["rosgraph_msgs/msg/Clock"](clock=stamp(self.ts, t)),
             t,
         )
         self._put(TF_TOPIC, "tf2_msgs/msg/TFMessage", m.tf(self._dynamic(frame, world)), t)

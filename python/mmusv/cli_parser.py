@@ -1,0 +1,110 @@
+"""The arguments of the ``mmusv`` command (:func:`parser`): its subcommands and their options, those of
+``convert``, ``generate``, ``editor``, ``train``, ``dataset`` and ``study detection`` / ``robustness`` added by
+their own ``cli`` modules. :func:`mmusv.cli.main` parses with it.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+__all__ = ["BUNDLED_WAVE_SCENARIO", "parser"]
+
+BUNDLED_WAVE_SCENARIO = "scenarios/island_port_waves.yaml"
+
+
+def parser() -> argparse.ArgumentParser:
+    """The ``mmusv`` command's argument parser, every subcommand in it."""
+    p = argparse.ArgumentParser(
+        prog="mmusv", description="Headless maritime multi-USV simulator and dataset generator."
+    )
+    from mmusv import __version__
+
+    p.add_argument("--version", action="version", version=f"mmusv {__version__}", help="print the version and exit")
+    sub = p.add_subparsers(dest="command", required=True)
+    sub.add_parser("version", help="print the version")
+    p_assets = sub.add_parser("assets", help="list the vessel library")
+    p_assets.add_argument("--render", metavar="DIR", help="also write a close-up PNG per asset and contact_sheet.png")
+    sub.add_parser("scenarios", help="list the bundled scenarios (mmusv run NAME runs one from any directory)")
+    study = sub.add_parser("study", help="reproduce the paper's experiments")
+    studies = study.add_subparsers(dest="study", required=True)
+    waves = studies.add_parser("waves", help="Table I: heave/roll/pitch RMS under W0..W3")
+    waves.add_argument(
+        "--scenario", default=BUNDLED_WAVE_SCENARIO, help=f"scenario YAML (default {BUNDLED_WAVE_SCENARIO})"
+    )
+    waves.add_argument(
+        "-o", "--output", default="out/wave_study", help="output folder for CSV and plot (default out/wave_study)"
+    )
+    waves.add_argument("--frames", type=int, default=None, help="override the scenario's frame count")
+    waves.add_argument(
+        "--motion",
+        choices=("paper", "physical"),
+        default="paper",
+        help="paper: Table I with the paper's formula (default); physical: every hull's response to the sea",
+    )
+    agree = studies.add_parser("agreement", help="Table II: 3D-box annotations vs top-view semantic rendering")
+    agree.add_argument("scenarios", nargs="*", help="scenario YAMLs (default: the three bundled map scenarios)")
+    agree.add_argument(
+        "-o", "--output", default="out/agreement_study", help="output folder (default out/agreement_study)"
+    )
+    agree.add_argument("--frames", type=int, default=None, help="frames per scenario (default: all)")
+    from mmusv.studies.detection.cli import add_parsers as add_detection_parsers
+
+    add_detection_parsers(studies)
+    run = sub.add_parser("run", help="run a scenario (or a folder of them) into an MCAP recording + Parquet tables")
+    run.add_argument("scenario", help="scenario YAML, or a folder of scenario YAMLs")
+    run.add_argument("-o", "--output", default="out", help="output folder (default out/)")
+    run.add_argument("--overwrite", action="store_true", help="replace an existing recording")
+    run.add_argument("--frames", type=int, default=None, help="run only the first N frames")
+    run.add_argument(
+        "--jobs", type=int, default=1, help="for a folder: scenarios run in parallel processes (default 1)"
+    )
+    from mmusv.batch.cli import add_dataset_parser, add_run_options
+
+    add_run_options(run)
+    add_dataset_parser(sub)
+    run.add_argument(
+        "--no-checks",
+        action="store_true",
+        help="skip the route checks on the map (in water: an error; clearances, separation: warnings)",
+    )
+    run.add_argument(
+        "--profile",
+        action="store_true",
+        help="print the time per stage per frame (each sensor, annotation, encoding, writing, the rest)",
+    )
+    info = sub.add_parser(
+        "info", help="agents, topics, frames and duration of a recording; damage and missing frames if any"
+    )
+    info.add_argument("recording", help="an .mcap (or .mcap.partial, .parts.json) written by mmusv run, or its folder")
+    rec = sub.add_parser(
+        "recover",
+        help="finish the .partial recording of a killed run into a valid MCAP (summary, index) and rebuild its tables",
+    )
+    rec.add_argument("target", help="the run folder (holding NAME.mcap.partial) or the .partial file")
+    rec.add_argument("--overwrite", action="store_true", help="replace an existing NAME.mcap")
+    prev = sub.add_parser("preview", help="one picture of a recorded frame (surround RGB, depth, semantic, PPI, BEV)")
+    prev.add_argument("recording", help="an .mcap (or .mcap.partial, .parts.json) written by mmusv run")
+    prev.add_argument("--frame", type=int, default=0, help="acquisition index (default 0)")
+    prev.add_argument("--agent", default=None, help="USV id (default: the first that recorded a picture)")
+    prev.add_argument(
+        "-o",
+        "--output",
+        default=None,
+        help="picture path (.png, .jpg) or an existing folder (default: next to the recording, "
+        "NAME_frameNNNNNN_AGENT.png)",
+    )
+    schema = sub.add_parser(
+        "schema", help="print the JSON Schema of scenario or spec files (for editors: yaml-language-server)"
+    )
+    schema.add_argument("kind", choices=("scenario", "spec"), help="scenario files or generation specs")
+    schema.add_argument("-o", "--output", default=None, help="write it to this file (default: the standard output)")
+    from mmusv.editor.cli import add_parser as add_editor_parser
+    from mmusv.export.cli import add_parser as add_convert_parser
+    from mmusv.generate.cli import add_parser as add_generate_parser
+    from mmusv.learn.cli import add_parser as add_train_parser
+
+    add_generate_parser(sub)
+    add_convert_parser(sub)
+    add_editor_parser(sub)
+    add_train_parser(sub)
+    return p

@@ -1,0 +1,185 @@
+"""The subcommands that read a recorded run: ``mmusv info`` (agents, topics, frames and duration; damage,
+missing frames and table problems), ``mmusv preview`` (one picture of a frame) and ``mmusv recover`` (a killed
+run's ``.partial`` finished into a valid recording).
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from mmusv.cli_console import rich_console
+from mmusv.cli_paths import output_arg, path_arg
+from mmusv.errors import MmusvError
+
+__all__ = ["cmd_info", "cmd_preview", "cmd_recover"]
+
+
+def cmd_info(args: argparse.Namespace) -> int:
+    from rich.table import Table
+
+    from mmusv.recording import summary
+    from mmusv.recording.info import recording_name
+
+    target = Path(path_arg(args.recording, flag="recording"))
+    folder: Path | None = None
+    if target.is_dir():  # a run folder: its recording (finished, else the .partial) and its tables
+        folder = target
+        found = sorted(target.glob("*.parts.json")) or sorted(target.glob("*.mcap"))
+        found = found or sorted(target.glob("*.mcap.partial"))
+        if not found:
+            raise MmusvError(
+                f"{target} is a folder without a recording (*.mcap, *.mcap.partial or *.parts.json)"
+                + _recordings_below(target)
+            )
+        if len(found) > 1:
+            raise MmusvError(f"{target} holds {len(found)} recordings ({', '.join(f.name for f in found)}); name one")
+        target = found[0]
+    info = summary(target)
+    console = rich_console()
+    meta = info.get("metadata", {})
+    run_meta = meta.get("run", {})
+    frames = info.get("frames") or {}
+    if not info.get("complete", True):
+        console.print(
+            "[yellow]incomplete recording (.partial, no summary or damaged): counts come from reading every "
+            "chunk[/yellow]"
+        )
+    if info.get("frames") is None:  # an MCAP file, but not a recording of mmusv run: its messages only
+        console.print(
+            f"[bold]{target}[/bold]: an MCAP file not written by mmusv run (no scenario/sensors metadata): its "
+            "messages only",
+            markup=True,
+            highlight=False,
+        )
+    else:
+        written = run_meta.get("frames_written", "?")
+        if frames:  # the complete frames read: a killed run's .partial has no run metadata saying it ("? frames")
+            read, expected = frames["read"], frames["expected"]
+            written = str(read) if read == expected else f"{read} of {expected}"
+        console.print(
+            f"[bold]{target}[/bold]: scenario {run_meta.get('scenario') or _scenario_of(meta, target)}, "
+            f"status {run_meta.get('status', 'unfinished (no run metadata: the run was killed or is still going)')}, "
+            f"{written} frames, agents {run_meta.get('agents') or _agents_of(meta)}",
+            markup=True,
+            highlight=False,
+        )
+    start, end = info.get("start_ns", 0), info.get("end_ns", 0)
+    console.print(
+        f"time {start / 1e9:.3f} .. {end / 1e9:.3f} s (duration {(end - start) / 1e9:.3f} s), "
+        f"{info.get('messages', 0)} messages"
+    )
+    table = Table(title="topics")
+    for col in ("topic", "schema", "messages"):
+        table.add_column(col)
+    for topic, t in sorted(info.get("topics", {}).items()):
+        table.add_row(topic, t["schema"], str(t["messages"]))
+    console.print(table)
+    problems = [frames["report"]] if frames and frames.get("report") else list(info.get("damage", []))
+    if folder is not None and frames:
+        problems += _table_problems(target, frames)
+    for line in problems:
+        console.print(f"mmusv: warning: {line}", markup=False, highlight=False, style="yellow")
+    if target.name.endswith(".mcap.partial"):
+        if frames and frames.get("read"):
+            console.print(
+                f"`mmusv recover {target.parent}` finishes it into {recording_name(target)}.mcap with its tables"
+            )
+        else:  # recover refuses a .partial without a complete frame: nothing to finish
+            console.print(
+                f"it holds no complete frame: nothing to recover (`mmusv run` on {target.parent} records it again)"
+            )
+    return 0
+
+
+def _scenario_of(meta: dict[str, dict[str, str]], target: Path) -> str:
+    """The scenario's name as its ``scenario`` metadata says (a killed run has no ``run`` metadata), else the
+    recording's name."""
+    from mmusv.recording.info import recording_name
+
+    name = (meta.get("scenario") or {}).get("name")
+    return str(name) if name else recording_name(target)
+
+
+def _agents_of(meta: dict[str, dict[str, str]]) -> str:
+    """The agents the ``sensors`` metadata names (a killed run has no ``run`` metadata saying them), else ``?``."""
+    import json
+
+    try:
+        sensors = json.loads(meta["sensors"]["json"])
+    except (KeyError, TypeError, ValueError):
+        return "?"
+    return ",".join(map(str, sensors)) if isinstance(sensors, dict) and sensors else "?"
+
+
+def _recordings_below(folder: Path) -> str:
+    """``"; below it: a, b (name one)"``: the recordings in the folders below ``folder`` (a batch's output
+    folder), or ``""``."""
+    from mmusv.recording.info import find_recordings
+
+    try:
+        found = find_recordings(folder)
+    except MmusvError:
+        return ""
+    if not found:
+        return ""
+    names = [str(f.relative_to(folder)) for f in found[:5]]
+    more = f" and {len(found) - 5} more" if len(found) > 5 else ""
+    return f"; below it: {', '.join(names)}{more} (name one)"
+
+
+def _table_problems(recording: Path, frames: dict[str, object]) -> list[str]:
+    """What is wrong with the Parquet tables beside ``recording`` (damaged parts, frames without rows): those of
+    its run folder, or for a parts manifest those of each recorded part's folder."""
+    from mmusv.recording.parts import is_parts_manifest, part_files
+
+    missing = set(frames.get("missing", []))  # type: ignore[call-overload]
+    if not is_parts_manifest(recording):
+        first = frames.get("first", 0)
+        expected = frames.get("expected")
+        span = range(first, first + expected) if isinstance(first, int) and isinstance(expected, int) else None
+        return _tables_of(recording.parent / "tables", span, missing)
+    out = []
+    for first, stop, f in part_files(recording):
+        if f is not None:  # a part not recorded yet: its frames are said missing above
+            out += _tables_of(f.parent / "tables", range(first, stop), missing)
+    return out
+
+
+def _tables_of(tables: Path, span: range | None, missing: set[int]) -> list[str]:
+    from mmusv.recording.tables import SCHEMAS, read_table
+
+    if not tables.is_dir():
+        if span is not None and all(k in missing for k in span):  # no frame recorded, so no table either
+            return []
+        return [f"{tables} does not exist (a run killed before its first table flush; `mmusv recover` rebuilds it)"]
+    out = []
+    for name in SCHEMAS:
+        got = read_table(tables, name, expected=span if name == "world_state" else None)
+        got.missing = [k for k in got.missing if k not in missing]  # frames the recording lacks too: said above
+        line = got.report()
+        if line is not None:
+            out.append(line)
+    return out
+
+
+def cmd_recover(args: argparse.Namespace) -> int:
+    from mmusv.recording.recover import recover
+
+    res = recover(path_arg(args.target, flag="target"), overwrite=args.overwrite)
+    for line in res.lines():
+        print(line)
+    return 0
+
+
+def cmd_preview(args: argparse.Namespace) -> int:
+    from mmusv import arguments
+    from mmusv.preview import write_preview
+
+    path_arg(args.recording, flag="recording")
+    if args.output is not None:
+        output_arg(args.output)
+    arguments.whole(args.frame, name="--frame", lo=0)  # -1 was "frame -1 is not in ...", not what is allowed
+    out = write_preview(args.recording, frame=args.frame, agent=args.agent, output=args.output)
+    print(f"wrote {out}")
+    return 0

@@ -1,0 +1,161 @@
+"""What a conversion (:func:`mmusv.export.convert`) checks before it writes anything: its options (the 2D box and
+contrast filters, the agents and frames selected) and the recordings given (files, or batch output folders as their
+complete recordings; the selected agents and frames in them), each refused with a
+:class:`~mmusv.errors.ConfigError` or :class:`~mmusv.errors.IoError` naming the argument."""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Iterable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+from mmusv import arguments
+from mmusv.errors import ConfigError, IoError
+from mmusv.export.contrast import MAX_CONTRAST
+from mmusv.export.writer import DatasetWriter
+from mmusv.recording.info import RecordingInfo
+from mmusv.recording.stream import FrameStream
+
+__all__ = [
+    "agent_selection",
+    "as_list",
+    "box_filter",
+    "check_agents",
+    "contrast_filter",
+    "frame_selection",
+    "outside_frames",
+]
+
+
+def as_list(recordings: str | Path | Iterable[str | Path]) -> list[Path]:
+    """The recordings given: files (``.mcap``, parts manifests) as they are, a folder holding a ``dataset.json``
+    (a batch run's output) as its complete recordings."""
+    from mmusv.batch.index import dataset_recordings, find_index
+
+    if isinstance(recordings, (str, os.PathLike)):
+        given = [arguments.path(recordings, name="recordings")]
+    elif isinstance(recordings, (bytes, Mapping)) or not isinstance(recordings, Iterable):
+        raise ConfigError(
+            f"recordings = {arguments.shown(recordings)}: must be a path (str or pathlib.Path) or a list of paths"
+        )
+    else:
+        given = [arguments.path(r, name=f"recordings[{i}]") for i, r in enumerate(recordings)]
+    out: list[Path] = []
+    for p in given:
+        if p.is_dir():
+            index = find_index(p)
+            if index is None:
+                raise IoError(
+                    f"{p} is not a file but a folder without a dataset.json; give recordings (.mcap, .parts.json) "
+                    "or a batch output folder"
+                )
+            found = dataset_recordings(index)
+            if not found:
+                raise ConfigError(f"{index} lists no complete recording")
+            out.extend(found)
+        else:
+            out.append(p)
+    if not out:
+        raise ConfigError("no recordings given")
+    return out
+
+
+def box_filter(min_box_px: Any, max_occlusion: Any) -> tuple[float, float]:
+    px = arguments.real(min_box_px, name="min_box_px", unit="pixels", finite=False)
+    occ = arguments.real(max_occlusion, name="max_occlusion", finite=False)
+    if not (math.isfinite(px) and px >= 0):
+        raise ConfigError(f"min_box_px = {min_box_px!r}: must be a finite number of pixels >= 0")
+    if not (math.isfinite(occ) and 0 <= occ <= 1):
+        raise ConfigError(f"max_occlusion = {max_occlusion!r}: must be a fraction in [0, 1]")
+    return px, occ
+
+
+def contrast_filter(min_contrast: Any) -> float | None:
+    """``min_contrast`` as a float in ``[0, MAX_CONTRAST]``, or ``None``; :class:`~mmusv.errors.ConfigError` naming it
+    otherwise."""
+    if min_contrast is None:
+        return None
+    allowed = (
+        f"must be a Weber contrast >= 0 and <= {MAX_CONTRAST:.1f} (the largest an 8-bit image holds; 0.05 is the "
+        "WMO's visibility threshold), or None to keep every box"
+    )
+    c = arguments.real(min_contrast, name="min_contrast", finite=False)
+    if not (math.isfinite(c) and 0 <= c <= MAX_CONTRAST):
+        raise ConfigError(f"min_contrast = {arguments.shown(min_contrast)}: {allowed}")
+    return c
+
+
+def agent_selection(agents: Iterable[str] | str | None) -> tuple[str, ...] | None:
+    """``agents`` (a list of ids or ``"usv_1,usv_2"``) as sorted unique ids, or ``None``; an empty selection or an
+    id that is not a string is a :class:`~mmusv.errors.ConfigError` naming ``agents``."""
+    if agents is None:
+        return None
+    if isinstance(agents, str):
+        items = [a.strip() for a in agents.split(",")]
+    elif isinstance(agents, Iterable):
+        items = list(agents)
+    else:
+        raise ConfigError(f"agents = {arguments.shown(agents)}: must be agent ids (a list or 'usv_1,usv_2')")
+    if not all(isinstance(a, str) and a for a in items) or not items:
+        raise ConfigError(
+            f"agents = {arguments.shown(agents)}: must be one or more agent ids (non-empty strings, comma-separated)"
+        )
+    return tuple(sorted(set(items)))
+
+
+def outside_frames(infos: list[RecordingInfo], frames: tuple[int, int | None] | None) -> dict[int, str]:
+    """Per recording (index in ``infos``) that holds none of ``frames`` by its run's own account, why; a
+    :class:`~mmusv.errors.ConfigError` before anything is written when no recording holds one."""
+    if frames is None:
+        return {}
+    out: dict[int, str] = {}
+    for j, info in enumerate(infos):
+        try:
+            FrameStream(info, lambda _t: False, frames=frames)  # refuses a range outside what the run wrote
+        except ConfigError as exc:
+            out[j] = str(exc).split(": ", 1)[1]
+    if out and len(out) == len(infos):
+        stop = "" if frames[1] is None else frames[1]
+        raise ConfigError(f"frames = {frames[0]}:{stop}: " + "; ".join(out[j] for j in sorted(out)))
+    return out
+
+
+def frame_selection(frames: Sequence[int | None] | str | None) -> tuple[int, int | None] | None:
+    """``frames`` (``(start, stop)`` or ``"start:stop"``, ``stop`` excluded and optional) as ``(start, stop)``, or
+    ``None``; :class:`~mmusv.errors.ConfigError` naming ``frames`` unless ``0 <= start < stop``."""
+    if frames is None:
+        return None
+    shown = arguments.shown(frames)
+    if isinstance(frames, str):
+        head, sep, tail = frames.partition(":")
+        if not sep or not head.strip().isdigit() or not (tail.strip().isdigit() or tail.strip() == ""):
+            raise ConfigError(f"frames = {shown}: must be START:STOP (acquisition indices, STOP excluded or empty)")
+        pair: list[Any] = [int(head), int(tail) if tail.strip() else None]
+    elif isinstance(frames, Sequence) and len(frames) == 2:
+        pair = [frames[0], frames[1]]
+    else:
+        raise ConfigError(f"frames = {shown}: must be (start, stop) or 'START:STOP'")
+    start = arguments.whole(pair[0], name="frames start", lo=0)
+    stop = None if pair[1] is None else arguments.whole(pair[1], name="frames stop", lo=start + 1)
+    return start, stop
+
+
+def check_agents(cls: type[DatasetWriter], infos: list[RecordingInfo], agents: tuple[str, ...]) -> None:
+    """Every selected agent is an agent of some recording, and every recording holds a selected agent the format
+    uses (:class:`~mmusv.errors.ConfigError` naming the ids or the recording otherwise)."""
+    known = sorted({a.id for i in infos for a in i.agents})
+    unknown = [a for a in agents if a not in known]
+    if unknown:
+        raise ConfigError(
+            f"agents: {', '.join(unknown)} {'is not an agent' if len(unknown) == 1 else 'are not agents'} of the "
+            f"recordings (their agents: {', '.join(known)})"
+        )
+    for i in infos:
+        if not any(a.id in agents and cls.uses_agent(a) is None for a in i.agents):
+            unusable = [f"{a.id} {cls.uses_agent(a)}" for a in i.agents if a.id in agents]
+            raise ConfigError(
+                f"{i.path}: no selected agent ({', '.join(agents)}) to convert to {cls.format_name()}: "
+                + (f"{'; '.join(unusable)}" if unusable else f"its agents are {', '.join(a.id for a in i.agents)}")
+            )

@@ -1,0 +1,117 @@
+"""The output folder of a conversion (:func:`mmusv.export.convert`): checked, locked against a second conversion
+into it, and, when ``overwrite`` replaces a previous conversion, written as a staging folder beside it that is
+swapped in only once the new conversion is complete (the previous one stays when it fails)."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import shutil
+from collections.abc import Iterator
+from pathlib import Path
+
+from mmusv.errors import IoError
+from mmusv.export.convert_report import REPORT_NAME
+from mmusv.recording.guard import FolderLock
+
+__all__ = ["prepare_out", "staged"]
+
+
+def prepare_out(out: Path, overwrite: bool, inputs: list[Path]) -> tuple[Path, FolderLock]:
+    """Checks ``out``, locks it (:class:`~mmusv.recording.guard.FolderLock`: a second conversion into it, from
+    another process or thread, is refused instead of mixing its files with this one's) and returns the folder to
+    write into, with the lock to release when done: ``out`` itself (created), or, when ``overwrite`` replaces a
+    previous conversion there, a staging folder beside it that :func:`staged` swaps in once the new conversion is
+    complete, so that one failing halfway (a full disk) leaves the previous one as it was. Where ``out`` cannot be
+    swapped (it is, or holds, the working folder, e.g. ``-o .``; it is a link; its parent takes no new folder) the
+    previous conversion is emptied in place instead."""
+    if out.exists() and not out.is_dir():
+        raise IoError(f"output {out} exists and is not a folder")
+    # The output folder is replaced on --overwrite: it may not hold a recording being converted.
+    home = out.resolve()
+    for p in inputs:
+        where = p.resolve()
+        if where == home or home in where.parents:
+            raise IoError(
+                f"output folder {out} holds {p}, which is being converted; write the conversion to another folder"
+            )
+    lock = FolderLock.create(out, what="mmusv convert")
+    try:
+        return _prepare_locked(out, home, overwrite), lock
+    except BaseException:
+        lock.release()
+        raise
+
+
+def _prepare_locked(out: Path, home: Path, overwrite: bool) -> Path:
+    """:func:`prepare_out` once ``out`` exists and is locked."""
+    if any(out.iterdir()):
+        if not overwrite:
+            raise IoError(
+                f"output folder {out} already exists and is not empty; pass overwrite=True (--overwrite) to replace it"
+            )
+        if not (out / REPORT_NAME).is_file():
+            raise IoError(
+                f"output folder {out} is not empty and holds no {REPORT_NAME} from a previous conversion; "
+                "refusing to delete it, choose another folder"
+            )
+        here = Path.cwd().resolve()
+        if not out.is_symlink() and home != here and home not in here.parents:
+            _remove_stale_stages(out)
+            stage = out.parent / f".{out.name}.converting-{os.getpid()}"
+            try:
+                if stage.exists():
+                    shutil.rmtree(stage)
+                stage.mkdir()
+                return stage
+            except OSError:
+                pass  # the parent takes no new folder: replaced in place
+        for child in sorted(out.iterdir()):
+            if child.is_dir() and not child.is_symlink():
+                shutil.rmtree(child)
+            else:
+                child.unlink()
+    return out
+
+
+def _remove_stale_stages(out: Path) -> None:
+    """Removes the staging and replaced folders beside ``out`` left by conversions that were killed (their process
+    no longer runs): ``.<name>.converting-<pid>`` and ``.<name>.replaced-<pid>``."""
+    for kind in ("converting", "replaced"):
+        for left in out.parent.glob(f".{out.name}.{kind}-*"):
+            pid = left.name.rpartition("-")[2]
+            if not pid.isdigit() or not left.is_dir() or left.is_symlink():
+                continue
+            try:
+                os.kill(int(pid), 0)
+            except ProcessLookupError:
+                shutil.rmtree(left, ignore_errors=True)
+            except (PermissionError, OverflowError, ValueError):
+                continue
+
+
+@contextlib.contextmanager
+def staged(work: Path, out: Path) -> Iterator[None]:
+    """Around a conversion written into ``work`` (:func:`prepare_out`): when that is a staging folder, swaps it in
+    for ``out`` on success (the previous conversion is removed only then) and removes it on failure (the previous
+    conversion stays)."""
+    if work == out:
+        yield
+        return
+    try:
+        yield
+    except BaseException:
+        shutil.rmtree(work, ignore_errors=True)
+        raise
+    old = out.parent / f".{out.name}.replaced-{os.getpid()}"
+    try:
+        os.replace(out, old)
+        try:
+            os.replace(work, out)
+        except OSError:
+            os.replace(old, out)
+            raise
+    except OSError as exc:
+        shutil.rmtree(work, ignore_errors=True)
+        raise IoError(f"cannot replace {out} with the new conversion: {exc.strerror or exc}") from None
+    shutil.rmtree(old, ignore_errors=True)

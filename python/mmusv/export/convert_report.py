@@ -1,0 +1,88 @@
+"""What a conversion reports (:func:`mmusv.export.convert`): per recording where it went and which frames were
+converted or skipped, the totals, and the report file ``conversion.yaml`` (:data:`REPORT_NAME`) read back."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+__all__ = ["REPORT_NAME", "ConvertReport", "RecordingReport", "load_report"]
+
+REPORT_NAME = "conversion.yaml"
+
+
+@dataclass
+class RecordingReport:
+    """One recording's conversion: where it went and which frames were converted or skipped (``skipped``:
+    ``{"frames": [first, last], "reason": ...}`` ranges)."""
+
+    path: Path
+    scenario: str
+    folder: str
+    split: str | None
+    frames_converted: int = 0
+    first_frame: int | None = None
+    last_frame: int | None = None
+    skipped: list[dict[str, Any]] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    status: str = ""
+
+    def as_dict(self) -> dict[str, Any]:
+        """The recording's entry of ``conversion.yaml``."""
+        return {
+            "source": self.path.name,
+            "scenario": self.scenario,
+            "folder": self.folder,
+            "split": self.split,
+            "run_status": self.status,
+            "frames_converted": self.frames_converted,
+            "frames": None if self.first_frame is None else [self.first_frame, self.last_frame],
+            "skipped": self.skipped,
+            "notes": self.notes,
+        }
+
+
+@dataclass
+class ConvertReport:
+    """What a conversion wrote: per recording, totals, seconds (wall) and bytes on disk."""
+
+    out_dir: Path
+    target: str
+    recordings: list[RecordingReport]
+    agent_frames: int = 0
+    files: int = 0
+    bytes: int = 0
+    seconds: float = 0.0
+
+    @property
+    def frames(self) -> int:
+        """Frames converted (each one for every agent of its recording)."""
+        return sum(r.frames_converted for r in self.recordings)
+
+    @property
+    def skipped(self) -> list[dict[str, Any]]:
+        """Every skipped range, with its recording's file name."""
+        return [{"recording": r.path.name, **s} for r in self.recordings for s in r.skipped]
+
+    def lines(self) -> list[str]:
+        """A human summary, one line per recording and a total."""
+        out = []
+        for r in self.recordings:
+            where = f"{r.split}/{r.folder}" if r.split else r.folder
+            out.append(f"{r.path.name} -> {where}: {r.frames_converted} frames")
+            out += [f"  skipped frames {s['frames'][0]}..{s['frames'][1]}: {s['reason']}" for s in r.skipped]
+            out += [f"  note: {n}" for n in r.notes]
+        out.append(
+            f"{self.frames} frames ({self.agent_frames} agent-frames), {self.files} files, {self.bytes / 1e6:.1f} MB "
+            f"in {self.seconds:.1f} s -> {self.out_dir}"
+        )
+        return out
+
+
+def load_report(out_dir: str | Path) -> dict[str, Any]:
+    """The ``conversion.yaml`` of a converted folder."""
+    doc: dict[str, Any] = yaml.safe_load((Path(out_dir) / REPORT_NAME).read_text(encoding="utf-8"))
+    return doc
