@@ -21,6 +21,16 @@ def test_version_and_assets() -> None:
     assert "container_ship_300m" in out and "usv_wamv" in out
 
 
+def test_python_dash_m_mmusv_is_the_command() -> None:
+    """``python -m mmusv`` (no console script on the path) was "No module named mmusv.__main__"."""
+    r = subprocess.run(
+        [sys.executable, "-m", "mmusv", "version"], capture_output=True, text=True, cwd=ROOT, timeout=120
+    )
+    assert r.returncode == 0 and r.stdout.startswith("mmusv "), r.stderr
+    bad = subprocess.run([sys.executable, "-m", "mmusv", "run"], capture_output=True, text=True, cwd=ROOT, timeout=120)
+    assert bad.returncode == 2 and "usage: mmusv" in bad.stderr and "Traceback" not in bad.stderr
+
+
 def test_wave_study_command(tmp_path: Path) -> None:
     r = run("study", "waves", "--frames", "100", "-o", str(tmp_path))
     assert r.returncode == 0, r.stderr

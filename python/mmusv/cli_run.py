@@ -23,7 +23,8 @@ def _run_one(
     checks: bool = True,
     profile: bool = False,
 ) -> str:
-    """Runs one scenario; returns a one-line report. Used directly and in worker processes."""
+    """Runs one scenario for `mmusv run SCENARIO`; returns a one-line report (batches of scenarios run through
+    :mod:`mmusv.batch.task` instead)."""
     from mmusv.acquire import run
     from mmusv.config import load_scenario
 
