@@ -17,6 +17,63 @@ from mmusv.world.vessels import library
 
 FLOORS = ((15.0, 4000, "under 15 m"), (80.0, 15000, "15-80 m"), (float("inf"), 40000, "80 m and over"))
 
+USER_MESHES = """## Your own vessels: mesh files
+
+An asset entry with `mesh:` (a file trimesh reads: `.glb`, `.gltf`, `.obj`, `.ply`, `.stl`, `.off`) builds a vessel
+from your own model; `load_asset_file(..., register=True)` (or `load_asset_catalog` for a list) adds it to the
+library, and a scenario's vessel names it as `asset:`. The entry's keys are those of
+`mmusv.world.asset_spec.MeshAssetSpec`:
+
+```python
+from mmusv.world.vessels import load_asset_file
+
+load_asset_file(
+    {
+        "name": "my_usv",
+        "mesh": "models/my_usv.glb",  # relative to the YAML file's folder (a mapping: base_dir, else the cwd)
+        "scale": 1.0,  # file units -> metres: 0.01 for a model in centimetres
+        "draft": 0.4,  # metres below the waterline from the lowest point; or waterline_z (file units, default 0)
+        "semantic_class": "usv",
+        "mounts": {"lidar": {"xyz": [0.0, 0.0, 2.5]}},
+    },
+    register=True,
+)
+```
+
+**Axes.** `up_axis` and `forward_axis` (the file's up and bow directions, any of x, y, z, -x, -y, -z) turn the
+file into the body frame: x forward (bow), y to port, z up, z = 0 the waterline. When an entry gives neither, the
+file's format decides (`mmusv.world.asset_spec.FORMAT_AXES`): a `.gltf`/`.glb` file is read +Y up with its bow
+towards +Z, as glTF 2.0 defines (section 3.4, "Coordinate System and Units"; Blender's glTF export writes it so),
+and every other format z up, x forward (`mmusv.world.asset_spec.DEFAULT_AXES`: OBJ, PLY, STL and OFF have no
+convention of their own). When an entry gives one axis, the other defaults to z (up) or x (forward) whatever the
+format. A mesh that comes out wider than long under a defaulted axis gets a warning (`MmusvWarning`) naming the
+file and the keys to set; giving both axes silences it.
+
+**Changed:** before, every file, glTF included, defaulted to z up, x forward. A `.gltf`/`.glb` written z-up (a
+z-up mesh exported by trimesh, some CAD tools) whose entry gives neither axis now loads on its side: add
+`up_axis: z` and `forward_axis: x` to its entry. Read as glTF, such a hull comes out wider than long (its length
+becomes its beam), so the warning above names it and this fix. Entries that give either axis load exactly as
+before.
+
+**Units and node graphs.** A glTF scene's node transforms (nested, scaled, mirrored) are applied; glTF is in
+metres, other files in whatever their author used: `scale` converts.
+
+**Materials.** A glTF/GLB file's PBR materials come through per face as glTF 2.0 defines them, each texture by its
+mean over its texels: base colour = `baseColorFactor` x `baseColorTexture` (sRGB, averaged in linear RGB);
+roughness and metallic = `roughnessFactor` and `metallicFactor` (default 1) x the green and blue channels of the
+`metallicRoughnessTexture`; emission = `emissiveFactor` (default 0) x `emissiveTexture` (sRGB) x
+`KHR_materials_emissive_strength`, 1 standing for `mmusv.world.mesh_files.GLTF_EMISSIVE_SCALE` cd/m². Not read:
+alpha (`alphaMode`, a base colour's alpha: every face is opaque), `doubleSided` (the ray caster hits both sides of
+every face anyway), normal and occlusion textures, vertex colours, and the materials of other formats (an OBJ's MTL
+file, a PLY's colours): those faces, and glTF primitives without a material, get the class's default look.
+
+**Bad files** are one `AssetSpecError` line naming the entry's `mesh` key, the file and what is wrong: missing, a
+folder, empty, an extension trimesh does not read, a GLB shorter than its header says, a `.gltf` whose `.bin` or
+texture file is missing or not an image, non-finite coordinates, no triangles, or trimesh's own reason for a file it
+cannot parse. A texture or buffer URI is read as glTF means it: percent-decoded and relative to the `.gltf`
+(`../textures/` included).
+"""
+
 
 def floor(length: float) -> tuple[int, str]:
     """The triangle floor and size class of a vessel ``length`` metres long."""
@@ -60,6 +117,7 @@ def table() -> str:
         "|---|---|---:|---:|---:|---|---:|---|",
         *rows,
         "",
+        USER_MESHES,
     ]
     return "\n".join(lines)
 

@@ -224,7 +224,9 @@ def test_gltf_pbr_materials_come_through_per_face(tmp_path: Path) -> None:
     b.visual = trimesh.visual.TextureVisuals(material=blue)
     path = tmp_path / "two.glb"
     path.write_bytes(trimesh.Scene([a, b]).export(file_type="glb"))
-    asset = load_asset_file({"name": "two_boxes", "mesh": str(path), "waterline_z": 0.0})
+    # written z-up, x forward (not glTF's +Y up, +Z front): the entry says so
+    zup = {"up_axis": "z", "forward_axis": "x"}
+    asset = load_asset_file({"name": "two_boxes", "mesh": str(path), "waterline_z": 0.0, **zup})
     mesh = asset.mesh
     centroid_x = mesh.vertices[mesh.faces].mean(axis=1)[:, 0]
     ids_a = set(mesh.materials[centroid_x < -0.01].tolist())
@@ -237,7 +239,7 @@ def test_gltf_pbr_materials_come_through_per_face(tmp_path: Path) -> None:
     np.testing.assert_allclose(mb.base_color, [0.1, 0.2, 0.9], atol=1 / 255)
     assert (ma.roughness, ma.metallic, mb.roughness, mb.metallic) == pytest.approx((0.6, 0.0, 0.3, 1.0))
     assert mb.emissive[2] > 0 and ma.emissive == (0.0, 0.0, 0.0)
-    again = load_asset_file({"name": "two_boxes", "mesh": str(path), "waterline_z": 0.0})
+    again = load_asset_file({"name": "two_boxes", "mesh": str(path), "waterline_z": 0.0, **zup})
     assert np.array_equal(again.mesh.materials, mesh.materials)  # the same materials, the same ids
 
 
@@ -253,7 +255,7 @@ def test_gltf_base_colour_texture_mean_is_taken_in_linear_rgb(tmp_path: Path) ->
     b.visual = trimesh.visual.TextureVisuals(uv=uv, material=mat)
     path = tmp_path / "tex.glb"
     path.write_bytes(trimesh.Scene([b]).export(file_type="glb"))
-    a = load_asset_file({"name": "tex_box", "mesh": str(path)})
+    a = load_asset_file({"name": "tex_box", "mesh": str(path), "up_axis": "z", "forward_axis": "x"})
     m = all_materials()[int(a.mesh.materials[0])]
     # sRGB 188/255 decodes to ((188/255 + 0.055) / 1.055) ** 2.4 linear; the mean of the two pixels, times the factor
     blue = ((188 / 255 + 0.055) / 1.055) ** 2.4

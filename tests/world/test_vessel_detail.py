@@ -215,7 +215,7 @@ def test_glb_user_mesh_keeps_per_face_materials_through_the_asset(tmp_path: Path
     box.visual = trimesh.visual.TextureVisuals(material=PBRMaterial(name="grey", baseColorFactor=[0.5, 0.5, 0.5, 1]))
     path = tmp_path / "one.glb"
     path.write_bytes(trimesh.Scene([box]).export(file_type="glb"))
-    a = load_asset_file({"name": "one_box", "mesh": str(path)})
+    a = load_asset_file({"name": "one_box", "mesh": str(path), "up_axis": "z", "forward_axis": "x"})  # written z-up
     assert len(set(a.mesh.materials.tolist())) == 1 and all_materials()[int(a.mesh.materials[0])].name == "one:grey"
 
 

@@ -60,9 +60,11 @@ stays ``m`` metres inside the deck outline; every part takes ``material`` (a nam
     pipes      x0, x1, ys [y, ...], z, radius=0.2, support=6, base
     winch      x, y=0, base, radius, width
 
-Mesh asset keys: ``mesh`` (file path), ``scale=1``, ``up_axis=z``, ``forward_axis=x`` (any of ±x/±y/±z),
-``waterline_z`` or ``draft``. Both kinds: ``name``, ``category=custom``, ``description``, ``semantic_class=vessel``
-(``vessel`` | ``usv``), ``mounts`` (``{name: {xyz, rpy_deg=[0, 0, 0]}}``).
+Mesh asset keys: ``mesh`` (file path), ``scale=1``, ``up_axis``, ``forward_axis`` (any of ±x/±y/±z; when neither
+is given, the file format's convention: ``y`` up and ``z`` forward for ``.gltf``/``.glb`` as glTF 2.0 defines,
+:data:`FORMAT_AXES`, else ``z`` up and ``x`` forward, :data:`DEFAULT_AXES`, which also fills in the one left out when
+only one is given), ``waterline_z`` or ``draft``. Both kinds: ``name``, ``category=custom``, ``description``,
+``semantic_class=vessel`` (``vessel`` | ``usv``), ``mounts`` (``{name: {xyz, rpy_deg=[0, 0, 0]}}``).
 
 :func:`parse_asset` validates an entry; errors are one :class:`AssetSpecError` whose ``field`` is the dotted path
 of the first problem (``tug_32m.hull.beam``, ``tug_32m.parts[3].top``) and whose message says what is allowed.
@@ -76,6 +78,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping
+from pathlib import PurePath
 from typing import Annotated, Literal
 
 from pydantic import BaseModel, BeforeValidator, Field, ValidationError, model_validator
@@ -99,7 +102,9 @@ from mmusv.world.part_spec import MaterialName, PartSpec
 
 __all__ = [
     "AXES",
+    "DEFAULT_AXES",
     "DIMENSION_RANGES",
+    "FORMAT_AXES",
     "HULL_MIN_SIZE",
     "MAX_PARTS",
     "MIN_TAPER",
@@ -138,6 +143,16 @@ NAME_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.\-]*$")
 
 AXES: dict[str, tuple[float, float, float]] = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
 """The axis letters of a mesh file's ``up_axis`` / ``forward_axis`` (optionally with a sign) as unit vectors."""
+
+DEFAULT_AXES: tuple[str, str] = ("z", "x")
+"""``(up_axis, forward_axis)`` of a mesh file whose format has no convention of its own (OBJ, STL, PLY, OFF) when the
+entry gives neither; for every format, the default of the one axis an entry leaves out when it gives the other."""
+
+FORMAT_AXES: dict[str, tuple[str, str]] = {".gltf": ("y", "z"), ".glb": ("y", "z")}
+"""``(up_axis, forward_axis)`` by file extension, for formats that define their axes, when the entry gives neither:
+glTF 2.0 (section 3.4, "Coordinate System and Units") is +Y up, metres, and an asset's front faces +Z (Blender's
+glTF export writes it so). Until this table existed every format defaulted to :data:`DEFAULT_AXES`: a glTF/GLB file
+written z-up needs ``up_axis: z, forward_axis: x`` in its entry now."""
 
 
 DIMENSION_RANGES: dict[str, tuple[float, float]] = {
@@ -322,9 +337,12 @@ class MeshAssetSpec(_AssetSpec):
     """The mesh file (OBJ/STL/PLY/GLB/... read with trimesh); relative to the YAML file's folder."""
     scale: Positive = 1.0
     """File units -> metres."""
-    up_axis: Axis = "z"
-    forward_axis: Axis = "x"
-    """The bow direction in the file, perpendicular to ``up_axis``."""
+    up_axis: Axis | None = None
+    """The up direction in the file. Not given: ``y`` for ``.gltf``/``.glb`` when ``forward_axis`` is not given either
+    (:data:`FORMAT_AXES`, glTF's convention), else ``z`` (:data:`DEFAULT_AXES`)."""
+    forward_axis: Axis | None = None
+    """The bow direction in the file, perpendicular to ``up_axis``. Not given: ``z`` for ``.gltf``/``.glb`` when
+    ``up_axis`` is not given either (:data:`FORMAT_AXES`), else ``x`` (:data:`DEFAULT_AXES`)."""
     waterline_z: Number | None = None
     """Waterline height along ``up_axis`` in file units (default 0); or give ``draft``."""
     draft: Positive | None = None
@@ -332,11 +350,20 @@ class MeshAssetSpec(_AssetSpec):
 
     @model_validator(mode="after")
     def _consistent(self) -> MeshAssetSpec:
-        if self.up_axis[-1] == self.forward_axis[-1]:
-            raise invalid_field("forward_axis", "must be perpendicular to up_axis")
+        if self.up_axis is not None or self.forward_axis is not None:
+            up, fwd = self.axes("")
+            if up[-1] == fwd[-1]:
+                raise invalid_field("forward_axis", "must be perpendicular to up_axis")
         if self.waterline_z is not None and self.draft is not None:
             raise invalid_field("draft", "give either waterline_z or draft, not both")
         return self
+
+    def axes(self, mesh_path: str) -> tuple[str, str]:
+        """``(up_axis, forward_axis)`` for the mesh file ``mesh_path``: the entry's; its file format's when it gives
+        neither (:data:`FORMAT_AXES`, else :data:`DEFAULT_AXES`); the one it leaves out from :data:`DEFAULT_AXES`."""
+        if self.up_axis is None and self.forward_axis is None:
+            return FORMAT_AXES.get(PurePath(mesh_path).suffix.lower(), DEFAULT_AXES)
+        return (self.up_axis or DEFAULT_AXES[0], self.forward_axis or DEFAULT_AXES[1])
 
 
 class ProceduralAssetSpec(_AssetSpec):

@@ -10,7 +10,8 @@ bounding box: ``length`` = x extent, ``beam`` = y extent, ``height`` = z extent 
 Built-in assets are described in ``vessel_catalog.yaml`` (entries validated by the schema in
 :mod:`mmusv.world.asset_spec`, procedural meshes built by :mod:`mmusv.world.vessel_shapes`) and built on first use,
 then cached. Users add their own with
-:func:`load_asset_file` (a mesh file, OBJ/STL/PLY/GLB via trimesh, or a procedural hull/parts entry) and
+:func:`load_asset_file` (a mesh file, OBJ/STL/PLY/GLB via trimesh, a glTF/GLB read +Y up and bow +Z as glTF
+defines unless the entry says otherwise, or a procedural hull/parts entry) and
 :func:`register_asset`; glTF/GLB files bring their PBR materials (registered with
 :func:`mmusv.world.materials.register_material`; the files are read by :mod:`mmusv.world.mesh_files`)::
 
@@ -450,11 +451,15 @@ def load_asset_file(
     """Builds one user asset from a mapping or a YAML file holding one mapping.
 
     Mesh entry keys: ``name`` (required), ``category`` ("custom"), ``description``, ``semantic_class``
-    (``vessel`` | ``usv``), ``mesh`` (path, OBJ/STL/PLY/GLB/... read with ``trimesh.load(force="mesh")``;
-    relative to the YAML file's folder, or ``base_dir``/cwd for a mapping), ``scale`` (file units -> metres, 1.0),
-    ``up_axis`` (``z``; ``y`` for glTF-style files; any of ±x/±y/±z), ``forward_axis`` (bow direction in the file,
-    ``x``; any of ±x/±y/±z perpendicular to up), ``waterline_z`` (waterline height along ``up_axis`` in file units,
-    0.0) or ``draft`` (metres above the lowest point), ``mounts`` (``{name: {xyz, rpy_deg}}`` in the asset frame).
+    (``vessel`` | ``usv``), ``mesh`` (path, OBJ/STL/PLY/OFF/GLB/glTF/... read with trimesh by
+    :mod:`mmusv.world.mesh_files`; relative to the YAML file's folder, or ``base_dir``/cwd for a mapping), ``scale``
+    (file units -> metres, 1.0), ``up_axis`` and ``forward_axis`` (the up and bow directions in the file, any of
+    ±x/±y/±z, perpendicular; when neither is given, the format's convention: ``y`` up and ``z`` forward for a
+    ``.gltf``/``.glb`` file as glTF 2.0 defines, ``z`` up and ``x`` forward for the rest; when one is given, the
+    other defaults to ``z`` / ``x`` for every format; a mesh that comes out wider than long under a defaulted axis
+    gets a :class:`~mmusv.scenario_checks.MmusvWarning`), ``waterline_z`` (waterline height along ``up_axis`` in
+    file units, 0.0) or ``draft`` (metres above the lowest point), ``mounts`` (``{name: {xyz, rpy_deg}}`` in the
+    asset frame).
     A procedural entry gives ``hull`` and ``parts`` instead of ``mesh`` (see :mod:`mmusv.world.asset_spec`).
 
     The mesh is rotated to the body frame, scaled, shifted so the waterline is z = 0 and re-centred in x/y;
