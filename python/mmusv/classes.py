@@ -10,7 +10,7 @@ from enum import IntEnum
 
 import numpy as np
 
-__all__ = ["PALETTE", "SemanticClass", "class_name", "palette_array"]
+__all__ = ["PALETTE", "ROLE_COLOURS", "SemanticClass", "class_name", "palette_array"]
 
 
 class SemanticClass(IntEnum):
@@ -58,3 +58,12 @@ def class_name(class_id: int) -> str:
         return SemanticClass(class_id).name.lower()
     except ValueError:
         return f"unknown_{class_id}"
+
+
+ROLE_COLOURS: dict[str, tuple[float, float, float, float]] = {
+    "usv": (0.2, 0.9, 0.9, 0.5),
+    "target": (1.0, 0.3, 0.2, 0.5),
+    "moored": (1.0, 0.8, 0.2, 0.5),
+}
+"""Box colour ``(r, g, b, a)`` in ``[0, 1]`` per vessel role, as 3D viewers draw the boxes: the recording's Foxglove
+scene entities and the ROS 2 export's RViz markers."""

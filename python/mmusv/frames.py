@@ -33,6 +33,7 @@ from mmusv.errors import InputError
 __all__ = [
     "BODY_TO_OPTICAL",
     "MIRROR_Y",
+    "OPTICAL_IN_BODY",
     "carla_matrix",
     "carla_pose",
     "carla_pose_from_eta",
@@ -54,6 +55,10 @@ MIRROR_Y = np.diag([1.0, -1.0, 1.0, 1.0])
 
 BODY_TO_OPTICAL = np.array([[0.0, -1.0, 0.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0]])
 """``(3, 3)`` camera body (x forward, y left, z up) → optical (x right, y down, z forward)."""
+
+OPTICAL_IN_BODY = np.eye(4)
+OPTICAL_IN_BODY[:3, :3] = BODY_TO_OPTICAL.T
+"""``(4, 4)`` optical frame → camera body frame (the inverse of :data:`BODY_TO_OPTICAL`, homogeneous)."""
 
 
 def _floats(value: Any, *, name: str, tail: tuple[int, ...], what: str) -> np.ndarray:

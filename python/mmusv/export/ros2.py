@@ -24,7 +24,7 @@ from typing import Any, ClassVar, Literal
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from mmusv.classes import class_name
+from mmusv.classes import ROLE_COLOURS, class_name
 from mmusv.errors import ConfigError
 from mmusv.export.ros2_msgs import Msgs, stamp
 from mmusv.export.ros2_names import (
@@ -42,7 +42,7 @@ from mmusv.export.ros2_names import (
     top_view_frame,
 )
 from mmusv.export.writer import DatasetWriter
-from mmusv.frames import BODY_TO_OPTICAL, pose_matrices
+from mmusv.frames import OPTICAL_IN_BODY, pose_matrices
 from mmusv.recording import topics
 from mmusv.recording.decode import WorldFrame
 from mmusv.recording.info import AgentInfo, RecordingInfo
@@ -71,17 +71,10 @@ CLOCK_TOPIC = "/clock"
 BAG_VERSION: Literal[8] = 8
 """rosbag2 metadata version (Jazzy's)."""
 
-OPTICAL_IN_BODY = np.eye(4)
-OPTICAL_IN_BODY[:3, :3] = BODY_TO_OPTICAL.T
-"""``(4, 4)`` optical frame → camera body frame."""
-
 PIXEL_CENTRE = 0.5
 """Where mmusv's pixel coordinates put a pixel's centre (pixel ``(i, j)`` covers ``[i, i + 1) × [j, j + 1)``: its
 intrinsics, 2D boxes); ROS, like OpenCV (``image_geometry``, ``depth_image_proc``, ``cv2.projectPoints``), puts it
 at ``(i, j)``, so ``CameraInfo``'s principal point and the ``Detection2D`` centres are mmusv's less this."""
-
-ROLE_COLOURS = {"usv": (0.2, 0.9, 0.9, 0.5), "target": (1.0, 0.3, 0.2, 0.5), "moored": (1.0, 0.8, 0.2, 0.5)}
-"""RViz box colour (r, g, b, a) per vessel role."""
 
 
 def camera_distortion(agent: AgentInfo, name: str) -> np.ndarray:

@@ -33,9 +33,10 @@ import numpy as np
 import yaml
 from scipy.spatial.transform import Rotation
 
+from mmusv.classes import ROLE_COLOURS
 from mmusv.config import scenario_hash
 from mmusv.errors import MmusvError
-from mmusv.frames import BODY_TO_OPTICAL
+from mmusv.frames import OPTICAL_IN_BODY
 from mmusv.recording import topics
 from mmusv.recording.guard import HeldSignals
 from mmusv.recording.writer import ImageFormat, Recording
@@ -43,12 +44,6 @@ from mmusv.sensors.camera import CameraImages
 from mmusv.simulation import FrameCapture, Simulation
 
 __all__ = ["OPTICAL_IN_BODY", "FrameRecorder", "pose7"]
-
-OPTICAL_IN_BODY = np.eye(4)
-OPTICAL_IN_BODY[:3, :3] = BODY_TO_OPTICAL.T
-"""``(4, 4)`` optical frame → camera body frame."""
-
-_ROLE_COLOURS = {"usv": (0.2, 0.9, 0.9, 0.5), "target": (1.0, 0.3, 0.2, 0.5), "moored": (1.0, 0.8, 0.2, 0.5)}
 
 
 def _images(
@@ -248,7 +243,7 @@ class FrameRecorder:
                 )
                 lid = cols["lidar"]
                 colours = np.array(
-                    [_ROLE_COLOURS.get(self.roles.get(i, "target"), (1, 1, 1, 0.5)) for i in lid["target_id"]]
+                    [ROLE_COLOURS.get(self.roles.get(i, "target"), (1, 1, 1, 0.5)) for i in lid["target_id"]]
                 ).reshape(-1, 4)
                 # The boxes are in the LiDAR frame, or in the vessel's body frame when the rig has no LiDAR
                 # (mmusv.annotate): name the frame /tf defines for them, or Foxglove cannot place them.
