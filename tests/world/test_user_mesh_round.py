@@ -455,3 +455,25 @@ def test_the_lidar_sees_the_glb_hull_where_its_box_is(tmp_path: Path) -> None:
         assert np.all(mast[:, 1] > 0.5)  # port side: the side facing the ego, which lies to the target's left
     finally:
         unregister_asset("test_user_mesh_round")
+
+
+@pytest.mark.parametrize(
+    ("entry", "field", "says"),
+    [
+        (
+            {"up_axis": "x"},
+            "forward_axis",
+            "is not given, so it is x (the default), which is not perpendicular to up_axis x",
+        ),
+        ({"forward_axis": "-z"}, "up_axis", "is not given, so it is z (the default), which is not perpendicular"),
+        ({"up_axis": "y", "forward_axis": "-y"}, "forward_axis", "must be perpendicular to up_axis"),
+    ],
+)
+def test_axes_that_clash_say_which_one_was_defaulted(entry: dict[str, str], field: str, says: str) -> None:
+    """With only ``up_axis: x`` given the error said "forward_axis: must be perpendicular to up_axis", naming a key
+    the entry does not have without saying it had defaulted to x."""
+    from mmusv.world.asset_spec import parse_asset
+
+    with pytest.raises(AssetSpecError) as info:
+        parse_asset({"name": "boat", "mesh": "boat.obj", **entry}, path="boat")
+    assert info.value.field == f"boat.{field}" and says in str(info.value), str(info.value)

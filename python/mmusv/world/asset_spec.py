@@ -353,6 +353,18 @@ class MeshAssetSpec(_AssetSpec):
         if self.up_axis is not None or self.forward_axis is not None:
             up, fwd = self.axes("")
             if up[-1] == fwd[-1]:
+                if self.forward_axis is None:  # the default filled in: say so, and which key to give
+                    raise invalid_field(
+                        "forward_axis",
+                        f"is not given, so it is {fwd} (the default), which is not perpendicular to up_axis {up}; "
+                        "give forward_axis (the bow's direction in the file)",
+                    )
+                if self.up_axis is None:
+                    raise invalid_field(
+                        "up_axis",
+                        f"is not given, so it is {up} (the default), which is not perpendicular to forward_axis "
+                        f"{fwd}; give up_axis (the up direction in the file)",
+                    )
                 raise invalid_field("forward_axis", "must be perpendicular to up_axis")
         if self.waterline_z is not None and self.draft is not None:
             raise invalid_field("draft", "give either waterline_z or draft, not both")
