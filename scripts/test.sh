@@ -49,6 +49,10 @@ echo "   GUI build (opencv-python, needing libGL), which would overwrite the hea
 echo "   imports besides is installed above"
 python3 -m pip install --quiet --disable-pip-version-check --no-deps "ultralytics>=8.4,<9" "ultralytics-thop>=2"
 
+echo "== TrackEval, the MOTChallenge peer of tests/export/test_mot.py, without its dependencies for the same reason (it"
+echo "   asks for opencv-python); numpy, scipy and tabulate, what its MOTChallenge loader and metrics import, are above"
+python3 -m pip install --quiet --disable-pip-version-check --no-deps "trackeval>=1.3,<2"
+
 echo "== cargo clippy, warnings are errors (release: reuses the build scripts and proc macros built above)"
 cargo clippy -p mmusv-core -p mmusv-benches -p mmusv-py --release --all-targets --quiet -- -D warnings
 

@@ -25,7 +25,7 @@ from mmusv.recording import read_messages
 
 LIDAR = {"channels": 16, "points_per_second": 20000, "rotation_hz": 5}
 DIST = [-0.1, 0.02, 0.001, -0.001, 0.0]
-FORMATS = ("opv2v", "kitti", "ros2", "coco", "yolo", "mastr", "semantickitti")
+FORMATS = ("opv2v", "kitti", "ros2", "coco", "yolo", "mastr", "semantickitti", "mot")
 
 
 def coop(name: str, frames: int, rigs: dict[str, Any]) -> dict[str, Any]:
@@ -150,6 +150,20 @@ def check_yolo(out: Path) -> int:
             assert all(0.0 <= float(v) <= 1.0 for v in b) and float(b[2]) > 0 and float(b[3]) > 0
             boxes += 1
     return boxes
+
+
+def check_mot(out: Path) -> int:
+    """Lines of every MOTChallenge ``gt/gt.txt``, each read back as nine comma-separated numbers with 1-based frames
+    and ids (MOTChallenge's convention); every sequence has its ``seqinfo.ini`` and ``img1`` images."""
+    lines = 0
+    for gt in sorted(out.rglob("gt/gt.txt")):
+        seq = gt.parent.parent
+        assert (seq / "seqinfo.ini").is_file() and any((seq / "img1").iterdir()), seq
+        for row in gt.read_text().splitlines():
+            v = [float(x) for x in row.split(",")]
+            assert len(v) == 9 and v[0] >= 1 and v[1] >= 1 and v[4] > 0 and v[5] > 0, row
+            lines += 1
+    return lines
 
 
 def check_mastr(out: Path) -> int:
@@ -288,9 +302,12 @@ def test_two_different_rigs_read_back_in_every_format(mixed_rec: Path, tmp_path:
             "yolo": check_yolo,
             "mastr": check_mastr,
             "semantickitti": check_semantickitti,
+            "mot": check_mot,
         }[to](out)
     assert found["kitti"] == 4 and found["semantickitti"] == 4 and found["opv2v"] > 0 and found["ros2"] > 20
     assert found["mastr"] == 2  # usv_b's front camera; the rear one records no semantic image
+    assert found["mot"] == found["yolo"]  # the same visible boxes, one gt.txt line each (usv_b's front camera)
+    assert "agent usv_a has no camera recording rgb and instance images and is left out" in notes(tmp_path / "mot")
     # The default --box visible takes YOLO's boxes from the instance images, so usv_b's rear camera (RGB only) is left
     # out, as in COCO; --box projected (the recorded boxes, the only ones before --box) converts it from RGB alone.
     assert len(list((tmp_path / "yolo" / "images").rglob("*.png"))) == 2  # usv_b's front, 2 frames
@@ -317,7 +334,8 @@ def test_empty_scans_and_no_vessel_are_said_and_read_back(lonely_rec: Path, tmp_
     assert read_bag(tmp_path / "ros2" / "edge_lonely") > 5
     assert check_coco(tmp_path / "coco") == 0 and check_yolo(tmp_path / "yolo") == 0
     assert check_mastr(tmp_path / "mastr") == 1
-    for to in ("coco", "yolo"):
+    assert check_mot(tmp_path / "mot") == 0
+    for to in ("coco", "yolo", "mot"):
         assert "no vessel is visible in any converted image" in notes(tmp_path / to), to
 
 

@@ -22,7 +22,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 from functools import cached_property
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any, ClassVar, TypeVar
 
 import numpy as np
 
@@ -35,7 +35,19 @@ from mmusv.recording.decode import WorldFrame
 from mmusv.recording.info import AgentInfo, CameraInfo
 from mmusv.recording.stream import Frame
 
-__all__ = ["CATEGORIES", "CameraWriter", "ImageBox", "Sample", "Shared", "mask_box"]
+__all__ = [
+    "CATEGORIES",
+    "CameraWriter",
+    "ContrastBoxes",
+    "ImageBox",
+    "Sample",
+    "Shared",
+    "VisibleBoxes",
+    "box_writer",
+    "mask_box",
+]
+
+_W = TypeVar("_W", bound="CameraWriter")
 
 CATEGORIES: tuple[int, ...] = tuple(int(c) for c in SemanticClass if c != SemanticClass.NONE)
 """The detection categories: every semantic class of :mod:`mmusv.classes` but ``NONE`` (0, nothing hit), by id."""
@@ -289,6 +301,38 @@ class CameraWriter(DatasetWriter):
                 f"all {self.visible_boxes} visible 2D boxes were left out by {filters}: no 2D box, every image is "
                 "background"
             )
+
+
+class VisibleBoxes(CameraWriter):
+    """Base to put first among the bases of a box format's writer for ``box="visible"`` (YOLO, MOT): the boxes come
+    from the instance images, so a camera must record them too (COCO always needs them for its masks)."""
+
+    kinds: ClassVar[tuple[str, ...]] = ("rgb", "instance")
+    no_agent_reason: ClassVar[str] = (
+        "no camera recording rgb and instance images (--box visible, the default, takes each box from the instance "
+        "image; --box projected writes the recorded boxes from rgb images alone)"
+    )
+    left_out_why: ClassVar[str] = " (--box visible takes the boxes from the instance images; --box projected does not)"
+
+
+class ContrastBoxes(CameraWriter):
+    """Base to put first among the bases of a box format's writer for ``box="projected"`` with ``min_contrast``: the
+    contrast is measured on the vessel's pixels in the instance images, so a camera must record them too."""
+
+    kinds: ClassVar[tuple[str, ...]] = ("rgb", "instance")
+    no_agent_reason: ClassVar[str] = (
+        "no camera recording rgb and instance images (--min-contrast measures each vessel on its pixels in the "
+        "instance image)"
+    )
+    left_out_why: ClassVar[str] = " (--min-contrast measures each vessel on its pixels in the instance images)"
+
+
+def box_writer(options: Options, projected: type[_W], visible: type[_W], contrast: type[_W]) -> type[_W]:
+    """The writer of a box format that needs only RGB images for ``box="projected"``: ``visible`` for
+    ``box="visible"``, ``contrast`` for ``box="projected"`` with ``min_contrast``, else ``projected``."""
+    if options.box == "visible":
+        return visible
+    return projected if options.min_contrast is None else contrast
 
 
 def category_names() -> dict[int, str]:

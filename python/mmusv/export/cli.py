@@ -1,4 +1,4 @@
-"""``mmusv convert REC.mcap [REC ...] --to opv2v|kitti|ros2|coco|yolo|mastr|semantickitti -o DIR``: the
+"""``mmusv convert REC.mcap [REC ...] --to opv2v|kitti|ros2|coco|yolo|mastr|semantickitti|mot -o DIR``: the
 command-line face of :func:`mmusv.export.convert`.
 
 :func:`add_parser` adds the subcommand to the ``mmusv`` argparse sub-parsers and :func:`run` executes it (a rich
@@ -23,11 +23,13 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
 
     p: argparse.ArgumentParser = subparsers.add_parser(
         "convert",
-        help="convert recordings into a dataset: OPV2V, KITTI, ROS 2 bags, COCO, YOLO, MaSTr or SemanticKITTI",
+        help="convert recordings into a dataset: OPV2V, KITTI, ROS 2 bags, COCO, YOLO, MaSTr, SemanticKITTI or "
+        "MOTChallenge",
         description="Converts mmusv recordings into the OPV2V layout (CARLA frame, per-agent folders), KITTI-style "
         "per-agent folders, rosbag2 folders (one per recording), COCO or YOLO 2D detection sets, MaSTr1325-style "
-        "obstacle/water/sky masks or SemanticKITTI LiDAR scans and labels, split into train/validate/test by "
-        "recording with a fixed seed (docs/exports.md).",
+        "obstacle/water/sky masks, SemanticKITTI LiDAR scans and labels or MOTChallenge tracking sequences (one per "
+        "camera, gt.txt with a track id per vessel), split into train/validate/test by recording with a fixed seed "
+        "(docs/exports.md).",
     )
     p.add_argument(
         "recordings",
@@ -38,8 +40,8 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     p.add_argument(
         "--to",
         default="opv2v",
-        help="target layout: opv2v (default), kitti, ros2 (rosbag2 folders, never split), coco, yolo, mastr or "
-        "semantickitti",
+        help="target layout: opv2v (default), kitti, ros2 (rosbag2 folders, never split), coco, yolo, mastr, "
+        "semantickitti or mot (MOTChallenge: MOT17/MOT20 sequences for multi-object tracking)",
     )
     p.add_argument("-o", "--output", required=True, help="output folder")
     g = p.add_mutually_exclusive_group()
@@ -70,29 +72,30 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         "--min-box-px",
         type=float,
         default=0.0,
-        help="coco, yolo: leave out 2D boxes whose shorter side is under this many pixels (default 0)",
+        help="coco, yolo, mot: leave out 2D boxes whose shorter side is under this many pixels (default 0)",
     )
     p.add_argument(
         "--max-occlusion",
         type=float,
         default=1.0,
-        help="coco, yolo: leave out 2D boxes hidden by more than this fraction, 0..1 (default 1: keep all)",
+        help="coco, yolo, mot: leave out 2D boxes hidden by more than this fraction, 0..1 (default 1: keep all)",
     )
     p.add_argument(
         "--min-contrast",
         type=float,
         default=None,
         metavar="C",
-        help="coco, yolo: leave out 2D boxes whose apparent (Weber) contrast in the recorded RGB image is under C, "
-        "e.g. 0.05, the WMO's visibility threshold: vessels lost in fog, haze or the dark (default: keep all; needs "
+        help="coco, yolo, mot: leave out 2D boxes whose apparent (Weber) contrast in the recorded RGB image is under "
+        "C, e.g. 0.05, the WMO's visibility threshold: vessels lost in fog, haze or the dark (default: keep all; needs "
         "instance images, also with --box projected)",
     )
     p.add_argument(
         "--box",
         default="visible",
-        help="coco, yolo: the 2D box written: visible (default: the tight box of the vessel's pixels in the instance "
-        "image, COCO's bbox convention; yolo then needs instance images) or projected (the recording's box: the "
-        "projected 3D box clipped to the image, reaching down to the keel); kitti and ros2 keep the recorded box",
+        help="coco, yolo, mot: the 2D box written: visible (default: the tight box of the vessel's pixels in the "
+        "instance image, COCO's bbox convention; yolo and mot then need instance images) or projected (the recording's "
+        "box: the projected 3D box clipped to the image, reaching down to the keel); kitti and ros2 keep the recorded "
+        "box",
     )
     p.add_argument(
         "--agents",

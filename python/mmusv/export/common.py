@@ -35,14 +35,14 @@ __all__ = [
     "rounded",
 ]
 
-TARGETS = ("opv2v", "kitti", "ros2", "coco", "yolo", "mastr", "semantickitti")
+TARGETS = ("opv2v", "kitti", "ros2", "coco", "yolo", "mastr", "semantickitti", "mot")
 EXTRAS = ("depth", "semantic", "instance", "radar", "top_view")
 DEFAULT_EXTRAS = ("depth", "semantic", "radar", "top_view")
 CAV_ID_BASE = 1000
 DEPTH_UNIT_M = 0.01
 """Depth PNGs are uint16 centimetres along the optical axis: 0 = no hit (sky), 65535 = 655.35 m or farther."""
 BOXES = ("visible", "projected")
-"""The 2D boxes the COCO and YOLO exports can write (``--box``; the first is the default)."""
+"""The 2D boxes the COCO, YOLO and MOT exports can write (``--box``; the first is the default)."""
 BOX_DEFINITIONS = {
     "visible": "the tight box of the vessel's visible pixels: the instance image's pixels equal to its instance id "
     "(pixel edges: [x_min, y_min, x_max + 1, y_max + 1] of those pixels; COCO: pycocotools' toBbox of its "
@@ -94,15 +94,16 @@ class Options:
     include_usvs: bool = False
     extras: tuple[str, ...] = DEFAULT_EXTRAS
     min_box_px: float = 0.0
-    """COCO/YOLO: 2D boxes whose shorter side is under this many pixels are left out."""
+    """COCO/YOLO/MOT: 2D boxes whose shorter side is under this many pixels are left out."""
     max_occlusion: float = 1.0
-    """COCO/YOLO: 2D boxes whose occlusion (fraction hidden, 0..1) is above this are left out."""
+    """COCO/YOLO/MOT: 2D boxes whose occlusion (fraction hidden, 0..1) is above this are left out."""
     min_contrast: float | None = None
-    """COCO/YOLO: 2D boxes whose apparent contrast in the RGB image (:func:`mmusv.export.contrast.apparent_contrast`,
-    Weber, dimensionless) is under this are left out; ``None``: every box is kept."""
+    """COCO/YOLO/MOT: 2D boxes whose apparent contrast in the RGB image
+    (:func:`mmusv.export.contrast.apparent_contrast`, Weber, dimensionless) is under this are left out; ``None``: every
+    box is kept."""
     box: str = "visible"
-    """COCO/YOLO: the 2D box written (one of :data:`BOXES`): ``visible``, the tight box of the vessel's pixels in the
-    instance image; ``projected``, the recording's box (the projected 3D box clipped to the image)."""
+    """COCO/YOLO/MOT: the 2D box written (one of :data:`BOXES`): ``visible``, the tight box of the vessel's pixels in
+    the instance image; ``projected``, the recording's box (the projected 3D box clipped to the image)."""
     agents: tuple[str, ...] | None = None
     """The agents (USV ids) to convert; ``None``: every agent the format uses."""
     frames: tuple[int, int | None] | None = None

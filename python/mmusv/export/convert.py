@@ -7,7 +7,7 @@ reports progress and skipped frames, and hands each complete frame to the format
 :class:`~mmusv.export.writer.DatasetWriter`. Output root ``out_dir``:
 ``{train,validate,test}/<scenario>/...`` (or ``<scenario>/...`` with ``splits=None``) for the formats with one
 folder per recording (OPV2V, KITTI, MaSTr; ROS 2 bags, never split), the format's own layout for the others (COCO,
-YOLO, SemanticKITTI: see their modules), plus ``conversion.yaml`` (options, sources, split of every recording,
+YOLO, SemanticKITTI, MOT: see their modules), plus ``conversion.yaml`` (options, sources, split of every recording,
 frames converted and skipped; no times or absolute paths, so two conversions of the same input are
 byte-identical). ``conversion.yaml`` is written first with ``status: in_progress`` and rewritten at the end; an
 existing ``out_dir`` is replaced only with ``overwrite`` and only when it is empty or holds a previous conversion
@@ -50,6 +50,11 @@ _contrast_filter = contrast_filter
 """:func:`~mmusv.export.convert_checks.contrast_filter` by its name here before the split (tests import it)."""
 
 
+_BOX_FORMATS = ("coco", "yolo", "mot")
+"""The formats whose 2D boxes the options ``box``, ``min_box_px``, ``max_occlusion`` and ``min_contrast`` choose
+(recorded in ``conversion.yaml``'s ``options``)."""
+
+
 def writer_class(to: str) -> type[DatasetWriter]:
     """The writer of format ``to`` (one of :data:`~mmusv.export.common.TARGETS`)."""
     if to == "opv2v":
@@ -80,6 +85,10 @@ def writer_class(to: str) -> type[DatasetWriter]:
         from mmusv.export.semantickitti import SemanticKittiWriter
 
         return SemanticKittiWriter
+    if to == "mot":
+        from mmusv.export.mot import MotWriter
+
+        return MotWriter
     raise ConfigError(f"unknown target {to!r}; allowed: {', '.join(TARGETS)}")
 
 
@@ -140,7 +149,8 @@ def convert(
             into frame ranges (read as one sequence), or folders holding a ``dataset.json`` (their complete
             recordings).
         to: one of :data:`~mmusv.export.common.TARGETS`: ``"opv2v"``, ``"kitti"``, ``"ros2"`` (a rosbag2 folder
-            per recording), ``"coco"``, ``"yolo"``, ``"mastr"``, ``"semantickitti"`` (``docs/exports.md``).
+            per recording), ``"coco"``, ``"yolo"``, ``"mastr"``, ``"semantickitti"``, ``"mot"`` (MOTChallenge
+            sequences; ``docs/exports.md``).
         splits: ``(train, validate, test)`` fractions (split per recording, shuffled with ``seed``, a whole number
             >= 0) or ``None``
             for one folder of scenarios. ROS 2 bags are never split: with ``to="ros2"`` only the default or
@@ -150,14 +160,15 @@ def convert(
         include_usvs: list the other USVs as targets too (default: only non-instrumented vessels).
         extras: any of ``depth``, ``semantic``, ``instance``, ``radar``, ``top_view`` (OPV2V and KITTI: extra
             files stock loaders skip).
-        min_box_px: COCO and YOLO: leave out 2D boxes whose shorter side is under this many pixels.
-        max_occlusion: COCO and YOLO: leave out 2D boxes hidden by more than this fraction (0..1).
-        min_contrast: COCO and YOLO: leave out 2D boxes whose apparent contrast in the recorded RGB image (the
+        min_box_px: COCO, YOLO and MOT: leave out 2D boxes whose shorter side is under this many pixels.
+        max_occlusion: COCO, YOLO and MOT: leave out 2D boxes hidden by more than this fraction (0..1).
+        min_contrast: COCO, YOLO and MOT: leave out 2D boxes whose apparent contrast in the recorded RGB image (the
             vessel's Weber contrast against the background around it, :mod:`mmusv.export.contrast`; 0.05 is the
             WMO's visibility threshold) is under this; ``None`` (the default) keeps every box. It needs the cameras'
             instance images (also with ``box="projected"``).
-        box: COCO and YOLO: the 2D box written, ``"visible"`` (the default: the tight box of the vessel's pixels in
-            the instance image, COCO's convention for ``bbox``; YOLO then needs cameras recording instance images)
+        box: COCO, YOLO and MOT: the 2D box written, ``"visible"`` (the default: the tight box of the vessel's
+            pixels in the instance image, COCO's convention for ``bbox``; YOLO and MOT then need cameras recording
+            instance images)
             or ``"projected"`` (the recording's box: the vessel's projected 3D box clipped to the image, reaching
             down to the keel and over what hides it). ``min_box_px`` applies to the box written. Other formats
             keep their boxes (KITTI and ROS 2: the recorded box).
@@ -223,8 +234,8 @@ def convert(
                 "eval_range_m": rng,
                 "include_usvs": options.include_usvs,
                 "extras": list(options.extras),
-                **({"min_box_px": box_px, "max_occlusion": max_occ, "box": box} if to in ("coco", "yolo") else {}),
-                **({"min_contrast": min_c} if to in ("coco", "yolo") and min_c is not None else {}),
+                **({"min_box_px": box_px, "max_occlusion": max_occ, "box": box} if to in _BOX_FORMATS else {}),
+                **({"min_contrast": min_c} if to in _BOX_FORMATS and min_c is not None else {}),
                 "splits": None
                 if ratios is None
                 else dict(zip(SPLIT_NAMES, [round(r, 9) for r in ratios], strict=True)),

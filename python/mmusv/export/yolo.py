@@ -32,7 +32,16 @@ import re
 from pathlib import Path
 from typing import Any, ClassVar
 
-from mmusv.export.camera import CATEGORIES, CameraWriter, Sample, Shared, category_names
+from mmusv.export.camera import (
+    CATEGORIES,
+    CameraWriter,
+    ContrastBoxes,
+    Sample,
+    Shared,
+    VisibleBoxes,
+    box_writer,
+    category_names,
+)
 from mmusv.export.common import BOX_DEFINITIONS, Options, Sink, dump_yaml, png_bytes
 from mmusv.export.splits import SPLIT_NAMES
 
@@ -70,9 +79,7 @@ class YoloWriter(CameraWriter):
 
     @classmethod
     def for_options(cls, options: Options) -> type[YoloWriter]:
-        if options.box == "visible":
-            return YoloVisibleWriter
-        return YoloWriter if options.min_contrast is None else YoloContrastWriter
+        return box_writer(options, YoloWriter, YoloVisibleWriter, YoloContrastWriter)
 
     @classmethod
     def format_name(cls) -> str:
@@ -112,25 +119,11 @@ class YoloWriter(CameraWriter):
         sink.write(out / "data.yaml", dump_yaml(doc))
 
 
-class YoloVisibleWriter(YoloWriter):
+class YoloVisibleWriter(VisibleBoxes, YoloWriter):
     """:class:`YoloWriter` with ``box="visible"``: the boxes come from the instance images, so a camera must record
     them too."""
 
-    kinds: ClassVar[tuple[str, ...]] = ("rgb", "instance")
-    no_agent_reason: ClassVar[str] = (
-        "no camera recording rgb and instance images (--box visible, the default, takes each box from the instance "
-        "image; --box projected writes the recorded boxes from rgb images alone)"
-    )
-    left_out_why: ClassVar[str] = " (--box visible takes the boxes from the instance images; --box projected does not)"
 
-
-class YoloContrastWriter(YoloWriter):
+class YoloContrastWriter(ContrastBoxes, YoloWriter):
     """:class:`YoloWriter` with ``box="projected"`` and ``min_contrast``: the contrast is measured on the vessel's
     pixels in the instance images, so a camera must record them too."""
-
-    kinds: ClassVar[tuple[str, ...]] = ("rgb", "instance")
-    no_agent_reason: ClassVar[str] = (
-        "no camera recording rgb and instance images (--min-contrast measures each vessel on its pixels in the "
-        "instance image)"
-    )
-    left_out_why: ClassVar[str] = " (--min-contrast measures each vessel on its pixels in the instance images)"

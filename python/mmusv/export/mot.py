@@ -1,0 +1,258 @@
+"""``--to mot``: MOTChallenge (MOT17/MOT20) ground truth for multi-object tracking, one sequence per agent camera.
+
+Layout (what TrackEval's ``MotChallenge2DBox`` and py-motmetrics read): ``<split>/<sequence>/`` per camera of each
+converted agent, ``split`` = ``train``, ``validate``, ``test`` (by recording, :mod:`mmusv.export.splits`; every
+sequence in ``train``, MOTChallenge's folder of sequences with ground truth, without a split), ``sequence`` =
+``<scenario>.<agent>.<camera>`` (:func:`sequence_name`: the scenario folder, the agent id and the camera name, which
+hold no ``.``, so the name splits back from the right). Each sequence holds:
+
+* ``seqinfo.ini``: ``[Sequence]`` ``name``, ``imDir=img1``, ``frameRate`` (the recording's ``frequency_hz``),
+  ``seqLength`` (frames converted), ``imWidth``, ``imHeight``, ``imExt=.png``;
+* ``img1/000001.png`` …: the recorded RGB PNG of each converted frame, copied (as COCO and YOLO do);
+* ``gt/gt.txt``: one line per kept 2D box (:meth:`mmusv.export.camera.CameraWriter.boxes_of`: COCO's and YOLO's boxes
+  and filters, option ``box`` included), ``frame,id,bb_left,bb_top,bb_width,bb_height,conf,class,visibility``,
+  sorted by frame, then id; empty for a camera that saw no vessel;
+* ``frames.txt``: the recording's acquisition index of MOT frame ``k`` on line ``k``.
+
+Fields. ``frame``: 1-based and consecutive over the converted frames (MOT frame ``k`` is image ``k`` of ``img1``;
+TrackEval refuses a frame outside ``1..seqLength``), whatever acquisition indices ``frames`` selects. ``id``: the
+track id, :func:`track_id`: 1 + the vessel's row in the world state (scenario vessels in file order, then moored
+ships; OPV2V's ``cav_id`` − 999), the same integer for the vessel in every frame and every sequence of a recording.
+Box: MOTChallenge's coordinates are 1-based (its instructions: frame numbers, target ids and bounding boxes), the
+image's top-left pixel is ``(1, 1)``: ``bb_left`` = ``x_min + 1``, ``bb_top`` = ``y_min + 1`` of mmusv's box (origin
+at the image's top-left corner, pixel ``(i, j)`` over ``[i, i + 1) × [j, j + 1)``), ``bb_width`` and ``bb_height``
+unchanged. With ``box="visible"`` (the default) that is the tight box of the vessel's pixels in the instance image:
+``bb_left`` the 1-based column of its leftmost pixel, ``bb_width`` its number of columns (py-motmetrics' loader
+subtracts the 1 again). ``conf`` 1 (every line is evaluated). ``class``: the vessel's semantic class id of
+:mod:`mmusv.classes` (COCO's ``category_id``: 10 ``vessel``, 11 ``usv``). ``visibility``: 1 − the recorded
+``occlusion`` (:mod:`mmusv.annotate`: the share of the vessel's silhouette above the still water level that other
+objects or the waves hide; the part outside the image, truncation, is not counted). Numbers: whole numbers as such,
+the rest to 3 decimals (boxes) or 6 (visibility).
+
+At the root: ``classes.csv`` (``class,name``: every class of :data:`mmusv.export.camera.CATEGORIES`), ``tracks.csv``
+(``split,scenario,track_id,vessel_id,role,class,asset``: every vessel of every converted recording's world state)
+and ``seqmaps/<split>.txt`` (TrackEval's sequence maps: ``name``, then the split's sequences).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, ClassVar
+
+from mmusv.classes import class_name
+from mmusv.errors import IoError
+from mmusv.export.camera import (
+    CATEGORIES,
+    CameraWriter,
+    ContrastBoxes,
+    Sample,
+    Shared,
+    VisibleBoxes,
+    box_writer,
+)
+from mmusv.export.common import Options, Sink, png_bytes
+from mmusv.export.splits import SPLIT_NAMES
+from mmusv.recording.decode import WorldFrame
+from mmusv.recording.stream import Frame
+
+__all__ = [
+    "CLASSES_FILE",
+    "GT_COLUMNS",
+    "TRACKS_FILE",
+    "MotContrastWriter",
+    "MotVisibleWriter",
+    "MotWriter",
+    "mot_split",
+    "sequence_name",
+    "track_id",
+]
+
+GT_COLUMNS = ("frame", "id", "bb_left", "bb_top", "bb_width", "bb_height", "conf", "class", "visibility")
+"""The columns of ``gt/gt.txt`` (MOT17/MOT20 ground truth)."""
+CLASSES_FILE = "classes.csv"
+TRACKS_FILE = "tracks.csv"
+IMAGE_DIR = "img1"
+IMAGE_EXT = ".png"
+
+
+def sequence_name(scenario: str, agent: str, camera: str) -> str:
+    """``<scenario>.<agent>.<camera>``: agent ids and camera names hold no ``.`` (only letters, digits, ``_``, ``-``),
+    so two (scenario, agent, camera) never share a name (``-`` would join ``a-b`` + ``c`` and ``a`` + ``b-c``)."""
+    return f"{scenario}.{agent}.{camera}"
+
+
+def mot_split(split: str) -> str:
+    """The folder of a conversion split: the split's name, ``train`` without a split (``all``)."""
+    return "train" if split == "all" else split
+
+
+def track_id(world: WorldFrame, vessel_id: str) -> int:
+    """The MOT track id of a vessel: 1 + its row in the world state."""
+    return world.ids.index(vessel_id) + 1
+
+
+def _num(value: float, decimals: int) -> str:
+    """``value`` rounded to ``decimals``: a whole number without a point, else Python's shortest repr."""
+    r = round(float(value), decimals) + 0.0
+    return str(int(r)) if r.is_integer() else repr(r)
+
+
+def _csv(rows: list[list[Any]]) -> bytes:
+    buf = io.StringIO()
+    csv.writer(buf, lineterminator="\n").writerows(rows)
+    return buf.getvalue().encode("utf-8")
+
+
+@dataclass
+class _Sequence:
+    """One camera of one agent: its folder and its boxes by acquisition index."""
+
+    name: str
+    folder: Path
+    width: int
+    height: int
+    rows: dict[int, list[tuple[int, str, str, str, str, int, str]]] = field(default_factory=dict)
+    """acquisition index → ``(id, bb_left, bb_top, bb_width, bb_height, class, visibility)`` per kept box."""
+
+
+class _MotShared(Shared):
+    def __init__(self, out: Path, box: str) -> None:
+        super().__init__(out=out)
+        self.box = box
+        self.sequences: dict[str, list[str]] = {}
+        """MOT split folder → its sequence names."""
+        self.tracks: list[list[Any]] = []
+        """The rows of ``tracks.csv``."""
+
+
+class MotWriter(CameraWriter):
+    """Writes MOTChallenge sequences (see the module docstring); this class with ``box="projected"``, which needs
+    only RGB images, :class:`MotVisibleWriter` with ``box="visible"`` and :class:`MotContrastWriter` with
+    ``box="projected"`` and ``min_contrast``."""
+
+    kinds: ClassVar[tuple[str, ...]] = ("rgb",)
+    boxes: ClassVar[bool] = True
+    no_agent_reason: ClassVar[str] = "no camera recording rgb images"
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.sequences: dict[tuple[str, str], _Sequence] = {}
+        self.rows: dict[str, int] = {}
+        """Vessel id → world-state row, as first seen (every later frame must agree)."""
+        self.world: WorldFrame | None = None
+        """The first converted frame's world state (``tracks.csv``)."""
+
+    @classmethod
+    def for_options(cls, options: Options) -> type[MotWriter]:
+        return box_writer(options, MotWriter, MotVisibleWriter, MotContrastWriter)
+
+    @classmethod
+    def format_name(cls) -> str:
+        return "mot"
+
+    @classmethod
+    def start(cls, out: Path, options: Options, sink: Sink) -> Any:
+        return _MotShared(out, options.box)
+
+    def write_frame(self, frame: Frame) -> None:
+        world = frame.world
+        assert world is not None
+        if self.world is None:
+            self.world = world
+        for row, vid in enumerate(world.ids):
+            if self.rows.setdefault(vid, row) != row:
+                raise IoError(
+                    f"{self.info.path}: vessel {vid!r} is in world-state row {row} at frame {frame.index} and in row "
+                    f"{self.rows[vid]} before: its MOT track id would change"
+                )
+        for seq in self.sequences.values():
+            seq.rows.pop(frame.index, None)  # a frame recorded twice: the last copy is kept, as in every format
+        super().write_frame(frame)
+
+    def sequence(self, sample: Sample) -> _Sequence:
+        """The sample's sequence, created on its first frame."""
+        key = (sample.agent.id, sample.camera.name)
+        seq = self.sequences.get(key)
+        if seq is None:
+            name = sequence_name(self.folder.name, *key)
+            split = mot_split(sample.split)
+            seq = _Sequence(name, self.root / split / name, sample.camera.width, sample.camera.height)
+            self.sequences[key] = seq
+            self.shared.sequences.setdefault(split, []).append(name)
+        return seq
+
+    def write_sample(self, sample: Sample) -> None:
+        seq = self.sequence(sample)
+        # named by acquisition index + 1 while writing, renumbered 1.. over the converted frames in finish()
+        image = self.sink.mkdir(seq.folder / IMAGE_DIR) / f"{sample.frame.index + 1:06d}{IMAGE_EXT}"
+        self.put(image, png_bytes(sample.message("rgb")))
+        rows = seq.rows.setdefault(sample.frame.index, [])
+        for b in self.boxes_of(sample):
+            rows.append(
+                (
+                    track_id(sample.world, b.target_id),
+                    _num(b.x_min + 1.0, 3),
+                    _num(b.y_min + 1.0, 3),
+                    _num(b.width, 3),
+                    _num(b.height, 3),
+                    b.semantic_class,
+                    _num(min(1.0, max(0.0, 1.0 - b.occlusion)), 6),
+                )
+            )
+
+    def finish(self, frames: list[int], skipped: list[dict[str, Any]]) -> None:
+        super().finish(frames, skipped)
+        freq = _num(self.info.frequency_hz, 6)
+        for seq in self.sequences.values():
+            order = sorted(seq.rows)
+            img = seq.folder / IMAGE_DIR
+            for k, index in enumerate(order, start=1):
+                if index + 1 != k:  # k <= index + 1: the target is free (its own image has moved already)
+                    (img / f"{index + 1:06d}{IMAGE_EXT}").rename(img / f"{k:06d}{IMAGE_EXT}")
+            lines = [
+                f"{k},{r[0]},{r[1]},{r[2]},{r[3]},{r[4]},1,{r[5]},{r[6]}\n"
+                for k, index in enumerate(order, start=1)
+                for r in sorted(seq.rows[index])
+            ]
+            self.put(self.sink.mkdir(seq.folder / "gt") / "gt.txt", "".join(lines).encode())
+            ini = (
+                f"[Sequence]\nname={seq.name}\nimDir={IMAGE_DIR}\nframeRate={freq}\nseqLength={len(order)}\n"
+                f"imWidth={seq.width}\nimHeight={seq.height}\nimExt={IMAGE_EXT}\n\n"
+            )
+            self.put(seq.folder / "seqinfo.ini", ini.encode())
+            self.put(seq.folder / "frames.txt", "".join(f"{i}\n" for i in order).encode())
+        if self.world is not None and self.sequences:
+            split = mot_split(self.split_name)
+            w = self.world
+            self.shared.tracks += [
+                [split, self.folder.name, i + 1, vid, w.roles[i], int(w.classes[i]), w.assets[i]]
+                for i, vid in enumerate(w.ids)
+            ]
+
+    @classmethod
+    def finish_all(cls, shared: Any, out: Path, sink: Sink) -> None:
+        st: _MotShared = shared
+        if not st.sequences:
+            return
+        sink.write(out / CLASSES_FILE, _csv([["class", "name"], *([c, class_name(c)] for c in CATEGORIES)]))
+        tracks = sorted(st.tracks, key=lambda r: (r[1], r[2]))
+        head = ["split", "scenario", "track_id", "vessel_id", "role", "class", "asset"]
+        sink.write(out / TRACKS_FILE, _csv([head, *tracks]))
+        sink.mkdir(out / "seqmaps")
+        for split in [*SPLIT_NAMES]:
+            if split in st.sequences:
+                names = sorted(st.sequences[split])
+                sink.write(out / "seqmaps" / f"{split}.txt", "".join(f"{n}\n" for n in ["name", *names]).encode())
+
+
+class MotVisibleWriter(VisibleBoxes, MotWriter):
+    """:class:`MotWriter` with ``box="visible"``: the boxes come from the instance images, so a camera must record
+    them too."""
+
+
+class MotContrastWriter(ContrastBoxes, MotWriter):
+    """:class:`MotWriter` with ``box="projected"`` and ``min_contrast``: the contrast is measured on the vessel's
+    pixels in the instance images, so a camera must record them too."""
