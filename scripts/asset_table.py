@@ -58,19 +58,53 @@ before.
 **Units and node graphs.** A glTF scene's node transforms (nested, scaled, mirrored) are applied; glTF is in
 metres, other files in whatever their author used: `scale` converts.
 
-**Materials.** A glTF/GLB file's PBR materials come through per face as glTF 2.0 defines them, each texture by its
-mean over its texels: base colour = `baseColorFactor` x `baseColorTexture` (sRGB, averaged in linear RGB);
-roughness and metallic = `roughnessFactor` and `metallicFactor` (default 1) x the green and blue channels of the
-`metallicRoughnessTexture`; emission = `emissiveFactor` (default 0) x `emissiveTexture` (sRGB) x
-`KHR_materials_emissive_strength`, 1 standing for `mmusv.world.mesh_files.GLTF_EMISSIVE_SCALE` cd/m². Not read:
-alpha (`alphaMode`, a base colour's alpha: every face is opaque), `doubleSided` (the ray caster hits both sides of
-every face anyway), normal and occlusion textures, vertex colours, and the materials of other formats (an OBJ's MTL
-file, a PLY's colours): those faces, and glTF primitives without a material, get the class's default look.
+**Materials** come through per face, each texture by its mean over its texels (mmusv shades one material per
+face); the conversions are `mmusv.world.mesh_materials`'s.
+
+- *glTF/GLB*, as glTF 2.0 defines them: base colour = `baseColorFactor` x `baseColorTexture` (sRGB, averaged in
+  linear RGB); roughness and metallic = `roughnessFactor` and `metallicFactor` (default 1) x the green and blue
+  channels of the `metallicRoughnessTexture`; emission = `emissiveFactor` (default 0) x `emissiveTexture` (sRGB) x
+  `KHR_materials_emissive_strength`, 1 standing for `mmusv.world.mesh_files.GLTF_EMISSIVE_SCALE` cd/m². Not read:
+  alpha (`alphaMode`, a base colour's alpha: every face is opaque), `doubleSided` (the ray caster hits both sides of
+  every face anyway), normal and occlusion textures, vertex colours (`COLOR_0`).
+- *OBJ with MTL*: each face takes the material its `usemtl` names (`<file stem>:<newmtl name>`), from the files its
+  `mtllib` lines name (relative to the `.obj`; textures relative to the `.mtl`, options such as `-s 1 1 1` skipped,
+  as the [MTL spec](https://paulbourke.net/dataformats/mtl/) writes them, else by their file name beside the `.mtl`,
+  as obj2gltf looks for an absolute path written on another machine), converted as Blender's OBJ importer
+  (`source/blender/io/wavefront_obj/importer/obj_import_mtl.cc`) does:
+
+  - `Kd` is the base colour, taken as linear RGB as stored: Blender sets it as the (scene-linear) Base Color and
+    exports Base Color as `Kd`, so a model looks as it did in Blender; CesiumGS obj2gltf writes it as the linear
+    `baseColorFactor` (three.js's MTLLoader decodes it from sRGB instead). A `map_Kd` texture takes its place, by
+    its mean in linear RGB (sRGB-decoded), as Blender (texture linked to Base Color) and obj2gltf (factor 1) do.
+    Neither: 0.8 grey, Blender's default Base Color.
+  - roughness = `Pr` (the PBR extension) where given, else 1 - sqrt(clamp(`Ns`, 0, 1000) / 1000) (Blender's
+    importer), 1 without `Ns` (obj2gltf's default `Ns` is 0).
+  - metallic = `Pm` where given, else 0 (obj2gltf; Blender reads the mean of `Ka` as metallic for `illum 3` only,
+    which mmusv does not follow: most files' `Ka` is an ambient colour, often white).
+  - emission = `Ke` (a `map_Ke` texture's mean in its place), `Ke` 1 standing for `GLTF_EMISSIVE_SCALE` cd/m² as a
+    glTF `emissiveFactor` of 1 does: Blender imports `Ke` as Emission Color at strength 1 and exports that as
+    `emissiveFactor`.
+  - not read: `d` and `Tr` (every face is opaque), `Ka`, `Ks`, `Ni`, `illum`, bump and normal maps.
+
+  An OBJ without `mtllib` keeps the class's default look (its `usemtl` lines name nothing to read), as do faces
+  before the first `usemtl`.
+- *Vertex and face colours* (PLY `red`/`green`/`blue`, OBJ `v x y z r g b`, face colours of any format trimesh
+  reads them from) are taken as sRGB (the default of Blender's PLY importer and exporter; three.js's PLYLoader
+  decodes them so too). A face's colour is the mean of its three vertices' in linear RGB (the mean, over the face,
+  of the colour a modelling tool interpolates across it), quantised to 64 levels per sRGB channel (steps of 1/63);
+  each distinct colour is one material `vertex_colour:#rrggbb` (roughness 0.5, metallic 0, as the class default),
+  shared by all files. A file with more than 256 distinct face colours
+  (`mmusv.world.mesh_materials.MAX_COLOUR_MATERIALS`) is quantised coarser (32, 16, ... levels) until it has no
+  more, with a `MmusvWarning` saying so. An OBJ's faces with an MTL material keep that material.
+- STL, OFF and other files without colours, and glTF primitives without a material, get the class's default look.
 
 **Bad files** are one `AssetSpecError` line naming the entry's `mesh` key, the file and what is wrong: missing, a
 folder, empty, an extension trimesh does not read, a GLB shorter than its header says, a `.gltf` whose `.bin` or
-texture file is missing or not an image, non-finite coordinates, no triangles, or trimesh's own reason for a file it
-cannot parse. A texture or buffer URI is read as glTF means it: percent-decoded and relative to the `.gltf`
+texture file is missing or not an image, an OBJ whose `.mtl` (`mtllib`) or `map_Kd`/`map_Ke` texture is missing
+(naming the entry and the path looked for) or not an image, a `usemtl` naming no material of its MTL files, an MTL
+value out of range (`Kd` outside [0, 1], ...), non-finite coordinates, no triangles, or trimesh's own reason for a
+file it cannot parse. A texture or buffer URI is read as glTF means it: percent-decoded and relative to the `.gltf`
 (`../textures/` included).
 """
 

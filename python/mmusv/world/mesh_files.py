@@ -3,14 +3,12 @@
 :func:`load_mesh_file` first checks what trimesh would report obscurely or not at all (an empty file, an extension
 trimesh cannot read, a GLB shorter than its header says, a glTF buffer or image file that is missing), reads the file
 unprocessed, refuses non-finite vertex coordinates (trimesh's processing would drop the faces touching them without
-a word), then processes each piece as ``trimesh.load(process=True)`` would. glTF/GLB files bring their PBR materials
-as glTF 2.0 defines them, each texture by its mean over its texels: base colour = ``baseColorFactor`` times the
-``baseColorTexture`` (sRGB-encoded, averaged in linear RGB); roughness and metallic = ``roughnessFactor`` and
-``metallicFactor`` (default 1) times the mean of the ``metallicRoughnessTexture``'s green and blue channels (linear);
-emission = ``emissiveFactor`` (default 0) times the ``emissiveTexture`` (sRGB, averaged in linear RGB) times
-``KHR_materials_emissive_strength`` (default 1), scaled by :data:`GLTF_EMISSIVE_SCALE`. They are registered in
-:mod:`mmusv.world.materials`, one id per face; other formats (and glTF primitives without a material) get material
-0, the class's default look. :func:`mesh_asset` turns a file's mesh into the body frame of a
+a word), then processes each piece as ``trimesh.load(process=True)`` would. Each face gets a registered material
+(:mod:`mmusv.world.mesh_materials`, which says how each is converted): a glTF/GLB file's PBR materials, an OBJ's MTL
+materials by ``usemtl`` (a missing ``.mtl`` or texture is an error, an OBJ without ``mtllib`` the class's default
+look), vertex or face colours (PLY, OBJ) quantised to at most
+:data:`~mmusv.world.mesh_materials.MAX_COLOUR_MATERIALS` materials a file; other faces get material 0, the class's
+default look. :func:`mesh_asset` turns a file's mesh into the body frame of a
 :class:`~mmusv.world.vessels.VesselAsset` (:mod:`mmusv.world.vessels` builds the asset around it), by the entry's
 ``up_axis``/``forward_axis`` or, when it gives neither, the file format's convention
 (:data:`~mmusv.world.asset_spec.FORMAT_AXES`: glTF is +Y up, front +Z).
@@ -23,6 +21,7 @@ import math
 import os
 import struct
 import warnings
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 from urllib.parse import unquote
@@ -32,7 +31,16 @@ import numpy as np
 from mmusv.errors import ConfigError
 from mmusv.validation import join
 from mmusv.world.asset_spec import AXES, FORMAT_AXES, AssetSpecError, MeshAssetSpec, dimension_problem
-from mmusv.world.materials import NAV_LAMP_RADIANCE, Material, register_material
+from mmusv.world.mesh_materials import (
+    GLTF_EMISSIVE_SCALE,
+    ObjMaterials,
+    check_image,
+    colour_material_ids,
+    face_colours,
+    gltf_material_id,
+    obj_materials,
+    one_line,
+)
 from mmusv.world.primitives import TriMesh
 
 if TYPE_CHECKING:
@@ -44,102 +52,6 @@ __all__ = ["GLTF_EMISSIVE_SCALE", "load_mesh_file", "mesh_asset"]
 def _axis(name: str) -> np.ndarray:
     """The unit vector of a validated axis name (``x`` ... ``-z``)."""
     return (-1.0 if name.startswith("-") else 1.0) * np.array(AXES[name[-1]])
-
-
-GLTF_EMISSIVE_SCALE = 0.05 * NAV_LAMP_RADIANCE
-"""cd/m² of a glTF ``emissiveFactor`` of 1 (glTF's emission is relative; 1e3 cd/m² is a bright lit panel)."""
-
-
-def _srgb_to_linear(c: np.ndarray) -> np.ndarray:
-    c = np.clip(np.asarray(c, dtype=np.float64), 0.0, 1.0)
-    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
-
-
-def _unit_factor(value: object, n: int, default: float) -> np.ndarray:
-    """A trimesh colour/factor as floats in [0, 1] (trimesh keeps colour factors as uint8)."""
-    if value is None:
-        return np.full(n, default)
-    a = np.asarray(value).reshape(-1)[:n]
-    f = a.astype(np.float64) / 255.0 if a.dtype.kind in "ui" else a.astype(np.float64)
-    return np.pad(f, (0, n - f.shape[0]), constant_values=default)
-
-
-def _texture_mean(tex: object, *, srgb: bool) -> np.ndarray:
-    """The mean RGB of a texture image over its texels, in [0, 1]: decoded from sRGB to linear first when ``srgb``
-    (colour textures), as stored otherwise (data textures: metallic-roughness)."""
-    pix = np.asarray(tex.convert("RGB"), dtype=np.float64).reshape(-1, 3) / 255.0  # type: ignore[attr-defined]
-    return np.asarray((_srgb_to_linear(pix) if srgb else pix).mean(axis=0), dtype=np.float64)
-
-
-def _pbr_material(mat: object, name: str, emissive_strength: float = 1.0) -> Material:
-    """A :class:`Material` from a trimesh material (glTF PBR; a plain material's diffuse colour otherwise).
-
-    As glTF 2.0 defines it (module docstring), each texture by its mean: ``baseColorFactor`` (linear) times the
-    sRGB ``baseColorTexture``; ``roughnessFactor`` / ``metallicFactor`` (default 1) times the green / blue channel
-    of the linear ``metallicRoughnessTexture``; ``emissiveFactor`` (default 0) times the sRGB ``emissiveTexture``
-    times ``emissive_strength`` (``KHR_materials_emissive_strength``), scaled by :data:`GLTF_EMISSIVE_SCALE`.
-    """
-    base = np.ones(3)
-    rough, metal, emis = 1.0, 1.0, np.zeros(3)
-    factor = getattr(mat, "baseColorFactor", None)
-    if factor is not None or hasattr(mat, "roughnessFactor"):
-        base = _unit_factor(factor, 3, 1.0)
-        tex = getattr(mat, "baseColorTexture", None)
-        if tex is not None:
-            base = base * _texture_mean(tex, srgb=True)
-        r = getattr(mat, "roughnessFactor", None)
-        m = getattr(mat, "metallicFactor", None)
-        rough = 1.0 if r is None else float(r)
-        metal = 1.0 if m is None else float(m)
-        mr = getattr(mat, "metallicRoughnessTexture", None)
-        if mr is not None:
-            mr_mean = _texture_mean(mr, srgb=False)
-            rough, metal = rough * float(mr_mean[1]), metal * float(mr_mean[2])
-        e = getattr(mat, "emissiveFactor", None)
-        if e is not None:
-            emis = _unit_factor(e, 3, 0.0) * emissive_strength * GLTF_EMISSIVE_SCALE
-            etex = getattr(mat, "emissiveTexture", None)
-            if etex is not None:
-                emis = emis * _texture_mean(etex, srgb=True)
-    else:
-        diffuse = getattr(mat, "diffuse", None)
-        base = _srgb_to_linear(_unit_factor(diffuse, 3, 1.0)) if diffuse is not None else np.full(3, 0.5)
-        rough, metal = 0.5, 0.0
-    return Material(
-        name=name,
-        base_color=(float(base[0]), float(base[1]), float(base[2])),
-        roughness=float(np.clip(rough, 0.02, 1.0)),
-        metallic=float(np.clip(metal, 0.0, 1.0)),
-        emissive=(float(emis[0]), float(emis[1]), float(emis[2])),
-    )
-
-
-def _material_ids(mat: object, stem: str, cache: dict[int, int], strengths: dict[str | None, float]) -> int:
-    """The registered id of a trimesh material (named ``<file stem>:<material name>``, suffixed if that name is
-    taken by another material); ``strengths``: the file's ``KHR_materials_emissive_strength`` by material name."""
-    key = id(mat)
-    if key in cache:
-        return cache[key]
-    raw = getattr(mat, "name", None)
-    label = str(raw or "material")
-    strength = strengths.get(raw if isinstance(raw, str) else None, 1.0)
-    k = 1
-    while True:
-        name = f"{stem}:{label}" if k == 1 else f"{stem}:{label}#{k}"
-        m = _pbr_material(mat, name, strength)
-        try:
-            cache[key] = register_material(m)
-            return cache[key]
-        except ConfigError as exc:
-            if "already registered" not in str(exc):
-                raise
-            k += 1
-
-
-def _one_line(exc: BaseException) -> str:
-    """An exception as one line of text (its type too where its message alone says little, a ``KeyError``'s)."""
-    text = " ".join(str(exc).split())
-    return f"{type(exc).__name__}: {text}" if isinstance(exc, LookupError) or not text else text
 
 
 _MESH_FORMATS = frozenset({"3mf", "dae", "glb", "gltf", "obj", "off", "ply", "stl"})
@@ -178,21 +90,10 @@ def _gltf_json(path: Path, where: str) -> dict[str, object]:
             text = path.read_bytes()
         data = json.loads(text)
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise AssetSpecError(where, f"{shown} is not a glTF file: its JSON does not parse ({_one_line(exc)})") from exc
+        raise AssetSpecError(where, f"{shown} is not a glTF file: its JSON does not parse ({one_line(exc)})") from exc
     if not isinstance(data, dict):
         raise AssetSpecError(where, f"{shown} is not a glTF file: its JSON is not an object")
     return data
-
-
-def _check_image(target: Path, what: str, where: str) -> None:
-    """Refuses a texture file that is not an image Pillow reads (trimesh would leave the texture out silently)."""
-    from PIL import Image, UnidentifiedImageError
-
-    try:
-        with Image.open(target) as img:
-            img.verify()
-    except (OSError, UnidentifiedImageError, SyntaxError, ValueError) as exc:
-        raise AssetSpecError(where, f"{what} is not an image mmusv can read ({_one_line(exc)})") from None
 
 
 def _gltf_checks(path: Path, data: dict[str, object], where: str) -> dict[str | None, float]:
@@ -214,7 +115,7 @@ def _gltf_checks(path: Path, data: dict[str, object], where: str) -> dict[str | 
                     f"{str(target)!r}); keep a .gltf's .bin and texture files beside it",
                 )
             if kind == "images":
-                _check_image(target, f"{shown}: its texture {uri!r} ({kind}[{i}].uri)", where)
+                check_image(target, f"{shown}: its texture {uri!r} ({kind}[{i}].uri)", where)
     strengths: dict[str | None, float] = {}
     materials = data.get("materials")
     for i, m in enumerate(materials if isinstance(materials, list) else []):
@@ -279,10 +180,67 @@ def _check_file(path: Path, where: str, formats: list[str]) -> dict[str | None, 
     return _gltf_checks(path, _gltf_json(path, where), where)
 
 
+_FACE_COLOURS = "mmusv_face_colours"
+"""The metadata key of a piece's face colours, taken before trimesh's processing merges vertices."""
+
+
+def _mtl_resolver(path: Path, mtl: ObjMaterials) -> FilePathResolver:
+    """A trimesh file resolver for the OBJ ``path`` that answers its ``mtllib`` with every material's name and index
+    (:meth:`ObjMaterials.resolver_text`): trimesh then groups the faces by ``usemtl`` and names the material of each
+    piece, and reads no file itself (it would leave a missing one out without a word)."""
+    from trimesh.resolvers import FilePathResolver
+
+    class MtlResolver(FilePathResolver):  # type: ignore[misc,unused-ignore]
+        def get(self, name: str) -> bytes:
+            return mtl.resolver_text()
+
+    return MtlResolver(str(path))
+
+
+def _face_materials(
+    pieces: Sequence[object],
+    path: Path,
+    where: str,
+    strengths: dict[str | None, float] | None,
+    mtl: ObjMaterials | None,
+) -> np.ndarray:
+    """The material id of every face of the file's ``pieces`` (trimesh meshes), in order: a glTF's PBR materials
+    (``strengths`` given), an OBJ's MTL materials, else its vertex/face colours, else 0, the class default."""
+    out: list[np.ndarray] = []
+    colour_at: list[tuple[int, np.ndarray]] = []
+    cache: dict[int, int] = {}
+    for g in pieces:
+        n = len(g.faces)  # type: ignore[attr-defined]
+        visual = getattr(g, "visual", None)
+        mat = getattr(visual, "material", None)
+        if strengths is not None:
+            try:
+                mid = gltf_material_id(mat, path.stem, cache, strengths) if hasattr(visual, "material") else 0
+            except ConfigError as exc:
+                raise AssetSpecError(where, f"{str(path)!r}: {one_line(exc)}") from None
+            out.append(np.full(n, mid, dtype=np.uint16))
+            continue
+        index = getattr(mat, "kwargs", {}).get("mmusv_index") if mtl is not None else None
+        if index is not None:
+            out.append(np.full(n, mtl.material_id(int(index[0])), dtype=np.uint16))  # type: ignore[union-attr]
+            continue
+        colours = getattr(g, "metadata", {}).get(_FACE_COLOURS)
+        if colours is not None:
+            colour_at.append((len(out), colours))
+        out.append(np.zeros(n, dtype=np.uint16))
+    if colour_at:
+        ids = colour_material_ids(np.concatenate([c for _, c in colour_at]), path, where)
+        start = 0
+        for k, c in colour_at:
+            out[k] = ids[start : start + len(c)]
+            start += len(c)
+    return np.concatenate(out)
+
+
 def load_mesh_file(path: Path, where: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Vertices ``(V, 3)``, faces ``(F, 3)`` and material ids ``(F,)`` of a mesh file (glTF/GLB: its PBR
-    materials, registered; other formats: material 0). Every problem is one :class:`AssetSpecError` at ``where``
-    naming the file and what is wrong with it."""
+    """Vertices ``(V, 3)``, faces ``(F, 3)`` and material ids ``(F,)`` of a mesh file (its glTF PBR or OBJ MTL
+    materials, or its vertex/face colours, registered; else material 0). Every problem is one
+    :class:`AssetSpecError` at ``where`` naming the file and what is wrong with it."""
     if not path.is_file():
         what = "is a folder, not a mesh file" if path.is_dir() else "does not exist"
         raise AssetSpecError(where, f"mesh file {str(path)!r} {what}")
@@ -292,13 +250,14 @@ def load_mesh_file(path: Path, where: str) -> tuple[np.ndarray, np.ndarray, np.n
         raise AssetSpecError(where, "loading mesh files needs the 'trimesh' package (pip install trimesh)") from exc
     strengths = _check_file(path, where, list(trimesh.available_formats()))
     gltf = path.suffix.lower() in FORMAT_AXES
+    mtl = obj_materials(path, where) if path.suffix.lower() == ".obj" else None
     try:
         # Read unprocessed: trimesh's processing silently drops every face touching a NaN/inf vertex, so the raw
         # arrays are checked first; each piece is then processed exactly as ``trimesh.load(process=True)`` would.
-        resolver = _resolver(path) if gltf else None
+        resolver = _resolver(path) if gltf else (_mtl_resolver(path, mtl) if mtl is not None else None)
         scene = trimesh.load(str(path), force="scene", process=False, resolver=resolver)
     except Exception as exc:  # trimesh raises many types for unreadable files
-        raise AssetSpecError(where, f"cannot read {str(path)!r}: {_one_line(exc)}") from exc
+        raise AssetSpecError(where, f"cannot read {str(path)!r}: {one_line(exc)}") from exc
     if not isinstance(scene, trimesh.Scene):
         raise AssetSpecError(where, f"{str(path)!r} does not hold a triangle mesh")
     geoms = [g for g in scene.geometry.values() if isinstance(g, trimesh.Trimesh)]
@@ -312,38 +271,20 @@ def load_mesh_file(path: Path, where: str) -> tuple[np.ndarray, np.ndarray, np.n
             )
     try:
         for g in geoms:
+            if not gltf:  # before processing: it merges vertices at one place whatever their colours
+                g.metadata[_FACE_COLOURS] = face_colours(g)
             g.process()
-        loaded = scene if gltf else scene.to_mesh()
+        pieces = [g for g in scene.dump() if isinstance(g, trimesh.Trimesh)]
     except Exception as exc:  # trimesh raises many types for unreadable files
-        raise AssetSpecError(where, f"cannot read {str(path)!r}: {_one_line(exc)}") from exc
-    if gltf and isinstance(loaded, trimesh.Scene):
-        pieces = [g for g in loaded.dump() if isinstance(g, trimesh.Trimesh)]
-        cache: dict[int, int] = {}
-        try:
-            mats = [
-                np.full(
-                    len(g.faces),
-                    _material_ids(getattr(g.visual, "material", None), path.stem, cache, strengths)
-                    if hasattr(g.visual, "material")
-                    else 0,
-                    dtype=np.uint16,
-                )
-                for g in pieces
-            ]
-        except ConfigError as exc:
-            raise AssetSpecError(where, f"{str(path)!r}: {_one_line(exc)}") from None
-        if not pieces:
-            raise AssetSpecError(where, f"{str(path)!r} holds no triangles")
-        offsets = np.cumsum([0] + [len(g.vertices) for g in pieces[:-1]])
-        v = np.concatenate([np.asarray(g.vertices, dtype=np.float64) for g in pieces])
-        fc = np.concatenate([np.asarray(g.faces, dtype=np.int64) + o for g, o in zip(pieces, offsets, strict=True)])
-        fm = np.concatenate(mats)
-    elif isinstance(loaded, trimesh.Trimesh):
-        v = np.asarray(loaded.vertices, dtype=np.float64).reshape(-1, 3)
-        fc = np.asarray(loaded.faces, dtype=np.int64).reshape(-1, 3)
-        fm = np.zeros(fc.shape[0], dtype=np.uint16)
-    else:
-        raise AssetSpecError(where, f"{str(path)!r} does not hold a triangle mesh")
+        raise AssetSpecError(where, f"cannot read {str(path)!r}: {one_line(exc)}") from exc
+    if not pieces:
+        raise AssetSpecError(where, f"{str(path)!r} holds no triangles")
+    fm = _face_materials(pieces, path, where, strengths if gltf else None, mtl)
+    offsets = np.cumsum([0] + [len(g.vertices) for g in pieces[:-1]])
+    v = np.concatenate([np.asarray(g.vertices, dtype=np.float64).reshape(-1, 3) for g in pieces])
+    fc = np.concatenate(
+        [np.asarray(g.faces, dtype=np.int64).reshape(-1, 3) + o for g, o in zip(pieces, offsets, strict=True)]
+    )
     v = v.reshape(-1, 3)
     fc = fc.reshape(-1, 3)
     if fc.shape[0] == 0:
