@@ -46,8 +46,10 @@ file's format decides (`mmusv.world.asset_spec.FORMAT_AXES`): a `.gltf`/`.glb` f
 towards +Z, as glTF 2.0 defines (section 3.4, "Coordinate System and Units"; Blender's glTF export writes it so),
 and every other format z up, x forward (`mmusv.world.asset_spec.DEFAULT_AXES`: OBJ, PLY, STL and OFF have no
 convention of their own). When an entry gives one axis, the other defaults to z (up) or x (forward) whatever the
-format. A mesh that comes out wider than long under a defaulted axis gets a warning (`MmusvWarning`) naming the
-file and the keys to set; giving both axes silences it.
+format. A mesh that comes out wider or taller than long under a defaulted axis gets a warning (`MmusvWarning`)
+naming the file and the keys to set; giving both axes silences it. Taller than long is what an OBJ or PLY exported
+from Blender with its defaults (Y up) looks like read z up: a hull standing on end; the warning says to give
+`up_axis: y` and the bow's direction. A dinghy whose mast stands higher than its hull is long warns too.
 
 **Changed:** before, every file, glTF included, defaulted to z up, x forward. A `.gltf`/`.glb` written z-up (a
 z-up mesh exported by trimesh, some CAD tools) whose entry gives neither axis now loads on its side: add

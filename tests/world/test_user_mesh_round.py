@@ -184,6 +184,23 @@ def test_a_mesh_lying_sideways_under_default_axes_is_warned_about(tmp_path: Path
     _check_geometry(_load({"mesh": str(path), "up_axis": "z", "forward_axis": "y"}))
 
 
+def test_a_y_up_obj_standing_on_end_under_default_axes_is_warned_about(tmp_path: Path) -> None:
+    """An OBJ exported y-up (Blender's OBJ default) read z up stands on end: 10 m tall, 3 m long, no word (the
+    wider-than-long warning could not see it: the length became the height, not the beam)."""
+    import trimesh
+
+    path = tmp_path / "blender.obj"
+    # A low hull, 10 m long, 3 m beam, 2 m high, y up and the bow along file +z: read z up it is 3 m "long", 2 m
+    # "wide" and 10 m tall, so only its height gives it away.
+    trimesh.creation.box(extents=[3.0, 2.0, 10.0]).export(path)
+    with pytest.warns(MmusvWarning, match=r"blender\.obj.*10 m tall but 3 m long.*give up_axis: y"):
+        load_asset_file({"name": "user_hull", "mesh": str(path)})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # both axes given: no warning
+        a = load_asset_file({"name": "user_hull_2", "mesh": str(path), "up_axis": "y", "forward_axis": "z"})
+    assert (a.length, a.beam) == pytest.approx((10.0, 3.0))
+
+
 # --------------------------------------------------------------------------------- node graphs and units
 
 

@@ -26,7 +26,8 @@ unchanged. With ``box="visible"`` (the default) that is the tight box of the ves
 subtracts the 1 again). ``conf`` 1 (every line is evaluated). ``class``: the vessel's semantic class id of
 :mod:`mmusv.classes` (COCO's ``category_id``: 10 ``vessel``, 11 ``usv``). ``visibility``: 1 − the recorded
 ``occlusion`` (:mod:`mmusv.annotate`: the share of the vessel's silhouette above the still water level that other
-objects or the waves hide; the part outside the image, truncation, is not counted). Numbers: whole numbers as such,
+objects or the waves hide; the part outside the image, truncation, is not counted, where MOT16/MOT17's
+ratio also counts the part cropped by the image border). Numbers: whole numbers as such,
 the rest to 3 decimals (boxes) or 6 (visibility).
 
 At the root: ``classes.csv`` (``class,name``: every class of :data:`mmusv.export.camera.CATEGORIES`), ``tracks.csv``

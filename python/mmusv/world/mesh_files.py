@@ -33,9 +33,11 @@ from mmusv.validation import join
 from mmusv.world.asset_spec import AXES, FORMAT_AXES, AssetSpecError, MeshAssetSpec, dimension_problem
 from mmusv.world.mesh_materials import (
     GLTF_EMISSIVE_SCALE,
+    EmissiveKey,
     ObjMaterials,
     check_image,
     colour_material_ids,
+    emissive_key,
     face_colours,
     gltf_material_id,
     obj_materials,
@@ -96,10 +98,11 @@ def _gltf_json(path: Path, where: str) -> dict[str, object]:
     return data
 
 
-def _gltf_checks(path: Path, data: dict[str, object], where: str) -> dict[str | None, float]:
+def _gltf_checks(path: Path, data: dict[str, object], where: str) -> dict[EmissiveKey, float]:
     """Refuses a glTF whose external buffers or images are missing (trimesh would fail with the bare file name, or
-    leave a texture out without a word); returns ``KHR_materials_emissive_strength`` by material name (trimesh
-    drops the extension), refusing a material name that stands for two different strengths."""
+    leave a texture out without a word); returns ``KHR_materials_emissive_strength`` by material name and
+    ``emissiveFactor`` (:func:`~mmusv.world.mesh_materials.emissive_key`; trimesh drops the extension), refusing two
+    materials of one name and one factor with different strengths."""
     shown = repr(str(path))
     for kind in ("buffers", "images"):
         items = data.get(kind)
@@ -116,7 +119,7 @@ def _gltf_checks(path: Path, data: dict[str, object], where: str) -> dict[str | 
                 )
             if kind == "images":
                 check_image(target, f"{shown}: its texture {uri!r} ({kind}[{i}].uri)", where)
-    strengths: dict[str | None, float] = {}
+    strengths: dict[EmissiveKey, float] = {}
     materials = data.get("materials")
     for i, m in enumerate(materials if isinstance(materials, list) else []):
         if not isinstance(m, dict):
@@ -130,14 +133,16 @@ def _gltf_checks(path: Path, data: dict[str, object], where: str) -> dict[str | 
                 where,
                 f"{shown}: materials[{i}] has KHR_materials_emissive_strength {value!r}; it must be a number >= 0",
             )
-        name = m.get("name") if isinstance(m.get("name"), str) else None
-        if strengths.get(name, float(value)) != float(value):
+        key = emissive_key(m.get("name"), m.get("emissiveFactor"))
+        if key is None:  # emits nothing: the strength changes nothing
+            continue
+        if strengths.get(key, float(value)) != float(value):
             raise AssetSpecError(
                 where,
-                f"{shown}: two materials named {name!r} have different KHR_materials_emissive_strength; give them "
-                "different names",
+                f"{shown}: two materials named {key[0]!r} with the same emissiveFactor have different "
+                "KHR_materials_emissive_strength; give them different names",
             )
-        strengths[name] = float(value)
+        strengths[key] = float(value)
     return strengths
 
 
@@ -164,9 +169,9 @@ def _resolver(path: Path) -> FilePathResolver:
         return GltfResolver(str(path))
 
 
-def _check_file(path: Path, where: str, formats: list[str]) -> dict[str | None, float]:
+def _check_file(path: Path, where: str, formats: list[str]) -> dict[EmissiveKey, float]:
     """Refuses what trimesh would read obscurely or not at all (module docstring); returns a glTF's emissive
-    strengths by material name (empty for other formats)."""
+    strengths by material name and factor (empty for other formats)."""
     shown = repr(str(path))
     name = path.name.lower()
     if not any(name.endswith("." + f) for f in formats):
@@ -201,7 +206,7 @@ def _face_materials(
     pieces: Sequence[object],
     path: Path,
     where: str,
-    strengths: dict[str | None, float] | None,
+    strengths: dict[EmissiveKey, float] | None,
     mtl: ObjMaterials | None,
 ) -> np.ndarray:
     """The material id of every face of the file's ``pieces`` (trimesh meshes), in order: a glTF's PBR materials
@@ -319,7 +324,7 @@ def mesh_asset(spec: MeshAssetSpec, *, path: str, base_dir: Path | None, cls: in
             f"{spec.scale:g} (file units -> metres) applied to {str(mesh_path)!r} {problem}; "
             "check the mesh's units and scale",
         )
-    if (spec.up_axis is None or spec.forward_axis is None) and ext[1] > ext[0]:
+    if (spec.up_axis is None or spec.forward_axis is None) and max(ext[1], ext[2]) > ext[0]:
         _warn_sideways(spec, mesh_path, path, (up_name, fwd_name), ext)
     body = body * spec.scale
     zmin, zmax = float(body[:, 2].min()), float(body[:, 2].max())
@@ -351,7 +356,9 @@ def _defaulted(spec: MeshAssetSpec, mesh_path: Path) -> str:
 
 def _warn_sideways(spec: MeshAssetSpec, mesh_path: Path, path: str, axes: tuple[str, str], ext: list[float]) -> None:
     """Warns (:class:`~mmusv.scenario_checks.MmusvWarning`) that a mesh read with a defaulted axis came out wider
-    than long: its bow probably does not point along the forward axis assumed (or the file is z-up glTF)."""
+    or taller than long: its bow probably does not point along the forward axis assumed (or the file is z-up glTF,
+    or y-up OBJ/PLY as Blender exports them by default, which stands the hull on end). A dinghy whose mast is taller
+    than its hull is long warns too: giving both axes silences it."""
     from mmusv.scenario_checks import MmusvWarning  # here: scenario_checks imports the config, which imports us
 
     given = (
@@ -366,9 +373,16 @@ def _warn_sideways(spec: MeshAssetSpec, mesh_path: Path, path: str, axes: tuple[
         if gltf and given.startswith("neither")
         else ""
     )
+    tall = ext[2] > ext[1]
+    if tall and not hint:
+        hint = (
+            " A y-up file (Blender's OBJ and PLY export default) is read standing on end: give up_axis: y and "
+            "forward_axis the bow's direction in the file."
+        )
+    size = f"{ext[2]:.4g} m tall" if tall else f"{ext[1]:.4g} m wide"
     warnings.warn(
         f"{join(path, 'mesh')}: {str(mesh_path)!r}, read with {given} given (up {axes[0]}, forward {axes[1]}), is "
-        f"{ext[1]:.4g} m wide but {ext[0]:.4g} m long: if its bow does not point along "
+        f"{size} but {ext[0]:.4g} m long: if its bow does not point along "
         f"{axes[1]}, set forward_axis and up_axis in the entry (giving both also silences this warning).{hint}",
         MmusvWarning,
         stacklevel=5,

@@ -65,6 +65,7 @@ __all__ = [
     "ObjMaterials",
     "check_image",
     "colour_material_ids",
+    "emissive_key",
     "face_colours",
     "gltf_material_id",
     "obj_materials",
@@ -92,13 +93,15 @@ def one_line(exc: BaseException) -> str:
 
 
 def check_image(target: Path, what: str, where: str) -> None:
-    """Refuses a texture file that is not an image Pillow reads (trimesh would leave the texture out silently)."""
-    from PIL import Image, UnidentifiedImageError
+    """Refuses a texture file that is not an image Pillow reads (trimesh would leave the texture out silently).
+    Any exception counts: other libraries replace ``PIL.Image.open`` (Ultralytics, once imported, answers a file
+    Pillow cannot identify with its HEIF plugin's ``ModuleNotFoundError``)."""
+    from PIL import Image
 
     try:
         with Image.open(target) as img:
             img.verify()
-    except (OSError, UnidentifiedImageError, SyntaxError, ValueError) as exc:
+    except Exception as exc:
         raise AssetSpecError(where, f"{what} is not an image mmusv can read ({one_line(exc)})") from None
 
 
@@ -189,13 +192,34 @@ def _register(stem: str, label: str, make: object) -> int:
             k += 1
 
 
-def gltf_material_id(mat: object, stem: str, cache: dict[int, int], strengths: dict[str | None, float]) -> int:
+EmissiveKey = tuple[str | None, tuple[float, ...]]
+"""A glTF material's name and ``emissiveFactor``: what its ``KHR_materials_emissive_strength`` is found by."""
+
+
+def emissive_key(name: object, factor: object) -> EmissiveKey | None:
+    """The key of a glTF material's ``KHR_materials_emissive_strength`` (trimesh drops the extension, so the strength
+    is read from the file's JSON and found again by the material's name and ``emissiveFactor``); ``None`` for a
+    material that emits nothing (no ``emissiveFactor``, or all zero: its strength changes nothing)."""
+    if factor is None:
+        return None
+    try:
+        f = tuple(float(x) for x in np.asarray(factor, dtype=np.float64).reshape(-1))
+    except (TypeError, ValueError):
+        return None
+    if not any(f):
+        return None
+    return (name if isinstance(name, str) else None, f)
+
+
+def gltf_material_id(mat: object, stem: str, cache: dict[int, int], strengths: dict[EmissiveKey, float]) -> int:
     """The registered id of a trimesh material (named ``<file stem>:<material name>``, suffixed if that name is
-    taken by another material); ``strengths``: the file's ``KHR_materials_emissive_strength`` by material name."""
+    taken by another material); ``strengths``: the file's ``KHR_materials_emissive_strength`` by
+    :func:`emissive_key`."""
     key = id(mat)
     if key not in cache:
         raw = getattr(mat, "name", None)
-        strength = strengths.get(raw if isinstance(raw, str) else None, 1.0)
+        found = emissive_key(raw, getattr(mat, "emissiveFactor", None))
+        strength = 1.0 if found is None else strengths.get(found, 1.0)
         cache[key] = _register(stem, str(raw or "material"), lambda name: _pbr_material(mat, name, strength))
     return cache[key]
 
@@ -229,10 +253,14 @@ class ObjMaterials:
     where: str
     entries: list[_MtlEntry]
     ids: dict[int, int] = field(default_factory=dict)
+    aliases: dict[str, int] = field(default_factory=dict)
+    """A ``usemtl`` name as trimesh's OBJ reader takes it (the rest of the line, a ``#`` comment included) → the
+    index of the material it names, where that differs from the material's name."""
 
     def resolver_text(self) -> bytes:
         """An MTL text naming every material with its index, for trimesh (it reads no texture from it)."""
-        return "".join(f"newmtl {e.name}\nmmusv_index {i}\n" for i, e in enumerate(self.entries)).encode()
+        named = [(e.name, i) for i, e in enumerate(self.entries)] + list(self.aliases.items())
+        return "".join(f"newmtl {name}\nmmusv_index {i}\n" for name, i in named).encode()
 
     def material_id(self, index: int) -> int:
         """The registered id of material ``index`` (``<OBJ stem>:<newmtl name>``)."""
@@ -380,7 +408,8 @@ def obj_materials(path: Path, where: str) -> ObjMaterials | None:
     :class:`~mmusv.world.asset_spec.AssetSpecError` at ``where`` naming the OBJ, the entry and the path looked for.
     """
     shown = repr(str(path))
-    lines = _obj_lines(path.read_bytes().decode("utf-8", errors="replace"))
+    text = path.read_bytes().decode("utf-8", errors="replace")
+    lines = _obj_lines(text)
     libs = [(n, toks[1:]) for n, toks in lines if toks[0] == "mtllib" and len(toks) > 1]
     if not libs:
         return None
@@ -406,7 +435,16 @@ def obj_materials(path: Path, where: str) -> ObjMaterials | None:
                 f"{shown}: usemtl {' '.join(toks[1:])!r} (line {n}) names no material of its material libraries "
                 f"({', '.join(repr(k) for k in sorted(known)) or 'none'})",
             )
-    return ObjMaterials(path, where, entries)
+    index = {e.name: i for i, e in enumerate(entries)}  # a name given twice: the last, as trimesh keeps it
+    aliases = {}
+    for raw in text.splitlines():  # trimesh names a usemtl by the rest of its line: 'Deck#2', 'Hull # red'
+        line = raw.strip()
+        if line.startswith("usemtl "):
+            name = line[6:].strip()
+            ours = " ".join(name.split("#", 1)[0].split())
+            if name != ours and ours in index:
+                aliases[name] = index[ours]
+    return ObjMaterials(path, where, entries, aliases=aliases)
 
 
 # ------------------------------------------------------------------------------------------ vertex/face colours
