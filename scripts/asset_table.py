@@ -68,7 +68,16 @@ face); the conversions are `mmusv.world.mesh_materials`'s.
   channels of the `metallicRoughnessTexture`; emission = `emissiveFactor` (default 0) x `emissiveTexture` (sRGB) x
   `KHR_materials_emissive_strength`, 1 standing for `mmusv.world.mesh_files.GLTF_EMISSIVE_SCALE` cd/m². Not read:
   alpha (`alphaMode`, a base colour's alpha: every face is opaque), `doubleSided` (the ray caster hits both sides of
-  every face anyway), normal and occlusion textures, vertex colours (`COLOR_0`).
+  every face anyway), normal and occlusion textures.
+
+  A primitive's vertex colours (`COLOR_0`: float, or unsigned byte/short normalized; RGB or RGBA, alpha not read)
+  multiply its base colour, as glTF 2.0 defines them (section 3.9.2: "an additional linear multiplier to base
+  color") and Blender's glTF importer and three.js's GLTFLoader apply them: taken as linear RGB as stored (not
+  decoded from sRGB, unlike PLY colours), a face's colour is the mean of its three vertices', times the material's
+  base colour, quantised to 64 levels per sRGB channel as vertex colours below. Each distinct result is one
+  material `<file stem>:<material name>:#rrggbb`, the glTF material with that base colour (roughness, metallic and
+  emission kept); a primitive with `COLOR_0` and no material gets the `vertex_colour:#rrggbb` materials below. A
+  hard colour edge (a corner written once per face, as exporters split it) keeps each face's colour.
 - *OBJ with MTL*: each face takes the material its `usemtl` names (`<file stem>:<newmtl name>`), from the files its
   `mtllib` lines name (relative to the `.obj`; textures relative to the `.mtl`, options such as `-s 1 1 1` skipped,
   as the [MTL spec](https://paulbourke.net/dataformats/mtl/) writes them, else by their file name beside the `.mtl`,
@@ -98,16 +107,20 @@ face); the conversions are `mmusv.world.mesh_materials`'s.
   each distinct colour is one material `vertex_colour:#rrggbb` (roughness 0.5, metallic 0, as the class default),
   shared by all files. A file with more than 256 distinct face colours
   (`mmusv.world.mesh_materials.MAX_COLOUR_MATERIALS`) is quantised coarser (32, 16, ... levels) until it has no
-  more, with a `MmusvWarning` saying so. An OBJ's faces with an MTL material keep that material.
-- STL, OFF and other files without colours, and glTF primitives without a material, get the class's default look.
+  more (a glTF's `COLOR_0` materials counted with them), with a `MmusvWarning` saying so. An OBJ's faces with an
+  MTL material keep that material.
+- STL, OFF and other files without colours, and glTF primitives with neither a material nor `COLOR_0`, get the
+  class's default look.
 
 **Bad files** are one `AssetSpecError` line naming the entry's `mesh` key, the file and what is wrong: missing, a
 folder, empty, an extension trimesh does not read, a GLB shorter than its header says, a `.gltf` whose `.bin` or
 texture file is missing or not an image, an OBJ whose `.mtl` (`mtllib`) or `map_Kd`/`map_Ke` texture is missing
 (naming the entry and the path looked for) or not an image, a `usemtl` naming no material of its MTL files, an MTL
-value out of range (`Kd` outside [0, 1], ...), non-finite coordinates, no triangles, or trimesh's own reason for a
-file it cannot parse. A texture or buffer URI is read as glTF means it: percent-decoded and relative to the `.gltf`
-(`../textures/` included).
+value out of range (`Kd` outside [0, 1], ...), a `COLOR_0` that glTF does not allow or that does not fit its
+primitive (naming the primitive and accessor: another count than its `POSITION`, not VEC3/VEC4, not float or
+normalized unsigned byte/short, non-finite or outside [0, 1]), non-finite coordinates, no triangles, or trimesh's
+own reason for a file it cannot parse. A texture or buffer URI is read as glTF means it: percent-decoded and
+relative to the `.gltf` (`../textures/` included).
 """
 
 

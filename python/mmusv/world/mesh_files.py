@@ -1,10 +1,12 @@
 """User vessel meshes from files: OBJ, STL, PLY, OFF, GLB/glTF and the rest trimesh reads.
 
 :func:`load_mesh_file` first checks what trimesh would report obscurely or not at all (an empty file, an extension
-trimesh cannot read, a GLB shorter than its header says, a glTF buffer or image file that is missing), reads the file
-unprocessed, refuses non-finite vertex coordinates (trimesh's processing would drop the faces touching them without
-a word), then processes each piece as ``trimesh.load(process=True)`` would. Each face gets a registered material
-(:mod:`mmusv.world.mesh_materials`, which says how each is converted): a glTF/GLB file's PBR materials, an OBJ's MTL
+trimesh cannot read, a GLB shorter than its header says, a glTF buffer or image file that is missing, a ``COLOR_0``
+that does not fit its primitive), reads the file unprocessed, refuses non-finite vertex coordinates (trimesh's
+processing would drop the faces touching them without a word), takes each face's colours (merging vertices would
+keep one colour per place), then processes each piece as ``trimesh.load(process=True)`` would. Each face gets a
+registered material (:mod:`mmusv.world.mesh_materials`, which says how each is converted): a glTF/GLB file's PBR
+materials (times its primitives' ``COLOR_0`` vertex colours, read here from the loader's raw arrays), an OBJ's MTL
 materials by ``usemtl`` (a missing ``.mtl`` or texture is an error, an OBJ without ``mtllib`` the class's default
 look), vertex or face colours (PLY, OBJ) quantised to at most
 :data:`~mmusv.world.mesh_materials.MAX_COLOUR_MATERIALS` materials a file; other faces get material 0, the class's
@@ -146,6 +148,124 @@ def _gltf_checks(path: Path, data: dict[str, object], where: str) -> dict[Emissi
     return strengths
 
 
+_GLTF_MODES = frozenset({0, 1, 4, 5})
+"""The primitive modes trimesh's glTF loader reads (points, lines, triangles, triangle strips), one geometry each."""
+
+_COLOR_TYPES = {5126: "float", 5121: "unsigned byte", 5123: "unsigned short"}
+"""The component types glTF 2.0 allows for ``COLOR_n`` (the integer ones normalized)."""
+
+
+def _accessor(data: dict[str, object], index: object) -> dict[str, object] | None:
+    """``accessors[index]`` of a glTF JSON, ``None`` when ``index`` names none."""
+    accessors = data.get("accessors")
+    ok = isinstance(index, int) and not isinstance(index, bool) and isinstance(accessors, list)
+    if not ok or not 0 <= index < len(accessors):  # type: ignore[operator,arg-type]
+        return None
+    a = accessors[index]  # type: ignore[index]
+    return a if isinstance(a, dict) else None
+
+
+def _color_0_checks(path: Path, data: dict[str, object], where: str) -> list[str]:
+    """Refuses a ``COLOR_0`` that glTF 2.0 does not allow or that does not fit its primitive (not an accessor, not
+    VEC3/VEC4, not float or normalized unsigned byte/short, another count than ``POSITION``'s: trimesh would drop or
+    misread it without a word); returns the name (``meshes[i].primitives[j]``) of each primitive trimesh makes a
+    geometry of, in its order."""
+    shown = repr(str(path))
+    names: list[str] = []
+    meshes = data.get("meshes")
+    for i, m in enumerate(meshes if isinstance(meshes, list) else []):
+        prims = m.get("primitives") if isinstance(m, dict) else None
+        for j, p in enumerate(prims if isinstance(prims, list) else []):
+            if not isinstance(p, dict):
+                continue
+            label = f"meshes[{i}].primitives[{j}]"
+            mode = p.get("mode", 4)
+            if isinstance(mode, int) and mode in _GLTF_MODES:
+                names.append(label)
+            attrs = p.get("attributes")
+            if not isinstance(attrs, dict) or "COLOR_0" not in attrs:
+                continue
+            at = f"{shown}: {label}.attributes.COLOR_0"
+            k = attrs["COLOR_0"]
+            acc = _accessor(data, k)
+            if acc is None:
+                raise AssetSpecError(where, f"{at} is {k!r}, which names no accessor of the file")
+            at = f"{at} (accessors[{k}])"
+            kind, comp = acc.get("type"), acc.get("componentType")
+            if kind not in ("VEC3", "VEC4"):
+                raise AssetSpecError(where, f"{at} is of type {kind!r}; a vertex colour must be VEC3 or VEC4")
+            if comp not in _COLOR_TYPES or (comp != 5126 and acc.get("normalized") is not True):
+                what = _COLOR_TYPES.get(comp, "")  # type: ignore[call-overload]
+                got = f"{comp!r} ({what}, not normalized)" if what else repr(comp)
+                raise AssetSpecError(
+                    where,
+                    f"{at} has componentType {got}; a vertex colour must be float (5126), or unsigned byte (5121) "
+                    "or unsigned short (5123) with normalized: true",
+                )
+            pos = _accessor(data, attrs.get("POSITION"))
+            count, vertices = acc.get("count"), None if pos is None else pos.get("count")
+            if vertices is not None and count != vertices:
+                raise AssetSpecError(
+                    where, f"{at} has {count!r} colours for the {vertices!r} vertices of its POSITION accessor"
+                )
+    return names
+
+
+def _color_0_linear(raw: object, at: str, where: str) -> np.ndarray:
+    """A primitive's raw ``COLOR_0`` (trimesh's copy of the accessor) as ``(V, 3)`` linear RGB in [0, 1] (glTF
+    stores it linear; normalized integers divided by their maximum; alpha dropped); non-finite values or values
+    outside [0, 1] are refused."""
+    a = np.asarray(raw)
+    top = {"u1": 255.0, "u2": 65535.0}.get(f"{a.dtype.kind}{a.dtype.itemsize}")
+    if a.ndim != 2 or a.shape[1] not in (3, 4) or (top is None and a.dtype.kind != "f"):
+        raise AssetSpecError(where, f"{at} is not RGB or RGBA colours (read as {a.dtype} {list(a.shape)})")
+    rgb = a[:, :3].astype(np.float64) / (top or 1.0)
+    bad = ~np.isfinite(rgb)
+    if bad.any():
+        raise AssetSpecError(
+            where,
+            f"{at} has non-finite (NaN/inf) values at {int(bad.any(axis=1).sum())} of its {len(rgb)} vertices; "
+            "every vertex colour must be finite",
+        )
+    out = (rgb < 0.0) | (rgb > 1.0)
+    if out.any():
+        raise AssetSpecError(
+            where,
+            f"{at} has values outside [0, 1] at {int(out.any(axis=1).sum())} of its {len(rgb)} vertices (e.g. "
+            f"{rgb[out.any(axis=1)][0].tolist()}); a vertex colour is a linear multiplier in [0, 1]",
+        )
+    return rgb
+
+
+_COLOR_0 = "mmusv_color_0"
+"""The metadata key of a glTF piece's ``COLOR_0`` as linear RGB per vertex, before processing."""
+
+
+def _load_gltf(trimesh: object, path: Path, where: str, names: list[str]) -> object:
+    """The glTF ``path`` as an unprocessed trimesh scene whose pieces keep their ``COLOR_0`` exactly
+    (metadata :data:`_COLOR_0`): trimesh's loader is called for its keyword arguments, and the raw colours it passes
+    on are taken out before trimesh turns them into 8-bit visual colours (a float colour of 0.002 would become
+    1/255) or into an unread vertex attribute. ``names``: :func:`_color_0_checks`'s, for the errors."""
+    from trimesh.exchange.gltf import load_glb, load_gltf
+
+    loader = load_glb if path.suffix.lower() == ".glb" else load_gltf
+    with path.open("rb") as f:
+        kwargs = loader(file_obj=f, resolver=_resolver(path))
+    geometry = kwargs.get("geometry", {}) if isinstance(kwargs, dict) else {}
+    labels = names if len(names) == len(geometry) else [f"mesh {k!r}" for k in geometry]
+    for label, (key, g) in zip(labels, geometry.items(), strict=True):
+        if not isinstance(g, dict):
+            continue
+        raw = g.pop("vertex_colors", None)
+        attrs = getattr(g.get("visual"), "vertex_attributes", None)
+        if attrs is not None and "color" in attrs:
+            raw = attrs.pop("color")
+        if raw is not None:
+            at = f"{str(path)!r}: {label}.attributes.COLOR_0 (geometry {key!r})"
+            g.setdefault("metadata", {})[_COLOR_0] = _color_0_linear(raw, at, where)
+    return trimesh.load(kwargs, force="scene", process=False)  # type: ignore[attr-defined]
+
+
 def _resolver(path: Path) -> FilePathResolver:
     """A trimesh file resolver for the glTF ``path`` that reads its buffers and images as glTF means their URIs:
     percent-decoded (``hull%20paint.png`` is the file ``hull paint.png``; trimesh would look for the literal name and
@@ -169,9 +289,10 @@ def _resolver(path: Path) -> FilePathResolver:
         return GltfResolver(str(path))
 
 
-def _check_file(path: Path, where: str, formats: list[str]) -> dict[EmissiveKey, float]:
+def _check_file(path: Path, where: str, formats: list[str]) -> tuple[dict[EmissiveKey, float], list[str]]:
     """Refuses what trimesh would read obscurely or not at all (module docstring); returns a glTF's emissive
-    strengths by material name and factor (empty for other formats)."""
+    strengths by material name and factor and the names of its primitives (:func:`_color_0_checks`), both empty
+    for other formats."""
     shown = repr(str(path))
     name = path.name.lower()
     if not any(name.endswith("." + f) for f in formats):
@@ -181,8 +302,9 @@ def _check_file(path: Path, where: str, formats: list[str]) -> dict[EmissiveKey,
     if path.stat().st_size == 0:
         raise AssetSpecError(where, f"{shown} is empty (0 bytes): it holds no triangles")
     if path.suffix.lower() not in FORMAT_AXES:
-        return {}
-    return _gltf_checks(path, _gltf_json(path, where), where)
+        return {}, []
+    data = _gltf_json(path, where)
+    return _gltf_checks(path, data, where), _color_0_checks(path, data, where)
 
 
 _FACE_COLOURS = "mmusv_face_colours"
@@ -210,33 +332,38 @@ def _face_materials(
     mtl: ObjMaterials | None,
 ) -> np.ndarray:
     """The material id of every face of the file's ``pieces`` (trimesh meshes), in order: a glTF's PBR materials
-    (``strengths`` given), an OBJ's MTL materials, else its vertex/face colours, else 0, the class default."""
+    (``strengths`` given), times its ``COLOR_0`` where a primitive has one (a ``COLOR_0`` without a material: vertex
+    colour materials), an OBJ's MTL materials, else its vertex/face colours, else 0, the class default."""
     out: list[np.ndarray] = []
-    colour_at: list[tuple[int, np.ndarray]] = []
+    colour_at: list[tuple[int, np.ndarray, int]] = []
     cache: dict[int, int] = {}
     for g in pieces:
         n = len(g.faces)  # type: ignore[attr-defined]
         visual = getattr(g, "visual", None)
         mat = getattr(visual, "material", None)
+        colours = getattr(g, "metadata", {}).get(_FACE_COLOURS)
         if strengths is not None:
+            has = hasattr(visual, "material")
             try:
-                mid = gltf_material_id(mat, path.stem, cache, strengths) if hasattr(visual, "material") else 0
+                mid = gltf_material_id(mat, path.stem, cache, strengths) if has else 0
             except ConfigError as exc:
                 raise AssetSpecError(where, f"{str(path)!r}: {one_line(exc)}") from None
+            if colours is not None:
+                colour_at.append((len(out), colours, mid if has else -1))
             out.append(np.full(n, mid, dtype=np.uint16))
             continue
         index = getattr(mat, "kwargs", {}).get("mmusv_index") if mtl is not None else None
         if index is not None:
             out.append(np.full(n, mtl.material_id(int(index[0])), dtype=np.uint16))  # type: ignore[union-attr]
             continue
-        colours = getattr(g, "metadata", {}).get(_FACE_COLOURS)
         if colours is not None:
-            colour_at.append((len(out), colours))
+            colour_at.append((len(out), colours, -1))
         out.append(np.zeros(n, dtype=np.uint16))
     if colour_at:
-        ids = colour_material_ids(np.concatenate([c for _, c in colour_at]), path, where)
+        tints = np.concatenate([np.full(len(c), t, dtype=np.int64) for _, c, t in colour_at])
+        ids = colour_material_ids(np.concatenate([c for _, c, _ in colour_at]), path, where, tints)
         start = 0
-        for k, c in colour_at:
+        for k, c, _ in colour_at:
             out[k] = ids[start : start + len(c)]
             start += len(c)
     return np.concatenate(out)
@@ -253,14 +380,19 @@ def load_mesh_file(path: Path, where: str) -> tuple[np.ndarray, np.ndarray, np.n
         import trimesh
     except ImportError as exc:  # pragma: no cover - depends on the install
         raise AssetSpecError(where, "loading mesh files needs the 'trimesh' package (pip install trimesh)") from exc
-    strengths = _check_file(path, where, list(trimesh.available_formats()))
+    strengths, names = _check_file(path, where, list(trimesh.available_formats()))
     gltf = path.suffix.lower() in FORMAT_AXES
     mtl = obj_materials(path, where) if path.suffix.lower() == ".obj" else None
     try:
         # Read unprocessed: trimesh's processing silently drops every face touching a NaN/inf vertex, so the raw
         # arrays are checked first; each piece is then processed exactly as ``trimesh.load(process=True)`` would.
-        resolver = _resolver(path) if gltf else (_mtl_resolver(path, mtl) if mtl is not None else None)
-        scene = trimesh.load(str(path), force="scene", process=False, resolver=resolver)
+        if gltf:
+            scene = _load_gltf(trimesh, path, where, names)
+        else:
+            resolver = _mtl_resolver(path, mtl) if mtl is not None else None
+            scene = trimesh.load(str(path), force="scene", process=False, resolver=resolver)
+    except AssetSpecError:
+        raise
     except Exception as exc:  # trimesh raises many types for unreadable files
         raise AssetSpecError(where, f"cannot read {str(path)!r}: {one_line(exc)}") from exc
     if not isinstance(scene, trimesh.Scene):
@@ -275,8 +407,11 @@ def load_mesh_file(path: Path, where: str) -> tuple[np.ndarray, np.ndarray, np.n
                 f"{len(g.vertices)} vertices; every vertex coordinate must be a finite number",
             )
     try:
-        for g in geoms:
-            if not gltf:  # before processing: it merges vertices at one place whatever their colours
+        for g in geoms:  # face colours before processing: it merges vertices at one place whatever their colours
+            if gltf:
+                lin = g.metadata.pop(_COLOR_0, None)
+                g.metadata[_FACE_COLOURS] = None if lin is None else lin[np.asarray(g.faces)].mean(axis=1)
+            else:
                 g.metadata[_FACE_COLOURS] = face_colours(g)
             g.process()
         pieces = [g for g in scene.dump() if isinstance(g, trimesh.Trimesh)]

@@ -8,7 +8,18 @@ mean over its texels (mmusv shades with one material per face).
 ``baseColorTexture`` (sRGB-encoded, averaged in linear RGB); roughness and metallic = ``roughnessFactor`` and
 ``metallicFactor`` (default 1) times the mean of the ``metallicRoughnessTexture``'s green and blue channels
 (linear); emission = ``emissiveFactor`` (default 0) times the ``emissiveTexture`` (sRGB, averaged in linear RGB)
-times ``KHR_materials_emissive_strength`` (default 1), scaled by :data:`GLTF_EMISSIVE_SCALE`.
+times ``KHR_materials_emissive_strength`` (default 1), scaled by :data:`GLTF_EMISSIVE_SCALE`. A primitive's
+``COLOR_0`` vertex colours (glTF 2.0 section 3.9.2: "an additional linear multiplier to base color"; float, or
+unsigned byte/short normalized; RGB or RGBA, alpha not read) are taken as linear RGB as stored (glTF defines them
+linear; Blender's glTF importer stores them unconverted as a Color Attribute multiplied into Base Color, white
+without a material: KhronosGroup/glTF-Blender-IO #227 and #1649; three.js's GLTFLoader sets ``vertexColors``, a
+multiplier of the material colour): a face's colour is the mean of its three vertices' (linear), times the
+material's base colour, quantised as vertex colours are below; each distinct result is one material
+``<material>:#rrggbb``, the glTF material with that base colour (its roughness, metallic and emission kept). A
+primitive with ``COLOR_0`` and no material gets the vertex colour materials ``vertex_colour:#rrggbb`` below
+(without ``COLOR_0``: material 0, the class's default look). A ``COLOR_0`` of another count than ``POSITION``,
+another type than VEC3/VEC4, another component type than float or normalized unsigned byte/short, or with
+non-finite values or values outside [0, 1] is an error (:mod:`mmusv.world.mesh_files`).
 
 **OBJ with MTL** (:func:`obj_materials`): each face takes the material its ``usemtl`` names, read from the files
 its ``mtllib`` lines name (relative to the OBJ; texture files relative to the MTL, as the Wavefront MTL spec and
@@ -36,17 +47,19 @@ leave each out without a word). An OBJ without ``mtllib`` gets material 0, the c
 lines name nothing to read), as do faces before its first ``usemtl``.
 
 **Vertex and face colours** (:func:`colour_material_ids`: PLY ``red/green/blue``, OBJ ``v x y z r g b``, and any
-colours trimesh reads from other formats; not glTF ``COLOR_0``): taken as sRGB-encoded (Blender's PLY importer and
-exporter default, three.js's PLYLoader); a face's colour is the mean of its three vertices' colours in linear RGB
-(the mean over the face of the colour a modelling tool interpolates across it), re-encoded to sRGB and quantised
-to :data:`COLOUR_LEVELS` levels per channel (1/63 steps); each distinct colour is one material
+colours trimesh reads from other formats; glTF ``COLOR_0`` is linear, above): taken as sRGB-encoded (Blender's
+PLY importer and exporter default, three.js's PLYLoader); a face's colour is the mean of its three vertices'
+colours in linear RGB (the mean over the face of the colour a modelling tool interpolates across it), re-encoded
+to sRGB and quantised to :data:`COLOUR_LEVELS` levels per channel (1/63 steps); each distinct colour is one material
 ``vertex_colour:#rrggbb`` (roughness 0.5, metallic 0, the class default's), shared by every file. A file with more
 than :data:`MAX_COLOUR_MATERIALS` distinct face colours is quantised coarser (32, 16, ... levels) until it has no
-more, with a :class:`~mmusv.scenario_checks.MmusvWarning`. OBJ faces with an MTL material keep it.
+more (glTF ``COLOR_0`` materials counted with them), with a :class:`~mmusv.scenario_checks.MmusvWarning`. OBJ
+faces with an MTL material keep it.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 from dataclasses import dataclass, field
@@ -56,7 +69,7 @@ import numpy as np
 
 from mmusv.errors import ConfigError
 from mmusv.world.asset_spec import AssetSpecError
-from mmusv.world.materials import NAV_LAMP_RADIANCE, Material, register_material
+from mmusv.world.materials import NAV_LAMP_RADIANCE, Material, all_materials, register_material
 
 __all__ = [
     "COLOUR_LEVELS",
@@ -467,14 +480,22 @@ def _colour_material(name: str, byte: np.ndarray) -> Material:
     return _material(name, _srgb_to_linear(byte / 255.0), 0.5, 0.0, np.zeros(3))
 
 
-def colour_material_ids(colours: np.ndarray, path: Path, where: str) -> np.ndarray:
+def colour_material_ids(colours: np.ndarray, path: Path, where: str, tints: np.ndarray | None = None) -> np.ndarray:
     """The material ids ``(F,)`` of faces of linear colours ``(F, 3)`` (module docstring: quantised in sRGB to
-    :data:`COLOUR_LEVELS` levels, coarser with a warning beyond :data:`MAX_COLOUR_MATERIALS` colours)."""
-    srgb = _linear_to_srgb(colours)
+    :data:`COLOUR_LEVELS` levels, coarser with a warning beyond :data:`MAX_COLOUR_MATERIALS` materials).
+
+    ``tints`` ``(F,)``: per face, the registered glTF material its colour (``COLOR_0``) multiplies, or -1 for a
+    plain vertex colour material (all -1 when not given)."""
+    tint = np.full(len(colours), -1, dtype=np.int64) if tints is None else np.asarray(tints, dtype=np.int64)
+    table = all_materials()
+    base = np.ones((len(colours), 3))
+    for t in np.unique(tint[tint >= 0]).tolist():
+        base[tint == t] = table[t].base_color
+    srgb = _linear_to_srgb(np.asarray(colours, dtype=np.float64) * base)
     levels = COLOUR_LEVELS
     while True:
         byte = np.round(np.round(srgb * (levels - 1)) * 255.0 / (levels - 1)).astype(np.int64)
-        uniq, inverse = np.unique(byte, axis=0, return_inverse=True)
+        uniq, inverse = np.unique(np.c_[tint, byte], axis=0, return_inverse=True)
         if len(uniq) <= MAX_COLOUR_MATERIALS:
             break
         levels //= 2
@@ -489,9 +510,16 @@ def colour_material_ids(colours: np.ndarray, path: Path, where: str) -> np.ndarr
         )
     ids = np.empty(len(uniq), dtype=np.uint16)
     try:
-        for k, b in enumerate(uniq):
-            name = "vertex_colour:#{:02x}{:02x}{:02x}".format(*(int(c) for c in b))
-            ids[k] = register_material(_colour_material(name, b.astype(np.float64)))
+        for k, row in enumerate(uniq):
+            t, b = int(row[0]), row[1:].astype(np.float64)
+            label = "#{:02x}{:02x}{:02x}".format(*(int(c) for c in b))
+            if t < 0:
+                m = _colour_material(f"vertex_colour:{label}", b)
+            else:
+                lin = _srgb_to_linear(b / 255.0)
+                rgb = (float(lin[0]), float(lin[1]), float(lin[2]))
+                m = dataclasses.replace(table[t], name=f"{table[t].name}:{label}", base_color=rgb)
+            ids[k] = register_material(m)
     except ConfigError as exc:
         raise AssetSpecError(where, f"{str(path)!r}: {one_line(exc)}") from None
     return ids[inverse.reshape(-1)]
