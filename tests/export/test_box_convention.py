@@ -4,8 +4,9 @@
 for ``bbox`` (pycocotools' ``toBbox`` of the segmentation) and what detectors trained on COCO or YOLO sets expect;
 ``projected`` writes the recording's box (the vessel's projected 3D box clipped to the image, which reaches down to
 the keel below the waterline). Every expectation is computed here from the recording (its instance images and 2D
-annotations) and pycocotools, never from the exporters' code. Boxes are in pixel-edge coordinates: pixel ``(i, j)``
-over ``[i, i + 1) × [j, j + 1)``, so the tight box of columns ``c0..c1`` is ``[c0, c1 + 1)``.
+annotations, by ``recorded_boxes.recorded``) and pycocotools, never from the exporters' code. Boxes are in
+pixel-edge coordinates: pixel ``(i, j)`` over ``[i, i + 1) × [j, j + 1)``, so the tight box of columns ``c0..c1``
+is ``[c0, c1 + 1)``.
 """
 
 from __future__ import annotations
@@ -25,8 +26,9 @@ from mmusv.errors import ConfigError
 from mmusv.export import cli as export_cli
 from mmusv.export import convert
 from mmusv.export.common import Options
-from mmusv.recording import decode_image, frame_messages, read_info, topics
+from mmusv.recording import read_info
 from pycocotools import mask as mask_util
+from recorded_boxes import Boxes, recorded
 
 FRAMES = 3
 """conftest's ``port`` recording: 3 frames, 3 USVs with 4 cameras of 160 × 120."""
@@ -34,46 +36,9 @@ CLASSES = [int(c) for c in SemanticClass if c != SemanticClass.NONE]
 """The YOLO class index of an mmusv class is its position here (docs/exports.md: every class but ``none``)."""
 
 
-def tight_box(inst: np.ndarray, instance_id: int) -> list[float] | None:
-    """``[x_min, y_min, x_max, y_max]`` in pixel edges of ``inst``'s pixels equal to ``instance_id``."""
-    ys, xs = np.nonzero(inst == instance_id)
-    if xs.size == 0:
-        return None
-    return [float(xs.min()), float(ys.min()), float(xs.max() + 1), float(ys.max() + 1)]
-
-
-def recorded(rec: Path) -> dict[tuple[str, str, int], dict[str, dict[str, Any]]]:
-    """Per image ``(agent, camera, frame)``, per vessel id with a 2D box that has a visible pixel: the recorded
-    (projected) box, its tight visible box from the instance image, its class, occlusion and the image size."""
-    info = read_info(rec)
-    out: dict[tuple[str, str, int], dict[str, dict[str, Any]]] = {}
-    for k in range(FRAMES):
-        msgs = frame_messages(rec, k)
-        world = {v.id: v for v in msgs[topics.WORLD_STATE].vessels}
-        for a in info.agents:
-            ann = msgs[topics.agent_annotations(a.id)]
-            for name, cam in a.cameras.items():
-                inst = np.asarray(decode_image(msgs[topics.camera(a.id, name, "instance")]))
-                per: dict[str, dict[str, Any]] = {}
-                for b in ann.boxes_camera:
-                    if b.camera != name or b.visible_pixels == 0:
-                        continue
-                    v = world[b.target_id]
-                    per[b.target_id] = {
-                        "projected": [b.x_min, b.y_min, b.x_max, b.y_max],
-                        "visible": tight_box(inst, v.instance_id),
-                        "class": int(v.semantic_class),
-                        "occlusion": float(b.occlusion),
-                        "truncation": float(b.truncation),
-                        "size": (cam.width, cam.height),
-                    }
-                out[(a.id, name, k)] = per
-    return out
-
-
 @pytest.fixture(scope="module")
-def port_boxes(port_rec: Path) -> dict[tuple[str, str, int], dict[str, dict[str, Any]]]:
-    return recorded(port_rec)
+def port_boxes(port_rec: Path) -> Boxes:
+    return recorded(port_rec, FRAMES)
 
 
 def coco_dir(port_rec: Path, root: Path, **kwargs: Any) -> Path:

@@ -28,6 +28,7 @@ from mmusv.errors import ConfigError
 from mmusv.export import convert
 from mmusv.recording import decode_image, frame_messages, read_info, topics
 from PIL import Image
+from recorded_boxes import Boxes, recorded
 
 FRAMES = 3
 """conftest's ``port`` recording: 3 frames, 3 USVs with 4 cameras of 160 × 120 (12 sequences)."""
@@ -51,37 +52,12 @@ def world_rows(rec: Path) -> dict[int, list[Any]]:
     return out
 
 
-def truth(rec: Path) -> dict[tuple[str, str, int], dict[str, dict[str, Any]]]:
-    """Per image ``(agent, camera, frame)``, per vessel with a visible pixel in its recorded 2D box: the tight box of
-    its pixels in the instance image, brute force (0-based ``[x_min, y_min, x_max, y_max]``, pixel edges), its
-    class and recorded occlusion."""
-    info = read_info(rec)
-    out: dict[tuple[str, str, int], dict[str, dict[str, Any]]] = {}
-    for k in range(FRAMES):
-        msgs = frame_messages(rec, k)
-        world = {v.id: v for v in msgs[topics.WORLD_STATE].vessels}
-        for a in info.agents:
-            ann = msgs[topics.agent_annotations(a.id)]
-            for name in a.cameras:
-                inst = np.asarray(decode_image(msgs[topics.camera(a.id, name, "instance")]))
-                per: dict[str, dict[str, Any]] = {}
-                for b in ann.boxes_camera:
-                    if b.camera != name or b.visible_pixels == 0:
-                        continue
-                    v = world[b.target_id]
-                    ys, xs = np.nonzero(inst == v.instance_id)
-                    per[b.target_id] = {
-                        "box": [int(xs.min()), int(ys.min()), int(xs.max()) + 1, int(ys.max()) + 1],
-                        "class": int(v.semantic_class),
-                        "occlusion": float(b.occlusion),
-                    }
-                out[(a.id, name, k)] = per
-    return out
-
-
 @pytest.fixture(scope="module")
-def port_truth(port_rec: Path) -> dict[tuple[str, str, int], dict[str, dict[str, Any]]]:
-    return truth(port_rec)
+def port_truth(port_rec: Path) -> Boxes:
+    """Per image, per vessel with a visible pixel in its recorded 2D box: ``recorded_boxes.recorded``'s entry, whose
+    ``visible`` is the tight box of its pixels in the instance image, brute force (0-based ``[x_min, y_min, x_max,
+    y_max]``, pixel edges), with its class and recorded occlusion."""
+    return recorded(port_rec, FRAMES)
 
 
 def read_csv(path: Path) -> list[dict[str, str]]:
@@ -99,7 +75,7 @@ def box_problems(
     """What a sequence's gt lines get wrong against the recording: one line per kept vessel and frame, ``bb_left``
     = its leftmost pixel column + 1 (1-based), ``bb_width`` = its column count (the same for rows), exactly; the
     class; visibility = 1 − occlusion. ``frames``: the acquisition index of MOT frame k at ``k - 1``; ``want``: per
-    acquisition index, per vessel id, :func:`truth`'s entry; ``names``: track id → vessel id."""
+    acquisition index, per vessel id, :func:`port_truth`'s entry; ``names``: track id → vessel id."""
     got: dict[tuple[int, str], list[str]] = {}
     problems = []
     for f in lines:
@@ -114,9 +90,9 @@ def box_problems(
         if (k, vid) not in expected:
             continue
         e = want[k][vid]
-        x0, y0, x1, y1 = e["box"]
+        x0, y0, x1, y1 = e["visible"]
         if [float(v) for v in f[2:6]] != [x0 + 1, y0 + 1, x1 - x0, y1 - y0]:
-            problems.append(f"frame {k} {vid}: box {f[2:6]}, pixels {e['box']}")
+            problems.append(f"frame {k} {vid}: box {f[2:6]}, pixels {e['visible']}")
         if (f[6], int(f[7])) != ("1", e["class"]):
             problems.append(f"frame {k} {vid}: conf, class {f[6:8]}")
         if abs(float(f[8]) - (1.0 - e["occlusion"])) > 5e-7:
@@ -277,7 +253,7 @@ def test_motmetrics_reads_gt_and_scores_it_perfect(mot_dir: Path, port_truth: An
         frames = [int(x) for x in (seq / "frames.txt").read_text().split()]
         for (fid, tid), row in gt.iterrows():
             e = port_truth[(agent, camera, frames[fid - 1])][names[tid]]
-            x0, y0, x1, y1 = e["box"]  # motmetrics takes the 1 off: 0-based pixel edges again
+            x0, y0, x1, y1 = e["visible"]  # motmetrics takes the 1 off: 0-based pixel edges again
             assert [row["X"], row["Y"], row["Width"], row["Height"]] == [x0, y0, x1 - x0, y1 - y0]
             assert (row["Confidence"], row["ClassId"]) == (1, e["class"])
             assert row["Visibility"] == pytest.approx(1.0 - e["occlusion"], abs=5e-7)
