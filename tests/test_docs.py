@@ -251,7 +251,7 @@ def script_commands(doc: Doc) -> list[tuple[str, str, list[str]]]:
         except ValueError:
             continue
         for cmd in _split_commands(tokens):
-            if cmd and re.match(r"^python3?$", cmd[0]):
+            if cmd and re.match(r"^(?:\S*/)?python3?$", cmd[0]):  # python3, venv/bin/python
                 cmd = cmd[1:]
             if len(cmd) >= 2 and cmd[0] == "-m" and cmd[1].startswith("mmusv."):
                 script = "python/" + cmd[1].replace(".", "/") + ".py"
