@@ -25,7 +25,7 @@ from mmusv.recording import read_messages
 
 LIDAR = {"channels": 16, "points_per_second": 20000, "rotation_hz": 5}
 DIST = [-0.1, 0.02, 0.001, -0.001, 0.0]
-FORMATS = ("opv2v", "kitti", "ros2", "coco", "yolo", "mastr", "semantickitti", "mot")
+FORMATS = ("opv2v", "kitti", "ros2", "coco", "yolo", "mastr", "semantickitti", "mot", "kitti_tracking")
 
 
 def coop(name: str, frames: int, rigs: dict[str, Any]) -> dict[str, Any]:
@@ -166,6 +166,31 @@ def check_mot(out: Path) -> int:
     return lines
 
 
+def check_kitti_tracking(out: Path) -> int:
+    """Every sequence of every split's seqmap as TrackEval's ``Kitti2DBox`` finds it (``<split>/label_02/<seq>.txt``,
+    frames ``0 .. n - 1`` of the seqmap's ``n``, 17 fields a line, a track id >= 0), a scan per frame and a calibration
+    with the tracking devkit's keys; returns the scan count."""
+    scans = 0
+    seqmaps = sorted(out.glob("*/evaluate_tracking.seqmap.*"))
+    assert seqmaps
+    for seqmap in seqmaps:
+        split = seqmap.parent
+        assert seqmap.name == f"evaluate_tracking.seqmap.{split.name}"
+        for row in seqmap.read_text().splitlines():
+            seq, empty, first, frames = row.split()
+            n = int(frames)
+            assert (len(seq), empty, first) == (4, "empty", "000000") and n > 0, row
+            assert sorted(p.name for p in (split / "velodyne" / seq).iterdir()) == [f"{k:06d}.bin" for k in range(n)]
+            for line in (split / "label_02" / f"{seq}.txt").read_text().splitlines():
+                f = line.split()
+                assert len(f) == 17 and 0 <= int(f[0]) < n and int(f[1]) >= 0, line
+            calib = [line.split()[0] for line in (split / "calib" / f"{seq}.txt").read_text().splitlines()]
+            assert calib == ["P0:", "P1:", "P2:", "P3:", "R_rect", "Tr_velo_cam", "Tr_imu_velo"]
+            assert len((split / "pose" / f"{seq}.txt").read_text().splitlines()) == n
+            scans += n
+    return scans
+
+
 def check_mastr(out: Path) -> int:
     """Every mask beside an image of its size, uint8 values in MaSTr1325's {0, 1, 2, 4}; returns the mask count."""
     from PIL import Image
@@ -277,7 +302,7 @@ def test_kitti_records_the_front_camera_distortion(mixed_rec: Path, tmp_path: Pa
 # ---------------------------------------------------------------------------------------------- refusals
 
 
-@pytest.mark.parametrize("to", ["opv2v", "kitti"])
+@pytest.mark.parametrize("to", ["opv2v", "kitti", "kitti_tracking"])
 def test_lidar_formats_refuse_a_recording_without_lidar_up_front(no_lidar_rec: Path, tmp_path: Path, to: str) -> None:
     # Before: a folder holding only conversion.yaml ("complete", 0 frames) and exit status 1.
     with pytest.raises(ConfigError, match=rf"export_no_lidar\.mcap: cannot convert to {to}: no agent with a LiDAR"):
@@ -303,8 +328,12 @@ def test_two_different_rigs_read_back_in_every_format(mixed_rec: Path, tmp_path:
             "mastr": check_mastr,
             "semantickitti": check_semantickitti,
             "mot": check_mot,
+            "kitti_tracking": check_kitti_tracking,
         }[to](out)
     assert found["kitti"] == 4 and found["semantickitti"] == 4 and found["opv2v"] > 0 and found["ros2"] > 20
+    assert found["kitti_tracking"] == 4  # usv_a (no camera: no image_02) and usv_b, 2 frames each
+    assert sorted(p.name for p in (tmp_path / "kitti_tracking" / "train" / "image_02").iterdir()) == ["0001"]
+    assert "agent usv_a has no front camera: no image_02" in notes(tmp_path / "kitti_tracking")
     assert found["mastr"] == 2  # usv_b's front camera; the rear one records no semantic image
     assert found["mot"] == found["yolo"]  # the same visible boxes, one gt.txt line each (usv_b's front camera)
     assert "agent usv_a has no camera recording rgb and instance images and is left out" in notes(tmp_path / "mot")
@@ -335,6 +364,8 @@ def test_empty_scans_and_no_vessel_are_said_and_read_back(lonely_rec: Path, tmp_
     assert check_coco(tmp_path / "coco") == 0 and check_yolo(tmp_path / "yolo") == 0
     assert check_mastr(tmp_path / "mastr") == 1
     assert check_mot(tmp_path / "mot") == 0
+    assert check_kitti_tracking(tmp_path / "kitti_tracking") == 1
+    assert (tmp_path / "kitti_tracking" / "train" / "label_02" / "0000.txt").read_bytes() == b""
     for to in ("coco", "yolo", "mot"):
         assert "no vessel is visible in any converted image" in notes(tmp_path / to), to
 

@@ -1,6 +1,6 @@
 """Converting recordings into public dataset layouts (``mmusv convert REC.mcap --to FORMAT -o DIR``): OPV2V,
-KITTI-style per-agent folders, ROS 2 bags, COCO, YOLO, MaSTr1325-style masks, SemanticKITTI and MOTChallenge
-(``docs/exports.md``).
+KITTI-style per-agent folders, ROS 2 bags, COCO, YOLO, MaSTr1325-style masks, SemanticKITTI, MOTChallenge and KITTI
+tracking (``docs/exports.md``).
 
 Modules, one job each: :mod:`~mmusv.recording.stream` (recording → frames), :mod:`~mmusv.export.convert` (the one
 job every format shares: reading, validation, splitting, frame selection, progress and its report; with
@@ -11,8 +11,9 @@ targets per agent, mmusv frames), :mod:`~mmusv.export.splits` (train/validate/te
 (:mod:`~mmusv.export.opv2v`, :mod:`~mmusv.export.kitti`, :mod:`~mmusv.export.ros2` with
 :mod:`~mmusv.export.ros2_names`, :mod:`~mmusv.export.ros2_msgs` and :mod:`~mmusv.export.ros2_types`,
 :mod:`~mmusv.export.coco`, :mod:`~mmusv.export.yolo`, :mod:`~mmusv.export.mastr`,
-:mod:`~mmusv.export.semantickitti`, :mod:`~mmusv.export.mot`; frame changes only through :mod:`mmusv.frames`),
-:mod:`~mmusv.export.pcd` (Open3D-style ASCII PCD) and :mod:`~mmusv.export.cli` (the command).
+:mod:`~mmusv.export.semantickitti`, :mod:`~mmusv.export.mot`, :mod:`~mmusv.export.kitti_tracking`; frame changes
+only through :mod:`mmusv.frames`), :mod:`~mmusv.export.pcd` (Open3D-style ASCII PCD) and :mod:`~mmusv.export.cli`
+(the command).
 """
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
-"""``mmusv convert REC.mcap [REC ...] --to opv2v|kitti|ros2|coco|yolo|mastr|semantickitti|mot -o DIR``: the
-command-line face of :func:`mmusv.export.convert`.
+"""``mmusv convert REC.mcap [REC ...] --to opv2v|kitti|ros2|coco|yolo|mastr|semantickitti|mot|kitti_tracking -o
+DIR``: the command-line face of :func:`mmusv.export.convert`.
 
 :func:`add_parser` adds the subcommand to the ``mmusv`` argparse sub-parsers and :func:`run` executes it (a rich
 progress bar, then one line per recording and the totals). Bad input raises :class:`mmusv.errors.MmusvError`,
@@ -23,12 +23,13 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
 
     p: argparse.ArgumentParser = subparsers.add_parser(
         "convert",
-        help="convert recordings into a dataset: OPV2V, KITTI, ROS 2 bags, COCO, YOLO, MaSTr, SemanticKITTI or "
-        "MOTChallenge",
+        help="convert recordings into a dataset: OPV2V, KITTI, ROS 2 bags, COCO, YOLO, MaSTr, SemanticKITTI, "
+        "MOTChallenge or KITTI tracking",
         description="Converts mmusv recordings into the OPV2V layout (CARLA frame, per-agent folders), KITTI-style "
         "per-agent folders, rosbag2 folders (one per recording), COCO or YOLO 2D detection sets, MaSTr1325-style "
-        "obstacle/water/sky masks, SemanticKITTI LiDAR scans and labels or MOTChallenge tracking sequences (one per "
-        "camera, gt.txt with a track id per vessel), split into train/validate/test by recording with a fixed seed "
+        "obstacle/water/sky masks, SemanticKITTI LiDAR scans and labels, MOTChallenge tracking sequences (one per "
+        "camera, gt.txt with a track id per vessel) or KITTI tracking sequences (one per agent: LiDAR scans, front "
+        "images, label_02 with a track id per vessel), split into train/validate/test by recording with a fixed seed "
         "(docs/exports.md).",
     )
     p.add_argument(
@@ -41,7 +42,8 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         "--to",
         default="opv2v",
         help="target layout: opv2v (default), kitti, ros2 (rosbag2 folders, never split), coco, yolo, mastr, "
-        "semantickitti or mot (MOTChallenge: MOT17/MOT20 sequences for multi-object tracking)",
+        "semantickitti or mot (MOTChallenge: MOT17/MOT20 sequences for multi-object tracking) or kitti_tracking "
+        "(the KITTI tracking benchmark's layout for 3D multi-object tracking)",
     )
     p.add_argument("-o", "--output", required=True, help="output folder")
     g = p.add_mutually_exclusive_group()
@@ -108,6 +110,13 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         metavar="START:STOP",
         help="convert only the acquisition indices START..STOP-1 (STOP may be left out: to the end)",
     )
+    p.add_argument(
+        "--kitti-class",
+        default=None,
+        metavar="NAME",
+        help="kitti_tracking: the type written for every vessel, e.g. Car, the class stock TrackEval and the KITTI "
+        "devkit score (default: each vessel's class name, Vessel or Usv)",
+    )
     p.add_argument("--overwrite", action="store_true", help="replace a previous conversion in the output folder")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     return p
@@ -144,6 +153,7 @@ def run(args: argparse.Namespace) -> int:
         "overwrite": args.overwrite,
         "agents": args.agents,
         "frames": args.frames,
+        "kitti_class": args.kitti_class,
     }
     if args.no_progress:
         report = convert(args.recordings, **kwargs)

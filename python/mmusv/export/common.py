@@ -35,7 +35,7 @@ __all__ = [
     "rounded",
 ]
 
-TARGETS = ("opv2v", "kitti", "ros2", "coco", "yolo", "mastr", "semantickitti", "mot")
+TARGETS = ("opv2v", "kitti", "ros2", "coco", "yolo", "mastr", "semantickitti", "mot", "kitti_tracking")
 EXTRAS = ("depth", "semantic", "instance", "radar", "top_view")
 DEFAULT_EXTRAS = ("depth", "semantic", "radar", "top_view")
 CAV_ID_BASE = 1000
@@ -108,6 +108,9 @@ class Options:
     """The agents (USV ids) to convert; ``None``: every agent the format uses."""
     frames: tuple[int, int | None] | None = None
     """The acquisition indices to convert, ``[start, stop)`` (``stop`` ``None``: to the end); ``None``: all."""
+    kitti_class: str | None = None
+    """KITTI tracking: the type written for every target (``Car``, which stock TrackEval and the KITTI devkit score);
+    ``None``: each target's class name (``Vessel``, ``Usv``)."""
 
     def wants_frame(self, index: int) -> bool:
         """Whether acquisition index ``index`` lies in :attr:`frames`."""

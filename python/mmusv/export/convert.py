@@ -7,8 +7,8 @@ reports progress and skipped frames, and hands each complete frame to the format
 :class:`~mmusv.export.writer.DatasetWriter`. Output root ``out_dir``:
 ``{train,validate,test}/<scenario>/...`` (or ``<scenario>/...`` with ``splits=None``) for the formats with one
 folder per recording (OPV2V, KITTI, MaSTr; ROS 2 bags, never split), the format's own layout for the others (COCO,
-YOLO, SemanticKITTI, MOT: see their modules), plus ``conversion.yaml`` (options, sources, split of every recording,
-frames converted and skipped; no times or absolute paths, so two conversions of the same input are
+YOLO, SemanticKITTI, MOT, KITTI tracking: see their modules), plus ``conversion.yaml`` (options, sources, split of
+every recording, frames converted and skipped; no times or absolute paths, so two conversions of the same input are
 byte-identical). ``conversion.yaml`` is written first with ``status: in_progress`` and rewritten at the end; an
 existing ``out_dir`` is replaced only with ``overwrite`` and only when it is empty or holds a previous conversion
 (its ``conversion.yaml``), and then only once the new one is complete (written beside it, then swapped in).
@@ -34,6 +34,7 @@ from mmusv.export.convert_checks import (
     check_agents,
     contrast_filter,
     frame_selection,
+    kitti_type,
     outside_frames,
 )
 from mmusv.export.convert_output import prepare_out, staged
@@ -89,6 +90,10 @@ def writer_class(to: str) -> type[DatasetWriter]:
         from mmusv.export.mot import MotWriter
 
         return MotWriter
+    if to == "kitti_tracking":
+        from mmusv.export.kitti_tracking import KittiTrackingWriter
+
+        return KittiTrackingWriter
     raise ConfigError(f"unknown target {to!r}; allowed: {', '.join(TARGETS)}")
 
 
@@ -139,6 +144,7 @@ def convert(
     overwrite: bool = False,
     agents: Iterable[str] | str | None = None,
     frames: Sequence[int | None] | str | None = None,
+    kitti_class: str | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> ConvertReport:
     """Converts one or many recordings into a dataset folder (see the module docstring).
@@ -150,7 +156,7 @@ def convert(
             recordings).
         to: one of :data:`~mmusv.export.common.TARGETS`: ``"opv2v"``, ``"kitti"``, ``"ros2"`` (a rosbag2 folder
             per recording), ``"coco"``, ``"yolo"``, ``"mastr"``, ``"semantickitti"``, ``"mot"`` (MOTChallenge
-            sequences; ``docs/exports.md``).
+            sequences), ``"kitti_tracking"`` (KITTI tracking sequences; ``docs/exports.md``).
         splits: ``(train, validate, test)`` fractions (split per recording, shuffled with ``seed``, a whole number
             >= 0) or ``None``
             for one folder of scenarios. ROS 2 bags are never split: with ``to="ros2"`` only the default or
@@ -177,6 +183,9 @@ def convert(
             them. ``None``: all.
         frames: the acquisition indices to convert, ``(start, stop)`` or ``"start:stop"`` (``stop`` excluded; left
             out or ``None``: to the end). The others are neither converted nor reported missing. ``None``: all.
+        kitti_class: ``to="kitti_tracking"`` only: the type its labels give every target, one word (``"Car"``: what
+            stock TrackEval's ``Kitti2DBox`` and the KITTI devkit score); ``None`` (the default): each target's class
+            name (``Vessel``, ``Usv``).
         progress: called with (frames done, frames expected) after every frame (a callable of two arguments).
 
     Raises:
@@ -198,6 +207,7 @@ def convert(
     box_px, max_occ = box_filter(min_box_px, max_occlusion)
     min_c = contrast_filter(min_contrast)
     box = parse_box(box)
+    kind = kitti_type(kitti_class, to)
     options = Options(
         to=to,
         eval_range_m=rng,
@@ -209,6 +219,7 @@ def convert(
         box=box,
         agents=agent_selection(agents),
         frames=frame_selection(frames),
+        kitti_class=kind,
     )
     cls = cls.for_options(options)
     paths = as_list(recordings)
@@ -242,6 +253,7 @@ def convert(
                 "seed": seed,
                 **({"agents": list(options.agents)} if options.agents is not None else {}),
                 **({"frames": list(options.frames)} if options.frames is not None else {}),
+                **({"kitti_class": kind} if kind is not None else {}),
             },
         }
         with staged(work, out):

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -25,6 +26,7 @@ __all__ = [
     "check_agents",
     "contrast_filter",
     "frame_selection",
+    "kitti_type",
     "outside_frames",
 ]
 
@@ -85,6 +87,26 @@ def contrast_filter(min_contrast: Any) -> float | None:
     if not (math.isfinite(c) and 0 <= c <= MAX_CONTRAST):
         raise ConfigError(f"min_contrast = {arguments.shown(min_contrast)}: {allowed}")
     return c
+
+
+def kitti_type(kitti_class: Any, to: str) -> str | None:
+    """``kitti_class`` (the type KITTI tracking labels give every target) as given, or ``None``;
+    :class:`~mmusv.errors.ConfigError` naming it unless it is one word of letters, digits and ``_`` starting with a
+    letter (a KITTI type, e.g. ``Car``), not ``DontCare`` (KITTI's regions to ignore), and ``to`` is
+    ``kitti_tracking``."""
+    if kitti_class is None:
+        return None
+    shown = arguments.shown(kitti_class)
+    if to != "kitti_tracking":
+        raise ConfigError(f"kitti_class = {shown}: only --to kitti_tracking writes it, not --to {to}")
+    if not isinstance(kitti_class, str) or not re.fullmatch(r"[A-Za-z][A-Za-z0-9_]*", kitti_class):
+        raise ConfigError(
+            f"kitti_class = {shown}: must be one KITTI type word (letters, digits, _; e.g. Car, which stock TrackEval "
+            "and the KITTI devkit score), or None for each vessel's class name"
+        )
+    if kitti_class.lower() == "dontcare":
+        raise ConfigError(f"kitti_class = {shown}: DontCare marks regions to ignore, not objects to track")
+    return kitti_class
 
 
 def agent_selection(agents: Iterable[str] | str | None) -> tuple[str, ...] | None:

@@ -37,7 +37,19 @@ from mmusv.recording.decode import WorldFrame
 from mmusv.recording.info import AgentInfo
 from mmusv.recording.stream import Frame
 
-__all__ = ["LIDAR_OPTICAL", "KittiWriter", "front_calib", "kitti_label", "kitti_numbers", "occlusion_level"]
+__all__ = [
+    "LIDAR_OPTICAL",
+    "OBJECT_CALIB_KEYS",
+    "KittiWriter",
+    "calib_text",
+    "camera0",
+    "front_calib",
+    "kitti_label",
+    "kitti_numbers",
+    "label_lines",
+    "occlusion_level",
+    "truncation_level",
+]
 
 
 LIDAR_OPTICAL = np.eye(4)
@@ -70,8 +82,70 @@ def front_calib(agent: AgentInfo, view: AgentView) -> tuple[np.ndarray, np.ndarr
     return np.array([[fx, 0.0, cx, 0.0], [0.0, fy, cy, 0.0], [0.0, 0.0, 1.0, 0.0]]), velo_to_cam
 
 
-def kitti_label(target: Target, velo_to_cam: np.ndarray, box2d: Any | None) -> str:
-    """One ``label_2`` line of ``target`` (box in the LiDAR frame) for the camera ``velo_to_cam`` (4×4)."""
+def camera0(agent: AgentInfo, view: AgentView) -> tuple[np.ndarray, np.ndarray]:
+    """KITTI's camera 0 of ``agent`` at ``view`` as the labels and calibration files use it: :func:`front_calib`,
+    with, for an agent without a front camera, the LiDAR's own optical axes (:data:`LIDAR_OPTICAL`) as the camera,
+    so that its labels keep KITTI's camera conventions (y down, ``rotation_y`` about y)."""
+    k, velo_to_cam = front_calib(agent, view)
+    return k, (velo_to_cam if "front" in agent.cameras else LIDAR_OPTICAL)
+
+
+OBJECT_CALIB_KEYS = ("R0_rect:", "Tr_velo_to_cam:", "Tr_imu_to_velo:")
+"""The names KITTI's object benchmark gives ``R0_rect``, ``Tr_velo_to_cam`` and ``Tr_imu_to_velo`` in its calibration
+files (``calib/<ts>.txt``), with their colons; the tracking benchmark spells them otherwise."""
+
+
+def calib_text(k: np.ndarray, velo_to_cam: np.ndarray, lidar_mount: np.ndarray, keys: tuple[str, ...]) -> bytes:
+    """A KITTI calibration file: ``P0..P3`` = ``k`` (3×4), then the rectification (the identity), LiDAR → camera 0
+    (``velo_to_cam``, 4×4) and vessel body → LiDAR (the inverse of ``lidar_mount``), named by ``keys``
+    (:data:`OBJECT_CALIB_KEYS` or the tracking benchmark's)."""
+    calib = [f"P{i}: {kitti_numbers(k)}" for i in range(4)]
+    rect, velo, imu = keys
+    calib += [
+        f"{rect} {kitti_numbers(np.eye(3))}",
+        f"{velo} {kitti_numbers(velo_to_cam[:3, :])}",
+        f"{imu} {kitti_numbers(invert(lidar_mount)[:3, :])}",
+    ]
+    return ("\n".join(calib) + "\n").encode()
+
+
+def label_lines(
+    view: AgentView,
+    targets: list[Target],
+    messages: dict[str, Any],
+    velo_to_cam: np.ndarray,
+    kind: str | None = None,
+    *,
+    levels: bool = False,
+) -> list[str]:
+    """The ``label_2`` lines of ``targets`` (:func:`kitti_label`) for camera 0 ``velo_to_cam`` (:func:`camera0`), their
+    2D boxes from the frame's ``messages`` (the agent's annotations: the front camera's boxes; none without a front
+    camera), ``kind`` the type written for every target (``None``: each target's class name); ``levels``: truncation
+    as the tracking benchmark's level (:func:`truncation_level`)."""
+    a = view.agent
+    boxes: dict[str, Any] = {}
+    ann = messages.get(topics.agent_annotations(a.id))
+    if ann is not None and "front" in a.cameras:
+        boxes = {b.target_id: b for b in ann.boxes_camera if b.camera == "front"}
+    return [kitti_label(t, velo_to_cam, boxes.get(t.id), kind, levels=levels) for t in targets]
+
+
+def truncation_level(fraction: float | None) -> int:
+    """The KITTI tracking benchmark's truncation (its raw data's tracklet levels: 0 in the image, 1 cut by the image
+    border, 2 out of the image) of a target whose recorded 2D box is cut by ``fraction`` (0..1, taken at the object
+    labels' two decimals, so the two exports agree; ``None``: no box in the image)."""
+    if fraction is None:
+        return 2
+    f = round(float(fraction), 2)
+    return 0 if f <= 0.0 else 2 if f >= 1.0 else 1
+
+
+def kitti_label(
+    target: Target, velo_to_cam: np.ndarray, box2d: Any | None, kind: str | None = None, *, levels: bool = False
+) -> str:
+    """One ``label_2`` line of ``target`` (box in the LiDAR frame) for the camera ``velo_to_cam`` (4×4); ``kind``:
+    the type written (``None``: the target's class name, capitalised); ``levels``: truncation written as the
+    tracking benchmark's integer level (:func:`truncation_level`) instead of the object benchmark's fraction."""
     length, beam, height = (float(x) for x in target.size)
     box_cam = velo_to_cam @ target.box_in_lidar
     centre = box_cam[:3, 3]
@@ -87,9 +161,10 @@ def kitti_label(target: Target, velo_to_cam: np.ndarray, box2d: Any | None) -> s
     else:
         trunc, occ = float(box2d.truncation), occlusion_level(float(box2d.occlusion))
         bb = (box2d.x_min, box2d.y_min, box2d.x_max, box2d.y_max)
-    name = class_name(target.semantic_class).capitalize()
+    name = kind if kind is not None else class_name(target.semantic_class).capitalize()
     vals = [trunc, occ, alpha, *bb, height, beam, length, *bottom, ry]
-    return f"{name} {vals[0]:.2f} {int(vals[1])} " + " ".join(f"{round(float(v), 2) + 0.0:.2f}" for v in vals[2:])
+    cut = f"{truncation_level(None if box2d is None else trunc)}" if levels else f"{vals[0]:.2f}"
+    return f"{name} {cut} {int(vals[1])} " + " ".join(f"{round(float(v), 2) + 0.0:.2f}" for v in vals[2:])
 
 
 class KittiWriter(DatasetWriter):
@@ -97,23 +172,30 @@ class KittiWriter(DatasetWriter):
 
     cameras: ClassVar[dict[str, int]] = {"front": 2}
     needs_agent: ClassVar[bool] = True
+    image_folder: ClassVar[str] = "image_2"
+    """The front images' folder (the notes name it)."""
+    velo_key: ClassVar[str] = "Tr_velo_to_cam"
+    """LiDAR → camera 0's name in the calibration files (the notes name it)."""
+    distortion_file: ClassVar[str] = "; coefficients in mmusv_kitti.yaml"
+    """Where else the notes say a front camera's lens distortion is written."""
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
+        image = self.image_folder
         for a in self.agents:
             cam = a.cameras.get("front")
             if cam is None:
                 self.notes.append(
-                    f"agent {a.id} has no front camera: no image_2, P0..P3 are zeros and Tr_velo_to_cam is the "
+                    f"agent {a.id} has no front camera: no {image}, P0..P3 are zeros and {self.velo_key} is the "
                     "LiDAR's own optical axes (labels without 2D boxes, occluded 3)"
                 )
                 continue
             if "rgb" not in cam.outputs:
-                self.notes.append(f"agent {a.id}: front camera records no rgb images: no image_2")
+                self.notes.append(f"agent {a.id}: front camera records no rgb images: no {image}")
             if cam.distortion is not None and any(cam.distortion):
                 self.notes.append(
                     f"agent {a.id}: front camera has lens distortion {list(cam.distortion)} [k1, k2, p1, p2, k3]: "
-                    "image_2 is not rectified (P2 is its pinhole K; coefficients in mmusv_kitti.yaml)"
+                    f"{image} is not rectified (P2 is its pinhole K{self.distortion_file})"
                 )
 
     def optional_topics(self) -> list[str]:
@@ -122,51 +204,50 @@ class KittiWriter(DatasetWriter):
     def _dir(self, agent: AgentInfo, sub: str) -> Path:
         return self.sink.mkdir(self.folder / str(cav_id(agent.index)) / sub)
 
-    def write_agent(self, frame: Frame, world: WorldFrame, view: AgentView, targets: list[Target]) -> None:
+    def frame_file(self, agent: AgentInfo, folder: str, index: int, ext: str) -> Path:
+        """Where the file of ``agent`` at acquisition index ``index`` in ``folder`` (KITTI's object layout's name:
+        ``velodyne``, ``image_2``, ``depth_2``, …, ``top_view_semantic``) goes, its folder created."""
+        return self._dir(agent, folder) / f"{index:06d}{ext}"
+
+    def write_sensors(self, frame: Frame, view: AgentView) -> None:
+        """The agent's LiDAR scan (``velodyne``), front image (``image_2``) and extras of ``frame``."""
         from mmusv.recording import decode_point_cloud
 
         a = view.agent
-        assert view.lidar is not None and a.lidar_mount is not None
-        ts = f"{frame.index:06d}"
         msgs = frame.messages
         cloud = decode_point_cloud(msgs[topics.lidar(a.id)])
         n = len(cloud["x"])
         pts = np.column_stack([cloud["x"], cloud["y"], cloud["z"], cloud.get("intensity", np.zeros(n))]).astype("<f4")
-        self.put(self._dir(a, "velodyne") / f"{ts}.bin", pts.tobytes())
-        self.put(self._dir(a, "pose") / f"{ts}.txt", (kitti_numbers(view.lidar[:3, :]) + "\n").encode())
-        cam = a.cameras.get("front")
-        k, velo_to_cam = front_calib(a, view)
-        if cam is None:
-            velo_to_cam = LIDAR_OPTICAL  # labels in KITTI's camera axes (y down, rotation_y about y) at the LiDAR
-        calib = [f"P{i}: {kitti_numbers(k)}" for i in range(4)]
-        calib += [
-            f"R0_rect: {kitti_numbers(np.eye(3))}",
-            f"Tr_velo_to_cam: {kitti_numbers(velo_to_cam[:3, :])}",
-            f"Tr_imu_to_velo: {kitti_numbers(invert(a.lidar_mount)[:3, :])}",
-        ]
-        self.put(self._dir(a, "calib") / f"{ts}.txt", ("\n".join(calib) + "\n").encode())
-        boxes: dict[str, Any] = {}
-        ann = msgs.get(topics.agent_annotations(a.id))
-        if ann is not None:
-            boxes = {b.target_id: b for b in ann.boxes_camera if b.camera == "front"}
-        lines = [kitti_label(t, velo_to_cam, boxes.get(t.id) if cam is not None else None) for t in targets]
-        self.put(self._dir(a, "label_2") / f"{ts}.txt", "".join(line + "\n" for line in lines).encode())
-        if cam is not None:
+        self.put(self.frame_file(a, "velodyne", frame.index, ".bin"), pts.tobytes())
+        if "front" in a.cameras:
             base = topics.camera(a.id, "front") + "/"
             if base + "rgb" in msgs:
-                self.put(self._dir(a, "image_2") / f"{ts}.png", png_bytes(msgs[base + "rgb"]))
+                self.put(self.frame_file(a, "image_2", frame.index, ".png"), png_bytes(msgs[base + "rgb"]))
             if "depth" in self.options.extras and base + "depth" in msgs:
-                self.put(self._dir(a, "depth_2") / f"{ts}.png", depth_png(msgs[base + "depth"]), "depth")
+                self.put(self.frame_file(a, "depth_2", frame.index, ".png"), depth_png(msgs[base + "depth"]), "depth")
             for kind in ("semantic", "instance"):
                 if kind in self.options.extras and base + kind in msgs:
-                    self.put(self._dir(a, f"{kind}_2") / f"{ts}.png", png_bytes(msgs[base + kind]), kind)
+                    path = self.frame_file(a, f"{kind}_2", frame.index, ".png")
+                    self.put(path, png_bytes(msgs[base + kind]), kind)
         if "radar" in self.options.extras and topics.radar_ppi(a.id) in msgs:
-            self.put(self._dir(a, "radar_ppi") / f"{ts}.png", png_bytes(msgs[topics.radar_ppi(a.id)]), "radar")
+            path = self.frame_file(a, "radar_ppi", frame.index, ".png")
+            self.put(path, png_bytes(msgs[topics.radar_ppi(a.id)]), "radar")
         if "top_view" in self.options.extras:
             for kind in ("rgb", "semantic"):
                 m = msgs.get(topics.top_view(a.id, kind))
                 if m is not None:
-                    self.put(self._dir(a, f"top_view_{kind}") / f"{ts}.png", png_bytes(m), "top_view")
+                    self.put(self.frame_file(a, f"top_view_{kind}", frame.index, ".png"), png_bytes(m), "top_view")
+
+    def write_agent(self, frame: Frame, world: WorldFrame, view: AgentView, targets: list[Target]) -> None:
+        a = view.agent
+        assert view.lidar is not None and a.lidar_mount is not None
+        ts = f"{frame.index:06d}"
+        self.write_sensors(frame, view)
+        self.put(self._dir(a, "pose") / f"{ts}.txt", (kitti_numbers(view.lidar[:3, :]) + "\n").encode())
+        k, velo_to_cam = camera0(a, view)
+        self.put(self._dir(a, "calib") / f"{ts}.txt", calib_text(k, velo_to_cam, a.lidar_mount, OBJECT_CALIB_KEYS))
+        lines = label_lines(view, targets, frame.messages, velo_to_cam)
+        self.put(self._dir(a, "label_2") / f"{ts}.txt", "".join(line + "\n" for line in lines).encode())
 
     def finish(self, frames: list[int], skipped: list[dict[str, Any]]) -> None:
         super().finish(frames, skipped)

@@ -62,19 +62,25 @@ from mmusv.recording.stream import Frame
 __all__ = [
     "CLASSES_FILE",
     "GT_COLUMNS",
+    "TRACKS_COLUMNS",
     "TRACKS_FILE",
     "MotContrastWriter",
     "MotVisibleWriter",
     "MotWriter",
+    "TrackRows",
+    "csv_bytes",
     "mot_split",
     "sequence_name",
     "track_id",
+    "track_rows",
 ]
 
 GT_COLUMNS = ("frame", "id", "bb_left", "bb_top", "bb_width", "bb_height", "conf", "class", "visibility")
 """The columns of ``gt/gt.txt`` (MOT17/MOT20 ground truth)."""
 CLASSES_FILE = "classes.csv"
 TRACKS_FILE = "tracks.csv"
+TRACKS_COLUMNS = ("split", "scenario", "track_id", "vessel_id", "role", "class", "asset")
+"""The columns of ``tracks.csv`` (the MOT and KITTI tracking exports)."""
 IMAGE_DIR = "img1"
 IMAGE_EXT = ".png"
 
@@ -95,13 +101,41 @@ def track_id(world: WorldFrame, vessel_id: str) -> int:
     return world.ids.index(vessel_id) + 1
 
 
+def track_rows(split: str, scenario: str, world: WorldFrame) -> list[list[Any]]:
+    """The ``tracks.csv`` rows (:data:`TRACKS_COLUMNS`) of every vessel of ``world``, a recording's world state."""
+    w = world
+    return [[split, scenario, i + 1, vid, w.roles[i], int(w.classes[i]), w.assets[i]] for i, vid in enumerate(w.ids)]
+
+
+class TrackRows:
+    """The world-state row of each vessel of one recording as first seen: :meth:`check` refuses a frame where a vessel
+    has moved to another row, since its track id (:func:`track_id`) would change."""
+
+    def __init__(self, path: Path, what: str) -> None:
+        self.path = path
+        self.what = what
+        self.rows: dict[str, int] = {}
+        """Vessel id → world-state row."""
+
+    def check(self, world: WorldFrame, index: int) -> None:
+        """Raises :class:`~mmusv.errors.IoError` when a vessel of ``world`` (acquisition index ``index``) is not in
+        the row it was in before."""
+        for row, vid in enumerate(world.ids):
+            if self.rows.setdefault(vid, row) != row:
+                raise IoError(
+                    f"{self.path}: vessel {vid!r} is in world-state row {row} at frame {index} and in row "
+                    f"{self.rows[vid]} before: its {self.what} track id would change"
+                )
+
+
 def _num(value: float, decimals: int) -> str:
     """``value`` rounded to ``decimals``: a whole number without a point, else Python's shortest repr."""
     r = round(float(value), decimals) + 0.0
     return str(int(r)) if r.is_integer() else repr(r)
 
 
-def _csv(rows: list[list[Any]]) -> bytes:
+def csv_bytes(rows: list[list[Any]]) -> bytes:
+    """``rows`` as CSV (``\\n`` line ends), UTF-8."""
     buf = io.StringIO()
     csv.writer(buf, lineterminator="\n").writerows(rows)
     return buf.getvalue().encode("utf-8")
@@ -141,8 +175,7 @@ class MotWriter(CameraWriter):
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self.sequences: dict[tuple[str, str], _Sequence] = {}
-        self.rows: dict[str, int] = {}
-        """Vessel id → world-state row, as first seen (every later frame must agree)."""
+        self.rows = TrackRows(self.info.path, "MOT")
         self.world: WorldFrame | None = None
         """The first converted frame's world state (``tracks.csv``)."""
 
@@ -163,12 +196,7 @@ class MotWriter(CameraWriter):
         assert world is not None
         if self.world is None:
             self.world = world
-        for row, vid in enumerate(world.ids):
-            if self.rows.setdefault(vid, row) != row:
-                raise IoError(
-                    f"{self.info.path}: vessel {vid!r} is in world-state row {row} at frame {frame.index} and in row "
-                    f"{self.rows[vid]} before: its MOT track id would change"
-                )
+        self.rows.check(world, frame.index)
         for seq in self.sequences.values():
             seq.rows.pop(frame.index, None)  # a frame recorded twice: the last copy is kept, as in every format
         super().write_frame(frame)
@@ -226,22 +254,16 @@ class MotWriter(CameraWriter):
             self.put(seq.folder / "seqinfo.ini", ini.encode())
             self.put(seq.folder / "frames.txt", "".join(f"{i}\n" for i in order).encode())
         if self.world is not None and self.sequences:
-            split = mot_split(self.split_name)
-            w = self.world
-            self.shared.tracks += [
-                [split, self.folder.name, i + 1, vid, w.roles[i], int(w.classes[i]), w.assets[i]]
-                for i, vid in enumerate(w.ids)
-            ]
+            self.shared.tracks += track_rows(mot_split(self.split_name), self.folder.name, self.world)
 
     @classmethod
     def finish_all(cls, shared: Any, out: Path, sink: Sink) -> None:
         st: _MotShared = shared
         if not st.sequences:
             return
-        sink.write(out / CLASSES_FILE, _csv([["class", "name"], *([c, class_name(c)] for c in CATEGORIES)]))
+        sink.write(out / CLASSES_FILE, csv_bytes([["class", "name"], *([c, class_name(c)] for c in CATEGORIES)]))
         tracks = sorted(st.tracks, key=lambda r: (r[1], r[2]))
-        head = ["split", "scenario", "track_id", "vessel_id", "role", "class", "asset"]
-        sink.write(out / TRACKS_FILE, _csv([head, *tracks]))
+        sink.write(out / TRACKS_FILE, csv_bytes([list(TRACKS_COLUMNS), *tracks]))
         sink.mkdir(out / "seqmaps")
         for split in [*SPLIT_NAMES]:
             if split in st.sequences:
