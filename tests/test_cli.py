@@ -57,3 +57,18 @@ def test_run_checks_its_options_for_one_file_as_for_a_folder(tmp_path: Path) -> 
         r = run("run", scenario, *out, *args)
         assert r.returncode == 2 and said in r.stderr and "Traceback" not in r.stderr, r.stderr
     assert not (tmp_path / "out").exists()
+
+
+def test_run_counts_one_frame_as_one_frame(tmp_path: Path) -> None:
+    # A one-frame run said "1 frames in ...", in mmusv run's line and in a folder run's table.
+    import yaml
+    from tiny_scenario import lidar_scenario
+
+    for frames, said in ((1, " 1 frame in "), (2, " 2 frames in ")):
+        src = tmp_path / f"s{frames}"
+        src.mkdir()
+        (src / "tiny.yaml").write_text(yaml.safe_dump(lidar_scenario("tiny", frames=frames)))
+        one = run("run", str(src / "tiny.yaml"), "-o", str(tmp_path / f"one{frames}"))
+        assert one.returncode == 0 and said in one.stdout, one.stdout + one.stderr
+        folder = run("run", str(src), "-o", str(tmp_path / f"many{frames}"), "--jobs", "1")
+        assert folder.returncode == 0 and said.strip() in " ".join(folder.stdout.split()), folder.stdout

@@ -67,7 +67,8 @@ def _run_one(
             print(f"mmusv: note: {note}", file=sys.stderr)
     fps = res.frames_written / res.seconds if res.seconds > 0 else float("nan")
     line = (
-        f"{scenario.name}: {res.frames_written} frames in {res.seconds:.1f} s ({fps:.2f} frames/s), "
+        f"{scenario.name}: {res.frames_written} frame{'' if res.frames_written == 1 else 's'} in {res.seconds:.1f} s "
+        f"({fps:.2f} frames/s), "
         f"{res.messages} messages, {res.bytes / 1e6:.1f} MB -> {res.recording}"
     )
     return line if res.profile is None else f"{res.profile.render()}\n{line}"

@@ -139,7 +139,7 @@ def print_report(report: BatchReport, console: Console) -> None:
         elif o.status == "skipped":
             result = f"complete, same config hash: {where(o.recording)}"
         else:
-            result = f"{o.frames} frames in {o.seconds:.1f} s -> {where(o.recording)}"
+            result = f"{o.frames} frame{'' if o.frames == 1 else 's'} in {o.seconds:.1f} s -> {where(o.recording)}"
         table.add_row(
             o.file.name,
             f"[{colour[o.status]}]{o.status}[/{colour[o.status]}]",
