@@ -106,9 +106,10 @@ face); the conversions are `mmusv.world.mesh_materials`'s.
   of the colour a modelling tool interpolates across it), quantised to 64 levels per sRGB channel (steps of 1/63);
   each distinct colour is one material `vertex_colour:#rrggbb` (roughness 0.5, metallic 0, as the class default),
   shared by all files. A file with more than 256 distinct face colours
-  (`mmusv.world.mesh_materials.MAX_COLOUR_MATERIALS`) is quantised coarser (32, 16, ... levels) until it has no
-  more (a glTF's `COLOR_0` materials counted with them), with a `MmusvWarning` saying so. An OBJ's faces with an
-  MTL material keep that material.
+  (`mmusv.world.mesh_materials.MAX_COLOUR_MATERIALS`) is quantised coarser (32, 16, ... down to 2 levels) until it
+  has no more (a glTF's `COLOR_0` materials counted with them; should they still be more at 2 levels, each glTF
+  material its `COLOR_0` multiplies takes the mean of its faces' colours), with a `MmusvWarning` saying so. An
+  OBJ's faces with an MTL material keep that material.
 - STL, OFF and other files without colours, and glTF primitives with neither a material nor `COLOR_0`, get the
   class's default look.
 
@@ -118,9 +119,9 @@ texture file is missing or not an image, an OBJ whose `.mtl` (`mtllib`) or `map_
 (naming the entry and the path looked for) or not an image, a `usemtl` naming no material of its MTL files, an MTL
 value out of range (`Kd` outside [0, 1], ...), a `COLOR_0` that glTF does not allow or that does not fit its
 primitive (naming the primitive and accessor: another count than its `POSITION`, not VEC3/VEC4, not float or
-normalized unsigned byte/short, non-finite or outside [0, 1]), non-finite coordinates, no triangles, or trimesh's
-own reason for a file it cannot parse. A texture or buffer URI is read as glTF means it: percent-decoded and
-relative to the `.gltf` (`../textures/` included).
+normalized unsigned byte/short, a sparse accessor (trimesh does not apply its values), non-finite or outside
+[0, 1]), non-finite coordinates, no triangles, or trimesh's own reason for a file it cannot parse. A texture or
+buffer URI is read as glTF means it: percent-decoded and relative to the `.gltf` (`../textures/` included).
 """
 
 

@@ -167,8 +167,8 @@ def _accessor(data: dict[str, object], index: object) -> dict[str, object] | Non
 
 def _color_0_checks(path: Path, data: dict[str, object], where: str) -> list[str]:
     """Refuses a ``COLOR_0`` that glTF 2.0 does not allow or that does not fit its primitive (not an accessor, not
-    VEC3/VEC4, not float or normalized unsigned byte/short, another count than ``POSITION``'s: trimesh would drop or
-    misread it without a word); returns the name (``meshes[i].primitives[j]``) of each primitive trimesh makes a
+    VEC3/VEC4, not float or normalized unsigned byte/short, sparse, another count than ``POSITION``'s: trimesh would
+    drop or misread it without a word); returns the name (``meshes[i].primitives[j]``) of each primitive trimesh makes a
     geometry of, in its order."""
     shown = repr(str(path))
     names: list[str] = []
@@ -201,6 +201,13 @@ def _color_0_checks(path: Path, data: dict[str, object], where: str) -> list[str
                     where,
                     f"{at} has componentType {got}; a vertex colour must be float (5126), or unsigned byte (5121) "
                     "or unsigned short (5123) with normalized: true",
+                )
+            if "sparse" in acc:
+                read = "its bufferView's values" if "bufferView" in acc else "zeros (black)"
+                raise AssetSpecError(
+                    where,
+                    f"{at} is a sparse accessor, whose substitutions trimesh's glTF reader does not apply (it would "
+                    f"read {read}); write COLOR_0 as a plain accessor, as Blender's and trimesh's exporters do",
                 )
             pos = _accessor(data, attrs.get("POSITION"))
             count, vertices = acc.get("count"), None if pos is None else pos.get("count")

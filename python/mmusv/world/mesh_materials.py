@@ -18,8 +18,9 @@ material's base colour, quantised as vertex colours are below; each distinct res
 ``<material>:#rrggbb``, the glTF material with that base colour (its roughness, metallic and emission kept). A
 primitive with ``COLOR_0`` and no material gets the vertex colour materials ``vertex_colour:#rrggbb`` below
 (without ``COLOR_0``: material 0, the class's default look). A ``COLOR_0`` of another count than ``POSITION``,
-another type than VEC3/VEC4, another component type than float or normalized unsigned byte/short, or with
-non-finite values or values outside [0, 1] is an error (:mod:`mmusv.world.mesh_files`).
+another type than VEC3/VEC4, another component type than float or normalized unsigned byte/short, a sparse
+accessor (trimesh does not apply its values), or with non-finite values or values outside [0, 1] is an error
+(:mod:`mmusv.world.mesh_files`).
 
 **OBJ with MTL** (:func:`obj_materials`): each face takes the material its ``usemtl`` names, read from the files
 its ``mtllib`` lines name (relative to the OBJ; texture files relative to the MTL, as the Wavefront MTL spec and
@@ -52,9 +53,10 @@ PLY importer and exporter default, three.js's PLYLoader); a face's colour is the
 colours in linear RGB (the mean over the face of the colour a modelling tool interpolates across it), re-encoded
 to sRGB and quantised to :data:`COLOUR_LEVELS` levels per channel (1/63 steps); each distinct colour is one material
 ``vertex_colour:#rrggbb`` (roughness 0.5, metallic 0, the class default's), shared by every file. A file with more
-than :data:`MAX_COLOUR_MATERIALS` distinct face colours is quantised coarser (32, 16, ... levels) until it has no
-more (glTF ``COLOR_0`` materials counted with them), with a :class:`~mmusv.scenario_checks.MmusvWarning`. OBJ
-faces with an MTL material keep it.
+than :data:`MAX_COLOUR_MATERIALS` distinct face colours is quantised coarser (32, 16, ... down to 2 levels) until
+it has no more (glTF ``COLOR_0`` materials counted with them; should they still be more at 2 levels, each glTF
+material its ``COLOR_0`` multiplies takes the mean of its faces' colours), with a
+:class:`~mmusv.scenario_checks.MmusvWarning`. OBJ faces with an MTL material keep it.
 """
 
 from __future__ import annotations
@@ -480,6 +482,11 @@ def _colour_material(name: str, byte: np.ndarray) -> Material:
     return _material(name, _srgb_to_linear(byte / 255.0), 0.5, 0.0, np.zeros(3))
 
 
+def _quantise(srgb: np.ndarray, levels: int) -> np.ndarray:
+    """sRGB values in [0, 1] rounded to ``levels`` (>= 2) levels per channel, as bytes (``int64``)."""
+    return np.round(np.round(srgb * (levels - 1)) * 255.0 / (levels - 1)).astype(np.int64)
+
+
 def colour_material_ids(colours: np.ndarray, path: Path, where: str, tints: np.ndarray | None = None) -> np.ndarray:
     """The material ids ``(F,)`` of faces of linear colours ``(F, 3)`` (module docstring: quantised in sRGB to
     :data:`COLOUR_LEVELS` levels, coarser with a warning beyond :data:`MAX_COLOUR_MATERIALS` materials).
@@ -494,17 +501,29 @@ def colour_material_ids(colours: np.ndarray, path: Path, where: str, tints: np.n
     srgb = _linear_to_srgb(np.asarray(colours, dtype=np.float64) * base)
     levels = COLOUR_LEVELS
     while True:
-        byte = np.round(np.round(srgb * (levels - 1)) * 255.0 / (levels - 1)).astype(np.int64)
+        byte = _quantise(srgb, levels)
         uniq, inverse = np.unique(np.c_[tint, byte], axis=0, return_inverse=True)
-        if len(uniq) <= MAX_COLOUR_MATERIALS:
+        if len(uniq) <= MAX_COLOUR_MATERIALS or levels <= 2:
             break
         levels //= 2
+    per_material = len(uniq) > MAX_COLOUR_MATERIALS  # only COLOR_0 gets here: 2 levels are 8 plain colours at most
+    if per_material:
+        for t in np.unique(tint[tint >= 0]).tolist():
+            mean = (np.asarray(colours, dtype=np.float64) * base)[tint == t].mean(axis=0)
+            byte[tint == t] = _quantise(_linear_to_srgb(mean), COLOUR_LEVELS)
+        uniq, inverse = np.unique(np.c_[tint, byte], axis=0, return_inverse=True)
     if levels < COLOUR_LEVELS:
         from mmusv.scenario_checks import MmusvWarning  # here: scenario_checks imports the config, which imports us
 
+        how = (
+            "even at 2 levels its COLOR_0 vertex colours give more, so each glTF material they multiply takes the "
+            "mean of its faces' colours, the other faces 2 levels"
+            if per_material
+            else f"quantised to {levels} levels"
+        )
         warnings.warn(
             f"{where}: {str(path)!r} has more than {MAX_COLOUR_MATERIALS} distinct face colours at {COLOUR_LEVELS} "
-            f"levels per channel; quantised to {levels} levels ({len(uniq)} materials)",
+            f"levels per channel; {how} ({len(uniq)} materials)",
             MmusvWarning,
             stacklevel=6,
         )
