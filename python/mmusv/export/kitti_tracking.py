@@ -20,7 +20,8 @@ over the whole conversion in its order: split, scenario, agent; so no two sequen
   camera is rigid on the hull, so LiDAR → camera is one matrix per sequence, checked on every frame (a camera that
   moved against the LiDAR is refused, :class:`~mmusv.errors.IoError`);
 * ``pose/<seq>.txt``: line ``frame``: LiDAR → mmusv world, 3×4 row-major (the KITTI export's ``pose``);
-* ``frames/<seq>.txt``: line ``frame``: the recording's acquisition index (sim time = index / ``frequency_hz``);
+* ``frames/<seq>.txt``: line ``frame``: the recording's acquisition index (sim time = index / ``frequency_hz``;
+  where frames in the middle were skipped, consecutive frames are further apart, which the conversion's notes say);
 * ``evaluate_tracking.seqmap.<split>``: ``<seq> empty 000000 <frames:06d>`` per sequence (TrackEval's and the
   devkit's sequence map; ``GT_FOLDER`` = ``<split>``, ``SPLIT_TO_EVAL`` = ``<split>``).
 
@@ -65,6 +66,20 @@ FOLDERS = {"image_2": "image_02", "depth_2": "depth_02", "semantic_2": "semantic
 """The KITTI object layout's per-frame folders renamed in the tracking layout (the others keep their name)."""
 RIGID_TOLERANCE = 1e-6
 """The most an entry of LiDAR → front camera (metres, or a rotation's entry) may differ between frames of a sequence."""
+
+
+def _shown(indices: list[int]) -> str:
+    """Sorted acquisition indices as ranges: ``2, 5..7``."""
+    out: list[str] = []
+    start = prev = indices[0]
+    for k in [*indices[1:], None]:
+        if k is not None and k == prev + 1:
+            prev = k
+            continue
+        out.append(f"{start}" if start == prev else f"{start}..{prev}")
+        if k is not None:
+            start = prev = k
+    return ", ".join(out)
 
 
 def seqmap_name(split: str) -> str:
@@ -183,6 +198,13 @@ class KittiTrackingWriter(KittiWriter):
         st: _Shared = self.shared
         for seq in self.sequences.values():
             order = sorted(seq.labels)
+            gaps = [k for k in range(order[0], order[-1] + 1) if k not in seq.labels] if order else []
+            if gaps:  # a tracker steps by frame: say where a step is longer than 1 / frequency_hz
+                what = "index {} is" if len(gaps) == 1 else "indices {} are"
+                self.notes.append(
+                    f"{self.split_folder}/{seq.name}: acquisition {what.format(_shown(gaps))} not converted, so its "
+                    f"frames are not all 1 / frequency_hz apart (frames/{seq.name}.txt gives each frame's index)"
+                )
             for sub, ext in seq.files.items():
                 where = seq.folder / sub
                 for k, index in enumerate(order):
