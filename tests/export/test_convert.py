@@ -154,6 +154,19 @@ def test_a_frame_range_beyond_every_recording_is_refused_before_writing(
     assert not (tmp_path / "two" / "export_short").exists()
 
 
+def test_a_frame_range_reaching_past_the_recording_is_noted(coop_rec: Path, tmp_path: Path) -> None:
+    """``--frames 1:10`` of a 3-frame recording converted frames 1 and 2 without a word about 3..9; the report says
+    which indices of the range the recording does not hold (a range inside it, or open-ended, says nothing)."""
+    rep = convert(coop_rec, out_dir=tmp_path / "o", to="kitti", frames="1:10", splits=None)
+    (r,) = rep.recordings
+    assert r.frames_converted == 2
+    said = [n for n in r.notes if "reach past" in n]
+    assert said == ["frames 1:10 reach past the recording, which holds frames 0..2: 3..9 not in it"], r.notes
+    for frames in ("1:3", "1:"):
+        rep = convert(coop_rec, out_dir=tmp_path / frames.replace(":", "_"), to="kitti", frames=frames, splits=None)
+        assert not [n for n in rep.recordings[0].notes if "reach past" in n], rep.recordings[0].notes
+
+
 def test_interrupted_run(tmp_path: Path, make_coop: Callable[..., dict[str, Any]]) -> None:
     from mmusv.acquire import recording_path, run
 

@@ -56,6 +56,24 @@ _BOX_FORMATS = ("coco", "yolo", "mot")
 (recorded in ``conversion.yaml``'s ``options``)."""
 
 
+def _beyond(frames: tuple[int, int | None] | None, first: int, end: int) -> str | None:
+    """What of ``frames`` (``[start, stop)``, the ``--frames`` asked for) lies outside the acquisition indices
+    ``first..end - 1`` a recording's run set out to write, said as a note (``None``: nothing): a range that reaches
+    past the recording would otherwise convert fewer frames than asked without a word."""
+    if frames is None or end <= first:
+        return None
+    start, stop = frames
+    before = (start, first if stop is None else min(stop, first))
+    after = (max(start, end), end if stop is None else stop)
+    out = [f"{a}" if b == a + 1 else f"{a}..{b - 1}" for a, b in (before, after) if a < b]
+    if not out:
+        return None
+    asked = f"{start}:{'' if stop is None else stop}"
+    return (
+        f"frames {asked} reach past the recording, which holds frames {first}..{end - 1}: {' and '.join(out)} not in it"
+    )
+
+
 def writer_class(to: str) -> type[DatasetWriter]:
     """The writer of format ``to`` (one of :data:`~mmusv.export.common.TARGETS`)."""
     if to == "opv2v":
@@ -323,6 +341,9 @@ def convert(
                     rep.skipped += [{"frames": [a, b], "reason": why} for a, b in _ranges(absent)]
                 elif stream.truncated:
                     rep.notes.append(stream.truncated)
+                beyond = _beyond(options.frames, first, first + configured)
+                if beyond:
+                    rep.notes.append(beyond)
                 if stream.out_of_order:
                     again = sorted(set(stream.out_of_order))
                     rep.notes.append(f"frames {again} appear more than once; the last copy was kept")
