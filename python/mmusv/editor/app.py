@@ -8,10 +8,13 @@ Endpoints (JSON in and out unless said otherwise; errors are ``{"error": "..."}`
 ``GET /api/assets``       the vessel library (name, category, class, sizes in metres, USV or not)
 ``GET /api/bundled``      the bundled scenarios; ``GET /api/bundled/{name}`` one of them as a document
 ``GET /api/files``        the scenario files in the folder; ``GET /api/files/{name}`` one as a document, with
-                          its ``etag`` (also the ``ETag`` header)
-``PUT /api/files/{name}`` saves ``{document, comment, overwrite}`` as YAML into the folder (409 if it exists);
-                          with ``If-Match: ETAG`` only if the file is still that version (412 if it changed;
-                          a list of ETags and ``*``, any version, are understood)
+                          its ``etag`` (also the ``ETag`` header); both documents come with the file's leading
+                          ``comment`` and its other ``comments`` (``[{path, at, text}]``, :mod:`.comments`)
+``PUT /api/files/{name}`` saves ``{document, comment, comments, overwrite}`` as YAML into the folder (409 if it
+                          exists); with ``If-Match: ETAG`` only if the file is still that version (412 if it
+                          changed; a list of ETags and ``*``, any version, are understood). ``comments`` left
+                          out: those of the file it replaces. The answer's ``comments`` are the new file's, its
+                          ``note`` says which comments lost their anchor (moved to the end of the file)
 ``POST /api/map``         ``{map}`` -> the map's layers (:mod:`mmusv.editor.maplayers`)
 ``POST /api/evaluate``    ``{document}`` -> validation, checks and motion (:mod:`mmusv.editor.evaluate`)
 ``POST /api/poses``       ``{document, frame}`` -> every vessel's ``[x, y, yaw]`` at that index
@@ -33,15 +36,16 @@ elsewhere (a Content-Security-Policy says so to the browser).
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import re
 import sys
 import threading
 import traceback
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Annotated, Any, get_args
+from typing import Annotated, Any, Literal, get_args
 
 from fastapi import FastAPI, Request
 from fastapi import Path as PathParam
@@ -55,7 +59,8 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from mmusv import yamlio
 from mmusv.config import EnvironmentConfig, MapConfig, Scenario, VesselConfig, load_scenario, validation_problems
-from mmusv.editor.document import leading_comment, scenario_yaml, to_document
+from mmusv.editor.comments import Comment, comment_problem, moved_note, read_comments
+from mmusv.editor.document import leading_comment, scenario_file, to_document
 from mmusv.editor.evaluate import MAX_BULK_FRAMES, evaluate, poses_at, validate
 from mmusv.editor.files import ChangedInFolder, FileExistsInFolder, ScenarioFolder, check_name, etag
 from mmusv.editor.jobs import Jobs, RunGoingOn
@@ -63,7 +68,7 @@ from mmusv.editor.maplayers import map_layers
 from mmusv.errors import ConfigError, InputError, MmusvError, NotFoundError
 from mmusv.yamlio import parse_yaml
 
-__all__ = ["MAX_BODY_BYTES", "STATIC_DIR", "InitialScenario", "create_app"]
+__all__ = ["MAX_BODY_BYTES", "STATIC_DIR", "InitialScenario", "comments_json", "create_app"]
 
 STATIC_DIR = Path(__file__).parent / "static"
 """The page's files (HTML, CSS, JavaScript modules), shipped in the package."""
@@ -86,6 +91,13 @@ class InitialScenario:
     in_folder: bool = False
     etag: str | None = None
     """The ETag of the file when ``in_folder`` (the page saves it with ``If-Match``)."""
+    comments: list[dict[str, Any]] = field(default_factory=list)
+    """The file's other comments (:func:`comments_json`), which the page sends back when it saves."""
+
+
+def comments_json(text: str) -> list[dict[str, Any]]:
+    """The comments of a scenario file's ``text`` but its leading block, as the API carries them."""
+    return [c.as_json() for c in read_comments(text)]
 
 
 _NOT_YAML = re.compile("[^\x09\x0a\x0d\x20-\x7e\x85\xa0-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
@@ -151,8 +163,31 @@ class DocumentBody(_Strict):
         return _jsonable(document, "document")
 
 
+class CommentBody(_Strict):
+    """A comment of the file and its anchor (:class:`mmusv.editor.comments.Comment`)."""
+
+    path: list[str | int] = Field(max_length=64)
+    at: Literal["before", "end"]
+    text: str = Field(max_length=20_000)
+
+    @field_validator("text")
+    @classmethod
+    def _one_comment_line(cls, text: str) -> str:
+        problem = comment_problem(text)
+        if problem is not None:
+            raise ValueError(problem)
+        return text
+
+    @field_validator("path")
+    @classmethod
+    def _path_is_text(cls, path: list[str | int]) -> list[str | int]:
+        _jsonable({"path": path}, "comments")
+        return path
+
+
 class SaveBody(DocumentBody):
     comment: str = Field(default="", max_length=20_000)
+    comments: list[CommentBody] | None = None
     overwrite: bool = False
 
     @field_validator("comment")
@@ -469,7 +504,13 @@ def create_app(
             raise NotFoundError(f"no bundled scenario {name!r}; bundled: {', '.join(sorted(files))}")
         text = files[stem].read_text(encoding="utf-8")
         doc, valid = _load_document(text, f"bundled {files[stem].name}")
-        return {"name": files[stem].name, "document": doc, "valid": valid, "comment": leading_comment(text)}
+        return {
+            "name": files[stem].name,
+            "document": doc,
+            "valid": valid,
+            "comment": leading_comment(text),
+            "comments": comments_json(text),
+        }
 
     @app.get("/api/files")
     def files() -> list[dict[str, Any]]:
@@ -487,7 +528,14 @@ def create_app(
         text, tag = got.text, got.etag
         doc, valid = _load_document(text, name)
         return JSONResponse(
-            {"name": name, "document": doc, "valid": valid, "comment": leading_comment(text), "etag": tag},
+            {
+                "name": name,
+                "document": doc,
+                "valid": valid,
+                "comment": leading_comment(text),
+                "comments": comments_json(text),
+                "etag": tag,
+            },
             headers={"ETag": f'"{tag}"'},
         )
 
@@ -506,14 +554,29 @@ def create_app(
                 "and two numbers), the most a scenario file may hold (mmusv.yamlio.MAX_YAML_VALUES), so the file "
                 "would not load again: use fewer waypoints or vessels"
             )
-        text = scenario_yaml(scenario, comment=body.comment)
+        if body.comments is not None:
+            comments = [Comment(tuple(c.path), c.at, c.text) for c in body.comments]
+        else:  # a client that does not carry them: those of the file it replaces (if it can be read)
+            comments = []
+            if body.overwrite and store.path(name).is_file():
+                with contextlib.suppress(MmusvError):
+                    comments = read_comments(store.read_text(name).text)
+        text, moved = scenario_file(scenario, comment=body.comment, comments=comments)
         path = store.write_text(
             name, text, overwrite=body.overwrite, if_match=_if_match(request.headers.get("if-match"))
         )
         tag = etag(text.encode("utf-8"))
-        return JSONResponse(
-            {"name": name, "path": str(path), "bytes": path.stat().st_size, "etag": tag}, headers={"ETag": f'"{tag}"'}
-        )
+        answer = {
+            "name": name,
+            "path": str(path),
+            "bytes": path.stat().st_size,
+            "etag": tag,
+            "comments": comments_json(text),
+        }
+        note = moved_note(moved)
+        if note is not None:
+            answer["note"] = note
+        return JSONResponse(answer, headers={"ETag": f'"{tag}"'})
 
     @app.post("/api/map")
     def map_(body: MapBody) -> Response:

@@ -86,7 +86,7 @@ def run(args: argparse.Namespace) -> int:
     from mmusv.bundled import resolve_scenario
     from mmusv.cli_paths import path_arg
     from mmusv.config import load_scenario
-    from mmusv.editor.app import InitialScenario, create_app
+    from mmusv.editor.app import InitialScenario, comments_json, create_app
     from mmusv.editor.document import leading_comment, to_document
     from mmusv.editor.files import check_name
 
@@ -101,7 +101,8 @@ def run(args: argparse.Namespace) -> int:
         initial = InitialScenario(
             name=check_name(path.name if path.suffix in (".yaml", ".yml") else f"{path.name}.yaml"),
             document=to_document(scenario),
-            comment=leading_comment(path.read_text(encoding="utf-8", errors="replace")),
+            comment=leading_comment(text := path.read_text(encoding="utf-8", errors="replace")),
+            comments=comments_json(text),
             in_folder=path.resolve().parent == folder.resolve(),
         )
     host = str(args.host)

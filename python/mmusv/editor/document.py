@@ -5,7 +5,8 @@ keys a person writes by hand (name, seed, map, environment, acquisition, rigs, v
 speed and route) always, everything else only where it differs from its default, and each rig only where it
 differs from its ``preset``. Validating the document again gives a scenario equal to the original, which is why
 "load, save unchanged" gives an equal scenario. :func:`scenario_yaml` writes it the way the bundled scenarios are
-written (top-level blocks, one flow line per vessel), with the file's leading comment kept. A text holding a line
+written (top-level blocks, one flow line per vessel), with the file's leading comment kept and its other comments
+written back at their anchors (a key, a rig, a vessel by its id: :mod:`mmusv.editor.comments`). A text holding a line
 break, a tab or a character outside printable Unicode (a rig named ``"a\\x85b"``) is written double-quoted with
 escapes, so it reads back as written (PyYAML's default style would fold such a break into a space).
 """
@@ -13,14 +14,16 @@ escapes, so it reads back as written (PyYAML's default style would fold such a b
 from __future__ import annotations
 
 import re
+from collections.abc import Iterable
 from typing import Any
 
 import yaml
 
 from mmusv.config import Scenario, VesselConfig
+from mmusv.editor.comments import Comment, place_comments
 from mmusv.sensors.config import RigConfig
 
-__all__ = ["leading_comment", "scenario_yaml", "to_document"]
+__all__ = ["leading_comment", "scenario_file", "scenario_yaml", "to_document"]
 
 _ALWAYS_VESSEL = ("id", "role", "asset", "speed_mps", "route")
 
@@ -147,8 +150,17 @@ def leading_comment(text: str) -> str:
     return "\n".join(lines)
 
 
-def scenario_yaml(scenario: Scenario, *, comment: str = "") -> str:
-    """The YAML text of ``scenario`` (its :func:`to_document`), ``comment`` as a leading ``#`` block."""
+def scenario_yaml(scenario: Scenario, *, comment: str = "", comments: Iterable[Comment] = ()) -> str:
+    """The YAML text of ``scenario`` (its :func:`to_document`), ``comment`` as a leading ``#`` block and
+    ``comments`` (:func:`mmusv.editor.comments.read_comments` of the file it came from) at their anchors."""
+    return scenario_file(scenario, comment=comment, comments=comments)[0]
+
+
+def scenario_file(
+    scenario: Scenario, *, comment: str = "", comments: Iterable[Comment] = ()
+) -> tuple[str, list[Comment]]:
+    """:func:`scenario_yaml`'s text and the comments whose anchor is gone, which it wrote at the end of the file
+    (:func:`mmusv.editor.comments.place_comments`)."""
     doc = to_document(scenario)
     top: dict[str, Any] = {}
     for key, value in doc.items():
@@ -159,5 +171,8 @@ def scenario_yaml(scenario: Scenario, *, comment: str = "") -> str:
         else:
             top[key] = _flowed(value)
     body = yaml.dump(top, Dumper=_Dumper, sort_keys=False, allow_unicode=True, width=120, indent=2)
+    body, moved = place_comments(body, comments)
     head = "".join(f"# {line}".rstrip() + "\n" for line in comment.splitlines()) if comment.strip() else ""
-    return head + body
+    if body.startswith("#"):  # comments of the first key: a blank line keeps them out of the leading block
+        head += "\n"
+    return head + body, moved

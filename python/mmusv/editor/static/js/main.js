@@ -116,7 +116,13 @@ async function refreshOpen() {
 async function load(value) {
   const [kind, name] = [value.slice(0, value.indexOf(":")), value.slice(value.indexOf(":") + 1)];
   const res = kind === "file" ? await api.readFile(name) : await api.bundledOne(name);
-  state.load({ document: res.document, comment: res.comment, name: res.name, savedName: kind === "file" ? res.name : null });
+  state.load({
+    document: res.document,
+    comment: res.comment,
+    comments: res.comments,
+    name: res.name,
+    savedName: kind === "file" ? res.name : null,
+  });
   savedEtag = kind === "file" ? res.etag : null;
   openedBundled = kind === "bundled" ? name : null;
   remember();
@@ -169,15 +175,16 @@ async function save(overwrite = false) {
   try {
     const same = name === state.savedName;
     const key = state.key(); // what is sent: edits made while it is on its way are not saved
-    const body = { document: state.doc, comment: state.comment, overwrite: overwrite || same };
+    const body = { document: state.doc, comment: state.comment, comments: state.comments, overwrite: overwrite || same };
     const res = await api.writeFile(name, body, same && !overwrite ? savedEtag : null);
     savedEtag = res.etag;
+    state.comments = res.comments || []; // as the file now holds them (a removed vessel's at its end)
     state.savedName = name;
     state.fileName = name;
     state.markSaved(key);
     remember();
     renderAll(); // the title's unsaved mark and file name
-    status(`saved ${res.name} (${res.bytes} bytes)`);
+    status(`saved ${res.name} (${res.bytes} bytes)${res.note ? `; ${res.note}` : ""}`);
     document.body.dataset.saved = name;
     await refreshOpen();
     return true;
@@ -461,6 +468,7 @@ async function boot() {
       state.load({
         document: info.initial.document,
         comment: info.initial.comment,
+        comments: info.initial.comments,
         name: info.initial.name,
         savedName: info.initial.in_folder ? info.initial.name : null,
       });
@@ -468,7 +476,7 @@ async function boot() {
     } else if (!opened) {
       const first = bundled.find((b) => b.name === "port_entry") || bundled[0];
       const res = await api.bundledOne(first.name);
-      state.load({ document: res.document, comment: res.comment, name: res.name });
+      state.load({ document: res.document, comment: res.comment, comments: res.comments, name: res.name });
     }
     if (!opened) remember();
     map.applyView();

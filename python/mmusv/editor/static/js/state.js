@@ -17,6 +17,7 @@ export class EditorState {
   constructor() {
     this.doc = null; // scenario document, as /api/evaluate and the YAML file know it
     this.comment = "";
+    this.comments = []; // the file's other comments with their anchors, sent back on save (the page does not edit them)
     this.fileName = "";
     this.savedName = null; // the folder file this document was loaded from or saved to
     this.savedKey = null; // canonical text of the scenario (document and comment) last opened or saved
@@ -70,9 +71,10 @@ export class EditorState {
   }
 
   /** Replaces the whole document (opening a file): clears the history. */
-  load({ document, comment, name, savedName }) {
+  load({ document, comment, comments, name, savedName }) {
     this.doc = structuredClone(document);
     this.comment = comment || "";
+    this.comments = comments || [];
     this.fileName = name || "";
     this.savedName = savedName || null;
     this.savedKey = this.key();

@@ -1,0 +1,46 @@
+"""The page carries a file's comments through an edit and a save (Selenium, headless Chromium): a bundled scenario's
+comment above a vessel is written back above it, and one of a vessel deleted in the page is kept at the end of the file
+with a word in the status line."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from mmusv.bundled import bundled_dir
+from mmusv.editor.comments import read_comments
+from selenium.webdriver.common.by import By
+from selenium.webdriver.support.select import Select
+from test_browser import LiveServer, _wait, open_editor, settled
+from test_browser_round import js_errors
+from test_browser_round2 import save_as
+
+
+def test_the_page_saves_a_bundled_scenario_with_its_comments(browser: Any, live_server: LiveServer) -> None:
+    open_editor(browser, live_server)
+    js_errors(browser)
+    Select(browser.find_element(By.ID, "open")).select_by_value("bundled:island_occlusion")
+    _wait(browser, "return window.mmusvEditor.state.fileName === 'island_occlusion.yaml'", "the bundled scenario")
+    settled(browser)
+    # a waypoint moved: the comments stay at their vessel
+    browser.execute_script("window.mmusvEditor.state.edit((d) => { d.vessels[0].route[0][0] += 5; });")
+    save_as(browser, "occlusion.yaml")
+    saved = (Path(live_server.folder) / "occlusion.yaml").read_text(encoding="utf-8")
+    original = (bundled_dir() / "island_occlusion.yaml").read_text(encoding="utf-8")
+    assert read_comments(saved) == read_comments(original)
+    lines = saved.splitlines()
+    trawler = next(i for i, line in enumerate(lines) if line.startswith("- {id: trawler"))
+    assert lines[trawler - 2].startswith("# Near traffic on each flank")
+    # the trawler deleted: its comments go to the end of the file, and the status line says so
+    browser.execute_script(
+        "window.mmusvEditor.state.edit((d) => { d.vessels = d.vessels.filter((v) => v.id !== 'trawler'); });"
+    )
+    settled(browser)
+    browser.find_element(By.ID, "save").click()
+    _wait(browser, "return !window.mmusvEditor.state.dirty", "the save")
+    status = browser.find_element(By.ID, "status").text
+    assert "2 comments of the removed vessel trawler were moved to the end of the file" in status, status
+    saved = (Path(live_server.folder) / "occlusion.yaml").read_text(encoding="utf-8")
+    assert saved.splitlines()[-3] == "# [removed from the scenario: vessel trawler]"
+    assert browser.execute_script("return window.mmusvEditor.state.comments.at(-3).text") == saved.splitlines()[-3]
+    assert js_errors(browser) == []
