@@ -157,7 +157,7 @@ def test_a_resume_refusal_names_what_differs(model: Path, tmp_path: Path, kwargs
 
     shutil.copytree(model.parent, tmp_path / "m")
     args: dict[str, Any] = {"p": preset("tiny"), "mode": "single", **kwargs}
-    with pytest.raises(InputError, match=rf"last\.pt: a checkpoint of another run \({said}\); use another --out"):
+    with pytest.raises(InputError, match=rf"last\.pt: a checkpoint of another run \({said}\); use another -o"):
         train(MemorySource(SCENES), out=tmp_path / "m", epochs=2, progress=False, **args)
 
 

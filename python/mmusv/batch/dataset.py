@@ -57,6 +57,21 @@ class DatasetReport:
         return self.batch.ok
 
 
+def _conversion_complete(opv2v: Path) -> bool:
+    """Whether ``opv2v`` holds a finished conversion: its report says ``status: complete``. A conversion into a
+    folder that was not there (removed by hand) writes into it directly and starts its report as ``in_progress``:
+    stopped there (Ctrl-C), a re-run took the half-written folder for up to date, as the index still named the
+    same recordings."""
+    from mmusv.export.convert_report import REPORT_NAME
+    from mmusv.yamlio import read_yaml
+
+    try:
+        doc = read_yaml(opv2v / REPORT_NAME)
+    except (OSError, MmusvError, ValueError):
+        return False
+    return isinstance(doc, dict) and doc.get("status") == "complete"
+
+
 def _spec_hash(spec: Any) -> str:
     text = json.dumps(spec.model_dump(mode="json"), sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()
@@ -130,7 +145,7 @@ def build_dataset(
     docstring); the batch options are those of :func:`mmusv.batch.run_many` (``overwrite``: record every scenario
     again, replacing whatever ``DIR/recordings`` holds for it)."""
     from mmusv.bundled import resolve_spec
-    from mmusv.export.convert import REPORT_NAME, convert
+    from mmusv.export.convert import convert
     from mmusv.generate.runner import generate
     from mmusv.generate.spec import load_spec
 
@@ -198,9 +213,7 @@ def build_dataset(
         section = old.get("opv2v") or {}
         converted: int | None = None
         up_to_date = (
-            section.get("sources") == sources
-            and section.get("status") == "complete"
-            and (opv2v / REPORT_NAME).is_file()
+            section.get("sources") == sources and section.get("status") == "complete" and _conversion_complete(opv2v)
         )
         if sources and not up_to_date:
             recs = [out / r["recording"] for r in doc["recordings"] if r["name"] in sources]

@@ -35,7 +35,7 @@ import numpy as np
 
 from mmusv.learn._errors import input_error
 
-__all__ = ["Cache", "Sample", "build_cache", "dataset_fingerprints", "same_data"]
+__all__ = ["Cache", "Sample", "build_cache", "cache_identity", "dataset_fingerprints", "same_data"]
 
 Sample = tuple[np.ndarray, list[tuple[np.ndarray, np.ndarray]], np.ndarray]
 """``(ego points (N, 4) float32, [(neighbour points (N_i, 4) float32 own frame, rel (4, 4) neighbour → ego)],
@@ -69,6 +69,22 @@ def dataset_fingerprints(ds: Any) -> dict[str, str]:
         except Exception:  # a fingerprint is a check's input: reading the sequence reports a bad file
             continue
     return out
+
+
+def _identity_of(meta: dict[str, Any]) -> dict[str, Any]:
+    keys = (*_IDENTITY, "split", "ratios", "seed")
+    return {k: meta[k] for k in keys if k in meta}
+
+
+def cache_identity(path: str | Path) -> dict[str, Any] | None:
+    """:meth:`Cache.identity` of the cache file ``path`` read from its ``meta`` alone (not its arrays); ``None``
+    where it cannot be read (:class:`Cache` says why when it is loaded)."""
+    try:
+        with open(path, "rb") as fh, np.load(fh, allow_pickle=False) as z:
+            meta = json.loads(str(z["meta"]))
+    except (OSError, ValueError, EOFError, TypeError, KeyError, zipfile.BadZipFile):
+        return None
+    return _identity_of(meta) if isinstance(meta, dict) else None
 
 
 def same_data(a: dict[str, Any] | None, b: dict[str, Any] | None) -> bool:
@@ -258,8 +274,7 @@ class Cache:
     def identity(self) -> dict[str, Any]:
         """What the cache was built from (module docstring): ``sources``, ``fingerprints`` (when recorded),
         ``range_m``, ``frame_stride``, and the ``split``, ``ratios`` and ``seed`` that chose the sequences."""
-        keys = (*_IDENTITY, "split", "ratios", "seed")
-        return {k: self.meta[k] for k in keys if k in self.meta}
+        return _identity_of(self.meta)
 
     def cloud(self, c: int) -> np.ndarray:
         """``(N, 4)`` float32 points of cloud ``c`` (LiDAR frame, metres; intensity in [0, 1])."""

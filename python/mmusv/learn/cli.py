@@ -113,6 +113,10 @@ def run(args: argparse.Namespace) -> int:
     if args.opv2v is not None:
         path_arg(args.opv2v, flag="--opv2v")
     ratios = split_ratios(args.split_ratios)
+    from mmusv.studies.detection.data import check_split
+
+    # before --generate, which refused a bad --split or --seed only after generating and recording the whole dataset
+    check_split(args.split, args.seed if args.opv2v is None else 0)
     _torch()
     _check_device(args.device)
     from mmusv.learn.cache import build_cache
@@ -164,6 +168,21 @@ def run(args: argparse.Namespace) -> int:
     if threads is None and jobs > 1:
         threads = max(1, (os.cpu_count() or 1) // jobs)
     p = preset(args.preset)
+    from mmusv.learn.cache import cache_identity
+    from mmusv.learn.train import resumable_checkpoint
+
+    identity = cache_identity(cache)
+    # A run whose every model would refuse its checkpoint (another preset or seed into the same -o) is refused once,
+    # before any process starts: each process refused alone, and the summary of the models there was replaced by one
+    # of none. Where only some would, the others train (a failing model does not stop them).
+    refusals: list[InputError] = []
+    for mode in modes:
+        try:
+            resumable_checkpoint(out / mode, p=p, mode=mode, seed=args.seed, identity=identity)
+        except InputError as exc:
+            refusals.append(exc)
+    if refusals and len(refusals) == len(modes):
+        raise refusals[0]
     summary: dict[str, Any] = {"preset": p.to_dict(), "seed": args.seed, "jobs": jobs, "models": {}}
     task = {
         "cache": str(cache),

@@ -60,7 +60,7 @@ from mmusv.learn.model import PillarNet, torch_device
 from mmusv.learn.presets import PRESETS, Preset, parse_overrides, preset
 from mmusv.learn.targets import points_in_boxes
 
-__all__ = ["TrainResult", "TrainingSet", "main", "plot_losses", "plot_runs", "train"]
+__all__ = ["TrainResult", "TrainingSet", "main", "plot_losses", "plot_runs", "resumable_checkpoint", "train"]
 
 WARMUP_STEPS = 100
 LOG_EVERY = 10
@@ -145,6 +145,36 @@ def _differs(ck: dict[str, Any], p: Preset, mode: str, seed: int) -> str | None:
     return "; ".join(out) or None
 
 
+def resumable_checkpoint(
+    out: str | Path,
+    *,
+    p: Preset,
+    mode: str,
+    seed: int,
+    identity: dict[str, Any] | None,
+    device: Any = "cpu",
+) -> dict[str, Any] | None:
+    """The ``last.pt`` in model folder ``out`` that this run (preset ``p``, ``mode``, ``seed``, data ``identity``)
+    resumes, ``None`` without one; refuses one of another run, naming the file and what differs. ``mmusv train``
+    asks it for every model before it starts any: refused only in each model's process, a run of another preset into
+    the same ``-o`` printed the refusal once per model and replaced ``train_summary.json`` with one of no model."""
+    last = Path(out) / "last.pt"
+    if not last.is_file():
+        return None
+    what = f"{last}: not a checkpoint of mmusv train (remove it to start again, or use another -o)"
+    ck = load_checkpoint(last, what=what, device=device)
+    other = _differs(ck, p, mode, seed)
+    if other is not None:  # it said "preset/mode/seed differ", not which
+        raise input_error(f"{last}: a checkpoint of another run ({other}); use another -o")
+    if not same_data(ck.get("data"), identity):
+        before = ", ".join(str(x) for x in ck["data"].get("sources", [])) or "?"
+        raise input_error(
+            f"{last}: a checkpoint of a run on other data (trained on {before}); use another -o, or remove "
+            f"{out} to start again"
+        )
+    return ck
+
+
 def train(
     cache: Cache | str | Path,
     *,
@@ -190,18 +220,9 @@ def train(
     steps_per_epoch = math.ceil(len(data) / p.batch)
     start_epoch, step, log, spent = 0, 0, [], 0.0
     last = out_p / "last.pt"
-    if last.is_file():
-        what = f"{last}: not a checkpoint of mmusv train (remove it to start again, or use another --out)"
-        ck = load_checkpoint(last, what=what, device=dev)
-        other = _differs(ck, p, mode, seed)
-        if other is not None:  # it said "preset/mode/seed differ", not which
-            raise input_error(f"{last}: a checkpoint of another run ({other}); use another --out")
-        if not same_data(ck.get("data"), identity):
-            before = ", ".join(str(x) for x in ck["data"].get("sources", [])) or "?"
-            raise input_error(
-                f"{last}: a checkpoint of a run on other data (trained on {before}); use another --out, or remove "
-                f"{out_p} to start again"
-            )
+    ck = resumable_checkpoint(out_p, p=p, mode=mode, seed=seed, identity=identity, device=dev)
+    if ck is not None:
+        what = f"{last}: not a checkpoint of mmusv train (remove it to start again, or use another -o)"
         try:
             model.load_state_dict(ck["model"])
             opt.load_state_dict(ck["optimizer"])

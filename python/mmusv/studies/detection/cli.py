@@ -150,6 +150,7 @@ def run(args: argparse.Namespace) -> int:
     from mmusv.cli_paths import check_output_folder, path_arg
     from mmusv.errors import InputError
     from mmusv.learn.cli import check_threads, split_ratios
+    from mmusv.studies.detection.data import check_split
     from mmusv.studies.detection.detector import BASELINE_NOTE, load_detector
     from mmusv.studies.detection.fusion import parse_modes
     from mmusv.studies.detection.robustness import Setting, parse_settings
@@ -171,6 +172,9 @@ def run(args: argparse.Namespace) -> int:
             path_arg(value, flag=flag)
     out = check_output_folder(args.output)
     ratios = split_ratios(args.split_ratios)
+    # before --generate, which refused a bad --split or --seed only after generating and recording the whole dataset
+    # (a pre-split OPV2V folder's --split takes no seed)
+    check_split(args.split or ("test" if args.generate is not None else "all"), args.seed if args.opv2v is None else 0)
     # --range: a finite distance (inf was taken, and cropped the clouds at inf metres)
     range_m = arguments.real(args.range_m, name="--range", unit="metres", above=0.0, error=InputError)
     if args.model is not None:

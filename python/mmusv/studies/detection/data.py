@@ -33,6 +33,7 @@ __all__ = [
     "SceneFrame",
     "SequenceData",
     "boxes_in_frame",
+    "check_split",
     "gt_in_ego",
     "gt_with_ids",
     "opv2v_scenarios",
@@ -311,15 +312,26 @@ def read_opv2v(folder: str | Path) -> SequenceData:
     return SequenceData(d.name, tuple(frames))
 
 
+def check_split(split: str, seed: int) -> None:
+    """Refuses a ``--split`` other than ``train``, ``validate``, ``test`` or ``all``, and a negative ``--seed`` where
+    it seeds a split. The CLIs ask before ``--generate``: both were refused only after the whole dataset had been
+    generated and recorded."""
+    from mmusv.export.splits import SPLIT_NAMES
+
+    if split not in (*SPLIT_NAMES, "all"):
+        raise InputError(f"--split {split!r}: expected one of {', '.join((*SPLIT_NAMES, 'all'))}")
+    if split != "all" and (isinstance(seed, bool) or not isinstance(seed, int) or seed < 0):
+        raise InputError(f"--seed {seed!r}: the split's seed must be a whole number >= 0")
+
+
 def split_sequences(names: Sequence[str], *, split: str, ratios: Sequence[float], seed: int) -> list[str]:
     """The names in ``split`` (``train``, ``validate``, ``test`` or ``all``), split by sequence with the seeded
     shuffle of :func:`mmusv.export.splits.assign_splits`, in sorted order."""
-    from mmusv.export.splits import SPLIT_NAMES, assign_splits
+    from mmusv.export.splits import assign_splits
 
+    check_split(split, seed)
     if split == "all":
         return sorted(names)
-    if split not in SPLIT_NAMES:
-        raise InputError(f"--split {split!r}: expected one of {', '.join((*SPLIT_NAMES, 'all'))}")
     sp = assign_splits(list(names), ratios, seed)
     return sorted(n for n in names if sp[n] == split)
 
