@@ -51,7 +51,23 @@ TABLE_PART_FRAMES = 200
 
 @dataclass
 class RunResult:
-    """What a run wrote and how it ended: ``status`` is ``complete``, ``interrupted`` or ``failed``."""
+    """What a run wrote and how it ended.
+
+    Attributes:
+        recording: the MCAP file written, ``out_dir/<scenario name>.mcap``.
+        tables: the folder of the Parquet tables, ``out_dir/tables`` (``world_state``, ``boxes_3d``, ``boxes_2d``).
+        frames_written: acquisition indices recorded whole (every sensor, annotation and table row of each).
+        status: ``complete``, ``interrupted`` or ``failed`` (what the recording's ``run`` metadata says;
+            :func:`run` returns only complete runs and raises otherwise, after finishing the recording).
+        seconds: wall-clock seconds of the whole run (checks, world building, every frame, finishing).
+        messages: MCAP messages in the recording, every topic.
+        bytes: size of the MCAP file in bytes.
+        error: ``"<ExceptionType>: <message>"`` of what failed the run, else ``None``.
+        frame_seconds: wall-clock seconds of each frame, in acquisition order (capture, annotation and handing
+            it to the writer; the first includes the first capture made before anything was written).
+        profile: per-stage times with ``run(..., profile=True)`` (:class:`~mmusv.profiling.RunProfile`), else
+            ``None``.
+    """
 
     recording: Path
     tables: Path

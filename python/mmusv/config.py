@@ -556,7 +556,11 @@ def load_scenario(source: str | os.PathLike[str] | dict[str, Any] | Scenario) ->
         raise located(exc, where) from None
 
 
-def scenario_hash(scenario: Scenario) -> str:
-    """SHA-256 (hex) of the resolved scenario's canonical JSON: the config hash written into manifests."""
+def scenario_hash(scenario: str | os.PathLike[str] | dict[str, Any] | Scenario) -> str:
+    """SHA-256 (64 lowercase hex digits) of the resolved scenario's canonical JSON: the config hash written into
+    manifests (``RecordingInfo.config_hash``, ``dataset.json``'s ``config_hash``). ``scenario`` is anything
+    :func:`load_scenario` takes (a YAML path, a dict or a :class:`Scenario`), validated first: a dict and its YAML
+    file hash alike, and anything else is a :class:`~mmusv.errors.ConfigError`."""
+    scenario = load_scenario(scenario)
     text = json.dumps(scenario.model_dump(mode="json"), sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()

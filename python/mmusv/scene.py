@@ -118,9 +118,16 @@ def surface_tiles(foci: npt.ArrayLike, *, radius_m: float) -> int:
     """How many tiles the displaced sea surface around ``foci`` ``(F, 2)`` (world x, y, metres) out to
     ``radius_m`` (metres) holds: the core samples their bounding rectangle, grown by ``radius_m``, as one grid of
     :data:`SURFACE_TILE_M` tiles aligned on multiples of :data:`SURFACE_TILE_M` (so a side may take one tile more
-    than its length over the tile's); 0 without foci."""
-    f = np.ascontiguousarray(np.asarray(foci, dtype=np.float32).reshape(-1, 2))
-    return int(core.surface_tiles(f, radius_m=float(radius_m), tile_m=SURFACE_TILE_M))  # the core's own count
+    than its length over the tile's); 0 without foci. ``foci`` must be finite (cast to float32) and ``radius_m`` a
+    finite number > 0, else an :class:`~mmusv.errors.InputError` naming the argument."""
+    f = _array(foci, name="foci", dtype=np.float32, shape_tail=(2,))
+    if not np.isfinite(f).all():
+        bad = int(np.count_nonzero(~np.isfinite(f).all(axis=1)))
+        raise InputError(
+            f"foci: every focus must be a finite world x, y (metres, within float32); {bad} of {len(f)} are not"
+        )
+    radius = arguments.real(radius_m, name="radius_m", unit="metres", above=0.0, error=InputError)
+    return int(core.surface_tiles(f, radius_m=radius, tile_m=SURFACE_TILE_M))  # the core's own count
 
 
 _SEA_FIELDS = ("hs_m", "tp_s", "gamma", "direction_rad", "spread_s")

@@ -353,7 +353,13 @@ class Simulation:
         return out
 
     def agent(self, agent_id: str) -> Agent:
-        """The agent (USV) named ``agent_id``."""
+        """The agent (USV) named ``agent_id`` (a ``str``, a USV's ``id`` in the scenario), else a ``ConfigError``
+        listing the USVs."""
+        if not isinstance(agent_id, str):
+            raise ConfigError(
+                f"agent_id = {arguments.shown(agent_id)}: must be a USV's id (a str), not {type(agent_id).__name__}; "
+                f"the USVs are {[a.id for a in self.agents]}"
+            )
         for a in self.agents:
             if a.id == agent_id:
                 return a

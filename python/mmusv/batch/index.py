@@ -34,8 +34,10 @@ from mmusv.errors import IoError
 __all__ = [
     "INDEX_FORMAT",
     "INDEX_NAME",
+    "OWN_SECTIONS",
     "STATUSES",
     "Entry",
+    "check_extra",
     "dataset_recordings",
     "find_index",
     "read_index",
@@ -122,6 +124,34 @@ def write_index(path: str | os.PathLike[str], entries: Iterable[Entry], extra: M
             raise IoError(f"{path}: section {key!r} is the index's own")
         doc[key] = value
     return write_json(path, doc)
+
+
+OWN_SECTIONS = ("format", "version", "recordings", "totals")
+"""The sections :func:`write_index` writes itself: an ``extra`` section may not take their names."""
+
+
+def check_extra(extra: Mapping[str, Any] | None, *, name: str) -> None:
+    """Refuses (:class:`~mmusv.errors.ConfigError` naming ``name``) ``extra`` sections :func:`write_index` could not
+    write: one named like the index's own (:data:`OWN_SECTIONS`), or a value that is not plain JSON (dicts with
+    string keys, lists, strings, finite numbers, booleans, ``None``). Checked before a batch starts, not when its
+    index is written after the first recording."""
+    import json
+
+    from mmusv.arguments import shown
+    from mmusv.errors import ConfigError
+
+    for key, value in (extra or {}).items():
+        if key in OWN_SECTIONS:
+            raise ConfigError(
+                f"{name}: section {key!r} is the index's own ({', '.join(OWN_SECTIONS)}); give it another name"
+            )
+        try:
+            json.dumps(value, allow_nan=False)
+        except (TypeError, ValueError) as exc:
+            raise ConfigError(
+                f"{name}[{key!r}] = {shown(value)}: must be plain JSON (dicts with string keys, lists, strings, finite "
+                f"numbers, booleans, None): {exc}"
+            ) from None
 
 
 def find_index(folder: str | os.PathLike[str]) -> Path | None:

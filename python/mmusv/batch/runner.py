@@ -32,7 +32,7 @@ from mmusv.batch.executors import (
     refuse_in_daemon,
     refuse_in_worker_import,
 )
-from mmusv.batch.index import INDEX_NAME, Entry, folder_bytes, write_index
+from mmusv.batch.index import INDEX_NAME, Entry, check_extra, folder_bytes, write_index
 from mmusv.batch.plan import ScenarioPlan, plan_scenarios, prepare, scenario_files, task_complete
 from mmusv.batch.task import TaskResult
 from mmusv.errors import ConfigError, IoError, MmusvError
@@ -190,7 +190,9 @@ def run_many(
         overwrite: run every scenario again, and replace complete recordings of another configuration (without
             it those fail).
         checks: the route checks of :func:`mmusv.acquire.run`.
-        index: where ``dataset.json`` goes (default ``out_dir/dataset.json``); ``index_extra``: extra sections.
+        index: where ``dataset.json`` goes (default ``out_dir/dataset.json``); ``index_extra``: extra sections
+            (a dict of plain JSON values, keyed by names other than the index's own ``format``, ``version``,
+            ``recordings`` and ``totals``; checked before anything runs).
         progress: called with (frames done, frames in all) after each task (skipped frames count as done).
         stop_on_full_disk: when a task fails because the disk is full (``No space left on device``), stop: the
             tasks not started are cancelled and reported as failed with that cause (the default goes on, marking
@@ -228,6 +230,7 @@ def run_many(
     stop_on_full_disk = arguments.flag(stop_on_full_disk, name="stop_on_full_disk")
     progress = arguments.callback(progress, name="progress", nargs=2)
     index_extra = arguments.mapping(index_extra, name="index_extra")
+    check_extra(index_extra, name="index_extra")
     if isinstance(replace, (str, bytes)) or not isinstance(replace, Iterable):
         raise ConfigError(f"replace = {arguments.shown(replace)}: must be a collection of scenario file stems")
     stems = frozenset(replace)

@@ -31,6 +31,7 @@ from mmusv.export.convert_checks import (
     agent_selection,
     as_list,
     box_filter,
+    box_options,
     check_agents,
     contrast_filter,
     frame_selection,
@@ -184,7 +185,9 @@ def convert(
         include_usvs: list the other USVs as targets too (default: only non-instrumented vessels).
         extras: any of ``depth``, ``semantic``, ``instance``, ``radar``, ``top_view`` (OPV2V and KITTI: extra
             files stock loaders skip).
-        min_box_px: COCO, YOLO and MOT: leave out 2D boxes whose shorter side is under this many pixels.
+        min_box_px: COCO, YOLO and MOT: leave out 2D boxes whose shorter side is under this many pixels. This
+            option, ``max_occlusion``, ``min_contrast`` and ``box`` other than their defaults are refused for the
+            other formats, which would ignore them.
         max_occlusion: COCO, YOLO and MOT: leave out 2D boxes hidden by more than this fraction (0..1).
         min_contrast: COCO, YOLO and MOT: leave out 2D boxes whose apparent contrast in the recorded RGB image (the
             vessel's Weber contrast against the background around it, :mod:`mmusv.export.contrast`; 0.05 is the
@@ -225,6 +228,7 @@ def convert(
     box_px, max_occ = box_filter(min_box_px, max_occlusion)
     min_c = contrast_filter(min_contrast)
     box = parse_box(box)
+    box_options(to, min_box_px=box_px, max_occlusion=max_occ, min_contrast=min_c, box=box)
     kind = kitti_type(kitti_class, to)
     options = Options(
         to=to,

@@ -23,6 +23,7 @@ __all__ = [
     "agent_selection",
     "as_list",
     "box_filter",
+    "box_options",
     "check_agents",
     "contrast_filter",
     "frame_selection",
@@ -72,6 +73,27 @@ def box_filter(min_box_px: Any, max_occlusion: Any) -> tuple[float, float]:
     if not (math.isfinite(occ) and 0 <= occ <= 1):
         raise ConfigError(f"max_occlusion = {max_occlusion!r}: must be a fraction in [0, 1]")
     return px, occ
+
+
+BOX_FORMATS = ("coco", "yolo", "mot")
+"""The formats whose 2D boxes the options ``box``, ``min_box_px``, ``max_occlusion`` and ``min_contrast`` choose."""
+
+
+def box_options(to: str, *, min_box_px: float, max_occlusion: float, min_contrast: float | None, box: str) -> None:
+    """Refuses (:class:`~mmusv.errors.ConfigError` naming the option) a 2D box option other than its default for a
+    format ``to`` that writes no such boxes (not in :data:`BOX_FORMATS`): it would change nothing, silently."""
+    given = [
+        f"min_box_px = {min_box_px:g}" if min_box_px != 0.0 else "",
+        f"max_occlusion = {max_occlusion:g}" if max_occlusion != 1.0 else "",
+        f"min_contrast = {min_contrast:g}" if min_contrast is not None else "",
+        f"box = {box!r}" if box != "visible" else "",
+    ]
+    given = [g for g in given if g]
+    if to not in BOX_FORMATS and given:
+        raise ConfigError(
+            f"{', '.join(given)}: only the COCO, YOLO and MOT exports (to = 'coco', 'yolo' or 'mot') choose their 2D "
+            f"boxes with it, not to = {to!r}, which would ignore it; leave it out"
+        )
 
 
 def contrast_filter(min_contrast: Any) -> float | None:

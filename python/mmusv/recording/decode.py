@@ -41,9 +41,19 @@ def _need(msg: Any, fields: tuple[str, ...], what: str, caller: str) -> None:
 
 
 def decode_image(msg: Any) -> np.ndarray:
-    """A ``foxglove.RawImage`` or ``foxglove.CompressedImage`` (PNG) as a new, writable numpy array (``(H, W)`` or
-    ``(H, W, 3)``). Another message is an :class:`~mmusv.errors.InputError`; image bytes that do not decode an
-    :class:`~mmusv.errors.IoError`."""
+    """A ``foxglove.RawImage`` or ``foxglove.CompressedImage`` (PNG) as a new, writable numpy array, row 0 at the
+    top. Another message is an :class:`~mmusv.errors.InputError`; image bytes that do not decode an
+    :class:`~mmusv.errors.IoError`.
+
+    What an mmusv recording's images decode to (``docs/recording.md``):
+
+    - ``.../rgb`` (PNG) and ``.../radar/ppi`` (PNG): ``(H, W, 3)`` uint8 sRGB;
+    - ``.../semantic`` (PNG): ``(H, W)`` uint16 class ids (:mod:`mmusv.classes`, 0 = sky);
+    - ``.../instance`` (PNG): ``(H, W)`` uint16 scene instance ids, 65535 = sky (a capture's ``-1``);
+    - ``.../depth`` (``RawImage`` ``32FC1``): ``(H, W)`` float32 metres along the optical axis, ``+inf`` = sky.
+
+    A ``RawImage`` decodes by its encoding: ``rgb8`` ``(H, W, 3)`` uint8; ``mono8`` / ``8UC1`` ``(H, W)`` uint8;
+    ``mono16`` / ``16UC1`` ``(H, W)`` uint16; ``32FC1`` ``(H, W)`` float32; ``32SC1`` ``(H, W)`` int32."""
     if hasattr(msg, "format"):
         _need(msg, ("data",), "foxglove.CompressedImage", "decode_image")
         try:
@@ -69,9 +79,17 @@ def decode_image(msg: Any) -> np.ndarray:
 
 
 def decode_point_cloud(msg: Any) -> dict[str, np.ndarray]:
-    """A ``foxglove.PointCloud`` as ``{field name: (N,) array}`` using the packed field offsets (another message is
-    an :class:`~mmusv.errors.InputError`; bytes that are not whole points, or fields that do not fit in a point, an
-    :class:`~mmusv.errors.IoError`)."""
+    """A ``foxglove.PointCloud`` as ``{field name: (N,) array}`` (new, writable arrays, in the message's field
+    order, each of its field's type: FLOAT32 float32, UINT16 uint16, INT32 int32, ...) using the packed field
+    offsets. Another message is an :class:`~mmusv.errors.InputError`; bytes that are not whole points, or fields
+    that do not fit in a point, an :class:`~mmusv.errors.IoError`.
+
+    An mmusv recording's ``/{agent}/lidar`` gives ``x``, ``y``, ``z`` (float32 metres, the LiDAR frame
+    ``{agent}/lidar``), ``intensity`` (float32, 0..1), ``ring`` (uint16), ``azimuth`` (float32 radians, 0..2π,
+    counter-clockwise from x), ``class`` (uint16, :mod:`mmusv.classes`), ``instance`` (int32);
+    ``/{agent}/radar/returns`` gives ``x``, ``y``, ``z``, ``range`` (float32 metres, the radar frame),
+    ``azimuth``, ``elevation`` (float32 radians), ``intensity`` (float32, linear) and ``instance`` (int32, -1:
+    clutter). See ``docs/recording.md``."""
     _need(msg, ("point_stride", "data", "fields"), "foxglove.PointCloud", "decode_point_cloud")
     stride = int(msg.point_stride)
     raw = np.frombuffer(msg.data, dtype=np.uint8)
@@ -101,9 +119,20 @@ def decode_point_cloud(msg: Any) -> dict[str, np.ndarray]:
 
 @dataclass(frozen=True)
 class WorldFrame:
-    """One ``/world/state``: per vessel (scenario vessels in file order, then moored ships) its id, asset,
-    role, class, instance, pose ``(V, 6)`` [x, y, z, roll, pitch, yaw], velocity ``(V, 3)``, box centre
-    ``(V, 3)`` (world) and box size ``(V, 3)`` (length, beam, height)."""
+    """One ``/world/state``: per vessel (V of them: scenario vessels in file order, then moored ships) its id,
+    asset, role, class and instance, in the world frame (x east, y north, z up).
+
+    Attributes:
+        frame: the acquisition index; ``time_s``: its time ``k / f``, seconds.
+        ids, assets, roles: ``V`` strings each (roles ``usv``, ``target``, ``moored``).
+        classes: ``(V,)`` int64 semantic class (:mod:`mmusv.classes`); ``instance_ids``: ``(V,)`` int64 scene
+            instance (what the LiDAR's ``instance`` field and the cameras' instance images hold).
+        poses: ``(V, 6)`` float64 ``[x, y, z, roll, pitch, yaw]``, metres and radians (yaw counter-clockwise from
+            east).
+        velocities: ``(V, 3)`` float64, m/s, world frame.
+        box_centers: ``(V, 3)`` float64, metres, world frame; ``box_sizes``: ``(V, 3)`` float64 length, beam,
+            height, metres.
+    """
 
     frame: int
     time_s: float

@@ -34,7 +34,8 @@ def read_messages(
     ``topics`` is a list of topic names (``["/world/state"]``; a single string is refused, not read as its
     characters). A topic the recording does not have is a :class:`~mmusv.errors.ConfigError` listing the ones it
     has, raised once the file has been read (after the messages of the topics it has) unless the file is damaged.
-    The arguments are checked when iteration starts."""
+    The arguments are checked when iteration starts. A message of a channel that is not protobuf-encoded (an MCAP
+    file not written by mmusv) is an :class:`~mmusv.errors.IoError` naming the channel, not skipped."""
     from mcap_protobuf.decoder import DecoderFactory
 
     path = recording_arg(path)
@@ -67,8 +68,11 @@ def read_messages(
                 except Exception as exc:
                     raise IoError(f"{p}: channel {ch.topic} has an unreadable schema ({type(exc).__name__})") from None
             dec = decoders[msg.channel_id]
-            if dec is None:
-                continue
+            if dec is None:  # not protobuf: no recording of mmusv's (yielding nothing would look like an empty one)
+                raise IoError(
+                    f"{p}: channel {ch.topic} holds {ch.message_encoding or 'unencoded'!r} messages, not protobuf: "
+                    "not a recording of mmusv run (read other MCAP files with the mcap package)"
+                )
             try:
                 decoded = dec(msg.data)
             except Exception as exc:
