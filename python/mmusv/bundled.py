@@ -28,19 +28,27 @@ def _names(folder: Path | None = None) -> list[str]:
     return sorted(p.stem for p in (folder or bundled_dir()).glob("*.yaml"))
 
 
-def _resolve(name: str | Path, folder: Path, parents: tuple[str, ...], noun: str) -> Path:
+def _resolve(
+    name: str | Path, folder: Path, parents: tuple[str, ...], noun: str, other: tuple[Path, str] | None = None
+) -> Path:
     """``name`` itself when it exists, otherwise the bundled file of that stem in ``folder`` when ``name`` is bare
-    or under one of the repository-relative ``parents``; else :class:`~mmusv.errors.NotFoundError`."""
+    or under one of the repository-relative ``parents``; else :class:`~mmusv.errors.NotFoundError`, which says so
+    when ``name`` is a bundled file of the other kind (``other``: its folder and what to do with it)."""
     p = Path(name)
     if p.exists():
         return p
     stem = p.name[: -len(".yaml")] if p.name.endswith(".yaml") else p.name
-    if p.parent in (Path("."), *(Path(x) for x in parents)):
+    bare = p.parent == Path(".")
+    if bare or p.parent in (Path(x) for x in parents):
         cand = folder / f"{stem}.yaml"
         if cand.is_file():
             return cand
+    hint = ""
+    if other is not None and bare and (other[0] / f"{stem}.yaml").is_file():  # `mmusv run island_demo`, a spec
+        hint = f" ({stem} is {other[1].format(stem=stem)})"
     raise NotFoundError(
         f"{noun} file {str(name)!r} does not exist and is not a bundled {noun}; bundled: {', '.join(_names(folder))}"
+        + hint
     )
 
 
@@ -48,7 +56,8 @@ def resolve_scenario(name: str | Path) -> Path:
     """``name`` as a scenario file: the path itself when it exists, otherwise the bundled scenario of that name.
 
     Raises :class:`~mmusv.errors.NotFoundError` naming the bundled scenarios when neither exists."""
-    return _resolve(name, bundled_dir(), ("scenarios",), "scenario")
+    specs = (bundled_dir() / "specs", "a bundled generation spec: mmusv generate {stem}")
+    return _resolve(name, bundled_dir(), ("scenarios",), "scenario", specs)
 
 
 def resolve_spec(name: str | Path) -> Path:
@@ -56,7 +65,8 @@ def resolve_spec(name: str | Path) -> Path:
     (``coop_detection``, ``scenarios/specs/coop_detection.yaml``), so bundled specs work from any folder.
 
     Raises :class:`~mmusv.errors.NotFoundError` naming the bundled specs when neither exists."""
-    return _resolve(name, bundled_dir() / "specs", ("specs", "scenarios/specs"), "spec")
+    scenarios = (bundled_dir(), "a bundled scenario: mmusv run {stem}")
+    return _resolve(name, bundled_dir() / "specs", ("specs", "scenarios/specs"), "spec", scenarios)
 
 
 @dataclass(frozen=True)

@@ -6,17 +6,50 @@ their own ``cli`` modules. :func:`mmusv.cli.main` parses with it.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import re
+import sys
+from collections.abc import Sequence
+from typing import NoReturn
 
-__all__ = ["BUNDLED_WAVE_SCENARIO", "parser"]
+__all__ = ["BUNDLED_WAVE_SCENARIO", "CommandParser", "parser"]
 
 BUNDLED_WAVE_SCENARIO = "scenarios/island_port_waves.yaml"
 
 
+class CommandParser(argparse.ArgumentParser):
+    """An argument parser whose usage errors are one line, as the command's other errors are: ``mmusv: error:
+    argument --jobs: invalid int value: 'abc' (see mmusv run --help)``, exit status 2. argparse's own printed its
+    usage block first (a dozen lines for ``run``) and named the subcommand only there. ``--help`` is unchanged.
+    The subcommands' parsers are of this class too (``add_subparsers`` makes them of the parent's class)."""
+
+    _deepest: str | None = None
+    """The ``prog`` of the innermost (sub)parser of the parse under way: the one an unrecognised argument,
+    which argparse reports from the top parser, belongs to."""
+
+    def parse_known_args(  # type: ignore[override]
+        self, args: Sequence[str] | None = None, namespace: argparse.Namespace | None = None
+    ) -> tuple[argparse.Namespace, list[str]]:
+        CommandParser._deepest = self.prog
+        return super().parse_known_args(args, namespace)
+
+    def error(self, message: str) -> NoReturn:
+        prog = self.prog
+        if message.startswith("unrecognized arguments") and CommandParser._deepest:
+            prog = CommandParser._deepest
+        message = " ".join(message.split())
+        choice = re.fullmatch(r"argument (\w+): invalid choice: (.*)", message)  # a subcommand (``command``)
+        if choice:
+            message = f"unknown {choice[1]} {choice[2]}"
+        line = f"{prog.split()[0]}: error: {message} (see {prog} --help)"
+        with contextlib.suppress(OSError, ValueError):
+            print(line, file=sys.stderr, flush=True)
+        self.exit(2)
+
+
 def parser() -> argparse.ArgumentParser:
     """The ``mmusv`` command's argument parser, every subcommand in it."""
-    p = argparse.ArgumentParser(
-        prog="mmusv", description="Headless maritime multi-USV simulator and dataset generator."
-    )
+    p = CommandParser(prog="mmusv", description="Headless maritime multi-USV simulator and dataset generator.")
     from mmusv import __version__
 
     p.add_argument("--version", action="version", version=f"mmusv {__version__}", help="print the version and exit")

@@ -5,14 +5,16 @@ subcommand's module (``batch``, ``editor``, ``generate``, ``learn``, ``studies.d
 
 from __future__ import annotations
 
+import contextlib
 import os
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 from mmusv import arguments
 from mmusv.errors import ConfigError
 
-__all__ = ["check_output_folder", "output_arg", "path_arg", "ready_output_folder"]
+__all__ = ["check_output_folder", "made_output_folder", "output_arg", "path_arg", "ready_output_folder"]
 
 
 def path_arg(value: str, *, flag: str, empty: str = "give a path") -> str:
@@ -84,3 +86,27 @@ def ready_output_folder(output: str, *, flag: str = "-o/--output") -> None:
         Path(output).mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise IoError(f"{flag} {output}: cannot create the folder: {exc.strerror or exc}") from None
+
+
+@contextlib.contextmanager
+def made_output_folder(output: str, *, flag: str = "-o/--output") -> Iterator[Path]:
+    """:func:`ready_output_folder` for the work of the ``with`` block: when the block fails or is interrupted
+    (Ctrl-C, SIGTERM), the folders it created are removed again if they are still empty (``mmusv study agreement``
+    stopped in its first scenario left an empty ``-o`` folder behind). A folder that existed before, or one the
+    work wrote into, is left as it is."""
+    out = Path(output)
+    made = []  # the folders that do not exist yet, deepest first: those that ready_output_folder creates
+    for q in (out, *out.parents):
+        if os.path.lexists(q):
+            break
+        made.append(q)
+    ready_output_folder(output, flag=flag)
+    try:
+        yield out
+    except BaseException:
+        for q in made:
+            try:
+                q.rmdir()  # only an empty folder
+            except OSError:
+                break
+        raise

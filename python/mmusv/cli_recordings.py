@@ -11,6 +11,7 @@ from pathlib import Path
 from mmusv.cli_console import rich_console
 from mmusv.cli_paths import output_arg, path_arg
 from mmusv.errors import MmusvError
+from mmusv.text import counted
 
 __all__ = ["cmd_info", "cmd_preview", "cmd_recover"]
 
@@ -56,11 +57,15 @@ def cmd_info(args: argparse.Namespace) -> int:
         written = run_meta.get("frames_written", "?")
         if frames:  # the complete frames read: a killed run's .partial has no run metadata saying it ("? frames")
             read, expected = frames["read"], frames["expected"]
-            written = str(read) if read == expected else f"{read} of {expected}"
+            written = counted(read, "frame") if read == expected else f"{read} of {counted(expected, 'frame')}"
+        elif isinstance(written, int) or (isinstance(written, str) and written.isdigit()):  # a parts manifest's "4"
+            written = counted(int(written), "frame")
+        else:
+            written = f"{written} frames"
         console.print(
             f"[bold]{target}[/bold]: scenario {run_meta.get('scenario') or _scenario_of(meta, target)}, "
             f"status {run_meta.get('status', 'unfinished (no run metadata: the run was killed or is still going)')}, "
-            f"{written} frames, agents {run_meta.get('agents') or _agents_of(meta)}",
+            f"{written}, agents {run_meta.get('agents') or _agents_of(meta)}",
             markup=True,
             highlight=False,
         )

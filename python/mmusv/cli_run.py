@@ -10,6 +10,7 @@ from pathlib import Path
 
 from mmusv.cli_paths import output_arg, path_arg
 from mmusv.errors import ConfigError, MmusvError
+from mmusv.text import counted
 
 __all__ = ["cmd_run"]
 
@@ -67,7 +68,7 @@ def _run_one(
             print(f"mmusv: note: {note}", file=sys.stderr)
     fps = res.frames_written / res.seconds if res.seconds > 0 else float("nan")
     line = (
-        f"{scenario.name}: {res.frames_written} frame{'' if res.frames_written == 1 else 's'} in {res.seconds:.1f} s "
+        f"{scenario.name}: {counted(res.frames_written, 'frame')} in {res.seconds:.1f} s "
         f"({fps:.2f} frames/s), "
         f"{res.messages} messages, {res.bytes / 1e6:.1f} MB -> {res.recording}"
     )

@@ -551,6 +551,12 @@ def load_scenario(source: str | os.PathLike[str] | dict[str, Any] | Scenario) ->
     try:
         return Scenario.model_validate(data)
     except ValidationError as exc:
+        if "combinations" in data and "vessels" not in data:  # a spec's dozen "invalid config" problems said less
+            shown = where if isinstance(source, (str, os.PathLike)) else "SPEC.yaml"
+            raise ConfigError(
+                f"{where} is a generation spec (combinations:, no vessels:), not a scenario: make scenarios from "
+                f"it with `mmusv generate {shown}` (or a recorded dataset with `mmusv dataset {shown}`)"
+            ) from None
         raise validation_error(exc, where, data=data) from None
     except MmusvError as exc:  # a validator that checks through the core (wave presets, ...)
         raise located(exc, where) from None

@@ -23,6 +23,8 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 
+from mmusv.text import counted
+
 __all__ = ["RunProfile", "StageRow"]
 
 MAIN = "main"
@@ -121,8 +123,9 @@ class RunProfile:
             lines.append(f"{name:<32} {r.ms_per_frame:>10.1f} {100 * r.share:>7.1f}%")
         la = " ".join(f"{x:.2f}" for x in self.load_average)
         lines.append(
-            f"wall {self.wall_s:.1f} s for {self.frames} frames: {self.frames_per_s:.2f} frames/s, "
-            f"CPU {self.cpu_percent:.0f} % ({os.cpu_count()} cores, {self.cpu_s / max(self.frames, 1):.2f} CPU s per "
+            f"wall {self.wall_s:.1f} s for {counted(self.frames, 'frame')}: {self.frames_per_s:.2f} frames/s, "
+            f"CPU {self.cpu_percent:.0f} % ({counted(os.cpu_count() or 1, 'core')}, "
+            f"{self.cpu_s / max(self.frames, 1):.2f} CPU s per "
             f"frame), peak RSS {self.peak_rss_mb:.0f} MB, "
             f"load average {la}"
         )

@@ -125,7 +125,7 @@ def test_a_run_at_its_time_limit_takes_no_more_steps(tmp_path: Path) -> None:
         again = train(src, p=p, mode="single", out=tmp_path, epochs=5, time_limit_s=1e-6, progress=False)
         assert (again.steps, again.stopped) == (1, "time limit")
         assert (tmp_path / "model.pt").read_bytes() == model
-    assert "0 of 5 epochs, stopped at its time limit, 1 steps" in load_models(tmp_path / "model.pt").describe()
+    assert "0 of 5 epochs, stopped at its time limit, 1 step" in load_models(tmp_path / "model.pt").describe()
 
 
 def test_an_interrupted_model_says_so_and_resumes_to_the_same_weights(
@@ -245,10 +245,10 @@ def test_the_study_says_which_models_and_whether_they_saw_the_data(
     # the model's training recording, evaluated (here --split all; with another --seed, the test split can be it)
     assert main([*base, str(island), "--model", str(trained), "-o", str(tmp_path / "own")]) == 0
     out = capsys.readouterr().out
-    warning = "warning: 1 of the 1 sequences evaluated (ur_island) are in the training data of the learned models"
+    warning = "warning: 1 of the 1 sequence evaluated (ur_island) is in the training data of the learned models"
     assert warning in " ".join(out.split())
     note = (tmp_path / "own" / "detection_note.txt").read_text(encoding="utf-8")
-    assert "learned models: single: " in note and "(preset tiny, 1 epochs" in note, note
+    assert "learned models: single: " in note and "(preset tiny, 1 epoch," in note, note
     assert warning in note and "single: split 'all' made with --seed 0" in note, note
     assert "learned models" not in (tmp_path / "own" / "baseline" / "detection_note.txt").read_text(encoding="utf-8")
     # another recording: no warning; the model's own folder is accepted by --model (it was "no model.pt there")

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from mmusv.errors import ConfigError
+from mmusv.text import counted
 
 if TYPE_CHECKING:
     from rich.console import Console
@@ -125,7 +126,9 @@ def print_report(report: BatchReport, console: Console) -> None:
     """The table of a batch run, its warnings and the summary line."""
     from rich.table import Table
 
-    table = Table(title=f"mmusv run: {len(report.outcomes)} scenarios on {report.backend} -> {report.out_dir}")
+    table = Table(
+        title=f"mmusv run: {counted(len(report.outcomes), 'scenario')} on {report.backend} -> {report.out_dir}"
+    )
     for col in ("scenario", "status", "frames", "parts", "retried", "result"):
         table.add_column(col, overflow="fold", justify="right" if col in ("frames", "parts", "retried") else "left")
     colour = {"done": "green", "skipped": "cyan", "failed": "red"}
@@ -139,7 +142,7 @@ def print_report(report: BatchReport, console: Console) -> None:
         elif o.status == "skipped":
             result = f"complete, same config hash: {where(o.recording)}"
         else:
-            result = f"{o.frames} frame{'' if o.frames == 1 else 's'} in {o.seconds:.1f} s -> {where(o.recording)}"
+            result = f"{counted(o.frames, 'frame')} in {o.seconds:.1f} s -> {where(o.recording)}"
         table.add_row(
             o.file.name,
             f"[{colour[o.status]}]{o.status}[/{colour[o.status]}]",
@@ -318,7 +321,7 @@ def run_dataset(args: argparse.Namespace) -> int:
         console.print("opv2v: nothing to convert (no complete recording)")
     else:
         console.print(
-            f"opv2v: {rep.converted} frames converted into {rep.opv2v}"
+            f"opv2v: {counted(rep.converted, 'frame')} converted into {rep.opv2v}"
             if rep.converted is not None
             else f"opv2v: {rep.opv2v} is up to date"
         )

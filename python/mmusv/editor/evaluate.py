@@ -41,6 +41,7 @@ from mmusv.generate.samples import budget_problem, sample_counts
 from mmusv.motion import build_fleet
 from mmusv.scenario_checks import check_mounts, map_check_spec, map_findings
 from mmusv.sensors.config import RigConfig
+from mmusv.text import counted
 from mmusv.world.vessels import get_asset
 
 __all__ = [
@@ -190,7 +191,9 @@ def evaluate(document: dict[str, Any]) -> dict[str, Any]:
             {
                 "check": "more",
                 "severity": "error" if n_err else "warning",
-                "message": f"{len(left):,} more problems ({n_err:,} errors, {len(left) - n_err:,} warnings) are "
+                "message": f"{counted(len(left), 'more problem', fmt=',')} "
+                f"({counted(n_err, 'error', fmt=',')}, "
+                f"{counted(len(left) - n_err, 'warning', fmt=',')}) {'is' if len(left) == 1 else 'are'} "
                 f"not listed; the editor lists at most {MAX_PROBLEMS:,}",
                 "field": "",
                 "vessels": [],

@@ -29,6 +29,7 @@ from pathlib import Path
 from typing import Any
 
 from mmusv.errors import InputError, NotFoundError
+from mmusv.text import counted
 
 __all__ = ["KEEP_FINISHED", "MAX_RUNNING", "Job", "Jobs", "RunGoingOn"]
 
@@ -251,7 +252,7 @@ def _earlier_runs(root: Path) -> list[Job]:
             continue
         rel = f"out/{folder.name}"
         status = str(meta["status"])
-        error, frames = None, f"{written} frame{'' if written == 1 else 's'}"
+        error, frames = None, counted(written, "frame")
         if status == "interrupted":
             error = f"stopped before the end; the recording holds {frames}"
         elif status == "failed":

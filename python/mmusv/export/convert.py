@@ -45,6 +45,7 @@ from mmusv.export.splits import DEFAULT_RATIOS, SPLIT_NAMES, assign_splits, pars
 from mmusv.export.writer import DatasetWriter
 from mmusv.recording.info import RecordingInfo, read_info
 from mmusv.recording.stream import FrameStream
+from mmusv.text import counted
 
 __all__ = ["REPORT_NAME", "ConvertReport", "RecordingReport", "convert", "writer_class"]
 
@@ -336,9 +337,9 @@ def convert(
                 if absent:
                     written = stream.run.get("frames_written")
                     why = (
-                        f"not in the recording (run {rep.status}: {written} of {configured} frames written)"
+                        f"not in the recording (run {rep.status}: {written} of {counted(configured, 'frame')} written)"
                         if written is not None
-                        else f"not in the recording (the run did not finish; {configured} frames configured)"
+                        else f"not in the recording (the run did not finish; {counted(configured, 'frame')} configured)"
                     )
                     if stream.truncated:
                         why += "; " + stream.truncated

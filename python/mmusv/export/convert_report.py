@@ -9,6 +9,8 @@ from typing import Any
 
 import yaml
 
+from mmusv.text import counted
+
 __all__ = ["REPORT_NAME", "ConvertReport", "RecordingReport", "load_report"]
 
 REPORT_NAME = "conversion.yaml"
@@ -76,7 +78,8 @@ class ConvertReport:
             out += [f"  skipped frames {s['frames'][0]}..{s['frames'][1]}: {s['reason']}" for s in r.skipped]
             out += [f"  note: {n}" for n in r.notes]
         out.append(
-            f"{self.frames} frames ({self.agent_frames} agent-frames), {self.files} files, {self.bytes / 1e6:.1f} MB "
+            f"{counted(self.frames, 'frame')} ({counted(self.agent_frames, 'agent-frame')}), "
+            f"{counted(self.files, 'file')}, {self.bytes / 1e6:.1f} MB "
             f"in {self.seconds:.1f} s -> {self.out_dir}"
         )
         return out

@@ -16,6 +16,8 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
+from mmusv.text import counted
+
 __all__ = ["add_parser", "run", "seed_arg"]
 
 
@@ -117,8 +119,8 @@ def run(args: argparse.Namespace) -> int:
     report.print(console)
     rate = report.accepted / elapsed if elapsed > 0 else float("inf")
     console.print(
-        f"wrote {report.accepted} scenarios and report.json to {out}: map built in {t_map:.1f} s, "
-        f"generated in {elapsed:.1f} s ({rate:.1f} scenarios/s, {report.attempts} attempts)"
+        f"wrote {counted(report.accepted, 'scenario')} and report.json to {out}: map built in {t_map:.1f} s, "
+        f"generated in {elapsed:.1f} s ({rate:.1f} scenarios/s, {counted(report.attempts, 'attempt')})"
     )
     return 0 if report.all_met else 1
 

@@ -14,6 +14,8 @@ import json
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+from mmusv.text import counted
+
 if TYPE_CHECKING:
     from rich.console import Console
 
@@ -56,7 +58,9 @@ class ComboReport:
         """One line: "quota met" or why not (attempt cap, the top rejecting constraints with an example)."""
         if self.met:
             return "quota met"
-        head = f"{self.accepted}/{self.quota} accepted after {self.attempts} attempts (cap {self.max_attempts})"
+        head = (
+            f"{self.accepted}/{self.quota} accepted after {counted(self.attempts, 'attempt')} (cap {self.max_attempts})"
+        )
         if self.infeasible:
             head += f"; {self.infeasible}"
         top = sorted(self.rejected.items(), key=lambda kv: (-kv[1], kv[0]))[:3]

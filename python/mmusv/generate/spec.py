@@ -525,6 +525,12 @@ def load_spec(source: str | os.PathLike[str] | dict[str, Any] | GenerationSpec) 
     try:
         spec = GenerationSpec.model_validate(data)
     except ValidationError as exc:
+        if "vessels" in data and "combinations" not in data:  # a scenario: its "vessels: extra input" said less
+            shown = where if isinstance(source, (str, os.PathLike)) else "SCENARIO.yaml"
+            raise ConfigError(
+                f"{where} is a scenario (vessels:, no combinations:), not a generation spec: record it with "
+                f"`mmusv run {shown}`"
+            ) from None
         raise validation_error(exc, where, noun="spec", root="spec") from None
     except MmusvError as exc:  # a validator that checks through the core (wave presets, ...)
         raise located(exc, where) from None

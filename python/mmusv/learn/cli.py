@@ -19,6 +19,7 @@ Without the ``learn`` extra (PyTorch) both raise :class:`mmusv.errors.InputError
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
 import os
@@ -28,6 +29,7 @@ from pathlib import Path
 from typing import Any
 
 from mmusv.errors import InputError, MmusvError
+from mmusv.text import counted
 
 __all__ = ["add_parser", "load_for_study", "run"]
 
@@ -206,7 +208,11 @@ def run(args: argparse.Namespace) -> int:
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor, as_completed
 
-        print(f"training {', '.join(modes)} side by side: {jobs} processes, {threads} torch thread(s) each", flush=True)
+        print(
+            f"training {', '.join(modes)} side by side: {counted(jobs, 'process', 'processes')}, "
+            f"{counted(threads, 'torch thread')} each",
+            flush=True,
+        )
         ctx = multiprocessing.get_context("spawn")  # a fresh interpreter per model: no forked torch thread pools
         done: dict[str, dict[str, Any]] = {}
         with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
@@ -223,11 +229,13 @@ def run(args: argparse.Namespace) -> int:
         short = ""
         if r["stopped"] == "time limit":  # the line read as a run that went through
             short = (
-                f" (stopped at --time-limit {args.time_limit:g} s, {r['epochs']} of {r['planned']} epochs done; "
+                f" (stopped at --time-limit {args.time_limit:g} s, "
+                f"{r['epochs']} of {counted(r['planned'], 'epoch')} done; "
                 "started again with a higher limit, it goes on)"
             )
         print(
-            f"{mode}: {r['epochs']} epochs, {r['steps']} steps, {r['seconds']:.1f} s of training -> {r['out']} "
+            f"{mode}: {counted(r['epochs'], 'epoch')}, {counted(r['steps'], 'step')}, "
+            f"{r['seconds']:.1f} s of training -> {r['out']} "
             f"({r['plot']}){short}",
             flush=True,
         )
@@ -377,10 +385,14 @@ def _fit_scorers(
     """Fits the IoU scorer (:func:`mmusv.learn.scorer.fit_scorer`) of each trained model in ``modes`` on the
     training cache, each into ``OUT/<mode>/scorer.pt``; returns what each fit measured. ``threads``: torch's
     threads (``None``: as they are). ``keep_current``: a ``scorer.pt`` already fitted for the model's weights as they
-    are is kept, not fitted again (a rerun of a finished training: minutes of work for the same scorer)."""
+    are is kept, not fitted again (a rerun of a finished training: minutes of work for the same scorer), and so is
+    a fit that failed for these weights, this cache and seed (``OUT/<mode>/scorer_skipped.json``, written when the
+    model finds too few boxes: the fit is deterministic, and a rerun ran the model over the whole cache again, for
+    minutes, to fail the same way). ``--scorers-only`` (``keep_current`` false) always fits: the way to try again.
+    Any other failure (Ctrl-C, out of memory) is not recorded and the next run fits again."""
     import torch
 
-    from mmusv.learn.cache import Cache
+    from mmusv.learn.cache import Cache, cache_identity
     from mmusv.learn.checkpoint import remove_stale_temporaries, weights_digest
     from mmusv.learn.detector import load_models
     from mmusv.learn.example import early_cloud
@@ -398,14 +410,29 @@ def _fit_scorers(
         det = load_models(out / mode / "model.pt", refine=True, rescore=False)
         model = det.models[mode]
         current = out / mode / SCORER_FILE
+        digest = weights_digest(model.state_dict())
         if keep_current and current.is_file():
             try:
                 kept = load_scorer(current).info
             except MmusvError:
                 kept = {}
-            if kept.get("model") == weights_digest(model.state_dict()):
+            if kept.get("model") == digest:
                 done[mode] = kept
                 print(f"{mode}: {current} was fitted for these weights; kept", flush=True)
+                continue
+        skipped_file = out / mode / SCORER_SKIPPED
+        # as read back from its file (JSON: tuples are lists)
+        failed_fit = json.loads(json.dumps({"model": digest, "cache": cache_identity(cache_path), "seed": seed}))
+        if keep_current:  # a scorer.pt for these weights was kept above; a stale one does not count
+            before = _read_json(skipped_file)
+            if before is not None and {k: before.get(k) for k in failed_fit} == failed_fit:
+                done[mode] = {"skipped": before.get("reason", "")}
+                print(
+                    f"{mode}: no IoU scorer (its fit failed before for these weights and data: {before.get('reason')};"
+                    f" {skipped_file}); the model's boxes keep the network's scores (try again: mmusv train "
+                    f"--scorers-only -o {out})",
+                    flush=True,
+                )
                 continue
 
         def sample(k: int, mode: str = mode, det: Any = det) -> tuple[Any, Any, Any, Any]:
@@ -421,10 +448,15 @@ def _fit_scorers(
             scorer, fit = fit_scorer(sample, ks, groups, refine=RefineParams(), nms_iou=model.preset.nms_iou, seed=seed)
         except InputError as e:  # a model that finds (almost) nothing: it is used as it is, and this is said
             done[mode] = {"skipped": str(e)}
+            # recorded: the same weights, cache and seed fail the same way (a rerun took minutes to say it again)
+            with contextlib.suppress(OSError):  # not recorded: the next run fits again
+                skipped_file.write_text(json.dumps({**failed_fit, "reason": str(e)}, indent=2) + "\n", encoding="utf-8")
             print(f"{mode}: no IoU scorer ({e}); the model's boxes keep the network's scores", flush=True)
             continue
+        with contextlib.suppress(OSError):
+            skipped_file.unlink(missing_ok=True)
         info = {
-            "model": weights_digest(model.state_dict()),  # the weights it was fitted for (load_models checks)
+            "model": digest,  # the weights it was fitted for (load_models checks)
             "boxes": fit.boxes,
             "frames": fit.frames,
             "beta": fit.beta,
@@ -437,12 +469,27 @@ def _fit_scorers(
         base = next(x for x in fit.held_out if x[0] == 0.0)
         chosen = next(x for x in fit.held_out if x[0] == fit.beta)
         print(
-            f"{mode}: IoU scorer on {fit.boxes} boxes of {fit.frames} ego-frames, β = {fit.beta:g} (held-out "
+            f"{mode}: IoU scorer on {counted(fit.boxes, 'box', 'boxes')} "
+            f"of {counted(fit.frames, 'ego-frame')}, β = {fit.beta:g} (held-out "
             f"AP@0.5 {base[1]:.3f} -> {chosen[1]:.3f}, AP@0.7 {base[2]:.3f} -> {chosen[2]:.3f}), "
             f"{info['seconds']:.0f} s -> {path}",
             flush=True,
         )
     return done
+
+
+SCORER_SKIPPED = "scorer_skipped.json"
+"""Beside a model whose IoU-scorer fit failed (too few boxes): for which weights, cache and seed, and why
+(:func:`_fit_scorers`)."""
+
+
+def _read_json(path: Path) -> dict[str, Any] | None:
+    """The JSON object in ``path``; ``None`` when there is none (missing, unreadable, not an object)."""
+    try:
+        value = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return value if isinstance(value, dict) else None
 
 
 def _train_one(task: dict[str, Any]) -> dict[str, Any]:

@@ -32,6 +32,7 @@ from mmusv.learn.example import MODES, collate, make_example, message_bytes
 from mmusv.learn.model import PillarNet, from_checkpoint
 from mmusv.learn.refine import RefineParams
 from mmusv.learn.scorer import SCORER_FILE, IoUScorer, load_scorer, second_stage
+from mmusv.text import counted
 
 __all__ = ["LearnedDetector", "load_models"]
 
@@ -115,9 +116,9 @@ def _progress(v: dict[str, Any]) -> str:
     at its time limit`` when that is why)."""
     planned = v.get("epochs")
     if not isinstance(planned, int) or v["epoch"] >= planned:
-        return f"{v['epoch']} epochs, {v['step']} steps"
+        return f"{counted(v['epoch'], 'epoch')}, {counted(v['step'], 'step')}"
     why = "stopped at its time limit" if v.get("stopped") == "time limit" else "unfinished"
-    return f"{v['epoch']} of {planned} epochs, {why}, {v['step']} steps"
+    return f"{v['epoch']} of {counted(planned, 'epoch')}, {why}, {counted(v['step'], 'step')}"
 
 
 class LearnedDetector:

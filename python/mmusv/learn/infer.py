@@ -30,6 +30,7 @@ from mmusv.learn.checkpoint import load_checkpoint
 from mmusv.learn.decode import peaks
 from mmusv.learn.example import MODES, collate, make_example, message_bytes
 from mmusv.learn.model import PillarNet, from_checkpoint, torch_device
+from mmusv.text import counted
 
 __all__ = ["infer_cache", "main", "merge_main", "merge_peaks"]
 
@@ -89,7 +90,7 @@ def infer_cache(
         arrays[f"{mode}_offsets"] = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
         if mode == "intermediate":
             arrays["intermediate_bytes"] = np.array(sent, dtype=np.int64)
-        print(f"{mode}: {len(counts)} inferences, {time.perf_counter() - t0:.1f} s", flush=True)
+        print(f"{mode}: {counted(len(counts), 'inference')}, {time.perf_counter() - t0:.1f} s", flush=True)
     if not arrays:  # an empty peaks file was written, and replayed into predictions without a box
         raise input_error(
             f"--models {root}: no {'|'.join(m for m in MODES if m in modes)}/model.pt there (mmusv train's output "

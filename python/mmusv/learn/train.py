@@ -59,6 +59,7 @@ from mmusv.learn.loss import centerpoint_loss
 from mmusv.learn.model import PillarNet, torch_device
 from mmusv.learn.presets import PRESETS, Preset, parse_overrides, preset
 from mmusv.learn.targets import points_in_boxes
+from mmusv.text import counted
 
 __all__ = ["TrainResult", "TrainingSet", "main", "plot_losses", "plot_runs", "resumable_checkpoint", "train"]
 
@@ -478,7 +479,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             progress=not a.no_progress,
         )
         print(
-            f"{mode}: {r.epochs} epochs, {r.steps} steps, {r.seconds:.1f} s "
+            f"{mode}: {counted(r.epochs, 'epoch')}, {counted(r.steps, 'step')}, {r.seconds:.1f} s "
             f"({r.steps / max(r.seconds, 1e-9):.2f} steps/s), finished={r.finished} -> {r.out}",
             flush=True,
         )

@@ -32,6 +32,7 @@ from mmusv.recording.info import RecordingInfo, check_mcap, read_info
 from mmusv.recording.scan import Scan
 from mmusv.recording.stream import FrameStream
 from mmusv.recording.tables import TableWriter
+from mmusv.text import counted
 
 __all__ = ["Recovered", "find_partial", "rebuild_tables", "recover"]
 
@@ -60,7 +61,8 @@ class Recovered:
 
         got = f"frames {frame_ranges(self.frames)}" if self.frames else "no complete frame"
         out = [
-            f"recovered {len(self.frames)} of {self.frames_requested or self.frames_configured} frames ({got}) from "
+            f"recovered {len(self.frames)} of {counted(self.frames_requested or self.frames_configured, 'frame')} "
+            f"({got}) from "
             f"{self.source} "
             f"into {self.recording}"
         ]

@@ -9,8 +9,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from mmusv.cli_console import rich_console
-from mmusv.cli_paths import check_output_folder, path_arg, ready_output_folder
+from mmusv.cli_paths import check_output_folder, made_output_folder, path_arg
 from mmusv.config import MAX_FRAMES  # also the bound of `study waves --frames`
+from mmusv.text import counted
 
 if TYPE_CHECKING:
     from mmusv.config import Scenario
@@ -45,29 +46,30 @@ def study_waves(args: argparse.Namespace) -> int:
     # The scenario's own checks (a USV, 2 frames) before the output folder: a scenario without USVs left an empty
     # folder behind, and one of a single frame a table of zeros.
     check_scenario(scenario, record_s=PHYSICAL_RECORD_S if args.motion == "physical" and args.frames is None else None)
-    ready_output_folder(args.output)
-    if args.motion == "physical":
-        return _physical_wave_study(scenario, args)
-    study = run_wave_study(scenario)
-    table = Table(
-        title=f"Wave study on {scenario.name} ({study.table['usvs'][0]} USVs × {study.table['frames'][0]} frames)"
-    )
-    for col in ("wave", "H (m)", "heave RMS (m)", "roll RMS (°)", "pitch RMS (°)"):
-        table.add_column(col, justify="right")
-    for r in study.table.iter_rows(named=True):
-        table.add_row(
-            str(r["wave"]),
-            f"{r['H_m']:.1f}",
-            f"{r['heave_rms_m']:.4f}",
-            f"{r['roll_rms_deg']:.4f}",
-            f"{r['pitch_rms_deg']:.4f}",
+    with made_output_folder(args.output):  # removed again if still empty when the study fails or is interrupted
+        if args.motion == "physical":
+            return _physical_wave_study(scenario, args)
+        study = run_wave_study(scenario)
+        table = Table(
+            title=f"Wave study on {scenario.name} "
+            f"({counted(int(study.table['usvs'][0]), 'USV')} × {study.table['frames'][0]} frames)"
         )
-    console = rich_console()
-    console.print(table)
-    console.print("R² of a linear fit in H: " + ", ".join(f"{k} {v:.4f}" for k, v in study.r2.items()))
-    paths = study.write(Path(args.output))
-    console.print(f"wrote {paths['csv']} and {paths['png']}")
-    return 0
+        for col in ("wave", "H (m)", "heave RMS (m)", "roll RMS (°)", "pitch RMS (°)"):
+            table.add_column(col, justify="right")
+        for r in study.table.iter_rows(named=True):
+            table.add_row(
+                str(r["wave"]),
+                f"{r['H_m']:.1f}",
+                f"{r['heave_rms_m']:.4f}",
+                f"{r['roll_rms_deg']:.4f}",
+                f"{r['pitch_rms_deg']:.4f}",
+            )
+        console = rich_console()
+        console.print(table)
+        console.print("R² of a linear fit in H: " + ", ".join(f"{k} {v:.4f}" for k, v in study.r2.items()))
+        paths = study.write(Path(args.output))
+        console.print(f"wrote {paths['csv']} and {paths['png']}")
+        return 0
 
 
 def _physical_wave_study(scenario: Scenario, args: argparse.Namespace) -> int:
@@ -120,7 +122,7 @@ def _physical_wave_study(scenario: Scenario, args: argparse.Namespace) -> int:
     console.print(per)
     mono = study.monotonic()
     rising = sorted(k for k, ok in mono.items() if ok)
-    console.print(f"all three RMS rise with the sea state for {len(rising)} of {len(mono)} vessels")
+    console.print(f"all three RMS rise with the sea state for {len(rising)} of {counted(len(mono), 'vessel')}")
     paths = study.write(Path(args.output))
     console.print(f"wrote {paths['summary']} and {paths['vessels']}")
     return 0
@@ -140,29 +142,29 @@ def study_agreement(args: argparse.Namespace) -> int:
     # Every scenario loaded and checked (a top-view camera) before the output folder and the first run: a missing
     # or broken one left an empty folder behind, after the scenarios before it had run.
     scenarios = load_scenarios(args.scenarios or BUNDLED_SCENARIOS)
-    ready_output_folder(args.output)
-    study = run_agreement_study(scenarios, frames=args.frames)
-    table = Table(title="Annotation vs top-view rendering (Table II)")
-    for col in (
-        "map",
-        "valid samples",
-        "median centre error (px)",
-        "median centroid error (px)",
-        "mean containment",
-        "mean hull occupancy",
-    ):
-        table.add_column(col, justify="right")
-    for r in study.summary.iter_rows(named=True):
-        table.add_row(
-            str(r["map"]),
-            str(r["valid_samples"]),
-            f"{r['median_centre_error_px']:.3f}",
-            f"{r['median_centroid_error_px']:.3f}",
-            f"{r['mean_containment']:.4f}",
-            f"{r['mean_hull_occupancy']:.3f}",
-        )
-    console = rich_console()
-    console.print(table)
-    paths = study.write(Path(args.output))
-    console.print(f"wrote {paths['samples']} and {paths['summary']}")
-    return 0
+    with made_output_folder(args.output):  # removed again if still empty when the study fails or is interrupted
+        study = run_agreement_study(scenarios, frames=args.frames)
+        table = Table(title="Annotation vs top-view rendering (Table II)")
+        for col in (
+            "map",
+            "valid samples",
+            "median centre error (px)",
+            "median centroid error (px)",
+            "mean containment",
+            "mean hull occupancy",
+        ):
+            table.add_column(col, justify="right")
+        for r in study.summary.iter_rows(named=True):
+            table.add_row(
+                str(r["map"]),
+                str(r["valid_samples"]),
+                f"{r['median_centre_error_px']:.3f}",
+                f"{r['median_centroid_error_px']:.3f}",
+                f"{r['mean_containment']:.4f}",
+                f"{r['mean_hull_occupancy']:.3f}",
+            )
+        console = rich_console()
+        console.print(table)
+        paths = study.write(Path(args.output))
+        console.print(f"wrote {paths['samples']} and {paths['summary']}")
+        return 0

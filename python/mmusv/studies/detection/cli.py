@@ -14,6 +14,8 @@ import time
 from pathlib import Path
 from typing import Any
 
+from mmusv.text import counted
+
 __all__ = ["add_dataset_arguments", "add_parsers", "run"]
 
 _BOXES_HELP = (
@@ -230,7 +232,8 @@ def run(args: argparse.Namespace) -> int:
             console.print(f"[yellow]generate: {escape(line)}[/]", highlight=False)
         short = f" (quotas not met: {shortfalls[0]})" if shortfalls else ""
         console.print(
-            f"dataset: {len(inputs)} recordings in {out / 'dataset'}{short} ({time.perf_counter() - t0:.1f} s)",
+            f"dataset: {counted(len(inputs), 'recording')} "
+            f"in {out / 'dataset'}{short} ({time.perf_counter() - t0:.1f} s)",
             highlight=False,
         )
     split = args.split or ("test" if args.generate is not None else "all")
@@ -283,7 +286,8 @@ def run(args: argparse.Namespace) -> int:
         if res.ego_frames == 0:
             delay = max(s.delay_frames for s in settings)
             why = (
-                f" (the robustness study leaves out the first {delay} frames of every sequence: --settings holds "
+                f" (the robustness study leaves out the first {counted(delay, 'frame')} of every "
+                f"sequence: --settings holds "
                 f"delay:{delay})"
                 if delay > 0
                 else ""
@@ -311,7 +315,7 @@ def run(args: argparse.Namespace) -> int:
                 kb = sum(learned.shared_bytes) / len(learned.shared_bytes) / 1024
                 console.print(
                     f"intermediate fusion: {kb:.1f} KiB shared per ego-frame on average (the neighbours' pillar "
-                    f"features, float32, and cells; {len(learned.shared_bytes)} ego-frames)",
+                    f"features, float32, and cells; {counted(len(learned.shared_bytes), 'ego-frame')})",
                     highlight=False,
                 )
         elif det is not None and name == "baseline":
@@ -319,7 +323,8 @@ def run(args: argparse.Namespace) -> int:
         if any(m == "late" for m in run_modes):
             console.print(f"late fusion merge: {args.late_merge}", highlight=False)
         console.print(
-            f"split {split}: {len(res.sequences)} sequences, {res.frames} frames, {res.ego_frames} ego-frames, "
+            f"split {split}: {counted(len(res.sequences), 'sequence')}, {counted(res.frames, 'frame')}, "
+            f"{counted(res.ego_frames, 'ego-frame')}, "
             f"{res.gt_boxes / max(res.ego_frames, 1):.2f} ground-truth boxes per ego-frame; evaluation "
             f"{eval_s:.1f} s, total {time.perf_counter() - t0:.1f} s",
             highlight=False,
@@ -368,7 +373,8 @@ def _training_overlap(learned: Any, dataset: Any) -> str | None:
         )
     trained = "; ".join(f"{' and '.join(m)}: {h}" for h, m in how.items())
     return (
-        f"warning: {len(names)} of the {len(dataset.sources)} sequences evaluated ({shown}) are in the training data "
+        f"warning: {len(names)} of the {counted(len(dataset.sources), 'sequence')} evaluated "
+        f"({shown}) {'is' if len(names) == 1 else 'are'} in the training data "
         f"of the learned models ({trained}): their scores are not held-out; evaluate a split made with the same "
         "--seed and --split-ratios"
     )

@@ -21,6 +21,7 @@ from mmusv.config import MAX_COORDINATE_M
 from mmusv.errors import InputError
 from mmusv.frames import matrix_to_pose, pose_matrices
 from mmusv.studies.detection.data import AgentFrame, SequenceData
+from mmusv.text import counted
 
 __all__ = ["DEFAULT_SETTINGS", "MAX_SIGMA_RPY_DEG", "MAX_SIGMA_XYZ_M", "Setting", "neighbours_for", "parse_settings"]
 
@@ -132,7 +133,7 @@ def neighbours_for(seq: SequenceData, index: int, ego_id: str, setting: Setting,
     past = seq.frame_at(now.frame - setting.delay_frames)
     if past is None:
         raise InputError(
-            f"sequence {seq.name}: frame {now.frame} has no data {setting.delay_frames} frames earlier "
+            f"sequence {seq.name}: frame {now.frame} has no data {counted(setting.delay_frames, 'frame')} earlier "
             f"(frame {now.frame - setting.delay_frames} is not in the sequence)"
         )
     by_id = {a.id: a for a in past.agents}

@@ -28,6 +28,7 @@ from mmusv.studies.detection.data import (
     recording_summary,
     split_sequences,
 )
+from mmusv.text import counted
 
 __all__ = ["BUNDLED_SPEC", "Dataset", "generate_dataset", "lidar_only", "resolve_dataset"]
 
@@ -210,7 +211,7 @@ def generate_dataset(
     scen_dir, lidar_dir = out / "scenarios", out / "lidar_only"
     gen = generate(sp, scen_dir, force=True)
     if shortfall is not None and not gen.all_met:
-        shortfall(f"{gen.accepted} of the {sum(c.quota for c in gen.combos)} scenarios the spec asks for")
+        shortfall(f"{gen.accepted} of the {counted(sum(c.quota for c in gen.combos), 'scenario')} the spec asks for")
         for c in gen.combos:
             if not c.met:
                 shortfall(f"quota not met {c.name}: {c.why()}")
@@ -234,6 +235,7 @@ def generate_dataset(
     failed = [o for o in report.outcomes if o.status == "failed"]
     if failed:
         raise InputError(
-            f"--generate: {len(failed)} of {len(files)} scenarios could not be recorded; first: {failed[0].error}"
+            f"--generate: {len(failed)} of {counted(len(files), 'scenario')} could not be recorded; "
+            f"first: {failed[0].error}"
         )
     return dataset_recordings(out / "recordings")
