@@ -25,11 +25,21 @@ state.on("status", ({ text, error }) => status(text, error));
 
 // ------------------------------------------------------------------------------------- map layers
 
+// A scenario opened: the map shows it whole once its map is there (the view of the scenario shown before may miss
+// it, on another part of the map or on another map).
+let fitOnMap = false;
+
 async function ensureMap() {
   const m = state.doc?.map;
   if (!m) return;
   const key = JSON.stringify([m.type, m.seed, m.params || {}]);
-  if (key === state.mapKey) return;
+  if (key === state.mapKey) {
+    if (fitOnMap && state.mapLayers) {
+      fitOnMap = false;
+      map.fitScenario();
+    }
+    return; // the same map (a request for it in flight fits the scenario when it is there)
+  }
   state.mapKey = key;
   status("generating the map…");
   try {
@@ -38,10 +48,15 @@ async function ensureMap() {
     const first = !state.mapLayers;
     state.mapLayers = layers;
     map.renderMap();
-    if (first) map.fitScenario();
+    if (first || fitOnMap) map.fitScenario();
+    fitOnMap = false;
     map.renderScreen();
     status(`${layers.kind.replace("_", " ")} map, seed ${layers.seed}, ${layers.extent} m square`);
   } catch (err) {
+    if (state.mapKey === key && fitOnMap) {
+      fitOnMap = false;
+      map.fitScenario(); // the routes, without their map
+    }
     status(`map: ${err.message}`, true);
   }
 }
@@ -67,7 +82,12 @@ function togglePlay() {
     return;
   }
   const ev = state.evaluation?.valid ? state.evaluation : null;
-  if (!ev) return;
+  if (!ev) {
+    // nothing to play yet: say why, rather than a button that does nothing
+    if (state.pending()) status("play: the scenario is being checked; press Play again when the check has ended", true);
+    else status("play: the scenario does not validate, so it has no motion to play; fix the errors listed under Checks", true);
+    return;
+  }
   $("play").textContent = "Pause";
   const t0 = performance.now(), k0 = state.frame >= ev.frames - 1 ? 0 : state.frame;
   const step = () => {
@@ -190,6 +210,8 @@ async function save(overwrite = false) {
     return true;
   } catch (err) {
     if (err.status === 409) {
+      // (and the status no longer shows what an earlier attempt said)
+      status(`not saved: ${name} exists; Overwrite replaces it, Cancel keeps it (then give another file name)`, true);
       $("save-confirm-text").textContent = `${name} exists.`;
       $("save-confirm").hidden = false;
     } else if (err.status === 412) {
@@ -257,10 +279,11 @@ function showRun(job) {
   p.value = job.done;
   $("run-stop").hidden = job.status !== "running";
   let text = `${job.status} · frame ${job.done}${job.total ? ` / ${job.total}` : ""}`;
+  const frames = `${job.done} frame${job.done === 1 ? "" : "s"}`;
   if (job.status === "complete") {
     text = job.earlier
-      ? `done: ${job.done} frames → ${job.output}/ (recorded before this editor started)`
-      : `done: ${job.done} frames in ${job.seconds} s → ${job.output}/`;
+      ? `done: ${frames} → ${job.output}/ (recorded before this editor started)`
+      : `done: ${frames} in ${job.seconds} s → ${job.output}/`;
   }
   if (job.status === "failed" || job.status === "interrupted") text = `${job.status}: ${job.error}`;
   $("run-text").textContent = text;
@@ -305,7 +328,11 @@ function follow(job) {
     try {
       const j = await api.run(job.id);
       showRun(j);
-      if (j.status !== "running") clearInterval(runTimer);
+      if (j.status !== "running") {
+        clearInterval(runTimer);
+        // the run's end replaces what the status said meanwhile (a refused second Run: "… wait for it to end")
+        status(`run of ${j.scenario}: ${$("run-text").textContent}`, j.status === "failed");
+      }
     } catch (err) {
       clearInterval(runTimer);
       status(err.message, true);
@@ -330,6 +357,7 @@ function renderAll() {
 }
 
 state.on("loaded", () => {
+  fitOnMap = true;
   ensureMap();
 });
 state.on("doc", () => {

@@ -458,11 +458,16 @@ export class Panels {
     $("v-zoom").addEventListener("click", () => this.map.zoomTo(this.state.selected));
     $("v-delete").addEventListener("click", () => {
       const id = this.state.selected;
+      const at = this.state.vesselIndex(id);
       this.forgetRefused("vessels[");
       this.state.edit((doc) => {
         doc.vessels = doc.vessels.filter((v) => v.id !== id);
       });
       this.state.select(null);
+      // the button is gone with the vessel's panel: the keyboard goes on at the vessel that took its place in the
+      // list (else the last one, else the library), not at the top of the page
+      const items = $("fleet").querySelectorAll("li[data-id]");
+      (items[Math.min(at, items.length - 1)] || $("library-search")).focus();
     });
   }
 
@@ -509,9 +514,12 @@ export class Panels {
       msg.className = "msg";
       msg.textContent = p.message;
       li.append(check, field, msg);
-      if (p.vessels?.length || p.point) {
+      // a schema error goes to the form field it concerns (a vessel's, once the vessel is selected)
+      const schemaField = p.check === "schema" && p.field;
+      if (p.vessels?.length || p.point || (schemaField && this.fieldFor(p))) {
         li.tabIndex = 0; // Enter shows it, like a click
         li.setAttribute("role", "button");
+        li.title = schemaField ? "show the field" : "show it on the map";
       }
       li.addEventListener("click", () => {
         if (p.vessels?.length) this.state.select(p.vessels[0]);
@@ -521,9 +529,26 @@ export class Panels {
         } else if (p.vessels?.length) {
           this.map.zoomTo(p.vessels[0]);
         }
+        if (schemaField) {
+          const el = this.fieldFor(p);
+          if (el) {
+            el.scrollIntoView({ block: "center" });
+            el.focus({ preventScroll: true });
+          }
+        }
       });
       ul.appendChild(li);
     }
+  }
+
+  /** The form field, shown on the page, that the schema error `p` concerns (for a table, its first box), or null. */
+  fieldFor(p) {
+    for (const el of document.querySelectorAll(FIELDS)) {
+      if (el.closest("[hidden]") || !concerns(p.field, p.message, el.dataset.field)) continue;
+      const box = el.tagName === "TABLE" ? el.querySelector("input, button") : el;
+      if (box) return box;
+    }
+    return null;
   }
 
   // ------------------------------------------------------------------------------------- scenario form
@@ -607,6 +632,7 @@ export class Panels {
       const del = document.createElement("button");
       del.textContent = "Remove";
       del.dataset.action = "remove";
+      del.setAttribute("aria-label", `Remove rig ${name}`); // which of the rigs, to a screen reader too
       head.appendChild(del);
       const grid = document.createElement("div");
       grid.className = "grid";
