@@ -252,7 +252,7 @@ def pinhole_intrinsics(*, width: int, height: int, hfov: float) -> npt.NDArray[n
 
 def _pinhole_directions(*, width: int, height: int, hfov: float) -> npt.NDArray[np.float32]:
     """Test helper, not API. (width·height, 3) float32 unit ray directions through pixel centres, camera body
-    frame, row-major from top-left."""
+    frame, row-major from top-left; ``width`` and ``height`` in 1..=16384."""
 
 def _lidar_directions(
     *, elevations: Sequence[float] | npt.NDArray[np.floating[Any]], azimuth_steps: int
@@ -261,7 +261,8 @@ def _lidar_directions(
     in radians), LiDAR frame, azimuth-major."""
 
 def uniform_elevations(*, channels: int, lower: float, upper: float) -> npt.NDArray[np.float64]:
-    """(channels,) float64 elevation angles in radians, lowest first, spread uniformly over ``[lower, upper]``."""
+    """(channels,) float64 elevation angles in radians, lowest first, spread uniformly over ``[lower, upper]``;
+    ``channels`` in 1..=1024."""
 
 def lidar_trace_order(*, channels: int, azimuth_steps: int, block: int = 8) -> npt.NDArray[np.uint32]:
     """(channels·azimuth_steps,) uint32 packet-friendly trace order: indices into ``_lidar_directions``' azimuth-major
@@ -578,7 +579,7 @@ class Fleet:
         straight within ``tolerances_m`` (V,) of that line (inf: on to the wake's end), how long ago the vessel
         passed there (s); out to its wake's reach, at most 32 pieces a vessel; none for a vessel at rest."""
     def poses_at_times(self, times: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
-        """(T, V, 6) float64 poses at each time (seconds); GIL released."""
+        """(T, V, 6) float64 poses at each time (seconds), at most 2**26 poses (T·V) a call; GIL released."""
 
 def default_amplitudes() -> tuple[float, float, float]:
     """Default base amplitudes (heave m, roll rad, pitch rad), calibrated on the reference 5 m USV."""

@@ -13,7 +13,7 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from mmusv.errors import ConfigError
+from mmusv.errors import ConfigError, InputError
 from mmusv.sensors.config import Mount
 from mmusv.world.build import pose_matrices
 from mmusv.world.vessels import VesselAsset
@@ -46,18 +46,33 @@ def mount_matrix(asset: VesselAsset, mount: Mount, *, where: str) -> np.ndarray:
     return m
 
 
+MAX_INSIDE_RAYS = 1024
+"""Most rays :func:`inside_mesh` casts (each re-cast up to 64 times)."""
+
+
 def inside_mesh(vertices: np.ndarray, faces: np.ndarray, point: np.ndarray, *, rays: int = 9) -> bool:
     """Whether ``point`` lies inside the closed (union of) mesh(es) ``vertices``/``faces`` (same frame).
 
     Along each of ``rays`` directions every crossing is found by re-casting past the previous hit; the winding
     number is (back-face exits − front-face entries). The point is inside when most rays give a positive one.
+    ``point``: 3 finite coordinates; ``rays``: a whole number in ``1..=MAX_INSIDE_RAYS``.
     """
     from mmusv.scene import Scene
+
+    if isinstance(rays, bool) or not isinstance(rays, (int, np.integer)) or not 1 <= rays <= MAX_INSIDE_RAYS:
+        raise InputError(f"rays = {rays!r}: must be a whole number in 1..{MAX_INSIDE_RAYS}")
+    rays = int(rays)
+    try:
+        p = np.asarray(point, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise InputError(f"point must be 3 finite coordinates (x, y, z): {e}") from None
+    if p.shape != (3,) or not np.all(np.isfinite(p)):
+        raise InputError(f"point must be 3 finite coordinates (x, y, z), got shape {p.shape}")
 
     scene = Scene()
     scene.add_instance(scene.add_mesh(vertices, faces, classes=0))
     dirs = _sphere_directions(rays)
-    origin = np.tile(np.asarray(point, dtype=np.float64), (rays, 1))
+    origin = np.tile(p, (rays, 1))
     winding = np.zeros(rays, dtype=np.int64)
     active = np.ones(rays, dtype=bool)
     for _ in range(64):

@@ -58,6 +58,9 @@ pub struct VesselParams {
     pub hull: Hull,
 }
 
+/// Most poses (times × vessels) one [`Fleet::poses_at_times`] call returns: 2²⁶, 3 GiB of float64.
+pub const MAX_POSES: usize = 1 << 26;
+
 /// The reference USV hull: 5 m × 2.5 m, draft 0.45 m, Cb 0.45, GM 0.6 m, default roll gyradius and damping.
 pub const REFERENCE_HULL: Hull = Hull {
     length_m: 5.0,
@@ -305,12 +308,24 @@ impl Fleet {
     }
 
     /// Poses at many times, flattened time-major: entry `k · len() + v` is vessel `v` at `times[k]`
-    /// (a T×V×6 array). Every time must be finite and ≥ 0 (errors name `times[k]`). Runs over rayon.
+    /// (a T×V×6 array). Every time must be finite and ≥ 0 (errors name `times[k]`); at most [`MAX_POSES`] poses
+    /// (T·V) a call, checked before anything is allocated. Runs over rayon.
     pub fn poses_at_times(&self, times: &[f64]) -> Result<Vec<[f64; 6]>> {
+        let nv = self.vessels.len();
+        if times.len().saturating_mul(nv) > MAX_POSES {
+            return Err(MmusvError::input(
+                "times",
+                format!(
+                    "{} times × {nv} vessels would be {} poses; at most {MAX_POSES} a call: ask for fewer times at \
+                     once",
+                    times.len(),
+                    times.len().saturating_mul(nv)
+                ),
+            ));
+        }
         for (k, &t) in times.iter().enumerate() {
             self.check_travel(t, &format!("times[{k}]"))?;
         }
-        let nv = self.vessels.len();
         let mut out = vec![[0.0; 6]; times.len() * nv];
         if nv == 0 {
             return Ok(out);
@@ -533,6 +548,16 @@ mod tests {
         let err = f.poses_at_times(&[0.0, 1.0, -2.0]);
         assert!(matches!(err, Err(MmusvError::InvalidInput { ref field, .. }) if field == "times[2]"));
         assert_eq!(Fleet::new(Vec::new(), WaveSetting::W0).poses_at_times(&[1.0]).map(|v| v.len()), Ok(0));
+    }
+
+    #[test]
+    fn poses_at_times_refuses_more_than_max_poses_before_allocating() {
+        // 4 vessels at MAX_POSES / 4 + 1 times: one pose too many (used to allocate T·V·48 bytes, unbounded).
+        let f = fleet(VesselDims::REFERENCE, WaveSetting::W1, 1);
+        let times = vec![0.0; MAX_POSES / 4 + 1];
+        let err = f.poses_at_times(&times);
+        assert!(matches!(err, Err(MmusvError::InvalidInput { ref field, .. }) if field == "times"), "{err:?}");
+        assert_eq!(f.poses_at_times(&times[..2]).map(|v| v.len()), Ok(8));
     }
 
     #[test]

@@ -147,6 +147,10 @@ impl Recorder {
     /// Starts a recording that will be named `path`. An existing `path` is refused unless `overwrite`; it is
     /// then replaced only when [`finish`](Self::finish) succeeds. A stale `<path>.partial` is truncated.
     pub fn create(path: &Path, overwrite: bool) -> Result<Self> {
+        if path.as_os_str().is_empty() {
+            // An empty path would write `.partial` into the working directory and rename it to "" on finish.
+            return Err(MmusvError::input("path", "is empty; give the recording's file name (e.g. run.mcap)"));
+        }
         if path.is_dir() {
             return Err(MmusvError::Io { path: path.display().to_string(), reason: "is a directory".into() });
         }
@@ -341,6 +345,12 @@ impl Drop for Recorder {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_empty_path_is_refused_before_anything_is_written() {
+        let e = Recorder::create(Path::new(""), true).err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(e.contains("path") && e.contains("empty"), "{e}");
+    }
 
     #[test]
     fn write_errors_name_the_operating_systems_reason() {

@@ -29,7 +29,17 @@ pub fn pinhole_intrinsics(width: u32, height: u32, hfov: f64) -> Result<[f64; 4]
 
 /// Unit ray directions through every pixel centre of a pinhole camera, in the camera BODY frame
 /// (x forward, y left, z up). Row-major, `width × height` rows of `[x, y, z]`.
+/// Sides above [`MAX_SIDE`](crate::sensors::camera::MAX_SIDE) are refused (a camera's own bound), before anything
+/// is allocated.
 pub fn pinhole_directions(width: u32, height: u32, hfov: f64) -> Result<Vec<[f32; 3]>> {
+    let max = crate::sensors::camera::MAX_SIDE;
+    if width > max || height > max {
+        return Err(MmusvError::config(
+            "resolution",
+            format!("[{width}, {height}]"),
+            format!("width and height must be in 1..={max}"),
+        ));
+    }
     let [fx, fy, cx, cy] = pinhole_intrinsics(width, height, hfov)?;
     let mut out = Vec::with_capacity(width as usize * height as usize);
     for v in 0..height {
@@ -45,10 +55,13 @@ pub fn pinhole_directions(width: u32, height: u32, hfov: f64) -> Result<Vec<[f32
 }
 
 /// Elevation angles (radians) of `channels` beams spread uniformly over `[lower, upper]` radians,
-/// lowest first.
+/// lowest first; `channels` in `1..=MAX_CHANNELS`.
 pub fn uniform_elevations(channels: u32, lower: f64, upper: f64) -> Result<Vec<f64>> {
     if channels == 0 {
         return Err(MmusvError::config("channels", channels, "a LiDAR needs at least one channel"));
+    }
+    if channels > MAX_CHANNELS {
+        return Err(MmusvError::config("channels", channels, format!("must be in 1..={MAX_CHANNELS}")));
     }
     if !(lower.is_finite()
         && upper.is_finite()
@@ -129,6 +142,18 @@ pub fn lidar_trace_order(channels: u32, azimuth_steps: u32, block: u32) -> Resul
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn huge_sizes_are_refused_before_allocating() {
+        // Each used to try to allocate gigabytes (and abort the process when that failed).
+        let side = crate::sensors::camera::MAX_SIDE;
+        assert!(pinhole_directions(side + 1, 6, 1.0).is_err());
+        assert!(pinhole_directions(8, u32::MAX, 1.0).is_err());
+        assert!(uniform_elevations(MAX_CHANNELS + 1, -0.1, 0.1).is_err());
+        assert!(uniform_elevations(u32::MAX, -0.1, 0.1).is_err());
+        assert_eq!(uniform_elevations(MAX_CHANNELS, -0.1, 0.1).map(|e| e.len()).ok(), Some(MAX_CHANNELS as usize));
+        assert_eq!(pinhole_directions(side, 1, 1.0).map(|d| d.len()).ok(), Some(side as usize));
+    }
 
     #[test]
     fn pinhole_centre_ray_is_forward_and_corners_match_fov() {
