@@ -34,8 +34,10 @@
 //! beam's uniform draw, `I = −⟨I⟩ ln u` is exponential about `⟨I⟩` and exceeds `I_d` exactly when `u < P_d`, so
 //! a detected return's intensity is `I_d` plus an exponential of mean `⟨I⟩`, never below the threshold
 //! ([`speckle_intensity`]). `I_d` ([`DETECTION_THRESHOLD`]) is set so
-//! that a beam 20 m out over a W1 sea (U ≈ 8.4 m/s, grazing at 80°) returns with the probability 0.2 of the
-//! empirical rule this model replaces; calm water (W0) then returns almost nothing, as at 905 nm it should.
+//! that a beam 20 m out over a W1 sea at 80° incidence (10° grazing) returns with the probability 0.2 of the
+//! empirical rule this model replaces, with U = 8.4 m/s, the W1 sea's Pierson–Moskowitz wind at 19.5 m (at the
+//! 8.2 m/s at 10 m the sensors take since 2026-11-30, `mmusv.sensors.env.wind_from_wave_height`, it is 0.17);
+//! calm water (W0) then returns almost nothing, as at 905 nm it should.
 
 use super::shade::foam::FOAM_ALBEDO;
 
