@@ -120,6 +120,8 @@ def surface_tiles(foci: npt.ArrayLike, *, radius_m: float) -> int:
     :data:`SURFACE_TILE_M` tiles aligned on multiples of :data:`SURFACE_TILE_M` (so a side may take one tile more
     than its length over the tile's); 0 without foci. ``foci`` must be finite (cast to float32) and ``radius_m`` a
     finite number > 0, else an :class:`~mmusv.errors.InputError` naming the argument."""
+    if isinstance(foci, (list, tuple, np.ndarray)) and np.shape(foci) == (0,):  # no foci: ``[]`` is (0,), not (0, 2)
+        foci = np.zeros((0, 2), dtype=np.float32)
     f = _array(foci, name="foci", dtype=np.float32, shape_tail=(2,))
     if not np.isfinite(f).all():
         bad = int(np.count_nonzero(~np.isfinite(f).all(axis=1)))

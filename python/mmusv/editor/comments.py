@@ -169,7 +169,8 @@ def _comment_at(line: str, offset: int, spans: list[tuple[int, int]]) -> int | N
 
 def read_comments(text: str) -> list[Comment]:
     """The comments of the YAML ``text`` but its leading block, in the order of the file, with their anchors (see
-    the module docstring); ``[]`` for a text PyYAML cannot compose."""
+    the module docstring); ``[]`` for a text PyYAML cannot compose. A leading byte-order mark is not text."""
+    text = text.removeprefix("\ufeff")  # (else the file's first line, a comment, would be neither kind)
     lines = _lines(text)
     first = 0
     while first < len(lines) and lines[first][1].startswith("#"):  # the leading block (leading_comment's)

@@ -142,7 +142,7 @@ def _flowed(value: Any) -> Any:
 def leading_comment(text: str) -> str:
     """The file's leading ``#`` comment block without the ``#`` marks (lines joined by newlines; empty if none)."""
     lines = []
-    for line in text.splitlines():
+    for line in text.removeprefix("\ufeff").splitlines():  # a byte-order mark is not the first line's text
         if not line.startswith("#"):
             break
         body = line[1:]
