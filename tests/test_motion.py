@@ -186,3 +186,17 @@ def test_hull_raos_are_the_closed_forms(asset: str) -> None:
             hull=list(hull), omega=omega, beta=np.full(40, beta), omega_e=omega - k * u * math.cos(beta)
         )
         np.testing.assert_allclose(np.abs(rao), _jmo_amplitudes(hull, omega, beta, u), rtol=1e-9, atol=1e-12)
+
+
+def test_scenario_poses_in_batches_are_the_same_poses(monkeypatch: pytest.MonkeyPatch) -> None:
+    # A long scenario's poses are asked in batches (the core bounds one call: 7 vessels x 10^7 frames, which the
+    # scenario schema allows, were refused naming `times`, an argument the user never gave); same values either way.
+    import mmusv.motion as motion
+    from tiny_scenario import lidar_scenario
+
+    scenario = load_scenario({**lidar_scenario("batches", frames=23), "environment": {"motion": "physical"}})
+    whole = motion.scenario_poses(scenario)
+    monkeypatch.setattr(motion, "POSE_BATCH", 7)  # 3 times a call with 2 vessels
+    batched = motion.scenario_poses(scenario)
+    assert whole.shape == batched.shape == (23, 2, 6)
+    assert np.array_equal(whole, batched)

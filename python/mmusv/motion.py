@@ -50,8 +50,16 @@ def build_fleet(scenario: Scenario, *, wave: str | float | None = None) -> Any:
     )
 
 
+POSE_BATCH = 1 << 20
+"""Most poses (times × vessels) :func:`scenario_poses` asks the core for in one call: a long scenario's poses are
+taken in batches of times, as the core bounds one call's (``Fleet.poses_at_times``), the same values either way."""
+
+
 def scenario_poses(scenario: Scenario, *, wave: str | float | None = None) -> npt.NDArray[np.float64]:
     """``(frames, vessels, 6)`` float64 poses at every acquisition time t_k = k / f."""
     fleet = build_fleet(scenario, wave=wave)
     times = np.arange(scenario.acquisition.frames, dtype=np.float64) / scenario.acquisition.frequency_hz
-    return np.asarray(fleet.poses_at_times(times))
+    step = max(1, POSE_BATCH // max(1, len(scenario.vessels)))
+    if len(times) <= step:
+        return np.asarray(fleet.poses_at_times(times))
+    return np.concatenate([np.asarray(fleet.poses_at_times(times[k : k + step])) for k in range(0, len(times), step)])
