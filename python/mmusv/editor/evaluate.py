@@ -19,7 +19,8 @@ returns, JSON-ready:
 Bounds (:func:`mmusv.generate.samples.budget_problem`, the ones ``mmusv run`` checks): the checks take at most
 ``MAX_CHECK_SAMPLES`` samples x vessels and ``MAX_CHECK_PAIR_SAMPLES`` time samples x pairs of vessels (the
 separation check compares every pair at every time: without this bound a fleet of a few thousand vessels, a body
-of a few hundred kB, would take minutes); above either the document is not valid and ``errors`` says why. At most
+of a few hundred kB, would take minutes); above either the document is not valid and ``errors`` says why, at the
+field ``acquisition`` when the samples in time set the count (frames and frequency), else ``vessels``. At most
 :data:`MAX_PROBLEMS` problems are listed; one more entry (check ``more``) then says how many were left out.
 
 World frame, metres, radians (yaw from +x, counter-clockwise); coordinates rounded to millimetres.
@@ -37,7 +38,7 @@ from pydantic import ValidationError
 from mmusv.config import Scenario, validation_problems
 from mmusv.errors import ConfigError, MmusvError
 from mmusv.generate.mapctx import map_context
-from mmusv.generate.samples import budget_problem, sample_counts
+from mmusv.generate.samples import MAX_CHECK_SAMPLES, budget_problem, sample_counts
 from mmusv.motion import build_fleet
 from mmusv.scenario_checks import check_mounts, map_check_spec, map_findings
 from mmusv.sensors.config import RigConfig
@@ -130,6 +131,22 @@ def poses_at(scenario: Scenario, frame: int) -> list[list[float]]:
     return _frame_poses(build_fleet(scenario), scenario, np.array([frame]))[0].tolist()  # type: ignore[no-any-return]
 
 
+def _budget_error(problem: str, n_motion: int, n_route: int, n_vessels: int) -> tuple[str, str]:
+    """The field and message of a scenario too large to check (``problem``, from :func:`budget_problem`).
+
+    When the samples in time set the count (the acquisition's frames and rate do, and every pair of vessels is
+    compared at every time), the field is ``acquisition`` and the message names ``acquisition.frames`` and
+    ``acquisition.frequency_hz``: the page shows it next to those two boxes, where the change that caused it was
+    made. Otherwise the longest route sets the count: ``vessels``."""
+    if n_motion >= n_route or max(n_motion, n_route) * n_vessels <= MAX_CHECK_SAMPLES:
+        advice = (
+            "lower acquisition.frames or raise acquisition.frequency_hz (a shorter acquisition), "
+            "lower the speeds or use fewer vessels"
+        )
+        return "acquisition", f"{problem}: {advice}"
+    return "vessels", f"{problem}: shorten the routes or use fewer vessels"
+
+
 def evaluate(document: dict[str, Any]) -> dict[str, Any]:
     """Validates ``document`` and, when valid, samples its motion and runs the named checks (module docstring)."""
     out: dict[str, Any] = {"valid": False, "errors": [], "problems": [], "vessels": [], "frames": None}
@@ -141,11 +158,11 @@ def evaluate(document: dict[str, Any]) -> dict[str, Any]:
     out.update(frames=acq.frames, frequency_hz=acq.frequency_hz, valid=True)
     out["map"] = {"type": scenario.map.type, "seed": scenario.map.seed, "params": scenario.map.param_values()}
     spec = map_check_spec(scenario)
-    problem = budget_problem(scenario, *sample_counts(scenario, spec))  # the bounds `mmusv run` checks
+    n_motion, n_route = sample_counts(scenario, spec)
+    problem = budget_problem(scenario, n_motion, n_route)  # the bounds `mmusv run` checks
     if problem is not None:
         out["valid"] = False
-        advice = "shorten the routes or the acquisition, lower the speeds or use fewer vessels"
-        out["errors"] = [_error("vessels", f"{problem}: {advice}", document)]
+        out["errors"] = [_error(*_budget_error(problem, n_motion, n_route, len(scenario.vessels)), document)]
         return out
     ctx = map_context(scenario.map.type, scenario.map.seed, scenario.map.param_values())
     samples, findings = map_findings(scenario, ctx, spec)

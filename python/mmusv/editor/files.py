@@ -17,6 +17,8 @@ Lost updates: every read gives the file's ETag (:func:`etag`, a hash of its byte
 it started from (``if_match``) is refused with :class:`ChangedInFolder` when the file has changed since (another
 browser tab, or another program, saved it), so an edit is never silently overwritten; the check and the write
 happen under one lock of the folder object.
+
+Size: a text larger than :data:`MAX_FILE_BYTES` is never written (the editor could not open the file again).
 """
 
 from __future__ import annotations
@@ -151,8 +153,15 @@ class ScenarioFolder:
         """Writes ``text`` to the file ``name`` (atomically); :class:`FileExistsInFolder` when it exists and
         ``overwrite`` is false, or when the name is a folder or another non-file; :class:`ChangedInFolder` when
         ``if_match`` (the ETags of an ``If-Match`` header, ``"*"`` for any version) is given, the file exists and
-        its ETag is none of them, or it is ``"*"`` and the file does not exist."""
+        its ETag is none of them, or it is ``"*"`` and the file does not exist; :class:`ConfigError` when the text
+        is larger than :data:`MAX_FILE_BYTES` (the file would not open again): nothing is written."""
         p = self.path(name)
+        data = text.encode("utf-8")
+        if len(data) > MAX_FILE_BYTES:
+            raise ConfigError(
+                f"{name}: not saved, its text would take {len(data):,} bytes, more than {MAX_FILE_BYTES:,} bytes, the "
+                "most the editor opens, so the file would not open again: use fewer waypoints, vessels or comments"
+            )
         with self._write_lock:
             if p.exists() and not p.is_file():
                 raise FileExistsInFolder(
@@ -176,7 +185,7 @@ class ScenarioFolder:
                         "edit is lost: open it again to see the other version, save under another name, or "
                         "overwrite it"
                     )
-            self._replace(p, text.encode("utf-8"), name=name)
+            self._replace(p, data, name=name)
         return p
 
     def _replace(self, p: Path, data: bytes, *, name: str) -> None:

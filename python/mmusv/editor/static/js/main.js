@@ -331,7 +331,7 @@ function follow(job) {
       if (j.status !== "running") {
         clearInterval(runTimer);
         // the run's end replaces what the status said meanwhile (a refused second Run: "… wait for it to end")
-        status(`run of ${j.scenario}: ${$("run-text").textContent}`, j.status === "failed");
+        status(`run of ${j.scenario}: ${$("run-text").textContent}`, j.status === "failed" || j.status === "interrupted");
       }
     } catch (err) {
       clearInterval(runTimer);
@@ -374,11 +374,29 @@ state.on("evaluated", () => {
     status(`${ev.vessels.length} vessels · ${ev.frames} frames · ${errors} error(s), ${ev.problems.length - errors} warning(s)`, errors > 0);
   }
 });
+/** Scrolls the left panel so that the Selected vessel panel is seen (a vessel picked on the map or in a list may
+ * have it below the panel's fold). Scrolling moves no focus: a selection from the map keeps the keyboard there. The
+ * panel is left where it is when it is seen whole already or the keyboard is in it (its id renamed, say). */
+function revealVesselPanel() {
+  const panel = $("vessel-panel");
+  if (panel.hidden || panel.contains(document.activeElement)) return;
+  const scroller = panel.closest(".panel");
+  if (!scroller) return;
+  const r = panel.getBoundingClientRect();
+  const s = scroller.getBoundingClientRect();
+  if (r.top >= s.top && r.bottom <= s.bottom) return;
+  panel.scrollIntoView({ block: r.height <= s.height ? "nearest" : "start" });
+}
+let revealedSelection = null; // the vessel whose selection last brought the panel into view
 state.on("selection", () => {
   panels.renderFleet();
   panels.renderVessel();
   panels.renderNotes();
   map.renderScenario();
+  if (state.selected !== revealedSelection) {
+    revealedSelection = state.selected;
+    if (state.selected) revealVesselPanel();
+  }
 });
 state.on("frame", () => {
   map.renderFrame();
