@@ -96,7 +96,7 @@ def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[st
         StructureClearance,
     )
     from mmusv.generate.mapctx import MapContext
-    from mmusv.generate.samples import budget_problem, sample_counts
+    from mmusv.generate.samples import FEWER_TIMES, budget_problem, sample_counts
     from mmusv.generate.spec import GenerationSpec
 
     spec = GenerationSpec.model_validate({"combinations": [{"family": "crossing"}]})
@@ -104,7 +104,7 @@ def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[st
     if problem is not None:
         raise ConfigError(
             f"{source}: {problem} (they cover every frame that is run): skip them with --no-checks "
-            "(checks=False), run fewer frames (--frames), or lower acquisition.frames or acquisition.frequency_hz"
+            f"(checks=False), run fewer frames (--frames), or {FEWER_TIMES}"
         )
     samples = scenario_samples(scenario, MapContext(world), spec)
     cons = spec.constraints

@@ -112,6 +112,23 @@ def test_take_samples_refuses_instead_of_allocating() -> None:
         scenario_samples(sc, map_context("open_sea", 2, {}))
 
 
+@pytest.mark.usefixtures("no_sampling")
+def test_too_many_samples_advises_what_lowers_them() -> None:
+    # The refusal advised "lower acquisition.frames or acquisition.frequency_hz": over the same frames a lower rate
+    # is a longer acquisition, whose vessels sail further: never fewer samples, and more once the speed sets them.
+    from mmusv.scenario_checks import scenario_samples
+
+    sc = _scenario(frequency_hz=1000, frames=10_000_000)
+    with pytest.raises(ConfigError) as info:
+        scenario_samples(sc, map_context("open_sea", 2, {}))
+    assert samples.FEWER_TIMES in str(info.value) and "or acquisition.frequency_hz" not in str(info.value)
+    for frames, hz, speed in ((10_000, 0.5, 10.0), (10_000, 5.0, 0.5), (200, 1.0, 30.0)):
+        n = samples.time_samples(frames, hz, 2.0, speed)
+        assert samples.time_samples(frames, hz / 2, 2.0, speed) >= n >= samples.time_samples(frames, hz * 2, 2.0, speed)
+    assert samples.time_samples(10_000, 0.25, 2.0, 10.0) > samples.time_samples(10_000, 0.5, 2.0, 10.0)
+    assert samples.time_samples(5_000, 0.5, 2.0, 10.0) < samples.time_samples(10_000, 0.5, 2.0, 10.0)
+
+
 def test_sample_counts_saturate_instead_of_overflowing() -> None:
     sc = _scenario(frequency_hz=5, frames=10)
     n_t, n_g = samples._counts(sc, np.array([math.inf]), 2.0)  # was an OverflowError

@@ -38,7 +38,7 @@ from pydantic import ValidationError
 from mmusv.config import Scenario, validation_problems
 from mmusv.errors import ConfigError, MmusvError
 from mmusv.generate.mapctx import map_context
-from mmusv.generate.samples import MAX_CHECK_SAMPLES, budget_problem, sample_counts
+from mmusv.generate.samples import FEWER_TIMES, MAX_CHECK_SAMPLES, budget_problem, sample_counts
 from mmusv.motion import build_fleet
 from mmusv.scenario_checks import check_mounts, map_check_spec, map_findings
 from mmusv.sensors.config import RigConfig
@@ -139,10 +139,7 @@ def _budget_error(problem: str, n_motion: int, n_route: int, n_vessels: int) -> 
     ``acquisition.frequency_hz``: the page shows it next to those two boxes, where the change that caused it was
     made. Otherwise the longest route sets the count: ``vessels``."""
     if n_motion >= n_route or max(n_motion, n_route) * n_vessels <= MAX_CHECK_SAMPLES:
-        advice = (
-            "lower acquisition.frames or raise acquisition.frequency_hz (a shorter acquisition), "
-            "lower the speeds or use fewer vessels"
-        )
+        advice = f"{FEWER_TIMES}, lower the speeds or use fewer vessels"
         return "acquisition", f"{problem}: {advice}"
     return "vessels", f"{problem}: shorten the routes or use fewer vessels"
 

@@ -126,6 +126,11 @@ def _ceil_count(x: float) -> int:
     return max(math.ceil(x) + 1, 2)
 
 
+FEWER_TIMES = "lower acquisition.frames or raise acquisition.frequency_hz (a shorter acquisition)"
+"""What takes fewer samples in time (:func:`time_samples`): fewer frames, or the same frames over a shorter time. A
+lower rate never helps: over the same frames the acquisition lasts longer and the vessels sail further."""
+
+
 def time_samples(frames: int, frequency_hz: float, step: float, max_speed_mps: float) -> int:
     """Motion samples per vessel over ``frames`` frames at ``frequency_hz``: at least one a frame, and one each
     ``step`` metres at ``max_speed_mps`` (saturated like every count here)."""
@@ -191,9 +196,7 @@ def take_samples(scenario: Scenario, meta: CandidateMeta, ctx: MapContext, spec:
     n_t, n_g = _counts(scenario, lengths, step)
     problem = budget_problem(scenario, n_t, n_g)
     if problem is not None:
-        raise ConfigError(
-            f"{problem}: lower acquisition.frames or acquisition.frequency_hz, shorten the routes or lower the speeds"
-        )
+        raise ConfigError(f"{problem}: {FEWER_TIMES}, shorten the routes or lower the speeds")
     times = np.linspace(0.0, t_last, n_t)
     frame_times = np.arange(acq.frames, dtype=np.float64) / acq.frequency_hz
     poses = np.asarray(fleet.poses_at_times(np.concatenate([times, frame_times])))
