@@ -1,6 +1,7 @@
 """The 2D boxes of a recording, computed for the export tests from what it recorded, never from an exporter's code:
 the annotations' projected boxes and the tight boxes of the vessels' pixels in the instance images, brute force
-(``test_box_convention.py``'s COCO/YOLO boxes, ``test_mot.py``'s MOTChallenge boxes).
+(``test_box_convention.py``'s COCO/YOLO boxes, ``test_mot.py``'s MOTChallenge boxes, ``test_peer_readers.py``'s
+boxes the peers' readers must give).
 
 Boxes are in pixel-edge coordinates: pixel ``(i, j)`` covers ``[i, i + 1) × [j, j + 1)``, so the tight box of
 columns ``c0..c1`` is ``[c0, c1 + 1)``.
@@ -31,7 +32,8 @@ def recorded(rec: Path, frames: int) -> Boxes:
     """Per image ``(agent, camera, frame)`` of the first ``frames`` frames, per vessel id with a recorded 2D box that
     has a visible pixel: ``projected``, the recorded (projected, clipped) box; ``visible``, the tight box of the
     vessel's pixels in the instance image (whole-number floats; such a vessel must have a pixel there); ``class``, its
-    semantic class; the box's recorded ``occlusion`` and ``truncation``; ``size``, the image's (width, height)."""
+    semantic class; ``instance``, its instance id; the box's recorded ``occlusion`` and ``truncation``; ``size``, the
+    image's (width, height)."""
     info = read_info(rec)
     out: Boxes = {}
     for k in range(frames):
@@ -52,6 +54,7 @@ def recorded(rec: Path, frames: int) -> Boxes:
                         "projected": [b.x_min, b.y_min, b.x_max, b.y_max],
                         "visible": visible,
                         "class": int(v.semantic_class),
+                        "instance": int(v.instance_id),
                         "occlusion": float(b.occlusion),
                         "truncation": float(b.truncation),
                         "size": (cam.width, cam.height),

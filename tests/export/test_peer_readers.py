@@ -38,6 +38,7 @@ import pytest
 from mmusv.classes import SemanticClass, class_name
 from mmusv.export import convert
 from mmusv.recording import decode_image, decode_point_cloud, frame_messages, read_info, topics
+from recorded_boxes import recorded
 from scipy.spatial.transform import Rotation
 
 CLASSES = [int(c) for c in SemanticClass if c != 0]
@@ -67,36 +68,23 @@ def image_boxes(rec: Path, frames: int) -> dict[str, list[dict[str, Any]]]:
     """Per image ``<scenario>/<agent>/<camera>/<frame:06d>``: the recorded 2D boxes with a visible pixel (the default
     filters), each with its class, instance id, pixel box and the image size. The pixel box is the default
     ``--box visible`` (docs/exports.md): the tight box, in pixel edges, of the instance image's pixels equal to the
-    vessel's instance id (it was the recorded projected box while that was the only box the exports wrote)."""
-    info = read_info(rec)
-    out: dict[str, list[dict[str, Any]]] = {}
-    for k in range(frames):
-        msgs = frame_messages(rec, k)
-        world = {v.id: v for v in msgs[topics.WORLD_STATE].vessels}
-        for a in info.agents:
-            ann = msgs[topics.agent_annotations(a.id)]
-            for name, cam in a.cameras.items():
-                inst = np.asarray(decode_image(msgs[topics.camera(a.id, name, "instance")]))
-                out[f"{rec.stem}/{a.id}/{name}/{k:06d}"] = [
-                    {
-                        "class": int(world[b.target_id].semantic_class),
-                        "instance": int(world[b.target_id].instance_id),
-                        "xyxy": visible_box(inst, int(world[b.target_id].instance_id)),
-                        "size": (cam.width, cam.height),
-                        "agent": a.id,
-                        "camera": name,
-                        "frame": k,
-                    }
-                    for b in ann.boxes_camera
-                    if b.camera == name and b.visible_pixels > 0
-                ]
-    return out
-
-
-def visible_box(inst: np.ndarray, instance_id: int) -> np.ndarray:
-    """``[x_min, y_min, x_max, y_max]`` in pixel edges of ``inst``'s pixels equal to ``instance_id``."""
-    ys, xs = np.nonzero(inst == instance_id)
-    return np.array([xs.min(), ys.min(), xs.max() + 1, ys.max() + 1], dtype=np.float64)
+    vessel's instance id (it was the recorded projected box while that was the only box the exports wrote), from
+    ``recorded_boxes.recorded``'s walk of the instance images."""
+    return {
+        f"{rec.stem}/{agent}/{camera}/{k:06d}": [
+            {
+                "class": e["class"],
+                "instance": e["instance"],
+                "xyxy": np.array(e["visible"], dtype=np.float64),
+                "size": e["size"],
+                "agent": agent,
+                "camera": camera,
+                "frame": k,
+            }
+            for e in per.values()
+        ]
+        for (agent, camera, k), per in recorded(rec, frames).items()
+    }
 
 
 def documented_yolo_path(key: str) -> str:
