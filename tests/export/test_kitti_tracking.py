@@ -23,6 +23,7 @@ from mcap_protobuf.decoder import DecoderFactory
 from mmusv.errors import ConfigError, IoError
 from mmusv.export import convert
 from mmusv.recording import read_info
+from trackeval_run import trackeval_scores
 
 FRAMES = 3
 OPTIONS: dict[str, Any] = {"splits": None, "include_usvs": True, "eval_range_m": 2000.0}
@@ -223,33 +224,8 @@ def test_every_track_id_is_one_vessel_in_every_frame_and_sequence(exports: dict[
 
 
 def _trackeval(gt: Path, trackers: Path) -> Any:
-    import trackeval
-
-    quiet = {"PRINT_CONFIG": False}
-    evaluator = trackeval.Evaluator(
-        {
-            **quiet,
-            "USE_PARALLEL": False,
-            "PRINT_RESULTS": False,
-            "OUTPUT_SUMMARY": False,
-            "OUTPUT_DETAILED": False,
-            "PLOT_CURVES": False,
-            "TIME_PROGRESS": False,
-            "DISPLAY_LESS_PROGRESS": True,
-        }
-    )
-    dataset = trackeval.datasets.Kitti2DBox(
-        {
-            **quiet,
-            "GT_FOLDER": str(gt),
-            "TRACKERS_FOLDER": str(trackers),
-            "SPLIT_TO_EVAL": "train",
-            "CLASSES_TO_EVAL": ["car"],
-        }
-    )
-    metrics = [trackeval.metrics.HOTA(quiet), trackeval.metrics.CLEAR(quiet), trackeval.metrics.Identity(quiet)]
-    res, msg = evaluator.evaluate([dataset], metrics)
-    return dataset, res["Kitti2DBox"], msg["Kitti2DBox"]
+    folders = {"GT_FOLDER": str(gt), "TRACKERS_FOLDER": str(trackers)}
+    return trackeval_scores("Kitti2DBox", {**folders, "SPLIT_TO_EVAL": "train", "CLASSES_TO_EVAL": ["car"]})
 
 
 def test_trackeval_kitti2dbox_scores_gt_perfect_and_a_swap_lower(exports: dict[str, Path], tmp_path: Path) -> None:

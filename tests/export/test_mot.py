@@ -29,6 +29,7 @@ from mmusv.export import convert
 from mmusv.recording import decode_image, frame_messages, read_info, topics
 from PIL import Image
 from recorded_boxes import Boxes, recorded
+from trackeval_run import trackeval_scores
 
 FRAMES = 3
 """conftest's ``port`` recording: 3 frames, 3 USVs with 4 cameras of 160 × 120 (12 sequences)."""
@@ -283,7 +284,6 @@ def test_trackeval_loads_and_scores_gt_perfect(mot_dir: Path, tmp_path: Path) ->
     pedestrian, alone); the ground truth written as a tracker's results (class -1) scores HOTA = MOTA = IDF1 = 1."""
     if importlib.util.find_spec("trackeval") is None:
         pytest.skip("trackeval is not installed (scripts/test.sh installs it without its dependencies)")
-    import trackeval
 
     trk = tmp_path / "trackers" / "gt_copy" / "data"
     trk.mkdir(parents=True)
@@ -291,34 +291,19 @@ def test_trackeval_loads_and_scores_gt_perfect(mot_dir: Path, tmp_path: Path) ->
     for seq in seqs:
         text = "".join(",".join([*f[:6], "1", "-1", "-1", "-1"]) + "\n" for f in gt_lines(seq))
         (trk / f"{seq.name}.txt").write_text(text)
-    quiet = {"PRINT_CONFIG": False}
-    evaluator = trackeval.Evaluator(
+    dataset, res, msg = trackeval_scores(
+        "MotChallenge2DBox",
         {
-            **quiet,
-            "USE_PARALLEL": False,
-            "PRINT_RESULTS": False,
-            "OUTPUT_SUMMARY": False,
-            "OUTPUT_DETAILED": False,
-            "PLOT_CURVES": False,
-            "TIME_PROGRESS": False,
-            "DISPLAY_LESS_PROGRESS": True,
-        }
-    )
-    dataset = trackeval.datasets.MotChallenge2DBox(
-        {
-            **quiet,
             "GT_FOLDER": str(mot_dir / "train"),
             "SKIP_SPLIT_FOL": True,
             "SEQMAP_FILE": str(mot_dir / "seqmaps" / "train.txt"),
             "TRACKERS_FOLDER": str(tmp_path / "trackers"),
             "DO_PREPROC": False,
-        }
+        },
     )
     assert dataset.seq_lengths == {s.name: FRAMES for s in seqs}
-    metrics = [trackeval.metrics.HOTA(quiet), trackeval.metrics.CLEAR(quiet), trackeval.metrics.Identity(quiet)]
-    res, msg = evaluator.evaluate([dataset], metrics)
-    assert msg == {"MotChallenge2DBox": {"gt_copy": "Success"}}
-    r = res["MotChallenge2DBox"]["gt_copy"]["COMBINED_SEQ"]["pedestrian"]
+    assert msg == {"gt_copy": "Success"}
+    r = res["gt_copy"]["COMBINED_SEQ"]["pedestrian"]
     assert r["CLEAR"]["MOTA"] == 1.0 and r["Identity"]["IDF1"] == 1.0 and float(np.mean(r["HOTA"]["HOTA"])) == 1.0
     assert r["Count"]["GT_Dets"] == sum(len(gt_lines(s)) for s in seqs)
     assert r["Count"]["GT_IDs"] == sum(len({f[1] for f in gt_lines(s)}) for s in seqs)
