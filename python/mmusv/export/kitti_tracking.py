@@ -49,7 +49,7 @@ from mmusv.export.splits import SPLIT_NAMES
 from mmusv.export.writer import DatasetWriter
 from mmusv.recording.decode import WorldFrame
 from mmusv.recording.info import AgentInfo
-from mmusv.recording.stream import Frame
+from mmusv.recording.stream import Frame, frame_ranges
 
 __all__ = [
     "SEQUENCES_COLUMNS",
@@ -66,20 +66,6 @@ FOLDERS = {"image_2": "image_02", "depth_2": "depth_02", "semantic_2": "semantic
 """The KITTI object layout's per-frame folders renamed in the tracking layout (the others keep their name)."""
 RIGID_TOLERANCE = 1e-6
 """The most an entry of LiDAR → front camera (metres, or a rotation's entry) may differ between frames of a sequence."""
-
-
-def _shown(indices: list[int]) -> str:
-    """Sorted acquisition indices as ranges: ``2, 5..7``."""
-    out: list[str] = []
-    start = prev = indices[0]
-    for k in [*indices[1:], None]:
-        if k is not None and k == prev + 1:
-            prev = k
-            continue
-        out.append(f"{start}" if start == prev else f"{start}..{prev}")
-        if k is not None:
-            start = prev = k
-    return ", ".join(out)
 
 
 def seqmap_name(split: str) -> str:
@@ -202,8 +188,8 @@ class KittiTrackingWriter(KittiWriter):
             if gaps:  # a tracker steps by frame: say where a step is longer than 1 / frequency_hz
                 what = "index {} is" if len(gaps) == 1 else "indices {} are"
                 self.notes.append(
-                    f"{self.split_folder}/{seq.name}: acquisition {what.format(_shown(gaps))} not converted, so its "
-                    f"frames are not all 1 / frequency_hz apart (frames/{seq.name}.txt gives each frame's index)"
+                    f"{self.split_folder}/{seq.name}: acquisition {what.format(frame_ranges(gaps))} not converted, so "
+                    f"its frames are not all 1 / frequency_hz apart (frames/{seq.name}.txt gives each frame's index)"
                 )
             for sub, ext in seq.files.items():
                 where = seq.folder / sub
