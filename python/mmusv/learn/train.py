@@ -146,6 +146,11 @@ def _differs(ck: dict[str, Any], p: Preset, mode: str, seed: int) -> str | None:
     return "; ".join(out) or None
 
 
+def _not_a_checkpoint(last: Path) -> str:
+    """What is said of a ``last.pt`` that cannot be resumed from."""
+    return f"{last}: not a checkpoint of mmusv train (remove it to start again, or use another -o)"
+
+
 def resumable_checkpoint(
     out: str | Path,
     *,
@@ -162,8 +167,7 @@ def resumable_checkpoint(
     last = Path(out) / "last.pt"
     if not last.is_file():
         return None
-    what = f"{last}: not a checkpoint of mmusv train (remove it to start again, or use another -o)"
-    ck = load_checkpoint(last, what=what, device=device)
+    ck = load_checkpoint(last, what=_not_a_checkpoint(last), device=device)
     other = _differs(ck, p, mode, seed)
     if other is not None:  # it said "preset/mode/seed differ", not which
         raise input_error(f"{last}: a checkpoint of another run ({other}); use another -o")
@@ -223,13 +227,12 @@ def train(
     last = out_p / "last.pt"
     ck = resumable_checkpoint(out_p, p=p, mode=mode, seed=seed, identity=identity, device=dev)
     if ck is not None:
-        what = f"{last}: not a checkpoint of mmusv train (remove it to start again, or use another -o)"
         try:
             model.load_state_dict(ck["model"])
             opt.load_state_dict(ck["optimizer"])
             start_epoch, step, log, spent = int(ck["epoch"]), int(ck["step"]), list(ck["log"]), float(ck["seconds"])
         except (KeyError, TypeError, RuntimeError, ValueError) as exc:
-            raise input_error(f"{what} ({type(exc).__name__}: {exc})") from None
+            raise input_error(f"{_not_a_checkpoint(last)} ({type(exc).__name__}: {exc})") from None
     log_path = out_p / "log.jsonl"
     t0 = time.perf_counter() - spent
     finished = True
