@@ -32,52 +32,59 @@ field). Request bodies are JSON objects sent as ``application/json``; their fiel
 ``"3"`` is refused, not read as 1 or 3), and a text must be valid Unicode (an unpaired ``\\ud800`` escape is
 refused). Nothing outside the folder is read or written (:mod:`mmusv.editor.files`); the page loads nothing from
 elsewhere (a Content-Security-Policy says so to the browser).
+
+This module assembles the application and its endpoints; the request bodies are :mod:`mmusv.editor.bodies`, the HTTP
+plumbing (errors and their statuses, the body limit, the messages for unreadable requests) :mod:`mmusv.editor.web`,
+opening a file's text as the page's document :mod:`mmusv.editor.opening`.
 """
 
 from __future__ import annotations
 
 import contextlib
-import json
-import math
-import re
 import sys
 import threading
 import traceback
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Annotated, Any, Literal, get_args
+from typing import Annotated, Any
 
 from fastapi import FastAPI, Request
 from fastapi import Path as PathParam
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import FileResponse, JSONResponse, Response
 from fastapi.staticfiles import StaticFiles
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic import ValidationError
 from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.middleware.trustedhost import TrustedHostMiddleware
-from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from mmusv import yamlio
-from mmusv.config import EnvironmentConfig, MapConfig, Scenario, VesselConfig, load_scenario, validation_problems
-from mmusv.editor.comments import Comment, comment_problem, moved_note, read_comments
+from mmusv.config import EnvironmentConfig, MapConfig, Scenario, VesselConfig, validation_problems
+from mmusv.editor.bodies import DocumentBody, FrameBody, MapBody, PreviewBody, RunBody, SaveBody
+from mmusv.editor.carry import value_count
+from mmusv.editor.comments import Comment, moved_note, read_comments
 from mmusv.editor.document import leading_comment, scenario_file, to_document
 from mmusv.editor.evaluate import MAX_BULK_FRAMES, evaluate, poses_at, validate
-from mmusv.editor.files import ChangedInFolder, FileExistsInFolder, ScenarioFolder, check_name, etag
-from mmusv.editor.jobs import Jobs, RunGoingOn
+from mmusv.editor.files import ScenarioFolder, check_name, etag
+from mmusv.editor.jobs import Jobs
 from mmusv.editor.maplayers import map_layers
-from mmusv.errors import ConfigError, InputError, MmusvError, NotFoundError
-from mmusv.yamlio import parse_yaml
+from mmusv.editor.opening import load_document
+from mmusv.editor.web import (
+    CSP,
+    MAX_BODY_BYTES,
+    BodyLimit,
+    choices,
+    error,
+    if_match,
+    request_error,
+    status_of,
+    unreadable_body,
+)
+from mmusv.errors import ConfigError, MmusvError, NotFoundError
 
 __all__ = ["MAX_BODY_BYTES", "STATIC_DIR", "InitialScenario", "comments_json", "create_app"]
 
 STATIC_DIR = Path(__file__).parent / "static"
 """The page's files (HTML, CSS, JavaScript modules), shipped in the package."""
-MAX_BODY_BYTES = 16 * 1024 * 1024
-"""Largest request body (16 MiB); larger requests get 413."""
-_CSP = (
-    "default-src 'self'; img-src 'self' data: blob:; style-src 'self'; script-src 'self'; connect-src 'self'; "
-    "object-src 'none'; base-uri 'none'; frame-ancestors 'none'"
-)
 
 
 @dataclass(frozen=True)
@@ -100,284 +107,8 @@ def comments_json(text: str) -> list[dict[str, Any]]:
     return [c.as_json() for c in read_comments(text)]
 
 
-_NOT_YAML = re.compile("[^\x09\x0a\x0d\x20-\x7e\x85\xa0-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
-"""A character a YAML file may not hold anywhere, comments included (control characters but tab and line breaks,
-unpaired surrogates, U+FFFE/U+FFFF): a file with one does not load again."""
-_SURROGATE = re.compile("[\ud800-\udfff]")
 _JOB_ID = r"^(0|[1-9][0-9]{0,17})$"
 """A run id as the API gives it: a whole number in decimal digits (no sign, spaces, ``_`` or leading zeros)."""
-
-
-def _path(parts: list[str | int]) -> str:
-    """``vessels[0].route`` from the keys and indices ``parts``."""
-    out = ""
-    for p in parts:
-        out += f"[{p}]" if isinstance(p, int) else (f".{p}" if out else p)
-    return out
-
-
-def _unjsonable(value: Any, root: str) -> str | None:
-    """Where ``value`` (plain JSON-like data) holds what JSON cannot carry back to the page, and what it is:
-    a number that is not finite (``.nan``, ``.inf`` in YAML, ``NaN`` in lenient JSON) or a text with an unpaired
-    UTF-16 surrogate (``"\\ud800"``); None when there is nothing."""
-    stack: list[tuple[Any, list[str | int]]] = [(value, [root] if root else [])]
-    while stack:
-        v, parts = stack.pop()
-        if isinstance(v, float) and not math.isfinite(v):
-            return f"{_path(parts) or 'the value'} = {v}: not a finite number"
-        if isinstance(v, str) and _SURROGATE.search(v) is not None:
-            return f"{_path(parts) or 'the value'} = {v!r}: an unpaired UTF-16 surrogate is not text"
-        if isinstance(v, dict):
-            for k, item in v.items():
-                if isinstance(k, str) and _SURROGATE.search(k) is not None:
-                    return (
-                        f"{_path(parts) or 'the mapping'} has the key {k!r}: an unpaired UTF-16 surrogate is not text"
-                    )
-                stack.append((item, [*parts, str(k)]))
-        elif isinstance(v, list):
-            stack.extend((item, [*parts, i]) for i, item in enumerate(v))
-    return None
-
-
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", strict=True)
-
-
-def _jsonable(value: dict[str, Any], name: str) -> dict[str, Any]:
-    """``value`` (a request field ``name``) when JSON can carry all of it back (:func:`_unjsonable`); else the
-    ``ValueError`` pydantic reports as a 422 naming the path."""
-    problem = _unjsonable(value, name)
-    if problem is not None:
-        raise ValueError(problem)
-    return value
-
-
-class DocumentBody(_Strict):
-    """A scenario document (the JSON form of a scenario file)."""
-
-    document: dict[str, Any]
-
-    @field_validator("document")
-    @classmethod
-    def _text_is_unicode(cls, document: dict[str, Any]) -> dict[str, Any]:
-        return _jsonable(document, "document")
-
-
-class CommentBody(_Strict):
-    """A comment of the file and its anchor (:class:`mmusv.editor.comments.Comment`)."""
-
-    path: list[str | int] = Field(max_length=64)
-    at: Literal["before", "end"]
-    text: str = Field(max_length=20_000)
-
-    @field_validator("text")
-    @classmethod
-    def _one_comment_line(cls, text: str) -> str:
-        problem = comment_problem(text)
-        if problem is not None:
-            raise ValueError(problem)
-        return text
-
-    @field_validator("path")
-    @classmethod
-    def _path_is_text(cls, path: list[str | int]) -> list[str | int]:
-        _jsonable({"path": path}, "comments")
-        return path
-
-
-class SaveBody(DocumentBody):
-    comment: str = Field(default="", max_length=20_000)
-    comments: list[CommentBody] | None = None
-    overwrite: bool = False
-
-    @field_validator("comment")
-    @classmethod
-    def _comment_fits_yaml(cls, comment: str) -> str:
-        bad = _NOT_YAML.search(comment)
-        if bad is not None:
-            raise ValueError(
-                f"character U+{ord(bad.group()):04X} at position {bad.start()} cannot be written into a YAML file "
-                "(the file would not load again): control characters other than tab and line breaks are not allowed"
-            )
-        return comment
-
-
-class FrameBody(DocumentBody):
-    frame: int = Field(ge=0)
-
-
-class PreviewBody(FrameBody):
-    agent: str | None = Field(default=None, max_length=64)
-
-
-class MapBody(_Strict):
-    map: dict[str, Any]
-
-    @field_validator("map")
-    @classmethod
-    def _text_is_unicode(cls, value: dict[str, Any]) -> dict[str, Any]:
-        return _jsonable(value, "map")
-
-
-class RunBody(_Strict):
-    name: str = Field(max_length=1000)
-    frames: int | None = Field(default=None, ge=1)
-
-
-def _error(status: int, message: str) -> JSONResponse:
-    return JSONResponse({"error": message}, status_code=status)
-
-
-def _status(exc: MmusvError) -> int:
-    if isinstance(exc, (FileExistsInFolder, RunGoingOn)):
-        return 409
-    if isinstance(exc, ChangedInFolder):
-        return 412
-    if isinstance(exc, NotFoundError):
-        return 404
-    if isinstance(exc, ConfigError):
-        return 422
-    if isinstance(exc, InputError):
-        return 400
-    return 500
-
-
-class _BodyLimit:
-    """Refuses request bodies over ``limit`` bytes with 413, whether or not they say their length up front: the body
-    is read here (at most ``limit`` bytes are kept) before the app sees the request, so a body streamed without a
-    Content-Length (chunked) gets the same 413, not an error from whatever reads it."""
-
-    def __init__(self, app: ASGIApp, limit: int) -> None:
-        self.app, self.limit = app, limit
-
-    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
-        if scope["type"] != "http":
-            await self.app(scope, receive, send)
-            return
-        too_large = f"the request body is larger than {self.limit} bytes, the most the editor takes"
-        length = dict(scope.get("headers") or []).get(b"content-length")
-        if length is not None and not length.isdigit():
-            shown = length.decode("latin-1")[:40]
-            await _error(400, f"the Content-Length header {shown!r} is not a number of bytes")(scope, receive, send)
-            return
-        if length is not None and int(length) > self.limit:
-            await _error(413, too_large)(scope, receive, send)
-            return
-        chunks: list[bytes] = []
-        seen = 0
-        while True:
-            msg = await receive()
-            if msg["type"] != "http.request":  # the client went away
-                return
-            chunk = msg.get("body", b"")
-            seen += len(chunk)
-            if seen > self.limit:
-                await _error(413, too_large)(scope, receive, send)
-                return
-            chunks.append(chunk)
-            if not msg.get("more_body", False):
-                break
-        body: list[Message] = [{"type": "http.request", "body": b"".join(chunks), "more_body": False}]
-
-        async def replay() -> Message:
-            return body.pop() if body else await receive()
-
-        await self.app(scope, replay, send)
-
-
-def _choices(model: type[BaseModel], name: str) -> list[str]:
-    return list(get_args(model.model_fields[name].annotation))
-
-
-def _request_error(exc: RequestValidationError, content_type: str | None) -> str:
-    parts = []
-    for e in exc.errors():
-        loc = ".".join(str(p) for p in e.get("loc", ()) if p != "body") or "body"
-        if e.get("type") == "json_invalid":
-            parts.append(f"the request body is not valid JSON ({e.get('ctx', {}).get('error', 'unreadable')})")
-        elif loc == "body" and not _is_json(content_type):
-            got = f"Content-Type {content_type!r}" if content_type else "no Content-Type"
-            parts.append(f"body: the request body must be a JSON object sent as application/json (got {got})")
-        else:
-            parts.append(f"{loc}: {e.get('msg', 'invalid')}")
-    return "malformed request: " + "; ".join(parts)
-
-
-def _is_json(content_type: str | None) -> bool:
-    kind = (content_type or "").split(";", 1)[0].strip().lower()
-    return kind == "application/json" or (kind.startswith("application/") and kind.endswith("+json"))
-
-
-def _unreadable_body(cause: BaseException | None) -> str:
-    """Why FastAPI could not read a JSON body (it says only "There was an error parsing the body")."""
-    if isinstance(cause, RecursionError):
-        return "the request body is not valid JSON: nested too deeply"
-    if isinstance(cause, UnicodeDecodeError):
-        bad = cause.object[cause.start : cause.start + 1].hex()
-        return f"the request body is not valid JSON: not UTF-8 text (byte 0x{bad} at offset {cause.start})"
-    if isinstance(cause, ValueError) and "digits" in str(cause):
-        return "the request body is not valid JSON: an integer of more than 4,300 digits"
-    return "the request body cannot be read" + (f" ({type(cause).__name__})" if cause is not None else "")
-
-
-def _if_match(header: str | None) -> list[str] | None:
-    """The ETags of an ``If-Match`` header (quotes and ``W/`` dropped; ``*`` kept), or None without one."""
-    if header is None:
-        return None
-    return [t.strip().removeprefix("W/").strip('"') for t in header.split(",") if t.strip()]
-
-
-def _value_count(document: Any, limit: int) -> int:
-    """How many values (mappings, lists, keys and scalars) ``document`` holds, as :mod:`mmusv.yamlio` counts them
-    when the file is read again; stops counting above ``limit``."""
-    count, stack = 0, [document]
-    while stack and count <= limit:
-        v = stack.pop()
-        count += 1
-        if isinstance(v, dict):
-            stack.extend(v.keys())
-            stack.extend(v.values())
-        elif isinstance(v, list):
-            stack.extend(v)
-    return count
-
-
-def _load_document(text: str, where: str) -> tuple[dict[str, Any], bool]:
-    """``(document, valid)`` of a scenario file's text: the editor's document of a valid scenario, else the raw
-    mapping (the page then lists what is wrong); :class:`ConfigError` when it is not a YAML mapping."""
-    data = parse_yaml(text, where)
-    if not isinstance(data, dict):
-        raise ConfigError(f"{where}: a scenario must be a YAML mapping with at least `vessels:`")
-    try:
-        return to_document(load_scenario(data)), True
-    except MmusvError as exc:
-        if not _editable(data):  # the page could not show it: say what is wrong instead
-            raise ConfigError(
-                f"{exc}; the editor opens files whose vessels and routes are lists (fix it as text)"
-            ) from None
-        raw = json.loads(json.dumps(data, default=str))
-        problem = _unjsonable(raw, "")
-        if problem is not None:  # JSON cannot carry it to the page
-            raise ConfigError(f"{where}: {problem}; the editor cannot show this value (fix it as text)") from None
-        return raw, False
-
-
-def _editable(data: dict[str, Any]) -> bool:
-    """Whether an invalid scenario mapping still has the shape the page draws: sections are mappings, ``vessels``
-    a list of mappings whose ``route`` is a list of ``[x, y]`` numbers."""
-    if any(k in data and not isinstance(data[k], dict) for k in ("map", "environment", "acquisition", "rigs")):
-        return False
-    vessels = data.get("vessels", [])
-    if not isinstance(vessels, list) or not all(isinstance(v, dict) for v in vessels):
-        return False
-    for v in vessels:
-        route = v.get("route", [])
-        if not isinstance(route, list):
-            return False
-        for p in route:
-            if not (isinstance(p, list) and len(p) == 2 and all(isinstance(c, (int, float)) for c in p)):
-                return False
-    return True
 
 
 def create_app(
@@ -397,27 +128,27 @@ def create_app(
 
     @app.exception_handler(MmusvError)
     async def _mmusv_error(request: Request, exc: MmusvError) -> JSONResponse:
-        return _error(_status(exc), str(exc))
+        return error(status_of(exc), str(exc))
 
     @app.exception_handler(RequestValidationError)
     async def _bad_request(request: Request, exc: RequestValidationError) -> JSONResponse:
-        return _error(422, _request_error(exc, request.headers.get("content-type")))
+        return error(422, request_error(exc, request.headers.get("content-type")))
 
     @app.exception_handler(StarletteHTTPException)
     async def _http_error(request: Request, exc: StarletteHTTPException) -> JSONResponse:
         if exc.status_code == 400 and exc.detail == "There was an error parsing the body":  # FastAPI's words
-            return _error(400, _unreadable_body(exc.__cause__))
-        return _error(exc.status_code, str(exc.detail))
+            return error(400, unreadable_body(exc.__cause__))
+        return error(exc.status_code, str(exc.detail))
 
     @app.exception_handler(Exception)
     async def _internal(request: Request, exc: Exception) -> JSONResponse:
         traceback.print_exception(exc, file=sys.stderr)  # for the person running the server, not the client
-        return _error(500, f"internal error ({type(exc).__name__}); the server's console has the details")
+        return error(500, f"internal error ({type(exc).__name__}); the server's console has the details")
 
     @app.middleware("http")
     async def _headers(request: Request, call_next: Any) -> Response:
         response: Response = await call_next(request)
-        response.headers["Content-Security-Policy"] = _CSP
+        response.headers["Content-Security-Policy"] = CSP
         response.headers["X-Content-Type-Options"] = "nosniff"
         response.headers["Cache-Control"] = "no-store"
         return response
@@ -439,15 +170,15 @@ def create_app(
             "folder": str(store.root),
             "initial": None if initial is None else initial.__dict__,
             "choices": {
-                "map_type": _choices(MapConfig, "type"),
-                "weather": _choices(EnvironmentConfig, "weather"),
+                "map_type": choices(MapConfig, "type"),
+                "weather": choices(EnvironmentConfig, "weather"),
                 "wave": [{"name": k, "height_m": v} for k, v in WAVE_PRESETS.items()],
                 "wave_height_m": [0.0, MAX_WAVE_HEIGHT_M],  # a custom wave's height: lowest, highest
-                "motion": _choices(EnvironmentConfig, "motion"),
-                "role": _choices(VesselConfig, "role"),
-                "end": _choices(VesselConfig, "end"),
+                "motion": choices(EnvironmentConfig, "motion"),
+                "role": choices(VesselConfig, "role"),
+                "end": choices(VesselConfig, "end"),
                 "rig_preset": sorted(RIG_PRESETS),
-                "camera_quality": _choices(CameraConfig, "quality"),
+                "camera_quality": choices(CameraConfig, "quality"),
             },
             "limits": {"bulk_frames": MAX_BULK_FRAMES, "body_bytes": MAX_BODY_BYTES},
         }
@@ -503,7 +234,7 @@ def create_app(
         if stem not in files:
             raise NotFoundError(f"no bundled scenario {name!r}; bundled: {', '.join(sorted(files))}")
         text = files[stem].read_text(encoding="utf-8")
-        doc, valid = _load_document(text, f"bundled {files[stem].name}")
+        doc, valid = load_document(text, f"bundled {files[stem].name}")
         return {
             "name": files[stem].name,
             "document": doc,
@@ -526,7 +257,7 @@ def create_app(
         name = _sent_name(request, name)
         got = store.read_text(name)  # the text and the ETag of the same bytes, read once
         text, tag = got.text, got.etag
-        doc, valid = _load_document(text, name)
+        doc, valid = load_document(text, name)
         return JSONResponse(
             {
                 "name": name,
@@ -548,7 +279,7 @@ def create_app(
                 f"{name}: not saved, the scenario does not validate: " + "; ".join(e["message"] for e in errors)
             )
         limit = yamlio.MAX_YAML_VALUES
-        if _value_count(to_document(scenario), limit) > limit:  # the file would not load again
+        if value_count(to_document(scenario), limit) > limit:  # the file would not load again
             raise ConfigError(
                 f"{name}: not saved, the scenario holds more than {limit:,} values (a waypoint counts three: its list "
                 "and two numbers), the most a scenario file may hold (mmusv.yamlio.MAX_YAML_VALUES), so the file "
@@ -563,7 +294,7 @@ def create_app(
                     comments = read_comments(store.read_text(name).text)
         text, moved = scenario_file(scenario, comment=body.comment, comments=comments)
         path = store.write_text(
-            name, text, overwrite=body.overwrite, if_match=_if_match(request.headers.get("if-match"))
+            name, text, overwrite=body.overwrite, if_match=if_match(request.headers.get("if-match"))
         )
         tag = etag(text.encode("utf-8"))
         answer = {
@@ -643,12 +374,7 @@ def create_app(
     def unknown(rest: str) -> Response:
         raise NotFoundError(f"no API endpoint /api/{rest}")
 
-    app.add_middleware(_BodyLimitMiddleware)
+    app.add_middleware(BodyLimit)
     if allowed_hosts is not None:
         app.add_middleware(TrustedHostMiddleware, allowed_hosts=allowed_hosts)
     return app
-
-
-class _BodyLimitMiddleware(_BodyLimit):
-    def __init__(self, app: ASGIApp) -> None:
-        super().__init__(app, MAX_BODY_BYTES)

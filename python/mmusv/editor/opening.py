@@ -1,0 +1,55 @@
+"""A scenario file's text opened in the editor: the page's document of a valid scenario (:func:`load_document`),
+else the raw mapping, so that the page can list what is wrong, as long as the page can draw it (vessels and routes
+as lists) and JSON can carry it.
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+from mmusv.config import load_scenario
+from mmusv.editor.carry import unjsonable
+from mmusv.editor.document import to_document
+from mmusv.errors import ConfigError, MmusvError
+from mmusv.yamlio import parse_yaml
+
+__all__ = ["load_document"]
+
+
+def load_document(text: str, where: str) -> tuple[dict[str, Any], bool]:
+    """``(document, valid)`` of a scenario file's text: the editor's document of a valid scenario, else the raw
+    mapping (the page then lists what is wrong); :class:`ConfigError` when it is not a YAML mapping."""
+    data = parse_yaml(text, where)
+    if not isinstance(data, dict):
+        raise ConfigError(f"{where}: a scenario must be a YAML mapping with at least `vessels:`")
+    try:
+        return to_document(load_scenario(data)), True
+    except MmusvError as exc:
+        if not _editable(data):  # the page could not show it: say what is wrong instead
+            raise ConfigError(
+                f"{exc}; the editor opens files whose vessels and routes are lists (fix it as text)"
+            ) from None
+        raw = json.loads(json.dumps(data, default=str))
+        problem = unjsonable(raw, "")
+        if problem is not None:  # JSON cannot carry it to the page
+            raise ConfigError(f"{where}: {problem}; the editor cannot show this value (fix it as text)") from None
+        return raw, False
+
+
+def _editable(data: dict[str, Any]) -> bool:
+    """Whether an invalid scenario mapping still has the shape the page draws: sections are mappings, ``vessels``
+    a list of mappings whose ``route`` is a list of ``[x, y]`` numbers."""
+    if any(k in data and not isinstance(data[k], dict) for k in ("map", "environment", "acquisition", "rigs")):
+        return False
+    vessels = data.get("vessels", [])
+    if not isinstance(vessels, list) or not all(isinstance(v, dict) for v in vessels):
+        return False
+    for v in vessels:
+        route = v.get("route", [])
+        if not isinstance(route, list):
+            return False
+        for p in route:
+            if not (isinstance(p, list) and len(p) == 2 and all(isinstance(c, (int, float)) for c in p)):
+                return False
+    return True
