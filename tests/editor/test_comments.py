@@ -83,6 +83,7 @@ def _line_of(text: str, start: str) -> int:
 def test_comments_are_read_with_their_key_paths_and_vessel_ids() -> None:
     got = [(c.path, c.at, c.text) for c in read_comments(HAND_WRITTEN)]
     assert got == [
+        (("name",), "before", ""),  # the blank line between the leading block and the first key's comment
         (("name",), "before", "# about the name"),
         (("name",), "end", "# the name"),
         (("map",), "end", "# the harbour"),
@@ -145,6 +146,74 @@ def test_an_unchanged_save_keeps_every_comment_at_its_anchor_and_gives_the_same_
     assert load_scenario(parse_yaml(out, "out")) == load_scenario(parse_yaml(HAND_WRITTEN, "in"))
     assert _save(out) == (out, [])
     assert _save(HAND_WRITTEN)[0] == out
+
+
+SPACED = """\
+# Sections set apart by blank lines.
+
+name: spaced
+seed: 7
+
+# the map
+map: {type: port, seed: 3}
+environment:
+  time_of_day: "16:30"
+
+  weather: clear
+acquisition: {frequency_hz: 5, frames: 20}
+
+rigs:
+  usv_standard: {}
+
+vessels:
+  - {id: usv_1, role: usv, asset: usv_wamv, rig: usv_standard, speed_mps: 2.5,
+
+     route: [[-170, -110], [-170, -30]]}
+
+  # the ferry
+  - {id: ferry, role: target, asset: ropax_ferry_90m, speed_mps: 4.0, route: [[-40, 0], [-110, -90]]}
+
+# the end
+
+
+"""
+
+
+def test_blank_lines_that_set_entries_apart_are_kept_and_read_as_empty_comments() -> None:
+    got = [(c.path, c.at, c.text) for c in read_comments(SPACED)]
+    assert got == [
+        (("name",), "before", ""),
+        (("map",), "before", ""),
+        (("map",), "before", "# the map"),
+        (("rigs",), "before", ""),
+        (("vessels",), "before", ""),
+        (("vessels", "ferry"), "before", ""),
+        (("vessels", "ferry"), "before", "# the ferry"),
+        ((), "before", ""),
+        ((), "before", "# the end"),
+    ]  # not the ones inside `environment` and the first vessel's flow line, nor the two after the last line
+    out, moved = _save(SPACED)
+    assert moved == []
+    lines = out.splitlines()
+    for key in ("name:", "rigs:", "vessels:"):
+        assert lines[_line_of(out, key) - 1] == "", key
+    assert lines[_line_of(out, "map:") - 2 : _line_of(out, "map:")] == ["", "# the map"]
+    ferry = _line_of(out, "- {id: ferry")
+    assert lines[ferry - 2 : ferry] == ["", "# the ferry"]
+    assert out.endswith("\n\n# the end\n")
+    assert "\n\n\n" not in out and lines[_line_of(out, "name:") - 2] == "# Sections set apart by blank lines."
+    assert leading_comment(out) == "Sections set apart by blank lines."
+    # the same bytes again, and the same scenario
+    assert _save(out) == (out, [])
+    assert load_scenario(parse_yaml(out, "out")) == load_scenario(parse_yaml(SPACED, "in"))
+
+
+def test_a_blank_line_inside_a_text_is_not_layout_and_a_removed_vessels_blank_line_goes_with_it() -> None:
+    text = "name: |\n  two\n\n  paragraphs\nseed: 7\n\nvessels:\n\n  - {id: a}\n"
+    assert [(c.path, c.text) for c in read_comments(text)] == [(("vessels",), ""), (("vessels", "a"), "")]
+    body = "name: x\nvessels:\n- {id: b}\n"
+    out, moved = place_comments(body, [Comment(("vessels", "a"), "before", ""), Comment(("vessels",), "before", "")])
+    assert (out, moved) == ("name: x\n\nvessels:\n- {id: b}\n", [])
 
 
 def test_a_vessels_comments_follow_it_when_the_list_is_reordered_and_a_waypoint_moves() -> None:
@@ -260,6 +329,17 @@ def test_api_opens_a_file_with_its_comments_and_a_save_writes_them_back(client: 
     assert "[-160, -110]" in saved and "note" not in w.json()
     assert w.json()["comments"] == client.get("/api/files/hand.yaml").json()["comments"]
     assert w.json()["etag"] == client.get("/api/files/hand.yaml").json()["etag"]
+
+
+def test_api_carries_blank_lines_as_empty_comments_and_a_save_keeps_them(client: TestClient, folder: Path) -> None:
+    (folder / "spaced.yaml").write_text(SPACED, encoding="utf-8")
+    got = client.get("/api/files/spaced.yaml").json()
+    assert {"path": ["vessels", "ferry"], "at": "before", "text": ""} in got["comments"]
+    body = {"document": _document_moved(got["document"]), "comment": got["comment"], "comments": got["comments"]}
+    assert client.put("/api/files/spaced.yaml", json={**body, "overwrite": True}).status_code == 200
+    saved = (folder / "spaced.yaml").read_text(encoding="utf-8")
+    assert saved == _save(SPACED, lambda d: d["vessels"][0]["route"][0].__setitem__(0, -160))[0]
+    assert "\n\nrigs:" in saved and "\n\n# the ferry\n" in saved
 
 
 def test_api_save_without_comments_keeps_those_of_the_file_it_replaces(client: TestClient, folder: Path) -> None:

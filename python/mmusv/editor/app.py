@@ -9,7 +9,8 @@ Endpoints (JSON in and out unless said otherwise; errors are ``{"error": "..."}`
 ``GET /api/bundled``      the bundled scenarios; ``GET /api/bundled/{name}`` one of them as a document
 ``GET /api/files``        the scenario files in the folder; ``GET /api/files/{name}`` one as a document, with
                           its ``etag`` (also the ``ETag`` header); both documents come with the file's leading
-                          ``comment`` and its other ``comments`` (``[{path, at, text}]``, :mod:`.comments`)
+                          ``comment`` and its other ``comments`` (``[{path, at, text}]``, :mod:`.comments`; a
+                          blank line that sets an entry apart is a comment whose ``text`` is empty)
 ``PUT /api/files/{name}`` saves ``{document, comment, comments, overwrite}`` as YAML into the folder (409 if it
                           exists); with ``If-Match: ETAG`` only if the file is still that version (412 if it
                           changed; a list of ETags and ``*``, any version, are understood). ``comments`` left

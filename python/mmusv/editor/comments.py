@@ -21,9 +21,14 @@ written out in full moves above the one flow line that now holds it), in the ord
 line. A comment whose home is still there but whose own key is not (``environment.rain`` set back to its default)
 stays with that home. A comment whose home is gone (a deleted or renamed vessel or rig) is kept, not dropped: it is
 written at the end of the file under a line ``# [removed from the scenario: vessel ferry]`` and returned, so the
-save can say so; later saves keep it there as one of the file's last comments. Blank lines between comments are not
-kept. The same text and comments give the same bytes, and saving a file written this way again gives it back byte
-for byte.
+save can say so; later saves keep it there as one of the file's last comments.
+
+**Blank lines.** A blank line that sets off an entry the editor writes on a line of its own (a top-level key, a rig,
+a vessel, with the comments above it) is kept as an empty comment (``text == ""``) anchored before that entry, and
+one before the comments at the end of the file likewise; blank lines inside a block the editor writes as one flow
+line, inside a text (a ``|`` block) and after the file's last line are not (the flow line has no place for them).
+So a file whose sections are set apart by blank lines keeps them. The same text and comments give the same bytes,
+and saving a file written this way again gives it back byte for byte.
 """
 
 from __future__ import annotations
@@ -51,8 +56,9 @@ _NOT_IN_COMMENT = re.compile("[^\x09\x20-\x7e\xa0-\u2027\u202a-\ud7ff\ue000-\uff
 
 @dataclass(frozen=True)
 class Comment:
-    """One comment: ``text`` as written from its ``#`` (trailing spaces dropped), its anchor ``path`` (``()``: the
-    end of the file) and where it stood, ``"before"`` the entry (on a line of its own) or at the ``"end"`` of it."""
+    """One comment: ``text`` as written from its ``#`` (trailing spaces dropped; ``""`` for a blank line), its anchor
+    ``path`` (``()``: the end of the file) and where it stood, ``"before"`` the entry (on a line of its own) or at the
+    ``"end"`` of it."""
 
     path: Path
     at: Literal["before", "end"]
@@ -63,7 +69,9 @@ class Comment:
 
 
 def comment_problem(text: str) -> str | None:
-    """Why ``text`` cannot be written as one comment line (None when it can)."""
+    """Why ``text`` cannot be written as one comment line, or an empty one as a blank line (None when it can)."""
+    if text == "":
+        return None
     if not text.startswith("#"):
         return f"a comment starts with '#': {text[:40]!r}"
     bad = _NOT_IN_COMMENT.search(text)
@@ -175,7 +183,7 @@ def read_comments(text: str) -> list[Comment]:
     first = 0
     while first < len(lines) and lines[first][1].startswith("#"):  # the leading block (leading_comment's)
         first += 1
-    if not any("#" in line for _, line in lines[first:]):
+    if not any("#" in line or not line.strip() for _, line in lines[first:]):
         return []
     try:
         anchors, spans = _compose(text)
@@ -196,6 +204,8 @@ def read_comments(text: str) -> list[Comment]:
             content.append(number)
         if j is not None and number >= first:
             found.append((number, j, line[j:].rstrip(), not head.strip()))
+        elif not line.strip() and number >= first and not _in_span(spans, offset):  # a blank line (not in a text)
+            found.append((number, 0, "", True))
     out: list[Comment] = []
     for number, _, body, own in found:
         anchor: _Anchor | None = None
@@ -217,7 +227,11 @@ def read_comments(text: str) -> list[Comment]:
         elif nxt is not None:  # a line that continues an entry (a wrapped flow value): that entry
             i = bisect.bisect_left(starts, nxt) - 1
             anchor = anchors[i] if i >= 0 else None
-        out.append(Comment(anchor.path if anchor is not None else (), "before", body))
+        path = anchor.path if anchor is not None else ()
+        if body or _home(path) == path:  # a blank line only before an entry with a line of its own
+            out.append(Comment(path, "before", body))
+    while out and out[-1] == Comment((), "before", ""):  # blank lines after the file's last line
+        out.pop()
     return out
 
 
@@ -277,7 +291,8 @@ def place_comments(body: str, comments: Iterable[Comment]) -> tuple[str, list[Co
         if not home:
             trailing.append(c.text)
         elif home not in homes:
-            moved.setdefault(home, []).append(c)
+            if c.text:  # (a removed entry's blank line goes with it)
+                moved.setdefault(home, []).append(c)
         elif c.at == "end" and c.path == home:
             after.setdefault(homes[home].eol, []).append(c.text)
         else:
@@ -285,7 +300,7 @@ def place_comments(body: str, comments: Iterable[Comment]) -> tuple[str, list[Co
     out: list[str] = []
     for number, line in enumerate(lines):
         indent = line[: len(line) - len(line.lstrip(" "))]
-        out.extend(indent + text for text in above.get(number, []))
+        out.extend(indent + text if text else "" for text in above.get(number, []))
         out.append("  ".join([line, *after.get(number, [])]))
     out.extend(trailing)
     for home, cs in moved.items():
