@@ -1,6 +1,7 @@
 """The page carries a file's comments through an edit and a save (Selenium, headless Chromium): a bundled scenario's
 comment above a vessel is written back above it, and one of a vessel deleted in the page is kept at the end of the file
-with a word in the status line."""
+with a word in the status line; a vessel renamed in the page keeps its comments, and undoing the rename takes them
+back."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ from mmusv.editor.comments import read_comments
 from selenium.webdriver.common.by import By
 from selenium.webdriver.support.select import Select
 from test_browser import LiveServer, _wait, open_editor, settled
-from test_browser_round import js_errors
+from test_browser_round import js_errors, type_into
 from test_browser_round2 import save_as
 
 
@@ -43,4 +44,36 @@ def test_the_page_saves_a_bundled_scenario_with_its_comments(browser: Any, live_
     saved = (Path(live_server.folder) / "occlusion.yaml").read_text(encoding="utf-8")
     assert saved.splitlines()[-3] == "# [removed from the scenario: vessel trawler]"
     assert browser.execute_script("return window.mmusvEditor.state.comments.at(-3).text") == saved.splitlines()[-3]
+    assert js_errors(browser) == []
+
+
+def test_a_renamed_vessels_comments_follow_it_and_undo_takes_them_back(browser: Any, live_server: LiveServer) -> None:
+    open_editor(browser, live_server)
+    js_errors(browser)
+    Select(browser.find_element(By.ID, "open")).select_by_value("bundled:island_occlusion")
+    _wait(browser, "return window.mmusvEditor.state.fileName === 'island_occlusion.yaml'", "the bundled scenario")
+    settled(browser)
+    original = read_comments((bundled_dir() / "island_occlusion.yaml").read_text(encoding="utf-8"))
+    trawler = [c for c in original if c.path[:2] == ("vessels", "trawler")]
+    assert len(trawler) == 2
+    browser.find_element(By.CSS_SELECTOR, '#fleet li[data-id="trawler"]').click()
+    type_into(browser, browser.find_element(By.ID, "v-id"), "trawler_2")
+    settled(browser)
+    save_as(browser, "renamed.yaml")
+    # Was: the two comments counted as those of a removed vessel, moved to the end of the file.
+    status = browser.find_element(By.ID, "status").text
+    assert "moved to the end" not in status, status
+    saved = (Path(live_server.folder) / "renamed.yaml").read_text(encoding="utf-8")
+    assert "removed from the scenario" not in saved
+    lines = saved.splitlines()
+    at = next(i for i, line in enumerate(lines) if line.startswith("- {id: trawler_2"))
+    assert lines[at - 2 : at] == [c.text for c in trawler]
+    # undo: the vessel and its comments are the trawler's again
+    browser.find_element(By.ID, "undo").click()
+    settled(browser)
+    assert browser.execute_script("return window.mmusvEditor.state.vessel('trawler') !== null")
+    browser.find_element(By.ID, "save").click()
+    _wait(browser, "return !window.mmusvEditor.state.dirty", "the save")
+    saved = (Path(live_server.folder) / "renamed.yaml").read_text(encoding="utf-8")
+    assert read_comments(saved) == original and "removed from the scenario" not in saved
     assert js_errors(browser) == []

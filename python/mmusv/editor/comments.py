@@ -19,7 +19,8 @@ top-level key). :func:`place_comments` writes a comment at the end of its home's
 entry's own line, and on a line of its own just above its home's line otherwise (a comment inside a vessel or block
 written out in full moves above the one flow line that now holds it), in the order of the file, indented as that
 line. A comment whose home is still there but whose own key is not (``environment.rain`` set back to its default)
-stays with that home. A comment whose home is gone (a deleted or renamed vessel or rig) is kept, not dropped: it is
+stays with that home. A comment whose home is gone (a deleted vessel or rig, or one renamed by a client that did not
+rename its comments' anchors with it, as the editor's page does) is kept, not dropped: it is
 written at the end of the file under a line ``# [removed from the scenario: vessel ferry]`` and returned, so the
 save can say so; later saves keep it there as one of the file's last comments.
 

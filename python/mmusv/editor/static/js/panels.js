@@ -383,9 +383,7 @@ export class Panels {
         return;
       }
       this.accept(ev.target);
-      this.editVessel((v) => {
-        v.id = id;
-      });
+      this.state.renameVessel(this.state.selected, id);
       this.state.select(id);
     });
     $("v-role").addEventListener("change", (ev) => this.editVessel((v, doc) => {

@@ -17,7 +17,8 @@ export class EditorState {
   constructor() {
     this.doc = null; // scenario document, as /api/evaluate and the YAML file know it
     this.comment = "";
-    this.comments = []; // the file's other comments with their anchors, sent back on save (the page does not edit them)
+    this.comments = []; // the file's other comments with their anchors, sent back on save (the page edits none; a
+    // renamed vessel's follow it)
     this.fileName = "";
     this.savedName = null; // the folder file this document was loaded from or saved to
     this.savedKey = null; // canonical text of the scenario (document and comment) last opened or saved
@@ -89,11 +90,23 @@ export class EditorState {
     this.changed();
   }
 
+  /** The document and the comments as one entry of the undo history (a renamed vessel's comments follow it, and
+   * undoing the rename takes them back). */
+  snapshot() {
+    return JSON.stringify({ doc: this.doc, comments: this.comments });
+  }
+
+  restore(entry) {
+    const { doc, comments } = JSON.parse(entry);
+    this.doc = doc;
+    this.comments = comments;
+  }
+
   /** Applies fn(doc) as one undoable edit. `live` edits (a drag in progress) push history once per gesture. */
   edit(fn, { gesture = null } = {}) {
     if (!this.doc) return;
     if (gesture === null || gesture !== this.lastGesture) {
-      this.undoStack.push(JSON.stringify(this.doc));
+      this.undoStack.push(this.snapshot());
       if (this.undoStack.length > HISTORY) this.undoStack.shift();
       this.redoStack = [];
     }
@@ -102,10 +115,23 @@ export class EditorState {
     this.changed();
   }
 
+  /** Renames vessel `from` to `to` as one undoable edit; the file's comments anchored at that vessel follow it (the
+   * server matches a vessel's comments by its id). */
+  renameVessel(from, to) {
+    const i = this.vesselIndex(from);
+    if (i < 0) return;
+    this.edit((doc) => {
+      doc.vessels[i].id = to;
+      this.comments = this.comments.map((c) =>
+        c.path.length >= 2 && c.path[0] === "vessels" && c.path[1] === from ? { ...c, path: ["vessels", to, ...c.path.slice(2)] } : c,
+      );
+    });
+  }
+
   undo() {
     if (!this.undoStack.length) return;
-    this.redoStack.push(JSON.stringify(this.doc));
-    this.doc = JSON.parse(this.undoStack.pop());
+    this.redoStack.push(this.snapshot());
+    this.restore(this.undoStack.pop());
     this.lastGesture = null;
     if (this.selected && !this.vessel()) this.selected = null;
     this.emit("jump");
@@ -114,8 +140,8 @@ export class EditorState {
 
   redo() {
     if (!this.redoStack.length) return;
-    this.undoStack.push(JSON.stringify(this.doc));
-    this.doc = JSON.parse(this.redoStack.pop());
+    this.undoStack.push(this.snapshot());
+    this.restore(this.redoStack.pop());
     this.lastGesture = null;
     if (this.selected && !this.vessel()) this.selected = null;
     this.emit("jump");
