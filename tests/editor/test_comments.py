@@ -214,6 +214,7 @@ def test_a_blank_line_inside_a_text_is_not_layout_and_a_removed_vessels_blank_li
     body = "name: x\nvessels:\n- {id: b}\n"
     out, moved = place_comments(body, [Comment(("vessels", "a"), "before", ""), Comment(("vessels",), "before", "")])
     assert (out, moved) == ("name: x\n\nvessels:\n- {id: b}\n", [])
+    assert place_comments(body, [Comment(("name",), "end", "")]) == (body, [])  # no trailing spaces
 
 
 def test_a_vessels_comments_follow_it_when_the_list_is_reordered_and_a_waypoint_moves() -> None:

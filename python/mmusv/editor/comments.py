@@ -289,6 +289,8 @@ def place_comments(body: str, comments: Iterable[Comment]) -> tuple[str, list[Co
     comments = [Comment(c.path, c.at, c.text.rstrip()) for c in comments]  # as they read back
     for c in comments:
         home = _home(c.path)
+        if not c.text and c.at == "end":  # a blank line is a line of its own: at a line's end, nothing to write
+            continue
         if not home:
             trailing.append(c.text)
         elif home not in homes:
