@@ -40,6 +40,7 @@ __all__ = [
     "CameraWriter",
     "ContrastBoxes",
     "ImageBox",
+    "ProjectedBoxes",
     "Sample",
     "Shared",
     "VisibleBoxes",
@@ -301,6 +302,16 @@ class CameraWriter(DatasetWriter):
                 f"all {self.visible_boxes} visible 2D boxes were left out by {filters}: no 2D box, every image is "
                 "background"
             )
+
+
+class ProjectedBoxes(CameraWriter):
+    """Base of a box format's writer whose ``box="projected"`` boxes (the recorded ones) need only the RGB images
+    (YOLO, MOT): the writer for that option itself; its ``box="visible"`` and ``min_contrast`` variants put
+    :class:`VisibleBoxes` or :class:`ContrastBoxes` first among their bases (:func:`box_writer` picks one)."""
+
+    kinds: ClassVar[tuple[str, ...]] = ("rgb",)
+    boxes: ClassVar[bool] = True
+    no_agent_reason: ClassVar[str] = "no camera recording rgb images"
 
 
 class VisibleBoxes(CameraWriter):

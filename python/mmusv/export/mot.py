@@ -41,14 +41,14 @@ import csv
 import io
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any
 
 from mmusv.classes import class_name
 from mmusv.errors import IoError
 from mmusv.export.camera import (
     CATEGORIES,
-    CameraWriter,
     ContrastBoxes,
+    ProjectedBoxes,
     Sample,
     Shared,
     VisibleBoxes,
@@ -163,14 +163,10 @@ class _MotShared(Shared):
         """The rows of ``tracks.csv``."""
 
 
-class MotWriter(CameraWriter):
+class MotWriter(ProjectedBoxes):
     """Writes MOTChallenge sequences (see the module docstring); this class with ``box="projected"``, which needs
     only RGB images, :class:`MotVisibleWriter` with ``box="visible"`` and :class:`MotContrastWriter` with
     ``box="projected"`` and ``min_contrast``."""
-
-    kinds: ClassVar[tuple[str, ...]] = ("rgb",)
-    boxes: ClassVar[bool] = True
-    no_agent_reason: ClassVar[str] = "no camera recording rgb images"
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)

@@ -242,7 +242,7 @@ class Ros2Writer(DatasetWriter):
         return out
 
     def _agent(self, frame: Frame, world: WorldFrame, a: AgentInfo) -> None:
-        from mmusv.recording import decode_image, decode_point_cloud
+        from mmusv.recording import decode_image
 
         m, t, msgs = self.m, frame.log_time_ns, frame.messages
         body = pose_matrices(world.poses[a.index])
@@ -256,18 +256,10 @@ class Ros2Writer(DatasetWriter):
             twist=self.T("geometry_msgs/msg/TwistWithCovariance")(twist=twist, covariance=np.zeros(36)),
         )
         self._put(odom_topic(a.id), "nav_msgs/msg/Odometry", odom, t)
-        lidar = msgs.get(topics.lidar(a.id))
-        if lidar is not None:
-            cloud = decode_point_cloud(lidar)
-            fields = ["x", "y", "z", "intensity", "ring", "azimuth", "class", "instance"]
-            pc = m.point_cloud(t, topics.lidar_frame(a.id), cloud, fields)
-            self._put(topics.lidar(a.id), "sensor_msgs/msg/PointCloud2", pc, t)
-        radar = msgs.get(topics.radar_returns(a.id))
-        if radar is not None:
-            cloud = decode_point_cloud(radar)
-            fields = ["x", "y", "z", "range", "azimuth", "elevation", "intensity", "instance"]
-            pc = m.point_cloud(t, topics.radar_frame(a.id), cloud, fields)
-            self._put(topics.radar_returns(a.id), "sensor_msgs/msg/PointCloud2", pc, t)
+        lidar_fields = ["x", "y", "z", "intensity", "ring", "azimuth", "class", "instance"]
+        self._point_cloud(frame, topics.lidar(a.id), topics.lidar_frame(a.id), lidar_fields)
+        radar_fields = ["x", "y", "z", "range", "azimuth", "elevation", "intensity", "instance"]
+        self._point_cloud(frame, topics.radar_returns(a.id), topics.radar_frame(a.id), radar_fields)
         ppi = msgs.get(topics.radar_ppi(a.id))
         if ppi is not None:
             img = decode_image(ppi)
@@ -286,6 +278,16 @@ class Ros2Writer(DatasetWriter):
     def T(self, name: str) -> Any:
         """The message class ``name``."""
         return self.ts.types[name]
+
+    def _point_cloud(self, frame: Frame, topic: str, frame_id: str, fields: list[str]) -> None:
+        """The recorded point cloud on ``topic`` (a LiDAR's, the radar's returns), if the frame holds one, as a
+        ``PointCloud2`` of ``fields`` on the same topic."""
+        from mmusv.recording import decode_point_cloud
+
+        msg = frame.messages.get(topic)
+        if msg is not None:
+            pc = self.m.point_cloud(frame.log_time_ns, frame_id, decode_point_cloud(msg), fields)
+            self._put(topic, "sensor_msgs/msg/PointCloud2", pc, frame.log_time_ns)
 
     def _camera(self, frame: Frame, frame_id: str, base: str) -> None:
         """The images of one camera (or the top view): RGB as PNG ``CompressedImage`` on ``<base>/rgb/compressed``

@@ -30,12 +30,12 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any
 
 from mmusv.export.camera import (
     CATEGORIES,
-    CameraWriter,
     ContrastBoxes,
+    ProjectedBoxes,
     Sample,
     Shared,
     VisibleBoxes,
@@ -69,13 +69,9 @@ class _YoloShared(Shared):
         self.splits: set[str] = set()
 
 
-class YoloWriter(CameraWriter):
+class YoloWriter(ProjectedBoxes):
     """Writes the Ultralytics layout (see the module docstring); this class with ``box="projected"``, which needs
     only RGB images, :class:`YoloVisibleWriter` with ``box="visible"``."""
-
-    kinds: ClassVar[tuple[str, ...]] = ("rgb",)
-    boxes: ClassVar[bool] = True
-    no_agent_reason: ClassVar[str] = "no camera recording rgb images"
 
     @classmethod
     def for_options(cls, options: Options) -> type[YoloWriter]:

@@ -31,7 +31,7 @@ from mmusv.errors import IoError
 from mmusv.recording.info import RecordingInfo, check_mcap, read_info
 from mmusv.recording.scan import Scan
 from mmusv.recording.stream import FrameStream
-from mmusv.recording.tables import TableWriter
+from mmusv.recording.tables import BOX_3D_VECTORS, WORLD_STATE_VECTORS, TableWriter, spread_columns
 from mmusv.text import counted
 
 __all__ = ["Recovered", "find_partial", "rebuild_tables", "recover"]
@@ -137,14 +137,7 @@ def _world_rows(w: Any, static: dict[str, bool]) -> dict[str, Any]:
         "semantic_class": w.classes.astype(np.int64),
         "instance_id": w.instance_ids.astype(np.int64),
     }
-    for block, keys in (
-        (w.poses, ("x", "y", "z", "roll", "pitch", "yaw")),
-        (w.velocities, ("vx", "vy", "vz")),
-        (w.box_centers, ("box_cx", "box_cy", "box_cz")),
-        (w.box_sizes, ("length", "beam", "height")),
-    ):
-        for j, k in enumerate(keys):
-            cols[k] = np.ascontiguousarray(block[:, j])
+    spread_columns(cols, (w.poses, w.velocities, w.box_centers, w.box_sizes), WORLD_STATE_VECTORS)
     return cols
 
 
@@ -178,12 +171,7 @@ def _box_rows(ann: Any, roles: dict[str, str], static: dict[str, bool]) -> tuple
         "static": np.array([stat(b.target_id) for b in lid], dtype=bool),
         "wave_occlusion": _waves(lid),
     }
-    for j, k in enumerate(("x", "y", "z")):
-        box3[k] = c[:, j]
-    for j, k in enumerate(("length", "beam", "height")):
-        box3[k] = s[:, j]
-    for j, k in enumerate(("qx", "qy", "qz", "qw")):
-        box3[k] = q[:, j]
+    spread_columns(box3, (c, s, q), BOX_3D_VECTORS)
     box2: dict[str, Any] = {
         "frame": np.full(m, ann.frame, dtype=np.int64),
         "time_s": np.full(m, ann.time_s, dtype=np.float64),

@@ -28,7 +28,15 @@ if TYPE_CHECKING:
     from mmusv.annotate import Annotations
     from mmusv.simulation import FrameCapture, VesselInfo
 
-__all__ = ["SCHEMAS", "TableRead", "TableWriter", "read_table"]
+__all__ = [
+    "BOX_3D_VECTORS",
+    "SCHEMAS",
+    "WORLD_STATE_VECTORS",
+    "TableRead",
+    "TableWriter",
+    "read_table",
+    "spread_columns",
+]
 
 _F = pl.Float64
 _I = pl.Int64
@@ -86,6 +94,28 @@ LEGACY_MISSING: dict[str, tuple[str, ...]] = {"boxes_3d": ("wave_occlusion",), "
 them null (not recorded), never as zeros."""
 
 
+WORLD_STATE_VECTORS: tuple[tuple[str, ...], ...] = (
+    ("x", "y", "z", "roll", "pitch", "yaw"),
+    ("vx", "vy", "vz"),
+    ("box_cx", "box_cy", "box_cz"),
+    ("length", "beam", "height"),
+)
+"""The ``world_state`` columns that hold vectors, one name per component: the pose, the velocity, the box centre and
+the box size (:func:`spread_columns`)."""
+
+BOX_3D_VECTORS: tuple[tuple[str, ...], ...] = (("x", "y", "z"), ("length", "beam", "height"), ("qx", "qy", "qz", "qw"))
+"""The ``boxes_3d`` columns that hold vectors, one name per component: the box centre, its size and its rotation
+quaternion (:func:`spread_columns`)."""
+
+
+def spread_columns(cols: dict[str, Any], blocks: Sequence[np.ndarray], names: Sequence[Sequence[str]]) -> None:
+    """Adds a table's vector fields to its columns ``cols``, one column per component: column ``j`` of the ``(n, k)``
+    array ``blocks[i]`` under the name ``names[i][j]`` (:data:`WORLD_STATE_VECTORS`, :data:`BOX_3D_VECTORS`)."""
+    for block, keys in zip(blocks, names, strict=True):
+        for j, k in enumerate(keys):
+            cols[k] = block[:, j]
+
+
 class TableWriter:
     """Collects table rows column-wise and flushes them as numbered Parquet parts under ``root``."""
 
@@ -141,14 +171,7 @@ class TableWriter:
             "semantic_class": np.array([v.semantic_class for v in vessels], dtype=np.int64),
             "instance_id": np.array([v.instance_id for v in vessels], dtype=np.int64),
         }
-        for j, k in enumerate(("x", "y", "z", "roll", "pitch", "yaw")):
-            cols[k] = poses[:, j]
-        for j, k in enumerate(("vx", "vy", "vz")):
-            cols[k] = vel[:, j]
-        for j, k in enumerate(("box_cx", "box_cy", "box_cz")):
-            cols[k] = centres[:, j]
-        for j, k in enumerate(("length", "beam", "height")):
-            cols[k] = size[:, j]
+        spread_columns(cols, (poses, vel, centres, size), WORLD_STATE_VECTORS)
         self._add("world_state", n, cols)
 
     def add_annotations(self, ann: Annotations, cols: dict[str, Any]) -> None:
@@ -173,12 +196,7 @@ class TableWriter:
             "static": np.asarray(lid["static"], dtype=bool),
             "wave_occlusion": np.asarray(lid["wave_occlusion"], dtype=np.float64),
         }
-        for j, k in enumerate(("x", "y", "z")):
-            box3[k] = c[:, j]
-        for j, k in enumerate(("length", "beam", "height")):
-            box3[k] = s[:, j]
-        for j, k in enumerate(("qx", "qy", "qz", "qw")):
-            box3[k] = q[:, j]
+        spread_columns(box3, (c, s, q), BOX_3D_VECTORS)
         self._add("boxes_3d", n, box3)
         cam = cols["camera"]
         m = len(cam["target_id"])

@@ -22,7 +22,7 @@ from mmusv.errors import ConfigError, InputError
 from mmusv.frames import BODY_TO_OPTICAL
 from mmusv.scene import Scene, _pose
 from mmusv.sensors.config import CameraConfig, TopViewConfig
-from mmusv.sensors.env import check_env, wake_rows
+from mmusv.sensors.env import check_sensor_args, wake_rows
 
 __all__ = ["BODY_TO_OPTICAL", "CameraImages", "camera_from_config", "render", "top_view_from_config"]
 
@@ -124,10 +124,7 @@ def render(
             f"top_view_from_config(TopViewConfig(...)), or Simulation.agent(id).cameras[name][0]), "
             f"not {type(camera).__name__}"
         )
-    if not isinstance(scene, Scene):
-        raise InputError(f"scene must be an mmusv.Scene, got {type(scene).__name__}")
-    check_env(env)
-    seed = arguments.whole(seed, name="seed", lo=0, hi=2**64 - 1, error=InputError)
+    seed = check_sensor_args(scene, env, seed)
     radiance = arguments.flag(radiance, name="radiance", error=InputError)
     p = _pose(pose, name="pose")
     w = wake_rows(wakes)

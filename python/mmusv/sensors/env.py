@@ -35,12 +35,14 @@ import numpy.typing as npt
 from mmusv import arguments
 from mmusv._native import core
 from mmusv.errors import ConfigError, InputError
+from mmusv.scene import Scene
 from mmusv.world.environment import Environment
 
 __all__ = [
     "SEA_ALBEDO",
     "WATER_ALBEDO",
     "check_env",
+    "check_sensor_args",
     "sensor_env",
     "turbidity_from_visibility",
     "wake_rows",
@@ -87,6 +89,17 @@ def check_env(env: Any) -> core.SensorEnv:
             f"Simulation.sensor_env), not {type(env).__name__}"
         )
     return env
+
+
+def check_sensor_args(scene: Any, env: Any, seed: Any) -> int:
+    """Checks the arguments every sensor call (:func:`~mmusv.sensors.lidar.scan`,
+    :func:`~mmusv.sensors.camera.render`, :func:`~mmusv.sensors.radar.radar_sweep`) shares, in this order:
+    ``scene`` an :class:`mmusv.Scene`, ``env`` the sensors' environment (:func:`check_env`) and ``seed`` a whole
+    number in ``0..2⁶⁴−1``; the first bad one raises :class:`mmusv.InputError` naming it. Returns the seed."""
+    if not isinstance(scene, Scene):
+        raise InputError(f"scene must be an mmusv.Scene, got {type(scene).__name__}")
+    check_env(env)
+    return arguments.whole(seed, name="seed", lo=0, hi=2**64 - 1, error=InputError)
 
 
 def turbidity_from_visibility(visibility_m: float) -> float:

@@ -19,7 +19,7 @@ from mmusv._native import core
 from mmusv.errors import ConfigError, InputError
 from mmusv.scene import Scene, _pose
 from mmusv.sensors.config import LidarConfig
-from mmusv.sensors.env import check_env, wake_rows
+from mmusv.sensors.env import check_sensor_args, wake_rows
 
 __all__ = ["LidarPoints", "lidar_from_config", "scan"]
 
@@ -116,10 +116,7 @@ def scan(
             f"lidar = {arguments.shown(lidar)}: must be a native lidar (lidar_from_config(LidarConfig(...)), or "
             f"Simulation.agent(id).lidar), not {type(lidar).__name__}"
         )
-    if not isinstance(scene, Scene):
-        raise InputError(f"scene must be an mmusv.Scene, got {type(scene).__name__}")
-    check_env(env)
-    seed = arguments.whole(seed, name="seed", lo=0, hi=2**64 - 1, error=InputError)
+    seed = check_sensor_args(scene, env, seed)
     p = _pose(pose, name="pose")
     w = wake_rows(wakes)
     return LidarPoints.from_native(lidar.scan(scene.native, pose=p, env=env, seed=seed, wakes=w))

@@ -47,7 +47,7 @@ from mmusv._native import core
 from mmusv.errors import ConfigError, InputError
 from mmusv.scene import Scene, _pose
 from mmusv.sensors.config import RadarConfig
-from mmusv.sensors.env import check_env
+from mmusv.sensors.env import check_sensor_args
 
 __all__ = [
     "MAX_PPI_SIZE",
@@ -230,10 +230,7 @@ def radar_sweep(
             f"radar = {arguments.shown(radar)}: must be a native radar (radar_from_config(RadarConfig(...)), or "
             f"Simulation.agent(id).radar), not {type(radar).__name__}"
         )
-    if not isinstance(scene, Scene):
-        raise InputError(f"scene must be an mmusv.Scene, got {type(scene).__name__}")
-    check_env(env)
-    seed = arguments.whole(seed, name="seed", lo=0, hi=2**64 - 1, error=InputError)
+    seed = check_sensor_args(scene, env, seed)
     p = _pose(pose, name="pose")
     return RadarReturns.from_native(radar.sweep(scene.native, pose=p, env=env, seed=seed), pose=p, radar=radar)
 
