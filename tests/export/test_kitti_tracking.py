@@ -106,7 +106,7 @@ def test_layout_sequences_and_seqmap(exports: dict[str, Path], port_rec: Path) -
         (f"{i:04d}", a.id, str(1000 + a.index), "port_entry", "train", str(FRAMES)) for i, a in enumerate(info.agents)
     ]
     assert {r["frequency_hz"] for r in seqs.values()} == {"5.0"}
-    want = sorted([*PER_FRAME, "calib", "evaluate_tracking.seqmap.train", "frames", "label_02", "pose"])
+    want = sorted([*PER_FRAME, "calib", "evaluate_tracking.seqmap.train", "frames", "label_02", "oxts", "pose"])
     assert sorted(p.name for p in train.iterdir()) == want
     assert (train / "evaluate_tracking.seqmap.train").read_text() == "".join(
         f"{s} empty 000000 {FRAMES:06d}\n" for s in seqs
@@ -118,6 +118,7 @@ def test_layout_sequences_and_seqmap(exports: dict[str, Path], port_rec: Path) -
     for s in seqs:
         assert (train / "frames" / f"{s}.txt").read_text() == "0\n1\n2\n"
         assert len((train / "pose" / f"{s}.txt").read_text().splitlines()) == FRAMES
+        assert len((train / "oxts" / f"{s}.txt").read_text().splitlines()) == FRAMES  # test_kitti_oxts.py reads them
         keys = [line.split()[0] for line in (train / "calib" / f"{s}.txt").read_text().splitlines()]
         assert keys == ["P0:", "P1:", "P2:", "P3:", "R_rect", "Tr_velo_cam", "Tr_imu_velo"]  # the devkit's names
 

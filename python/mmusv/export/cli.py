@@ -117,6 +117,14 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         help="kitti_tracking: the type written for every vessel, e.g. Car, the class stock TrackEval and the KITTI "
         "devkit score (default: each vessel's class name, Vessel or Usv)",
     )
+    p.add_argument(
+        "--oxts-origin",
+        default=None,
+        metavar="LAT,LON",
+        help="kitti_tracking: the geodetic point (degrees) of the world origin in the oxts files' latitudes and "
+        "longitudes, LAT in [-85, 85], LON in [-180, 180], e.g. --oxts-origin=-33.9,151.3 (with = before a minus) "
+        "(default 45,-2: at sea in the Bay of Biscay)",
+    )
     p.add_argument("--overwrite", action="store_true", help="replace a previous conversion in the output folder")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     return p
@@ -129,6 +137,7 @@ def run(args: argparse.Namespace) -> int:
 
     from mmusv.export.common import BOXES, TARGETS
     from mmusv.export.convert import convert
+    from mmusv.export.kitti_oxts import parse_origin
 
     if args.to not in TARGETS:
         raise ConfigError(f"unknown --to {args.to!r}; allowed: {', '.join(TARGETS)}")
@@ -137,6 +146,13 @@ def run(args: argparse.Namespace) -> int:
             f"unknown --box {args.box!r}; allowed: visible (the tight box of the vessel's visible pixels, the default) "
             "or projected (the recording's box: the projected 3D box clipped to the image)"
         )
+    origin = None
+    if args.oxts_origin is not None:  # checked here, so that the message names the option as typed
+        origin = parse_origin(args.oxts_origin)
+        if args.to != "kitti_tracking":
+            raise ConfigError(
+                f"--oxts-origin {args.oxts_origin!r}: only --to kitti_tracking writes it, not --to {args.to}"
+            )
     console = Console(width=None if sys.stdout.isatty() else 160)
     kwargs: dict[str, Any] = {
         "to": args.to,
@@ -154,6 +170,7 @@ def run(args: argparse.Namespace) -> int:
         "agents": args.agents,
         "frames": args.frames,
         "kitti_class": args.kitti_class,
+        "oxts_origin": origin,
     }
     if args.no_progress:
         report = convert(args.recordings, **kwargs)

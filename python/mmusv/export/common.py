@@ -111,6 +111,9 @@ class Options:
     kitti_class: str | None = None
     """KITTI tracking: the type written for every target (``Car``, which stock TrackEval and the KITTI devkit score);
     ``None``: each target's class name (``Vessel``, ``Usv``)."""
+    oxts_origin: tuple[float, float] | None = None
+    """KITTI tracking: the geodetic point (latitude, longitude, degrees) of the world origin in the ``oxts`` files;
+    ``None``: :data:`mmusv.export.kitti_oxts.DEFAULT_ORIGIN`."""
 
     def wants_frame(self, index: int) -> bool:
         """Whether acquisition index ``index`` lies in :attr:`frames`."""

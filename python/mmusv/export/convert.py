@@ -37,6 +37,7 @@ from mmusv.export.convert_checks import (
     frame_selection,
     kitti_type,
     outside_frames,
+    oxts_origin_of,
 )
 from mmusv.export.convert_output import prepare_out, staged
 from mmusv.export.convert_report import REPORT_NAME, ConvertReport, RecordingReport
@@ -165,6 +166,7 @@ def convert(
     agents: Iterable[str] | str | None = None,
     frames: Sequence[int | None] | str | None = None,
     kitti_class: str | None = None,
+    oxts_origin: Sequence[float] | str | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> ConvertReport:
     """Converts one or many recordings into a dataset folder (see the module docstring).
@@ -208,6 +210,9 @@ def convert(
         kitti_class: ``to="kitti_tracking"`` only: the type its labels give every target, one word (``"Car"``: what
             stock TrackEval's ``Kitti2DBox`` and the KITTI devkit score); ``None`` (the default): each target's class
             name (``Vessel``, ``Usv``).
+        oxts_origin: ``to="kitti_tracking"`` only: the geodetic point ``(lat, lon)`` (degrees, ``|lat| <= 85``,
+            ``|lon| <= 180``; or ``"LAT,LON"``) of the world origin in its ``oxts`` files; ``None`` (the default):
+            :data:`mmusv.export.kitti_oxts.DEFAULT_ORIGIN`.
         progress: called with (frames done, frames expected) after every frame (a callable of two arguments).
 
     Raises:
@@ -231,6 +236,7 @@ def convert(
     box = parse_box(box)
     box_options(to, min_box_px=box_px, max_occlusion=max_occ, min_contrast=min_c, box=box)
     kind = kitti_type(kitti_class, to)
+    origin = oxts_origin_of(oxts_origin, to)
     options = Options(
         to=to,
         eval_range_m=rng,
@@ -243,6 +249,7 @@ def convert(
         agents=agent_selection(agents),
         frames=frame_selection(frames),
         kitti_class=kind,
+        oxts_origin=origin,
     )
     cls = cls.for_options(options)
     paths = as_list(recordings)
@@ -277,6 +284,7 @@ def convert(
                 **({"agents": list(options.agents)} if options.agents is not None else {}),
                 **({"frames": list(options.frames)} if options.frames is not None else {}),
                 **({"kitti_class": kind} if kind is not None else {}),
+                **({"oxts_origin": list(origin)} if origin is not None else {}),
             },
         }
         with staged(work, out):

@@ -29,6 +29,7 @@ __all__ = [
     "frame_selection",
     "kitti_type",
     "outside_frames",
+    "oxts_origin_of",
 ]
 
 
@@ -203,3 +204,16 @@ def check_agents(cls: type[DatasetWriter], infos: list[RecordingInfo], agents: t
                 f"{i.path}: no selected agent ({', '.join(agents)}) to convert to {cls.format_name()}: "
                 + (f"{'; '.join(unusable)}" if unusable else f"its agents are {', '.join(a.id for a in i.agents)}")
             )
+
+
+def oxts_origin_of(value: Any, to: str) -> tuple[float, float] | None:
+    """``value`` (``(lat, lon)`` in degrees or ``"LAT,LON"``; the KITTI tracking ``oxts`` files' world origin) as a
+    pair, or ``None``; :class:`ConfigError` for another format or a point that is not one
+    (:func:`mmusv.export.kitti_oxts.parse_origin`)."""
+    from mmusv.export.kitti_oxts import parse_origin
+
+    if value is None:
+        return None
+    if to != "kitti_tracking":
+        raise ConfigError(f"oxts_origin = {arguments.shown(value)}: only --to kitti_tracking writes it, not --to {to}")
+    return parse_origin(value, "oxts_origin =")

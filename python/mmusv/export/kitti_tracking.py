@@ -20,6 +20,10 @@ over the whole conversion in its order: split, scenario, agent; so no two sequen
   camera is rigid on the hull, so LiDAR → camera is one matrix per sequence, checked on every frame (a camera that
   moved against the LiDAR is refused, :class:`~mmusv.errors.IoError`);
 * ``pose/<seq>.txt``: line ``frame``: LiDAR → mmusv world, 3×4 row-major (the KITTI export's ``pose``);
+* ``oxts/<seq>.txt``: line ``frame``: the vessel body's (the IMU frame of ``Tr_imu_velo``) GPS/IMU values as KITTI's
+  oxts files hold them (:func:`mmusv.export.kitti_oxts.oxts_lines`: latitude and longitude on the devkit's
+  Mercator projection with the world origin at :attr:`~mmusv.export.common.Options.oxts_origin`, roll, pitch, yaw,
+  velocities, accelerations and angular rates by finite differences at the frames' times);
 * ``frames/<seq>.txt``: line ``frame``: the recording's acquisition index (sim time = index / ``frequency_hz``;
   where frames in the middle were skipped, consecutive frames are further apart, which the conversion's notes say);
 * ``evaluate_tracking.seqmap.<split>``: ``<seq> empty 000000 <frames:06d>`` per sequence (TrackEval's and the
@@ -44,6 +48,7 @@ from mmusv.errors import IoError
 from mmusv.export.common import Options, Sink, cav_id
 from mmusv.export.geometry import AgentView, Target
 from mmusv.export.kitti import KittiWriter, calib_text, camera0, kitti_numbers, label_lines
+from mmusv.export.kitti_oxts import DEFAULT_ORIGIN, oxts_lines
 from mmusv.export.mot import TRACKS_COLUMNS, TrackRows, csv_bytes, mot_split, track_id, track_rows
 from mmusv.export.splits import SPLIT_NAMES
 from mmusv.export.writer import DatasetWriter
@@ -86,6 +91,8 @@ class _Sequence:
     labels: dict[int, list[str]] = field(default_factory=dict)
     """Acquisition index → the frame's label lines without the frame number."""
     poses: dict[int, str] = field(default_factory=dict)
+    bodies: dict[int, np.ndarray] = field(default_factory=dict)
+    """Acquisition index → the vessel body → world pose (``oxts``)."""
     files: dict[str, str] = field(default_factory=dict)
     """Per-frame folders written (under the split folder) → their files' extension."""
 
@@ -120,6 +127,8 @@ class KittiTrackingWriter(KittiWriter):
         self.rows = TrackRows(self.info.path, "KITTI tracking")
         self.world: WorldFrame | None = None
         """The first converted frame's world state (``tracks.csv``)."""
+        self.origin = self.options.oxts_origin or DEFAULT_ORIGIN
+        """The geodetic point (latitude, longitude) of the world origin in the ``oxts`` files."""
 
     @classmethod
     def format_name(cls) -> str:
@@ -178,6 +187,7 @@ class KittiTrackingWriter(KittiWriter):
         ids = [track_id(world, t.id) for t in targets]
         seq.labels[frame.index] = [f"{i} {line}" for i, line in sorted(zip(ids, lines, strict=True))]
         seq.poses[frame.index] = kitti_numbers(view.lidar[:3, :])
+        seq.bodies[frame.index] = np.array(view.body, dtype=np.float64)
 
     def finish(self, frames: list[int], skipped: list[dict[str, Any]]) -> None:
         DatasetWriter.finish(self, frames, skipped)  # the KITTI export's mmusv_kitti.yaml is not written
@@ -191,6 +201,7 @@ class KittiTrackingWriter(KittiWriter):
                     f"{self.split_folder}/{seq.name}: acquisition {what.format(frame_ranges(gaps))} not converted, so "
                     f"its frames are not all 1 / frequency_hz apart (frames/{seq.name}.txt gives each frame's index)"
                 )
+            freq = self.info.frequency_hz
             for sub, ext in seq.files.items():
                 where = seq.folder / sub
                 for k, index in enumerate(order):
@@ -201,18 +212,21 @@ class KittiTrackingWriter(KittiWriter):
                 ("label_02", [f"{k} {line}" for k, index in enumerate(order) for line in seq.labels[index]]),
                 ("pose", [seq.poses[index] for index in order]),
                 ("frames", [str(index) for index in order]),
+                ("oxts", oxts_lines([i / freq for i in order], [seq.bodies[i] for i in order], self.origin)),
             ):
                 text = "".join(x + "\n" for x in lines)
                 self.put(self.sink.mkdir(seq.folder / sub) / f"{seq.name}.txt", text.encode())
             self.put(self.sink.mkdir(seq.folder / "calib") / f"{seq.name}.txt", seq.calib)
             split = self.split_folder
             st.seqmaps.setdefault(split, []).append(f"{seq.name} empty 000000 {len(order):06d}")
-            freq = self.info.frequency_hz
             st.sequences.append(
                 [split, seq.name, self.folder.name, seq.agent.id, cav_id(seq.agent.index), len(order), freq]
             )
         if self.world is not None and self.sequences:
             st.tracks += track_rows(self.split_folder, self.folder.name, self.world)
+        if self.sequences:
+            lat, lon = self.origin
+            self.notes.append(f"oxts: the world origin is at latitude {lat!r}, longitude {lon!r} (--oxts-origin)")
 
     @classmethod
     def finish_all(cls, shared: Any, out: Path, sink: Sink) -> None:
