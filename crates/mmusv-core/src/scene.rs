@@ -442,18 +442,8 @@ impl Scene {
         water: Option<(u32, [u32; PACKET])>,
         scratch: &mut Scratch,
     ) -> ([u32; PACKET], [u32; PACKET]) {
-        let mut v = PacketInstances {
-            lv,
-            scene: self,
-            scratch_single: &mut scratch.bottom,
-            stack: &mut scratch.packet_bottom,
-            sub: &mut scratch.sub_packet,
-            instance: [u32::MAX; PACKET],
-            triangle: [u32::MAX; PACKET],
-            any: false,
-            hidden: self.hidden_instance(),
-        };
-        self.tlas.closest_packet(p, &mut scratch.packet_top, &mut v);
+        let (mut v, top) = PacketInstances::new(lv, self, scratch, false);
+        self.tlas.closest_packet(p, top, &mut v);
         if let Some((sid, pieces)) = water {
             for r in 0..p.n {
                 if v.instance[r] == u32::MAX && pieces[r] != u32::MAX {
@@ -470,18 +460,8 @@ impl Scene {
     #[inline(always)]
     pub fn occluded_packet_with<L: Level>(&self, lv: L, p: &mut Packet, scratch: &mut Scratch) {
         self.wave_block_packet(p);
-        let mut v = PacketInstances {
-            lv,
-            scene: self,
-            scratch_single: &mut scratch.bottom,
-            stack: &mut scratch.packet_bottom,
-            sub: &mut scratch.sub_packet,
-            instance: [u32::MAX; PACKET],
-            triangle: [u32::MAX; PACKET],
-            any: true,
-            hidden: self.hidden_instance(),
-        };
-        self.tlas.any_packet(p, &mut scratch.packet_top, &mut v);
+        let (mut v, top) = PacketInstances::new(lv, self, scratch, true);
+        self.tlas.any_packet(p, top, &mut v);
     }
 
     /// Whether the ray `origin + t·dir` (`dir` unit length) hits anything with `0 < t < max_range`: the shadow-ray

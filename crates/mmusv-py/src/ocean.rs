@@ -31,6 +31,19 @@ fn same_len(a: &[f64], b: &[f64], na: &str, nb: &str) -> PyResult<()> {
     Ok(())
 }
 
+/// `f(x[i], y[i])` at each of the world points given as the columns `x`, `y` (m, one entry each; errors name them),
+/// evaluated with the GIL released: the point-wise queries of [`WaveField`].
+fn at_points<T: Send>(
+    py: Python<'_>,
+    x: &PyReadonlyArray1<'_, f64>,
+    y: &PyReadonlyArray1<'_, f64>,
+    f: impl Fn(f64, f64) -> T + Sync,
+) -> PyResult<Vec<T>> {
+    let (xs, ys) = (flat(x, "x")?, flat(y, "y")?);
+    same_len(xs, ys, "x", "y")?;
+    detached(py, || Ok(xs.iter().zip(ys).map(|(&a, &b)| f(a, b)).collect()))
+}
+
 #[pymethods]
 impl WaveField {
     /// Significant height `hs_m` (m), peak period `tp_s` (s), peak enhancement `gamma`, mean travel direction
@@ -84,11 +97,8 @@ impl WaveField {
         y: PyReadonlyArray1<'py, f64>,
         t: f64,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let (xs, ys) = (flat(&x, "x")?, flat(&y, "y")?);
-        same_len(xs, ys, "x", "y")?;
         let f = &self.inner;
-        let out = detached(py, || Ok(xs.iter().zip(ys).map(|(&a, &b)| f.elevation(a, b, t)).collect::<Vec<_>>()))?;
-        Ok(out.into_pyarray(py))
+        Ok(at_points(py, &x, &y, |a, b| f.elevation(a, b, t))?.into_pyarray(py))
     }
 
     /// `(N, 2)` float64 slopes `[∂η/∂x, ∂η/∂y]` at world points `x`, `y` (m) and time `t` (s).
@@ -99,11 +109,8 @@ impl WaveField {
         y: PyReadonlyArray1<'py, f64>,
         t: f64,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let (xs, ys) = (flat(&x, "x")?, flat(&y, "y")?);
-        same_len(xs, ys, "x", "y")?;
         let f = &self.inner;
-        let out = detached(py, || Ok(xs.iter().zip(ys).map(|(&a, &b)| f.slope(a, b, t)).collect::<Vec<_>>()))?;
-        rows_to_array(py, out)
+        rows_to_array(py, at_points(py, &x, &y, |a, b| f.slope(a, b, t))?)
     }
 
     /// `(N, 3)` float64 orbital velocities (m/s, world) at `(N, 3)` world points (m) and time `t` (s).

@@ -1,7 +1,7 @@
 //! The top-level leaf visitors of a [`Scene`]'s traversals: at each leaf of the instance BVH, the instances
 //! whose boxes the ray (or packet) enters, cheapest first, each traced in its own frame.
 
-use super::Scene;
+use super::{Scene, Scratch};
 use crate::bvh::{box_entry, Packet, PacketStack, PacketVisit, Stack, Visit, PACKET};
 use crate::geometry::RigidPose;
 use crate::ray::RayPrep;
@@ -99,6 +99,28 @@ pub(super) struct PacketInstances<'a, L> {
     pub(super) triangle: [u32; PACKET],
     pub(super) any: bool,
     pub(super) hidden: u32,
+}
+
+impl<'a, L: Level> PacketInstances<'a, L> {
+    /// The visitor of `scene`'s packets at level `lv`, on `scratch`'s stacks and with no hit yet; `any`: occlusion
+    /// (each ray stops at its first hit), else the closest hits. Also hands back `scratch`'s top-level packet stack,
+    /// for the walk of the instance BVH that this visitor serves.
+    #[inline(always)]
+    pub(super) fn new(lv: L, scene: &'a Scene, scratch: &'a mut Scratch, any: bool) -> (Self, &'a mut PacketStack) {
+        let Scratch { bottom, packet_top, packet_bottom, sub_packet, .. } = scratch;
+        let visitor = Self {
+            lv,
+            scene,
+            scratch_single: bottom,
+            stack: packet_bottom,
+            sub: sub_packet,
+            instance: [u32::MAX; PACKET],
+            triangle: [u32::MAX; PACKET],
+            any,
+            hidden: scene.hidden_instance(),
+        };
+        (visitor, packet_top)
+    }
 }
 
 impl<L: Level> PacketVisit for PacketInstances<'_, L> {
