@@ -217,6 +217,25 @@ def test_a_blank_line_inside_a_text_is_not_layout_and_a_removed_vessels_blank_li
     assert place_comments(body, [Comment(("name",), "end", "")]) == (body, [])  # no trailing spaces
 
 
+def test_a_blank_line_at_the_end_of_the_file_is_not_written_so_a_save_gives_the_same_bytes_again() -> None:
+    """Blank lines after the file's last line are not read (not layout), so none is written there either: an empty
+    comment last at the end of the file (a client's) gave a file whose next save lost that blank line."""
+    body = "name: x\nseed: 7\n"
+    for comments, want in (
+        ([Comment((), "before", "")], body),
+        ([Comment((), "before", ""), Comment((), "before", "")], body),
+        ([Comment((), "before", ""), Comment((), "before", "# a"), Comment((), "before", "")], body[:-1] + "\n\n# a\n"),
+        # a blank line before a removed vessel's comments is not the last line: kept
+        (
+            [Comment((), "before", ""), Comment(("vessels", "b"), "before", "# b")],
+            body + "\n# [removed from the scenario: vessel b]\n# b\n",
+        ),
+    ):
+        out, _ = place_comments(body, comments)
+        assert out == want, comments
+        assert place_comments(body, read_comments(out))[0] == out, comments
+
+
 def test_a_vessels_comments_follow_it_when_the_list_is_reordered_and_a_waypoint_moves() -> None:
     def edit(data: dict[str, Any]) -> None:
         data["vessels"].reverse()

@@ -305,6 +305,8 @@ def place_comments(body: str, comments: Iterable[Comment]) -> tuple[str, list[Co
         indent = line[: len(line) - len(line.lstrip(" "))]
         out.extend(indent + text if text else "" for text in above.get(number, []))
         out.append("  ".join([line, *after.get(number, [])]))
+    while trailing and not trailing[-1] and not moved:  # a blank line after the file's last line is not layout
+        trailing.pop()
     out.extend(trailing)
     for home, cs in moved.items():
         out.append(f"# [removed from the scenario: {_what(home)}]")
