@@ -1,7 +1,7 @@
 """The page carries a file's comments through an edit and a save (Selenium, headless Chromium): a bundled scenario's
 comment above a vessel is written back above it, and one of a vessel deleted in the page is kept at the end of the file
 with a word in the status line; a vessel renamed in the page keeps its comments, and undoing the rename takes them
-back."""
+back, also when the rename comes while a save is on its way."""
 
 from __future__ import annotations
 
@@ -76,4 +76,41 @@ def test_a_renamed_vessels_comments_follow_it_and_undo_takes_them_back(browser: 
     _wait(browser, "return !window.mmusvEditor.state.dirty", "the save")
     saved = (Path(live_server.folder) / "renamed.yaml").read_text(encoding="utf-8")
     assert read_comments(saved) == original and "removed from the scenario" not in saved
+    assert js_errors(browser) == []
+
+
+def test_a_vessel_renamed_while_a_save_is_on_its_way_keeps_its_comments(browser: Any, live_server: LiveServer) -> None:
+    """The save's answer brings the file's comments as the server wrote them: anchored at the id the save sent. A
+    rename made while the save was on its way (its field left after Ctrl+S) keeps its comments' new anchors."""
+    open_editor(browser, live_server)
+    js_errors(browser)
+    Select(browser.find_element(By.ID, "open")).select_by_value("bundled:island_occlusion")
+    _wait(browser, "return window.mmusvEditor.state.fileName === 'island_occlusion.yaml'", "the bundled scenario")
+    settled(browser)
+    save_as(browser, "race.yaml")
+    original = read_comments((Path(live_server.folder) / "race.yaml").read_text(encoding="utf-8"))
+    browser.execute_script(
+        """const fetched = window.fetch;
+        window.heldSave = null;
+        window.fetch = (url, init) => init?.method === "PUT"
+          ? new Promise((done) => { window.heldSave = () => { window.fetch = fetched; done(fetched(url, init)); }; })
+          : fetched(url, init);"""
+    )
+    browser.find_element(By.ID, "save").click()
+    _wait(browser, "return window.heldSave !== null", "the save on its way")
+    browser.find_element(By.CSS_SELECTOR, '#fleet li[data-id="trawler"]').click()
+    type_into(browser, browser.find_element(By.ID, "v-id"), "trawler_2")
+    settled(browser)
+    browser.execute_script("document.getElementById('status').textContent = ''; window.heldSave();")
+    _wait(browser, "return document.getElementById('status').textContent.startsWith('saved race.yaml')", "the answer")
+    assert browser.execute_script("return window.mmusvEditor.state.dirty")  # the rename came after what was sent
+    # was: the answer's comments (anchored at "trawler") replaced the renamed ones; the next save moved them to the end
+    anchors = browser.execute_script("return window.mmusvEditor.state.comments.map((c) => c.path[1] ?? null)")
+    assert "trawler_2" in anchors and "trawler" not in anchors, anchors
+    browser.find_element(By.ID, "save").click()
+    _wait(browser, "return !window.mmusvEditor.state.dirty", "the second save")
+    saved = (Path(live_server.folder) / "race.yaml").read_text(encoding="utf-8")
+    assert "removed from the scenario" not in saved, saved
+    renamed = [c for c in read_comments(saved) if c.path[:2] == ("vessels", "trawler_2")]
+    assert [c.text for c in renamed] == [c.text for c in original if c.path[:2] == ("vessels", "trawler")]
     assert js_errors(browser) == []

@@ -195,10 +195,13 @@ async function save(overwrite = false) {
   try {
     const same = name === state.savedName;
     const key = state.key(); // what is sent: edits made while it is on its way are not saved
-    const body = { document: state.doc, comment: state.comment, comments: state.comments, overwrite: overwrite || same };
+    const sent = state.comments;
+    const body = { document: state.doc, comment: state.comment, comments: sent, overwrite: overwrite || same };
     const res = await api.writeFile(name, body, same && !overwrite ? savedEtag : null);
     savedEtag = res.etag;
-    state.comments = res.comments || []; // as the file now holds them (a removed vessel's at its end)
+    // as the file now holds them (a removed vessel's at its end); but not over anchors changed while the save was on
+    // its way (a vessel renamed then: the answer's are at its old id, and the next save would move them to the end)
+    if (state.comments === sent) state.comments = res.comments || [];
     state.savedName = name;
     state.fileName = name;
     state.markSaved(key);
