@@ -124,7 +124,9 @@ def test_the_command_takes_the_origin(port_rec: Path, tmp_path: Path) -> None:
 BAD_ORIGINS = ["91,0", "45", "45,181", "a,b", "nan,0", "45,0,1", "-85.5,0", ""]
 
 
-@pytest.mark.parametrize(("value", "to"), [*((v, "kitti_tracking") for v in BAD_ORIGINS), ("45,-2", "coco")])
+@pytest.mark.parametrize(
+    ("value", "to"), [*((v, "kitti_tracking") for v in BAD_ORIGINS), ("45,-2", "coco"), ("91,0", "coco")]
+)
 def test_a_bad_oxts_origin_is_refused_in_one_line_before_writing(
     port_rec: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], value: str, to: str
 ) -> None:
@@ -148,6 +150,9 @@ def test_a_bad_oxts_origin_is_refused_in_one_line_before_writing(
     [
         ((91.0, 0.0), "kitti_tracking", "oxts_origin = (91.0, 0.0): must be LAT,LON in degrees, LAT in [-85, 85]"),
         ("45", "kitti_tracking", "oxts_origin = '45': must be LAT,LON in degrees"),
+        # were read as 1, 0 and 45, -2: true/false and texts are not numbers (as the API's other numbers say)
+        ((True, False), "kitti_tracking", "oxts_origin = (True, False): must be LAT,LON in degrees"),
+        (("45", "-2"), "kitti_tracking", "oxts_origin = ('45', '-2'): must be LAT,LON in degrees"),
         ((45.0, -2.0), "mot", "oxts_origin = (45.0, -2.0): only --to kitti_tracking writes it, not --to mot"),
     ],
 )

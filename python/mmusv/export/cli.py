@@ -148,11 +148,11 @@ def run(args: argparse.Namespace) -> int:
         )
     origin = None
     if args.oxts_origin is not None:  # checked here, so that the message names the option as typed
-        origin = parse_origin(args.oxts_origin)
-        if args.to != "kitti_tracking":
+        if args.to != "kitti_tracking":  # (before its value, as the API checks it)
             raise ConfigError(
                 f"--oxts-origin {args.oxts_origin!r}: only --to kitti_tracking writes it, not --to {args.to}"
             )
+        origin = parse_origin(args.oxts_origin)
     console = Console(width=None if sys.stdout.isatty() else 160)
     kwargs: dict[str, Any] = {
         "to": args.to,

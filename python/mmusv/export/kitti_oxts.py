@@ -31,6 +31,7 @@ the level frame, ``wf wl wu``. Status: simulated truth with fixed, plausible val
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Sequence
 from typing import Any
 
@@ -79,15 +80,18 @@ STATUS = (4, 11, 6, 6, 6)
 
 
 def parse_origin(value: Any, name: str = "--oxts-origin") -> tuple[float, float]:
-    """``value`` (``"LAT,LON"`` or a pair) as ``(lat, lon)`` in degrees; :class:`~mmusv.errors.ConfigError` in one
-    line naming ``name`` unless both are finite numbers, ``|lat|`` <= :data:`MAX_LATITUDE_DEG` and ``|lon|`` <= 180."""
+    """``value`` (``"LAT,LON"`` or a pair of numbers) as ``(lat, lon)`` in degrees; :class:`~mmusv.errors.ConfigError`
+    in one line naming ``name`` unless both are finite numbers (not true/false), ``|lat|`` <=
+    :data:`MAX_LATITUDE_DEG` and ``|lon|`` <= 180."""
     lat, lon = DEFAULT_ORIGIN
     why = (
         f"{name} {value!r}: must be LAT,LON in degrees, LAT in [-{MAX_LATITUDE_DEG:g}, {MAX_LATITUDE_DEG:g}] and "
         f"LON in [-180, 180] (default {lat:g},{lon:g})"
     )
-    parts = value.split(",") if isinstance(value, str) else value
     try:
+        parts = value.split(",") if isinstance(value, str) else list(value)
+        if not isinstance(value, str) and not all(isinstance(p, numbers.Real) and not _is_bool(p) for p in parts):
+            raise TypeError  # a pair holds numbers: not true/false (read as 1 and 0), not texts
         got = [float(p) for p in parts]
     except (TypeError, ValueError):
         raise ConfigError(why) from None
@@ -97,6 +101,10 @@ def parse_origin(value: Any, name: str = "--oxts-origin") -> tuple[float, float]
     if not (math.isfinite(lat) and math.isfinite(lon) and abs(lat) <= MAX_LATITUDE_DEG and abs(lon) <= 180.0):
         raise ConfigError(why)
     return lat + 0.0, lon + 0.0
+
+
+def _is_bool(value: Any) -> bool:
+    return isinstance(value, (bool, np.bool_))
 
 
 def mercator_scale(lat_deg: float) -> float:
