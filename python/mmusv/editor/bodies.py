@@ -62,6 +62,9 @@ class CommentBody(_Strict):
 
 
 class SaveBody(DocumentBody):
+    """``PUT /api/files/{name}``: the document, the leading ``comment``, the other ``comments`` (``None``: those of
+    the file it replaces) and whether it may replace a file."""
+
     comment: str = Field(default="", max_length=20_000)
     comments: list[CommentBody] | None = None
     overwrite: bool = False
@@ -79,14 +82,21 @@ class SaveBody(DocumentBody):
 
 
 class FrameBody(DocumentBody):
+    """``POST /api/poses``: the document and an acquisition index."""
+
     frame: int = Field(ge=0)
 
 
 class PreviewBody(FrameBody):
+    """``POST /api/preview``: the document, an acquisition index and the agent whose sheet is drawn (``None``: the
+    first USV)."""
+
     agent: str | None = Field(default=None, max_length=64)
 
 
 class MapBody(_Strict):
+    """``POST /api/map``: a scenario's ``map`` section."""
+
     map: dict[str, Any]
 
     @field_validator("map")
@@ -96,5 +106,7 @@ class MapBody(_Strict):
 
 
 class RunBody(_Strict):
+    """``POST /api/runs``: a saved file of the folder and how many frames to record (``None``: all)."""
+
     name: str = Field(max_length=1000)
     frames: int | None = Field(default=None, ge=1)

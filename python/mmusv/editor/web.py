@@ -39,10 +39,14 @@ CSP = (
 
 
 def error(status: int, message: str) -> JSONResponse:
+    """The API's error answer: ``{"error": message}`` with HTTP ``status``."""
     return JSONResponse({"error": message}, status_code=status)
 
 
 def status_of(exc: MmusvError) -> int:
+    """The HTTP status of an error of mmusv's tree: 409 a file exists or a run of it is going on, 412 the file
+    changed (If-Match), 404 nothing of that name, 422 a scenario or request that does not validate, 400 other bad
+    input, 500 anything else."""
     if isinstance(exc, (FileExistsInFolder, RunGoingOn)):
         return 409
     if isinstance(exc, ChangedInFolder):
@@ -100,6 +104,7 @@ class _LimitedBody:
 
 
 def choices(model: type[BaseModel], name: str) -> list[str]:
+    """The allowed values of the ``Literal`` field ``name`` of ``model`` (the page's drop-down lists)."""
     return list(get_args(model.model_fields[name].annotation))
 
 
