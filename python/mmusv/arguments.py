@@ -26,7 +26,7 @@ import numpy as np
 
 from mmusv.errors import ConfigError
 
-__all__ = ["callback", "flag", "mapping", "names", "path", "real", "shown", "whole"]
+__all__ = ["callback", "flag", "is_number", "mapping", "names", "path", "real", "shown", "whole"]
 
 _REPR = reprlib.Repr()
 _REPR.maxstring, _REPR.maxother = 60, 60
@@ -39,6 +39,12 @@ def shown(value: Any) -> str:
 
 def _is_bool(value: Any) -> bool:
     return isinstance(value, (bool, np.bool_))
+
+
+def is_number(value: Any) -> bool:
+    """Whether ``value`` is a real number: a Python or numpy integer or float, not true/false (which
+    :class:`numbers.Real` holds) and not a string. Its range is the caller's to check."""
+    return isinstance(value, numbers.Real) and not _is_bool(value)
 
 
 def whole(
@@ -95,7 +101,7 @@ def real(
     bounds = [f">= {lo:g}" if lo is not None else "", f"> {above:g}" if above is not None else ""]
     bounds += [f"<= {hi:g}" if hi is not None else ""]
     allowed = what + "".join(f" {b}" for b in bounds if b)
-    if _is_bool(value) or not isinstance(value, numbers.Real):
+    if not is_number(value):
         kind = "true/false" if _is_bool(value) else type(value).__name__
         raise error(f"{name} = {shown(value)}: must be {allowed}, not {kind}")
     x = float(value)

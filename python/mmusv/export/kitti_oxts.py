@@ -31,13 +31,13 @@ the level frame, ``wf wl wu``. Status: simulated truth with fixed, plausible val
 from __future__ import annotations
 
 import math
-import numbers
 from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from mmusv import arguments
 from mmusv.errors import ConfigError
 
 __all__ = [
@@ -90,7 +90,7 @@ def parse_origin(value: Any, name: str = "--oxts-origin") -> tuple[float, float]
     )
     try:
         parts = value.split(",") if isinstance(value, str) else list(value)
-        if not isinstance(value, str) and not all(isinstance(p, numbers.Real) and not _is_bool(p) for p in parts):
+        if not isinstance(value, str) and not all(arguments.is_number(p) for p in parts):
             raise TypeError  # a pair holds numbers: not true/false (read as 1 and 0), not texts
         got = [float(p) for p in parts]
     except (TypeError, ValueError):
@@ -101,10 +101,6 @@ def parse_origin(value: Any, name: str = "--oxts-origin") -> tuple[float, float]
     if not (math.isfinite(lat) and math.isfinite(lon) and abs(lat) <= MAX_LATITUDE_DEG and abs(lon) <= 180.0):
         raise ConfigError(why)
     return lat + 0.0, lon + 0.0
-
-
-def _is_bool(value: Any) -> bool:
-    return isinstance(value, (bool, np.bool_))
 
 
 def mercator_scale(lat_deg: float) -> float:

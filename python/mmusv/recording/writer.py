@@ -21,7 +21,6 @@ Frames: world x east, y north, z up, metres; sensor frames x forward, y left, z 
 
 from __future__ import annotations
 
-import numbers
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -31,6 +30,7 @@ from typing import Any, Literal
 import numpy as np
 import numpy.typing as npt
 
+from mmusv import arguments
 from mmusv._native import core
 from mmusv.errors import InputError
 
@@ -46,7 +46,7 @@ POINT_DTYPES: tuple[str, ...] = ("uint8", "int8", "uint16", "int16", "uint32", "
 def to_ns(time_s: float) -> int:
     """Simulation time in seconds (a real number, ``0 <= time_s < 2**64 ns``, about 584 years) → integer
     nanoseconds (rounded), the time unit of every record call (an MCAP log time is an unsigned 64-bit count)."""
-    if isinstance(time_s, (bool, np.bool_)) or not isinstance(time_s, numbers.Real):
+    if not arguments.is_number(time_s):
         raise InputError(f"invalid time_s: {time_s!r:.60} must be a number of seconds, not {type(time_s).__name__}")
     if not np.isfinite(time_s) or time_s < 0:
         raise InputError(f"invalid time_s: {time_s} must be finite and >= 0")

@@ -26,7 +26,6 @@ and waves.
 from __future__ import annotations
 
 import math
-import numbers
 from typing import Any
 
 import numpy as np
@@ -151,7 +150,7 @@ def sensor_env(
         "exposure_ev100": exposure_ev100,
     }
     for name, value in given.items():
-        if value is not None and (isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real)):
+        if value is not None and not arguments.is_number(value):
             raise ConfigError(
                 f"invalid config env.{name} = {arguments.shown(value)}: must be a number or None, "
                 f"not {type(value).__name__}"

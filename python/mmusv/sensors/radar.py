@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import copy
 import math
-import numbers
 import os
 import tempfile
 from dataclasses import dataclass, field, fields
@@ -313,7 +312,7 @@ MAX_PPI_SIZE = 8192
 def _number(value: Any, name: str, what: str, error: type[Exception]) -> float:
     """``value`` as a float when it is a real number (not a string, not a boolean), else ``error`` naming
     ``name``; its range is the core's to check (as it names it)."""
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+    if not arguments.is_number(value):
         raise error(f"{name} = {arguments.shown(value)}: must be {what}, not {type(value).__name__}")
     return float(value)
 
