@@ -17,12 +17,18 @@ from test_browser_round import js_errors, type_into
 from test_browser_round2 import save_as
 
 
-def test_the_page_saves_a_bundled_scenario_with_its_comments(browser: Any, live_server: LiveServer) -> None:
+def open_occlusion(browser: Any, live_server: LiveServer) -> None:
+    """The page with the bundled ``island_occlusion`` open (its trawler has two comments above it), settled, the
+    JavaScript error log read and emptied."""
     open_editor(browser, live_server)
     js_errors(browser)
     Select(browser.find_element(By.ID, "open")).select_by_value("bundled:island_occlusion")
     _wait(browser, "return window.mmusvEditor.state.fileName === 'island_occlusion.yaml'", "the bundled scenario")
     settled(browser)
+
+
+def test_the_page_saves_a_bundled_scenario_with_its_comments(browser: Any, live_server: LiveServer) -> None:
+    open_occlusion(browser, live_server)
     # a waypoint moved: the comments stay at their vessel
     browser.execute_script("window.mmusvEditor.state.edit((d) => { d.vessels[0].route[0][0] += 5; });")
     save_as(browser, "occlusion.yaml")
@@ -48,11 +54,7 @@ def test_the_page_saves_a_bundled_scenario_with_its_comments(browser: Any, live_
 
 
 def test_a_renamed_vessels_comments_follow_it_and_undo_takes_them_back(browser: Any, live_server: LiveServer) -> None:
-    open_editor(browser, live_server)
-    js_errors(browser)
-    Select(browser.find_element(By.ID, "open")).select_by_value("bundled:island_occlusion")
-    _wait(browser, "return window.mmusvEditor.state.fileName === 'island_occlusion.yaml'", "the bundled scenario")
-    settled(browser)
+    open_occlusion(browser, live_server)
     original = read_comments((bundled_dir() / "island_occlusion.yaml").read_text(encoding="utf-8"))
     trawler = [c for c in original if c.path[:2] == ("vessels", "trawler")]
     assert len(trawler) == 2
@@ -82,11 +84,7 @@ def test_a_renamed_vessels_comments_follow_it_and_undo_takes_them_back(browser: 
 def test_a_vessel_renamed_while_a_save_is_on_its_way_keeps_its_comments(browser: Any, live_server: LiveServer) -> None:
     """The save's answer brings the file's comments as the server wrote them: anchored at the id the save sent. A
     rename made while the save was on its way (its field left after Ctrl+S) keeps its comments' new anchors."""
-    open_editor(browser, live_server)
-    js_errors(browser)
-    Select(browser.find_element(By.ID, "open")).select_by_value("bundled:island_occlusion")
-    _wait(browser, "return window.mmusvEditor.state.fileName === 'island_occlusion.yaml'", "the bundled scenario")
-    settled(browser)
+    open_occlusion(browser, live_server)
     save_as(browser, "race.yaml")
     original = read_comments((Path(live_server.folder) / "race.yaml").read_text(encoding="utf-8"))
     browser.execute_script(
