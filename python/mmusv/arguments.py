@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from typing_extensions import TypeIs
 
 from mmusv.errors import ConfigError
 
@@ -41,9 +42,10 @@ def _is_bool(value: Any) -> bool:
     return isinstance(value, (bool, np.bool_))
 
 
-def is_number(value: Any) -> bool:
+def is_number(value: object) -> TypeIs[numbers.Real]:
     """Whether ``value`` is a real number: a Python or numpy integer or float, not true/false (which
-    :class:`numbers.Real` holds) and not a string. Its range is the caller's to check."""
+    :class:`numbers.Real` holds) and not a string. Its range is the caller's to check; where it is true, type
+    checkers know ``value`` is a :class:`numbers.Real` (``float(value)`` is allowed)."""
     return isinstance(value, numbers.Real) and not _is_bool(value)
 
 

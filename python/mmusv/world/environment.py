@@ -16,12 +16,9 @@ sun.
 from __future__ import annotations
 
 import math
-import numbers
 import re
 from dataclasses import dataclass
 from typing import Literal
-
-import numpy as np
 
 from mmusv import arguments
 from mmusv._native import core
@@ -62,7 +59,7 @@ def wave_problem(wave: object) -> str | None:
     allowed = f"allowed presets are {', '.join(WAVE_PRESETS)} or a wave height in metres (0..{MAX_WAVE_HEIGHT_M:g})"
     if isinstance(wave, str):
         return None if wave.strip().upper() in WAVE_PRESETS else allowed
-    if isinstance(wave, (bool, np.bool_)) or not isinstance(wave, numbers.Real):
+    if not arguments.is_number(wave):
         return f"{allowed}, not {type(wave).__name__}"
     h = float(wave)
     if not (math.isfinite(h) and 0 <= h <= MAX_WAVE_HEIGHT_M):
