@@ -17,9 +17,11 @@ from mmusv.sensors.env import sensor_env
 from mmusv.sensors.lidar import lidar_from_config, scan
 from mmusv.wave_occlusion import (
     exposed_hidden,
+    exposed_hidden_boxes,
     lidar_beam_rays,
     lidar_box_beams,
     lidar_box_rays,
+    lidar_boxes_beams,
     pattern_angles,
     share,
 )
@@ -334,6 +336,78 @@ def test_lidar_box_rays_find_the_beams_that_testing_every_beam_finds() -> None:
         assert dirs.shape == expected.shape and np.array_equal(dirs, expected), k
 
 
+def test_many_boxes_beams_are_each_box_s_own() -> None:
+    """:func:`lidar_boxes_beams` gives each of a stack of boxes the beams a test of every beam selects for it alone
+    (boxes behind the LiDAR, overlapping boxes and an empty stack included), in ``starts``' slices."""
+    el = np.deg2rad(np.linspace(-25.0, 15.0, 32))
+    az = np.linspace(-np.pi, np.pi, 256, endpoint=False)
+    a, e = np.meshgrid(az, el, indexing="ij")
+    pattern = np.stack([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)], -1).reshape(-1, 3)
+    pattern = pattern.astype(np.float32)
+    angles = pattern_angles(pattern)
+    rng = np.random.default_rng(11)
+    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=np.float64)
+    for k in range(60):
+        th = rng.uniform(-np.pi, np.pi)
+        pose = np.eye(4)
+        pose[:2, :2] = [[np.cos(th), -np.sin(th)], [np.sin(th), np.cos(th)]]
+        pose[:3, 3] = rng.normal(size=3) * 5.0
+        boxes = []
+        for _ in range(k % 7):
+            centre = np.array([rng.uniform(-200, 200), rng.uniform(-200, 200), rng.uniform(0, 10)])
+            if rng.uniform() < 0.3:  # straight behind the sensor: the box straddles azimuth ±π
+                centre[:2] = pose[:2, 3] - 80.0 * pose[:2, 0]
+            boxes.append(centre + rng.uniform([1.0, 0.5, 0.5], [150.0, 20.0, 15.0]) * signs)
+        stack = np.array(boxes, dtype=np.float64).reshape(-1, 8, 3)
+        beams, starts = lidar_boxes_beams(angles, pose, stack)
+        assert beams.dtype == starts.dtype == np.int64 and starts.shape == (len(boxes) + 1,) and starts[0] == 0
+        assert starts[-1] == len(beams)
+        for b, corners in enumerate(boxes):
+            want = _box_beams_by_testing_every_beam(pattern, pose, corners)
+            np.testing.assert_array_equal(beams[starts[b] : starts[b + 1]], want, err_msg=f"stack {k}, box {b}")
+            np.testing.assert_array_equal(lidar_box_beams(angles, pose, corners), want)
+
+
+def test_many_targets_counted_at_once_are_each_counted_alone() -> None:
+    """:func:`exposed_hidden_boxes` over several targets' rows gives each the counts :func:`exposed_hidden` gives
+    it alone: rays cast here or read from the full scene's answers, within a range, with an empty target and rows
+    shared by two targets; over W3 crests, where some rays are hidden."""
+    scene, _, alone, _ = _world(Sea(hs_m=3.5, tp_s=8.0))
+    origins, dirs = _fan(np.array([0.0, 0.0, 2.0]), np.array([150.0, 0.0, 0.8]), n=40)
+    t = alone.cast_rays(origins, dirs).distance
+    first = scene.cast_rays(origins, dirs).instance_id
+    n = len(t)
+    # Targets: the first half, nothing, the second half, a middle slice again (rows listed twice).
+    rows = [np.arange(0, n // 2), np.arange(0, 0), np.arange(n // 2, n), np.arange(n // 4, 3 * n // 4)]
+    idx = np.concatenate(rows)
+    starts = np.concatenate([[0], np.cumsum([len(r) for r in rows])])
+    for inst in (None, first):
+        for reach in (float("inf"), 151.0):
+            got = exposed_hidden_boxes(
+                scene,
+                origins[idx],
+                dirs[idx],
+                t[idx],
+                starts,
+                scene_instance=None if inst is None else inst[idx],
+                max_range_m=reach,
+            )
+            want = [
+                exposed_hidden(
+                    scene,
+                    origins[r],
+                    dirs[r],
+                    t[r],
+                    scene_instance=None if inst is None else inst[r],
+                    max_range_m=reach,
+                )
+                for r in rows
+            ]
+            assert got[0].dtype == got[1].dtype == np.int64
+            assert list(zip(got[0].tolist(), got[1].tolist(), strict=True)) == want
+    assert want[1] == (0, 0) and want[0][1] + want[2][1] > 0  # some rays hidden by the crests
+
+
 def test_pattern_angles_are_remembered_by_content() -> None:
     """The same pattern twice gives the remembered angles; another pattern its own (not a stale entry)."""
     rng = np.random.default_rng(5)
@@ -410,6 +484,9 @@ def _bad_calls() -> list[tuple[str, Any, str]]:
     lbb: Any = lidar_box_beams
     lbr: Any = lidar_beam_rays
     lbx: Any = lidar_box_rays
+    lbs: Any = lidar_boxes_beams
+    ehb: Any = exposed_hidden_boxes
+    stack = np.stack([corners, corners + 1.0])
     return [
         # answers for counts that are not counts
         ("share(3, 5)", lambda: sh(3, 5), "hidden = 5: must be <= exposed = 3"),
@@ -445,6 +522,19 @@ def _bad_calls() -> list[tuple[str, Any, str]]:
         ("pose scaled", lambda: lbb(angles, scaled, corners), "lidar_pose must be a (4, 4) rigid"),
         ("corners (8, 2)", lambda: lbb(angles, pose, corners[:, :2]), "corners_world must be the (8, 3)"),
         ("corners NaN", lambda: lbb(angles, pose, corners + np.nan), "corners_world must be"),
+        # lidar_boxes_beams: many boxes at once, checked as one
+        ("boxes (2, 8, 2)", lambda: lbs(angles, pose, stack[..., :2]), "corners_world must be the (B, 8, 3)"),
+        ("one box (8, 3)", lambda: lbs(angles, pose, corners), "corners_world must be the (B, 8, 3)"),
+        ("box 1 NaN", lambda: lbs(angles, pose, stack * [[[1.0]], [[np.nan]]]), "box 1 corner 0"),
+        ("boxes pose scaled", lambda: lbs(angles, scaled, stack), "lidar_pose must be a (4, 4) rigid"),
+        # exposed_hidden_boxes: offsets that are not the rows' slices
+        ("starts past N", lambda: ehb(scene, o, d, t, [0, 5]), "starts must be (B + 1,) row offsets rising from 0"),
+        ("starts not from 0", lambda: ehb(scene, o, d, t, [1, 4]), "got [1, 4]"),
+        ("starts falling", lambda: ehb(scene, o, d, t, [0, 3, 2, 4]), "got [0, 3, 2, 4]"),
+        ("starts empty", lambda: ehb(scene, o, d, t, []), "got []"),
+        ("starts float", lambda: ehb(scene, o, d, t, [0.0, 4.0]), "starts must be (B + 1,) row offsets"),
+        ("starts bool", lambda: ehb(scene, o, d, t, [False, True]), "got dtype bool"),
+        ("starts (1, 2)", lambda: ehb(scene, o, d, t, [[0, 4]]), "starts must be (B + 1,)"),
         # lidar_beam_rays: -1 gave the last beam's ray, a boolean mask was read as one
         ("beam -1", lambda: lbr(p, pose, np.array([-1])), "beams must be indices of the pattern's beams, in 0..3"),
         ("beam 9", lambda: lbr(p, pose, np.array([9])), "got 9"),

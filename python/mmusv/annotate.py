@@ -35,7 +35,15 @@ from mmusv._equality import same
 from mmusv.errors import InputError
 from mmusv.frames import BODY_TO_OPTICAL, translation
 from mmusv.scene import Scene
-from mmusv.wave_occlusion import exposed_hidden, lidar_beam_rays, lidar_box_beams, pattern_angles, share
+from mmusv.wave_occlusion import (
+    BeamAngles,
+    exposed_hidden,
+    exposed_hidden_boxes,
+    lidar_beam_rays,
+    lidar_boxes_beams,
+    pattern_angles,
+    share,
+)
 from mmusv.world.vessels import get_asset
 
 __all__ = [
@@ -226,6 +234,23 @@ class SilhouetteCache:
             return np.zeros(0, dtype=np.float32)
         return scene.cast_rays(origins, directions).distance
 
+    def distances_boxes(
+        self,
+        assets: list[str],
+        poses: list[np.ndarray],
+        origins: np.ndarray,
+        directions: np.ndarray,
+        starts: np.ndarray,
+    ) -> np.ndarray:
+        """:meth:`distances` of many vessels' rays at once: ``(N,)`` float32, rows ``starts[b]:starts[b + 1]`` of
+        ``origins`` and ``directions`` (``(N, 3)``, world) cast against vessel ``assets[b]`` at ``poses[b]`` (body
+        → world) alone; ``starts`` ``(B + 1,)`` row offsets from 0 to ``N``."""
+        parts = [
+            self.distances(a, p, origins[starts[b] : starts[b + 1]], directions[starts[b] : starts[b + 1]])
+            for b, (a, p) in enumerate(zip(assets, poses, strict=True))
+        ]
+        return np.concatenate(parts) if parts else np.zeros(0, dtype=np.float32)
+
 
 EDGE_STEPS = 32
 """Pieces each box edge is cut into for a camera with lens distortion, which bends the edges' images."""
@@ -291,6 +316,29 @@ def _distort(x: np.ndarray, y: np.ndarray, cam: Any, reach: float) -> tuple[np.n
     return d[:, 0] / s, d[:, 1] / s
 
 
+def _lidar_wave_shares(
+    scene: Scene,
+    pattern: np.ndarray,
+    angles: BeamAngles,
+    lidar_pose: np.ndarray,
+    corners: np.ndarray,
+    assets: list[str],
+    poses: list[np.ndarray],
+    silhouettes: SilhouetteCache,
+    lidar_beams: np.ndarray | None,
+    max_range_m: float,
+) -> list[float]:
+    """The LiDAR's wave-occlusion share of each of ``B`` boxes (``corners`` ``(B, 8, 3)`` world, of vessels
+    ``assets`` at ``poses``), all boxes' beams selected, cast against their vessels and counted in one pass:
+    the shares :func:`~mmusv.wave_occlusion.share` gives box by box."""
+    beams, starts = lidar_boxes_beams(angles, lidar_pose, corners)
+    o, d = lidar_beam_rays(pattern, lidar_pose, beams)
+    t = silhouettes.distances_boxes(assets, poses, o, d, starts)
+    first = None if lidar_beams is None else np.asarray(lidar_beams)[beams]
+    n_exposed, n_hidden = exposed_hidden_boxes(scene, o, d, t, starts, scene_instance=first, max_range_m=max_range_m)
+    return [share(e, h) for e, h in zip(n_exposed, n_hidden, strict=True)]
+
+
 def annotate_agent(
     *,
     agent_id: str,
@@ -340,12 +388,15 @@ def annotate_agent(
             inv, p = np.linalg.inv(pose), np.ascontiguousarray(pose, dtype=np.float64)
             views[name] = (cam, cam.intrinsics, inv, p, inst_img, _lens(cam, p, inv))
     rotations: list[np.ndarray] = []  # the 3D boxes' rotation matrices, turned into quaternions in one call
+    lidar_shares = scene is not None and lidar_pose is not None and lidar_pattern is not None and angles is not None
+    share_boxes: list[tuple[int, np.ndarray, str, np.ndarray]] = []  # 3D box row, corners, asset, pose
     for vi, info in enumerate(vessels):
         if vi == agent_index:
             continue
         box_world = state.matrices[vi] @ translation(info.box_center_body)
         box_ref = ref_inv @ box_world
         rng = float(np.linalg.norm(box_ref[:3, 3]))
+        corners_world = box_corners(box_world, info.box_size)
         if footprint_in_range(box_ref, info.box_size, max_range_m):
             ann.lidar_ids.append(info.id)
             ann.lidar_instance.append(info.instance_id)
@@ -358,16 +409,9 @@ def annotate_agent(
             ann.lidar_range.append(rng)
             ann.lidar_role.append(info.role)
             ann.lidar_static.append(bool(info.static))
-            wave = 0.0
-            if scene is not None and lidar_pose is not None and lidar_pattern is not None and angles is not None:
-                corners = box_corners(box_world, info.box_size)
-                beams = lidar_box_beams(angles, lidar_pose, corners)
-                o, d = lidar_beam_rays(lidar_pattern, lidar_pose, beams)
-                t = silhouettes.distances(info.asset, state.matrices[vi], o, d)
-                first = None if lidar_beams is None else np.asarray(lidar_beams)[beams]
-                wave = share(*exposed_hidden(scene, o, d, t, scene_instance=first, max_range_m=max_range_m))
-            ann.lidar_wave_occlusion.append(wave)
-        corners_world = box_corners(box_world, info.box_size)
+            if lidar_shares:  # worked out below for all boxes at once
+                share_boxes.append((len(ann.lidar_wave_occlusion), corners_world, info.asset, state.matrices[vi]))
+            ann.lidar_wave_occlusion.append(0.0)
         for name, (cam, k, inv, pose, inst_img, lens) in views.items():
             h, w = inst_img.shape
             body = corners_world @ inv[:3, :3].T + inv[:3, 3]
@@ -410,6 +454,28 @@ def annotate_agent(
             if waves and scene is not None and sil:
                 wave = share(*exposed_hidden(scene, o, dn, t_alone, scene_instance=window.reshape(-1)))
             ann.cam_wave_occlusion.append(wave)
+    if (
+        share_boxes
+        and scene is not None
+        and lidar_pose is not None
+        and lidar_pattern is not None
+        and angles is not None
+    ):
+        rows, corners, assets, poses = zip(*share_boxes, strict=True)
+        shares = _lidar_wave_shares(
+            scene,
+            lidar_pattern,
+            angles,
+            lidar_pose,
+            np.stack(corners),
+            list(assets),
+            list(poses),
+            silhouettes,
+            lidar_beams,
+            max_range_m,
+        )
+        for row, value in zip(rows, shares, strict=True):
+            ann.lidar_wave_occlusion[row] = value
     if rotations:
         # One call for every box (scipy converts a stack row by row, the same bits as one matrix at a time).
         ann.lidar_rotation = list(Rotation.from_matrix(np.stack(rotations)).as_quat())

@@ -36,9 +36,11 @@ from mmusv.scene import Scene
 __all__ = [
     "BeamAngles",
     "exposed_hidden",
+    "exposed_hidden_boxes",
     "lidar_beam_rays",
     "lidar_box_beams",
     "lidar_box_rays",
+    "lidar_boxes_beams",
     "pattern_angles",
     "share",
 ]
@@ -112,7 +114,7 @@ def exposed_hidden(
     max_range_m: float = float("inf"),
 ) -> tuple[int, int]:
     """``(exposed, hidden)`` ray counts of one target (see the module docstring): ``int``, ``0 <= hidden <=
-    exposed <= N``.
+    exposed <= N``. One target of :func:`exposed_hidden_boxes`.
 
     Args:
         scene: the full scene (a :class:`~mmusv.scene.Scene`), with its sea and wave surface set.
@@ -127,6 +129,42 @@ def exposed_hidden(
         max_range_m: only the part of the vessel within this distance (metres, ``> 0``, ``inf``: all of it) of the
             origins counts (a LiDAR's range: what lies beyond it is neither seen nor hidden).
     """
+    exposed, hidden = _counts(scene, origins, directions, vessel_t, None, scene_instance, max_range_m)
+    return int(exposed[0]), int(hidden[0])
+
+
+def exposed_hidden_boxes(
+    scene: Scene,
+    origins: npt.NDArray[np.float32],
+    directions: npt.NDArray[np.float32],
+    vessel_t: npt.NDArray[np.float32],
+    starts: npt.NDArray[np.int64],
+    *,
+    scene_instance: npt.NDArray[np.int32] | None = None,
+    max_range_m: float = float("inf"),
+) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
+    """``(exposed, hidden)`` ray counts of ``B`` targets at once, each ``(B,)`` int64 with ``0 <= hidden <=
+    exposed``: target ``b``'s rays are rows ``starts[b]:starts[b + 1]`` of the arrays, and its counts are those
+    :func:`exposed_hidden` gives for them alone (a ray may appear in several targets' rows).
+
+    Args:
+        scene, origins, directions, vessel_t, scene_instance, max_range_m: as for :func:`exposed_hidden`, over all
+            ``N`` rows (``vessel_t``: each row's distance to its own target alone).
+        starts: ``(B + 1,)`` integer row offsets, non-decreasing, from 0 to ``N`` (:func:`lidar_boxes_beams`).
+    """
+    return _counts(scene, origins, directions, vessel_t, starts, scene_instance, max_range_m)
+
+
+def _counts(
+    scene: Any,
+    origins: Any,
+    directions: Any,
+    vessel_t: Any,
+    starts: Any,
+    scene_instance: Any,
+    max_range_m: Any,
+) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
+    """:func:`exposed_hidden_boxes` (``starts`` ``None``: all rows are one target), its arguments checked here."""
     if not isinstance(scene, Scene):
         raise InputError(
             f"scene = {arguments.shown(scene)}: must be a mmusv.scene.Scene (the full scene, with its sea), not "
@@ -148,6 +186,14 @@ def exposed_hidden(
         raise InputError(
             f"vessel_t must be distances >= 0 (inf where a ray misses the vessel): row {row} is {vessel_t[row]}"
         )
+    what = f"(B + 1,) row offsets rising from 0 to N = {n_rays}"
+    starts = (
+        np.array([0, n_rays])
+        if starts is None
+        else _array(starts, name="starts", shape=(None,), what=what, integer=True)
+    )
+    if starts.size == 0 or starts[0] != 0 or starts[-1] != n_rays or (np.diff(starts) < 0).any():
+        raise InputError(f"starts must be {what}, got {starts.tolist()[:8]}{' ...' if starts.size > 8 else ''}")
     if scene_instance is not None:
         scene_instance = _array(
             scene_instance,
@@ -159,6 +205,8 @@ def exposed_hidden(
     max_range_m = arguments.real(
         max_range_m, name="max_range_m", unit="metres", above=0.0, finite=False, error=InputError
     )
+    n_boxes = starts.size - 1
+    box = np.repeat(np.arange(n_boxes), np.diff(starts))
     o = np.asarray(origins, dtype=np.float64)
     d = np.asarray(directions, dtype=np.float64)
     t = np.asarray(vessel_t, dtype=np.float64)
@@ -167,16 +215,17 @@ def exposed_hidden(
     exposed = hit & (z > 0.0)
     if np.isfinite(max_range_m):
         exposed &= np.where(hit, t, 0.0) * np.linalg.norm(d, axis=1) <= max_range_m
-    n = int(np.count_nonzero(exposed))
+    counts = np.bincount(box[exposed], minlength=n_boxes).astype(np.int64)
     water = scene.sea_instance
-    if n == 0 or water is None or scene.wave_top is None:
-        return n, 0
+    if not exposed.any() or water is None or scene.wave_top is None:
+        return counts, np.zeros(n_boxes, dtype=np.int64)
     if scene_instance is None:
         hits = scene.cast_rays(o[exposed].astype(np.float32), d[exposed].astype(np.float32))
         first = hits.instance_id
     else:
         first = np.asarray(scene_instance)[exposed]
-    return n, int(np.count_nonzero(first == water))
+    hidden = np.bincount(box[exposed][first == water], minlength=n_boxes).astype(np.int64)
+    return counts, hidden
 
 
 class BeamAngles(NamedTuple):
@@ -293,26 +342,61 @@ def lidar_box_beams(
 ) -> npt.NDArray[np.int64]:
     """``(K,)`` int64 pattern indices (ascending) of the beams whose direction lies within the azimuth and
     elevation extent of the box ``corners_world`` ``(8, 3)`` float64 (world, metres) seen from the LiDAR at
-    ``lidar_pose`` ``(4, 4)`` float64 rigid LiDAR → world; ``angles`` the pattern's :func:`pattern_angles`."""
+    ``lidar_pose`` ``(4, 4)`` float64 rigid LiDAR → world; ``angles`` the pattern's :func:`pattern_angles`. One box
+    of :func:`lidar_boxes_beams`."""
+    beams, _ = lidar_boxes_beams(angles, lidar_pose, _box(corners_world)[None])
+    return beams
+
+
+def lidar_boxes_beams(
+    angles: BeamAngles,
+    lidar_pose: npt.NDArray[np.float64],
+    corners_world: npt.NDArray[np.float64],
+) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
+    """The beams of many boxes at once, as :func:`lidar_box_beams` finds them one box at a time: ``(beams,
+    starts)``, where box ``b``'s beams are ``beams[starts[b]:starts[b + 1]]`` (pattern indices, int64, ascending
+    within each box; a beam in two boxes' extents is listed in both) and ``starts`` ``(B + 1,)`` int64 begins at 0.
+
+    Args:
+        angles: the pattern's :func:`pattern_angles`.
+        lidar_pose: ``(4, 4)`` float64 rigid LiDAR → world.
+        corners_world: ``(B, 8, 3)`` float64 world corners of ``B`` boxes (metres, finite; ``B`` may be 0).
+    """
     angles = _angles(angles)
     lidar_pose = _rigid(lidar_pose, name="lidar_pose")
-    corners_world = _box(corners_world)
+    what = "the (B, 8, 3) world corners of B boxes (float, metres)"
+    corners = _array(corners_world, name="corners_world", shape=(None, 8, 3), what=what)
+    bad = ~np.isfinite(corners).all(axis=2)
+    if bad.any():
+        b, k = (int(i) for i in np.argwhere(bad)[0])
+        raise InputError(f"corners_world must be {what}: box {b} corner {k} ({corners[b, k].tolist()}) is not finite")
+    n_boxes = corners.shape[0]
+    starts = np.zeros(n_boxes + 1, dtype=np.int64)
+    if n_boxes == 0:
+        return np.zeros(0, dtype=np.int64), starts
     inv = np.linalg.inv(lidar_pose)
-    c = corners_world @ inv[:3, :3].T + inv[:3, 3]
-    az = np.arctan2(c[:, 1], c[:, 0])
-    el = np.arctan2(c[:, 2], np.hypot(c[:, 0], c[:, 1]))
-    # Azimuths relative to the box's mean direction, so a box straddling ±π is one interval.
-    mid = np.arctan2(np.sin(az).mean(), np.cos(az).mean())
-    rel = np.angle(np.exp(1j * (az - mid)))
+    c = corners @ inv[:3, :3].T + inv[:3, 3]  # (B, 8, 3): box by box, the same product as one (8, 3) box alone
+    az = np.arctan2(c[..., 1], c[..., 0])
+    el = np.arctan2(c[..., 2], np.hypot(c[..., 0], c[..., 1]))
+    # Azimuths relative to each box's mean direction, so a box straddling ±π is one interval.
+    mids = [np.arctan2(s, co) for s, co in zip(np.sin(az).mean(axis=1), np.cos(az).mean(axis=1), strict=True)]
+    mid = np.array(mids, dtype=np.float64)
+    rel = np.angle(np.exp(1j * (az - mid[:, None])))
+    rel_lo, rel_hi, el_lo, el_hi = rel.min(axis=1), rel.max(axis=1), el.min(axis=1), el.max(axis=1)
     # Candidates: the beams whose azimuth lies in the window (a margin wider, wrapped into [-π, π]) by binary
     # search on the sorted azimuths; the exact test below then keeps what testing every beam would keep.
-    lo, hi = mid + rel.min() - 1e-6, mid + rel.max() + 1e-6
-    cand = _azimuth_window(angles, lo, hi)
+    cands = [
+        _azimuth_window(angles, float(mid[b] + rel_lo[b] - 1e-6), float(mid[b] + rel_hi[b] + 1e-6))
+        for b in range(n_boxes)
+    ]
+    cand = np.concatenate(cands)
+    box = np.repeat(np.arange(n_boxes), [len(k) for k in cands])
     paz, pel = angles.az[cand], angles.el[cand]
-    near = (pel >= el.min()) & (pel <= el.max())
-    prel = np.angle(np.exp(1j * (paz[near] - mid)))
-    idx: npt.NDArray[np.int64] = cand[near][(prel >= rel.min()) & (prel <= rel.max())]
-    return idx
+    prel = np.angle(np.exp(1j * (paz - mid[box])))
+    keep = (pel >= el_lo[box]) & (pel <= el_hi[box]) & (prel >= rel_lo[box]) & (prel <= rel_hi[box])
+    np.cumsum(np.bincount(box[keep], minlength=n_boxes), out=starts[1:])
+    beams: npt.NDArray[np.int64] = cand[keep].astype(np.int64, copy=False)
+    return beams, starts
 
 
 def lidar_beam_rays(
