@@ -2,13 +2,14 @@
 
 :func:`load_mesh_file` first checks what trimesh would report obscurely or not at all (an empty file, an extension
 trimesh cannot read, a GLB shorter than its header says, a glTF buffer or image file that is missing, a ``COLOR_0``
-that does not fit its primitive), reads the file unprocessed, refuses non-finite vertex coordinates (trimesh's
-processing would drop the faces touching them without a word), takes each face's colours (merging vertices would
-keep one colour per place), then processes each piece as ``trimesh.load(process=True)`` would. Each face gets a
-registered material (:mod:`mmusv.world.mesh_materials`, which says how each is converted): a glTF/GLB file's PBR
-materials (times its primitives' ``COLOR_0`` vertex colours, read here from the loader's raw arrays), an OBJ's MTL
-materials by ``usemtl`` (a missing ``.mtl`` or texture is an error, an OBJ without ``mtllib`` the class's default
-look), vertex or face colours (PLY, OBJ) quantised to at most
+that does not fit its primitive, a glTF that requires an extension it does not read or a ``POSITION`` it would
+misread; Draco-compressed glTF geometry is decoded with DracoPy), reads the file unprocessed, refuses non-finite
+vertex coordinates (trimesh's processing would drop the faces touching them without a word), takes each face's
+colours (merging vertices would keep one colour per place), then processes each piece as
+``trimesh.load(process=True)`` would. Each face gets a registered material (:mod:`mmusv.world.mesh_materials`, which
+says how each is converted): a glTF/GLB file's PBR materials (times its primitives' ``COLOR_0`` vertex colours, read
+here from the loader's raw arrays), an OBJ's MTL materials by ``usemtl`` (a missing ``.mtl`` or texture is an error,
+an OBJ without ``mtllib`` the class's default look), vertex or face colours (PLY, OBJ) quantised to at most
 :data:`~mmusv.world.mesh_materials.MAX_COLOUR_MATERIALS` materials a file; other faces get material 0, the class's
 default look. :func:`mesh_asset` turns a file's mesh into the body frame of a
 :class:`~mmusv.world.vessels.VesselAsset` (:mod:`mmusv.world.vessels` builds the asset around it), by the entry's
@@ -165,6 +166,75 @@ def _accessor(data: dict[str, object], index: object) -> dict[str, object] | Non
     return a if isinstance(a, dict) else None
 
 
+_READ_EXTENSIONS = {
+    "KHR_draco_mesh_compression": "decoded with DracoPy",
+    "KHR_materials_emissive_strength": "read here",
+    "KHR_materials_pbrSpecularGlossiness": "converted to metallic-roughness by trimesh",
+    "KHR_mesh_quantization": "integer positions read as their numbers (normalized ones refused)",
+    "KHR_texture_transform": "textures are taken by their mean, whatever their coordinates",
+    "EXT_texture_webp": "read by Pillow",
+}
+"""The glTF extensions a file may require (``extensionsRequired``) that its meshes and materials are read right
+with, and how; glTF 2.0 asks a reader to refuse a file that requires any other (trimesh would read such a file on,
+e.g. meshopt-compressed geometry as zeros, without a word)."""
+
+
+def _extension_checks(path: Path, data: dict[str, object], where: str) -> None:
+    """Refuses a glTF that requires an extension outside :data:`_READ_EXTENSIONS`, that needs Draco decoding
+    without DracoPy installed (trimesh would read the geometry as zeros with a printed warning), or whose
+    ``POSITION`` is a normalized or sparse accessor (trimesh would read the raw integers, or leave the sparse
+    substitutions out)."""
+    shown = repr(str(path))
+    required = data.get("extensionsRequired", [])
+    if not isinstance(required, list) or not all(isinstance(e, str) for e in required):
+        raise AssetSpecError(where, f"{shown}: extensionsRequired must be a list of extension names, got {required!r}")
+    for name in required:
+        if name not in _READ_EXTENSIONS:
+            known = ", ".join(sorted(_READ_EXTENSIONS))
+            raise AssetSpecError(
+                where,
+                f"{shown} requires the glTF extension {name!r} (extensionsRequired), which mmusv does not read; the "
+                f"ones it reads are {known}: export the file without {name}",
+            )
+    draco = "KHR_draco_mesh_compression" in required
+    meshes = data.get("meshes")
+    for i, m in enumerate(meshes if isinstance(meshes, list) else []):
+        prims = m.get("primitives") if isinstance(m, dict) else None
+        for j, p in enumerate(prims if isinstance(prims, list) else []):
+            if not isinstance(p, dict):
+                continue
+            ext = p.get("extensions")
+            draco = draco or (isinstance(ext, dict) and "KHR_draco_mesh_compression" in ext)
+            attrs = p.get("attributes")
+            k = attrs.get("POSITION") if isinstance(attrs, dict) else None
+            acc = _accessor(data, k)
+            if acc is None:
+                continue
+            at = f"{shown}: meshes[{i}].primitives[{j}].attributes.POSITION (accessors[{k}])"
+            if acc.get("normalized") is True:
+                raise AssetSpecError(
+                    where,
+                    f"{at} is a normalized integer accessor, which trimesh's glTF reader would take as the raw "
+                    "integers (a mesh hundreds of times too large); write positions as float, or as integers without "
+                    "normalized with the scale in the node",
+                )
+            if "sparse" in acc:
+                raise AssetSpecError(
+                    where,
+                    f"{at} is a sparse accessor, whose substitutions trimesh's glTF reader does not apply (the shape "
+                    "would be wrong without a word); write POSITION as a plain accessor",
+                )
+    if draco:
+        try:
+            import DracoPy  # noqa: F401
+        except ImportError:
+            raise AssetSpecError(
+                where,
+                f"{shown} holds Draco-compressed geometry (KHR_draco_mesh_compression), which needs the DracoPy "
+                "package to decode (pip install DracoPy; mmusv's install has it); else trimesh reads it as zeros",
+            ) from None
+
+
 def _color_0_checks(path: Path, data: dict[str, object], where: str) -> list[str]:
     """Refuses a ``COLOR_0`` that glTF 2.0 does not allow or that does not fit its primitive (not an accessor, not
     VEC3/VEC4, not float or normalized unsigned byte/short, sparse, another count than ``POSITION``'s: trimesh would
@@ -311,6 +381,7 @@ def _check_file(path: Path, where: str, formats: list[str]) -> tuple[dict[Emissi
     if path.suffix.lower() not in FORMAT_AXES:
         return {}, []
     data = _gltf_json(path, where)
+    _extension_checks(path, data, where)
     return _gltf_checks(path, data, where), _color_0_checks(path, data, where)
 
 
