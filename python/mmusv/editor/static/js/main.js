@@ -16,12 +16,44 @@ let runTimer = null;
 let currentRun = null;
 let runAfterSave = null; // {frames}: the run to start once the file is saved over (Run, then Overwrite)
 
-function status(text, error = false) {
+/** Shows `text` in the status (role=status: a screen reader reads it out); `detail`, read out after it, is not
+ * shown (the page shows it elsewhere, and a longer status would wrap and move the map under the pointer). */
+function status(text, error = false, detail = "") {
   const s = $("status");
   s.textContent = text;
+  if (detail) {
+    const more = document.createElement("span");
+    more.className = "sr-only";
+    more.textContent = ` ${detail}`;
+    s.appendChild(more);
+  }
   s.classList.toggle("error", error);
 }
 state.on("status", ({ text, error }) => status(text, error));
+
+/** Marks the toolbar box `id` (the file name, the run's frames) as the one the status's error is about: invalid,
+ * described by the status, and focused so that the person can fix it there; `false` takes the mark away. */
+function markField(id, bad) {
+  const box = $(id);
+  if (!bad) {
+    box.removeAttribute("aria-invalid");
+    if (box.getAttribute("aria-describedby") === "status") box.removeAttribute("aria-describedby");
+    return;
+  }
+  box.setAttribute("aria-invalid", "true");
+  box.setAttribute("aria-describedby", "status");
+  box.focus();
+}
+
+/** Hides the box that asks whether to overwrite a file; the keyboard, when it was on one of its buttons, goes on at
+ * `then` (not at the top of the page, where a hidden button leaves it). */
+function hideConfirm(then) {
+  const box = $("save-confirm");
+  const had = box.contains(document.activeElement);
+  box.hidden = true;
+  $("save-overwrite").textContent = "Overwrite";
+  if (had && then) then.focus();
+}
 
 // ------------------------------------------------------------------------------------- map layers
 
@@ -186,10 +218,10 @@ let savedEtag = null;
 
 async function save(overwrite = false) {
   const name = $("file-name").value.trim();
-  $("save-confirm").hidden = true;
-  $("save-overwrite").textContent = "Overwrite";
+  hideConfirm($("save"));
   if (!name) {
-    status("give the file a name ending in .yaml", true);
+    status("give the file a name ending in .yaml (letters, digits, _ - and .) in the File box: it is empty; not saved", true);
+    markField("file-name", true);
     return false;
   }
   try {
@@ -199,6 +231,7 @@ async function save(overwrite = false) {
     const body = { document: state.doc, comment: state.comment, comments: sent, overwrite: overwrite || same };
     const res = await api.writeFile(name, body, same && !overwrite ? savedEtag : null);
     savedEtag = res.etag;
+    markField("file-name", false);
     // as the file now holds them (a removed vessel's at its end); but not over anchors changed while the save was on
     // its way (a vessel renamed then: the answer's are at its old id, and the next save would move them to the end)
     if (state.comments === sent) state.comments = res.comments || [];
@@ -223,6 +256,7 @@ async function save(overwrite = false) {
       $("save-confirm").hidden = false;
     } else {
       status(`not saved: ${err.message}`, true);
+      if (err.status === 400 && err.message.startsWith("file name")) markField("file-name", true);
     }
     return false;
   }
@@ -299,9 +333,11 @@ async function run() {
   const framesText = box.value.trim();
   const frames = framesText ? Number(framesText) : null;
   if (box.validity.badInput || (frames !== null && !(Number.isInteger(frames) && frames >= 1))) {
-    status("frames: type a whole number of frames (1 or more), or leave the box empty to run every frame", true);
+    status("not run: Frames must be a whole number of frames (1 or more); leave it empty to run every frame", true);
+    markField("run-frames", true);
     return;
   }
+  markField("run-frames", false);
   runAfterSave = null;
   if (!(await save(false))) {
     // the file exists or changed: the Overwrite button saves it and then starts the run asked for
@@ -371,7 +407,12 @@ state.on("evaluated", () => {
   renderAll();
   const ev = state.evaluation;
   if (!ev) status(`cannot check: ${state.evalError}`, true);
-  else if (!ev.valid) status(`${ev.errors.length} error(s): the scenario does not validate`, true);
+  else if (!ev.valid) {
+    // read out with the first error, its field and what it allows (seen next to the field and under Checks)
+    const first = ev.errors[0] ? `First: ${ev.errors[0].message}.` : "";
+    const more = ev.errors.length > 1 ? ` ${ev.errors.length - 1} more under Checks.` : "";
+    status(`${ev.errors.length} error(s): the scenario does not validate`, true, `${first}${more}`);
+  }
   else {
     const errors = ev.problems.filter((p) => p.severity === "error").length;
     status(`${ev.vessels.length} vessels · ${ev.frames} frames · ${errors} error(s), ${ev.problems.length - errors} warning(s)`, errors > 0);
@@ -421,6 +462,8 @@ $("open").addEventListener("change", (ev) => open(ev.target.value));
 $("file-name").addEventListener("change", (ev) => {
   state.fileName = ev.target.value.trim();
 });
+$("file-name").addEventListener("input", () => markField("file-name", false));
+$("run-frames").addEventListener("input", () => markField("run-frames", false));
 $("save").addEventListener("click", () => {
   runAfterSave = null;
   save(false);
@@ -430,10 +473,13 @@ $("save-overwrite").addEventListener("click", async () => {
   runAfterSave = null;
   if ((await save(true)) && then) await startRun(then.frames);
 });
-$("save-cancel").addEventListener("click", () => {
+// Cancel (or Escape) keeps the file: the keyboard goes to the file name, to give another
+function cancelConfirm() {
   runAfterSave = null;
-  $("save-confirm").hidden = true;
-});
+  hideConfirm($("file-name"));
+  status("not saved: the file was kept as it is; give another file name to save under it");
+}
+$("save-cancel").addEventListener("click", cancelConfirm);
 $("undo").addEventListener("click", () => state.undo());
 $("redo").addEventListener("click", () => state.redo());
 $("preview").addEventListener("click", preview);
@@ -479,6 +525,11 @@ window.addEventListener("keydown", (ev) => {
     ev.preventDefault();
     runAfterSave = null;
     save(false);
+  } else if (ev.key === "Escape" && !$("save-confirm").hidden) {
+    ev.preventDefault();
+    const inside = $("save-confirm").contains(document.activeElement) || document.activeElement === $("save");
+    cancelConfirm();
+    if (inside) $("file-name").focus();
   } else if (!typing && (ev.ctrlKey || ev.metaKey) && ev.key.toLowerCase() === "z") {
     ev.preventDefault();
     if (ev.shiftKey) state.redo();

@@ -516,6 +516,19 @@ export class MapView {
         this.deleteWaypoint(this.activeWaypoint.vessel, this.activeWaypoint.index);
       } else if (ev.key === "Enter" || ev.key === "Escape") {
         if (this.mode !== "select") this.setMode("select");
+      } else if (ev.key.startsWith("Arrow") && !ev.ctrlKey && !ev.metaKey && !ev.altKey) {
+        // the keyboard pans the map: an eighth of the view a press (Shift: half of it)
+        ev.preventDefault();
+        const { w, h } = this.size();
+        const k = ev.shiftKey ? 0.5 : 0.125;
+        const [dx, dy] = { ArrowLeft: [-w, 0], ArrowRight: [w, 0], ArrowUp: [0, h], ArrowDown: [0, -h] }[ev.key] || [0, 0];
+        this.view = { ...this.view, cx: this.view.cx + (dx * k) / this.view.scale, cy: this.view.cy + (dy * k) / this.view.scale };
+        this.applyView();
+      } else if (["+", "=", "-", "_"].includes(ev.key) && !ev.ctrlKey && !ev.metaKey && !ev.altKey) {
+        // and zooms about the middle, as the + and − buttons do
+        ev.preventDefault();
+        const { w, h } = this.size();
+        this.zoomAt(ev.key === "+" || ev.key === "=" ? 1.5 : 1 / 1.5, w / 2, h / 2);
       }
     });
   }

@@ -377,6 +377,12 @@ export class Panels {
     $("v-id").addEventListener("change", (ev) => {
       const id = ev.target.value.trim();
       const others = (this.state.doc.vessels || []).filter((v) => v.id !== this.state.selected).map((v) => v.id);
+      if (!id) {
+        // written, the vessel would have no name in the list or on the map, and the buttons that act on the
+        // selected vessel (Extend route, Zoom to) would find none
+        this.refuse(ev.target, `id: empty; give the vessel an id (e.g. usv_1, tanker). It keeps ${JSON.stringify(this.state.selected)}.`);
+        return;
+      }
       if (others.includes(id)) {
         // written, the panel would show the other vessel of that id and the next edit would go to it
         this.refuse(ev.target, `id: ${JSON.stringify(id)} is the id of another vessel; give this vessel an id of its own (ids must be unique). It keeps ${JSON.stringify(this.state.selected)}.`);
