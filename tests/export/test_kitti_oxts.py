@@ -167,6 +167,27 @@ def test_the_api_refuses_a_bad_oxts_origin_before_writing(
     assert not (tmp_path / "bad").exists()
 
 
+@pytest.mark.parametrize(("value", "kind"), [({45.0, 10.0}, "set"), ({45.0: 0, -2.0: 0}, "dict")])
+def test_an_origin_without_order_is_refused_not_read_swapped(value: Any, kind: str) -> None:
+    """A set has no order: ``{45.0, 10.0}`` was read as latitude 10, longitude 45 (a dict as its keys), silently."""
+    from mmusv.errors import ConfigError
+    from mmusv.export.kitti_oxts import parse_origin
+
+    with pytest.raises(ConfigError, match=f"a pair in order \\(a tuple or a list\\), not {kind}$"):
+        parse_origin(value, "oxts_origin =")
+    assert parse_origin(np.array([45.0, 10.0]), "oxts_origin =") == (45.0, 10.0)  # an array keeps its order
+
+
+def test_a_huge_origin_is_shown_shortened() -> None:
+    """The message echoed the whole value: a megabyte of text was a megabyte of error line."""
+    from mmusv.errors import ConfigError
+    from mmusv.export.kitti_oxts import parse_origin
+
+    with pytest.raises(ConfigError) as err:
+        parse_origin("45," * 100_000)
+    assert len(str(err.value)) < 300 and str(err.value).startswith("--oxts-origin '45,45,")
+
+
 # ------------------------------------------------------------------------------------------------- the maths
 
 

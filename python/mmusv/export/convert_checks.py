@@ -139,10 +139,13 @@ def agent_selection(agents: Iterable[str] | str | None) -> tuple[str, ...] | Non
         return None
     if isinstance(agents, str):
         items = [a.strip() for a in agents.split(",")]
-    elif isinstance(agents, Iterable):
+    elif isinstance(agents, Iterable) and not isinstance(agents, Mapping):  # a dict's keys are not a selection
         items = list(agents)
     else:
-        raise ConfigError(f"agents = {arguments.shown(agents)}: must be agent ids (a list or 'usv_1,usv_2')")
+        raise ConfigError(
+            f"agents = {arguments.shown(agents)}: must be agent ids (a list or 'usv_1,usv_2'), not "
+            f"{type(agents).__name__}"
+        )
     if not all(isinstance(a, str) and a for a in items) or not items:
         raise ConfigError(
             f"agents = {arguments.shown(agents)}: must be one or more agent ids (non-empty strings, comma-separated)"

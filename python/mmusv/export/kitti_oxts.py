@@ -80,14 +80,18 @@ STATUS = (4, 11, 6, 6, 6)
 
 
 def parse_origin(value: Any, name: str = "--oxts-origin") -> tuple[float, float]:
-    """``value`` (``"LAT,LON"`` or a pair of numbers) as ``(lat, lon)`` in degrees; :class:`~mmusv.errors.ConfigError`
-    in one line naming ``name`` unless both are finite numbers (not true/false), ``|lat|`` <=
-    :data:`MAX_LATITUDE_DEG` and ``|lon|`` <= 180."""
+    """``value`` (``"LAT,LON"`` or a pair of numbers in order: a tuple, a list or a numpy array) as ``(lat, lon)`` in
+    degrees; :class:`~mmusv.errors.ConfigError` in one line naming ``name`` unless both are finite numbers (not
+    true/false), ``|lat|`` <= :data:`MAX_LATITUDE_DEG` and ``|lon|`` <= 180. A set or a dict is refused: it has no
+    order, so its latitude and longitude could be swapped."""
     lat, lon = DEFAULT_ORIGIN
     why = (
-        f"{name} {value!r}: must be LAT,LON in degrees, LAT in [-{MAX_LATITUDE_DEG:g}, {MAX_LATITUDE_DEG:g}] and "
-        f"LON in [-180, 180] (default {lat:g},{lon:g})"
+        f"{name} {arguments.shown(value)}: must be LAT,LON in degrees, LAT in [-{MAX_LATITUDE_DEG:g}, "
+        f"{MAX_LATITUDE_DEG:g}] and LON in [-180, 180] (default {lat:g},{lon:g})"
     )
+    if not isinstance(value, (str, Sequence, np.ndarray)) or isinstance(value, bytes):
+        # a set or a dict has no order: {45.0, 10.0} iterated as (10.0, 45.0), latitude and longitude swapped
+        raise ConfigError(f"{why}; a pair in order (a tuple or a list), not {type(value).__name__}")
     try:
         parts = value.split(",") if isinstance(value, str) else list(value)
         if not isinstance(value, str) and not all(arguments.is_number(p) for p in parts):
