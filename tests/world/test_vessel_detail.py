@@ -255,3 +255,54 @@ def test_cli_assets_lists_parts_and_render_names_a_bad_folder(
     assert main(["assets"]) == 0
     assert "parts" in capsys.readouterr().out
     assert not list(tmp_path.glob("*.png"))
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "said"),
+    [
+        # a bare string was read as its letters: "unknown vessel asset 'u'"
+        pytest.param(
+            {"names": "usv_wamv"},
+            "names = 'usv_wamv': must be a list of names, e.g. ['usv_wamv'], not a single string",
+            id="names-string",
+        ),
+        # sizes were PIL's and numpy's own errors (ValueError, OverflowError, TypeError, IndexError)
+        pytest.param({"tile": (0, 0)}, "tile[0] = 0: must be a whole number in 1..16384", id="tile-zero"),
+        pytest.param({"tile": "a"}, "tile = 'a': must be (width, height) in pixels", id="tile-text"),
+        pytest.param(
+            {"asset_size": (-5, 10)}, "asset_size[0] = -5: must be a whole number in 1..16384", id="size-negative"
+        ),
+        pytest.param({"asset_size": (2.5, 10)}, "asset_size[0] = 2.5: must be a whole number", id="size-float"),
+        pytest.param(
+            {"asset_size": (16384, 16384)},
+            "asset_size = (16384, 16384): 268,435,456 pixels, more than a camera's",
+            id="size-huge",
+        ),
+        pytest.param(
+            {"tile": (16384, 100), "names": ["usv_wamv", "kayak_4m"]},
+            "the sheet of 2 assets would be 32768 x 122",
+            id="sheet-huge",
+        ),
+        # the first assets were rendered and written before the unknown one was named
+        pytest.param({"names": ["usv_wamv", "nope"]}, "unknown vessel asset 'nope'", id="unknown-after-known"),
+    ],
+)
+def test_contact_sheet_refuses_bad_arguments_before_writing(tmp_path: Path, kwargs: dict[str, Any], said: str) -> None:
+    from mmusv.errors import MmusvError
+    from mmusv.world.contact_sheet import write_contact_sheet
+
+    with pytest.raises(MmusvError) as err:
+        write_contact_sheet(tmp_path / "sheet", **{"names": ["usv_wamv"], "asset_size": (8, 6), **kwargs})
+    assert said in str(err.value)
+    assert not (tmp_path / "sheet").exists()
+
+
+def test_contact_sheet_names_the_file_it_cannot_write(tmp_path: Path) -> None:
+    """A PNG that cannot be written was a bare OSError naming the hidden temporary file."""
+    from mmusv.errors import IoError
+    from mmusv.world.contact_sheet import write_contact_sheet
+
+    (tmp_path / ".usv_wamv.png.part").mkdir()  # in the way of the temporary file
+    with pytest.raises(IoError, match=r"cannot write .*/usv_wamv\.png: Is a directory \(.*\.usv_wamv\.png\.part\)$"):
+        write_contact_sheet(tmp_path, names=["usv_wamv"], asset_size=(8, 6))
+    assert not (tmp_path / "usv_wamv.png").exists() and not (tmp_path / "contact_sheet.png").exists()

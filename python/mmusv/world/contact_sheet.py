@@ -9,9 +9,11 @@ nothing here is random.
 
 from __future__ import annotations
 
+import contextlib
 import inspect
 import math
 import os
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -19,13 +21,23 @@ from typing import Any
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
-from mmusv.errors import ConfigError
+from mmusv import arguments
+from mmusv.errors import ConfigError, IoError
 from mmusv.scene import Scene
 from mmusv.sensors.camera import render
+from mmusv.sensors.config import MAX_IMAGE_PIXELS
 from mmusv.world.materials import material_table
 from mmusv.world.vessels import VesselAsset, get_asset
 
-__all__ = ["LABEL_H", "SheetLayout", "camera_pose", "render_asset", "sheet_layout", "write_contact_sheet"]
+__all__ = [
+    "LABEL_H",
+    "MAX_SIDE_PX",
+    "SheetLayout",
+    "camera_pose",
+    "render_asset",
+    "sheet_layout",
+    "write_contact_sheet",
+]
 
 LABEL_H = 22
 """Height in pixels of the label strip above each tile."""
@@ -34,6 +46,8 @@ _TEXT = (235, 235, 235)
 _HFOV_DEG = 40.0
 _AZIMUTH_DEG = 35.0  # from the bow towards port
 _ELEVATION_DEG = 24.0
+MAX_SIDE_PX = 16384
+"""The widest and tallest a close-up, a tile or the sheet may be, in pixels (a camera's largest image side)."""
 
 
 @dataclass(frozen=True)
@@ -122,30 +136,67 @@ def write_contact_sheet(
 ) -> Path:
     """Renders every asset of ``names`` (default: the whole library) to ``<out_dir>/<name>.png`` at
     ``asset_size`` and writes the grid of them, ``tile`` pixels each, to ``<out_dir>/contact_sheet.png``
-    (returned). Raises :class:`mmusv.ConfigError` if ``out_dir`` is a file."""
+    (returned). Raises :class:`mmusv.ConfigError` if ``out_dir`` is a file, ``names`` is not a list of asset names
+    or a size is not ``(width, height)`` in whole pixels (1..:data:`MAX_SIDE_PX` each; a close-up at most a
+    camera's ``MAX_IMAGE_PIXELS``, the sheet at most :data:`MAX_SIDE_PX` a side), and
+    :class:`mmusv.NotFoundError` for a name the library does not hold, all before anything is written;
+    :class:`mmusv.IoError` naming the file that cannot be written."""
     from mmusv.world.vessels import asset_names
 
-    out = Path(out_dir)
+    out = arguments.path(out_dir, name="out_dir")
+    if names is not None:  # a bare string was read as its letters ('u' is not an asset)
+        arguments.names(names, name="names", example="['usv_wamv']")
+    chosen = asset_names() if names is None else list(names)
+    tile = _size(tile, "tile")
+    asset_size = _size(asset_size, "asset_size")
+    if asset_size[0] * asset_size[1] > MAX_IMAGE_PIXELS:
+        raise ConfigError(
+            f"asset_size = {asset_size}: {asset_size[0] * asset_size[1]:,} pixels, more than a camera's "
+            f"{MAX_IMAGE_PIXELS:,} (mmusv.sensors.config.MAX_IMAGE_PIXELS)"
+        )
+    assets = [get_asset(name) for name in chosen]  # an unknown name is named before any file is written
+    layout = sheet_layout(len(chosen), tile)
+    if max(layout.size) > MAX_SIDE_PX:
+        raise ConfigError(
+            f"tile = {tile}: the sheet of {len(chosen)} assets would be {layout.size[0]} x {layout.size[1]} pixels, "
+            f"more than {MAX_SIDE_PX} a side: give smaller tiles"
+        )
     if out.exists() and not out.is_dir():
         raise ConfigError(f"--render: {str(out)!r} is a file, not a folder")
     out.mkdir(parents=True, exist_ok=True)
-    chosen = asset_names() if names is None else list(names)
-    layout = sheet_layout(len(chosen), tile)
     sheet = Image.new("RGB", layout.size, _BG)
     draw = ImageDraw.Draw(sheet)
     font = ImageFont.load_default(size=13)
-    for k, name in enumerate(chosen):
-        asset = get_asset(name)
+    for k, (name, asset) in enumerate(zip(chosen, assets, strict=True)):
         img = Image.fromarray(render_asset(asset, size=asset_size))
-        tmp = out / f".{name}.png.part"
-        img.save(tmp, format="PNG")
-        tmp.replace(out / f"{name}.png")
+        _save(img, out / f"{name}.png")
         col, row = k % layout.cols, k // layout.cols
         x0, y0 = col * tile[0], row * (tile[1] + LABEL_H)
         draw.text((x0 + 6, y0 + 4), _label(asset), fill=_TEXT, font=font)
         sheet.paste(img.resize(tile, Image.Resampling.LANCZOS), (x0, y0 + LABEL_H))
     path = out / "contact_sheet.png"
-    tmp = out / ".contact_sheet.png.part"
-    sheet.save(tmp, format="PNG")
-    tmp.replace(path)
+    _save(sheet, path)
     return path
+
+
+def _size(value: Any, name: str) -> tuple[int, int]:
+    """``value`` as ``(width, height)``, whole numbers of pixels in 1..:data:`MAX_SIDE_PX`; else a ConfigError
+    naming ``name``."""
+    if isinstance(value, (str, bytes)) or not isinstance(value, Sequence) or len(value) != 2:
+        raise ConfigError(f"{name} = {arguments.shown(value)}: must be (width, height) in pixels, e.g. (320, 240)")
+    w, h = (arguments.whole(v, name=f"{name}[{i}]", lo=1, hi=MAX_SIDE_PX) for i, v in enumerate(value))
+    return w, h
+
+
+def _save(img: Image.Image, path: Path) -> None:
+    """``img`` written as the PNG ``path`` through a temporary file beside it (never a half-written PNG); an
+    :class:`mmusv.IoError` naming ``path`` when it cannot be written, the temporary file removed."""
+    tmp = path.with_name(f".{path.name}.part")
+    try:
+        img.save(tmp, format="PNG")
+        tmp.replace(path)
+    except OSError as exc:
+        with contextlib.suppress(OSError):
+            tmp.unlink()
+        where = f" ({exc.filename})" if exc.filename and exc.filename != str(path) else ""
+        raise IoError(f"cannot write {path}: {exc.strerror or exc}{where}") from None
