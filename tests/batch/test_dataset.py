@@ -125,6 +125,33 @@ def test_a_bad_index_is_named(tmp_path: Path) -> None:
         convert(tmp_path / "plain", out_dir=tmp_path / "o")
 
 
+@pytest.mark.parametrize(
+    ("key", "value", "said"),
+    [
+        # followed out of the dataset's folder: its index holds paths relative to it only
+        ("recording", "../outside/x.mcap", "recordings[0].recording = '../outside/x.mcap': must be a relative path"),
+        ("recording", "/abs/x.mcap", "recordings[0].recording = '/abs/x.mcap': must be a relative path"),
+        ("recording", 5, "recordings[0].recording = 5: must be a relative path"),  # read as the file '5'
+        ("status", ["complete"], "recordings[0].status = ['complete']: must be a string, not list"),  # TypeError
+        ("name", None, "recordings[0].name = None: must be a string, not NoneType"),
+    ],
+)
+def test_an_index_entry_of_the_wrong_kind_is_named(tmp_path: Path, key: str, value: object, said: str) -> None:
+    (tmp_path / "outside").mkdir()
+    (tmp_path / "outside/x.mcap").write_bytes(b"")
+    (tmp_path / "ds/a").mkdir(parents=True)
+    (tmp_path / "ds/a/a.mcap").write_bytes(b"")
+    entry = Entry("a", "a.yaml", "a", "0" * 64, 1, "a/a.mcap", "complete", 1, 1, 1, 10)
+    write_index(tmp_path / "ds/dataset.json", [entry])
+    assert dataset_recordings(tmp_path / "ds") == [tmp_path / "ds/a/a.mcap"]
+    doc = json.loads((tmp_path / "ds/dataset.json").read_text())
+    doc["recordings"][0][key] = value
+    (tmp_path / "ds/dataset.json").write_text(json.dumps(doc))
+    with pytest.raises(IoError) as err:
+        dataset_recordings(tmp_path / "ds")
+    assert str(err.value).startswith(f"{tmp_path / 'ds/dataset.json'}: ") and said in str(err.value), str(err.value)
+
+
 def test_a_killed_batch_leaves_an_index_of_what_is_done(tmp_path: Path) -> None:
     """The index is rewritten after every scenario, atomically: a driver killed between two leaves a valid one."""
     src = good_folder(tmp_path / "src")

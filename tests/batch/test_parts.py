@@ -216,3 +216,42 @@ def test_switching_layouts(split: Path, reference: tuple[Path, dict[str, str]], 
     assert {k: v for k, v in tree(out).items() if k.startswith("a_sea/")} == {
         k: v for k, v in ref.items() if k.startswith("a_sea/")
     }
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        # read as first_frame 0, 1 and 2 (int() of a float, true/false, a text): a wrong manifest taken, or a
+        # message that showed another value than the file's
+        (lambda d: d["parts"][0].update(first_frame=0.5), "parts[0].first_frame = 0.5: must be a whole number"),
+        (lambda d: d["parts"][0].update(first_frame=True), "parts[0].first_frame = True: must be a whole number"),
+        (lambda d: d["parts"][1].update(first_frame="2"), "parts[1].first_frame = '2': must be a whole number"),
+        # "invalid field value (cannot convert float NaN to integer)": no field named
+        (lambda d: d.update(frames=float("nan")), "frames = nan: must be a whole number"),
+        (lambda d: d.update(parts={"a": 1}), "parts = {'a': 1}: must be a JSON list, not dict"),
+        (lambda d: d.update(parts=[[0, 2]]), "parts[0] = [0, 2]: must be a JSON object"),
+        # None and 5 were taken as the texts 'None' and '5'
+        (lambda d: d.update(scenario=None), "scenario = None: must be a string, not NoneType"),
+        (lambda d: d["parts"][0].update(recording=5), "parts[0].recording = 5: must be a string, not int"),
+    ],
+)
+def test_a_parts_manifest_field_of_the_wrong_type_is_named(tmp_path: Path, change: Any, message: str) -> None:
+    doc: dict[str, Any] = {
+        "format": "mmusv.parts",
+        "version": 1,
+        "scenario": "s",
+        "config_hash": "0" * 64,
+        "frames": 3,
+        "parts": [
+            {"first_frame": 0, "frames": 2, "recording": "parts/000000-000001/s.mcap"},
+            {"first_frame": 2, "frames": 1, "recording": "parts/000002-000002/s.mcap"},
+        ],
+    }
+    path = tmp_path / "s.parts.json"
+    path.write_text(json.dumps(doc))
+    assert read_parts_manifest(path).frames == 3
+    change(doc)
+    path.write_text(json.dumps(doc))
+    with pytest.raises(IoError) as exc:
+        read_parts_manifest(path)
+    assert str(exc.value).startswith(f"{path}: ") and message in str(exc.value), str(exc.value)

@@ -26,9 +26,10 @@ from __future__ import annotations
 import os
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 from typing import Any
 
+from mmusv import arguments
 from mmusv.errors import IoError
 
 __all__ = [
@@ -177,6 +178,13 @@ def read_index(path: str | os.PathLike[str]) -> dict[str, Any]:
     recs = doc.get("recordings")
     if not isinstance(recs, list) or not all(isinstance(r, dict) and "name" in r and "status" in r for r in recs):
         raise IoError(f"{p}: field 'recordings' must be a list of entries with a name and a status")
+    for i, r in enumerate(recs):  # a status ['complete'] was a bare TypeError (unhashable) in dataset_recordings
+        for key in ("name", "status"):
+            if not isinstance(r[key], str):
+                raise IoError(
+                    f"{p}: recordings[{i}].{key} = {arguments.shown(r[key])}: must be a string, not "
+                    f"{type(r[key]).__name__}"
+                )
     return doc
 
 
@@ -192,7 +200,14 @@ def dataset_recordings(path: str | os.PathLike[str], *, statuses: Iterable[str] 
     for i, r in enumerate(doc["recordings"]):
         if r["status"] not in want or not r.get("recording"):
             continue
-        rec = root / str(r["recording"])
+        rel = r["recording"]
+        if not isinstance(rel, str) or PurePosixPath(rel).is_absolute() or ".." in PurePosixPath(rel).parts:
+            # an absolute path or ../ was followed out of the dataset's folder
+            raise IoError(
+                f"{root / INDEX_NAME}: recordings[{i}].recording = {arguments.shown(rel)}: must be a relative path "
+                "below the index's folder (an .mcap or a .parts.json)"
+            )
+        rec = root / rel
         if not rec.is_file():
             raise IoError(f"{root / INDEX_NAME}: recordings[{i}] ({r['name']}) lists {rec}, which does not exist")
         out.append(rec)

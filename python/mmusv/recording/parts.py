@@ -123,6 +123,26 @@ def _check(p: Path, m: PartsManifest) -> None:
         raise IoError(f"{p}: the parts cover frames 0..{nxt - 1}, but frames = {m.frames}")
 
 
+def _field(p: Path, obj: Any, key: str, kind: type, where: str) -> Any:
+    """``obj[key]`` of the manifest ``p`` when it is of ``kind`` (``int``: a whole number, not a float, a text or
+    true/false, which were read as 0, 2 or 1; ``str``; ``list``); else an :class:`~mmusv.errors.IoError` naming the
+    file and the field ``where + key``."""
+    from mmusv import arguments
+
+    name = f"{where}{key}"
+    if not isinstance(obj, dict):
+        raise IoError(f"{p}: {where.rstrip('.')} = {arguments.shown(obj)}: must be a JSON object")
+    if key not in obj:
+        raise IoError(f"{p}: field {key!r} is missing" + (f" from {where.rstrip('.')}" if where else ""))
+    value = obj[key]
+    if kind is int:
+        return arguments.whole(value, name=f"{p}: {name}", error=IoError)
+    if not isinstance(value, kind):
+        what = "a string" if kind is str else "a JSON list"
+        raise IoError(f"{p}: {name} = {arguments.shown(value)}: must be {what}, not {type(value).__name__}")
+    return value
+
+
 def read_parts_manifest(path: str | os.PathLike[str]) -> PartsManifest:
     """The manifest at ``path``; :class:`~mmusv.errors.IoError` naming the file and the field when it is not one."""
     from mmusv.jsonio import read_json
@@ -134,18 +154,21 @@ def read_parts_manifest(path: str | os.PathLike[str]) -> PartsManifest:
             f"{p}: not a parts manifest (format = {doc.get('format')!r}, version = {doc.get('version')!r}; "
             f"expected {PARTS_FORMAT!r}, {_VERSION})"
         )
-    try:
-        parts = tuple(
-            Part(first_frame=int(d["first_frame"]), frames=int(d["frames"]), recording=str(d["recording"]))
-            for d in doc["parts"]
+    parts_doc = _field(p, doc, "parts", list, "")
+    parts = tuple(
+        Part(
+            first_frame=_field(p, d, "first_frame", int, f"parts[{i}]."),
+            frames=_field(p, d, "frames", int, f"parts[{i}]."),
+            recording=_field(p, d, "recording", str, f"parts[{i}]."),
         )
-        m = PartsManifest(
-            scenario=str(doc["scenario"]), config_hash=str(doc["config_hash"]), frames=int(doc["frames"]), parts=parts
-        )
-    except KeyError as exc:
-        raise IoError(f"{p}: field {exc.args[0]!r} is missing") from None
-    except (TypeError, ValueError) as exc:
-        raise IoError(f"{p}: invalid field value ({exc})") from None
+        for i, d in enumerate(parts_doc)
+    )
+    m = PartsManifest(
+        scenario=_field(p, doc, "scenario", str, ""),
+        config_hash=_field(p, doc, "config_hash", str, ""),
+        frames=_field(p, doc, "frames", int, ""),
+        parts=parts,
+    )
     _check(p, m)
     return m
 
