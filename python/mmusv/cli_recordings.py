@@ -47,12 +47,12 @@ def cmd_info(args: argparse.Namespace) -> int:
             "chunk[/yellow]"
         )
     if info.get("frames") is None:  # an MCAP file, but not a recording of mmusv run: its messages only
-        console.print(
-            f"[bold]{target}[/bold]: an MCAP file not written by mmusv run (no scenario/sensors metadata): its "
-            "messages only",
-            markup=True,
-            highlight=False,
+        why = (
+            "its mmusv metadata cannot be read"
+            if info.get("metadata_problem")
+            else "an MCAP file not written by mmusv run (no scenario/sensors metadata)"
         )
+        console.print(f"[bold]{target}[/bold]: {why}: its messages only", markup=True, highlight=False)
     else:
         written = run_meta.get("frames_written", "?")
         if frames:  # the complete frames read: a killed run's .partial has no run metadata saying it ("? frames")
@@ -81,6 +81,8 @@ def cmd_info(args: argparse.Namespace) -> int:
         table.add_row(topic, t["schema"], str(t["messages"]))
     console.print(table)
     problems = [frames["report"]] if frames and frames.get("report") else list(info.get("damage", []))
+    if info.get("metadata_problem"):  # "unreadable ... metadata (...)": it was shown as a file of another program
+        problems.insert(0, info["metadata_problem"])
     if folder is not None and frames:
         problems += _table_problems(target, frames)
     for line in problems:

@@ -159,3 +159,50 @@ def test_the_batch_index_and_the_editor_open_damaged_files_cleanly(small: Path, 
             assert name in r.json()["error"]
         else:
             assert r.json()["valid"] is False
+
+
+def _with_run_metadata(src: Path, dst: Path, **changes: str) -> Path:
+    """``src`` copied record by record with ``changes`` made to its ``run`` metadata."""
+    from mcap.records import Channel, Message, Metadata, Schema
+    from mcap.stream_reader import StreamReader
+    from mcap.writer import Writer
+
+    with src.open("rb") as f, dst.open("wb") as g:
+        w = Writer(g)
+        w.start(profile="", library="test")
+        schemas: dict[int, int] = {}
+        channels: dict[int, int] = {}
+        for rec in StreamReader(f).records:
+            if isinstance(rec, Schema):
+                schemas[rec.id] = w.register_schema(rec.name, rec.encoding, rec.data)
+            elif isinstance(rec, Channel):
+                channels[rec.id] = w.register_channel(
+                    rec.topic, rec.message_encoding, schemas.get(rec.schema_id, 0), rec.metadata
+                )
+            elif isinstance(rec, Message):
+                w.add_message(channels[rec.channel_id], rec.log_time, rec.data, rec.publish_time, rec.sequence)
+            elif isinstance(rec, Metadata):
+                w.add_metadata(rec.name, {**rec.metadata, **changes} if rec.name == "run" else rec.metadata)
+        w.finish()  # type: ignore[no-untyped-call]
+    return dst
+
+
+@pytest.mark.parametrize("value", ["x", "-3", "1e3"])
+def test_a_run_count_that_is_not_a_whole_number_is_named(small: Path, tmp_path: Path, value: str) -> None:
+    """``frames_written = "x"`` in the run metadata was a ValueError traceback in the middle of a conversion (after
+    its output folder was made); ``"-3"`` was taken."""
+    from mmusv.recording.info import read_info
+
+    bad = _with_run_metadata(small / "tiny.mcap", tmp_path / "tiny.mcap", frames_written=value)
+    with pytest.raises(IoError) as err:
+        read_info(bad)
+    said = f"{bad}: damaged run metadata: frames_written = '{value}', must be a whole number of frames in 0..10,000,000"
+    assert str(err.value) == said
+    code, _out, cli_err = cli_main("convert", str(bad), "--to", "opv2v", "-o", str(tmp_path / "conv"), "--no-progress")
+    assert code == 2 and cli_err == f"mmusv: error: {said}\n", cli_err
+    assert not (tmp_path / "conv").exists()
+    # info read it as another program's MCAP file "(no scenario/sensors metadata)", without saying what is damaged
+    code, out, _err = cli_main("info", str(bad))
+    text = " ".join(out.split())
+    assert code == 0 and "its mmusv metadata cannot be read: its messages only" in text, text
+    assert f"mmusv: warning: {said}" in text and "no scenario/sensors metadata" not in text, text

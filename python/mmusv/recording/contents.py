@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from mmusv.errors import IoError
-from mmusv.recording.info import RecordingInfo, check_mcap, read_info, recording_arg
+from mmusv.recording.info import check_mcap, read_info, recording_arg
 from mmusv.recording.parts import is_parts_manifest
 from mmusv.recording.scan import Scan
 from mmusv.recording.stream import FrameStream
@@ -23,7 +23,8 @@ __all__ = ["summary"]
 def summary(path: str | os.PathLike[str]) -> dict[str, Any]:
     """What a recording holds: ``{"path", "complete", "messages", "start_ns", "end_ns", "duration_s",
     "topics": {topic: {"schema", "encoding", "messages"}}, "metadata": {name: {key: value}},
-    "attachments": [name, ...], "damage": [line, ...], "frames": {...} or None}``, counted by reading every
+    "attachments": [name, ...], "damage": [line, ...], "frames": {...} or None}`` (and ``"metadata_problem"``, why
+    a recording of mmusv run whose metadata is damaged is read as messages only), counted by reading every
     chunk (checking its CRC). ``complete`` is False for a ``.partial`` file, one without a summary section or one
     with damage. ``frames`` (for a recording of mmusv): ``{"read", "expected", "first", "missing", "incomplete",
     "report"}``, the complete frames read, how many the run set out to write (from acquisition index ``first``:
@@ -37,11 +38,12 @@ def summary(path: str | os.PathLike[str]) -> dict[str, Any]:
         return _parts_summary(p)
     check_mcap(p)
     try:
-        info: RecordingInfo | None = read_info(p)
-    except IoError:
-        info = None  # not a recording of mmusv run (or its metadata is damaged): messages only
-    if info is None:
-        return _plain_summary(p)
+        info = read_info(p)
+    except IoError as exc:  # not a recording of mmusv run (or its metadata is damaged): messages only
+        plain = _plain_summary(p)
+        if {"scenario", "sensors"} <= set(plain["metadata"]):  # damaged, not absent: say why it is not read
+            plain["metadata_problem"] = str(exc)
+        return plain
     stream = FrameStream(info, want=lambda _t: False)
     for _ in stream:
         pass

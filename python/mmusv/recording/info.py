@@ -296,6 +296,7 @@ def _info(p: Path, meta: dict[str, dict[str, str]], has_summary: bool) -> Record
         raise ValueError("the scenario and sensors metadata must be mappings")
     manifest = meta.get("manifest", {})
     run = meta.get("run", {})
+    _check_run_counts(p, run)
     ids = [str(v["id"]) for v in scenario.get("vessels", [])]
     acq = scenario.get("acquisition", {})
     agents: list[AgentInfo] = []
@@ -351,6 +352,28 @@ def _info(p: Path, meta: dict[str, dict[str, str]], has_summary: bool) -> Record
         has_summary=has_summary,
         planned=_planned(manifest),
     )
+
+
+RUN_COUNTS = ("first_frame", "frames_configured", "frames_requested", "frames_written")
+"""The ``run`` metadata fields that are whole numbers of frames (the readers take them as ``int``)."""
+
+
+def _check_run_counts(p: Path, run: dict[str, str]) -> None:
+    """Refuses (:class:`~mmusv.errors.IoError` naming the file and the field) a ``run`` metadata count of
+    :data:`RUN_COUNTS` that is not a whole number in ``0..MAX_FRAMES``: ``frames_written = "x"`` was a bare
+    ``ValueError`` traceback in the middle of a conversion, ``"-3"`` was taken."""
+    from mmusv.config import MAX_FRAMES
+
+    for key in RUN_COUNTS:
+        value = run.get(key)
+        if value in (None, ""):  # not said (an older or interrupted run): the readers fall back
+            continue
+        text = str(value).strip()
+        if not (text.isascii() and text.isdigit() and int(text) <= MAX_FRAMES):
+            raise IoError(
+                f"{p}: damaged run metadata: {key} = {arguments.shown(value)}, must be a whole number of frames in "
+                f"0..{MAX_FRAMES:,}"
+            )
 
 
 def _planned(manifest: dict[str, str]) -> tuple[int, int] | None:
