@@ -408,6 +408,22 @@ def test_many_targets_counted_at_once_are_each_counted_alone() -> None:
     assert want[1] == (0, 0) and want[0][1] + want[2][1] > 0  # some rays hidden by the crests
 
 
+def test_unsigned_offsets_are_offsets() -> None:
+    """``starts`` of any integer dtype (``lidar_boxes_beams`` gives int64; a user's may be unsigned) counts each
+    target's rows as int64 offsets do: uint64 offsets were a ``TypeError`` (numpy will not repeat by them)."""
+    scene, _, alone, _ = _world(Sea(hs_m=3.5, tp_s=8.0))
+    # 144 rays: offsets that fit uint8
+    origins, dirs = _fan(np.array([0.0, 0.0, 2.0]), np.array([150.0, 0.0, 0.8]), n=12)
+    t = alone.cast_rays(origins, dirs).distance
+    n = len(t)
+    want = exposed_hidden_boxes(scene, origins, dirs, t, np.array([0, n // 2, n // 2, n], np.int64))
+    assert want[0].sum() > 0
+    for dtype in (np.uint8, np.uint16, np.uint32, np.uint64, np.int32):
+        offsets = np.array([0, n // 2, n // 2, n]).astype(dtype)
+        got = exposed_hidden_boxes(scene, origins, dirs, t, offsets)
+        assert got[0].tolist() == want[0].tolist() and got[1].tolist() == want[1].tolist(), dtype
+
+
 def test_pattern_angles_are_remembered_by_content() -> None:
     """The same pattern twice gives the remembered angles; another pattern its own (not a stale entry)."""
     rng = np.random.default_rng(5)
@@ -535,6 +551,9 @@ def _bad_calls() -> list[tuple[str, Any, str]]:
         ("starts float", lambda: ehb(scene, o, d, t, [0.0, 4.0]), "starts must be (B + 1,) row offsets"),
         ("starts bool", lambda: ehb(scene, o, d, t, [False, True]), "got dtype bool"),
         ("starts (1, 2)", lambda: ehb(scene, o, d, t, [[0, 4]]), "starts must be (B + 1,)"),
+        # unsigned offsets that fall: np.diff wrapped round to a rise (uint32: a 32 GiB array), a bare IndexError
+        ("starts uint8 falling", lambda: ehb(scene, o, d, t, np.array([0, 3, 2, 4], np.uint8)), "got [0, 3, 2, 4]"),
+        ("starts uint16 falling", lambda: ehb(scene, o, d, t, np.array([0, 3, 2, 4], np.uint16)), "got [0, 3, 2, 4]"),
         # lidar_beam_rays: -1 gave the last beam's ray, a boolean mask was read as one
         ("beam -1", lambda: lbr(p, pose, np.array([-1])), "beams must be indices of the pattern's beams, in 0..3"),
         ("beam 9", lambda: lbr(p, pose, np.array([9])), "got 9"),

@@ -192,8 +192,10 @@ def _counts(
         if starts is None
         else _array(starts, name="starts", shape=(None,), what=what, integer=True)
     )
-    if starts.size == 0 or starts[0] != 0 or starts[-1] != n_rays or (np.diff(starts) < 0).any():
+    # Compared pairwise, not by np.diff: a difference of unsigned offsets wraps round (uint8 2 - 3 is 255, a rise).
+    if starts.size == 0 or starts[0] != 0 or starts[-1] != n_rays or (starts[1:] < starts[:-1]).any():
         raise InputError(f"starts must be {what}, got {starts.tolist()[:8]}{' ...' if starts.size > 8 else ''}")
+    starts = starts.astype(np.int64, copy=False)  # within 0..N now: uint64 offsets are counts np.repeat takes
     if scene_instance is not None:
         scene_instance = _array(
             scene_instance,
