@@ -167,3 +167,68 @@ def test_files_trimesh_would_misread_are_refused(
         _load(path)
     msg = str(err.value)
     assert words in msg and "hull.gltf" in msg and "\n" not in msg, (label, msg)
+
+
+def _draco_with_fallback(path: Path) -> Path:
+    """A GLB of the hull whose primitive is Draco-compressed and also stored plain (every accessor has its
+    bufferView), Draco in ``extensionsUsed`` only: a reader without a decoder reads the plain accessors (glTF 2.0)."""
+    import struct
+
+    import DracoPy
+
+    hull = _hull()
+    v, f = hull.vertices.astype(np.float32), hull.faces.astype(np.uint32)
+    blob = DracoPy.encode(v, f, quantization_bits=14)
+    position_id = DracoPy.decode(blob).attributes[0]["unique_id"]
+    views, data = [], b""
+    for chunk in (blob, v.tobytes(), f.tobytes()):
+        views.append({"buffer": 0, "byteOffset": len(data), "byteLength": len(chunk)})
+        data += chunk + b"\0" * (-len(chunk) % 4)
+    draco = {"bufferView": 0, "attributes": {"POSITION": position_id}}
+    doc = {
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_draco_mesh_compression"],
+        "buffers": [{"byteLength": len(data)}],
+        "bufferViews": views,
+        "accessors": [
+            {"bufferView": 2, "componentType": 5125, "type": "SCALAR", "count": int(f.size)},
+            {
+                "bufferView": 1,
+                "componentType": 5126,
+                "type": "VEC3",
+                "count": len(v),
+                "min": v.min(0).tolist(),
+                "max": v.max(0).tolist(),
+            },
+        ],
+        "meshes": [
+            {
+                "primitives": [
+                    {"attributes": {"POSITION": 1}, "indices": 0, "extensions": {"KHR_draco_mesh_compression": draco}}
+                ]
+            }
+        ],
+        "nodes": [{"mesh": 0}],
+        "scenes": [{"nodes": [0]}],
+        "scene": 0,
+    }
+    text = json.dumps(doc).encode()
+    text += b" " * (-len(text) % 4)
+    body = struct.pack("<II", len(text), 0x4E4F534A) + text + struct.pack("<II", len(data), 0x004E4942) + data
+    path.write_bytes(struct.pack("<III", 0x46546C67, 2, 12 + len(body)) + body)
+    return path
+
+
+def test_draco_with_a_fallback_loads_with_or_without_its_decoder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Draco only in ``extensionsUsed``, the geometry also stored plain: decoded where DracoPy is installed, read
+    from the plain accessors where it is not (was: refused, "needs the DracoPy package")."""
+    path = _draco_with_fallback(tmp_path / "fallback.glb")
+    decoded = _load(path)
+    monkeypatch.setitem(sys.modules, "DracoPy", None)  # import DracoPy raises ImportError
+    plain = _load(path)
+    assert decoded.mesh.faces.shape == plain.mesh.faces.shape == (1280, 3)
+    tol = 12.0 / 2**14 * 1.5
+    assert abs(decoded.length - plain.length) < 2 * tol and abs(decoded.beam - plain.beam) < 2 * tol
+    np.testing.assert_allclose(np.sort(plain.mesh.vertices, axis=0), np.sort(decoded.mesh.vertices, axis=0), atol=tol)

@@ -181,9 +181,9 @@ e.g. meshopt-compressed geometry as zeros, without a word)."""
 
 def _extension_checks(path: Path, data: dict[str, object], where: str) -> None:
     """Refuses a glTF that requires an extension outside :data:`_READ_EXTENSIONS`, that needs Draco decoding
-    without DracoPy installed (trimesh would read the geometry as zeros with a printed warning), or whose
-    ``POSITION`` is a normalized or sparse accessor (trimesh would read the raw integers, or leave the sparse
-    substitutions out)."""
+    without DracoPy installed (Draco required, or a Draco primitive without uncompressed fallback accessors: trimesh
+    would read the geometry as zeros with a printed warning), or whose ``POSITION`` is a normalized or sparse
+    accessor (trimesh would read the raw integers, or leave the sparse substitutions out)."""
     shown = repr(str(path))
     required = data.get("extensionsRequired", [])
     if not isinstance(required, list) or not all(isinstance(e, str) for e in required):
@@ -204,8 +204,13 @@ def _extension_checks(path: Path, data: dict[str, object], where: str) -> None:
             if not isinstance(p, dict):
                 continue
             ext = p.get("extensions")
-            draco = draco or (isinstance(ext, dict) and "KHR_draco_mesh_compression" in ext)
             attrs = p.get("attributes")
+            if isinstance(ext, dict) and "KHR_draco_mesh_compression" in ext:
+                # Only geometry without an uncompressed fallback needs decoding: where every accessor has its
+                # bufferView (Draco only in extensionsUsed), trimesh reads those when it cannot decode.
+                used = [p.get("indices"), *(attrs.values() if isinstance(attrs, dict) else [])]
+                accs = [_accessor(data, a) for a in used if a is not None]
+                draco = draco or not all(a is not None and "bufferView" in a for a in accs)
             k = attrs.get("POSITION") if isinstance(attrs, dict) else None
             acc = _accessor(data, k)
             if acc is None:
