@@ -164,3 +164,31 @@ def test_the_status_names_the_first_schema_error(browser: Any, live_server: Live
     settled(browser)
     assert "does not validate" not in status(browser)
     assert js_errors(browser) == []
+
+
+def test_escape_elsewhere_keeps_the_overwrite_question(browser: Any, live_server: LiveServer) -> None:
+    """Escape is the question's where the keyboard is on it or on what asked it (tested above); pressed on a vessel's
+    button to end drawing a route, or in a vessel's field, it did not end the drawing and threw the question (and the
+    run it held) away instead."""
+    open_editor(browser, live_server)
+    js_errors(browser)
+    save_as(browser, "held.yaml")  # names of their own: the folder is the module's
+    save_as(browser, "elsewhere.yaml")
+    ask_to_overwrite(browser, "held.yaml")
+
+    browser.find_element(By.CSS_SELECTOR, '#fleet li[data-id="tug"]').click()
+    browser.find_element(By.ID, "v-extend").click()
+    assert browser.execute_script("return window.mmusvEditor.map.mode") == "draw"
+    assert active_id(browser) == "v-extend"
+    ActionChains(browser).send_keys(Keys.ESCAPE).perform()
+    assert browser.execute_script("return window.mmusvEditor.map.mode") == "select"  # was: still drawing
+    assert browser.execute_script(CONFIRM_SHOWN)  # was: closed, "not saved: the file was kept as it is"
+
+    browser.find_element(By.ID, "v-speed").click()
+    ActionChains(browser).send_keys(Keys.ESCAPE).perform()
+    assert browser.execute_script(CONFIRM_SHOWN)
+
+    browser.find_element(By.ID, "save-overwrite").send_keys(Keys.ESCAPE)  # on the question: it closes
+    assert not browser.execute_script(CONFIRM_SHOWN)
+    assert active_id(browser) == "file-name"
+    assert js_errors(browser) == []

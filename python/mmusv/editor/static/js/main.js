@@ -480,6 +480,14 @@ function cancelConfirm() {
   status("not saved: the file was kept as it is; give another file name to save under it");
 }
 $("save-cancel").addEventListener("click", cancelConfirm);
+/** Whether Escape is the overwrite question's: the keyboard is on the question, on the toolbar box or button that
+ * asked it (file name, Save, Frames, Run) or on nothing. Elsewhere Escape keeps its own meaning (on the map or a
+ * vessel's button it ends placing or drawing) and the question, with the run it may hold, stays. */
+function confirmHasKeyboard() {
+  const at = document.activeElement;
+  if (!at || at === document.body || $("save-confirm").contains(at)) return true;
+  return ["file-name", "save", "run-frames", "run"].includes(at.id);
+}
 $("undo").addEventListener("click", () => state.undo());
 $("redo").addEventListener("click", () => state.redo());
 $("preview").addEventListener("click", preview);
@@ -525,7 +533,7 @@ window.addEventListener("keydown", (ev) => {
     ev.preventDefault();
     runAfterSave = null;
     save(false);
-  } else if (ev.key === "Escape" && !$("save-confirm").hidden) {
+  } else if (ev.key === "Escape" && !$("save-confirm").hidden && confirmHasKeyboard()) {
     ev.preventDefault();
     const inside = $("save-confirm").contains(document.activeElement) || document.activeElement === $("save");
     cancelConfirm();
