@@ -297,6 +297,28 @@ def test_contact_sheet_refuses_bad_arguments_before_writing(tmp_path: Path, kwar
     assert not (tmp_path / "sheet").exists()
 
 
+def test_contact_sheet_takes_a_generator_of_names_and_numpy_sizes(tmp_path: Path) -> None:
+    """Valid before the arguments were checked: names from a generator (refused as 'not generator') and sizes
+    as numpy arrays (refused as 'must be (width, height)'); a 2-D or float array is still refused."""
+    from mmusv.errors import ConfigError
+    from mmusv.world.contact_sheet import write_contact_sheet
+    from PIL import Image
+
+    path = write_contact_sheet(
+        tmp_path / "a",
+        names=(n for n in ["usv_wamv", "kayak_4m"]),
+        tile=np.array([16, 12]),
+        asset_size=np.array([8, 6], dtype=np.int32),
+    )
+    assert sorted(p.name for p in path.parent.glob("*.png")) == ["contact_sheet.png", "kayak_4m.png", "usv_wamv.png"]
+    with Image.open(tmp_path / "a" / "usv_wamv.png") as img:
+        assert img.size == (8, 6)
+    for bad in (np.array([[16, 12]]), np.array([16.0, 12.0])):
+        with pytest.raises(ConfigError, match="tile"):
+            write_contact_sheet(tmp_path / "b", names=["usv_wamv"], tile=bad, asset_size=(8, 6))
+    assert not (tmp_path / "b").exists()
+
+
 def test_contact_sheet_names_the_file_it_cannot_write(tmp_path: Path) -> None:
     """A PNG that cannot be written was a bare OSError naming the hidden temporary file."""
     from mmusv.errors import IoError

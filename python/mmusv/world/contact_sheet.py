@@ -13,7 +13,7 @@ import contextlib
 import inspect
 import math
 import os
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -144,6 +144,8 @@ def write_contact_sheet(
     from mmusv.world.vessels import asset_names
 
     out = arguments.path(out_dir, name="out_dir")
+    if isinstance(names, Iterator):  # a generator of names, read once (an ordered iterable, as before)
+        names = list(names)
     if names is not None:  # a bare string was read as its letters ('u' is not an asset)
         arguments.names(names, name="names", example="['usv_wamv']")
     chosen = asset_names() if names is None else list(names)
@@ -182,6 +184,8 @@ def write_contact_sheet(
 def _size(value: Any, name: str) -> tuple[int, int]:
     """``value`` as ``(width, height)``, whole numbers of pixels in 1..:data:`MAX_SIDE_PX`; else a ConfigError
     naming ``name``."""
+    if isinstance(value, np.ndarray) and value.ndim == 1:  # np.array([320, 240]): numpy integers, checked below
+        value = tuple(value)
     if isinstance(value, (str, bytes)) or not isinstance(value, Sequence) or len(value) != 2:
         raise ConfigError(f"{name} = {arguments.shown(value)}: must be (width, height) in pixels, e.g. (320, 240)")
     w, h = (arguments.whole(v, name=f"{name}[{i}]", lo=1, hi=MAX_SIDE_PX) for i, v in enumerate(value))
