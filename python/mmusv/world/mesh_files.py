@@ -24,7 +24,7 @@ import math
 import os
 import struct
 import warnings
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 from urllib.parse import unquote
@@ -179,6 +179,17 @@ with, and how; glTF 2.0 asks a reader to refuse a file that requires any other (
 e.g. meshopt-compressed geometry as zeros, without a word)."""
 
 
+def _primitives(data: dict[str, object]) -> Iterator[tuple[int, int, dict[str, object]]]:
+    """``(i, j, primitive)`` of every ``meshes[i].primitives[j]`` of a glTF JSON that is an object, in file order
+    (entries of other kinds are skipped: trimesh's loader reports them)."""
+    meshes = data.get("meshes")
+    for i, m in enumerate(meshes if isinstance(meshes, list) else []):
+        prims = m.get("primitives") if isinstance(m, dict) else None
+        for j, p in enumerate(prims if isinstance(prims, list) else []):
+            if isinstance(p, dict):
+                yield i, j, p
+
+
 def _extension_checks(path: Path, data: dict[str, object], where: str) -> None:
     """Refuses a glTF that requires an extension outside :data:`_READ_EXTENSIONS`, that needs Draco decoding
     without DracoPy installed (Draco required, or a Draco primitive without uncompressed fallback accessors: trimesh
@@ -197,38 +208,33 @@ def _extension_checks(path: Path, data: dict[str, object], where: str) -> None:
                 f"ones it reads are {known}: export the file without {name}",
             )
     draco = "KHR_draco_mesh_compression" in required
-    meshes = data.get("meshes")
-    for i, m in enumerate(meshes if isinstance(meshes, list) else []):
-        prims = m.get("primitives") if isinstance(m, dict) else None
-        for j, p in enumerate(prims if isinstance(prims, list) else []):
-            if not isinstance(p, dict):
-                continue
-            ext = p.get("extensions")
-            attrs = p.get("attributes")
-            if isinstance(ext, dict) and "KHR_draco_mesh_compression" in ext:
-                # Only geometry without an uncompressed fallback needs decoding: where every accessor has its
-                # bufferView (Draco only in extensionsUsed), trimesh reads those when it cannot decode.
-                used = [p.get("indices"), *(attrs.values() if isinstance(attrs, dict) else [])]
-                accs = [_accessor(data, a) for a in used if a is not None]
-                draco = draco or not all(a is not None and "bufferView" in a for a in accs)
-            k = attrs.get("POSITION") if isinstance(attrs, dict) else None
-            acc = _accessor(data, k)
-            if acc is None:
-                continue
-            at = f"{shown}: meshes[{i}].primitives[{j}].attributes.POSITION (accessors[{k}])"
-            if acc.get("normalized") is True:
-                raise AssetSpecError(
-                    where,
-                    f"{at} is a normalized integer accessor, which trimesh's glTF reader would take as the raw "
-                    "integers (a mesh hundreds of times too large); write positions as float, or as integers without "
-                    "normalized with the scale in the node",
-                )
-            if "sparse" in acc:
-                raise AssetSpecError(
-                    where,
-                    f"{at} is a sparse accessor, whose substitutions trimesh's glTF reader does not apply (the shape "
-                    "would be wrong without a word); write POSITION as a plain accessor",
-                )
+    for i, j, p in _primitives(data):
+        ext = p.get("extensions")
+        attrs = p.get("attributes")
+        if isinstance(ext, dict) and "KHR_draco_mesh_compression" in ext:
+            # Only geometry without an uncompressed fallback needs decoding: where every accessor has its
+            # bufferView (Draco only in extensionsUsed), trimesh reads those when it cannot decode.
+            used = [p.get("indices"), *(attrs.values() if isinstance(attrs, dict) else [])]
+            accs = [_accessor(data, a) for a in used if a is not None]
+            draco = draco or not all(a is not None and "bufferView" in a for a in accs)
+        k = attrs.get("POSITION") if isinstance(attrs, dict) else None
+        acc = _accessor(data, k)
+        if acc is None:
+            continue
+        at = f"{shown}: meshes[{i}].primitives[{j}].attributes.POSITION (accessors[{k}])"
+        if acc.get("normalized") is True:
+            raise AssetSpecError(
+                where,
+                f"{at} is a normalized integer accessor, which trimesh's glTF reader would take as the raw "
+                "integers (a mesh hundreds of times too large); write positions as float, or as integers without "
+                "normalized with the scale in the node",
+            )
+        if "sparse" in acc:
+            raise AssetSpecError(
+                where,
+                f"{at} is a sparse accessor, whose substitutions trimesh's glTF reader does not apply (the shape "
+                "would be wrong without a word); write POSITION as a plain accessor",
+            )
     if draco:
         try:
             import DracoPy  # noqa: F401
@@ -247,49 +253,44 @@ def _color_0_checks(path: Path, data: dict[str, object], where: str) -> list[str
     geometry of, in its order."""
     shown = repr(str(path))
     names: list[str] = []
-    meshes = data.get("meshes")
-    for i, m in enumerate(meshes if isinstance(meshes, list) else []):
-        prims = m.get("primitives") if isinstance(m, dict) else None
-        for j, p in enumerate(prims if isinstance(prims, list) else []):
-            if not isinstance(p, dict):
-                continue
-            label = f"meshes[{i}].primitives[{j}]"
-            mode = p.get("mode", 4)
-            if isinstance(mode, int) and mode in _GLTF_MODES:
-                names.append(label)
-            attrs = p.get("attributes")
-            if not isinstance(attrs, dict) or "COLOR_0" not in attrs:
-                continue
-            at = f"{shown}: {label}.attributes.COLOR_0"
-            k = attrs["COLOR_0"]
-            acc = _accessor(data, k)
-            if acc is None:
-                raise AssetSpecError(where, f"{at} is {k!r}, which names no accessor of the file")
-            at = f"{at} (accessors[{k}])"
-            kind, comp = acc.get("type"), acc.get("componentType")
-            if kind not in ("VEC3", "VEC4"):
-                raise AssetSpecError(where, f"{at} is of type {kind!r}; a vertex colour must be VEC3 or VEC4")
-            if comp not in _COLOR_TYPES or (comp != 5126 and acc.get("normalized") is not True):
-                what = _COLOR_TYPES.get(comp, "")  # type: ignore[call-overload]
-                got = f"{comp!r} ({what}, not normalized)" if what else repr(comp)
-                raise AssetSpecError(
-                    where,
-                    f"{at} has componentType {got}; a vertex colour must be float (5126), or unsigned byte (5121) "
-                    "or unsigned short (5123) with normalized: true",
-                )
-            if "sparse" in acc:
-                read = "its bufferView's values" if "bufferView" in acc else "zeros (black)"
-                raise AssetSpecError(
-                    where,
-                    f"{at} is a sparse accessor, whose substitutions trimesh's glTF reader does not apply (it would "
-                    f"read {read}); write COLOR_0 as a plain accessor, as Blender's and trimesh's exporters do",
-                )
-            pos = _accessor(data, attrs.get("POSITION"))
-            count, vertices = acc.get("count"), None if pos is None else pos.get("count")
-            if vertices is not None and count != vertices:
-                raise AssetSpecError(
-                    where, f"{at} has {count!r} colours for the {vertices!r} vertices of its POSITION accessor"
-                )
+    for i, j, p in _primitives(data):
+        label = f"meshes[{i}].primitives[{j}]"
+        mode = p.get("mode", 4)
+        if isinstance(mode, int) and mode in _GLTF_MODES:
+            names.append(label)
+        attrs = p.get("attributes")
+        if not isinstance(attrs, dict) or "COLOR_0" not in attrs:
+            continue
+        at = f"{shown}: {label}.attributes.COLOR_0"
+        k = attrs["COLOR_0"]
+        acc = _accessor(data, k)
+        if acc is None:
+            raise AssetSpecError(where, f"{at} is {k!r}, which names no accessor of the file")
+        at = f"{at} (accessors[{k}])"
+        kind, comp = acc.get("type"), acc.get("componentType")
+        if kind not in ("VEC3", "VEC4"):
+            raise AssetSpecError(where, f"{at} is of type {kind!r}; a vertex colour must be VEC3 or VEC4")
+        if comp not in _COLOR_TYPES or (comp != 5126 and acc.get("normalized") is not True):
+            what = _COLOR_TYPES.get(comp, "")  # type: ignore[call-overload]
+            got = f"{comp!r} ({what}, not normalized)" if what else repr(comp)
+            raise AssetSpecError(
+                where,
+                f"{at} has componentType {got}; a vertex colour must be float (5126), or unsigned byte (5121) "
+                "or unsigned short (5123) with normalized: true",
+            )
+        if "sparse" in acc:
+            read = "its bufferView's values" if "bufferView" in acc else "zeros (black)"
+            raise AssetSpecError(
+                where,
+                f"{at} is a sparse accessor, whose substitutions trimesh's glTF reader does not apply (it would "
+                f"read {read}); write COLOR_0 as a plain accessor, as Blender's and trimesh's exporters do",
+            )
+        pos = _accessor(data, attrs.get("POSITION"))
+        count, vertices = acc.get("count"), None if pos is None else pos.get("count")
+        if vertices is not None and count != vertices:
+            raise AssetSpecError(
+                where, f"{at} has {count!r} colours for the {vertices!r} vertices of its POSITION accessor"
+            )
     return names
 
 
