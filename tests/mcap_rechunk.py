@@ -6,9 +6,9 @@ from pathlib import Path
 from typing import Any
 
 
-def rechunk(src: Path, dst: Path, chunk_size: int) -> None:
+def rechunk(src: Path, dst: Path, chunk_size: int, *, run_changes: dict[str, str] | None = None) -> None:
     """Copies a recording record by record into small zstd chunks (with CRCs) using the official writer (a real
-    run's chunks are ~4 MiB)."""
+    run's chunks are ~4 MiB); ``run_changes``, when given, are made to its ``run`` metadata."""
     from mcap.records import Channel, Message, Metadata, Schema
     from mcap.stream_reader import StreamReader
     from mcap.writer import CompressionType, Writer
@@ -28,7 +28,8 @@ def rechunk(src: Path, dst: Path, chunk_size: int) -> None:
             elif isinstance(rec, Message):
                 w.add_message(channels[rec.channel_id], rec.log_time, rec.data, rec.publish_time, rec.sequence)
             elif isinstance(rec, Metadata):
-                w.add_metadata(rec.name, rec.metadata)
+                changed = {**rec.metadata, **run_changes} if run_changes and rec.name == "run" else rec.metadata
+                w.add_metadata(rec.name, changed)
         w.finish()  # type: ignore[no-untyped-call]
 
 

@@ -7,6 +7,7 @@ import random
 from pathlib import Path
 
 import pytest
+from mcap_rechunk import rechunk
 from mmusv.errors import IoError, MmusvError
 
 from .conftest import api_readers, check_against, chunk_spans, cli_main, frames_of
@@ -163,27 +164,7 @@ def test_the_batch_index_and_the_editor_open_damaged_files_cleanly(small: Path, 
 
 def _with_run_metadata(src: Path, dst: Path, **changes: str) -> Path:
     """``src`` copied record by record with ``changes`` made to its ``run`` metadata."""
-    from mcap.records import Channel, Message, Metadata, Schema
-    from mcap.stream_reader import StreamReader
-    from mcap.writer import Writer
-
-    with src.open("rb") as f, dst.open("wb") as g:
-        w = Writer(g)
-        w.start(profile="", library="test")
-        schemas: dict[int, int] = {}
-        channels: dict[int, int] = {}
-        for rec in StreamReader(f).records:
-            if isinstance(rec, Schema):
-                schemas[rec.id] = w.register_schema(rec.name, rec.encoding, rec.data)
-            elif isinstance(rec, Channel):
-                channels[rec.id] = w.register_channel(
-                    rec.topic, rec.message_encoding, schemas.get(rec.schema_id, 0), rec.metadata
-                )
-            elif isinstance(rec, Message):
-                w.add_message(channels[rec.channel_id], rec.log_time, rec.data, rec.publish_time, rec.sequence)
-            elif isinstance(rec, Metadata):
-                w.add_metadata(rec.name, {**rec.metadata, **changes} if rec.name == "run" else rec.metadata)
-        w.finish()  # type: ignore[no-untyped-call]
+    rechunk(src, dst, 4 * 1024 * 1024, run_changes=changes)
     return dst
 
 
