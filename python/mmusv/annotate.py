@@ -388,7 +388,6 @@ def annotate_agent(
             inv, p = np.linalg.inv(pose), np.ascontiguousarray(pose, dtype=np.float64)
             views[name] = (cam, cam.intrinsics, inv, p, inst_img, _lens(cam, p, inv))
     rotations: list[np.ndarray] = []  # the 3D boxes' rotation matrices, turned into quaternions in one call
-    lidar_shares = scene is not None and lidar_pose is not None and lidar_pattern is not None and angles is not None
     share_boxes: list[tuple[int, np.ndarray, str, np.ndarray]] = []  # 3D box row, corners, asset, pose
     for vi, info in enumerate(vessels):
         if vi == agent_index:
@@ -409,8 +408,8 @@ def annotate_agent(
             ann.lidar_range.append(rng)
             ann.lidar_role.append(info.role)
             ann.lidar_static.append(bool(info.static))
-            if lidar_shares:  # worked out below for all boxes at once
-                share_boxes.append((len(ann.lidar_wave_occlusion), corners_world, info.asset, state.matrices[vi]))
+            # the wave-occlusion share: worked out below for all boxes at once (0 where there is none to work out)
+            share_boxes.append((len(ann.lidar_wave_occlusion), corners_world, info.asset, state.matrices[vi]))
             ann.lidar_wave_occlusion.append(0.0)
         for name, (cam, k, inv, pose, inst_img, lens) in views.items():
             h, w = inst_img.shape
