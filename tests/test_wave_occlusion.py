@@ -309,27 +309,41 @@ def _box_beams_by_testing_every_beam(pattern: np.ndarray, pose: np.ndarray, corn
     return np.flatnonzero(inside & (prel >= rel.min()) & (prel <= rel.max()))
 
 
+_SIGNS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=np.float64)
+"""The corners of a box as signs of its half sizes."""
+
+
+def _grid_pattern(az: np.ndarray, el: np.ndarray) -> np.ndarray:
+    """``(len(az) * len(el), 3)`` float32 unit beams on the azimuth × elevation grid (radians), azimuth-major."""
+    a, e = np.meshgrid(az, el, indexing="ij")
+    pattern = np.stack([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)], -1).reshape(-1, 3)
+    return pattern.astype(np.float32)
+
+
+def _random_pose(rng: np.random.Generator) -> np.ndarray:
+    """A LiDAR pose turned by a random yaw about z and moved a few metres (draws: the yaw, then the offset)."""
+    th = rng.uniform(-np.pi, np.pi)
+    pose = np.eye(4)
+    pose[:2, :2] = [[np.cos(th), -np.sin(th)], [np.sin(th), np.cos(th)]]
+    pose[:3, 3] = rng.normal(size=3) * 5.0
+    return pose
+
+
 def test_lidar_box_rays_find_the_beams_that_testing_every_beam_finds() -> None:
     """The binary search over sorted azimuths selects exactly the beams a test of every beam selects, boxes
     behind the LiDAR (straddling ±π) and boxes wider than half a turn included."""
     el = np.deg2rad(np.linspace(-25.0, 15.0, 64))
     az = np.linspace(-np.pi, np.pi, 512, endpoint=False)
-    a, e = np.meshgrid(az, el, indexing="ij")
-    pattern = np.stack([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)], -1).reshape(-1, 3)
-    pattern = pattern.astype(np.float32)
+    pattern = _grid_pattern(az, el)
     angles = pattern_angles(pattern)
     rng = np.random.default_rng(3)
-    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=np.float64)
     for k in range(200):
-        th = rng.uniform(-np.pi, np.pi)
-        pose = np.eye(4)
-        pose[:2, :2] = [[np.cos(th), -np.sin(th)], [np.sin(th), np.cos(th)]]
-        pose[:3, 3] = rng.normal(size=3) * 5.0
+        pose = _random_pose(rng)
         centre = np.array([rng.uniform(-200, 200), rng.uniform(-200, 200), rng.uniform(0, 10)])
         if k % 4 == 0:  # straight behind the sensor: the box straddles azimuth ±π
             centre[:2] = pose[:2, 3] - 80.0 * pose[:2, 0]
         half = rng.uniform([1.0, 0.5, 0.5], [150.0, 20.0, 15.0])
-        corners = centre + half * signs
+        corners = centre + half * _SIGNS
         _, dirs = lidar_box_rays(pattern, angles, pose, corners)
         want = _box_beams_by_testing_every_beam(pattern, pose, corners)
         expected = (pattern.astype(np.float64)[want] @ pose[:3, :3].T).astype(np.float32)
@@ -341,23 +355,17 @@ def test_many_boxes_beams_are_each_box_s_own() -> None:
     (boxes behind the LiDAR, overlapping boxes and an empty stack included), in ``starts``' slices."""
     el = np.deg2rad(np.linspace(-25.0, 15.0, 32))
     az = np.linspace(-np.pi, np.pi, 256, endpoint=False)
-    a, e = np.meshgrid(az, el, indexing="ij")
-    pattern = np.stack([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)], -1).reshape(-1, 3)
-    pattern = pattern.astype(np.float32)
+    pattern = _grid_pattern(az, el)
     angles = pattern_angles(pattern)
     rng = np.random.default_rng(11)
-    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=np.float64)
     for k in range(60):
-        th = rng.uniform(-np.pi, np.pi)
-        pose = np.eye(4)
-        pose[:2, :2] = [[np.cos(th), -np.sin(th)], [np.sin(th), np.cos(th)]]
-        pose[:3, 3] = rng.normal(size=3) * 5.0
+        pose = _random_pose(rng)
         boxes = []
         for _ in range(k % 7):
             centre = np.array([rng.uniform(-200, 200), rng.uniform(-200, 200), rng.uniform(0, 10)])
             if rng.uniform() < 0.3:  # straight behind the sensor: the box straddles azimuth ±π
                 centre[:2] = pose[:2, 3] - 80.0 * pose[:2, 0]
-            boxes.append(centre + rng.uniform([1.0, 0.5, 0.5], [150.0, 20.0, 15.0]) * signs)
+            boxes.append(centre + rng.uniform([1.0, 0.5, 0.5], [150.0, 20.0, 15.0]) * _SIGNS)
         stack = np.array(boxes, dtype=np.float64).reshape(-1, 8, 3)
         beams, starts = lidar_boxes_beams(angles, pose, stack)
         assert beams.dtype == starts.dtype == np.int64 and starts.shape == (len(boxes) + 1,) and starts[0] == 0
