@@ -3,28 +3,25 @@
 :func:`load_mesh_file` first checks what trimesh would report obscurely or not at all (an empty file, an extension
 trimesh cannot read, a GLB shorter than its header says, a glTF buffer or image file that is missing, a ``COLOR_0``
 that does not fit its primitive, a glTF that requires an extension it does not read or a ``POSITION`` it would
-misread; Draco-compressed glTF geometry is decoded with DracoPy), reads the file unprocessed, refuses non-finite
-vertex coordinates (trimesh's processing would drop the faces touching them without a word), takes each face's
-colours (merging vertices would keep one colour per place), then processes each piece as
-``trimesh.load(process=True)`` would. Each face gets a registered material (:mod:`mmusv.world.mesh_materials`, which
-says how each is converted): a glTF/GLB file's PBR materials (times its primitives' ``COLOR_0`` vertex colours, read
-here from the loader's raw arrays), an OBJ's MTL materials by ``usemtl`` (a missing ``.mtl`` or texture is an error,
-an OBJ without ``mtllib`` the class's default look), vertex or face colours (PLY, OBJ) quantised to at most
-:data:`~mmusv.world.mesh_materials.MAX_COLOUR_MATERIALS` materials a file; other faces get material 0, the class's
-default look. :func:`mesh_asset` turns a file's mesh into the body frame of a
-:class:`~mmusv.world.vessels.VesselAsset` (:mod:`mmusv.world.vessels` builds the asset around it), by the entry's
-``up_axis``/``forward_axis`` or, when it gives neither, the file format's convention
+misread: a glTF's are :mod:`mmusv.world.gltf_checks`'s; Draco-compressed glTF geometry is decoded with DracoPy),
+reads the file unprocessed, refuses non-finite vertex coordinates (trimesh's processing would drop the faces
+touching them without a word), takes each face's colours (merging vertices would keep one colour per place), then
+processes each piece as ``trimesh.load(process=True)`` would. Each face gets a registered material
+(:mod:`mmusv.world.mesh_materials`, which says how each is converted): a glTF/GLB file's PBR materials (times its
+primitives' ``COLOR_0`` vertex colours, read here from the loader's raw arrays), an OBJ's MTL materials by
+``usemtl`` (a missing ``.mtl`` or texture is an error, an OBJ without ``mtllib`` the class's default look), vertex
+or face colours (PLY, OBJ) quantised to at most :data:`~mmusv.world.mesh_materials.MAX_COLOUR_MATERIALS` materials a
+file; other faces get material 0, the class's default look. :func:`mesh_asset` turns a file's mesh into the body
+frame of a :class:`~mmusv.world.vessels.VesselAsset` (:mod:`mmusv.world.vessels` builds the asset around it), by the
+entry's ``up_axis``/``forward_axis`` or, when it gives neither, the file format's convention
 (:data:`~mmusv.world.asset_spec.FORMAT_AXES`: glTF is +Y up, front +Z).
 """
 
 from __future__ import annotations
 
-import json
-import math
 import os
-import struct
 import warnings
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 from urllib.parse import unquote
@@ -34,13 +31,12 @@ import numpy as np
 from mmusv.errors import ConfigError
 from mmusv.validation import join
 from mmusv.world.asset_spec import AXES, FORMAT_AXES, AssetSpecError, MeshAssetSpec, dimension_problem
+from mmusv.world.gltf_checks import check_gltf
 from mmusv.world.mesh_materials import (
     GLTF_EMISSIVE_SCALE,
     EmissiveKey,
     ObjMaterials,
-    check_image,
     colour_material_ids,
-    emissive_key,
     face_colours,
     gltf_material_id,
     obj_materials,
@@ -62,236 +58,6 @@ def _axis(name: str) -> np.ndarray:
 _MESH_FORMATS = frozenset({"3mf", "dae", "glb", "gltf", "obj", "off", "ply", "stl"})
 """The triangle-mesh formats named in the error for a file trimesh cannot read (those of them it can read in this
 install; it also reads archives of them and formats of other kinds)."""
-
-_GLB_MAGIC = b"glTF"
-_GLB_JSON = 0x4E4F534A
-
-
-def _gltf_json(path: Path, where: str) -> dict[str, object]:
-    """The JSON of a .gltf file or of a GLB's first chunk; a GLB whose header or JSON chunk runs past the file's end
-    is refused as truncated, and either whose JSON does not parse as not glTF."""
-    shown = repr(str(path))
-    try:
-        if path.suffix.lower() == ".glb":
-            size = path.stat().st_size
-            with path.open("rb") as f:
-                head = f.read(20)
-                if len(head) < 12 or head[:4] != _GLB_MAGIC:
-                    raise AssetSpecError(
-                        where, f"{shown} is not a binary glTF (GLB) file: it does not start with the 'glTF' magic"
-                    )
-                declared = struct.unpack_from("<I", head, 8)[0]
-                if declared > size:
-                    raise AssetSpecError(
-                        where, f"{shown} is truncated: its GLB header declares {declared} bytes, the file holds {size}"
-                    )
-                chunk, kind = struct.unpack_from("<II", head, 12) if len(head) == 20 else (0, 0)
-                if kind != _GLB_JSON or 20 + chunk > declared:
-                    raise AssetSpecError(
-                        where, f"{shown} is not a valid GLB file: it does not begin with a JSON chunk within its length"
-                    )
-                text = f.read(chunk)
-        else:
-            text = path.read_bytes()
-        data = json.loads(text)
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise AssetSpecError(where, f"{shown} is not a glTF file: its JSON does not parse ({one_line(exc)})") from exc
-    if not isinstance(data, dict):
-        raise AssetSpecError(where, f"{shown} is not a glTF file: its JSON is not an object")
-    return data
-
-
-def _gltf_checks(path: Path, data: dict[str, object], where: str) -> dict[EmissiveKey, float]:
-    """Refuses a glTF whose external buffers or images are missing (trimesh would fail with the bare file name, or
-    leave a texture out without a word); returns ``KHR_materials_emissive_strength`` by material name and
-    ``emissiveFactor`` (:func:`~mmusv.world.mesh_materials.emissive_key`; trimesh drops the extension), refusing two
-    materials of one name and one factor with different strengths."""
-    shown = repr(str(path))
-    for kind in ("buffers", "images"):
-        items = data.get(kind)
-        for i, item in enumerate(items if isinstance(items, list) else []):
-            uri = item.get("uri") if isinstance(item, dict) else None
-            if not isinstance(uri, str) or uri.startswith("data:"):
-                continue
-            target = path.parent / unquote(uri)
-            if not target.is_file():
-                raise AssetSpecError(
-                    where,
-                    f"{shown} needs the file {uri!r} ({kind}[{i}].uri), which is missing (looked for "
-                    f"{str(target)!r}); keep a .gltf's .bin and texture files beside it",
-                )
-            if kind == "images":
-                check_image(target, f"{shown}: its texture {uri!r} ({kind}[{i}].uri)", where)
-    strengths: dict[EmissiveKey, float] = {}
-    materials = data.get("materials")
-    for i, m in enumerate(materials if isinstance(materials, list) else []):
-        if not isinstance(m, dict):
-            continue
-        ext = m.get("extensions")
-        ks = ext.get("KHR_materials_emissive_strength") if isinstance(ext, dict) else None
-        value = ks.get("emissiveStrength", 1.0) if isinstance(ks, dict) else 1.0
-        ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value) and value >= 0
-        if not ok:
-            raise AssetSpecError(
-                where,
-                f"{shown}: materials[{i}] has KHR_materials_emissive_strength {value!r}; it must be a number >= 0",
-            )
-        key = emissive_key(m.get("name"), m.get("emissiveFactor"))
-        if key is None:  # emits nothing: the strength changes nothing
-            continue
-        if strengths.get(key, float(value)) != float(value):
-            raise AssetSpecError(
-                where,
-                f"{shown}: two materials named {key[0]!r} with the same emissiveFactor have different "
-                "KHR_materials_emissive_strength; give them different names",
-            )
-        strengths[key] = float(value)
-    return strengths
-
-
-_GLTF_MODES = frozenset({0, 1, 4, 5})
-"""The primitive modes trimesh's glTF loader reads (points, lines, triangles, triangle strips), one geometry each."""
-
-_COLOR_TYPES = {5126: "float", 5121: "unsigned byte", 5123: "unsigned short"}
-"""The component types glTF 2.0 allows for ``COLOR_n`` (the integer ones normalized)."""
-
-
-def _accessor(data: dict[str, object], index: object) -> dict[str, object] | None:
-    """``accessors[index]`` of a glTF JSON, ``None`` when ``index`` names none."""
-    accessors = data.get("accessors")
-    ok = isinstance(index, int) and not isinstance(index, bool) and isinstance(accessors, list)
-    if not ok or not 0 <= index < len(accessors):  # type: ignore[operator,arg-type]
-        return None
-    a = accessors[index]  # type: ignore[index]
-    return a if isinstance(a, dict) else None
-
-
-_READ_EXTENSIONS = {
-    "KHR_draco_mesh_compression": "decoded with DracoPy",
-    "KHR_materials_emissive_strength": "read here",
-    "KHR_materials_pbrSpecularGlossiness": "converted to metallic-roughness by trimesh",
-    "KHR_mesh_quantization": "integer positions read as their numbers (normalized ones refused)",
-    "KHR_texture_transform": "textures are taken by their mean, whatever their coordinates",
-    "EXT_texture_webp": "read by Pillow",
-}
-"""The glTF extensions a file may require (``extensionsRequired``) that its meshes and materials are read right
-with, and how; glTF 2.0 asks a reader to refuse a file that requires any other (trimesh would read such a file on,
-e.g. meshopt-compressed geometry as zeros, without a word)."""
-
-
-def _primitives(data: dict[str, object]) -> Iterator[tuple[int, int, dict[str, object]]]:
-    """``(i, j, primitive)`` of every ``meshes[i].primitives[j]`` of a glTF JSON that is an object, in file order
-    (entries of other kinds are skipped: trimesh's loader reports them)."""
-    meshes = data.get("meshes")
-    for i, m in enumerate(meshes if isinstance(meshes, list) else []):
-        prims = m.get("primitives") if isinstance(m, dict) else None
-        for j, p in enumerate(prims if isinstance(prims, list) else []):
-            if isinstance(p, dict):
-                yield i, j, p
-
-
-def _extension_checks(path: Path, data: dict[str, object], where: str) -> None:
-    """Refuses a glTF that requires an extension outside :data:`_READ_EXTENSIONS`, that needs Draco decoding
-    without DracoPy installed (Draco required, or a Draco primitive without uncompressed fallback accessors: trimesh
-    would read the geometry as zeros with a printed warning), or whose ``POSITION`` is a normalized or sparse
-    accessor (trimesh would read the raw integers, or leave the sparse substitutions out)."""
-    shown = repr(str(path))
-    required = data.get("extensionsRequired", [])
-    if not isinstance(required, list) or not all(isinstance(e, str) for e in required):
-        raise AssetSpecError(where, f"{shown}: extensionsRequired must be a list of extension names, got {required!r}")
-    for name in required:
-        if name not in _READ_EXTENSIONS:
-            known = ", ".join(sorted(_READ_EXTENSIONS))
-            raise AssetSpecError(
-                where,
-                f"{shown} requires the glTF extension {name!r} (extensionsRequired), which mmusv does not read; the "
-                f"ones it reads are {known}: export the file without {name}",
-            )
-    draco = "KHR_draco_mesh_compression" in required
-    for i, j, p in _primitives(data):
-        ext = p.get("extensions")
-        attrs = p.get("attributes")
-        if isinstance(ext, dict) and "KHR_draco_mesh_compression" in ext:
-            # Only geometry without an uncompressed fallback needs decoding: where every accessor has its
-            # bufferView (Draco only in extensionsUsed), trimesh reads those when it cannot decode.
-            used = [p.get("indices"), *(attrs.values() if isinstance(attrs, dict) else [])]
-            accs = [_accessor(data, a) for a in used if a is not None]
-            draco = draco or not all(a is not None and "bufferView" in a for a in accs)
-        k = attrs.get("POSITION") if isinstance(attrs, dict) else None
-        acc = _accessor(data, k)
-        if acc is None:
-            continue
-        at = f"{shown}: meshes[{i}].primitives[{j}].attributes.POSITION (accessors[{k}])"
-        if acc.get("normalized") is True:
-            raise AssetSpecError(
-                where,
-                f"{at} is a normalized integer accessor, which trimesh's glTF reader would take as the raw "
-                "integers (a mesh hundreds of times too large); write positions as float, or as integers without "
-                "normalized with the scale in the node",
-            )
-        if "sparse" in acc:
-            raise AssetSpecError(
-                where,
-                f"{at} is a sparse accessor, whose substitutions trimesh's glTF reader does not apply (the shape "
-                "would be wrong without a word); write POSITION as a plain accessor",
-            )
-    if draco:
-        try:
-            import DracoPy  # noqa: F401
-        except ImportError:
-            raise AssetSpecError(
-                where,
-                f"{shown} holds Draco-compressed geometry (KHR_draco_mesh_compression), which needs the DracoPy "
-                "package to decode (pip install DracoPy; mmusv's install has it); else trimesh reads it as zeros",
-            ) from None
-
-
-def _color_0_checks(path: Path, data: dict[str, object], where: str) -> list[str]:
-    """Refuses a ``COLOR_0`` that glTF 2.0 does not allow or that does not fit its primitive (not an accessor, not
-    VEC3/VEC4, not float or normalized unsigned byte/short, sparse, another count than ``POSITION``'s: trimesh would
-    drop or misread it without a word); returns the name (``meshes[i].primitives[j]``) of each primitive trimesh makes a
-    geometry of, in its order."""
-    shown = repr(str(path))
-    names: list[str] = []
-    for i, j, p in _primitives(data):
-        label = f"meshes[{i}].primitives[{j}]"
-        mode = p.get("mode", 4)
-        if isinstance(mode, int) and mode in _GLTF_MODES:
-            names.append(label)
-        attrs = p.get("attributes")
-        if not isinstance(attrs, dict) or "COLOR_0" not in attrs:
-            continue
-        at = f"{shown}: {label}.attributes.COLOR_0"
-        k = attrs["COLOR_0"]
-        acc = _accessor(data, k)
-        if acc is None:
-            raise AssetSpecError(where, f"{at} is {k!r}, which names no accessor of the file")
-        at = f"{at} (accessors[{k}])"
-        kind, comp = acc.get("type"), acc.get("componentType")
-        if kind not in ("VEC3", "VEC4"):
-            raise AssetSpecError(where, f"{at} is of type {kind!r}; a vertex colour must be VEC3 or VEC4")
-        if comp not in _COLOR_TYPES or (comp != 5126 and acc.get("normalized") is not True):
-            what = _COLOR_TYPES.get(comp, "")  # type: ignore[call-overload]
-            got = f"{comp!r} ({what}, not normalized)" if what else repr(comp)
-            raise AssetSpecError(
-                where,
-                f"{at} has componentType {got}; a vertex colour must be float (5126), or unsigned byte (5121) "
-                "or unsigned short (5123) with normalized: true",
-            )
-        if "sparse" in acc:
-            read = "its bufferView's values" if "bufferView" in acc else "zeros (black)"
-            raise AssetSpecError(
-                where,
-                f"{at} is a sparse accessor, whose substitutions trimesh's glTF reader does not apply (it would "
-                f"read {read}); write COLOR_0 as a plain accessor, as Blender's and trimesh's exporters do",
-            )
-        pos = _accessor(data, attrs.get("POSITION"))
-        count, vertices = acc.get("count"), None if pos is None else pos.get("count")
-        if vertices is not None and count != vertices:
-            raise AssetSpecError(
-                where, f"{at} has {count!r} colours for the {vertices!r} vertices of its POSITION accessor"
-            )
-    return names
 
 
 def _color_0_linear(raw: object, at: str, where: str) -> np.ndarray:
@@ -328,7 +94,8 @@ def _load_gltf(trimesh: object, path: Path, where: str, names: list[str]) -> obj
     """The glTF ``path`` as an unprocessed trimesh scene whose pieces keep their ``COLOR_0`` exactly
     (metadata :data:`_COLOR_0`): trimesh's loader is called for its keyword arguments, and the raw colours it passes
     on are taken out before trimesh turns them into 8-bit visual colours (a float colour of 0.002 would become
-    1/255) or into an unread vertex attribute. ``names``: :func:`_color_0_checks`'s, for the errors."""
+    1/255) or into an unread vertex attribute. ``names``: :func:`~mmusv.world.gltf_checks.check_gltf`'s, for the
+    errors."""
     from trimesh.exchange.gltf import load_glb, load_gltf
 
     loader = load_glb if path.suffix.lower() == ".glb" else load_gltf
@@ -374,8 +141,8 @@ def _resolver(path: Path) -> FilePathResolver:
 
 def _check_file(path: Path, where: str, formats: list[str]) -> tuple[dict[EmissiveKey, float], list[str]]:
     """Refuses what trimesh would read obscurely or not at all (module docstring); returns a glTF's emissive
-    strengths by material name and factor and the names of its primitives (:func:`_color_0_checks`), both empty
-    for other formats."""
+    strengths by material name and factor and the names of its primitives
+    (:func:`~mmusv.world.gltf_checks.check_gltf`), both empty for other formats."""
     shown = repr(str(path))
     name = path.name.lower()
     if not any(name.endswith("." + f) for f in formats):
@@ -386,9 +153,7 @@ def _check_file(path: Path, where: str, formats: list[str]) -> tuple[dict[Emissi
         raise AssetSpecError(where, f"{shown} is empty (0 bytes): it holds no triangles")
     if path.suffix.lower() not in FORMAT_AXES:
         return {}, []
-    data = _gltf_json(path, where)
-    _extension_checks(path, data, where)
-    return _gltf_checks(path, data, where), _color_0_checks(path, data, where)
+    return check_gltf(path, where)
 
 
 _FACE_COLOURS = "mmusv_face_colours"
