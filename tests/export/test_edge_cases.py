@@ -456,6 +456,45 @@ def test_overwrite_keeps_the_previous_conversion_until_the_new_one_is_complete(
     assert sorted(p.name for p in tmp_path.iterdir()) == ["ds"]
 
 
+def test_a_conversion_stopping_halfway_in_a_new_folder_says_so_in_its_report(
+    lonely_rec: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A conversion into a folder of its own that stops halfway (a bug's exception, a full disk, Ctrl-C) leaves the
+    frames it wrote, and its ``conversion.yaml`` said ``in_progress`` for ever after: it now says ``failed`` (or
+    ``interrupted``) and why. The next conversion replaces it with ``overwrite``."""
+    from mmusv.export.kitti import KittiWriter
+
+    calls: list[int] = []
+
+    def broken(self: Any, frame: Any) -> None:
+        calls.append(frame.index)
+        raise ZeroDivisionError("division by zero")
+
+    out = tmp_path / "ds"
+    with monkeypatch.context() as m:
+        m.setattr(KittiWriter, "write_frame", broken)
+        with pytest.raises(ZeroDivisionError):
+            convert(lonely_rec, to="kitti", out_dir=out, splits=None)
+    report = load_report(out)
+    assert calls and report["status"] == "failed" and report["error"] == "ZeroDivisionError: division by zero"
+    assert report["format"] == "kitti" and "frames_converted" not in report
+
+    with monkeypatch.context() as m:
+        m.setattr(KittiWriter, "write_frame", lambda self, frame: (_ for _ in ()).throw(KeyboardInterrupt()))
+        with pytest.raises(KeyboardInterrupt):
+            convert(lonely_rec, to="kitti", out_dir=out, splits=None, overwrite=True)
+    # --overwrite stages the new conversion beside the old: the failed one stays as it was, the staging goes
+    assert load_report(out)["status"] == "failed" and sorted(p.name for p in tmp_path.iterdir()) == ["ds"]
+    with monkeypatch.context() as m:
+        m.setattr(KittiWriter, "write_frame", lambda self, frame: (_ for _ in ()).throw(KeyboardInterrupt()))
+        with pytest.raises(KeyboardInterrupt):
+            convert(lonely_rec, to="kitti", out_dir=tmp_path / "ds2", splits=None)
+    assert load_report(tmp_path / "ds2") == {**report, "status": "interrupted", "error": "KeyboardInterrupt"}
+
+    done = convert(lonely_rec, to="kitti", out_dir=out, splits=None, overwrite=True)
+    assert done.frames > 0 and load_report(out)["status"] == "complete" and "error" not in load_report(out)
+
+
 def test_agents_and_frames_select_what_is_converted(mixed_rec: Path, tmp_path: Path) -> None:
     """``agents`` and ``frames`` (``--agents``, ``--frames``) convert a part of a recording: the other agents'
     folders are not written, the frames outside the range are neither converted nor reported missing, and the

@@ -391,4 +391,5 @@ def test_a_front_camera_moving_against_the_lidar_is_refused(
     with pytest.raises(IoError, match=r"port_entry\.mcap: agent usv_1's front camera moves against its LiDAR") as exc:
         convert(port_rec, to="kitti_tracking", out_dir=tmp_path / "o", splits=None, extras=None)
     assert "(by 0.001 at frame 1)" in str(exc.value)  # usv_2's calibration already drifted: usv_1 at frame 1
-    assert yaml.safe_load((tmp_path / "o" / "conversion.yaml").read_text())["status"] == "in_progress"
+    report = yaml.safe_load((tmp_path / "o" / "conversion.yaml").read_text())
+    assert report["status"] == "failed" and report["error"] == str(exc.value)

@@ -9,7 +9,8 @@ reports progress and skipped frames, and hands each complete frame to the format
 folder per recording (OPV2V, KITTI, MaSTr; ROS 2 bags, never split), the format's own layout for the others (COCO,
 YOLO, SemanticKITTI, MOT, KITTI tracking: see their modules), plus ``conversion.yaml`` (options, sources, split of
 every recording, frames converted and skipped; no times or absolute paths, so two conversions of the same input are
-byte-identical). ``conversion.yaml`` is written first with ``status: in_progress`` and rewritten at the end; an
+byte-identical). ``conversion.yaml`` is written first with ``status: in_progress`` and rewritten at the end
+(``complete``, or ``failed``/``interrupted`` with the error when the conversion stops halfway in a new folder); an
 existing ``out_dir`` is replaced only with ``overwrite`` and only when it is empty or holds a previous conversion
 (its ``conversion.yaml``), and then only once the new one is complete (written beside it, then swapped in).
 
@@ -39,7 +40,7 @@ from mmusv.export.convert_checks import (
     outside_frames,
     oxts_origin_of,
 )
-from mmusv.export.convert_output import prepare_out, staged
+from mmusv.export.convert_output import prepare_out, reported, staged
 from mmusv.export.convert_report import REPORT_NAME, ConvertReport, RecordingReport
 from mmusv.export.convert_report import load_report as load_report  # importable from here as before
 from mmusv.export.splits import DEFAULT_RATIOS, SPLIT_NAMES, assign_splits, parse_ratios
@@ -287,8 +288,7 @@ def convert(
                 **({"oxts_origin": list(origin)} if origin is not None else {}),
             },
         }
-        with staged(work, out):
-            (work / REPORT_NAME).write_bytes(dump_yaml({**header, "status": "in_progress"}))
+        with staged(work, out), reported(work / REPORT_NAME, header):
             sink = Sink()
             shared = cls.start(work, options, sink)
             report = ConvertReport(out_dir=out, target=to, recordings=reports)

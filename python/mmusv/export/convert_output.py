@@ -1,6 +1,7 @@
 """The output folder of a conversion (:func:`mmusv.export.convert`): checked, locked against a second conversion
 into it, and, when ``overwrite`` replaces a previous conversion, written as a staging folder beside it that is
-swapped in only once the new conversion is complete (the previous one stays when it fails)."""
+swapped in only once the new conversion is complete (the previous one stays when it fails); its report says what
+became of a conversion that stopped halfway in a folder of its own."""
 
 from __future__ import annotations
 
@@ -9,12 +10,14 @@ import os
 import shutil
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
-from mmusv.errors import IoError
+from mmusv.errors import IoError, MmusvError
+from mmusv.export.common import dump_yaml
 from mmusv.export.convert_report import REPORT_NAME
 from mmusv.recording.guard import FolderLock
 
-__all__ = ["prepare_out", "staged"]
+__all__ = ["prepare_out", "reported", "staged"]
 
 
 def prepare_out(out: Path, overwrite: bool, inputs: list[Path]) -> tuple[Path, FolderLock]:
@@ -115,3 +118,20 @@ def staged(work: Path, out: Path) -> Iterator[None]:
         shutil.rmtree(work, ignore_errors=True)
         raise IoError(f"cannot replace {out} with the new conversion: {exc.strerror or exc}") from None
     shutil.rmtree(old, ignore_errors=True)
+
+
+@contextlib.contextmanager
+def reported(report: Path, header: dict[str, Any]) -> Iterator[None]:
+    """Around a conversion whose report is ``report``: writes it first with ``status: in_progress`` and, when the
+    conversion stops with an exception, rewrites it with ``status: failed`` (``interrupted`` for Ctrl-C) and the
+    error, so that a folder left with part of a conversion says so and why; the files already written stay. (Inside
+    a staging folder, :func:`staged` then removes it all.) The conversion writes the complete report itself."""
+    report.write_bytes(dump_yaml({**header, "status": "in_progress"}))
+    try:
+        yield
+    except BaseException as exc:
+        status = "interrupted" if isinstance(exc, KeyboardInterrupt) else "failed"
+        error = str(exc) if isinstance(exc, MmusvError) else f"{type(exc).__name__}: {exc}".rstrip(": ")
+        with contextlib.suppress(OSError):  # a full disk keeps the in_progress report: still not complete
+            report.write_bytes(dump_yaml({**header, "status": status, "error": error}))
+        raise
