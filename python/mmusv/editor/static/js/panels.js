@@ -88,6 +88,7 @@ export class Panels {
     // replaced (open, undo, redo).
     this.refused = new Map();
     this.lastErrors = [];
+    this.libraryStop = null; // the library entry that holds its one tab stop (renderLibrary)
     state.on("jump", () => this.forgetRefused(""));
   }
 
@@ -189,12 +190,15 @@ export class Panels {
     const focused = document.activeElement?.closest?.("#library li")?.dataset.asset;
     ul.replaceChildren();
     const armed = this.map.placing?.asset?.name;
+    // One tab stop for the whole list (a roving tabindex, as WAI-ARIA's listbox and toolbar patterns): the entry
+    // focused last, else the armed one, else the first; the arrow keys, Home and End move among the entries.
+    const stop = focused ?? this.libraryStop ?? armed;
     for (const a of this.state.assets) {
       const hay = `${a.name} ${a.category} ${a.class} ${a.description}`.toLowerCase();
       if (q && !q.split(/\s+/).every((w) => hay.includes(w))) continue;
       const li = document.createElement("li");
       li.dataset.asset = a.name;
-      li.tabIndex = 0;
+      li.tabIndex = -1;
       li.setAttribute("role", "button");
       li.setAttribute("aria-pressed", String(a.name === armed));
       li.title = `${a.description}\n${a.length} m long, ${a.beam} m beam, ${a.height} m high, ${a.draft} m draft`;
@@ -214,11 +218,44 @@ export class Panels {
       ul.appendChild(li);
       if (a.name === focused) li.focus();
     }
+    const entries = [...ul.children];
+    (entries.find((li) => li.dataset.asset === stop) ?? entries[0])?.setAttribute("tabindex", "0");
+  }
+
+  /** Moves the library's one tab stop to ``li`` and focuses it. */
+  focusLibraryEntry(li) {
+    for (const other of $("library").querySelectorAll('li[tabindex="0"]')) other.tabIndex = -1;
+    li.tabIndex = 0;
+    this.libraryStop = li.dataset.asset;
+    li.focus();
+    li.scrollIntoView({ block: "nearest" });
   }
 
   bindLibrary() {
     $("library-search").addEventListener("input", () => this.renderLibrary());
     clickOnEnter($("library"), "li[data-asset]");
+    $("library").addEventListener("keydown", (ev) => {
+      const li = ev.target.closest("li[data-asset]");
+      if (!li || ev.ctrlKey || ev.metaKey || ev.altKey) return;
+      const entries = [...$("library").children];
+      const at = entries.indexOf(li);
+      const to = { ArrowDown: at + 1, ArrowUp: at - 1, Home: 0, End: entries.length - 1 }[ev.key];
+      if (to === undefined) return;
+      ev.preventDefault();
+      if (to >= 0 && to < entries.length) this.focusLibraryEntry(entries[to]);
+    });
+    $("library").addEventListener("focusin", (ev) => {
+      const li = ev.target.closest("li[data-asset]");
+      if (li && li.tabIndex !== 0) this.focusLibraryEntry(li); // reached by a click: the tab stop follows
+    });
+    $("library-search").addEventListener("keydown", (ev) => {
+      // from the search box down into what it found
+      const first = $("library").querySelector("li[data-asset]");
+      if (ev.key === "ArrowDown" && first) {
+        ev.preventDefault();
+        this.focusLibraryEntry(first);
+      }
+    });
     $("library").addEventListener("click", (ev) => {
       const li = ev.target.closest("li[data-asset]");
       if (!li) return;

@@ -1,0 +1,98 @@
+"""A seventh round through the editor in a real headless Chromium, by keyboard and at a small window: the vessel
+library was one Tab stop per entry (37 presses to get past it), and at 900 x 650 the selected vessel's "at the end"
+box showed its choice cut short ("ping pon").
+
+Each browser test checks the browser's console for JavaScript errors (failed requests the page explains are not
+errors).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from selenium.webdriver.common.action_chains import ActionChains
+from selenium.webdriver.common.by import By
+from selenium.webdriver.common.keys import Keys
+from test_browser import LiveServer, open_editor
+from test_browser_round import js_errors
+from test_browser_round4 import window
+
+FOCUSED_ASSET = "return document.activeElement.dataset.asset || null"
+ARROW_PX = 20  # Chromium's drop-down arrow beside a select's text
+STOPS = (
+    "return [...document.querySelectorAll('#library li')].filter((li) => li.tabIndex === 0)"
+    ".map((li) => li.dataset.asset)"
+)
+
+
+def test_the_library_is_one_tab_stop_walked_with_the_arrow_keys(browser: Any, live_server: LiveServer) -> None:
+    open_editor(browser, live_server)
+    js_errors(browser)
+    names = browser.execute_script("return [...document.querySelectorAll('#library li')].map((li) => li.dataset.asset)")
+    assert len(names) >= 30
+    assert browser.execute_script(STOPS) == [names[0]]
+
+    browser.find_element(By.ID, "library-search").click()
+    ActionChains(browser).send_keys(Keys.TAB).perform()  # the search box -> the role -> the library
+    ActionChains(browser).send_keys(Keys.TAB).perform()
+    assert browser.execute_script(FOCUSED_ASSET) == names[0]
+    ActionChains(browser).send_keys(Keys.TAB).perform()  # one press past it all (was: 37)
+    assert browser.execute_script(FOCUSED_ASSET) is None
+    assert browser.execute_script("return !document.activeElement.closest('#library')")
+
+    browser.execute_script("document.querySelector('#library li').focus()")
+    ActionChains(browser).send_keys(Keys.ARROW_DOWN, Keys.ARROW_DOWN).perform()
+    assert browser.execute_script(FOCUSED_ASSET) == names[2]
+    ActionChains(browser).send_keys(Keys.ARROW_UP).perform()
+    assert browser.execute_script(FOCUSED_ASSET) == names[1]
+    ActionChains(browser).send_keys(Keys.END).perform()
+    assert browser.execute_script(FOCUSED_ASSET) == names[-1]
+    ActionChains(browser).send_keys(Keys.ARROW_DOWN).perform()  # stays at the last entry; the map does not pan
+    assert browser.execute_script(FOCUSED_ASSET) == names[-1]
+    ActionChains(browser).send_keys(Keys.HOME, Keys.ARROW_DOWN).perform()
+    assert browser.execute_script(FOCUSED_ASSET) == names[1]
+    assert browser.execute_script(STOPS) == [names[1]]  # the tab stop follows: Shift+Tab and back returns here
+
+    ActionChains(browser).send_keys(Keys.ENTER).perform()  # Enter still picks the vessel to place
+    assert browser.execute_script("return window.mmusvEditor.map.mode") == "place"
+    assert browser.execute_script("return window.mmusvEditor.map.placing.asset.name") == names[1]
+    assert browser.execute_script(FOCUSED_ASSET) == names[1] and browser.execute_script(STOPS) == [names[1]]
+    ActionChains(browser).send_keys(Keys.ESCAPE).perform()
+    assert browser.execute_script("return window.mmusvEditor.map.mode") == "select"
+
+    # a search keeps one stop; the arrow down from the search box enters what it found
+    box = browser.find_element(By.ID, "library-search")
+    box.send_keys("tug")
+    found = browser.execute_script("return [...document.querySelectorAll('#library li')].map((li) => li.dataset.asset)")
+    assert "tug_32m" in found and len(found) < len(names)
+    assert len(browser.execute_script(STOPS)) == 1
+    ActionChains(browser).send_keys(Keys.ARROW_DOWN).perform()
+    assert browser.execute_script(FOCUSED_ASSET) == found[0]
+    box.clear()
+    box.send_keys(" ")
+    box.send_keys(Keys.BACKSPACE)
+    assert browser.execute_script(STOPS) and len(browser.execute_script(STOPS)) == 1
+    assert js_errors(browser) == []
+
+
+def test_the_end_choice_is_read_whole_in_a_small_window(browser: Any, live_server: LiveServer) -> None:
+    with window(browser, 900, 650):
+        open_editor(browser, live_server)
+        js_errors(browser)
+        browser.find_element(By.CSS_SELECTOR, '#fleet li[data-id="tug"]').click()
+        widths = browser.execute_script(
+            "const out = [];"
+            "for (const id of ['v-role', 'v-end', 'v-rig', 'v-asset']) {"
+            "  const s = document.getElementById(id); if (!s || s.offsetParent === null) continue;"
+            "  const c = document.createElement('canvas').getContext('2d'), st = getComputedStyle(s);"
+            "  c.font = `${st.fontWeight} ${st.fontSize} ${st.fontFamily}`;"
+            "  const longest = Math.max(...[...s.options].map((o) => c.measureText(o.text).width));"
+            "  const inner = s.clientWidth - parseFloat(st.paddingLeft) - parseFloat(st.paddingRight);"
+            "  out.push([id, longest, inner]);"
+            "}"
+            "return out"
+        )
+        assert [w[0] for w in widths] == ["v-role", "v-end", "v-asset"]  # the tug has no rig
+        for name, longest, inner in widths[:2]:  # the asset box is as wide as the panel; long names are cut there
+            assert longest + ARROW_PX <= inner, (name, longest, inner)
+        assert js_errors(browser) == []
