@@ -22,7 +22,14 @@
 //!    `water_range_m + water_range_per_wave_m · H` — calm water is a mirror at 905 nm, waves give the beam facets
 //!    to return from;
 //! 4. weather: two-way transmission `τ = exp(−2 (σ_fog + σ_rain) r)` with `σ_fog` the visibility extinction
-//!    (Koschmieder, 3 / V) and `σ_rain = 1e-5 · R^0.6` per metre (R in mm/h); the return is lost with
+//!    (Koschmieder, 3 / V) and `σ_rain = 1e-5 · R^0.6` per metre (R in mm/h). The rain term has no source
+//!    (an outside re-check of 2026-12-02 found none) and is small on purpose: the
+//!    visibility `V` is the meteorological optical range in the scenario's air, rain included, and the drops,
+//!    far larger than the wavelength, extinguish 905 nm as they do visible light (geometric optics, extinction
+//!    efficiency 2: with Marshall & Palmer's 1948 drop sizes `≈ 0.365 · R^0.63` per km, 1.6 km⁻¹ at 10 mm/h,
+//!    a visibility of 1.9 km from the rain alone), so `3 / V` carries the rain's extinction when the visibility
+//!    given is the one in that rain, and this term adds 2.4–2.7 % of the drops' own extinction over 1–50 mm/h
+//!    (kept: it is in every recording made in rain). The return is lost with
 //!    probability `1 − τ` — but for the physical water returns of step 3, whose speckle threshold already met the
 //!    attenuated mean `τ ⟨I⟩` (until 2026-12-01 they were lost with probability `1 − τ` as well, the fog counted
 //!    twice: at 600 m visibility a fifth fewer water returns 20 m out than the model gives, a third 40 m out);
