@@ -70,6 +70,15 @@ face); the conversions are `mmusv.world.mesh_materials`'s.
   alpha (`alphaMode`, a base colour's alpha: every face is opaque), `doubleSided` (the ray caster hits both sides of
   every face anyway), normal and occlusion textures.
 
+  Geometry compressed with Draco (`KHR_draco_mesh_compression`, as Blender's exporter and Sketchfab write it) is
+  decoded with DracoPy, installed with mmusv (positions come back within Draco's quantisation: 14 bits over the
+  mesh by default). A file that *requires* another extension (`extensionsRequired`) is refused, as glTF 2.0 asks
+  of a reader that does not know it: mmusv reads `KHR_draco_mesh_compression`, `KHR_materials_emissive_strength`,
+  `KHR_materials_pbrSpecularGlossiness` (trimesh converts it), `KHR_mesh_quantization` (integer positions read as
+  their numbers; `normalized` positions are refused, trimesh would read them raw), `KHR_texture_transform`
+  (textures are taken by their mean) and `EXT_texture_webp`; re-export a file that needs `EXT_meshopt_compression`
+  or another without it. A sparse `POSITION` accessor is refused too (trimesh leaves its substitutions out).
+
   A primitive's vertex colours (`COLOR_0`: float, or unsigned byte/short normalized; RGB or RGBA, alpha not read)
   multiply its base colour, as glTF 2.0 defines them (section 3.9.2: "an additional linear multiplier to base
   color") and Blender's glTF importer and three.js's GLTFLoader apply them: taken as linear RGB as stored (not
