@@ -86,6 +86,27 @@ def test_paper_motion_keeps_the_papers_formula() -> None:
     assert build_fleet(load_scenario(scenario())).physical  # physical is the default
 
 
+def test_reference_usvs_move_as_the_papers_reference_usv() -> None:
+    """``reference_usvs`` (``mmusv study waves --usvs reference``): the paper's formula, ``S(H)·α_v·r·g(t)``, is
+    linear in the size factor, so each USV's heave, roll and pitch about its route are its own divided by its
+    ``α_v`` (that of the reference USV being 1); the route, yaw and every other vessel stay as they were."""
+    s = load_scenario({**scenario(), "environment": {"wave": "W2", "motion": "paper"}})
+    mine, ref = scenario_poses(s), scenario_poses(s, reference_usvs=True)
+    alphas = build_fleet(s).alphas()
+    assert alphas[0] != pytest.approx(1.0, abs=0.05)  # the WAM-V is not the reference size: the test can see it
+    still = scenario_poses(s.with_wave(0.0))  # the same route at H = 0: the perturbation is what waves add
+    np.testing.assert_allclose(ref[:, 0, 2:5] - still[:, 0, 2:5], (mine[:, 0, 2:5] - still[:, 0, 2:5]) / alphas[0])
+    np.testing.assert_array_equal(ref[:, 0, [0, 1, 5]], mine[:, 0, [0, 1, 5]])
+    np.testing.assert_array_equal(ref[:, 1:], mine[:, 1:])  # not USVs
+    from mmusv._native import core
+
+    assert core.reference_usv_dims() == (5.0, 2.5, 1.5)
+    with pytest.raises(mmusv.ConfigError, match=r"environment\.motion = 'physical'.*motion: paper"):
+        build_fleet(load_scenario(scenario()), reference_usvs=True)
+    with pytest.raises(mmusv.ConfigError, match="reference_usvs"):
+        build_fleet(s, reference_usvs="yes")  # type: ignore[arg-type]
+
+
 LEGS = [("usv_wamv", 3.0, 2.3), ("tug_32m", 4.0, 0.9), ("bulk_carrier_190m", 6.0, 3.0)]
 """A 5 m USV, a 32 m tug and a 190 m bulk carrier: asset, speed m/s, heading rad."""
 

@@ -42,6 +42,7 @@ __all__ = [
     "hull_rao",
     "lidar_trace_order",
     "pinhole_intrinsics",
+    "reference_usv_dims",
     "response_variance",
     "sea_limits",
     "sea_presets",
@@ -583,6 +584,10 @@ class Fleet:
 
 def default_amplitudes() -> tuple[float, float, float]:
     """Default base amplitudes (heave m, roll rad, pitch rad), calibrated on the reference 5 m USV."""
+
+def reference_usv_dims() -> tuple[float, float, float]:
+    """(length m, beam m, height m) of the paper's reference USV (α_v = 1), on which the default amplitudes are
+    calibrated."""
 
 def wave_height(wave: str | float) -> float:
     """Wave height H in metres of a preset "W0".."W3" or a height in metres (validated)."""

@@ -15,23 +15,35 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from mmusv import arguments
 from mmusv._native import core
 from mmusv.config import Scenario
+from mmusv.errors import ConfigError
 from mmusv.world.hydrostatics import hull_particulars
 from mmusv.world.vessels import get_asset
 
 __all__ = ["build_fleet", "scenario_poses"]
 
 
-def build_fleet(scenario: Scenario, *, wave: str | float | None = None) -> Any:
+def build_fleet(scenario: Scenario, *, wave: str | float | None = None, reference_usvs: bool = False) -> Any:
     """The ``mmusv._core.Fleet`` of ``scenario`` (vessel ``i`` = ``scenario.vessels[i]``), optionally with another
     wave setting (``wave`` drives the paper's formula, and the physical sea when ``environment.sea`` is not set).
-    Wave phases and frequencies come from ``scenario.seed``."""
+    Wave phases and frequencies come from ``scenario.seed``. ``reference_usvs``: the paper's formula takes every
+    vessel with ``role: usv`` at the size of the paper's reference USV (``core.reference_usv_dims()``, 5 × 2.5 ×
+    1.5 m, ``α_v = 1``: the USV the amplitudes are calibrated on, which Table I describes) instead of its asset's
+    box; only with ``motion: paper`` (the physical response reads the hulls themselves)."""
     vessels = scenario.vessels
     assets = [get_asset(v.asset) for v in vessels]
     dims = np.array([[a.length, a.beam, a.height] for a in assets], dtype=np.float64)
-    amps = np.tile(np.array(core.default_amplitudes(), dtype=np.float64), (len(vessels), 1))
     env = scenario.environment if wave is None else scenario.with_wave(wave).environment
+    if arguments.flag(reference_usvs, name="reference_usvs"):
+        if env.motion != "paper":
+            raise ConfigError(
+                f"environment.motion = {env.motion!r}: USVs of the paper's reference size are a setting of the "
+                "paper's formula (motion: paper); the physical response reads each hull's own particulars"
+            )
+        dims[[i for i, v in enumerate(vessels) if v.role == "usv"]] = core.reference_usv_dims()
+    amps = np.tile(np.array(core.default_amplitudes(), dtype=np.float64), (len(vessels), 1))
     physical: dict[str, Any] = {}
     if env.motion == "physical":
         physical["sea"] = env.sea_spec().field(scenario_seed=scenario.seed)
@@ -55,9 +67,12 @@ POSE_BATCH = 1 << 20
 taken in batches of times, as the core bounds one call's (``Fleet.poses_at_times``), the same values either way."""
 
 
-def scenario_poses(scenario: Scenario, *, wave: str | float | None = None) -> npt.NDArray[np.float64]:
-    """``(frames, vessels, 6)`` float64 poses at every acquisition time t_k = k / f."""
-    fleet = build_fleet(scenario, wave=wave)
+def scenario_poses(
+    scenario: Scenario, *, wave: str | float | None = None, reference_usvs: bool = False
+) -> npt.NDArray[np.float64]:
+    """``(frames, vessels, 6)`` float64 poses at every acquisition time t_k = k / f (``wave``, ``reference_usvs``:
+    as :func:`build_fleet`)."""
+    fleet = build_fleet(scenario, wave=wave, reference_usvs=reference_usvs)
     times = np.arange(scenario.acquisition.frames, dtype=np.float64) / scenario.acquisition.frequency_hz
     step = max(1, POSE_BATCH // max(1, len(scenario.vessels)))
     if len(times) <= step:

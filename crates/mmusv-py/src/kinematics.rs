@@ -211,6 +211,14 @@ fn default_amplitudes() -> (f64, f64, f64) {
     (a.heave_m, a.roll_rad, a.pitch_rad)
 }
 
+/// `(length_m, beam_m, height_m)` of the paper's reference USV, whose size factor `α_v` is 1 (the vessel the
+/// default amplitudes are calibrated on: the paper's formula gives it Table I).
+#[pyfunction]
+fn reference_usv_dims() -> (f64, f64, f64) {
+    let d = VesselDims::REFERENCE;
+    (d.length_m, d.beam_m, d.height_m)
+}
+
 /// Wave height H (m) of a preset name `"W0".."W3"` or a height given in metres (validated).
 #[pyfunction]
 fn wave_height(wave: &Bound<'_, PyAny>) -> PyResult<f64> {
@@ -227,6 +235,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Fleet>()?;
     m.add_function(wrap_pyfunction!(wave_presets, m)?)?;
     m.add_function(wrap_pyfunction!(default_amplitudes, m)?)?;
+    m.add_function(wrap_pyfunction!(reference_usv_dims, m)?)?;
     m.add_function(wrap_pyfunction!(wave_height, m)?)?;
     Ok(())
 }
