@@ -37,7 +37,6 @@ from mmusv.frames import BODY_TO_OPTICAL, translation
 from mmusv.scene import Scene
 from mmusv.wave_occlusion import (
     BeamAngles,
-    exposed_hidden,
     exposed_hidden_boxes,
     lidar_beam_rays,
     lidar_boxes_beams,
@@ -389,6 +388,8 @@ def annotate_agent(
             views[name] = (cam, cam.intrinsics, inv, p, inst_img, _lens(cam, p, inv))
     rotations: list[np.ndarray] = []  # the 3D boxes' rotation matrices, turned into quaternions in one call
     share_boxes: list[tuple[int, np.ndarray, str, np.ndarray]] = []  # 3D box row, corners, asset, pose
+    # 2D box row, its pixels' rays (origins, unit directions), distances to the vessel alone, instances seen first
+    cam_shares: list[tuple[int, np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
     for vi, info in enumerate(vessels):
         if vi == agent_index:
             continue
@@ -449,10 +450,22 @@ def annotate_agent(
             ann.cam_occlusion.append(float(1.0 - seen / exposed) if exposed else float(sil > 0 and visible == 0))
             ann.cam_role.append(info.role)
             ann.cam_static.append(bool(info.static))
-            wave = 0.0
-            if waves and scene is not None and sil:
-                wave = share(*exposed_hidden(scene, o, dn, t_alone, scene_instance=window.reshape(-1)))
-            ann.cam_wave_occlusion.append(wave)
+            if waves and sil:  # the wave-occlusion share: worked out below for every 2D box at once
+                cam_shares.append((len(ann.cam_wave_occlusion), o, dn, t_alone, window.reshape(-1)))
+            ann.cam_wave_occlusion.append(0.0)
+    if cam_shares and scene is not None:
+        rows_2d, origins, directions, distances, seen_first = zip(*cam_shares, strict=True)
+        offsets = np.concatenate(([0], np.cumsum([t.size for t in distances])))
+        n_exposed, n_hidden = exposed_hidden_boxes(
+            scene,
+            np.concatenate(origins),
+            np.concatenate(directions),
+            np.concatenate(distances),
+            offsets,
+            scene_instance=np.concatenate(seen_first),
+        )
+        for row, e, h in zip(rows_2d, n_exposed, n_hidden, strict=True):
+            ann.cam_wave_occlusion[row] = share(int(e), int(h))
     if (
         share_boxes
         and scene is not None
