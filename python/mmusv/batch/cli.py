@@ -3,7 +3,8 @@
 
 Both show a rich progress bar over the frames of the whole batch (on a terminal), then the table of every
 scenario (done, skipped, failed with its error, retried) and one summary line; the exit status is 1 when a
-scenario failed. Bad options raise :class:`mmusv.errors.MmusvError` (one line, exit status 2).
+scenario failed or the index could not be written (a full disk: the warning says why). Bad options raise
+:class:`mmusv.errors.MmusvError` (one line, exit status 2).
 """
 
 from __future__ import annotations
@@ -157,7 +158,8 @@ def print_report(report: BatchReport, console: Console) -> None:
             console.print(f"mmusv: warning: {w}", markup=False, highlight=False)
     if report.index_error is not None:
         console.print(f"mmusv: warning: {report.index_error}", markup=False, highlight=False)
-    console.print(f"{report.summary()} in {report.seconds:.1f} s; index {report.index}")
+    index = f"index {report.index}" if report.index_error is None else f"no index written to {report.index}"
+    console.print(f"{report.summary()} in {report.seconds:.1f} s; {index}")
 
 
 MAX_RETRIES = 100
@@ -181,6 +183,11 @@ def check_batch_options(args: argparse.Namespace) -> None:
     if args.cpus_per_task is not None and args.cpus_per_task < 1:
         raise ConfigError(f"--cpus-per-task {args.cpus_per_task}: must be at least 1")
     if args.ray is not None:  # the cluster's CPUs: the Ray executor checks --cpus-per-task against them
+        if not args.ray.strip():  # --ray "$ADDRESS" with the variable unset started a local instance without a word
+            raise ConfigError(
+                f"--ray {args.ray!r}: an empty address; give HOST:PORT or 'auto' to join a cluster, or --ray without "
+                "an address for a local instance"
+            )
         _check_ray_address(args.ray)
         return
     cpus = available_cpus()
@@ -241,7 +248,7 @@ def run_batch(args: argparse.Namespace, source: Path | list[Path]) -> int:
             stop_on_full_disk=args.stop_on_full_disk,
         )
     print_report(report, console)
-    return 0 if report.ok else 1
+    return 0 if report.ok and report.index_error is None else 1  # an index that could not be written: not done
 
 
 def _check_file_names(source: Path | list[Path]) -> None:

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from mmusv.batch.index import INDEX_NAME, read_index, write_index
+from mmusv.batch.index import INDEX_NAME, check_replaceable, read_index, write_index
 from mmusv.batch.runner import BatchReport, join_ray, run_many
 from mmusv.errors import IoError, MmusvError
 
@@ -94,6 +94,26 @@ def _generated_set(scen_dir: Path) -> list[str] | None:
     return shortfall
 
 
+def _refuse_foreign(scen_dir: Path) -> None:
+    """Refuses (:class:`~mmusv.errors.IoError`) scenario files in ``scen_dir`` that the spec's generation did not
+    write (not listed in its ``report.json``): the batch records every ``*.yaml`` and ``*.yml`` there, so a file put
+    there by hand (or a ``.yml``, which generate does not check) was recorded, converted and indexed as part of the
+    spec's dataset without a word."""
+    try:
+        data = json.loads((scen_dir / "report.json").read_text(encoding="utf-8"))
+        listed = {f for c in data["combinations"] for f in c["files"] if isinstance(f, str)}
+    except (OSError, ValueError, KeyError, TypeError):
+        listed = set()
+    found = [*scen_dir.glob("*.yaml"), *scen_dir.glob("*.yml")]
+    foreign = sorted(p.name for p in found if p.name not in listed and p.name != "report.yaml")
+    if foreign:
+        names = ", ".join(foreign[:3]) + (" ..." if len(foreign) > 3 else "")
+        raise IoError(
+            f"{scen_dir} holds scenario files the spec's generation did not write ({names}; its report.json lists "
+            "what it wrote): mmusv dataset records the spec's scenarios only; move them away"
+        )
+
+
 def _own_recordings(old: dict[str, Any]) -> set[str]:
     """The scenarios whose recording folder ``DIR/recordings/<name>/`` an earlier ``mmusv dataset`` run into this
     folder indexed (its ``dataset.json``, with the ``spec`` section only that command writes)."""
@@ -111,6 +131,21 @@ def _own_recordings(old: dict[str, Any]) -> set[str]:
         ):
             out.add(name)
     return out
+
+
+def _opv2v_section(old: dict[str, Any]) -> dict[str, Any] | None:
+    """The ``opv2v`` section of an earlier run's index when it is one this command wrote (a JSON object of plain
+    JSON values), else None: the conversion is then not known to be up to date and is done again. A damaged one
+    (a text, a list) was an AttributeError traceback after every scenario had been recorded, one holding NaN a
+    refusal naming ``index_extra['opv2v']``, an argument no user gave."""
+    section = old.get("opv2v")
+    if not isinstance(section, dict):
+        return None
+    try:
+        json.dumps(section, allow_nan=False)
+    except (TypeError, ValueError):
+        return None
+    return section
 
 
 def _remove_stale(rec_dir: Path, own: set[str], stems: set[str]) -> None:
@@ -154,10 +189,12 @@ def build_dataset(
     out = Path(out_dir)
     scen_dir, rec_dir, opv2v = out / "scenarios", out / "recordings", out / "opv2v"
     index_path = out / INDEX_NAME
+    check_replaceable(index_path, writer="mmusv dataset")  # the batch refuses it too, but after the generation
     try:
         old: dict[str, Any] = read_index(index_path) if index_path.is_file() else {}
     except MmusvError:
         old = {}
+    old_opv2v = _opv2v_section(old)
     spec_section = {"file": Path(sp).name, "name": loaded.name, "hash": _spec_hash(loaded)}
     kept = _generated_set(scen_dir) if old.get("spec") == spec_section else None
     generated = kept is None
@@ -181,6 +218,7 @@ def build_dataset(
             shortfall = [f"{c.name}: {c.accepted} of {c.quota}" for c in report.combos if not c.met]
         if progress is not None:
             progress("generate", quota, quota)
+        _refuse_foreign(scen_dir)
         _remove_stale(rec_dir, own, {p.stem for p in scen_dir.glob("*.yaml")})
         if not any(scen_dir.glob("*.yaml")):  # no candidate met the spec: nothing to record (the shortfall says so)
             nothing = {"folder": opv2v.name, "status": "nothing to convert", "frames": 0, "sources": {}}
@@ -199,7 +237,7 @@ def build_dataset(
             split_frames=split_frames,
             checks=checks,
             index=index_path,
-            index_extra={"spec": spec_section, "opv2v": old.get("opv2v")},
+            index_extra={"spec": spec_section, "opv2v": old_opv2v},
             progress=None if progress is None else (lambda d, t: progress("record", d, t)),
             stop_on_full_disk=stop_on_full_disk,
             overwrite=overwrite,
@@ -210,7 +248,7 @@ def build_dataset(
             joined = None
         doc = read_index(index_path)
         sources = {r["name"]: r["config_hash"] for r in doc["recordings"] if r["status"] == "complete"}
-        section = old.get("opv2v") or {}
+        section = old_opv2v or {}
         converted: int | None = None
         up_to_date = (
             section.get("sources") == sources and section.get("status") == "complete" and _conversion_complete(opv2v)

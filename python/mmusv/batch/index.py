@@ -39,6 +39,7 @@ __all__ = [
     "STATUSES",
     "Entry",
     "check_extra",
+    "check_replaceable",
     "dataset_recordings",
     "find_index",
     "read_index",
@@ -153,6 +154,31 @@ def check_extra(extra: Mapping[str, Any] | None, *, name: str) -> None:
                 f"{name}[{key!r}] = {shown(value)}: must be plain JSON (dicts with string keys, lists, strings, finite "
                 f"numbers, booleans, None): {exc}"
             ) from None
+
+
+def check_replaceable(path: Path, *, writer: str) -> None:
+    """Raises :class:`~mmusv.errors.IoError` when ``path`` holds what writing an index there would lose or fail on:
+    a folder (found only after every recording, as a warning), or a file that is not an mmusv dataset index (a
+    ``dataset.json`` of another tool was replaced without a word). An index of mmusv's, even a damaged one, is
+    recognised by its ``format`` at the top (:func:`write_index` writes it first) and may be replaced. ``writer``
+    says who writes the index, for the message."""
+    import re
+
+    if not path.exists():
+        return
+    if not path.is_file():
+        what = "a folder" if path.is_dir() else "not a regular file"
+        raise IoError(f"index {path} is {what}: move it away ({writer} writes its index there)")
+    try:
+        with path.open("rb") as f:
+            head = f.read(4096).decode("utf-8", errors="replace")
+    except OSError as exc:
+        raise IoError(f"cannot read {path}: {exc.strerror or exc}") from None
+    if not re.match(rf'\s*\{{\s*"format"\s*:\s*"{re.escape(INDEX_FORMAT)}"', head):
+        raise IoError(
+            f"{path} is not an mmusv dataset index, and {writer} would replace it with its own: move it away or "
+            "choose another output folder"
+        )
 
 
 def find_index(folder: str | os.PathLike[str]) -> Path | None:

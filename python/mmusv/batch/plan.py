@@ -100,11 +100,14 @@ def scenario_files(source: str | os.PathLike[str] | Sequence[str | os.PathLike[s
         if src.is_dir():
             # .yml too: the run of one file takes either, and a folder's .yml scenarios were skipped without a word
             found = [*src.glob("*.yaml"), *src.glob("*.yml")]
-            files = sorted(p for p in found if p.name != "report.yaml" and p.is_file())
+            files = sorted(p for p in found if p.name != "report.yaml")
             if not files:
                 raise ConfigError(f"{src} holds no *.yaml or *.yml scenarios")
+            for f in files:  # a broken link or a folder of a scenario's name was skipped without a word
+                if not f.is_file():
+                    raise ConfigError(f"{f}: {_not_a_file(f)}, not a scenario file; remove it or move it away")
             _check_stems(files)
-            return [f.resolve() for f in files]
+            return [_absolute(f) for f in files]
         files = [src]
     else:
         if isinstance(source, (bytes, Mapping)) or not isinstance(source, Iterable):
@@ -119,7 +122,20 @@ def scenario_files(source: str | os.PathLike[str] | Sequence[str | os.PathLike[s
         if not f.is_file():
             raise ConfigError(f"{f}: no such scenario file")
     _check_stems(files)
-    return sorted((f.resolve() for f in files), key=lambda f: f.stem)
+    return sorted((_absolute(f) for f in files), key=lambda f: f.stem)
+
+
+def _absolute(f: Path) -> Path:
+    """``f`` as an absolute path whose name is still the one given: a symbolic link is not followed (resolved,
+    ``c.yaml -> a.yaml`` took the stem ``a``: both files recorded into ``OUT/a`` and listed as ``a.yaml``)."""
+    return Path(os.path.abspath(f))
+
+
+def _not_a_file(f: Path) -> str:
+    """What the folder entry ``f``, which is not a regular file, is."""
+    if f.is_symlink() and not f.exists():
+        return f"a broken symbolic link (to {os.readlink(f)})"
+    return "a folder" if f.is_dir() else "not a regular file (a pipe, socket or device)"
 
 
 def _check_stems(files: Sequence[Path]) -> None:
@@ -189,7 +205,9 @@ def _conflict(folder: Path, scenario: str, config_hash: str, frames: int, file: 
         if m.get("config_hash") != config_hash:
             return f"{rec} is a complete recording of another configuration (config hash differs from {file}'s)"
         n, first = m.get("frames_written"), m.get("first_frame", 0)
-        if (n, first) != (frames, 0) and isinstance(n, int) and isinstance(first, int) and rec.is_file():
+        # counts only (true was read as a complete recording of 1 frame, refused as a conflict)
+        counts = all(isinstance(x, int) and not isinstance(x, bool) for x in (n, first))
+        if (n, first) != (frames, 0) and counts and rec.is_file():
             return (
                 f"{rec} is a complete recording of frames {first}..{first + n - 1}, and this run asks for frames "
                 f"0..{frames - 1} (frames = {frames})"

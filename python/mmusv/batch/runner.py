@@ -32,7 +32,7 @@ from mmusv.batch.executors import (
     refuse_in_daemon,
     refuse_in_worker_import,
 )
-from mmusv.batch.index import INDEX_NAME, Entry, check_extra, folder_bytes, write_index
+from mmusv.batch.index import INDEX_NAME, Entry, check_extra, check_replaceable, folder_bytes, write_index
 from mmusv.batch.plan import ScenarioPlan, plan_scenarios, prepare, scenario_files, task_complete
 from mmusv.batch.task import TaskResult
 from mmusv.errors import ConfigError, IoError, MmusvError
@@ -119,7 +119,7 @@ def join_ray(ray: bool | str, *, cpus_per_task: int | None = None, lost_worker_r
     Raises:
         ConfigError: bad arguments, Ray asked for but missing, or a cluster without the CPUs of one task.
         IoError: Ray cannot be started or joined."""
-    if ray is False or not isinstance(ray, (bool, str)):
+    if ray is False or not isinstance(ray, (bool, str)) or (isinstance(ray, str) and not ray.strip()):
         raise ConfigError(f"ray = {arguments.shown(ray)}: must be True, 'local', 'auto' or a Ray address to join")
     if cpus_per_task is not None:
         cpus_per_task = arguments.whole(cpus_per_task, name="cpus_per_task", lo=1)
@@ -136,8 +136,17 @@ def _entry(plan: ScenarioPlan, status: str, error: str | None, root: Path) -> En
             m = read_json(Path(t.out_dir) / "manifest.json")
         except MmusvError:  # no (readable) manifest: nothing of this task recorded
             continue
-        if m.get("config_hash") == plan.config_hash:
-            frames += int(m.get("frames_written", 0) or 0)
+        n = m.get("frames_written")
+        # a damaged count ('abc', 1e400, [3]) was a bare ValueError or TypeError before the batch began: such a
+        # task is not complete (plan.task_complete), so it runs again and writes its manifest anew; until then
+        # the index counts none of its frames
+        if (
+            m.get("config_hash") == plan.config_hash
+            and isinstance(n, int)
+            and not isinstance(n, bool)
+            and 0 < n <= t.expected_frames
+        ):
+            frames += n
     rec = None if plan.recording is None else plan.recording.relative_to(root).as_posix()
     return Entry(
         name=plan.name,
@@ -236,7 +245,8 @@ def run_many(
     stems = frozenset(replace)
     if not all(isinstance(n, str) for n in stems):
         raise ConfigError(f"replace = {arguments.shown(replace)}: must be a collection of scenario file stems")
-    if not isinstance(ray, (bool, str)):
+    # an empty address (an unset variable) started a local instance without a word, not the cluster meant
+    if not isinstance(ray, (bool, str)) or (isinstance(ray, str) and not ray.strip()):
         raise ConfigError(f"ray = {arguments.shown(ray)}: must be False, True, 'local', 'auto' or a Ray address")
     if ray is False and (jobs > 1 or cpus_per_task is not None):  # the local pool (see _executor)
         refuse_in_daemon(f"mmusv.run_many(jobs={jobs})")
@@ -244,6 +254,7 @@ def run_many(
     out = arguments.path(out_dir, name="out_dir").resolve()
     index_path = arguments.path(index, name="index").resolve() if index is not None else out / INDEX_NAME
     root = index_path.parent
+    check_replaceable(index_path, writer="the batch")
     plans = plan_scenarios(
         files,
         out,
@@ -425,6 +436,21 @@ def _prepare(plan: ScenarioPlan) -> None:
             why = f"cannot prepare its output folder {plan.folder}{where}: {exc.strerror or exc}"
         plan.error = f"{plan.file}: {why}"
         plan.tasks, plan.to_run = [], []
+        return
+    # a part's folder (or OUT/<stem>/parts) that is a file failed each of its tasks as an "internal error
+    # NotADirectoryError" of the worker
+    for t in plan.to_run:
+        folder = Path(t.out_dir)
+        for d in (folder, *folder.parents):
+            if d == plan.folder:
+                break
+            if d.exists() and not d.is_dir():
+                plan.error = (
+                    f"{plan.file}: the folder of its part {d} is a file: move it away (the parts are recorded into "
+                    "OUT/<stem>/parts/<first>-<last>/)"
+                )
+                plan.tasks, plan.to_run = [], []
+                return
 
 
 def _complete_on_disk(plan: ScenarioPlan) -> bool:

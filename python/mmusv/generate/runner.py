@@ -110,6 +110,12 @@ def _existing(out: Path, force: bool, spec_path: Path | None) -> tuple[list[Path
         raise IoError(f"output {str(out)!r} exists and is not a directory")
     if not out.is_dir():
         return None
+    for name in ("report.json", JOURNAL):  # found only when written: report.json after the whole generation
+        if (out / name).exists() and not (out / name).is_file():
+            raise IoError(
+                f"output directory {str(out)!r}: {name} is a folder (or another non-file) where generate writes its "
+                f"{'report' if name == 'report.json' else 'journal'}: move it away"
+            )
     yamls = sorted(out.glob("*.yaml"))
     report, journal = out / "report.json", out / JOURNAL
     if not yamls and not report.is_file():  # a journal alone: a run stopped before its first file

@@ -137,6 +137,8 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.output)
     if args.scorers_only and args.no_scorers:
         raise InputError("--scorers-only and --no-scorers: give one")
+    if args.scorers_only and args.cache_only:  # --cache-only was ignored: the scorers were fitted (minutes)
+        raise InputError("--scorers-only and --cache-only: give one")
     if args.scorers_only:
         cache_file = out / f"cache_{args.split}.npz"
         if not cache_file.is_file():

@@ -168,13 +168,21 @@ def load_scenarios(scenarios: Sequence[str | Path | Scenario]) -> list[Scenario]
     scenario was an empty table and exit status 0). :func:`run_agreement_study`'s check, for a caller to make
     before it prepares anything (a missing second scenario was named only after the first had run)."""
     out = []
+    seen: dict[str, str] = {}
     for path in scenarios:
         sc = path if isinstance(path, Scenario) else load_scenario(resolve_scenario(path))
+        where = f"scenario {sc.name!r}" if isinstance(path, Scenario) else str(path)
         usvs = [v for v in sc.vessels if v.role == "usv"]
         if not any((sc.rigs[v.rig] if v.rig is not None else RigConfig()).top_view is not None for v in usvs):
             why = "no vessel with role: usv" if not usvs else "no USV whose rig has a top_view (rigs.NAME.top_view)"
-            where = f"scenario {sc.name!r}" if isinstance(path, Scenario) else str(path)
             raise located(ConfigError(f"the agreement study needs a USV's top-view camera; it has {why}"), where)
+        if sc.name in seen:  # its samples were counted twice in the table, under one name in the samples' file
+            raise ConfigError(
+                f"{where}: the scenario name {sc.name!r} is taken by an earlier scenario of the study "
+                f"({seen[sc.name]}): the samples name their scenario, and a scenario given twice counts twice; give "
+                "each scenario once, under a name of its own"
+            )
+        seen[sc.name] = where
         out.append(sc)
     return out
 

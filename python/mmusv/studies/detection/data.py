@@ -19,6 +19,7 @@ from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import yaml
@@ -269,7 +270,12 @@ def read_opv2v(folder: str | Path) -> SequenceData:
 
     d = Path(folder)
     cavs = sorted((c for c in d.iterdir() if c.is_dir() and c.name.isdigit()), key=lambda c: int(c.name))
-    stamps = sorted({p.stem for c in cavs for p in c.glob("*.pcd")})
+    clouds = [p for c in cavs for p in c.glob("*.pcd")]
+    odd = [p for p in clouds if not p.stem.isdigit()]
+    if odd:  # int(stem) below was a bare ValueError
+        raise IoError(f"{odd[0]}: not an OPV2V frame (a CAV's frames are <timestamp>.pcd and <timestamp>.yaml)")
+    # the frames of the .yaml files too: one whose .pcd is gone is said below (a lone CAV's frame was dropped)
+    stamps = sorted({p.stem for p in clouds} | {p.stem for c in cavs for p in c.glob("*.yaml") if p.stem.isdigit()})
     frames: list[SceneFrame] = []
     for ts in stamps:
         afs: list[AgentFrame] = []
@@ -277,23 +283,24 @@ def read_opv2v(folder: str | Path) -> SequenceData:
         sizes: dict[str, np.ndarray] = {}
         for c in cavs:
             y_path, p_path = c / f"{ts}.yaml", c / f"{ts}.pcd"
-            if not (y_path.is_file() and p_path.is_file()):
+            if not (y_path.is_file() or p_path.is_file()):
                 continue
+            if not (y_path.is_file() and p_path.is_file()):  # the CAV was left out of the frame without a word
+                have, lack = (y_path, p_path) if y_path.is_file() else (p_path, y_path)
+                raise IoError(f"{lack}: missing beside {have.name}; an OPV2V frame of a CAV is a .pcd and a .yaml")
             try:
                 doc = yaml.safe_load(y_path.read_text(encoding="utf-8"))
                 xyz, inten = read_pcd(p_path)
                 lidar = mirror_transform(carla_matrix(np.asarray(doc["lidar_pose"], dtype=np.float64)))
                 body = mirror_transform(carla_matrix(np.asarray(doc["true_ego_pos"], dtype=np.float64)))
-            except (OSError, ValueError, KeyError, TypeError, yaml.YAMLError) as exc:
-                raise IoError(f"{y_path}: not a readable OPV2V frame ({type(exc).__name__}: {exc})") from None
+                # inside the try: a vehicle without a location or of 2 angles was a bare KeyError / ValueError
+                for vid, (box, size) in _opv2v_vehicles(doc.get("vehicles") or {}).items():
+                    vehicles[vid], sizes[vid] = box, size
+            except (OSError, ValueError, KeyError, TypeError, AttributeError, yaml.YAMLError) as exc:
+                why = " ".join(str(exc).split())  # a YAML error spans several lines
+                raise IoError(f"{y_path}: not a readable OPV2V frame ({type(exc).__name__}: {why})") from None
             pts = np.column_stack([xyz[:, 0], -xyz[:, 1], xyz[:, 2], inten]).astype(np.float32)
             afs.append(AgentFrame(c.name, pts, body, invert(body) @ lidar))
-            for vid, v in (doc.get("vehicles") or {}).items():
-                loc = np.asarray(v["location"], dtype=np.float64) + np.asarray(v["center"], dtype=np.float64)
-                roll, yaw, pitch = (float(x) for x in v["angle"])
-                box = mirror_transform(carla_matrix(np.array([loc[0], loc[1], loc[2], roll, yaw, pitch])))
-                vehicles[str(vid)] = box
-                sizes[str(vid)] = 2.0 * np.asarray(v["extent"], dtype=np.float64)
         if not afs:
             continue
         ids = sorted(k for k in vehicles if k not in {a.id for a in afs})
@@ -310,6 +317,27 @@ def read_opv2v(folder: str | Path) -> SequenceData:
             )
         )
     return SequenceData(d.name, tuple(frames))
+
+
+def _opv2v_vehicles(doc: Any) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Vehicle id → (box pose in mmusv's frame, size ``2 * extent``) of an OPV2V frame's ``vehicles``; a
+    ``ValueError`` naming the vehicle for a location, centre or angle that is not finite or an extent that is not
+    finite and >= 0 (a NaN or negative box was scored without a word)."""
+    out: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+    for vid, v in doc.items():
+        loc = np.asarray(v["location"], dtype=np.float64) + np.asarray(v["center"], dtype=np.float64)
+        angle = np.asarray(v["angle"], dtype=np.float64)
+        extent = np.asarray(v["extent"], dtype=np.float64)
+        if loc.shape != (3,) or angle.shape != (3,) or extent.shape != (3,):
+            raise ValueError(f"vehicles[{vid!r}]: location, center, angle and extent must be 3 numbers each")
+        if not (np.isfinite(loc).all() and np.isfinite(angle).all()):
+            raise ValueError(f"vehicles[{vid!r}]: location, center and angle must be finite numbers")
+        if not (np.isfinite(extent).all() and (extent >= 0).all()):
+            raise ValueError(f"vehicles[{vid!r}].extent = {extent.tolist()}: must be finite half-sizes >= 0 (metres)")
+        roll, yaw, pitch = (float(x) for x in angle)
+        box = mirror_transform(carla_matrix(np.array([loc[0], loc[1], loc[2], roll, yaw, pitch])))
+        out[str(vid)] = (box, 2.0 * extent)
+    return out
 
 
 def check_split(split: str, seed: int) -> None:

@@ -229,4 +229,6 @@ def _as_boxes(out: tuple[np.ndarray, np.ndarray], who: str = "the detector") -> 
     if not (np.isfinite(boxes).all() and np.isfinite(scores).all()):
         bad = "boxes" if not np.isfinite(boxes).all() else "scores"
         raise InputError(f"{who} returned {bad} that are not finite (NaN or inf); {expected}")
+    if (boxes[:, 3:6] < 0).any():  # scored without a word
+        raise InputError(f"{who} returned a box of negative size (l, w or h); {expected}, sizes not negative")
     return boxes, scores

@@ -311,6 +311,14 @@ def _check_prediction_values(path: Path, df: pl.DataFrame) -> None:
                 f"--predictions {path}: column {c} must hold finite numbers; {first(bad)} has "
                 f"{float(col.filter(bad)[0])!r}"
             )
+    for c in ("l", "w", "h"):  # a negative size was scored without a word
+        col = df[c]
+        bad = pl.Series(col.to_numpy().astype(np.float64) < 0)
+        if bad.any():
+            raise InputError(
+                f"--predictions {path}: column {c} must hold box sizes in metres, not negative; {first(bad)} has "
+                f"{float(col.filter(bad)[0])!r}"
+            )
 
 
 def check_prediction_coverage(
