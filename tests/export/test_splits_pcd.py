@@ -72,3 +72,27 @@ def test_pcd_deterministic_and_empty() -> None:
     assert pcd_bytes(xyz, [0.5]) == pcd_bytes(xyz.copy(), [0.5])
     assert b"\n0.0000 0.0000 1.0000 8388608\n" in pcd_bytes(xyz, [0.5])
     assert b"POINTS 0\n" in pcd_bytes(np.zeros((0, 3)), np.zeros(0))
+
+
+def test_read_pcd_refuses_a_file_cut_short(tmp_path: Path) -> None:
+    """A cloud cut after some rows read as fewer points without a word (a study then scored a damaged frame), and
+    one cut inside its header as none with only numpy's warning; both name the file now. Whole files, the empty
+    one included, read back."""
+    rng = np.random.default_rng(1)
+    p = tmp_path / "000001.pcd"
+    write_pcd(p, rng.normal(size=(40, 3)), rng.uniform(size=40))
+    data = p.read_bytes()
+    assert read_pcd(p)[0].shape == (40, 3)
+    empty = tmp_path / "000002.pcd"
+    write_pcd(empty, np.zeros((0, 3)), np.zeros(0))
+    assert read_pcd(empty)[0].shape == (0, 3) and read_pcd(empty)[1].shape == (0,)
+    header = data.index(b"DATA ascii\n") + len(b"DATA ascii\n")
+    cut_rows = data[: header + data[header:].index(b"\n", 200) + 1]  # whole rows, fewer than 40
+    for cut, why in ((cut_rows, r"POINTS 40, and it holds \d+ \(a file cut short"), (data[:100], "not an ASCII")):
+        p.write_bytes(cut)
+        with pytest.raises(ValueError, match=why) as exc:
+            read_pcd(p)
+        assert str(p) in str(exc.value)
+    p.write_bytes(data[:-9])  # inside the last row: a row of too few numbers
+    with pytest.raises(ValueError):
+        read_pcd(p)

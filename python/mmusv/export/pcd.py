@@ -9,6 +9,7 @@ loaders fail.
 from __future__ import annotations
 
 import io
+import re
 from pathlib import Path
 
 import numpy as np
@@ -47,11 +48,22 @@ def write_pcd(path: Path, xyz: npt.ArrayLike, intensity: npt.ArrayLike) -> int:
 
 
 def read_pcd(path: Path) -> tuple[np.ndarray, np.ndarray]:
-    """``(N, 3)`` points and ``(N,)`` intensities (red byte / 255) of a file written by :func:`write_pcd`."""
+    """``(N, 3)`` points and ``(N,)`` intensities (red byte / 255) of a file written by :func:`write_pcd`.
+
+    Raises:
+        ValueError: naming the file, when it is not an ASCII ``x y z rgb`` PCD (its header cut short too), or holds
+            another number of points than its header's ``POINTS`` (a file cut short read as fewer points)."""
     text = path.read_text(encoding="ascii")
-    head, _, body = text.partition("DATA ascii\n")
-    if "FIELDS x y z rgb" not in head:
-        raise ValueError(f"{path} is not an x y z rgb PCD")
-    arr = np.loadtxt(io.StringIO(body), dtype=np.float64, ndmin=2).reshape(-1, 4)
+    head, sep, body = text.partition("DATA ascii\n")
+    if not sep or "FIELDS x y z rgb" not in head:
+        raise ValueError(f"{path} is not an ASCII x y z rgb PCD (no FIELDS x y z rgb and DATA ascii header)")
+    points = re.search(r"^POINTS (\d+)$", head, flags=re.MULTILINE)
+    if points is None:
+        raise ValueError(f"{path}: its header gives no POINTS")
+    n = int(points.group(1))
+    rows = [line for line in body.splitlines() if line.strip()]
+    if len(rows) != n:
+        raise ValueError(f"{path}: its header gives POINTS {n}, and it holds {len(rows)} (a file cut short?)")
+    arr = np.loadtxt(rows, dtype=np.float64, ndmin=2).reshape(-1, 4) if n else np.zeros((0, 4))
     rgb = arr[:, 3].astype(np.int64)
     return arr[:, :3], ((rgb >> 16) & 0xFF) / 255.0
