@@ -74,6 +74,13 @@ def parser() -> argparse.ArgumentParser:
         default="paper",
         help="paper: Table I with the paper's formula (default); physical: every hull's response to the sea",
     )
+    waves.add_argument(
+        "--usvs",
+        choices=("scenario", "reference"),
+        default="scenario",
+        help="scenario: the scenario's USVs at their own sizes (default); reference: every USV at the paper's "
+        "reference size, 5 x 2.5 x 1.5 m (alpha_v = 1), on its own route, which gives Table I (--motion paper only)",
+    )
     agree = studies.add_parser("agreement", help="Table II: 3D-box annotations vs top-view semantic rendering")
     agree.add_argument("scenarios", nargs="*", help="scenario YAMLs (default: the three bundled map scenarios)")
     agree.add_argument(

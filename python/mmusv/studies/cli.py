@@ -28,13 +28,18 @@ def study_waves(args: argparse.Namespace) -> int:
     from mmusv import arguments
     from mmusv.bundled import resolve_scenario
     from mmusv.config import load_scenario
-    from mmusv.errors import MmusvError, located
-    from mmusv.studies.waves import PHYSICAL_RECORD_S, check_scenario, run_wave_study
+    from mmusv.errors import ConfigError, MmusvError, located
+    from mmusv.studies.waves import PAPER_TABLE_I, PHYSICAL_RECORD_S, check_scenario, run_wave_study
 
     # --frames first, within a scenario's own bound: a bad count made the output folder before it was refused,
     # and 10**30 was a numpy traceback (the copy of the scenario below is not validated).
     if args.frames is not None:
         arguments.whole(args.frames, name="--frames", lo=2, hi=MAX_FRAMES)
+    if args.usvs == "reference" and args.motion != "paper":
+        raise ConfigError(
+            f"--usvs reference with --motion {args.motion}: the reference USV is a size of the paper's formula "
+            "(--motion paper); the physical response reads each hull's own particulars"
+        )
     try:  # "scenario '/tmp' is a directory, not a file" did not say which flag gave it
         scenario = load_scenario(resolve_scenario(path_arg(args.scenario, flag="--scenario")))
     except MmusvError as exc:
@@ -49,20 +54,23 @@ def study_waves(args: argparse.Namespace) -> int:
     with made_output_folder(args.output):  # removed again if still empty when the study fails or is interrupted
         if args.motion == "physical":
             return _physical_wave_study(scenario, args)
-        study = run_wave_study(scenario)
+        study = run_wave_study(scenario, usvs=args.usvs)
+        sized = " of the paper's reference size, 5 × 2.5 × 1.5 m," if args.usvs == "reference" else ""
         table = Table(
             title=f"Wave study on {scenario.name} "
-            f"({counted(int(study.table['usvs'][0]), 'USV')} × {study.table['frames'][0]} frames)"
+            f"({counted(int(study.table['usvs'][0]), 'USV')}{sized} × {study.table['frames'][0]} frames)"
         )
-        for col in ("wave", "H (m)", "heave RMS (m)", "roll RMS (°)", "pitch RMS (°)"):
+        for col in ("wave", "H (m)", "heave RMS (m)", "roll RMS (°)", "pitch RMS (°)", "paper Table I"):
             table.add_column(col, justify="right")
         for r in study.table.iter_rows(named=True):
+            paper = PAPER_TABLE_I.get(str(r["wave"]))
             table.add_row(
                 str(r["wave"]),
                 f"{r['H_m']:.1f}",
                 f"{r['heave_rms_m']:.4f}",
                 f"{r['roll_rms_deg']:.4f}",
                 f"{r['pitch_rms_deg']:.4f}",
+                "" if paper is None else " / ".join(f"{x:.4f}" for x in paper),
             )
         console = rich_console()
         console.print(table)

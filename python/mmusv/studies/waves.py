@@ -7,7 +7,9 @@ every acquisition frame. A straight-line fit of each statistic against H gives R
 ``motion="paper"`` (the default) moves the vessels by the paper's formula, whose amplitudes are fitted to Table I
 for a USV of the reference size (a 5 × 2.5 × 1.5 m box, ``α_v = 1``): on the bundled ``island_port_waves``, whose
 USVs are three 4.88 m WAM-Vs and a 12 m patrol boat (``α_v`` 0.85 and 0.42), every statistic is 0.76–0.77 times
-Table I's, the shape (monotonic, linear in H) the paper's (``docs/sea.md``, *mmusv study waves against Table I*). With
+Table I's, the shape (monotonic, linear in H) the paper's (``docs/sea.md``, *mmusv study waves against Table I*);
+``usvs="reference"`` (``--usvs reference``) moves them as USVs of the reference size on the same routes, which gives
+Table I itself. With
 ``motion="physical"`` every vessel responds to the fully developed sea of each setting (Hs = H, Pierson–Moskowitz
 Tp; :mod:`mmusv.world.sea_state`) through its hull's RAOs; :func:`run_physical_wave_study` then reports, beside
 the paper's Table I (:data:`PAPER_TABLE_I`) and the paper mode, the RMS of the USVs and of every vessel of the
@@ -24,6 +26,7 @@ from typing import Literal
 import numpy as np
 import polars as pl
 
+from mmusv import arguments
 from mmusv.config import AcquisitionConfig, Scenario
 from mmusv.errors import ConfigError
 from mmusv.forking import check_polars
@@ -33,6 +36,7 @@ from mmusv.world.environment import WAVE_PRESETS, wave_height_m
 
 __all__ = [
     "PAPER_TABLE_I",
+    "USV_SIZES",
     "PhysicalWaveStudy",
     "WaveStudy",
     "check_scenario",
@@ -47,6 +51,9 @@ PAPER_TABLE_I: dict[str, tuple[float, float, float]] = {
     "W3": (0.1923, 1.4421, 0.4774),
 }
 """The paper's Table I: (heave RMS m, roll RMS °, pitch RMS °) of its USVs under W0..W3."""
+
+USV_SIZES = ("scenario", "reference")
+""":func:`run_wave_study`'s ``usvs``: the scenario's USVs at their assets' sizes, or at the paper's reference size."""
 
 
 @dataclass(frozen=True)
@@ -124,15 +131,25 @@ def run_wave_study(
     *,
     waves: tuple[str | float, ...] = tuple(WAVE_PRESETS),
     motion: Literal["paper", "physical"] = "paper",
+    usvs: Literal["scenario", "reference"] = "scenario",
 ) -> WaveStudy:
     """Runs the study on ``scenario``'s USVs for each wave setting (names ``W0``.. or heights in metres), with the
-    paper's motion formula (default) or the physical response to the fully developed sea of each setting."""
+    paper's motion formula (default) or the physical response to the fully developed sea of each setting.
+    ``usvs="reference"`` (paper motion only) moves every USV as the paper's reference USV (5 × 2.5 × 1.5 m,
+    ``α_v = 1``: :func:`~mmusv.motion.build_fleet`'s ``reference_usvs``) on its own route: Table I itself."""
     check_polars("mmusv study waves")
+    if usvs not in USV_SIZES:
+        raise ConfigError(f"usvs = {arguments.shown(usvs)}: must be one of {', '.join(USV_SIZES)}")
+    if usvs == "reference" and motion != "paper":
+        raise ConfigError(
+            f"usvs = 'reference' with motion = {arguments.shown(motion)}: the reference USV is a size of the "
+            "paper's formula (motion: paper); the physical response reads each hull's own particulars"
+        )
     usv_idx = check_scenario(scenario)
     scenario = scenario.with_sea(None, motion=motion)
     rows = []
     for w in waves:
-        poses = scenario_poses(scenario, wave=w)[:, usv_idx, :]
+        poses = scenario_poses(scenario, wave=w, reference_usvs=usvs == "reference")[:, usv_idx, :]
         heave, roll, pitch = _rms_stats(poses)
         rows.append(
             {
