@@ -57,13 +57,18 @@ def read_pcd(path: Path) -> tuple[np.ndarray, np.ndarray]:
     head, sep, body = text.partition("DATA ascii\n")
     if not sep or "FIELDS x y z rgb" not in head:
         raise ValueError(f"{path} is not an ASCII x y z rgb PCD (no FIELDS x y z rgb and DATA ascii header)")
-    points = re.search(r"^POINTS (\d+)$", head, flags=re.MULTILINE)
+    points = re.search(r"^POINTS[ \t]+(\d+)[ \t]*$", head, flags=re.MULTILINE)
     if points is None:
         raise ValueError(f"{path}: its header gives no POINTS")
     n = int(points.group(1))
     rows = [line for line in body.splitlines() if line.strip()]
     if len(rows) != n:
         raise ValueError(f"{path}: its header gives POINTS {n}, and it holds {len(rows)} (a file cut short?)")
-    arr = np.loadtxt(rows, dtype=np.float64, ndmin=2).reshape(-1, 4) if n else np.zeros((0, 4))
+    if rows and not body.rstrip(" \t").endswith("\n"):  # as many rows, the last one cut (inside a number: read)
+        raise ValueError(f"{path}: its last row {rows[-1]!r} ends without a newline (a file cut short?)")
+    try:
+        arr = np.loadtxt(rows, dtype=np.float64, ndmin=2).reshape(-1, 4) if n else np.zeros((0, 4))
+    except ValueError as exc:
+        raise ValueError(f"{path}: not rows of 4 numbers x y z rgb ({exc})") from None
     rgb = arr[:, 3].astype(np.int64)
     return arr[:, :3], ((rgb >> 16) & 0xFF) / 255.0
