@@ -489,7 +489,9 @@ def test_a_conversion_stopping_halfway_in_a_new_folder_says_so_in_its_report(
         m.setattr(KittiWriter, "write_frame", lambda self, frame: (_ for _ in ()).throw(KeyboardInterrupt()))
         with pytest.raises(KeyboardInterrupt):
             convert(lonely_rec, to="kitti", out_dir=tmp_path / "ds2", splits=None)
-    assert load_report(tmp_path / "ds2") == {**report, "status": "interrupted", "error": "KeyboardInterrupt"}
+    assert load_report(tmp_path / "ds2") == {k: v for k, v in report.items() if k != "error"} | {
+        "status": "interrupted"
+    }
 
     done = convert(lonely_rec, to="kitti", out_dir=out, splits=None, overwrite=True)
     assert done.frames > 0 and load_report(out)["status"] == "complete" and "error" not in load_report(out)

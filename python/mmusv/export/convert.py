@@ -10,7 +10,7 @@ folder per recording (OPV2V, KITTI, MaSTr; ROS 2 bags, never split), the format'
 YOLO, SemanticKITTI, MOT, KITTI tracking: see their modules), plus ``conversion.yaml`` (options, sources, split of
 every recording, frames converted and skipped; no times or absolute paths, so two conversions of the same input are
 byte-identical). ``conversion.yaml`` is written first with ``status: in_progress`` and rewritten at the end
-(``complete``, or ``failed``/``interrupted`` with the error when the conversion stops halfway in a new folder); an
+(``complete``; ``failed`` with the error, or ``interrupted``, when it stops halfway in a new folder); an
 existing ``out_dir`` is replaced only with ``overwrite`` and only when it is empty or holds a previous conversion
 (its ``conversion.yaml``), and then only once the new one is complete (written beside it, then swapped in).
 

@@ -123,15 +123,21 @@ def staged(work: Path, out: Path) -> Iterator[None]:
 @contextlib.contextmanager
 def reported(report: Path, header: dict[str, Any]) -> Iterator[None]:
     """Around a conversion whose report is ``report``: writes it first with ``status: in_progress`` and, when the
-    conversion stops with an exception, rewrites it with ``status: failed`` (``interrupted`` for Ctrl-C) and the
-    error, so that a folder left with part of a conversion says so and why; the files already written stay. (Inside
-    a staging folder, :func:`staged` then removes it all.) The conversion writes the complete report itself."""
+    conversion stops with an exception, rewrites it with ``status: failed`` and the ``error``, or ``status:
+    interrupted`` for a stop (Ctrl-C, or SIGTERM through the command line's handler: a ``KeyboardInterrupt``, as a
+    recording's run metadata say it), so that a folder left with part of a conversion says so and why; the files
+    already written stay. (Inside a staging folder, :func:`staged` then removes it all.) The conversion writes the
+    complete report itself."""
     report.write_bytes(dump_yaml({**header, "status": "in_progress"}))
     try:
         yield
     except BaseException as exc:
-        status = "interrupted" if isinstance(exc, KeyboardInterrupt) else "failed"
-        error = str(exc) if isinstance(exc, MmusvError) else f"{type(exc).__name__}: {exc}".rstrip(": ")
-        with contextlib.suppress(OSError):  # a full disk keeps the in_progress report: still not complete
-            report.write_bytes(dump_yaml({**header, "status": status, "error": error}))
+        if isinstance(exc, KeyboardInterrupt):
+            ended: dict[str, Any] = {"status": "interrupted"}
+        else:
+            error = str(exc) if isinstance(exc, MmusvError) else f"{type(exc).__name__}: {exc}".rstrip(": ")
+            ended = {"status": "failed", "error": error}
+        # where even this cannot be written (a full disk), the report is left empty or cut: not complete either
+        with contextlib.suppress(OSError):
+            report.write_bytes(dump_yaml({**header, **ended}))
         raise
