@@ -40,6 +40,7 @@ from mmusv.sensors.camera import render
 from mmusv.world.build import pose_matrices
 from mmusv.world.environment import Weather
 from mmusv.world.sea_state import sea_spec_for_height
+from nrl_clutter import nrl_sigma0
 
 C_LIGHT = 299_792_458.0
 """Speed of light, m/s."""
@@ -86,12 +87,6 @@ WATER_K2 = 0.93
 
 # --- NRL sea clutter ---
 
-NRL = {
-    "HH": (-73.0, 20.781, 7.351, 25.65, 0.0054),
-    "VV": (-50.796, 25.93, 0.7093, 21.588, 0.00211),
-}
-"""Gregers-Hansen & Mital (2012), the 0.1°–60° fit: c1..c5 as in the NRL memo's code (``NRL_SigmaSea.m``, V.
-Gregers-Hansen 2010); the paper's table prints them rounded (HH c2 20.78; VV c1 −50.79, c4 21.58: ≤ 0.03 dB)."""
 DOUGLAS_UPPER = (0.1, 0.5, 1.25, 2.5, 4.0, 6.0)
 """WMO code table 3700 (Douglas): the upper Hs bound (m) of sea states 1..6 (state 0: glassy, Hs 0)."""
 EARTH_K, EARTH_RADIUS_M = 4.0 / 3.0, 6_371_000.0
@@ -154,18 +149,6 @@ def _radar(
 def _quad(scene: Scene, corners: list[list[float]], cls: int) -> int:
     v = np.array(corners, dtype=float)
     return scene.add_instance(scene.add_mesh(v, np.array([[0, 1, 2], [0, 2, 3]]), classes=cls, name="quad"))
-
-
-def _nrl_sigma0(pol: str, f_ghz: float, ss: float, psi_deg: np.ndarray) -> np.ndarray:
-    c1, c2, c3, c4, c5 = NRL[pol]
-    db = (
-        c1
-        + c2 * np.log10(np.sin(np.radians(psi_deg)))
-        + (27.5 + c3 * psi_deg) * math.log10(f_ghz) / (1 + 0.95 * psi_deg)
-        + c4 * (ss + 1) ** (1 / (2 + 0.085 * psi_deg + 0.033 * ss))
-        + c5 * psi_deg**2
-    )
-    return 10 ** (db / 10)
 
 
 def _douglas_state(hs: float) -> float:
@@ -312,11 +295,11 @@ def test_nrl_sea_clutter_vv_and_s_band(f_ghz: float, pol: str) -> None:
         psi = np.degrees(np.arcsin(height / r - r / (2 * EARTH_K * EARTH_RADIUS_M)))
         assert psi.min() > 0.1 and psi.max() < 60.0  # inside the fit: no clamp involved
         ss = _douglas_state(hs)
-        want = _nrl_sigma0(pol, f_ghz, ss, psi)
+        want = nrl_sigma0(pol, f_ghz, ss, psi)
         got = phys["intensity"].astype(float) / fixed["intensity"] * sigma_1m * hs**2
         np.testing.assert_allclose(got, want, rtol=0.01, err_msg=f"Hs {hs}")
         rel = phys["intensity"].astype(float) / phys_x["intensity"]
-        np.testing.assert_allclose(rel, want / _nrl_sigma0("HH", 9.41, ss, psi), rtol=0.01, err_msg=f"Hs {hs}")
+        np.testing.assert_allclose(rel, want / nrl_sigma0("HH", 9.41, ss, psi), rtol=0.01, err_msg=f"Hs {hs}")
 
 
 def test_douglas_states_quoted_in_the_sea_doc() -> None:

@@ -44,6 +44,7 @@ from mmusv.world.hydrostatics import hull_particulars
 from mmusv.world.primitives import box
 from mmusv.world.sea_state import sea_spec_for_height
 from mmusv.world.vessels import get_asset
+from nrl_clutter import nrl_sigma0
 from scipy import integrate, special
 
 G = 9.80665
@@ -101,8 +102,6 @@ COX_MUNK = (0.003, 5.12e-3)
 """Cox & Munk (1954), clean sea: total mean square slope σ² = 0.003 + 5.12·10⁻³ U."""
 DIELECTRIC_F0 = 0.04
 """Schlick F0 of a dielectric in the metallic workflow (Burley 2012)."""
-NRL_HH = (-73.0, 20.78, 7.351, 25.65, 0.0054)
-"""Gregers-Hansen & Mital (2012), horizontal polarisation, 0.1°–60°: c1..c5."""
 DOUGLAS_MIDDLE = (0.0, 0.05, 0.3, 0.875, 1.875, 3.25, 5.0)
 """Hs at the middle of the WMO/Douglas bands of states 0..6 (0–0.1, 0.1–0.5, 0.5–1.25, 1.25–2.5, 2.5–4, 4–6 m),
 where a sea of that state is the NRL model's state (the clutter model interpolates between them)."""
@@ -638,20 +637,6 @@ def test_water_reflectance_is_fresnel_over_cox_munk_facets() -> None:
 # --- 6. radar sea clutter ---
 
 
-def _nrl_sigma0(f_ghz: float, ss: np.ndarray | float, psi_deg: np.ndarray) -> np.ndarray:
-    """Gregers-Hansen & Mital (2012), HH: σ⁰(dB) = c1 + c2 log10 sin ψ + (27.5 + c3 ψ) log10 f / (1 + 0.95 ψ)
-    + c4 (SS + 1)^(1/(2 + 0.085 ψ + 0.033 SS)) + c5 ψ² (ψ in degrees, f in GHz), linear."""
-    c1, c2, c3, c4, c5 = NRL_HH
-    db = (
-        c1
-        + c2 * np.log10(np.sin(np.radians(psi_deg)))
-        + (27.5 + c3 * psi_deg) * math.log10(f_ghz) / (1 + 0.95 * psi_deg)
-        + c4 * (ss + 1) ** (1 / (2 + 0.085 * psi_deg + 0.033 * ss))
-        + c5 * psi_deg**2
-    )
-    return 10 ** (db / 10)
-
-
 def test_radar_sea_clutter_is_the_nrl_model() -> None:
     """A radar 15 m above a displaced sea, threshold 0 (every cell reported), no rain: a cell's clutter is
     μ·(−ln u) with u the cell's own seeded draw. The same sweep over the same water without the wave surface
@@ -707,7 +692,7 @@ def test_radar_sea_clutter_is_the_nrl_model() -> None:
         psi = np.clip(np.degrees(np.arcsin(height / r - r / (2 * earth))), 0.1, 60.0)
         ss = np.interp(hs, DOUGLAS_MIDDLE, np.arange(len(DOUGLAS_MIDDLE)))
         sigma0 = phys["intensity"].astype(float) / fixed["intensity"].astype(float) * sigma_1m * hs**2
-        np.testing.assert_allclose(sigma0, _nrl_sigma0(X_BAND_GHZ, ss, psi), rtol=0.01)
+        np.testing.assert_allclose(sigma0, nrl_sigma0("HH", X_BAND_GHZ, ss, psi), rtol=0.01)
         if hs == 1.0:
             # The pulse-limited cell A = r θ_az Δr sec ψ (Skolnik, Introduction to Radar Systems, §13.2), ψ unclamped.
             sec_psi = 1.0 / np.sqrt(1.0 - np.clip(height / r - r / (2 * earth), 0.0, None) ** 2)
@@ -715,7 +700,7 @@ def test_radar_sea_clutter_is_the_nrl_model() -> None:
             # Times the fan's Gaussian two-way gain exp(−8 ln 2 e² / θ_el²) where the water lies, e = −atan(h / r),
             # θ_el = 20° (Probert-Jones 1962).
             g2 = np.exp(-8 * math.log(2) * (np.arctan(height / r) / math.radians(20.0)) ** 2)
-            mu = _nrl_sigma0(X_BAND_GHZ, ss, psi) * area * g2 * (1000.0 / r) ** 4
+            mu = nrl_sigma0("HH", X_BAND_GHZ, ss, psi) * area * g2 * (1000.0 / r) ** 4
             for rr in np.unique(r)[::20]:
                 m = r == rr
                 assert np.mean(phys["intensity"][m] / mu[m]) == pytest.approx(1.0, rel=0.1)
