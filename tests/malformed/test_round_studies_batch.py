@@ -154,7 +154,7 @@ def test_an_index_path_that_is_a_folder_is_refused_before_anything_runs(tmp_path
     assert not (out / "a").exists()
 
 
-@pytest.mark.parametrize("text", ['{"my": "notes"}\n', "[1, 2]\n", "not JSON\n", ""])
+@pytest.mark.parametrize("text", ['{"my": "notes"}\n', "[1, 2]\n", "not JSON\n"])
 def test_a_dataset_json_of_another_tool_is_not_replaced(tmp_path: Path, text: str) -> None:
     """``OUT/dataset.json`` that mmusv did not write (another tool's metadata) was replaced by the batch's index
     without a word; an index of mmusv's, even one cut short, is still replaced."""

@@ -225,7 +225,8 @@ def _check_ray_address(address: str) -> None:
 
 
 def run_batch(args: argparse.Namespace, source: Path | list[Path]) -> int:
-    """``mmusv run DIR`` (or a file with batch options): runs the batch, prints the table; 1 if a scenario failed."""
+    """``mmusv run DIR`` (or a file with batch options): runs the batch, prints the table; 1 if a scenario failed
+    or the index could not be written."""
     from mmusv.batch.runner import run_many
 
     check_batch_options(args)

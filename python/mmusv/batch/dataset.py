@@ -95,17 +95,16 @@ def _generated_set(scen_dir: Path) -> list[str] | None:
 
 
 def _refuse_foreign(scen_dir: Path) -> None:
-    """Refuses (:class:`~mmusv.errors.IoError`) scenario files in ``scen_dir`` that the spec's generation did not
-    write (not listed in its ``report.json``): the batch records every ``*.yaml`` and ``*.yml`` there, so a file put
-    there by hand (or a ``.yml``, which generate does not check) was recorded, converted and indexed as part of the
-    spec's dataset without a word."""
-    try:
-        data = json.loads((scen_dir / "report.json").read_text(encoding="utf-8"))
-        listed = {f for c in data["combinations"] for f in c["files"] if isinstance(f, str)}
-    except (OSError, ValueError, KeyError, TypeError):
-        listed = set()
-    found = [*scen_dir.glob("*.yaml"), *scen_dir.glob("*.yml")]
-    foreign = sorted(p.name for p in found if p.name not in listed and p.name != "report.yaml")
+    """Refuses (:class:`~mmusv.errors.IoError`) scenario files in ``scen_dir`` that no generation there wrote (not
+    listed in its ``report.json``, nor in the journal of one stopped before its report): the batch records every
+    ``*.yaml`` and ``*.yml`` there, so a file put there by hand (or a ``.yml``, which generate does not check) was
+    recorded, converted and indexed as part of the spec's dataset without a word. Checked before the generation
+    (a ``.yml`` was refused only once the whole spec had been generated)."""
+    from mmusv.batch.plan import folder_entries
+    from mmusv.generate.runner import JOURNAL, _generated_here, _journal_names
+
+    listed = _generated_here(scen_dir / "report.json") | _journal_names(scen_dir / JOURNAL)
+    foreign = [p.name for p in folder_entries(scen_dir) if p.name not in listed]
     if foreign:
         names = ", ".join(foreign[:3]) + (" ..." if len(foreign) > 3 else "")
         raise IoError(
@@ -201,6 +200,7 @@ def build_dataset(
     shortfall: list[str] = [] if kept is None else kept
     quota = sum(c.quota for c in loaded.combinations)
     own = _own_recordings(old)
+    _refuse_foreign(scen_dir)  # before the generation, which replaces only what a generation wrote
     # Ray before anything changes on disk: a cluster that could not be joined failed the batch after the scenarios
     # were generated and stale recordings removed. (With nothing to generate or remove, the batch joins it if it has
     # something to record, before it writes anything, as `mmusv run DIR --ray` does.)
@@ -218,7 +218,6 @@ def build_dataset(
             shortfall = [f"{c.name}: {c.accepted} of {c.quota}" for c in report.combos if not c.met]
         if progress is not None:
             progress("generate", quota, quota)
-        _refuse_foreign(scen_dir)
         _remove_stale(rec_dir, own, {p.stem for p in scen_dir.glob("*.yaml")})
         if not any(scen_dir.glob("*.yaml")):  # no candidate met the spec: nothing to record (the shortfall says so)
             nothing = {"folder": opv2v.name, "status": "nothing to convert", "frames": 0, "sources": {}}

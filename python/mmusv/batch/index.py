@@ -160,8 +160,11 @@ def check_replaceable(path: Path, *, writer: str) -> None:
     """Raises :class:`~mmusv.errors.IoError` when ``path`` holds what writing an index there would lose or fail on:
     a folder (found only after every recording, as a warning), or a file that is not an mmusv dataset index (a
     ``dataset.json`` of another tool was replaced without a word). An index of mmusv's, even a damaged one, is
-    recognised by its ``format`` at the top (:func:`write_index` writes it first) and may be replaced. ``writer``
-    says who writes the index, for the message."""
+    recognised by its ``format`` at the top (:func:`write_index` writes it first) and may be replaced, as may a
+    file holding nothing else (empty, blanks or NUL bytes, or cut short before its ``format``: what a crash of the
+    machine can leave of an index being written, since an index is renamed into place unsynced; a re-run after
+    it, which the batch promises finishes the work, was refused as "not an mmusv dataset index"). ``writer`` says
+    who writes the index, for the message."""
     import re
 
     if not path.exists():
@@ -174,7 +177,8 @@ def check_replaceable(path: Path, *, writer: str) -> None:
             head = f.read(4096).decode("utf-8", errors="replace")
     except OSError as exc:
         raise IoError(f"cannot read {path}: {exc.strerror or exc}") from None
-    if not re.match(rf'\s*\{{\s*"format"\s*:\s*"{re.escape(INDEX_FORMAT)}"', head):
+    start, squeezed = f'{{"format":"{INDEX_FORMAT}"', re.sub(r"[\s\x00]", "", head)
+    if not (squeezed.startswith(start) or start.startswith(squeezed)):
         raise IoError(
             f"{path} is not an mmusv dataset index, and {writer} would replace it with its own: move it away or "
             "choose another output folder"

@@ -98,9 +98,7 @@ def scenario_files(source: str | os.PathLike[str] | Sequence[str | os.PathLike[s
     if isinstance(source, (str, os.PathLike)):
         src = arguments.path(source, name="source")
         if src.is_dir():
-            # .yml too: the run of one file takes either, and a folder's .yml scenarios were skipped without a word
-            found = [*src.glob("*.yaml"), *src.glob("*.yml")]
-            files = sorted(p for p in found if p.name != "report.yaml")
+            files = folder_entries(src)
             if not files:
                 raise ConfigError(f"{src} holds no *.yaml or *.yml scenarios")
             for f in files:  # a broken link or a folder of a scenario's name was skipped without a word
@@ -125,10 +123,22 @@ def scenario_files(source: str | os.PathLike[str] | Sequence[str | os.PathLike[s
     return sorted((_absolute(f) for f in files), key=lambda f: f.stem)
 
 
+def folder_entries(folder: Path) -> list[Path]:
+    """The entries of ``folder`` a batch takes for scenario files, sorted: every ``*.yaml`` and ``*.yml`` (the run
+    of one file takes either, and a folder's ``.yml`` scenarios were skipped without a word) but ``report.yaml``
+    and a hidden entry that is not a file, such as the lock link ``.#a.yaml`` Emacs keeps beside a file being
+    edited (a broken link, which :func:`scenario_files` refuses). Not all of them need be files."""
+    found = [*folder.glob("*.yaml"), *folder.glob("*.yml")]
+    return sorted(p for p in found if p.name != "report.yaml" and (p.is_file() or not p.name.startswith(".")))
+
+
 def _absolute(f: Path) -> Path:
-    """``f`` as an absolute path whose name is still the one given: a symbolic link is not followed (resolved,
-    ``c.yaml -> a.yaml`` took the stem ``a``: both files recorded into ``OUT/a`` and listed as ``a.yaml``)."""
-    return Path(os.path.abspath(f))
+    """``f`` as an absolute path whose name is still the one given: a symbolic link named ``f`` is not followed
+    (resolved, ``c.yaml -> a.yaml`` took the stem ``a``: both files recorded into ``OUT/a`` and listed as
+    ``a.yaml``), while its folder is resolved as before: ``link/../scen`` is where the system finds it (a lexical
+    ``os.path.abspath`` named another folder), and a folder reached through a link is named by its real path, the
+    one a Ray cluster's nodes mount."""
+    return f.parent.resolve() / f.name
 
 
 def _not_a_file(f: Path) -> str:

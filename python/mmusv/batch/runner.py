@@ -426,19 +426,9 @@ def _prepare(plan: ScenarioPlan) -> None:
     """:func:`~mmusv.batch.plan.prepare` of one scenario; a folder that cannot be readied (``OUT/<stem>`` is a
     file, ...) fails that scenario alone (the batch ended at once in one line naming a ``.parts.json`` no one
     asked for, running none of the others)."""
-    try:
-        prepare(plan)
-    except OSError as exc:
-        if plan.folder.exists() and not plan.folder.is_dir():
-            why = f"its output folder {plan.folder} is a file: move it away (the recording goes into OUT/<stem>/)"
-        else:
-            where = f" ({exc.filename})" if exc.filename else ""
-            why = f"cannot prepare its output folder {plan.folder}{where}: {exc.strerror or exc}"
-        plan.error = f"{plan.file}: {why}"
-        plan.tasks, plan.to_run = [], []
-        return
     # a part's folder (or OUT/<stem>/parts) that is a file failed each of its tasks as an "internal error
-    # NotADirectoryError" of the worker
+    # NotADirectoryError" of the worker; checked before prepare, which removes the other layout's recording and
+    # writes the parts manifest of a scenario that then fails
     for t in plan.to_run:
         folder = Path(t.out_dir)
         for d in (folder, *folder.parents):
@@ -451,6 +441,16 @@ def _prepare(plan: ScenarioPlan) -> None:
                 )
                 plan.tasks, plan.to_run = [], []
                 return
+    try:
+        prepare(plan)
+    except OSError as exc:
+        if plan.folder.exists() and not plan.folder.is_dir():
+            why = f"its output folder {plan.folder} is a file: move it away (the recording goes into OUT/<stem>/)"
+        else:
+            where = f" ({exc.filename})" if exc.filename else ""
+            why = f"cannot prepare its output folder {plan.folder}{where}: {exc.strerror or exc}"
+        plan.error = f"{plan.file}: {why}"
+        plan.tasks, plan.to_run = [], []
 
 
 def _complete_on_disk(plan: ScenarioPlan) -> bool:

@@ -179,8 +179,8 @@ def load_scenarios(scenarios: Sequence[str | Path | Scenario]) -> list[Scenario]
         if sc.name in seen:  # its samples were counted twice in the table, under one name in the samples' file
             raise ConfigError(
                 f"{where}: the scenario name {sc.name!r} is taken by an earlier scenario of the study "
-                f"({seen[sc.name]}): the samples name their scenario, and a scenario given twice counts twice; give "
-                "each scenario once, under a name of its own"
+                f"({seen[sc.name]}): the samples name their scenario, so two of one name cannot be told apart (and "
+                "one given twice counts twice); give each scenario once, under a name of its own (its name: field)"
             )
         seen[sc.name] = where
         out.append(sc)
