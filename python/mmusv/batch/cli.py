@@ -158,7 +158,11 @@ def print_report(report: BatchReport, console: Console) -> None:
             console.print(f"mmusv: warning: {w}", markup=False, highlight=False)
     if report.index_error is not None:
         console.print(f"mmusv: warning: {report.index_error}", markup=False, highlight=False)
-    index = f"index {report.index}" if report.index_error is None else f"no index written to {report.index}"
+    index = (
+        f"index {report.index}"
+        if report.index_error is None
+        else f"no index written to {report.index} (one there from an earlier run is out of date)"
+    )
     console.print(f"{report.summary()} in {report.seconds:.1f} s; {index}")
 
 
