@@ -25,6 +25,14 @@ def _write(path: Path, data: dict[str, Any]) -> Path:
     return path
 
 
+def _scenario_folder(tmp_path: Path, *, frames: int = 1) -> Path:
+    """``tmp_path/src`` holding one tiny LiDAR scenario, ``a.yaml`` of ``frames`` frames: a batch's input."""
+    src = tmp_path / "src"
+    src.mkdir()
+    _write(src / "a.yaml", lidar_scenario("a", frames=frames))
+    return src
+
+
 # -------------------------------------------------------------------------------------------- batch: manifests
 
 
@@ -33,9 +41,7 @@ def test_a_damaged_frame_count_in_a_tasks_manifest_is_recorded_again(tmp_path: P
     """``frames_written`` of a recording's ``manifest.json`` damaged ('abc', a list, 1e400): the re-run ended in a
     bare ValueError / TypeError / OverflowError traceback before anything ran. The task is not complete, so it is
     recorded again and the index counts its frames once it is."""
-    src = tmp_path / "src"
-    src.mkdir()
-    _write(src / "a.yaml", lidar_scenario("a", frames=2))
+    src = _scenario_folder(tmp_path, frames=2)
     out = tmp_path / "out"
     assert run_many(src, out_dir=out).ok
     manifest = out / "a" / "manifest.json"
@@ -54,9 +60,7 @@ def test_a_damaged_frame_count_in_a_tasks_manifest_is_recorded_again(tmp_path: P
 
 def test_a_broken_link_in_a_scenario_folder_is_refused_by_name(tmp_path: Path) -> None:
     """A ``*.yaml`` link to a file that is gone was skipped without a word (the batch said '1 done')."""
-    src = tmp_path / "src"
-    src.mkdir()
-    _write(src / "a.yaml", lidar_scenario("a", frames=1))
+    src = _scenario_folder(tmp_path)
     (src / "b.yaml").symlink_to(tmp_path / "gone.yaml")
     with pytest.raises(ConfigError, match=r"b\.yaml: a broken symbolic link \(to .*gone\.yaml\), not a scenario"):
         scenario_files(src)
@@ -66,9 +70,7 @@ def test_a_broken_link_in_a_scenario_folder_is_refused_by_name(tmp_path: Path) -
 
 
 def test_a_folder_named_like_a_scenario_is_refused_by_name(tmp_path: Path) -> None:
-    src = tmp_path / "src"
-    src.mkdir()
-    _write(src / "a.yaml", lidar_scenario("a", frames=1))
+    src = _scenario_folder(tmp_path)
     (src / "b.yaml").mkdir()
     with pytest.raises(ConfigError, match=r"b\.yaml: a folder, not a scenario file"):
         scenario_files(src)
@@ -81,9 +83,7 @@ def test_a_link_to_a_scenario_is_recorded_under_its_own_name(tmp_path: Path) -> 
     other = tmp_path / "other"
     other.mkdir()
     _write(other / "a.yaml", lidar_scenario("other", frames=1, seed=2))
-    src = tmp_path / "src"
-    src.mkdir()
-    _write(src / "a.yaml", lidar_scenario("a", frames=1))
+    src = _scenario_folder(tmp_path)
     (src / "c.yaml").symlink_to("a.yaml")
     (src / "d.yaml").symlink_to(other / "a.yaml")
     assert [f.name for f in scenario_files(src)] == ["a.yaml", "c.yaml", "d.yaml"]
@@ -108,9 +108,7 @@ def test_a_link_to_a_scenario_is_recorded_under_its_own_name(tmp_path: Path) -> 
 def test_a_file_where_a_part_is_recorded_fails_that_scenario_by_name(tmp_path: Path, blocked: str) -> None:
     """A file where a part's folder (or ``OUT/<stem>/parts``) goes: each of its tasks failed as an 'internal error
     NotADirectoryError' of the worker."""
-    src = tmp_path / "src"
-    src.mkdir()
-    _write(src / "a.yaml", lidar_scenario("a", frames=2))
+    src = _scenario_folder(tmp_path, frames=2)
     _write(src / "b.yaml", lidar_scenario("b", frames=1))
     out = tmp_path / "out"
     (out / "a" / blocked).parent.mkdir(parents=True)
@@ -127,9 +125,7 @@ def test_an_empty_ray_address_is_refused(tmp_path: Path, capsys: Any) -> None:
     instead of joining the cluster meant; ``run_many(ray='')`` did the same."""
     from mmusv.cli import main
 
-    src = tmp_path / "src"
-    src.mkdir()
-    _write(src / "a.yaml", lidar_scenario("a", frames=1))
+    src = _scenario_folder(tmp_path)
     out = tmp_path / "out"
     assert main(["run", str(src), "-o", str(out), "--ray", ""]) == 2
     err = capsys.readouterr().err.strip()
@@ -144,9 +140,7 @@ def test_an_index_path_that_is_a_folder_is_refused_before_anything_runs(tmp_path
     status 0, the summary line naming the index as written."""
     from mmusv.errors import IoError
 
-    src = tmp_path / "src"
-    src.mkdir()
-    _write(src / "a.yaml", lidar_scenario("a", frames=1))
+    src = _scenario_folder(tmp_path)
     out = tmp_path / "out"
     (out / "dataset.json").mkdir(parents=True)
     with pytest.raises(IoError, match=r"index .*dataset\.json is a folder: move it away"):
@@ -160,9 +154,7 @@ def test_a_dataset_json_of_another_tool_is_not_replaced(tmp_path: Path, text: st
     without a word; an index of mmusv's, even one cut short, is still replaced."""
     from mmusv.errors import IoError
 
-    src = tmp_path / "src"
-    src.mkdir()
-    _write(src / "a.yaml", lidar_scenario("a", frames=1))
+    src = _scenario_folder(tmp_path)
     out = tmp_path / "out"
     out.mkdir()
     (out / "dataset.json").write_text(text, encoding="utf-8")
@@ -187,9 +179,7 @@ def test_mmusv_run_of_a_folder_whose_index_cannot_be_written_exits_1(
         raise IoError(f"cannot write {path}: No space left on device")
 
     monkeypatch.setattr(runner, "write_index", full)
-    src = tmp_path / "src"
-    src.mkdir()
-    _write(src / "a.yaml", lidar_scenario("a", frames=1))
+    src = _scenario_folder(tmp_path)
     out = tmp_path / "out"
     assert main(["run", str(src), "-o", str(out)]) == 1
     said = " ".join(capsys.readouterr().out.split())  # the console wraps long lines

@@ -20,7 +20,7 @@ import pytest
 from mmusv.batch import run_many
 from mmusv.batch.plan import scenario_files
 from mmusv.errors import ConfigError, IoError
-from test_round_studies_batch import TINY_SPEC, _write
+from test_round_studies_batch import TINY_SPEC, _scenario_folder, _write
 from tiny_scenario import lidar_scenario
 
 
@@ -59,9 +59,7 @@ def test_a_scenario_folder_through_a_link_is_named_by_its_real_path(tmp_path: Pa
 def test_an_editors_lock_link_does_not_stop_the_batch(tmp_path: Path) -> None:
     """Emacs keeps ``.#a.yaml`` (a link to ``user@host.pid:boot``, broken) beside ``a.yaml`` while it is edited:
     such an entry was skipped as it is not a file; the round refused the whole folder for it."""
-    src = tmp_path / "src"
-    src.mkdir()
-    _write(src / "a.yaml", lidar_scenario("a", frames=1))
+    src = _scenario_folder(tmp_path)
     (src / ".#a.yaml").symlink_to("me@host.1234:1700000000")
     assert [f.name for f in scenario_files(src)] == ["a.yaml"]
     (src / "b.yaml").symlink_to(tmp_path / "gone.yaml")  # a visible broken link is still refused
@@ -76,9 +74,7 @@ def test_an_index_left_empty_by_a_crash_is_replaced(tmp_path: Path, text: str) -
     tool's), though it holds nothing to lose."""
     from mmusv.batch.index import check_replaceable
 
-    src = tmp_path / "src"
-    src.mkdir()
-    _write(src / "a.yaml", lidar_scenario("a", frames=1))
+    src = _scenario_folder(tmp_path)
     out = tmp_path / "out"
     out.mkdir()
     (out / "dataset.json").write_text(text, encoding="utf-8")
@@ -107,9 +103,7 @@ def test_a_blocked_part_leaves_the_earlier_recording_as_it_was(tmp_path: Path) -
     """``--split-frames`` with a file where ``OUT/a/parts`` goes fails the scenario, naming the file; the check ran
     after the folder was readied, which removed the earlier whole recording and wrote ``a.parts.json`` for parts
     never to be recorded."""
-    src = tmp_path / "src"
-    src.mkdir()
-    _write(src / "a.yaml", lidar_scenario("a", frames=2))
+    src = _scenario_folder(tmp_path, frames=2)
     out = tmp_path / "out"
     assert run_many(src, out_dir=out).ok
     before = (out / "a" / "a.mcap").read_bytes()
