@@ -1,10 +1,13 @@
-"""The NRL sea-clutter model, written from its source for the independent physics tests (one copy for both)."""
+"""The NRL sea-clutter model, written from its source, and the pair of sweeps that measures mmusv's against it:
+one copy for both independent physics tests."""
 
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
+from mmusv.world.sea_state import sea_spec_for_height
 
 NRL = {
     "HH": (-73.0, 20.781, 7.351, 25.65, 0.0054),
@@ -26,3 +29,23 @@ def nrl_sigma0(pol: str, f_ghz: float, ss: np.ndarray | float, psi_deg: np.ndarr
         + c5 * psi_deg**2
     )
     return np.asarray(10 ** (db / 10))
+
+
+def fixed_and_physical_sweeps(
+    scene: Any, radars: list[Any], pose: np.ndarray, env: Any, *, seed: int = 5
+) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    """``radars[0]``'s sweep over ``scene``'s sea without a wave surface (the fixed clutter model, σ⁰_1m H²), then
+    each radar's over a physical wave surface round the origin (the NRL model): with one seed every cell draws the
+    same number in both, so a cell's ratio is the ratio of the two models' σ⁰. Returns (fixed, [physical, ...])."""
+    scene.set_wave_surface(None, scenario_seed=1, time_s=0.0, foci=[[0.0, 0.0]])
+    fixed = radars[0].sweep(scene.native, pose=pose, env=env, seed=seed)
+    scene.set_wave_surface(
+        sea_spec_for_height(1.0),
+        scenario_seed=1,
+        time_s=0.0,
+        foci=[[0.0, 0.0]],
+        radius_m=200.0,
+        detail=False,
+        slopes=False,
+    )
+    return fixed, [radar.sweep(scene.native, pose=pose, env=env, seed=seed) for radar in radars]

@@ -39,8 +39,7 @@ from mmusv.scene import Scene
 from mmusv.sensors.camera import render
 from mmusv.world.build import pose_matrices
 from mmusv.world.environment import Weather
-from mmusv.world.sea_state import sea_spec_for_height
-from nrl_clutter import nrl_sigma0
+from nrl_clutter import fixed_and_physical_sweeps, nrl_sigma0
 
 C_LIGHT = 299_792_458.0
 """Speed of light, m/s."""
@@ -276,20 +275,7 @@ def test_nrl_sea_clutter_vv_and_s_band(f_ghz: float, pol: str) -> None:
     radar, x_hh = _radar(f_ghz=f_ghz, pol=pol, **kw), _radar(f_ghz=9.41, pol="HH", **kw)
     pose = pose_matrices(np.array([0.0, 0.0, height, 0.0, 0.0, 0.0]))
     for hs in (0.5, 1.5, 3.5, 6.5):
-        env = clear_env(wave_height_m=hs)
-        scene.set_wave_surface(None, scenario_seed=1, time_s=0.0, foci=[[0.0, 0.0]])
-        fixed = radar.sweep(scene.native, pose=pose, env=env, seed=5)
-        scene.set_wave_surface(
-            sea_spec_for_height(1.0),
-            scenario_seed=1,
-            time_s=0.0,
-            foci=[[0.0, 0.0]],
-            radius_m=200.0,
-            detail=False,
-            slopes=False,
-        )
-        phys = radar.sweep(scene.native, pose=pose, env=env, seed=5)
-        phys_x = x_hh.sweep(scene.native, pose=pose, env=env, seed=5)
+        fixed, (phys, phys_x) = fixed_and_physical_sweeps(scene, [radar, x_hh], pose, clear_env(wave_height_m=hs))
         assert np.array_equal(fixed["range"], phys["range"]) and np.array_equal(phys["range"], phys_x["range"])
         r = phys["range"].astype(float)
         psi = np.degrees(np.arcsin(height / r - r / (2 * EARTH_K * EARTH_RADIUS_M)))

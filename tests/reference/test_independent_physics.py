@@ -42,9 +42,8 @@ from mmusv.sensors.env import wind_from_wave_height
 from mmusv.world.build import pose_matrices
 from mmusv.world.hydrostatics import hull_particulars
 from mmusv.world.primitives import box
-from mmusv.world.sea_state import sea_spec_for_height
 from mmusv.world.vessels import get_asset
-from nrl_clutter import nrl_sigma0
+from nrl_clutter import fixed_and_physical_sweeps, nrl_sigma0
 from scipy import integrate, special
 
 G = 9.80665
@@ -675,18 +674,7 @@ def test_radar_sea_clutter_is_the_nrl_model() -> None:
     pose = pose_matrices(np.array([0.0, 0.0, height, 0.0, 0.0, 0.0]))
     earth = 6_371_000.0 * 4 / 3
     for hs in (0.3, 1.0, 3.0, 5.0):
-        s.set_wave_surface(None, scenario_seed=1, time_s=0.0, foci=[[0.0, 0.0]])
-        fixed = radar.sweep(s.native, pose=pose, env=clear_env(wave_height_m=hs), seed=5)
-        s.set_wave_surface(
-            sea_spec_for_height(1.0),
-            scenario_seed=1,
-            time_s=0.0,
-            foci=[[0.0, 0.0]],
-            radius_m=200.0,
-            detail=False,
-            slopes=False,
-        )
-        phys = radar.sweep(s.native, pose=pose, env=clear_env(wave_height_m=hs), seed=5)
+        fixed, (phys,) = fixed_and_physical_sweeps(s, [radar], pose, clear_env(wave_height_m=hs))
         assert np.array_equal(fixed["range"], phys["range"]) and np.array_equal(fixed["azimuth"], phys["azimuth"])
         r = phys["range"].astype(float)
         psi = np.clip(np.degrees(np.arcsin(height / r - r / (2 * earth))), 0.1, 60.0)
