@@ -110,14 +110,14 @@ def _existing(out: Path, force: bool, spec_path: Path | None) -> tuple[list[Path
         raise IoError(f"output {str(out)!r} exists and is not a directory")
     if not out.is_dir():
         return None
-    for name in ("report.json", JOURNAL):  # found only when written: report.json after the whole generation
-        if (out / name).exists() and not (out / name).is_file():
+    report, journal = out / "report.json", out / JOURNAL
+    for path, what in ((report, "report"), (journal, "journal")):  # found only when written: the report at the end
+        if path.exists() and not path.is_file():
             raise IoError(
-                f"output directory {str(out)!r}: {name} is a folder (or another non-file) where generate writes its "
-                f"{'report' if name == 'report.json' else 'journal'}: move it away"
+                f"output directory {str(out)!r}: {path.name} is a folder (or another non-file) where generate writes "
+                f"its {what}: move it away"
             )
     yamls = sorted(out.glob("*.yaml"))
-    report, journal = out / "report.json", out / JOURNAL
     if not yamls and not report.is_file():  # a journal alone: a run stopped before its first file
         return None
     ours = _generated_here(report) | _journal_names(journal)
