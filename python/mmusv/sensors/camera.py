@@ -18,11 +18,11 @@ import numpy.typing as npt
 from mmusv import arguments
 from mmusv._equality import same
 from mmusv._native import core
-from mmusv.errors import ConfigError, InputError
+from mmusv.errors import InputError
 from mmusv.frames import BODY_TO_OPTICAL
 from mmusv.scene import Scene, _pose
 from mmusv.sensors.config import CameraConfig, TopViewConfig
-from mmusv.sensors.env import check_sensor_args, wake_rows
+from mmusv.sensors.env import check_config, check_sensor, check_sensor_args, wake_rows
 
 __all__ = ["BODY_TO_OPTICAL", "CameraImages", "camera_from_config", "render", "top_view_from_config"]
 
@@ -59,7 +59,7 @@ class CameraImages:
 def camera_from_config(cfg: CameraConfig) -> core.Camera:
     """The native pinhole camera for ``cfg``, a :class:`CameraConfig` (``CameraConfig(**fields)`` validates a dict;
     else :class:`mmusv.ConfigError`); shades RGB when ``rgb`` is among its outputs."""
-    _check_config(cfg, CameraConfig)
+    check_config(cfg, CameraConfig)
     w, h = cfg.resolution
     rgb = "rgb" in cfg.outputs
     noise = None if cfg.noise is None else (cfg.noise.full_well_e, cfg.noise.read_noise_e)
@@ -79,7 +79,7 @@ def camera_from_config(cfg: CameraConfig) -> core.Camera:
 def top_view_from_config(cfg: TopViewConfig) -> core.Camera:
     """The native orthographic camera of a top view, ``cfg`` a :class:`TopViewConfig` (else
     :class:`mmusv.ConfigError`)."""
-    _check_config(cfg, TopViewConfig)
+    check_config(cfg, TopViewConfig)
     w, h = cfg.resolution
     rgb = "rgb" in cfg.outputs
     mpp, range_max = cfg.metres_per_pixel, cfg.altitude_m + 500.0
@@ -92,14 +92,6 @@ def top_view_from_config(cfg: TopViewConfig) -> core.Camera:
         quality=cfg.quality,
         exposure=cfg.exposure.native(),
     )
-
-
-def _check_config(cfg: Any, cls: type) -> None:
-    if not isinstance(cfg, cls):
-        raise ConfigError(
-            f"cfg = {arguments.shown(cfg)}: must be a {cls.__name__} (mmusv.sensors.config.{cls.__name__}(**fields)), "
-            f"not {type(cfg).__name__}"
-        )
 
 
 def render(
@@ -118,12 +110,13 @@ def render(
     :func:`mmusv.sensors.env.wake_rows`) of the vessels under way; ``radiance`` also returns the linear radiance
     ``(H, W, 3)`` float32 in cd/m² (linear sRGB primaries, before sensor noise and exposure). ``seed`` is a whole
     number in ``0..2⁶⁴−1``; a bad seed, pose or scene raises :class:`mmusv.InputError` naming it."""
-    if not isinstance(camera, core.Camera):
-        raise InputError(
-            f"camera = {arguments.shown(camera)}: must be a native camera (camera_from_config(CameraConfig(...)), "
-            f"top_view_from_config(TopViewConfig(...)), or Simulation.agent(id).cameras[name][0]), "
-            f"not {type(camera).__name__}"
-        )
+    check_sensor(
+        camera,
+        core.Camera,
+        name="camera",
+        made_by="camera_from_config(CameraConfig(...)), top_view_from_config(TopViewConfig(...)), or "
+        "Simulation.agent(id).cameras[name][0]",
+    )
     seed = check_sensor_args(scene, env, seed)
     radiance = arguments.flag(radiance, name="radiance", error=InputError)
     p = _pose(pose, name="pose")

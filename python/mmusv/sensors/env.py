@@ -40,7 +40,9 @@ from mmusv.world.environment import Environment
 __all__ = [
     "SEA_ALBEDO",
     "WATER_ALBEDO",
+    "check_config",
     "check_env",
+    "check_sensor",
     "check_sensor_args",
     "sensor_env",
     "turbidity_from_visibility",
@@ -99,6 +101,26 @@ def check_sensor_args(scene: Any, env: Any, seed: Any) -> int:
         raise InputError(f"scene must be an mmusv.Scene, got {type(scene).__name__}")
     check_env(env)
     return arguments.whole(seed, name="seed", lo=0, hi=2**64 - 1, error=InputError)
+
+
+def check_config(cfg: Any, cls: type) -> None:
+    """Checks that ``cfg``, the argument of a ``*_from_config`` builder, is a ``cls`` (a sensor config model of
+    :mod:`mmusv.sensors.config`), else :class:`mmusv.ConfigError` naming the model that validates a dict."""
+    if not isinstance(cfg, cls):
+        raise ConfigError(
+            f"cfg = {arguments.shown(cfg)}: must be a {cls.__name__} (mmusv.sensors.config.{cls.__name__}(**fields)), "
+            f"not {type(cfg).__name__}"
+        )
+
+
+def check_sensor(sensor: Any, kind: type, *, name: str, made_by: str) -> None:
+    """Checks that ``sensor``, the first argument of a sensor call, is a native ``kind`` (``core.Lidar``,
+    ``core.Radar``, ``core.Camera``), else :class:`mmusv.InputError` naming the argument ``name`` (also the sensor's
+    word, "lidar") and ``made_by``, the ways to get one."""
+    if not isinstance(sensor, kind):
+        raise InputError(
+            f"{name} = {arguments.shown(sensor)}: must be a native {name} ({made_by}), not {type(sensor).__name__}"
+        )
 
 
 def turbidity_from_visibility(visibility_m: float) -> float:

@@ -13,13 +13,11 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from mmusv import arguments
 from mmusv._equality import same
 from mmusv._native import core
-from mmusv.errors import ConfigError, InputError
 from mmusv.scene import Scene, _pose
 from mmusv.sensors.config import LidarConfig
-from mmusv.sensors.env import check_sensor_args, wake_rows
+from mmusv.sensors.env import check_config, check_sensor, check_sensor_args, wake_rows
 
 __all__ = ["LidarPoints", "lidar_from_config", "scan"]
 
@@ -76,11 +74,7 @@ class LidarPoints:
 def lidar_from_config(cfg: LidarConfig) -> core.Lidar:
     """The native LiDAR (pattern computed once) for ``cfg``, a :class:`LidarConfig` (``LidarConfig(**fields)``
     validates a dict), else :class:`mmusv.ConfigError`."""
-    if not isinstance(cfg, LidarConfig):
-        raise ConfigError(
-            f"cfg = {arguments.shown(cfg)}: must be a LidarConfig (mmusv.sensors.config.LidarConfig(**fields)), "
-            f"not {type(cfg).__name__}"
-        )
+    check_config(cfg, LidarConfig)
     return core.Lidar(
         elevations=cfg.elevations_rad(),
         azimuth_steps=cfg.azimuth_steps,
@@ -111,11 +105,9 @@ def scan(
     :meth:`mmusv.simulation.Simulation.wakes`, :func:`mmusv.sensors.env.wake_rows`) of the vessels under way: over
     a wave surface, beams that meet their foam return from it (the foam the cameras draw). ``seed`` is a whole
     number in ``0..2⁶⁴−1``; a bad seed, pose or scene raises :class:`mmusv.InputError` naming it."""
-    if not isinstance(lidar, core.Lidar):
-        raise InputError(
-            f"lidar = {arguments.shown(lidar)}: must be a native lidar (lidar_from_config(LidarConfig(...)), or "
-            f"Simulation.agent(id).lidar), not {type(lidar).__name__}"
-        )
+    check_sensor(
+        lidar, core.Lidar, name="lidar", made_by="lidar_from_config(LidarConfig(...)), or Simulation.agent(id).lidar"
+    )
     seed = check_sensor_args(scene, env, seed)
     p = _pose(pose, name="pose")
     w = wake_rows(wakes)

@@ -46,7 +46,7 @@ from mmusv._native import core
 from mmusv.errors import ConfigError, InputError
 from mmusv.scene import Scene, _pose
 from mmusv.sensors.config import RadarConfig
-from mmusv.sensors.env import check_sensor_args
+from mmusv.sensors.env import check_config, check_sensor, check_sensor_args
 
 __all__ = [
     "MAX_PPI_SIZE",
@@ -68,11 +68,7 @@ def radar_from_config(cfg: RadarConfig) -> core.Radar:
     """The native radar for ``cfg`` (degrees become radians; the core checks everything again as a last guard,
     naming ``radar.<core field>``, which a validated ``cfg`` never trips). ``cfg`` must be a :class:`RadarConfig`
     (``RadarConfig(**fields)`` validates a dict), else :class:`mmusv.ConfigError`."""
-    if not isinstance(cfg, RadarConfig):
-        raise ConfigError(
-            f"cfg = {arguments.shown(cfg)}: must be a RadarConfig (mmusv.sensors.config.RadarConfig(**fields)), "
-            f"not {type(cfg).__name__}"
-        )
+    check_config(cfg, RadarConfig)
     lo, hi = cfg.elevation_fan_deg
     return core.Radar(
         range_min_m=cfg.min_range_m,
@@ -224,11 +220,9 @@ def radar_sweep(
     Raises :class:`mmusv.ConfigError` for waves or rain out of range, :class:`mmusv.InputError` for a bad radar,
     scene, pose, environment or seed.
     """
-    if not isinstance(radar, core.Radar):
-        raise InputError(
-            f"radar = {arguments.shown(radar)}: must be a native radar (radar_from_config(RadarConfig(...)), or "
-            f"Simulation.agent(id).radar), not {type(radar).__name__}"
-        )
+    check_sensor(
+        radar, core.Radar, name="radar", made_by="radar_from_config(RadarConfig(...)), or Simulation.agent(id).radar"
+    )
     seed = check_sensor_args(scene, env, seed)
     p = _pose(pose, name="pose")
     return RadarReturns.from_native(radar.sweep(scene.native, pose=p, env=env, seed=seed), pose=p, radar=radar)
