@@ -228,6 +228,17 @@ def _floats(value: Any, *, name: str) -> np.ndarray:
         raise InputError(f"{name} must be a real numeric array: {exc}") from None
 
 
+def _uint16s(value: Any, *, name: str) -> np.ndarray:
+    """``value``, one integer or a 1-D integer array of ids in ``0..65535`` (classes, materials), as a ``(N,)``
+    C-contiguous uint16 array (``(1,)`` for one id); else an :class:`InputError` naming ``name``."""
+    a = np.atleast_1d(np.asarray(value))
+    if a.ndim != 1 or not np.issubdtype(a.dtype, np.integer):
+        raise InputError(f"{name} must be an int or a 1-D integer array, got {a.dtype} with shape {a.shape}")
+    if a.size and (a.min() < 0 or a.max() > 65535):
+        raise InputError(f"{name} must be in 0..65535")
+    return np.ascontiguousarray(a, dtype=np.uint16)
+
+
 def _id(value: Any, *, name: str, kind: str) -> int:
     """A non-negative integer id that fits in uint32, else :class:`InputError` / :class:`NotFoundError`."""
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
@@ -295,23 +306,12 @@ class Scene:
                 f"indices must be in 0..{v.shape[0] - 1}"
             )
         f = _array(raw_faces, name="faces", dtype=np.int64, shape_tail=(3,))
-        c = np.atleast_1d(np.asarray(classes))
-        if c.ndim != 1 or not np.issubdtype(c.dtype, np.integer):
-            raise InputError(f"classes must be an int or a 1-D integer array, got {c.dtype} with shape {c.shape}")
-        if c.size and (c.min() < 0 or c.max() > 65535):
-            raise InputError("classes must be in 0..65535")
+        c = _uint16s(classes, name="classes")
         if v.shape[0] and not np.isfinite(np.asarray(vertices, dtype=np.float64)).all():
             bad = int(np.argwhere(~np.isfinite(np.asarray(vertices, dtype=np.float64)).all(axis=1))[0, 0])
             raise GeometryError(f"invalid geometry in vertices[{bad}]: vertex is not finite; remove NaN/inf vertices")
-        m = None
-        if materials is not None:
-            m = np.atleast_1d(np.asarray(materials))
-            if m.ndim != 1 or not np.issubdtype(m.dtype, np.integer):
-                raise InputError(f"materials must be an int or a 1-D integer array, got {m.dtype} with shape {m.shape}")
-            if m.size and (m.min() < 0 or m.max() > 65535):
-                raise InputError("materials must be in 0..65535")
-            m = np.ascontiguousarray(m, dtype=np.uint16)
-        return int(self._native.add_mesh(v, f, np.ascontiguousarray(c, dtype=np.uint16), name, m))
+        m = None if materials is None else _uint16s(materials, name="materials")
+        return int(self._native.add_mesh(v, f, c, name, m))
 
     def set_materials(self, table: npt.ArrayLike) -> None:
         """Sets the material table: ``(M, 11)`` float rows ``r, g, b, roughness, metallic, er, eg, eb, nav_light,

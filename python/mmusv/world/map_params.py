@@ -10,7 +10,7 @@ checked by validators that run in field order, so every error still names its fi
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, StrictBool, ValidationError, ValidationInfo, field_validator
@@ -84,6 +84,21 @@ def _known(info: ValidationInfo, *names: str) -> bool:
     return all(n in info.data and info.data[n] is not None for n in names)
 
 
+_Bounded = TypeVar("_Bounded", float, tuple[float, float])
+
+
+def _up_to_extent(value: _Bounded, info: ValidationInfo, *, lo: float, divisor: int) -> _Bounded:
+    """``value`` (metres: a number, or a pair ``(a, b)``) checked to lie in ``[lo, extent_m / divisor]`` by
+    :func:`_within` (or :func:`_pair`), the error saying the upper bound comes from ``extent_m``; unchecked when
+    ``extent_m`` itself failed (it is reported on its own)."""
+    if not _known(info, "extent_m"):
+        return value
+    hi, bounds = info.data["extent_m"] / divisor, _EXTENT.format(divisor)
+    if isinstance(value, tuple):
+        return _pair(value, lo, hi, bounds=bounds)
+    return _within(value, lo, hi, bounds=bounds)
+
+
 class _CommonParams(BaseModel):
     """Parameters shared by every map kind (metres)."""
 
@@ -126,9 +141,7 @@ class _CommonParams(BaseModel):
     @field_validator("clearance_m")
     @classmethod
     def _clearance(cls, v: float, info: ValidationInfo) -> float:
-        if not _known(info, "extent_m"):
-            return v
-        return _within(v, 0.0, info.data["extent_m"] / 4.0, bounds=_EXTENT.format(4))
+        return _up_to_extent(v, info, lo=0.0, divisor=4)
 
 
 class IslandParams(_CommonParams):
@@ -150,7 +163,7 @@ class IslandParams(_CommonParams):
     @field_validator("island_radius_m")
     @classmethod
     def _radius(cls, v: tuple[float, float], info: ValidationInfo) -> tuple[float, float]:
-        return _pair(v, 15.0, info.data["extent_m"] / 2.0, bounds=_EXTENT.format(2)) if _known(info, "extent_m") else v
+        return _up_to_extent(v, info, lo=15.0, divisor=2)
 
     @field_validator("island_height_m")
     @classmethod
@@ -160,9 +173,7 @@ class IslandParams(_CommonParams):
     @field_validator("min_gap_m")
     @classmethod
     def _gap(cls, v: float, info: ValidationInfo) -> float:
-        if not _known(info, "extent_m"):
-            return v
-        return _within(v, 0.0, info.data["extent_m"] / 2.0, bounds=_EXTENT.format(2))
+        return _up_to_extent(v, info, lo=0.0, divisor=2)
 
 
 class OpenSeaParams(_CommonParams):
@@ -179,7 +190,7 @@ class OpenSeaParams(_CommonParams):
     @field_validator("islet_radius_m")
     @classmethod
     def _radius(cls, v: tuple[float, float], info: ValidationInfo) -> tuple[float, float]:
-        return _pair(v, 10.0, info.data["extent_m"] / 4.0, bounds=_EXTENT.format(4)) if _known(info, "extent_m") else v
+        return _up_to_extent(v, info, lo=10.0, divisor=4)
 
     @field_validator("islet_height_m")
     @classmethod

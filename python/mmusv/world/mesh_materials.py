@@ -380,19 +380,25 @@ def _colour(e: _MtlEntry, key: str, label: str, at: str, where: str) -> np.ndarr
     return np.array(vals * 3 if len(vals) == 1 else vals, dtype=np.float64)
 
 
+def _mapped_colour(e: _MtlEntry, key: str, value: np.ndarray) -> np.ndarray:
+    """The ``(3,)`` float64 linear RGB in [0, 1] of MTL material ``e``'s texture map ``key`` (``map_kd``,
+    ``map_ke``): the mean of its texels decoded from sRGB, when it has that map; else ``value``, the colour its
+    plain statement (or the default) gives."""
+    if key not in e.maps:
+        return value
+    from PIL import Image
+
+    with Image.open(e.maps[key][1]) as img:
+        return _texture_mean(img, srgb=True)
+
+
 def _mtl_values(e: _MtlEntry, obj: Path, where: str) -> tuple[np.ndarray, float, float, np.ndarray]:
     """Base colour, roughness, metallic and emission of an MTL material (module docstring)."""
     at = f"{str(obj)!r}: material {e.name!r} of {e.mtl.name!r} (line {e.line})"
     kd = _colour(e, "kd", "Kd", at, where)
     if kd is not None and not np.all((kd >= 0.0) & (kd <= 1.0)):
         raise AssetSpecError(where, f"{at}: Kd {kd.tolist()} must be in [0, 1]")
-    if "map_kd" in e.maps:
-        from PIL import Image
-
-        with Image.open(e.maps["map_kd"][1]) as img:
-            base = _texture_mean(img, srgb=True)
-    else:
-        base = kd if kd is not None else np.full(3, MTL_DEFAULT_KD)
+    base = _mapped_colour(e, "map_kd", kd if kd is not None else np.full(3, MTL_DEFAULT_KD))
     scalars = {}
     for key, label, top in (("ns", "Ns", math.inf), ("pr", "Pr", 1.0), ("pm", "Pm", 1.0)):
         vals = e.values.get(key)
@@ -405,13 +411,7 @@ def _mtl_values(e: _MtlEntry, obj: Path, where: str) -> tuple[np.ndarray, float,
     ke = _colour(e, "ke", "Ke", at, where)
     if ke is not None and np.any(ke < 0.0):
         raise AssetSpecError(where, f"{at}: Ke {ke.tolist()} must be >= 0")
-    if "map_ke" in e.maps:
-        from PIL import Image
-
-        with Image.open(e.maps["map_ke"][1]) as img:
-            emis = _texture_mean(img, srgb=True)
-    else:
-        emis = ke if ke is not None else np.zeros(3)
+    emis = _mapped_colour(e, "map_ke", ke if ke is not None else np.zeros(3))
     return base, rough, 0.0 if pm is None else pm, emis * GLTF_EMISSIVE_SCALE
 
 

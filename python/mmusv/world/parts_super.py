@@ -380,6 +380,19 @@ def _lantern(*, at: np.ndarray, size: float, lamp: int, housing: int, cls: int) 
     return transformed(m, translation=tuple(at))
 
 
+def _lantern_post(*, top: np.ndarray, height: float, size: float, cls: int, material: int) -> TriMesh:
+    """The post a lantern of ``size`` stands on: a 6-sided tube of radius ``0.1 · size`` from ``height`` below
+    ``top`` (``(3,)`` float, body frame, metres: the foot of the lantern) up to ``top``."""
+    return tubes(
+        starts=[top - [0.0, 0.0, height]],
+        ends=[top],
+        radius=0.1 * size,
+        cls=cls,
+        material=material,
+        segments=6,
+    )
+
+
 def nav_lights_mesh(p: NavLightsPart, ctx: Ctx) -> TriMesh:
     """COLREG lanterns: masthead white, port red (+y), starboard green (-y), stern white, with brackets."""
     hull, s = ctx.hull, p.size
@@ -450,31 +463,13 @@ def nav_lights_mesh(p: NavLightsPart, ctx: Ctx) -> TriMesh:
             )
         )
         if posts:
-            out.append(
-                tubes(
-                    starts=[c - [0.0, 0.0, 0.35 * s + 0.1]],
-                    ends=[c],
-                    radius=0.1 * s,
-                    cls=ctx.cls,
-                    material=steel,
-                    segments=6,
-                )
-            )
+            out.append(_lantern_post(top=c, height=0.35 * s + 0.1, size=s, cls=ctx.cls, material=steel))
     if p.stern is not None:
         st = np.array(p.stern, dtype=np.float64)
     else:
         xs = -hull.length / 2.0 + 0.6 * s + 0.05
         st = np.array([xs, 0.0, ctx.base(None, xs) + 0.3 * s + 0.1])
-        out.append(
-            tubes(
-                starts=[st - [0.0, 0.0, 0.3 * s + 0.1]],
-                ends=[st],
-                radius=0.1 * s,
-                cls=ctx.cls,
-                material=steel,
-                segments=6,
-            )
-        )
+        out.append(_lantern_post(top=st, height=0.3 * s + 0.1, size=s, cls=ctx.cls, material=steel))
     out.append(_lantern(at=st, size=s, lamp=material_id("nav_stern_white"), housing=housing, cls=ctx.cls))
     return merge(out)
 

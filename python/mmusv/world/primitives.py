@@ -40,6 +40,20 @@ def _no_materials() -> np.ndarray:
     return np.zeros(0, dtype=np.uint16)
 
 
+def _per_face(ids: object, faces: int, *, name: str, empty_is_zero: bool) -> np.ndarray:
+    """``ids`` (a mesh's classes or materials) as ``(faces,)`` uint16 ids, one per face: one id is broadcast to
+    every face, and so, with ``empty_is_zero``, is id 0 when none is given; another count is a ``ValueError``
+    naming ``name``."""
+    a = np.ascontiguousarray(ids, dtype=np.uint16).reshape(-1)
+    if empty_is_zero and a.size == 0:
+        a = np.zeros(faces, dtype=np.uint16)
+    elif a.size == 1 and faces != 1:
+        a = np.full(faces, a[0], dtype=np.uint16)
+    if a.shape[0] != faces:
+        raise ValueError(f"{name} has {a.shape[0]} entries for {faces} faces")
+    return a
+
+
 @dataclass(frozen=True, eq=False)
 class TriMesh:
     """A labelled triangle mesh (see module docstring for shapes and dtypes). Two compare equal (``==``) when
@@ -63,18 +77,8 @@ class TriMesh:
     def __post_init__(self) -> None:
         v = np.ascontiguousarray(self.vertices, dtype=np.float64).reshape(-1, 3)
         f = np.ascontiguousarray(self.faces, dtype=np.int64).reshape(-1, 3)
-        c = np.ascontiguousarray(self.classes, dtype=np.uint16).reshape(-1)
-        if c.size == 1 and f.shape[0] != 1:
-            c = np.full(f.shape[0], c[0], dtype=np.uint16)
-        if c.shape[0] != f.shape[0]:
-            raise ValueError(f"classes has {c.shape[0]} entries for {f.shape[0]} faces")
-        m = np.ascontiguousarray(self.materials, dtype=np.uint16).reshape(-1)
-        if m.size == 0:
-            m = np.zeros(f.shape[0], dtype=np.uint16)
-        elif m.size == 1 and f.shape[0] != 1:
-            m = np.full(f.shape[0], m[0], dtype=np.uint16)
-        if m.shape[0] != f.shape[0]:
-            raise ValueError(f"materials has {m.shape[0]} entries for {f.shape[0]} faces")
+        c = _per_face(self.classes, f.shape[0], name="classes", empty_is_zero=False)
+        m = _per_face(self.materials, f.shape[0], name="materials", empty_is_zero=True)
         object.__setattr__(self, "vertices", v)
         object.__setattr__(self, "faces", f)
         object.__setattr__(self, "classes", c)
