@@ -66,10 +66,6 @@ class Finding:
     route: dict[str, np.ndarray] = field(default_factory=dict)
 
 
-def _first(findings: list[Finding]) -> str | None:
-    return findings[0].message if findings else None
-
-
 class Constraint(Protocol):
     """A named check: ``check(samples)`` returns None when satisfied, else a one-line reason."""
 
@@ -78,11 +74,31 @@ class Constraint(Protocol):
     def check(self, s: Samples) -> str | None: ...
 
 
+class _FindingsCheck:
+    """A check that lists every failure (``findings``, for the editor's map); its ``check`` reason is the message
+    of the first of them, so the generator and the editor say the same thing."""
+
+    name: str
+
+    def check(self, s: Samples) -> str | None:
+        found = self.findings(s)
+        return found[0].message if found else None
+
+    def findings(self, s: Samples) -> list[Finding]:
+        raise NotImplementedError
+
+
+def _below(share: np.ndarray, need: float) -> list[int]:
+    """Indices ``k`` of the ``(N,)`` float ``share`` (fractions of frames) with ``share[k] < need``, the lowest
+    share first (a stable sort: on a tie, the lower index first)."""
+    return [int(k) for k in np.argsort(share, kind="stable") if share[k] < need]
+
+
 def _where(xy: np.ndarray) -> str:
     return f"({xy[0]:.0f}, {xy[1]:.0f})"
 
 
-class _Clearance:
+class _Clearance(_FindingsCheck):
     """Shared body of in_water / shore_clearance / structure_clearance: ``raster - cell slack - δ - hull >= need``
     at every sample of the vessel's centre (``hull=False``) or of its capsule axis (``hull=True``)."""
 
@@ -91,9 +107,6 @@ class _Clearance:
 
     def __init__(self, raster: str, need: float, hull: bool, what: str) -> None:
         self.raster, self.need, self.hull, self.what = raster, need, hull, what
-
-    def check(self, s: Samples) -> str | None:
-        return _first(self.findings(s))
 
     def findings(self, s: Samples) -> list[Finding]:
         """One finding per failing vessel, at its first failing sample (route samples before motion samples);
@@ -150,14 +163,11 @@ class StructureClearance(_Clearance):
         super().__init__("d_struct", cfg.min_m, True, "a port structure, buoy or moored ship (hull)")
 
 
-class Separation:
+class Separation(_FindingsCheck):
     name = "separation"
 
     def __init__(self, cfg: SeparationCheck) -> None:
         self.min_m = cfg.min_m
-
-    def check(self, s: Samples) -> str | None:
-        return _first(self.findings(s))
 
     def findings(self, s: Samples) -> list[Finding]:
         """One finding per pair of vessels that come too close, at their closest moment; the tightest first."""
@@ -249,14 +259,11 @@ class TargetRange:
         return None
 
 
-class SensingRange:
+class SensingRange(_FindingsCheck):
     name = "sensing_range"
 
     def __init__(self, cfg: SensingRangeCheck) -> None:
         self.range_m, self.share, self.targets = cfg.range_m, cfg.min_share, cfg.targets
-
-    def check(self, s: Samples) -> str | None:
-        return _first(self.findings(s))
 
     def findings(self, s: Samples) -> list[Finding]:
         """One finding per target too rarely within range of a USV, in target order (every target when there is
@@ -298,14 +305,11 @@ class TargetDensity:
         return None
 
 
-class Cooperation:
+class Cooperation(_FindingsCheck):
     name = "cooperation"
 
     def __init__(self, cfg: CooperationCheck) -> None:
         self.lo, self.hi, self.share = cfg.min_m, cfg.max_m, cfg.min_share
-
-    def check(self, s: Samples) -> str | None:
-        return _first(self.findings(s))
 
     def findings(self, s: Samples) -> list[Finding]:
         """One finding per USV whose nearest USV is too rarely in the distance band; the lowest share first."""
@@ -323,19 +327,15 @@ class Cooperation:
                 f" need {self.share:.0%}",
                 (s.ids[u[k]],),
             )
-            for k in np.argsort(share, kind="stable")
-            if share[k] < self.share
+            for k in _below(share, self.share)
         ]
 
 
-class LineOfSight:
+class LineOfSight(_FindingsCheck):
     name = "line_of_sight"
 
     def __init__(self, cfg: LineOfSightCheck) -> None:
         self.share = cfg.min_share
-
-    def check(self, s: Samples) -> str | None:
-        return _first(self.findings(s))
 
     def findings(self, s: Samples) -> list[Finding]:
         """One finding per role target too rarely seen by a USV; the lowest share first (every target when there
@@ -349,8 +349,7 @@ class LineOfSight:
                 f"{s.meta.targets[k]} is seen by a USV in {share[k]:.0%} of frames; need {self.share:.0%}",
                 (s.meta.targets[k],),
             )
-            for k in np.argsort(share, kind="stable")
-            if share[k] < self.share
+            for k in _below(share, self.share)
         ]
 
 
