@@ -230,7 +230,7 @@ def lidar_wake(out: Path, lines: list[str]) -> None:
     assert ac.lidar is not None and ac.lidar_pose is not None
     agent = sim.agents[0]
     assert agent.lidar is not None
-    seed = sensor_seed(sim.scenario.seed, frame, agent.index, "lidar")
+    seed = sensor_seed(sim.scenario.seed, frame=frame, agent=agent.index, sensor="lidar")
     without = scan(agent.lidar, sim.ws.scene, pose=ac.lidar_pose, env=sim.sensor_env, seed=seed)
     fig, axes = plt.subplots(1, 2, figsize=(12, 5.4), sharex=True, sharey=True)
     for ax, (name, pts) in zip(axes, (("before (no wakes)", without), ("after", ac.lidar)), strict=True):

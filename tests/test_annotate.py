@@ -95,7 +95,7 @@ def test_a_long_ship_whose_stern_is_near_gets_its_box() -> None:
             continue
         box = np.linalg.inv(ref) @ cap.world.matrices[vi] @ translation(info.box_center_body)
         near = _footprint_distance(box, info.box_size) <= 200.0
-        assert footprint_in_range(box, info.box_size, 200.0) == near == (info.id in ann.lidar_ids), info.id
+        assert footprint_in_range(box, size=info.box_size, range_m=200.0) == near == (info.id in ann.lidar_ids), info.id
     # The rule against shapely over boxes all around, half of them reaching in.
     rng = np.random.default_rng(5)
     for _ in range(300):
@@ -106,4 +106,4 @@ def test_a_long_ship_whose_stern_is_near_gets_its_box() -> None:
         box[:2, 3] = x, y
         d = _footprint_distance(box, size)
         if abs(d - 150.0) > 1e-6:
-            assert footprint_in_range(box, size, 150.0) == (d <= 150.0)
+            assert footprint_in_range(box, size=size, range_m=150.0) == (d <= 150.0)

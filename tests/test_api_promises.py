@@ -631,7 +631,12 @@ def test_matrix_to_pose_ranges_and_gimbal_lock() -> None:
     eta = F.matrix_to_pose(m)
     assert (np.abs(eta[:, 4]) <= math.pi / 2).all() and (np.abs(eta[:, 3:]) <= math.pi).all()
     np.testing.assert_allclose(F.pose_matrices(eta), m, atol=1e-9)
-    seeds = {sensor_seed(7, k, a, s) for k in range(3) for a in range(2) for s in ("lidar", "radar", "camera")}
+    seeds = {
+        sensor_seed(7, frame=k, agent=a, sensor=s)
+        for k in range(3)
+        for a in range(2)
+        for s in ("lidar", "radar", "camera")
+    }
     assert len(seeds) == 18 and all(0 <= s < 2**64 for s in seeds) and max(seeds) >= 2**32
     assert frame_ranges([9, 3, 1, 2, 2, 7, 10, 12]) == "1..3, 7, 9..10, 12"
 

@@ -122,8 +122,8 @@ def test_inside_mesh_checks_its_ray_count(args: str, words: tuple[str, ...]) -> 
         v = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
         f = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1], [2, 3, 7], [2, 7, 6],
                       [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
-        assert inside_mesh(v, f, np.zeros(3)) and not inside_mesh(v, f, np.array([5.0, 0.0, 0.0]))
-        inside_mesh(v, f, np.zeros(3), {args})
+        assert inside_mesh(v, f, point=np.zeros(3)) and not inside_mesh(v, f, point=np.array([5.0, 0.0, 0.0]))
+        inside_mesh(v, f, point=np.zeros(3), {args})
     """
     _refused(code, "InputError", *words)
 
@@ -132,7 +132,7 @@ def test_inside_mesh_checks_its_ray_count(args: str, words: tuple[str, ...]) -> 
 def test_inside_mesh_checks_its_point(point: str) -> None:
     code = f"""
         from mmusv.sensors.mounts import inside_mesh
-        inside_mesh(np.zeros((3, 3)), np.array([[0, 1, 2]]), {point})
+        inside_mesh(np.zeros((3, 3)), np.array([[0, 1, 2]]), point={point})
     """
     _refused(code, "InputError", "point")
 

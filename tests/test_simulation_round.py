@@ -88,15 +88,21 @@ def test_an_agent_pickles_as_its_rig_and_its_sensors_capture_the_same(sim: Simul
     scene, env, seed = sim.ws.scene, sim.sensor_env, sim.scenario.seed
     wakes = sim.wakes(cap.world)
     assert ac.lidar is not None and ac.lidar_pose is not None
-    lidar_seed = sensor_seed(seed, cap.frame, agent.index, "lidar")
+    lidar_seed = sensor_seed(seed, frame=cap.frame, agent=agent.index, sensor="lidar")
     points = scan(back.lidar, scene, pose=ac.lidar_pose, env=env, seed=lidar_seed, wakes=wakes)
     assert np.array_equal(points.xyz, ac.lidar.xyz) and np.array_equal(points.instance, ac.lidar.instance)
     cam, _, _ = back.cameras["front"]
-    cam_seed = sensor_seed(seed, cap.frame, 0, "camera", 0)
+    cam_seed = sensor_seed(seed, frame=cap.frame, agent=0, sensor="camera", index=0)
     img = render(cam, scene, pose=ac.camera_poses["front"], env=env, seed=cam_seed, wakes=wakes)
     assert np.array_equal(img.rgb, ac.cameras["front"].rgb)
     assert ac.top_view_pose is not None
-    top = render(back.top_view, scene, pose=ac.top_view_pose, env=env, seed=sensor_seed(seed, cap.frame, 0, "top_view"))
+    top = render(
+        back.top_view,
+        scene,
+        pose=ac.top_view_pose,
+        env=env,
+        seed=sensor_seed(seed, frame=cap.frame, agent=0, sensor="top_view"),
+    )
     assert np.array_equal(top.semantic, ac.top_view.semantic)
 
 
@@ -219,13 +225,16 @@ def test_sensor_seed_refuses_what_it_would_seed_silently() -> None:
     ]
     for args, words in bad:
         with pytest.raises(ConfigError) as e:
-            sensor_seed(*args)
+            sensor_seed(args[0], **dict(zip(("frame", "agent", "sensor", "index"), args[1:], strict=False)))
         assert words in str(e.value), (args, str(e.value))
     # The seeds of before (worked out by the function as it was: recordings made with them stay reproducible).
-    assert sensor_seed(7, 0, 0, "lidar") == 4555428456120885206
-    assert sensor_seed(np.int64(7), np.int32(0), np.uint8(0), "lidar", np.int16(0)) == 4555428456120885206
-    assert sensor_seed(7, 0, 0, "camera", np.uint8(2)) == 1693360538744150905
-    assert len({sensor_seed(7, 0, 0, s) for s in ("lidar", "radar", "camera", "top_view")}) == 4
+    assert sensor_seed(7, frame=0, agent=0, sensor="lidar") == 4555428456120885206
+    assert (
+        sensor_seed(np.int64(7), frame=np.int32(0), agent=np.uint8(0), sensor="lidar", index=np.int16(0))
+        == 4555428456120885206
+    )
+    assert sensor_seed(7, frame=0, agent=0, sensor="camera", index=np.uint8(2)) == 1693360538744150905
+    assert len({sensor_seed(7, frame=0, agent=0, sensor=s) for s in ("lidar", "radar", "camera", "top_view")}) == 4
 
 
 # ---------------------------------------------------------------------------- the sensors' Python wrappers

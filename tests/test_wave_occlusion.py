@@ -102,7 +102,7 @@ def test_crests_hide_a_craft_at_150_m_as_a_dense_march_says() -> None:
     o = np.array([0.0, 0.0, 2.0])
     origins, dirs = _fan(o, np.array([150.0, 0.0, 0.8]))
     t = alone.cast_rays(origins, dirs).distance
-    exposed, hidden = exposed_hidden(scene, origins, dirs, t)
+    exposed, hidden = exposed_hidden(scene, origins=origins, directions=dirs, vessel_t=t)
     # Independent: march every exposed ray's segment to the hull against the surface heights.
     hit = np.isfinite(t)
     pts = origins[hit].astype(np.float64) + dirs[hit].astype(np.float64) * t[hit, None]
@@ -121,7 +121,7 @@ def test_flat_sea_hides_nothing_and_lidar_box_rays_cover_the_box() -> None:
     o = np.array([0.0, 0.0, 2.0])
     origins, dirs = _fan(o, np.array([150.0, 0.0, 0.8]), n=20)
     t = alone.cast_rays(origins, dirs).distance
-    exposed, hidden = exposed_hidden(scene, origins, dirs, t)
+    exposed, hidden = exposed_hidden(scene, origins=origins, directions=dirs, vessel_t=t)
     assert exposed > 0 and hidden == 0
     # LiDAR beams within the box's extent: every beam of the full pattern that meets the box alone is among them.
     pattern = lidar_from_config(
@@ -131,7 +131,7 @@ def test_flat_sea_hides_nothing_and_lidar_box_rays_cover_the_box() -> None:
     corners = np.array(
         [[150 + sx * 2.5, sy * 1.0, 0.2 + sz * 1.0] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]
     )
-    bo, bd = lidar_box_rays(pattern, pattern_angles(pattern), pose, corners)
+    bo, bd = lidar_box_rays(pattern, pattern_angles(pattern), lidar_pose=pose, corners_world=corners)
     full = np.isfinite(alone.cast_rays(np.tile(pose[:3, 3], (len(pattern), 1)), pattern).distance).sum()
     assert full > 0 and np.isfinite(alone.cast_rays(bo, bd).distance).sum() == full
 
@@ -344,7 +344,7 @@ def test_lidar_box_rays_find_the_beams_that_testing_every_beam_finds() -> None:
             centre[:2] = pose[:2, 3] - 80.0 * pose[:2, 0]
         half = rng.uniform([1.0, 0.5, 0.5], [150.0, 20.0, 15.0])
         corners = centre + half * _SIGNS
-        _, dirs = lidar_box_rays(pattern, angles, pose, corners)
+        _, dirs = lidar_box_rays(pattern, angles, lidar_pose=pose, corners_world=corners)
         want = _box_beams_by_testing_every_beam(pattern, pose, corners)
         expected = (pattern.astype(np.float64)[want] @ pose[:3, :3].T).astype(np.float32)
         assert dirs.shape == expected.shape and np.array_equal(dirs, expected), k
@@ -367,13 +367,13 @@ def test_many_boxes_beams_are_each_box_s_own() -> None:
                 centre[:2] = pose[:2, 3] - 80.0 * pose[:2, 0]
             boxes.append(centre + rng.uniform([1.0, 0.5, 0.5], [150.0, 20.0, 15.0]) * _SIGNS)
         stack = np.array(boxes, dtype=np.float64).reshape(-1, 8, 3)
-        beams, starts = lidar_boxes_beams(angles, pose, stack)
+        beams, starts = lidar_boxes_beams(angles, lidar_pose=pose, corners_world=stack)
         assert beams.dtype == starts.dtype == np.int64 and starts.shape == (len(boxes) + 1,) and starts[0] == 0
         assert starts[-1] == len(beams)
         for b, corners in enumerate(boxes):
             want = _box_beams_by_testing_every_beam(pattern, pose, corners)
             np.testing.assert_array_equal(beams[starts[b] : starts[b + 1]], want, err_msg=f"stack {k}, box {b}")
-            np.testing.assert_array_equal(lidar_box_beams(angles, pose, corners), want)
+            np.testing.assert_array_equal(lidar_box_beams(angles, lidar_pose=pose, corners_world=corners), want)
 
 
 def test_many_targets_counted_at_once_are_each_counted_alone() -> None:
@@ -393,19 +393,19 @@ def test_many_targets_counted_at_once_are_each_counted_alone() -> None:
         for reach in (float("inf"), 151.0):
             got = exposed_hidden_boxes(
                 scene,
-                origins[idx],
-                dirs[idx],
-                t[idx],
-                starts,
+                origins=origins[idx],
+                directions=dirs[idx],
+                vessel_t=t[idx],
+                starts=starts,
                 scene_instance=None if inst is None else inst[idx],
                 max_range_m=reach,
             )
             want = [
                 exposed_hidden(
                     scene,
-                    origins[r],
-                    dirs[r],
-                    t[r],
+                    origins=origins[r],
+                    directions=dirs[r],
+                    vessel_t=t[r],
                     scene_instance=None if inst is None else inst[r],
                     max_range_m=reach,
                 )
@@ -424,11 +424,13 @@ def test_unsigned_offsets_are_offsets() -> None:
     origins, dirs = _fan(np.array([0.0, 0.0, 2.0]), np.array([150.0, 0.0, 0.8]), n=12)
     t = alone.cast_rays(origins, dirs).distance
     n = len(t)
-    want = exposed_hidden_boxes(scene, origins, dirs, t, np.array([0, n // 2, n // 2, n], np.int64))
+    want = exposed_hidden_boxes(
+        scene, origins=origins, directions=dirs, vessel_t=t, starts=np.array([0, n // 2, n // 2, n], np.int64)
+    )
     assert want[0].sum() > 0
     for dtype in (np.uint8, np.uint16, np.uint32, np.uint64, np.int32):
         offsets = np.array([0, n // 2, n // 2, n]).astype(dtype)
-        got = exposed_hidden_boxes(scene, origins, dirs, t, offsets)
+        got = exposed_hidden_boxes(scene, origins=origins, directions=dirs, vessel_t=t, starts=offsets)
         assert got[0].tolist() == want[0].tolist() and got[1].tolist() == want[1].tolist(), dtype
 
 
@@ -519,57 +521,161 @@ def _bad_calls() -> list[tuple[str, Any, str]]:
         ("share(True, True)", lambda: sh(True, True), "exposed = True"),
         ("share(2.5, 1)", lambda: sh(2.5, 1), "exposed = 2.5"),
         # exposed_hidden: broadcast, NaN read as a miss, a range that is no range, bare errors
-        ("one origin for 4 rays", lambda: eh(scene, o[:1], d, t), "directions must be (N, 3)"),
-        ("origins (4, 2)", lambda: eh(scene, o[:, :2], d, t), "origins must be (N, 3)"),
-        ("3 distances for 4 rays", lambda: eh(scene, o, d, t[:3]), "vessel_t must be (N,)"),
-        ("a NaN distance", lambda: eh(scene, o, d, np.full(4, np.nan)), "vessel_t must be distances >= 0"),
-        ("a negative distance", lambda: eh(scene, o, d, -t), "row 0 is -5.0"),
-        ("NaN origins", lambda: eh(scene, o + np.nan, d, t), "origins must be finite"),
-        ("a zero direction", lambda: eh(scene, o, d * 0, t), "directions must be directions of any non-zero"),
-        ("origins 'abc'", lambda: eh(scene, "abc", d, t), "origins must be (N, 3)"),
-        ("bool directions", lambda: eh(scene, o, d > 0, t), "got dtype bool"),
-        ("scene None", lambda: eh(None, o, d, t), "scene = None: must be a mmusv.scene.Scene"),
-        ("max_range_m NaN", lambda: eh(scene, o, d, t, max_range_m=float("nan")), "max_range_m = nan"),
-        ("max_range_m -1", lambda: eh(scene, o, d, t, max_range_m=-1.0), "max_range_m = -1.0"),
-        ("float instances", lambda: eh(scene, o, d, t, scene_instance=t), "scene_instance must be (N,)"),
-        ("2 instances", lambda: eh(scene, o, d, t, scene_instance=np.zeros(2, np.int32)), "scene_instance"),
+        (
+            "one origin for 4 rays",
+            lambda: eh(scene, origins=o[:1], directions=d, vessel_t=t),
+            "directions must be (N, 3)",
+        ),
+        ("origins (4, 2)", lambda: eh(scene, origins=o[:, :2], directions=d, vessel_t=t), "origins must be (N, 3)"),
+        ("3 distances for 4 rays", lambda: eh(scene, origins=o, directions=d, vessel_t=t[:3]), "vessel_t must be (N,)"),
+        (
+            "a NaN distance",
+            lambda: eh(scene, origins=o, directions=d, vessel_t=np.full(4, np.nan)),
+            "vessel_t must be distances >= 0",
+        ),
+        ("a negative distance", lambda: eh(scene, origins=o, directions=d, vessel_t=-t), "row 0 is -5.0"),
+        ("NaN origins", lambda: eh(scene, origins=o + np.nan, directions=d, vessel_t=t), "origins must be finite"),
+        (
+            "a zero direction",
+            lambda: eh(scene, origins=o, directions=d * 0, vessel_t=t),
+            "directions must be directions of any non-zero",
+        ),
+        ("origins 'abc'", lambda: eh(scene, origins="abc", directions=d, vessel_t=t), "origins must be (N, 3)"),
+        ("bool directions", lambda: eh(scene, origins=o, directions=d > 0, vessel_t=t), "got dtype bool"),
+        (
+            "scene None",
+            lambda: eh(None, origins=o, directions=d, vessel_t=t),
+            "scene = None: must be a mmusv.scene.Scene",
+        ),
+        (
+            "max_range_m NaN",
+            lambda: eh(scene, origins=o, directions=d, vessel_t=t, max_range_m=float("nan")),
+            "max_range_m = nan",
+        ),
+        (
+            "max_range_m -1",
+            lambda: eh(scene, origins=o, directions=d, vessel_t=t, max_range_m=-1.0),
+            "max_range_m = -1.0",
+        ),
+        (
+            "float instances",
+            lambda: eh(scene, origins=o, directions=d, vessel_t=t, scene_instance=t),
+            "scene_instance must be (N,)",
+        ),
+        (
+            "2 instances",
+            lambda: eh(scene, origins=o, directions=d, vessel_t=t, scene_instance=np.zeros(2, np.int32)),
+            "scene_instance",
+        ),
         # pattern_angles: NaN and (0, 0, 0) beams got angles
         ("pattern (4, 2)", lambda: pa(p[:, :2]), "pattern must be (M, 3)"),
         ("NaN pattern", lambda: pa(np.full((3, 3), np.nan, np.float32)), "pattern must be finite"),
         ("zero beam", lambda: pa(np.zeros((3, 3), np.float32)), "row 0 is (0, 0, 0)"),
         ("pattern 'x'", lambda: pa("x"), "pattern must be (M, 3)"),
         # lidar_box_beams: a NaN pose gave no beams, a singular one LinAlgError, a scaled one wrong angles
-        ("angles a tuple", lambda: lbb((1, 2), pose, corners), "angles = (1, 2): must be the BeamAngles"),
-        ("pose (3, 3)", lambda: lbb(angles, np.eye(3), corners), "lidar_pose must be a (4, 4) rigid"),
-        ("pose singular", lambda: lbb(angles, np.zeros((4, 4)), corners), "lidar_pose must be a (4, 4) rigid"),
-        ("pose NaN", lambda: lbb(angles, pose + np.nan, corners), "not finite"),
-        ("pose scaled", lambda: lbb(angles, scaled, corners), "lidar_pose must be a (4, 4) rigid"),
-        ("corners (8, 2)", lambda: lbb(angles, pose, corners[:, :2]), "corners_world must be the (8, 3)"),
-        ("corners NaN", lambda: lbb(angles, pose, corners + np.nan), "corners_world must be"),
+        (
+            "angles a tuple",
+            lambda: lbb((1, 2), lidar_pose=pose, corners_world=corners),
+            "angles = (1, 2): must be the BeamAngles",
+        ),
+        (
+            "pose (3, 3)",
+            lambda: lbb(angles, lidar_pose=np.eye(3), corners_world=corners),
+            "lidar_pose must be a (4, 4) rigid",
+        ),
+        (
+            "pose singular",
+            lambda: lbb(angles, lidar_pose=np.zeros((4, 4)), corners_world=corners),
+            "lidar_pose must be a (4, 4) rigid",
+        ),
+        ("pose NaN", lambda: lbb(angles, lidar_pose=pose + np.nan, corners_world=corners), "not finite"),
+        (
+            "pose scaled",
+            lambda: lbb(angles, lidar_pose=scaled, corners_world=corners),
+            "lidar_pose must be a (4, 4) rigid",
+        ),
+        (
+            "corners (8, 2)",
+            lambda: lbb(angles, lidar_pose=pose, corners_world=corners[:, :2]),
+            "corners_world must be the (8, 3)",
+        ),
+        ("corners NaN", lambda: lbb(angles, lidar_pose=pose, corners_world=corners + np.nan), "corners_world must be"),
         # lidar_boxes_beams: many boxes at once, checked as one
-        ("boxes (2, 8, 2)", lambda: lbs(angles, pose, stack[..., :2]), "corners_world must be the (B, 8, 3)"),
-        ("one box (8, 3)", lambda: lbs(angles, pose, corners), "corners_world must be the (B, 8, 3)"),
-        ("box 1 NaN", lambda: lbs(angles, pose, stack * [[[1.0]], [[np.nan]]]), "box 1 corner 0"),
-        ("boxes pose scaled", lambda: lbs(angles, scaled, stack), "lidar_pose must be a (4, 4) rigid"),
+        (
+            "boxes (2, 8, 2)",
+            lambda: lbs(angles, lidar_pose=pose, corners_world=stack[..., :2]),
+            "corners_world must be the (B, 8, 3)",
+        ),
+        (
+            "one box (8, 3)",
+            lambda: lbs(angles, lidar_pose=pose, corners_world=corners),
+            "corners_world must be the (B, 8, 3)",
+        ),
+        (
+            "box 1 NaN",
+            lambda: lbs(angles, lidar_pose=pose, corners_world=stack * [[[1.0]], [[np.nan]]]),
+            "box 1 corner 0",
+        ),
+        (
+            "boxes pose scaled",
+            lambda: lbs(angles, lidar_pose=scaled, corners_world=stack),
+            "lidar_pose must be a (4, 4) rigid",
+        ),
         # exposed_hidden_boxes: offsets that are not the rows' slices
-        ("starts past N", lambda: ehb(scene, o, d, t, [0, 5]), "starts must be (B + 1,) row offsets rising from 0"),
-        ("starts not from 0", lambda: ehb(scene, o, d, t, [1, 4]), "got [1, 4]"),
-        ("starts falling", lambda: ehb(scene, o, d, t, [0, 3, 2, 4]), "got [0, 3, 2, 4]"),
-        ("starts empty", lambda: ehb(scene, o, d, t, []), "got []"),
-        ("starts float", lambda: ehb(scene, o, d, t, [0.0, 4.0]), "starts must be (B + 1,) row offsets"),
-        ("starts bool", lambda: ehb(scene, o, d, t, [False, True]), "got dtype bool"),
-        ("starts (1, 2)", lambda: ehb(scene, o, d, t, [[0, 4]]), "starts must be (B + 1,)"),
+        (
+            "starts past N",
+            lambda: ehb(scene, origins=o, directions=d, vessel_t=t, starts=[0, 5]),
+            "starts must be (B + 1,) row offsets rising from 0",
+        ),
+        ("starts not from 0", lambda: ehb(scene, origins=o, directions=d, vessel_t=t, starts=[1, 4]), "got [1, 4]"),
+        (
+            "starts falling",
+            lambda: ehb(scene, origins=o, directions=d, vessel_t=t, starts=[0, 3, 2, 4]),
+            "got [0, 3, 2, 4]",
+        ),
+        ("starts empty", lambda: ehb(scene, origins=o, directions=d, vessel_t=t, starts=[]), "got []"),
+        (
+            "starts float",
+            lambda: ehb(scene, origins=o, directions=d, vessel_t=t, starts=[0.0, 4.0]),
+            "starts must be (B + 1,) row offsets",
+        ),
+        (
+            "starts bool",
+            lambda: ehb(scene, origins=o, directions=d, vessel_t=t, starts=[False, True]),
+            "got dtype bool",
+        ),
+        (
+            "starts (1, 2)",
+            lambda: ehb(scene, origins=o, directions=d, vessel_t=t, starts=[[0, 4]]),
+            "starts must be (B + 1,)",
+        ),
         # unsigned offsets that fall: np.diff wrapped round to a rise (uint32: a 32 GiB array), a bare IndexError
-        ("starts uint8 falling", lambda: ehb(scene, o, d, t, np.array([0, 3, 2, 4], np.uint8)), "got [0, 3, 2, 4]"),
-        ("starts uint16 falling", lambda: ehb(scene, o, d, t, np.array([0, 3, 2, 4], np.uint16)), "got [0, 3, 2, 4]"),
+        (
+            "starts uint8 falling",
+            lambda: ehb(scene, origins=o, directions=d, vessel_t=t, starts=np.array([0, 3, 2, 4], np.uint8)),
+            "got [0, 3, 2, 4]",
+        ),
+        (
+            "starts uint16 falling",
+            lambda: ehb(scene, origins=o, directions=d, vessel_t=t, starts=np.array([0, 3, 2, 4], np.uint16)),
+            "got [0, 3, 2, 4]",
+        ),
         # lidar_beam_rays: -1 gave the last beam's ray, a boolean mask was read as one
-        ("beam -1", lambda: lbr(p, pose, np.array([-1])), "beams must be indices of the pattern's beams, in 0..3"),
-        ("beam 9", lambda: lbr(p, pose, np.array([9])), "got 9"),
-        ("float beams", lambda: lbr(p, pose, np.array([0.0, 1.0])), "beams must be (K,) beam indices"),
-        ("a mask", lambda: lbr(p, pose, np.array([True, False, True, False])), "got dtype bool"),
-        ("NaN beam", lambda: lbr(p + np.nan, pose, np.array([2])), "row 2"),
+        (
+            "beam -1",
+            lambda: lbr(p, lidar_pose=pose, beams=np.array([-1])),
+            "beams must be indices of the pattern's beams, in 0..3",
+        ),
+        ("beam 9", lambda: lbr(p, lidar_pose=pose, beams=np.array([9])), "got 9"),
+        ("float beams", lambda: lbr(p, lidar_pose=pose, beams=np.array([0.0, 1.0])), "beams must be (K,) beam indices"),
+        ("a mask", lambda: lbr(p, lidar_pose=pose, beams=np.array([True, False, True, False])), "got dtype bool"),
+        ("NaN beam", lambda: lbr(p + np.nan, lidar_pose=pose, beams=np.array([2])), "row 2"),
         # lidar_box_rays: the angles of another pattern gave another pattern's beams
-        ("angles of 4, pattern of 2", lambda: lbx(p[:2], angles, pose, corners), "angles are of a pattern of 4"),
+        (
+            "angles of 4, pattern of 2",
+            lambda: lbx(p[:2], angles, lidar_pose=pose, corners_world=corners),
+            "angles are of a pattern of 4",
+        ),
     ]
 
 
@@ -591,20 +697,25 @@ def test_the_helpers_still_take_what_they_document() -> None:
     np.testing.assert_array_equal(angles.el, [0.0, 0.0, np.pi / 2, 0.0])
     th = 0.3
     pose = np.array([[np.cos(th), -np.sin(th), 0, 5], [np.sin(th), np.cos(th), 0, 6], [0, 0, 1, 2], [0, 0, 0, 1]])
-    o, d = lidar_beam_rays(np.asarray(p, np.float32), pose.astype(np.float32), np.array([3, 0], np.uint8))
+    o, d = lidar_beam_rays(
+        np.asarray(p, np.float32), lidar_pose=pose.astype(np.float32), beams=np.array([3, 0], np.uint8)
+    )
     np.testing.assert_allclose(o, [[5, 6, 2], [5, 6, 2]])
     np.testing.assert_allclose(d, [[-np.cos(th), -np.sin(th), 0], [np.cos(th), np.sin(th), 0]], atol=1e-7)
-    o, d = lidar_beam_rays(np.asarray(p, np.float32), pose, [])
+    o, d = lidar_beam_rays(np.asarray(p, np.float32), lidar_pose=pose, beams=[])
     assert o.shape == d.shape == (0, 3)
     # A box 10 m straight ahead of the LiDAR (in its frame): the forward beam only.
     ahead = np.array([[10.0 + sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
     corners = ahead @ pose[:3, :3].T + pose[:3, 3]
-    np.testing.assert_array_equal(lidar_box_beams(angles, pose, corners), [0])
+    np.testing.assert_array_equal(lidar_box_beams(angles, lidar_pose=pose, corners_world=corners), [0])
     scene, _, alone, _ = _world(None)
     origins, dirs = _fan(np.array([0.0, 0.0, 2.0]), np.array([150.0, 0.0, 0.8]), n=8)
     t = alone.cast_rays(origins, dirs).distance
     n = int(np.count_nonzero(np.isfinite(t) & (origins[:, 2] + dirs[:, 2] * t > 0)))
-    assert exposed_hidden(scene, origins, dirs, t, max_range_m=np.float32(1e4)) == (n, 0) and n > 0
+    assert (
+        exposed_hidden(scene, origins=origins, directions=dirs, vessel_t=t, max_range_m=np.float32(1e4)) == (n, 0)
+        and n > 0
+    )
 
 
 def test_a_user_round_on_a_real_capture_is_unchanged() -> None:
@@ -628,13 +739,18 @@ def test_a_user_round_on_a_real_capture_is_unchanged() -> None:
         if vi == agent.index:
             continue
         corners = box_corners(cap.world.matrices[vi] @ translation(info.box_center_body), info.box_size)
-        beams = lidar_box_beams(angles, pose, corners)
+        beams = lidar_box_beams(angles, lidar_pose=pose, corners_world=corners)
         np.testing.assert_array_equal(beams, _box_beams_by_testing_every_beam(pattern, pose, corners))
-        o, d = lidar_box_rays(pattern, angles, pose, corners)
+        o, d = lidar_box_rays(pattern, angles, lidar_pose=pose, corners_world=corners)
         assert o.dtype == d.dtype == np.float32 and o.shape == d.shape == (len(beams), 3)
-        t = sil.distances(info.asset, cap.world.matrices[vi], o, d)
+        t = sil.distances(info.asset, pose=cap.world.matrices[vi], origins=o, directions=d)
         exposed, hidden = exposed_hidden(
-            sim.ws.scene, o, d, t, scene_instance=beams_hit[beams], max_range_m=agent.rig.lidar.range_m
+            sim.ws.scene,
+            origins=o,
+            directions=d,
+            vessel_t=t,
+            scene_instance=beams_hit[beams],
+            max_range_m=agent.rig.lidar.range_m,
         )
         water = sim.ws.scene.sea_instance
         reach = np.isfinite(t) & (t <= agent.rig.lidar.range_m)

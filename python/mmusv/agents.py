@@ -153,7 +153,7 @@ def _check_mounts(agent: Agent, where: str) -> None:
     index = {f"camera/{c.name}": i for i, c in enumerate(agent.rig.cameras)}
     for key, m in agent.mounts().items():
         name = f"{where}.cameras[{index[key]}].mount" if key in index else f"{where}.{key}.mount"
-        if inside_mesh(agent.asset.mesh.vertices, agent.asset.mesh.faces, m[:3, 3]):
+        if inside_mesh(agent.asset.mesh.vertices, agent.asset.mesh.faces, point=m[:3, 3]):
             xyz = np.round(m[:3, 3], 3).tolist()
             raise ConfigError(
                 f"invalid config {name} = {xyz}: the sensor sits inside the hull of vessel {agent.id!r} "

@@ -78,7 +78,7 @@ def in_target_range(centres: np.ndarray, range_m: float) -> np.ndarray:
     return np.asarray(np.hypot(c[..., 0], c[..., 1]) <= range_m)
 
 
-def footprint_in_range(box: np.ndarray, size: np.ndarray, range_m: float) -> bool:
+def footprint_in_range(box: np.ndarray, *, size: np.ndarray, range_m: float) -> bool:
     """Whether a box's bird's-eye-view footprint comes within ``range_m`` metres of the ego LiDAR: the distance from
     the origin to the rectangle of ``size[0]`` (length) by ``size[1]`` (beam) centred at the box's ``(x, y)`` and
     turned by its yaw (the BEV box), 0 inside it. ``box``: ``(4, 4)`` box → ego LiDAR frame (centred), metres.
@@ -214,12 +214,12 @@ class SilhouetteCache:
     def __init__(self) -> None:
         self._scenes: dict[str, tuple[Scene, int]] = {}
 
-    def hits(self, asset: str, pose: np.ndarray, origins: np.ndarray, directions: np.ndarray) -> np.ndarray:
+    def hits(self, asset: str, *, pose: np.ndarray, origins: np.ndarray, directions: np.ndarray) -> np.ndarray:
         """``(N,)`` bool: which rays hit the vessel ``asset`` at ``pose`` (body → world), alone in the world."""
-        hit: np.ndarray = np.isfinite(self.distances(asset, pose, origins, directions))
+        hit: np.ndarray = np.isfinite(self.distances(asset, pose=pose, origins=origins, directions=directions))
         return hit
 
-    def distances(self, asset: str, pose: np.ndarray, origins: np.ndarray, directions: np.ndarray) -> np.ndarray:
+    def distances(self, asset: str, *, pose: np.ndarray, origins: np.ndarray, directions: np.ndarray) -> np.ndarray:
         """``(N,)`` float32 distance (metres along each normalised direction) at which each ray meets the vessel
         ``asset`` at ``pose`` (body → world), alone in the world; ``inf`` where it misses."""
         if asset not in self._scenes:
@@ -236,6 +236,7 @@ class SilhouetteCache:
     def distances_boxes(
         self,
         assets: list[str],
+        *,
         poses: list[np.ndarray],
         origins: np.ndarray,
         directions: np.ndarray,
@@ -245,7 +246,9 @@ class SilhouetteCache:
         ``origins`` and ``directions`` (``(N, 3)``, world) cast against vessel ``assets[b]`` at ``poses[b]`` (body
         → world) alone; ``starts`` ``(B + 1,)`` row offsets from 0 to ``N``."""
         parts = [
-            self.distances(a, p, origins[starts[b] : starts[b + 1]], directions[starts[b] : starts[b + 1]])
+            self.distances(
+                a, pose=p, origins=origins[starts[b] : starts[b + 1]], directions=directions[starts[b] : starts[b + 1]]
+            )
             for b, (a, p) in enumerate(zip(assets, poses, strict=True))
         ]
         return np.concatenate(parts) if parts else np.zeros(0, dtype=np.float32)
@@ -330,11 +333,13 @@ def _lidar_wave_shares(
     """The LiDAR's wave-occlusion share of each of ``B`` boxes (``corners`` ``(B, 8, 3)`` world, of vessels
     ``assets`` at ``poses``), all boxes' beams selected, cast against their vessels and counted in one pass:
     the shares :func:`~mmusv.wave_occlusion.share` gives box by box."""
-    beams, starts = lidar_boxes_beams(angles, lidar_pose, corners)
-    o, d = lidar_beam_rays(pattern, lidar_pose, beams)
-    t = silhouettes.distances_boxes(assets, poses, o, d, starts)
+    beams, starts = lidar_boxes_beams(angles, lidar_pose=lidar_pose, corners_world=corners)
+    o, d = lidar_beam_rays(pattern, lidar_pose=lidar_pose, beams=beams)
+    t = silhouettes.distances_boxes(assets, poses=poses, origins=o, directions=d, starts=starts)
     first = None if lidar_beams is None else np.asarray(lidar_beams)[beams]
-    n_exposed, n_hidden = exposed_hidden_boxes(scene, o, d, t, starts, scene_instance=first, max_range_m=max_range_m)
+    n_exposed, n_hidden = exposed_hidden_boxes(
+        scene, origins=o, directions=d, vessel_t=t, starts=starts, scene_instance=first, max_range_m=max_range_m
+    )
     return [share(e, h) for e, h in zip(n_exposed, n_hidden, strict=True)]
 
 
@@ -397,7 +402,7 @@ def annotate_agent(
         box_ref = ref_inv @ box_world
         rng = float(np.linalg.norm(box_ref[:3, 3]))
         corners_world = box_corners(box_world, info.box_size)
-        if footprint_in_range(box_ref, info.box_size, max_range_m):
+        if footprint_in_range(box_ref, size=info.box_size, range_m=max_range_m):
             ann.lidar_ids.append(info.id)
             ann.lidar_instance.append(info.instance_id)
             ann.lidar_class.append(info.semantic_class)
@@ -430,7 +435,7 @@ def annotate_agent(
             vv, uu = np.mgrid[v0:v1, u0:u1]
             pix = np.ascontiguousarray((vv * w + uu).reshape(-1), dtype=np.int64)
             o, d = cam.pixel_rays(pose, pix)
-            t_alone = silhouettes.distances(info.asset, state.matrices[vi], o, d)
+            t_alone = silhouettes.distances(info.asset, pose=state.matrices[vi], origins=o, directions=d)
             alone = np.isfinite(t_alone)
             sil = int(np.count_nonzero(alone))
             if sil == 0 and visible == 0:
@@ -458,10 +463,10 @@ def annotate_agent(
         offsets = np.concatenate(([0], np.cumsum([t.size for t in distances])))
         n_exposed, n_hidden = exposed_hidden_boxes(
             scene,
-            np.concatenate(origins),
-            np.concatenate(directions),
-            np.concatenate(distances),
-            offsets,
+            origins=np.concatenate(origins),
+            directions=np.concatenate(directions),
+            vessel_t=np.concatenate(distances),
+            starts=offsets,
             scene_instance=np.concatenate(seen_first),
         )
         for row, e, h in zip(rows_2d, n_exposed, n_hidden, strict=True):

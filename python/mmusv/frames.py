@@ -168,7 +168,7 @@ def mirror_transform(m: npt.ArrayLike) -> np.ndarray:
     return out
 
 
-def carla_rotation(roll_deg: npt.ArrayLike, yaw_deg: npt.ArrayLike, pitch_deg: npt.ArrayLike) -> np.ndarray:
+def carla_rotation(*, roll_deg: npt.ArrayLike, yaw_deg: npt.ArrayLike, pitch_deg: npt.ArrayLike) -> np.ndarray:
     """``(..., 3, 3)`` the rotation CARLA/OpenCOOD loaders build from ``[roll, yaw, pitch]`` degrees."""
     r, y, p = (np.radians(np.asarray(a, dtype=np.float64)) for a in (roll_deg, yaw_deg, pitch_deg))
     cr, sr, cy, sy, cp, sp = np.cos(r), np.sin(r), np.cos(y), np.sin(y), np.cos(p), np.sin(p)
@@ -185,7 +185,7 @@ def carla_matrix(pose: npt.ArrayLike) -> np.ndarray:
     """``(..., 4, 4)`` the CARLA transform of ``[x, y, z, roll, yaw, pitch]`` poses ``(..., 6)`` (left-handed)."""
     pose = _floats(pose, name="pose", tail=(6,), what="(..., 6) CARLA poses [x, y, z, roll, yaw, pitch]")
     m = np.zeros((*pose.shape[:-1], 4, 4), dtype=np.float64)
-    m[..., :3, :3] = carla_rotation(pose[..., 3], pose[..., 4], pose[..., 5])
+    m[..., :3, :3] = carla_rotation(roll_deg=pose[..., 3], yaw_deg=pose[..., 4], pitch_deg=pose[..., 5])
     m[..., :3, 3] = pose[..., :3]
     m[..., 3, 3] = 1.0
     return m

@@ -14,7 +14,7 @@ __all__ = ["sensor_seed"]
 _SENSOR_CODES = {"lidar": 1, "radar": 2, "camera": 3, "top_view": 4}
 
 
-def sensor_seed(scenario_seed: int, frame: int, agent: int, sensor: str, index: int = 0) -> int:
+def sensor_seed(scenario_seed: int, *, frame: int, agent: int, sensor: str, index: int = 0) -> int:
     """The 64-bit seed (a whole number in ``0..2**64 - 1``) of one sensor capture: a hash of (scenario seed, frame,
     agent index, sensor, index), as :meth:`mmusv.simulation.Simulation.capture` seeds its sensors.
 

@@ -447,18 +447,26 @@ class Simulation:
                 cap.sensors[key] = SensorMount(mount=m, pose=p)
             if agent.lidar is not None and "lidar" in kinds:
                 cap.lidar_pose = poses["lidar"]
-                tasks.append((agent.lidar, _pose(cap.lidar_pose), sensor_seed(sc.seed, frame, agent.index, "lidar")))
+                tasks.append(
+                    (
+                        agent.lidar,
+                        _pose(cap.lidar_pose),
+                        sensor_seed(sc.seed, frame=frame, agent=agent.index, sensor="lidar"),
+                    )
+                )
                 slots.append((agent, cap, "lidar"))
             for k, (name, (cam, _, _)) in enumerate(agent.cameras.items()):
                 if "cameras" not in kinds:
                     break
                 p = poses[f"camera/{name}"]
                 cap.camera_poses[name] = p
-                tasks.append((cam, _pose(p), sensor_seed(sc.seed, frame, agent.index, "camera", k)))
+                tasks.append(
+                    (cam, _pose(p), sensor_seed(sc.seed, frame=frame, agent=agent.index, sensor="camera", index=k))
+                )
                 slots.append((agent, cap, f"camera/{name}"))
             if agent.top_view is not None and "top_view" in kinds:
                 cap.top_view_pose = poses["top_view"]
-                seed = sensor_seed(sc.seed, frame, agent.index, "top_view")
+                seed = sensor_seed(sc.seed, frame=frame, agent=agent.index, sensor="top_view")
                 tasks.append((agent.top_view, _pose(cap.top_view_pose), seed))
                 slots.append((agent, cap, "top_view"))
             if "radar" in kinds and agent.radar is not None and agent.rig.radar is not None:
@@ -471,7 +479,14 @@ class Simulation:
                     metres_per_pixel=cfg.ppi_metres_per_pixel,
                     orientation=cfg.ppi_orientation,
                 )
-                tasks.append((agent.radar, cap.radar_pose, sensor_seed(sc.seed, frame, agent.index, "radar"), ppi))
+                tasks.append(
+                    (
+                        agent.radar,
+                        cap.radar_pose,
+                        sensor_seed(sc.seed, frame=frame, agent=agent.index, sensor="radar"),
+                        ppi,
+                    )
+                )
                 slots.append((agent, cap, "radar"))
             out[agent.id] = cap
         wakes = self.wakes(state)

@@ -106,10 +106,10 @@ def _rigid(value: Any, *, name: str) -> np.ndarray:
 
 def exposed_hidden(
     scene: Scene,
+    *,
     origins: npt.NDArray[np.float32],
     directions: npt.NDArray[np.float32],
     vessel_t: npt.NDArray[np.float32],
-    *,
     scene_instance: npt.NDArray[np.int32] | None = None,
     max_range_m: float = float("inf"),
 ) -> tuple[int, int]:
@@ -135,11 +135,11 @@ def exposed_hidden(
 
 def exposed_hidden_boxes(
     scene: Scene,
+    *,
     origins: npt.NDArray[np.float32],
     directions: npt.NDArray[np.float32],
     vessel_t: npt.NDArray[np.float32],
     starts: npt.NDArray[np.int64],
-    *,
     scene_instance: npt.NDArray[np.int32] | None = None,
     max_range_m: float = float("inf"),
 ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
@@ -320,6 +320,7 @@ def _remember(pattern: npt.NDArray[np.float32], angles: BeamAngles) -> None:
 def lidar_box_rays(
     pattern: npt.NDArray[np.float32],
     angles: BeamAngles,
+    *,
     lidar_pose: npt.NDArray[np.float64],
     corners_world: npt.NDArray[np.float64],
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
@@ -334,11 +335,13 @@ def lidar_box_rays(
         raise InputError(
             f"angles are of a pattern of {n} beams, pattern has {m}: give pattern_angles(pattern) of this pattern"
         )
-    return lidar_beam_rays(pattern, lidar_pose, lidar_box_beams(angles, lidar_pose, corners_world))
+    beams = lidar_box_beams(angles, lidar_pose=lidar_pose, corners_world=corners_world)
+    return lidar_beam_rays(pattern, lidar_pose=lidar_pose, beams=beams)
 
 
 def lidar_box_beams(
     angles: BeamAngles,
+    *,
     lidar_pose: npt.NDArray[np.float64],
     corners_world: npt.NDArray[np.float64],
 ) -> npt.NDArray[np.int64]:
@@ -346,12 +349,13 @@ def lidar_box_beams(
     elevation extent of the box ``corners_world`` ``(8, 3)`` float64 (world, metres) seen from the LiDAR at
     ``lidar_pose`` ``(4, 4)`` float64 rigid LiDAR → world; ``angles`` the pattern's :func:`pattern_angles`. One box
     of :func:`lidar_boxes_beams`."""
-    beams, _ = lidar_boxes_beams(angles, lidar_pose, _box(corners_world)[None])
+    beams, _ = lidar_boxes_beams(angles, lidar_pose=lidar_pose, corners_world=_box(corners_world)[None])
     return beams
 
 
 def lidar_boxes_beams(
     angles: BeamAngles,
+    *,
     lidar_pose: npt.NDArray[np.float64],
     corners_world: npt.NDArray[np.float64],
 ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
@@ -402,7 +406,7 @@ def lidar_boxes_beams(
 
 
 def lidar_beam_rays(
-    pattern: npt.NDArray[np.float32], lidar_pose: npt.NDArray[np.float64], beams: npt.NDArray[np.int64]
+    pattern: npt.NDArray[np.float32], *, lidar_pose: npt.NDArray[np.float64], beams: npt.NDArray[np.int64]
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
     """The world rays ``(origins, directions)`` (each ``(K, 3)`` float32, world frame: origins in metres,
     directions the beams' turned by the pose) of the pattern's ``beams`` (``(K,)`` integer indices in ``0..M - 1``,

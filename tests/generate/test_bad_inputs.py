@@ -123,10 +123,18 @@ def test_too_many_samples_advises_what_lowers_them() -> None:
         scenario_samples(sc, map_context("open_sea", 2, {}))
     assert samples.FEWER_TIMES in str(info.value) and "or acquisition.frequency_hz" not in str(info.value)
     for frames, hz, speed in ((10_000, 0.5, 10.0), (10_000, 5.0, 0.5), (200, 1.0, 30.0)):
-        n = samples.time_samples(frames, hz, 2.0, speed)
-        assert samples.time_samples(frames, hz / 2, 2.0, speed) >= n >= samples.time_samples(frames, hz * 2, 2.0, speed)
-    assert samples.time_samples(10_000, 0.25, 2.0, 10.0) > samples.time_samples(10_000, 0.5, 2.0, 10.0)
-    assert samples.time_samples(5_000, 0.5, 2.0, 10.0) < samples.time_samples(10_000, 0.5, 2.0, 10.0)
+        n = samples.time_samples(frames, frequency_hz=hz, step=2.0, max_speed_mps=speed)
+        assert (
+            samples.time_samples(frames, frequency_hz=hz / 2, step=2.0, max_speed_mps=speed)
+            >= n
+            >= samples.time_samples(frames, frequency_hz=hz * 2, step=2.0, max_speed_mps=speed)
+        )
+    assert samples.time_samples(10_000, frequency_hz=0.25, step=2.0, max_speed_mps=10.0) > samples.time_samples(
+        10_000, frequency_hz=0.5, step=2.0, max_speed_mps=10.0
+    )
+    assert samples.time_samples(5_000, frequency_hz=0.5, step=2.0, max_speed_mps=10.0) < samples.time_samples(
+        10_000, frequency_hz=0.5, step=2.0, max_speed_mps=10.0
+    )
 
 
 def test_sample_counts_saturate_instead_of_overflowing() -> None:

@@ -83,7 +83,7 @@ def test_separation_in_blocks_is_the_whole_array(monkeypatch: object) -> None:
     iu, ju = np.triu_indices(len(s.ids), 1)
     d = np.stack([np.cos(s.motion_yaw), np.sin(s.motion_yaw)], axis=-1) * s.half[None, :, None]
     p, q = s.motion - d, s.motion + d
-    hull = segment_distance(p[:, iu], q[:, iu], p[:, ju], q[:, ju]) - (s.radius[iu] + s.radius[ju])[None, :]
+    hull = segment_distance(p[:, iu], q[:, iu], p2=p[:, ju], q2=q[:, ju]) - (s.radius[iu] + s.radius[ju])[None, :]
     slack = s.motion_slack + s.motion_turn
     gap = hull - (slack[iu] + slack[ju])[None, :] - sep.min_m
     worst = gap.min(axis=0)

@@ -50,7 +50,7 @@ def _check_frame(sim: Simulation, frame: int) -> None:
     for agent in sim.agents:
         ac = cap.agents[agent.id]
         assert agent.lidar is not None and ac.lidar is not None and ac.lidar_pose is not None
-        lidar_seed = sensor_seed(seed, frame, agent.index, "lidar")
+        lidar_seed = sensor_seed(seed, frame=frame, agent=agent.index, sensor="lidar")
         one = scan(agent.lidar, scene, pose=ac.lidar_pose, env=env, seed=lidar_seed, wakes=wakes)
         assert len(one) > 0
         for name in ("xyz", "range", "intensity", "ring", "azimuth", "semantic_class", "instance", "ray_index"):
@@ -62,7 +62,7 @@ def _check_frame(sim: Simulation, frame: int) -> None:
                 scene,
                 pose=ac.camera_poses[name],
                 env=env,
-                seed=sensor_seed(seed, frame, agent.index, "camera", k),
+                seed=sensor_seed(seed, frame=frame, agent=agent.index, sensor="camera", index=k),
                 wakes=wakes,
             )
             got = ac.cameras[name]
@@ -78,7 +78,7 @@ def _check_frame(sim: Simulation, frame: int) -> None:
             scene,
             pose=ac.top_view_pose,
             env=env,
-            seed=sensor_seed(seed, frame, agent.index, "top_view"),
+            seed=sensor_seed(seed, frame=frame, agent=agent.index, sensor="top_view"),
             wakes=wakes,
         )
         assert _same(ac.top_view.depth, tv.depth) and _same(ac.top_view.instance, tv.instance)
@@ -89,7 +89,11 @@ def _check_frame(sim: Simulation, frame: int) -> None:
         assert agent.radar is not None and agent.rig.radar is not None and ac.radar is not None
         assert ac.radar_pose is not None and ac.radar_ppi is not None
         ret = radar_sweep(
-            agent.radar, scene, pose=ac.radar_pose, env=env, seed=sensor_seed(seed, frame, agent.index, "radar")
+            agent.radar,
+            scene,
+            pose=ac.radar_pose,
+            env=env,
+            seed=sensor_seed(seed, frame=frame, agent=agent.index, sensor="radar"),
         )
         assert len(ret) > 0
         for name in ("range", "azimuth", "elevation", "intensity", "instance_id", "semantic_class"):

@@ -52,13 +52,13 @@ def test_a_mount_that_is_not_a_finite_pose_is_refused_by_name() -> None:
 )
 def test_inside_mesh_of_a_box(point: tuple[float, float, float], inside: bool) -> None:
     v, f = _box((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))
-    assert inside_mesh(v, f, np.array(point)) is inside
+    assert inside_mesh(v, f, point=np.array(point)) is inside
 
 
 def test_inside_mesh_of_two_boxes_is_their_union() -> None:
     a, fa = _box((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))
     b, fb = _box((3.0, 0.0, 0.0), (4.0, 1.0, 1.0))
     v, f = np.concatenate([a, b]), np.concatenate([fa, fb + 8])
-    assert inside_mesh(v, f, np.array([3.5, 0.5, 0.5]))  # rays through the first box count it in and out
-    assert inside_mesh(v, f, np.array([0.5, 0.5, 0.5]))
-    assert not inside_mesh(v, f, np.array([2.0, 0.5, 0.5]))  # between them
+    assert inside_mesh(v, f, point=np.array([3.5, 0.5, 0.5]))  # rays through the first box count it in and out
+    assert inside_mesh(v, f, point=np.array([0.5, 0.5, 0.5]))
+    assert not inside_mesh(v, f, point=np.array([2.0, 0.5, 0.5]))  # between them

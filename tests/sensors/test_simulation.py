@@ -141,9 +141,11 @@ def test_scenario_seed_drives_the_noise() -> None:
     la, lb = base.agents["usv_1"].lidar, other.agents["usv_1"].lidar
     assert la is not None and lb is not None
     assert not (len(la) == len(lb) and np.array_equal(la.range, lb.range)), "another seed, other noise"
-    assert sensor_seed(11, 3, 0, "lidar") != sensor_seed(12, 3, 0, "lidar")
-    assert sensor_seed(11, 3, 0, "lidar") != sensor_seed(11, 4, 0, "lidar")
-    assert sensor_seed(11, 3, 0, "camera", 0) != sensor_seed(11, 3, 0, "camera", 1)
+    assert sensor_seed(11, frame=3, agent=0, sensor="lidar") != sensor_seed(12, frame=3, agent=0, sensor="lidar")
+    assert sensor_seed(11, frame=3, agent=0, sensor="lidar") != sensor_seed(11, frame=4, agent=0, sensor="lidar")
+    assert sensor_seed(11, frame=3, agent=0, sensor="camera", index=0) != sensor_seed(
+        11, frame=3, agent=0, sensor="camera", index=1
+    )
 
 
 _HASH_SCRIPT = """

@@ -118,7 +118,7 @@ class _Clearance(_FindingsCheck):
         route_bad: np.ndarray | None = None
         for r, (pts, yaw, slack, turn) in enumerate(runs):
             if self.hull:
-                axis, axis_slack = axis_points(pts, yaw, s.half, self.axis_spacing)
+                axis, axis_slack = axis_points(pts, yaw=yaw, half=s.half, spacing=self.axis_spacing)
                 d = s.ctx.lookup(raster, axis).min(axis=2)
                 margin = d - s.ctx.cell_slack - (slack + turn + s.radius + axis_slack)[None, :]
             else:
@@ -191,7 +191,7 @@ class Separation(_FindingsCheck):
             t_step = max(1, _PAIR_BLOCK // len(cols))
             for t0 in range(0, len(s.times), t_step):
                 t = slice(t0, t0 + t_step)
-                hull = segment_distance(p[t, a_], q[t, a_], p[t, b_], q[t, b_]) - reach[None, c]
+                hull = segment_distance(p[t, a_], q[t, a_], p2=p[t, b_], q2=q[t, b_]) - reach[None, c]
                 gap = hull - pair_slack[None, c] - self.min_m
                 k = np.argmin(gap, axis=0)
                 better = gap[k, cols] < worst[c]  # strictly: an earlier block keeps a tie, as argmin would

@@ -82,7 +82,9 @@ def _escorts(inp: FamilyInput, anchor: np.ndarray, vel: np.ndarray, t_at: float)
             turn = float(rng.uniform(-0.05, 0.05))
             c, s = math.cos(turn), math.sin(turn)
             v = np.array([c * vel[0] - s * vel[1], s * vel[0] + c * vel[1]])
-            return [straight_track(coop, anchor + d * heading(bearing), v, t_at, inp.duration, rng)]
+            return [
+                straight_track(coop, at=anchor + d * heading(bearing), vel=v, t_at=t_at, duration=inp.duration, rng=rng)
+            ]
 
         out += pick_best(inp, make)
     return out
@@ -100,9 +102,11 @@ def _encounter(kind: str) -> Callable[[FamilyInput], Layout]:
         t0 = big_t * float(rng.uniform(0.35, 0.65))
 
         def make_ego() -> list[Track]:
-            centre = inp.ctx.sample_points(1, inp.encounter_clearance, rng)[0]
+            centre = inp.ctx.sample_points(1, min_clearance=inp.encounter_clearance, rng=rng)[0]
             theta = float(rng.uniform(0.0, 2.0 * math.pi))
-            return [straight_track(inp.ego, centre, inp.ego.speed * heading(theta), t0, big_t, rng)]
+            return [
+                straight_track(inp.ego, at=centre, vel=inp.ego.speed * heading(theta), t_at=t0, duration=big_t, rng=rng)
+            ]
 
         ego = pick_best(inp, make_ego)[0]
         v_e = ego.speed * unit(ego.route[-1] - ego.route[0], heading(0.0))
@@ -129,7 +133,7 @@ def _encounter(kind: str) -> Callable[[FamilyInput], Layout]:
                 v_t = speed * heading(psi)
                 ego_at = centre + v_e * (t_e - t0)
                 p = _cpa_point(ego_at, v_e, v_t, _range(inp), rng, ahead=kind == "crossing")
-                return [straight_track(tgt, p, v_t, t_e, big_t, rng)]
+                return [straight_track(tgt, at=p, vel=v_t, t_at=t_e, duration=big_t, rng=rng)]
 
             tracks += pick_best(inp, make)
         tracks += _escorts(inp, centre, v_e, t0)
@@ -151,7 +155,7 @@ def _convoy(inp: FamilyInput) -> Layout:
     total = float(sum(gaps))
 
     def make() -> list[Track]:
-        centre = inp.ctx.sample_points(1, inp.encounter_clearance, rng)[0]
+        centre = inp.ctx.sample_points(1, min_clearance=inp.encounter_clearance, rng=rng)[0]
         fwd = heading(float(rng.uniform(0.0, 2.0 * math.pi)))
         side = 1.0 if rng.uniform() < 0.5 else -1.0
         lead_at = centre + side * _range(inp) * perp(fwd)
@@ -159,7 +163,7 @@ def _convoy(inp: FamilyInput) -> Layout:
         end = lead_at + fwd * u * (big_t - t_e)
         mid = (start + end) / 2.0 + perp(fwd) * float(rng.uniform(-0.02, 0.02)) * float(np.hypot(*(end - start)))
         route = np.array([start, mid, end])
-        out = [straight_track(inp.ego, centre, u * fwd, t_e, big_t, rng)]
+        out = [straight_track(inp.ego, at=centre, vel=u * fwd, t_at=t_e, duration=big_t, rng=rng)]
         offset = total
         for k, tgt in enumerate(inp.targets):
             out.append(Track(tgt, route.copy(), u, offset))
@@ -183,12 +187,12 @@ def _surround(inp: FamilyInput) -> Layout:
     primary = inp.targets[0]
 
     def make_group() -> list[Track]:
-        centre = inp.ctx.sample_points(1, inp.encounter_clearance, rng)[0]
-        out = [straight_track(primary, centre, v, t_e, big_t, rng)]
+        centre = inp.ctx.sample_points(1, min_clearance=inp.encounter_clearance, rng=rng)[0]
+        out = [straight_track(primary, at=centre, vel=v, t_at=t_e, duration=big_t, rng=rng)]
         for tgt in inp.targets[1:]:
             d = primary.radius + tgt.radius + inp.separation_m + float(rng.uniform(10.0, 60.0))
             at = centre + d * heading(float(rng.uniform(0.0, 2.0 * math.pi)))
-            out.append(straight_track(tgt, at, v, t_e, big_t, rng))
+            out.append(straight_track(tgt, at=at, vel=v, t_at=t_e, duration=big_t, rng=rng))
         return out
 
     target_tracks = pick_best(inp, make_group)
@@ -200,7 +204,11 @@ def _surround(inp: FamilyInput) -> Layout:
 
         def make(k: int = k, usv: Role = usv) -> list[Track]:
             bearing = base + 2.0 * math.pi * k / len(usvs) + float(rng.uniform(-0.3, 0.3))
-            return [straight_track(usv, centre + _range(inp) * heading(bearing), v, t_e, big_t, rng)]
+            return [
+                straight_track(
+                    usv, at=centre + _range(inp) * heading(bearing), vel=v, t_at=t_e, duration=big_t, rng=rng
+                )
+            ]
 
         usv_tracks += pick_best(inp, make)
     return Layout(usv_tracks + target_tracks, [primary.id], centre)
@@ -220,8 +228,8 @@ def _occluded(inp: FamilyInput) -> Layout:
     for _ in range(8):
         phi = float(rng.uniform(0.0, 2.0 * math.pi))
         behind = phi + math.pi + float(rng.uniform(-0.3, 0.3))
-        e1 = ctx.ray_exit(occ.centre, phi, inp.ego.radius + pad, reach)
-        e2 = ctx.ray_exit(occ.centre, behind, primary.radius + pad, reach)
+        e1 = ctx.ray_exit(occ.centre, angle=phi, need=inp.ego.radius + pad, max_len=reach)
+        e2 = ctx.ray_exit(occ.centre, angle=behind, need=primary.radius + pad, max_len=reach)
         r = _range(inp)
         if e1 is None or e2 is None or r - e1 - e2 < 20.0:
             continue
@@ -237,20 +245,20 @@ def _occluded(inp: FamilyInput) -> Layout:
     v_t = min(primary.speed, 4.0) * heading(behind + side * math.pi / 2.0)
     v_e = min(inp.ego.speed, 1.5) * heading(phi + side * math.pi / 2.0)
     tracks = [
-        straight_track(inp.ego, ego_at, v_e, t_e, big_t, rng),
-        straight_track(primary, tgt_at, v_t, t_e, big_t, rng),
+        straight_track(inp.ego, at=ego_at, vel=v_e, t_at=t_e, duration=big_t, rng=rng),
+        straight_track(primary, at=tgt_at, vel=v_t, t_at=t_e, duration=big_t, rng=rng),
     ]
     for k, coop in enumerate(inp.coops):
 
         def make_coop(k: int = k, coop: Role = coop) -> list[Track]:
             flank = (1.0 if k % 2 == 0 else -1.0) * (float(rng.uniform(1.05, 1.9)) + 0.3 * (k // 2))
             ang = behind + flank
-            e = ctx.ray_exit(occ.centre, ang, coop.radius + pad, reach)
+            e = ctx.ray_exit(occ.centre, angle=ang, need=coop.radius + pad, max_len=reach)
             if e is None:
                 return []
             at = occ.centre + (e + float(rng.uniform(20.0, 120.0))) * heading(ang)
             v_c = min(coop.speed, 1.5) * heading(ang + side * math.pi / 2.0)
-            return [straight_track(coop, at, v_c, t_e, big_t, rng)]
+            return [straight_track(coop, at=at, vel=v_c, t_at=t_e, duration=big_t, rng=rng)]
 
         placed = pick_best(inp, make_coop)
         if not placed:
@@ -262,7 +270,7 @@ def _occluded(inp: FamilyInput) -> Layout:
             v = tgt.speed * heading(float(rng.uniform(0.0, 2.0 * math.pi)))
             t_k = big_t * float(rng.uniform(0.25, 0.75))
             p = _cpa_point(ego_at + v_e * (t_k - t_e), v_e, v, _range(inp), rng, ahead=False)
-            return [straight_track(tgt, p, v, t_k, big_t, rng)]
+            return [straight_track(tgt, at=p, vel=v, t_at=t_k, duration=big_t, rng=rng)]
 
         tracks += pick_best(inp, make_tgt)
     return Layout(tracks, [t.id for t in inp.targets], ego_at)
@@ -281,7 +289,7 @@ def _port_entry(inp: FamilyInput) -> Layout:
         u = min(tgt.speed, 5.0)
         frac = float(rng.uniform(0.3, 0.7)) if k == 0 else float(rng.uniform(0.1, 0.9))
         try:
-            path = planner.approach(tgt.beam_r + inp.clearance_m + 10.0, u * big_t * frac, rng)
+            path = planner.approach(tgt.beam_r + inp.clearance_m + 10.0, entry_after_m=u * big_t * frac, rng=rng)
         except PlannerError as exc:
             raise SamplingError(f"{tgt.asset}: {exc}") from None
         target_tracks.append(Track(tgt, path, u))
@@ -305,7 +313,7 @@ def _port_entry(inp: FamilyInput) -> Layout:
     else:
         raise SamplingError("no open water for the ego beside the primary target's harbour approach")
     v_e = float(rng.uniform(0.3, 1.0)) * heading(float(rng.uniform(0.0, 2.0 * math.pi)))
-    tracks = [straight_track(inp.ego, at, v_e, t_e, big_t, rng), *target_tracks]
+    tracks = [straight_track(inp.ego, at=at, vel=v_e, t_at=t_e, duration=big_t, rng=rng), *target_tracks]
     tracks += _escorts(inp, at, v_e, t_e)
     return Layout(tracks, [inp.targets[0].id], q)
 

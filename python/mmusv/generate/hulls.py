@@ -28,7 +28,7 @@ def capsule(asset: str) -> tuple[float, float]:
     return 0.0, math.hypot(v.length, v.beam) / 2.0
 
 
-def axis_points(xy: np.ndarray, yaw: np.ndarray, half: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray]:
+def axis_points(xy: np.ndarray, *, yaw: np.ndarray, half: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray]:
     """Points along every capsule axis: ``xy`` ``(N, V, 2)``, ``yaw`` ``(N, V)``, ``half`` ``(V,)`` ->
     ``(N, V, K, 2)`` points (the same K for all vessels, evenly spread from ``-a`` to ``+a``) and ``(V,)`` the
     largest distance from any axis point to its nearest sample (half the point spacing, at most ``spacing/2``)."""
@@ -41,7 +41,7 @@ def axis_points(xy: np.ndarray, yaw: np.ndarray, half: np.ndarray, spacing: floa
     return pts, slack
 
 
-def segment_distance(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.ndarray) -> np.ndarray:
+def segment_distance(p1: np.ndarray, q1: np.ndarray, *, p2: np.ndarray, q2: np.ndarray) -> np.ndarray:
     """Distances between segments ``p1q1`` and ``p2q2`` (arrays ``(..., 2)``, broadcast) -> ``(...)``; closest
     points by clamped parameters (Ericson, Real-Time Collision Detection, 5.1.9), degenerate segments included."""
     d1, d2, r = q1 - p1, q2 - p2, p1 - p2

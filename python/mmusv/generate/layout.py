@@ -127,7 +127,7 @@ def unit(v: np.ndarray, fallback: np.ndarray) -> np.ndarray:
 
 
 def straight_track(
-    role: Role, at: np.ndarray, vel: np.ndarray, t_at: float, duration: float, rng: np.random.Generator
+    role: Role, *, at: np.ndarray, vel: np.ndarray, t_at: float, duration: float, rng: np.random.Generator
 ) -> Track:
     """A track passing ``at`` at time ``t_at`` with velocity ``vel`` (m/s), covering ``[0, duration]``, with a
     middle waypoint bent sideways by up to 3 % of its length; at rest (speed 0) when it would move under 1 m."""

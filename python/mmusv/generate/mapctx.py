@@ -96,7 +96,7 @@ class MapContext:
         """Conservative distance (metres) from points ``xy`` ``(..., 2)`` to any obstacle: ``d_nav - cell_slack``."""
         return self.lookup(self.d_nav, xy) - self.cell_slack
 
-    def sample_points(self, n: int, min_clearance: float, rng: np.random.Generator) -> np.ndarray:
+    def sample_points(self, n: int, *, min_clearance: float, rng: np.random.Generator) -> np.ndarray:
         """``n`` points ``(n, 2)`` uniform over the water cells of the map priors whose shore distance is at
         least ``min_clearance`` (halved, down to the priors' ``clearance``, while no cell qualifies), each
         jittered uniformly inside its cell. Raises ``ValueError`` when the map has no valid cell at all."""
@@ -189,7 +189,7 @@ class MapContext:
             )
         return tuple(out)
 
-    def ray_exit(self, centre: np.ndarray, angle: float, need: float, max_len: float) -> float | None:
+    def ray_exit(self, centre: np.ndarray, *, angle: float, need: float, max_len: float) -> float | None:
         """Distance from ``centre`` along the ray at ``angle`` (radians from +x) to the first point from which
         the conservative clearance stays at least ``need`` for 40 m; None when there is none within ``max_len``."""
         step = self.resolution / 2.0

@@ -91,7 +91,7 @@ class HarbourPlanner:
         self._fields[key] = fld
         return fld
 
-    def approach(self, need: float, entry_after_m: float, rng: np.random.Generator) -> np.ndarray:
+    def approach(self, need: float, *, entry_after_m: float, rng: np.random.Generator) -> np.ndarray:
         """A path ``(K, 2)`` (metres) from an open-water cell into the basin goal, crossing into the basin about
         ``entry_after_m`` metres after its start, simplified to waypoints; raises :class:`PlannerError`."""
         fld = self.field(need)

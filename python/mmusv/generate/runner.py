@@ -292,7 +292,7 @@ def generate(
             name = f"{rep.name}_{rep.accepted:0{width}d}"
             total_attempts += 1
             try:
-                cand = sample_candidate(spec, i, attempt, ctx, name)
+                cand = sample_candidate(spec, combo_index=i, attempt=attempt, ctx=ctx, name=name)
             except SamplingError as exc:
                 rep.reject("sampling", str(exc))
             except ConfigError as exc:

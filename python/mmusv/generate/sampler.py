@@ -80,12 +80,12 @@ class Candidate:
     meta: CandidateMeta
 
 
-def attempt_rng(seed: int, combo_index: int, attempt: int) -> np.random.Generator:
+def attempt_rng(seed: int, *, combo_index: int, attempt: int) -> np.random.Generator:
     """The random generator of one attempt (see module docstring)."""
     return np.random.default_rng(np.random.SeedSequence([int(seed), int(combo_index), int(attempt)]))
 
 
-def scenario_seed(seed: int, combo_index: int, attempt: int) -> int:
+def scenario_seed(seed: int, *, combo_index: int, attempt: int) -> int:
     """The ``seed`` written into a scenario (wave phases etc.), in ``[0, 2**63)``, from the same triple."""
     hi, lo = np.random.SeedSequence([int(seed), int(combo_index), int(attempt), 1]).generate_state(2, np.uint32)
     return ((int(hi) << 32) | int(lo)) >> 1
@@ -141,13 +141,13 @@ def _vessel(t: Track, rig: str) -> dict[str, Any]:
     return out
 
 
-def sample_candidate(spec: GenerationSpec, combo_index: int, attempt: int, ctx: MapContext, name: str) -> Candidate:
+def sample_candidate(spec: GenerationSpec, *, combo_index: int, attempt: int, ctx: MapContext, name: str) -> Candidate:
     """Draws candidate ``attempt`` of combination ``combo_index``, named ``name``; raises :class:`SamplingError`
     when the template cannot place the vessels."""
     combo: Combination = spec.combinations[combo_index]
     fam = FAMILIES[combo.family]
     diff = spec.difficulties[combo.difficulty]
-    rng = attempt_rng(spec.seed, combo_index, attempt)
+    rng = attempt_rng(spec.seed, combo_index=combo_index, attempt=attempt)
     acq = spec.acquisition
     duration = max((acq.frames - 1) / acq.frequency_hz, 1.0 / acq.frequency_hz)
     cons = spec.constraints
@@ -203,7 +203,9 @@ def sample_candidate(spec: GenerationSpec, combo_index: int, attempt: int, ctx: 
             at = layout.centre + dist * np.array([math.cos(bearing), math.sin(bearing)])
             psi = float(rng.uniform(0.0, 2.0 * math.pi))
             vel = role.speed * np.array([math.cos(psi), math.sin(psi)])
-            return [straight_track(role, at, vel, float(rng.uniform(0.0, duration)), duration, rng)]
+            return [
+                straight_track(role, at=at, vel=vel, t_at=float(rng.uniform(0.0, duration)), duration=duration, rng=rng)
+            ]
 
         distractors += pick_best(inp, make)
     tracks = layout.tracks + distractors
@@ -212,7 +214,7 @@ def sample_candidate(spec: GenerationSpec, combo_index: int, attempt: int, ctx: 
     tracks.sort(key=lambda t: (order[t.role.role], 0 if t.role.id == "usv_ego" else 1))
     data: dict[str, Any] = {
         "name": name,
-        "seed": scenario_seed(spec.seed, combo_index, attempt),
+        "seed": scenario_seed(spec.seed, combo_index=combo_index, attempt=attempt),
         "map": {"type": map_cfg.type, "seed": map_cfg.seed, "params": map_cfg.param_values()},
         "environment": env,
         "acquisition": {"frequency_hz": acq.frequency_hz, "frames": acq.frames},

@@ -131,7 +131,7 @@ FEWER_TIMES = "lower acquisition.frames or raise acquisition.frequency_hz (a sho
 lower rate never helps: over the same frames the acquisition lasts longer and the vessels sail further."""
 
 
-def time_samples(frames: int, frequency_hz: float, step: float, max_speed_mps: float) -> int:
+def time_samples(frames: int, *, frequency_hz: float, step: float, max_speed_mps: float) -> int:
     """Motion samples per vessel over ``frames`` frames at ``frequency_hz``: at least one a frame, and one each
     ``step`` metres at ``max_speed_mps`` (saturated like every count here)."""
     t_last = (frames - 1) / frequency_hz
@@ -144,7 +144,9 @@ def _counts(scenario: Scenario, lengths: np.ndarray, step: float) -> tuple[int, 
     large for any budget (or from non-finite inputs) saturate instead of overflowing."""
     acq = scenario.acquisition
     fastest = max(v.speed_mps for v in scenario.vessels)
-    return time_samples(acq.frames, acq.frequency_hz, step, fastest), _ceil_count(float(lengths.max()) / step)
+    return time_samples(acq.frames, frequency_hz=acq.frequency_hz, step=step, max_speed_mps=fastest), _ceil_count(
+        float(lengths.max()) / step
+    )
 
 
 def _fmt(n: int) -> str:

@@ -502,7 +502,7 @@ def _check_budget(spec: GenerationSpec, fail: Callable[[str, object, str], None]
 
     acq = spec.acquisition
     speeds = [spec.usv.speed_mps[1], *(c.speed_mps[1] for c in spec.size_classes.values())]
-    n_t = time_samples(acq.frames, acq.frequency_hz, spec.check_step_m, max(speeds))
+    n_t = time_samples(acq.frames, frequency_hz=acq.frequency_hz, step=spec.check_step_m, max_speed_mps=max(speeds))
     for i, combo in enumerate(spec.combinations):
         diff = spec.difficulties.get(combo.difficulty)
         n_v = 1 + combo.cooperating + len(combo.targets) + (diff.extra_targets[1] if diff is not None else 0)

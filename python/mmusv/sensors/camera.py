@@ -117,7 +117,7 @@ def render(
         made_by="camera_from_config(CameraConfig(...)), top_view_from_config(TopViewConfig(...)), or "
         "Simulation.agent(id).cameras[name][0]",
     )
-    seed = check_sensor_args(scene, env, seed)
+    seed = check_sensor_args(scene, env=env, seed=seed)
     radiance = arguments.flag(radiance, name="radiance", error=InputError)
     p = _pose(pose, name="pose")
     w = wake_rows(wakes)

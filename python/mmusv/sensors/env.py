@@ -92,7 +92,7 @@ def check_env(env: Any) -> core.SensorEnv:
     return env
 
 
-def check_sensor_args(scene: Any, env: Any, seed: Any) -> int:
+def check_sensor_args(scene: Any, *, env: Any, seed: Any) -> int:
     """Checks the arguments every sensor call (:func:`~mmusv.sensors.lidar.scan`,
     :func:`~mmusv.sensors.camera.render`, :func:`~mmusv.sensors.radar.radar_sweep`) shares, in this order:
     ``scene`` an :class:`mmusv.Scene`, ``env`` the sensors' environment (:func:`check_env`) and ``seed`` a whole

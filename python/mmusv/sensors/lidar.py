@@ -108,7 +108,7 @@ def scan(
     check_sensor(
         lidar, core.Lidar, name="lidar", made_by="lidar_from_config(LidarConfig(...)), or Simulation.agent(id).lidar"
     )
-    seed = check_sensor_args(scene, env, seed)
+    seed = check_sensor_args(scene, env=env, seed=seed)
     p = _pose(pose, name="pose")
     w = wake_rows(wakes)
     return LidarPoints.from_native(lidar.scan(scene.native, pose=p, env=env, seed=seed, wakes=w))

@@ -50,7 +50,7 @@ MAX_INSIDE_RAYS = 1024
 """Most rays :func:`inside_mesh` casts (each re-cast up to 64 times)."""
 
 
-def inside_mesh(vertices: np.ndarray, faces: np.ndarray, point: np.ndarray, *, rays: int = 9) -> bool:
+def inside_mesh(vertices: np.ndarray, faces: np.ndarray, *, point: np.ndarray, rays: int = 9) -> bool:
     """Whether ``point`` lies inside the closed (union of) mesh(es) ``vertices``/``faces`` (same frame).
 
     Along each of ``rays`` directions every crossing is found by re-casting past the previous hit; the winding

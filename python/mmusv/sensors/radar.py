@@ -223,7 +223,7 @@ def radar_sweep(
     check_sensor(
         radar, core.Radar, name="radar", made_by="radar_from_config(RadarConfig(...)), or Simulation.agent(id).radar"
     )
-    seed = check_sensor_args(scene, env, seed)
+    seed = check_sensor_args(scene, env=env, seed=seed)
     p = _pose(pose, name="pose")
     return RadarReturns.from_native(radar.sweep(scene.native, pose=p, env=env, seed=seed), pose=p, radar=radar)
 

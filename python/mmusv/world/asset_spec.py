@@ -177,7 +177,7 @@ MOUNT_REACH: tuple[float, float] = (2.0, 50.0)
 """A mount may lie at most ``max(MOUNT_REACH[0] * length, MOUNT_REACH[1])`` metres outside the asset's bounding box."""
 
 
-def dimension_problem(length: float, beam: float, height: float) -> str | None:
+def dimension_problem(*, length: float, beam: float, height: float) -> str | None:
     """What is wrong with an asset of this bounding-box size (metres), or ``None`` when every dimension lies in
     :data:`DIMENSION_RANGES`; non-finite sizes are always wrong."""
     size = {"length": length, "beam": beam, "height": height}

@@ -89,7 +89,7 @@ def _gltf_checks(path: Path, data: dict[str, object], where: str) -> dict[Emissi
                     f"{str(target)!r}); keep a .gltf's .bin and texture files beside it",
                 )
             if kind == "images":
-                check_image(target, f"{shown}: its texture {uri!r} ({kind}[{i}].uri)", where)
+                check_image(target, what=f"{shown}: its texture {uri!r} ({kind}[{i}].uri)", where=where)
     strengths: dict[EmissiveKey, float] = {}
     materials = data.get("materials")
     for i, m in enumerate(materials if isinstance(materials, list) else []):

@@ -136,7 +136,7 @@ def _section(hull: HullSpec, u: np.ndarray, z_frac: np.ndarray, below: bool) -> 
     return flare + (1.0 - flare) * z_frac ** (0.8 + 0.6 * tb)
 
 
-def side_half_width(hull: HullSpec, x: np.ndarray, z: np.ndarray) -> np.ndarray:
+def side_half_width(hull: HullSpec, *, x: np.ndarray, z: np.ndarray) -> np.ndarray:
     """Half-width ``(N,)`` metres of the hull's side at body ``x`` and height ``z`` ``(N,)`` (one demihull's outer
     side for twins); an approximation near the raked ends."""
     x = np.asarray(x, dtype=np.float64)

@@ -377,7 +377,7 @@ def generate_port(*, seed: int, params: PortParams | None = None) -> MapWorld:
     half = p.extent_m / 2.0
     coast_noise = fbm(rng=rng, x=cx, y=np.zeros_like(cx), half_extent_m=half, cell_m=220.0, octaves=3)
     hill_noise = fbm(rng=rng, x=cx, y=cy, half_extent_m=half, cell_m=260.0, octaves=4)
-    z = port_terrain(plan, cx, cy, coast_noise=coast_noise, hill_noise=hill_noise, hill_m=p.hill_height_m)
+    z = port_terrain(plan, x=cx, y=cy, coast_noise=coast_noise, hill_noise=hill_noise, hill_m=p.hill_height_m)
     hf = Heightfield(x0=float(xs[0]), y0=float(xs[0]), spacing=spacing, z=z)
     classify = _vegetation(rng, p.extent_m, p.vegetation, plan.land_h + 2.5)
 

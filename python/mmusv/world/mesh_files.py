@@ -301,7 +301,7 @@ def mesh_asset(spec: MeshAssetSpec, *, path: str, base_dir: Path | None, cls: in
     # Python floats: an overflowing product is inf (no numpy warning), which the range check then refuses.
     lo3, hi3 = body.min(axis=0), body.max(axis=0)
     ext = [float(hi) * spec.scale - float(lo) * spec.scale for lo, hi in zip(lo3, hi3, strict=True)]
-    problem = dimension_problem(*ext)
+    problem = dimension_problem(length=ext[0], beam=ext[1], height=ext[2])
     if problem is not None:
         raise AssetSpecError(
             join(path, "scale"),

@@ -107,7 +107,7 @@ def one_line(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {text}" if isinstance(exc, LookupError) or not text else text
 
 
-def check_image(target: Path, what: str, where: str) -> None:
+def check_image(target: Path, *, what: str, where: str) -> None:
     """Refuses a texture file that is not an image Pillow reads (trimesh would leave the texture out silently).
     Any exception counts: other libraries replace ``PIL.Image.open`` (Ultralytics, once imported, answers a file
     Pillow cannot identify with its HEIF plugin's ``ModuleNotFoundError``)."""
@@ -365,7 +365,7 @@ def _read_mtl(obj: Path, entry: str, mtl: Path, where: str) -> list[_MtlEntry]:
                     f"{what} needs the texture {name!r}, which is missing (looked for {str(target)!r}{also}); keep "
                     "texture files where the .mtl names them",
                 )
-            check_image(target, what, where)
+            check_image(target, what=what, where=where)
             entries[-1].maps[key] = (name, target)
     return entries
 

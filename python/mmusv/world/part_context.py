@@ -45,7 +45,7 @@ class Ctx:
         """``base``, or the deck height at ``x`` when it is not given (metres)."""
         return deck_z(self.hull, x) if base is None else base
 
-    def zspan(self, base: float | None, top: float | None, height: float | None, x: float) -> tuple[float, float]:
+    def zspan(self, *, base: float | None, top: float | None, height: float | None, x: float) -> tuple[float, float]:
         """The vertical extent ``(z0, z1)`` of a part standing on ``base`` up to ``top`` or ``base + height``."""
         z0 = self.base(base, x)
         z1 = top if top is not None else z0 + (height or 0.0)
@@ -62,7 +62,7 @@ class Ctx:
             raise AssetSpecError(f"{self.where}.fit", f"no room inside the deck outline between x={x0:g} and x={x1:g}")
         return min(width, 2.0 * room)
 
-    def count(self, n: float, key: str, what: str) -> int:
+    def count(self, n: float, *, key: str, what: str) -> int:
         """``n`` as the number of pieces a part makes, checked against :data:`MAX_PIECES` (an error at ``key``)."""
         if not n <= MAX_PIECES:  # also catches nan
             raise self.error(key, f"would make {n:.3g} {what}; at most {MAX_PIECES} per part")

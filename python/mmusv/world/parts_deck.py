@@ -81,7 +81,7 @@ def _rail_meshes(
 
 def _spaced(p0: np.ndarray, p1: np.ndarray, spacing: float, ctx: Ctx) -> np.ndarray:
     """Points from ``p0`` to ``p1`` (both included) about ``spacing`` apart."""
-    n = max(1, ctx.count(math.ceil(float(np.linalg.norm(p1 - p0)) / spacing), "spacing", "stanchions"))
+    n = max(1, ctx.count(math.ceil(float(np.linalg.norm(p1 - p0)) / spacing), key="spacing", what="stanchions"))
     t = np.linspace(0.0, 1.0, n + 1)[:, None]
     return np.asarray(p0 + t * (p1 - p0), dtype=np.float64)
 
@@ -109,7 +109,7 @@ def _railing(p: RailingPart, ctx: Ctx) -> TriMesh:
     half_l = hull.length / 2.0
     x0 = -half_l + max(p.inset, r) + 0.05 if p.x0 is None else p.x0
     x1 = half_l - 0.05 if p.x1 is None else p.x1
-    n = max(2, ctx.count(math.ceil((x1 - x0) / p.spacing) + 1, "spacing", "stanchions"))
+    n = max(2, ctx.count(math.ceil((x1 - x0) / p.spacing) + 1, key="spacing", what="stanchions"))
     xs = np.linspace(x0, x1, n)
     ys = _half_widths(ctx, xs) - max(p.inset, r)
     ok = ys > max(2.0 * r, 0.02)
@@ -150,7 +150,7 @@ def containers_mesh(p: ContainersPart, ctx: Ctx) -> TriMesh:
         raise ctx.error("bays", f"{p.bays} bays with gap {p.gap:g} leave {lb:.2f} m per bay")
     n_long = max(
         1,
-        ctx.count(round(lb / 12.5) * p.bays * p.rows * max(p.tiers), "x1", "containers")
+        ctx.count(round(lb / 12.5) * p.bays * p.rows * max(p.tiers), key="x1", what="containers")
         // (p.bays * p.rows * max(p.tiers)),
     )
     cl = (lb - 0.25 * (n_long - 1)) / n_long
@@ -200,7 +200,7 @@ def containers_mesh(p: ContainersPart, ctx: Ctx) -> TriMesh:
 
 def hatches_mesh(p: HatchesPart, ctx: Ctx) -> TriMesh:
     """Hatch covers on coamings, each with transverse stiffener ribs; top at ``base + height``."""
-    ctx.count(p.count * (p.ribs + 2), "count", "hatch pieces")
+    ctx.count(p.count * (p.ribs + 2), key="count", what="hatch pieces")
     lx = (p.x1 - p.x0 - p.gap * (p.count - 1)) / p.count
     if lx <= 0.5:
         raise ctx.error("count", f"{p.count} hatches do not fit between x0 and x1")
@@ -320,7 +320,7 @@ def fenders_mesh(p: FendersPart, ctx: Ctx) -> TriMesh:
     hull = ctx.hull
     xs = np.linspace(p.x0, p.x1, p.count)
     zs = np.full(p.count, p.z)
-    hw = side_half_width(hull, xs, zs)
+    hw = side_half_width(hull, x=xs, z=zs)
     if p.kind == "tyre":
         minor = 0.32 * p.radius
         tyre = torus(major=p.radius - minor, minor=minor, cls=ctx.cls, material=ctx.mat, segments=(16, 8))
@@ -377,7 +377,7 @@ def pipes_mesh(p: PipesPart, ctx: Ctx) -> TriMesh:
     starts = np.column_stack([np.full_like(ys, p.x0), ys, np.full_like(ys, p.z)])
     ends = starts + np.array([p.x1 - p.x0, 0.0, 0.0])
     pipes = tubes(starts=starts, ends=ends, radius=p.radius, cls=ctx.cls, material=ctx.mat, segments=12)
-    n = max(2, ctx.count((p.x1 - p.x0) // p.support + 1, "support", "pipe supports"))
+    n = max(2, ctx.count((p.x1 - p.x0) // p.support + 1, key="support", what="pipe supports"))
     sx = np.linspace(p.x0 + 0.3, p.x1 - 0.3, n)
     z0 = _deck_z(ctx.hull, sx) if p.base is None else np.full(n, p.base)
     top = p.z - p.radius

@@ -151,7 +151,7 @@ def box_mesh(p: BoxPart, ctx: Ctx) -> TriMesh:
     """A box (frustum with ``taper``), with a window band when ``windows`` is given."""
     x, y = p.x, p.y
     lx, ly = p.size
-    z0, z1 = ctx.zspan(p.base, p.top, p.height, x)
+    z0, z1 = ctx.zspan(base=p.base, top=p.top, height=p.height, x=x)
     ly = ctx.fit_width(p.fit, x0=x - lx / 2, x1=x + lx / 2, y=y, width=ly)
     body = block(
         x=x, y=y, lx=lx, ly=ly, z0=z0, z1=z1, cls=ctx.cls, material=ctx.mat, taper=p.taper, yaw=math.radians(p.yaw_deg)
@@ -160,7 +160,7 @@ def box_mesh(p: BoxPart, ctx: Ctx) -> TriMesh:
         return body
     if p.yaw_deg != 0.0:
         raise ctx.error("windows", "windows need an unturned box (yaw_deg 0)")
-    ctx.count(2.0 * (lx + ly) / p.windows[2], "windows", "windows")
+    ctx.count(2.0 * (lx + ly) / p.windows[2], key="windows", what="windows")
     win = _block_windows(
         x=x,
         y=y,
@@ -191,7 +191,7 @@ def house_mesh(p: HousePart, ctx: Ctx) -> TriMesh:
         ly = ctx.fit_width(p.fit, x0=xc - lx / 2, x1=xc + lx / 2, y=y, width=ly)
         parts.append(block(x=xc, y=y, lx=lx, ly=ly, z0=z, z1=z + h, cls=ctx.cls, material=ctx.mat, taper=p.taper))
         if p.windows is not None:
-            ctx.count(4.0 * (lx + ly) / p.windows[2], "windows", "windows")
+            ctx.count(4.0 * (lx + ly) / p.windows[2], key="windows", what="windows")
             parts.append(
                 _block_windows(
                     x=xc,
@@ -219,7 +219,7 @@ def house_mesh(p: HousePart, ctx: Ctx) -> TriMesh:
 def windows_mesh(p: WindowsPart, ctx: Ctx) -> TriMesh:
     """Rows of windows on a wall, the deck outline or the hull side (see :class:`WindowsPart`)."""
     hull = ctx.hull
-    n = ctx.count(((p.x1 - p.x0 - p.width) // p.pitch + 1) * p.rows, "pitch", "windows") // p.rows
+    n = ctx.count(((p.x1 - p.x0 - p.width) // p.pitch + 1) * p.rows, key="pitch", what="windows") // p.rows
     xs = p.x0 + p.width / 2.0 + np.arange(n) * p.pitch
     out: list[TriMesh] = []
     sides = {"both": (1.0, -1.0), "port": (1.0,), "starboard": (-1.0,)}[p.side]
@@ -231,8 +231,8 @@ def windows_mesh(p: WindowsPart, ctx: Ctx) -> TriMesh:
             ang = np.zeros_like(xs)
         else:
             if p.wall == "hull":
-                yy = side_half_width(hull, xs, zz) - p.inset
-                ahead = side_half_width(hull, xs + 0.1, zz) - p.inset
+                yy = side_half_width(hull, x=xs, z=zz) - p.inset
+                ahead = side_half_width(hull, x=xs + 0.1, z=zz) - p.inset
             else:
                 yy = half_widths(hull, xs) - p.inset
                 ahead = half_widths(hull, xs + 0.1) - p.inset
@@ -262,7 +262,7 @@ def funnel_mesh(p: FunnelPart, ctx: Ctx) -> TriMesh:
     """A funnel casing (elliptic or square, tapering) with a company ``band`` and a black top, and exhaust pipes."""
     x, y = p.x, p.y
     lx, ly = p.size
-    z0, z1 = ctx.zspan(p.base, p.top, p.height, x)
+    z0, z1 = ctx.zspan(base=p.base, top=p.top, height=p.height, x=x)
     h = z1 - z0
     pipe_out = min(0.08 * h, 1.0) if p.pipes else 0.0
     zt = z1 - pipe_out
@@ -296,7 +296,7 @@ def funnel_mesh(p: FunnelPart, ctx: Ctx) -> TriMesh:
 def mast_mesh(p: MastPart, ctx: Ctx) -> TriMesh:
     """A tapered tubular mast (inside the square of side ``width``) with a crosswise yard."""
     x, y, w = p.x, p.y, p.width
-    z0, z1 = ctx.zspan(p.base, p.top, p.height, x)
+    z0, z1 = ctx.zspan(base=p.base, top=p.top, height=p.height, x=x)
     out = [
         transformed(
             lathe([(w / 2.0, z0), (0.7 * w / 2.0, z1)], cls=ctx.cls, material=ctx.mat, segments=10),
@@ -401,14 +401,15 @@ def nav_lights_mesh(p: NavLightsPart, ctx: Ctx) -> TriMesh:
     screen = material_id("hull_black")
     out: list[TriMesh] = []
     masts = sorted(
-        (q for q in ctx.parts if isinstance(q, MastPart)), key=lambda q: -ctx.zspan(q.base, q.top, q.height, q.x)[1]
+        (q for q in ctx.parts if isinstance(q, MastPart)),
+        key=lambda q: -ctx.zspan(base=q.base, top=q.top, height=q.height, x=q.x)[1],
     )
     if p.masthead is not None:
         heads = [np.array(v, dtype=np.float64) for v in p.masthead]
     elif masts:
         heads = []
         for q in masts[: 2 if hull.length >= 50.0 else 1]:
-            z0, z1 = ctx.zspan(q.base, q.top, q.height, q.x)
+            z0, z1 = ctx.zspan(base=q.base, top=q.top, height=q.height, x=q.x)
             zl = z1 - 1.5 * s - max(0.0, 0.1 * (z1 - z0) if hull.length >= 50.0 else 0.0)
             heads.append(np.array([q.x + q.width / 2.0 + 0.6 * s, q.y, zl]))
             out.append(

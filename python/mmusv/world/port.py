@@ -126,7 +126,7 @@ def plan_port(p: PortParams, *, grid: float, rng: np.random.Generator) -> PortPl
 
 
 def port_terrain(
-    plan: PortPlan, x: np.ndarray, y: np.ndarray, *, coast_noise: np.ndarray, hill_noise: np.ndarray, hill_m: float
+    plan: PortPlan, *, x: np.ndarray, y: np.ndarray, coast_noise: np.ndarray, hill_noise: np.ndarray, hill_m: float
 ) -> np.ndarray:
     """Canonical-frame terrain heights (metres, shape of ``x``).
 

@@ -109,7 +109,7 @@ def _hull_block(p: HullBlockPart, ctx: Ctx) -> TriMesh:
         raise ctx.error("x0", f"must be within the hull, [{-half_l:g}, {half_l:g}] m; got {x0}")
     if x1 > half_l:
         raise ctx.error("x1", f"must be <= {half_l:g} m (the stem), got {x1}")
-    z0, z1 = ctx.zspan(p.base, p.top, p.height, (x0 + x1) / 2.0)
+    z0, z1 = ctx.zspan(base=p.base, top=p.top, height=p.height, x=(x0 + x1) / 2.0)
     u0, u1 = (x0 + half_l) / hull.length, (x1 + half_l) / hull.length
     st = stations(hull)
     u = np.unique(np.concatenate([[u0, u1], st[(st > u0 + 1e-9) & (st < u1 - 1e-9)]]))
@@ -138,7 +138,7 @@ def _row(p: RowPart, ctx: Ctx) -> TriMesh:
 
 def _cylinder(p: CylinderPart, ctx: Ctx) -> TriMesh:
     r, rt = p.radius, p.top_radius
-    z0, z1 = ctx.zspan(p.base, p.top, p.height, p.x)
+    z0, z1 = ctx.zspan(base=p.base, top=p.top, height=p.height, x=p.x)
     m = lathe([(r, z0), (r if rt is None else rt, z1)], cls=ctx.cls, material=ctx.mat, segments=p.segments)
     return transformed(m, translation=(p.x, p.y, 0.0))
 
@@ -165,7 +165,7 @@ def _plate(p: PlatePart, ctx: Ctx) -> TriMesh:
 
 def _gantry(p: GantryPart, ctx: Ctx) -> TriMesh:
     x, span, leg, lean = p.x, p.span, p.leg, p.lean
-    z0, z1 = ctx.zspan(p.base, p.top, p.height, x)
+    z0, z1 = ctx.zspan(base=p.base, top=p.top, height=p.height, x=x)
     cls, mat = ctx.cls, ctx.mat
     parts = []
     for side in (-1.0, 1.0):

@@ -197,7 +197,7 @@ class VesselAsset:
             raise AssetSpecError(
                 f"{self.name}.mesh", f"mesh spans z [{lo[2]:g}, {hi[2]:g}] m; it must cross the waterline z = 0"
             )
-        problem = dimension_problem(float(ext[0]), float(ext[1]), float(ext[2]))
+        problem = dimension_problem(length=float(ext[0]), beam=float(ext[1]), height=float(ext[2]))
         if problem is not None:
             raise AssetSpecError(f"{self.name}.mesh", f"the mesh's bounding box {problem}")
         bbox = np.stack([lo, hi])
