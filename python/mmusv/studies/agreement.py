@@ -210,11 +210,14 @@ def run_agreement_study(
     and evaluates every other vessel (see the module docstring); every ``stride``-th frame. ``frames`` and
     ``stride`` below 1 raise :class:`~mmusv.errors.ConfigError` (before any scenario is loaded): they evaluated
     nothing and wrote an empty table; every scenario is loaded and checked (:func:`load_scenarios`) before the
-    first is run."""
+    first is run. The scenarios run, and their samples come, in name order, whatever the order given: the same
+    scenarios give the same bytes."""
     check_polars("mmusv study agreement")
     check_counts(frames, stride)
     rows: list[dict[str, object]] = []
-    for sc in load_scenarios(scenarios):
+    # In name order (the names are unique, load_scenarios checks): the samples were in the order the scenarios were
+    # given and the per-map means summed them so, so `A B` and `B A` wrote other bytes (the means' last digits too).
+    for sc in sorted(load_scenarios(scenarios), key=lambda s: s.name):
         sim = Simulation(sc)
         n = sc.acquisition.frames if frames is None else min(frames, sc.acquisition.frames)
         for k in range(0, n, stride):
