@@ -91,9 +91,11 @@ def _common(p: argparse.ArgumentParser, default_out: str) -> None:
         "--threads",
         type=int,
         default=None,
-        help="with --model: torch's CPU threads for the learned models (default: torch's own, one per core). 1 "
-        "where other work shares the cores: torch's waiting threads spin, and two studies side by side with the "
-        "default had not finished Table III after 28 minutes, which one thread each did in 3",
+        help="with --model: torch's CPU threads for the learned models, in this process and in each --jobs process "
+        "(default 1: the same bytes with any --jobs and on any machine; the outputs of a network depend on its "
+        "thread count, the order of its float sums). More threads run faster where no other work shares the cores: "
+        "torch's waiting threads spin, and two studies side by side with torch's own default (one per core) had "
+        "not finished Table III after 28 minutes, which one thread each did in 3",
     )
     p.add_argument(
         "--late-merge",
@@ -116,7 +118,8 @@ def _common(p: argparse.ArgumentParser, default_out: str) -> None:
         type=int,
         default=1,
         help="processes, one sequence each (default 1); the tables and boxes are the same with any number "
-        "(mmusv.studies.detection.parallel). With --model each runs torch on --threads threads (default 1)",
+        "(mmusv.studies.detection.parallel). With --model each runs torch on --threads threads (default 1), as "
+        "--jobs 1 does",
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("-o", "--output", default=default_out, help=f"output folder (default {default_out})")
@@ -189,12 +192,14 @@ def run(args: argparse.Namespace) -> int:
     if args.model is None and (args.refine != "auto" or args.rescore != "auto"):
         flag = f"--refine {args.refine}" if args.refine != "auto" else f"--rescore {args.rescore}"
         raise InputError(f"{flag}: only with --model (the learned detector's second stage)")
-    if args.threads is not None:
-        if args.model is None:
-            raise InputError(f"--threads {args.threads}: only with --model (torch's threads of the learned models)")
+    if args.threads is not None and args.model is None:
+        raise InputError(f"--threads {args.threads}: only with --model (torch's threads of the learned models)")
+    if args.model is not None:
         import torch
 
-        torch.set_num_threads(args.threads)
+        # 1 when left out, as in every --jobs process: a network's outputs depend on torch's thread count (the order
+        # of its float sums), and torch's default (one per core) here gave other scores with --jobs 1 than --jobs N
+        torch.set_num_threads(args.threads or 1)
     default_modes = ",".join(learned.fusion_modes) if learned is not None else "none,late,early"
     modes = parse_modes(default_modes if args.modes is None else args.modes)  # "" was taken as the default
     if learned is not None:
