@@ -27,7 +27,7 @@ def test_wave_study_on_bundled_scenario(tmp_path: Path) -> None:
     # Magnitudes in the range of the paper's Table I for USV-sized vessels.
     assert 0.005 < t["heave_rms_m"][0] < 0.06 and 0.05 < t["roll_rms_deg"][0] < 0.5
     paths = study.write(tmp_path)
-    assert pl.read_csv(paths["csv"]).shape == (4, 7)
+    assert pl.read_csv(paths["csv"]).shape == (4, 8)  # the columns above and usv_size
     assert paths["png"].stat().st_size > 10_000
 
 
@@ -93,7 +93,10 @@ def test_reference_usvs_give_table_i_on_the_bundled_scenario(tmp_path: Path, cap
     assert main(["study", "waves", "--usvs", "reference", "--frames", "50", "-o", str(tmp_path / "a")]) == 0
     printed = capsys.readouterr().out  # type: ignore[attr-defined]
     assert "reference size" in printed and "0.0274 / 0.2054 / 0.0684" in printed  # Table I beside
-    assert pl.read_csv(tmp_path / "a" / "wave_study.csv").columns == own.table.columns
+    written = pl.read_csv(tmp_path / "a" / "wave_study.csv")
+    assert written.columns == own.table.columns
+    # the CSV says which USVs made it: the two tables differ by 23 % and were otherwise alike to read
+    assert set(written["usv_size"]) == {"reference"} and set(own.table["usv_size"]) == {"scenario"}
     assert main(["study", "waves", "--usvs", "reference", "--motion", "physical", "-o", str(tmp_path / "b")]) == 2
     assert "mmusv: error: --usvs reference with --motion physical" in capsys.readouterr().err  # type: ignore[attr-defined]
     assert not (tmp_path / "b").exists()

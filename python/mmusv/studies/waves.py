@@ -59,7 +59,8 @@ USV_SIZES = ("scenario", "reference")
 @dataclass(frozen=True)
 class WaveStudy:
     """Result: ``table`` (one row per wave setting: wave, H_m, heave_rms_m, roll_rms_deg, pitch_rms_deg, usvs,
-    frames) and ``r2`` (R² of a linear fit against H per statistic; NaN with fewer than 3 settings)."""
+    usv_size (``scenario``: the USVs at their assets' sizes; ``reference``: at the paper's reference size, 5 × 2.5 ×
+    1.5 m), frames) and ``r2`` (R² of a linear fit against H per statistic; NaN with fewer than 3 settings)."""
 
     table: pl.DataFrame
     r2: dict[str, float]
@@ -159,6 +160,7 @@ def run_wave_study(
                 "roll_rms_deg": roll,
                 "pitch_rms_deg": pitch,
                 "usvs": len(usv_idx),
+                "usv_size": usvs,
                 "frames": poses.shape[0],
             }
         )
@@ -296,6 +298,7 @@ def _plot(study: WaveStudy, path: Path | io.BytesIO) -> None:
         ax.set_ylabel(label)
         ax.set_title(f"R² = {study.r2[col]:.4f}", fontsize=9)
         ax.grid(alpha=0.3)
-    fig.suptitle("mmusv wave study: USV pose perturbation vs wave setting")
+    sized = " (USVs of the paper's reference size)" if t["usv_size"][0] == "reference" else ""
+    fig.suptitle(f"mmusv wave study: USV pose perturbation vs wave setting{sized}")
     fig.savefig(path, dpi=110, format="png")
     plt.close(fig)
