@@ -74,3 +74,37 @@ def test_classes_and_materials_broadcast_to_the_faces() -> None:
         TriMesh(v, faces, np.array([], dtype=np.uint16))
     with pytest.raises(ValueError, match=r"^materials has 3 entries for 2 faces$"):
         TriMesh(v, faces, np.array(1), np.array([1, 2, 3]))
+
+
+@pytest.mark.parametrize(
+    ("call", "expected"),
+    [
+        (
+            "scan",
+            "lidar = 'x': must be a native lidar (lidar_from_config(LidarConfig(...)), or Simulation.agent(id).lidar), "
+            "not str",
+        ),
+        (
+            "radar_sweep",
+            "radar = 'x': must be a native radar (radar_from_config(RadarConfig(...)), or Simulation.agent(id).radar), "
+            "not str",
+        ),
+        (
+            "render",
+            "camera = 'x': must be a native camera (camera_from_config(CameraConfig(...)), "
+            "top_view_from_config(TopViewConfig(...)), or Simulation.agent(id).cameras[name][0]), not str",
+        ),
+    ],
+)
+def test_each_sensor_call_names_its_own_sensor_and_makers(call: str, expected: str) -> None:
+    """The whole message of each sensor call given something that is not its native sensor: the argument's name and
+    the ways to make one are the call's own (a wrong ``name=`` or ``made_by=`` at a call site would show here)."""
+    from mmusv.scene import Scene
+    from mmusv.sensors.camera import render
+    from mmusv.sensors.lidar import scan
+    from mmusv.sensors.radar import radar_sweep
+
+    fn = {"scan": scan, "radar_sweep": radar_sweep, "render": render}[call]
+    with pytest.raises(InputError) as err:
+        fn("x", Scene(), pose=np.eye(4), env=None, seed=0)  # the sensor is checked first
+    assert str(err.value) == expected
