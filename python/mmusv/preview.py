@@ -197,7 +197,7 @@ def compose_preview(path: str | Path, *, frame: int = 0, agent: str | None = Non
     for kind in ("rgb", "depth", "semantic"):
         row = []
         for cam in sorted(a.cameras):
-            m = msgs.get(topics.camera(a_id, cam, kind))
+            m = msgs.get(topics.camera(a_id, cam, kind=kind))
             if m is None:
                 continue
             img = decode_image(m)

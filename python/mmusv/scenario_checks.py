@@ -100,7 +100,8 @@ def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[st
     from mmusv.generate.spec import GenerationSpec
 
     spec = GenerationSpec.model_validate({"combinations": [{"family": "crossing"}]})
-    problem = budget_problem(scenario, *sample_counts(scenario, spec))
+    n_motion, n_route = sample_counts(scenario, spec)
+    problem = budget_problem(scenario, n_motion=n_motion, n_route=n_route)
     if problem is not None:
         raise ConfigError(
             f"{source}: {problem} (they cover every frame that is run): skip them with --no-checks "

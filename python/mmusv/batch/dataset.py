@@ -221,7 +221,7 @@ def build_dataset(
         _remove_stale(rec_dir, own, {p.stem for p in scen_dir.glob("*.yaml")})
         if not any(scen_dir.glob("*.yaml")):  # no candidate met the spec: nothing to record (the shortfall says so)
             nothing = {"folder": opv2v.name, "status": "nothing to convert", "frames": 0, "sources": {}}
-            write_index(index_path, [], {"spec": spec_section, "opv2v": nothing})
+            write_index(index_path, [], extra={"spec": spec_section, "opv2v": nothing})
             empty = BatchReport(out_dir=rec_dir, backend="serial", outcomes=[], index=index_path)
             return DatasetReport(
                 out_dir=out, generated=generated, shortfall=shortfall, batch=empty, converted=0, opv2v=opv2v
@@ -277,7 +277,7 @@ def build_dataset(
         from mmusv.batch.index import Entry
 
         entries = [Entry(**{k: r[k] for k in Entry.__dataclass_fields__}) for r in doc["recordings"]]
-        write_index(index_path, entries, {"spec": spec_section, "opv2v": section})
+        write_index(index_path, entries, extra={"spec": spec_section, "opv2v": section})
         return DatasetReport(
             out_dir=out, generated=generated, shortfall=shortfall, batch=batch, converted=converted, opv2v=opv2v
         )

@@ -100,7 +100,9 @@ def folder_bytes(folder: Path) -> int:
     return total
 
 
-def write_index(path: str | os.PathLike[str], entries: Iterable[Entry], extra: Mapping[str, Any] | None = None) -> Path:
+def write_index(
+    path: str | os.PathLike[str], entries: Iterable[Entry], *, extra: Mapping[str, Any] | None = None
+) -> Path:
     """Writes the index (entries sorted by name, totals, then the ``extra`` sections) atomically to ``path``."""
     from mmusv.jsonio import write_json
 

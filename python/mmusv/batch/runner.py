@@ -330,7 +330,7 @@ def _run(
 
     def write() -> None:  # a full disk must not stop the batch: the index is written again after the next task
         try:
-            write_index(index_path, entries.values(), index_extra)
+            write_index(index_path, entries.values(), extra=index_extra)
             index_error.clear()
         except IoError as exc:
             index_error[:] = [str(exc)]

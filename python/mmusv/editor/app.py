@@ -321,7 +321,7 @@ def create_app(
                 )
             ) from None
         with evaluate_lock:
-            text = map_layers(cfg.type, cfg.seed, cfg.param_values())
+            text = map_layers(cfg.type, seed=cfg.seed, params=cfg.param_values())
         return Response(text, media_type="application/json")
 
     @app.post("/api/evaluate")
@@ -347,7 +347,7 @@ def create_app(
 
         scenario = _valid(body.document)
         with evaluate_lock:
-            world = map_context(scenario.map.type, scenario.map.seed, scenario.map.param_values()).world
+            world = map_context(scenario.map.type, seed=scenario.map.seed, params=scenario.map.param_values()).world
         with preview_lock:
             png = preview_png(scenario, frame=body.frame, agent=body.agent, world=world)
         return Response(png, media_type="image/png")

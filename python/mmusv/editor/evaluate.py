@@ -156,12 +156,12 @@ def evaluate(document: dict[str, Any]) -> dict[str, Any]:
     out["map"] = {"type": scenario.map.type, "seed": scenario.map.seed, "params": scenario.map.param_values()}
     spec = map_check_spec(scenario)
     n_motion, n_route = sample_counts(scenario, spec)
-    problem = budget_problem(scenario, n_motion, n_route)  # the bounds `mmusv run` checks
+    problem = budget_problem(scenario, n_motion=n_motion, n_route=n_route)  # the bounds `mmusv run` checks
     if problem is not None:
         out["valid"] = False
         out["errors"] = [_error(*_budget_error(problem, n_motion, n_route, len(scenario.vessels)), document)]
         return out
-    ctx = map_context(scenario.map.type, scenario.map.seed, scenario.map.param_values())
+    ctx = map_context(scenario.map.type, seed=scenario.map.seed, params=scenario.map.param_values())
     samples, findings = map_findings(scenario, ctx, spec)
     index = {v.id: i for i, v in enumerate(scenario.vessels)}
     for mf in findings:

@@ -115,10 +115,10 @@ def _layers(ctx: MapContext) -> dict[str, Any]:
 
 @lru_cache(maxsize=8)
 def _cached(kind: str, seed: int, params_json: str) -> str:
-    return json.dumps(_layers(map_context(kind, seed, json.loads(params_json))), separators=(",", ":"))
+    return json.dumps(_layers(map_context(kind, seed=seed, params=json.loads(params_json))), separators=(",", ":"))
 
 
-def map_layers(kind: str, seed: int, params: dict[str, Any]) -> str:
+def map_layers(kind: str, *, seed: int, params: dict[str, Any]) -> str:
     """The layers of the map ``kind``/``seed``/``params`` (the given map parameters) as a JSON text (see the module
     docstring), cached."""
     return _cached(kind, int(seed), json.dumps(params, sort_keys=True))

@@ -98,7 +98,7 @@ class Sample:
 
     def message(self, kind: str) -> Any:
         """The camera's ``kind`` image message (``rgb``, ``depth``, ``semantic``, ``instance``)."""
-        return self.frame.messages[topics.camera(self.agent.id, self.camera.name, kind)]
+        return self.frame.messages[topics.camera(self.agent.id, self.camera.name, kind=kind)]
 
     @cached_property
     def instance(self) -> np.ndarray:
@@ -188,7 +188,7 @@ class CameraWriter(DatasetWriter):
     def required_topics(self) -> list[str]:
         out = [topics.WORLD_STATE]
         for a in self.agents:
-            out += [topics.camera(a.id, n, k) for n in self.cams[a.id] for k in self.kinds]
+            out += [topics.camera(a.id, n, kind=k) for n in self.cams[a.id] for k in self.kinds]
             if self.boxes:
                 out.append(topics.agent_annotations(a.id))
         return out
@@ -338,7 +338,7 @@ class ContrastBoxes(CameraWriter):
     left_out_why: ClassVar[str] = " (--min-contrast measures each vessel on its pixels in the instance images)"
 
 
-def box_writer(options: Options, projected: type[_W], visible: type[_W], contrast: type[_W]) -> type[_W]:
+def box_writer(options: Options, *, projected: type[_W], visible: type[_W], contrast: type[_W]) -> type[_W]:
     """The writer of a box format that needs only RGB images for ``box="projected"``: ``visible`` for
     ``box="visible"``, ``contrast`` for ``box="projected"`` with ``min_contrast``, else ``projected``."""
     if options.box == "visible":

@@ -263,7 +263,7 @@ def convert(
     folders = _folders(infos)
     split_of: dict[str, str | None] = dict.fromkeys(folders)
     if ratios is not None:
-        split_of = dict(assign_splits(folders, ratios, seed))
+        split_of = dict(assign_splits(folders, ratios=ratios, seed=seed))
     work, lock = prepare_out(out, overwrite, [Path(i.path) for i in infos])
     try:
         reports = [

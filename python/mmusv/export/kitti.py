@@ -95,7 +95,7 @@ OBJECT_CALIB_KEYS = ("R0_rect:", "Tr_velo_to_cam:", "Tr_imu_to_velo:")
 files (``calib/<ts>.txt``), with their colons; the tracking benchmark spells them otherwise."""
 
 
-def calib_text(k: np.ndarray, velo_to_cam: np.ndarray, lidar_mount: np.ndarray, keys: tuple[str, ...]) -> bytes:
+def calib_text(k: np.ndarray, *, velo_to_cam: np.ndarray, lidar_mount: np.ndarray, keys: tuple[str, ...]) -> bytes:
     """A KITTI calibration file: ``P0..P3`` = ``k`` (3×4), then the rectification (the identity), LiDAR → camera 0
     (``velo_to_cam``, 4×4) and vessel body → LiDAR (the inverse of ``lidar_mount``), named by ``keys``
     (:data:`OBJECT_CALIB_KEYS` or the tracking benchmark's)."""
@@ -127,7 +127,7 @@ def label_lines(
     ann = messages.get(topics.agent_annotations(a.id))
     if ann is not None and "front" in a.cameras:
         boxes = {b.target_id: b for b in ann.boxes_camera if b.camera == "front"}
-    return [kitti_label(t, velo_to_cam, boxes.get(t.id), kind, levels=levels) for t in targets]
+    return [kitti_label(t, velo_to_cam, box2d=boxes.get(t.id), kind=kind, levels=levels) for t in targets]
 
 
 def truncation_level(fraction: float | None) -> int:
@@ -141,7 +141,7 @@ def truncation_level(fraction: float | None) -> int:
 
 
 def kitti_label(
-    target: Target, velo_to_cam: np.ndarray, box2d: Any | None, kind: str | None = None, *, levels: bool = False
+    target: Target, velo_to_cam: np.ndarray, *, box2d: Any | None, kind: str | None = None, levels: bool = False
 ) -> str:
     """One ``label_2`` line of ``target`` (box in the LiDAR frame) for the camera ``velo_to_cam`` (4×4); ``kind``:
     the type written (``None``: the target's class name, capitalised); ``levels``: truncation written as the
@@ -204,7 +204,7 @@ class KittiWriter(DatasetWriter):
     def _dir(self, agent: AgentInfo, sub: str) -> Path:
         return self.sink.mkdir(self.folder / str(cav_id(agent.index)) / sub)
 
-    def frame_file(self, agent: AgentInfo, folder: str, index: int, ext: str) -> Path:
+    def frame_file(self, agent: AgentInfo, folder: str, *, index: int, ext: str) -> Path:
         """Where the file of ``agent`` at acquisition index ``index`` in ``folder`` (KITTI's object layout's name:
         ``velodyne``, ``image_2``, ``depth_2``, …, ``top_view_semantic``) goes, its folder created."""
         return self._dir(agent, folder) / f"{index:06d}{ext}"
@@ -218,25 +218,31 @@ class KittiWriter(DatasetWriter):
         cloud = decode_point_cloud(msgs[topics.lidar(a.id)])
         n = len(cloud["x"])
         pts = np.column_stack([cloud["x"], cloud["y"], cloud["z"], cloud.get("intensity", np.zeros(n))]).astype("<f4")
-        self.put(self.frame_file(a, "velodyne", frame.index, ".bin"), pts.tobytes())
+        self.put(self.frame_file(a, "velodyne", index=frame.index, ext=".bin"), pts.tobytes())
         if "front" in a.cameras:
             base = topics.camera(a.id, "front") + "/"
             if base + "rgb" in msgs:
-                self.put(self.frame_file(a, "image_2", frame.index, ".png"), png_bytes(msgs[base + "rgb"]))
+                self.put(self.frame_file(a, "image_2", index=frame.index, ext=".png"), png_bytes(msgs[base + "rgb"]))
             if "depth" in self.options.extras and base + "depth" in msgs:
-                self.put(self.frame_file(a, "depth_2", frame.index, ".png"), depth_png(msgs[base + "depth"]), "depth")
+                self.put(
+                    self.frame_file(a, "depth_2", index=frame.index, ext=".png"),
+                    depth_png(msgs[base + "depth"]),
+                    "depth",
+                )
             for kind in ("semantic", "instance"):
                 if kind in self.options.extras and base + kind in msgs:
-                    path = self.frame_file(a, f"{kind}_2", frame.index, ".png")
+                    path = self.frame_file(a, f"{kind}_2", index=frame.index, ext=".png")
                     self.put(path, png_bytes(msgs[base + kind]), kind)
         if "radar" in self.options.extras and topics.radar_ppi(a.id) in msgs:
-            path = self.frame_file(a, "radar_ppi", frame.index, ".png")
+            path = self.frame_file(a, "radar_ppi", index=frame.index, ext=".png")
             self.put(path, png_bytes(msgs[topics.radar_ppi(a.id)]), "radar")
         if "top_view" in self.options.extras:
             for kind in ("rgb", "semantic"):
                 m = msgs.get(topics.top_view(a.id, kind))
                 if m is not None:
-                    self.put(self.frame_file(a, f"top_view_{kind}", frame.index, ".png"), png_bytes(m), "top_view")
+                    self.put(
+                        self.frame_file(a, f"top_view_{kind}", index=frame.index, ext=".png"), png_bytes(m), "top_view"
+                    )
 
     def write_agent(self, frame: Frame, world: WorldFrame, view: AgentView, targets: list[Target]) -> None:
         a = view.agent
@@ -245,7 +251,10 @@ class KittiWriter(DatasetWriter):
         self.write_sensors(frame, view)
         self.put(self._dir(a, "pose") / f"{ts}.txt", (kitti_numbers(view.lidar[:3, :]) + "\n").encode())
         k, velo_to_cam = camera0(a, view)
-        self.put(self._dir(a, "calib") / f"{ts}.txt", calib_text(k, velo_to_cam, a.lidar_mount, OBJECT_CALIB_KEYS))
+        self.put(
+            self._dir(a, "calib") / f"{ts}.txt",
+            calib_text(k, velo_to_cam=velo_to_cam, lidar_mount=a.lidar_mount, keys=OBJECT_CALIB_KEYS),
+        )
         lines = label_lines(view, targets, frame.messages, velo_to_cam)
         self.put(self._dir(a, "label_2") / f"{ts}.txt", "".join(line + "\n" for line in lines).encode())
 

@@ -116,7 +116,7 @@ def _mercator_y(lat_deg: float) -> float:
     return float(np.log(np.tan((90.0 + lat_deg) * np.pi / 360.0)))
 
 
-def latlon(east: np.ndarray, north: np.ndarray, origin: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
+def latlon(*, east: np.ndarray, north: np.ndarray, origin: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
     """Latitudes and longitudes (degrees) of world points ``east``, ``north`` (metres, world origin at ``origin``)
     such that the devkit's Mercator projection with the scale of the first point's latitude gives them back:
     the scale is solved for by fixed-point iteration (it converges in a few steps: metres move it by ~1e-7)."""
@@ -178,7 +178,7 @@ def oxts_lines(times: Sequence[float], poses: Sequence[np.ndarray], origin: tupl
         raise ValueError(f"{len(t)} times for {len(p)} poses")
     if not len(t):
         return []
-    lat, lon = latlon(p[:, 0, 3], p[:, 1, 3], origin)
+    lat, lon = latlon(east=p[:, 0, 3], north=p[:, 1, 3], origin=origin)
     vel, acc, omega = _rates(t, p)
     up = np.array([0.0, 0.0, GRAVITY])
     lines = []

@@ -149,7 +149,7 @@ class KittiTrackingWriter(KittiWriter):
             self.world = frame.world
         super().write_frame(frame)
 
-    def frame_file(self, agent: AgentInfo, folder: str, index: int, ext: str) -> Path:
+    def frame_file(self, agent: AgentInfo, folder: str, *, index: int, ext: str) -> Path:
         seq = self.sequences[agent.id]
         sub = f"{FOLDERS.get(folder, folder)}/{seq.name}"
         seq.files[sub] = ext
@@ -164,7 +164,7 @@ class KittiTrackingWriter(KittiWriter):
             st: _Shared = self.shared
             k, velo_to_cam = camera0(a, view)
             folder = st.out / self.split_folder
-            calib = calib_text(k, velo_to_cam, a.lidar_mount, TRACKING_CALIB_KEYS)
+            calib = calib_text(k, velo_to_cam=velo_to_cam, lidar_mount=a.lidar_mount, keys=TRACKING_CALIB_KEYS)
             seq = _Sequence(st.count, folder, a, velo_to_cam, calib)
             st.count += 1
             self.sequences[a.id] = seq
@@ -223,7 +223,7 @@ class KittiTrackingWriter(KittiWriter):
                 [split, seq.name, self.folder.name, seq.agent.id, cav_id(seq.agent.index), len(order), freq]
             )
         if self.world is not None and self.sequences:
-            st.tracks += track_rows(self.split_folder, self.folder.name, self.world)
+            st.tracks += track_rows(self.split_folder, scenario=self.folder.name, world=self.world)
         if self.sequences:
             lat, lon = self.origin
             self.notes.append(f"oxts: the world origin is at latitude {lat!r}, longitude {lon!r} (--oxts-origin)")

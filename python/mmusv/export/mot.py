@@ -85,7 +85,7 @@ IMAGE_DIR = "img1"
 IMAGE_EXT = ".png"
 
 
-def sequence_name(scenario: str, agent: str, camera: str) -> str:
+def sequence_name(scenario: str, *, agent: str, camera: str) -> str:
     """``<scenario>.<agent>.<camera>``: agent ids and camera names hold no ``.`` (only letters, digits, ``_``, ``-``),
     so two (scenario, agent, camera) never share a name (``-`` would join ``a-b`` + ``c`` and ``a`` + ``b-c``)."""
     return f"{scenario}.{agent}.{camera}"
@@ -101,7 +101,7 @@ def track_id(world: WorldFrame, vessel_id: str) -> int:
     return world.ids.index(vessel_id) + 1
 
 
-def track_rows(split: str, scenario: str, world: WorldFrame) -> list[list[Any]]:
+def track_rows(split: str, *, scenario: str, world: WorldFrame) -> list[list[Any]]:
     """The ``tracks.csv`` rows (:data:`TRACKS_COLUMNS`) of every vessel of ``world``, a recording's world state."""
     w = world
     return [[split, scenario, i + 1, vid, w.roles[i], int(w.classes[i]), w.assets[i]] for i, vid in enumerate(w.ids)]
@@ -177,7 +177,7 @@ class MotWriter(ProjectedBoxes):
 
     @classmethod
     def for_options(cls, options: Options) -> type[MotWriter]:
-        return box_writer(options, MotWriter, MotVisibleWriter, MotContrastWriter)
+        return box_writer(options, projected=MotWriter, visible=MotVisibleWriter, contrast=MotContrastWriter)
 
     @classmethod
     def format_name(cls) -> str:
@@ -202,7 +202,7 @@ class MotWriter(ProjectedBoxes):
         key = (sample.agent.id, sample.camera.name)
         seq = self.sequences.get(key)
         if seq is None:
-            name = sequence_name(self.folder.name, *key)
+            name = sequence_name(self.folder.name, agent=sample.agent.id, camera=sample.camera.name)
             split = mot_split(sample.split)
             seq = _Sequence(name, self.root / split / name, sample.camera.width, sample.camera.height)
             self.sequences[key] = seq
@@ -250,7 +250,7 @@ class MotWriter(ProjectedBoxes):
             self.put(seq.folder / "seqinfo.ini", ini.encode())
             self.put(seq.folder / "frames.txt", "".join(f"{i}\n" for i in order).encode())
         if self.world is not None and self.sequences:
-            self.shared.tracks += track_rows(mot_split(self.split_name), self.folder.name, self.world)
+            self.shared.tracks += track_rows(mot_split(self.split_name), scenario=self.folder.name, world=self.world)
 
     @classmethod
     def finish_all(cls, shared: Any, out: Path, sink: Sink) -> None:

@@ -146,7 +146,7 @@ class Opv2vWriter(DatasetWriter):
                 "distortion": rounded(cam.distortion or (0.0, 0.0, 0.0, 0.0, 0.0), 9),
                 "extrinsic": _matrix_list(invert(carla_matrix(np.array(cords))) @ lidar_m),
             }
-            rgb = msgs.get(topics.camera(a.id, name, "rgb"))
+            rgb = msgs.get(topics.camera(a.id, name, kind="rgb"))
             if rgb is not None:
                 self.put(d / f"{ts}_camera{idx}.png", png_bytes(rgb))
             base = topics.camera(a.id, name) + "/"

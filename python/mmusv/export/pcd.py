@@ -40,7 +40,7 @@ def pcd_bytes(xyz: npt.ArrayLike, intensity: npt.ArrayLike, *, decimals: int = 4
     return buf.getvalue().encode("ascii")
 
 
-def write_pcd(path: Path, xyz: npt.ArrayLike, intensity: npt.ArrayLike) -> int:
+def write_pcd(path: Path, *, xyz: npt.ArrayLike, intensity: npt.ArrayLike) -> int:
     """Writes :func:`pcd_bytes` to ``path``; returns the number of bytes."""
     data = pcd_bytes(xyz, intensity)
     path.write_bytes(data)

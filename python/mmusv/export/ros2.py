@@ -151,7 +151,7 @@ class Ros2Writer(DatasetWriter):
             out += [topics.lidar(a.id), topics.radar_returns(a.id), topics.radar_ppi(a.id)]
             out += [topics.agent_annotations(a.id), topics.TF]
             for name in a.cameras:
-                out += [topics.camera(a.id, name, kind) for kind in topics.CAMERA_KINDS]
+                out += [topics.camera(a.id, name, kind=kind) for kind in topics.CAMERA_KINDS]
             out += [topics.top_view(a.id, kind) for kind in topics.CAMERA_KINDS]
         return out
 
@@ -209,15 +209,17 @@ class Ros2Writer(DatasetWriter):
         m = self.m
         out = []
         for a in self.agents:
-            out.append(m.transform(t, MAP_FRAME, odom_frame(a.id), np.eye(4)))
+            out.append(m.transform(t, parent=MAP_FRAME, child=odom_frame(a.id), m=np.eye(4)))
             base = base_link(a.id)
             if a.lidar_mount is not None:
-                out.append(m.transform(t, base, topics.lidar_frame(a.id), a.lidar_mount))
+                out.append(m.transform(t, parent=base, child=topics.lidar_frame(a.id), m=a.lidar_mount))
             if a.radar_mount is not None:
-                out.append(m.transform(t, base, topics.radar_frame(a.id), a.radar_mount))
+                out.append(m.transform(t, parent=base, child=topics.radar_frame(a.id), m=a.radar_mount))
             for name, cam in sorted(a.cameras.items()):
-                out.append(m.transform(t, base, camera_frame(a.id, name), cam.mount))
-                out.append(m.transform(t, camera_frame(a.id, name), optical_frame(a.id, name), OPTICAL_IN_BODY))
+                out.append(m.transform(t, parent=base, child=camera_frame(a.id, name), m=cam.mount))
+                out.append(
+                    m.transform(t, parent=camera_frame(a.id, name), child=optical_frame(a.id, name), m=OPTICAL_IN_BODY)
+                )
         return out
 
     def _dynamic(self, frame: Frame, world: WorldFrame) -> list[Any]:
@@ -226,7 +228,7 @@ class Ros2Writer(DatasetWriter):
         agents = {a.id for a in self.agents}
         mats = pose_matrices(world.poses)
         out = [
-            m.transform(t, odom_frame(vid) if vid in agents else MAP_FRAME, base_link(vid), mats[i])
+            m.transform(t, parent=odom_frame(vid) if vid in agents else MAP_FRAME, child=base_link(vid), m=mats[i])
             for i, vid in enumerate(world.ids)
         ]
         tf = frame.messages.get(topics.TF)
@@ -238,7 +240,7 @@ class Ros2Writer(DatasetWriter):
                     mat[:3, 3] = (x.translation.x, x.translation.y, x.translation.z)
                     q = (x.rotation.x, x.rotation.y, x.rotation.z, x.rotation.w)
                     mat[:3, :3] = Rotation.from_quat(q).as_matrix()
-                    out.append(m.transform(t, MAP_FRAME, top_view_frame(tops[x.child_frame_id]), mat))
+                    out.append(m.transform(t, parent=MAP_FRAME, child=top_view_frame(tops[x.child_frame_id]), m=mat))
         return out
 
     def _agent(self, frame: Frame, world: WorldFrame, a: AgentInfo) -> None:
@@ -265,7 +267,10 @@ class Ros2Writer(DatasetWriter):
             img = decode_image(ppi)
             enc = "rgb8" if img.ndim == 3 else "mono8"
             self._put(
-                topics.radar_ppi(a.id), "sensor_msgs/msg/Image", m.image(t, topics.radar_frame(a.id), img, enc), t
+                topics.radar_ppi(a.id),
+                "sensor_msgs/msg/Image",
+                m.image(t, topics.radar_frame(a.id), img=img, encoding=enc),
+                t,
             )
         for name in sorted(a.cameras):
             self._camera(frame, optical_frame(a.id, name), topics.camera(a.id, name))
@@ -301,20 +306,25 @@ class Ros2Writer(DatasetWriter):
                 self._put(
                     f"{base}/rgb/compressed",
                     "sensor_msgs/msg/CompressedImage",
-                    m.compressed(t, frame_id, bytes(rgb.data), "png"),
+                    m.compressed(t, frame_id, data=bytes(rgb.data), fmt="png"),
                     t,
                 )
             else:
-                self._put(f"{base}/rgb", "sensor_msgs/msg/Image", m.image(t, frame_id, decode_image(rgb), "rgb8"), t)
+                self._put(
+                    f"{base}/rgb",
+                    "sensor_msgs/msg/Image",
+                    m.image(t, frame_id, img=decode_image(rgb), encoding="rgb8"),
+                    t,
+                )
         depth = msgs.get(f"{base}/depth")
         if depth is not None:
             img = np.asarray(decode_image(depth), dtype=np.float32)
-            self._put(f"{base}/depth", "sensor_msgs/msg/Image", m.image(t, frame_id, img, "32FC1"), t)
+            self._put(f"{base}/depth", "sensor_msgs/msg/Image", m.image(t, frame_id, img=img, encoding="32FC1"), t)
         for kind in ("semantic", "instance"):
             msg = msgs.get(f"{base}/{kind}")
             if msg is not None:
                 img = np.asarray(decode_image(msg), dtype=np.uint16)
-                self._put(f"{base}/{kind}", "sensor_msgs/msg/Image", m.image(t, frame_id, img, "16UC1"), t)
+                self._put(f"{base}/{kind}", "sensor_msgs/msg/Image", m.image(t, frame_id, img=img, encoding="16UC1"), t)
 
     def _camera_info(self, t: int, a: AgentInfo, name: str) -> Any:
         """Pinhole intrinsics in ROS's (OpenCV's) pixel coordinates, where pixel centres are whole numbers: the

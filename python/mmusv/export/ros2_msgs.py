@@ -39,7 +39,7 @@ class Msgs:
             orientation=self.quaternion(Rotation.from_matrix(m[:3, :3]).as_quat()),
         )
 
-    def transform(self, t_ns: int, parent: str, child: str, m: np.ndarray) -> Any:
+    def transform(self, t_ns: int, *, parent: str, child: str, m: np.ndarray) -> Any:
         tr = self.T["geometry_msgs/msg/Transform"](
             translation=self.vector3(m[:3, 3]), rotation=self.quaternion(Rotation.from_matrix(m[:3, :3]).as_quat())
         )
@@ -86,7 +86,7 @@ class Msgs:
             is_dense=True,
         )
 
-    def image(self, t_ns: int, frame_id: str, img: np.ndarray, encoding: str) -> Any:
+    def image(self, t_ns: int, frame_id: str, *, img: np.ndarray, encoding: str) -> Any:
         """A ``sensor_msgs/Image`` of ``img`` (``(H, W)`` or ``(H, W, 3)``, little-endian, rows top to bottom)."""
         a = np.ascontiguousarray(img)
         a = a.astype(a.dtype.newbyteorder("<"), copy=False)
@@ -101,7 +101,7 @@ class Msgs:
             data=np.frombuffer(a.tobytes(), dtype=np.uint8),
         )
 
-    def compressed(self, t_ns: int, frame_id: str, data: bytes, fmt: str) -> Any:
+    def compressed(self, t_ns: int, frame_id: str, *, data: bytes, fmt: str) -> Any:
         return self.T["sensor_msgs/msg/CompressedImage"](
             header=self.header(t_ns, frame_id), format=fmt, data=np.frombuffer(data, dtype=np.uint8)
         )

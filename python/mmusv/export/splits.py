@@ -67,7 +67,7 @@ def split_counts(n: int, ratios: Sequence[float]) -> list[int]:
     return counts
 
 
-def assign_splits(keys: Sequence[str], ratios: Sequence[float], seed: int) -> dict[str, str]:
+def assign_splits(keys: Sequence[str], *, ratios: Sequence[float], seed: int) -> dict[str, str]:
     """Split name of every key (unique strings, e.g. recording paths): deterministic in (set of keys, ratios,
     seed), independent of the order of ``keys``."""
     if len(set(keys)) != len(keys):

@@ -121,7 +121,7 @@ class DatasetWriter:
             out.append(topics.lidar(a.id))
             for name, _ in self.agent_cameras(a):
                 if "rgb" in a.cameras[name].outputs:
-                    out.append(topics.camera(a.id, name, "rgb"))
+                    out.append(topics.camera(a.id, name, kind="rgb"))
         return out
 
     def optional_topics(self) -> list[str]:
@@ -130,7 +130,9 @@ class DatasetWriter:
         out: list[str] = []
         for a in self.agents:
             for name, _ in self.agent_cameras(a):
-                out += [topics.camera(a.id, name, kind) for kind in ("depth", "semantic", "instance") if kind in ex]
+                out += [
+                    topics.camera(a.id, name, kind=kind) for kind in ("depth", "semantic", "instance") if kind in ex
+                ]
             if "radar" in ex:
                 out.append(topics.radar_ppi(a.id))
             if "top_view" in ex:

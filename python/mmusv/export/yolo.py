@@ -75,7 +75,7 @@ class YoloWriter(ProjectedBoxes):
 
     @classmethod
     def for_options(cls, options: Options) -> type[YoloWriter]:
-        return box_writer(options, YoloWriter, YoloVisibleWriter, YoloContrastWriter)
+        return box_writer(options, projected=YoloWriter, visible=YoloVisibleWriter, contrast=YoloContrastWriter)
 
     @classmethod
     def format_name(cls) -> str:

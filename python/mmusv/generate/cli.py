@@ -86,13 +86,17 @@ def run(args: argparse.Namespace) -> int:
         spec = with_seed(spec, seed, name="--seed")
     out = Path(args.output) if args.output is not None else Path("scenarios/generated") / spec.name
     check_output_folder(str(out))  # before the map is built: a file there was named after it
-    check_output(out, args.force, spec_path)  # an earlier run's files, without --force: refused before the maps
+    check_output(
+        out, force=args.force, spec_path=spec_path
+    )  # an earlier run's files, without --force: refused before the maps
     total = sum(c.quota for c in spec.combinations)
     t0 = time.perf_counter()
     maps = {(m.type, m.seed): m for m in (spec.map_of(c) for c in spec.combinations)}
     for (kind, seed), m in sorted(maps.items()):
         with console.status(f"building map {kind} seed {seed}", spinner="dots"):
-            _ = map_context(m.type, m.seed, m.param_values()).scene  # built here, so the progress bar is generation
+            _ = map_context(
+                m.type, seed=m.seed, params=m.param_values()
+            ).scene  # built here, so the progress bar is generation
     t_map = time.perf_counter() - t0
     t0 = time.perf_counter()
     if args.no_progress:

@@ -214,6 +214,6 @@ def _cached(kind: str, seed: int, params_json: str) -> MapContext:
     return MapContext(generate_map(kind, seed=seed, **params))
 
 
-def map_context(kind: str, seed: int, params: dict[str, Any]) -> MapContext:
+def map_context(kind: str, *, seed: int, params: dict[str, Any]) -> MapContext:
     """The (cached) :class:`MapContext` of the map ``kind``/``seed``/``params``."""
     return _cached(kind, int(seed), json.dumps(params, sort_keys=True))

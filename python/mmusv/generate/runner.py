@@ -95,7 +95,7 @@ file appears; removed once ``report.json`` is in place. A run stopped before its
 disk) leaves it, so ``--force`` (and ``mmusv dataset`` run again) knows those files are a generate run's own."""
 
 
-def check_output(out: str | os.PathLike[str], force: bool, spec_path: str | os.PathLike[str] | None = None) -> None:
+def check_output(out: str | os.PathLike[str], *, force: bool, spec_path: str | os.PathLike[str] | None = None) -> None:
     """Raises the :class:`~mmusv.errors.IoError` that generating into ``out`` would end in (a file there, YAML
     files no generate run wrote, or, without ``force``, an earlier run's files), changing nothing: ``mmusv generate``
     calls it before building the maps, which took seconds before such a refusal."""
@@ -264,8 +264,10 @@ def generate(
     spec = load_spec(spec_source)
     out = Path(out_dir)
     spec_path = Path(spec_source) if isinstance(spec_source, (str, os.PathLike)) else None
-    check_output(out, force, spec_path)  # before the maps are built: a refusal took their seconds first
-    contexts = [map_context(m.type, m.seed, m.param_values()) for m in (spec.map_of(c) for c in spec.combinations)]
+    check_output(out, force=force, spec_path=spec_path)  # before the maps are built: a refusal took their seconds first
+    contexts = [
+        map_context(m.type, seed=m.seed, params=m.param_values()) for m in (spec.map_of(c) for c in spec.combinations)
+    ]
     constraints = build_constraints(spec)
     _prepare_dir(out, force, spec_path)
     journal = out / JOURNAL

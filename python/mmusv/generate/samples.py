@@ -153,7 +153,7 @@ def _fmt(n: int) -> str:
     return f"{n:,}" if n < _SATURATE else f"over {_SATURATE:.1e}"
 
 
-def budget_problem(scenario: Scenario, n_motion: int, n_route: int) -> str | None:
+def budget_problem(scenario: Scenario, *, n_motion: int, n_route: int) -> str | None:
     """None when ``n_motion``/``n_route`` samples per vessel (:func:`sample_counts`) fit :data:`MAX_CHECK_SAMPLES`
     and the pairs of vessels at every motion sample fit :data:`MAX_CHECK_PAIR_SAMPLES`, else why not: the sample
     count, split into time and route samples, or the pair count (callers add what to do about it)."""
@@ -196,7 +196,7 @@ def take_samples(scenario: Scenario, meta: CandidateMeta, ctx: MapContext, spec:
     acq = scenario.acquisition
     t_last = (acq.frames - 1) / acq.frequency_hz
     n_t, n_g = _counts(scenario, lengths, step)
-    problem = budget_problem(scenario, n_t, n_g)
+    problem = budget_problem(scenario, n_motion=n_t, n_route=n_g)
     if problem is not None:
         raise ConfigError(f"{problem}: {FEWER_TIMES}, shorten the routes or lower the speeds")
     times = np.linspace(0.0, t_last, n_t)

@@ -55,7 +55,7 @@ def _points(m: np.ndarray, pts: np.ndarray) -> np.ndarray:
 
 
 def apply(
-    a: Augmentation, ego: np.ndarray, neighbours: list[tuple[np.ndarray, np.ndarray]], boxes: np.ndarray
+    a: Augmentation, *, ego: np.ndarray, neighbours: list[tuple[np.ndarray, np.ndarray]], boxes: np.ndarray
 ) -> tuple[np.ndarray, list[tuple[np.ndarray, np.ndarray]], np.ndarray]:
     """``ego`` points ``(N, 4)``, ``neighbours`` ``[(points (N_i, 4) in their own frame, rel (4, 4))]`` and
     ``boxes`` ``(G, 7)`` (ego frame) under draw ``a`` (module docstring)."""

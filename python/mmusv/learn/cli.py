@@ -211,7 +211,7 @@ def run(args: argparse.Namespace) -> int:
         from concurrent.futures import ProcessPoolExecutor, as_completed
 
         print(
-            f"training {', '.join(modes)} side by side: {counted(jobs, 'process', 'processes')}, "
+            f"training {', '.join(modes)} side by side: {counted(jobs, 'process', plural='processes')}, "
             f"{counted(threads, 'torch thread')} each",
             flush=True,
         )
@@ -447,7 +447,9 @@ def _fit_scorers(
         groups = [cache.key(int(cache.arrays["sample_cloud"][k]))[0] for k in ks]
         t0 = time.perf_counter()
         try:
-            scorer, fit = fit_scorer(sample, ks, groups, refine=RefineParams(), nms_iou=model.preset.nms_iou, seed=seed)
+            scorer, fit = fit_scorer(
+                sample, samples=ks, groups=groups, refine=RefineParams(), nms_iou=model.preset.nms_iou, seed=seed
+            )
         except InputError as e:  # a model that finds (almost) nothing: it is used as it is, and this is said
             done[mode] = {"skipped": str(e)}
             # recorded: the same weights, cache and seed fail the same way (a rerun took minutes to say it again)
@@ -471,7 +473,7 @@ def _fit_scorers(
         base = next(x for x in fit.held_out if x[0] == 0.0)
         chosen = next(x for x in fit.held_out if x[0] == fit.beta)
         print(
-            f"{mode}: IoU scorer on {counted(fit.boxes, 'box', 'boxes')} "
+            f"{mode}: IoU scorer on {counted(fit.boxes, 'box', plural='boxes')} "
             f"of {counted(fit.frames, 'ego-frame')}, β = {fit.beta:g} (held-out "
             f"AP@0.5 {base[1]:.3f} -> {chosen[1]:.3f}, AP@0.7 {base[2]:.3f} -> {chosen[2]:.3f}), "
             f"{info['seconds']:.0f} s -> {path}",

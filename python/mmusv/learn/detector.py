@@ -186,8 +186,8 @@ class LearnedDetector:
         boxes, scores = self._infer(mode, ego, neighbours)
         return second_stage(
             ego,
-            boxes,
-            scores,
+            boxes=boxes,
+            scores=scores,
             refine=self.refine,
             scorer=self.scorers.get(mode),
             nms_iou=self.models[mode].preset.nms_iou,
@@ -200,7 +200,7 @@ class LearnedDetector:
             raise input_error(f"--model: no {mode} model (have {', '.join(self.models)}); train it with mmusv train")
         model = self.models[mode]
         p = model.preset
-        ex = make_example(np.asarray(ego, dtype=np.float32), list(neighbours), None, mode=mode, p=p)
+        ex = make_example(np.asarray(ego, dtype=np.float32), neighbours=list(neighbours), boxes=None, mode=mode, p=p)
         if mode == "intermediate" and ex.nb is not None:
             self.shared_bytes.append(message_bytes(ex.nb, p.pfn_channels))
         dev = next(model.parameters()).device

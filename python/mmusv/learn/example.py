@@ -110,9 +110,9 @@ def message_bytes(nb: Pillars, channels: int) -> int:
 
 def make_example(
     ego: np.ndarray,
+    *,
     neighbours: Sequence[tuple[np.ndarray, np.ndarray]],
     boxes: np.ndarray | None,
-    *,
     mode: str,
     p: Preset,
 ) -> Example:

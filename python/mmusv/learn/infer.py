@@ -44,9 +44,9 @@ def _model(path: Path, dev: torch.device) -> PillarNet:
 
 def infer_cache(
     cache: Cache,
+    *,
     models: str | Path,
     out: str | Path,
-    *,
     device: str | None = None,
     limit: int | None = None,
     modes: Sequence[str] = MODES,
@@ -74,10 +74,10 @@ def infer_cache(
         t0 = time.perf_counter()
         for i in items:
             if mode == "single":
-                ex = make_example(cache.cloud(i), [], None, mode=mode, p=p)
+                ex = make_example(cache.cloud(i), neighbours=[], boxes=None, mode=mode, p=p)
             else:
                 ego, nbs, _ = cache.sample(i)
-                ex = make_example(ego, nbs, None, mode=mode, p=p)
+                ex = make_example(ego, neighbours=nbs, boxes=None, mode=mode, p=p)
                 if ex.nb is not None:
                     sent.append(message_bytes(ex.nb, p.pfn_channels))
             with torch.no_grad():
@@ -139,7 +139,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--modes", default=",".join(MODES), help="the models to run (default: every one found)")
     a = ap.parse_args(argv)
     modes = [m.strip() for m in a.modes.split(",") if m.strip()]
-    infer_cache(Cache(a.cache), a.models, a.out, device=a.device, limit=a.limit, modes=modes)
+    infer_cache(Cache(a.cache), models=a.models, out=a.out, device=a.device, limit=a.limit, modes=modes)
     return 0
 
 

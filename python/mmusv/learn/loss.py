@@ -36,6 +36,7 @@ def gather(feature: torch.Tensor, index: torch.Tensor) -> torch.Tensor:
 
 def regression_loss(
     out: dict[str, torch.Tensor],
+    *,
     index: torch.Tensor,
     weight: torch.Tensor,
     reg: torch.Tensor,
@@ -53,6 +54,7 @@ def regression_loss(
 
 def centerpoint_loss(
     out: dict[str, torch.Tensor],
+    *,
     heatmap: torch.Tensor,
     index: torch.Tensor,
     mask: torch.Tensor,
@@ -66,5 +68,9 @@ def centerpoint_loss(
     n = mask.sum().clamp(min=1).float()
     w = mask.float() if weight is None else weight.float()
     hm = focal_loss(out["heatmap"], heatmap) / n
-    rg = REG_WEIGHT * regression_loss(out, index, w, reg, code_weights) / w.sum().clamp(min=1.0)
+    rg = (
+        REG_WEIGHT
+        * regression_loss(out, index=index, weight=w, reg=reg, code_weights=code_weights)
+        / w.sum().clamp(min=1.0)
+    )
     return {"loss": hm + rg, "heatmap": hm.detach(), "regression": rg.detach()}

@@ -58,10 +58,10 @@ class PillarNet(nn.Module):
     def canvas(self, b: Batch) -> torch.Tensor:
         """The BEV pillar canvas ``(B, C, ny, nx)`` (neighbours max-fused in intermediate mode)."""
         f = self.encoder(b.features, b.mask)
-        out = scatter(f, b.coords, b.batch, size=b.size, grid=self.preset.grid)
+        out = scatter(f, coords=b.coords, batch=b.batch, size=b.size, grid=self.preset.grid)
         if self.mode == "intermediate" and len(b.nb_cells):
             g = self.encoder(b.nb_features, b.nb_mask)
-            out = scatter_max(out, g, b.nb_cells, b.nb_batch)
+            out = scatter_max(out, features=g, cells=b.nb_cells, batch=b.nb_batch)
         return out
 
     def forward(self, b: Batch) -> dict[str, torch.Tensor]:

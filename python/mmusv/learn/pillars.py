@@ -110,7 +110,7 @@ class PillarEncoder(nn.Module):
 
 
 def scatter(
-    features: torch.Tensor, coords: torch.Tensor, batch: torch.Tensor, *, size: int, grid: tuple[int, int]
+    features: torch.Tensor, *, coords: torch.Tensor, batch: torch.Tensor, size: int, grid: tuple[int, int]
 ) -> torch.Tensor:
     """The BEV canvas ``(size, C, ny, nx)`` with ``features`` ``(P, C)`` at ``coords`` ``(P, 2)`` ``(iy, ix)``
     of sample ``batch`` ``(P,)``; empty cells are 0. Cells must be unique per sample."""
@@ -122,7 +122,9 @@ def scatter(
     return canvas.reshape(size, ny, nx, c).permute(0, 3, 1, 2).contiguous()
 
 
-def scatter_max(canvas: torch.Tensor, features: torch.Tensor, cells: torch.Tensor, batch: torch.Tensor) -> torch.Tensor:
+def scatter_max(
+    canvas: torch.Tensor, *, features: torch.Tensor, cells: torch.Tensor, batch: torch.Tensor
+) -> torch.Tensor:
     """``canvas`` ``(B, C, ny, nx)`` with ``features`` ``(P, C)`` max-fused into the cells ``cells`` ``(P, 2)``
     ``(iy, ix)`` of samples ``batch`` ``(P,)`` (several features may land in one cell: the max is taken, which
     does not depend on their order)."""

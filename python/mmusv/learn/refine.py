@@ -139,7 +139,7 @@ def _refine_once(xy: np.ndarray, box: np.ndarray, p: RefineParams) -> np.ndarray
     return out
 
 
-def refine_box(xy: np.ndarray, box: np.ndarray, p: RefineParams) -> np.ndarray:
+def refine_box(xy: np.ndarray, *, box: np.ndarray, p: RefineParams) -> np.ndarray:
     """``(7,)`` the proposal ``box`` refined on ``xy`` ``(K, 2)``, the cloud's :func:`surface_points` (steps 1–4
     of the module docstring); a copy of ``box`` when it holds fewer than ``p.min_points`` of them."""
     out = np.array(box, dtype=np.float64)
@@ -151,10 +151,10 @@ def refine_box(xy: np.ndarray, box: np.ndarray, p: RefineParams) -> np.ndarray:
     return out
 
 
-def refine_on(xy: np.ndarray, boxes: np.ndarray, p: RefineParams) -> np.ndarray:
+def refine_on(xy: np.ndarray, *, boxes: np.ndarray, p: RefineParams) -> np.ndarray:
     """``(M, 7)`` float64 ``boxes`` ``(M, 7)`` refined on a cloud's :func:`surface_points` ``xy``, row for row."""
     b = np.asarray(boxes, dtype=np.float64).reshape(-1, 7)
-    return np.array([refine_box(xy, row, p) for row in b]).reshape(-1, 7)
+    return np.array([refine_box(xy, box=row, p=p) for row in b]).reshape(-1, 7)
 
 
 def refine_boxes(points: np.ndarray, boxes: np.ndarray, *, params: RefineParams | None = None) -> np.ndarray:
@@ -162,4 +162,4 @@ def refine_boxes(points: np.ndarray, boxes: np.ndarray, *, params: RefineParams 
     origin; module docstring), row for row."""
     p = params or RefineParams()
     b = np.asarray(boxes, dtype=np.float64).reshape(-1, 7)
-    return refine_on(surface_points(points, p), b, p) if b.shape[0] else b.copy()
+    return refine_on(surface_points(points, p), boxes=b, p=p) if b.shape[0] else b.copy()

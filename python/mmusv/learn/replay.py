@@ -134,9 +134,9 @@ def _built_with(cache: Cache, lead: str) -> str:
 def write_predictions(
     peaks: str | Path,
     cache: Cache,
+    *,
     inputs: Sequence[str | Path],
     out: str | Path,
-    *,
     split: str = "test",
     ratios: Sequence[float] = (0.7, 0.15, 0.15),
     seed: int = 0,
@@ -179,7 +179,7 @@ def write_predictions(
         if refine is None or len(s) == 0:
             return b, s
         scorer = (scorers or {}).get(model)
-        return second_stage(points(), b, s, refine=refine, scorer=scorer, nms_iou=nms_iou)
+        return second_stage(points(), boxes=b, scores=s, refine=refine, scorer=scorer, nms_iou=nms_iou)
 
     own: dict[Key, tuple[np.ndarray, np.ndarray]] = {}
     fused: dict[tuple[Key, str], tuple[np.ndarray, np.ndarray]] = {}
@@ -281,8 +281,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     path = write_predictions(
         a.peaks,
         Cache(a.cache),
-        a.inputs,
-        a.out,
+        inputs=a.inputs,
+        out=a.out,
         split=a.split,
         ratios=ratios,
         seed=a.seed,

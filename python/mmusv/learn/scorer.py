@@ -80,7 +80,7 @@ SCORER_FILE = "scorer.pt"
 
 
 def box_features(
-    xy: np.ndarray, net_boxes: np.ndarray, boxes: np.ndarray, scores: np.ndarray, p: RefineParams
+    xy: np.ndarray, *, net_boxes: np.ndarray, boxes: np.ndarray, scores: np.ndarray, p: RefineParams
 ) -> np.ndarray:
     """``(M, len(FEATURES))`` float32 features (:data:`FEATURES`) of the refined ``boxes`` ``(M, 7)`` made from
     ``net_boxes`` ``(M, 7)`` (``x, y, z, l, w, h, yaw``, the points' frame, metres and radians) with network
@@ -181,9 +181,9 @@ def load_scorer(path: str | Path) -> IoUScorer:
 
 def second_stage(
     points: np.ndarray,
+    *,
     boxes: np.ndarray,
     scores: np.ndarray,
-    *,
     refine: RefineParams | None,
     scorer: IoUScorer | None,
     nms_iou: float,
@@ -197,9 +197,9 @@ def second_stage(
     if refine is None or len(b) == 0:
         return b, s
     xy = surface_points(points, refine)
-    ref = refine_on(xy, b, refine)
+    ref = refine_on(xy, boxes=b, p=refine)
     if scorer is not None:
-        s = scorer.rescore(box_features(xy, b, ref, s, refine), s)
+        s = scorer.rescore(box_features(xy, net_boxes=b, boxes=ref, scores=s, p=refine), s)
     keep = rotated_nms(ref, s, iou_threshold=nms_iou)
     return ref[keep], s[keep]
 
@@ -233,8 +233,8 @@ def _frames(
         s = np.asarray(scores, dtype=np.float64).reshape(-1)
         if len(b):
             xy = surface_points(points, refine)
-            ref = refine_on(xy, b, refine)
-            f = box_features(xy, b, ref, s, refine)
+            ref = refine_on(xy, boxes=b, p=refine)
+            f = box_features(xy, net_boxes=b, boxes=ref, scores=s, p=refine)
             # The boxes the rescored detector would keep whatever the new scores: the NMS of the refined boxes by
             # the network's scores (the final NMS removes only boxes that grew onto one hull).
             keep = rotated_nms(ref, s, iou_threshold=nms_iou)
@@ -252,19 +252,19 @@ def _ap(frames: Sequence[Frame], scores: Sequence[np.ndarray], thr: float) -> fl
         n_gt += len(gt)
         if len(b) == 0:
             continue
-        m = match_frame(b, s, gt, iou_threshold=thr) if len(gt) else np.full(len(b), -1)
+        m = match_frame(b, det_scores=s, gt_boxes=gt, iou_threshold=thr) if len(gt) else np.full(len(b), -1)
         all_s.append(s)
         all_tp.append(m >= 0)
     if not all_s:
         return 0.0
-    return average_precision(np.concatenate(all_s), np.concatenate(all_tp), n_gt)
+    return average_precision(np.concatenate(all_s), tp=np.concatenate(all_tp), n_gt=n_gt)
 
 
 def fit_scorer(
     sample: Callable[[int], tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]],
+    *,
     samples: Sequence[int],
     groups: Sequence[object],
-    *,
     refine: RefineParams,
     nms_iou: float,
     seed: int = 0,

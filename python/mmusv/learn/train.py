@@ -97,11 +97,11 @@ class TrainingSet(torch.utils.data.Dataset[Example]):
         ego, nbs, gt = self.cache.sample(k)
         if self.augment:
             rng = np.random.default_rng([self.seed, self.epoch, k])
-            ego, nbs, gt = apply(draw(rng, self.p), ego, nbs, gt)
+            ego, nbs, gt = apply(draw(rng, self.p), ego=ego, neighbours=nbs, boxes=gt)
         if self.p.min_points > 0 and len(gt):
             seen = ego if self.mode == "single" else early_cloud(ego, nbs)
             gt = gt[points_in_boxes(seen, gt) >= self.p.min_points]
-        return make_example(ego, nbs, gt, mode=self.mode, p=self.p)
+        return make_example(ego, neighbours=nbs, boxes=gt, mode=self.mode, p=self.p)
 
 
 @dataclass(frozen=True)
@@ -281,7 +281,15 @@ def train(
             with torch.autocast(device_type=dev.type, dtype=torch.bfloat16, enabled=amp):
                 outs = model(b)
             assert b.heatmap is not None and b.index is not None and b.reg_mask is not None and b.reg is not None
-            losses = centerpoint_loss(outs, b.heatmap, b.index, b.reg_mask, b.reg, b.reg_weight, p.code_weights)
+            losses = centerpoint_loss(
+                outs,
+                heatmap=b.heatmap,
+                index=b.index,
+                mask=b.reg_mask,
+                reg=b.reg,
+                weight=b.reg_weight,
+                code_weights=p.code_weights,
+            )
             opt.zero_grad(set_to_none=True)
             losses["loss"].backward()  # type: ignore[no-untyped-call]
             norm = torch.nn.utils.clip_grad_norm_(model.parameters(), 35.0)

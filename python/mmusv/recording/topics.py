@@ -62,7 +62,7 @@ radar_frame = _per_agent("{agent}/radar", "frame id of the agent's radar.")
 top_view_frame = _per_agent("{agent}/top_view", "frame id (optical) of the agent's top-view camera.")
 
 
-def camera(agent: str, name: str, kind: str | None = None) -> str:
+def camera(agent: str, name: str, *, kind: str | None = None) -> str:
     """``/{agent}/camera/{name}`` (prefix) or ``/{agent}/camera/{name}/{kind}``."""
     base = f"/{agent}/camera/{name}"
     return base if kind is None else f"{base}/{kind}"

@@ -108,7 +108,7 @@ class SequenceData:
         return None if k is None else self.frames[k]
 
 
-def boxes_in_frame(to_frame: np.ndarray, boxes: np.ndarray, sizes: np.ndarray) -> np.ndarray:
+def boxes_in_frame(to_frame: np.ndarray, *, boxes: np.ndarray, sizes: np.ndarray) -> np.ndarray:
     """``(K, 7)`` ``x, y, z, l, w, h, yaw`` of box → world transforms ``boxes`` ``(K, 4, 4)`` with ``sizes``
     ``(K, 3)`` seen from the frame whose world → frame transform is ``to_frame`` (yaw of the box x axis
     projected on the frame's xy plane)."""
@@ -127,7 +127,7 @@ def gt_in_ego(frame: SceneFrame, ego: AgentFrame, *, range_m: float = 200.0) -> 
 
 def gt_with_ids(frame: SceneFrame, ego: AgentFrame, *, range_m: float = 200.0) -> tuple[np.ndarray, list[str]]:
     """:func:`gt_in_ego` and the vessel id of each of its boxes."""
-    b = boxes_in_frame(invert(ego.lidar), frame.targets, frame.target_sizes)
+    b = boxes_in_frame(invert(ego.lidar), boxes=frame.targets, sizes=frame.target_sizes)
     if not len(b):
         return b, []
     keep = in_target_range(b[:, :3], range_m)
@@ -143,7 +143,7 @@ def wave_shares(ego: AgentFrame, ids: Sequence[str]) -> np.ndarray:
 
 def usv_boxes_in_ego(frame: SceneFrame, ego: AgentFrame) -> np.ndarray:
     """``(U, 7)`` every USV platform (the ego's included) in ``ego``'s LiDAR frame."""
-    return boxes_in_frame(invert(ego.lidar), frame.usv_boxes, frame.usv_sizes)
+    return boxes_in_frame(invert(ego.lidar), boxes=frame.usv_boxes, sizes=frame.usv_sizes)
 
 
 def _box_mats(poses: np.ndarray, centres: np.ndarray) -> np.ndarray:
@@ -360,7 +360,7 @@ def split_sequences(names: Sequence[str], *, split: str, ratios: Sequence[float]
     check_split(split, seed)
     if split == "all":
         return sorted(names)
-    sp = assign_splits(list(names), ratios, seed)
+    sp = assign_splits(list(names), ratios=ratios, seed=seed)
     return sorted(n for n in names if sp[n] == split)
 
 

@@ -135,7 +135,7 @@ SEA_COLUMN_M = 1.0
 """BEV column (metres) whose returns :func:`sea_height` leaves out when they stack higher than ``sea_stack_m``."""
 
 
-def sea_height(points: np.ndarray, height: np.ndarray, r: np.ndarray, params: BaselineParams) -> float:
+def sea_height(points: np.ndarray, *, height: np.ndarray, r: np.ndarray, params: BaselineParams) -> float:
     """How high the sea's own returns stand above the fitted water plane (metres; step 2 of the module docstring):
     the ``params.sea_quantile`` of the ``height`` of the ``points`` ``(N, ≥2)`` within ``params.sea_near_m``
     (``r``: their BEV range; the sensor's own ``params.self_radius_m`` left out) that lie below
@@ -181,7 +181,7 @@ def above_water(
     plane = water_plane(p, cell_m=prm.plane_cell_m)
     height = p[:, 2] - (plane[0] * p[:, 0] + plane[1] * p[:, 1] + plane[2])
     r = np.hypot(p[:, 0], p[:, 1])
-    sea = sea_height(p, height, r, prm)
+    sea = sea_height(p, height=height, r=r, params=prm)
     keep: np.ndarray = (height > max(prm.min_height_m, sea)) & (r > prm.self_radius_m)
     return keep, height, plane, sea
 

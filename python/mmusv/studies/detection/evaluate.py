@@ -82,9 +82,9 @@ def bev_iou(a: np.ndarray | Sequence[Sequence[float]], b: np.ndarray | Sequence[
 
 def match_frame(
     det_boxes: np.ndarray,
+    *,
     det_scores: np.ndarray,
     gt_boxes: np.ndarray,
-    *,
     iou_threshold: float,
     iou: np.ndarray | None = None,
 ) -> np.ndarray:
@@ -120,7 +120,7 @@ def voc_ap(recall: np.ndarray, precision: np.ndarray) -> float:
     return float(np.sum((mrec[steps] - mrec[steps - 1]) * mpre[steps]))
 
 
-def average_precision(scores: np.ndarray, tp: np.ndarray, n_gt: int) -> float:
+def average_precision(scores: np.ndarray, *, tp: np.ndarray, n_gt: int) -> float:
     """AP of detections with ``scores`` ``(D,)`` and true-positive flags ``tp`` ``(D,)`` against ``n_gt``
     ground truths: NaN when there is no ground truth, 0 when there are no detections."""
     if n_gt == 0:
@@ -172,6 +172,7 @@ class FrameMatch:
     @staticmethod
     def evaluate(
         det_boxes: np.ndarray,
+        *,
         det_scores: np.ndarray,
         gt_boxes: np.ndarray,
         thresholds: Sequence[float] = IOU_THRESHOLDS,
@@ -180,7 +181,9 @@ class FrameMatch:
         d, g = _boxes(det_boxes), _boxes(gt_boxes)
         s = np.asarray(det_scores, dtype=np.float64).reshape(-1)
         iou = bev_iou(d, g)
-        return FrameMatch(d, s, g, {t: match_frame(d, s, g, iou_threshold=t, iou=iou) for t in thresholds})
+        return FrameMatch(
+            d, s, g, {t: match_frame(d, det_scores=s, gt_boxes=g, iou_threshold=t, iou=iou) for t in thresholds}
+        )
 
     def det_bins(self, threshold: float = 0.5) -> np.ndarray:
         """``(D,)`` range bin of each detection (its matched ground truth's when a TP at ``threshold``)."""
@@ -207,7 +210,7 @@ def summarize(frames: Sequence[FrameMatch]) -> dict[str, float]:
     n_gt = int(sum(f.gt_boxes.shape[0] for f in frames))
     for t in IOU_THRESHOLDS:
         tp = np.concatenate([f.matches[t] >= 0 for f in frames]) if frames else np.zeros(0, dtype=bool)
-        out[f"ap{round(t * 100)}"] = average_precision(scores, tp, n_gt)
+        out[f"ap{round(t * 100)}"] = average_precision(scores, tp=tp, n_gt=n_gt)
         if t == 0.5:
             n_tp = int(tp.sum())
             out["precision50"] = n_tp / len(tp) if len(tp) else math.nan
@@ -221,7 +224,7 @@ def summarize(frames: Sequence[FrameMatch]) -> dict[str, float]:
         dbin = gbin = np.zeros(0, dtype=np.int64)
     for k in range(len(RANGE_BINS)):
         sel = dbin == k
-        out[f"ap50_{bin_label(k)}"] = average_precision(scores[sel], tp50[sel], int((gbin == k).sum()))
+        out[f"ap50_{bin_label(k)}"] = average_precision(scores[sel], tp=tp50[sel], n_gt=int((gbin == k).sum()))
     out["ego_frames"] = float(len(frames))
     out["gt"] = float(n_gt)
     out["det"] = float(len(scores))

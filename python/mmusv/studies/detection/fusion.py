@@ -105,7 +105,7 @@ def rotated_nms(boxes: np.ndarray, scores: np.ndarray, *, iou_threshold: float =
     return np.array(keep, dtype=np.int64)
 
 
-def fuse_boxes(boxes: np.ndarray, scores: np.ndarray, agents: np.ndarray, *, iou_threshold: float = WBF_IOU) -> Boxes:
+def fuse_boxes(boxes: np.ndarray, *, scores: np.ndarray, agents: np.ndarray, iou_threshold: float = WBF_IOU) -> Boxes:
     """Score-weighted box fusion of several USVs' boxes ``(M, 7)`` (one frame), ``scores`` ``(M,)`` in [0, 1] and
     the ``agents`` ``(M,)`` that made them. After weighted boxes fusion (Solovyev, Wang and Gabruseva, "Weighted
     boxes fusion: ensembling boxes from different object detection models", Image Vision Comput. 107, 2021),
@@ -188,7 +188,7 @@ def fuse(
         boxes, scores = np.concatenate(bs, axis=0), np.concatenate(ss)
         if late_merge == "wbf":
             agents = np.concatenate([np.full(len(x), k) for k, x in enumerate(ss)])
-            return fuse_boxes(boxes, scores, agents)
+            return fuse_boxes(boxes, scores=scores, agents=agents)
         keep = rotated_nms(boxes, scores)
         return boxes[keep], scores[keep]
     if mode == "early":

@@ -188,7 +188,9 @@ def rescore(boxes: pl.DataFrame) -> dict[str, float]:
         t = g.filter(pl.col("kind") == "gt")
         frames.append(
             FrameMatch.evaluate(
-                d.select(list(BOX_COLUMNS)).to_numpy(), d["score"].to_numpy(), t.select(list(BOX_COLUMNS)).to_numpy()
+                d.select(list(BOX_COLUMNS)).to_numpy(),
+                det_scores=d["score"].to_numpy(),
+                gt_boxes=t.select(list(BOX_COLUMNS)).to_numpy(),
             )
         )
     return summarize(frames)

@@ -519,7 +519,7 @@ def _score_ego(
                     late_merge=o.late_merge,
                 )
             boxes, scores = _keep(boxes, scores, usv, range_m=o.range_m, margin=o.platform_margin_m)
-            fm = FrameMatch.evaluate(boxes, scores, gt)
+            fm = FrameMatch.evaluate(boxes, det_scores=scores, gt_boxes=gt)
             key = (s.name, mode)
             res.matches.setdefault(key, []).append(fm)
             gm = fm.gt_matched(0.5)
