@@ -654,7 +654,9 @@ def test_recording_topics_are_the_codes() -> None:
     a, c = "{agent}", "{name}"
     expected = {topics.TF, topics.WORLD_STATE, topics.lidar(a), topics.radar_returns(a), topics.radar_ppi(a)}
     expected |= {topics.boxes(a), topics.agent_annotations(a)}
-    expected |= {topics.camera(a, c, k) for k in topics.CAMERA_KINDS} | {topics.top_view(a, k) for k in _TOP_OUTPUTS}
+    expected |= {topics.camera(a, c, kind=k) for k in topics.CAMERA_KINDS} | {
+        topics.top_view(a, k) for k in _TOP_OUTPUTS
+    }
     assert documented == expected
 
 

@@ -88,7 +88,11 @@ def test_counts_of_one_are_singular() -> None:
     from mmusv.learn.detector import _progress
     from mmusv.text import counted
 
-    assert [counted(1, "epoch"), counted(2, "epoch"), counted(0, "box", "boxes")] == ["1 epoch", "2 epochs", "0 boxes"]
+    assert [counted(1, "epoch"), counted(2, "epoch"), counted(0, "box", plural="boxes")] == [
+        "1 epoch",
+        "2 epochs",
+        "0 boxes",
+    ]
     assert counted(1234, "frame", fmt=",") == "1,234 frames"
     # mmusv study detection's "learned models:" line (and the notes): "1 epochs, 1 steps"
     assert _progress({"epoch": 1, "step": 1, "epochs": 1}) == "1 epoch, 1 step"

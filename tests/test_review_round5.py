@@ -11,7 +11,7 @@ from mmusv.export.pcd import read_pcd, write_pcd
 
 def _cloud(tmp_path: Path) -> tuple[Path, bytes]:
     p = tmp_path / "000001.pcd"
-    write_pcd(p, np.array([[1.0, 2.0, 3.0], [4.0, 5.0, 6.0], [7.0, 8.0, 9.5]]), [0.5, 1.0, 0.2])
+    write_pcd(p, xyz=np.array([[1.0, 2.0, 3.0], [4.0, 5.0, 6.0], [7.0, 8.0, 9.5]]), intensity=[0.5, 1.0, 0.2])
     return p, p.read_bytes()
 
 

@@ -62,7 +62,7 @@ def test_a_dataset_on_a_ray_cluster_it_cannot_join_changes_nothing(
         parts=1,
         bytes=26,
     )
-    write_index(out / "dataset.json", [entry], {"spec": {"file": "s.yaml", "name": "older", "hash": "0" * 64}})
+    write_index(out / "dataset.json", [entry], extra={"spec": {"file": "s.yaml", "name": "older", "hash": "0" * 64}})
     before = tree(out)
     no_ray_cluster(monkeypatch)
     with pytest.raises(IoError, match=r"--ray auto: cannot start or join Ray: Could not find any running Ray"):

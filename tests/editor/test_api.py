@@ -214,7 +214,7 @@ def test_map_layers(client: TestClient) -> None:
     from mmusv.generate.mapctx import map_context
 
     m = client.post("/api/map", json={"map": {"type": "port", "seed": 3}}).json()
-    ctx = map_context("port", 3, {})
+    ctx = map_context("port", seed=3, params={})
     assert m["kind"] == "port" and m["bounds"] == [-1000.0, -1000.0, 1000.0, 1000.0]
     assert len(m["moored"]) == len(ctx.world.moored) and len(m["structures"]) == len(ctx.priors.structure_boundaries)
     img = Image.open(io.BytesIO(__import__("base64").b64decode(m["image"].split(",", 1)[1])))
@@ -262,7 +262,7 @@ def test_evaluate_flags_a_route_over_land_where_it_happens(client: TestClient) -
     bad = np.zeros(len(path), bool)
     for a, b in p["segments"]["ferry"]:
         bad[a : b + 1] = True
-    land = map_context("port", 3, {}).world.heightfield.sample(path) > 0.0
+    land = map_context("port", seed=3, params={}).world.heightfield.sample(path) > 0.0
     assert land.any() and not (land & ~bad).any()  # every route sample on land is in a red segment
     assert bad[0] and not bad[-1]
 

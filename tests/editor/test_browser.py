@@ -141,7 +141,7 @@ def test_opens_a_bundled_scenario(browser: Any, live_server: LiveServer) -> None
 
 
 def test_place_draw_drag_onto_land_and_back_save_and_run(browser: Any, live_server: LiveServer, tmp_path: Path) -> None:
-    ctx = map_context("port", 3, {})
+    ctx = map_context("port", seed=3, params={})
     for p in [*USV_ROUTE, *TARGET_ROUTE]:
         assert ctx.lookup(ctx.d_nav, np.array(p)) > 60.0, f"{p} should be open water"
     assert ctx.lookup(ctx.d_shore, np.array(LAND)) == 0.0 and ctx.world.heightfield.sample(np.array([LAND]))[0] > 0

@@ -42,7 +42,7 @@ def recorded(rec: Path, frames: int) -> Boxes:
         for a in info.agents:
             ann = msgs[topics.agent_annotations(a.id)]
             for name, cam in a.cameras.items():
-                inst = np.asarray(decode_image(msgs[topics.camera(a.id, name, "instance")]))
+                inst = np.asarray(decode_image(msgs[topics.camera(a.id, name, kind="instance")]))
                 per: dict[str, dict[str, Any]] = {}
                 for b in ann.boxes_camera:
                     if b.camera != name or b.visible_pixels == 0:

@@ -69,11 +69,11 @@ def test_masks_decode_to_the_instance_images(coco_dir: Path, port_rec: Path) -> 
     frames = {k: frame_messages(port_rec, k) for k in range(3)}
     for img in gt.loadImgs(gt.getImgIds()):
         msgs = frames[img["frame"]]
-        inst = decode_image(msgs[topics.camera(img["agent"], img["camera"], "instance")])
+        inst = decode_image(msgs[topics.camera(img["agent"], img["camera"], kind="instance")])
         rgb = np.asarray(Image.open(coco_dir / "images" / "all" / img["file_name"]))
         cam = cams[img["agent"]][img["camera"]]
         assert rgb.shape == (cam.height, cam.width, 3) == (img["height"], img["width"], 3)
-        np.testing.assert_array_equal(rgb, decode_image(msgs[topics.camera(img["agent"], img["camera"], "rgb")]))
+        np.testing.assert_array_equal(rgb, decode_image(msgs[topics.camera(img["agent"], img["camera"], kind="rgb")]))
         world = {v.id: v for v in msgs[topics.WORLD_STATE].vessels}
         boxes = {
             b.target_id: b

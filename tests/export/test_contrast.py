@@ -269,8 +269,8 @@ def fog_rec(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 def frame_views(rec: Path, k: int) -> tuple[np.ndarray, np.ndarray, WorldFrame, Any]:
     msgs = frame_messages(rec, k)
-    rgb = np.asarray(decode_image(msgs[topics.camera("u", "front", "rgb")]))
-    inst = np.asarray(decode_image(msgs[topics.camera("u", "front", "instance")]))
+    rgb = np.asarray(decode_image(msgs[topics.camera("u", "front", kind="rgb")]))
+    inst = np.asarray(decode_image(msgs[topics.camera("u", "front", kind="instance")]))
     return rgb, inst, WorldFrame.from_message(msgs[topics.WORLD_STATE]), msgs[topics.agent_annotations("u")]
 
 

@@ -332,7 +332,7 @@ def test_splits_number_sequences_over_the_conversion(many_recs: list[Path], tmp_
 
     out = tmp_path / "s"
     convert(many_recs, to="kitti_tracking", out_dir=out, seed=3)
-    want = assign_splits([p.stem for p in many_recs], parse_ratios((0.7, 0.15, 0.15)), 3)
+    want = assign_splits([p.stem for p in many_recs], ratios=parse_ratios((0.7, 0.15, 0.15)), seed=3)
     rows = read_csv(out / "sequences.csv")
     # every (recording, agent) once, numbered 0000 … in the conversion's order: split, scenario, agent
     assert [r["sequence"] for r in rows] == [f"{i:04d}" for i in range(2 * len(many_recs))]

@@ -30,12 +30,12 @@ def test_masks_agree_with_the_semantic_images(mastr_dir: Path, port_rec: Path) -
             for name, cam in a.cameras.items():
                 rel = f"{port_rec.stem}/{a.id}/{name}/{k:06d}"
                 mask = np.asarray(Image.open(mastr_dir / "masks" / f"{rel}m.png"))
-                sem = decode_image(msgs[topics.camera(a.id, name, "semantic")])
+                sem = decode_image(msgs[topics.camera(a.id, name, kind="semantic")])
                 assert mask.dtype == np.uint8 and mask.shape == sem.shape == (cam.height, cam.width)
                 want = np.where(sem == 0, 2, np.where(sem == 1, 1, 0))  # sky (nothing hit), water, obstacle
                 np.testing.assert_array_equal(mask, want)
                 rgb = np.asarray(Image.open(mastr_dir / "images" / f"{rel}.png"))
-                np.testing.assert_array_equal(rgb, decode_image(msgs[topics.camera(a.id, name, "rgb")]))
+                np.testing.assert_array_equal(rgb, decode_image(msgs[topics.camera(a.id, name, kind="rgb")]))
                 seen |= set(np.unique(mask).tolist())
                 n += 1
     assert n == 36 and seen == {0, 1, 2}  # the port scene shows all three

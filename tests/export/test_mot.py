@@ -171,7 +171,7 @@ def test_layout_seqinfo_and_images(mot_dir: Path, port_rec: Path) -> None:
             assert (seq / "frames.txt").read_text().split() == [str(k) for k in range(FRAMES)]
             for k in range(FRAMES):
                 img = np.asarray(Image.open(seq / "img1" / f"{k + 1:06d}.png"))
-                np.testing.assert_array_equal(img, decode_image(msgs[k][topics.camera(a.id, name, "rgb")]))
+                np.testing.assert_array_equal(img, decode_image(msgs[k][topics.camera(a.id, name, kind="rgb")]))
 
 
 def test_classes_and_tracks_files(mot_dir: Path, port_rec: Path) -> None:
@@ -335,7 +335,7 @@ def test_frames_are_renumbered_from_one(port_rec: Path, port_truth: Any, tmp_pat
         camera = seq.name.split(".")[-1]
         for k in (1, 2):  # MOT frame k - 0 is acquisition index k
             img = np.asarray(Image.open(seq / "img1" / f"{k:06d}.png"))
-            np.testing.assert_array_equal(img, decode_image(msgs[k][topics.camera("usv_3", camera, "rgb")]))
+            np.testing.assert_array_equal(img, decode_image(msgs[k][topics.camera("usv_3", camera, kind="rgb")]))
         want = {k: port_truth[("usv_3", camera, k)] for k in (1, 2)}
         assert box_problems(gt_lines(seq), [1, 2], want, names) == []
 
@@ -378,7 +378,7 @@ def test_splits_follow_the_recordings(many_recs: list[Path], tmp_path: Path) -> 
 
     out = tmp_path / "s"
     convert(many_recs, to="mot", out_dir=out, seed=3)
-    want = assign_splits([p.stem for p in many_recs], parse_ratios((0.7, 0.15, 0.15)), 3)
+    want = assign_splits([p.stem for p in many_recs], ratios=parse_ratios((0.7, 0.15, 0.15)), seed=3)
     tracks = read_csv(out / "tracks.csv")
     for split in ("train", "validate", "test"):
         seqs = (out / "seqmaps" / f"{split}.txt").read_text().splitlines()[1:]

@@ -414,7 +414,7 @@ def instance_masks(rec: Path, boxes: list[dict[str, Any]]) -> np.ndarray:
     if not boxes:
         return np.zeros((0, 0, 0), np.uint8)
     b = boxes[0]
-    inst = decode_image(frame_messages(rec, b["frame"])[topics.camera(b["agent"], b["camera"], "instance")])
+    inst = decode_image(frame_messages(rec, b["frame"])[topics.camera(b["agent"], b["camera"], kind="instance")])
     return np.stack([(inst == x["instance"]).astype(np.uint8) for x in boxes])
 
 

@@ -147,19 +147,19 @@ def test_points_images_and_stamps_equal_the_recording(bag: Path, coop_rec: Path)
             for name in ("x", "y", "z", "intensity", "ring", "class", "instance"):
                 np.testing.assert_array_equal(pts[name], ref[name])
         for name, cam in a.cameras.items():
-            rgb = topics.camera(a.id, name, "rgb")
+            rgb = topics.camera(a.id, name, kind="rgb")
             for (_t, img), (_t0, msg) in zip(got[rgb + "/compressed"], src[rgb], strict=True):
                 arr = np.asarray(Image.open(io.BytesIO(bytes(img.data))))
                 assert arr.shape == (cam.height, cam.width, 3) and img.header.frame_id == optical_frame(a.id, name)
                 np.testing.assert_array_equal(arr, decode_image(msg))
-            depth = topics.camera(a.id, name, "depth")
+            depth = topics.camera(a.id, name, kind="depth")
             for (_t, img), (_t0, msg) in zip(got[depth], src[depth], strict=True):
                 assert (img.height, img.width, img.encoding) == (cam.height, cam.width, "32FC1")
                 np.testing.assert_array_equal(
                     np.frombuffer(bytes(img.data), "<f4").reshape(cam.height, cam.width), decode_image(msg)
                 )
             for kind in ("semantic", "instance"):
-                topic = topics.camera(a.id, name, kind)
+                topic = topics.camera(a.id, name, kind=kind)
                 for (_t, img), (_t0, msg) in zip(got[topic], src[topic], strict=True):
                     arr = np.frombuffer(bytes(img.data), "<u2").reshape(img.height, img.width)
                     np.testing.assert_array_equal(arr, decode_image(msg))

@@ -28,17 +28,17 @@ def test_split_counts() -> None:
 
 def test_assign_splits_deterministic_and_order_independent() -> None:
     keys = [f"scenario_{i:02d}" for i in range(20)]
-    a = assign_splits(keys, parse_ratios((0.7, 0.15, 0.15)), seed=0)
-    b = assign_splits(list(reversed(keys)), parse_ratios((0.7, 0.15, 0.15)), seed=0)
+    a = assign_splits(keys, ratios=parse_ratios((0.7, 0.15, 0.15)), seed=0)
+    b = assign_splits(list(reversed(keys)), ratios=parse_ratios((0.7, 0.15, 0.15)), seed=0)
     assert a == b
     assert sorted(a.values()).count("train") == 14
-    c = assign_splits(keys, parse_ratios((0.7, 0.15, 0.15)), seed=1)
+    c = assign_splits(keys, ratios=parse_ratios((0.7, 0.15, 0.15)), seed=1)
     assert c != a
     with pytest.raises(ConfigError):
-        assign_splits(["x", "x"], (1.0, 0.0, 0.0), seed=0)
+        assign_splits(["x", "x"], ratios=(1.0, 0.0, 0.0), seed=0)
     # random.Random(-1) shuffles as random.Random(1): a negative seed is refused, not a copy of another
     with pytest.raises(ConfigError, match=r"seed = -1: the split's seed must be a whole number >= 0"):
-        assign_splits(keys, parse_ratios((0.7, 0.15, 0.15)), seed=-1)
+        assign_splits(keys, ratios=parse_ratios((0.7, 0.15, 0.15)), seed=-1)
 
 
 @pytest.mark.parametrize("bad", ["0.7,0.3", "a,b,c", "-1,1,1", "0,0,0", (0.5, float("nan"), 0.5)])
@@ -54,7 +54,7 @@ def test_pcd_open3d_reads_points_and_intensity(tmp_path: Path) -> None:
     inten = rng.uniform(size=500)
     inten[:3] = [0.0, 1.0, 1.7]  # out-of-range values are clipped
     p = tmp_path / "a.pcd"
-    write_pcd(p, xyz, inten)
+    write_pcd(p, xyz=xyz, intensity=inten)
     text = p.read_text()
     assert "FIELDS x y z rgb\n" in text and "DATA ascii\n" in text
     pc = o3d.io.read_point_cloud(str(p))
@@ -80,11 +80,11 @@ def test_read_pcd_refuses_a_file_cut_short(tmp_path: Path) -> None:
     one included, read back."""
     rng = np.random.default_rng(1)
     p = tmp_path / "000001.pcd"
-    write_pcd(p, rng.normal(size=(40, 3)), rng.uniform(size=40))
+    write_pcd(p, xyz=rng.normal(size=(40, 3)), intensity=rng.uniform(size=40))
     data = p.read_bytes()
     assert read_pcd(p)[0].shape == (40, 3)
     empty = tmp_path / "000002.pcd"
-    write_pcd(empty, np.zeros((0, 3)), np.zeros(0))
+    write_pcd(empty, xyz=np.zeros((0, 3)), intensity=np.zeros(0))
     assert read_pcd(empty)[0].shape == (0, 3) and read_pcd(empty)[1].shape == (0,)
     header = data.index(b"DATA ascii\n") + len(b"DATA ascii\n")
     cut_rows = data[: header + data[header:].index(b"\n", 200) + 1]  # whole rows, fewer than 40

@@ -39,14 +39,14 @@ def test_boxes_round_trip_to_pixels(yolo_dir: Path, port_rec: Path) -> None:
             for name, cam in a.cameras.items():
                 rel = f"{port_rec.stem}/{a.id}/{name}/{k:06d}"
                 img = np.asarray(Image.open(yolo_dir / "images" / "all" / f"{rel}.png"))
-                np.testing.assert_array_equal(img, decode_image(msgs[topics.camera(a.id, name, "rgb")]))
+                np.testing.assert_array_equal(img, decode_image(msgs[topics.camera(a.id, name, kind="rgb")]))
                 lines = (yolo_dir / "labels" / "all" / f"{rel}.txt").read_text().splitlines()
                 want = [
                     b
                     for b in msgs[topics.agent_annotations(a.id)].boxes_camera
                     if b.camera == name and b.visible_pixels > 0
                 ]
-                inst = np.asarray(decode_image(msgs[topics.camera(a.id, name, "instance")]))
+                inst = np.asarray(decode_image(msgs[topics.camera(a.id, name, kind="instance")]))
                 assert len(lines) == len(want)
                 n_images += 1
                 for line, b in zip(lines, want, strict=True):
@@ -72,7 +72,7 @@ def test_splits_by_sequence(many_recs: list[Path], tmp_path: Path) -> None:
     convert(many_recs, to="yolo", out_dir=out, max_occlusion=0.3)
     doc = yaml.safe_load((out / "data.yaml").read_text())
     assert (doc["train"], doc["val"], doc["test"]) == ("images/train", "images/validate", "images/test")
-    want = assign_splits([p.stem for p in many_recs], parse_ratios((0.7, 0.15, 0.15)), 0)
+    want = assign_splits([p.stem for p in many_recs], ratios=parse_ratios((0.7, 0.15, 0.15)), seed=0)
     for split in ("train", "validate", "test"):
         got = {p.name for p in (out / "images" / split).iterdir()}
         assert got == {k for k, s in want.items() if s == split}

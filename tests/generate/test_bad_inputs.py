@@ -109,7 +109,7 @@ def test_take_samples_refuses_instead_of_allocating() -> None:
 
     sc = _scenario(frequency_hz=1000, frames=10_000_000)
     with pytest.raises(ConfigError, match=r"10,000,000 samples.*acquisition\.frames"):
-        scenario_samples(sc, map_context("open_sea", 2, {}))
+        scenario_samples(sc, map_context("open_sea", seed=2, params={}))
 
 
 @pytest.mark.usefixtures("no_sampling")
@@ -120,7 +120,7 @@ def test_too_many_samples_advises_what_lowers_them() -> None:
 
     sc = _scenario(frequency_hz=1000, frames=10_000_000)
     with pytest.raises(ConfigError) as info:
-        scenario_samples(sc, map_context("open_sea", 2, {}))
+        scenario_samples(sc, map_context("open_sea", seed=2, params={}))
     assert samples.FEWER_TIMES in str(info.value) and "or acquisition.frequency_hz" not in str(info.value)
     for frames, hz, speed in ((10_000, 0.5, 10.0), (10_000, 5.0, 0.5), (200, 1.0, 30.0)):
         n = samples.time_samples(frames, frequency_hz=hz, step=2.0, max_speed_mps=speed)
@@ -141,9 +141,10 @@ def test_sample_counts_saturate_instead_of_overflowing() -> None:
     sc = _scenario(frequency_hz=5, frames=10)
     n_t, n_g = samples._counts(sc, np.array([math.inf]), 2.0)  # was an OverflowError
     assert n_t == 10 and n_g > samples.MAX_CHECK_SAMPLES
-    problem = samples.budget_problem(sc, n_t, n_g)
+    problem = samples.budget_problem(sc, n_motion=n_t, n_route=n_g)
     assert problem is not None and "along the longest route" in problem
-    assert samples.budget_problem(sc, *samples._counts(sc, np.array([600.0]), 2.0)) is None
+    n_t, n_g = samples._counts(sc, np.array([600.0]), 2.0)
+    assert samples.budget_problem(sc, n_motion=n_t, n_route=n_g) is None
 
 
 def test_generator_rejects_a_candidate_past_the_budget(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
@@ -192,7 +193,7 @@ def test_spec_encounter_clearance_is_bounded(tmp_path: Path) -> None:
 
 
 def test_eligible_cells_halve_in_a_loop() -> None:
-    ctx = map_context("island", 4, {})
+    ctx = map_context("island", seed=4, params={})
     pri = ctx.priors
     ok = pri.water_mask & pri.valid_zones
     cells = ctx._eligible(1.0e308)  # was a RecursionError

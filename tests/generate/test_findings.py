@@ -27,7 +27,7 @@ def test_first_finding_is_the_check_and_every_vessel_is_listed() -> None:
             2: [[-700, -800], [-650, -850]],
         }
     )
-    ctx = map_context("port", 3, {})
+    ctx = map_context("port", seed=3, params={})
     spec = map_check_spec(sc)
     s = scenario_samples(sc, ctx, spec)
     cons = spec.constraints
@@ -55,7 +55,7 @@ def test_first_finding_is_the_check_and_every_vessel_is_listed() -> None:
 def test_map_findings_of_the_bundled_scenarios_are_clean_or_warnings() -> None:
     for name in ("port_entry", "island_occlusion"):
         sc = load_scenario(resolve_scenario(name))
-        _, found = map_findings(sc, map_context(sc.map.type, sc.map.seed, sc.map.param_values()))
+        _, found = map_findings(sc, map_context(sc.map.type, seed=sc.map.seed, params=sc.map.param_values()))
         assert all(f.severity == "warning" for f in found), name
         assert np.all([f.check != "in_water" for f in found])
 
@@ -76,7 +76,7 @@ def test_separation_in_blocks_is_the_whole_array(monkeypatch: object) -> None:
     from mmusv.generate.hulls import segment_distance
 
     sc = _crowded()
-    ctx = map_context("port", 3, {})
+    ctx = map_context("port", seed=3, params={})
     spec = map_check_spec(sc)
     s = scenario_samples(sc, ctx, spec)
     sep = Separation(spec.constraints.separation)
@@ -109,7 +109,7 @@ def test_route_separation_is_the_closest_pair_of_route_samples() -> None:
     from mmusv.generate.spec import RouteSeparationCheck
 
     sc = _crowded()
-    s = scenario_samples(sc, map_context("port", 3, {}), map_check_spec(sc))
+    s = scenario_samples(sc, map_context("port", seed=3, params={}), map_check_spec(sc))
     usv, target = s.index("usv_3"), s.index("pilot")
     brute = float(np.linalg.norm(s.geo[:, usv, None, :] - s.geo[None, :, target, :], axis=-1).min())
     gap = brute - s.geo_slack[usv] - s.geo_slack[target]
@@ -128,9 +128,9 @@ def test_a_fleet_too_large_to_compare_pairwise_is_refused_before_sampling() -> N
     base = data["vessels"][3]
     data["vessels"] += [{**base, "id": f"extra_{k}"} for k in range(1500)]
     sc = load_scenario(data)
-    problem = budget_problem(sc, 100, 100)
+    problem = budget_problem(sc, n_motion=100, n_route=100)
     assert problem is not None and "pairs of vessels" in problem and f"{MAX_CHECK_PAIR_SAMPLES:,}" in problem
-    assert budget_problem(load_scenario(resolve_scenario("port_entry")), 100, 100) is None
+    assert budget_problem(load_scenario(resolve_scenario("port_entry")), n_motion=100, n_route=100) is None
 
 
 def test_overlapping_hulls_are_said_to_overlap() -> None:

@@ -24,7 +24,7 @@ def test_points_stay_in_their_boxes() -> None:
     grown[:, 3:5] += 0.02  # points lie on the sides
     before = _inside(pts, grown)
     for a in (Augmentation(flip=True, angle=0.7, scale=1.05), Augmentation(angle=-2.0, scale=0.95)):
-        p2, _, b2 = apply(a, pts, [], boxes)
+        p2, _, b2 = apply(a, ego=pts, neighbours=[], boxes=boxes)
         g2 = b2.copy()
         g2[:, 3:5] += 0.03
         assert (_inside(p2, g2) == before).all()
@@ -37,8 +37,8 @@ def test_neighbour_points_land_where_the_ego_sees_them() -> None:
     rel = np.array([[c, -s, 0, 30.0], [s, c, 0, -10.0], [0, 0, 1, 0.5], [0, 0, 0, 1]])
     ego = np.zeros((0, 4), np.float32)
     a = Augmentation(flip=True, angle=1.1, scale=1.04)
-    want = early_cloud(*apply(a, early_cloud(ego, [(nb_pts, rel)]), [], np.zeros((0, 7)))[:1], [])
-    e2, nbs2, _ = apply(a, ego, [(nb_pts, rel)], np.zeros((0, 7)))
+    want = early_cloud(*apply(a, ego=early_cloud(ego, [(nb_pts, rel)]), neighbours=[], boxes=np.zeros((0, 7)))[:1], [])
+    e2, nbs2, _ = apply(a, ego=ego, neighbours=[(nb_pts, rel)], boxes=np.zeros((0, 7)))
     np.testing.assert_allclose(early_cloud(e2, nbs2), want, atol=1e-4)
 
 

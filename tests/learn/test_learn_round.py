@@ -240,12 +240,12 @@ def test_infer_without_a_model_is_refused_and_writes_the_name_given(
     root, cache, _ = peaks_setup
     # a folder without a model: an empty peaks file, exit status 0
     with pytest.raises(InputError, match=r"--models .*nowhere: no single\|early\|intermediate/model\.pt there"):
-        infer_cache(cache, tmp_path / "nowhere", tmp_path / "empty.npz")
+        infer_cache(cache, models=tmp_path / "nowhere", out=tmp_path / "empty.npz")
     assert not (tmp_path / "empty.npz").exists()
     with pytest.raises(InputError, match=r"--models .*: no early/model\.pt there"):
-        infer_cache(cache, root / "models", tmp_path / "early.npz", modes=["early"])
+        infer_cache(cache, models=root / "models", out=tmp_path / "early.npz", modes=["early"])
     # -o peaks wrote peaks.npz, and returned the name of a file that was not there
-    out = infer_cache(cache, root / "models", tmp_path / "peaks")
+    out = infer_cache(cache, models=root / "models", out=tmp_path / "peaks")
     assert out == tmp_path / "peaks" and out.is_file() and not (tmp_path / "peaks.npz").exists()
     assert sorted(np.load(out).files) == ["single_boxes", "single_offsets", "single_scores"]
     # a merge of parts none of which is there: an empty peaks file
@@ -256,17 +256,17 @@ def test_infer_without_a_model_is_refused_and_writes_the_name_given(
 
 def test_replay_refuses_peaks_and_caches_that_do_not_fit(peaks_setup: tuple[Path, Cache, Path], tmp_path: Path) -> None:
     root, cache, recording = peaks_setup
-    whole = infer_cache(cache, root / "models", tmp_path / "whole.npz")
-    ok = write_predictions(whole, cache, [recording], tmp_path / "ok.parquet", split="all")
+    whole = infer_cache(cache, models=root / "models", out=tmp_path / "whole.npz")
+    ok = write_predictions(whole, cache, inputs=[recording], out=tmp_path / "ok.parquet", split="all")
     assert pl.read_parquet(ok).height > 0
     # the peaks of an --limit run (or of another cache): an IndexError traceback
-    short = infer_cache(cache, root / "models", tmp_path / "short.npz", limit=2)
+    short = infer_cache(cache, models=root / "models", out=tmp_path / "short.npz", limit=2)
     with pytest.raises(InputError, match=r"short\.npz: single_offsets: peaks of 2 items, where the cache .* 6 clouds"):
-        write_predictions(short, cache, [recording], tmp_path / "short.parquet", split="all")
+        write_predictions(short, cache, inputs=[recording], out=tmp_path / "short.parquet", split="all")
     # recordings the cache does not hold: a predictions file without a row
     other = _record("lr_other", tmp_path)
     with pytest.raises(InputError, match=r"cache_all\.npz: holds no sequence lr_other of split 'all'"):
-        write_predictions(whole, cache, [other], tmp_path / "other.parquet", split="all")
+        write_predictions(whole, cache, inputs=[other], out=tmp_path / "other.parquet", split="all")
     assert not (tmp_path / "short.parquet").exists() and not (tmp_path / "other.parquet").exists()
 
 

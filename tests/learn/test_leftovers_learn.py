@@ -75,7 +75,7 @@ def test_the_predictions_of_a_model_that_found_nothing_score_as_ap_0(
     cover."""
     cache = Cache(build_cache([recording], tmp_path / "cache.npz", split="all"))
     peaks = _no_peaks(cache, tmp_path / "peaks.npz")
-    pred = write_predictions(peaks, cache, [recording], tmp_path / "p.parquet", split="all")
+    pred = write_predictions(peaks, cache, inputs=[recording], out=tmp_path / "p.parquet", split="all")
     df = pl.read_parquet(pred)
     assert df.filter(pl.col("kind") == "det").height == 0
     frames = df.filter(pl.col("kind") == "frame")

@@ -26,15 +26,21 @@ def test_regression_loss_weights_rows_and_columns_by_hand() -> None:
         wt * sum(c * abs(pred[j, i] - reg[0, r, j].item()) for j, c in enumerate(code))
         for r, (i, wt) in enumerate(zip((5, 0, 11), (1.0, 0.5, 0.0), strict=True))
     )
-    got = regression_loss(out, index, weight, reg, code).item()
+    got = regression_loss(out, index=index, weight=weight, reg=reg, code_weights=code).item()
     assert got == pytest.approx(want, rel=1e-5)
     # without code weights every column counts once; a bool mask is a 0/1 weight
-    plain = regression_loss(out, index, torch.tensor([[True, True, False]]), reg).item()
+    plain = regression_loss(out, index=index, weight=torch.tensor([[True, True, False]]), reg=reg).item()
     want1 = sum(abs(pred[j, i] - reg[0, r, j].item()) for r, i in enumerate((5, 0)) for j in range(8))
     assert plain == pytest.approx(want1, rel=1e-5)
     # centerpoint_loss: the L1 part per unit of row weight, times REG_WEIGHT
     parts = centerpoint_loss(
-        out, torch.zeros(1, 1, 3, 4), index, torch.tensor([[True, False, False]]), reg, weight, code
+        out,
+        heatmap=torch.zeros(1, 1, 3, 4),
+        index=index,
+        mask=torch.tensor([[True, False, False]]),
+        reg=reg,
+        weight=weight,
+        code_weights=code,
     )
     assert parts["regression"].item() == pytest.approx(REG_WEIGHT * want / 1.5, rel=1e-5)
 

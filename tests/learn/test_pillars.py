@@ -63,7 +63,9 @@ def test_scatter_and_scatter_max_against_numpy() -> None:
     coords = np.array([[0, 0], [4, 5], [2, 3], [1, 1]])
     batch = np.array([0, 0, 1, 1])
     feats = rng.random((4, 3)).astype(np.float32)
-    canvas = scatter(torch.from_numpy(feats), torch.from_numpy(coords), torch.from_numpy(batch), size=2, grid=grid)
+    canvas = scatter(
+        torch.from_numpy(feats), coords=torch.from_numpy(coords), batch=torch.from_numpy(batch), size=2, grid=grid
+    )
     want = np.zeros((2, 3, 5, 6), np.float32)
     for f, (iy, ix), b in zip(feats, coords, batch, strict=True):
         want[b, :, iy, ix] = f
@@ -72,7 +74,9 @@ def test_scatter_and_scatter_max_against_numpy() -> None:
     more = rng.random((3, 3)).astype(np.float32)
     cells = np.array([[0, 0], [0, 0], [3, 2]])
     mb = np.array([0, 0, 1])
-    fused = scatter_max(canvas, torch.from_numpy(more), torch.from_numpy(cells), torch.from_numpy(mb))
+    fused = scatter_max(
+        canvas, features=torch.from_numpy(more), cells=torch.from_numpy(cells), batch=torch.from_numpy(mb)
+    )
     for f, (iy, ix), b in zip(more, cells, mb, strict=True):
         want[b, :, iy, ix] = np.maximum(want[b, :, iy, ix], f)
     np.testing.assert_array_equal(fused.numpy(), want)

@@ -157,13 +157,13 @@ def test_the_sea_height_is_the_quantile_of_the_near_returns() -> None:
     keep, height, _, got = above_water(sea[:, :3], w)
     r = np.hypot(sea[:, 0], sea[:, 1])
     want = np.quantile(height[(r > w.self_radius_m) & (r < w.sea_near_m) & (height < w.sea_cap_m)], 0.95)
-    assert sea_height(sea, height, r, w) == got == want + w.sea_margin_m
+    assert sea_height(sea, height=height, r=r, params=w) == got == want + w.sea_margin_m
     assert 0.7 * 2.5 < want < 2.5  # the carpet's crests, above the trough plane
     assert np.array_equal(keep, (height > got) & (r > w.self_radius_m))
     # A calm sea returns from a few patches of water only: no sea height, the fixed rule as before.
     calm = sea[:300]
     keep2, h2, _, got2 = above_water(calm[:, :3], w)
-    assert sea_height(calm, h2, np.hypot(calm[:, 0], calm[:, 1]), w) == got2 == 0.0
+    assert sea_height(calm, height=h2, r=np.hypot(calm[:, 0], calm[:, 1]), params=w) == got2 == 0.0
     assert np.array_equal(keep2, (h2 > w.min_height_m) & (np.hypot(calm[:, 0], calm[:, 1]) > w.self_radius_m))
 
 
@@ -181,7 +181,7 @@ def test_a_hulls_side_near_the_sensor_does_not_raise_the_sea_height() -> None:
 
     def height_of(pts: np.ndarray, prm: BaselineParams) -> float:
         h = pts[:, 2] - WATER_Z
-        return sea_height(pts, h, np.hypot(pts[:, 0], pts[:, 1]), prm)
+        return sea_height(pts, height=h, r=np.hypot(pts[:, 0], pts[:, 1]), params=prm)
 
     alone = height_of(sea, w)
     assert alone > 0.0

@@ -51,8 +51,8 @@ def trained(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Cache, Path
 def test_per_mode_inference_merges_to_one_run(trained: tuple[Path, Cache, Path], tmp_path: Path) -> None:
     _, cache, root = trained
     models = root / "models"
-    whole = np.load(infer_cache(cache, models, tmp_path / "all.npz"))
-    parts = [infer_cache(cache, models, tmp_path / f"{m}.npz", modes=[m]) for m in MODES]
+    whole = np.load(infer_cache(cache, models=models, out=tmp_path / "all.npz"))
+    parts = [infer_cache(cache, models=models, out=tmp_path / f"{m}.npz", modes=[m]) for m in MODES]
     assert set(np.load(parts[0]).files) == {"single_boxes", "single_scores", "single_offsets"}
     merged = np.load(merge_peaks([*parts, tmp_path / "missing.npz"], tmp_path / "merged.npz"))
     assert sorted(merged.files) == sorted(whole.files)
@@ -61,7 +61,7 @@ def test_per_mode_inference_merges_to_one_run(trained: tuple[Path, Cache, Path],
     with pytest.raises(InputError, match="in two of the peak files"):
         merge_peaks([parts[0], parts[0]], tmp_path / "twice.npz")
     with pytest.raises(InputError, match="allowed: single, early, intermediate"):
-        infer_cache(cache, models, tmp_path / "bad.npz", modes=["late"])
+        infer_cache(cache, models=models, out=tmp_path / "bad.npz", modes=["late"])
 
 
 def _rows(df: pl.DataFrame, key: tuple[str, int, str], mode: str) -> tuple[np.ndarray, np.ndarray]:
@@ -98,9 +98,14 @@ def test_replay_equals_the_detector_on_the_same_clouds(
     trained: tuple[Path, Cache, Path], tmp_path: Path, refine: bool
 ) -> None:
     rec, cache, root = trained
-    peaks = infer_cache(cache, root / "models", tmp_path / "peaks.npz")
+    peaks = infer_cache(cache, models=root / "models", out=tmp_path / "peaks.npz")
     out = write_predictions(
-        peaks, cache, [rec], tmp_path / "pred.parquet", split="all", refine=RefineParams() if refine else None
+        peaks,
+        cache,
+        inputs=[rec],
+        out=tmp_path / "pred.parquet",
+        split="all",
+        refine=RefineParams() if refine else None,
     )
     df = pl.read_parquet(out)
     assert set(df["mode"].unique().to_list()) == {"none", "late", "early", "intermediate"}
@@ -119,10 +124,10 @@ def test_replay_equals_the_detector_on_the_same_clouds(
 
 def test_replay_rejects_an_unknown_late_merge(trained: tuple[Path, Cache, Path], tmp_path: Path) -> None:
     rec, cache, root = trained
-    peaks = infer_cache(cache, root / "models", tmp_path / "peaks.npz", modes=["single"])
+    peaks = infer_cache(cache, models=root / "models", out=tmp_path / "peaks.npz", modes=["single"])
     with pytest.raises(InputError, match="--late-merge 'mean': allowed: nms, wbf"):
-        write_predictions(peaks, cache, [rec], tmp_path / "p.parquet", split="all", late_merge="mean")
-    out = write_predictions(peaks, cache, [rec], tmp_path / "p.parquet", split="all", late_merge="wbf")
+        write_predictions(peaks, cache, inputs=[rec], out=tmp_path / "p.parquet", split="all", late_merge="mean")
+    out = write_predictions(peaks, cache, inputs=[rec], out=tmp_path / "p.parquet", split="all", late_merge="wbf")
     assert set(pl.read_parquet(out)["mode"].unique().to_list()) == {"none", "late"}
 
 
@@ -152,10 +157,10 @@ def test_replay_with_scorers_equals_the_rescoring_detector(trained: tuple[Path, 
     for mode in MODES:
         n = len(FEATURES)
         IoUScorer(np.zeros(n), np.ones(n), beta=0.5).save(models / mode / SCORER_FILE, {"test": True})
-    peaks = infer_cache(cache, models, tmp_path / "peaks.npz")
+    peaks = infer_cache(cache, models=models, out=tmp_path / "peaks.npz")
     scorers = {m: load_scorer(models / m / SCORER_FILE) for m in MODES}
     out = write_predictions(
-        peaks, cache, [rec], tmp_path / "pred.parquet", split="all", refine=RefineParams(), scorers=scorers
+        peaks, cache, inputs=[rec], out=tmp_path / "pred.parquet", split="all", refine=RefineParams(), scorers=scorers
     )
     df = pl.read_parquet(out)
     det = load_models(models, refine=True)  # rescored: the scorers are found beside the models

@@ -29,7 +29,7 @@ def test_features_of_a_hand_built_box() -> None:
     net = np.array([[51.0, 0.0, 0.0, 8.0, 4.0, 3.0, 0.3]])
     # 9 points inside (x 46..54 step 1, y = 1), 2 in the margins only (x 58, 59), 1 far away.
     xy = np.array([[46.0 + i, 1.0] for i in range(9)] + [[58.0, 0.0], [59.0, 0.0], [150.0, 0.0]])
-    f = box_features(xy, net, box, np.array([0.8]), p)[0]
+    f = box_features(xy, net_boxes=net, boxes=box, scores=np.array([0.8]), p=p)[0]
     want = {
         "score_logit": np.log(0.8 / 0.2),
         "log_length": np.log(10.0),
@@ -48,7 +48,9 @@ def test_features_of_a_hand_built_box() -> None:
     assert list(want) == list(FEATURES)
     np.testing.assert_allclose(f, np.array(list(want.values()), dtype=np.float32), rtol=1e-5, atol=1e-6)
     # A heading turned by π is the same heading.
-    flipped = box_features(xy, net, box + np.array([0, 0, 0, 0, 0, 0, np.pi]), np.array([0.8]), p)[0]
+    flipped = box_features(
+        xy, net_boxes=net, boxes=box + np.array([0, 0, 0, 0, 0, 0, np.pi]), scores=np.array([0.8]), p=p
+    )[0]
     assert flipped[12] == pytest.approx(0.3, abs=1e-5)
 
 
@@ -85,15 +87,15 @@ def _scene(k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
 def test_fitted_scorer_ranks_the_tight_boxes_first(tmp_path: Path) -> None:
     p = RefineParams()
     ks = list(range(60))
-    scorer, fit = fit_scorer(_scene, ks, [k // 3 for k in ks], refine=p, nms_iou=0.1, seed=0, epochs=300)
+    scorer, fit = fit_scorer(_scene, samples=ks, groups=[k // 3 for k in ks], refine=p, nms_iou=0.1, seed=0, epochs=300)
     # The refined boxes on seen hulls are tight (the rule of mmusv.learn.refine), the others loose.
     pts, boxes, scores, gt = _scene(1000)
     xy = surface_points(pts, p)
-    out_b, out_s = second_stage(pts, boxes, scores, refine=p, scorer=scorer, nms_iou=0.1)
+    out_b, out_s = second_stage(pts, boxes=boxes, scores=scores, refine=p, scorer=scorer, nms_iou=0.1)
     seen = [i for i in range(len(out_b)) if max(iou(out_b[i], g) for g in gt[:2]) > 0.8]
     others = [i for i in range(len(out_b)) if i not in seen]
     assert len(seen) == 2 and others
-    q = scorer.iou(box_features(xy, out_b, out_b, out_s, p))
+    q = scorer.iou(box_features(xy, net_boxes=out_b, boxes=out_b, scores=out_s, p=p))
     assert min(q[seen]) > max(q[others]) + 0.1, (q, seen)
     # On the held-out sequences, ranking by the predicted IoU beats the network's (random) scores at AP@0.7.
     by_beta = {b: (a5, a7) for b, a5, a7 in fit.held_out}
@@ -101,10 +103,10 @@ def test_fitted_scorer_ranks_the_tight_boxes_first(tmp_path: Path) -> None:
     # Saved and read back: the same predictions; the same seed gives the same weights.
     path = scorer.save(tmp_path / "scorer.pt", {"note": "test"})
     again = load_scorer(path)
-    f = box_features(xy, boxes, boxes, scores, p)
+    f = box_features(xy, net_boxes=boxes, boxes=boxes, scores=scores, p=p)
     np.testing.assert_array_equal(again.iou(f), scorer.iou(f))
     assert again.beta == scorer.beta
-    twin, _ = fit_scorer(_scene, ks, [k // 3 for k in ks], refine=p, nms_iou=0.1, seed=0, epochs=300)
+    twin, _ = fit_scorer(_scene, samples=ks, groups=[k // 3 for k in ks], refine=p, nms_iou=0.1, seed=0, epochs=300)
     assert all(torch.equal(a, b) for a, b in zip(twin.state_dict().values(), scorer.state_dict().values(), strict=True))
 
 
@@ -113,7 +115,7 @@ def test_too_few_boxes_and_foreign_files_are_clear_errors(tmp_path: Path) -> Non
         return np.zeros((0, 4), np.float32), np.zeros((0, 7)), np.zeros(0), np.zeros((1, 7))
 
     with pytest.raises(InputError, match="found 0 boxes"):
-        fit_scorer(empty, list(range(10)), list(range(10)), refine=RefineParams(), nms_iou=0.1)
+        fit_scorer(empty, samples=list(range(10)), groups=list(range(10)), refine=RefineParams(), nms_iou=0.1)
     bad = tmp_path / "scorer.pt"
     torch.save({"features": ["other"], "state": {}, "beta": 0.5}, bad)
     with pytest.raises(InputError, match=r"not an mmusv\.learn scorer"):

@@ -37,7 +37,7 @@ def test_tiny_model_overfits_a_few_frames(tmp_path: Path) -> None:
     for k in range(len(src)):
         pts, _, gt = src.sample(k)
         boxes, scores = det(pts)
-        frames.append(FrameMatch.evaluate(boxes, scores, gt))
+        frames.append(FrameMatch.evaluate(boxes, det_scores=scores, gt_boxes=gt))
     m = summarize(frames)
     assert m["ap50"] >= 0.9, m
     # the geometric second stage: off by default for the tiny preset, on request it keeps the network's scores
@@ -97,7 +97,8 @@ def test_channels_last_model_is_the_same_function() -> None:
 
     src = MemorySource(SCENES[:2])
     p = preset("tiny")
-    batch = collate([make_example(*src.sample(k), mode="single", p=p) for k in range(2)])
+    samples = [src.sample(k) for k in range(2)]
+    batch = collate([make_example(ego, neighbours=nbs, boxes=gt, mode="single", p=p) for ego, nbs, gt in samples])
     torch.manual_seed(3)
     a = PillarNet(p, "single")
     b = PillarNet(p, "single")
@@ -117,7 +118,9 @@ def test_channels_last_model_is_the_same_function() -> None:
     for model in (a, b):
         opt = torch.optim.SGD(model.parameters(), lr=0.1)
         out = model(batch)
-        loss = centerpoint_loss(out, batch.heatmap, batch.index, batch.reg_mask, batch.reg, batch.reg_weight)
+        loss = centerpoint_loss(
+            out, heatmap=batch.heatmap, index=batch.index, mask=batch.reg_mask, reg=batch.reg, weight=batch.reg_weight
+        )
         opt.zero_grad()
         loss["loss"].backward()
         opt.step()

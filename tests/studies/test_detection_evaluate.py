@@ -27,7 +27,7 @@ def box(x: float, y: float, length: float = 4.0, w: float = 2.0, yaw: float = 0.
 def test_identical_boxes_iou_one_and_ap_one() -> None:
     b = np.array([box(10, 5, yaw=0.3), box(-20, 40, 6, 3, -1.0)])
     assert np.allclose(np.diag(bev_iou(b, b)), 1.0)
-    fm = FrameMatch.evaluate(b, np.array([0.9, 0.8]), b)
+    fm = FrameMatch.evaluate(b, det_scores=np.array([0.9, 0.8]), gt_boxes=b)
     m = summarize([fm])
     assert m["ap30"] == m["ap50"] == m["ap70"] == 1.0
     assert m["precision50"] == m["recall50"] == 1.0
@@ -65,12 +65,12 @@ def test_rotated_90_degrees_and_180_degrees() -> None:
 def test_duplicate_detection_is_a_false_positive() -> None:
     gt = np.array([box(0, 0)])
     dets = np.array([box(0.2, 0), box(0.1, 0)])  # both overlap; the higher score takes the GT
-    m = match_frame(dets, np.array([0.9, 0.5]), gt, iou_threshold=0.5)
+    m = match_frame(dets, det_scores=np.array([0.9, 0.5]), gt_boxes=gt, iou_threshold=0.5)
     assert m.tolist() == [0, -1]
     # Score order decides, not IoU: the worse-overlapping but higher-scored box takes the GT.
-    m = match_frame(dets, np.array([0.5, 0.9]), gt, iou_threshold=0.5)
+    m = match_frame(dets, det_scores=np.array([0.5, 0.9]), gt_boxes=gt, iou_threshold=0.5)
     assert m.tolist() == [-1, 0]
-    s = summarize([FrameMatch.evaluate(dets, np.array([0.9, 0.5]), gt)])
+    s = summarize([FrameMatch.evaluate(dets, det_scores=np.array([0.9, 0.5]), gt_boxes=gt)])
     assert s["precision50"] == 0.5 and s["recall50"] == 1.0
     assert s["ap50"] == 1.0  # PR points (1, 1), (1, 0.5): all-point area 1
 
@@ -78,37 +78,37 @@ def test_duplicate_detection_is_a_false_positive() -> None:
 def test_best_unmatched_gt_is_taken() -> None:
     gt = np.array([box(0, 0), box(1.0, 0)])  # det 0 overlaps gt 1 best (IoU 1), det 1 then gets gt 0
     dets = np.array([box(1.0, 0), box(0.3, 0)])
-    assert match_frame(dets, np.array([0.9, 0.8]), gt, iou_threshold=0.5).tolist() == [1, 0]
+    assert match_frame(dets, det_scores=np.array([0.9, 0.8]), gt_boxes=gt, iou_threshold=0.5).tolist() == [1, 0]
 
 
 def test_iou_threshold_is_inclusive_and_levels_differ() -> None:
     gt = np.array([box(0, 0)])
     det = np.array([box(1.0, 0)])  # IoU 0.6
-    fm = FrameMatch.evaluate(det, np.array([1.0]), gt)
+    fm = FrameMatch.evaluate(det, det_scores=np.array([1.0]), gt_boxes=gt)
     assert fm.matches[0.3].tolist() == [0] and fm.matches[0.5].tolist() == [0] and fm.matches[0.7].tolist() == [-1]
     exact = np.array([box(0, 0, 4.0, 2.0)])
     half = np.array([box(0, 0, 2.0, 2.0)])  # inside: IoU exactly 0.5
-    assert match_frame(half, np.array([1.0]), exact, iou_threshold=0.5).tolist() == [0]
+    assert match_frame(half, det_scores=np.array([1.0]), gt_boxes=exact, iou_threshold=0.5).tolist() == [0]
 
 
 def test_misses_lower_recall_and_ap() -> None:
     gt = np.array([box(0, 0), box(30, 0)])
-    fm = FrameMatch.evaluate(np.array([box(0, 0)]), np.array([0.7]), gt)
+    fm = FrameMatch.evaluate(np.array([box(0, 0)]), det_scores=np.array([0.7]), gt_boxes=gt)
     s = summarize([fm])
     assert s["recall50"] == 0.5 and s["precision50"] == 1.0 and s["ap50"] == pytest.approx(0.5)
 
 
 def test_empty_frames() -> None:
-    no_gt = FrameMatch.evaluate(np.array([box(5, 5)]), np.array([0.9]), np.zeros((0, 7)))
-    no_det = FrameMatch.evaluate(np.zeros((0, 7)), np.zeros(0), np.array([box(0, 0)]))
-    both = FrameMatch.evaluate(np.zeros((0, 7)), np.zeros(0), np.zeros((0, 7)))
+    no_gt = FrameMatch.evaluate(np.array([box(5, 5)]), det_scores=np.array([0.9]), gt_boxes=np.zeros((0, 7)))
+    no_det = FrameMatch.evaluate(np.zeros((0, 7)), det_scores=np.zeros(0), gt_boxes=np.array([box(0, 0)]))
+    both = FrameMatch.evaluate(np.zeros((0, 7)), det_scores=np.zeros(0), gt_boxes=np.zeros((0, 7)))
     assert no_gt.matches[0.5].tolist() == [-1]
     assert math.isnan(summarize([no_gt])["ap50"])  # nothing to find: AP undefined
     assert summarize([no_det])["ap50"] == 0.0  # nothing found
     assert math.isnan(summarize([no_det])["precision50"])
     assert math.isnan(summarize([both])["ap50"])
     # A frame without ground truth adds its false positives to the others: one TP (0.8) and one FP (0.9).
-    hit = FrameMatch.evaluate(np.array([box(0, 0)]), np.array([0.8]), np.array([box(0, 0)]))
+    hit = FrameMatch.evaluate(np.array([box(0, 0)]), det_scores=np.array([0.8]), gt_boxes=np.array([box(0, 0)]))
     s = summarize([no_gt, hit, both])
     assert s["precision50"] == 0.5 and s["recall50"] == 1.0
     assert s["ap50"] == pytest.approx(0.5)  # PR: (0, 0) then (1, 0.5)
@@ -123,16 +123,18 @@ def test_ap_interpolation_on_a_hand_computed_curve() -> None:
     # recall .25 .25 .5 .5 .75, precision 1 .5 2/3 .5 .6; interpolated precision at the recall steps:
     # .25 → 1, .5 → 2/3, .75 → .6, 1 → 0: AP = .25·(1 + 2/3 + .6) = 0.5666…
     expected = 0.25 * (1 + 2 / 3 + 0.6)
-    assert average_precision(np.array([0.9, 0.8, 0.7, 0.6, 0.5]), np.array([1, 0, 1, 0, 1], bool), 4) == pytest.approx(
-        expected, abs=1e-12
-    )
+    assert average_precision(
+        np.array([0.9, 0.8, 0.7, 0.6, 0.5]), tp=np.array([1, 0, 1, 0, 1], bool), n_gt=4
+    ) == pytest.approx(expected, abs=1e-12)
     assert voc_ap(np.array([0.25, 0.25, 0.5, 0.5, 0.75]), np.array([1, 0.5, 2 / 3, 0.5, 0.6])) == pytest.approx(
         expected, abs=1e-12
     )
     # The same curve built from boxes over two frames (global sort by score across frames).
     gts = [np.array([box(0, 0), box(20, 0)]), np.array([box(0, 0), box(20, 0)])]
-    f1 = FrameMatch.evaluate(np.array([box(0, 0), box(50, 50), box(20, 0)]), np.array([0.9, 0.6, 0.5]), gts[0])
-    f2 = FrameMatch.evaluate(np.array([box(60, 60), box(0, 0)]), np.array([0.8, 0.7]), gts[1])
+    f1 = FrameMatch.evaluate(
+        np.array([box(0, 0), box(50, 50), box(20, 0)]), det_scores=np.array([0.9, 0.6, 0.5]), gt_boxes=gts[0]
+    )
+    f2 = FrameMatch.evaluate(np.array([box(60, 60), box(0, 0)]), det_scores=np.array([0.8, 0.7]), gt_boxes=gts[1])
     assert summarize([f1, f2])["ap50"] == pytest.approx(expected, abs=1e-12)
 
 
@@ -147,7 +149,7 @@ def test_range_bins() -> None:
 def test_ap_per_range_bin() -> None:
     gt = np.array([box(30, 0), box(0, 120), box(50.5, 0, 4, 2)])
     dets = np.array([box(30, 0), box(49.8, 0, 4, 2), box(170, 0)])  # TP (0-50), TP (its GT at 50.5), FP (150-200)
-    fm = FrameMatch.evaluate(dets, np.array([0.9, 0.8, 0.7]), gt)
+    fm = FrameMatch.evaluate(dets, det_scores=np.array([0.9, 0.8, 0.7]), gt_boxes=gt)
     assert fm.det_bins(0.5).tolist() == [0, 1, 3]
     s = summarize([fm])
     assert s["ap50_0-50"] == 1.0
@@ -292,7 +294,7 @@ def test_matches_opencood_algorithm_on_random_cases(seed: int) -> None:
                 gts.reshape(-1, 7),
             )
         )
-    got = summarize([FrameMatch.evaluate(d, s, g) for d, s, g in frames])
+    got = summarize([FrameMatch.evaluate(d, det_scores=s, gt_boxes=g) for d, s, g in frames])
     if sum(len(g) for _, _, g in frames) == 0:
         assert math.isnan(got["ap50"])
         return

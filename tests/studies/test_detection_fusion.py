@@ -127,7 +127,7 @@ def scene(rng: np.random.Generator) -> tuple[SceneFrame, AgentFrame, AgentFrame,
     target[:3, 3] = [150.0, 20.0, 1.0]
     sizes = np.array([[12.0, 4.0, 3.0]])
     ego = AgentFrame("usv_1", water(rng), ego_body, MOUNT)
-    nb_box = boxes_in_frame(invert(nb_body @ MOUNT), target[None], sizes)[0]
+    nb_box = boxes_in_frame(invert(nb_body @ MOUNT), boxes=target[None], sizes=sizes)[0]
     nb = AgentFrame("usv_2", np.concatenate([water(rng), box_surface(nb_box, rng)]).astype(np.float32), nb_body, MOUNT)
     usv = np.stack([ego_body, nb_body])
     frame = SceneFrame(0, (ego, nb), ("t",), target[None], sizes, usv, np.tile([5.0, 2.4, 2.5], (2, 1)))
@@ -201,16 +201,16 @@ def test_fuse_boxes_groups_by_iou_and_agent() -> None:
     boxes = np.stack([a, same, far, same])
     scores = np.array([0.5, 0.5, 0.9, 0.4])
     agents = np.array([0, 1, 0, 0])  # the last: a second box of agent 0 on the same vessel
-    fb, fs = fuse_boxes(boxes, scores, agents)
+    fb, fs = fuse_boxes(boxes, scores=scores, agents=agents)
     assert fs.tolist() == pytest.approx([0.9, 0.75])  # agent 0's second box does not add confidence
     np.testing.assert_array_equal(fb[0], far)
     assert fb[1, 0] == pytest.approx(0.25)
     assert abs(abs(fb[1, 6]) - np.pi / 2) < 1e-9  # not the naive mean 0
     # one agent alone: its boxes as they are (a box under the threshold is not merged)
-    one, sc = fuse_boxes(boxes[:3], np.array([0.5, 0.4, 0.9]), np.zeros(3, int), iou_threshold=0.95)
+    one, sc = fuse_boxes(boxes[:3], scores=np.array([0.5, 0.4, 0.9]), agents=np.zeros(3, int), iou_threshold=0.95)
     assert sc.tolist() == [0.9, 0.5, 0.4]
     np.testing.assert_array_equal(one, boxes[[2, 0, 1]])
-    empty = fuse_boxes(np.zeros((0, 7)), np.zeros(0), np.zeros(0, int))
+    empty = fuse_boxes(np.zeros((0, 7)), scores=np.zeros(0), agents=np.zeros(0, int))
     assert empty[0].shape == (0, 7) and empty[1].shape == (0,)
 
 
