@@ -84,6 +84,21 @@ def test_an_unfinished_dataset_is_finished(built: tuple[Path, Path, str], tmp_pa
     assert stamps(out / "recordings", others) == keep and tree(out) == tree(done)
 
 
+def test_a_sequence_removed_by_hand_is_converted_again(built: tuple[Path, Path, str], tmp_path: Path) -> None:
+    """A converted sequence's folder removed by hand (``conversion.yaml`` still says complete): the re-run said
+    "opv2v: ... is up to date" and left it missing; it converts again, into the same bytes, the recordings kept."""
+    spec, done, _ = built
+    out = tmp_path / "ds"
+    shutil.copytree(done, out)
+    seq = sorted(p for p in (out / "opv2v").glob("*/*") if p.is_dir() and p.parent.name != "opencood")[0]
+    shutil.rmtree(seq)
+    names = [p.name for p in (out / "recordings").iterdir() if p.is_dir() and not p.name.startswith(".")]
+    keep = stamps(out / "recordings", names)
+    rep = build_dataset(spec, out_dir=out)
+    assert rep.converted and rep.batch.summary() == "0 done, 0 failed, 3 skipped, 0 retried"
+    assert seq.is_dir() and tree(out) == tree(done) and stamps(out / "recordings", names) == keep
+
+
 def test_consumers_read_the_index(built: tuple[Path, Path, str], tmp_path: Path) -> None:
     _spec, out, _ = built
     recs = dataset_recordings(out)

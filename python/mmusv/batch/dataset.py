@@ -58,7 +58,8 @@ class DatasetReport:
 
 
 def _conversion_complete(opv2v: Path) -> bool:
-    """Whether ``opv2v`` holds a finished conversion: its report says ``status: complete``. A conversion into a
+    """Whether ``opv2v`` holds a finished conversion: its report says ``status: complete`` and every recording it
+    converted frames of still has its folder (``<split>/<folder>``). A conversion into a
     folder that was not there (removed by hand) writes into it directly and starts its report as ``in_progress``:
     stopped there (Ctrl-C), a re-run took the half-written folder for up to date, as the index still named the
     same recordings."""
@@ -69,7 +70,23 @@ def _conversion_complete(opv2v: Path) -> bool:
         doc = read_yaml(opv2v / REPORT_NAME)
     except (OSError, MmusvError, ValueError):
         return False
-    return isinstance(doc, dict) and doc.get("status") == "complete"
+    if not isinstance(doc, dict) or doc.get("status") != "complete":
+        return False
+    # Every recording that was converted still has its folder: one removed by hand (to make room, or to convert it
+    # again) was taken for up to date, "opv2v: ... is up to date" with its sequence gone.
+    recordings = doc.get("recordings")
+    if not isinstance(recordings, list):
+        return False
+    for r in recordings:
+        if (
+            not isinstance(r, dict)
+            or not isinstance(r.get("folder"), str)
+            or not isinstance(r.get("split"), str | None)
+        ):
+            return False
+        if r.get("frames_converted") and not (opv2v / (r["split"] or "") / r["folder"]).is_dir():
+            return False
+    return True
 
 
 def _spec_hash(spec: Any) -> str:
