@@ -47,6 +47,10 @@ def _built(where: str, kind: str, build: Callable[[], _T]) -> _T:
 class Agent:
     """An instrumented USV and its native sensors (each configured once from the rig).
 
+    ``lidar_mount``, ``radar_mount``: ``(4, 4)`` float64 sensor → vessel body matrices (metres; read-only; ``None``
+    without that sensor); ``cameras``: name → (native camera, its :class:`CameraConfig`, ``(4, 4)`` float64 camera
+    body → vessel body mount, read-only); :meth:`mounts` gathers them.
+
     Two agents compare equal (``==``) when they hold the same values, as captures do (:mod:`mmusv.captures`): the
     same index, vessel, asset, rig and mounts (arrays by dtype, shape and value), and the same sensors present.
     The native sensors are built from the rig, so they are compared through it: the agents of two simulations of

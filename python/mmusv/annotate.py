@@ -65,7 +65,8 @@ NEAR_M = 0.05
 def in_target_range(centres: np.ndarray, range_m: float) -> np.ndarray:
     """The box-centre target rule: which box centres lie within ``range_m`` metres of the ego LiDAR in bird's-eye
     view, ``hypot(x, y) <= range_m`` (height ignored). ``centres``: ``(..., 3)`` (or ``(..., 2)``) in the ego's
-    LiDAR frame (its body frame when it has none), metres; returns a bool array of shape ``centres.shape[:-1]``.
+    LiDAR frame (its body frame when it has none), metres; returns a bool array of shape ``centres.shape[:-1]``
+    (a 0-d array for one centre).
 
     Used by the OPV2V and KITTI exports (which vessels are labelled) and the detection study (the BEV distance it
     evaluates within), as OpenCOOD selects its objects; the recording's own 3D/BEV boxes reach farther, to every
@@ -98,8 +99,8 @@ def footprint_in_range(box: np.ndarray, *, size: np.ndarray, range_m: float) -> 
 
 
 def box_corners(matrix: np.ndarray, size: np.ndarray) -> np.ndarray:
-    """``(8, 3)`` corners of a box with pose ``matrix`` (``(4, 4)`` box → frame, centred) and full ``size``
-    (length, beam, height along the box's x, y, z), in the frame ``matrix`` maps to. Corner ``i`` lies at
+    """``(8, 3)`` float64 corners of a box with pose ``matrix`` (``(4, 4)`` box → frame, centred) and full ``size``
+    (length, beam, height along the box's x, y, z; metres), in the frame ``matrix`` maps to. Corner ``i`` lies at
     ``±size / 2`` in the box frame, the sign of x from bit 0 of ``i``, of y from bit 1 and of z from bit 2 (set:
     +; corner 0 is (−x, −y, −z), corner 7 (+x, +y, +z)). Other shapes raise :class:`mmusv.InputError`."""
     matrix, size = np.asarray(matrix, dtype=np.float64), np.asarray(size, dtype=np.float64)
@@ -112,8 +113,9 @@ def box_corners(matrix: np.ndarray, size: np.ndarray) -> np.ndarray:
 
 @dataclass(eq=False)
 class Annotations:
-    """Columns of one agent's annotations at one frame (see the module docstring). Lengths: ``n3d`` for
-    ``lidar_*``/``bev_*``, ``n2d`` for ``cam_*``. Two compare equal (``==``) when they hold the same values
+    """Columns of one agent's annotations at acquisition index ``frame``, ``time_s`` seconds (see the module
+    docstring), as lists, one entry per box, in the units and frames of :meth:`columns`. Lengths: ``n3d`` for
+    ``lidar_*``, ``n2d`` for ``cam_*``. Two compare equal (``==``) when they hold the same values
     (arrays by dtype, shape and value)."""
 
     agent: str
@@ -151,7 +153,8 @@ class Annotations:
     def columns(self) -> dict[str, Any]:
         """Numpy columns, the ``Recording.annotations`` groups: ``{"lidar", "bev", "camera"}``, each a dict of
         columns in the order the vessels are in the world state (``n3d`` rows for ``lidar``/``bev``, ``n2d`` for
-        ``camera``, which goes vessel by vessel, camera by camera):
+        ``camera``, which goes vessel by vessel, camera by camera; ``role`` and ``static`` go to the Parquet tables
+        only: the MCAP's ``AgentAnnotations`` has no such fields and ``Recording.annotations`` ignores them):
 
         - ``lidar`` (the agent's LiDAR frame, metres, radians): ``target_id``, ``role`` lists of str;
           ``instance_id``, ``semantic_class``, ``lidar_points`` ``(n3d,)`` uint32; ``center`` ``(n3d, 3)``,
@@ -215,7 +218,8 @@ class SilhouetteCache:
         self._scenes: dict[str, tuple[Scene, int]] = {}
 
     def hits(self, asset: str, *, pose: np.ndarray, origins: np.ndarray, directions: np.ndarray) -> np.ndarray:
-        """``(N,)`` bool: which rays hit the vessel ``asset`` at ``pose`` (body → world), alone in the world."""
+        """``(N,)`` bool: which rays (``origins``, ``directions`` ``(N, 3)`` world, metres) hit the vessel ``asset``
+        at ``pose`` (``(4, 4)`` body → world), alone in the world."""
         hit: np.ndarray = np.isfinite(self.distances(asset, pose=pose, origins=origins, directions=directions))
         return hit
 

@@ -32,8 +32,8 @@ class VesselInfo:
     role: str  # "usv", "target" or "moored"
     semantic_class: int
     instance_id: int
-    box_center_body: np.ndarray  # (3,) box centre in the vessel body frame, metres
-    box_size: np.ndarray  # (3,) length, beam, height, metres
+    box_center_body: np.ndarray  # (3,) float64 box centre in the vessel body frame, metres (read-only)
+    box_size: np.ndarray  # (3,) float64 length, beam, height, metres (read-only)
     static: bool = False  # never moves: moored ships, and scenario vessels at speed 0 (VesselConfig.static)
 
     def __eq__(self, other: object) -> bool:
@@ -45,8 +45,10 @@ class VesselInfo:
 
 @dataclass(frozen=True, eq=False)
 class WorldState:
-    """Every vessel at one frame: ``poses`` ``(V, 6)`` [x, y, z, roll, pitch, yaw] (m, rad, world),
-    ``velocities`` ``(V, 3)`` m/s world, ``box_centers`` ``(V, 3)`` world, ``matrices`` ``(V, 4, 4)`` body → world."""
+    """Every vessel at one frame (V vessels, in ``Simulation.vessels`` order), at acquisition index ``frame`` and
+    time ``time_s`` (``k / f``, seconds). Arrays are float64: ``poses`` ``(V, 6)`` [x, y, z, roll, pitch, yaw] (m,
+    rad, world), ``velocities`` ``(V, 3)`` m/s world, ``box_centers`` ``(V, 3)`` world metres (the bounding-box
+    centres), ``matrices`` ``(V, 4, 4)`` vessel body → world."""
 
     frame: int
     time_s: float
@@ -82,7 +84,10 @@ class SensorMount:
 class AgentCapture:
     """Everything one USV's sensors produced at one frame, with the sensor poses (sensor → world).
 
-    ``body`` is the USV's ``(4, 4)`` body → world matrix and ``sensors`` every sensor of the USV (captured or
+    Poses (``lidar_pose``, ``camera_poses[name]``, ``top_view_pose``, ``radar_pose``) are ``(4, 4)`` float64 sensor
+    → world, ``None`` for a sensor not captured; ``radar_ppi`` is the ``(S, S)`` float32 linear-intensity PPI of
+    :func:`~mmusv.sensors.radar.ppi_image` (``S`` = the rig's ``ppi_size_px``; 0 where nothing).
+    ``body`` is the USV's ``(4, 4)`` float64 body → world matrix and ``sensors`` every sensor of the USV (captured or
     not) as a :class:`SensorMount`, keyed ``lidar``, ``radar``, ``camera/<name>``, ``top_view``: read the mounts
     and poses there rather than recomputing ``body · mount``.
     """
@@ -113,7 +118,8 @@ class AgentCapture:
 
 @dataclass(eq=False)
 class FrameCapture:
-    """One acquisition index: the world state and every agent's capture."""
+    """One acquisition index ``frame`` at ``time_s`` (``k / f``, seconds): the world state and every agent's
+    capture, keyed by agent id."""
 
     frame: int
     time_s: float

@@ -70,8 +70,9 @@ taken in batches of times, as the core bounds one call's (``Fleet.poses_at_times
 def scenario_poses(
     scenario: Scenario, *, wave: str | float | None = None, reference_usvs: bool = False
 ) -> npt.NDArray[np.float64]:
-    """``(frames, vessels, 6)`` float64 poses at every acquisition time t_k = k / f (``wave``, ``reference_usvs``:
-    as :func:`build_fleet`)."""
+    """``(frames, vessels, 6)`` float64 poses ``[x, y, z, roll, pitch, yaw]`` (world frame, metres, radians) of
+    ``scenario.vessels`` at every acquisition time t_k = k / f (``wave``, ``reference_usvs``: as
+    :func:`build_fleet`)."""
     fleet = build_fleet(scenario, wave=wave, reference_usvs=reference_usvs)
     times = np.arange(scenario.acquisition.frames, dtype=np.float64) / scenario.acquisition.frequency_hz
     step = max(1, POSE_BATCH // max(1, len(scenario.vessels)))

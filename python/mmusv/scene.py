@@ -379,8 +379,8 @@ class Scene:
         return int(self._native.add_instance(_id(mesh_id, name="mesh_id", kind="mesh"), p, cls))
 
     def set_poses(self, instance_ids: npt.ArrayLike, poses: npt.ArrayLike) -> None:
-        """Moves instances: ``instance_ids`` ``(K,)`` ints, ``poses`` ``(K, 4, 4)`` float. Only the top level is
-        rebuilt."""
+        """Moves instances: ``instance_ids`` ``(K,)`` ints, ``poses`` ``(K, 4, 4)`` float body → world (metres; one
+        ``(4, 4)`` for one id). Only the top level is rebuilt."""
         ids = np.atleast_1d(np.asarray(instance_ids))
         p = _floats(poses, name="poses")
         if ids.size == 0 and p.size == 0:
@@ -486,7 +486,7 @@ class Scene:
 
     @property
     def wave_top(self) -> float | None:
-        """The crest bound (highest world z) of the displaced sea surface, or ``None`` when none is set."""
+        """The crest bound (highest world z, metres) of the displaced sea surface, or ``None`` when none is set."""
         top: float | None = self._native.wave_top
         return top
 
@@ -517,8 +517,9 @@ class Scene:
         return RayHits(dist, inst, tri, normal, cls, back)
 
     def world_mesh(self) -> dict[str, np.ndarray]:
-        """The world triangles at the current poses: ``vertices`` (V,3) f32, ``faces`` (F,3) u32, ``classes``,
-        ``instance_ids`` and ``triangle_ids`` (F,)."""
+        """The world triangles at the current poses: ``vertices`` ``(V, 3)`` float32 world metres, ``faces``
+        ``(F, 3)`` uint32 vertex indices, ``classes`` ``(F,)`` uint16, ``instance_ids`` and ``triangle_ids`` ``(F,)``
+        uint32."""
         v, f, c, i, t = self._native.world_mesh()
         return {"vertices": v, "faces": f, "classes": c, "instance_ids": i, "triangle_ids": t}
 
@@ -528,11 +529,11 @@ class Scene:
         self._native.export(os.fspath(arguments.path(path, name="path", error=InputError)))
 
     def instance_aabb(self, instance_id: int) -> np.ndarray:
-        """``(2, 3)`` float32 world AABB (min row, max row) of an instance at its current pose."""
+        """``(2, 3)`` float32 world AABB (min row, max row), metres, of an instance at its current pose."""
         return np.asarray(self._native.instance_aabb(_id(instance_id, name="instance_id", kind="instance")))
 
     def instance_pose(self, instance_id: int) -> np.ndarray:
-        """``(4, 4)`` float64 current pose of an instance."""
+        """``(4, 4)`` float64 current pose of an instance (body → world, metres)."""
         return np.asarray(self._native.instance_pose(_id(instance_id, name="instance_id", kind="instance")))
 
     @property
@@ -560,8 +561,9 @@ def demo_scene(
     """The synthetic maritime benchmark scene: seabed/islands heightfield (``2·terrain_cells²`` triangles,
     instance 0), water plane at z = 0 (instance 1) and ``vessels`` hull instances around the origin.
 
-    ``seed``: a whole number in ``0..2**64 - 1``; ``extent``: metres (>= 100); ``terrain_cells`` in
-    ``1..MAX_DEMO_CELLS`` and ``vessels`` in ``0..MAX_DEMO_CELLS`` (whole numbers).
+    ``seed``: a whole number in ``0..2**64 - 1``; ``extent``: side of the square world centred on the origin,
+    metres (>= 100); ``terrain_cells`` in ``1..MAX_DEMO_CELLS`` and ``vessels`` in ``0..MAX_DEMO_CELLS`` (whole
+    numbers).
     Returns ``(scene, vessel_instance_ids)``. Deterministic from ``seed``.
     """
     seed = arguments.whole(seed, name="seed", lo=0, hi=2**64 - 1, error=InputError)

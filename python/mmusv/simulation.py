@@ -64,7 +64,12 @@ SENSOR_KINDS = ("lidar", "cameras", "top_view", "radar")
 
 
 class Simulation:
-    """A runnable scenario (see the module docstring). ``source``: a path, a dict or a :class:`Scenario`."""
+    """A runnable scenario (see the module docstring). ``source``: a path, a dict or a :class:`Scenario`.
+
+    ``vessels``: a :class:`VesselInfo` per vessel, in world-state row order (scenario vessels, then moored ships);
+    ``agents``: the USVs (:class:`Agent`); ``ws``: the scene and its instance ids; ``sea``: the physical sea
+    (``None``: flat water).
+    """
 
     def __init__(self, source: Any, *, world: MapWorld | None = None) -> None:
         if world is not None and not isinstance(world, MapWorld):
@@ -366,9 +371,10 @@ class Simulation:
         raise ConfigError(f"no USV named {agent_id!r}; the USVs are {[a.id for a in self.agents]}")
 
     def sensor_poses(self, agent: Agent, state: WorldState) -> dict[str, np.ndarray]:
-        """Sensor → world matrices of every sensor of ``agent`` in ``state``: keys ``lidar``, ``radar``,
-        ``camera/<name>``, ``top_view``. ``agent`` is one of this simulation's agents (or one equal to it: of a
-        simulation of the same scenario), ``state`` a world state of this simulation (:meth:`world_state`)."""
+        """``(4, 4)`` float64 sensor → world matrices (metres; sensor frames x forward, y left, z up) of every sensor
+        of ``agent`` in ``state``: keys ``lidar``, ``radar``, ``camera/<name>``, ``top_view``. ``agent`` is one of
+        this simulation's agents (or one equal to it: of a simulation of the same scenario), ``state`` a world state
+        of this simulation (:meth:`world_state`)."""
         if not isinstance(agent, Agent):
             raise ConfigError(
                 f"agent = {arguments.shown(agent)}: must be an Agent (Simulation.agent(id) or Simulation.agents), "

@@ -21,7 +21,9 @@ __all__ = ["AgentView", "Target", "agent_view", "targets_of"]
 
 @dataclass(frozen=True)
 class AgentView:
-    """An agent at one frame: ``body``, ``lidar`` and ``cameras[name]`` are ``(4, 4)`` → world matrices."""
+    """An agent at one frame: ``body``, ``lidar`` and ``cameras[name]`` are ``(4, 4)`` float64 vessel body / LiDAR
+    / camera body (x forward = optical axis, y left, z up) → world matrices, metres (``lidar`` ``None`` without a
+    LiDAR); ``speed_mps`` the agent's speed (norm of its world velocity), m/s."""
 
     agent: AgentInfo
     body: np.ndarray
@@ -33,8 +35,9 @@ class AgentView:
 @dataclass(frozen=True)
 class Target:
     """A vessel seen as a target by one agent: ``index`` its world-state row, ``body`` ``(4, 4)`` body → world,
-    ``box`` ``(4, 4)`` box → world (body rotation, box centre), ``box_in_lidar`` ``(4, 4)`` box → agent LiDAR,
-    ``size`` (length, beam, height)."""
+    ``box`` ``(4, 4)`` box → world (body rotation, box centre), ``box_in_lidar`` ``(4, 4)`` box → agent LiDAR (the
+    agent's body frame when it has no LiDAR), all float64 metres; ``size`` ``(3,)`` float64 length, beam, height,
+    metres; ``speed_mps`` its speed (norm of its world velocity), m/s."""
 
     index: int
     id: str

@@ -71,8 +71,9 @@ def kitti_numbers(values: Any) -> str:
 
 
 def front_calib(agent: AgentInfo, view: AgentView) -> tuple[np.ndarray, np.ndarray]:
-    """KITTI's camera 0 of ``agent`` at ``view``: the front camera's ``K·[I|0]`` ``(3, 4)`` and the LiDAR → front
-    optical frame transform ``(4, 4)``; zeros and the identity when the agent has no front camera."""
+    """KITTI's camera 0 of ``agent`` at ``view``: the front camera's ``K·[I|0]`` ``(3, 4)`` float64 (pixels) and
+    the LiDAR → front optical frame (x right, y down, z forward) transform ``(4, 4)`` float64 (metres); zeros and
+    the identity when the agent has no front camera."""
     assert view.lidar is not None
     cam = agent.cameras.get("front")
     if cam is None:

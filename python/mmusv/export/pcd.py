@@ -24,8 +24,9 @@ _HEADER = (
 
 
 def pcd_bytes(xyz: npt.ArrayLike, intensity: npt.ArrayLike, *, decimals: int = 4) -> bytes:
-    """The PCD file of ``(N, 3)`` points and ``(N,)`` intensities in [0, 1] (clipped), coordinates rounded to
-    ``decimals`` places (0.1 mm by default)."""
+    """The PCD file (ASCII bytes) of ``(N, 3)`` points (metres, written in the frame given: the OPV2V export gives
+    the LiDAR frame mirrored to CARLA's, y right) and ``(N,)`` intensities in [0, 1] (clipped, NaN as 0),
+    coordinates rounded to ``decimals`` places (0.1 mm by default)."""
     xyz = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
     n = xyz.shape[0]
     red = np.rint(np.clip(np.nan_to_num(np.asarray(intensity, dtype=np.float64).reshape(n), nan=0.0), 0.0, 1.0) * 255.0)
@@ -41,14 +42,16 @@ def pcd_bytes(xyz: npt.ArrayLike, intensity: npt.ArrayLike, *, decimals: int = 4
 
 
 def write_pcd(path: Path, *, xyz: npt.ArrayLike, intensity: npt.ArrayLike) -> int:
-    """Writes :func:`pcd_bytes` to ``path``; returns the number of bytes."""
+    """Writes :func:`pcd_bytes` of ``xyz`` ``(N, 3)`` metres and ``intensity`` ``(N,)`` in [0, 1] to ``path``;
+    returns the number of bytes."""
     data = pcd_bytes(xyz, intensity)
     path.write_bytes(data)
     return len(data)
 
 
 def read_pcd(path: Path) -> tuple[np.ndarray, np.ndarray]:
-    """``(N, 3)`` points and ``(N,)`` intensities (red byte / 255) of a file written by :func:`write_pcd`.
+    """``(N, 3)`` float64 points (metres, the file's frame) and ``(N,)`` float64 intensities in [0, 1] (red byte /
+    255) of a file written by :func:`write_pcd`.
 
     Raises:
         ValueError: naming the file, when it is not an ASCII ``x y z rgb`` PCD (its header cut short too), or holds

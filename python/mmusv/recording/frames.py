@@ -66,7 +66,8 @@ def _images(
 
 
 def pose7(m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Translation ``(3,)`` and quaternion ``(4,)`` (x, y, z, w) of a ``(4, 4)`` rigid transform."""
+    """Translation ``(3,)`` (``m``'s dtype and unit: metres for a pose) and unit quaternion ``(4,)`` float64
+    (x, y, z, w) of a ``(4, 4)`` rigid transform."""
     return m[:3, 3].copy(), Rotation.from_matrix(m[:3, :3]).as_quat()
 
 

@@ -45,8 +45,9 @@ __all__ = [
 
 @dataclass(frozen=True)
 class CameraInfo:
-    """A pinhole camera of an agent: image size, intrinsics ``(fx, fy, cx, cy)`` pixels, ``mount``
-    ``(4, 4)`` camera body (x forward = optical axis, y left, z up) → vessel body, recorded outputs, and its
+    """A pinhole camera of an agent: image size (``width``, ``height`` pixels), horizontal field of view
+    ``hfov_deg`` degrees, intrinsics ``(fx, fy, cx, cy)`` pixels, ``mount`` ``(4, 4)`` float64 camera body (x
+    forward = optical axis, y left, z up) → vessel body (metres), recorded outputs, and its
     Brown–Conrady ``distortion`` ``(k1, k2, p1, p2, k3)`` (OpenCV's order; ``None``: an ideal pinhole)."""
 
     name: str
@@ -72,7 +73,8 @@ def _distortion(value: Any) -> tuple[float, float, float, float, float] | None:
 @dataclass(frozen=True)
 class AgentInfo:
     """An instrumented USV: ``index`` in the scenario's vessel list (= its row in the world state), mounts
-    ``(4, 4)`` sensor → vessel body, its cameras and the rig as recorded."""
+    ``(4, 4)`` float64 sensor → vessel body (metres; ``None`` without that sensor), its cameras and the rig as
+    recorded."""
 
     id: str
     index: int
@@ -83,9 +85,10 @@ class AgentInfo:
     rig: dict[str, Any]
 
     def sensor_poses(self, world: WorldFrame) -> tuple[np.ndarray, np.ndarray | None, dict[str, np.ndarray]]:
-        """``(body, lidar, cameras)`` at ``world``: ``(4, 4)`` vessel body → world (from the world-state pose) and
-        sensor → world = body · the recorded mount (LiDAR ``None`` without one; cameras by name, camera body frame
-        x forward = optical axis). The one place a reader of the file composes body and mount."""
+        """``(body, lidar, cameras)`` at ``world``: ``(4, 4)`` float64 vessel body → world (metres; from the
+        world-state pose) and sensor → world = body · the recorded mount (LiDAR ``None`` without one; cameras by
+        name, camera body frame x forward = optical axis). The one place a reader of the file composes body and
+        mount."""
         from mmusv.frames import pose_matrices
 
         body = pose_matrices(world.poses[self.index])

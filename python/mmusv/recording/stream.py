@@ -31,7 +31,9 @@ __all__ = ["Frame", "FrameStream", "frame_ranges", "warn_missing"]
 
 @dataclass
 class Frame:
-    """Every decoded message of one acquisition index: ``messages`` by topic."""
+    """Every decoded message of acquisition index ``index``: ``log_time_ns`` its log time (simulation time
+    ``k / f``, integer nanoseconds), ``world`` its decoded ``/world/state``, ``messages`` the decoded messages by
+    topic."""
 
     index: int
     log_time_ns: int

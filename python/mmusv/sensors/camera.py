@@ -29,8 +29,11 @@ __all__ = ["BODY_TO_OPTICAL", "CameraImages", "camera_from_config", "render", "t
 
 @dataclass(frozen=True, eq=False)
 class CameraImages:
-    """One camera's images (see the module docstring); ``rgb`` is ``None`` for a camera without ``rgb`` output.
-    Two compare equal (``==``) when their arrays are (dtype, shape and value)."""
+    """One camera's images (see the module docstring), ``(H, W)`` row-major: ``depth`` float32 metres along the
+    optical axis (``inf`` = sky), ``semantic`` uint16 class ids, ``instance`` int32 scene instance ids (−1 = sky),
+    ``rgb`` ``(H, W, 3)`` uint8 sRGB (``None`` for a camera without ``rgb`` output), ``radiance`` ``(H, W, 3)``
+    float32 cd/m² (only when asked for: :func:`render`'s ``radiance``; else ``None``). Two compare equal (``==``)
+    when their arrays are (dtype, shape and value)."""
 
     depth: npt.NDArray[np.float32]
     semantic: npt.NDArray[np.uint16]

@@ -28,8 +28,8 @@ def rpy_matrix(xyz: tuple[float, float, float], rpy_deg: tuple[float, float, flo
 
 
 def mount_matrix(asset: VesselAsset, mount: Mount, *, where: str) -> np.ndarray:
-    """``(4, 4)`` sensor → vessel body transform of ``mount`` on ``asset``
-    (see :class:`~mmusv.sensors.config.Mount`)."""
+    """``(4, 4)`` float64 sensor → vessel body transform (metres; both frames x forward, y left, z up) of
+    ``mount`` on ``asset`` (see :class:`~mmusv.sensors.config.Mount`)."""
     base = np.eye(4)
     if mount.point is not None:
         if mount.point in asset.mounts:

@@ -90,7 +90,8 @@ def build_world_scene(world: MapWorld, vessels: list[tuple[str, str]], initial_p
         world: the generated map.
         vessels: ``(asset_name, role)`` per scenario vessel, role ``"usv"`` or ``"target"``; a USV's faces are
             labelled :data:`SemanticClass.USV` whatever the asset says.
-        initial_poses: ``(V, 6)`` float64 poses η of the vessels at the first frame.
+        initial_poses: ``(V, 6)`` float64 poses η ``[x, y, z, roll, pitch, yaw]`` (world frame, metres, radians)
+            of the vessels at the first frame.
     """
     ws = build_static_scene(world)
     mats = pose_matrices(np.asarray(initial_poses, dtype=np.float64).reshape(-1, 6))

@@ -72,9 +72,10 @@ class MapWorld:
         kind: ``"island"``, ``"open_sea"`` or ``"port"``.
         seed: the generation seed.
         params: the validated parameters (a pydantic model of :mod:`mmusv.world.map_params`).
-        static_meshes: name -> TriMesh in the world frame, keys sorted; a subset of ``"buoys"``,
+        static_meshes: name -> TriMesh in the world frame (metres), keys sorted; a subset of ``"buoys"``,
             ``"port_structures"``, ``"terrain"``, ``"water"`` (empty parts are left out; ``"water"`` always there).
-        moored: ships to instantiate from the vessel library: ``(asset_name, (x, y, yaw))`` (see module docstring).
+        moored: ships to instantiate from the vessel library: ``(asset_name, (x, y, yaw))``, world metres and
+            radians (see module docstring).
         priors: the map priors.
         heightfield: the terrain heightfield the terrain mesh was built from (exact heights via ``sample``).
     """

@@ -219,7 +219,8 @@ def _face_materials(
 
 
 def load_mesh_file(path: Path, where: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Vertices ``(V, 3)``, faces ``(F, 3)`` and material ids ``(F,)`` of a mesh file (its glTF PBR or OBJ MTL
+    """Vertices ``(V, 3)`` float64 (the file's own units and axes, unused vertices dropped), faces ``(F, 3)``
+    int64 and material ids ``(F,)`` uint16 of a mesh file (its glTF PBR or OBJ MTL
     materials, or its vertex/face colours, registered; else material 0). Every problem is one
     :class:`AssetSpecError` at ``where`` naming the file and what is wrong with it."""
     if not path.is_file():

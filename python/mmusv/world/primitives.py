@@ -86,7 +86,7 @@ class TriMesh:
 
     @property
     def bounds(self) -> np.ndarray:
-        """``(2, 3)`` array: min and max corner of the axis-aligned bounding box, metres."""
+        """``(2, 3)`` float64: min and max corner of the axis-aligned bounding box, metres, the mesh's frame."""
         return np.stack([self.vertices.min(axis=0), self.vertices.max(axis=0)])
 
     @property
@@ -114,7 +114,7 @@ def with_material(mesh: TriMesh, material: int) -> TriMesh:
 
 
 def rotation_z(yaw: float) -> np.ndarray:
-    """``(3, 3)`` rotation about +z by ``yaw`` radians (counter-clockwise seen from above)."""
+    """``(3, 3)`` float64 rotation about +z by ``yaw`` radians (counter-clockwise seen from above)."""
     c, s = np.cos(yaw), np.sin(yaw)
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 

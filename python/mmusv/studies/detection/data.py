@@ -53,9 +53,9 @@ about the body origin."""
 @dataclass(frozen=True)
 class AgentFrame:
     """One instrumented USV at one frame: ``points`` ``(N, 4)`` float32 ``x, y, z, intensity`` in its LiDAR
-    frame, ``body`` ``(4, 4)`` body → world and ``mount`` ``(4, 4)`` LiDAR → body; ``wave_occlusion``: the share
-    (0..1) of each target (by vessel id) that the waves hide from this USV's LiDAR, from its annotations (a
-    recording's ``boxes_lidar``; empty where the source has none, e.g. OPV2V)."""
+    frame (metres), ``body`` ``(4, 4)`` float64 body → world and ``mount`` ``(4, 4)`` float64 LiDAR → body;
+    ``wave_occlusion``: the share (0..1) of each target (by vessel id) that the waves hide from this USV's LiDAR,
+    from its annotations (a recording's ``boxes_lidar``; empty where the source has none, e.g. OPV2V)."""
 
     id: str
     points: np.ndarray
@@ -65,7 +65,7 @@ class AgentFrame:
 
     @property
     def lidar(self) -> np.ndarray:
-        """``(4, 4)`` LiDAR → world."""
+        """``(4, 4)`` float64 LiDAR → world (metres)."""
         out: np.ndarray = self.body @ self.mount
         return out
 
@@ -73,8 +73,8 @@ class AgentFrame:
 @dataclass(frozen=True)
 class SceneFrame:
     """One acquisition index of a sequence: the USVs (``agents``, scenario order) and the world-frame boxes of
-    the targets (``targets`` ``(K, 4, 4)`` box → world, ``target_sizes`` ``(K, 3)`` l, w, h) and of the USV
-    platforms (``usv_boxes``, ``usv_sizes``)."""
+    the targets (``targets`` ``(K, 4, 4)`` float64 box → world, ``target_sizes`` ``(K, 3)`` float64 l, w, h,
+    metres) and of the USV platforms (``usv_boxes``, ``usv_sizes``, the same)."""
 
     frame: int
     agents: tuple[AgentFrame, ...]
@@ -109,9 +109,9 @@ class SequenceData:
 
 
 def boxes_in_frame(to_frame: np.ndarray, *, boxes: np.ndarray, sizes: np.ndarray) -> np.ndarray:
-    """``(K, 7)`` ``x, y, z, l, w, h, yaw`` of box → world transforms ``boxes`` ``(K, 4, 4)`` with ``sizes``
-    ``(K, 3)`` seen from the frame whose world → frame transform is ``to_frame`` (yaw of the box x axis
-    projected on the frame's xy plane)."""
+    """``(K, 7)`` float64 ``x, y, z, l, w, h, yaw`` (metres, radians) of box → world transforms ``boxes``
+    ``(K, 4, 4)`` with ``sizes`` ``(K, 3)`` seen from the frame whose world → frame transform is ``to_frame``
+    (``(4, 4)``; yaw of the box x axis projected on the frame's xy plane)."""
     if len(boxes) == 0:
         return np.zeros((0, 7))
     m = np.einsum("ij,kjl->kil", to_frame, boxes)
@@ -120,7 +120,8 @@ def boxes_in_frame(to_frame: np.ndarray, *, boxes: np.ndarray, sizes: np.ndarray
 
 
 def gt_in_ego(frame: SceneFrame, ego: AgentFrame, *, range_m: float = 200.0) -> np.ndarray:
-    """``(G, 7)`` ground-truth target boxes in ``ego``'s LiDAR frame within ``range_m`` by the box-centre rule,
+    """``(G, 7)`` float64 ground-truth target boxes ``x, y, z, l, w, h, yaw`` (metres, radians) in ``ego``'s
+    LiDAR frame within ``range_m`` by the box-centre rule,
     :func:`mmusv.annotate.in_target_range` (BEV distance ``<= range_m``)."""
     return gt_with_ids(frame, ego, range_m=range_m)[0]
 
@@ -142,7 +143,8 @@ def wave_shares(ego: AgentFrame, ids: Sequence[str]) -> np.ndarray:
 
 
 def usv_boxes_in_ego(frame: SceneFrame, ego: AgentFrame) -> np.ndarray:
-    """``(U, 7)`` every USV platform (the ego's included) in ``ego``'s LiDAR frame."""
+    """``(U, 7)`` float64 boxes ``x, y, z, l, w, h, yaw`` (metres, radians) of every USV platform (the ego's
+    included) in ``ego``'s LiDAR frame."""
     return boxes_in_frame(invert(ego.lidar), boxes=frame.usv_boxes, sizes=frame.usv_sizes)
 
 

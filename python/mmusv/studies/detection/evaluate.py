@@ -45,6 +45,7 @@ IOU_THRESHOLDS = (0.3, 0.5, 0.7)
 RANGE_BINS: tuple[tuple[float, float], ...] = ((0.0, 50.0), (50.0, 100.0), (100.0, 150.0), (150.0, 200.0))
 """Ego-centric range bins (metres, ``lo <= r < hi``) of the per-range AP@0.5."""
 BOX_COLUMNS = ("x", "y", "z", "l", "w", "h", "yaw")
+"""The columns of a box row: centre (metres), length, width, height (metres), yaw (radians), ego LiDAR frame."""
 
 
 def _boxes(a: np.ndarray | Sequence[Sequence[float]]) -> np.ndarray:
@@ -57,7 +58,8 @@ def _boxes(a: np.ndarray | Sequence[Sequence[float]]) -> np.ndarray:
 
 
 def box_polygons(boxes: np.ndarray | Sequence[Sequence[float]]) -> np.ndarray:
-    """``(M,)`` shapely polygons of the BEV rectangles of ``(M, 7)`` boxes (corners counter-clockwise)."""
+    """``(M,)`` object array of shapely polygons: the BEV rectangles (x, y metres, in the boxes' frame) of
+    ``(M, 7)`` boxes (corners counter-clockwise)."""
     b = _boxes(boxes)
     half = np.array([[1, 1], [-1, 1], [-1, -1], [1, -1]], dtype=np.float64) * 0.5
     local = half[None, :, :] * b[:, None, 3:5]  # (M, 4, 2)
@@ -68,7 +70,8 @@ def box_polygons(boxes: np.ndarray | Sequence[Sequence[float]]) -> np.ndarray:
 
 
 def bev_iou(a: np.ndarray | Sequence[Sequence[float]], b: np.ndarray | Sequence[Sequence[float]]) -> np.ndarray:
-    """``(A, B)`` BEV rotated IoU between the boxes of ``a`` ``(A, 7)`` and ``b`` ``(B, 7)``."""
+    """``(A, B)`` float64 BEV rotated IoU in [0, 1] between the boxes of ``a`` ``(A, 7)`` and ``b`` ``(B, 7)``
+    (one frame)."""
     pa, pb = box_polygons(a), box_polygons(b)
     if pa.size == 0 or pb.size == 0:
         return np.zeros((pa.size, pb.size))
@@ -121,7 +124,7 @@ def voc_ap(recall: np.ndarray, precision: np.ndarray) -> float:
 
 
 def average_precision(scores: np.ndarray, *, tp: np.ndarray, n_gt: int) -> float:
-    """AP of detections with ``scores`` ``(D,)`` and true-positive flags ``tp`` ``(D,)`` against ``n_gt``
+    """AP of detections with ``scores`` ``(D,)`` float and true-positive flags ``tp`` ``(D,)`` bool against ``n_gt``
     ground truths: NaN when there is no ground truth, 0 when there are no detections."""
     if n_gt == 0:
         return math.nan
@@ -141,8 +144,8 @@ def average_precision(scores: np.ndarray, *, tp: np.ndarray, n_gt: int) -> float
 
 
 def range_bin(xy: np.ndarray) -> np.ndarray:
-    """``(M,)`` int64 range-bin index of BEV positions ``(M, 2)`` (ego-centric distance), ``-1`` outside
-    :data:`RANGE_BINS`."""
+    """``(M,)`` int64 range-bin index of BEV positions ``(M, 2)`` (x, y metres, ego LiDAR frame; the bin of the
+    distance ``hypot(x, y)``), ``-1`` outside :data:`RANGE_BINS`."""
     p = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
     r = np.hypot(p[:, 0], p[:, 1])
     out = np.full(r.shape[0], -1, dtype=np.int64)
@@ -161,8 +164,8 @@ def bin_label(k: int) -> str:
 
 @dataclass
 class FrameMatch:
-    """One evaluated frame: boxes ``(D, 7)`` / ``(G, 7)``, scores ``(D,)``, and per IoU threshold the matched
-    ground-truth index of every detection (``-1``: FP)."""
+    """One evaluated frame: float64 boxes ``(D, 7)`` / ``(G, 7)`` (:data:`BOX_COLUMNS`), float64 scores ``(D,)``,
+    and per IoU threshold the ``(D,)`` int64 matched ground-truth index of every detection (``-1``: FP)."""
 
     det_boxes: np.ndarray
     det_scores: np.ndarray
@@ -186,7 +189,8 @@ class FrameMatch:
         )
 
     def det_bins(self, threshold: float = 0.5) -> np.ndarray:
-        """``(D,)`` range bin of each detection (its matched ground truth's when a TP at ``threshold``)."""
+        """``(D,)`` int64 range bin of each detection (:func:`range_bin`; its matched ground truth's when a TP at
+        ``threshold``)."""
         m = self.matches[threshold]
         xy = self.det_boxes[:, :2].copy()
         hit = m >= 0
@@ -194,7 +198,7 @@ class FrameMatch:
         return range_bin(xy)
 
     def gt_matched(self, threshold: float = 0.5) -> np.ndarray:
-        """``(G,)`` whether each ground truth is matched at ``threshold``."""
+        """``(G,)`` bool: whether each ground truth is matched at ``threshold``."""
         out = np.zeros(self.gt_boxes.shape[0], dtype=bool)
         m = self.matches[threshold]
         out[m[m >= 0]] = True

@@ -69,14 +69,15 @@ def parse_modes(text: str | Sequence[str]) -> tuple[str, ...]:
 
 
 def relative(ego: AgentFrame, other: AgentFrame) -> np.ndarray:
-    """``(4, 4)`` ``other``'s LiDAR frame → ``ego``'s LiDAR frame."""
+    """``(4, 4)`` float64 transform, ``other``'s LiDAR frame → ``ego``'s LiDAR frame (metres)."""
     out: np.ndarray = invert(ego.lidar) @ other.lidar
     return out
 
 
 def transform_boxes(m: np.ndarray, boxes: np.ndarray) -> np.ndarray:
-    """``(M, 7)`` boxes moved by the rigid ``(4, 4)`` transform ``m``: centres transformed, yaw = heading of the
-    transformed box x axis in the target xy plane; sizes unchanged."""
+    """``(M, 7)`` float64 boxes ``x, y, z, l, w, h, yaw`` (metres, radians) moved by the rigid ``(4, 4)``
+    transform ``m`` (source frame → target frame): centres transformed, yaw = heading of the transformed box x
+    axis in the target xy plane, in [-π, π]; sizes unchanged."""
     b: np.ndarray = np.asarray(boxes, dtype=np.float64).reshape(-1, 7)
     out: np.ndarray = b.copy()
     if b.shape[0] == 0:
@@ -88,8 +89,9 @@ def transform_boxes(m: np.ndarray, boxes: np.ndarray) -> np.ndarray:
 
 
 def rotated_nms(boxes: np.ndarray, scores: np.ndarray, *, iou_threshold: float = NMS_IOU) -> np.ndarray:
-    """Indices kept by greedy NMS on BEV rotated IoU, in descending score (stable): a box is dropped when its IoU
-    with a kept, higher-scored box exceeds ``iou_threshold``."""
+    """``(K,)`` int64 indices into ``boxes`` ``(M, 7)`` kept by greedy NMS on BEV rotated IoU, in descending
+    ``scores`` ``(M,)`` (stable): a box is dropped when its IoU with a kept, higher-scored box exceeds
+    ``iou_threshold``."""
     s = np.asarray(scores, dtype=np.float64).reshape(-1)
     if s.size == 0:
         return np.zeros(0, dtype=np.int64)
@@ -113,8 +115,8 @@ def fuse_boxes(boxes: np.ndarray, *, scores: np.ndarray, agents: np.ndarray, iou
     ``iou_threshold`` with it form a group; of each agent the group keeps its best box; the fused box is the
     score-weighted mean of those in ``x, y, z, l, w, h`` and in heading (as ``2ψ``: a BEV box is the same at ψ
     and ψ + π), its score the noisy-OR ``1 − Π(1 − s)`` of theirs (independent agents that agree make a
-    detection likelier; one agent alone keeps its score and box). Returns the fused boxes ``(K, 7)`` and scores
-    ``(K,)`` by descending score (stable)."""
+    detection likelier; one agent alone keeps its score and box). Returns the fused boxes ``(K, 7)`` float64 (in
+    the frame of ``boxes``, metres, radians) and scores ``(K,)`` float64 by descending score (stable)."""
     b = np.asarray(boxes, dtype=np.float64).reshape(-1, 7)
     s = np.asarray(scores, dtype=np.float64).reshape(-1)
     ag = np.asarray(agents).reshape(-1)
@@ -169,7 +171,9 @@ def fuse(
     crop_m: float = 220.0,
     late_merge: str = "nms",
 ) -> Boxes:
-    """Boxes ``(M, 7)`` and scores ``(M,)`` in ``ego``'s LiDAR frame for fusion ``mode`` (module docstring).
+    """Boxes ``(M, 7)`` ``x, y, z, l, w, h, yaw`` (metres, radians) and scores ``(M,)`` in ``ego``'s LiDAR frame
+    for fusion ``mode`` (module docstring); float64 from the detector (for ``none`` and ``late``, the dtype
+    ``own_detections`` gives, when given).
     ``own_detections(agent)`` returns the detector's output on an agent's own cloud (a cache may back it);
     ``late_merge``: one of :data:`LATE_MERGES`."""
     who = detector_name(detector)
