@@ -134,3 +134,12 @@ def test_wrap() -> None:
         frames.wrap_deg([180.0, -180.0, 190.0, -190.0, 360.0]), [180.0, 180.0, -170.0, 170.0, 0.0]
     )
     np.testing.assert_allclose(frames.wrap_rad([3 * math.pi, -math.pi / 2]), [math.pi, -math.pi / 2])
+
+
+def test_carla_rotation_broadcasts_its_angles() -> None:
+    """One roll and pitch with several yaws is the stack of each yaw's rotation (the rows were broadcast one by one,
+    and the last row, without yaw, refused arrays of other shapes)."""
+    together = frames.carla_rotation(roll_deg=10.0, yaw_deg=[0.0, 45.0, -120.0], pitch_deg=-5.0)
+    one_by_one = [frames.carla_rotation(roll_deg=10.0, yaw_deg=y, pitch_deg=-5.0) for y in (0.0, 45.0, -120.0)]
+    assert together.shape == (3, 3, 3)
+    np.testing.assert_array_equal(together, np.stack(one_by_one))

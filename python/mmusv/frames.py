@@ -51,14 +51,14 @@ __all__ = [
 ]
 
 MIRROR_Y = np.diag([1.0, -1.0, 1.0, 1.0])
-"""``(4, 4)`` the y mirror ``S`` between mmusv's right-handed frames and CARLA's left-handed ones."""
+"""``(4, 4)`` float64 the y mirror ``S`` between mmusv's right-handed frames and CARLA's left-handed ones."""
 
 BODY_TO_OPTICAL = np.array([[0.0, -1.0, 0.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0]])
-"""``(3, 3)`` camera body (x forward, y left, z up) → optical (x right, y down, z forward)."""
+"""``(3, 3)`` float64 rotation, camera body (x forward, y left, z up) → optical (x right, y down, z forward)."""
 
 OPTICAL_IN_BODY = np.eye(4)
 OPTICAL_IN_BODY[:3, :3] = BODY_TO_OPTICAL.T
-"""``(4, 4)`` optical frame → camera body frame (the inverse of :data:`BODY_TO_OPTICAL`, homogeneous)."""
+"""``(4, 4)`` float64 optical frame → camera body frame (the inverse of :data:`BODY_TO_OPTICAL`, homogeneous)."""
 
 
 def _floats(value: Any, *, name: str, tail: tuple[int, ...], what: str) -> np.ndarray:
@@ -119,8 +119,9 @@ def translation(v: npt.ArrayLike) -> np.ndarray:
 
 
 def matrix_to_pose(m: npt.ArrayLike) -> np.ndarray:
-    """``(..., 6)`` poses ``[x, y, z, roll, pitch, yaw]`` of ``(..., 4, 4)`` rigid transforms (the inverse of
-    :func:`pose_matrices`; pitch in [-π/2, π/2], roll = 0 at gimbal lock)."""
+    """``(..., 6)`` float64 poses ``[x, y, z, roll, pitch, yaw]`` (metres, radians; roll and yaw in [-π, π]) of
+    ``(..., 4, 4)`` rigid transforms, e.g. body → world (the inverse of :func:`pose_matrices`; pitch in [-π/2, π/2],
+    roll = 0 at gimbal lock)."""
     m = _transforms(m, name="m")
     r = m[..., :3, :3]
     pitch = np.arcsin(np.clip(-r[..., 2, 0], -1.0, 1.0))
@@ -132,7 +133,7 @@ def matrix_to_pose(m: npt.ArrayLike) -> np.ndarray:
 
 
 def invert(m: npt.ArrayLike) -> np.ndarray:
-    """The inverse of ``(..., 4, 4)`` rigid transforms (Rᵀ, −Rᵀt)."""
+    """``(..., 4, 4)`` float64 inverse of ``(..., 4, 4)`` rigid transforms (Rᵀ, −Rᵀt): a → b becomes b → a."""
     m = _transforms(m, name="m")
     out = np.zeros_like(m)
     rt = np.swapaxes(m[..., :3, :3], -1, -2)
@@ -162,15 +163,18 @@ def mirror_points(points: npt.ArrayLike) -> np.ndarray:
 
 
 def mirror_transform(m: npt.ArrayLike) -> np.ndarray:
-    """``S·m·S`` for ``(..., 4, 4)`` transforms: a right-handed body → world transform as the left-handed one
-    (and back)."""
+    """``(..., 4, 4)`` float64 ``S·m·S`` for ``(..., 4, 4)`` transforms: a right-handed body → world transform as
+    the left-handed (CARLA) one, metres (and back)."""
     out: np.ndarray = MIRROR_Y @ _transforms(m, name="m") @ MIRROR_Y
     return out
 
 
 def carla_rotation(*, roll_deg: npt.ArrayLike, yaw_deg: npt.ArrayLike, pitch_deg: npt.ArrayLike) -> np.ndarray:
-    """``(..., 3, 3)`` the rotation CARLA/OpenCOOD loaders build from ``[roll, yaw, pitch]`` degrees."""
-    r, y, p = (np.radians(np.asarray(a, dtype=np.float64)) for a in (roll_deg, yaw_deg, pitch_deg))
+    """``(..., 3, 3)`` float64 rotation (left-handed CARLA frame) that CARLA/OpenCOOD loaders build from
+    ``[roll, yaw, pitch]`` degrees, three arrays that broadcast together to ``...``."""
+    r, y, p = np.broadcast_arrays(
+        *(np.radians(np.asarray(a, dtype=np.float64)) for a in (roll_deg, yaw_deg, pitch_deg))
+    )
     cr, sr, cy, sy, cp, sp = np.cos(r), np.sin(r), np.cos(y), np.sin(y), np.cos(p), np.sin(p)
     rows = [
         [cp * cy, cy * sp * sr - sy * cr, -cy * sp * cr - sy * sr],
@@ -182,7 +186,8 @@ def carla_rotation(*, roll_deg: npt.ArrayLike, yaw_deg: npt.ArrayLike, pitch_deg
 
 
 def carla_matrix(pose: npt.ArrayLike) -> np.ndarray:
-    """``(..., 4, 4)`` the CARLA transform of ``[x, y, z, roll, yaw, pitch]`` poses ``(..., 6)`` (left-handed)."""
+    """``(..., 4, 4)`` float64 CARLA body → world transform (left-handed, metres) of ``[x, y, z, roll, yaw, pitch]``
+    poses ``(..., 6)`` (metres, degrees)."""
     pose = _floats(pose, name="pose", tail=(6,), what="(..., 6) CARLA poses [x, y, z, roll, yaw, pitch]")
     m = np.zeros((*pose.shape[:-1], 4, 4), dtype=np.float64)
     m[..., :3, :3] = carla_rotation(roll_deg=pose[..., 3], yaw_deg=pose[..., 4], pitch_deg=pose[..., 5])
@@ -192,7 +197,7 @@ def carla_matrix(pose: npt.ArrayLike) -> np.ndarray:
 
 
 def carla_pose(m: npt.ArrayLike) -> np.ndarray:
-    """``(..., 6)`` CARLA pose ``[x, y, z, roll, yaw, pitch]`` (metres, degrees) of a right-handed body → world
+    """``(..., 6)`` float64 CARLA pose ``[x, y, z, roll, yaw, pitch]`` (metres, degrees) of a right-handed body → world
     transform ``m`` ``(..., 4, 4)`` in mmusv frames: the mirrored transform ``S·m·S`` read with the loader's
     rotation convention, so that ``carla_matrix(carla_pose(m)) == S·m·S``."""
     c = mirror_transform(m)
@@ -206,8 +211,9 @@ def carla_pose(m: npt.ArrayLike) -> np.ndarray:
 
 
 def carla_pose_from_eta(eta: npt.ArrayLike) -> np.ndarray:
-    """``(..., 6)`` CARLA pose of mmusv poses ``[x, y, z, roll, pitch, yaw]``: ``[x, -y, z, deg(roll),
-    -deg(yaw), -deg(pitch)]`` (closed form of :func:`carla_pose` for Euler poses)."""
+    """``(..., 6)`` float64 CARLA pose (metres, degrees) of mmusv poses ``[x, y, z, roll, pitch, yaw]``
+    ``(..., 6)`` (metres, radians): ``[x, -y, z, deg(roll), -deg(yaw), -deg(pitch)]`` (closed form of
+    :func:`carla_pose` for Euler poses)."""
     eta = _floats(eta, name="eta", tail=(6,), what="(..., 6) poses [x, y, z, roll, pitch, yaw]")
     out: np.ndarray = np.stack(
         [
@@ -224,18 +230,19 @@ def carla_pose_from_eta(eta: npt.ArrayLike) -> np.ndarray:
 
 
 def x1_to_x2(pose1: npt.ArrayLike, pose2: npt.ArrayLike) -> np.ndarray:
-    """``(4, 4)`` transform from the frame of CARLA pose ``pose1`` to that of ``pose2`` (``inv(T2)·T1``)."""
+    """``(4, 4)`` float64 transform (left-handed, metres) from the frame of CARLA pose ``pose1`` to that of
+    ``pose2``, each ``(6,)`` ``[x, y, z, roll, yaw, pitch]`` metres, degrees (``inv(T2)·T1``)."""
     out: np.ndarray = invert(carla_matrix(pose2)) @ carla_matrix(pose1)
     return out
 
 
 def wrap_deg(a: npt.ArrayLike) -> np.ndarray:
-    """Angles in degrees wrapped to (-180, 180]."""
+    """float64 angles in degrees wrapped to (-180, 180], the shape of ``a``."""
     w: np.ndarray = 180.0 - np.mod(180.0 - np.asarray(a, dtype=np.float64), 360.0)
     return w
 
 
 def wrap_rad(a: npt.ArrayLike) -> np.ndarray:
-    """Angles in radians wrapped to (-π, π]."""
+    """float64 angles in radians wrapped to (-π, π], the shape of ``a``."""
     w: np.ndarray = math.pi - np.mod(math.pi - np.asarray(a, dtype=np.float64), 2 * math.pi)
     return w
