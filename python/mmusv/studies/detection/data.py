@@ -109,9 +109,9 @@ class SequenceData:
 
 
 def boxes_in_frame(to_frame: np.ndarray, *, boxes: np.ndarray, sizes: np.ndarray) -> np.ndarray:
-    """``(K, 7)`` float64 ``x, y, z, l, w, h, yaw`` (metres, radians) of box → world transforms ``boxes``
-    ``(K, 4, 4)`` with ``sizes`` ``(K, 3)`` seen from the frame whose world → frame transform is ``to_frame``
-    (``(4, 4)``; yaw of the box x axis projected on the frame's xy plane)."""
+    """``(K, 7)`` ``x, y, z, l, w, h, yaw`` (metres, radians; float64, float32 only where every input is) of box →
+    world transforms ``boxes`` ``(K, 4, 4)`` with ``sizes`` ``(K, 3)`` seen from the frame whose world → frame
+    transform is ``to_frame`` (``(4, 4)``; yaw of the box x axis projected on the frame's xy plane)."""
     if len(boxes) == 0:
         return np.zeros((0, 7))
     m = np.einsum("ij,kjl->kil", to_frame, boxes)

@@ -172,12 +172,17 @@ def fuse(
     late_merge: str = "nms",
 ) -> Boxes:
     """Boxes ``(M, 7)`` ``x, y, z, l, w, h, yaw`` (metres, radians) and scores ``(M,)`` in ``ego``'s LiDAR frame
-    for fusion ``mode`` (module docstring); float64 from the detector (for ``none`` and ``late``, the dtype
-    ``own_detections`` gives, when given).
-    ``own_detections(agent)`` returns the detector's output on an agent's own cloud (a cache may back it);
-    ``late_merge``: one of :data:`LATE_MERGES`."""
+    for fusion ``mode`` (module docstring), float64 in every mode.
+    ``own_detections(agent)`` returns the detector's output on an agent's own cloud (a cache may back it; checked
+    and made float64 as the detector's is); ``late_merge``: one of :data:`LATE_MERGES`."""
     who = detector_name(detector)
-    own = own_detections or (lambda a: _as_boxes(detector(a.points), who))
+    # A given own_detections was returned as it came for `none` (float32 stayed float32) while `late` moved the
+    # neighbours' boxes to float64 and kept the scores': one dtype whatever the mode and the source.
+    source = own_detections or (lambda a: detector(a.points))
+
+    def own(agent: AgentFrame) -> Boxes:
+        return _as_boxes(source(agent), who)
+
     if mode == "none":
         return own(ego)
     if mode == "late":
