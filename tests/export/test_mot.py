@@ -75,7 +75,8 @@ def box_problems(
 ) -> list[str]:
     """What a sequence's gt lines get wrong against the recording: one line per kept vessel and frame, ``bb_left``
     = its leftmost pixel column + 1 (1-based), ``bb_width`` = its column count (the same for rows), exactly; the
-    class; visibility = 1 − occlusion. ``frames``: the acquisition index of MOT frame k at ``k - 1``; ``want``: per
+    class; visibility = (1 − occlusion) · (1 − truncation), MOT16's share in view counting the image border's crop.
+    ``frames``: the acquisition index of MOT frame k at ``k - 1``; ``want``: per
     acquisition index, per vessel id, :func:`port_truth`'s entry; ``names``: track id → vessel id."""
     got: dict[tuple[int, str], list[str]] = {}
     problems = []
@@ -96,8 +97,8 @@ def box_problems(
             problems.append(f"frame {k} {vid}: box {f[2:6]}, pixels {e['visible']}")
         if (f[6], int(f[7])) != ("1", e["class"]):
             problems.append(f"frame {k} {vid}: conf, class {f[6:8]}")
-        if abs(float(f[8]) - (1.0 - e["occlusion"])) > 5e-7:
-            problems.append(f"frame {k} {vid}: visibility {f[8]}, occlusion {e['occlusion']}")
+        if abs(float(f[8]) - (1.0 - e["occlusion"]) * (1.0 - e["truncation"])) > 5e-7:
+            problems.append(f"frame {k} {vid}: visibility {f[8]}, occlusion {e['occlusion']}, {e['truncation']}")
     return problems
 
 
@@ -436,3 +437,42 @@ def test_the_command_writes_mot_and_its_help_lists_it(
     assert main(["convert", str(no_camera_rec), "--to", "mot", "-o", str(tmp_path / "n"), "--no-progress"]) == 2
     err = capsys.readouterr().err
     assert err.startswith("mmusv: error: ") and err.count("\n") == 1 and "cannot convert to mot" in err
+
+
+def test_visibility_counts_the_part_cropped_by_the_image_border(tmp_path: Path, make_coop: Any) -> None:
+    """MOT16/MOT17's visibility counts occlusion *and* cropping by the image border. A tug straddling the front
+    camera's left edge (45° off the bow, 60 m out) is cut by it: its line's visibility is the recorded
+    ``(1 − occlusion) · (1 − truncation)``, below 1 − occlusion (which is all the export wrote before)."""
+    from mmusv.acquire import run
+
+    cam = {"name": "front", "resolution": [160, 120], "hfov_deg": 90, "outputs": ["rgb", "instance"]}
+    cfg = make_coop(
+        name="mot_cropped",
+        acquisition={"frequency_hz": 5, "frames": 1},
+        rigs={
+            "r": {
+                "lidar": None,
+                "radar": None,
+                "top_view": None,
+                "cameras": [{**cam, "mount": {"point": "camera_front"}}],
+            }
+        },
+        vessels=[
+            {
+                "id": "usv_a",
+                "role": "usv",
+                "asset": "usv_wamv",
+                "rig": "r",
+                "speed_mps": 2.0,
+                "route": [[0, 0], [300, 0]],
+            },
+            {"id": "tug", "role": "target", "asset": "tug_32m", "speed_mps": 2.0, "route": [[60, 60], [360, 60]]},
+        ],
+    )
+    rec = Path(run(cfg, out_dir=tmp_path / "rec").recording)
+    truth = recorded(rec, 1)[("usv_a", "front", 0)]["tug"]
+    assert 0.1 < truth["truncation"] < 0.9  # the border cuts it
+    convert(rec, to="mot", out_dir=tmp_path / "mot", splits=None)
+    (line,) = gt_lines(tmp_path / "mot" / "train" / "mot_cropped.usv_a.front")
+    want = (1.0 - truth["occlusion"]) * (1.0 - truth["truncation"])
+    assert abs(float(line[8]) - want) <= 5e-7 and float(line[8]) < 1.0 - truth["occlusion"] - 0.05

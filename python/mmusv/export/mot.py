@@ -24,10 +24,11 @@ at the image's top-left corner, pixel ``(i, j)`` over ``[i, i + 1) × [j, j + 1)
 unchanged. With ``box="visible"`` (the default) that is the tight box of the vessel's pixels in the instance image:
 ``bb_left`` the 1-based column of its leftmost pixel, ``bb_width`` its number of columns (py-motmetrics' loader
 subtracts the 1 again). ``conf`` 1 (every line is evaluated). ``class``: the vessel's semantic class id of
-:mod:`mmusv.classes` (COCO's ``category_id``: 10 ``vessel``, 11 ``usv``). ``visibility``: 1 − the recorded
-``occlusion`` (:mod:`mmusv.annotate`: the share of the vessel's silhouette above the still water level that other
-objects or the waves hide; the part outside the image, truncation, is not counted, where MOT16/MOT17's
-ratio also counts the part cropped by the image border). Numbers: whole numbers as such,
+:mod:`mmusv.classes` (COCO's ``category_id``: 10 ``vessel``, 11 ``usv``). ``visibility``: MOT16/MOT17's ratio,
+which counts both occlusion and the part cropped by the image border: ``(1 − occlusion) · (1 − truncation)`` of the
+recorded 2D box (:mod:`mmusv.annotate`: ``occlusion`` the share of the vessel's silhouette above the still water
+level, within the image, that other objects or the waves hide; ``truncation`` the share of the projected box outside
+the image); a vessel wholly in view and unhidden has 1. Numbers: whole numbers as such,
 the rest to 3 decimals (boxes) or 6 (visibility).
 
 At the root: ``classes.csv`` (``class,name``: every class of :data:`mmusv.export.camera.CATEGORIES`), ``tracks.csv``
@@ -73,6 +74,7 @@ __all__ = [
     "sequence_name",
     "track_id",
     "track_rows",
+    "visibility",
 ]
 
 GT_COLUMNS = ("frame", "id", "bb_left", "bb_top", "bb_width", "bb_height", "conf", "class", "visibility")
@@ -99,6 +101,14 @@ def mot_split(split: str) -> str:
 def track_id(world: WorldFrame, vessel_id: str) -> int:
     """The MOT track id of a vessel: 1 + its row in the world state."""
     return world.ids.index(vessel_id) + 1
+
+
+def visibility(*, occlusion: float, truncation: float) -> float:
+    """MOTChallenge's ``visibility`` (MOT16: the level of occlusion *and cropping* of each object) of a recorded 2D
+    box: the share of the vessel in view within the image, ``1 − occlusion``, times the share of its projected box
+    inside the image, ``1 − truncation``; both fractions in ``[0, 1]`` (clamped), the result too."""
+    inside = min(1.0, max(0.0, 1.0 - truncation))
+    return min(1.0, max(0.0, 1.0 - occlusion)) * inside
 
 
 def track_rows(split: str, *, scenario: str, world: WorldFrame) -> list[list[Any]]:
@@ -224,7 +234,7 @@ class MotWriter(ProjectedBoxes):
                     _num(b.width, 3),
                     _num(b.height, 3),
                     b.semantic_class,
-                    _num(min(1.0, max(0.0, 1.0 - b.occlusion)), 6),
+                    _num(visibility(occlusion=b.occlusion, truncation=b.truncation), 6),
                 )
             )
 
