@@ -156,7 +156,7 @@ def as_tracking(line: str) -> str:
     KITTI raw data's tracklets: 0 in the image, 1 cut by the border, 2 out of the image: occluded 3 here)."""
     f = line.split()
     frac = float(f[1])
-    f[1] = "2" if f[2] == "3" else "0" if frac <= 0.0 else "2" if frac >= 1.0 else "1"
+    f[1] = "2" if f[2] == "3" else "0" if frac <= 0.0 else "1"  # with a box (occluded < 3) it is in the image
     return " ".join(f)
 
 

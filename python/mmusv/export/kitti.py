@@ -10,7 +10,7 @@ range (same filter as OPV2V): ``type truncated occluded alpha x1 y1 x2 y2 h w l 
 camera frame (location = the box centre moved h/2 down the camera's y axis: KITTI's bottom centre of an upright
 box, so that readers adding h/2 back get the box centre, also when the hull or the USV rolls in waves); the 2D box,
 truncation and occlusion come from the recording's camera annotations (occluded 0: < 25 % hidden, 1: < 60 %,
-2: more, 3: not in the front image, with box ``0 0 0 0``).
+2: more, 3: not in the front image, with box ``0 0 0 0`` and truncated ``1.00``: wholly out of the image).
 An agent without a front camera has no ``image_2``, zero ``P0..P3`` and, as camera, the LiDAR's own optical axes
 (``Tr_velo_to_cam`` = the rotation x right, y down, z forward): its labels keep KITTI's camera conventions, so
 KITTI's readers turn them into LiDAR boxes with the right heading. A front camera's lens distortion (KITTI's
@@ -134,11 +134,11 @@ def label_lines(
 def truncation_level(fraction: float | None) -> int:
     """The KITTI tracking benchmark's truncation (its raw data's tracklet levels: 0 in the image, 1 cut by the image
     border, 2 out of the image) of a target whose recorded 2D box is cut by ``fraction`` (0..1, taken at the object
-    labels' two decimals, so the two exports agree; ``None``: no box in the image)."""
+    labels' two decimals, so the two exports agree; ``None``: no box in the image, 2). A target with a box is in the
+    image, so 1 however much of it is cut (a sliver of a long ship whose fraction rounds to 1.00 too)."""
     if fraction is None:
         return 2
-    f = round(float(fraction), 2)
-    return 0 if f <= 0.0 else 2 if f >= 1.0 else 1
+    return 0 if round(float(fraction), 2) <= 0.0 else 1
 
 
 def kitti_label(
@@ -146,7 +146,9 @@ def kitti_label(
 ) -> str:
     """One ``label_2`` line of ``target`` (box in the LiDAR frame) for the camera ``velo_to_cam`` (4×4); ``kind``:
     the type written (``None``: the target's class name, capitalised); ``levels``: truncation written as the
-    tracking benchmark's integer level (:func:`truncation_level`) instead of the object benchmark's fraction."""
+    tracking benchmark's integer level (:func:`truncation_level`) instead of the object benchmark's fraction.
+    Without ``box2d`` (no box in the front image) the target is out of the image: truncated 1 (the object benchmark's
+    fraction of it "leaving image boundaries"; the tracking level 2), occluded 3 and box ``0 0 0 0``."""
     length, beam, height = (float(x) for x in target.size)
     box_cam = velo_to_cam @ target.box_in_lidar
     centre = box_cam[:3, 3]
@@ -157,8 +159,8 @@ def kitti_label(
     d = box_cam[:3, 0]
     ry = float(wrap_rad(math.atan2(-d[2], d[0])))
     alpha = float(wrap_rad(ry - math.atan2(centre[0], centre[2])))
-    if box2d is None:
-        trunc, occ, bb = 0.0, 3, (0.0, 0.0, 0.0, 0.0)
+    if box2d is None:  # out of the image: wholly "leaving image boundaries" (KITTI's truncated 1), state unknown
+        trunc, occ, bb = 1.0, 3, (0.0, 0.0, 0.0, 0.0)
     else:
         trunc, occ = float(box2d.truncation), occlusion_level(float(box2d.occlusion))
         bb = (box2d.x_min, box2d.y_min, box2d.x_max, box2d.y_max)

@@ -1,0 +1,90 @@
+"""Fields of the KITTI, KITTI tracking, COCO, YOLO, SemanticKITTI and MaSTr exports checked against what the peers'
+own definitions say they mean, with the values expected from the recording (its annotations), not from the writers.
+
+* KITTI object ``truncated``: the devkit's readme (``devkit_object/readme.txt``) defines it as a "Float from 0
+  (non-truncated) to 1 (truncated), where truncated refers to the object leaving image boundaries"; a target with no
+  box in the front image (behind or beside the camera, occluded 3, box ``0 0 0 0``) has wholly left the image, so 1,
+  as the tracking export's level 2 ("out of the image") of the same line says, not 0 (a target wholly in the image).
+* KITTI tracking ``truncated``: the devkit's readme (``devkit_tracking/readme.txt``) makes it an "Integer (0,1,2)
+  indicating the level of truncation", the levels of KITTI's raw-data tracklets (``TRUNC_IN_IMAGE`` 0,
+  ``TRUNC_TRUNCATED`` 1, ``TRUNC_OUT_IMAGE`` 2): a target with a box in the image is never 2, however much of it the
+  border cuts (a sliver of a long ship whose object-label fraction rounds to 1.00).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from mmusv.export import convert
+from mmusv.export.geometry import Target
+from mmusv.export.kitti import LIDAR_OPTICAL, kitti_label
+from mmusv.recording import frame_messages, read_info, topics
+
+
+@pytest.fixture(params=["port_rec", "no_camera_rec"])
+def kitti_case(request: pytest.FixtureRequest, tmp_path: Path) -> tuple[Path, Path]:
+    """A recording (``port``: targets in range behind and beside the front cameras; ``no_camera``: agents without a
+    front camera) and its KITTI export's scenario folder."""
+    rec: Path = request.getfixturevalue(request.param)
+    convert(rec, to="kitti", out_dir=tmp_path / "o", splits=None)
+    return rec, tmp_path / "o" / rec.stem
+
+
+def test_kitti_truncated_is_one_for_a_target_out_of_the_front_image(kitti_case: tuple[Path, Path]) -> None:
+    """Every label line of a target without a recorded front-camera box says it is wholly truncated (1.00, occluded 3,
+    box ``0 0 0 0``); a target with one keeps the recorded fraction (the devkit's 0..1, two decimals)."""
+    rec, kitti = kitti_case
+    info = read_info(rec)
+    out_of_image = in_image = 0
+    for a in info.agents:
+        folder = kitti / str(1000 + a.index) / "label_2"
+        for path in sorted(folder.glob("*.txt")):
+            k = int(path.stem)
+            ann = frame_messages(rec, k)[topics.agent_annotations(a.id)]
+            boxes = [b for b in ann.boxes_camera if b.camera == "front"]
+            for line in path.read_text().splitlines():
+                f = line.split()
+                truncated, occluded, bbox = float(f[1]), int(f[2]), [float(v) for v in f[4:8]]
+                assert 0.0 <= truncated <= 1.0 and f[1] == f"{truncated:.2f}"
+                if occluded == 3:
+                    assert bbox == [0.0, 0.0, 0.0, 0.0]
+                    assert truncated == 1.0, (a.id, k, line)
+                    out_of_image += 1
+                else:
+                    b = min(
+                        boxes,
+                        key=lambda b: float(np.abs(np.subtract([b.x_min, b.y_min, b.x_max, b.y_max], bbox)).max()),
+                    )
+                    assert truncated == pytest.approx(float(b.truncation), abs=0.005)
+                    in_image += 1
+    assert out_of_image >= 2  # targets in range the front cameras do not see (or no front camera)
+
+
+def _target_ahead() -> Target:
+    """A 30 m ship 40 m ahead of the LiDAR (x forward), heading across the view (its x axis to the left)."""
+    box = np.eye(4)
+    box[:3, :3] = [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
+    box[:3, 3] = [40.0, 0.0, 2.0]
+    size = np.array([30.0, 8.0, 10.0])
+    return Target(0, "ship", "ship", "target", 10, 5, box, box, box, size, 0.0)
+
+
+@pytest.mark.parametrize(
+    ("fraction", "level"), [(0.0, "0"), (0.004, "0"), (0.3, "1"), (0.996, "1"), (1.0 - 1e-9, "1"), (None, "2")]
+)
+def test_kitti_tracking_truncation_level_is_2_only_out_of_the_image(fraction: float | None, level: str) -> None:
+    """The tracking line's level: 0 when the object label writes 0.00, 1 for any box the border cuts (also one whose
+    fraction the object label writes as 1.00), 2 only without a box in the image (occluded 3)."""
+    box2d = (
+        None
+        if fraction is None
+        else SimpleNamespace(truncation=fraction, occlusion=0.1, x_min=150.0, y_min=50.0, x_max=160.0, y_max=70.0)
+    )
+    line = kitti_label(_target_ahead(), LIDAR_OPTICAL, box2d=box2d, levels=True).split()
+    obj = kitti_label(_target_ahead(), LIDAR_OPTICAL, box2d=box2d).split()
+    assert line[1] == level and (line[2] == "3") == (fraction is None)
+    assert line[:1] + line[2:] == obj[:1] + obj[2:]  # the object label's line but for truncated
+    assert obj[1] == ("1.00" if fraction is None else f"{round(fraction, 2) + 0.0:.2f}")
