@@ -454,9 +454,10 @@ def test_ros2_camera_info_projects_lidar_onto_the_image(sim: Any, exports: dict[
     ``/tf_static`` chain ``lidar → base_link → camera → camera_optical`` and ``cv2.projectPoints`` with ``K``, ``D``
     lands where the camera sees each point; the ``Detection2D`` boxes are in the same pixel coordinates."""
     pytest.importorskip("rosbags")
+    from mmusv.export.ros2 import TIME_OFFSET_NS
     from rosbags.highlevel import AnyReader
 
-    stamp = round(FRAME / 5.0 * 1e9)
+    stamp = round(FRAME / 5.0 * 1e9) + TIME_OFFSET_NS  # the bag's time: the sim time + the offset (never 0)
     with AnyReader([exports["ros2"] / "port_entry"]) as r:
         msgs: dict[str, Any] = {}
         static: list[Any] = []

@@ -23,6 +23,7 @@ from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 from mmusv.errors import ConfigError
 from mmusv.export import convert
+from mmusv.export.ros2 import TIME_OFFSET_NS
 from mmusv.recording import decode_point_cloud, read_messages, topics
 from mmusv.recording.decode import WorldFrame
 from scipy.spatial.transform import Rotation
@@ -81,7 +82,7 @@ def test_ros2_boxes_of_a_usv_without_lidar_are_in_its_tf_tree(no_lidar_rec: Path
     checked = 0
     for agent in ("usv_a", "usv_b"):
         for t, msg in msgs[f"/{agent}/detections"]:
-            w = worlds[t]
+            w = worlds[t - TIME_OFFSET_NS]  # the bag's time is the sim time + TIME_OFFSET_NS
             for det in msg.detections:
                 assert det.header.frame_id == msg.header.frame_id
                 to_map = in_map(det.header.frame_id, t)

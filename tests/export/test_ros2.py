@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 import pytest
 from mmusv.export import convert
-from mmusv.export.ros2 import MAP_FRAME, base_link, camera_info_topic, odom_frame, optical_frame
+from mmusv.export.ros2 import MAP_FRAME, TIME_OFFSET_NS, base_link, camera_info_topic, odom_frame, optical_frame
 from mmusv.recording import decode_image, decode_point_cloud, read_info, read_messages, topics
 from PIL import Image
 from rosbags.highlevel import AnyReader
@@ -127,13 +127,15 @@ def test_points_images_and_stamps_equal_the_recording(bag: Path, coop_rec: Path)
     with AnyReader([bag]) as r:
         for c, t, raw in r.messages():
             got[c.topic].append((t, r.deserialize(raw, c.msgtype)))
-    assert [t for t, _ in got["/clock"]] == [t for t, _ in src[topics.WORLD_STATE]]
+    # the bag's time is the sim time + TIME_OFFSET_NS (no stamp at time 0, tf2's "latest")
+    assert [t for t, _ in got["/clock"]] == [t + TIME_OFFSET_NS for t, _ in src[topics.WORLD_STATE]]
     for a in info.agents:
         lidar = topics.lidar(a.id)
         assert len(got[lidar]) == len(src[lidar]) == 3
         for (t, pc), (t0, msg) in zip(got[lidar], src[lidar], strict=True):
             ref = decode_point_cloud(msg)
-            assert t == t0 and pc.header.stamp.sec * 10**9 + pc.header.stamp.nanosec == t0
+            assert t == t0 + TIME_OFFSET_NS
+            assert pc.header.stamp.sec * 10**9 + pc.header.stamp.nanosec == t0 + TIME_OFFSET_NS
             assert pc.width * pc.height == len(ref["x"]) and pc.header.frame_id == topics.lidar_frame(a.id)
             dt = np.dtype(
                 {
@@ -192,7 +194,7 @@ def test_tf_chain_equals_the_recording(bag: Path, coop_rec: Path) -> None:
         for x in static[0].transforms
     }
     for (t, msg), (t0, ref) in zip(tf, src[topics.TF], strict=True):
-        assert t == t0
+        assert t == t0 + TIME_OFFSET_NS
         edges = dict(edges_static)
         edges.update(
             {

@@ -5,7 +5,8 @@ Written with rosbags' rosbag2 writer (:class:`rosbags.rosbag2.Writer`, format ve
 metadata record), messages serialised by rosbags' CDR serialiser from the types of
 :func:`mmusv.export.ros2_types.typestore`. Standard message types only; ``docs/exports.md`` lists every topic.
 
-Stamps (header, log time) are the scenario's sim time, published on ``/clock``. Frames (REP 105/103): ``map`` (the
+Stamps (header, log time) are the scenario's sim time plus :data:`TIME_OFFSET_NS` (1 s: no stamp is time 0, which
+tf2 reads as "the latest transform"), published on ``/clock``. Frames (REP 105/103): ``map`` (the
 mmusv world: x east, y north, z up); per instrumented USV ``<usv>/odom`` (= ``map``, static) → ``<usv>/base_link``
 (x forward, y left, z up; ``/tf`` every frame) → ``<usv>/lidar``, ``<usv>/radar``, ``<usv>/camera_<name>`` (x
 forward) → ``<usv>/camera_<name>_optical`` (x right, y down, z forward) on ``/tf_static`` (transient local);
@@ -50,6 +51,7 @@ from mmusv.recording.stream import Frame
 
 __all__ = [
     "MAP_FRAME",
+    "TIME_OFFSET_NS",
     "Ros2Writer",
     "base_link",
     "camera_distortion",
@@ -70,6 +72,12 @@ TF_STATIC_TOPIC = "/tf_static"
 CLOCK_TOPIC = "/clock"
 BAG_VERSION: Literal[8] = 8
 """rosbag2 metadata version (Jazzy's)."""
+TIME_OFFSET_NS = 1_000_000_000
+"""What the bag's stamps and log times add to the scenario's sim time (ns): frame k at ``1 + k / f`` s. ROS keeps
+time 0 for "no time": tf2 looks a transform up at the *latest* stamp it holds for a request at time 0
+(``tf2::TimeCache::findClosest``), and rclcpp's clock is not ``started()`` at 0, so a first frame stamped 0 would be
+placed with the newest pose in the buffer and its ``/clock`` read as "not yet". The same for every frame and every
+conversion (``--frames`` too); written in ``metadata.yaml``'s ``custom_data`` as ``mmusv.time_offset_ns``."""
 
 PIXEL_CENTRE = 0.5
 """Where mmusv's pixel coordinates put a pixel's centre (pixel ``(i, j)`` covers ``[i, i + 1) × [j, j + 1)``: its
@@ -189,7 +197,7 @@ class Ros2Writer(DatasetWriter):
     def write_frame(self, frame: Frame) -> None:
         world = frame.world
         assert world is not None
-        t = frame.log_time_ns
+        t = self.stamp_ns(frame)
         m = self.m
         if self.bag is None:
             self._open()
@@ -203,6 +211,11 @@ class Ros2Writer(DatasetWriter):
         self._put(TF_TOPIC, "tf2_msgs/msg/TFMessage", m.tf(self._dynamic(frame, world)), t)
         for a in self.agents:
             self._agent(frame, world, a)
+
+    @staticmethod
+    def stamp_ns(frame: Frame) -> int:
+        """The bag's time of ``frame`` (header stamps and log time), ns: its sim time plus :data:`TIME_OFFSET_NS`."""
+        return frame.log_time_ns + TIME_OFFSET_NS
 
     def _static(self, t: int) -> list[Any]:
         """map → odom of every USV, and its sensor mounts (constant)."""
@@ -224,7 +237,7 @@ class Ros2Writer(DatasetWriter):
 
     def _dynamic(self, frame: Frame, world: WorldFrame) -> list[Any]:
         """Every vessel's body pose (USVs through their odom frame) and the top-view cameras."""
-        m, t = self.m, frame.log_time_ns
+        m, t = self.m, self.stamp_ns(frame)
         agents = {a.id for a in self.agents}
         mats = pose_matrices(world.poses)
         out = [
@@ -246,7 +259,7 @@ class Ros2Writer(DatasetWriter):
     def _agent(self, frame: Frame, world: WorldFrame, a: AgentInfo) -> None:
         from mmusv.recording import decode_image
 
-        m, t, msgs = self.m, frame.log_time_ns, frame.messages
+        m, t, msgs = self.m, self.stamp_ns(frame), frame.messages
         body = pose_matrices(world.poses[a.index])
         twist = self.T("geometry_msgs/msg/Twist")(
             linear=m.vector3(body[:3, :3].T @ world.velocities[a.index]), angular=m.vector3((0.0, 0.0, 0.0))
@@ -291,15 +304,20 @@ class Ros2Writer(DatasetWriter):
 
         msg = frame.messages.get(topic)
         if msg is not None:
-            pc = self.m.point_cloud(frame.log_time_ns, frame_id, decode_point_cloud(msg), fields)
-            self._put(topic, "sensor_msgs/msg/PointCloud2", pc, frame.log_time_ns)
+            t = self.stamp_ns(frame)
+            self._put(
+                topic,
+                "sensor_msgs/msg/PointCloud2",
+                self.m.point_cloud(t, frame_id, decode_point_cloud(msg), fields),
+                t,
+            )
 
     def _camera(self, frame: Frame, frame_id: str, base: str) -> None:
         """The images of one camera (or the top view): RGB as PNG ``CompressedImage`` on ``<base>/rgb/compressed``
         (image_transport's name), depth ``32FC1`` metres (+inf: no hit), semantic and instance ``16UC1``."""
         from mmusv.recording import decode_image
 
-        m, t, msgs = self.m, frame.log_time_ns, frame.messages
+        m, t, msgs = self.m, self.stamp_ns(frame), frame.messages
         rgb = msgs.get(f"{base}/rgb")
         if rgb is not None:
             if str(getattr(rgb, "format", "")).lower() == "png":
@@ -462,6 +480,7 @@ class Ros2Writer(DatasetWriter):
         self.bag.set_custom_data("mmusv.source", self.info.path.name)
         self.bag.set_custom_data("mmusv.scenario", self.info.scenario_name)
         self.bag.set_custom_data("mmusv.config_hash", self.info.config_hash)
+        self.bag.set_custom_data("mmusv.time_offset_ns", str(TIME_OFFSET_NS))
         self.bag.close()
         self.bag = None
         for p in sorted(self.folder.iterdir()):
