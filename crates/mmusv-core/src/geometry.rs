@@ -218,7 +218,8 @@ impl PreparedTriangle {
 }
 
 /// Edge functions recomputed in `f64` when one of them is exactly zero in `f32` (an edge through the ray):
-/// the paper's fallback that decides such rays consistently for both triangles of the edge.
+/// Woop, Benthin and Wald's (JCGT 2013, see [`crate::ray`]) fallback that decides such rays consistently for both
+/// triangles of the edge.
 #[inline(never)]
 fn edges_f64(p: [f32; 6]) -> (f32, f32, f32) {
     let [ax, ay, bx, by, cx, cy] = p.map(f64::from);

@@ -1,6 +1,12 @@
 //! Vessel motion (paper eq. 1–3): spline routes travelled at a nominal speed, with wave-driven heave, roll
 //! and pitch superimposed.
 //!
+//! Model: the perception-centric vessel motion model of the MMUSV-Sim paper (Li, Z., Ye, J., Tang, B., Zhang,
+//! L., Zuo, K., Huang, S. & Gao, C., "MMUSV-Sim: A Perception-Oriented Simulation and Data-Generation Platform
+//! for Multi-USV Cooperative Perception", submitted to the IEEE), §"Perception-Centric Vessel Motion Model",
+//! eqs. 1–3; "the paper" below and in [`waves`] is that paper. With a [`WaveField`] ([`Fleet::with_sea`]) heave,
+//! roll and pitch come instead from the hull's RAOs ([`crate::ocean::response`](mod@crate::ocean::response)).
+//!
 //! For vessel `v` at time `t ≥ 0` (seconds), with travelled distance `d = offset + u·t` mapped to an arc
 //! length `s` and direction `σ ∈ {+1, −1, 0}` by [`Route::distance_to_arc`]:
 //!

@@ -327,7 +327,8 @@ impl Route {
     /// - [`EndBehaviour::PingPong`]: with `r = d mod 2L`, `s = r, sign = +1` for `r ≤ L`, else `s = 2L − r,
     ///   sign = −1` (travelling backwards, heading `yaw(s) + π`).
     ///
-    /// The horizontal velocity is `u · sign · tangent(s)`.
+    /// The horizontal velocity is `u · sign · tangent(s)`. A non-finite `d` gives `(0, 0)` (the kinematics refuses
+    /// such times before asking).
     pub fn distance_to_arc(&self, d: f64) -> (f64, f64) {
         let len = self.length();
         if !d.is_finite() || len <= 0.0 {

@@ -1,4 +1,5 @@
-//! Wave-driven heave, roll and pitch perturbations (paper eq. 2).
+//! Wave-driven heave, roll and pitch perturbations (paper eq. 2: the MMUSV-Sim paper's pose perturbation, see
+//! [`super`]'s header for the reference).
 //!
 //! For vessel `v` at time `t` (seconds):
 //!

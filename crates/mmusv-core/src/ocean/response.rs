@@ -420,6 +420,28 @@ mod tests {
         }
     }
 
+    /// The module docs' sign conventions, against the pose the kinematics builds (`RigidPose::from_xyz_rpy`): a
+    /// long beam wave whose surface rises towards port gives roll ≈ ∂ζ/∂y_body > 0, and a positive roll lifts the
+    /// port side (+y); a positive pitch puts the bow (+x) down.
+    #[test]
+    fn roll_and_pitch_signs_match_the_pose() {
+        use crate::geometry::RigidPose;
+        use parry3d::math::Vec3;
+        let hd = ok(Hull::new(50.0, 10.0, 3.0, 0.6, 1.0));
+        let omega = 0.05;
+        let k = omega * omega / GRAVITY;
+        // Waves travelling towards body +y (β = π/2); at ψ = −π/2 the surface `cos ψ` rises with y_body.
+        let r = hd.rao(omega, PI / 2.0, omega);
+        let psi: f64 = -PI / 2.0;
+        let roll = cmul(r.roll, [psi.cos(), psi.sin()])[0];
+        // Within 1 %: the roll oscillator still adds 1/(1 − Λ²) ≈ 1.004 at Λ = ω/ω_φ ≈ 0.06.
+        assert!((roll / k - 1.0).abs() < 1e-2, "roll {roll} vs the slope {k}");
+        let port = RigidPose::from_xyz_rpy([0.0; 3], [roll, 0.0, 0.0]).transform_vector(Vec3::Y);
+        assert!(port.z > 0.0);
+        let bow = RigidPose::from_xyz_rpy([0.0; 3], [0.0, 0.1, 0.0]).transform_vector(Vec3::X);
+        assert!(bow.z < 0.0);
+    }
+
     #[test]
     fn bad_hulls_name_their_field() {
         assert!(

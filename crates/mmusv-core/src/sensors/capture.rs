@@ -21,7 +21,7 @@ use crate::scene::Scene;
 use rayon::prelude::*;
 use std::time::Instant;
 
-/// What the LiDAR takes of the environment: fog, rain, waves.
+/// What the LiDAR takes of the environment: fog, rain, waves and wind.
 pub fn lidar_env(env: &ShadeEnv) -> LidarEnv {
     LidarEnv {
         fog_extinction_per_m: env.fog_extinction_per_m,
@@ -49,7 +49,7 @@ pub struct PpiRequest {
 /// One sensor of one USV at one frame: the configured sensor, its pose (sensor → world) and its seed.
 #[derive(Debug, Clone, Copy)]
 pub enum SensorTask<'a> {
-    /// A LiDAR sweep ([`Lidar::scan`]).
+    /// A LiDAR sweep ([`Lidar::scan_with_wakes`], with the frame's wakes).
     Lidar {
         /// The LiDAR.
         lidar: &'a Lidar,
@@ -58,7 +58,8 @@ pub enum SensorTask<'a> {
         /// Noise, dropout and water-return seed.
         seed: u64,
     },
-    /// A camera image set ([`Camera::render`]), shaded RGB when `rgb`.
+    /// A camera image set ([`Camera::render_with`], with the frame's wakes, no linear radiance), shaded RGB when
+    /// `rgb`.
     Camera {
         /// The camera (pinhole or orthographic).
         camera: &'a Camera,
@@ -66,7 +67,8 @@ pub enum SensorTask<'a> {
         rgb: bool,
         /// Camera body → world.
         pose: RigidPose,
-        /// Ripple and rain seed.
+        /// Seed of the swell, rain streaks, anti-aliasing jitter, glossy reflection directions and sensor noise
+        /// ([`Camera::render_with`]).
         seed: u64,
     },
     /// A radar revolution ([`radar_sweep`]) and, when asked, its PPI ([`ppi_image`]).

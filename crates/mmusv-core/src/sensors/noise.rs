@@ -16,7 +16,8 @@ pub mod stream {
     pub const WEATHER: u64 = 4;
     /// Rain streaks in camera images.
     pub const RAIN: u64 = 5;
-    /// Water surface ripples in camera images.
+    /// Directions and phases of the cameras' fixed four-component swell (the water's normals on a sea without a
+    /// wave surface, `Shader::new`).
     pub const RIPPLE: u64 = 6;
     /// The directions of a camera's traced water reflections (`camera/glossy.rs`).
     pub const GLOSSY: u64 = 7;

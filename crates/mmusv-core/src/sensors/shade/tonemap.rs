@@ -70,8 +70,9 @@ pub fn min_metered_lux(max_iso: f32) -> f32 {
 pub struct Exposure {
     /// A fixed (manual) exposure value at ISO 100; `None` meters it automatically from the scene's light.
     pub ev100: Option<f32>,
-    /// Stops added to the automatic exposure (+1 doubles it; the highlight limit shifts with it); ignored with a
-    /// fixed `ev100`.
+    /// Stops added to the automatic exposure (+1 doubles it; the highlight limit shifts with it). Must be 0 with a
+    /// fixed `ev100` ([`Exposure::validate`] refuses both); ignored when the environment fixes the exposure
+    /// (`ShadeEnv::exposure_ev100`).
     pub compensation_ev: f32,
     /// The highest ISO the automatic exposure reaches at f/1.4 and 1/30 s: sets the darkest light it adapts to
     /// ([`min_metered_lux`]); below it pictures darken with the light.
