@@ -15,20 +15,22 @@ pub const MAX_CHANNELS: u32 = 1024;
 pub const MAX_AZIMUTH_STEPS: u32 = 1 << 16;
 
 /// Pinhole intrinsics from an image size and horizontal field of view: `fx = fy = W / (2 tan(hfov/2))`,
-/// principal point at the image centre `(W/2, H/2)`. Returns `[fx, fy, cx, cy]` in pixels.
+/// principal point at the image centre `(W/2, H/2)`. Returns `[fx, fy, cx, cy]` in pixels. `hfov` is in radians,
+/// in `(0, π)`; a zero side or an `hfov` outside that range is an error naming `resolution` or `hfov`.
 pub fn pinhole_intrinsics(width: u32, height: u32, hfov: f64) -> Result<[f64; 4]> {
     if width == 0 || height == 0 {
         return Err(MmusvError::config("resolution", format!("[{width}, {height}]"), "width and height must be >= 1"));
     }
     if !(hfov > 0.0 && hfov < std::f64::consts::PI) {
-        return Err(MmusvError::config("hfov", hfov, "horizontal field of view must be in (0, 180) degrees"));
+        return Err(MmusvError::config("hfov", hfov, "horizontal field of view must be in (0, π) radians"));
     }
     let f = width as f64 / (2.0 * (hfov / 2.0).tan());
     Ok([f, f, width as f64 / 2.0, height as f64 / 2.0])
 }
 
 /// Unit ray directions through every pixel centre of a pinhole camera, in the camera BODY frame
-/// (x forward, y left, z up). Row-major, `width × height` rows of `[x, y, z]`.
+/// (x forward, y left, z up). Row-major, `width × height` rows of `[x, y, z]`; `hfov` in radians, as in
+/// [`pinhole_intrinsics`].
 /// Sides above [`MAX_SIDE`](crate::sensors::camera::MAX_SIDE) are refused (a camera's own bound), before anything
 /// is allocated.
 pub fn pinhole_directions(width: u32, height: u32, hfov: f64) -> Result<Vec<[f32; 3]>> {
@@ -142,6 +144,16 @@ pub fn lidar_trace_order(channels: u32, azimuth_steps: u32, block: u32) -> Resul
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_out_of_range_hfov_is_refused_in_its_unit() {
+        // `hfov` is in radians: the message said "(0, 180) degrees", which 4.0 lies within.
+        for hfov in [0.0, -1.0, 4.0, std::f64::consts::PI, f64::NAN] {
+            let e = pinhole_intrinsics(8, 8, hfov).err().map(|e| e.to_string()).unwrap_or_default();
+            assert!(e.contains("hfov") && e.contains("radians") && !e.contains("degrees"), "{hfov}: {e}");
+        }
+        assert!(pinhole_intrinsics(8, 8, 3.1).is_ok());
+    }
 
     #[test]
     fn huge_sizes_are_refused_before_allocating() {
