@@ -18,7 +18,8 @@ import yaml
 from mmusv.export import convert
 from mmusv.recording import decode_image, decode_point_cloud, read_messages
 
-EXTRA_FILES = {"_depth{i}.png", "_semantic{i}.png"}
+EXTRA_FILES = {"_depth{i}.png", "_depth_cm{i}.png", "_semantic{i}.png"}
+"""Depth: HEAL's 8-bit metres under OPV2V-H's name, the uint16 centimetres beside it (``_depth_cm``)."""
 YAML_KEYS = {
     "camera0",
     "camera1",

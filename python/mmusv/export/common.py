@@ -26,7 +26,9 @@ __all__ = [
     "Options",
     "Sink",
     "cav_id",
+    "depth_metres",
     "depth_png",
+    "depth_units_png",
     "dump_yaml",
     "mask_box",
     "parse_box",
@@ -169,10 +171,20 @@ def encode_png(img: np.ndarray, *, compress_level: int = 6) -> bytes:
 
 def depth_png(msg: Any) -> bytes:
     """A depth image message (metres, float; +inf or 0 = no hit) as a uint16 PNG in units of
-    :data:`DEPTH_UNIT_M` (0 = no hit, 65535 = saturated)."""
+    :data:`DEPTH_UNIT_M` (0 = no hit, 65535 = saturated): :func:`depth_metres` then :func:`depth_units_png`."""
+    return depth_units_png(depth_metres(msg))
+
+
+def depth_metres(msg: Any) -> np.ndarray:
+    """A depth image message decoded: ``(H, W)`` float64 metres along the optical axis (+inf or 0 = no hit)."""
     from mmusv.recording import decode_image
 
-    d = np.asarray(decode_image(msg), dtype=np.float64)
+    return np.asarray(decode_image(msg), dtype=np.float64)
+
+
+def depth_units_png(d: np.ndarray) -> bytes:
+    """``(H, W)`` depths in metres (+inf or 0 = no hit) as a uint16 PNG in units of :data:`DEPTH_UNIT_M` (0 = no
+    hit, 65535 = saturated)."""
     units = np.where(np.isfinite(d) & (d > 0), np.clip(np.rint(d / DEPTH_UNIT_M), 1, 65535), 0).astype(np.uint16)
     return encode_png(units, compress_level=1)
 

@@ -17,8 +17,19 @@ rate ``vz`` is part of it, so a vessel sailing at ``speed_mps`` shows a little m
 ``speed_mps`` under way).
 
 Files beyond stock OPV2V, which stock loaders skip: ``<ts>_additional.yaml`` (our names, classes and LiDAR point
-counts of the listed vehicles), ``<ts>_depth{i}.png`` (uint16 cm), ``<ts>_semantic{i}.png``,
+counts of the listed vehicles), ``<ts>_depth{i}.png`` (HEAL's OPV2V-H depth: 8-bit grayscale, whole metres
+along the optical axis, 255 = no hit or 254.5 m and farther; :func:`heal_depth_png`), ``<ts>_depth_cm{i}.png`` (the
+same depth as uint16 centimetres, 0 = no hit, 65535 = 655.35 m or farther), ``<ts>_semantic{i}.png``,
 ``<ts>_instance{i}.png`` (uint16 ids), ``<ts>_radar_ppi.png``, ``<ts>_topview_{rgb,semantic}.png``.
+
+HEAL (``yifanlu0227/HEAL``, ``opencood/data_utils/datasets/basedataset/opv2v_basedataset.py``) reads
+``<ts>_depth{i}.png`` with ``PIL.Image.open`` and turns it into its depth channel with
+``torchvision.transforms.ToTensor()(img) * 255`` (``intermediate_heter_fusion_dataset.py`` and the other fusion
+datasets), which its LSS encoders bin as metres (``ddiscr`` ``[2, 50, 48]`` …, values past the last bin clamped to it).
+That is only metres for an 8-bit image: ``ToTensor`` divides a mode ``L`` image by 255, but returns a 16-bit PNG
+(mode ``I;16``) as int16 counts, unscaled, which the ``* 255`` then overflows. HEAL looks for the depth files under
+the camera folder's path with ``OPV2V`` replaced by ``OPV2V_Hetero``: beside the cameras when the path has no
+``OPV2V`` in it, otherwise in that mirror folder (``docs/opencood.md``).
 
 Beside the export, ``opencood/point_pillar_{early,late,intermediate}_fusion.yaml``: OpenCOOD hypes sized from
 the exported vessels and distances (:mod:`mmusv.export.opencood`, ``docs/opencood.md``).
@@ -32,7 +43,16 @@ from typing import Any, ClassVar
 import numpy as np
 
 from mmusv.classes import class_name
-from mmusv.export.common import DEPTH_UNIT_M, cav_id, depth_png, dump_yaml, png_bytes, rounded
+from mmusv.export.common import (
+    DEPTH_UNIT_M,
+    cav_id,
+    depth_metres,
+    depth_units_png,
+    dump_yaml,
+    encode_png,
+    png_bytes,
+    rounded,
+)
 from mmusv.export.geometry import AgentView, Target
 from mmusv.export.opencood import HypesStats, constants, hypes
 from mmusv.export.pcd import pcd_bytes
@@ -42,10 +62,25 @@ from mmusv.recording import topics
 from mmusv.recording.decode import WorldFrame
 from mmusv.recording.stream import Frame
 
-__all__ = ["OPV2V_CAMERAS", "Opv2vWriter", "timestamp"]
+__all__ = ["HEAL_DEPTH_FAR", "OPV2V_CAMERAS", "Opv2vWriter", "heal_depth_png", "timestamp"]
 
 OPV2V_CAMERAS = {"front": 0, "right": 1, "left": 2, "rear": 3, "back": 3}
 """Our camera name → OPV2V camera index."""
+
+
+HEAL_DEPTH_FAR = 255
+"""The value of ``<ts>_depth{i}.png`` for no hit (sky) and for 254.5 m or farther: the largest 8-bit value, which
+HEAL's depth binning clamps into its farthest bin (a 0 would be its nearest)."""
+
+
+def heal_depth_png(d: np.ndarray) -> bytes:
+    """``(H, W)`` depths in metres along the optical axis (+inf or 0 = no hit; :func:`~mmusv.export.common.depth_metres`
+    of a depth image message) as HEAL reads ``<ts>_depth{i}.png``: an 8-bit grayscale PNG (PIL mode ``L``) whose pixel
+    value is the depth in metres, rounded to the nearest metre; no hit and anything from 254.5 m on are
+    :data:`HEAL_DEPTH_FAR`. ``ToTensor()(img) * 255`` gives back the pixel values as metres."""
+    hit = np.isfinite(d) & (d > 0)
+    metres = np.clip(np.rint(np.where(hit, d, 0.0)), 0, HEAL_DEPTH_FAR)
+    return encode_png(np.where(hit, metres, HEAL_DEPTH_FAR).astype(np.uint8), compress_level=1)
 
 
 def timestamp(frame: int) -> str:
@@ -151,7 +186,10 @@ class Opv2vWriter(DatasetWriter):
                 self.put(d / f"{ts}_camera{idx}.png", png_bytes(rgb))
             base = topics.camera(a.id, name) + "/"
             if "depth" in self.options.extras and base + "depth" in msgs:
-                self.put(d / f"{ts}_depth{idx}.png", depth_png(msgs[base + "depth"]), "depth")
+                # HEAL's name and encoding (8-bit metres), and the centimetres beside it.
+                metres = depth_metres(msgs[base + "depth"])
+                self.put(d / f"{ts}_depth{idx}.png", heal_depth_png(metres), "depth")
+                self.put(d / f"{ts}_depth_cm{idx}.png", depth_units_png(metres), "depth")
             for kind in ("semantic", "instance"):
                 if kind in self.options.extras and base + kind in msgs:
                     self.put(d / f"{ts}_{kind}{idx}.png", png_bytes(msgs[base + kind]), kind)
@@ -272,7 +310,23 @@ class Opv2vWriter(DatasetWriter):
                 "in the agent's LiDAR frame; the agent itself never, other USVs only if include_usvs",
                 "include_usvs": o.include_usvs,
                 "extras": list(o.extras),
-                "depth_png": {"unit_m": DEPTH_UNIT_M, "no_hit": 0, "saturated": 65535, "along": "optical axis"},
+                "depth_png": {
+                    "file": "<ts>_depth{i}.png",
+                    "dtype": "uint8",
+                    "unit_m": 1.0,
+                    "no_hit": HEAL_DEPTH_FAR,
+                    "saturated": HEAL_DEPTH_FAR,
+                    "along": "optical axis",
+                    "read_as": "HEAL: torchvision ToTensor()(img) * 255 = metres",
+                },
+                "depth_cm_png": {
+                    "file": "<ts>_depth_cm{i}.png",
+                    "dtype": "uint16",
+                    "unit_m": DEPTH_UNIT_M,
+                    "no_hit": 0,
+                    "saturated": 65535,
+                    "along": "optical axis",
+                },
                 "frames_converted": len(frames),
                 "frames_skipped": skipped,
             },
