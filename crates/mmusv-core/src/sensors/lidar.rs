@@ -29,7 +29,12 @@
 //!    efficiency 2: with Marshall & Palmer's 1948 drop sizes `≈ 0.365 · R^0.63` per km, 1.6 km⁻¹ at 10 mm/h,
 //!    a visibility of 1.9 km from the rain alone), so `3 / V` carries the rain's extinction when the visibility
 //!    given is the one in that rain, and this term adds 2.4–2.7 % of the drops' own extinction over 1–50 mm/h
-//!    (kept: it is in every recording made in rain). The return is lost with
+//!    (kept: it is in every recording made in rain). The same numbers, `0.01 · R^0.6`, are the rain extinction
+//!    that the LISA code (Kilic et al. 2021, "Lidar Light Scattering Augmentation (LISA)", arXiv:2107.07004;
+//!    `velatkilic/LISA`, `python_old/atmos_models.py`, `msu_rain`) attributes to Goodin, Carruth, Doude & Hudson
+//!    (2019), "Predicting the Influence of Rain on LIDAR in ADAS", Electronics 8(1), 89, and applies per metre
+//!    (1000 times ours: 0.04 m⁻¹ at 10 mm/h, a visibility of 75 m from the rain alone); Goodin et al.'s own text
+//!    was not read, so neither that paper as the source nor its unit is confirmed. The return is lost with
 //!    probability `1 − τ` — but for the physical water returns of step 3, whose speckle threshold already met the
 //!    attenuated mean `τ ⟨I⟩` (until 2026-12-01 they were lost with probability `1 − τ` as well, the fog counted
 //!    twice: at 600 m visibility a fifth fewer water returns 20 m out than the model gives, a third 40 m out);
@@ -40,7 +45,21 @@
 //!    limits); the point is `origin + r' · d` in the LiDAR frame.
 //!
 //! Intensity in `[0, 1]`: `ρ(class) · |cos θ| · τ / (1 + (r / 100 m)²)`, θ the incidence angle, ρ a per-class
-//! reflectivity ([`reflectivity`]).
+//! reflectivity ([`reflectivity`]). This is the project's own calibration, not a published law; it lies between
+//! two published conventions:
+//! * the received power of the LiDAR range equation for an extended Lambertian target, `P_r ∝ ρ cos α · η_atm / R²`
+//!   (Höfle & Pfeifer 2007, "Correction of laser scanning intensity data: Data and model-driven approaches", ISPRS
+//!   Journal of Photogrammetry and Remote Sensing, their model-driven correction for spherical loss, incidence angle
+//!   and atmospheric transmission). Ours has that `ρ cos θ τ`, but its range factor is inverse-square only far out:
+//!   `1 / (1 + (r / 100 m)²)` is `x² / (1 + x²)` of `(100 m / r)²`, 0.8 of it at the default 200 m range, 0.5 at
+//!   100 m, 0.04 at 20 m (Pfeifer et al. 2007, Optical 3-D Measurement Techniques VIII, 328–337, found the
+//!   inverse-square law too simple for a Riegl LMS-Z420i over 1.2–48 m anyway);
+//! * the range-compensated reflectivity that spinning LiDARs report: Velodyne's VLP-16 User Manual, §6.1
+//!   *Calibrated Reflectivity* (reflectivity "independent of laser power and distances", 0–100 for 0–100 %
+//!   diffuse reflectors, 101–255 for retro-reflectors), Ouster's firmware manual, *Calibrated Reflectivity*
+//!   (signal photons scaled by range and sensor sensitivity), Hesai's PandarXT-16 manual (the reflectivity field
+//!   linear in target reflectivity). Against a range-independent `ρ |cos θ| τ` ours is 4 % low at 20 m, 20 % at
+//!   50 m, 50 % at 100 m and 80 % at 200 m: the intensity is neither a raw power nor a calibrated reflectivity.
 
 use super::lidar_water;
 use super::noise::{self, stream};
@@ -221,6 +240,13 @@ impl LidarScan {
 }
 
 /// Reflectivity of each semantic class at the LiDAR wavelength (dimensionless, `[0, 1]`).
+///
+/// The project's own values, not measured ones: no published 905 nm table for these classes (hull paint, quay
+/// concrete, rock and sand, vegetation, containers, cranes) was found (searched 2026-12-02), so they are chosen to
+/// order the classes plausibly (water darkest, retro-reflective buoys brightest), not to match a sensor. Water's
+/// 0.05 serves only the flat sea's empirical rule (module header, step 3); over the displaced sea the returns'
+/// intensity is [`super::lidar_water`]'s. Retro-reflective tape, which Velodyne's calibrated reflectivity puts
+/// above every diffuse surface (101–255 against 0–100), is 0.80 here, inside the `[0, 1]` of diffuse ones.
 pub fn reflectivity(class: u16) -> f32 {
     match class {
         1 => 0.05,       // water

@@ -13,7 +13,9 @@
 //!   `4 ρ cos²θ`; `ρ` is a per-class radar reflectivity, not an albedo), so a face-on patch of `A` m² is a
 //!   target of `ρ A` m². Summing rays over a cell makes the echo grow with the target's visible size (more rays
 //!   hit it). `ρ` per class: [`class_reflectivity`]. Each ray's echo is weighted by the fan's two-way elevation
-//!   gain `G²(e)` (Gaussian main lobe, `radar/pattern.rs`; 1 on the fan's axis).
+//!   gain `G²(e)` (Gaussian main lobe, `radar/pattern.rs`; 1 on the fan's axis). This diffuse-target law and the
+//!   per-class `ρ` are the project's own choice, not a published target model (none was found, 2026-12-02): the
+//!   `cos²θ` is the Lambertian one, the factor ¼ and the `ρ` values only set how bright each class is.
 //! * **Rain attenuation** (two-way): specific attenuation `γ = k · R^α` dB/km for a rain rate `R` in mm/h, with
 //!   `k` and `α` of the radar's frequency `f` and polarisation from ITU-R P.838-3 (2005), "Specific attenuation
 //!   model for rain for use in prediction methods", eqs. (2)–(3) and Tables 1–4: `log10 k = Σⱼ aⱼ exp(−((log10 f −
@@ -27,7 +29,18 @@
 //!   (Skolnik §13.2, [`CellShape::sea_area`]; until 2026-12-01 without the `sec ψ`), and past the critical range
 //!   `R_c = critical_range_per_m · H` the interference fall-off `g = (R_c / r)⁴` (so clutter falls as `r⁻³`
 //!   close in and `r⁻⁷` beyond `R_c`: higher waves give stronger clutter reaching farther); zero beyond
-//!   `sea_max_range_m` and for `H = 0`.
+//!   `sea_max_range_m` and for `H = 0`. This flat-sea rule is the project's calibration, not a published model: no
+//!   source for `σ⁰ ∝ H²` was found (2026-12-02), and `R_c = 300 m` per metre of `H` is a tuned constant (it does
+//!   not follow the antenna's height or the wavelength). What is published is its fall-off: below a "critical
+//!   angle" the direct field and the one the sea reflects interfere destructively (Katzin, M. (1957), "On the
+//!   Mechanisms of Radar Sea Clutter", Proc. IRE 45(1), 44–54), and interference theory predicts `σ⁰ ∝ ψ⁴` at
+//!   small grazing angles ψ, some measurements conforming, while empirical models give `ψ²` (Sittrop, the HYB
+//!   model) or about `ψ` (the GIT model) (Nathanson, *Radar Design Principles*, 2nd ed., §7.8). With `ψ ≈ h / r`,
+//!   `(R_c / r)⁴` is the `ψ⁴` law beyond `R_c`; within it the rule has no grazing dependence at all. It is used
+//!   only where the scene has no displaced wave surface: `environment.motion: paper` scenarios (flat water),
+//!   `Simulation.set_sea_surface(None)` or a sea of `Hs = 0`, and core users who set no wave surface; its knobs are
+//!   the scenario's `sea_clutter_sigma0` (4·10⁻⁷) and `clutter_critical_range_per_m` (300). Scenarios by default
+//!   (`motion: physical`) take the NRL model below.
 //!   Over the physical sea (a scene with a displaced wave surface) σ⁰ instead follows sea state and grazing
 //!   angle by the NRL model of Gregers-Hansen & Mital (2012), `sensors/radar/sea_clutter.rs`, and the sea part
 //!   is `σ⁰ · A(r) · (R_ref/r)⁴ · L_rain(r)` ([`clutter_mean_sigma0`]). Either is weighted per beam by the fan's

@@ -12,6 +12,18 @@
 //! there (geometric shadowing, as the radar's own echoes are). The rays are those the sweep casts anyway, so a low
 //! object that no ray met casts no shadow; the crests are water and shadow nothing here (their shadowing of the
 //! troughs is in the NRL model's σ⁰). Rain clutter, from the air above, is not shadowed.
+//!
+//! The model is geometric visibility (line of sight from the antenna), the approach of Billingsley, J. B. (2002),
+//! *Low-Angle Radar Land Clutter: Measurements and Empirical Models* (William Andrew / SciTech), ch. 4, whose
+//! site-specific clutter model captures the patchiness of low-angle clutter "via deterministic computation of
+//! geometric terrain visibility from the radar site" (there from digitized terrain elevation data, here from the
+//! sweep's own rays). Beyond that principle the details are the project's: a shadowed share of the beam returns
+//! no sea clutter at all (no diffraction into the shadow, no multipath), `e_h` is the sensor's horizontal plane and
+//! the still water's depression the flat-earth `atan(h / r)` (the clutter's own grazing angle keeps the 4/3-earth
+//! model).
+//! The crests' shadowing of the troughs, left to σ⁰ here, is the other, statistical shadowing of sea clutter
+//! models (Ward, Tough & Watts, *Sea Clutter: Scattering, the K Distribution and Radar Performance*, §3.6–3.8:
+//! negligible at 10° grazing, below it a loss of 4 dB per decade in their composite model).
 
 /// The rays of one azimuth sample that stopped on something other than water: `(elevation, distance)` in the
 /// sensor frame (radians, metres), kept only at or below the horizon and beyond the blind range.

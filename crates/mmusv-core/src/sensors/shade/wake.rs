@@ -11,6 +11,17 @@
 //! the bend's outer corner). A wake row without a piece after it whose path bent (`reach_m` short of the foam's own
 //! reach) thins to nothing over the last quarter of that stretch (at most four beams). No foam where the vessel
 //! never went. The foam is broken up by the same noise as the whitecaps (`foam.rs`).
+//!
+//! Only the Kelvin angle is a published law. The foam is the project's own calibration, not a published model: no
+//! published law for a wake's foam density against speed, its fade time or its track's widening was found
+//! (searched 2026-12-02). The strengths `(V / 6 m/s)²` (track) and `(V / 8 m/s)²` (arms), full from 6 and 8 m/s,
+//! the 30 s e-folding fade, the track's half-width `½ B (1 + ¼ √(d / max(B, 1 m)))` (`B` the beam, `d` the
+//! metres of path since the stern passed) and an arm's width `0.3 m + 0.02 · (metres from the bow) + 0.1 B` were
+//! chosen so that a slow craft leaves a faint trace and a fast one a bright track as wide as its beam with two
+//! fainter arms (`docs/realism/README.md`, *A wake behind a fast craft*). The Kelvin angle itself holds for a
+//! point source in deep water; from airborne images Rabaud & Moisy (2013), "Ship wakes: Kelvin or Mach angle?",
+//! arXiv:1304.2653, find the wake angle falling as `1 / U` above a hull Froude number `U / √(g L)` ≈ 0.5 (0.76
+//! for a 35 m boat at 14 m/s), where these arms keep 19.47°.
 
 //!
 //! The Kelvin arms round a bend are worked out in `kelvin_bend.rs`.
