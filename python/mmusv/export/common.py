@@ -42,7 +42,9 @@ EXTRAS = ("depth", "semantic", "instance", "radar", "top_view")
 DEFAULT_EXTRAS = ("depth", "semantic", "radar", "top_view")
 CAV_ID_BASE = 1000
 DEPTH_UNIT_M = 0.01
-"""Depth PNGs are uint16 centimetres along the optical axis: 0 = no hit (sky), 65535 = 655.35 m or farther."""
+"""The uint16 depth PNGs (:func:`depth_png`: KITTI's ``depth_2``, OPV2V's ``<ts>_depth_cm{i}.png``) are centimetres
+along the optical axis: 0 = no hit (sky), 65535 = 655.35 m or farther. OPV2V's ``<ts>_depth{i}.png`` is HEAL's 8-bit
+metres instead (:func:`mmusv.export.opv2v.heal_depth_png`)."""
 BOXES = ("visible", "projected")
 """The 2D boxes the COCO, YOLO and MOT exports can write (``--box``; the first is the default)."""
 BOX_DEFINITIONS = {

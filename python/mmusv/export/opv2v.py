@@ -79,8 +79,10 @@ def heal_depth_png(d: np.ndarray) -> bytes:
     value is the depth in metres, rounded to the nearest metre; no hit and anything from 254.5 m on are
     :data:`HEAL_DEPTH_FAR`. ``ToTensor()(img) * 255`` gives back the pixel values as metres."""
     hit = np.isfinite(d) & (d > 0)
-    metres = np.clip(np.rint(np.where(hit, d, 0.0)), 0, HEAL_DEPTH_FAR)
-    return encode_png(np.where(hit, metres, HEAL_DEPTH_FAR).astype(np.uint8), compress_level=1)
+    # 254.5 m itself is far too: np.rint rounds that half to the even 254.
+    near = hit & (d < HEAL_DEPTH_FAR - 0.5)
+    metres = np.clip(np.rint(np.where(near, d, 0.0)), 0, HEAL_DEPTH_FAR - 1)
+    return encode_png(np.where(near, metres, HEAL_DEPTH_FAR).astype(np.uint8), compress_level=1)
 
 
 def timestamp(frame: int) -> str:
@@ -95,6 +97,8 @@ def _matrix_list(m: np.ndarray) -> list[list[float]]:
 class Opv2vWriter(DatasetWriter):
     """Writes one recording as one OPV2V scenario folder (see the module docstring)."""
 
+    format_version: ClassVar[int] = 2
+    """2 (2026-12-02): ``<ts>_depth{i}.png`` is HEAL's 8-bit metres, the centimetres ``<ts>_depth_cm{i}.png``."""
     cameras: ClassVar[dict[str, int]] = {k: v for k, v in OPV2V_CAMERAS.items() if k != "back"}
     needs_agent: ClassVar[bool] = True
 
