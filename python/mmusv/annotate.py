@@ -52,6 +52,7 @@ __all__ = [
     "box_corners",
     "footprint_in_range",
     "in_target_range",
+    "pinhole_truncation",
 ]
 
 # Corner order of a box: bit 0 → +x, bit 1 → +y, bit 2 → +z.
@@ -296,6 +297,32 @@ def _project_box(
     return np.array([u.min(), v.min(), u.max(), v.max()])
 
 
+def _clip_box(box: np.ndarray, width: int, height: int) -> tuple[np.ndarray, float, float]:
+    """A pixel box ``[x0, y0, x1, y1]`` clipped to the ``width × height`` image: the clipped box, the box's own area
+    and the clipped area (pixels²; 0 when the box is empty or lies wholly outside the image)."""
+    area = max(box[2] - box[0], 0.0) * max(box[3] - box[1], 0.0)
+    clipped = np.array([max(box[0], 0.0), max(box[1], 0.0), min(box[2], float(width)), min(box[3], float(height))])
+    if clipped[2] <= clipped[0] or clipped[3] <= clipped[1] or area <= 0:
+        return clipped, float(area), 0.0
+    return clipped, float(area), float((clipped[2] - clipped[0]) * (clipped[3] - clipped[1]))
+
+
+def pinhole_truncation(
+    corners_opt: np.ndarray, *, intrinsics: tuple[float, float, float, float], width: int, height: int
+) -> float:
+    """The share of a box's pinhole image that lies outside a ``width × height`` image: ``1 −`` clipped area /
+    unclipped area of the projected box (as the 2D boxes' ``truncation``, without lens distortion), from its ``(8,
+    3)`` corners in the optical frame (x right, y down, z forward; metres) and ``intrinsics`` ``(fx, fy, cx, cy)``
+    pixels; 1.0 when the box lies wholly behind the camera or outside the image. For a target without a recorded 2D
+    box (too small or too far for any pixel centre to meet it), so that an export can tell one in view from one
+    out of it."""
+    box = _project_box(np.asarray(corners_opt, dtype=np.float64), intrinsics)
+    if box is None:
+        return 1.0
+    _clipped, area, carea = _clip_box(box, width, height)
+    return 1.0 if carea <= 0 else float(1.0 - carea / area)
+
+
 def _lens(cam: Any, pose: np.ndarray, world_to_body: np.ndarray) -> tuple[Any, float] | None:
     """A pinhole camera with lens distortion (``mmusv._core.Camera``) and its reach (the largest undistorted
     normalised radius its image corners see, from the camera's own corner rays), or ``None`` without distortion.
@@ -427,11 +454,9 @@ def annotate_agent(
             box = _project_box(body @ BODY_TO_OPTICAL.T, k, lens)
             if box is None:
                 continue
-            area = max(box[2] - box[0], 0.0) * max(box[3] - box[1], 0.0)
-            clipped = np.array([max(box[0], 0.0), max(box[1], 0.0), min(box[2], float(w)), min(box[3], float(h))])
-            if clipped[2] <= clipped[0] or clipped[3] <= clipped[1] or area <= 0:
+            clipped, area, carea = _clip_box(box, w, h)
+            if carea <= 0:
                 continue
-            carea = (clipped[2] - clipped[0]) * (clipped[3] - clipped[1])
             u0, v0 = int(np.floor(clipped[0])), int(np.floor(clipped[1]))
             u1, v1 = int(np.ceil(clipped[2])), int(np.ceil(clipped[3]))
             window = inst_img[v0:v1, u0:u1]

@@ -153,10 +153,12 @@ def test_files_are_the_kitti_exports_by_sequence(exports: dict[str, Path]) -> No
 
 def as_tracking(line: str) -> str:
     """A KITTI object ``label_2`` line with its truncation fraction turned into the tracking benchmark's level (the
-    KITTI raw data's tracklets: 0 in the image, 1 cut by the border, 2 out of the image: occluded 3 here)."""
+    KITTI raw data's tracklets: 0 in the image, 1 cut by the border, 2 out of the image: a line without a box,
+    occluded 3, and truncated 1.00; one without a box but in view, too small for a pixel, is 0 or 1 by its share)."""
     f = line.split()
     frac = float(f[1])
-    f[1] = "2" if f[2] == "3" else "0" if frac <= 0.0 else "1"  # with a box (occluded < 3) it is in the image
+    out = f[2] == "3" and frac >= 1.0  # with a box (occluded < 3) it is in the image, however much is cut
+    f[1] = "2" if out else "0" if frac <= 0.0 else "1"
     return " ".join(f)
 
 

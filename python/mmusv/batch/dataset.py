@@ -58,11 +58,13 @@ class DatasetReport:
 
 
 def _conversion_complete(opv2v: Path) -> bool:
-    """Whether ``opv2v`` holds a finished conversion: its report says ``status: complete`` and every recording it
-    converted frames of still has its folder (``<split>/<folder>``). A conversion into a
-    folder that was not there (removed by hand) writes into it directly and starts its report as ``in_progress``:
-    stopped there (Ctrl-C), a re-run took the half-written folder for up to date, as the index still named the
-    same recordings."""
+    """Whether ``opv2v`` holds a finished conversion of today's format: its report says ``status: complete`` and
+    ``format_version`` the OPV2V writer's (:attr:`~mmusv.export.writer.DatasetWriter.format_version`: a folder
+    converted before a file's meaning changed is converted again), and every recording it converted frames of still
+    has its folder (``<split>/<folder>``). A conversion into a folder that was not there (removed by hand) writes
+    into it directly and starts its report as ``in_progress``: stopped there (Ctrl-C), a re-run took the
+    half-written folder for up to date, as the index still named the same recordings."""
+    from mmusv.export.convert import writer_class
     from mmusv.export.convert_report import REPORT_NAME
     from mmusv.yamlio import read_yaml
 
@@ -71,6 +73,9 @@ def _conversion_complete(opv2v: Path) -> bool:
     except (OSError, MmusvError, ValueError):
         return False
     if not isinstance(doc, dict) or doc.get("status") != "complete":
+        return False
+    # Converted by an earlier version whose files mean something else today (OPV2V 2: the depth PNGs' encoding).
+    if doc.get("format_version", 1) != writer_class("opv2v").format_version:
         return False
     # Every recording that was converted still has its folder: one removed by hand (to make room, or to convert it
     # again) was taken for up to date, "opv2v: ... is up to date" with its sequence gone.

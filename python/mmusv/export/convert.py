@@ -272,6 +272,7 @@ def convert(
         ]
         header = {
             "format": to,
+            "format_version": cls.format_version,
             "options": {
                 "eval_range_m": rng,
                 "include_usvs": options.include_usvs,

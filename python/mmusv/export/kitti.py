@@ -10,7 +10,8 @@ range (same filter as OPV2V): ``type truncated occluded alpha x1 y1 x2 y2 h w l 
 camera frame (location = the box centre moved h/2 down the camera's y axis: KITTI's bottom centre of an upright
 box, so that readers adding h/2 back get the box centre, also when the hull or the USV rolls in waves); the 2D box,
 truncation and occlusion come from the recording's camera annotations (occluded 0: < 25 % hidden, 1: < 60 %,
-2: more, 3: not in the front image, with box ``0 0 0 0`` and truncated ``1.00``: wholly out of the image).
+2: more, 3: no box in the front image, with box ``0 0 0 0`` and truncated the share of the target out of the image:
+``1.00`` behind or beside the camera, the projected box's share for one in view too small for any pixel centre).
 An agent without a front camera has no ``image_2``, zero ``P0..P3`` and, as camera, the LiDAR's own optical axes
 (``Tr_velo_to_cam`` = the rotation x right, y down, z forward): its labels keep KITTI's camera conventions, so
 KITTI's readers turn them into LiDAR boxes with the right heading. A front camera's lens distortion (KITTI's
@@ -27,6 +28,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from mmusv.annotate import box_corners, pinhole_truncation
 from mmusv.classes import class_name
 from mmusv.export.common import cav_id, depth_png, dump_yaml, png_bytes
 from mmusv.export.geometry import AgentView, Target
@@ -126,9 +128,18 @@ def label_lines(
     a = view.agent
     boxes: dict[str, Any] = {}
     ann = messages.get(topics.agent_annotations(a.id))
-    if ann is not None and "front" in a.cameras:
+    cam = a.cameras.get("front")
+    if ann is not None and cam is not None:
         boxes = {b.target_id: b for b in ann.boxes_camera if b.camera == "front"}
-    return [kitti_label(t, velo_to_cam, box2d=boxes.get(t.id), kind=kind, levels=levels) for t in targets]
+    lines = []
+    for t in targets:
+        box2d = boxes.get(t.id)
+        unseen = 1.0  # no front camera, or a target out of its view
+        if box2d is None and cam is not None:  # in view but too small for a pixel centre to meet it?
+            corners = box_corners(velo_to_cam @ t.box_in_lidar, np.asarray(t.size, dtype=np.float64))
+            unseen = pinhole_truncation(corners, intrinsics=cam.intrinsics, width=cam.width, height=cam.height)
+        lines.append(kitti_label(t, velo_to_cam, box2d=box2d, kind=kind, levels=levels, unseen_truncation=unseen))
+    return lines
 
 
 def truncation_level(fraction: float | None) -> int:
@@ -142,13 +153,21 @@ def truncation_level(fraction: float | None) -> int:
 
 
 def kitti_label(
-    target: Target, velo_to_cam: np.ndarray, *, box2d: Any | None, kind: str | None = None, levels: bool = False
+    target: Target,
+    velo_to_cam: np.ndarray,
+    *,
+    box2d: Any | None,
+    kind: str | None = None,
+    levels: bool = False,
+    unseen_truncation: float = 1.0,
 ) -> str:
     """One ``label_2`` line of ``target`` (box in the LiDAR frame) for the camera ``velo_to_cam`` (4×4); ``kind``:
     the type written (``None``: the target's class name, capitalised); ``levels``: truncation written as the
     tracking benchmark's integer level (:func:`truncation_level`) instead of the object benchmark's fraction.
-    Without ``box2d`` (no box in the front image) the target is out of the image: truncated 1 (the object benchmark's
-    fraction of it "leaving image boundaries"; the tracking level 2), occluded 3 and box ``0 0 0 0``."""
+    Without ``box2d`` (no recorded box in the front image) occluded is 3 ("unknown"), the box ``0 0 0 0`` and
+    truncated ``unseen_truncation``: the share of the target "leaving image boundaries" — 1 (the tracking level 2)
+    for a target behind or beside the camera or without one, the share of its projected box outside the image
+    (:func:`mmusv.annotate.pinhole_truncation`) for one in view that no pixel centre meets (:func:`label_lines`)."""
     length, beam, height = (float(x) for x in target.size)
     box_cam = velo_to_cam @ target.box_in_lidar
     centre = box_cam[:3, 3]
@@ -159,20 +178,23 @@ def kitti_label(
     d = box_cam[:3, 0]
     ry = float(wrap_rad(math.atan2(-d[2], d[0])))
     alpha = float(wrap_rad(ry - math.atan2(centre[0], centre[2])))
-    if box2d is None:  # out of the image: wholly "leaving image boundaries" (KITTI's truncated 1), state unknown
-        trunc, occ, bb = 1.0, 3, (0.0, 0.0, 0.0, 0.0)
+    if box2d is None:  # no recorded box: state unknown, the share of it out of the image as given
+        trunc, occ, bb = float(unseen_truncation), 3, (0.0, 0.0, 0.0, 0.0)
     else:
         trunc, occ = float(box2d.truncation), occlusion_level(float(box2d.occlusion))
         bb = (box2d.x_min, box2d.y_min, box2d.x_max, box2d.y_max)
     name = kind if kind is not None else class_name(target.semantic_class).capitalize()
     vals = [trunc, occ, alpha, *bb, height, beam, length, *bottom, ry]
-    cut = f"{truncation_level(None if box2d is None else trunc)}" if levels else f"{vals[0]:.2f}"
+    out_of_image = box2d is None and trunc >= 1.0
+    cut = f"{truncation_level(None if out_of_image else trunc)}" if levels else f"{vals[0]:.2f}"
     return f"{name} {cut} {int(vals[1])} " + " ".join(f"{round(float(v), 2) + 0.0:.2f}" for v in vals[2:])
 
 
 class KittiWriter(DatasetWriter):
     """Writes one recording as KITTI-style per-agent folders (see the module docstring)."""
 
+    format_version: ClassVar[int] = 2
+    """2 (2026-12-02): ``truncated`` of a target without a front box is its share out of the image (it was 0)."""
     cameras: ClassVar[dict[str, int]] = {"front": 2}
     needs_agent: ClassVar[bool] = True
     image_folder: ClassVar[str] = "image_2"

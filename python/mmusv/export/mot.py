@@ -42,7 +42,7 @@ import csv
 import io
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 from mmusv.classes import class_name
 from mmusv.errors import IoError
@@ -177,6 +177,9 @@ class MotWriter(ProjectedBoxes):
     """Writes MOTChallenge sequences (see the module docstring); this class with ``box="projected"``, which needs
     only RGB images, :class:`MotVisibleWriter` with ``box="visible"`` and :class:`MotContrastWriter` with
     ``box="projected"`` and ``min_contrast``."""
+
+    format_version: ClassVar[int] = 2
+    """2 (2026-12-02): ``visibility`` counts the part cut by the image border too (it was 1 − occlusion)."""
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)

@@ -101,6 +101,8 @@ def camera_distortion(agent: AgentInfo, name: str) -> np.ndarray:
 class Ros2Writer(DatasetWriter):
     """Writes one recording as one rosbag2 folder (see the module docstring)."""
 
+    format_version: ClassVar[int] = 2
+    """2 (2026-12-02): the bag's time is the sim time plus :data:`TIME_OFFSET_NS` (it was the sim time)."""
     owns_folder: ClassVar[bool] = False
     splits: ClassVar[bool] = False
     needs_agent: ClassVar[bool] = False

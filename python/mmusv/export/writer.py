@@ -41,6 +41,11 @@ class DatasetWriter:
     splits: ClassVar[bool] = True
     no_agent_reason: ClassVar[str] = "no agent with a LiDAR"
     needs_agent: ClassVar[bool] = False
+    format_version: ClassVar[int] = 1
+    """The version of what the format's files mean, written in ``conversion.yaml`` (``format_version``): raised
+    when a file of an earlier conversion would be read otherwise today (its name, encoding, a field's meaning), so
+    that a folder converted before is not taken for a current one (``mmusv dataset`` converts it again). A report
+    without the key predates the versions: 1."""
 
     def __init__(
         self,
