@@ -139,3 +139,31 @@ def test_kitti_truncated_is_not_one_for_a_boxless_target_inside_the_image(tmp_pa
             inside.append(line)
     assert inside, "the kayak ahead should be a box-less line (occluded 3) inside the front image"
     assert all(ln.split()[1] == "0.00" for ln in inside), inside
+
+
+def test_convert_piped_prints_no_empty_line_before_an_error(tmp_path: Path) -> None:
+    """``mmusv convert`` of a missing recording with its output piped (no ``--no-progress``): the transient progress
+    bar, on no terminal, left an empty line on stdout before the error on stderr (a README walk's finding). The bar
+    shows on a terminal only; stdout stays empty and stderr holds the one error line."""
+    import subprocess
+    import sys
+
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "mmusv",
+            "convert",
+            str(tmp_path / "nope.mcap"),
+            "--to",
+            "kitti",
+            "-o",
+            str(tmp_path / "k"),
+        ],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert r.returncode == 2
+    assert r.stdout == ""
+    assert r.stderr.startswith("mmusv: error: recording ") and "does not exist" in r.stderr

@@ -80,9 +80,9 @@ def uses_batch(args: argparse.Namespace) -> bool:
 
 
 def _console() -> Console:
-    from rich.console import Console
+    from mmusv.cli_console import rich_console
 
-    return Console(width=None if sys.stdout.isatty() else 160)
+    return rich_console()
 
 
 @contextmanager

@@ -9,7 +9,6 @@ which the ``mmusv`` entry point prints as one line (exit status 2).
 from __future__ import annotations
 
 import argparse
-import sys
 from typing import Any
 
 from mmusv.errors import ConfigError
@@ -132,9 +131,9 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     """Runs ``mmusv convert``; returns the exit status (0 when at least one frame was converted, 1 otherwise)."""
-    from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
+    from mmusv.cli_console import rich_console
     from mmusv.export.common import BOXES, TARGETS
     from mmusv.export.convert import convert
     from mmusv.export.kitti_oxts import parse_origin
@@ -153,7 +152,7 @@ def run(args: argparse.Namespace) -> int:
                 f"--oxts-origin {args.oxts_origin!r}: only --to kitti_tracking writes it, not --to {args.to}"
             )
         origin = parse_origin(args.oxts_origin)
-    console = Console(width=None if sys.stdout.isatty() else 160)
+    console = rich_console()
     kwargs: dict[str, Any] = {
         "to": args.to,
         "out_dir": args.output,
@@ -172,7 +171,7 @@ def run(args: argparse.Namespace) -> int:
         "kitti_class": args.kitti_class,
         "oxts_origin": origin,
     }
-    if args.no_progress:
+    if args.no_progress or not console.is_terminal:  # a bar only on a terminal (piped, it left an empty line)
         report = convert(args.recordings, **kwargs)
     else:
         with Progress(

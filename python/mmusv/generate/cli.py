@@ -65,15 +65,15 @@ def seed_arg(text: str, *, flag: str = "--seed") -> int:
 
 def run(args: argparse.Namespace) -> int:
     """Runs ``mmusv generate``; returns the exit status (0 all quotas met, 1 otherwise)."""
-    from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
+    from mmusv.cli_console import rich_console
     from mmusv.cli_paths import check_output_folder, output_arg, path_arg
     from mmusv.generate.mapctx import map_context
     from mmusv.generate.runner import check_output, generate
     from mmusv.generate.spec import load_spec, with_seed
 
-    console = Console(width=None if sys.stdout.isatty() else 160)
+    console = rich_console()
     if args.output is not None:  # an empty -o took the default folder without a word
         output_arg(args.output)
     from mmusv.bundled import resolve_spec
