@@ -21,8 +21,8 @@ from test_docs import DOCS, ROOT, SHELL_LANGS, Doc, _blocks, _docs, _doctored, _
 IMAGE = re.compile(r"!\[([^\]]*)\]\(([^)\s]+)(?:\s+\"[^\"]*\")?\)")
 MAGIC = (b"\x89PNG\r\n\x1a\n", b"\xff\xd8\xff", b"GIF87a", b"GIF89a", b"<svg", b"<?xml")
 HASH = re.compile(r"(?<![\w./#@-])([0-9a-f]{7,40})(?!\w)")
-EXTERNAL_COMMITS = {"31ba160"}
-"""Commits of other repositories the docs quote: OpenCOOD's, in docs/opencood.md."""
+EXTERNAL_COMMITS = {"31ba160", "96812ed"}
+"""Commits of other repositories the docs quote: OpenCOOD's and HEAL's, in docs/opencood.md."""
 
 
 def _base(doc: Doc) -> Path:

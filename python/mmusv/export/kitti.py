@@ -144,9 +144,9 @@ def label_lines(
 
 def truncation_level(fraction: float | None) -> int:
     """The KITTI tracking benchmark's truncation (its raw data's tracklet levels: 0 in the image, 1 cut by the image
-    border, 2 out of the image) of a target whose recorded 2D box is cut by ``fraction`` (0..1, taken at the object
-    labels' two decimals, so the two exports agree; ``None``: no box in the image, 2). A target with a box is in the
-    image, so 1 however much of it is cut (a sliver of a long ship whose fraction rounds to 1.00 too)."""
+    border, 2 out of the image) of a target whose box in the image is cut by ``fraction`` (0..1, taken at the object
+    labels' two decimals, so the two exports agree; ``None``: no part of it in the image, 2). A target with a box is in
+    the image, so 1 however much of it is cut (a sliver of a long ship whose fraction rounds to 1.00 too)."""
     if fraction is None:
         return 2
     return 0 if round(float(fraction), 2) <= 0.0 else 1
