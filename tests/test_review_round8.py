@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from kitti_files import label_corners, read_calib
 
 
 def _read_png(data: bytes) -> np.ndarray:
@@ -91,16 +92,6 @@ def test_opencood_doc_says_what_else_heals_camera_hypes_need() -> None:
     assert "bev_visibility.png" in section and "label_type: 'lidar'" in section
 
 
-def _kitti_corners(f: list[str]) -> np.ndarray:
-    """The 8 corners (camera frame) of a KITTI label line's box: location its bottom centre, ``rotation_y`` about y."""
-    h, w, l_, x, y, z, ry = (float(v) for v in f[8:15])
-    xs = np.array([1, 1, -1, -1, 1, 1, -1, -1]) * l_ / 2
-    ys = np.array([0, 0, 0, 0, -1, -1, -1, -1]) * h
-    zs = np.array([1, -1, -1, 1, 1, -1, -1, 1]) * w / 2
-    c, s = np.cos(ry), np.sin(ry)
-    return np.stack([c * xs + s * zs + x, ys + y, -s * xs + c * zs + z], axis=1)
-
-
 def test_kitti_truncated_is_not_one_for_a_boxless_target_inside_the_image(tmp_path: Path) -> None:
     """The devkit's ``truncated`` is the share of the object "leaving image boundaries". A kayak 189 m dead ahead of
     the front camera (160×120, 90°: under a pixel tall) has no recorded 2D box (no pixel centre hits it), yet its
@@ -123,14 +114,13 @@ def test_kitti_truncated_is_not_one_for_a_boxless_target_inside_the_image(tmp_pa
     rec = Path(run(cfg, out_dir=tmp_path / "rec", frames=1).recording)
     convert(rec, to="kitti", out_dir=tmp_path / "k", splits=None, extras=())
     agent = tmp_path / "k" / "kayak_ahead" / "1000"  # usv_a
-    p2 = next(ln for ln in (agent / "calib" / "000000.txt").read_text().splitlines() if ln.startswith("P2:"))
-    p = np.array([float(v) for v in p2.split()[1:]]).reshape(3, 4)
+    p = read_calib(agent / "calib" / "000000.txt")["P2"].reshape(3, 4)
     with Image.open(agent / "image_2" / "000000.png") as img:
         width, height = img.size
     inside = []
     for line in (agent / "label_2" / "000000.txt").read_text().splitlines():
         f = line.split()
-        corners = _kitti_corners(f)
+        corners = label_corners(f)
         if f[2] != "3" or not np.all(corners[:, 2] > 1.0):
             continue
         uvw = np.c_[corners, np.ones(8)] @ p.T

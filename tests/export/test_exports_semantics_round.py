@@ -19,6 +19,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from kitti_files import label_corners, read_calib
 from mmusv.export import convert
 from mmusv.export.geometry import Target
 from mmusv.export.kitti import LIDAR_OPTICAL, kitti_label
@@ -34,23 +35,18 @@ def kitti_case(request: pytest.FixtureRequest, tmp_path: Path) -> tuple[Path, Pa
     return rec, tmp_path / "o" / rec.stem
 
 
-def _share_out_of_image(fields: list[str], calib: str, image: Path) -> float | None:
+def _share_out_of_image(fields: list[str], calib: Path, image: Path) -> float | None:
     """The share of a label line's 3D box (KITTI's conventions: bottom-centre location, ``h w l``, ``rotation_y``
     about the camera's y) whose pinhole image (``P2`` of ``calib``) lies outside ``image``: 1.0 without a camera (zero
     ``P2``) or with the box wholly behind it; ``None`` for a box across the camera's plane (not worked out here)."""
-    p = np.array([float(v) for v in next(ln for ln in calib.splitlines() if ln.startswith("P2:")).split()[1:]])
+    p = read_calib(calib)["P2"]
     if not p.any() or not image.is_file():
         return 1.0
     from PIL import Image
 
     with Image.open(image) as img:
         width, height = img.size
-    h, w, l_, x, y, z, ry = (float(v) for v in fields[8:15])
-    xs = np.array([1, 1, -1, -1, 1, 1, -1, -1]) * l_ / 2
-    ys = np.array([0, 0, 0, 0, -1, -1, -1, -1]) * h
-    zs = np.array([1, -1, -1, 1, 1, -1, -1, 1]) * w / 2
-    c, s = np.cos(ry), np.sin(ry)
-    corners = np.stack([c * xs + s * zs + x, ys + y, -s * xs + c * zs + z], axis=1)
+    corners = label_corners(fields)
     if np.all(corners[:, 2] <= 0.0):
         return 1.0
     if np.any(corners[:, 2] <= 0.1):
@@ -77,7 +73,7 @@ def test_kitti_truncated_is_the_share_out_of_the_front_image(kitti_case: tuple[P
             k = int(path.stem)
             ann = frame_messages(rec, k)[topics.agent_annotations(a.id)]
             boxes = [b for b in ann.boxes_camera if b.camera == "front"]
-            calib = (agent / "calib" / path.name).read_text()
+            calib = agent / "calib" / path.name
             for line in path.read_text().splitlines():
                 f = line.split()
                 truncated, occluded, bbox = float(f[1]), int(f[2]), [float(v) for v in f[4:8]]
