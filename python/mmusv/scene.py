@@ -249,6 +249,20 @@ def _id(value: Any, *, name: str, kind: str) -> int:
     return i
 
 
+def _instance_ids(values: npt.ArrayLike) -> np.ndarray:
+    """``instance_ids`` as a contiguous ``(K,)`` uint32 array: not a 1-D integer array is :class:`InputError`, an id
+    below 0 or from 2³² on is :class:`NotFoundError` (as an id the scene does not hold is, from the core)."""
+    ids = np.atleast_1d(np.asarray(values))
+    if ids.size == 0:
+        return np.zeros(0, dtype=np.uint32)
+    if ids.ndim != 1 or not np.issubdtype(ids.dtype, np.integer):
+        raise InputError(f"instance_ids must be a 1-D integer array, got {ids.dtype} with shape {ids.shape}")
+    if ids.min() < 0 or ids.max() >= 2**32:
+        bad = int(ids.min()) if ids.min() < 0 else int(ids.max())
+        raise NotFoundError(f"unknown instance id {bad}: instance ids are the non-negative ids add_instance returned")
+    return np.ascontiguousarray(ids, dtype=np.uint32)
+
+
 def _pose(pose: Any, *, name: str) -> np.ndarray:
     arr = _floats(pose, name=name)
     if arr.shape != (4, 4):
@@ -350,15 +364,12 @@ class Scene:
         self._native.set_seabed(z, x0=xy0[0], y0=xy0[1], spacing=step)
 
     def set_lights(self, instance_ids: npt.ArrayLike, *, on: bool) -> None:
-        """Turns the navigation lights (materials with ``nav_light``) of ``instance_ids`` on or off (``on``: a
-        ``bool``)."""
+        """Turns the navigation lights (materials with ``nav_light``) of ``instance_ids`` ``(K,)`` on or off (``on``:
+        a ``bool``); an id the scene does not hold is :class:`NotFoundError`."""
         on = arguments.flag(on, name="on", error=InputError)
-        ids = np.atleast_1d(np.asarray(instance_ids))
-        if ids.size == 0:
-            return
-        if ids.ndim != 1 or not np.issubdtype(ids.dtype, np.integer) or ids.min() < 0 or ids.max() >= 2**32:
-            raise InputError(f"instance_ids must be non-negative instance ids, got {ids!r}")
-        self._native.set_lights(np.ascontiguousarray(ids, dtype=np.uint32), bool(on))
+        ids = _instance_ids(instance_ids)
+        if ids.size:
+            self._native.set_lights(ids, bool(on))
 
     def add_instance(
         self, mesh_id: int, *, pose: npt.ArrayLike | None = None, class_override: int | None = None
@@ -381,22 +392,15 @@ class Scene:
     def set_poses(self, instance_ids: npt.ArrayLike, poses: npt.ArrayLike) -> None:
         """Moves instances: ``instance_ids`` ``(K,)`` ints, ``poses`` ``(K, 4, 4)`` float body → world (metres; one
         ``(4, 4)`` for one id). Only the top level is rebuilt."""
-        ids = np.atleast_1d(np.asarray(instance_ids))
         p = _floats(poses, name="poses")
-        if ids.size == 0 and p.size == 0:
+        if np.size(instance_ids) == 0 and p.size == 0:
             return
-        if ids.ndim != 1 or not np.issubdtype(ids.dtype, np.integer):
-            raise InputError(f"instance_ids must be a 1-D integer array, got {ids.dtype} with shape {ids.shape}")
-        if ids.min() < 0 or ids.max() >= 2**32:
-            bad = int(ids.min()) if ids.min() < 0 else int(ids.max())
-            raise NotFoundError(
-                f"unknown instance id {bad}: instance ids are the non-negative ids add_instance returned"
-            )
+        ids = _instance_ids(instance_ids)
         if p.ndim == 2:
             p = p[None]
         if p.ndim != 3 or p.shape[1:] != (4, 4):
             raise InputError(f"poses must have shape (K, 4, 4) (or (4, 4) for one id), got {np.shape(poses)}")
-        self._native.set_poses(np.ascontiguousarray(ids, dtype=np.uint32), np.ascontiguousarray(p))
+        self._native.set_poses(ids, np.ascontiguousarray(p))
 
     def set_sea(self, surface: int, *, moving: npt.ArrayLike = ()) -> None:
         """Declares instance ``surface`` the sea surface, a horizontal plane (else :class:`InputError`), and

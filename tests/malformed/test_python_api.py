@@ -18,7 +18,7 @@ import mmusv
 import numpy as np
 import pytest
 import yaml
-from mmusv.errors import ConfigError, GeometryError, InputError, MmusvError
+from mmusv.errors import ConfigError, GeometryError, InputError, MmusvError, NotFoundError
 from mmusv.export import convert
 from mmusv.recording import decode_image, decode_point_cloud, frame_messages, read_info, read_messages, summary, to_ns
 from mmusv.recording.decode import WorldFrame
@@ -254,6 +254,12 @@ def test_scene_arguments_of_the_wrong_kind(scene: Scene) -> None:
     _refused(lambda: s.cast_rays(o, d, max_range="5"), InputError, "max_range = '5'")  # type: ignore[arg-type]
     _refused(lambda: s.cast_rays(o, d, max_range=True), InputError, "max_range = True")  # a 1 m range
     _refused(lambda: s.set_lights([0], on="off"), InputError, "on = 'off'")  # type: ignore[arg-type]  # lit them
+    # an id the scene cannot hold is one it does not hold, as set_poses and the core say (InputError for -1 only)
+    for bad in ([-1], [2**32], [999]):
+        _refused(lambda b=bad: s.set_lights(b, on=True), NotFoundError, f"unknown instance id {bad[0]}")
+        _refused(lambda b=bad: s.set_poses(b, np.eye(4)), NotFoundError, f"unknown instance id {bad[0]}")
+    _refused(lambda: s.set_lights([[0]], on=True), InputError, "instance_ids must be a 1-D integer array")
+    _refused(lambda: s.set_lights([0.5], on=True), InputError, "instance_ids must be a 1-D integer array")
     _refused(lambda: s.set_sea(0, moving=[0.5]), InputError, "moving")  # truncated to instance 0
     _refused(lambda: s.set_materials("red"), InputError, "materials")  # ValueError
     _refused(lambda: s.set_seabed("flat"), InputError, "seabed heights")  # ValueError
