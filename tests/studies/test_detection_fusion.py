@@ -371,7 +371,10 @@ def test_pose_noise_is_seeded_shared_and_zero_mean() -> None:
 
 def test_parse_settings() -> None:
     got = parse_settings("delay:1,noise:0.5/0.5,delay:3")
-    assert [s.name for s in got] == ["clean", "delay:1", "noise:0.5/0.5", "delay:3"]
+    assert [s.name for s in got] == ["clean", "delay:1", "delay:3", "noise:0.5/0.5"]
+    # sorted whatever the order given (the study's tables were in the order of the command line)
+    got = parse_settings("noise:2/1,delay:3,noise:1/2,clean,delay:1,noise:1/1")
+    assert [s.name for s in got] == ["clean", "delay:1", "delay:3", "noise:1/1", "noise:1/2", "noise:2/1"]
     for bad in ("delay:0", "delay:x", "noise:-1/1", "noise:0/0", "jitter:1"):
         with pytest.raises(InputError, match="--settings"):
             parse_settings(bad)

@@ -353,6 +353,9 @@ def test_delay_takes_the_neighbour_of_frame_k_minus_d(rec: Path, tmp_path: Path)
     clean = gt.filter((pl.col("setting") == "clean") & (pl.col("mode") == "late")).drop("setting")
     for s in ("delay:1", "delay:2"):  # the ground truth stays current
         assert clean.equals(gt.filter((pl.col("setting") == s) & (pl.col("mode") == "late")).drop("setting"))
+    # the table in the settings' order, not the command line's (delay:2 came first)
+    table = pl.read_csv(out / "robustness_table.csv")
+    assert table["setting"].to_list() == ["clean", "delay:1", "delay:2"]
 
 
 @pytest.mark.filterwarnings("default::mmusv.scenario_checks.MmusvWarning")  # the missing frames, said on stderr
@@ -515,7 +518,7 @@ def test_noise_settings_that_print_alike_stay_apart(rec: Path, tmp_path: Path) -
     """``noise:1/1`` and ``noise:1.0000001/1`` were both named ``noise:1/1`` (``%g``): one key, so each row held the
     frames of both (twice the ground truth) and both drew the same noise."""
     got = parse_settings("noise:1/1,noise:1.0000001/1,noise:0.5,noise:0.50/0.5")
-    assert [s.name for s in got] == ["clean", "noise:1/1", "noise:1.0000001/1", "noise:0.5/0.5"]
+    assert [s.name for s in got] == ["clean", "noise:0.5/0.5", "noise:1/1", "noise:1.0000001/1"]  # sorted
     out = study(["study", "robustness", str(rec), "--settings", "noise:1/1,noise:1.0000001/1"], tmp_path / "rob")
     metrics = pl.read_csv(out / "robustness_metrics.csv")
     assert metrics["setting"].unique(maintain_order=True).to_list() == ["clean", "noise:1/1", "noise:1.0000001/1"]

@@ -74,7 +74,8 @@ DEFAULT_SETTINGS = (
 
 def parse_settings(text: str | Sequence[str]) -> tuple[Setting, ...]:
     """Settings from ``"clean,delay:1,delay:2,noise:0.5/0.5"`` (or a list of such items; ``noise:S`` is
-    ``noise:S/S``); ``clean`` is always included first, each setting once."""
+    ``noise:S/S``); ``clean`` first, then the delays by ``K``, then the noises by their σs, each setting once (the
+    study's tables follow this order, whatever the order given)."""
     items = [s.strip() for s in (text.split(",") if isinstance(text, str) else text) if s.strip()]
     if not items:  # "" ran the clean setting alone, a robustness study of nothing
         raise InputError("--settings is empty: give clean, delay:K or noise:SIGMA_XYZ_M/SIGMA_RPY_DEG items")
@@ -105,7 +106,8 @@ def parse_settings(text: str | Sequence[str]) -> tuple[Setting, ...]:
             ) from None
         if st not in out:
             out.append(st)
-    return tuple(out)
+    order = {"clean": 0, "delay": 1, "noise": 2}
+    return tuple(sorted(out, key=lambda st: (order[st.kind], st.delay_frames, st.sigma_xyz_m, st.sigma_rpy_deg)))
 
 
 def _seed_words(seed: int, seq: str, frame: int, ego: str, nb: str, setting: Setting) -> list[int]:
