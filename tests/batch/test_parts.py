@@ -216,6 +216,8 @@ def test_switching_layouts(split: Path, reference: tuple[Path, dict[str, str]], 
     assert {k: v for k, v in tree(out).items() if k.startswith("a_sea/")} == {
         k: v for k, v in ref.items() if k.startswith("a_sea/")
     }
+    # nor the parts' task files (`.mmusv/a_sea@000000-000049.task`, ... stayed beside `a_sea.task`)
+    assert sorted(p.name for p in (out / ".mmusv").glob("a_sea*")) == ["a_sea.task"]
 
 
 @pytest.mark.parametrize(

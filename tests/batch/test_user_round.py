@@ -90,6 +90,8 @@ def test_a_spec_that_makes_fewer_scenarios_drops_their_recordings(dataset: Path,
     kept = {k: v for k, v in tree(dataset / "recordings").items() if not k.startswith("crossing_near_2usv_small_001")}
     assert tree(out / "recordings") == kept
     assert sorted(doc["opv2v"]["sources"]) == _names(out / "recordings")
+    # and its task file went with it (an empty `.mmusv/crossing_near_2usv_small_001.task` stayed)
+    assert sorted(p.stem for p in (out / "recordings/.mmusv").iterdir()) == _names(out / "recordings")
 
 
 def test_a_recording_the_index_does_not_list_is_replaced_only_with_overwrite(

@@ -30,6 +30,7 @@ from pathlib import Path
 from typing import Any
 
 from mmusv.batch.index import INDEX_NAME, check_replaceable, read_index, write_index
+from mmusv.batch.plan import STATE_DIR, remove_task_files
 from mmusv.batch.runner import BatchReport, join_ray, run_many
 from mmusv.errors import IoError, MmusvError
 
@@ -170,8 +171,10 @@ def _opv2v_section(old: dict[str, Any]) -> dict[str, Any] | None:
 
 
 def _remove_stale(rec_dir: Path, own: set[str], stems: set[str]) -> None:
-    """Removes the recording folders of this dataset's own scenarios that the spec no longer makes."""
+    """Removes the recording folders of this dataset's own scenarios that the spec no longer makes, and their
+    task files."""
     for name in sorted(own - stems):
+        remove_task_files(rec_dir / STATE_DIR, name, keep=set())
         folder = rec_dir / name
         if folder.is_dir() and not folder.is_symlink():
             try:

@@ -366,6 +366,7 @@ def prepare(plan: ScenarioPlan) -> None:
     if not plan.to_run or plan.scenario is None:
         return
     folder, name = plan.folder, plan.scenario
+    remove_task_files(Path(plan.tasks[0].state_file).parent, plan.name, keep={t.key for t in plan.tasks})
     if plan.parts is None:
         (folder / f"{name}{PARTS_SUFFIX}").unlink(missing_ok=True)
         _remove_parts(folder, keep=set())
@@ -380,6 +381,21 @@ def prepare(plan: ScenarioPlan) -> None:
 
     if not (plan.recording.is_file() and plan.recording.read_bytes() == dump_json(plan.parts.as_dict())):
         write_parts_manifest(plan.recording, plan.parts)  # (an unchanged manifest is left as it is)
+
+
+def remove_task_files(state_dir: Path, name: str, *, keep: set[str]) -> None:
+    """Removes the task files (``<name>.task``, ``<name>@<part>.task``) in ``state_dir`` of the scenario ``name``
+    whose task key is not in ``keep``: those of a layout no longer used (parts of another split, the whole
+    recording when it is now split) or of a scenario no longer recorded. (A worker of a killed run that still holds
+    one keeps its open file; nothing takes that key again.)"""
+    if not state_dir.is_dir():
+        return
+    for f in sorted(state_dir.iterdir()):
+        if f.suffix != ".task" or f.stem in keep:
+            continue
+        key, at, part = f.stem.partition("@")
+        if key == name and (not at or _PART_DIR.match(part)):
+            f.unlink(missing_ok=True)
 
 
 def _remove_parts(folder: Path, keep: set[str]) -> None:
