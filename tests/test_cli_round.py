@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import copy
 import json
+import shutil
 from pathlib import Path
 from typing import Any
 
@@ -118,10 +119,45 @@ def test_info_of_an_mcap_not_written_by_mmusv(tmp_path: Path, capsys: pytest.Cap
     assert "killed" not in out and "agents" not in out, out
 
 
-def test_info_of_a_batch_folder_names_the_recordings_below(runs: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """`mmusv info OUT` on a batch's output folder said only "a folder without a recording"."""
-    code, _, err = _cli(["info", str(runs / "split")], capsys)
-    assert code == 2 and "below it: tiny4/tiny.parts.json (name one)" in err, err
+HEAD = ["scenario", "status", "frames", "agents", "problems"]
+
+
+def test_info_of_a_batch_folder_lists_the_recordings_below(
+    runs: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`mmusv info OUT` on a batch's output folder was refused ("a folder without a recording ...; below it: ...
+    (name one)"); it shows one row per recording below, a killed run's `.partial` and a damaged file included."""
+    monkeypatch.setenv("COLUMNS", "250")  # one line a row
+    out_dir = tmp_path / "batch"
+    for run in ("tiny", "blind"):  # (an earlier test removes tables of the split run's parts)
+        shutil.copytree(runs / run, out_dir / run)
+    shutil.copytree(runs / "split" / "tiny4", out_dir / "split" / "tiny4", ignore=shutil.ignore_patterns("tables"))
+    (out_dir / "killed").mkdir()
+    _killed_copy(runs / "tiny" / "tiny.mcap", out_dir / "killed" / "tiny.mcap.partial", messages=12)
+    (out_dir / "broken").mkdir()
+    (out_dir / "broken" / "broken.mcap").write_bytes(b"not an mcap")
+    main(["info", str(out_dir)])
+    lines = capsys.readouterr().out.splitlines()
+    assert "5 recordings below" in lines[0], lines
+    rows = {ln.split("│")[1].strip(): [c.strip() for c in ln.split("│")[2:-1]] for ln in lines if ln.count("│") == 7}
+    assert any(ln.replace("┃", " ").split() == ["recording", *HEAD] for ln in lines), lines
+    assert rows["blind/blind.mcap"] == ["blind", "complete", "1", "a,u", ""], rows
+    assert rows["tiny/tiny.mcap"] == ["tiny", "complete", "3", "u", ""], rows
+    assert rows["split/tiny4/tiny.parts.json"][:4] == ["tiny", "complete", "4", "u"], rows
+    assert rows["split/tiny4/tiny.parts.json"][4].startswith("split/tiny4/parts/000000-000001/tables does not"), rows
+    assert rows["killed/tiny.mcap.partial"][:4] == ["tiny", "unfinished", "2 of 3", "u"], rows
+    assert rows["broken/broken.mcap"][1:] == [
+        "unreadable",
+        "?",
+        "?",
+        "broken/broken.mcap is not an MCAP file (it does not start with the MCAP magic bytes)",
+    ], rows
+    assert rows["killed/tiny.mcap.partial"][4].startswith("2 of 3 frames read; frames 2 missing"), rows
+    assert "3 recordings unfinished, damaged or unreadable" in " ".join(lines[-2:]), lines
+    # a folder with nothing below it is still refused
+    (tmp_path / "empty").mkdir()
+    code, _, err = _cli(["info", str(tmp_path / "empty")], capsys)
+    assert code == 2 and "a folder without a recording" in err, err
 
 
 # ------------------------------------------------------------------------------------------------ recover

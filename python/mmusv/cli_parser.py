@@ -115,7 +115,11 @@ def parser() -> argparse.ArgumentParser:
     info = sub.add_parser(
         "info", help="agents, topics, frames and duration of a recording; damage and missing frames if any"
     )
-    info.add_argument("recording", help="an .mcap (or .mcap.partial, .parts.json) written by mmusv run, or its folder")
+    info.add_argument(
+        "recording",
+        help="an .mcap (or .mcap.partial, .parts.json) written by mmusv run, or its folder; a folder of run folders "
+        "(a batch's output): one row per recording below",
+    )
     rec = sub.add_parser(
         "recover",
         help="finish the .partial recording of a killed run into a valid MCAP (summary, index) and rebuild its tables",

@@ -6,6 +6,7 @@ run's ``.partial`` finished into a valid recording).
 from __future__ import annotations
 
 import argparse
+import os
 from pathlib import Path
 
 from mmusv.cli_console import rich_console
@@ -29,10 +30,10 @@ def cmd_info(args: argparse.Namespace) -> int:
         found = sorted(target.glob("*.parts.json")) or sorted(target.glob("*.mcap"))
         found = found or sorted(target.glob("*.mcap.partial"))
         if not found:
-            raise MmusvError(
-                f"{target} is a folder without a recording (*.mcap, *.mcap.partial or *.parts.json)"
-                + _recordings_below(target)
-            )
+            below = _recordings_in(target)
+            if below:  # a batch's output folder: one line per recording
+                return _overview(target, below)
+            raise MmusvError(f"{target} is a folder without a recording (*.mcap, *.mcap.partial or *.parts.json)")
         if len(found) > 1:
             raise MmusvError(f"{target} holds {len(found)} recordings ({', '.join(f.name for f in found)}); name one")
         target = found[0]
@@ -119,20 +120,68 @@ def _agents_of(meta: dict[str, dict[str, str]]) -> str:
     return ",".join(map(str, sensors)) if isinstance(sensors, dict) and sensors else "?"
 
 
-def _recordings_below(folder: Path) -> str:
-    """``"; below it: a, b (name one)"``: the recordings in the folders below ``folder`` (a batch's output
-    folder), or ``""``."""
+def _recordings_in(folder: Path) -> list[Path]:
+    """The recordings in the folders below ``folder`` (a batch's output folder), sorted: those of
+    :func:`~mmusv.recording.info.find_recordings` and the ``.mcap.partial`` of a killed run beside no ``.mcap``."""
     from mmusv.recording.info import find_recordings
 
-    try:
-        found = find_recordings(folder)
-    except MmusvError:
-        return ""
-    if not found:
-        return ""
-    names = [str(f.relative_to(folder)) for f in found[:5]]
-    more = f" and {len(found) - 5} more" if len(found) > 5 else ""
-    return f"; below it: {', '.join(names)}{more} (name one)"
+    found = find_recordings(folder)
+    partial = [p for p in folder.rglob("*.mcap.partial") if not p.with_suffix("").exists()]
+    return sorted([*found, *partial])
+
+
+def _overview(folder: Path, found: list[Path]) -> int:
+    """``mmusv info`` on a folder of recordings: one row each (scenario, status, frames, agents, problems)."""
+    from rich.table import Table
+
+    from mmusv.recording import summary
+
+    def short(name: str, problems: list[str]) -> str:  # relative paths, cut: `mmusv info` on one says it all
+        text = "; ".join(problems).replace(f"{folder}{os.sep}", "").removeprefix(f"{name}: ")
+        return text if len(text) <= 100 else text[:99] + "…"
+
+    table = Table(title=f"{counted(len(found), 'recording')} below {folder}")
+    for col in ("recording", "scenario", "status", "frames", "agents", "problems"):
+        table.add_column(col, overflow="fold")
+    troubled = 0
+    for rec in found:
+        name = str(rec.relative_to(folder))
+        try:
+            info = summary(rec)
+        except MmusvError as exc:
+            troubled += 1
+            table.add_row(name, "?", "unreadable", "?", "?", short(name, [str(exc)]))
+            continue
+        meta = info.get("metadata", {})
+        run_meta = meta.get("run", {})
+        frames = info.get("frames") or {}
+        if info.get("frames") is None:
+            troubled += 1
+            table.add_row(
+                name, "?", "not a recording of mmusv run", "?", "?", short(name, [info.get("metadata_problem") or ""])
+            )
+            continue
+        problems = [frames["report"]] if frames.get("report") else list(info.get("damage", []))
+        problems += _table_problems(rec, frames)
+        troubled += bool(problems) or not info.get("complete", True)
+        read, expected = frames.get("read"), frames.get("expected")
+        table.add_row(
+            name,
+            str(run_meta.get("scenario") or _scenario_of(meta, rec)),
+            str(run_meta.get("status", "unfinished")),
+            f"{read}" if read == expected else f"{read} of {expected}",
+            str(run_meta.get("agents") or _agents_of(meta)),
+            short(name, problems),
+        )
+    console = rich_console()
+    console.print(table)
+    if troubled:
+        console.print(
+            f"{counted(troubled, 'recording')} unfinished, damaged or unreadable: `mmusv info` on one says more",
+            markup=False,
+            highlight=False,
+        )
+    return 0
 
 
 def _table_problems(recording: Path, frames: dict[str, object]) -> list[str]:
