@@ -21,8 +21,11 @@
 //! fainter arms (`docs/realism/README.md`, *A wake behind a fast craft*). The Kelvin angle itself holds for a
 //! point source in deep water; from airborne images Rabaud & Moisy (2013), "Ship wakes: Kelvin or Mach angle?",
 //! arXiv:1304.2653, find the wake angle falling as `1 / U` above a hull Froude number `U / √(g L)` ≈ 0.5 (0.76
-//! for a 35 m boat at 14 m/s), where these arms keep 19.47°.
-
+//! for a 35 m boat at 14 m/s), where these arms keep 19.47°. Darmon, Benzaquen & Raphaël (2014), "Kelvin wake
+//! pattern at large Froude numbers", J. Fluid Mech. 738, R3 (arXiv:1309.6751), find for a moving pressure
+//! disturbance that the angle of the waves' *largest amplitude* falls as `1 / Fr` while the angle *bounding* the
+//! wake, outside which the water is flat, stays the Kelvin angle at every Froude number: these arms mark that
+//! bound; the narrower crest of the brightest waves at high Froude number is not drawn.
 //!
 //! The Kelvin arms round a bend are worked out in `kelvin_bend.rs`.
 
