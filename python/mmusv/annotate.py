@@ -13,9 +13,10 @@ agent's own hull is never a target):
   area, ``visible_pixels`` (pixels whose instance is the vessel), ``box_pixels`` (the clipped box area) and
   ``occlusion`` = 1 − visible / silhouette over the vessel's part above the still water level (world z > 0):
   the silhouette is the pixels whose rays, cast against the vessel alone, meet it above that level (the part of
-  the hull a flat calm sea never hides), visible those of them whose pixel shows the vessel; so a vessel in plain
-  view on flat water has occlusion 0, and other objects and the waves' crests raise it (the waves' own share is
-  ``wave_occlusion``, below). The 2D box is the projected 3D box, which reaches down to the keel.
+  the hull a flat calm sea never hides; all of them for a vessel met only below it, a small craft wholly in a wave
+  trough), visible those of them whose pixel shows the vessel; so a vessel in plain view on flat water has
+  occlusion 0, and other objects and the waves' crests raise it (the waves' own share is ``wave_occlusion``,
+  below). The 2D box is the projected 3D box, which reaches down to the keel.
 * over a displaced sea (a scene with a wave surface), per 3D box and per 2D box, ``wave_occlusion``: the share of
   the vessel's part above the still water level that the water hides from that sensor (:mod:`mmusv.wave_occlusion`);
   0 over a flat sea.
@@ -473,6 +474,8 @@ def annotate_agent(
             # hull below the waterline: that is no occlusion).
             dn = d / np.linalg.norm(d, axis=1, keepdims=True)
             above = alone & (o[:, 2] + dn[:, 2] * np.where(alone, t_alone, 0.0) > 0.0)
+            if sil and not above.any():
+                above = alone  # wholly below the still level (a craft in a trough): its whole silhouette counts
             exposed = int(np.count_nonzero(above))
             seen = int(np.count_nonzero(above & (window.reshape(-1) == info.instance_id)))
             ann.cam_ids.append(info.id)

@@ -2,10 +2,12 @@
 
 A target's *exposed silhouette* is the set of a sensor's rays that meet the vessel when it is alone in the
 world (:class:`~mmusv.annotate.SilhouetteCache`) at a point above the still water level (world z > 0): the part
-of the hull a flat calm sea would never hide. Its wave-occlusion share is the fraction of those rays that the
-full scene stops at the water first — a crest in front, or the local surface over that part of the hull. With a
-flat sea the share is 0 by construction; it is only computed where the scene has a displaced wave surface
-(:meth:`~mmusv.scene.Scene.set_wave_surface`).
+of the hull a flat calm sea would never hide. A target that no ray meets above that level while some meet it
+below (a small craft wholly in a wave trough) has its whole silhouette as its exposed silhouette, so that a craft
+the crests hide is counted hidden rather than left out. Its wave-occlusion share is the fraction of those rays
+that the full scene stops at the water first — a crest in front, or the local surface over that part of the
+hull. With a flat sea the share is 0 by construction; it is only computed where the scene has a displaced wave
+surface (:meth:`~mmusv.scene.Scene.set_wave_surface`).
 
 * Cameras: the rays of the box's pixels; "stopped at the water" reads the captured instance image (the water
   instance there).
@@ -213,10 +215,15 @@ def _counts(
     d = np.asarray(directions, dtype=np.float64)
     t = np.asarray(vessel_t, dtype=np.float64)
     hit = np.isfinite(t)
+    if np.isfinite(max_range_m):
+        hit &= np.where(hit, t, 0.0) * np.linalg.norm(d, axis=1) <= max_range_m
     z = o[:, 2] + d[:, 2] * np.where(hit, t, 0.0)
     exposed = hit & (z > 0.0)
-    if np.isfinite(max_range_m):
-        exposed &= np.where(hit, t, 0.0) * np.linalg.norm(d, axis=1) <= max_range_m
+    # A target met only below the still level (a small craft wholly in a trough): its whole silhouette stands for
+    # the exposed one, so a craft a crest hides is counted hidden, not left out (the share of nothing, 0).
+    low = (np.bincount(box[exposed], minlength=n_boxes) == 0) & (np.bincount(box[hit], minlength=n_boxes) > 0)
+    if low.any():
+        exposed |= hit & low[box]
     counts = np.bincount(box[exposed], minlength=n_boxes).astype(np.int64)
     water = scene.sea_instance
     if not exposed.any() or water is None or scene.wave_top is None:
