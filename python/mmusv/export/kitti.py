@@ -40,12 +40,14 @@ from mmusv.recording.info import AgentInfo
 from mmusv.recording.stream import Frame
 
 __all__ = [
+    "LEVEL_TOLERANCE_DEG",
     "LIDAR_OPTICAL",
     "OBJECT_CALIB_KEYS",
     "KittiWriter",
     "calib_text",
     "camera0",
     "front_calib",
+    "front_camera_turn",
     "kitti_label",
     "kitti_numbers",
     "label_lines",
@@ -83,6 +85,34 @@ def front_calib(agent: AgentInfo, view: AgentView) -> tuple[np.ndarray, np.ndarr
     velo_to_cam = LIDAR_OPTICAL @ invert(view.cameras["front"]) @ view.lidar
     fx, fy, cx, cy = cam.intrinsics
     return np.array([[fx, 0.0, cx, 0.0], [0.0, fy, cy, 0.0], [0.0, 0.0, 1.0, 0.0]]), velo_to_cam
+
+
+LEVEL_TOLERANCE_DEG = 0.005
+"""The largest turn (degrees) of a front camera against the LiDAR's own optical axes that :func:`front_camera_turn`
+reports as none: below what its note's two decimals show."""
+
+
+def front_camera_turn(agent: AgentInfo) -> tuple[float, float, float] | None:
+    """How ``agent``'s front camera is turned against its LiDAR (both rigid on the hull, so the same in every frame):
+    ``(angle, tilt, yaw)`` degrees, the angle of the rotation from the LiDAR's own optical axes
+    (:data:`LIDAR_OPTICAL`) to the camera's, the angle between the camera's y axis (down) and the LiDAR's -z, and the
+    bearing of the camera's optical axis from the LiDAR's x in the LiDAR's x-y plane (counter-clockwise, to the left
+    positive); ``None`` without a front camera or LiDAR, or for a camera turned by at most
+    :data:`LEVEL_TOLERANCE_DEG` (the rigs' default mounts: level and forward). KITTI's readers that turn labels into
+    LiDAR boxes without the calibration's rotation (OpenPCDet's ``boxes3d_kitti_camera_to_lidar``: h/2 along the
+    LiDAR's z, heading ``-(rotation_y + pi/2)``) are right only for a camera that is not turned."""
+    cam = agent.cameras.get("front")
+    if cam is None or agent.lidar_mount is None:
+        return None
+    r = (LIDAR_OPTICAL @ invert(cam.mount) @ agent.lidar_mount)[:3, :3]  # LiDAR -> front optical, rotation
+    rel = r @ BODY_TO_OPTICAL.T  # the turn: identity for a level, forward camera
+    angle = math.degrees(math.acos(max(-1.0, min(1.0, (float(np.trace(rel)) - 1.0) / 2.0))))
+    if angle <= LEVEL_TOLERANCE_DEG:
+        return None
+    down, axis = r[1], r[2]  # the camera's y (down) and z (optical axis) in LiDAR coordinates
+    tilt = math.degrees(math.acos(max(-1.0, min(1.0, -float(down[2])))))
+    yaw = math.degrees(math.atan2(float(axis[1]), float(axis[0])))
+    return angle, tilt, yaw
 
 
 def camera0(agent: AgentInfo, view: AgentView) -> tuple[np.ndarray, np.ndarray]:
@@ -221,6 +251,18 @@ class KittiWriter(DatasetWriter):
                 self.notes.append(
                     f"agent {a.id}: front camera has lens distortion {list(cam.distortion)} [k1, k2, p1, p2, k3]: "
                     f"{image} is not rectified (P2 is its pinhole K{self.distortion_file})"
+                )
+            turn = front_camera_turn(a)
+            if turn is not None:
+                angle, tilt, yaw = turn
+                self.notes.append(
+                    f"agent {a.id}: front camera turned {angle:.2f} deg against the LiDAR (its y axis {tilt:.2f} deg "
+                    f"off the LiDAR's -z, its optical axis {yaw:+.2f} deg off the LiDAR's x in bird's-eye view): the "
+                    f"labels are in its frame, as KITTI's devkit reads them, but readers that take the camera as "
+                    f"level and forward (OpenPCDet's boxes3d_kitti_camera_to_lidar: h/2 added along the LiDAR's z, "
+                    f"heading -(rotation_y + pi/2)) get LiDAR boxes h * sin({tilt / 2:.2f} deg) off centre (h the box "
+                    f"height) and turned by about {-yaw:+.2f} deg; turn the labels with the inverse of {self.velo_key} "
+                    f"instead"
                 )
 
     def optional_topics(self) -> list[str]:
