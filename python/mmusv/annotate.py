@@ -8,9 +8,12 @@ agent's own hull is never a target):
 * the vessel's ``role`` (``target``, ``usv`` — another instrumented USV, never a detection target — or
   ``moored``) and ``static`` flag (moored ships, and scenario vessels that never move), so users can filter;
 * an ego-centric BEV box: the 3D box's footprint in the LiDAR frame's xy plane (x, y, length, width, yaw);
-* per pinhole camera, a 2D box: the projected 3D-box corners (edges clipped at the near plane; through a camera's
-  lens distortion, the projected edges), clipped to the image, with ``truncation`` = 1 − clipped area / unclipped
-  area, ``visible_pixels`` (pixels whose instance is the vessel), ``box_pixels`` (the clipped box area) and
+* per pinhole camera, a 2D box: the bounding box of the projected 3D-box corners (edges clipped at the near plane;
+  through a camera's lens distortion, the projected edges); where the image border cuts it, the bounding box of the
+  part of the 3D box's image inside the image (its faces' images united and clipped to the border, so a long hull
+  seen at a slant and cut by a corner gets no empty band), with ``truncation`` = 1 − the area of the bounding box
+  clipped to the image / its unclipped area, ``visible_pixels`` (pixels whose instance is the vessel),
+  ``box_pixels`` (the recorded box's area, whole pixels) and
   ``occlusion`` = 1 − visible / silhouette over the vessel's part above the still water level (world z > 0):
   the silhouette is the pixels whose rays, cast against the vessel alone, meet it above that level (the part of
   the hull a flat calm sea never hides; all of them for a vessel met only below it, a small craft wholly in a wave
@@ -298,6 +301,59 @@ def _project_box(
     return np.array([u.min(), v.min(), u.max(), v.max()])
 
 
+_FACES = [[0, 2, 6, 4], [1, 3, 7, 5], [0, 1, 5, 4], [2, 3, 7, 6], [0, 1, 3, 2], [4, 5, 7, 6]]
+"""The box's six faces (−x, +x, −y, +y, −z, +z), each as its four corner indices in order round it (corner bits
+as :func:`box_corners`)."""
+
+
+def _near_face(face: np.ndarray) -> np.ndarray:
+    """The part of a convex polygon ``(n, 3)`` (optical frame) in front of the near plane ``z >= NEAR_M`` (one
+    Sutherland–Hodgman pass), ``(m, 3)``, ``m`` 0 when none of it is."""
+    out = []
+    for i in range(len(face)):
+        a, b = face[i], face[(i + 1) % len(face)]
+        ina, inb = a[2] >= NEAR_M, b[2] >= NEAR_M
+        if ina:
+            out.append(a)
+        if ina != inb:
+            out.append(a + (NEAR_M - a[2]) / (b[2] - a[2]) * (b - a))
+    return np.array(out).reshape(-1, 3)
+
+
+def _in_image_box(
+    corners_opt: np.ndarray,
+    k: tuple[float, float, float, float],
+    lens: tuple[Any, float] | None,
+    width: int,
+    height: int,
+) -> np.ndarray | None:
+    """The pixel box ``[x0, y0, x1, y1]`` of the part of a box's image that lies inside the ``width × height`` image
+    (the union of its faces' images, each face clipped at the near plane, intersected with the image), ``None`` when
+    none of it does. Tighter than the box's projected bounding box clipped to the image where the border cuts the
+    image of a long box seen at a slant; the same where the image lies wholly inside. Through a lens the faces'
+    edges are sampled (:data:`EDGE_STEPS`), as in :func:`_project_box`."""
+    from shapely import MultiPoint, Polygon, box, unary_union
+
+    fx, fy, cx, cy = k
+    faces = [f for f in (_near_face(corners_opt[face]) for face in _FACES) if len(f) >= 3]
+    if lens is None:  # a pinhole keeps straight lines straight: the image is the corners' convex hull
+        p = np.concatenate(faces) if faces else np.zeros((0, 3))
+        image = MultiPoint(np.column_stack([fx * p[:, 0] / p[:, 2] + cx, fy * p[:, 1] / p[:, 2] + cy])).convex_hull
+    else:
+        t = np.linspace(0.0, 1.0, EDGE_STEPS, endpoint=False)[:, None]
+        shapes = []
+        for f in faces:
+            pts = np.concatenate([a + t * (b - a) for a, b in zip(f, np.roll(f, -1, axis=0), strict=True)])
+            x, y = _distort(pts[:, 0] / pts[:, 2], pts[:, 1] / pts[:, 2], *lens)
+            shape = Polygon(np.column_stack([fx * x + cx, fy * y + cy]))
+            shapes.append(shape if shape.is_valid else shape.buffer(0))
+        image = unary_union(shapes)
+    inside = image.intersection(box(0.0, 0.0, float(width), float(height)))
+    if inside.is_empty:
+        return None
+    return np.array(inside.bounds, dtype=np.float64)
+
+
 def _clip_box(box: np.ndarray, width: int, height: int) -> tuple[np.ndarray, float, float]:
     """A pixel box ``[x0, y0, x1, y1]`` clipped to the ``width × height`` image: the clipped box, the box's own area
     and the clipped area (pixels²; 0 when the box is empty or lies wholly outside the image)."""
@@ -458,6 +514,11 @@ def annotate_agent(
             clipped, area, carea = _clip_box(box, w, h)
             if carea <= 0:
                 continue
+            if box[0] < 0.0 or box[1] < 0.0 or box[2] > w or box[3] > h:  # cut by the border: its part inside
+                inside = _in_image_box(body @ BODY_TO_OPTICAL.T, k, lens, w, h)
+                if inside is None:
+                    continue
+                clipped = inside
             u0, v0 = int(np.floor(clipped[0])), int(np.floor(clipped[1]))
             u1, v1 = int(np.ceil(clipped[2])), int(np.ceil(clipped[3]))
             window = inst_img[v0:v1, u0:u1]
