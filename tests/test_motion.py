@@ -221,3 +221,56 @@ def test_scenario_poses_in_batches_are_the_same_poses(monkeypatch: pytest.Monkey
     batched = motion.scenario_poses(scenario)
     assert whole.shape == batched.shape == (23, 2, 6)
     assert np.array_equal(whole, batched)
+
+
+PORT = {
+    "name": "moored_waves",
+    "seed": 5,
+    "map": {"type": "port", "seed": 3},
+    "acquisition": {"frequency_hz": 5, "frames": 12},
+    "environment": {"wave": "W3"},
+    "rigs": {"r": {"preset": "lidar_only", "lidar": {"channels": 8, "points_per_second": 20480}}},
+    "vessels": [
+        {"id": "u", "role": "usv", "asset": "usv_wamv", "rig": "r", "speed_mps": 2, "route": [[0, 0], [50, 0]]}
+    ],
+}
+
+
+def test_moored_ships_ride_the_physical_sea_as_vessels_at_speed_0() -> None:
+    """The moored ships of a port map stood fixed at the still level while the physical sea rose and fell along
+    their hulls (W3: metres). Each now heaves, rolls and pitches as a scenario vessel of its asset at speed 0 at its
+    berth and heading does, in the same wave field (its lines hold it in surge, sway and yaw), and the scene moves
+    its instance with it; with ``motion: paper`` the moored ships stay fixed (the paper's bytes)."""
+    from mmusv.simulation import Simulation
+
+    sim = Simulation(PORT)
+    n = len(sim.scenario.vessels)
+    moored = sim.world.moored
+    assert len(moored) >= 3
+    twins = [  # a scenario vessel of each moored ship's asset at speed 0, at its berth, heading its way
+        {
+            "id": f"twin{k}",
+            "asset": name,
+            "speed_mps": 0,
+            "route": [[x, y], [x + 10 * math.cos(yaw), y + 10 * math.sin(yaw)]],
+        }
+        for k, (name, (x, y, yaw)) in enumerate(moored)
+    ]
+    twin_poses = scenario_poses(load_scenario({**PORT, "vessels": [*PORT["vessels"], *twins]}))[:, n:]
+    heave = []
+    for k in range(sim.frames):
+        state = sim.world_state(k)
+        got = state.poses[n:]
+        assert np.allclose(got[:, :5], twin_poses[k, :, :5], atol=1e-9), (k, got, twin_poses[k])
+        assert np.allclose(np.angle(np.exp(1j * (got[:, 5] - [m[1][2] for m in moored]))), 0.0, atol=1e-9)
+        assert np.allclose(got[:, :2], [m[1][:2] for m in moored], atol=1e-9)  # held at the berth
+        heave.append(got[:, 2])
+    spread = np.ptp(np.array(heave), axis=0)
+    assert (spread > 0.05).all(), spread  # every ship heaves over the 12 frames at W3
+    state = sim.set_frame(7)
+    for inst, m in zip(sim.ws.moored_instances, state.matrices[n:], strict=True):
+        assert np.allclose(sim.ws.scene.instance_pose(inst), m, atol=1e-6)
+    paper = Simulation({**PORT, "environment": {"wave": "W3", "motion": "paper"}})
+    for k in (0, 6):
+        fixed = paper.world_state(k).poses[n:]
+        assert (fixed[:, 2:5] == 0.0).all() and np.allclose(fixed[:, :2], [m[1][:2] for m in moored])

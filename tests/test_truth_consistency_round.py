@@ -3,8 +3,8 @@ independent computation (own projections, own lens undistortion, own ray casts a
 
 One small recording (module-scoped, 3 frames): the port map at dusk (20:45) on the physical W3 sea, one 12 m USV
 with a 32-channel LiDAR, a radar, a top view and four 160 × 120 cameras, two of them with Brown–Conrady lens
-distortion; a 120 m cargo ship passing within about 30 m, four moored ships (fixed at the quays while the W3 sea
-runs through the basin) and a 5 m speedboat 160 m astern, heaving in and out of the troughs (in frame 2 a trough
+distortion; a 120 m cargo ship passing within about 30 m, four moored ships (riding the W3 sea at their berths)
+and a 5 m speedboat 160 m astern, heaving in and out of the troughs (in frame 2 a trough
 hides it wholly from the rear camera).
 """
 

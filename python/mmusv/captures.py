@@ -34,7 +34,7 @@ class VesselInfo:
     instance_id: int
     box_center_body: np.ndarray  # (3,) float64 box centre in the vessel body frame, metres (read-only)
     box_size: np.ndarray  # (3,) float64 length, beam, height, metres (read-only)
-    static: bool = False  # never moves: moored ships, and scenario vessels at speed 0 (VesselConfig.static)
+    static: bool = False  # never travels (moored ships, scenario vessels at speed 0: VesselConfig.static); rides waves
 
     def __eq__(self, other: object) -> bool:
         """Field by field, arrays by dtype, shape and value (:mod:`mmusv._equality`)."""

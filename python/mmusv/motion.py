@@ -22,7 +22,7 @@ from mmusv.errors import ConfigError
 from mmusv.world.hydrostatics import hull_particulars
 from mmusv.world.vessels import get_asset
 
-__all__ = ["build_fleet", "scenario_poses"]
+__all__ = ["build_fleet", "build_moored_fleet", "scenario_poses"]
 
 
 def build_fleet(scenario: Scenario, *, wave: str | float | None = None, reference_usvs: bool = False) -> Any:
@@ -59,6 +59,43 @@ def build_fleet(scenario: Scenario, *, wave: str | float | None = None, referenc
         seed=scenario.seed,
         wave=env.wave,
         **physical,
+    )
+
+
+MOORED_ROUTE_M = 10.0
+"""The length of the route a moored ship's fleet is given along its heading (it does not sail it: speed 0)."""
+
+
+def build_moored_fleet(scenario: Scenario, moored: list[tuple[str, tuple[float, float, float]]]) -> Any | None:
+    """The ``mmusv._core.Fleet`` of a port map's moored ships ``(asset_name, (x, y, yaw))`` (world metres, radians),
+    or ``None`` where they stay fixed at the still level: with ``motion: paper`` (the paper's ships at the quays do
+    not move, and its bytes stay as published), with a sea of no height, or without moored ships. Over a physical
+    sea each ship heaves, rolls and pitches in the scenario's wave field at speed 0 through its own RAOs, as a
+    scenario vessel at speed 0 does (its lines hold it in surge, sway and yaw), at its berth and heading."""
+    env = scenario.environment
+    if env.motion != "physical" or not moored:
+        return None
+    sea = env.sea_spec()
+    if sea.hs_m <= 0.0:
+        return None
+    assets = [get_asset(name) for name, _ in moored]
+    routes = [
+        np.array([[x, y], [x + MOORED_ROUTE_M * np.cos(yaw), y + MOORED_ROUTE_M * np.sin(yaw)]], dtype=np.float64)
+        for _, (x, y, yaw) in moored
+    ]
+    n = len(moored)
+    return core.Fleet(
+        routes=routes,
+        end_behaviours=["stop"] * n,
+        speeds=np.zeros(n, dtype=np.float64),
+        start_offsets=np.zeros(n, dtype=np.float64),
+        z_base=np.zeros(n, dtype=np.float64),
+        dims=np.array([[a.length, a.beam, a.height] for a in assets], dtype=np.float64),
+        amplitudes=np.tile(np.array(core.default_amplitudes(), dtype=np.float64), (n, 1)),
+        seed=scenario.seed,
+        wave=env.wave,
+        sea=sea.field(scenario_seed=scenario.seed),
+        hulls=np.array([hull_particulars(a) for a in assets], dtype=np.float64).reshape(-1, 5),
     )
 
 

@@ -32,7 +32,7 @@ from mmusv.agents import Agent, build_agent, frozen
 from mmusv.captures import AgentCapture, FrameCapture, SensorMount, VesselInfo, WorldState
 from mmusv.config import Scenario, VesselConfig, load_scenario
 from mmusv.errors import ConfigError
-from mmusv.motion import build_fleet
+from mmusv.motion import build_fleet, build_moored_fleet
 from mmusv.scene import MAX_SURFACE_TILES, SURFACE_TILE_M, SeaState, check_sea, surface_tiles
 from mmusv.seeds import sensor_seed
 from mmusv.sensors.camera import CameraImages
@@ -98,13 +98,13 @@ class Simulation:
         self.vessels: list[VesselInfo] = []
         for v, inst in zip(sc.vessels, self.ws.vessel_instances, strict=True):
             self.vessels.append(self._info(v.id, v.asset, v.role, int(inst), static=v.static))
-        self._moored_mats = []
-        for k, ((asset_name, (x, y, yaw)), inst) in enumerate(
-            zip(self.world.moored, self.ws.moored_instances, strict=True)
-        ):
+        for k, ((asset_name, _berth), inst) in enumerate(zip(self.world.moored, self.ws.moored_instances, strict=True)):
             self.vessels.append(self._info(f"moored_{k:02d}", asset_name, "moored", inst, static=True))
-            self._moored_mats.append(pose_matrices(np.array([x, y, 0.0, 0.0, 0.0, yaw])))
         self._moored_eta = np.array([[x, y, 0.0, 0.0, 0.0, yaw] for _, (x, y, yaw) in self.world.moored]).reshape(-1, 6)
+        # Over a physical sea the moored ships heave, roll and pitch at their berths (motion.build_moored_fleet).
+        self._moored_fleet = build_moored_fleet(sc, self.world.moored)
+        if self._moored_fleet is not None:
+            self.ws.moving_moored()
         self.agents: list[Agent] = [self._agent(i, v) for i, v in enumerate(sc.vessels) if v.role == "usv"]
         # COLREG lights burn on the vessels under way (not on moored ships or vessels at speed 0).
         under_way = [int(inst) for v, inst in zip(sc.vessels, self.ws.vessel_instances, strict=True) if not v.static]
@@ -163,8 +163,13 @@ class Simulation:
         eta = np.asarray(self.fleet.poses_at_times(np.array([t])))[0]
         vel = np.asarray(self.fleet.velocities_at(t))
         n_moored = self._moored_eta.shape[0]
-        eta_all = np.concatenate([eta, self._moored_eta]) if n_moored else eta
-        vel_all = np.concatenate([vel, np.zeros((n_moored, 3))]) if n_moored else vel
+        if self._moored_fleet is not None:
+            eta_moored = np.asarray(self._moored_fleet.poses_at_times(np.array([t])))[0]
+            vel_moored = np.asarray(self._moored_fleet.velocities_at(t))
+        else:
+            eta_moored, vel_moored = self._moored_eta, np.zeros((n_moored, 3))
+        eta_all = np.concatenate([eta, eta_moored]) if n_moored else eta
+        vel_all = np.concatenate([vel, vel_moored]) if n_moored else vel
         mats = pose_matrices(eta_all)
         centres_body = np.array([v.box_center_body for v in self.vessels]).reshape(-1, 3)
         centres = np.einsum("vij,vj->vi", mats[:, :3, :3], centres_body) + mats[:, :3, 3]
@@ -208,6 +213,8 @@ class Simulation:
         state = ahead[1] if ahead is not None and ahead[0] == frame else self.world_state(frame)
         n = len(self.scenario.vessels)
         self.ws.scene.set_poses(self.ws.vessel_instances, state.matrices[:n])
+        if self._moored_fleet is not None:
+            self.ws.scene.set_poses(self.ws.moored_instances, state.matrices[n:])
         if self.sea is not None and "water" in self.ws.static_instances:
             self.ws.scene.set_wave_surface(self.sea, **self._surface_of(state, sea_radius_m, shading_detail))
         self._frame = frame

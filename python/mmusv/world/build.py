@@ -40,6 +40,13 @@ class WorldScene:
     moored_instances: list[int] = field(default_factory=list)
     asset_meshes: dict[str, int] = field(default_factory=dict)
 
+    def moving_moored(self) -> None:
+        """Declares the moored ships instances that move too, beside the vessels, to the sea's shortcuts
+        (:meth:`~mmusv.scene.Scene.set_sea`): over a physical sea they heave, roll and pitch at their berths."""
+        if "water" in self.static_instances and self.moored_instances:
+            moving = np.concatenate([self.vessel_instances, np.asarray(self.moored_instances, dtype=np.int64)])
+            self.scene.set_sea(self.static_instances["water"], moving=moving)
+
 
 def _add(scene: Scene, mesh: TriMesh, name: str) -> int:
     """Adds ``mesh`` with its materials; the scene's material table is (re)set first when the mesh names a
