@@ -85,8 +85,33 @@ def test_convert_refuses_2d_box_options_a_format_would_ignore(
     assert not (tmp_path / "x").exists()
 
 
+@pytest.mark.parametrize(
+    ("to", "options", "said"),
+    [
+        ("coco", {"eval_range_m": 100}, "eval_range_m = 100"),
+        ("yolo", {"include_usvs": True}, "include_usvs = True"),
+        ("mot", {"eval_range_m": 50, "include_usvs": True}, "eval_range_m = 50, include_usvs = True"),
+        ("semantickitti", {"eval_range_m": 80}, "eval_range_m = 80"),
+        ("mastr", {"include_usvs": True}, "include_usvs = True"),
+        ("ros2", {"eval_range_m": 80}, "eval_range_m = 80"),
+    ],
+)
+def test_convert_refuses_target_options_a_format_would_ignore(
+    rec: Path, tmp_path: Path, to: str, options: dict[str, Any], said: str
+) -> None:
+    """Before: ``mmusv convert --to coco --range 100 --include-usvs`` converted as if neither had been given (only
+    OPV2V, KITTI and KITTI tracking choose their targets by range and role; a helper's cross-export round)."""
+    with pytest.raises(ConfigError, match=re.escape(said) + r".*only the OPV2V, KITTI and KITTI tracking exports"):
+        convert(rec, to=to, out_dir=tmp_path / "x", splits=None, **options)
+    assert not (tmp_path / "x").exists()
+
+
 def test_convert_box_options_at_their_defaults_pass_for_every_format(rec: Path, tmp_path: Path) -> None:
     report = convert(rec, to="kitti", out_dir=tmp_path / "k", min_box_px=0, max_occlusion=1, box="visible")
+    assert report.frames == 1
+    report = convert(rec, to="coco", out_dir=tmp_path / "c", eval_range_m=200, include_usvs=False)
+    assert report.frames == 1
+    report = convert(rec, to="kitti", out_dir=tmp_path / "r", eval_range_m=80, include_usvs=True)
     assert report.frames == 1
 
 

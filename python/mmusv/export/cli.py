@@ -58,10 +58,12 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         type=float,
         default=200.0,
         dest="range_m",
-        help="evaluation range in metres: targets within R in BEV (default 200)",
+        help="opv2v, kitti, kitti_tracking: evaluation range in metres, targets within R in BEV (default 200)",
     )
     p.add_argument(
-        "--include-usvs", action="store_true", help="list the other USVs as targets too (default: not, as in the paper)"
+        "--include-usvs",
+        action="store_true",
+        help="opv2v, kitti, kitti_tracking: list the other USVs as targets too (default: not, as in the paper)",
     )
     p.add_argument(
         "--extras",
@@ -95,7 +97,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         default="visible",
         help="coco, yolo, mot: the 2D box written: visible (default: the tight box of the vessel's pixels in the "
         "instance image, COCO's bbox convention; yolo and mot then need instance images) or projected (the recording's "
-        "box: the projected 3D box clipped to the image, reaching down to the keel); kitti and ros2 keep the recorded "
+        "box: the projected 3D box's part in the image, reaching down to the keel); kitti and ros2 keep the recorded "
         "box",
     )
     p.add_argument(
@@ -143,7 +145,7 @@ def run(args: argparse.Namespace) -> int:
     if args.box not in BOXES:
         raise ConfigError(
             f"unknown --box {args.box!r}; allowed: visible (the tight box of the vessel's visible pixels, the default) "
-            "or projected (the recording's box: the projected 3D box clipped to the image)"
+            "or projected (the recording's box: the projected 3D box's part in the image)"
         )
     origin = None
     if args.oxts_origin is not None:  # checked here, so that the message names the option as typed

@@ -29,6 +29,7 @@ from mmusv import arguments
 from mmusv.errors import ConfigError, IoError
 from mmusv.export.common import DEFAULT_EXTRAS, TARGETS, Options, Sink, dump_yaml, parse_box, parse_extras
 from mmusv.export.convert_checks import (
+    DEFAULT_RANGE_M,
     agent_selection,
     as_list,
     box_filter,
@@ -39,6 +40,7 @@ from mmusv.export.convert_checks import (
     kitti_type,
     outside_frames,
     oxts_origin_of,
+    target_options,
 )
 from mmusv.export.convert_output import prepare_out, reported, staged
 from mmusv.export.convert_report import REPORT_NAME, ConvertReport, RecordingReport
@@ -156,7 +158,7 @@ def convert(
     out_dir: str | Path,
     splits: Sequence[float] | str | None = DEFAULT_RATIOS,
     seed: int = 0,
-    eval_range_m: float = 200.0,
+    eval_range_m: float = DEFAULT_RANGE_M,
     include_usvs: bool = False,
     extras: Iterable[str] | str | None = DEFAULT_EXTRAS,
     min_box_px: float = 0.0,
@@ -184,9 +186,11 @@ def convert(
             >= 0) or ``None``
             for one folder of scenarios. ROS 2 bags are never split: with ``to="ros2"`` only the default or
             ``None`` is accepted.
-        eval_range_m: targets are vessels whose box centre lies within ``eval_range_m`` of the agent's LiDAR in
-            bird's-eye view (:func:`mmusv.annotate.in_target_range`).
-        include_usvs: list the other USVs as targets too (default: only non-instrumented vessels).
+        eval_range_m: OPV2V, KITTI and KITTI tracking: targets are vessels whose box centre lies within
+            ``eval_range_m`` of the agent's LiDAR in bird's-eye view (:func:`mmusv.annotate.in_target_range`). The
+            other formats refuse a value other than the default (they label every vessel they hold).
+        include_usvs: OPV2V, KITTI and KITTI tracking: list the other USVs as targets too (default: only
+            non-instrumented vessels); the other formats refuse ``True``.
         extras: any of ``depth``, ``semantic``, ``instance``, ``radar``, ``top_view`` (OPV2V and KITTI: extra
             files stock loaders skip).
         min_box_px: COCO, YOLO and MOT: leave out 2D boxes whose shorter side is under this many pixels. This
@@ -236,6 +240,7 @@ def convert(
     min_c = contrast_filter(min_contrast)
     box = parse_box(box)
     box_options(to, min_box_px=box_px, max_occlusion=max_occ, min_contrast=min_c, box=box)
+    target_options(to, eval_range_m=rng, include_usvs=include_usvs)
     kind = kitti_type(kitti_class, to)
     origin = oxts_origin_of(oxts_origin, to)
     options = Options(

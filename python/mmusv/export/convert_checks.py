@@ -97,6 +97,30 @@ def box_options(to: str, *, min_box_px: float, max_occlusion: float, min_contras
         )
 
 
+TARGET_FORMATS = ("opv2v", "kitti", "kitti_tracking")
+"""The formats that list targets by the evaluation range (``eval_range_m``, ``--range``) and ``include_usvs``."""
+DEFAULT_RANGE_M = 200.0
+"""``eval_range_m``'s default (metres)."""
+
+
+def target_options(to: str, *, eval_range_m: float, include_usvs: bool) -> None:
+    """Refuses (:class:`~mmusv.errors.ConfigError` naming the option) an evaluation range other than its default, or
+    ``include_usvs``, for a format ``to`` that does not list targets by them (not in :data:`TARGET_FORMATS`): the
+    camera exports label every vessel in the image, SemanticKITTI and MaSTr every point and pixel, and ROS 2 bags
+    every recorded box; it would change nothing, silently."""
+    given = [
+        f"eval_range_m = {eval_range_m:g}" if eval_range_m != DEFAULT_RANGE_M else "",
+        "include_usvs = True" if include_usvs else "",
+    ]
+    given = [g for g in given if g]
+    if to not in TARGET_FORMATS and given:
+        raise ConfigError(
+            f"{', '.join(given)}: only the OPV2V, KITTI and KITTI tracking exports (to = 'opv2v', 'kitti' or "
+            f"'kitti_tracking') choose their targets with it, not to = {to!r}, which labels every vessel it holds "
+            "whatever its range or role; leave it out"
+        )
+
+
 def contrast_filter(min_contrast: Any) -> float | None:
     """``min_contrast`` as a float in ``[0, MAX_CONTRAST]``, or ``None``; :class:`~mmusv.errors.ConfigError` naming it
     otherwise."""
