@@ -16,6 +16,7 @@ order of completion.
 from __future__ import annotations
 
 import os
+import re
 import time
 import uuid
 from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
@@ -127,6 +128,24 @@ def join_ray(ray: bool | str, *, cpus_per_task: int | None = None, lost_worker_r
     return _executor(1, ray, cpus_per_task, lost_worker_retries)
 
 
+def _portable_error(error: str | None, plan: ScenarioPlan, root: Path) -> str | None:
+    """``error`` as the index keeps it, without the absolute paths the batch's messages name (the scenario file, the
+    output folders: the batch makes them absolute), so that the index holds none and is the same bytes wherever the
+    scenarios and the output are: the scenario file by its name (as ``scenario_file``), another file of its folder
+    by its name, and a path below the index's folder relative to it (that folder itself: ``.``). The console keeps
+    the full paths. Before, a failed scenario's ``error`` began with ``/home/me/scenarios/bad.yaml: ...``."""
+    if error is None:
+        return None
+    text = error.replace(str(plan.file), plan.file.name)
+    # the longer folder first: the scenarios may sit below the index's folder (mmusv dataset's DIR/scenarios); never
+    # the file system's root, whose prefix is every absolute path's
+    folders = [f.rstrip(os.sep) for f in sorted({str(plan.file.parent), str(root)}, key=len, reverse=True)]
+    for folder in (f for f in folders if f):
+        text = text.replace(folder + os.sep, "")
+    bare = str(root).rstrip(os.sep)
+    return re.sub(re.escape(bare) + r"(?![^\s:;,'\")\]])", ".", text) if bare else text
+
+
 def _entry(plan: ScenarioPlan, status: str, error: str | None, root: Path) -> Entry:
     from mmusv.jsonio import read_json
 
@@ -160,7 +179,7 @@ def _entry(plan: ScenarioPlan, status: str, error: str | None, root: Path) -> En
         frames_requested=plan.frames,
         parts=len(plan.tasks) if plan.split else (1 if plan.tasks else 0),
         bytes=folder_bytes(plan.folder) if plan.folder.is_dir() else 0,
-        error=error,
+        error=_portable_error(error, plan, root),
     )
 
 

@@ -77,12 +77,14 @@ def kitti_numbers(values: Any) -> str:
 def front_calib(agent: AgentInfo, view: AgentView) -> tuple[np.ndarray, np.ndarray]:
     """KITTI's camera 0 of ``agent`` at ``view``: the front camera's ``K·[I|0]`` ``(3, 4)`` float64 (pixels) and
     the LiDAR → front optical frame (x right, y down, z forward) transform ``(4, 4)`` float64 (metres); zeros and
-    the identity when the agent has no front camera."""
-    assert view.lidar is not None
+    the identity when the agent has no front camera. Both sensors are rigid on the hull: the transform is that of
+    their mounts, the same bits in every frame (from the frame's world poses, its rounding moved with the hull's
+    pose: entries of 1e-19 where 0 is exact, another in each frame's calibration file)."""
+    assert view.lidar is not None and agent.lidar_mount is not None
     cam = agent.cameras.get("front")
     if cam is None:
         return np.zeros((3, 4)), np.eye(4)
-    velo_to_cam = LIDAR_OPTICAL @ invert(view.cameras["front"]) @ view.lidar
+    velo_to_cam = LIDAR_OPTICAL @ invert(cam.mount) @ agent.lidar_mount
     fx, fy, cx, cy = cam.intrinsics
     return np.array([[fx, 0.0, cx, 0.0], [0.0, fy, cy, 0.0], [0.0, 0.0, 1.0, 0.0]]), velo_to_cam
 

@@ -284,21 +284,24 @@ def _plot(study: WaveStudy, path: Path | io.BytesIO) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    t = study.table
-    fig, axes = plt.subplots(1, 3, figsize=(11, 3.2), constrained_layout=True)
-    for ax, (col, label) in zip(
-        axes,
-        [("heave_rms_m", "heave RMS (m)"), ("roll_rms_deg", "roll RMS (°)"), ("pitch_rms_deg", "pitch RMS (°)")],
-        strict=False,
-    ):
-        ax.plot(t["H_m"], t[col], "o-")
-        for name, x, y in zip(t["wave"], t["H_m"], t[col], strict=False):
-            ax.annotate(str(name), (x, y), textcoords="offset points", xytext=(4, -10), fontsize=8)
-        ax.set_xlabel("wave height H (m)")
-        ax.set_ylabel(label)
-        ax.set_title(f"R² = {study.r2[col]:.4f}", fontsize=9)
-        ax.grid(alpha=0.3)
-    sized = " (USVs of the paper's reference size)" if t["usv_size"][0] == "reference" else ""
-    fig.suptitle(f"mmusv wave study: USV pose perturbation vs wave setting{sized}")
-    fig.savefig(path, dpi=110, format="png")
+    from mmusv.studies.plotting import default_style
+
+    with default_style():  # not the user's matplotlibrc or style: the same bytes wherever it is drawn
+        t = study.table
+        fig, axes = plt.subplots(1, 3, figsize=(11, 3.2), constrained_layout=True)
+        for ax, (col, label) in zip(
+            axes,
+            [("heave_rms_m", "heave RMS (m)"), ("roll_rms_deg", "roll RMS (°)"), ("pitch_rms_deg", "pitch RMS (°)")],
+            strict=False,
+        ):
+            ax.plot(t["H_m"], t[col], "o-")
+            for name, x, y in zip(t["wave"], t["H_m"], t[col], strict=False):
+                ax.annotate(str(name), (x, y), textcoords="offset points", xytext=(4, -10), fontsize=8)
+            ax.set_xlabel("wave height H (m)")
+            ax.set_ylabel(label)
+            ax.set_title(f"R² = {study.r2[col]:.4f}", fontsize=9)
+            ax.grid(alpha=0.3)
+        sized = " (USVs of the paper's reference size)" if t["usv_size"][0] == "reference" else ""
+        fig.suptitle(f"mmusv wave study: USV pose perturbation vs wave setting{sized}")
+        fig.savefig(path, dpi=110, format="png")
     plt.close(fig)

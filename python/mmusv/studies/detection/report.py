@@ -12,6 +12,7 @@ import polars as pl
 from mmusv.studies.detection.detector import BASELINE_NOTE
 from mmusv.studies.detection.evaluate import RANGE_BINS, bin_label
 from mmusv.studies.detection.study import StudyResult
+from mmusv.studies.plotting import default_style
 
 __all__ = ["DETECTION_METRICS", "detection_table", "fmt", "robustness_table", "write_detection", "write_robustness"]
 
@@ -123,14 +124,17 @@ def _plot_detection(table: pl.DataFrame, path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(1, 2, figsize=(10, 4))
-    modes = table["mode"].to_list()
-    for m in modes:
-        r = table.filter(pl.col("mode") == m).row(0, named=True)
-        ax[0].plot([0.3, 0.5, 0.7], [r["ap30"], r["ap50"], r["ap70"]], marker="o", label=m)
-        ax[1].plot(range(len(BINS)), [r[f"ap50_{b}"] for b in BINS], marker="o", label=m)
-    ax[1].set_xticks(range(len(BINS)), BINS)
-    _finish(fig, ax, [("IoU threshold", "AP"), ("range bin (m)", "AP@0.5")], "Cooperative detection (Table III)", path)
+    with default_style():  # not the user's matplotlibrc or style: the same bytes wherever it is drawn
+        fig, ax = plt.subplots(1, 2, figsize=(10, 4))
+        modes = table["mode"].to_list()
+        for m in modes:
+            r = table.filter(pl.col("mode") == m).row(0, named=True)
+            ax[0].plot([0.3, 0.5, 0.7], [r["ap30"], r["ap50"], r["ap70"]], marker="o", label=m)
+            ax[1].plot(range(len(BINS)), [r[f"ap50_{b}"] for b in BINS], marker="o", label=m)
+        ax[1].set_xticks(range(len(BINS)), BINS)
+        _finish(
+            fig, ax, [("IoU threshold", "AP"), ("range bin (m)", "AP@0.5")], "Cooperative detection (Table III)", path
+        )
 
 
 def _finish(fig: Any, ax: Any, labels: list[tuple[str, str]], title: str, path: Path) -> None:
@@ -155,26 +159,27 @@ def _plot_robustness(res: StudyResult, path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    t = res.table()
-    fig, ax = plt.subplots(1, 2, figsize=(10, 4))
-    clean = {r["mode"]: r["ap50"] for r in t.filter(pl.col("setting") == "clean").iter_rows(named=True)}
-    for a, kind, xcol in ((ax[0], "delay", "delay_frames"), (ax[1], "noise", "sigma_xyz_m")):
-        for m in res.options.modes:
-            if m == "none":
-                if "none" in clean:
-                    a.axhline(clean["none"], color="grey", ls="--", label="none")
-                continue
-            sub = t.filter((pl.col("mode") == m) & (pl.col("kind") == kind)).sort(xcol)
-            xs = [0.0, *sub[xcol].cast(pl.Float64).to_list()]
-            ys = [clean.get(m, math.nan), *sub["ap50"].to_list()]
-            a.plot(xs, ys, marker="o", label=m)
-    _finish(
-        fig,
-        ax,
-        [("delay (frames)", "AP@0.5"), ("pose noise σ_xyz (m) = σ_rpy (°)", "AP@0.5")],
-        "Robustness (Table IV)",
-        path,
-    )
+    with default_style():  # not the user's matplotlibrc or style: the same bytes wherever it is drawn
+        t = res.table()
+        fig, ax = plt.subplots(1, 2, figsize=(10, 4))
+        clean = {r["mode"]: r["ap50"] for r in t.filter(pl.col("setting") == "clean").iter_rows(named=True)}
+        for a, kind, xcol in ((ax[0], "delay", "delay_frames"), (ax[1], "noise", "sigma_xyz_m")):
+            for m in res.options.modes:
+                if m == "none":
+                    if "none" in clean:
+                        a.axhline(clean["none"], color="grey", ls="--", label="none")
+                    continue
+                sub = t.filter((pl.col("mode") == m) & (pl.col("kind") == kind)).sort(xcol)
+                xs = [0.0, *sub[xcol].cast(pl.Float64).to_list()]
+                ys = [clean.get(m, math.nan), *sub["ap50"].to_list()]
+                a.plot(xs, ys, marker="o", label=m)
+        _finish(
+            fig,
+            ax,
+            [("delay (frames)", "AP@0.5"), ("pose noise σ_xyz (m) = σ_rpy (°)", "AP@0.5")],
+            "Robustness (Table IV)",
+            path,
+        )
 
 
 def rescore(boxes: pl.DataFrame) -> dict[str, float]:
