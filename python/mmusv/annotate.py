@@ -330,8 +330,9 @@ def _in_image_box(
     """The pixel box ``[x0, y0, x1, y1]`` of the part of a box's image that lies inside the ``width × height`` image
     (the union of its faces' images, each face clipped at the near plane, intersected with the image), ``None`` when
     none of it does. Tighter than the box's projected bounding box clipped to the image where the border cuts the
-    image of a long box seen at a slant; the same where the image lies wholly inside. Through a lens the faces'
-    edges are sampled (:data:`EDGE_STEPS`), as in :func:`_project_box`."""
+    image of a long box seen at a slant; the same where the image lies wholly inside. Through a lens each face's
+    pinhole image, clipped to the lens's reach, has its edges sampled (:data:`EDGE_STEPS`) in the image plane and
+    distorted."""
     from shapely import MultiPoint, Polygon, box, unary_union
 
     fx, fy, cx, cy = k
@@ -340,11 +341,21 @@ def _in_image_box(
         p = np.concatenate(faces) if faces else np.zeros((0, 3))
         image = MultiPoint(np.column_stack([fx * p[:, 0] / p[:, 2] + cx, fy * p[:, 1] / p[:, 2] + cy])).convex_hull
     else:
+        # Each face's pinhole image (a convex polygon in undistorted normalised coordinates, exact) clipped to the
+        # square of half side the lens's reach (beyond it `_distort` carries points out of the image), then its
+        # edges sampled evenly there and distorted: sampled in 3D, a face cut at the near plane put most samples
+        # ~10^5 px out, and the chords between them crossed the image where the curved edge does not.
+        reach = min(float(lens[1]), 1e6)
+        square = box(-reach, -reach, reach, reach)
         t = np.linspace(0.0, 1.0, EDGE_STEPS, endpoint=False)[:, None]
         shapes = []
         for f in faces:
-            pts = np.concatenate([a + t * (b - a) for a, b in zip(f, np.roll(f, -1, axis=0), strict=True)])
-            x, y = _distort(pts[:, 0] / pts[:, 2], pts[:, 1] / pts[:, 2], *lens)
+            flat = MultiPoint(np.column_stack([f[:, 0] / f[:, 2], f[:, 1] / f[:, 2]])).convex_hull.intersection(square)
+            if flat.is_empty or flat.geom_type != "Polygon":
+                continue
+            ring = np.asarray(flat.exterior.coords)[:-1]
+            pts = np.concatenate([a + t * (b - a) for a, b in zip(ring, np.roll(ring, -1, axis=0), strict=True)])
+            x, y = _distort(pts[:, 0], pts[:, 1], *lens)
             shape = Polygon(np.column_stack([fx * x + cx, fy * y + cy]))
             shapes.append(shape if shape.is_valid else shape.buffer(0))
         image = unary_union(shapes)
