@@ -19,6 +19,7 @@ __all__ = ["cmd_info", "cmd_preview", "cmd_recover"]
 
 def cmd_info(args: argparse.Namespace) -> int:
     from rich.table import Table
+    from rich.text import Text
 
     from mmusv.recording import summary
     from mmusv.recording.info import recording_name
@@ -79,7 +80,7 @@ def cmd_info(args: argparse.Namespace) -> int:
     for col in ("topic", "schema", "messages"):
         table.add_column(col)
     for topic, t in sorted(info.get("topics", {}).items()):
-        table.add_row(topic, t["schema"], str(t["messages"]))
+        table.add_row(Text(topic), Text(t["schema"]), str(t["messages"]))
     console.print(table)
     problems = [frames["report"]] if frames and frames.get("report") else list(info.get("damage", []))
     if info.get("metadata_problem"):  # "unreadable ... metadata (...)": it was shown as a file of another program
@@ -121,18 +122,29 @@ def _agents_of(meta: dict[str, dict[str, str]]) -> str:
 
 
 def _recordings_in(folder: Path) -> list[Path]:
-    """The recordings in the folders below ``folder`` (a batch's output folder), sorted: those of
-    :func:`~mmusv.recording.info.find_recordings` and the ``.mcap.partial`` of a killed run beside no ``.mcap``."""
-    from mmusv.recording.info import find_recordings
+    """The recordings in the folders below ``folder`` (a batch's output folder), sorted: every parts manifest (an
+    unreadable one too: its row says why), every ``.mcap`` and every ``.mcap.partial`` of a killed run beside no
+    ``.mcap``, but the parts a readable manifest names (its row covers them)."""
+    from mmusv.recording.parts import read_parts_manifest
 
-    found = find_recordings(folder)
-    partial = [p for p in folder.rglob("*.mcap.partial") if not p.with_suffix("").exists()]
-    return sorted([*found, *partial])
+    manifests = sorted(folder.rglob("*.parts.json"))
+    parts: set[Path] = set()
+    for m in manifests:
+        try:
+            for part in read_parts_manifest(m).parts:
+                rec = (m.parent / part.recording).resolve()
+                parts |= {rec, rec.with_name(rec.name + ".partial")}
+        except MmusvError:
+            continue  # listed, and its row says what is wrong with it
+    mcaps = [p for p in folder.rglob("*.mcap") if p.resolve() not in parts]
+    partial = [p for p in folder.rglob("*.mcap.partial") if not p.with_suffix("").exists() and p.resolve() not in parts]
+    return sorted([*manifests, *mcaps, *partial])
 
 
 def _overview(folder: Path, found: list[Path]) -> int:
     """``mmusv info`` on a folder of recordings: one row each (scenario, status, frames, agents, problems)."""
     from rich.table import Table
+    from rich.text import Text
 
     from mmusv.recording import summary
 
@@ -140,7 +152,7 @@ def _overview(folder: Path, found: list[Path]) -> int:
         text = "; ".join(problems).replace(f"{folder}{os.sep}", "").removeprefix(f"{name}: ")
         return text if len(text) <= 100 else text[:99] + "…"
 
-    table = Table(title=f"{counted(len(found), 'recording')} below {folder}")
+    table = Table(title=Text(f"{counted(len(found), 'recording')} below {folder}"))
     for col in ("recording", "scenario", "status", "frames", "agents", "problems"):
         table.add_column(col, overflow="fold")
     troubled = 0
@@ -150,22 +162,21 @@ def _overview(folder: Path, found: list[Path]) -> int:
             info = summary(rec)
         except MmusvError as exc:
             troubled += 1
-            table.add_row(name, "?", "unreadable", "?", "?", short(name, [str(exc)]))
+            table.add_row(*map(Text, (name, "?", "unreadable", "?", "?", short(name, [str(exc)]))))
             continue
         meta = info.get("metadata", {})
         run_meta = meta.get("run", {})
         frames = info.get("frames") or {}
         if info.get("frames") is None:
             troubled += 1
-            table.add_row(
-                name, "?", "not a recording of mmusv run", "?", "?", short(name, [info.get("metadata_problem") or ""])
-            )
+            problem = short(name, [info.get("metadata_problem") or ""])
+            table.add_row(*map(Text, (name, "?", "not a recording of mmusv run", "?", "?", problem)))
             continue
         problems = [frames["report"]] if frames.get("report") else list(info.get("damage", []))
         problems += _table_problems(rec, frames)
         troubled += bool(problems) or not info.get("complete", True)
         read, expected = frames.get("read"), frames.get("expected")
-        table.add_row(
+        cells = (
             name,
             str(run_meta.get("scenario") or _scenario_of(meta, rec)),
             str(run_meta.get("status", "unfinished")),
@@ -173,6 +184,7 @@ def _overview(folder: Path, found: list[Path]) -> int:
             str(run_meta.get("agents") or _agents_of(meta)),
             short(name, problems),
         )
+        table.add_row(*map(Text, cells))  # Text: a name like a[/b] is no markup
     console = rich_console()
     console.print(table)
     if troubled:
