@@ -35,6 +35,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
 import yaml
 from tiny_scenario import lidar_scenario
 
@@ -178,3 +179,39 @@ def test_the_detection_picture_is_the_same_under_a_caller_s_style(tmp_path: Path
     with matplotlib.rc_context({"lines.linewidth": 4.0, "axes.facecolor": "black", "savefig.dpi": 50}):
         _plot_detection(table, tmp_path / "styled.png")
     assert (tmp_path / "styled.png").read_bytes() == (tmp_path / "plain.png").read_bytes()
+
+
+@pytest.mark.parametrize(
+    ("error", "said"),
+    [
+        ("cannot write /private/tmp/out/bad/bad.mcap", "cannot write /private/tmp/out/bad/bad.mcap"),  # not inside
+        ("cannot write /tmp/out/", "cannot write ."),  # the path vanished
+        ("/tmp/out/a/b.mcap: x; see /tmp/output/c", "a/b.mcap: x; see /tmp/output/c"),  # a prefix of another
+        ("/tmp/out/scenarios/other.yaml: y", "other.yaml: y"),
+        ("in /tmp/out, stop", "in ., stop"),
+    ],
+)
+def test_an_index_error_loses_only_the_folders_where_a_path_starts(error: str, said: str) -> None:
+    """The review's: the folders were replaced anywhere in the message (``/private/tmp/out/...`` became
+    ``/privatebad/...``; ``/tmp/out/`` vanished)."""
+    from types import SimpleNamespace
+
+    from mmusv.batch.runner import _portable_error
+
+    plan = SimpleNamespace(file=Path("/tmp/out/scenarios/bad.yaml"))
+    assert _portable_error(error, plan, Path("/tmp/out")) == said  # type: ignore[arg-type]
+
+
+def test_task_files_of_a_name_holding_an_at_sign_are_its_own(tmp_path: Path) -> None:
+    """The review's: a name was cut at its first ``@``, so ``b@x``'s stale part ``b@x@000000-000001.task`` stayed and
+    ``b@x``'s clean-up could take another scenario's files; now a task file is the name's own when the name is
+    followed by nothing or by ``@`` and a part folder's name. (``a@000000-000001`` is ``a``'s first part's key, and
+    the key of a scenario file of that name: the batch's keys cannot tell those two apart.)"""
+    from mmusv.batch.plan import remove_task_files
+
+    for key in ("a", "a@000000-000001", "ab", "b@x", "b@x@000000-000001", "b@x@y"):
+        (tmp_path / f"{key}.task").write_text("")
+    remove_task_files(tmp_path, "b@x", keep={"b@x"})
+    assert sorted(p.stem for p in tmp_path.iterdir()) == ["a", "a@000000-000001", "ab", "b@x", "b@x@y"]
+    remove_task_files(tmp_path, "a", keep=set())
+    assert sorted(p.stem for p in tmp_path.iterdir()) == ["ab", "b@x", "b@x@y"]

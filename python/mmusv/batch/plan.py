@@ -393,8 +393,8 @@ def remove_task_files(state_dir: Path, name: str, *, keep: set[str]) -> None:
     for f in sorted(state_dir.iterdir()):
         if f.suffix != ".task" or f.stem in keep:
             continue
-        key, at, part = f.stem.partition("@")
-        if key == name and (not at or _PART_DIR.match(part)):
+        rest = f.stem[len(name) :] if f.stem.startswith(name) else None  # (a name may hold "@" itself)
+        if rest == "" or (rest is not None and rest.startswith("@") and _PART_DIR.match(rest[1:])):
             f.unlink(missing_ok=True)
 
 

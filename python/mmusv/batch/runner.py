@@ -137,13 +137,18 @@ def _portable_error(error: str | None, plan: ScenarioPlan, root: Path) -> str | 
     if error is None:
         return None
     text = error.replace(str(plan.file), plan.file.name)
-    # the longer folder first: the scenarios may sit below the index's folder (mmusv dataset's DIR/scenarios); never
-    # the file system's root, whose prefix is every absolute path's
-    folders = [f.rstrip(os.sep) for f in sorted({str(plan.file.parent), str(root)}, key=len, reverse=True)]
-    for folder in (f for f in folders if f):
-        text = text.replace(folder + os.sep, "")
-    bare = str(root).rstrip(os.sep)
-    return re.sub(re.escape(bare) + r"(?![^\s:;,'\")\]])", ".", text) if bare else text
+    # the longer folder first: the scenarios may sit below the index's folder (mmusv dataset's DIR/scenarios); a
+    # folder only where a path starts (not inside /private/tmp/out for /tmp/out) and ends (not /tmp/output)
+    seps = re.escape("/" + os.sep)
+    for folder in sorted({str(plan.file.parent), str(root)}, key=len, reverse=True):
+        folder = folder.rstrip("/" + os.sep)
+        if not folder:  # the file system's root: every absolute path's prefix
+            continue
+        head = r"(?<![\w.~" + seps + r"])" + re.escape(folder)
+        text = re.sub(head + "[" + seps + r"]+(?=[^\s:;,'\")\]])", "", text)  # a path below it: relative
+        if folder == str(root).rstrip("/" + os.sep):  # the index's folder itself: .
+            text = re.sub(head + "[" + seps + r"]*(?![^\s:;,'\")\].])|" + head + r"(?=\.(?:\s|$))", ".", text)
+    return text
 
 
 def _entry(plan: ScenarioPlan, status: str, error: str | None, root: Path) -> Entry:
