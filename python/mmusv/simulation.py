@@ -178,7 +178,8 @@ class Simulation:
     @one_at_a_time
     def set_sea_surface(self, sea: SeaState | None) -> None:
         """Makes the water the displaced surface of the physical sea ``sea`` (its wave field drawn from the
-        scenario's sea seed) from the next :meth:`set_frame` on, or flat again with ``None``.
+        scenario's sea seed) from the next :meth:`set_frame` on, or flat again with ``None``. The water only: the
+        vessels and the moored ships keep the motion of the scenario's own sea.
 
         Scenarios with ``environment.motion: physical`` (the default) start with their ``environment.sea_spec()``.
         Every frame then samples the surface at the frame time, finest around the USVs (the same surface for

@@ -255,7 +255,8 @@ class Opv2vWriter(DatasetWriter):
         }
 
     def _static(self, t: Target) -> bool:
-        """The vessel never moves: a moored ship, or a scenario vessel at speed 0 (``VesselConfig.static``)."""
+        """The vessel never travels (it rides the waves): a moored ship, or a scenario vessel at speed 0
+        (``VesselConfig.static``)."""
         return t.role == "moored" or t.id in self.static_ids
 
     def finish(self, frames: list[int], skipped: list[dict[str, Any]]) -> None:
