@@ -94,17 +94,20 @@ class Simulation:
             self.sea = spec if spec.hs_m > 0.0 else None
         self.sensor_env: core.SensorEnv = self._sensor_env()
         poses0 = np.asarray(self.fleet.poses_at_times(np.zeros(1)))[0]
-        self.ws: WorldScene = build_world_scene(self.world, [(v.asset, v.role) for v in sc.vessels], poses0)
+        # Over a physical sea the moored ships heave, roll and pitch at their berths (motion.build_moored_fleet).
+        self._moored_fleet = build_moored_fleet(sc, self.world.moored)
+        self.ws: WorldScene = build_world_scene(
+            self.world,
+            [(v.asset, v.role) for v in sc.vessels],
+            poses0,
+            moored_move=self._moored_fleet is not None,
+        )
         self.vessels: list[VesselInfo] = []
         for v, inst in zip(sc.vessels, self.ws.vessel_instances, strict=True):
             self.vessels.append(self._info(v.id, v.asset, v.role, int(inst), static=v.static))
         for k, ((asset_name, _berth), inst) in enumerate(zip(self.world.moored, self.ws.moored_instances, strict=True)):
             self.vessels.append(self._info(f"moored_{k:02d}", asset_name, "moored", inst, static=True))
         self._moored_eta = np.array([[x, y, 0.0, 0.0, 0.0, yaw] for _, (x, y, yaw) in self.world.moored]).reshape(-1, 6)
-        # Over a physical sea the moored ships heave, roll and pitch at their berths (motion.build_moored_fleet).
-        self._moored_fleet = build_moored_fleet(sc, self.world.moored)
-        if self._moored_fleet is not None:
-            self.ws.moving_moored()
         self.agents: list[Agent] = [self._agent(i, v) for i, v in enumerate(sc.vessels) if v.role == "usv"]
         # COLREG lights burn on the vessels under way (not on moored ships or vessels at speed 0).
         under_way = [int(inst) for v, inst in zip(sc.vessels, self.ws.vessel_instances, strict=True) if not v.static]

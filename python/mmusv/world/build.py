@@ -40,13 +40,6 @@ class WorldScene:
     moored_instances: list[int] = field(default_factory=list)
     asset_meshes: dict[str, int] = field(default_factory=dict)
 
-    def moving_moored(self) -> None:
-        """Declares the moored ships instances that move too, beside the vessels, to the sea's shortcuts
-        (:meth:`~mmusv.scene.Scene.set_sea`): over a physical sea they heave, roll and pitch at their berths."""
-        if "water" in self.static_instances and self.moored_instances:
-            moving = np.concatenate([self.vessel_instances, np.asarray(self.moored_instances, dtype=np.int64)])
-            self.scene.set_sea(self.static_instances["water"], moving=moving)
-
 
 def _add(scene: Scene, mesh: TriMesh, name: str) -> int:
     """Adds ``mesh`` with its materials; the scene's material table is (re)set first when the mesh names a
@@ -90,7 +83,9 @@ def _mesh_for(ws: WorldScene, asset_name: str) -> int:
     return ws.asset_meshes[asset_name]
 
 
-def build_world_scene(world: MapWorld, vessels: list[tuple[str, str]], initial_poses: np.ndarray) -> WorldScene:
+def build_world_scene(
+    world: MapWorld, vessels: list[tuple[str, str]], initial_poses: np.ndarray, *, moored_move: bool = False
+) -> WorldScene:
     """The full scene: static map, moored ships, and one instance per scenario vessel.
 
     Args:
@@ -99,6 +94,8 @@ def build_world_scene(world: MapWorld, vessels: list[tuple[str, str]], initial_p
             labelled :data:`SemanticClass.USV` whatever the asset says.
         initial_poses: ``(V, 6)`` float64 poses η ``[x, y, z, roll, pitch, yaw]`` (world frame, metres, radians)
             of the vessels at the first frame.
+        moored_move: the moored ships move too (over a physical sea they heave, roll and pitch at their berths):
+            the sea's shortcuts count them among the moving instances, not in the static height bound.
     """
     ws = build_static_scene(world)
     mats = pose_matrices(np.asarray(initial_poses, dtype=np.float64).reshape(-1, 6))
@@ -109,5 +106,8 @@ def build_world_scene(world: MapWorld, vessels: list[tuple[str, str]], initial_p
     ws.vessel_instances = np.asarray(ids, dtype=np.int64)
     if "water" in ws.static_instances:
         # Exact shortcuts for rays that can only meet the sea or the sky (vessels are the instances that move).
-        ws.scene.set_sea(ws.static_instances["water"], moving=ws.vessel_instances)
+        moving = ws.vessel_instances
+        if moored_move and ws.moored_instances:
+            moving = np.concatenate([moving, np.asarray(ws.moored_instances, dtype=np.int64)])
+        ws.scene.set_sea(ws.static_instances["water"], moving=moving)
     return ws
