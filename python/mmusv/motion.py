@@ -43,19 +43,45 @@ def build_fleet(scenario: Scenario, *, wave: str | float | None = None, referenc
                 "paper's formula (motion: paper); the physical response reads each hull's own particulars"
             )
         dims[[i for i, v in enumerate(vessels) if v.role == "usv"]] = core.reference_usv_dims()
-    amps = np.tile(np.array(core.default_amplitudes(), dtype=np.float64), (len(vessels), 1))
+    return _core_fleet(
+        scenario,
+        env,
+        assets,
+        dims,
+        routes=[np.ascontiguousarray(v.route, dtype=np.float64) for v in vessels],
+        ends=[v.end for v in vessels],
+        speeds=np.array([v.speed_mps for v in vessels], dtype=np.float64),
+        offsets=np.array([v.start_offset_m for v in vessels], dtype=np.float64),
+        z_base=np.array([v.z_base_m for v in vessels], dtype=np.float64),
+    )
+
+
+def _core_fleet(
+    scenario: Scenario,
+    env: Any,
+    assets: list[Any],
+    dims: np.ndarray,
+    *,
+    routes: list[np.ndarray],
+    ends: list[str],
+    speeds: np.ndarray,
+    offsets: np.ndarray,
+    z_base: np.ndarray,
+) -> Any:
+    """The ``mmusv._core.Fleet`` of vessels of ``assets`` (box ``dims``) on ``routes``, moved by the paper's formula
+    or, with ``env.motion`` physical, by the scenario's sea through each hull's particulars."""
     physical: dict[str, Any] = {}
     if env.motion == "physical":
         physical["sea"] = env.sea_spec().field(scenario_seed=scenario.seed)
         physical["hulls"] = np.array([hull_particulars(a) for a in assets], dtype=np.float64).reshape(-1, 5)
     return core.Fleet(
-        routes=[np.ascontiguousarray(v.route, dtype=np.float64) for v in vessels],
-        end_behaviours=[v.end for v in vessels],
-        speeds=np.array([v.speed_mps for v in vessels], dtype=np.float64),
-        start_offsets=np.array([v.start_offset_m for v in vessels], dtype=np.float64),
-        z_base=np.array([v.z_base_m for v in vessels], dtype=np.float64),
+        routes=routes,
+        end_behaviours=ends,
+        speeds=speeds,
+        start_offsets=offsets,
+        z_base=z_base,
         dims=dims,
-        amplitudes=amps,
+        amplitudes=np.tile(np.array(core.default_amplitudes(), dtype=np.float64), (len(assets), 1)),
         seed=scenario.seed,
         wave=env.wave,
         **physical,
@@ -73,30 +99,17 @@ def build_moored_fleet(scenario: Scenario, moored: list[tuple[str, tuple[float, 
     sea each ship heaves, rolls and pitches in the scenario's wave field at speed 0 through its own RAOs, as a
     scenario vessel at speed 0 does (its lines hold it in surge, sway and yaw), at its berth and heading."""
     env = scenario.environment
-    if env.motion != "physical" or not moored:
-        return None
-    sea = env.sea_spec()
-    if sea.hs_m <= 0.0:
+    if env.motion != "physical" or not moored or env.sea_spec().hs_m <= 0.0:
         return None
     assets = [get_asset(name) for name, _ in moored]
     routes = [
         np.array([[x, y], [x + MOORED_ROUTE_M * np.cos(yaw), y + MOORED_ROUTE_M * np.sin(yaw)]], dtype=np.float64)
         for _, (x, y, yaw) in moored
     ]
-    n = len(moored)
-    return core.Fleet(
-        routes=routes,
-        end_behaviours=["stop"] * n,
-        speeds=np.zeros(n, dtype=np.float64),
-        start_offsets=np.zeros(n, dtype=np.float64),
-        z_base=np.zeros(n, dtype=np.float64),
-        dims=np.array([[a.length, a.beam, a.height] for a in assets], dtype=np.float64),
-        amplitudes=np.tile(np.array(core.default_amplitudes(), dtype=np.float64), (n, 1)),
-        seed=scenario.seed,
-        wave=env.wave,
-        sea=sea.field(scenario_seed=scenario.seed),
-        hulls=np.array([hull_particulars(a) for a in assets], dtype=np.float64).reshape(-1, 5),
-    )
+    zeros = np.zeros(len(moored), dtype=np.float64)
+    dims = np.array([[a.length, a.beam, a.height] for a in assets], dtype=np.float64)
+    ends = ["stop"] * len(moored)
+    return _core_fleet(scenario, env, assets, dims, routes=routes, ends=ends, speeds=zeros, offsets=zeros, z_base=zeros)
 
 
 POSE_BATCH = 1 << 20
