@@ -84,9 +84,16 @@ def front_calib(agent: AgentInfo, view: AgentView) -> tuple[np.ndarray, np.ndarr
     cam = agent.cameras.get("front")
     if cam is None:
         return np.zeros((3, 4)), np.eye(4)
-    velo_to_cam = LIDAR_OPTICAL @ invert(cam.mount) @ agent.lidar_mount
+    velo_to_cam = _lidar_to_front(agent.lidar_mount, cam.mount)
     fx, fy, cx, cy = cam.intrinsics
     return np.array([[fx, 0.0, cx, 0.0], [0.0, fy, cy, 0.0], [0.0, 0.0, 1.0, 0.0]]), velo_to_cam
+
+
+def _lidar_to_front(lidar_mount: np.ndarray, camera_mount: np.ndarray) -> np.ndarray:
+    """The LiDAR → front optical frame transform ``(4, 4)`` of a LiDAR and a camera rigid on the hull, from their
+    mounts (sensor → hull)."""
+    out: np.ndarray = LIDAR_OPTICAL @ invert(camera_mount) @ lidar_mount
+    return out
 
 
 LEVEL_TOLERANCE_DEG = 0.005
@@ -106,7 +113,7 @@ def front_camera_turn(agent: AgentInfo) -> tuple[float, float, float] | None:
     cam = agent.cameras.get("front")
     if cam is None or agent.lidar_mount is None:
         return None
-    r = (LIDAR_OPTICAL @ invert(cam.mount) @ agent.lidar_mount)[:3, :3]  # LiDAR -> front optical, rotation
+    r = _lidar_to_front(agent.lidar_mount, cam.mount)[:3, :3]  # LiDAR -> front optical, rotation
     rel = r @ BODY_TO_OPTICAL.T  # the turn: identity for a level, forward camera
     angle = math.degrees(math.acos(max(-1.0, min(1.0, (float(np.trace(rel)) - 1.0) / 2.0))))
     if angle <= LEVEL_TOLERANCE_DEG:
