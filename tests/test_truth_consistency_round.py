@@ -407,6 +407,42 @@ def test_top_view_pixels_lie_on_their_bev_boxes(rec: Rec) -> None:
     assert checked > 300
 
 
+def _above_part_out_of_image(cam: CameraInfo, pose: np.ndarray, box: np.ndarray, size: np.ndarray) -> bool:
+    """Whether the box (``box`` → world, ``size`` metres) has a part above the still level and none of it shows in
+    the image: its surface above z = 0 sampled on a fine grid and projected by the lens model here (forward
+    Brown–Conrady within the reach the image corners see)."""
+    g = np.linspace(-0.5, 0.5, 41)
+    a, b = np.meshgrid(g, g)
+    a, b = a.ravel(), b.ravel()
+    faces = []
+    for axis in range(3):
+        for side in (-0.5, 0.5):
+            p = np.zeros((a.size, 3))
+            p[:, axis] = side
+            p[:, (axis + 1) % 3], p[:, (axis + 2) % 3] = a, b
+            faces.append(p)
+    pts = (np.concatenate(faces) * np.asarray(size)) @ box[:3, :3].T + box[:3, 3]
+    pts = pts[pts[:, 2] > 0.0]
+    if len(pts) == 0:
+        return False  # wholly below the still level: a craft in a trough
+    inv = np.linalg.inv(pose)
+    opt = (pts @ inv[:3, :3].T + inv[:3, 3]) @ BODY_TO_OPTICAL.T
+    opt = opt[opt[:, 2] > 1e-3]
+    x, y = opt[:, 0] / opt[:, 2], opt[:, 1] / opt[:, 2]
+    fx, fy, cx, cy = cam.intrinsics
+    corners = np.array([[0.0, 0.0], [cam.width, 0.0], [0.0, cam.height], [cam.width, cam.height]])
+    reach = float(np.max(np.hypot(*_undistort(cam, corners).T)))
+    keep = np.hypot(x, y) <= reach
+    x, y = x[keep], y[keep]
+    if cam.distortion is not None:
+        k1, k2, p1, p2, k3 = cam.distortion
+        r2 = x * x + y * y
+        radial = 1 + k1 * r2 + k2 * r2 * r2 + k3 * r2**3
+        x, y = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x), y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y
+    u, v = fx * x + cx, fy * y + cy
+    return not bool(((u >= 0) & (u <= cam.width) & (v >= 0) & (v <= cam.height)).any())
+
+
 def test_occlusion_and_wave_share_agree_with_an_own_ray_count(rec: Rec) -> None:
     """For every small 2D box (≤ 150 box pixels: the speedboat, the moored pilot and fishing boats, the moored
     ferry 400 m off), the pixels' rays cast here against the hull mesh alone (Möller–Trumbore) give the
@@ -443,10 +479,17 @@ def test_occlusion_and_wave_share_agree_with_an_own_ray_count(rec: Rec) -> None:
             t = _ray_mesh(pose[:3, 3], d, v0 @ pm[:3, :3].T + pm[:3, 3], faces)
             sil = np.isfinite(t)
             above = sil & (pose[2, 3] + d[:, 2] * np.where(sil, t, 0.0) > 0.0)
-            exposed = above if above.any() else sil
+            # met only below the still level: all of the silhouette, unless the image holds nothing of the 3D
+            # box's part above that level (a ship's upper part out of the picture)
+            box = _box_matrix(w, i)
+            if above.any():
+                exposed = above
+            else:
+                exposed = np.zeros_like(sil) if _above_part_out_of_image(cam, pose, box, w.box_sizes[i]) else sil
             first = inst[vv.ravel(), uu.ravel()]
             n = int(exposed.sum())
             if n == 0:
+                assert b.wave_occlusion == 0.0, (f.index, b.camera, b.target_id)
                 continue
             seen = int((exposed & (first == w.instance_ids[i])).sum())
             hidden = int((exposed & (first == water)).sum())
@@ -493,12 +536,14 @@ def test_cut_2d_boxes_bound_the_pixels_whose_rays_meet_random_boxes(distortion: 
     test): the box holds them to within the pixel grid's quantisation and, 5 px wide and tall, reaches at most 2 px
     beyond."""
     from mmusv import _core as core
-    from mmusv.annotate import BODY_TO_OPTICAL, NEAR_M, _in_image_box, _lens, _project_box, box_corners
+    from mmusv.annotate import box_corners
+    from mmusv.frames import BODY_TO_OPTICAL
+    from mmusv.image_boxes import NEAR_M, camera_lens, in_image_box, project_box
 
     w, h = 160, 90
     cam = core.Camera(width=w, height=h, rgb=False, hfov=np.radians(100), distortion=distortion)
     pose = np.eye(4)
-    lens = _lens(cam, pose, pose)
+    lens = camera_lens(cam, pose=pose, world_to_body=pose)
     o0, d0 = cam.pixel_rays(pose, np.arange(w * h, dtype=np.int64))
     o0, d0 = np.asarray(o0, dtype=np.float64), np.asarray(d0, dtype=np.float64)
     rng = np.random.default_rng(7)
@@ -511,10 +556,10 @@ def test_cut_2d_boxes_bound_the_pixels_whose_rays_meet_random_boxes(distortion: 
         if np.all(np.abs(inv[:3, 3]) < size / 2 + 0.1):
             continue  # the camera inside the box
         corners = box_corners(m, size) @ BODY_TO_OPTICAL.T
-        b = _project_box(corners, cam.intrinsics, lens)
+        b = project_box(corners, intrinsics=cam.intrinsics, lens=lens)
         if b is None or not (b[0] < 0 or b[1] < 0 or b[2] > w or b[3] > h):
             continue
-        got = _in_image_box(corners, cam.intrinsics, lens, w, h)
+        got = in_image_box(corners, intrinsics=cam.intrinsics, lens=lens, width=w, height=h)
         o, d = o0 @ inv[:3, :3].T + inv[:3, 3], d0 @ inv[:3, :3].T
         with np.errstate(divide="ignore", invalid="ignore"):
             t1, t2 = (-size / 2 - o) / d, (size / 2 - o) / d

@@ -18,6 +18,7 @@ from mmusv.sensors.lidar import lidar_from_config, scan
 from mmusv.wave_occlusion import (
     exposed_hidden,
     exposed_hidden_boxes,
+    exposed_rays,
     lidar_beam_rays,
     lidar_box_beams,
     lidar_box_rays,
@@ -416,6 +417,33 @@ def test_many_targets_counted_at_once_are_each_counted_alone() -> None:
     assert want[1] == (0, 0) and want[0][1] + want[2][1] > 0  # some rays hidden by the crests
 
 
+def test_the_whole_silhouette_stands_in_only_where_allowed() -> None:
+    """:func:`exposed_rays`: the rays above the still level; for a target met only below it, all its rays, unless
+    its flag says no (a camera box cut by the border whose ship rises above the level); a target met above keeps
+    only those, and one met by no ray has none. The counts of :func:`exposed_hidden_boxes` follow the flags."""
+    hit = np.array([True, True, False, True, True, True, False])
+    z = np.array([0.5, -0.2, 9.0, -1.0, -0.5, -0.3, 1.0])
+    box = np.array([0, 0, 0, 1, 1, 2, 3])  # 0: met above and below, 1 and 2: only below, 3: no ray meets it
+    np.testing.assert_array_equal(exposed_rays(hit, z, box=box, n_boxes=4), [1, 0, 0, 1, 1, 1, 0])
+    flags = np.array([False, True, False, True])
+    np.testing.assert_array_equal(exposed_rays(hit, z, box=box, n_boxes=4, whole_when_low=flags), [1, 0, 0, 1, 1, 0, 0])
+    np.testing.assert_array_equal(exposed_rays(hit[3:5], z[3:5]), [1, 1])  # one target: all rays its
+    # through the counts: a craft sunk in a trough 150 m off, the crests hiding some of it; flagged off, nothing
+    scene, _, alone, _ = _world(Sea(hs_m=3.5, tp_s=8.0))
+    origins, dirs = _fan(np.array([0.0, 0.0, 2.0]), np.array([150.0, 0.0, 0.8]), n=30)
+    t = alone.cast_rays(origins, dirs).distance
+    low = np.isfinite(t) & (origins[:, 2] + dirs[:, 2] * np.where(np.isfinite(t), t, 0.0) <= 0.0)
+    t = np.where(low, t, np.inf).astype(np.float32)  # only the rays meeting it below the still level
+    assert low.sum() > 50
+    starts = np.array([0, len(t)])
+    e, h = exposed_hidden_boxes(scene, origins=origins, directions=dirs, vessel_t=t, starts=starts)
+    assert e[0] == low.sum() and h[0] > 0
+    e, h = exposed_hidden_boxes(
+        scene, origins=origins, directions=dirs, vessel_t=t, starts=starts, whole_when_low=np.array([False])
+    )
+    assert e[0] == h[0] == 0
+
+
 def test_unsigned_offsets_are_offsets() -> None:
     """``starts`` of any integer dtype (``lidar_boxes_beams`` gives int64; a user's may be unsigned) counts each
     target's rows as int64 offsets do: uint64 offsets were a ``TypeError`` (numpy will not repeat by them)."""
@@ -512,6 +540,7 @@ def _bad_calls() -> list[tuple[str, Any, str]]:
     lbx: Any = lidar_box_rays
     lbs: Any = lidar_boxes_beams
     ehb: Any = exposed_hidden_boxes
+    er: Any = exposed_rays
     stack = np.stack([corners, corners + 1.0])
     return [
         # answers for counts that are not counts
@@ -648,6 +677,36 @@ def _bad_calls() -> list[tuple[str, Any, str]]:
             "starts (1, 2)",
             lambda: ehb(scene, origins=o, directions=d, vessel_t=t, starts=[[0, 4]]),
             "starts must be (B + 1,)",
+        ),
+        (
+            "whole_when_low of 1 for 2 targets",
+            lambda: ehb(scene, origins=o, directions=d, vessel_t=t, starts=[0, 2, 4], whole_when_low=np.array([True])),
+            "whole_when_low must be a (2,) bool array",
+        ),
+        (
+            "whole_when_low as numbers",
+            lambda: ehb(scene, origins=o, directions=d, vessel_t=t, starts=[0, 4], whole_when_low=np.array([1])),
+            "whole_when_low must be a (1,) bool array",
+        ),
+        # the exposed-silhouette rule, called on its own
+        ("exposed_rays hit as numbers", lambda: er(np.ones(3), np.zeros(3)), "hit must be an (N,) bool array"),
+        ("exposed_rays z short", lambda: er(np.ones(3, bool), np.zeros(2)), "z must be (N,) world heights"),
+        (
+            "exposed_rays box past n_boxes",
+            lambda: er(np.ones(3, bool), np.zeros(3), box=np.array([0, 1, 2]), n_boxes=2),
+            "box must be (N,) targets in 0..1: it holds 0..2",
+        ),
+        (
+            "exposed_rays box negative",
+            lambda: er(np.ones(2, bool), np.zeros(2), box=np.array([-1, 0]), n_boxes=2),
+            "it holds -1..0",
+        ),
+        ("exposed_rays no box for 2", lambda: er(np.ones(2, bool), np.zeros(2), n_boxes=2), "box is needed"),
+        ("exposed_rays n_boxes 0", lambda: er(np.ones(2, bool), np.zeros(2), n_boxes=0), "n_boxes = 0"),
+        (
+            "exposed_rays flags short",
+            lambda: er(np.ones(2, bool), np.zeros(2), box=np.array([0, 1]), n_boxes=2, whole_when_low=np.ones(1, bool)),
+            "whole_when_low must be a (2,) bool array",
         ),
         # unsigned offsets that fall: np.diff wrapped round to a rise (uint32: a 32 GiB array), a bare IndexError
         (

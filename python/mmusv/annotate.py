@@ -17,9 +17,10 @@ agent's own hull is never a target):
   ``occlusion`` = 1 − visible / silhouette over the vessel's part above the still water level (world z > 0):
   the silhouette is the pixels whose rays, cast against the vessel alone, meet it above that level (the part of
   the hull a flat calm sea never hides; all of them for a vessel met only below it, a small craft wholly in a wave
-  trough), visible those of them whose pixel shows the vessel; so a vessel in plain view on flat water has
-  occlusion 0, and other objects and the waves' crests raise it (the waves' own share is ``wave_occlusion``,
-  below). The 2D box is the projected 3D box, which reaches down to the keel.
+  trough, but none where the image border cuts off all of the box's part above it:
+  :func:`~mmusv.wave_occlusion.exposed_rays`), visible those of them whose pixel shows the vessel; so a vessel in
+  plain view on flat water has occlusion 0, and other objects and the waves' crests raise it (the waves' own share
+  is ``wave_occlusion``, below). The 2D box is the projected 3D box, which reaches down to the keel.
 * over a displaced sea (a scene with a wave surface), per 3D box and per 2D box, ``wave_occlusion``: the share of
   the vessel's part above the still water level that the water hides from that sensor (:mod:`mmusv.wave_occlusion`);
   0 over a flat sea.
@@ -38,10 +39,20 @@ from scipy.spatial.transform import Rotation
 from mmusv._equality import same
 from mmusv.errors import InputError
 from mmusv.frames import BODY_TO_OPTICAL, translation
+from mmusv.image_boxes import (
+    camera_lens,
+    clip_box,
+    faces_above,
+    faces_in_image_box,
+    in_image_box,
+    pinhole_truncation,
+    project_box,
+)
 from mmusv.scene import Scene
 from mmusv.wave_occlusion import (
     BeamAngles,
     exposed_hidden_boxes,
+    exposed_rays,
     lidar_beam_rays,
     lidar_boxes_beams,
     pattern_angles,
@@ -63,8 +74,6 @@ __all__ = [
 _SIGNS = np.array(
     [[(i & 1) * 2 - 1, ((i >> 1) & 1) * 2 - 1, ((i >> 2) & 1) * 2 - 1] for i in range(8)], dtype=np.float64
 )
-_EDGES = [(a, b) for a in range(8) for b in range(a + 1, 8) if bin(a ^ b).count("1") == 1]
-NEAR_M = 0.05
 
 
 def in_target_range(centres: np.ndarray, range_m: float) -> np.ndarray:
@@ -263,160 +272,6 @@ class SilhouetteCache:
         return np.concatenate(parts) if parts else np.zeros(0, dtype=np.float32)
 
 
-EDGE_STEPS = 32
-"""Pieces each box edge is cut into for a camera with lens distortion, which bends the edges' images."""
-
-
-def _project_box(
-    corners_opt: np.ndarray, k: tuple[float, float, float, float], lens: tuple[Any, float] | None = None
-) -> np.ndarray | None:
-    """Pixel bounding box ``[x0, y0, x1, y1]`` of a box given by its corners in the optical frame, with edges
-    clipped at the near plane; ``None`` when the box is entirely behind the camera. ``lens``: the camera with
-    lens distortion and its reach (:func:`_lens`), or ``None`` for an ideal pinhole, where the corners
-    alone bound the image; through a lens the box's edges are sampled (their images are curves)."""
-    fx, fy, cx, cy = k
-    pts = [c for c in corners_opt if c[2] >= NEAR_M]
-    ends = []
-    for a, b in _EDGES:
-        pa, pb = corners_opt[a], corners_opt[b]
-        za, zb = pa[2], pb[2]
-        if (za - NEAR_M) * (zb - NEAR_M) < 0:
-            cut = pa + (NEAR_M - za) / (zb - za) * (pb - pa)
-            pts.append(cut)
-            ends.append((pa, cut) if za >= NEAR_M else (cut, pb))
-        elif za >= NEAR_M and zb >= NEAR_M:
-            ends.append((pa, pb))
-    if not pts:
-        return None
-    if lens is None:
-        p = np.array(pts)
-        u = fx * p[:, 0] / p[:, 2] + cx
-        v = fy * p[:, 1] / p[:, 2] + cy
-    else:
-        t = np.linspace(0.0, 1.0, EDGE_STEPS + 1)[:, None]
-        p = np.concatenate([pa + t * (pb - pa) for pa, pb in ends])
-        x, y = _distort(p[:, 0] / p[:, 2], p[:, 1] / p[:, 2], *lens)
-        u = fx * x + cx
-        v = fy * y + cy
-    return np.array([u.min(), v.min(), u.max(), v.max()])
-
-
-_FACES = [[0, 2, 6, 4], [1, 3, 7, 5], [0, 1, 5, 4], [2, 3, 7, 6], [0, 1, 3, 2], [4, 5, 7, 6]]
-"""The box's six faces (−x, +x, −y, +y, −z, +z), each as its four corner indices in order round it (corner bits
-as :func:`box_corners`)."""
-
-
-def _near_face(face: np.ndarray) -> np.ndarray:
-    """The part of a convex polygon ``(n, 3)`` (optical frame) in front of the near plane ``z >= NEAR_M`` (one
-    Sutherland–Hodgman pass), ``(m, 3)``, ``m`` 0 when none of it is."""
-    out = []
-    for i in range(len(face)):
-        a, b = face[i], face[(i + 1) % len(face)]
-        ina, inb = a[2] >= NEAR_M, b[2] >= NEAR_M
-        if ina:
-            out.append(a)
-        if ina != inb:
-            out.append(a + (NEAR_M - a[2]) / (b[2] - a[2]) * (b - a))
-    return np.array(out).reshape(-1, 3)
-
-
-def _in_image_box(
-    corners_opt: np.ndarray,
-    k: tuple[float, float, float, float],
-    lens: tuple[Any, float] | None,
-    width: int,
-    height: int,
-) -> np.ndarray | None:
-    """The pixel box ``[x0, y0, x1, y1]`` of the part of a box's image that lies inside the ``width × height`` image
-    (the union of its faces' images, each face clipped at the near plane, intersected with the image), ``None`` when
-    none of it does. Tighter than the box's projected bounding box clipped to the image where the border cuts the
-    image of a long box seen at a slant; the same where the image lies wholly inside. Through a lens each face's
-    pinhole image, clipped to the lens's reach, has its edges sampled (:data:`EDGE_STEPS`) in the image plane and
-    distorted."""
-    from shapely import MultiPoint, Polygon, box, unary_union
-
-    fx, fy, cx, cy = k
-    faces = [f for f in (_near_face(corners_opt[face]) for face in _FACES) if len(f) >= 3]
-    if lens is None:  # a pinhole keeps straight lines straight: the image is the corners' convex hull
-        p = np.concatenate(faces) if faces else np.zeros((0, 3))
-        image = MultiPoint(np.column_stack([fx * p[:, 0] / p[:, 2] + cx, fy * p[:, 1] / p[:, 2] + cy])).convex_hull
-    else:
-        # Each face's pinhole image (a convex polygon in undistorted normalised coordinates, exact) clipped to the
-        # square of half side the lens's reach (beyond it `_distort` carries points out of the image), then its
-        # edges sampled evenly there and distorted: sampled in 3D, a face cut at the near plane put most samples
-        # ~10^5 px out, and the chords between them crossed the image where the curved edge does not.
-        reach = min(float(lens[1]), 1e6)
-        square = box(-reach, -reach, reach, reach)
-        t = np.linspace(0.0, 1.0, EDGE_STEPS, endpoint=False)[:, None]
-        shapes = []
-        for f in faces:
-            flat = MultiPoint(np.column_stack([f[:, 0] / f[:, 2], f[:, 1] / f[:, 2]])).convex_hull.intersection(square)
-            if flat.is_empty or flat.geom_type != "Polygon":
-                continue
-            ring = np.asarray(flat.exterior.coords)[:-1]
-            pts = np.concatenate([a + t * (b - a) for a, b in zip(ring, np.roll(ring, -1, axis=0), strict=True)])
-            x, y = _distort(pts[:, 0], pts[:, 1], *lens)
-            shape = Polygon(np.column_stack([fx * x + cx, fy * y + cy]))
-            shapes.append(shape if shape.is_valid else shape.buffer(0))
-        image = unary_union(shapes)
-    inside = image.intersection(box(0.0, 0.0, float(width), float(height)))
-    if inside.is_empty:
-        return None
-    return np.array(inside.bounds, dtype=np.float64)
-
-
-def _clip_box(box: np.ndarray, width: int, height: int) -> tuple[np.ndarray, float, float]:
-    """A pixel box ``[x0, y0, x1, y1]`` clipped to the ``width × height`` image: the clipped box, the box's own area
-    and the clipped area (pixels²; 0 when the box is empty or lies wholly outside the image)."""
-    area = max(box[2] - box[0], 0.0) * max(box[3] - box[1], 0.0)
-    clipped = np.array([max(box[0], 0.0), max(box[1], 0.0), min(box[2], float(width)), min(box[3], float(height))])
-    if clipped[2] <= clipped[0] or clipped[3] <= clipped[1] or area <= 0:
-        return clipped, float(area), 0.0
-    return clipped, float(area), float((clipped[2] - clipped[0]) * (clipped[3] - clipped[1]))
-
-
-def pinhole_truncation(
-    corners_opt: np.ndarray, *, intrinsics: tuple[float, float, float, float], width: int, height: int
-) -> float:
-    """The share of a box's pinhole image that lies outside a ``width × height`` image: ``1 −`` clipped area /
-    unclipped area of the projected box (as the 2D boxes' ``truncation``, without lens distortion), from its ``(8,
-    3)`` corners in the optical frame (x right, y down, z forward; metres) and ``intrinsics`` ``(fx, fy, cx, cy)``
-    pixels; 1.0 when the box lies wholly behind the camera or outside the image. For a target without a recorded 2D
-    box (too small or too far for any pixel centre to meet it), so that an export can tell one in view from one
-    out of it."""
-    box = _project_box(np.asarray(corners_opt, dtype=np.float64), intrinsics)
-    if box is None:
-        return 1.0
-    _clipped, area, carea = _clip_box(box, width, height)
-    return 1.0 if carea <= 0 else float(1.0 - carea / area)
-
-
-def _lens(cam: Any, pose: np.ndarray, world_to_body: np.ndarray) -> tuple[Any, float] | None:
-    """A pinhole camera with lens distortion (``mmusv._core.Camera``) and its reach (the largest undistorted
-    normalised radius its image corners see, from the camera's own corner rays), or ``None`` without distortion.
-    Within the reach the camera's distortion maps every point to the pixel whose ray meets it; beyond it, where the
-    polynomial may fold back into the image, points are carried radially outwards, outside the image."""
-    if cam.distortion is None:
-        return None
-    w, h = cam.resolution
-    corners = np.array([0, w - 1, (h - 1) * w, h * w - 1], dtype=np.int64)
-    _, d = cam.pixel_rays(pose, corners)
-    opt = np.asarray(d, dtype=np.float64) @ world_to_body[:3, :3].T @ BODY_TO_OPTICAL.T
-    reach = float(np.max(np.hypot(opt[:, 0], opt[:, 1]) / opt[:, 2]))
-    # A single pixel's centre is the image centre: nothing to fold past, the polynomial alone.
-    return cam, reach if reach > 0.0 else np.inf
-
-
-def _distort(x: np.ndarray, y: np.ndarray, cam: Any, reach: float) -> tuple[np.ndarray, np.ndarray]:
-    """Distorted normalised coordinates of undistorted ``(x, y)`` through ``cam``'s own Brown–Conrady model (the
-    core's ``Distortion::distort``, which the render uses); a point beyond ``reach`` is distorted at the reach and
-    scaled back out radially."""
-    r = np.hypot(x, y)
-    s = np.where(r > reach, reach / np.maximum(r, 1e-300), 1.0)
-    d = cam.distort(np.column_stack([x * s, y * s]).astype(np.float64))
-    return d[:, 0] / s, d[:, 1] / s
-
-
 def _lidar_wave_shares(
     scene: Scene,
     pattern: np.ndarray,
@@ -489,11 +344,11 @@ def annotate_agent(
     for name, (cam, pose, inst_img) in cameras.items():
         if cam.intrinsics is not None:
             inv, p = np.linalg.inv(pose), np.ascontiguousarray(pose, dtype=np.float64)
-            views[name] = (cam, cam.intrinsics, inv, p, inst_img, _lens(cam, p, inv))
+            views[name] = (cam, cam.intrinsics, inv, p, inst_img, camera_lens(cam, pose=p, world_to_body=inv))
     rotations: list[np.ndarray] = []  # the 3D boxes' rotation matrices, turned into quaternions in one call
     share_boxes: list[tuple[int, np.ndarray, str, np.ndarray]] = []  # 3D box row, corners, asset, pose
     # 2D box row, its pixels' rays (origins, unit directions), distances to the vessel alone, instances seen first
-    cam_shares: list[tuple[int, np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
+    cam_shares: list[tuple[int, np.ndarray, np.ndarray, np.ndarray, np.ndarray, bool]] = []
     for vi, info in enumerate(vessels):
         if vi == agent_index:
             continue
@@ -519,14 +374,15 @@ def annotate_agent(
         for name, (cam, k, inv, pose, inst_img, lens) in views.items():
             h, w = inst_img.shape
             body = corners_world @ inv[:3, :3].T + inv[:3, 3]
-            box = _project_box(body @ BODY_TO_OPTICAL.T, k, lens)
+            box = project_box(body @ BODY_TO_OPTICAL.T, intrinsics=k, lens=lens)
             if box is None:
                 continue
-            clipped, area, carea = _clip_box(box, w, h)
+            clipped, area, carea = clip_box(box, width=w, height=h)
             if carea <= 0:
                 continue
-            if box[0] < 0.0 or box[1] < 0.0 or box[2] > w or box[3] > h:  # cut by the border: its part inside
-                inside = _in_image_box(body @ BODY_TO_OPTICAL.T, k, lens, w, h)
+            cut = box[0] < 0.0 or box[1] < 0.0 or box[2] > w or box[3] > h
+            if cut:  # its part inside the image
+                inside = in_image_box(body @ BODY_TO_OPTICAL.T, intrinsics=k, lens=lens, width=w, height=h)
                 if inside is None:
                     continue
                 clipped = inside
@@ -545,9 +401,17 @@ def annotate_agent(
             # The silhouette above the still water level, and the part of it the camera sees (a flat sea hides the
             # hull below the waterline: that is no occlusion).
             dn = d / np.linalg.norm(d, axis=1, keepdims=True)
-            above = alone & (o[:, 2] + dn[:, 2] * np.where(alone, t_alone, 0.0) > 0.0)
-            if sil and not above.any():
-                above = alone  # wholly below the still level (a craft in a trough): its whole silhouette counts
+            z = o[:, 2] + dn[:, 2] * np.where(alone, t_alone, 0.0)
+            # Met only below the still level: a craft wholly in a trough, whose whole silhouette counts; but where
+            # the border cuts off all of the box's part above that level, the lower hull of a ship whose upper part
+            # is out of the picture (no exposed silhouette in this image).
+            whole_when_low = True
+            if cut and sil and not (alone & (z > 0.0)).any():
+                above_opt = [(f @ inv[:3, :3].T + inv[:3, 3]) @ BODY_TO_OPTICAL.T for f in faces_above(corners_world)]
+                if above_opt:  # (none: the whole box lies below the still level)
+                    seen_above = faces_in_image_box(above_opt, intrinsics=k, lens=lens, width=w, height=h)
+                    whole_when_low = seen_above is not None
+            above = exposed_rays(alone, z, whole_when_low=np.array([whole_when_low]))
             exposed = int(np.count_nonzero(above))
             seen = int(np.count_nonzero(above & (window.reshape(-1) == info.instance_id)))
             ann.cam_ids.append(info.id)
@@ -560,10 +424,10 @@ def annotate_agent(
             ann.cam_role.append(info.role)
             ann.cam_static.append(bool(info.static))
             if waves and sil:  # the wave-occlusion share: worked out below for every 2D box at once
-                cam_shares.append((len(ann.cam_wave_occlusion), o, dn, t_alone, window.reshape(-1)))
+                cam_shares.append((len(ann.cam_wave_occlusion), o, dn, t_alone, window.reshape(-1), whole_when_low))
             ann.cam_wave_occlusion.append(0.0)
     if cam_shares and scene is not None:
-        rows_2d, origins, directions, distances, seen_first = zip(*cam_shares, strict=True)
+        rows_2d, origins, directions, distances, seen_first, whole = zip(*cam_shares, strict=True)
         offsets = np.concatenate(([0], np.cumsum([t.size for t in distances])))
         n_exposed, n_hidden = exposed_hidden_boxes(
             scene,
@@ -572,6 +436,7 @@ def annotate_agent(
             vessel_t=np.concatenate(distances),
             starts=offsets,
             scene_instance=np.concatenate(seen_first),
+            whole_when_low=np.array(whole, dtype=bool),
         )
         for row, e, h in zip(rows_2d, n_exposed, n_hidden, strict=True):
             ann.cam_wave_occlusion[row] = share(int(e), int(h))

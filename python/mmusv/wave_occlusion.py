@@ -2,12 +2,17 @@
 
 A target's *exposed silhouette* is the set of a sensor's rays that meet the vessel when it is alone in the
 world (:class:`~mmusv.annotate.SilhouetteCache`) at a point above the still water level (world z > 0): the part
-of the hull a flat calm sea would never hide. A target that no ray meets above that level while some meet it
-below (a small craft wholly in a wave trough) has its whole silhouette as its exposed silhouette, so that a craft
-the crests hide is counted hidden rather than left out. Its wave-occlusion share is the fraction of those rays
-that the full scene stops at the water first — a crest in front, or the local surface over that part of the
-hull. With a flat sea the share is 0 by construction; it is only computed where the scene has a displaced wave
-surface (:meth:`~mmusv.scene.Scene.set_wave_surface`).
+of the hull a flat calm sea would never hide. Its wave-occlusion share is the fraction of those rays that the
+full scene stops at the water first — a crest in front, or the local surface over that part of the hull. With a
+flat sea the share is 0 by construction; it is only computed where the scene has a displaced wave surface
+(:meth:`~mmusv.scene.Scene.set_wave_surface`).
+
+A target that no ray meets above the still level while some meet it below (a small craft wholly in a wave
+trough) has its whole silhouette as its exposed silhouette, so that a craft the crests hide is counted hidden
+rather than left out. A camera's box whose part above the still level the image border cuts off entirely is the
+exception: its rays then meet only the lower hull of a ship whose upper part is out of the picture, and its exposed
+silhouette is empty. :func:`exposed_rays` is the one home of this rule; the cameras' ``occlusion``
+(:mod:`mmusv.annotate`) uses it too.
 
 * Cameras: the rays of the box's pixels; "stopped at the water" reads the captured instance image (the water
   instance there).
@@ -39,6 +44,7 @@ __all__ = [
     "BeamAngles",
     "exposed_hidden",
     "exposed_hidden_boxes",
+    "exposed_rays",
     "lidar_beam_rays",
     "lidar_box_beams",
     "lidar_box_rays",
@@ -56,6 +62,60 @@ def share(exposed: int, hidden: int) -> float:
     if hidden > exposed:
         raise InputError(f"hidden = {hidden}: must be <= exposed = {exposed} (the hidden rays are exposed rays)")
     return float(hidden / exposed) if exposed else 0.0
+
+
+def exposed_rays(
+    hit: npt.NDArray[np.bool_],
+    z: npt.NDArray[np.float64],
+    *,
+    box: npt.NDArray[np.int64] | None = None,
+    n_boxes: int = 1,
+    whole_when_low: npt.NDArray[np.bool_] | None = None,
+) -> npt.NDArray[np.bool_]:
+    """The rays of each target's exposed silhouette (module docstring), ``(N,)`` bool.
+
+    Args:
+        hit: ``(N,)`` bool, whether each ray meets its target (alone in the world).
+        z: ``(N,)`` float world height (metres, z up) where it meets it (any value where it does not).
+        box: ``(N,)`` integer, each ray's target in ``0..n_boxes - 1``; ``None``: all rays are one target's.
+        n_boxes: the number of targets ``B``, ``>= 1``.
+        whole_when_low: ``(B,)`` bool, whether a target that no ray meets above the still level (while some meet
+            it below) counts all the rays that meet it; ``None``: every target does.
+
+    Returns the rays meeting their target above the still level 0, and every ray meeting a target met only below
+    it where ``whole_when_low`` allows."""
+    hit = np.asarray(hit)
+    if hit.dtype != np.bool_ or hit.ndim != 1:
+        raise InputError(f"hit must be an (N,) bool array, got {arguments.shown(hit)}")
+    n = hit.size
+    z = _array(z, name="z", shape=(n,), what=f"(N,) world heights in metres, N = {n}")
+    n_boxes = arguments.whole(n_boxes, name="n_boxes", lo=1, error=InputError)
+    if box is None:
+        if n_boxes != 1:
+            raise InputError(f"box is needed for n_boxes = {n_boxes}: each ray's target in 0..{n_boxes - 1}")
+        box = np.zeros(n, dtype=np.int64)
+    box = _array(box, name="box", shape=(n,), what=f"(N,) targets in 0..{n_boxes - 1}, N = {n}", integer=True)
+    if box.size and (box.min() < 0 or box.max() >= n_boxes):
+        raise InputError(f"box must be (N,) targets in 0..{n_boxes - 1}: it holds {int(box.min())}..{box.max()}")
+    if whole_when_low is not None:
+        whole_when_low = np.asarray(whole_when_low)
+        if whole_when_low.shape != (n_boxes,) or whole_when_low.dtype != np.bool_:
+            raise InputError(
+                f"whole_when_low must be a ({n_boxes},) bool array, a flag per target; got "
+                f"{arguments.shown(whole_when_low)}"
+            )
+    return _exposed(hit, z, box.astype(np.int64, copy=False), n_boxes, whole_when_low)
+
+
+def _exposed(
+    hit: np.ndarray, z: np.ndarray, box: np.ndarray, n_boxes: int, whole_when_low: np.ndarray | None
+) -> npt.NDArray[np.bool_]:
+    """:func:`exposed_rays`, its arguments checked."""
+    exposed: npt.NDArray[np.bool_] = hit & (z > 0.0)
+    low = (np.bincount(box[exposed], minlength=n_boxes) == 0) & (np.bincount(box[hit], minlength=n_boxes) > 0)
+    if whole_when_low is not None:
+        low &= whole_when_low
+    return exposed | (hit & low[box]) if low.any() else exposed
 
 
 def _array(value: Any, *, name: str, shape: tuple[int | None, ...], what: str, integer: bool = False) -> np.ndarray:
@@ -144,6 +204,7 @@ def exposed_hidden_boxes(
     starts: npt.NDArray[np.int64],
     scene_instance: npt.NDArray[np.int32] | None = None,
     max_range_m: float = float("inf"),
+    whole_when_low: npt.NDArray[np.bool_] | None = None,
 ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
     """``(exposed, hidden)`` ray counts of ``B`` targets at once, each ``(B,)`` int64 with ``0 <= hidden <=
     exposed``: target ``b``'s rays are rows ``starts[b]:starts[b + 1]`` of the arrays, and its counts are those
@@ -153,8 +214,11 @@ def exposed_hidden_boxes(
         scene, origins, directions, vessel_t, scene_instance, max_range_m: as for :func:`exposed_hidden`, over all
             ``N`` rows (``vessel_t``: each row's distance to its own target alone).
         starts: ``(B + 1,)`` integer row offsets, non-decreasing, from 0 to ``N`` (:func:`lidar_boxes_beams`).
+        whole_when_low: ``(B,)`` bool, whether a target that no ray meets above the still level counts its whole
+            silhouette as exposed (:func:`exposed_rays`); ``None``: every target does. A camera passes ``False``
+            for a box whose part above the still level lies wholly outside the image.
     """
-    return _counts(scene, origins, directions, vessel_t, starts, scene_instance, max_range_m)
+    return _counts(scene, origins, directions, vessel_t, starts, scene_instance, max_range_m, whole_when_low)
 
 
 def _counts(
@@ -165,6 +229,7 @@ def _counts(
     starts: Any,
     scene_instance: Any,
     max_range_m: Any,
+    whole_when_low: Any = None,
 ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
     """:func:`exposed_hidden_boxes` (``starts`` ``None``: all rows are one target), its arguments checked here."""
     if not isinstance(scene, Scene):
@@ -210,6 +275,14 @@ def _counts(
         max_range_m, name="max_range_m", unit="metres", above=0.0, finite=False, error=InputError
     )
     n_boxes = starts.size - 1
+    if whole_when_low is not None:
+        given = np.asarray(whole_when_low)
+        if given.shape != (n_boxes,) or given.dtype != np.bool_:
+            raise InputError(
+                f"whole_when_low must be a ({n_boxes},) bool array, a flag per target; got "
+                f"{arguments.shown(whole_when_low)}"
+            )
+        whole_when_low = given
     box = np.repeat(np.arange(n_boxes), np.diff(starts))
     o = np.asarray(origins, dtype=np.float64)
     d = np.asarray(directions, dtype=np.float64)
@@ -218,12 +291,7 @@ def _counts(
     if np.isfinite(max_range_m):
         hit &= np.where(hit, t, 0.0) * np.linalg.norm(d, axis=1) <= max_range_m
     z = o[:, 2] + d[:, 2] * np.where(hit, t, 0.0)
-    exposed = hit & (z > 0.0)
-    # A target met only below the still level (a small craft wholly in a trough): its whole silhouette stands for
-    # the exposed one, so a craft a crest hides is counted hidden, not left out (the share of nothing, 0).
-    low = (np.bincount(box[exposed], minlength=n_boxes) == 0) & (np.bincount(box[hit], minlength=n_boxes) > 0)
-    if low.any():
-        exposed |= hit & low[box]
+    exposed = _exposed(hit, z, box, n_boxes, whole_when_low)
     counts = np.bincount(box[exposed], minlength=n_boxes).astype(np.int64)
     water = scene.sea_instance
     if not exposed.any() or water is None or scene.wave_top is None:

@@ -28,12 +28,13 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from mmusv.annotate import box_corners, pinhole_truncation
+from mmusv.annotate import box_corners
 from mmusv.classes import class_name
 from mmusv.export.common import cav_id, depth_png, dump_yaml, png_bytes
 from mmusv.export.geometry import AgentView, Target
 from mmusv.export.writer import DatasetWriter
 from mmusv.frames import BODY_TO_OPTICAL, invert, wrap_rad
+from mmusv.image_boxes import pinhole_truncation
 from mmusv.recording import topics
 from mmusv.recording.decode import WorldFrame
 from mmusv.recording.info import AgentInfo
@@ -206,7 +207,7 @@ def kitti_label(
     Without ``box2d`` (no recorded box in the front image) occluded is 3 ("unknown"), the box ``0 0 0 0`` and
     truncated ``unseen_truncation``: the share of the target "leaving image boundaries" — 1 (the tracking level 2)
     for a target behind or beside the camera or without one, the share of its projected box outside the image
-    (:func:`mmusv.annotate.pinhole_truncation`) for one in view that no pixel centre meets (:func:`label_lines`)."""
+    (:func:`mmusv.image_boxes.pinhole_truncation`) for one in view that no pixel centre meets (:func:`label_lines`)."""
     length, beam, height = (float(x) for x in target.size)
     box_cam = velo_to_cam @ target.box_in_lidar
     centre = box_cam[:3, 3]
