@@ -97,7 +97,7 @@ def main() -> None:
     labels = args.labels.split(",") if args.labels else ["W1", "W3", "W?"][: len(args.dirs)]
     if len(labels) != len(args.dirs) or len(args.dirs) < 2:
         ap.error("give two or more folders and as many labels")
-    tables = [pl.read_csv(d / "detection_table.csv") for d in args.dirs]
+    tables = [pl.read_csv((d / "detection_table.csv").read_bytes()) for d in args.dirs]
     print(markdown(tables, labels))
     if args.png is not None:
         plot(tables, labels, args.png, args.title)

@@ -19,6 +19,7 @@ import yaml
 from mcap.writer import Writer
 from mcap_rechunk import killed_copy
 from mmusv.cli import main
+from mmusv.errors import MmusvError
 from tiny_scenario import lidar_scenario
 
 
@@ -145,8 +146,9 @@ def test_info_of_a_batch_folder_lists_the_recordings_below(
     shutil.copytree(runs / "split" / "tiny4", killed_part, ignore=shutil.ignore_patterns("tables"))
     last = killed_part / "parts" / "000002-000003" / "tiny.mcap"
     last.rename(last.with_name("tiny.mcap.partial"))
-    main(["info", str(out_dir)])
+    code = main(["info", str(out_dir)])
     lines = capsys.readouterr().out.splitlines()
+    assert code == 1  # two recordings cannot be read at all (`mmusv info` on either alone is an error)
     assert "8 recordings below" in lines[0], lines
     rows = {ln.split("│")[1].strip(): [c.strip() for c in ln.split("│")[2:-1]] for ln in lines if ln.count("│") == 7}
     assert any(ln.replace("┃", " ").split() == ["recording", *HEAD] for ln in lines), lines
@@ -158,15 +160,62 @@ def test_info_of_a_batch_folder_lists_the_recordings_below(
     assert rows["broken/broken.mcap"][1:4] == ["unreadable", "?", "?"], rows
     assert rows["broken/broken.mcap"][4].startswith("broken/broken.mcap is not an MCAP file"), rows
     assert rows["killed/tiny.mcap.partial"][4].startswith("2 of 3 frames read; frames 2 missing"), rows
-    assert rows["a[/b]/tiny.mcap"][:4] == ["tiny", "complete", "3", "u"], rows  # (polars reads [ ] as a glob)
+    # polars read the tables of a folder a[/b] as a glob pattern, and the row called them damaged
+    assert rows["a[/b]/tiny.mcap"] == ["tiny", "complete", "3", "u", ""], rows
     assert rows["bad/bad.parts.json"][1] == "unreadable" and "not a parts manifest" in rows["bad/bad.parts.json"][4]
     assert rows["split2/tiny4/tiny.parts.json"][:2] == ["tiny", "complete"], rows
     assert not any(r.startswith("split2/tiny4/parts") for r in rows), rows
-    assert "6 recordings unfinished, damaged or unreadable" in " ".join(lines[-2:]), lines
+    assert "5 recordings unfinished, damaged or unreadable" in " ".join(lines[-2:]), lines
+    # the readable ones alone: exit 0, as `mmusv info` on a damaged or unfinished recording warns and exits 0
+    shutil.rmtree(out_dir / "broken")
+    shutil.rmtree(out_dir / "bad")
+    assert main(["info", str(out_dir)]) == 0
+    capsys.readouterr()
     # a folder with nothing below it is still refused
     (tmp_path / "empty").mkdir()
     code, _, err = _cli(["info", str(tmp_path / "empty")], capsys)
     assert code == 2 and "a folder without a recording" in err, err
+
+
+def test_info_of_a_batch_folder_follows_linked_run_folders(
+    runs: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A batch gathered from two disks, its run folders links: `mmusv info OUT` said "a folder without a
+    recording" (rglob does not follow links to folders). Each linked recording is listed once, and a link back up
+    the tree is no loop; the finders of the studies (`find_recordings`) see the same."""
+    from mmusv.recording.info import find_recordings
+
+    monkeypatch.setenv("COLUMNS", "250")
+    out_dir = tmp_path / "batch"
+    out_dir.mkdir()
+    shutil.copytree(runs / "tiny", tmp_path / "disk2" / "tiny")
+    (out_dir / "tiny").symlink_to(tmp_path / "disk2" / "tiny", target_is_directory=True)
+    (out_dir / "tiny_again").symlink_to(tmp_path / "disk2" / "tiny", target_is_directory=True)  # walked once
+    shutil.copytree(runs / "blind", out_dir / "blind")
+    (out_dir / "blind" / "up").symlink_to(out_dir, target_is_directory=True)  # a loop
+    shutil.copytree(runs / "blind", out_dir / "z_runs" / "run_2")  # named by its own path, not by a_latest
+    (out_dir / "a_latest").symlink_to(out_dir / "z_runs" / "run_2", target_is_directory=True)
+    code, out, err = _cli(["info", str(out_dir)], capsys)
+    assert code == 0 and "3 recordings below" in out, (out, err)
+    assert "tiny/tiny.mcap" in out and "tiny_again" not in out and "blind/blind.mcap" in out, out
+    assert "z_runs/run_2/blind.mcap" in out and "a_latest" not in out, out
+    assert find_recordings(out_dir) == [
+        out_dir / "blind" / "blind.mcap",
+        out_dir / "tiny" / "tiny.mcap",
+        out_dir / "z_runs" / "run_2" / "blind.mcap",
+    ]
+    # an unreadable parts manifest: the studies' finder refuses it, naming it; `info` lists it as a row
+    (out_dir / "bad.parts.json").write_text('{"parts": 3}')
+    with pytest.raises(MmusvError, match=r"bad\.parts\.json"):
+        find_recordings(out_dir)
+    assert out_dir / "bad.parts.json" in find_recordings(out_dir, unfinished=True)
+    (out_dir / "bad.parts.json").unlink()
+    # a broken link to a recording is listed (it was left out without a word): a row saying it cannot be read
+    (out_dir / "gone").mkdir()
+    (out_dir / "gone" / "gone.mcap").symlink_to(tmp_path / "nowhere.mcap")
+    assert out_dir / "gone" / "gone.mcap" in find_recordings(out_dir)
+    code, out, err = _cli(["info", str(out_dir)], capsys)
+    assert code == 1 and "4 recordings below" in out and "gone.mcap" in out and "unreadable" in out, (out, err)
 
 
 # ------------------------------------------------------------------------------------------------ recover

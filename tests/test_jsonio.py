@@ -55,3 +55,17 @@ def test_a_failed_write_keeps_the_old_file_and_leaves_no_temporary(tmp_path: Pat
     assert target.read_bytes() == b"old\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["manifest.json"]
     assert write_bytes_atomic(target, b"new\n") == target and target.read_bytes() == b"new\n"
+
+
+def test_a_name_with_brackets_is_no_glob_pattern(tmp_path: Path) -> None:
+    """A file ``a[1].json`` (a run named so): its name went into a glob pattern, where ``[1]`` matches "1", so its
+    own stale temporary was kept and ``a1.json``'s removed, its process id read at the wrong place."""
+    from mmusv.jsonio import remove_stale_temps
+
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    own = tmp_path / f".a[1].json.{int(dead.stdout)}.tmp"
+    other = tmp_path / f".a1.json.{int(dead.stdout)}.tmp"
+    own.write_bytes(b"")
+    other.write_bytes(b"")
+    remove_stale_temps(tmp_path / "a[1].json")
+    assert not own.exists() and other.exists()

@@ -118,7 +118,8 @@ def parser() -> argparse.ArgumentParser:
     info.add_argument(
         "recording",
         help="an .mcap (or .mcap.partial, .parts.json) written by mmusv run, or its folder; a folder of run folders "
-        "(a batch's output): one row per recording below",
+        "(a batch's output, links to run folders followed): one row per recording below; exits 1 when one of them "
+        "cannot be read at all",
     )
     rec = sub.add_parser(
         "recover",

@@ -22,7 +22,7 @@ def cmd_info(args: argparse.Namespace) -> int:
     from rich.text import Text
 
     from mmusv.recording import summary
-    from mmusv.recording.info import recording_name
+    from mmusv.recording.info import find_recordings, recording_name
 
     target = Path(path_arg(args.recording, flag="recording"))
     folder: Path | None = None
@@ -31,7 +31,7 @@ def cmd_info(args: argparse.Namespace) -> int:
         found = sorted(target.glob("*.parts.json")) or sorted(target.glob("*.mcap"))
         found = found or sorted(target.glob("*.mcap.partial"))
         if not found:
-            below = _recordings_in(target)
+            below = find_recordings(target, unfinished=True)
             if below:  # a batch's output folder: one line per recording
                 return _overview(target, below)
             raise MmusvError(f"{target} is a folder without a recording (*.mcap, *.mcap.partial or *.parts.json)")
@@ -121,28 +121,10 @@ def _agents_of(meta: dict[str, dict[str, str]]) -> str:
     return ",".join(map(str, sensors)) if isinstance(sensors, dict) and sensors else "?"
 
 
-def _recordings_in(folder: Path) -> list[Path]:
-    """The recordings in the folders below ``folder`` (a batch's output folder), sorted: every parts manifest (an
-    unreadable one too: its row says why), every ``.mcap`` and every ``.mcap.partial`` of a killed run beside no
-    ``.mcap``, but the parts a readable manifest names (its row covers them)."""
-    from mmusv.recording.parts import read_parts_manifest
-
-    manifests = sorted(folder.rglob("*.parts.json"))
-    parts: set[Path] = set()
-    for m in manifests:
-        try:
-            for part in read_parts_manifest(m).parts:
-                rec = (m.parent / part.recording).resolve()
-                parts |= {rec, rec.with_name(rec.name + ".partial")}
-        except MmusvError:
-            continue  # listed, and its row says what is wrong with it
-    mcaps = [p for p in folder.rglob("*.mcap") if p.resolve() not in parts]
-    partial = [p for p in folder.rglob("*.mcap.partial") if not p.with_suffix("").exists() and p.resolve() not in parts]
-    return sorted([*manifests, *mcaps, *partial])
-
-
 def _overview(folder: Path, found: list[Path]) -> int:
-    """``mmusv info`` on a folder of recordings: one row each (scenario, status, frames, agents, problems)."""
+    """``mmusv info`` on a folder of recordings: one row each (scenario, status, frames, agents, problems). Exits 1
+    when a recording cannot be read at all (``mmusv info`` on it alone is an error too); a damaged or unfinished one
+    that reads is a row with its problems, as ``mmusv info`` on it alone warns and exits 0."""
     from rich.table import Table
     from rich.text import Text
 
@@ -155,13 +137,14 @@ def _overview(folder: Path, found: list[Path]) -> int:
     table = Table(title=Text(f"{counted(len(found), 'recording')} below {folder}"))
     for col in ("recording", "scenario", "status", "frames", "agents", "problems"):
         table.add_column(col, overflow="fold")
-    troubled = 0
+    troubled = unreadable = 0
     for rec in found:
         name = str(rec.relative_to(folder))
         try:
             info = summary(rec)
         except MmusvError as exc:
             troubled += 1
+            unreadable += 1
             table.add_row(*map(Text, (name, "?", "unreadable", "?", "?", short(name, [str(exc)]))))
             continue
         meta = info.get("metadata", {})
@@ -193,7 +176,7 @@ def _overview(folder: Path, found: list[Path]) -> int:
             markup=False,
             highlight=False,
         )
-    return 0
+    return 1 if unreadable else 0
 
 
 def _table_problems(recording: Path, frames: dict[str, object]) -> list[str]:

@@ -11,6 +11,7 @@ names the file in every error (:class:`~mmusv.errors.IoError`).
 from __future__ import annotations
 
 import contextlib
+import glob
 import json
 import os
 from collections.abc import Mapping
@@ -41,7 +42,7 @@ def _alive(pid: int) -> bool:
 def remove_stale_temps(path: Path) -> None:
     """Removes the temporary files of earlier writes of ``path`` (``.NAME.PID.tmp`` beside it) whose writer no
     longer runs: what a writer killed between writing and renaming leaves behind."""
-    for tmp in path.parent.glob(f".{path.name}.*.tmp"):
+    for tmp in path.parent.glob(f".{glob.escape(path.name)}.*.tmp"):  # a name a[1].json is no pattern
         pid = tmp.name[len(path.name) + 2 : -len(".tmp")]
         if pid.isdigit() and int(pid) != os.getpid() and not _alive(int(pid)):
             tmp.unlink(missing_ok=True)

@@ -456,6 +456,19 @@ def test_overwrite_keeps_the_previous_conversion_until_the_new_one_is_complete(
     assert sorted(p.name for p in tmp_path.iterdir()) == ["ds"]
 
 
+def test_a_killed_conversions_staging_folder_beside_a_name_with_brackets(tmp_path: Path) -> None:
+    """An output folder ``a[1]``: its name went into a glob pattern (``[1]`` matches "1"), so a killed conversion's
+    staging folder beside it stayed for ever, and ``a1``'s was taken for its."""
+    from mmusv.export.convert_output import _remove_stale_stages
+
+    own = tmp_path / ".a[1].converting-999999999"
+    other = tmp_path / ".a1.converting-999999999"
+    own.mkdir()
+    other.mkdir()
+    _remove_stale_stages(tmp_path / "a[1]")
+    assert not own.exists() and other.exists()
+
+
 def test_a_conversion_stopping_halfway_in_a_new_folder_says_so_in_its_report(
     lonely_rec: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -566,6 +566,13 @@ def test_predictions_without_a_setting_are_refused(
         tmp_path / "rob3",
     )
     assert (rob / "robustness_table.csv").read_bytes() == (again / "robustness_table.csv").read_bytes()
+    # a predictions file whose path holds [ ] (a run's name): polars read it as a glob ("not a readable Parquet
+    # file (ComputeError)")
+    odd = tmp_path / "runs[1]" / "boxes[a].parquet"
+    odd.parent.mkdir()
+    shutil.copyfile(rob / "robustness_boxes.parquet", odd)
+    rob4 = study(["study", "robustness", str(rec), "--settings", "delay:1", "--predictions", str(odd)], tmp_path / "r4")
+    assert (rob4 / "robustness_table.csv").read_bytes() == (rob / "robustness_table.csv").read_bytes()
 
 
 @pytest.mark.parametrize(
@@ -637,3 +644,14 @@ def test_a_recording_without_lidar_says_so(tmp_path: Path, capsys: pytest.Captur
     for modes in ("none,late,early", "none"):
         err = refused(["study", "detection", str(rec), "--modes", modes], tmp_path / "o", capsys)
         assert "sequence nolidar" in err and "no LiDAR" in err and "--modes none" not in err, err
+
+
+def test_one_recording_given_twice_is_named(rec: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A recording given twice (here through a batch folder's link to its run folder and by its own folder) was
+    refused as "the same recording is given twice", naming neither: the two paths and the file are named."""
+    batch = tmp_path / "batch"
+    batch.mkdir()
+    (batch / "run").symlink_to(rec.parent, target_is_directory=True)
+    err = refused(["study", "detection", str(batch), str(rec.parent)], tmp_path / "o", capsys)
+    assert "the same recording is given twice" in err and str(batch / "run" / rec.name) in err, err
+    assert str(rec.resolve()) in err, err

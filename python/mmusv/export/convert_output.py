@@ -6,6 +6,7 @@ became of a conversion that stopped halfway in a folder of its own."""
 from __future__ import annotations
 
 import contextlib
+import glob
 import os
 import shutil
 from collections.abc import Iterator
@@ -81,7 +82,7 @@ def _remove_stale_stages(out: Path) -> None:
     """Removes the staging and replaced folders beside ``out`` left by conversions that were killed (their process
     no longer runs): ``.<name>.converting-<pid>`` and ``.<name>.replaced-<pid>``."""
     for kind in ("converting", "replaced"):
-        for left in out.parent.glob(f".{out.name}.{kind}-*"):
+        for left in out.parent.glob(f".{glob.escape(out.name)}.{kind}-*"):  # a folder a[1] is no pattern
             pid = left.name.rpartition("-")[2]
             if not pid.isdigit() or not left.is_dir() or left.is_symlink():
                 continue

@@ -71,7 +71,8 @@ def assign_splits(keys: Sequence[str], *, ratios: Sequence[float], seed: int) ->
     """Split name of every key (unique strings, e.g. recording paths): deterministic in (set of keys, ratios,
     seed), independent of the order of ``keys``."""
     if len(set(keys)) != len(keys):
-        raise ConfigError("the same recording is given twice")
+        twice = next(k for i, k in enumerate(keys) if k in keys[:i])
+        raise ConfigError(f"the same recording is given twice: {twice}")
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         # random.Random takes |seed|: -1 would split as 1 does
         raise ConfigError(f"seed = {seed!r}: the split's seed must be a whole number >= 0")

@@ -180,19 +180,63 @@ def recording_name(path: str | os.PathLike[str]) -> str:
     return Path(path).stem
 
 
-def find_recordings(folder: str | os.PathLike[str]) -> list[Path]:
+def find_recordings(folder: str | os.PathLike[str], *, unfinished: bool = False) -> list[Path]:
     """The recordings below ``folder``, sorted: every parts manifest and every ``.mcap`` that is not one of a
-    manifest's parts. ``folder`` must be an existing folder (:class:`~mmusv.errors.IoError` otherwise)."""
+    manifest's parts. Folders reached through a link are searched too (a batch's run folders may be links), each
+    once. ``folder`` must be an existing folder (:class:`~mmusv.errors.IoError` otherwise).
+
+    ``unfinished=True`` (``mmusv info`` on a batch's folder, which reports what is wrong with each) also lists
+    every ``.mcap.partial`` of a killed run beside no ``.mcap``, and keeps an unreadable parts manifest (without
+    it, that is an :class:`~mmusv.errors.IoError`); a readable manifest's parts stay out, ``.partial`` or not."""
     root = arguments.path(folder, name="folder")
     if not root.is_dir():
         what = "does not exist" if not root.exists() else "is not a folder"
         raise IoError(f"folder = {root} {what}: give a folder holding recordings (.mcap or .parts.json)")
-    manifests = sorted(root.rglob("*.parts.json"))
-    parts = set()
+    files = _files_below(root)
+    manifests = sorted(f for f in files if f.name.endswith(".parts.json"))
+    parts: set[Path] = set()
     for m in manifests:
-        parts |= {(m.parent / p.recording).resolve() for p in read_parts_manifest(m).parts}
-    mcaps = [p for p in sorted(root.rglob("*.mcap")) if p.resolve() not in parts]
-    return sorted([*manifests, *mcaps])
+        try:
+            named = read_parts_manifest(m).parts
+        except IoError:
+            if not unfinished:
+                raise
+            continue  # listed: what reads it says what is wrong with it
+        for part in named:
+            rec = (m.parent / part.recording).resolve()
+            parts |= {rec, rec.with_name(rec.name + ".partial")}
+    mcaps = [f for f in files if f.suffix == ".mcap" and f.resolve() not in parts]
+    partial = (
+        [f for f in files if f.name.endswith(".mcap.partial") and not f.with_suffix("").exists()] if unfinished else []
+    )
+    return sorted([*manifests, *mcaps, *(f for f in partial if f.resolve() not in parts)])
+
+
+def _files_below(root: Path) -> list[Path]:
+    """Every entry below ``root`` that is not a folder (a file, or a broken link, listed so that what reads it says
+    what is wrong), through links to folders too: the real folders first, so that a recording is named by its own
+    path where it has one below ``root``, then each folder reached only through a link; each real folder once (a
+    link back up the tree is no loop)."""
+    out: list[Path] = []
+    seen: set[Path] = set()
+    links: list[Path] = []
+
+    def walk(top: Path, follow: bool) -> None:
+        for here, dirs, names in os.walk(top, followlinks=follow):
+            real = Path(here).resolve()
+            if real in seen:
+                dirs[:] = []
+                continue
+            seen.add(real)
+            dirs.sort()
+            if not follow:  # os.walk lists a link to a folder among the folders, and does not enter it
+                links.extend(Path(here) / d for d in dirs if (Path(here) / d).is_symlink())
+            out.extend(Path(here) / n for n in sorted(names))
+
+    walk(root, False)
+    for link in links:
+        walk(link, True)
+    return out
 
 
 def _read_parts_info(p: Path) -> RecordingInfo:

@@ -309,7 +309,7 @@ def read_table(root: str | os.PathLike[str], table: str, *, expected: range | Se
     damaged: list[str] = []
     for part in sorted((root / table).glob("part-*.parquet")):
         try:
-            df = pl.read_parquet(part)
+            df = pl.read_parquet(part, glob=False)  # a folder a[1] is a name, not a pattern
         except Exception as exc:  # polars raises several kinds for a damaged file; any means unreadable
             first = str(exc).strip().splitlines()[0][:120] if str(exc).strip() else ""
             damaged.append(

@@ -129,7 +129,14 @@ def _sequence_names(recs: Sequence[Path]) -> dict[str, Path]:
 
     uniq = sorted({r.resolve() for r in recs})
     if len(uniq) != len(recs):
-        raise InputError("the same recording is given twice")
+        by: dict[Path, list[Path]] = {}
+        for r in recs:
+            by.setdefault(r.resolve(), []).append(r)
+        twice = next(paths for paths in by.values() if len(paths) > 1)
+        raise InputError(
+            f"the same recording is given twice: {twice[0]} and {twice[1]}"
+            + (f" (both {twice[0].resolve()})" if twice[0] != twice[1] else "")
+        )
     stems = [recording_name(r) for r in uniq]
     if len(set(stems)) == len(stems):
         return dict(zip(stems, uniq, strict=True))

@@ -217,7 +217,7 @@ def load_predictions(path: str | Path) -> dict[tuple[str, int, str, str, str], t
     if not p.is_file():
         raise InputError(f"--predictions {p}: no such file")
     try:
-        df = pl.read_parquet(p)
+        df = pl.read_parquet(p, glob=False)  # a file a[1].parquet is a name, not a pattern
     except (OSError, pl.exceptions.PolarsError) as exc:
         raise InputError(f"--predictions {p}: not a readable Parquet file ({type(exc).__name__})") from None
     need = ["sequence", "frame", "ego", "mode", *BOX_COLUMNS, "score"]
