@@ -97,14 +97,21 @@ def exposed_rays(
     box = _array(box, name="box", shape=(n,), what=f"(N,) targets in 0..{n_boxes - 1}, N = {n}", integer=True)
     if box.size and (box.min() < 0 or box.max() >= n_boxes):
         raise InputError(f"box must be (N,) targets in 0..{n_boxes - 1}: it holds {int(box.min())}..{box.max()}")
-    if whole_when_low is not None:
-        whole_when_low = np.asarray(whole_when_low)
-        if whole_when_low.shape != (n_boxes,) or whole_when_low.dtype != np.bool_:
-            raise InputError(
-                f"whole_when_low must be a ({n_boxes},) bool array, a flag per target; got "
-                f"{arguments.shown(whole_when_low)}"
-            )
+    whole_when_low = _flags(whole_when_low, n_boxes)
     return _exposed(hit, z, box.astype(np.int64, copy=False), n_boxes, whole_when_low)
+
+
+def _flags(whole_when_low: Any, n_boxes: int) -> np.ndarray | None:
+    """``whole_when_low`` as a ``(n_boxes,)`` bool array (``None`` stays ``None``), else an :class:`InputError`."""
+    if whole_when_low is None:
+        return None
+    given = np.asarray(whole_when_low)
+    if given.shape != (n_boxes,) or given.dtype != np.bool_:
+        raise InputError(
+            f"whole_when_low must be a ({n_boxes},) bool array, a flag per target; got "
+            f"{arguments.shown(whole_when_low)}"
+        )
+    return given
 
 
 def _exposed(
@@ -275,14 +282,7 @@ def _counts(
         max_range_m, name="max_range_m", unit="metres", above=0.0, finite=False, error=InputError
     )
     n_boxes = starts.size - 1
-    if whole_when_low is not None:
-        given = np.asarray(whole_when_low)
-        if given.shape != (n_boxes,) or given.dtype != np.bool_:
-            raise InputError(
-                f"whole_when_low must be a ({n_boxes},) bool array, a flag per target; got "
-                f"{arguments.shown(whole_when_low)}"
-            )
-        whole_when_low = given
+    whole_when_low = _flags(whole_when_low, n_boxes)
     box = np.repeat(np.arange(n_boxes), np.diff(starts))
     o = np.asarray(origins, dtype=np.float64)
     d = np.asarray(directions, dtype=np.float64)
