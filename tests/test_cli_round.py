@@ -218,6 +218,36 @@ def test_info_of_a_batch_folder_follows_linked_run_folders(
     assert code == 1 and "4 recordings below" in out and "gone.mcap" in out and "unreadable" in out, (out, err)
 
 
+def test_a_folder_below_that_cannot_be_read_is_named(
+    runs: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A run folder of a batch that cannot be read (its permissions; simulated, since the tests may run as root):
+    the search skipped it without a word, so a study left its recordings out and `mmusv info` showed the others
+    as if that were all. The studies' finder refuses, naming the folder; `info` gives it a row and exits 1."""
+    import os
+
+    from mmusv.recording.info import find_recordings
+
+    monkeypatch.setenv("COLUMNS", "250")
+    out_dir = tmp_path / "batch"
+    shutil.copytree(runs / "tiny", out_dir / "tiny")
+    shutil.copytree(runs / "blind", out_dir / "locked")
+    scandir = os.scandir
+
+    def guarded(path: Any = ".") -> Any:
+        if Path(path).name == "locked":
+            raise PermissionError(13, "Permission denied", str(path))
+        return scandir(path)
+
+    monkeypatch.setattr(os, "scandir", guarded)
+    monkeypatch.setattr(os, "listdir", lambda p=".": [e.name for e in guarded(p)])
+    with pytest.raises(MmusvError, match=r"cannot read the folder .*locked below it \(Permission denied\)"):
+        find_recordings(out_dir)
+    assert find_recordings(out_dir, unfinished=True) == [out_dir / "locked", out_dir / "tiny" / "tiny.mcap"]
+    code, out, err = _cli(["info", str(out_dir)], capsys)
+    assert code == 1 and "2 recordings below" in out and "cannot read the folder: Permission denied" in out, (out, err)
+
+
 # ------------------------------------------------------------------------------------------------ recover
 
 

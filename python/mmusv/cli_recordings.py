@@ -140,6 +140,16 @@ def _overview(folder: Path, found: list[Path]) -> int:
     troubled = unreadable = 0
     for rec in found:
         name = str(rec.relative_to(folder))
+        if rec.is_dir():  # a folder below that could not be searched (find_recordings lists it)
+            troubled += 1
+            unreadable += 1
+            try:
+                os.listdir(rec)
+                why = "the folder could not be searched"
+            except OSError as exc:
+                why = f"cannot read the folder: {exc.strerror or type(exc).__name__}"
+            table.add_row(*map(Text, (name, "?", "unreadable", "?", "?", why)))
+            continue
         try:
             info = summary(rec)
         except MmusvError as exc:

@@ -186,13 +186,19 @@ def find_recordings(folder: str | os.PathLike[str], *, unfinished: bool = False)
     once. ``folder`` must be an existing folder (:class:`~mmusv.errors.IoError` otherwise).
 
     ``unfinished=True`` (``mmusv info`` on a batch's folder, which reports what is wrong with each) also lists
-    every ``.mcap.partial`` of a killed run beside no ``.mcap``, and keeps an unreadable parts manifest (without
-    it, that is an :class:`~mmusv.errors.IoError`); a readable manifest's parts stay out, ``.partial`` or not."""
+    every ``.mcap.partial`` of a killed run beside no ``.mcap``, keeps an unreadable parts manifest and lists a
+    folder below that cannot be read (without it, each is an :class:`~mmusv.errors.IoError`: its recordings would
+    be left out without a word); a readable manifest's parts stay out, ``.partial`` or not."""
     root = arguments.path(folder, name="folder")
     if not root.is_dir():
         what = "does not exist" if not root.exists() else "is not a folder"
         raise IoError(f"folder = {root} {what}: give a folder holding recordings (.mcap or .parts.json)")
-    files = _files_below(root)
+    files, closed = _files_below(root)
+    if closed and not unfinished:
+        where, why = closed[0]
+        raise IoError(
+            f"{root}: cannot read the folder {where} below it ({why}): the recordings in it would be left out"
+        )
     manifests = sorted(f for f in files if f.name.endswith(".parts.json"))
     parts: set[Path] = set()
     for m in manifests:
@@ -209,20 +215,24 @@ def find_recordings(folder: str | os.PathLike[str], *, unfinished: bool = False)
     partial = (
         [f for f in files if f.name.endswith(".mcap.partial") and not f.with_suffix("").exists()] if unfinished else []
     )
-    return sorted([*manifests, *mcaps, *(f for f in partial if f.resolve() not in parts)])
+    return sorted([*manifests, *mcaps, *(f for f in partial if f.resolve() not in parts), *(c for c, _ in closed)])
 
 
-def _files_below(root: Path) -> list[Path]:
+def _files_below(root: Path) -> tuple[list[Path], list[tuple[Path, str]]]:
     """Every entry below ``root`` that is not a folder (a file, or a broken link, listed so that what reads it says
     what is wrong), through links to folders too: the real folders first, so that a recording is named by its own
     path where it has one below ``root``, then each folder reached only through a link; each real folder once (a
-    link back up the tree is no loop)."""
+    link back up the tree is no loop). Beside them, the folders that could not be read, each with the reason."""
     out: list[Path] = []
     seen: set[Path] = set()
     links: list[Path] = []
+    closed: list[tuple[Path, str]] = []
+
+    def unreadable(exc: OSError) -> None:
+        closed.append((Path(str(exc.filename)), exc.strerror or type(exc).__name__))
 
     def walk(top: Path, follow: bool) -> None:
-        for here, dirs, names in os.walk(top, followlinks=follow):
+        for here, dirs, names in os.walk(top, onerror=unreadable, followlinks=follow):
             real = Path(here).resolve()
             if real in seen:
                 dirs[:] = []
@@ -236,7 +246,7 @@ def _files_below(root: Path) -> list[Path]:
     walk(root, False)
     for link in links:
         walk(link, True)
-    return out
+    return out, closed
 
 
 def _read_parts_info(p: Path) -> RecordingInfo:
