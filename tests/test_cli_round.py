@@ -235,17 +235,38 @@ def test_a_folder_below_that_cannot_be_read_is_named(
     scandir = os.scandir
 
     def guarded(path: Any = ".") -> Any:
-        if Path(path).name == "locked":
+        if Path(path).resolve().name == "locked":  # (through a link too, as the real refusal is)
             raise PermissionError(13, "Permission denied", str(path))
         return scandir(path)
 
     monkeypatch.setattr(os, "scandir", guarded)
     monkeypatch.setattr(os, "listdir", lambda p=".": [e.name for e in guarded(p)])
-    with pytest.raises(MmusvError, match=r"cannot read the folder .*locked below it \(Permission denied\)"):
+    (out_dir / "via").symlink_to(out_dir / "locked", target_is_directory=True)  # the same folder: one row
+    with pytest.raises(MmusvError, match=r"cannot read the folder .*locked below it \(Permission denied\):"):
         find_recordings(out_dir)
     assert find_recordings(out_dir, unfinished=True) == [out_dir / "locked", out_dir / "tiny" / "tiny.mcap"]
     code, out, err = _cli(["info", str(out_dir)], capsys)
-    assert code == 1 and "2 recordings below" in out and "cannot read the folder: Permission denied" in out, (out, err)
+    out = " ".join(out.split())  # (the title wraps)
+    assert code == 1 and "1 recording below" in out and "1 folder that cannot be read" in out, (out, err)
+    assert "cannot read the folder: Permission denied" in out and "via" not in out, out
+    assert "1 folder below cannot be read: the recordings in it are not listed" in out, out
+    # the folder given cannot be read itself: said so (it was "a folder below it" of itself, and a row ".")
+    with pytest.raises(MmusvError, match=r"folder = .*locked cannot be read \(Permission denied\)$"):
+        find_recordings(out_dir / "locked", unfinished=True)
+    (out_dir / "via").unlink()
+    # a folder gone between its listing and its reading (a batch still writing renames its folders): nothing in it
+    # to leave out, so nothing refused
+    monkeypatch.setattr(os, "scandir", scandir)
+    shutil.copytree(runs / "blind", out_dir / "moving")
+    shutil.rmtree(out_dir / "locked")
+
+    def vanishing(path: Any = ".") -> Any:
+        if Path(path).name == "moving":
+            raise FileNotFoundError(2, "No such file or directory", str(path))
+        return scandir(path)
+
+    monkeypatch.setattr(os, "scandir", vanishing)
+    assert find_recordings(out_dir) == [out_dir / "tiny" / "tiny.mcap"]
 
 
 # ------------------------------------------------------------------------------------------------ recover

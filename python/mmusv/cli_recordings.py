@@ -134,18 +134,19 @@ def _overview(folder: Path, found: list[Path]) -> int:
         text = "; ".join(problems).replace(f"{folder}{os.sep}", "").removeprefix(f"{name}: ")
         return text if len(text) <= 100 else text[:99] + "…"
 
-    table = Table(title=Text(f"{counted(len(found), 'recording')} below {folder}"))
+    closed = [rec for rec in found if rec.is_dir()]  # folders below that could not be searched (find_recordings)
+    title = f"{counted(len(found) - len(closed), 'recording')} below {folder}"
+    table = Table(title=Text(title + (f", {counted(len(closed), 'folder')} that cannot be read" if closed else "")))
     for col in ("recording", "scenario", "status", "frames", "agents", "problems"):
         table.add_column(col, overflow="fold")
     troubled = unreadable = 0
     for rec in found:
         name = str(rec.relative_to(folder))
-        if rec.is_dir():  # a folder below that could not be searched (find_recordings lists it)
-            troubled += 1
+        if rec in closed:
             unreadable += 1
             try:
                 os.listdir(rec)
-                why = "the folder could not be searched"
+                why = "the folder could not be read when it was searched (it can now: run again)"
             except OSError as exc:
                 why = f"cannot read the folder: {exc.strerror or type(exc).__name__}"
             table.add_row(*map(Text, (name, "?", "unreadable", "?", "?", why)))
@@ -183,6 +184,12 @@ def _overview(folder: Path, found: list[Path]) -> int:
     if troubled:
         console.print(
             f"{counted(troubled, 'recording')} unfinished, damaged or unreadable: `mmusv info` on one says more",
+            markup=False,
+            highlight=False,
+        )
+    if closed:
+        console.print(
+            f"{counted(len(closed), 'folder')} below cannot be read: the recordings in it are not listed",
             markup=False,
             highlight=False,
         )

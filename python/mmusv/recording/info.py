@@ -193,11 +193,16 @@ def find_recordings(folder: str | os.PathLike[str], *, unfinished: bool = False)
     if not root.is_dir():
         what = "does not exist" if not root.exists() else "is not a folder"
         raise IoError(f"folder = {root} {what}: give a folder holding recordings (.mcap or .parts.json)")
+    try:
+        os.scandir(root).close()
+    except OSError as exc:
+        raise IoError(f"folder = {root} cannot be read ({exc.strerror or type(exc).__name__})") from None
     files, closed = _files_below(root)
     if closed and not unfinished:
         where, why = closed[0]
+        more = f" (and {len(closed) - 1} more)" if len(closed) > 1 else ""
         raise IoError(
-            f"{root}: cannot read the folder {where} below it ({why}): the recordings in it would be left out"
+            f"{root}: cannot read the folder {where} below it ({why}){more}: the recordings in it would be left out"
         )
     manifests = sorted(f for f in files if f.name.endswith(".parts.json"))
     parts: set[Path] = set()
@@ -227,11 +232,17 @@ def _files_below(root: Path) -> tuple[list[Path], list[tuple[Path, str]]]:
     seen: set[Path] = set()
     links: list[Path] = []
     closed: list[tuple[Path, str]] = []
-
-    def unreadable(exc: OSError) -> None:
-        closed.append((Path(str(exc.filename)), exc.strerror or type(exc).__name__))
+    closed_real: set[Path] = set()
 
     def walk(top: Path, follow: bool) -> None:
+        def unreadable(exc: OSError) -> None:
+            if isinstance(exc, FileNotFoundError) or exc.filename is None:
+                return  # gone since it was listed (a batch still writing removes its staging folders)
+            where = Path(os.fsdecode(exc.filename))
+            if where.resolve() not in closed_real:  # (also reached through a link: one row)
+                closed_real.add(where.resolve())
+                closed.append((where, exc.strerror or type(exc).__name__))
+
         for here, dirs, names in os.walk(top, onerror=unreadable, followlinks=follow):
             real = Path(here).resolve()
             if real in seen:
