@@ -1,7 +1,9 @@
 """Where the sequences of a detection study come from: recordings given on the command line (files, folders
 holding a batch run's ``dataset.json`` (its complete recordings), the ``recordings`` folder of a ``mmusv dataset``
 folder (the complete recordings its ``dataset.json`` lists), or other folders searched for ``*.mcap`` and parts
-manifests of split recordings), an OPV2V folder, or the bundled detection spec generated and recorded LiDAR-only.
+manifests of split recordings, through links to folders too, a folder that cannot be read refused by name:
+:func:`~mmusv.recording.info.find_recordings`), an OPV2V folder, or the bundled detection spec generated and
+recorded LiDAR-only.
 
 Sequences are split by sequence before any agent-as-ego expansion: recordings and OPV2V scenario folders without
 split folders by :func:`~mmusv.studies.detection.data.split_sequences`; an OPV2V tree that already has
