@@ -297,6 +297,13 @@ def _lidar_wave_shares(
     return [share(e, h) for e, h in zip(n_exposed, n_hidden, strict=True)]
 
 
+def _world_to_optical(points: np.ndarray, world_to_body: np.ndarray) -> np.ndarray:
+    """World points ``(n, 3)`` in a camera's optical frame (x right, y down, z forward; metres), through its
+    ``(4, 4)`` world → camera-body transform."""
+    out: np.ndarray = (points @ world_to_body[:3, :3].T + world_to_body[:3, 3]) @ BODY_TO_OPTICAL.T
+    return out
+
+
 def annotate_agent(
     *,
     agent_id: str,
@@ -373,8 +380,8 @@ def annotate_agent(
             ann.lidar_wave_occlusion.append(0.0)
         for name, (cam, k, inv, pose, inst_img, lens) in views.items():
             h, w = inst_img.shape
-            body = corners_world @ inv[:3, :3].T + inv[:3, 3]
-            box = project_box(body @ BODY_TO_OPTICAL.T, intrinsics=k, lens=lens)
+            corners_opt = _world_to_optical(corners_world, inv)
+            box = project_box(corners_opt, intrinsics=k, lens=lens)
             if box is None:
                 continue
             clipped, area, carea = clip_box(box, width=w, height=h)
@@ -382,7 +389,7 @@ def annotate_agent(
                 continue
             cut = box[0] < 0.0 or box[1] < 0.0 or box[2] > w or box[3] > h
             if cut:  # its part inside the image
-                inside = in_image_box(body @ BODY_TO_OPTICAL.T, intrinsics=k, lens=lens, width=w, height=h)
+                inside = in_image_box(corners_opt, intrinsics=k, lens=lens, width=w, height=h)
                 if inside is None:
                     continue
                 clipped = inside
@@ -407,7 +414,7 @@ def annotate_agent(
             # is out of the picture (no exposed silhouette in this image).
             whole_when_low = True
             if cut and sil and not (alone & (z > 0.0)).any():
-                above_opt = [(f @ inv[:3, :3].T + inv[:3, 3]) @ BODY_TO_OPTICAL.T for f in faces_above(corners_world)]
+                above_opt = [_world_to_optical(f, inv) for f in faces_above(corners_world)]
                 if above_opt:  # (none: the whole box lies below the still level)
                     seen_above = faces_in_image_box(above_opt, intrinsics=k, lens=lens, width=w, height=h)
                     whole_when_low = seen_above is not None
