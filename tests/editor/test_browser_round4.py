@@ -113,6 +113,26 @@ def test_a_scenario_opened_after_another_is_shown_whole(browser: Any, live_serve
     assert js_errors(browser) == []
 
 
+def test_a_map_slower_than_the_check_does_not_hide_its_verdict(browser: Any, live_server: LiveServer) -> None:
+    """A scenario on another map: when the map came after the check, its "island map, seed ..." replaced the
+    check's "N vessels · ... error(s)" in the status line, for good (CI saw it as a flaky wait). The map is held
+    back here until the check has ended: the status says both."""
+    open_editor(browser, live_server)
+    js_errors(browser)
+    browser.execute_script(
+        """const real = window.fetch;
+        window.fetch = async (url, opts) => {
+          if (String(url).endsWith('/api/map')) await new Promise((r) => setTimeout(r, 1500));
+          return real(url, opts);
+        };"""
+    )
+    Select(browser.find_element(By.ID, "open")).select_by_value("bundled:island_port_waves")
+    _wait(browser, "return document.getElementById('status').textContent.includes('m square')", "the map")
+    text = browser.find_element(By.ID, "status").text
+    assert "vessels" in text and "frames" in text and "map, seed" in text, text
+    assert js_errors(browser) == []
+
+
 def test_the_status_is_read_whole_and_says_what_happened_last(browser: Any, live_server: LiveServer) -> None:
     """At 1280 x 800 a refused save said "not saved: file name ..." (the rest, what to do, cut off); a save that
     asked to overwrite a file left the earlier attempt's "give the file a name" error beside its question."""

@@ -83,7 +83,10 @@ async function ensureMap() {
     if (first || fitOnMap) map.fitScenario();
     fitOnMap = false;
     map.renderScreen();
-    status(`${layers.kind.replace("_", " ")} map, seed ${layers.seed}, ${layers.extent} m square`);
+    const shown = `${layers.kind.replace("_", " ")} map, seed ${layers.seed}, ${layers.extent} m square`;
+    // a map slower than the check must not hide the check's verdict: both are said
+    if (!state.pending() && (state.evaluation || state.evalError)) showCheck(`${shown} · `);
+    else status(shown);
   } catch (err) {
     if (state.mapKey === key && fitOnMap) {
       fitOnMap = false;
@@ -405,19 +408,23 @@ state.on("doc", () => {
 });
 state.on("evaluated", () => {
   renderAll();
+  showCheck();
+});
+/** Says the last check's verdict in the status line, after `prefix` (the map just shown, say). */
+function showCheck(prefix = "") {
   const ev = state.evaluation;
-  if (!ev) status(`cannot check: ${state.evalError}`, true);
+  if (!ev) status(`${prefix}cannot check: ${state.evalError}`, true);
   else if (!ev.valid) {
     // read out with the first error, its field and what it allows (seen next to the field and under Checks)
     const first = ev.errors[0] ? `First: ${ev.errors[0].message}.` : "";
     const more = ev.errors.length > 1 ? ` ${ev.errors.length - 1} more under Checks.` : "";
-    status(`${ev.errors.length} error(s): the scenario does not validate`, true, `${first}${more}`);
+    status(`${prefix}${ev.errors.length} error(s): the scenario does not validate`, true, `${first}${more}`);
   }
   else {
     const errors = ev.problems.filter((p) => p.severity === "error").length;
-    status(`${ev.vessels.length} vessels · ${ev.frames} frames · ${errors} error(s), ${ev.problems.length - errors} warning(s)`, errors > 0);
+    status(`${prefix}${ev.vessels.length} vessels · ${ev.frames} frames · ${errors} error(s), ${ev.problems.length - errors} warning(s)`, errors > 0);
   }
-});
+}
 /** Scrolls the left panel so that the Selected vessel panel is seen (a vessel picked on the map or in a list may
  * have it below the panel's fold). Scrolling moves no focus: a selection from the map keeps the keyboard there. The
  * panel is left where it is when it is seen whole already or the keyboard is in it (its id renamed, say). */
