@@ -117,11 +117,16 @@ from mmusv.acquire import run
 def progress(done, total):
     if done == int(sys.argv[3]):
         os.kill(os.getpid(), signal.SIGKILL)
-run(sys.argv[1], out_dir=sys.argv[2], frame_range=(40, 300), progress=progress)
+span = None if sys.argv[4] == "whole" else (int(sys.argv[4]), 300)
+run(sys.argv[1], out_dir=sys.argv[2], frame_range=span, frames=300 if span is None else None, progress=progress)
 """
 
 
-def test_a_recovered_frame_range_says_where_it_starts(tmp_path: Path) -> None:
+@pytest.mark.parametrize("first", [40, 0, None], ids=["range-from-40", "range-from-0", "whole-run"])
+def test_a_recovered_frame_range_says_where_it_starts(tmp_path: Path, first: int | None) -> None:
+    """A range from frame 0 (a split run's part 0, recovered away from its parts manifest) kept no ``first_frame``
+    either: it and a whole run said the same (first frame 0) until the ``manifest`` metadata said
+    ``frame_range``. A whole run recovered still says nothing of a first frame."""
     from mcap.reader import make_reader
     from mmusv.recording.recover import recover
 
@@ -130,16 +135,22 @@ def test_a_recovered_frame_range_says_where_it_starts(tmp_path: Path) -> None:
     out = tmp_path / "run"
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1] / "python")}
     proc = subprocess.run(  # 110 frames of ~60 kB: the first 4 MiB chunk is on disk when it is killed
-        [sys.executable, "-c", _KILL_AT, str(src), str(out), "110"], env=env, capture_output=True, timeout=120
+        [sys.executable, "-c", _KILL_AT, str(src), str(out), "110", "whole" if first is None else str(first)],
+        env=env,
+        capture_output=True,
+        timeout=120,
     )
     assert proc.returncode == -9, proc.stderr.decode()
     rec = recover(out)
-    assert rec.frames and rec.frames[0] == 40, rec.frames[:3]
+    assert rec.frames and rec.frames[0] == (first or 0), rec.frames[:3]
     manifest = json.loads((out / "manifest.json").read_text(encoding="utf-8"))
     with (out / "dense.mcap").open("rb") as f:
         run = {m.name: dict(m.metadata) for m in make_reader(f).iter_metadata()}["run"]
     assert manifest["status"] == "interrupted" and manifest["frames_written"] == len(rec.frames)
-    assert manifest.get("first_frame") == 40 and run.get("first_frame") == "40", (manifest, run)
+    if first is None:
+        assert "first_frame" not in manifest and "first_frame" not in run, (manifest, run)
+    else:
+        assert manifest.get("first_frame") == first and run.get("first_frame") == str(first), (manifest, run)
 
 
 def test_the_wave_study_picture_is_the_same_from_a_folder_with_a_matplotlibrc(tmp_path: Path) -> None:

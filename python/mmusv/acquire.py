@@ -346,7 +346,9 @@ def _record(
     held = HeldSignals().hold()
     try:
         try:
-            recorder = FrameRecorder(rec_path, sim, overwrite=overwrite, frames=(first, total - first))
+            recorder = FrameRecorder(
+                rec_path, sim, overwrite=overwrite, frames=(first, total - first), frame_range=frame_range is not None
+            )
         except MmusvError as exc:  # the metadata could not be written (a full disk): say why
             if not _writes_into(exc, out):
                 raise

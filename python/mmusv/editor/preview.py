@@ -50,7 +50,7 @@ def preview_png(scenario: Scenario, *, frame: int, agent: str | None = None, wor
     anns = annotations_for(sim, cap, SilhouetteCache())
     with tempfile.TemporaryDirectory(prefix="mmusv-editor-preview-") as tmp:
         path = Path(tmp) / "preview.mcap"
-        rec = FrameRecorder(path, sim, frames=(frame, 1))  # a recording of this one frame, saying so
+        rec = FrameRecorder(path, sim, frames=(frame, 1), frame_range=True)  # a recording of this one frame, saying so
         try:
             rec.write_frame(cap, {a: ann.columns() for a, ann in anns.items()})
         finally:

@@ -105,11 +105,20 @@ class FrameRecorder:
     """
 
     def __init__(
-        self, path: Path, sim: Simulation, *, overwrite: bool = False, frames: tuple[int, int] | None = None
+        self,
+        path: Path,
+        sim: Simulation,
+        *,
+        overwrite: bool = False,
+        frames: tuple[int, int] | None = None,
+        frame_range: bool = False,
     ) -> None:
         """``frames``: ``(first, count)``, the acquisition indices the run sets out to write, kept in the
         ``manifest`` metadata from the start, so that a run killed before :meth:`finish` still says what it
-        meant to record (``None``: the scenario's ``acquisition.frames`` from index 0)."""
+        meant to record (``None``: the scenario's ``acquisition.frames`` from index 0). ``frame_range``: these
+        frames are a range recorded alone (one part of a split recording, ``acquire.run(frame_range=...)``), not a
+        whole run from index 0 cut short by ``frames``; the ``manifest`` metadata then says ``frame_range: true``,
+        so that a killed part 0 recovered away from its parts manifest still says where it starts."""
         self.sim = sim
         self._lock = threading.Lock()
         self.encode_seconds = 0.0
@@ -127,6 +136,7 @@ class FrameRecorder:
                 "config_hash": scenario_hash(sc),
                 "first_frame": first,
                 "frames_requested": count,
+                **({"frame_range": "true"} if frame_range else {}),
             },
             "sensors": {"json": json.dumps(_sensors(sim), sort_keys=True)},
         }

@@ -126,6 +126,10 @@ class RecordingInfo:
     planned: tuple[int, int] | None = None
     """``(first, count)``: the acquisition indices the run set out to write, as its ``manifest`` metadata said
     from the start (also in a ``.partial`` of a killed run); ``None`` for recordings that predate it."""
+    planned_range: bool = False
+    """Whether :attr:`planned` is a frame range recorded alone (one part of a split recording, ``acquire.run(
+    frame_range=...)``, a preview's one frame) rather than a whole run from index 0 (the ``manifest`` metadata's
+    ``frame_range: true``): a part 0 says so, where a whole run cut short by ``--frames`` does not."""
 
     @property
     def vessel_ids(self) -> list[str]:
@@ -419,6 +423,7 @@ def _info(p: Path, meta: dict[str, dict[str, str]], has_summary: bool) -> Record
         run=dict(run),
         has_summary=has_summary,
         planned=_planned(manifest),
+        planned_range=manifest.get("frame_range") == "true",
     )
 
 

@@ -318,10 +318,11 @@ def recover(target: str | os.PathLike[str], *, overwrite: bool = False) -> Recov
                 run["first_frame"] = str(part[0])
             elif "first_frame" in run and keep:
                 run["frames_requested"] = str(len(keep))
-            elif info.planned is not None and info.planned[0] > 0:
+            elif info.planned is not None and (info.planned[0] > 0 or info.planned_range):
                 # a frame range recorded alone (acquire.run(frame_range=...)), or a part recovered away from its
                 # parts manifest: the manifest metadata, written before the first frame, says where it starts (the
-                # recovered run and manifest.json said nothing of it, as for a whole run from frame 0)
+                # recovered run and manifest.json said nothing of it, as for a whole run from frame 0); a range
+                # from frame 0 (a split run's part 0) says frame_range there, as a whole run cut short does not
                 run["first_frame"] = str(info.planned[0])
             w.add_metadata("run", run)
             w.finish()  # type: ignore[no-untyped-call]
