@@ -299,6 +299,15 @@ def test_kitti_records_the_front_camera_distortion(mixed_rec: Path, tmp_path: Pa
     assert "agent usv_b: front camera has lens distortion" in notes(tmp_path / "k")
 
 
+def test_semantickitti_notes_the_front_camera_distortion(mixed_rec: Path, tmp_path: Path) -> None:
+    """calib.txt's P0..P3 are the pinhole K; the notes said nothing of a distorting lens (KITTI's did)."""
+    convert(mixed_rec, to="semantickitti", out_dir=tmp_path / "s", splits=None)
+    said = notes(tmp_path / "s")
+    assert "agent usv_b: front camera has lens distortion" in said
+    assert "agent usv_a: front camera has lens distortion" not in said
+    assert str(list(DIST)) in said
+
+
 # ---------------------------------------------------------------------------------------------- refusals
 
 

@@ -6,8 +6,9 @@ LiDAR frame: x forward, y left, z up), ``labels/<scan>.label`` (uint32 per point
 bits, the semantic class id of :mod:`mmusv.classes` in the lower 16; the instance is the vessel's world-state
 ``instance_id`` for points on a vessel, 0 for the rest: water, land, structures, buoys), ``poses.txt``
 (per scan, the 3×4 row-major pose of camera 0 in camera 0's frame at the first scan), ``calib.txt`` (``P0``..``P3``:
-the front camera's ``K·[I|0]``; ``Tr``: LiDAR → front optical frame; all zeros and the identity without a front
-camera, so camera 0 is the LiDAR) and ``times.txt`` (sim time of each scan, s). Scans are numbered ``000000``
+the front camera's ``K·[I|0]``, its pinhole even when its lens distorts (the conversion's notes then give the
+coefficients); ``Tr``: LiDAR → front optical frame; all zeros and the identity without a front camera, so camera 0
+is the LiDAR) and ``times.txt`` (sim time of each scan, s). Scans are numbered ``000000``
 consecutively over the converted frames (SemanticKITTI's readers pair scan ``i`` with line ``i`` of
 ``poses.txt``); ``frames.txt`` gives the recording's frame index of each scan.
 
@@ -96,6 +97,15 @@ class SemanticKittiWriter(DatasetWriter):
         super().__init__(*args, **kwargs)
         self.extra_counts = {}
         self.sequences: dict[str, _Sequence] = {}
+        for a in self.agents:
+            cam = a.cameras.get("front")
+            if cam is not None and cam.distortion is not None and any(cam.distortion):
+                self.notes.append(
+                    f"agent {a.id}: front camera has lens distortion {list(cam.distortion)} [k1, k2, p1, p2, k3]: "
+                    "calib.txt's P0..P3 are its pinhole K, so a scan's points projected with P2 * Tr land where "
+                    "the recorded (unrectified) image shows them only once the distortion is applied (OpenCV's "
+                    "projectPoints with these coefficients)"
+                )
 
     @classmethod
     def start(cls, out: Path, options: Options, sink: Sink) -> Any:
