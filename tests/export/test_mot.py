@@ -419,6 +419,30 @@ def test_visible_boxes_need_instance_images(tmp_path: Path, make_coop: Any) -> N
     assert sorted(p.name for p in (out / "train").iterdir()) == ["mot_rgb_only.usv_a.front", "mot_rgb_only.usv_b.front"]
 
 
+@pytest.mark.parametrize(("hz", "rate"), [(2.5, "3"), (0.4, "1"), (12.0, "12")])
+def test_frame_rate_is_a_whole_number(tmp_path: Path, make_coop: Any, hz: float, rate: str) -> None:
+    """MOTChallenge's ``frameRate`` is a whole number, and trackers read it with ``int()`` (FairMOT, JDE): a 2.5 Hz
+    recording wrote ``frameRate=2.5``, which they refuse. It is the nearest whole number now (at least 1), and the
+    notes give the exact rate."""
+    from mmusv.acquire import run
+    from mmusv.export.convert_report import load_report
+
+    cam = {"name": "front", "resolution": [64, 48], "quality": "draft", "outputs": ["rgb"]}
+    cfg = make_coop(name="mot_rate", acquisition={"frequency_hz": hz, "frames": 1})
+    cfg["rigs"] = {"r": {"preset": "lidar_only", "cameras": [{**cam, "mount": {"point": "camera_front"}}]}}
+    rec = Path(run(cfg, out_dir=tmp_path / "rec").recording)
+    convert(rec, to="mot", out_dir=tmp_path / "o", box="projected", splits=None)
+    ini = configparser.ConfigParser()
+    ini.read(tmp_path / "o" / "train" / "mot_rate.usv_a.front" / "seqinfo.ini")
+    assert ini["Sequence"]["frameRate"] == rate
+    assert int(ini["Sequence"]["frameRate"]) >= 1
+    notes = [n for r in load_report(tmp_path / "o")["recordings"] for n in r["notes"]]
+    said = [n for n in notes if "frameRate" in n]
+    assert said == ([] if hz.is_integer() else [said[0]])
+    if said:
+        assert f"recorded at {hz:g} Hz: seqinfo.ini's frameRate is {rate}" in said[0]
+
+
 def test_the_command_writes_mot_and_its_help_lists_it(
     port_rec: Path, no_camera_rec: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -16,8 +16,8 @@ An agent without a front camera has no ``image_2``, zero ``P0..P3`` and, as came
 (``Tr_velo_to_cam`` = the rotation x right, y down, z forward): its labels keep KITTI's camera conventions, so
 KITTI's readers turn them into LiDAR boxes with the right heading. A front camera's lens distortion (KITTI's
 images are rectified; ``P2`` is a pinhole) is in ``mmusv_kitti.yaml`` and the conversion's notes.
-Extras: ``depth_2`` (uint16 cm), ``semantic_2``, ``instance_2``, ``radar_ppi``, ``top_view_rgb``,
-``top_view_semantic``.
+Extras: ``depth_2`` (uint16 cm, 0 = no hit, 65535 = 655.35 m or farther), ``semantic_2``, ``instance_2``,
+``radar_ppi``, ``top_view_rgb``, ``top_view_semantic``.
 """
 
 from __future__ import annotations

@@ -6,7 +6,9 @@ sequence in ``train``, MOTChallenge's folder of sequences with ground truth, wit
 ``<scenario>.<agent>.<camera>`` (:func:`sequence_name`: the scenario folder, the agent id and the camera name, which
 hold no ``.``, so the name splits back from the right). Each sequence holds:
 
-* ``seqinfo.ini``: ``[Sequence]`` ``name``, ``imDir=img1``, ``frameRate`` (the recording's ``frequency_hz``),
+* ``seqinfo.ini``: ``[Sequence]`` ``name``, ``imDir=img1``, ``frameRate`` (the recording's ``frequency_hz``, the
+  nearest whole number, at least 1, where it is not one, as MOTChallenge's files and readers have it; the notes then
+  say so),
   ``seqLength`` (frames converted), ``imWidth``, ``imHeight``, ``imExt=.png``;
 * ``img1/000001.png`` …: the recorded RGB PNG of each converted frame, copied (as COCO and YOLO do);
 * ``gt/gt.txt``: one line per kept 2D box (:meth:`mmusv.export.camera.CameraWriter.boxes_of`: COCO's and YOLO's boxes
@@ -40,6 +42,7 @@ from __future__ import annotations
 
 import csv
 import io
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar
@@ -244,6 +247,13 @@ class MotWriter(ProjectedBoxes):
     def finish(self, frames: list[int], skipped: list[dict[str, Any]]) -> None:
         super().finish(frames, skipped)
         freq = _num(self.info.frequency_hz, 6)
+        rate = str(max(1, math.floor(self.info.frequency_hz + 0.5)))
+        if rate != freq and self.sequences:
+            self.notes.append(
+                f"recorded at {freq} Hz: seqinfo.ini's frameRate is {rate}, the nearest whole number, since "
+                "MOTChallenge's files hold whole numbers and trackers read them so (FairMOT's and JDE's int()); a "
+                f"frame's time is its frames.txt index / {freq} s"
+            )
         for seq in self.sequences.values():
             order = sorted(seq.rows)
             img = seq.folder / IMAGE_DIR
@@ -257,7 +267,7 @@ class MotWriter(ProjectedBoxes):
             ]
             self.put(self.sink.mkdir(seq.folder / "gt") / "gt.txt", "".join(lines).encode())
             ini = (
-                f"[Sequence]\nname={seq.name}\nimDir={IMAGE_DIR}\nframeRate={freq}\nseqLength={len(order)}\n"
+                f"[Sequence]\nname={seq.name}\nimDir={IMAGE_DIR}\nframeRate={rate}\nseqLength={len(order)}\n"
                 f"imWidth={seq.width}\nimHeight={seq.height}\nimExt={IMAGE_EXT}\n\n"
             )
             self.put(seq.folder / "seqinfo.ini", ini.encode())
