@@ -181,8 +181,9 @@ class MotWriter(ProjectedBoxes):
     only RGB images, :class:`MotVisibleWriter` with ``box="visible"`` and :class:`MotContrastWriter` with
     ``box="projected"`` and ``min_contrast``."""
 
-    format_version: ClassVar[int] = 2
-    """2 (2026-12-02): ``visibility`` counts the part cut by the image border too (it was 1 − occlusion)."""
+    format_version: ClassVar[int] = 3
+    """2 (2026-12-02): ``visibility`` counts the part cut by the image border too (it was 1 − occlusion). 3
+    (2026-12-03): ``frameRate`` is a whole number (a rate that is not one was written as it was, ``2.5``)."""
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
