@@ -407,3 +407,24 @@ def test_numpys_blas_runs_on_one_thread_while_recording(tmp_path: Path) -> None:
     with pytest.raises(RuntimeError):
         run(lidar_scenario("blas", frames=2), out_dir=tmp_path / "b", progress=stop)
     assert blas_threads() == before
+
+
+def test_a_second_scenario_into_the_same_folder_is_refused(tmp_path: Path) -> None:
+    """A review's: a second scenario run into a folder holding another's finished run replaced that run's
+    manifest.json, scenario.yaml and tables without a word (the first recording was left without its tables). It
+    is refused now, naming the other recording, with everything left as it was; ``overwrite=True`` replaces them."""
+    from mmusv.errors import IoError
+    from tiny_scenario import lidar_scenario
+
+    out = tmp_path / "out"
+    run(lidar_scenario("first", frames=2), out_dir=out)
+    before = {p.relative_to(out): p.read_bytes() for p in sorted(out.rglob("*")) if p.is_file()}
+    with pytest.raises(IoError, match=r"holds the run of another recording, first\.mcap .*overwrite"):
+        run(lidar_scenario("second", frames=2), out_dir=out)
+    assert {p.relative_to(out): p.read_bytes() for p in sorted(out.rglob("*")) if p.is_file()} == before
+    run(lidar_scenario("first", frames=2), out_dir=out, overwrite=True)  # its own run again: replaced as before
+    run(lidar_scenario("second", frames=2), out_dir=out, overwrite=True)
+    manifest = json.loads((out / "manifest.json").read_text(encoding="utf-8"))
+    assert manifest["recording"] == "second.mcap" and (out / "first.mcap").is_file()
+    (out / "second.mcap").unlink()  # the other run's recording gone: nothing of it is lost by replacing the rest
+    run(lidar_scenario("third", frames=2), out_dir=out)

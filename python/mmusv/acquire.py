@@ -189,7 +189,7 @@ def run(
         raise ConfigError(f"notes = {arguments.shown(notes)}: must be a list (lines are appended to it), or None")
     count = None if frames is None else arguments.whole(frames, name="frames")
     span = None if frame_range is None else _frame_range(frame_range)
-    if isinstance(cfg, (str, os.PathLike)) and Path(cfg).is_dir():
+    if isinstance(cfg, (str, os.PathLike)) and os.path.isdir(cfg):  # False, not OSError, for text given as cfg
         raise ConfigError(
             f"{cfg} is a directory; mmusv.run takes one scenario file (run a folder with `mmusv run {cfg} -o OUT`)"
         )
@@ -215,6 +215,8 @@ def run(
     rec_path = recording_path(out, scenario)
     if rec_path.exists() and not overwrite:
         raise IoError(f"{rec_path} already exists; pass overwrite=True (mmusv run --overwrite) to replace it")
+    if not overwrite:
+        _refuse_another_run(out, rec_path)
     try:  # builds the world: any remaining config problem surfaces here, before writing
         sim = Simulation(scenario)
     except MmusvError as exc:
@@ -295,6 +297,8 @@ def _record(
 
     if rec_path.exists() and not overwrite:  # again, now that no other run can be writing it
         raise IoError(f"{rec_path} already exists; pass overwrite=True (mmusv run --overwrite) to replace it")
+    if not overwrite:
+        _refuse_another_run(out, rec_path)
 
     partial = rec_path.with_name(rec_path.name + ".partial")
     tables_dir = out / "tables"
@@ -463,6 +467,22 @@ def _record(
     if failure is not None:
         raise failure
     return result
+
+
+def _refuse_another_run(out: Path, rec_path: Path) -> None:
+    """Raises :class:`~mmusv.errors.IoError` when ``out`` holds the finished run of another recording
+    (:func:`~mmusv.recording.info.another_run`): this run would replace that run's ``manifest.json``,
+    ``scenario.yaml`` and tables, which a second scenario run into the same folder did without a word, leaving the
+    first recording without its tables."""
+    from mmusv.recording.info import another_run
+
+    other = another_run(out, rec_path.name)
+    if other is not None:
+        raise IoError(
+            f"{out} holds the run of another recording, {other} (its manifest.json, scenario.yaml and tables/), "
+            f"which a run of {rec_path.name} there would replace; give each scenario a folder of its own (-o), or "
+            f"pass overwrite=True (mmusv run --overwrite) to replace them ({other} itself is kept)"
+        )
 
 
 def _replace_outputs(out: Path, scenario: Scenario, stale: list[Path]) -> None:

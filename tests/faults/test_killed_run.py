@@ -3,6 +3,7 @@ finishes it into a valid MCAP with its tables, and ``mmusv run`` on the folder r
 
 from __future__ import annotations
 
+import json
 import random
 import shutil
 import subprocess
@@ -176,3 +177,21 @@ def test_a_plan_out_of_bounds_is_not_believed() -> None:
     for first, count in (("0", str(10**18)), ("-1", "5"), ("0", "0"), ("x", "5"), (None, "5")):
         meta = {"frames_requested": count} if first is None else {"first_frame": first, "frames_requested": count}
         assert _planned(meta) is None, meta
+
+
+def test_recover_beside_another_finished_run_is_refused(killed: tuple[Path, Path, int], tmp_path: Path) -> None:
+    """A review's: recovering a ``.partial`` in a folder holding another recording's finished run rebuilt the
+    folder's tables and manifest.json from the ``.partial`` alone, and that run's tables were gone. It is refused
+    now, naming the other recording, with every file as it was; ``--overwrite`` replaces them."""
+    _src, ref, _k = killed
+    folder = _copy_of_killed(ref, tmp_path / "killed")
+    shutil.copy(ref / "dense.mcap", folder / "other.mcap")
+    (folder / "manifest.json").write_text(json.dumps({"recording": "other.mcap", "status": "complete"}))
+    before = {p.relative_to(folder): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+    code, _out, err = cli_main("recover", str(folder))
+    assert code != 0 and "holds the run of another recording, other.mcap" in err and "left as it was" in err, err
+    assert {p.relative_to(folder): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()} == before
+    code, _out, err = cli_main("recover", str(folder), "--overwrite")
+    assert code == 0, err
+    assert json.loads((folder / "manifest.json").read_text())["recording"] == "dense.mcap"
+    assert (folder / "other.mcap").is_file()

@@ -174,6 +174,21 @@ def _mat(v: Any) -> np.ndarray | None:
     return np.asarray(v, dtype=np.float64).reshape(4, 4)
 
 
+def another_run(folder: Path, recording: str) -> str | None:
+    """The file name of the recording whose finished run ``folder`` holds, when it is not ``recording`` (a file
+    name) and is still there; ``None`` otherwise (no ``manifest.json``, one that is not a run's, or its recording
+    gone). A run or a recovery of ``recording`` into ``folder`` would replace that run's ``manifest.json`` and
+    tables."""
+    try:
+        manifest = json.loads((folder / "manifest.json").read_bytes())
+    except (OSError, ValueError):
+        return None
+    other = manifest.get("recording") if isinstance(manifest, dict) else None
+    if not isinstance(other, str) or other == recording or "/" in other or "\\" in other or other in ("", ".", ".."):
+        return None
+    return other if (folder / other).is_file() else None
+
+
 def recording_name(path: str | os.PathLike[str]) -> str:
     """The name of the recording at ``path``: the file name without ``.mcap`` (``.mcap.partial``) or
     ``.parts.json``."""

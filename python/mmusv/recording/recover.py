@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Any
 
 from mmusv.errors import IoError
-from mmusv.recording.info import RecordingInfo, check_mcap, read_info
+from mmusv.recording.info import RecordingInfo, another_run, check_mcap, read_info
 from mmusv.recording.scan import Scan
 from mmusv.recording.stream import FrameStream
 from mmusv.recording.tables import BOX_3D_VECTORS, WORLD_STATE_VECTORS, TableWriter, spread_columns
@@ -264,6 +264,13 @@ def recover(target: str | os.PathLike[str], *, overwrite: bool = False) -> Recov
     info = read_info(src)
     planned = info.planned[1] if info.planned is not None else info.frames_configured
     folder = src.parent
+    other = None if overwrite else another_run(folder, final.name)
+    if other is not None:  # its tables and manifest.json would be rebuilt from this one's: the other run's lost
+        raise IoError(
+            f"{folder} holds the run of another recording, {other} (its manifest.json and tables/), which "
+            f"recovering {src.name} there would replace; move {src.name} into a folder of its own first, or pass "
+            f"--overwrite to replace them ({other} itself is kept); {src} is left as it was"
+        )
     # pass 1: which frames are complete (and their tables)
     tables_dir = folder / "tables"
     stream = rebuild_tables(src, tables_dir, keep_if_empty=True)
