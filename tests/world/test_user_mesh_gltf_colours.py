@@ -271,3 +271,28 @@ def test_bad_color_0_is_one_line_naming_the_file_and_the_entry(tmp_path: Path, c
         load_asset_file({"name": "user_hull", "mesh": str(path), **AXES})
     msg = str(info.value)
     assert info.value.field == "user_hull.mesh" and repr(str(path)) in msg and "\n" not in msg
+
+
+def test_a_large_texture_is_averaged_without_a_float_per_texel() -> None:
+    """A review's: a 4000 x 4000 texture (a 2 kB PNG) took 2.1 GB to average, float64 per texel, so one near PIL's
+    size limit would have been killed for memory. The mean is the same, counted by level (sRGB decoded per level)."""
+    import tracemalloc
+
+    from mmusv.world.mesh_materials import _srgb_to_linear, _texture_mean
+    from PIL import Image
+
+    rng = np.random.default_rng(3)
+    small = Image.fromarray(rng.integers(0, 256, size=(37, 53, 3), dtype=np.uint8))
+    pix = np.asarray(small, dtype=np.float64).reshape(-1, 3) / 255.0
+    for srgb in (False, True):
+        want = (_srgb_to_linear(pix) if srgb else pix).mean(axis=0)
+        np.testing.assert_allclose(_texture_mean(small, srgb=srgb), want, rtol=1e-12, atol=1e-15)
+    big = Image.new("1", (4000, 4000), 1)
+    tracemalloc.start()
+    try:
+        mean = _texture_mean(big, srgb=True)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    np.testing.assert_allclose(mean, [1.0, 1.0, 1.0])
+    assert peak < 20e6, peak  # float64 texels: 384 MB

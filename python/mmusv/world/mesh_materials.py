@@ -104,7 +104,9 @@ MTL_DEFAULT_KD = 0.8
 def one_line(exc: BaseException) -> str:
     """An exception as one line of text (its type too where its message alone says little, a ``KeyError``'s)."""
     text = " ".join(str(exc).split())
-    return f"{type(exc).__name__}: {text}" if isinstance(exc, LookupError) or not text else text
+    if not text:  # an AssertionError of a reader: its type alone (it said "AssertionError: ")
+        return type(exc).__name__
+    return f"{type(exc).__name__}: {text}" if isinstance(exc, LookupError) else text
 
 
 def check_image(target: Path, *, what: str, where: str) -> None:
@@ -142,8 +144,14 @@ def _unit_factor(value: object, n: int, default: float) -> np.ndarray:
 def _texture_mean(tex: object, *, srgb: bool) -> np.ndarray:
     """The mean RGB of a texture image over its texels, in [0, 1]: decoded from sRGB to linear first when ``srgb``
     (colour textures), as stored otherwise (data textures: metallic-roughness)."""
-    pix = np.asarray(tex.convert("RGB"), dtype=np.float64).reshape(-1, 3) / 255.0  # type: ignore[attr-defined]
-    return np.asarray((_srgb_to_linear(pix) if srgb else pix).mean(axis=0), dtype=np.float64)
+    # Counted per 8-bit level (256 bins a channel), not converted per texel: a 4000 x 4000 texture (a 2 kB PNG) took
+    # 2.1 GB as float64 texels, and one near PIL's size limit would have been killed for memory. The mean is the same
+    # sum over the same levels.
+    levels = np.arange(256, dtype=np.float64) / 255.0
+    if srgb:
+        levels = _srgb_to_linear(levels)
+    hist = np.asarray(tex.convert("RGB").histogram(), dtype=np.float64).reshape(3, 256)  # type: ignore[attr-defined]
+    return np.asarray(hist @ levels / np.maximum(hist.sum(axis=1), 1.0), dtype=np.float64)
 
 
 def _material(name: str, base: np.ndarray, rough: float, metal: float, emis: np.ndarray) -> Material:
