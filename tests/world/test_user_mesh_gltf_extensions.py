@@ -232,3 +232,44 @@ def test_draco_with_a_fallback_loads_with_or_without_its_decoder(
     tol = 12.0 / 2**14 * 1.5
     assert abs(decoded.length - plain.length) < 2 * tol and abs(decoded.beam - plain.beam) < 2 * tol
     np.testing.assert_allclose(np.sort(plain.mesh.vertices, axis=0), np.sort(decoded.mesh.vertices, axis=0), atol=tol)
+
+
+@pytest.mark.parametrize(
+    ("label", "change", "words"),
+    [
+        ("scene out of range", lambda d: d.update(scene=5), "scene is 5, but the file has 1 scenes (indices 0..0)"),
+        ("no scenes", lambda d: d.update(scenes=[]), "scene is 0, but the file has 0 scenes (none)"),
+        (
+            "material out of range",
+            lambda d: d["meshes"][0]["primitives"][0].update(material=7),
+            "meshes[0].primitives[0].material is 7, but the file has 0 materials (none)",
+        ),
+        (
+            "base colour out of [0, 1]",
+            lambda d: d.update(materials=[{"pbrMetallicRoughness": {"baseColorFactor": [5, -1, 0.5, 1]}}]),
+            "materials[0].pbrMetallicRoughness.baseColorFactor is [5, -1, 0.5, 1]; glTF 2.0 allows 4 numbers in [0, 1]",
+        ),
+        (
+            "roughness below 0",
+            lambda d: d.update(materials=[{"pbrMetallicRoughness": {"roughnessFactor": -3}}]),
+            "materials[0].pbrMetallicRoughness.roughnessFactor is -3; glTF 2.0 allows a number in [0, 1]",
+        ),
+        (
+            "emissive too short",
+            lambda d: d.update(materials=[{"emissiveFactor": [1, 1]}]),
+            "materials[0].emissiveFactor is [1, 1]; glTF 2.0 allows 3 numbers in [0, 1]",
+        ),
+    ],
+)
+def test_indices_and_factors_out_of_range_are_named(tmp_path: Path, label: str, change: Any, words: str) -> None:
+    """A review's: a scene or material index out of range failed inside trimesh with a bare ``IndexError: list index
+    out of range``, and material factors outside glTF's [0, 1] (NaN too) were clamped without a word (trimesh keeps
+    colour factors as bytes), where an OBJ's ``Kd`` out of [0, 1] is refused."""
+    path = _gltf(tmp_path / "hull.gltf", _tetra())
+    doc = json.loads(path.read_text())
+    change(doc)
+    path.write_text(json.dumps(doc))
+    with pytest.raises(AssetSpecError) as err:
+        _load(path)
+    msg = str(err.value)
+    assert words in msg and "hull.gltf" in msg and "\n" not in msg, (label, msg)

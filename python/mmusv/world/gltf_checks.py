@@ -3,7 +3,9 @@
 its header says or without a JSON chunk; a buffer or image file that is missing (or an image Pillow cannot read); an
 extension the file requires that mmusv does not read (:data:`READ_EXTENSIONS`), Draco geometry without DracoPy to
 decode it, a normalized or sparse ``POSITION``; a ``COLOR_0`` glTF 2.0 does not allow or that does not fit its
-primitive; two materials of one name and one factor with different ``KHR_materials_emissive_strength``. Each is one
+primitive; two materials of one name and one factor with different ``KHR_materials_emissive_strength``; an index
+into one of its lists that is not in it (a scene, node, mesh, material, accessor, buffer view, buffer or image); a
+material factor outside glTF's [0, 1]. Each is one
 :class:`~mmusv.world.asset_spec.AssetSpecError` at the asset entry naming the file and the glTF entry.
 """
 
@@ -28,7 +30,9 @@ def check_gltf(path: Path, where: str) -> tuple[dict[EmissiveKey, float], list[s
     the name (``meshes[i].primitives[j]``) of each primitive trimesh makes a geometry of, in its order."""
     data = _gltf_json(path, where)
     _extension_checks(path, data, where)
-    return _gltf_checks(path, data, where), _color_0_checks(path, data, where)
+    strengths, names = _gltf_checks(path, data, where), _color_0_checks(path, data, where)
+    _reference_checks(repr(str(path)), data, where)  # after the checks that say more of their own entries
+    return strengths, names
 
 
 _GLB_MAGIC = b"glTF"
@@ -95,6 +99,7 @@ def _gltf_checks(path: Path, data: dict[str, object], where: str) -> dict[Emissi
     for i, m in enumerate(materials if isinstance(materials, list) else []):
         if not isinstance(m, dict):
             continue
+        _factor_checks(shown, i, m, where)
         ext = m.get("extensions")
         ks = ext.get("KHR_materials_emissive_strength") if isinstance(ext, dict) else None
         value = ks.get("emissiveStrength", 1.0) if isinstance(ks, dict) else 1.0
@@ -115,6 +120,92 @@ def _gltf_checks(path: Path, data: dict[str, object], where: str) -> dict[Emissi
             )
         strengths[key] = float(value)
     return strengths
+
+
+def _references(data: dict[str, object]) -> Iterator[tuple[str, object, str]]:
+    """Every index the glTF's JSON gives into one of its lists: ``(where it is, the index, the list's name)``."""
+
+    def items(name: str) -> list[object]:
+        v = data.get(name)
+        return v if isinstance(v, list) else []
+
+    if "scene" in data:
+        yield "scene", data["scene"], "scenes"
+    for i, sc in enumerate(items("scenes")):
+        for j, n in enumerate(
+            sc.get("nodes", []) if isinstance(sc, dict) and isinstance(sc.get("nodes"), list) else []
+        ):
+            yield f"scenes[{i}].nodes[{j}]", n, "nodes"
+    for i, nd in enumerate(items("nodes")):
+        if not isinstance(nd, dict):
+            continue
+        if "mesh" in nd:
+            yield f"nodes[{i}].mesh", nd["mesh"], "meshes"
+        kids = nd.get("children")
+        for j, n in enumerate(kids if isinstance(kids, list) else []):
+            yield f"nodes[{i}].children[{j}]", n, "nodes"
+    for i, me in enumerate(items("meshes")):
+        prims = me.get("primitives") if isinstance(me, dict) else None
+        for j, pr in enumerate(prims if isinstance(prims, list) else []):
+            if not isinstance(pr, dict):
+                continue
+            at = f"meshes[{i}].primitives[{j}]"
+            if "material" in pr:
+                yield f"{at}.material", pr["material"], "materials"
+            if "indices" in pr:
+                yield f"{at}.indices", pr["indices"], "accessors"
+            attrs = pr.get("attributes")
+            for name, a in attrs.items() if isinstance(attrs, dict) else []:
+                yield f"{at}.attributes.{name}", a, "accessors"
+    for i, ac in enumerate(items("accessors")):
+        if isinstance(ac, dict) and "bufferView" in ac:
+            yield f"accessors[{i}].bufferView", ac["bufferView"], "bufferViews"
+    for i, bv in enumerate(items("bufferViews")):
+        if isinstance(bv, dict) and "buffer" in bv:
+            yield f"bufferViews[{i}].buffer", bv["buffer"], "buffers"
+    for i, tx in enumerate(items("textures")):
+        if isinstance(tx, dict) and "source" in tx:
+            yield f"textures[{i}].source", tx["source"], "images"
+
+
+def _reference_checks(shown: str, data: dict[str, object], where: str) -> None:
+    """Refuses an index into one of the glTF's lists that is not in it (``scene: 5`` with one scene, a primitive's
+    ``material: 7`` with one material): trimesh failed on them with a bare ``IndexError: list index out of range``."""
+    for at, index, kind in _references(data):
+        items = data.get(kind)
+        n = len(items) if isinstance(items, list) else 0
+        if isinstance(index, bool) or not isinstance(index, int) or not 0 <= index < n:
+            have = f"indices 0..{n - 1}" if n else "none"
+            raise AssetSpecError(where, f"{shown}: {at} is {index!r}, but the file has {n} {kind} ({have})")
+
+
+_FACTORS = (
+    ("pbrMetallicRoughness", "baseColorFactor", 4),
+    ("pbrMetallicRoughness", "metallicFactor", 0),
+    ("pbrMetallicRoughness", "roughnessFactor", 0),
+    (None, "emissiveFactor", 3),
+)
+"""A material's factors glTF 2.0 bounds to [0, 1]: (the object holding it, its name, its length; 0: a number)."""
+
+
+def _factor_checks(shown: str, i: int, material: dict[str, object], where: str) -> None:
+    """Refuses a factor of ``materials[i]`` outside glTF 2.0's [0, 1] (or not a number): trimesh keeps colour
+    factors as bytes, so ``baseColorFactor [5, -1, 0.5]`` was read as (1, 0, 0.5) and ``roughnessFactor -3`` as
+    0.02, without a word, where an OBJ's ``Kd 5 -1 0.5`` is refused."""
+    for holder, name, n in _FACTORS:
+        obj = material.get(holder) if holder else material
+        if not isinstance(obj, dict) or name not in obj:
+            continue
+        value = obj[name]
+        values = value if n and isinstance(value, list) and len(value) == n else [value] if not n else None
+        field = f"materials[{i}].{holder + '.' if holder else ''}{name}"
+        ok = values is not None and all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and 0.0 <= v <= 1.0
+            for v in values
+        )
+        if not ok:
+            what = f"{n} numbers in [0, 1]" if n else "a number in [0, 1]"
+            raise AssetSpecError(where, f"{shown}: {field} is {value!r}; glTF 2.0 allows {what}")
 
 
 _GLTF_MODES = frozenset({0, 1, 4, 5})

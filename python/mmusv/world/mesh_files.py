@@ -244,7 +244,13 @@ def load_mesh_file(path: Path, where: str) -> tuple[np.ndarray, np.ndarray, np.n
     except AssetSpecError:
         raise
     except Exception as exc:  # trimesh raises many types for unreadable files
-        raise AssetSpecError(where, f"cannot read {str(path)!r}: {one_line(exc)}") from exc
+        hint = (
+            " (trimesh's glTF reader failed inside: a buffer's length or base64 data, an accessor or the index data "
+            "does not fit the file; the Khronos glTF Validator names the entry)"
+            if gltf and isinstance(exc, (AssertionError, LookupError, ValueError, TypeError))
+            else ""
+        )
+        raise AssetSpecError(where, f"cannot read {str(path)!r}: {one_line(exc)}{hint}") from exc
     if not isinstance(scene, trimesh.Scene):
         raise AssetSpecError(where, f"{str(path)!r} does not hold a triangle mesh")
     geoms = [g for g in scene.geometry.values() if isinstance(g, trimesh.Trimesh)]
