@@ -176,3 +176,36 @@ def test_time_of_day_takes_ascii_digits_only() -> None:
     data["environment"] = {"time_of_day": "١٢:٠٠"}
     with pytest.raises(mmusv.ConfigError, match=r"environment\.time_of_day = .*HH:MM"):
         load_scenario(data)
+
+
+@pytest.mark.parametrize(
+    ("sea", "said"),
+    [({}, "neither was given"), ({"tp_s": 8}, "neither was given"), ({"state": 4, "hs_m": 2.0}, "not both")],
+)
+def test_a_sea_without_a_height_says_neither_was_given(sea: dict[str, float], said: str) -> None:
+    """A review's: ``sea: {tp_s: 8}`` was told "give either `state` or `hs_m`, not both"."""
+    from mmusv.config import SeaConfig
+
+    with pytest.raises(ValueError, match=said):
+        SeaConfig.model_validate(sea)
+
+
+@pytest.mark.parametrize(
+    ("given", "said"),
+    [
+        ("name: a\nseed: 1\nvessels: []\n", "given as text"),
+        ("x" * 300, "cannot be read: File name too long"),
+        ("a/" * 3000, "cannot be read: File name too long"),
+    ],
+    ids=["yaml-text", "long-name", "long-path"],
+)
+def test_text_or_a_name_too_long_is_a_config_error(given: str, said: str) -> None:
+    """A review's: ``mmusv.run(open("s.yaml").read())`` raised a bare ``OSError: File name too long`` from a path
+    check (and so did ``load_scenario`` on a name too long for the file system)."""
+    import mmusv
+    from mmusv.config import load_scenario
+    from mmusv.errors import ConfigError
+
+    for call in (load_scenario, mmusv.run):
+        with pytest.raises(ConfigError, match=said):
+            call(given)

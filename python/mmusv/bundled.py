@@ -9,6 +9,7 @@ scenarios, so ``mmusv run port_entry`` works from any directory.
 from __future__ import annotations
 
 import importlib.resources
+import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,16 +36,16 @@ def _resolve(
     or under one of the repository-relative ``parents``; else :class:`~mmusv.errors.NotFoundError`, which says so
     when ``name`` is a bundled file of the other kind (``other``: its folder and what to do with it)."""
     p = Path(name)
-    if p.exists():
+    if os.path.exists(p):  # False, where Path.exists raised OSError, for a name too long to be a file's
         return p
     stem = p.name[: -len(".yaml")] if p.name.endswith(".yaml") else p.name
     bare = p.parent == Path(".")
     if bare or p.parent in (Path(x) for x in parents):
         cand = folder / f"{stem}.yaml"
-        if cand.is_file():
+        if os.path.isfile(cand):
             return cand
     hint = ""
-    if other is not None and bare and (other[0] / f"{stem}.yaml").is_file():  # `mmusv run island_demo`, a spec
+    if other is not None and bare and os.path.isfile(other[0] / f"{stem}.yaml"):  # `mmusv run island_demo`, a spec
         hint = f" ({stem} is {other[1].format(stem=stem)})"
     raise NotFoundError(
         f"{noun} file {str(name)!r} does not exist and is not a bundled {noun}; bundled: {', '.join(_names(folder))}"

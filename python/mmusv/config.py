@@ -156,7 +156,8 @@ class SeaConfig(_Model):
     @model_validator(mode="after")
     def _one_height(self) -> SeaConfig:
         if (self.state is None) == (self.hs_m is None):
-            raise ValueError("environment.sea: give either `state` (WMO sea state 0..9) or `hs_m` (metres), not both")
+            given = "neither was given" if self.state is None else "not both"
+            raise ValueError(f"environment.sea: give either `state` (WMO sea state 0..9) or `hs_m` (metres), {given}")
         if self.state is not None and self.tp_s is not None:
             raise ValueError("environment.sea: `tp_s` goes with `hs_m`; a WMO `state` is a fully developed sea")
         self.spec()  # the core checks the steepness and the ranges together
@@ -541,6 +542,11 @@ def load_scenario(source: str | os.PathLike[str] | dict[str, Any] | Scenario) ->
     (:func:`mmusv.bundled.resolve_scenario`)."""
     if isinstance(source, Scenario):
         return source
+    if isinstance(source, str) and ("\n" in source or "\r" in source):  # the path's OSError said "File name too long"
+        raise ConfigError(
+            "the scenario is given as text (it holds line breaks), not as the path of a file: give the path of its "
+            ".yaml file, or the mapping (yaml.safe_load(text))"
+        )
     if isinstance(source, (str, os.PathLike)) and not os.path.exists(source):
         from mmusv.bundled import resolve_scenario
         from mmusv.errors import NotFoundError

@@ -15,6 +15,7 @@ and ``load_spec`` take their input.
 
 from __future__ import annotations
 
+import errno
 import os
 from pathlib import Path
 from typing import Any
@@ -170,6 +171,11 @@ def _check_expansion(data: Any, where: str) -> None:
 def read_yaml(path: str | os.PathLike[str], *, kind: str = "YAML") -> Any:
     """Reads and parses the YAML file ``path`` (``kind`` names it in errors: "scenario", "spec", ...)."""
     p = Path(os.fspath(path))
+    try:
+        p.stat()
+    except OSError as exc:  # a name too long, a loop of links, a file below a file: said, not raised as OSError
+        if exc.errno not in (errno.ENOENT, errno.ENOTDIR):
+            raise ConfigError(f"{kind} file {str(p)!r} cannot be read: {exc.strerror or exc}") from None
     if p.is_dir():
         raise ConfigError(f"{kind} {str(p)!r} is a directory, not a file")
     if not p.is_file():
