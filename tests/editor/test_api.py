@@ -383,6 +383,20 @@ def test_runs_start_report_progress_and_stop(client: TestClient, folder: Path) -
     assert client.get("/api/runs/abc").status_code == 422
 
 
+def test_a_run_of_more_frames_than_the_file_records_is_refused(client: TestClient, folder: Path) -> None:
+    """A review's: ``frames`` above the file's ``acquisition.frames`` started a job that then failed (and the page's
+    20-digit count was rounded on its way); it is refused before anything starts, naming the file's count."""
+    doc = small(bundled_doc(client))
+    total = int(doc["acquisition"]["frames"])
+    assert client.put("/api/files/few.yaml", json={"document": doc}).status_code == 200
+    for frames in (total + 1, 10**20):
+        r = client.post("/api/runs", json={"name": "few.yaml", "frames": frames})
+        assert r.status_code == 422, r.text
+        assert f"few.yaml records {total} (acquisition.frames); give 1..{total}" in r.json()["error"]
+    assert client.get("/api/runs").json() == []
+    assert not (folder / "out" / "few").exists()
+
+
 def test_a_failing_run_reports_its_error(client: TestClient, folder: Path) -> None:
     doc = small(bundled_doc(client))
     doc["vessels"][0]["route"][2] = [-120, 600]  # over land: mmusv run refuses it

@@ -1,6 +1,7 @@
 """A seventh round through the editor in a real headless Chromium, by keyboard and at a small window: the vessel
 library was one Tab stop per entry (37 presses to get past it), and at 900 x 650 the selected vessel's "at the end"
-box showed its choice cut short ("ping pon").
+box showed its choice cut short ("ping pon"). Then a review's: deleting waypoints went down to a route of one point,
+and a number box's note kept saying "empty" after a second text the browser cannot read.
 
 Each browser test checks the browser's console for JavaScript errors (failed requests the page explains are not
 errors).
@@ -96,3 +97,50 @@ def test_the_end_choice_is_read_whole_in_a_small_window(browser: Any, live_serve
         for name, longest, inner in widths[:2]:  # the asset box is as wide as the panel; long names are cut there
             assert longest + ARROW_PX <= inner, (name, longest, inner)
         assert js_errors(browser) == []
+
+
+def test_a_route_is_not_deleted_below_two_waypoints(browser: Any, live_server: LiveServer) -> None:
+    """A review's: deleting waypoints (the route table's x, a right click on the map) went down to a route of one
+    point, which the check then refused in pydantic's words; the page now keeps two and says why."""
+    from test_browser import document_of, settled
+
+    open_editor(browser, live_server)
+    js_errors(browser)
+    browser.find_element(By.CSS_SELECTOR, '#fleet li[data-id="tug"]').click()
+    i = [v["id"] for v in document_of(browser)["vessels"]].index("tug")
+    while len(route := document_of(browser)["vessels"][i]["route"]) > 2:
+        browser.find_element(By.CSS_SELECTOR, '#v-route button[data-delete="0"]').click()
+        settled(browser)
+        assert len(document_of(browser)["vessels"][i]["route"]) == len(route) - 1
+    browser.find_element(By.CSS_SELECTOR, '#v-route button[data-delete="0"]').click()
+    handle = browser.find_element(By.CSS_SELECTOR, 'circle.waypoint[data-vessel="tug"][data-index="1"]')
+    ActionChains(browser).context_click(handle).perform()
+    settled(browser)
+    assert document_of(browser)["vessels"][i]["route"] == route
+    assert "tug's route has 2 waypoints, the fewest a route has" in browser.find_element(By.ID, "status").text
+    assert js_errors(browser) == []
+
+
+def test_a_number_box_s_note_follows_a_second_unreadable_text(browser: Any, live_server: LiveServer) -> None:
+    """A review's: "NaN" in the speed box was refused as "empty" (the browser reads it as ""); "1e400" typed next
+    left that note as it was, since the value stayed "" and no change event came. Leaving the box says "not a
+    number" now; a number then takes the note away."""
+    from test_browser import document_of, settled
+    from test_browser_round import note, type_into
+
+    open_editor(browser, live_server)
+    js_errors(browser)
+    browser.find_element(By.CSS_SELECTOR, '#fleet li[data-id="tug"]').click()
+    i = [v["id"] for v in document_of(browser)["vessels"]].index("tug")
+    speed = document_of(browser)["vessels"][i]["speed_mps"]
+    box = browser.find_element(By.ID, "v-speed")
+    type_into(browser, box, "")
+    assert "speed: empty" in note(browser, f"vessels[{i}].speed_mps")
+    type_into(browser, box, "1e400")
+    assert "speed: not a number" in note(browser, f"vessels[{i}].speed_mps")
+    assert document_of(browser)["vessels"][i]["speed_mps"] == speed
+    type_into(browser, box, "3")
+    settled(browser)
+    assert note(browser, f"vessels[{i}].speed_mps") == ""
+    assert document_of(browser)["vessels"][i]["speed_mps"] == 3
+    assert js_errors(browser) == []

@@ -357,6 +357,18 @@ def create_app(
         path = store.path(body.name)
         if not path.is_file():
             raise NotFoundError(f"no scenario file {body.name!r} in the editor's folder; save it first")
+        if body.frames is not None:  # more than the file records: the job started, then failed (a review's)
+            from mmusv.config import load_scenario
+
+            try:
+                total: int | None = load_scenario(path).acquisition.frames
+            except MmusvError:
+                total = None  # the run says what is wrong with the file
+            if total is not None and body.frames > total:
+                raise ConfigError(
+                    f"frames = {body.frames}: {body.name} records {total} (acquisition.frames); give 1..{total}, "
+                    "or leave it empty for all"
+                )
         return jobs.start(path, frames=body.frames).as_dict()
 
     @app.get("/api/runs")

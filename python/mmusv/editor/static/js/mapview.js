@@ -414,6 +414,14 @@ export class MapView {
     this.activeWaypoint = null;
     const v = this.state.vessel(id);
     if (!v || !Array.isArray(v.route) || !(index >= 0 && index < v.route.length)) return; // gone meanwhile
+    if (v.route.length <= 2) {
+      // a route of one point is no route: deleting down to it left the file invalid (a review's)
+      this.state.emit("status", {
+        text: `${id}'s route has ${v.route.length} waypoints, the fewest a route has: move this one instead, or delete the vessel`,
+        error: true,
+      });
+      return;
+    }
     this.state.edit((doc) => doc.vessels[this.state.vesselIndex(id)].route.splice(index, 1));
   }
 

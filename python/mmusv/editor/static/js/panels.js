@@ -90,6 +90,15 @@ export class Panels {
     this.lastErrors = [];
     this.libraryStop = null; // the library entry that holds its one tab stop (renderLibrary)
     state.on("jump", () => this.forgetRefused(""));
+    // A number box refused as empty, then given another text the browser cannot read ("1e400" after "NaN"): its
+    // value stays "", so no change event comes and the note kept saying "empty" (a review's). On leaving the box
+    // the note says what is there now.
+    document.addEventListener("focusout", (ev) => {
+      const el = ev.target;
+      if (!(el instanceof HTMLInputElement) || el.type !== "number" || !el.validity.badInput) return;
+      const text = el.dataset.field ? this.refused.get(el.dataset.field) : undefined;
+      if (text && text.includes(": empty; ")) this.refuse(el, text.replace(": empty; ", ": not a number; "));
+    });
   }
 
   // ------------------------------------------------------------------------------------- notes next to fields
