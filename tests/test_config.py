@@ -209,3 +209,28 @@ def test_text_or_a_name_too_long_is_a_config_error(given: str, said: str) -> Non
     for call in (load_scenario, mmusv.run):
         with pytest.raises(ConfigError, match=said):
             call(given)
+
+
+@pytest.mark.parametrize(
+    ("mount", "said"),
+    [
+        (
+            {"xyz": [1e39, 0, 0]},
+            "rigs.usv_standard.lidar.mount.xyz = [1e+39, 0, 0]: must be three numbers within ±100,000 m",
+        ),
+        ({"xyz": [0, -1e308, 0]}, "lidar.mount.xyz = [0, -1e+308, 0]: must be three numbers within ±100,000 m"),
+        ({"rpy_deg": [0, 0, 1e308]}, "lidar.mount.rpy_deg = [0, 0, 1e+308]: must be three numbers within ±360 degrees"),
+    ],
+)
+def test_a_mount_out_of_all_reach_is_named(mount: dict[str, object], said: str) -> None:
+    """A review's: a LiDAR mounted 1e39 m off overflowed the core's floats ("invalid origins[0]: [inf, 0.0, 0.0]",
+    naming no field), and a turn of 1e308 degrees was taken."""
+    import yaml
+    from mmusv.config import load_scenario
+    from mmusv.errors import ConfigError
+
+    doc = yaml.safe_load((Path(__file__).resolve().parents[1] / "scenarios" / "port_entry.yaml").read_text())
+    doc["rigs"]["usv_standard"] = {"lidar": {"mount": mount}}
+    with pytest.raises(ConfigError) as err:
+        load_scenario(doc)
+    assert said in str(err.value), str(err.value)

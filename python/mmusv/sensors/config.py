@@ -18,7 +18,8 @@ Mounts: ``point`` names a mount point of the vessel asset (``lidar``, ``radar``,
 frame (axes of the vessel body frame, x forward, y left, z up, turned by the point's rpy: on ``camera_left``, which
 looks left, ``xyz: [1, 0, 0]`` moves the sensor 1 m to the left). Without ``point``, they are relative to the vessel
 origin (midship, at the waterline), in the vessel body frame. Assets without any mount point fall back to the top
-of the hull's bounding box (a point an asset with mount points lacks is refused).
+of the hull's bounding box (a point an asset with mount points lacks is refused). ``xyz`` is within ±100 km
+(:data:`MAX_MOUNT_OFFSET_M`) and ``rpy_deg`` within ±360 degrees.
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ import math
 from collections.abc import Sequence
 from typing import Literal, get_args
 
-from pydantic import Field, field_validator, model_validator
+from pydantic import Field, ValidationInfo, field_validator, model_validator
 
 from mmusv._native import core
 from mmusv.strict import StrictModel
@@ -100,6 +101,10 @@ def _check_outputs(v: Sequence[str], allowed: tuple[str, ...], drop: str) -> Non
         raise ValueError(f"lists {', '.join(twice)} more than once; list each output once (of {', '.join(allowed)})")
 
 
+MAX_MOUNT_OFFSET_M = 100_000.0
+"""The largest mount offset a sensor takes, metres (the longest sensor range, :attr:`LidarConfig.range_m`'s bound)."""
+
+
 class Mount(_Model):
     """Where a sensor sits on its vessel (see the module docstring)."""
 
@@ -109,9 +114,14 @@ class Mount(_Model):
 
     @field_validator("xyz", "rpy_deg")
     @classmethod
-    def _finite(cls, v: tuple[float, float, float]) -> tuple[float, float, float]:
+    def _finite(cls, v: tuple[float, float, float], info: ValidationInfo) -> tuple[float, float, float]:
         if not all(math.isfinite(x) for x in v):
             raise ValueError("must be three finite numbers")
+        # An offset beyond any range the sensors reach (1e39 overflowed the core's floats: "invalid origins[0]:
+        # [inf, 0.0, 0.0]", naming no field), and turns beyond a whole turn, are typing errors.
+        bound, unit = (MAX_MOUNT_OFFSET_M, "m") if info.field_name == "xyz" else (360.0, "degrees")
+        if any(abs(x) > bound for x in v):
+            raise ValueError(f"must be three numbers within ±{bound:,.0f} {unit}")
         return v
 
 
