@@ -149,3 +149,26 @@ def test_the_output_is_a_picture_path_or_a_folder(recording: Path, tmp_path: Pat
             write_preview(recording, frame=0, output=bad)
         assert not bad.exists()
     assert write_preview(recording, frame=0, output=tmp_path / "p.JPG").stat().st_size > 0
+
+
+def test_a_frame_after_a_stopped_run_s_last_is_said_to_be_past_it(tmp_path: Path) -> None:
+    """A review's: a run stopped after its first frames was said to hold every frame it set out to write ("holds
+    frames 0..4999" of a run interrupted after 297), and a frame past its last was looked for as if damaged."""
+    from mmusv.acquire import run
+    from mmusv.errors import ConfigError
+    from mmusv.recording import frame_messages
+    from tiny_scenario import lidar_scenario
+
+    def stop(done: int, _total: int) -> None:
+        if done == 2:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run(lidar_scenario("stopped", frames=6), out_dir=tmp_path, progress=stop)
+    rec = tmp_path / "stopped.mcap"
+    assert frame_messages(rec, 1)
+    with pytest.raises(ConfigError) as err:
+        frame_messages(rec, 4)
+    assert "which holds frames 0..1 (its run is interrupted: 2 of the 6 frames it set out to write)" in str(err.value)
+    with pytest.raises(ConfigError, match=r"which holds frames 0\.\.5\b"):  # outside what it set out to write
+        frame_messages(rec, 9)

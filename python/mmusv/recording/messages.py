@@ -110,6 +110,16 @@ def frame_messages(path: str | Path, frame: int) -> dict[str, Any]:
     if said and frame not in span:
         held = f"frames {span.start}..{span.stop - 1}" if len(span) else "no frames"
         raise ConfigError(f"frame = {frame}: not in {p}, which holds {held}")
+    status, written = info.run.get("status"), str(info.run.get("frames_written", ""))
+    if said and status not in (None, "complete") and written.isdigit() and frame >= span.start + int(written):
+        # an interrupted or failed run holds its first frames_written frames (written in order), not all it set out
+        # to write: "holds frames 0..4999" was said of a run stopped after 297
+        n = int(written)
+        held = f"frames {span.start}..{span.start + n - 1}" if n else "no frames"
+        raise ConfigError(
+            f"frame = {frame}: not in {p}, which holds {held} (its run is {status}: {n} of the {len(span)} frames "
+            "it set out to write)"
+        )
     # only the chunks around the frame are decompressed (a negative frame is in no recording: read to say so)
     stream = FrameStream(info, want=lambda _t: True, frames=(frame, frame + 1) if frame >= 0 else None)
     for fr in stream:
