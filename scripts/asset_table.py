@@ -126,7 +126,10 @@ face); the conversions are `mmusv.world.mesh_materials`'s.
 folder, empty, an extension trimesh does not read, a GLB shorter than its header says, a `.gltf` whose `.bin` or
 texture file is missing or not an image, an OBJ whose `.mtl` (`mtllib`) or `map_Kd`/`map_Ke` texture is missing
 (naming the entry and the path looked for) or not an image, a `usemtl` naming no material of its MTL files, an MTL
-value out of range (`Kd` outside [0, 1], ...), a `COLOR_0` that glTF does not allow or that does not fit its
+value out of range (`Kd` outside [0, 1], ...), a glTF material factor outside [0, 1] (`baseColorFactor`,
+`metallicFactor`, `roughnessFactor`, `emissiveFactor`: trimesh would clamp it), a glTF index into one of the file's
+lists that is not in it (`scene`, a node's `mesh`, a primitive's `material` or accessors, ...), a `COLOR_0`
+that glTF does not allow or that does not fit its
 primitive (naming the primitive and accessor: another count than its `POSITION`, not VEC3/VEC4, not float or
 normalized unsigned byte/short, a sparse accessor (trimesh does not apply its values), non-finite or outside
 [0, 1]), non-finite coordinates, no triangles, or trimesh's own reason for a file it cannot parse. A texture or
