@@ -16,6 +16,7 @@ import math
 import struct
 from collections.abc import Iterator
 from pathlib import Path
+from typing import TypeGuard
 from urllib.parse import unquote
 
 from mmusv.world.asset_spec import AssetSpecError
@@ -103,7 +104,7 @@ def _gltf_checks(path: Path, data: dict[str, object], where: str) -> dict[Emissi
         ext = m.get("extensions")
         ks = ext.get("KHR_materials_emissive_strength") if isinstance(ext, dict) else None
         value = ks.get("emissiveStrength", 1.0) if isinstance(ks, dict) else 1.0
-        ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value) and value >= 0
+        ok = _finite_number(value) and value >= 0
         if not ok:
             raise AssetSpecError(
                 where,
@@ -179,6 +180,11 @@ def _reference_checks(shown: str, data: dict[str, object], where: str) -> None:
             raise AssetSpecError(where, f"{shown}: {at} is {index!r}, but the file has {n} {kind} ({have})")
 
 
+def _finite_number(value: object) -> TypeGuard[float]:
+    """Whether a JSON value is a finite number (``true`` and ``false`` are not)."""
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
 _FACTORS = (
     ("pbrMetallicRoughness", "baseColorFactor", 4),
     ("pbrMetallicRoughness", "metallicFactor", 0),
@@ -197,13 +203,10 @@ def _factor_checks(shown: str, i: int, material: dict[str, object], where: str) 
         if not isinstance(obj, dict) or name not in obj:
             continue
         value = obj[name]
-        values = value if n and isinstance(value, list) and len(value) == n else [value] if not n else None
+        shaped = not n or (isinstance(value, list) and len(value) == n)  # n > 0: a list of n numbers
+        values = value if n and shaped else [value]
         field = f"materials[{i}].{holder + '.' if holder else ''}{name}"
-        ok = values is not None and all(
-            isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and 0.0 <= v <= 1.0
-            for v in values
-        )
-        if not ok:
+        if not shaped or not all(_finite_number(v) and 0.0 <= v <= 1.0 for v in values):
             what = f"{n} numbers in [0, 1]" if n else "a number in [0, 1]"
             raise AssetSpecError(where, f"{shown}: {field} is {value!r}; glTF 2.0 allows {what}")
 
