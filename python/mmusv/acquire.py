@@ -40,7 +40,7 @@ from mmusv.jsonio import dump_json, write_bytes_atomic
 from mmusv.profiling import RunProfile, clocks
 from mmusv.recording.background import BackgroundWriter
 from mmusv.recording.guard import FolderLock, HeldSignals, write_cause
-from mmusv.recording.tables import TableWriter
+from mmusv.recording.tables import SCHEMAS, TableWriter
 from mmusv.scenario_checks import check_mounts, check_routes
 from mmusv.simulation import FrameCapture, Simulation
 
@@ -169,8 +169,10 @@ def run(
     Raises:
         ConfigError: the scenario or an argument is invalid, or the first frame cannot be captured (nothing is
             written); flags (``overwrite``, ``checks``, ``profile``) must be ``bool``.
-        IoError: the output exists and ``overwrite`` is false, another run writes the folder, or it cannot be
-            written (the message names the cause, e.g. ``No space left on device``, and the frames that are safe).
+        IoError: the output exists and ``overwrite`` is false, another run writes the folder, a name the run
+            writes there is taken by the wrong kind (a file named ``tables``, a folder named ``manifest.json``:
+            refused before anything is written), or it cannot be written (the message names the cause, e.g.
+            ``No space left on device``, and the frames that are safe).
         KeyboardInterrupt: re-raised after the recording was finished with every completed frame.
     """
 
@@ -217,6 +219,7 @@ def run(
         raise IoError(f"{rec_path} already exists; pass overwrite=True (mmusv run --overwrite) to replace it")
     if not overwrite:
         _refuse_another_run(out, rec_path)
+    _refuse_wrong_kinds(out)
     try:  # builds the world: any remaining config problem surfaces here, before writing
         sim = Simulation(scenario)
     except MmusvError as exc:
@@ -417,6 +420,15 @@ def _record(
     result.frames_written = writer.done
     # finish what can be finished; a write that fails here (a full disk) is named below, not raised half-way
     problems: list[tuple[str, BaseException]] = []
+    # The last table part is written before the recording is finished, so that a recording never says
+    # `complete` of a run whose tables could not be written (it says `failed`, and why).
+    try:
+        tables.flush()  # the writer thread has ended: the tables are the main thread's again
+    except OSError as exc:
+        problems.append(("writing the tables", exc))
+        if result.status == "complete":
+            result.status = "failed"
+            result.error = f"writing the tables: {write_cause(out, exc)}"
     try:
         summary = recorder.finish(
             status=result.status,
@@ -428,10 +440,6 @@ def _record(
         result.messages, result.bytes = summary.get("messages", 0), summary.get("bytes", 0)
     except (MmusvError, OSError) as exc:
         problems.append((f"finishing {rec_path.name}", exc))
-    try:
-        tables.flush()  # the writer thread has ended: the tables are the main thread's again
-    except OSError as exc:
-        problems.append(("writing the tables", exc))
     result.seconds = time.perf_counter() - t0
     if prof is not None:
         prof.stop(result.frames_written)
@@ -453,7 +461,7 @@ def _record(
         "frequency_hz": scenario.acquisition.frequency_hz,
         "agents": [a.id for a in sim.agents],
         "recording": rec_path.name,
-        "tables": sorted(p.name for p in tables_dir.iterdir()) if tables_dir.exists() else [],
+        "tables": sorted(p.name for p in tables_dir.iterdir()) if tables_dir.is_dir() else [],
     }
     if frame_range is not None:
         manifest["first_frame"] = first
@@ -482,6 +490,24 @@ def _refuse_another_run(out: Path, rec_path: Path) -> None:
             f"{out} holds the run of another recording, {other} (its manifest.json, scenario.yaml and tables/), "
             f"which a run of {rec_path.name} there would replace; give each scenario a folder of its own (-o), or "
             f"pass overwrite=True (mmusv run --overwrite) to replace them ({other} itself is kept)"
+        )
+
+
+def _refuse_wrong_kinds(out: Path) -> None:
+    """Raises :class:`~mmusv.errors.IoError` when one of the names a run writes in ``out`` is taken by the wrong
+    kind of entry: ``tables`` and its three table folders must be folders, ``manifest.json`` and ``scenario.yaml``
+    files. Checked before anything is written; before, a file named ``tables`` failed the run only after its last
+    frame, with the recording finished as ``complete``, no tables and no manifest."""
+    wanted = {"manifest.json": False, "scenario.yaml": False, "tables": True}
+    wanted.update({f"tables/{name}": True for name in SCHEMAS})
+    for name, folder in wanted.items():
+        path = out / name
+        if not (path.exists() or path.is_symlink()) or path.is_dir() == folder:
+            continue
+        kind, must = ("a folder", "a file") if path.is_dir() else ("not a folder", "a folder")
+        raise IoError(
+            f"{path} is {kind}, but a run writes its {name} there as {must}; move it out of {out} or give the run "
+            "another folder (-o)"
         )
 
 

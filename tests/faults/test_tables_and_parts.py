@@ -122,3 +122,56 @@ def test_a_part_swapped_for_another_recording_is_named(tmp_path: Path) -> None:
     assert code == 2 and "starts at frame 8, the manifest says 4" in err, err
     part.write_bytes(kept)
     assert cli_main("info", str(manifest))[0] == 0
+
+
+@pytest.mark.parametrize(
+    ("name", "make"),
+    [
+        ("tables", lambda p: p.write_bytes(b"")),
+        ("tables/boxes_2d", lambda p: p.write_bytes(b"")),
+        ("manifest.json", lambda p: p.mkdir()),
+        ("scenario.yaml", lambda p: p.mkdir()),
+    ],
+    ids=["tables-file", "table-file", "manifest-folder", "scenario-folder"],
+)
+def test_a_name_the_run_writes_taken_by_the_wrong_kind_is_refused_before_writing(
+    tmp_path: Path, name: str, make: object
+) -> None:
+    """A file named ``tables`` in the output folder failed the run only after its last frame: the recording was
+    finished as ``complete``, with no tables and no manifest, and the error said only "Not a directory" (found by
+    the malformed-input review). Now it is refused before anything is written."""
+    src = write_yaml(tmp_path / "tiny.yaml", scenario("tiny", frames=2))
+    out = tmp_path / "out"
+    target = out / name
+    target.parent.mkdir(parents=True, exist_ok=True)
+    make(target)  # type: ignore[operator]
+    code, _out, err = cli_main("run", str(src), "-o", str(out))
+    assert code == 2 and "Traceback" not in err, err
+    assert str(target) in err and ("is not a folder" in err or "is a folder" in err), err
+    assert not (out / "tiny.mcap").exists() and not (out / "tiny.mcap.partial").exists()
+
+
+def test_tables_that_cannot_be_written_at_the_end_leave_a_failed_recording(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The last table part was written after the recording was finished as ``complete``: a failure there left a
+    recording that said complete, without its tables. Now the tables are written first, and the recording and the
+    manifest say ``failed`` and why."""
+    import errno
+    import json
+    import os
+
+    from mmusv.acquire import run
+    from mmusv.recording.info import read_info
+    from mmusv.recording.tables import TableWriter
+
+    def full(self: TableWriter) -> None:
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(tmp_path / "out/tables/world_state"))
+
+    monkeypatch.setattr(TableWriter, "flush", full)
+    with pytest.raises(IoError, match="while writing the tables"):
+        run(scenario("tiny", frames=2), out_dir=tmp_path / "out")
+    info = read_info(tmp_path / "out/tiny.mcap")
+    assert info.run.get("status") == "failed" and "writing the tables" in info.run.get("error", ""), info.run
+    manifest = json.loads((tmp_path / "out/manifest.json").read_text())
+    assert manifest["status"] == "failed" and manifest["tables"] == []

@@ -355,7 +355,7 @@ def recover(target: str | os.PathLike[str], *, overwrite: bool = False) -> Recov
             "frequency_hz": info.frequency_hz,
             "agents": [a.id for a in info.agents],
             "recording": final.name,
-            "tables": sorted(p.name for p in tables_dir.iterdir()) if tables_dir.exists() else [],
+            "tables": sorted(p.name for p in tables_dir.iterdir()) if tables_dir.is_dir() else [],
             "recovered_from": src.name,
         }
         if "first_frame" in run:
