@@ -154,6 +154,32 @@ def test_a_frame_range_beyond_every_recording_is_refused_before_writing(
     assert not (tmp_path / "two" / "export_short").exists()
 
 
+def test_a_frame_range_past_an_interrupted_run_s_last_frame_is_refused_before_writing(tmp_path: Path) -> None:
+    """The malformed-input review's: ``--frames 20:30`` of a run interrupted after 10 of its 50 frames wrote a
+    conversion of nothing and exited 1, and ``--frames 150:160`` was refused as past "frames 0..49", frames the run
+    never wrote. Both are refused before anything is written, naming the frames it holds and why."""
+    from mmusv.acquire import run
+    from tiny_scenario import lidar_scenario
+
+    def stop(done: int, _total: int) -> None:
+        if done == 2:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run(lidar_scenario("stopped", frames=6), out_dir=tmp_path / "run", progress=stop)
+    rec = tmp_path / "run" / "stopped.mcap"
+    for frames in ("3:5", "8:9"):
+        with pytest.raises(ConfigError) as err:
+            convert(rec, out_dir=tmp_path / "o", to="semantickitti", frames=frames, splits=None)
+        assert (
+            f"frames = {frames}: none is in {rec}, which holds frames 0..1 (its run is interrupted: 2 of the 6 "
+            "frames it set out to write)" in str(err.value)
+        ), err.value
+        assert not (tmp_path / "o").exists()
+    rep = convert(rec, out_dir=tmp_path / "o", to="semantickitti", frames="1:5", splits=None)
+    assert rep.frames == 1
+
+
 def test_a_frame_range_reaching_past_the_recording_is_noted(coop_rec: Path, tmp_path: Path) -> None:
     """``--frames 1:10`` of a 3-frame recording converted frames 1 and 2 without a word about 3..9; the report says
     which indices of the range the recording does not hold (a range inside it, or open-ended, says nothing)."""

@@ -18,7 +18,7 @@ from mmusv.errors import ConfigError, IoError
 from mmusv.recording.info import check_mcap, read_info, recording_arg
 from mmusv.recording.parts import is_parts_manifest, part_files
 from mmusv.recording.scan import Scan
-from mmusv.recording.stream import FrameStream
+from mmusv.recording.stream import FrameStream, held_text
 
 __all__ = ["frame_messages", "read_messages"]
 
@@ -103,23 +103,15 @@ def frame_messages(path: str | Path, frame: int) -> dict[str, Any]:
                 if part is None:
                     raise ConfigError(f"frame {frame} is not in {p}: its part is not recorded yet")
                 return frame_messages(part, frame)
-        held = f"frames {files[0][0]}..{files[-1][1] - 1}" if files else "no frames"
-        raise ConfigError(f"frame = {frame}: not in {p}, which holds {held}")
+        held = range(files[0][0], files[-1][1]) if files else range(0)
+        raise ConfigError(f"frame = {frame}: not in {p}, which holds {held_text(held)}")
     info = read_info(p)
-    span, said = FrameStream(info, want=lambda _t: False).expected()  # the frames the run wrote (or set out to)
-    if said and frame not in span:
-        held = f"frames {span.start}..{span.stop - 1}" if len(span) else "no frames"
-        raise ConfigError(f"frame = {frame}: not in {p}, which holds {held}")
-    status, written = info.run.get("status"), str(info.run.get("frames_written", ""))
-    if said and status not in (None, "complete") and written.isdigit() and frame >= span.start + int(written):
-        # an interrupted or failed run holds its first frames_written frames (written in order), not all it set out
-        # to write: "holds frames 0..4999" was said of a run stopped after 297
-        n = int(written)
-        held = f"frames {span.start}..{span.start + n - 1}" if n else "no frames"
-        raise ConfigError(
-            f"frame = {frame}: not in {p}, which holds {held} (its run is {status}: {n} of the {len(span)} frames "
-            "it set out to write)"
-        )
+    probe = FrameStream(info, want=lambda _t: False)
+    span, _said = probe.expected()  # the frames the run set out to write
+    held, said, why = probe.held()  # of them, those it wrote (an interrupted run: its first frames_written)
+    if said and frame not in held:
+        # "holds frames 0..4999" was said of a run stopped after 297
+        raise ConfigError(f"frame = {frame}: not in {p}, which holds {held_text(held)}{why}")
     # only the chunks around the frame are decompressed (a negative frame is in no recording: read to say so)
     stream = FrameStream(info, want=lambda _t: True, frames=(frame, frame + 1) if frame >= 0 else None)
     for fr in stream:
@@ -133,7 +125,7 @@ def frame_messages(path: str | Path, frame: int) -> dict[str, Any]:
     if stream.truncated and frame in span:  # a frame of the run, lost with a damaged chunk or a cut-off end
         raise IoError(f"frame {frame} of {p} is lost to damage ({stream.truncated})")
     where = f" ({stream.truncated})" if stream.truncated else ""
-    held = f"frames {span.start}..{span.stop - 1}" if len(span) else "no frames"
     raise ConfigError(
-        f"frame = {frame}: not in {p}, {'which holds' if said else 'whose run set out to write'} {held}{where}"
+        f"frame = {frame}: not in {p}, {'which holds' if said else 'whose run set out to write'} "
+        f"{held_text(span)}{where}"
     )

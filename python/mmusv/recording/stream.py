@@ -26,7 +26,7 @@ from mmusv.recording.parts import is_parts_manifest, part_files
 from mmusv.recording.scan import Scan
 from mmusv.recording.topics import WORLD_STATE
 
-__all__ = ["Frame", "FrameStream", "frame_ranges", "warn_missing"]
+__all__ = ["Frame", "FrameStream", "frame_ranges", "held_text", "warn_missing"]
 
 
 @dataclass
@@ -134,12 +134,11 @@ class FrameStream:
         """Chunks hopped over unread because they hold no frame of :attr:`frames`."""
         self._missing_parts: list[tuple[int, int, str]] = []
         self._ended = False
-        span, said = self._expected_all()
-        if frames is not None and said and not self._in_range(span.start, span.stop - 1):
+        held, said, why = self.held()
+        if frames is not None and said and not self._in_range(held.start, held.stop - 1):
             # The run said which frames it wrote and none is in the range: an empty stream would look like a
-            # recording without frames.
-            held = f"frames {span.start}..{span.stop - 1}" if len(span) else "no frames"
-            raise ConfigError(f"frames = {frames!r}: none is in {info.path}, which holds {held}")
+            # recording without frames (and a conversion of it wrote an empty dataset).
+            raise ConfigError(f"frames = {frames!r}: none is in {info.path}, which holds {held_text(held)}{why}")
 
     def _index(self, log_time_ns: int, world: WorldFrame | None) -> int:
         if world is not None:
@@ -344,6 +343,27 @@ class FrameStream:
             span = range(max(span.start, start), span.stop if stop is None else min(span.stop, stop))
         return span, said
 
+    def held(self) -> tuple[range, bool, str]:
+        """The frames the recording holds as its ``run`` metadata says (all of :attr:`frames`, unlike
+        :meth:`expected`), whether it says so (``False``: the run did not finish, and the range is what it set out
+        to write), and why it holds fewer than it set out to write, as ``" (its run is interrupted: 297 of the 5000
+        frames it set out to write)"`` (``""`` for a complete run). An interrupted or failed run holds its first
+        ``frames_written`` frames: they are written in frame order (a recovered one says only those). A parts
+        manifest's parts may be missing anywhere: it holds what its parts set out to write."""
+        span, said = self._expected_all()
+        status, written = self.run.get("status"), str(self.run.get("frames_written", ""))
+        if (
+            not said
+            or is_parts_manifest(self.info.path)
+            or status in (None, "complete")
+            or not written.isdigit()
+            or int(written) >= len(span)
+        ):
+            return span, said, ""
+        n = int(written)
+        why = f" (its run is {status}: {n} of the {len(span)} frames it set out to write)"
+        return range(span.start, span.start + n), said, why
+
     def _expected_all(self) -> tuple[range, bool]:
         run = self.run
         if is_parts_manifest(self.info.path):
@@ -386,6 +406,11 @@ class FrameStream:
             parts.append(f"{name} (frames {first}..{stop - 1}) is not recorded")
         parts += self.damage
         return "; ".join(parts)
+
+
+def held_text(frames: range) -> str:
+    """``"frames 0..296"`` (``"no frames"`` for an empty range): what a recording holds, in messages."""
+    return f"frames {frames.start}..{frames.stop - 1}" if len(frames) else "no frames"
 
 
 def warn_missing(stream: FrameStream, *, reader: str) -> None:
