@@ -3,11 +3,13 @@ priors and the map meshes, checked with an independent numpy vertical-ray caster
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
 import shapely
+import yaml
 from mmusv.classes import SemanticClass
 from mmusv.world.maps import (
     MAP_KINDS,
@@ -20,6 +22,8 @@ from mmusv.world.maps import (
     make_params,
 )
 from mmusv.world.primitives import TriMesh
+
+ROOT = Path(__file__).resolve().parents[2]
 
 WATER = int(SemanticClass.WATER)
 
@@ -439,6 +443,7 @@ def test_port_priors_hold_structures_and_tall_occluders() -> None:
         ("port", {"entrance_width_m": 5000.0}, "entrance_width_m"),
         ("port", {"n_cranes": 100}, "n_cranes"),
         ("port", {"moored_assets": [["ship", -1.0, 5.0]]}, "moored_assets"),
+        ("port", {"moored_assets": [["tug_32m", 32.0, 9.0], ["tug_32", 32.0, 9.0]]}, "moored_assets"),
         ("port", {"vegetation": "yes"}, "vegetation"),
     ],
 )
@@ -482,8 +487,22 @@ def test_islands_that_cannot_fit_are_reported() -> None:
     assert err.value.field == "n_islands"
 
 
+def test_an_unknown_moored_asset_is_named_with_its_entry_in_the_scenario() -> None:
+    """The malformed-input review's: an unknown name in ``moored_assets`` was refused only when the port was built,
+    as "unknown vessel asset 'no_such_ship'", naming no field; now with its path and entry, as a vessel's asset."""
+    from mmusv.config import load_scenario
+    from mmusv.errors import ConfigError
+
+    doc = yaml.safe_load((ROOT / "scenarios" / "port_entry.yaml").read_text())
+    doc["map"]["params"] = {"moored_assets": [["tug_32m", 32, 9], ["tug_32", 32, 9]]}
+    with pytest.raises(ConfigError) as err:
+        load_scenario(doc)
+    said = str(err.value)
+    assert "map.params.moored_assets" in said and "entry 1 ('tug_32')" in said and "did you mean tug_32m" in said
+
+
 def test_params_accept_yaml_style_lists_and_keep_defaults() -> None:
-    p = make_params("port", pier_length_m=[100, 150], moored_assets=[["tug", 30, 10]])
+    p = make_params("port", pier_length_m=[100, 150], moored_assets=[["tug_32m", 30, 10]])
     assert isinstance(p, PortParams)
-    assert p.pier_length_m == (100.0, 150.0) and p.moored_assets == (("tug", 30.0, 10.0),)
+    assert p.pier_length_m == (100.0, 150.0) and p.moored_assets == (("tug_32m", 30.0, 10.0),)
     assert IslandParams().extent_m == 2000.0 and OpenSeaParams().extent_m == 4000.0 and PortParams().extent_m == 2000.0

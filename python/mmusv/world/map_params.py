@@ -323,6 +323,13 @@ class PortParams(_CommonParams):
     def _moored(cls, v: tuple[_Berth, ...], info: ValidationInfo) -> tuple[_Berth, ...]:
         if any(not a or length <= 0.0 or beam <= 0.0 for a, length, beam in v) or (info.data.get("n_moored") and not v):
             raise ValueError("must be a list of [asset_name, length_m > 0, beam_m > 0] (non-empty when n_moored > 0)")
+        from mmusv.world.vessels import AssetNameError, known_asset  # the library is built lazily, never here
+
+        for k, (name, _length, _beam) in enumerate(v):
+            try:
+                known_asset(name)
+            except AssetNameError as exc:  # said with the entry, as a vessel's asset is: not only when built
+                raise ValueError(f"entry {k} ({name!r}): {exc}") from None
         return v
 
 
