@@ -97,7 +97,7 @@ class MapConfig(_Model):
     ``params`` dump as the values that were given (resolved port knobs stay on the model, out of the dump)."""
 
     type: Literal["island", "open_sea", "port"] = "island"
-    seed: int = Field(default=0, ge=0)
+    seed: int = Field(default=0, ge=0, lt=2**63)
     params: MapParams = Field(default=None, validate_default=True)
 
     @field_validator("params", mode="before")
@@ -150,7 +150,7 @@ class SeaConfig(_Model):
     hs_m: float | None = Field(default=None, ge=0, le=MAX_WAVE_HEIGHT_M)
     tp_s: float | None = Field(default=None, ge=TP_RANGE_S[0], le=TP_RANGE_S[1])
     gamma: float | None = Field(default=None, ge=1, le=7)
-    direction_deg: float = 0.0
+    direction_deg: float = Field(default=0.0, ge=-360, le=360, allow_inf_nan=False)
     spread_s: float = Field(default=10.0, ge=0.5, le=100)
 
     @model_validator(mode="after")

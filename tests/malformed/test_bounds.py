@@ -63,6 +63,7 @@ def _refused(doc: dict[str, Any], tmp_path: Path) -> str:
         ("vessels.1.speed_mps", True, "vessels[1].speed_mps"),  # read as 1 m/s
         ("environment.wave", True, "environment.wave"),  # read as a 1 m sea
         ("environment.wave", 1e9, "environment.wave"),  # the paper's formula took a 1e9 m sea; physical: named hs_m
+        ("map.seed", 10**30, "map.seed"),  # accepted, as the scenario's own seed was not (< 2**63)
         ("name", "..", "name"),  # wrote `...mcap`; exports then failed
         ("name", ".hidden", "name"),
     ],
@@ -80,11 +81,25 @@ def test_camera_settings_out_of_range_are_refused(tmp_path: Path) -> None:
         assert f"rigs.r.cameras[0].noise.{key}" in _refused(_with("rigs.r.cameras", cams), tmp_path)
 
 
+@pytest.mark.parametrize("direction", [1e300, -721.0, float("nan")])
+def test_a_sea_direction_past_a_turn_is_refused(direction: float, tmp_path: Path) -> None:
+    """The malformed-input review's: ``environment.sea.direction_deg: 1e300`` was taken (its sine and cosine then
+    any values at all), as a mount's ``rpy_deg`` no longer is."""
+    doc = yaml.safe_load(yaml.safe_dump(BASE))
+    doc["environment"] = {"sea": {"state": 3, "direction_deg": direction}}
+    assert "environment.sea.direction_deg" in _refused(doc, tmp_path)
+
+
 def test_the_values_at_the_bounds_still_load() -> None:
     doc = _with("vessels.1.speed_mps", 100.0)
     doc["vessels"][1]["route"] = [[-1e6, 100], [1e6, 100]]
     doc["environment"] = {"weather": "rain", "rain_mm_per_h": 500, "visibility_m": 1, "time_of_day": "13:00"}
     doc["acquisition"]["frequency_hz"] = 0.01
+    load_scenario(doc)
+    doc["environment"] = {"sea": {"state": 3, "direction_deg": -360}}
+    doc["map"]["seed"] = 2**63 - 1
+    load_scenario(doc)
+    doc["environment"]["sea"]["direction_deg"] = 360
     load_scenario(doc)
 
 
