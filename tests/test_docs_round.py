@@ -65,8 +65,10 @@ def _world_state_only(name: str) -> dict[str, object]:
 
 def test_recording_snippet_prints_what_it_says(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     import mmusv
+    from mmusv.scenario_checks import MmusvWarning
 
-    mmusv.run(_world_state_only("run"), out_dir=tmp_path)  # writes run.mcap, the file the snippet opens
+    with pytest.warns(MmusvWarning, match="no vessel has role: usv"):  # said, and the world state recorded
+        mmusv.run(_world_state_only("run"), out_dir=tmp_path)  # writes run.mcap, the file the snippet opens
     code = next(
         body for lang, body, _ in _blocks(Doc("docs/recording.md", _doc("docs/recording.md"))) if lang == "python"
     )

@@ -41,7 +41,7 @@ from mmusv.profiling import RunProfile, clocks
 from mmusv.recording.background import BackgroundWriter
 from mmusv.recording.guard import FolderLock, HeldSignals, write_cause
 from mmusv.recording.tables import SCHEMAS, TableWriter
-from mmusv.scenario_checks import check_mounts, check_routes
+from mmusv.scenario_checks import check_mounts, check_routes, check_sensors
 from mmusv.simulation import FrameCapture, Simulation
 
 __all__ = ["TABLE_PART_FRAMES", "RunResult", "recording_path", "run"]
@@ -224,6 +224,7 @@ def run(
         sim = Simulation(scenario)
     except MmusvError as exc:
         raise located(exc, source) from None
+    check_sensors(scenario, source=source)  # not a check of the map: said with or without checks
     if checks:
         check_mounts(scenario, source=source)
         # The routes as far as this run sails them: frames 0 .. total - 1 (the stop of a frame range).

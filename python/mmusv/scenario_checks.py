@@ -7,6 +7,9 @@ label wrong; ``shore_clearance``, ``structure_clearance`` and ``separation`` are
 what a user wants). ``mmusv run --no-checks`` and ``mmusv.run(..., checks=False)`` skip them.
 
 :func:`check_mounts` warns about sensor mounts far from their hull (a units mistake: millimetres for metres).
+:func:`check_sensors` warns about a scenario that records no sensor at all: no vessel with ``role: usv``, or USVs
+whose rigs switch every sensor off (``preset: lidar_only`` with ``lidar: null``); such a run records the world state
+and the boxes only, which may be meant (ground-truth trajectories), so it is a warning.
 Warnings are :class:`MmusvWarning` through :mod:`warnings`; the CLI prints each as one line.
 
 :func:`map_findings` is what the scenario editor (``mmusv editor``) shows: the same samples and named checks, plus
@@ -31,6 +34,7 @@ if TYPE_CHECKING:
     from mmusv.generate.mapctx import MapContext
     from mmusv.generate.samples import Samples
     from mmusv.generate.spec import GenerationSpec
+    from mmusv.sensors.config import RigConfig
     from mmusv.world.maps import MapWorld
 
 __all__ = [
@@ -39,6 +43,7 @@ __all__ = [
     "MmusvWarning",
     "check_mounts",
     "check_routes",
+    "check_sensors",
     "map_check_spec",
     "map_findings",
     "scenario_samples",
@@ -232,3 +237,32 @@ def check_mounts(scenario: Scenario, *, source: str) -> list[str]:
     for w in found:
         warnings.warn(w, MmusvWarning, stacklevel=2)
     return found
+
+
+def check_sensors(scenario: Scenario, *, source: str) -> list[str]:
+    """Warns (and returns the warning) when no vessel of ``scenario`` carries a sensor: none has ``role: usv``,
+    or every USV's rig has its LiDAR, radar and top view off and no camera. The run then records the world state
+    (and each USV's boxes) only; before, it did so without a word."""
+    usvs = [v for v in scenario.vessels if v.role == "usv"]
+    found: list[str] = []
+    if not usvs:
+        found.append(
+            f"{source}: no vessel has role: usv, so the recording holds no sensor data and no per-agent boxes, "
+            "only the world state (give a vessel `role: usv` and a `rig`)"
+        )
+    else:
+        empty = sorted({v.rig for v in usvs if v.rig is not None and _no_sensor(scenario.rigs[v.rig])})
+        if len(empty) == len({v.rig for v in usvs}):
+            rigs = ", ".join(f"rigs.{r}" for r in empty)
+            found.append(
+                f"{source}: {rigs} switch{'es' if len(empty) == 1 else ''} every sensor off (lidar, radar and "
+                "top_view null, cameras empty), so the recording holds no sensor data, only the world state and "
+                "the boxes"
+            )
+    for w in found:
+        warnings.warn(w, MmusvWarning, stacklevel=2)
+    return found
+
+
+def _no_sensor(rig: RigConfig) -> bool:
+    return rig.lidar is None and rig.radar is None and rig.top_view is None and not rig.cameras

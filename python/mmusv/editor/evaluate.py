@@ -40,7 +40,7 @@ from mmusv.errors import ConfigError, MmusvError
 from mmusv.generate.mapctx import map_context
 from mmusv.generate.samples import FEWER_TIMES, MAX_CHECK_SAMPLES, budget_problem, sample_counts
 from mmusv.motion import build_fleet
-from mmusv.scenario_checks import check_mounts, map_check_spec, map_findings
+from mmusv.scenario_checks import check_mounts, check_sensors, map_check_spec, map_findings
 from mmusv.sensors.config import RigConfig
 from mmusv.text import counted
 from mmusv.world.vessels import get_asset
@@ -184,14 +184,16 @@ def evaluate(document: dict[str, Any]) -> dict[str, Any]:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         mounts = check_mounts(scenario, source="scenario")
-    for msg in mounts:
+        sensors = check_sensors(scenario, source="scenario")
+    for check, msg in [("mounts", m) for m in mounts] + [("sensors", m) for m in sensors]:
         text = msg.removeprefix("scenario: ")
+        field = text.split(" ", 1)[0].rstrip(",")
         out["problems"].append(
             {
-                "check": "mounts",
+                "check": check,
                 "severity": "warning",
                 "message": text,
-                "field": text.split(" ", 1)[0],
+                "field": field if field.startswith("rigs.") else "vessels",
                 "vessels": [],
                 "point": None,
                 "segments": {},

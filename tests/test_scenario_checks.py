@@ -1,0 +1,91 @@
+"""mmusv.scenario_checks.check_sensors: a scenario that records no sensor at all is said so, once, as a warning (the
+malformed-input review's: ``preset: lidar_only`` with ``lidar: null``, or no vessel with ``role: usv``, ran without a
+word and recorded the world state only)."""
+
+from __future__ import annotations
+
+import copy
+import warnings
+from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
+from mmusv.cli import main
+from mmusv.config import load_scenario
+from mmusv.scenario_checks import MmusvWarning, check_sensors
+
+BASE: dict[str, Any] = {
+    "name": "t",
+    "map": {"type": "open_sea", "seed": 2},
+    "acquisition": {"frequency_hz": 5, "frames": 2},
+    "rigs": {"r": {"preset": "lidar_only"}},
+    "vessels": [
+        {"id": "u", "role": "usv", "asset": "usv_wamv", "rig": "r", "speed_mps": 3, "route": [[-300, 0], [300, 0]]},
+        {"id": "t1", "asset": "fishing_boat_12m", "speed_mps": 3, "route": [[-100, 20], [-400, 25]]},
+    ],
+}
+
+
+def _no_lidar() -> dict[str, Any]:
+    doc = copy.deepcopy(BASE)
+    doc["rigs"]["r"]["lidar"] = None
+    return doc
+
+
+def _no_usv() -> dict[str, Any]:
+    doc = copy.deepcopy(BASE)
+    del doc["rigs"]
+    doc["vessels"] = doc["vessels"][1:]
+    return doc
+
+
+def _one_rig_empty() -> dict[str, Any]:  # two USVs, one of them with a sensor: nothing to say
+    doc = copy.deepcopy(BASE)
+    doc["rigs"]["off"] = {"preset": "lidar_only", "lidar": None}
+    doc["vessels"].append({**doc["vessels"][0], "id": "u2", "rig": "off", "route": [[-300, 50], [300, 50]]})
+    return doc
+
+
+@pytest.mark.parametrize(
+    ("make", "said"),
+    [
+        (_no_lidar, "rigs.r switches every sensor off"),
+        (_no_usv, "no vessel has role: usv"),
+        (_one_rig_empty, None),
+        (lambda: copy.deepcopy(BASE), None),
+    ],
+    ids=["lidar-null", "no-usv", "one-of-two-empty", "lidar-only"],
+)
+def test_a_scenario_without_any_sensor_is_warned_about(make: Any, said: str | None) -> None:
+    scenario = load_scenario(make())
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        found = check_sensors(scenario, source="s.yaml")
+    assert [str(w.message) for w in caught if w.category is MmusvWarning] == found
+    if said is None:
+        assert found == []
+    else:
+        assert len(found) == 1 and found[0].startswith(f"s.yaml: {said}"), found
+
+
+def test_the_run_says_it_on_the_command_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    src = tmp_path / "t.yaml"
+    src.write_text(yaml.safe_dump(_no_lidar()), encoding="utf-8")
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", MmusvWarning)  # printed, as on the command line (the tests make them errors)
+        assert main(["run", str(src), "-o", str(tmp_path / "out")]) == 0
+    err = capsys.readouterr().err
+    assert f"mmusv: warning: {src}: rigs.r switches every sensor off" in err, err
+    assert (tmp_path / "out" / "t.mcap").exists()  # a warning: the run still records the world state
+
+
+def test_the_editor_lists_it_among_the_problems() -> None:
+    from mmusv.editor.evaluate import evaluate
+
+    ev = evaluate(_no_lidar())
+    (p,) = [p for p in ev["problems"] if p["check"] == "sensors"]
+    assert p["severity"] == "warning" and p["field"] == "rigs.r" and "switches every sensor off" in p["message"]
+    ev = evaluate(_no_usv())
+    (p,) = [p for p in ev["problems"] if p["check"] == "sensors"]
+    assert p["field"] == "vessels" and "no vessel has role: usv" in p["message"]
