@@ -144,3 +144,29 @@ def test_a_number_box_s_note_follows_a_second_unreadable_text(browser: Any, live
     assert note(browser, f"vessels[{i}].speed_mps") == ""
     assert document_of(browser)["vessels"][i]["speed_mps"] == 3
     assert js_errors(browser) == []
+
+
+def test_a_rig_in_use_is_not_removed(browser: Any, live_server: LiveServer) -> None:
+    """A review's: Remove on a rig its USVs carried dropped their ``rig`` without a word, and a USV without a rig
+    carries the paper's full suite (a LiDAR-only USV became fully instrumented). A rig in use is now kept, and the
+    status says who carries it; an unused one is removed as before."""
+    from test_browser import document_of, settled
+
+    open_editor(browser, live_server)
+    js_errors(browser)
+    before = document_of(browser)
+    users = [v["id"] for v in before["vessels"] if v.get("rig") == "usv_standard"]
+    assert users
+    browser.find_element(By.CSS_SELECTOR, '#rigs [data-rig="usv_standard"] button[data-action="remove"]').click()
+    settled(browser)
+    after = document_of(browser)
+    assert after["rigs"] == before["rigs"] and after["vessels"] == before["vessels"]
+    said = browser.find_element(By.ID, "status").text
+    assert f"rig usv_standard is carried by {', '.join(users)}" in said and "not removed" in said, said
+    browser.find_element(By.ID, "rig-add").click()  # rig_2, carried by none
+    settled(browser)
+    assert "rig_2" in document_of(browser)["rigs"]
+    browser.find_element(By.CSS_SELECTOR, '#rigs [data-rig="rig_2"] button[data-action="remove"]').click()
+    settled(browser)
+    assert "rig_2" not in document_of(browser)["rigs"]
+    assert js_errors(browser) == []

@@ -933,10 +933,19 @@ export class Panels {
       const b = ev.target.closest("button[data-action=remove]");
       if (!b) return;
       const name = b.closest("[data-rig]").dataset.rig;
+      const users = (this.state.doc.vessels || []).filter((v) => v.rig === name).map((v) => v.id);
+      if (users.length) {
+        // removed, its vessels were left without a rig, which is the paper's full suite: a LiDAR-only USV became a
+        // fully instrumented one without a word (a review's)
+        this.state.emit("status", {
+          text: `rig ${name} is carried by ${users.join(", ")}: give ${users.length === 1 ? "that vessel" : "those vessels"} another rig first (a USV without one carries the paper's full suite); not removed`,
+          error: true,
+        });
+        return;
+      }
       this.forgetRefused(`rigs.${name}.`);
       edit((d) => {
         delete d.rigs[name];
-        for (const v of d.vessels || []) if (v.rig === name) delete v.rig;
       });
     });
     $("rig-add").addEventListener("click", () => {
