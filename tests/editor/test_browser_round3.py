@@ -216,8 +216,15 @@ def test_a_sea_is_shown_set_and_replaced_by_a_wave(browser: Any, live_server: Li
     type_into(browser, sea, '{"state": 3}')  # and a sea the wave
     settled(browser)
     env = document_of(browser)["environment"]
-    assert env["sea"] == {"state": 3} and env["wave"] == "W0" and value(browser, "e-wave") == "sea"
+    # the sea replaces the wave: the file keeps no wave (W0, the default, goes with a sea; it wrote `wave: W0`)
+    assert env["sea"] == {"state": 3} and "wave" not in env and value(browser, "e-wave") == "sea"
     assert not browser.find_elements(By.CSS_SELECTOR, ".field-note")
+    type_into(browser, sea, "")  # the sea cleared: the wave it replaced comes back (a review's: it left W0)
+    settled(browser)
+    env = document_of(browser)["environment"]
+    assert env["wave"] == "W2" and "sea" not in env and value(browser, "e-wave") == "W2"
+    type_into(browser, sea, '{"state": 3}')
+    settled(browser)
     browser.find_element(By.ID, "undo").click()
     settled(browser)
     assert value(browser, "e-wave") == "W2" and value(browser, "e-sea") == ""

@@ -89,7 +89,12 @@ export class Panels {
     this.refused = new Map();
     this.lastErrors = [];
     this.libraryStop = null; // the library entry that holds its one tab stop (renderLibrary)
-    state.on("jump", () => this.forgetRefused(""));
+    // The wave a scenario had when a sea was typed over it: clearing the sea brings it back (none: the default W0).
+    this.waveBeforeSea = undefined;
+    state.on("jump", () => {
+      this.forgetRefused("");
+      this.waveBeforeSea = undefined; // another scenario, or another version of it
+    });
     // A number box refused as empty, then given another text the browser cannot read ("1e400" after "NaN"): its
     // value stays "", so no change event comes and the note kept saying "empty" (a review's). On leaving the box
     // the note says what is there now.
@@ -826,6 +831,7 @@ export class Panels {
     // a wave picked replaces a `sea` (a scenario gives one or the other)
     const setWave = (value) => {
       this.forgetRefused("environment.sea");
+      this.waveBeforeSea = undefined;
       edit((d) => {
         d.environment ||= {};
         d.environment.wave = value;
@@ -889,10 +895,15 @@ export class Panels {
       this.accept(ev.target);
       edit((d) => {
         d.environment ||= {};
-        if (sea === null) delete d.environment.sea;
-        else {
+        if (sea === null) {
+          delete d.environment.sea;
+          // the wave the scenario had before a sea was typed comes back (clearing the sea left W0, a review's)
+          if (this.waveBeforeSea !== undefined) d.environment.wave = this.waveBeforeSea;
+          this.waveBeforeSea = undefined;
+        } else {
+          if (!isMapping(d.environment.sea) && d.environment.wave !== undefined) this.waveBeforeSea = d.environment.wave;
           d.environment.sea = sea;
-          d.environment.wave = "W0"; // the sea replaces the wave: W0, the default, is the one that goes with a sea
+          delete d.environment.wave; // the sea replaces the wave: the default, W0, is the one that goes with a sea
         }
       });
     });
