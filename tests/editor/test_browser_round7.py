@@ -170,3 +170,38 @@ def test_a_rig_in_use_is_not_removed(browser: Any, live_server: LiveServer) -> N
     settled(browser)
     assert "rig_2" not in document_of(browser)["rigs"]
     assert js_errors(browser) == []
+
+
+def test_a_vessel_is_placed_and_its_route_drawn_from_the_keyboard(browser: Any, live_server: LiveServer) -> None:
+    """A review's: a vessel picked in the library could be placed only with a pointer (Enter on the map ended the
+    placing). Now Enter on the map places it at the cross in the map's middle, the arrow keys move the map under
+    the cross, Space adds waypoints there, and Enter ends the route."""
+    from test_browser import document_of, settled
+
+    open_editor(browser, live_server)
+    js_errors(browser)
+    before = len(document_of(browser)["vessels"])
+    browser.execute_script("document.querySelector('#library li').focus()")
+    ActionChains(browser).send_keys(Keys.ENTER).perform()
+    assert browser.execute_script("return window.mmusvEditor.map.mode") == "place"
+    browser.execute_script("document.getElementById('map').focus()")
+    centre = browser.execute_script("return window.mmusvEditor.map.centre()")
+    assert browser.execute_script("return document.activeElement.id") == "map"  # after keys: focus-visible
+    assert browser.execute_script("return getComputedStyle(document.getElementById('crosshair')).display") == "block"
+    ActionChains(browser).send_keys(Keys.ENTER).perform()
+    settled(browser)
+    vessels = document_of(browser)["vessels"]
+    assert len(vessels) == before + 1
+    new = vessels[-1]
+    assert new["route"] == [[round(c, 1) for c in centre]]
+    assert browser.execute_script("return window.mmusvEditor.map.mode") == "draw"
+    ActionChains(browser).send_keys(Keys.ARROW_RIGHT, Keys.ARROW_RIGHT).perform()  # the map moves under the cross
+    moved = browser.execute_script("return window.mmusvEditor.map.centre()")
+    assert moved[0] > centre[0] and moved[1] == centre[1]
+    ActionChains(browser).send_keys(Keys.SPACE).perform()
+    settled(browser)
+    route = document_of(browser)["vessels"][-1]["route"]
+    assert route == [[round(c, 1) for c in centre], [round(c, 1) for c in moved]]
+    ActionChains(browser).send_keys(Keys.ENTER).perform()
+    assert browser.execute_script("return window.mmusvEditor.map.mode") == "select"
+    assert js_errors(browser) == []

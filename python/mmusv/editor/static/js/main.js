@@ -457,8 +457,8 @@ state.on("mode", ({ mode, asset, vessel }) => {
   const box = $("drawing");
   box.hidden = mode === "select";
   $("drawing-text").textContent = mode === "place"
-    ? `Click the map to place ${asset.name} (${asset.length} × ${asset.beam} m)`
-    : mode === "draw" ? `Click to add waypoints to ${vessel}; double-click or Enter to finish` : "";
+    ? `Click the map to place ${asset.name} (${asset.length} × ${asset.beam} m), or Enter on the map: at the cross in its middle`
+    : mode === "draw" ? `Click to add waypoints to ${vessel} (Space on the map: at the cross); double-click or Enter to finish` : "";
   $("mode-hint").textContent = mode === "select"
     ? "Pick a vessel, then click the map to place it and click again to add waypoints."
     : $("drawing-text").textContent;

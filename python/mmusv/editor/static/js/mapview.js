@@ -356,6 +356,11 @@ export class MapView {
     return `${base}_${n}`;
   }
 
+  /** The world point (metres) under the middle of the map, where the keyboard places and adds waypoints. */
+  centre() {
+    return [this.view.cx, this.view.cy];
+  }
+
   round(p) {
     return [Math.round(p[0] * 10) / 10, Math.round(p[1] * 10) / 10];
   }
@@ -522,6 +527,16 @@ export class MapView {
       if ((ev.key === "Delete" || ev.key === "Backspace") && this.activeWaypoint?.vessel === this.state.selected) {
         ev.preventDefault();
         this.deleteWaypoint(this.activeWaypoint.vessel, this.activeWaypoint.index);
+      } else if (this.mode === "place" && (ev.key === "Enter" || ev.key === " ")) {
+        // from the keyboard: the vessel goes where the cross in the map's middle is (the arrow keys move the map
+        // under it); placing needed a pointer before (a review's)
+        ev.preventDefault();
+        ev.stopPropagation(); // the page's own Enter ends placing and drawing
+        this.place(this.centre());
+      } else if (this.mode === "draw" && ev.key === " ") {
+        ev.preventDefault();
+        ev.stopPropagation();
+        this.appendWaypoint(this.centre());
       } else if (ev.key === "Enter" || ev.key === "Escape") {
         if (this.mode !== "select") this.setMode("select");
       } else if (ev.key.startsWith("Arrow") && !ev.ctrlKey && !ev.metaKey && !ev.altKey) {
