@@ -73,6 +73,8 @@ def test_run_many_refuses_index_sections_it_cannot_write_before_it_runs(
         ("kitti", {"max_occlusion": 0.5}, "max_occlusion = 0.5"),
         ("kitti_tracking", {"min_contrast": 0.05}, "min_contrast = 0.05"),
         ("mastr", {"box": "projected"}, "box = 'projected'"),
+        ("ros2", {"box": "projected"}, "box = 'projected'"),
+        ("ros2", {"min_contrast": 0.05}, "min_contrast = 0.05"),
     ],
 )
 def test_convert_refuses_2d_box_options_a_format_would_ignore(
@@ -80,7 +82,7 @@ def test_convert_refuses_2d_box_options_a_format_would_ignore(
 ) -> None:
     """Before: ``convert(rec, to="opv2v", min_box_px=8)`` converted as if the option had not been given (only COCO,
     YOLO and MOT choose 2D boxes), while ``kitti_class`` with another format was refused."""
-    with pytest.raises(ConfigError, match=re.escape(said) + r".*only the COCO, YOLO and MOT exports"):
+    with pytest.raises(ConfigError, match=re.escape(said) + r".*only the COCO, YOLO(,| and) MOT( and ROS 2)? exports"):
         convert(rec, to=to, out_dir=tmp_path / "x", splits=None, **options)
     assert not (tmp_path / "x").exists()
 

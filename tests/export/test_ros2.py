@@ -241,3 +241,41 @@ def test_camera_info_carries_the_lens_distortion(
     for ci in infos:
         assert ci.distortion_model == "plumb_bob"
         np.testing.assert_array_equal(ci.d, no_lidar_distortion)
+
+
+def test_max_occlusion_and_min_box_px_filter_the_2d_detections(coop_rec: Path, tmp_path: Path) -> None:
+    """The export review's: ``Detection2DArray`` holds the boxes of wholly hidden vessels, and ``Detection2D`` has no
+    field to say so. ``max_occlusion`` and ``min_box_px`` (COCO's, YOLO's and MOT's filters) now apply here too, on
+    the recorded box and occlusion; the default keeps every box, as before."""
+    from mmusv.export.ros2_names import detections_2d_topic
+
+    src = recording(coop_rec)
+    info = read_info(coop_rec)
+    cases = {"all": {}, "filtered": {"max_occlusion": 0.5, "min_box_px": 4.0}}
+    kept: dict[str, int] = {}
+    for name, options in cases.items():
+        out = tmp_path / name
+        rep = convert(coop_rec, to="ros2", out_dir=out, **options)  # type: ignore[arg-type]
+        got: dict[str, list[Any]] = defaultdict(list)
+        with AnyReader([out / "export_coop"]) as r:
+            for c, _t, raw in r.messages():
+                if c.msgtype == "vision_msgs/msg/Detection2DArray":
+                    got[c.topic].append(r.deserialize(raw, c.msgtype))
+        occ, px = options.get("max_occlusion", 1.0), options.get("min_box_px", 0.0)
+        kept[name] = 0
+        for a in info.agents:
+            ann = [msg for _t, msg in src[topics.agent_annotations(a.id)]]
+            for cam in a.cameras:
+                msgs = got[detections_2d_topic(a.id, cam)]
+                assert len(msgs) == len(ann) == 3
+                for d, frame in zip(msgs, ann, strict=True):
+                    want = [
+                        b.target_id
+                        for b in frame.boxes_camera
+                        if b.camera == cam and b.occlusion <= occ and min(b.x_max - b.x_min, b.y_max - b.y_min) >= px
+                    ]
+                    assert [x.id for x in d.detections] == want
+                    kept[name] += len(want)
+        notes = " ".join(n for r in rep.recordings for n in r.notes)
+        assert ("2D boxes left out of the Detection2DArray" in notes) == (name == "filtered"), notes
+    assert 0 < kept["filtered"] < kept["all"], kept

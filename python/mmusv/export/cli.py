@@ -75,13 +75,14 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         "--min-box-px",
         type=float,
         default=0.0,
-        help="coco, yolo, mot: leave out 2D boxes whose shorter side is under this many pixels (default 0)",
+        help="coco, yolo, mot, ros2: leave out 2D boxes whose shorter side is under this many pixels (default 0)",
     )
     p.add_argument(
         "--max-occlusion",
         type=float,
         default=1.0,
-        help="coco, yolo, mot: leave out 2D boxes hidden by more than this fraction, 0..1 (default 1: keep all)",
+        help="coco, yolo, mot, ros2: leave out 2D boxes hidden by more than this fraction, 0..1 (default 1: keep all; "
+        "ros2's Detection2DArray then holds wholly hidden vessels too, with no field to say so)",
     )
     p.add_argument(
         "--min-contrast",

@@ -193,10 +193,11 @@ def convert(
             non-instrumented vessels); the other formats refuse ``True``.
         extras: any of ``depth``, ``semantic``, ``instance``, ``radar``, ``top_view`` (OPV2V and KITTI: extra
             files stock loaders skip).
-        min_box_px: COCO, YOLO and MOT: leave out 2D boxes whose shorter side is under this many pixels. This
-            option, ``max_occlusion``, ``min_contrast`` and ``box`` other than their defaults are refused for the
-            other formats, which would ignore them.
-        max_occlusion: COCO, YOLO and MOT: leave out 2D boxes hidden by more than this fraction (0..1).
+        min_box_px: COCO, YOLO and MOT (and ROS 2, see ``max_occlusion``): leave out 2D boxes whose shorter side is
+            under this many pixels. This option, ``max_occlusion``, ``min_contrast`` and ``box`` other than their
+            defaults are refused for the other formats, which would ignore them.
+        max_occlusion: COCO, YOLO and MOT: leave out 2D boxes hidden by more than this fraction (0..1); ROS 2 too
+            (and ``min_box_px``), from its ``Detection2DArray`` messages, on the recorded box and occlusion.
         min_contrast: COCO, YOLO and MOT: leave out 2D boxes whose apparent contrast in the recorded RGB image (the
             vessel's Weber contrast against the background around it, :mod:`mmusv.export.contrast`; 0.05 is the
             WMO's visibility threshold) is under this; ``None`` (the default) keeps every box. It needs the cameras'
@@ -283,6 +284,7 @@ def convert(
                 "include_usvs": options.include_usvs,
                 "extras": list(options.extras),
                 **({"min_box_px": box_px, "max_occlusion": max_occ, "box": box} if to in _BOX_FORMATS else {}),
+                **({"min_box_px": box_px, "max_occlusion": max_occ} if to == "ros2" else {}),
                 **({"min_contrast": min_c} if to in _BOX_FORMATS and min_c is not None else {}),
                 "splits": None
                 if ratios is None

@@ -80,12 +80,26 @@ BOX_FORMATS = ("coco", "yolo", "mot")
 """The formats whose 2D boxes the options ``box``, ``min_box_px``, ``max_occlusion`` and ``min_contrast`` choose."""
 
 
+FILTER_FORMATS = (*BOX_FORMATS, "ros2")
+"""The formats whose 2D boxes ``min_box_px`` and ``max_occlusion`` filter: :data:`BOX_FORMATS` and ROS 2 (its
+``Detection2DArray`` messages, on the recorded box: ``Detection2D`` has no field for occlusion)."""
+
+
 def box_options(to: str, *, min_box_px: float, max_occlusion: float, min_contrast: float | None, box: str) -> None:
     """Refuses (:class:`~mmusv.errors.ConfigError` naming the option) a 2D box option other than its default for a
-    format ``to`` that writes no such boxes (not in :data:`BOX_FORMATS`): it would change nothing, silently."""
-    given = [
+    format ``to`` that writes no such boxes (``min_box_px`` and ``max_occlusion``: not in :data:`FILTER_FORMATS`;
+    ``min_contrast`` and ``box``: not in :data:`BOX_FORMATS`): it would change nothing, silently."""
+    filters = [
         f"min_box_px = {min_box_px:g}" if min_box_px != 0.0 else "",
         f"max_occlusion = {max_occlusion:g}" if max_occlusion != 1.0 else "",
+    ]
+    filters = [g for g in filters if g]
+    if to not in FILTER_FORMATS and filters:
+        raise ConfigError(
+            f"{', '.join(filters)}: only the COCO, YOLO, MOT and ROS 2 exports (to = 'coco', 'yolo', 'mot' or 'ros2') "
+            f"filter their 2D boxes with it, not to = {to!r}, which would ignore it; leave it out"
+        )
+    given = [
         f"min_contrast = {min_contrast:g}" if min_contrast is not None else "",
         f"box = {box!r}" if box != "visible" else "",
     ]

@@ -113,6 +113,8 @@ class Ros2Writer(DatasetWriter):
         from mmusv.export.ros2_types import typestore
 
         self.extra_counts = {}
+        self.boxes_left_out = 0
+        """2D boxes left out by ``min_box_px`` and ``max_occlusion`` (the recorded box, its recorded occlusion)."""
         self.ts = typestore()
         self.m = Msgs(self.ts)
         self.bag: Any = None
@@ -418,8 +420,14 @@ class Ros2Writer(DatasetWriter):
         )
         by_cam: dict[str, list[Any]] = {name: [] for name in a.cameras}
         ident = m.pose(np.eye(4))
+        o = self.options
         for b in ann.boxes_camera:
             if b.camera not in by_cam:
+                continue
+            # Detection2D has no field for occlusion: max_occlusion leaves out the vessels hidden by more (1, the
+            # default: every recorded box, wholly hidden ones too), min_box_px the small boxes
+            if b.occlusion > o.max_occlusion or min(b.x_max - b.x_min, b.y_max - b.y_min) < o.min_box_px:
+                self.boxes_left_out += 1
                 continue
             j = row.get(b.target_id)
             name = class_name(int(world.classes[j])) if j is not None else "unknown"
@@ -476,6 +484,12 @@ class Ros2Writer(DatasetWriter):
         )
 
     def finish(self, frames: list[int], skipped: list[dict[str, Any]]) -> None:
+        o = self.options
+        if o.max_occlusion != 1.0 or o.min_box_px != 0.0:
+            self.notes.append(
+                f"{self.boxes_left_out} 2D boxes left out of the Detection2DArray messages (max_occlusion = "
+                f"{o.max_occlusion:g}, min_box_px = {o.min_box_px:g}, on the recorded box and occlusion)"
+            )
         super().finish(frames, skipped)
         if self.bag is None:
             return
