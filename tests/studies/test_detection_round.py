@@ -640,7 +640,13 @@ def test_a_recording_without_lidar_says_so(tmp_path: Path, capsys: pytest.Captur
 
     data = scenario("nolidar", 2)
     data["rigs"]["r"]["lidar"] = None
-    rec = run(data, out_dir=tmp_path / "rec", checks=False).recording
+    if not any(data["rigs"]["r"].get(k) for k in ("radar", "cameras", "top_view")):  # no sensor at all: said
+        from mmusv.scenario_checks import MmusvWarning
+
+        with pytest.warns(MmusvWarning, match="switches every sensor off"):
+            rec = run(data, out_dir=tmp_path / "rec", checks=False).recording
+    else:
+        rec = run(data, out_dir=tmp_path / "rec", checks=False).recording
     for modes in ("none,late,early", "none"):
         err = refused(["study", "detection", str(rec), "--modes", modes], tmp_path / "o", capsys)
         assert "sequence nolidar" in err and "no LiDAR" in err and "--modes none" not in err, err

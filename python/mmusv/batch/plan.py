@@ -180,8 +180,26 @@ def task_complete(out_dir: Path, *, scenario: str, config_hash: str, frames: int
         and m.get("frames_requested") == frames
         and m.get("first_frame", 0) == first_frame
         and m.get("recording") == f"{scenario}.mcap"
-        and (out_dir / f"{scenario}.mcap").is_file()
+        and _ends_whole(out_dir / f"{scenario}.mcap")
     )
+
+
+def _ends_whole(path: Path) -> bool:
+    """Whether ``path`` is a file that starts and ends with the MCAP magic: a recording cut short or overwritten
+    after its run (a copy that stopped, a file replaced) is recorded again, not skipped as complete because its
+    manifest says so (a review's: a re-run skipped both, and the conversion then failed on them)."""
+    from mmusv.recording.scan import MAGIC
+
+    try:
+        with path.open("rb") as f:
+            head = f.read(len(MAGIC))
+            size = f.seek(0, 2)
+            if size < 2 * len(MAGIC):
+                return False
+            f.seek(size - len(MAGIC))
+            return head == MAGIC and f.read(len(MAGIC)) == MAGIC
+    except OSError:
+        return False
 
 
 def _complete_parts(path: Path, *, config_hash: str, frames: int) -> bool:
