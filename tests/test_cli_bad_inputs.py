@@ -269,3 +269,26 @@ def test_jobs_for_one_scenario_is_said_to_do_nothing(tmp_path: Path, capsys: pyt
     assert main(["run", str(path), "-o", str(tmp_path / "out"), "--frames", "1", "--jobs", "3", "--no-checks"]) == 0
     _, err = capsys.readouterr()
     assert "mmusv: note: --jobs 3 runs the scenarios of a folder side by side" in err, err
+
+
+@pytest.mark.parametrize(
+    ("argv", "hint"),
+    [
+        (["run", "port_entry", "--frame", "3"], "--frame: did you mean --frames?"),  # was taken as --frames 3
+        (["run", "port_entry", "--frmes", "3"], "--frmes: did you mean --frames?"),
+        (["convert", "rec", "-o", "out", "--max-occ", "1"], "--max-occ: did you mean --max-occlusion?"),
+    ],
+)
+def test_a_shortened_or_misspelt_flag_is_refused_with_the_flag_it_may_mean(
+    argv: list[str], hint: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # argparse took any unambiguous prefix: ``--frame 3`` ran 3 frames, and a script using it would change
+    # meaning the day a second flag shared the prefix. Now it is an unrecognised argument, nothing is written.
+    argv = [str(tmp_path / a) if a in ("rec", "out") else a for a in argv]
+    with pytest.raises(SystemExit) as e:
+        main(argv)
+    assert e.value.code == 2
+    err = capsys.readouterr().err
+    assert "unrecognized arguments" in err and hint in err and "Traceback" not in err, err
+    assert err.count("\n") == 1, err
+    assert list(tmp_path.iterdir()) == []

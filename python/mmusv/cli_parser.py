@@ -7,10 +7,11 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import difflib
 import re
 import sys
 from collections.abc import Sequence
-from typing import NoReturn
+from typing import Any, NoReturn
 
 __all__ = ["BUNDLED_WAVE_SCENARIO", "CommandParser", "parser"]
 
@@ -23,20 +24,29 @@ class CommandParser(argparse.ArgumentParser):
     usage block first (a dozen lines for ``run``) and named the subcommand only there. ``--help`` is unchanged.
     The subcommands' parsers are of this class too (``add_subparsers`` makes them of the parent's class)."""
 
-    _deepest: str | None = None
-    """The ``prog`` of the innermost (sub)parser of the parse under way: the one an unrecognised argument,
-    which argparse reports from the top parser, belongs to."""
+    _deepest: CommandParser | None = None
+    """The innermost (sub)parser of the parse under way: the one an unrecognised argument, which argparse
+    reports from the top parser, belongs to."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        # No abbreviations: ``--frame 3`` was taken as ``--frames 3`` without a word, and a script using a
+        # shortened flag would change meaning the day a second flag shares its prefix. A shortened flag is
+        # now an unrecognised argument, with the flag it may mean (see :meth:`error`).
+        kwargs.setdefault("allow_abbrev", False)
+        super().__init__(*args, **kwargs)
 
     def parse_known_args(  # type: ignore[override]
         self, args: Sequence[str] | None = None, namespace: argparse.Namespace | None = None
     ) -> tuple[argparse.Namespace, list[str]]:
-        CommandParser._deepest = self.prog
+        CommandParser._deepest = self
         return super().parse_known_args(args, namespace)
 
     def error(self, message: str) -> NoReturn:
         prog = self.prog
-        if message.startswith("unrecognized arguments") and CommandParser._deepest:
-            prog = CommandParser._deepest
+        deepest = CommandParser._deepest
+        if message.startswith("unrecognized arguments") and deepest is not None:
+            prog = deepest.prog
+            message += _did_you_mean(deepest, message)
         message = " ".join(message.split())
         choice = re.fullmatch(r"argument (\w+): invalid choice: (.*)", message)  # a subcommand (``command``)
         if choice:
@@ -45,6 +55,21 @@ class CommandParser(argparse.ArgumentParser):
         with contextlib.suppress(OSError, ValueError):
             print(line, file=sys.stderr, flush=True)
         self.exit(2)
+
+
+def _did_you_mean(parser: argparse.ArgumentParser, message: str) -> str:
+    """``; did you mean --frames?`` for each unrecognised ``--flag`` (or ``--flag=value``) of ``message`` that is
+    the prefix of, or close to, one of ``parser``'s own flags; empty when none is."""
+    flags = sorted(o for a in parser._actions for o in a.option_strings if o.startswith("--"))
+    hints = []
+    for word in message.partition(":")[2].split():
+        given = word.split("=", 1)[0]
+        if not given.startswith("--") or given in flags:
+            continue
+        near = [f for f in flags if f.startswith(given)] or difflib.get_close_matches(given, flags, n=3, cutoff=0.75)
+        if near:
+            hints.append(f"{given}: did you mean {' or '.join(near)}?")
+    return "; " + "; ".join(hints) if hints else ""
 
 
 def parser() -> argparse.ArgumentParser:
