@@ -96,3 +96,28 @@ def test_read_pcd_refuses_a_file_cut_short(tmp_path: Path) -> None:
     p.write_bytes(data[:-9])  # inside the last row: a row of too few numbers
     with pytest.raises(ValueError):
         read_pcd(p)
+
+
+@pytest.mark.parametrize(("bad", "total"), [("0.7,0.2,0.2", "1.1"), ((0.5, 0.25, 0.1), "0.85"), ("7.5,2,1", "10.5")])
+def test_fractions_that_do_not_add_up_to_one_are_refused_not_rescaled(bad: object, total: str) -> None:
+    # 0.7,0.2,0.2 (a typo for 0.7,0.15,0.15) was rescaled to 0.64/0.18/0.18 without a word (docs review).
+    with pytest.raises(ConfigError, match=rf"the fractions add up to {total}; they must add up to 1"):
+        parse_ratios(bad)  # type: ignore[arg-type]
+
+
+def test_whole_number_weights_and_fractions_of_one_are_taken() -> None:
+    assert parse_ratios("7,2,1") == pytest.approx((0.7, 0.2, 0.1))
+    assert parse_ratios((1, 1, 1)) == pytest.approx((1 / 3,) * 3)
+    assert parse_ratios("0.1,0.2,0.7") == pytest.approx((0.1, 0.2, 0.7))  # float sum 1 within rounding
+    assert sum(parse_ratios("0.78,0,0.22")) == pytest.approx(1.0)
+
+
+def test_a_frame_range_that_ends_before_it_starts_says_so() -> None:
+    # Was "frames stop = 1: must be a whole number >= 3", which did not say why 3.
+    from mmusv.export.convert_checks import frame_selection
+
+    with pytest.raises(ConfigError, match=r"STOP \(1\) must be greater than START \(2\); STOP is excluded, so 2:3"):
+        frame_selection("2:1")
+    with pytest.raises(ConfigError, match=r"STOP \(2\) must be greater than START \(2\)"):
+        frame_selection((2, 2))
+    assert frame_selection("2:3") == (2, 3) and frame_selection("4:") == (4, None)

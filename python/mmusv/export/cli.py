@@ -47,7 +47,10 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", required=True, help="output folder")
     g = p.add_mutually_exclusive_group()
     g.add_argument(
-        "--split", default="0.7,0.15,0.15", help="train,validate,test fractions, by recording (default 0.7,0.15,0.15)"
+        "--split",
+        default="0.7,0.15,0.15",
+        help="train,validate,test fractions that add up to 1, or whole-number weights such as 7,2,1; by recording "
+        "(default 0.7,0.15,0.15)",
     )
     g.add_argument(
         "--no-split", action="store_true", help="no train/validate/test folders: scenarios directly in the output"

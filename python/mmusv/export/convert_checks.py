@@ -224,7 +224,12 @@ def frame_selection(frames: Sequence[int | None] | str | None) -> tuple[int, int
     else:
         raise ConfigError(f"frames = {shown}: must be (start, stop) or 'START:STOP'")
     start = arguments.whole(pair[0], name="frames start", lo=0)
-    stop = None if pair[1] is None else arguments.whole(pair[1], name="frames stop", lo=start + 1)
+    stop = None if pair[1] is None else arguments.whole(pair[1], name="frames stop", lo=0)
+    if stop is not None and stop <= start:  # was "frames stop = 1: must be a whole number >= 3"
+        raise ConfigError(
+            f"frames = {shown}: STOP ({stop}) must be greater than START ({start}); STOP is excluded, so "
+            f"{start}:{start + 1} is frame {start} alone and {start}: runs to the last frame"
+        )
     return start, stop
 
 

@@ -23,8 +23,10 @@ DEFAULT_RATIOS = (0.7, 0.15, 0.15)
 
 
 def parse_ratios(ratios: Sequence[float] | str) -> tuple[float, float, float]:
-    """Validated ``(train, validate, test)`` fractions from a sequence or a ``"0.7,0.15,0.15"`` string; they
-    are normalised to sum to 1."""
+    """Validated ``(train, validate, test)`` fractions from a sequence or a ``"0.7,0.15,0.15"`` string: three
+    fractions that add up to 1 (within 1e-6), or three whole-number weights (``7,2,1``, ``1,1,1``), normalised to
+    sum to 1. Fractions that add up to something else (``0.7,0.2,0.2``) are refused: they were rescaled without
+    a word, so a typo changed the proportions asked for."""
     if isinstance(ratios, str):
         try:
             vals = [float(x) for x in ratios.split(",")]
@@ -47,7 +49,16 @@ def parse_ratios(ratios: Sequence[float] | str) -> tuple[float, float, float]:
     if not all(math.isfinite(v) and v >= 0 for v in vals) or sum(vals) <= 0:
         raise ConfigError(f"split {vals}: fractions must be finite, non-negative and not all zero")
     total = sum(vals)
+    if abs(total - 1.0) > 1e-6 and not all(float(v).is_integer() for v in vals):
+        raise ConfigError(
+            f"split {_shown_ratios(vals)}: the fractions add up to {total:.6g}; they must add up to 1 "
+            "(e.g. 0.7,0.15,0.15), or be whole-number weights (e.g. 7,2,1)"
+        )
     return (vals[0] / total, vals[1] / total, vals[2] / total)
+
+
+def _shown_ratios(vals: Sequence[float]) -> str:
+    return ",".join(f"{v:g}" for v in vals)
 
 
 def split_counts(n: int, ratios: Sequence[float]) -> list[int]:
