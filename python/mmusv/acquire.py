@@ -216,7 +216,7 @@ def run(
         frame_range = span
     rec_path = recording_path(out, scenario)
     if rec_path.exists() and not overwrite:
-        raise IoError(f"{rec_path} already exists; pass overwrite=True (mmusv run --overwrite) to replace it")
+        raise IoError(f"{rec_path} already exists; pass --overwrite (overwrite=True in Python) to replace it")
     if not overwrite:
         _refuse_another_run(out, rec_path)
     _refuse_wrong_kinds(out)
@@ -300,7 +300,7 @@ def _record(
     from mmusv.recording.frames import FrameRecorder  # the MCAP side, kept apart from the loop
 
     if rec_path.exists() and not overwrite:  # again, now that no other run can be writing it
-        raise IoError(f"{rec_path} already exists; pass overwrite=True (mmusv run --overwrite) to replace it")
+        raise IoError(f"{rec_path} already exists; pass --overwrite (overwrite=True in Python) to replace it")
     if not overwrite:
         _refuse_another_run(out, rec_path)
 
@@ -490,7 +490,7 @@ def _refuse_another_run(out: Path, rec_path: Path) -> None:
         raise IoError(
             f"{out} holds the run of another recording, {other} (its manifest.json, scenario.yaml and tables/), "
             f"which a run of {rec_path.name} there would replace; give each scenario a folder of its own (-o), or "
-            f"pass overwrite=True (mmusv run --overwrite) to replace them ({other} itself is kept)"
+            f"pass --overwrite (overwrite=True in Python) to replace them ({other} itself is kept)"
         )
 
 

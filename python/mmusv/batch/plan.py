@@ -320,7 +320,7 @@ def plan_scenarios(
                 continue
             conflict = _conflict(folder, name, h, total, f.name)
             if conflict is not None and plan.name not in replace:
-                plan.error = f"{conflict}; pass --overwrite (overwrite=True) to replace it"
+                plan.error = f"{conflict}; pass --overwrite (overwrite=True in Python) to replace it"
                 continue
         if split_frames is not None and total > split_frames:
             ranges = split_ranges(total, split_frames)

@@ -52,7 +52,8 @@ def _prepare_locked(out: Path, home: Path, overwrite: bool) -> Path:
     if any(out.iterdir()):
         if not overwrite:
             raise IoError(
-                f"output folder {out} already exists and is not empty; pass overwrite=True (--overwrite) to replace it"
+                f"output folder {out} already exists and is not empty; pass --overwrite (overwrite=True in Python) "
+                "to replace it"
             )
         if not (out / REPORT_NAME).is_file():
             raise IoError(
