@@ -524,14 +524,21 @@ def validation_problems(
 
 
 def validation_error(
-    err: ValidationError, source: str, *, noun: str = "config", root: str = "scenario", data: Any = None
+    err: ValidationError,
+    source: str,
+    *,
+    noun: str = "config",
+    root: str = "scenario",
+    data: Any = None,
+    model: type[BaseModel] | None = None,
 ) -> ConfigError:
     """A pydantic ``ValidationError`` as one :class:`ConfigError` line per problem: ``invalid <noun> <field
     path> = <value>: <what is allowed>``; ``root`` names the whole document when the problem has no field; ``data``
-    is the document validated (see :func:`validation_problems`)."""
+    is the document validated and ``model`` the model that validated it, for the keys allowed where a key is
+    unknown (see :func:`validation_problems`)."""
     lines = [
         f"invalid {noun}: {msg}" if not field else f"invalid {noun} {field} = {shown}: {msg}"
-        for field, shown, msg in validation_problems(err, root=root, data=data)
+        for field, shown, msg in validation_problems(err, root=root, data=data, model=model)
     ]
     return ConfigError(f"{source}: " + "; ".join(lines))
 

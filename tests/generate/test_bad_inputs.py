@@ -290,3 +290,27 @@ def test_force_replaces_only_what_a_generate_run_wrote(tmp_path: Path) -> None:
     with pytest.raises(IoError, match="--force"):
         (out / "b.yaml").write_text("name: b\n")
         _prepare_dir(out, False)
+
+
+@pytest.mark.parametrize(
+    ("extra", "field", "hint"),
+    [
+        ({"sed": 3}, "sed = 3", "did you mean 'seed'? allowed keys: name, seed, map,"),
+        (
+            {"size_classes": {"small": {"lenght_m": [0, 15]}}},
+            "size_classes.small.lenght_m",
+            "did you mean 'length_m'? allowed keys: length_m, speed_mps, assets",
+        ),
+        (
+            {"combinations": [{**SPEC["combinations"][0], "dificulty": "near"}]},
+            "combinations[0].dificulty",
+            "did you mean 'difficulty'? allowed keys: name, family, difficulty,",
+        ),
+    ],
+)
+def test_an_unknown_spec_key_gets_the_closest_and_the_allowed_keys(
+    tmp_path: Path, extra: dict[str, Any], field: str, hint: str
+) -> None:
+    # A typo said only "Extra inputs are not permitted" (docs review); a scenario's unknown keys said more.
+    msg = _spec_error(tmp_path, extra)
+    assert f"invalid spec {field}" in msg and hint in msg, msg

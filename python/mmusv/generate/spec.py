@@ -531,7 +531,9 @@ def load_spec(source: str | os.PathLike[str] | dict[str, Any] | GenerationSpec) 
                 f"{where} is a scenario (vessels:, no combinations:), not a generation spec: record it with "
                 f"`mmusv run {shown}`"
             ) from None
-        raise validation_error(exc, where, noun="spec", root="spec") from None
+        # an unknown key gets the keys allowed there and the closest one, as in a scenario ("sed": did you mean
+        # 'seed'?); it said only "Extra inputs are not permitted"
+        raise validation_error(exc, where, noun="spec", root="spec", data=data, model=GenerationSpec) from None
     except MmusvError as exc:  # a validator that checks through the core (wave presets, ...)
         raise located(exc, where) from None
     _cross_checks(spec, where)
