@@ -40,6 +40,25 @@ load_asset_file(
 )
 ```
 
+**From a scenario file.** `load_asset_file` registers an asset in one Python process only. A scenario run from the
+command line (`mmusv run`, a batch, `mmusv dataset`, the editor) lists its asset files under `assets:`; each is a YAML
+file holding one entry like the mapping above (or a list of them), its path relative to the scenario's folder, and
+its `mesh:` relative to the asset file:
+
+```yaml
+# scenarios/with_my_usv.yaml
+assets: [models/my_usv.yaml]   # name: my_usv, mesh: my_usv.glb, draft: 0.4, ...
+vessels:
+  - {id: usv_1, role: usv, asset: my_usv, speed_mps: 2, route: [[0, 0], [200, 0]]}
+```
+
+The files are read when the scenario is (an error names the scenario, `assets[i]` and the file), and read again in
+the same process only when the asset file or its mesh changed. A name the library already holds (a built-in asset, or
+another file's) is refused, naming both. The scenario's config hash (`manifest.json`'s `config_hash`) covers the
+assets' meshes, so a batch re-run records a scenario again when its mesh changed, rather than skipping it as
+complete. The `scenario.yaml` a run writes beside its recording keeps the paths as written: copy the asset files
+along to run it again from there.
+
 **Axes.** `up_axis` and `forward_axis` (the file's up and bow directions, any of x, y, z, -x, -y, -z) turn the
 file into the body frame: x forward (bow), y to port, z up, z = 0 the waterline. When an entry gives neither, the
 file's format decides (`mmusv.world.asset_spec.FORMAT_AXES`): a `.gltf`/`.glb` file is read +Y up with its bow

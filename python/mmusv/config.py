@@ -28,7 +28,7 @@ import reprlib
 import types
 import typing
 from dataclasses import replace
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 from pydantic import (
     BaseModel,
@@ -322,6 +322,9 @@ class Scenario(_Model):
     environment: EnvironmentConfig = Field(default_factory=EnvironmentConfig)
     acquisition: AcquisitionConfig = Field(default_factory=AcquisitionConfig)
     rigs: dict[str, RigConfig] = Field(default_factory=dict)
+    assets: list[Annotated[str, Field(min_length=1, max_length=4096)]] = Field(default_factory=list, max_length=256)
+    """Asset YAML files of the user's own vessels (meshes or procedural entries), relative to the scenario's folder:
+    :func:`load_scenario` builds and registers them before the vessels are read (:mod:`mmusv.scenario_assets`)."""
     vessels: list[VesselConfig] = Field(min_length=1)
 
     @field_validator("rigs", mode="before")
@@ -561,6 +564,11 @@ def load_scenario(source: str | os.PathLike[str] | dict[str, Any] | Scenario) ->
         with contextlib.suppress(NotFoundError):  # not bundled either: the file error below names the path
             source = resolve_scenario(os.fspath(source))
     data, where = mapping_source(source, kind="scenario", root_hint="at least `vessels:`")
+    if data.get("assets"):  # the user's own vessels, registered before the vessels naming them are read
+        from mmusv.scenario_assets import register_scenario_assets, scenario_base
+
+        path = source if isinstance(source, (str, os.PathLike)) else None
+        register_scenario_assets(data["assets"], base_dir=scenario_base(path), where=where)
     try:
         return Scenario.model_validate(data)
     except ValidationError as exc:
@@ -582,4 +590,9 @@ def scenario_hash(scenario: str | os.PathLike[str] | dict[str, Any] | Scenario) 
     file hash alike, and anything else is a :class:`~mmusv.errors.ConfigError`."""
     scenario = load_scenario(scenario)
     text = json.dumps(scenario.model_dump(mode="json"), sort_keys=True, separators=(",", ":"))
+    from mmusv.scenario_assets import asset_digest
+
+    # the user's own assets by their meshes: a changed mesh is a changed configuration (empty for built-ins,
+    # so a scenario of built-in assets hashes as it always did)
+    text += asset_digest(v.asset for v in scenario.vessels)
     return hashlib.sha256(text.encode()).hexdigest()

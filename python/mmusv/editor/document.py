@@ -78,15 +78,18 @@ def to_document(scenario: Scenario) -> dict[str, Any]:
     params = scenario.map.param_values()
     if params:
         map_doc["params"] = params
-    return {
+    doc = {
         "name": scenario.name,
         "seed": scenario.seed,
         "map": map_doc,
         "environment": env,
         "acquisition": full["acquisition"],
         "rigs": {name: _rig_document(rig) for name, rig in scenario.rigs.items()},
-        "vessels": [_vessel_document(v) for v in scenario.vessels],
     }
+    if scenario.assets:  # the user's own vessels' files: saved as written (they were dropped on save)
+        doc["assets"] = list(scenario.assets)
+    doc["vessels"] = [_vessel_document(v) for v in scenario.vessels]
+    return doc
 
 
 class _Dumper(yaml.SafeDumper):

@@ -313,7 +313,10 @@ def known_asset(name: str) -> str:
     if name not in names:
         close = difflib.get_close_matches(name, names, n=3, cutoff=0.5)
         hint = f"; did you mean {', '.join(close)}?" if close else ""
-        raise AssetNameError(f"unknown asset{hint} (`mmusv assets` lists all {len(names)})")
+        raise AssetNameError(
+            f"unknown asset{hint} (`mmusv assets` lists all {len(names)}; a vessel of your own: list its asset file "
+            "under the scenario's `assets:`, docs/assets.md)"
+        )
     return name
 
 
