@@ -129,4 +129,3 @@ def asset_digest(names: Iterable[str]) -> str:
 def scenario_base(source: str | os.PathLike[str] | None) -> Path:
     """The folder a scenario's relative asset paths start from: its file's folder, else the current one."""
     return Path(os.fspath(source)).expanduser().resolve().parent if source is not None else Path.cwd()
-
