@@ -7,6 +7,7 @@ import shutil
 from pathlib import Path
 
 import pytest
+import yaml
 from mmusv.cli import main
 from test_detection_study import record
 
@@ -21,6 +22,23 @@ def two_sequences(tmp_path_factory: pytest.TempPathFactory) -> Path:
         rec = record(root / f"r{len(usvs)}", usvs, frames=frames)
         shutil.copy(rec, folder / rec.name)
     return folder
+
+
+def _blind(out: Path) -> Path:
+    """A recording (2 USVs, 2 frames) whose rig carries no LiDAR."""
+    from mmusv.acquire import run
+    from mmusv.scenario_checks import MmusvWarning
+    from mmusv.studies.detection.sources import lidar_only
+    from test_detection_study import SCENARIO
+
+    data = lidar_only(yaml.safe_load(SCENARIO.read_text(encoding="utf-8")))
+    data["vessels"] = [v for v in data["vessels"] if v["role"] != "usv" or v["id"] in ("usv_1", "usv_3")]
+    data["name"] = "tiny_blind"
+    data["acquisition"]["frames"] = 2
+    data["rigs"] = {name: {**rig, "lidar": None} for name, rig in data["rigs"].items()}
+    with pytest.warns(MmusvWarning, match="switches every sensor off"):
+        rec: Path = run(data, out_dir=out).recording
+    return rec
 
 
 def study(args: list[str], out: Path) -> Path:
@@ -52,10 +70,10 @@ def test_a_workers_bad_input_is_one_line(
 ) -> None:
     mixed = tmp_path / "mixed"
     shutil.copytree(two_sequences, mixed)
-    lone = record(tmp_path / "lone", ("usv_1",), frames=2)
-    shutil.copy(lone, mixed / lone.name)
+    blind = _blind(tmp_path / "blind")  # refused in its worker (a sequence of one USV is scored, in mode none)
+    shutil.copy(blind, mixed / blind.name)
     assert main(["study", "detection", str(mixed), "--jobs", "2", "-o", str(tmp_path / "o"), "--no-progress"]) == 2
     err = capsys.readouterr().err
-    assert "sequence tiny_1usv" in err and "needs at least 2" in err and "Traceback" not in err
+    assert "sequence tiny_blind: no LiDAR" in err and "Traceback" not in err
     assert main(["study", "detection", str(two_sequences), "--jobs", "0", "-o", str(tmp_path / "o")]) == 2
     assert "--jobs 0: must be >= 1" in capsys.readouterr().err

@@ -204,7 +204,9 @@ def test_bad_input_errors(two_usv: Path, tmp_path: Path, capsys: pytest.CaptureF
         assert main([*args, "-o", str(tmp_path / "o"), "--no-progress"]) == 2
         return capsys.readouterr().err
 
-    assert "needs at least 2" in err(["study", "detection", str(one)])
+    # one USV: nothing to fuse, scored in mode none only (tests/studies/test_detection_leftovers.py); no mode none:
+    # nothing to score, said
+    assert "add none to --modes" in err(["study", "detection", str(one), "--modes", "late"])
     assert "only with --model" in err(["study", "detection", str(two_usv), "--refine", "off"])
     assert "--rescore on: only with --model" in err(["study", "detection", str(two_usv), "--rescore", "on"])
     assert "--threads 1: only with --model" in err(["study", "detection", str(two_usv), "--threads", "1"])

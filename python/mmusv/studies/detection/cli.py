@@ -295,6 +295,9 @@ def run(args: argparse.Namespace) -> int:
                 f"sequence: --settings holds "
                 f"delay:{delay})"
                 if delay > 0
+                else f" ({counted(len(res.none_only), 'sequence')} of one USV with a LiDAR, nothing to fuse: "
+                f"{', '.join(res.none_only)}; add none to --modes to score them without fusion)"
+                if res.none_only
                 else ""
             )
             raise InputError(
@@ -314,6 +317,11 @@ def run(args: argparse.Namespace) -> int:
             written = report.write_detection(res, run_out, detector=name, notes=notes)
             _print_detection(console, res)
         paths.update({f"{name}:{k}": v for k, v in written.items()})
+        lone = report.none_only_line(res)
+        if lone is not None:
+            from rich.markup import escape
+
+            console.print(f"[yellow]{escape(lone)}[/]", highlight=False)
         if det is learned and learned is not None:
             console.print(f"learned models: {learned.describe()}", highlight=False)
             if learned.shared_bytes:

@@ -14,7 +14,15 @@ from mmusv.studies.detection.evaluate import RANGE_BINS, bin_label
 from mmusv.studies.detection.study import StudyResult
 from mmusv.studies.plotting import default_style
 
-__all__ = ["DETECTION_METRICS", "detection_table", "fmt", "robustness_table", "write_detection", "write_robustness"]
+__all__ = [
+    "DETECTION_METRICS",
+    "detection_table",
+    "fmt",
+    "none_only_line",
+    "robustness_table",
+    "write_detection",
+    "write_robustness",
+]
 
 BINS = [bin_label(k) for k in range(len(RANGE_BINS))]
 
@@ -103,12 +111,24 @@ def write_robustness(res: StudyResult, out: Path, *, detector: str, notes: Seque
     return paths
 
 
+def none_only_line(res: StudyResult) -> str | None:
+    """The line saying which sequences had one USV with a LiDAR, so were scored in mode ``none`` only (or, without
+    mode ``none``, not at all); ``None`` when there were none."""
+    if not res.none_only:
+        return None
+    names = ", ".join(res.none_only)
+    if "none" in res.options.modes:
+        return f"scored in mode none only (one USV with a LiDAR: nothing to fuse): {names}"
+    return f"not scored (one USV with a LiDAR: nothing to fuse, and --modes has no none): {names}"
+
+
 def _note(res: StudyResult, detector: str, notes: Sequence[str] = ()) -> str:
     lines = [f"detector: {_detector_name(res, detector)}", *notes]
     if detector == "baseline" and res.options.predictions is None:
         lines.append(BASELINE_NOTE)
     lines += [
         f"sequences: {len(res.sequences)} ({', '.join(res.sequences)})",
+        *([line] if (line := none_only_line(res)) is not None else []),
         f"frames: {res.frames}",
         f"ego-frames: {res.ego_frames}",
         f"ground-truth boxes: {res.gt_boxes}",

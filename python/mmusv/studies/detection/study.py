@@ -1,9 +1,10 @@
 """The detection study (Table III) and the robustness study (Table IV) over a set of sequences.
 
 For every sequence of the chosen split, every frame and every instrumented USV as the ego in turn, each fusion
-mode (and, for Table IV, each robustness setting) yields boxes in the ego LiDAR frame. Detections farther than
-``range_m`` from the ego, or centred within ``platform_margin_m`` of a USV's platform (the ego's or a neighbour's:
-USVs are not targets), are dropped; the rest are matched against the ground truth
+mode (and, for Table IV, each robustness setting) yields boxes in the ego LiDAR frame; a sequence of one USV with
+a LiDAR, which has nothing to fuse, is scored in mode ``none`` only (:attr:`StudyResult.none_only`). Detections
+farther than ``range_m`` from the ego, or centred within ``platform_margin_m`` of a USV's platform (the ego's or a
+neighbour's: USVs are not targets), are dropped; the rest are matched against the ground truth
 (:func:`~mmusv.studies.detection.data.gt_in_ego`) by :mod:`~mmusv.studies.detection.evaluate`.
 
 Every ground truth also records ``ego_points``, the number of the ego's own LiDAR points inside it (BEV rectangle,
@@ -115,6 +116,11 @@ class StudyResult:
     0.5, matched at 0.3, and its wave-occlusion share from the ego (NaN where unknown)."""
     rows: dict[str, list[Any]] = field(default_factory=dict)
     sequences: list[str] = field(default_factory=list)
+    none_only: list[str] = field(default_factory=list)
+    """The sequences of one USV with a LiDAR (nothing to fuse), scored in mode ``none`` only (of :attr:`sequences`)
+    or, where ``none`` is not among the modes, not at all (not in :attr:`sequences`)."""
+    key_frames: dict[Key, int] = field(default_factory=dict)
+    """The frames scored per (setting, mode): fewer for the fusion modes where sequences were :attr:`none_only`."""
     frames: int = 0
     ego_frames: int = 0
     gt_boxes: int = 0
@@ -133,6 +139,9 @@ class StudyResult:
             for col, values in part.rows.items():
                 out.rows.setdefault(col, []).extend(values)
             out.sequences.extend(part.sequences)
+            out.none_only.extend(part.none_only)
+            for key, n in part.key_frames.items():
+                out.key_frames[key] = out.key_frames.get(key, 0) + n
             out.frames += part.frames
             out.ego_frames += part.ego_frames
             out.gt_boxes += part.gt_boxes
@@ -145,7 +154,9 @@ class StudyResult:
         ...; module docstring) and their counts ``gt_visible``, ``gt_hidden``, ``gt_unseen``, ``gt_wave_hidden``;
         ``frames`` is the number of frames scored, ``ego_frames`` that of (frame, ego USV) pairs."""
         out = summarize(self.matches.get(key, []))
-        out["frames"] = float(self.frames)  # summarize counts the ego-frames (one per USV of a frame)
+        # summarize counts the ego-frames (one per USV of a frame); a fusion mode has fewer frames than none where a
+        # sequence of one USV was scored in none only
+        out["frames"] = float(self.key_frames.get(key, self.frames))
         vis = self.visibility.get(key, [])
         cls = np.concatenate([v[0] for v in vis]) if vis else np.zeros(0)
         hit50 = np.concatenate([v[1] for v in vis]) if vis else np.zeros(0, dtype=bool)
@@ -393,7 +404,8 @@ def run_study(
     """Evaluates ``sequences`` (see the module docstring). With delays, a frame ``k`` is scored only where the
     sequence holds the frame ``k - d`` of every delay ``d`` (so the first ``max delay`` frames of every sequence, and
     those just after missing frames, are left out), for every setting: all settings are scored on the same frames.
-    ``check_predictions``:
+    A sequence of one USV with a LiDAR has nothing to fuse: it is scored in mode ``none`` only, and listed in
+    :attr:`StudyResult.none_only`. ``check_predictions``:
     raise when a predictions file matched nothing evaluated (:func:`check_predictions_used`; off for one
     sequence of many, :mod:`~mmusv.studies.detection.parallel`)."""
     check_polars("the detection study")
@@ -428,19 +440,24 @@ def run_study(
                 f"sequence {seq.name}: no LiDAR: none of its instrumented USVs carries one (a rig with lidar: null), "
                 "and the study detects in LiDAR clouds"
             )
+        modes = o.modes
         if fusion and len(seq.agent_ids) < 2:
-            raise InputError(
-                f"sequence {seq.name}: {len(seq.agent_ids)} instrumented USV(s) with a LiDAR; "
-                f"{'/'.join(fusion)} fusion needs at least 2 (use --modes none)"
-            )
+            # one USV: nothing to fuse, so no cooperative mode (it refused the whole dataset); none alone is scored
+            res.none_only.append(seq.name)
+            modes = tuple(m for m in o.modes if m == "none")
+            if not modes:
+                continue
         res.sequences.append(seq.name)
+        keys = [(s.name, m) for s in o.settings for m in modes if m != "none" or s.name == "clean"]
         own = _OwnDetections(o.detector)
         for t, frame in enumerate(seq.frames):
             if any(seq.frame_at(frame.frame - d) is None for d in delays):
                 continue  # a delay has no frame k - d here: left out for every setting
             res.frames += 1
+            for key in keys:
+                res.key_frames[key] = res.key_frames.get(key, 0) + 1
             for ego in frame.agents:
-                _score_ego(res, seq, t, frame, ego, own)
+                _score_ego(res, seq, t, frame, ego, own, modes)
             done += 1
             if progress is not None:
                 progress(done, total_frames or done)
@@ -483,6 +500,7 @@ def _score_ego(
     frame: SceneFrame,
     ego: AgentFrame,
     own: Callable[[AgentFrame], tuple[np.ndarray, np.ndarray]],
+    modes: Sequence[str],
 ) -> None:
     o = res.options
     res.ego_frames += 1
@@ -499,7 +517,7 @@ def _score_ego(
     gbin = range_bin(gt[:, :2])
     for s in o.settings:
         nbs = neighbours_for(seq, t, ego.id, s, seed=o.seed)
-        for mode in o.modes:
+        for mode in modes:
             if mode == "none" and s.name != "clean":
                 continue  # no fusion does not depend on the neighbours
             if o.predictions is not None:

@@ -1,0 +1,86 @@
+"""``mmusv study detection|robustness``: a sequence with one USV is scored in mode ``none`` only (it refused the whole
+dataset), the report is written after every run is computed and atomically (an interruption left half a report),
+and a ``--model`` folder of models of other presets or seeds is named (the modes compared models of different
+training without a word). Tiny data: 3 frames, LiDAR only."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import polars as pl
+import pytest
+from mmusv.cli import main
+from test_detection_study import record
+
+REPORT = ("detection_table.csv", "detection_boxes.parquet", "detection_ap.png", "detection_note.txt")
+
+
+@pytest.fixture(scope="module")
+def mixed(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A folder of two recordings of 3 frames: ``tiny_2usv`` (2 USVs) and ``tiny_1usv`` (1 USV)."""
+    root = tmp_path_factory.mktemp("mixed")
+    folder = root / "recordings"
+    folder.mkdir()
+    for usvs in (("usv_1", "usv_3"), ("usv_1",)):
+        rec = record(root / f"r{len(usvs)}", usvs, frames=3)
+        shutil.copy(rec, folder / rec.name)
+    return folder
+
+
+def _study(args: list[str], out: Path) -> int:
+    return main([*args, "-o", str(out), "--no-progress"])
+
+
+def test_a_one_usv_sequence_is_scored_in_none_only(
+    mixed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "det"
+    assert _study(["study", "detection", str(mixed)], out) == 0
+    text = capsys.readouterr().out
+    said = "scored in mode none only (one USV with a LiDAR: nothing to fuse): tiny_1usv"
+    assert said in " ".join(text.split()), text
+    assert said in (out / "detection_note.txt").read_text(encoding="utf-8")
+    table = pl.read_csv(out / "detection_table.csv")
+    assert table["mode"].to_list() == ["none", "late", "early"]
+    frames = dict(zip(table["mode"], table["frames"], strict=True))
+    ego_frames = dict(zip(table["mode"], table["ego_frames"], strict=True))
+    assert frames == {"none": 6, "late": 3, "early": 3}  # the lone sequence's 3 frames count for none only
+    assert ego_frames == {"none": 9, "late": 6, "early": 6}
+    boxes = pl.read_parquet(out / "detection_boxes.parquet")
+    assert set(boxes.filter(pl.col("sequence") == "tiny_1usv")["mode"].to_list()) == {"none"}
+    assert set(boxes.filter(pl.col("sequence") == "tiny_2usv")["mode"].to_list()) == {"none", "late", "early"}
+    # the sequence with two USVs scores as it does alone
+    alone = tmp_path / "alone"
+    shutil.copytree(mixed, alone, ignore=shutil.ignore_patterns("tiny_1usv*"))
+    assert _study(["study", "detection", str(alone)], tmp_path / "a") == 0
+    capsys.readouterr()
+    two = pl.read_csv(tmp_path / "a" / "detection_table.csv")
+    assert two.filter(pl.col("mode") != "none").equals(table.filter(pl.col("mode") != "none"))
+    # over two processes: the same bytes
+    assert _study(["study", "detection", str(mixed), "--jobs", "2"], tmp_path / "j") == 0
+    assert said in " ".join(capsys.readouterr().out.split())
+    for name in REPORT:
+        assert (out / name).read_bytes() == (tmp_path / "j" / name).read_bytes(), name
+
+
+def test_a_one_usv_sequence_in_the_robustness_study(
+    mixed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "rob"
+    assert _study(["study", "robustness", str(mixed), "--settings", "delay:1,noise:1/1"], out) == 0
+    assert "tiny_1usv" in " ".join(capsys.readouterr().out.split())
+    boxes = pl.read_parquet(out / "robustness_boxes.parquet")
+    lone = boxes.filter(pl.col("sequence") == "tiny_1usv")
+    assert set(zip(lone["setting"], lone["mode"], strict=True)) == {("clean", "none")}
+    assert "tiny_1usv" in (out / "robustness_note.txt").read_text(encoding="utf-8")
+    # only sequences of one USV and no mode none: nothing to score, said
+    lone_only = tmp_path / "lone"
+    shutil.copytree(mixed, lone_only, ignore=shutil.ignore_patterns("tiny_2usv*"))
+    assert _study(["study", "detection", str(lone_only), "--modes", "late"], tmp_path / "o") == 2
+    err = " ".join(capsys.readouterr().err.split())
+    assert "empty dataset" in err and "tiny_1usv" in err and "one USV with a LiDAR" in err and "--modes" in err, err
+    # with mode none they are scored there
+    assert _study(["study", "detection", str(lone_only)], tmp_path / "n") == 0
+    capsys.readouterr()
+    assert pl.read_csv(tmp_path / "n" / "detection_table.csv")["mode"].to_list() == ["none"]
