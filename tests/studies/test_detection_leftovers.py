@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import shutil
 from pathlib import Path
+from typing import Any
 
 import polars as pl
 import pytest
@@ -84,3 +85,80 @@ def test_a_one_usv_sequence_in_the_robustness_study(
     assert _study(["study", "detection", str(lone_only)], tmp_path / "n") == 0
     capsys.readouterr()
     assert pl.read_csv(tmp_path / "n" / "detection_table.csv")["mode"].to_list() == ["none"]
+
+
+def test_an_interrupted_report_leaves_no_half_of_it(
+    pair: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from mmusv.studies.detection import report
+
+    out = tmp_path / "det"
+    assert _study(["study", "detection", str(pair), "--modes", "none"], out) == 0
+    before = {name: (out / name).read_bytes() for name in REPORT}
+
+    def interrupted(*args: Any, **kwargs: Any) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(report, "_plot_detection", interrupted)  # Ctrl-C while the plot is drawn
+    assert _study(["study", "detection", str(pair)], out) == 130
+    assert "interrupted" in capsys.readouterr().err
+    # the earlier report whole, not a new table beside the old plot
+    assert {name: (out / name).read_bytes() for name in REPORT} == before
+    assert sorted(p.name for p in out.iterdir()) == sorted(REPORT)  # no temporary file either
+    fresh = tmp_path / "fresh"
+    assert _study(["study", "detection", str(pair)], fresh) == 130
+    assert not fresh.exists() or not any(fresh.iterdir())
+
+
+def _models(folder: Path, made: dict[str, tuple[str, int]]) -> Path:
+    """A ``--model`` folder of untrained models: ``{mode: (preset, seed)}``, each written as mmusv train writes it."""
+    import torch
+    from mmusv.learn.checkpoint import save_checkpoint
+    from mmusv.learn.model import PillarNet
+    from mmusv.learn.presets import preset
+
+    for mode, (name, seed) in made.items():
+        torch.manual_seed(seed)
+        p = preset(name)
+        (folder / mode).mkdir(parents=True, exist_ok=True)
+        state = {"preset": p.to_dict(), "mode": mode, "seed": seed, "epoch": 1, "epochs": 1, "stopped": None}
+        state |= {"step": 1, "log": [], "data": None, "model": PillarNet(p, mode).state_dict()}
+        save_checkpoint(state, folder / mode / "model.pt")
+    return folder
+
+
+@pytest.fixture(scope="module")
+def pair(mixed: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The recording of 2 USVs alone (3 frames)."""
+    folder = tmp_path_factory.mktemp("pair")
+    shutil.copy(mixed / "tiny_2usv.mcap", folder / "tiny_2usv.mcap")
+    return folder
+
+
+def test_a_second_run_interrupted_leaves_no_report_of_the_first(
+    pair: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """With --model the learned model's run and the baseline's beside it: the first's report was written before the
+    second ran, so a Ctrl-C in the second left a report that looked complete."""
+    pytest.importorskip("torch")
+    from mmusv.studies.detection import study
+
+    models = _models(tmp_path / "m", {"single": ("tiny", 0)})
+    calls: list[int] = []
+    real = study.run_study
+
+    def second_interrupted(*args: Any, **kwargs: Any) -> Any:
+        calls.append(1)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(study, "run_study", second_interrupted)
+    out = tmp_path / "o"
+    assert _study(["study", "detection", str(pair), "--model", str(models), "--refine", "off"], out) == 130
+    assert len(calls) == 2
+    assert "interrupted" in capsys.readouterr().err
+    assert not out.exists() or not any(out.rglob("*.*")), sorted(out.rglob("*"))
+    monkeypatch.setattr(study, "run_study", real)
+    assert _study(["study", "detection", str(pair), "--model", str(models), "--refine", "off"], out) == 0
+    assert all((out / name).is_file() and (out / "baseline" / name).is_file() for name in REPORT)

@@ -257,7 +257,9 @@ def run(args: argparse.Namespace) -> int:
         base_modes = tuple(m for m in modes if m != "intermediate")
         if base_modes and (not robust or any(m != "none" for m in base_modes)):
             runs.append((load_detector("baseline"), "baseline", base_modes, out / "baseline"))
-    paths: dict[str, Path] = {}
+    from mmusv.studies.detection import report
+
+    files: report.Files = {}  # every run's report, written once all are computed (module docstring of report)
     for det, name, run_modes, run_out in runs:
         options = StudyOptions(
             modes=run_modes,
@@ -305,18 +307,16 @@ def run(args: argparse.Namespace) -> int:
                 f"evaluate{why}"
             )
         eval_s = time.perf_counter() - t1
-        from mmusv.studies.detection import report
-
         if len(runs) > 1:
             console.print(f"[bold]{name}[/]", highlight=False)
         notes = learned_notes if det is learned and learned is not None else []
         if robust:
-            written = report.write_robustness(res, run_out, detector=name, notes=notes)
+            made = report.robustness_files(res, run_out, detector=name, notes=notes)
             _print_robustness(console, res)
         else:
-            written = report.write_detection(res, run_out, detector=name, notes=notes)
+            made = report.detection_files(res, run_out, detector=name, notes=notes)
             _print_detection(console, res)
-        paths.update({f"{name}:{k}": v for k, v in written.items()})
+        files.update({f"{name}:{k}": v for k, v in made.items()})
         lone = report.none_only_line(res)
         if lone is not None:
             from rich.markup import escape
@@ -342,6 +342,7 @@ def run(args: argparse.Namespace) -> int:
             f"{eval_s:.1f} s, total {time.perf_counter() - t0:.1f} s",
             highlight=False,
         )
+    paths = report.write_files(files)
     console.print("wrote " + ", ".join(str(p) for p in paths.values()), highlight=False)
     return 0
 

@@ -1,14 +1,22 @@
-"""Presenting a detection study: rich tables, CSV, a plot (matplotlib) and the Parquet of every scored box."""
+"""Presenting a detection study: rich tables, CSV, a plot (matplotlib) and the Parquet of every scored box.
+
+:func:`detection_files` and :func:`robustness_files` make a report's files in memory; the command writes those of
+all its runs together, once every run is computed, with :func:`~mmusv.jsonio.write_files_atomic` (an error or a
+Ctrl-C half-way left the first files of a report, or the first run's whole report, beside nothing or an earlier
+run's others). :func:`write_detection` and :func:`write_robustness` do both for one run.
+"""
 
 from __future__ import annotations
 
+import io
 import math
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 import polars as pl
 
+from mmusv.jsonio import write_files_atomic
 from mmusv.studies.detection.detector import BASELINE_NOTE
 from mmusv.studies.detection.evaluate import RANGE_BINS, bin_label
 from mmusv.studies.detection.study import StudyResult
@@ -16,11 +24,14 @@ from mmusv.studies.plotting import default_style
 
 __all__ = [
     "DETECTION_METRICS",
+    "detection_files",
     "detection_table",
     "fmt",
     "none_only_line",
+    "robustness_files",
     "robustness_table",
     "write_detection",
+    "write_files",
     "write_robustness",
 ]
 
@@ -71,44 +82,60 @@ def _detector_name(res: StudyResult, detector: str) -> str:
     return "predictions file" if res.options.predictions is not None else detector
 
 
-def write_detection(res: StudyResult, out: Path, *, detector: str, notes: Sequence[str] = ()) -> dict[str, Path]:
-    """Writes ``detection_table.csv``, ``detection_boxes.parquet``, ``detection_ap.png`` and
-    ``detection_note.txt`` (with the lines ``notes``: a learned detector's models and second stage) into ``out``;
-    returns the paths."""
-    out.mkdir(parents=True, exist_ok=True)
+Files = dict[str, tuple[Path, bytes]]
+"""A report made in memory: ``{key: (path, bytes)}``."""
+
+
+def detection_files(res: StudyResult, out: Path, *, detector: str, notes: Sequence[str] = ()) -> Files:
+    """``detection_table.csv``, ``detection_boxes.parquet``, ``detection_ap.png`` and ``detection_note.txt`` (with
+    the lines ``notes``: a learned detector's models and second stage) of ``out``, made in memory, the note last."""
     table = detection_table(res)
-    paths = {
-        "csv": out / "detection_table.csv",
-        "parquet": out / "detection_boxes.parquet",
-        "png": out / "detection_ap.png",
-        "note": out / "detection_note.txt",
+    png = io.BytesIO()
+    _plot_detection(table, png)
+    return {
+        "csv": (out / "detection_table.csv", table.write_csv().encode("utf-8")),
+        "parquet": (out / "detection_boxes.parquet", _parquet(res.boxes_frame(with_setting=False))),
+        "png": (out / "detection_ap.png", png.getvalue()),
+        "note": (out / "detection_note.txt", _note(res, detector, notes).encode("utf-8")),
     }
-    table.write_csv(paths["csv"])
-    res.boxes_frame(with_setting=False).write_parquet(paths["parquet"])
-    _plot_detection(table, paths["png"])
-    paths["note"].write_text(_note(res, detector, notes), encoding="utf-8")
-    return paths
+
+
+def robustness_files(res: StudyResult, out: Path, *, detector: str, notes: Sequence[str] = ()) -> Files:
+    """``robustness_table.csv`` (AP@0.5 per setting and mode), ``robustness_metrics.csv`` (every metric),
+    ``robustness_boxes.parquet``, ``robustness_ap.png`` and ``robustness_note.txt`` (with the lines ``notes``) of
+    ``out``, made in memory, the note last."""
+    png = io.BytesIO()
+    _plot_robustness(res, png)
+    return {
+        "csv": (out / "robustness_table.csv", robustness_table(res).write_csv().encode("utf-8")),
+        "metrics": (out / "robustness_metrics.csv", res.table().write_csv().encode("utf-8")),
+        "parquet": (out / "robustness_boxes.parquet", _parquet(res.boxes_frame(with_setting=True))),
+        "png": (out / "robustness_ap.png", png.getvalue()),
+        "note": (out / "robustness_note.txt", _note(res, detector, notes).encode("utf-8")),
+    }
+
+
+def write_files(files: Files) -> dict[str, Path]:
+    """Writes ``files`` (of one report or of several, keys distinct) with
+    :func:`~mmusv.jsonio.write_files_atomic`; returns their paths by key."""
+    write_files_atomic(dict(files.values()))
+    return {key: path for key, (path, _) in files.items()}
+
+
+def write_detection(res: StudyResult, out: Path, *, detector: str, notes: Sequence[str] = ()) -> dict[str, Path]:
+    """Writes :func:`detection_files` into ``out`` (created); returns the paths."""
+    return write_files(detection_files(res, out, detector=detector, notes=notes))
 
 
 def write_robustness(res: StudyResult, out: Path, *, detector: str, notes: Sequence[str] = ()) -> dict[str, Path]:
-    """Writes ``robustness_table.csv`` (AP@0.5 per setting and mode), ``robustness_metrics.csv`` (every metric),
-    ``robustness_boxes.parquet``, ``robustness_ap.png`` and ``robustness_note.txt`` (with the lines ``notes``)
-    into ``out``."""
-    out.mkdir(parents=True, exist_ok=True)
-    paths = {
-        "csv": out / "robustness_table.csv",
-        "metrics": out / "robustness_metrics.csv",
-        "parquet": out / "robustness_boxes.parquet",
-        "png": out / "robustness_ap.png",
-        "note": out / "robustness_note.txt",
-    }
-    wide = robustness_table(res)
-    wide.write_csv(paths["csv"])
-    res.table().write_csv(paths["metrics"])
-    res.boxes_frame(with_setting=True).write_parquet(paths["parquet"])
-    _plot_robustness(res, paths["png"])
-    paths["note"].write_text(_note(res, detector, notes), encoding="utf-8")
-    return paths
+    """Writes :func:`robustness_files` into ``out`` (created); returns the paths."""
+    return write_files(robustness_files(res, out, detector=detector, notes=notes))
+
+
+def _parquet(df: pl.DataFrame) -> bytes:
+    buf = io.BytesIO()
+    df.write_parquet(buf)
+    return buf.getvalue()
 
 
 def none_only_line(res: StudyResult) -> str | None:
@@ -138,7 +165,7 @@ def _note(res: StudyResult, detector: str, notes: Sequence[str] = ()) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _plot_detection(table: pl.DataFrame, path: Path) -> None:
+def _plot_detection(table: pl.DataFrame, path: Path | IO[bytes]) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -157,7 +184,7 @@ def _plot_detection(table: pl.DataFrame, path: Path) -> None:
         )
 
 
-def _finish(fig: Any, ax: Any, labels: list[tuple[str, str]], title: str, path: Path) -> None:
+def _finish(fig: Any, ax: Any, labels: list[tuple[str, str]], title: str, path: Path | IO[bytes]) -> None:
     """Axis labels, limits, grid and legends of the two panels; saves ``fig`` (no timestamp) and closes it."""
     import matplotlib.pyplot as plt
 
@@ -169,11 +196,11 @@ def _finish(fig: Any, ax: Any, labels: list[tuple[str, str]], title: str, path: 
         a.legend()
     fig.suptitle(title)
     fig.tight_layout()
-    fig.savefig(path, dpi=100, metadata={"Software": None})
+    fig.savefig(path, format="png", dpi=100, metadata={"Software": None})
     plt.close(fig)
 
 
-def _plot_robustness(res: StudyResult, path: Path) -> None:
+def _plot_robustness(res: StudyResult, path: Path | IO[bytes]) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
