@@ -135,6 +135,30 @@ def pair(mixed: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
     return folder
 
 
+@pytest.mark.filterwarnings("always::mmusv.scenario_checks.MmusvWarning")  # said on stderr by mmusv's main
+def test_models_of_other_presets_or_seeds_are_named(
+    pair: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    pytest.importorskip("torch")
+    base = ["study", "detection", str(pair), "--refine", "off"]
+    presets = _models(tmp_path / "presets", {"single": ("tiny", 0), "early": ("cpu", 0)})
+    assert _study([*base, "--model", str(presets), "--modes", "none,early"], tmp_path / "p") == 0
+    err = " ".join(capsys.readouterr().err.split())
+    assert f"mmusv: warning: --model {presets}: its models were trained with other presets or seeds" in err, err
+    assert "(single: preset tiny, seed 0; early: preset cpu, seed 0)" in err and "mmusv train" in err, err
+    note = (tmp_path / "p" / "detection_note.txt").read_text(encoding="utf-8")
+    assert "single: preset tiny, seed 0; early: preset cpu, seed 0" in note
+    assert "seed 0" not in (tmp_path / "p" / "baseline" / "detection_note.txt").read_text(encoding="utf-8")
+    seeds = _models(tmp_path / "seeds", {"single": ("tiny", 0), "early": ("tiny", 1)})
+    assert _study([*base, "--model", str(seeds), "--modes", "late,early"], tmp_path / "s") == 0
+    assert "(single: preset tiny, seed 0; early: preset tiny, seed 1)" in " ".join(capsys.readouterr().err.split())
+    # one model scored (none and late run the single model), or models of one training: nothing said
+    assert _study([*base, "--model", str(presets), "--modes", "none,late"], tmp_path / "n") == 0
+    same = _models(tmp_path / "same", {"single": ("tiny", 3), "early": ("tiny", 3)})
+    assert _study([*base, "--model", str(same), "--modes", "none,early"], tmp_path / "t") == 0
+    assert "warning" not in capsys.readouterr().err
+
+
 def test_a_second_run_interrupted_leaves_no_report_of_the_first(
     pair: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -204,6 +204,13 @@ def run(args: argparse.Namespace) -> int:
     modes = parse_modes(default_modes if args.modes is None else args.modes)  # "" was taken as the default
     if learned is not None:
         _check_model_modes(args.model, learned, modes)
+    mixed = _mixed_training(args.model, learned, modes) if learned is not None else None
+    if mixed is not None:
+        import warnings
+
+        from mmusv.scenario_checks import MmusvWarning
+
+        warnings.warn(mixed, MmusvWarning, stacklevel=2)
     settings = parse_settings(args.settings) if robust else (Setting(),)
     if robust and not any(m != "none" for m in modes):
         raise InputError("--modes: the robustness study needs late and/or early fusion")
@@ -248,6 +255,8 @@ def run(args: argparse.Namespace) -> int:
         from rich.markup import escape
 
         learned_notes.append(f"learned models: {learned.describe()}")
+        if mixed is not None:
+            learned_notes.append(f"warning: {mixed}")
         leak = _training_overlap(learned, dataset)
         if leak:
             console.print(f"[yellow]{escape(leak)}[/]", highlight=False)
@@ -364,6 +373,26 @@ def _check_model_modes(model: str, learned: Any, modes: tuple[str, ...]) -> None
             f"hold (it has {', '.join(learned.models)}: modes {','.join(learned.fusion_modes)}; train it with "
             "mmusv train --modes)"
         )
+
+
+def _mixed_training(model: str, learned: Any, modes: tuple[str, ...]) -> str | None:
+    """A warning line when the models the fusion ``modes`` run (``--model``'s ``single``, ``early``,
+    ``intermediate``) were trained with other presets or seeds (a folder put together from several runs): the modes
+    compared models of different training, not fusion alone, without a word."""
+    used = [m for m in learned.models if m in {_NEEDS[mode] for mode in modes}]
+
+    def seed(v: Any) -> str:
+        return f"seed {v}" if v is not None else "seed not recorded"
+
+    how = {m: (learned.info[m].get("preset"), learned.info[m].get("seed")) for m in used}
+    if len(set(how.values())) < 2:
+        return None
+    each = "; ".join(f"{m}: preset {p}, {seed(s)}" for m, (p, s) in how.items())
+    return (
+        f"--model {model}: its models were trained with other presets or seeds ({each}), so the modes they serve "
+        "differ by training as well as by fusion; train them in one mmusv train run (one --preset and --seed, "
+        f"--modes {','.join(used)})"
+    )
 
 
 def _training_overlap(learned: Any, dataset: Any) -> str | None:
