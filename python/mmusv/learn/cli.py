@@ -121,6 +121,7 @@ def run(args: argparse.Namespace) -> int:
     check_split(args.split, args.seed if args.opv2v is None else 0)
     _torch()
     _check_device(args.device)
+    from mmusv.jsonio import write_bytes_atomic
     from mmusv.learn.cache import build_cache
     from mmusv.learn.example import MODES
     from mmusv.learn.presets import preset
@@ -173,21 +174,11 @@ def run(args: argparse.Namespace) -> int:
         threads = max(1, (os.cpu_count() or 1) // jobs)
     p = preset(args.preset)
     from mmusv.learn.cache import cache_identity
-    from mmusv.learn.train import resumable_checkpoint
 
     identity = cache_identity(cache)
-    # A run whose every model would refuse its checkpoint (another preset or seed into the same -o) is refused once,
-    # before any process starts: each process refused alone, and the summary of the models there was replaced by one
-    # of none. Where only some would, the others train (a failing model does not stop them).
-    refusals: list[InputError] = []
-    for mode in modes:
-        try:
-            resumable_checkpoint(out / mode, p=p, mode=mode, seed=args.seed, identity=identity)
-        except InputError as exc:
-            refusals.append(exc)
-    if refusals and len(refusals) == len(modes):
-        raise refusals[0]
-    summary: dict[str, Any] = {"preset": p.to_dict(), "seed": args.seed, "jobs": jobs, "models": {}}
+    _check_same_run(out, modes, p=p, seed=args.seed, identity=identity)
+    summary = _summary_to_keep(out / "train_summary.json", modes, p=p.to_dict(), seed=args.seed)
+    summary["jobs"] = jobs
     task = {
         "cache": str(cache),
         "preset": args.preset,
@@ -219,12 +210,16 @@ def run(args: argparse.Namespace) -> int:
         done: dict[str, dict[str, Any]] = {}
         with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
             futures = {pool.submit(_train_one, {**task, "mode": mode, "out": str(out / mode)}): mode for mode in modes}
-            for f in as_completed(futures):
-                try:
-                    done[futures[f]] = f.result()
-                except Exception as e:  # reported here, the first one raised after the others
-                    failures.append(e)
-                    print(f"{futures[f]}: failed: {e}", file=sys.stderr, flush=True)
+            try:
+                for f in as_completed(futures):
+                    try:
+                        done[futures[f]] = f.result()
+                    except Exception as e:  # reported here, the first one raised after the others
+                        failures.append(e)
+                        print(f"{futures[f]}: failed: {e}", file=sys.stderr, flush=True)
+            except BaseException:  # Ctrl-C, a kill: the models stop too (leaving the pool waited for them, hours)
+                _stop_workers(pool)
+                raise
         finished = [(mode, done[mode]) for mode in modes if mode in done]
     for mode, r in finished:
         summary["models"][mode] = {k: r[k] for k in ("epochs", "steps", "seconds", "finished", "stopped")}
@@ -243,11 +238,77 @@ def run(args: argparse.Namespace) -> int:
         )
         if "scorer" in r:
             summary.setdefault("scorers", {})[mode] = r["scorer"]
-    (out / "train_summary.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
+    for key in ("models", "scorers"):  # in the order of MODES, the kept ones and this run's together
+        if key in summary:
+            summary[key] = {m: summary[key][m] for m in MODES if m in summary[key]}
+    # whole or not at all (a Ctrl-C while writing it)
+    write_bytes_atomic(out / "train_summary.json", (json.dumps(summary, indent=2) + "\n").encode("utf-8"))
     if failures:
         raise failures[0]
     print(f"total {time.perf_counter() - t0:.1f} s; score with: mmusv study detection --model {out} ...", flush=True)
     return 0
+
+
+def _stop_workers(pool: Any, *, grace_s: float = 10.0) -> None:
+    """Stops the training processes of ``pool`` (a ``ProcessPoolExecutor``) when ``mmusv train`` is interrupted:
+    the models not started are cancelled, and each running one gets SIGINT, so it stops as Ctrl-C stops a model
+    trained in turn (its ``last.pt`` and ``model.pt`` whole, as saved last), and is killed if it has not stopped
+    within ``grace_s`` seconds. Without it, a ``kill`` of ``mmusv train`` (or a Ctrl-C that reached only it) left
+    the pool waiting for every model to finish training."""
+    import signal
+
+    # the pool has no public handle on its processes, and forgets them when shut down
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for proc in processes:
+        if proc.is_alive() and proc.pid is not None:
+            with contextlib.suppress(OSError):
+                os.kill(proc.pid, signal.SIGINT)
+    deadline = time.monotonic() + grace_s
+    for proc in processes:
+        proc.join(max(0.0, deadline - time.monotonic()))
+        if proc.is_alive():
+            proc.kill()
+            proc.join(1.0)
+
+
+def _check_same_run(out: Path, modes: list[str], *, p: Any, seed: int, identity: dict[str, Any] | None) -> None:
+    """Refuses, before any model trains, a run into an ``-o`` holding a checkpoint of another run (another preset,
+    seed or data) for any model, the ones this run trains or not: the models of one ``-o`` are scored together
+    (:func:`load_for_study`). Refused only where every model would refuse, the others trained: a ``--preset cpu``
+    run into a folder of ``tiny`` models left ``single`` of one preset beside ``early`` of the other, and the
+    summary named only the new ones; and refused in each model's process, each printed its refusal and the summary
+    was replaced by one of no model."""
+    from mmusv.learn.example import MODES
+    from mmusv.learn.train import resumable_checkpoint
+
+    for mode in [*modes, *(m for m in MODES if m not in modes)]:
+        try:
+            resumable_checkpoint(out / mode, p=p, mode=mode, seed=seed, identity=identity)
+        except InputError as exc:
+            others = [m for m in modes if m != mode]
+            hint = f", or leave {mode} out (--modes {','.join(others)})" if mode in modes and others else ""
+            if mode not in modes:
+                hint = f" (the {mode} model there is scored with the ones this run trains)"
+            raise InputError(f"{exc}{hint}") from None
+
+
+def _summary_to_keep(path: Path, modes: list[str], *, p: dict[str, Any], seed: int) -> dict[str, Any]:
+    """The ``train_summary.json`` to write for a run training ``modes``: the earlier summary's entries for the other
+    models there of the same preset and seed (``--modes early`` after ``--modes single`` replaced the summary with one
+    naming ``early`` alone), less the entries this run writes again."""
+    summary: dict[str, Any] = {"preset": p, "seed": seed, "jobs": 1, "models": {}}
+    before = _read_json(path)
+    if before is None or before.get("preset") != json.loads(json.dumps(p)) or before.get("seed") != seed:  # as read
+        return summary
+    for key in ("models", "scorers"):
+        kept = before.get(key)
+        if isinstance(kept, dict):
+            # a model folder removed since is not named
+            kept = {m: v for m, v in kept.items() if m not in modes and (path.parent / m / "model.pt").is_file()}
+            if kept:
+                summary[key] = kept
+    return summary
 
 
 def _check_cache(
