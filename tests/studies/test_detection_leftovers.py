@@ -186,3 +186,25 @@ def test_a_second_run_interrupted_leaves_no_report_of_the_first(
     monkeypatch.setattr(study, "run_study", real)
     assert _study(["study", "detection", str(pair), "--model", str(models), "--refine", "off"], out) == 0
     assert all((out / name).is_file() and (out / "baseline" / name).is_file() for name in REPORT)
+
+
+def test_only_the_models_of_the_asked_modes_are_read(
+    pair: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # a damaged early/model.pt stopped --modes none,late, which runs the single model alone (read before the modes)
+    pytest.importorskip("torch")
+    models = _models(tmp_path / "models", {"single": ("tiny", 0), "early": ("tiny", 0)})
+    (models / "early" / "model.pt").write_bytes(b"PK\x03\x04 cut short")
+    base = ["study", "detection", str(pair), "--refine", "off", "--model", str(models)]
+    for jobs in ("1", "2"):
+        assert _study([*base, "--modes", "none,late", "--jobs", jobs], tmp_path / f"nl{jobs}") == 0, jobs
+        note = (tmp_path / f"nl{jobs}" / "detection_note.txt").read_text(encoding="utf-8")
+        assert "early" not in note.split("learned models:")[1].split("\n")[0], note
+    capsys.readouterr()
+    for jobs in ("1", "2"):
+        assert (tmp_path / "nl1" / "detection_table.csv").read_bytes() == (
+            tmp_path / f"nl{jobs}" / "detection_table.csv"
+        ).read_bytes()
+    # a mode that runs it still names the file
+    assert _study([*base, "--modes", "none,early"], tmp_path / "ne") == 2
+    assert f"--model {models / 'early' / 'model.pt'}: not an mmusv.learn model.pt" in capsys.readouterr().err

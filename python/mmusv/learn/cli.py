@@ -25,6 +25,7 @@ import math
 import os
 import sys
 import time
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -44,14 +45,27 @@ def _torch() -> None:
         raise InputError(f"mmusv.learn {_INSTALL}") from None
 
 
-def load_for_study(path: str, *, refine: bool | None = None, rescore: bool | None = None) -> Any:
+STUDY_NEEDS = {"none": "single", "late": "single", "early": "early", "intermediate": "intermediate"}
+"""The model each of the study's fusion modes runs."""
+
+
+def load_for_study(
+    path: str,
+    *,
+    refine: bool | None = None,
+    rescore: bool | None = None,
+    modes: Sequence[str] | None = None,
+) -> Any:
     """The :class:`~mmusv.learn.detector.LearnedDetector` at ``path`` (``--model``); ``refine``: the geometric
     second stage on or off, ``rescore``: the IoU scorers on or off (``None``: the defaults of
-    :func:`~mmusv.learn.detector.load_models`)."""
+    :func:`~mmusv.learn.detector.load_models`); ``modes``: the study's fusion modes (``none``, ``late``, ``early``,
+    ``intermediate``) to load the models of (``None``: every model there). ``--modes none,late`` read the early
+    and intermediate models too: one damaged, or of another version, stopped a study that does not run it."""
     _torch()
     from mmusv.learn.detector import load_models
 
-    return load_models(path, refine=refine, rescore=rescore)
+    models = None if modes is None else sorted({STUDY_NEEDS[m] for m in modes if m in STUDY_NEEDS})
+    return load_models(path, refine=refine, rescore=rescore, models=models)
 
 
 def add_parser(sub: Any) -> None:

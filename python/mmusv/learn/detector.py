@@ -48,14 +48,21 @@ def _load(path: Path, device: torch.device, mode: str | None = None) -> tuple[Pi
 
 
 def load_models(
-    path: str | Path, *, device: str = "cpu", refine: bool | None = None, rescore: bool | None = None
+    path: str | Path,
+    *,
+    device: str = "cpu",
+    refine: bool | None = None,
+    rescore: bool | None = None,
+    models: Sequence[str] | None = None,
 ) -> LearnedDetector:
     """The models at ``path`` (module docstring) as one detector; raises ``InputError`` naming the path when
     there is none or one is unreadable. ``refine``: apply the geometric second stage
     (:mod:`mmusv.learn.refine`) to every model's boxes; ``None`` (default): only when every model is of the
     ``cpu`` preset, the one it was measured on. ``rescore``: rank the refined boxes by each model's IoU scorer
     (:mod:`mmusv.learn.scorer`); ``None`` (default): where a model has one and the boxes are refined; ``True``:
-    every model must have one (an ``InputError`` names the one without)."""
+    every model must have one (an ``InputError`` names the one without). ``models``: of a folder holding
+    ``single/``, ``early/``, ``intermediate/``, load only these (``None``: every one there); the others are not
+    read, so one that is damaged or of another training does not stop a study that does not run it."""
     p = Path(path)
     dev = torch.device(device)
     files: dict[str, Path] = {}
@@ -65,16 +72,17 @@ def load_models(
         _, ck = _load(p, dev)
         files[str(ck["mode"])] = p
     elif p.is_dir():
-        files = {m: p / m / "model.pt" for m in MODES if (p / m / "model.pt").is_file()}
+        wanted = MODES if models is None else tuple(m for m in MODES if m in models)
+        files = {m: p / m / "model.pt" for m in wanted if (p / m / "model.pt").is_file()}
     if not files:
         raise input_error(
             f"--model {p}: no model.pt there (a model.pt, a folder holding one, or a folder with "
             f"{'/'.join(MODES)}/model.pt)"
         )
-    models: dict[str, PillarNet] = {}
+    nets: dict[str, PillarNet] = {}
     info: dict[str, dict[str, Any]] = {}
     for mode, f in files.items():
-        models[mode], ck = _load(f, dev, mode if p.is_dir() else None)
+        nets[mode], ck = _load(f, dev, mode if p.is_dir() else None)
         info[mode] = {
             "file": str(f),
             "epoch": int(ck["epoch"]),
@@ -96,7 +104,7 @@ def load_models(
             if refine and sf.is_file():
                 scorer = load_scorer(sf)
                 fitted_for = scorer.info.get("model")
-                if fitted_for is not None and fitted_for != weights_digest(models[mode].state_dict()):
+                if fitted_for is not None and fitted_for != weights_digest(nets[mode].state_dict()):
                     # the model trained on after its scorer was fitted (mmusv train --no-scorers, or a resumed run):
                     # the scorer ranks boxes it never saw, so it is left out, and the line of describe() says so
                     why = f"{sf} was fitted for other weights of this model; refit it: mmusv train --scorers-only"
@@ -108,7 +116,7 @@ def load_models(
                 info[mode]["scorer"] = str(sf)
             elif rescore:
                 raise input_error(f"--rescore on: {mode} has no {sf} (fit it with mmusv train --scorers-only)")
-    return LearnedDetector(models, info, refine=RefineParams() if refine else None, scorers=scorers)
+    return LearnedDetector(nets, info, refine=RefineParams() if refine else None, scorers=scorers)
 
 
 def _progress(v: dict[str, Any]) -> str:

@@ -14,6 +14,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from mmusv.learn.cli import STUDY_NEEDS
 from mmusv.text import counted
 
 __all__ = ["add_dataset_arguments", "add_parsers", "run"]
@@ -188,7 +189,9 @@ def run(args: argparse.Namespace) -> int:
             raise InputError("give one of --model, --detector or --predictions")
         from mmusv.learn.cli import load_for_study
 
-        learned = load_for_study(args.model, refine=tri[args.refine], rescore=tri[args.rescore])
+        # only the models the asked --modes run (one damaged or of another training stopped a study not running it)
+        asked = parse_modes(args.modes) if args.modes is not None else None
+        learned = load_for_study(args.model, refine=tri[args.refine], rescore=tri[args.rescore], modes=asked)
     if args.model is None and (args.refine != "auto" or args.rescore != "auto"):
         flag = f"--refine {args.refine}" if args.refine != "auto" else f"--rescore {args.rescore}"
         raise InputError(f"{flag}: only with --model (the learned detector's second stage)")
@@ -288,7 +291,11 @@ def run(args: argparse.Namespace) -> int:
 
                 if learned is not None and det is learned:
                     spec = DetectorSpec(
-                        model=args.model, refine=tri[args.refine], rescore=tri[args.rescore], threads=args.threads or 1
+                        model=args.model,
+                        refine=tri[args.refine],
+                        rescore=tri[args.rescore],
+                        threads=args.threads or 1,
+                        modes=modes,
                     )
                 elif det is None:
                     spec = DetectorSpec(predictions=args.predictions)
@@ -356,7 +363,7 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-_NEEDS = {"none": "single", "late": "single", "early": "early", "intermediate": "intermediate"}
+_NEEDS = STUDY_NEEDS
 """The learned model each fusion mode runs (:class:`mmusv.learn.detector.LearnedDetector`)."""
 
 

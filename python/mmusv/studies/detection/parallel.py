@@ -41,6 +41,8 @@ class DetectorSpec:
     rescore: bool | None = None
     threads: int = 1
     predictions: str | None = None
+    modes: tuple[str, ...] | None = None
+    """The study's fusion modes, whose models are loaded (``None``: every model at ``model``)."""
 
     def build(self) -> tuple[Any, Any]:
         """``(detector, predictions)`` for :class:`~mmusv.studies.detection.study.StudyOptions`."""
@@ -54,7 +56,7 @@ class DetectorSpec:
             from mmusv.learn.cli import load_for_study
 
             torch.set_num_threads(self.threads)
-            return load_for_study(self.model, refine=self.refine, rescore=self.rescore), None
+            return load_for_study(self.model, refine=self.refine, rescore=self.rescore, modes=self.modes), None
         from mmusv.studies.detection.detector import load_detector
 
         return load_detector(self.detector), None
