@@ -543,7 +543,7 @@ def test_agents_and_frames_select_what_is_converted(mixed_rec: Path, tmp_path: P
         ("usv_9", None, "usv_9 is not an agent of the recordings (their agents: usv_a, usv_b)"),
         ("usv_a", None, "no selected agent (usv_a) to convert to coco: usv_a has no camera"),
         ("", None, "agents = '': must be one or more agent ids"),
-        (None, "2:1", "frames stop = 1: must be a whole number >= 3"),
+        (None, "2:1", "frames = '2:1': STOP (1) must be greater than START (2)"),
         (None, "x", "frames = 'x': must be START:STOP"),
         (None, (-1, 2), "frames start = -1: must be a whole number >= 0"),
     ):
