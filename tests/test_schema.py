@@ -4,8 +4,10 @@ for a typo or a wrong type are invalid, and `mmusv schema` writes the same bytes
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import json
+import os
 import re
 from collections.abc import Iterator
 from pathlib import Path
@@ -113,7 +115,32 @@ def _doc_examples() -> Iterator[tuple[str, str, str]]:
             yield module, kind, re.sub(r"(?m)^    ", "", m.group(1))
 
 
-def test_documented_examples_are_valid() -> None:
+@contextlib.contextmanager
+def _user_assets(paths: list[str], folder: Path) -> Iterator[None]:
+    """In ``folder`` (the current folder meanwhile: a scenario given as a dict reads its ``assets:`` from there),
+    each asset file of ``paths``, named after its file, a 6 m box; the library as it was afterwards."""
+    import trimesh
+    from mmusv import scenario_assets
+    from mmusv.world.vessels import asset_names, unregister_asset
+
+    for rel in paths:
+        f = folder / rel
+        f.parent.mkdir(parents=True, exist_ok=True)
+        trimesh.creation.box(extents=[6.0, 2.4, 1.6]).export(f.with_suffix(".ply"))
+        entry = {"name": f.stem, "mesh": f.with_suffix(".ply").name, "draft": 0.4, "semantic_class": "vessel"}
+        f.write_text(yaml.safe_dump(entry), encoding="utf-8")
+    before, cwd = set(asset_names()), Path.cwd()
+    os.chdir(folder)
+    try:
+        yield
+    finally:
+        os.chdir(cwd)
+        for name in set(asset_names()) - before:
+            unregister_asset(name)
+        scenario_assets._loaded.clear()
+
+
+def test_documented_examples_are_valid(tmp_path: Path) -> None:
     seen = 0
     for where, kind, text in _doc_examples():
         doc = yaml.safe_load(text)
@@ -121,7 +148,11 @@ def test_documented_examples_are_valid() -> None:
             continue
         if kind == "scenario" and "vessels" not in doc:  # a fragment (docs/sea.md): in a whole scenario
             doc = {**SCENARIO, **doc}
-        _valid(kind, doc, where)
+        if kind == "scenario" and "assets" in doc:  # the user's own asset files (docs/assets.md): made here
+            with _user_assets(doc["assets"], tmp_path / f"assets_{seen}"):
+                _valid(kind, doc, where)
+        else:
+            _valid(kind, doc, where)
         seen += 1
     assert seen >= 5
 
