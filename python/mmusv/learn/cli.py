@@ -191,8 +191,7 @@ def run(args: argparse.Namespace) -> int:
 
     identity = cache_identity(cache)
     _check_same_run(out, modes, p=p, seed=args.seed, identity=identity)
-    summary = _summary_to_keep(out / "train_summary.json", modes, p=p.to_dict(), seed=args.seed)
-    summary["jobs"] = jobs
+    summary = _summary_to_keep(out / "train_summary.json", modes, p=p.to_dict(), seed=args.seed, jobs=jobs)
     task = {
         "cache": str(cache),
         "preset": args.preset,
@@ -301,17 +300,20 @@ def _check_same_run(out: Path, modes: list[str], *, p: Any, seed: int, identity:
             resumable_checkpoint(out / mode, p=p, mode=mode, seed=seed, identity=identity)
         except InputError as exc:
             others = [m for m in modes if m != mode]
-            hint = f", or leave {mode} out (--modes {','.join(others)})" if mode in modes and others else ""
             if mode not in modes:
                 hint = f" (the {mode} model there is scored with the ones this run trains)"
+            elif others:
+                hint = f", or leave {mode} out (--modes {','.join(others)})"
+            else:
+                hint = ""
             raise InputError(f"{exc}{hint}") from None
 
 
-def _summary_to_keep(path: Path, modes: list[str], *, p: dict[str, Any], seed: int) -> dict[str, Any]:
+def _summary_to_keep(path: Path, modes: list[str], *, p: dict[str, Any], seed: int, jobs: int) -> dict[str, Any]:
     """The ``train_summary.json`` to write for a run training ``modes``: the earlier summary's entries for the other
     models there of the same preset and seed (``--modes early`` after ``--modes single`` replaced the summary with one
     naming ``early`` alone), less the entries this run writes again."""
-    summary: dict[str, Any] = {"preset": p, "seed": seed, "jobs": 1, "models": {}}
+    summary: dict[str, Any] = {"preset": p, "seed": seed, "jobs": jobs, "models": {}}
     before = _read_json(path)
     if before is None or before.get("preset") != json.loads(json.dumps(p)) or before.get("seed") != seed:  # as read
         return summary

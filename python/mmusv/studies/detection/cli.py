@@ -363,18 +363,14 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-_NEEDS = STUDY_NEEDS
-"""The learned model each fusion mode runs (:class:`mmusv.learn.detector.LearnedDetector`)."""
-
-
 def _check_model_modes(model: str, learned: Any, modes: tuple[str, ...]) -> None:
     """Refuses fusion ``modes`` the models at ``--model`` cannot run, before any frame is read (the error came
     from the first frame, naming the missing model but not the mode asked for)."""
     from mmusv.errors import InputError
 
-    missing = [m for m in modes if _NEEDS[m] not in learned.models]
+    missing = [m for m in modes if STUDY_NEEDS[m] not in learned.models]
     if missing:
-        needs = sorted({_NEEDS[m] for m in missing})
+        needs = sorted({STUDY_NEEDS[m] for m in missing})
         raise InputError(
             f"--modes {','.join(missing)}: needs the {' and '.join(needs)} model, which --model {model} does not "
             f"hold (it has {', '.join(learned.models)}: modes {','.join(learned.fusion_modes)}; train it with "
@@ -386,7 +382,7 @@ def _mixed_training(model: str, learned: Any, modes: tuple[str, ...]) -> str | N
     """A warning line when the models the fusion ``modes`` run (``--model``'s ``single``, ``early``,
     ``intermediate``) were trained with other presets or seeds (a folder put together from several runs): the modes
     compared models of different training, not fusion alone, without a word."""
-    used = [m for m in learned.models if m in {_NEEDS[mode] for mode in modes}]
+    used = [m for m in learned.models if m in {STUDY_NEEDS[mode] for mode in modes}]
 
     def seed(v: Any) -> str:
         return f"seed {v}" if v is not None else "seed not recorded"
