@@ -28,8 +28,9 @@ import torch
 from mmusv.learn._errors import input_error
 from mmusv.learn.checkpoint import load_checkpoint, weights_digest
 from mmusv.learn.decode import decode
-from mmusv.learn.example import MODES, collate, make_example, message_bytes
+from mmusv.learn.example import collate, make_example, message_bytes
 from mmusv.learn.model import PillarNet, from_checkpoint
+from mmusv.learn.modes import MODELS, fusion_modes
 from mmusv.learn.refine import RefineParams
 from mmusv.learn.scorer import SCORER_FILE, IoUScorer, load_scorer, second_stage
 from mmusv.text import counted
@@ -72,12 +73,12 @@ def load_models(
         _, ck = _load(p, dev)
         files[str(ck["mode"])] = p
     elif p.is_dir():
-        wanted = MODES if models is None else tuple(m for m in MODES if m in models)
+        wanted = MODELS if models is None else tuple(m for m in MODELS if m in models)
         files = {m: p / m / "model.pt" for m in wanted if (p / m / "model.pt").is_file()}
     if not files:
         raise input_error(
             f"--model {p}: no model.pt there (a model.pt, a folder holding one, or a folder with "
-            f"{'/'.join(MODES)}/model.pt)"
+            f"{'/'.join(MODELS)}/model.pt)"
         )
     nets: dict[str, PillarNet] = {}
     info: dict[str, dict[str, Any]] = {}
@@ -151,11 +152,8 @@ class LearnedDetector:
 
     @property
     def fusion_modes(self) -> tuple[str, ...]:
-        """The study's fusion modes these models can run: none and late need ``single``."""
-        out = [m for m, need in (("none", "single"), ("late", "single"), ("early", "early")) if need in self.models]
-        if "intermediate" in self.models:
-            out.append("intermediate")
-        return tuple(out)
+        """The study's fusion modes these models can run (:data:`mmusv.learn.modes.STUDY_NEEDS`)."""
+        return fusion_modes(self.models)
 
     def describe(self) -> str:
         """One line: each model's file, preset and the epochs it was trained for (``3 of 12 epochs, unfinished``

@@ -20,14 +20,15 @@ import numpy as np
 import torch
 
 from mmusv.learn._errors import input_error
+from mmusv.learn.modes import MODELS
 from mmusv.learn.pillars import FEATURES, Pillars, pillar_centres, pillarize
 from mmusv.learn.presets import Preset
 from mmusv.learn.targets import Targets, center_targets
 
 __all__ = ["MODES", "Batch", "Example", "collate", "early_cloud", "make_example", "message_bytes"]
 
-MODES = ("single", "early", "intermediate")
-"""The three models: ``single`` serves no and late fusion."""
+MODES = MODELS
+"""The three models (:data:`mmusv.learn.modes.MODELS`): ``single`` serves no and late fusion."""
 
 
 @dataclass(frozen=True)

@@ -44,15 +44,13 @@ import numpy as np
 from mmusv.learn._errors import input_error, input_error_types
 from mmusv.learn.cache import Cache
 from mmusv.learn.example import early_cloud
+from mmusv.learn.modes import MODELS
 from mmusv.learn.refine import RefineParams
 from mmusv.learn.scorer import SCORER_FILE, IoUScorer, load_scorer, second_stage
 
 __all__ = ["main", "write_predictions"]
 
 Key = tuple[str, int, str]
-
-MODELS = ("single", "early", "intermediate")
-"""The models whose peaks a run may hold (``single`` serves ``none`` and ``late``)."""
 
 
 def _no_detector(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -14,7 +14,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from mmusv.learn.cli import STUDY_NEEDS
+from mmusv.learn.modes import STUDY_NEEDS, models_for
 from mmusv.text import counted
 
 __all__ = ["add_dataset_arguments", "add_parsers", "run"]
@@ -370,7 +370,7 @@ def _check_model_modes(model: str, learned: Any, modes: tuple[str, ...]) -> None
 
     missing = [m for m in modes if STUDY_NEEDS[m] not in learned.models]
     if missing:
-        needs = sorted({STUDY_NEEDS[m] for m in missing})
+        needs = models_for(missing)
         raise InputError(
             f"--modes {','.join(missing)}: needs the {' and '.join(needs)} model, which --model {model} does not "
             f"hold (it has {', '.join(learned.models)}: modes {','.join(learned.fusion_modes)}; train it with "
@@ -382,7 +382,7 @@ def _mixed_training(model: str, learned: Any, modes: tuple[str, ...]) -> str | N
     """A warning line when the models the fusion ``modes`` run (``--model``'s ``single``, ``early``,
     ``intermediate``) were trained with other presets or seeds (a folder put together from several runs): the modes
     compared models of different training, not fusion alone, without a word."""
-    used = [m for m in learned.models if m in {STUDY_NEEDS[mode] for mode in modes}]
+    used = [m for m in learned.models if m in models_for(modes)]
 
     def seed(v: Any) -> str:
         return f"seed {v}" if v is not None else "seed not recorded"
