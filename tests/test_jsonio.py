@@ -69,3 +69,16 @@ def test_a_name_with_brackets_is_no_glob_pattern(tmp_path: Path) -> None:
     other.write_bytes(b"")
     remove_stale_temps(tmp_path / "a[1].json")
     assert not own.exists() and other.exists()
+
+
+def test_read_json_or_none_is_the_object_or_none(tmp_path: Path) -> None:
+    from mmusv.jsonio import read_json_or_none
+
+    good, listed, broken, binary = (tmp_path / n for n in ("good.json", "list.json", "broken.json", "bin.json"))
+    good.write_text('{"a": [1, 2]}', encoding="utf-8")
+    listed.write_text("[1, 2]", encoding="utf-8")
+    broken.write_text('{"a": ', encoding="utf-8")
+    binary.write_bytes(b"\xff\xfe{")
+    assert read_json_or_none(good) == {"a": [1, 2]}
+    for path in (listed, broken, binary, tmp_path / "missing.json", tmp_path):
+        assert read_json_or_none(path) is None

@@ -5,7 +5,8 @@ writes of the same document are byte-identical; :func:`write_json` replaces a fi
 killed writer never leaves half a file behind) through :func:`write_bytes_atomic`, which other small files the
 project writes whole (a run's ``manifest.json``, a JSON Schema, a study's tables and plots:
 :func:`write_files_atomic`) use too; :func:`read_json` reads one object and
-names the file in every error (:class:`~mmusv.errors.IoError`).
+names the file in every error (:class:`~mmusv.errors.IoError`); :func:`read_json_or_none` reads one that may be
+missing or damaged.
 """
 
 from __future__ import annotations
@@ -20,7 +21,15 @@ from typing import Any
 
 from mmusv.errors import IoError
 
-__all__ = ["dump_json", "read_json", "remove_stale_temps", "write_bytes_atomic", "write_files_atomic", "write_json"]
+__all__ = [
+    "dump_json",
+    "read_json",
+    "read_json_or_none",
+    "remove_stale_temps",
+    "write_bytes_atomic",
+    "write_files_atomic",
+    "write_json",
+]
 
 
 def dump_json(doc: Any) -> bytes:
@@ -109,3 +118,12 @@ def read_json(path: str | os.PathLike[str]) -> dict[str, Any]:
     if not isinstance(doc, dict):
         raise IoError(f"{p}: expected a JSON object at the top, got {type(doc).__name__}")
     return doc
+
+
+def read_json_or_none(path: str | os.PathLike[str]) -> dict[str, Any] | None:
+    """The JSON object in ``path``; ``None`` where there is none (missing, unreadable, not JSON, not an object):
+    for a file the project writes beside its outputs to remember a past run, which a rerun may do without."""
+    try:
+        return read_json(path)
+    except IoError:
+        return None

@@ -37,6 +37,7 @@ from mmusv.learn.infer import _model, infer_cache, merge_peaks
 from mmusv.learn.pillars import pillarize
 from mmusv.learn.presets import preset
 from mmusv.learn.replay import write_predictions
+from mmusv.learn.scorer_fit import fit_scorers
 from mmusv.learn.train import train
 from mmusv.studies.detection.sources import lidar_only
 
@@ -178,8 +179,6 @@ def test_the_same_seed_writes_the_same_scorer_bytes(
     # scorer.pt held the fit's wall-clock seconds (the summary keeps them)
     import shutil
 
-    import mmusv.learn.cli as cli
-
     cache = build_cache([recording], tmp_path / "cache_all.npz", split="all")
     p = preset("tiny", x_range=(-48.0, 48.0), y_range=(-48.0, 48.0), score_threshold=0.02)
     train(Cache(cache), p=p, mode="single", out=tmp_path / "a" / "single", epochs=1, max_steps=2, progress=False)
@@ -188,7 +187,7 @@ def test_the_same_seed_writes_the_same_scorer_bytes(
     for run, tick in (("a", 3.0), ("b", 11.0)):  # a clock that runs at another pace in each fit
         clock = iter(np.arange(0.0, 1e6, tick))
         monkeypatch.setattr(time, "perf_counter", lambda clock=clock: float(next(clock)))
-        fits.append(cli._fit_scorers(tmp_path / run, cache, ["single"], seed=0)["single"])
+        fits.append(fit_scorers(tmp_path / run, cache, ["single"], seed=0)["single"])
         monkeypatch.undo()
     assert "boxes" in fits[0] and fits[0]["seconds"] != fits[1]["seconds"]  # a scorer was fitted, at other times
     assert (tmp_path / "a" / "single" / "scorer.pt").read_bytes() == (

@@ -182,13 +182,13 @@ def test_mmusv_train_scorers_only_fits_every_model(trained: tuple[Path, Cache, P
     and its neighbours) writes a scorer beside each model that the detector then loads."""
     import shutil
 
-    from mmusv.learn.cli import _fit_scorers
     from mmusv.learn.scorer import SCORER_FILE
+    from mmusv.learn.scorer_fit import fit_scorers
 
     _, cache, root = trained
     out = tmp_path / "out"
     shutil.copytree(root / "models", out)
-    done = _fit_scorers(out, cache.path, list(MODES), seed=0, threads=1)
+    done = fit_scorers(out, cache.path, list(MODES), seed=0, threads=1)
     fitted = [m for m in MODES if "beta" in done[m]]
     assert fitted, done  # the tiny models find boxes at their low threshold
     for m in MODES:

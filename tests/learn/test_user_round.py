@@ -331,7 +331,7 @@ def test_a_rerun_of_a_finished_training_keeps_its_scorer(
     # by the review of this round). A scorer.pt fitted for the weights as they are is kept; one for other weights
     # is fitted again.
     from mmusv.learn.checkpoint import weights_digest
-    from mmusv.learn.cli import _fit_scorers
+    from mmusv.learn.scorer_fit import fit_scorers
 
     out = tmp_path / "out"
     train(MemorySource(SCENES), p=preset("tiny"), mode="single", out=out / "single", epochs=1, progress=False)
@@ -340,11 +340,11 @@ def test_a_rerun_of_a_finished_training_keeps_its_scorer(
     scorer = out / "single" / SCORER_FILE
     IoUScorer(np.zeros(len(FEATURES)), np.ones(len(FEATURES))).save(scorer, {"model": digest, "boxes": 7})
     first = scorer.read_bytes()
-    kept = _fit_scorers(out, cache, ["single"], seed=0, keep_current=True)
+    kept = fit_scorers(out, cache, ["single"], seed=0, keep_current=True)
     assert kept["single"]["model"] == digest and kept["single"]["boxes"] == 7
     assert f"single: {scorer} was fitted for these weights; kept" in capsys.readouterr().out
     assert scorer.read_bytes() == first
     IoUScorer(np.zeros(len(FEATURES)), np.ones(len(FEATURES))).save(scorer, {"model": "other weights", "boxes": 7})
-    again = _fit_scorers(out, cache, ["single"], seed=0, keep_current=True)
+    again = fit_scorers(out, cache, ["single"], seed=0, keep_current=True)
     assert "was fitted for these weights; kept" not in capsys.readouterr().out
     assert again["single"].get("boxes") != 7  # fitted again (or skipped, for a model that finds too little)

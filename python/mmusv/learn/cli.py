@@ -30,6 +30,9 @@ from pathlib import Path
 from typing import Any
 
 from mmusv.errors import InputError, MmusvError
+from mmusv.jsonio import read_json_or_none
+from mmusv.learn.modes import MODELS, models_for
+from mmusv.learn.scorer_fit import fit_scorers
 from mmusv.text import counted
 
 __all__ = ["add_parser", "load_for_study", "run"]
@@ -43,10 +46,6 @@ def _torch() -> None:
         import tqdm  # noqa: F401
     except ImportError:
         raise InputError(f"mmusv.learn {_INSTALL}") from None
-
-
-STUDY_NEEDS = {"none": "single", "late": "single", "early": "early", "intermediate": "intermediate"}
-"""The model each of the study's fusion modes runs."""
 
 
 def load_for_study(
@@ -64,7 +63,7 @@ def load_for_study(
     _torch()
     from mmusv.learn.detector import load_models
 
-    models = None if modes is None else sorted({STUDY_NEEDS[m] for m in modes if m in STUDY_NEEDS})
+    models = None if modes is None else models_for(modes)
     return load_models(path, refine=refine, rescore=rescore, models=models)
 
 
@@ -137,14 +136,13 @@ def run(args: argparse.Namespace) -> int:
     _check_device(args.device)
     from mmusv.jsonio import write_bytes_atomic
     from mmusv.learn.cache import build_cache
-    from mmusv.learn.example import MODES
     from mmusv.learn.presets import preset
 
     modes = [m.strip() for m in args.modes.split(",") if m.strip()]
-    bad = [m for m in modes if m not in MODES]
+    bad = [m for m in modes if m not in MODELS]
     if bad or not modes:
         what = f"unknown {', '.join(bad)}" if bad else "no model named"
-        raise InputError(f"--modes {args.modes!r}: {what}; allowed: {', '.join(MODES)}")
+        raise InputError(f"--modes {args.modes!r}: {what}; allowed: {', '.join(MODELS)}")
     twice = sorted({m for m in modes if modes.count(m) > 1})
     if twice:  # side by side, two processes trained the same model into the same folder at once
         raise InputError(f"--modes {args.modes!r}: {', '.join(twice)} given twice; each model once")
@@ -158,7 +156,7 @@ def run(args: argparse.Namespace) -> int:
         cache_file = out / f"cache_{args.split}.npz"
         if not cache_file.is_file():
             raise InputError(f"--scorers-only: no {cache_file}; train first (mmusv train ... -o {out})")
-        _fit_scorers(out, cache_file, modes, seed=args.seed, threads=args.threads)
+        fit_scorers(out, cache_file, modes, seed=args.seed, threads=args.threads)
         return 0
     inputs: list[Any] = list(args.inputs)
     if args.generate is not None:
@@ -251,9 +249,9 @@ def run(args: argparse.Namespace) -> int:
         )
         if "scorer" in r:
             summary.setdefault("scorers", {})[mode] = r["scorer"]
-    for key in ("models", "scorers"):  # in the order of MODES, the kept ones and this run's together
+    for key in ("models", "scorers"):  # in the order of MODELS, the kept ones and this run's together
         if key in summary:
-            summary[key] = {m: summary[key][m] for m in MODES if m in summary[key]}
+            summary[key] = {m: summary[key][m] for m in MODELS if m in summary[key]}
     # whole or not at all (a Ctrl-C while writing it)
     write_bytes_atomic(out / "train_summary.json", (json.dumps(summary, indent=2) + "\n").encode("utf-8"))
     if failures:
@@ -292,10 +290,9 @@ def _check_same_run(out: Path, modes: list[str], *, p: Any, seed: int, identity:
     run into a folder of ``tiny`` models left ``single`` of one preset beside ``early`` of the other, and the
     summary named only the new ones; and refused in each model's process, each printed its refusal and the summary
     was replaced by one of no model."""
-    from mmusv.learn.example import MODES
     from mmusv.learn.train import resumable_checkpoint
 
-    for mode in [*modes, *(m for m in MODES if m not in modes)]:
+    for mode in [*modes, *(m for m in MODELS if m not in modes)]:
         try:
             resumable_checkpoint(out / mode, p=p, mode=mode, seed=seed, identity=identity)
         except InputError as exc:
@@ -314,7 +311,7 @@ def _summary_to_keep(path: Path, modes: list[str], *, p: dict[str, Any], seed: i
     models there of the same preset and seed (``--modes early`` after ``--modes single`` replaced the summary with one
     naming ``early`` alone), less the entries this run writes again."""
     summary: dict[str, Any] = {"preset": p, "seed": seed, "jobs": jobs, "models": {}}
-    before = _read_json(path)
+    before = read_json_or_none(path)
     if before is None or before.get("preset") != json.loads(json.dumps(p)) or before.get("seed") != seed:  # as read
         return summary
     for key in ("models", "scorers"):
@@ -452,127 +449,6 @@ def _jobs(value: str, models: int, device: str | None) -> int:
     return min(n, models)
 
 
-def _fit_scorers(
-    out: Path,
-    cache_path: Path,
-    modes: list[str],
-    *,
-    seed: int,
-    threads: int | None = None,
-    keep_current: bool = False,
-) -> dict[str, dict[str, Any]]:
-    """Fits the IoU scorer (:func:`mmusv.learn.scorer.fit_scorer`) of each trained model in ``modes`` on the
-    training cache, each into ``OUT/<mode>/scorer.pt``; returns what each fit measured. ``threads``: torch's
-    threads (``None``: as they are). ``keep_current``: a ``scorer.pt`` already fitted for the model's weights as they
-    are is kept, not fitted again (a rerun of a finished training: minutes of work for the same scorer), and so is
-    a fit that failed for these weights, this cache and seed (``OUT/<mode>/scorer_skipped.json``, written when the
-    model finds too few boxes: the fit is deterministic, and a rerun ran the model over the whole cache again, for
-    minutes, to fail the same way). ``--scorers-only`` (``keep_current`` false) always fits: the way to try again.
-    Any other failure (Ctrl-C, out of memory) is not recorded and the next run fits again."""
-    import torch
-
-    from mmusv.learn.cache import Cache, cache_identity
-    from mmusv.learn.checkpoint import remove_stale_temporaries, weights_digest
-    from mmusv.learn.detector import load_models
-    from mmusv.learn.example import early_cloud
-    from mmusv.learn.refine import RefineParams
-    from mmusv.learn.scorer import SCORER_FILE, fit_scorer, load_scorer
-
-    if threads is not None:
-        torch.set_num_threads(threads)
-    cache = Cache(cache_path)
-    done: dict[str, dict[str, Any]] = {}
-    for mode in modes:
-        if not (out / mode / "model.pt").is_file():
-            raise InputError(f"--scorers-only: no {out / mode / 'model.pt'}; train the {mode} model first")
-        remove_stale_temporaries(out / mode)  # of a fit killed while it saved its scorer.pt
-        det = load_models(out / mode / "model.pt", refine=True, rescore=False)
-        model = det.models[mode]
-        current = out / mode / SCORER_FILE
-        digest = weights_digest(model.state_dict())
-        if keep_current and current.is_file():
-            try:
-                kept = load_scorer(current).info
-            except MmusvError:
-                kept = {}
-            if kept.get("model") == digest:
-                done[mode] = kept
-                print(f"{mode}: {current} was fitted for these weights; kept", flush=True)
-                continue
-        skipped_file = out / mode / SCORER_SKIPPED
-        # as read back from its file (JSON: tuples are lists)
-        failed_fit = json.loads(json.dumps({"model": digest, "cache": cache_identity(cache_path), "seed": seed}))
-        if keep_current:  # a scorer.pt for these weights was kept above; a stale one does not count
-            before = _read_json(skipped_file)
-            if before is not None and {k: before.get(k) for k in failed_fit} == failed_fit:
-                done[mode] = {"skipped": before.get("reason", "")}
-                print(
-                    f"{mode}: no IoU scorer (its fit failed before for these weights and data: {before.get('reason')};"
-                    f" {skipped_file}); the model's boxes keep the network's scores (try again: mmusv train "
-                    f"--scorers-only -o {out})",
-                    flush=True,
-                )
-                continue
-
-        def sample(k: int, mode: str = mode, det: Any = det) -> tuple[Any, Any, Any, Any]:
-            ego, nbs, gt = cache.sample(k)
-            points = early_cloud(ego, nbs) if mode == "early" else ego
-            boxes, scores = det._infer(mode, points, nbs if mode == "intermediate" else [])
-            return points, boxes, scores, gt
-
-        ks = list(range(len(cache)))
-        groups = [cache.key(int(cache.arrays["sample_cloud"][k]))[0] for k in ks]
-        t0 = time.perf_counter()
-        try:
-            scorer, fit = fit_scorer(
-                sample, samples=ks, groups=groups, refine=RefineParams(), nms_iou=model.preset.nms_iou, seed=seed
-            )
-        except InputError as e:  # a model that finds (almost) nothing: it is used as it is, and this is said
-            done[mode] = {"skipped": str(e)}
-            # recorded: the same weights, cache and seed fail the same way (a rerun took minutes to say it again)
-            with contextlib.suppress(OSError):  # not recorded: the next run fits again
-                skipped_file.write_text(json.dumps({**failed_fit, "reason": str(e)}, indent=2) + "\n", encoding="utf-8")
-            print(f"{mode}: no IoU scorer ({e}); the model's boxes keep the network's scores", flush=True)
-            continue
-        with contextlib.suppress(OSError):
-            skipped_file.unlink(missing_ok=True)
-        info = {
-            "model": digest,  # the weights it was fitted for (load_models checks)
-            "boxes": fit.boxes,
-            "frames": fit.frames,
-            "beta": fit.beta,
-            "held_out": [{"beta": b, "ap50": round(a5, 4), "ap70": round(a7, 4)} for b, a5, a7 in fit.held_out],
-            "seconds": round(time.perf_counter() - t0, 1),
-        }
-        # the file without the fit's wall-clock time (the summary has it): the same seed, the same bytes
-        path = scorer.save(out / mode / SCORER_FILE, {k: v for k, v in info.items() if k != "seconds"})
-        done[mode] = info
-        base = next(x for x in fit.held_out if x[0] == 0.0)
-        chosen = next(x for x in fit.held_out if x[0] == fit.beta)
-        print(
-            f"{mode}: IoU scorer on {counted(fit.boxes, 'box', plural='boxes')} "
-            f"of {counted(fit.frames, 'ego-frame')}, β = {fit.beta:g} (held-out "
-            f"AP@0.5 {base[1]:.3f} -> {chosen[1]:.3f}, AP@0.7 {base[2]:.3f} -> {chosen[2]:.3f}), "
-            f"{info['seconds']:.0f} s -> {path}",
-            flush=True,
-        )
-    return done
-
-
-SCORER_SKIPPED = "scorer_skipped.json"
-"""Beside a model whose IoU-scorer fit failed (too few boxes): for which weights, cache and seed, and why
-(:func:`_fit_scorers`)."""
-
-
-def _read_json(path: Path) -> dict[str, Any] | None:
-    """The JSON object in ``path``; ``None`` when there is none (missing, unreadable, not an object)."""
-    try:
-        value = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
-    return value if isinstance(value, dict) else None
-
-
 def _train_one(task: dict[str, Any]) -> dict[str, Any]:
     """Trains one model (``task``: the cache, preset name, mode, output folder and the run's options), plots
     its losses and, unless ``--no-scorers``, fits its IoU scorer; returns its epochs, steps, seconds, whether it
@@ -611,6 +487,6 @@ def _train_one(task: dict[str, Any]) -> dict[str, Any]:
         "plot": png.name,
     }
     if task["scorer"]:
-        fits = _fit_scorers(out.parent, Path(task["cache"]), [task["mode"]], seed=task["seed"], keep_current=True)
+        fits = fit_scorers(out.parent, Path(task["cache"]), [task["mode"]], seed=task["seed"], keep_current=True)
         done["scorer"] = fits[task["mode"]]
     return done
