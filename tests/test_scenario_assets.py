@@ -12,14 +12,13 @@ from pathlib import Path
 import numpy as np
 import polars as pl
 import pytest
-import trimesh
 import yaml
-from mmusv import scenario_assets
 from mmusv.cli import main
 from mmusv.config import load_scenario, scenario_hash
 from mmusv.editor.document import scenario_file
 from mmusv.errors import ConfigError
-from mmusv.world.vessels import asset_names, get_asset, unregister_asset
+from mmusv.world.vessels import get_asset
+from user_assets import library_restored, write_boat
 
 SCENARIO = """\
 name: own_boat
@@ -36,19 +35,12 @@ vessels:
 @pytest.fixture(autouse=True)
 def _clean_library() -> Iterator[None]:
     """Each test's registered assets are removed after it (the library is per process)."""
-    before = set(asset_names())
-    yield
-    for name in set(asset_names()) - before:
-        unregister_asset(name)
-    scenario_assets._loaded.clear()
+    with library_restored():
+        yield
 
 
 def _boat(folder: Path, *, length: float = 6.0, name: str = "my_skiff") -> None:
-    (folder / "boats").mkdir(parents=True, exist_ok=True)
-    box = trimesh.creation.box(extents=[length, 2.4, 1.6])
-    box.export(folder / "boats" / "skiff.ply")
-    entry = {"name": name, "mesh": "skiff.ply", "draft": 0.4, "semantic_class": "vessel"}
-    (folder / "boats" / "skiff.yaml").write_text(yaml.safe_dump(entry), encoding="utf-8")
+    write_boat(folder / "boats" / "skiff.yaml", name=name, length=length)
 
 
 def test_a_scenario_names_its_own_mesh_and_mmusv_run_records_it(

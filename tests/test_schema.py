@@ -24,6 +24,7 @@ from mmusv.schema import DIALECT, json_schema, schema_text
 from mmusv.sensors.config import RIG_PRESETS
 from mmusv.world.map_params import PARAM_MODELS
 from mmusv.yamlio import read_yaml
+from user_assets import library_restored, write_boat
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENARIOS = sorted((ROOT / "scenarios").glob("*.yaml"))
@@ -119,25 +120,15 @@ def _doc_examples() -> Iterator[tuple[str, str, str]]:
 def _user_assets(paths: list[str], folder: Path) -> Iterator[None]:
     """In ``folder`` (the current folder meanwhile: a scenario given as a dict reads its ``assets:`` from there),
     each asset file of ``paths``, named after its file, a 6 m box; the library as it was afterwards."""
-    import trimesh
-    from mmusv import scenario_assets
-    from mmusv.world.vessels import asset_names, unregister_asset
-
     for rel in paths:
-        f = folder / rel
-        f.parent.mkdir(parents=True, exist_ok=True)
-        trimesh.creation.box(extents=[6.0, 2.4, 1.6]).export(f.with_suffix(".ply"))
-        entry = {"name": f.stem, "mesh": f.with_suffix(".ply").name, "draft": 0.4, "semantic_class": "vessel"}
-        f.write_text(yaml.safe_dump(entry), encoding="utf-8")
-    before, cwd = set(asset_names()), Path.cwd()
+        write_boat(folder / rel, name=Path(rel).stem)
+    cwd = Path.cwd()
     os.chdir(folder)
     try:
-        yield
+        with library_restored():
+            yield
     finally:
         os.chdir(cwd)
-        for name in set(asset_names()) - before:
-            unregister_asset(name)
-        scenario_assets._loaded.clear()
 
 
 def test_documented_examples_are_valid(tmp_path: Path) -> None:
