@@ -1,9 +1,9 @@
-"""``python -m mmusv``: the ``mmusv`` command (:func:`mmusv.cli.main`), for environments without the console
+"""``python -m mmusv``: the ``mmusv`` command (:func:`mmusv._launch.main`), for environments without the console
 script on their path."""
 
 import sys
 
-from mmusv.cli import main
+from mmusv._launch import main
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -1,0 +1,61 @@
+"""The ``mmusv`` command's entry point (the console script and ``python -m mmusv``): loads :mod:`mmusv.cli` and
+runs it.
+
+Loading the command (its modules and its argument parser, whose sub-commands load theirs: numpy, Polars,
+pydantic, the scenario models) takes about a second. A Ctrl-C or SIGTERM meanwhile is held until the load is
+done, then ends the command as one at any other moment does (``mmusv: interrupted``, exit status 130;
+``mmusv: terminated (SIGTERM)``, 143) before it starts. It was a ``KeyboardInterrupt`` traceback of whichever
+import it cut; and an interrupt in the middle of an import is not safe to catch: a library's ``except`` around
+its optional imports swallowed it (the run went on to its end), and one cut inside a C extension's module code
+made CPython end the process by SIGINT after the message (exit status -2). Needs ``import mmusv`` to be light
+(:mod:`mmusv`'s lazy names): the package's own import runs before this module's code.
+"""
+
+from __future__ import annotations
+
+import signal
+import sys
+import threading
+from collections.abc import Callable
+
+__all__ = ["main"]
+
+_SIGNALS = ("SIGINT", "SIGTERM")
+
+
+def _stopped(signum: int) -> int:
+    """Says why the command ends; returns its exit status, 128 + ``signum``."""
+    name = "interrupted" if signum == signal.SIGINT else f"terminated ({signal.Signals(signum).name})"
+    sys.stderr.write(f"mmusv: {name}\n")
+    return 128 + signum
+
+
+def _load() -> tuple[Callable[[], int], int | None]:
+    """:func:`mmusv.cli.main` after the command's modules are loaded, and the first signal held meanwhile."""
+    noted: list[int] = []
+    old: dict[int, object] = {}
+    if threading.current_thread() is threading.main_thread():
+        for name in _SIGNALS:
+            num = getattr(signal, name, None)
+            if num is not None and signal.getsignal(num) is not None:  # None: a handler from outside Python
+                old[num] = signal.signal(num, lambda signum, frame: noted.append(signum))
+    try:
+        from mmusv.cli import main as cli_main
+        from mmusv.cli_parser import parser
+
+        parser()  # the sub-commands' parsers load their modules; cli_main builds it again from them at once
+    finally:
+        for num, handler in old.items():
+            signal.signal(num, handler)  # type: ignore[arg-type]
+    return cli_main, (noted[0] if noted else None)
+
+
+def main() -> int:
+    """Runs the ``mmusv`` command on ``sys.argv``; returns its exit status."""
+    try:
+        cli_main, held = _load()
+        if held is not None:
+            return _stopped(held)
+        return cli_main()
+    except KeyboardInterrupt:  # between the load and the command's own handling, or after it
+        return _stopped(signal.SIGINT)

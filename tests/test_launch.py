@@ -1,0 +1,113 @@
+"""The ``mmusv`` command's start (:mod:`mmusv._launch`) and the light ``import mmusv`` it needs: a Ctrl-C while
+the command's modules load is ``mmusv: interrupted`` and exit status 130, not a traceback of the import; the
+package's names load on first use and are the same objects as before."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import mmusv
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+# a signal sent to the process at the moment the named module starts loading (a Ctrl-C or a kill then)
+_SIGNAL_AT = """\
+import os, signal, sys
+class At:
+    def find_spec(self, name, path=None, target=None):
+        if name == {module!r}:
+            sys.meta_path.remove(self)
+            os.kill(os.getpid(), signal.{signal})
+sys.meta_path.insert(0, At())
+"""
+
+_STARTS = [
+    "from mmusv._launch import main\nsys.exit(main())",  # what the console script does
+    "import runpy\nrunpy.run_module('mmusv', run_name='__main__')",  # python -m mmusv
+]
+
+
+def _python(code: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=False, timeout=120)
+
+
+def test_import_mmusv_loads_only_the_core_and_the_errors() -> None:
+    out = _python(
+        "import sys, mmusv\n"
+        "heavy = sorted(m for m in ('mmusv.config', 'mmusv.acquire', 'polars', 'pydantic', 'scipy') "
+        "if m in sys.modules)\n"
+        "print(heavy)\n"
+    )
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "[]"
+
+
+def test_the_package_names_are_their_modules_objects() -> None:
+    from mmusv import acquire, batch, config, scene, simulation
+
+    assert mmusv.run is acquire.run and mmusv.RunResult is acquire.RunResult
+    assert mmusv.run_many is batch.run_many and mmusv.BatchReport is batch.BatchReport
+    assert mmusv.Scene is scene.Scene and mmusv.RayHits is scene.RayHits
+    assert mmusv.Simulation is simulation.Simulation and mmusv.config is config
+    assert mmusv.InputError is mmusv.errors.InputError
+    assert set(mmusv.__all__) <= set(dir(mmusv))
+    namespace: dict[str, object] = {}
+    exec("from mmusv import *", namespace)
+    assert set(mmusv.__all__) <= set(namespace)
+    with pytest.raises(AttributeError, match="no attribute 'not_a_name'"):
+        _ = mmusv.not_a_name
+
+
+@pytest.mark.parametrize("module", ["mmusv.config", "numpy", "mmusv.cli_run", "mmusv.generate.cli"])
+@pytest.mark.parametrize("start", _STARTS)
+def test_ctrl_c_while_the_command_loads_ends_it_after_the_load_in_one_line(module: str, start: str) -> None:
+    # held to the end of the load (an interrupt inside an import was a traceback, or lost in a library's except),
+    # then the command does not start: no version printed
+    code = _SIGNAL_AT.format(module=module, signal="SIGINT") + "sys.argv = ['mmusv', 'version']\n" + start + "\n"
+    out = _python(code)
+    assert "Traceback" not in out.stderr, out.stderr
+    assert out.stderr == "mmusv: interrupted\n"
+    assert out.returncode == 130
+    assert out.stdout == ""
+
+
+@pytest.mark.parametrize("start", _STARTS)
+def test_a_kill_while_the_command_loads_is_one_line_and_status_143(start: str) -> None:
+    code = _SIGNAL_AT.format(module="mmusv.config", signal="SIGTERM") + "sys.argv = ['mmusv', 'version']\n" + start
+    out = _python(code + "\n")
+    assert out.stderr == "mmusv: terminated (SIGTERM)\n"
+    assert out.returncode == 128 + signal.SIGTERM
+    assert out.stdout == ""
+
+
+def test_after_the_load_the_previous_handlers_are_back_and_the_command_runs() -> None:
+    out = _python(
+        "import signal, sys\nsys.argv = ['mmusv', 'version']\nfrom mmusv._launch import main\n"
+        "code = main()\nprint(signal.getsignal(signal.SIGINT) is signal.default_int_handler, "
+        "signal.getsignal(signal.SIGTERM) is signal.SIG_DFL, code)\n"
+    )
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.splitlines()[0].startswith("mmusv ")
+    assert out.stdout.splitlines()[1] == "True True 0"
+
+
+@pytest.mark.parametrize("delay_s", [0.15, 0.3, 0.6])
+def test_a_real_ctrl_c_during_the_start_is_one_line(tmp_path: Path, delay_s: float) -> None:
+    # the start takes about a second here; the signal lands in it, or in the command (the same words and status)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "mmusv", "run", str(ROOT / "scenarios" / "port_entry.yaml"), "-o", str(tmp_path)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    time.sleep(delay_s)
+    proc.send_signal(signal.SIGINT)
+    _, stderr = proc.communicate(timeout=120)
+    assert "Traceback" not in stderr, stderr
+    assert proc.returncode == 130, stderr
+    assert stderr.strip().endswith("mmusv: interrupted"), stderr
