@@ -63,7 +63,7 @@ def test_the_package_names_are_their_modules_objects() -> None:
         _ = mmusv.not_a_name
 
 
-@pytest.mark.parametrize("module", ["mmusv.config", "numpy", "mmusv.cli_run", "mmusv.generate.cli"])
+@pytest.mark.parametrize("module", ["mmusv.export.convert", "numpy", "mmusv.cli_run", "mmusv.generate.cli"])
 @pytest.mark.parametrize("start", _STARTS)
 def test_ctrl_c_while_the_command_loads_ends_it_after_the_load_in_one_line(module: str, start: str) -> None:
     # held to the end of the load (an interrupt inside an import was a traceback, or lost in a library's except),
@@ -78,7 +78,9 @@ def test_ctrl_c_while_the_command_loads_ends_it_after_the_load_in_one_line(modul
 
 @pytest.mark.parametrize("start", _STARTS)
 def test_a_kill_while_the_command_loads_is_one_line_and_status_143(start: str) -> None:
-    code = _SIGNAL_AT.format(module="mmusv.config", signal="SIGTERM") + "sys.argv = ['mmusv', 'version']\n" + start
+    code = (
+        _SIGNAL_AT.format(module="mmusv.export.convert", signal="SIGTERM") + "sys.argv = ['mmusv', 'version']\n" + start
+    )
     out = _python(code + "\n")
     assert out.stderr == "mmusv: terminated (SIGTERM)\n"
     assert out.returncode == 128 + signal.SIGTERM
@@ -111,3 +113,36 @@ def test_a_real_ctrl_c_during_the_start_is_one_line(tmp_path: Path, delay_s: flo
     assert "Traceback" not in stderr, stderr
     assert proc.returncode == 130, stderr
     assert stderr.strip().endswith("mmusv: interrupted"), stderr
+
+
+def test_the_parser_every_command_builds_loads_no_scenario_model_or_dataset_reader() -> None:
+    # mmusv --help took 1.5-1.9 s here: the parser imported the detection dataset reader for one constant (0.7 s),
+    # the generator's sampler and map builder (0.26 s), and the scenario models for a warning class
+    out = _python(
+        "import sys\nsys.argv = ['mmusv', 'version']\nfrom mmusv._launch import main\nassert main() == 0\n"
+        "print(sorted(m for m in ('mmusv.config', 'mmusv.studies.detection.sources', 'mmusv.generate.runner', "
+        "'mmusv.generate.families', 'polars') if m in sys.modules))\n"
+    )
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.splitlines()[-1] == "[]"
+
+
+def test_the_generate_package_names_are_its_modules_objects() -> None:
+    import importlib
+    import pkgutil
+
+    import mmusv.generate as gen
+    from mmusv.studies import detection
+    from mmusv.studies.detection import sources
+
+    for info in pkgutil.iter_modules(gen.__path__):  # a submodule loaded does not shadow a name of the package
+        if info.name not in ("cli",):
+            importlib.import_module(f"mmusv.generate.{info.name}")
+    from mmusv.generate import runner, spec
+
+    assert gen.generate is runner.generate and callable(gen.generate)
+    assert gen.load_spec is spec.load_spec and gen.GenerationSpec is spec.GenerationSpec
+    assert set(gen.__all__) <= set(dir(gen)) | set(gen._LAZY)
+    assert sources.BUNDLED_SPEC == detection.BUNDLED_SPEC == "scenarios/specs/coop_detection.yaml"
+    with pytest.raises(AttributeError, match="no attribute 'nothing'"):
+        _ = gen.nothing

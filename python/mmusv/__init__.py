@@ -13,11 +13,10 @@ which a Ctrl-C of the ``mmusv`` command was a traceback of the import (:mod:`mmu
 
 from __future__ import annotations
 
-import importlib
-import importlib.util
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from mmusv import errors
+from mmusv._lazy import attributes
 from mmusv._native import core as _core_module
 from mmusv.errors import *  # noqa: F403 (the exception tree, as listed once in mmusv.errors.__all__)
 
@@ -55,17 +54,9 @@ __all__ = [
 __all__ += errors.__all__
 
 
-def __getattr__(name: str) -> Any:
-    """``mmusv.run`` and the other names of :data:`__all__` from their modules, and ``mmusv.<submodule>``,
-    imported on first use and kept."""
-    if name in _LAZY:
-        value = getattr(importlib.import_module(_LAZY[name]), name)
-    elif not name.startswith("__") and importlib.util.find_spec(f"{__name__}.{name}") is not None:
-        value = importlib.import_module(f"{__name__}.{name}")
-    else:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    globals()[name] = value
-    return value
+__getattr__ = attributes(__name__, _LAZY, submodules=True)
+"""``mmusv.run`` and the other names of :data:`__all__` from their modules, and ``mmusv.<submodule>``, imported on
+first use and kept."""
 
 
 def __dir__() -> list[str]:

@@ -26,10 +26,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from mmusv.config import Scenario
 from mmusv.errors import ConfigError
 
 if TYPE_CHECKING:
+    from mmusv.config import Scenario
     from mmusv.generate.checks import Finding
     from mmusv.generate.mapctx import MapContext
     from mmusv.generate.samples import Samples

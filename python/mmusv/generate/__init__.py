@@ -13,9 +13,28 @@ YAML per accepted candidate plus ``report.json`` (:mod:`.report`). Python API::
 
 from __future__ import annotations
 
-from mmusv.generate.families import FAMILIES
-from mmusv.generate.report import ComboReport, RunReport
-from mmusv.generate.runner import generate
-from mmusv.generate.spec import GenerationSpec, load_spec
+from typing import TYPE_CHECKING
+
+from mmusv._lazy import attributes
+
+if TYPE_CHECKING:
+    from mmusv.generate.families import FAMILIES
+    from mmusv.generate.report import ComboReport, RunReport
+    from mmusv.generate.runner import generate
+    from mmusv.generate.spec import GenerationSpec, load_spec
 
 __all__ = ["FAMILIES", "ComboReport", "GenerationSpec", "RunReport", "generate", "load_spec"]
+
+_LAZY = {
+    "FAMILIES": "mmusv.generate.families",
+    "ComboReport": "mmusv.generate.report",
+    "GenerationSpec": "mmusv.generate.spec",
+    "RunReport": "mmusv.generate.report",
+    "generate": "mmusv.generate.runner",
+    "load_spec": "mmusv.generate.spec",
+}
+"""The names above, loaded on first use (PEP 562): ``mmusv generate``'s parser is built by every ``mmusv`` command
+(``mmusv --help`` loaded the sampler, the map builder and the vessel library, a quarter of a second)."""
+
+
+__getattr__ = attributes(__name__, _LAZY)

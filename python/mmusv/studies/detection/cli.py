@@ -30,7 +30,7 @@ _BOXES_HELP = (
 def add_dataset_arguments(p: argparse.ArgumentParser, *, into: str, then: str) -> None:
     """The dataset a detection command reads: ``inputs`` (recordings or folders), ``--opv2v`` or ``--generate
     [SPEC]`` (the bundled spec recorded LiDAR-only into the folder ``into``, then ``then``)."""
-    from mmusv.studies.detection.sources import BUNDLED_SPEC
+    from mmusv.studies.detection import BUNDLED_SPEC
 
     p.add_argument("inputs", nargs="*", help="recordings (.mcap) or folders of them")
     p.add_argument("--opv2v", default=None, help="an OPV2V folder written by mmusv convert --to opv2v")

@@ -20,6 +20,7 @@ from typing import Any
 import yaml
 
 from mmusv.errors import InputError, IoError
+from mmusv.studies.detection import BUNDLED_SPEC
 from mmusv.studies.detection.data import (
     SequenceData,
     find_recordings,
@@ -33,9 +34,6 @@ from mmusv.studies.detection.data import (
 from mmusv.text import counted
 
 __all__ = ["BUNDLED_SPEC", "Dataset", "generate_dataset", "lidar_only", "resolve_dataset"]
-
-BUNDLED_SPEC = "scenarios/specs/coop_detection.yaml"
-"""The bundled detection dataset spec (run from the repository root)."""
 
 
 @dataclass(frozen=True)
