@@ -15,12 +15,11 @@ from __future__ import annotations
 
 import signal
 import sys
-import threading
 from collections.abc import Callable
 
-__all__ = ["main"]
+from mmusv.held_signals import HeldSignals
 
-_SIGNALS = ("SIGINT", "SIGTERM")
+__all__ = ["main"]
 
 
 def _stopped(signum: int) -> int:
@@ -32,22 +31,15 @@ def _stopped(signum: int) -> int:
 
 def _load() -> tuple[Callable[[], int], int | None]:
     """:func:`mmusv.cli.main` after the command's modules are loaded, and the first signal held meanwhile."""
-    noted: list[int] = []
-    old: dict[int, object] = {}
-    if threading.current_thread() is threading.main_thread():
-        for name in _SIGNALS:
-            num = getattr(signal, name, None)
-            if num is not None and signal.getsignal(num) is not None:  # None: a handler from outside Python
-                old[num] = signal.signal(num, lambda signum, frame: noted.append(signum))
+    held = HeldSignals().hold()
     try:
         from mmusv.cli import main as cli_main
         from mmusv.cli_parser import parser
 
         parser()  # the sub-commands' parsers load their modules; cli_main builds it again from them at once
     finally:
-        for num, handler in old.items():
-            signal.signal(num, handler)  # type: ignore[arg-type]
-    return cli_main, (noted[0] if noted else None)
+        noted = held.release(hand_on=False)
+    return cli_main, noted
 
 
 def main() -> int:

@@ -36,10 +36,11 @@ from mmusv.annotate import Annotations, SilhouetteCache, annotate_agent
 from mmusv.config import Scenario, load_scenario, scenario_hash
 from mmusv.errors import ConfigError, IoError, MmusvError, located
 from mmusv.forking import check_polars
+from mmusv.held_signals import HeldSignals
 from mmusv.jsonio import dump_json, write_bytes_atomic
 from mmusv.profiling import RunProfile, clocks
 from mmusv.recording.background import BackgroundWriter
-from mmusv.recording.guard import FolderLock, HeldSignals, write_cause
+from mmusv.recording.guard import FolderLock, write_cause
 from mmusv.recording.tables import SCHEMAS, TableWriter
 from mmusv.scenario_checks import check_mounts, check_routes, check_sensors
 from mmusv.simulation import FrameCapture, Simulation

@@ -37,8 +37,8 @@ from mmusv.classes import ROLE_COLOURS
 from mmusv.config import scenario_hash
 from mmusv.errors import MmusvError
 from mmusv.frames import OPTICAL_IN_BODY
+from mmusv.held_signals import HeldSignals
 from mmusv.recording import topics
-from mmusv.recording.guard import HeldSignals
 from mmusv.recording.writer import ImageFormat, Recording
 from mmusv.sensors.camera import CameraImages
 from mmusv.simulation import FrameCapture, Simulation

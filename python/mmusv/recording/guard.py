@@ -1,5 +1,6 @@
 """Guarding an output folder: one writer at a time (:class:`FolderLock`), naming why a write failed
-(:func:`write_cause`), and holding a stop back while a few writes must happen together (:class:`HeldSignals`).
+(:func:`write_cause`), and holding a stop back while a few writes must happen together (:class:`HeldSignals`, from
+:mod:`mmusv.held_signals`).
 
 :class:`FolderLock` is an advisory lock (``fcntl.flock``, released by the kernel when its holder exits, however it
 exits) on the folder itself. A second ``mmusv run`` (or batch) into the same folder does not wait for it: it refuses
@@ -27,9 +28,9 @@ import re
 import tempfile
 from pathlib import Path
 from types import TracebackType
-from typing import Any
 
 from mmusv.errors import IoError
+from mmusv.held_signals import HeldSignals  # its home; here as before for the recorder's callers
 
 __all__ = ["FolderLock", "HeldSignals", "write_cause"]
 
@@ -182,73 +183,3 @@ def write_cause(folder: str | os.PathLike[str], exc: BaseException | None = None
     if code is not None:
         return os.strerror(code)
     return str(exc) if exc is not None else "unknown cause"
-
-
-class HeldSignals:
-    """SIGINT and SIGTERM held back while steps run that a stop must not split (see the module docstring).
-
-    :meth:`hold` (or entering ``with``) replaces the handlers of both signals with one that only notes the first
-    signal; :meth:`release` (or leaving ``with``) puts the handlers back, then hands a noted signal to the handler
-    that was in place: Python's default SIGINT handler and the command line's (``mmusv.cli``) raise
-    ``KeyboardInterrupt`` there, a pool worker's finishes its task as interrupted, ``SIG_DFL`` gets the signal's
-    default action, ``SIG_IGN`` nothing. A stop is never lost, only moved to the end of the steps. Holds nest (an
-    inner release hands the signal to the outer hold). Python runs signal handlers in the main thread only: in
-    another thread this holds nothing."""
-
-    SIGNALS = ("SIGINT", "SIGTERM")
-
-    def __init__(self) -> None:
-        self._old: dict[int, Any] = {}
-        self._noted: int | None = None
-
-    def hold(self) -> HeldSignals:
-        """Starts holding the signals back; returns ``self``."""
-        import signal
-        import threading
-
-        if threading.current_thread() is not threading.main_thread():
-            return self
-        for name in self.SIGNALS:
-            num = getattr(signal, name, None)
-            if num is None or num in self._old:
-                continue
-            old = signal.getsignal(num)
-            if old is None:  # a handler installed outside Python: it could not be put back, so it is left alone
-                continue
-            signal.signal(num, self._note)
-            self._old[num] = old
-        return self
-
-    def _note(self, signum: int, frame: object) -> None:
-        if self._noted is None:
-            self._noted = signum
-
-    @property
-    def noted(self) -> int | None:
-        """The signal that came while held (not yet handed on), else None."""
-        return self._noted
-
-    def release(self) -> None:
-        """Puts the handlers back, then hands a signal that came meanwhile to its handler (which may raise
-        ``KeyboardInterrupt``). Releasing again does nothing."""
-        import signal
-
-        old, self._old = self._old, {}
-        for num, handler in old.items():
-            signal.signal(num, handler)
-        noted, self._noted = self._noted, None
-        if noted is None:
-            return
-        handler = old.get(noted)
-        if callable(handler):
-            handler(noted, None)
-        elif handler == signal.SIG_DFL:
-            signal.raise_signal(noted)
-
-    def __enter__(self) -> HeldSignals:
-        return self.hold()
-
-    def __exit__(
-        self, exc_type: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
-    ) -> None:
-        self.release()

@@ -1,0 +1,85 @@
+"""Holding SIGINT and SIGTERM back while steps run that a stop must not split (:class:`HeldSignals`): a
+recording opened and its metadata written (:mod:`mmusv.recording.guard`), the ``mmusv`` command's modules loaded
+(:mod:`mmusv._launch`). A module of its own, light to import: the command holds the signals before it loads the
+rest of mmusv.
+"""
+
+from __future__ import annotations
+
+from types import TracebackType
+from typing import Any
+
+__all__ = ["HeldSignals"]
+
+
+class HeldSignals:
+    """SIGINT and SIGTERM held back while steps run that a stop must not split (see the module docstring).
+
+    :meth:`hold` (or entering ``with``) replaces the handlers of both signals with one that only notes the first
+    signal; :meth:`release` (or leaving ``with``) puts the handlers back, then hands a noted signal to the handler
+    that was in place: Python's default SIGINT handler and the command line's (``mmusv.cli``) raise
+    ``KeyboardInterrupt`` there, a pool worker's finishes its task as interrupted, ``SIG_DFL`` gets the signal's
+    default action, ``SIG_IGN`` nothing. A stop is never lost, only moved to the end of the steps. Holds nest (an
+    inner release hands the signal to the outer hold). Python runs signal handlers in the main thread only: in
+    another thread this holds nothing."""
+
+    SIGNALS = ("SIGINT", "SIGTERM")
+
+    def __init__(self) -> None:
+        self._old: dict[int, Any] = {}
+        self._noted: int | None = None
+
+    def hold(self) -> HeldSignals:
+        """Starts holding the signals back; returns ``self``."""
+        import signal
+        import threading
+
+        if threading.current_thread() is not threading.main_thread():
+            return self
+        for name in self.SIGNALS:
+            num = getattr(signal, name, None)
+            if num is None or num in self._old:
+                continue
+            old = signal.getsignal(num)
+            if old is None:  # a handler installed outside Python: it could not be put back, so it is left alone
+                continue
+            signal.signal(num, self._note)
+            self._old[num] = old
+        return self
+
+    def _note(self, signum: int, frame: object) -> None:
+        if self._noted is None:
+            self._noted = signum
+
+    @property
+    def noted(self) -> int | None:
+        """The signal that came while held (not yet handed on), else None."""
+        return self._noted
+
+    def release(self, *, hand_on: bool = True) -> int | None:
+        """Puts the handlers back, then hands a signal that came meanwhile to its handler (which may raise
+        ``KeyboardInterrupt``); returns that signal, else None. ``hand_on=False``: the caller ends the work itself
+        (the ``mmusv`` command's start, :mod:`mmusv._launch`), and the signal is only returned. Releasing again does
+        nothing."""
+        import signal
+
+        old, self._old = self._old, {}
+        for num, handler in old.items():
+            signal.signal(num, handler)
+        noted, self._noted = self._noted, None
+        if noted is None or not hand_on:
+            return noted
+        handler = old.get(noted)
+        if callable(handler):
+            handler(noted, None)
+        elif handler == signal.SIG_DFL:
+            signal.raise_signal(noted)
+        return noted
+
+    def __enter__(self) -> HeldSignals:
+        return self.hold()
+
+    def __exit__(
+        self, exc_type: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
+    ) -> None:
+        self.release()
