@@ -101,7 +101,7 @@ def test_a_semantickitti_calibration_is_the_same_whatever_the_first_frame(tmp_pa
     whose rounding (1e-19..1e-14 where 0 is exact) changed from frame to frame, so a SemanticKITTI sequence's
     calib.txt (its first converted frame's) was other bytes with ``--frames 1:`` than with all frames, and KITTI's
     per-frame calib files differed, though both sensors are rigid on the hull; it is the mounts' now."""
-    from mmusv.export.convert import convert
+    from mmusv.export.conversion import convert
 
     rec = _front_camera_recording(tmp_path / "rec")
     convert(rec, to="semantickitti", out_dir=tmp_path / "all", splits=None)

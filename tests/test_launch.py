@@ -63,7 +63,7 @@ def test_the_package_names_are_their_modules_objects() -> None:
         _ = mmusv.not_a_name
 
 
-@pytest.mark.parametrize("module", ["mmusv.export.convert", "numpy", "mmusv.cli_run", "mmusv.generate.cli"])
+@pytest.mark.parametrize("module", ["mmusv.export.common", "numpy", "mmusv.cli_run", "mmusv.generate.cli"])
 @pytest.mark.parametrize("start", _STARTS)
 def test_ctrl_c_while_the_command_loads_ends_it_after_the_load_in_one_line(module: str, start: str) -> None:
     # held to the end of the load (an interrupt inside an import was a traceback, or lost in a library's except),
@@ -79,7 +79,7 @@ def test_ctrl_c_while_the_command_loads_ends_it_after_the_load_in_one_line(modul
 @pytest.mark.parametrize("start", _STARTS)
 def test_a_kill_while_the_command_loads_is_one_line_and_status_143(start: str) -> None:
     code = (
-        _SIGNAL_AT.format(module="mmusv.export.convert", signal="SIGTERM") + "sys.argv = ['mmusv', 'version']\n" + start
+        _SIGNAL_AT.format(module="mmusv.export.common", signal="SIGTERM") + "sys.argv = ['mmusv', 'version']\n" + start
     )
     out = _python(code + "\n")
     assert out.stderr == "mmusv: terminated (SIGTERM)\n"
@@ -121,10 +121,31 @@ def test_the_parser_every_command_builds_loads_no_scenario_model_or_dataset_read
     out = _python(
         "import sys\nsys.argv = ['mmusv', 'version']\nfrom mmusv._launch import main\nassert main() == 0\n"
         "print(sorted(m for m in ('mmusv.config', 'mmusv.studies.detection.sources', 'mmusv.generate.runner', "
-        "'mmusv.generate.families', 'polars') if m in sys.modules))\n"
+        "'mmusv.generate.families', 'polars', 'mmusv.export.conversion', 'mmusv.annotate', 'scipy') "
+        "if m in sys.modules))\n"
     )
     assert out.returncode == 0, out.stderr
     assert out.stdout.splitlines()[-1] == "[]"
+
+
+def test_the_export_package_names_are_its_modules_objects_whatever_was_loaded_first() -> None:
+    # mmusv convert's parser loaded the conversion job with the package (annotations, geometry, scipy: 0.45 s of
+    # mmusv --help's 0.9 s); lazily loaded, the function convert must not be shadowed by a submodule of that name
+    out = _python(
+        "import importlib, pkgutil, sys\n"
+        "import mmusv.export as ex\n"
+        "for info in pkgutil.iter_modules(ex.__path__):\n"
+        "    importlib.import_module(f'mmusv.export.{info.name}')\n"
+        "from mmusv.export import DEFAULT_EXTRAS, EXTRAS, TARGETS, ConvertReport, RecordingReport, convert, cli\n"
+        "from mmusv.export import common, conversion, convert_report\n"
+        "assert convert is conversion.convert and callable(convert), convert\n"
+        "assert ConvertReport is convert_report.ConvertReport and RecordingReport is convert_report.RecordingReport\n"
+        "assert (TARGETS, EXTRAS, DEFAULT_EXTRAS) == (common.TARGETS, common.EXTRAS, common.DEFAULT_EXTRAS)\n"
+        "assert cli is sys.modules['mmusv.export.cli'] and set(ex.__all__) <= set(dir(ex))\n"
+        "try:\n    ex.nothing\nexcept AttributeError as e:\n    print(e)\n"
+    )
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "module 'mmusv.export' has no attribute 'nothing'"
 
 
 def test_the_generate_package_names_are_its_modules_objects() -> None:
@@ -146,3 +167,22 @@ def test_the_generate_package_names_are_its_modules_objects() -> None:
     assert sources.BUNDLED_SPEC == detection.BUNDLED_SPEC == "scenarios/specs/coop_detection.yaml"
     with pytest.raises(AttributeError, match="no attribute 'nothing'"):
         _ = gen.nothing
+
+
+@pytest.mark.parametrize("where", ["dispatch", "load"])
+def test_a_ctrl_c_inside_string_code_under_python_m_ends_with_130_not_by_the_signal(tmp_path: Path, where: str) -> None:
+    # CPython marks a KeyboardInterrupt leaving exec(str) (every dataclass method as a module loads) as unhandled
+    # even when caught, and under python -m ended the process by SIGINT after "mmusv: interrupted" (-2, not 130)
+    kill = "exec('import os, signal\\nos.kill(os.getpid(), signal.SIGINT)\\nfor _ in range(10**6): pass', {})\n"
+    if where == "dispatch":  # in the command, under the command line's handler
+        body = f"import mmusv.cli as cli\ndef dispatch(args):\n    {kill}    return 0\ncli._dispatch = dispatch\n"
+    else:  # after the load, before the command's handler: Python's own
+        body = f"import mmusv.cli as cli\ndef run(argv=None):\n    {kill}    return 0\ncli.main = run\n"
+    (tmp_path / "ctrl_c_in_exec.py").write_text(
+        "import sys\n" + body + "sys.argv = ['mmusv', 'version']\nfrom mmusv._launch import main\nsys.exit(main())\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-m", "ctrl_c_in_exec"], cwd=tmp_path, capture_output=True, text=True, timeout=120, check=False
+    )
+    assert out.stderr == "mmusv: interrupted\n"
+    assert out.returncode == 130

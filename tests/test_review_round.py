@@ -20,7 +20,7 @@ import pytest
 import yaml
 from mmusv.errors import ConfigError
 from mmusv.export.contrast import MAX_CONTRAST
-from mmusv.export.convert import _contrast_filter
+from mmusv.export.conversion import _contrast_filter
 
 KAYAK_TOP_MPS = 3.0
 

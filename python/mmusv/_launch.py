@@ -1,13 +1,13 @@
-"""The ``mmusv`` command's entry point (the console script and ``python -m mmusv``): loads :mod:`mmusv.cli` and
-runs it.
+"""The ``mmusv`` command's entry point (the console script and ``python -m mmusv``): loads :mod:`mmusv.cli` and runs it.
 
-Loading the command (its modules and its argument parser, whose sub-commands load theirs: numpy, Polars,
-pydantic, the scenario models) takes about a second. A Ctrl-C or SIGTERM meanwhile is held until the load is
-done, then ends the command as one at any other moment does (``mmusv: interrupted``, exit status 130;
-``mmusv: terminated (SIGTERM)``, 143) before it starts. It was a ``KeyboardInterrupt`` traceback of whichever
-import it cut; and an interrupt in the middle of an import is not safe to catch: a library's ``except`` around
-its optional imports swallowed it (the run went on to its end), and one cut inside a C extension's module code
-made CPython end the process by SIGINT after the message (exit status -2). Needs ``import mmusv`` to be light
+Loading the command (its modules and its argument parser, whose sub-commands load theirs: numpy, rich) takes about half
+a second; each command loads the rest (Polars, pydantic, the scenario models) when it starts. A Ctrl-C or SIGTERM
+meanwhile is held until the load is done, then ends the command as one at any other moment does (``mmusv: interrupted``,
+exit status 130; ``mmusv: terminated (SIGTERM)``, 143) before it starts. It was a ``KeyboardInterrupt`` traceback of
+whichever import it cut; and an interrupt in the middle of an import is not safe to catch: a library's ``except`` around
+its optional imports swallowed it (the run went on to its end), and one cut inside code a library builds from a string
+(a dataclass's methods) made CPython end the process by SIGINT after the message (exit status -2; the command's end
+clears that mark: :func:`mmusv.held_signals.forget_handled_interrupt`). Needs ``import mmusv`` to be light
 (:mod:`mmusv`'s lazy names): the package's own import runs before this module's code.
 """
 
@@ -17,7 +17,7 @@ import signal
 import sys
 from collections.abc import Callable
 
-from mmusv.held_signals import HeldSignals
+from mmusv.held_signals import HeldSignals, forget_handled_interrupt
 
 __all__ = ["main"]
 
@@ -50,4 +50,5 @@ def main() -> int:
             return _stopped(held)
         return cli_main()
     except KeyboardInterrupt:  # between the load and the command's own handling, or after it
+        forget_handled_interrupt()
         return _stopped(signal.SIGINT)

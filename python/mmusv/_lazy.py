@@ -1,8 +1,8 @@
 """Names of a package loaded on first use (PEP 562): the ``__getattr__`` of :mod:`mmusv` and :mod:`mmusv.generate`.
 Every ``mmusv`` command builds the whole argument parser, whose sub-commands import these packages; loading what
-each package's names need only when a name is used keeps a command's start (and ``import mmusv``) short.
-(:mod:`mmusv.export` stays eager: its ``convert`` names both a function and a submodule, and a lazily loaded
-submodule would rebind the name to itself.)"""
+each package's names need only when a name is used keeps a command's start (and ``import mmusv``) short. A lazy
+name must not also be a submodule's name: importing the submodule would bind the name to the module (hence
+:mod:`mmusv.export.conversion`, whose function is ``mmusv.export.convert``)."""
 
 from __future__ import annotations
 

@@ -27,6 +27,7 @@ from mmusv.cli_recordings import cmd_info, cmd_preview, cmd_recover
 from mmusv.cli_run import cmd_run
 from mmusv.cli_schema import cmd_schema
 from mmusv.errors import MmusvError
+from mmusv.held_signals import forget_handled_interrupt
 
 
 class _Signals:
@@ -133,8 +134,10 @@ def _run_command(args: argparse.Namespace) -> int:
         except KeyboardInterrupt:
             name = "terminated (SIGTERM)" if signals.received not in (None, 2) else "interrupted"
             cli_console.say(f"mmusv: {name}")
-            return signals.status(130)
-        return signals.status(code)
+            code = 130
+    if signals.received is not None:  # the command ends with its own status, not CPython's for an interrupt
+        forget_handled_interrupt()
+    return signals.status(code)
 
 
 def _dispatch(args: argparse.Namespace) -> int:

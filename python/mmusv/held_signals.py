@@ -9,7 +9,7 @@ from __future__ import annotations
 from types import TracebackType
 from typing import Any
 
-__all__ = ["HeldSignals"]
+__all__ = ["HeldSignals", "forget_handled_interrupt"]
 
 
 class HeldSignals:
@@ -83,3 +83,15 @@ class HeldSignals:
         self, exc_type: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
     ) -> None:
         self.release()
+
+
+def forget_handled_interrupt() -> None:
+    """Tells CPython that the ``KeyboardInterrupt`` a command caught was handled, so that its exit status stands.
+
+    CPython marks a ``KeyboardInterrupt`` that leaves code run from a string (``exec(str)``, ``eval(str)``: every
+    dataclass method is made that way while a module loads) as unhandled, even when a caller catches it later;
+    under ``python -m`` the interpreter then ends the process by SIGINT at exit instead of with the status the
+    command returned (``mmusv: interrupted``, then status -2 for ``subprocess``, not 130: 4 of 38 Ctrl-Cs in the
+    first second of ``python -m mmusv run``). Each string evaluation clears the mark when it starts, so an empty
+    one does (CPython's ``run_eval_code_obj``); where there is no mark it does nothing."""
+    exec("pass", {})

@@ -20,7 +20,7 @@ import pytest
 import yaml
 from mmusv.errors import ConfigError
 from mmusv.export import convert
-from mmusv.export.convert import load_report
+from mmusv.export.conversion import load_report
 from mmusv.recording import read_messages
 
 LIDAR = {"channels": 16, "points_per_second": 20000, "rotation_hz": 5}

@@ -99,7 +99,7 @@ def test_a_file_without_summary_is_read_in_full(chunky: Chunky, tmp_path: Path) 
 
 
 def test_convert_frames_reads_a_part_and_writes_the_full_conversion_s_files(chunky: Chunky, tmp_path: Path) -> None:
-    from mmusv.export.convert import convert
+    from mmusv.export.conversion import convert
 
     path, _reference = chunky
     assert cli_main("convert", str(path), "-o", str(tmp_path / "all"), "--no-progress", "--no-split")[0] == 0

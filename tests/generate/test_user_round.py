@@ -370,7 +370,7 @@ def test_a_full_disk_while_converting_names_the_folder_and_the_way_on(
     """A full disk during the OPV2V conversion ended ``mmusv dataset`` with "No space left on device" alone."""
     from mmusv.batch.dataset import build_dataset
 
-    export_convert = importlib.import_module("mmusv.export.convert")  # the module (the package exports the function)
+    export_convert = importlib.import_module("mmusv.export.conversion")
     spec = _spec_file(tmp_path, dict(TINY, combinations=TINY["combinations"][1:]))
     out = tmp_path / "ds"
     real = export_convert.convert

@@ -378,7 +378,7 @@ def test_study_detection_refuses_a_detector_box_of_negative_size(
 @pytest.fixture(scope="module")
 def opv2v_sequence(one_usv_recording: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
     """One OPV2V scenario folder (``<cav>/<frame>.pcd`` + ``.yaml``) of the one-USV recording."""
-    from mmusv.export.convert import convert
+    from mmusv.export.conversion import convert
     from mmusv.studies.detection.data import opv2v_scenarios
 
     out = tmp_path_factory.mktemp("opv2v") / "opv2v"

@@ -154,7 +154,7 @@ def test_robustness_study_end_to_end(two_usv: Path, tmp_path: Path) -> None:
 def test_opv2v_input_gives_the_same_ground_truth(
     two_usv: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from mmusv.export.convert import convert
+    from mmusv.export.conversion import convert
 
     convert([two_usv], to="opv2v", out_dir=tmp_path / "opv2v", splits=None, extras="")
     rec_out, opv_out = tmp_path / "a", tmp_path / "b"

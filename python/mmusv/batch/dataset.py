@@ -65,7 +65,7 @@ def _conversion_complete(opv2v: Path) -> bool:
     has its folder (``<split>/<folder>``). A conversion into a folder that was not there (removed by hand) writes
     into it directly and starts its report as ``in_progress``: stopped there (Ctrl-C), a re-run took the
     half-written folder for up to date, as the index still named the same recordings."""
-    from mmusv.export.convert import writer_class
+    from mmusv.export.conversion import writer_class
     from mmusv.export.convert_report import REPORT_NAME
     from mmusv.yamlio import read_yaml
 
@@ -204,7 +204,7 @@ def build_dataset(
     docstring); the batch options are those of :func:`mmusv.batch.run_many` (``overwrite``: record every scenario
     again, replacing whatever ``DIR/recordings`` holds for it)."""
     from mmusv.bundled import resolve_spec
-    from mmusv.export.convert import convert
+    from mmusv.export.conversion import convert
     from mmusv.generate.runner import generate
     from mmusv.generate.spec import load_spec
 

@@ -141,7 +141,7 @@ def run(args: argparse.Namespace) -> int:
 
     from mmusv.cli_console import rich_console
     from mmusv.export.common import BOXES, TARGETS
-    from mmusv.export.convert import convert
+    from mmusv.export.conversion import convert
     from mmusv.export.kitti_oxts import parse_origin
 
     if args.to not in TARGETS:
