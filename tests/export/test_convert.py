@@ -90,9 +90,8 @@ def test_existing_output_refused_without_overwrite(coop_rec: Path, tmp_path: Pat
     convert(coop_rec, out_dir=out, splits=None, extras=())
     with pytest.raises(IoError, match="already exists"):
         convert(coop_rec, out_dir=out, splits=None, extras=())
-    (out / "stale.txt").write_text("x")
     rep = convert(coop_rec, out_dir=out, splits=None, extras=(), overwrite=True)
-    assert rep.frames == 3 and not (out / "stale.txt").exists()
+    assert rep.frames == 3
     foreign = tmp_path / "foreign"
     foreign.mkdir()
     (foreign / "precious.txt").write_text("keep me")
@@ -112,6 +111,61 @@ def test_overwrite_never_deletes_the_recording_being_converted(coop_rec: Path, t
         with pytest.raises(IoError, match="being converted"):
             convert(inside, out_dir=target, splits=None, extras=(), overwrite=True)
         assert inside.stat().st_size == coop_rec.stat().st_size
+
+
+def test_overwrite_replaces_only_what_the_previous_conversion_wrote(coop_rec: Path, tmp_path: Path) -> None:
+    # --overwrite deleted any folder with a conversion.yaml at its top: recordings below it, a user's notes
+    out = tmp_path / "o"
+    convert(coop_rec, out_dir=out, splits=None, extras=())
+    doc = yaml.safe_load((out / "conversion.yaml").read_text())
+    assert doc["contents"] == {
+        "entries": ["export_coop", "opencood"],
+        "files": sum(1 for p in out.rglob("*") if p.is_file()) - 1,
+    }
+    run = out / "runs" / "a"  # a recording's run folder (copied), its tables included
+    run.mkdir(parents=True)
+    shutil.copyfile(coop_rec, run / "a.mcap")
+    (run / "manifest.json").write_text("{}")
+    before = tree(out)
+    with pytest.raises(IoError, match=r"holds .*a\.mcap, .*manifest\.json, which no conversion writes"):
+        convert(coop_rec, out_dir=out, splits=None, extras=(), overwrite=True)
+    assert tree(out) == before
+    shutil.rmtree(out / "runs")
+    for name in ("notes.txt", "export_coop/notes.txt"):  # a file at the top, a file inside the layout
+        (out / name).write_text("mine")
+        before = tree(out)
+        with pytest.raises(IoError, match="refusing to delete what no conversion wrote"):
+            convert(coop_rec, out_dir=out, splits=None, extras=(), overwrite=True)
+        assert tree(out) == before
+        (out / name).unlink()
+    for name, data in (("b.parquet", b"PAR1"), ("c.mcap.partial", b""), ("d.parts.json", b"{}")):
+        (out / "export_coop" / name).write_bytes(data)
+        with pytest.raises(IoError, match="which no conversion writes"):
+            convert(coop_rec, out_dir=out, splits=None, extras=(), overwrite=True)
+        (out / "export_coop" / name).unlink()
+    assert convert(coop_rec, out_dir=out, splits=None, extras=(), overwrite=True).frames == 3
+    # a conversion that did not finish says nothing of its files: a recording below it is still refused
+    (out / "conversion.yaml").write_text("status: interrupted\n")
+    (out / "x.mcap").write_bytes(coop_rec.read_bytes()[:4096])
+    with pytest.raises(IoError, match="which no conversion writes"):
+        convert(coop_rec, out_dir=out, splits=None, extras=(), overwrite=True)
+    (out / "x.mcap").unlink()
+    assert convert(coop_rec, out_dir=out, splits=None, extras=(), overwrite=True).frames == 3
+
+
+def test_a_killed_run_s_missing_frames_are_those_it_set_out_to_write(short_rec: Path, tmp_path: Path) -> None:
+    # a run of 2 of the scenario's 3 frames, killed (no run metadata): its manifest says 2; the conversion
+    # listed frames 0..2 of the scenario as skipped, one of them never asked for
+    small = tmp_path / "export_short.mcap"
+    rechunk(short_rec, small, 64 * 1024)
+    data = small.read_bytes()
+    cut = tmp_path / "export_short.mcap.partial"
+    cut.write_bytes(data[: int(len(data) * 0.7)])  # inside frame 1
+    rep = convert(cut, out_dir=tmp_path / "o", splits=None, extras=())
+    assert rep.frames == 1
+    skipped = rep.recordings[0].skipped
+    assert [s["frames"] for s in skipped] == [[1, 1]], skipped
+    assert "3 frames" not in skipped[0]["reason"]
 
 
 @pytest.mark.parametrize("to", ["opv2v", "kitti"])
@@ -247,10 +301,14 @@ def test_cut_before_any_frame(coop_rec: Path, tmp_path: Path) -> None:
         end = next(f.tell() for rec in StreamReader(f, emit_chunks=True).records if isinstance(rec, Chunk))
     cut = tmp_path / "x.mcap.partial"
     cut.write_bytes(coop_rec.read_bytes()[: end - 10])
-    rep = convert(cut, out_dir=tmp_path / "o", splits=None)
-    assert rep.frames == 0 and rep.skipped and "nothing written" in " ".join(rep.recordings[0].notes)
-    assert not (tmp_path / "o" / "export_coop").exists()
-    assert export_cli.run(parse([str(cut), "-o", str(tmp_path / "o2"), "--no-progress"])) == 1
+    # a new folder is left as it was: it was a conversion.yaml saying "complete" over no frame (exit status 1)
+    with pytest.raises(IoError, match=r"nothing converted: no complete frame in .*x\.mcap\.partial; nothing written"):
+        convert(cut, out_dir=tmp_path / "o", splits=None)
+    assert not (tmp_path / "o").exists()
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(IoError, match="nothing written"):
+        export_cli.run(parse([str(cut), "-o", str(tmp_path / "empty"), "--no-progress"]))
+    assert list((tmp_path / "empty").iterdir()) == []
     # over a good conversion, --overwrite that converts nothing keeps it (it used to replace it with an empty one)
     good = convert(coop_rec, out_dir=tmp_path / "good", splits=None)
     before = tree(tmp_path / "good")

@@ -20,6 +20,7 @@ Its parts: the checks made before anything is written (:mod:`~mmusv.export.conve
 
 from __future__ import annotations
 
+import contextlib
 import shutil
 import time
 from collections.abc import Callable, Iterable, Sequence
@@ -42,7 +43,7 @@ from mmusv.export.convert_checks import (
     oxts_origin_of,
     target_options,
 )
-from mmusv.export.convert_output import prepare_out, reported, staged
+from mmusv.export.convert_output import contents, prepare_out, reported, staged
 from mmusv.export.convert_report import REPORT_NAME, ConvertReport, RecordingReport
 from mmusv.export.convert_report import load_report as load_report  # importable from here as before
 from mmusv.export.splits import DEFAULT_RATIOS, SPLIT_NAMES, assign_splits, parse_ratios
@@ -60,6 +61,19 @@ _contrast_filter = contrast_filter
 _BOX_FORMATS = ("coco", "yolo", "mot")
 """The formats whose 2D boxes the options ``box``, ``min_box_px``, ``max_occlusion`` and ``min_contrast`` choose
 (recorded in ``conversion.yaml``'s ``options``)."""
+
+
+def _clear(out: Path, *, remove: bool) -> None:
+    """Empties ``out`` of what a conversion that converted nothing wrote there (it was empty, or emptied for it),
+    and removes it when the conversion created it."""
+    for child in sorted(out.iterdir()):
+        if child.is_dir() and not child.is_symlink():
+            shutil.rmtree(child, ignore_errors=True)
+        else:
+            child.unlink(missing_ok=True)
+    if remove:
+        with contextlib.suppress(OSError):
+            out.rmdir()
 
 
 def _beyond(frames: tuple[int, int | None] | None, first: int, end: int) -> str | None:
@@ -270,7 +284,9 @@ def convert(
     split_of: dict[str, str | None] = dict.fromkeys(folders)
     if ratios is not None:
         split_of = dict(assign_splits(folders, ratios=ratios, seed=seed))
+    created = not out.exists()
     work, lock = prepare_out(out, overwrite, [Path(i.path) for i in infos])
+    nothing = False
     try:
         reports = [
             RecordingReport(path=i.path, scenario=i.scenario_name, folder=f, split=split_of[f])
@@ -343,19 +359,19 @@ def convert(
                 for k, why in incomplete:
                     rep.skipped.append({"frames": [k, k], "reason": why})
                 seen = set(converted) | {k for k, _ in incomplete}
-                # the frames the run set out to write: --frames N cuts a run short on purpose, those after N are
-                # not missing
-                configured = int(
-                    stream.run.get("frames_requested", stream.run.get("frames_configured", info.frames_configured)) or 0
-                )
-                first = int(stream.run.get("first_frame", 0) or 0)  # one part of a split recording given alone
-                absent = [k for k in range(first, first + configured) if k not in seen and options.wants_frame(k)]
+                # the frames the run set out to write (its run metadata, or for one that did not finish its
+                # manifest's): --frames N cuts a run short on purpose, those after N are not missing; one part of a
+                # split recording given alone starts at its first frame
+                span = stream.set_out()
+                first, configured = span.start, len(span)
+                absent = [k for k in span if k not in seen and options.wants_frame(k)]
                 if absent:
                     written = stream.run.get("frames_written")
                     why = (
                         f"not in the recording (run {rep.status}: {written} of {counted(configured, 'frame')} written)"
                         if written is not None
-                        else f"not in the recording (the run did not finish; {counted(configured, 'frame')} configured)"
+                        else "not in the recording (the run did not finish; it set out to write "
+                        f"{counted(configured, 'frame')})"
                     )
                     if stream.truncated:
                         why += "; " + stream.truncated
@@ -378,11 +394,13 @@ def convert(
                     rep.notes.append("no complete frame: nothing written for this recording")
                     if cls.owns_folder:
                         shutil.rmtree(folder, ignore_errors=True)
-            if report.frames == 0 and work != out:
-                # --overwrite with nothing to show for it: the previous conversion stays (the staging folder goes)
+            if report.frames == 0:
+                # nothing to show for it: --overwrite keeps the previous conversion (the staging folder goes), a new
+                # folder is left as it was (a report saying "complete" over no frame looked like a dataset)
+                nothing = True
                 raise IoError(
                     f"nothing converted: no complete frame in {', '.join(str(r.path) for r in reports)}; "
-                    f"{out} keeps its previous conversion"
+                    + (f"{out} keeps its previous conversion" if work != out else "nothing written")
                 )
             cls.finish_all(shared, work, sink)
             doc = {
@@ -391,11 +409,16 @@ def convert(
                 "frames_converted": report.frames,
                 "agent_frames": report.agent_frames,
                 "recordings": [r.as_dict() for r in sorted(reports, key=lambda r: (r.split or "", r.folder))],
+                "contents": contents(work),
             }
             data = dump_yaml(doc)
             (work / REPORT_NAME).write_bytes(data)
             report.files = sink.files + 1
             report.bytes = sink.bytes + len(data)
+    except IoError:
+        if nothing and work == out:
+            _clear(out, remove=created)
+        raise
     finally:
         lock.release()
     report.seconds = time.perf_counter() - t0

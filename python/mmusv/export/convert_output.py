@@ -17,8 +17,9 @@ from mmusv.errors import IoError, MmusvError
 from mmusv.export.common import dump_yaml
 from mmusv.export.convert_report import REPORT_NAME
 from mmusv.recording.guard import FolderLock
+from mmusv.text import counted
 
-__all__ = ["prepare_out", "reported", "staged"]
+__all__ = ["contents", "prepare_out", "reported", "staged"]
 
 
 def prepare_out(out: Path, overwrite: bool, inputs: list[Path]) -> tuple[Path, FolderLock]:
@@ -60,6 +61,7 @@ def _prepare_locked(out: Path, home: Path, overwrite: bool) -> Path:
                 f"output folder {out} is not empty and holds no {REPORT_NAME} from a previous conversion; "
                 "refusing to delete it, choose another folder"
             )
+        _check_only_a_conversion(out)
         here = Path.cwd().resolve()
         if not out.is_symlink() and home != here and home not in here.parents:
             _remove_stale_stages(out)
@@ -77,6 +79,91 @@ def _prepare_locked(out: Path, home: Path, overwrite: bool) -> Path:
             else:
                 child.unlink()
     return out
+
+
+RUN_FILES = ("manifest.json", "dataset.json")
+"""Files of a recording's run folder or a batch that no conversion writes."""
+RUN_SUFFIXES = (".mcap.partial", ".parts.json", ".parquet")
+"""Endings of a recording's files (a killed run's, a split recording's manifest, its tables) no conversion writes."""
+
+
+def contents(folder: Path) -> dict[str, Any]:
+    """What a conversion wrote into ``folder`` besides its report, kept in the report so that ``--overwrite`` can
+    tell it from what was added since: its top-level ``entries`` (sorted names) and the number of ``files`` below
+    it (links not followed)."""
+    entries = sorted(p.name for p in folder.iterdir() if p.name != REPORT_NAME)
+    files = sum(len(names) for _root, _dirs, names in os.walk(folder)) - int((folder / REPORT_NAME).exists())
+    return {"entries": entries, "files": files}
+
+
+def _check_only_a_conversion(out: Path) -> None:
+    """Refuses (:class:`~mmusv.errors.IoError`) to replace ``out`` when it holds what its previous conversion did
+    not write: a recording or a batch anywhere below (``--overwrite`` deleted a folder that had a
+    ``conversion.yaml`` at its top, recordings and all), or, where its report says what the conversion wrote
+    (:func:`contents`), another top-level entry or more files than that."""
+    found: list[str] = []
+    for root, _dirs, names in os.walk(out):
+        for name in sorted(names):
+            path = Path(root) / name
+            if name in RUN_FILES or name.endswith(RUN_SUFFIXES) or (name.endswith(".mcap") and _recording(path)):
+                found.append(str(path))
+    if found:
+        raise IoError(
+            f"output folder {out} holds {_listed(found)}, which no conversion writes (a recording, its tables or a "
+            "batch); refusing to delete it: convert into another folder, or move them out first"
+        )
+    try:
+        import yaml
+
+        said = yaml.safe_load((out / REPORT_NAME).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, yaml.YAMLError):
+        return  # a report cut short (a conversion killed while writing it): the recordings check above stands
+    wrote = said.get("contents") if isinstance(said, dict) else None
+    if not isinstance(wrote, dict):
+        return  # a conversion that did not finish, or from before the record
+    entries, files = wrote.get("entries"), wrote.get("files")
+    if isinstance(entries, list):
+        extra = sorted(p.name for p in out.iterdir() if p.name != REPORT_NAME and p.name not in entries)
+        if extra:
+            raise IoError(
+                f"output folder {out} holds {_listed([str(out / e) for e in extra])} besides the conversion its "
+                f"{REPORT_NAME} describes; refusing to delete what no conversion wrote: convert into another folder, "
+                "or move them out first"
+            )
+    if isinstance(files, int) and not isinstance(files, bool):
+        now = contents(out)["files"]
+        if now > files:
+            raise IoError(
+                f"output folder {out} holds {counted(now - files, 'file')} more than the conversion its {REPORT_NAME} "
+                f"describes wrote ({files}); refusing to delete what no conversion wrote: convert into another "
+                "folder, or move them out first"
+            )
+
+
+def _recording(path: Path) -> bool:
+    """Whether ``path`` is an MCAP file written by mmusv (its header's library says so; a ROS 2 bag's does not)."""
+    import struct
+
+    try:
+        with path.open("rb") as f:
+            head = f.read(512)
+    except OSError:
+        return False
+    if not head.startswith(b"\x89MCAP0\r\n") or len(head) < 21 or head[8] != 0x01:
+        return False
+    at = 17
+    (n,) = struct.unpack_from("<I", head, at)  # the profile
+    at += 4 + n
+    if at + 4 > len(head):
+        return False
+    (n,) = struct.unpack_from("<I", head, at)  # the library
+    return head[at + 4 : at + 4 + n].startswith(b"mmusv")
+
+
+def _listed(paths: list[str]) -> str:
+    """Up to three paths, and how many more."""
+    more = len(paths) - 3
+    return ", ".join(paths[:3]) + (f" and {more} more" if more > 0 else "")
 
 
 def _remove_stale_stages(out: Path) -> None:

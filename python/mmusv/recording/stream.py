@@ -333,6 +333,10 @@ class FrameStream:
         self.yielded.append(fr.index)
         return fr
 
+    def set_out(self) -> range:
+        """Every frame the run set out to write (:meth:`expected` before :attr:`frames` narrows it)."""
+        return self._expected_all()[0]
+
     def expected(self) -> tuple[range, bool]:
         """The frames the run set out to write (those in :attr:`frames` when given) and whether its ``run``
         metadata says so (``False``: it did not finish; the range is then the one its ``manifest`` metadata gave
