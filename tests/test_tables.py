@@ -9,7 +9,7 @@ import numpy as np
 import polars as pl
 from mmusv.acquire import annotations_for
 from mmusv.annotate import Annotations, SilhouetteCache
-from mmusv.recording.tables import SCHEMAS, TableWriter
+from mmusv.recording.tables import ROWS_DIGEST_KEY, SCHEMAS, TableWriter, rows_digest
 from mmusv.simulation import FrameCapture, Simulation
 from test_acquire import small_scenario
 
@@ -114,7 +114,8 @@ class _RowWise:
                 continue
             d = self.root / name
             d.mkdir(parents=True, exist_ok=True)
-            pl.DataFrame(rows).write_parquet(d / f"part-{self.part:05d}.parquet")
+            df = pl.DataFrame(rows)
+            df.write_parquet(d / f"part-{self.part:05d}.parquet", metadata={ROWS_DIGEST_KEY: rows_digest(df)})
             rows.clear()
         self.part += 1
 
@@ -189,6 +190,48 @@ def test_parts_written_before_wave_occlusion_read_with_it_null(tmp_path: Path) -
         assert got.rows["wave_occlusion"].null_count() == new.height
         assert got.rows.drop("wave_occlusion").equals(new.drop("wave_occlusion"))
         assert len(got.damaged) == 1 and "part-00001" in got.damaged[0]
+
+
+def test_changed_bytes_in_a_part_are_named_damaged_never_read_as_other_rows(tmp_path: Path) -> None:
+    """Bytes flipped inside a data page read back as other numbers (a range of 100.49 as -0.045) with no word: the
+    part's rows checksum (file metadata) names it damaged; a part without one (an older mmusv) still reads."""
+    from mmusv.recording.tables import read_table
+
+    sim = Simulation(small_scenario(frames=2))
+    silhouettes = SilhouetteCache()
+    w = TableWriter(tmp_path / "good")
+    for k in range(2):
+        cap = sim.capture(k)
+        anns = annotations_for(sim, cap, silhouettes)
+        w.add_frame(sim.vessels, cap, {agent: (a, a.columns()) for agent, a in anns.items()})
+    w.flush()
+    for table in SCHEMAS:
+        good = read_table(tmp_path / "good", table)
+        src = (tmp_path / "good" / table / "part-00000.parquet").read_bytes()
+        assert not good.damaged and good.rows.height > 0
+        assert pl.read_parquet_metadata(tmp_path / "good" / table / "part-00000.parquet")[ROWS_DIGEST_KEY] == (
+            rows_digest(pl.read_parquet(tmp_path / "good" / table / "part-00000.parquet"))
+        )
+        bad = tmp_path / "bad" / table / "part-00000.parquet"
+        bad.parent.mkdir(parents=True, exist_ok=True)
+        outcomes = {"damaged": 0, "same": 0}
+        for at in range(4, len(src) - 8, 29):
+            flipped = bytearray(src)
+            for i in range(at, at + 8):
+                flipped[i] ^= 0xFF
+            bad.write_bytes(bytes(flipped))
+            got = read_table(tmp_path / "bad", table)
+            if got.damaged:
+                outcomes["damaged"] += 1
+            else:
+                assert got.rows.equals(good.rows), (table, at)  # never other values without a word
+                outcomes["same"] += 1
+        assert outcomes["damaged"] > 0, outcomes
+        old = tmp_path / "old" / table / "part-00000.parquet"  # no checksum: read as before
+        old.parent.mkdir(parents=True, exist_ok=True)
+        good.rows.write_parquet(old)
+        again = read_table(tmp_path / "old", table)
+        assert not again.damaged and again.rows.equals(good.rows)
 
 
 def test_an_unknown_table_name_is_a_config_error_listing_the_tables(tmp_path: Path) -> None:

@@ -240,7 +240,8 @@ class TableWriter:
             final = d / f"part-{self.part:05d}.parquet"
             tmp = final.with_name(final.name + ".tmp")
             try:
-                pl.DataFrame(data, schema=schema).write_parquet(tmp)
+                df = pl.DataFrame(data, schema=schema)
+                df.write_parquet(tmp, metadata={ROWS_DIGEST_KEY: rows_digest(df)})
             except pl.exceptions.PolarsError as exc:  # a failed write (a full disk) comes back as a polars error
                 tmp.unlink(missing_ok=True)
                 raise OSError(f"{final}: the Parquet part could not be written ({exc})") from exc
@@ -248,6 +249,49 @@ class TableWriter:
             self._rows[table] = 0
         self.part += 1
         self.frames = 0
+
+
+ROWS_DIGEST_KEY = "mmusv.rows_sha256"
+"""The key of a part's file-level Parquet metadata holding :func:`rows_digest` of the rows written: Parquet's own
+page checksums are optional and Polars writes none, so changed bytes inside a page read back as other numbers
+(a ``range_m`` of 100.49 read as -0.045) without it."""
+
+
+def rows_digest(df: pl.DataFrame) -> str:
+    """SHA-256 (hex) of a table's rows: per column its name, its null mask and its values (numbers and flags as
+    their little-endian bytes, strings length-prefixed UTF-8), independent of how Parquet encodes them."""
+    import hashlib
+
+    h = hashlib.sha256()
+    for name in df.columns:
+        col = df[name]
+        h.update(len(name).to_bytes(4, "little") + name.encode("utf-8"))
+        h.update(np.ascontiguousarray(col.is_null().to_numpy()).tobytes())
+        if col.dtype == pl.String:
+            for v in col.to_list():
+                b = b"" if v is None else v.encode("utf-8", "surrogatepass")
+                h.update(len(b).to_bytes(8, "little") + b)
+        else:
+            values = np.ascontiguousarray(col.to_numpy())
+            h.update(values.astype(values.dtype.newbyteorder("<"), copy=False).tobytes())
+    return h.hexdigest()
+
+
+def _said_digest(part: Path) -> str | None:
+    """The :func:`rows_digest` ``part`` was written with, or ``None`` for a part written before it was kept."""
+    try:
+        return pl.read_parquet_metadata(part).get(ROWS_DIGEST_KEY)
+    except BaseException as exc:  # its footer read with the rows just before: a failure here is a part from elsewhere
+        if not _unreadable(exc):
+            raise
+        return None
+
+
+def _unreadable(exc: BaseException) -> bool:
+    """Whether ``exc``, raised reading a Parquet file, says the file cannot be read: any error, and a panic of
+    Polars' Rust code (pyo3's ``PanicException`` is a ``BaseException``: changed bytes in a page made it escape
+    as a traceback), but not a stop (Ctrl-C, SIGTERM, exit)."""
+    return isinstance(exc, Exception) or type(exc).__name__ == "PanicException"
 
 
 @dataclass
@@ -310,11 +354,17 @@ def read_table(root: str | os.PathLike[str], table: str, *, expected: range | Se
     for part in sorted((root / table).glob("part-*.parquet")):
         try:
             df = pl.read_parquet(part, glob=False)  # a folder a[1] is a name, not a pattern
-        except Exception as exc:  # polars raises several kinds for a damaged file; any means unreadable
+        except BaseException as exc:  # polars raises several kinds for a damaged file; any means unreadable
+            if not _unreadable(exc):
+                raise
             first = str(exc).strip().splitlines()[0][:120] if str(exc).strip() else ""
             damaged.append(
                 f"{part} is not a readable Parquet file ({type(exc).__name__}{': ' + first if first else ''})"
             )
+            continue
+        said = _said_digest(part)
+        if said is not None and said != rows_digest(df):
+            damaged.append(f"{part} holds rows that differ from those written (damaged bytes: its checksum fails)")
             continue
         legacy = [c for c in LEGACY_MISSING.get(table, ()) if c not in df.columns]
         if legacy and list(df.columns) == [c for c in schema if c not in legacy]:
