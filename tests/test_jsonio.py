@@ -7,7 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from mmusv.jsonio import read_json, write_json
+from mmusv.jsonio import read_json, write_bytes_atomic, write_json
 
 
 def test_a_killed_writers_temporary_file_is_removed_by_the_next_write(tmp_path: Path) -> None:
@@ -82,3 +82,37 @@ def test_read_json_or_none_is_the_object_or_none(tmp_path: Path) -> None:
     assert read_json_or_none(good) == {"a": [1, 2]}
     for path in (listed, broken, binary, tmp_path / "missing.json", tmp_path):
         assert read_json_or_none(path) is None
+
+
+def test_a_link_is_written_through_and_a_fifo_or_device_into(tmp_path: Path) -> None:
+    """``mmusv schema -o`` onto a FIFO, a device or a link to ``/proc/self/fd/1`` replaced it with a regular file
+    (``/dev/full`` itself, as root) and said ``wrote``: the temporary was renamed onto it."""
+    import stat
+    import threading
+
+    target = tmp_path / "real.json"
+    target.write_text("old")
+    link = tmp_path / "link.json"
+    link.symlink_to(target)
+    write_bytes_atomic(link, b"new")
+    assert link.is_symlink() and target.read_bytes() == b"new"
+
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    got: list[bytes] = []
+
+    def read() -> None:
+        with open(fifo, "rb") as f:
+            got.append(f.read())
+
+    reader = threading.Thread(target=read, daemon=True)
+    reader.start()
+    write_bytes_atomic(fifo, b"through the pipe")
+    reader.join(timeout=10)
+    assert stat.S_ISFIFO(os.stat(fifo).st_mode) and got == [b"through the pipe"]
+
+    to_null = tmp_path / "null"  # a link to a device: written into, the device and the link stay
+    to_null.symlink_to("/dev/null")
+    write_bytes_atomic(to_null, b"gone")
+    assert to_null.is_symlink() and stat.S_ISCHR(os.stat("/dev/null").st_mode)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link.json", "null", "pipe", "real.json"]  # no temporary

@@ -15,6 +15,7 @@ import contextlib
 import glob
 import json
 import os
+import stat
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -61,8 +62,23 @@ def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
     """Writes ``data`` to ``path`` through a temporary file beside it (``.NAME.PID.tmp``) and an atomic rename, so
     a reader or a writer killed on the way never leaves half a file; temporary files of earlier writers that no
     longer run are removed first. The folder must exist. An :class:`OSError` is raised as it came, after the
-    temporary is removed: the caller words it (it names no file)."""
+    temporary is removed: the caller words it (it names no file).
+
+    A ``path`` that is a link is written through: the file it points to is replaced, the link stays. One that is
+    no file (a device, a FIFO, ``/dev/stdout``) is written into directly: renaming a temporary onto it replaced
+    ``/dev/full`` itself with a file (as root), a FIFO and a link to ``/proc/self/fd/1`` likewise."""
     p = Path(path)
+    try:
+        mode = os.stat(p).st_mode  # through links
+    except (FileNotFoundError, NotADirectoryError):
+        mode = None
+    if mode is not None and not stat.S_ISREG(mode) and not stat.S_ISDIR(mode):
+        with open(p, "wb") as f:
+            f.write(data)
+        return p
+    if p.is_symlink():
+        write_bytes_atomic(os.path.realpath(p), data)
+        return p
     tmp = p.with_name(f".{p.name}.{os.getpid()}.tmp")
     try:
         remove_stale_temps(p)
