@@ -428,3 +428,55 @@ def test_a_second_scenario_into_the_same_folder_is_refused(tmp_path: Path) -> No
     assert manifest["recording"] == "second.mcap" and (out / "first.mcap").is_file()
     (out / "second.mcap").unlink()  # the other run's recording gone: nothing of it is lost by replacing the rest
     run(lidar_scenario("third", frames=2), out_dir=out)
+
+
+def test_a_user_s_scenario_yaml_or_manifest_in_the_folder_is_never_replaced(tmp_path: Path) -> None:
+    """A run replaced a scenario.yaml or manifest.json it did not write without a word, --overwrite or not: the
+    user's notes, and the very scenario it ran (``mmusv run scenario.yaml -o .``). Refused before anything is
+    written; a run's own files (beside its recording, or a scenario.yaml it dumped) are replaced as before."""
+    from mmusv.errors import IoError
+    from tiny_scenario import lidar_scenario
+
+    hand = yaml.safe_dump(lidar_scenario("mine", frames=1), sort_keys=True)
+    for overwrite in (False, True):
+        out = tmp_path / f"same_{overwrite}"
+        out.mkdir()
+        (out / "scenario.yaml").write_text("# my notes: keep\n" + hand)
+        with pytest.raises(IoError, match=r"scenario file .*scenario\.yaml is where a run into .* writes"):
+            run(out / "scenario.yaml", out_dir=out, overwrite=overwrite)
+        with pytest.raises(IoError, match=r"scenario\.yaml was not written by an mmusv run"):
+            run(lidar_scenario("other", frames=1), out_dir=out, overwrite=overwrite)
+        assert sorted(p.name for p in out.iterdir()) == ["scenario.yaml"]
+        assert (out / "scenario.yaml").read_text().startswith("# my notes: keep\n")
+    mine = tmp_path / "manifest"
+    mine.mkdir()
+    (mine / "manifest.json").write_text('{"a": 1}')
+    with pytest.raises(IoError, match=r"manifest\.json was not written by an mmusv run"):
+        run(lidar_scenario("other", frames=1), out_dir=mine)
+    assert sorted(p.name for p in mine.iterdir()) == ["manifest.json"]
+    out = tmp_path / "ours"  # a run's own scenario.yaml: again beside its recording, and alone (the rest moved)
+    run(lidar_scenario("again", frames=1), out_dir=out)
+    run(out / "scenario.yaml", out_dir=out, overwrite=True)
+    for name in ("again.mcap", "manifest.json"):
+        (out / name).unlink()
+    run(lidar_scenario("again", frames=1), out_dir=out)
+
+
+def test_overwrite_leaves_the_folder_a_fresh_run_would(tmp_path: Path) -> None:
+    """An earlier run's table that this run writes no row of stayed as an empty folder, and the manifest listed it:
+    the folder differed from a fresh run's."""
+    from tiny_scenario import lidar_scenario
+
+    fresh, again = tmp_path / "fresh", tmp_path / "again"
+    run(lidar_scenario("same", frames=2), out_dir=fresh)
+    run(lidar_scenario("same", frames=2), out_dir=again)
+    stale = again / "tables" / "boxes_2d" / "part-00000.parquet"  # the camera table of an earlier run
+    stale.parent.mkdir()
+    stale.write_bytes(b"PAR1")
+    run(lidar_scenario("same", frames=2), out_dir=again, overwrite=True)
+
+    def files(root: Path) -> dict[str, bytes]:
+        return {str(p.relative_to(root)): p.read_bytes() for p in sorted(root.rglob("*")) if p.is_file()}
+
+    assert sorted(p.name for p in (again / "tables").iterdir()) == sorted(p.name for p in (fresh / "tables").iterdir())
+    assert files(again) == files(fresh)

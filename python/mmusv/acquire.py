@@ -21,6 +21,7 @@ Ctrl-C or an error still finishes the MCAP (every completed frame is in it, its 
 
 from __future__ import annotations
 
+import contextlib
 import os
 import time
 from collections.abc import Callable
@@ -221,6 +222,7 @@ def run(
     if not overwrite:
         _refuse_another_run(out, rec_path)
     _refuse_wrong_kinds(out)
+    _refuse_foreign_files(out, cfg)
     try:  # builds the world: any remaining config problem surfaces here, before writing
         sim = Simulation(scenario)
     except MmusvError as exc:
@@ -513,6 +515,51 @@ def _refuse_wrong_kinds(out: Path) -> None:
         )
 
 
+def _refuse_foreign_files(out: Path, cfg: object) -> None:
+    """Raises :class:`~mmusv.errors.IoError` when ``out`` holds a ``scenario.yaml`` or ``manifest.json`` that no
+    run wrote: a run replaces both, and replaced a user's own notes, a hand-written scenario (the scenario it ran
+    included: ``mmusv run scenario.yaml -o .``) or manifest without a word, ``--overwrite`` or not. A run's
+    ``scenario.yaml`` lies beside its recording (``.mcap``, or ``.mcap.partial`` of a killed run), or is the
+    resolved scenario as :func:`_replace_outputs` dumps it (read back and dumped again, it is the same text); its
+    ``manifest.json`` is a JSON object naming its ``recording`` and ``mmusv_version``."""
+    import json
+    import warnings
+
+    from mmusv.config import load_scenario
+
+    scenario_file, manifest = out / "scenario.yaml", out / "manifest.json"
+    foreign: Path | None = None
+    ran = any(out.glob("*.mcap")) or any(out.glob("*.mcap.partial"))  # a run's, its scenario.yaml beside it
+    if scenario_file.is_file() and not ran:
+        try:
+            text = scenario_file.read_text(encoding="utf-8")
+            with warnings.catch_warnings():  # its own warnings are not this run's
+                warnings.simplefilter("ignore")
+                dumped = yaml.safe_dump(load_scenario(scenario_file).model_dump(mode="json"), sort_keys=False)
+        except (MmusvError, OSError, ValueError, yaml.YAMLError):
+            text, dumped = "", None
+        if text != dumped:
+            foreign = scenario_file
+    if foreign is None and manifest.is_file():
+        try:
+            doc = json.loads(manifest.read_bytes())
+        except (OSError, ValueError):
+            doc = None
+        if not (isinstance(doc, dict) and isinstance(doc.get("recording"), str) and "mmusv_version" in doc):
+            foreign = manifest
+    if foreign is None:
+        return
+    if isinstance(cfg, (str, os.PathLike)) and Path(cfg).resolve() == foreign.resolve():
+        raise IoError(
+            f"the scenario file {cfg} is where a run into {out} writes its resolved scenario: it would be replaced "
+            "(--overwrite or not); run into another folder (-o), or copy the scenario out of it first"
+        )
+    raise IoError(
+        f"{foreign} was not written by an mmusv run, and a run into {out} replaces its {foreign.name} (--overwrite "
+        f"or not); run into another folder (-o), or move it out of {out}"
+    )
+
+
 def _replace_outputs(out: Path, scenario: Scenario, stale: list[Path]) -> None:
     """Removes an earlier run's ``manifest.json`` (written last: a run in progress never has one) and table parts
     ``stale`` (tables of another run, replaced or killed before it finished, never mix with these) and writes this
@@ -520,6 +567,9 @@ def _replace_outputs(out: Path, scenario: Scenario, stale: list[Path]) -> None:
     (out / "manifest.json").unlink(missing_ok=True)
     for old in stale:
         old.unlink(missing_ok=True)
+    for folder in sorted({old.parent for old in stale}):  # a table this run writes no row of is not listed
+        with contextlib.suppress(OSError):
+            folder.rmdir()  # only when empty
     (out / "scenario.yaml").write_text(
         yaml.safe_dump(scenario.model_dump(mode="json"), sort_keys=False), encoding="utf-8"
     )
