@@ -324,6 +324,19 @@ def test_a_folders_yml_scenarios_are_run_too(tmp_path: Path) -> None:
         scenario_files(src)
 
 
+def test_scenario_files_whose_stems_differ_only_in_case_are_refused(tmp_path: Path) -> None:
+    """``a.yaml`` and ``A.yaml`` were recorded into ``OUT/a`` and ``OUT/A``: one folder on macOS or Windows."""
+    from mmusv.batch.plan import scenario_files
+
+    src = tmp_path / "src"
+    src.mkdir()
+    write(src / "a.yaml", scenario("a", frames=1))
+    write(src / "A.yaml", scenario("b", frames=1))
+    for given in (src, [src / "a.yaml", src / "A.yaml"]):
+        with pytest.raises(ConfigError, match=r"'A' and 'a' have stems that differ only in case"):
+            scenario_files(given)
+
+
 def test_the_detection_studys_generate_records_a_changed_spec_again(tmp_path: Path) -> None:
     """`study detection --generate SPEC -o OUT` after editing the spec: every scenario failed ("a complete
     recording of another configuration; pass --overwrite", which the study does not take). Now the changed ones

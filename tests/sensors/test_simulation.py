@@ -496,6 +496,8 @@ def test_lidar_misconfig_names_the_field(make_scenario: Any, lidar: dict[str, An
         ({"lidars": {}}, r"rigs\.r\.lidars"),
         ({"sonar": None}, r"rigs\.r\.sonar"),
         ({"cameras": [{"name": "a"}, {"name": "a"}]}, r"rigs\.r\b.*repeated: a"),
+        # front and FRONT: one export folder on a file system that ignores case (they were both accepted)
+        ({"cameras": [{"name": "front"}, {"name": "FRONT"}]}, r"rigs\.r\b.*than case: 'front' and 'FRONT'"),
         ({"cameras": [{"name": "bad name!"}]}, r"rigs\.r\.cameras\[0\]\.name"),
         ({"top_view": {"orientation": "south_up"}}, r"rigs\.r\.top_view\.orientation"),
     ],

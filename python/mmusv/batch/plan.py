@@ -149,14 +149,22 @@ def _not_a_file(f: Path) -> str:
 
 
 def _check_stems(files: Sequence[Path]) -> None:
-    """Two scenario files of one stem (``a.yaml`` and ``a.yml``, or the same name in two folders) would share the
-    output folder ``OUT/<stem>``: a :class:`~mmusv.errors.ConfigError`."""
+    """Two scenario files of one stem (``a.yaml`` and ``a.yml``, or the same name in two folders), or of stems that
+    differ only in case, would share the output folder ``OUT/<stem>``: a :class:`~mmusv.errors.ConfigError`."""
     stems = [f.stem for f in files]
     dup = sorted({s for s in stems if stems.count(s) > 1})
     if dup:
         raise ConfigError(
             f"scenario files {dup} share a file stem; each gets the output folder OUT/<stem>, rename them"
         )
+    folded: dict[str, str] = {}
+    for s in stems:  # a.yaml and A.yaml: one output folder on a file system that ignores case (macOS, Windows)
+        other = folded.setdefault(s.casefold(), s)
+        if other != s:
+            raise ConfigError(
+                f"scenario files {min(other, s)!r} and {max(other, s)!r} have stems that differ only in case; each "
+                "gets the output folder OUT/<stem>, one on a file system that ignores case: rename one"
+            )
 
 
 def _manifest(folder: Path) -> dict[str, Any] | None:

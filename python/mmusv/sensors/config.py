@@ -459,4 +459,14 @@ class RigConfig(_Model):
         dup = sorted({n for n in names if names.count(n) > 1})
         if dup:
             raise ValueError(f"camera names must be unique; repeated: {', '.join(dup)}")
+        # the exports name files and folders after them (train/<scenario>.<usv>.<camera>): front and FRONT would be
+        # one folder on a file system that ignores case (macOS, Windows), as vessel ids would
+        folded: dict[str, str] = {}
+        for n in names:
+            other = folded.setdefault(n.casefold(), n)
+            if other != n:
+                raise ValueError(
+                    f"camera names must differ in more than case: {other!r} and {n!r} (the exports name files and "
+                    "folders after them, one on a file system that ignores case)"
+                )
         return self
