@@ -480,3 +480,21 @@ def test_overwrite_leaves_the_folder_a_fresh_run_would(tmp_path: Path) -> None:
 
     assert sorted(p.name for p in (again / "tables").iterdir()) == sorted(p.name for p in (fresh / "tables").iterdir())
     assert files(again) == files(fresh)
+
+
+def test_a_run_refused_over_an_interrupted_one_says_it_was_interrupted(tmp_path: Path) -> None:
+    """``mmusv run`` again over a run stopped by Ctrl-C said only that the recording exists, as for a finished one."""
+    from mmusv.errors import IoError
+    from tiny_scenario import lidar_scenario
+
+    def stop(done: int, total: int) -> None:
+        if done == 1:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run(lidar_scenario("stopped", frames=3), out_dir=tmp_path / "a", progress=stop)
+    with pytest.raises(IoError, match=r"stopped\.mcap already exists \(its run was interrupted: 1 of 3 frames"):
+        run(lidar_scenario("stopped", frames=3), out_dir=tmp_path / "a")
+    run(lidar_scenario("done", frames=1), out_dir=tmp_path / "b")
+    with pytest.raises(IoError, match=r"done\.mcap already exists; pass --overwrite"):
+        run(lidar_scenario("done", frames=1), out_dir=tmp_path / "b")

@@ -218,7 +218,10 @@ def run(
         frame_range = span
     rec_path = recording_path(out, scenario)
     if rec_path.exists() and not overwrite:
-        raise IoError(f"{rec_path} already exists; pass --overwrite (overwrite=True in Python) to replace it")
+        raise IoError(
+            f"{rec_path} already exists{_earlier_run(out, rec_path)}; pass --overwrite (overwrite=True in Python) "
+            "to replace it"
+        )
     if not overwrite:
         _refuse_another_run(out, rec_path)
     _refuse_wrong_kinds(out)
@@ -303,7 +306,10 @@ def _record(
     from mmusv.recording.frames import FrameRecorder  # the MCAP side, kept apart from the loop
 
     if rec_path.exists() and not overwrite:  # again, now that no other run can be writing it
-        raise IoError(f"{rec_path} already exists; pass --overwrite (overwrite=True in Python) to replace it")
+        raise IoError(
+            f"{rec_path} already exists{_earlier_run(out, rec_path)}; pass --overwrite (overwrite=True in Python) "
+            "to replace it"
+        )
     if not overwrite:
         _refuse_another_run(out, rec_path)
 
@@ -479,6 +485,25 @@ def _record(
     if failure is not None:
         raise failure
     return result
+
+
+def _earlier_run(out: Path, rec_path: Path) -> str:
+    """What the run folder ``out`` says of the run that wrote ``rec_path`` when it did not finish, as
+    ``" (its run was interrupted: 61 of 300 frames written)"`` (``""`` otherwise): refused without a word on it, a
+    stopped run looked like a finished one that a second run would only repeat."""
+    import json
+
+    try:
+        manifest = json.loads((out / "manifest.json").read_bytes())
+    except (OSError, ValueError):
+        return ""
+    if not isinstance(manifest, dict) or manifest.get("recording") != rec_path.name:
+        return ""
+    status, written, asked = manifest.get("status"), manifest.get("frames_written"), manifest.get("frames_requested")
+    if status in (None, "complete") or not isinstance(status, str):
+        return ""
+    counts = f": {written} of {asked} frames written" if isinstance(written, int) and isinstance(asked, int) else ""
+    return f" (its run was {status}{counts})"
 
 
 def _refuse_another_run(out: Path, rec_path: Path) -> None:
