@@ -297,10 +297,11 @@ def test_cut_before_any_frame(coop_rec: Path, tmp_path: Path) -> None:
     from mcap.records import Chunk
     from mcap.stream_reader import StreamReader
 
-    with coop_rec.open("rb") as f:  # the end of the first chunk: metadata read, no message complete
-        end = next(f.tell() for rec in StreamReader(f, emit_chunks=True).records if isinstance(rec, Chunk))
+    with coop_rec.open("rb") as f:  # the start of the first chunk: metadata read, no message complete
+        chunk, end = next((r, f.tell()) for r in StreamReader(f, emit_chunks=True).records if isinstance(r, Chunk))
+    start = end - (9 + 8 + 8 + 8 + 4 + 4 + len(chunk.compression) + 8 + len(chunk.data))
     cut = tmp_path / "x.mcap.partial"
-    cut.write_bytes(coop_rec.read_bytes()[: end - 10])
+    cut.write_bytes(coop_rec.read_bytes()[: start + 60])
     # a new folder is left as it was: it was a conversion.yaml saying "complete" over no frame (exit status 1)
     with pytest.raises(IoError, match=r"nothing converted: no complete frame in .*x\.mcap\.partial; nothing written"):
         convert(cut, out_dir=tmp_path / "o", splits=None)

@@ -334,8 +334,20 @@ class FrameStream:
         return fr
 
     def set_out(self) -> range:
-        """Every frame the run set out to write (:meth:`expected` before :attr:`frames` narrows it)."""
-        return self._expected_all()[0]
+        """Every frame the run set out to write, as its ``run`` metadata says (``frames_requested`` from
+        ``first_frame``), else as its ``manifest`` metadata said before the first frame (a killed run; a recovered
+        one, whose run metadata count the frames kept), else the scenario's ``frames_configured``; a parts
+        manifest's frames. Not narrowed to :attr:`frames`."""
+        run = self.run
+        if is_parts_manifest(self.info.path):
+            return self._expected_all()[0]
+        first = int(run.get("first_frame", 0) or 0)
+        if "frames_requested" in run:
+            return range(first, first + int(run.get("frames_requested") or 0))
+        if self.info.planned is not None:
+            start, count = self.info.planned
+            return range(start, start + count)
+        return range(first, first + int(run.get("frames_configured", self.info.frames_configured) or 0))
 
     def expected(self) -> tuple[range, bool]:
         """The frames the run set out to write (those in :attr:`frames` when given) and whether its ``run``

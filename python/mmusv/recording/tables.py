@@ -251,7 +251,7 @@ class TableWriter:
         self.frames = 0
 
 
-ROWS_DIGEST_KEY = "mmusv.rows_sha256"
+ROWS_DIGEST_KEY = "mmusv_rows_sha256"
 """The key of a part's file-level Parquet metadata holding :func:`rows_digest` of the rows written: Parquet's own
 page checksums are optional and Polars writes none, so changed bytes inside a page read back as other numbers
 (a ``range_m`` of 100.49 read as -0.045) without it."""
