@@ -13,8 +13,11 @@ shrinks under a reader must not crash it) and never trusts a length it has not c
   searching forward for the next record that checks out in full (a chunk, metadata, a message index or the data
   end, each with lengths that agree with each other); the bytes in between are one damaged region;
 - a file that ends inside a record (a killed writer, a ``.partial`` file, a truncated copy) yields everything
-  before that record and reports where it ends; the chunk the recorder was writing when it was killed (its length
-  still the placeholder ``2**64 - 1``) is read as far as its zstd stream and records are complete;
+  before that record and reports where it ends; a chunk the file ends inside is read as far as its compressed
+  stream and records are complete (zstd and lz4 decode whole blocks only; a record cut off is never read), without
+  a CRC to check them against: the chunk the recorder was writing when it was killed (its length still the
+  placeholder ``2**64 - 1``) and a closed chunk cut short (an interrupted copy, power loss after its length was
+  filled in), whose header must then agree with its record length;
 - the data section's CRC (in the data end record) is checked as well, so damage outside the chunks (metadata,
   message indexes) is reported too.
 
@@ -79,7 +82,8 @@ class _Bad(Exception):
 class Damage:
     """A damaged or missing region of a file: bytes ``start .. end`` (``end`` = the file size for a file that ends
     inside a record), ``what`` happened, and the log times (ns) of the messages lost there when the damaged
-    chunk's header still says so (``None`` otherwise)."""
+    chunk's header still says so (``None`` otherwise; for a chunk the file ends inside whose first records were
+    read, from the log time of the message cut off, or just after the last one read)."""
 
     start: int
     end: int
@@ -95,6 +99,17 @@ class Damage:
             a, b = (round(t * frequency_hz / 1e9) for t in self.times)
             frames = f" (frame{'s' if a != b else ''} {a}{f'..{b}' if a != b else ''})"
         return f"{where}{frames}: {self.what}"
+
+
+@dataclass
+class _Cut:
+    """What a chunk the file ends inside gave: its complete ``messages`` (in file order), whether it was ``whole``
+    (every record decompressed and read, its CRC checked: the file ends in the compressed stream's last bytes) and
+    the log time of the message record that is cut off, when its header was decompressed (``cut_time``)."""
+
+    messages: list[Any]
+    whole: bool = False
+    cut_time: int | None = None
 
 
 @dataclass
@@ -164,6 +179,44 @@ def _decompress(c: _Chunk) -> bytes:
     if c.crc != 0 and zlib.crc32(raw) != c.crc:
         raise _Bad("CRC mismatch: its records are not the bytes that were written")
     return raw
+
+
+def _decompress_cut(compression: bytes, data: bytes, limit: int) -> bytes:
+    """The records of a chunk whose compressed bytes ``data`` are cut short, as far as they decompress: the zstd or
+    lz4 stream up to its last block that is there in full, uncompressed records as they are; at most ``limit``
+    bytes (and :data:`MAX_CHUNK_BYTES`); nothing for an unknown compression."""
+    limit = min(limit, MAX_CHUNK_BYTES)
+    if compression == b"":
+        return data[:limit]
+    pieces: list[bytes] = []
+    got = 0
+    if compression == b"zstd":
+        import zstandard
+
+        try:
+            with zstandard.ZstdDecompressor().stream_reader(io.BytesIO(data), read_across_frames=True) as r:
+                while got < limit:
+                    piece = r.read(min(1 << 16, limit - got))
+                    if not piece:
+                        break
+                    pieces.append(piece)
+                    got += len(piece)
+        except zstandard.ZstdError:
+            pass  # the stream ends where the file does: keep what decoded
+    elif compression == b"lz4":
+        import lz4.frame
+
+        dec = lz4.frame.LZ4FrameDecompressor()
+        try:
+            for at in range(0, len(data), 1 << 16):
+                if got >= limit or dec.eof:
+                    break
+                piece = dec.decompress(data[at : at + (1 << 16)], max_length=limit - got)
+                pieces.append(piece)
+                got += len(piece)
+        except RuntimeError:
+            pass  # the stream ends where the file does: keep what decoded
+    return b"".join(pieces)[:limit]
 
 
 def _read_record(opcode: int, body: bytes) -> Any:
@@ -355,7 +408,8 @@ class Scan:
             op, n = head[0], _u64(head, 1)
             end = pos + 9 + n
             if op == _CHUNK and n == _OPEN and self.chunks:  # the chunk being written when the writer stopped
-                for rec in self._open_chunk(f, pos):
+                cut = self._cut_chunk(f, pos, n)
+                for rec in [] if cut is None else cut.messages:
                     yield rec, None
                 d = Damage(
                     pos,
@@ -370,18 +424,34 @@ class Scan:
             if op not in _NAMES or end > size:
                 nxt = self._resync(f, pos + 1)
                 if nxt is None and op in _NAMES:
-                    d = Damage(
-                        pos,
-                        size,
+                    what = (
                         f"the file ends inside a {_NAMES[op]} record: it starts at byte {pos} and needs {n + 9} "
-                        f"bytes, {size - pos} are there",
-                        truncated=True,
+                        f"bytes, {size - pos} are there"
                     )
+                    times: tuple[int, int] | None = None
                     f.seek(pos + 9)
                     if op == _CHUNK and size - pos - 9 >= 16:  # the lost frames start here
                         t0, t1 = struct.unpack("<QQ", f.read(16))
                         if t0 <= t1:
-                            d = Damage(d.start, d.end, d.what, (int(t0), int(t1)), truncated=True)
+                            times = (int(t0), int(t1))
+                    cut = self._cut_chunk(f, pos, n) if op == _CHUNK and self.chunks else None
+                    if cut is not None and cut.messages:  # an interrupted copy, power loss after the length was set
+                        for rec in cut.messages:
+                            yield rec, None
+                        if cut.whole:
+                            what += "; every record of the chunk was read, its CRC checks"
+                            times = None
+                        else:
+                            what += (
+                                f"; its {len(cut.messages)} complete messages before the cut were read, without the "
+                                "chunk's CRC to check them against"
+                            )
+                            # the messages lost: from the one cut off when its header was read, else after the
+                            # last one read (whether that frame is whole is then up to the reader of its topics)
+                            last = max(int(m.log_time) for m in cut.messages)
+                            first = cut.cut_time if cut.cut_time is not None else last + 1
+                            times = (first, times[1]) if times is not None and first <= times[1] else None
+                    d = Damage(pos, size, what, times, truncated=True)
                     self.damage.append(d)
                     yield None, d
                     return
@@ -489,57 +559,64 @@ class Scan:
                 return
             pos = end
 
-    def _open_chunk(self, f: IO[bytes], pos: int) -> list[Any]:
-        """The complete messages of a chunk whose writer was killed (see :data:`_OPEN`): its zstd stream
-        decompressed as far as it goes (at most :data:`MAX_CHUNK_BYTES`), its records read up to the first one cut
-        off; schemas and channels are taken in as they come."""
+    def _cut_chunk(self, f: IO[bytes], pos: int, n: int) -> _Cut | None:
+        """The complete records of the chunk record at ``pos`` (record length ``n``) that the file ends inside: its
+        compressed stream decompressed as far as it goes (:func:`_decompress_cut`), its records read up to the
+        first one cut off; schemas and channels are taken in as they come. ``n`` is :data:`_OPEN` for the chunk a
+        killed writer was writing (whose other lengths and CRC are placeholders too); a closed chunk's header must
+        agree with ``n`` and name a known compression, and the records are read up to its uncompressed size.
+        ``None`` when its header is cut off or does not check out, or when it decompresses in full but its CRC
+        does not match (its records are damaged, not just cut off)."""
         f.seek(pos + 9)
-        body = f.read(self.size - pos - 9)
+        body = f.read(min(n, self.size - pos - 9))
         if len(body) < 40:
-            return []
+            return None
         clen = _u32(body, 28)
         if clen > 16 or len(body) < 40 + clen:
-            return []
+            return None
         comp, data = body[32 : 32 + clen], body[40 + clen :]
-        raw = b""
-        if comp == b"zstd":
-            import zstandard
-
-            pieces: list[bytes] = []
-            got = 0
-            try:
-                with zstandard.ZstdDecompressor().stream_reader(io.BytesIO(data), read_across_frames=True) as r:
-                    while got < MAX_CHUNK_BYTES:
-                        piece = r.read(1 << 16)
-                        if not piece:
-                            break
-                        pieces.append(piece)
-                        got += len(piece)
-            except zstandard.ZstdError:
-                pass  # the stream ends where the writer stopped: keep what decoded
-            raw = b"".join(pieces)
-        elif comp == b"":
-            raw = data
-        out: list[Any] = []
+        limit = MAX_CHUNK_BYTES
+        usize = crc = 0
+        if n != _OPEN:
+            t0, t1, usize, crc = struct.unpack_from("<QQQI", body, 0)
+            if (
+                comp not in (b"", b"lz4", b"zstd")
+                or 40 + clen + _u64(body, 32 + clen) != n
+                or usize > MAX_CHUNK_BYTES
+                or t0 > t1
+            ):
+                return None
+            limit = int(usize)
+        raw = _decompress_cut(comp, data, limit)
+        whole = n != _OPEN and len(raw) == usize
+        if whole and crc != 0 and zlib.crc32(raw) != crc:
+            return None
+        found: list[tuple[int, Any]] = []
         at = 0
+        cut_time = None
         while at + 9 <= len(raw):
-            op, n = raw[at], _u64(raw, at + 1)
-            if at + 9 + n > len(raw):
+            op, m = raw[at], _u64(raw, at + 1)
+            if at + 9 + m > len(raw):
+                if op == _MESSAGE and at + 9 + 14 <= len(raw):  # the message cut off: channel, sequence, log time
+                    cut_time = _u64(raw, at + 9 + 6)
                 break
-            rec: Any = None
             try:
                 if op in (_SCHEMA, _CHANNEL, _MESSAGE):
-                    rec = _read_record(op, raw[at + 9 : at + 9 + n])
-            except _Bad:
+                    found.append((op, _read_record(op, raw[at + 9 : at + 9 + m])))
+            except _Bad:  # read up to here; a chunk whose CRC was checked is damaged, as one not cut off is
+                if whole:
+                    return None
                 break
+            at += 9 + m
+        out: list[Any] = []
+        for op, rec in found:
             if op == _SCHEMA:
                 self.schemas[rec.id] = rec
             elif op == _CHANNEL:
                 self.channels[rec.id] = rec
-            elif op == _MESSAGE:
+            else:
                 out.append(rec)
-            at += 9 + n
-        return out
+        return _Cut(out, whole=whole and at == len(raw), cut_time=cut_time)
 
     def _footer(self, f: IO[bytes]) -> None:
         size = self.size
