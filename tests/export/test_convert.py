@@ -70,6 +70,8 @@ def test_cli_errors_are_one_line(coop_rec: Path, tmp_path: Path) -> None:
         with pytest.raises(kind) as exc:
             export_cli.run(parse([*argv, "--no-progress"]))
         assert isinstance(exc.value, MmusvError) and "\n" not in str(exc.value)
+    with pytest.raises(ConfigError, match=r"^-o/--output is empty"):  # it named the API's out_dir
+        export_cli.run(parse([str(coop_rec), "-o", "", "--no-progress"]))
 
 
 def test_cli_converts(coop_rec: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -140,6 +140,7 @@ def run(args: argparse.Namespace) -> int:
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
     from mmusv.cli_console import rich_console
+    from mmusv.cli_paths import output_arg
     from mmusv.export.common import BOXES, TARGETS
     from mmusv.export.conversion import convert
     from mmusv.export.kitti_oxts import parse_origin
@@ -151,6 +152,7 @@ def run(args: argparse.Namespace) -> int:
             f"unknown --box {args.box!r}; allowed: visible (the tight box of the vessel's visible pixels, the default) "
             "or projected (the recording's box: the projected 3D box's part in the image)"
         )
+    output_arg(args.output)  # named as the flag, not as the API's out_dir
     origin = None
     if args.oxts_origin is not None:  # checked here, so that the message names the option as typed
         if args.to != "kitti_tracking":  # (before its value, as the API checks it)
