@@ -371,3 +371,19 @@ def test_two_conversions_into_one_folder_at_once(coop_rec: Path, tmp_path: Path)
     for r in refused:
         assert "is being written by another mmusv convert" in str(r), r
     assert tree(out) == tree(tmp_path / "ref")
+
+
+def test_frames_lost_to_damage_in_a_complete_run_are_said_lost_not_absent(coop_rec: Path, tmp_path: Path) -> None:
+    """A damaged chunk of a finished run: its frames were said "not in the recording (run complete: 3 of 3 frames
+    written)", which the run says they are."""
+    small = tmp_path / "export_coop.mcap"
+    rechunk(coop_rec, small, 64 * 1024)
+    data = bytearray(small.read_bytes())
+    at = len(data) // 2
+    data[at : at + 64] = bytes(b ^ 0xFF for b in data[at : at + 64])
+    small.write_bytes(bytes(data))
+    rep = convert(small, out_dir=tmp_path / "o", splits=None, extras=())
+    skipped = rep.recordings[0].skipped
+    assert 0 < rep.frames < 3 and skipped, skipped
+    lost = [s for s in skipped if s["reason"].startswith("lost from the recording (run complete: 3 of 3 frames")]
+    assert lost and not [s for s in skipped if "not in the recording" in s["reason"]], skipped

@@ -367,8 +367,12 @@ def convert(
                 absent = [k for k in span if k not in seen and options.wants_frame(k)]
                 if absent:
                     written = stream.run.get("frames_written")
+                    # every frame written, yet some not read: lost to damage or a cut (it said "not in the recording
+                    # (run complete: 6 of 6 frames written)")
+                    lost = written is not None and str(written).isdigit() and int(written) >= configured
                     why = (
-                        f"not in the recording (run {rep.status}: {written} of {counted(configured, 'frame')} written)"
+                        f"{'lost from' if lost else 'not in'} the recording (run {rep.status}: {written} of "
+                        f"{counted(configured, 'frame')} written)"
                         if written is not None
                         else "not in the recording (the run did not finish; it set out to write "
                         f"{counted(configured, 'frame')})"
