@@ -143,14 +143,16 @@ def parser() -> argparse.ArgumentParser:
     info.add_argument(
         "recording",
         help="an .mcap (or .mcap.partial, .parts.json) written by mmusv run, or its folder; a folder of run folders "
-        "(a batch's output, links to run folders followed): one row per recording below; exits 1 when one of them "
-        "cannot be read at all",
+        "(a batch's output, links to run folders followed): one row per recording below, and one per recording its "
+        "dataset.json or a run's manifest.json names that is gone; exits 1 when one of them is gone, cannot be read "
+        "at all or holds no readable frame",
     )
     rec = sub.add_parser(
         "recover",
-        help="finish the .partial recording of a killed run into a valid MCAP (summary, index) and rebuild its tables",
+        help="finish the .partial recording of a killed run into a valid MCAP (summary, index) and rebuild its "
+        "tables; for a finished run, rebuild its tables when they are missing or damaged",
     )
-    rec.add_argument("target", help="the run folder (holding NAME.mcap.partial) or the .partial file")
+    rec.add_argument("target", help="the run folder (holding NAME.mcap.partial, or a finished NAME.mcap) or the file")
     rec.add_argument("--overwrite", action="store_true", help="replace an existing NAME.mcap")
     prev = sub.add_parser("preview", help="one picture of a recorded frame (surround RGB, depth, semantic, PPI, BEV)")
     prev.add_argument("recording", help="an .mcap (or .mcap.partial, .parts.json) written by mmusv run")

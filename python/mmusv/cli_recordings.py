@@ -8,11 +8,15 @@ from __future__ import annotations
 import argparse
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from mmusv.cli_console import rich_console
 from mmusv.cli_paths import output_arg, path_arg
 from mmusv.errors import MmusvError
 from mmusv.text import counted
+
+if TYPE_CHECKING:
+    from mmusv.recording.info import MissingRecording
 
 __all__ = ["cmd_info", "cmd_preview", "cmd_recover"]
 
@@ -22,7 +26,7 @@ def cmd_info(args: argparse.Namespace) -> int:
     from rich.text import Text
 
     from mmusv.recording import summary
-    from mmusv.recording.info import find_recordings, recording_name
+    from mmusv.recording.info import find_recordings, missing_recordings, recording_name
 
     target = Path(path_arg(args.recording, flag="recording"))
     folder: Path | None = None
@@ -32,8 +36,15 @@ def cmd_info(args: argparse.Namespace) -> int:
         found = found or sorted(target.glob("*.mcap.partial"))
         if not found:
             below = find_recordings(target, unfinished=True)
-            if below:  # a batch's output folder: one line per recording
-                return _overview(target, below)
+            gone = missing_recordings(target)
+            own = [m for m in gone if m.path.parent == target]
+            if own and not below:  # a run folder whose recording is gone
+                raise MmusvError(
+                    f"{target} is a folder without a recording: {own[0].path.name} is gone, though "
+                    + " and ".join(f"{by.name} names it ({what})" for by, what in own[0].named_by)
+                )
+            if below or gone:  # a batch's output folder: one line per recording
+                return _overview(target, below, gone)
             raise MmusvError(f"{target} is a folder without a recording (*.mcap, *.mcap.partial or *.parts.json)")
         if len(found) > 1:
             raise MmusvError(f"{target} holds {len(found)} recordings ({', '.join(f.name for f in found)}); name one")
@@ -85,10 +96,16 @@ def cmd_info(args: argparse.Namespace) -> int:
     problems = [frames["report"]] if frames and frames.get("report") else list(info.get("damage", []))
     if info.get("metadata_problem"):  # "unreadable ... metadata (...)": it was shown as a file of another program
         problems.insert(0, info["metadata_problem"])
+    rebuild: list[Path] = []
     if folder is not None and frames:
-        problems += _table_problems(target, frames)
+        tables, rebuild = _table_problems(target, frames)
+        problems += tables
     for line in problems:
         console.print(f"mmusv: warning: {line}", markup=False, highlight=False, style="yellow")
+    for run_folder in rebuild:
+        console.print(
+            f"`mmusv recover {run_folder}` rebuilds the tables from the recording", markup=False, highlight=False
+        )
     if target.name.endswith(".mcap.partial"):
         if frames and frames.get("read"):
             console.print(
@@ -121,10 +138,13 @@ def _agents_of(meta: dict[str, dict[str, str]]) -> str:
     return ",".join(map(str, sensors)) if isinstance(sensors, dict) and sensors else "?"
 
 
-def _overview(folder: Path, found: list[Path]) -> int:
-    """``mmusv info`` on a folder of recordings: one row each (scenario, status, frames, agents, problems). Exits 1
-    when a recording cannot be read at all (``mmusv info`` on it alone is an error too); a damaged or unfinished one
-    that reads is a row with its problems, as ``mmusv info`` on it alone warns and exits 0."""
+def _overview(folder: Path, found: list[Path], gone: list[MissingRecording]) -> int:
+    """``mmusv info`` on a folder of recordings: one row each (scenario, status, frames, agents, problems), and one
+    for each recording that a ``dataset.json`` or a run's ``manifest.json`` below names but that is gone
+    (:func:`~mmusv.recording.info.missing_recordings`). Exits 1 when a recording is gone, cannot be read at all
+    (``mmusv info`` on it alone is an error too) or holds no readable frame (a killed run's ``.partial`` of none,
+    a file damaged throughout): a dataset to convert or study lacks it. A damaged or unfinished one that reads is
+    a row with its problems, as ``mmusv info`` on it alone warns and exits 0."""
     from rich.table import Table
     from rich.text import Text
 
@@ -134,12 +154,26 @@ def _overview(folder: Path, found: list[Path]) -> int:
         text = "; ".join(problems).replace(f"{folder}{os.sep}", "").removeprefix(f"{name}: ")
         return text if len(text) <= 100 else text[:99] + "…"
 
+    def rel(p: Path) -> str:
+        try:
+            return str(p.relative_to(folder))
+        except ValueError:
+            return str(p)
+
     closed = [rec for rec in found if rec.is_dir()]  # folders below that could not be searched (find_recordings)
     title = f"{counted(len(found) - len(closed), 'recording')} below {folder}"
+    title += f", {len(gone)} missing" if gone else ""
     table = Table(title=Text(title + (f", {counted(len(closed), 'folder')} that cannot be read" if closed else "")))
     for col in ("recording", "scenario", "status", "frames", "agents", "problems"):
         table.add_column(col, overflow="fold")
-    troubled = unreadable = 0
+    troubled = unreadable = empty = 0
+    rows: list[tuple[str, tuple[str, ...]]] = []
+    for m in gone:
+        name = rel(m.path)
+        named = " and ".join(f"{rel(by)} ({what})" for by, what in m.named_by)
+        count = "?" if m.frames_requested is None else f"0 of {m.frames_requested}"
+        why = f"gone; named by {named}"
+        rows.append((name, (name, m.scenario or "?", "missing", count, ",".join(m.agents) or "?", short(name, [why]))))
     for rec in found:
         name = str(rec.relative_to(folder))
         if rec in closed:
@@ -149,28 +183,31 @@ def _overview(folder: Path, found: list[Path]) -> int:
                 why = "the folder could not be read when it was searched (it can now: run again)"
             except OSError as exc:
                 why = f"cannot read the folder: {exc.strerror or type(exc).__name__}"
-            table.add_row(*map(Text, (name, "?", "unreadable", "?", "?", why)))
+            rows.append((name, (name, "?", "unreadable", "?", "?", why)))
             continue
         try:
             info = summary(rec)
         except MmusvError as exc:
             troubled += 1
             unreadable += 1
-            table.add_row(*map(Text, (name, "?", "unreadable", "?", "?", short(name, [str(exc)]))))
+            rows.append((name, (name, "?", "unreadable", "?", "?", short(name, [str(exc)]))))
             continue
         meta = info.get("metadata", {})
         run_meta = meta.get("run", {})
         frames = info.get("frames") or {}
         if info.get("frames") is None:
             troubled += 1
-            problem = short(name, [info.get("metadata_problem") or ""])
-            table.add_row(*map(Text, (name, "?", "not a recording of mmusv run", "?", "?", problem)))
+            hurt = [info["metadata_problem"]] if info.get("metadata_problem") else list(info.get("damage", []))
+            if hurt and not info.get("messages"):  # damaged throughout: not one message reads
+                empty += 1
+            rows.append((name, (name, "?", "not a recording of mmusv run", "?", "?", short(name, hurt))))
             continue
         problems = [frames["report"]] if frames.get("report") else list(info.get("damage", []))
-        problems += _table_problems(rec, frames)
+        problems += _table_problems(rec, frames)[0]
         troubled += bool(problems) or not info.get("complete", True)
         read, expected = frames.get("read"), frames.get("expected")
-        cells = (
+        empty += not read and bool(expected)
+        cells: tuple[str, ...] = (
             name,
             str(run_meta.get("scenario") or _scenario_of(meta, rec)),
             str(run_meta.get("status", "unfinished")),
@@ -178,6 +215,8 @@ def _overview(folder: Path, found: list[Path]) -> int:
             str(run_meta.get("agents") or _agents_of(meta)),
             short(name, problems),
         )
+        rows.append((name, cells))
+    for _name, cells in sorted(rows, key=lambda r: Path(r[0])):  # (the order of find_recordings)
         table.add_row(*map(Text, cells))  # Text: a name like a[/b] is no markup
     console = rich_console()
     console.print(table)
@@ -187,18 +226,34 @@ def _overview(folder: Path, found: list[Path]) -> int:
             markup=False,
             highlight=False,
         )
+    if empty:
+        console.print(
+            f"{counted(empty, 'recording')} {'holds' if empty == 1 else 'hold'} no readable frame",
+            markup=False,
+            highlight=False,
+        )
+    if gone:
+        console.print(
+            f"{counted(len(gone), 'recording')} missing: named by the batch's dataset.json or its run's manifest.json, "
+            "but not there (a batch re-run records it again)",
+            markup=False,
+            highlight=False,
+        )
     if closed:
         console.print(
             f"{counted(len(closed), 'folder')} below cannot be read: the recordings in it are not listed",
             markup=False,
             highlight=False,
         )
-    return 1 if unreadable else 0
+    return 1 if unreadable or empty or gone else 0
 
 
-def _table_problems(recording: Path, frames: dict[str, object]) -> list[str]:
-    """What is wrong with the Parquet tables beside ``recording`` (damaged parts, frames without rows): those of
-    its run folder, or for a parts manifest those of each recorded part's folder."""
+def _table_problems(recording: Path, frames: dict[str, object]) -> tuple[list[str], list[Path]]:
+    """What is wrong with the Parquet tables beside ``recording`` (a missing folder, damaged parts, frames without
+    rows): those of its run folder, or for a parts manifest those of each recorded part's folder; and the run
+    folders whose tables ``mmusv recover`` rebuilds from their finished recording (a ``.partial``'s recovery
+    rebuilds them anyway; none where the recording lacks frames whose rows the tables still hold, which recover
+    refuses to lose)."""
     from mmusv.recording.parts import is_parts_manifest, part_files
 
     missing = set(frames.get("missing", []))  # type: ignore[call-overload]
@@ -206,29 +261,39 @@ def _table_problems(recording: Path, frames: dict[str, object]) -> list[str]:
         first = frames.get("first", 0)
         expected = frames.get("expected")
         span = range(first, first + expected) if isinstance(first, int) and isinstance(expected, int) else None
-        return _tables_of(recording.parent / "tables", span, missing)
-    out = []
+        return _tables_of(recording, span, missing)
+    out: list[str] = []
+    rebuild: list[Path] = []
     for first, stop, f in part_files(recording):
         if f is not None:  # a part not recorded yet: its frames are said missing above
-            out += _tables_of(f.parent / "tables", range(first, stop), missing)
-    return out
+            lines, folders = _tables_of(f, range(first, stop), missing)
+            out += lines
+            rebuild += folders
+    return out, rebuild
 
 
-def _tables_of(tables: Path, span: range | None, missing: set[int]) -> list[str]:
-    from mmusv.recording.tables import SCHEMAS, read_table
+def _tables_of(recording: Path, span: range | None, missing: set[int]) -> tuple[list[str], list[Path]]:
+    from mmusv.recording.info import recording_name
+    from mmusv.recording.recover import check_tables, listed_tables
 
-    if not tables.is_dir():
-        if span is not None and all(k in missing for k in span):  # no frame recorded, so no table either
-            return []
-        return [f"{tables} does not exist (a run killed before its first table flush; `mmusv recover` rebuilds it)"]
-    out = []
-    for name in SCHEMAS:
-        got = read_table(tables, name, expected=span if name == "world_state" else None)
-        got.missing = [k for k in got.missing if k not in missing]  # frames the recording lacks too: said above
-        line = got.report()
-        if line is not None:
-            out.append(line)
-    return out
+    tables = recording.parent / "tables"
+    try:
+        problems, held = check_tables(tables, span, missing, listed=listed_tables(recording.parent, recording.name))
+    except MmusvError as exc:  # a tables folder that holds no tables (read_table says what it holds)
+        return [str(exc)], []
+    partial = recording.name.endswith(".partial")
+    if problems and problems[0].startswith(f"{tables} does not exist"):
+        why = (
+            f"a run killed before its first table flush; `mmusv recover {recording.parent}` rebuilds it"
+            if partial
+            else f"`mmusv recover {recording.parent}` rebuilds it from {recording_name(recording)}.mcap"
+        )
+        problems[0] += f" ({why})"
+        return problems, []
+    rebuilds = (  # as recover does: a finished recording of some frame, beside a tables folder it may replace
+        bool(problems) and not partial and not held and tables.is_dir() and any(k not in missing for k in span or ())
+    )
+    return problems, [recording.parent] if rebuilds else []
 
 
 def cmd_recover(args: argparse.Namespace) -> int:

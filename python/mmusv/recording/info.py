@@ -35,9 +35,11 @@ if TYPE_CHECKING:
 __all__ = [
     "AgentInfo",
     "CameraInfo",
+    "MissingRecording",
     "RecordingInfo",
     "check_mcap",
     "find_recordings",
+    "missing_recordings",
     "read_info",
     "recording_name",
 ]
@@ -240,6 +242,93 @@ def find_recordings(folder: str | os.PathLike[str], *, unfinished: bool = False)
         [f for f in files if f.name.endswith(".mcap.partial") and not f.with_suffix("").exists()] if unfinished else []
     )
     return sorted([*manifests, *mcaps, *(f for f in partial if f.resolve() not in parts), *(c for c, _ in closed)])
+
+
+@dataclass(frozen=True)
+class MissingRecording:
+    """A recording that a file below a folder names but that is not there (:func:`missing_recordings`): ``path``
+    where it should be; ``named_by``, each file naming it with what it says (``(dataset.json, "c: status
+    complete")``); the scenario, agents and frames that file gives, when it does."""
+
+    path: Path
+    named_by: tuple[tuple[Path, str], ...]
+    scenario: str | None = None
+    agents: tuple[str, ...] = ()
+    frames_requested: int | None = None
+
+
+def missing_recordings(folder: str | os.PathLike[str]) -> list[MissingRecording]:
+    """The recordings that are named below ``folder`` but gone (``mmusv info`` on a batch's folder lists them: left
+    out, a batch looked whole where a run had lost its recording): those a batch's ``dataset.json`` lists as
+    ``complete`` (what ``mmusv convert`` reads, and refuses when one is gone) and those a run folder's
+    ``manifest.json`` names (written once the run has its recording), each neither there nor as its ``.partial``
+    (a broken link is there: its reader says what is wrong). Sorted by path; a file naming it that is not an index
+    or a manifest of mmusv, or names nothing below its folder, is passed over. ``folder`` as for
+    :func:`find_recordings` (folders below that cannot be read are skipped: that lists them)."""
+    root = arguments.path(folder, name="folder")
+    if not root.is_dir():
+        return []
+    files, _closed = _files_below(root)
+    found: dict[Path, MissingRecording] = {}
+
+    def note(path: Path, by: Path, what: str, doc: dict[str, Any]) -> None:
+        if os.path.lexists(path) or (path.suffix == ".mcap" and os.path.lexists(f"{path}.partial")):
+            return
+        key = Path(os.path.realpath(path.parent)) / path.name  # (named by the index and, through a link, its run)
+        agents, frames = doc.get("agents"), doc.get("frames_requested")
+        this = MissingRecording(
+            path=path,
+            named_by=((by, what),),
+            scenario=_text(doc.get("scenario")),
+            agents=tuple(map(str, agents)) if isinstance(agents, list) else (),
+            frames_requested=frames if isinstance(frames, int) and not isinstance(frames, bool) else None,
+        )
+        had = found.get(key)
+        found[key] = (
+            this
+            if had is None
+            else MissingRecording(
+                path=had.path,
+                named_by=had.named_by + this.named_by,
+                scenario=had.scenario or this.scenario,
+                agents=had.agents or this.agents,
+                frames_requested=this.frames_requested if had.frames_requested is None else had.frames_requested,
+            )
+        )
+
+    for f in files:
+        if f.name not in ("dataset.json", "manifest.json"):
+            continue
+        try:
+            doc = json.loads(f.read_bytes())
+        except (OSError, ValueError):
+            continue
+        if not isinstance(doc, dict):
+            continue
+        if f.name == "manifest.json":
+            rec = doc.get("recording")
+            if _plain_name(rec) and isinstance(doc.get("status"), str):
+                note(f.parent / str(rec), f, f"status {doc['status']}", doc)
+            continue
+        entries = doc.get("recordings") if doc.get("format") == "mmusv.dataset" else None
+        for r in entries if isinstance(entries, list) else []:
+            rel = r.get("recording") if isinstance(r, dict) else None
+            if not isinstance(r, dict) or r.get("status") != "complete" or not isinstance(rel, str):
+                continue
+            parts = Path(rel).parts
+            if not parts or Path(rel).is_absolute() or ".." in parts or "\\" in rel:
+                continue
+            note(f.parent / rel, f, f"{r.get('name')}: status complete", r)
+    return sorted(found.values(), key=lambda m: str(m.path))
+
+
+def _plain_name(name: object) -> bool:
+    """Whether ``name`` is a file name (no folder, not ``.`` or ``..``)."""
+    return isinstance(name, str) and name not in ("", ".", "..") and "/" not in name and "\\" not in name
+
+
+def _text(value: object) -> str | None:
+    return value if isinstance(value, str) and value else None
 
 
 def _files_below(root: Path) -> tuple[list[Path], list[tuple[Path, str]]]:

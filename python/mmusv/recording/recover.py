@@ -13,28 +13,44 @@ turns it into what a stopped run leaves:
    parts as the run would have written: :data:`mmusv.acquire.TABLE_PART_FRAMES` frames per part), replacing any
    table parts the killed run left;
 4. writes ``manifest.json`` (status ``interrupted``, so a batch re-run records the scenario again) and removes the
-   ``.partial`` once everything else is in place. Each file is written under a temporary name and renamed.
+   ``.partial`` once everything else is in place. The recording is written as ``<name>.mcap.recovering`` and the
+   tables in ``tables.rebuilding``; both are put in place together at the end (a Ctrl-C or SIGTERM then waits
+   until they are), and an error or a stop before that removes them: the folder is left as it was.
 
 The messages keep their bytes; the file around them differs from the recorder's (another writer), so a
 recovered recording is not byte-identical to an unbroken run's, but decodes to the same messages frame by frame.
+
+Given a finished run (a folder without a ``.partial``, or its ``.mcap``), :func:`recover` rebuilds its tables when
+they are missing or damaged (:func:`rebuild_finished_tables`; :func:`check_tables` says what is wrong, as ``mmusv
+info`` does): from a whole recording they are the bytes the run wrote. Whole tables are left alone ("nothing to
+recover"), and so are tables holding rows of frames that a damaged recording lacks (a rebuild would lose them).
 """
 
 from __future__ import annotations
 
 import os
 import shutil
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from mmusv.errors import IoError
-from mmusv.recording.info import RecordingInfo, another_run, check_mcap, read_info
+from mmusv.recording.info import RecordingInfo, another_run, check_mcap, read_info, recording_arg
 from mmusv.recording.scan import Scan
 from mmusv.recording.stream import FrameStream
 from mmusv.recording.tables import BOX_3D_VECTORS, WORLD_STATE_VECTORS, TableWriter, spread_columns
 from mmusv.text import counted
 
-__all__ = ["Recovered", "find_partial", "rebuild_tables", "recover"]
+__all__ = [
+    "Recovered",
+    "check_tables",
+    "find_partial",
+    "listed_tables",
+    "rebuild_finished_tables",
+    "rebuild_tables",
+    "recover",
+]
 
 _CHUNK_BYTES = 4 << 20
 
@@ -43,7 +59,8 @@ _CHUNK_BYTES = 4 << 20
 class Recovered:
     """What :func:`recover` did: the recording written, the ``.partial`` it came from, the frames kept (of those
     the scenario configures, and of those the run set out to write), frames left out as incomplete (with why), the
-    damage met and the tables folder."""
+    damage met and the tables folder; for a finished recording whose tables it rebuilt, what was wrong with them
+    (:attr:`tables_only`)."""
 
     recording: Path
     source: Path
@@ -54,12 +71,24 @@ class Recovered:
     tables: Path | None = None
     frames_requested: int | None = None
     """The frames the run set out to write (``mmusv run --frames N``), when the recording says so."""
+    tables_only: list[str] = field(default_factory=list)
+    """For a finished recording whose tables were rebuilt (:func:`rebuild_finished_tables`; ``source`` is then the
+    recording itself): what was wrong with them, one line each. Empty when a ``.partial`` was finished."""
 
     def lines(self) -> list[str]:
         """What to tell the user, one line each."""
         from mmusv.recording.stream import frame_ranges
 
         got = f"frames {frame_ranges(self.frames)}" if self.frames else "no complete frame"
+        if self.tables_only:
+            return [
+                f"rebuilt the tables of {self.recording} ({len(self.frames)} of "
+                f"{counted(self.frames_requested or self.frames_configured, 'frame')}, {got}) in {self.tables}: "
+                "the recording is finished, its tables were missing or damaged",
+                *(f"before: {line}" for line in self.tables_only),
+                *(f"left out frame {k}: {why}" for k, why in self.incomplete),
+                *(f"damage: {d}" for d in self.damage),
+            ]
         out = [
             f"recovered {len(self.frames)} of {counted(self.frames_requested or self.frames_configured, 'frame')} "
             f"({got}) from "
@@ -207,16 +236,37 @@ def rebuild_tables(
     """Writes the Parquet tables of every complete frame of ``recording`` into ``tables_dir`` (replacing the parts
     there): ``world_state`` from ``/world/state``, ``boxes_3d`` and ``boxes_2d`` from each agent's
     ``/<agent>/annotations``, roles from the world state and static flags from the recorded scenario; parts end
-    at the frames where a run flushes them. With ``keep_if_empty``, a recording without one complete frame leaves
-    ``tables_dir`` as it was. Returns the stream that read it (its damage and missing frames)."""
+    at the frames where a run flushes them, so the parts of a whole recording are the bytes its run wrote. With
+    ``keep_if_empty``, a recording without one complete frame leaves ``tables_dir`` as it was. The tables are
+    built beside ``tables_dir`` first (``<tables_dir>.rebuilding``, removed whatever happens), so an error or a
+    stop while they are built leaves ``tables_dir`` as it was. Returns the stream that read it (its damage and
+    missing frames)."""
+    root = Path(tables_dir)
+    staged = _staging(root)
+    try:
+        stream = _stage_tables(recording, staged)
+        if not (keep_if_empty and not stream.yielded):
+            _install_tables(staged, root)
+    finally:
+        shutil.rmtree(staged, ignore_errors=True)
+    return stream
+
+
+def _staging(root: Path) -> Path:
+    """The folder the tables of ``root`` are built in before they replace its parts (emptied first)."""
+    staged = root.with_name(root.name + ".rebuilding")
+    shutil.rmtree(staged, ignore_errors=True)
+    return staged
+
+
+def _stage_tables(recording: str | os.PathLike[str], staged: Path) -> FrameStream:
+    """The tables of every complete frame of ``recording`` written into the folder ``staged`` (see
+    :func:`rebuild_tables`); the stream that read it."""
     from mmusv.acquire import TABLE_PART_FRAMES
 
     info = read_info(Path(recording))
     static = _static_flags(info)
-    root = Path(tables_dir)
-    tmp = root.with_name(root.name + ".rebuilding")
-    shutil.rmtree(tmp, ignore_errors=True)
-    tables = TableWriter(tmp)
+    tables = TableWriter(staged)
     stream = FrameStream(info, _want)
     try:
         for fr in stream:
@@ -233,36 +283,94 @@ def rebuild_tables(
             if (fr.index + 1) % TABLE_PART_FRAMES == 0:
                 tables.flush()
         tables.flush()
-        if keep_if_empty and not stream.yielded:
-            return stream
-        for old in sorted(root.glob("*/part-*.parquet")):
-            old.unlink()
-        for new in sorted(tmp.glob("*/part-*.parquet")):
-            dest = root / new.parent.name / new.name
-            dest.parent.mkdir(parents=True, exist_ok=True)
-            os.replace(new, dest)
     except OSError as exc:
-        raise IoError(f"cannot write the tables into {root}: {exc.strerror or exc}") from None
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
+        raise IoError(f"cannot write the tables into {staged}: {exc.strerror or exc}") from None
     return stream
 
 
+def _install_tables(staged: Path, root: Path) -> None:
+    """Replaces the table parts of ``root`` with those built in ``staged``; a stop meanwhile waits until it is
+    done (half the old parts and half the new were no tables of anything)."""
+    from mmusv.held_signals import HeldSignals
+
+    try:
+        with HeldSignals():
+            for old in sorted(root.glob("*/part-*.parquet")):
+                old.unlink()
+            for new in sorted(staged.glob("*/part-*.parquet")):
+                dest = root / new.parent.name / new.name
+                dest.parent.mkdir(parents=True, exist_ok=True)
+                os.replace(new, dest)
+    except OSError as exc:
+        raise IoError(f"cannot write the tables into {root}: {exc.strerror or exc}") from None
+
+
+def check_tables(
+    tables: str | os.PathLike[str], frames: range | None, lacking: Collection[int] = (), *, listed: Sequence[str] = ()
+) -> tuple[list[str], list[int]]:
+    """What is wrong with the tables folder ``tables`` of a run whose recording holds the frames ``frames`` (the
+    run's; ``None``: not known) but ``lacking`` (damaged or never written): ``(problems, held)``, one line per
+    problem (a missing folder, a damaged part, frames without ``world_state`` rows, a table ``listed`` in the
+    run's ``manifest.json`` whose folder is gone; ``[]`` when the tables are whole), and the frames of ``lacking``
+    that readable parts still hold rows of (tables rebuilt from the recording would lose them). A folder without
+    tables where the recording holds no frame is whole. A ``tables`` that is not a tables folder at all (a folder
+    of other things): :class:`~mmusv.errors.IoError`, as :func:`~mmusv.recording.tables.read_table` says."""
+    from mmusv.recording.tables import SCHEMAS, read_table
+
+    root = Path(tables)
+    lack = set(lacking)
+    if not root.is_dir():
+        if frames is not None and all(k in lack for k in frames):  # no frame recorded, so no table either
+            return [], []
+        return [f"{root} {'is not a folder' if root.exists() or root.is_symlink() else 'does not exist'}"], []
+    problems: list[str] = []
+    held: set[int] = set()
+    for name in SCHEMAS:
+        got = read_table(root, name, expected=frames if name == "world_state" else None)
+        got.missing = [k for k in got.missing if k not in lack]  # frames the recording lacks too: said there
+        line = got.report()
+        if line is None and name in listed and not (root / name).is_dir():
+            line = f"table {name}: {root / name} does not exist (manifest.json lists it)"
+        if line is not None:
+            problems.append(line)
+        if lack and got.rows.height:
+            held |= lack & {int(k) for k in got.rows["frame"].unique().to_list()}
+    return problems, sorted(held)
+
+
+def listed_tables(folder: Path, recording: str) -> list[str]:
+    """The tables the run's ``manifest.json`` in ``folder`` lists, when it is the manifest of ``recording`` (a file
+    name); else none."""
+    import json
+
+    try:
+        manifest = json.loads((folder / "manifest.json").read_bytes())
+    except (OSError, ValueError):
+        return []
+    if not isinstance(manifest, dict) or manifest.get("recording") != recording:
+        return []
+    names = manifest.get("tables")
+    return [str(n) for n in names if isinstance(n, str)] if isinstance(names, list) else []
+
+
 def recover(target: str | os.PathLike[str], *, overwrite: bool = False) -> Recovered:
-    """Finishes the ``.partial`` recording of ``target`` (a run folder or the file; see the module docstring).
+    """Finishes the ``.partial`` recording of ``target`` (a run folder or the file; see the module docstring), or,
+    for a finished recording (a run folder without a ``.partial``, or the ``.mcap``), rebuilds its tables when they
+    are missing or damaged (:func:`rebuild_finished_tables`). An error or a stop (Ctrl-C, SIGTERM) on the way
+    leaves the folder as it was: the recording and tables are written under temporary names, removed then, and
+    put in place together at the end (a stop then waits until that is done).
 
     Raises:
         IoError: nothing to recover, the finished name exists (without ``overwrite``), the file is not a
             recording of ``mmusv run``, or the folder cannot be written.
     """
-    from mcap.writer import CompressionType, Writer
-
-    src = find_partial(target)
+    src = _recover_target(target)
+    if not src.name.endswith(".partial"):
+        return rebuild_finished_tables(src)
     final = src.with_name(src.name[: -len(".partial")])
     if final.exists() and not overwrite:
         raise IoError(f"{final} already exists; pass --overwrite to replace it with the recovery of {src.name}")
     info = read_info(src)
-    planned = info.planned[1] if info.planned is not None else info.frames_configured
     folder = src.parent
     other = None if overwrite else another_run(folder, final.name)
     if other is not None:  # its tables and manifest.json would be rebuilt from this one's: the other run's lost
@@ -271,9 +379,130 @@ def recover(target: str | os.PathLike[str], *, overwrite: bool = False) -> Recov
             f"recovering {src.name} there would replace; move {src.name} into a folder of its own first, or pass "
             f"--overwrite to replace them ({other} itself is kept); {src} is left as it was"
         )
-    # pass 1: which frames are complete (and their tables)
     tables_dir = folder / "tables"
-    stream = rebuild_tables(src, tables_dir, keep_if_empty=True)
+    staged = _staging(tables_dir)
+    tmp = final.with_name(final.name + ".recovering")
+    try:
+        return _finish(src, info, final, tmp, staged, tables_dir)
+    except BaseException:  # an error or a stop (KeyboardInterrupt): the temporary file goes, the .partial stays
+        tmp.unlink(missing_ok=True)
+        raise
+    finally:
+        shutil.rmtree(staged, ignore_errors=True)
+
+
+def _recover_target(target: str | os.PathLike[str]) -> Path:
+    """The recording ``target`` names for :func:`recover`: its ``.partial`` (:func:`find_partial`), else, in a
+    run folder without one, its one finished ``.mcap``, or the ``.mcap`` named."""
+    p = Path(target)
+    if not p.exists():
+        raise IoError(
+            f"{p} does not exist; recover takes a run folder, a .mcap.partial file left by a killed run, or a "
+            "finished .mcap whose tables are missing or damaged"
+        )
+    if p.is_dir() and not any(p.glob("*.mcap.partial")):
+        done = sorted(p.glob("*.mcap"))
+        if len(done) > 1:
+            raise IoError(
+                f"{p} holds {len(done)} finished recordings ({', '.join(f.name for f in done)}) and no .partial; "
+                "name the one whose tables to rebuild"
+            )
+        if done:
+            return check_mcap(done[0])
+        split = sorted(f.name for f in p.glob("*.parts.json"))
+        hint = f" ({split[0]} is a split run: give the folder of one of its parts)" if split else ""
+        raise IoError(
+            f"nothing to recover in {p}: it holds no .mcap.partial recording of a killed run, nor a finished .mcap"
+            + hint
+        )
+    if p.is_file() and p.name.endswith(".mcap"):
+        return check_mcap(p)
+    if not p.is_dir() and not p.name.endswith(".mcap.partial"):
+        raise IoError(
+            f"{p}: recover takes a run folder, a .mcap.partial file left by a killed run, or a finished .mcap "
+            "whose tables are missing or damaged"
+        )
+    return find_partial(p)
+
+
+def rebuild_finished_tables(recording: str | os.PathLike[str]) -> Recovered:
+    """Rebuilds the tables of the finished recording ``recording`` from it (:func:`rebuild_tables`) when they are
+    missing or damaged (:func:`check_tables`): the parts its run wrote, byte for byte, for a whole recording. The
+    recording and ``manifest.json`` are left as they are. Refused (:class:`~mmusv.errors.IoError`, nothing
+    changed): whole tables (nothing to recover), tables of another recording's run in the folder, a recording of
+    no readable frame, and a damaged recording lacking frames whose rows the tables still hold (a rebuild would
+    lose them)."""
+    from mmusv.recording.stream import frame_ranges
+
+    rec = check_mcap(recording_arg(recording))
+    folder = rec.parent
+    tables_dir = folder / "tables"
+    other = another_run(folder, rec.name)
+    if other is not None:
+        raise IoError(
+            f"{folder} holds the run of another recording, {other}: its tables/ are that run's, not those of "
+            f"{rec.name}; move {rec.name} into a folder of its own to rebuild its tables there; nothing changed"
+        )
+    if tables_dir.exists() and not tables_dir.is_dir():
+        raise IoError(
+            f"{tables_dir} is not a folder, where {rec.name}'s run keeps its tables; move it away and run recover "
+            "again to rebuild them; nothing changed"
+        )
+    info = read_info(rec)
+    listed = listed_tables(folder, rec.name)
+    held = FrameStream(info, lambda _t: False).held()[0]  # as the run metadata says, before reading every chunk
+    problems, _ = check_tables(tables_dir, held, listed=listed)
+    if not problems:
+        raise IoError(f"nothing to recover in {folder}: {rec.name} is finished and its tables are whole")
+    staged = _staging(tables_dir)
+    try:
+        stream = _stage_tables(rec, staged)
+        got = sorted(set(stream.yielded))
+        if not got:
+            raise IoError(
+                f"{rec} holds no readable frame to rebuild its tables from ({'; '.join(problems)}); "
+                f"{tables_dir} is left as it was"
+            )
+        span = stream.expected()[0]
+        lacking = [k for k in span if k not in set(got)]
+        problems, lost = check_tables(tables_dir, span, lacking, listed=listed)
+        if lost:
+            raise IoError(
+                f"{rec} lacks frames {frame_ranges(lost)}, whose rows its tables still hold: tables rebuilt from it "
+                f"would lose them; {tables_dir} is left as it was ({'; '.join(problems)})"
+            )
+        if not problems:  # the tables lack only frames the recording lacks too: a rebuild gives them back as they are
+            raise IoError(
+                f"nothing to recover in {folder}: the tables of {rec.name} hold every frame it holds "
+                f"({stream.report()})"
+            )
+        _install_tables(staged, tables_dir)
+    finally:
+        shutil.rmtree(staged, ignore_errors=True)
+    return Recovered(
+        recording=rec,
+        source=rec,
+        frames=got,
+        frames_configured=info.frames_configured,
+        frames_requested=len(span),
+        incomplete=list(stream.incomplete),
+        damage=list(stream.damage),
+        tables=tables_dir,
+        tables_only=problems,
+    )
+
+
+def _finish(src: Path, info: RecordingInfo, final: Path, tmp: Path, staged: Path, tables_dir: Path) -> Recovered:
+    """:func:`recover` of the ``.partial`` ``src`` into ``final`` (written as ``tmp``), its tables built in
+    ``staged``; the caller removes ``tmp`` and ``staged`` on the way out."""
+    from mcap.writer import CompressionType, Writer
+
+    from mmusv.held_signals import HeldSignals
+
+    planned = info.planned[1] if info.planned is not None else info.frames_configured
+    folder = src.parent
+    # pass 1: which frames are complete (and their tables)
+    stream = _stage_tables(src, staged)
     keep = set(stream.yielded)
     if not keep:
         # Nothing to finish: a recording of no frame would replace the .partial (and its chance of a better tool).
@@ -283,7 +512,6 @@ def recover(target: str | os.PathLike[str], *, overwrite: bool = False) -> Recov
         )
     times = {round(k / info.frequency_hz * 1e9) for k in keep} if info.frequency_hz > 0 else set()
     # pass 2: copy their messages into a finished MCAP
-    tmp = final.with_name(final.name + ".recovering")
     scan = Scan(src)
     try:
         with tmp.open("wb") as f:
@@ -335,33 +563,38 @@ def recover(target: str | os.PathLike[str], *, overwrite: bool = False) -> Recov
             w.finish()  # type: ignore[no-untyped-call]
             f.flush()
             os.fsync(f.fileno())
-        os.replace(tmp, final)
     except OSError as exc:
-        tmp.unlink(missing_ok=True)
         raise IoError(f"cannot write {final}: {exc.strerror or exc}; {src} is left as it was") from None
-    manifest_path = folder / "manifest.json"
-    if (folder / "scenario.yaml").is_file() or manifest_path.is_file() or tables_dir.is_dir():
-        from mmusv.jsonio import write_json
+    # the recording, its tables and manifest.json put in place together: a stop waits until they are
+    with HeldSignals():
+        try:
+            os.replace(tmp, final)
+        except OSError as exc:
+            raise IoError(f"cannot write {final}: {exc.strerror or exc}; {src} is left as it was") from None
+        _install_tables(staged, tables_dir)
+        manifest_path = folder / "manifest.json"
+        if (folder / "scenario.yaml").is_file() or manifest_path.is_file() or tables_dir.is_dir():
+            from mmusv.jsonio import write_json
 
-        meta = scan.metadata.get("manifest", {})
-        manifest: dict[str, Any] = {
-            "mmusv_version": meta.get("mmusv_version", info.mmusv_version),
-            "scenario": info.scenario_name,
-            "seed": info.seed,
-            "config_hash": info.config_hash,
-            "status": "interrupted",
-            "frames_written": len(keep),
-            "frames_requested": int(run.get("frames_requested", planned)),
-            "frequency_hz": info.frequency_hz,
-            "agents": [a.id for a in info.agents],
-            "recording": final.name,
-            "tables": sorted(p.name for p in tables_dir.iterdir()) if tables_dir.is_dir() else [],
-            "recovered_from": src.name,
-        }
-        if "first_frame" in run:
-            manifest["first_frame"] = int(run["first_frame"])
-        write_json(manifest_path, manifest)
-    src.unlink()
+            meta = scan.metadata.get("manifest", {})
+            manifest: dict[str, Any] = {
+                "mmusv_version": meta.get("mmusv_version", info.mmusv_version),
+                "scenario": info.scenario_name,
+                "seed": info.seed,
+                "config_hash": info.config_hash,
+                "status": "interrupted",
+                "frames_written": len(keep),
+                "frames_requested": int(run.get("frames_requested", planned)),
+                "frequency_hz": info.frequency_hz,
+                "agents": [a.id for a in info.agents],
+                "recording": final.name,
+                "tables": sorted(p.name for p in tables_dir.iterdir()) if tables_dir.is_dir() else [],
+                "recovered_from": src.name,
+            }
+            if "first_frame" in run:
+                manifest["first_frame"] = int(run["first_frame"])
+            write_json(manifest_path, manifest)
+        src.unlink()
     return Recovered(
         recording=final,
         source=src,
