@@ -123,7 +123,9 @@ def frame_messages(path: str | Path, frame: int) -> dict[str, Any]:
     if bad:
         raise IoError(f"frame {frame} of {p} is damaged: {bad[0]}; {stream.truncated}")
     if stream.truncated and frame in span:  # a frame of the run, lost with a damaged chunk or a cut-off end
-        raise IoError(f"frame {frame} of {p} is lost to damage ({stream.truncated})")
+        # without run metadata (a killed run's .partial, or a copy cut short) it may never have been written
+        unsure = "" if said else " (or was never written: the run's metadata, written at its end, is not there)"
+        raise IoError(f"frame {frame} of {p} is lost to damage{unsure} ({stream.truncated})")
     where = f" ({stream.truncated})" if stream.truncated else ""
     raise ConfigError(
         f"frame = {frame}: not in {p}, {'which holds' if said else 'whose run set out to write'} "
