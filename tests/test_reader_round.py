@@ -158,3 +158,28 @@ def test_a_frame_range_outside_the_recording_is_refused_not_an_empty_stream(run_
     assert [fr.index for fr in overlap] == [2] and overlap.missing() == [] and overlap.report() is None
     with pytest.raises(ConfigError, match=r"frame = 4: not in .*tiny\.mcap, which holds frames 0\.\.2"):
         frame_messages(run_dir / "tiny.mcap", 4)
+
+
+def test_a_recording_cut_inside_its_metadata_is_named_damaged_not_foreign(run_dir: Path, tmp_path: Path) -> None:
+    """A copy of a recording cut inside its first metadata record was "an MCAP file not written by mmusv run": its
+    header still says mmusv wrote it. A ROS 2 bag's does not."""
+    from mmusv.recording.contents import summary
+    from mmusv.recording.info import written_by_mmusv
+
+    rec = run_dir / "tiny.mcap"
+    data = rec.read_bytes()
+    meta = data.index(b"\x0c", 8 + 9 + 4)  # the first metadata record after the header (opcode 0x0C)
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(data[: meta + 200])
+    assert written_by_mmusv(rec) and written_by_mmusv(cut)
+    got = summary(cut)
+    assert got["frames"] is None and "metadata_problem" in got, got
+    other = tmp_path / "other.mcap"  # an MCAP file of another writer
+    from mcap.writer import Writer
+
+    with other.open("wb") as f:
+        w = Writer(f)
+        w.start(profile="ros2", library="rosbag2")
+        w.finish()
+    assert not written_by_mmusv(other) and "metadata_problem" not in summary(other)
+    assert not written_by_mmusv(tmp_path / "missing.mcap")

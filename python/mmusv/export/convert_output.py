@@ -17,6 +17,7 @@ from mmusv.errors import IoError, MmusvError
 from mmusv.export.common import dump_yaml
 from mmusv.export.convert_report import REPORT_NAME
 from mmusv.recording.guard import FolderLock
+from mmusv.recording.info import written_by_mmusv
 from mmusv.text import counted
 
 __all__ = ["contents", "prepare_out", "reported", "staged"]
@@ -105,7 +106,7 @@ def _check_only_a_conversion(out: Path) -> None:
     for root, _dirs, names in os.walk(out):
         for name in sorted(names):
             path = Path(root) / name
-            if name in RUN_FILES or name.endswith(RUN_SUFFIXES) or (name.endswith(".mcap") and _recording(path)):
+            if name in RUN_FILES or name.endswith(RUN_SUFFIXES) or (name.endswith(".mcap") and written_by_mmusv(path)):
                 found.append(str(path))
     if found:
         raise IoError(
@@ -138,26 +139,6 @@ def _check_only_a_conversion(out: Path) -> None:
                 f"describes wrote ({files}); refusing to delete what no conversion wrote: convert into another "
                 "folder, or move them out first"
             )
-
-
-def _recording(path: Path) -> bool:
-    """Whether ``path`` is an MCAP file written by mmusv (its header's library says so; a ROS 2 bag's does not)."""
-    import struct
-
-    try:
-        with path.open("rb") as f:
-            head = f.read(512)
-    except OSError:
-        return False
-    if not head.startswith(b"\x89MCAP0\r\n") or len(head) < 21 or head[8] != 0x01:
-        return False
-    at = 17
-    (n,) = struct.unpack_from("<I", head, at)  # the profile
-    at += 4 + n
-    if at + 4 > len(head):
-        return False
-    (n,) = struct.unpack_from("<I", head, at)  # the library
-    return head[at + 4 : at + 4 + n].startswith(b"mmusv")
 
 
 def _listed(paths: list[str]) -> str:

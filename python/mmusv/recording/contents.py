@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from mmusv.errors import IoError
-from mmusv.recording.info import check_mcap, read_info, recording_arg
+from mmusv.recording.info import check_mcap, read_info, recording_arg, written_by_mmusv
 from mmusv.recording.parts import is_parts_manifest
 from mmusv.recording.scan import Scan
 from mmusv.recording.stream import FrameStream
@@ -41,7 +41,8 @@ def summary(path: str | os.PathLike[str]) -> dict[str, Any]:
         info = read_info(p)
     except IoError as exc:  # not a recording of mmusv run (or its metadata is damaged): messages only
         plain = _plain_summary(p)
-        if {"scenario", "sensors"} <= set(plain["metadata"]):  # damaged, not absent: say why it is not read
+        # damaged, not absent: say why it is not read (metadata cut off or damaged: its header says mmusv wrote it)
+        if {"scenario", "sensors"} <= set(plain["metadata"]) or written_by_mmusv(p):
             plain["metadata_problem"] = str(exc)
         return plain
     stream = FrameStream(info, want=lambda _t: False)

@@ -42,6 +42,7 @@ __all__ = [
     "missing_recordings",
     "read_info",
     "recording_name",
+    "written_by_mmusv",
 ]
 
 
@@ -157,6 +158,28 @@ def check_mcap(path: str | Path) -> Path:
     if head != MAGIC:
         raise IoError(f"{p} is not an MCAP file (it does not start with the MCAP magic bytes)")
     return p
+
+
+def written_by_mmusv(path: str | os.PathLike[str]) -> bool:
+    """Whether ``path`` is an MCAP file whose header names mmusv as its writer (``mmusv run``, ``mmusv recover``),
+    read from its first bytes alone: a recording whose metadata is damaged or cut off is still one, and a ROS 2 bag
+    (another library) is not. ``False`` for anything unreadable."""
+    import struct
+
+    try:
+        with open(path, "rb") as f:
+            head = f.read(512)
+    except OSError:
+        return False
+    if not head.startswith(MAGIC) or len(head) < len(MAGIC) + 13 or head[len(MAGIC)] != 0x01:
+        return False
+    at = len(MAGIC) + 9  # the header record's opcode and length, then its profile and library strings
+    (n,) = struct.unpack_from("<I", head, at)
+    at += 4 + n
+    if at + 4 > len(head):
+        return False
+    (n,) = struct.unpack_from("<I", head, at)
+    return head[at + 4 : at + 4 + n].startswith(b"mmusv")
 
 
 def _scan_metadata(p: Path) -> Scan:
