@@ -149,6 +149,9 @@ def test_a_bad_index_is_named(tmp_path: Path) -> None:
         ("recording", 5, "recordings[0].recording = 5: must be a relative path"),  # read as the file '5'
         ("status", ["complete"], "recordings[0].status = ['complete']: must be a string, not list"),  # TypeError
         ("name", None, "recordings[0].name = None: must be a string, not NoneType"),
+        # passed over without a word: the conversion and the studies read fewer recordings than listed
+        ("status", "bogus", "recordings[0] (a).status = 'bogus': must be one of complete, failed, pending"),
+        ("recording", None, "recordings[0] (a) is complete but names no recording"),
     ],
 )
 def test_an_index_entry_of_the_wrong_kind_is_named(tmp_path: Path, key: str, value: object, said: str) -> None:

@@ -217,6 +217,17 @@ def read_index(path: str | os.PathLike[str]) -> dict[str, Any]:
                     f"{p}: recordings[{i}].{key} = {arguments.shown(r[key])}: must be a string, not "
                     f"{type(r[key]).__name__}"
                 )
+        # a status "bogus", or a complete entry without its recording, was passed over without a word
+        if r["status"] not in STATUSES:
+            raise IoError(
+                f"{p}: recordings[{i}] ({r['name']}).status = {arguments.shown(r['status'])}: must be one of "
+                f"{', '.join(STATUSES)}"
+            )
+        if r["status"] == "complete" and not r.get("recording"):
+            raise IoError(
+                f"{p}: recordings[{i}] ({r['name']}) is complete but names no recording (field 'recording': the path "
+                "of its .mcap or .parts.json below the index's folder)"
+            )
     return doc
 
 
