@@ -92,3 +92,16 @@ def test_python_api_takes_bundled_names(tmp_path: Path) -> None:
             load_scenario("no_such_scenario")
     finally:
         os.chdir(cwd)
+
+
+def test_a_link_that_leads_nowhere_is_named_as_one(tmp_path: Path) -> None:
+    """A dangling link or a loop of links given as the scenario "does not exist and is not a bundled scenario"."""
+    from mmusv.bundled import resolve_spec
+
+    (tmp_path / "a.yaml").symlink_to(tmp_path / "b.yaml")
+    (tmp_path / "b.yaml").symlink_to(tmp_path / "a.yaml")
+    (tmp_path / "gone.yaml").symlink_to("nothere.yaml")
+    with pytest.raises(NotFoundError, match=r"'.*a\.yaml' is a link that leads nowhere: a loop of links"):
+        resolve_scenario(tmp_path / "a.yaml")
+    with pytest.raises(NotFoundError, match=r"gone\.yaml' is a link that leads nowhere: it points to nothere\.yaml"):
+        resolve_spec(tmp_path / "gone.yaml")

@@ -8,6 +8,7 @@ scenarios, so ``mmusv run port_entry`` works from any directory.
 
 from __future__ import annotations
 
+import errno
 import importlib.resources
 import os
 import re
@@ -44,6 +45,17 @@ def _resolve(
         cand = folder / f"{stem}.yaml"
         if os.path.isfile(cand):
             return cand
+    if os.path.islink(p):  # a link to nothing: "does not exist" sent the user looking for the name itself
+        try:
+            os.stat(p)
+            why = "its target cannot be read"
+        except OSError as exc:
+            why = (
+                "a loop of links"
+                if exc.errno == errno.ELOOP
+                else f"it points to {os.readlink(p)}, which does not exist"
+            )
+        raise NotFoundError(f"{noun} file {str(name)!r} is a link that leads nowhere: {why}")
     hint = ""
     if other is not None and bare and os.path.isfile(other[0] / f"{stem}.yaml"):  # `mmusv run island_demo`, a spec
         hint = f" ({stem} is {other[1].format(stem=stem)})"
