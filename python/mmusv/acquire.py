@@ -217,6 +217,7 @@ def run(
             )
         frame_range = span
     rec_path = recording_path(out, scenario)
+    _refuse_wrong_kinds(out, rec_path)
     if rec_path.exists() and not overwrite:
         raise IoError(
             f"{rec_path} already exists{_earlier_run(out, rec_path)}; pass --overwrite (overwrite=True in Python) "
@@ -224,7 +225,6 @@ def run(
         )
     if not overwrite:
         _refuse_another_run(out, rec_path)
-    _refuse_wrong_kinds(out)
     _refuse_foreign_files(out, cfg)
     try:  # builds the world: any remaining config problem surfaces here, before writing
         sim = Simulation(scenario)
@@ -522,12 +522,16 @@ def _refuse_another_run(out: Path, rec_path: Path) -> None:
         )
 
 
-def _refuse_wrong_kinds(out: Path) -> None:
+def _refuse_wrong_kinds(out: Path, rec_path: Path) -> None:
     """Raises :class:`~mmusv.errors.IoError` when one of the names a run writes in ``out`` is taken by the wrong
-    kind of entry: ``tables`` and its three table folders must be folders, ``manifest.json`` and ``scenario.yaml``
-    files. Checked before anything is written; before, a file named ``tables`` failed the run only after its last
-    frame, with the recording finished as ``complete``, no tables and no manifest."""
+    kind of entry: ``tables`` and its three table folders must be folders, ``manifest.json``, ``scenario.yaml`` and
+    the recording ``rec_path`` (and its ``.partial``) files. Checked before anything is written; before, a file
+    named ``tables`` failed the run only after its last frame, with the recording finished as ``complete``, no
+    tables and no manifest."""
     wanted = {"manifest.json": False, "scenario.yaml": False, "tables": True}
+    # the recording and a killed run's .partial: a folder of that name was "left by an interrupted run", then
+    # "cannot write into out: Is a directory"
+    wanted.update({rec_path.name: False, rec_path.name + ".partial": False})
     wanted.update({f"tables/{name}": True for name in SCHEMAS})
     for name, folder in wanted.items():
         path = out / name

@@ -131,8 +131,11 @@ def test_a_part_swapped_for_another_recording_is_named(tmp_path: Path) -> None:
         ("tables/boxes_2d", lambda p: p.write_bytes(b"")),
         ("manifest.json", lambda p: p.mkdir()),
         ("scenario.yaml", lambda p: p.mkdir()),
+        # "already exists; pass --overwrite"; "left by an interrupted run", then "cannot write ...: Is a directory"
+        ("tiny.mcap", lambda p: p.mkdir()),
+        ("tiny.mcap.partial", lambda p: p.mkdir()),
     ],
-    ids=["tables-file", "table-file", "manifest-folder", "scenario-folder"],
+    ids=["tables-file", "table-file", "manifest-folder", "scenario-folder", "recording-folder", "partial-folder"],
 )
 def test_a_name_the_run_writes_taken_by_the_wrong_kind_is_refused_before_writing(
     tmp_path: Path, name: str, make: object
@@ -148,7 +151,9 @@ def test_a_name_the_run_writes_taken_by_the_wrong_kind_is_refused_before_writing
     code, _out, err = cli_main("run", str(src), "-o", str(out))
     assert code == 2 and "Traceback" not in err, err
     assert str(target) in err and ("is not a folder" in err or "is a folder" in err), err
-    assert not (out / "tiny.mcap").exists() and not (out / "tiny.mcap.partial").exists()
+    assert not (out / "tiny.mcap").is_file() and not (out / "tiny.mcap.partial").is_file()
+    code, _out, err = cli_main("run", str(src), "-o", str(out), "--overwrite")
+    assert code == 2 and str(target) in err and "move it out of" in err, err
 
 
 def test_tables_that_cannot_be_written_at_the_end_leave_a_failed_recording(
