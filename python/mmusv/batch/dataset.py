@@ -239,7 +239,7 @@ def build_dataset(
                 if progress is not None:
                     progress("generate", accepted, quota)
 
-            report = generate(loaded, scen_dir, force=True, progress=tick)
+            report = generate(loaded, scen_dir, force=True, progress=tick, source=str(sp))
             shortfall = [f"{c.name}: {c.accepted} of {c.quota}" for c in report.combos if not c.met]
         if progress is not None:
             progress("generate", quota, quota)

@@ -70,7 +70,7 @@ def run(args: argparse.Namespace) -> int:
     from mmusv.cli_console import rich_console
     from mmusv.cli_paths import check_output_folder, output_arg, path_arg
     from mmusv.generate.mapctx import map_context
-    from mmusv.generate.runner import check_output, generate
+    from mmusv.generate.runner import check_output, generate, infeasible_error
     from mmusv.generate.spec import load_spec, with_seed
 
     console = rich_console()
@@ -98,10 +98,14 @@ def run(args: argparse.Namespace) -> int:
                 m.type, seed=m.seed, params=m.param_values()
             ).scene  # built here, so the progress bar is generation
     t_map = time.perf_counter() - t0
+    contexts = [map_context(m.type, seed=m.seed, params=m.param_values()) for m in map(spec.map_of, spec.combinations)]
+    refused = infeasible_error(spec, contexts, source=str(spec_path))
+    if refused is not None:  # a clearance no water offers: said before the progress bar, and nothing written
+        raise refused
     t0 = time.perf_counter()
     if args.no_progress:
         with _resume_hint(out):
-            report = generate(spec, out, force=args.force)
+            report = generate(spec, out, force=args.force, source=str(spec_path))
     else:
         columns = (
             TextColumn("[bold]{task.description}"),
@@ -117,7 +121,7 @@ def run(args: argparse.Namespace) -> int:
                 bar.update(task, completed=accepted, attempts=attempts, description=name)
 
             with _resume_hint(out):
-                report = generate(spec, out, force=args.force, progress=tick)
+                report = generate(spec, out, force=args.force, progress=tick, source=str(spec_path))
             bar.update(task, completed=total, description="done")
     elapsed = time.perf_counter() - t0
     report.print(console)

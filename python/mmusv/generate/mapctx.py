@@ -134,10 +134,6 @@ class MapContext:
         out: np.ndarray = self.cache[key]
         return out
 
-    def max_clearance(self) -> float:
-        """The largest conservative clearance anywhere on the map (metres)."""
-        return float(self.d_nav.max()) - self.cell_slack
-
     # ------------------------------------------------------------------------------------- ray casting
 
     @property

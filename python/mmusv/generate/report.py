@@ -36,7 +36,6 @@ class ComboReport:
     rejected: dict[str, int] = field(default_factory=dict)
     examples: dict[str, str] = field(default_factory=dict)
     files: list[str] = field(default_factory=list)
-    infeasible: str | None = None
 
     def reject(self, name: str, reason: str) -> None:
         """Counts a rejected attempt against ``name``, keeping the first reason as an example."""
@@ -61,8 +60,6 @@ class ComboReport:
         head = (
             f"{self.accepted}/{self.quota} accepted after {counted(self.attempts, 'attempt')} (cap {self.max_attempts})"
         )
-        if self.infeasible:
-            head += f"; {self.infeasible}"
         top = sorted(self.rejected.items(), key=lambda kv: (-kv[1], kv[0]))[:3]
         parts = [f"{name} rejected {n} (e.g. {self.examples[name]})" for name, n in top]
         return head + ("; " + "; ".join(parts) if parts else "")

@@ -7,7 +7,9 @@ Per combination ``i`` (in spec order) attempts ``0, 1, ...`` are drawn by :func:
 the hidden ``.generate.partial`` first, so a run stopped before its report is known by ``--force``), read back (YAML
 safe loader, libyaml's when installed: the same resolver as ``yaml.safe_load``), validated with
 :func:`mmusv.config.load_scenario` and compared with the checked scenario before it counts. The loop stops at the
-quota or at ``max_attempts``, so it always ends; the same spec gives the same files byte for byte.
+quota or at ``max_attempts``, so it always ends; the same spec gives the same files byte for byte. A combination
+whose vessels fit nowhere on its map at the clearances asked (:func:`infeasible_error`) is refused before the first
+attempt, and nothing is written.
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import yaml
 
 from mmusv.config import load_scenario
@@ -34,7 +37,7 @@ from mmusv.generate.sampler import Candidate, sample_candidate
 from mmusv.generate.samples import take_samples
 from mmusv.generate.spec import GenerationSpec, class_assets, load_spec
 
-__all__ = ["JOURNAL", "Progress", "check_output", "dump_scenario", "generate"]
+__all__ = ["JOURNAL", "Progress", "check_output", "dump_scenario", "generate", "infeasible_error"]
 
 Progress = Callable[[str, int, int], None]
 """Called after every attempt with (combination name, accepted so far in total, attempts so far in total)."""
@@ -219,23 +222,79 @@ def _same_file(a: Path, b: Path) -> bool:
         return False
 
 
-def _infeasible(spec: GenerationSpec, ctx: MapContext, idx: int) -> str | None:
-    """A reason the combination can never pass the clearance checks (the slimmest asset of one of its target
-    classes fits nowhere on the map), or None. Attempts still run (and are counted) so the report shows them."""
+def _infeasible(spec: GenerationSpec, ctx: MapContext, idx: int) -> tuple[str, float, str] | None:
+    """Why combination ``idx`` can never pass the clearance checks on its map ``ctx``, as ``(constraint field, its
+    value, why)`` (:func:`infeasible_error` words it), or None. Exact: the clearance checks ask every point of a
+    hull capsule's axis for ``raster - cell slack - radius - (more slack) >= min_m``, so a vessel (the slimmest
+    asset its role may take: a target's size class, the ego, a cooperating USV) fits only where one cell of the
+    map leaves that much room from the shore and from the structures at once; where none does, every attempt
+    would be spent on rejections (``shore_clearance: {min_m: 100000}`` ran 100,000 attempts for 12 minutes)."""
     combo = spec.combinations[idx]
     cons = spec.constraints
-    need = max(
-        cons.shore_clearance.min_m if cons.shore_clearance.enabled else 0.0,
-        cons.structure_clearance.min_m if cons.structure_clearance.enabled else 0.0,
-    )
-    best = ctx.max_clearance()
-    for cls in combo.targets:
-        slimmest = min(class_assets(spec.size_classes[cls]), key=lambda a: capsule(a)[1])
+    shore = cons.shore_clearance.min_m if cons.shore_clearance.enabled else None
+    struct = cons.structure_clearance.min_m if cons.structure_clearance.enabled else None
+    if shore is None and struct is None:
+        return None
+    roles = [(f"size class {cls!r}", class_assets(spec.size_classes[cls])) for cls in dict.fromkeys(combo.targets)]
+    roles.append((f"the ego ({combo.ego or spec.usv.assets[0]})", [combo.ego or spec.usv.assets[0]]))
+    if combo.cooperating:
+        roles.append(("a cooperating USV", list(spec.usv.assets)))
+    room_shore = ctx.d_shore - ctx.cell_slack  # the clearance every point of a cell has, conservatively
+    room_struct = ctx.d_struct - ctx.cell_slack
+    best_shore, best_struct = float(room_shore.max(initial=0.0)), float(room_struct.max(initial=0.0))
+    m = spec.map_of(combo)
+    where = f"on this map ({m.type}, seed {m.seed})"
+    for role, assets in roles:
+        slimmest = min(assets, key=lambda a: (capsule(a)[1], a))
         r = capsule(slimmest)[1]
-        if r + need > best:
+        fits = np.ones(room_shore.shape, dtype=bool)
+        if shore is not None:
+            fits &= room_shore - r >= shore - _EPS
+        if struct is not None:
+            fits &= room_struct - r >= struct - _EPS
+        if fits.any():
+            continue
+        hull = f"{slimmest} hull radius {r:.1f} m"
+        if shore is not None and best_shore - r < shore - _EPS:
             return (
-                f"infeasible: size class {cls!r} needs {r + need:.0f} m of clearance ({slimmest} hull half-width"
-                f" {r:.0f} m + {need:g} m) and the most open water on this map offers {best:.0f} m"
+                "shore_clearance.min_m",
+                shore,
+                f"{role} needs {r + shore:.0f} m of clearance from the shore ({hull} + {shore:g} m) and the most "
+                f"open water {where} offers {best_shore:.0f} m: lower shore_clearance.min_m",
+            )
+        if struct is not None and best_struct - r < struct - _EPS:
+            return (
+                "structure_clearance.min_m",
+                struct,
+                f"{role} needs {r + struct:.0f} m of clearance from port structures, buoys and moored ships ({hull} "
+                f"+ {struct:g} m) and no water {where} lies farther than {best_struct:.0f} m from them: lower "
+                "structure_clearance.min_m",
+            )
+        return (
+            "shore_clearance.min_m",
+            float(shore or 0.0),
+            f"{role} needs {r + (shore or 0.0):.0f} m of clearance from the shore and {r + (struct or 0.0):.0f} m "
+            f"from port structures, buoys and moored ships ({hull}), and no water {where} offers both: lower "
+            "shore_clearance.min_m or structure_clearance.min_m",
+        )
+    return None
+
+
+_EPS = 1e-9
+"""Metres of rounding :func:`_infeasible` forgives, so it never refuses what the checks could accept."""
+
+
+def infeasible_error(spec: GenerationSpec, contexts: list[MapContext], *, source: str = "spec") -> ConfigError | None:
+    """The :class:`~mmusv.errors.ConfigError` that refuses ``spec`` when one of its combinations can never pass the
+    clearance checks on its map (``contexts[i]`` is combination ``i``'s; :func:`_infeasible`), worded as the spec's
+    other impossible constraints are (:func:`mmusv.generate.spec.load_spec`); None when none is found."""
+    for i, ctx in enumerate(contexts):
+        bad = _infeasible(spec, ctx, i)
+        if bad is not None:
+            field, value, why = bad
+            return ConfigError(
+                f"{source}: invalid spec constraints.{field} = {value!r}: combinations[{i}] "
+                f"({spec.combinations[i].label()}) could never pass: {why}"
             )
     return None
 
@@ -258,9 +317,13 @@ def generate(
     *,
     force: bool = False,
     progress: Progress | None = None,
+    source: str | None = None,
 ) -> RunReport:
     """Generates the scenarios of a spec into ``out_dir`` (created; refuses to overwrite earlier scenario files
-    unless ``force``) and writes ``report.json`` there; returns the report."""
+    unless ``force``) and writes ``report.json`` there; returns the report. A combination that can never pass the
+    clearance checks on its map is refused with a :class:`~mmusv.errors.ConfigError` before anything is written, as
+    :func:`~mmusv.generate.spec.load_spec` refuses other impossible constraints; ``source`` names the spec in it
+    (default: the path given, else ``spec``)."""
     spec = load_spec(spec_source)
     out = Path(out_dir)
     spec_path = Path(spec_source) if isinstance(spec_source, (str, os.PathLike)) else None
@@ -268,6 +331,10 @@ def generate(
     contexts = [
         map_context(m.type, seed=m.seed, params=m.param_values()) for m in (spec.map_of(c) for c in spec.combinations)
     ]
+    where = source if source is not None else str(spec_path) if spec_path is not None else "spec"
+    refused = infeasible_error(spec, contexts, source=where)
+    if refused is not None:  # every attempt would be rejected: said at once, nothing written
+        raise refused
     constraints = build_constraints(spec)
     _prepare_dir(out, force, spec_path)
     journal = out / JOURNAL
@@ -285,7 +352,6 @@ def generate(
     for i, combo in enumerate(spec.combinations):
         ctx = contexts[i]
         rep = ComboReport(combo.label(), combo.family, combo.difficulty, combo.quota, spec.max_attempts(combo))
-        rep.infeasible = _infeasible(spec, ctx, i)
         report.combos.append(rep)
         width = max(3, int(math.log10(combo.quota)) + 1)
         for attempt in range(rep.max_attempts):

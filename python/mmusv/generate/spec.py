@@ -15,7 +15,8 @@ Units: metres, seconds, metres per second; shares are fractions of the frames in
   ``cooperating`` USVs, ``targets`` (one size class per role target, the first is primary), ``quota``,
   optional ``max_attempts`` (default ``quota x max_attempts_per_scenario``), ``name`` and ``map`` (this
   combination's own map instead of the spec's, so one spec can cover several maps);
-- ``constraints``: the named checks and thresholds (:mod:`mmusv.generate.spec_constraints`);
+- ``constraints``: the named checks and thresholds (:mod:`mmusv.generate.spec_constraints`): all on, except
+  ``target_density`` and ``line_of_sight``; writing a check's block turns it on unless it says ``enabled: false``;
 - ``max_attempts_per_scenario`` (default 40: a combination's attempt cap is its quota times this);
 - tuning: ``check_step_m`` (sample spacing of the checks), ``sensor_height_m``, ``encounter_clearance_m``,
   ``proposals`` (prior-guided proposals per placed vessel).
@@ -40,7 +41,9 @@ the value given and what is allowed, in the style of :func:`mmusv.config.load_sc
 candidate of a combination could meet together are refused here, naming the constraint, the combination and the
 other bound (``separation.min_m`` above the difficulty's ``range_m`` or ``cooperation.max_m``, a sensing or
 density range inside the separation, ``target_density.min_targets`` above the targets a combination has, a lone
-ego whose target is kept beyond its sensing range), rather than spending every attempt on them.
+ego whose target is kept beyond its sensing range), rather than spending every attempt on them. A clearance that
+no water of a combination's map offers to its vessels needs the map: :func:`mmusv.generate.runner.generate` refuses
+it the same way once the map is built, before the first attempt.
 """
 
 from __future__ import annotations

@@ -3,6 +3,11 @@
 Units: metres; shares are fractions of the acquisition frames in [0, 1]. Every constraint has ``enabled``;
 :func:`mmusv.generate.checks.build_constraints` turns the enabled ones into checks, in the order of
 :class:`Constraints` (cheap first).
+
+Every check is on by default, except ``target_density`` and ``line_of_sight``, which are off while a spec does not
+mention them. Writing a check's block turns it on, whatever fields it gives (``target_density: {min_targets: 2}``,
+even ``line_of_sight: {}``), unless the block says ``enabled: false``: a block of thresholds is never dropped
+without a word.
 """
 
 from __future__ import annotations
@@ -46,6 +51,8 @@ _Model = SpecModel
 
 class _Check(_Model):
     enabled: bool = True
+    """On unless the block says ``enabled: false``; a check a spec does not mention keeps the default of
+    :class:`Constraints` (on, except ``target_density`` and ``line_of_sight``)."""
 
 
 class InWaterCheck(_Check):
@@ -95,9 +102,8 @@ class SensingRangeCheck(_Check):
 class TargetDensityCheck(_Check):
     """Each USV has at least ``min_targets`` targets (role targets and distractors; other USVs do not count)
     within ``range_m`` (centre to centre, BEV) for at least ``min_share`` of the frames: datasets dense enough
-    to learn detection from. Off unless a spec sets it."""
+    to learn detection from. Off while a spec does not mention it; on once it writes the block (module docs)."""
 
-    enabled: bool = False
     range_m: float = Field(default=200.0, gt=0.0, le=MAX_DISTANCE_M)
     min_targets: int = Field(default=1, ge=1, le=64)
     min_share: float = Field(default=0.8, ge=0.0, le=1.0)
@@ -120,9 +126,9 @@ class CooperationCheck(_Check):
 
 class LineOfSightCheck(_Check):
     """Each role target seen (ray cast against the static map, within sensing range) by at least one USV for
-    at least ``min_share`` of the frames."""
+    at least ``min_share`` of the frames. Off while a spec does not mention it; on once it writes the block (module
+    docs)."""
 
-    enabled: bool = False
     min_share: float = Field(default=0.5, ge=0.0, le=1.0)
 
 
@@ -145,7 +151,7 @@ class Constraints(_Model):
     route_separation: RouteSeparationCheck = Field(default_factory=RouteSeparationCheck)
     target_range: TargetRangeCheck = Field(default_factory=TargetRangeCheck)
     sensing_range: SensingRangeCheck = Field(default_factory=SensingRangeCheck)
-    target_density: TargetDensityCheck = Field(default_factory=TargetDensityCheck)
+    target_density: TargetDensityCheck = Field(default_factory=lambda: TargetDensityCheck(enabled=False))
     cooperation: CooperationCheck = Field(default_factory=CooperationCheck)
-    line_of_sight: LineOfSightCheck = Field(default_factory=LineOfSightCheck)
+    line_of_sight: LineOfSightCheck = Field(default_factory=lambda: LineOfSightCheck(enabled=False))
     occlusion: OcclusionCheck = Field(default_factory=OcclusionCheck)
