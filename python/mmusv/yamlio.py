@@ -7,7 +7,13 @@ what is wrong, never a ``UnicodeDecodeError`` or a bare parser error:
   save them), Latin-1 text and binary files are refused with the byte offset of the first bad byte;
 * duplicate keys in a mapping are refused, naming the key and both lines (the YAML spec forbids them, and
   PyYAML would silently keep the last one: two ``vessels:`` blocks would drop the first fleet);
-* syntax errors name the line and column.
+* syntax errors name the line and column;
+* the numbers only YAML 1.1 has are refused, naming the field, its line and column, the text as written, what YAML
+  1.1 reads it as and what to write instead: an unquoted ``seed: 017`` is octal (15), ``frames: 1:0`` and
+  ``time_of_day: 13:00`` base 60 (60, 780), ``0b11`` binary (3) and ``0x1F`` hexadecimal (31), which YAML 1.2
+  and most other readers take otherwise (as text, or 17), and which nobody writing a seed or a frame count means.
+  Integers are written in decimal (``17``, ``-60``, ``1_000``), floats as decimals (``0.5``, ``-1.5``,
+  ``1.0e+3``, ``.inf``); a time, a version or any text that looks like one of these numbers goes in quotes.
 
 :func:`mapping_source` accepts a path, a dict or an already validated model, which is how ``load_scenario``
 and ``load_spec`` take their input.
@@ -42,7 +48,7 @@ _BOMS = {
 
 
 class _UniqueKeyLoader(yaml.SafeLoader):
-    """PyYAML's safe loader, refusing duplicate keys in any mapping."""
+    """PyYAML's safe loader, refusing duplicate keys in any mapping and the numbers only YAML 1.1 has."""
 
 
 # The same on libyaml's C parser where PyYAML was built with it (its wheels are): the same documents, ten times
@@ -84,9 +90,128 @@ class _DuplicateKey(Exception):
     pass
 
 
+class _Yaml11Number(Exception):
+    """A number written in a form only YAML 1.1 reads as a number (:func:`_yaml11_kind`); ``path`` is filled in
+    by :func:`_load` once the node is found in the document."""
+
+    def __init__(self, node: yaml.ScalarNode, kind: str, value: int | float) -> None:
+        super().__init__(node.value)
+        self.node, self.kind, self.value = node, kind, value
+        self.path: tuple[str, str | None, bool] = ("", None, False)
+
+
+def _yaml11_kind(text: str, *, integer: bool) -> str | None:
+    """What YAML-1.1-only number the plain scalar ``text`` (resolved as an integer when ``integer``, else as a
+    float) is written as: ``"base-60"`` (``1:20``, ``13:00``, ``1:20.5``), ``"octal"`` (``017``), ``"binary"``
+    (``0b11``) or ``"hexadecimal"`` (``0x1F``); None for a decimal number."""
+    body = text.replace("_", "").lstrip("+-")
+    if ":" in body:
+        return "base-60"
+    if not integer:
+        return None
+    low = body.lower()
+    if low.startswith("0b"):
+        return "binary"
+    if low.startswith("0x"):
+        return "hexadecimal"
+    if len(body) > 1 and body.startswith("0"):
+        return "octal"
+    return None
+
+
+def _construct_int(loader: Any, node: yaml.ScalarNode) -> int:
+    value: int = yaml.constructor.SafeConstructor.construct_yaml_int(loader, node)
+    kind = _yaml11_kind(str(node.value), integer=True)
+    if kind is not None:
+        raise _Yaml11Number(node, kind, value)
+    return value
+
+
+def _construct_float(loader: Any, node: yaml.ScalarNode) -> float:
+    value: float = yaml.constructor.SafeConstructor.construct_yaml_float(loader, node)
+    kind = _yaml11_kind(str(node.value), integer=False)
+    if kind is not None:
+        raise _Yaml11Number(node, kind, value)
+    return value
+
+
 for _loader in (_UniqueKeyLoader, _FastUniqueKeyLoader):
     if _loader is not None:
         _loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
+        _loader.add_constructor("tag:yaml.org,2002:int", _construct_int)
+        _loader.add_constructor("tag:yaml.org,2002:float", _construct_float)
+
+
+def _load(text: str, loader_class: Any) -> Any:
+    """``yaml.load(text, Loader=loader_class)``, keeping the document's nodes so that a refused number can be named
+    by the field it is written in."""
+    loader = loader_class(text)
+    try:
+        root = loader.get_single_node()
+        if root is None:
+            return None
+        try:
+            return loader.construct_document(root)
+        except _Yaml11Number as exc:
+            exc.path = _node_path(root, exc.node)
+            raise
+    finally:
+        loader.dispose()
+
+
+def _node_path(root: yaml.Node, target: yaml.Node) -> tuple[str, str | None, bool]:
+    """``(path, last key, is a key)`` of ``target`` in the document ``root``: ``("vessels[0].route[1][0]",
+    "route", False)``, ``("environment.time_of_day[0]", "time_of_day", False)``; a mapping key is named by the path
+    of its mapping (``("rigs", "rigs", True)``); ``("", None, False)`` for the root or a node not found. Depth first
+    in document order, each node once (an anchor is found where it is written, however often aliases repeat it)."""
+    stack: list[tuple[yaml.Node, str, str | None]] = [(root, "", None)]
+    seen: set[int] = set()
+    while stack:
+        node, path, key = stack.pop()
+        if node is target:
+            return path, key, False
+        if id(node) in seen:
+            continue
+        seen.add(id(node))
+        children: list[tuple[yaml.Node, str, str | None]] = []
+        if isinstance(node, yaml.MappingNode):
+            for k, v in node.value:
+                name = str(k.value) if isinstance(k, yaml.ScalarNode) else "?"
+                if k is target:
+                    return path, key, True
+                children.append((v, f"{path}.{name}" if path else name, name))
+        elif isinstance(node, yaml.SequenceNode):
+            children = [(v, f"{path}[{i}]", key) for i, v in enumerate(node.value)]
+        stack.extend(reversed(children))
+    return "", None, False
+
+
+def _yaml11_message(exc: _Yaml11Number) -> str:
+    """The explanation of a refused YAML-1.1-only number (:class:`_Yaml11Number`)."""
+    mark = exc.node.start_mark
+    text = str(exc.node.value)
+    path, key, is_key = exc.path
+    if is_key:
+        what = f"the key {text} of {path}" if path else f"the key {text}"
+    else:
+        what = f"{path} = {text}" if path else text
+    at = f"{what} at line {mark.line + 1}, column {mark.column + 1}"
+    if key == "time_of_day":
+        example = f'"{text}"' if exc.kind == "base-60" else '"16:30"'
+        return (
+            f'{at}: use 24-hour "HH:MM" in quotes, e.g. {example} (unquoted, YAML reads it as the number {exc.value})'
+        )
+    if exc.kind == "octal":
+        sign = "-" if text.startswith("-") else ""
+        digits = text.replace("_", "").lstrip("+-").lstrip("0") or "0"
+        instead = f"without the leading zero ({sign}{digits})"
+    else:
+        instead = f"in decimal ({exc.value})"
+    article = "an" if exc.kind == "octal" else "a"
+    return (
+        f"{at} is {article} {exc.kind} number in YAML 1.1, which reads it as {exc.value}; write the number {instead} "
+        f'or, if it is text, put it in quotes ("{text}")'
+    )
 
 
 def decode_text(raw: bytes, where: str) -> str:
@@ -117,14 +242,16 @@ def parse_yaml(text: str, where: str, *, trusted: bool = False) -> Any:
     try:
         if trusted and _FastUniqueKeyLoader is not None:
             try:
-                return yaml.load(text, Loader=_FastUniqueKeyLoader)
+                return _load(text, _FastUniqueKeyLoader)
             except yaml.YAMLError:
                 pass  # refused: again below, for the pure-Python parser's message
-        data = yaml.load(text, Loader=_UniqueKeyLoader)
+        data = _load(text, _UniqueKeyLoader)
         _check_expansion(data, where)
         return data
     except _DuplicateKey as exc:
         raise ConfigError(f"{where}: {exc}; each key may appear once") from None
+    except _Yaml11Number as exc:
+        raise ConfigError(f"{where}: {_yaml11_message(exc)}") from None
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         at = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""

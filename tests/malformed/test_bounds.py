@@ -116,7 +116,8 @@ def _yaml_refused(text: str, tmp_path: Path) -> str:
 def test_an_unquoted_time_is_explained(tmp_path: Path) -> None:
     text = yaml.safe_dump(BASE) + "environment: {time_of_day: 13:00}\n"
     msg = _yaml_refused(text, tmp_path)
-    assert "environment.time_of_day = 780" in msg and "in quotes" in msg, msg
+    assert "environment.time_of_day = 13:00 at line" in msg and "in quotes" in msg, msg
+    assert "reads it as the number 780" in msg, msg
 
 
 def test_pydantic_step_names_stay_out_of_field_paths(tmp_path: Path) -> None:
