@@ -46,20 +46,26 @@ def killed_copy(src: Path, dst: Path, *, messages: int | None = None) -> Path:
         msgs = list(reader.iter_messages())[:messages]
     with dst.open("wb") as out:
         w = Writer(out, chunk_size=1, compression=CompressionType.NONE)  # every message in a chunk of its own
-        w.start(profile="", library="mmusv test")
-        for name, md in meta:
-            w.add_metadata(name, md)
-        schemas: dict[int, int] = {}
-        channels: dict[int, int] = {}
-        for schema, ch, m in msgs:
-            assert schema is not None
-            if schema.id not in schemas:
-                schemas[schema.id] = w.register_schema(schema.name, schema.encoding, schema.data)
-            if ch.id not in channels:
-                channels[ch.id] = w.register_channel(ch.topic, ch.message_encoding, schemas[schema.id], ch.metadata)
-            w.add_message(channels[ch.id], m.log_time, m.data, m.publish_time, m.sequence)
+        write_records(w, meta, msgs)
         # no w.finish(): the process was killed
     return dst
+
+
+def write_records(w: Any, meta: list[tuple[str, dict[str, str]]], msgs: list[Any]) -> None:
+    """Starts the official writer ``w`` and writes ``meta`` (name, metadata) and the ``(schema, channel, message)``
+    triples ``msgs`` of ``make_reader(...).iter_messages()`` into it, registering each schema and channel once."""
+    w.start(profile="", library="mmusv test")
+    for name, md in meta:
+        w.add_metadata(name, md)
+    schemas: dict[int, int] = {}
+    channels: dict[int, int] = {}
+    for schema, ch, m in msgs:
+        assert schema is not None
+        if schema.id not in schemas:
+            schemas[schema.id] = w.register_schema(schema.name, schema.encoding, schema.data)
+        if ch.id not in channels:
+            channels[ch.id] = w.register_channel(ch.topic, ch.message_encoding, schemas[schema.id], ch.metadata)
+        w.add_message(channels[ch.id], m.log_time, m.data, m.publish_time, m.sequence)
 
 
 def no_ray_cluster(monkeypatch: Any) -> None:

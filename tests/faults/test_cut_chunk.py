@@ -11,6 +11,7 @@ import struct
 from pathlib import Path
 
 import pytest
+from mcap_rechunk import write_records
 
 from .conftest import chunk_spans, cli_main, frames_of, scenario
 
@@ -43,18 +44,7 @@ def _one_chunk(src: Path, dst: Path, compression: str) -> Path:
         msgs = list(reader.iter_messages())
     with dst.open("wb") as out:
         w = Writer(out, chunk_size=1 << 30, compression=CompressionType[compression.upper()])
-        w.start(profile="", library="mmusv test")
-        for name, md in meta:
-            w.add_metadata(name, md)
-        schemas: dict[int, int] = {}
-        channels: dict[int, int] = {}
-        for schema, ch, m in msgs:
-            assert schema is not None
-            if schema.id not in schemas:
-                schemas[schema.id] = w.register_schema(schema.name, schema.encoding, schema.data)
-            if ch.id not in channels:
-                channels[ch.id] = w.register_channel(ch.topic, ch.message_encoding, schemas[schema.id], ch.metadata)
-            w.add_message(channels[ch.id], m.log_time, m.data, m.publish_time, m.sequence)
+        write_records(w, meta, msgs)
         w.finish()  # type: ignore[no-untyped-call]
     return dst
 
