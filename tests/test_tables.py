@@ -165,19 +165,24 @@ def test_a_table_without_rows_writes_no_part(tmp_path: Path) -> None:
     assert ws["vessel_id"].to_list() == [v.id for v in sim.vessels]
 
 
+def _write_tables(root: Path, *, frames: int) -> None:
+    """The tables of the first ``frames`` frames of the small scenario, one part, written into ``root``."""
+    sim = Simulation(small_scenario(frames=frames))
+    silhouettes = SilhouetteCache()
+    w = TableWriter(root)
+    for k in range(frames):
+        cap = sim.capture(k)
+        anns = annotations_for(sim, cap, silhouettes)
+        w.add_frame(sim.vessels, cap, {agent: (a, a.columns()) for agent, a in anns.items()})
+    w.flush()
+
+
 def test_parts_written_before_wave_occlusion_read_with_it_null(tmp_path: Path) -> None:
     """A part of an older mmusv (no ``wave_occlusion`` column) reads with that column null, not as damaged and
     not as zeros; a part missing any other column is still damaged."""
     from mmusv.recording.tables import read_table
 
-    sim = Simulation(small_scenario(frames=2))
-    silhouettes = SilhouetteCache()
-    w = TableWriter(tmp_path / "new")
-    for k in range(2):
-        cap = sim.capture(k)
-        anns = annotations_for(sim, cap, silhouettes)
-        w.add_frame(sim.vessels, cap, {agent: (a, a.columns()) for agent, a in anns.items()})
-    w.flush()
+    _write_tables(tmp_path / "new", frames=2)
     for table in ("boxes_3d", "boxes_2d"):
         new = pl.read_parquet(tmp_path / "new" / table / "part-00000.parquet")
         assert new["wave_occlusion"].null_count() == 0
@@ -197,14 +202,7 @@ def test_changed_bytes_in_a_part_are_named_damaged_never_read_as_other_rows(tmp_
     part's rows checksum (file metadata) names it damaged; a part without one (an older mmusv) still reads."""
     from mmusv.recording.tables import read_table
 
-    sim = Simulation(small_scenario(frames=2))
-    silhouettes = SilhouetteCache()
-    w = TableWriter(tmp_path / "good")
-    for k in range(2):
-        cap = sim.capture(k)
-        anns = annotations_for(sim, cap, silhouettes)
-        w.add_frame(sim.vessels, cap, {agent: (a, a.columns()) for agent, a in anns.items()})
-    w.flush()
+    _write_tables(tmp_path / "good", frames=2)
     for table in SCHEMAS:
         good = read_table(tmp_path / "good", table)
         src = (tmp_path / "good" / table / "part-00000.parquet").read_bytes()
