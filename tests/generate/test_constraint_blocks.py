@@ -140,3 +140,13 @@ def test_the_ego_is_checked_too() -> None:
     room = 10 + (r_ego + r_target) / 2
     bad = _infeasible(spec, _ctx([room, room], [np.inf, np.inf]), 0)
     assert bad is not None and f"the ego ({spec.usv.assets[0]})" in bad[2]
+
+
+def test_a_closest_approach_range_of_one_value_is_refused() -> None:
+    """``range_m: [100, 100]`` was accepted, then every attempt failed ("is 100 m, outside [100, 100] m")."""
+    spec = dict(TINY, difficulties={"close": {"range_m": [100, 100]}})
+    with pytest.raises(
+        ConfigError, match=r"difficulties\.close\.range_m.*low < high: no candidate passes at exactly 100"
+    ):
+        load_spec(spec)
+    load_spec(dict(TINY, difficulties={"close": {"range_m": [99, 100]}}))

@@ -234,6 +234,11 @@ class Difficulty(_Model):
             raise ValueError("must be >= 0")
         if v[1] > MAX_RANGE_M:
             raise ValueError(f"must be <= {MAX_RANGE_M:,.0f} m")
+        if v[0] == v[1]:  # accepted, then every attempt failed: a closest approach is never exactly that
+            raise ValueError(
+                f"must be [low, high] with low < high: no candidate passes at exactly {v[0]:g} m (give a range, e.g. "
+                f"[{max(v[0] - 10.0, 0.0):g}, {v[1] + 10.0:g}])"
+            )
         return _ordered(v, "range_m")
 
     @field_validator("extra_targets", mode="before")
