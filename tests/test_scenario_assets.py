@@ -73,6 +73,18 @@ def test_a_missing_asset_file_is_named_with_its_field_before_anything_is_written
     assert not out.exists()
 
 
+@pytest.mark.parametrize(("text", "kind"), [("just words\n", "text"), ("42\n", "a number"), ("", "nothing")])
+def test_an_asset_file_that_holds_no_asset_says_what_it_holds(tmp_path: Path, text: str, kind: str) -> None:
+    """It said "must hold one asset mapping; use load_asset_catalog() for a list", the Python API's advice, though a
+    scenario's assets entry takes a list already."""
+    (tmp_path / "boats").mkdir()
+    (tmp_path / "boats" / "skiff.yaml").write_text(text, encoding="utf-8")
+    (tmp_path / "scen.yaml").write_text(SCENARIO, encoding="utf-8")
+    with pytest.raises(ConfigError, match=rf"skiff\.yaml holds {kind}, not an asset: .*or a list of them") as info:
+        load_scenario(tmp_path / "scen.yaml")
+    assert "load_asset_catalog" not in str(info.value)
+
+
 def test_an_asset_name_the_library_holds_is_refused_naming_both(tmp_path: Path) -> None:
     _boat(tmp_path, name="usv_wamv")
     (tmp_path / "scen.yaml").write_text(SCENARIO, encoding="utf-8")

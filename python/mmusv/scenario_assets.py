@@ -78,6 +78,12 @@ def register_scenario_assets(entries: Any, *, base_dir: Path, where: str) -> Non
                     continue
                 data = read_yaml(path, kind="asset file")
                 is_list = isinstance(data, list) or (isinstance(data, dict) and "vessels" in data)
+                if not is_list and not isinstance(data, dict):  # (load_asset_file's message names its Python twin)
+                    raise ConfigError(
+                        f"{path} holds {_kind(data)}, not an asset: "
+                        "an asset file holds one asset (a mapping with a name and a mesh or a hull) or a list of "
+                        "them (docs/assets.md)"
+                    )
                 assets = load_asset_catalog(path) if is_list else [load_asset_file(path)]
             except (AssetSpecError, ConfigError, OSError) as exc:
                 raise ConfigError(f"{field}: {exc}") from None
@@ -129,3 +135,14 @@ def asset_digest(names: Iterable[str]) -> str:
 def scenario_base(source: str | os.PathLike[str] | None) -> Path:
     """The folder a scenario's relative asset paths start from: its file's folder, else the current one."""
     return Path(os.fspath(source)).expanduser().resolve().parent if source is not None else Path.cwd()
+
+
+def _kind(data: object) -> str:
+    """What a YAML document that is no asset holds, in words."""
+    if data is None:
+        return "nothing"
+    if isinstance(data, bool):
+        return "a true/false value"
+    if isinstance(data, (int, float)):
+        return "a number"
+    return "text" if isinstance(data, str) else f"a {type(data).__name__}"
