@@ -218,6 +218,21 @@ def test_a_recover_stopped_or_failing_midway_leaves_the_folder_as_it_was(
     assert res.frames == list(range(8)) and (folder / "tiny.mcap").is_file() and (folder / "tables").is_dir()
 
 
+def test_recover_refuses_a_folder_a_run_is_still_writing(small: Path, tmp_path: Path) -> None:
+    """recover did not take the folder's lock: a .partial a run was still writing was finished under it, its tables
+    replaced."""
+    from mmusv.recording.guard import FolderLock
+    from mmusv.recording.recover import recover
+
+    folder = _killed_run(small, tmp_path / "running")
+    before = _files(folder)
+    with FolderLock(folder, what="mmusv run"):  # as the run holds it while it writes
+        with pytest.raises(IoError, match=r"running is being written by another mmusv process"):
+            recover(folder)
+        assert _files(folder) == before
+    assert recover(folder).frames == list(range(8))
+
+
 _STOPPER = """
 import os, signal, sys
 from mcap.writer import Writer

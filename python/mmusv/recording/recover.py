@@ -36,6 +36,7 @@ from pathlib import Path
 from typing import Any
 
 from mmusv.errors import IoError
+from mmusv.recording.guard import FolderLock
 from mmusv.recording.info import RecordingInfo, another_run, check_mcap, read_info, recording_arg
 from mmusv.recording.scan import Scan
 from mmusv.recording.stream import FrameStream
@@ -365,6 +366,13 @@ def recover(target: str | os.PathLike[str], *, overwrite: bool = False) -> Recov
             recording of ``mmusv run``, or the folder cannot be written.
     """
     src = _recover_target(target)
+    # a run still writing the folder holds its lock: recovering its .partial meanwhile replaced its tables
+    with FolderLock(src.parent, what="mmusv process (a run, or a recover)"):
+        return _recover(src, overwrite)
+
+
+def _recover(src: Path, overwrite: bool) -> Recovered:
+    """:func:`recover` of the recording ``src``, its folder locked."""
     if not src.name.endswith(".partial"):
         return rebuild_finished_tables(src)
     final = src.with_name(src.name[: -len(".partial")])
