@@ -499,6 +499,8 @@ def test_lidar_misconfig_names_the_field(make_scenario: Any, lidar: dict[str, An
         # front and FRONT: one export folder on a file system that ignores case (they were both accepted)
         ({"cameras": [{"name": "front"}, {"name": "FRONT"}]}, r"rigs\.r\b.*than case: 'front' and 'FRONT'"),
         ({"cameras": [{"name": "bad name!"}]}, r"rigs\.r\.cameras\[0\]\.name"),
+        # 0 in the native sensors' 32-bit floats: refused as "range_m = 0", though the file said 1e-300
+        ({"cameras": [{"name": "a", "range_m": 1e-300}]}, r"rigs\.r\.cameras\[0\]\.range_m = 1e-300: .*0\.01"),
         ({"top_view": {"orientation": "south_up"}}, r"rigs\.r\.top_view\.orientation"),
     ],
 )

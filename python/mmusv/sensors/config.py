@@ -101,6 +101,10 @@ def _check_outputs(v: Sequence[str], allowed: tuple[str, ...], drop: str) -> Non
         raise ValueError(f"lists {', '.join(twice)} more than once; list each output once (of {', '.join(allowed)})")
 
 
+MIN_RANGE_M = 0.01
+"""The shortest range a LiDAR, radar or camera takes, metres: the native sensors hold ranges as 32-bit floats, in
+which a range of 1e-300 m is 0 (refused then as ``range_m = 0``, though the file said otherwise)."""
+
 MAX_MOUNT_OFFSET_M = 100_000.0
 """The largest mount offset a sensor takes, metres (the longest sensor range, :attr:`LidarConfig.range_m`'s bound)."""
 
@@ -138,7 +142,7 @@ class LidarConfig(_Model):
     elevations_deg: list[float] | None = None
     points_per_second: float = Field(default=131_072.0, gt=0, le=1e10)
     rotation_hz: float = Field(default=5.0, ge=0.1, le=100)
-    range_m: float = Field(default=200.0, gt=0, le=100_000)
+    range_m: float = Field(default=200.0, ge=MIN_RANGE_M, le=100_000)
     range_min_m: float = Field(default=0.5, ge=0)
     range_noise_std_m: float = Field(default=0.02, ge=0, le=100)
     dropout: float = Field(default=0.0, ge=0, le=1)
@@ -244,7 +248,7 @@ class RadarConfig(_Model):
     weakens the clutter close in: the counts are lower now, not measured again here.)
     """
 
-    range_m: float = Field(default=3000.0, gt=0, le=100_000)
+    range_m: float = Field(default=3000.0, ge=MIN_RANGE_M, le=100_000)
     min_range_m: float = Field(default=10.0, ge=0)
     range_resolution_m: float = Field(default=3.0, ge=1e-6, le=100_000)
     azimuth_bins: int = Field(default=2048, ge=1, le=65536)
@@ -340,7 +344,7 @@ class CameraConfig(_Model):
     outputs: list[CameraOutput] = Field(
         default_factory=lambda: list(_ALL_OUTPUTS), json_schema_extra={"uniqueItems": True}
     )
-    range_m: float = Field(default=5000.0, gt=0, le=1e6)
+    range_m: float = Field(default=5000.0, ge=MIN_RANGE_M, le=1e6)
     mount: Mount = Mount()
     quality: Quality = "standard"
     distortion: tuple[float, float, float, float, float] | None = None
