@@ -491,13 +491,10 @@ def _earlier_run(out: Path, rec_path: Path) -> str:
     """What the run folder ``out`` says of the run that wrote ``rec_path`` when it did not finish, as
     ``" (its run was interrupted: 61 of 300 frames written)"`` (``""`` otherwise): refused without a word on it, a
     stopped run looked like a finished one that a second run would only repeat."""
-    import json
+    from mmusv.jsonio import read_json_or_none
 
-    try:
-        manifest = json.loads((out / "manifest.json").read_bytes())
-    except (OSError, ValueError):
-        return ""
-    if not isinstance(manifest, dict) or manifest.get("recording") != rec_path.name:
+    manifest = read_json_or_none(out / "manifest.json")
+    if manifest is None or manifest.get("recording") != rec_path.name:
         return ""
     status, written, asked = manifest.get("status"), manifest.get("frames_written"), manifest.get("frames_requested")
     if status in (None, "complete") or not isinstance(status, str):
@@ -551,10 +548,10 @@ def _refuse_foreign_files(out: Path, cfg: object) -> None:
     ``scenario.yaml`` lies beside its recording (``.mcap``, or ``.mcap.partial`` of a killed run), or is the
     resolved scenario as :func:`_replace_outputs` dumps it (read back and dumped again, it is the same text); its
     ``manifest.json`` is a JSON object naming its ``recording`` and ``mmusv_version``."""
-    import json
     import warnings
 
     from mmusv.config import load_scenario
+    from mmusv.jsonio import read_json_or_none
 
     scenario_file, manifest = out / "scenario.yaml", out / "manifest.json"
     foreign: Path | None = None
@@ -570,11 +567,8 @@ def _refuse_foreign_files(out: Path, cfg: object) -> None:
         if text != dumped:
             foreign = scenario_file
     if foreign is None and manifest.is_file():
-        try:
-            doc = json.loads(manifest.read_bytes())
-        except (OSError, ValueError):
-            doc = None
-        if not (isinstance(doc, dict) and isinstance(doc.get("recording"), str) and "mmusv_version" in doc):
+        doc = read_json_or_none(manifest)
+        if not (doc is not None and isinstance(doc.get("recording"), str) and "mmusv_version" in doc):
             foreign = manifest
     if foreign is None:
         return
