@@ -292,3 +292,34 @@ def test_a_shortened_or_misspelt_flag_is_refused_with_the_flag_it_may_mean(
     assert "unrecognized arguments" in err and hint in err and "Traceback" not in err, err
     assert err.count("\n") == 1, err
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    ("argv", "said"),
+    [
+        # argparse said "unknown command '1'", naming the option's value as the command
+        (["--frames", "1", "run", "rec"], "option --frames is given before the command 'run'"),
+        # argparse said "unrecognized arguments: --frames=1 (see mmusv run --help)", though run takes --frames
+        (["--frames=1", "run", "rec"], "option --frames=1 is given before the command 'run'"),
+        (["-o", "out", "convert", "rec"], "option -o is given before the command 'convert'"),
+        (["--frames", "1"], "option --frames is given before any command"),
+    ],
+)
+def test_an_option_before_the_command_is_said_to_belong_after_it(
+    argv: list[str], said: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    with pytest.raises(SystemExit) as e:
+        main(argv)
+    assert e.value.code == 2
+    err = capsys.readouterr().err
+    assert err.startswith("mmusv: error: ") and said in err and "Traceback" not in err, err
+    assert err.count("\n") == 1, err
+    if "any command" not in said:
+        command = argv[argv.index(said.split("'")[1])]
+        assert f"as in: mmusv {command} " in err, err
+
+
+def test_a_misspelt_command_is_still_named_as_unknown(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit):
+        main(["runn", "x"])
+    assert "unknown command 'runn'" in capsys.readouterr().err

@@ -35,16 +35,24 @@ class CommandParser(argparse.ArgumentParser):
         kwargs.setdefault("allow_abbrev", False)
         super().__init__(*args, **kwargs)
 
+    _given: list[str] | None = None
+    """The arguments the top parser (``mmusv``) was given, for :func:`_misplaced_options`."""
+
     def parse_known_args(  # type: ignore[override]
         self, args: Sequence[str] | None = None, namespace: argparse.Namespace | None = None
     ) -> tuple[argparse.Namespace, list[str]]:
         CommandParser._deepest = self
+        if " " not in self.prog:  # the top parser: sub-parsers' progs are ``mmusv run`` and the like
+            self._given = list(sys.argv[1:] if args is None else args)
         return super().parse_known_args(args, namespace)
 
     def error(self, message: str) -> NoReturn:
         prog = self.prog
         deepest = CommandParser._deepest
-        if message.startswith("unrecognized arguments") and deepest is not None:
+        misplaced = _misplaced_options(self)
+        if misplaced:
+            message, prog = misplaced, self.prog.split()[0]
+        elif message.startswith("unrecognized arguments") and deepest is not None:
             prog = deepest.prog
             message += _did_you_mean(deepest, message)
         message = " ".join(message.split())
@@ -55,6 +63,32 @@ class CommandParser(argparse.ArgumentParser):
         with contextlib.suppress(OSError, ValueError):
             print(line, file=sys.stderr, flush=True)
         self.exit(2)
+
+
+def _misplaced_options(parser: argparse.ArgumentParser) -> str | None:
+    """The error for options given before the command's name (``mmusv --frames 1 run x``), which argparse
+    reported as ``unknown command '1'`` or as an argument ``mmusv run`` does not know (it knows ``--frames``);
+    None when ``parser`` is not the top parser or no option precedes the command."""
+    given = getattr(parser, "_given", None)
+    commands = next((a.choices for a in parser._actions if isinstance(a, argparse._SubParsersAction)), None)
+    if given is None or not commands:
+        return None
+    own = {o for a in parser._actions for o in a.option_strings}
+    at = next((i for i, word in enumerate(given) if word in commands), None)
+    before = given[: len(given) if at is None else at]
+    options = [w for w in before if w.startswith("-") and w != "-" and w.split("=", 1)[0] not in own]
+    if not options:
+        return None
+    if at is None:
+        return (
+            f"option {options[0]} is given before any command: mmusv itself takes only --help and --version; "
+            "a command's options go after its name (mmusv COMMAND --help lists them)"
+        )
+    command = given[at]
+    return (
+        f"option {' '.join(options)} is given before the command {command!r}: a command's options go after its "
+        f"name, as in: mmusv {' '.join([command, *given[at + 1 :], *before])}"
+    )
 
 
 def _did_you_mean(parser: argparse.ArgumentParser, message: str) -> str:
