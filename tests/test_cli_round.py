@@ -98,7 +98,7 @@ def test_info_of_a_killed_run_without_a_frame_does_not_suggest_recover(
     folder.mkdir()
     _killed_copy(runs / "tiny" / "tiny.mcap", folder / "tiny.mcap.partial", messages=0)
     code, out, _ = _cli(["info", str(folder)], capsys)
-    assert code == 0 and "0 of 3 frames" in out and "nothing to recover" in out, out
+    assert code == 1 and "0 of 3 frames" in out and "nothing to recover" in out, out  # no frame: exit 1
     assert "mmusv recover" not in out and "tables does not exist" not in out, out
     code, _, err = _cli(["recover", str(folder)], capsys)
     assert code == 2 and "no complete frame" in err  # what the hint no longer promises

@@ -178,8 +178,8 @@ def parser() -> argparse.ArgumentParser:
         "recording",
         help="an .mcap (or .mcap.partial, .parts.json) written by mmusv run, or its folder; a folder of run folders "
         "(a batch's output, links to run folders followed): one row per recording below, and one per recording its "
-        "dataset.json or a run's manifest.json names that is gone; exits 1 when one of them is gone, cannot be read "
-        "at all or holds no readable frame",
+        "dataset.json or a run's manifest.json names that is gone; exits 1 when the recording (or one of them) is "
+        "gone, cannot be read at all or holds no readable frame",
     )
     rec = sub.add_parser(
         "recover",

@@ -115,7 +115,11 @@ def cmd_info(args: argparse.Namespace) -> int:
             console.print(
                 f"it holds no complete frame: nothing to recover (`mmusv run` on {target.parent} records it again)"
             )
-    return 0
+    # Exit 1 when not one frame reads, as a folder's overview does for such a row: there is nothing to convert,
+    # study or preview (a damaged or unfinished recording that reads in part warns and exits 0).
+    if frames:
+        return 1 if not frames.get("read") and frames.get("expected") else 0
+    return 1 if info.get("frames") is None and problems and not info.get("messages") else 0
 
 
 def _scenario_of(meta: dict[str, dict[str, str]], target: Path) -> str:

@@ -11,6 +11,7 @@ fix:
 
 from __future__ import annotations
 
+import re
 import shutil
 import subprocess
 import sys
@@ -99,6 +100,19 @@ def test_info_of_a_batch_exits_1_for_a_recording_of_no_readable_frame(
     (copy / "b" / "b.mcap").write_bytes(bytes(data))
     code, out, err = cli_main("info", str(copy))
     assert code == 1 and _rows(out)["b/b.mcap"][2] == "0 of 2" and "holds no readable frame" in out, (out, err)
+    # each on its own exits 1 as well: it exited 0, so `mmusv info rec && mmusv convert rec` went on to nothing
+    for one in (copy / "b" / "b.mcap", copy / "b"):
+        code, out, err = cli_main("info", str(one))
+        assert code == 1 and "0 of 2 frames" in out and "Traceback" not in err, (out, err)
+    killed_copy(batch / "b" / "b.mcap", copy / "b" / "b.mcap.partial", messages=0)
+    (copy / "b" / "b.mcap").unlink()
+    code, out, err = cli_main("info", str(copy / "b" / "b.mcap.partial"))
+    assert code == 1 and "nothing to recover" in out, (out, err)
+    # one that reads in part still warns and exits 0
+    killed_copy(batch / "b" / "b.mcap", copy / "b" / "b.mcap.partial", messages=8)
+    code, out, err = cli_main("info", str(copy / "b" / "b.mcap.partial"))
+    assert code == 0 and "mmusv recover" in out, (out, err)
+    assert re.search(r", 1 of 2 frames,", " ".join(out.split())), out
 
 
 # ------------------------------------------------------------------------- recover: tables of a finished run
