@@ -79,7 +79,10 @@ def test_a_stop_while_the_recording_opens_leaves_a_run_that_says_what_it_is(
     info = read_info(out / "stopme.mcap")
     assert info.run["status"] == "interrupted" and info.config_hash == manifest["config_hash"]
     code, text, err = _cli(["info", str(out)], capsys)
-    assert code == 0 and "not written by mmusv run" not in text and "status interrupted" in text, (text, err)
+    assert code == 1 and "not written by mmusv run" not in text and "status interrupted" in text, (
+        text,
+        err,
+    )  # no frame
 
 
 def test_held_signals_hand_a_stop_on_once_released() -> None:

@@ -160,4 +160,4 @@ def test_a_stop_while_the_new_recording_opens_leaves_a_run_that_says_so(
     info = read_info(out / "keepme.mcap")
     assert info.run["status"] == "interrupted"
     code, text, err = _cli(["info", str(out)], capsys)
-    assert code == 0 and "status interrupted" in text, (text, err)
+    assert code == 1 and "status interrupted" in text and "0 of 2 frames" in text, (text, err)  # 1: no frame

@@ -70,7 +70,7 @@ def test_truncation_at_random_byte_offsets(chunky: tuple[Path, dict[int, dict[st
         whole = [s for s in chunk_spans(src) if s[1] <= cut]
         assert len(frames) >= len(whole) - 2, (cut, len(frames), len(whole))
         code, out, err = cli_main("info", str(path))
-        assert code == 0 and "Traceback" not in err
+        assert code == (0 if frames else 1) and "Traceback" not in err, (cut, len(frames), err)  # 1: no frame reads
         assert "mmusv: warning:" in out and "truncated" in out
         if len(frames) < 12:
             assert f"{len(frames)} of 12 frames" in out and "missing" in out, out

@@ -100,7 +100,8 @@ def test_mutated_recordings_give_a_clean_error_or_the_right_frames(
                     assert path.name in str(res), res
             check_against(results, reference)
             code, _out, err = cli_main("info", str(path))
-        assert code in (0, 2) and "Traceback" not in err
+        # 2: not readable at all; 1: read, but not one frame (nothing to convert); 0: frames read, damage warned
+        assert code in (0, 1, 2) and "Traceback" not in err
         if code == 2:
             assert err.startswith("mmusv: error: ") and err.count("\n") == 1, err
 
