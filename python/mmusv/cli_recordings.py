@@ -278,7 +278,7 @@ def _table_problems(recording: Path, frames: dict[str, object]) -> tuple[list[st
 
 def _tables_of(recording: Path, span: range | None, missing: set[int]) -> tuple[list[str], list[Path]]:
     from mmusv.recording.info import recording_name
-    from mmusv.recording.recover import check_tables, listed_tables
+    from mmusv.recording.rebuild import check_tables, listed_tables
 
     tables = recording.parent / "tables"
     try:
