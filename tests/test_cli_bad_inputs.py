@@ -323,3 +323,14 @@ def test_a_misspelt_command_is_still_named_as_unknown(capsys: pytest.CaptureFixt
     with pytest.raises(SystemExit):
         main(["runn", "x"])
     assert "unknown command 'runn'" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("seed", ["-1", str(2**63)])
+def test_train_seed_is_refused_by_name_before_anything_is_written(
+    seed: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # -1 built the tensor cache, then failed each model with numpy's "expected non-negative integer" and a traceback
+    argv = ["train", str(tmp_path / "missing.mcap"), "--no-progress", "-o", str(tmp_path / "tr"), "--seed", seed]
+    _, err = _refused(argv, capsys)
+    assert f"--seed {seed}: the seed of the split, the weights and the augmentation must be a whole number" in err, err
+    assert not (tmp_path / "tr").exists()

@@ -362,14 +362,19 @@ def _check_cache(
 
 
 def _check_numbers(args: argparse.Namespace) -> None:
-    """``--epochs``, ``--time-limit`` and ``--workers`` checked before anything is built or written: a negative
-    or NaN time limit stopped training after one step with a model that looked complete."""
+    """``--epochs``, ``--time-limit``, ``--workers`` and ``--seed`` checked before anything is built or written: a
+    negative or NaN time limit stopped training after one step with a model that looked complete."""
     if args.epochs is not None and args.epochs < 1:
         raise InputError(f"--epochs {args.epochs}: must be >= 1 (or left out for the preset's)")
     if args.time_limit is not None and not (math.isfinite(args.time_limit) and args.time_limit > 0):
         raise InputError(f"--time-limit {args.time_limit}: seconds, a finite number > 0 (or left out for no limit)")
     if args.workers < 0:
         raise InputError(f"--workers {args.workers}: must be >= 0 (0: load data in the training process)")
+    if not 0 <= args.seed < 2**63:  # -1 failed each model after the cache was built, a numpy traceback
+        raise InputError(
+            f"--seed {args.seed}: the seed of the split, the weights and the augmentation must be a whole number in "
+            f"0..{2**63 - 1}"
+        )
     from mmusv.batch.executors import available_cpus
 
     check_threads(args.threads)
