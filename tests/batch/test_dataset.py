@@ -214,3 +214,31 @@ def test_a_spec_no_candidate_meets_is_a_quota_shortfall_not_a_crash(
         doc = read_index(out / "dataset.json")
         assert doc["recordings"] == [] and doc["opv2v"]["status"] == "nothing to convert"
         assert doc["spec"]["name"] == "impossible_port"
+
+
+def test_an_index_left_by_a_stop_during_the_conversion_does_not_call_it_complete(
+    built: tuple[Path, Path, str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The index kept the earlier conversion's ``complete`` while ``opv2v/`` was being written again: a Ctrl-C then
+    left ``"opv2v": {"status": "complete"}`` over a folder of a part of the files. It says ``converting`` until the
+    conversion is done; a re-run finishes it into the same bytes."""
+    from mmusv.export import conversion
+
+    spec, done, _ = built
+    out = tmp_path / "ds"
+    shutil.copytree(done, out)
+    shutil.rmtree(out / "opv2v")
+    real = conversion.convert
+    seen: list[str] = []
+
+    def stopped(*args: object, **kwargs: object) -> object:
+        seen.append(read_index(out)["opv2v"]["status"])
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(conversion, "convert", stopped)
+    with pytest.raises(KeyboardInterrupt):
+        build_dataset(spec, out_dir=out)
+    assert seen == ["converting"] and read_index(out)["opv2v"]["status"] == "converting"
+    monkeypatch.setattr(conversion, "convert", real)
+    rep = build_dataset(spec, out_dir=out)
+    assert rep.converted and tree(out) == tree(done)

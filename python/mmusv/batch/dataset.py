@@ -15,7 +15,8 @@ Steps, each skipped on a re-run when its result is already there:
 3. convert the complete recordings to OPV2V (:func:`mmusv.export.convert`) into ``DIR/opv2v`` (skipped when the
    last conversion was of the same recordings and configurations);
 4. ``DIR/dataset.json`` (:mod:`mmusv.batch.index`) lists every recording, with sections ``spec`` (file name,
-   name, hash) and ``opv2v`` (folder, frames converted, the recordings converted with their hashes).
+   name, hash) and ``opv2v`` (folder, status, frames converted, the recordings converted with their hashes; status
+   ``converting`` while step 3 runs, so an index left by a stop then never calls a half-written folder complete).
 """
 
 from __future__ import annotations
@@ -277,8 +278,16 @@ def build_dataset(
         up_to_date = (
             section.get("sources") == sources and section.get("status") == "complete" and _conversion_complete(opv2v)
         )
+        from mmusv.batch.index import Entry
+
+        entries = [Entry(**{k: r[k] for k in Entry.__dataclass_fields__}) for r in doc["recordings"]]
         if sources and not up_to_date:
             recs = [out / r["recording"] for r in doc["recordings"] if r["name"] in sources]
+            # the index says the conversion is under way until it is done: it kept the earlier conversion's
+            # "complete" while DIR/opv2v was being replaced, so a stop meanwhile left it saying complete over a
+            # folder holding a part of the files (conversion.yaml said interrupted)
+            converting = {"folder": opv2v.name, "status": "converting", "frames": 0, "sources": {}}
+            write_index(index_path, entries, extra={"spec": spec_section, "opv2v": converting})
             try:
                 conv = convert(
                     recs,
@@ -299,9 +308,6 @@ def build_dataset(
         elif not sources:
             section = {"folder": opv2v.name, "status": "nothing to convert", "frames": 0, "sources": {}}
             converted = 0  # not "up to date": no recording is complete
-        from mmusv.batch.index import Entry
-
-        entries = [Entry(**{k: r[k] for k in Entry.__dataclass_fields__}) for r in doc["recordings"]]
         write_index(index_path, entries, extra={"spec": spec_section, "opv2v": section})
         return DatasetReport(
             out_dir=out, generated=generated, shortfall=shortfall, batch=batch, converted=converted, opv2v=opv2v
