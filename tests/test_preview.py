@@ -172,3 +172,29 @@ def test_a_frame_after_a_stopped_run_s_last_is_said_to_be_past_it(tmp_path: Path
     assert "which holds frames 0..1 (its run is interrupted: 2 of the 6 frames it set out to write)" in str(err.value)
     with pytest.raises(ConfigError, match=r"which holds frames 0\.\.1 \(its run is interrupted"):  # past the plan
         frame_messages(rec, 9)
+
+
+def test_a_preview_that_cannot_be_written_leaves_the_picture_before_it(recording: Path, tmp_path: Path) -> None:
+    """``-o`` of an existing picture and a write that fails (here the file size limit; a full disk alike): the
+    picture was cut to the limit, a PNG that no longer reads, and the one before it lost."""
+    import subprocess
+    import sys
+
+    out = tmp_path / "keep.png"
+    before = b"\x89PNG\r\n\x1a\n" + b"an earlier preview" * 10
+    out.write_bytes(before)
+
+    code = (
+        "import resource, sys\nfrom mmusv.errors import IoError\nfrom mmusv.preview import write_preview\n"
+        "resource.setrlimit(resource.RLIMIT_FSIZE, (4096, 4096))\n"
+        "try:\n    write_preview(sys.argv[1], frame=0, output=sys.argv[2])\n"
+        "except IoError as exc:\n    print(exc)\n    sys.exit(3)\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code, str(recording), str(out)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert done.returncode == 3 and "cannot write the preview" in done.stdout, (done.stdout, done.stderr)
+    assert out.read_bytes() == before and [p.name for p in tmp_path.iterdir()] == ["keep.png"]

@@ -284,8 +284,14 @@ def write_preview(
     a = panels[0].title.split(" · ")[0]
     name = f"{recording_name(path)}_frame{frame:06d}_{a}.png"
     out = Path(path).with_name(name) if target is None else target / name if target.is_dir() else target
-    try:
-        canvas.save(out)
+    import io
+
+    from mmusv.jsonio import write_bytes_atomic
+
+    data = io.BytesIO()
+    canvas.save(data, format="PNG" if out.suffix.lower() == ".png" else "JPEG")
+    try:  # through a temporary file and a rename: a full disk or a kill left a cut picture over the one before
+        write_bytes_atomic(out, data.getvalue())
     except OSError as exc:
         raise IoError(f"cannot write the preview {out}: {exc.strerror or exc}") from None
     return out
