@@ -523,3 +523,20 @@ def test_a_restarted_server_shows_the_runs_already_in_its_folder(client: TestCli
         assert [j["scenario"] for j in TestClient(create_app(folder)).get("/api/runs").json()] == ["cli.yml"]
     finally:
         jobs.KEEP_FINISHED = keep
+
+
+def test_a_stopped_run_names_its_recording_and_frames(client: TestClient, folder: Path) -> None:
+    """A run stopped from the page said ``"recording": null`` though its recording held every completed frame (a
+    restarted server named it, from the run's manifest.json)."""
+    doc = small(bundled_doc(client))
+    assert client.put("/api/files/stopme.yaml", json={"document": doc}).status_code == 200
+    job = client.post("/api/runs", json={"name": "stopme.yaml"}).json()
+    deadline = time.monotonic() + 120
+    while client.get(f"/api/runs/{job['id']}").json()["done"] < 1:  # a frame written: the recording is open
+        assert time.monotonic() < deadline, "no frame in 120 s"
+        time.sleep(0.05)
+    client.delete(f"/api/runs/{job['id']}")
+    end = _wait_run(client, job["id"])
+    manifest = json.loads((folder / "out" / "stopme" / "manifest.json").read_text())
+    assert end["status"] == "interrupted" and end["recording"] == str(folder / "out" / "stopme" / "port_entry.mcap")
+    assert end["done"] == manifest["frames_written"] >= 1, (end, manifest)

@@ -4,7 +4,7 @@ It calls :func:`mmusv.acquire.run` (what ``mmusv run SCENARIO -o OUT --overwrite
 JSON object per line: ``{"done": k, "total": n}`` after every frame, ``{"warning": "..."}`` for each check warning,
 and last ``{"status": "complete", "frames": k, "recording": path, "seconds": s}``, ``{"status": "failed",
 "error": "..."}`` (exit status 2) or ``{"status": "interrupted", ...}`` after SIGINT (exit status 130; the
-recording then holds every completed frame).
+recording then holds every completed frame, and the line names it and its frames as for a complete run).
 """
 
 from __future__ import annotations
@@ -20,6 +20,23 @@ __all__ = ["main"]
 
 def _say(obj: dict[str, Any]) -> None:
     print(json.dumps(obj), flush=True)
+
+
+def _kept(args: argparse.Namespace) -> dict[str, Any]:
+    """``frames`` and ``recording`` of a stopped run, as its ``manifest.json`` (written on the way out) names them;
+    empty when it has none (stopped before its recording opened). The status line said ``"recording": null`` of a
+    recording holding every completed frame."""
+    from pathlib import Path
+
+    from mmusv.jsonio import read_json_or_none
+
+    out = Path(args.output)
+    manifest = read_json_or_none(out / "manifest.json")
+    name = None if manifest is None else manifest.get("recording")
+    if not isinstance(name, str) or not (out / name).is_file():
+        return {}
+    frames = manifest.get("frames_written") if manifest is not None else None
+    return {"recording": str(out / name), **({"frames": frames} if isinstance(frames, int) else {})}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -52,7 +69,7 @@ def main(argv: list[str] | None = None) -> int:
         _say({"status": "failed", "error": str(exc)})
         return 2
     except KeyboardInterrupt:
-        _say({"status": "interrupted", "error": "stopped; the recording holds every completed frame"})
+        _say({"status": "interrupted", "error": "stopped; the recording holds every completed frame", **_kept(args)})
         return 130
     _say(
         {
