@@ -180,6 +180,18 @@ def test_if_match_star_needs_the_file_to_exist(client: TestClient, folder: Path,
     assert not (folder / "gone.yaml").exists()
 
 
+def test_if_match_of_a_file_deleted_since_is_refused(client: TestClient, folder: Path, doc: dict[str, Any]) -> None:
+    """An ETag of a file deleted (or renamed in another tab) since: it was created again under its old name, 200,
+    where ``*`` was refused (RFC 9110: If-Match fails when no current version matches)."""
+    tag = client.put("/api/files/was.yaml", json={"document": doc}).json()["etag"]
+    (folder / "was.yaml").rename(folder / "renamed.yaml")
+    r = client.put("/api/files/was.yaml", json={"document": doc, "overwrite": True}, headers={"If-Match": f'"{tag}"'})
+    assert "does not exist" in error_of(r, 412) and "deleted or renamed" in r.text
+    assert not (folder / "was.yaml").exists()
+    # saved again without If-Match (the page's Overwrite), it is created
+    assert client.put("/api/files/was.yaml", json={"document": doc, "overwrite": True}).status_code == 200
+
+
 # ------------------------------------------------------------------------------------------------ opening files
 
 

@@ -153,7 +153,7 @@ class ScenarioFolder:
         """Writes ``text`` to the file ``name`` (atomically); :class:`FileExistsInFolder` when it exists and
         ``overwrite`` is false, or when the name is a folder or another non-file; :class:`ChangedInFolder` when
         ``if_match`` (the ETags of an ``If-Match`` header, ``"*"`` for any version) is given, the file exists and
-        its ETag is none of them, or it is ``"*"`` and the file does not exist; :class:`ConfigError` when the text
+        its ETag is none of them, or the file does not exist (whatever the ETags); :class:`ConfigError` when the text
         is larger than :data:`MAX_FILE_BYTES` (the file would not open again): nothing is written."""
         p = self.path(name)
         data = text.encode("utf-8")
@@ -174,10 +174,10 @@ class ScenarioFolder:
                 )
             if if_match is not None:
                 now = self.etag_of(name)
-                if now is None and "*" in if_match:
-                    raise ChangedInFolder(
+                if now is None:  # no version of it matches (RFC 9110, 13.1.1): an ETag of it was not refused
+                    raise ChangedInFolder(  # and the file came back under its old name, renamed in another tab
                         f"{name} does not exist in the editor's folder (If-Match names a version of an existing "
-                        "file; was it deleted or renamed?): save it again without If-Match"
+                        "file; was it deleted or renamed?): save it again without If-Match (Overwrite) to create it"
                     )
                 if now is not None and "*" not in if_match and now not in if_match:
                     raise ChangedInFolder(
