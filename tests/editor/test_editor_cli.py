@@ -57,3 +57,45 @@ def test_bad_arguments_end_with_one_line(args: list[str], says: str, capsys: pyt
     assert main(args) == 2
     err = capsys.readouterr().err
     assert says in err and err.count("\n") == 1 and err.startswith("mmusv: error:")
+
+
+def _opened(argv: list[str], monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> tuple[dict, str]:
+    """``mmusv editor ARGV`` up to serving: the page's ``initial`` scenario (``/api/info``) and what was printed."""
+    import warnings
+
+    from mmusv.editor import cli as editor_cli
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # starlette's notice about its httpx-based test client
+        from fastapi.testclient import TestClient
+
+    apps: list[object] = []
+    monkeypatch.setattr(editor_cli, "serve", lambda app, **kw: apps.append(app))
+    assert main(argv) == 0
+    (app,) = apps
+    info = TestClient(app, base_url="http://127.0.0.1").get("/api/info").json()  # type: ignore[arg-type]
+    return info["initial"], capsys.readouterr().err
+
+
+def test_a_scenario_that_does_not_validate_opens_to_be_fixed(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """It was refused (exit 2), though the page opens the same file from its Open box and lists what is wrong."""
+    path = tmp_path / "broken.yaml"
+    path.write_text("# my harbour\nname: broken\nvessels: []\n")
+    initial, err = _opened(["editor", str(path), "--port", "0"], monkeypatch, capsys)
+    assert initial["name"] == "broken.yaml" and initial["in_folder"] is True and initial["etag"], initial
+    assert initial["document"]["vessels"] == [] and initial["comment"] == "my harbour", initial
+    assert "the page lists what is wrong under Checks" in err, err
+
+
+def test_a_file_not_named_yaml_is_said_to_be_saved_under_another_name(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The page was told it was the folder's ``scen.txt.yaml`` (a file that does not exist, saved beside it)."""
+    src = Path(__file__).resolve().parents[2] / "scenarios" / "port_entry.yaml"
+    path = tmp_path / "scen.txt"
+    path.write_bytes(src.read_bytes())
+    initial, err = _opened(["editor", str(path), "--port", "0"], monkeypatch, capsys)
+    assert initial["name"] == "scen.txt.yaml" and initial["in_folder"] is False and initial["etag"] is None
+    assert "scen.txt is saved as scen.txt.yaml" in err, err

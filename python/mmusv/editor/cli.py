@@ -89,6 +89,8 @@ def run(args: argparse.Namespace) -> int:
     from mmusv.editor.app import InitialScenario, comments_json, create_app
     from mmusv.editor.document import leading_comment, to_document
     from mmusv.editor.files import check_name
+    from mmusv.editor.opening import load_document
+    from mmusv.errors import MmusvError
 
     initial = None
     # an empty --dir served the current folder, an empty SCENARIO read "." (a folder): both named now
@@ -97,13 +99,21 @@ def run(args: argparse.Namespace) -> int:
         path = resolve_scenario(path_arg(args.scenario, flag="scenario"))
         if args.dir is None and Path(args.scenario).is_file():
             folder = path.parent
-        scenario = load_scenario(path)
+        text = path.read_text(encoding="utf-8", errors="replace")
+        try:
+            document = to_document(load_scenario(path))
+        except MmusvError as exc:  # opened to be fixed, as the page opens such a file: refused only when it cannot
+            document, _ = load_document(text, str(path))  # draw it (a ConfigError saying why)
+            print(f"mmusv editor: {exc}; the page lists what is wrong under Checks", file=sys.stderr)
+        name = path.name if path.suffix in (".yaml", ".yml") else f"{path.name}.yaml"
+        if name != path.name:  # the page was told it is the folder's file NAME.yaml, and saved that beside it
+            print(f"mmusv editor: the editor saves .yaml files: {path.name} is saved as {name}", file=sys.stderr)
         initial = InitialScenario(
-            name=check_name(path.name if path.suffix in (".yaml", ".yml") else f"{path.name}.yaml"),
-            document=to_document(scenario),
-            comment=leading_comment(text := path.read_text(encoding="utf-8", errors="replace")),
+            name=check_name(name),
+            document=document,
+            comment=leading_comment(text),
             comments=comments_json(text),
-            in_folder=path.resolve().parent == folder.resolve(),
+            in_folder=path.resolve().parent == folder.resolve() and name == path.name,
         )
     host = str(args.host)
     hosts = ["*"] if host in ("0.0.0.0", "::", "") else sorted({host, "127.0.0.1", "localhost", "[::1]"})
