@@ -266,9 +266,13 @@ def test_jobs_for_one_scenario_is_said_to_do_nothing(tmp_path: Path, capsys: pyt
     scenario["vessels"] = [{**v, "rig": "r"} if v.get("role") == "usv" else v for v in scenario["vessels"]]
     path = tmp_path / "one.yaml"
     path.write_text(yaml.safe_dump(scenario))
-    assert main(["run", str(path), "-o", str(tmp_path / "out"), "--frames", "1", "--jobs", "3", "--no-checks"]) == 0
+    argv = ["run", str(path), "-o", str(tmp_path / "out"), "--frames", "1", "--jobs", "3", "--no-checks"]
+    assert main([*argv, "--stop-on-full-disk"]) == 0
     _, err = capsys.readouterr()
     assert "mmusv: note: --jobs 3 runs the scenarios of a folder side by side" in err, err
+    # --stop-on-full-disk was dropped without a word too
+    assert "mmusv: note: --stop-on-full-disk stops a batch's other recordings" in err, err
+    assert (tmp_path / "out" / f"{scenario['name']}.mcap").is_file()  # one file's layout: not a batch of one
 
 
 @pytest.mark.parametrize(

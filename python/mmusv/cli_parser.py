@@ -150,7 +150,11 @@ def parser() -> argparse.ArgumentParser:
 
     add_detection_parsers(studies)
     run = sub.add_parser("run", help="run a scenario (or a folder of them) into an MCAP recording + Parquet tables")
-    run.add_argument("scenario", help="scenario YAML, or a folder of scenario YAMLs")
+    run.add_argument(
+        "scenario",
+        help="scenario YAML, or a folder of scenario YAMLs (a batch: OUT/<file stem>/ each, and OUT/dataset.json); "
+        "one file given --ray, --retries, --split-frames or --cpus-per-task runs as a batch of one, in that layout",
+    )
     run.add_argument("-o", "--output", default="out", help="output folder (default out/)")
     run.add_argument("--overwrite", action="store_true", help="replace an existing recording")
     run.add_argument("--frames", type=int, default=None, help="run only the first N frames")

@@ -97,6 +97,12 @@ def cmd_run(args: argparse.Namespace) -> int:
         if args.profile:
             raise MmusvError("--profile times one run in this process; leave out --ray, --retries and --split-frames")
         return run_batch(args, [src])
+    if args.stop_on_full_disk:  # taken without a word
+        print(
+            "mmusv: note: --stop-on-full-disk stops a batch's other recordings when one fails for a full disk; one "
+            "scenario's run stops there anyway",
+            file=sys.stderr,
+        )
     if args.jobs > 1:  # taken without a word: one scenario runs in this process, on every core
         print(
             f"mmusv: note: --jobs {args.jobs} runs the scenarios of a folder side by side; one scenario runs in "
