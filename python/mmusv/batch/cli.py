@@ -158,6 +158,13 @@ def print_report(report: BatchReport, console: Console) -> None:
             console.print(f"mmusv: warning: {w}", markup=False, highlight=False)
     if report.index_error is not None:
         console.print(f"mmusv: warning: {report.index_error}", markup=False, highlight=False)
+    if report.kept:
+        console.print(
+            f"mmusv: note: {report.index.name} keeps listing {counted(len(report.kept), 'recording')} of an earlier "
+            f"run that this run does not record: {', '.join(report.kept)}",
+            markup=False,
+            highlight=False,
+        )
     index = (
         f"index {report.index}"
         if report.index_error is None

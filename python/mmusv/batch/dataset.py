@@ -219,6 +219,13 @@ def build_dataset(
         old: dict[str, Any] = read_index(index_path) if index_path.is_file() else {}
     except MmusvError:
         old = {}
+    listed = old.get("recordings")
+    if isinstance(listed, list) and listed and not isinstance(old.get("spec"), dict):
+        raise IoError(
+            f"{index_path} is the index of a batch run (mmusv run DIR), not of mmusv dataset: it lists "
+            f"{len(listed)} recording(s) that a dataset there would leave unlisted (its index replaces this one); "
+            "give the dataset a folder of its own (-o)"
+        )
     old_opv2v = _opv2v_section(old)
     spec_section = {"file": Path(sp).name, "name": loaded.name, "hash": _spec_hash(loaded)}
     kept = _generated_set(scen_dir) if old.get("spec") == spec_section else None

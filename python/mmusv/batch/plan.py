@@ -11,7 +11,8 @@ A task is complete when its folder's ``manifest.json`` (written last by :func:`m
 before a task starts) says ``status: complete`` with the scenario's config hash
 (:func:`mmusv.config.scenario_hash`) and the frames asked for. A re-run skips a scenario whose recording is
 complete in either layout; other tasks run again from scratch. A complete recording of another configuration
-is replaced only with ``overwrite``.
+is replaced only with ``overwrite``, and so is a file of the recording's name that no run wrote; a
+``scenario.yaml`` or ``manifest.json`` that no run wrote is never replaced (the scenario fails, naming it).
 """
 
 from __future__ import annotations
@@ -354,7 +355,37 @@ def plan_scenarios(
                 Path(t.out_dir), scenario=name, config_hash=h, frames=t.expected_frames, first_frame=t.first_frame
             )
         ]
+        foreign = next((w for t in plan.to_run if (w := _foreign(Path(t.out_dir), name, f, overwrite))), None)
+        if foreign is not None:
+            plan.error, plan.tasks, plan.to_run = foreign, [], []
     return plans
+
+
+def _foreign(folder: Path, scenario: str, file: Path, overwrite: bool) -> str | None:
+    """Why the run of ``file`` may not write into ``folder``, a task's run folder, or None: it holds a
+    ``scenario.yaml`` or ``manifest.json`` that no run wrote (refused ``--overwrite`` or not, as the run of one file
+    refuses them: :func:`mmusv.run_folder.refuse_foreign_files`), or, without ``overwrite``, a ``<scenario>.mcap``
+    that is no recording of an mmusv run (its header does not say so and no run's ``manifest.json`` there names
+    it). A batch replaced them without a word (its tasks run with ``overwrite``: the folder is the batch's)."""
+    from mmusv.errors import IoError
+    from mmusv.recording.info import written_by_mmusv
+    from mmusv.run_folder import refuse_foreign_files
+
+    try:
+        refuse_foreign_files(folder, str(file))
+    except IoError as exc:
+        return f"{file}: {exc}"
+    rec = folder / f"{scenario}.mcap"
+    if overwrite or not (rec.is_file() or rec.is_symlink()) or written_by_mmusv(rec):
+        return None
+    m = _manifest(folder)
+    if m is not None and m.get("recording") == rec.name and "mmusv_version" in m:  # the run's, damaged since
+        return None
+    return (
+        f"{rec} is not a recording of an mmusv run (its header does not say so, and no run's manifest.json names "
+        f"it), and the run of {file.name} would replace it; move it out of {folder}, or pass --overwrite "
+        "(overwrite=True in Python) to replace it"
+    )
 
 
 def _task(

@@ -33,7 +33,15 @@ from mmusv.batch.executors import (
     refuse_in_daemon,
     refuse_in_worker_import,
 )
-from mmusv.batch.index import INDEX_NAME, Entry, check_extra, check_replaceable, folder_bytes, write_index
+from mmusv.batch.index import (
+    INDEX_NAME,
+    Entry,
+    check_extra,
+    check_replaceable,
+    folder_bytes,
+    read_index,
+    write_index,
+)
 from mmusv.batch.plan import ScenarioPlan, plan_scenarios, prepare, scenario_files, task_complete
 from mmusv.batch.task import TaskResult
 from mmusv.errors import ConfigError, IoError, MmusvError
@@ -77,6 +85,9 @@ class BatchReport:
     seconds: float = 0.0
     index_error: str | None = None
     """Why the index could not be written at the end (a full disk), else None."""
+    kept: list[str] = field(default_factory=list)
+    """Recordings an earlier run into the folder indexed that this run does not record (names, sorted): its index
+    keeps listing them."""
 
     def count(self, status: str) -> int:
         """How many scenarios ended with ``status``."""
@@ -279,6 +290,14 @@ def run_many(
     index_path = arguments.path(index, name="index").resolve() if index is not None else out / INDEX_NAME
     root = index_path.parent
     check_replaceable(index_path, writer="the batch")
+    earlier = _earlier_index(index_path)
+    spec = earlier.get("spec")
+    if index_extra is None and isinstance(spec, dict) and not overwrite:
+        raise IoError(
+            f"{index_path} is the index of an `mmusv dataset` run (spec {spec.get('name')!r}): a batch run there "
+            "would replace it with one of its own, losing its spec and opv2v sections; run into another folder "
+            "(-o), or pass --overwrite (overwrite=True in Python) to replace it"
+        )
     plans = plan_scenarios(
         files,
         out,
@@ -292,6 +311,8 @@ def run_many(
     for p in plans:
         if p.recording is not None and not p.recording.is_relative_to(root):
             raise ConfigError(f"index {index_path} must be in a folder above the output {out}")
+    names = {p.name for p in plans}
+    kept = [e for e in _entries_of(earlier) if e.name not in names and e.recording and (root / e.recording).is_file()]
     # The executor first: Ray that cannot be imported or joined fails the batch here, before anything is written
     # (it wrote an index calling every scenario pending, and readied their folders, as if work had been scheduled).
     executor = _executor(jobs, ray, cpus_per_task, lost_worker_retries) if any(p.to_run for p in plans) else None
@@ -314,9 +335,26 @@ def run_many(
             progress,
             stop_on_full_disk,
             t0,
+            kept,
         )
     finally:
         lock.release()
+
+
+def _earlier_index(path: Path) -> dict[str, Any]:
+    """The index an earlier batch wrote at ``path`` (``{}``: none, or one that cannot be read)."""
+    if not path.is_file():
+        return {}
+    try:
+        return read_index(path)
+    except MmusvError:
+        return {}
+
+
+def _entries_of(index: Mapping[str, Any]) -> list[Entry]:
+    """The entries of an index :func:`_earlier_index` read."""
+    rows = index.get("recordings", [])
+    return [Entry(**{k: r[k] for k in Entry.__dataclass_fields__}) for r in rows if isinstance(r, dict)]
 
 
 def _run(
@@ -331,6 +369,7 @@ def _run(
     progress: Callable[[int, int], None] | None,
     stop_on_full_disk: bool,
     t0: float,
+    kept: list[Entry],
 ) -> BatchReport:
     """The batch of :func:`run_many` once planned, with the output folder locked, on the executor ``started``
     (``None`` when nothing was to run; closed here)."""
@@ -344,7 +383,11 @@ def _run(
         for p in plans:
             status[p.name] = "failed" if p.error else "pending" if p.to_run else "complete"
             errors[p.name] = p.error
-        entries = {p.name: _entry(p, status[p.name], errors[p.name], root) for p in plans}
+        # an earlier run's recordings that this one does not record (a folder run before with more scenarios, or
+        # another folder run into the same output) stay listed: the index was rewritten with this run's alone,
+        # leaving them on disk unlisted, so that conversion and the studies no longer read them
+        entries = {e.name: e for e in kept}
+        entries.update({p.name: _entry(p, status[p.name], errors[p.name], root) for p in plans})
     except BaseException:
         if started is not None:
             started.close(cancel=True)
@@ -443,6 +486,7 @@ def _run(
         index=index_path,
         seconds=time.perf_counter() - t0,
         index_error=index_error[0] if index_error else None,
+        kept=sorted(e.name for e in kept),
     )
 
 

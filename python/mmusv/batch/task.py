@@ -110,12 +110,16 @@ class _TaskState:
 def execute(task: Task) -> TaskResult:
     """Runs ``task`` (see the module docstring); returns its result, never raises but ``KeyboardInterrupt``."""
     from mmusv.acquire import run
+    from mmusv.run_folder import refuse_foreign_files
 
     t0 = time.perf_counter()
     res = TaskResult(key=task.key, status="failed", pid=os.getpid(), threads=os.environ.get("RAYON_NUM_THREADS"))
     try:
         with _TaskState(Path(task.state_file), task.run_id) as state:
             res.attempts = state.attempts
+            # a manifest.json (or scenario.yaml) no run wrote is refused before the task's own manifest goes: the
+            # plan checked (batch.plan), but a user may have put one there since
+            refuse_foreign_files(Path(task.out_dir), task.scenario_file)
             (Path(task.out_dir) / "manifest.json").unlink(missing_ok=True)
             notes: list[str] = []
             with warnings.catch_warnings(record=True) as caught:
