@@ -100,6 +100,9 @@ def test_output_folders_under_a_file_are_named_as_the_option_before_any_work(
         ["dataset", SPEC, "-o", str(afile / "ds")],
         ["study", "detection", str(tmp_path / "missing.mcap"), "-o", str(afile)],
         ["train", str(tmp_path / "missing.mcap"), "-o", str(afile)],
+        # "cannot create output folder ...: File exists" (or "Not a directory" below it)
+        ["run", SCENARIO, "-o", str(afile)],
+        ["run", str(Path(SCENARIO).parent), "-o", str(afile / "batch")],
     ):
         _, err = _refused(argv, capsys)
         assert f"-o/--output {argv[-1]}: {afile} is a file, not a folder" in err, (argv, err)

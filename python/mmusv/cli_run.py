@@ -8,7 +8,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from mmusv.cli_paths import output_arg, path_arg
+from mmusv.cli_paths import check_output_folder, path_arg
 from mmusv.errors import ConfigError, MmusvError
 from mmusv.text import counted
 
@@ -87,7 +87,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         raise ConfigError(f"--frames {args.frames}: must be at least 1")
     if not str(args.output).strip():
         raise ConfigError("-o/--output is empty: give the output folder (default out/)")
-    output_arg(args.output)
+    check_output_folder(args.output)  # a file there or above was "cannot create output folder: File exists"
     check_batch_options(args)
     if src.is_dir():
         if args.profile:

@@ -117,15 +117,15 @@ def test_a_read_only_output_folder_is_one_line(tmp_path: Path) -> None:
 
 def test_an_output_folder_that_cannot_be_made_names_it_and_the_cause(tmp_path: Path) -> None:
     """``run``, a batch and ``convert`` start the same way (:meth:`FolderLock.create`): an output folder under a file
-    is one line naming the folder and the system's cause, and nothing is written."""
+    is one line naming the folder and the file in the way (the system's "Not a directory" named neither), and
+    nothing is written; ``run`` says so of its option before it reads the scenario."""
     src = write_yaml(tmp_path / "in" / "tiny.yaml", scenario("tiny", frames=2))
     blocker = tmp_path / "file"
     blocker.write_text("not a folder")
-    cause = os.strerror(errno.ENOTDIR)
     code, _out, err = cli_main("run", str(src), "-o", str(blocker / "out"))
-    assert code == 2 and err == f"mmusv: error: cannot create output folder {blocker / 'out'}: {cause}\n", err
+    assert code == 2 and err == f"mmusv: error: -o/--output {blocker / 'out'}: {blocker} is a file, not a folder\n"
     code, _out, err = cli_main("run", str(src.parent), "-o", str(blocker / "batch"))
-    assert code == 2 and f"cannot create output folder {blocker / 'batch'}: {cause}" in err, err
+    assert code == 2 and f"-o/--output {blocker / 'batch'}: {blocker} is a file, not a folder" in err, err
     assert "Traceback" not in err and err.count("\n") == 1, err
     rec = tmp_path / "rec"
     code, _out, err = cli_main("run", str(src), "-o", str(rec))
@@ -133,5 +133,6 @@ def test_an_output_folder_that_cannot_be_made_names_it_and_the_cause(tmp_path: P
     code, _out, err = cli_main(
         "convert", str(rec / "tiny.mcap"), "-o", str(blocker / "conv"), "--no-progress", "--no-split"
     )
-    assert code == 2 and err == f"mmusv: error: cannot create output folder {blocker / 'conv'}: {cause}\n", err
+    said = f"cannot create output folder {blocker / 'conv'}: {blocker} is a file, not a folder; give another folder"
+    assert code == 2 and err == f"mmusv: error: {said}\n", err
     assert blocker.read_text() == "not a folder"

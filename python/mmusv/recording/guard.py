@@ -56,6 +56,10 @@ class FolderLock:
         path = Path(folder)
         try:
             path.mkdir(parents=True, exist_ok=True)
+        except (FileExistsError, NotADirectoryError):  # the path or a folder above it is a file (said neither)
+            above = next((p for p in (path, *path.parents) if p.exists() and not p.is_dir()), path)
+            what = "it is a file" if above == path else f"{above} is a file"
+            raise IoError(f"cannot create output folder {path}: {what}, not a folder; give another folder") from None
         except OSError as exc:
             raise IoError(f"cannot create output folder {path}: {write_cause(path, exc)}") from None
         return cls(path, what=what).acquire()
