@@ -320,7 +320,23 @@ def test_a_folders_yml_scenarios_are_run_too(tmp_path: Path) -> None:
     rep = run_many(src, out_dir=tmp_path / "out")
     assert rep.summary() == "2 done, 0 failed, 0 skipped, 0 retried"
     write(src / "a.yml", scenario("a", frames=1))
-    with pytest.raises(ConfigError, match=r"\['a'\] share a file stem"):
+    with pytest.raises(ConfigError) as err:
+        scenario_files(src)
+    # named by their files ("files ['a'] share a file stem" named neither)
+    assert f"scenario files {src / 'a.yaml'} and {src / 'a.yml'} share a file stem" in str(err.value), err.value
+
+
+def test_a_folder_whose_scenarios_are_in_a_folder_below_says_so(tmp_path: Path) -> None:
+    from mmusv.batch.plan import scenario_files
+
+    src = tmp_path / "src"
+    (src / "set1").mkdir(parents=True)
+    write(src / "set1" / "a.yaml", scenario("a", frames=1))
+    with pytest.raises(
+        ConfigError,
+        match=r"holds no \*\.yaml or \*\.yml scenarios \(folders below are not searched: "
+        r"set1/ holds some; give it\)",
+    ):
         scenario_files(src)
 
 

@@ -101,7 +101,9 @@ def scenario_files(source: str | os.PathLike[str] | Sequence[str | os.PathLike[s
         if src.is_dir():
             files = folder_entries(src)
             if not files:
-                raise ConfigError(f"{src} holds no *.yaml or *.yml scenarios")
+                below = next((d.name for d in sorted(src.iterdir()) if d.is_dir() and folder_entries(d)), None)
+                hint = f" (folders below are not searched: {below}/ holds some; give it)" if below else ""
+                raise ConfigError(f"{src} holds no *.yaml or *.yml scenarios{hint}")
             for f in files:  # a broken link or a folder of a scenario's name was skipped without a word
                 if not f.is_file():
                     raise ConfigError(f"{f}: {_not_a_file(f)}, not a scenario file; remove it or move it away")
@@ -154,9 +156,10 @@ def _check_stems(files: Sequence[Path]) -> None:
     differ only in case, would share the output folder ``OUT/<stem>``: a :class:`~mmusv.errors.ConfigError`."""
     stems = [f.stem for f in files]
     dup = sorted({s for s in stems if stems.count(s) > 1})
-    if dup:
+    if dup:  # named by their files: "files ['a'] share a file stem" named neither a.yaml nor a.yml
+        clash = "; ".join(" and ".join(sorted(str(f) for f in files if f.stem == s)) for s in dup)
         raise ConfigError(
-            f"scenario files {dup} share a file stem; each gets the output folder OUT/<stem>, rename them"
+            f"scenario files {clash} share a file stem; each gets the output folder OUT/<stem>: rename one"
         )
     folded: dict[str, str] = {}
     for s in stems:  # a.yaml and A.yaml: one output folder on a file system that ignores case (macOS, Windows)
