@@ -195,6 +195,11 @@ def test_opv2v_input_gives_the_same_ground_truth(
     assert main([*argv, "--jobs", "2", "-o", str(jobs)]) == 0
     for name in ("detection_table.csv", "detection_boxes.parquet"):
         assert (opv_out / name).read_bytes() == (jobs / name).read_bytes(), name
+    # the OPV2V folder given where recordings go: it said only "folder holds no .mcap recording"
+    capsys.readouterr()
+    assert main(["study", "detection", str(tmp_path / "opv2v"), "-o", str(tmp_path / "c"), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert f"it is an OPV2V folder: give it as --opv2v {tmp_path / 'opv2v'}" in err, err
 
 
 def test_bad_input_errors(two_usv: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

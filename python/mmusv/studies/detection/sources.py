@@ -113,13 +113,26 @@ def _recordings(inputs: Sequence[str | Path]) -> list[Path]:
                     f"{p}: {p.resolve().parent / 'dataset.json'} lists no complete recording in this folder"
                 )
             if not found:
-                raise InputError(f"{p}: folder holds no .mcap recording")
+                raise InputError(f"{p}: folder holds no .mcap recording{_opv2v_hint(p)}")
             out.extend(found)
         elif p.is_file():
             out.append(p)
         else:
             raise IoError(f"{p}: no such recording or folder")
     return out
+
+
+def _opv2v_hint(folder: Path) -> str:
+    """``"; it is an OPV2V folder: give it as --opv2v ..."`` when ``folder`` is one (``mmusv convert --to opv2v``'s
+    output), else empty: it was said to hold no recording, with no word of the option that reads it."""
+    from mmusv.errors import MmusvError
+    from mmusv.studies.detection.data import opv2v_scenarios
+
+    try:
+        opv2v_scenarios(folder)
+    except (MmusvError, OSError):
+        return ""
+    return f"; it is an OPV2V folder: give it as --opv2v {folder}"
 
 
 def _sequence_names(recs: Sequence[Path]) -> dict[str, Path]:
