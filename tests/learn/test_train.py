@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pytest
 import torch
 from mmusv.learn.detector import load_models
 from mmusv.learn.presets import preset
@@ -127,3 +128,19 @@ def test_channels_last_model_is_the_same_function() -> None:
     oa, ob = a(batch), b(batch)
     for k in oa:
         torch.testing.assert_close(oa[k], ob[k], rtol=5e-3, atol=5e-2)
+
+
+def test_a_model_trained_further_than_asked_is_kept_and_said_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``epochs`` fewer than the folder's model has trained: the model was kept and reported as done, and nothing
+    said that the epochs asked for were not those of the model."""
+    src = MemorySource(SCENES[:1])
+    p = preset("tiny")
+    train(src, p=p, mode="single", out=tmp_path, seed=1, epochs=2, progress=False)
+    before = (tmp_path / "model.pt").read_bytes()
+    capsys.readouterr()
+    r = train(src, p=p, mode="single", out=tmp_path, seed=1, epochs=1, progress=False)
+    out = capsys.readouterr().out
+    assert "has trained 2 epochs, more than the 1 asked for: it is kept as it is" in out, out
+    assert r.epochs == 2 and (tmp_path / "model.pt").read_bytes() == before

@@ -243,6 +243,12 @@ def train(
         stop = "time limit"
     elif start_epoch < n_epochs and max_steps is not None and step >= max_steps:
         stop = "max steps"
+    if start_epoch > n_epochs:  # kept as it is: said, not taken for a model of the epochs asked for
+        print(
+            f"{mode}: {last} has trained {start_epoch} epochs, more than the {n_epochs} asked for: it is kept as it "
+            "is (train into another folder for a model of fewer epochs)",
+            flush=True,
+        )
     if start_epoch < n_epochs and stop is None:
         if step:
             print(f"{mode}: resuming {last} at epoch {start_epoch + 1}/{n_epochs}, step {step}", flush=True)
