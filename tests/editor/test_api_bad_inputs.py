@@ -449,3 +449,17 @@ def test_a_bundled_name_with_a_trailing_newline_is_not_another_scenario(client: 
     assert client.get("/api/bundled/port_entry").status_code == 200
     r = client.get("/api/bundled/port_entry%0A")
     assert r.status_code == 404 and "no bundled scenario" in r.text
+
+
+def test_a_comment_anchored_to_a_vessel_by_its_position_is_refused(
+    client: TestClient, folder: Path, doc: dict[str, Any]
+) -> None:
+    """``["vessels", 1]`` was taken for the ``vessels:`` key: the comment saved above it, with no note."""
+    for path in (["vessels", 1], ["vessels", -1, "route"], ["rigs", 0]):
+        body = {"document": doc, "comments": [{"path": path, "at": "before", "text": "# v1"}]}
+        r = client.put("/api/files/anchored.yaml", json=body)
+        assert "is named by its id, a string" in error_of(r, 422), r.text
+    assert not (folder / "anchored.yaml").exists()
+    vid = doc["vessels"][0]["id"]
+    body = {"document": doc, "comments": [{"path": ["vessels", vid, "route", 1], "at": "before", "text": "# ok"}]}
+    assert client.put("/api/files/anchored.yaml", json=body).status_code == 200

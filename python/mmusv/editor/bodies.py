@@ -58,6 +58,12 @@ class CommentBody(_Strict):
     @classmethod
     def _path_is_text(cls, path: list[str | int]) -> list[str | int]:
         _jsonable({"path": path}, "comments")
+        if len(path) >= 2 and path[0] in ("vessels", "rigs") and not isinstance(path[1], str):
+            # ["vessels", 1] was taken for the `vessels:` key itself, the comment moved there without a word
+            what = "vessel" if path[0] == "vessels" else "rig"
+            raise ValueError(
+                f"a {what} is named by its id, a string ([{path[0]!r}, 'ferry', ...]), not by its position {path[1]!r}"
+            )
         return path
 
 
