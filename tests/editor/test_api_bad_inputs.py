@@ -463,3 +463,16 @@ def test_a_comment_anchored_to_a_vessel_by_its_position_is_refused(
     vid = doc["vessels"][0]["id"]
     body = {"document": doc, "comments": [{"path": ["vessels", vid, "route", 1], "at": "before", "text": "# ok"}]}
     assert client.put("/api/files/anchored.yaml", json=body).status_code == 200
+
+
+def test_a_leading_comment_with_another_line_separator_is_refused(
+    client: TestClient, folder: Path, doc: dict[str, Any]
+) -> None:
+    """U+0085, U+2028 and U+2029 were saved as line breaks and read back as ``\\n``: the text changed without a
+    word (each comment of ``comments`` refuses them already)."""
+    for sep in ("\x85", "\u2028", "\u2029"):
+        r = client.put("/api/files/lead.yaml", json={"document": doc, "comment": f"first{sep}second"})
+        assert f"U+{ord(sep):04X} at position 5 would be written as a line break" in error_of(r, 422), r.text
+    assert not (folder / "lead.yaml").exists()
+    assert client.put("/api/files/lead.yaml", json={"document": doc, "comment": "first\nsecond"}).status_code == 200
+    assert client.get("/api/files/lead.yaml").json()["comment"] == "first\nsecond"
