@@ -476,3 +476,11 @@ def test_a_leading_comment_with_another_line_separator_is_refused(
     assert not (folder / "lead.yaml").exists()
     assert client.put("/api/files/lead.yaml", json={"document": doc, "comment": "first\nsecond"}).status_code == 200
     assert client.get("/api/files/lead.yaml").json()["comment"] == "first\nsecond"
+
+
+def test_a_file_name_refused_says_the_limits_it_broke(client: TestClient, doc: dict[str, Any]) -> None:
+    """A 129-character name and a name with letters outside ASCII were refused by a rule that named neither."""
+    assert client.put(f"/api/files/{'a' * 123}.yaml", json={"document": doc}).status_code == 200  # 128: the most
+    for name in (f"{'a' * 124}.yaml", "h\u00e4fen.yaml"):
+        said = error_of(client.put(f"/api/files/{name}", json={"document": doc}), 400)
+        assert "ASCII letters" in said and "at most 128 characters" in said, said

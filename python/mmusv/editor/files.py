@@ -47,6 +47,8 @@ __all__ = [
 ]
 
 _NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.\-]{0,122}\.ya?ml")
+MAX_NAME_CHARS = 128
+"""The longest file name the editor saves (what :data:`_NAME` allows: 1 + 122 + ``.yaml``)."""
 
 MAX_FILE_BYTES = 16 * 1024 * 1024
 """Largest scenario file the editor opens (16 MiB, as large as the largest request it takes); larger files are
@@ -72,7 +74,7 @@ def check_name(name: str) -> str:
         shown = repr(name) if len(str(name)) <= 80 else repr(str(name)[:80] + "...")
         raise InputError(
             f"file name {shown} is not allowed: give a bare file name in the editor's folder, ending in .yaml or "
-            ".yml (letters, digits, _ - and ., no folders, no leading dot)"
+            f".yml (ASCII letters, digits, _ - and ., no folders, no leading dot, at most {MAX_NAME_CHARS} characters)"
         )
     return name
 
