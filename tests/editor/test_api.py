@@ -429,7 +429,12 @@ def test_a_failing_run_reports_its_error(client: TestClient, folder: Path) -> No
         ("PUT", "/api/files/a.yaml", {"json": {"document": {}, "comment": "x" * 30000}}, 422, "comment"),
         ("POST", "/api/runs", {"json": {}}, 422, "name"),
         ("GET", "/api/nothing", {}, 404, "no API endpoint"),
-        ("DELETE", "/api/files/a.yaml", {}, 405, "Method Not Allowed"),
+        # an endpoint asked with another method: "no API endpoint" (404) or a bare "Method Not Allowed"
+        ("DELETE", "/api/files/a.yaml", {}, 405, "/api/files/a.yaml takes GET or PUT, not DELETE"),
+        ("POST", "/api/files/a.yaml", {}, 405, "/api/files/a.yaml takes GET or PUT, not POST"),
+        ("GET", "/api/evaluate", {}, 405, "/api/evaluate takes POST, not GET"),
+        ("POST", "/api/runs/1", {}, 405, "/api/runs/1 takes DELETE or GET, not POST"),
+        ("GET", "/api/runs/-1", {}, 422, "run id '-1': a run is named by a whole number"),  # it showed the regex
         ("PATCH", "/api/nothing", {}, 405, "Method Not Allowed"),
         (
             "POST",

@@ -26,7 +26,8 @@ Endpoints (JSON in and out unless said otherwise; errors are ``{"error": "..."}`
 ========================  =====================================================================================
 
 Status codes: 400 bad input (a file name, a request the server cannot serve, a body that cannot be read as JSON:
-the message says why), 404 nothing of that name, 409 the file exists (or the name is a folder; or a run of the
+the message says why), 404 nothing of that name, 405 an endpoint asked with a method it does not take (the
+message and ``Allow`` say which it takes), 409 the file exists (or the name is a folder; or a run of the
 same scenario is going on), 412 the file changed since the client read it (If-Match), 413 the request is larger
 than :data:`MAX_BODY_BYTES`, 422 the request body or the scenario does not validate (the message names the
 field). Request bodies are JSON objects sent as ``application/json``; their fields are strict (``frame: true`` or
@@ -53,6 +54,7 @@ from fastapi import FastAPI, Request
 from fastapi import Path as PathParam
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import FileResponse, JSONResponse, Response
+from fastapi.routing import APIRoute
 from fastapi.staticfiles import StaticFiles
 from pydantic import ValidationError
 from starlette.exceptions import HTTPException as StarletteHTTPException
@@ -383,9 +385,23 @@ def create_app(
     def run_cancel(job_id: Annotated[str, PathParam(pattern=_JOB_ID)]) -> dict[str, Any]:
         return jobs.cancel(int(job_id)).as_dict()
 
-    @app.api_route("/api/{rest:path}", methods=["GET", "POST", "PUT"], include_in_schema=False)
-    def unknown(rest: str) -> Response:
-        raise NotFoundError(f"no API endpoint /api/{rest}")
+    @app.api_route("/api/{rest:path}", methods=["GET", "POST", "PUT", "DELETE"], include_in_schema=False)
+    def unknown(rest: str, request: Request) -> Response:
+        # an endpoint asked with another method (POST /api/files/a.yaml) was "no API endpoint" (404), or a bare 405
+        path = f"/api/{rest}"
+        takes = sorted(
+            {
+                m
+                for r in app.routes
+                if isinstance(r, APIRoute) and r.endpoint is not unknown and r.path_regex.match(path)
+                for m in r.methods or ()
+            }
+        )
+        if takes:
+            answer = error(405, f"{path} takes {' or '.join(takes)}, not {request.method}")
+            answer.headers["Allow"] = ", ".join(takes)
+            return answer
+        raise NotFoundError(f"no API endpoint {path}")
 
     app.add_middleware(BodyLimit)
     if allowed_hosts is not None:

@@ -117,6 +117,8 @@ def request_error(exc: RequestValidationError, content_type: str | None) -> str:
         elif loc == "body" and not _is_json(content_type):
             got = f"Content-Type {content_type!r}" if content_type else "no Content-Type"
             parts.append(f"body: the request body must be a JSON object sent as application/json (got {got})")
+        elif e.get("type") == "string_pattern_mismatch" and loc == "path.job_id":  # it showed the regex itself
+            parts.append(f"run id {e.get('input')!r}: a run is named by a whole number, as /api/runs lists them")
         else:
             parts.append(f"{loc}: {e.get('msg', 'invalid')}")
     return "malformed request: " + "; ".join(parts)
