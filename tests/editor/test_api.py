@@ -545,3 +545,23 @@ def test_a_stopped_run_names_its_recording_and_frames(client: TestClient, folder
     manifest = json.loads((folder / "out" / "stopme" / "manifest.json").read_text())
     assert end["status"] == "interrupted" and end["recording"] == str(folder / "out" / "stopme" / "port_entry.mcap")
     assert end["done"] == manifest["frames_written"] >= 1, (end, manifest)
+
+
+def test_a_run_past_the_most_at_a_time_is_a_conflict(
+    client: TestClient, folder: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """It was 400, the answer to a bad request; the request is good and the editor busy: 409, as for a second run of
+    the same output folder."""
+    from mmusv.editor import jobs as editor_jobs
+
+    monkeypatch.setattr(editor_jobs, "MAX_RUNNING", 1)
+    doc = small(bundled_doc(client))
+    for name in ("one.yaml", "two.yaml"):
+        assert client.put(f"/api/files/{name}", json={"document": doc}).status_code == 200
+    first = client.post("/api/runs", json={"name": "one.yaml"}).json()
+    try:
+        r = client.post("/api/runs", json={"name": "two.yaml"})
+        assert r.status_code == 409 and "the most the editor runs at a time" in r.json()["error"], r.text
+    finally:
+        client.delete(f"/api/runs/{first['id']}")
+        _wait_run(client, first["id"])

@@ -40,7 +40,7 @@ KEEP_FINISHED = 100
 
 
 class RunGoingOn(InputError):
-    """A run of the same output folder is going on already."""
+    """A run of the same output folder, or :data:`MAX_RUNNING` runs, are going on already (HTTP 409)."""
 
 
 @dataclass
@@ -111,8 +111,10 @@ class Jobs:
                 raise RunGoingOn(
                     f"run {same[0].id} ({same[0].scenario}) is writing {rel_out} already; wait for it to end or stop it"
                 )
-            if len(running) >= MAX_RUNNING:
-                raise InputError(
+            if (
+                len(running) >= MAX_RUNNING
+            ):  # 409, as for a run of the same folder: the request is good, the editor busy
+                raise RunGoingOn(
                     f"{len(running)} runs are going on already, the most the editor runs at a time; wait for one to "
                     "end or stop it"
                 )
