@@ -434,7 +434,7 @@ def test_a_failing_run_reports_its_error(client: TestClient, folder: Path) -> No
         ("POST", "/api/files/a.yaml", {}, 405, "/api/files/a.yaml takes GET or PUT, not POST"),
         ("GET", "/api/evaluate", {}, 405, "/api/evaluate takes POST, not GET"),
         ("POST", "/api/runs/1", {}, 405, "/api/runs/1 takes DELETE or GET, not POST"),
-        ("GET", "/api/runs/-1", {}, 422, "run id '-1': a run is named by a whole number"),  # it showed the regex
+        ("GET", "/api/runs/-1", {}, 422, "path.job_id '-1': a run is named by a whole number"),  # it showed the regex
         ("PATCH", "/api/nothing", {}, 405, "Method Not Allowed"),
         (
             "POST",

@@ -5,7 +5,6 @@ and what it saves can be read again (:mod:`mmusv.editor.carry`).
 
 from __future__ import annotations
 
-import re
 from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator
@@ -84,12 +83,6 @@ class SaveBody(DocumentBody):
             raise ValueError(
                 f"character U+{ord(bad.group()):04X} at position {bad.start()} cannot be written into a YAML file "
                 "(the file would not load again): control characters other than tab and line breaks are not allowed"
-            )
-        other = re.search("[\x85\u2028\u2029]", comment)
-        if other is not None:  # written as a line break, read back as "\n": the text changed without a word
-            raise ValueError(
-                f"character U+{ord(other.group()):04X} at position {other.start()} would be written as a line break "
-                "and read back as one: break the comment's lines with \\n"
             )
         return comment
 

@@ -6,6 +6,7 @@ its length), and the one-line messages for requests FastAPI cannot read (:func:`
 
 from __future__ import annotations
 
+import re
 from typing import get_args
 
 from fastapi.exceptions import RequestValidationError
@@ -118,7 +119,7 @@ def request_error(exc: RequestValidationError, content_type: str | None) -> str:
             got = f"Content-Type {content_type!r}" if content_type else "no Content-Type"
             parts.append(f"body: the request body must be a JSON object sent as application/json (got {got})")
         elif e.get("type") == "string_pattern_mismatch" and loc == "path.job_id":  # it showed the regex itself
-            parts.append(f"run id {e.get('input')!r}: a run is named by a whole number, as /api/runs lists them")
+            parts.append(f"{loc} {e.get('input')!r}: a run is named by a whole number, as /api/runs lists them")
         else:
             parts.append(f"{loc}: {e.get('msg', 'invalid')}")
     return "malformed request: " + "; ".join(parts)
@@ -145,7 +146,15 @@ def if_match(header: str | None) -> list[str] | None:
     """The ETags of an ``If-Match`` header (quotes and ``W/`` dropped; ``*`` kept), or None without one."""
     if header is None:
         return None
-    return [t.strip().removeprefix("W/").strip('"') for t in header.split(",") if t.strip()]
+    tags = [t.strip().removeprefix("W/").strip('"') for t in header.split(",") if t.strip()]
+    bad = next((t for t in tags if t != "*" and not re.fullmatch(r"[0-9a-f]{32}", t)), None)
+    if not tags or bad is not None:  # it was "changed since you opened it", which it was not
+        shown = repr(header[:80])
+        raise InputError(
+            f"If-Match {shown} names no version the editor gave: send the etag of GET /api/files/NAME (32 hex "
+            'digits, in quotes), "*" for any version, or no If-Match'
+        )
+    return tags
 
 
 class BodyLimit(_LimitedBody):
