@@ -57,6 +57,10 @@ def test_bad_options(coop_rec: Path, tmp_path: Path) -> None:
         convert(coop_rec, out_dir=tmp_path / "o", splits=(0.5, 0.5))
     with pytest.raises(ConfigError, match="same scenario configuration"):
         convert([coop_rec, coop_rec], out_dir=tmp_path / "o")
+    # extras for a format that writes none: COCO exited 0 and wrote no depth (conversion.yaml listed it)
+    for to in ("coco", "yolo", "mastr", "semantickitti", "mot", "ros2"):
+        with pytest.raises(ConfigError, match=rf"extras = 'depth': only the OPV2V, .* not to = '{to}'"):
+            convert(coop_rec, to=to, out_dir=tmp_path / "o", extras="depth")
     assert not (tmp_path / "o").exists()
 
 

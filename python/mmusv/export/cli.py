@@ -71,8 +71,8 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     p.add_argument(
         "--extras",
         default=",".join(DEFAULT_EXTRAS),
-        help=f"extra files, comma-separated from {','.join(EXTRAS)}; empty for none "
-        f"(default {','.join(DEFAULT_EXTRAS)})",
+        help=f"extra files of the OPV2V, KITTI and KITTI tracking exports (the others write none), comma-separated "
+        f"from {','.join(EXTRAS)}; empty for none (default {','.join(DEFAULT_EXTRAS)})",
     )
     p.add_argument(
         "--min-box-px",

@@ -37,6 +37,7 @@ from mmusv.export.convert_checks import (
     box_options,
     check_agents,
     contrast_filter,
+    extras_option,
     frame_selection,
     kitti_type,
     outside_frames,
@@ -256,6 +257,7 @@ def convert(
     box = parse_box(box)
     box_options(to, min_box_px=box_px, max_occlusion=max_occ, min_contrast=min_c, box=box)
     target_options(to, eval_range_m=rng, include_usvs=include_usvs)
+    extras_option(to, parse_extras(extras))
     kind = kitti_type(kitti_class, to)
     origin = oxts_origin_of(oxts_origin, to)
     options = Options(

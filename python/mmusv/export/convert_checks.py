@@ -111,6 +111,23 @@ def box_options(to: str, *, min_box_px: float, max_occlusion: float, min_contras
         )
 
 
+EXTRAS_FORMATS = ("opv2v", "kitti", "kitti_tracking")
+"""The formats that write the extra files ``extras`` (``--extras``) names."""
+
+
+def extras_option(to: str, extras: tuple[str, ...]) -> None:
+    """Refuses (:class:`~mmusv.errors.ConfigError`) ``extras`` other than the default or none for a format ``to`` that
+    writes no extra files (not in :data:`EXTRAS_FORMATS`): ``--to coco --extras depth`` wrote no depth, and said
+    nothing of it."""
+    from mmusv.export.common import DEFAULT_EXTRAS
+
+    if to not in EXTRAS_FORMATS and extras not in ((), DEFAULT_EXTRAS):  # none: what it writes anyway
+        raise ConfigError(
+            f"extras = {','.join(extras)!r}: only the OPV2V, KITTI and KITTI tracking exports (to = 'opv2v', "
+            f"'kitti' or 'kitti_tracking') write extra files, not to = {to!r}, which would ignore it; leave it out"
+        )
+
+
 TARGET_FORMATS = ("opv2v", "kitti", "kitti_tracking")
 """The formats that list targets by the evaluation range (``eval_range_m``, ``--range``) and ``include_usvs``."""
 DEFAULT_RANGE_M = 200.0
