@@ -103,6 +103,11 @@ def test_existing_output_refused_without_overwrite(coop_rec: Path, tmp_path: Pat
     (foreign / "precious.txt").write_text("keep me")
     with pytest.raises(IoError, match="refusing to delete"):
         convert(coop_rec, out_dir=foreign, overwrite=True)
+    # without --overwrite it is not told to pass it (it said so, then refused when it was)
+    with pytest.raises(IoError) as err:
+        convert(coop_rec, out_dir=foreign)
+    assert "holds no conversion.yaml of a previous conversion; choose another folder" in str(err.value)
+    assert "overwrite" not in str(err.value)
     assert (foreign / "precious.txt").read_text() == "keep me"
 
 

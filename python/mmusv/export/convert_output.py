@@ -52,10 +52,15 @@ def prepare_out(out: Path, overwrite: bool, inputs: list[Path]) -> tuple[Path, F
 def _prepare_locked(out: Path, home: Path, overwrite: bool) -> Path:
     """:func:`prepare_out` once ``out`` exists and is locked."""
     if any(out.iterdir()):
+        if not overwrite and not (out / REPORT_NAME).is_file():  # --overwrite would refuse it too: not a hint
+            raise IoError(
+                f"output folder {out} already exists, is not empty and holds no {REPORT_NAME} of a previous "
+                "conversion; choose another folder (-o)"
+            )
         if not overwrite:
             raise IoError(
-                f"output folder {out} already exists and is not empty; pass --overwrite (overwrite=True in Python) "
-                "to replace it"
+                f"output folder {out} already exists and holds a conversion; pass --overwrite (overwrite=True in "
+                "Python) to replace it"
             )
         if not (out / REPORT_NAME).is_file():
             raise IoError(
