@@ -59,6 +59,7 @@ def test_waves_without_usvs_is_refused_before_the_output_folder(
         )
         assert not out.exists()  # was an empty folder left behind
         assert "'no_usvs'" in err and "role: usv" in err, err
+        assert err.startswith(f"mmusv: error: {scenario}: "), err  # the file given: its name: inside did not say it
 
 
 def test_waves_of_a_one_frame_scenario_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -41,7 +41,8 @@ def study_waves(args: argparse.Namespace) -> int:
             "(--motion paper); the physical response reads each hull's own particulars"
         )
     try:  # "scenario '/tmp' is a directory, not a file" did not say which flag gave it
-        scenario = load_scenario(resolve_scenario(path_arg(args.scenario, flag="--scenario")))
+        source = resolve_scenario(path_arg(args.scenario, flag="--scenario"))
+        scenario = load_scenario(source)
     except MmusvError as exc:
         raise located(exc, "--scenario") from None
     if args.frames is not None:
@@ -50,7 +51,12 @@ def study_waves(args: argparse.Namespace) -> int:
         )
     # The scenario's own checks (a USV, 2 frames) before the output folder: a scenario without USVs left an empty
     # folder behind, and one of a single frame a table of zeros.
-    check_scenario(scenario, record_s=PHYSICAL_RECORD_S if args.motion == "physical" and args.frames is None else None)
+    try:  # named by its file: "scenario 'island_occlusion'" named the name: inside it, not the file given
+        check_scenario(
+            scenario, record_s=PHYSICAL_RECORD_S if args.motion == "physical" and args.frames is None else None
+        )
+    except MmusvError as exc:
+        raise located(exc, str(source)) from None
     with made_output_folder(args.output):  # removed again if still empty when the study fails or is interrupted
         if args.motion == "physical":
             return _physical_wave_study(scenario, args)
