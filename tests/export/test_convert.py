@@ -396,3 +396,17 @@ def test_frames_lost_to_damage_in_a_complete_run_are_said_lost_not_absent(coop_r
     assert 0 < rep.frames < 3 and skipped, skipped
     lost = [s for s in skipped if s["reason"].startswith("lost from the recording (run complete: 3 of 3 frames")]
     assert lost and not [s for s in skipped if "not in the recording" in s["reason"]], skipped
+
+
+def test_splits_that_get_no_recording_are_said(coop_rec: Path, tmp_path: Path) -> None:
+    """One recording split 0.7/0.15/0.15 goes to train alone (a split takes whole recordings): nothing said so, and
+    YOLO's data.yaml then validates on the training images."""
+    rep = convert(coop_rec, to="yolo", out_dir=tmp_path / "y", box="projected")
+    lines = rep.lines()
+    assert lines[0].endswith("-> train/export_coop: 3 frames"), lines
+    assert (
+        "note: validate and test hold no recording (a split takes whole recordings, and 1 recording was given); "
+        "data.yaml's val is the train images"
+    ) in lines, lines
+    unsplit = convert(coop_rec, to="yolo", out_dir=tmp_path / "n", box="projected", splits=None)
+    assert not any("hold no recording" in line for line in unsplit.lines())

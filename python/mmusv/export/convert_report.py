@@ -74,9 +74,20 @@ class ConvertReport:
         out = []
         for r in self.recordings:
             where = f"{r.split}/{r.folder}" if r.split else r.folder
-            out.append(f"{r.path.name} -> {where}: {r.frames_converted} frames")
+            out.append(f"{r.path.name} -> {where}: {counted(r.frames_converted, 'frame')}")
             out += [f"  skipped frames {s['frames'][0]}..{s['frames'][1]}: {s['reason']}" for s in r.skipped]
             out += [f"  note: {n}" for n in r.notes]
+        taken = {r.split for r in self.recordings if r.split}
+        empty = [s for s in ("train", "validate", "test") if s not in taken]
+        if taken and empty:  # a split is by recording: 1 recording went to train alone, and nothing said so
+            n = len(self.recordings)
+            line = (
+                f"note: {' and '.join(empty)} {'holds' if len(empty) == 1 else 'hold'} no recording (a split takes "
+                f"whole recordings, and {counted(n, 'recording')} {'was' if n == 1 else 'were'} given)"
+            )
+            if self.target == "yolo" and "validate" in empty:
+                line += "; data.yaml's val is the train images"
+            out.append(line)
         out.append(
             f"{counted(self.frames, 'frame')} ({counted(self.agent_frames, 'agent-frame')}), "
             f"{counted(self.files, 'file')}, {self.bytes / 1e6:.1f} MB "
