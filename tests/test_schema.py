@@ -354,6 +354,16 @@ def test_cli_prints_and_writes_the_schema(kind: str, tmp_path: Path, capsys: pyt
     assert [p.name for p in tmp_path.iterdir()] == [out.name]  # no temporary left
 
 
+def test_cli_output_dash_is_the_standard_output(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    assert cli.main(["schema", "spec", "-o", "-"]) == 0  # it wrote a file named "-" and said "wrote -"
+    assert capsys.readouterr().out == schema_text("spec") and list(tmp_path.iterdir()) == []
+    assert cli.main(["schema", "spec", "-o", ""]) == 2
+    assert "give the schema's file name" in capsys.readouterr().err  # not '"." for the current folder'
+
+
 def test_written_schema_works_as_the_files_schema(tmp_path: Path) -> None:
     """The file from `mmusv schema scenario -o` validates a scenario that names it in its first line."""
     schema_file = tmp_path / "scenario.schema.json"

@@ -207,7 +207,9 @@ def parser() -> argparse.ArgumentParser:
         "schema", help="print the JSON Schema of scenario or spec files (for editors: yaml-language-server)"
     )
     schema.add_argument("kind", choices=("scenario", "spec"), help="scenario files or generation specs")
-    schema.add_argument("-o", "--output", default=None, help="write it to this file (default: the standard output)")
+    schema.add_argument(
+        "-o", "--output", default=None, help="write it to this file (default, or -: the standard output)"
+    )
     from mmusv.editor.cli import add_parser as add_editor_parser
     from mmusv.export.cli import add_parser as add_convert_parser
     from mmusv.generate.cli import add_parser as add_generate_parser

@@ -14,14 +14,16 @@ __all__ = ["cmd_schema"]
 
 
 def cmd_schema(args: argparse.Namespace) -> int:
-    from mmusv.errors import IoError
+    from mmusv.errors import ConfigError, IoError
     from mmusv.jsonio import write_bytes_atomic
     from mmusv.schema import schema_text
 
     text = schema_text(args.kind)
-    if args.output is None:
+    if args.output is None or args.output == "-":  # `-o -`: the standard output, as for most tools (it wrote "./-")
         sys.stdout.write(text)
         return 0
+    if not args.output:  # output_arg's hint, "." for the current folder, is no file name
+        raise ConfigError("-o/--output is empty: give the schema's file name (or leave -o out for the standard output)")
     out = Path(output_arg(args.output, flag="-o/--output"))
     if out.is_file() and not _is_our_schema(out):  # `-o my_scenario.yaml` replaced the scenario, for good
         raise IoError(
