@@ -156,8 +156,9 @@ def callback(value: Any, *, name: str, nargs: int, error: type[Exception] = Conf
         return value
     try:
         sig.bind(*range(nargs))
-    except TypeError as exc:
-        raise error(f"{name} = {shown(value)}: must take {nargs} positional arguments ({exc})") from None
+    except TypeError as exc:  # Python's words are the call's ("too many positional arguments"), not the function's
+        why = "it takes fewer" if "too many" in str(exc) else "it needs others" if "missing" in str(exc) else exc
+        raise error(f"{name} = {shown(value)}: must take {nargs} positional arguments; {why}") from None
     return value
 
 

@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from mmusv import arguments
 from mmusv.errors import ConfigError, IoError
 from mmusv.recording.decode import WorldFrame
 from mmusv.recording.info import RecordingInfo
@@ -99,6 +100,7 @@ class FrameStream:
             )
         if not callable(want):
             raise ConfigError(f"want = {want!r:.80}: must be a function of a topic name returning True or False")
+        arguments.callback(want, name="want", nargs=1)  # `lambda: True` was a bare TypeError once reading began
         if isinstance(frames, tuple):  # numpy integers (an index taken from an array) count as ints
             frames = tuple(int(k) if isinstance(k, np.integer) else k for k in frames)  # type: ignore[assignment]
         if frames is not None and not (

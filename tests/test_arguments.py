@@ -1,0 +1,32 @@
+"""``mmusv.arguments``: the checks of the plain arguments the Python API takes; here the callbacks'."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from mmusv import arguments
+from mmusv.errors import ConfigError
+
+
+def test_a_callback_of_the_wrong_arity_is_said_to_take_fewer_or_need_more() -> None:
+    # "must take 2 positional arguments (too many positional arguments)" read as if it took too many
+    with pytest.raises(ConfigError, match=r"progress = .*: must take 2 positional arguments; it takes fewer$"):
+        arguments.callback(lambda done: None, name="progress", nargs=2)
+    with pytest.raises(ConfigError, match=r"want = .*: must take 1 positional arguments; it needs others$"):
+        arguments.callback(lambda a, b: True, name="want", nargs=1)
+    assert arguments.callback(lambda a, b=0: True, name="want", nargs=1) is not None
+    assert arguments.callback(None, name="want", nargs=1) is None
+
+
+def test_a_frame_stream_checks_its_want_before_reading(tmp_path: Path) -> None:
+    """``FrameStream(info, lambda: True)`` was a bare TypeError once it began reading."""
+    from mmusv.acquire import run
+    from mmusv.recording import read_info
+    from mmusv.recording.stream import FrameStream
+    from tiny_scenario import lidar_scenario
+
+    rec = run(lidar_scenario("want", frames=1), out_dir=tmp_path).recording
+    with pytest.raises(ConfigError, match=r"want = .*: must take 1 positional arguments; it takes fewer"):
+        FrameStream(read_info(rec), lambda: True)  # type: ignore[arg-type,misc]
+    assert len(list(FrameStream(read_info(rec), lambda topic: False))) == 1
