@@ -91,9 +91,13 @@ def test_read_table_refuses_a_path_that_is_not_a_tables_folder(run_dir: Path, tm
     for root in (None, 3):  # was a bare TypeError
         with pytest.raises(ConfigError, match="root = "):
             read_table(root, "world_state")  # type: ignore[arg-type]
-    for expected in (5, "0:3"):  # was a bare TypeError
-        with pytest.raises(ConfigError, match=r"expected = .*range"):
+    for expected in (5, "0:3", [-1], range(-1, 2)):  # a bare TypeError; the negative: "frames -1 have no rows"
+        with pytest.raises(ConfigError, match=r"expected = .*range.*frame numbers >= 0"):
             read_table(run_dir / "tables", "world_state", expected=expected)  # type: ignore[arg-type]
+    # numpy's frame numbers as numpy gives them (an array was refused, its integers taken)
+    import numpy as np
+
+    assert read_table(run_dir / "tables", "world_state", expected=np.arange(4)).missing == [3]
     (tmp_path / "empty").mkdir()  # an empty tables folder: a run that wrote no rows yet
     assert read_table(tmp_path / "empty", "world_state").rows.height == 0
 

@@ -328,16 +328,15 @@ def read_table(root: str | os.PathLike[str], table: str, *, expected: range | Se
     root = arguments.path(root, name="root")
     if not isinstance(table, str) or table not in SCHEMAS:
         raise ConfigError(f"table = {table!r:.60}: not a table of a recording; tables: {', '.join(SCHEMAS)}")
+    if isinstance(expected, np.ndarray) and expected.ndim == 1:  # an array of frame numbers, as numpy gives them
+        expected = expected.tolist()
     if expected is not None and not (
-        isinstance(expected, range)
-        or (
-            isinstance(expected, (list, tuple))
-            and all(isinstance(k, (int, np.integer)) and not isinstance(k, bool) for k in expected)
-        )
+        isinstance(expected, (range, list, tuple))
+        and all(isinstance(k, (int, np.integer)) and not isinstance(k, bool) and k >= 0 for k in expected)
     ):
         raise ConfigError(
-            f"expected = {arguments.shown(expected)}: must be the frames the run wrote, a range (range(0, 50)) or a "
-            "list of frame numbers, or None"
+            f"expected = {arguments.shown(expected)}: must be the frames the run wrote, a range (range(0, 50)), a "
+            "list or a 1-D array of frame numbers >= 0, or None"
         )
     if not root.is_dir():
         what = "does not exist" if not root.exists() else "is not a folder"
