@@ -19,6 +19,10 @@ def test_split_counts() -> None:
     assert sum(split_counts(10, r)) == 10
     assert split_counts(20, r) == [14, 3, 3]
     assert split_counts(5, parse_ratios("1,0,0")) == [5, 0, 0]
+    # three fractions in a numpy array: "expected three fractions", though it held three
+    import numpy as np
+
+    assert parse_ratios(np.array([0.7, 0.15, 0.15])) == r
     for n in range(0, 40):
         c = split_counts(n, r)
         assert sum(c) == n and min(c) >= 0

@@ -12,6 +12,8 @@ import math
 import random
 from collections.abc import Sequence
 
+import numpy as np
+
 from mmusv import arguments
 from mmusv.errors import ConfigError
 
@@ -35,6 +37,8 @@ def parse_ratios(ratios: Sequence[float] | str) -> tuple[float, float, float]:
                 f"split {ratios!r}: expected three comma-separated fractions, e.g. 0.7,0.15,0.15"
             ) from None
     else:
+        if isinstance(ratios, np.ndarray) and ratios.ndim == 1:  # three fractions as numpy holds them
+            ratios = ratios.tolist()
         if not isinstance(ratios, (list, tuple)):
             raise ConfigError(
                 f"split {arguments.shown(ratios)}: expected three fractions (train, validate, test), e.g. "
