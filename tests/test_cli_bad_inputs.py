@@ -341,3 +341,27 @@ def test_train_seed_is_refused_by_name_before_anything_is_written(
     _, err = _refused(argv, capsys)
     assert f"--seed {seed}: the seed of the split, the weights and the augmentation must be a whole number" in err, err
     assert not (tmp_path / "tr").exists()
+
+
+@pytest.mark.parametrize(
+    ("argv", "hint"),
+    [
+        (["convert", "rec", "--split", "-1,1,1", "-o", "out"], "given as --split=-1,1,1"),
+        (["convert", "rec", "--oxts-origin", "-10,5,0", "-o", "out"], "given as --oxts-origin=-10,5,0"),
+        (["convert", "rec", "-o", "--frames", "1"], None),  # a value forgotten: no such hint
+    ],
+)
+def test_a_value_that_begins_with_a_dash_is_shown_how_to_give_it(
+    argv: list[str], hint: str | None, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # argparse takes "-1,1,1" for an option and said only "argument --split: expected one argument"
+    argv = [str(tmp_path / a) if a in ("rec", "out") else a for a in argv]
+    with pytest.raises(SystemExit) as e:
+        main(argv)
+    assert e.value.code == 2
+    err = capsys.readouterr().err
+    assert "expected one argument" in err and err.count("\n") == 1, err
+    if hint is None:
+        assert "begins with '-'" not in err, err
+    else:
+        assert f"; a value that begins with '-' is {hint} (see mmusv convert --help)" in err, err

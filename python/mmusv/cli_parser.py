@@ -11,7 +11,7 @@ import difflib
 import re
 import sys
 from collections.abc import Sequence
-from typing import Any, NoReturn
+from typing import Any, ClassVar, NoReturn
 
 __all__ = ["BUNDLED_WAVE_SCENARIO", "CommandParser", "parser"]
 
@@ -43,8 +43,11 @@ class CommandParser(argparse.ArgumentParser):
     ) -> tuple[argparse.Namespace, list[str]]:
         CommandParser._deepest = self
         if " " not in self.prog:  # the top parser: sub-parsers' progs are ``mmusv run`` and the like
-            self._given = list(sys.argv[1:] if args is None else args)
+            self._given = CommandParser._argv = list(sys.argv[1:] if args is None else args)
         return super().parse_known_args(args, namespace)
+
+    _argv: ClassVar[list[str]] = []
+    """The arguments of the parse under way (the top parser's), for :func:`_dash_value`."""
 
     def error(self, message: str) -> NoReturn:
         prog = self.prog
@@ -55,7 +58,7 @@ class CommandParser(argparse.ArgumentParser):
         elif message.startswith("unrecognized arguments") and deepest is not None:
             prog = deepest.prog
             message += _did_you_mean(deepest, message)
-        message = " ".join(message.split())
+        message = " ".join(message.split()) + _dash_value(message)
         choice = re.fullmatch(r"argument (\w+): invalid choice: (.*)", message)  # a subcommand (``command``)
         if choice:
             message = f"unknown {choice[1]} {choice[2]}"
@@ -89,6 +92,21 @@ def _misplaced_options(parser: argparse.ArgumentParser) -> str | None:
         f"option {' '.join(options)} is given before the command {command!r}: a command's options go after its "
         f"name, as in: mmusv {' '.join([command, *given[at + 1 :], *before])}"
     )
+
+
+def _dash_value(message: str) -> str:
+    """``"; a value that begins with '-' is given as --split=-1,1,1"`` when ``message`` says an option got no value
+    and the word after it begins with ``-`` (argparse takes ``-1,1,1`` for an option, and said only "expected one
+    argument"); empty otherwise."""
+    got = re.fullmatch(r"argument (\S+): expected one argument", message)
+    if got is None:
+        return ""
+    flags = got[1].split("/")
+    argv = CommandParser._argv
+    at = next((i for i, word in enumerate(argv) if word in flags), None)
+    if at is None or at + 1 >= len(argv) or not re.match(r"-[0-9.]", argv[at + 1]):  # a negative number's start
+        return ""
+    return f"; a value that begins with '-' is given as {argv[at]}={argv[at + 1]}"
 
 
 def _did_you_mean(parser: argparse.ArgumentParser, message: str) -> str:
