@@ -142,7 +142,11 @@ def parser() -> argparse.ArgumentParser:
         "--scenario", default=BUNDLED_WAVE_SCENARIO, help=f"scenario YAML (default {BUNDLED_WAVE_SCENARIO})"
     )
     waves.add_argument(
-        "-o", "--output", default="out/wave_study", help="output folder for CSV and plot (default out/wave_study)"
+        "-o",
+        "--output",
+        default="out/wave_study",
+        help="output folder (default out/wave_study): wave_study.csv and .png with --motion paper, "
+        "wave_study_physical.csv and wave_study_vessels.csv with --motion physical",
     )
     waves.add_argument("--frames", type=int, default=None, help="override the scenario's frame count")
     waves.add_argument(
