@@ -119,3 +119,12 @@ def test_too_many_frames_names_the_scenario_file(tmp_path: Path) -> None:
     with pytest.raises(ConfigError, match=r"--frames\): must be in 1\.\.5, the acquisition\.frames of .*five\.yaml"):
         run(path, out_dir=tmp_path / "out", frames=10)
     assert not (tmp_path / "out").exists()
+
+
+def test_the_allowed_keys_are_listed_once_where_several_keys_are_unknown(tmp_path: Path) -> None:
+    """A JSON Schema given as a scenario listed the allowed top-level keys after each of its eight keys."""
+    doc = _scenario()
+    doc.update({"nmae": "x", "sed": 3, "title": "t"})
+    msg = _refused(tmp_path, doc)
+    assert msg.count("allowed keys: ") == 1, msg
+    assert "did you mean 'name'?" in msg and "did you mean 'seed'?" in msg, msg  # each still told its nearest

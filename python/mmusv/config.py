@@ -483,8 +483,9 @@ def _model_at(model: type[BaseModel], loc: tuple[int | str, ...], data: Any) -> 
     return tp if isinstance(tp, type) and issubclass(tp, BaseModel) else None
 
 
-def _unknown_key_hint(model: type[BaseModel], loc: tuple[int | str, ...], data: Any) -> str:
-    """For the unknown key at the end of ``loc``: the closest allowed key and every allowed key, or ``""``."""
+def _unknown_key_hint(model: type[BaseModel], loc: tuple[int | str, ...], data: Any, *, keys_said: bool) -> str:
+    """For the unknown key at the end of ``loc``: the closest allowed key and every allowed key (but when
+    ``keys_said``, already said for another unknown key there), or ``""``."""
     if not loc or not isinstance(loc[-1], str):
         return ""
     where = _model_at(model, loc[:-1], data)
@@ -493,6 +494,8 @@ def _unknown_key_hint(model: type[BaseModel], loc: tuple[int | str, ...], data: 
     keys = list(where.model_fields)
     close = difflib.get_close_matches(loc[-1], keys, n=1, cutoff=0.75)
     hint = f"did you mean {close[0]!r}? " if close else ""
+    if keys_said:
+        return f"; {hint.removesuffix(' ')}" if hint else ""
     return f"; {hint}allowed keys: {', '.join(keys)}"
 
 
@@ -507,7 +510,8 @@ def validation_problems(
     if model is None and err.title == Scenario.__name__:
         model = Scenario
     out = []
-    for e in err.errors():
+    keys_said: set[tuple[int | str, ...]] = set()  # where the allowed keys were listed: once each (a JSON Schema
+    for e in err.errors():  # given as a scenario listed them 8 times)
         # Pydantic adds the union member or validator name to `loc`; drop the non-field parts.
         loc = tuple(p for p in e["loc"] if not (isinstance(p, str) and ("[" in p or p in _VALIDATOR_STEPS)))
         value = e.get("input")
@@ -518,7 +522,8 @@ def validation_problems(
         if e["type"] == "missing":  # pydantic's input is the mapping the field is missing from, not the field's
             shown, msg = "<missing>", "required"
         if e["type"] == "extra_forbidden" and model is not None:
-            msg += _unknown_key_hint(model, loc, data)
+            msg += _unknown_key_hint(model, loc, data, keys_said=loc[:-1] in keys_said)
+            keys_said.add(loc[:-1])
         if not loc and isinstance(value, dict):  # a check across fields: its message names the fields itself
             out.append(("", shown, msg))
             continue
