@@ -35,19 +35,17 @@ class CommandParser(argparse.ArgumentParser):
         kwargs.setdefault("allow_abbrev", False)
         super().__init__(*args, **kwargs)
 
-    _given: list[str] | None = None
-    """The arguments the top parser (``mmusv``) was given, for :func:`_misplaced_options`."""
-
     def parse_known_args(  # type: ignore[override]
         self, args: Sequence[str] | None = None, namespace: argparse.Namespace | None = None
     ) -> tuple[argparse.Namespace, list[str]]:
         CommandParser._deepest = self
         if " " not in self.prog:  # the top parser: sub-parsers' progs are ``mmusv run`` and the like
-            self._given = CommandParser._argv = list(sys.argv[1:] if args is None else args)
+            CommandParser._argv = list(sys.argv[1:] if args is None else args)
         return super().parse_known_args(args, namespace)
 
     _argv: ClassVar[list[str]] = []
-    """The arguments of the parse under way (the top parser's), for :func:`_dash_value`."""
+    """The arguments of the parse under way (the top parser's), for :func:`_misplaced_options` and
+    :func:`_dash_value`."""
 
     def error(self, message: str) -> NoReturn:
         prog = self.prog
@@ -72,10 +70,10 @@ def _misplaced_options(parser: argparse.ArgumentParser) -> str | None:
     """The error for options given before the command's name (``mmusv --frames 1 run x``), which argparse
     reported as ``unknown command '1'`` or as an argument ``mmusv run`` does not know (it knows ``--frames``);
     None when ``parser`` is not the top parser or no option precedes the command."""
-    given = getattr(parser, "_given", None)
     commands = next((a.choices for a in parser._actions if isinstance(a, argparse._SubParsersAction)), None)
-    if given is None or not commands:
+    if " " in parser.prog or not commands:
         return None
+    given = CommandParser._argv
     own = {o for a in parser._actions for o in a.option_strings}
     at = next((i for i, word in enumerate(given) if word in commands), None)
     before = given[: len(given) if at is None else at]
