@@ -15,6 +15,7 @@ from __future__ import annotations
 import contextlib
 import os
 from pathlib import Path
+from typing import Any, TypeGuard
 
 import yaml
 
@@ -24,6 +25,7 @@ from mmusv.recording.guard import write_cause
 from mmusv.recording.tables import SCHEMAS
 
 __all__ = [
+    "is_run_manifest",
     "refuse_earlier_run",
     "refuse_foreign_files",
     "refuse_wrong_kinds",
@@ -125,10 +127,8 @@ def refuse_foreign_files(out: Path, cfg: object) -> None:
             text, dumped = "", None
         if text != dumped:
             foreign = scenario_file
-    if foreign is None and manifest.is_file():
-        doc = read_json_or_none(manifest)
-        if not (doc is not None and isinstance(doc.get("recording"), str) and "mmusv_version" in doc):
-            foreign = manifest
+    if foreign is None and manifest.is_file() and not is_run_manifest(read_json_or_none(manifest)):
+        foreign = manifest
     if foreign is None:
         return
     if isinstance(cfg, (str, os.PathLike)) and Path(cfg).resolve() == foreign.resolve():
@@ -140,6 +140,12 @@ def refuse_foreign_files(out: Path, cfg: object) -> None:
         f"{foreign} was not written by an mmusv run, and a run into {out} replaces its {foreign.name} (--overwrite "
         f"or not); run into another folder (-o), or move it out of {out}"
     )
+
+
+def is_run_manifest(doc: dict[str, Any] | None) -> TypeGuard[dict[str, Any]]:
+    """Whether ``doc``, a ``manifest.json`` read (``None``: none that reads), is one a run wrote: a JSON object naming
+    its ``recording`` and ``mmusv_version``."""
+    return doc is not None and isinstance(doc.get("recording"), str) and "mmusv_version" in doc
 
 
 def replace_outputs(out: Path, scenario: Scenario, stale: list[Path]) -> None:

@@ -30,7 +30,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from mmusv.batch.index import INDEX_NAME, check_replaceable, read_index, write_index
+from mmusv.batch.index import (
+    INDEX_NAME,
+    check_replaceable,
+    index_entries,
+    read_earlier_index,
+    read_index,
+    write_index,
+)
 from mmusv.batch.plan import STATE_DIR, remove_task_files
 from mmusv.batch.runner import BatchReport, join_ray, run_many
 from mmusv.errors import IoError, MmusvError
@@ -215,10 +222,7 @@ def build_dataset(
     scen_dir, rec_dir, opv2v = out / "scenarios", out / "recordings", out / "opv2v"
     index_path = out / INDEX_NAME
     check_replaceable(index_path, writer="mmusv dataset")  # the batch refuses it too, but after the generation
-    try:
-        old: dict[str, Any] = read_index(index_path) if index_path.is_file() else {}
-    except MmusvError:
-        old = {}
+    old = read_earlier_index(index_path)
     listed = old.get("recordings")
     if isinstance(listed, list) and listed and not isinstance(old.get("spec"), dict):
         raise IoError(
@@ -285,9 +289,7 @@ def build_dataset(
         up_to_date = (
             section.get("sources") == sources and section.get("status") == "complete" and _conversion_complete(opv2v)
         )
-        from mmusv.batch.index import Entry
-
-        entries = [Entry(**{k: r[k] for k in Entry.__dataclass_fields__}) for r in doc["recordings"]]
+        entries = index_entries(doc)
         if sources and not up_to_date:
             recs = [out / r["recording"] for r in doc["recordings"] if r["name"] in sources]
             # the index says the conversion is under way until it is done: it kept the earlier conversion's

@@ -42,6 +42,8 @@ __all__ = [
     "check_replaceable",
     "dataset_recordings",
     "find_index",
+    "index_entries",
+    "read_earlier_index",
     "read_index",
     "write_index",
 ]
@@ -229,6 +231,24 @@ def read_index(path: str | os.PathLike[str]) -> dict[str, Any]:
                 "of its .mcap or .parts.json below the index's folder)"
             )
     return doc
+
+
+def read_earlier_index(path: Path) -> dict[str, Any]:
+    """The index an earlier run wrote at ``path`` (:func:`read_index`); ``{}`` when there is none or it cannot be
+    read (a writer then replaces it: :func:`check_replaceable` says whether it may)."""
+    from mmusv.errors import MmusvError
+
+    if not path.is_file():
+        return {}
+    try:
+        return read_index(path)
+    except MmusvError:
+        return {}
+
+
+def index_entries(doc: Mapping[str, Any]) -> list[Entry]:
+    """The entries of an index :func:`read_index` read (``{}``: none), as :class:`Entry`."""
+    return [Entry(**{k: r[k] for k in Entry.__dataclass_fields__}) for r in doc.get("recordings", [])]
 
 
 def dataset_recordings(path: str | os.PathLike[str], *, statuses: Iterable[str] = ("complete",)) -> list[Path]:

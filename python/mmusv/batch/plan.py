@@ -372,7 +372,7 @@ def _foreign(folder: Path, scenario: str, file: Path, overwrite: bool) -> str | 
     it). A batch replaced them without a word (its tasks run with ``overwrite``: the folder is the batch's)."""
     from mmusv.errors import IoError
     from mmusv.recording.info import written_by_mmusv
-    from mmusv.run_folder import refuse_foreign_files
+    from mmusv.run_folder import is_run_manifest, refuse_foreign_files
 
     try:
         refuse_foreign_files(folder, str(file))
@@ -382,7 +382,7 @@ def _foreign(folder: Path, scenario: str, file: Path, overwrite: bool) -> str | 
     if overwrite or not (rec.is_file() or rec.is_symlink()) or written_by_mmusv(rec):
         return None
     m = _manifest(folder)
-    if m is not None and m.get("recording") == rec.name and "mmusv_version" in m:  # the run's, damaged since
+    if is_run_manifest(m) and m["recording"] == rec.name:  # the run's, damaged since
         return None
     return (
         f"{rec} is not a recording of an mmusv run (its header does not say so, and no run's manifest.json names "

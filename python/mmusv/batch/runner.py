@@ -39,7 +39,8 @@ from mmusv.batch.index import (
     check_extra,
     check_replaceable,
     folder_bytes,
-    read_index,
+    index_entries,
+    read_earlier_index,
     write_index,
 )
 from mmusv.batch.plan import ScenarioPlan, plan_scenarios, prepare, scenario_files, task_complete
@@ -290,7 +291,7 @@ def run_many(
     index_path = arguments.path(index, name="index").resolve() if index is not None else out / INDEX_NAME
     root = index_path.parent
     check_replaceable(index_path, writer="the batch")
-    earlier = _earlier_index(index_path)
+    earlier = read_earlier_index(index_path)
     spec = earlier.get("spec")
     if index_extra is None and isinstance(spec, dict) and not overwrite:
         raise IoError(
@@ -312,7 +313,7 @@ def run_many(
         if p.recording is not None and not p.recording.is_relative_to(root):
             raise ConfigError(f"index {index_path} must be in a folder above the output {out}")
     names = {p.name for p in plans}
-    kept = [e for e in _entries_of(earlier) if e.name not in names and e.recording and (root / e.recording).is_file()]
+    kept = [e for e in index_entries(earlier) if e.name not in names and e.recording and (root / e.recording).is_file()]
     # The executor first: Ray that cannot be imported or joined fails the batch here, before anything is written
     # (it wrote an index calling every scenario pending, and readied their folders, as if work had been scheduled).
     executor = _executor(jobs, ray, cpus_per_task, lost_worker_retries) if any(p.to_run for p in plans) else None
@@ -339,22 +340,6 @@ def run_many(
         )
     finally:
         lock.release()
-
-
-def _earlier_index(path: Path) -> dict[str, Any]:
-    """The index an earlier batch wrote at ``path`` (``{}``: none, or one that cannot be read)."""
-    if not path.is_file():
-        return {}
-    try:
-        return read_index(path)
-    except MmusvError:
-        return {}
-
-
-def _entries_of(index: Mapping[str, Any]) -> list[Entry]:
-    """The entries of an index :func:`_earlier_index` read."""
-    rows = index.get("recordings", [])
-    return [Entry(**{k: r[k] for k in Entry.__dataclass_fields__}) for r in rows if isinstance(r, dict)]
 
 
 def _run(
