@@ -257,14 +257,15 @@ def convert(
     box = parse_box(box)
     box_options(to, min_box_px=box_px, max_occlusion=max_occ, min_contrast=min_c, box=box)
     target_options(to, eval_range_m=rng, include_usvs=include_usvs)
-    extras_option(to, parse_extras(extras))
+    extras_given = parse_extras(extras)
+    extras_option(to, extras_given)
     kind = kitti_type(kitti_class, to)
     origin = oxts_origin_of(oxts_origin, to)
     options = Options(
         to=to,
         eval_range_m=rng,
         include_usvs=include_usvs,
-        extras=parse_extras(extras),
+        extras=extras_given,
         min_box_px=box_px,
         max_occlusion=max_occ,
         min_contrast=min_c,
