@@ -67,12 +67,12 @@ def output_arg(value: str, *, flag: str = "-o/--output") -> str:
 def check_output_folder(value: str, *, flag: str = "-o/--output") -> Path:
     """``value`` (:func:`output_arg`) as the output folder of ``flag``, checked without creating anything: it, or
     the nearest of its parents that exists, is a folder. A file there was named only after the computing."""
+    from mmusv.recording.guard import file_in_the_way
+
     out = Path(output_arg(value, flag=flag))
-    for q in (out, *out.parents):
-        if q.exists():
-            if not q.is_dir():
-                raise ConfigError(f"{flag} {value}: {q} is a file, not a folder")
-            break
+    blocking = file_in_the_way(out)
+    if blocking is not None:
+        raise ConfigError(f"{flag} {value}: {blocking} is a file, not a folder")
     return out
 
 

@@ -32,10 +32,19 @@ from types import TracebackType
 from mmusv.errors import IoError
 from mmusv.held_signals import HeldSignals  # its home; here as before for the recorder's callers
 
-__all__ = ["FolderLock", "HeldSignals", "write_cause"]
+__all__ = ["FolderLock", "HeldSignals", "file_in_the_way", "write_cause"]
 
 _OS_ERROR = re.compile(r"os error (\d+)")
 _PROBE_BYTES = 1 << 16
+
+
+def file_in_the_way(folder: Path) -> Path | None:
+    """The nearest of ``folder`` and its parents that exists, when it is not a folder (a file where the folder, or
+    one above it, would be made); None when that one is a folder, or none exists."""
+    for q in (folder, *folder.parents):
+        if q.exists():
+            return None if q.is_dir() else q
+    return None
 
 
 class FolderLock:
@@ -57,7 +66,7 @@ class FolderLock:
         try:
             path.mkdir(parents=True, exist_ok=True)
         except (FileExistsError, NotADirectoryError):  # the path or a folder above it is a file (said neither)
-            above = next((p for p in (path, *path.parents) if p.exists() and not p.is_dir()), path)
+            above = file_in_the_way(path) or path
             what = "it is a file" if above == path else f"{above} is a file"
             raise IoError(f"cannot create output folder {path}: {what}, not a folder; give another folder") from None
         except OSError as exc:
