@@ -31,11 +31,10 @@ def _kept(args: argparse.Namespace) -> dict[str, Any]:
     from mmusv.jsonio import read_json_or_none
 
     out = Path(args.output)
-    manifest = read_json_or_none(out / "manifest.json")
-    name = None if manifest is None else manifest.get("recording")
+    manifest = read_json_or_none(out / "manifest.json") or {}
+    name, frames = manifest.get("recording"), manifest.get("frames_written")
     if not isinstance(name, str) or not (out / name).is_file():
         return {}
-    frames = manifest.get("frames_written") if manifest is not None else None
     return {"recording": str(out / name), **({"frames": frames} if isinstance(frames, int) else {})}
 
 

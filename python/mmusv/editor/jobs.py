@@ -111,9 +111,7 @@ class Jobs:
                 raise RunGoingOn(
                     f"run {same[0].id} ({same[0].scenario}) is writing {rel_out} already; wait for it to end or stop it"
                 )
-            if (
-                len(running) >= MAX_RUNNING
-            ):  # 409, as for a run of the same folder: the request is good, the editor busy
+            if len(running) >= MAX_RUNNING:  # 409, as for a run of the same folder: a good request, a busy editor
                 raise RunGoingOn(
                     f"{len(running)} runs are going on already, the most the editor runs at a time; wait for one to "
                     "end or stop it"
