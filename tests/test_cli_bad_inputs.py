@@ -28,6 +28,16 @@ def _refused(argv: Sequence[str], capsys: pytest.CaptureFixture[str]) -> tuple[s
     return out, err
 
 
+def _usage_error(argv: Sequence[str], capsys: pytest.CaptureFixture[str]) -> str:
+    """Runs ``mmusv argv``, which argparse refuses: asserts exit status 2 and one error line; returns it."""
+    with pytest.raises(SystemExit) as e:
+        main(list(argv))
+    assert e.value.code == 2
+    err = capsys.readouterr().err
+    assert err.startswith("mmusv: error: ") and err.count("\n") == 1 and "Traceback" not in err, err
+    return err
+
+
 @pytest.fixture
 def cwd(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     """An empty current folder, to see that nothing lands there."""
@@ -292,12 +302,8 @@ def test_a_shortened_or_misspelt_flag_is_refused_with_the_flag_it_may_mean(
     # argparse took any unambiguous prefix: ``--frame 3`` ran 3 frames, and a script using it would change
     # meaning the day a second flag shared the prefix. Now it is an unrecognised argument, nothing is written.
     argv = [str(tmp_path / a) if a in ("rec", "out") else a for a in argv]
-    with pytest.raises(SystemExit) as e:
-        main(argv)
-    assert e.value.code == 2
-    err = capsys.readouterr().err
-    assert "unrecognized arguments" in err and hint in err and "Traceback" not in err, err
-    assert err.count("\n") == 1, err
+    err = _usage_error(argv, capsys)
+    assert "unrecognized arguments" in err and hint in err, err
     assert list(tmp_path.iterdir()) == []
 
 
@@ -315,12 +321,8 @@ def test_a_shortened_or_misspelt_flag_is_refused_with_the_flag_it_may_mean(
 def test_an_option_before_the_command_is_said_to_belong_after_it(
     argv: list[str], said: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    with pytest.raises(SystemExit) as e:
-        main(argv)
-    assert e.value.code == 2
-    err = capsys.readouterr().err
-    assert err.startswith("mmusv: error: ") and said in err and "Traceback" not in err, err
-    assert err.count("\n") == 1, err
+    err = _usage_error(argv, capsys)
+    assert said in err, err
     if "any command" not in said:
         command = argv[argv.index(said.split("'")[1])]
         assert f"as in: mmusv {command} " in err, err
@@ -356,11 +358,8 @@ def test_a_value_that_begins_with_a_dash_is_shown_how_to_give_it(
 ) -> None:
     # argparse takes "-1,1,1" for an option and said only "argument --split: expected one argument"
     argv = [str(tmp_path / a) if a in ("rec", "out") else a for a in argv]
-    with pytest.raises(SystemExit) as e:
-        main(argv)
-    assert e.value.code == 2
-    err = capsys.readouterr().err
-    assert "expected one argument" in err and err.count("\n") == 1, err
+    err = _usage_error(argv, capsys)
+    assert "expected one argument" in err, err
     if hint is None:
         assert "begins with '-'" not in err, err
     else:
