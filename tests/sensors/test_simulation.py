@@ -822,3 +822,25 @@ def test_a_wake_reach_cuts_the_foam_every_sensor_sees() -> None:
         scan(lidar, scene, pose=_pose(0.0, 0.0, 2.5), env=env, seed=4, wakes=[[*row, -1.0]])
     with pytest.raises(InputError, match=r"\(K, 6\) to \(K, 9\)"):
         scan(lidar, scene, pose=_pose(0.0, 0.0, 2.5), env=env, seed=4, wakes=[row[:5]])
+
+
+@pytest.mark.parametrize("hs_m", [1e-6, 1e-3])
+def test_a_calm_physical_sea_still_holds_the_water(make_scenario: Any, hs_m: float) -> None:
+    """A sea of micrometre waves (``environment.sea.hs_m: 1e-6``, allowed) is water to every ray, as flat water
+    is: its band of heights was thinner than a ray's height rounds to, and rays went through to the seabed, or
+    out of the world."""
+    sc = make_scenario()
+    sc["environment"] = {"sea": {"hs_m": hs_m}}
+    sc["vessels"] = sc["vessels"][:1]
+    sim = Simulation(sc)
+    assert sim.sea is not None and sim.sea.hs_m == hs_m
+    sim.set_frame(0)
+    g = np.arange(-200.0, 200.0, 7.3)
+    xy = np.stack(np.meshgrid(g, g), axis=-1).reshape(-1, 2)
+    o = np.column_stack([xy, np.full(len(xy), 30.0)]).astype(np.float32)
+    d = np.tile(np.array([0.0, 0.0, -1.0], np.float32), (len(xy), 1))
+    dist, inst = sim.ws.scene._native.cast_rays(o, d, 1000.0)[:2]
+    water = inst == sim.ws.static_instances["water"]
+    assert water.sum() > 0.95 * len(xy)
+    np.testing.assert_allclose(30.0 - dist[water], 0.0, atol=1e-2)
+    assert (inst[~water] == sim.ws.vessel_instances[0]).all()  # the USV's hull, nothing under the water

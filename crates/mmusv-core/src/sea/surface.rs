@@ -34,6 +34,10 @@ const MAX_LEVEL: u32 = 5;
 /// Rays that rise from within this height (metres) above the surface under their origin leave the water: the
 /// surface does not occlude them ([`WaveSurface::leaves`]).
 pub const SKIN_M: f32 = 0.25;
+
+/// The least half-height of the band `[zmin, zmax]` the march walks, metres: a flat or micrometre sea's band is
+/// widened to it, so that a ray's height above the water, rounded at its range, still changes sign inside it.
+pub const MIN_BAND_HALF_M: f32 = 0.01;
 /// Crest columns given to a [`crate::sea::Horizon`] ([`WaveSurface::add_crests`]) stand this much (metres) above
 /// the highest node under them: far more than the rounding of the surface's planes.
 const CREST_MARGIN_M: f64 = 1e-3;
@@ -226,8 +230,11 @@ impl WaveSurface {
                 phasors.tile(ix, iy, level, foci, &spec)
             })
             .collect();
-        let mut zmin = level;
-        let mut zmax = level;
+        // The band is at least ±MIN_BAND_HALF_M about the still level: a calmer sea's (hs_m of micrometres, or
+        // no waves) is thinner than a ray's height rounds to at its range, and the march's sign test over it let
+        // every ray through. A wider band is still a bound, so no hit of a real sea changes.
+        let mut zmin = level - MIN_BAND_HALF_M;
+        let mut zmax = level + MIN_BAND_HALF_M;
         for t in &tiles {
             if t.n > 0 {
                 zmin = zmin.min(t.zmin);

@@ -490,3 +490,26 @@ fn the_tile_count_is_the_grids_and_huge_extents_are_refused() {
     assert_eq!(huge.tiles_for(&[[0.0, 0.0]]), u64::MAX);
     assert!(huge.check_extent(&[[0.0, 0.0]]).is_err());
 }
+
+#[test]
+fn a_calm_sea_still_stops_every_ray() {
+    // Waves of micrometres (hs_m 1e-6, or no waves at all) make a band of heights thinner than a ray's height
+    // rounds to at its range: it must still hold the water, as the still plane does.
+    let k = TAU / 40.0;
+    for a in [0.0, 5e-7, 1e-6, 1e-4] {
+        let c = [comp(a, k, 0.0, 0.0, 0.0)];
+        let s = surface(&c, 0.0, &[[0.0, 0.0]], SurfaceSpec::default());
+        for (o, d) in [
+            ([0.0f32, 0.0, 50.0], [0.0f32, 0.0, -1.0]),
+            ([20.0, 5.0, 30.0], [0.0, 0.0, -1.0]),
+            ([40.0, -20.0, 3000.0], [0.0, 0.0, -1.0]),
+            ([0.0, 0.0, 2.0], [0.6, 0.0, -0.8]),
+            ([0.0, 0.0, 2.0], [0.99995, 0.0, -0.01]),
+            ([9000.0, 0.0, 40.0], [0.0, 0.6, -0.8]),
+        ] {
+            let Some(h) = s.intersect(o, d, 1e5) else { panic!("a = {a}: {o:?} + t {d:?} passes through the water") };
+            let z = o[2] + d[2] * h.t;
+            assert!(z.abs() < 2e-3 * (1.0 + h.t / 1000.0), "a = {a}: {o:?} + t {d:?} meets z = {z}");
+        }
+    }
+}
