@@ -14,6 +14,7 @@ import numpy.typing as npt
 
 __all__ = [
     "MAX_DEMO_SIZE",
+    "MAX_IMAGE_PIXELS",
     "MAX_SURFACE_TILES",
     "Camera",
     "ConfigError",
@@ -509,6 +510,9 @@ def capture_frame(
 MAX_DEMO_SIZE: int
 """Largest ``terrain_cells`` (a side) and ``vessels`` of ``demo_scene`` (mmusv_core::demo::MAX_DEMO_SIZE)."""
 
+MAX_IMAGE_PIXELS: int
+"""Most pixels of one camera image (4096 x 4096; mmusv_core::sensors::camera::MAX_PIXELS); ``Camera`` refuses more."""
+
 MAX_SURFACE_TILES: int
 """Most tiles one displaced sea surface may hold (2**22; mmusv_core::sea::MAX_TILES)."""
 
@@ -694,7 +698,7 @@ class Recorder:
 
     def __new__(cls, path: str | os.PathLike[str], *, overwrite: bool = False) -> Recorder:
         """Starts a recording; an existing ``path`` raises ``IoError`` unless ``overwrite`` (replaced only on
-        finish)."""
+        finish), and so does a ``path`` whose ``.partial`` another recorder is still writing (it is locked)."""
 
     @property
     def path(self) -> str:

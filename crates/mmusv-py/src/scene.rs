@@ -118,14 +118,11 @@ fn surface_key(
     }
     let spec = SurfaceSpec { tile_m, near_m, radius_m, taper_m, detail, slopes, fine_m };
     spec.check_extent(&foci).map_err(crate::errors::to_py)?; // before any tile is allocated
-    Ok(Some(SurfaceKey {
-        sea: SeaSpec { hs, tp: tp_s, gamma, direction_rad, spread_s },
-        seed: sea_seed(scenario_seed),
-        time_s,
-        level,
-        foci,
-        spec,
-    }))
+                                                             // The sea itself too, here: `prefetch_wave_surface` promises its checks, and a sea checked only where it is
+                                                             // sampled (on the prefetch's thread) was refused later, at `set_wave_surface`, or never.
+    let sea = SeaSpec { hs, tp: tp_s, gamma, direction_rad, spread_s };
+    sea.validate().map_err(crate::errors::to_py)?;
+    Ok(Some(SurfaceKey { sea, seed: sea_seed(scenario_seed), time_s, level, foci, spec }))
 }
 
 fn poisoned() -> PyErr {
@@ -341,6 +338,12 @@ impl Scene {
         let Some(key) = key else {
             return self.write(|s| s.set_wave_surface(None))?.map_err(crate::errors::to_py);
         };
+        if self.read(|s| Ok(s.sea_instance().is_none()))? {
+            // Refused before the surface is sampled (seconds for a wide one), not after, as the core would.
+            // An empty surface (no waves) costs nothing and gets the core's own refusal.
+            let none = WaveSurface::new(&[], key.time_s, key.level, &[], key.spec).map_err(crate::errors::to_py)?;
+            return self.write(|s| s.set_wave_surface(Some(none)))?.map_err(crate::errors::to_py);
+        }
         let (field, surface) = match ahead {
             // Sampled ahead from the same arguments: the same surface, waited for (a panic there is re-raised
             // here, and reported as one).

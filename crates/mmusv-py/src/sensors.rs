@@ -90,6 +90,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<SensorEnv>()?;
     m.add_class::<Lidar>()?;
     m.add_class::<Camera>()?;
+    m.add("MAX_IMAGE_PIXELS", mmusv_core::sensors::camera::MAX_PIXELS)?;
     Ok(())
 }
 

@@ -147,7 +147,9 @@ class Recording:
 
     def __init__(self, path: str | os.PathLike[str], *, overwrite: bool = False) -> None:
         """Starts writing ``<path>.partial``. An existing ``path`` raises :class:`mmusv.IoError` unless
-        ``overwrite`` (the old file is replaced only when :meth:`finish` succeeds)."""
+        ``overwrite`` (the old file is replaced only when :meth:`finish` succeeds), and so does a ``path`` another
+        recording is still writing, in this process or another (its ``.partial`` is locked until it is finished,
+        abandoned or dropped)."""
         self._rec = core.Recorder(os.fspath(path), overwrite=overwrite)
 
     @property

@@ -70,8 +70,9 @@ class _Model(StrictModel):
     for numbers)."""
 
 
-MAX_IMAGE_PIXELS = 4096 * 4096
-"""Largest image of any camera: about 16.8 M pixels (a 4096 x 4096 frame takes ~0.6 GB of buffers per frame)."""
+MAX_IMAGE_PIXELS: int = core.MAX_IMAGE_PIXELS
+"""Largest image of any camera: about 16.8 M pixels (a 4096 x 4096 frame takes ~0.6 GB of buffers per frame); the
+core's own bound (``mmusv._core.MAX_IMAGE_PIXELS``), which ``Camera`` refuses beyond."""
 MAX_LIDAR_RAYS = 1 << 22
 """Most LiDAR rays per sweep (4.2 M: ~0.3 GB of points per sweep)."""
 MAX_RADAR_RAYS = 1 << 23

@@ -214,6 +214,31 @@ fn dropped_recorder_stays_partial_but_readable() -> Result<()> {
 }
 
 #[test]
+fn a_second_recorder_on_the_same_name_is_refused() -> Result<()> {
+    // Two recorders on one name truncated each other's `.partial`: the first finish renamed a damaged MCAP into
+    // place and said it held every message.
+    let path = scratch("twice.mcap");
+    let mut first = Recorder::create(&path, false)?;
+    write_all(&mut first)?;
+    let Err(MmusvError::Io { path: named, reason }) = Recorder::create(&path, true) else {
+        panic!("a second recorder on a name being written was allowed")
+    };
+    assert!(named.ends_with("twice.mcap.partial") && reason.contains("another recorder"), "{named}: {reason}");
+    let summary = first.finish()?;
+    assert_eq!(summary.messages, 14);
+    let bytes = std::fs::read(&path).map_err(io)?;
+    assert_eq!(mcap::MessageStream::new(&bytes).map_err(io)?.filter(|m| m.is_ok()).count(), 14);
+    // Finished (or dropped), the name is free again; a stale `.partial` left by a dropped recorder is emptied.
+    drop(Recorder::create(&path, true)?);
+    let mut again = Recorder::create(&path, true)?;
+    write_all(&mut again)?;
+    again.finish()?;
+    let bytes = std::fs::read(&path).map_err(io)?;
+    assert_eq!(mcap::MessageStream::new(&bytes).map_err(io)?.filter(|m| m.is_ok()).count(), 14);
+    Ok(())
+}
+
+#[test]
 fn rejects_bad_input() -> Result<()> {
     let path = scratch("bad.mcap");
     let mut rec = Recorder::create(&path, false)?;

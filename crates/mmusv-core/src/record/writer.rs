@@ -136,6 +136,34 @@ fn mcap_err(path: &Path) -> impl Fn(mcap::McapError) -> MmusvError + '_ {
     move |e| MmusvError::Io { path: path.display().to_string(), reason: mcap_reason(&e) }
 }
 
+/// Opens `<path>.partial` for a new recording: locked (an exclusive advisory lock, held until the file closes),
+/// then emptied. A `.partial` another recorder is writing — in this process or another — is refused, naming it:
+/// two recorders on one name truncated each other's file, and the first `finish` renamed a damaged MCAP into
+/// place. A file system without locks (`Unsupported`) is written unlocked, as before.
+fn open_partial(partial: &Path) -> Result<File> {
+    let file = std::fs::OpenOptions::new()
+        .write(true)
+        .create(true)
+        .truncate(false) // emptied below, once this recorder holds the lock
+        .open(partial)
+        .map_err(io_err(partial))?;
+    match file.try_lock() {
+        Ok(()) => {}
+        Err(std::fs::TryLockError::WouldBlock) => {
+            return Err(MmusvError::Io {
+                path: partial.display().to_string(),
+                reason: "another recorder is writing this file (an open Recorder, or a run in another process); \
+                         finish it first or record under another name"
+                    .into(),
+            })
+        }
+        Err(std::fs::TryLockError::Error(e)) if e.kind() == std::io::ErrorKind::Unsupported => {}
+        Err(std::fs::TryLockError::Error(e)) => return Err(io_err(partial)(e)),
+    }
+    file.set_len(0).map_err(io_err(partial))?;
+    Ok(file)
+}
+
 /// Completes the MCAP (summary, footer), flushes and syncs the file.
 fn close(mut writer: Writer<BufWriter<File>>, partial: &Path) -> Result<()> {
     writer.finish().map_err(mcap_err(partial))?;
@@ -145,7 +173,8 @@ fn close(mut writer: Writer<BufWriter<File>>, partial: &Path) -> Result<()> {
 
 impl Recorder {
     /// Starts a recording that will be named `path`. An existing `path` is refused unless `overwrite`; it is
-    /// then replaced only when [`finish`](Self::finish) succeeds. A stale `<path>.partial` is truncated.
+    /// then replaced only when [`finish`](Self::finish) succeeds. A stale `<path>.partial` is truncated; one that
+    /// another recorder is still writing is refused ([`open_partial`]).
     pub fn create(path: &Path, overwrite: bool) -> Result<Self> {
         if path.as_os_str().is_empty() {
             // An empty path would write `.partial` into the working directory and rename it to "" on finish.
@@ -162,7 +191,7 @@ impl Recorder {
             });
         }
         let partial = partial_path(path);
-        let file = File::create(&partial).map_err(io_err(&partial))?;
+        let file = open_partial(&partial)?;
         let options = WriteOptions::new()
             .compression(Some(mcap::Compression::Zstd))
             .compression_level(ZSTD_LEVEL)

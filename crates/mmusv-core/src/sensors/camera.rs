@@ -39,6 +39,9 @@ use radiance::Reflections;
 
 /// Largest image side, pixels.
 pub const MAX_SIDE: u32 = 16_384;
+/// Most pixels of one image (4096 × 4096, about 16.8 M): a camera's rays and a frame's buffers take about 150 bytes
+/// a pixel, so a 16384 × 16384 image (both sides allowed) would want some 40 GB and abort in the allocator.
+pub const MAX_PIXELS: u64 = 4096 * 4096;
 
 /// How pixels map to rays.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -199,6 +202,16 @@ impl Camera {
                 "camera.resolution",
                 format!("[{}, {}]", cfg.width, cfg.height),
                 format!("width and height must be in 1..={MAX_SIDE}"),
+            ));
+        }
+        if u64::from(cfg.width) * u64::from(cfg.height) > MAX_PIXELS {
+            return Err(MmusvError::config(
+                "camera.resolution",
+                format!("[{}, {}]", cfg.width, cfg.height),
+                format!(
+                    "{} pixels, more than the {MAX_PIXELS} allowed (4096 x 4096)",
+                    u64::from(cfg.width) * u64::from(cfg.height)
+                ),
             ));
         }
         if !(cfg.range_max > 0.0) {

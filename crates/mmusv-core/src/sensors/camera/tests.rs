@@ -222,6 +222,12 @@ fn bad_configs_name_the_field() {
     assert!(bad(CameraConfig { range_max: -1.0, ..ok }).contains("camera.range_m"));
     assert!(bad(CameraConfig { projection: Projection::Orthographic { metres_per_pixel: 0.0 }, ..ok })
         .contains("metres_per_pixel"));
+    // Both sides allowed, but more pixels than an image may hold: refused before the rays are allocated (some
+    // 40 GB at 16384 x 16384, which aborted in the allocator); the most allowed, a strip of a side, still builds.
+    assert!(bad(CameraConfig { width: 4097, height: 4096, ..ok }).contains("camera.resolution"));
+    let e = bad(CameraConfig { width: MAX_SIDE, height: MAX_SIDE, ..ok });
+    assert!(e.contains("camera.resolution") && e.contains(&MAX_PIXELS.to_string()), "{e}");
+    assert!(Camera::new(CameraConfig { width: MAX_SIDE, height: 2, ..ok }).is_ok());
 }
 
 /// Standard quality traces one water reflection per 2 × 2 block and reconstructs the others from the block

@@ -1,0 +1,99 @@
+"""The native boundary, second hostile round (a sweep of ``mmusv._core`` and the API over it). What it found:
+
+- Two recordings opened on one name each wrote its ``.partial``: the second truncated the first's, the first's
+  ``finish`` said it held every message and renamed an MCAP that no longer read into place, and the second's
+  ``finish`` failed with "No such file or directory".
+- ``Camera(width=16384, height=16384)`` (both sides allowed) allocated its rays, some 7 GB, and rendering would
+  want 33 GB: under a memory limit the process aborted in Rust's allocator.
+- ``Scene.prefetch_wave_surface`` promised ``set_wave_surface``'s checks but took ``hs_m=NaN`` or ``-5`` without a
+  word (the sea was checked on the sampling thread, so the error came later or never).
+
+Each allocation-sized case runs in a subprocess under a 4 GiB address space (tests/test_native_fuzz_round.py's
+harness), so a regression is a failed test rather than a dead test run.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import mmusv
+import numpy as np
+import pytest
+from mcap.reader import make_reader
+from mmusv._native import core
+from mmusv.recording.writer import Recording
+from mmusv.sensors.config import MAX_IMAGE_PIXELS
+from test_native_fuzz_round import _refused, _run
+
+
+def _count(path: Path) -> int:
+    with path.open("rb") as f:
+        return sum(1 for _ in make_reader(f).iter_messages())
+
+
+def _write(rec: Recording, n: int) -> None:
+    for i in range(n):
+        rec.raw_image("/img", log_time_ns=i, frame_id="c", image=np.full((8, 8), i % 255, np.uint8))
+
+
+def test_a_second_recording_on_a_name_being_written_is_refused(tmp_path: Path) -> None:
+    path = tmp_path / "x.mcap"
+    first = Recording(path)
+    _write(first, 20)
+    with pytest.raises(mmusv.IoError, match=r"x\.mcap\.partial.*another recorder"):
+        Recording(path, overwrite=True)
+    _write(first, 20)  # the refusal left the first one's file alone
+    assert first.finish()["messages"] == 40
+    assert _count(path) == 40
+    # Finished, the name is free: a new recording replaces it (with overwrite), and reads back whole.
+    again = Recording(path, overwrite=True)
+    _write(again, 3)
+    again.finish()
+    assert _count(path) == 3
+
+
+def test_a_dropped_or_abandoned_recording_frees_its_name(tmp_path: Path) -> None:
+    path = tmp_path / "y.mcap"
+    rec = Recording(path)
+    _write(rec, 2)
+    del rec  # dropped unfinished: its .partial is left (readable), and unlocked
+    rec = Recording(path)
+    _write(rec, 2)
+    rec._rec.abandon()
+    rec = Recording(path)
+    _write(rec, 1)
+    rec.finish()
+    assert _count(path) == 1
+
+
+def test_a_camera_of_more_pixels_than_an_image_may_hold_is_refused_not_aborted() -> None:
+    assert MAX_IMAGE_PIXELS == core.MAX_IMAGE_PIXELS == 4096 * 4096  # one bound, the core's
+    _refused(
+        "_core.Camera(width=16384, height=16384, rgb=True, hfov=1.0)",
+        "ConfigError",
+        "camera.resolution",
+        "16777216",
+    )
+    _refused("_core.Camera(width=4097, height=4096, rgb=True, hfov=1.0)", "ConfigError", "camera.resolution")
+    r = _run("assert _core.Camera(width=16384, height=4, rgb=True, hfov=1.0).resolution == (16384, 4)")
+    assert r["outcome"] == "ok", r
+
+
+@pytest.mark.parametrize(("kwargs", "field"), [({"hs_m": float("nan")}, "hs_m"), ({"hs_m": -5.0}, "hs_m")])
+def test_sampling_ahead_checks_the_sea_as_setting_it_does(kwargs: dict[str, float], field: str) -> None:
+    scene, ids = core.demo_scene(extent=200.0, terrain_cells=8, vessels=1)
+    scene.set_sea(1, np.array(ids, np.uint32))
+    foci = np.zeros((1, 2), np.float32)
+    with pytest.raises(mmusv.ConfigError, match=field):
+        scene.set_wave_surface(**kwargs, foci=foci)
+    with pytest.raises(mmusv.ConfigError, match=field):
+        scene.prefetch_wave_surface(**kwargs, foci=foci)
+    with pytest.raises(mmusv.ConfigError, match="tp_s"):
+        scene.prefetch_wave_surface(1.0, tp_s=0.0, foci=foci)
+
+
+def test_a_wave_surface_on_a_scene_without_a_sea_is_refused() -> None:
+    scene, _ = core.demo_scene(extent=200.0, terrain_cells=8, vessels=1)
+    with pytest.raises(mmusv.InputError, match="no sea surface; declare it with set_sea"):
+        scene.set_wave_surface(1.0, foci=np.zeros((1, 2), np.float32), radius_m=3000.0)
+    assert scene.wave_top is None
