@@ -153,10 +153,27 @@ def _rebuilt(index: int, vessel: VesselConfig, asset: VesselAsset, rig: RigConfi
 
 
 def _check_mounts(agent: Agent, where: str) -> None:
-    """A sensor whose origin lies inside its own hull would see only the hull's inside: refuse it."""
+    """A sensor whose origin lies inside its own hull would see only the hull's inside, and one under the still
+    water (its vessel's ``z_base_m`` counted) the sea from below, hulls under their waterlines and a sky below the
+    horizon: refuse both."""
     index = {f"camera/{c.name}": i for i, c in enumerate(agent.rig.cameras)}
     for key, m in agent.mounts().items():
         name = f"{where}.cameras[{index[key]}].mount" if key in index else f"{where}.{key}.mount"
+        z = float(m[2, 3]) + agent.vessel.z_base_m  # the origin's height over the still water, at rest
+        if z < 0.0:
+            xyz = np.round(m[:3, 3], 3).tolist()
+            zb = agent.vessel.z_base_m
+            base, fix = ("", "z > 0 in the vessel frame")
+            if zb:
+                base, fix = (
+                    f" (the vessel's z_base_m = {zb:g} lowers it)",
+                    f"z > {-zb:g} m in the vessel frame, or raise z_base_m",
+                )
+            raise ConfigError(
+                f"invalid config {name} = {xyz}: the sensor sits {-z:.2f} m under the still water{base} on vessel "
+                f"{agent.id!r} ({agent.asset.name}); cameras, LiDAR and radar see nothing through water: mount it "
+                f"above the waterline ({fix}), e.g. on a mount point (`mmusv assets` lists them)"
+            )
         if inside_mesh(agent.asset.mesh.vertices, agent.asset.mesh.faces, point=m[:3, 3]):
             xyz = np.round(m[:3, 3], 3).tolist()
             raise ConfigError(

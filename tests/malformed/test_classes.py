@@ -260,6 +260,35 @@ def test_a_camera_inside_the_hull_is_named_by_its_index(capsys: pytest.CaptureFi
     assert "invalid config rigs.r.cameras[1].mount = " in err and "inside the hull" in err, err
 
 
+def test_a_sensor_under_the_water_is_refused_naming_its_field(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """A camera 3 m under the waterline saw the sea from below and labelled half its picture sky; a USV lowered by
+    ``z_base_m`` took its LiDAR and radar under with it, and they returned points on hulls under their waterlines.
+    Both ran without a word; now each is refused, naming the field, before anything is written."""
+    d = tiny()
+    cam = {"resolution": [32, 24], "outputs": ["depth"]}
+    d["rigs"]["r"]["cameras"] = [
+        {**cam, "name": "bow", "mount": {"point": "camera_front"}},
+        {**cam, "name": "keel", "mount": {"xyz": [0.0, 0.0, -3.0]}},
+    ]
+    path = write(tmp_path / "under.yaml", d)
+    err = cli_error(capsys, ["run", str(path), "-o", str(tmp_path / "out")])
+    assert "invalid config rigs.r.cameras[1].mount = [0.0, 0.0, -3.0]" in err, err
+    assert "3.00 m under the still water" in err and "z > 0 in the vessel frame" in err, err
+    d = tiny()
+    d["vessels"][0]["z_base_m"] = -5.0
+    with pytest.raises(ConfigError, match=r"rigs\.r\.lidar\.mount = .* under the still water \(the vessel's z_base_m"):
+        mmusv.run(d, out_dir=tmp_path / "o")
+    assert not (tmp_path / "out").exists() and not (tmp_path / "o").exists()
+    # At the waterline (a camera without a mount sits there) is still allowed.
+    d = tiny()
+    d["rigs"]["r"]["cameras"] = [{**cam, "name": "low", "mount": {"xyz": [5.0, 0.0, 0.0]}}]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert mmusv.run(d, out_dir=tmp_path / "ok").frames_written == 2
+
+
 def test_close_passes_are_warnings(tmp_path: Path) -> None:
     d = tiny()
     d["vessels"][1]["route"] = [[0, 8], [60, 8]]  # 8 m abeam of the USV
