@@ -3,7 +3,8 @@
 :func:`check_routes` runs, on the scenario's routes and motion, the checks ``mmusv generate`` applies to every
 scenario it writes (:mod:`mmusv.generate.checks`): ``in_water`` (every vessel's centre on navigable water,
 along the whole route and at every sampled time) is an error, since a vessel sailing over land makes every
-label wrong; ``shore_clearance``, ``structure_clearance`` and ``separation`` are warnings (a close pass can be
+label wrong, and so is ``hulls_intersect`` (two hulls running into each other: a LiDAR inside the other hull sees
+only its inside); ``shore_clearance``, ``structure_clearance`` and ``separation`` are warnings (a close pass can be
 what a user wants). ``mmusv run --no-checks`` and ``mmusv.run(..., checks=False)`` skip them.
 
 :func:`check_mounts` warns about sensor mounts far from their hull (a units mistake: millimetres for metres).
@@ -95,6 +96,7 @@ def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[st
     scenario whose checks would take more than :data:`~mmusv.generate.samples.MAX_CHECK_SAMPLES` samples is refused
     (a ``ConfigError`` that says how many and how to skip them) before anything is sampled."""
     from mmusv.generate.checks import (
+        HullsIntersect,
         InWater,
         Separation,
         ShoreClearance,
@@ -120,6 +122,15 @@ def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[st
         index = {v.id: i for i, v in enumerate(scenario.vessels)}
         fails = "; ".join(f"{f.message} (vessels[{index[f.vessels[0]]}].route)" for f in stranded)
         raise ConfigError(f"{source}: in_water: {fails}; routes must stay on navigable water (--no-checks skips this)")
+    crossing = HullsIntersect().findings(samples)
+    if crossing:
+        index = {v.id: i for i, v in enumerate(scenario.vessels)}
+        fails = "; ".join(
+            f"{f.message} (vessels[{index[f.vessels[0]]}] and vessels[{index[f.vessels[1]]}])" for f in crossing
+        )
+        raise ConfigError(
+            f"{source}: hulls_intersect: {fails}; move a route or a start_offset_m apart (--no-checks skips this)"
+        )
     found: list[str] = []
     for check in (
         ShoreClearance(cons.shore_clearance),
@@ -177,13 +188,14 @@ def map_findings(
     scenario: Scenario, ctx: MapContext, spec: GenerationSpec | None = None
 ) -> tuple[Samples, list[MapFinding]]:
     """The samples and every failure of the named checks on ``scenario`` sailing on ``ctx``'s map, in check order:
-    ``in_water`` (an error, as in ``mmusv run``), then as warnings ``shore_clearance``, ``structure_clearance``,
-    ``separation``, ``sensing_range`` (every target within range of a USV in a share of the frames),
-    ``cooperation`` (each USV's nearest USV within a distance band) and ``line_of_sight`` (each target seen past
-    the static map by a USV within range in a share of the frames), with ``spec``'s thresholds (default
-    :func:`map_check_spec`)."""
+    ``in_water`` and ``hulls_intersect`` (errors, as in ``mmusv run``), then as warnings ``shore_clearance``,
+    ``structure_clearance``, ``separation``, ``sensing_range`` (every target within range of a USV in a share of
+    the frames), ``cooperation`` (each USV's nearest USV within a distance band) and ``line_of_sight`` (each
+    target seen past the static map by a USV within range in a share of the frames), with ``spec``'s thresholds
+    (default :func:`map_check_spec`)."""
     from mmusv.generate.checks import (
         Cooperation,
+        HullsIntersect,
         InWater,
         LineOfSight,
         SensingRange,
@@ -197,6 +209,7 @@ def map_findings(
     cons = spec.constraints
     checks = (
         InWater(),
+        HullsIntersect(),
         ShoreClearance(cons.shore_clearance),
         StructureClearance(cons.structure_clearance),
         Separation(cons.separation),
@@ -205,7 +218,7 @@ def map_findings(
         LineOfSight(cons.line_of_sight),
     )
     found = [
-        MapFinding(c.name, "error" if c.name == "in_water" else "warning", f)
+        MapFinding(c.name, "error" if c.name in ("in_water", "hulls_intersect") else "warning", f)
         for c in checks
         for f in c.findings(samples)
     ]

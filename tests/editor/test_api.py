@@ -267,6 +267,21 @@ def test_evaluate_flags_a_route_over_land_where_it_happens(client: TestClient) -
     assert bad[0] and not bad[-1]
 
 
+def test_evaluate_flags_hulls_that_intersect_as_an_error(client: TestClient) -> None:
+    """``mmusv run`` refuses two hulls that run into each other; the editor's map says so, as an error."""
+    doc = bundled_doc(client)
+    doc["vessels"][1]["route"] = [list(map(float, xy)) for xy in doc["vessels"][0]["route"]]
+    doc["vessels"][1]["speed_mps"] = doc["vessels"][0]["speed_mps"]
+    doc["vessels"][1].pop("start_offset_m", None)
+    doc["vessels"][0].pop("start_offset_m", None)
+    ev = client.post("/api/evaluate", json={"document": doc}).json()
+    hits = [p for p in ev["problems"] if p["check"] == "hulls_intersect"]
+    assert len(hits) == 1, ev["problems"]
+    ids = [doc["vessels"][0]["id"], doc["vessels"][1]["id"]]
+    assert hits[0]["severity"] == "error" and hits[0]["vessels"] == ids and hits[0]["field"] == "vessels[0]"
+    assert "intersect at t=0.0 s" in hits[0]["message"]
+
+
 def test_evaluate_lists_every_vessel_that_fails(client: TestClient) -> None:
     doc = bundled_doc(client)
     doc["vessels"][0]["route"][2] = [-120, 600]

@@ -296,6 +296,50 @@ def test_close_passes_are_warnings(tmp_path: Path) -> None:
         mmusv.run(d, out_dir=tmp_path / "o")
 
 
+def test_hulls_that_run_into_each_other_are_an_error_unless_checks_are_off(tmp_path: Path) -> None:
+    """A USV sailing inside a tug recorded 26,202 of 26,202 LiDAR points on the tug's inside, with a warning only
+    ("overlap by 10.2 m"); two hulls that intersect are an error now, as a route over land is, naming both."""
+    d = tiny()
+    d["vessels"][1] = {"id": "t", "asset": "tug_32m", "speed_mps": 2, "route": [[0, 0], [50, 0]]}
+    with pytest.raises(ConfigError) as info:
+        mmusv.run(d, out_dir=tmp_path / "o")
+    msg = str(info.value)
+    assert "hulls_intersect: the hulls of u and t intersect at t=0.0 s" in msg, msg
+    assert "(vessels[0] and vessels[1])" in msg and "--no-checks" in msg, msg
+    assert not (tmp_path / "o").exists()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert mmusv.run(d, out_dir=tmp_path / "o2", checks=False).frames_written == 2
+    # Alongside, 8 m abeam, is a close pass: a warning, not an error.
+    d["vessels"][1]["route"] = [[0, 8], [50, 8]]
+    with pytest.warns(MmusvWarning, match="separation: u and t pass with their hull capsules overlapping by"):
+        mmusv.run(d, out_dir=tmp_path / "o3")
+
+
+def test_a_separation_warning_says_when_only_the_motion_between_samples_is_too_close() -> None:
+    """A 300 m ship turning a hairpin 150 m off a USV was said to "come 120.3 m apart (hulls) ...; need 15 m": the
+    check's allowance for the motion between its samples was not said."""
+    from mmusv.simulation import Simulation
+
+    d = tiny(acquisition={"frequency_hz": 0.05, "frames": 6})
+    d["vessels"][0]["route"] = [[-200, -150], [-100, -150]]
+    d["vessels"][1] = {
+        "id": "ship",
+        "asset": "container_ship_300m",
+        "speed_mps": 8,
+        "route": [[0, 0], [400, 0], [0, 5]],
+    }
+    sc = load_scenario(d)
+    with pytest.warns(MmusvWarning) as caught:
+        from mmusv.scenario_checks import check_routes
+
+        found = check_routes(sc, Simulation(sc).world, source="hairpin.yaml")
+    assert len(found) == 1 and len(caught) == 1, found
+    msg = found[0]
+    assert msg.startswith("hairpin.yaml: separation: u and ship come "), msg
+    assert "between the samples checked they can come up to" in msg and msg.endswith("need 15 m"), msg
+
+
 def test_generation_spec_shares_the_scenario_field_types() -> None:
     d = yaml.safe_load(SPEC.read_text(encoding="utf-8"))
     d["environment"]["time_of_day"] = ["7:30 pm"]

@@ -21,6 +21,7 @@ the first of them, so the generator and the editor say the same thing.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Protocol
 
@@ -163,6 +164,31 @@ class StructureClearance(_Clearance):
         super().__init__("d_struct", cfg.min_m, True, "a port structure, buoy or moored ship (hull)")
 
 
+def closest_hulls(s: Samples) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Every pair ``(iu[j], ju[j])`` of vessels (``iu < ju``), the least distance ``hull[j]`` (metres; below 0 the
+    capsules overlap by that much) between their hull capsules over the motion samples and the sample ``at[j]``
+    where it is (the first, on a tie), worked out over blocks of times x pairs in bounded memory."""
+    n = len(s.ids)
+    iu, ju = np.triu_indices(n, 1)
+    d = np.stack([np.cos(s.motion_yaw), np.sin(s.motion_yaw)], axis=-1) * s.half[None, :, None]
+    p, q = s.motion - d, s.motion + d  # capsule axes (T, V, 2)
+    reach = s.radius[iu] + s.radius[ju]
+    worst = np.full(len(iu), np.inf)
+    at = np.zeros(len(iu), dtype=np.int64)
+    for c0 in range(0, len(iu), _PAIR_BLOCK):
+        c = slice(c0, min(c0 + _PAIR_BLOCK, len(iu)))
+        a_, b_, cols = iu[c], ju[c], np.arange(c.stop - c0)
+        t_step = max(1, _PAIR_BLOCK // len(cols))
+        for t0 in range(0, len(s.times), t_step):
+            t = slice(t0, t0 + t_step)
+            hull = segment_distance(p[t, a_], q[t, a_], p2=p[t, b_], q2=q[t, b_]) - reach[None, c]
+            k = np.argmin(hull, axis=0)
+            better = hull[k, cols] < worst[c]  # strictly: an earlier block keeps a tie, as argmin would
+            worst[c] = np.where(better, hull[k, cols], worst[c])
+            at[c] = np.where(better, t0 + k, at[c])
+    return iu, ju, worst, at
+
+
 class Separation(_FindingsCheck):
     name = "separation"
 
@@ -170,43 +196,62 @@ class Separation(_FindingsCheck):
         self.min_m = cfg.min_m
 
     def findings(self, s: Samples) -> list[Finding]:
-        """One finding per pair of vessels that come too close, at their closest moment; the tightest first."""
-        n = len(s.ids)
-        if n < 2:
+        """One finding per pair of vessels that come too close, at their closest moment; the tightest first. The
+        hulls' distance at the samples must exceed ``min_m`` by both vessels' slack (how far each can move, and
+        its capsule turn, between two samples), so that the separation holds at every instant; a message whose
+        distance is above ``min_m`` says that slack."""
+        if len(s.ids) < 2:
             return []
-        iu, ju = np.triu_indices(n, 1)
-        d = np.stack([np.cos(s.motion_yaw), np.sin(s.motion_yaw)], axis=-1) * s.half[None, :, None]
-        p, q = s.motion - d, s.motion + d  # capsule axes (T, V, 2)
+        iu, ju, hull, at = closest_hulls(s)
         slack = s.motion_slack + s.motion_turn
-        reach = s.radius[iu] + s.radius[ju]
         pair_slack = slack[iu] + slack[ju]
-        # Each pair's tightest moment (the first, on a tie), over blocks of times x pairs: the same values as one
-        # (T, pairs) array, in bounded memory.
-        worst = np.full(len(iu), np.inf)
-        at = np.zeros(len(iu), dtype=np.int64)
-        hull_at = np.zeros(len(iu))
-        for c0 in range(0, len(iu), _PAIR_BLOCK):
-            c = slice(c0, min(c0 + _PAIR_BLOCK, len(iu)))
-            a_, b_, cols = iu[c], ju[c], np.arange(c.stop - c0)
-            t_step = max(1, _PAIR_BLOCK // len(cols))
-            for t0 in range(0, len(s.times), t_step):
-                t = slice(t0, t0 + t_step)
-                hull = segment_distance(p[t, a_], q[t, a_], p2=p[t, b_], q2=q[t, b_]) - reach[None, c]
-                gap = hull - pair_slack[None, c] - self.min_m
-                k = np.argmin(gap, axis=0)
-                better = gap[k, cols] < worst[c]  # strictly: an earlier block keeps a tie, as argmin would
-                worst[c] = np.where(better, gap[k, cols], worst[c])
-                at[c] = np.where(better, t0 + k, at[c])
-                hull_at[c] = np.where(better, hull[k, cols], hull_at[c])
+        worst = hull - pair_slack - self.min_m  # the slack is each vessel's own: the same closest moment
         out = []
         for j in sorted(np.flatnonzero(worst < 0.0), key=lambda j: (float(worst[j]), int(j))):
             k = int(at[j])
             a, b = int(iu[j]), int(ju[j])
             mid = (s.motion[k, a] + s.motion[k, b]) / 2.0
+            between = ""
+            if hull[j] >= self.min_m:  # the samples pass: only the motion between them can come closer
+                between = (
+                    f", and between the samples checked they can come up to {float(pair_slack[j]):.1f} m closer "
+                    "(their motion and turns from one sample to the next)"
+                )
             out.append(
                 Finding(
-                    f"{s.ids[a]} and {s.ids[b]} {separation_words(float(hull_at[j]))} at t={s.times[k]:.1f} s; "
-                    f"need {self.min_m:g} m",
+                    f"{s.ids[a]} and {s.ids[b]} {separation_words(float(hull[j]))} at "
+                    f"t={s.times[k]:.1f} s{between}; need {self.min_m:g} m",
+                    (s.ids[a], s.ids[b]),
+                    (float(mid[0]), float(mid[1])),
+                )
+            )
+        return out
+
+
+class HullsIntersect(_FindingsCheck):
+    """Two vessels whose hulls run into each other at some sample: the capsules inscribed in their hull rectangles
+    (the covering capsule's axis, radius ``B/2`` instead of ``B/√2``: :mod:`mmusv.generate.hulls`) overlap, so the
+    rectangles surely do. Covering capsules that only overlap (two hulls alongside) are a close pass,
+    :class:`Separation`'s. Every label of both is then wrong (a LiDAR inside the other hull sees only its inside),
+    so :func:`mmusv.scenario_checks.check_routes` makes it an error."""
+
+    name = "hulls_intersect"
+
+    def findings(self, s: Samples) -> list[Finding]:
+        if len(s.ids) < 2:
+            return []
+        iu, ju, hull, at = closest_hulls(s)
+        # The inscribed capsules' distance: the axes' distance less their radii, B/2 = r/√2 each.
+        inner = hull + (s.radius[iu] + s.radius[ju]) * (1.0 - math.sqrt(0.5))
+        out = []
+        for j in sorted(np.flatnonzero(inner < 0.0), key=lambda j: (float(inner[j]), int(j))):
+            k = int(at[j])
+            a, b = int(iu[j]), int(ju[j])
+            mid = (s.motion[k, a] + s.motion[k, b]) / 2.0
+            out.append(
+                Finding(
+                    f"the hulls of {s.ids[a]} and {s.ids[b]} intersect at t={s.times[k]:.1f} s near "
+                    f"{_where(mid)} (by at least {-float(inner[j]):.1f} m)",
                     (s.ids[a], s.ids[b]),
                     (float(mid[0]), float(mid[1])),
                 )
@@ -215,10 +260,12 @@ class Separation(_FindingsCheck):
 
 
 def separation_words(hull_m: float) -> str:
-    """How two hulls ``hull_m`` metres apart are said: "come 3.2 m apart (hulls)", or, below 0, "overlap by 33.7 m
-    (hulls)" (a negative distance read as "come -33.7 m apart")."""
+    """How two hulls ``hull_m`` metres apart (their covering capsules', :mod:`mmusv.generate.hulls`) are said:
+    "come 3.2 m apart (hulls)", or, below 0, "pass with their hull capsules overlapping by 2.2 m" (a negative
+    distance read as "come -2.2 m apart"; covering capsules overlap alongside, where the hulls need not:
+    :class:`HullsIntersect` says when they do)."""
     if hull_m < 0.0:
-        return f"overlap by {-hull_m:.1f} m (hulls)"
+        return f"pass with their hull capsules overlapping by {-hull_m:.1f} m"
     return f"come {hull_m:.1f} m apart (hulls)"
 
 
