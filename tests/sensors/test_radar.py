@@ -233,6 +233,8 @@ def test_sea_clutter_grows_from_w0_to_w3() -> None:
         ({"horizon_fraction": 2.0}, "horizon_fraction"),
         ({"horizon_band_deg": 90.0}, "horizon_band_deg"),
         ({"sea_clutter_sigma0": float("nan")}, "sea_clutter_sigma0"),
+        # A range bin longer than the span it measures: every echo was reported beyond the range, none returned.
+        ({"range_m": 100.0, "min_range_m": 1.0, "range_resolution_m": 1000.0}, "range_resolution_m"),
     ],
 )
 def test_bad_settings_raise_an_error_naming_the_field(change: dict[str, Any], field: str) -> None:

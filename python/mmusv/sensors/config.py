@@ -279,6 +279,12 @@ class RadarConfig(_Model):
             raise ValueError("elevation_fan_deg needs -90 < lower <= upper < 90 degrees")
         if self.min_range_m >= self.range_m:
             raise ValueError(f"min_range_m ({self.min_range_m}) must be below range_m ({self.range_m})")
+        if self.range_resolution_m > self.range_m - self.min_range_m:
+            # A bin longer than the span it measures reports its echoes at a range outside it: a radar of no return.
+            raise ValueError(
+                f"range_resolution_m ({self.range_resolution_m:g}) must be at most range_m - min_range_m "
+                f"({self.range_m - self.min_range_m:g} m): a coarser range bin reports no echo within the range"
+            )
         bins = math.ceil(self.range_m / self.range_resolution_m)
         if bins > 2**20:
             raise ValueError(
