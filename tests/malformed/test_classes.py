@@ -236,6 +236,17 @@ def test_a_route_over_land_is_an_error_unless_checks_are_off(tmp_path: Path) -> 
     assert res.frames_written == 2
 
 
+def test_a_route_off_the_map_is_said_to_leave_the_map(tmp_path: Path) -> None:
+    """Routes 50 km out on a 4 km open-sea map were said to leave "navigable water (centre)", as if over land."""
+    d = tiny(map={"type": "open_sea", "seed": 0, "params": {"extent_m": 4000}})
+    d["vessels"][1]["route"] = [[50000, 50000], [50100, 50000]]
+    with pytest.raises(ConfigError) as info:
+        mmusv.run(d, out_dir=tmp_path / "o")
+    msg = str(info.value)
+    assert "in_water: t leaves the map near (50000, 50000) (the map spans x -2000..2000 m, y -2000..2000 m)" in msg
+    assert "(vessels[1].route)" in msg and "u leaves" not in msg, msg
+
+
 def test_every_stranded_route_is_named_by_its_field(tmp_path: Path) -> None:
     d = tiny(map={"type": "island", "seed": 4})
     d["vessels"][0]["route"] = [[460, -330], [500, -200]]  # across the islet of island map 4

@@ -132,12 +132,20 @@ class _Clearance(_FindingsCheck):
                     k = int(np.argmax(bad[:, vi]))
                     first[int(vi)] = (r, k, pts[k, vi])
         out = []
+        (x0, y0), (x1, y1) = s.ctx.origin, (
+            s.ctx.origin[0] + s.ctx.priors.shape[1] * s.ctx.resolution,
+            s.ctx.origin[1] + s.ctx.priors.shape[0] * s.ctx.resolution,
+        )
         for v, (_, _, at) in sorted(first.items(), key=lambda kv: (kv[1][0], kv[1][1], kv[0])):
-            what = (
-                f"{s.ids[v]} leaves {self.what} near {_where(at)}"
-                if not self.hull
-                else f"{s.ids[v]} comes within {self.need:g} m of {self.what} near {_where(at)}"
-            )
+            if self.hull:
+                what = f"{s.ids[v]} comes within {self.need:g} m of {self.what} near {_where(at)}"
+            elif not (x0 <= at[0] < x1 and y0 <= at[1] < y1):  # off the map, not on land: said so
+                what = (
+                    f"{s.ids[v]} leaves the map near {_where(at)} (the map spans x {x0:.0f}..{x1:.0f} m, "
+                    f"y {y0:.0f}..{y1:.0f} m)"
+                )
+            else:
+                what = f"{s.ids[v]} leaves {self.what} near {_where(at)}"
             mask = {s.ids[v]: route_bad[:, v].copy()} if route_bad is not None and route_bad[:, v].any() else {}
             out.append(Finding(what, (s.ids[v],), (float(at[0]), float(at[1])), mask))
         return out
