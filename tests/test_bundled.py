@@ -105,3 +105,17 @@ def test_a_link_that_leads_nowhere_is_named_as_one(tmp_path: Path) -> None:
         resolve_scenario(tmp_path / "a.yaml")
     with pytest.raises(NotFoundError, match=r"gone\.yaml' is a link that leads nowhere: it points to nothere\.yaml"):
         resolve_spec(tmp_path / "gone.yaml")
+
+
+def test_a_package_without_its_scenarios_says_so(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A copy of the package that lost its data (a broken link to ``scenarios/``) listed an empty table, exit 0."""
+    import mmusv.bundled
+
+    monkeypatch.setattr(mmusv.bundled, "bundled_dir", lambda: tmp_path / "scenarios")
+    with pytest.raises(NotFoundError, match=r"no bundled scenario in .*scenarios: the package's data is missing"):
+        mmusv.bundled.bundled_scenarios()
+    assert main(["scenarios"]) != 0
+    err = capsys.readouterr().err
+    assert err.startswith("mmusv: error: no bundled scenario in ") and "Traceback" not in err, err

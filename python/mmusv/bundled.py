@@ -108,9 +108,17 @@ def _description(text: str) -> str:
 
 
 def bundled_scenarios() -> list[BundledScenario]:
-    """Every bundled scenario, sorted by name, loaded and validated (map type, USV/target counts, frames)."""
+    """Every bundled scenario, sorted by name, loaded and validated (map type, USV/target counts, frames). A package
+    whose scenarios folder is missing or empty (a copy that lost its data) is a :class:`~mmusv.errors.NotFoundError`
+    naming the folder, not an empty list."""
+    names = _names()
+    if not names:
+        raise NotFoundError(
+            f"no bundled scenario in {bundled_dir()}: the package's data is missing; reinstall mmusv "
+            "(pip install mmusv, or pip install -e . in a checkout)"
+        )
     out = []
-    for stem in _names():
+    for stem in names:
         path = bundled_dir() / f"{stem}.yaml"
         sc = load_scenario(path)
         usvs = sum(1 for v in sc.vessels if v.role == "usv")
