@@ -40,6 +40,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "MOUNT_WARN_FACTOR",
+    "SHARP_TURN_RATIO",
     "MapFinding",
     "MmusvWarning",
     "check_mounts",
@@ -49,6 +50,7 @@ __all__ = [
     "map_findings",
     "scenario_samples",
     "sensing_range_m",
+    "sharp_turns",
 ]
 
 MOUNT_WARN_FACTOR = 2.0
@@ -131,7 +133,7 @@ def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[st
         raise ConfigError(
             f"{source}: hulls_intersect: {fails}; move a route or a start_offset_m apart (--no-checks skips this)"
         )
-    found: list[str] = []
+    found: list[str] = [f"{source}: sharp_turn: {m}" for m in sharp_turns(scenario, samples)]
     for check in (
         ShoreClearance(cons.shore_clearance),
         StructureClearance(cons.structure_clearance),
@@ -143,6 +145,46 @@ def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[st
     for w in found:
         warnings.warn(w, MmusvWarning, stacklevel=2)
     return found
+
+
+SHARP_TURN_RATIO = 0.1
+"""A route whose path turns at a radius below this many hull lengths gets a warning (:func:`sharp_turns`): a
+ship's turning circle is a few lengths across, the generator's tightest harbour turns are about 0.2 lengths, and a
+reversal on the spot (a waypoint that doubles back) measures well under 0.01."""
+
+
+def sharp_turns(scenario: Scenario, samples: Samples) -> list[str]:
+    """One line per moving vessel whose route turns tighter than :data:`SHARP_TURN_RATIO` hull lengths somewhere:
+    the path's radius there (its sample spacing over its heading change, from ``samples.geo``), where, and the
+    waypoint nearest to it. The spline goes through every waypoint, so a waypoint that doubles back (or legs a few
+    metres apart) makes a hull pivot on the spot, or a 300 m ship swing about at hundreds of degrees a second, and
+    the boxes, wakes and headings follow. A warning: the motion is what the route says."""
+    from mmusv.world.vessels import get_asset
+
+    out = []
+    for vi, v in enumerate(scenario.vessels):
+        if v.static:
+            continue
+        length = get_asset(v.asset).length
+        xy, yaw = samples.geo[:, vi], np.unwrap(samples.geo_yaw[:, vi])
+        ds = np.hypot(*np.diff(xy, axis=0).T)
+        turn = np.abs(np.diff(yaw))
+        radius = np.full(len(ds), np.inf)
+        np.divide(ds, turn, out=radius, where=turn > 1e-9)
+        k = int(np.argmin(radius))
+        if radius[k] >= SHARP_TURN_RATIO * length:
+            continue
+        at = (xy[k] + xy[k + 1]) / 2.0
+        route = np.asarray(v.route, dtype=np.float64)
+        d = np.hypot(*(route - at).T)
+        d[[0, -1]] += 1e-6  # a doubling-back waypoint on top of an end is named as the turn's
+        w = int(np.argmin(d))
+        out.append(
+            f"{v.id} turns at a radius of {radius[k]:.1f} m near ({at[0]:.0f}, {at[1]:.0f}) "
+            f"(vessels[{vi}].route[{w}]), far tighter than its {length:g} m hull can (a ship turns in a few lengths; "
+            f"this warns below {SHARP_TURN_RATIO:g} of one): widen the corner or spread the waypoints"
+        )
+    return out
 
 
 def sensing_range_m(scenario: Scenario) -> float:

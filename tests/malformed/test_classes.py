@@ -345,10 +345,34 @@ def test_a_separation_warning_says_when_only_the_motion_between_samples_is_too_c
         from mmusv.scenario_checks import check_routes
 
         found = check_routes(sc, Simulation(sc).world, source="hairpin.yaml")
-    assert len(found) == 1 and len(caught) == 1, found
-    msg = found[0]
+    seps = [m for m in found if ": separation: " in m]  # beside it, the hairpin's sharp_turn
+    assert len(seps) == 1 and len(caught) == len(found), found
+    msg = seps[0]
     assert msg.startswith("hairpin.yaml: separation: u and ship come "), msg
     assert "between the samples checked they can come up to" in msg and msg.endswith("need 15 m"), msg
+
+
+def test_a_route_that_doubles_back_warns_of_a_turn_no_hull_can_make(tmp_path: Path) -> None:
+    """A 12 m boat reversed on the spot at a waypoint that doubled back (heading 0 to 180 degrees in 0.2 s), and a
+    300 m ship swung round a 5 m hairpin at 300 degrees a second, without a word."""
+    d = tiny()
+    d["vessels"][1]["route"] = [[0, 60], [60, 60], [0, 60.5], [60, 61]]
+    with pytest.warns(MmusvWarning) as caught:
+        mmusv.run(d, out_dir=tmp_path / "o")
+    turns = [str(w.message) for w in caught if "sharp_turn" in str(w.message)]
+    assert len(turns) == 1, [str(w.message) for w in caught]
+    msg = turns[0]
+    assert msg.startswith("scenario: sharp_turn: t turns at a radius of ") and "(vessels[1].route[" in msg, msg
+    assert "tighter than its 12 m hull can" in msg, msg
+    # The bundled scenarios' turns (the tightest a 90 m ferry's, 1.4 lengths) are not warned of.
+    from mmusv.bundled import bundled_scenarios
+    from mmusv.generate.mapctx import map_context
+    from mmusv.scenario_checks import map_check_spec, scenario_samples, sharp_turns
+
+    for b in bundled_scenarios():
+        sc = load_scenario(b.path)
+        ctx = map_context(sc.map.type, seed=sc.map.seed, params=sc.map.param_values())
+        assert sharp_turns(sc, scenario_samples(sc, ctx, map_check_spec(sc))) == [], b.name
 
 
 def test_generation_spec_shares_the_scenario_field_types() -> None:

@@ -132,10 +132,8 @@ class _Clearance(_FindingsCheck):
                     k = int(np.argmax(bad[:, vi]))
                     first[int(vi)] = (r, k, pts[k, vi])
         out = []
-        (x0, y0), (x1, y1) = s.ctx.origin, (
-            s.ctx.origin[0] + s.ctx.priors.shape[1] * s.ctx.resolution,
-            s.ctx.origin[1] + s.ctx.priors.shape[0] * s.ctx.resolution,
-        )
+        x0, y0 = s.ctx.origin  # the map's rectangle, rows along y
+        x1, y1 = x0 + s.ctx.priors.shape[1] * s.ctx.resolution, y0 + s.ctx.priors.shape[0] * s.ctx.resolution
         for v, (_, _, at) in sorted(first.items(), key=lambda kv: (kv[1][0], kv[1][1], kv[0])):
             if self.hull:
                 what = f"{s.ids[v]} comes within {self.need:g} m of {self.what} near {_where(at)}"
