@@ -97,3 +97,14 @@ def test_a_wave_surface_on_a_scene_without_a_sea_is_refused() -> None:
     with pytest.raises(mmusv.InputError, match="no sea surface; declare it with set_sea"):
         scene.set_wave_surface(1.0, foci=np.zeros((1, 2), np.float32), radius_m=3000.0)
     assert scene.wave_top is None
+
+
+def test_huge_numbers_in_messages_are_written_short() -> None:
+    """A translation of 1e300 was said as 301 digits, hiding what was allowed (Rust prints floats in full)."""
+    scene, _ = core.demo_scene(extent=200.0, terrain_cells=8, vessels=1)
+    pose = np.eye(4)
+    pose[0, 3] = 1e300
+    with pytest.raises(mmusv.InputError) as info:
+        scene.add_instance(0, pose)
+    msg = str(info.value)
+    assert "1e300" in msg and len(msg) < 200 and "0" * 40 not in msg, msg

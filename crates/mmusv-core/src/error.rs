@@ -58,11 +58,11 @@ pub enum MmusvError {
 impl MmusvError {
     /// Shorthand for [`MmusvError::InvalidInput`].
     pub fn input(field: impl Into<String>, reason: impl Into<String>) -> Self {
-        Self::InvalidInput { field: field.into(), reason: reason.into() }
+        Self::InvalidInput { field: field.into(), reason: short_numbers(reason.into()) }
     }
     /// Shorthand for [`MmusvError::Geometry`].
     pub fn geometry(field: impl Into<String>, reason: impl Into<String>) -> Self {
-        Self::Geometry { field: field.into(), reason: reason.into() }
+        Self::Geometry { field: field.into(), reason: short_numbers(reason.into()) }
     }
     /// The same error with `prefix.` put in front of its field name, e.g. `vessels[2].` + `speed_mps`.
     pub fn within(self, prefix: &str) -> Self {
@@ -76,6 +76,65 @@ impl MmusvError {
 
     /// Shorthand for [`MmusvError::Config`].
     pub fn config(field: impl Into<String>, value: impl ToString, reason: impl Into<String>) -> Self {
-        Self::Config { field: field.into(), value: value.to_string(), reason: reason.into() }
+        Self::Config {
+            field: field.into(),
+            value: short_numbers(value.to_string()),
+            reason: short_numbers(reason.into()),
+        }
+    }
+}
+
+/// Most digits a number keeps in a message: Rust prints a float in full, so `1e300` (given by a user, or an
+/// `f64::MAX` bound) came out as 301 digits that hid the rest of the message. Integers up to `u128` fit.
+const MAX_MESSAGE_DIGITS: usize = 40;
+
+/// `text` with every run of more than [`MAX_MESSAGE_DIGITS`] digits (and its decimals) written short, as
+/// `1.7976931348623157e308`.
+fn short_numbers(text: String) -> String {
+    let b = text.as_bytes();
+    let mut out = String::with_capacity(text.len());
+    let mut i = 0;
+    while i < b.len() {
+        if !b[i].is_ascii_digit() || (i > 0 && (b[i - 1].is_ascii_digit() || b[i - 1] == b'.')) {
+            let ch = text[i..].chars().next().unwrap_or(' ');
+            out.push(ch);
+            i += ch.len_utf8();
+            continue;
+        }
+        let start = i;
+        while i < b.len() && b[i].is_ascii_digit() {
+            i += 1;
+        }
+        let digits = i - start;
+        if i + 1 < b.len() && b[i] == b'.' && b[i + 1].is_ascii_digit() {
+            i += 1;
+            while i < b.len() && b[i].is_ascii_digit() {
+                i += 1;
+            }
+        }
+        match text[start..i].parse::<f64>() {
+            Ok(v) if digits > MAX_MESSAGE_DIGITS => out.push_str(&format!("{v:e}")),
+            _ => out.push_str(&text[start..i]),
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn huge_numbers_are_written_short_and_the_rest_kept() {
+        let e = MmusvError::config("radar.detection_threshold", -1.0, format!("must be in [0, {}]", f64::MAX));
+        assert_eq!(
+            e.to_string(),
+            "invalid config radar.detection_threshold = -1: must be in [0, 1.7976931348623157e308]"
+        );
+        let e = MmusvError::config("hs_m", 1e300, "must be in [0, 25] m");
+        assert_eq!(e.to_string(), "invalid config hs_m = 1e300: must be in [0, 25] m");
+        let t = format!("translation {} and seed {} at 0.25 é 3", 1e300 + 0.5, u64::MAX);
+        let e = MmusvError::input("pose", t);
+        assert_eq!(e.to_string(), "invalid pose: translation 1e300 and seed 18446744073709551615 at 0.25 é 3");
     }
 }
