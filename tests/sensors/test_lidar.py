@@ -246,6 +246,16 @@ def test_explicit_elevation_table_is_honoured() -> None:
         LidarConfig(channels=5, elevations_deg=table)
 
 
+def test_rings_that_would_fire_the_same_rays_are_refused() -> None:
+    """16 channels over a vertical field of view of no angle ([0, 0]) fired one ring's rays 16 times, as did a table
+    that repeats an elevation; one channel over [0, 0] is a single ring, as meant."""
+    with pytest.raises(ValueError, match=r"vertical_fov_deg \[0\.0, 0\.0\] spans no angle: its 16 channels"):
+        LidarConfig(channels=16, vertical_fov_deg=(0.0, 0.0))
+    with pytest.raises(ValueError, match=r"elevations_deg repeats \[-2\.0\]"):
+        LidarConfig(channels=3, elevations_deg=[-2.0, 0.0, -2.0])
+    assert LidarConfig(channels=1, vertical_fov_deg=(0.0, 0.0)).elevations_rad() == [0.0]
+
+
 # ------------------------------------------------------------------------------------------ noise, dropout, weather
 
 

@@ -168,6 +168,14 @@ class LidarConfig(_Model):
                 raise ValueError(f"elevations_deg has {len(self.elevations_deg)} entries for {self.channels} channels")
             if not all(-90 < e < 90 for e in self.elevations_deg):
                 raise ValueError("every elevation must be strictly between -90 and 90 degrees")
+            if len(set(self.elevations_deg)) != len(self.elevations_deg):
+                twice = sorted({e for e in self.elevations_deg if self.elevations_deg.count(e) > 1})
+                raise ValueError(f"elevations_deg repeats {twice}: two rings would fire the same rays")
+        elif self.channels > 1 and self.vertical_fov_deg[0] == self.vertical_fov_deg[1]:
+            raise ValueError(
+                f"vertical_fov_deg {list(self.vertical_fov_deg)} spans no angle: its {self.channels} channels would "
+                "all fire the same rays; give lower < upper, or channels: 1"
+            )
         if self.range_min_m >= self.range_m:
             raise ValueError(f"range_min_m ({self.range_min_m}) must be below range_m ({self.range_m})")
         if not 1 <= self.azimuth_steps <= 65536:
