@@ -15,6 +15,7 @@ harness), so a regression is a failed test rather than a dead test run.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import mmusv
 import numpy as np
@@ -108,3 +109,33 @@ def test_huge_numbers_in_messages_are_written_short() -> None:
         scene.add_instance(0, pose)
     msg = str(info.value)
     assert "1e300" in msg and len(msg) < 200 and "0" * 40 not in msg, msg
+
+
+def _env(**change: Any) -> Any:
+    kw: dict[str, Any] = {
+        "sun_direction": [0.0, 0.6, 0.8],
+        "turbidity": 3.0,
+        "cloud_cover": 0.0,
+        "ground_albedo": 0.1,
+        "fog_extinction_per_m": 0.0,
+        "rain_mm_per_h": 0.0,
+        "wave_height_m": 0.5,
+        "wind_speed_m_s": 5.0,
+        "water_albedo": [0.02, 0.03, 0.04],
+    }
+    return core.SensorEnv(**{**kw, **change})
+
+
+def test_the_environment_takes_a_cameras_exposure_range_and_unit_directions() -> None:
+    """``SensorEnv(exposure_ev100=1e9)`` was taken (every image black) where a camera refuses it; ``sky_radiance``
+    read a NaN or zero direction as the ground's radiance."""
+    assert _env(exposure_ev100=15.0) is not None
+    for ev in (1e9, -7.0, float("inf")):
+        with pytest.raises(mmusv.ConfigError, match=r"env\.exposure_ev100 = .*: must be a finite EV100 in \[-6, 20\]"):
+            _env(exposure_ev100=ev)
+    env = _env()
+    up = np.asarray(env.sky_radiance(np.array([[0.0, 0.0, 1.0]], np.float32)))
+    assert up.shape == (1, 3) and np.isfinite(up).all()
+    for bad in ([np.nan, 0.0, 1.0], [0.0, 0.0, 0.0], [0.0, 0.0, 2.0]):
+        with pytest.raises(mmusv.InputError, match=r"dirs\[1\] = .*must be a unit vector"):
+            env.sky_radiance(np.array([[0.0, 0.0, 1.0], bad], np.float32))

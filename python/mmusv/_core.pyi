@@ -274,10 +274,10 @@ def lidar_trace_order(*, channels: int, azimuth_steps: int, block: int = 8) -> n
 class SensorEnv:
     """The physical environment every sensor sees: sun direction (world unit vector towards it), Preetham
     turbidity (1.7..10), cloud cover and ground albedo in [0, 1], fog extinction 1/m, rain mm/h, significant wave
-    height m, wind m/s, the water body's linear RGB albedo, a fixed exposure (EV100) or None for metered, and
-    whether cameras cast shadow rays, and whether the water keeps the light reflected more than once between its
-    wave facets (off: single-scattering microfacet reflection alone, as a renderer's rough BSDF). A value out of
-    range raises ``ConfigError`` naming ``env.<field>``."""
+    height m, wind m/s, the water body's linear RGB albedo, a fixed exposure (EV100 in [-6, 20], as a camera's) or
+    None for metered, whether cameras cast shadow rays, and whether the water keeps the light reflected more than
+    once between its wave facets (off: single-scattering microfacet reflection alone, as a renderer's rough BSDF).
+    A value out of range raises ``ConfigError`` naming ``env.<field>``."""
 
     def __new__(
         cls,
@@ -300,7 +300,8 @@ class SensorEnv:
         """(horizontal illuminance of sun and sky in lux, exposure scale from cd/m² to the tone curve's input)."""
     def sky_radiance(self, dirs: npt.NDArray[np.float32], *, sun_disc: bool = False) -> npt.NDArray[np.float32]:
         """Sky radiance (N, 3) float32 cd/m² along unit world directions ``dirs`` (N, 3) (ground below the
-        horizon), with the sun's disc when ``sun_disc``."""
+        horizon), with the sun's disc when ``sun_disc``; a direction whose length is not 1 (within 1e-3) raises
+        ``InputError`` naming it."""
     @property
     def sun_irradiance(self) -> list[float]:
         """Direct-normal irradiance of the sun, lux (linear RGB, a list of 3); zero at night."""

@@ -179,7 +179,16 @@ impl SensorEnv {
             )));
         }
         let exposure_ev100 = match exposure_ev100 {
-            Some(ev) => env_value("exposure_ev100", ev, false)?,
+            // The range a camera's fixed exposure takes (an EV100 of 1e9 exposed every image black).
+            Some(ev) => {
+                let (lo, hi) = mmusv_core::sensors::shade::tonemap::EV100_RANGE;
+                if !(ev.is_finite() && (lo..=hi).contains(&ev)) {
+                    return Err(crate::errors::ConfigError::new_err(format!(
+                        "invalid config env.exposure_ev100 = {ev}: must be a finite EV100 in [{lo}, {hi}]"
+                    )));
+                }
+                ev
+            }
             None => f32::NAN,
         };
         let shade = ShadeEnv {
@@ -218,6 +227,15 @@ impl SensorEnv {
         sun_disc: bool,
     ) -> PyResult<Bound<'py, PyArray2<f32>>> {
         let d = crate::native::rows::<f32, 3>(&dirs, "dirs")?;
+        // Unit directions, as documented: a NaN or zero one read as the ground's radiance, without a word.
+        if let Some((k, v)) = d.iter().enumerate().find(|(_, v)| {
+            let n = v.iter().map(|x| x * x).sum::<f32>().sqrt();
+            !(n.is_finite() && (n - 1.0).abs() <= 1e-3)
+        }) {
+            return Err(crate::errors::InputError::new_err(format!(
+                "invalid dirs[{k}] = {v:?}: must be a unit vector (length 1 within 1e-3; normalise it)"
+            )));
+        }
         let l = mmusv_core::sensors::shade::envlight::Lighting::shared(&self.shade.lighting_key());
         let out: Vec<[f32; 3]> = d.iter().map(|v| l.radiance_along(*v, sun_disc)).collect();
         rows_to_array(py, out)
