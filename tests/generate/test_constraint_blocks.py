@@ -108,6 +108,31 @@ def _small_radius() -> float:
     return min(capsule(a)[1] for a in class_assets(load_spec(TINY).size_classes["small"]))
 
 
+@pytest.mark.parametrize(
+    ("change", "field"),
+    [
+        ({"difficulties": {"close": {"range_m": [6000, 7000]}}}, r"difficulties\.close\.range_m = 6000\.0"),
+        (
+            {"constraints": {"cooperation": {"min_m": 6000, "max_m": 7000}}},
+            r"constraints\.cooperation\.min_m = 6000\.0",
+        ),
+    ],
+)
+def test_a_distance_beyond_the_maps_water_is_refused_at_once(
+    change: dict[str, Any], field: str, tmp_path: Path
+) -> None:
+    """A cooperation of 3,000 m, or a closest approach of 5,000 m, on a 2,000 m island map spent every attempt on
+    rejections (120 of them, then "quota not met"): no two points of its water lie that far apart."""
+    out = tmp_path / "out"
+    with pytest.raises(
+        ConfigError,
+        match=rf"^spec: invalid spec {field}: combinations\[0\] \(crossing_close_2usv_small\) could never pass: .* "
+        r"the navigable water of this map \(open_sea, seed 2\) spans at most \d+ m: lower",
+    ):
+        generate(dict(TINY, **change), out)
+    assert not out.exists()
+
+
 def test_the_clearance_refusal_is_exact() -> None:
     """A clearance a cell just offers is kept; a vessel needs one cell clear of the shore and the structures at
     once, each against its own raster (the old estimate took the nearer of both for either)."""
@@ -117,14 +142,14 @@ def test_the_clearance_refusal_is_exact() -> None:
     assert _infeasible(both, _ctx([50 + widest, 0], [50 + widest, 0]), 0) is None
     assert _infeasible(both, _ctx([50 + widest - 0.01, 0], [50 + widest, 0]), 0) is not None
     bad = _infeasible(both, _ctx([1000, 10], [10, 1000]), 0)
-    assert bad is not None and bad[:2] == ("shore_clearance.min_m", 50.0)
+    assert bad is not None and bad[:2] == ("constraints.shore_clearance.min_m", 50.0)
     assert bad[2].startswith(f"size class 'small' needs {50 + r:.0f} m of clearance from the shore and ")
     assert bad[2].endswith(
         "and no water on this map (open_sea, seed 2) offers both: lower shore_clearance.min_m or "
         "structure_clearance.min_m"
     )
     bad = _infeasible(both, _ctx([1000, 1000], [10, 40]), 0)
-    assert bad is not None and bad[0] == "structure_clearance.min_m" and "lies farther than 40 m" in bad[2]
+    assert bad is not None and bad[0] == "constraints.structure_clearance.min_m" and "lies farther than 40 m" in bad[2]
     shore_only = load_spec(_spec({"shore_clearance": {"min_m": 50}, "structure_clearance": {"enabled": False}}))
     assert _infeasible(shore_only, _ctx([1000, 10], [10, 1000]), 0) is None
     off = load_spec(_spec({"shore_clearance": {"enabled": False}, "structure_clearance": {"enabled": False}}))

@@ -257,21 +257,21 @@ def _infeasible(spec: GenerationSpec, ctx: MapContext, idx: int) -> tuple[str, f
         hull = f"{slimmest} hull radius {r:.1f} m"
         if shore is not None and best_shore - r < shore - _EPS:
             return (
-                "shore_clearance.min_m",
+                "constraints.shore_clearance.min_m",
                 shore,
                 f"{role} needs {r + shore:.0f} m of clearance from the shore ({hull} + {shore:g} m) and the most "
                 f"open water {where} offers {best_shore:.0f} m: lower shore_clearance.min_m",
             )
         if struct is not None and best_struct - r < struct - _EPS:
             return (
-                "structure_clearance.min_m",
+                "constraints.structure_clearance.min_m",
                 struct,
                 f"{role} needs {r + struct:.0f} m of clearance from port structures, buoys and moored ships ({hull} "
                 f"+ {struct:g} m) and no water {where} lies farther than {best_struct:.0f} m from them: lower "
                 "structure_clearance.min_m",
             )
         return (
-            "shore_clearance.min_m",
+            "constraints.shore_clearance.min_m",
             float(shore or 0.0),
             f"{role} needs {r + (shore or 0.0):.0f} m of clearance from the shore and {r + (struct or 0.0):.0f} m "
             f"from port structures, buoys and moored ships ({hull}), and no water {where} offers both: lower "
@@ -284,16 +284,50 @@ _EPS = 1e-9
 """Metres of rounding :func:`_infeasible` forgives, so it never refuses what the checks could accept."""
 
 
+def _out_of_reach(spec: GenerationSpec, ctx: MapContext, idx: int) -> tuple[str, float, str] | None:
+    """Why combination ``idx`` can never pass a distance it asks for on its map ``ctx``, as :func:`_infeasible`
+    says it, or None: its difficulty's closest-approach range, or (with more than one USV) the cooperation
+    distance, farther than any two points of the map's navigable water lie apart (the diagonal of the box round
+    them). A cooperation of 3,000 m on a 2,000 m island map spent every attempt on rejections."""
+    combo = spec.combinations[idx]
+    water = ctx.d_shore > 0.0
+    if not water.any():
+        return None
+    rows, cols = np.nonzero(water)
+    span = math.hypot(
+        (int(cols.max()) - int(cols.min()) + 1) * ctx.resolution,
+        (int(rows.max()) - int(rows.min()) + 1) * ctx.resolution,
+    )
+    m = spec.map_of(combo)
+    where = f"the navigable water of this map ({m.type}, seed {m.seed}) spans at most {span:.0f} m"
+    lo = spec.difficulties[combo.difficulty].range_m[0]
+    if spec.constraints.target_range.enabled and lo > span + _EPS:
+        return (
+            f"difficulties.{combo.difficulty}.range_m",
+            lo,
+            f"its targets must come no nearer than {lo:g} m to the ego and {where}: lower range_m",
+        )
+    coop = spec.constraints.cooperation
+    if combo.cooperating and coop.enabled and coop.min_share > 0.0 and coop.min_m > span + _EPS:
+        return (
+            "constraints.cooperation.min_m",
+            coop.min_m,
+            f"its USVs must keep {coop.min_m:g} m from each other and {where}: lower cooperation.min_m",
+        )
+    return None
+
+
 def infeasible_error(spec: GenerationSpec, contexts: list[MapContext], *, source: str = "spec") -> ConfigError | None:
     """The :class:`~mmusv.errors.ConfigError` that refuses ``spec`` when one of its combinations can never pass the
-    clearance checks on its map (``contexts[i]`` is combination ``i``'s; :func:`_infeasible`), worded as the spec's
-    other impossible constraints are (:func:`mmusv.generate.spec.load_spec`); None when none is found."""
+    clearance checks on its map (``contexts[i]`` is combination ``i``'s; :func:`_infeasible`), or a distance it asks
+    for (:func:`_out_of_reach`), worded as the spec's other impossible constraints are
+    (:func:`mmusv.generate.spec.load_spec`); None when none is found."""
     for i, ctx in enumerate(contexts):
-        bad = _infeasible(spec, ctx, i)
+        bad = _out_of_reach(spec, ctx, i) or _infeasible(spec, ctx, i)
         if bad is not None:
             field, value, why = bad
             return ConfigError(
-                f"{source}: invalid spec constraints.{field} = {value!r}: combinations[{i}] "
+                f"{source}: invalid spec {field} = {value!r}: combinations[{i}] "
                 f"({spec.combinations[i].label()}) could never pass: {why}"
             )
     return None
