@@ -8,8 +8,8 @@ the hidden ``.generate.partial`` first, so a run stopped before its report is kn
 safe loader, libyaml's when installed: the same resolver as ``yaml.safe_load``), validated with
 :func:`mmusv.config.load_scenario` and compared with the checked scenario before it counts. The loop stops at the
 quota or at ``max_attempts``, so it always ends; the same spec gives the same files byte for byte. A combination
-whose vessels fit nowhere on its map at the clearances asked (:func:`infeasible_error`) is refused before the first
-attempt, and nothing is written.
+whose vessels fit nowhere on its map at the clearances asked, or whose distances (closest approach, cooperation)
+exceed what its water spans (:func:`infeasible_error`), is refused before the first attempt, and nothing is written.
 """
 
 from __future__ import annotations
