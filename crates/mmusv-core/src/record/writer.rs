@@ -174,7 +174,7 @@ fn close(mut writer: Writer<BufWriter<File>>, partial: &Path) -> Result<()> {
 impl Recorder {
     /// Starts a recording that will be named `path`. An existing `path` is refused unless `overwrite`; it is
     /// then replaced only when [`finish`](Self::finish) succeeds. A stale `<path>.partial` is truncated; one that
-    /// another recorder is still writing is refused ([`open_partial`]).
+    /// another recorder is still writing is refused (its `.partial` is locked while it is written).
     pub fn create(path: &Path, overwrite: bool) -> Result<Self> {
         if path.as_os_str().is_empty() {
             // An empty path would write `.partial` into the working directory and rename it to "" on finish.
