@@ -22,6 +22,7 @@ the first of them, so the generator and the editor say the same thing.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Protocol
 
@@ -173,7 +174,15 @@ class StructureClearance(_Clearance):
 def closest_hulls(s: Samples) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Every pair ``(iu[j], ju[j])`` of vessels (``iu < ju``), the least distance ``hull[j]`` (metres; below 0 the
     capsules overlap by that much) between their hull capsules over the motion samples and the sample ``at[j]``
-    where it is (the first, on a tie), worked out over blocks of times x pairs in bounded memory."""
+    where it is (the first, on a tie), worked out over blocks of times x pairs in bounded memory, once per
+    ``s`` (kept in ``s.derived``: a few seconds at the sampling budget, and two checks read it)."""
+    if "closest_hulls" not in s.derived:
+        s.derived["closest_hulls"] = _closest_hulls(s)
+    done: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] = s.derived["closest_hulls"]
+    return done
+
+
+def _closest_hulls(s: Samples) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     n = len(s.ids)
     iu, ju = np.triu_indices(n, 1)
     d = np.stack([np.cos(s.motion_yaw), np.sin(s.motion_yaw)], axis=-1) * s.half[None, :, None]
@@ -208,30 +217,21 @@ class Separation(_FindingsCheck):
         distance is above ``min_m`` says that slack."""
         if len(s.ids) < 2:
             return []
-        iu, ju, hull, at = closest_hulls(s)
+        iu, ju, hull, _ = closest_hulls(s)
         slack = s.motion_slack + s.motion_turn
         pair_slack = slack[iu] + slack[ju]
         worst = hull - pair_slack - self.min_m  # the slack is each vessel's own: the same closest moment
-        out = []
-        for j in sorted(np.flatnonzero(worst < 0.0), key=lambda j: (float(worst[j]), int(j))):
-            k = int(at[j])
-            a, b = int(iu[j]), int(ju[j])
-            mid = (s.motion[k, a] + s.motion[k, b]) / 2.0
+
+        def message(j: int, a: str, b: str, t: float, mid: np.ndarray) -> str:
             between = ""
             if hull[j] >= self.min_m:  # the samples pass: only the motion between them can come closer
                 between = (
                     f", and between the samples checked they can come up to {float(pair_slack[j]):.1f} m closer "
                     "(their motion and turns from one sample to the next)"
                 )
-            out.append(
-                Finding(
-                    f"{s.ids[a]} and {s.ids[b]} {separation_words(float(hull[j]))} at "
-                    f"t={s.times[k]:.1f} s{between}; need {self.min_m:g} m",
-                    (s.ids[a], s.ids[b]),
-                    (float(mid[0]), float(mid[1])),
-                )
-            )
-        return out
+            return f"{a} and {b} {separation_words(float(hull[j]))} at t={t:.1f} s{between}; need {self.min_m:g} m"
+
+        return _pair_findings(s, worst, message)
 
 
 class HullsIntersect(_FindingsCheck):
@@ -246,23 +246,38 @@ class HullsIntersect(_FindingsCheck):
     def findings(self, s: Samples) -> list[Finding]:
         if len(s.ids) < 2:
             return []
-        iu, ju, hull, at = closest_hulls(s)
+        iu, ju, hull, _ = closest_hulls(s)
         # The inscribed capsules' distance: the axes' distance less their radii, B/2 = r/√2 each.
         inner = hull + (s.radius[iu] + s.radius[ju]) * (1.0 - math.sqrt(0.5))
-        out = []
-        for j in sorted(np.flatnonzero(inner < 0.0), key=lambda j: (float(inner[j]), int(j))):
-            k = int(at[j])
-            a, b = int(iu[j]), int(ju[j])
-            mid = (s.motion[k, a] + s.motion[k, b]) / 2.0
-            out.append(
-                Finding(
-                    f"the hulls of {s.ids[a]} and {s.ids[b]} intersect at t={s.times[k]:.1f} s near "
-                    f"{_where(mid)} (by at least {-float(inner[j]):.1f} m)",
-                    (s.ids[a], s.ids[b]),
-                    (float(mid[0]), float(mid[1])),
-                )
+        return _pair_findings(
+            s,
+            inner,
+            lambda j, a, b, t, mid: (
+                f"the hulls of {a} and {b} intersect at t={t:.1f} s near {_where(mid)} "
+                f"(by at least {-float(inner[j]):.1f} m)"
+            ),
+        )
+
+
+def _pair_findings(
+    s: Samples, score: np.ndarray, message: Callable[[int, str, str, float, np.ndarray], str]
+) -> list[Finding]:
+    """One :class:`Finding` per pair ``j`` of :func:`closest_hulls` whose ``score[j]`` is below 0, the lowest score
+    first (the lower pair index on a tie), at the pair's closest sample: ``message(j, id_a, id_b, time, midpoint)``
+    says it, and the point is the two vessels' midpoint then."""
+    iu, ju, _, at = closest_hulls(s)
+    out = []
+    for j in sorted(np.flatnonzero(score < 0.0), key=lambda j: (float(score[j]), int(j))):
+        k, a, b = int(at[j]), int(iu[j]), int(ju[j])
+        mid = (s.motion[k, a] + s.motion[k, b]) / 2.0
+        out.append(
+            Finding(
+                message(int(j), s.ids[a], s.ids[b], float(s.times[k]), mid),
+                (s.ids[a], s.ids[b]),
+                (float(mid[0]), float(mid[1])),
             )
-        return out
+        )
+    return out
 
 
 def separation_words(hull_m: float) -> str:

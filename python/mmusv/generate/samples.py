@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -78,6 +79,9 @@ class Samples:
     frames: np.ndarray
     sensor_height: float
     sensor_range: float
+    derived: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
+    """What checks work out from the samples and share, once per candidate (:func:`mmusv.generate.checks.closest_hulls`:
+    the separation and the hulls' intersection both read it)."""
     _visible: dict[str, np.ndarray] = field(default_factory=dict)
 
     def index(self, vid: str) -> int:
