@@ -76,10 +76,7 @@ struct Prefetch {
 fn sample(key: &SurfaceKey, cached: Option<Arc<WaveField>>) -> Sampled {
     let field = match cached {
         Some(f) => f,
-        None => {
-            key.sea.validate()?;
-            Arc::new(WaveField::new(&key.sea, key.seed)?)
-        }
+        None => Arc::new(WaveField::new(&key.sea, key.seed)?), // checks the sea (as `surface_key` did)
     };
     let surface = WaveSurface::new(field.components(), key.time_s, key.level, &key.foci, key.spec)?;
     Ok((field, surface))
@@ -117,9 +114,9 @@ fn surface_key(
         return Err(InputError::new_err("wave surface: time_s, level and foci must be finite"));
     }
     let spec = SurfaceSpec { tile_m, near_m, radius_m, taper_m, detail, slopes, fine_m };
-    spec.check_extent(&foci).map_err(crate::errors::to_py)?; // before any tile is allocated
-                                                             // The sea itself too, here: `prefetch_wave_surface` promises its checks, and a sea checked only where it is
-                                                             // sampled (on the prefetch's thread) was refused later, at `set_wave_surface`, or never.
+    // Before any tile is allocated. The sea itself too, here: `prefetch_wave_surface` promises its checks, and a
+    // sea checked only where it is sampled (on the prefetch's thread) was refused later, or never.
+    spec.check_extent(&foci).map_err(crate::errors::to_py)?;
     let sea = SeaSpec { hs, tp: tp_s, gamma, direction_rad, spread_s };
     sea.validate().map_err(crate::errors::to_py)?;
     Ok(Some(SurfaceKey { sea, seed: sea_seed(scenario_seed), time_s, level, foci, spec }))
