@@ -28,6 +28,8 @@ use std::sync::Arc;
 
 mod batch;
 pub use batch::KnownWater;
+mod lamps;
+pub use lamps::{Lamp, LAMP_GROUP_M};
 mod sea_routes;
 mod visit;
 mod waves;

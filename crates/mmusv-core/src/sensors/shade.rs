@@ -8,6 +8,7 @@
 //!   prefiltered maps;
 //! * [`water`]: Cox–Munk capillary roughness, Monahan whitecaps, Kelvin wakes and the water body;
 //! * [`rough_water`]: the rough sea's single-scattering microfacet reflection (Beckmann, Smith, Fresnel);
+//! * [`lamp_glitter`]: the navigation lamps' glitter on that water at night, by next-event estimation;
 //! * [`sky_lobe`]: the sky's mean over the rough water's reflection lobe, tabulated per environment;
 //! * [`sea_ms`]: the light reflected more than once between the wave facets (Heitz et al.'s random walk),
 //!   restored over that lobe (Turquin's energy compensation);
@@ -38,6 +39,7 @@ mod class_material;
 pub mod envlight;
 pub mod foam;
 pub mod kelvin;
+pub mod lamp_glitter;
 pub mod rough_water;
 pub mod sea_ms;
 mod sea_ms_table;
@@ -489,6 +491,20 @@ impl Shader {
         self.water_alpha * self.water_alpha + unresolved_mss.max(0.0)
     }
 
+    /// The rough water's directional reflectance seen at `cos_o` with roughness `alpha`, light scattered more than
+    /// once between the facets included when the environment asks for it (`sea_ms.rs`), and its ratio to the
+    /// single-scattering one (what a glint is scaled by).
+    #[inline(always)]
+    fn water_reflectance(&self, cos_o: f32, alpha: f32) -> (f32, f32) {
+        let e_single = rough_water::reflectance(cos_o, alpha);
+        if self.env.water_multiple_scattering {
+            let e = sea_ms::reflectance(cos_o, alpha);
+            (e, if e_single > 0.0 { e / e_single } else { 1.0 })
+        } else {
+            (e_single, 1.0)
+        }
+    }
+
     /// Radiance (before aerial perspective) of the water seen along `d`: Fresnel-weighted `reflected` radiance
     /// (along [`Shader::reflection_ray`]; `None` reads the sky there), the sun's Cox–Munk glint when `sunlit`,
     /// the water body, and foam.
@@ -507,13 +523,7 @@ impl Shader {
         let alpha_r = self.water_mss(hit.unresolved_mss).sqrt();
         // Light scattered more than once between the facets is spent over the same lobe (`sea_ms.rs`): the
         // reflection weighted by the reflectance of every order, the glitter scaled by its share over the first.
-        let e_single = rough_water::reflectance(cos_o, alpha_r);
-        let (e_r, ms_gain) = if self.env.water_multiple_scattering {
-            let e = sea_ms::reflectance(cos_o, alpha_r);
-            (e, if e_single > 0.0 { e / e_single } else { 1.0 })
-        } else {
-            (e_single, 1.0)
-        };
+        let (e_r, ms_gain) = self.water_reflectance(cos_o, alpha_r);
         let mut c = l_r * e_r;
         let mut entering = self.light.water_entering;
         if sunlit {

@@ -9,7 +9,8 @@
 
 use super::glossy;
 use crate::error::Result;
-use crate::scene::{RayHits, Scene};
+use crate::scene::{RayHits, Scene, Scratch};
+use crate::sensors::shade::lamp_glitter::LampSet;
 use crate::sensors::shade::tonemap;
 use crate::sensors::shade::{Shader, SurfaceHit};
 use parry3d::math::Vec3;
@@ -309,6 +310,11 @@ pub fn radiance(
     };
     let is_candidate = |k: usize| candidate.get(k).copied().unwrap_or(false);
     let lit = sunlit(scene, shader, shadows, (hits, origins, dirs), |k| !is_candidate(k))?;
+    // At night the lamps' glitter is estimated at every water ray (`shade/lamp_glitter.rs`), and the traced
+    // reflections leave the lamps out; not at draft quality, which traces no reflections.
+    let lamps = (shader.lamps_by_glitter() && !matches!(reflections, Reflections::Sky))
+        .then(|| LampSet::new(scene.nav_lamps()))
+        .filter(|set| !set.is_empty());
     // Reflected rays of the water hits (their representatives'), traced, and the radiance they bring back:
     // `index[k]` is ray k's own traced reflection in `values`, `u32::MAX` where it has none.
     let mut values: Vec<Vec3> = Vec::new();
@@ -385,7 +391,12 @@ pub fn radiance(
             })
             .unzip();
         let rhits = scene.cast_rays(&ro, &rd, REFLECTION_RANGE)?;
-        let rsurface = |j: usize| surface_at(shader, scene, &rhits, &ro, &rd, j).filter(|h| !h.is_water());
+        let rsurface = |j: usize| {
+            let mut h = surface_at(shader, scene, &rhits, &ro, &rd, j).filter(|h| !h.is_water())?;
+            // The lamps' light on the water is their glitter's, below.
+            h.lights_on &= lamps.is_none();
+            Some(h)
+        };
         let rlit = sunlit(scene, shader, shadows, (&rhits, &ro, &rd), |j| rhits.class[j] != 1)?;
         values = (0..ro.len())
             .into_par_iter()
@@ -479,6 +490,19 @@ pub fn radiance(
     out.par_chunks_mut(SHADE_CHUNK).enumerate().for_each(|(c, chunk)| {
         shade_chunk(shader, dirs, (&lit, &reflected_of), (c * SHADE_CHUNK, &|k| !is_candidate(k), &hit_of), chunk);
     });
+    // The lamps' glitter on the water rays shaded themselves (a shared one takes its anchors' mean, glitter and
+    // all; one whose anchors differ gets its own below).
+    let glitter_of = |which: &[u32]| match &lamps {
+        Some(set) => lamp_glow(scene, shader, set, (origins, dirs, hits), which),
+        None => Vec::new(),
+    };
+    if lamps.is_some() {
+        let water: Vec<u32> =
+            (0..n).into_par_iter().filter(|&k| is_water(k) && !is_candidate(k)).map(|k| k as u32).collect();
+        for (&k, g) in water.iter().zip(glitter_of(&water)) {
+            out[k as usize] += g;
+        }
+    }
     if let Some(grid) = shared {
         // The candidates: the anchors' mean where they look alike; the others (`redo`) need their own shading.
         // The exposure the view is shown with (the metered pixels are anchors: shaded themselves, above).
@@ -547,8 +571,61 @@ pub fn radiance(
         for (&k, c) in redo.iter().zip(shaded) {
             out[k as usize] = c;
         }
+        if lamps.is_some() {
+            let water: Vec<u32> = redo.iter().copied().filter(|&k| is_water(k as usize)).collect();
+            for (&k, g) in water.iter().zip(glitter_of(&water)) {
+                out[k as usize] += g;
+            }
+        }
     }
     Ok(Shaded { radiance: out, reflected: blurred.map(|(b, _)| b), exposure })
+}
+
+/// The lamps' glitter (`shade/lamp_glitter.rs`) that each water ray of `which` brings to the camera through the
+/// fog, in that order: every lamp near the lobe of its hit ([`LampSet::near_lobe`]), each behind a shadow ray from
+/// the water to the lamp, stopped short of the lamp's lantern.
+fn lamp_glow(
+    scene: &Scene,
+    shader: &Shader,
+    set: &LampSet,
+    (origins, dirs, hits): (&[[f32; 3]], &[[f32; 3]], &RayHits),
+    which: &[u32],
+) -> Vec<Vec3> {
+    // (slot in `which`, its glitter through the fog, shadow-ray origin, direction and length) per lamp near a hit.
+    let pairs: Vec<(u32, Vec3, Vec3, Vec3, f32)> = which
+        .par_iter()
+        .enumerate()
+        .with_min_len(PASS_CHUNK / 8)
+        .flat_map_iter(|(j, &k)| {
+            let k = k as usize;
+            let mut out = Vec::new();
+            let Some(h) = surface_at(shader, scene, hits, origins, dirs, k) else { return out };
+            let d = Vec3::from_array(dirs[k]);
+            let mut near = Vec::new();
+            set.near_lobe(h.point, h.shading_normal, -d, shader.water_mss(h.unresolved_mss), &mut near);
+            for i in near {
+                let lamp = &set.lamps()[i as usize];
+                if let Some((value, l, r)) = shader.lamp_glitter(d, &h, lamp) {
+                    let origin = h.point + h.normal * (0.02 + 1e-4 * h.t);
+                    out.push((j as u32, shader.transmitted(value, h.t), origin, l, r - 1.5 * lamp.radius));
+                }
+            }
+            out
+        })
+        .collect();
+    let seen: Vec<bool> = pairs
+        .par_iter()
+        .map_init(Scratch::default, |scratch, &(_, _, o, l, range)| {
+            range <= 0.0 || !scene.occluded_with(o, l, range, scratch)
+        })
+        .collect();
+    let mut glow = vec![Vec3::ZERO; which.len()];
+    for (&(j, value, ..), seen) in pairs.iter().zip(seen) {
+        if seen {
+            glow[j as usize] += value;
+        }
+    }
+    glow
 }
 
 /// The surface a ray of the batch hit (`None`: a miss).

@@ -1,0 +1,191 @@
+//! The scene's lit navigation lamps as small light sources, for the camera's next-event estimation of their
+//! glitter on the water (`sensors/shade/lamp_glitter.rs`).
+//!
+//! A lamp is the faces of one instance that share a navigation-light material
+//! ([`crate::material::Material::nav_light`]) and lie within [`LAMP_GROUP_M`] of the first face of their group
+//! (a lantern's lens: a ring of faces round a vertical axis). Its intensity towards a direction `ω` is its
+//! radiance times its projected area, `L_e · ½ Σ A_i |n_i · ω|` (the half: a closed lens shows each direction one
+//! side of every pair of opposite faces), inside the lamp's COLREG arc and nothing outside it.
+
+use super::Scene;
+use crate::geometry::RigidPose;
+use crate::material::Material;
+use parry3d::math::Vec3;
+
+/// Faces of one navigation-light material within this distance (metres, body frame) of a group's first face
+/// belong to that lamp; farther ones start another (two masthead lanterns of one ship lie metres apart).
+pub const LAMP_GROUP_M: f32 = 1.0;
+
+/// One lit lamp, in the world frame.
+#[derive(Debug, Clone)]
+pub struct Lamp {
+    /// Centre of its faces (area-weighted), world frame, metres.
+    pub centre: Vec3,
+    /// Largest distance of a face's corner from the centre, metres.
+    pub radius: f32,
+    /// Area vectors of its faces (unit normal times area, m²), world frame.
+    pub faces: Vec<Vec3>,
+    /// Its material (radiance, arc).
+    pub material: Material,
+    /// Its instance's pose (the arc is a bearing in the body frame).
+    pub pose: RigidPose,
+}
+
+impl Lamp {
+    /// Intensity (cd, linear RGB) towards unit world direction `out` (from the lamp outwards): the projected area
+    /// of the lens times its radiance inside the lamp's arc, zero outside it.
+    pub fn intensity(&self, out: Vec3) -> Vec3 {
+        if !self.material.emits_towards(self.pose.inverse_transform_vector(out)) {
+            return Vec3::ZERO;
+        }
+        let area = 0.5 * self.faces.iter().map(|a| a.dot(out).abs()).sum::<f32>();
+        Vec3::from_array(self.material.emissive) * area
+    }
+}
+
+impl Scene {
+    /// The navigation lamps of the instances whose lights are on ([`Scene::set_lights`]), instance by instance in
+    /// id order, each instance's in the order of their first face.
+    pub fn nav_lamps(&self) -> Vec<Lamp> {
+        let mut out = Vec::new();
+        for inst in self.instances.iter().filter(|i| i.lights_on()) {
+            let mesh = &self.meshes[inst.mesh() as usize];
+            let (verts, faces) = (mesh.vertices(), mesh.faces());
+            // Per lamp (body frame): its material, its first face's centroid, and its faces' corners and area
+            // vectors.
+            let mut groups: Vec<(u16, Vec3, Vec<Vec3>, Vec<Vec3>)> = Vec::new();
+            for (t, f) in faces.iter().enumerate() {
+                let id = mesh.material(t as u32);
+                let Some(m) = self.materials.get(id as usize).filter(|m| id != 0 && m.nav_light) else {
+                    continue;
+                };
+                if m.emissive.iter().all(|&e| e <= 0.0) {
+                    continue;
+                }
+                let [a, b, c] = f.map(|v| verts[v as usize]);
+                let centroid = (a + b + c) / 3.0;
+                let area = 0.5 * (b - a).cross(c - a);
+                let at = groups.iter().position(|g| g.0 == id && (g.1 - centroid).length() <= LAMP_GROUP_M);
+                let g = match at {
+                    Some(i) => &mut groups[i],
+                    None => {
+                        groups.push((id, centroid, Vec::new(), Vec::new()));
+                        groups.last_mut().unwrap_or_else(|| unreachable!("a group was pushed"))
+                    }
+                };
+                g.2.extend([a, b, c]);
+                g.3.push(area);
+            }
+            let pose = *inst.pose();
+            for (id, _, corners, areas) in groups {
+                // The area-weighted centre of the faces (their corners' mean where every face is degenerate).
+                let total: f32 = areas.iter().map(|a| a.length()).sum();
+                let centre = if total > 0.0 {
+                    corners.chunks(3).zip(&areas).map(|(c, a)| (c[0] + c[1] + c[2]) / 3.0 * a.length()).sum::<Vec3>()
+                        / total
+                } else {
+                    corners.iter().copied().sum::<Vec3>() / corners.len() as f32
+                };
+                let radius = corners.iter().map(|c| (*c - centre).length()).fold(0.0, f32::max);
+                out.push(Lamp {
+                    centre: pose.transform_point(centre),
+                    radius,
+                    faces: areas.iter().map(|a| pose.transform_vector(*a)).collect(),
+                    material: self.materials[id as usize],
+                    pose,
+                });
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::Mesh;
+
+    /// A closed square prism (side `s`, height `h`) round `at`, its 4 sides of material 1 and its caps of 2.
+    fn lantern(at: Vec3, s: f32, h: f32) -> (Vec<[f32; 3]>, Vec<[i64; 3]>, Vec<u16>) {
+        let r = s / 2.0;
+        let mut v = Vec::new();
+        for z in [0.0, h] {
+            for (x, y) in [(-r, -r), (r, -r), (r, r), (-r, r)] {
+                v.push([at.x + x, at.y + y, at.z + z]);
+            }
+        }
+        let mut f = Vec::new();
+        let mut m = Vec::new();
+        for i in 0..4i64 {
+            let j = (i + 1) % 4;
+            f.extend([[i, j, j + 4], [i, j + 4, i + 4]]);
+            m.extend([1u16, 1]);
+        }
+        f.extend([[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7]]);
+        m.extend([2u16; 4]);
+        (v, f, m)
+    }
+
+    fn lamp_material(emissive: f32, arc: [f32; 2]) -> Material {
+        Material {
+            base_color: [1.0; 3],
+            roughness: 0.5,
+            metallic: 0.0,
+            emissive: [emissive; 3],
+            nav_light: true,
+            arc_deg: arc,
+        }
+    }
+
+    fn scene_with(arc: [f32; 2], lights: bool) -> crate::error::Result<Scene> {
+        let (mut v, mut f, mut m) = lantern(Vec3::new(0.0, 0.0, 10.0), 0.2, 0.3);
+        // A second lantern of the same material 5 m aft: a lamp of its own.
+        let (v2, f2, m2) = lantern(Vec3::new(-5.0, 0.0, 10.0), 0.2, 0.3);
+        let off = v.len() as i64;
+        v.extend(v2);
+        f.extend(f2.iter().map(|t| t.map(|i| i + off)));
+        m.extend(m2);
+        let classes = vec![3u16; f.len()];
+        let mesh = Mesh::new("lanterns", &v, &f, &classes)?.with_materials(&m)?;
+        let mut scene = Scene::new();
+        let id = scene.add_mesh(mesh);
+        let housing = Material { nav_light: false, emissive: [0.0; 3], ..lamp_material(0.0, [0.0, 180.0]) };
+        scene.set_materials(vec![housing, lamp_material(2e4, arc), housing])?;
+        let pose = RigidPose::from_xyz_rpy([100.0, 50.0, 0.0], [0.0, 0.0, std::f64::consts::FRAC_PI_2]);
+        let inst = scene.add_instance(id, pose, None)?;
+        scene.set_lights(&[inst], lights)?;
+        Ok(scene)
+    }
+
+    #[test]
+    fn lamps_are_grouped_placed_and_measured() -> crate::error::Result<()> {
+        assert!(scene_with([0.0, 180.0], false)?.nav_lamps().is_empty(), "lights off: no lamps");
+        let lamps = scene_with([0.0, 180.0], true)?.nav_lamps();
+        assert_eq!(lamps.len(), 2, "two lanterns 5 m apart are two lamps");
+        // Body (0, 0, 10.15) turned 90° about z and moved to (100, 50): world (100, 50, 10.15); the aft one at
+        // body x = −5 lies at world y = 45.
+        assert!((lamps[0].centre - Vec3::new(100.0, 50.0, 10.15)).length() < 1e-4, "{:?}", lamps[0].centre);
+        assert!((lamps[1].centre - Vec3::new(100.0, 45.0, 10.15)).length() < 1e-4, "{:?}", lamps[1].centre);
+        // Seen horizontally square-on, the prism shows one 0.2 × 0.3 side: 0.06 m²; along a diagonal, √2 of it.
+        let l = &lamps[0];
+        assert!((l.intensity(Vec3::X).x - 2e4 * 0.06).abs() < 0.5, "{:?}", l.intensity(Vec3::X));
+        let diag = Vec3::new(1.0, 1.0, 0.0).normalize();
+        assert!((l.intensity(diag).x - 2e4 * 0.06 * 2f32.sqrt()).abs() < 1.0);
+        // Straight down the sides show nothing (the caps are not lamp faces).
+        assert!(l.intensity(-Vec3::Z).x.abs() < 1e-3);
+        // The corners lie √(0.1² + 0.1² + 0.15²) from the centre.
+        assert!((l.radius - (0.02f32 + 0.0225).sqrt()).abs() < 1e-4);
+        Ok(())
+    }
+
+    #[test]
+    fn a_lamp_shines_only_inside_its_arc() -> crate::error::Result<()> {
+        // A sidelight to port (+y in the body): the body is turned 90°, so port is world −x.
+        let lamps = scene_with([90.0, 56.25], true)?.nav_lamps();
+        let l = &lamps[0];
+        assert!(l.intensity(-Vec3::X).x > 0.0, "towards port");
+        assert_eq!(l.intensity(Vec3::X), Vec3::ZERO, "towards starboard");
+        assert_eq!(l.intensity(Vec3::new(0.0, -1.0, 0.0)), Vec3::ZERO, "right astern");
+        Ok(())
+    }
+}
