@@ -2,8 +2,9 @@
 //! camera, estimated by next-event estimation (a light sampled explicitly at every shaded point) instead of by the
 //! traced reflection rays that find a lamp only by chance.
 //!
-//! **Why.** A lamp is a few square centimetres of 2·10⁴ cd/m² (`materials.py` `NAV_LAMP_RADIANCE`), the water's
-//! reflection lobe at W1 spans a tenth of a steradian. The glossy reflections (`sensors/camera/glossy.rs`) draw a
+//! **Why.** A lamp is a small lens of a few thousand cd/m² (a masthead light of 94 cd, COLREG Annex I §8, over a
+//! 0.04 m² lens: `materials.py` `COLREG_INTENSITY_CD`), the water's reflection lobe at W1 spans a tenth of a
+//! steradian. The glossy reflections (`sensors/camera/glossy.rs`) draw a
 //! direction per traced ray from that lobe and spread what it brings back over the lobe's footprint in the image:
 //! a lamp drawn by one ray in a hundred thousand became a saturated hard-edged rectangle of water, and a lamp no
 //! ray drew left none (the 640 × 480 view of a ferry 130 m off at midnight: 4,571 saturated water pixels at `high`
@@ -24,9 +25,10 @@
 //!   glitter is then the lamp's reflected image at its own size, not a point;
 //! * `V` a shadow ray from the water point to the lamp (hulls, the lamp's own vessel, and wave crests occlude).
 //!
-//! The traced reflections then leave the lamps out (they would count them twice). Only while the sun is below
-//! the horizon: in daylight the sky's reflection outshines a lamp's glitter (a lamp 10 m off at W1 adds about a
-//! hundredth of it), the traced reflections keep the lamps, and every daylight image is as before.
+//! The traced reflections then leave the lamps out (they would count them twice). Only while the sun stands less
+//! than [`LAMP_GLITTER_SUN_DEG`] high: above, the sky's reflection outshines a lamp's glitter (a 94 cd lamp 10 m off
+//! gives a glitter of about 2 cd/m² at its brightest at W1, the daylight sky's reflection there some hundreds), the
+//! traced reflections keep the lamps, and every daylight image is as before.
 
 use super::rough_water;
 use super::tables::water_fresnel;
@@ -38,6 +40,10 @@ use parry3d::math::Vec3;
 /// normal by `tan²θ_h ≤ GLITTER_TAN2 · α²`: beyond, the Beckmann distribution is below `e^{−9}` (1.2·10⁻⁴) of its
 /// peak.
 pub const GLITTER_TAN2: f32 = 9.0;
+
+/// The sun's elevation (degrees) from which the lamps' glitter is left to the traced reflections
+/// ([`Shader::lamps_by_glitter`]).
+pub const LAMP_GLITTER_SUN_DEG: f32 = 10.0;
 
 /// Lamps tested together by [`LampSet::near_lobe`].
 const LANES: usize = 8;
@@ -112,10 +118,10 @@ impl LampSet {
 
 impl Shader {
     /// Whether the camera estimates the lamps' glitter ([`Shader::lamp_glitter`]) and leaves them out of its
-    /// traced reflections: while the sun is below the horizon.
+    /// traced reflections: while the sun stands lower than [`LAMP_GLITTER_SUN_DEG`] (or is not lit at all).
     #[inline]
     pub fn lamps_by_glitter(&self) -> bool {
-        !self.sun_up()
+        !self.sun_up() || self.sun.z < LAMP_GLITTER_SUN_DEG.to_radians().sin()
     }
 
     /// The glitter of `lamp` at water hit `hit` seen along `d`, before the lamp's visibility and the camera's
@@ -283,7 +289,11 @@ mod tests {
 
     #[test]
     fn daylight_keeps_the_traced_reflections() {
-        let env = ShadeEnv { sun_direction: [0.0, 0.94, 0.342], ..ShadeEnv::default() };
-        assert!(!Shader::new(&env, 1, &[]).lamps_by_glitter());
+        let at = |deg: f32| {
+            let (s, c) = deg.to_radians().sin_cos();
+            Shader::new(&ShadeEnv { sun_direction: [0.0, c, s], ..ShadeEnv::default() }, 1, &[]).lamps_by_glitter()
+        };
+        assert!(!at(20.0) && !at(10.5));
+        assert!(at(9.5) && at(1.0) && at(-5.0));
     }
 }
