@@ -404,8 +404,8 @@ def test_nav_lights_show_across_their_colreg_arcs(asset: str) -> None:
 def _lamp_glow(asset: str, bearing: np.ndarray) -> list[tuple[str, np.ndarray, np.ndarray, np.ndarray]]:
     """For every lantern of ``asset`` under way at night: (material, bearings, seen, lit): ``seen`` whether the ray
     from 300 m out at the lamp's height aimed at the lantern's centre meets the lantern first, ``lit`` whether a
-    1-pixel camera on that ray gets the lamp's glow (radiance above 1e3 cd/m²; the lamp's is 2e4, a dark housing
-    at night far below 1)."""
+    1-pixel camera on that ray gets the lamp's glow (radiance above 100 cd/m²: the dimmest lens, the green
+    sidelight's, is 441 in its brightest channel, a dark housing at night far below 1)."""
     m = get_asset(asset).mesh
     s = Scene()
     s.set_materials(material_table())
@@ -431,7 +431,7 @@ def _lamp_glow(asset: str, bearing: np.ndarray) -> list[tuple[str, np.ndarray, n
                 pose = pose_matrices(np.array([*eye, 0.0, 0.0, math.radians(b + 180.0)]))
                 img = render(cam, s, pose=pose, env=env, seed=1, radiance=True)
                 assert img.radiance is not None
-                lit[k] = float(img.radiance.max()) > 1e3
+                lit[k] = float(img.radiance.max()) > 100.0
             found.append((lamp, bearing, seen, lit))
     return found
 

@@ -15,6 +15,9 @@ import numpy.typing as npt
 import pytest
 from mmusv.simulation import Simulation
 
+#: sRGB level above which a water pixel counts as lit by a lamp (the moonless night sea around is 0 to 2).
+LIT = 20
+
 
 def _night(*, quality: str, ferry_speed: float = 6.0) -> dict[str, Any]:
     cam = {"name": "front", "mount": {"point": "camera_front"}, "quality": quality, "resolution": [320, 240]}
@@ -60,9 +63,10 @@ def test_standard_and_high_show_the_same_glitter(standard: Any) -> None:
     rgb_s, sem, _ = standard
     rgb_h, _, _ = _front(_night(quality="high"))
     water = sem == 1
-    lit_s = (rgb_s.max(axis=2) > 50) & water
-    lit_h = (rgb_h.max(axis=2) > 50) & water
-    # The glitter paths are there (before: no water pixel above 50 at standard, 4,571 of 307,200 at high).
+    lit_s = (rgb_s.max(axis=2) > LIT) & water
+    lit_h = (rgb_h.max(axis=2) > LIT) & water
+    # The glitter paths are there (before: no lit water pixel at standard; at high, 640 × 480, a saturated
+    # rectangle of 4,571).
     assert lit_s.sum() > 0.01 * water.sum(), lit_s.sum()
     assert abs(int(lit_h.sum()) - int(lit_s.sum())) <= 0.05 * lit_s.sum(), (lit_s.sum(), lit_h.sum())
     diff = np.abs(rgb_h.astype(np.int16) - rgb_s.astype(np.int16))[water]
@@ -74,7 +78,7 @@ def test_the_glitter_lies_below_the_ferrys_lamps(standard: Any) -> None:
     ids, counts = np.unique(inst[(sem != 1) & (inst >= 0)], return_counts=True)
     ferry = inst == ids[counts.argmax()]  # the largest vessel in view
     cols = np.flatnonzero(ferry.any(axis=0))
-    glitter = (rgb.max(axis=2) > 50) & (sem == 1)
+    glitter = (rgb.max(axis=2) > LIT) & (sem == 1)
     gcols = np.flatnonzero(glitter.any(axis=0))
     # Each path runs from the ferry's waterline towards the camera, under the lamps: within the ferry's columns.
     assert gcols.size > 0 and cols.min() - 5 <= gcols.min() and gcols.max() <= cols.max() + 5, (cols, gcols)
@@ -85,9 +89,9 @@ def test_the_glitter_lies_below_the_ferrys_lamps(standard: Any) -> None:
 def test_no_glitter_without_lamps() -> None:
     # A ferry at speed 0 is not under way: its lamps are off, and no water pixel lights up.
     rgb, sem, _ = _front(_night(quality="standard", ferry_speed=0.0))
-    assert ((rgb.max(axis=2) > 50) & (sem == 1)).sum() == 0
+    assert ((rgb.max(axis=2) > LIT) & (sem == 1)).sum() == 0
 
 
 def test_draft_traces_no_reflections_and_shows_none() -> None:
     rgb, sem, _ = _front(_night(quality="draft"))
-    assert ((rgb.max(axis=2) > 50) & (sem == 1)).sum() == 0
+    assert ((rgb.max(axis=2) > LIT) & (sem == 1)).sum() == 0

@@ -11,6 +11,7 @@ import pytest
 from mmusv.errors import ConfigError
 from mmusv.world.materials import (
     BUILTIN_COUNT,
+    LANTERN_LENS_AREA_M2,
     MATERIALS,
     Material,
     all_materials,
@@ -91,10 +92,35 @@ def test_physical_character_of_key_materials() -> None:
     assert MATERIALS[material_id("rubber")].roughness >= 0.8
     for n in ("nav_masthead_white", "nav_port_red", "nav_starboard_green", "nav_stern_white"):
         m = MATERIALS[material_id(n)]
-        assert m.nav_light and max(m.emissive) >= 1e4
+        assert m.nav_light and max(m.emissive) > 0
     red, green = MATERIALS[material_id("nav_port_red")], MATERIALS[material_id("nav_starboard_green")]
     assert red.emissive[0] > 10 * red.emissive[1] and green.emissive[1] > 2 * green.emissive[0]
     assert not any(m.nav_light or max(m.emissive) > 0 for m in MATERIALS if not m.name.startswith("nav_"))
+
+
+def test_lamps_have_the_colreg_intensities() -> None:
+    # COLREG 1972 Annex I §8(b): 6 nautical miles (the masthead light of a vessel of 50 m or more) ask 94 cd, 3 miles
+    # (its sidelights and sternlight) 12 cd. The intensity of a default lantern towards the side: its lamp faces'
+    # projected area along x (half the sum of |area vector · x| over the closed lens band) times the luminance of the
+    # lens radiance (Rec. 709 / sRGB weights).
+    from mmusv.world.parts_super import _lantern
+
+    lamp = material_id("nav_masthead_white")
+    m = _lantern(at=np.zeros(3), size=0.3, lamp=lamp, housing=material_id("steel"), cls=3)
+    tri = np.asarray(m.vertices, dtype=np.float64)[np.asarray(m.faces)]
+    area = 0.5 * np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    side_on = 0.5 * np.abs(area[np.asarray(m.materials) == lamp][:, 0]).sum()
+    # A 12-sided band seen along x: its model, a cylinder's 2 r h, within the polygon's width.
+    assert side_on == pytest.approx(LANTERN_LENS_AREA_M2, rel=0.04)
+    for name, cd in [
+        ("nav_masthead_white", 94.0),
+        ("nav_port_red", 12.0),
+        ("nav_starboard_green", 12.0),
+        ("nav_stern_white", 12.0),
+    ]:
+        e = MATERIALS[material_id(name)].emissive
+        luminance = 0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2]
+        assert luminance * LANTERN_LENS_AREA_M2 == pytest.approx(cd, rel=1e-6), name
 
 
 def test_unknown_name_lists_the_known_ones() -> None:

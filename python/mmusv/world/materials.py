@@ -1,11 +1,11 @@
 """The material table of mmusv: a small named list of PBR materials, one id per face of every mesh.
 
-A :class:`Material` is a metallic-roughness PBR description (the glTF 2.0 model): linear-RGB albedo
-``base_color`` in [0, 1], perceptual ``roughness`` in [0.02, 1] (the GGX alpha is ``roughness**2``), ``metallic``
-in [0, 1], ``emissive`` radiance (linear RGB, cd/m² scale; a lit navigation lamp is about 2e4), ``nav_light``
-(the lamp emits only on vessels under way, COLREG lights) and a lamp's horizontal ``arc_deg`` (centre bearing and
-half-width in the vessel's body frame, 0 right ahead and +90 to port; COLREG 1972 Rule 21: masthead 225°,
-sidelights 112.5° each from right ahead to 22.5° abaft the beam, sternlight 135° about right astern). A
+A :class:`Material` is a metallic-roughness PBR description (the glTF 2.0 model): linear-RGB albedo ``base_color``
+in [0, 1], perceptual ``roughness`` in [0.02, 1] (the GGX alpha is ``roughness**2``), ``metallic`` in [0, 1],
+``emissive`` radiance (linear RGB, cd/m² scale; a lit masthead lamp is about 2.6e3, :data:`NAV_LAMP_RADIANCE`),
+``nav_light`` (the lamp emits only on vessels under way, COLREG lights) and a lamp's horizontal ``arc_deg`` (centre
+bearing and half-width in the vessel's body frame, 0 right ahead and +90 to port; COLREG 1972 Rule 21: masthead
+225°, sidelights 112.5° each from right ahead to 22.5° abaft the beam, sternlight 135° about right astern). A
 material's id is its index in the table; id 0 is ``class_default``: the shading falls back to the semantic class
 colour (maps, user meshes without materials).
 
@@ -30,6 +30,8 @@ from mmusv.errors import ConfigError
 
 __all__ = [
     "BUILTIN_COUNT",
+    "COLREG_INTENSITY_CD",
+    "LANTERN_LENS_AREA_M2",
     "MATERIALS",
     "NAV_LAMP_RADIANCE",
     "Material",
@@ -39,8 +41,27 @@ __all__ = [
     "register_material",
 ]
 
-NAV_LAMP_RADIANCE = 2.0e4
-"""Emitted radiance of a lit navigation lamp's lens, cd/m² (a 10 W LED lantern of a few cm², order of magnitude)."""
+LANTERN_LENS_AREA_M2 = 2.0 * (0.36 * 0.3) * (0.57 * 0.3)
+"""Projected area of the lens of a lantern of the default size (``NavLightsPart.size`` 0.3 m: a lens band of radius
+0.36 and height 0.57 of the size, ``parts_super._lantern``) seen from the side, m²."""
+
+COLREG_INTENSITY_CD = {"masthead": 94.0, "sidelight": 12.0, "sternlight": 12.0}
+"""Luminous intensity of each navigation light, cd: COLREG 1972 Annex I §8(b), the minimum for the ranges of
+visibility Rule 22(a) asks of a vessel of 50 m or more (masthead light 6 nautical miles, sidelights and sternlight
+3)."""
+
+
+def _lamp_radiance(colour: tuple[float, float, float], intensity_cd: float) -> tuple[float, float, float]:
+    """The lens radiance (linear sRGB, cd/m²) of the ``colour`` (relative channels) whose luminance, over the default
+    lantern's lens, gives ``intensity_cd``."""
+    luminance = 0.2126 * colour[0] + 0.7152 * colour[1] + 0.0722 * colour[2]
+    k = intensity_cd / (LANTERN_LENS_AREA_M2 * luminance)
+    return (k * colour[0], k * colour[1], k * colour[2])
+
+
+NAV_LAMP_RADIANCE = _lamp_radiance((1.0, 1.0, 0.92), COLREG_INTENSITY_CD["masthead"])[0]
+"""Emitted radiance of a lit masthead lamp's lens, cd/m² (about 2.5e3: :data:`COLREG_INTENSITY_CD` over
+:data:`LANTERN_LENS_AREA_M2`); the other lamps are dimmer, as Annex I asks."""
 
 
 @dataclass(frozen=True)
@@ -55,7 +76,7 @@ class Material:
     metallic: float
     """0 (dielectric) .. 1 (metal)."""
     emissive: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    """Emitted radiance, linear RGB, cd/m² scale (a lit navigation lamp is about 2e4)."""
+    """Emitted radiance, linear RGB, cd/m² scale (a lit masthead lamp is about 2.6e3, :data:`NAV_LAMP_RADIANCE`)."""
     nav_light: bool = False
     """True: emits only on vessels under way (COLREG lights)."""
     arc_deg: tuple[float, float] = (0.0, 180.0)
@@ -132,7 +153,10 @@ def _m(
     return Material(name, rgb, roughness, metallic, emissive, nav, arc_deg)
 
 
-_L = NAV_LAMP_RADIANCE
+_MASTHEAD = _lamp_radiance((1.0, 1.0, 0.92), COLREG_INTENSITY_CD["masthead"])
+_RED = _lamp_radiance((1.0, 0.0, 0.0), COLREG_INTENSITY_CD["sidelight"])
+_GREEN = _lamp_radiance((0.0, 1.0, 0.3), COLREG_INTENSITY_CD["sidelight"])
+_STERN = _lamp_radiance((1.0, 1.0, 0.92), COLREG_INTENSITY_CD["sternlight"])
 
 # Typical PBR values (linear RGB albedo, roughness, metallic) after the common PBR charts named in the module
 # docstring: marine paints are semi-gloss dielectrics (roughness 0.35-0.6), antifouling is matt, bare metals use
@@ -191,13 +215,13 @@ MATERIALS: tuple[Material, ...] = (
     # sensors
     _m("sensor_housing", (0.06, 0.06, 0.065), 0.35),  # dark plastic radome / LiDAR housing
     # COLREG navigation lights: emissive only on vessels under way, across their Rule 21 arcs
-    _m("nav_masthead_white", (0.80, 0.80, 0.80), 0.1, 0.0, (_L, _L, 0.92 * _L), True, (0.0, 112.5)),
+    _m("nav_masthead_white", (0.80, 0.80, 0.80), 0.1, 0.0, _MASTHEAD, True, (0.0, 112.5)),
     # COLREG sidelights: red, and a bluish green inside Annex I §7's green area (CIE x, y = 0.265, 0.475), with no
     # light at all in the other channels (a faint share there would still saturate under a night exposure and draw
     # the lamp white).
-    _m("nav_port_red", (0.60, 0.02, 0.02), 0.1, 0.0, (_L, 0.0, 0.0), True, (56.25, 56.25)),
-    _m("nav_starboard_green", (0.02, 0.50, 0.20), 0.1, 0.0, (0.0, _L, 0.3 * _L), True, (-56.25, 56.25)),
-    _m("nav_stern_white", (0.80, 0.80, 0.80), 0.1, 0.0, (_L, _L, 0.92 * _L), True, (180.0, 67.5)),
+    _m("nav_port_red", (0.60, 0.02, 0.02), 0.1, 0.0, _RED, True, (56.25, 56.25)),
+    _m("nav_starboard_green", (0.02, 0.50, 0.20), 0.1, 0.0, _GREEN, True, (-56.25, 56.25)),
+    _m("nav_stern_white", (0.80, 0.80, 0.80), 0.1, 0.0, _STERN, True, (180.0, 67.5)),
 )
 """The built-in materials; a material's id is its index (:func:`all_materials` adds the registered ones)."""
 

@@ -71,7 +71,7 @@ import numpy as np
 
 from mmusv.errors import ConfigError
 from mmusv.world.asset_spec import AssetSpecError
-from mmusv.world.materials import NAV_LAMP_RADIANCE, Material, all_materials, register_material
+from mmusv.world.materials import Material, all_materials, register_material
 
 __all__ = [
     "COLOUR_LEVELS",
@@ -87,7 +87,7 @@ __all__ = [
     "one_line",
 ]
 
-GLTF_EMISSIVE_SCALE = 0.05 * NAV_LAMP_RADIANCE
+GLTF_EMISSIVE_SCALE = 1.0e3
 """cd/m² of a glTF ``emissiveFactor`` (or an MTL ``Ke``) of 1 (glTF's emission is relative; 1e3 cd/m² is a bright
 lit panel)."""
 
