@@ -14,6 +14,8 @@ with the new one, draws the same frames from the same poses. Each view is writte
 * ``ferry_dusk_zoom``: its mast and bridge enlarged 4× (the lights are a few pixels each);
 * ``dusk_series``: the same ferry and view through the hour of dusk (19:45, 20:15, 20:30 above; 20:45, 21:00,
   21:15 below; 480 × 270 each);
+* ``night_glitter``: a 90 m ferry under way at midnight, about 130 m off, at ``standard`` and at ``high`` quality
+  side by side (its lamps' glitter on the water);
 * ``exposure_settings``: that view at 21:15 through four cameras differing only in their ``exposure`` (the
   default, −1 EV, +1 EV, ISO 25 600; *after* only);
 * ``whitecaps_w3``: open water at wave level W3, from 8 m above the sea;
@@ -147,6 +149,41 @@ def ferry_dusk_zoom(path: Path) -> None:
         ferry_dusk(full)
         with Image.open(full) as im:
             im.crop((330, 150, 530, 270)).resize((800, 480), Image.Resampling.NEAREST).save(path)
+
+
+def night_glitter(path: Path) -> None:
+    """A ro-pax ferry under way at midnight (21 June, 45° N), about 130 m off with its port side towards a WAM-V's
+    bow camera (640 × 480, 90°), at W1: the same view at ``standard`` (left) and ``high`` quality (right). The
+    scenario of the sweep that found the glossy reflections' artefact at night (2026-12-04)."""
+    from PIL import Image
+
+    halves = []
+    for quality in ("standard", "high"):
+        camera = {"name": "view", "outputs": ["rgb"], "mount": {"point": "camera_front"}, "quality": quality}
+        scenario = {
+            "name": "night_glitter",
+            "seed": 1,
+            "map": {"type": "open_sea", "seed": 2},
+            "environment": {"time_of_day": "00:00", "weather": "clear", "wave": "W1"},
+            "acquisition": {"frequency_hz": 5, "frames": 1},
+            "rigs": {"view": {"lidar": None, "radar": None, "top_view": None, "cameras": [camera]}},
+            "vessels": [
+                {
+                    "id": "usv",
+                    "role": "usv",
+                    "asset": "usv_wamv",
+                    "rig": "view",
+                    "speed_mps": 1.5,
+                    "route": [[0, 0], [100, 0]],
+                },
+                {"id": "ferry", "asset": "ropax_ferry_90m", "speed_mps": 6.0, "route": [[120, -60], [120, 200]]},
+            ],
+        }
+        sim = mmusv.Simulation(scenario)
+        rgb = sim.capture(0, sensors=["cameras"]).agents["usv"].cameras["view"].rgb
+        assert rgb is not None
+        halves.append(np.asarray(rgb))
+    Image.fromarray(np.concatenate(halves, axis=1)).save(path)
 
 
 def dusk_series(path: Path) -> None:
@@ -360,6 +397,7 @@ VIEWS: dict[str, Callable[[Path], None]] = {
     "ferry_dusk": ferry_dusk,
     "ferry_dusk_zoom": ferry_dusk_zoom,
     "dusk_series": dusk_series,
+    "night_glitter": night_glitter,
     "exposure_settings": exposure_settings,
     "whitecaps_w3": whitecaps_w3,
     "wake_chase": wake_chase,
