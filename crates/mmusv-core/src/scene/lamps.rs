@@ -29,6 +29,8 @@ pub struct Lamp {
     pub material: Material,
     /// Its instance's pose (the arc is a bearing in the body frame).
     pub pose: RigidPose,
+    /// Its instance.
+    pub instance: u32,
 }
 
 impl Lamp {
@@ -48,7 +50,7 @@ impl Scene {
     /// id order, each instance's in the order of their first face.
     pub fn nav_lamps(&self) -> Vec<Lamp> {
         let mut out = Vec::new();
-        for inst in self.instances.iter().filter(|i| i.lights_on()) {
+        for (id, inst) in self.instances.iter().enumerate().filter(|(_, i)| i.lights_on()) {
             let mesh = &self.meshes[inst.mesh() as usize];
             let (verts, faces) = (mesh.vertices(), mesh.faces());
             // Per lamp (body frame): its material, its first face's centroid, and its faces' corners and area
@@ -77,7 +79,7 @@ impl Scene {
                 g.3.push(area);
             }
             let pose = *inst.pose();
-            for (id, _, corners, areas) in groups {
+            for (mat, _, corners, areas) in groups {
                 // The area-weighted centre of the faces (their corners' mean where every face is degenerate).
                 let total: f32 = areas.iter().map(|a| a.length()).sum();
                 let centre = if total > 0.0 {
@@ -91,8 +93,9 @@ impl Scene {
                     centre: pose.transform_point(centre),
                     radius,
                     faces: areas.iter().map(|a| pose.transform_vector(*a)).collect(),
-                    material: self.materials[id as usize],
+                    material: self.materials[mat as usize],
                     pose,
+                    instance: id as u32,
                 });
             }
         }
@@ -166,6 +169,7 @@ mod tests {
         // body x = −5 lies at world y = 45.
         assert!((lamps[0].centre - Vec3::new(100.0, 50.0, 10.15)).length() < 1e-4, "{:?}", lamps[0].centre);
         assert!((lamps[1].centre - Vec3::new(100.0, 45.0, 10.15)).length() < 1e-4, "{:?}", lamps[1].centre);
+        assert!(lamps.iter().all(|l| l.instance == 0));
         // Seen horizontally square-on, the prism shows one 0.2 × 0.3 side: 0.06 m²; along a diagonal, √2 of it.
         let l = &lamps[0];
         assert!((l.intensity(Vec3::X).x - 2e4 * 0.06).abs() < 0.5, "{:?}", l.intensity(Vec3::X));

@@ -30,6 +30,7 @@ use rayon::prelude::*;
 mod antialias;
 mod distortion;
 mod glossy;
+mod lamp_points;
 pub mod radiance;
 
 use antialias::surface_key;
@@ -456,6 +457,13 @@ impl Camera {
             let reflected = shaded.reflected.as_ref();
             let centres = antialias::Centres { frame: &frame, surface: &surface, hits: &hits, reflected };
             self.antialias(scene, pose, (&shader, env.shadows, options.seed, k), centres, &mut linear)?;
+        }
+        if shader.lamps_by_glitter() {
+            // Lamps smaller than a pixel, from the lamps themselves (`camera/lamp_points.rs`).
+            let lamps = scene.nav_lamps();
+            if !lamps.is_empty() {
+                self.add_lamp_points(scene, pose, &shader, &lamps, (&frame, &mut linear))?;
+            }
         }
         if self.cfg.image.noise.is_some() || env.rain_mm_per_h > 0.0 {
             linear.par_iter_mut().enumerate().for_each(|(i, c)| {

@@ -184,6 +184,7 @@ mod tests {
                 arc_deg: arc,
             },
             pose: RigidPose::IDENTITY,
+            instance: 0,
         }
     }
 
