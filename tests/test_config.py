@@ -47,6 +47,22 @@ def test_bad_vessel_fields_are_named(vessel: dict[str, object], field: str, frag
     assert fragment in str(info.value)
 
 
+def test_a_hull_sunk_whole_is_refused() -> None:
+    # z_base_m lowers a vessel's frame: a target 30 m down was seen by no sensor and still got 3D and 2D boxes. The
+    # whole hull under the water is an error naming the field and how far it may go; lifting stays allowed (a
+    # controlled set-up: tests/export/test_contrast.py lifts a boat 30 m against the horizon sky).
+    from mmusv.world.vessels import get_asset
+
+    hi = float(get_asset("usv_wamv").bbox[1, 2])
+    for z in (-30.0, -hi - 0.01):
+        with pytest.raises(mmusv.ConfigError) as info:
+            load_scenario(minimal(z_base_m=z))
+        msg = str(info.value)
+        assert "vessels[0].z_base_m" in msg and "below the still water" in msg and f"above {-hi:.2f} m" in msg, msg
+    assert load_scenario(minimal(z_base_m=-0.3)).vessels[0].z_base_m == -0.3
+    assert load_scenario(minimal(z_base_m=30.0)).vessels[0].z_base_m == 30.0
+
+
 def test_unknown_wave_setting_is_rejected_with_allowed_values() -> None:
     data = minimal()
     data["environment"] = {"wave": "W7"}

@@ -289,6 +289,9 @@ class VesselConfig(_Model):
     end: Literal["stop", "loop", "ping_pong"] = "stop"
     start_offset_m: float = Field(default=0.0, ge=0, le=MAX_COORDINATE_M, allow_inf_nan=False)
     z_base_m: float = Field(default=0.0, ge=-30, le=30, allow_inf_nan=False)
+    """Height (m) of the vessel's frame over the still water: 0 floats the asset at its own waterline, below 0 sits it
+    deeper (not so deep that the whole hull is under the water), above 0 lifts it (clear of the water, for a
+    controlled set-up: an object against the horizon sky)."""
 
     @field_validator("asset")
     @classmethod
@@ -372,6 +375,15 @@ class Scenario(_Model):
                     f"vessels[{i}].rig = {v.rig!r}: only instrumented vessels (role: usv) carry a rig; "
                     f"vessel {v.id!r} has role {v.role!r} (add `role: usv` or remove `rig`)"
                 )
+            if v.z_base_m < 0.0:
+                # A hull sunk whole is seen by no sensor yet labelled in every frame.
+                lo, hi = (float(z) for z in get_asset(v.asset).bbox[:, 2])
+                if hi + v.z_base_m <= 0.0:
+                    problems.append(
+                        f"vessels[{i}].z_base_m = {v.z_base_m:g}: it puts the whole hull of {v.asset} (z from {lo:.2f} "
+                        f"to {hi:.2f} m in its own frame) below the still water; a vessel floats, so z_base_m must "
+                        f"be above {-hi:.2f} m (0: the asset's own waterline)"
+                    )
             if v.role == "usv" and v.rig is not None and v.rig in self.rigs:
                 try:
                     _check_mount_points(v, i, v.rig, self.rigs[v.rig])

@@ -288,8 +288,16 @@ def test_a_sensor_under_the_water_is_refused_naming_its_field(
     assert "invalid config rigs.r.cameras[1].mount = [0.0, 0.0, -3.0]" in err, err
     assert "3.00 m under the still water" in err and "z > 0 in the vessel frame" in err, err
     d = tiny()
+    # Lowered 2.1 m, the WAM-V (hull top at z = 2.20 m) still floats, with a camera 1 m up its frame under the water.
+    d["rigs"]["r"]["cameras"] = [{**cam, "name": "low", "mount": {"xyz": [2.0, 0.0, 1.0]}}]
+    d["vessels"][0]["z_base_m"] = -2.1
+    with pytest.raises(ConfigError, match=r"cameras\[0\]\.mount = .* under the still water \(the vessel's z_base_m"):
+        mmusv.run(d, out_dir=tmp_path / "o")
+    # Lowered 5 m, its whole hull is under the water: refused for that first.
     d["vessels"][0]["z_base_m"] = -5.0
-    with pytest.raises(ConfigError, match=r"rigs\.r\.lidar\.mount = .* under the still water \(the vessel's z_base_m"):
+    with pytest.raises(
+        ConfigError, match=r"vessels\[0\]\.z_base_m = -5: it puts the whole hull .* below the still water"
+    ):
         mmusv.run(d, out_dir=tmp_path / "o")
     assert not (tmp_path / "out").exists() and not (tmp_path / "o").exists()
     # At the waterline (a camera without a mount sits there) is still allowed.
