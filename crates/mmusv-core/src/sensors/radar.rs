@@ -15,7 +15,9 @@
 //! the sweep are cast in one [`Scene::cast_rays`] call.
 //!
 //! Range bin `k` covers `[k Δr, (k+1) Δr)` and is reported at its centre `(k + ½) Δr`; bins whose centre lies
-//! outside `[range_min_m, range_max_m)` are blind. Hits are aggregated per cell (azimuth bin, range bin):
+//! outside `[range_min_m, range_max_m)` are blind, and so are echoes from nearer than `range_min_m` in any bin
+//! (the receiver is blanked while it transmits: until 2026-12-04 a bin straddling `range_min_m` took them, and a
+//! coarse bin reported the own hull). Hits are aggregated per cell (azimuth bin, range bin):
 //! intensity is the sum of [`radar_model::ray_power`] over the rays hitting something other than water (each
 //! weighted by the fan's two-way elevation gain, [`RadarConfig::two_way_gain`]), plus the cell's clutter draw
 //! ([`radar_model::clutter_mean`]); a cell is reported when its intensity is positive and at least
@@ -157,7 +159,8 @@ pub fn radar_sweep(
                         blockers.push(f64::from(elevation), d);
                     }
                     let bin = (d / cfg.range_resolution_m).floor() as u32;
-                    if bin < first || bin >= end {
+                    // An echo from inside the blind range is not received, whatever bin it falls in.
+                    if bin < first || bin >= end || d < cfg.range_min_m {
                         continue;
                     }
                     let n = &hits.normal[3 * i..3 * i + 3];

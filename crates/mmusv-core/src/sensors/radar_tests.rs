@@ -116,6 +116,16 @@ fn target_lands_in_its_range_and_azimuth_bin() {
 }
 
 #[test]
+fn echoes_from_inside_the_blind_range_are_not_received() {
+    // Bins of 30 m: the first, [0, 30), is reported at 15 m, beyond a blind range of 13 m. A 10 m cube from 2 to
+    // 12 m lies wholly inside the blind range: nothing comes back (it was reported at 15 m). One from 40 m is seen.
+    let cfg = RadarConfig { range_min_m: 13.0, range_resolution_m: 30.0, ..small_cfg() };
+    assert!(sweep(&sea_with_box(2.0, 0.0), &cfg, 0.0, 1).is_empty());
+    let far = sweep(&sea_with_box(40.0, 0.0), &cfg, 0.0, 1);
+    assert!(!far.is_empty() && far.range.iter().all(|&r| r == 45.0), "{:?}", far.range);
+}
+
+#[test]
 fn bigger_and_nearer_targets_are_brighter_rain_attenuates() {
     let cfg = small_cfg();
     let total = |r: &RadarReturns| r.intensity.iter().map(|&x| x as f64).sum::<f64>();
