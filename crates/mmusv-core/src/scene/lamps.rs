@@ -40,8 +40,12 @@ impl Lamp {
         if !self.material.emits_towards(self.pose.inverse_transform_vector(out)) {
             return Vec3::ZERO;
         }
-        let area = 0.5 * self.faces.iter().map(|a| a.dot(out).abs()).sum::<f32>();
-        Vec3::from_array(self.material.emissive) * area
+        Vec3::from_array(self.material.emissive) * self.projected_area(out)
+    }
+
+    /// Area (m²) of the lens seen along unit direction `dir` (either way): `½ Σ A_i |n_i · dir|`.
+    pub fn projected_area(&self, dir: Vec3) -> f32 {
+        0.5 * self.faces.iter().map(|a| a.dot(dir).abs()).sum::<f32>()
     }
 }
 
@@ -57,8 +61,8 @@ impl Scene {
             // vectors.
             let mut groups: Vec<(u16, Vec3, Vec<Vec3>, Vec<Vec3>)> = Vec::new();
             for (t, f) in faces.iter().enumerate() {
-                let id = mesh.material(t as u32);
-                let Some(m) = self.materials.get(id as usize).filter(|m| id != 0 && m.nav_light) else {
+                let mat = mesh.material(t as u32);
+                let Some(m) = self.materials.get(mat as usize).filter(|m| mat != 0 && m.nav_light) else {
                     continue;
                 };
                 if m.emissive.iter().all(|&e| e <= 0.0) {
@@ -67,11 +71,11 @@ impl Scene {
                 let [a, b, c] = f.map(|v| verts[v as usize]);
                 let centroid = (a + b + c) / 3.0;
                 let area = 0.5 * (b - a).cross(c - a);
-                let at = groups.iter().position(|g| g.0 == id && (g.1 - centroid).length() <= LAMP_GROUP_M);
+                let at = groups.iter().position(|g| g.0 == mat && (g.1 - centroid).length() <= LAMP_GROUP_M);
                 let g = match at {
                     Some(i) => &mut groups[i],
                     None => {
-                        groups.push((id, centroid, Vec::new(), Vec::new()));
+                        groups.push((mat, centroid, Vec::new(), Vec::new()));
                         groups.last_mut().unwrap_or_else(|| unreachable!("a group was pushed"))
                     }
                 };

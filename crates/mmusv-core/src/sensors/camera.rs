@@ -30,6 +30,7 @@ use rayon::prelude::*;
 mod antialias;
 mod distortion;
 mod glossy;
+mod lamp_glow;
 mod lamp_points;
 pub mod radiance;
 
@@ -422,6 +423,7 @@ impl Camera {
         let shader = Shader::new(env, options.seed, options.wakes)
             .with_kelvin_waves(q.kelvin_waves())
             .with_materials(scene.material_table())
+            .with_lamps(scene)
             .with_seabed(scene.seabed())
             .with_waves(scene.wave_surface())
             .with_footprint(pixel_rad, pixel_m)
@@ -458,12 +460,9 @@ impl Camera {
             let centres = antialias::Centres { frame: &frame, surface: &surface, hits: &hits, reflected };
             self.antialias(scene, pose, (&shader, env.shadows, options.seed, k), centres, &mut linear)?;
         }
-        if shader.lamps_by_glitter() {
+        if !shader.lamps().is_empty() {
             // Lamps smaller than a pixel, from the lamps themselves (`camera/lamp_points.rs`).
-            let lamps = scene.nav_lamps();
-            if !lamps.is_empty() {
-                self.add_lamp_points(scene, pose, &shader, &lamps, (&frame, &mut linear))?;
-            }
+            self.add_lamp_points(scene, pose, &shader, (&frame, &mut linear))?;
         }
         if self.cfg.image.noise.is_some() || env.rain_mm_per_h > 0.0 {
             linear.par_iter_mut().enumerate().for_each(|(i, c)| {

@@ -195,6 +195,8 @@ pub struct Shader {
     /// A pinhole pixel's angle (radians) and an orthographic pixel's width (metres): [`Shader::with_footprint`].
     pixel_rad: f32,
     pixel_m: f32,
+    /// The lit navigation lamps whose glitter and direct light the camera samples ([`Shader::with_lamps`]).
+    lamps: Arc<lamp_glitter::LampSet>,
 }
 
 impl Shader {
@@ -236,6 +238,7 @@ impl Shader {
             waves: None,
             pixel_rad: 0.0,
             pixel_m: 0.0,
+            lamps: Arc::default(),
         }
     }
 

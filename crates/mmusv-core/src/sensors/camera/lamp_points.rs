@@ -16,19 +16,18 @@
 use super::{Camera, CameraFrame, Projection};
 use crate::error::Result;
 use crate::geometry::RigidPose;
-use crate::scene::{Lamp, Scene, Scratch};
+use crate::scene::{Scene, Scratch};
 use crate::sensors::shade::Shader;
 use parry3d::math::Vec3;
 
 impl Camera {
     /// Adds the lamps smaller than a pixel to `linear` (row-major, linear RGB) of the frame rendered from `pose`
-    /// (see the module docs); `lamps` the scene's lit lamps.
+    /// (see the module docs); the lamps are the shader's ([`Shader::lamps`]).
     pub(super) fn add_lamp_points(
         &self,
         scene: &Scene,
         pose: &RigidPose,
         shader: &Shader,
-        lamps: &[Lamp],
         (frame, linear): (&CameraFrame, &mut [Vec3]),
     ) -> Result<()> {
         let Projection::Pinhole { .. } = self.cfg.projection else { return Ok(()) };
@@ -36,7 +35,7 @@ impl Camera {
         let eye = pose.translation;
         let axis = pose.transform_vector(Vec3::X);
         let mut scratch = Scratch::default();
-        for lamp in lamps {
+        for lamp in shader.lamps().lamps() {
             let to = lamp.centre - eye;
             let r = to.length();
             if r.is_nan() || r <= 0.0 {
@@ -49,8 +48,7 @@ impl Camera {
                 continue;
             }
             let omega = self.pixel_solid_angle(px as f64, py as f64);
-            let area = 0.5 * lamp.faces.iter().map(|a| a.dot(l).abs()).sum::<f32>();
-            let cover = area / (r * r * omega);
+            let cover = lamp.projected_area(l) / (r * r * omega);
             // A lamp of a pixel or more: the pixel rays see it.
             if cover.is_nan() || cover >= 1.0 {
                 continue;

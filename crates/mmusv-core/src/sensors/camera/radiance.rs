@@ -9,8 +9,7 @@
 
 use super::glossy;
 use crate::error::Result;
-use crate::scene::{RayHits, Scene, Scratch};
-use crate::sensors::shade::lamp_glitter::LampSet;
+use crate::scene::{RayHits, Scene};
 use crate::sensors::shade::tonemap;
 use crate::sensors::shade::{Shader, SurfaceHit};
 use parry3d::math::Vec3;
@@ -312,9 +311,7 @@ pub fn radiance(
     let lit = sunlit(scene, shader, shadows, (hits, origins, dirs), |k| !is_candidate(k))?;
     // At night the lamps' glitter is estimated at every water ray (`shade/lamp_glitter.rs`), and the traced
     // reflections leave the lamps out; not at draft quality, which traces no reflections.
-    let lamps = (shader.lamps_by_glitter() && !matches!(reflections, Reflections::Sky))
-        .then(|| LampSet::new(scene.nav_lamps()))
-        .filter(|set| !set.is_empty());
+    let lamps = Some(shader.lamps()).filter(|set| !set.is_empty() && !matches!(reflections, Reflections::Sky));
     // Reflected rays of the water hits (their representatives'), traced, and the radiance they bring back:
     // `index[k]` is ray k's own traced reflection in `values`, `u32::MAX` where it has none.
     let mut values: Vec<Vec3> = Vec::new();
@@ -492,16 +489,19 @@ pub fn radiance(
     });
     // The lamps' glitter on the water rays shaded themselves (a shared one takes its anchors' mean, glitter and
     // all; one whose anchors differ gets its own below).
-    let glitter_of = |which: &[u32]| match &lamps {
-        Some(set) => lamp_glow(scene, shader, set, (origins, dirs, hits), which),
-        None => Vec::new(),
+    let add_glitter = |out: &mut [Vec3], water: &[u32]| {
+        if let Some(set) = lamps {
+            for (&k, g) in
+                water.iter().zip(super::lamp_glow::lamp_glow(scene, shader, set, (origins, dirs, hits), water))
+            {
+                out[k as usize] += g;
+            }
+        }
     };
     if lamps.is_some() {
         let water: Vec<u32> =
             (0..n).into_par_iter().filter(|&k| is_water(k) && !is_candidate(k)).map(|k| k as u32).collect();
-        for (&k, g) in water.iter().zip(glitter_of(&water)) {
-            out[k as usize] += g;
-        }
+        add_glitter(&mut out, &water);
     }
     if let Some(grid) = shared {
         // The candidates: the anchors' mean where they look alike; the others (`redo`) need their own shading.
@@ -573,59 +573,10 @@ pub fn radiance(
         }
         if lamps.is_some() {
             let water: Vec<u32> = redo.iter().copied().filter(|&k| is_water(k as usize)).collect();
-            for (&k, g) in water.iter().zip(glitter_of(&water)) {
-                out[k as usize] += g;
-            }
+            add_glitter(&mut out, &water);
         }
     }
     Ok(Shaded { radiance: out, reflected: blurred.map(|(b, _)| b), exposure })
-}
-
-/// The lamps' glitter (`shade/lamp_glitter.rs`) that each water ray of `which` brings to the camera through the
-/// fog, in that order: every lamp near the lobe of its hit ([`LampSet::near_lobe`]), each behind a shadow ray from
-/// the water to the lamp, stopped short of the lamp's lantern.
-fn lamp_glow(
-    scene: &Scene,
-    shader: &Shader,
-    set: &LampSet,
-    (origins, dirs, hits): (&[[f32; 3]], &[[f32; 3]], &RayHits),
-    which: &[u32],
-) -> Vec<Vec3> {
-    // (slot in `which`, its glitter through the fog, shadow-ray origin, direction and length) per lamp near a hit.
-    let pairs: Vec<(u32, Vec3, Vec3, Vec3, f32)> = which
-        .par_iter()
-        .enumerate()
-        .with_min_len(PASS_CHUNK / 8)
-        .flat_map_iter(|(j, &k)| {
-            let k = k as usize;
-            let mut out = Vec::new();
-            let Some(h) = surface_at(shader, scene, hits, origins, dirs, k) else { return out };
-            let d = Vec3::from_array(dirs[k]);
-            let mut near = Vec::new();
-            set.near_lobe(h.point, h.shading_normal, -d, shader.water_mss(h.unresolved_mss), &mut near);
-            for i in near {
-                let lamp = &set.lamps()[i as usize];
-                if let Some((value, l, r)) = shader.lamp_glitter(d, &h, lamp) {
-                    let origin = h.point + h.normal * (0.02 + 1e-4 * h.t);
-                    out.push((j as u32, shader.transmitted(value, h.t), origin, l, r - 1.5 * lamp.radius));
-                }
-            }
-            out
-        })
-        .collect();
-    let seen: Vec<bool> = pairs
-        .par_iter()
-        .map_init(Scratch::default, |scratch, &(_, _, o, l, range)| {
-            range <= 0.0 || !scene.occluded_with(o, l, range, scratch)
-        })
-        .collect();
-    let mut glow = vec![Vec3::ZERO; which.len()];
-    for (&(j, value, ..), seen) in pairs.iter().zip(seen) {
-        if seen {
-            glow[j as usize] += value;
-        }
-    }
-    glow
 }
 
 /// The surface a ray of the batch hit (`None`: a miss).
@@ -637,7 +588,7 @@ type MeansAndRedo = (Vec<(u32, Vec3)>, Vec<u32>);
 /// Rays shaded together per task of the final pass.
 const SHADE_CHUNK: usize = 4096;
 /// Least rays per task of the cheap per-ray passes (kinds, candidates, means).
-const PASS_CHUNK: usize = 4096;
+pub(super) const PASS_CHUNK: usize = 4096;
 
 crate::dispatch! {
     /// Shades the rays `start..start + out.len()` that `which` accepts into `out` (the others are left as they

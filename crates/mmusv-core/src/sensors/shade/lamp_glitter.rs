@@ -33,8 +33,9 @@
 use super::rough_water;
 use super::tables::water_fresnel;
 use super::{Shader, SurfaceHit};
-use crate::scene::Lamp;
+use crate::scene::{Lamp, Scene};
 use parry3d::math::Vec3;
+use std::sync::Arc;
 
 /// A lamp counts at a water point where the half vector between the view and the lamp leans from the shading
 /// normal by `tan²θ_h ≤ GLITTER_TAN2 · α²`: beyond, the Beckmann distribution is below `e^{−9}` (1.2·10⁻⁴) of its
@@ -122,6 +123,21 @@ impl Shader {
     #[inline]
     pub fn lamps_by_glitter(&self) -> bool {
         !self.sun_up() || self.sun.z < LAMP_GLITTER_SUN_DEG.to_radians().sin()
+    }
+
+    /// This shader with the lit lamps of `scene` ([`Scene::nav_lamps`], gathered once per render) when it samples
+    /// them ([`Shader::lamps_by_glitter`]); none otherwise.
+    pub fn with_lamps(mut self, scene: &Scene) -> Self {
+        if self.lamps_by_glitter() {
+            self.lamps = Arc::new(LampSet::new(scene.nav_lamps()));
+        }
+        self
+    }
+
+    /// The lamps the camera samples ([`Shader::with_lamps`]; empty by day).
+    #[inline]
+    pub fn lamps(&self) -> &LampSet {
+        &self.lamps
     }
 
     /// The glitter of `lamp` at water hit `hit` seen along `d`, before the lamp's visibility and the camera's
