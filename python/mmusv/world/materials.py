@@ -59,8 +59,10 @@ def _lamp_radiance(colour: tuple[float, float, float], intensity_cd: float) -> t
     return (k * colour[0], k * colour[1], k * colour[2])
 
 
-NAV_LAMP_RADIANCE = _lamp_radiance((1.0, 1.0, 0.92), COLREG_INTENSITY_CD["masthead"])[0]
-"""Emitted radiance of a lit masthead lamp's lens, cd/m² (about 2.5e3: :data:`COLREG_INTENSITY_CD` over
+_MASTHEAD = _lamp_radiance((1.0, 1.0, 0.92), COLREG_INTENSITY_CD["masthead"])
+
+NAV_LAMP_RADIANCE = _MASTHEAD[0]
+"""Emitted radiance of a lit masthead lamp's lens, cd/m² (about 2.6e3: :data:`COLREG_INTENSITY_CD` over
 :data:`LANTERN_LENS_AREA_M2`); the other lamps are dimmer, as Annex I asks."""
 
 
@@ -153,7 +155,6 @@ def _m(
     return Material(name, rgb, roughness, metallic, emissive, nav, arc_deg)
 
 
-_MASTHEAD = _lamp_radiance((1.0, 1.0, 0.92), COLREG_INTENSITY_CD["masthead"])
 _RED = _lamp_radiance((1.0, 0.0, 0.0), COLREG_INTENSITY_CD["sidelight"])
 _GREEN = _lamp_radiance((0.0, 1.0, 0.3), COLREG_INTENSITY_CD["sidelight"])
 _STERN = _lamp_radiance((1.0, 1.0, 0.92), COLREG_INTENSITY_CD["sternlight"])
