@@ -215,6 +215,29 @@ def test_range_max_cuts_far_surfaces() -> None:
     assert np.all(np.isposinf(img.depth)) and np.all(img.instance == -1) and np.all(img.semantic == 0)
 
 
+def test_the_sea_beyond_the_range_is_water_at_its_depth() -> None:
+    """A declared sea plane smaller than the view, a camera 3 m up, pitched down and rolled, with a 60 m range:
+    every pixel whose ray (rebuilt from the intrinsics) goes down is water, the sea's class and instance, at the
+    depth where the ray meets z = 0 (the plane past the range and past the mesh's edge alike); every pixel whose
+    ray rises is sky (+inf, class 0, instance -1). Before, the sea beyond the range was labelled sky."""
+    s = plane_scene(200.0, cls=1)
+    s.set_sea(0)
+    cam = core.Camera(rgb=False, width=48, height=36, hfov=math.radians(90), range_max=60.0)
+    pose = pose_matrices(np.array([0.0, 0.0, 3.0, 0.2, 0.05, 0.3]))
+    img = render(cam, s, pose=pose, env=sensor_env(), seed=1)
+    d = pixel_rays_world(cam.intrinsics, 48, 36, pose).reshape(36, 48, 3)
+    down = d[..., 2] < 0
+    assert 0 < down.sum() < down.size
+    with np.errstate(divide="ignore"):
+        t = np.where(down, 3.0 / -d[..., 2], np.inf)
+    want = t * (d @ pose[:3, 0])
+    assert (want[down] > 60.0).sum() > 48  # a band of pixels sees the sea past the range
+    np.testing.assert_allclose(img.depth[down], want[down], rtol=1e-4)
+    assert np.all(img.semantic[down] == 1) and np.all(img.instance[down] == 0)
+    assert np.all(np.isposinf(img.depth[~down])) and np.all(img.semantic[~down] == 0)
+    assert np.all(img.instance[~down] == -1)
+
+
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [

@@ -351,7 +351,9 @@ class CameraConfig(_Model):
     the RGB's anti-aliasing and reflections; ``distortion`` is Brown–Conrady ``[k1, k2, p1, p2, k3]`` in OpenCV's
     order (none by default); ``noise`` adds seeded shot and read noise (none by default); ``exposure``
     (:class:`ExposureConfig`) is automatic unless fixed. Depth, semantic and instance images always come from the
-    pixel centres."""
+    pixel centres. ``range_m`` (metres) is how far the camera traces surfaces: a vessel or island beyond it is not
+    seen, while the sea beyond it is still drawn, labelled water and given its still water's depth (so depth is
+    +inf, and the instance -1, exactly where the pixel sees the sky)."""
 
     name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$")
     resolution: tuple[int, int] = (640, 480)

@@ -76,6 +76,24 @@ impl Scene {
         self.sea.as_ref().map(|s| s.instance)
     }
 
+    /// What a ray that met nothing within its range would meet beyond it, where that is the sea: the sea
+    /// instance's id, its semantic class and the distance along the ray to the still water, when the scene has a
+    /// sea and the ray from `origin` above the still water goes down along unit `dir` (it meets the water
+    /// somewhere, past the range or past the water's mesh), else `None` (also where that distance overflows).
+    /// A camera labels such a pixel water, as its shading draws it ([`crate::sensors::camera::Camera`]), not sky.
+    pub fn sea_beyond(&self, origin: [f32; 3], dir: [f32; 3]) -> Option<(i32, u16, f32)> {
+        let sea = self.sea.as_ref()?;
+        if !(origin[2] > sea.level && dir[2] < 0.0) {
+            return None;
+        }
+        let t = (origin[2] - sea.level) / -dir[2];
+        let inst = self.instances.get(sea.instance as usize)?;
+        let class = inst
+            .class_override
+            .unwrap_or_else(|| self.meshes[inst.mesh as usize].classes().first().copied().unwrap_or(super::CLASS_NONE));
+        t.is_finite().then_some((sea.instance as i32, class, t))
+    }
+
     /// The sea shortcut for a closest-hit query: whether the ray rises from above the surface clear of
     /// everything (then it hits nothing: a miss, exactly as the full trace finds). `horizon`, when given, is the
     /// [`Horizon`] of the ray's origin. A ray going down is always traced: the full trace finds the surface as

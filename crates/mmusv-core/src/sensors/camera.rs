@@ -15,6 +15,12 @@
 //! on water and sub-pixel rays on edges ([`radiance`], [`Quality`]). Outputs per pixel: depth (float32 metres,
 //! +inf for sky), semantic class (uint16, 0 for sky), instance id (int32, −1 for sky), all from the pixel centre,
 //! and optionally sRGB (uint8 × 3) and linear radiance (float32 × 3, cd/m²).
+//!
+//! A pixel's ray that goes down towards the sea and meets nothing within the range (`range_max`), or past the
+//! water's mesh, meets the still water beyond it ([`Scene::sea_beyond`]): the pixel is water in the semantic and
+//! instance images (the sea's class and instance) with the still water's depth, as the RGB shades it (the sea
+//! below the horizon). So depth is +inf exactly where the instance is −1, the sky. Before, such pixels were
+//! labelled sky: with `range_m: 150`, the band of sea from 150 m out to the horizon.
 
 use super::rays;
 use super::shade::tonemap::{self, SensorNoise};
@@ -115,7 +121,7 @@ pub struct CameraConfig {
     pub height: u32,
     /// Projection.
     pub projection: Projection,
-    /// Farthest surface rendered (metres, > 0; may be infinite).
+    /// Farthest surface traced (metres, > 0; may be infinite); the still water beyond it is still water.
     pub range_max: f32,
     /// Image formation of the RGB.
     pub image: ImageOptions,
@@ -406,6 +412,13 @@ impl Camera {
             }
             frame.semantic[i] = hits.class[k];
             frame.instance[i] = hits.instance[k];
+            if !t.is_finite() {
+                if let Some((sea, class, t)) = scene.sea_beyond(origins[k], dirs[k]) {
+                    frame.depth[i] = t * Vec3::from_array(dirs[k]).dot(axis);
+                    frame.semantic[i] = class;
+                    frame.instance[i] = sea;
+                }
+            }
             if !surface.is_empty() {
                 let material = scene.material_index(hits.instance[k], hits.triangle[k]);
                 surface[i] = surface_key(hits.instance[k], hits.class[k], material);

@@ -270,16 +270,22 @@ fn a_camera_over_the_waves_sees_the_marched_hits() {
         let marched = s.cast_rays(&o, &d, cfg.range_max).unwrap_or_default();
         let axis = pose.transform_vector(Vec3::X);
         for i in 0..o.len() {
-            let t = marched.distance[i];
+            let (mut t, mut instance) = (marched.distance[i], marched.instance[i]);
+            if !t.is_finite() {
+                // Past the range, a ray going down meets the still water (`Scene::sea_beyond`).
+                if let Some((sea, _, beyond)) = s.sea_beyond(o[i], d[i]) {
+                    (t, instance) = (beyond, sea);
+                }
+            }
             let depth = if t.is_finite() { t * Vec3::from_array(d[i]).dot(axis) } else { f32::INFINITY };
-            let same = frame.instance[i] == marched.instance[i]
+            let same = frame.instance[i] == instance
                 && (depth == frame.depth[i] || (depth - frame.depth[i]).abs() <= 1e-4 * depth);
             if !same {
                 differ += 1;
                 assert!(
-                    marched.instance[i] == 1 && frame.instance[i] == 1,
+                    instance == 1 && frame.instance[i] == 1,
                     "view {k} pixel {i}: marched {} at {depth}, rasterised {} at {}",
-                    marched.instance[i],
+                    instance,
                     frame.instance[i],
                     frame.depth[i]
                 );

@@ -287,3 +287,52 @@ fn the_image_roll_is_the_cameras_roll_about_its_axis() {
     let pitched = super::image_roll(&RigidPose::from_xyz_rpy([0.0; 3], [0.1, 0.3, 0.0]));
     assert!((pitched + 0.1).abs() < 0.02, "{pitched}");
 }
+
+/// A pixel whose ray goes down to the sea but meets nothing within the camera's range is water in the semantic and
+/// instance images (the sea's class and instance), at the still water's depth, as the RGB shades it; one that rises
+/// is sky. Brute force over every pixel of a level camera 1.5 m up: its ray goes down exactly when the pixel's
+/// centre lies below the image's centre row, and meets z = 0 at depth `1.5 fx / (v + ½ − cy)` along the axis.
+/// Without a declared sea nothing changes.
+#[test]
+fn the_sea_beyond_the_range_is_water_not_sky() -> crate::error::Result<()> {
+    let (w, h) = (64usize, 48usize);
+    let hfov = 1.5f64;
+    let cfg = CameraConfig {
+        width: w as u32,
+        height: h as u32,
+        projection: Projection::Pinhole { hfov },
+        range_max: 30.0,
+        image: Default::default(),
+    };
+    let cam = Camera::new(cfg)?;
+    let pose = RigidPose::from_xyz_rpy([0.0, 0.0, 1.5], [0.0, 0.0, 0.0]);
+    let mut scene = ground_with_box();
+    let plain = cam.render(&scene, &pose, &ShadeEnv::default(), false, 1)?;
+    scene.set_sea(0, &[])?;
+    let f = cam.render(&scene, &pose, &ShadeEnv::default(), false, 1)?;
+    let fx = w as f64 / (2.0 * (0.5 * hfov).tan());
+    let (mut beyond, mut within) = (0, 0);
+    for v in 0..h {
+        for u in 0..w {
+            let i = v * w + u;
+            let below = v as f64 + 0.5 - h as f64 / 2.0;
+            if plain.depth[i].is_finite() {
+                within += usize::from(below > 0.0);
+                assert_eq!(f.depth[i].to_bits(), plain.depth[i].to_bits(), "depth of ({u}, {v})");
+                assert_eq!((f.semantic[i], f.instance[i]), (plain.semantic[i], plain.instance[i]), "({u}, {v})");
+            } else if below < 0.0 {
+                assert_eq!((f.semantic[i], f.instance[i]), (0, -1), "sky at ({u}, {v})");
+                assert!(f.depth[i] == f32::INFINITY, "sky's depth at ({u}, {v})");
+            } else {
+                beyond += 1;
+                assert_eq!((plain.semantic[i], plain.instance[i]), (0, -1), "no sea declared: ({u}, {v})");
+                assert_eq!((f.semantic[i], f.instance[i]), (1, 0), "the sea beyond the range at ({u}, {v})");
+                let want = 1.5 * fx / below;
+                let got = f64::from(f.depth[i]);
+                assert!(want > 30.0 && (got - want).abs() < 1e-4 * want, "depth {got} at ({u}, {v}), want {want}");
+            }
+        }
+    }
+    assert!(beyond >= w && within > 10 * w, "{beyond} beyond the range, {within} within");
+    Ok(())
+}
