@@ -507,6 +507,13 @@ def test_set_poses_moves_instances_and_only_them() -> None:
     up = s.cast_rays([target - (0.0, 0.0, 50.0)], [[0.0, 0.0, 1.0]])
     assert up.instance_id[0] == ids[1] and up.distance[0] <= 50.0 + 1e-4
 
+    # An id given twice is refused, naming it, and nothing moves (the last of its poses used to win silently).
+    before = [s.instance_pose(i) for i in ids]
+    with pytest.raises(InputError, match=rf"instance id {ids[2]} is given 2 times \(at 0, 2\)"):
+        s.set_poses([ids[2], ids[0], ids[2]], np.stack([pose(translation=(0.0, 0.0, 7.0))] * 3))
+    for i, p in zip(ids, before, strict=True):
+        np.testing.assert_array_equal(s.instance_pose(i), p)
+
 
 def test_instance_ids_and_semantic_classes() -> None:
     """Per-face classes, a whole-mesh class, and class_override per instance."""

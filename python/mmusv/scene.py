@@ -390,8 +390,9 @@ class Scene:
         return int(self._native.add_instance(_id(mesh_id, name="mesh_id", kind="mesh"), p, cls))
 
     def set_poses(self, instance_ids: npt.ArrayLike, poses: npt.ArrayLike) -> None:
-        """Moves instances: ``instance_ids`` ``(K,)`` ints, ``poses`` ``(K, 4, 4)`` float body → world (metres; one
-        ``(4, 4)`` for one id). Only the top level is rebuilt."""
+        """Moves instances: ``instance_ids`` ``(K,)`` ints, each once, ``poses`` ``(K, 4, 4)`` float body → world
+        (metres; one ``(4, 4)`` for one id). Only the top level is rebuilt; a bad or repeated id or a bad pose is an
+        :class:`~mmusv.errors.InputError` (or :class:`~mmusv.errors.NotFoundError`) and moves nothing."""
         p = _floats(poses, name="poses")
         if np.size(instance_ids) == 0 and p.size == 0:
             return

@@ -283,6 +283,21 @@ impl Scene {
         for &id in ids {
             self.check_instance(id)?;
         }
+        let mut sorted = ids.to_vec();
+        sorted.sort_unstable();
+        if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
+            let at: Vec<String> =
+                ids.iter().enumerate().filter(|(_, &id)| id == w[0]).map(|(i, _)| i.to_string()).collect();
+            return Err(MmusvError::input(
+                "instance_ids",
+                format!(
+                    "instance id {} is given {} times (at {}); give each instance one pose",
+                    w[0],
+                    at.len(),
+                    at.join(", ")
+                ),
+            ));
+        }
         for (i, pose) in poses.iter().enumerate() {
             pose.validate(&format!("poses[{i}]"))?;
         }

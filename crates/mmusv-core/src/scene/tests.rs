@@ -100,6 +100,11 @@ fn bad_rays_and_ids_are_errors_not_panics() {
     assert!(said.contains("the scene has 2 instances (ids 0 to 1)"), "{said}");
     let said = s.add_instance(m + 1, RigidPose::IDENTITY, None).err().map(|e| e.to_string()).unwrap_or_default();
     assert!(said.contains("the scene has 1 mesh (id 0)"), "{said}");
+    // One id twice: refused, naming the id and where it stands, and nothing moves (the last pose used to win).
+    let moved = RigidPose::from_xyz_rpy([5.0, 0.0, 0.0], [0.0; 3]);
+    let said = s.set_poses(&[1, 0, 1], &[moved; 3]).err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(said.contains("instance id 1 is given 2 times (at 0, 2)"), "{said}");
+    assert!(s.instances().iter().all(|i| i.pose().translation.x == 0.0));
 }
 
 #[test]
