@@ -440,7 +440,8 @@ class Scene:
             sea: the directional JONSWAP sea; its wave field is drawn from the scenario's sea seed, the one field
                 the hulls ride.
             scenario_seed: the scenario's seed.
-            time_s: the frame time, seconds.
+            time_s: the frame time, seconds, within ±1e9 (about 32 years; the waves' phases lose precision
+                past it).
             foci: ``(F, 2)`` float world x, y (metres) the sampling is finest around (the USVs); the same foci for
                 every sensor of a frame give every sensor the same surface.
             radius_m: the waves taper to still water this far from the nearest focus (metres, > 0).

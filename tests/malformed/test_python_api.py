@@ -290,6 +290,8 @@ def test_wave_surface_arguments(scene: Scene) -> None:
         ({"radius_m": "x"}, "radius_m = 'x'"),  # ValueError
         ({"radius_m": 1e30}, "radius_m = 1e+30"),  # a Rust panic: capacity overflow
         ({"time_s": "now"}, "time_s = 'now'"),  # ValueError
+        ({"time_s": 1e308}, "time_s"),  # every height NaN: a sea every ray passed through
+        ({"time_s": -2e9}, "time_s"),  # phases of no precision
         ({"scenario_seed": -1}, "scenario_seed = -1"),  # OverflowError
         ({"scenario_seed": 2**64}, "scenario_seed"),  # OverflowError
         ({"scenario_seed": 1.5}, "scenario_seed = 1.5"),  # truncated to 1

@@ -42,8 +42,8 @@ pub use sun_mask::SunMask;
 #[cfg(test)]
 pub(crate) use surface::tests::comp as test_component;
 pub use surface::{
-    PinholeView, Raster, SurfaceHit, SurfaceShading, SurfaceSpec, WaterHit, WaveSurface, DETAIL_CELLS, FLAT_PIECE,
-    MAX_TILES, SKIN_M, TILE_CELLS,
+    check_time, PinholeView, Raster, SurfaceHit, SurfaceShading, SurfaceSpec, WaterHit, WaveSurface, DETAIL_CELLS,
+    FLAT_PIECE, MAX_TILES, MAX_TIME_S, SKIN_M, TILE_CELLS,
 };
 
 /// Most cells per side of the height grid.

@@ -113,6 +113,7 @@ fn surface_key(
     if !(time_s.is_finite() && level.is_finite()) || foci.iter().any(|f| !(f[0].is_finite() && f[1].is_finite())) {
         return Err(InputError::new_err("wave surface: time_s, level and foci must be finite"));
     }
+    mmusv_core::sea::check_time(time_s).map_err(crate::errors::to_py)?;
     let spec = SurfaceSpec { tile_m, near_m, radius_m, taper_m, detail, slopes, fine_m };
     // Before any tile is allocated. The sea itself too, here: `prefetch_wave_surface` promises its checks, and a
     // sea checked only where it is sampled (on the prefetch's thread) was refused later, or never.

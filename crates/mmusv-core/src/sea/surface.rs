@@ -87,6 +87,22 @@ impl Default for SurfaceSpec {
 /// radius would ask for more memory than a machine has; [`SurfaceSpec::check_extent`] refuses them first.
 pub const MAX_TILES: u64 = 1 << 22;
 
+/// The largest frame time a wave surface is sampled at, seconds either side of 0 (about 32 years): the waves'
+/// phases `ω t` keep a precision of microradians up to it, and at 1e308 s they were NaN, a sea every ray passed
+/// through.
+pub const MAX_TIME_S: f64 = 1e9;
+
+/// `time_s` checked for [`WaveSurface::new`]: finite and within ±[`MAX_TIME_S`], else an error naming `time_s`.
+pub fn check_time(time_s: f64) -> crate::Result<()> {
+    if time_s.abs() <= MAX_TIME_S {
+        return Ok(());
+    }
+    Err(crate::MmusvError::input(
+        "time_s",
+        format!("{time_s} s is not allowed; give a frame time within ±{MAX_TIME_S:e} s (about 32 years)"),
+    ))
+}
+
 impl SurfaceSpec {
     /// How many tiles [`WaveSurface::new`] samples for `foci` (world x, y, metres): the foci's bounding rectangle
     /// grown by `radius_m`, in tiles of `tile_m` (0 without foci). Counted in `f64` and saturated, never
@@ -194,7 +210,8 @@ pub struct SurfaceHit {
 
 impl WaveSurface {
     /// Samples `components` at time `time_s` around the `foci` (world x, y), with still level `level`.
-    /// Deterministic: the same inputs give the same surface, whatever the thread count. Foci and a radius whose
+    /// Deterministic: the same inputs give the same surface, whatever the thread count. A time past ±[`MAX_TIME_S`]
+    /// is an error naming `time_s` ([`check_time`]). Foci and a radius whose
     /// surface would hold more than [`MAX_TILES`] tiles are an error naming `foci` ([`SurfaceSpec::check_extent`]:
     /// far-apart foci asked for more memory than a machine has, or overflowed the tile count).
     pub fn new(
@@ -204,6 +221,7 @@ impl WaveSurface {
         foci: &[[f32; 2]],
         spec: SurfaceSpec,
     ) -> crate::Result<Self> {
+        check_time(time_s)?;
         spec.check_extent(foci)?;
         let tile_m = spec.tile_m.max(1e-3);
         let reach = spec.radius_m.max(0.0);

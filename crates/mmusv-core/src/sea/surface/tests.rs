@@ -491,6 +491,22 @@ fn the_tile_count_is_the_grids_and_huge_extents_are_refused() {
     assert!(huge.check_extent(&[[0.0, 0.0]]).is_err());
 }
 
+/// Frame times up to ±`MAX_TIME_S` sample a finite sea; past it (1e308 s made every height NaN, a sea that every
+/// ray passed through) or not finite, `new` is an error naming `time_s`.
+#[test]
+fn frame_times_past_the_bound_are_refused() {
+    let sea = test_sea();
+    let spec = SurfaceSpec { radius_m: 64.0, ..SurfaceSpec::default() };
+    for t in [-MAX_TIME_S, 0.0, 3.7e8, MAX_TIME_S] {
+        let s = surface(&sea, t, &[[0.0, 0.0]], spec);
+        assert!(s.zmin.is_finite() && s.zmax.is_finite() && s.zmax > s.zmin, "{t}");
+    }
+    for t in [1.0000001e9, -2e9, 1e308, f64::INFINITY, f64::NAN] {
+        let Err(e) = WaveSurface::new(&sea, t, 0.0, &[[0.0, 0.0]], spec) else { panic!("time {t} accepted") };
+        assert!(e.to_string().contains("time_s"), "{e}");
+    }
+}
+
 #[test]
 fn a_calm_sea_still_stops_every_ray() {
     // Waves of micrometres (hs_m 1e-6, or no waves at all) make a band of heights thinner than a ray's height
