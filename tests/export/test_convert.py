@@ -410,3 +410,47 @@ def test_splits_that_get_no_recording_are_said(coop_rec: Path, tmp_path: Path) -
     ) in lines, lines
     unsplit = convert(coop_rec, to="yolo", out_dir=tmp_path / "n", box="projected", splits=None)
     assert not any("hold no recording" in line for line in unsplit.lines())
+
+
+# ---------------------------------------------------------------------------------------------- a frame twice
+
+
+def _frame_twice(src: Path, dst: Path, *, frame: int) -> Path:
+    """``dst``: ``src`` with every message of its ``frame``-th frame (by log time) written again after the last frame,
+    as a recording that holds a frame twice (a run resumed over frames it had written) has it."""
+    from mcap.reader import make_reader
+    from mcap.writer import CompressionType, Writer
+    from mcap_rechunk import write_records
+
+    with src.open("rb") as f:
+        reader = make_reader(f)
+        meta = [(m.name, dict(m.metadata)) for m in reader.iter_metadata()]
+        msgs = list(reader.iter_messages())
+    again = sorted({m.log_time for _, _, m in msgs})[frame]
+    dst.mkdir(parents=True)
+    out = dst / src.name
+    with out.open("wb") as g:
+        w = Writer(g, compression=CompressionType.NONE)
+        write_records(w, meta, msgs + [t for t in msgs if t[2].log_time == again])
+        w.finish()  # type: ignore[no-untyped-call]
+    return out
+
+
+@pytest.mark.parametrize("to", ["coco", "semantickitti", "ros2"])
+def test_a_frame_recorded_twice_is_converted_once(coop_rec: Path, tmp_path: Path, to: str) -> None:
+    """A recording holding frame 1 twice converts to what the recording with it once does, file for file: its first
+    copy, once (COCO listed the image twice, with its annotations, SemanticKITTI added a fourth scan, the bag held
+    every message of the frame twice), and ``conversion.yaml`` counts 3 frames converted, not 4."""
+    twice = _frame_twice(coop_rec, tmp_path / "twice", frame=1)
+    once = convert(coop_rec, to=to, out_dir=tmp_path / "once", splits=None)
+    got = convert(twice, to=to, out_dir=tmp_path / "got", splits=None)
+    a, b = tree(tmp_path / "once"), tree(tmp_path / "got")
+    assert a.pop("conversion.yaml") and b.pop("conversion.yaml")
+    if to == "ros2":  # the bag's own metadata name its file's size and chunk layout alike
+        a = {k: v for k, v in a.items() if not k.endswith("metadata.yaml")}
+        b = {k: v for k, v in b.items() if not k.endswith("metadata.yaml")}
+    assert a == b
+    assert once.frames == 3 and got.frames == 3
+    assert any("frames [1] appear more than once" in n for r in got.recordings for n in r.notes)
+    doc = yaml.safe_load((tmp_path / "got" / "conversion.yaml").read_text())
+    assert doc["frames_converted"] == 3 and doc["recordings"][0]["skipped"] == []

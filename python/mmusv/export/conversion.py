@@ -338,11 +338,16 @@ def convert(
                 wanted = writer.topic_filter()
                 stream = FrameStream(info, wanted.__contains__, frames=options.frames)
                 converted: list[int] = []
-                incomplete: list[tuple[int, str]] = []
+                kept: set[int] = set()  # converted, as a set
+                incomplete: dict[int, str] = {}
                 for fr in stream:
                     missing = writer.missing(fr)
                     if not options.wants_frame(fr.index):
                         pass  # outside --frames: neither converted nor missing
+                    elif fr.index in kept:
+                        # a frame recorded again: its first complete copy stands (handed to the writer again, COCO
+                        # listed the image twice, SemanticKITTI added a scan and a bag held every message twice)
+                        pass
                     elif fr.world is None or missing or not writer.agents:
                         why = (
                             writer.no_agent_reason
@@ -350,18 +355,20 @@ def convert(
                             else f"incomplete: missing {', '.join(missing[:4])}"
                             + (f" and {len(missing) - 4} more" if len(missing) > 4 else "")
                         )
-                        incomplete.append((fr.index, why))
+                        incomplete.setdefault(fr.index, why)
                     else:
                         writer.write_frame(fr)
                         converted.append(fr.index)
+                        kept.add(fr.index)
                         report.agent_frames += len(writer.agents)
                     done += 1
                     if progress is not None:
                         progress(done, max(expected, done))
                 rep.status = stream.run.get("status", "unfinished (no run metadata)")
-                for k, why in incomplete:
-                    rep.skipped.append({"frames": [k, k], "reason": why})
-                seen = set(converted) | {k for k, _ in incomplete}
+                for k, why in incomplete.items():
+                    if k not in kept:  # an incomplete copy of a frame converted from another copy is no loss
+                        rep.skipped.append({"frames": [k, k], "reason": why})
+                seen = set(converted) | set(incomplete)
                 # the frames the run set out to write (its run metadata, or for one that did not finish its
                 # manifest's): --frames N cuts a run short on purpose, those after N are not missing; one part of a
                 # split recording given alone starts at its first frame
@@ -390,7 +397,7 @@ def convert(
                     rep.notes.append(beyond)
                 if stream.out_of_order:
                     again = sorted(set(stream.out_of_order))
-                    rep.notes.append(f"frames {again} appear more than once; the last copy was kept")
+                    rep.notes.append(f"frames {again} appear more than once; the first complete copy was converted")
                 rep.skipped.sort(key=lambda s: s["frames"][0])
                 writer.finish(sorted(converted), rep.skipped)
                 rep.notes += writer.notes

@@ -211,7 +211,7 @@ class MotWriter(ProjectedBoxes):
             self.world = world
         self.rows.check(world, frame.index)
         for seq in self.sequences.values():
-            seq.rows.pop(frame.index, None)  # a frame recorded twice: the last copy is kept, as in every format
+            seq.rows.pop(frame.index, None)  # a frame written again replaces its rows (convert hands each frame once)
         super().write_frame(frame)
 
     def sequence(self, sample: Sample) -> _Sequence:
