@@ -280,8 +280,9 @@ def check_script_command(where: str, script: str, flags: list[str]) -> list[str]
     return [f"{where}: {script} has no option {f!r}" for f in flags if f not in known]
 
 
-OTHER_TOOLS_FLAGS = {"--bench", "--release", "--example", "--clock"}
-"""Flags of cargo (``cargo bench --bench seacam``) and ROS 2 (``ros2 bag play --clock``) named in the text."""
+OTHER_TOOLS_FLAGS = {"--bench", "--release", "--example", "--clock", "--open", "--doc"}
+"""Flags of cargo (``cargo bench --bench seacam``, ``cargo doc --open``, ``cargo test --doc``) and ROS 2
+(``ros2 bag play --clock``) named in the text."""
 
 
 @cache

@@ -24,6 +24,61 @@
 //! - [`ocean`]: the physical sea (JONSWAP spectrum, seeded wave field) and the vessels' response to it.
 //!
 //! Conventions: metres, seconds, radians; world frame right-handed, x east, y north, z up, water at z = 0.
+//!
+//! ## Example
+//!
+//! A sea plane and a 10 m box of a hull 60 m east; a 64-channel LiDAR 2 m above the water sweeps them, and a
+//! 64 × 48 camera looking east renders depth, semantic classes and instances (RGB too, with `rgb: true`):
+//!
+//! ```
+//! use mmusv_core::sensors::camera::{Camera, CameraConfig, Projection};
+//! use mmusv_core::sensors::lidar::{Lidar, LidarConfig, LidarEnv};
+//! use mmusv_core::sensors::shade::ShadeEnv;
+//! use mmusv_core::{Mesh, RigidPose, Scene};
+//!
+//! # fn main() -> mmusv_core::Result<()> {
+//! let mut scene = Scene::new();
+//! // The sea: two triangles of class 1 (water), declared the sea surface so the exact shortcuts apply.
+//! let sea = [[-500.0, -500.0, 0.0], [500.0, -500.0, 0.0], [500.0, 500.0, 0.0], [-500.0, 500.0, 0.0]];
+//! let water = scene.add_mesh(Mesh::new("sea", &sea, &[[0, 1, 2], [0, 2, 3]], &[1, 1])?);
+//! let sea_id = scene.add_instance(water, RigidPose::IDENTITY, None)?;
+//! // A hull: a 10 m cube (class 2) from 55 to 65 m east, standing 1 m in the water; it will move.
+//! let v: Vec<[f32; 3]> = (0..8)
+//!     .map(|i| [(i & 1) as f32, (i >> 1 & 1) as f32, (i >> 2 & 1) as f32])
+//!     .map(|[x, y, z]| [55.0 + 10.0 * x, -5.0 + 10.0 * y, -1.0 + 10.0 * z])
+//!     .collect();
+//! let f = [[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4]];
+//! let f = [f.as_slice(), &[[2, 6, 3], [3, 6, 7], [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5]]].concat();
+//! let hull = scene.add_mesh(Mesh::new("hull", &v, &f, &[2; 12])?);
+//! let hull_id = scene.add_instance(hull, RigidPose::IDENTITY, None)?;
+//! scene.set_sea(sea_id, &[hull_id])?;
+//!
+//! // One ray east from 2 m up meets the hull's face at x = 55.
+//! let hits = scene.cast_rays(&[[0.0, 0.0, 2.0]], &[[1.0, 0.0, 0.0]], 200.0)?;
+//! assert_eq!((hits.instance[0], hits.class[0]), (hull_id as i32, 2));
+//! assert!((hits.distance[0] - 55.0).abs() < 1e-4);
+//!
+//! // A LiDAR sweep (the paper's 64 channels over [-25°, 15°], 0.5–200 m), points in the LiDAR's frame.
+//! let lidar = Lidar::new(LidarConfig::default())?;
+//! let pose = RigidPose::from_xyz_rpy([0.0, 0.0, 2.0], [0.0, 0.0, 0.0]);
+//! let scan = lidar.scan(&scene, &pose, &LidarEnv::default(), 7)?;
+//! assert!(scan.instance.iter().any(|&i| i == hull_id as i32));
+//!
+//! // A camera: depth along the optical axis (x forward), classes and instances from the pixel centres.
+//! let camera = Camera::new(CameraConfig {
+//!     width: 64,
+//!     height: 48,
+//!     projection: Projection::Pinhole { hfov: 1.2 },
+//!     range_max: 1000.0,
+//!     image: Default::default(),
+//! })?;
+//! let frame = camera.render(&scene, &pose, &ShadeEnv::default(), false, 7)?;
+//! let centre = 24 * 64 + 32;
+//! assert_eq!(frame.semantic[centre], 2);
+//! assert!((frame.depth[centre] - 55.0).abs() < 0.05);
+//! # Ok(())
+//! # }
+//! ```
 
 // SIMD-style code: loops over lanes index several parallel arrays at once (boxes, rays, triangles); iterating
 // over one of them would hide the structure-of-arrays layout the compiler vectorises.
