@@ -139,3 +139,23 @@ def test_the_environment_takes_a_cameras_exposure_range_and_unit_directions() ->
     for bad in ([np.nan, 0.0, 1.0], [0.0, 0.0, 0.0], [0.0, 0.0, 2.0]):
         with pytest.raises(mmusv.InputError, match=r"dirs\[1\] = .*must be a unit vector"):
             env.sky_radiance(np.array([[0.0, 0.0, 1.0], bad], np.float32))
+
+
+def test_abandon_after_close_returns_where_the_file_is(tmp_path: Path) -> None:
+    """``abandon()`` once closed is a no-op that names the file that exists: the final name after ``finish()`` (it
+    named the ``.partial``, gone by then), the ``.partial`` after an abandon or an exception in ``with``."""
+    done = Recording(tmp_path / "done.mcap")
+    _write(done, 2)
+    done.finish()
+    assert done.abandon() == tmp_path / "done.mcap" and done.abandon().is_file()
+    with Recording(tmp_path / "clean.mcap") as clean:
+        _write(clean, 1)
+    assert clean.abandon() == tmp_path / "clean.mcap" and clean.abandon().is_file()
+    left = Recording(tmp_path / "left.mcap")
+    _write(left, 1)
+    first = left.abandon()
+    assert first == tmp_path / "left.mcap.partial" and first.is_file() and left.abandon() == first
+    with pytest.raises(RuntimeError), Recording(tmp_path / "failed.mcap") as failed:
+        _write(failed, 1)
+        raise RuntimeError("stop")
+    assert failed.abandon() == tmp_path / "failed.mcap.partial" and failed.abandon().is_file()

@@ -834,7 +834,8 @@ class Recorder:
         """Completes the file and renames it to ``path``; returns ``{"path", "messages", "channels", "bytes"}``."""
 
     def abandon(self) -> str:
-        """Completes the file but keeps the ``.partial`` name; returns that path (no-op once closed)."""
+        """Completes the file but keeps the ``.partial`` name; returns that path (once closed, a no-op returning where
+        the file is: its final name after ``finish()``)."""
 
     def __enter__(self) -> Recorder: ...
     def __exit__(self, exc_type: object = None, exc_value: object = None, traceback: object = None) -> bool:

@@ -18,6 +18,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
 
@@ -129,6 +130,8 @@ fn same_len(n: usize, what: &str, lens: &[(&str, usize)]) -> PyResult<()> {
 pub struct Recorder {
     inner: Mutex<Option<CoreRecorder>>,
     path: PathBuf,
+    /// Whether `finish()` (or a clean `with` exit) closed it: the file then has its final name.
+    finished: AtomicBool,
 }
 
 impl Recorder {
@@ -161,6 +164,7 @@ impl Recorder {
         let rec =
             self.take(py)?.ok_or_else(|| crate::errors::to_py(self.closed_error("finish() was already called")))?;
         let s = detached(py, || rec.finish())?;
+        self.finished.store(true, Ordering::Relaxed);
         let d = PyDict::new(py);
         d.set_item("path", s.path.display().to_string())?;
         d.set_item("messages", s.messages)?;
@@ -177,7 +181,7 @@ impl Recorder {
     #[pyo3(signature = (path, *, overwrite = false))]
     fn new(py: Python<'_>, path: PathBuf, overwrite: bool) -> PyResult<Self> {
         let rec = detached(py, || CoreRecorder::create(&path, overwrite))?;
-        Ok(Self { inner: Mutex::new(Some(rec)), path })
+        Ok(Self { inner: Mutex::new(Some(rec)), path, finished: AtomicBool::new(false) })
     }
 
     /// The final file name.
@@ -524,10 +528,14 @@ impl Recorder {
         self.finish_dict(py)
     }
 
-    /// Completes the file but keeps the `.partial` name; returns that path. A no-op once closed.
+    /// Completes the file but keeps the `.partial` name; returns that path. A no-op once closed, returning where
+    /// the file is: the final name after `finish()` (it returned the `.partial` name, a file no longer there).
     fn abandon(&self, py: Python<'_>) -> PyResult<String> {
         if let Some(rec) = self.take(py)? {
             return Ok(detached(py, || rec.abandon())?.display().to_string());
+        }
+        if self.finished.load(Ordering::Relaxed) {
+            return Ok(self.path.display().to_string());
         }
         Ok(self.partial_path())
     }
@@ -550,7 +558,10 @@ impl Recorder {
         let Some(rec) = self.take(py)? else { return Ok(false) };
         match exc_type {
             Some(_) => detached(py, || rec.abandon().map(|_| ()))?,
-            None => detached(py, || rec.finish().map(|_| ()))?,
+            None => {
+                detached(py, || rec.finish().map(|_| ()))?;
+                self.finished.store(true, Ordering::Relaxed);
+            }
         }
         Ok(false)
     }

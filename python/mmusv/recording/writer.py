@@ -382,7 +382,8 @@ class Recording:
         return self._rec.finish()
 
     def abandon(self) -> Path:
-        """Completes the file but keeps the ``.partial`` name; returns that path."""
+        """Completes the file but keeps the ``.partial`` name; returns that path. Once closed, a no-op that returns
+        where the file is (its final name after :meth:`finish`)."""
         return Path(self._rec.abandon())
 
     def __enter__(self) -> Recording:
