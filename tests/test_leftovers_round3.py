@@ -139,7 +139,7 @@ def test_an_interrupted_agreement_study_leaves_no_empty_output_folder(
     earlier = tmp_path / "results"
     (earlier / "sub").mkdir(parents=True)
     (earlier / "sub" / "agreement_summary.csv").write_text("map\n", encoding="utf-8")
-    assert main(["study", "agreement", "--frames", "1", "-o", str(earlier / "sub")]) == 130
+    assert main(["study", "agreement", "--frames", "1", "-o", str(earlier / "sub"), "--overwrite"]) == 130
     assert (earlier / "sub" / "agreement_summary.csv").read_text(encoding="utf-8") == "map\n"
 
 

@@ -132,6 +132,9 @@ def parser() -> argparse.ArgumentParser:
     sub.add_parser("version", help="print the version")
     p_assets = sub.add_parser("assets", help="list the vessel library")
     p_assets.add_argument("--render", metavar="DIR", help="also write a close-up PNG per asset and contact_sheet.png")
+    p_assets.add_argument(
+        "--overwrite", action="store_true", help="with --render: replace files of those names already in DIR"
+    )
     sub.add_parser("scenarios", help="list the bundled scenarios (mmusv run NAME runs one from any directory)")
     study = sub.add_parser("study", help="reproduce the paper's experiments")
     studies = study.add_subparsers(dest="study", required=True)
@@ -147,6 +150,7 @@ def parser() -> argparse.ArgumentParser:
         "wave_study_physical.csv and wave_study_vessels.csv with --motion physical",
     )
     waves.add_argument("--frames", type=int, default=None, help="override the scenario's frame count")
+    waves.add_argument("--overwrite", action="store_true", help="replace the files of its names already in -o")
     waves.add_argument(
         "--motion",
         choices=("paper", "physical"),
@@ -166,6 +170,7 @@ def parser() -> argparse.ArgumentParser:
         "-o", "--output", default="out/agreement_study", help="output folder (default out/agreement_study)"
     )
     agree.add_argument("--frames", type=int, default=None, help="frames per scenario (default: all)")
+    agree.add_argument("--overwrite", action="store_true", help="replace the files of its names already in -o")
     from mmusv.studies.detection.cli import add_parsers as add_detection_parsers
 
     add_detection_parsers(studies)

@@ -8,13 +8,20 @@ from __future__ import annotations
 import contextlib
 import os
 import sys
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 from mmusv import arguments
-from mmusv.errors import ConfigError
+from mmusv.errors import ConfigError, IoError
 
-__all__ = ["check_output_folder", "made_output_folder", "output_arg", "path_arg", "ready_output_folder"]
+__all__ = [
+    "check_output_folder",
+    "made_output_folder",
+    "output_arg",
+    "path_arg",
+    "ready_output_folder",
+    "refuse_replacing",
+]
 
 
 def path_arg(value: str, *, flag: str, empty: str = "give a path") -> str:
@@ -79,13 +86,37 @@ def check_output_folder(value: str, *, flag: str = "-o/--output") -> Path:
 def ready_output_folder(output: str, *, flag: str = "-o/--output") -> None:
     """Creates a command's output folder before its work, so that a folder that cannot be written is named (as
     ``flag``) at once, not after the computing."""
-    from mmusv.errors import IoError
-
     check_output_folder(output, flag=flag)  # a file there (or above) is named as such, not as "File exists"
     try:
         Path(output).mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise IoError(f"{flag} {output}: cannot create the folder: {exc.strerror or exc}") from None
+
+
+def refuse_replacing(
+    folder: str | os.PathLike[str],
+    names: Iterable[str],
+    *,
+    overwrite: bool,
+    flag: str = "-o/--output",
+    how: str = "pass --overwrite",
+) -> None:
+    """Raises :class:`~mmusv.errors.IoError` unless ``overwrite`` when a file (or anything else) of one of
+    ``names`` (paths relative to ``folder``) is already there, before any work: a command that writes files of
+    fixed names into an existing folder (``mmusv assets --render``, ``mmusv study ... -o``) replaced a user's
+    files of those names without a word. The message names the folder by ``flag``, the files and ``how`` to
+    replace them (``pass --overwrite``; ``overwrite=True`` for a Python caller)."""
+    if overwrite:
+        return
+    base = Path(folder)
+    taken = [n for n in names if os.path.lexists(base / n)]
+    if not taken:
+        return
+    shown = ", ".join(taken[:4]) + (f" and {len(taken) - 4} more" if len(taken) > 4 else "")
+    raise IoError(
+        f"{flag} {os.fspath(folder)}: {shown} {'is' if len(taken) == 1 else 'are'} already there (from an earlier "
+        f"run, or files of yours); {how} to replace {'it' if len(taken) == 1 else 'them'}, or give another folder"
+    )
 
 
 @contextlib.contextmanager

@@ -100,7 +100,7 @@ def test_an_interrupted_report_leaves_no_half_of_it(
         raise KeyboardInterrupt
 
     monkeypatch.setattr(report, "_plot_detection", interrupted)  # Ctrl-C while the plot is drawn
-    assert _study(["study", "detection", str(pair)], out) == 130
+    assert _study(["study", "detection", str(pair), "--overwrite"], out) == 130
     assert "interrupted" in capsys.readouterr().err
     # the earlier report whole, not a new table beside the old plot
     assert {name: (out / name).read_bytes() for name in REPORT} == before

@@ -97,3 +97,56 @@ def test_waves_names_the_scenario_flag(tmp_path: Path, capsys: pytest.CaptureFix
     err = capsys.readouterr().err
     assert rc == 2 and "--scenario: " in err and "is a directory" in err, err
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize(
+    ("command", "names"),
+    [
+        (["waves", "--frames", "2"], ["wave_study.png"]),
+        (["waves", "--frames", "2", "--motion", "physical"], ["wave_study_physical.csv", "wave_study_vessels.csv"]),
+        (["agreement", str(ROOT / "scenarios/open_sea_convoy.yaml"), "--frames", "1"], ["agreement_summary.csv"]),
+        (["detection", "no_such_recordings"], ["detection_note.txt"]),
+        (["robustness", "no_such_recordings"], ["robustness_table.csv", "robustness_ap.png"]),
+    ],
+    ids=["waves", "waves-physical", "agreement", "detection", "robustness"],
+)
+def test_a_study_keeps_files_of_its_names_already_in_the_folder(
+    command: list[str], names: list[str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``mmusv study ... -o DIR`` replaced a user's files of the names it writes (``wave_study.png``,
+    ``agreement_summary.csv``, ...) without a word, after the whole study: now refused before any work, naming
+    the folder, the files and ``--overwrite``; the files and the rest of the folder are left as they were."""
+    out = tmp_path / "mine"
+    out.mkdir()
+    for n in [*names, "notes.txt"]:
+        (out / n).write_text(f"my {n}")
+    assert main(["study", *command, "-o", str(out)]) == 2
+    captured = capsys.readouterr()
+    shown = ", ".join(names)
+    said = "is" if len(names) == 1 else "are"
+    assert captured.err.strip() == (
+        f"mmusv: error: -o/--output {out}: {shown} {said} already there (from an earlier run, or files of yours); "
+        f"pass --overwrite to replace {'it' if len(names) == 1 else 'them'}, or give another folder"
+    )
+    assert captured.out == ""  # refused before the study ran
+    assert sorted(p.name for p in out.iterdir()) == sorted([*names, "notes.txt"])
+    assert all((out / n).read_text() == f"my {n}" for n in [*names, "notes.txt"])
+
+
+def test_a_study_with_overwrite_replaces_its_files_and_nothing_else(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "waves"
+    out.mkdir()
+    (out / "wave_study.csv").write_text("mine")
+    (out / "notes.txt").write_text("mine")
+    assert main(["study", "waves", "--frames", "2", "-o", str(out), "--overwrite"]) == 0
+    assert (out / "wave_study.csv").read_text().startswith("wave,") and (out / "notes.txt").read_text() == "mine"
+    # with --overwrite the detection study goes on to its input (here missing), past its files
+    det = tmp_path / "det"
+    det.mkdir()
+    (det / "detection_table.csv").write_text("mine")
+    capsys.readouterr()
+    assert main(["study", "detection", str(tmp_path / "none"), "-o", str(det), "--overwrite"]) == 2
+    err = capsys.readouterr().err
+    assert "already there" not in err and "none" in err

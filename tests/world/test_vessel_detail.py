@@ -328,3 +328,49 @@ def test_contact_sheet_names_the_file_it_cannot_write(tmp_path: Path) -> None:
     with pytest.raises(IoError, match=r"cannot write .*/usv_wamv\.png: Is a directory \(.*\.usv_wamv\.png\.part\)$"):
         write_contact_sheet(tmp_path, names=["usv_wamv"], asset_size=(8, 6))
     assert not (tmp_path / "usv_wamv.png").exists() and not (tmp_path / "contact_sheet.png").exists()
+
+
+def test_contact_sheet_keeps_files_of_its_names_already_there(tmp_path: Path) -> None:
+    """A ``contact_sheet.png`` (or ``<asset>.png``) of the user's in the folder was replaced without a word: now
+    an IoError naming the folder and the files, before anything is written; ``overwrite=True`` replaces them."""
+    from mmusv.errors import ConfigError, IoError
+    from mmusv.world.contact_sheet import write_contact_sheet
+
+    mine = tmp_path / "contact_sheet.png"
+    mine.write_bytes(b"my own picture")
+    with pytest.raises(IoError) as err:
+        write_contact_sheet(tmp_path, names=["usv_wamv"], asset_size=(8, 6))
+    assert str(err.value) == (
+        f"out_dir {tmp_path}: contact_sheet.png is already there (from an earlier run, or files of yours); pass "
+        "overwrite=True to replace it, or give another folder"
+    )
+    assert mine.read_bytes() == b"my own picture" and sorted(p.name for p in tmp_path.iterdir()) == [mine.name]
+    path = write_contact_sheet(tmp_path, names=["usv_wamv"], asset_size=(8, 6), overwrite=True)
+    assert path == mine and mine.read_bytes().startswith(b"\x89PNG")
+    above = tmp_path / "a_file"
+    above.write_text("x")
+    with pytest.raises(ConfigError, match=r"out_dir = '.*a_file/sheet': '.*a_file' is a file, not a folder$"):
+        write_contact_sheet(above / "sheet", names=["usv_wamv"], asset_size=(8, 6))  # it was mkdir's bare OSError
+
+
+def test_cli_assets_render_keeps_files_of_its_names_already_there(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``mmusv assets --render DIR`` replaced a user's ``DIR/usv_wamv.png`` and ``contact_sheet.png`` without a
+    word; now refused before the table, naming --render, the files and --overwrite."""
+    from mmusv.cli import main
+
+    (tmp_path / "usv_wamv.png").write_bytes(b"mine")
+    (tmp_path / "contact_sheet.png").write_bytes(b"also mine")
+    assert main(["assets", "--render", str(tmp_path)]) == 2
+    out, err = capsys.readouterr()
+    assert err.strip() == (
+        f"mmusv: error: --render {tmp_path}: usv_wamv.png, contact_sheet.png are already there (from an earlier "
+        "run, or files of yours); pass --overwrite to replace them, or give another folder"
+    )
+    assert "parts" not in out
+    assert (tmp_path / "usv_wamv.png").read_bytes() == b"mine"
+    assert (tmp_path / "contact_sheet.png").read_bytes() == b"also mine"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["contact_sheet.png", "usv_wamv.png"]
+    assert main(["assets", "--overwrite"]) == 2  # nothing to overwrite without --render: said, not ignored
+    assert "--overwrite: only with --render DIR" in capsys.readouterr().err

@@ -52,6 +52,7 @@ from mmusv.simulation import Simulation
 
 __all__ = [
     "BUNDLED_SCENARIOS",
+    "FILES",
     "AgreementStudy",
     "check_counts",
     "load_scenarios",
@@ -60,6 +61,8 @@ __all__ = [
 ]
 
 BUNDLED_SCENARIOS = ("scenarios/island_occlusion.yaml", "scenarios/open_sea_convoy.yaml", "scenarios/port_entry.yaml")
+FILES = ("agreement_samples.parquet", "agreement_summary.csv")
+"""The files :meth:`AgreementStudy.write` writes (the samples, the summary)."""
 _VESSEL_CLASSES = (10, 11)
 
 
@@ -143,7 +146,7 @@ class AgreementStudy:
     def write(self, out_dir: Path) -> dict[str, Path]:
         """Writes ``agreement_samples.parquet`` and ``agreement_summary.csv`` under ``out_dir`` (created) with
         :func:`mmusv.jsonio.write_files_atomic`; returns their paths."""
-        paths = {"samples": out_dir / "agreement_samples.parquet", "summary": out_dir / "agreement_summary.csv"}
+        paths = {key: out_dir / name for key, name in zip(("samples", "summary"), FILES, strict=True)}
         samples = io.BytesIO()
         self.samples.write_parquet(samples)
         write_files_atomic(

@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from mmusv.cli_console import rich_console
-from mmusv.cli_paths import check_output_folder, made_output_folder, path_arg
+from mmusv.cli_paths import check_output_folder, made_output_folder, path_arg, refuse_replacing
 from mmusv.config import MAX_FRAMES  # also the bound of `study waves --frames`
 from mmusv.text import counted
 
@@ -29,7 +29,14 @@ def study_waves(args: argparse.Namespace) -> int:
     from mmusv.bundled import resolve_scenario
     from mmusv.config import load_scenario
     from mmusv.errors import ConfigError, MmusvError, located
-    from mmusv.studies.waves import PAPER_TABLE_I, PHYSICAL_RECORD_S, check_scenario, run_wave_study
+    from mmusv.studies.waves import (
+        PAPER_FILES,
+        PAPER_TABLE_I,
+        PHYSICAL_FILES,
+        PHYSICAL_RECORD_S,
+        check_scenario,
+        run_wave_study,
+    )
 
     # --frames first, within a scenario's own bound: a bad count made the output folder before it was refused,
     # and 10**30 was a numpy traceback (the copy of the scenario below is not validated).
@@ -57,6 +64,11 @@ def study_waves(args: argparse.Namespace) -> int:
         )
     except MmusvError as exc:
         raise located(exc, str(source)) from None
+    check_output_folder(args.output)
+    # files of its names already there (a user's wave_study.csv) were replaced without a word, after the study
+    refuse_replacing(
+        args.output, PHYSICAL_FILES if args.motion == "physical" else PAPER_FILES, overwrite=args.overwrite
+    )
     with made_output_folder(args.output):  # removed again if still empty when the study fails or is interrupted
         if args.motion == "physical":
             return _physical_wave_study(scenario, args)
@@ -147,12 +159,13 @@ def study_agreement(args: argparse.Namespace) -> int:
     writes its files into ``-o``; exit status 0."""
     from rich.table import Table
 
-    from mmusv.studies.agreement import BUNDLED_SCENARIOS, check_counts, load_scenarios, run_agreement_study
+    from mmusv.studies.agreement import BUNDLED_SCENARIOS, FILES, check_counts, load_scenarios, run_agreement_study
 
     check_counts(args.frames)  # before the output folder is made
     for scenario in args.scenarios:
         path_arg(scenario, flag="scenario")
     check_output_folder(args.output)
+    refuse_replacing(args.output, FILES, overwrite=args.overwrite)  # a user's files of its names were replaced
     # Every scenario loaded and checked (a top-view camera) before the output folder and the first run: a missing
     # or broken one left an empty folder behind, after the scenarios before it had run.
     scenarios = load_scenarios(args.scenarios or BUNDLED_SCENARIOS)

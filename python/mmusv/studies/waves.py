@@ -35,7 +35,9 @@ from mmusv.motion import scenario_poses
 from mmusv.world.environment import WAVE_PRESETS, wave_height_m
 
 __all__ = [
+    "PAPER_FILES",
     "PAPER_TABLE_I",
+    "PHYSICAL_FILES",
     "USV_SIZES",
     "PhysicalWaveStudy",
     "WaveStudy",
@@ -51,6 +53,11 @@ PAPER_TABLE_I: dict[str, tuple[float, float, float]] = {
     "W3": (0.1923, 1.4421, 0.4774),
 }
 """The paper's Table I: (heave RMS m, roll RMS °, pitch RMS °) of its USVs under W0..W3."""
+
+PAPER_FILES = ("wave_study.csv", "wave_study.png")
+"""The files :meth:`WaveStudy.write` writes (the table, the plot)."""
+PHYSICAL_FILES = ("wave_study_physical.csv", "wave_study_vessels.csv")
+"""The files :meth:`PhysicalWaveStudy.write` writes (the summary, per vessel)."""
 
 USV_SIZES = ("scenario", "reference")
 """:func:`run_wave_study`'s ``usvs``: the scenario's USVs at their assets' sizes, or at the paper's reference size."""
@@ -68,7 +75,7 @@ class WaveStudy:
     def write(self, out_dir: Path) -> dict[str, Path]:
         """Writes ``wave_study.csv`` and ``wave_study.png`` into ``out_dir`` (created) with
         :func:`~mmusv.jsonio.write_files_atomic`; returns their paths."""
-        paths = {"csv": out_dir / "wave_study.csv", "png": out_dir / "wave_study.png"}
+        paths = {key: out_dir / name for key, name in zip(("csv", "png"), PAPER_FILES, strict=True)}
         png = io.BytesIO()
         _plot(self, png)
         write_files_atomic({paths["csv"]: self.table.write_csv().encode("utf-8"), paths["png"]: png.getvalue()})
@@ -193,7 +200,7 @@ class PhysicalWaveStudy:
     def write(self, out_dir: Path) -> dict[str, Path]:
         """Writes ``wave_study_physical.csv`` (summary) and ``wave_study_vessels.csv`` into ``out_dir`` (created)
         with :func:`~mmusv.jsonio.write_files_atomic`; returns their paths."""
-        paths = {"summary": out_dir / "wave_study_physical.csv", "vessels": out_dir / "wave_study_vessels.csv"}
+        paths = {key: out_dir / name for key, name in zip(("summary", "vessels"), PHYSICAL_FILES, strict=True)}
         write_files_atomic(
             {
                 paths["summary"]: self.summary.write_csv().encode("utf-8"),

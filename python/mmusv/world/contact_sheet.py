@@ -35,6 +35,7 @@ __all__ = [
     "SheetLayout",
     "camera_pose",
     "render_asset",
+    "sheet_files",
     "sheet_layout",
     "write_contact_sheet",
 ]
@@ -133,6 +134,7 @@ def write_contact_sheet(
     names: list[str] | None = None,
     tile: tuple[int, int] = (320, 240),
     asset_size: tuple[int, int] = (640, 480),
+    overwrite: bool = False,
 ) -> Path:
     """Renders every asset of ``names`` (default: the whole library) to ``<out_dir>/<name>.png`` at
     ``asset_size`` and writes the grid of them, ``tile`` pixels each, to ``<out_dir>/contact_sheet.png``
@@ -140,10 +142,15 @@ def write_contact_sheet(
     or a size is not ``(width, height)`` in whole pixels (1..:data:`MAX_SIDE_PX` each; a close-up at most a
     camera's ``MAX_IMAGE_PIXELS``, the sheet at most :data:`MAX_SIDE_PX` a side), and
     :class:`mmusv.NotFoundError` for a name the library does not hold, all before anything is written;
-    :class:`mmusv.IoError` naming the file that cannot be written."""
+    :class:`mmusv.IoError` naming the file that cannot be written, and, unless ``overwrite``, naming the files of
+    those names already in ``out_dir`` (an earlier sheet's, or a user's own ``contact_sheet.png``), before anything
+    is written."""
+    from mmusv.cli_paths import refuse_replacing
+    from mmusv.recording.guard import file_in_the_way
     from mmusv.world.vessels import asset_names
 
     out = arguments.path(out_dir, name="out_dir")
+    overwrite = arguments.flag(overwrite, name="overwrite")
     if isinstance(names, Iterator):  # a generator of names, read once (an ordered iterable, as before)
         names = list(names)
     if names is not None:  # a bare string was read as its letters ('u' is not an asset)
@@ -163,8 +170,11 @@ def write_contact_sheet(
             f"tile = {tile}: the sheet of {len(chosen)} assets would be {layout.size[0]} x {layout.size[1]} pixels, "
             f"more than {MAX_SIDE_PX} a side: give smaller tiles"
         )
-    if out.exists() and not out.is_dir():
-        raise ConfigError(f"--render: {str(out)!r} is a file, not a folder")
+    blocking = file_in_the_way(out)  # out, or a folder above it, is a file (mkdir's bare OSError)
+    if blocking is not None:
+        where = "a file" if blocking == out else f"{str(blocking)!r} is a file"
+        raise ConfigError(f"out_dir = {str(out)!r}: {where}, not a folder")
+    refuse_replacing(out, sheet_files(chosen), overwrite=overwrite, flag="out_dir", how="pass overwrite=True")
     out.mkdir(parents=True, exist_ok=True)
     sheet = Image.new("RGB", layout.size, _BG)
     draw = ImageDraw.Draw(sheet)
@@ -179,6 +189,12 @@ def write_contact_sheet(
     path = out / "contact_sheet.png"
     _save(sheet, path)
     return path
+
+
+def sheet_files(names: Sequence[str]) -> list[str]:
+    """The names of the files :func:`write_contact_sheet` writes for the assets ``names``: one PNG each and
+    ``contact_sheet.png``."""
+    return [*(f"{n}.png" for n in names), "contact_sheet.png"]
 
 
 def _size(value: Any, name: str) -> tuple[int, int]:

@@ -124,6 +124,9 @@ def _common(p: argparse.ArgumentParser, default_out: str) -> None:
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("-o", "--output", default=default_out, help=f"output folder (default {default_out})")
+    p.add_argument(
+        "--overwrite", action="store_true", help="replace the files of its names already in -o (and -o/baseline)"
+    )
 
 
 def add_parsers(studies: Any) -> None:
@@ -223,6 +226,20 @@ def run(args: argparse.Namespace) -> int:
         learned if learned is not None else None if args.predictions is not None else load_detector(args.detector)
     )
     detector_name = f"learned model {args.model}" if learned is not None else args.detector
+    runs: list[tuple[Any, str, tuple[str, ...], Path]] = [(detector, detector_name, modes, out)]
+    if learned is not None:  # the learned model beside the baseline, on the same frames
+        base_modes = tuple(m for m in modes if m != "intermediate")
+        if base_modes and (not robust or any(m != "none" for m in base_modes)):
+            runs.append((load_detector("baseline"), "baseline", base_modes, out / "baseline"))
+    # the files of its names already there (a user's detection_table.csv) were replaced without a word, after the
+    # whole study (and --generate's recording)
+    from mmusv.cli_paths import refuse_replacing
+    from mmusv.studies.detection.report import DETECTION_FILES, ROBUSTNESS_FILES
+
+    names = ROBUSTNESS_FILES if robust else DETECTION_FILES
+    refuse_replacing(
+        out, [str(run_out.relative_to(out) / n) for *_, run_out in runs for n in names], overwrite=args.overwrite
+    )
     predictions = load_predictions(args.predictions) if args.predictions is not None else None
     if predictions is not None:
         check_prediction_coverage(args.predictions, predictions, modes=modes, settings=settings)
@@ -264,11 +281,6 @@ def run(args: argparse.Namespace) -> int:
         if leak:
             console.print(f"[yellow]{escape(leak)}[/]", highlight=False)
             learned_notes.append(leak)
-    runs: list[tuple[Any, str, tuple[str, ...], Path]] = [(detector, detector_name, modes, out)]
-    if learned is not None:  # the learned model beside the baseline, on the same frames
-        base_modes = tuple(m for m in modes if m != "intermediate")
-        if base_modes and (not robust or any(m != "none" for m in base_modes)):
-            runs.append((load_detector("baseline"), "baseline", base_modes, out / "baseline"))
     from mmusv.studies.detection import report
 
     files: report.Files = {}  # every run's report, written once all are computed (module docstring of report)

@@ -23,7 +23,9 @@ from mmusv.studies.detection.study import StudyResult
 from mmusv.studies.plotting import default_style
 
 __all__ = [
+    "DETECTION_FILES",
     "DETECTION_METRICS",
+    "ROBUSTNESS_FILES",
     "detection_files",
     "detection_table",
     "fmt",
@@ -36,6 +38,17 @@ __all__ = [
 ]
 
 BINS = [bin_label(k) for k in range(len(RANGE_BINS))]
+
+DETECTION_FILES = ("detection_table.csv", "detection_boxes.parquet", "detection_ap.png", "detection_note.txt")
+"""The files of :func:`detection_files`, in its order."""
+ROBUSTNESS_FILES = (
+    "robustness_table.csv",
+    "robustness_metrics.csv",
+    "robustness_boxes.parquet",
+    "robustness_ap.png",
+    "robustness_note.txt",
+)
+"""The files of :func:`robustness_files`, in its order."""
 
 DETECTION_METRICS: tuple[tuple[str, str | None], ...] = (
     ("ap30", "AP@0.3"),
@@ -92,11 +105,12 @@ def detection_files(res: StudyResult, out: Path, *, detector: str, notes: Sequen
     table = detection_table(res)
     png = io.BytesIO()
     _plot_detection(table, png)
+    csv, parquet, plot, note = (out / name for name in DETECTION_FILES)
     return {
-        "csv": (out / "detection_table.csv", table.write_csv().encode("utf-8")),
-        "parquet": (out / "detection_boxes.parquet", _parquet(res.boxes_frame(with_setting=False))),
-        "png": (out / "detection_ap.png", png.getvalue()),
-        "note": (out / "detection_note.txt", _note(res, detector, notes).encode("utf-8")),
+        "csv": (csv, table.write_csv().encode("utf-8")),
+        "parquet": (parquet, _parquet(res.boxes_frame(with_setting=False))),
+        "png": (plot, png.getvalue()),
+        "note": (note, _note(res, detector, notes).encode("utf-8")),
     }
 
 
@@ -106,12 +120,13 @@ def robustness_files(res: StudyResult, out: Path, *, detector: str, notes: Seque
     ``out``, made in memory, the note last."""
     png = io.BytesIO()
     _plot_robustness(res, png)
+    csv, metrics, parquet, plot, note = (out / name for name in ROBUSTNESS_FILES)
     return {
-        "csv": (out / "robustness_table.csv", robustness_table(res).write_csv().encode("utf-8")),
-        "metrics": (out / "robustness_metrics.csv", res.table().write_csv().encode("utf-8")),
-        "parquet": (out / "robustness_boxes.parquet", _parquet(res.boxes_frame(with_setting=True))),
-        "png": (out / "robustness_ap.png", png.getvalue()),
-        "note": (out / "robustness_note.txt", _note(res, detector, notes).encode("utf-8")),
+        "csv": (csv, robustness_table(res).write_csv().encode("utf-8")),
+        "metrics": (metrics, res.table().write_csv().encode("utf-8")),
+        "parquet": (parquet, _parquet(res.boxes_frame(with_setting=True))),
+        "png": (plot, png.getvalue()),
+        "note": (note, _note(res, detector, notes).encode("utf-8")),
     }
 
 
