@@ -45,6 +45,35 @@ def test_assign_splits_deterministic_and_order_independent() -> None:
         assign_splits(keys, ratios=parse_ratios((0.7, 0.15, 0.15)), seed=-1)
 
 
+@pytest.mark.parametrize(
+    ("ratios", "said"),
+    [
+        ((0.5, 0.5), "expected three fractions"),  # zip()'s ValueError
+        ((0.7, 0.7, 0.7), "add up to"),  # 7 train, 3 validate, 0 test of 10, without a word
+        ((-1.0, 1.0, 1.0), "non-negative"),  # a negative count of recordings for train, without a word
+        ((0.5, float("nan"), 0.5), r"split\[1\] = nan: must be a number"),
+    ],
+)
+def test_assign_splits_checks_its_ratios(ratios: tuple[float, ...], said: str) -> None:
+    """assign_splits (and the detection study's split_sequences and resolve_dataset, which call it from Python)
+    took the ratios unchecked, where the command line parsed them first."""
+    from mmusv.studies.detection.data import split_sequences
+
+    keys = [f"s{i}" for i in range(10)]
+    with pytest.raises(ConfigError, match=said):
+        assign_splits(keys, ratios=ratios, seed=0)
+    with pytest.raises(ConfigError, match=said):
+        split_sequences(keys, split="train", ratios=ratios, seed=0)
+
+
+def test_assign_splits_takes_weights_and_a_text_as_parse_ratios_does() -> None:
+    keys = [f"s{i}" for i in range(10)]
+    want = assign_splits(keys, ratios=parse_ratios((0.7, 0.2, 0.1)), seed=3)
+    assert assign_splits(keys, ratios=(7, 2, 1), seed=3) == want  # 70, 20 and 10 recordings asked of 10: 7, 3, 0
+    assert assign_splits(keys, ratios="0.7,0.2,0.1", seed=3) == want  # a TypeError of math.floor
+    assert assign_splits(keys, ratios=(0.7, 0.2, 0.1), seed=3) == want
+
+
 @pytest.mark.parametrize("bad", ["0.7,0.3", "a,b,c", "-1,1,1", "0,0,0", (0.5, float("nan"), 0.5)])
 def test_parse_ratios_rejects(bad: object) -> None:
     with pytest.raises(ConfigError):

@@ -84,16 +84,23 @@ def split_counts(n: int, ratios: Sequence[float]) -> list[int]:
 
 def assign_splits(keys: Sequence[str], *, ratios: Sequence[float], seed: int) -> dict[str, str]:
     """Split name of every key (unique strings, e.g. recording paths): deterministic in (set of keys, ratios,
-    seed), independent of the order of ``keys``."""
+    seed), independent of the order of ``keys``. ``ratios`` as :func:`parse_ratios` takes them (three fractions
+    adding up to 1, or three whole-number weights); :class:`~mmusv.errors.ConfigError` for others."""
     if len(set(keys)) != len(keys):
         twice = next(k for i, k in enumerate(keys) if k in keys[:i])
         raise ConfigError(f"the same recording is given twice: {twice}")
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         # random.Random takes |seed|: -1 would split as 1 does
         raise ConfigError(f"seed = {seed!r}: the split's seed must be a whole number >= 0")
+    # checked as parse_ratios checks them (a caller in Python gave them unchecked: two fractions were zip()'s
+    # ValueError, a string a TypeError, (0.7, 0.7, 0.7) or a negative one a split of other proportions, silently);
+    # fractions that add up to 1 are used as given, so that the splits they made stay the same
+    checked = parse_ratios(ratios)
+    given = [float(r) for r in ratios] if not isinstance(ratios, str) else list(checked)
+    fractions = given if abs(sum(given) - 1.0) <= 1e-6 else list(checked)
     ordered = sorted(keys)
     random.Random(seed).shuffle(ordered)
-    counts = split_counts(len(ordered), ratios)
+    counts = split_counts(len(ordered), fractions)
     out: dict[str, str] = {}
     start = 0
     for name, c in zip(SPLIT_NAMES, counts, strict=True):
