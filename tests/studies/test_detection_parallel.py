@@ -3,6 +3,7 @@ as one process; a worker's bad input is the same one-line error."""
 
 from __future__ import annotations
 
+import re
 import shutil
 from pathlib import Path
 
@@ -77,3 +78,20 @@ def test_a_workers_bad_input_is_one_line(
     assert "sequence tiny_blind: no LiDAR" in err and "Traceback" not in err
     assert main(["study", "detection", str(two_sequences), "--jobs", "0", "-o", str(tmp_path / "o")]) == 2
     assert "--jobs 0: must be >= 1" in capsys.readouterr().err
+
+
+def test_the_python_api_names_its_own_arguments() -> None:
+    """split_sequences(split=..., seed=...) and run_study_jobs(jobs=...) called from Python were refused as
+    "--split 'x'", "--seed -1", "--jobs 0", naming flags the caller never gave (and jobs="2" was a TypeError)."""
+    from mmusv.errors import InputError
+    from mmusv.studies.detection.data import split_sequences
+    from mmusv.studies.detection.parallel import run_study_jobs
+
+    ratios = (0.7, 0.15, 0.15)
+    with pytest.raises(InputError, match=r"^split = 'x' \(--split\): expected one of train, validate, test, all$"):
+        split_sequences(["a", "b"], split="x", ratios=ratios, seed=0)
+    with pytest.raises(InputError, match=r"^seed = -1 \(--seed\): the split's seed must be a whole number >= 0$"):
+        split_sequences(["a", "b"], split="train", ratios=ratios, seed=-1)
+    for bad, said in ((0, "jobs (--jobs) = 0: must be a whole number"), ("2", "not str")):
+        with pytest.raises(InputError, match=re.escape(said)):
+            run_study_jobs(None, options=None, spec=None, jobs=bad)  # type: ignore[arg-type]

@@ -343,15 +343,16 @@ def _opv2v_vehicles(doc: Any) -> dict[str, tuple[np.ndarray, np.ndarray]]:
 
 
 def check_split(split: str, seed: int) -> None:
-    """Refuses a ``--split`` other than ``train``, ``validate``, ``test`` or ``all``, and a negative ``--seed`` where
-    it seeds a split. The CLIs ask before ``--generate``: both were refused only after the whole dataset had been
-    generated and recorded."""
+    """Refuses a ``split`` (``--split``) other than ``train``, ``validate``, ``test`` or ``all``, and a negative
+    ``seed`` (``--seed``) where it seeds a split; the message names both the argument and the flag (a Python caller
+    of :func:`split_sequences` was told of ``--split``, which it never gave). The CLIs ask before ``--generate``:
+    both were refused only after the whole dataset had been generated and recorded."""
     from mmusv.export.splits import SPLIT_NAMES
 
     if split not in (*SPLIT_NAMES, "all"):
-        raise InputError(f"--split {split!r}: expected one of {', '.join((*SPLIT_NAMES, 'all'))}")
+        raise InputError(f"split = {split!r} (--split): expected one of {', '.join((*SPLIT_NAMES, 'all'))}")
     if split != "all" and (isinstance(seed, bool) or not isinstance(seed, int) or seed < 0):
-        raise InputError(f"--seed {seed!r}: the split's seed must be a whole number >= 0")
+        raise InputError(f"seed = {seed!r} (--seed): the split's seed must be a whole number >= 0")
 
 
 def split_sequences(names: Sequence[str], *, split: str, ratios: Sequence[float], seed: int) -> list[str]:

@@ -21,6 +21,7 @@ from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wai
 from dataclasses import dataclass, replace
 from typing import Any
 
+from mmusv import arguments
 from mmusv.batch.executors import refuse_in_daemon, workers_skip_unimportable_main
 from mmusv.errors import InputError, MmusvError
 from mmusv.studies.detection.sources import Dataset
@@ -95,8 +96,7 @@ def run_study_jobs(
     :class:`~mmusv.studies.detection.study.StudyResult` and, for a learned model, the bytes its intermediate
     fusion shared per call (in sequence order). ``options``' detector and predictions are ignored: each task
     builds them from ``spec``. ``progress(done, total)`` counts frames, a sequence at a time."""
-    if jobs < 1:
-        raise InputError(f"--jobs {jobs}: must be >= 1")
+    jobs = arguments.whole(jobs, name="jobs (--jobs)", lo=1, error=InputError)  # "2" was a TypeError of <
     refuse_in_daemon(f"the detection study with --jobs {jobs}")  # the batch's rules for a pool of spawned workers
     names = sorted(dataset.sources)
     frames = dataset.frames_by_sequence()
