@@ -286,6 +286,18 @@ def _tables_of(recording: Path, span: range | None, missing: set[int]) -> tuple[
     except MmusvError as exc:  # a tables folder that holds no tables (read_table says what it holds)
         return [str(exc)], []
     partial = recording.name.endswith(".partial")
+    killed = recording.with_name(recording.name + ".partial")
+    if not partial and killed.exists():
+        # a later run of it (mmusv run --overwrite) killed: the earlier recording stays until the new one finishes,
+        # but its manifest, tables and scenario.yaml were replaced when the new one opened; shown as complete and
+        # whole, the folder read as the earlier run's while its tables held the killed run's frames
+        problems.insert(
+            0,
+            f"{killed} lies beside it: a later run of it (mmusv run --overwrite) was killed, so the tables and "
+            f"scenario.yaml here are that run's, not {recording.name}'s; `mmusv recover {recording.parent} "
+            f"--overwrite` finishes it into {recording.name} with its tables",
+        )
+        return problems, []
     if problems and problems[0].startswith(f"{tables} does not exist"):
         why = (
             f"a run killed before its first table flush; `mmusv recover {recording.parent}` rebuilds it"

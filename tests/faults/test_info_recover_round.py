@@ -277,3 +277,37 @@ def test_ctrl_c_during_recover_leaves_the_folder_as_it_was(small: Path, tmp_path
     assert _files(folder) == before
     code, out, err = cli_main("recover", str(folder))
     assert code == 0 and "recovered 8 of 12 frames" in out, (out, err)
+
+
+# ------------------------------------------------------------ info: a killed --overwrite run beside a finished one
+
+
+def test_info_names_the_partial_of_a_killed_overwrite_run_beside_a_finished_recording(
+    small: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``mmusv run --overwrite`` killed (SIGKILL, a power cut) leaves the earlier finished ``tiny.mcap`` beside the
+    new run's ``.partial``, with the new run's tables and scenario.yaml and no manifest. ``mmusv info`` on the folder,
+    and on a folder of such folders, showed the earlier recording complete with no problem, as if the tables were
+    its own; now a warning names the ``.partial`` and the way out (``recover --overwrite``), which works."""
+    monkeypatch.setenv("COLUMNS", "400")  # one line a row and a warning
+    folder = tmp_path / "runs" / "run"
+    shutil.copytree(small, folder)
+    (folder / "manifest.json").unlink()  # removed when the killed run opened its recording
+    n = sum(1 for _ in _messages(small / "tiny.mcap")) * 8 // 12
+    killed_copy(small / "tiny.mcap", folder / "tiny.mcap.partial", messages=n)
+    said = (
+        f"{folder}/tiny.mcap.partial lies beside it: a later run of it (mmusv run --overwrite) was killed, so the "
+        f"tables and scenario.yaml here are that run's, not tiny.mcap's; `mmusv recover {folder} --overwrite` "
+        "finishes it into tiny.mcap with its tables"
+    )
+    code, out, err = cli_main("info", str(folder))
+    assert code == 0 and f"mmusv: warning: {said}" in " ".join(out.split()), (out, err)
+    assert "rebuilds the tables" not in out  # not from the earlier recording: they are the killed run's
+    code, out, err = cli_main("info", str(tmp_path / "runs"))
+    row = _rows(out)["run/tiny.mcap"]
+    assert row[-1].startswith("run/tiny.mcap.partial lies beside it: a later run of it"), row
+    assert "1 recording unfinished, damaged or unreadable" in out
+    code, out, err = cli_main("recover", str(folder), "--overwrite")
+    assert code == 0, (out, err)
+    code, out, err = cli_main("info", str(folder))
+    assert code == 0 and "warning" not in out and "status interrupted" in out, out
