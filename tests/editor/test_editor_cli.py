@@ -59,6 +59,16 @@ def test_bad_arguments_end_with_one_line(args: list[str], says: str, capsys: pyt
     assert says in err and err.count("\n") == 1 and err.startswith("mmusv: error:")
 
 
+def test_a_folder_given_as_the_scenario_is_named_as_such(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A folder for SCENARIO was read as a file: "DIR: Is a directory", naming neither the argument nor the way to
+    edit a folder's scenarios."""
+    assert main(["editor", str(tmp_path)]) == 2
+    assert capsys.readouterr().err == (
+        f"mmusv: error: scenario {str(tmp_path)!r} is a folder, not a scenario file: give a YAML file, or --dir "
+        f"{tmp_path} to edit the scenarios in that folder\n"
+    )
+
+
 def _opened(argv: list[str], monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> tuple[dict, str]:
     """``mmusv editor ARGV`` up to serving: the page's ``initial`` scenario (``/api/info``) and what was printed."""
     import warnings

@@ -97,6 +97,11 @@ def run(args: argparse.Namespace) -> int:
     folder = Path(path_arg(args.dir, flag="--dir")) if args.dir is not None else Path.cwd()
     if args.scenario is not None:
         path = resolve_scenario(path_arg(args.scenario, flag="scenario"))
+        if path.is_dir():  # it was read as a file: "DIR: Is a directory"
+            raise ConfigError(
+                f"scenario {args.scenario!r} is a folder, not a scenario file: give a YAML file, or --dir "
+                f"{args.scenario} to edit the scenarios in that folder"
+            )
         if args.dir is None and Path(args.scenario).is_file():
             folder = path.parent
         text = path.read_text(encoding="utf-8", errors="replace")
