@@ -153,7 +153,11 @@ def _folders(infos: list[RecordingInfo]) -> list[str]:
     dup = {k for k in keys if keys.count(k) > 1}
     if dup:
         a = [str(i.path) for i, k in zip(infos, keys, strict=True) if k in dup]
-        raise ConfigError(f"recordings {', '.join(a)} are runs of the same scenario configuration; give each only once")
+        raise ConfigError(
+            f"recordings {', '.join(a)} are runs of the same scenario configuration (the same scenario and seed give "
+            "the same data: converted together, every frame would be in the dataset twice, or in two of its splits); "
+            "give each only once: pass the recordings to convert instead of their folder, leaving one of these out"
+        )
     return [n if names.count(n) == 1 else k for n, k in zip(names, keys, strict=True)]
 
 
