@@ -4,7 +4,8 @@ Endpoints (JSON in and out unless said otherwise; errors are ``{"error": "..."}`
 
 ========================  =====================================================================================
 ``GET /``                 the page (``static/index.html``); ``/static/...`` its CSS and JavaScript modules
-``GET /api/info``         version, folder, the scenario given on the command line, choices from the schema
+``GET /api/info``         version, folder, the scenario given on the command line (its file as it is now, when it
+                          is the folder's), choices from the schema
 ``GET /api/assets``       the vessel library (name, category, class, sizes in metres, USV or not)
 ``GET /api/bundled``      the bundled scenarios; ``GET /api/bundled/{name}`` one of them as a document
 ``GET /api/files``        the scenario files in the folder; ``GET /api/files/{name}`` one as a document, with
@@ -171,7 +172,7 @@ def create_app(
         return {
             "version": __version__,
             "folder": str(store.root),
-            "initial": None if initial is None else initial.__dict__,
+            "initial": None if initial is None else _initial_now(initial).__dict__,
             "choices": {
                 "map_type": choices(MapConfig, "type"),
                 "weather": choices(EnvironmentConfig, "weather"),
@@ -185,6 +186,26 @@ def create_app(
             },
             "limits": {"bulk_frames": MAX_BULK_FRAMES, "body_bytes": MAX_BODY_BYTES},
         }
+
+    def _initial_now(first: InitialScenario) -> InitialScenario:
+        """The command line's scenario as a page loaded now sees it: when it is the folder's file, the file as it is
+        now (a tab opened after another tab or program saved it showed the version of the server's start, with
+        nothing marked unsaved, and its save was refused as changed); the version of the start when it cannot be
+        read now."""
+        if not first.in_folder:
+            return first
+        try:
+            got = store.read_text(first.name)
+            document, _ = load_document(got.text, first.name)
+        except MmusvError:  # deleted, or no longer a scenario the page can show: what the server started with
+            return first
+        return replace(
+            first,
+            document=document,
+            comment=leading_comment(got.text),
+            comments=comments_json(got.text),
+            etag=got.etag,
+        )
 
     @app.get("/api/assets")
     def assets() -> list[dict[str, Any]]:
