@@ -495,6 +495,15 @@ function confirmHasKeyboard() {
   if (!at || at === document.body || $("save-confirm").contains(at)) return true;
   return ["file-name", "save", "run-frames", "run"].includes(at.id);
 }
+/** Applies what is being typed into the focused box (its change event comes on leaving it) before Ctrl+S saves: the
+ * scenario was saved without it, said "saved" and showed no unsaved mark, while the box showed the text. The box
+ * keeps the keyboard. */
+function commitTyping() {
+  const at = document.activeElement;
+  if (!at || !["INPUT", "TEXTAREA", "SELECT"].includes(at.tagName)) return;
+  at.blur(); // the browser sends its change event (once, as on leaving the box)
+  if (at.isConnected) at.focus();
+}
 $("undo").addEventListener("click", () => state.undo());
 $("redo").addEventListener("click", () => state.redo());
 $("preview").addEventListener("click", preview);
@@ -539,6 +548,7 @@ window.addEventListener("keydown", (ev) => {
   if ((ev.ctrlKey || ev.metaKey) && ev.key.toLowerCase() === "s") {
     ev.preventDefault();
     runAfterSave = null;
+    commitTyping();
     save(false);
   } else if (ev.key === "Escape" && !$("save-confirm").hidden && confirmHasKeyboard()) {
     ev.preventDefault();

@@ -1,0 +1,53 @@
+"""An eighth round through the editor in a real headless Chromium: Ctrl+S pressed while typing in a box saved the
+scenario without what the box showed (its change event comes on leaving the box), said "saved" and showed no unsaved
+mark.
+
+Each browser test checks the browser's console for JavaScript errors (failed requests the page explains are not
+errors).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from mmusv.config import load_scenario
+from selenium.webdriver.common.action_chains import ActionChains
+from selenium.webdriver.common.by import By
+from selenium.webdriver.common.keys import Keys
+from test_browser import LiveServer, _wait, open_editor
+from test_browser_round import js_errors
+from test_browser_round2 import active_id, save_as
+
+
+def ctrl_s(driver: Any) -> None:
+    driver.execute_script("delete document.body.dataset.saved")
+    ActionChains(driver).key_down(Keys.CONTROL).send_keys("s").key_up(Keys.CONTROL).perform()
+    _wait(driver, "return document.body.dataset.saved === 'typed.yaml'", "the save")
+
+
+def test_ctrl_s_while_typing_saves_what_the_box_shows(browser: Any, live_server: LiveServer) -> None:
+    open_editor(browser, live_server)
+    js_errors(browser)
+    save_as(browser, "typed.yaml")
+    path = live_server.folder / "typed.yaml"
+
+    box = browser.find_element(By.ID, "s-name")
+    box.click()
+    box.send_keys(Keys.END, "_typed")  # not left: no change event yet
+    ctrl_s(browser)
+    assert load_scenario(path).name == "port_entry_typed"  # was: port_entry, while the box showed the new name
+    assert not browser.execute_script("return window.mmusvEditor.state.dirty")
+    assert not browser.title.startswith("●")
+    assert active_id(browser) == "s-name"  # the keyboard stays in the box
+    box.send_keys("2")  # typing on goes on in the box, and a second Ctrl+S saves it too
+    ctrl_s(browser)
+    assert load_scenario(path).name == "port_entry_typed2"
+
+    speed = browser.find_element(By.ID, "a-frequency")  # a number box
+    speed.click()
+    speed.send_keys(Keys.CONTROL, "a")
+    speed.send_keys("2")
+    ctrl_s(browser)
+    assert load_scenario(path).acquisition.frequency_hz == 2
+    assert browser.execute_script("return window.mmusvEditor.state.undoStack.length") == 3  # one edit each
+    assert js_errors(browser) == []
