@@ -223,9 +223,9 @@ def test_the_etag_is_of_the_very_bytes_whose_text_is_shown(
     assert client.put("/api/files/e.yaml", json={"document": doc}).status_code == 200
     load = editor_app.load_document
 
-    def load_while_another_program_saves(text: str, where: str) -> tuple[dict[str, Any], bool]:
+    def load_while_another_program_saves(text: str, where: str, **kw: Any) -> tuple[dict[str, Any], bool]:
         (folder / "e.yaml").write_text(text.replace("seed: 7", "seed: 8"))  # between reading and answering
-        return load(text, where)
+        return load(text, where, **kw)
 
     monkeypatch.setattr(editor_app, "load_document", load_while_another_program_saves)
     shown = client.get("/api/files/e.yaml").json()

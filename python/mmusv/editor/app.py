@@ -47,6 +47,7 @@ import contextlib
 import sys
 import threading
 import traceback
+from collections.abc import Collection
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Annotated, Any
@@ -116,12 +117,19 @@ _JOB_ID = r"^(0|[1-9][0-9]{0,17})$"
 
 
 def create_app(
-    folder: str | Path, *, initial: InitialScenario | None = None, allowed_hosts: list[str] | None = None
+    folder: str | Path,
+    *,
+    initial: InitialScenario | None = None,
+    allowed_hosts: list[str] | None = None,
+    asset_files: Collection[str | Path] = (),
 ) -> FastAPI:
     """The editor application serving scenario files of ``folder``; ``initial`` is opened when the page loads;
     ``allowed_hosts`` are the host names requests may address (default: any; the command line passes the bound
-    host and its loopback names, so other sites cannot reach the server through DNS rebinding)."""
+    host and its loopback names, so other sites cannot reach the server through DNS rebinding). A scenario's own
+    asset files (``assets:``) are read from the folder; ``asset_files`` are those outside it that may be read too
+    (the command line's scenario's, which it read)."""
     store = ScenarioFolder(folder)
+    also = frozenset(Path(p).resolve() for p in asset_files)
     if initial is not None and initial.in_folder and initial.etag is None:  # the version the page starts from
         initial = replace(initial, etag=store.etag_of(initial.name))
     jobs = Jobs(store.root)
@@ -196,7 +204,7 @@ def create_app(
             return first
         try:
             got = store.read_text(first.name)
-            document, _ = load_document(got.text, first.name)
+            document, _ = load_document(got.text, first.name, folder=store.root, also=also)
         except MmusvError:  # deleted, or no longer a scenario the page can show: what the server started with
             return first
         return replace(
@@ -281,7 +289,7 @@ def create_app(
         name = _sent_name(request, name)
         got = store.read_text(name)  # the text and the ETag of the same bytes, read once
         text, tag = got.text, got.etag
-        doc, valid = load_document(text, name)
+        doc, valid = load_document(text, name, folder=store.root, also=also)
         return JSONResponse(
             {
                 "name": name,
@@ -297,7 +305,7 @@ def create_app(
     @app.put("/api/files/{name:path}")
     def write_file(name: str, body: SaveBody, request: Request) -> JSONResponse:
         name = check_name(_sent_name(request, name))
-        scenario, errors = validate(body.document)
+        scenario, errors = validate(body.document, folder=store.root, also=also)
         if scenario is None:
             raise ConfigError(
                 f"{name}: not saved, the scenario does not validate: " + "; ".join(e["message"] for e in errors)
@@ -350,10 +358,10 @@ def create_app(
     @app.post("/api/evaluate")
     def evaluate_(body: DocumentBody) -> dict[str, Any]:
         with evaluate_lock:
-            return evaluate(body.document)
+            return evaluate(body.document, folder=store.root, also=also)
 
     def _valid(document: dict[str, Any]) -> Scenario:
-        scenario, errors = validate(document)
+        scenario, errors = validate(document, folder=store.root, also=also)
         if scenario is None:
             raise ConfigError("the scenario does not validate: " + "; ".join(e["message"] for e in errors))
         return scenario

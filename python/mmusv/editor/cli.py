@@ -93,6 +93,7 @@ def run(args: argparse.Namespace) -> int:
     from mmusv.errors import MmusvError
 
     initial = None
+    asset_files: list[Path] = []  # the command line's scenario's own asset files, which may lie outside the folder
     # an empty --dir served the current folder, an empty SCENARIO read "." (a folder): both named now
     folder = Path(path_arg(args.dir, flag="--dir")) if args.dir is not None else Path.cwd()
     if args.scenario is not None:
@@ -106,7 +107,9 @@ def run(args: argparse.Namespace) -> int:
             folder = path.parent
         text = path.read_text(encoding="utf-8", errors="replace")
         try:
-            document = to_document(load_scenario(path))
+            scenario = load_scenario(path)  # (reads its asset files, relative to its folder)
+            document = to_document(scenario)
+            asset_files = [(path.parent / Path(a).expanduser()).resolve() for a in scenario.assets]
         except MmusvError as exc:  # opened to be fixed, as the page opens such a file: refused only when it cannot
             document, _ = load_document(text, str(path))  # draw it (a ConfigError saying why)
             print(f"mmusv editor: {exc}; the page lists what is wrong under Checks", file=sys.stderr)
@@ -122,7 +125,7 @@ def run(args: argparse.Namespace) -> int:
         )
     host = str(args.host)
     hosts = ["*"] if host in ("0.0.0.0", "::", "") else sorted({host, "127.0.0.1", "localhost", "[::1]"})
-    app = create_app(folder, initial=initial, allowed_hosts=hosts)
+    app = create_app(folder, initial=initial, allowed_hosts=hosts, asset_files=asset_files)
     with contextlib.suppress(KeyboardInterrupt):
         serve(app, host=host, port=int(args.port))
     print("mmusv editor: stopped", file=sys.stderr)

@@ -30,6 +30,8 @@ from __future__ import annotations
 
 import re
 import warnings
+from collections.abc import Collection
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -50,6 +52,7 @@ __all__ = [
     "MAX_PROBLEMS",
     "evaluate",
     "poses_at",
+    "register_assets",
     "validate",
 ]
 
@@ -76,8 +79,54 @@ def _error(field: str, message: str, document: dict[str, Any]) -> dict[str, Any]
     return {"field": field, "message": message, "vessel": _vessel_of(field, document)}
 
 
-def validate(document: dict[str, Any]) -> tuple[Scenario | None, list[dict[str, Any]]]:
-    """The scenario of ``document`` (None when invalid) and its schema and route errors (see module docstring)."""
+def register_assets(
+    document: dict[str, Any], folder: str | Path, *, also: Collection[Path] = ()
+) -> list[dict[str, Any]]:
+    """Registers the asset files of ``document``'s ``assets:`` (the user's own vessels) from ``folder``, the editor's
+    folder where its file lies, as ``mmusv run`` of that file does; the errors (``[]`` when none): a file outside
+    the folder (never read: the editor reads nothing outside it; ``also``: resolved files outside it that may be read,
+    those of the scenario named on the command line), or one that does not exist or holds no asset.
+    Before, the editor never read them: a scenario of its own vessels did not validate ("unknown asset"), and could
+    not be saved, unless the server's current folder happened to be the scenario's when the file was opened."""
+    from mmusv.scenario_assets import register_scenario_assets
+
+    entries = document.get("assets")
+    if not isinstance(entries, list) or not entries:
+        return []
+    root = Path(folder).resolve()
+    for i, entry in enumerate(entries):
+        if not isinstance(entry, str) or not entry.strip():
+            continue  # said by register_scenario_assets below
+        path = (root / Path(entry).expanduser()).resolve()
+        if root not in path.parents and path not in also:
+            field = f"assets[{i}]"
+            return [
+                _error(
+                    field,
+                    f"{field} = {entry!r}: {path} is outside the editor's folder {root}; the editor reads asset files "
+                    "in its folder only: give a path under it, relative to the folder, or start the editor on a "
+                    "--dir that holds both",
+                    document,
+                )
+            ]
+    try:
+        register_scenario_assets(entries, base_dir=root, where="scenario")
+    except ConfigError as exc:
+        message = str(exc).removeprefix("scenario: invalid scenario ")
+        m = re.match(r"assets\[\d+\]", message)
+        return [_error(m.group(0) if m else "assets", message, document)]
+    return []
+
+
+def validate(
+    document: dict[str, Any], *, folder: str | Path | None = None, also: Collection[Path] = ()
+) -> tuple[Scenario | None, list[dict[str, Any]]]:
+    """The scenario of ``document`` (None when invalid) and its schema and route errors (see module docstring);
+    with ``folder``, the asset files of its ``assets:`` are read from there first (:func:`register_assets`)."""
+    if folder is not None:
+        asset_errors = register_assets(document, folder, also=also)
+        if asset_errors:
+            return None, asset_errors
     try:
         scenario = Scenario.model_validate(document)
     except ValidationError as exc:
@@ -144,10 +193,13 @@ def _budget_error(problem: str, n_motion: int, n_route: int, n_vessels: int) -> 
     return "vessels", f"{problem}: shorten the routes or use fewer vessels"
 
 
-def evaluate(document: dict[str, Any]) -> dict[str, Any]:
-    """Validates ``document`` and, when valid, samples its motion and runs the named checks (module docstring)."""
+def evaluate(
+    document: dict[str, Any], *, folder: str | Path | None = None, also: Collection[Path] = ()
+) -> dict[str, Any]:
+    """Validates ``document`` (its asset files read from ``folder``: :func:`validate`) and, when valid, samples its
+    motion and runs the named checks (module docstring)."""
     out: dict[str, Any] = {"valid": False, "errors": [], "problems": [], "vessels": [], "frames": None}
-    scenario, errors = validate(document)
+    scenario, errors = validate(document, folder=folder, also=also)
     if scenario is None:
         out["errors"] = errors
         return out

@@ -6,6 +6,8 @@ as lists) and JSON can carry it.
 from __future__ import annotations
 
 import json
+from collections.abc import Collection
+from pathlib import Path
 from typing import Any
 
 from mmusv.config import load_scenario
@@ -17,24 +19,39 @@ from mmusv.yamlio import parse_yaml
 __all__ = ["load_document"]
 
 
-def load_document(text: str, where: str) -> tuple[dict[str, Any], bool]:
+def load_document(
+    text: str, where: str, *, folder: str | Path | None = None, also: Collection[Path] = ()
+) -> tuple[dict[str, Any], bool]:
     """``(document, valid)`` of a scenario file's text: the editor's document of a valid scenario, else the raw
-    mapping (the page then lists what is wrong); :class:`ConfigError` when it is not a YAML mapping."""
+    mapping (the page then lists what is wrong); :class:`ConfigError` when it is not a YAML mapping. ``folder``: the
+    file's folder, where the asset files of its ``assets:`` are read (:func:`mmusv.editor.evaluate.register_assets`;
+    without it, relative to the current folder, as :func:`mmusv.config.load_scenario` reads a mapping's)."""
     data = parse_yaml(text, where)
     if not isinstance(data, dict):
         raise ConfigError(f"{where}: a scenario must be a YAML mapping with at least `vessels:`")
+    if folder is not None and data.get("assets"):
+        from mmusv.editor.evaluate import validate
+
+        scenario, errors = validate(data, folder=folder, also=also)
+        if scenario is not None:
+            return to_document(scenario), True
+        return _raw(data, where, f"{where}: " + "; ".join(e["message"] for e in errors)), False
     try:
         return to_document(load_scenario(data)), True
     except MmusvError as exc:
-        if not _editable(data):  # the page could not show it: say what is wrong instead
-            raise ConfigError(
-                f"{exc}; the editor opens files whose vessels and routes are lists (fix it as text)"
-            ) from None
-        raw = json.loads(json.dumps(data, default=str))
-        problem = unjsonable(raw, "")
-        if problem is not None:  # JSON cannot carry it to the page
-            raise ConfigError(f"{where}: {problem}; the editor cannot show this value (fix it as text)") from None
-        return raw, False
+        return _raw(data, where, str(exc)), False
+
+
+def _raw(data: dict[str, Any], where: str, problem: str) -> dict[str, Any]:
+    """The mapping of a file that does not validate (``problem`` says why), as the page gets it to be fixed;
+    :class:`ConfigError` when the page could not show it."""
+    if not _editable(data):  # the page could not show it: say what is wrong instead
+        raise ConfigError(f"{problem}; the editor opens files whose vessels and routes are lists (fix it as text)")
+    raw: dict[str, Any] = json.loads(json.dumps(data, default=str))
+    unjson = unjsonable(raw, "")
+    if unjson is not None:  # JSON cannot carry it to the page
+        raise ConfigError(f"{where}: {unjson}; the editor cannot show this value (fix it as text)")
+    return raw
 
 
 def _editable(data: dict[str, Any]) -> bool:
