@@ -1,6 +1,7 @@
 """An eighth round through the editor in a real headless Chromium: Ctrl+S pressed while typing in a box saved the
 scenario without what the box showed (its change event comes on leaving the box), said "saved" and showed no unsaved
-mark.
+mark. Undo after an edit of the description (the leading comment) left the description and took back the edit before
+it.
 
 Each browser test checks the browser's console for JavaScript errors (failed requests the page explains are not
 errors).
@@ -14,8 +15,8 @@ from mmusv.config import load_scenario
 from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
-from test_browser import LiveServer, _wait, open_editor
-from test_browser_round import js_errors
+from test_browser import LiveServer, _wait, document_of, open_editor, settled
+from test_browser_round import js_errors, type_into
 from test_browser_round2 import active_id, save_as
 
 
@@ -50,4 +51,28 @@ def test_ctrl_s_while_typing_saves_what_the_box_shows(browser: Any, live_server:
     ctrl_s(browser)
     assert load_scenario(path).acquisition.frequency_hz == 2
     assert browser.execute_script("return window.mmusvEditor.state.undoStack.length") == 3  # one edit each
+    assert js_errors(browser) == []
+
+
+def test_undo_takes_back_an_edited_description(browser: Any, live_server: LiveServer) -> None:
+    open_editor(browser, live_server)
+    js_errors(browser)
+    comment = browser.execute_script("return window.mmusvEditor.state.comment")
+    type_into(browser, browser.find_element(By.ID, "s-name"), "renamed")
+    settled(browser)
+    type_into(browser, browser.find_element(By.ID, "s-comment"), "my description")
+    settled(browser)
+    browser.find_element(By.ID, "undo").click()
+    settled(browser)
+    box = browser.find_element(By.ID, "s-comment")
+    assert box.get_attribute("value") == comment  # was: "my description" kept, and the rename undone
+    assert document_of(browser)["name"] == "renamed"
+    browser.find_element(By.ID, "redo").click()
+    settled(browser)
+    assert box.get_attribute("value") == "my description"
+    assert browser.execute_script("return window.mmusvEditor.state.comment") == "my description"
+    browser.find_element(By.ID, "undo").click()
+    browser.find_element(By.ID, "undo").click()
+    settled(browser)
+    assert not browser.execute_script("return window.mmusvEditor.state.dirty")  # back to the file as opened
     assert js_errors(browser) == []

@@ -779,8 +779,10 @@ export class Panels {
       });
     });
     $("s-comment").addEventListener("change", (ev) => {
-      this.state.comment = ev.target.value; // the unsaved mark follows it (state.dirty compares the scenario)
-      this.state.emit("doc");
+      // an edit as any other: undone by Undo, and the unsaved mark follows it (state.dirty compares the scenario)
+      this.state.edit(() => {
+        this.state.comment = ev.target.value;
+      });
     });
     $("m-type").addEventListener("change", (ev) => edit((d) => {
       d.map = { ...d.map, type: ev.target.value };

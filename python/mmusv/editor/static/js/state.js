@@ -90,15 +90,17 @@ export class EditorState {
     this.changed();
   }
 
-  /** The document and the comments as one entry of the undo history (a renamed vessel's comments follow it, and
-   * undoing the rename takes them back). */
+  /** The document, its description (the leading comment) and the other comments as one entry of the undo history
+   * (a renamed vessel's comments follow it, and undoing the rename takes them back; an edited description is undone
+   * as any edit: without it, Undo left the description and took back the edit before it). */
   snapshot() {
-    return JSON.stringify({ doc: this.doc, comments: this.comments });
+    return JSON.stringify({ doc: this.doc, comment: this.comment, comments: this.comments });
   }
 
   restore(entry) {
-    const { doc, comments } = JSON.parse(entry);
+    const { doc, comment, comments } = JSON.parse(entry);
     this.doc = doc;
+    this.comment = comment;
     this.comments = comments;
   }
 
