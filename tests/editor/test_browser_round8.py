@@ -1,7 +1,7 @@
 """An eighth round through the editor in a real headless Chromium: Ctrl+S pressed while typing in a box saved the
 scenario without what the box showed (its change event comes on leaving the box), said "saved" and showed no unsaved
-mark. Undo after an edit of the description (the leading comment) left the description and took back the edit before
-it.
+mark; and leaving the page (a reload, closing the tab) then asked nothing, and lost the text. Undo after an edit of
+the description (the leading comment) left the description and took back the edit before it.
 
 Each browser test checks the browser's console for JavaScript errors (failed requests the page explains are not
 errors).
@@ -75,4 +75,20 @@ def test_undo_takes_back_an_edited_description(browser: Any, live_server: LiveSe
     browser.find_element(By.ID, "undo").click()
     settled(browser)
     assert not browser.execute_script("return window.mmusvEditor.state.dirty")  # back to the file as opened
+    assert js_errors(browser) == []
+
+
+LEAVE = "const e = new Event('beforeunload', {cancelable: true}); window.dispatchEvent(e); return e.defaultPrevented"
+
+
+def test_leaving_the_page_while_typing_asks_first(browser: Any, live_server: LiveServer) -> None:
+    open_editor(browser, live_server)
+    js_errors(browser)
+    assert browser.execute_script(LEAVE) is False  # nothing to lose
+    box = browser.find_element(By.ID, "s-name")
+    box.click()
+    box.send_keys(Keys.END, "_typed")  # not left: no change event yet
+    assert browser.execute_script(LEAVE) is True  # was: False, and a reload lost the text without a question
+    assert browser.execute_script("return window.mmusvEditor.state.doc.name") == "port_entry_typed"
+    assert active_id(browser) == "s-name"
     assert js_errors(browser) == []

@@ -564,6 +564,7 @@ window.addEventListener("keydown", (ev) => {
   }
 });
 window.addEventListener("beforeunload", (ev) => {
+  commitTyping(); // what is being typed in a box counts as unsaved: it was lost without a question
   if (state.dirty) ev.preventDefault();
 });
 
