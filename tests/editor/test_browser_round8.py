@@ -1,7 +1,8 @@
 """An eighth round through the editor in a real headless Chromium: Ctrl+S pressed while typing in a box saved the
 scenario without what the box showed (its change event comes on leaving the box), said "saved" and showed no unsaved
 mark; and leaving the page (a reload, closing the tab) then asked nothing, and lost the text. Undo after an edit of
-the description (the leading comment) left the description and took back the edit before it.
+the description (the leading comment) left the description and took back the edit before it. A reload of a file
+that can no longer be opened showed another scenario, its check's verdict replacing at once the status that said why.
 
 Each browser test checks the browser's console for JavaScript errors (failed requests the page explains are not
 errors).
@@ -91,4 +92,31 @@ def test_leaving_the_page_while_typing_asks_first(browser: Any, live_server: Liv
     assert browser.execute_script(LEAVE) is True  # was: False, and a reload lost the text without a question
     assert browser.execute_script("return window.mmusvEditor.state.doc.name") == "port_entry_typed"
     assert active_id(browser) == "s-name"
+    assert js_errors(browser) == []
+
+
+def test_a_reload_of_a_file_that_no_longer_opens_says_why_with_the_scenario_shown_instead(
+    browser: Any, live_server: LiveServer
+) -> None:
+    open_editor(browser, live_server)
+    js_errors(browser)
+    save_as(browser, "broken.yaml")
+    path = live_server.folder / "broken.yaml"
+    path.write_text(path.read_text(encoding="utf-8").replace("map: {", "map: null\nx: {"), encoding="utf-8")
+    browser.refresh()  # the address names #file:broken.yaml
+    _wait(
+        browser,
+        "return document.body.dataset.ready === '1' && document.body.dataset.pending === '0' "
+        "&& !!document.getElementById('map-image')",
+        "the page to show another scenario",
+    )
+    said = browser.find_element(By.ID, "status")
+    text = said.text
+    assert text.startswith("cannot open broken.yaml again: "), text  # was: "8 vessels · 50 frames · ..." only
+    assert "map = None" in text and "sections are mappings" in text, text
+    assert "showing port_entry.yaml instead · 8 vessels" in text, text
+    assert "error" in said.get_attribute("class").split()
+    type_into(browser, browser.find_element(By.ID, "s-seed"), "5")  # an edit of what is shown: the note has been read
+    settled(browser)
+    assert not said.text.startswith("cannot open"), said.text
     assert js_errors(browser) == []

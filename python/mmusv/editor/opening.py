@@ -46,7 +46,10 @@ def _raw(data: dict[str, Any], where: str, problem: str) -> dict[str, Any]:
     """The mapping of a file that does not validate (``problem`` says why), as the page gets it to be fixed;
     :class:`ConfigError` when the page could not show it."""
     if not _editable(data):  # the page could not show it: say what is wrong instead
-        raise ConfigError(f"{problem}; the editor opens files whose vessels and routes are lists (fix it as text)")
+        raise ConfigError(
+            f"{problem}; the editor opens files whose sections are mappings and whose vessels and routes are "
+            "lists (fix it as text)"
+        )
     raw: dict[str, Any] = json.loads(json.dumps(data, default=str))
     unjson = unjsonable(raw, "")
     if unjson is not None:  # JSON cannot carry it to the page

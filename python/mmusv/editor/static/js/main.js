@@ -180,6 +180,7 @@ async function load(value) {
   });
   savedEtag = kind === "file" ? res.etag : null;
   openedBundled = kind === "bundled" ? name : null;
+  bootNote = "";
   remember();
   status(`opened ${kind === "file" ? name : `bundled ${name}`}${res.valid ? "" : " (it does not validate: see Checks)"}`);
 }
@@ -191,6 +192,7 @@ function remember() {
   history.replaceState(null, "", `${location.pathname}${location.search}${hash}`);
 }
 let openedBundled = null; // the bundled scenario last opened, while no folder file holds the scenario
+let bootNote = ""; // why the scenario the address named (a reload) did not open: said with the checks (showCheck)
 
 async function open(value) {
   if (!value) return;
@@ -241,6 +243,7 @@ async function save(overwrite = false) {
     state.savedName = name;
     state.fileName = name;
     state.markSaved(key);
+    bootNote = "";
     remember();
     renderAll(); // the title's unsaved mark and file name
     status(`saved ${res.name} (${res.bytes} bytes)${res.note ? `; ${res.note}` : ""}`);
@@ -403,6 +406,7 @@ state.on("loaded", () => {
   ensureMap();
 });
 state.on("doc", () => {
+  if (state.undoStack.length) bootNote = ""; // an edit of the scenario shown instead
   ensureMap();
   renderAll();
 });
@@ -410,9 +414,13 @@ state.on("evaluated", () => {
   renderAll();
   showCheck();
 });
-/** Says the last check's verdict in the status line, after `prefix` (the map just shown, say). */
+/** Says the last check's verdict in the status line, after `prefix` (the map just shown, say), and after why the
+ * scenario the page's address names did not open, until the scenario shown instead is edited or another is opened
+ * (the check's verdict replaced it at once: the person saw another scenario, without a word why). */
 function showCheck(prefix = "") {
   const ev = state.evaluation;
+  const note = bootNote ? `${bootNote}; showing ${state.fileName || "another scenario"} instead · ` : "";
+  prefix = `${note}${prefix}`;
   if (!ev) status(`${prefix}cannot check: ${state.evalError}`, true);
   else if (!ev.valid) {
     // read out with the first error, its field and what it allows (seen next to the field and under Checks)
@@ -422,7 +430,7 @@ function showCheck(prefix = "") {
   }
   else {
     const errors = ev.problems.filter((p) => p.severity === "error").length;
-    status(`${prefix}${ev.vessels.length} vessels · ${ev.frames} frames · ${errors} error(s), ${ev.problems.length - errors} warning(s)`, errors > 0);
+    status(`${prefix}${ev.vessels.length} vessels · ${ev.frames} frames · ${errors} error(s), ${ev.problems.length - errors} warning(s)`, errors > 0 || !!note);
   }
 }
 /** Scrolls the left panel so that the Selected vessel panel is seen (a vessel picked on the map or in a list may
@@ -587,7 +595,8 @@ async function boot() {
         await load(asked);
         opened = true;
       } catch (err) {
-        status(`cannot open ${asked.slice(asked.indexOf(":") + 1)} again: ${err.message}`, true);
+        bootNote = `cannot open ${asked.slice(asked.indexOf(":") + 1)} again: ${err.message}`;
+        status(bootNote, true);
       }
     }
     if (!opened && info.initial) {
