@@ -3,6 +3,7 @@ scenario without what the box showed (its change event comes on leaving the box)
 mark; and leaving the page (a reload, closing the tab) then asked nothing, and lost the text. Undo after an edit of
 the description (the leading comment) left the description and took back the edit before it. A reload of a file
 that can no longer be opened showed another scenario, its check's verdict replacing at once the status that said why.
+A save of a file deleted since it was opened asked whether to overwrite a file "changed by another tab or program".
 
 Each browser test checks the browser's console for JavaScript errors (failed requests the page explains are not
 errors).
@@ -119,4 +120,22 @@ def test_a_reload_of_a_file_that_no_longer_opens_says_why_with_the_scenario_show
     type_into(browser, browser.find_element(By.ID, "s-seed"), "5")  # an edit of what is shown: the note has been read
     settled(browser)
     assert not said.text.startswith("cannot open"), said.text
+    assert js_errors(browser) == []
+
+
+def test_a_save_of_a_file_deleted_since_says_it_is_gone(browser: Any, live_server: LiveServer) -> None:
+    open_editor(browser, live_server)
+    js_errors(browser)
+    save_as(browser, "gone.yaml")
+    (live_server.folder / "gone.yaml").unlink()
+    type_into(browser, browser.find_element(By.ID, "s-seed"), "5")
+    settled(browser)
+    browser.find_element(By.ID, "save").click()
+    _wait(browser, "return !document.getElementById('save-confirm').hidden", "the question")
+    _wait(browser, "return document.getElementById('save-confirm-text').textContent !== ''", "the question's text")
+    asked = browser.find_element(By.ID, "save-confirm-text").text
+    assert asked.startswith("gone.yaml is no longer in the folder"), asked  # was: "... was changed by another tab"
+    browser.find_element(By.ID, "save-overwrite").click()
+    _wait(browser, "return document.body.dataset.saved === 'gone.yaml' && !window.mmusvEditor.state.dirty", "the save")
+    assert load_scenario(live_server.folder / "gone.yaml").seed == 5
     assert js_errors(browser) == []

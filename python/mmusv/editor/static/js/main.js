@@ -258,7 +258,11 @@ async function save(overwrite = false) {
       $("save-confirm").hidden = false;
     } else if (err.status === 412) {
       status(`not saved: ${err.message}`, true);
-      $("save-confirm-text").textContent = `${name} was changed by another tab or program since you opened it.`;
+      // (a file deleted or renamed since is no file "changed": Overwrite creates it again)
+      const gone = (await api.files().catch(() => null))?.every((f) => f.name !== name);
+      $("save-confirm-text").textContent = gone
+        ? `${name} is no longer in the folder (deleted or renamed since you opened it); Overwrite saves it again.`
+        : `${name} was changed by another tab or program since you opened it.`;
       $("save-confirm").hidden = false;
     } else {
       status(`not saved: ${err.message}`, true);
