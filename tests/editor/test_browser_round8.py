@@ -3,7 +3,8 @@ scenario without what the box showed (its change event comes on leaving the box)
 mark; and leaving the page (a reload, closing the tab) then asked nothing, and lost the text. Undo after an edit of
 the description (the leading comment) left the description and took back the edit before it. A reload of a file
 that can no longer be opened showed another scenario, its check's verdict replacing at once the status that said why.
-A save of a file deleted since it was opened asked whether to overwrite a file "changed by another tab or program".
+The Open list missed the files another tab or program saved since the page loaded. A save of a file deleted since it
+was opened asked whether to overwrite a file "changed by another tab or program".
 
 Each browser test checks the browser's console for JavaScript errors (failed requests the page explains are not
 errors).
@@ -11,12 +12,15 @@ errors).
 
 from __future__ import annotations
 
+import shutil
 from typing import Any
 
+from mmusv.bundled import resolve_scenario
 from mmusv.config import load_scenario
 from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
+from selenium.webdriver.support.ui import Select
 from test_browser import LiveServer, _wait, document_of, open_editor, settled
 from test_browser_round import js_errors, type_into
 from test_browser_round2 import active_id, save_as
@@ -138,4 +142,19 @@ def test_a_save_of_a_file_deleted_since_says_it_is_gone(browser: Any, live_serve
     browser.find_element(By.ID, "save-overwrite").click()
     _wait(browser, "return document.body.dataset.saved === 'gone.yaml' && !window.mmusvEditor.state.dirty", "the save")
     assert load_scenario(live_server.folder / "gone.yaml").seed == 5
+    assert js_errors(browser) == []
+
+
+def test_the_open_list_shows_files_saved_elsewhere_since(browser: Any, live_server: LiveServer) -> None:
+    open_editor(browser, live_server)
+    js_errors(browser)
+    shutil.copy(resolve_scenario("open_sea_convoy"), live_server.folder / "from_elsewhere.yaml")
+    browser.find_element(By.ID, "open").click()  # reached: the list is read again
+    _wait(
+        browser,
+        "return [...document.querySelectorAll('#open option')].some((o) => o.value === 'file:from_elsewhere.yaml')",
+        "the file saved elsewhere in the list",
+    )  # was: only at start and after a save of this page
+    Select(browser.find_element(By.ID, "open")).select_by_value("file:from_elsewhere.yaml")
+    _wait(browser, "return window.mmusvEditor.state.savedName === 'from_elsewhere.yaml'", "the file opened")
     assert js_errors(browser) == []

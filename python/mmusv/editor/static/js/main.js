@@ -478,6 +478,8 @@ state.on("mode", ({ mode, asset, vessel }) => {
 });
 
 $("open").addEventListener("change", (ev) => open(ev.target.value));
+// the folder's files as they are when the list is reached (one another tab or program saved since was missing)
+$("open").addEventListener("focus", () => refreshOpen().catch((err) => status(`open: ${err.message}`, true)));
 $("file-name").addEventListener("change", (ev) => {
   state.fileName = ev.target.value.trim();
 });
