@@ -143,3 +143,24 @@ def test_asset_files_outside_the_folder_are_refused_unread(folder: Path, tmp_pat
     client = TestClient(create_app(folder, asset_files=[outside]))
     (folder / "own.yaml").write_text(OWN_BOAT.replace("ASSET", "../models/skiff.yaml"), encoding="utf-8")
     assert client.get("/api/files/own.yaml").json()["valid"] is True
+
+
+@pytest.mark.usefixtures("_library")
+def test_the_command_line_scenario_keeps_its_asset_files_outside_the_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from mmusv.cli import main
+    from mmusv.editor import cli as editor_cli
+
+    write_boat(tmp_path / "models" / "skiff.yaml", name="editor_skiff")
+    (tmp_path / "scen").mkdir()
+    (tmp_path / "scen" / "own.yaml").write_text(OWN_BOAT.replace("ASSET", "../models/skiff.yaml"), encoding="utf-8")
+    apps: list[object] = []
+    monkeypatch.setattr(editor_cli, "serve", lambda app, **kw: apps.append(app))
+    assert main(["editor", str(tmp_path / "scen" / "own.yaml"), "--port", "0"]) == 0
+    (app,) = apps
+    client = TestClient(app, base_url="http://127.0.0.1")  # type: ignore[arg-type]
+    doc = client.get("/api/info").json()["initial"]["document"]
+    ev = client.post("/api/evaluate", json={"document": doc}).json()
+    assert ev["valid"] is True, ev["errors"]
+    assert client.put("/api/files/own.yaml", json={"document": doc, "overwrite": True}).status_code == 200
