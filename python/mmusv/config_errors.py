@@ -7,6 +7,7 @@ allowed; an unknown key is told the keys allowed there and the nearest one (:fun
 from __future__ import annotations
 
 import difflib
+import re
 import reprlib
 import types
 import typing
@@ -107,6 +108,31 @@ def _unknown_key_hint(model: type[BaseModel], loc: tuple[int | str, ...], data: 
     return f"; {hint}allowed keys: {', '.join(keys)}"
 
 
+_PATTERN_WORDS = {
+    r"^[A-Za-z0-9_\-]+$": ("use ASCII letters, digits, _ and - only", r"[A-Za-z0-9_\-]"),
+    r"^[A-Za-z0-9_\-][A-Za-z0-9_\-.]*$": (
+        "use ASCII letters, digits, _, - and . only, not starting with . (it names files and folders)",
+        r"[A-Za-z0-9_\-.]",
+    ),
+}
+"""What the schema's name patterns allow, in words, and the characters they take: pydantic's message is the regex
+itself ("String should match pattern '^[A-Za-z0-9_\\-]+$'"), which a person typing a name need not read."""
+
+
+def _pattern_words(pattern: Any, value: Any) -> str | None:
+    """The words of a name ``pattern`` of :data:`_PATTERN_WORDS` for ``value``, naming its first character that is
+    not allowed (or the leading dot); ``None`` for another pattern."""
+    said = _PATTERN_WORDS.get(str(pattern))
+    if said is None or not isinstance(value, str):
+        return None
+    words, chars = said
+    allowed = re.compile(chars)
+    bad = next((c for c in value if not allowed.fullmatch(c)), None)
+    if bad is not None:
+        return f"{words}; {bad!r} is not allowed"
+    return f"{words}; it starts with {value[:1]!r}" if value else words
+
+
 def validation_problems(
     err: ValidationError, *, root: str = "scenario", model: type[BaseModel] | None = None, data: Any = None
 ) -> list[tuple[str, str, str]]:
@@ -131,6 +157,8 @@ def validation_problems(
         msg = str(e["msg"]).removeprefix("Value error, ")
         if e["type"] == "missing":  # pydantic's input is the mapping the field is missing from, not the field's
             shown, msg = "<missing>", "required"
+        if e["type"] == "string_pattern_mismatch":
+            msg = _pattern_words(e.get("ctx", {}).get("pattern"), value) or msg
         if e["type"] == "extra_forbidden" and model is not None:
             msg += _unknown_key_hint(model, loc, data, keys_said=loc[:-1] in keys_said)
             keys_said.add(loc[:-1])

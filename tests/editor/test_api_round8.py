@@ -3,7 +3,8 @@ as it was when the server started, so a second tab (or the URL the command line 
 version another tab or program had since replaced, as if nothing were unsaved, and its save was refused as changed.
 A scenario of the user's own vessels (``assets:``) did not validate in the editor ("unknown asset"), so it could not be
 saved or previewed, unless the server's current folder happened to be the scenario's; its asset files are read from
-the editor's folder now, and never from outside it."""
+the editor's folder now, and never from outside it. A name or id with a character the schema refuses (a space, a
+letter outside ASCII) was told the regular expression itself ("String should match pattern '^[A-Za-z0-9_\\-]+$'")."""
 
 from __future__ import annotations
 
@@ -164,3 +165,29 @@ def test_the_command_line_scenario_keeps_its_asset_files_outside_the_folder(
     ev = client.post("/api/evaluate", json={"document": doc}).json()
     assert ev["valid"] is True, ev["errors"]
     assert client.put("/api/files/own.yaml", json={"document": doc, "overwrite": True}).status_code == 200
+
+
+def test_a_refused_name_or_id_says_the_characters_allowed_in_words(folder: Path) -> None:
+    client = TestClient(create_app(folder))
+    doc = client.get("/api/bundled/port_entry").json()["document"]
+    doc["name"] = "港口 north"
+    doc["vessels"][0]["id"] = "usv 1"
+    doc["rigs"]["usv_standard"]["cameras"] = [{"name": "bow cam"}]
+    errors = {e["field"]: e["message"] for e in client.post("/api/evaluate", json={"document": doc}).json()["errors"]}
+    assert errors["name"] == (
+        "name = '港口 north': use ASCII letters, digits, _, - and . only, not starting with . (it names files and "
+        "folders); '港' is not allowed"
+    ), errors
+    assert (
+        errors["vessels[0].id"]
+        == "vessels[0].id = 'usv 1': use ASCII letters, digits, _ and - only; ' ' is not allowed"
+    )
+    assert errors["rigs.usv_standard.cameras[0].name"].endswith("_ and - only; ' ' is not allowed"), errors
+    assert not any("pattern" in m for m in errors.values()), errors  # was: the regular expression
+    doc["name"], doc["vessels"][0]["id"] = ".hidden", "usv_1"
+    doc["rigs"]["usv_standard"].pop("cameras")
+    errors = {e["field"]: e["message"] for e in client.post("/api/evaluate", json={"document": doc}).json()["errors"]}
+    assert errors == {
+        "name": "name = '.hidden': use ASCII letters, digits, _, - and . only, not starting with . (it "
+        "names files and folders); it starts with '.'"
+    }, errors
