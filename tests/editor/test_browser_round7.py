@@ -113,6 +113,7 @@ def test_a_route_is_not_deleted_below_two_waypoints(browser: Any, live_server: L
         settled(browser)
         assert len(document_of(browser)["vessels"][i]["route"]) == len(route) - 1
     browser.find_element(By.CSS_SELECTOR, '#v-route button[data-delete="0"]').click()
+    settled(browser)  # the refusal redraws the map: a handle found before then went stale on a busy machine
     handle = browser.find_element(By.CSS_SELECTOR, 'circle.waypoint[data-vessel="tug"][data-index="1"]')
     ActionChains(browser).context_click(handle).perform()
     settled(browser)
