@@ -47,11 +47,12 @@ fn a_wave_surface_of_non_finite_inputs_is_refused_not_a_vanished_sea() {
     ok("set_sea", || scene.set_sea(si, &[]));
     let spec_s = mmusv_core::sea::SurfaceSpec::default();
     let comps = field.components();
-    for (what, t, level) in
-        [("NaN time", f64::NAN, 0.0f32), ("infinite time", f64::INFINITY, 0.0), ("NaN level", 0.0, f32::NAN)]
-    {
-        let w = ok(what, || mmusv_core::sea::WaveSurface::new(comps, t, level, &[[0.0, 0.0]], spec_s));
-        refuses(what, "surface", || scene.set_wave_surface(Some(w)));
+    // A NaN level gives a surface the scene refuses; a time that is not finite (or past ±MAX_TIME_S) is refused
+    // by WaveSurface::new itself, naming time_s.
+    let w = ok("NaN level", || mmusv_core::sea::WaveSurface::new(comps, 0.0, f32::NAN, &[[0.0, 0.0]], spec_s));
+    refuses("NaN level", "surface", || scene.set_wave_surface(Some(w)));
+    for (what, t) in [("NaN time", f64::NAN), ("infinite time", f64::INFINITY), ("time past the bound", 1e12)] {
+        refuses(what, "time_s", || mmusv_core::sea::WaveSurface::new(comps, t, 0.0, &[[0.0, 0.0]], spec_s));
     }
     // A NaN focus has no extent: WaveSurface::new itself refuses it.
     refuses("NaN focus", "foci", || mmusv_core::sea::WaveSurface::new(comps, 0.0, 0.0, &[[f32::NAN, 0.0]], spec_s));
