@@ -57,7 +57,9 @@ the same process only when the asset file or its mesh changed. A name the librar
 another file's) is refused, naming both. The scenario's config hash (`manifest.json`'s `config_hash`) covers the
 assets' meshes, so a batch re-run records a scenario again when its mesh changed, rather than skipping it as
 complete. The `scenario.yaml` a run writes beside its recording keeps the paths as written: copy the asset files
-along to run it again from there.
+along to run it again from there. The editor (`mmusv editor`) reads a scenario's asset files from its folder
+(`--dir`), relative to it, as `mmusv run` of the saved file does; it reads none outside that folder (Checks names the
+`assets[i]` to fix) but those of the scenario named on its command line.
 
 **Axes.** `up_axis` and `forward_axis` (the file's up and bow directions, any of x, y, z, -x, -y, -z) turn the
 file into the body frame: x forward (bow), y to port, z up, z = 0 the waterline. When an entry gives neither, the
