@@ -31,6 +31,7 @@ pub use batch::KnownWater;
 mod lamps;
 pub use lamps::{Lamp, LAMP_GROUP_M};
 mod sea_routes;
+pub use sea_routes::SeaBeyond;
 mod visit;
 mod waves;
 
@@ -502,14 +503,21 @@ impl Scene {
     /// Unit world normal (triangle winding) and semantic class of a hit.
     #[inline(always)]
     pub fn hit_normal_class(&self, hit: &Hit) -> (Vec3, u16) {
+        if let Some(n) = self.wave_piece_normal(hit.instance, hit.triangle) {
+            return (n, self.face_class(hit.instance, 0));
+        }
         let inst = &self.instances[hit.instance as usize];
         let mesh = &self.meshes[inst.mesh as usize];
-        if let Some(n) = self.wave_piece_normal(hit.instance, hit.triangle) {
-            return (n, inst.class_override.unwrap_or(mesh.classes()[0]));
-        }
         let n = inst.pose.transform_vector(mesh.triangle(hit.triangle).normal()).normalize_or_zero();
-        let class = inst.class_override.unwrap_or(mesh.classes()[hit.triangle as usize]);
-        (n, class)
+        (n, self.face_class(hit.instance, hit.triangle))
+    }
+
+    /// Semantic class of triangle `triangle` of instance `instance` (both valid): the instance's override, else the
+    /// mesh's class of that face.
+    #[inline(always)]
+    fn face_class(&self, instance: u32, triangle: u32) -> u16 {
+        let inst = &self.instances[instance as usize];
+        inst.class_override.unwrap_or(self.meshes[inst.mesh as usize].classes()[triangle as usize])
     }
 
     /// Every triangle in the world frame at the current poses.

@@ -341,14 +341,13 @@ def convert(
                 writer = cls(info, folder, options, sink, split=rep.split, shared=shared)
                 wanted = writer.topic_filter()
                 stream = FrameStream(info, wanted.__contains__, frames=options.frames)
-                converted: list[int] = []
-                kept: set[int] = set()  # converted, as a set
+                converted: set[int] = set()
                 incomplete: dict[int, str] = {}
                 for fr in stream:
                     missing = writer.missing(fr)
                     if not options.wants_frame(fr.index):
                         pass  # outside --frames: neither converted nor missing
-                    elif fr.index in kept:
+                    elif fr.index in converted:
                         # a frame recorded again: its first complete copy stands (handed to the writer again, COCO
                         # listed the image twice, SemanticKITTI added a scan and a bag held every message twice)
                         pass
@@ -362,17 +361,16 @@ def convert(
                         incomplete.setdefault(fr.index, why)
                     else:
                         writer.write_frame(fr)
-                        converted.append(fr.index)
-                        kept.add(fr.index)
+                        converted.add(fr.index)
                         report.agent_frames += len(writer.agents)
                     done += 1
                     if progress is not None:
                         progress(done, max(expected, done))
                 rep.status = stream.run.get("status", "unfinished (no run metadata)")
                 for k, why in incomplete.items():
-                    if k not in kept:  # an incomplete copy of a frame converted from another copy is no loss
+                    if k not in converted:  # an incomplete copy of a frame converted from another copy is no loss
                         rep.skipped.append({"frames": [k, k], "reason": why})
-                seen = set(converted) | set(incomplete)
+                seen = converted | set(incomplete)
                 # the frames the run set out to write (its run metadata, or for one that did not finish its
                 # manifest's): --frames N cuts a run short on purpose, those after N are not missing; one part of a
                 # split recording given alone starts at its first frame

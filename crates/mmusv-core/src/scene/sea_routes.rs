@@ -76,22 +76,12 @@ impl Scene {
         self.sea.as_ref().map(|s| s.instance)
     }
 
-    /// What a ray that met nothing within its range would meet beyond it, where that is the sea: the sea
-    /// instance's id, its semantic class and the distance along the ray to the still water, when the scene has a
-    /// sea and the ray from `origin` above the still water goes down along unit `dir` (it meets the water
-    /// somewhere, past the range or past the water's mesh), else `None` (also where that distance overflows).
-    /// A camera labels such a pixel water, as its shading draws it ([`crate::sensors::camera::Camera`]), not sky.
-    pub fn sea_beyond(&self, origin: [f32; 3], dir: [f32; 3]) -> Option<(i32, u16, f32)> {
+    /// The still water beyond every ray's range ([`SeaBeyond`]), when the scene has a sea.
+    /// A camera labels a pixel that meets it water, as its shading draws it ([`crate::sensors::camera::Camera`]),
+    /// not sky.
+    pub fn sea_beyond(&self) -> Option<SeaBeyond> {
         let sea = self.sea.as_ref()?;
-        if !(origin[2] > sea.level && dir[2] < 0.0) {
-            return None;
-        }
-        let t = (origin[2] - sea.level) / -dir[2];
-        let inst = self.instances.get(sea.instance as usize)?;
-        let class = inst
-            .class_override
-            .unwrap_or_else(|| self.meshes[inst.mesh as usize].classes().first().copied().unwrap_or(super::CLASS_NONE));
-        t.is_finite().then_some((sea.instance as i32, class, t))
+        Some(SeaBeyond { instance: sea.instance as i32, class: self.face_class(sea.instance, 0), level: sea.level })
     }
 
     /// The sea shortcut for a closest-hit query: whether the ray rises from above the surface clear of
@@ -239,4 +229,29 @@ enum Lift {
     Beyond,
     /// Not known: trace it.
     Unknown,
+}
+
+/// What a ray that met nothing within its range would meet beyond it, where that is the sea ([`Scene::sea_beyond`]):
+/// the sea instance's id and semantic class, and the still water's level.
+#[derive(Debug, Clone, Copy)]
+pub struct SeaBeyond {
+    /// Instance id of the sea surface.
+    pub instance: i32,
+    /// Its semantic class.
+    pub class: u16,
+    level: f32,
+}
+
+impl SeaBeyond {
+    /// The distance along the ray from `origin` along unit `dir` to the still water, when the ray starts above it and
+    /// goes down (it meets the water somewhere, past the range or past the water's mesh); `None` otherwise, and where
+    /// that distance overflows.
+    #[inline]
+    pub fn meet(&self, origin: [f32; 3], dir: [f32; 3]) -> Option<f32> {
+        if !(origin[2] > self.level && dir[2] < 0.0) {
+            return None;
+        }
+        let t = (origin[2] - self.level) / -dir[2];
+        t.is_finite().then_some(t)
+    }
 }

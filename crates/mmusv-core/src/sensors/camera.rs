@@ -392,6 +392,7 @@ impl Camera {
         let hits = scene.cast_rays_over(&origins, &dirs, range, water.as_ref().map(|w| w as &KnownWater<'_>))?;
         let n = origins.len();
         let axis = pose.transform_vector(Vec3::X);
+        let sea_beyond = scene.sea_beyond();
         let mut frame = CameraFrame {
             width: self.cfg.width,
             height: self.cfg.height,
@@ -413,10 +414,10 @@ impl Camera {
             frame.semantic[i] = hits.class[k];
             frame.instance[i] = hits.instance[k];
             if !t.is_finite() {
-                if let Some((sea, class, t)) = scene.sea_beyond(origins[k], dirs[k]) {
+                if let Some((sea, t)) = sea_beyond.and_then(|s| s.meet(origins[k], dirs[k]).map(|t| (s, t))) {
                     frame.depth[i] = t * Vec3::from_array(dirs[k]).dot(axis);
-                    frame.semantic[i] = class;
-                    frame.instance[i] = sea;
+                    frame.semantic[i] = sea.class;
+                    frame.instance[i] = sea.instance;
                 }
             }
             if !surface.is_empty() {

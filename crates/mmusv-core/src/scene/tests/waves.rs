@@ -273,7 +273,7 @@ fn a_camera_over_the_waves_sees_the_marched_hits() {
             let (mut t, mut instance) = (marched.distance[i], marched.instance[i]);
             if !t.is_finite() {
                 // Past the range, a ray going down meets the still water (`Scene::sea_beyond`).
-                if let Some((sea, _, beyond)) = s.sea_beyond(o[i], d[i]) {
+                if let Some((sea, beyond)) = s.sea_beyond().and_then(|b| Some((b.instance, b.meet(o[i], d[i])?))) {
                     (t, instance) = (beyond, sea);
                 }
             }
