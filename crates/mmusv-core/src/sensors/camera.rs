@@ -39,6 +39,7 @@ mod glossy;
 mod lamp_glow;
 mod lamp_points;
 pub mod radiance;
+mod sunlit;
 
 use antialias::surface_key;
 use distortion::check_distortion;

@@ -12,20 +12,22 @@
 //! * [`sky_lobe`]: the sky's mean over the rough water's reflection lobe, tabulated per environment;
 //! * [`sea_ms`]: the light reflected more than once between the wave facets (Heitz et al.'s random walk),
 //!   restored over that lobe (Turquin's energy compensation);
+//! * [`swell`]: the fixed four-component swell of linear waves, the water's normals where the scene has no
+//!   displaced wave surface;
 //! * [`tonemap`]: physical exposure from the scene's illuminance and the ACES filmic curve.
 //!
 //! A surface of material `m` seen along `d` (`v = −d`) is lit by the sun (irradiance `E_s` along `s`, when the
 //! camera's shadow ray finds it unoccluded) and by the environment:
 //! `L = L_e + (f_d + f_s(v, s)) E_s (n·s) + f_d E_env(n) + P(r', roughness) (F0 A + B)`, with `f_d = (1 − metallic)
 //! base / π` and `r'` the rough lobe's dominant direction (Lagarde & de Rousiers 2014). The environment light is
-//! not occluded (no ambient occlusion): every surface sees the whole sky and the sea, a known limit of the model. Water is a dielectric (IOR 1.33) whose normals and roughness come from the wave surface where the scene has one
-//! (`WaveSurface::shading`, the far sea beyond its sampled part included), else from a fixed four-component swell:
-//! `L = F(θ_o) L_r + glint + L_body`, where `L_r`
-//! is the radiance along the reflected ray (traced by the camera, so ships mirror in it; the sky's otherwise),
-//! the glint is the sun through a Cox–Munk GGX lobe, and `L_body` the smooth-plastic water body; foam (whitecaps
-//! and wakes) is Lambertian on top. Aerial perspective: `L·T + L_air (1 − T)`, `T = e^{−σ t}` (Koschmieder),
-//! `L_air` the horizon sky's radiance along the view's azimuth (in twilight, the haze in the Earth's shadow,
-//! `twilight::shadowed_haze`).
+//! not occluded (no ambient occlusion): every surface sees the whole sky and the sea, a known limit of the model.
+//! Water is a dielectric (IOR 1.33) whose normals and roughness come from the wave surface where the scene has one
+//! (`WaveSurface::shading`, the far sea beyond its sampled part included), else from a fixed four-component swell
+//! ([`swell`]): `L = F(θ_o) L_r + glint + L_body`, where `L_r` is the radiance along the reflected ray (traced by
+//! the camera, so ships mirror in it; the sky's otherwise), the glint is the sun through a Cox–Munk GGX lobe, and
+//! `L_body` the smooth-plastic water body; foam (whitecaps and wakes) is Lambertian on top. Aerial perspective:
+//! `L·T + L_air (1 − T)`, `T = e^{−σ t}` (Koschmieder), `L_air` the horizon sky's radiance along the view's azimuth
+//! (in twilight, the haze in the Earth's shadow, `twilight::shadowed_haze`).
 
 use super::noise::{self, stream};
 use crate::material::Material;
@@ -45,6 +47,7 @@ pub mod sea_ms;
 mod sea_ms_table;
 pub mod sky;
 pub mod sky_lobe;
+pub mod swell;
 mod tables;
 pub mod tonemap;
 pub mod twilight;
@@ -55,7 +58,8 @@ use brdf::{dfg, specular_cos};
 pub use class_material::class_material;
 use envlight::{Lighting, LightingKey, WATER_IOR};
 use foam::{Foam, FOAM_ALBEDO};
-use tables::{fast_cos, water_fresnel};
+use swell::Swell;
+use tables::water_fresnel;
 use wake::Wake;
 use water::ShallowWater;
 
@@ -154,23 +158,13 @@ impl SurfaceHit {
     }
 }
 
-/// One swell component of the water surface: direction `(cos, sin)`, wave number, phase and slope amplitude.
-#[derive(Debug, Clone, Copy)]
-struct Swell {
-    c: f32,
-    s: f32,
-    k: f32,
-    phase: f32,
-    amp_k: f32,
-}
-
 /// Shading of one render: the environment's lighting (shared between renders), swell, foam and exposure,
 /// computed once; then [`Shader::shade`] per ray.
 #[derive(Debug, Clone)]
 pub struct Shader {
     env: ShadeEnv,
     light: Arc<Lighting>,
-    swell: [Swell; 4],
+    swell: Swell,
     sun: Vec3,
     sun_e: Vec3,
     water_alpha: f32,
@@ -203,18 +197,7 @@ impl Shader {
     /// Precomputes the shading of a render with environment `env`, seed `seed` (swell and rain streaks) and the
     /// vessels under way `wakes`.
     pub fn new(env: &ShadeEnv, seed: u64, wakes: &[Wake]) -> Self {
-        let h = env.wave_height_m.max(0.0);
-        let swell = std::array::from_fn(|i| {
-            let i = i as u64;
-            let dir = std::f32::consts::TAU * noise::uniform(seed, stream::RIPPLE, 2 * i) as f32;
-            let phase = std::f32::consts::TAU * noise::uniform(seed, stream::RIPPLE, 2 * i + 1) as f32;
-            let wavelength = [41.0f32, 23.0, 11.0, 3.7][i as usize];
-            let k = std::f32::consts::TAU / wavelength;
-            // Steepness limited so slopes stay below ~0.35.
-            let amp = (0.5 * h).min(0.05 * wavelength) * [0.5f32, 0.3, 0.15, 0.05][i as usize];
-            let (s, c) = dir.sin_cos();
-            Swell { c, s, k, phase, amp_k: amp * k }
-        });
+        let swell = Swell::new(env.wave_height_m, seed);
         let light = Lighting::shared(&env.lighting_key());
         let exposure = tonemap::exposure_scale(env.exposure_ev100, light.horizontal_lux);
         Self {
@@ -391,18 +374,10 @@ impl Shader {
         c * f + self.air_light(d) * (1.0 - f)
     }
 
-    /// Swell normal of the water surface at `p`.
+    /// Swell normal of the water surface at `p` ([`Swell::normal`]).
     #[inline(always)]
     pub fn water_normal(&self, p: Vec3) -> Vec3 {
-        let mut gx = 0.0;
-        let mut gy = 0.0;
-        for w in &self.swell {
-            let arg = w.k * (w.c * p.x + w.s * p.y) + w.phase;
-            let slope = w.amp_k * fast_cos(arg);
-            gx += slope * w.c;
-            gy += slope * w.s;
-        }
-        Vec3::new(-gx, -gy, 1.0).normalize_or_zero()
+        self.swell.normal(p)
     }
 
     /// `hit` with its shading normal set: for water seen along `d`, the wave surface's (with the roughness of the
