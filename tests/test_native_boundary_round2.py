@@ -159,3 +159,90 @@ def test_abandon_after_close_returns_where_the_file_is(tmp_path: Path) -> None:
         _write(failed, 1)
         raise RuntimeError("stop")
     assert failed.abandon() == tmp_path / "failed.mcap.partial" and failed.abandon().is_file()
+
+
+_HULL = [5.0, 2.5, 0.5, 0.5, 1.0]
+_ONE = np.ones(1)
+
+
+def _field() -> Any:
+    return core.WaveField(hs_m=2.0, tp_s=8.0, gamma=3.3, direction_rad=0.0, spread_s=10.0, seed=1)
+
+
+@pytest.mark.parametrize(
+    ("call", "match"),
+    [
+        (
+            lambda f: f.elevation(np.array([np.nan]), _ONE, 1.0),
+            r"invalid x\[0\]: NaN is not allowed; give a finite number",
+        ),
+        (lambda f: f.slope(np.ones(2), np.array([1.0, np.inf]), 1.0), r"invalid y\[1\]: inf is not allowed"),
+        (
+            lambda f: f.elevation(_ONE, _ONE, float("nan")),
+            r"invalid t: NaN is not allowed; give a finite time in seconds",
+        ),
+        (
+            lambda f: f.orbital_velocity(np.array([[0.0, 0.0, -np.inf]]), 1.0),
+            r"invalid points\[0\]\[2\]: -inf is not allowed",
+        ),
+        (lambda f: f.orbital_velocity(np.zeros((1, 3)), float("inf")), r"invalid t: inf is not allowed"),
+        (lambda f: _response(positions=np.nan), r"invalid positions\[0\]\[0\]: NaN is not allowed"),
+        (lambda f: _response(yaw=np.inf), r"invalid yaw\[0\]: inf is not allowed"),
+        (lambda f: _response(velocities=-np.inf), r"invalid velocities\[0\]\[0\]: -inf is not allowed"),
+        (lambda f: _response(times=np.nan), r"invalid times\[0\]: NaN is not allowed"),
+        (lambda f: _rao(beta=np.nan), r"invalid beta\[0\]: NaN is not allowed"),
+        (
+            lambda f: _rao(omega_e=np.inf),
+            r"invalid omega_e\[0\]: inf is not allowed; give an encounter frequency within ±1e6 rad/s",
+        ),
+        (
+            lambda f: _rao(omega=1e300, omega_e=1.0),
+            r"invalid omega\[0\]: 1e300 is not allowed; give a wave frequency within \[1e-6, 1e6\] rad/s",
+        ),
+        (
+            lambda f: _rao(omega=1e-300, omega_e=1e-300),
+            r"invalid omega\[0\]: 1e-300 is not allowed; give a wave frequency within \[1e-6, 1e6\] rad/s$",
+        ),
+        (lambda f: _variance(yaw=float("nan")), r"yaw = NaN: must be a finite heading in radians"),
+        (lambda f: _variance(speed_mps=1e200), r"speed_mps = 1e200: must be a speed within \[0, 1e6\] m/s"),
+    ],
+)
+def test_the_wave_fields_and_hulls_queries_refuse_what_they_would_answer_nan(call: Any, match: str) -> None:
+    """The private wave field's point queries, the hull's RAOs and its response variances refused nothing but
+    mismatched lengths (and omega <= 0): a NaN or infinite point, heading, velocity or time, a frequency past 1e77
+    rad/s or below 1e-155, an encounter frequency of 1e300, a speed of 1e200 m/s all answered NaN without a word,
+    which every sum over them carries. Each is refused now, naming the argument, its index and the range allowed."""
+    with pytest.raises((mmusv.InputError, mmusv.ConfigError), match=match):
+        call(_field())
+
+
+def _response(*, positions: float = 0.0, yaw: float = 0.0, velocities: float = 1.0, times: float = 1.0) -> Any:
+    return _field().hull_response(
+        hull=_HULL,
+        positions=np.full((1, 2), positions),
+        yaw=np.array([yaw]),
+        velocities=np.full((1, 2), velocities),
+        times=np.array([times]),
+    )
+
+
+def _rao(*, omega: float = 1.0, beta: float = 0.0, omega_e: float = 1.0) -> Any:
+    return core.hull_rao(hull=_HULL, omega=np.array([omega]), beta=np.array([beta]), omega_e=np.array([omega_e]))
+
+
+def _variance(*, yaw: float = 0.0, speed_mps: float = 3.0) -> Any:
+    return core.response_variance(
+        hull=_HULL, hs_m=2.0, tp_s=8.0, gamma=3.3, direction_rad=0.0, spread_s=10.0, yaw=yaw, speed_mps=speed_mps
+    )
+
+
+def test_the_wave_frequencies_a_hull_takes_give_finite_raos() -> None:
+    """Over the whole range ``hull_rao`` takes — ω in [1e-6, 1e6] rad/s, encounter frequencies within ±1e6 of
+    either sign and any heading — every RAO of three hulls (3 m to 330 m) is finite: the range refuses nothing the
+    closed forms can answer, and answers nothing they cannot."""
+    w = np.logspace(-6, 6, 49)
+    ww, we = np.meshgrid(w, np.concatenate([-w[::-1], [0.0], w]))
+    for hull in ([3.0, 1.2, 0.3, 0.4, 0.3], _HULL, [330.0, 60.0, 22.0, 0.85, 5.0]):
+        for beta in (-7.0, 0.0, 0.4, np.pi / 2, np.pi, 1e6):
+            r = core.hull_rao(hull=hull, omega=ww.ravel(), beta=np.full(ww.size, beta), omega_e=we.ravel())
+            assert np.isfinite(r).all(), (hull, beta)

@@ -674,7 +674,9 @@ def hull_rao(
 ) -> npt.NDArray[np.complex128]:
     """(N, 3) complex128 RAOs (heave m/m, roll rad/m, pitch rad/m) of a hull ``[length, beam, draft,
     block_coefficient, gm]`` (m, m, m, 1, m) for waves of frequency ``omega`` (rad/s), heading ``beta`` relative to
-    the hull (rad: 0 following, π/2 beam, π head) and encounter frequency ``omega_e`` (rad/s), all ``(N,)``."""
+    the hull (rad: 0 following, π/2 beam, π head) and encounter frequency ``omega_e`` (rad/s), all ``(N,)``.
+    Raises InputError for ``omega`` outside [1e-6, 1e6] rad/s, ``|omega_e|`` past 1e6 or a ``beta`` that is not
+    finite."""
 
 def response_variance(
     *,
@@ -687,7 +689,8 @@ def response_variance(
     yaw: float,
     speed_mps: float,
 ) -> tuple[float, float, float]:
-    """Spectral prediction (heave m², roll rad², pitch rad²)."""
+    """Spectral prediction (heave m², roll rad², pitch rad²) at heading ``yaw`` (rad, finite) and speed
+    ``speed_mps`` (within [0, 1e6] m/s; a ConfigError names either otherwise)."""
 
 # --- record ---
 

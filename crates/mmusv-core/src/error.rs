@@ -85,11 +85,12 @@ impl MmusvError {
 }
 
 /// Most digits a number keeps in a message: Rust prints a float in full, so `1e300` (given by a user, or an
-/// `f64::MAX` bound) came out as 301 digits that hid the rest of the message. Integers up to `u128` fit.
+/// `f64::MAX` bound) came out as 301 digits that hid the rest of the message, and `1e-300` as 302 characters of
+/// `0.000…1`. Integers up to `u128` fit.
 const MAX_MESSAGE_DIGITS: usize = 40;
 
-/// `text` with every run of more than [`MAX_MESSAGE_DIGITS`] digits (and its decimals) written short, as
-/// `1.7976931348623157e308`.
+/// `text` with every number of more than [`MAX_MESSAGE_DIGITS`] digits before or after its point written short,
+/// as `1.7976931348623157e308` or `1e-300`.
 fn short_numbers(text: String) -> String {
     let b = text.as_bytes();
     let mut out = String::with_capacity(text.len());
@@ -105,12 +106,14 @@ fn short_numbers(text: String) -> String {
         while i < b.len() && b[i].is_ascii_digit() {
             i += 1;
         }
-        let digits = i - start;
+        let mut digits = i - start;
         if i + 1 < b.len() && b[i] == b'.' && b[i + 1].is_ascii_digit() {
             i += 1;
+            let point = i;
             while i < b.len() && b[i].is_ascii_digit() {
                 i += 1;
             }
+            digits = digits.max(i - point);
         }
         match text[start..i].parse::<f64>() {
             Ok(v) if digits > MAX_MESSAGE_DIGITS => out.push_str(&format!("{v:e}")),
@@ -136,5 +139,9 @@ mod tests {
         let t = format!("translation {} and seed {} at 0.25 é 3", 1e300 + 0.5, u64::MAX);
         let e = MmusvError::input("pose", t);
         assert_eq!(e.to_string(), "invalid pose: translation 1e300 and seed 18446744073709551615 at 0.25 é 3");
+        // Tiny ones too (`0.000…1`, 302 characters for 1e-300), and the shortest float; ordinary decimals kept.
+        let t = format!("{} and {} but {} in 0.25 s", 1e-300, 5e-324, 0.1 + 0.2);
+        let e = MmusvError::input("omega", t);
+        assert_eq!(e.to_string(), "invalid omega: 1e-300 and 5e-324 but 0.30000000000000004 in 0.25 s");
     }
 }

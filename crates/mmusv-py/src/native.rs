@@ -74,6 +74,37 @@ pub fn c_order<'a, T: numpy::Element, D: Dimension>(
     arr.as_slice().map_err(|_| refused())
 }
 
+/// Refuses the first entry of `values` that is not finite, naming it `name[i]` with its value: the wave field's
+/// point queries and the hull's RAOs return NaN for it, which every later sum would carry without a word.
+pub fn all_finite(values: &[f64], name: &str) -> PyResult<()> {
+    match values.iter().position(|v| !v.is_finite()) {
+        Some(i) => Err(not_allowed(&format!("{name}[{i}]"), values[i], "a finite number")),
+        None => Ok(()),
+    }
+}
+
+/// [`all_finite`] over rows of `K`, naming the entry `name[i][j]`.
+pub fn rows_finite<const K: usize>(rows: &[[f64; K]], name: &str) -> PyResult<()> {
+    match rows.as_flattened().iter().position(|v| !v.is_finite()) {
+        Some(n) => Err(not_allowed(&format!("{name}[{}][{}]", n / K, n % K), rows[n / K][n % K], "a finite number")),
+        None => Ok(()),
+    }
+}
+
+/// Refuses a time `t` (s) that is not finite, naming `name`.
+pub fn finite_time(t: f64, name: &str) -> PyResult<()> {
+    if t.is_finite() {
+        return Ok(());
+    }
+    Err(not_allowed(name, t, "a finite time in seconds"))
+}
+
+/// The error of a number `value` that `field` does not take: "invalid FIELD: VALUE is not allowed; give WHAT",
+/// the core's [`MmusvError::InvalidInput`](mmusv_core::MmusvError) (huge numbers written short).
+pub fn not_allowed(field: &str, value: f64, what: &str) -> PyErr {
+    to_py(mmusv_core::MmusvError::input(field, format!("{value} is not allowed; give {what}")))
+}
+
 /// A rigid pose from 16 row-major numbers of a 4×4 matrix; `field` names the argument in errors.
 pub fn pose_from(m: &[f64], field: &str) -> PyResult<RigidPose> {
     let m: [f64; 16] = m.try_into().map_err(|_| InputError::new_err(format!("{field} must be a 4x4 matrix")))?;

@@ -1,7 +1,7 @@
 //! Bindings for `mmusv_core::ocean`: the wave field, sea-state presets, hull RAOs and response statistics.
 
 use crate::errors::{to_py, InputError};
-use crate::native::{detached, flat, rows, rows_to_array};
+use crate::native::{all_finite, detached, finite_time, flat, not_allowed, rows, rows_finite, rows_to_array};
 use mmusv_core::ocean::{paper_sea_states, presets, response, wmo_sea_states, Hull, SeaSpec, WaveField as CoreField};
 use mmusv_core::MmusvError;
 use numpy::ndarray::Array2;
@@ -32,15 +32,20 @@ fn same_len(a: &[f64], b: &[f64], na: &str, nb: &str) -> PyResult<()> {
 }
 
 /// `f(x[i], y[i])` at each of the world points given as the columns `x`, `y` (m, one entry each; errors name them),
-/// evaluated with the GIL released: the point-wise queries of [`WaveField`].
+/// evaluated with the GIL released: the point-wise queries of [`WaveField`]. A point or time `t` that is not finite
+/// is refused.
 fn at_points<T: Send>(
     py: Python<'_>,
     x: &PyReadonlyArray1<'_, f64>,
     y: &PyReadonlyArray1<'_, f64>,
+    t: f64,
     f: impl Fn(f64, f64) -> T + Sync,
 ) -> PyResult<Vec<T>> {
     let (xs, ys) = (flat(x, "x")?, flat(y, "y")?);
     same_len(xs, ys, "x", "y")?;
+    all_finite(xs, "x")?;
+    all_finite(ys, "y")?;
+    finite_time(t, "t")?;
     detached(py, || Ok(xs.iter().zip(ys).map(|(&a, &b)| f(a, b)).collect()))
 }
 
@@ -98,7 +103,7 @@ impl WaveField {
         t: f64,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let f = &self.inner;
-        Ok(at_points(py, &x, &y, |a, b| f.elevation(a, b, t))?.into_pyarray(py))
+        Ok(at_points(py, &x, &y, t, |a, b| f.elevation(a, b, t))?.into_pyarray(py))
     }
 
     /// `(N, 2)` float64 slopes `[∂η/∂x, ∂η/∂y]` at world points `x`, `y` (m) and time `t` (s).
@@ -110,7 +115,7 @@ impl WaveField {
         t: f64,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let f = &self.inner;
-        rows_to_array(py, at_points(py, &x, &y, |a, b| f.slope(a, b, t))?)
+        rows_to_array(py, at_points(py, &x, &y, t, |a, b| f.slope(a, b, t))?)
     }
 
     /// `(N, 3)` float64 orbital velocities (m/s, world) at `(N, 3)` world points (m) and time `t` (s).
@@ -121,6 +126,8 @@ impl WaveField {
         t: f64,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let p = rows::<f64, 3>(&points, "points")?;
+        rows_finite(p, "points")?;
+        finite_time(t, "t")?;
         let f = &self.inner;
         let out = detached(py, || Ok(p.iter().map(|q| f.orbital_velocity(q[0], q[1], q[2], t)).collect::<Vec<_>>()))?;
         rows_to_array(py, out)
@@ -167,6 +174,10 @@ impl WaveField {
                 return Err(InputError::new_err(format!("{name} has {len} entries for {} times", ts.len())));
             }
         }
+        rows_finite(p, "positions")?;
+        all_finite(yw, "yaw")?;
+        rows_finite(v, "velocities")?;
+        all_finite(ts, "times")?;
         let f = &self.inner;
         let out = detached(py, || {
             use rayon::prelude::*;
@@ -222,6 +233,9 @@ fn dnv_gamma(hs_m: f64, tp_s: f64) -> f64 {
     presets::dnv_gamma(hs_m, tp_s)
 }
 
+/// The wave frequencies (rad/s) [`hull_rao`] takes; its encounter frequencies lie within ± the upper one.
+const RAO_OMEGA_RAD_S: (f64, f64) = (1e-6, 1e6);
+
 /// `(N, 3)` complex128 RAOs (heave m/m, roll rad/m, pitch rad/m) of a hull `[length, beam, draft,
 /// block_coefficient, gm]` for waves of frequency `omega` (rad/s), heading `beta` (rad, 0 following, π head) and
 /// encounter frequency `omega_e` (rad/s), all `(N,)`.
@@ -238,8 +252,23 @@ fn hull_rao<'py>(
     let (w, b, we) = (flat(&omega, "omega")?, flat(&beta, "beta")?, flat(&omega_e, "omega_e")?);
     same_len(w, b, "omega", "beta")?;
     same_len(w, we, "omega", "omega_e")?;
-    if let Some(i) = w.iter().position(|v| !v.is_finite() || *v <= 0.0) {
-        return Err(InputError::new_err(format!("omega[{i}] must be a finite frequency > 0 rad/s")));
+    // Outside [1e-6, 1e6] rad/s (periods of 73 days to 6 µs) the closed forms lose every digit to under- and
+    // overflow: below about 1e-155 rad/s and above 1e77 they were NaN.
+    let (lo, hi) = RAO_OMEGA_RAD_S;
+    if let Some(i) = w.iter().position(|v| !(lo..=hi).contains(v)) {
+        return Err(not_allowed(
+            &format!("omega[{i}]"),
+            w[i],
+            &format!("a wave frequency within [{lo:e}, {hi:e}] rad/s"),
+        ));
+    }
+    all_finite(b, "beta")?;
+    if let Some(i) = we.iter().position(|v| !(-hi..=hi).contains(v)) {
+        return Err(not_allowed(
+            &format!("omega_e[{i}]"),
+            we[i],
+            &format!("an encounter frequency within ±{hi:e} rad/s"),
+        ));
     }
     let rows: Vec<[Complex64; 3]> = (0..w.len())
         .map(|i| {

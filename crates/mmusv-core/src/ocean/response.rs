@@ -229,6 +229,9 @@ pub fn response(field: &WaveField, hull: &Hull, x: f64, y: f64, yaw: f64, vx: f6
     out
 }
 
+/// The fastest speed (m/s) [`response_variance`] takes: far past any vessel, short of where its sums overflow.
+pub const MAX_SPEED_MPS: f64 = 1e6;
+
 /// The spectral prediction of the response variances `[heave m², roll rad², pitch rad²]` of a hull at heading
 /// `yaw` and speed `speed_mps` (along the heading) in the sea `spec`:
 /// `∫∫ |H(ω, θ − yaw, ω_e)|² S(ω) D(θ − θ̄) dω dθ`, by Simpson in ln ω over `[0.1, 40]·ωp` (4000 intervals)
@@ -236,8 +239,13 @@ pub fn response(field: &WaveField, hull: &Hull, x: f64, y: f64, yaw: f64, vx: f6
 pub fn response_variance(hull: &Hull, spec: &SeaSpec, yaw: f64, speed_mps: f64) -> Result<[f64; 3]> {
     spec.validate()?;
     hull.validate()?;
-    if !speed_mps.is_finite() || speed_mps < 0.0 {
-        return Err(MmusvError::config("speed_mps", speed_mps, "must be a finite speed >= 0 m/s"));
+    // Past 1e6 m/s the encounter frequencies overflow (1e200 m/s gave NaN variances); a heading that is not finite
+    // gave NaN too.
+    if !(0.0..=MAX_SPEED_MPS).contains(&speed_mps) {
+        return Err(MmusvError::config("speed_mps", speed_mps, "must be a speed within [0, 1e6] m/s"));
+    }
+    if !yaw.is_finite() {
+        return Err(MmusvError::config("yaw", yaw, "must be a finite heading in radians"));
     }
     if spec.hs == 0.0 {
         return Ok([0.0; 3]);
@@ -453,5 +461,28 @@ mod tests {
         assert!(
             matches!(Hull::new(5.0, 1.0, 1.0, 0.5, -1.0), Err(MmusvError::Config { field, .. }) if field == "hull.gm_m")
         );
+    }
+
+    /// A heading that is not finite, or a speed past [`MAX_SPEED_MPS`], is refused by name: both gave NaN
+    /// variances (a yaw of NaN or ∞; a speed of 1e200 m/s). The fastest speed allowed still gives finite ones.
+    #[test]
+    fn response_variance_refuses_what_it_cannot_sum() {
+        let sea = SeaSpec { hs: 2.0, tp: 8.0, gamma: 3.3, direction_rad: 0.0, spread_s: 10.0 };
+        let hull = ok(Hull::new(5.0, 2.5, 0.5, 0.5, 1.0));
+        for (yaw, speed, field) in [
+            (f64::NAN, 3.0, "yaw"),
+            (f64::INFINITY, 3.0, "yaw"),
+            (0.3, 1e200, "speed_mps"),
+            (0.3, f64::NAN, "speed_mps"),
+            (0.3, -1.0, "speed_mps"),
+        ] {
+            let got = response_variance(&hull, &sea, yaw, speed);
+            assert!(
+                matches!(&got, Err(MmusvError::Config { field: f, .. }) if f == field),
+                "yaw {yaw}, speed {speed}: {got:?}"
+            );
+        }
+        let fastest = ok(response_variance(&hull, &sea, 0.3, MAX_SPEED_MPS));
+        assert!(fastest.iter().all(|v| v.is_finite() && *v >= 0.0), "{fastest:?}");
     }
 }
