@@ -53,13 +53,18 @@ vessels:
 ```
 
 The files are read when the scenario is (an error names the scenario, `assets[i]` and the file), and read again in
-the same process only when the asset file or its mesh changed. A name the library already holds (a built-in asset, or
-another file's) is refused, naming both. The scenario's config hash (`manifest.json`'s `config_hash`) covers the
-assets' meshes, so a batch re-run records a scenario again when its mesh changed, rather than skipping it as
-complete. The `scenario.yaml` a run writes beside its recording keeps the paths as written: copy the asset files
-along to run it again from there. The editor (`mmusv editor`) reads a scenario's asset files from its folder
-(`--dir`), relative to it, as `mmusv run` of the saved file does; it reads none outside that folder (Checks names the
-`assets[i]` to fix) but those of the scenario named on its command line.
+the same process only when the asset file or its mesh changed. A name the library already holds (a built-in asset,
+or another of the scenario's files') is refused, naming both. Each scenario sees the built-in assets (and those a
+Python session registered) and its own asset files' assets only, none of another scenario's, wherever several are
+read in one process (a batch, `mmusv run FOLDER`, in one process or its workers; the editor; a study; a Python
+session): two scenarios may each name an asset of theirs `skiff`, and one that lists no asset file cannot use
+another's. The scenario's config hash (`manifest.json`'s `config_hash`) covers the assets' meshes, so a batch re-run
+records a scenario again when its mesh changed, rather than skipping it as complete. The `scenario.yaml` a run
+writes beside its recording keeps the paths as written: copy the asset files along to run it again from there. The
+editor (`mmusv editor`) reads a scenario's asset files from its folder (`--dir`), relative to it, as `mmusv run` of
+the saved file does; it reads none outside that folder (Checks names the `assets[i]` to fix) but those of the
+scenario named on its command line. Its vessel library and asset menus list the built-in assets and the
+open scenario's own.
 
 **Axes.** `up_axis` and `forward_axis` (the file's up and bow directions, any of x, y, z, -x, -y, -z) turn the
 file into the body frame: x forward (bow), y to port, z up, z = 0 the waterline. When an entry gives neither, the

@@ -119,3 +119,37 @@ def test_a_package_without_its_scenarios_says_so(
     assert main(["scenarios"]) != 0
     err = capsys.readouterr().err
     assert err.startswith("mmusv: error: no bundled scenario in ") and "Traceback" not in err, err
+
+
+def test_a_folder_of_a_bundled_name_is_not_taken_for_it_silently(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``mmusv run port_entry -o port_entry`` twice: the second run took the first's output folder for a folder of
+    scenarios and recorded its ``scenario.yaml`` as a batch into it (``port_entry/scenario/``, a ``dataset.json``
+    beside the run), and the editor and ``mmusv study agreement`` said "is a folder". Both meanings are named."""
+    from mmusv.bundled import resolve_spec
+    from mmusv.errors import InputError
+
+    cwd = os.getcwd()
+    os.chdir(tmp_path)
+    try:
+        (tmp_path / "port_entry").mkdir()
+        (tmp_path / "port_entry" / "scenario.yaml").write_bytes((REPO_SCENARIOS / "port_entry.yaml").read_bytes())
+        (tmp_path / "coop_detection").mkdir()
+        said = r"'port_entry' is both a folder here and a bundled scenario: give ./port_entry for the folder or "
+        with pytest.raises(InputError, match=said + r"port_entry\.yaml for the bundled scenario"):
+            resolve_scenario("port_entry")
+        with pytest.raises(InputError, match=r"'coop_detection' is both a folder here and a bundled spec"):
+            resolve_spec("coop_detection")
+        assert resolve_scenario("./port_entry") == Path("port_entry")  # the folder, as typed
+        assert resolve_scenario("port_entry.yaml").read_bytes() == (REPO_SCENARIOS / "port_entry.yaml").read_bytes()
+        from mmusv.config import load_scenario
+
+        with pytest.raises(InputError, match=said):  # it said "'port_entry' is a directory, not a file"
+            load_scenario("port_entry")
+        assert main(["run", "port_entry", "-o", "out", "--frames", "1"]) == 2
+        assert "is both a folder here and a bundled scenario" in capsys.readouterr().err
+        assert not (tmp_path / "out").exists()
+        assert sorted(p.name for p in (tmp_path / "port_entry").iterdir()) == ["scenario.yaml"]
+    finally:
+        os.chdir(cwd)

@@ -90,13 +90,16 @@ def test_an_asset_name_the_library_holds_is_refused_naming_both(tmp_path: Path) 
     (tmp_path / "scen.yaml").write_text(SCENARIO, encoding="utf-8")
     with pytest.raises(ConfigError, match=r"assets\[0\].*asset 'usv_wamv' is already in the library, from the built"):
         load_scenario(tmp_path / "scen.yaml")
-    # another file giving a registered user asset's name: both files named
+    # another of the scenario's own files giving a name an earlier one registered: both files named (another
+    # scenario's file may: tests/test_scenario_assets_per_scenario.py)
     _boat(tmp_path)
-    load_scenario(tmp_path / "scen.yaml")
     other = tmp_path / "other"
     _boat(other)
-    (other / "scen.yaml").write_text(SCENARIO, encoding="utf-8")
-    with pytest.raises(ConfigError) as info:
+    (other / "scen.yaml").write_text(
+        SCENARIO.replace("assets: [boats/skiff.yaml]", "assets: [../boats/skiff.yaml, boats/skiff.yaml]"),
+        encoding="utf-8",
+    )
+    with pytest.raises(ConfigError, match=r"assets\[1\]") as info:
         load_scenario(other / "scen.yaml")
     assert str(other / "scen.yaml") in str(info.value) and str(tmp_path / "boats" / "skiff.yaml") in str(info.value)
 

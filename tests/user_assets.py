@@ -33,3 +33,4 @@ def library_restored() -> Iterator[None]:
         for name in set(asset_names()) - before:
             unregister_asset(name)
         scenario_assets._loaded.clear()
+        scenario_assets._parked.clear()

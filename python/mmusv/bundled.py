@@ -3,7 +3,9 @@
 In the source tree ``python/mmusv/scenarios`` is a link to the repository's ``scenarios/`` folder; a wheel holds
 the files themselves. :func:`resolve_scenario` turns a user's argument into a file: an existing path wins, else a
 bare name (``port_entry``, ``port_entry.yaml``, ``scenarios/port_entry.yaml``) is looked up among the bundled
-scenarios, so ``mmusv run port_entry`` works from any directory.
+scenarios, so ``mmusv run port_entry`` works from any directory. A bare name that is both a folder there and a
+bundled name (the output folder of an earlier ``mmusv run port_entry -o port_entry``) is refused, naming both ways
+to write it (``./port_entry``, ``port_entry.yaml``).
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from mmusv.config import load_scenario
-from mmusv.errors import NotFoundError
+from mmusv.errors import InputError, NotFoundError
 
 __all__ = ["BundledScenario", "bundled_dir", "bundled_scenarios", "resolve_scenario", "resolve_spec"]
 
@@ -37,10 +39,21 @@ def _resolve(
     or under one of the repository-relative ``parents``; else :class:`~mmusv.errors.NotFoundError`, which says so
     when ``name`` is a bundled file of the other kind (``other``: its folder and what to do with it)."""
     p = Path(name)
-    if os.path.exists(p):  # False, where Path.exists raised OSError, for a name too long to be a file's
-        return p
     stem = p.name[: -len(".yaml")] if p.name.endswith(".yaml") else p.name
     bare = p.parent == Path(".")
+    typed = os.fspath(name)
+    if (
+        os.path.isdir(p)
+        and not any(sep in typed for sep in ("/", os.sep))
+        and not typed.endswith(".yaml")
+        and os.path.isfile(folder / f"{stem}.yaml")
+    ):  # `mmusv run port_entry` beside the folder an earlier `-o port_entry` wrote: it ran that folder as a batch
+        raise InputError(
+            f"{noun} {typed!r} is both a folder here and a bundled {noun}: give ./{typed} for the folder "
+            f"or {typed}.yaml for the bundled {noun}"
+        )
+    if os.path.exists(p):  # False, where Path.exists raised OSError, for a name too long to be a file's
+        return p
     if bare or p.parent in (Path(x) for x in parents):
         cand = folder / f"{stem}.yaml"
         if os.path.isfile(cand):

@@ -31,6 +31,7 @@ from typing import Annotated, Any, Literal
 from pydantic import (
     BaseModel,
     Field,
+    PrivateAttr,
     SerializationInfo,
     ValidationError,
     ValidationInfo,
@@ -42,6 +43,7 @@ from pydantic_core import InitErrorDetails, PydanticCustomError
 
 from mmusv.config_errors import short_repr, validation_error, validation_problems
 from mmusv.errors import ConfigError, MmusvError, located
+from mmusv.scenario_assets import AssetHome
 from mmusv.sensors.config import RigConfig
 from mmusv.strict import StrictModel
 from mmusv.world.environment import MAX_WAVE_HEIGHT_M, Environment, wave_height_m, wave_problem
@@ -328,6 +330,8 @@ class Scenario(_Model):
     """Asset YAML files of the user's own vessels (meshes or procedural entries), relative to the scenario's folder:
     :func:`load_scenario` builds and registers them before the vessels are read (:mod:`mmusv.scenario_assets`)."""
     vessels: list[VesselConfig] = Field(min_length=1)
+    _asset_home: AssetHome | None = PrivateAttr(default=None)
+    """Where its user assets come from, when :func:`load_scenario` read it (:mod:`mmusv.scenario_assets`)."""
 
     @field_validator("rigs", mode="before")
     @classmethod
@@ -434,26 +438,34 @@ def load_scenario(source: str | os.PathLike[str] | dict[str, Any] | Scenario) ->
     not exist but names a bundled scenario (``"port_entry"``) is that scenario, as on the command line
     (:func:`mmusv.bundled.resolve_scenario`)."""
     if isinstance(source, Scenario):
+        home = source._asset_home
+        if home is not None and not home.held():  # another scenario was read since: the library held for it again
+            from mmusv.scenario_assets import use_scenario_assets
+
+            use_scenario_assets(list(home.entries), base_dir=home.base_dir, where=home.where)
         return source
     if isinstance(source, str) and ("\n" in source or "\r" in source):  # the path's OSError said "File name too long"
         raise ConfigError(
             "the scenario is given as text (it holds line breaks), not as the path of a file: give the path of its "
             ".yaml file, or the mapping (yaml.safe_load(text))"
         )
-    if isinstance(source, (str, os.PathLike)) and not os.path.exists(source):
+    if isinstance(source, (str, os.PathLike)) and not os.path.isfile(source):  # a folder: a bundled name too?
         from mmusv.bundled import resolve_scenario
         from mmusv.errors import NotFoundError
 
         with contextlib.suppress(NotFoundError):  # not bundled either: the file error below names the path
             source = resolve_scenario(os.fspath(source))
     data, where = mapping_source(source, kind="scenario", root_hint="at least `vessels:`")
-    if data.get("assets"):  # the user's own vessels, registered before the vessels naming them are read
-        from mmusv.scenario_assets import register_scenario_assets, scenario_base
+    # the user's own vessels, registered before the vessels naming them are read; those of the other scenarios read
+    # in this process taken out of the library first (a batch, a study or a Python session reads several)
+    from mmusv.scenario_assets import scenario_base, use_scenario_assets
 
-        path = source if isinstance(source, (str, os.PathLike)) else None
-        register_scenario_assets(data["assets"], base_dir=scenario_base(path), where=where)
+    path = source if isinstance(source, (str, os.PathLike)) else None
+    home = use_scenario_assets(data.get("assets"), base_dir=scenario_base(path), where=where)
     try:
-        return Scenario.model_validate(data)
+        scenario = Scenario.model_validate(data)
+        scenario._asset_home = home  # load_scenario of it holds the library for it again (mmusv.run, Simulation)
+        return scenario
     except ValidationError as exc:
         if "combinations" in data and "vessels" not in data:  # a spec's dozen "invalid config" problems said less
             shown = where if isinstance(source, (str, os.PathLike)) else "SPEC.yaml"

@@ -157,6 +157,10 @@ def validation_problems(
         msg = str(e["msg"]).removeprefix("Value error, ")
         if e["type"] == "missing":  # pydantic's input is the mapping the field is missing from, not the field's
             shown, msg = "<missing>", "required"
+        if e["type"] == "too_short":  # was pydantic's "List should have at least 1 item after validation, not 0"
+            ctx = e.get("ctx", {})
+            n, got = ctx.get("min_length", 1), ctx.get("actual_length")
+            msg = f"must hold at least {n} {'entry' if n == 1 else 'entries'}, got {got}"
         if e["type"] == "string_pattern_mismatch":
             msg = _pattern_words(e.get("ctx", {}).get("pattern"), value) or msg
         if e["type"] == "extra_forbidden" and model is not None:

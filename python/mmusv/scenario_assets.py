@@ -8,11 +8,21 @@ keys: ``name``, ``mesh``, ``scale``, ``draft``, ...) or a list of them (a catalo
 :func:`~mmusv.world.vessels.load_asset_catalog`). A relative path is relative to the scenario file's folder (the
 current folder for a scenario given as a mapping); a mesh path inside the asset file is relative to that file.
 
-Reading the same scenario again in one process rebuilds an asset only when its file or the mesh it names changed
-(size or modification time), and replaces it; an asset name that another file, a Python ``register_asset`` call or
-the built-in library already holds is refused, naming both. :func:`asset_digest` gives the SHA-256 of the user
-assets a scenario uses, which :func:`mmusv.config.scenario_hash` folds in: a changed mesh is a changed
-configuration, so a batch records it again instead of skipping it as complete.
+Each scenario sees the built-in library, the assets registered by Python calls and its own asset files' assets,
+none of another scenario's: the library is one per process, and a batch (``mmusv run FOLDER``, in one process or in
+reused workers), the editor, a study or a Python session reads several scenarios in one, so two scenarios' files may
+each name an asset ``skiff`` and a scenario that lists no asset file cannot use another's (as ``mmusv run`` of it
+cannot). :func:`use_scenario_assets` (:func:`mmusv.config.load_scenario`) first takes the assets of the other files
+read so far out of the library (:func:`keep_scenario_assets`; taken out, they are put back without being built again
+when their scenario is read next, unless their file changed), then registers the scenario's own; a
+:class:`~mmusv.config.Scenario` loaded before another remembers its files (:class:`AssetHome`), and
+``load_scenario`` of it (what ``mmusv.run``, :class:`~mmusv.simulation.Simulation` and the studies call) holds the
+library for it again. Reading the same scenario again rebuilds an asset only when its file or the mesh it names
+changed (size or modification time), and replaces it; an asset name that another of the scenario's files, a Python
+``register_asset`` call or the built-in library already holds is refused, naming both.
+:func:`asset_digest` gives the SHA-256 of the user assets a scenario uses, which
+:func:`mmusv.config.scenario_hash` folds in: a changed mesh is a changed configuration, so a batch records it again
+instead of skipping it as complete.
 """
 
 from __future__ import annotations
@@ -21,16 +31,112 @@ import hashlib
 import os
 import threading
 from collections.abc import Iterable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from mmusv.errors import ConfigError
 
-__all__ = ["asset_digest", "register_scenario_assets"]
+__all__ = [
+    "AssetHome",
+    "asset_digest",
+    "asset_file_path",
+    "asset_files",
+    "keep_scenario_assets",
+    "register_scenario_assets",
+    "use_scenario_assets",
+]
 
 _lock = threading.Lock()
 _loaded: dict[str, tuple[tuple[Any, ...], tuple[str, ...]]] = {}
 """Resolved asset file -> (its signature, the names of the assets it registered)."""
+_parked: dict[str, tuple[tuple[Any, ...], list[Any]]] = {}
+"""Resolved asset file -> (its signature, its assets), taken out of the library by :func:`keep_scenario_assets`."""
+
+
+def asset_file_path(base_dir: Path, entry: str) -> Path:
+    """The resolved path of the asset file ``entry`` (an ``assets:`` entry) relative to ``base_dir``;
+    :class:`ValueError` saying why when it cannot name a file (a NUL character, ``~name`` of no user of this machine,
+    a name longer than the system takes), which was an internal error (a traceback) before."""
+    try:
+        path = (base_dir / Path(entry).expanduser()).resolve()
+        os.stat(path)
+    except RuntimeError:  # expanduser: "Could not determine home directory"
+        raise ValueError(f"{entry.split('/', 1)[0]!r} names no user of this machine") from None
+    except ValueError:
+        raise ValueError("it holds a NUL character, which no file name can") from None
+    except (FileNotFoundError, NotADirectoryError):
+        pass  # said by the caller: it does not exist
+    except OSError as exc:  # a name too long, a folder that cannot be read
+        raise ValueError(f"not a file this system can open ({exc.strerror or exc})") from None
+    return path
+
+
+def asset_files(entries: Any, base_dir: Path) -> frozenset[Path]:
+    """The resolved asset files a scenario's ``assets:`` value ``entries`` lists, relative to ``base_dir``: those of
+    its entries that can name a file (:func:`register_scenario_assets` says what is wrong with the others)."""
+    out: set[Path] = set()
+    for entry in entries if isinstance(entries, list) else ():
+        if isinstance(entry, str) and entry.strip():
+            try:
+                out.add(asset_file_path(base_dir, entry))
+            except ValueError:
+                continue
+    return frozenset(out)
+
+
+@dataclass(frozen=True, eq=False)
+class AssetHome:
+    """Where the user assets of a loaded :class:`~mmusv.config.Scenario` come from: its ``assets:`` entries, the
+    folder they are relative to and the scenario's name in messages (``where``), for :func:`use_scenario_assets` to
+    hold the library for it again after another scenario was read. Not part of the scenario's value: it compares
+    equal to any other (and to none), so a scenario equals another of the same fields, as before."""
+
+    entries: tuple[str, ...]
+    base_dir: Path
+    where: str
+
+    def __eq__(self, other: object) -> bool:
+        return other is None or isinstance(other, AssetHome)
+
+    def __hash__(self) -> int:
+        return 0
+
+    def held(self) -> bool:
+        """Whether the library holds the assets of exactly this scenario's files, of no other scenario's."""
+        with _lock:
+            return set(_loaded) == {str(p) for p in asset_files(list(self.entries), self.base_dir)}
+
+
+def use_scenario_assets(entries: Any, *, base_dir: Path, where: str) -> AssetHome:
+    """Holds the library for one scenario (see the module docstring): the assets of other scenarios' files out
+    (:func:`keep_scenario_assets`), those of ``entries`` (its ``assets:`` value, relative to ``base_dir``) in
+    (:func:`register_scenario_assets`, whose :class:`~mmusv.errors.ConfigError` it raises); its :class:`AssetHome`."""
+    keep_scenario_assets(asset_files(entries, base_dir))
+    if entries:
+        register_scenario_assets(entries, base_dir=base_dir, where=where)
+    return AssetHome(tuple(entries) if isinstance(entries, list) else (), base_dir, where)
+
+
+def keep_scenario_assets(paths: Iterable[Path]) -> None:
+    """Takes out of the library the assets of every asset file read so far that is not among ``paths`` (resolved
+    asset file paths: those of the scenario about to be read), so that its names are free for that scenario's own
+    files and a name it does not list is unknown to it, as to ``mmusv run`` of that file. Assets registered by
+    other means (the built-in library, a Python ``register_asset`` call) stay."""
+    from mmusv.world.vessels import get_asset, unregister_asset
+
+    keep = {str(p) for p in paths}
+    with _lock:
+        for key in [k for k in _loaded if k not in keep]:
+            sig, names = _loaded.pop(key)
+            assets = []
+            for name in names:
+                try:
+                    assets.append(get_asset(name))
+                    unregister_asset(name)
+                except KeyError:  # unregistered meanwhile by other means: built again when needed
+                    continue
+            _parked[key] = (sig, assets)
 
 
 def _stat(path: Path) -> tuple[str, int, int]:
@@ -67,7 +173,10 @@ def register_scenario_assets(entries: Any, *, base_dir: Path, where: str) -> Non
         field = f"{where}: invalid scenario assets[{i}] = {entry!r:.80}"
         if not isinstance(entry, str) or not entry.strip():
             raise ConfigError(f"{field}: must be the path of an asset YAML file (relative to the scenario's folder)")
-        path = (base_dir / Path(entry).expanduser()).resolve()
+        try:
+            path = asset_file_path(base_dir, entry)
+        except ValueError as exc:
+            raise ConfigError(f"{field}: {exc}; give the path of an asset YAML file") from None
         if not path.is_file():
             what = "is a folder" if path.is_dir() else "does not exist"
             raise ConfigError(f"{field}: {path} {what}; give an asset YAML file (docs/assets.md)")
@@ -76,15 +185,19 @@ def register_scenario_assets(entries: Any, *, base_dir: Path, where: str) -> Non
                 sig = _signature(path)
                 if str(path) in _loaded and _loaded[str(path)][0] == sig:  # unchanged since last read
                     continue
-                data = read_yaml(path, kind="asset file")
-                is_list = isinstance(data, list) or (isinstance(data, dict) and "vessels" in data)
-                if not is_list and not isinstance(data, dict):  # (load_asset_file's message names its Python twin)
-                    raise ConfigError(
-                        f"{path} holds {_kind(data)}, not an asset: "
-                        "an asset file holds one asset (a mapping with a name and a mesh or a hull) or a list of "
-                        "them (docs/assets.md)"
-                    )
-                assets = load_asset_catalog(path) if is_list else [load_asset_file(path)]
+                parked = _parked.pop(str(path), None)
+                if parked is not None and parked[0] == sig:  # taken out by keep_scenario_assets: put back
+                    assets = parked[1]
+                else:
+                    data = read_yaml(path, kind="asset file")
+                    is_list = isinstance(data, list) or (isinstance(data, dict) and "vessels" in data)
+                    if not is_list and not isinstance(data, dict):  # (load_asset_file's message names its twin)
+                        raise ConfigError(
+                            f"{path} holds {_kind(data)}, not an asset: "
+                            "an asset file holds one asset (a mapping with a name and a mesh or a hull) or a list "
+                            "of them (docs/assets.md)"
+                        )
+                    assets = load_asset_catalog(path) if is_list else [load_asset_file(path)]
             except (AssetSpecError, ConfigError, OSError) as exc:
                 raise ConfigError(f"{field}: {exc}") from None
             previous = _loaded.pop(str(path), (None, ()))[1]

@@ -10,6 +10,7 @@ from typing import Any
 
 import pytest
 from editor_server import LiveServer, serve
+from user_assets import library_restored
 
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
 CHROMEDRIVER = shutil.which("chromedriver") or "/usr/bin/chromedriver"
@@ -47,3 +48,10 @@ def folder(tmp_path: Path) -> Path:
     d = tmp_path / "scenarios"
     d.mkdir()
     return d
+
+
+@pytest.fixture
+def _library() -> Iterator[None]:
+    """The vessel library put back as it was after the test (the user assets it registered taken out)."""
+    with library_restored():
+        yield

@@ -19,13 +19,14 @@ class LiveServer:
 
 
 @contextlib.contextmanager
-def serve(folder: Path) -> Iterator[LiveServer]:
-    """An editor server on ``folder`` at a free port of 127.0.0.1, in a thread; stopped (its runs too) on exit."""
+def serve(folder: Path, *, initial: Any = None) -> Iterator[LiveServer]:
+    """An editor server on ``folder`` at a free port of 127.0.0.1, in a thread; stopped (its runs too) on exit.
+    ``initial``: the scenario of its command line (an :class:`mmusv.editor.app.InitialScenario`)."""
     import uvicorn
     from mmusv.editor.app import create_app
     from mmusv.editor.cli import _bind
 
-    app = create_app(folder, allowed_hosts=["127.0.0.1", "localhost"])
+    app = create_app(folder, initial=initial, allowed_hosts=["127.0.0.1", "localhost"])
     sock = _bind("127.0.0.1", 0)
     server = uvicorn.Server(uvicorn.Config(app, log_level="warning", lifespan="off"))
     thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import shutil
 import warnings
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -24,7 +23,7 @@ from mmusv.config import load_scenario
 from mmusv.editor.app import InitialScenario, comments_json, create_app
 from mmusv.editor.document import leading_comment, to_document
 from mmusv.world.vessels import asset_names
-from user_assets import library_restored, write_boat
+from user_assets import write_boat
 
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")
 
@@ -88,12 +87,6 @@ vessels:
   - {id: u, role: usv, asset: usv_wamv, rig: r, speed_mps: 2, route: [[-60, -300], [60, -300]]}
   - {id: s, asset: editor_skiff, speed_mps: 3, route: [[0, -280], [40, -280]]}
 """
-
-
-@pytest.fixture
-def _library() -> Iterator[None]:
-    with library_restored():
-        yield
 
 
 @pytest.mark.usefixtures("_library")

@@ -49,7 +49,7 @@ def test_serves_the_named_scenario_on_loopback_and_stops_on_ctrl_c(tmp_path: Pat
     ("args", "says"),
     [
         (["editor", "--dir", "/nonexistent/folder"], "does not exist"),
-        (["editor", "no_such_scenario.yaml"], "does not exist and is not a bundled scenario"),
+        (["editor", "no_such_scenario"], "does not exist and is not a bundled scenario"),
         (["editor", "--port", "70000"], "--port 70000"),
     ],
 )

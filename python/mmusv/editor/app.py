@@ -6,7 +6,10 @@ Endpoints (JSON in and out unless said otherwise; errors are ``{"error": "..."}`
 ``GET /``                 the page (``static/index.html``); ``/static/...`` its CSS and JavaScript modules
 ``GET /api/info``         version, folder, the scenario given on the command line (its file as it is now, when it
                           is the folder's), choices from the schema
-``GET /api/assets``       the vessel library (name, category, class, sizes in metres, USV or not)
+``GET /api/assets``       the vessel library (name, category, class, sizes in metres, USV or not) of a scenario:
+                          the built-in assets and, with ``?assets=PATH`` (once per entry of the scenario's
+                          ``assets:``, in order), its own asset files' assets, none of another scenario's (an entry
+                          that cannot be read adds nothing: the checks of the scenario say why)
 ``GET /api/bundled``      the bundled scenarios; ``GET /api/bundled/{name}`` one of them as a document
 ``GET /api/files``        the scenario files in the folder; ``GET /api/files/{name}`` one as a document, with
                           its ``etag`` (also the ``ETag`` header); both documents come with the file's leading
@@ -52,7 +55,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Annotated, Any
 
-from fastapi import FastAPI, Request
+from fastapi import FastAPI, Query, Request
 from fastapi import Path as PathParam
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import FileResponse, JSONResponse, Response
@@ -68,7 +71,7 @@ from mmusv.editor.bodies import DocumentBody, FrameBody, MapBody, PreviewBody, R
 from mmusv.editor.carry import value_count
 from mmusv.editor.comments import Comment, moved_note, read_comments
 from mmusv.editor.document import leading_comment, scenario_file, to_document
-from mmusv.editor.evaluate import MAX_BULK_FRAMES, evaluate, poses_at, validate
+from mmusv.editor.evaluate import MAX_BULK_FRAMES, AssetScope, evaluate, poses_at, register_assets, validate
 from mmusv.editor.files import ScenarioFolder, check_name, etag
 from mmusv.editor.jobs import Jobs
 from mmusv.editor.maplayers import map_layers
@@ -105,6 +108,8 @@ class InitialScenario:
     """The ETag of the file when ``in_folder`` (the page saves it with ``If-Match``)."""
     comments: list[dict[str, Any]] = field(default_factory=list)
     """The file's other comments (:func:`comments_json`), which the page sends back when it saves."""
+    new: bool = False
+    """The file does not exist yet: the document is a new scenario (:func:`mmusv.editor.opening.new_document`)."""
 
 
 def comments_json(text: str) -> list[dict[str, Any]]:
@@ -133,6 +138,7 @@ def create_app(
     if initial is not None and initial.in_folder and initial.etag is None:  # the version the page starts from
         initial = replace(initial, etag=store.etag_of(initial.name))
     jobs = Jobs(store.root)
+    scope = AssetScope(store.root)  # the user assets of the scenario of each request, no other scenario's
     evaluate_lock, preview_lock = threading.Lock(), threading.Lock()
     app = FastAPI(title="mmusv editor", docs_url=None, redoc_url=None, openapi_url=None)
     app.state.jobs = jobs
@@ -199,16 +205,21 @@ def create_app(
         """The command line's scenario as a page loaded now sees it: when it is the folder's file, the file as it is
         now (a tab opened after another tab or program saved it showed the version of the server's start, with
         nothing marked unsaved, and its save was refused as changed); the version of the start when it cannot be
-        read now."""
-        if not first.in_folder:
+        read now. A new scenario's file (:attr:`InitialScenario.new`) saved since is that file: a page loaded after
+        the save showed the empty new scenario, said not to exist yet."""
+        if first.new and store.path(first.name).is_file():
+            now = replace(first, new=False, in_folder=True)
+        elif first.in_folder:
+            now = first
+        else:
             return first
         try:
             got = store.read_text(first.name)
-            document, _ = load_document(got.text, first.name, folder=store.root, also=also)
+            document, _ = load_document(got.text, first.name, folder=store.root, also=also, scope=scope)
         except MmusvError:  # deleted, or no longer a scenario the page can show: what the server started with
             return first
         return replace(
-            first,
+            now,
             document=document,
             comment=leading_comment(got.text),
             comments=comments_json(got.text),
@@ -216,23 +227,26 @@ def create_app(
         )
 
     @app.get("/api/assets")
-    def assets() -> list[dict[str, Any]]:
+    def assets_(entries: Annotated[list[str], Query(alias="assets")] = []) -> list[dict[str, Any]]:  # noqa: B006
         from mmusv.world.vessels import library
 
-        return [
-            {
-                "name": a.name,
-                "category": a.category,
-                "class": a.semantic_class.name.lower(),
-                "usv": a.is_usv,
-                "length": round(a.length, 2),
-                "beam": round(a.beam, 2),
-                "height": round(a.height, 2),
-                "draft": round(a.draft, 2),
-                "description": a.description,
-            }
-            for a in library()
-        ]
+        with scope.use({"assets": entries}):
+            for entry in entries:  # one at a time: the assets of every file that can be read, beside one that cannot
+                register_assets({"assets": [entry]}, store.root, also=also)
+            return [
+                {
+                    "name": a.name,
+                    "category": a.category,
+                    "class": a.semantic_class.name.lower(),
+                    "usv": a.is_usv,
+                    "length": round(a.length, 2),
+                    "beam": round(a.beam, 2),
+                    "height": round(a.height, 2),
+                    "draft": round(a.draft, 2),
+                    "description": a.description,
+                }
+                for a in library()
+            ]
 
     @app.get("/api/bundled")
     def bundled() -> list[dict[str, Any]]:
@@ -266,7 +280,7 @@ def create_app(
         if stem not in files:
             raise NotFoundError(f"no bundled scenario {name!r}; bundled: {', '.join(sorted(files))}")
         text = files[stem].read_text(encoding="utf-8")
-        doc, valid = load_document(text, f"bundled {files[stem].name}")
+        doc, valid = load_document(text, f"bundled {files[stem].name}", scope=scope)
         return {
             "name": files[stem].name,
             "document": doc,
@@ -289,7 +303,7 @@ def create_app(
         name = _sent_name(request, name)
         got = store.read_text(name)  # the text and the ETag of the same bytes, read once
         text, tag = got.text, got.etag
-        doc, valid = load_document(text, name, folder=store.root, also=also)
+        doc, valid = load_document(text, name, folder=store.root, also=also, scope=scope)
         return JSONResponse(
             {
                 "name": name,
@@ -305,7 +319,8 @@ def create_app(
     @app.put("/api/files/{name:path}")
     def write_file(name: str, body: SaveBody, request: Request) -> JSONResponse:
         name = check_name(_sent_name(request, name))
-        scenario, errors = validate(body.document, folder=store.root, also=also)
+        with scope.use(body.document):
+            scenario, errors = validate(body.document, folder=store.root, also=also)
         if scenario is None:
             raise ConfigError(
                 f"{name}: not saved, the scenario does not validate: " + "; ".join(e["message"] for e in errors)
@@ -357,7 +372,7 @@ def create_app(
 
     @app.post("/api/evaluate")
     def evaluate_(body: DocumentBody) -> dict[str, Any]:
-        with evaluate_lock:
+        with scope.use(body.document), evaluate_lock:
             return evaluate(body.document, folder=store.root, also=also)
 
     def _valid(document: dict[str, Any]) -> Scenario:
@@ -368,19 +383,21 @@ def create_app(
 
     @app.post("/api/poses")
     def poses(body: FrameBody) -> dict[str, Any]:
-        scenario = _valid(body.document)
-        return {"frame": body.frame, "poses": poses_at(scenario, body.frame)}
+        with scope.use(body.document):
+            scenario = _valid(body.document)
+            return {"frame": body.frame, "poses": poses_at(scenario, body.frame)}
 
     @app.post("/api/preview")
     def preview(body: PreviewBody) -> Response:
         from mmusv.editor.preview import preview_png
         from mmusv.generate.mapctx import map_context
 
-        scenario = _valid(body.document)
-        with evaluate_lock:
-            world = map_context(scenario.map.type, seed=scenario.map.seed, params=scenario.map.param_values()).world
-        with preview_lock:
-            png = preview_png(scenario, frame=body.frame, agent=body.agent, world=world)
+        with scope.use(body.document):
+            scenario = _valid(body.document)
+            with evaluate_lock:
+                world = map_context(scenario.map.type, seed=scenario.map.seed, params=scenario.map.param_values()).world
+            with preview_lock:
+                png = preview_png(scenario, frame=body.frame, agent=body.agent, world=world)
         return Response(png, media_type="image/png")
 
     @app.post("/api/runs")
@@ -392,7 +409,8 @@ def create_app(
             from mmusv.config import load_scenario
 
             try:
-                total: int | None = load_scenario(path).acquisition.frames
+                with scope.use(yamlio.parse_yaml(store.read_text(body.name).text, body.name)):
+                    total: int | None = load_scenario(path).acquisition.frames
             except MmusvError:
                 total = None  # the run says what is wrong with the file
             if total is not None and body.frames > total:

@@ -10,12 +10,13 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import os
 import socket
 import sys
 from pathlib import Path
 from typing import Any
 
-from mmusv.errors import ConfigError, IoError
+from mmusv.errors import ConfigError, IoError, NotFoundError
 
 __all__ = ["DEFAULT_PORT", "add_parser", "run", "serve"]
 
@@ -81,6 +82,38 @@ def serve(app: Any, *, host: str, port: int, announce: bool = True) -> None:
         sock.close()
 
 
+def _new_scenario(given: str, missing: NotFoundError, *, folder: Path, dir_given: bool) -> tuple[Any, Path]:
+    """The page's first scenario and the editor's folder for SCENARIO ``given``, a file that does not exist yet
+    (``missing`` says so): a new scenario, saved into the folder under the file's name (``given``'s folder unless
+    ``--dir`` names one). Refused, saying why, when ``given`` does not end in .yaml or .yml (a mistyped bundled
+    name, more likely), when its folder does not exist, or when its name is not one the editor saves."""
+    from mmusv.editor.app import InitialScenario
+    from mmusv.editor.files import check_name
+    from mmusv.editor.opening import new_document
+
+    path = Path(given)
+    if os.path.islink(path):  # a link that leads nowhere: said so (a save would not write through it)
+        raise missing
+    if path.suffix not in (".yaml", ".yml"):
+        raise NotFoundError(f"{missing}; to start a new scenario, give a file name ending in .yaml") from None
+    if not path.parent.is_dir():
+        what = "is a file, not a folder" if path.parent.exists() else "does not exist"
+        raise NotFoundError(
+            f"scenario {given!r}: cannot start a new scenario there: the folder {str(path.parent)!r} {what}; "
+            "create it first, or give a file name in an existing folder"
+        )
+    name = check_name(path.name)
+    if not dir_given:
+        folder = path.parent
+    print(
+        f"mmusv editor: {given} does not exist yet: opening a new scenario, which Save writes to "
+        f"{folder.resolve() / name}",
+        file=sys.stderr,
+    )
+    initial = InitialScenario(name=name, document=new_document(path.stem), comment="", new=True)
+    return initial, folder
+
+
 def run(args: argparse.Namespace) -> int:
     """Runs ``mmusv editor`` with parsed ``args``; returns the exit status."""
     from mmusv.bundled import resolve_scenario
@@ -88,41 +121,50 @@ def run(args: argparse.Namespace) -> int:
     from mmusv.config import load_scenario
     from mmusv.editor.app import InitialScenario, comments_json, create_app
     from mmusv.editor.document import leading_comment, to_document
-    from mmusv.editor.files import check_name
+    from mmusv.editor.files import check_name, read_bounded
     from mmusv.editor.opening import load_document
     from mmusv.errors import MmusvError
+    from mmusv.yamlio import decode_text
 
     initial = None
     asset_files: list[Path] = []  # the command line's scenario's own asset files, which may lie outside the folder
     # an empty --dir served the current folder, an empty SCENARIO read "." (a folder): both named now
     folder = Path(path_arg(args.dir, flag="--dir")) if args.dir is not None else Path.cwd()
     if args.scenario is not None:
-        path = resolve_scenario(path_arg(args.scenario, flag="scenario"))
-        if path.is_dir():  # it was read as a file: "DIR: Is a directory"
-            raise ConfigError(
-                f"scenario {args.scenario!r} is a folder, not a scenario file: give a YAML file, or --dir "
-                f"{args.scenario} to edit the scenarios in that folder"
-            )
-        if args.dir is None and Path(args.scenario).is_file():
-            folder = path.parent
-        text = path.read_text(encoding="utf-8", errors="replace")
+        given = path_arg(args.scenario, flag="scenario")
+        path: Path | None
         try:
-            scenario = load_scenario(path)  # (reads its asset files, relative to its folder)
-            document = to_document(scenario)
-            asset_files = [(path.parent / Path(a).expanduser()).resolve() for a in scenario.assets]
-        except MmusvError as exc:  # opened to be fixed, as the page opens such a file: refused only when it cannot
-            document, _ = load_document(text, str(path))  # draw it (a ConfigError saying why)
-            print(f"mmusv editor: {exc}; the page lists what is wrong under Checks", file=sys.stderr)
-        name = path.name if path.suffix in (".yaml", ".yml") else f"{path.name}.yaml"
-        if name != path.name:  # the page was told it is the folder's file NAME.yaml, and saved that beside it
-            print(f"mmusv editor: the editor saves .yaml files: {path.name} is saved as {name}", file=sys.stderr)
-        initial = InitialScenario(
-            name=check_name(name),
-            document=document,
-            comment=leading_comment(text),
-            comments=comments_json(text),
-            in_folder=path.resolve().parent == folder.resolve() and name == path.name,
-        )
+            path = resolve_scenario(given)
+        except NotFoundError as exc:  # a new file: it was refused as "does not exist"
+            initial, folder = _new_scenario(given, exc, folder=folder, dir_given=args.dir is not None)
+            path = None
+        if path is not None:
+            if path.is_dir():  # it was read as a file: "DIR: Is a directory"
+                raise ConfigError(
+                    f"scenario {args.scenario!r} is a folder, not a scenario file: give a YAML file, or --dir "
+                    f"{args.scenario} to edit the scenarios in that folder"
+                )
+            if args.dir is None and Path(args.scenario).is_file():
+                folder = path.parent
+            # a binary or UTF-16 file: was read with replacement characters and refused as "not valid YAML"
+            text = decode_text(read_bounded(path, str(path)), str(path))
+            try:
+                scenario = load_scenario(path)  # (reads its asset files, relative to its folder)
+                document = to_document(scenario)
+                asset_files = [(path.parent / Path(a).expanduser()).resolve() for a in scenario.assets]
+            except MmusvError as exc:  # opened to be fixed, as the page opens such a file: refused only when it cannot
+                document, _ = load_document(text, str(path))  # draw it (a ConfigError saying why)
+                print(f"mmusv editor: {exc}; the page lists what is wrong under Checks", file=sys.stderr)
+            name = path.name if path.suffix in (".yaml", ".yml") else f"{path.name}.yaml"
+            if name != path.name:  # the page was told it is the folder's file NAME.yaml, and saved that beside it
+                print(f"mmusv editor: the editor saves .yaml files: {path.name} is saved as {name}", file=sys.stderr)
+            initial = InitialScenario(
+                name=check_name(name),
+                document=document,
+                comment=leading_comment(text),
+                comments=comments_json(text),
+                in_folder=path.resolve().parent == folder.resolve() and name == path.name,
+            )
     host = str(args.host)
     hosts = ["*"] if host in ("0.0.0.0", "::", "") else sorted({host, "127.0.0.1", "localhost", "[::1]"})
     app = create_app(folder, initial=initial, allowed_hosts=hosts, asset_files=asset_files)

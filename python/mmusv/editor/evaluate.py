@@ -28,9 +28,11 @@ World frame, metres, radians (yaw from +x, counter-clockwise); coordinates round
 
 from __future__ import annotations
 
+import contextlib
 import re
+import threading
 import warnings
-from collections.abc import Collection
+from collections.abc import Collection, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -50,6 +52,7 @@ from mmusv.world.vessels import get_asset
 __all__ = [
     "MAX_BULK_FRAMES",
     "MAX_PROBLEMS",
+    "AssetScope",
     "evaluate",
     "poses_at",
     "register_assets",
@@ -79,6 +82,51 @@ def _error(field: str, message: str, document: dict[str, Any]) -> dict[str, Any]
     return {"field": field, "message": message, "vessel": _vessel_of(field, document)}
 
 
+class AssetScope:
+    """The user assets one editor server's requests see: those of the asset files the scenario of the request lists
+    (``assets:``), none of another scenario's. The vessel library is one per process, so two scenario files that
+    each name an asset ``skiff`` in their own asset file clashed ("already in the library") when the second was
+    opened, and a scenario that listed no asset file validated with another scenario's assets; now
+    :meth:`use` takes the assets of other files out of the library first
+    (:func:`mmusv.scenario_assets.keep_scenario_assets`, as :func:`mmusv.config.load_scenario` does for each
+    scenario it reads; what a scope adds is the waiting of threads). Requests of scenarios listing the same asset
+    files run together; one that lists others waits until they have ended (they hold the assets while they build,
+    check or render the scenario)."""
+
+    def __init__(self, folder: str | Path) -> None:
+        self._root = Path(folder).resolve()
+        self._cond = threading.Condition()
+        self._key: frozenset[Path] | None = None
+        self._users = 0
+
+    def key(self, data: Any) -> frozenset[Path]:
+        """The resolved asset files a scenario mapping ``data`` lists (its ``assets:`` entries that are paths)."""
+        from mmusv.scenario_assets import asset_files
+
+        return asset_files(data.get("assets") if isinstance(data, dict) else None, self._root)
+
+    @contextlib.contextmanager
+    def use(self, data: Any) -> Iterator[None]:
+        """Holds the library for the scenario mapping ``data`` (its asset files' assets, and no others'), while the
+        block reads, checks or renders it."""
+        from mmusv.scenario_assets import keep_scenario_assets
+
+        key = self.key(data)
+        with self._cond:
+            while self._users and self._key != key:
+                self._cond.wait()
+            if self._key != key:
+                keep_scenario_assets(key)
+                self._key = key
+            self._users += 1
+        try:
+            yield
+        finally:
+            with self._cond:
+                self._users -= 1
+                self._cond.notify_all()
+
+
 def register_assets(
     document: dict[str, Any], folder: str | Path, *, also: Collection[Path] = ()
 ) -> list[dict[str, Any]]:
@@ -88,7 +136,7 @@ def register_assets(
     those of the scenario named on the command line), or one that does not exist or holds no asset.
     Before, the editor never read them: a scenario of its own vessels did not validate ("unknown asset"), and could
     not be saved, unless the server's current folder happened to be the scenario's when the file was opened."""
-    from mmusv.scenario_assets import register_scenario_assets
+    from mmusv.scenario_assets import asset_file_path, register_scenario_assets
 
     entries = document.get("assets")
     if not isinstance(entries, list) or not entries:
@@ -97,7 +145,11 @@ def register_assets(
     for i, entry in enumerate(entries):
         if not isinstance(entry, str) or not entry.strip():
             continue  # said by register_scenario_assets below
-        path = (root / Path(entry).expanduser()).resolve()
+        field = f"assets[{i}]"
+        try:
+            path = asset_file_path(root, entry)
+        except ValueError as exc:  # was an internal error
+            return [_error(field, f"{field} = {entry!r:.80}: {exc}; give the path of an asset YAML file", document)]
         if root not in path.parents and path not in also:
             field = f"assets[{i}]"
             return [

@@ -44,6 +44,7 @@ __all__ = [
     "ScenarioText",
     "check_name",
     "etag",
+    "read_bounded",
 ]
 
 _NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.\-]{0,122}\.ya?ml")
@@ -61,6 +62,20 @@ class FileExistsInFolder(IoError):
 
 class ChangedInFolder(IoError):
     """Saving would replace a file that changed since the client read it (its ETag differs)."""
+
+
+def read_bounded(path: Path, label: str) -> bytes:
+    """The bytes of the scenario file ``path``, read once and at most :data:`MAX_FILE_BYTES` of them: an
+    :class:`~mmusv.errors.IoError` when it cannot be read, a :class:`~mmusv.errors.ConfigError` when it is larger,
+    each naming ``label``. The editor's one read of a scenario file (its folder's files and the command line's)."""
+    try:
+        with path.open("rb") as f:
+            data = f.read(MAX_FILE_BYTES + 1)
+    except OSError as exc:
+        raise IoError(f"{label}: cannot be read: {exc.strerror or exc}") from None
+    if len(data) > MAX_FILE_BYTES:
+        raise ConfigError(f"{label}: larger than {MAX_FILE_BYTES:,} bytes, the most the editor opens; edit it as text")
+    return data
 
 
 def etag(data: bytes) -> str:
@@ -130,15 +145,7 @@ class ScenarioFolder:
         p = self.path(name)
         if not p.is_file():
             raise NotFoundError(f"no scenario file {name!r} in the editor's folder")
-        try:
-            with p.open("rb") as f:
-                data = f.read(MAX_FILE_BYTES + 1)
-        except OSError as exc:
-            raise IoError(f"{name}: cannot be read: {exc.strerror or exc}") from None
-        if len(data) > MAX_FILE_BYTES:
-            raise ConfigError(
-                f"{name}: larger than {MAX_FILE_BYTES:,} bytes, the most the editor opens; edit it as text"
-            )
+        data = read_bounded(p, name)
         return ScenarioText(p, decode_text(data, name), etag(data))
 
     def etag_of(self, name: str) -> str | None:

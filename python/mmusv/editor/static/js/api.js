@@ -34,7 +34,11 @@ async function call(method, path, body, headers = {}) {
 
 export const api = {
   info: () => call("GET", "/api/info"),
-  assets: () => call("GET", "/api/assets"),
+  // the library of a scenario whose `assets:` lists `entries`: the built-in assets and those of its own asset files
+  assets: (entries = []) => {
+    const query = entries.map((e) => `assets=${encodeURIComponent(e)}`).join("&");
+    return call("GET", query ? `/api/assets?${query}` : "/api/assets");
+  },
   bundled: () => call("GET", "/api/bundled"),
   bundledOne: (name) => call("GET", `/api/bundled/${encodeURIComponent(name)}`),
   files: () => call("GET", "/api/files"),

@@ -167,11 +167,44 @@ async function refreshOpen() {
   sel.value = keep && [...sel.options].some((o) => o.value === keep) ? keep : "";
 }
 
+/** The entries of `doc`'s `assets:` (its own asset files), as the library is asked for them, and their key. */
+function assetEntries(doc) {
+  const entries = Array.isArray(doc?.assets) ? doc.assets.filter((e) => typeof e === "string") : [];
+  return { entries, key: JSON.stringify(entries) };
+}
+
+/** Shows the scenario `opened` (state.load's argument) with its own library: the built-in assets and its asset
+ * files' (the library loaded once at the start listed the assets the server held then, so a scenario opened later
+ * lacked its own and listed another's, refused as "unknown asset" once placed). Both are shown at once, never the
+ * new scenario with the library of the one before. Rejects, showing nothing new, when the library cannot be had. */
+async function show(opened) {
+  const { entries, key } = assetEntries(opened.document);
+  const assets = await api.assets(entries);
+  panels.setAssets(assets, key);
+  state.load(opened);
+}
+
+// A change of the scenario's `assets:` (none of the page's forms makes one; an undo could): its library again
+let libraryAsked = null;
+async function refreshLibrary() {
+  const { entries, key } = assetEntries(state.doc);
+  if (key === panels.assetsKey || key === libraryAsked) return;
+  libraryAsked = key;
+  try {
+    const assets = await api.assets(entries);
+    if (assetEntries(state.doc).key === key) panels.setAssets(assets, key);
+  } catch (err) {
+    status(`vessel library: ${err.message}`, true);
+  } finally {
+    if (libraryAsked === key) libraryAsked = null;
+  }
+}
+
 /** Loads `value` (`file:NAME` or `bundled:NAME`, as the Open box names them); rejects when it cannot. */
 async function load(value) {
   const [kind, name] = [value.slice(0, value.indexOf(":")), value.slice(value.indexOf(":") + 1)];
   const res = kind === "file" ? await api.readFile(name) : await api.bundledOne(name);
-  state.load({
+  await show({
     document: res.document,
     comment: res.comment,
     comments: res.comments,
@@ -181,6 +214,7 @@ async function load(value) {
   savedEtag = kind === "file" ? res.etag : null;
   openedBundled = kind === "bundled" ? name : null;
   bootNote = "";
+  newNote = "";
   remember();
   status(`opened ${kind === "file" ? name : `bundled ${name}`}${res.valid ? "" : " (it does not validate: see Checks)"}`);
 }
@@ -193,6 +227,9 @@ function remember() {
 }
 let openedBundled = null; // the bundled scenario last opened, while no folder file holds the scenario
 let bootNote = ""; // why the scenario the address named (a reload) did not open: said with the checks (showCheck)
+// the command line named a file that does not exist yet: the page shows a new scenario, and says so with the checks
+// (whose verdict, "does not validate" as it has no vessel yet, said nothing of it) until it is edited or saved
+let newNote = "";
 
 async function open(value) {
   if (!value) return;
@@ -207,6 +244,28 @@ async function open(value) {
     status(err.message, true);
   }
   $("open").value = "";
+}
+
+/** The address edited by hand (#file:NAME or #bundled:NAME, Enter in the address bar, or Back to such an address)
+ * opens what it names, asking first when there are unsaved changes, as the Open box does; it changed the address
+ * only, and the page went on showing (and saving) the scenario it had. The address goes back to the scenario shown
+ * when it names none, or the person keeps the changes, or it cannot be opened. */
+async function openAddress() {
+  let asked = "";
+  try {
+    asked = decodeURIComponent(location.hash.slice(1));
+  } catch {
+    // not percent-encoded text: said below
+  }
+  if (!/^(file|bundled):./.test(asked)) {
+    if (location.hash.length > 1) {
+      status(`the address ${location.hash} names no scenario: use #file:NAME.yaml (a file of the folder) or #bundled:NAME`, true);
+    }
+    remember();
+    return;
+  }
+  await open(asked);
+  remember();
 }
 
 /** Shows the latest run of the file open (one that ended too, as a run that just ended shows); else a run going
@@ -244,6 +303,7 @@ async function save(overwrite = false) {
     state.fileName = name;
     state.markSaved(key);
     bootNote = "";
+    newNote = "";
     remember();
     renderAll(); // the title's unsaved mark and file name
     status(`saved ${res.name} (${res.bytes} bytes)${res.note ? `; ${res.note}` : ""}`);
@@ -265,7 +325,8 @@ async function save(overwrite = false) {
         : `${name} was changed by another tab or program since you opened it.`;
       $("save-confirm").hidden = false;
     } else {
-      status(`not saved: ${err.message}`, true);
+      // (the server's "NAME: not saved, the scenario does not validate: ..." read "not saved: NAME: not saved, ...")
+      status(`not saved: ${err.message.replace(/^([^:\s]+): not saved, /, "$1: ")}`, true);
       if (err.status === 400 && err.message.startsWith("file name")) markField("file-name", true);
     }
     return false;
@@ -405,12 +466,27 @@ function renderAll() {
   document.title = `${state.dirty ? "● " : ""}${state.fileName || "scenario"} · mmusv editor`;
 }
 
+/** Ends drawing a route when its vessel is gone (deleted, its placing undone, another scenario opened): the hint
+ * "Click to add waypoints to usv_1" stayed, and the next click on the map only ended the drawing. While it is being
+ * drawn the route is the selected vessel's: the hint follows a rename (or another vessel picked from the list, which
+ * the clicks then add to). Run after the edit's own handlers (a rename selects the new id after the edit). */
+function followDrawing() {
+  queueMicrotask(() => {
+    if (map.mode !== "draw") return;
+    if (!state.vessel(state.selected)) map.setMode("select");
+    else if (map.drawing !== state.selected) map.setMode("draw", { vessel: state.selected });
+  });
+}
+
 state.on("loaded", () => {
   fitOnMap = true;
   ensureMap();
+  followDrawing();
 });
 state.on("doc", () => {
-  if (state.undoStack.length) bootNote = ""; // an edit of the scenario shown instead
+  followDrawing();
+  refreshLibrary();
+  if (state.undoStack.length) bootNote = newNote = ""; // an edit of the scenario shown instead, or of the new one
   ensureMap();
   renderAll();
 });
@@ -424,7 +500,7 @@ state.on("evaluated", () => {
 function showCheck(prefix = "") {
   const ev = state.evaluation;
   const note = bootNote ? `${bootNote}; showing ${state.fileName || "another scenario"} instead · ` : "";
-  prefix = `${note}${prefix}`;
+  prefix = `${note}${newNote ? `${newNote} · ` : ""}${prefix}`;
   if (!ev) status(`${prefix}cannot check: ${state.evalError}`, true);
   else if (!ev.valid) {
     // read out with the first error, its field and what it allows (seen next to the field and under Checks)
@@ -452,6 +528,7 @@ function revealVesselPanel() {
 }
 let revealedSelection = null; // the vessel whose selection last brought the panel into view
 state.on("selection", () => {
+  followDrawing();
   panels.renderFleet();
   panels.renderVessel();
   panels.renderNotes();
@@ -478,6 +555,9 @@ state.on("mode", ({ mode, asset, vessel }) => {
 });
 
 $("open").addEventListener("change", (ev) => open(ev.target.value));
+window.addEventListener("hashchange", () => {
+  if (document.body.dataset.ready === "1") openAddress(); // (while booting, boot reads the address itself)
+});
 // the folder's files as they are when the list is reached (one another tab or program saved since was missing)
 $("open").addEventListener("focus", () => refreshOpen().catch((err) => status(`open: ${err.message}`, true)));
 $("file-name").addEventListener("change", (ev) => {
@@ -584,9 +664,9 @@ window.addEventListener("beforeunload", (ev) => {
 
 async function boot() {
   try {
-    const [info, assets, bundledList] = await Promise.all([api.info(), api.assets(), api.bundled()]);
+    const [info, bundledList] = await Promise.all([api.info(), api.bundled()]);
     bundled = bundledList;
-    panels.init(info.choices, assets);
+    panels.init(info.choices, [], null); // the library comes with the scenario opened below (show)
     await refreshOpen();
     // a page loaded again opens the scenario it had open (the address names it), else the one of the command line
     let asked = "";
@@ -606,7 +686,7 @@ async function boot() {
       }
     }
     if (!opened && info.initial) {
-      state.load({
+      await show({
         document: info.initial.document,
         comment: info.initial.comment,
         comments: info.initial.comments,
@@ -614,10 +694,14 @@ async function boot() {
         savedName: info.initial.in_folder ? info.initial.name : null,
       });
       savedEtag = info.initial.in_folder ? info.initial.etag : null;
+      if (info.initial.new) {
+        newNote = `new scenario: ${info.initial.name} does not exist yet; place vessels from the library, then Save creates it`;
+        status(newNote);
+      }
     } else if (!opened) {
       const first = bundled.find((b) => b.name === "port_entry") || bundled[0];
       const res = await api.bundledOne(first.name);
-      state.load({ document: res.document, comment: res.comment, comments: res.comments, name: res.name });
+      await show({ document: res.document, comment: res.comment, comments: res.comments, name: res.name });
     }
     if (!opened) remember();
     map.applyView();

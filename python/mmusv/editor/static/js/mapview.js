@@ -343,6 +343,7 @@ export class MapView {
   setMode(mode, extra = {}) {
     this.mode = mode;
     this.placing = mode === "place" ? extra : null;
+    this.drawing = mode === "draw" ? extra.vessel : null; // the vessel whose route is being drawn
     this.svg.classList.toggle("placing", mode === "place");
     this.svg.classList.toggle("drawing", mode === "draw");
     this.state.emit("mode", { mode, ...extra });

@@ -89,6 +89,7 @@ export class Panels {
     this.refused = new Map();
     this.lastErrors = [];
     this.libraryStop = null; // the library entry that holds its one tab stop (renderLibrary)
+    this.assetsKey = null; // the `assets:` entries of the scenario whose library is shown (setAssets)
     // The wave a scenario had when a sea was typed over it: clearing the sea brings it back (none: the default W0).
     this.waveBeforeSea = undefined;
     state.on("jump", () => {
@@ -177,13 +178,12 @@ export class Panels {
     }
   }
 
-  init(choices, assets) {
+  init(choices, assets, key) {
     const s = this.state;
     s.choices = choices;
-    s.assets = assets;
+    this.setAssets(assets, key);
     fillSelect($("v-role"), choices.role);
     fillSelect($("v-end"), choices.end.map((e) => [e, e.replace("_", " ")]));
-    fillSelect($("v-asset"), assets.map((a) => [a.name, `${a.name} (${a.length} × ${a.beam} m)`]));
     fillSelect($("m-type"), choices.map_type.map((t) => [t, t.replace("_", " ")]));
     fillSelect($("e-weather"), choices.weather);
     fillSelect($("e-wave"), [...choices.wave.map((w) => [w.name, `${w.name} (H ${w.height_m} m)`]), ["custom", "custom height…"], ["sea", "by the sea"]]);
@@ -197,6 +197,24 @@ export class Panels {
   }
 
   // ------------------------------------------------------------------------------------- library
+
+  /** Shows `assets` (the library of the scenario whose `assets:` entries `key` names: the built-in assets and its own
+   * asset files') in the library and the selected vessel's asset menu. A vessel being placed is placed as the
+   * library's asset of that name now, or no longer when it has none. */
+  setAssets(assets, key) {
+    this.state.assets = assets;
+    this.assetsKey = key;
+    const menu = $("v-asset");
+    const was = menu.value;
+    fillSelect(menu, assets.map((a) => [a.name, `${a.name} (${a.length} × ${a.beam} m)`]));
+    menu.value = was;
+    if (this.map.mode === "place") {
+      const asset = assets.find((a) => a.name === this.map.placing?.asset?.name);
+      if (asset) this.map.setMode("place", { ...this.map.placing, asset });
+      else this.map.setMode("select");
+    }
+    this.renderLibrary();
+  }
 
   renderLibrary() {
     const q = $("library-search").value.trim().toLowerCase();
