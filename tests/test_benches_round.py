@@ -16,6 +16,7 @@ from pathlib import Path
 
 import mmusv
 import pytest
+from help_pages import check_help_page
 
 ROOT = Path(__file__).resolve().parents[1]
 BENCHES = ROOT / "benches"
@@ -72,18 +73,7 @@ def test_help_describes_each_script_and_every_option() -> None:
     pages = dict(re.findall(r"===== (\S+)\n(.*?)(?=\n===== |\Z)", out, re.S))
     assert len(pages) == len(SCRIPTS), out
     for path, page in pages.items():
-        name = Path(path).name
-        body = page.split("\n\n", 1)[1]  # after the usage lines
-        description = " ".join(re.split(r"\n(?:positional arguments|options):\n", body)[0].split())
-        assert description and description[-1] in ".):", f"{name}: description cut short: {description!r}"
-        # every option line carries its help on that line or the next, more indented one
-        lines = body.split("\n")
-        for i, line in enumerate(lines):
-            m = re.match(r"^  (-\S.*?|[a-z]\w*)(?:\s{2,}(\S.*))?$", line)
-            if not m or m.group(1).startswith("-h"):
-                continue
-            follows = i + 1 < len(lines) and re.match(r"^ {6,}\S", lines[i + 1]) is not None
-            assert m.group(2) or follows, f"{name}: option without help: {line.strip()!r}"
+        check_help_page(Path(path).name, page)
 
 
 ZERO_COUNTS = [

@@ -190,8 +190,8 @@ def test_train_threads_and_workers_are_bounded_by_the_cpus(
     ("option", "said"),
     [
         (["--range", "inf"], "--range = inf: must be a finite number of metres > 0"),
-        (["--modes", ""], "--modes '': unknown mode(s) []; allowed: none, late, early, intermediate"),
-        (["--split-ratios", "1,2"], "--split-ratios: split '1,2': expected three fractions"),
+        (["--modes", ""], "--modes '': no mode; allowed: none, late, early, intermediate"),
+        (["--split-ratios", "1,2"], "--split-ratios 1,2: expected three fractions"),
         (["--model", "missing", "--threads", str(10**11)], f"--threads {10**11}: must be at most"),
     ],
 )
@@ -269,7 +269,7 @@ def test_robustness_settings_may_not_be_empty(tmp_path: Path, capsys: pytest.Cap
     """``--settings ""`` ran the clean setting alone: a robustness study of nothing."""
     argv = ["study", "robustness", str(tmp_path / "missing.mcap"), "--settings", "", "-o", str(tmp_path / "rob")]
     _, err = _refused(argv, capsys)
-    assert "--settings is empty" in err, err
+    assert "--settings '': empty; give clean" in err, err
 
 
 def test_jobs_for_one_scenario_is_said_to_do_nothing(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -102,8 +102,8 @@ def test_a_train_of_another_preset_is_refused_once_and_keeps_the_summary(
 @pytest.mark.parametrize(
     ("option", "said"),
     [
-        (["--seed", "-1"], "seed = -1 (--seed): the split's seed must be a whole number >= 0"),
-        (["--split", "bogus"], "split = 'bogus' (--split): expected one of train, validate, test, all"),
+        (["--seed", "-1"], "--seed -1: the split's seed must be a whole number >= 0"),
+        (["--split", "bogus"], "--split bogus: expected one of train, validate, test, all"),
     ],
 )
 def test_a_bad_split_or_seed_is_refused_before_generating(

@@ -153,7 +153,7 @@ def test_a_bad_oxts_origin_is_refused_in_one_line_before_writing(
         # were read as 1, 0 and 45, -2: true/false and texts are not numbers (as the API's other numbers say)
         ((True, False), "kitti_tracking", "oxts_origin = (True, False): must be LAT,LON in degrees"),
         (("45", "-2"), "kitti_tracking", "oxts_origin = ('45', '-2'): must be LAT,LON in degrees"),
-        ((45.0, -2.0), "mot", "oxts_origin = (45.0, -2.0): only --to kitti_tracking writes it, not --to mot"),
+        ((45.0, -2.0), "mot", "oxts_origin = (45.0, -2.0): only to = 'kitti_tracking' writes it, not to = 'mot'"),
     ],
 )
 def test_the_api_refuses_a_bad_oxts_origin_before_writing(

@@ -320,8 +320,8 @@ def test_the_command_renumbers_frames_from_zero_and_writes_the_class(
     assert "or kitti_tracking (the KITTI tracking benchmark's layout" in text and "--kitti-class NAME" in text
     bad = ["convert", str(port_rec), "-o", str(tmp_path / "bad"), "--no-progress", "--kitti-class"]
     for more, said in (
-        (["two words", "--to", "kitti_tracking"], "kitti_class = 'two words': must be one KITTI type word"),
-        (["Car", "--to", "coco"], "kitti_class = 'Car': only --to kitti_tracking writes it, not --to coco"),
+        (["two words", "--to", "kitti_tracking"], "--kitti-class two words: must be one KITTI type word"),
+        (["Car", "--to", "coco"], "--kitti-class Car: only --to kitti_tracking writes it, not --to coco"),
     ):
         assert main([*bad, *more]) == 2
         err = capsys.readouterr().err
@@ -361,7 +361,11 @@ def test_bad_input_is_refused_in_one_line_before_writing(port_rec: Path, no_lida
     out = tmp_path / "o"
     for rec, kwargs, said in (
         (no_lidar_rec, {}, r"export_no_lidar\.mcap: cannot convert to kitti_tracking: no agent with a LiDAR"),
-        (port_rec, {"kitti_class": "Car", "to": "mot"}, r"kitti_class = 'Car': only --to kitti_tracking writes it"),
+        (
+            port_rec,
+            {"kitti_class": "Car", "to": "mot"},
+            r"kitti_class = 'Car': only to = 'kitti_tracking' writes it, not to",
+        ),
         (port_rec, {"kitti_class": 5}, r"kitti_class = 5: must be one KITTI type word"),
         (port_rec, {"kitti_class": "Car "}, r"kitti_class = 'Car ': must be one KITTI type word"),
         (port_rec, {"kitti_class": "DontCare"}, r"kitti_class = 'DontCare': DontCare marks regions to ignore"),

@@ -74,3 +74,19 @@ def test_opv2v_export_writes_the_hypes_beside_it(coop_rec: Path, tmp_path: Path)
     assert doc["root_dir"] == "."  # relative to the export folder: the bytes do not depend on where it is
     g = _grid(doc)
     assert g[0] % BACKBONE_STRIDE == 0 and doc["postprocess"]["anchor_args"]["l"] > 3.9
+
+
+def test_hypes_name_split_folders_that_are_there(coop_rec: Path, tmp_path: Path) -> None:
+    """One recording goes to train: validate_dir said ``validate``, a folder the export does not have (OpenCOOD lists
+    it for its validation and inference); now another split's folder, said in the header. Only test held: both
+    said ``.``, which lists ``test`` and ``opencood`` as scenarios."""
+    for splits, root, val in (((0.7, 0.15, 0.15), "train", "train"), ((0, 0, 1), "test", "test")):
+        out = tmp_path / f"o{root}"
+        convert(coop_rec, to="opv2v", out_dir=out, splits=splits)
+        for f in (out / "opencood").iterdir():
+            text = f.read_text()
+            doc = yaml.safe_load(text)
+            assert (doc["root_dir"], doc["validate_dir"]) == (root, val), f
+            assert (out / doc["root_dir"]).is_dir() and (out / doc["validate_dir"]).is_dir()
+            assert f"# validate_dir is {val}: no recording went to validate" in text
+            assert ("# root_dir is" in text) == (root != "train")

@@ -51,7 +51,7 @@ def test_assign_splits_deterministic_and_order_independent() -> None:
         ((0.5, 0.5), "expected three fractions"),  # zip()'s ValueError
         ((0.7, 0.7, 0.7), "add up to"),  # 7 train, 3 validate, 0 test of 10, without a word
         ((-1.0, 1.0, 1.0), "non-negative"),  # a negative count of recordings for train, without a word
-        ((0.5, float("nan"), 0.5), r"split\[1\] = nan: must be a number"),
+        ((0.5, float("nan"), 0.5), r"^ratios\[1\] = nan: must be a number"),
     ],
 )
 def test_assign_splits_checks_its_ratios(ratios: tuple[float, ...], said: str) -> None:

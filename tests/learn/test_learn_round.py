@@ -106,7 +106,7 @@ def test_a_model_pt_of_another_version_is_one_error_naming_the_field(
     # got an unexpected keyword argument"; an unknown mode: an error that did not name the file
     bad = _variant(model, tmp_path / name / "single", change)
     for path in (bad, bad.parent.parent):
-        with pytest.raises(InputError, match=rf"--model {bad}: not an mmusv\.learn model\.pt {said}"):
+        with pytest.raises(InputError, match=rf"^path = '{bad}': not an mmusv\.learn model\.pt {said}"):
             load_models(path)
     with pytest.raises(InputError, match=said):
         _model(bad, torch.device("cpu"))
@@ -217,7 +217,8 @@ def test_a_damaged_cache_is_named_by_its_array(recording: Path, tmp_path: Path) 
     gt = good["gt"].copy()
     gt[1, 0] = np.nan
     # a NaN box: "ValueError: cannot convert float NaN to integer" in training
-    with pytest.raises(InputError, match=r"nan\.npz: gt: 1 row\(s\) with values that are not finite .* first row 1"):
+    said = r"^cache = '.*nan\.npz': gt: 1 row\(s\) with values that are not finite .* first row 1"  # train's cache
+    with pytest.raises(InputError, match=said):
         train(damaged("nan.npz", gt=gt), p=preset("tiny"), mode="single", out=tmp_path / "m", epochs=1, progress=False)
     offsets = good["cloud_offsets"].copy()
     offsets[-1] += 10
@@ -241,10 +242,10 @@ def test_infer_without_a_model_is_refused_and_writes_the_name_given(
 ) -> None:
     root, cache, _ = peaks_setup
     # a folder without a model: an empty peaks file, exit status 0
-    with pytest.raises(InputError, match=r"--models .*nowhere: no single\|early\|intermediate/model\.pt there"):
+    with pytest.raises(InputError, match=r"^models = '.*nowhere': no single\|early\|intermediate/model\.pt there"):
         infer_cache(cache, models=tmp_path / "nowhere", out=tmp_path / "empty.npz")
     assert not (tmp_path / "empty.npz").exists()
-    with pytest.raises(InputError, match=r"--models .*: no early/model\.pt there"):
+    with pytest.raises(InputError, match=r"^models = '.*': no early/model\.pt there"):
         infer_cache(cache, models=root / "models", out=tmp_path / "early.npz", modes=["early"])
     # -o peaks wrote peaks.npz, and returned the name of a file that was not there
     out = infer_cache(cache, models=root / "models", out=tmp_path / "peaks")
@@ -267,7 +268,11 @@ def test_replay_refuses_peaks_and_caches_that_do_not_fit(peaks_setup: tuple[Path
         write_predictions(short, cache, inputs=[recording], out=tmp_path / "short.parquet", split="all")
     # recordings the cache does not hold: a predictions file without a row
     other = _record("lr_other", tmp_path)
-    with pytest.raises(InputError, match=r"cache_all\.npz: holds no sequence lr_other of split 'all'"):
+    said = (  # write_predictions' own arguments, not the replay command's flags
+        r"^cache = '.*cache_all\.npz': holds no sequence lr_other of split 'all'.* it was built with split = 'all', "
+        r"ratios = \[0\.7, 0\.15, 0\.15\], seed = 0\); give the inputs, split, ratios and seed"
+    )
+    with pytest.raises(InputError, match=said):
         write_predictions(whole, cache, inputs=[other], out=tmp_path / "other.parquet", split="all")
     assert not (tmp_path / "short.parquet").exists() and not (tmp_path / "other.parquet").exists()
 

@@ -137,9 +137,9 @@ def test_replay_takes_the_split_ratios_the_cache_was_built_with(recording: Path,
     # the default ratios put the one recording in train: refused, saying how the cache was built
     with pytest.raises(InputError, match=r"--split-ratios 0,0,1 --seed 0"):
         replay_main([*args, "-o", str(tmp_path / "default.parquet")])
-    with pytest.raises(MmusvError, match=r"--split-ratios: split '1,2': expected three fractions"):
+    with pytest.raises(MmusvError, match=r"^--split-ratios 1,2: expected three fractions"):
         replay_main([*args, "--split-ratios", "1,2", "-o", str(tmp_path / "bad.parquet")])
-    with pytest.raises(MmusvError, match=r"--split-ratios: .*not all zero"):
+    with pytest.raises(MmusvError, match=r"^--split-ratios 0,0,0: .*not all zero"):
         replay_main([*args, "--split-ratios", "0,0,0", "-o", str(tmp_path / "bad.parquet")])
     assert not (tmp_path / "default.parquet").exists() and not (tmp_path / "bad.parquet").exists()
 
@@ -198,3 +198,34 @@ def test_a_save_that_fails_leaves_no_temporary(tmp_path: Path, monkeypatch: pyte
     with pytest.raises(OSError, match="No space left"):
         IoUScorer(np.zeros(n), np.ones(n), beta=0.5).save(out / "scorer.pt", {"test": True})
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+
+
+def test_cut_short_peaks_and_a_missing_model_are_named_as_their_user_gives_them(
+    recording: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The peaks of an inference cut short (``limit``) and a scorer fit without a model named the commands' flags,
+    ``--limit`` and ``--scorers-only``, to a Python caller of write_predictions and fit_scorers; now their
+    arguments (infer_cache's limit, out = '...') from Python and the flags from the commands."""
+    from mmusv.learn.scorer_fit import fit_scorers
+
+    cache = Cache(build_cache([recording], tmp_path / "cache_train.npz", split="all"))
+    peaks = _no_peaks(cache, tmp_path / "peaks.npz")
+    with np.load(peaks) as z:
+        short = {k: (v[:2] if k.endswith("_offsets") else v) for k, v in z.items()}  # as infer --limit 1 writes
+    np.savez(peaks, **short)
+    with pytest.raises(InputError, match=r"an inference of its first items only \(mmusv\.learn\.infer\.infer_cache's "):
+        write_predictions(peaks, cache, inputs=[recording], out=tmp_path / "p.parquet", split="all")
+    argv = [str(peaks), str(cache.path), str(recording), "--split", "all", "-o", str(tmp_path / "p.parquet")]
+    with pytest.raises(InputError, match=r"first items only \(python -m mmusv\.learn\.infer --limit\)"):
+        replay_main(argv)
+    out = tmp_path / "run"
+    out.mkdir()
+    with pytest.raises(InputError, match=rf"^out = '{out}': no {out / 'single' / 'model.pt'}; train the single"):
+        fit_scorers(out, cache.path, ["single"], seed=0)
+    (out / "cache_all.npz").write_bytes(cache.path.read_bytes())  # --split all
+    capsys.readouterr()
+    argv = ["train", str(recording), "--split", "all", "--modes", "single", "--scorers-only", "-o", str(out)]
+    assert mmusv_main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"mmusv: error: --scorers-only -o {out}: no {out / 'single' / 'model.pt'}; train"), err
+    assert not (tmp_path / "p.parquet").exists()

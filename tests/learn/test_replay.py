@@ -125,7 +125,7 @@ def test_replay_equals_the_detector_on_the_same_clouds(
 def test_replay_rejects_an_unknown_late_merge(trained: tuple[Path, Cache, Path], tmp_path: Path) -> None:
     rec, cache, root = trained
     peaks = infer_cache(cache, models=root / "models", out=tmp_path / "peaks.npz", modes=["single"])
-    with pytest.raises(InputError, match="--late-merge 'mean': allowed: nms, wbf"):
+    with pytest.raises(InputError, match=r"^late_merge = 'mean': allowed: nms, wbf"):
         write_predictions(peaks, cache, inputs=[rec], out=tmp_path / "p.parquet", split="all", late_merge="mean")
     out = write_predictions(peaks, cache, inputs=[rec], out=tmp_path / "p.parquet", split="all", late_merge="wbf")
     assert set(pl.read_parquet(out)["mode"].unique().to_list()) == {"none", "late"}
@@ -173,7 +173,7 @@ def test_replay_with_scorers_equals_the_rescoring_detector(trained: tuple[Path, 
         _, s0 = plain(ego)
         changed += int(s0.shape != expect["none"][1].shape or not np.allclose(np.sort(s0), np.sort(expect["none"][1])))
     assert changed > 0
-    with pytest.raises(InputError, match="--rescore on: single has no"):
+    with pytest.raises(InputError, match=r"^rescore = True: single has no"):
         load_models(root / "models", refine=True, rescore=True)
 
 

@@ -413,9 +413,9 @@ BAD_CONVERT_ARGS: list[tuple[dict[str, Any], str]] = [
     ({"recordings": None}, "recordings = None"),
     ({"recordings": b"/tmp/x.mcap"}, "recordings = b"),  # iterated as integers
     ({"recordings": [5]}, "recordings[0] = 5"),
-    ({"splits": 5}, "split 5"),  # TypeError
-    ({"splits": ["a", 1, 1]}, "split[0] = 'a'"),  # ValueError
-    ({"splits": (True, 0, 0)}, "split[0] = True"),
+    ({"splits": 5}, "splits = 5"),  # TypeError
+    ({"splits": ["a", 1, 1]}, "splits[0] = 'a'"),  # ValueError
+    ({"splits": (True, 0, 0)}, "splits[0] = True"),
     ({"seed": None}, "seed = None"),  # a random split: a different dataset every run
     ({"seed": "x"}, "seed = 'x'"),
     ({"seed": 1.5}, "seed = 1.5"),

@@ -371,7 +371,7 @@ def test_study_detection_refuses_a_detector_box_of_negative_size(
     argv = ["study", "detection", str(one_usv_recording), "--modes", "none", "--no-progress", "-o", str(out)]
     assert main([*argv, "--detector", "negative_detector:detect"]) == 2
     err = capsys.readouterr().err.strip()
-    assert "'negative_detector:detect' returned a box of negative size (l, w or h)" in err and "\n" not in err
+    assert "--detector negative_detector:detect returned a box of negative size (l, w or h)" in err and "\n" not in err
     assert not out.exists()
 
 

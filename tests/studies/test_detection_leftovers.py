@@ -58,6 +58,11 @@ def test_a_one_usv_sequence_is_scored_in_none_only(
     capsys.readouterr()
     two = pl.read_csv(tmp_path / "a" / "detection_table.csv")
     assert two.filter(pl.col("mode") != "none").equals(table.filter(pl.col("mode") != "none"))
+    # without mode none the lone sequence is not scored, said in words for both entry points (not as a flag)
+    assert _study(["study", "detection", str(mixed), "--modes", "late"], tmp_path / "late") == 0
+    unscored = "not scored (one USV with a LiDAR: nothing to fuse, and mode none was not asked for): tiny_1usv"
+    assert unscored in " ".join(capsys.readouterr().out.split())
+    assert unscored in (tmp_path / "late" / "detection_note.txt").read_text(encoding="utf-8")
     # over two processes: the same bytes
     assert _study(["study", "detection", str(mixed), "--jobs", "2"], tmp_path / "j") == 0
     assert said in " ".join(capsys.readouterr().out.split())

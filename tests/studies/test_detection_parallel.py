@@ -88,10 +88,10 @@ def test_the_python_api_names_its_own_arguments() -> None:
     from mmusv.studies.detection.parallel import run_study_jobs
 
     ratios = (0.7, 0.15, 0.15)
-    with pytest.raises(InputError, match=r"^split = 'x' \(--split\): expected one of train, validate, test, all$"):
+    with pytest.raises(InputError, match=r"^split = 'x': expected one of train, validate, test, all$"):
         split_sequences(["a", "b"], split="x", ratios=ratios, seed=0)
-    with pytest.raises(InputError, match=r"^seed = -1 \(--seed\): the split's seed must be a whole number >= 0$"):
+    with pytest.raises(InputError, match=r"^seed = -1: the split's seed must be a whole number >= 0$"):
         split_sequences(["a", "b"], split="train", ratios=ratios, seed=-1)
-    for bad, said in ((0, "jobs (--jobs) = 0: must be a whole number"), ("2", "not str")):
+    for bad, said in ((0, "jobs = 0: must be a whole number"), ("2", "not str")):
         with pytest.raises(InputError, match=re.escape(said)):
             run_study_jobs(None, options=None, spec=None, jobs=bad)  # type: ignore[arg-type]

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import yaml
 from mmusv.cli import main
-from mmusv.errors import ConfigError
+from mmusv.errors import ConfigError, InputError
 from mmusv.studies.agreement import run_agreement_study
 from mmusv.studies.detection.detector import load_detector
 
@@ -40,12 +40,12 @@ POINTS = np.zeros((5, 4), dtype=np.float32)
 
 def test_a_detector_of_another_signature_names_the_detector() -> None:
     det = load_detector("os:getcwd")
-    with pytest.raises(ConfigError, match=r"--detector 'os:getcwd'.*TypeError.*expected detect\(points \(N, 4\)"):
+    with pytest.raises(ConfigError, match=r"^spec = 'os:getcwd'.*TypeError.*expected detect\(points \(N, 4\)"):
         det(POINTS)
 
 
 def test_a_detector_returning_no_pair_names_the_detector() -> None:
-    with pytest.raises(ConfigError, match=r"--detector 'builtins:len'.*returned int"):
+    with pytest.raises(ConfigError, match=r"^spec = 'builtins:len'.*returned int"):
         load_detector("builtins:len")(POINTS)
 
 
@@ -68,7 +68,7 @@ def test_a_working_user_detector_and_its_early_entry_run_as_they_are(
     boxes, scores = det(POINTS)
     assert boxes.shape == (1, 7) and scores.shape == (1,)
     assert det.tag == "mine"
-    with pytest.raises(ConfigError, match=r"--detector 'my_bad_args_detector:detect': its 'early'.*broken early"):
+    with pytest.raises(ConfigError, match=r"^spec = 'my_bad_args_detector:detect': its 'early'.*broken early"):
         det.early(POINTS)
 
 
@@ -86,7 +86,8 @@ def test_study_detection_with_a_failing_detector_is_one_line(
     code = main(["study", "detection", str(rec), "--detector", "os:getcwd", "-o", str(tmp_path / "o"), "--no-progress"])
     assert code == 2
     err = capsys.readouterr().err
-    assert err.startswith("mmusv: error: --detector 'os:getcwd'") and "TypeError" in err and "Traceback" not in err
+    assert err.startswith("mmusv: error: --detector os:getcwd: calling it"), err
+    assert "TypeError" in err and "Traceback" not in err
 
 
 def test_waves_names_the_scenario_flag(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -150,3 +151,29 @@ def test_a_study_with_overwrite_replaces_its_files_and_nothing_else(
     assert main(["study", "detection", str(tmp_path / "none"), "-o", str(det), "--overwrite"]) == 2
     err = capsys.readouterr().err
     assert "already there" not in err and "none" in err
+
+
+@pytest.mark.parametrize(
+    ("study", "flag", "value", "python", "command"),
+    [
+        ("detection", "--modes", "none,bogus", "text = 'none,bogus': unknown mode(s)", "--modes none,bogus: unknown"),
+        ("detection", "--modes", "", "text = '': no mode", "--modes '': no mode"),
+        ("robustness", "--settings", "delay:0", "text = 'delay:0': item 'delay:0'", "--settings delay:0: item"),
+        ("robustness", "--settings", "", "text = '': empty", "--settings '': empty"),
+    ],
+)
+def test_modes_and_settings_are_named_by_the_entry_point(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], study: str, flag: str, value: str, python: str, command: str
+) -> None:
+    """parse_modes and parse_settings named --modes and --settings to a Python caller; the command line names them
+    as typed, Python by the argument ``text``."""
+    from mmusv.studies.detection.fusion import parse_modes
+    from mmusv.studies.detection.robustness import parse_settings
+
+    with pytest.raises(InputError) as err:
+        (parse_modes if flag == "--modes" else parse_settings)(value)
+    assert str(err.value).startswith(python) and "--" not in str(err.value), err.value
+    capsys.readouterr()
+    assert main(["study", study, str(tmp_path / "x.mcap"), f"{flag}={value}", "-o", str(tmp_path / "o")]) == 2
+    said = capsys.readouterr().err
+    assert said.startswith(f"mmusv: error: {command}") and "text" not in said, said

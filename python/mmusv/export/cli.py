@@ -12,8 +12,30 @@ import argparse
 from typing import Any
 
 from mmusv.errors import ConfigError
+from mmusv.text import command_line
 
-__all__ = ["add_parser", "run"]
+__all__ = ["FLAGS", "add_parser", "run"]
+
+FLAGS = {
+    "to": "--to",
+    "out_dir": "-o/--output",
+    "splits": "--split",
+    "seed": "--seed",
+    "eval_range_m": "--range",
+    "include_usvs": "--include-usvs",
+    "extras": "--extras",
+    "min_box_px": "--min-box-px",
+    "max_occlusion": "--max-occlusion",
+    "min_contrast": "--min-contrast",
+    "box": "--box",
+    "overwrite": "--overwrite",
+    "agents": "--agents",
+    "frames": "--frames",
+    "kitti_class": "--kitti-class",
+    "oxts_origin": "--oxts-origin",
+}
+"""The flag of each argument of :func:`mmusv.export.convert`: its messages name these under ``mmusv convert``
+(:func:`mmusv.text.command_line`), ``--range 100`` where a Python caller reads ``eval_range_m = 100``."""
 
 
 def add_parser(subparsers: Any) -> argparse.ArgumentParser:
@@ -137,12 +159,10 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     """Runs ``mmusv convert``; returns the exit status (0 when at least one frame was converted, 1 otherwise)."""
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
     from mmusv.cli_console import rich_console
     from mmusv.cli_paths import output_arg
     from mmusv.export.common import BOXES, TARGETS
-    from mmusv.export.conversion import convert
     from mmusv.export.kitti_oxts import parse_origin
 
     if args.to not in TARGETS:
@@ -179,6 +199,18 @@ def run(args: argparse.Namespace) -> int:
         "kitti_class": args.kitti_class,
         "oxts_origin": origin,
     }
+    with command_line(FLAGS):  # convert's messages name these flags, not its keyword arguments
+        report = _convert(args, console, kwargs)
+    for line in report.lines():
+        console.print(line, highlight=False, markup=False)
+    return 0 if report.frames > 0 else 1
+
+
+def _convert(args: argparse.Namespace, console: Any, kwargs: dict[str, Any]) -> Any:
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+    from mmusv.export.conversion import convert
+
     if args.no_progress or not console.is_terminal:  # a bar only on a terminal (piped, it left an empty line)
         report = convert(args.recordings, **kwargs)
     else:
@@ -194,6 +226,4 @@ def run(args: argparse.Namespace) -> int:
             report = convert(
                 args.recordings, progress=lambda done, total: bar.update(task, completed=done, total=total), **kwargs
             )
-    for line in report.lines():
-        console.print(line, highlight=False, markup=False)
-    return 0 if report.frames > 0 else 1
+    return report

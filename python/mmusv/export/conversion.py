@@ -51,7 +51,7 @@ from mmusv.export.splits import DEFAULT_RATIOS, SPLIT_NAMES, assign_splits, pars
 from mmusv.export.writer import DatasetWriter
 from mmusv.recording.info import RecordingInfo, read_info
 from mmusv.recording.stream import FrameStream
-from mmusv.text import counted
+from mmusv.text import counted, given, named
 
 __all__ = ["REPORT_NAME", "ConvertReport", "RecordingReport", "convert", "writer_class"]
 
@@ -245,16 +245,18 @@ def convert(
     """
     t0 = time.perf_counter()
     cls = writer_class(to)
-    rng = arguments.real(eval_range_m, name="eval_range_m", unit="metres", above=0.0)
-    seed = arguments.whole(seed, name="seed", lo=0)
+    rng = arguments.real(eval_range_m, name=named("eval_range_m"), unit="metres", above=0.0)
+    seed = arguments.whole(seed, name=named("seed"), lo=0)
     include_usvs = arguments.flag(include_usvs, name="include_usvs")
     overwrite = arguments.flag(overwrite, name="overwrite")
     progress = arguments.callback(progress, name="progress", nargs=2)
     out = arguments.path(out_dir, name="out_dir")
-    ratios = None if splits is None else parse_ratios(splits)
+    ratios = None if splits is None else parse_ratios(splits, name="splits")
     if not cls.splits and ratios is not None:
         if ratios != parse_ratios(DEFAULT_RATIOS):
-            raise ConfigError(f"split {splits!r}: --to {to} writes one folder per recording and is never split")
+            raise ConfigError(
+                f"{given('splits', splits)}: {given('to', to)} writes one folder per recording and is never split"
+            )
         ratios = None
     box_px, max_occ = box_filter(min_box_px, max_occlusion)
     min_c = contrast_filter(min_contrast)

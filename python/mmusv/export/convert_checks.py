@@ -18,6 +18,7 @@ from mmusv.export.contrast import MAX_CONTRAST
 from mmusv.export.writer import DatasetWriter
 from mmusv.recording.info import RecordingInfo
 from mmusv.recording.stream import FrameStream
+from mmusv.text import given, named
 
 __all__ = [
     "agent_selection",
@@ -67,12 +68,12 @@ def as_list(recordings: str | Path | Iterable[str | Path]) -> list[Path]:
 
 
 def box_filter(min_box_px: Any, max_occlusion: Any) -> tuple[float, float]:
-    px = arguments.real(min_box_px, name="min_box_px", unit="pixels", finite=False)
-    occ = arguments.real(max_occlusion, name="max_occlusion", finite=False)
+    px = arguments.real(min_box_px, name=named("min_box_px"), unit="pixels", finite=False)
+    occ = arguments.real(max_occlusion, name=named("max_occlusion"), finite=False)
     if not (math.isfinite(px) and px >= 0):
-        raise ConfigError(f"min_box_px = {min_box_px!r}: must be a finite number of pixels >= 0")
+        raise ConfigError(f"{given('min_box_px', min_box_px)}: must be a finite number of pixels >= 0")
     if not (math.isfinite(occ) and 0 <= occ <= 1):
-        raise ConfigError(f"max_occlusion = {max_occlusion!r}: must be a fraction in [0, 1]")
+        raise ConfigError(f"{given('max_occlusion', max_occlusion)}: must be a fraction in [0, 1]")
     return px, occ
 
 
@@ -90,25 +91,32 @@ def box_options(to: str, *, min_box_px: float, max_occlusion: float, min_contras
     format ``to`` that writes no such boxes (``min_box_px`` and ``max_occlusion``: not in :data:`FILTER_FORMATS`;
     ``min_contrast`` and ``box``: not in :data:`BOX_FORMATS`): it would change nothing, silently."""
     filters = [
-        f"min_box_px = {min_box_px:g}" if min_box_px != 0.0 else "",
-        f"max_occlusion = {max_occlusion:g}" if max_occlusion != 1.0 else "",
+        given("min_box_px", float(min_box_px)) if min_box_px != 0.0 else "",
+        given("max_occlusion", float(max_occlusion)) if max_occlusion != 1.0 else "",
     ]
     filters = [g for g in filters if g]
     if to not in FILTER_FORMATS and filters:
         raise ConfigError(
-            f"{', '.join(filters)}: only the COCO, YOLO, MOT and ROS 2 exports (to = 'coco', 'yolo', 'mot' or 'ros2') "
-            f"filter their 2D boxes with it, not to = {to!r}, which would ignore it; leave it out"
+            f"{', '.join(filters)}: only the COCO, YOLO, MOT and ROS 2 exports ({_formats(FILTER_FORMATS)}) "
+            f"filter their 2D boxes with it, not {given('to', to)}, which would ignore it; leave it out"
         )
-    given = [
-        f"min_contrast = {min_contrast:g}" if min_contrast is not None else "",
-        f"box = {box!r}" if box != "visible" else "",
+    chosen = [
+        given("min_contrast", float(min_contrast)) if min_contrast is not None else "",
+        given("box", box) if box != "visible" else "",
     ]
-    given = [g for g in given if g]
-    if to not in BOX_FORMATS and given:
+    chosen = [g for g in chosen if g]
+    if to not in BOX_FORMATS and chosen:
         raise ConfigError(
-            f"{', '.join(given)}: only the COCO, YOLO and MOT exports (to = 'coco', 'yolo' or 'mot') choose their 2D "
-            f"boxes with it, not to = {to!r}, which would ignore it; leave it out"
+            f"{', '.join(chosen)}: only the COCO, YOLO and MOT exports ({_formats(BOX_FORMATS)}) choose their 2D "
+            f"boxes with it, not {given('to', to)}, which would ignore it; leave it out"
         )
+
+
+def _formats(formats: Sequence[str]) -> str:
+    """``to = 'coco', 'yolo' or 'mot'`` (Python), ``--to coco, yolo or mot`` (the command line)."""
+    flag = named("to")
+    lead, values = (f"{flag} ", list(formats)) if flag != "to" else ("to = ", [repr(f) for f in formats])
+    return lead + (values[0] if len(values) == 1 else ", ".join(values[:-1]) + f" or {values[-1]}")
 
 
 EXTRAS_FORMATS = ("opv2v", "kitti", "kitti_tracking")
@@ -123,8 +131,9 @@ def extras_option(to: str, extras: tuple[str, ...]) -> None:
 
     if to not in EXTRAS_FORMATS and extras not in ((), DEFAULT_EXTRAS):  # none: what it writes anyway
         raise ConfigError(
-            f"extras = {','.join(extras)!r}: only the OPV2V, KITTI and KITTI tracking exports (to = 'opv2v', "
-            f"'kitti' or 'kitti_tracking') write extra files, not to = {to!r}, which would ignore it; leave it out"
+            f"{given('extras', ','.join(extras))}: only the OPV2V, KITTI and KITTI tracking exports "
+            f"({_formats(EXTRAS_FORMATS)}) write extra files, not {given('to', to)}, which would ignore it; leave it "
+            "out"
         )
 
 
@@ -139,16 +148,16 @@ def target_options(to: str, *, eval_range_m: float, include_usvs: bool) -> None:
     ``include_usvs``, for a format ``to`` that does not list targets by them (not in :data:`TARGET_FORMATS`): the
     camera exports label every vessel in the image, SemanticKITTI and MaSTr every point and pixel, and ROS 2 bags
     every recorded box; it would change nothing, silently."""
-    given = [
-        f"eval_range_m = {eval_range_m:g}" if eval_range_m != DEFAULT_RANGE_M else "",
-        "include_usvs = True" if include_usvs else "",
+    chosen = [
+        given("eval_range_m", float(eval_range_m)) if eval_range_m != DEFAULT_RANGE_M else "",
+        given("include_usvs", True) if include_usvs else "",
     ]
-    given = [g for g in given if g]
-    if to not in TARGET_FORMATS and given:
+    chosen = [g for g in chosen if g]
+    if to not in TARGET_FORMATS and chosen:
         raise ConfigError(
-            f"{', '.join(given)}: only the OPV2V, KITTI and KITTI tracking exports (to = 'opv2v', 'kitti' or "
-            f"'kitti_tracking') choose their targets with it, not to = {to!r}, which labels every vessel it holds "
-            "whatever its range or role; leave it out"
+            f"{', '.join(chosen)}: only the OPV2V, KITTI and KITTI tracking exports ({_formats(TARGET_FORMATS)}) "
+            f"choose their targets with it, not {given('to', to)}, which labels every vessel it holds whatever its "
+            "range or role; leave it out"
         )
 
 
@@ -159,11 +168,12 @@ def contrast_filter(min_contrast: Any) -> float | None:
         return None
     allowed = (
         f"must be a Weber contrast >= 0 and <= {MAX_CONTRAST:.1f} (the largest an 8-bit image holds; 0.05 is the "
-        "WMO's visibility threshold), or None to keep every box"
+        f"WMO's visibility threshold), or {'None' if named('min_contrast') == 'min_contrast' else 'left out'} to keep "
+        "every box"
     )
-    c = arguments.real(min_contrast, name="min_contrast", finite=False)
+    c = arguments.real(min_contrast, name=named("min_contrast"), finite=False)
     if not (math.isfinite(c) and 0 <= c <= MAX_CONTRAST):
-        raise ConfigError(f"min_contrast = {arguments.shown(min_contrast)}: {allowed}")
+        raise ConfigError(f"{given('min_contrast', min_contrast)}: {allowed}")
     return c
 
 
@@ -174,16 +184,16 @@ def kitti_type(kitti_class: Any, to: str) -> str | None:
     ``kitti_tracking``."""
     if kitti_class is None:
         return None
-    shown = arguments.shown(kitti_class)
+    shown = given("kitti_class", kitti_class)
     if to != "kitti_tracking":
-        raise ConfigError(f"kitti_class = {shown}: only --to kitti_tracking writes it, not --to {to}")
+        raise ConfigError(f"{shown}: only {_formats(['kitti_tracking'])} writes it, not {given('to', to)}")
     if not isinstance(kitti_class, str) or not re.fullmatch(r"[A-Za-z][A-Za-z0-9_]*", kitti_class):
         raise ConfigError(
-            f"kitti_class = {shown}: must be one KITTI type word (letters, digits, _; e.g. Car, which stock TrackEval "
+            f"{shown}: must be one KITTI type word (letters, digits, _; e.g. Car, which stock TrackEval "
             "and the KITTI devkit score), or None for each vessel's class name"
         )
     if kitti_class.lower() == "dontcare":
-        raise ConfigError(f"kitti_class = {shown}: DontCare marks regions to ignore, not objects to track")
+        raise ConfigError(f"{shown}: DontCare marks regions to ignore, not objects to track")
     return kitti_class
 
 
@@ -278,5 +288,7 @@ def oxts_origin_of(value: Any, to: str) -> tuple[float, float] | None:
     if value is None:
         return None
     if to != "kitti_tracking":
-        raise ConfigError(f"oxts_origin = {arguments.shown(value)}: only --to kitti_tracking writes it, not --to {to}")
+        raise ConfigError(
+            f"{given('oxts_origin', value)}: only {_formats(['kitti_tracking'])} writes it, not {given('to', to)}"
+        )
     return parse_origin(value, "oxts_origin =")

@@ -134,14 +134,24 @@ class Opv2vWriter(DatasetWriter):
         st: HypesStats = shared
         if not st.usv_positions:
             return
-        split = (out / "train").is_dir()
-        root = "train" if split else "."
-        val = "validate" if split else "."
+        # OpenCOOD lists the folders root_dir and validate_dir name (validate_dir: its validation, and the set its
+        # inference scores): a split without a recording in validate (or train) names another split's folder, as
+        # YOLO's val does, rather than one that is not there
+        held = [d for d in ("train", "validate", "test") if (out / d).is_dir()]
+        root = next((d for d in ("train", "validate", "test") if d in held), ".")
+        val = next((d for d in ("validate", "test", "train") if d in held), ".")
+        stand_in = "".join(
+            f"# {key} is {given}: no recording went to {wanted} (a split takes whole recordings).\n"
+            for key, given, wanted in (("root_dir", root, "train"), ("validate_dir", val, "validate"))
+            if held and given != wanted
+        )
         consts = constants(st)
         header = (
             "# OpenCOOD hypes written by mmusv convert --to opv2v (docs/opencood.md). root_dir and validate_dir are\n"
             "# relative to the export folder (run OpenCOOD from there, or make them absolute).\n"
-            "# Also change in OpenCOOD's code:\n" + "".join(f"#   {k}: {v}\n" for k, v in consts.items())
+            + stand_in
+            + "# Also change in OpenCOOD's code:\n"
+            + "".join(f"#   {k}: {v}\n" for k, v in consts.items())
         ).encode("utf-8")
         sink.mkdir(out / "opencood")
         for stem, doc in hypes(st, root_dir=root, validate_dir=val).items():

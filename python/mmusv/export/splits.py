@@ -16,6 +16,7 @@ import numpy as np
 
 from mmusv import arguments
 from mmusv.errors import ConfigError
+from mmusv.text import given, named
 
 __all__ = ["DEFAULT_RATIOS", "SPLIT_NAMES", "assign_splits", "parse_ratios", "split_counts"]
 
@@ -24,45 +25,39 @@ DEFAULT_RATIOS = (0.7, 0.15, 0.15)
 """The default ``(train, validate, test)`` fractions."""
 
 
-def parse_ratios(ratios: Sequence[float] | str) -> tuple[float, float, float]:
+def parse_ratios(ratios: Sequence[float] | str, *, name: str = "ratios") -> tuple[float, float, float]:
     """Validated ``(train, validate, test)`` fractions from a sequence or a ``"0.7,0.15,0.15"`` string: three
     fractions that add up to 1 (within 1e-6), or three whole-number weights (``7,2,1``, ``1,1,1``), normalised to
     sum to 1. Fractions that add up to something else (``0.7,0.2,0.2``) are refused: they were rescaled without
-    a word, so a typo changed the proportions asked for."""
+    a word, so a typo changed the proportions asked for. ``name``: the keyword argument that gave them (``ratios``
+    of :func:`assign_splits`, ``splits`` of :func:`mmusv.export.convert`), which the messages name as their user
+    gave it (:func:`mmusv.text.given`: ``splits = (0.7, 0.2, 0.2)`` from Python, ``--split 0.7,0.2,0.2`` or
+    ``--split-ratios 1,2`` from a command); they said ``split`` whatever the caller gave."""
+    shown = given(name, ratios)
     if isinstance(ratios, str):
         try:
             vals = [float(x) for x in ratios.split(",")]
         except ValueError:
-            raise ConfigError(
-                f"split {ratios!r}: expected three comma-separated fractions, e.g. 0.7,0.15,0.15"
-            ) from None
+            raise ConfigError(f"{shown}: expected three comma-separated fractions, e.g. 0.7,0.15,0.15") from None
     else:
         if isinstance(ratios, np.ndarray) and ratios.ndim == 1:  # three fractions as numpy holds them
             ratios = ratios.tolist()
         if not isinstance(ratios, (list, tuple)):
             raise ConfigError(
-                f"split {arguments.shown(ratios)}: expected three fractions (train, validate, test), e.g. "
-                "(0.7, 0.15, 0.15) or '0.7,0.15,0.15'"
+                f"{shown}: expected three fractions (train, validate, test), e.g. (0.7, 0.15, 0.15) or '0.7,0.15,0.15'"
             )
-        vals = [arguments.real(x, name=f"split[{i}]", finite=False) for i, x in enumerate(ratios)]
+        vals = [arguments.real(x, name=f"{named(name)}[{i}]", finite=False) for i, x in enumerate(ratios)]
     if len(vals) != 3:
-        raise ConfigError(
-            f"split {list(ratios) if not isinstance(ratios, str) else ratios!r}: "
-            "expected three fractions (train, validate, test)"
-        )
+        raise ConfigError(f"{shown}: expected three fractions (train, validate, test)")
     if not all(math.isfinite(v) and v >= 0 for v in vals) or sum(vals) <= 0:
-        raise ConfigError(f"split {vals}: fractions must be finite, non-negative and not all zero")
+        raise ConfigError(f"{shown}: fractions must be finite, non-negative and not all zero")
     total = sum(vals)
     if abs(total - 1.0) > 1e-6 and not all(float(v).is_integer() for v in vals):
         raise ConfigError(
-            f"split {_shown_ratios(vals)}: the fractions add up to {total:.6g}; they must add up to 1 "
+            f"{shown}: the fractions add up to {total:.6g}; they must add up to 1 "
             "(e.g. 0.7,0.15,0.15), or be whole-number weights (e.g. 7,2,1)"
         )
     return (vals[0] / total, vals[1] / total, vals[2] / total)
-
-
-def _shown_ratios(vals: Sequence[float]) -> str:
-    return ",".join(f"{v:g}" for v in vals)
 
 
 def split_counts(n: int, ratios: Sequence[float]) -> list[int]:
@@ -95,9 +90,9 @@ def assign_splits(keys: Sequence[str], *, ratios: Sequence[float], seed: int) ->
     # checked as parse_ratios checks them (a caller in Python gave them unchecked: two fractions were zip()'s
     # ValueError, a string a TypeError, (0.7, 0.7, 0.7) or a negative one a split of other proportions, silently);
     # fractions that add up to 1 are used as given, so that the splits they made stay the same
-    checked = parse_ratios(ratios)
-    given = [float(r) for r in ratios] if not isinstance(ratios, str) else list(checked)
-    fractions = given if abs(sum(given) - 1.0) <= 1e-6 else list(checked)
+    checked = parse_ratios(ratios, name="ratios")
+    asked = [float(r) for r in ratios] if not isinstance(ratios, str) else list(checked)
+    fractions = asked if abs(sum(asked) - 1.0) <= 1e-6 else list(checked)
     ordered = sorted(keys)
     random.Random(seed).shuffle(ordered)
     counts = split_counts(len(ordered), fractions)

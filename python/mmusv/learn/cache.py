@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from mmusv.learn._errors import input_error
+from mmusv.text import given
 
 __all__ = ["Cache", "Sample", "build_cache", "cache_identity", "dataset_fingerprints", "same_data"]
 
@@ -188,13 +189,13 @@ def build_cache(
     return out_p
 
 
-def _check_arrays(path: Path, a: dict[str, np.ndarray]) -> None:
+def _check_arrays(path: Path, a: dict[str, np.ndarray], given_as: str) -> None:
     """Refuses a cache whose arrays do not fit together or hold values that are not finite, naming the array: a NaN
     ground-truth box was a ``ValueError`` traceback in training (``cannot convert float NaN to integer``), and offsets
     past the points an ``IndexError`` at some sample."""
 
     def bad(what: str) -> Exception:
-        return input_error(f"--cache {path}: {what} (a damaged or edited cache: build it again)")
+        return input_error(f"{given(given_as, path)}: {what} (a damaged or edited cache: build it again)")
 
     n_clouds, n_frames = len(a["cloud_lidar"]), len(a["frame_seq"])
     shapes = {
@@ -243,26 +244,28 @@ class Cache:
         "meta",
     )
 
-    def __init__(self, path: str | Path) -> None:
+    def __init__(self, path: str | Path, *, name: str = "path") -> None:
+        """Reads the cache at ``path``; ``name`` is the argument that gave it, for the messages (``path``; ``cache``
+        where :func:`mmusv.learn.train.train` reads it; a flag on the command line: :func:`mmusv.text.given`)."""
         p = Path(path)
         try:
             # numpy leaves the file it opened open when it is not a zip: the file is ours to close
             with open(p, "rb") as fh, np.load(fh, allow_pickle=False) as z:
                 missing = [k for k in self.KEYS if k not in z.files]
                 if missing:
-                    raise input_error(f"--cache {p}: not an mmusv.learn cache (missing {missing})")
+                    raise input_error(f"{given(name, p)}: not an mmusv.learn cache (missing {missing})")
                 self.arrays: dict[str, np.ndarray] = {k: z[k] for k in self.KEYS}
                 if "cloud_agent" in z.files:  # caches written before it was added lack it
                     self.arrays["cloud_agent"] = z["cloud_agent"]
         except (OSError, ValueError, EOFError, TypeError, zipfile.BadZipFile) as exc:  # a cut copy; a .npy (TypeError)
-            raise input_error(f"--cache {p}: not a readable .npz cache ({type(exc).__name__}: {exc})") from None
+            raise input_error(f"{given(name, p)}: not a readable .npz cache ({type(exc).__name__}: {exc})") from None
         self.path = p
         try:
             self.meta: dict[str, Any] = json.loads(str(self.arrays["meta"]))
         except ValueError:
-            raise input_error(f"--cache {p}: meta: not JSON (not an mmusv.learn cache)") from None
+            raise input_error(f"{given(name, p)}: meta: not JSON (not an mmusv.learn cache)") from None
         a = self.arrays
-        _check_arrays(p, a)
+        _check_arrays(p, a, name)
         self.frame_clouds: list[np.ndarray] = [np.zeros(0, np.int64)] * len(a["frame_seq"])
         order = np.argsort(a["cloud_frame"], kind="stable")
         bounds = np.searchsorted(a["cloud_frame"][order], np.arange(len(a["frame_seq"]) + 1))

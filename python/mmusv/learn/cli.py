@@ -29,13 +29,18 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from mmusv.errors import InputError, MmusvError
+from mmusv.errors import InputError
 from mmusv.jsonio import read_json_or_none
 from mmusv.learn.modes import MODELS, models_for
 from mmusv.learn.scorer_fit import fit_scorers
-from mmusv.text import counted
+from mmusv.text import command_line, counted
 
 __all__ = ["add_parser", "load_for_study", "run"]
+
+_NAMES = {"cache": "cache", "path": "model", "mode": "--modes", "out": "-o"}
+"""How ``mmusv train``'s messages name what the API's name ``cache``, ``path``, ``mode`` and ``out``: the cache and
+the models it writes under ``-o`` (``cache OUT/cache_train.npz: ...``), the ``--modes`` it was given, its ``-o``
+(:func:`mmusv.text.command_line`)."""
 
 _INSTALL = "needs the learn extra (PyTorch): pip install 'mmusv[learn]' (or pip install torch tqdm)"
 
@@ -64,7 +69,9 @@ def load_for_study(
     from mmusv.learn.detector import load_models
 
     models = None if modes is None else models_for(modes)
-    return load_models(path, refine=refine, rescore=rescore, models=models)
+    # the messages name the flags of mmusv study (--model, not load_models' path)
+    with command_line({"path": "--model", "refine": "--refine on", "rescore": "--rescore on"}):
+        return load_models(path, refine=refine, rescore=rescore, models=models)
 
 
 def add_parser(sub: Any) -> None:
@@ -118,7 +125,15 @@ def add_parser(sub: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Runs ``mmusv train``; returns the exit status."""
+    """Runs ``mmusv train``; returns the exit status. The dataset's messages name its flags
+    (:data:`mmusv.studies.detection.cli.DATASET_FLAGS`: ``--opv2v x: not a folder``, not ``opv2v = 'x'``)."""
+    from mmusv.studies.detection.cli import DATASET_FLAGS
+
+    with command_line(DATASET_FLAGS):
+        return _run(args)
+
+
+def _run(args: argparse.Namespace) -> int:
     from mmusv.cli_paths import check_output_folder, path_arg
 
     _check_numbers(args)
@@ -156,7 +171,8 @@ def run(args: argparse.Namespace) -> int:
         cache_file = out / f"cache_{args.split}.npz"
         if not cache_file.is_file():
             raise InputError(f"--scorers-only: no {cache_file}; train first (mmusv train ... -o {out})")
-        fit_scorers(out, cache_file, modes, seed=args.seed, threads=args.threads)
+        with command_line({**_NAMES, "out": "--scorers-only -o"}):
+            fit_scorers(out, cache_file, modes, seed=args.seed, threads=args.threads)
         return 0
     inputs: list[Any] = list(args.inputs)
     if args.generate is not None:
@@ -165,7 +181,8 @@ def run(args: argparse.Namespace) -> int:
         from mmusv.studies.detection.sources import generate_dataset
 
         shortfalls: list[str] = []
-        inputs = generate_dataset(out / "dataset", spec=args.generate, shortfall=shortfalls.append)
+        with command_line({"spec": "--generate"}):
+            inputs = generate_dataset(out / "dataset", spec=args.generate, shortfall=shortfalls.append)
         if shortfalls:  # said by mmusv study detection --generate; training went on without a word
             print(f"generate: quotas not met: {shortfalls[0]}", file=sys.stderr, flush=True)
             for line in shortfalls[1:]:
@@ -398,14 +415,13 @@ def check_threads(threads: int | None) -> None:
 
 
 def split_ratios(text: str) -> tuple[float, float, float]:
-    """``--split-ratios`` as three fractions; its errors name the option (they said only "split")."""
-    from mmusv.errors import located
+    """``--split-ratios`` (of ``mmusv train``, ``mmusv study`` and :mod:`mmusv.learn.replay`) as three fractions;
+    its errors name the option as typed (``--split-ratios 1,2: ...``; they said "split", then "--split-ratios:
+    split '1,2'"), where a Python caller of :func:`mmusv.export.splits.parse_ratios` reads its ``ratios``."""
     from mmusv.export.splits import parse_ratios
 
-    try:
+    with command_line({"ratios": "--split-ratios"}):
         return parse_ratios(text)
-    except MmusvError as exc:
-        raise located(exc, "--split-ratios") from None
 
 
 _DEVICES = "cpu, cuda, cuda:N or mps"
@@ -462,11 +478,16 @@ def _train_one(task: dict[str, Any]) -> dict[str, Any]:
     leaves is not idle (the scorers took 6 min 40 s after the training in turn, on the 2-core Xeon)."""
     import torch
 
+    if task["threads"] is not None:
+        torch.set_num_threads(task["threads"])
+    with command_line(_NAMES):  # also in a worker process of --jobs, which the caller's block does not reach
+        return _train_and_fit(task)
+
+
+def _train_and_fit(task: dict[str, Any]) -> dict[str, Any]:
     from mmusv.learn.presets import preset
     from mmusv.learn.train import plot_losses, train
 
-    if task["threads"] is not None:
-        torch.set_num_threads(task["threads"])
     out = Path(task["out"])
     r = train(
         task["cache"],

@@ -33,13 +33,13 @@ from mmusv.learn.model import PillarNet, from_checkpoint
 from mmusv.learn.modes import MODELS, fusion_modes
 from mmusv.learn.refine import RefineParams
 from mmusv.learn.scorer import SCORER_FILE, IoUScorer, load_scorer, second_stage
-from mmusv.text import counted
+from mmusv.text import counted, given
 
 __all__ = ["LearnedDetector", "load_models"]
 
 
 def _load(path: Path, device: torch.device, mode: str | None = None) -> tuple[PillarNet, dict[str, Any]]:
-    what = f"--model {path}: not an mmusv.learn model.pt"
+    what = f"{given('path', path)}: not an mmusv.learn model.pt"
     ck = load_checkpoint(path, what=what, device=device)
     model = from_checkpoint(ck, what, mode=mode)
     model.to(device).eval()
@@ -61,9 +61,10 @@ def load_models(
     (:mod:`mmusv.learn.refine`) to every model's boxes; ``None`` (default): only when every model is of the
     ``cpu`` preset, the one it was measured on. ``rescore``: rank the refined boxes by each model's IoU scorer
     (:mod:`mmusv.learn.scorer`); ``None`` (default): where a model has one and the boxes are refined; ``True``:
-    every model must have one (an ``InputError`` names the one without). ``models``: of a folder holding
-    ``single/``, ``early/``, ``intermediate/``, load only these (``None``: every one there); the others are not
-    read, so one that is damaged or of another training does not stop a study that does not run it."""
+    every model must have one (an ``InputError`` names the one without). The messages name ``path``, ``refine``
+    and ``rescore`` (the flags of a command that calls it in :func:`mmusv.text.command_line`). ``models``: of a
+    folder holding ``single/``, ``early/``, ``intermediate/``, load only these (``None``: every one there); the
+    others are not read, so one that is damaged or of another training does not stop a study that does not run it."""
     p = Path(path)
     dev = torch.device(device)
     files: dict[str, Path] = {}
@@ -77,7 +78,7 @@ def load_models(
         files = {m: p / m / "model.pt" for m in wanted if (p / m / "model.pt").is_file()}
     if not files:
         raise input_error(
-            f"--model {p}: no model.pt there (a model.pt, a folder holding one, or a folder with "
+            f"{given('path', p)}: no model.pt there (a model.pt, a folder holding one, or a folder with "
             f"{'/'.join(MODELS)}/model.pt)"
         )
     nets: dict[str, PillarNet] = {}
@@ -99,7 +100,10 @@ def load_models(
     scorers: dict[str, IoUScorer] = {}
     if rescore is not False:
         if not refine and rescore:
-            raise input_error("--rescore on needs the refined boxes (--refine on): the scorer reads the refinement")
+            raise input_error(
+                f"{given('rescore', True)} needs the refined boxes ({given('refine', True)}; without it, only models "
+                "of the cpu preset are refined): the scorer reads the refinement"
+            )
         for mode, f in files.items():
             sf = f.parent / SCORER_FILE
             if refine and sf.is_file():
@@ -110,13 +114,15 @@ def load_models(
                     # the scorer ranks boxes it never saw, so it is left out, and the line of describe() says so
                     why = f"{sf} was fitted for other weights of this model; refit it: mmusv train --scorers-only"
                     if rescore:
-                        raise input_error(f"--rescore on: {why}")
+                        raise input_error(f"{given('rescore', True)}: {why}")
                     info[mode]["stale_scorer"] = str(sf)
                     continue
                 scorers[mode] = scorer
                 info[mode]["scorer"] = str(sf)
             elif rescore:
-                raise input_error(f"--rescore on: {mode} has no {sf} (fit it with mmusv train --scorers-only)")
+                raise input_error(
+                    f"{given('rescore', True)}: {mode} has no {sf} (fit it with mmusv train --scorers-only)"
+                )
     return LearnedDetector(nets, info, refine=RefineParams() if refine else None, scorers=scorers)
 
 
@@ -203,7 +209,9 @@ class LearnedDetector:
         self, mode: str, ego: np.ndarray, neighbours: Sequence[tuple[np.ndarray, np.ndarray]]
     ) -> tuple[np.ndarray, np.ndarray]:
         if mode not in self.models:
-            raise input_error(f"--model: no {mode} model (have {', '.join(self.models)}); train it with mmusv train")
+            raise input_error(
+                f"no {mode} model among those loaded (have {', '.join(self.models)}); train it with mmusv train"
+            )
         model = self.models[mode]
         p = model.preset
         ex = make_example(np.asarray(ego, dtype=np.float32), neighbours=list(neighbours), boxes=None, mode=mode, p=p)

@@ -30,7 +30,7 @@ from mmusv.learn.checkpoint import load_checkpoint
 from mmusv.learn.decode import peaks
 from mmusv.learn.example import MODES, collate, make_example, message_bytes
 from mmusv.learn.model import PillarNet, from_checkpoint, torch_device
-from mmusv.text import counted
+from mmusv.text import command_line, counted, given
 
 __all__ = ["infer_cache", "main", "merge_main", "merge_peaks"]
 
@@ -56,7 +56,7 @@ def infer_cache(
     with its own ``out``, runs the models side by side; :func:`merge_peaks` joins their files."""
     unknown = sorted(set(modes) - set(MODES))
     if unknown:
-        raise input_error(f"--modes {','.join(unknown)}: allowed: {', '.join(MODES)}")
+        raise input_error(f"{given('modes', list(modes))}: unknown {', '.join(unknown)}; allowed: {', '.join(MODES)}")
     dev = torch_device(device)
     root = Path(models)
     arrays: dict[str, np.ndarray] = {}
@@ -93,8 +93,8 @@ def infer_cache(
         print(f"{mode}: {counted(len(counts), 'inference')}, {time.perf_counter() - t0:.1f} s", flush=True)
     if not arrays:  # an empty peaks file was written, and replayed into predictions without a box
         raise input_error(
-            f"--models {root}: no {'|'.join(m for m in MODES if m in modes)}/model.pt there (mmusv train's output "
-            "folder holds one per model)"
+            f"{given('models', root)}: no {'|'.join(m for m in MODES if m in modes)}/model.pt there (mmusv train's "
+            "output folder holds one per model)"
         )
     return _write(arrays, out)
 
@@ -139,7 +139,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--modes", default=",".join(MODES), help="the models to run (default: every one found)")
     a = ap.parse_args(argv)
     modes = [m.strip() for m in a.modes.split(",") if m.strip()]
-    infer_cache(Cache(a.cache), models=a.models, out=a.out, device=a.device, limit=a.limit, modes=modes)
+    with command_line({"cache": "--cache", "models": "--models", "modes": "--modes"}):  # the messages name these flags
+        cache = Cache(a.cache, name="cache")
+        infer_cache(cache, models=a.models, out=a.out, device=a.device, limit=a.limit, modes=modes)
     return 0
 
 

@@ -191,20 +191,26 @@ def parse_overrides(items: Sequence[str]) -> dict[str, Any]:
     """``{field: value}`` from ``KEY=VALUE`` strings (``--set`` on the command line): ``KEY`` a :class:`Preset`
     field other than ``name``, ``VALUE`` JSON of that field's kind (a number, ``true``/``false``, or a list for
     the tuple fields, e.g. ``code_weights=[1,1,0.1,1,1,1,1,1]``); ``blocks`` as a list of ``[channels, layers,
-    stride]`` lists. Raises the training core's input error naming the item and what is allowed."""
+    stride]`` lists. Raises the training core's input error naming the item (``items[0] = 'k=v'``; ``--set 'k=v'``
+    on the command line) and what is allowed."""
     from mmusv.learn._errors import input_error
+    from mmusv.text import named
 
     defaults = {f.name: getattr(PRESETS["paper"], f.name) for f in fields(Preset) if f.name != "name"}
     out: dict[str, Any] = {}
-    for item in items:
+    if isinstance(items, str):  # one string was read as its characters ("min_points=1" as 'm', 'i', ...)
+        raise input_error(f"items = {items!r}: must be a list of KEY=VALUE strings, e.g. [{items!r}]")
+    for i, item in enumerate(items):
+        # the item as its user gave it: --set 'k=v' on the command line, items[i] = 'k=v' in Python
+        said = f"items[{i}] = {item!r}" if named("items") == "items" else f"{named('items')} {item!r}"
         key, sep, text = item.partition("=")
         key = key.strip()
         if not sep or key not in defaults:
-            raise input_error(f"--set {item!r}: expected KEY=VALUE with KEY one of {', '.join(defaults)}")
+            raise input_error(f"{said}: expected KEY=VALUE with KEY one of {', '.join(defaults)}")
         try:
             value = json.loads(text)
         except json.JSONDecodeError:
-            raise input_error(f"--set {item!r}: the value is not JSON (a number, true/false or a list)") from None
+            raise input_error(f"{said}: the value is not JSON (a number, true/false or a list)") from None
         old = defaults[key]
         if isinstance(old, tuple):
             ok = isinstance(value, list) and (key != "code_weights" or len(value) == len(old))
@@ -223,6 +229,6 @@ def parse_overrides(items: Sequence[str]) -> dict[str, Any]:
             ok, what = type(value) in (int, float), "a number"
             value = float(value) if ok else value
         if not ok:
-            raise input_error(f"--set {item!r}: {key} must be {what}")
+            raise input_error(f"{said}: {key} must be {what}")
         out[key] = value
     return out

@@ -47,6 +47,7 @@ from mmusv.learn.example import early_cloud
 from mmusv.learn.modes import MODELS
 from mmusv.learn.refine import RefineParams
 from mmusv.learn.scorer import SCORER_FILE, IoUScorer, load_scorer, second_stage
+from mmusv.text import command_line, given, named
 
 __all__ = ["main", "write_predictions"]
 
@@ -74,7 +75,10 @@ def _aggregate(cache: Cache, k: int) -> np.ndarray:
 def _read_peaks(peaks: str | Path, cache: Cache) -> dict[str, np.ndarray]:
     """The arrays of the peaks file ``peaks`` (:mod:`mmusv.learn.infer`), checked against ``cache``: one item per
     cloud (``single``) or sample (``early``, ``intermediate``) of the cache. The peaks of another cache, or of a run
-    with ``--limit``, were an ``IndexError`` traceback, or boxes put on the clouds of other frames."""
+    with ``--limit``, were an ``IndexError`` traceback, or boxes put on the clouds of other frames. The message names
+    that limit as the caller's side gives it: ``infer_cache``'s ``limit`` to a Python caller,
+    ``python -m mmusv.learn.infer --limit`` to this module's command (it said ``--limit`` to both)."""
+    limited = named("limit") if named("limit") != "limit" else "mmusv.learn.infer.infer_cache's limit"
     import zipfile
 
     try:
@@ -92,7 +96,8 @@ def _read_peaks(peaks: str | Path, cache: Cache) -> dict[str, np.ndarray]:
         if len(o) != n + 1:
             raise input_error(
                 f"{peaks}: {m}_offsets: peaks of {len(o) - 1} items, where the cache {cache.path} has {n} {what}: the "
-                "peaks of another cache, or of a run with --limit; infer them on this cache"
+                f"peaks of another cache, or of an inference of its first items only ({limited}); infer them on this "
+                "cache"
             )
         if b is None or sc is None or b.ndim != 2 or b.shape[1] != 7 or len(b) != len(sc) or o[-1] != len(sc):
             raise input_error(f"{peaks}: {m}_boxes/{m}_scores: not (M, 7) boxes and (M,) scores as {m}_offsets says")
@@ -114,19 +119,20 @@ def _check_same_sequences(ds: object, cache: Cache, split: str) -> None:
     if missing or other:
         why = f"holds no sequence {', '.join(missing)}" if missing else f"holds {', '.join(other)} recorded differently"
         raise input_error(
-            f"--cache {cache.path}: {why} of split {split!r} of the recordings given (it holds "
-            f"{', '.join(sorted(held))}{_built_with(cache, '; it was built with ')}); give the recordings, --split, "
-            "--split-ratios and --seed the cache was built from"
+            f"{given('cache', cache.path)}: {why} of split {split!r} of the recordings given (it holds "
+            f"{', '.join(sorted(held))}{_built_with(cache, '; it was built with ')}); give the {named('inputs')}, "
+            f"{named('split')}, {named('ratios')} and {named('seed')} the cache was built from"
         )
 
 
 def _built_with(cache: Cache, lead: str) -> str:
-    """``lead`` and the ``--split``, ``--split-ratios`` and ``--seed`` the cache records it was built with (``""``
-    where it does not)."""
+    """``lead`` and the ``split``, ``ratios`` and ``seed`` the cache records it was built with, as its user gives
+    them (``--split``, ``--split-ratios`` and ``--seed`` on the command line); ``""`` where it does not."""
     split, ratios, seed = (cache.meta.get(k) for k in ("split", "ratios", "seed"))
     if not isinstance(ratios, list) or not all(isinstance(r, (int, float)) for r in ratios):
         return ""
-    return f"{lead}--split {split} --split-ratios {','.join(f'{float(r):g}' for r in ratios)} --seed {seed}"
+    shown = [given("split", split), given("ratios", [float(r) for r in ratios]), given("seed", seed)]
+    return lead + (" " if named("split") != "split" else ", ").join(shown)
 
 
 def write_predictions(
@@ -155,7 +161,7 @@ def write_predictions(
     from mmusv.studies.detection.sources import resolve_dataset
 
     if late_merge not in LATE_MERGES:
-        raise input_error(f"--late-merge {late_merge!r}: allowed: {', '.join(LATE_MERGES)}")
+        raise input_error(f"{given('late_merge', late_merge)}: allowed: {', '.join(LATE_MERGES)}")
     z = _read_peaks(peaks, cache)
     try:
         ds = resolve_dataset(list(inputs), opv2v=None, split=split, ratios=tuple(ratios), seed=seed)
@@ -240,10 +246,10 @@ def write_predictions(
 
 def main(argv: Sequence[str] | None = None) -> int:
     """The command line of the module docstring."""
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0] if __doc__ else None)
-    ap.add_argument("peaks")
-    ap.add_argument("cache")
-    ap.add_argument("inputs", nargs="+")
+    ap = argparse.ArgumentParser(description=" ".join((__doc__ or "").split("\n\n")[0].split()))
+    ap.add_argument("peaks", help="the peaks .npz of mmusv.learn.infer (scripts/learn_train.py infer) on CACHE")
+    ap.add_argument("cache", help="the tensor cache the peaks were inferred on (mmusv train --cache-only)")
+    ap.add_argument("inputs", nargs="+", help="the recordings (.mcap) or folders of them the cache was built from")
     ap.add_argument("--split", default="test", help="the split the cache holds (default test)")
     ap.add_argument(
         "--split-ratios",
@@ -262,7 +268,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         help="with --refine: rescore by the IoU scorers DIR/<single|early|intermediate>/scorer.pt (mmusv train's "
         "output folder)",
     )
-    ap.add_argument("-o", "--out", required=True)
+    ap.add_argument("-o", "--out", required=True, help="the predictions Parquet to write")
     a = ap.parse_args(argv)
     from mmusv.learn.cli import split_ratios
 
@@ -276,9 +282,21 @@ def main(argv: Sequence[str] | None = None) -> int:
         scorers = {m: load_scorer(root / m / SCORER_FILE) for m in MODELS if (root / m / SCORER_FILE).is_file()}
         if not scorers:
             raise input_error(f"--scorers {root}: no <{'|'.join(MODELS)}>/{SCORER_FILE} there")
+    flags = {"cache": "cache", "inputs": "recordings", "split": "--split", "ratios": "--split-ratios", "seed": "--seed"}
+    flags["limit"] = "python -m mmusv.learn.infer --limit"  # how the peaks were cut short, for _read_peaks
+    with command_line({**flags, "late_merge": "--late-merge"}):  # the messages name what the command line takes
+        return _write(a, ratios, refine, scorers)
+
+
+def _write(
+    a: argparse.Namespace,
+    ratios: Sequence[float],
+    refine: RefineParams | None,
+    scorers: dict[str, IoUScorer] | None,
+) -> int:
     path = write_predictions(
         a.peaks,
-        Cache(a.cache),
+        Cache(a.cache, name="cache"),
         inputs=a.inputs,
         out=a.out,
         split=a.split,

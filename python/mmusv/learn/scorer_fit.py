@@ -14,7 +14,7 @@ from typing import Any
 
 from mmusv.errors import InputError, MmusvError
 from mmusv.jsonio import read_json_or_none
-from mmusv.text import counted
+from mmusv.text import counted, given, named
 
 __all__ = ["SCORER_SKIPPED", "fit_scorers"]
 
@@ -39,7 +39,9 @@ def fit_scorers(
     a fit that failed for these weights, this cache and seed (``OUT/<mode>/scorer_skipped.json``, written when the
     model finds too few boxes: the fit is deterministic, and a rerun ran the model over the whole cache again, for
     minutes, to fail the same way). ``--scorers-only`` (``keep_current`` false) always fits: the way to try again.
-    Any other failure (Ctrl-C, out of memory) is not recorded and the next run fits again."""
+    Any other failure (Ctrl-C, out of memory) is not recorded and the next run fits again. A mode without a model
+    is refused naming ``out`` as its user gave it (:func:`mmusv.text.given`: ``out = 'run'``, ``--scorers-only -o run``
+    from ``mmusv train``; it said ``--scorers-only`` to a Python caller)."""
     import torch
 
     from mmusv.learn.cache import Cache, cache_identity
@@ -55,7 +57,7 @@ def fit_scorers(
     done: dict[str, dict[str, Any]] = {}
     for mode in modes:
         if not (out / mode / "model.pt").is_file():
-            raise InputError(f"--scorers-only: no {out / mode / 'model.pt'}; train the {mode} model first")
+            raise InputError(f"{given('out', out)}: no {out / mode / 'model.pt'}; train the {mode} model first")
         remove_stale_temporaries(out / mode)  # of a fit killed while it saved its scorer.pt
         det = load_models(out / mode / "model.pt", refine=True, rescore=False)
         model = det.models[mode]
@@ -77,10 +79,10 @@ def fit_scorers(
             before = read_json_or_none(skipped_file)
             if before is not None and {k: before.get(k) for k in failed_fit} == failed_fit:
                 done[mode] = {"skipped": before.get("reason", "")}
+                again = f"mmusv train --scorers-only -o {out}" if named("out") != "out" else "keep_current = False"
                 print(
                     f"{mode}: no IoU scorer (its fit failed before for these weights and data: {before.get('reason')};"
-                    f" {skipped_file}); the model's boxes keep the network's scores (try again: mmusv train "
-                    f"--scorers-only -o {out})",
+                    f" {skipped_file}); the model's boxes keep the network's scores (try again: {again})",
                     flush=True,
                 )
                 continue

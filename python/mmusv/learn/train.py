@@ -59,7 +59,7 @@ from mmusv.learn.loss import centerpoint_loss
 from mmusv.learn.model import PillarNet, torch_device
 from mmusv.learn.presets import PRESETS, Preset, parse_overrides, preset
 from mmusv.learn.targets import points_in_boxes
-from mmusv.text import counted
+from mmusv.text import command_line, counted, given
 
 __all__ = ["TrainResult", "TrainingSet", "main", "plot_losses", "plot_runs", "resumable_checkpoint", "train"]
 
@@ -199,8 +199,8 @@ def train(
     """Trains model ``mode`` of preset ``p`` on ``cache`` into ``out`` (module docstring); resumes from
     ``out/last.pt`` when present. ``epochs`` defaults to the preset's; ``max_steps`` stops early (tests)."""
     if mode not in MODES:
-        raise input_error(f"--mode {mode!r}: allowed: {', '.join(MODES)}")
-    c = Cache(cache) if isinstance(cache, (str, Path)) else cache
+        raise input_error(f"{given('mode', mode)}: allowed: {', '.join(MODES)}")
+    c = Cache(cache, name="cache") if isinstance(cache, (str, Path)) else cache
     out_p = Path(out)
     out_p.mkdir(parents=True, exist_ok=True)
     remove_stale_temporaries(out_p)  # of a run killed while it saved (they were left in the folder for good)
@@ -220,7 +220,7 @@ def train(
     opt = torch.optim.AdamW(model.parameters(), lr=p.lr, weight_decay=p.weight_decay)
     data = TrainingSet(c, p, mode, seed=seed, augment=augment, indices=indices)
     if len(data) == 0:
-        raise input_error(f"--cache {getattr(c, 'path', c)}: no training sample")
+        raise input_error(f"{given('cache', getattr(c, 'path', c))}: no training sample")
     identity = c.identity() if isinstance(c, Cache) else None
     steps_per_epoch = math.ceil(len(data) / p.batch)
     start_epoch, step, log, spent = 0, 0, [], 0.0
@@ -454,17 +454,17 @@ def main(argv: Sequence[str] | None = None) -> int:
     """``python -m mmusv.learn.train`` / ``scripts/learn_train.py``: train one or more modes from a cache."""
     ap = argparse.ArgumentParser(description="Train mmusv.learn models from a tensor cache (torch + numpy only).")
     ap.add_argument("--cache", required=True, help="the .npz tensor cache (mmusv train --cache-only writes one)")
-    ap.add_argument("--preset", default="cpu", choices=sorted(PRESETS))
+    ap.add_argument("--preset", default="cpu", choices=sorted(PRESETS), help="cpu (default), paper (a GPU) or tiny")
     ap.add_argument("--modes", default="single,early,intermediate", help="models to train, in turn")
     ap.add_argument("-o", "--out", required=True, help="output folder (one sub-folder per mode)")
-    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--seed", type=int, default=0, help="seed of the weights and the augmentation (default 0)")
     ap.add_argument("--epochs", type=int, default=None, help="epochs (default: the preset's)")
     ap.add_argument("--time-limit", type=float, default=None, help="seconds per mode (stops at the limit)")
     ap.add_argument("--max-steps", type=int, default=None, help="stop after this many steps (smoke tests)")
     ap.add_argument("--workers", type=int, default=0, help="data-loader worker processes")
     ap.add_argument("--device", default=None, help="cpu or cuda (default: cuda when available)")
     ap.add_argument("--threads", type=int, default=None, help="CPU threads of torch (default: torch's)")
-    ap.add_argument("--no-progress", action="store_true")
+    ap.add_argument("--no-progress", action="store_true", help="no progress bar")
     ap.add_argument(
         "--set",
         action="append",
@@ -474,13 +474,18 @@ def main(argv: Sequence[str] | None = None) -> int:
         "--set code_weights=[1,1,0.1,1,1,1,1,1]; the checkpoint records the preset as trained",
     )
     a = ap.parse_args(argv)
+    with command_line({"cache": "--cache", "items": "--set", "mode": "--modes"}):  # the messages name these flags
+        return _main(a)
+
+
+def _main(a: argparse.Namespace) -> int:
     if a.threads is not None:
         torch.set_num_threads(max(1, a.threads))
     overrides = parse_overrides(a.set)
     p = preset(a.preset, **overrides)
     if overrides:
         print(f"preset {p.name} with {overrides}", flush=True)
-    cache = Cache(a.cache)
+    cache = Cache(a.cache, name="cache")
     for mode in [m.strip() for m in a.modes.split(",") if m.strip()]:
         r = train(
             cache,

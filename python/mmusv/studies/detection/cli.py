@@ -15,9 +15,38 @@ from pathlib import Path
 from typing import Any
 
 from mmusv.learn.modes import STUDY_NEEDS, models_for
-from mmusv.text import counted
+from mmusv.text import command_line, counted
 
-__all__ = ["add_dataset_arguments", "add_parsers", "run"]
+__all__ = ["DATASET_FLAGS", "FLAGS", "add_dataset_arguments", "add_parsers", "run"]
+
+DATASET_FLAGS = {
+    "inputs": "recordings",
+    "opv2v": "--opv2v",
+    "generate": "--generate",
+    "split": "--split",
+    "ratios": "--split-ratios",
+    "seed": "--seed",
+}
+"""The flags of the dataset a detection command reads (:func:`add_dataset_arguments`, ``--split``, ``--split-ratios``,
+``--seed``) by the keyword arguments of :func:`~mmusv.studies.detection.sources.resolve_dataset` they give: ``mmusv
+study`` and ``mmusv train`` call it within :func:`mmusv.text.command_line` of these, so its messages name the flags
+(``--opv2v x: not a folder``) where a Python caller reads ``opv2v = 'x'``. ``generate_dataset``'s ``spec`` is
+``--generate`` (a block of its own: the study's ``spec`` is ``--detector``)."""
+
+FLAGS = {
+    **DATASET_FLAGS,
+    "spec": "--detector",
+    "path": "--predictions",
+    "predictions": "--predictions",
+    "modes": "--modes",
+    "settings": "--settings",
+    "model": "--model",
+    "jobs": "--jobs",
+}
+"""How ``mmusv study detection|robustness`` names the keyword arguments of the API it calls (:data:`DATASET_FLAGS`;
+``load_detector``'s ``spec``, ``load_predictions``' ``path``, the :class:`~mmusv.studies.detection.study.StudyOptions`'
+``predictions``, ``modes`` and ``settings``, ...): the study runs in :func:`mmusv.text.command_line` of these, and
+its ``--jobs`` processes too (:mod:`mmusv.studies.detection.parallel`)."""
 
 _BOXES_HELP = (
     "Parquet columns: sequence, frame, ego, [setting], mode, kind (det|gt), x, y, z, l, w, h, yaw "
@@ -152,7 +181,13 @@ def add_parsers(studies: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Runs ``mmusv study detection|robustness``; returns the exit status."""
+    """Runs ``mmusv study detection|robustness``; returns the exit status. Its messages, and those of the API it
+    calls, name its flags (:data:`FLAGS`)."""
+    with command_line(FLAGS):
+        return _run(args)
+
+
+def _run(args: argparse.Namespace) -> int:
     from rich.console import Console
 
     from mmusv import arguments
@@ -193,7 +228,8 @@ def run(args: argparse.Namespace) -> int:
         from mmusv.learn.cli import load_for_study
 
         # only the models the asked --modes run (one damaged or of another training stopped a study not running it)
-        asked = parse_modes(args.modes) if args.modes is not None else None
+        with command_line({"text": "--modes"}):
+            asked = parse_modes(args.modes) if args.modes is not None else None
         learned = load_for_study(args.model, refine=tri[args.refine], rescore=tri[args.rescore], modes=asked)
     if args.model is None and (args.refine != "auto" or args.rescore != "auto"):
         flag = f"--refine {args.refine}" if args.refine != "auto" else f"--rescore {args.rescore}"
@@ -207,7 +243,8 @@ def run(args: argparse.Namespace) -> int:
         # of its float sums), and torch's default (one per core) here gave other scores with --jobs 1 than --jobs N
         torch.set_num_threads(args.threads or 1)
     default_modes = ",".join(learned.fusion_modes) if learned is not None else "none,late,early"
-    modes = parse_modes(default_modes if args.modes is None else args.modes)  # "" was taken as the default
+    with command_line({"text": "--modes"}):
+        modes = parse_modes(default_modes if args.modes is None else args.modes)  # "" was taken as the default
     if learned is not None:
         _check_model_modes(args.model, learned, modes)
     mixed = _mixed_training(args.model, learned, modes) if learned is not None else None
@@ -217,7 +254,8 @@ def run(args: argparse.Namespace) -> int:
         from mmusv.scenario_checks import MmusvWarning
 
         warnings.warn(mixed, MmusvWarning, stacklevel=2)
-    settings = parse_settings(args.settings) if robust else (Setting(),)
+    with command_line({"text": "--settings"}):
+        settings = parse_settings(args.settings) if robust else (Setting(),)
     if robust and not any(m != "none" for m in modes):
         raise InputError("--modes: the robustness study needs late and/or early fusion")
     if args.predictions is not None and args.detector != "baseline":
@@ -251,7 +289,10 @@ def run(args: argparse.Namespace) -> int:
         from rich.markup import escape
 
         shortfalls: list[str] = []
-        with _bar(console, "generate + record (LiDAR-only)", args.no_progress) as (bar, task):
+        with (
+            _bar(console, "generate + record (LiDAR-only)", args.no_progress) as (bar, task),
+            command_line({"spec": "--generate"}),
+        ):
             inputs = generate_dataset(
                 out / "dataset",
                 spec=args.generate,

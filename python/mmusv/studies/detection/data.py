@@ -27,6 +27,7 @@ import yaml
 from mmusv.annotate import in_target_range
 from mmusv.errors import InputError, IoError
 from mmusv.frames import carla_matrix, invert, mirror_transform, pose_matrices
+from mmusv.text import given
 
 __all__ = [
     "OPV2V_USV_RADIUS_M",
@@ -243,13 +244,15 @@ def _wave_occlusion(annotations: object) -> dict[str, float]:
     return out
 
 
-def opv2v_scenarios(root: str | Path) -> list[Path]:
+def opv2v_scenarios(root: str | Path, *, name: str = "root") -> list[Path]:
     """The scenario folders of an OPV2V tree: ``root`` itself when it holds CAV folders, else its
     sub-folders (one level, or split folders ``train``/``validate``/``test`` below them) that do. Raises
-    :class:`~mmusv.IoError` when there is none."""
+    :class:`~mmusv.IoError` when there is none, naming ``root`` as the argument ``name`` its user gave
+    (:func:`mmusv.text.given`: ``opv2v = '...'`` of :func:`~mmusv.studies.detection.sources.resolve_dataset`,
+    ``--opv2v ...`` of ``mmusv study`` and ``mmusv train``; it said ``--opv2v`` to every caller)."""
     r = Path(root)
     if not r.is_dir():
-        raise IoError(f"--opv2v {r}: not a folder")
+        raise IoError(f"{given(name, r)}: not a folder")
 
     def is_scenario(d: Path) -> bool:
         return any(c.is_dir() and c.name.isdigit() and any(c.glob("*.pcd")) for c in d.iterdir())
@@ -260,7 +263,7 @@ def opv2v_scenarios(root: str | Path) -> list[Path]:
     if not found:
         found = sorted(s for d in r.iterdir() if d.is_dir() for s in d.iterdir() if s.is_dir() and is_scenario(s))
     if not found:
-        raise IoError(f"--opv2v {r}: not an OPV2V folder (no <scenario>/<cav_id>/<timestamp>.pcd + .yaml found)")
+        raise IoError(f"{given(name, r)}: not an OPV2V folder (no <scenario>/<cav_id>/<timestamp>.pcd + .yaml found)")
     return found
 
 
@@ -343,16 +346,17 @@ def _opv2v_vehicles(doc: Any) -> dict[str, tuple[np.ndarray, np.ndarray]]:
 
 
 def check_split(split: str, seed: int) -> None:
-    """Refuses a ``split`` (``--split``) other than ``train``, ``validate``, ``test`` or ``all``, and a negative
-    ``seed`` (``--seed``) where it seeds a split; the message names both the argument and the flag (a Python caller
-    of :func:`split_sequences` was told of ``--split``, which it never gave). The CLIs ask before ``--generate``:
-    both were refused only after the whole dataset had been generated and recorded."""
+    """Refuses a ``split`` other than ``train``, ``validate``, ``test`` or ``all``, and a negative ``seed`` where it
+    seeds a split, each named as its user gave it (:func:`mmusv.text.given`: ``split = 'x'`` from Python, ``--split
+    x`` from ``mmusv study`` and ``mmusv train``; a Python caller of :func:`split_sequences` was told of
+    ``--split``, which it never gave). The CLIs ask before ``--generate``: both were refused only after the whole
+    dataset had been generated and recorded."""
     from mmusv.export.splits import SPLIT_NAMES
 
     if split not in (*SPLIT_NAMES, "all"):
-        raise InputError(f"split = {split!r} (--split): expected one of {', '.join((*SPLIT_NAMES, 'all'))}")
+        raise InputError(f"{given('split', split)}: expected one of {', '.join((*SPLIT_NAMES, 'all'))}")
     if split != "all" and (isinstance(seed, bool) or not isinstance(seed, int) or seed < 0):
-        raise InputError(f"seed = {seed!r} (--seed): the split's seed must be a whole number >= 0")
+        raise InputError(f"{given('seed', seed)}: the split's seed must be a whole number >= 0")
 
 
 def split_sequences(names: Sequence[str], *, split: str, ratios: Sequence[float], seed: int) -> list[str]:

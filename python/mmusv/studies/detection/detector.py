@@ -48,6 +48,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from mmusv.errors import ConfigError, MmusvError
+from mmusv.text import given
 
 __all__ = [
     "BASELINE_NOTE",
@@ -384,19 +385,20 @@ def baseline_detect(points: np.ndarray, params: BaselineParams | None = None) ->
 
 def load_detector(spec: str) -> Detector:
     """The callable named by ``spec`` = ``"package.module:function"``, as a :class:`UserDetector` whose failures
-    name ``spec`` (``"baseline"`` is :func:`baseline_detect`)."""
+    name ``spec`` (``"baseline"`` is :func:`baseline_detect`): as its user gave it (:func:`mmusv.text.given`:
+    ``spec = 'pkg.mod:fn'`` from Python, ``--detector pkg.mod:fn`` from ``mmusv study``)."""
     if spec == "baseline":
         return baseline_detect
     mod_name, sep, attr = spec.partition(":")
     if not sep or not mod_name or not attr:
-        raise ConfigError(f"--detector {spec!r}: expected 'baseline' or 'package.module:function'")
+        raise ConfigError(f"{given('spec', spec)}: expected 'baseline' or 'package.module:function'")
     try:
         mod = importlib.import_module(mod_name)
     except ImportError as exc:
-        raise ConfigError(f"--detector {spec!r}: cannot import module {mod_name!r} ({exc})") from None
+        raise ConfigError(f"{given('spec', spec)}: cannot import module {mod_name!r} ({exc})") from None
     fn = getattr(mod, attr, None)
     if not callable(fn):
-        raise ConfigError(f"--detector {spec!r}: module {mod_name!r} has no callable {attr!r}")
+        raise ConfigError(f"{given('spec', spec)}: module {mod_name!r} has no callable {attr!r}")
     return baseline_detect if fn is baseline_detect else UserDetector(spec, fn)
 
 
@@ -407,8 +409,9 @@ _SIGNATURE = (
 
 
 class UserDetector:
-    """The user's detector ``fn`` named by ``--detector spec``, called as itself: an exception it raises (a
-    function of another signature, a bug in it) becomes a :class:`~mmusv.errors.ConfigError` naming ``spec``,
+    """The user's detector ``fn`` named by ``spec`` (``--detector`` of ``mmusv study``), called as itself: an
+    exception it raises (a function of another signature, a bug in it) becomes a :class:`~mmusv.errors.ConfigError`
+    naming ``spec`` as :func:`load_detector` does,
     what failed and the signature expected. Its other attributes (``early``, a detector's own early-fusion
     entry) are its own, ``early`` checked the same way."""
 
@@ -423,11 +426,11 @@ class UserDetector:
             raise
         except Exception as exc:
             raise ConfigError(
-                f"--detector {self.spec!r}: {what} on a ({len(points)}, 4) point cloud failed: "
+                f"{given('spec', self.spec)}: {what} on a ({len(points)}, 4) point cloud failed: "
                 f"{type(exc).__name__}: {exc}; {_SIGNATURE}"
             ) from exc
         if not isinstance(out, (tuple, list)) or len(out) != 2:
-            raise ConfigError(f"--detector {self.spec!r}: {what} returned {type(out).__name__}; {_SIGNATURE}")
+            raise ConfigError(f"{given('spec', self.spec)}: {what} returned {type(out).__name__}; {_SIGNATURE}")
         return out[0], out[1]
 
     def __getattr__(self, name: str) -> object:

@@ -29,6 +29,7 @@ from mmusv.frames import invert, transform_points
 from mmusv.studies.detection.data import AgentFrame
 from mmusv.studies.detection.detector import Detector
 from mmusv.studies.detection.evaluate import bev_iou
+from mmusv.text import given, named
 
 __all__ = [
     "DEFAULT_MODES",
@@ -60,11 +61,13 @@ Boxes = tuple[np.ndarray, np.ndarray]
 
 
 def parse_modes(text: str | Sequence[str]) -> tuple[str, ...]:
-    """Validated fusion modes from ``"none,late,early"`` or a list, in :data:`MODES` order."""
+    """Validated fusion modes from ``"none,late,early"`` or a list, in :data:`MODES` order; an
+    :class:`~mmusv.errors.InputError` names ``text`` (``--modes`` in ``mmusv study``, :func:`mmusv.text.given`)."""
     items = [s.strip() for s in (text.split(",") if isinstance(text, str) else text) if s.strip()]
     bad = [s for s in items if s not in MODES]
     if bad or not items:
-        raise InputError(f"--modes {','.join(items) or repr(text)}: unknown mode(s) {bad}; allowed: {', '.join(MODES)}")
+        what = f"unknown mode(s) {bad}" if bad else "no mode"
+        raise InputError(f"{given('text', text)}: {what}; allowed: {', '.join(MODES)}")
     return tuple(m for m in MODES if m in items)
 
 
@@ -206,15 +209,17 @@ def fuse(
     if mode == "intermediate":
         inter = getattr(detector, "intermediate", None)
         if inter is None:
-            raise InputError("intermediate fusion needs a learned model (--model), not a points -> boxes detector")
+            learned = named("model") if named("model") != "model" else "mmusv.learn.detector.load_models"
+            raise InputError(f"intermediate fusion needs a learned model ({learned}), not a points -> boxes detector")
         return _as_boxes(inter(ego.points, [(nb.points, relative(ego, nb)) for nb in neighbours]), who)
     raise InputError(f"fusion mode {mode!r}: allowed: {', '.join(MODES)}")
 
 
 def detector_name(detector: object) -> str:
-    """How errors name ``detector``: ``--detector 'pkg.mod:fn'`` for a user's detector, else "the detector"."""
+    """How errors name ``detector``: a user's detector as its ``spec`` was given (``spec = 'pkg.mod:fn'``, ``--detector
+    pkg.mod:fn`` from ``mmusv study``: :func:`mmusv.text.given`), else "the detector"."""
     spec = getattr(detector, "spec", None)
-    return f"--detector {spec!r}" if isinstance(spec, str) else "the detector"
+    return given("spec", spec) if isinstance(spec, str) else "the detector"
 
 
 def _as_boxes(out: tuple[np.ndarray, np.ndarray], who: str = "the detector") -> Boxes:

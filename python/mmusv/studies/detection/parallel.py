@@ -10,7 +10,9 @@ once. So the tables and the boxes Parquet are the same, byte for byte, with any 
 
 Workers are started with ``spawn`` (a clean interpreter: safe after torch has started its threads, and the same on
 every platform); with a learned model each sets torch to ``threads`` CPU threads (1 by default: ``jobs`` processes
-share the cores).
+share the cores). Each task runs in the :func:`mmusv.text.command_line` block of its caller (:func:`mmusv.text.flags`,
+passed with it), so that a worker's messages name what the caller's do: ``--detector ...`` and ``--predictions ...``
+from ``mmusv study``, ``spec = ...`` and ``path = ...`` from Python.
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ from mmusv.batch.executors import refuse_in_daemon, workers_skip_unimportable_ma
 from mmusv.errors import InputError, MmusvError
 from mmusv.studies.detection.sources import Dataset
 from mmusv.studies.detection.study import StudyOptions, StudyResult, check_predictions_used, run_study
+from mmusv.text import command_line, flags, given, named
 
 __all__ = ["DetectorSpec", "run_study_jobs"]
 
@@ -68,9 +71,17 @@ _BUILT: dict[DetectorSpec, tuple[Any, Any]] = {}
 read), for every sequence the process is given, as the one process of ``--jobs 1`` does."""
 
 
-def _task(dataset: Dataset, name: str, options: StudyOptions, spec: DetectorSpec) -> tuple[str, Any, list[int]]:
+def _task(
+    dataset: Dataset, name: str, options: StudyOptions, spec: DetectorSpec, said: dict[str, str]
+) -> tuple[str, Any, list[int]]:
     """One sequence's study: ``("ok", StudyResult, shared bytes)`` or ``("error", message, [])`` for bad input
-    (re-raised in the parent as :class:`~mmusv.errors.InputError`, whose own class need not pickle)."""
+    (re-raised in the parent as :class:`~mmusv.errors.InputError`, whose own class need not pickle). ``said``: the
+    flags of the caller's :func:`mmusv.text.command_line` block, which a worker process does not inherit."""
+    with command_line(said):
+        return _run_task(dataset, name, options, spec)
+
+
+def _run_task(dataset: Dataset, name: str, options: StudyOptions, spec: DetectorSpec) -> tuple[str, Any, list[int]]:
     try:
         if spec not in _BUILT:
             _BUILT[spec] = spec.build()
@@ -96,8 +107,8 @@ def run_study_jobs(
     :class:`~mmusv.studies.detection.study.StudyResult` and, for a learned model, the bytes its intermediate
     fusion shared per call (in sequence order). ``options``' detector and predictions are ignored: each task
     builds them from ``spec``. ``progress(done, total)`` counts frames, a sequence at a time."""
-    jobs = arguments.whole(jobs, name="jobs (--jobs)", lo=1, error=InputError)  # "2" was a TypeError of <
-    refuse_in_daemon(f"the detection study with --jobs {jobs}")  # the batch's rules for a pool of spawned workers
+    jobs = arguments.whole(jobs, name=named("jobs"), lo=1, error=InputError)  # "2" was a TypeError of <
+    refuse_in_daemon(f"the detection study with {given('jobs', jobs)}")  # the batch's rules for spawned workers
     names = sorted(dataset.sources)
     frames = dataset.frames_by_sequence()
     total = sum(frames.values())
@@ -109,7 +120,7 @@ def run_study_jobs(
     with ProcessPoolExecutor(max_workers=min(jobs, max(1, len(names))), mp_context=ctx) as pool:
         with workers_skip_unimportable_main():  # the submissions start the workers
             pending: dict[Future[tuple[str, Any, list[int]]], str] = {
-                pool.submit(_task, dataset, n, bare, spec): n for n in names
+                pool.submit(_task, dataset, n, bare, spec, flags()): n for n in names
             }
         while pending:
             finished, _ = wait(pending, return_when=FIRST_COMPLETED)

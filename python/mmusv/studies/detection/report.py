@@ -155,13 +155,14 @@ def _parquet(df: pl.DataFrame) -> bytes:
 
 def none_only_line(res: StudyResult) -> str | None:
     """The line saying which sequences had one USV with a LiDAR, so were scored in mode ``none`` only (or, without
-    mode ``none``, not at all); ``None`` when there were none."""
+    mode ``none``, not at all); ``None`` when there were none. Worded for the command line and the Python API
+    alike (it said "--modes has no none" in a report of ``modes=...``)."""
     if not res.none_only:
         return None
     names = ", ".join(res.none_only)
     if "none" in res.options.modes:
         return f"scored in mode none only (one USV with a LiDAR: nothing to fuse): {names}"
-    return f"not scored (one USV with a LiDAR: nothing to fuse, and --modes has no none): {names}"
+    return f"not scored (one USV with a LiDAR: nothing to fuse, and mode none was not asked for): {names}"
 
 
 def _note(res: StudyResult, detector: str, notes: Sequence[str] = ()) -> str:

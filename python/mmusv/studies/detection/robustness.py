@@ -76,9 +76,11 @@ def parse_settings(text: str | Sequence[str]) -> tuple[Setting, ...]:
     """Settings from ``"clean,delay:1,delay:2,noise:0.5/0.5"`` (or a list of such items; ``noise:S`` is
     ``noise:S/S``); ``clean`` first, then the delays by ``K``, then the noises by their σs, each setting once (the
     study's tables follow this order, whatever the order given)."""
+    from mmusv.text import given
+
     items = [s.strip() for s in (text.split(",") if isinstance(text, str) else text) if s.strip()]
     if not items:  # "" ran the clean setting alone, a robustness study of nothing
-        raise InputError("--settings is empty: give clean, delay:K or noise:SIGMA_XYZ_M/SIGMA_RPY_DEG items")
+        raise InputError(f"{given('text', text)}: empty; give clean, delay:K or noise:SIGMA_XYZ_M/SIGMA_RPY_DEG items")
     out: list[Setting] = [Setting()]
     for it in items:
         kind, _, val = it.partition(":")
@@ -100,7 +102,7 @@ def parse_settings(text: str | Sequence[str]) -> tuple[Setting, ...]:
                 raise ValueError
         except ValueError:
             raise InputError(
-                f"--settings item {it!r}: expected clean, delay:K (K ≥ 1 frames) or "
+                f"{given('text', text)}: item {it!r}: expected clean, delay:K (K ≥ 1 frames) or "
                 f"noise:SIGMA_XYZ_M/SIGMA_RPY_DEG (0 ≤ SIGMA_XYZ_M ≤ {MAX_SIGMA_XYZ_M:g} m, 0 ≤ SIGMA_RPY_DEG ≤ "
                 f"{MAX_SIGMA_RPY_DEG:g}°, not both 0)"
             ) from None

@@ -31,7 +31,7 @@ from mmusv.studies.detection.data import (
     recording_summary,
     split_sequences,
 )
-from mmusv.text import counted
+from mmusv.text import counted, given, named
 
 __all__ = ["BUNDLED_SPEC", "Dataset", "generate_dataset", "lidar_only", "resolve_dataset"]
 
@@ -123,8 +123,9 @@ def _recordings(inputs: Sequence[str | Path]) -> list[Path]:
 
 
 def _opv2v_hint(folder: Path) -> str:
-    """``"; it is an OPV2V folder: give it as --opv2v ..."`` when ``folder`` is one (``mmusv convert --to opv2v``'s
-    output), else empty: it was said to hold no recording, with no word of the option that reads it."""
+    """``"; it is an OPV2V folder: give it as opv2v = '...'"`` (``--opv2v ...`` from a command,
+    :func:`mmusv.text.given`) when ``folder`` is one (``mmusv convert --to opv2v``'s output), else empty: it was said
+    to hold no recording, with no word of the option that reads it."""
     from mmusv.errors import MmusvError
     from mmusv.studies.detection.data import opv2v_scenarios
 
@@ -132,7 +133,7 @@ def _opv2v_hint(folder: Path) -> str:
         opv2v_scenarios(folder)
     except (MmusvError, OSError):
         return ""
-    return f"; it is an OPV2V folder: give it as --opv2v {folder}"
+    return f"; it is an OPV2V folder: give it as {given('opv2v', folder)}"
 
 
 def _sequence_names(recs: Sequence[Path]) -> dict[str, Path]:
@@ -166,11 +167,13 @@ def resolve_dataset(
     seed: int = 0,
 ) -> Dataset:
     """The sequences of ``split`` from recordings ``inputs`` or the OPV2V folder ``opv2v`` (not both). Raises
-    :class:`~mmusv.InputError` when nothing is given or the split is empty."""
+    :class:`~mmusv.InputError` when nothing is given or the split is empty. The messages name the arguments as their
+    user gave them (:func:`mmusv.text.given`: ``opv2v = '...'``, ``split = 'test'``; ``--opv2v``, ``--split`` and
+    ``--generate`` from ``mmusv study`` and ``mmusv train``: :data:`mmusv.studies.detection.cli.DATASET_FLAGS`)."""
     if inputs and opv2v is not None:
-        raise InputError("give recordings or --opv2v DIR, not both")
+        raise InputError(f"give {named('inputs')} or {named('opv2v')}, not both")
     if opv2v is not None:
-        folders = opv2v_scenarios(opv2v)
+        folders = opv2v_scenarios(opv2v, name="opv2v")
         kind = "opv2v"
         names = {
             f.name if f.parent.name not in ("train", "validate", "test") else f"{f.parent.name}/{f.name}": f
@@ -185,13 +188,15 @@ def resolve_dataset(
     else:
         recs = _recordings(inputs)
         if not recs:
-            raise InputError("empty dataset: give recordings (.mcap or folders of them), --opv2v DIR or --generate")
+            gen = [named("generate")] if named("generate") != "generate" else []  # a command's --generate
+            choices = [f"{named('inputs')} (.mcap files or folders of them)", named("opv2v"), *gen]
+            raise InputError(f"empty dataset: give {', '.join(choices[:-1])} or {choices[-1]}")
         kind = "recording"
         by_name = _sequence_names(recs)
         chosen = {n: by_name[n] for n in split_sequences(list(by_name), split=split, ratios=ratios, seed=seed)}
     if not chosen:
         where = opv2v if opv2v is not None else ", ".join(str(x) for x in inputs)
-        raise InputError(f"empty dataset: split {split!r} of {where} holds no sequence (try --split all)")
+        raise InputError(f"empty dataset: split {split!r} of {where} holds no sequence (try {given('split', 'all')})")
     return Dataset(chosen, kind, split)
 
 
@@ -221,7 +226,8 @@ def generate_dataset(
     generated of how many asked for, then with one line per role combination whose quota the generator did not
     meet, with the generator's reason
     (:meth:`mmusv.generate.report.ComboReport.why`). Raises :class:`~mmusv.InputError` when a scenario could not
-    be recorded."""
+    be recorded; its messages name ``spec`` as its user gave it (``--generate`` from a command,
+    :func:`mmusv.text.given`)."""
     from mmusv.batch import dataset_recordings, run_many
     from mmusv.bundled import resolve_spec
     from mmusv.generate.runner import generate
@@ -237,7 +243,7 @@ def generate_dataset(
                 shortfall(f"quota not met {c.name}: {c.why()}")
     files = sorted(scen_dir.glob("*.yaml"))
     if not files:
-        raise InputError(f"--generate: spec {sp} produced no scenario (see {scen_dir / 'report.json'})")
+        raise InputError(f"{given('spec', sp)}: produced no scenario (see {scen_dir / 'report.json'})")
     lidar_dir.mkdir(parents=True, exist_ok=True)
     for old in lidar_dir.glob("*.yaml"):
         old.unlink()
@@ -255,7 +261,7 @@ def generate_dataset(
     failed = [o for o in report.outcomes if o.status == "failed"]
     if failed:
         raise InputError(
-            f"--generate: {len(failed)} of {counted(len(files), 'scenario')} could not be recorded; "
+            f"{given('spec', sp)}: {len(failed)} of {counted(len(files), 'scenario')} could not be recorded; "
             f"first: {failed[0].error}"
         )
     return dataset_recordings(out / "recordings")

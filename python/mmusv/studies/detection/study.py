@@ -68,6 +68,7 @@ from mmusv.studies.detection.evaluate import (
 )
 from mmusv.studies.detection.fusion import DEFAULT_MODES, MODES, _as_boxes, detector_name, fuse, relative
 from mmusv.studies.detection.robustness import Setting, neighbours_for
+from mmusv.text import given, named
 
 __all__ = [
     "StudyOptions",
@@ -223,18 +224,21 @@ _ROW_SCHEMA: dict[str, Any] = {
 
 def load_predictions(path: str | Path) -> dict[tuple[str, int, str, str, str], tuple[np.ndarray, np.ndarray]]:
     """The detections of a predictions Parquet (module docstring) keyed by (sequence, frame, ego, mode,
-    setting); a key the file covers (a ``frame`` or ``gt`` row) without a detection maps to no box."""
+    setting); a key the file covers (a ``frame`` or ``gt`` row) without a detection maps to no box. Its refusals name
+    ``path`` as its user gave it (:func:`mmusv.text.given`: ``path = '...'``, ``--predictions ...`` from ``mmusv
+    study``)."""
     p = Path(path)
+    shown = given("path", p)
     if not p.is_file():
-        raise InputError(f"--predictions {p}: no such file")
+        raise InputError(f"{shown}: no such file")
     try:
         df = pl.read_parquet(p, glob=False)  # a file a[1].parquet is a name, not a pattern
     except (OSError, pl.exceptions.PolarsError) as exc:
-        raise InputError(f"--predictions {p}: not a readable Parquet file ({type(exc).__name__})") from None
+        raise InputError(f"{shown}: not a readable Parquet file ({type(exc).__name__})") from None
     need = ["sequence", "frame", "ego", "mode", *BOX_COLUMNS, "score"]
     missing = [c for c in need if c not in df.columns]
     if missing:
-        raise InputError(f"--predictions {p}: missing column(s) {missing}; required: {need}")
+        raise InputError(f"{shown}: missing column(s) {missing}; required: {need}")
     df = df.with_row_index("_row")
     if "setting" not in df.columns:
         df = df.with_columns(pl.lit("clean").alias("setting"))
@@ -244,9 +248,9 @@ def load_predictions(path: str | Path) -> dict[tuple[str, int, str, str, str], t
         df = df.filter(kind == "det")
     else:
         covered = df.clear()
-    _check_prediction_keys(p, df, rows="det")
-    _check_prediction_values(p, df)
-    _check_prediction_keys(p, covered, rows=" or ".join(COVERAGE_KINDS))
+    _check_prediction_keys(shown, df, rows="det")
+    _check_prediction_values(shown, df)
+    _check_prediction_keys(shown, covered, rows=" or ".join(COVERAGE_KINDS))
     out: dict[tuple[str, int, str, str, str], tuple[np.ndarray, np.ndarray]] = {}
     keys = ["sequence", "frame", "ego", "mode", "setting"]
 
@@ -264,10 +268,10 @@ def load_predictions(path: str | Path) -> dict[tuple[str, int, str, str, str], t
     return out
 
 
-def _check_prediction_keys(path: Path, df: pl.DataFrame, *, rows: str) -> None:
+def _check_prediction_keys(shown: str, df: pl.DataFrame, *, rows: str) -> None:
     """Refuses rows (``_row`` = the row in the file) of a predictions table with a null key, a frame that is not a
     whole number or a mode that is not one: a null frame was a TypeError traceback and 1.5 was read as frame 1.
-    ``rows``: the kind of the rows, for the message."""
+    ``shown``: the file as its user gave it; ``rows``: the kind of the rows, for the message."""
 
     def first(mask: pl.Series) -> str:
         return f"row {int(df['_row'].filter(mask)[0])}"
@@ -276,28 +280,26 @@ def _check_prediction_keys(path: Path, df: pl.DataFrame, *, rows: str) -> None:
         nulls = df[c].is_null()
         if nulls.any():
             raise InputError(
-                f"--predictions {path}: column {c} has {int(nulls.sum())} null value(s) (first: {first(nulls)}); "
+                f"{shown}: column {c} has {int(nulls.sum())} null value(s) (first: {first(nulls)}); "
                 f"every {rows} row needs one"
             )
     frame = df["frame"]
     if not frame.dtype.is_numeric():
-        raise InputError(f"--predictions {path}: column frame must hold integer acquisition indices, not {frame.dtype}")
+        raise InputError(f"{shown}: column frame must hold integer acquisition indices, not {frame.dtype}")
     if frame.dtype.is_float():
         values = frame.to_numpy()
         bad = pl.Series(~np.isfinite(values) | (values != np.round(values)) | (np.abs(values) > 2**62))
         if bad.any():
             raise InputError(
-                f"--predictions {path}: column frame must hold integer acquisition indices; {first(bad)} has "
+                f"{shown}: column frame must hold integer acquisition indices; {first(bad)} has "
                 f"{float(values[bad.to_numpy()][0])!r}"
             )
     unknown = sorted(set(df["mode"].cast(pl.Utf8).to_list()) - set(MODES))
     if unknown:
-        raise InputError(
-            f"--predictions {path}: column mode has unknown value(s) {unknown}; allowed: {', '.join(MODES)}"
-        )
+        raise InputError(f"{shown}: column mode has unknown value(s) {unknown}; allowed: {', '.join(MODES)}")
 
 
-def _check_prediction_values(path: Path, df: pl.DataFrame) -> None:
+def _check_prediction_values(shown: str, df: pl.DataFrame) -> None:
     """Refuses a predictions table (its ``det`` rows, ``_row`` = the row in the file) with a box or score that is
     null or not a finite number: a NaN box was dropped and a NaN score ranked anyhow, each without a word."""
 
@@ -308,26 +310,25 @@ def _check_prediction_values(path: Path, df: pl.DataFrame) -> None:
         nulls = df[c].is_null()
         if nulls.any():
             raise InputError(
-                f"--predictions {path}: column {c} has {int(nulls.sum())} null value(s) (first: {first(nulls)}); "
+                f"{shown}: column {c} has {int(nulls.sum())} null value(s) (first: {first(nulls)}); "
                 "every det row needs one"
             )
     for c in (*BOX_COLUMNS, "score"):
         col = df[c]
         if not col.dtype.is_numeric():
             unit = "" if c == "score" else " (metres, radians)"
-            raise InputError(f"--predictions {path}: column {c} must hold finite numbers{unit}, not {col.dtype}")
+            raise InputError(f"{shown}: column {c} must hold finite numbers{unit}, not {col.dtype}")
         bad = pl.Series(~np.isfinite(col.to_numpy().astype(np.float64)))
         if bad.any():
             raise InputError(
-                f"--predictions {path}: column {c} must hold finite numbers; {first(bad)} has "
-                f"{float(col.filter(bad)[0])!r}"
+                f"{shown}: column {c} must hold finite numbers; {first(bad)} has {float(col.filter(bad)[0])!r}"
             )
     for c in ("l", "w", "h"):  # a negative size was scored without a word
         col = df[c]
         bad = pl.Series(col.to_numpy().astype(np.float64) < 0)
         if bad.any():
             raise InputError(
-                f"--predictions {path}: column {c} must hold box sizes in metres, not negative; {first(bad)} has "
+                f"{shown}: column {c} must hold box sizes in metres, not negative; {first(bad)} has "
                 f"{float(col.filter(bad)[0])!r}"
             )
 
@@ -342,7 +343,9 @@ def check_prediction_coverage(
     """Refuses predictions that cover no frame of a (setting, mode) the study scores (no ``det`` row, nor a
     ``frame`` or ``gt`` row saying it was covered): Table III's boxes (setting ``clean`` only) scored as Table IV
     gave AP 0 for every delay and noise setting, as if measured. A covered (setting, mode) without a detection is a
-    model that found nothing: AP 0, as ``--model`` scores it."""
+    model that found nothing: AP 0, as a learned model is scored. The message names ``path``, ``modes`` and
+    ``settings`` as their user gave them (:func:`mmusv.text.given`; ``--predictions``, ``--modes`` and
+    ``--settings`` from ``mmusv study``)."""
     held = {(k[4], k[3]) for k in predictions}
     wanted = [(s.name, m) for s in settings for m in modes if m != "none" or s.name == "clean"]
     missing = [w for w in wanted if w not in held]
@@ -363,8 +366,8 @@ def check_prediction_coverage(
         "mmusv.learn.replay writes)"
     )
     raise InputError(
-        f"--predictions {path}: no row of {listed(missing)}; {holds}. Give the detections of every setting "
-        "(--settings) and mode (--modes) scored, or leave those out"
+        f"{given('path', path)}: no row of {listed(missing)}; {holds}. Give the detections of every setting "
+        f"({named('settings')}) and mode ({named('modes')}) scored, or leave those out"
     )
 
 
@@ -468,10 +471,11 @@ def run_study(
 
 def check_predictions_used(res: StudyResult) -> None:
     """Raises :class:`~mmusv.errors.InputError` when ``res`` was scored from predictions of which no row matched
-    any (sequence, frame, ego, mode) evaluated: a misnamed file, not a detector that found nothing."""
+    any (sequence, frame, ego, mode) evaluated: a misnamed file, not a detector that found nothing. The message
+    names the options' ``predictions`` (``--predictions`` from ``mmusv study``, :func:`mmusv.text.named`)."""
     if res.options.predictions is not None and res.predictions_used == 0 and res.ego_frames:
         raise InputError(
-            "--predictions: no row matches any (sequence, frame, ego, mode) evaluated; check the "
+            f"{named('predictions')}: no row matches any (sequence, frame, ego, mode) evaluated; check the "
             f"sequence names ({', '.join(res.sequences[:3])}, ...) and the ego ids"
         )
 
