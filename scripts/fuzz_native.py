@@ -1030,15 +1030,21 @@ def run(cases: list[str], *, timeout: float, mem: int, rss_kib: int, log: Any) -
 
 
 def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("-o", "--out", default="/tmp/fuzz_native.jsonl")
-    ap.add_argument("--timeout", type=float, default=20.0)
-    ap.add_argument("--mem-gib", type=float, default=4.0)
-    ap.add_argument("--rss-gib", type=float, default=1.0)
-    ap.add_argument("--only", default="")
-    ap.add_argument("--random", type=int, default=0)
-    ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--list", action="store_true")
+    ap = argparse.ArgumentParser(description=" ".join(__doc__.split("\n\n")[0].split()))
+    ap.add_argument(
+        "-o", "--out", default="/tmp/fuzz_native.jsonl", help="JSON lines, one per case (default %(default)s)"
+    )
+    ap.add_argument("--timeout", type=float, default=20.0, help="seconds per case (default %(default)s)")
+    ap.add_argument(
+        "--mem-gib", type=float, default=4.0, help="a worker's address-space limit, GiB (default %(default)s)"
+    )
+    ap.add_argument(
+        "--rss-gib", type=float, default=1.0, help="a worker's resident-memory limit, GiB (default %(default)s)"
+    )
+    ap.add_argument("--only", default="", help="only the cases whose code holds this text")
+    ap.add_argument("--random", type=int, default=0, help="this many random cases more, two or three arguments each")
+    ap.add_argument("--seed", type=int, default=0, help="seed of the random cases (default %(default)s)")
+    ap.add_argument("--list", action="store_true", help="print the cases and stop")
     a = ap.parse_args()
     cases = build_cases() + random_cases(a.random, a.seed)
     if a.only:

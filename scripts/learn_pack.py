@@ -5,14 +5,18 @@ Usage: ``python3 scripts/learn_pack.py SRC DST``."""
 
 from __future__ import annotations
 
+import argparse
 import shutil
-import sys
 from pathlib import Path
 
-import torch
-
 if __name__ == "__main__":
-    src, dst = Path(sys.argv[1]), Path(sys.argv[2])
+    ap = argparse.ArgumentParser(description=" ".join(__doc__.split("\n\n")[0].split()))
+    ap.add_argument("src", type=Path, help="scripts/learn_train.py's output folder (SRC/<mode>/model.pt)")
+    ap.add_argument("dst", type=Path, help="the folder to write <mode>.pt and <mode>.jsonl into")
+    args = ap.parse_args()
+    import torch
+
+    src, dst = args.src, args.dst
     dst.mkdir(parents=True, exist_ok=True)
     for d in sorted(x for x in src.iterdir() if (x / "model.pt").is_file()):
         ck = torch.load(d / "model.pt", map_location="cpu", weights_only=True)

@@ -134,11 +134,11 @@ def machine() -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--width", type=int, default=192)
-    p.add_argument("--height", type=int, default=128)
+    p = argparse.ArgumentParser(description=" ".join(__doc__.split("\n\n")[0].split()))
+    p.add_argument("--width", type=int, default=192, help="image width in pixels (default %(default)s)")
+    p.add_argument("--height", type=int, default=128, help="image height in pixels (default %(default)s)")
     p.add_argument("--spp", type=int, default=1024, help="Mitsuba samples per pixel of the environment layers")
-    p.add_argument("--out", type=Path, default=ROOT / "docs" / "realism")
+    p.add_argument("--out", type=Path, default=ROOT / "docs" / "realism", help="output folder (default docs/realism)")
     p.add_argument("--scenes", nargs="*", default=None, help="scene names (default: all)")
     args = p.parse_args(argv)
     import mitsuba as mi

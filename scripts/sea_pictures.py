@@ -255,8 +255,8 @@ def lidar_wake(out: Path, lines: list[str]) -> None:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("-o", "--out", default=str(ROOT / "docs/sea"))
+    ap = argparse.ArgumentParser(description=" ".join(__doc__.split("\n\n")[0].split()))
+    ap.add_argument("-o", "--out", default=str(ROOT / "docs/sea"), help="output folder (default docs/sea)")
     ap.add_argument("--only", default="craft,faces,radar,wake", help="comma-separated: craft, faces, radar, wake")
     args = ap.parse_args()
     out = Path(args.out)

@@ -88,11 +88,11 @@ def plot(tables: list[pl.DataFrame], labels: list[str], path: Path, title: str) 
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=" ".join(__doc__.split("\n\n")[0].split()))
     ap.add_argument("dirs", nargs="+", type=Path, help="study output folders (detection_table.csv), first = reference")
     ap.add_argument("--labels", default=None, help="comma-separated sea labels (default W1,W3)")
     ap.add_argument("--png", type=Path, default=None, help="write the AP-by-range picture here")
-    ap.add_argument("--title", default="AP@0.5 by range at two sea states")
+    ap.add_argument("--title", default="AP@0.5 by range at two sea states", help="the picture's title")
     args = ap.parse_args()
     labels = args.labels.split(",") if args.labels else ["W1", "W3", "W?"][: len(args.dirs)]
     if len(labels) != len(args.dirs) or len(args.dirs) < 2:
