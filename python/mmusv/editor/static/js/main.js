@@ -192,7 +192,10 @@ async function refreshLibrary() {
   libraryAsked = key;
   try {
     const assets = await api.assets(entries);
-    if (assetEntries(state.doc).key === key) panels.setAssets(assets, key);
+    if (assetEntries(state.doc).key === key) {
+      panels.setAssets(assets, key);
+      panels.renderVessel(); // the selected vessel's asset in the new menu, or said to be missing from it
+    }
   } catch (err) {
     status(`vessel library: ${err.message}`, true);
   } finally {

@@ -22,6 +22,20 @@ function setValue(input, value) {
   input.value = value ?? "";
 }
 
+/** Shows `value` in `select`, with an option of its own saying `why` (as "tugg (not in the library)") when none of
+ * the menu's options is it: a scenario naming an asset or rig that is not there showed a blank menu. That option goes
+ * again once the value is one of the menu's. */
+function selectValue(select, value, why) {
+  for (const o of select.querySelectorAll("option[data-missing]")) o.remove();
+  const v = value ?? "";
+  if (![...select.options].some((o) => o.value === v)) {
+    const o = option(v, `${v} (${why})`);
+    o.dataset.missing = "1";
+    select.appendChild(o);
+  }
+  select.value = v;
+}
+
 function numberOrNull(input) {
   if (input.value.trim() === "") return null;
   const n = Number(input.value);
@@ -207,7 +221,7 @@ export class Panels {
     const menu = $("v-asset");
     const was = menu.value;
     fillSelect(menu, assets.map((a) => [a.name, `${a.name} (${a.length} × ${a.beam} m)`]));
-    menu.value = was;
+    menu.value = was; // the vessel form (renderVessel) says so when this library lacks it
     if (this.map.mode === "place") {
       const asset = assets.find((a) => a.name === this.map.placing?.asset?.name);
       if (asset) this.map.setMode("place", { ...this.map.placing, asset });
@@ -362,10 +376,10 @@ export class Panels {
     $("v-add-y").dataset.field = `${at}.route.(new)[1]`;
     setValue($("v-id"), v.id);
     setValue($("v-role"), v.role || "target");
-    setValue($("v-asset"), v.asset);
+    selectValue($("v-asset"), v.asset, "not in the library");
     const rigs = Object.keys(this.state.doc.rigs || {});
     fillSelect($("v-rig"), [["", "(default rig)"], ...rigs]);
-    $("v-rig").value = v.rig || "";
+    selectValue($("v-rig"), v.rig || "", "no such rig");
     $("v-rig-label").hidden = v.role !== "usv";
     setValue($("v-speed"), v.speed_mps ?? 0);
     setValue($("v-end"), v.end || "stop");
