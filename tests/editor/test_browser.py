@@ -22,6 +22,7 @@ from mmusv.bundled import resolve_scenario
 from mmusv.config import load_scenario
 from mmusv.generate.mapctx import map_context
 from mmusv.recording.info import read_info
+from selenium.common.exceptions import StaleElementReferenceException
 from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
@@ -43,6 +44,21 @@ def _wait(driver: Any, script: str, what: str) -> Any:
     return WebDriverWait(driver, WAIT_S, poll_frequency=0.05).until(
         lambda d: d.execute_script(script), message=f"timed out waiting for {what}"
     )
+
+
+def act_on(driver: Any, css: str, act: Any) -> Any:
+    """``act(element)`` on the element ``css`` finds, found again while a redraw replaced it in between: a map
+    redraw (after an evaluation, on a busy machine) can make a handle or marker stale between finding it and acting
+    on it, and Selenium refuses a stale element before any input is sent, so trying again is safe. Returns what
+    ``act`` returned (``None`` taken as done)."""
+
+    def attempt(d: Any) -> Any:
+        out = act(d.find_element(By.CSS_SELECTOR, css))
+        return True if out is None else out
+
+    return WebDriverWait(
+        driver, WAIT_S, poll_frequency=0.05, ignored_exceptions=(StaleElementReferenceException,)
+    ).until(attempt, message=f"timed out acting on {css}")
 
 
 def settled(driver: Any) -> None:
@@ -95,18 +111,20 @@ def click_world(driver: Any, x: float, y: float) -> tuple[float, float]:
 
 
 def drag_waypoint(driver: Any, vessel: str, index: int, to: tuple[float, float]) -> None:
-    handle = driver.find_element(By.CSS_SELECTOR, f'circle.waypoint[data-vessel="{vessel}"][data-index="{index}"]')
-    v = view(driver)
-    hx, hy = float(handle.get_attribute("cx")) + v["left"], float(handle.get_attribute("cy")) + v["top"]
-    tx, ty = page_xy(v, *to)
-    chain = ActionChains(driver).click_and_hold(handle)
-    steps = 6
-    done_x = done_y = 0
-    for k in range(1, steps + 1):
-        sx, sy = round((tx - hx) * k / steps) - done_x, round((ty - hy) * k / steps) - done_y
-        chain.move_by_offset(sx, sy)
-        done_x, done_y = done_x + sx, done_y + sy
-    chain.release().perform()
+    def drag(handle: Any) -> None:
+        v = view(driver)
+        hx, hy = float(handle.get_attribute("cx")) + v["left"], float(handle.get_attribute("cy")) + v["top"]
+        tx, ty = page_xy(v, *to)
+        chain = ActionChains(driver).click_and_hold(handle)
+        steps = 6
+        done_x = done_y = 0
+        for k in range(1, steps + 1):
+            sx, sy = round((tx - hx) * k / steps) - done_x, round((ty - hy) * k / steps) - done_y
+            chain.move_by_offset(sx, sy)
+            done_x, done_y = done_x + sx, done_y + sy
+        chain.release().perform()
+
+    act_on(driver, f'circle.waypoint[data-vessel="{vessel}"][data-index="{index}"]', drag)
 
 
 def document_of(driver: Any) -> dict[str, Any]:

@@ -21,7 +21,7 @@ from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
 from selenium.webdriver.support.select import Select
 from selenium.webdriver.support.ui import WebDriverWait
-from test_browser import LiveServer, _wait, document_of, open_editor, settled
+from test_browser import LiveServer, _wait, act_on, document_of, open_editor, settled
 
 
 def js_errors(driver: Any) -> list[str]:
@@ -137,8 +137,11 @@ def test_delete_key_after_the_vessel_is_gone(browser: Any, live_server: LiveServ
     open_editor(browser, live_server)
     js_errors(browser)
     browser.find_element(By.CSS_SELECTOR, '#fleet li[data-id="tug"]').click()
-    handle = browser.find_element(By.CSS_SELECTOR, 'circle.waypoint[data-vessel="tug"][data-index="0"]')
-    ActionChains(browser).click(handle).perform()
+    act_on(
+        browser,
+        'circle.waypoint[data-vessel="tug"][data-index="0"]',
+        lambda handle: ActionChains(browser).click(handle).perform(),
+    )
     browser.find_element(By.ID, "v-delete").click()
     settled(browser)
     steps = browser.execute_script("return window.mmusvEditor.state.undoStack.length")

@@ -13,7 +13,7 @@ from typing import Any
 from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 from selenium.webdriver.support.select import Select
-from test_browser import LiveServer, _wait, open_editor, settled
+from test_browser import LiveServer, _wait, act_on, open_editor, settled
 from test_browser_round import js_errors, type_into
 from test_browser_round2 import save_as
 from test_browser_round4 import status, window
@@ -36,8 +36,11 @@ def test_a_selected_vessel_brings_its_panel_into_view(browser: Any, live_server:
         assert browser.execute_script(PANEL_SEEN), "the panel, after a pick in the list"
 
         browser.execute_script("window.mmusvEditor.state.select(null); document.getElementById('left').scrollTop = 0")
-        marker = browser.find_element(By.CSS_SELECTOR, '#map .vessel-marker[data-id="yacht"]')
-        ActionChains(browser).move_to_element(marker).click().perform()
+        act_on(
+            browser,
+            '#map .vessel-marker[data-id="yacht"]',
+            lambda marker: ActionChains(browser).move_to_element(marker).click().perform(),
+        )
         assert browser.execute_script("return window.mmusvEditor.state.selected") == "yacht"
         assert browser.execute_script(PANEL_SEEN), "the panel, after a pick on the map"
         assert browser.execute_script("return document.activeElement.id") == "map"  # the keyboard stays there

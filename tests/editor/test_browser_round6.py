@@ -16,7 +16,7 @@ from typing import Any
 from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
-from test_browser import LiveServer, _wait, document_of, drag_waypoint, open_editor, settled, view
+from test_browser import LiveServer, _wait, act_on, document_of, drag_waypoint, open_editor, settled, view
 from test_browser_round import js_errors, note, type_into
 from test_browser_round2 import active_id, save_as
 from test_browser_round4 import status, window
@@ -130,8 +130,11 @@ def test_the_map_pans_and_zooms_from_the_keyboard_in_a_small_window(browser: Any
 
         # and the mouse still works there: a vessel picked on the map, a waypoint of it dragged
         browser.execute_script("window.mmusvEditor.map.zoomTo('tug')")
-        marker = browser.find_element(By.CSS_SELECTOR, '#map .vessel-marker[data-id="tug"]')
-        ActionChains(browser).move_to_element(marker).click().perform()
+        act_on(
+            browser,
+            '#map .vessel-marker[data-id="tug"]',
+            lambda marker: ActionChains(browser).move_to_element(marker).click().perform(),
+        )
         assert browser.execute_script("return window.mmusvEditor.state.selected") == "tug"
         x, y = browser.execute_script("return window.mmusvEditor.state.vessel('tug').route[1]")
         drag_waypoint(browser, "tug", 1, (x + 20, y + 10))
