@@ -63,8 +63,9 @@ records a scenario again when its mesh changed, rather than skipping it as compl
 writes beside its recording keeps the paths as written: copy the asset files along to run it again from there. The
 editor (`mmusv editor`) reads a scenario's asset files from its folder (`--dir`), relative to it, as `mmusv run` of
 the saved file does; it reads none outside that folder (Checks names the `assets[i]` to fix) but those of the
-scenario named on its command line. Its vessel library and asset menus list the built-in assets and the
-open scenario's own.
+scenario named on its command line, which the page names by their full paths when that scenario lies outside
+the folder (so a copy saved into the folder names the same files). Its vessel library and asset menus list the
+built-in assets and the open scenario's own.
 
 **Axes.** `up_axis` and `forward_axis` (the file's up and bow directions, any of x, y, z, -x, -y, -z) turn the
 file into the body frame: x forward (bow), y to port, z up, z = 0 the waterline. When an entry gives neither, the

@@ -82,6 +82,23 @@ def serve(app: Any, *, host: str, port: int, announce: bool = True) -> None:
         sock.close()
 
 
+def _assets_by_full_path(entries: list[str], files: list[Path]) -> list[str]:
+    """The ``assets:`` entries of a scenario opened from outside the editor's folder, each by the full path of the
+    file ``mmusv run`` reads (``files``, resolved from the scenario's own folder): the page resolves entries from the
+    editor's folder, so ``boats/skiff.yaml`` beside the scenario was looked for there ("does not exist"), and a copy
+    saved into the folder would have named a file that is not there. What changed is said on stderr."""
+    out = [str(f) for f in files]
+    if len(out) != len(entries):  # (one file per entry, as load_scenario read them)
+        return entries
+    for was, now in zip(entries, out, strict=True):
+        if was != now:
+            print(
+                f"mmusv editor: assets: {was} is named {now} on the page (the folder is not the scenario's)",
+                file=sys.stderr,
+            )
+    return out
+
+
 def _new_scenario(given: str, missing: NotFoundError, *, folder: Path, dir_given: bool) -> tuple[Any, Path]:
     """The page's first scenario and the editor's folder for SCENARIO ``given``, a file that does not exist yet
     (``missing`` says so): a new scenario, saved into the folder under the file's name (``given``'s folder unless
@@ -152,6 +169,8 @@ def run(args: argparse.Namespace) -> int:
                 scenario = load_scenario(path)  # (reads its asset files, relative to its folder)
                 document = to_document(scenario)
                 asset_files = [(path.parent / Path(a).expanduser()).resolve() for a in scenario.assets]
+                if path.resolve().parent != folder.resolve() and document.get("assets"):
+                    document["assets"] = _assets_by_full_path(document["assets"], asset_files)
             except MmusvError as exc:  # opened to be fixed, as the page opens such a file: refused only when it cannot
                 document, _ = load_document(text, str(path))  # draw it (a ConfigError saying why)
                 print(f"mmusv editor: {exc}; the page lists what is wrong under Checks", file=sys.stderr)
