@@ -76,3 +76,23 @@ def test_a_batch_records_each_scenario_with_its_own_skiff_in_one_process_or_in_w
             np.testing.assert_allclose(skiff["length"].to_numpy(), length, atol=1e-6)
         recorded[jobs] = {stem: (out / stem / f"{stem}.mcap").read_bytes() for stem in LENGTHS}
     assert recorded["1"] == recorded["2"]  # the same bytes in one process and in workers
+
+
+def test_a_simulation_annotates_with_its_own_skiff_after_another_scenario_was_read(tmp_path: Path) -> None:
+    """A Simulation keeps the assets it was built with: its annotations (a vessel's silhouette alone, for the share
+    of it hidden) and its wakes (the displacements) looked the asset up again by name when first asked, so a
+    scenario read in between, with a ``skiff`` of its own, gave the other scenario's skiff to this one's labels."""
+    from mmusv.acquire import annotations_for
+    from mmusv.annotate import SilhouetteCache
+
+    folder = _folder(tmp_path)
+    sim = Simulation(load_scenario(folder / "lake.yaml"))
+    alone = Simulation(load_scenario(folder / "lake.yaml"))  # nothing read after it: the reference
+    want = annotations_for(alone, alone.capture(1), SilhouetteCache())
+    want_wakes = alone.wakes(alone.world_state(1))
+
+    load_scenario(folder / "harbour.yaml")  # holds the library for the harbour's 6 m skiff
+    assert get_asset("skiff").length == pytest.approx(6.0)
+    got = annotations_for(sim, sim.capture(1), SilhouetteCache())
+    assert got and got == want  # was: the hidden shares of the 6 m skiff's silhouette
+    np.testing.assert_array_equal(sim.wakes(sim.world_state(1)), want_wakes)

@@ -109,6 +109,7 @@ def annotations_for(sim: Simulation, cap: FrameCapture, silhouettes: SilhouetteC
     is read only for what a run never changes (its sea instance, whether waves are set), since a capture gives
     each box's first hits itself (the cameras' instance images, the LiDAR's beams)."""
     out: dict[str, Annotations] = {}
+    silhouettes.assets = sim.assets  # the vessels as sim was built with them, not as the library holds them now
     for agent in sim.agents:
         ac = cap.agents.get(agent.id)
         if ac is None:

@@ -30,6 +30,7 @@ Frames: LiDAR frame x forward, y left, z up; image u right, v down, pixel centre
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -58,7 +59,7 @@ from mmusv.wave_occlusion import (
     pattern_angles,
     share,
 )
-from mmusv.world.vessels import get_asset
+from mmusv.world.vessels import VesselAsset, get_asset
 
 __all__ = [
     "Annotations",
@@ -226,10 +227,13 @@ class Annotations:
 
 
 class SilhouetteCache:
-    """One single-instance scene per vessel asset, to render a vessel with nothing else in the way."""
+    """One single-instance scene per vessel asset, to render a vessel with nothing else in the way. ``assets``: the
+    assets by name, as a :class:`~mmusv.simulation.Simulation` holds them (``sim.assets``), else those of the
+    library now (a scenario read since may hold another asset under the same name)."""
 
-    def __init__(self) -> None:
-        self._scenes: dict[str, tuple[Scene, int]] = {}
+    def __init__(self, assets: Mapping[str, VesselAsset] | None = None) -> None:
+        self._scenes: dict[str, tuple[VesselAsset, Scene, int]] = {}
+        self.assets = assets
 
     def hits(self, asset: str, *, pose: np.ndarray, origins: np.ndarray, directions: np.ndarray) -> np.ndarray:
         """``(N,)`` bool: which rays (``origins``, ``directions`` ``(N, 3)`` world, metres) hit the vessel ``asset``
@@ -240,12 +244,12 @@ class SilhouetteCache:
     def distances(self, asset: str, *, pose: np.ndarray, origins: np.ndarray, directions: np.ndarray) -> np.ndarray:
         """``(N,)`` float32 distance (metres along each normalised direction) at which each ray meets the vessel
         ``asset`` at ``pose`` (body → world), alone in the world; ``inf`` where it misses."""
-        if asset not in self._scenes:
-            a = get_asset(asset)
+        a = self.assets[asset] if self.assets is not None and asset in self.assets else get_asset(asset)
+        if asset not in self._scenes or self._scenes[asset][0] is not a:
             s = Scene()
             mid = s.add_mesh(a.mesh.vertices, a.mesh.faces, classes=a.mesh.classes, name=asset)
-            self._scenes[asset] = (s, s.add_instance(mid))
-        scene, inst = self._scenes[asset]
+            self._scenes[asset] = (a, s, s.add_instance(mid))
+        _, scene, inst = self._scenes[asset]
         scene.set_poses([inst], pose[None])
         if origins.shape[0] == 0:
             return np.zeros(0, dtype=np.float32)

@@ -47,7 +47,7 @@ from mmusv.world.build import WorldScene, build_world_scene, pose_matrices
 from mmusv.world.environment import Environment
 from mmusv.world.hydrostatics import hull_particulars
 from mmusv.world.maps import MapWorld, generate_map_from
-from mmusv.world.vessels import get_asset
+from mmusv.world.vessels import VesselAsset, get_asset
 
 __all__ = [
     "Agent",
@@ -67,8 +67,9 @@ class Simulation:
     """A runnable scenario (see the module docstring). ``source``: a path, a dict or a :class:`Scenario`.
 
     ``vessels``: a :class:`VesselInfo` per vessel, in world-state row order (scenario vessels, then moored ships);
-    ``agents``: the USVs (:class:`Agent`); ``ws``: the scene and its instance ids; ``sea``: the physical sea
-    (``None``: flat water).
+    ``assets``: the :class:`~mmusv.world.vessels.VesselAsset` of each asset name it uses, as they were when it was
+    built (a scenario read later may hold another under the same name); ``agents``: the USVs (:class:`Agent`);
+    ``ws``: the scene and its instance ids; ``sea``: the physical sea (``None``: flat water).
     """
 
     def __init__(self, source: Any, *, world: MapWorld | None = None) -> None:
@@ -85,6 +86,10 @@ class Simulation:
         sc = self.scenario
         self.environment: Environment = sc.environment.resolve()
         self.world: MapWorld = world if world is not None else generate_map_from(sc.map.params, seed=sc.map.seed)
+        # The assets it is built with, by name, kept: the library is one per process, and a scenario read later
+        # may hold another asset under a name of these (a user's own `skiff`) when a wake or a label asks again.
+        used = {v.asset for v in sc.vessels} | {name for name, _ in self.world.moored}
+        self.assets: dict[str, VesselAsset] = {name: get_asset(name) for name in sorted(used)}
         self.fleet = build_fleet(sc)
         # The physical sea (``environment.motion: physical``, the default) displaces the water every sensor sees;
         # with ``motion: paper`` the water stays the flat plane of the paper.
@@ -128,9 +133,8 @@ class Simulation:
 
     # ------------------------------------------------------------------------------------------ building
 
-    @staticmethod
-    def _info(vid: str, asset_name: str, role: str, instance: int, *, static: bool) -> VesselInfo:
-        a = get_asset(asset_name)
+    def _info(self, vid: str, asset_name: str, role: str, instance: int, *, static: bool) -> VesselInfo:
+        a = self.assets[asset_name]
         lo, hi = a.bbox[0], a.bbox[1]
         cls = 11 if role == "usv" else int(a.semantic_class)
         # Read-only: every frame's annotations read these boxes, so they must not change under them.
@@ -364,7 +368,7 @@ class Simulation:
         """Each scenario vessel's displaced volume ``Cb·L·B·T``, m³ (its hull particulars)."""
         out = []
         for v in self.scenario.vessels:
-            length, beam, draft, cb, _gm = hull_particulars(get_asset(v.asset))
+            length, beam, draft, cb, _gm = hull_particulars(self.assets[v.asset])
             out.append(cb * length * beam * draft)
         return out
 
