@@ -11,12 +11,10 @@ from __future__ import annotations
 
 from typing import Any
 
-from selenium.common.exceptions import StaleElementReferenceException
 from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
-from selenium.webdriver.support.ui import WebDriverWait
-from test_browser import WAIT_S, LiveServer, open_editor
+from test_browser import LiveServer, open_editor
 from test_browser_round import js_errors
 from test_browser_round4 import window
 
@@ -104,7 +102,7 @@ def test_the_end_choice_is_read_whole_in_a_small_window(browser: Any, live_serve
 def test_a_route_is_not_deleted_below_two_waypoints(browser: Any, live_server: LiveServer) -> None:
     """A review's: deleting waypoints (the route table's x, a right click on the map) went down to a route of one
     point, which the check then refused in pydantic's words; the page now keeps two and says why."""
-    from test_browser import document_of, settled
+    from test_browser import act_on, document_of, settled
 
     open_editor(browser, live_server)
     js_errors(browser)
@@ -117,14 +115,13 @@ def test_a_route_is_not_deleted_below_two_waypoints(browser: Any, live_server: L
     browser.find_element(By.CSS_SELECTOR, '#v-route button[data-delete="0"]').click()
     settled(browser)  # the refusal redraws the map: a handle found before then went stale on a busy machine
 
-    def right_click_handle(driver: Any) -> bool:
-        handle = driver.find_element(By.CSS_SELECTOR, 'circle.waypoint[data-vessel="tug"][data-index="1"]')
-        ActionChains(driver).context_click(handle).perform()
-        return True
-
     # a redraw may still replace the handle between finding it and clicking it (stale even after settling, on a
-    # busy machine): found again until the click reaches one; a stale handle is refused before any click is sent
-    WebDriverWait(browser, WAIT_S, ignored_exceptions=(StaleElementReferenceException,)).until(right_click_handle)
+    # busy machine): found again until the click reaches one (act_on)
+    act_on(
+        browser,
+        'circle.waypoint[data-vessel="tug"][data-index="1"]',
+        lambda handle: ActionChains(browser).context_click(handle).perform(),
+    )
     settled(browser)
     assert document_of(browser)["vessels"][i]["route"] == route
     assert "tug's route has 2 waypoints, the fewest a route has" in browser.find_element(By.ID, "status").text
