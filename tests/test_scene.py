@@ -37,6 +37,7 @@ from mmusv.errors import (
     NotFoundError,
 )
 from mmusv.scene import NO_HIT, RayHits, Scene, demo_scene
+from mmusv.world.sea_state import sea_spec_for_preset
 
 F32 = npt.NDArray[np.float32]
 F64 = npt.NDArray[np.float64]
@@ -1124,12 +1125,44 @@ def test_export_overwrites_atomically(tmp_path: Path) -> None:
 # ----------------------------------------------------------------------------------------------------------
 
 
+def _ticks_while_alive(call: Callable[[], object]) -> int:
+    """How many 1 ms sleeps the main thread completes (each needs the GIL to resume) while a worker thread runs
+    ``call``, up to 20; ``call``'s result must be truthy. Were the GIL held through the call, the main thread
+    could not resume at all until it returned. ``call`` goes to the native method with its arrays prepared: the
+    Python wrapper's checks (numpy, which releases the GIL in its loops) would give ticks of their own."""
+    started = threading.Event()
+    done: list[object] = []
+
+    def work() -> None:
+        started.set()
+        done.append(call())
+
+    worker = threading.Thread(target=work)
+    ticks = 0
+    worker.start()
+    started.wait()
+    while worker.is_alive() and ticks < 20:
+        time.sleep(0.001)
+        if worker.is_alive():
+            ticks += 1
+    worker.join()
+    assert done and done[0]
+    return ticks
+
+
+def _lasting(run: Callable[[int], object], *, probe: int, cap: int) -> int:
+    """A size for ``run`` that lasts about 0.3 s on this machine, calibrated on ``probe`` items (at most ``cap``)."""
+    t0 = time.perf_counter()
+    run(probe)
+    rate = probe / max(time.perf_counter() - t0, 1e-6)
+    return int(min(max(rate * 0.3, 4 * probe), cap))
+
+
 def test_cast_rays_releases_the_gil() -> None:
     """While a worker thread is inside one long ``cast_rays`` call, the main thread keeps running Python.
 
     Timing-robust: the ray count is calibrated so the call lasts ~0.3 s on this machine; the main thread only
-    needs to complete a handful of 1 ms sleeps (each needs the GIL to resume) while the worker is still alive.
-    If the GIL were held, the main thread could not resume at all until the call returned.
+    needs to complete a handful of 1 ms sleeps while the worker is still alive (:func:`_ticks_while_alive`).
     """
     s, _ = demo_scene(terrain_cells=64, vessels=8)
     rng = np.random.default_rng(15)
@@ -1141,30 +1174,30 @@ def test_cast_rays_releases_the_gil() -> None:
         d[:, 2] = -np.abs(d[:, 2])  # downwards: every ray does real traversal work
         return o, d
 
-    o, d = rays(50_000)
-    t0 = time.perf_counter()
-    s.cast_rays(o, d)
-    rate = 50_000 / max(time.perf_counter() - t0, 1e-6)
-    n = int(min(max(rate * 0.3, 200_000), 8_000_000))
+    n = _lasting(lambda k: s.cast_rays(*rays(k)), probe=50_000, cap=8_000_000)
     o, d = rays(n)
-    started = threading.Event()
-    done: list[RayHits] = []
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    ticks = _ticks_while_alive(lambda: s._native.cast_rays(o, d, 1000.0)[0].shape == (n,))
+    assert ticks >= 5, f"main thread only ran {ticks} times during a {n}-ray cast"
 
-    def work() -> None:
-        started.set()
-        done.append(s.cast_rays(o, d))
 
-    worker = threading.Thread(target=work)
-    ticks_while_alive = 0
-    worker.start()
-    started.wait()
-    while worker.is_alive() and ticks_while_alive < 20:
-        time.sleep(0.001)
-        if worker.is_alive():
-            ticks_while_alive += 1
-    worker.join()
-    assert done and done[0].distance.shape == (n,)
-    assert ticks_while_alive >= 5, f"main thread only ran {ticks_while_alive} times during a {n}-ray cast"
+def test_wave_heights_releases_the_gil() -> None:
+    """The same for one long ``wave_heights`` call over a W3-like displaced sea (was: the heights were looked up
+    with the GIL held, so every other Python thread, a recording's writer among them, stood still)."""
+    s = Scene()
+    h = 5_000.0
+    sea = s.add_mesh(np.array([[-h, -h, 0], [h, -h, 0], [h, h, 0], [-h, h, 0]]), np.array([[0, 1, 2], [0, 2, 3]]))
+    s.set_sea(s.add_instance(sea))
+    s.set_wave_surface(sea_spec_for_preset("5"), scenario_seed=1, time_s=0.0, foci=np.zeros((1, 2)), slopes=False)
+    rng = np.random.default_rng(16)
+
+    def points(n: int) -> npt.NDArray[np.float32]:
+        return rng.uniform(-300.0, 300.0, (n, 2)).astype(np.float32)
+
+    n = _lasting(lambda k: s.wave_heights(points(k)), probe=200_000, cap=40_000_000)
+    xy = points(n)
+    ticks = _ticks_while_alive(lambda: s._native.wave_heights(xy).shape == (n,))
+    assert ticks >= 5, f"main thread only ran {ticks} times while {n} wave heights were looked up"
 
 
 _DEADLOCK_SCRIPT = """

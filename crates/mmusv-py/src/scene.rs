@@ -410,7 +410,7 @@ impl Scene {
     }
 
     /// Heights (N,) float32 of the displaced sea surface at `xy` (N, 2) float32 world x, y (the still level
-    /// where no surface is set or outside it).
+    /// where no surface is set or outside it). GIL released.
     fn wave_heights<'py>(
         &self,
         py: Python<'py>,
@@ -418,9 +418,11 @@ impl Scene {
     ) -> PyResult<Bound<'py, PyArray1<f32>>> {
         let xy = rows::<f32, 2>(&xy, "xy")?;
         let out = self.read(|s| {
-            Ok(match s.wave_surface() {
-                Some(w) => xy.iter().map(|p| w.height(p[0], p[1])).collect::<Vec<f32>>(),
-                None => vec![0.0; xy.len()],
+            detached(py, || {
+                Ok(match s.wave_surface() {
+                    Some(w) => xy.iter().map(|p| w.height(p[0], p[1])).collect::<Vec<f32>>(),
+                    None => vec![0.0; xy.len()],
+                })
             })
         })?;
         Ok(out.into_pyarray(py))
