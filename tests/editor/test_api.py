@@ -187,6 +187,25 @@ def test_a_link_out_of_the_folder_is_not_served(client: TestClient, folder: Path
     assert r.status_code == 400 and secret.read_text().startswith("name: secret")
 
 
+def test_saving_a_link_in_the_folder_writes_through_it(client: TestClient, folder: Path) -> None:
+    """A file that is a link to another file of the folder (``current.yaml -> harbour.yaml``) is saved into the file
+    it points to, and stays a link (was: the link was replaced by a file of its own, so ``harbour.yaml`` kept the
+    old scenario and the two names parted)."""
+    doc = bundled_doc(client)
+    assert client.put("/api/files/harbour.yaml", json={"document": doc}).status_code == 200
+    os.symlink("harbour.yaml", folder / "current.yaml")
+    os.chmod(folder / "harbour.yaml", 0o640)
+    opened = client.get("/api/files/current.yaml")
+    assert opened.status_code == 200
+    doc = {**opened.json()["document"], "name": "renamed_through_the_link"}
+    r = client.put("/api/files/current.yaml", json={"document": doc, "overwrite": True})
+    assert r.status_code == 200, r.text
+    assert (folder / "current.yaml").is_symlink() and os.readlink(folder / "current.yaml") == "harbour.yaml"
+    assert "renamed_through_the_link" in (folder / "harbour.yaml").read_text()
+    assert (folder / "harbour.yaml").stat().st_mode & 0o777 == 0o640
+    assert sorted(p.name for p in folder.iterdir()) == ["current.yaml", "harbour.yaml"]  # no temporary left
+
+
 def test_reading_files(client: TestClient, folder: Path) -> None:
     assert client.get("/api/files/missing.yaml").status_code == 404
     (folder / "broken.yaml").write_text("vessels: [\n")

@@ -7,7 +7,8 @@ resolves outside the folder (a symbolic link pointing out) is refused the same w
 can be read or overwritten through the server. Writes go to a temporary file in the folder first (flushed to disk)
 and replace the target in one rename, so a file is never left half-written and a failed write leaves neither the
 temporary file nor a changed target behind; a new file gets the permissions of any file the user creates (the
-umask applies), a replaced one keeps its own. A name that is a folder or another non-file is never replaced.
+umask applies), a replaced one keeps its own. A name that is a link to another file of the folder is saved into
+that file and stays a link. A name that is a folder or another non-file is never replaced.
 
 Reading: a file must be UTF-8 text (a byte-order mark is accepted) of at most :data:`MAX_FILE_BYTES`; anything else
 is refused naming the file and the first bad byte, never opened with replacement characters (saving it back would
@@ -199,7 +200,10 @@ class ScenarioFolder:
 
     def _replace(self, p: Path, data: bytes, *, name: str) -> None:
         """Writes ``data`` to a new temporary file in the folder, flushes it to disk and renames it over ``p``;
-        on any failure the temporary file is removed and ``p`` is left as it was."""
+        on any failure the temporary file is removed and ``p`` is left as it was. A ``p`` that is a link (to a
+        file of the folder: :meth:`path`) is written through: the file it points to is replaced, the link stays."""
+        if p.is_symlink():
+            p = p.resolve()
         tmp = self.root / f".mmusv-editor-{secrets.token_hex(8)}.tmp"
         try:
             # created like any new file (mode 0666 less the umask), refusing to follow or reuse anything there
