@@ -6,6 +6,7 @@ assets another scenario had registered (which ``mmusv run`` of it alone refuses)
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -96,3 +97,33 @@ def test_a_simulation_annotates_with_its_own_skiff_after_another_scenario_was_re
     got = annotations_for(sim, sim.capture(1), SilhouetteCache())
     assert got and got == want  # was: the hidden shares of the 6 m skiff's silhouette
     np.testing.assert_array_equal(sim.wakes(sim.world_state(1)), want_wakes)
+
+
+def test_simulations_of_two_scenarios_built_in_two_threads_at_once_each_get_their_own_skiff(tmp_path: Path) -> None:
+    """Two threads each build Simulations of their own scenario (both name a ``skiff``, of other lengths) at the
+    same time (was: the library one thread held for its scenario could be switched by the other between reading
+    the scenario and looking its assets up, so a Simulation was built with the other's skiff, or refused it as
+    unknown)."""
+    folder = _folder(tmp_path)
+    got: dict[str, list[float]] = {stem: [] for stem in LENGTHS}
+    errors: list[BaseException] = []
+    start = threading.Barrier(2)
+
+    def build(stem: str) -> None:
+        try:
+            start.wait()
+            for _ in range(4):
+                sim = Simulation(folder / f"{stem}.yaml")
+                got[stem].append(sim.assets["skiff"].length)
+                got[stem].append(float(sim.vessels[1].box_size[0]))
+        except BaseException as exc:  # said below, in the test's thread
+            errors.append(exc)
+
+    threads = [threading.Thread(target=build, args=(stem,)) for stem in LENGTHS]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not errors, errors
+    for stem, length in LENGTHS.items():
+        np.testing.assert_allclose(got[stem], length, atol=1e-6)

@@ -436,7 +436,15 @@ def _check_mount_points(v: VesselConfig, index: int, rig_name: str, rig: RigConf
 def load_scenario(source: str | os.PathLike[str] | dict[str, Any] | Scenario) -> Scenario:
     """Validates a scenario given as a YAML path, a dict, or a :class:`Scenario` (returned as is). A path that does
     not exist but names a bundled scenario (``"port_entry"``) is that scenario, as on the command line
-    (:func:`mmusv.bundled.resolve_scenario`)."""
+    (:func:`mmusv.bundled.resolve_scenario`). The vessel library is then held for it (its own asset files' assets,
+    no other scenario's; :mod:`mmusv.scenario_assets`), while another thread reading a scenario waits."""
+    from mmusv.scenario_assets import holding_library
+
+    with holding_library():
+        return _load_scenario(source)
+
+
+def _load_scenario(source: str | os.PathLike[str] | dict[str, Any] | Scenario) -> Scenario:
     if isinstance(source, Scenario):
         home = source._asset_home
         if home is not None and not home.held():  # another scenario was read since: the library held for it again

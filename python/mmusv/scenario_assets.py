@@ -23,14 +23,21 @@ changed (size or modification time), and replaces it; an asset name that another
 :func:`asset_digest` gives the SHA-256 of the user assets a scenario uses, which
 :func:`mmusv.config.scenario_hash` folds in: a changed mesh is a changed configuration, so a batch records it again
 instead of skipping it as complete.
+
+Threads: the library is held for one scenario at a time. :func:`holding_library` (re-entrant) is held by a thread
+while it reads a scenario (:func:`mmusv.config.load_scenario`) and while a :class:`~mmusv.simulation.Simulation`
+is built from it (which keeps the assets it looked up, ``Simulation.assets``), so another thread reading another
+scenario waits instead of switching the library under it; the editor's requests hold it through
+:class:`mmusv.editor.evaluate.AssetScope`.
 """
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import threading
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -42,12 +49,34 @@ __all__ = [
     "asset_digest",
     "asset_file_path",
     "asset_files",
+    "holding_library",
     "keep_scenario_assets",
     "register_scenario_assets",
     "use_scenario_assets",
 ]
 
 _lock = threading.Lock()
+_held = threading.RLock()
+"""Held while a thread reads a scenario or builds a Simulation from it (:func:`holding_library`)."""
+
+
+@contextlib.contextmanager
+def holding_library() -> Iterator[None]:
+    """Holds the library for the calling thread's scenario (re-entrant): no other thread reads a scenario, and so
+    switches the library to that one's assets, until the block ends. Two threads building Simulations of two
+    scenarios that each name an asset ``skiff`` of their own got each other's skiff without it."""
+    with _held:
+        yield
+
+
+def _free_after_fork() -> None:
+    """A child forked while another thread held the library starts with it free: that thread is not there."""
+    global _held, _lock
+    _held, _lock = threading.RLock(), threading.Lock()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_free_after_fork)
 _loaded: dict[str, tuple[tuple[Any, ...], tuple[str, ...]]] = {}
 """Resolved asset file -> (its signature, the names of the assets it registered)."""
 _parked: dict[str, tuple[tuple[Any, ...], list[Any]]] = {}

@@ -33,6 +33,7 @@ from mmusv.captures import AgentCapture, FrameCapture, SensorMount, VesselInfo, 
 from mmusv.config import Scenario, VesselConfig, load_scenario
 from mmusv.errors import ConfigError
 from mmusv.motion import build_fleet, build_moored_fleet
+from mmusv.scenario_assets import holding_library
 from mmusv.scene import MAX_SURFACE_TILES, SURFACE_TILE_M, SeaState, check_sea, surface_tiles
 from mmusv.seeds import sensor_seed
 from mmusv.sensors.camera import CameraImages
@@ -82,41 +83,49 @@ class Simulation:
         self._lock = take_turns(self)
         self._given_world = world
         self._sea_set: tuple[SeaState | None] | None = None  # the sea of set_sea_surface, when it was called
-        self.scenario: Scenario = load_scenario(source)
-        sc = self.scenario
-        self.environment: Environment = sc.environment.resolve()
-        self.world: MapWorld = world if world is not None else generate_map_from(sc.map.params, seed=sc.map.seed)
-        # The assets it is built with, by name, kept: the library is one per process, and a scenario read later
-        # may hold another asset under a name of these (a user's own `skiff`) when a wake or a label asks again.
-        used = {v.asset for v in sc.vessels} | {name for name, _ in self.world.moored}
-        self.assets: dict[str, VesselAsset] = {name: get_asset(name) for name in sorted(used)}
-        self.fleet = build_fleet(sc)
-        # The physical sea (``environment.motion: physical``, the default) displaces the water every sensor sees;
-        # with ``motion: paper`` the water stays the flat plane of the paper.
-        self.sea: SeaState | None = None
-        if sc.environment.motion == "physical":
-            spec = sc.environment.sea_spec()
-            self.sea = spec if spec.hs_m > 0.0 else None
-        self.sensor_env: core.SensorEnv = self._sensor_env()
-        poses0 = np.asarray(self.fleet.poses_at_times(np.zeros(1)))[0]
-        # Over a physical sea the moored ships heave, roll and pitch at their berths (motion.build_moored_fleet).
-        self._moored_fleet = build_moored_fleet(sc, self.world.moored)
-        self.ws: WorldScene = build_world_scene(
-            self.world,
-            [(v.asset, v.role) for v in sc.vessels],
-            poses0,
-            moored_move=self._moored_fleet is not None,
-        )
-        self.vessels: list[VesselInfo] = []
-        for v, inst in zip(sc.vessels, self.ws.vessel_instances, strict=True):
-            self.vessels.append(self._info(v.id, v.asset, v.role, int(inst), static=v.static))
-        for k, ((asset_name, _berth), inst) in enumerate(zip(self.world.moored, self.ws.moored_instances, strict=True)):
-            self.vessels.append(self._info(f"moored_{k:02d}", asset_name, "moored", inst, static=True))
-        self._moored_eta = np.array([[x, y, 0.0, 0.0, 0.0, yaw] for _, (x, y, yaw) in self.world.moored]).reshape(-1, 6)
-        self.agents: list[Agent] = [self._agent(i, v) for i, v in enumerate(sc.vessels) if v.role == "usv"]
-        # COLREG lights burn on the vessels under way (not on moored ships or vessels at speed 0).
-        under_way = [int(inst) for v, inst in zip(sc.vessels, self.ws.vessel_instances, strict=True) if not v.static]
-        self.ws.scene.set_lights(under_way, on=True)
+        # The library is held for this scenario from its reading until every asset it uses has been looked up
+        # (scenario_assets.holding_library): another thread reading another scenario waits.
+        with holding_library():
+            self.scenario: Scenario = load_scenario(source)
+            sc = self.scenario
+            self.environment: Environment = sc.environment.resolve()
+            self.world: MapWorld = world if world is not None else generate_map_from(sc.map.params, seed=sc.map.seed)
+            # The assets it is built with, by name, kept: the library is one per process, and a scenario read later
+            # may hold another asset under a name of these (a user's own `skiff`) when a wake or a label asks again.
+            used = {v.asset for v in sc.vessels} | {name for name, _ in self.world.moored}
+            self.assets: dict[str, VesselAsset] = {name: get_asset(name) for name in sorted(used)}
+            self.fleet = build_fleet(sc)
+            # The physical sea (``environment.motion: physical``, the default) displaces the water every sensor sees;
+            # with ``motion: paper`` the water stays the flat plane of the paper.
+            self.sea: SeaState | None = None
+            if sc.environment.motion == "physical":
+                spec = sc.environment.sea_spec()
+                self.sea = spec if spec.hs_m > 0.0 else None
+            self.sensor_env: core.SensorEnv = self._sensor_env()
+            poses0 = np.asarray(self.fleet.poses_at_times(np.zeros(1)))[0]
+            # Over a physical sea the moored ships heave, roll and pitch at their berths (motion.build_moored_fleet).
+            self._moored_fleet = build_moored_fleet(sc, self.world.moored)
+            self.ws: WorldScene = build_world_scene(
+                self.world,
+                [(v.asset, v.role) for v in sc.vessels],
+                poses0,
+                moored_move=self._moored_fleet is not None,
+            )
+            self.vessels: list[VesselInfo] = []
+            for v, inst in zip(sc.vessels, self.ws.vessel_instances, strict=True):
+                self.vessels.append(self._info(v.id, v.asset, v.role, int(inst), static=v.static))
+            for k, ((asset_name, _berth), inst) in enumerate(
+                zip(self.world.moored, self.ws.moored_instances, strict=True)
+            ):
+                self.vessels.append(self._info(f"moored_{k:02d}", asset_name, "moored", inst, static=True))
+            berths = [berth for _, berth in self.world.moored]
+            self._moored_eta = np.array([[x, y, 0.0, 0.0, 0.0, yaw] for x, y, yaw in berths]).reshape(-1, 6)
+            self.agents: list[Agent] = [self._agent(i, v) for i, v in enumerate(sc.vessels) if v.role == "usv"]
+            # COLREG lights burn on the vessels under way (not on moored ships or vessels at speed 0).
+            under_way = [
+                int(inst) for v, inst in zip(sc.vessels, self.ws.vessel_instances, strict=True) if not v.static
+            ]
+            self.ws.scene.set_lights(under_way, on=True)
         self._frame: int | None = None
         # The world state `prefetch_frame` worked out, for the `set_frame` of that frame to take (once).
         self._ahead: tuple[int, WorldState] | None = None
