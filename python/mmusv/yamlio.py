@@ -48,7 +48,11 @@ _BOMS = {
 
 
 class _UniqueKeyLoader(yaml.SafeLoader):
-    """PyYAML's safe loader, refusing duplicate keys in any mapping and the numbers only YAML 1.1 has."""
+    """PyYAML's safe loader, refusing duplicate keys in any mapping and the numbers only YAML 1.1 has, and bounding
+    what merge keys copy (:func:`_flatten_mapping`)."""
+
+    def flatten_mapping(self, node: yaml.MappingNode) -> None:
+        _flatten_mapping(self, node)
 
 
 # The same on libyaml's C parser where PyYAML was built with it (its wheels are): the same documents, ten times
@@ -60,7 +64,11 @@ _CSafeLoader: Any = getattr(yaml, "CSafeLoader", None)
 _FastUniqueKeyLoader: Any = (
     None
     if _CSafeLoader is None
-    else type("_FastUniqueKeyLoader", (_CSafeLoader,), {"__doc__": _UniqueKeyLoader.__doc__})
+    else type(
+        "_FastUniqueKeyLoader",
+        (_CSafeLoader,),
+        {"__doc__": _UniqueKeyLoader.__doc__, "flatten_mapping": _UniqueKeyLoader.flatten_mapping},
+    )
 )
 
 
@@ -84,6 +92,61 @@ def _construct_mapping(loader: Any, node: yaml.MappingNode, deep: bool = False) 
         seen[key] = line
     mapping: dict[Any, Any] = loader.construct_mapping(node, deep=deep)
     return mapping
+
+
+def _flatten_mapping(loader: Any, node: yaml.MappingNode) -> None:
+    """PyYAML's ``flatten_mapping`` (the entries of merge keys, ``<<: *base`` or ``<<: [*a, *b]``, copied into the
+    mapping, the first listed winning), counting the entries copied in the whole document: each mapping that merges
+    another holds a copy of its entries, so a few hundred bytes of merges of merges (``<<: [*a, *a, *a, *a]`` ten
+    deep) copied millions of entries (a minute and gigabytes, 4 times more for each level), though the mapping they
+    make has a few keys. Past :data:`MAX_YAML_VALUES` entries :class:`_MergeBomb` stops it, before copying them."""
+    merge: list[tuple[yaml.Node, yaml.Node]] = []
+    index = 0
+    while index < len(node.value):
+        key_node, value_node = node.value[index]
+        if key_node.tag == "tag:yaml.org,2002:merge":
+            del node.value[index]
+            if isinstance(value_node, yaml.MappingNode):
+                subnodes = [value_node]
+            elif isinstance(value_node, yaml.SequenceNode):
+                subnodes = list(value_node.value)
+            else:
+                raise yaml.constructor.ConstructorError(
+                    "while constructing a mapping",
+                    node.start_mark,
+                    f"expected a mapping or list of mappings for merging, but found {value_node.id}",
+                    value_node.start_mark,
+                )
+            for subnode in subnodes:
+                if not isinstance(subnode, yaml.MappingNode):
+                    raise yaml.constructor.ConstructorError(
+                        "while constructing a mapping",
+                        node.start_mark,
+                        f"expected a mapping for merging, but found {subnode.id}",
+                        subnode.start_mark,
+                    )
+                _flatten_mapping(loader, subnode)
+            for subnode in reversed(subnodes):
+                copied = getattr(loader, "_mmusv_merged", 0) + len(subnode.value)
+                if copied > MAX_YAML_VALUES:
+                    raise _MergeBomb(node.start_mark)
+                loader._mmusv_merged = copied
+                merge.extend(subnode.value)
+        elif key_node.tag == "tag:yaml.org,2002:value":
+            key_node.tag = "tag:yaml.org,2002:str"
+            index += 1
+        else:
+            index += 1
+    if merge:
+        node.value = merge + node.value
+
+
+class _MergeBomb(Exception):
+    """The merge keys of a document copy more than :data:`MAX_YAML_VALUES` entries (:func:`_flatten_mapping`)."""
+
+    def __init__(self, mark: yaml.Mark) -> None:
+        super().__init__(mark)
+        self.mark = mark
 
 
 class _DuplicateKey(Exception):
@@ -248,6 +311,11 @@ def parse_yaml(text: str, where: str, *, trusted: bool = False) -> Any:
         data = _load(text, _UniqueKeyLoader)
         _check_expansion(data, where)
         return data
+    except _MergeBomb as exc:
+        raise ConfigError(
+            f"{where}: the merge keys (<<) at line {exc.mark.line + 1} copy more than {MAX_YAML_VALUES:,} entries "
+            "(merges of mappings that merge others, repeated); write the values out or merge fewer times"
+        ) from None
     except _DuplicateKey as exc:
         raise ConfigError(f"{where}: {exc}; each key may appear once") from None
     except _Yaml11Number as exc:
