@@ -289,7 +289,26 @@ def load_mesh_file(path: Path, where: str) -> tuple[np.ndarray, np.ndarray, np.n
     v, fc = v[used], inverse.reshape(-1, 3).astype(np.int64)
     if not np.all(np.isfinite(v)):
         raise AssetSpecError(where, f"{str(path)!r} has non-finite vertices")
+    if not _any_area(v, fc):
+        raise AssetSpecError(
+            where,
+            f"{str(path)!r} holds no triangle of any area: each of its {len(fc)} faces has its corners at one point "
+            "or on one line (no sensor would see the vessel, yet it would be labelled in every frame)",
+        )
     return v, fc, fm
+
+
+def _any_area(v: np.ndarray, fc: np.ndarray) -> bool:
+    """Whether a face of the mesh ``v``, ``fc`` encloses an area: twice its area past 1e-12 of the square of the
+    mesh's largest extent (rounding leaves a face of three points on one line an area of about 1e-16 of it), measured
+    in units of that extent (a mesh of 1e-300 units is not taken for a point)."""
+    with np.errstate(over="ignore", invalid="ignore"):  # huge coordinates: inf areas, refused by their size later
+        extent = float(np.max(np.ptp(v, axis=0)))
+        if not extent > 0.0:
+            return False
+        corners = (v[fc] - v.min(axis=0)) / extent
+        doubled = np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
+        return bool(np.any(~(doubled <= 1e-12)))
 
 
 def mesh_asset(spec: MeshAssetSpec, *, path: str, base_dir: Path | None, cls: int) -> TriMesh:
