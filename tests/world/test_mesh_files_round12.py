@@ -50,3 +50,60 @@ def test_a_small_mesh_in_large_units_is_not_taken_for_degenerate(tmp_path: Path)
         {"name": "user_hull", "mesh": str(mesh), "up_axis": "z", "forward_axis": "x", "scale": 1000, "draft": 0.4}
     )
     assert asset.length == pytest.approx(6.0)
+
+
+# A face naming a vertex the file does not hold was read as another vertex without a word: trimesh kept a PLY face's
+# -1 (numpy then took the last vertex) and read an OBJ face's 0 as -1 (OBJ counts from 1, so 0 names none).
+
+BOX = [(0, 0, 0), (6, 0, 0), (6, 2, 0), (0, 2, 0), (0, 0, 1.5), (6, 0, 1.5), (6, 2, 1.5), (0, 2, 1.5)]
+
+
+def _ply(faces: list[tuple[int, int, int]]) -> str:
+    head = (
+        "ply\nformat ascii 1.0\n"
+        f"element vertex {len(BOX)}\nproperty float x\nproperty float y\nproperty float z\n"
+        f"element face {len(faces)}\nproperty list uchar int vertex_indices\nend_header\n"
+    )
+    return head + "".join(f"{x} {y} {z}\n" for x, y, z in BOX) + "".join(f"3 {a} {b} {c}\n" for a, b, c in faces)
+
+
+def _obj(faces: str) -> str:
+    return "".join(f"v {x} {y} {z}\n" for x, y, z in BOX) + "vn 0 0 1\nvt 0 0\n" + faces
+
+
+def _load_mesh(tmp_path: Path, name: str, text: str) -> object:
+    mesh = tmp_path / name
+    mesh.write_text(text, encoding="utf-8")
+    return load_asset_file({"name": "user_hull", "mesh": str(mesh), "up_axis": "z", "forward_axis": "x", "draft": 0.4})
+
+
+@pytest.mark.parametrize("bad", [-1, -8, 8])
+def test_a_ply_face_past_its_vertices_is_refused(tmp_path: Path, bad: int) -> None:
+    with pytest.raises(AssetSpecError) as info:
+        _load_mesh(tmp_path, "hull.ply", _ply([(0, 1, 2), (0, 2, bad), (4, 5, 6)]))
+    msg = str(info.value)
+    assert info.value.field == "user_hull.mesh" and "hull.ply" in msg, msg
+    assert f"index {bad}" in msg and "vertices are numbered 0..7" in msg and "damaged" in msg, msg
+
+
+@pytest.mark.parametrize(
+    ("faces", "line"),
+    [
+        ("f 1 2 3\nf 1 3 0\nf 5 6 7\n", 12),  # a vertex
+        ("f 1/1 2/1 3/1\nf 5/0 6/1 7/1\n", 12),  # a texture coordinate
+        ("f 1//1 2//1 3//1\r\nf 5//1 6//1 7//0", 12),  # a normal, CRLF, no line end at the end
+        ("f 1 2 3 # 0 in a comment\nf 5 6 -0\n", 12),
+    ],
+)
+def test_an_obj_face_naming_index_0_is_refused_naming_its_line(tmp_path: Path, faces: str, line: int) -> None:
+    with pytest.raises(AssetSpecError) as info:
+        _load_mesh(tmp_path, "hull.obj", _obj(faces))
+    msg = str(info.value)
+    assert info.value.field == "user_hull.mesh" and "hull.obj" in msg, msg
+    assert f"the face on line {line} names index 0" in msg and "from 1" in msg, msg
+
+
+def test_obj_faces_of_10_and_negative_indices_are_read(tmp_path: Path) -> None:
+    faces = "f 1 2 3\nf 1 3 4\n# f 0 1 2\nf -4 -3 -2\nf 5/1/1 6/1/1 8/1/1\n" + "v 0 0 10\n" * 3 + "f 1 10 11\n"
+    asset = _load_mesh(tmp_path, "hull.obj", _obj(faces))
+    assert asset.num_triangles == 5  # type: ignore[attr-defined]

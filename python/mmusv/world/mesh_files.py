@@ -20,6 +20,7 @@ entry's ``up_axis``/``forward_axis`` or, when it gives neither, the file format'
 from __future__ import annotations
 
 import os
+import re
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
@@ -233,6 +234,8 @@ def load_mesh_file(path: Path, where: str) -> tuple[np.ndarray, np.ndarray, np.n
     strengths, names = _check_file(path, where, list(trimesh.available_formats()))
     gltf = path.suffix.lower() in FORMAT_AXES
     mtl = obj_materials(path, where) if path.suffix.lower() == ".obj" else None
+    if path.suffix.lower() == ".obj":
+        _check_obj_indices(path, where)
     try:
         # Read unprocessed: trimesh's processing silently drops every face touching a NaN/inf vertex, so the raw
         # arrays are checked first; each piece is then processed exactly as ``trimesh.load(process=True)`` would.
@@ -261,6 +264,15 @@ def load_mesh_file(path: Path, where: str) -> tuple[np.ndarray, np.ndarray, np.n
                 where,
                 f"{str(path)!r} has non-finite (NaN/inf) coordinates at {int(bad.any(axis=-1).sum())} of its "
                 f"{len(g.vertices)} vertices; every vertex coordinate must be a finite number",
+            )
+        faces = np.asarray(g.faces)
+        outside = (faces < 0) | (faces >= len(g.vertices))
+        if outside.any():
+            raise AssetSpecError(
+                where,
+                f"{str(path)!r}: {int(outside.any(axis=-1).sum())} of its {len(faces)} faces name a vertex it does "
+                f"not hold (index {int(faces[outside][0])}; its {len(g.vertices)} vertices are numbered 0.."
+                f"{len(g.vertices) - 1}): the file is damaged",
             )
     try:
         for g in geoms:  # face colours before processing: it merges vertices at one place whatever their colours
@@ -309,6 +321,41 @@ def _any_area(v: np.ndarray, fc: np.ndarray) -> bool:
         corners = (v[fc] - v.min(axis=0)) / extent
         doubled = np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
         return bool(np.any(~(doubled <= 1e-12)))
+
+
+_SEPARATOR = np.zeros(256, dtype=bool)
+_SEPARATOR[list(b" \t/+-")] = True
+_AFTER = np.zeros(256, dtype=bool)
+_AFTER[list(b" \t/#\r\n0")] = True
+_ZERO_INDEX = re.compile(r"[+-]?0+")
+
+
+def _check_obj_indices(path: Path, where: str) -> None:
+    """Refuses an OBJ face naming index 0 (``f 0 1 2``, ``f 1/0 2/0 3/0``): OBJ numbers vertices, texture
+    coordinates and normals from 1 (negative numbers count back from the last), so 0 names nothing, and trimesh read
+    it as -1, the last one, without a word (a file written counting from 0, or damaged). The bytes are searched with
+    numpy for a ``0`` standing alone on a line starting ``f`` (a regular expression took a second for 1 million
+    faces); the few lines found are then read as text."""
+    raw = np.frombuffer(path.read_bytes() + b"\n", dtype=np.uint8)
+    zeros = np.flatnonzero(raw == ord("0"))
+    zeros = zeros[zeros > 0]
+    zeros = zeros[_SEPARATOR[raw[zeros - 1]] & _AFTER[raw[zeros + 1]]]
+    if len(zeros) == 0:
+        return
+    breaks = np.flatnonzero(raw == ord("\n"))
+    starts = np.concatenate(([0], breaks + 1))  # line k runs from starts[k] to breaks[k]
+    lines = np.unique(np.searchsorted(breaks, zeros))
+    lines = lines[raw[starts[lines]] == ord("f")]
+    for k in lines:
+        line = raw[starts[k] : breaks[k]].tobytes().decode("utf-8", errors="replace").split("#", 1)[0]
+        tokens = line.split()
+        if tokens[:1] == ["f"] and any(_ZERO_INDEX.fullmatch(part) for t in tokens[1:] for part in t.split("/")):
+            raise AssetSpecError(
+                where,
+                f"{str(path)!r}: the face on line {int(k) + 1} names index 0 ({line.strip()!r}); OBJ numbers "
+                "vertices, texture coordinates and normals from 1 (negative numbers count back from the last), so 0 "
+                "names none: the file is damaged or was written counting from 0",
+            )
 
 
 def mesh_asset(spec: MeshAssetSpec, *, path: str, base_dir: Path | None, cls: int) -> TriMesh:
