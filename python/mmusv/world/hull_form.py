@@ -188,7 +188,9 @@ def _loft(hull: HullSpec, *, y0: float, half: float, cls: int, mats: tuple[int, 
                 t = fr * draft / depth
             else:
                 z = fr * dz
-                t = (draft + fr * hull.freeboard) / depth
+                # at most 1: draft + (depth - draft) rounds past depth for 42 of 3,626 hulls of whole decimetres
+                # (draft 0.6, depth 1.8), and (1 - t) ** 1.5 of a negative 1 - t was NaN, the stem's x at the deck
+                t = min(1.0, (draft + fr * hull.freeboard) / depth)
             x_bow = length / 2.0 - hull.rake * length * (1.0 - t) ** 1.5
             x_stern = -length / 2.0 + hull.overhang * length * (1.0 - t) ** 1.2
             x = x_stern + u * (x_bow - x_stern)
