@@ -211,4 +211,10 @@ class AntennasPart(Part):
         for i, a in enumerate(self.at):
             if not MIN_SIZE <= a[3] <= MAX_EXTENT:
                 raise invalid_field(f"at[{i}][3]", f"height must be {MIN_SIZE:g} to {MAX_EXTENT:g} m, got {a[3]:g}")
+            if a[3] <= 4.0 * self.radius:  # the whip rises from the top of its base mount, 4 radii tall
+                raise invalid_field(
+                    f"at[{i}][3]",
+                    f"height {a[3]:g} m must be more than 4 x radius ({4.0 * self.radius:g} m, the height of the "
+                    "antenna's base mount, above which the whip rises): a taller antenna or a smaller radius",
+                )
         return self
