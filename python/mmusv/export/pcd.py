@@ -73,5 +73,20 @@ def read_pcd(path: Path) -> tuple[np.ndarray, np.ndarray]:
         arr = np.loadtxt(rows, dtype=np.float64, ndmin=2).reshape(-1, 4) if n else np.zeros((0, 4))
     except ValueError as exc:
         raise ValueError(f"{path}: not rows of 4 numbers x y z rgb ({exc})") from None
-    rgb = arr[:, 3].astype(np.int64)
+    bad = ~np.isfinite(arr[:, :3]).all(axis=1)
+    if bad.any():  # a detector fitting the water plane failed on them with numpy's LinAlgError
+        k = int(np.argmax(bad))
+        raise ValueError(
+            f"{path}: point {k} ({rows[k].strip()!r}) and {int(bad.sum()) - 1} more have coordinates that are not "
+            "finite (NaN or infinity); every x y z must be a finite number of metres"
+        )
+    colour = arr[:, 3]
+    bad = ~((colour >= 0.0) & (colour < 2.0**32) & (colour == np.floor(colour)))
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise ValueError(
+            f"{path}: point {k} ({rows[k].strip()!r}) has rgb {colour[k]:g}; rgb is an unsigned 32-bit integer "
+            "(the intensity in its red byte)"
+        )
+    rgb = colour.astype(np.int64)
     return arr[:, :3], ((rgb >> 16) & 0xFF) / 255.0

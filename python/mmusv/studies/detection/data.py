@@ -15,6 +15,7 @@ vessel whose footprint comes within range, :func:`mmusv.annotate.footprint_in_ra
 
 from __future__ import annotations
 
+import reprlib
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -296,8 +297,8 @@ def read_opv2v(folder: str | Path) -> SequenceData:
             try:
                 doc = yaml.safe_load(y_path.read_text(encoding="utf-8"))
                 xyz, inten = read_pcd(p_path)
-                lidar = mirror_transform(carla_matrix(np.asarray(doc["lidar_pose"], dtype=np.float64)))
-                body = mirror_transform(carla_matrix(np.asarray(doc["true_ego_pos"], dtype=np.float64)))
+                lidar = mirror_transform(carla_matrix(_opv2v_pose(doc, "lidar_pose")))
+                body = mirror_transform(carla_matrix(_opv2v_pose(doc, "true_ego_pos")))
                 # inside the try: a vehicle without a location or of 2 angles was a bare KeyError / ValueError
                 for vid, (box, size) in _opv2v_vehicles(doc.get("vehicles") or {}).items():
                     vehicles[vid], sizes[vid] = box, size
@@ -322,6 +323,18 @@ def read_opv2v(folder: str | Path) -> SequenceData:
             )
         )
     return SequenceData(d.name, tuple(frames))
+
+
+def _opv2v_pose(doc: Any, key: str) -> np.ndarray:
+    """The CARLA pose ``doc[key]`` of an OPV2V frame (``lidar_pose``, ``true_ego_pos``); a ``ValueError`` naming
+    ``key`` unless it is 6 finite numbers: a NaN pose dropped the frame's ground truth without a word, and a pose of
+    another length was refused without naming the file."""
+    pose = np.asarray(doc[key], dtype=np.float64)
+    if pose.shape != (6,):
+        raise ValueError(f"{key} = {reprlib.repr(doc[key])}: must be 6 numbers [x, y, z, roll, yaw, pitch]")
+    if not np.isfinite(pose).all():
+        raise ValueError(f"{key} = {pose.tolist()}: must be 6 finite numbers [x, y, z, roll, yaw, pitch]")
+    return pose
 
 
 def _opv2v_vehicles(doc: Any) -> dict[str, tuple[np.ndarray, np.ndarray]]:
