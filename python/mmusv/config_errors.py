@@ -163,6 +163,15 @@ def validation_problems(
             msg = f"must hold at least {n} {'entry' if n == 1 else 'entries'}, got {got}"
         if e["type"] == "string_pattern_mismatch":
             msg = _pattern_words(e.get("ctx", {}).get("pattern"), value) or msg
+        if e["type"] == "invalid_key" and loc:
+            # pydantic's location ends with the key and its input is the key ("vessels[0][5] = 5: Keys should be
+            # strings" read as item 5 of a list holding 5): the mapping's path, the key in it, and the keys allowed
+            loc, shown = loc[:-1], f"{{{short_repr(value)}: ...}}"
+            msg = f"the key {short_repr(value)} is not text; keys are names"
+            if model is not None:
+                msg += _unknown_key_hint(model, (*loc, ""), data, keys_said=loc in keys_said).replace("; ", " (", 1)
+                msg += ")" if "(" in msg else ""
+                keys_said.add(loc)
         if e["type"] == "extra_forbidden" and model is not None:
             msg += _unknown_key_hint(model, loc, data, keys_said=loc[:-1] in keys_said)
             keys_said.add(loc[:-1])
