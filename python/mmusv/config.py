@@ -371,12 +371,13 @@ class Scenario(_Model):
                 )
             if v.rig is not None and v.rig not in self.rigs:
                 problems.append(
-                    f"vessel {v.id!r} names rig {v.rig!r}, which is not defined under rigs: ({sorted(self.rigs)})"
+                    f"vessel {v.id!r} names rig {short_repr(v.rig)}, which is not defined under rigs: "
+                    f"({sorted(self.rigs)})"
                 )
         for i, v in enumerate(self.vessels):
             if v.rig is not None and v.role != "usv":
                 problems.append(
-                    f"vessels[{i}].rig = {v.rig!r}: only instrumented vessels (role: usv) carry a rig; "
+                    f"vessels[{i}].rig = {short_repr(v.rig)}: only instrumented vessels (role: usv) carry a rig; "
                     f"vessel {v.id!r} has role {v.role!r} (add `role: usv` or remove `rig`)"
                 )
             if v.z_base_m < 0.0:

@@ -67,6 +67,7 @@ from mmusv.config import (
     validation_error,
     validation_problems,
 )
+from mmusv.config_errors import short_repr
 from mmusv.errors import ConfigError, MmusvError, located
 from mmusv.generate.families import FAMILIES
 from mmusv.generate.spec_constraints import (
@@ -384,7 +385,7 @@ def _cross_checks(spec: GenerationSpec, source: str) -> None:
     """Checks that need several fields; raises ConfigError naming the field at fault."""
 
     def fail(path: str, value: object, msg: str) -> None:
-        raise ConfigError(f"{source}: invalid spec {path} = {value!r}: {msg}")
+        raise ConfigError(f"{source}: invalid spec {path} = {short_repr(value)}: {msg}")
 
     if spec.rig not in spec.rigs:
         fail("rig", spec.rig, f"not defined under rigs: ({', '.join(sorted(spec.rigs))})")
