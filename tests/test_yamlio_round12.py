@@ -70,3 +70,26 @@ def test_a_merge_of_a_scalar_is_refused_as_before() -> None:
         parse_yaml("a: {<<: 3}\n", "m.yaml")
     with pytest.raises(ConfigError, match=r"m\.yaml: not valid YAML at line 1.*expected a mapping for merging"):
         parse_yaml("a: {<<: [{x: 1}, 3]}\n", "m.yaml")
+
+
+# A sequence or a scalar tagged !!map reached the duplicate-key check, which unpacked its items as pairs: a bare
+# TypeError traceback for `vessels: !!map [1, 2]`, and for `name: !!map x` "not valid YAML: not enough values to
+# unpack (expected 2, got 1); no value of a scenario needs one". Both are said as PyYAML says them.
+
+
+@pytest.mark.parametrize(
+    ("text", "found"),
+    [("name: x\nvessels: !!map [1, 2]\n", "sequence"), ("name: !!map x\n", "scalar"), ("a: !!map\n", "scalar")],
+)
+def test_a_map_tag_on_another_node_is_refused_naming_its_line(tmp_path: Path, text: str, found: str) -> None:
+    f = tmp_path / "tagged.yaml"
+    f.write_text(text, encoding="utf-8")
+    with pytest.raises(ConfigError) as info:
+        load_scenario(f)
+    msg = str(info.value)
+    assert msg.startswith(f"{f}: not valid YAML at line "), msg
+    assert f"expected a mapping node, but found {found}" in msg, msg
+
+
+def test_a_map_tag_on_a_mapping_is_read() -> None:
+    assert parse_yaml("a: !!map {b: 1}\nc: !!map\n  d: [1]\n", "m.yaml") == {"a": {"b": 1}, "c": {"d": [1]}}

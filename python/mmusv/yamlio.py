@@ -73,6 +73,10 @@ _FastUniqueKeyLoader: Any = (
 
 
 def _construct_mapping(loader: Any, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
+    if not isinstance(node, yaml.MappingNode):  # `!!map [1, 2]`: its items were unpacked as pairs (a TypeError)
+        raise yaml.constructor.ConstructorError(
+            None, None, f"expected a mapping node, but found {node.id} (tagged !!map)", node.start_mark
+        )
     # Only the keys written in this mapping must be unique: a merge key (`<<: *base`) brings in keys that the
     # mapping's own may override, as YAML's merge type says.
     explicit = [(k, v) for k, v in node.value if k.tag != "tag:yaml.org,2002:merge"]
