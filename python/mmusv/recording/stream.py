@@ -250,6 +250,10 @@ class FrameStream:
                 except Exception as exc:  # a message whose bytes do not decode: the frame is not usable
                     cur.bad = cur.bad or f"its {topic} message does not decode ({type(exc).__name__})"
                     continue
+                hollow = self._hollow(topic, decoded, cur.frame.world)
+                if hollow is not None:  # bytes that decode to a message without what every reader takes from it
+                    cur.bad = cur.bad or f"its {topic} message {hollow}"
+                    continue
                 cur.frame.messages[topic] = decoded
             if cur is not None:
                 yield from self._close(cur, pending, lost, reference, scan, seen, final=True)
@@ -268,6 +272,21 @@ class FrameStream:
         elif not self.metadata:
             self.metadata = dict(scan.metadata)
             self.attachments = list(scan.attachments)
+
+    def _hollow(self, topic: str, decoded: Any, world: WorldFrame | None) -> str | None:
+        """What a decoded message lacks that an mmusv recording's always holds, or ``None``: a world state without a
+        row for each USV (its ``index``), a point cloud without x, y and z fields. Bytes of an empty message (or one
+        cut at a field's end) decode without error to such a message, which the exporters then read as a bare
+        ``IndexError`` or ``KeyError`` traceback."""
+        if topic == WORLD_STATE and world is not None:
+            need = max((a.index for a in self.info.agents), default=-1) + 1
+            if len(world.ids) < need:
+                return f"holds {len(world.ids)} vessels, fewer than the USVs' rows ({need})"
+        elif type(decoded).__name__ == "PointCloud" and hasattr(decoded, "fields"):
+            names = {f.name for f in decoded.fields}
+            if not {"x", "y", "z"} <= names:
+                return f"is a point cloud without {', '.join(sorted({'x', 'y', 'z'} - names))} fields"
+        return None
 
     def _close(
         self,
