@@ -136,7 +136,14 @@ class Sink:
     created: list[Path] = field(default_factory=list)
 
     def write(self, path: Path, data: builtins.bytes) -> None:
-        path.write_bytes(data)
+        """Writes ``data`` to ``path``. An ``OSError`` of the write itself (a full disk), which names no file (only
+        opening one does), is raised again naming ``path``."""
+        try:
+            path.write_bytes(data)
+        except OSError as exc:
+            if exc.filename:
+                raise
+            raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from exc
         self.files += 1
         self.bytes += len(data)
 

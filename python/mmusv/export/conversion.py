@@ -23,7 +23,7 @@ from __future__ import annotations
 import contextlib
 import shutil
 import time
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from pathlib import Path
 
 from mmusv import arguments
@@ -75,6 +75,20 @@ def _clear(out: Path, *, remove: bool) -> None:
     if remove:
         with contextlib.suppress(OSError):
             out.rmdir()
+
+
+@contextlib.contextmanager
+def _write_failures(out: Path) -> Iterator[None]:
+    """Names a file in the ``OSError`` of a write of the conversion that names none (a full disk): the write to an
+    open file names no file (only opening one does), so the command line said only "No space left on device". The
+    writes through :class:`~mmusv.export.common.Sink` name their file; the others (a library's: rosbags') are named
+    by the output folder ``out``."""
+    try:
+        yield
+    except OSError as exc:
+        if exc.filename:
+            raise
+        raise OSError(exc.errno, exc.strerror or str(exc), str(out)) from exc
 
 
 def _beyond(frames: tuple[int, int | None] | None, first: int, end: int) -> str | None:
@@ -321,7 +335,7 @@ def convert(
                 **({"oxts_origin": list(origin)} if origin is not None else {}),
             },
         }
-        with staged(work, out), reported(work / REPORT_NAME, header):
+        with staged(work, out), reported(work / REPORT_NAME, header), _write_failures(out):
             sink = Sink()
             shared = cls.start(work, options, sink)
             report = ConvertReport(out_dir=out, target=to, recordings=reports)

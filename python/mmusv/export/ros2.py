@@ -20,6 +20,7 @@ The frame ids and topic names are :mod:`mmusv.export.ros2_names`'s, the messages
 
 from __future__ import annotations
 
+import contextlib
 from typing import Any, ClassVar, Literal
 
 import numpy as np
@@ -196,7 +197,21 @@ class Ros2Writer(DatasetWriter):
             qos = (self.latched,) if latched else ()
             conn = self.bag.add_connection(topic, msgtype, typestore=self.ts, offered_qos_profiles=qos)
             self.connections[topic] = conn
-        self.bag.write(conn, t_ns, self.ts.serialize_cdr(msg, msgtype))
+        data = self.ts.serialize_cdr(msg, msgtype)
+        try:
+            self.bag.write(conn, t_ns, data)
+        except OSError as exc:
+            raise self._failed(exc) from exc
+
+    def _failed(self, exc: OSError) -> OSError:
+        """After a failed write of the bag (a full disk): the bag closed without its summary (rosbags' ``abort``; its
+        file was left open) and ``exc`` naming the bag's file (rosbags' ``OSError`` names none)."""
+        bag, self.bag = self.bag, None
+        with contextlib.suppress(Exception):
+            bag.abort()
+        if exc.filename:
+            return exc
+        return OSError(exc.errno, exc.strerror or str(exc), str(self.folder / f"{self.folder.name}.mcap"))
 
     def write_frame(self, frame: Frame) -> None:
         world = frame.world
@@ -497,7 +512,10 @@ class Ros2Writer(DatasetWriter):
         self.bag.set_custom_data("mmusv.scenario", self.info.scenario_name)
         self.bag.set_custom_data("mmusv.config_hash", self.info.config_hash)
         self.bag.set_custom_data("mmusv.time_offset_ns", str(TIME_OFFSET_NS))
-        self.bag.close()
+        try:
+            self.bag.close()
+        except OSError as exc:
+            raise self._failed(exc) from exc
         self.bag = None
         for p in sorted(self.folder.iterdir()):
             self.sink.count(p)
