@@ -91,6 +91,19 @@ def _write_failures(out: Path) -> Iterator[None]:
         raise OSError(exc.errno, exc.strerror or str(exc), str(out)) from exc
 
 
+def _why_nothing(reports: list[RecordingReport]) -> str:
+    """Why the recordings of a conversion gave no complete frame, for its error (empty when none says): each one's
+    skipped frames with their reasons (damage, a cut, missing topics), else its notes; the error said only "no complete
+    frame in X", and these went with the report that is not written then."""
+    parts = []
+    for r in reports:
+        why = [f"frames {s['frames'][0]}..{s['frames'][1]} {s['reason']}" for s in r.skipped]
+        why = why or [n for n in r.notes if not n.startswith("no complete frame")]
+        if why:
+            parts.append(f"{r.path}: {'; '.join(dict.fromkeys(why))}")
+    return f" ({'; '.join(parts)})" if parts else ""
+
+
 def _beyond(frames: tuple[int, int | None] | None, first: int, end: int) -> str | None:
     """What of ``frames`` (``[start, stop)``, the ``--frames`` asked for) lies outside the acquisition indices
     ``first..end - 1`` a recording's run set out to write, said as a note (``None``: nothing): a range that reaches
@@ -433,6 +446,7 @@ def convert(
                 raise IoError(
                     f"nothing converted: no complete frame in {', '.join(str(r.path) for r in reports)}; "
                     + (f"{out} keeps its previous conversion" if work != out else "nothing written")
+                    + _why_nothing(reports)
                 )
             cls.finish_all(shared, work, sink)
             doc = {
