@@ -61,7 +61,7 @@ from mmusv.export.camera import (
 from mmusv.export.common import Options, Sink, png_bytes
 from mmusv.export.splits import SPLIT_NAMES
 from mmusv.recording.decode import WorldFrame
-from mmusv.recording.stream import Frame
+from mmusv.recording.stream import Frame, frame_ranges
 
 __all__ = [
     "CLASSES_FILE",
@@ -254,6 +254,16 @@ class MotWriter(ProjectedBoxes):
                 f"recorded at {freq} Hz: seqinfo.ini's frameRate is {rate}, the nearest whole number, since "
                 "MOTChallenge's files hold whole numbers and trackers read them so (FairMOT's and JDE's int()); a "
                 f"frame's time is its frames.txt index / {freq} s"
+            )
+        order = sorted(frames)
+        done = set(order)
+        gaps = [k for k in range(order[0], order[-1] + 1) if k not in done] if order else []
+        if gaps and self.sequences:  # a tracker steps by frame: say where a step is longer than 1 / frequency_hz
+            what = "index {} is" if len(gaps) == 1 else "indices {} are"
+            self.notes.append(
+                f"acquisition {what.format(frame_ranges(gaps))} not converted, so the frames of its sequences "
+                f"({', '.join(sorted(s.name for s in self.sequences.values()))}) are not all 1 / frequency_hz apart "
+                "(each sequence's frames.txt gives each frame's index)"
             )
         for seq in self.sequences.values():
             order = sorted(seq.rows)
