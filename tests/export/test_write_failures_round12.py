@@ -83,3 +83,17 @@ def test_full_disk_in_a_bag_names_the_bag(
     assert code == 2
     bag = out / "export_coop" / "export_coop.mcap"
     assert f"mmusv: error: {bag}: {os.strerror(errno.ENOSPC)}" in err.splitlines(), err
+
+
+def test_full_disk_before_the_report_leaves_no_folder(
+    coop_rec: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The first write, the report's: it left a new folder holding an empty conversion.yaml, which the next
+    conversion into it took for a previous conversion (--overwrite asked for), and named no file."""
+    out = tmp_path / "o"
+    monkeypatch.setattr(Path, "write_bytes", _full_disk_for("conversion.yaml"))
+    code = main(["convert", str(coop_rec), "--to", "coco", "-o", str(out), "--no-progress"])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert f"mmusv: error: {out / 'conversion.yaml'}: {os.strerror(errno.ENOSPC)}" in err.splitlines(), err
+    assert not out.exists()

@@ -127,6 +127,14 @@ class Options:
         return index >= start and (stop is None or index < stop)
 
 
+def naming(exc: OSError, path: Path) -> OSError:
+    """``exc`` when it names a file, else the same error naming ``path``: the ``OSError`` of a write to an open file (a
+    full disk) names none (only opening one does), so the command line said only "No space left on device"."""
+    if exc.filename:
+        return exc
+    return OSError(exc.errno, exc.strerror or str(exc), str(path))
+
+
 @dataclass
 class Sink:
     """Writes files and counts them."""
@@ -141,9 +149,7 @@ class Sink:
         try:
             path.write_bytes(data)
         except OSError as exc:
-            if exc.filename:
-                raise
-            raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from exc
+            raise naming(exc, path) from exc
         self.files += 1
         self.bytes += len(data)
 

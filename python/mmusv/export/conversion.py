@@ -28,7 +28,16 @@ from pathlib import Path
 
 from mmusv import arguments
 from mmusv.errors import ConfigError, IoError
-from mmusv.export.common import DEFAULT_EXTRAS, TARGETS, Options, Sink, dump_yaml, parse_box, parse_extras
+from mmusv.export.common import (
+    DEFAULT_EXTRAS,
+    TARGETS,
+    Options,
+    Sink,
+    dump_yaml,
+    naming,
+    parse_box,
+    parse_extras,
+)
 from mmusv.export.convert_checks import (
     DEFAULT_RANGE_M,
     agent_selection,
@@ -86,9 +95,7 @@ def _write_failures(out: Path) -> Iterator[None]:
     try:
         yield
     except OSError as exc:
-        if exc.filename:
-            raise
-        raise OSError(exc.errno, exc.strerror or str(exc), str(out)) from exc
+        raise naming(exc, out) from exc
 
 
 def _why_nothing(reports: list[RecordingReport]) -> str:
@@ -464,6 +471,11 @@ def convert(
     except IoError:
         if nothing and work == out:
             _clear(out, remove=created)
+        raise
+    except OSError:
+        if created and work == out:  # a new folder where not even the report could be written (a full disk)
+            with contextlib.suppress(OSError):
+                out.rmdir()  # only when empty
         raise
     finally:
         lock.release()

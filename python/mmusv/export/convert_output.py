@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from mmusv.errors import IoError, MmusvError
-from mmusv.export.common import dump_yaml
+from mmusv.export.common import dump_yaml, naming
 from mmusv.export.convert_report import REPORT_NAME
 from mmusv.recording.guard import FolderLock
 from mmusv.recording.info import written_by_mmusv
@@ -203,7 +203,12 @@ def reported(report: Path, header: dict[str, Any]) -> Iterator[None]:
     recording's run metadata say it), so that a folder left with part of a conversion says so and why; the files
     already written stay. (Inside a staging folder, :func:`staged` then removes it all.) The conversion writes the
     complete report itself."""
-    report.write_bytes(dump_yaml({**header, "status": "in_progress"}))
+    try:
+        report.write_bytes(dump_yaml({**header, "status": "in_progress"}))
+    except OSError as exc:  # a full disk: no report at all rather than an empty one, which read as a conversion
+        with contextlib.suppress(OSError):
+            report.unlink(missing_ok=True)
+        raise naming(exc, report) from exc
     try:
         yield
     except BaseException as exc:

@@ -28,6 +28,7 @@ from scipy.spatial.transform import Rotation
 
 from mmusv.classes import ROLE_COLOURS, class_name
 from mmusv.errors import ConfigError
+from mmusv.export.common import naming
 from mmusv.export.ros2_msgs import Msgs, stamp
 from mmusv.export.ros2_names import (
     MAP_FRAME,
@@ -209,9 +210,7 @@ class Ros2Writer(DatasetWriter):
         bag, self.bag = self.bag, None
         with contextlib.suppress(Exception):
             bag.abort()
-        if exc.filename:
-            return exc
-        return OSError(exc.errno, exc.strerror or str(exc), str(self.folder / f"{self.folder.name}.mcap"))
+        return naming(exc, self.folder / f"{self.folder.name}.mcap")
 
     def write_frame(self, frame: Frame) -> None:
         world = frame.world
