@@ -419,62 +419,76 @@ def _record(
         result.status = "failed"
         result.error = f"{type(exc).__name__}: {exc}"
         failure = exc
-    writer.close()  # every frame handed over is written, also after an error or a Ctrl-C
-    if writer.interrupted and failure is None:
-        result.status, failure = "interrupted", KeyboardInterrupt()
-    result.frames_written = writer.done
-    # finish what can be finished; a write that fails here (a full disk) is named below, not raised half-way
-    problems: list[tuple[str, BaseException]] = []
-    # The last table part is written before the recording is finished, so that a recording never says
-    # `complete` of a run whose tables could not be written (it says `failed`, and why).
+    # A stop (SIGINT, SIGTERM) while the run is finished is held until its manifest.json is written, then raised:
+    # unheld, a Ctrl-C as the last frame was written (or a second one while the first was handled) left the
+    # recording's .partial unfinished and no manifest.json, and the editor's stop button a run naming no recording.
+    finishing = HeldSignals().hold()
     try:
-        tables.flush()  # the writer thread has ended: the tables are the main thread's again
-    except OSError as exc:
-        problems.append(("writing the tables", exc))
-        if result.status == "complete":
+        writer.close()  # every frame handed over is written, also after an error or a Ctrl-C
+        if writer.interrupted and failure is None:
+            result.status, failure = "interrupted", KeyboardInterrupt()
+        result.frames_written = writer.done
+        # finish what can be finished; a write that fails here (a full disk) is named below, not raised half-way
+        problems: list[tuple[str, BaseException]] = []
+        # The last table part is written before the recording is finished, so that a recording never says
+        # `complete` of a run whose tables could not be written (it says `failed`, and why).
+        try:
+            tables.flush()  # the writer thread has ended: the tables are the main thread's again
+        except OSError as exc:
+            problems.append(("writing the tables", exc))
+            if result.status == "complete":
+                result.status = "failed"
+                result.error = f"writing the tables: {write_cause(out, exc)}"
+        try:
+            summary = recorder.finish(
+                status=result.status,
+                frames=result.frames_written,
+                error=result.error,
+                requested=total - first,
+                first_frame=None if frame_range is None else first,
+            )
+            result.messages, result.bytes = summary.get("messages", 0), summary.get("bytes", 0)
+        except (MmusvError, OSError) as exc:
+            problems.append((f"finishing {rec_path.name}", exc))
+        result.seconds = time.perf_counter() - t0
+        if prof is not None:
+            prof.stop(result.frames_written)
+        message = None
+        if failure is not None and writes_into(failure, out):
+            problems.insert(0, ("writing a frame", failure))
+        if problems:  # the disk is full, or the folder went read-only: say why and what is safe
             result.status = "failed"
-            result.error = f"writing the tables: {write_cause(out, exc)}"
+            message, safe = write_failure(out, rec_path, problems)
+            result.frames_written = safe
+        manifest = {
+            "mmusv_version": _version(),
+            "scenario": scenario.name,
+            "seed": scenario.seed,
+            "config_hash": scenario_hash(scenario),
+            "status": result.status,
+            "frames_written": result.frames_written,
+            "frames_requested": total - first,
+            "frequency_hz": scenario.acquisition.frequency_hz,
+            "agents": [a.id for a in sim.agents],
+            "recording": rec_path.name,
+            "tables": sorted(p.name for p in tables_dir.iterdir()) if tables_dir.is_dir() else [],
+        }
+        if frame_range is not None:
+            manifest["first_frame"] = first
+        try:  # renamed into place: never half-written
+            write_bytes_atomic(out / "manifest.json", dump_json(manifest))
+        except OSError as exc:
+            if message is None:
+                message, _safe = write_failure(out, rec_path, [("writing manifest.json", exc)])
+    except BaseException:
+        finishing.release(hand_on=False)  # an unexpected error ends the run anyway
+        raise
     try:
-        summary = recorder.finish(
-            status=result.status,
-            frames=result.frames_written,
-            error=result.error,
-            requested=total - first,
-            first_frame=None if frame_range is None else first,
-        )
-        result.messages, result.bytes = summary.get("messages", 0), summary.get("bytes", 0)
-    except (MmusvError, OSError) as exc:
-        problems.append((f"finishing {rec_path.name}", exc))
-    result.seconds = time.perf_counter() - t0
-    if prof is not None:
-        prof.stop(result.frames_written)
-    message = None
-    if failure is not None and writes_into(failure, out):
-        problems.insert(0, ("writing a frame", failure))
-    if problems:  # the disk is full, or the folder went read-only: say why and what is safe
-        result.status = "failed"
-        message, safe = write_failure(out, rec_path, problems)
-        result.frames_written = safe
-    manifest = {
-        "mmusv_version": _version(),
-        "scenario": scenario.name,
-        "seed": scenario.seed,
-        "config_hash": scenario_hash(scenario),
-        "status": result.status,
-        "frames_written": result.frames_written,
-        "frames_requested": total - first,
-        "frequency_hz": scenario.acquisition.frequency_hz,
-        "agents": [a.id for a in sim.agents],
-        "recording": rec_path.name,
-        "tables": sorted(p.name for p in tables_dir.iterdir()) if tables_dir.is_dir() else [],
-    }
-    if frame_range is not None:
-        manifest["first_frame"] = first
-    try:  # renamed into place: never half-written
-        write_bytes_atomic(out / "manifest.json", dump_json(manifest))
-    except OSError as exc:
-        if message is None:
-            message, _safe = write_failure(out, rec_path, [("writing manifest.json", exc)])
+        finishing.release()  # a stop held meanwhile: KeyboardInterrupt (the run's own error, if any, goes first)
+    except KeyboardInterrupt:
+        if message is None and failure is None:
+            raise  # the run was finished whole: the stop ends it now, as a stop in the loop would have
+        # else the run's own error (below) says more than the stop
     if message is not None:
         raise IoError(message) from None
     if failure is not None:

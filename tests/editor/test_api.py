@@ -566,8 +566,10 @@ def test_a_restarted_server_shows_the_runs_already_in_its_folder(client: TestCli
 
 def test_a_stopped_run_names_its_recording_and_frames(client: TestClient, folder: Path) -> None:
     """A run stopped from the page said ``"recording": null`` though its recording held every completed frame (a
-    restarted server named it, from the run's manifest.json)."""
+    restarted server named it, from the run's manifest.json). Its 200 frames outlast the stop: with the bundled 50
+    the run could end before it on a busy machine (and then, rightly, be complete)."""
     doc = small(bundled_doc(client))
+    doc["acquisition"] = {**doc["acquisition"], "frames": 200}
     assert client.put("/api/files/stopme.yaml", json={"document": doc}).status_code == 200
     job = client.post("/api/runs", json={"name": "stopme.yaml"}).json()
     deadline = time.monotonic() + 120

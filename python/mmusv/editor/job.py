@@ -4,13 +4,16 @@ It calls :func:`mmusv.acquire.run` (what ``mmusv run SCENARIO -o OUT --overwrite
 JSON object per line: ``{"done": k, "total": n}`` after every frame, ``{"warning": "..."}`` for each check warning,
 and last ``{"status": "complete", "frames": k, "recording": path, "seconds": s}``, ``{"status": "failed",
 "error": "..."}`` (exit status 2) or ``{"status": "interrupted", ...}`` after SIGINT (exit status 130; the
-recording then holds every completed frame, and the line names it and its frames as for a complete run).
+recording then holds every completed frame, and the line names it and its frames as for a complete run). A stop
+that comes once every frame is written changes nothing: the line says ``complete`` (exit status 0), as the recording
+and its manifest do.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import signal
 import sys
 import warnings
 from typing import Any
@@ -23,19 +26,23 @@ def _say(obj: dict[str, Any]) -> None:
 
 
 def _kept(args: argparse.Namespace) -> dict[str, Any]:
-    """``frames`` and ``recording`` of a stopped run, as its ``manifest.json`` (written on the way out) names them;
-    empty when it has none (stopped before its recording opened). The status line said ``"recording": null`` of a
-    recording holding every completed frame."""
+    """``status``, ``frames`` and ``recording`` of a stopped run, as its ``manifest.json`` (written on the way out)
+    names them; empty when it has none (stopped before its recording opened). The status line said ``"recording":
+    null`` of a recording holding every completed frame."""
     from pathlib import Path
 
     from mmusv.jsonio import read_json_or_none
 
     out = Path(args.output)
     manifest = read_json_or_none(out / "manifest.json") or {}
-    name, frames = manifest.get("recording"), manifest.get("frames_written")
+    name, frames, status = manifest.get("recording"), manifest.get("frames_written"), manifest.get("status")
     if not isinstance(name, str) or not (out / name).is_file():
         return {}
-    return {"recording": str(out / name), **({"frames": frames} if isinstance(frames, int) else {})}
+    return {
+        "recording": str(out / name),
+        **({"frames": frames} if isinstance(frames, int) else {}),
+        **({"status": status} if isinstance(status, str) else {}),
+    }
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -64,11 +71,21 @@ def main(argv: list[str] | None = None) -> int:
             frames=args.frames,
             progress=lambda done, total: _say({"done": done, "total": total}),
         )
+        # The run is over: a stop from here on (the editor's button pressed as it ended) is too late to change it.
+        # It ended the process with a traceback before the status line, and the editor then said "stopped before
+        # the first frame" of a complete run.
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
     except MmusvError as exc:
         _say({"status": "failed", "error": str(exc)})
         return 2
     except KeyboardInterrupt:
-        _say({"status": "interrupted", "error": "stopped; the recording holds every completed frame", **_kept(args)})
+        signal.signal(signal.SIGINT, signal.SIG_IGN)  # a second stop would cut the status line
+        kept = _kept(args)
+        if kept.get("status") == "complete":  # every frame was written before the stop came
+            _say({**kept, "seconds": None})
+            return 0
+        kept.pop("status", None)
+        _say({"status": "interrupted", "error": "stopped; the recording holds every completed frame", **kept})
         return 130
     _say(
         {
