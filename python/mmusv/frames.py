@@ -34,6 +34,7 @@ __all__ = [
     "BODY_TO_OPTICAL",
     "MIRROR_Y",
     "OPTICAL_IN_BODY",
+    "body_rates",
     "carla_matrix",
     "carla_pose",
     "carla_pose_from_eta",
@@ -106,6 +107,34 @@ def pose_matrices(eta: npt.ArrayLike) -> np.ndarray:
     m[..., :3, 3] = eta[..., :3]
     m[..., 3, 3] = 1.0
     return m
+
+
+def body_rates(times: npt.ArrayLike, rotations: npt.ArrayLike) -> np.ndarray:
+    """``(n, 3)`` float64 angular velocity (rad/s) in the body frame of ``n`` body → world rotations ``(n, 3, 3)``
+    at times ``times`` ``(n,)`` (seconds, increasing): the rotation vector of ``R_kᵀ·R_{k+1}`` over its step is
+    the rate between two samples; a sample between two gets their mean weighted as :func:`numpy.gradient` weights
+    an uneven grid's differences (second order), the first and last the one step beside them; zeros for fewer
+    than two samples."""
+    from scipy.spatial.transform import Rotation
+
+    t = _floats(times, name="times", tail=(), what="(n,) times").reshape(-1)
+    r = _floats(rotations, name="rotations", tail=(3, 3), what="(n, 3, 3) rotations").reshape(-1, 3, 3)
+    if len(t) != len(r):
+        raise InputError(f"times: {len(t)} times for {len(r)} rotations")
+    n = len(t)
+    if n < 2:
+        return np.zeros((n, 3))
+    steps = np.diff(t)
+    if not np.all(steps > 0):
+        raise InputError("times: must increase")
+    rot = Rotation.from_matrix(r)
+    step_rates = (rot[:-1].inv() * rot[1:]).as_rotvec() / steps[:, None]  # R_k^T R_{k+1}: body axes
+    omega = np.empty((n, 3))
+    omega[0], omega[-1] = step_rates[0], step_rates[-1]
+    if n > 2:
+        before, after = steps[:-1, None], steps[1:, None]  # np.gradient's weights: h_s·forward + h_d·backward
+        omega[1:-1] = (before * step_rates[1:] + after * step_rates[:-1]) / (before + after)
+    return omega
 
 
 def translation(v: npt.ArrayLike) -> np.ndarray:

@@ -35,10 +35,10 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from mmusv import arguments
 from mmusv.errors import ConfigError
+from mmusv.frames import body_rates
 
 __all__ = [
     "DEFAULT_ORIGIN",
@@ -152,16 +152,7 @@ def _rates(times: np.ndarray, poses: np.ndarray) -> tuple[np.ndarray, np.ndarray
         return np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3))
     vel = np.gradient(poses[:, :3, 3], times, axis=0)
     acc = np.gradient(vel, times, axis=0)
-    rot = Rotation.from_matrix(poses[:, :3, :3])
-    steps = np.diff(times)
-    # the rotation vector of R_k^T R_{k+1} over its step: the body rate between k and k+1, in either frame's axes
-    step_rates = (rot[:-1].inv() * rot[1:]).as_rotvec() / steps[:, None]
-    omega = np.empty((n, 3))
-    omega[0], omega[-1] = step_rates[0], step_rates[-1]
-    if n > 2:
-        before, after = steps[:-1, None], steps[1:, None]  # np.gradient's weights: h_s·forward + h_d·backward
-        omega[1:-1] = (before * step_rates[1:] + after * step_rates[:-1]) / (before + after)
-    return vel, acc, omega
+    return vel, acc, body_rates(times, poses[:, :3, :3])
 
 
 def _number(v: float) -> str:

@@ -21,6 +21,7 @@ The frame ids and topic names are :mod:`mmusv.export.ros2_names`'s, the messages
 from __future__ import annotations
 
 import contextlib
+from dataclasses import dataclass
 from typing import Any, ClassVar, Literal
 
 import numpy as np
@@ -45,7 +46,7 @@ from mmusv.export.ros2_names import (
     top_view_frame,
 )
 from mmusv.export.writer import DatasetWriter
-from mmusv.frames import OPTICAL_IN_BODY, pose_matrices
+from mmusv.frames import OPTICAL_IN_BODY, body_rates, pose_matrices
 from mmusv.recording import topics
 from mmusv.recording.decode import WorldFrame
 from mmusv.recording.info import AgentInfo, RecordingInfo
@@ -100,6 +101,17 @@ def camera_distortion(agent: AgentInfo, name: str) -> np.ndarray:
     return np.zeros(5)
 
 
+@dataclass(frozen=True)
+class _Odom:
+    """One frame's odometry of a USV before its angular velocity is known: stamp (ns), sim time (s), body → map
+    ``(4, 4)`` and linear velocity in the body frame ``(3,)`` m/s."""
+
+    stamp_ns: int
+    time_s: float
+    body: np.ndarray
+    linear: np.ndarray
+
+
 class Ros2Writer(DatasetWriter):
     """Writes one recording as one rosbag2 folder (see the module docstring)."""
 
@@ -121,6 +133,8 @@ class Ros2Writer(DatasetWriter):
         self.m = Msgs(self.ts)
         self.bag: Any = None
         self.connections: dict[str, Any] = {}
+        self._odom: dict[str, list[_Odom]] = {}
+        """Per USV, the odometry not yet written and the one before it (see :meth:`_odometry`)."""
         for a in self.agents:
             renamed = [n for n in (a.id, *sorted(a.cameras)) if ros_token(n) != n]
             if renamed:
@@ -212,6 +226,31 @@ class Ros2Writer(DatasetWriter):
             bag.abort()
         return naming(exc, self.folder / f"{self.folder.name}.mcap")
 
+    def _odometry(self, a: AgentInfo, now: _Odom | None) -> None:
+        """Writes ``a``'s odometry of the frame before ``now`` (``None``: the last frame): the recording holds no
+        angular velocity, so it is the body rate of the poses before and after (:func:`mmusv.frames.body_rates`),
+        and an odometry message waits one frame for its successor. ``/<usv>/odom`` said angular 0 of a hull rolling
+        and pitching in the waves, and turning."""
+        held = self._odom.pop(a.id, [])
+        if now is not None:
+            self._odom[a.id] = [*held[-1:], now]  # (before, now): ``now`` is written with the next frame
+        if not held:
+            return
+        window = [*held, now] if now is not None else held  # (before, this, after) or the ends' two
+        this = held[-1]
+        rates = body_rates([o.time_s for o in window], [o.body[:3, :3] for o in window])
+        m = self.m
+        twist = self.T("geometry_msgs/msg/Twist")(
+            linear=m.vector3(this.linear), angular=m.vector3(rates[len(held) - 1])
+        )
+        odom = self.T("nav_msgs/msg/Odometry")(
+            header=m.header(this.stamp_ns, odom_frame(a.id)),
+            child_frame_id=base_link(a.id),
+            pose=self.T("geometry_msgs/msg/PoseWithCovariance")(pose=m.pose(this.body), covariance=np.zeros(36)),
+            twist=self.T("geometry_msgs/msg/TwistWithCovariance")(twist=twist, covariance=np.zeros(36)),
+        )
+        self._put(odom_topic(a.id), "nav_msgs/msg/Odometry", odom, this.stamp_ns)
+
     def write_frame(self, frame: Frame) -> None:
         world = frame.world
         assert world is not None
@@ -279,16 +318,7 @@ class Ros2Writer(DatasetWriter):
 
         m, t, msgs = self.m, self.stamp_ns(frame), frame.messages
         body = pose_matrices(world.poses[a.index])
-        twist = self.T("geometry_msgs/msg/Twist")(
-            linear=m.vector3(body[:3, :3].T @ world.velocities[a.index]), angular=m.vector3((0.0, 0.0, 0.0))
-        )
-        odom = self.T("nav_msgs/msg/Odometry")(
-            header=m.header(t, odom_frame(a.id)),
-            child_frame_id=base_link(a.id),
-            pose=self.T("geometry_msgs/msg/PoseWithCovariance")(pose=m.pose(body), covariance=np.zeros(36)),
-            twist=self.T("geometry_msgs/msg/TwistWithCovariance")(twist=twist, covariance=np.zeros(36)),
-        )
-        self._put(odom_topic(a.id), "nav_msgs/msg/Odometry", odom, t)
+        self._odometry(a, _Odom(t, frame.log_time_ns * 1e-9, body, body[:3, :3].T @ world.velocities[a.index]))
         lidar_fields = ["x", "y", "z", "intensity", "ring", "azimuth", "class", "instance"]
         self._point_cloud(frame, topics.lidar(a.id), topics.lidar_frame(a.id), lidar_fields)
         radar_fields = ["x", "y", "z", "range", "azimuth", "elevation", "intensity", "instance"]
@@ -507,6 +537,8 @@ class Ros2Writer(DatasetWriter):
         super().finish(frames, skipped)
         if self.bag is None:
             return
+        for a in self.agents:  # each USV's last odometry, held for a successor that never came
+            self._odometry(a, None)
         self.bag.set_custom_data("mmusv.source", self.info.path.name)
         self.bag.set_custom_data("mmusv.scenario", self.info.scenario_name)
         self.bag.set_custom_data("mmusv.config_hash", self.info.config_hash)
