@@ -1,7 +1,8 @@
 """``/<usv>/odom``'s angular velocity (``--to ros2``): it was 0 of hulls rolling and pitching in the waves, and
 turning. Checked against the Euler-angle rates of the recorded poses (the kinematic relation ``ω = T(Θ)⁻¹·Θ̇``,
 Fossen 2011 eq. 2.29: a computation of its own, not the exporter's rotation-vector differences), and
-:func:`mmusv.frames.body_rates` against a constant rate, exactly."""
+:func:`mmusv.frames.body_rates` against a constant rate, exactly. Also: a ros2 conversion stopped midway closes its
+bag."""
 
 from __future__ import annotations
 
@@ -89,3 +90,28 @@ def test_odometry_angular_velocity_is_the_body_rate_of_the_recorded_poses(rollin
             assert np.linalg.norm(angular[k] - one_step) <= 0.1 * np.linalg.norm(one_step) + 1e-3, (usv, k)
         linear = np.array([lin for _s, _a, lin in msgs])  # unchanged: the recorded velocity in the hull frame
         assert np.abs(linear).max() > 1.0
+
+
+def test_a_stopped_ros2_conversion_leaves_a_closed_bag_of_the_frames_converted(coop_rec: Path, tmp_path: Path) -> None:
+    """Ctrl-C mid-conversion left the bag's file open, with no summary and no ``metadata.yaml`` (rosbags could not
+    open it), to a Python session that went on; it is closed whole, holding the frames converted so far."""
+    import os
+
+    import yaml
+
+    def stop(done: int, total: int) -> None:
+        if done == 2:
+            raise KeyboardInterrupt
+
+    out = tmp_path / "o"
+    with pytest.raises(KeyboardInterrupt):
+        convert(coop_rec, to="ros2", out_dir=out, progress=stop)
+    assert yaml.safe_load((out / "conversion.yaml").read_text())["status"] == "interrupted"
+    bag = out / "export_coop"
+    assert (bag / "metadata.yaml").is_file()
+    open_files = {os.path.realpath(f"/proc/self/fd/{fd}") for fd in os.listdir("/proc/self/fd")}
+    assert str((bag / "export_coop.mcap").resolve()) not in open_files
+    with AnyReader([bag]) as r:
+        clock = [t for c, t, _raw in r.messages() if c.topic == "/clock"]
+        odom = [t for c, t, _raw in r.messages() if c.topic == "/usv_a/odom"]
+    assert len(clock) == 2 and odom == clock  # frames 0 and 1, the odometry of frame 1 too

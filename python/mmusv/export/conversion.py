@@ -375,69 +375,74 @@ def convert(
                 if cls.owns_folder:
                     sink.mkdir(folder)
                 writer = cls(info, folder, options, sink, split=rep.split, shared=shared)
-                wanted = writer.topic_filter()
-                stream = FrameStream(info, wanted.__contains__, frames=options.frames)
-                converted: set[int] = set()
-                incomplete: dict[int, str] = {}
-                for fr in stream:
-                    missing = writer.missing(fr)
-                    if not options.wants_frame(fr.index):
-                        pass  # outside --frames: neither converted nor missing
-                    elif fr.index in converted:
-                        # a frame recorded again: its first complete copy stands (handed to the writer again, COCO
-                        # listed the image twice, SemanticKITTI added a scan and a bag held every message twice)
-                        pass
-                    elif fr.world is None or missing or not writer.agents:
+                try:
+                    wanted = writer.topic_filter()
+                    stream = FrameStream(info, wanted.__contains__, frames=options.frames)
+                    converted: set[int] = set()
+                    incomplete: dict[int, str] = {}
+                    for fr in stream:
+                        missing = writer.missing(fr)
+                        if not options.wants_frame(fr.index):
+                            pass  # outside --frames: neither converted nor missing
+                        elif fr.index in converted:
+                            # a frame recorded again: its first complete copy stands (handed to the writer again, COCO
+                            # listed the image twice, SemanticKITTI added a scan and a bag held every message twice)
+                            pass
+                        elif fr.world is None or missing or not writer.agents:
+                            why = (
+                                writer.no_agent_reason
+                                if not writer.agents
+                                else f"incomplete: missing {', '.join(missing[:4])}"
+                                + (f" and {len(missing) - 4} more" if len(missing) > 4 else "")
+                            )
+                            incomplete.setdefault(fr.index, why)
+                        else:
+                            writer.write_frame(fr)
+                            converted.add(fr.index)
+                            report.agent_frames += len(writer.agents)
+                        done += 1
+                        if progress is not None:
+                            progress(done, max(expected, done))
+                    rep.status = stream.run.get("status", "unfinished (no run metadata)")
+                    for k, why in incomplete.items():
+                        if k not in converted:  # an incomplete copy of a frame converted from another copy is no loss
+                            rep.skipped.append({"frames": [k, k], "reason": why})
+                    seen = converted | set(incomplete)
+                    # the frames the run set out to write (its run metadata, or for one that did not finish its
+                    # manifest's): --frames N cuts a run short on purpose, those after N are not missing; one part of a
+                    # split recording given alone starts at its first frame
+                    span = stream.set_out()
+                    first, configured = span.start, len(span)
+                    absent = [k for k in span if k not in seen and options.wants_frame(k)]
+                    if absent:
+                        written = stream.run.get("frames_written")
+                        # every frame written, yet some not read: lost to damage or a cut (it said "not in the recording
+                        # (run complete: 6 of 6 frames written)")
+                        lost = written is not None and str(written).isdigit() and int(written) >= configured
                         why = (
-                            writer.no_agent_reason
-                            if not writer.agents
-                            else f"incomplete: missing {', '.join(missing[:4])}"
-                            + (f" and {len(missing) - 4} more" if len(missing) > 4 else "")
+                            f"{'lost from' if lost else 'not in'} the recording (run {rep.status}: {written} of "
+                            f"{counted(configured, 'frame')} written)"
+                            if written is not None
+                            else "not in the recording (the run did not finish; it set out to write "
+                            f"{counted(configured, 'frame')})"
                         )
-                        incomplete.setdefault(fr.index, why)
-                    else:
-                        writer.write_frame(fr)
-                        converted.add(fr.index)
-                        report.agent_frames += len(writer.agents)
-                    done += 1
-                    if progress is not None:
-                        progress(done, max(expected, done))
-                rep.status = stream.run.get("status", "unfinished (no run metadata)")
-                for k, why in incomplete.items():
-                    if k not in converted:  # an incomplete copy of a frame converted from another copy is no loss
-                        rep.skipped.append({"frames": [k, k], "reason": why})
-                seen = converted | set(incomplete)
-                # the frames the run set out to write (its run metadata, or for one that did not finish its
-                # manifest's): --frames N cuts a run short on purpose, those after N are not missing; one part of a
-                # split recording given alone starts at its first frame
-                span = stream.set_out()
-                first, configured = span.start, len(span)
-                absent = [k for k in span if k not in seen and options.wants_frame(k)]
-                if absent:
-                    written = stream.run.get("frames_written")
-                    # every frame written, yet some not read: lost to damage or a cut (it said "not in the recording
-                    # (run complete: 6 of 6 frames written)")
-                    lost = written is not None and str(written).isdigit() and int(written) >= configured
-                    why = (
-                        f"{'lost from' if lost else 'not in'} the recording (run {rep.status}: {written} of "
-                        f"{counted(configured, 'frame')} written)"
-                        if written is not None
-                        else "not in the recording (the run did not finish; it set out to write "
-                        f"{counted(configured, 'frame')})"
-                    )
-                    if stream.truncated:
-                        why += "; " + stream.truncated
-                    rep.skipped += [{"frames": [a, b], "reason": why} for a, b in _ranges(absent)]
-                elif stream.truncated:
-                    rep.notes.append(stream.truncated)
-                beyond = _beyond(options.frames, first, first + configured)
-                if beyond:
-                    rep.notes.append(beyond)
-                if stream.out_of_order:
-                    again = sorted(set(stream.out_of_order))
-                    rep.notes.append(f"frames {again} appear more than once; the first complete copy was converted")
-                rep.skipped.sort(key=lambda s: s["frames"][0])
-                writer.finish(sorted(converted), rep.skipped)
+                        if stream.truncated:
+                            why += "; " + stream.truncated
+                        rep.skipped += [{"frames": [a, b], "reason": why} for a, b in _ranges(absent)]
+                    elif stream.truncated:
+                        rep.notes.append(stream.truncated)
+                    beyond = _beyond(options.frames, first, first + configured)
+                    if beyond:
+                        rep.notes.append(beyond)
+                    if stream.out_of_order:
+                        again = sorted(set(stream.out_of_order))
+                        rep.notes.append(f"frames {again} appear more than once; the first complete copy was converted")
+                    rep.skipped.sort(key=lambda s: s["frames"][0])
+                    writer.finish(sorted(converted), rep.skipped)
+                except BaseException as exc:  # a stop, or an error: a file the writer holds open is closed
+                    with contextlib.suppress(Exception):
+                        writer.stop(interrupted=isinstance(exc, KeyboardInterrupt))
+                    raise
                 rep.notes += writer.notes
                 rep.frames_converted = len(converted)
                 if converted:

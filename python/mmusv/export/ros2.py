@@ -527,17 +527,26 @@ class Ros2Writer(DatasetWriter):
             mesh_use_embedded_materials=False,
         )
 
-    def finish(self, frames: list[int], skipped: list[dict[str, Any]]) -> None:
-        o = self.options
-        if o.max_occlusion != 1.0 or o.min_box_px != 0.0:
-            self.notes.append(
-                f"{self.boxes_left_out} 2D boxes left out of the Detection2DArray messages (max_occlusion = "
-                f"{o.max_occlusion:g}, min_box_px = {o.min_box_px:g}, on the recorded box and occlusion)"
-            )
-        super().finish(frames, skipped)
+    def stop(self, *, interrupted: bool) -> None:
+        """A stop: the bag is closed whole (summary, ``metadata.yaml``: a bag ``ros2 bag play`` and rosbags read)
+        holding the frames converted so far, their odometry included; an error: the bag is closed without its
+        summary (rosbags' ``abort``). Either way its file is closed: a Ctrl-C left it open, without
+        ``metadata.yaml``, to a Python session that went on."""
         if self.bag is None:
             return
-        for a in self.agents:  # each USV's last odometry, held for a successor that never came
+        if interrupted:
+            with contextlib.suppress(Exception):  # a disk that cannot take the rest: aborted below
+                self._close()
+                return
+        bag, self.bag = self.bag, None
+        if bag is not None:
+            with contextlib.suppress(Exception):
+                bag.abort()
+
+    def _close(self) -> None:
+        """Writes each USV's last odometry (held for a successor that never came) and the bag's custom data, and
+        closes the bag."""
+        for a in self.agents:
             self._odometry(a, None)
         self.bag.set_custom_data("mmusv.source", self.info.path.name)
         self.bag.set_custom_data("mmusv.scenario", self.info.scenario_name)
@@ -548,5 +557,17 @@ class Ros2Writer(DatasetWriter):
         except OSError as exc:
             raise self._failed(exc) from exc
         self.bag = None
+
+    def finish(self, frames: list[int], skipped: list[dict[str, Any]]) -> None:
+        o = self.options
+        if o.max_occlusion != 1.0 or o.min_box_px != 0.0:
+            self.notes.append(
+                f"{self.boxes_left_out} 2D boxes left out of the Detection2DArray messages (max_occlusion = "
+                f"{o.max_occlusion:g}, min_box_px = {o.min_box_px:g}, on the recorded box and occlusion)"
+            )
+        super().finish(frames, skipped)
+        if self.bag is None:
+            return
+        self._close()
         for p in sorted(self.folder.iterdir()):
             self.sink.count(p)

@@ -24,8 +24,8 @@ class DatasetWriter:
     :func:`mmusv.export.convert` reads, validates, splits and selects the frames of every recording, reports
     progress, and calls, in this order: :meth:`for_options` (the class to use), :meth:`check` (every recording,
     before anything is written), :meth:`start` (once: state shared by the recordings of one conversion), the
-    constructor, :meth:`write_frame` per complete frame, :meth:`finish` per recording and :meth:`finish_all`
-    (once). Subclasses set :attr:`cameras` (our camera
+    constructor, :meth:`write_frame` per complete frame, :meth:`finish` per recording (:meth:`stop` instead when
+    it ends early) and :meth:`finish_all` (once). Subclasses set :attr:`cameras` (our camera
     name → the dataset's index) and implement :meth:`write_agent` (or :meth:`write_frame`) and :meth:`finish`.
 
     By default an agent without a LiDAR is left out (with a note), as OPV2V and KITTI need one; a format that
@@ -171,6 +171,11 @@ class DatasetWriter:
 
     def write_agent(self, frame: Frame, world: WorldFrame, view: AgentView, targets: list[Target]) -> None:
         raise NotImplementedError
+
+    def stop(self, *, interrupted: bool) -> None:
+        """Called instead of :meth:`finish` when the conversion of this recording ends early: ``interrupted`` for a
+        stop (Ctrl-C, SIGTERM), else an error. A writer holding a file open closes it here (the files already
+        written stay, and ``conversion.yaml`` says the conversion was interrupted or failed); by default nothing."""
 
     def finish(self, frames: list[int], skipped: list[dict[str, Any]]) -> None:
         """Called once after the last frame with the converted frame indices and the skipped ranges."""
