@@ -31,7 +31,7 @@ pub use batch::KnownWater;
 mod lamps;
 pub use lamps::{Lamp, LAMP_GROUP_M};
 mod sea_routes;
-pub use sea_routes::SeaBeyond;
+pub use sea_routes::{PreparedSea, SeaBeyond};
 mod visit;
 mod waves;
 

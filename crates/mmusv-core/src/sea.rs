@@ -165,6 +165,14 @@ impl Sea {
         }
     }
 
+    /// Whether `other` holds the same height grid (extent, cells and heights): built from the same geometry.
+    #[cfg(test)]
+    pub(crate) fn same_grid(&self, other: &Sea) -> bool {
+        (self.x0, self.y0, self.cell, self.nx, self.ny) == (other.x0, other.y0, other.cell, other.nx, other.ny)
+            && self.fixed == other.fixed
+            && self.heights == other.heights
+    }
+
     /// Recomputes the bound from the static geometry and the moving instances' current world boxes.
     pub fn update(&mut self, moving_boxes: impl Iterator<Item = Box3>) {
         let mut grid = self.fixed.clone();

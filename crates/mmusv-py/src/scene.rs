@@ -281,9 +281,12 @@ impl Scene {
     #[pyo3(signature = (surface, moving))]
     fn set_sea(&self, py: Python<'_>, surface: u32, moving: PyReadonlyArray1<'_, u32>) -> PyResult<()> {
         let moving = flat(&moving, "moving")?.to_vec();
-        let mut scene = self.read(|s| Ok(s.clone()))?;
-        detached(py, || scene.set_sea(surface, &moving))?;
-        self.write(|s| *s = scene)
+        // Built on a snapshot with the GIL released, installed under the write lock: the install keeps a
+        // `set_poses` made meanwhile (writing the snapshot back lost it) and rebuilds a grid whose fixed geometry
+        // changed.
+        let snapshot = Arc::clone(&*self.inner.read().map_err(|_| poisoned())?);
+        let prepared = detached(py, || snapshot.prepare_sea(surface, &moving))?;
+        self.write(|s| s.install_sea(prepared))?.map_err(crate::errors::to_py)
     }
 
     /// Sets the displaced sea surface of the current frame (see mmusv_core::sea::WaveSurface): the wave field

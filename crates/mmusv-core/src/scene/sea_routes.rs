@@ -4,6 +4,7 @@
 use super::Scene;
 use crate::bvh::Box3;
 use crate::error::{MmusvError, Result};
+use crate::geometry::RigidPose;
 use crate::ray::RayPrep;
 use crate::sea::{Horizon, Sea, SunMask};
 
@@ -16,6 +17,17 @@ const SEA_WALK_SHADOW: usize = 2;
 /// Longest walk (cells) over the height map for the stretch of a rising ray among the waves.
 const SEA_WALK_LIFT: usize = 8;
 
+/// A sea surface built from one state of a scene by [`Scene::prepare_sea`], to be installed by
+/// [`Scene::install_sea`].
+#[derive(Debug, Clone)]
+pub struct PreparedSea {
+    surface: u32,
+    moving: Vec<u32>,
+    sea: Sea,
+    /// Mesh and pose of every instance when the grid was built (by instance id).
+    placed: Vec<(u32, RigidPose)>,
+}
+
 impl Scene {
     /// Declares instance `surface` the sea surface, so rays that can only meet it or the sky are answered
     /// without a full trace (see [`crate::sea`]); `moving` lists the instances that will move (vessels): the
@@ -24,6 +36,14 @@ impl Scene {
     ///
     /// The surface's world triangles must all lie at one height (a horizontal plane), else an input error.
     pub fn set_sea(&mut self, surface: u32, moving: &[u32]) -> Result<()> {
+        let prepared = self.prepare_sea(surface, moving)?;
+        self.install_sea(prepared)
+    }
+
+    /// The costly half of [`Scene::set_sea`]: builds the height grid of this state of the scene without
+    /// changing it, so that a caller can build on a snapshot outside its lock and install the result under it
+    /// ([`Scene::install_sea`]). Errors as [`Scene::set_sea`].
+    pub fn prepare_sea(&self, surface: u32, moving: &[u32]) -> Result<PreparedSea> {
         self.check_instance(surface)?;
         for &id in moving {
             self.check_instance(id)?;
@@ -53,7 +73,25 @@ impl Scene {
                 );
             }
         }
-        let mut sea = Sea::new(surface, level, bounds, moving.to_vec(), &fixed);
+        Ok(PreparedSea {
+            surface,
+            moving: moving.to_vec(),
+            sea: Sea::new(surface, level, bounds, moving.to_vec(), &fixed),
+            placed: self.instances.iter().map(|i| (i.mesh, i.pose)).collect(),
+        })
+    }
+
+    /// Installs a sea built by [`Scene::prepare_sea`], possibly on an earlier state of this scene: the moving
+    /// instances' boxes are taken as they are now, and a grid whose fixed geometry has changed since (an
+    /// instance added, or one not declared moving placed anew) is built again here. So a `set_poses` made while
+    /// the grid was built elsewhere is kept and counted.
+    pub fn install_sea(&mut self, prepared: PreparedSea) -> Result<()> {
+        let stale = prepared.placed.len() != self.instances.len()
+            || self.instances.iter().zip(&prepared.placed).enumerate().any(|(id, (inst, &(mesh, pose)))| {
+                !prepared.moving.contains(&(id as u32)) && (inst.mesh != mesh || inst.pose != pose)
+            });
+        let PreparedSea { moving, mut sea, .. } =
+            if stale { self.prepare_sea(prepared.surface, &prepared.moving)? } else { prepared };
         let boxes = &self.world_aabbs;
         sea.update(
             moving

@@ -279,6 +279,47 @@ fn sea_shortcuts_give_exactly_the_full_trace() {
     assert!(tilted.set_sea(1, &vessels).is_err());
 }
 
+/// A sea prepared on an earlier state of the scene ([`Scene::prepare_sea`], as the Python binding builds it on a
+/// snapshot with the GIL released) and installed after the vessels and the fixed terrain moved answers every ray
+/// as the full trace of the scene as it is now.
+#[test]
+fn a_sea_prepared_before_moves_installs_as_one_built_after_them() {
+    let (mut s, vessels) = sea_world();
+    let mut rng = ChaCha8Rng::seed_from_u64(22);
+    let prepared = s.prepare_sea(1, &vessels).unwrap_or_else(|e| unreachable!("{e}"));
+    scatter(&mut s, &vessels, &mut rng, [0.3, 0.02, -0.03]);
+    for moved_terrain in [false, true] {
+        if moved_terrain {
+            let pose = RigidPose::from_xyz_rpy([40.0, -30.0, 0.0], [0.0, 0.0, 0.3]);
+            s.set_poses(&[0], &[pose]).unwrap_or_else(|e| unreachable!("{e}"));
+        }
+        let mut with = s.clone();
+        with.install_sea(prepared.clone()).unwrap_or_else(|e| unreachable!("{e}"));
+        assert_eq!(with.sea_instance(), Some(1));
+        let (o, d) = sensor_rays(&mut rng, 20_000);
+        let full = s.cast_rays(&o, &d, 800.0).unwrap_or_default();
+        assert_eq!(full, with.cast_rays(&o, &d, 800.0).unwrap_or_default(), "terrain moved: {moved_terrain}");
+        let high: Vec<[f32; 3]> = o.iter().map(|p| [p[0], p[1], 150.0]).collect();
+        assert_eq!(s.cast_rays(&high, &d, 800.0).ok(), with.cast_rays(&high, &d, 800.0).ok());
+        // Shadow rays from the water towards a low sun, where the sun mask settles most.
+        let so: Vec<[f32; 3]> =
+            (0..40_000).map(|k| [(k % 200) as f32 * 3.0 - 300.0, (k / 200) as f32 * 3.0 - 300.0, 0.03]).collect();
+        let sd = vec![[0.8f32, 0.3, 0.35]; so.len()];
+        let want = s.occluded_rays(&so, &sd, 5000.0).unwrap_or_default();
+        let got = with.occluded_rays(&so, &sd, 5000.0).unwrap_or_default();
+        let differ = want.iter().zip(&got).filter(|(a, b)| a != b).count();
+        assert!(differ == 0 && got.len() == so.len(), "{differ} shadow rays differ (terrain moved: {moved_terrain})");
+        assert!(want.iter().filter(|&&b| b).count() > 500, "too few points in shade to tell");
+        if moved_terrain {
+            // the fixed geometry moved since the grid was built: built again, as a grid built now
+            let mut fresh = s.clone();
+            fresh.set_sea(1, &vessels).unwrap_or_else(|e| unreachable!("{e}"));
+            let same = matches!((&with.sea, &fresh.sea), (Some(a), Some(b)) if a.same_grid(b));
+            assert!(same, "the grid of the terrain where it was was installed");
+        }
+    }
+}
+
 /// With the sea declared and one sun direction (the sun mask settles rays from their origins alone), a bad
 /// origin is still an error naming it, and the settled rays are those of the full trace.
 #[test]
