@@ -107,3 +107,36 @@ def test_obj_faces_of_10_and_negative_indices_are_read(tmp_path: Path) -> None:
     faces = "f 1 2 3\nf 1 3 4\n# f 0 1 2\nf -4 -3 -2\nf 5/1/1 6/1/1 8/1/1\n" + "v 0 0 10\n" * 3 + "f 1 10 11\n"
     asset = _load_mesh(tmp_path, "hull.obj", _obj(faces))
     assert asset.num_triangles == 5  # type: ignore[attr-defined]
+
+
+# Coordinates past about 9.2e10 file units: trimesh merges vertices by their coordinates rounded to 1e-8 as int64,
+# which overflow there, so distinct vertices became one point; the mesh was refused for "no triangle of any area"
+# (the wrong reason) or lost faces. It is refused for its coordinates, naming the file and what is allowed.
+
+
+def test_a_mesh_with_coordinates_past_what_trimesh_can_merge_is_refused_for_them(tmp_path: Path) -> None:
+    mesh = tmp_path / "far.obj"  # a 6 x 2 x 1.5 hull 1e11 units out along x
+    k = 1.0e11
+    mesh.write_text(
+        f"v {k} 0 0\nv {k + 6e6} 0 0\nv {k + 6e6} 2e6 0\nv {k} 2e6 1.5e6\nf 1 2 3\nf 1 3 4\nf 1 2 4\n",
+        encoding="utf-8",
+    )
+    entry = {"name": "user_hull", "mesh": str(mesh), "up_axis": "z", "forward_axis": "x", "scale": 1e-6}
+    with pytest.raises(AssetSpecError) as info:
+        load_asset_file({**entry, "draft": 0.4})
+    msg = str(info.value)
+    assert info.value.field == "user_hull.mesh" and repr(str(mesh)) in msg and "\n" not in msg, msg
+    assert "1e+11 file units" in msg and "±9e+10" in msg and "no triangle" not in msg, msg
+
+
+def test_a_mesh_just_within_the_coordinates_is_read_whole(tmp_path: Path) -> None:
+    mesh = tmp_path / "near.obj"  # the same hull 8e10 units out: every vertex kept apart
+    k = 8.0e10
+    mesh.write_text(
+        f"v {k} 0 0\nv {k + 6e6} 0 0\nv {k + 6e6} 2e6 0\nv {k} 2e6 1.5e6\nf 1 2 3\nf 1 3 4\nf 1 2 4\n",
+        encoding="utf-8",
+    )
+    asset = load_asset_file(
+        {"name": "user_hull", "mesh": str(mesh), "up_axis": "z", "forward_axis": "x", "scale": 1e-6, "draft": 0.4}
+    )
+    assert asset.length == pytest.approx(6.0)

@@ -48,7 +48,13 @@ from mmusv.world.primitives import TriMesh
 if TYPE_CHECKING:
     from trimesh.resolvers import FilePathResolver
 
-__all__ = ["GLTF_EMISSIVE_SCALE", "load_mesh_file", "mesh_asset"]
+__all__ = ["GLTF_EMISSIVE_SCALE", "MAX_COORDINATE", "load_mesh_file", "mesh_asset"]
+
+
+MAX_COORDINATE = 9.0e10
+"""The largest vertex coordinate (file units) a mesh file may hold: trimesh merges vertices by their coordinates
+rounded to 1e-8 as 64-bit integers, which overflow past about 9.2e10, so distinct vertices there became one point
+(the mesh was then refused as holding "no triangle of any area", or lost faces)."""
 
 
 def _axis(name: str) -> np.ndarray:
@@ -264,6 +270,14 @@ def load_mesh_file(path: Path, where: str) -> tuple[np.ndarray, np.ndarray, np.n
                 where,
                 f"{str(path)!r} has non-finite (NaN/inf) coordinates at {int(bad.any(axis=-1).sum())} of its "
                 f"{len(g.vertices)} vertices; every vertex coordinate must be a finite number",
+            )
+        far = float(np.abs(np.asarray(g.vertices, dtype=np.float64)).max(initial=0.0))
+        if far > MAX_COORDINATE:
+            raise AssetSpecError(
+                where,
+                f"{str(path)!r} has a vertex coordinate of {far:.3g} file units; a mesh is read with coordinates "
+                f"within ±{MAX_COORDINATE:.2g} (past that, trimesh merges distinct vertices into one point): write it "
+                "in larger units and set scale, or move it nearer its origin",
             )
         faces = np.asarray(g.faces)
         outside = (faces < 0) | (faces >= len(g.vertices))
