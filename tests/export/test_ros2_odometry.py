@@ -115,3 +115,35 @@ def test_a_stopped_ros2_conversion_leaves_a_closed_bag_of_the_frames_converted(c
         clock = [t for c, t, _raw in r.messages() if c.topic == "/clock"]
         odom = [t for c, t, _raw in r.messages() if c.topic == "/usv_a/odom"]
     assert len(clock) == 2 and odom == clock  # frames 0 and 1, the odometry of frame 1 too
+
+
+def test_a_frame_that_comes_back_complete_after_later_ones_gets_its_odometry(coop_rec: Path, tmp_path: Path) -> None:
+    """Frame 1 recorded first without its /world/state (skipped as incomplete), then whole after frame 2:
+    the writer got frames 0, 2, 1, and the rates of times going back refused the conversion ('times: must
+    increase'). Each USV's odometry is written once a frame, each from the frames beside it in order of conversion."""
+    from mcap.reader import make_reader
+    from mcap.writer import CompressionType, Writer
+    from mcap_rechunk import write_records
+
+    with coop_rec.open("rb") as f:
+        reader = make_reader(f)
+        meta = [(m.name, dict(m.metadata)) for m in reader.iter_metadata()]
+        msgs = list(reader.iter_messages())
+    t1 = sorted({m.log_time for _, _, m in msgs})[1]
+    first = [t for t in msgs if not (t[2].log_time == t1 and t[1].topic == "/world/state")]
+    src = tmp_path / "in" / coop_rec.name
+    src.parent.mkdir()
+    with src.open("wb") as g:
+        w = Writer(g, compression=CompressionType.NONE)
+        write_records(w, meta, first + [t for t in msgs if t[2].log_time == t1])
+        w.finish()  # type: ignore[no-untyped-call]
+    rep = convert(src, to="ros2", out_dir=tmp_path / "o")
+    assert rep.frames == 3
+    with AnyReader([tmp_path / "o" / "export_coop"]) as r:
+        stamps = [t for c, t, _raw in r.messages() if c.topic == "/usv_b/odom"]
+    assert sorted(stamps) == sorted({t for _c, t, _raw in _messages_of(tmp_path / "o" / "export_coop", "/clock")})
+
+
+def _messages_of(bag: Path, topic: str) -> list[tuple[Any, int, bytes]]:
+    with AnyReader([bag]) as r:
+        return [(c, t, bytes(raw)) for c, t, raw in r.messages() if c.topic == topic]

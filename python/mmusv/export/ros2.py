@@ -230,7 +230,10 @@ class Ros2Writer(DatasetWriter):
         """Writes ``a``'s odometry of the frame before ``now`` (``None``: the last frame): the recording holds no
         angular velocity, so it is the body rate of the poses before and after (:func:`mmusv.frames.body_rates`),
         and an odometry message waits one frame for its successor. ``/<usv>/odom`` said angular 0 of a hull rolling
-        and pitching in the waves, and turning."""
+        and pitching in the waves, and turning. A frame earlier than the one held (a recording whose frames come out
+        of order) is no successor: the one held is written from the frames before it, and ``now`` starts afresh."""
+        if now is not None and self._odom.get(a.id) and now.time_s <= self._odom[a.id][-1].time_s:
+            self._odometry(a, None)
         held = self._odom.pop(a.id, [])
         if now is not None:
             self._odom[a.id] = [*held[-1:], now]  # (before, now): ``now`` is written with the next frame
