@@ -105,10 +105,23 @@ def refuse_replacing(
     ``names`` (paths relative to ``folder``) is already there, before any work: a command that writes files of
     fixed names into an existing folder (``mmusv assets --render``, ``mmusv study ... -o``) replaced a user's
     files of those names without a word. The message names the folder by ``flag``, the files and ``how`` to
-    replace them (``pass --overwrite``; ``overwrite=True`` for a Python caller)."""
+    replace them (``pass --overwrite``; ``overwrite=True`` for a Python caller). A folder (or another non-file) of
+    one of ``names`` is refused even with ``overwrite``, which replaces files only: it was named only when the
+    files were written, after the work (a whole study), and said to need ``--overwrite`` without it."""
+    base = Path(folder)
+    names = list(names)
+    blocked = [n for n in names if (base / n).exists() and not (base / n).is_file()]
+    if blocked:
+        shown = ", ".join(blocked[:4]) + (f" and {len(blocked) - 4} more" if len(blocked) > 4 else "")
+        one = len(blocked) == 1
+        what = "is a folder (or another non-file)" if one else "are folders (or other non-files)"
+        raise IoError(
+            f"{flag} {os.fspath(folder)}: {shown} {what}, "
+            f"where {'a file' if one else 'files'} of {'that name is' if one else 'those names are'} written; "
+            f"remove {'it' if one else 'them'}, or give another folder"
+        )
     if overwrite:
         return
-    base = Path(folder)
     taken = [n for n in names if os.path.lexists(base / n)]
     if not taken:
         return
