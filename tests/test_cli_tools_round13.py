@@ -47,3 +47,37 @@ def test_the_contact_sheet_names_a_folder_of_its_files_names_before_rendering(tm
         "written; remove it, or give another folder"
     )
     assert sorted(p.name for p in tmp_path.iterdir()) == ["contact_sheet.png"]  # no usv_wamv.png rendered
+
+
+def test_paths_holding_brackets_are_printed_as_they_are(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The commands' consoles read what they printed as rich markup: a recording under ``[/x]`` (or ``-o "[/x]"``)
+    ended ``mmusv info`` (``mmusv study``, ``generate``, ``run`` of a folder) with rich's MarkupError traceback,
+    after the files were written, and a folder ``out [old]`` was said as ``out /...``. Now printed as given."""
+    from mmusv.acquire import run
+    from tiny_scenario import lidar_scenario
+
+    folder = tmp_path / "[/x]" / "out [old]"
+    run(lidar_scenario("tiny", frames=1), out_dir=folder)
+    assert main(["info", str(folder / "tiny.mcap")]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith(f"{folder / 'tiny.mcap'}: scenario tiny, status complete, 1 frame, agents u\n"), out
+    waves = tmp_path / "[/x]" / "[red]waves"
+    assert main(["study", "waves", "--frames", "2", "-o", str(waves)]) == 0
+    out = capsys.readouterr().out
+    said = " ".join(out.split())  # (a line past the console's width is wrapped)
+    assert said.endswith(f"wrote {waves / 'wave_study.csv'} and {waves / 'wave_study.png'}"), said
+
+
+def test_the_styled_lines_keep_their_words(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The lines and cells styled on purpose (the generate report's quota column, an unfinished recording's note)
+    are shown with their words, not their markup."""
+    from mmusv.acquire import run
+    from tiny_scenario import lidar_scenario
+
+    run(lidar_scenario("tiny", frames=1), out_dir=tmp_path / "r")
+    partial = tmp_path / "tiny.mcap.partial"
+    partial.write_bytes((tmp_path / "r" / "tiny.mcap").read_bytes()[:-200])
+    main(["info", str(partial)])
+    out = capsys.readouterr().out
+    assert out.startswith("incomplete recording (.partial, no summary or damaged): counts come from reading every")
+    assert "[" not in out.splitlines()[1].replace(str(tmp_path), "")

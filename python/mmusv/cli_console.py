@@ -233,7 +233,10 @@ def memory_hint() -> str:
 
 def rich_console() -> Console:
     """A rich console for a command's tables; wide when not writing to a terminal, so piped tables are not
-    wrapped."""
+    wrapped. What it prints is taken as it is, not as rich markup: a path or name holding brackets was read as
+    markup, so ``-o "out [old]"`` was said as ``out /...`` and ``-o "[/x]"`` ended the command with rich's
+    MarkupError traceback after its files were written. A styled line passes ``markup=True`` and escapes what it
+    embeds (:func:`rich.markup.escape`), or is a :class:`rich.text.Text`."""
     from rich.console import Console
 
-    return Console(width=None if sys.stdout.isatty() else 160)
+    return Console(width=None if sys.stdout.isatty() else 160, markup=False)

@@ -57,7 +57,8 @@ def cmd_info(args: argparse.Namespace) -> int:
     if not info.get("complete", True):
         console.print(
             "[yellow]incomplete recording (.partial, no summary or damaged): counts come from reading every "
-            "chunk[/yellow]"
+            "chunk[/yellow]",
+            markup=True,
         )
     if info.get("frames") is None:  # an MCAP file, but not a recording of mmusv run: its messages only
         why = (
@@ -65,7 +66,7 @@ def cmd_info(args: argparse.Namespace) -> int:
             if info.get("metadata_problem")
             else "an MCAP file not written by mmusv run (no scenario/sensors metadata)"
         )
-        console.print(f"[bold]{target}[/bold]: {why}: its messages only", markup=True, highlight=False)
+        console.print(Text.assemble((str(target), "bold"), f": {why}: its messages only"), highlight=False)
     else:
         written = run_meta.get("frames_written", "?")
         if frames:  # the complete frames read: a killed run's .partial has no run metadata saying it ("? frames")
@@ -76,10 +77,12 @@ def cmd_info(args: argparse.Namespace) -> int:
         else:
             written = f"{written} frames"
         console.print(
-            f"[bold]{target}[/bold]: scenario {run_meta.get('scenario') or _scenario_of(meta, target)}, "
-            f"status {run_meta.get('status', 'unfinished (no run metadata: the run was killed or is still going)')}, "
-            f"{written}, agents {run_meta.get('agents') or _agents_of(meta)}",
-            markup=True,
+            Text.assemble(
+                (str(target), "bold"),
+                f": scenario {run_meta.get('scenario') or _scenario_of(meta, target)}, "
+                f"status {run_meta.get('status', 'unfinished (no run metadata: the run was killed or is still going)')}"
+                f", {written}, agents {run_meta.get('agents') or _agents_of(meta)}",
+            ),
             highlight=False,
         )
     start, end = info.get("start_ns", 0), info.get("end_ns", 0)

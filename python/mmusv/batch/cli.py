@@ -126,6 +126,7 @@ def _resume_hint(args: argparse.Namespace) -> Iterator[None]:
 def print_report(report: BatchReport, console: Console) -> None:
     """The table of a batch run, its warnings and the summary line."""
     from rich.table import Table
+    from rich.text import Text
 
     table = Table(
         title=f"mmusv run: {counted(len(report.outcomes), 'scenario')} on {report.backend} -> {report.out_dir}"
@@ -146,7 +147,7 @@ def print_report(report: BatchReport, console: Console) -> None:
             result = f"{counted(o.frames, 'frame')} in {o.seconds:.1f} s -> {where(o.recording)}"
         table.add_row(
             o.file.name,
-            f"[{colour[o.status]}]{o.status}[/{colour[o.status]}]",
+            Text(o.status, style=colour[o.status]),
             f"{o.frames}/{o.frames_requested}",
             str(o.parts),
             str(o.retried),

@@ -133,6 +133,7 @@ class RunReport:
     def print(self, console: Console) -> None:
         """A rich table: one row per combination, then the totals and the unmet quotas' reasons."""
         from rich.table import Table
+        from rich.text import Text
 
         names = [*self.constraints, "sampling", "schema"]
         shown = [n for n in names if any(n in c.rejected for c in self.combos)]
@@ -146,7 +147,7 @@ class RunReport:
                 str(c.accepted),
                 str(c.attempts),
                 *(str(c.rejected.get(n, 0)) for n in shown),
-                "[green]yes[/]" if c.met else "[red]no[/]",
+                Text("yes", style="green") if c.met else Text("no", style="red"),
             )
         rej = self.rejected
         table.add_row(
@@ -161,4 +162,4 @@ class RunReport:
         console.print(table)
         for c in self.combos:
             if not c.met:
-                console.print(f"[red]quota not met[/] {c.name}: {c.why()}")
+                console.print(Text.assemble(("quota not met", "red"), f" {c.name}: {c.why()}"))

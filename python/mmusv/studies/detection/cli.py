@@ -9,7 +9,6 @@ point as one line (exit status 2).
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -188,9 +187,10 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
-    from rich.console import Console
+    from rich.text import Text
 
     from mmusv import arguments
+    from mmusv.cli_console import rich_console
     from mmusv.cli_paths import check_output_folder, path_arg
     from mmusv.errors import InputError
     from mmusv.learn.cli import check_threads, split_ratios
@@ -202,7 +202,7 @@ def _run(args: argparse.Namespace) -> int:
     from mmusv.studies.detection.study import StudyOptions, check_prediction_coverage, load_predictions, run_study
 
     robust = args.study == "robustness"
-    console = Console(width=None if sys.stdout.isatty() else 160)
+    console = rich_console()  # text as it is: a path holding brackets is no markup
     learned = None
     tri = {"auto": None, "on": True, "off": False}
     if args.jobs < 1:
@@ -302,7 +302,7 @@ def _run(args: argparse.Namespace) -> int:
                 shortfall=shortfalls.append,
             )
         for line in shortfalls[1:]:
-            console.print(f"[yellow]generate: {escape(line)}[/]", highlight=False)
+            console.print(f"[yellow]generate: {escape(line)}[/]", markup=True, highlight=False)
         short = f" (quotas not met: {shortfalls[0]})" if shortfalls else ""
         console.print(
             f"dataset: {counted(len(inputs), 'recording')} "
@@ -320,7 +320,7 @@ def _run(args: argparse.Namespace) -> int:
             learned_notes.append(f"warning: {mixed}")
         leak = _training_overlap(learned, dataset)
         if leak:
-            console.print(f"[yellow]{escape(leak)}[/]", highlight=False)
+            console.print(f"[yellow]{escape(leak)}[/]", markup=True, highlight=False)
             learned_notes.append(leak)
     from mmusv.studies.detection import report
 
@@ -377,7 +377,7 @@ def _run(args: argparse.Namespace) -> int:
             )
         eval_s = time.perf_counter() - t1
         if len(runs) > 1:
-            console.print(f"[bold]{name}[/]", highlight=False)
+            console.print(Text(name, style="bold"), highlight=False)
         notes = learned_notes if det is learned and learned is not None else []
         if robust:
             made = report.robustness_files(res, run_out, detector=name, notes=notes)
@@ -390,7 +390,7 @@ def _run(args: argparse.Namespace) -> int:
         if lone is not None:
             from rich.markup import escape
 
-            console.print(f"[yellow]{escape(lone)}[/]", highlight=False)
+            console.print(f"[yellow]{escape(lone)}[/]", markup=True, highlight=False)
         if det is learned and learned is not None:
             console.print(f"learned models: {learned.describe()}", highlight=False)
             if learned.shared_bytes:
@@ -401,7 +401,7 @@ def _run(args: argparse.Namespace) -> int:
                     highlight=False,
                 )
         elif det is not None and name == "baseline":
-            console.print(f"[yellow]{BASELINE_NOTE}[/]")
+            console.print(Text(BASELINE_NOTE, style="yellow"))
         if any(m == "late" for m in run_modes):
             console.print(f"late fusion merge: {args.late_merge}", highlight=False)
         console.print(
