@@ -99,6 +99,7 @@ def scenario_files(source: str | os.PathLike[str] | Sequence[str | os.PathLike[s
     if isinstance(source, (str, os.PathLike)):
         src = arguments.path(source, name="source")
         if src.is_dir():
+            _check_generated_whole(src)
             files = folder_entries(src)
             if not files:
                 below = next((d.name for d in sorted(src.iterdir()) if d.is_dir() and folder_entries(d)), None)
@@ -124,6 +125,20 @@ def scenario_files(source: str | os.PathLike[str] | Sequence[str | os.PathLike[s
             raise ConfigError(f"{f}: no such scenario file")
     _check_stems(files)
     return sorted((_absolute(f) for f in files), key=lambda f: f.stem)
+
+
+def _check_generated_whole(folder: Path) -> None:
+    """A folder a ``mmusv generate`` run was stopped in (its journal :data:`mmusv.generate.runner.JOURNAL` left,
+    its ``report.json`` not written) holds part of a set: a :class:`~mmusv.errors.ConfigError` saying how to go on.
+    Its scenarios were recorded and ``dataset.json`` written as for the whole set, without a word."""
+    from mmusv.generate.runner import JOURNAL
+
+    if (folder / JOURNAL).exists():
+        raise ConfigError(
+            f"{folder} holds part of a generated set: its mmusv generate run was stopped before the end ({JOURNAL} "
+            "is there, report.json is not); run mmusv generate again with --force to generate the whole set, or "
+            f"remove {folder / JOURNAL} to record the scenarios there as they are"
+        )
 
 
 def folder_entries(folder: Path) -> list[Path]:
