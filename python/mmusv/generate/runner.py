@@ -121,11 +121,14 @@ def _existing(out: Path, force: bool, spec_path: Path | None) -> tuple[list[Path
                 f"its {what}: move it away"
             )
     yamls = sorted(out.glob("*.yaml"))
-    if not yamls and not report.is_file():  # a journal alone: a run stopped before its first file
+    # generate writes .yaml only, but ``mmusv run`` of the folder records its .yml files too: each is foreign (a
+    # user's .yml there was accepted and recorded with the set)
+    ymls = sorted(out.glob("*.yml"))
+    if not yamls and not ymls and not report.is_file():  # a journal alone: a run stopped before its first file
         return None
     ours = _generated_here(report) | _journal_names(journal)
-    is_spec = [p for p in yamls if spec_path is not None and _same_file(p, spec_path)]
-    foreign = [p for p in yamls if p.name not in ours or p in is_spec]
+    is_spec = [p for p in [*yamls, *ymls] if spec_path is not None and _same_file(p, spec_path)]
+    foreign = sorted([p for p in yamls if p.name not in ours or p in is_spec] + ymls)
     if foreign:  # --force would not replace them either: say so at once, not after a first refusal
         names = ", ".join(p.name for p in foreign[:3]) + (" ..." if len(foreign) > 3 else "")
         raise IoError(
