@@ -5,6 +5,10 @@ Pydantic's lax mode reads ``true`` as 1 for an int or float field: ``frames: tru
 ``speed_mps: true`` sail at 1 m/s without a word. Here a boolean is refused wherever the field does not take one,
 also inside a field's lists, tuples and mappings (a waypoint ``[true, 0]`` sailed to x = 1): :class:`StrictModel`
 for the models, :func:`bool_for_a_number` for a model that needs other settings.
+
+Values from numpy (a seed drawn with ``rng.integers``, a route as an array) are taken as the Python values they
+stand for first: pydantic reads a numpy integer through a float, so ``np.int64(2**62 + 1)`` became the seed
+``2**62`` without a word and ``np.int64(2**63 - 1)`` was refused as too large; and ``np.True_`` is a boolean, not 1.
 """
 
 from __future__ import annotations
@@ -14,9 +18,10 @@ import typing
 from collections import abc
 from typing import Any
 
+import numpy as np
 from pydantic import BaseModel, ConfigDict, ValidationInfo, field_validator
 
-__all__ = ["StrictModel", "bool_for_a_number"]
+__all__ = ["StrictModel", "bool_for_a_number", "python_values"]
 
 
 class StrictModel(BaseModel):
@@ -31,13 +36,29 @@ class StrictModel(BaseModel):
 
 
 def bool_for_a_number(model: type[BaseModel], v: Any, info: ValidationInfo) -> Any:
-    """``v`` unchanged, or ``ValueError`` when it is, or holds where a number goes (in a list, tuple or mapping of
-    the field's type), ``true``/``false``: the body of a ``field_validator("*", mode="before")`` of ``model``."""
+    """``v`` with numpy values as Python's (:func:`python_values`), or ``ValueError`` when it is, or holds where a
+    number goes (in a list, tuple or mapping of the field's type), ``true``/``false`` (Python's or numpy's): the
+    body of a ``field_validator("*", mode="before")`` of ``model``."""
+    v = python_values(v)
     if info.field_name is None:
         return v
     field = model.model_fields.get(info.field_name)
     if field is not None and _bool_for_number(field.annotation, v):
         raise ValueError("a number is expected, not true/false")
+    return v
+
+
+def python_values(v: Any) -> Any:
+    """``v`` with numpy scalars and arrays, also inside lists, tuples and mappings, as the Python values they hold
+    (``np.int64`` an exact ``int``, ``np.bool_`` a ``bool``, an array its nested lists); anything else unchanged."""
+    if isinstance(v, np.ndarray):
+        return v.tolist()
+    if isinstance(v, np.generic):
+        return v.item() if isinstance(v, (np.bool_, np.integer, np.floating)) else v
+    if isinstance(v, (list, tuple)) and any(isinstance(x, (np.generic, np.ndarray, list, tuple, dict)) for x in v):
+        return type(v)(python_values(x) for x in v) if type(v) in (list, tuple) else v
+    if type(v) is dict and any(isinstance(x, (np.generic, np.ndarray, list, tuple, dict)) for x in v.values()):
+        return {k: python_values(x) for k, x in v.items()}
     return v
 
 

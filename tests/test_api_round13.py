@@ -1,0 +1,61 @@
+"""Round 13 of the API review: what a perception researcher's script hands mmusv from numpy, and the public helpers'
+refusals of input they cannot use."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from mmusv.config import load_scenario
+from mmusv.errors import ConfigError
+from tiny_scenario import lidar_scenario
+
+# ------------------------------------------------------------------------------------ numpy values in a config
+
+
+@pytest.mark.parametrize("seed", [np.int64(2**62 + 1), np.uint64(2**53 + 1), np.int64(2**63 - 1)])
+def test_a_numpy_integer_seed_is_taken_exactly(seed: np.integer) -> None:
+    """Pydantic read a numpy integer through a float: ``seed: np.int64(2**62 + 1)`` (drawn with ``rng.integers``)
+    became ``2**62`` without a word (another scenario's seed, recorded in its manifest), and ``np.int64(2**63 -
+    1)``, the largest seed allowed, was refused as 'Unable to parse input string as an integer'."""
+    doc = lidar_scenario("np_seed", frames=1)
+    doc["seed"] = seed
+    doc["map"]["seed"] = seed
+    sc = load_scenario(doc)
+    assert sc.seed == int(seed) and type(sc.seed) is int
+    assert sc.map.seed == int(seed)
+
+
+@pytest.mark.parametrize(
+    ("where", "field"),
+    [
+        (lambda d: d.__setitem__("seed", np.True_), "seed"),
+        (lambda d: d["vessels"][0].__setitem__("speed_mps", np.True_), "vessels[0].speed_mps"),
+        (lambda d: d["rigs"]["r"]["lidar"].__setitem__("channels", np.True_), "rigs.r.lidar.channels"),
+        (lambda d: d["vessels"][0].__setitem__("route", [[np.False_, 0], [50, 0]]), "vessels[0].route"),
+        (
+            lambda d: d["rigs"]["r"]["lidar"].__setitem__("elevations_deg", np.array([True, False] * 4)),
+            "rigs.r.lidar.elevations_deg",
+        ),
+    ],
+)
+def test_a_numpy_boolean_is_not_a_number(where: object, field: str) -> None:
+    """``true`` is never read as a number (mmusv.strict), but numpy's ``np.True_`` was: a seed of 1, a USV at 1
+    m/s, a LiDAR of 1 channel, and a boolean array of elevations said to 'repeat [0.0, 1.0]'."""
+    doc = lidar_scenario("np_bool", frames=1)
+    where(doc)  # type: ignore[operator]
+    with pytest.raises(ConfigError, match=r"a number is expected, not true/false") as e:
+        load_scenario(doc)
+    assert f"{field} = " in str(e.value)
+
+
+def test_numpy_values_that_are_numbers_still_load() -> None:
+    """Numpy scalars and arrays where numbers go load as the numbers they hold."""
+    doc = lidar_scenario("np_ok", frames=1)
+    doc["acquisition"]["frames"] = np.int8(3)
+    doc["acquisition"]["frequency_hz"] = np.float32(5.0)
+    doc["vessels"][0]["route"] = np.array([[0, 0], [50, 0]], dtype=np.int64)
+    doc["rigs"]["r"]["lidar"]["channels"] = np.uint16(8)
+    sc = load_scenario(doc)
+    assert sc.acquisition.frames == 3 and sc.acquisition.frequency_hz == 5.0
+    assert sc.vessels[0].route == [(0.0, 0.0), (50.0, 0.0)]
+    assert sc.rigs["r"].lidar is not None and sc.rigs["r"].lidar.channels == 8
