@@ -3,10 +3,14 @@ refusals of input they cannot use."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 import pytest
+from mmusv import frames
 from mmusv.config import load_scenario
-from mmusv.errors import ConfigError
+from mmusv.errors import ConfigError, InputError
 from tiny_scenario import lidar_scenario
 
 # ------------------------------------------------------------------------------------ numpy values in a config
@@ -59,3 +63,40 @@ def test_numpy_values_that_are_numbers_still_load() -> None:
     assert sc.acquisition.frames == 3 and sc.acquisition.frequency_hz == 5.0
     assert sc.vessels[0].route == [(0.0, 0.0), (50.0, 0.0)]
     assert sc.rigs["r"].lidar is not None and sc.rigs["r"].lidar.channels == 8
+
+
+# ------------------------------------------------------------------------------------------------ mmusv.frames
+
+
+@pytest.mark.parametrize(
+    ("call", "words"),
+    [
+        (lambda: frames.carla_rotation(roll_deg="a", yaw_deg=0.0, pitch_deg=0.0), "roll_deg must be angles"),
+        (lambda: frames.carla_rotation(roll_deg=0.0, yaw_deg=None, pitch_deg=0.0), "yaw_deg must be angles"),
+        (lambda: frames.carla_rotation(roll_deg=[1.0, 2.0], yaw_deg=[1.0, 2.0, 3.0], pitch_deg=0.0), "broadcast"),
+        (lambda: frames.wrap_deg("a"), "a must be angles in degrees"),
+        (lambda: frames.wrap_deg(None), "a must be angles in degrees"),
+        (lambda: frames.wrap_rad([1.0, None]), "a must be angles in radians"),
+        (lambda: frames.pose_matrices([0.0, 0.0, 0.0, 0.0, 0.0, None]), "eta .* it holds None"),
+        (lambda: frames.translation([True, False, True]), "v must be 3 numbers .* true/false"),
+        (lambda: frames.translation(np.array([1.0, 2.0, 3.0]) + 1j), "complex"),
+        (lambda: frames.body_rates([0.0, 1.0], np.zeros((2, 3, 3))), "rotations must be rotation matrices"),
+    ],
+)
+def test_the_frames_helpers_refuse_what_is_not_a_real_number(call: Callable[[], Any], words: str) -> None:
+    """mmusv.frames promises an InputError naming the argument for values that are not numbers: ``carla_rotation``,
+    ``wrap_deg`` and ``wrap_rad`` raised numpy's bare ValueError for text ('could not convert string to float')
+    and for angles of shapes that do not broadcast, and took ``None`` as NaN; the other helpers took ``None`` as
+    NaN, ``True`` as 1 and a complex number as its real part (after a ComplexWarning); ``body_rates`` of a matrix
+    that is no rotation ended in scipy's ValueError."""
+    with pytest.raises(InputError, match=words):
+        call()
+
+
+def test_the_frames_helpers_still_take_numbers_of_any_kind() -> None:
+    """Ints, numpy floats and lists of them are real numbers."""
+    np.testing.assert_allclose(frames.wrap_deg([540, np.float32(-190.0)]), [180.0, 170.0])
+    np.testing.assert_allclose(frames.wrap_rad(np.int64(0)), 0.0)
+    rot = frames.carla_rotation(roll_deg=[0, 0], yaw_deg=np.float32(90.0), pitch_deg=0)
+    assert rot.shape == (2, 3, 3)
+    np.testing.assert_allclose(frames.translation([1, np.float32(2.0), 3.0])[:3, 3], [1.0, 2.0, 3.0])

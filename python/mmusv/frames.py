@@ -28,6 +28,8 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from mmusv import arguments
+from mmusv.arguments import is_number
 from mmusv.errors import InputError
 
 __all__ = [
@@ -62,11 +64,25 @@ OPTICAL_IN_BODY[:3, :3] = BODY_TO_OPTICAL.T
 """``(4, 4)`` float64 optical frame → camera body frame (the inverse of :data:`BODY_TO_OPTICAL`, homogeneous)."""
 
 
+_KINDS = {"b": "true/false", "U": "text", "S": "bytes", "c": "complex numbers"}
+"""What a numpy array of each dtype kind holds, said where real numbers go."""
+
+
 def _floats(value: Any, *, name: str, tail: tuple[int, ...], what: str) -> np.ndarray:
     """``value`` as a float64 array whose last axes are ``tail``, else an :class:`InputError` naming ``name``
     and the shape ``what`` it must have."""
     try:
-        a = np.asarray(value, dtype=np.float64)
+        raw = np.asarray(value)
+        # Only real numbers: a None (NaN as float64), a bool, text ("1.5" converts) or a complex number (its
+        # imaginary part dropped) would be read as a number without a word.
+        kind = raw.dtype.kind
+        if kind == "O":
+            bad = [x for x in raw.flat if not is_number(x)][:1]
+            if bad:
+                raise TypeError(f"it holds {arguments.shown(bad[0])}")
+        elif kind not in "iuf":
+            raise TypeError(f"it holds {_KINDS.get(kind, f'{raw.dtype} values')}")
+        a = np.asarray(raw, dtype=np.float64)
     except (TypeError, ValueError) as exc:
         raise InputError(f"{name} must be {what} of real numbers: {exc}") from None
     if a.ndim < len(tail) or a.shape[a.ndim - len(tail) :] != tail:
@@ -127,7 +143,10 @@ def body_rates(times: npt.ArrayLike, rotations: npt.ArrayLike) -> np.ndarray:
     steps = np.diff(t)
     if not np.all(steps > 0):
         raise InputError("times: must increase")
-    rot = Rotation.from_matrix(r)
+    try:
+        rot = Rotation.from_matrix(r)
+    except ValueError as exc:  # scipy's: a matrix of determinant <= 0 (a mirror, zeros) is no rotation
+        raise InputError(f"rotations must be rotation matrices: {exc}") from None
     step_rates = (rot[:-1].inv() * rot[1:]).as_rotvec() / steps[:, None]  # R_k^T R_{k+1}: body axes
     omega = np.empty((n, 3))
     omega[0], omega[-1] = step_rates[0], step_rates[-1]
@@ -201,9 +220,13 @@ def mirror_transform(m: npt.ArrayLike) -> np.ndarray:
 def carla_rotation(*, roll_deg: npt.ArrayLike, yaw_deg: npt.ArrayLike, pitch_deg: npt.ArrayLike) -> np.ndarray:
     """``(..., 3, 3)`` float64 rotation (left-handed CARLA frame) that CARLA/OpenCOOD loaders build from
     ``[roll, yaw, pitch]`` degrees, three arrays that broadcast together to ``...``."""
-    r, y, p = np.broadcast_arrays(
-        *(np.radians(np.asarray(a, dtype=np.float64)) for a in (roll_deg, yaw_deg, pitch_deg))
-    )
+    angles = {"roll_deg": roll_deg, "yaw_deg": yaw_deg, "pitch_deg": pitch_deg}
+    given = [_floats(a, name=k, tail=(), what="angles in degrees") for k, a in angles.items()]
+    try:
+        r, y, p = np.broadcast_arrays(*(np.radians(a) for a in given))
+    except ValueError:
+        shapes = ", ".join(f"{k} {a.shape}" for k, a in zip(angles, given, strict=True))
+        raise InputError(f"roll_deg, yaw_deg and pitch_deg must broadcast together; got {shapes}") from None
     cr, sr, cy, sy, cp, sp = np.cos(r), np.sin(r), np.cos(y), np.sin(y), np.cos(p), np.sin(p)
     rows = [
         [cp * cy, cy * sp * sr - sy * cr, -cy * sp * cr - sy * sr],
@@ -267,11 +290,11 @@ def x1_to_x2(pose1: npt.ArrayLike, pose2: npt.ArrayLike) -> np.ndarray:
 
 def wrap_deg(a: npt.ArrayLike) -> np.ndarray:
     """float64 angles in degrees wrapped to (-180, 180], the shape of ``a``."""
-    w: np.ndarray = 180.0 - np.mod(180.0 - np.asarray(a, dtype=np.float64), 360.0)
+    w: np.ndarray = 180.0 - np.mod(180.0 - _floats(a, name="a", tail=(), what="angles in degrees"), 360.0)
     return w
 
 
 def wrap_rad(a: npt.ArrayLike) -> np.ndarray:
     """float64 angles in radians wrapped to (-π, π], the shape of ``a``."""
-    w: np.ndarray = math.pi - np.mod(math.pi - np.asarray(a, dtype=np.float64), 2 * math.pi)
+    w: np.ndarray = math.pi - np.mod(math.pi - _floats(a, name="a", tail=(), what="angles in radians"), 2 * math.pi)
     return w
