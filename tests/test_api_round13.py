@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 import pytest
 from mmusv import frames
+from mmusv.annotate import box_corners, footprint_in_range, in_target_range
 from mmusv.config import load_scenario
 from mmusv.errors import ConfigError, InputError
 from tiny_scenario import lidar_scenario
@@ -100,3 +101,39 @@ def test_the_frames_helpers_still_take_numbers_of_any_kind() -> None:
     rot = frames.carla_rotation(roll_deg=[0, 0], yaw_deg=np.float32(90.0), pitch_deg=0)
     assert rot.shape == (2, 3, 3)
     np.testing.assert_allclose(frames.translation([1, np.float32(2.0), 3.0])[:3, 3], [1.0, 2.0, 3.0])
+
+
+# ------------------------------------------------------------------------------------ mmusv.annotate's helpers
+
+
+@pytest.mark.parametrize(
+    ("call", "words"),
+    [
+        (lambda: in_target_range(np.zeros((2, 3)), "200"), "range_m = '200': must be a number of metres"),
+        (lambda: in_target_range(np.zeros((2, 3)), None), "range_m = None"),
+        (lambda: in_target_range(np.zeros((2, 3)), float("nan")), "range_m = nan"),
+        (lambda: in_target_range(np.zeros((2, 3)), -5.0), "range_m = -5.0: must be .* >= 0"),
+        (lambda: in_target_range("ab", 200.0), "centres must be .* it holds text"),
+        (lambda: footprint_in_range(np.eye(3), size=np.ones(3), range_m=200.0), r"box must be a \(4, 4\)"),
+        (lambda: footprint_in_range(np.eye(4), size=[1.0], range_m=200.0), r"\(3,\) or \(2,\) size"),
+        (lambda: footprint_in_range(np.eye(4), size=np.ones(3), range_m=float("nan")), "range_m = nan"),
+        (lambda: box_corners("a", [1.0, 2.0, 3.0]), "matrix must be .* it holds text"),
+        (lambda: box_corners(np.eye(4), [1.0, None, 3.0]), "size must be .* it holds None"),
+    ],
+)
+def test_the_annotation_helpers_refuse_what_they_cannot_use(call: Callable[[], Any], words: str) -> None:
+    """``in_target_range``, ``footprint_in_range`` and ``box_corners`` (mmusv.annotate's public target rules and
+    box corners, which the exports and the detection study use) ended in numpy's bare UFuncTypeError for a range
+    given as text, a TypeError for None, an IndexError for a (3, 3) box or a size of one entry, and a ValueError
+    for text; a NaN or negative range put every target out of range without a word. Each is an InputError naming
+    the argument."""
+    with pytest.raises(InputError, match=words):
+        call()
+
+
+def test_the_annotation_helpers_still_take_what_they_document() -> None:
+    """Lists, numpy numbers, an infinite range (every box) and a BEV size of two entries still work."""
+    assert in_target_range([[1.0, 2.0, 3.0]], np.float32(5.0)).tolist() == [True]
+    assert in_target_range(np.array([1e9, 0.0]), float("inf"))
+    assert footprint_in_range(np.eye(4).tolist(), size=[4.0, 2.0], range_m=0)
+    assert box_corners(np.eye(4).tolist(), [2, 2, 2]).shape == (8, 3)

@@ -37,9 +37,10 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from mmusv import arguments
 from mmusv._equality import same
 from mmusv.errors import InputError
-from mmusv.frames import BODY_TO_OPTICAL, translation
+from mmusv.frames import BODY_TO_OPTICAL, _floats, translation
 from mmusv.image_boxes import (
     camera_lens,
     clip_box,
@@ -88,10 +89,15 @@ def in_target_range(centres: np.ndarray, range_m: float) -> np.ndarray:
     vessel whose footprint comes within range (:func:`footprint_in_range`), and the ROS 2 export's 3D detections are
     those boxes.
     """
-    c = np.asarray(centres, dtype=np.float64)
+    c = _floats(centres, name="centres", tail=(), what="(..., 3) or (..., 2) centres (x, y[, z] metres)")
     if c.ndim == 0 or c.shape[-1] not in (2, 3):
         raise InputError(f"centres must have shape (..., 3) or (..., 2) (x, y[, z] metres), got {c.shape}")
-    return np.asarray(np.hypot(c[..., 0], c[..., 1]) <= range_m)
+    return np.asarray(np.hypot(c[..., 0], c[..., 1]) <= _range(range_m))
+
+
+def _range(range_m: Any) -> float:
+    """A target range, metres: a real number, not negative (infinite: every box)."""
+    return arguments.real(range_m, name="range_m", unit="metres", lo=0.0, finite=False, error=InputError)
 
 
 def footprint_in_range(box: np.ndarray, *, size: np.ndarray, range_m: float) -> bool:
@@ -102,7 +108,13 @@ def footprint_in_range(box: np.ndarray, *, size: np.ndarray, range_m: float) -> 
     The annotations' rule (:func:`annotate_agent`): a 330 m ship whose stern lies 45 m from the USV has its centre
     beyond a 200 m LiDAR's range, yet the LiDAR sees it; the centre rule of :func:`in_target_range` stays the
     exports' and the detection study's (OpenCOOD's convention)."""
-    m = np.asarray(box, dtype=np.float64)
+    m = _floats(box, name="box", tail=(4, 4), what="a (4, 4) box -> ego LiDAR transform")
+    size = _floats(size, name="size", tail=(), what="the box's size (length, beam[, height])")
+    if m.ndim != 2 or size.shape not in ((2,), (3,)):
+        raise InputError(
+            f"footprint_in_range takes a (4, 4) box and a (3,) or (2,) size, got {m.shape} and {size.shape}"
+        )
+    range_m = _range(range_m)
     yaw = np.arctan2(m[1, 0], m[0, 0])
     c, s = np.cos(yaw), np.sin(yaw)
     # The origin in the box's yaw-only frame, then its distance to the rectangle (0 inside).
@@ -118,7 +130,8 @@ def box_corners(matrix: np.ndarray, size: np.ndarray) -> np.ndarray:
     (length, beam, height along the box's x, y, z; metres), in the frame ``matrix`` maps to. Corner ``i`` lies at
     ``±size / 2`` in the box frame, the sign of x from bit 0 of ``i``, of y from bit 1 and of z from bit 2 (set:
     +; corner 0 is (−x, −y, −z), corner 7 (+x, +y, +z)). Other shapes raise :class:`mmusv.InputError`."""
-    matrix, size = np.asarray(matrix, dtype=np.float64), np.asarray(size, dtype=np.float64)
+    matrix = _floats(matrix, name="matrix", tail=(), what="a (4, 4) box pose")
+    size = _floats(size, name="size", tail=(), what="the box's (3,) size (length, beam, height)")
     if matrix.shape != (4, 4) or size.shape != (3,):
         raise InputError(f"box_corners takes a (4, 4) matrix and a (3,) size, got {matrix.shape} and {size.shape}")
     local = _SIGNS * (size / 2.0)
