@@ -221,10 +221,15 @@ class Ros2Writer(DatasetWriter):
     def _failed(self, exc: OSError) -> OSError:
         """After a failed write of the bag (a full disk): the bag closed without its summary (rosbags' ``abort``; its
         file was left open) and ``exc`` naming the bag's file (rosbags' ``OSError`` names none)."""
-        bag, self.bag = self.bag, None
-        with contextlib.suppress(Exception):
-            bag.abort()
+        self._abort()
         return naming(exc, self.folder / f"{self.folder.name}.mcap")
+
+    def _abort(self) -> None:
+        """Closes the bag's file without its summary (rosbags' ``abort``), if a bag is open."""
+        bag, self.bag = self.bag, None
+        if bag is not None:
+            with contextlib.suppress(Exception):
+                bag.abort()
 
     def _odometry(self, a: AgentInfo, now: _Odom | None) -> None:
         """Writes ``a``'s odometry of the frame before ``now`` (``None``: the last frame): the recording holds no
@@ -541,10 +546,7 @@ class Ros2Writer(DatasetWriter):
             with contextlib.suppress(Exception):  # a disk that cannot take the rest: aborted below
                 self._close()
                 return
-        bag, self.bag = self.bag, None
-        if bag is not None:
-            with contextlib.suppress(Exception):
-                bag.abort()
+        self._abort()
 
     def _close(self) -> None:
         """Writes each USV's last odometry (held for a successor that never came) and the bag's custom data, and
