@@ -198,3 +198,25 @@ def test_a_preview_that_cannot_be_written_leaves_the_picture_before_it(recording
     )
     assert done.returncode == 3 and "cannot write the preview" in done.stdout, (done.stdout, done.stderr)
     assert out.read_bytes() == before and [p.name for p in tmp_path.iterdir()] == ["keep.png"]
+
+
+def test_preview_names_the_flags_typed_and_python_the_arguments(
+    recording: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The command's messages named the API's keyword arguments (``frame = 5: not in ...``, ``output 'p.txt'``),
+    not the flags typed, though the same command's ``--frame = -1`` named its flag."""
+    from mmusv.cli import main
+    from mmusv.errors import ConfigError
+    from mmusv.preview import write_preview
+
+    assert main(["preview", str(recording), "--frame", "5"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("mmusv: error: --frame 5: not in ") and "which holds frame 0" in err, err
+    assert main(["preview", str(recording), "-o", str(tmp_path / "p.txt")]) == 2
+    err = capsys.readouterr().err
+    assert f"-o/--output {tmp_path / 'p.txt'}: give a picture path" in err, err
+    # Python keeps its keyword arguments' names
+    with pytest.raises(ConfigError, match=r"^frame = 5: not in "):
+        write_preview(recording, frame=5)
+    with pytest.raises(ConfigError, match=r"^output = '.*p\.txt': give a picture path"):
+        write_preview(recording, frame=0, output=tmp_path / "p.txt")

@@ -327,11 +327,14 @@ def cmd_recover(args: argparse.Namespace) -> int:
 def cmd_preview(args: argparse.Namespace) -> int:
     from mmusv import arguments
     from mmusv.preview import write_preview
+    from mmusv.text import command_line
 
     path_arg(args.recording, flag="recording")
     if args.output is not None:
         output_arg(args.output)
     arguments.whole(args.frame, name="--frame", lo=0)  # -1 was "frame -1 is not in ...", not what is allowed
-    out = write_preview(args.recording, frame=args.frame, agent=args.agent, output=args.output)
+    # the API's messages name the flags typed (`--frame 5: not in ...`, not `frame = 5`)
+    with command_line({"frame": "--frame", "agent": "--agent", "output": "-o/--output"}):
+        out = write_preview(args.recording, frame=args.frame, agent=args.agent, output=args.output)
     print(f"wrote {out}")
     return 0

@@ -25,6 +25,7 @@ from mmusv.recording import topics
 from mmusv.recording.decode import decode_image, decode_point_cloud
 from mmusv.recording.info import AgentInfo, read_info, recording_name
 from mmusv.recording.messages import frame_messages
+from mmusv.text import given
 
 __all__ = ["BOX_COLOUR", "Panel", "compose_preview", "write_preview"]
 
@@ -274,11 +275,11 @@ def write_preview(
     said_folder = output is not None and str(output).endswith(("/", os.sep))  # `-o previews/`: a folder
     if target is not None and said_folder and not target.is_dir():
         if target.exists():
-            raise ConfigError(f"output {str(output)!r}: {target} is a file, not a folder")
-        raise ConfigError(f"output {str(output)!r}: the folder {target} does not exist; create it first")
+            raise ConfigError(f"{given('output', str(output))}: {target} is a file, not a folder")
+        raise ConfigError(f"{given('output', str(output))}: the folder {target} does not exist; create it first")
     if target is not None and not target.is_dir() and target.suffix.lower() not in _PICTURE_SUFFIXES:
         raise ConfigError(
-            f"output {str(target)!r}: give a picture path ending in {', '.join(_PICTURE_SUFFIXES)}, or a folder"
+            f"{given('output', str(output))}: give a picture path ending in {', '.join(_PICTURE_SUFFIXES)}, or a folder"
         )
     canvas, panels = compose_preview(path, frame=frame, agent=agent)
     a = panels[0].title.split(" · ")[0]

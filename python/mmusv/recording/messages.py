@@ -19,6 +19,7 @@ from mmusv.recording.info import check_mcap, read_info, recording_arg
 from mmusv.recording.parts import is_parts_manifest, part_files
 from mmusv.recording.scan import Scan
 from mmusv.recording.stream import FrameStream, held_text
+from mmusv.text import given, named
 
 __all__ = ["frame_messages", "read_messages"]
 
@@ -95,23 +96,24 @@ def frame_messages(path: str | Path, frame: int) -> dict[str, Any]:
     missing bytes (naming the damage) and :class:`~mmusv.errors.ConfigError` when the recording does not hold it
     (``frame`` must be a whole number)."""
     p = recording_arg(path)
-    frame = arguments.whole(frame, name="frame")
+    frame = arguments.whole(frame, name=named("frame"))
+    said_frame = given("frame", frame)  # `--frame 5` from mmusv preview, `frame = 5` from Python
     if is_parts_manifest(p):
         files = part_files(p)
         for first, stop, part in files:
             if first <= frame < stop:
                 if part is None:
-                    raise ConfigError(f"frame {frame} is not in {p}: its part is not recorded yet")
+                    raise ConfigError(f"{said_frame}: its part of {p} is not recorded yet")
                 return frame_messages(part, frame)
         held = range(files[0][0], files[-1][1]) if files else range(0)
-        raise ConfigError(f"frame = {frame}: not in {p}, which holds {held_text(held)}")
+        raise ConfigError(f"{said_frame}: not in {p}, which holds {held_text(held)}")
     info = read_info(p)
     probe = FrameStream(info, want=lambda _t: False)
     span, _said = probe.expected()  # the frames the run set out to write
     held, said, why = probe.held()  # of them, those it wrote (an interrupted run: its first frames_written)
     if said and frame not in held:
         # "holds frames 0..4999" was said of a run stopped after 297
-        raise ConfigError(f"frame = {frame}: not in {p}, which holds {held_text(held)}{why}")
+        raise ConfigError(f"{said_frame}: not in {p}, which holds {held_text(held)}{why}")
     # only the chunks around the frame are decompressed (a negative frame is in no recording: read to say so)
     stream = FrameStream(info, want=lambda _t: True, frames=(frame, frame + 1) if frame >= 0 else None)
     for fr in stream:
@@ -128,6 +130,5 @@ def frame_messages(path: str | Path, frame: int) -> dict[str, Any]:
         raise IoError(f"frame {frame} of {p} is lost to damage{unsure} ({stream.truncated})")
     where = f" ({stream.truncated})" if stream.truncated else ""
     raise ConfigError(
-        f"frame = {frame}: not in {p}, {'which holds' if said else 'whose run set out to write'} "
-        f"{held_text(span)}{where}"
+        f"{said_frame}: not in {p}, {'which holds' if said else 'whose run set out to write'} {held_text(span)}{where}"
     )

@@ -446,7 +446,10 @@ class FrameStream:
 
 
 def held_text(frames: range) -> str:
-    """``"frames 0..296"`` (``"no frames"`` for an empty range): what a recording holds, in messages."""
+    """``"frames 0..296"`` (``"frame 0"`` for one, ``"no frames"`` for none): what a recording holds, in
+    messages."""
+    if len(frames) == 1:
+        return f"frame {frames.start}"
     return f"frames {frames.start}..{frames.stop - 1}" if len(frames) else "no frames"
 
 
