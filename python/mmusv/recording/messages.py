@@ -103,7 +103,7 @@ def frame_messages(path: str | Path, frame: int) -> dict[str, Any]:
         for first, stop, part in files:
             if first <= frame < stop:
                 if part is None:
-                    raise ConfigError(f"{said_frame}: its part of {p} is not recorded yet")
+                    raise ConfigError(f"{said_frame}: not in {p} yet: its part is not recorded")
                 return frame_messages(part, frame)
         held = range(files[0][0], files[-1][1]) if files else range(0)
         raise ConfigError(f"{said_frame}: not in {p}, which holds {held_text(held)}")
