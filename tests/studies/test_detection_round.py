@@ -662,3 +662,20 @@ def test_one_recording_given_twice_is_named(rec: Path, tmp_path: Path, capsys: p
     err = refused(["study", "detection", str(batch), str(rec.parent)], tmp_path / "o", capsys)
     assert "the same recording is given twice" in err and str(batch / "run" / rec.name) in err, err
     assert str(rec.resolve()) in err, err
+
+
+def test_copies_of_one_run_are_refused_not_counted_twice(
+    rec: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A copy of a run folder beside the run was studied as a second sequence: the same frames counted twice, and
+    split across the training and the test split. Two runs of one scenario configuration are refused, as convert
+    refuses them."""
+    from mmusv.studies.detection.sources import resolve_dataset
+
+    copy = tmp_path / "copy"
+    shutil.copytree(rec.parent, copy)
+    with pytest.raises(InputError, match="runs of the same scenario configuration"):
+        resolve_dataset([rec.parent, copy], opv2v=None, split="all")
+    err = refused(["study", "detection", str(rec), str(copy / rec.name)], tmp_path / "o", capsys)
+    assert "same scenario configuration" in err and str(copy / rec.name) in err, err
+    assert len(resolve_dataset([rec.parent], opv2v=None, split="all").sources) == 1

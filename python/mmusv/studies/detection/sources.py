@@ -151,11 +151,35 @@ def _sequence_names(recs: Sequence[Path]) -> dict[str, Path]:
             f"the same recording is given twice: {twice[0]} and {twice[1]}"
             + (f" (both {twice[0].resolve()})" if twice[0] != twice[1] else "")
         )
+    _refuse_same_runs(uniq)
     stems = [recording_name(r) for r in uniq]
     if len(set(stems)) == len(stems):
         return dict(zip(stems, uniq, strict=True))
     root = Path(os.path.commonpath([str(r.parent) for r in uniq]))
     return {str(r.parent.relative_to(root) / recording_name(r)): r for r in uniq}
+
+
+def _refuse_same_runs(recs: Sequence[Path]) -> None:
+    """Refuses two recordings of one scenario configuration (a copy of a run folder, or a scenario run twice): the
+    same scenario and seed give the same data, which would count as two sequences, and may land in the training and
+    the test split both. A file whose metadata cannot be read is left to the reading of its frames to report."""
+    from mmusv.errors import MmusvError
+
+    by: dict[str, list[Path]] = {}
+    for r in recs:
+        try:
+            key = recording_summary(r).config_hash
+        except (MmusvError, OSError):
+            continue
+        if key:
+            by.setdefault(key, []).append(r)
+    same = next((paths for paths in by.values() if len(paths) > 1), None)
+    if same is not None:
+        raise InputError(
+            f"recordings {', '.join(str(r) for r in same)} are runs of the same scenario configuration (the same "
+            "scenario and seed give the same data: studied together, each frame would count twice, and could be in "
+            "both the training and the test split); give each only once, leaving the others out"
+        )
 
 
 def resolve_dataset(
