@@ -107,13 +107,17 @@ def footprint_in_range(box: np.ndarray, *, size: np.ndarray, range_m: float) -> 
 
     The annotations' rule (:func:`annotate_agent`): a 330 m ship whose stern lies 45 m from the USV has its centre
     beyond a 200 m LiDAR's range, yet the LiDAR sees it; the centre rule of :func:`in_target_range` stays the
-    exports' and the detection study's (OpenCOOD's convention)."""
+    exports' and the detection study's (OpenCOOD's convention). A box or size that is not finite, or a size below 0,
+    raises :class:`mmusv.InputError`."""
     m = _floats(box, name="box", tail=(4, 4), what="a (4, 4) box -> ego LiDAR transform")
     size = _floats(size, name="size", tail=(), what="the box's size (length, beam[, height])")
     if m.ndim != 2 or size.shape not in ((2,), (3,)):
         raise InputError(
             f"footprint_in_range takes a (4, 4) box and a (3,) or (2,) size, got {m.shape} and {size.shape}"
         )
+    if not np.isfinite(m).all():
+        raise InputError(f"box must be a (4, 4) box -> ego LiDAR transform of finite numbers, got {m.tolist()}")
+    _extents(size)
     range_m = _range(range_m)
     yaw = np.arctan2(m[1, 0], m[0, 0])
     c, s = np.cos(yaw), np.sin(yaw)
@@ -129,14 +133,25 @@ def box_corners(matrix: np.ndarray, size: np.ndarray) -> np.ndarray:
     """``(8, 3)`` float64 corners of a box with pose ``matrix`` (``(4, 4)`` box → frame, centred) and full ``size``
     (length, beam, height along the box's x, y, z; metres), in the frame ``matrix`` maps to. Corner ``i`` lies at
     ``±size / 2`` in the box frame, the sign of x from bit 0 of ``i``, of y from bit 1 and of z from bit 2 (set:
-    +; corner 0 is (−x, −y, −z), corner 7 (+x, +y, +z)). Other shapes raise :class:`mmusv.InputError`."""
+    +; corner 0 is (−x, −y, −z), corner 7 (+x, +y, +z)). Other shapes, and a size not finite or below 0, raise
+    :class:`mmusv.InputError`."""
     matrix = _floats(matrix, name="matrix", tail=(), what="a (4, 4) box pose")
     size = _floats(size, name="size", tail=(), what="the box's (3,) size (length, beam, height)")
     if matrix.shape != (4, 4) or size.shape != (3,):
         raise InputError(f"box_corners takes a (4, 4) matrix and a (3,) size, got {matrix.shape} and {size.shape}")
+    _extents(size)
     local = _SIGNS * (size / 2.0)
     out: np.ndarray = local @ matrix[:3, :3].T + matrix[:3, 3]
     return out
+
+
+def _extents(size: np.ndarray) -> None:
+    """An :class:`InputError` unless a box's full ``size`` (length, beam[, height]) is finite metres >= 0: a negative
+    extent is no box (it would mirror the corners' order), a NaN no answer."""
+    if not (np.isfinite(size).all() and (size >= 0.0).all()):
+        raise InputError(
+            f"size must be a box's full extents, finite metres >= 0 (length, beam[, height]), got {size.tolist()}"
+        )
 
 
 @dataclass(eq=False)
