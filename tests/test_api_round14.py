@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from mmusv.annotate import box_corners, footprint_in_range
 from mmusv.errors import InputError
+from mmusv.image_boxes import clip_box, faces_in_image_box, in_image_box, pinhole_truncation, project_box
 
 # ------------------------------------------------------------------------------------ a box's size
 
@@ -47,3 +48,81 @@ def test_a_box_of_zero_size_still_has_corners() -> None:
     np.testing.assert_array_equal(c[:, 0], [-1.0, 1.0] * 4)
     assert not c[:, 1:].any()
     assert footprint_in_range(np.eye(4), size=np.zeros(3), range_m=0.0)
+
+
+# ------------------------------------------------------------------------------------ mmusv.image_boxes
+
+K = (100.0, 100.0, 80.0, 60.0)
+BOX = box_corners(np.eye(4), [2.0, 2.0, 2.0]) + np.array([0.0, 0.0, 10.0])  # in view, 10 m ahead of the camera
+
+
+@pytest.mark.parametrize(
+    ("call", "words"),
+    [
+        (
+            lambda: pinhole_truncation(np.ones((8, 3), dtype=bool), intrinsics=K, width=160, height=120),
+            r"corners_opt must be a box's \(8, 3\) corners in metres of real numbers: it holds true/false",
+        ),
+        (
+            lambda: pinhole_truncation(BOX.astype(str), intrinsics=K, width=160, height=120),
+            "corners_opt must be .* it holds text",
+        ),
+        (
+            lambda: pinhole_truncation(BOX, intrinsics="1234", width=160, height=120),
+            r"intrinsics must be \(fx, fy, cx, cy\) pixels of real numbers: it holds text",
+        ),
+        (
+            lambda: pinhole_truncation(BOX, intrinsics=("100", "100", "80", "60"), width=160, height=120),
+            "intrinsics must be .* it holds text",
+        ),
+        (lambda: clip_box("abcd", width=4, height=4), r"box must be a pixel box \[x0, y0, x1, y1\] .* it holds text"),
+        (lambda: clip_box(["0", "0", "2", "2"], width=4, height=4), "box must be a pixel box .* it holds text"),
+        (lambda: clip_box(np.ones(4, dtype=bool), width=4, height=4), "box must be .* it holds true/false"),
+        (
+            lambda: faces_in_image_box(None, intrinsics=K, lens=None, width=160, height=120),  # type: ignore[arg-type]
+            r"faces_opt must be a list of convex \(n, 3\) polygons .* got None",
+        ),
+        (
+            lambda: faces_in_image_box([None], intrinsics=K, lens=None, width=160, height=120),  # type: ignore[list-item]
+            r"faces_opt\[0\] must be a convex \(n, 3\) polygon .* it holds None",
+        ),
+        (
+            lambda: faces_in_image_box([np.ones((4, 2))], intrinsics=K, lens=None, width=160, height=120),
+            r"faces_opt\[0\] must be .* got shape \(4, 2\)",
+        ),
+        (
+            lambda: faces_in_image_box([np.full((4, 3), np.nan)], intrinsics=K, lens=None, width=160, height=120),
+            r"faces_opt\[0\] must be a convex \(n, 3\) polygon \(finite metres\)",
+        ),
+        (lambda: project_box(BOX, intrinsics=K, lens="x"), "lens = 'x': must be None .* or the .camera, reach. of"),
+        (
+            lambda: in_image_box(BOX, intrinsics=K, lens=(None, 1.0), width=160, height=120),
+            "lens = .* must be None",
+        ),
+    ],
+)
+def test_the_image_box_helpers_refuse_what_they_cannot_use(call: Callable[[], Any], words: str) -> None:
+    """mmusv.image_boxes (the 2D boxes' geometry, which annotate and the KITTI export use) read a box's corners of
+    true/false as ones and of text as the numbers written, intrinsics ``"1234"`` as ``(1, 2, 3, 4)`` (one digit
+    per entry) and intrinsics or a pixel box of text as numbers, all without a word; ``clip_box`` of ``"abcd"``
+    ended in numpy's bare ValueError, ``faces_in_image_box`` of None, ``[None]`` or ``(4, 2)`` faces in a bare
+    TypeError or ValueError (a reshape), and of a NaN face in None ('not in the image'); a lens that is not
+    ``camera_lens``'s ``(camera, reach)`` in a bare TypeError from inside. Each is an InputError naming the
+    argument."""
+    with pytest.raises(InputError, match=words):
+        call()
+
+
+def test_the_image_box_helpers_still_take_what_they_document() -> None:
+    """Lists, numpy numbers and arrays of faces still work, with the same answers."""
+    k32 = np.array(K, dtype=np.float32)
+    assert pinhole_truncation(BOX.tolist(), intrinsics=k32, width=np.int64(160), height=np.uint16(120)) == 0.0
+    r = 100.0 / 9.0  # the near face (z = 9 m) is the widest: 1 m at f = 100 px
+    np.testing.assert_allclose(project_box(BOX, intrinsics=list(K)), [80.0 - r, 60.0 - r, 80.0 + r, 60.0 + r])
+    clipped, area, carea = clip_box([-2, 0, 2, np.int32(2)], width=4, height=4)
+    assert clipped.tolist() == [0.0, 0.0, 2.0, 2.0] and (area, carea) == (8.0, 4.0)
+    assert faces_in_image_box([], intrinsics=K, lens=None, width=4, height=4) is None
+    whole = faces_in_image_box(
+        np.stack([BOX[[0, 1, 3, 2]], BOX[[4, 5, 7, 6]]]), intrinsics=K, lens=None, width=160, height=120
+    )
+    np.testing.assert_allclose(whole, project_box(BOX, intrinsics=K))

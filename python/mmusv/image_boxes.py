@@ -17,13 +17,14 @@ pixel centres at +0.5, intrinsics ``(fx, fy, cx, cy)`` pixels.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from typing import Any
 
 import numpy as np
 
 from mmusv import arguments
 from mmusv.errors import InputError
-from mmusv.frames import BODY_TO_OPTICAL
+from mmusv.frames import BODY_TO_OPTICAL, _floats
 
 __all__ = [
     "EDGE_STEPS",
@@ -56,6 +57,7 @@ def project_box(
     alone bound the image; through a lens the box's edges are sampled (their images are curves)."""
     fx, fy, cx, cy = _intrinsics(intrinsics)
     corners_opt = _corners(corners_opt, name="corners_opt")
+    lens = _lens(lens)
     pts = [c for c in corners_opt if c[2] >= NEAR_M]
     ends = []
     for a, b in _EDGES:
@@ -159,9 +161,10 @@ def faces_in_image_box(
     from shapely import MultiPoint, Polygon, box, unary_union
 
     fx, fy, cx, cy = _intrinsics(intrinsics)
+    lens = _lens(lens)
     width = arguments.whole(width, name="width", lo=1, error=InputError)
     height = arguments.whole(height, name="height", lo=1, error=InputError)
-    faces = [f for f in (_near_face(np.asarray(g, dtype=np.float64).reshape(-1, 3)) for g in faces_opt) if len(f) >= 3]
+    faces = [f for f in (_near_face(g) for g in _faces(faces_opt)) if len(f) >= 3]
     if lens is None:  # a pinhole keeps straight lines straight: the image is the corners' convex hull
         p = np.concatenate(faces) if faces else np.zeros((0, 3))
         image = MultiPoint(np.column_stack([fx * p[:, 0] / p[:, 2] + cx, fy * p[:, 1] / p[:, 2] + cy])).convex_hull
@@ -193,7 +196,7 @@ def faces_in_image_box(
 def clip_box(box: np.ndarray, *, width: int, height: int) -> tuple[np.ndarray, float, float]:
     """A pixel box ``[x0, y0, x1, y1]`` clipped to the ``width × height`` image: the clipped box, the box's own area
     and the clipped area (pixels²; 0 when the box is empty or lies wholly outside the image)."""
-    box = np.asarray(box, dtype=np.float64)
+    box = _floats(box, name="box", tail=(), what="a pixel box [x0, y0, x1, y1]")
     if box.shape != (4,) or not np.isfinite(box).all():
         raise InputError(f"box must be a pixel box [x0, y0, x1, y1] of four finite numbers, got {arguments.shown(box)}")
     width = arguments.whole(width, name="width", lo=1, error=InputError)
@@ -249,10 +252,7 @@ def _distort(x: np.ndarray, y: np.ndarray, cam: Any, reach: float) -> tuple[np.n
 
 def _corners(value: Any, *, name: str) -> np.ndarray:
     """``value`` as a box's ``(8, 3)`` float64 corners, else an :class:`InputError` naming ``name``."""
-    try:
-        c = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        c = np.zeros(0)
+    c = _floats(value, name=name, tail=(), what="a box's (8, 3) corners in metres")
     if c.shape != (8, 3) or not np.isfinite(c).all():
         raise InputError(
             f"{name} must be a box's (8, 3) corners, finite metres (corner bits as mmusv.annotate.box_corners), got "
@@ -263,12 +263,40 @@ def _corners(value: Any, *, name: str) -> np.ndarray:
 
 def _intrinsics(value: Any) -> tuple[float, float, float, float]:
     """``(fx, fy, cx, cy)`` pixels, finite, the focal lengths > 0, else an :class:`InputError`."""
-    try:
-        fx, fy, cx, cy = (float(v) for v in value)
-    except (TypeError, ValueError):
-        fx = fy = cx = cy = math.nan
+    k = _floats(value, name="intrinsics", tail=(), what="(fx, fy, cx, cy) pixels")
+    fx, fy, cx, cy = (float(v) for v in k) if k.shape == (4,) else (math.nan,) * 4
     if not (math.isfinite(cx) and math.isfinite(cy) and math.isfinite(fx) and math.isfinite(fy) and fx > 0 and fy > 0):
         raise InputError(
             f"intrinsics must be (fx, fy, cx, cy) pixels, finite, fx and fy > 0, got {arguments.shown(value)}"
         )
     return fx, fy, cx, cy
+
+
+def _faces(value: Any) -> list[np.ndarray]:
+    """``value`` as a list of ``(n, 3)`` float64 polygons (optical frame, finite metres), else an
+    :class:`InputError` naming ``faces_opt``."""
+    what = "a list of convex (n, 3) polygons in the optical frame (finite metres)"
+    if isinstance(value, (str, bytes)) or not isinstance(value, Iterable):
+        raise InputError(f"faces_opt must be {what}, got {arguments.shown(value)}")
+    faces = []
+    for i, g in enumerate(value):
+        f = _floats(g, name=f"faces_opt[{i}]", tail=(3,), what="a convex (n, 3) polygon (finite metres)")
+        if f.ndim != 2 or not np.isfinite(f).all():
+            raise InputError(
+                f"faces_opt[{i}] must be a convex (n, 3) polygon (finite metres), got {arguments.shown(g)}"
+            )
+        faces.append(f)
+    return faces
+
+
+def _lens(value: Any) -> tuple[Any, float] | None:
+    """``value`` as a lens: ``None`` (an ideal pinhole) or ``(camera, reach)`` as :func:`camera_lens` gives it, else
+    an :class:`InputError`."""
+    if value is None:
+        return None
+    if not (isinstance(value, tuple) and len(value) == 2 and callable(getattr(value[0], "distort", None))):
+        raise InputError(
+            f"lens = {arguments.shown(value)}: must be None (an ideal pinhole) or the (camera, reach) of camera_lens"
+        )
+    reach = arguments.real(value[1], name="lens reach", above=0.0, finite=False, error=InputError)
+    return value[0], reach
