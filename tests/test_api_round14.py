@@ -8,9 +8,46 @@ from typing import Any
 
 import numpy as np
 import pytest
+from mmusv import frames
 from mmusv.annotate import box_corners, footprint_in_range
 from mmusv.errors import InputError
 from mmusv.image_boxes import clip_box, faces_in_image_box, in_image_box, pinhole_truncation, project_box
+
+K = (100.0, 100.0, 80.0, 60.0)
+BOX = box_corners(np.eye(4), [2.0, 2.0, 2.0]) + np.array([0.0, 0.0, 10.0])  # in view, 10 m ahead of the camera
+
+# ------------------------------------------------------------------------------------ true/false among numbers
+
+
+@pytest.mark.parametrize(
+    ("call", "words"),
+    [
+        (lambda: frames.translation([True, 2.0, 3.0]), "v must be .* of real numbers: it holds true/false"),
+        (lambda: frames.transform_points(np.eye(4), [[1, 2, 3], [np.True_, 0, 0]]), "points must be .* true/false"),
+        (lambda: frames.wrap_deg([np.array(True), 5.0]), "a must be angles in degrees .* true/false"),
+        (lambda: box_corners(np.eye(4), [True, 2.0, 1.0]), "size must be .* it holds true/false"),
+        (
+            lambda: pinhole_truncation(BOX, intrinsics=(True, True, 80, 60), width=9, height=9),
+            "intrinsics .* true/false",
+        ),
+    ],
+)
+def test_true_false_in_a_list_of_numbers_is_not_a_number(call: Callable[[], Any], words: str) -> None:
+    """mmusv.frames' check of real numbers (which annotate and image_boxes use) refused an array of true/false but
+    not a list mixing them with numbers, which numpy reads as numbers: ``translation([True, 2, 3])`` moved 1 m
+    along x, a box of size ``[True, 2, 1]`` was 1 m long and intrinsics ``(True, True, 80, 60)`` a focal length
+    of 1 px, without a word. Each is an InputError naming the argument."""
+    with pytest.raises(InputError, match=words):
+        call()
+
+
+def test_lists_of_numbers_still_read_as_numbers() -> None:
+    """Lists of Python and numpy numbers, of arrays and of 0-d arrays are still the numbers they hold."""
+    np.testing.assert_array_equal(frames.translation([np.float32(1.0), 2, np.int64(3)])[:3, 3], [1.0, 2.0, 3.0])
+    np.testing.assert_array_equal(frames.wrap_deg([np.array(370.0), 5]), [10.0, 5.0])
+    rows = [np.array([1.0, 2.0, 3.0]), np.array([4, 5, 6])]
+    np.testing.assert_array_equal(frames.transform_points(np.eye(4), rows), [[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]])
+
 
 # ------------------------------------------------------------------------------------ a box's size
 
@@ -51,9 +88,6 @@ def test_a_box_of_zero_size_still_has_corners() -> None:
 
 
 # ------------------------------------------------------------------------------------ mmusv.image_boxes
-
-K = (100.0, 100.0, 80.0, 60.0)
-BOX = box_corners(np.eye(4), [2.0, 2.0, 2.0]) + np.array([0.0, 0.0, 10.0])  # in view, 10 m ahead of the camera
 
 
 @pytest.mark.parametrize(

@@ -76,7 +76,11 @@ def _floats(value: Any, *, name: str, tail: tuple[int, ...], what: str) -> np.nd
         # Only real numbers: a None (NaN as float64), a bool, text ("1.5" converts) or a complex number (its
         # imaginary part dropped) would be read as a number without a word.
         kind = raw.dtype.kind
-        if kind == "O":
+        if kind in "iuf" and raw.ndim > 0 and not isinstance(value, np.ndarray):
+            # A list mixing true/false with numbers ([True, 2.0]) is numbers to numpy: its entries are looked at.
+            if any(map(_true_false, np.asarray(value, dtype=object).flat)):
+                raise TypeError("it holds true/false")
+        elif kind == "O":
             bad = [x for x in raw.flat if not is_number(x)][:1]
             if bad:
                 raise TypeError(f"it holds {arguments.shown(bad[0])}")
@@ -88,6 +92,11 @@ def _floats(value: Any, *, name: str, tail: tuple[int, ...], what: str) -> np.nd
     if a.ndim < len(tail) or a.shape[a.ndim - len(tail) :] != tail:
         raise InputError(f"{name} must be {what}, got shape {a.shape}")
     return a
+
+
+def _true_false(x: object) -> bool:
+    """Whether ``x`` (an entry of a list numpy read as numbers) is true/false: a bool or a bool array."""
+    return isinstance(x, (bool, np.bool_)) or (isinstance(x, np.ndarray) and x.dtype.kind == "b")
 
 
 def _points(value: Any, *, name: str) -> np.ndarray:
