@@ -9,9 +9,11 @@ from typing import Any
 import numpy as np
 import pytest
 from mmusv import frames
-from mmusv.annotate import box_corners, footprint_in_range
+from mmusv.annotate import Annotations, SilhouetteCache, annotate_agent, box_corners, footprint_in_range
 from mmusv.errors import InputError
 from mmusv.image_boxes import clip_box, faces_in_image_box, in_image_box, pinhole_truncation, project_box
+from mmusv.simulation import Simulation
+from tiny_scenario import lidar_scenario
 
 K = (100.0, 100.0, 80.0, 60.0)
 BOX = box_corners(np.eye(4), [2.0, 2.0, 2.0]) + np.array([0.0, 0.0, 10.0])  # in view, 10 m ahead of the camera
@@ -160,3 +162,74 @@ def test_the_image_box_helpers_still_take_what_they_document() -> None:
         np.stack([BOX[[0, 1, 3, 2]], BOX[[4, 5, 7, 6]]]), intrinsics=K, lens=None, width=160, height=120
     )
     np.testing.assert_allclose(whole, project_box(BOX, intrinsics=K))
+
+
+# ------------------------------------------------------------------------------------ annotate_agent
+
+
+@pytest.fixture(scope="module")
+def agent_call() -> Callable[..., Annotations]:
+    """``annotate_agent`` of the first agent of a tiny scenario's frame 0, its arguments replaced by those given."""
+    sim = Simulation(lidar_scenario("round14", frames=1))
+    cap = sim.capture(0)
+    agent = sim.agents[0]
+    ac = cap.agents[agent.id]
+    assert ac.lidar is not None
+    base: dict[str, Any] = {
+        "agent_id": agent.id,
+        "agent_index": agent.index,
+        "frame": cap.frame,
+        "time_s": cap.time_s,
+        "vessels": sim.vessels,
+        "state": cap.world,
+        "lidar_pose": ac.lidar_pose,
+        "lidar_instances": ac.lidar.instance,
+        "cameras": {},
+        "silhouettes": SilhouetteCache(),
+        "max_range_m": 200.0,
+        "scene": sim.ws.scene,
+    }
+    return lambda **kw: annotate_agent(**{**base, **kw})
+
+
+@pytest.mark.parametrize(
+    ("kw", "words"),
+    [
+        ({"agent_index": -1}, r"agent_index = -1: must be a whole number in 0\.\.1"),
+        ({"agent_index": 2}, r"agent_index = 2: must be a whole number in 0\.\.1"),
+        ({"agent_index": True}, "agent_index = True: .* not true/false"),
+        ({"agent_index": "0"}, "agent_index = '0': .* not str"),
+        ({"max_range_m": float("nan")}, "max_range_m = nan: must be a number of metres >= 0"),
+        ({"lidar_pose": np.eye(3)}, r"lidar_pose must be a \(4, 4\) LiDAR -> world transform .* got shape \(3, 3\)"),
+        ({"lidar_pose": np.full((4, 4), np.nan)}, r"lidar_pose must be .*, finite, got"),
+        ({"lidar_instances": np.array([1.5])}, r"lidar_instances must be the \(N,\) instance ids \(integers\)"),
+        ({"frame": -1}, "frame = -1: must be a whole number >= 0"),
+        ({"frame": "0"}, "frame = '0'"),
+        ({"time_s": None}, "time_s = None: must be a finite number of seconds"),
+        ({"agent_id": None}, r"agent_id = None: must be the agent's id \(a str\)"),
+        ({"cameras": None}, "cameras = None: must be a dict name -> "),
+        ({"vessels": None}, "vessels = None: must be the list of the world state's VesselInfo"),
+        ({"silhouettes": None}, "silhouettes = None: must be a SilhouetteCache"),
+    ],
+)
+def test_annotate_agent_refuses_what_it_cannot_use(
+    agent_call: Callable[..., Annotations], kw: dict[str, Any], words: str
+) -> None:
+    """``annotate_agent`` took an ``agent_index`` that is no vessel's (-1, 2 of 2 vessels, ``"0"``) as 'no vessel is
+    the agent' and gave the agent its own hull as a target (and -1 the last vessel's pose as the reference), read
+    ``True`` as vessel 1, kept a frame of -1 or ``"0"``, a time of None and an agent id of None in its
+    Annotations, took LiDAR instance ids of 1.5 as 1, and named a NaN ``max_range_m`` 'range_m'; a (3, 3)
+    lidar_pose ended in numpy's bare matmul ValueError (a NaN one was blamed on 'box'), a list of instance ids, a
+    ``cameras`` or ``vessels`` of None in a bare AttributeError or TypeError. Each is an InputError naming the
+    argument."""
+    with pytest.raises(InputError, match=words):
+        agent_call(**kw)
+
+
+def test_annotate_agent_still_takes_what_it_documents(agent_call: Callable[..., Annotations]) -> None:
+    """numpy integers, a float32 time and a list of instance ids still give the same annotations."""
+    ann = agent_call()
+    assert ann.lidar_ids and ann.agent == "u"
+    assert agent_call(agent_index=np.int64(0), frame=np.uint32(0), time_s=np.float32(0.0)) == ann
+    target = ann.lidar_instance[0]
+    assert agent_call(lidar_instances=[target, target, 0]).lidar_points == [2]

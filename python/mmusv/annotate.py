@@ -336,6 +336,46 @@ def _world_to_optical(points: np.ndarray, world_to_body: np.ndarray) -> np.ndarr
     return out
 
 
+def _agent_arguments(
+    *,
+    agent_id: Any,
+    agent_index: Any,
+    frame: Any,
+    time_s: Any,
+    vessels: Any,
+    lidar_pose: Any,
+    cameras: Any,
+    silhouettes: Any,
+    max_range_m: Any,
+) -> tuple[int, int, float]:
+    """:func:`annotate_agent`'s arguments checked (an :class:`InputError` naming the first that is wrong):
+    ``agent_index``, ``frame`` and ``time_s`` in their one accepted form."""
+    if not isinstance(agent_id, str):
+        raise InputError(f"agent_id = {arguments.shown(agent_id)}: must be the agent's id (a str)")
+    if not isinstance(vessels, (list, tuple)):
+        raise InputError(f"vessels = {arguments.shown(vessels)}: must be the list of the world state's VesselInfo")
+    hi = len(vessels) - 1
+    index = arguments.whole(agent_index, name="agent_index", lo=0, hi=max(hi, 0), error=InputError)
+    if index > hi:
+        raise InputError(f"agent_index = {index}: there are no vessels to index")
+    frame = arguments.whole(frame, name="frame", lo=0, error=InputError)
+    time_s = arguments.real(time_s, name="time_s", unit="seconds", error=InputError)
+    if lidar_pose is not None:
+        what = "a (4, 4) LiDAR -> world transform (or None: the vessel's body)"
+        m = _floats(lidar_pose, name="lidar_pose", tail=(4, 4), what=what)
+        if m.ndim != 2 or not np.isfinite(m).all():
+            raise InputError(f"lidar_pose must be {what}, finite, got {arguments.shown(lidar_pose)}")
+    if not isinstance(cameras, Mapping):
+        raise InputError(
+            f"cameras = {arguments.shown(cameras)}: must be a dict name -> (camera, (4, 4) pose, (H, W) instance "
+            "image), {} for none"
+        )
+    if not isinstance(silhouettes, SilhouetteCache):
+        raise InputError(f"silhouettes = {arguments.shown(silhouettes)}: must be a SilhouetteCache")
+    arguments.real(max_range_m, name="max_range_m", unit="metres", lo=0.0, finite=False, error=InputError)
+    return index, frame, time_s
+
+
 def annotate_agent(
     *,
     agent_id: str,
@@ -368,7 +408,28 @@ def annotate_agent(
         lidar_beams: ``(M,)`` int32 instance each beam of the pattern met first in the capture (-1: none;
             :attr:`~mmusv.simulation.AgentCapture.lidar_beams`): the full scene's answer for the 3D boxes' share,
             read instead of casting the beams again.
+
+    Arguments that are not what is described here (an ``agent_index`` that is no vessel's, a ``lidar_pose`` that
+    is no finite ``(4, 4)`` matrix, ...) raise :class:`mmusv.InputError` naming them.
     """
+    agent_index, frame, time_s = _agent_arguments(
+        agent_id=agent_id,
+        agent_index=agent_index,
+        frame=frame,
+        time_s=time_s,
+        vessels=vessels,
+        lidar_pose=lidar_pose,
+        cameras=cameras,
+        silhouettes=silhouettes,
+        max_range_m=max_range_m,
+    )
+    if lidar_instances is not None:
+        lidar_instances = np.asarray(lidar_instances)
+        if lidar_instances.dtype.kind not in "iu" and lidar_instances.size:
+            raise InputError(
+                f"lidar_instances must be the (N,) instance ids (integers) of the LiDAR's points, got dtype "
+                f"{lidar_instances.dtype}"
+            )
     waves = scene is not None and scene.wave_top is not None
     angles = pattern_angles(lidar_pattern) if waves and lidar_pattern is not None else None
     ann = Annotations(agent=agent_id, frame=frame, time_s=time_s)
