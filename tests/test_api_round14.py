@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from mmusv import frames
 from mmusv.annotate import Annotations, SilhouetteCache, annotate_agent, box_corners, footprint_in_range
+from mmusv.classes import class_name
 from mmusv.errors import InputError
 from mmusv.image_boxes import clip_box, faces_in_image_box, in_image_box, pinhole_truncation, project_box
 from mmusv.simulation import Simulation
@@ -233,3 +234,29 @@ def test_annotate_agent_still_takes_what_it_documents(agent_call: Callable[..., 
     assert agent_call(agent_index=np.int64(0), frame=np.uint32(0), time_s=np.float32(0.0)) == ann
     target = ann.lidar_instance[0]
     assert agent_call(lidar_instances=[target, target, 0]).lidar_points == [2]
+
+
+# ------------------------------------------------------------------------------------ mmusv.classes
+
+
+@pytest.mark.parametrize(
+    ("class_id", "words"),
+    [
+        (True, "class_id = True: must be a whole number, not true/false"),
+        (10.0, r"class_id = 10.0: must be a whole number \(int or numpy integer\), not float"),
+        ("10", "class_id = '10': .* not str"),
+        (None, "class_id = None: .* not NoneType"),
+    ],
+)
+def test_class_name_of_what_is_no_class_id_is_refused(class_id: Any, words: str) -> None:
+    """``class_name`` named ``True`` 'water' (class 1) and ``10.0`` 'vessel', and ``"10"``, ``None`` or ``10.7``
+    'unknown_10', 'unknown_None', 'unknown_10.7', names no class has, without a word. Each is an InputError."""
+    with pytest.raises(InputError, match=words):
+        class_name(class_id)
+
+
+def test_class_name_still_names_class_ids() -> None:
+    """Python and numpy integers (and 0-d integer arrays) are named as before; unknown ids stay 'unknown_<id>'."""
+    assert class_name(10) == class_name(np.uint16(10)) == class_name(np.array(10, dtype=np.uint32)) == "vessel"
+    assert class_name(300) == class_name(np.int64(300)) == "unknown_300"
+    assert class_name(-1) == "unknown_-1"

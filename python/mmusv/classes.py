@@ -10,6 +10,9 @@ from enum import IntEnum
 
 import numpy as np
 
+from mmusv import arguments
+from mmusv.errors import InputError
+
 __all__ = ["PALETTE", "ROLE_COLOURS", "SemanticClass", "class_name", "palette_array"]
 
 
@@ -53,7 +56,10 @@ def palette_array() -> np.ndarray:
 
 
 def class_name(class_id: int) -> str:
-    """Lower-case name of a class id, e.g. ``class_name(10) == "vessel"``; ``"unknown_<id>"`` otherwise."""
+    """Lower-case name of a class id, e.g. ``class_name(10) == "vessel"``; ``"unknown_<id>"`` otherwise. A class id
+    is a whole number (``int`` or numpy integer); anything else (a float, true/false, text, None) is a
+    :class:`mmusv.InputError`."""
+    class_id = arguments.whole(class_id, name="class_id", error=InputError)
     try:
         return SemanticClass(class_id).name.lower()
     except ValueError:
