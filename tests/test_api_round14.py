@@ -13,6 +13,7 @@ from mmusv.annotate import Annotations, SilhouetteCache, annotate_agent, box_cor
 from mmusv.classes import class_name
 from mmusv.errors import InputError
 from mmusv.image_boxes import clip_box, faces_in_image_box, in_image_box, pinhole_truncation, project_box
+from mmusv.scene import Scene
 from mmusv.simulation import Simulation
 from tiny_scenario import lidar_scenario
 
@@ -260,3 +261,49 @@ def test_class_name_still_names_class_ids() -> None:
     assert class_name(10) == class_name(np.uint16(10)) == class_name(np.array(10, dtype=np.uint32)) == "vessel"
     assert class_name(300) == class_name(np.int64(300)) == "unknown_300"
     assert class_name(-1) == "unknown_-1"
+
+
+# ------------------------------------------------------------------------------------ mmusv.scene
+
+
+def _one_triangle() -> tuple[Scene, int]:
+    scene = Scene()
+    mesh = scene.add_mesh(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]), np.array([[0, 1, 2]]))
+    return scene, mesh
+
+
+@pytest.mark.parametrize(
+    ("call", "words"),
+    [
+        (
+            lambda s, m: s.add_instance(m, pose=np.eye(4).astype(str)),
+            "pose must be an array of real numbers: it holds text",
+        ),
+        (lambda s, m: s.add_instance(m, pose=np.eye(4, dtype=bool)), "pose must be .* it holds true/false"),
+        (lambda s, m: s.set_poses([s.add_instance(m)], np.eye(4).astype(str)), "poses must be .* it holds text"),
+        (lambda s, m: s.set_materials(np.ones((2, 11)).astype(str)), "materials must be .* it holds text"),
+        (lambda s, m: s.set_materials(np.ones((2, 11), dtype=bool)), "materials must be .* it holds true/false"),
+        (lambda s, m: s.set_seabed(np.zeros((2, 2)).astype(str)), "seabed heights must be .* it holds text"),
+        (lambda s, m: s.set_seabed(np.zeros((2, 2), dtype=bool)), "seabed heights must be .* it holds true/false"),
+    ],
+)
+def test_scene_poses_materials_and_seabed_of_text_or_true_false_are_refused(
+    call: Callable[[Scene, int], Any], words: str
+) -> None:
+    """Scene's poses, material table and seabed heights were read with numpy's float conversion: an identity pose
+    written as text or as true/false placed the instance, a seabed of text or true/false was set and a material
+    table of text loaded, without a word (a table of true/false was refused for its 'arc half-width' of 1). Each
+    is an InputError naming the argument, through mmusv.frames' check of real numbers (ray origins and directions
+    already refused them)."""
+    scene, mesh = _one_triangle()
+    with pytest.raises(InputError, match=words):
+        call(scene, mesh)
+
+
+def test_scene_still_takes_lists_and_numpy_numbers() -> None:
+    """Poses as lists or float32 arrays, and integer seabed heights, still work."""
+    scene, mesh = _one_triangle()
+    inst = scene.add_instance(mesh, pose=np.eye(4).tolist())
+    scene.set_poses([inst], np.eye(4, dtype=np.float32)[None])
+    scene.set_seabed(np.full((2, 2), -5, dtype=np.int32))
+    np.testing.assert_array_equal(scene.instance_pose(inst), np.eye(4))

@@ -838,12 +838,17 @@ BAD_CALLS: list[tuple[str, Callable[[Scene], object], type[MmusvError], str]] = 
         InputError,
         r"class_override must be in 0\.\.65535",
     ),
-    ("pose_string", lambda s: s.add_instance(0, pose="identity"), InputError, r"pose must be a real numeric array"),
+    (
+        "pose_string",
+        lambda s: s.add_instance(0, pose="identity"),
+        InputError,
+        r"pose must be an array of real numbers: it holds (text|complex numbers)",
+    ),
     (
         "pose_complex",
         lambda s: s.add_instance(0, pose=np.eye(4) * 1j),
         InputError,
-        r"pose must be a real numeric array",
+        r"pose must be an array of real numbers: it holds (text|complex numbers)",
     ),
     ("pose_3x3", lambda s: s.add_instance(0, pose=np.eye(3)), InputError, r"pose must be a \(4, 4\)"),
     (
@@ -897,12 +902,17 @@ BAD_CALLS: list[tuple[str, Callable[[Scene], object], type[MmusvError], str]] = 
         InputError,
         r"poses must have shape \(K, 4, 4\)",
     ),
-    ("set_poses_string", lambda s: s.set_poses([0], "identity"), InputError, r"poses must be a real numeric array"),
+    (
+        "set_poses_string",
+        lambda s: s.set_poses([0], "identity"),
+        InputError,
+        r"poses must be an array of real numbers: it holds (text|complex numbers)",
+    ),
     (
         "set_poses_complex",
         lambda s: s.set_poses([0], np.eye(4) + 0j),
         InputError,
-        r"poses must be a real numeric array",
+        r"poses must be an array of real numbers: it holds (text|complex numbers)",
     ),
     (
         "set_poses_bool_ids",

@@ -22,7 +22,7 @@ from typing import Any, Protocol
 import numpy as np
 import numpy.typing as npt
 
-from mmusv import arguments
+from mmusv import arguments, frames
 from mmusv._native import core
 from mmusv.errors import GeometryError, InputError, NotFoundError
 
@@ -218,14 +218,9 @@ def _array(value: Any, *, name: str, dtype: Any, shape_tail: tuple[int, ...]) ->
 
 
 def _floats(value: Any, *, name: str) -> np.ndarray:
-    """``value`` as a float64 array, or an :class:`InputError` naming ``name``."""
-    try:
-        arr = np.asarray(value)
-        if np.iscomplexobj(arr):
-            raise TypeError("complex values")
-        return np.asarray(arr, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"{name} must be a real numeric array: {exc}") from None
+    """``value`` as a float64 array of real numbers (not true/false, text, None or complex numbers: mmusv.frames'
+    check), or an :class:`InputError` naming ``name``."""
+    return frames._floats(value, name=name, tail=(), what="an array")
 
 
 def _uint16s(value: Any, *, name: str) -> np.ndarray:
