@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from mmusv import frames
+from mmusv import frames, wave_occlusion
 from mmusv.annotate import Annotations, SilhouetteCache, annotate_agent, box_corners, footprint_in_range
 from mmusv.classes import class_name
 from mmusv.errors import InputError
@@ -31,6 +31,18 @@ BOX = box_corners(np.eye(4), [2.0, 2.0, 2.0]) + np.array([0.0, 0.0, 10.0])  # in
         (lambda: frames.wrap_deg([np.array(True), 5.0]), "a must be angles in degrees .* true/false"),
         (lambda: box_corners(np.eye(4), [True, 2.0, 1.0]), "size must be .* it holds true/false"),
         (
+            lambda: wave_occlusion.exposed_rays(np.array([True, True]), [True, -0.5]),
+            r"z must be \(N,\) world heights .* it holds true/false",
+        ),
+        (
+            lambda: wave_occlusion.exposed_rays(np.ones(2, dtype=bool), [1.0, 1.0], box=[True, 0], n_boxes=2),
+            "box must be .* it holds true/false",
+        ),
+        (
+            lambda: wave_occlusion.lidar_beam_rays(np.eye(3, dtype=np.float32), lidar_pose=np.eye(4), beams=[True, 0]),
+            r"beams must be \(K,\) beam indices .* it holds true/false",
+        ),
+        (
             lambda: pinhole_truncation(BOX, intrinsics=(True, True, 80, 60), width=9, height=9),
             "intrinsics .* true/false",
         ),
@@ -40,7 +52,8 @@ def test_true_false_in_a_list_of_numbers_is_not_a_number(call: Callable[[], Any]
     """mmusv.frames' check of real numbers (which annotate and image_boxes use) refused an array of true/false but
     not a list mixing them with numbers, which numpy reads as numbers: ``translation([True, 2, 3])`` moved 1 m
     along x, a box of size ``[True, 2, 1]`` was 1 m long and intrinsics ``(True, True, 80, 60)`` a focal length
-    of 1 px, without a word. Each is an InputError naming the argument."""
+    of 1 px, without a word; mmusv.wave_occlusion's own check let the same lists through (a height ``[True, -0.5]``
+    was 1 m above the still level, beam ``True`` beam 1). Each is an InputError naming the argument."""
     with pytest.raises(InputError, match=words):
         call()
 

@@ -76,11 +76,9 @@ def _floats(value: Any, *, name: str, tail: tuple[int, ...], what: str) -> np.nd
         # Only real numbers: a None (NaN as float64), a bool, text ("1.5" converts) or a complex number (its
         # imaginary part dropped) would be read as a number without a word.
         kind = raw.dtype.kind
-        if kind in "iuf" and raw.ndim > 0 and not isinstance(value, np.ndarray):
-            # A list mixing true/false with numbers ([True, 2.0]) is numbers to numpy: its entries are looked at.
-            if any(map(_true_false, np.asarray(value, dtype=object).flat)):
-                raise TypeError("it holds true/false")
-        elif kind == "O":
+        if _holds_true_false(value, raw):
+            raise TypeError("it holds true/false")
+        if kind == "O":
             bad = [x for x in raw.flat if not is_number(x)][:1]
             if bad:
                 raise TypeError(f"it holds {arguments.shown(bad[0])}")
@@ -92,6 +90,15 @@ def _floats(value: Any, *, name: str, tail: tuple[int, ...], what: str) -> np.nd
     if a.ndim < len(tail) or a.shape[a.ndim - len(tail) :] != tail:
         raise InputError(f"{name} must be {what}, got shape {a.shape}")
     return a
+
+
+def _holds_true_false(value: Any, raw: np.ndarray) -> bool:
+    """Whether ``value``, which numpy read as ``raw``, holds true/false among numbers: a list such as ``[True,
+    2.0]`` is numbers to numpy (``[1.0, 2.0]``), so where ``raw`` is numbers and ``value`` no array, its entries
+    are looked at (a bool, numpy's, or a bool array)."""
+    if raw.dtype.kind not in "iuf" or raw.ndim == 0 or isinstance(value, np.ndarray):
+        return False
+    return any(map(_true_false, np.asarray(value, dtype=object).flat))
 
 
 def _true_false(x: object) -> bool:

@@ -38,6 +38,7 @@ import numpy.typing as npt
 
 from mmusv import arguments
 from mmusv.errors import InputError
+from mmusv.frames import _holds_true_false
 from mmusv.scene import Scene
 
 __all__ = [
@@ -134,9 +135,11 @@ def _array(value: Any, *, name: str, shape: tuple[int | None, ...], what: str, i
     except (TypeError, ValueError) as exc:
         raise InputError(f"{name} must be {what}: {exc}") from None
     kinds = "iu" if integer else "fiu"
+    kind = "integers" if integer else "real numbers"
     if a.dtype.kind not in kinds and not (integer and a.size == 0 and a.dtype.kind == "f"):
-        kind = "integers" if integer else "real numbers"
         raise InputError(f"{name} must be {what} ({kind}), got dtype {a.dtype}")
+    if _holds_true_false(value, a):
+        raise InputError(f"{name} must be {what} ({kind}): it holds true/false")
     if a.ndim != len(shape) or any(n is not None and a.shape[i] != n for i, n in enumerate(shape)):
         raise InputError(f"{name} must be {what}, got shape {a.shape}")
     return a
