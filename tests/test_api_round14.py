@@ -8,10 +8,11 @@ from typing import Any
 
 import numpy as np
 import pytest
-from mmusv import frames, wave_occlusion
+from mmusv import frames, motion, wave_occlusion
 from mmusv.annotate import Annotations, SilhouetteCache, annotate_agent, box_corners, footprint_in_range
 from mmusv.classes import class_name
-from mmusv.errors import InputError
+from mmusv.config import load_scenario
+from mmusv.errors import ConfigError, InputError
 from mmusv.image_boxes import clip_box, faces_in_image_box, in_image_box, pinhole_truncation, project_box
 from mmusv.scene import Scene
 from mmusv.simulation import Simulation
@@ -320,3 +321,26 @@ def test_scene_still_takes_lists_and_numpy_numbers() -> None:
     scene.set_poses([inst], np.eye(4, dtype=np.float32)[None])
     scene.set_seabed(np.full((2, 2), -5, dtype=np.int32))
     np.testing.assert_array_equal(scene.instance_pose(inst), np.eye(4))
+
+
+# ------------------------------------------------------------------------------------ mmusv.motion
+
+
+@pytest.mark.parametrize("given", [lambda: lidar_scenario("motion", frames=2), lambda: None, lambda: "scenario.yaml"])
+@pytest.mark.parametrize(
+    "call", [motion.build_fleet, motion.scenario_poses, lambda s: motion.build_moored_fleet(s, [])]
+)
+def test_motion_takes_a_scenario_only(given: Callable[[], Any], call: Callable[[Any], Any]) -> None:
+    """mmusv.motion's functions took a scenario's dict (as ``mmusv.run`` takes one), a path or None and ended in a
+    bare AttributeError ('dict' object has no attribute 'vessels'). Each is a ConfigError saying how to get a
+    Scenario."""
+    with pytest.raises(
+        ConfigError, match=r"scenario = .*: must be a mmusv.config.Scenario \(mmusv.config.load_scenario"
+    ):
+        call(given())
+
+
+def test_motion_of_a_loaded_scenario_is_unchanged() -> None:
+    sc = load_scenario(lidar_scenario("motion", frames=2))
+    assert motion.scenario_poses(sc).shape == (2, len(sc.vessels), 6)
+    assert motion.build_moored_fleet(sc, []) is None

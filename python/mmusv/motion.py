@@ -32,7 +32,7 @@ def build_fleet(scenario: Scenario, *, wave: str | float | None = None, referenc
     vessel with ``role: usv`` at the size of the paper's reference USV (``core.reference_usv_dims()``, 5 × 2.5 ×
     1.5 m, ``α_v = 1``: the USV the amplitudes are calibrated on, which Table I describes) instead of its asset's
     box; only with ``motion: paper`` (the physical response reads the hulls themselves)."""
-    vessels = scenario.vessels
+    vessels = _scenario(scenario).vessels
     assets = [get_asset(v.asset) for v in vessels]
     dims = np.array([[a.length, a.beam, a.height] for a in assets], dtype=np.float64)
     env = scenario.environment if wave is None else scenario.with_wave(wave).environment
@@ -92,13 +92,23 @@ MOORED_ROUTE_M = 10.0
 """The length of the route a moored ship's fleet is given along its heading (it does not sail it: speed 0)."""
 
 
+def _scenario(value: Any) -> Scenario:
+    """``value`` when it is a :class:`~mmusv.config.Scenario`, else a :class:`ConfigError` saying how to get one."""
+    if not isinstance(value, Scenario):
+        raise ConfigError(
+            f"scenario = {arguments.shown(value)}: must be a mmusv.config.Scenario (mmusv.config.load_scenario(path "
+            f"or dict) gives one), not {type(value).__name__}"
+        )
+    return value
+
+
 def build_moored_fleet(scenario: Scenario, moored: list[tuple[str, tuple[float, float, float]]]) -> Any | None:
     """The ``mmusv._core.Fleet`` of a port map's moored ships ``(asset_name, (x, y, yaw))`` (world metres, radians),
     or ``None`` where they stay fixed at the still level: with ``motion: paper`` (the paper's ships at the quays do
     not move, and its bytes stay as published), with a sea of no height, or without moored ships. Over a physical
     sea each ship heaves, rolls and pitches in the scenario's wave field at speed 0 through its own RAOs, as a
     scenario vessel at speed 0 does (its lines hold it in surge, sway and yaw), at its berth and heading."""
-    env = scenario.environment
+    env = _scenario(scenario).environment
     if env.motion != "physical" or not moored or env.sea_spec().hs_m <= 0.0:
         return None
     assets = [get_asset(name) for name, _ in moored]
