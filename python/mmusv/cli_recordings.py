@@ -26,7 +26,7 @@ def cmd_info(args: argparse.Namespace) -> int:
     from rich.text import Text
 
     from mmusv.recording import summary
-    from mmusv.recording.info import find_recordings, missing_recordings, recording_name
+    from mmusv.recording.info import find_recordings, missing_recordings, recording_name, unreadable_listings
 
     target = Path(path_arg(args.recording, flag="recording"))
     folder: Path | None = None
@@ -43,8 +43,9 @@ def cmd_info(args: argparse.Namespace) -> int:
                     f"{target} is a folder without a recording: {own[0].path.name} is gone, though "
                     + " and ".join(f"{by.name} names it ({what})" for by, what in own[0].named_by)
                 )
-            if below or gone:  # a batch's output folder: one line per recording
-                return _overview(target, below, gone)
+            damaged = unreadable_listings(target)  # a dataset.json that no longer reads: said, not passed over
+            if below or gone or damaged:  # a batch's output folder: one line per recording
+                return _overview(target, below, gone, damaged)
             raise MmusvError(f"{target} is a folder without a recording (*.mcap, *.mcap.partial or *.parts.json)")
         if len(found) > 1:
             raise MmusvError(f"{target} holds {len(found)} recordings ({', '.join(f.name for f in found)}); name one")
@@ -145,10 +146,11 @@ def _agents_of(meta: dict[str, dict[str, str]]) -> str:
     return ",".join(map(str, sensors)) if isinstance(sensors, dict) and sensors else "?"
 
 
-def _overview(folder: Path, found: list[Path], gone: list[MissingRecording]) -> int:
+def _overview(folder: Path, found: list[Path], gone: list[MissingRecording], damaged: list[tuple[Path, str]]) -> int:
     """``mmusv info`` on a folder of recordings: one row each (scenario, status, frames, agents, problems), and one
     for each recording that a ``dataset.json`` or a run's ``manifest.json`` below names but that is gone
-    (:func:`~mmusv.recording.info.missing_recordings`). Exits 1 when a recording is gone, cannot be read at all
+    (:func:`~mmusv.recording.info.missing_recordings`), and one for each such file that cannot be read
+    (:func:`~mmusv.recording.info.unreadable_listings`). Exits 1 when a recording is gone, cannot be read at all
     (``mmusv info`` on it alone is an error too) or holds no readable frame (a killed run's ``.partial`` of none,
     a file damaged throughout): a dataset to convert or study lacks it. A damaged or unfinished one that reads is
     a row with its problems, as ``mmusv info`` on it alone warns and exits 0."""
@@ -170,6 +172,7 @@ def _overview(folder: Path, found: list[Path], gone: list[MissingRecording]) -> 
     closed = [rec for rec in found if rec.is_dir()]  # folders below that could not be searched (find_recordings)
     title = f"{counted(len(found) - len(closed), 'recording')} below {folder}"
     title += f", {len(gone)} missing" if gone else ""
+    title += f", {counted(len(damaged), 'listing')} that cannot be read" if damaged else ""
     table = Table(title=Text(title + (f", {counted(len(closed), 'folder')} that cannot be read" if closed else "")))
     for col in ("recording", "scenario", "status", "frames", "agents", "problems"):
         table.add_column(col, overflow="fold")
@@ -181,6 +184,9 @@ def _overview(folder: Path, found: list[Path], gone: list[MissingRecording]) -> 
         count = "?" if m.frames_requested is None else f"0 of {m.frames_requested}"
         why = f"gone; named by {named}"
         rows.append((name, (name, m.scenario or "?", "missing", count, ",".join(m.agents) or "?", short(name, [why]))))
+    for f, why in damaged:
+        name = rel(f)
+        rows.append((name, (name, "?", "unreadable listing", "?", "?", short(name, [why]))))
     for rec in found:
         name = str(rec.relative_to(folder))
         if rec in closed:
@@ -252,7 +258,14 @@ def _overview(folder: Path, found: list[Path], gone: list[MissingRecording]) -> 
             markup=False,
             highlight=False,
         )
-    return 1 if unreadable or empty or gone else 0
+    if damaged:
+        console.print(
+            f"{counted(len(damaged), 'file')} listing recordings (dataset.json, manifest.json) cannot be read: "
+            "whether the recordings they name are there is not checked",
+            markup=False,
+            highlight=False,
+        )
+    return 1 if unreadable or empty or gone or damaged else 0
 
 
 def _table_problems(recording: Path, frames: dict[str, object]) -> tuple[list[str], list[Path]]:

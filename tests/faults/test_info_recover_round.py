@@ -115,6 +115,38 @@ def test_info_of_a_batch_exits_1_for_a_recording_of_no_readable_frame(
     assert re.search(r", 1 of 2 frames,", " ".join(out.split())), out
 
 
+def test_info_of_a_batch_names_a_listing_that_cannot_be_read_and_exits_1(
+    batch: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A batch whose dataset.json was cut short (or a run's manifest.json damaged) listed its recordings and exited
+    0, passing over the file without a word, though convert and the study refuse that folder and info could no
+    longer say whether the recordings it names are there. Another tool's file of that name stays passed over."""
+    monkeypatch.setenv("COLUMNS", "250")
+    copy = tmp_path / "batch2"
+    shutil.copytree(batch, copy)
+    index = (copy / "dataset.json").read_bytes()
+    (copy / "dataset.json").write_bytes(index[:150])
+    code, out, err = cli_main("info", str(copy))
+    assert code == 1 and "Traceback" not in err and "3 recordings below" in out, (out, err)
+    row = _rows(out)["dataset.json"]
+    assert row[1] == "unreadable listing" and row[4].startswith("not JSON: "), row
+    assert "1 file listing recordings (dataset.json, manifest.json) cannot be read" in out, out
+    code, _, err = cli_main("convert", str(copy), "--to", "kitti", "-o", str(tmp_path / "conv"))
+    assert code == 2 and "dataset.json is not a JSON file" in err, err  # what info now warns of
+    # an index of mmusv's format that its reader refuses, and a run's manifest.json that is no object
+    (copy / "dataset.json").write_bytes(index.replace(b'"status": "complete"', b'"status": "bogus"', 1))
+    (copy / "b" / "manifest.json").write_text('["mmusv_version"]')
+    code, out, _ = cli_main("info", str(copy))
+    rows = _rows(out)
+    assert code == 1 and "status = 'bogus': must be one of" in rows["dataset.json"][4], out
+    assert rows["b/manifest.json"][4] == "holds a JSON list, not an object", out
+    # another tool's dataset.json is none of mmusv's business
+    (copy / "dataset.json").write_text("{ not json, and not ours")
+    (copy / "b" / "manifest.json").write_bytes((batch / "b" / "manifest.json").read_bytes())
+    code, out, err = cli_main("info", str(copy))
+    assert code == 0 and "unreadable listing" not in out, (out, err)
+
+
 # ------------------------------------------------------------------------- recover: tables of a finished run
 
 

@@ -42,6 +42,7 @@ __all__ = [
     "missing_recordings",
     "read_info",
     "recording_name",
+    "unreadable_listings",
     "written_by_mmusv",
 ]
 
@@ -343,6 +344,45 @@ def missing_recordings(folder: str | os.PathLike[str]) -> list[MissingRecording]
                 continue
             note(f.parent / rel, f, f"{r.get('name')}: status complete", r)
     return sorted(found.values(), key=lambda m: str(m.path))
+
+
+def unreadable_listings(folder: str | os.PathLike[str]) -> list[tuple[Path, str]]:
+    """The files below ``folder`` that would say which recordings belong there but cannot be read, each with why:
+    a batch's ``dataset.json`` or a run's ``manifest.json`` written by mmusv (its bytes name ``mmusv``) that is no
+    longer JSON (cut short, damaged), and a ``dataset.json`` of mmusv's format that :func:`mmusv.batch.index.
+    read_index` refuses. :func:`missing_recordings` passes over what they name, as it passes over files of those
+    names that other tools wrote (which do not name ``mmusv``). Sorted by path; ``folder`` as for
+    :func:`find_recordings`."""
+    from mmusv.batch.index import INDEX_FORMAT, read_index
+    from mmusv.errors import MmusvError
+
+    root = arguments.path(folder, name="folder")
+    if not root.is_dir():
+        return []
+    out: list[tuple[Path, str]] = []
+    for f in _files_below(root)[0]:
+        if f.name not in ("dataset.json", "manifest.json"):
+            continue
+        try:
+            raw = f.read_bytes()
+        except OSError as exc:
+            out.append((f, f"cannot be read: {exc.strerror or type(exc).__name__}"))
+            continue
+        if b'"mmusv' not in raw:
+            continue  # another tool's file of that name
+        try:
+            doc = json.loads(raw)
+        except ValueError as exc:
+            out.append((f, f"not JSON: {exc}"))
+            continue
+        if not isinstance(doc, dict):
+            out.append((f, f"holds a JSON {type(doc).__name__}, not an object"))
+        elif f.name == "dataset.json" and doc.get("format") == INDEX_FORMAT:
+            try:
+                read_index(f)
+            except MmusvError as exc:
+                out.append((f, str(exc).removeprefix(f"{f}: ")))
+    return sorted(out, key=lambda x: str(x[0]))
 
 
 def _plain_name(name: object) -> bool:
