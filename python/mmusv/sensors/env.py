@@ -18,7 +18,7 @@ and waves.
   drag coefficient of 1.3·10⁻³; a neutral log profile of that drag coefficient would give 1.060 instead, 3 % less
   wind at 10 m: the published ratio is kept, as the oceanographic references quote it). Cox & Munk's fit was to
   the wind at 12.5 m (their anemometer), 1–2 % above the 10 m wind; taking it at 10 m makes their mean square
-  slope about 1 % smaller.
+  slope about 2 % smaller (1.8–1.9 % at the W0–W3 seas' winds, for the log profile of that drag coefficient).
 * **Water body**: diffuse reflectance (linear RGB) of clear open-ocean water, blue (Morel 1988's case-1 water:
   a few per cent in the blue, well under one in the red).
 """
