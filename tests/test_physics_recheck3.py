@@ -19,6 +19,10 @@ Models and sources:
   integrated numerically; Koschmieder's visibility ``V = −ln 0.05 / σ``.
 * Roll radius of gyration (``ocean/response.rs`` header): IMO IS Code 2008 §2.3, ``C = 0.373 + 0.023 B/d −
   0.043 L/100``; block coefficients by ship type (``mmusv.world.hydrostatics``): Schneekluth & Bertram (1998).
+* Kelvin ship waves (``sensors/shade/kelvin.rs``): the stationary phase of the transverse waves of a source moving
+  at U over deep water, ``min over θ of k0 r cos(θ − α) sec²θ``, ``k0 = g/U²`` (Lighthill 1978, §3.10).
+* The night sky (``sensors/shade/sky.rs``): a moonless clear night's horizontal illuminance, 0.002 lux, and the
+  natural sky's luminance, 1.74·10⁻⁴ cd/m² (Falchi et al. 2016) — xfail: the core's night sky is 3 times brighter.
 """
 
 from __future__ import annotations
