@@ -22,7 +22,7 @@ Models and sources:
 * Kelvin ship waves (``sensors/shade/kelvin.rs``): the stationary phase of the transverse waves of a source moving
   at U over deep water, ``min over θ of k0 r cos(θ − α) sec²θ``, ``k0 = g/U²`` (Lighthill 1978, §3.10).
 * The night sky (``sensors/shade/sky.rs``): a moonless clear night's horizontal illuminance, 0.002 lux, and the
-  natural sky's luminance, 1.74·10⁻⁴ cd/m² (Falchi et al. 2016) — xfail: the core's night sky is 3 times brighter.
+  natural sky's luminance, 1.74·10⁻⁴ cd/m² (Falchi et al. 2016).
 """
 
 from __future__ import annotations
@@ -325,16 +325,10 @@ e1600377), a uniform sky of which would give π · 1.74·10⁻⁴ = 5.5·10⁻�
 sky."""
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="sensors/shade/sky.rs NIGHT_FLOOR is 0.002 cd/m² of luminance over the whole sky, 'a moonless clear "
-    "night sky', whose horizontal illuminance π · 0.002 = 0.0063 lux is 3.1 times the 0.002 lux (illuminance) of "
-    "a moonless clear night; the luminance itself 11 times the natural night sky's 1.74e-4 cd/m²",
-)
 def test_the_night_sky_lights_the_ground_as_a_moonless_clear_night() -> None:
     """With the Sun 18° to 89° below the horizon (astronomical night), the clear sky's horizontal illuminance
     (``SensorEnv.exposure[0]``) is a moonless clear night's 0.002 lux within a factor 1.5 (the airglow varies by
-    about that much); measured 0.0063 lux, the sky's luminance 0.002 cd/m² everywhere."""
+    about that much). The core's night floor took that 0.002 for the sky's luminance in cd/m²: 0.0063 lux."""
     for depression in (18.0, 30.0, 60.0, 89.0):
         e = math.radians(-depression)
         lux = clear_env(sun=(0.0, math.cos(e), math.sin(e))).exposure[0]

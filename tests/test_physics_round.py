@@ -535,7 +535,7 @@ def test_docs_slopes_the_surface_levels_cannot_draw() -> None:
 def test_docs_exposure_and_sea_state_numbers() -> None:
     """``docs/realism/README.md``: the exposure floor 3.46 lux is 1.2π·2^EV100 of f/1.4, 1/30 s, ISO 6 400
     (EV100 = log2(N²/t) − log2(S/100) = −0.12), and the old 10 lux floor was ISO ≈ 2 200 at f/1.4, 1/30 s; the
-    horizontal light at 45° N on 21 June falls to 4.8, 0.58, 0.083, 0.018 lux at 20:30, 20:45, 21:00, 21:15 (the
+    horizontal light at 45° N on 21 June falls to 4.8, 0.58, 0.079, 0.0136 lux at 20:30, 20:45, 21:00, 21:15 (the
     sun 10° down at 21:00) and the metered scale holds π/3.46 below the floor; W3's wind at 10 m is 12.5 m/s and
     Monahan's coverage there 2.1 %; the Froude numbers U/√(gL) quoted (tug 32 m at 2 m/s 0.11, 300 m at 5 m/s
     0.09, 90 m at 6 m/s 0.20, 20 m at 7 m/s 0.50) and exp(−1/(32 Fr⁴)) = e^{−30} at Fr 0.18."""
@@ -545,7 +545,7 @@ def test_docs_exposure_and_sea_state_numbers() -> None:
     iso = 100 * 1.4**2 * 30 / (10 / (1.2 * math.pi))
     assert iso == pytest.approx(2200, rel=0.01)
     assert core.exposure_limits()["default_max_iso"] == 6400.0
-    for time, lux in [("20:30", 4.8), ("20:45", 0.58), ("21:00", 0.083), ("21:15", 0.018)]:
+    for time, lux in [("20:30", 4.8), ("20:45", 0.58), ("21:00", 0.079), ("21:15", 0.0136)]:
         env = sensor_env(Environment.make(time_of_day=time))
         assert env.exposure[0] == pytest.approx(lux, rel=0.03), time
         if lux < 3.46:

@@ -16,7 +16,8 @@
 //! * **Twilight and night**: Preetham is defined for the sun above the horizon. Below it the sky is the
 //!   model's horizon-sun sky scaled by `exp(h / 0.9°)` (`h` the sun's elevation in degrees: about 10⁻³ at the
 //!   end of civil twilight, −6°, the fall the zenith luminance shows from sunset), over a night floor of
-//!   0.002 cd/m² (a moonless clear night sky) — in level: its shape and colour are those of single scattering
+//!   0.002/π cd/m², a uniform sky whose horizontal illuminance `π L` is a moonless clear night's 0.002 lux (the
+//!   figure was once taken as the luminance itself: 3.1 times too bright) — in level: its shape and colour are those of single scattering
 //!   in a spherical atmosphere of pure air with the Earth's shadow and the ozone layer ([`super::twilight`]),
 //!   the blue zenith over the orange band of the sunward horizon, scaled to the same horizontal illuminance (so
 //!   what lights the scene and sets the metered exposure keeps its level). Between the horizon and 1° below it
@@ -39,8 +40,8 @@ pub const SUN_RADIUS_RAD: f32 = 0.004_651;
 const SIN2_SUN_RADIUS: f32 = 2.163_164_6e-5;
 /// `cos 2r`: directions farther from the sun than twice its radius are outside the disc, whatever the rounding.
 const COS_SUN_GUARD: f32 = 0.999_956_7;
-/// Night-sky floor, cd/m².
-const NIGHT_FLOOR: f32 = 0.002;
+/// Night-sky floor, cd/m²: a uniform sky lighting the ground with a moonless clear night's 0.002 lux (`π L`).
+const NIGHT_FLOOR: f32 = 0.002 / std::f32::consts::PI;
 /// Centre wavelengths of the R, G, B channels, µm (`twilight.rs` holds them in double precision).
 const LAMBDA: [f32; 3] = [0.61, 0.55, 0.465];
 /// Depression below which the twilight sky keeps its shape (only its level falls), radians (6°).
