@@ -17,7 +17,9 @@
 //!   oceanic shallow waters: influence of water depth and bottom albedo", Limnol. Oceanogr. 39(7), 1994), with a
 //!   sand bottom of albedo `A_b` and the diffuse attenuation `K_d` of clear coastal water: pure water's
 //!   absorption at the channels' wavelengths (R. M. Pope & E. S. Fry, Appl. Opt. 36(33), 1997: 0.264, 0.057 and
-//!   0.012 m⁻¹ at 610, 550 and 465 nm) plus 0.06 m⁻¹ for scattering and dissolved matter (an approximation).
+//!   0.010 m⁻¹ at 610, 550 and 465 nm, the last between the table's 0.00979 at 460 and 0.0106 at 470 nm; it was
+//!   0.012, the table's value near 477 nm, until 2026-12-05) plus 0.06 m⁻¹ for scattering and dissolved matter
+//!   (an approximation).
 //! * **Water body**: the light scattered back out of the water is the smooth-plastic model of Mitsuba 3 — a
 //!   dielectric interface (IOR 1.33) over a Lambertian body of diffuse reflectance `ρ`: radiance
 //!   `ρ / (1 − F_dr) · (1 − F(θ_o)) / η² · ∫ (1 − F(θ_i)) L cos θ_i dω / π`, with `F_dr` the interface's internal
@@ -28,7 +30,7 @@ use parry3d::math::Vec3;
 /// Albedo of a sand bottom, linear RGB.
 pub const BOTTOM_ALBEDO: [f32; 3] = [0.36, 0.31, 0.22];
 /// Diffuse attenuation of clear coastal water, 1/m, per channel (see the module docs).
-pub const K_D: [f32; 3] = [0.324, 0.117, 0.072];
+pub const K_D: [f32; 3] = [0.324, 0.117, 0.070];
 
 /// Diffuse reflectance of the water body `rho_deep` over a sand bottom `depth` metres down (Maritorena et al.).
 #[inline(always)]
@@ -42,7 +44,7 @@ pub fn shallow_albedo(rho_deep: Vec3, depth: f32) -> Vec3 {
 /// Depth steps per metre of [`ShallowWater`]'s table.
 const SHALLOW_STEPS_PER_M: f32 = 32.0;
 /// Depth past which [`ShallowWater`] takes the water as deep: the bottom's share `e^(−2 K_D d)` is below
-/// `e^(−2 · 0.072 · 64) ≈ 10⁻⁴` in every channel.
+/// `e^(−2 · 0.070 · 64) ≈ 10⁻⁴` in every channel.
 const SHALLOW_MAX_M: f32 = 64.0;
 
 /// [`shallow_albedo`] of one water body tabulated over depth (every 1/32 m to 64 m, read linearly: within
@@ -175,8 +177,18 @@ mod tests {
         let deep = Vec3::new(0.004, 0.018, 0.03);
         assert!((shallow_albedo(deep, 0.0) - Vec3::from_array(BOTTOM_ALBEDO)).length() < 1e-6);
         assert!((shallow_albedo(deep, 1000.0) - deep).length() < 1e-6);
-        // At 5 m the blue channel keeps exp(-2·0.072·5) = 0.487 of the bottom's contrast.
+        // At 5 m the blue channel keeps exp(-2·0.070·5) = 0.497 of the bottom's contrast.
         let b = shallow_albedo(deep, 5.0).z;
-        assert!((b - (0.03 + (0.22 - 0.03) * (-0.72f32).exp())).abs() < 1e-5);
+        assert!((b - (0.03 + (0.22 - 0.03) * (-0.70f32).exp())).abs() < 1e-5);
+    }
+
+    #[test]
+    fn diffuse_attenuation_is_pope_and_fry_plus_the_scattering_term() {
+        // Pope & Fry (1997), Table 3, pure water's absorption, 1/m: 0.2644 at 610 nm, 0.0565 at 550 nm, and 0.00979
+        // and 0.0106 at 460 and 470 nm, read linearly at 465 nm; plus the module's 0.06 for the rest.
+        let blue = 0.5 * (0.00979 + 0.0106);
+        for (k, a) in K_D.iter().zip([0.2644f32, 0.0565, blue]) {
+            assert!((k - (a + 0.06)).abs() < 0.001, "{k} against {}", a + 0.06);
+        }
     }
 }
