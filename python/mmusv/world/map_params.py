@@ -22,6 +22,7 @@ __all__ = [
     "COAST_SIDES",
     "DEFAULT_MOORED_ASSETS",
     "MAP_KINDS",
+    "MOORED_SIZE_SLACK_M",
     "PARAM_MODELS",
     "IslandParams",
     "MapConfigError",
@@ -238,7 +239,8 @@ class PortParams(_CommonParams):
     """Ships moored at the terminal quay and the piers (labelled ``moored_00``, ...); a port whose quay and piers
     have fewer free berths for ``moored_assets`` is refused when it is built, naming the most that fit."""
     moored_assets: tuple[_Berth, ...] = DEFAULT_MOORED_ASSETS
-    """Candidate moored ships: ``(asset_name, length_m, beam_m)``."""
+    """Candidate moored ships: ``(asset_name, length_m, beam_m)``, the size its berth is laid out for: the ship's
+    own length and beam (or larger, for more room), at most :data:`MOORED_SIZE_SLACK_M` less."""
     hill_height_m: float = Field(default=35.0, ge=0.0, le=200.0)
     vegetation: StrictBool = True
 
@@ -330,7 +332,35 @@ class PortParams(_CommonParams):
                 known_asset(name)
             except AssetNameError as exc:  # said with the entry, as a vessel's asset is: not only when built
                 raise ValueError(f"entry {k} ({name!r}): {exc}") from None
+        _berths_hold_their_ships(v)
         return v
+
+
+MOORED_SIZE_SLACK_M = 2.0
+"""How much shorter or narrower (metres) than its ship a ``moored_assets`` entry's ``length_m`` and ``beam_m`` may
+be. The port lays each berth out for the entry's size (3 m off the quay or pier face, at least 4 m from the next
+berth), and the map keeps buoys and the route checks off that footprint: a ship up to 2 m longer and broader than
+it (1 m a side) still clears all of them."""
+
+
+def _berths_hold_their_ships(entries: tuple[_Berth, ...]) -> None:
+    """A ``ValueError`` naming the first entry of ``moored_assets`` whose berth (its ``length_m`` x ``beam_m``) is
+    more than :data:`MOORED_SIZE_SLACK_M` shorter or narrower than its ship: ``[container_ship_300m, 1, 1]`` moored
+    ten 300 m ships 30 m apart, into each other and the quay, without a word. The defaults are the ships' own
+    figures (nothing built for them); another entry's asset is built (cached) for its size."""
+    from mmusv.world.vessels import get_asset
+
+    for k, (name, length, beam) in enumerate(entries):
+        if (name, length, beam) in DEFAULT_MOORED_ASSETS:
+            continue
+        ship = get_asset(name)
+        if length < ship.length - MOORED_SIZE_SLACK_M or beam < ship.beam - MOORED_SIZE_SLACK_M:
+            raise ValueError(
+                f"entry {k} ({name!r}) gives its berth length_m x beam_m = {length:g} x {beam:g} m, but the ship is "
+                f"{ship.length:g} x {ship.beam:g} m: the port lays the berth out for the size given, so a ship more "
+                f"than {MOORED_SIZE_SLACK_M:g} m longer or broader than it lies in the quay, a pier or the next ship; "
+                f"give the ship's own figures [{name}, {ship.length:g}, {ship.beam:g}] (or larger, for more room)"
+            )
 
 
 MapParams = IslandParams | OpenSeaParams | PortParams

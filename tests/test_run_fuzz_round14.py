@@ -1,0 +1,51 @@
+"""Round 14 of the run fuzz: scenarios that loaded but then ran wrong (tiny runs of mutated bundled and test
+scenarios). Each is now refused when the scenario loads, naming the field and what is allowed."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
+from mmusv.config import load_scenario
+from mmusv.errors import ConfigError
+from mmusv.world.map_params import MapConfigError, make_params
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _port_entry(**params: Any) -> dict[str, Any]:
+    doc: dict[str, Any] = yaml.safe_load((ROOT / "scenarios" / "port_entry.yaml").read_text(encoding="utf-8"))
+    doc["map"]["params"] = params
+    return doc
+
+
+# ------------------------------------------------------------------------------- moored ships and their berths
+
+
+def test_a_berth_smaller_than_its_moored_ship_is_refused_naming_the_entry() -> None:
+    """``moored_assets: [[container_ship_300m, 1, 1]]`` loaded and ran: the port laid out 1 m berths 15-40 m apart,
+    so ten 300 m ships lay in each other and in the quay (the map's buoys and the route checks kept off 1 m
+    footprints), without a word. The entry is refused with the ship's own figures."""
+    with pytest.raises(ConfigError) as err:
+        load_scenario(_port_entry(n_moored=3, moored_assets=[["tug_32m", 32, 12], ["container_ship_300m", 1, 1]]))
+    said = str(err.value)
+    assert "map.params.moored_assets" in said and "entry 1 ('container_ship_300m')" in said, said
+    assert "1 x 1 m" in said and "300 x 48.2 m" in said and "[container_ship_300m, 300, 48.2]" in said, said
+    with pytest.raises(MapConfigError) as err2:
+        make_params("port", moored_assets=[["usv_wamv", 1, 1]])
+    assert err2.value.field == "moored_assets" and "4.88 x 2.44 m" in str(err2.value), str(err2.value)
+
+
+@pytest.mark.parametrize(
+    "entries",
+    [
+        [["container_ship_300m", 300, 48.2]],  # the ship's own figures
+        [["tug_32m", 60, 20]],  # a larger berth: more room
+        [["tug_32m", 30, 10]],  # within the slack (1 m a side clears the quay, the piers and the next ship)
+    ],
+)
+def test_berths_of_the_ships_size_or_larger_still_load(entries: list[list[Any]]) -> None:
+    scenario = load_scenario(_port_entry(n_moored=1, moored_assets=entries))
+    assert [list(e) for e in scenario.map.params.moored_assets] == [[e[0], float(e[1]), float(e[2])] for e in entries]
