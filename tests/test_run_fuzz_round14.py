@@ -11,6 +11,7 @@ import yaml
 from mmusv.config import load_scenario
 from mmusv.errors import ConfigError
 from mmusv.world.map_params import MapConfigError, make_params
+from tiny_scenario import lidar_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -49,3 +50,24 @@ def test_a_berth_smaller_than_its_moored_ship_is_refused_naming_the_entry() -> N
 def test_berths_of_the_ships_size_or_larger_still_load(entries: list[list[Any]]) -> None:
     scenario = load_scenario(_port_entry(n_moored=1, moored_assets=entries))
     assert [list(e) for e in scenario.map.params.moored_assets] == [[e[0], float(e[1]), float(e[2])] for e in entries]
+
+
+# ------------------------------------------------------------------------------------- a vessel named 'world'
+
+
+@pytest.mark.parametrize("who", [0, 1])
+def test_a_vessel_id_world_is_refused(who: int) -> None:
+    """A vessel ``id: world`` loaded and ran: its body frame in /tf was a child of the world frame named 'world'
+    (a tree whose root moves with the hull), and a USV's topics /world/lidar, /world/boxes, ... were taken for the
+    world's (``mmusv preview`` of the recording: "frame 0 has no agent topics"). Other ids, 'World' among them,
+    load as before."""
+    from mmusv.recording import topics
+
+    doc = lidar_scenario("world_id", frames=1)
+    doc["vessels"][who]["id"] = topics.WORLD_FRAME
+    with pytest.raises(ConfigError) as err:
+        load_scenario(doc)
+    said = str(err.value)
+    assert f"vessels[{who}].id" in said and "'world' is the name of the world frame" in said, said
+    doc["vessels"][who]["id"] = "World"
+    assert load_scenario(doc).vessels[who].id == "World"

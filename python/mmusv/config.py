@@ -278,6 +278,11 @@ class AcquisitionConfig(_Model):
         return [k / self.frequency_hz for k in range(self.frames)]
 
 
+_WORLD_FRAME = "world"
+"""The world frame's id and topic namespace (:data:`mmusv.recording.topics.WORLD_FRAME`, not imported here: that
+package loads the recorder), which no vessel id may take."""
+
+
 class VesselConfig(_Model):
     """One vessel: a USV (instrumented, carries ``rig``) or a target, on a spline ``route`` through waypoints
     (metres, world frame) at ``speed_mps``; ``end`` says what happens at the route end."""
@@ -294,6 +299,19 @@ class VesselConfig(_Model):
     """Height (m) of the vessel's frame over the still water: 0 floats the asset at its own waterline, below 0 sits it
     deeper (not so deep that the whole hull is under the water), above 0 lifts it (clear of the water, for a
     controlled set-up: an object against the horizon sky)."""
+
+    @field_validator("id")
+    @classmethod
+    def _not_the_world(cls, v: str) -> str:
+        # The recording names each vessel's frame after its id, under the world frame, and each USV's topics
+        # /<id>/...: a vessel 'world' was a frame of the world frame's name (a /tf tree whose root moves with a hull)
+        # and a USV 'world' topics /world/... that readers take for the world's (`mmusv preview`: "no agent topics").
+        if v == _WORLD_FRAME:
+            raise ValueError(
+                f"{v!r} is the name of the world frame (the recording's /tf tree and /world/... topics use it); "
+                "choose another id"
+            )
+        return v
 
     @field_validator("asset")
     @classmethod
