@@ -71,3 +71,25 @@ def test_a_vessel_id_world_is_refused(who: int) -> None:
     assert f"vessels[{who}].id" in said and "'world' is the name of the world frame" in said, said
     doc["vessels"][who]["id"] = "World"
     assert load_scenario(doc).vessels[who].id == "World"
+
+
+# ------------------------------------------------------------------------------ a top view inside its own hull
+
+
+def test_a_top_view_at_or_below_its_hull_top_is_refused() -> None:
+    """``top_view: {altitude_m: 1e-9}`` (or 1 m over a 5.2 m patrol boat) loaded and ran: the top view looks down
+    from that height over the USV's own origin, inside its hull, and its picture held none of the USV (at 1e-9 m;
+    42 pixels of 156 at 1 m), without a word. Any altitude above the hull's top (its z_base_m counted) loads."""
+    doc = lidar_scenario("top_view_in_hull", frames=1)
+    doc["vessels"][0]["asset"] = "usv_patrol_12m"  # top at z = 5.2 m
+    doc["rigs"]["r"]["top_view"] = {"altitude_m": 1.0}
+    with pytest.raises(ConfigError) as err:
+        load_scenario(doc)
+    said = str(err.value)
+    assert "rigs.r.top_view.altitude_m = 1:" in said and "hull reaches 5.20 m" in said, said
+    assert "altitude_m must be above 5.20 m" in said, said
+    doc["rigs"]["r"]["top_view"] = {"altitude_m": 5.3}
+    assert load_scenario(doc).rigs["r"].top_view is not None
+    doc["vessels"][0]["z_base_m"] = 0.2  # lifts the hull's top to 5.4 m
+    with pytest.raises(ConfigError, match=r"altitude_m = 5\.3: .*5\.40 m with z_base_m = 0\.2"):
+        load_scenario(doc)

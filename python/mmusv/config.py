@@ -412,6 +412,10 @@ class Scenario(_Model):
                     _check_mount_points(v, i, v.rig, self.rigs[v.rig])
                 except ValueError as exc:
                     problems.append(str(exc))
+            if v.role == "usv" and (v.rig is None or v.rig in self.rigs):
+                why = _top_view_in_hull(v, i, v.rig, self.rigs[v.rig] if v.rig is not None else RigConfig())
+                if why is not None:
+                    problems.append(why)
         if problems:
             raise ValueError("; ".join(dict.fromkeys(problems)))
         return self
@@ -450,6 +454,27 @@ def _check_mount_points(v: VesselConfig, index: int, rig_name: str, rig: RigConf
                 f"rigs.{rig_name}.{where}.point = {m.point!r}: asset {v.asset} (vessels[{index}], {v.id}) has no such "
                 f"mount point; {hint}its points: {', '.join(points)}"
             )
+
+
+def _top_view_in_hull(v: VesselConfig, index: int, rig_name: str | None, rig: RigConfig) -> str | None:
+    """What is wrong with the top view of ``rig`` on USV ``v``, or ``None``: it looks straight down from ``altitude_m``
+    over the still water above the USV's own origin, so at or below the top of its hull (``z_base_m`` counted) it
+    sat in that hull, and its picture lost the USV (all of it at 1e-9 m, most of it at 1 m on a 5.2 m patrol boat)
+    without a word; a sensor mounted inside its hull is refused (:mod:`mmusv.agents`)."""
+    if rig.top_view is None:
+        return None
+    top = float(get_asset(v.asset).bbox[1, 2]) + v.z_base_m
+    altitude = rig.top_view.altitude_m
+    if altitude > top:
+        return None
+    field = f"rigs.{rig_name}.top_view.altitude_m" if rig_name is not None else "the default rig's top_view.altitude_m"
+    lifted = f" with z_base_m = {v.z_base_m:g}" if v.z_base_m else ""
+    return (
+        f"{field} = {altitude:g}: the top view looks down from {altitude:g} m over the still water above vessel "
+        f"{v.id!r} (vessels[{index}], {v.asset}), whose hull reaches {top:.2f} m{lifted}: it would cut through the "
+        f"hull and lose the vessel, whole or in part, from its picture; altitude_m must be above {top:.2f} m "
+        "(default 120)"
+    )
 
 
 def load_scenario(source: str | os.PathLike[str] | dict[str, Any] | Scenario) -> Scenario:
