@@ -1,4 +1,5 @@
-"""One clear, fog-free, windless sensor environment for the physics tests, every field explicit."""
+"""One clear, fog-free, windless sensor environment for the physics tests, every field explicit, and one LiDAR
+without noise, dropout or water returns to measure in it."""
 
 from __future__ import annotations
 
@@ -22,3 +23,20 @@ def clear_env(sun: np.ndarray | tuple[float, float, float] = (0.3, 0.2, 0.93), *
     }
     args.update(kw)
     return core.SensorEnv(**args)  # type: ignore[arg-type]
+
+
+def clear_lidar(*, channels: int, azimuth_steps: int) -> core.Lidar:
+    """A LiDAR of ``channels`` beams fanned over ±0.3° and ``azimuth_steps`` columns, 0.5–2,000 m, with no range
+    noise, no dropout and no water returns: every loss a test measures is the environment's."""
+    return core.Lidar(
+        elevations=list(core.uniform_elevations(channels=channels, lower=-0.3, upper=0.3)),
+        azimuth_steps=azimuth_steps,
+        range_min=0.5,
+        range_max=2000.0,
+        range_noise_std=0.0,
+        dropout=0.0,
+        water_probability=0.0,
+        water_probability_per_wave_m=0.0,
+        water_range_m=0.0,
+        water_range_per_wave_m=0.0,
+    )

@@ -33,7 +33,7 @@ import math
 
 import numpy as np
 import pytest
-from clear_env import clear_env
+from clear_env import clear_env, clear_lidar
 from mmusv._native import core
 from mmusv.scene import Scene
 from mmusv.sensors.camera import render
@@ -353,19 +353,7 @@ def test_lidar_fog_is_koschmieder_two_way() -> None:
     scene = Scene()
     x = 150.0
     _quad(scene, [[x, -400, -100], [x, 400, -100], [x, 400, 100], [x, -400, 100]], cls=5)
-    elevations = core.uniform_elevations(channels=32, lower=-0.3, upper=0.3)
-    lidar = core.Lidar(
-        elevations=list(elevations),
-        azimuth_steps=2048,
-        range_min=0.5,
-        range_max=2000.0,
-        range_noise_std=0.0,
-        dropout=0.0,
-        water_probability=0.0,
-        water_probability_per_wave_m=0.0,
-        water_range_m=0.0,
-        water_range_per_wave_m=0.0,
-    )
+    lidar = clear_lidar(channels=32, azimuth_steps=2048)
     pose = pose_matrices(np.array([0.0, 0.0, 5.0, 0.0, 0.0, 0.0]))
     clear = lidar.scan(scene.native, pose=pose, env=clear_env(), seed=3)
     foggy = lidar.scan(scene.native, pose=pose, env=clear_env(fog_extinction_per_m=sigma), seed=3)

@@ -33,7 +33,7 @@ import re
 
 import numpy as np
 import pytest
-from clear_env import clear_env
+from clear_env import clear_env, clear_lidar
 from mmusv._native import core
 from mmusv.frames import pose_matrices
 from mmusv.scene import Scene
@@ -186,18 +186,7 @@ def _wall_scan(rain_mm_per_h: float) -> dict[str, np.ndarray]:
     scene = Scene()
     wall = np.array([[150.0, -300, -80], [150.0, 300, -80], [150.0, 300, 80], [150.0, -300, 80]])
     scene.add_instance(scene.add_mesh(wall, np.array([[0, 1, 2], [0, 2, 3]]), classes=5, name="wall"))
-    lidar = core.Lidar(
-        elevations=list(core.uniform_elevations(channels=16, lower=-0.3, upper=0.3)),
-        azimuth_steps=1024,
-        range_min=0.5,
-        range_max=2000.0,
-        range_noise_std=0.0,
-        dropout=0.0,
-        water_probability=0.0,
-        water_probability_per_wave_m=0.0,
-        water_range_m=0.0,
-        water_range_per_wave_m=0.0,
-    )
+    lidar = clear_lidar(channels=16, azimuth_steps=1024)
     pose = pose_matrices(np.array([0.0, 0.0, 5.0, 0.0, 0.0, 0.0]))
     return lidar.scan(scene.native, pose=pose, env=clear_env(rain_mm_per_h=rain_mm_per_h), seed=3)
 
