@@ -50,7 +50,7 @@ BOX = box_corners(np.eye(4), [2.0, 2.0, 2.0]) + np.array([0.0, 0.0, 10.0])  # in
     ],
 )
 def test_true_false_in_a_list_of_numbers_is_not_a_number(call: Callable[[], Any], words: str) -> None:
-    """mmusv.frames' check of real numbers (which annotate and image_boxes use) refused an array of true/false but
+    """mmusv.arguments.reals (the check that frames, annotate and image_boxes use) refused an array of true/false but
     not a list mixing them with numbers, which numpy reads as numbers: ``translation([True, 2, 3])`` moved 1 m
     along x, a box of size ``[True, 2, 1]`` was 1 m long and intrinsics ``(True, True, 80, 60)`` a focal length
     of 1 px, without a word; mmusv.wave_occlusion's own check let the same lists through (a height ``[True, -0.5]``
@@ -307,7 +307,7 @@ def test_scene_poses_materials_and_seabed_of_text_or_true_false_are_refused(
     """Scene's poses, material table and seabed heights were read with numpy's float conversion: an identity pose
     written as text or as true/false placed the instance, a seabed of text or true/false was set and a material
     table of text loaded, without a word (a table of true/false was refused for its 'arc half-width' of 1). Each
-    is an InputError naming the argument, through mmusv.frames' check of real numbers (ray origins and directions
+    is an InputError naming the argument, through mmusv.arguments.reals (ray origins and directions
     already refused them)."""
     scene, mesh = _one_triangle()
     with pytest.raises(InputError, match=words):

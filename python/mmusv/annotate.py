@@ -40,7 +40,7 @@ from scipy.spatial.transform import Rotation
 from mmusv import arguments
 from mmusv._equality import same
 from mmusv.errors import InputError
-from mmusv.frames import BODY_TO_OPTICAL, _floats, translation
+from mmusv.frames import BODY_TO_OPTICAL, translation
 from mmusv.image_boxes import (
     camera_lens,
     clip_box,
@@ -89,7 +89,9 @@ def in_target_range(centres: np.ndarray, range_m: float) -> np.ndarray:
     vessel whose footprint comes within range (:func:`footprint_in_range`), and the ROS 2 export's 3D detections are
     those boxes.
     """
-    c = _floats(centres, name="centres", tail=(), what="(..., 3) or (..., 2) centres (x, y[, z] metres)")
+    c = arguments.reals(
+        centres, name="centres", what="(..., 3) or (..., 2) centres (x, y[, z] metres)", error=InputError
+    )
     if c.ndim == 0 or c.shape[-1] not in (2, 3):
         raise InputError(f"centres must have shape (..., 3) or (..., 2) (x, y[, z] metres), got {c.shape}")
     return np.asarray(np.hypot(c[..., 0], c[..., 1]) <= _range(range_m))
@@ -109,8 +111,8 @@ def footprint_in_range(box: np.ndarray, *, size: np.ndarray, range_m: float) -> 
     beyond a 200 m LiDAR's range, yet the LiDAR sees it; the centre rule of :func:`in_target_range` stays the
     exports' and the detection study's (OpenCOOD's convention). A box or size that is not finite, or a size below 0,
     raises :class:`mmusv.InputError`."""
-    m = _floats(box, name="box", tail=(4, 4), what="a (4, 4) box -> ego LiDAR transform")
-    size = _floats(size, name="size", tail=(), what="the box's size (length, beam[, height])")
+    m = arguments.reals(box, name="box", tail=(4, 4), what="a (4, 4) box -> ego LiDAR transform", error=InputError)
+    size = arguments.reals(size, name="size", what="the box's size (length, beam[, height])", error=InputError)
     if m.ndim != 2 or size.shape not in ((2,), (3,)):
         raise InputError(
             f"footprint_in_range takes a (4, 4) box and a (3,) or (2,) size, got {m.shape} and {size.shape}"
@@ -135,8 +137,8 @@ def box_corners(matrix: np.ndarray, size: np.ndarray) -> np.ndarray:
     ``±size / 2`` in the box frame, the sign of x from bit 0 of ``i``, of y from bit 1 and of z from bit 2 (set:
     +; corner 0 is (−x, −y, −z), corner 7 (+x, +y, +z)). Other shapes, and a size not finite or below 0, raise
     :class:`mmusv.InputError`."""
-    matrix = _floats(matrix, name="matrix", tail=(), what="a (4, 4) box pose")
-    size = _floats(size, name="size", tail=(), what="the box's (3,) size (length, beam, height)")
+    matrix = arguments.reals(matrix, name="matrix", what="a (4, 4) box pose", error=InputError)
+    size = arguments.reals(size, name="size", what="the box's (3,) size (length, beam, height)", error=InputError)
     if matrix.shape != (4, 4) or size.shape != (3,):
         raise InputError(f"box_corners takes a (4, 4) matrix and a (3,) size, got {matrix.shape} and {size.shape}")
     _extents(size)
@@ -362,7 +364,7 @@ def _agent_arguments(
     time_s = arguments.real(time_s, name="time_s", unit="seconds", error=InputError)
     if lidar_pose is not None:
         what = "a (4, 4) LiDAR -> world transform (or None: the vessel's body)"
-        m = _floats(lidar_pose, name="lidar_pose", tail=(4, 4), what=what)
+        m = arguments.reals(lidar_pose, name="lidar_pose", tail=(4, 4), what=what, error=InputError)
         if m.ndim != 2 or not np.isfinite(m).all():
             raise InputError(f"lidar_pose must be {what}, finite, got {arguments.shown(lidar_pose)}")
     if not isinstance(cameras, Mapping):

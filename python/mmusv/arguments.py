@@ -1,5 +1,5 @@
 """Checks of the plain arguments the Python API takes from a programmer: whole numbers (frame indices, counts,
-seeds), real numbers, flags, file and folder paths, callbacks and collections of names.
+seeds), real numbers and arrays of them, flags, file and folder paths, callbacks and collections of names.
 
 Each check returns the value in its one accepted form (``int``, ``float``, ``bool``, :class:`~pathlib.Path`, ...)
 or raises ``error`` (:class:`~mmusv.errors.ConfigError` unless the caller names another class of
@@ -27,7 +27,19 @@ from typing_extensions import TypeIs
 
 from mmusv.errors import ConfigError
 
-__all__ = ["callback", "flag", "is_number", "mapping", "names", "path", "real", "shown", "whole"]
+__all__ = [
+    "callback",
+    "flag",
+    "holds_true_false",
+    "is_number",
+    "mapping",
+    "names",
+    "path",
+    "real",
+    "reals",
+    "shown",
+    "whole",
+]
 
 _REPR = reprlib.Repr()
 _REPR.maxstring, _REPR.maxother = 60, 60
@@ -184,3 +196,48 @@ def mapping(value: Any, *, name: str, error: type[Exception] = ConfigError) -> M
     if not isinstance(value, Mapping) or not all(isinstance(k, str) for k in value):
         raise error(f"{name} = {shown(value)}: must be a dict with string keys, or None")
     return value
+
+
+_KINDS = {"b": "true/false", "U": "text", "S": "bytes", "c": "complex numbers"}
+"""What a numpy array of each dtype kind holds, said where real numbers go."""
+
+
+def reals(
+    value: Any, *, name: str, what: str, tail: tuple[int, ...] = (), error: type[Exception] = ConfigError
+) -> np.ndarray:
+    """``value`` as a float64 array of real numbers (not true/false, also inside a list, nor text, ``None`` or
+    complex numbers) whose last axes are ``tail``, else ``error`` naming ``name`` and the shape ``what`` it must
+    have."""
+    try:
+        raw = np.asarray(value)
+        # Only real numbers: a None (NaN as float64), a bool, text ("1.5" converts) or a complex number (its
+        # imaginary part dropped) would be read as a number without a word.
+        kind = raw.dtype.kind
+        if holds_true_false(value, raw):
+            raise TypeError("it holds true/false")
+        if kind == "O":
+            bad = [x for x in raw.flat if not is_number(x)][:1]
+            if bad:
+                raise TypeError(f"it holds {shown(bad[0])}")
+        elif kind not in "iuf":
+            raise TypeError(f"it holds {_KINDS.get(kind, f'{raw.dtype} values')}")
+        a = np.asarray(raw, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise error(f"{name} must be {what} of real numbers: {exc}") from None
+    if a.ndim < len(tail) or a.shape[a.ndim - len(tail) :] != tail:
+        raise error(f"{name} must be {what}, got shape {a.shape}")
+    return a
+
+
+def holds_true_false(value: Any, raw: np.ndarray) -> bool:
+    """Whether ``value``, which numpy read as ``raw``, holds true/false among numbers: a list such as ``[True,
+    2.0]`` is numbers to numpy (``[1.0, 2.0]``), so where ``raw`` is numbers and ``value`` no array, its entries
+    are looked at (a bool, numpy's, or a bool array)."""
+    if raw.dtype.kind not in "iuf" or raw.ndim == 0 or isinstance(value, np.ndarray):
+        return False
+    return any(map(_true_false, np.asarray(value, dtype=object).flat))
+
+
+def _true_false(x: object) -> bool:
+    """Whether ``x`` (an entry of a list numpy read as numbers) is true/false: a bool or a bool array."""
+    return isinstance(x, (bool, np.bool_)) or (isinstance(x, np.ndarray) and x.dtype.kind == "b")

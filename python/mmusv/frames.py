@@ -29,7 +29,6 @@ import numpy as np
 import numpy.typing as npt
 
 from mmusv import arguments
-from mmusv.arguments import is_number
 from mmusv.errors import InputError
 
 __all__ = [
@@ -64,46 +63,9 @@ OPTICAL_IN_BODY[:3, :3] = BODY_TO_OPTICAL.T
 """``(4, 4)`` float64 optical frame → camera body frame (the inverse of :data:`BODY_TO_OPTICAL`, homogeneous)."""
 
 
-_KINDS = {"b": "true/false", "U": "text", "S": "bytes", "c": "complex numbers"}
-"""What a numpy array of each dtype kind holds, said where real numbers go."""
-
-
 def _floats(value: Any, *, name: str, tail: tuple[int, ...], what: str) -> np.ndarray:
-    """``value`` as a float64 array whose last axes are ``tail``, else an :class:`InputError` naming ``name``
-    and the shape ``what`` it must have."""
-    try:
-        raw = np.asarray(value)
-        # Only real numbers: a None (NaN as float64), a bool, text ("1.5" converts) or a complex number (its
-        # imaginary part dropped) would be read as a number without a word.
-        kind = raw.dtype.kind
-        if _holds_true_false(value, raw):
-            raise TypeError("it holds true/false")
-        if kind == "O":
-            bad = [x for x in raw.flat if not is_number(x)][:1]
-            if bad:
-                raise TypeError(f"it holds {arguments.shown(bad[0])}")
-        elif kind not in "iuf":
-            raise TypeError(f"it holds {_KINDS.get(kind, f'{raw.dtype} values')}")
-        a = np.asarray(raw, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"{name} must be {what} of real numbers: {exc}") from None
-    if a.ndim < len(tail) or a.shape[a.ndim - len(tail) :] != tail:
-        raise InputError(f"{name} must be {what}, got shape {a.shape}")
-    return a
-
-
-def _holds_true_false(value: Any, raw: np.ndarray) -> bool:
-    """Whether ``value``, which numpy read as ``raw``, holds true/false among numbers: a list such as ``[True,
-    2.0]`` is numbers to numpy (``[1.0, 2.0]``), so where ``raw`` is numbers and ``value`` no array, its entries
-    are looked at (a bool, numpy's, or a bool array)."""
-    if raw.dtype.kind not in "iuf" or raw.ndim == 0 or isinstance(value, np.ndarray):
-        return False
-    return any(map(_true_false, np.asarray(value, dtype=object).flat))
-
-
-def _true_false(x: object) -> bool:
-    """Whether ``x`` (an entry of a list numpy read as numbers) is true/false: a bool or a bool array."""
-    return isinstance(x, (bool, np.bool_)) or (isinstance(x, np.ndarray) and x.dtype.kind == "b")
+    """:func:`mmusv.arguments.reals` with this module's :class:`InputError`."""
+    return arguments.reals(value, name=name, tail=tail, what=what, error=InputError)
 
 
 def _points(value: Any, *, name: str) -> np.ndarray:

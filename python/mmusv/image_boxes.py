@@ -24,7 +24,7 @@ import numpy as np
 
 from mmusv import arguments
 from mmusv.errors import InputError
-from mmusv.frames import BODY_TO_OPTICAL, _floats
+from mmusv.frames import BODY_TO_OPTICAL
 
 __all__ = [
     "EDGE_STEPS",
@@ -196,7 +196,7 @@ def faces_in_image_box(
 def clip_box(box: np.ndarray, *, width: int, height: int) -> tuple[np.ndarray, float, float]:
     """A pixel box ``[x0, y0, x1, y1]`` clipped to the ``width × height`` image: the clipped box, the box's own area
     and the clipped area (pixels²; 0 when the box is empty or lies wholly outside the image)."""
-    box = _floats(box, name="box", tail=(), what="a pixel box [x0, y0, x1, y1]")
+    box = arguments.reals(box, name="box", what="a pixel box [x0, y0, x1, y1]", error=InputError)
     if box.shape != (4,) or not np.isfinite(box).all():
         raise InputError(f"box must be a pixel box [x0, y0, x1, y1] of four finite numbers, got {arguments.shown(box)}")
     width = arguments.whole(width, name="width", lo=1, error=InputError)
@@ -252,7 +252,7 @@ def _distort(x: np.ndarray, y: np.ndarray, cam: Any, reach: float) -> tuple[np.n
 
 def _corners(value: Any, *, name: str) -> np.ndarray:
     """``value`` as a box's ``(8, 3)`` float64 corners, else an :class:`InputError` naming ``name``."""
-    c = _floats(value, name=name, tail=(), what="a box's (8, 3) corners in metres")
+    c = arguments.reals(value, name=name, what="a box's (8, 3) corners in metres", error=InputError)
     if c.shape != (8, 3) or not np.isfinite(c).all():
         raise InputError(
             f"{name} must be a box's (8, 3) corners, finite metres (corner bits as mmusv.annotate.box_corners), got "
@@ -263,7 +263,7 @@ def _corners(value: Any, *, name: str) -> np.ndarray:
 
 def _intrinsics(value: Any) -> tuple[float, float, float, float]:
     """``(fx, fy, cx, cy)`` pixels, finite, the focal lengths > 0, else an :class:`InputError`."""
-    k = _floats(value, name="intrinsics", tail=(), what="(fx, fy, cx, cy) pixels")
+    k = arguments.reals(value, name="intrinsics", what="(fx, fy, cx, cy) pixels", error=InputError)
     fx, fy, cx, cy = (float(v) for v in k) if k.shape == (4,) else (math.nan,) * 4
     if not (math.isfinite(cx) and math.isfinite(cy) and math.isfinite(fx) and math.isfinite(fy) and fx > 0 and fy > 0):
         raise InputError(
@@ -280,7 +280,9 @@ def _faces(value: Any) -> list[np.ndarray]:
         raise InputError(f"faces_opt must be {what}, got {arguments.shown(value)}")
     faces = []
     for i, g in enumerate(value):
-        f = _floats(g, name=f"faces_opt[{i}]", tail=(3,), what="a convex (n, 3) polygon (finite metres)")
+        f = arguments.reals(
+            g, name=f"faces_opt[{i}]", tail=(3,), what="a convex (n, 3) polygon (finite metres)", error=InputError
+        )
         if f.ndim != 2 or not np.isfinite(f).all():
             raise InputError(
                 f"faces_opt[{i}] must be a convex (n, 3) polygon (finite metres), got {arguments.shown(g)}"

@@ -22,7 +22,7 @@ from typing import Any, Protocol
 import numpy as np
 import numpy.typing as npt
 
-from mmusv import arguments, frames
+from mmusv import arguments
 from mmusv._native import core
 from mmusv.errors import GeometryError, InputError, NotFoundError
 
@@ -218,9 +218,9 @@ def _array(value: Any, *, name: str, dtype: Any, shape_tail: tuple[int, ...]) ->
 
 
 def _floats(value: Any, *, name: str) -> np.ndarray:
-    """``value`` as a float64 array of real numbers (not true/false, text, None or complex numbers: mmusv.frames'
-    check), or an :class:`InputError` naming ``name``."""
-    return frames._floats(value, name=name, tail=(), what="an array")
+    """``value`` as a float64 array of real numbers (:func:`mmusv.arguments.reals`: not true/false, text, None or
+    complex numbers), or an :class:`InputError` naming ``name``."""
+    return arguments.reals(value, name=name, what="an array", error=InputError)
 
 
 def _uint16s(value: Any, *, name: str) -> np.ndarray:

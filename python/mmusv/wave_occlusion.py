@@ -38,7 +38,6 @@ import numpy.typing as npt
 
 from mmusv import arguments
 from mmusv.errors import InputError
-from mmusv.frames import _holds_true_false
 from mmusv.scene import Scene
 
 __all__ = [
@@ -138,7 +137,7 @@ def _array(value: Any, *, name: str, shape: tuple[int | None, ...], what: str, i
     kind = "integers" if integer else "real numbers"
     if a.dtype.kind not in kinds and not (integer and a.size == 0 and a.dtype.kind == "f"):
         raise InputError(f"{name} must be {what} ({kind}), got dtype {a.dtype}")
-    if _holds_true_false(value, a):
+    if arguments.holds_true_false(value, a):
         raise InputError(f"{name} must be {what} ({kind}): it holds true/false")
     if a.ndim != len(shape) or any(n is not None and a.shape[i] != n for i, n in enumerate(shape)):
         raise InputError(f"{name} must be {what}, got shape {a.shape}")
