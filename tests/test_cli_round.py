@@ -183,7 +183,7 @@ def test_info_of_a_batch_folder_follows_linked_run_folders(
     """A batch gathered from two disks, its run folders links: `mmusv info OUT` said "a folder without a
     recording" (rglob does not follow links to folders). Each linked recording is listed once, and a link back up
     the tree is no loop; the finders of the studies (`find_recordings`) see the same."""
-    from mmusv.recording.info import find_recordings
+    from mmusv.recording.folders import find_recordings
 
     monkeypatch.setenv("COLUMNS", "250")
     out_dir = tmp_path / "batch"
@@ -226,7 +226,7 @@ def test_a_folder_below_that_cannot_be_read_is_named(
     as if that were all. The studies' finder refuses, naming the folder; `info` gives it a row and exits 1."""
     import os
 
-    from mmusv.recording.info import find_recordings
+    from mmusv.recording.folders import find_recordings
 
     monkeypatch.setenv("COLUMNS", "250")
     out_dir = tmp_path / "batch"

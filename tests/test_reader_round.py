@@ -103,7 +103,7 @@ def test_read_table_refuses_a_path_that_is_not_a_tables_folder(run_dir: Path, tm
 
 
 def test_find_recordings_refuses_what_is_not_a_folder(run_dir: Path, tmp_path: Path) -> None:
-    from mmusv.recording.info import find_recordings
+    from mmusv.recording.folders import find_recordings
 
     assert find_recordings(run_dir) == [run_dir / "tiny.mcap"]
     for bad in (tmp_path / "nope", run_dir / "tiny.mcap"):  # was [] for both

@@ -16,7 +16,7 @@ from mmusv.errors import MmusvError
 from mmusv.text import counted
 
 if TYPE_CHECKING:
-    from mmusv.recording.info import MissingRecording
+    from mmusv.recording.folders import MissingRecording
 
 __all__ = ["cmd_info", "cmd_preview", "cmd_recover"]
 
@@ -26,7 +26,8 @@ def cmd_info(args: argparse.Namespace) -> int:
     from rich.text import Text
 
     from mmusv.recording import summary
-    from mmusv.recording.info import find_recordings, missing_recordings, recording_name, unreadable_listings
+    from mmusv.recording.folders import find_recordings, missing_recordings, unreadable_listings
+    from mmusv.recording.info import recording_name
 
     target = Path(path_arg(args.recording, flag="recording"))
     folder: Path | None = None
@@ -149,8 +150,8 @@ def _agents_of(meta: dict[str, dict[str, str]]) -> str:
 def _overview(folder: Path, found: list[Path], gone: list[MissingRecording], damaged: list[tuple[Path, str]]) -> int:
     """``mmusv info`` on a folder of recordings: one row each (scenario, status, frames, agents, problems), and one
     for each recording that a ``dataset.json`` or a run's ``manifest.json`` below names but that is gone
-    (:func:`~mmusv.recording.info.missing_recordings`), and one for each such file that cannot be read
-    (:func:`~mmusv.recording.info.unreadable_listings`). Exits 1 when a recording is gone, cannot be read at all
+    (:func:`~mmusv.recording.folders.missing_recordings`), and one for each such file that cannot be read
+    (:func:`~mmusv.recording.folders.unreadable_listings`). Exits 1 when a recording is gone, cannot be read at all
     (``mmusv info`` on it alone is an error too) or holds no readable frame (a killed run's ``.partial`` of none,
     a file damaged throughout): a dataset to convert or study lacks it. A damaged or unfinished one that reads is
     a row with its problems, as ``mmusv info`` on it alone warns and exits 0."""

@@ -17,7 +17,8 @@ from mmusv.cli import main
 from mmusv.errors import ConfigError, IoError
 from mmusv.export import convert
 from mmusv.recording.contents import summary
-from mmusv.recording.info import find_recordings, read_info
+from mmusv.recording.folders import find_recordings
+from mmusv.recording.info import read_info
 from mmusv.recording.messages import frame_messages
 from mmusv.recording.parts import read_parts_manifest
 from mmusv.recording.stream import FrameStream

@@ -5,7 +5,8 @@ are spelled), :mod:`~mmusv.recording.writer` (:class:`Recording` over the core's
 written on a writer thread while the next is captured); the one reader: :mod:`~mmusv.recording.info` (what a
 recording says about itself), :mod:`~mmusv.recording.stream` (its frames, one at a time),
 :mod:`~mmusv.recording.messages` (its decoded messages), :mod:`~mmusv.recording.contents` (what it holds, for
-``mmusv info``), all over :mod:`~mmusv.recording.scan` (damaged files read to their end), and
+``mmusv info``), :mod:`~mmusv.recording.folders` (the recordings in a folder, and those its listings name that
+are gone), all over :mod:`~mmusv.recording.scan` (damaged files read to their end), and
 :mod:`~mmusv.recording.decode` (its messages as numpy arrays). The contract is ``docs/recording.md``.
 """
 

@@ -177,7 +177,7 @@ def recording_summary(path: str | Path) -> RecordingSummary:
 def find_recordings(folder: str | Path) -> list[Path]:
     """The recordings below ``folder`` (``.mcap`` files and parts manifests of split recordings, whose parts are
     not listed on their own), sorted."""
-    from mmusv.recording.info import find_recordings as find
+    from mmusv.recording.folders import find_recordings as find
 
     return find(folder)
 

@@ -2,7 +2,7 @@
 holding a batch run's ``dataset.json`` (its complete recordings), the ``recordings`` folder of a ``mmusv dataset``
 folder (the complete recordings its ``dataset.json`` lists), or other folders searched for ``*.mcap`` and parts
 manifests of split recordings, through links to folders too, a folder that cannot be read refused by name:
-:func:`~mmusv.recording.info.find_recordings`), an OPV2V folder, or the bundled detection spec generated and
+:func:`~mmusv.recording.folders.find_recordings`), an OPV2V folder, or the bundled detection spec generated and
 recorded LiDAR-only.
 
 Sequences are split by sequence before any agent-as-ego expansion: recordings and OPV2V scenario folders without
