@@ -9,6 +9,7 @@ Synchronisation is by explicit waits on the page's own state: ``body[data-ready]
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import tempfile
@@ -26,6 +27,7 @@ from selenium.common.exceptions import StaleElementReferenceException
 from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
+from selenium.webdriver.support.select import Select
 from selenium.webdriver.support.ui import WebDriverWait
 
 # Screenshots: into the folder named by MMUSV_EDITOR_SCREENSHOTS (`make screenshots` gives docs/editor/), else a
@@ -64,6 +66,20 @@ def act_on(driver: Any, css: str, act: Any) -> Any:
 def settled(driver: Any) -> None:
     """Waits until the page has evaluated the document as it is now."""
     _wait(driver, "return document.body.dataset.pending === '0'", "the evaluation")
+
+
+def pick_open(driver: Any, value: str) -> None:
+    """Picks ``value`` (``file:NAME`` or ``bundled:NAME``) in the Open box as a person does: reaching the box (its
+    focus) reads the folder's files again and replaces the list, so the option is picked once that list is shown
+    (``data-listing`` not "reading"), never one of the list it replaces (a stale element, on a busy machine)."""
+    driver.find_element(By.ID, "open").click()
+    _wait(
+        driver,
+        "const s = document.getElementById('open'); return s.dataset.listing !== 'reading' && "
+        f"[...s.options].some((o) => o.value === {json.dumps(value)})",
+        f"{value} in the Open box",
+    )
+    Select(driver.find_element(By.ID, "open")).select_by_value(value)
 
 
 def open_editor(driver: Any, server: LiveServer) -> None:
@@ -140,10 +156,7 @@ def shot(driver: Any, name: str) -> None:
 def test_opens_a_bundled_scenario(browser: Any, live_server: LiveServer) -> None:
     open_editor(browser, live_server)
     shot(browser, "overview.png")
-    select = browser.find_element(By.ID, "open")
-    from selenium.webdriver.support.select import Select
-
-    Select(select).select_by_value("bundled:island_occlusion")
+    pick_open(browser, "bundled:island_occlusion")
     _wait(
         browser,
         "const s = window.mmusvEditor.state; return s.doc.name === 'island_occlusion' && "

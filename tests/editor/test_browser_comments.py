@@ -11,8 +11,7 @@ from typing import Any
 from mmusv.bundled import bundled_dir
 from mmusv.editor.comments import read_comments
 from selenium.webdriver.common.by import By
-from selenium.webdriver.support.select import Select
-from test_browser import LiveServer, _wait, open_editor, settled
+from test_browser import LiveServer, _wait, open_editor, pick_open, settled
 from test_browser_round import js_errors, type_into
 from test_browser_round2 import save_as
 
@@ -22,7 +21,7 @@ def open_occlusion(browser: Any, live_server: LiveServer) -> None:
     JavaScript error log read and emptied."""
     open_editor(browser, live_server)
     js_errors(browser)
-    Select(browser.find_element(By.ID, "open")).select_by_value("bundled:island_occlusion")
+    pick_open(browser, "bundled:island_occlusion")
     _wait(browser, "return window.mmusvEditor.state.fileName === 'island_occlusion.yaml'", "the bundled scenario")
     settled(browser)
 

@@ -21,7 +21,7 @@ from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
 from selenium.webdriver.support.select import Select
 from selenium.webdriver.support.ui import WebDriverWait
-from test_browser import LiveServer, _wait, act_on, document_of, open_editor, settled
+from test_browser import LiveServer, _wait, act_on, document_of, open_editor, pick_open, settled
 
 
 def js_errors(driver: Any) -> list[str]:
@@ -222,7 +222,7 @@ def test_cancelled_open_and_save_leave_the_page_showing_what_it_holds(browser: A
     type_into(browser, browser.find_element(By.ID, "e-visibility"), "2000")
     settled(browser)
     assert browser.title.startswith("● port_entry.yaml")
-    Select(browser.find_element(By.ID, "open")).select_by_value("bundled:island_occlusion")
+    pick_open(browser, "bundled:island_occlusion")
     browser.switch_to.alert.dismiss()  # keep the edits
     # the Open box went on naming island_occlusion while port_entry stayed open
     assert browser.find_element(By.ID, "open").get_attribute("value") == ""

@@ -16,7 +16,7 @@ import pytest
 from editor_server import serve
 from selenium.webdriver.common.by import By
 from selenium.webdriver.support.select import Select
-from test_browser import _wait, click_world, open_editor, settled, view
+from test_browser import _wait, click_world, open_editor, pick_open, settled, view
 from test_browser_round import js_errors
 from user_assets import write_boat
 
@@ -85,8 +85,7 @@ def test_the_library_is_the_open_scenarios(browser: Any, folder: Path) -> None:
         js_errors(browser)
         browser.execute_script(RECORD)
 
-        browser.find_element(By.ID, "open").click()  # (the list is refreshed when reached)
-        Select(browser.find_element(By.ID, "open")).select_by_value("file:lake.yaml")
+        pick_open(browser, "file:lake.yaml")  # (the list is read again when reached)
         _opened(browser, "lake.yaml")
         assert {s[0] for s in _check_shown(browser)} == {"lake"}  # was: the start's library, no punt
         browser.execute_script("window.mmusvEditor.state.select('s')")

@@ -20,7 +20,7 @@ from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
 from selenium.webdriver.support.select import Select
-from test_browser import LiveServer, _wait, document_of, open_editor, settled
+from test_browser import LiveServer, _wait, document_of, open_editor, pick_open, settled
 from test_browser_round import js_errors, note, type_into
 
 
@@ -207,7 +207,7 @@ def test_a_page_loaded_again_shows_the_last_run_of_its_file(browser: Any, live_s
     assert not browser.find_element(By.ID, "run-stop").is_displayed()
     assert browser.execute_script("return window.mmusvEditor.state.savedName") == "ran.yaml"
 
-    Select(browser.find_element(By.ID, "open")).select_by_value("file:broken.yaml")  # another file: its run
+    pick_open(browser, "file:broken.yaml")  # another file: its run
     _wait(browser, "return document.getElementById('run-status').dataset.status === 'failed'", "the failed run")
     text = browser.find_element(By.ID, "run-text").text
     assert text.startswith("failed: ") and failed["error"][:40] in text, text
@@ -220,7 +220,7 @@ def test_a_restarted_server_shows_the_last_run_of_a_file(browser: Any, live_serv
     saved_and_run(browser, live_server, "before.yaml")
     with serve(live_server.folder) as restarted:
         open_editor(browser, restarted)
-        Select(browser.find_element(By.ID, "open")).select_by_value("file:before.yaml")
+        pick_open(browser, "file:before.yaml")
         _wait(browser, "return document.getElementById('run-status').dataset.status === 'complete'", "the last run")
         text = browser.find_element(By.ID, "run-text").text
         assert text == "done: 2 frames → out/before/ (recorded before this editor started)", text

@@ -20,7 +20,7 @@ from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
 from selenium.webdriver.support.select import Select
-from test_browser import LiveServer, _wait, open_editor, settled
+from test_browser import LiveServer, _wait, open_editor, pick_open, settled
 from test_browser_round import js_errors, type_into
 from test_browser_round2 import save_as
 
@@ -105,7 +105,7 @@ def test_a_scenario_opened_after_another_is_shown_whole(browser: Any, live_serve
     js_errors(browser)
     assert off_the_map(browser) == []
     for name in ("island_port_waves", "open_sea_convoy"):
-        Select(browser.find_element(By.ID, "open")).select_by_value(f"bundled:{name}")
+        pick_open(browser, f"bundled:{name}")
         _wait(browser, f"return window.mmusvEditor.state.doc.name === '{name}'", name)
         settled(browser)
         _wait(browser, "return document.getElementById('status').textContent.includes('vessels')", "the check")
@@ -126,7 +126,7 @@ def test_a_map_slower_than_the_check_does_not_hide_its_verdict(browser: Any, liv
           return real(url, opts);
         };"""
     )
-    Select(browser.find_element(By.ID, "open")).select_by_value("bundled:island_port_waves")
+    pick_open(browser, "bundled:island_port_waves")
     _wait(browser, "return document.getElementById('status').textContent.includes('m square')", "the map")
     text = browser.find_element(By.ID, "status").text
     assert "vessels" in text and "frames" in text and "map, seed" in text, text

@@ -20,8 +20,7 @@ from mmusv.config import load_scenario
 from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
-from selenium.webdriver.support.ui import Select
-from test_browser import LiveServer, _wait, document_of, open_editor, settled
+from test_browser import LiveServer, _wait, document_of, open_editor, pick_open, settled
 from test_browser_round import js_errors, type_into
 from test_browser_round2 import active_id, save_as
 
@@ -149,12 +148,7 @@ def test_the_open_list_shows_files_saved_elsewhere_since(browser: Any, live_serv
     open_editor(browser, live_server)
     js_errors(browser)
     shutil.copy(resolve_scenario("open_sea_convoy"), live_server.folder / "from_elsewhere.yaml")
-    browser.find_element(By.ID, "open").click()  # reached: the list is read again
-    _wait(
-        browser,
-        "return [...document.querySelectorAll('#open option')].some((o) => o.value === 'file:from_elsewhere.yaml')",
-        "the file saved elsewhere in the list",
-    )  # was: only at start and after a save of this page
-    Select(browser.find_element(By.ID, "open")).select_by_value("file:from_elsewhere.yaml")
+    pick_open(browser, "file:from_elsewhere.yaml")  # reached, the list is read again (was: only at start and after
+    # a save of this page), so the file saved elsewhere is in it
     _wait(browser, "return window.mmusvEditor.state.savedName === 'from_elsewhere.yaml'", "the file opened")
     assert js_errors(browser) == []

@@ -142,9 +142,22 @@ function togglePlay() {
 
 // ------------------------------------------------------------------------------------- open and save
 
+let listsReading = 0; // folder listings asked for and not yet shown (#open's data-listing says "reading" meanwhile)
+
+/** Lists the folder's files and the bundled scenarios in the Open box, the value picked kept where still listed. */
 async function refreshOpen() {
-  const files = await api.files();
   const sel = $("open");
+  listsReading += 1;
+  sel.dataset.listing = "reading";
+  try {
+    listOpen(sel, await api.files());
+  } finally {
+    listsReading -= 1;
+    sel.dataset.listing = listsReading ? "reading" : "done";
+  }
+}
+
+function listOpen(sel, files) {
   const keep = sel.value;
   sel.replaceChildren();
   const head = document.createElement("option");
