@@ -5,7 +5,9 @@ Layout: ``images/<split>/<scenario>/<agent>/<camera>/<frame>.png`` (the recorded
 the split is made by recording, :mod:`mmusv.export.splits`). Each file: ``info`` (with ``mmusv_box``, the option
 ``box`` the boxes were written with, and ``mmusv_box_definition``, what it means), ``licenses`` (empty),
 ``images`` (``id`` from 1, ``file_name`` relative to ``images/<split>``, ``width``, ``height``, and mmusv's
-``scenario``, ``agent``, ``camera``, ``frame``, ``time_s``), ``annotations`` and ``categories`` (every mmusv
+``scenario``, ``agent``, ``camera``, ``frame``, ``time_s``; ``scenario`` is the scenario folder, the first part of
+``file_name``, as MOT's and KITTI tracking's CSVs name it: the scenario's name, ``<name>_<hash8>`` where converted
+recordings share a name), ``annotations`` and ``categories`` (every mmusv
 semantic class but ``none``: ``id`` = the class id of :mod:`mmusv.classes`, ``name`` its name).
 
 An annotation per kept 2D box (:meth:`mmusv.export.camera.CameraWriter.boxes_of`): ``bbox`` ``[x, y, w, h]``
@@ -87,7 +89,7 @@ class CocoWriter(CameraWriter):
                 "file_name": name,
                 "width": w,
                 "height": h,
-                "scenario": self.info.scenario_name,
+                "scenario": self.folder.name,  # the scenario folder: recordings sharing a name stay apart
                 "agent": sample.agent.id,
                 "camera": sample.camera.name,
                 "frame": sample.frame.index,
