@@ -43,6 +43,14 @@ impl Lamp {
         Vec3::from_array(self.material.emissive) * self.projected_area(out)
     }
 
+    /// The most intensity (cd) the lamp gives in any direction and any colour: its brightest channel's radiance
+    /// times `½ Σ A_i`, a bound on its projected area (every face seen face on).
+    pub fn max_intensity(&self) -> f32 {
+        self.material.emissive.iter().fold(0.0f32, |a, &e| a.max(e))
+            * 0.5
+            * self.faces.iter().map(|a| a.length()).sum::<f32>()
+    }
+
     /// Area (m²) of the lens seen along unit direction `dir` (either way): `½ Σ A_i |n_i · dir|`.
     pub fn projected_area(&self, dir: Vec3) -> f32 {
         0.5 * self.faces.iter().map(|a| a.dot(dir).abs()).sum::<f32>()

@@ -37,6 +37,7 @@ mod antialias;
 mod distortion;
 mod glossy;
 mod lamp_glow;
+mod lamp_light;
 mod lamp_points;
 pub mod radiance;
 mod sunlit;

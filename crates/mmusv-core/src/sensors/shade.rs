@@ -9,6 +9,7 @@
 //! * [`water`]: Cox–Munk capillary roughness, Monahan whitecaps, Kelvin wakes and the water body;
 //! * [`rough_water`]: the rough sea's single-scattering microfacet reflection (Beckmann, Smith, Fresnel);
 //! * [`lamp_glitter`]: the navigation lamps' glitter on that water at night, by next-event estimation;
+//! * [`lamp_light`]: the lamps' light on hulls and everything else but the water at night, the same way;
 //! * [`sky_lobe`]: the sky's mean over the rough water's reflection lobe, tabulated per environment;
 //! * [`sea_ms`]: the light reflected more than once between the wave facets (Heitz et al.'s random walk),
 //!   restored over that lobe (Turquin's energy compensation);
@@ -21,6 +22,8 @@
 //! `L = L_e + (f_d + f_s(v, s)) E_s (n·s) + f_d E_env(n) + P(r', roughness) (F0 A + B)`, with `f_d = (1 − metallic)
 //! base / π` and `r'` the rough lobe's dominant direction (Lagarde & de Rousiers 2014). The environment light is
 //! not occluded (no ambient occlusion): every surface sees the whole sky and the sea, a known limit of the model.
+//! At night each lit navigation lamp adds its light the same way as the sun, `(f_d + f_s(v, l)) E_l (n·l)` behind a
+//! shadow ray ([`lamp_light`]; the camera adds it to the rays it shades, `camera/lamp_light.rs`).
 //! Water is a dielectric (IOR 1.33) whose normals and roughness come from the wave surface where the scene has one
 //! (`WaveSurface::shading`, the far sea beyond its sampled part included), else from a fixed four-component swell
 //! ([`swell`]): `L = F(θ_o) L_r + glint + L_body`, where `L_r` is the radiance along the reflected ray (traced by
@@ -42,6 +45,7 @@ pub mod envlight;
 pub mod foam;
 pub mod kelvin;
 pub mod lamp_glitter;
+pub mod lamp_light;
 pub mod rough_water;
 pub mod sea_ms;
 mod sea_ms_table;
@@ -148,6 +152,43 @@ pub struct SurfaceHit {
     /// For water on the displaced sea, the mean square slope of the waves too short for the surface's sampling
     /// there ([`crate::sea::SurfaceShading`]), added to the glint's roughness; 0 elsewhere.
     pub unresolved_mss: f32,
+}
+
+/// A material's reflection as the direct light sees it: the Lambert lobe `f_d = (1 − metallic) base / π`, the
+/// GGX lobe's Fresnel at normal incidence `f0` (0.04 for a dielectric, the base colour for a metal) and its
+/// roughness `α = roughness²` (at least [`brdf::ALPHA_MIN`]).
+#[derive(Debug, Clone, Copy)]
+pub struct Lobes {
+    /// `f_d`, linear RGB, 1/sr.
+    pub diffuse: Vec3,
+    /// Fresnel reflectance at normal incidence, linear RGB.
+    pub f0: Vec3,
+    /// GGX roughness `α`.
+    pub alpha: f32,
+}
+
+impl Lobes {
+    /// The lobes of material `m` (metallic workflow).
+    #[inline(always)]
+    pub fn of(m: &Material) -> Self {
+        let base = Vec3::from_array(m.base_color);
+        Self {
+            diffuse: base * ((1.0 - m.metallic) / std::f32::consts::PI),
+            f0: Vec3::splat(0.04) * (1.0 - m.metallic) + base * m.metallic,
+            alpha: (m.roughness * m.roughness).max(brdf::ALPHA_MIN),
+        }
+    }
+
+    /// Radiance towards unit `v` of light arriving from unit `l` with irradiance `e` normal to the beam, at a
+    /// surface of unit normal `n`: `(f_d + f_s(v, l)) (n·l) E`, zero where `l` is below the surface.
+    #[inline(always)]
+    pub fn direct(&self, n: Vec3, v: Vec3, l: Vec3, e: Vec3) -> Vec3 {
+        let nl = n.dot(l);
+        if nl <= 0.0 {
+            return Vec3::ZERO;
+        }
+        (self.diffuse * nl + specular_cos(n, v, l, self.alpha, self.f0)) * e
+    }
 }
 
 impl SurfaceHit {
@@ -427,20 +468,24 @@ impl Shader {
         (hit.point + hit.normal * (2e-3 + 1e-5 * hit.t), r.normalize())
     }
 
+    /// The material of a non-water hit: its face's from the table, else its class's default.
+    #[inline(always)]
+    pub fn material_of(&self, hit: &SurfaceHit) -> Material {
+        match self.materials.get(hit.material as usize) {
+            Some(m) if hit.material != 0 => *m,
+            _ => class_material(hit),
+        }
+    }
+
     /// Radiance (before aerial perspective) of a non-water surface seen along `d`, lit by the sun when `sunlit`.
     #[inline(always)]
     pub fn surface(&self, d: Vec3, hit: &SurfaceHit, sunlit: bool) -> Vec3 {
-        let m = match self.materials.get(hit.material as usize) {
-            Some(m) if hit.material != 0 => *m,
-            _ => class_material(hit),
-        };
-        let base = Vec3::from_array(m.base_color);
+        let m = self.material_of(hit);
         let n = hit.normal;
         let v = -d;
         let nv = n.dot(v).max(1e-4);
-        let f0 = Vec3::splat(0.04) * (1.0 - m.metallic) + base * m.metallic;
-        let diffuse = base * ((1.0 - m.metallic) / std::f32::consts::PI);
-        let alpha = (m.roughness * m.roughness).max(brdf::ALPHA_MIN);
+        let lobes = Lobes::of(&m);
+        let Lobes { diffuse, f0, alpha } = lobes;
         let mut c = diffuse * self.light.irradiance(n);
         let r = d - n * (2.0 * d.dot(n));
         // The rough lobe's dominant direction leans from the mirror direction towards the normal (Lagarde & de
@@ -450,10 +495,7 @@ impl Shader {
         let [a, b] = dfg(nv, m.roughness);
         c += self.light.prefiltered(dominant, m.roughness) * (f0 * a + Vec3::splat(b));
         if sunlit {
-            let ns = n.dot(self.sun);
-            if ns > 0.0 {
-                c += (diffuse * ns + specular_cos(n, v, self.sun, alpha, f0)) * self.sun_e;
-            }
+            c += lobes.direct(n, v, self.sun, self.sun_e);
         }
         if !m.nav_light || hit.lights_on {
             c += Vec3::from_array(m.emissive);

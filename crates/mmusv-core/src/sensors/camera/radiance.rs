@@ -413,6 +413,16 @@ pub fn radiance(
             (0..n).into_par_iter().filter(|&k| is_water(k) && !is_candidate(k)).map(|k| k as u32).collect();
         add_glitter(&mut out, &water);
     }
+    // The lamps' light on everything but the water (`shade/lamp_light.rs`), at every quality: such a ray is never
+    // a candidate for a shared shading, so each is shaded above.
+    if !shader.lamps().is_empty() {
+        let solid: Vec<u32> =
+            (0..n).into_par_iter().with_min_len(PASS_CHUNK).filter(|&k| kind(hits, k) == 0).map(|k| k as u32).collect();
+        let light = super::lamp_light::lamp_light(scene, shader, shader.lamps(), (origins, dirs, hits), &solid);
+        for (&k, c) in solid.iter().zip(light) {
+            out[k as usize] += c;
+        }
+    }
     if let Some(grid) = shared {
         // The candidates: the anchors' mean where they look alike; the others (`redo`) need their own shading.
         // The exposure the view is shown with (the metered pixels are anchors: shaded themselves, above).
