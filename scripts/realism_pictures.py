@@ -16,6 +16,8 @@ with the new one, draws the same frames from the same poses. Each view is writte
   21:15 below; 480 × 270 each);
 * ``night_glitter``: a 90 m ferry under way at midnight, about 130 m off, at ``standard`` and at ``high`` quality
   side by side (its lamps' glitter on the water);
+* ``night_hulls``: a 32 m tug and a 16 m pilot boat under way at midnight, 30–35 m off (the lamps' light on
+  their hulls);
 * ``exposure_settings``: that view at 21:15 through four cameras differing only in their ``exposure`` (the
   default, −1 EV, +1 EV, ISO 25 600; *after* only);
 * ``whitecaps_w3``: open water at wave level W3, from 8 m above the sea;
@@ -184,6 +186,19 @@ def night_glitter(path: Path) -> None:
         assert rgb is not None
         halves.append(np.asarray(rgb))
     Image.fromarray(np.concatenate(halves, axis=1)).save(path)
+
+
+def night_hulls(path: Path) -> None:
+    """A tug and a pilot boat under way at midnight (21 June, 45° N), the tug 35 m off on the camera's bow, the
+    pilot boat passing close along its port side, seen from 3 m up (960 × 540, 70°), at W1: the hulls lit by the
+    lamps (the tug's own and the pilot boat's), not by the night sky alone."""
+    x, y = _at(0.0, 35.0)
+    tug = {"id": "tug", "asset": "tug_32m", "speed_mps": 2.0, "route": _route(x, y, 150.0)}
+    px, py = _at(-12.0, 30.0)
+    pilot = {"id": "pilot", "asset": "pilot_boat_16m", "speed_mps": 2.5, "route": _route(px, py, 120.0)}
+    rig = _camera_rig(resolution=(960, 540), hfov_deg=70.0, xyz=(0.0, 0.0, 3.0), yaw_deg=-5.0, pitch_deg=-4.0)
+    env = {"time_of_day": "00:00", "weather": "clear", "wave": "W1"}
+    _save_rgb(_scenario("night_hulls", rig=rig, vessels=[tug, pilot], environment=env), path)
 
 
 def dusk_series(path: Path) -> None:
@@ -398,6 +413,7 @@ VIEWS: dict[str, Callable[[Path], None]] = {
     "ferry_dusk_zoom": ferry_dusk_zoom,
     "dusk_series": dusk_series,
     "night_glitter": night_glitter,
+    "night_hulls": night_hulls,
     "exposure_settings": exposure_settings,
     "whitecaps_w3": whitecaps_w3,
     "wake_chase": wake_chase,
