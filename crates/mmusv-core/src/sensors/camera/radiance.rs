@@ -313,6 +313,15 @@ pub fn radiance(
                 shader.reflected(Vec3::from_array(rd[j]), h.as_ref(), rlit[j])
             })
             .collect();
+        if let Some(set) = lamps {
+            // The lamps' light on what the reflections meet (a lamp-lit hull mirrors lit), through the fog of
+            // the reflected ray's own length as the rest of its shading.
+            let solid: Vec<u32> = (0..ro.len()).filter(|&j| kind(&rhits, j) == 0).map(|j| j as u32).collect();
+            let light = super::lamp_light::lamp_light(scene, shader, set, (&ro, &rd, &rhits), &solid);
+            for (&j, c) in solid.iter().zip(light) {
+                values[j as usize] += c;
+            }
+        }
         if glossy.is_some() {
             skies = (0..ro.len())
                 .into_par_iter()

@@ -27,8 +27,9 @@
 //! leaves it whole near the lamp and takes it smoothly to zero at `R` (12 % less at `R/2`, where it is four times
 //! that least step). The lenses of the lamps are not lit by lamps (their own radiance is thousands of times more).
 //! Only while the lamps' glitter is (the sun lower than `lamp_glitter::LAMP_GLITTER_SUN_DEG`): by day a lamp adds
-//! nothing a camera can see. Left out: the lamps' light in the water's reflections (a lamp-lit hull's mirror image
-//! shows it as the sky alone lights it), and the glow of a lamp in the fog around it.
+//! nothing a camera can see. The camera adds it to what its traced water reflections meet too, so a lamp-lit hull
+//! mirrors lit (not at `draft` quality, which traces no reflections). Left out: the glow of a lamp in the fog
+//! around it.
 
 use super::{Lobes, Shader, SurfaceHit};
 use crate::scene::Lamp;
