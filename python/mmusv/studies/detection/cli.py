@@ -13,7 +13,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from mmusv.learn.modes import STUDY_NEEDS, models_for
+from mmusv.learn.modes import MODELS, STUDY_NEEDS, fusion_modes, models_for
 from mmusv.text import command_line, counted
 
 __all__ = ["DATASET_FLAGS", "FLAGS", "add_dataset_arguments", "add_parsers", "run"]
@@ -230,6 +230,8 @@ def _run(args: argparse.Namespace) -> int:
         # only the models the asked --modes run (one damaged or of another training stopped a study not running it)
         with command_line({"text": "--modes"}):
             asked = parse_modes(args.modes) if args.modes is not None else None
+        if asked is not None:
+            _check_folder_modes(args.model, asked)
         learned = load_for_study(args.model, refine=tri[args.refine], rescore=tri[args.rescore], modes=asked)
     if args.model is None and (args.refine != "auto" or args.rescore != "auto"):
         flag = f"--refine {args.refine}" if args.refine != "auto" else f"--rescore {args.rescore}"
@@ -246,7 +248,7 @@ def _run(args: argparse.Namespace) -> int:
     with command_line({"text": "--modes"}):
         modes = parse_modes(default_modes if args.modes is None else args.modes)  # "" was taken as the default
     if learned is not None:
-        _check_model_modes(args.model, learned, modes)
+        _check_model_modes(args.model, tuple(learned.models), modes)
     mixed = _mixed_training(args.model, learned, modes) if learned is not None else None
     if mixed is not None:
         import warnings
@@ -416,19 +418,32 @@ def _run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _check_model_modes(model: str, learned: Any, modes: tuple[str, ...]) -> None:
-    """Refuses fusion ``modes`` the models at ``--model`` cannot run, before any frame is read (the error came
-    from the first frame, naming the missing model but not the mode asked for)."""
+def _check_model_modes(model: str, held: tuple[str, ...], modes: tuple[str, ...]) -> None:
+    """Refuses fusion ``modes`` the models ``held`` at ``--model`` (``single``, ``early``, ``intermediate``) cannot
+    run, before any frame is read (the error came from the first frame, naming the missing model but not the mode
+    asked for)."""
     from mmusv.errors import InputError
 
-    missing = [m for m in modes if STUDY_NEEDS[m] not in learned.models]
+    missing = [m for m in modes if STUDY_NEEDS[m] not in held]
     if missing:
         needs = models_for(missing)
         raise InputError(
             f"--modes {','.join(missing)}: needs the {' and '.join(needs)} model, which --model {model} does not "
-            f"hold (it has {', '.join(learned.models)}: modes {','.join(learned.fusion_modes)}; train it with "
+            f"hold (it has {', '.join(held)}: modes {','.join(fusion_modes(held))}; train it with "
             "mmusv train --modes)"
         )
+
+
+def _check_folder_modes(model: str, modes: tuple[str, ...]) -> None:
+    """Refuses fusion ``modes`` of which a ``--model`` folder of models (``OUT/single``, ``OUT/early``, ...) holds no
+    model, by :func:`_check_model_modes`, before any is loaded: only the models the modes run are loaded, and
+    ``--modes early`` with ``OUT`` holding ``single`` alone said "--model OUT: no model.pt there"."""
+    p = Path(model)
+    if not p.is_dir() or (p / "model.pt").is_file():  # a model.pt or a model's own folder: its file says its mode
+        return
+    held = tuple(m for m in MODELS if (p / m / "model.pt").is_file())
+    if held and not set(models_for(modes)) & set(held):
+        _check_model_modes(model, held, modes)
 
 
 def _mixed_training(model: str, learned: Any, modes: tuple[str, ...]) -> str | None:

@@ -1,0 +1,42 @@
+"""The learned detector's user paths met again (``mmusv train``, ``mmusv study detection --model``), on the tiny
+preset and in-memory scenes.
+
+Each test failed before its fix: ``--modes early`` with a ``--model`` folder holding the ``single`` model alone
+said "--model OUT: no model.pt there", where one is.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from mmusv.cli import main
+from mmusv.learn.presets import preset
+from mmusv.learn.train import train
+
+from learn.scenes import SCENES, MemorySource
+
+
+@pytest.fixture(scope="module")
+def single(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """``mmusv train``'s output folder holding the single model alone (tiny preset, one epoch)."""
+    out = tmp_path_factory.mktemp("round15") / "models"
+    train(MemorySource(SCENES), p=preset("tiny"), mode="single", out=out / "single", epochs=1, progress=False)
+    return out
+
+
+def _study(tmp_path: Path, *extra: str) -> int:
+    rec = tmp_path / "x.mcap"  # refused before any recording is read
+    rec.touch()
+    return main(["study", "detection", str(rec), "--no-progress", "-o", str(tmp_path / "study"), *extra])
+
+
+def test_modes_of_a_model_the_folder_lacks_name_the_mode(
+    single: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert _study(tmp_path, "--model", str(single), "--modes", "early") == 2
+    err = capsys.readouterr().err
+    assert "no model.pt there" not in err, err
+    assert f"--modes early: needs the early model, which --model {single} does not hold (it has single" in err, err
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    assert not (tmp_path / "study").exists()
