@@ -2,7 +2,8 @@
 preset and in-memory scenes.
 
 Each test failed before its fix: ``--modes early`` with a ``--model`` folder holding the ``single`` model alone
-said "--model OUT: no model.pt there", where one is.
+said "--model OUT: no model.pt there", where one is; a ``log.jsonl`` cut short (it was written in place) stayed so,
+and the same command run again failed plotting it.
 """
 
 from __future__ import annotations
@@ -40,3 +41,19 @@ def test_modes_of_a_model_the_folder_lacks_name_the_mode(
     assert f"--modes early: needs the early model, which --model {single} does not hold (it has single" in err, err
     assert err.count("\n") == 1 and "Traceback" not in err, err
     assert not (tmp_path / "study").exists()
+
+
+def test_a_log_cut_short_is_whole_again_when_the_run_is_started_again(tmp_path: Path) -> None:
+    from mmusv.learn.train import plot_losses
+
+    src, p = MemorySource(SCENES), preset("tiny")
+    train(src, p=p, mode="single", out=tmp_path, epochs=1, progress=False)
+    log = tmp_path / "log.jsonl"
+    whole = log.read_bytes()
+    log.write_bytes(whole[: len(whole) // 2])  # a run interrupted while it wrote the log (it was written in place)
+    # the same command again: nothing left to train, and plotting the log was a JSONDecodeError traceback
+    again = train(src, p=p, mode="single", out=tmp_path, epochs=1, progress=False)
+    assert again.epochs == 1
+    assert log.read_bytes() == whole
+    assert plot_losses(log, tmp_path / "loss.png").is_file()
+    assert not list(tmp_path.glob(".*.tmp"))

@@ -32,7 +32,8 @@ __all__ = ["load_checkpoint", "remove_stale_temporaries", "save_checkpoint", "we
 
 SAVED = ("model.pt", "last.pt", "scorer.pt")
 """The files :func:`save_checkpoint` writes."""
-_TEMPORARY = re.compile(r"\.(" + "|".join(re.escape(n) for n in SAVED) + r")\.([0-9]+)\.tmp")
+_TEMPORARY = re.compile(r"\.(" + "|".join(re.escape(n) for n in (*SAVED, "log.jsonl")) + r")\.([0-9]+)\.tmp")
+"""The temporaries of :func:`save_checkpoint` and of the training's ``log.jsonl`` (written the same way)."""
 
 
 def load_checkpoint(path: str | Path, *, what: str, device: torch.device | str = "cpu") -> dict[str, Any]:
@@ -100,7 +101,8 @@ def _alive(pid: int) -> bool:
 
 def remove_stale_temporaries(folder: str | Path) -> list[Path]:
     """Removes from ``folder`` the temporaries of :func:`save_checkpoint` (``.model.pt.<pid>.tmp``,
-    ``.last.pt.<pid>.tmp``, ``.scorer.pt.<pid>.tmp``) left by processes that are gone (killed while saving);
+    ``.last.pt.<pid>.tmp``, ``.scorer.pt.<pid>.tmp``) and of the training's log (``.log.jsonl.<pid>.tmp``) left by
+    processes that are gone (killed while saving);
     returns them. A file of any other name, or of a process still running, is left alone."""
     d = Path(folder)
     gone: list[Path] = []

@@ -41,6 +41,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -126,6 +127,19 @@ def _save(obj: dict[str, Any], path: Path) -> None:
     """``obj`` saved to ``path`` (:func:`mmusv.learn.checkpoint.save_checkpoint`: through a temporary file, so an
     interruption leaves the previous file whole and no temporary behind)."""
     save_checkpoint(obj, path)
+
+
+def _write_log(path: Path, log: list[dict[str, Any]]) -> None:
+    """``log.jsonl`` (one JSON object a line) written whole, through a temporary ``.log.jsonl.<pid>.tmp`` renamed
+    into place: written in place, a run interrupted while writing it left it cut short, and the same command run
+    again, with no epoch left to train, failed plotting it (a ``JSONDecodeError`` traceback)."""
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        tmp.write_text("".join(json.dumps(r) + "\n" for r in log), encoding="utf-8")
+        tmp.replace(path)
+    except BaseException:  # a full disk, a Ctrl-C: no temporary file is left behind
+        tmp.unlink(missing_ok=True)
+        raise
 
 
 def _differs(ck: dict[str, Any], p: Preset, mode: str, seed: int) -> str | None:
@@ -234,6 +248,8 @@ def train(
         except (KeyError, TypeError, RuntimeError, ValueError) as exc:
             raise input_error(f"{_not_a_checkpoint(last)} ({type(exc).__name__}: {exc})") from None
     log_path = out_p / "log.jsonl"
+    if ck is not None:  # whole again from last.pt's log, also when nothing is left to train (plot_losses reads it)
+        _write_log(log_path, log)
     t0 = time.perf_counter() - spent
     finished = True
     stop: str | None = None
@@ -355,7 +371,7 @@ def train(
             {**{k: v for k, v in state.items() if k != "seconds"}, "model": model.state_dict(), "log": []},
             out_p / "model.pt",
         )
-        log_path.write_text("".join(json.dumps(r) + "\n" for r in log), encoding="utf-8")
+        _write_log(log_path, log)
         if stopped:
             finished = max_steps is not None and step >= max_steps
             break
