@@ -3,7 +3,8 @@ preset and in-memory scenes.
 
 Each test failed before its fix: ``--modes early`` with a ``--model`` folder holding the ``single`` model alone
 said "--model OUT: no model.pt there", where one is; a ``log.jsonl`` cut short (it was written in place) stayed so,
-and the same command run again failed plotting it.
+and the same command run again failed plotting it; ``--detector baseline`` with ``--model`` or ``--predictions`` was
+ignored (it is the default).
 """
 
 from __future__ import annotations
@@ -57,3 +58,18 @@ def test_a_log_cut_short_is_whole_again_when_the_run_is_started_again(tmp_path: 
     assert log.read_bytes() == whole
     assert plot_losses(log, tmp_path / "loss.png").is_file()
     assert not list(tmp_path.glob(".*.tmp"))
+
+
+def test_detector_baseline_given_with_model_or_predictions_is_refused(
+    single: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # --detector baseline was the default itself, so given with --model the model was scored without a word
+    assert _study(tmp_path, "--model", str(single), "--detector", "baseline") == 2
+    err = capsys.readouterr().err
+    assert "give one of --model, --detector or --predictions" in err and "Traceback" not in err, err
+    boxes = tmp_path / "boxes.parquet"  # refused before it is read
+    boxes.touch()
+    assert _study(tmp_path, "--predictions", str(boxes), "--detector", "baseline") == 2
+    err = capsys.readouterr().err
+    assert "give --detector or --predictions, not both" in err and "Traceback" not in err, err
+    assert not (tmp_path / "study").exists()

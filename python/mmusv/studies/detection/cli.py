@@ -91,8 +91,8 @@ def _common(p: argparse.ArgumentParser, default_out: str) -> None:
     )
     p.add_argument(
         "--detector",
-        default="baseline",
-        help="'baseline' (training-free, not the paper's learned model) or package.module:function, a "
+        default=None,  # None, not "baseline": --detector baseline given with --model or --predictions is refused
+        help="'baseline' (training-free, not the paper's learned model; the default) or package.module:function, a "
         "callable (points (N,4) float32 ego LiDAR frame) -> (boxes (M,7) x,y,z,l,w,h,yaw, scores (M,))",
     )
     p.add_argument(
@@ -223,7 +223,7 @@ def _run(args: argparse.Namespace) -> int:
     range_m = arguments.real(args.range_m, name="--range", unit="metres", above=0.0, error=InputError)
     if args.model is not None:
         check_threads(args.threads)  # before the models load: 10**11 was a torch traceback
-        if args.predictions is not None or args.detector != "baseline":
+        if args.predictions is not None or args.detector is not None:
             raise InputError("give one of --model, --detector or --predictions")
         from mmusv.learn.cli import load_for_study
 
@@ -260,12 +260,11 @@ def _run(args: argparse.Namespace) -> int:
         settings = parse_settings(args.settings) if robust else (Setting(),)
     if robust and not any(m != "none" for m in modes):
         raise InputError("--modes: the robustness study needs late and/or early fusion")
-    if args.predictions is not None and args.detector != "baseline":
+    if args.predictions is not None and args.detector is not None:
         raise InputError("give --detector or --predictions, not both")
-    detector = (
-        learned if learned is not None else None if args.predictions is not None else load_detector(args.detector)
-    )
-    detector_name = f"learned model {args.model}" if learned is not None else args.detector
+    chosen = args.detector if args.detector is not None else "baseline"
+    detector = learned if learned is not None else None if args.predictions is not None else load_detector(chosen)
+    detector_name = f"learned model {args.model}" if learned is not None else chosen
     runs: list[tuple[Any, str, tuple[str, ...], Path]] = [(detector, detector_name, modes, out)]
     if learned is not None:  # the learned model beside the baseline, on the same frames
         base_modes = tuple(m for m in modes if m != "intermediate")
