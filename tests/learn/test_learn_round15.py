@@ -4,7 +4,7 @@ preset and in-memory scenes.
 Each test failed before its fix: ``--modes early`` with a ``--model`` folder holding the ``single`` model alone
 said "--model OUT: no model.pt there", where one is; a ``log.jsonl`` cut short (it was written in place) stayed so,
 and the same command run again failed plotting it; ``--detector baseline`` with ``--model`` or ``--predictions`` was
-ignored (it is the default).
+ignored (it is the default); a ``model.pt`` of another seed without its ``last.pt`` was replaced by training.
 """
 
 from __future__ import annotations
@@ -73,3 +73,23 @@ def test_detector_baseline_given_with_model_or_predictions_is_refused(
     err = capsys.readouterr().err
     assert "give --detector or --predictions, not both" in err and "Traceback" not in err, err
     assert not (tmp_path / "study").exists()
+
+
+def test_a_model_of_another_run_without_its_last_checkpoint_is_not_replaced(
+    single: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import shutil
+
+    from mmusv.errors import InputError
+
+    out = tmp_path / "m"
+    shutil.copytree(single / "single", out)
+    (out / "last.pt").unlink()  # removed (it holds the optimiser too), or the model.pt alone copied there
+    model = (out / "model.pt").read_bytes()
+    # another seed into the folder: it trained from the start and replaced the model without a word
+    with pytest.raises(InputError, match=r"model\.pt: a model of another run \(seed 0, this run 5\), without its last"):
+        train(MemorySource(SCENES), p=preset("tiny"), mode="single", out=out, seed=5, epochs=1, progress=False)
+    assert (out / "model.pt").read_bytes() == model
+    # the same run trains again as before (the same seed, the same weights)
+    train(MemorySource(SCENES), p=preset("tiny"), mode="single", out=out, epochs=1, progress=False)
+    assert (out / "model.pt").read_bytes() == model

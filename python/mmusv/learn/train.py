@@ -51,7 +51,7 @@ from typing import Any
 import numpy as np
 import torch
 
-from mmusv.learn._errors import input_error
+from mmusv.learn._errors import input_error, input_error_types
 from mmusv.learn.augment import apply, draw
 from mmusv.learn.cache import Cache, same_data
 from mmusv.learn.checkpoint import load_checkpoint, remove_stale_temporaries, save_checkpoint
@@ -180,6 +180,7 @@ def resumable_checkpoint(
     the same ``-o`` printed the refusal once per model and replaced ``train_summary.json`` with one of no model."""
     last = Path(out) / "last.pt"
     if not last.is_file():
+        _check_model_alone(Path(out) / "model.pt", p=p, mode=mode, seed=seed, identity=identity)
         return None
     ck = load_checkpoint(last, what=_not_a_checkpoint(last), device=device)
     other = _differs(ck, p, mode, seed)
@@ -192,6 +193,29 @@ def resumable_checkpoint(
             f"{out} to start again"
         )
     return ck
+
+
+def _check_model_alone(model: Path, *, p: Preset, mode: str, seed: int, identity: dict[str, Any] | None) -> None:
+    """Refuses a ``model.pt`` without the ``last.pt`` beside it (removed, or the file alone copied there) when it is
+    of another run (another preset, mode, seed or data): training started over and replaced it without a word, the
+    run's ``-o`` check passed it by, and a model of another training was lost. One that cannot be read is no
+    model to lose (it is replaced)."""
+    if not model.is_file():
+        return
+    try:
+        ck = load_checkpoint(model, what=str(model))
+    except input_error_types():
+        return
+    other = _differs(ck, p, mode, seed)
+    if other is None and not same_data(ck.get("data"), identity):
+        data = ck.get("data")
+        before = ", ".join(str(x) for x in data.get("sources", [])) if isinstance(data, dict) else ""
+        other = f"trained on other data: {before or '?'}"
+    if other is not None:
+        raise input_error(
+            f"{model}: a model of another run ({other}), without its last.pt, would be replaced by this run's; use "
+            f"another -o, or remove {model.parent} to start again"
+        )
 
 
 def train(
