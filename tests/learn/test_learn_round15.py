@@ -4,7 +4,9 @@ preset and in-memory scenes.
 Each test failed before its fix: ``--modes early`` with a ``--model`` folder holding the ``single`` model alone
 said "--model OUT: no model.pt there", where one is; a ``log.jsonl`` cut short (it was written in place) stayed so,
 and the same command run again failed plotting it; ``--detector baseline`` with ``--model`` or ``--predictions`` was
-ignored (it is the default); a ``model.pt`` of another seed without its ``last.pt`` was replaced by training.
+ignored (it is the default); a ``model.pt`` of another seed without its ``last.pt`` was replaced by training;
+``scripts/learn_train.py infer`` / ``merge`` and ``python -m mmusv.learn.replay`` with ``-o`` a folder failed after
+the work, naming and leaving a temporary file.
 """
 
 from __future__ import annotations
@@ -93,3 +95,25 @@ def test_a_model_of_another_run_without_its_last_checkpoint_is_not_replaced(
     # the same run trains again as before (the same seed, the same weights)
     train(MemorySource(SCENES), p=preset("tiny"), mode="single", out=out, epochs=1, progress=False)
     assert (out / "model.pt").read_bytes() == model
+
+
+def test_an_output_file_that_is_a_folder_is_refused_before_the_work(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import numpy as np
+    from mmusv.errors import InputError
+    from mmusv.learn._errors import command
+    from mmusv.learn.infer import infer_cache, merge_main
+
+    folder = tmp_path / "peaks"
+    folder.mkdir()
+    part = tmp_path / "single.npz"
+    np.savez(part, single_boxes=np.zeros((0, 7), np.float32))
+    # it failed when written, naming its temporary file (".peaks.partial: Is a directory"), and left that file
+    assert command(merge_main, ["-o", str(folder), str(part)]) == 2
+    err = capsys.readouterr().err
+    assert err == f"mmusv: error: -o {folder}: a folder; give the name of the file to write\n", err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["peaks", "single.npz"]
+    # infer: before any model runs (the peaks were computed first, minutes on a GPU)
+    with pytest.raises(InputError, match=r"out = '.*peaks': a folder; give the name"):
+        infer_cache(MemorySource(SCENES), models=tmp_path, out=folder)  # type: ignore[arg-type]

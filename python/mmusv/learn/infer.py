@@ -57,6 +57,7 @@ def infer_cache(
     unknown = sorted(set(modes) - set(MODES))
     if unknown:
         raise input_error(f"{given('modes', list(modes))}: unknown {', '.join(unknown)}; allowed: {', '.join(MODES)}")
+    check_out_file(out)
     dev = torch_device(device)
     root = Path(models)
     arrays: dict[str, np.ndarray] = {}
@@ -99,21 +100,36 @@ def infer_cache(
     return _write(arrays, out)
 
 
+def check_out_file(out: str | Path) -> Path:
+    """``out``, the file a command writes (``-o``), refused when it is a folder, before any work: the peaks were
+    computed (minutes on a GPU), then their file failed to take the folder's place, in a message naming the
+    temporary file (``.OUT.partial: Is a directory``), which was left behind."""
+    out_p = Path(out)
+    if out_p.is_dir():
+        raise input_error(f"{given('out', out)}: a folder; give the name of the file to write")
+    return out_p
+
+
 def _write(arrays: dict[str, np.ndarray], out: str | Path) -> Path:
     """``arrays`` into the ``.npz`` file ``out``, by that very name (numpy's own writer appended ``.npz`` to a name
     without it, and the path returned was not the file written), through a temporary file: an interrupted run leaves
-    no file that looks complete."""
-    out_p = Path(out)
+    no file that looks complete, and a failed one no temporary file."""
+    out_p = check_out_file(out)
     tmp = out_p.with_name(f".{out_p.name}.partial")
-    with open(tmp, "wb") as fh:
-        np.savez_compressed(fh, **arrays)  # type: ignore[arg-type]
-    tmp.replace(out_p)
+    try:
+        with open(tmp, "wb") as fh:
+            np.savez_compressed(fh, **arrays)  # type: ignore[arg-type]
+        tmp.replace(out_p)
+    except BaseException:  # a full disk, a Ctrl-C
+        tmp.unlink(missing_ok=True)
+        raise
     return out_p
 
 
 def merge_peaks(parts: Sequence[str | Path], out: str | Path) -> Path:
     """Joins the peak files ``parts`` of :func:`infer_cache` (one mode or more each, no mode twice) into
     ``out``; a missing part is skipped (a model that was not trained)."""
+    check_out_file(out)
     arrays: dict[str, np.ndarray] = {}
     for part in parts:
         if not Path(part).is_file():
@@ -139,7 +155,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--modes", default=",".join(MODES), help="the models to run (default: every one found)")
     a = ap.parse_args(argv)
     modes = [m.strip() for m in a.modes.split(",") if m.strip()]
-    with command_line({"cache": "--cache", "models": "--models", "modes": "--modes"}):  # the messages name these flags
+    with command_line({"cache": "--cache", "models": "--models", "modes": "--modes", "out": "-o"}):  # name these flags
         cache = Cache(a.cache, name="cache")
         infer_cache(cache, models=a.models, out=a.out, device=a.device, limit=a.limit, modes=modes)
     return 0
@@ -151,5 +167,6 @@ def merge_main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("parts", nargs="+")
     ap.add_argument("-o", "--out", required=True, help="output .npz")
     a = ap.parse_args(argv)
-    print(merge_peaks(a.parts, a.out))
+    with command_line({"out": "-o"}):
+        print(merge_peaks(a.parts, a.out))
     return 0

@@ -44,6 +44,7 @@ import numpy as np
 from mmusv.learn._errors import input_error, input_error_types
 from mmusv.learn.cache import Cache
 from mmusv.learn.example import early_cloud
+from mmusv.learn.infer import check_out_file
 from mmusv.learn.modes import MODELS
 from mmusv.learn.refine import RefineParams
 from mmusv.learn.scorer import SCORER_FILE, IoUScorer, load_scorer, second_stage
@@ -162,6 +163,7 @@ def write_predictions(
 
     if late_merge not in LATE_MERGES:
         raise input_error(f"{given('late_merge', late_merge)}: allowed: {', '.join(LATE_MERGES)}")
+    check_out_file(out)  # before the work: a folder failed only when written, naming no -o
     z = _read_peaks(peaks, cache)
     try:
         ds = resolve_dataset(list(inputs), opv2v=None, split=split, ratios=tuple(ratios), seed=seed)
@@ -284,7 +286,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             raise input_error(f"--scorers {root}: no <{'|'.join(MODELS)}>/{SCORER_FILE} there")
     flags = {"cache": "cache", "inputs": "recordings", "split": "--split", "ratios": "--split-ratios", "seed": "--seed"}
     flags["limit"] = "python -m mmusv.learn.infer --limit"  # how the peaks were cut short, for _read_peaks
-    with command_line({**flags, "late_merge": "--late-merge"}):  # the messages name what the command line takes
+    with command_line({**flags, "late_merge": "--late-merge", "out": "-o"}):  # the messages name what it takes
         return _write(a, ratios, refine, scorers)
 
 
