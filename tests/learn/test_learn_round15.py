@@ -6,7 +6,8 @@ said "--model OUT: no model.pt there", where one is; a ``log.jsonl`` cut short (
 and the same command run again failed plotting it; ``--detector baseline`` with ``--model`` or ``--predictions`` was
 ignored (it is the default); a ``model.pt`` of another seed without its ``last.pt`` was replaced by training;
 ``scripts/learn_train.py infer`` / ``merge`` and ``python -m mmusv.learn.replay`` with ``-o`` a folder failed after
-the work, naming and leaving a temporary file.
+the work, naming and leaving a temporary file; an ``-o`` that cannot be made was found by the study after its
+evaluation, and by ``mmusv train`` in a message without ``-o``.
 """
 
 from __future__ import annotations
@@ -117,3 +118,27 @@ def test_an_output_file_that_is_a_folder_is_refused_before_the_work(
     # infer: before any model runs (the peaks were computed first, minutes on a GPU)
     with pytest.raises(InputError, match=r"out = '.*peaks': a folder; give the name"):
         infer_cache(MemorySource(SCENES), models=tmp_path, out=folder)  # type: ignore[arg-type]
+
+
+def test_an_output_folder_that_cannot_be_made_is_named_before_the_work(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    locked = tmp_path / "locked"
+    made = Path.mkdir
+
+    def mkdir(self: Path, *args: object, **kwargs: object) -> None:  # a folder this user may not write (root may)
+        if self == locked:
+            raise PermissionError(13, "Permission denied", str(self))
+        made(self, *args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(Path, "mkdir", mkdir)
+    rec = tmp_path / "x.mcap"  # the -o refusal comes before any recording is read
+    rec.touch()
+    said = f"mmusv: error: -o/--output {locked}: cannot create the folder: Permission denied\n"
+    # the study evaluated every frame, then failed writing its tables ("cannot write .../detection_table.csv")
+    assert main(["study", "detection", str(rec), "--no-progress", "-o", str(locked)]) == 2
+    assert capsys.readouterr().err == said
+    # mmusv train named the folder without its -o ("mmusv: error: ...: Permission denied") when building the cache
+    argv = ["train", str(rec), "--preset", "tiny", "--modes", "single", "--epochs", "1", "--threads", "1"]
+    assert main([*argv, "--no-scorers", "--no-progress", "-o", str(locked)]) == 2
+    assert capsys.readouterr().err == said

@@ -129,12 +129,12 @@ def run(args: argparse.Namespace) -> int:
     (:data:`mmusv.studies.detection.cli.DATASET_FLAGS`: ``--opv2v x: not a folder``, not ``opv2v = 'x'``)."""
     from mmusv.studies.detection.cli import DATASET_FLAGS
 
-    with command_line(DATASET_FLAGS):
-        return _run(args)
+    with command_line(DATASET_FLAGS), contextlib.ExitStack() as stack:
+        return _run(args, stack)
 
 
-def _run(args: argparse.Namespace) -> int:
-    from mmusv.cli_paths import check_output_folder, path_arg
+def _run(args: argparse.Namespace, stack: contextlib.ExitStack) -> int:
+    from mmusv.cli_paths import check_output_folder, made_output_folder, path_arg
 
     _check_numbers(args)
     check_output_folder(args.output)  # an empty -o wrote the cache and the models into the current folder
@@ -167,6 +167,9 @@ def _run(args: argparse.Namespace) -> int:
         raise InputError("--scorers-only and --no-scorers: give one")
     if args.scorers_only and args.cache_only:  # --cache-only was ignored: the scorers were fitted (minutes)
         raise InputError("--scorers-only and --cache-only: give one")
+    # made, or named when it cannot be ("/x: Permission denied" named no -o), before the work; removed again if still
+    # empty when the run fails or is interrupted
+    stack.enter_context(made_output_folder(args.output))
     if args.scorers_only:
         cache_file = out / f"cache_{args.split}.npz"
         if not cache_file.is_file():

@@ -9,6 +9,7 @@ point as one line (exit status 2).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import time
 from pathlib import Path
 from typing import Any
@@ -182,16 +183,16 @@ def add_parsers(studies: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     """Runs ``mmusv study detection|robustness``; returns the exit status. Its messages, and those of the API it
     calls, name its flags (:data:`FLAGS`)."""
-    with command_line(FLAGS):
-        return _run(args)
+    with command_line(FLAGS), contextlib.ExitStack() as stack:
+        return _run(args, stack)
 
 
-def _run(args: argparse.Namespace) -> int:
+def _run(args: argparse.Namespace, stack: contextlib.ExitStack) -> int:
     from rich.text import Text
 
     from mmusv import arguments
     from mmusv.cli_console import rich_console
-    from mmusv.cli_paths import check_output_folder, path_arg
+    from mmusv.cli_paths import check_output_folder, made_output_folder, path_arg
     from mmusv.errors import InputError
     from mmusv.learn.cli import check_threads, split_ratios
     from mmusv.studies.detection.data import check_split
@@ -282,6 +283,9 @@ def _run(args: argparse.Namespace) -> int:
     predictions = load_predictions(args.predictions) if args.predictions is not None else None
     if predictions is not None:
         check_prediction_coverage(args.predictions, predictions, modes=modes, settings=settings)
+    # made (or named when it cannot be) before the work, which failed writing the tables after the whole study;
+    # removed again if still empty when the study fails or is interrupted
+    stack.enter_context(made_output_folder(args.output))
     t0 = time.perf_counter()
     inputs: list[Any] = list(args.inputs)
     if args.generate is not None:
