@@ -7,7 +7,8 @@ and the same command run again failed plotting it; ``--detector baseline`` with 
 ignored (it is the default); a ``model.pt`` of another seed without its ``last.pt`` was replaced by training;
 ``scripts/learn_train.py infer`` / ``merge`` and ``python -m mmusv.learn.replay`` with ``-o`` a folder failed after
 the work, naming and leaving a temporary file; an ``-o`` that cannot be made was found by the study after its
-evaluation, and by ``mmusv train`` in a message without ``-o``.
+evaluation, and by ``mmusv train`` in a message without ``-o``; ``python -m mmusv.learn.replay`` could not take the
+OPV2V folder a cache was built from, and told to give it "as opv2v = '...'".
 """
 
 from __future__ import annotations
@@ -142,3 +143,35 @@ def test_an_output_folder_that_cannot_be_made_is_named_before_the_work(
     argv = ["train", str(rec), "--preset", "tiny", "--modes", "single", "--epochs", "1", "--threads", "1"]
     assert main([*argv, "--no-scorers", "--no-progress", "-o", str(locked)]) == 2
     assert capsys.readouterr().err == said
+
+
+def test_replay_takes_the_opv2v_folder_a_cache_was_built_from(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import yaml
+    from mmusv.acquire import run
+    from mmusv.learn import replay
+    from mmusv.learn._errors import command
+    from mmusv.learn.cache import Cache, build_cache
+    from mmusv.learn.infer import infer_cache
+    from mmusv.studies.detection.sources import lidar_only
+
+    root = Path(__file__).resolve().parents[2]
+    data = lidar_only(yaml.safe_load((root / "scenarios" / "island_occlusion.yaml").read_text(encoding="utf-8")))
+    usvs = [v["id"] for v in data["vessels"] if v["role"] == "usv"][:2]
+    data["vessels"] = [v for v in data["vessels"] if v["role"] != "usv" or v["id"] in usvs]
+    data["name"], data["acquisition"]["frames"] = "r15", 3
+    rec = run(data, out_dir=tmp_path / "rec").recording
+    opv = tmp_path / "opv"
+    assert main(["convert", str(rec), "--to", "opv2v", "-o", str(opv), "--no-progress"]) == 0
+    capsys.readouterr()
+    cache = build_cache([], tmp_path / "cache.npz", opv2v=str(opv), split="all")
+    train(Cache(cache), p=preset("tiny"), mode="single", out=tmp_path / "models" / "single", epochs=1, progress=False)
+    peaks = infer_cache(Cache(cache), models=tmp_path / "models", out=tmp_path / "peaks.npz")
+    argv = [str(peaks), str(cache), "--split", "all", "-o", str(tmp_path / "p.parquet")]
+    # given as a recording, it was told to be given "as opv2v = '...'", which the command had no way to take
+    assert command(replay.main, [*argv, str(opv)]) == 2
+    err = capsys.readouterr().err
+    assert f"it is an OPV2V folder: give it as --opv2v {opv};" in err, err
+    assert command(replay.main, [*argv, "--opv2v", str(opv)]) == 0
+    assert (tmp_path / "p.parquet").is_file()

@@ -22,14 +22,14 @@ With ``--scorers DIR`` (and ``--refine``) the refined boxes are rescored by the 
 :mod:`mmusv.learn.scorer` as the detector does (:func:`mmusv.learn.scorer.second_stage`).
 
 The peaks must be those of this cache (one item per cloud or sample: the peaks of another cache, or of an ``infer
---limit`` run, are refused), and the cache must hold every sequence of ``split`` of the recordings given, recorded
-the same (a cache of another split wrote a predictions file without a row): ``--split``, ``--split-ratios`` and
-``--seed`` must be those the cache was built with (``mmusv train``'s and ``mmusv study``'s options of the same
-names; defaults ``test``, ``0.7,0.15,0.15`` and 0). Run as a command, a bad input is one line,
-``mmusv: error: ...``, and exit status 2.
+--limit`` run, are refused), and the cache must hold every sequence of ``split`` of the recordings given (or of
+the OPV2V folder, ``--opv2v``, for a cache ``mmusv train --opv2v`` built), recorded the same (a cache of another
+split wrote a predictions file without a row): ``--split``, ``--split-ratios`` and ``--seed`` must be those the
+cache was built with (``mmusv train``'s and ``mmusv study``'s options of the same names; defaults ``test``,
+``0.7,0.15,0.15`` and 0). Run as a command, a bad input is one line, ``mmusv: error: ...``, and exit status 2.
 
-``python -m mmusv.learn.replay PEAKS.npz CACHE.npz RECORDINGS... [--split test] [--split-ratios 0.7,0.15,0.15]
-[--seed 0] [--refine [--scorers DIR]] [--late-merge wbf] -o PREDICTIONS.parquet``
+``python -m mmusv.learn.replay PEAKS.npz CACHE.npz RECORDINGS...|--opv2v FOLDER [--split test] [--split-ratios
+0.7,0.15,0.15] [--seed 0] [--refine [--scorers DIR]] [--late-merge wbf] -o PREDICTIONS.parquet``
 """
 
 from __future__ import annotations
@@ -142,6 +142,7 @@ def write_predictions(
     *,
     inputs: Sequence[str | Path],
     out: str | Path,
+    opv2v: str | Path | None = None,
     split: str = "test",
     ratios: Sequence[float] = (0.7, 0.15, 0.15),
     seed: int = 0,
@@ -151,9 +152,10 @@ def write_predictions(
     scorers: dict[str, IoUScorer] | None = None,
 ) -> Path:
     """Writes the predictions Parquet (module docstring) of ``peaks`` on ``cache`` (built from the same
-    ``inputs`` and split) to ``out``; returns ``out``. ``refine``: the second stage's parameters, or ``None`` for
-    the network's boxes; ``late_merge``: one of :data:`mmusv.studies.detection.fusion.LATE_MERGES`; ``scorers``:
-    the IoU scorers by model (``single``, ``early``, ``intermediate``) for the refined boxes."""
+    ``inputs``, or OPV2V folder ``opv2v``, and split) to ``out``; returns ``out``. ``refine``: the second stage's
+    parameters, or ``None`` for the network's boxes; ``late_merge``: one of
+    :data:`mmusv.studies.detection.fusion.LATE_MERGES`; ``scorers``: the IoU scorers by model (``single``, ``early``,
+    ``intermediate``) for the refined boxes."""
     import polars as pl
 
     from mmusv.studies.detection.data import AgentFrame
@@ -166,7 +168,7 @@ def write_predictions(
     check_out_file(out)  # before the work: a folder failed only when written, naming no -o
     z = _read_peaks(peaks, cache)
     try:
-        ds = resolve_dataset(list(inputs), opv2v=None, split=split, ratios=tuple(ratios), seed=seed)
+        ds = resolve_dataset(list(inputs), opv2v=opv2v, split=split, ratios=tuple(ratios), seed=seed)
     except input_error_types() as exc:  # an empty split: say how the cache was made
         hint = _built_with(cache, f"; the cache {cache.path} was built with ")
         if not hint:
@@ -251,7 +253,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=" ".join((__doc__ or "").split("\n\n")[0].split()))
     ap.add_argument("peaks", help="the peaks .npz of mmusv.learn.infer (scripts/learn_train.py infer) on CACHE")
     ap.add_argument("cache", help="the tensor cache the peaks were inferred on (mmusv train --cache-only)")
-    ap.add_argument("inputs", nargs="+", help="the recordings (.mcap) or folders of them the cache was built from")
+    ap.add_argument("inputs", nargs="*", help="the recordings (.mcap) or folders of them the cache was built from")
+    ap.add_argument("--opv2v", default=None, help="the OPV2V folder the cache was built from (instead of recordings)")
     ap.add_argument("--split", default="test", help="the split the cache holds (default test)")
     ap.add_argument(
         "--split-ratios",
@@ -271,7 +274,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         "output folder)",
     )
     ap.add_argument("-o", "--out", required=True, help="the predictions Parquet to write")
-    a = ap.parse_args(argv)
+    a = ap.parse_intermixed_args(argv)  # recordings after the options too (inputs may be none, with --opv2v)
     from mmusv.learn.cli import split_ratios
 
     ratios = split_ratios(a.split_ratios)  # as mmusv train and mmusv study take it
@@ -285,6 +288,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if not scorers:
             raise input_error(f"--scorers {root}: no <{'|'.join(MODELS)}>/{SCORER_FILE} there")
     flags = {"cache": "cache", "inputs": "recordings", "split": "--split", "ratios": "--split-ratios", "seed": "--seed"}
+    flags["opv2v"] = "--opv2v"  # an OPV2V folder given as a recording is told to be given so
     flags["limit"] = "python -m mmusv.learn.infer --limit"  # how the peaks were cut short, for _read_peaks
     with command_line({**flags, "late_merge": "--late-merge", "out": "-o"}):  # the messages name what it takes
         return _write(a, ratios, refine, scorers)
@@ -300,6 +304,7 @@ def _write(
         a.peaks,
         Cache(a.cache, name="cache"),
         inputs=a.inputs,
+        opv2v=a.opv2v,
         out=a.out,
         split=a.split,
         ratios=ratios,
