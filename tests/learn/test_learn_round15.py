@@ -8,7 +8,8 @@ ignored (it is the default); a ``model.pt`` of another seed without its ``last.p
 ``scripts/learn_train.py infer`` / ``merge`` and ``python -m mmusv.learn.replay`` with ``-o`` a folder failed after
 the work, naming and leaving a temporary file; an ``-o`` that cannot be made was found by the study after its
 evaluation, and by ``mmusv train`` in a message without ``-o``; ``python -m mmusv.learn.replay`` could not take the
-OPV2V folder a cache was built from, and told to give it "as opv2v = '...'".
+OPV2V folder a cache was built from, and told to give it "as opv2v = '...'"; a ``--model`` file of bytes that are
+no pickle (YAML, text) was a traceback of the unpickler, and JSON said to hold "objects other than tensors".
 """
 
 from __future__ import annotations
@@ -175,3 +176,22 @@ def test_replay_takes_the_opv2v_folder_a_cache_was_built_from(
     assert f"it is an OPV2V folder: give it as --opv2v {opv};" in err, err
     assert command(replay.main, [*argv, "--opv2v", str(opv)]) == 0
     assert (tmp_path / "p.parquet").is_file()
+
+
+@pytest.mark.parametrize(
+    ("content", "said"),
+    [
+        (b"a: 1\nb: [2, 3]\n", "not a PyTorch checkpoint"),  # a YAML file: an IndexError traceback
+        (b"hello world\n", "not a PyTorch checkpoint"),  # a KeyError traceback
+        (b'{"model": "x"}\n', "not a PyTorch checkpoint"),  # said to hold "objects other than tensors"
+        (b"", "empty"),
+    ],
+)
+def test_a_model_file_of_other_bytes_is_named_without_a_traceback(
+    content: bytes, said: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    model = tmp_path / "model.pt"
+    model.write_bytes(content)
+    assert _study(tmp_path, "--model", str(model)) == 2
+    err = capsys.readouterr().err
+    assert err == f"mmusv: error: --model {model}: not an mmusv.learn model.pt ({said})\n", err

@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import hashlib
 import os
-import pickle
 import re
 import zipfile
 from collections.abc import Mapping
@@ -42,11 +41,20 @@ def load_checkpoint(path: str | Path, *, what: str, device: torch.device | str =
     p = Path(path)
     try:
         ck = torch.load(p, map_location=device, weights_only=True)
-    except (OSError, EOFError, pickle.UnpicklingError, RuntimeError, ValueError, zipfile.BadZipFile) as exc:
-        first = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
-        if "weights_only" in str(exc) or "Unsupported global" in str(exc):
-            first = "it holds objects other than tensors and plain values, which are not loaded"
-        raise input_error(f"{what} ({type(exc).__name__}: {first[:200]})") from None
+    except MemoryError:
+        raise
+    except Exception as exc:  # any bytes: the weights-only unpickler raises whatever its stack machine meets
+        # Bytes that are no pickle (a YAML or JSON file, a point cloud) made it fail with an IndexError or KeyError,
+        # a traceback, or were said to hold "objects other than tensors".
+        text = str(exc).strip()
+        no_pickle = "Unsupported operand" in text  # the unpickler's word for a byte that is no pickle opcode
+        if ("weights_only" in text or "Unsupported global" in text) and not no_pickle:
+            why = f"{type(exc).__name__}: it holds objects other than tensors and plain values, which are not loaded"
+        elif no_pickle or not isinstance(exc, (OSError, RuntimeError, zipfile.BadZipFile)):
+            why = "empty" if p.is_file() and p.stat().st_size == 0 else "not a PyTorch checkpoint"
+        else:  # an unreadable file, a cut-short archive: the first sentence of what was met
+            why = f"{type(exc).__name__}: {text.splitlines()[0].split('. ')[0][:200] if text else ''}"
+        raise input_error(f"{what} ({why})") from None
     if not isinstance(ck, dict):
         raise input_error(f"{what} (it holds a {type(ck).__name__}, not a dict)")
     return ck
