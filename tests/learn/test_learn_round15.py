@@ -9,7 +9,10 @@ ignored (it is the default); a ``model.pt`` of another seed without its ``last.p
 the work, naming and leaving a temporary file; an ``-o`` that cannot be made was found by the study after its
 evaluation, and by ``mmusv train`` in a message without ``-o``; ``python -m mmusv.learn.replay`` could not take the
 OPV2V folder a cache was built from, and told to give it "as opv2v = '...'"; a ``--model`` file of bytes that are
-no pickle (YAML, text) was a traceback of the unpickler, and JSON said to hold "objects other than tensors".
+no pickle (YAML, text) was a traceback of the unpickler, and JSON said to hold "objects other than tensors";
+``scripts/learn_train.py`` (:func:`mmusv.learn.train.train`) took ``--epochs 0``, a NaN or negative ``--time-limit``
+and ``--max-steps 0`` (training nothing, or without a limit), and ``--seed -1``, ``--workers -1`` and
+``--device tpu`` were tracebacks.
 """
 
 from __future__ import annotations
@@ -146,27 +149,36 @@ def test_an_output_folder_that_cannot_be_made_is_named_before_the_work(
     assert capsys.readouterr().err == said
 
 
-def test_replay_takes_the_opv2v_folder_a_cache_was_built_from(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
+@pytest.fixture(scope="module")
+def opv2v_cache(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    """An OPV2V folder converted from a 3-frame, 2-USV LiDAR-only recording, and the tensor cache of all of it."""
     import yaml
     from mmusv.acquire import run
-    from mmusv.learn import replay
-    from mmusv.learn._errors import command
-    from mmusv.learn.cache import Cache, build_cache
-    from mmusv.learn.infer import infer_cache
+    from mmusv.learn.cache import build_cache
     from mmusv.studies.detection.sources import lidar_only
 
+    tmp = tmp_path_factory.mktemp("round15_opv2v")
     root = Path(__file__).resolve().parents[2]
     data = lidar_only(yaml.safe_load((root / "scenarios" / "island_occlusion.yaml").read_text(encoding="utf-8")))
     usvs = [v["id"] for v in data["vessels"] if v["role"] == "usv"][:2]
     data["vessels"] = [v for v in data["vessels"] if v["role"] != "usv" or v["id"] in usvs]
     data["name"], data["acquisition"]["frames"] = "r15", 3
-    rec = run(data, out_dir=tmp_path / "rec").recording
-    opv = tmp_path / "opv"
+    rec = run(data, out_dir=tmp / "rec").recording
+    opv = tmp / "opv"
     assert main(["convert", str(rec), "--to", "opv2v", "-o", str(opv), "--no-progress"]) == 0
+    return opv, build_cache([], tmp / "cache.npz", opv2v=str(opv), split="all")
+
+
+def test_replay_takes_the_opv2v_folder_a_cache_was_built_from(
+    opv2v_cache: tuple[Path, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from mmusv.learn import replay
+    from mmusv.learn._errors import command
+    from mmusv.learn.cache import Cache
+    from mmusv.learn.infer import infer_cache
+
+    opv, cache = opv2v_cache
     capsys.readouterr()
-    cache = build_cache([], tmp_path / "cache.npz", opv2v=str(opv), split="all")
     train(Cache(cache), p=preset("tiny"), mode="single", out=tmp_path / "models" / "single", epochs=1, progress=False)
     peaks = infer_cache(Cache(cache), models=tmp_path / "models", out=tmp_path / "peaks.npz")
     argv = [str(peaks), str(cache), "--split", "all", "-o", str(tmp_path / "p.parquet")]
@@ -195,3 +207,32 @@ def test_a_model_file_of_other_bytes_is_named_without_a_traceback(
     assert _study(tmp_path, "--model", str(model)) == 2
     err = capsys.readouterr().err
     assert err == f"mmusv: error: --model {model}: not an mmusv.learn model.pt ({said})\n", err
+
+
+@pytest.mark.parametrize(
+    ("flag", "value", "said"),
+    [
+        ("--epochs", "0", "--epochs 0: must be a whole number >= 1"),  # trained nothing, "finished=True"
+        ("--epochs", "-3", "--epochs -3: must be a whole number >= 1"),
+        ("--time-limit", "nan", "--time-limit nan: seconds, a finite number > 0"),  # ignored: trained without one
+        ("--time-limit", "-1", "--time-limit -1"),  # no step, no model
+        ("--max-steps", "0", "--max-steps 0: must be a whole number >= 1"),
+        ("--seed", "-1", "--seed -1: must be a whole number in 0.."),  # a numpy traceback
+        ("--workers", "-1", "--workers -1: must be a whole number >= 0"),  # a torch traceback
+        ("--device", "tpu", "--device tpu: not a device; allowed: cpu, cuda, cuda:N or mps"),  # a torch traceback
+    ],
+)
+def test_learn_train_script_refuses_bad_numbers_before_training(
+    flag: str, value: str, said: str, opv2v_cache: tuple[Path, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from mmusv.learn._errors import command
+    from mmusv.learn.train import main as train_main
+
+    cache = opv2v_cache[1]
+    capsys.readouterr()
+    out = tmp_path / "out"
+    argv = ["--cache", str(cache), "--preset", "tiny", "--no-progress", "--threads", "1", "-o", str(out)]
+    assert command(train_main, [*argv, flag, value]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"mmusv: error: {said}") and err.count("\n") == 1, err
+    assert not out.exists()

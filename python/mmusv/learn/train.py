@@ -129,6 +129,46 @@ def _save(obj: dict[str, Any], path: Path) -> None:
     save_checkpoint(obj, path)
 
 
+def _whole(value: Any) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _check_options(
+    *,
+    epochs: int | None,
+    time_limit_s: float | None,
+    max_steps: int | None,
+    seed: int,
+    workers: int,
+    device: str | None,
+) -> torch.device:
+    """The device of :func:`train`, its other options checked before anything is written: ``scripts/learn_train.py``
+    (which checked none, ``mmusv train`` checks its own flags) trained nothing with ``--epochs 0`` or ``-3`` or
+    ``--time-limit -1`` and said ``finished=True`` or wrote no model, ignored ``--time-limit nan``, and ``--seed -1``,
+    ``--workers -1`` and ``--device tpu`` were tracebacks of numpy and torch."""
+    if epochs is not None and not (_whole(epochs) and epochs >= 1):
+        raise input_error(f"{given('epochs', epochs)}: must be a whole number >= 1 (or left out for the preset's)")
+    if time_limit_s is not None and not (
+        isinstance(time_limit_s, (int, float)) and math.isfinite(time_limit_s) and time_limit_s > 0
+    ):
+        raise input_error(
+            f"{given('time_limit_s', time_limit_s)}: seconds, a finite number > 0 (or left out for no limit)"
+        )
+    if max_steps is not None and not (_whole(max_steps) and max_steps >= 1):
+        raise input_error(f"{given('max_steps', max_steps)}: must be a whole number >= 1 (or left out for no limit)")
+    if not (_whole(seed) and 0 <= seed < 2**63):
+        raise input_error(f"{given('seed', seed)}: must be a whole number in 0..{2**63 - 1}")
+    if not (_whole(workers) and workers >= 0):
+        raise input_error(f"{given('workers', workers)}: must be a whole number >= 0 (0: load data in this process)")
+    try:
+        dev = torch_device(device)
+    except (RuntimeError, ValueError, TypeError):
+        raise input_error(f"{given('device', device)}: not a device; allowed: cpu, cuda, cuda:N or mps") from None
+    if dev.type == "cuda" and not torch.cuda.is_available():
+        raise input_error(f"{given('device', device)}: CUDA is not available on this machine; use cpu")
+    return dev
+
+
 def _write_log(path: Path, log: list[dict[str, Any]]) -> None:
     """``log.jsonl`` (one JSON object a line) written whole, through a temporary ``.log.jsonl.<pid>.tmp`` renamed
     into place: written in place, a run interrupted while writing it left it cut short, and the same command run
@@ -238,11 +278,13 @@ def train(
     ``out/last.pt`` when present. ``epochs`` defaults to the preset's; ``max_steps`` stops early (tests)."""
     if mode not in MODES:
         raise input_error(f"{given('mode', mode)}: allowed: {', '.join(MODES)}")
+    dev = _check_options(
+        epochs=epochs, time_limit_s=time_limit_s, max_steps=max_steps, seed=seed, workers=workers, device=device
+    )
     c = Cache(cache, name="cache") if isinstance(cache, (str, Path)) else cache
     out_p = Path(out)
     out_p.mkdir(parents=True, exist_ok=True)
     remove_stale_temporaries(out_p)  # of a run killed while it saved (they were left in the folder for good)
-    dev = torch_device(device)
     if dev.type == "cpu":
         torch.use_deterministic_algorithms(True)
         # Deterministic mode also fills every new tensor with NaN, to expose reads of memory never written; no
@@ -514,7 +556,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         "--set code_weights=[1,1,0.1,1,1,1,1,1]; the checkpoint records the preset as trained",
     )
     a = ap.parse_args(argv)
-    with command_line({"cache": "--cache", "items": "--set", "mode": "--modes"}):  # the messages name these flags
+    flags = {"cache": "--cache", "items": "--set", "mode": "--modes", "epochs": "--epochs", "seed": "--seed"}
+    flags.update(time_limit_s="--time-limit", max_steps="--max-steps", workers="--workers", device="--device")
+    with command_line(flags):  # the messages name these flags
         return _main(a)
 
 
@@ -525,6 +569,15 @@ def _main(a: argparse.Namespace) -> int:
     p = preset(a.preset, **overrides)
     if overrides:
         print(f"preset {p.name} with {overrides}", flush=True)
+    # before the cache is read (train checks them again)
+    _check_options(
+        epochs=a.epochs,
+        time_limit_s=a.time_limit,
+        max_steps=a.max_steps,
+        seed=a.seed,
+        workers=a.workers,
+        device=a.device,
+    )
     cache = Cache(a.cache, name="cache")
     for mode in [m.strip() for m in a.modes.split(",") if m.strip()]:
         r = train(
