@@ -12,7 +12,9 @@ OPV2V folder a cache was built from, and told to give it "as opv2v = '...'"; a `
 no pickle (YAML, text) was a traceback of the unpickler, and JSON said to hold "objects other than tensors";
 ``scripts/learn_train.py`` (:func:`mmusv.learn.train.train`) took ``--epochs 0``, a NaN or negative ``--time-limit``
 and ``--max-steps 0`` (training nothing, or without a limit), and ``--seed -1``, ``--workers -1`` and
-``--device tpu`` were tracebacks.
+``--device tpu`` were tracebacks; ``scripts/learn_train.py infer --limit -1`` inferred every item but the last,
+``--device tpu`` was a traceback, ``--modes ''`` said "no /model.pt there", and ``merge`` of a file that is no
+``.npz`` was a traceback.
 """
 
 from __future__ import annotations
@@ -236,3 +238,48 @@ def test_learn_train_script_refuses_bad_numbers_before_training(
     err = capsys.readouterr().err
     assert err.startswith(f"mmusv: error: {said}") and err.count("\n") == 1, err
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("extra", "said"),
+    [
+        (
+            ["--limit", "-1"],
+            "--limit -1: must be a whole number >= 1 (or left out for every item)",
+        ),  # every item but the last, without a word
+        (["--limit", "0"], "--limit 0: must be a whole number >= 1 (or left out for every item)"),  # no item
+        (["--device", "tpu"], "--device tpu: not a device; allowed: cpu, cuda, cuda:N or mps"),  # a torch traceback
+        (["--modes", ""], "--modes '': no model named; allowed: single, early, intermediate"),  # "no /model.pt there"
+    ],
+)
+def test_learn_train_infer_refuses_bad_options(
+    extra: list[str],
+    said: str,
+    single: Path,
+    opv2v_cache: tuple[Path, Path],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    from mmusv.learn._errors import command
+    from mmusv.learn.infer import main as infer_main
+
+    capsys.readouterr()
+    out = tmp_path / "peaks.npz"
+    argv = ["--cache", str(opv2v_cache[1]), "--models", str(single), "-o", str(out), *extra]
+    assert command(infer_main, argv) == 2
+    err = capsys.readouterr().err
+    assert err == f"mmusv: error: {said}\n", err
+    assert not out.exists()
+
+
+def test_learn_train_merge_names_a_part_that_is_not_a_peaks_file(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from mmusv.learn._errors import command
+    from mmusv.learn.infer import merge_main
+
+    part = tmp_path / "notes.npz"
+    part.write_text("a: 1\n", encoding="utf-8")  # a numpy ValueError traceback
+    assert command(merge_main, ["-o", str(tmp_path / "peaks.npz"), str(part)]) == 2
+    err = capsys.readouterr().err
+    assert err == f"mmusv: error: {part}: not a peaks .npz of mmusv.learn.infer (ValueError)\n", err

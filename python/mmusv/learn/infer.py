@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import time
+import zipfile
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -29,7 +30,7 @@ from mmusv.learn.cache import Cache
 from mmusv.learn.checkpoint import load_checkpoint
 from mmusv.learn.decode import peaks
 from mmusv.learn.example import MODES, collate, make_example, message_bytes
-from mmusv.learn.model import PillarNet, from_checkpoint, torch_device
+from mmusv.learn.model import PillarNet, checked_device, from_checkpoint
 from mmusv.text import command_line, counted, given
 
 __all__ = ["infer_cache", "main", "merge_main", "merge_peaks"]
@@ -55,10 +56,14 @@ def infer_cache(
     ``out`` (the first ``limit`` items per model only, when given: smoke tests). One process per mode, each
     with its own ``out``, runs the models side by side; :func:`merge_peaks` joins their files."""
     unknown = sorted(set(modes) - set(MODES))
-    if unknown:
-        raise input_error(f"{given('modes', list(modes))}: unknown {', '.join(unknown)}; allowed: {', '.join(MODES)}")
+    if unknown or not modes:  # none: "no /model.pt there"
+        what = f"unknown {', '.join(unknown)}" if unknown else "no model named"
+        raise input_error(f"{given('modes', list(modes) or '')}: {what}; allowed: {', '.join(MODES)}")
+    # -1 ran every item but the last (a slice), 0 none
+    if limit is not None and not (isinstance(limit, int) and not isinstance(limit, bool) and limit >= 1):
+        raise input_error(f"{given('limit', limit)}: must be a whole number >= 1 (or left out for every item)")
     check_out_file(out)
-    dev = torch_device(device)
+    dev = checked_device(device)  # "tpu" was a torch traceback
     root = Path(models)
     arrays: dict[str, np.ndarray] = {}
     n_clouds = len(cache.arrays["cloud_offsets"]) - 1
@@ -134,11 +139,15 @@ def merge_peaks(parts: Sequence[str | Path], out: str | Path) -> Path:
     for part in parts:
         if not Path(part).is_file():
             continue
-        with np.load(part) as f:
-            for k in f.files:
-                if k in arrays:
-                    raise input_error(f"{part}: {k} is in two of the peak files")
-                arrays[k] = f[k]
+        try:
+            with open(part, "rb") as fh, np.load(fh, allow_pickle=False) as f:
+                held = {k: f[k] for k in f.files}
+        except (ValueError, EOFError, TypeError, zipfile.BadZipFile) as exc:  # a numpy traceback
+            raise input_error(f"{part}: not a peaks .npz of mmusv.learn.infer ({type(exc).__name__})") from None
+        for k, v in held.items():
+            if k in arrays:
+                raise input_error(f"{part}: {k} is in two of the peak files")
+            arrays[k] = v
     if not arrays:
         raise input_error(f"{', '.join(str(x) for x in parts)}: none of the peak files is there")
     return _write(arrays, out)
@@ -155,7 +164,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--modes", default=",".join(MODES), help="the models to run (default: every one found)")
     a = ap.parse_args(argv)
     modes = [m.strip() for m in a.modes.split(",") if m.strip()]
-    with command_line({"cache": "--cache", "models": "--models", "modes": "--modes", "out": "-o"}):  # name these flags
+    flags = {"cache": "--cache", "models": "--models", "modes": "--modes", "out": "-o", "limit": "--limit"}
+    flags["device"] = "--device"
+    with command_line(flags):  # the messages name these flags
         cache = Cache(a.cache, name="cache")
         infer_cache(cache, models=a.models, out=a.out, device=a.device, limit=a.limit, modes=modes)
     return 0

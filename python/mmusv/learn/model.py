@@ -30,6 +30,20 @@ def torch_device(device: str | None) -> torch.device:
     return torch.device(device or ("cuda" if torch.cuda.is_available() else "cpu"))
 
 
+def checked_device(device: str | None) -> torch.device:
+    """:func:`torch_device`, refusing a ``device`` that names no device (``tpu``: a torch traceback) or CUDA on a
+    machine without it, naming ``device`` as its user gave it (:func:`mmusv.text.given`)."""
+    from mmusv.text import given
+
+    try:
+        dev = torch_device(device)
+    except (RuntimeError, ValueError, TypeError):
+        raise input_error(f"{given('device', device)}: not a device; allowed: cpu, cuda, cuda:N or mps") from None
+    if dev.type == "cuda" and not torch.cuda.is_available():
+        raise input_error(f"{given('device', device)}: CUDA is not available on this machine; use cpu")
+    return dev
+
+
 class PillarNet(nn.Module):
     """PointPillars + CenterPoint of preset ``p`` for training ``mode`` (``single``, ``early``,
     ``intermediate``)."""

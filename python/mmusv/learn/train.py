@@ -57,7 +57,7 @@ from mmusv.learn.cache import Cache, same_data
 from mmusv.learn.checkpoint import load_checkpoint, remove_stale_temporaries, save_checkpoint
 from mmusv.learn.example import MODES, Example, collate, early_cloud, make_example
 from mmusv.learn.loss import centerpoint_loss
-from mmusv.learn.model import PillarNet, torch_device
+from mmusv.learn.model import PillarNet, checked_device
 from mmusv.learn.presets import PRESETS, Preset, parse_overrides, preset
 from mmusv.learn.targets import points_in_boxes
 from mmusv.text import command_line, counted, given
@@ -160,13 +160,7 @@ def _check_options(
         raise input_error(f"{given('seed', seed)}: must be a whole number in 0..{2**63 - 1}")
     if not (_whole(workers) and workers >= 0):
         raise input_error(f"{given('workers', workers)}: must be a whole number >= 0 (0: load data in this process)")
-    try:
-        dev = torch_device(device)
-    except (RuntimeError, ValueError, TypeError):
-        raise input_error(f"{given('device', device)}: not a device; allowed: cpu, cuda, cuda:N or mps") from None
-    if dev.type == "cuda" and not torch.cuda.is_available():
-        raise input_error(f"{given('device', device)}: CUDA is not available on this machine; use cpu")
-    return dev
+    return checked_device(device)
 
 
 def _write_log(path: Path, log: list[dict[str, Any]]) -> None:
