@@ -14,7 +14,8 @@ no pickle (YAML, text) was a traceback of the unpickler, and JSON said to hold "
 and ``--max-steps 0`` (training nothing, or without a limit), and ``--seed -1``, ``--workers -1`` and
 ``--device tpu`` were tracebacks; ``scripts/learn_train.py infer --limit -1`` inferred every item but the last,
 ``--device tpu`` was a traceback, ``--modes ''`` said "no /model.pt there", and ``merge`` of a file that is no
-``.npz`` was a traceback.
+``.npz`` was a traceback; ``mmusv train --scorers-only`` left ``train_summary.json``'s ``scorers`` as the training
+wrote them.
 """
 
 from __future__ import annotations
@@ -283,3 +284,26 @@ def test_learn_train_merge_names_a_part_that_is_not_a_peaks_file(
     assert command(merge_main, ["-o", str(tmp_path / "peaks.npz"), str(part)]) == 2
     err = capsys.readouterr().err
     assert err == f"mmusv: error: {part}: not a peaks .npz of mmusv.learn.infer (ValueError)\n", err
+
+
+def test_scorers_only_records_its_fits_in_the_summary(
+    opv2v_cache: tuple[Path, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import json
+    import shutil
+
+    out = tmp_path / "m"
+    out.mkdir()
+    shutil.copy(opv2v_cache[1], out / "cache_all.npz")
+    argv = ["train", "--opv2v", str(opv2v_cache[0]), "--split", "all", "--preset", "tiny", "--modes", "single"]
+    argv += ["--epochs", "1", "--threads", "1", "--no-progress", "-o", str(out)]
+    assert main([*argv, "--no-scorers"]) == 0
+    assert "scorers" not in json.loads((out / "train_summary.json").read_text(encoding="utf-8"))
+    assert main([*argv, "--scorers-only"]) == 0
+    said = capsys.readouterr().out
+    summary = json.loads((out / "train_summary.json").read_text(encoding="utf-8"))
+    # it was left as the training wrote it: no word of the fit (here: too few boxes, which the line says)
+    assert set(summary["scorers"]) == {"single"}, summary
+    fit = summary["scorers"]["single"]
+    assert ("skipped" in fit and fit["skipped"] in said) or (out / "single" / "scorer.pt").is_file(), (fit, said)
+    assert list(summary["models"]) == ["single"]

@@ -175,7 +175,8 @@ def _run(args: argparse.Namespace, stack: contextlib.ExitStack) -> int:
         if not cache_file.is_file():
             raise InputError(f"--scorers-only: no {cache_file}; train first (mmusv train ... -o {out})")
         with command_line({**_NAMES, "out": "--scorers-only -o"}):
-            fit_scorers(out, cache_file, modes, seed=args.seed, threads=args.threads)
+            fits = fit_scorers(out, cache_file, modes, seed=args.seed, threads=args.threads)
+        _record_scorers(out / "train_summary.json", fits)
         return 0
     inputs: list[Any] = list(args.inputs)
     if args.generate is not None:
@@ -342,6 +343,21 @@ def _summary_to_keep(path: Path, modes: list[str], *, p: dict[str, Any], seed: i
             if kept:
                 summary[key] = kept
     return summary
+
+
+def _record_scorers(path: Path, fits: dict[str, dict[str, Any]]) -> None:
+    """``fits`` (what :func:`fit_scorers` measured, by model) in place of the ``scorers`` entries of the summary at
+    ``path``, if there is one: ``--scorers-only`` left them as the training wrote them, so a summary went on saying
+    why a model had no scorer (``skipped``) beside the ``scorer.pt`` fitted since, or gave another fit's ``beta``."""
+    from mmusv.jsonio import write_bytes_atomic
+
+    summary = read_json_or_none(path)
+    if summary is None:
+        return
+    kept = summary.get("scorers")
+    both = {**(kept if isinstance(kept, dict) else {}), **fits}
+    summary["scorers"] = {m: both[m] for m in MODELS if m in both}  # in the order of MODELS, as training writes it
+    write_bytes_atomic(path, (json.dumps(summary, indent=2) + "\n").encode("utf-8"))
 
 
 def _check_cache(
