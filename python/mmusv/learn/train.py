@@ -247,8 +247,8 @@ def _check_model_alone(model: Path, *, p: Preset, mode: str, seed: int, identity
         other = f"trained on other data: {before or '?'}"
     if other is not None:
         raise input_error(
-            f"{model}: a model of another run ({other}), without its last.pt, would be replaced by this run's; use "
-            f"another -o, or remove {model.parent} to start again"
+            f"{model}: a model of another run ({other}), without its last.pt; use another -o, or remove {model.parent} "
+            "to start again"
         )
 
 
