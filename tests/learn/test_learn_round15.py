@@ -15,7 +15,8 @@ and ``--max-steps 0`` (training nothing, or without a limit), and ``--seed -1``,
 ``--device tpu`` were tracebacks; ``scripts/learn_train.py infer --limit -1`` inferred every item but the last,
 ``--device tpu`` was a traceback, ``--modes ''`` said "no /model.pt there", and ``merge`` of a file that is no
 ``.npz`` was a traceback; ``mmusv train --scorers-only`` left ``train_summary.json``'s ``scorers`` as the training
-wrote them.
+wrote them; a folder where ``mmusv train`` writes a file (``train_summary.json``, the cache, ``model.pt``) failed
+when written, naming a temporary file, the summary after the training.
 """
 
 from __future__ import annotations
@@ -307,3 +308,24 @@ def test_scorers_only_records_its_fits_in_the_summary(
     fit = summary["scorers"]["single"]
     assert ("skipped" in fit and fit["skipped"] in said) or (out / "single" / "scorer.pt").is_file(), (fit, said)
     assert list(summary["models"]) == ["single"]
+
+
+@pytest.mark.parametrize(
+    ("folder", "said"),
+    [
+        ("train_summary.json", "train_summary.json is a folder (or another non-file), where a file"),
+        ("cache_all.npz", "cache_all.npz is a folder (or another non-file), where a file"),
+        ("single/model.pt", "single/model.pt is a folder (or another non-file), where a file"),
+    ],
+)
+def test_train_refuses_what_is_in_the_way_of_its_files_before_the_work(
+    folder: str, said: str, opv2v_cache: tuple[Path, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "m"
+    (out / folder).mkdir(parents=True)
+    argv = ["train", "--opv2v", str(opv2v_cache[0]), "--split", "all", "--preset", "tiny", "--modes", "single"]
+    # each failed when written, naming a temporary file ("Is a directory"), the summary after the training
+    assert main([*argv, "--epochs", "1", "--threads", "1", "--no-scorers", "--no-progress", "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"mmusv: error: -o/--output {out}: {said}") and err.count("\n") == 1, err
+    assert not (out / "single" / "last.pt").exists()

@@ -169,6 +169,7 @@ def _run(args: argparse.Namespace, stack: contextlib.ExitStack) -> int:
         raise InputError("--scorers-only and --cache-only: give one")
     # made, or named when it cannot be ("/x: Permission denied" named no -o), before the work; removed again if still
     # empty when the run fails or is interrupted
+    _check_in_the_way(out, args.split, modes)
     stack.enter_context(made_output_folder(args.output))
     if args.scorers_only:
         cache_file = out / f"cache_{args.split}.npz"
@@ -343,6 +344,21 @@ def _summary_to_keep(path: Path, modes: list[str], *, p: dict[str, Any], seed: i
             if kept:
                 summary[key] = kept
     return summary
+
+
+_WRITTEN = ("model.pt", "last.pt", "log.jsonl", "loss.png", "scorer.pt", "scorer_skipped.json")
+"""The files a model's folder ``OUT/<mode>/`` is written."""
+
+
+def _check_in_the_way(out: Path, split: str, modes: list[str]) -> None:
+    """Refuses, before the work, a folder (or another non-file) where ``mmusv train -o OUT`` writes a file
+    (``OUT/train_summary.json``, the cache, a model's ``model.pt``, ...): each failed when written, naming a temporary
+    file (``OUT/.train_summary.json.<pid>.tmp: Is a directory``), the summary after every model had trained. (A file
+    where a model's folder goes fails that model alone, in its process, before it trains.)"""
+    from mmusv.cli_paths import refuse_replacing
+
+    names = [f"cache_{split}.npz", "train_summary.json", *(f"{m}/{n}" for m in modes for n in _WRITTEN)]
+    refuse_replacing(out, names, overwrite=True)  # overwrite: the files are replaced (resumed); only others refused
 
 
 def _record_scorers(path: Path, fits: dict[str, dict[str, Any]]) -> None:
