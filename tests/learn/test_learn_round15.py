@@ -54,6 +54,9 @@ def test_modes_of_a_model_the_folder_lacks_name_the_mode(
     assert f"--modes early: needs the early model, which --model {single} does not hold (it has single" in err, err
     assert err.count("\n") == 1 and "Traceback" not in err, err
     assert not (tmp_path / "study").exists()
+    assert _study(tmp_path, "--model", str(single), "--modes", "early,intermediate") == 2
+    err = capsys.readouterr().err
+    assert "--modes early,intermediate: needs the early and intermediate models, which" in err, err  # was: model
 
 
 def test_a_log_cut_short_is_whole_again_when_the_run_is_started_again(tmp_path: Path) -> None:
@@ -224,6 +227,8 @@ def test_a_model_file_of_other_bytes_is_named_without_a_traceback(
         ("--seed", "-1", "--seed -1: must be a whole number in 0.."),  # a numpy traceback
         ("--workers", "-1", "--workers -1: must be a whole number >= 0"),  # a torch traceback
         ("--device", "tpu", "--device tpu: not a device; allowed: cpu, cuda, cuda:N or mps"),  # a torch traceback
+        ("--threads", "0", "--threads 0: must be a whole number >= 1"),  # taken as 1 without a word
+        ("--threads", "-2", "--threads -2: must be a whole number >= 1"),
     ],
 )
 def test_learn_train_script_refuses_bad_numbers_before_training(

@@ -558,7 +558,10 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _main(a: argparse.Namespace) -> int:
     if a.threads is not None:
-        torch.set_num_threads(max(1, a.threads))
+        # (0 and negative counts were taken as 1 without a word)
+        if a.threads < 1:
+            raise input_error(f"--threads {a.threads}: must be a whole number >= 1 (or left out for torch's)")
+        torch.set_num_threads(a.threads)
     overrides = parse_overrides(a.set)
     p = preset(a.preset, **overrides)
     if overrides:

@@ -431,7 +431,8 @@ def _check_model_modes(model: str, held: tuple[str, ...], modes: tuple[str, ...]
     if missing:
         needs = models_for(missing)
         raise InputError(
-            f"--modes {','.join(missing)}: needs the {' and '.join(needs)} model, which --model {model} does not "
+            f"--modes {','.join(missing)}: needs the {' and '.join(needs)} model{'s' if len(needs) > 1 else ''}, "
+            f"which --model {model} does not "
             f"hold (it has {', '.join(held)}: modes {','.join(fusion_modes(held))}; train it with "
             "mmusv train --modes)"
         )
