@@ -334,3 +334,25 @@ def test_train_refuses_what_is_in_the_way_of_its_files_before_the_work(
     err = capsys.readouterr().err
     assert err.startswith(f"mmusv: error: -o/--output {out}: {said}") and err.count("\n") == 1, err
     assert not (out / "single" / "last.pt").exists()
+
+
+@pytest.mark.parametrize("command", [["train"], ["study", "detection"]])
+def test_a_missing_generate_spec_is_named_by_its_flag(
+    command: list[str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "out"
+    assert main([*command, "--generate", "nosuch.yaml", "--no-progress", "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    # was: "spec file 'nosuch.yaml' does not exist ..." without the flag
+    assert err.startswith("mmusv: error: --generate nosuch.yaml: spec file 'nosuch.yaml' does not exist"), err
+    assert "bundled: coop_detection" in err and err.count("\n") == 1, err
+    assert not out.exists()
+
+
+def test_a_predictions_folder_is_said_to_be_a_folder(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    folder = tmp_path / "predictions"
+    folder.mkdir()
+    assert _study(tmp_path, "--predictions", str(folder)) == 2
+    err = capsys.readouterr().err
+    assert err == f"mmusv: error: --predictions {folder}: a folder; give the predictions Parquet file\n", err  # was:
+    # "no such file"

@@ -19,7 +19,7 @@ from typing import Any
 
 import yaml
 
-from mmusv.errors import InputError, IoError
+from mmusv.errors import InputError, IoError, NotFoundError
 from mmusv.studies.detection import BUNDLED_SPEC
 from mmusv.studies.detection.data import (
     SequenceData,
@@ -256,7 +256,10 @@ def generate_dataset(
     from mmusv.bundled import resolve_spec
     from mmusv.generate.runner import generate
 
-    sp = resolve_spec(spec)
+    try:
+        sp = resolve_spec(spec)
+    except NotFoundError as exc:  # (it said "spec file ..." without the flag that gave it)
+        raise NotFoundError(f"{given('spec', spec)}: {exc}") from None
     out = Path(out_dir)
     scen_dir, lidar_dir = out / "scenarios", out / "lidar_only"
     gen = generate(sp, scen_dir, force=True)

@@ -230,7 +230,7 @@ def load_predictions(path: str | Path) -> dict[tuple[str, int, str, str, str], t
     p = Path(path)
     shown = given("path", p)
     if not p.is_file():
-        raise InputError(f"{shown}: no such file")
+        raise InputError(f"{shown}: {'a folder; give the predictions Parquet file' if p.is_dir() else 'no such file'}")
     try:
         df = pl.read_parquet(p, glob=False)  # a file a[1].parquet is a name, not a pattern
     except (OSError, pl.exceptions.PolarsError) as exc:
