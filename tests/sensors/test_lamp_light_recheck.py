@@ -97,6 +97,7 @@ def _render(
     pose: npt.NDArray[np.float64] = POSE,
     ortho: bool = False,
     water: bool = False,
+    lantern_yaw_deg: float = 0.0,
 ) -> Any:
     """The camera's images (radiance too) of the wall and the lantern centred on ``lamp`` (and calm water at
     ``z = 0``, the last instance, with ``water``)."""
@@ -115,7 +116,14 @@ def _render(
         )
     )
     s.add_instance(s.add_mesh(*ms.box(*wall), classes=4, name="wall", materials=2))
-    lantern = s.add_instance(s.add_mesh(*_box_at(lamp, S), classes=4, name="lantern", materials=1))
+    # The lantern's mesh round its own origin, placed at ``lamp`` turned by ``lantern_yaw_deg`` (its body frame, in
+    # which the arc's bearings are, turned with it).
+    yaw = math.radians(lantern_yaw_deg)
+    placed = np.eye(4)
+    placed[:2, :2] = [[math.cos(yaw), -math.sin(yaw)], [math.sin(yaw), math.cos(yaw)]]
+    placed[:3, 3] = lamp
+    lantern_mesh = s.add_mesh(*_box_at((0.0, 0.0, 0.0), S), classes=4, name="lantern", materials=1)
+    lantern = s.add_instance(lantern_mesh, pose=placed)
     if screen is not None:
         s.add_instance(s.add_mesh(*ms.box(*screen), classes=4, name="screen", materials=3))
     if water:
@@ -228,6 +236,19 @@ def test_a_lamp_lights_only_inside_its_arc() -> None:
     assert inside.sum() >= 100 and outside.sum() >= 100, (inside.sum(), outside.sum())
     assert np.abs(split[inside] / cf["L"][inside] - 1.0).max() <= TOL
     assert np.abs(split[outside]).max() <= 1e-6 * cf["L"].max()
+
+
+def test_the_arc_turns_with_the_lamps_vessel() -> None:
+    # The lantern's instance turned 90° to port: the wall, at world bearing 180° from the lamp, lies at 90° (to
+    # port) in its body frame. An arc to port lights it as the closed form; one astern (180°, where the wall lies in
+    # the world frame) leaves it dark.
+    lamp = _lamp_at(2.0, 0.0)
+    cf = _closed_form(lamp)
+    port = _lamp_part(lamp, arc=(90.0, 20.0), lantern_yaw_deg=90.0)[..., 1]
+    assert np.abs(port / cf["L"] - 1.0).max() <= TOL
+    on = _rad(_render(lamp, arc=(180.0, 20.0), lantern_yaw_deg=90.0))
+    off = _rad(_render(lamp, arc=(180.0, 20.0), lantern_yaw_deg=90.0, on=False))
+    assert np.array_equal(on, off)
 
 
 def test_an_opaque_screen_shadows_the_wall() -> None:
