@@ -579,7 +579,9 @@ def test_a_stopped_run_names_its_recording_and_frames(client: TestClient, folder
     client.delete(f"/api/runs/{job['id']}")
     end = _wait_run(client, job["id"])
     manifest = json.loads((folder / "out" / "stopme" / "manifest.json").read_text())
-    assert end["status"] == "interrupted" and end["recording"] == str(folder / "out" / "stopme" / "port_entry.mcap")
+    assert end["status"] == "interrupted" and end["recording"] == str(folder / "out" / "stopme" / "port_entry.mcap"), (
+        end  # (its error says which way the recording went unnamed, should it again)
+    )
     assert end["done"] == manifest["frames_written"] >= 1, (end, manifest)
 
 

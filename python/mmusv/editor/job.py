@@ -21,8 +21,13 @@ from typing import Any
 __all__ = ["main"]
 
 
-def _say(obj: dict[str, Any]) -> None:
-    print(json.dumps(obj), flush=True)
+def _say(obj: dict[str, Any], *, after_a_stop: bool = False) -> None:
+    """One line of ``obj``'s JSON, written whole in one call (``print`` wrote the text and its newline apart, and a
+    stop between the two ran the status line on after a progress line: ``{"done": 1, ...}{"status": ...}``, a line
+    the editor could not read, so it said "stopped before the first frame" of a run whose recording held frames).
+    ``after_a_stop``: a newline first, which ends any line the stop cut short (an empty line is passed over)."""
+    sys.stdout.write(("\n" if after_a_stop else "") + json.dumps(obj) + "\n")
+    sys.stdout.flush()
 
 
 def _kept(args: argparse.Namespace) -> dict[str, Any]:
@@ -61,7 +66,7 @@ def main(argv: list[str] | None = None) -> int:
         from mmusv.acquire import run
         from mmusv.errors import MmusvError
     except KeyboardInterrupt:
-        _say({"status": "interrupted", "error": "stopped before the first frame"})
+        _say({"status": "interrupted", "error": "stopped before the first frame"}, after_a_stop=True)
         return 130
     try:
         res = run(
@@ -82,10 +87,11 @@ def main(argv: list[str] | None = None) -> int:
         signal.signal(signal.SIGINT, signal.SIG_IGN)  # a second stop would cut the status line
         kept = _kept(args)
         if kept.get("status") == "complete":  # every frame was written before the stop came
-            _say({**kept, "seconds": None})
+            _say({**kept, "seconds": None}, after_a_stop=True)
             return 0
         kept.pop("status", None)
-        _say({"status": "interrupted", "error": "stopped; the recording holds every completed frame", **kept})
+        said = {"status": "interrupted", "error": "stopped; the recording holds every completed frame", **kept}
+        _say(said, after_a_stop=True)
         return 130
     _say(
         {
