@@ -3,7 +3,8 @@
 It calls :func:`mmusv.acquire.run` (what ``mmusv run SCENARIO -o OUT --overwrite`` runs) and reports on stdout one
 JSON object per line: ``{"done": k, "total": n}`` after every frame, ``{"warning": "..."}`` for each check warning,
 and last ``{"status": "complete", "frames": k, "recording": path, "seconds": s}``, ``{"status": "failed",
-"error": "..."}`` (exit status 2) or ``{"status": "interrupted", ...}`` after SIGINT (exit status 130; the
+"error": "..."}`` (exit status 2) or ``{"status": "interrupted", ...}`` after SIGINT (after an empty line, which
+ends a line the stop may have cut short; exit status 130; the
 recording then holds every completed frame, and the line names it and its frames as for a complete run). A stop
 that comes once every frame is written changes nothing: the line says ``complete`` (exit status 0), as the recording
 and its manifest do.
@@ -21,12 +22,11 @@ from typing import Any
 __all__ = ["main"]
 
 
-def _say(obj: dict[str, Any], *, after_a_stop: bool = False) -> None:
-    """One line of ``obj``'s JSON, written whole in one call (``print`` wrote the text and its newline apart, and a
-    stop between the two ran the status line on after a progress line: ``{"done": 1, ...}{"status": ...}``, a line
-    the editor could not read, so it said "stopped before the first frame" of a run whose recording held frames).
-    ``after_a_stop``: a newline first, which ends any line the stop cut short (an empty line is passed over)."""
-    sys.stdout.write(("\n" if after_a_stop else "") + json.dumps(obj) + "\n")
+def _say(obj: dict[str, Any]) -> None:
+    """One line of ``obj``'s JSON, written whole in one call: ``print`` wrote the text and its newline apart, and a
+    stop between the two ran the status line on after a progress line (``{"done": 1, ...}{"status": ...}``), a line
+    the editor could not read, so it said "stopped before the first frame" of a run whose recording held frames."""
+    sys.stdout.write(json.dumps(obj) + "\n")
     sys.stdout.flush()
 
 
@@ -66,7 +66,7 @@ def main(argv: list[str] | None = None) -> int:
         from mmusv.acquire import run
         from mmusv.errors import MmusvError
     except KeyboardInterrupt:
-        _say({"status": "interrupted", "error": "stopped before the first frame"}, after_a_stop=True)
+        _say({"status": "interrupted", "error": "stopped before the first frame"})
         return 130
     try:
         res = run(
@@ -87,11 +87,12 @@ def main(argv: list[str] | None = None) -> int:
         signal.signal(signal.SIGINT, signal.SIG_IGN)  # a second stop would cut the status line
         kept = _kept(args)
         if kept.get("status") == "complete":  # every frame was written before the stop came
-            _say({**kept, "seconds": None}, after_a_stop=True)
+            _say({**kept, "seconds": None})
             return 0
         kept.pop("status", None)
-        said = {"status": "interrupted", "error": "stopped; the recording holds every completed frame", **kept}
-        _say(said, after_a_stop=True)
+        # A newline first ends any line the stop cut short (the editor passes an empty line over).
+        sys.stdout.write("\n")
+        _say({"status": "interrupted", "error": "stopped; the recording holds every completed frame", **kept})
         return 130
     _say(
         {
