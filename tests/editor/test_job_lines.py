@@ -10,12 +10,23 @@ line's text and its newline apart, a stop (SIGINT) between the two ran the statu
 from __future__ import annotations
 
 import json
+import signal
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import mmusv.acquire
 import pytest
 from mmusv.editor import job
+
+
+@pytest.fixture(autouse=True)
+def _sigint_handler_kept() -> Iterator[None]:
+    """The run process ignores SIGINT once its run is stopped: this test process (and the run processes the later
+    tests start, which inherit it) gets its handler back."""
+    kept = signal.getsignal(signal.SIGINT)
+    yield
+    signal.signal(signal.SIGINT, kept)
 
 
 def _cut_run(*args: Any, progress: Any, **kwargs: Any) -> Any:
