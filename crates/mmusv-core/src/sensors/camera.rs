@@ -39,6 +39,7 @@ mod glossy;
 mod lamp_glow;
 mod lamp_light;
 mod lamp_points;
+mod lamp_shadows;
 pub mod radiance;
 mod sunlit;
 
