@@ -30,7 +30,7 @@ import yaml
 from mmusv.config import load_scenario
 from mmusv.motion import build_fleet, scenario_poses
 from mmusv.world.maps import generate_map_from
-from mmusv.world.materials import material_id
+from mmusv.world.materials import lamp_ids
 from mmusv.world.vessels import asset_names, get_asset
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -111,7 +111,7 @@ NO_MASTHEAD = {"sailing_yacht", "sailing_catamaran", "kayak", "barge"}
 def _lamps(name: str, lamp: str) -> list[np.ndarray]:
     """Centres of the lanterns of material ``lamp`` on asset ``name`` (faces within 1 m grouped), body frame."""
     m = get_asset(name).mesh
-    centres = m.vertices[m.faces[m.materials == material_id(lamp)]].mean(axis=1)
+    centres = m.vertices[m.faces[np.isin(m.materials, lamp_ids(lamp))]].mean(axis=1)
     out = []
     while len(centres):
         near = np.linalg.norm(centres - centres[0], axis=1) < 1.0

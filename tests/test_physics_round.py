@@ -32,7 +32,7 @@ from mmusv.scene import Scene
 from mmusv.sensors.camera import render
 from mmusv.sensors.env import sensor_env, wind_from_wave_height
 from mmusv.world.environment import Environment
-from mmusv.world.materials import all_materials, material_id, material_table
+from mmusv.world.materials import all_materials, lamp_ids, material_id, material_table
 from mmusv.world.sea_state import sea_spec_for_height
 from mmusv.world.vessels import get_asset
 from scipy import special
@@ -378,7 +378,7 @@ def _lamp_visibility(asset: str) -> list[tuple[str, np.ndarray, np.ndarray]]:
     out_dir = np.stack(out, axis=1)
     found = []
     for lamp in LAMPS:
-        faces = np.flatnonzero(m.materials == material_id(lamp))
+        faces = np.flatnonzero(np.isin(m.materials, lamp_ids(lamp)))
         assert faces.size > 0
         todo = list(faces)
         while todo:  # one cluster per lantern (two masthead lights on a long hull)
@@ -418,7 +418,7 @@ def _lamp_glow(asset: str, bearing: np.ndarray) -> list[tuple[str, np.ndarray, n
     out_dir = np.stack([np.cos(rad), np.sin(rad), np.zeros(bearing.size)], axis=1)
     found = []
     for lamp in LAMPS:
-        faces = np.flatnonzero(m.materials == material_id(lamp))
+        faces = np.flatnonzero(np.isin(m.materials, lamp_ids(lamp)))
         todo = list(faces)
         while todo:  # one cluster per lantern (two masthead lights on a long hull)
             near = faces[np.linalg.norm(centroids[faces, :2] - centroids[todo[0], :2], axis=1) < 1.0]

@@ -11,16 +11,20 @@ import pytest
 from mmusv.errors import ConfigError
 from mmusv.world.materials import (
     BUILTIN_COUNT,
+    COLREG_RANGE_INTENSITY_CD,
     LANTERN_LENS_AREA_M2,
     MATERIALS,
     Material,
     all_materials,
+    lamp_ids,
+    lamp_material,
+    lamp_of,
     material_id,
     material_table,
     register_material,
 )
 from mmusv.world.primitives import TriMesh, box, boxes, lathe, merge, placed, sweep, torus, transformed, tubes
-from mmusv.world.vessels import load_asset_file
+from mmusv.world.vessels import asset_names, get_asset, load_asset_file
 
 REQUIRED = [
     "class_default",
@@ -121,6 +125,80 @@ def test_lamps_have_the_colreg_intensities() -> None:
         e = MATERIALS[material_id(name)].emissive
         luminance = 0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2]
         assert luminance * LANTERN_LENS_AREA_M2 == pytest.approx(cd, rel=1e-6), name
+
+
+def _rule_22(light: str, length: float) -> float:
+    """COLREG 1972 Rule 22's range of visibility (nautical miles), written out here from the rule's text."""
+    if length >= 50.0:  # Rule 22(a)
+        return {"masthead": 6, "side": 3, "stern": 3}[light]
+    if length >= 12.0:  # Rule 22(b)
+        return {"masthead": 3 if length < 20.0 else 5, "side": 2, "stern": 2}[light]
+    return {"masthead": 2, "side": 1, "stern": 2}[light]  # Rule 22(c)
+
+
+def _annex_i(miles: float) -> float:
+    """COLREG Annex I §8(a): ``I = 3.43·10⁶ T D² K^−D`` cd, ``T = 2·10⁻⁷`` lux, ``K = 0.8``."""
+    return 3.43e6 * 2e-7 * miles**2 * 0.8**-miles
+
+
+def test_annex_i_table_is_its_formula() -> None:
+    # §8(b) tabulates the formula to a tenth below 10 cd and to the candela above (0.857 -> 0.9, 94.2 -> 94).
+    assert sorted(COLREG_RANGE_INTENSITY_CD) == [1, 2, 3, 4, 5, 6]
+    for miles, cd in COLREG_RANGE_INTENSITY_CD.items():
+        i = _annex_i(miles)
+        assert (round(i, 1) if i < 10 else round(i)) == cd, miles
+
+
+_LIGHT = {"nav_masthead_white": "masthead", "nav_port_red": "side", "nav_starboard_green": "side"}
+
+
+@pytest.mark.parametrize("name", asset_names())
+def test_each_lamp_has_the_intensity_its_vessels_length_asks(name: str) -> None:
+    """Every lantern of every catalogue asset, measured from its mesh: its lamp faces' projected area towards the
+    centre of its arc (half the sum of |area vector · direction| over the closed lens band) times the luminance of
+    their radiance is COLREG Annex I §8's intensity for the range Rule 22 asks of the asset's length, whatever the
+    lantern's size (the lanterns scaled their intensity with their size: a 300 m ship's masthead light was 212 cd,
+    a 16.5 m pilot boat's 23.5 cd for the 12 cd of its length). Within 5 %: the 12-sided band's width varies by
+    3.4 % with the direction."""
+    asset = get_asset(name)
+    m = asset.mesh
+    tri = np.asarray(m.vertices, dtype=np.float64)[np.asarray(m.faces)]
+    area = 0.5 * np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    centres = tri.mean(axis=1)
+    table = all_materials()
+    seen = 0
+    for lamp in ("nav_masthead_white", "nav_port_red", "nav_starboard_green", "nav_stern_white"):
+        faces = np.flatnonzero(np.isin(m.materials, lamp_ids(lamp)))
+        while faces.size:  # one lantern at a time (a long hull has two masthead lights)
+            near = faces[np.linalg.norm(centres[faces] - centres[faces[0]], axis=1) < 1.0]
+            faces = np.setdiff1d(faces, near)
+            mats = {int(i) for i in m.materials[near]}
+            assert len(mats) == 1
+            mat = table[mats.pop()]
+            bearing = math.radians(mat.arc_deg[0])
+            d = np.array([math.cos(bearing), math.sin(bearing), 0.0])
+            e = mat.emissive
+            cd = (0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2]) * 0.5 * np.abs(area[near] @ d).sum()
+            want = _annex_i(_rule_22(_LIGHT.get(lamp, "stern"), asset.length))
+            assert cd == pytest.approx(want, rel=0.05), (lamp, cd, want, mat.name)
+            seen += 1
+    assert seen >= 3
+
+
+def test_lamp_variants_keep_the_lamps_colour_and_arc() -> None:
+    for lamp in ("nav_masthead_white", "nav_port_red", "nav_starboard_green", "nav_stern_white"):
+        base = MATERIALS[material_id(lamp)]
+        assert lamp_material(lamp, length_m=60.0, lantern_size=0.3) == material_id(lamp)
+        i = lamp_material(lamp, length_m=8.0, lantern_size=0.07)
+        assert i == lamp_material(lamp, length_m=8.0, lantern_size=0.07) != material_id(lamp)
+        v = all_materials()[i]
+        assert lamp_of(v) == lamp and lamp_of(base) == lamp and i in lamp_ids(lamp)
+        assert v.nav_light and v.arc_deg == base.arc_deg and v.base_color == base.base_color
+        ratio = np.array(v.emissive) / np.array(base.emissive).clip(1e-30)
+        assert np.allclose(ratio[np.array(base.emissive) > 0], ratio.max(), rtol=1e-6)  # the same colour
+    assert lamp_of(MATERIALS[material_id("glass")]) is None
+    with pytest.raises(ValueError, match="unknown navigation lamp 'glass'"):
+        lamp_material("glass", length_m=10.0, lantern_size=0.3)
 
 
 def test_unknown_name_lists_the_known_ones() -> None:

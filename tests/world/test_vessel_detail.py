@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from mmusv.world.asset_spec import ProceduralAssetSpec, parse_asset
 from mmusv.world.hull_form import boot_top_band
-from mmusv.world.materials import all_materials, material_id
+from mmusv.world.materials import all_materials, lamp_ids, material_id
 from mmusv.world.part_spec import DEFAULT_MATERIALS
 from mmusv.world.parts_deck import CONTAINER_COLOURS
 from mmusv.world.primitives import TriMesh
@@ -102,9 +102,10 @@ def test_every_face_has_a_valid_material_and_parts_theirs(name: str) -> None:
         elif part.type == "nav_lights":
             # masthead: [] is a vessel without a masthead light (under sail, under oars or towed: COLREG Rules 24-25)
             lamps = NAV[1:] if part.masthead == () else NAV
-            assert {material_id(n) for n in lamps} <= mats and material_id(
-                want if part.material else "paint_grey"
-            ) in mats
+            assert (
+                all(mats & set(lamp_ids(n)) for n in lamps)
+                and material_id(want if part.material else "paint_grey") in mats
+            )
         else:
             assert material_id(want) in mats, f"{name}.parts[{i}] ({part.type}) lacks {want}"
         if part.type == "windows":  # panes of the part's material (glass by default) in aluminium frames
@@ -145,13 +146,13 @@ def test_hull_bands_antifouling_boot_top_topside_deck(name: str) -> None:
 def test_colreg_lights_port_red_starboard_green_stern_aft(name: str) -> None:
     m = get_asset(name).mesh
     c = m.vertices[m.faces].mean(axis=1)
-    where = {k: c[m.materials == material_id(k)] for k in NAV}
+    where = {k: c[np.isin(m.materials, lamp_ids(k))] for k in NAV}
     # masthead: [] (under sail, under oars or towed: COLREG Rules 24-25) leaves the masthead lamp out
     lamps = NAV[1:] if any(p.type == "nav_lights" and p.masthead == () for p in _spec(name).parts) else NAV
     assert all(where[k].shape[0] > 0 for k in lamps)
     assert np.all(where["nav_port_red"][:, 1] > 0.0) and np.all(where["nav_starboard_green"][:, 1] < 0.0)
     assert where["nav_stern_white"][:, 0].max() < where["nav_port_red"][:, 0].min()
-    lamp = all_materials()[material_id("nav_port_red")]
+    lamp = all_materials()[int(m.materials[np.isin(m.materials, lamp_ids("nav_port_red"))][0])]
     assert lamp.nav_light and lamp.emissive[0] > 0
 
 

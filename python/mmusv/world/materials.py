@@ -31,11 +31,18 @@ from mmusv.errors import ConfigError
 __all__ = [
     "BUILTIN_COUNT",
     "COLREG_INTENSITY_CD",
+    "COLREG_RANGE_INTENSITY_CD",
+    "LAMP_KINDS",
     "LANTERN_LENS_AREA_M2",
     "MATERIALS",
     "NAV_LAMP_RADIANCE",
     "Material",
     "all_materials",
+    "colreg_range_nm",
+    "lamp_ids",
+    "lamp_material",
+    "lamp_of",
+    "lantern_lens_area",
     "material_id",
     "material_table",
     "register_material",
@@ -46,16 +53,51 @@ LANTERN_LENS_AREA_M2 = 2.0 * (0.36 * 0.3) * (0.57 * 0.3)
 0.36 and height 0.57 of the size, ``parts_super._lantern``) seen from the side, m²."""
 
 COLREG_INTENSITY_CD = {"masthead": 94.0, "sidelight": 12.0, "sternlight": 12.0}
-"""Luminous intensity of each navigation light, cd: COLREG 1972 Annex I §8(b), the minimum for the ranges of
+"""Luminous intensity of each built-in lamp material, cd: COLREG 1972 Annex I §8(b), the minimum for the ranges of
 visibility Rule 22(a) asks of a vessel of 50 m or more (masthead light 6 nautical miles, sidelights and sternlight
-3)."""
+3), on a lantern of the default size. A vessel's lanterns take :func:`lamp_material`: the intensity of its length
+on its lantern's size."""
 
 
-def _lamp_radiance(colour: tuple[float, float, float], intensity_cd: float) -> tuple[float, float, float]:
-    """The lens radiance (linear sRGB, cd/m²) of the ``colour`` (relative channels) whose luminance, over the default
-    lantern's lens, gives ``intensity_cd``."""
+COLREG_RANGE_INTENSITY_CD = {1: 0.9, 2: 4.3, 3: 12.0, 4: 27.0, 5: 52.0, 6: 94.0}
+"""COLREG 1972 Annex I §8(b): the minimum luminous intensity (cd) of a navigation light for its range of visibility
+in nautical miles (the table of §8(a)'s ``I = 3.43·10⁶ · T · D² · K^−D``, ``T = 2·10⁻⁷`` lux, ``K = 0.8``)."""
+
+LAMP_KINDS = {
+    "nav_masthead_white": "masthead",
+    "nav_port_red": "sidelight",
+    "nav_starboard_green": "sidelight",
+    "nav_stern_white": "sternlight",
+}
+"""The built-in navigation-lamp materials and the light each is under COLREG Rule 22."""
+
+
+def colreg_range_nm(light: str, length_m: float) -> int:
+    """The range of visibility (nautical miles) COLREG 1972 Rule 22 asks of a vessel ``length_m`` long for its
+    ``light`` (``masthead``, ``sidelight`` or ``sternlight``): (a) 50 m or more 6, 3, 3; (b) 12 to 50 m 5 (3 under
+    20 m), 2, 2; (c) under 12 m 2, 1, 2."""
+    if light not in ("masthead", "sidelight", "sternlight"):
+        raise ValueError(f"unknown navigation light {light!r}: masthead, sidelight or sternlight")
+    if length_m >= 50.0:
+        return {"masthead": 6, "sidelight": 3, "sternlight": 3}[light]
+    if length_m >= 12.0:
+        return {"masthead": 5 if length_m >= 20.0 else 3, "sidelight": 2, "sternlight": 2}[light]
+    return {"masthead": 2, "sidelight": 1, "sternlight": 2}[light]
+
+
+def lantern_lens_area(size: float) -> float:
+    """Projected side area (m²) of the lens of a lantern ``size`` metres tall (:data:`LANTERN_LENS_AREA_M2` at the
+    default 0.3 m; the lantern scales as a whole)."""
+    return LANTERN_LENS_AREA_M2 * (size / 0.3) ** 2
+
+
+def _lamp_radiance(
+    colour: tuple[float, float, float], intensity_cd: float, area_m2: float = LANTERN_LENS_AREA_M2
+) -> tuple[float, float, float]:
+    """The lens radiance (linear sRGB, cd/m²) of the ``colour`` (relative channels) whose luminance, over a lens of
+    projected area ``area_m2`` (the default lantern's), gives ``intensity_cd``."""
     luminance = 0.2126 * colour[0] + 0.7152 * colour[1] + 0.0722 * colour[2]
-    k = intensity_cd / (LANTERN_LENS_AREA_M2 * luminance)
+    k = intensity_cd / (area_m2 * luminance)
     return (k * colour[0], k * colour[1], k * colour[2])
 
 
@@ -274,3 +316,47 @@ def material_table() -> np.ndarray:
     with _lock:
         rows = [m.row() for m in _all]
     return np.asarray(rows, dtype=np.float32).reshape(-1, 11)
+
+
+def lamp_material(lamp: str, *, length_m: float, lantern_size: float) -> int:
+    """The id of built-in navigation lamp ``lamp`` (a name of :data:`LAMP_KINDS`) as a vessel ``length_m`` long
+    shows it on a lantern ``lantern_size`` metres tall: its lens radiance gives the COLREG Annex I §8 intensity of
+    the range Rule 22 asks of that length (:func:`colreg_range_nm`) over that lantern's lens, so a lamp's intensity
+    follows the vessel's length and not its lantern's size. The built-in material itself where that is its own
+    (50 m or more on the default 0.3 m lantern); otherwise a material ``"<lamp>@<cd>cd/<size>m"`` registered once
+    per process (its id may differ between processes; its values never do)."""
+    if lamp not in LAMP_KINDS:
+        raise ValueError(f"unknown navigation lamp {lamp!r}: one of {', '.join(LAMP_KINDS)}")
+    base = MATERIALS[_ids[lamp]]
+    cd = COLREG_RANGE_INTENSITY_CD[colreg_range_nm(LAMP_KINDS[lamp], length_m)]
+    if lantern_size == 0.3 and cd == COLREG_INTENSITY_CD[LAMP_KINDS[lamp]]:
+        return _ids[lamp]
+    e = base.emissive
+    peak = max(e)
+    colour = (e[0] / peak, e[1] / peak, e[2] / peak)
+    return register_material(
+        Material(
+            f"{lamp}@{cd:g}cd/{lantern_size:g}m",
+            base.base_color,
+            base.roughness,
+            base.metallic,
+            _lamp_radiance(colour, cd, lantern_lens_area(lantern_size)),
+            True,
+            base.arc_deg,
+        )
+    )
+
+
+def lamp_of(m: Material) -> str | None:
+    """The built-in navigation lamp (a name of :data:`LAMP_KINDS`) that ``m`` is or is a variant of
+    (:func:`lamp_material`), else ``None``."""
+    name = m.name.split("@", 1)[0]
+    return name if m.nav_light and name in LAMP_KINDS else None
+
+
+def lamp_ids(lamp: str) -> tuple[int, ...]:
+    """The ids of every material of this process that is built-in navigation lamp ``lamp`` or a variant of it
+    (:func:`lamp_of`), sorted: ``numpy.isin(mesh.materials, lamp_ids(lamp))`` marks a mesh's faces of that lamp."""
+    with _lock:
+        table = list(_all)
+    return tuple(i for i, m in enumerate(table) if lamp_of(m) == lamp)

@@ -177,7 +177,10 @@ class NavLightsPart(Part):
     top of the tallest mast, and of the second tallest too from 50 m of hull length, Rule 23(a)(ii); ``[]``: none,
     as a sailing vessel under sail, a vessel under oars or a towed one shows, Rules 24(e) and 25), ``sides`` red to
     port and green to starboard at ``[x, |y|, z]`` (default: on the bridge wings, else at the bow), ``stern`` white
-    at ``[x, y, z]`` (default: on the transom); ``size`` is the lantern's height."""
+    at ``[x, y, z]`` (default: on the transom); ``size`` is the lantern's height. Each lamp has the intensity COLREG
+    Rule 22 and Annex I §8 ask of the hull's length, whatever the lantern's size (under 12 m: masthead 4.3 cd,
+    sidelights 0.9, sternlight 4.3; 12–50 m: 12 cd under 20 m and 52 cd from 20 m, 4.3, 4.3; 50 m and over: 94,
+    12, 12)."""
 
     type: Literal["nav_lights"]
     masthead: Annotated[tuple[Point3, ...], sequence(0, MAX_ITEMS, f"a list of 0 to {MAX_ITEMS} points")] | None = None

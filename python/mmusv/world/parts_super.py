@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from mmusv.world.hull_form import half_width, half_widths, side_half_width
-from mmusv.world.materials import material_id
+from mmusv.world.materials import lamp_material, material_id
 from mmusv.world.part_context import Ctx, block
 from mmusv.world.part_spec import (
     AntennasPart,
@@ -394,7 +394,8 @@ def _lantern_post(*, top: np.ndarray, height: float, size: float, cls: int, mate
 
 
 def nav_lights_mesh(p: NavLightsPart, ctx: Ctx) -> TriMesh:
-    """COLREG lanterns: masthead white, port red (+y), starboard green (-y), stern white, with brackets."""
+    """COLREG lanterns: masthead white, port red (+y), starboard green (-y), stern white, with brackets; each lamp
+    of the intensity Rule 22 and Annex I §8 ask of the hull's length (:func:`mmusv.world.materials.lamp_material`)."""
     hull, s = ctx.hull, p.size
     housing = ctx.mat
     steel = material_id("steel")
@@ -424,7 +425,8 @@ def nav_lights_mesh(p: NavLightsPart, ctx: Ctx) -> TriMesh:
             )
     else:
         raise ctx.error("masthead", "the asset has no mast; give the masthead light's position [[x, y, z]]")
-    mast_mat = material_id("nav_masthead_white")
+    length = float(hull.length)
+    mast_mat = lamp_material("nav_masthead_white", length_m=length, lantern_size=s)
     for h in heads:
         out.append(_lantern(at=h, size=s, lamp=mast_mat, housing=housing, cls=ctx.cls))
     if p.sides is not None:
@@ -454,7 +456,8 @@ def nav_lights_mesh(p: NavLightsPart, ctx: Ctx) -> TriMesh:
             posts = True
     for sign, name in ((1.0, "nav_port_red"), (-1.0, "nav_starboard_green")):
         c = np.array([sx, sign * sy, sz])
-        out.append(_lantern(at=c, size=s, lamp=material_id(name), housing=housing, cls=ctx.cls))
+        lamp = lamp_material(name, length_m=length, lantern_size=s)
+        out.append(_lantern(at=c, size=s, lamp=lamp, housing=housing, cls=ctx.cls))
         out.append(
             boxes(
                 centers=[c + np.array([0.0, -sign * 0.55 * s, 0.5 * s])],
@@ -471,7 +474,8 @@ def nav_lights_mesh(p: NavLightsPart, ctx: Ctx) -> TriMesh:
         xs = -hull.length / 2.0 + 0.6 * s + 0.05
         st = np.array([xs, 0.0, ctx.base(None, xs) + 0.3 * s + 0.1])
         out.append(_lantern_post(top=st, height=0.3 * s + 0.1, size=s, cls=ctx.cls, material=steel))
-    out.append(_lantern(at=st, size=s, lamp=material_id("nav_stern_white"), housing=housing, cls=ctx.cls))
+    stern = lamp_material("nav_stern_white", length_m=length, lantern_size=s)
+    out.append(_lantern(at=st, size=s, lamp=stern, housing=housing, cls=ctx.cls))
     return merge(out)
 
 
