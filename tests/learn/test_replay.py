@@ -53,7 +53,7 @@ def test_per_mode_inference_merges_to_one_run(trained: tuple[Path, Cache, Path],
     models = root / "models"
     whole = np.load(infer_cache(cache, models=models, out=tmp_path / "all.npz"))
     parts = [infer_cache(cache, models=models, out=tmp_path / f"{m}.npz", modes=[m]) for m in MODES]
-    assert set(np.load(parts[0]).files) == {"single_boxes", "single_scores", "single_offsets"}
+    assert set(np.load(parts[0]).files) == {"single_boxes", "single_scores", "single_offsets", "single_model"}
     merged = np.load(merge_peaks([*parts, tmp_path / "missing.npz"], tmp_path / "merged.npz"))
     assert sorted(merged.files) == sorted(whole.files)
     assert all(np.array_equal(merged[k], whole[k]) for k in whole.files)
@@ -228,3 +228,43 @@ def test_the_study_scores_the_models_on_the_threads_asked(
         assert "--threads 0: must be >= 1" in capsys.readouterr().err
     finally:
         torch.set_num_threads(before)
+
+
+def test_replay_refuses_the_scorers_of_other_weights(trained: tuple[Path, Cache, Path], tmp_path: Path) -> None:
+    """A scorer fitted for other weights than the model whose peaks are replayed is refused, naming the model and
+    ``--scorers``: the predictions were written rescored by it without a word (the peaks recorded no model). The
+    scorer of the peaks' own weights is taken; peaks written before the digest are refused with scorers only."""
+    import shutil
+
+    from mmusv.learn.checkpoint import weights_digest
+    from mmusv.learn.replay import main as replay_main
+    from mmusv.learn.scorer import FEATURES, SCORER_FILE, IoUScorer, load_scorer
+
+    rec, cache, root = trained
+    models = tmp_path / "models"
+    shutil.copytree(root / "models", models)
+    peaks = infer_cache(cache, models=models, out=tmp_path / "peaks.npz", modes=["single"])
+    with np.load(peaks) as f:
+        held = {k: f[k] for k in f.files}
+    net = load_models(models).models["single"]
+    assert str(held["single_model"]) == weights_digest(net.state_dict())
+    other = {k: v + 1.0 if v.is_floating_point() else v for k, v in net.state_dict().items()}
+    n = len(FEATURES)
+    torch.manual_seed(3)
+    IoUScorer(np.zeros(n), np.ones(n)).save(models / "single" / SCORER_FILE, {"model": weights_digest(other)})
+    stale = {"single": load_scorer(models / "single" / SCORER_FILE)}
+    kw: dict[str, Any] = {"inputs": [rec], "split": "all", "refine": RefineParams()}
+    with pytest.raises(InputError, match=r"^scorers: the single scorer was fitted for other weights than the single"):
+        write_predictions(peaks, cache, out=tmp_path / "a.parquet", scorers=stale, **kw)
+    assert not (tmp_path / "a.parquet").exists()
+    argv = [str(peaks), str(cache.path), str(rec), "--split", "all", "--refine", "--scorers", str(models)]
+    with pytest.raises(InputError, match=r"^--scorers: the single scorer was fitted for other weights"):
+        replay_main([*argv, "-o", str(tmp_path / "b.parquet")])
+    IoUScorer(np.zeros(n), np.ones(n)).save(models / "single" / SCORER_FILE, {"model": str(held["single_model"])})
+    own = {"single": load_scorer(models / "single" / SCORER_FILE)}
+    assert write_predictions(peaks, cache, out=tmp_path / "c.parquet", scorers=own, **kw).is_file()
+    old = tmp_path / "old.npz"
+    np.savez(old, **{k: v for k, v in held.items() if k != "single_model"})
+    with pytest.raises(InputError, match=r"records no digest of its single model"):
+        write_predictions(old, cache, out=tmp_path / "d.parquet", scorers=own, **kw)
+    assert write_predictions(old, cache, out=tmp_path / "e.parquet", **kw).is_file()  # no scorers: nothing to match

@@ -4,7 +4,9 @@ and of the early- and intermediate-fusion models on every sample (the ego with i
 
 Output ``.npz``: for each of ``single`` (per cloud), ``early`` and ``intermediate`` (per sample): ``<m>_boxes``
 ``(M, 7)`` float32 ego-frame ``x, y, z, l, w, h, yaw``, ``<m>_scores`` ``(M,)``, ``<m>_offsets`` (rows of item
-``i`` are ``offsets[i]:offsets[i+1]``); and ``intermediate_bytes`` ``(K,)`` the bytes the neighbours sent.
+``i`` are ``offsets[i]:offsets[i+1]``), ``<m>_model`` ``()`` str the weights' digest
+(:func:`mmusv.learn.checkpoint.weights_digest`: replay checks the IoU scorers were fitted for them); and
+``intermediate_bytes`` ``(K,)`` the bytes the neighbours sent.
 :mod:`mmusv.learn.replay` turns it into the detection study's predictions Parquet (rotated NMS and late fusion
 done there by the study's own code). A ``--models`` folder without a model of the ``--modes`` asked for is refused
 (an empty peaks file was written). The file is written under the very name given (``-o peaks`` wrote
@@ -27,7 +29,7 @@ import torch
 
 from mmusv.learn._errors import input_error
 from mmusv.learn.cache import Cache
-from mmusv.learn.checkpoint import load_checkpoint
+from mmusv.learn.checkpoint import load_checkpoint, weights_digest
 from mmusv.learn.decode import peaks
 from mmusv.learn.example import MODES, collate, make_example, message_bytes
 from mmusv.learn.model import PillarNet, checked_device, from_checkpoint
@@ -94,6 +96,7 @@ def infer_cache(
         arrays[f"{mode}_boxes"] = np.concatenate(boxes) if boxes else np.zeros((0, 7), np.float32)
         arrays[f"{mode}_scores"] = np.concatenate(scores) if scores else np.zeros(0, np.float32)
         arrays[f"{mode}_offsets"] = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+        arrays[f"{mode}_model"] = np.array(weights_digest(model.state_dict()))
         if mode == "intermediate":
             arrays["intermediate_bytes"] = np.array(sent, dtype=np.int64)
         print(f"{mode}: {counted(len(counts), 'inference')}, {time.perf_counter() - t0:.1f} s", flush=True)

@@ -19,7 +19,8 @@ says which frames it looked at, and the study scores it as AP 0 (a file without 
 refused).
 
 With ``--scorers DIR`` (and ``--refine``) the refined boxes are rescored by the IoU scorers of
-:mod:`mmusv.learn.scorer` as the detector does (:func:`mmusv.learn.scorer.second_stage`).
+:mod:`mmusv.learn.scorer` as the detector does (:func:`mmusv.learn.scorer.second_stage`); a scorer fitted for other
+weights than the model whose peaks are replayed is refused (the peaks record each model's weights digest).
 
 The peaks must be those of this cache (one item per cloud or sample: the peaks of another cache, or of an ``infer
 --limit`` run, are refused), and the cache must hold every sequence of ``split`` of the recordings given (or of
@@ -105,6 +106,30 @@ def _read_peaks(peaks: str | Path, cache: Cache) -> dict[str, np.ndarray]:
     return z
 
 
+def _check_scorers(z: dict[str, np.ndarray], peaks: str | Path, scorers: dict[str, IoUScorer]) -> None:
+    """Refuses a scorer fitted for other weights than those of the model whose peaks ``z`` holds (the digest
+    :mod:`mmusv.learn.infer` records per model, ``<mode>_model``, against the one the fit saved): it ranked the boxes
+    of another model, and the predictions were written rescored by it without a word. A scorer that records no
+    model (not fitted by ``mmusv train``) is taken, as the detector takes it."""
+    for mode in sorted(scorers):
+        fitted_for = scorers[mode].info.get("model")
+        if fitted_for is None or f"{mode}_offsets" not in z:
+            continue
+        held = z.get(f"{mode}_model")
+        if held is None or held.shape != () or held.dtype.kind != "U":
+            raise input_error(
+                f"{named('scorers')}: {peaks} records no digest of its {mode} model (written by an mmusv.learn.infer "
+                "of before 2026-12-05), so the scorer cannot be matched to it; infer the peaks again, or leave "
+                f"out {named('scorers')}"
+            )
+        if str(held) != fitted_for:
+            raise input_error(
+                f"{named('scorers')}: the {mode} scorer was fitted for other weights than the {mode} model whose "
+                f"peaks {peaks} holds (model {str(held)[:12]}, scorer fitted for {str(fitted_for)[:12]}); give the "
+                "scorers of that model (its mmusv train folder), or refit them: mmusv train --scorers-only"
+            )
+
+
 def _check_same_sequences(ds: object, cache: Cache, split: str) -> None:
     """Refuses a cache that lacks a sequence of the dataset's split, or holds one of the same name recorded otherwise:
     its peaks were never matched to a frame, and the predictions file was written without a row."""
@@ -167,6 +192,7 @@ def write_predictions(
         raise input_error(f"{given('late_merge', late_merge)}: allowed: {', '.join(LATE_MERGES)}")
     check_out_file(out)  # before the work: a folder failed only when written, naming no -o
     z = _read_peaks(peaks, cache)
+    _check_scorers(z, peaks, scorers or {})
     try:
         ds = resolve_dataset(list(inputs), opv2v=opv2v, split=split, ratios=tuple(ratios), seed=seed)
     except input_error_types() as exc:  # an empty split: say how the cache was made
@@ -290,7 +316,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     flags = {"cache": "cache", "inputs": "recordings", "split": "--split", "ratios": "--split-ratios", "seed": "--seed"}
     flags["opv2v"] = "--opv2v"  # an OPV2V folder given as a recording is told to be given so
     flags["limit"] = "python -m mmusv.learn.infer --limit"  # how the peaks were cut short, for _read_peaks
-    with command_line({**flags, "late_merge": "--late-merge", "out": "-o"}):  # the messages name what it takes
+    flags |= {"late_merge": "--late-merge", "scorers": "--scorers", "out": "-o"}
+    with command_line(flags):  # the messages name what it takes
         return _write(a, ratios, refine, scorers)
 
 
