@@ -55,6 +55,7 @@ def test_ros2_no_stamp_is_time_zero_and_stamps_keep_the_sim_time_steps(coop_rec:
     meta = yaml.safe_load((bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
     assert meta["starting_time"]["nanoseconds_since_epoch"] == TIME_OFFSET_NS
     assert int(meta["custom_data"]["mmusv.time_offset_ns"]) == TIME_OFFSET_NS
+    assert meta["custom_data"]["mmusv.status"] == "complete"
 
 
 @pytest.mark.parametrize("start", [0, 1])

@@ -109,6 +109,9 @@ def test_a_stopped_ros2_conversion_leaves_a_closed_bag_of_the_frames_converted(c
     assert yaml.safe_load((out / "conversion.yaml").read_text())["status"] == "interrupted"
     bag = out / "export_coop"
     assert (bag / "metadata.yaml").is_file()
+    # the bag itself says it was cut short (peers read a closed bag as a whole one; only conversion.yaml said so)
+    custom = yaml.safe_load((bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]["custom_data"]
+    assert custom["mmusv.status"] == "interrupted"
     open_files = {os.path.realpath(f"/proc/self/fd/{fd}") for fd in os.listdir("/proc/self/fd")}
     assert str((bag / "export_coop.mcap").resolve()) not in open_files
     with AnyReader([bag]) as r:

@@ -537,26 +537,29 @@ class Ros2Writer(DatasetWriter):
 
     def stop(self, *, interrupted: bool) -> None:
         """A stop: the bag is closed whole (summary, ``metadata.yaml``: a bag ``ros2 bag play`` and rosbags read)
-        holding the frames converted so far, their odometry included; an error: the bag is closed without its
+        holding the frames converted so far, their odometry included, and ``mmusv.status: interrupted`` in
+        ``metadata.yaml``'s ``custom_data``; an error: the bag is closed without its
         summary (rosbags' ``abort``). Either way its file is closed: a Ctrl-C left it open, without
         ``metadata.yaml``, to a Python session that went on."""
         if self.bag is None:
             return
         if interrupted:
             with contextlib.suppress(Exception):  # a disk that cannot take the rest: aborted below
-                self._close()
+                self._close(status="interrupted")
                 return
         self._abort()
 
-    def _close(self) -> None:
-        """Writes each USV's last odometry (held for a successor that never came) and the bag's custom data, and
-        closes the bag."""
+    def _close(self, *, status: str) -> None:
+        """Writes each USV's last odometry (held for a successor that never came) and the bag's custom data, its
+        ``mmusv.status`` ``status`` (``complete``, or ``interrupted``: the bag itself says it holds only the frames
+        converted before a stop, which peers otherwise read as a whole one), and closes the bag."""
         for a in self.agents:
             self._odometry(a, None)
         self.bag.set_custom_data("mmusv.source", self.info.path.name)
         self.bag.set_custom_data("mmusv.scenario", self.info.scenario_name)
         self.bag.set_custom_data("mmusv.config_hash", self.info.config_hash)
         self.bag.set_custom_data("mmusv.time_offset_ns", str(TIME_OFFSET_NS))
+        self.bag.set_custom_data("mmusv.status", status)
         try:
             self.bag.close()
         except OSError as exc:
@@ -573,6 +576,6 @@ class Ros2Writer(DatasetWriter):
         super().finish(frames, skipped)
         if self.bag is None:
             return
-        self._close()
+        self._close(status="complete")
         for p in sorted(self.folder.iterdir()):
             self.sink.count(p)
