@@ -90,9 +90,10 @@ metres, other files in whatever their author used: `scale` converts.
 **Materials** come through per face, each texture by its mean over its texels (mmusv shades one material per
 face); the conversions are `mmusv.world.mesh_materials`'s.
 
-- *glTF/GLB*, as glTF 2.0 defines them: base colour = `baseColorFactor` x `baseColorTexture` (sRGB, averaged in
-  linear RGB); roughness and metallic = `roughnessFactor` and `metallicFactor` (default 1) x the green and blue
-  channels of the `metallicRoughnessTexture`; emission = `emissiveFactor` (default 0) x `emissiveTexture` (sRGB) x
+- *glTF/GLB*, as glTF 2.0 defines them: base colour = `baseColorFactor` (linear, as written: not rounded to 1/255) x
+  `baseColorTexture` (sRGB, 8 or 16 bits, averaged in linear RGB); roughness and metallic = `roughnessFactor` and
+  `metallicFactor` (default 1) x the green and blue channels of the `metallicRoughnessTexture`; emission =
+  `emissiveFactor` (default 0) x `emissiveTexture` (sRGB) x
   `KHR_materials_emissive_strength`, 1 standing for `mmusv.world.mesh_files.GLTF_EMISSIVE_SCALE` cd/m². Not read:
   alpha (`alphaMode`, a base colour's alpha: every face is opaque), `doubleSided` (the ray caster hits both sides of
   every face anyway), normal and occlusion textures.
@@ -155,7 +156,13 @@ texture file is missing or not an image, an OBJ whose `.mtl` (`mtllib`) or `map_
 (naming the entry and the path looked for) or not an image, a `usemtl` naming no material of its MTL files, an MTL
 value out of range (`Kd` outside [0, 1], ...), a glTF material factor outside [0, 1] (`baseColorFactor`,
 `metallicFactor`, `roughnessFactor`, `emissiveFactor`: trimesh would clamp it), a glTF index into one of the file's
-lists that is not in it (`scene`, a node's `mesh`, a primitive's `material` or accessors, ...), a `COLOR_0`
+lists that is not in it (`scene`, a node's `mesh`, a primitive's `material` or accessors, a material's texture,
+...), JSON without `asset.version` or of another glTF major version than 2, an accessor `componentType` or `type`
+glTF does not define, a `POSITION` that is not VEC3, `indices` that are not SCALAR unsigned integers, a
+`TRIANGLE_FAN` primitive (mode 6, which trimesh would leave out), a node with both `matrix` and TRS, a non-affine
+`matrix`, a `rotation` that is not a unit quaternion, a node with two parents or in a cycle, a buffer without
+`uri` (but a GLB's first, which needs the GLB's binary chunk), a base colour, metallic-roughness or emissive
+texture whose image cannot be read (trimesh would leave it out: the hull came out white), a `COLOR_0`
 that glTF does not allow or that does not fit its
 primitive (naming the primitive and accessor: another count than its `POSITION`, not VEC3/VEC4, not float or
 normalized unsigned byte/short, a sparse accessor (trimesh does not apply its values), non-finite or outside

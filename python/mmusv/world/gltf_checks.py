@@ -22,25 +22,35 @@ from urllib.parse import unquote
 from mmusv.world.asset_spec import AssetSpecError
 from mmusv.world.mesh_materials import EmissiveKey, check_image, emissive_key, one_line
 
-__all__ = ["READ_EXTENSIONS", "check_gltf"]
+__all__ = ["READ_EXTENSIONS", "TEXTURE_SLOTS", "PrimitiveMaterial", "check_gltf", "gltf_json"]
 
 
-def check_gltf(path: Path, where: str) -> tuple[dict[EmissiveKey, float], list[str]]:
+PrimitiveMaterial = tuple[int, dict[str, object]] | None
+"""A primitive's material: its index in the file's ``materials`` and its JSON object (``None``: no material)."""
+
+
+def check_gltf(path: Path, where: str) -> tuple[dict[EmissiveKey, float], list[str], list[PrimitiveMaterial]]:
     """Checks the glTF/GLB file ``path`` (module docstring; errors at the asset entry ``where``); returns its
-    ``KHR_materials_emissive_strength`` by material name and ``emissiveFactor`` (trimesh drops the extension) and
-    the name (``meshes[i].primitives[j]``) of each primitive trimesh makes a geometry of, in its order."""
-    data = _gltf_json(path, where)
+    ``KHR_materials_emissive_strength`` by material name and ``emissiveFactor`` (trimesh drops the extension), the
+    name (``meshes[i].primitives[j]``) of each primitive trimesh makes a geometry of, in its order, and the material
+    of each of them (:data:`PrimitiveMaterial`)."""
+    data = gltf_json(path, where)
+    shown = repr(str(path))
+    _asset_checks(shown, data, where)
     _extension_checks(path, data, where)
     strengths, names = _gltf_checks(path, data, where), _color_0_checks(path, data, where)
-    _reference_checks(repr(str(path)), data, where)  # after the checks that say more of their own entries
-    return strengths, names
+    _reference_checks(shown, data, where)  # after the checks that say more of their own entries
+    _accessor_checks(shown, data, where)
+    _node_checks(shown, data, where)
+    _buffer_checks(path, data, where)
+    return strengths, names, _primitive_materials(data)
 
 
 _GLB_MAGIC = b"glTF"
 _GLB_JSON = 0x4E4F534A
 
 
-def _gltf_json(path: Path, where: str) -> dict[str, object]:
+def gltf_json(path: Path, where: str) -> dict[str, object]:
     """The JSON of a .gltf file or of a GLB's first chunk; a GLB whose header or JSON chunk runs past the file's end
     is refused as truncated, and either whose JSON does not parse as not glTF."""
     shown = repr(str(path))
@@ -167,6 +177,10 @@ def _references(data: dict[str, object]) -> Iterator[tuple[str, object, str]]:
     for i, tx in enumerate(items("textures")):
         if isinstance(tx, dict) and "source" in tx:
             yield f"textures[{i}].source", tx["source"], "images"
+    for i, mat in enumerate(items("materials")):
+        for at, info in _material_textures(mat):
+            if isinstance(info, dict) and "index" in info:
+                yield f"materials[{i}].{at}.index", info["index"], "textures"
 
 
 def _reference_checks(shown: str, data: dict[str, object], where: str) -> None:
@@ -354,3 +368,219 @@ def _color_0_checks(path: Path, data: dict[str, object], where: str) -> list[str
                 where, f"{at} has {count!r} colours for the {vertices!r} vertices of its POSITION accessor"
             )
     return names
+
+
+TEXTURE_SLOTS = (
+    ("pbrMetallicRoughness", "baseColorTexture"),
+    ("pbrMetallicRoughness", "metallicRoughnessTexture"),
+    (None, "emissiveTexture"),
+)
+"""The texture slots of a material mmusv reads (by their mean): (the object holding it, its name)."""
+
+
+def _material_textures(material: object) -> Iterator[tuple[str, object]]:
+    """``(where, texture info)`` of each of :data:`TEXTURE_SLOTS` a glTF material gives (``pbrMetallicRoughness.
+    baseColorTexture``, ...)."""
+    if not isinstance(material, dict):
+        return
+    for holder, name in TEXTURE_SLOTS:
+        obj = material.get(holder) if holder else material
+        if isinstance(obj, dict) and name in obj:
+            yield (f"{holder}.{name}" if holder else name), obj[name]
+
+
+def _asset_checks(shown: str, data: dict[str, object], where: str) -> None:
+    """Refuses JSON that is not glTF 2.x: glTF 2.0 requires ``asset.version`` (``"2.0"``), and a reader refuses a
+    major version it does not know (glTF 1.0's JSON is laid out otherwise) or a ``minVersion`` above its own."""
+    asset = data.get("asset")
+    version = asset.get("version") if isinstance(asset, dict) else None
+    if not isinstance(version, str):
+        raise AssetSpecError(
+            where,
+            f"{shown} is not a glTF file: its JSON has no asset.version (glTF 2.0 requires "
+            '"asset": {"version": "2.0"})',
+        )
+    minimum = asset.get("minVersion", "2.0") if isinstance(asset, dict) else "2.0"
+    if version.split(".")[0] != "2" or not isinstance(minimum, str) or minimum.split(".")[0] != "2":
+        raise AssetSpecError(where, f"{shown} is glTF {version!r} (minVersion {minimum!r}); mmusv reads glTF 2.x files")
+
+
+_COMPONENTS = {5120: "byte", 5121: "unsigned byte", 5122: "short", 5123: "unsigned short", 5125: "unsigned int"}
+_COMPONENTS[5126] = "float"
+_TYPES = frozenset({"SCALAR", "VEC2", "VEC3", "VEC4", "MAT2", "MAT3", "MAT4"})
+_POSITION_COMPONENTS = frozenset({5126, 5120, 5121, 5122, 5123})
+"""float, and the integer types ``KHR_mesh_quantization`` allows for ``POSITION``."""
+_INDEX_COMPONENTS = frozenset({5121, 5123, 5125})
+_MODES = {0: "POINTS", 1: "LINES", 2: "LINE_LOOP", 3: "LINE_STRIP", 4: "TRIANGLES", 5: "TRIANGLE_STRIP"}
+_MODES[6] = "TRIANGLE_FAN"
+
+
+def _accessor_checks(shown: str, data: dict[str, object], where: str) -> None:
+    """Refuses an accessor of a ``componentType`` or ``type`` glTF 2.0 does not define, a primitive ``mode`` it does
+    not define or trimesh leaves out (``TRIANGLE_FAN``: its triangles were dropped without a word), a triangle
+    primitive without ``POSITION``, a ``POSITION`` that is not VEC3 of float (or the integers
+    ``KHR_mesh_quantization`` allows), and ``indices`` that are not SCALAR unsigned integers: trimesh failed on them
+    inside (a bare ``IndexError`` for a VEC2 ``POSITION``) or read them wrong."""
+    accessors = data.get("accessors")
+    for i, acc in enumerate(accessors if isinstance(accessors, list) else []):
+        if not isinstance(acc, dict):
+            raise AssetSpecError(where, f"{shown}: accessors[{i}] is {acc!r:.60}, not an object")
+        comp, kind = acc.get("componentType"), acc.get("type")
+        if isinstance(comp, bool) or comp not in _COMPONENTS:
+            known = ", ".join(f"{k} ({v})" for k, v in _COMPONENTS.items())
+            raise AssetSpecError(where, f"{shown}: accessors[{i}].componentType is {comp!r}; glTF 2.0 defines {known}")
+        if kind not in _TYPES:
+            raise AssetSpecError(
+                where, f"{shown}: accessors[{i}].type is {kind!r}; glTF 2.0 defines {', '.join(sorted(_TYPES))}"
+            )
+    for i, j, p in _primitives(data):
+        at = f"{shown}: meshes[{i}].primitives[{j}]"
+        mode = p.get("mode", 4)
+        if isinstance(mode, bool) or mode not in _MODES:
+            raise AssetSpecError(where, f"{at}.mode is {mode!r}; glTF 2.0 defines modes 0..6")
+        if mode == 6:
+            raise AssetSpecError(
+                where,
+                f"{at} is a TRIANGLE_FAN (mode 6), which trimesh's glTF reader leaves out (the vessel would lose "
+                "its triangles without a word); export it as TRIANGLES (mode 4)",
+            )
+        attrs = p.get("attributes")
+        if mode not in (4, 5):  # points and lines: no surface, left out
+            continue
+        if not isinstance(attrs, dict) or "POSITION" not in attrs:
+            raise AssetSpecError(where, f"{at} has no attributes.POSITION: its triangles have no vertices to read")
+        pos = _accessor(data, attrs["POSITION"])
+        if pos is not None and (pos.get("type") != "VEC3" or pos.get("componentType") not in _POSITION_COMPONENTS):
+            raise AssetSpecError(
+                where,
+                f"{at}.attributes.POSITION (accessors[{attrs['POSITION']}]) is {pos.get('type')!r} of "
+                f"{_COMPONENTS.get(pos.get('componentType'), '?')!r}; glTF 2.0 positions are VEC3 of float (or of the "  # type: ignore[call-overload]
+                "integers KHR_mesh_quantization allows)",
+            )
+        idx = _accessor(data, p.get("indices"))
+        if idx is not None and (idx.get("type") != "SCALAR" or idx.get("componentType") not in _INDEX_COMPONENTS):
+            raise AssetSpecError(
+                where,
+                f"{at}.indices (accessors[{p.get('indices')}]) is {idx.get('type')!r} of componentType "
+                f"{idx.get('componentType')!r}; glTF 2.0 indices are SCALAR unsigned byte, short or int "
+                "(5121, 5123, 5125)",
+            )
+
+
+def _numbers(value: object, n: int) -> TypeGuard[list[float]]:
+    """Whether a JSON value is a list of ``n`` finite numbers."""
+    return isinstance(value, list) and len(value) == n and all(_finite_number(v) for v in value)
+
+
+def _node_checks(shown: str, data: dict[str, object], where: str) -> None:
+    """Refuses node transforms and hierarchies glTF 2.0 does not allow, which trimesh read some way without a word:
+    a ``matrix`` given with ``translation``/``rotation``/``scale`` (both were applied), a ``matrix`` that is not 16
+    finite numbers of an affine transform (its last row (0, 0, 0, 1)), a ``rotation`` that is not a unit quaternion
+    (a zero one was read as no rotation), ``translation``/``scale`` not three finite numbers, and a node that is a
+    child of two nodes or of its own subtree (the nodes form disjoint strict trees)."""
+    nodes = data.get("nodes")
+    items = nodes if isinstance(nodes, list) else []
+    parent: dict[int, int] = {}
+    for i, node in enumerate(items):
+        if not isinstance(node, dict):
+            raise AssetSpecError(where, f"{shown}: nodes[{i}] is {node!r:.60}, not an object")
+        at = f"{shown}: nodes[{i}]"
+        trs = [k for k in ("translation", "rotation", "scale") if k in node]
+        if "matrix" in node:
+            m = node["matrix"]
+            if trs:
+                raise AssetSpecError(
+                    where, f"{at} has both a matrix and {', '.join(trs)}; glTF 2.0 allows one or the other"
+                )
+            if not _numbers(m, 16):
+                raise AssetSpecError(where, f"{at}.matrix is {m!r:.80}; glTF 2.0 asks for 16 finite numbers")
+            if [m[3], m[7], m[11], m[15]] != [0, 0, 0, 1]:
+                raise AssetSpecError(
+                    where,
+                    f"{at}.matrix's last row is {[m[3], m[7], m[11], m[15]]} (column-major: elements 3, 7, 11, 15), "
+                    "not [0, 0, 0, 1]; glTF 2.0 node matrices are affine (translation, rotation, scale)",
+                )
+        for key, n in (("translation", 3), ("rotation", 4), ("scale", 3)):
+            if key in node and not _numbers(node[key], n):
+                raise AssetSpecError(where, f"{at}.{key} is {node[key]!r:.80}; glTF 2.0 asks for {n} finite numbers")
+        if "rotation" in node:
+            norm = math.sqrt(sum(float(v) ** 2 for v in node["rotation"]))
+            if abs(norm - 1.0) > 1e-3:
+                raise AssetSpecError(
+                    where,
+                    f"{at}.rotation is {node['rotation']!r}, of length {norm:.6g}; glTF 2.0 rotations are unit "
+                    "quaternions [x, y, z, w] (no rotation: [0, 0, 0, 1])",
+                )
+        kids = node.get("children", [])
+        for c in kids if isinstance(kids, list) else []:
+            if not isinstance(c, int) or isinstance(c, bool):
+                continue  # _reference_checks refused it
+            if c in parent or c == i:
+                other = "itself" if c == i else f"nodes[{parent[c]}] too"
+                raise AssetSpecError(
+                    where,
+                    f"{at} names nodes[{c}] as a child, which is a child of {other}; glTF 2.0 nodes form disjoint "
+                    "trees (a node has one parent at most)",
+                )
+            parent[c] = i
+    for i in range(len(items)):  # a node among its own ancestors
+        seen, k = {i}, i
+        while k in parent:
+            k = parent[k]
+            if k in seen:
+                raise AssetSpecError(
+                    where, f"{shown}: nodes[{i}] is its own ancestor (a cycle of children); glTF 2.0 nodes form trees"
+                )
+            seen.add(k)
+
+
+def _buffer_checks(path: Path, data: dict[str, object], where: str) -> None:
+    """Refuses a buffer without ``uri`` where glTF 2.0 asks for one (every buffer of a ``.gltf``, every buffer but the
+    first of a GLB), and a GLB whose first buffer has no ``uri`` but that holds no binary chunk to take its place:
+    trimesh failed on them with a bare ``KeyError: 'uri'`` or ``IndexError``."""
+    shown = repr(str(path))
+    buffers = data.get("buffers")
+    glb = path.suffix.lower() == ".glb"
+    for i, b in enumerate(buffers if isinstance(buffers, list) else []):
+        if not isinstance(b, dict):
+            raise AssetSpecError(where, f"{shown}: buffers[{i}] is {b!r:.60}, not an object")
+        if "uri" in b:
+            continue
+        if not glb or i > 0:
+            raise AssetSpecError(
+                where,
+                f"{shown}: buffers[{i}] has no uri; glTF 2.0 leaves it out only for a GLB's first buffer (its "
+                "binary chunk): give the .bin file's name or a data: URI",
+            )
+        if not _glb_has_bin(path):
+            raise AssetSpecError(
+                where,
+                f"{shown}: buffers[0] has no uri, so it is the GLB's binary chunk, but the file holds no binary "
+                "chunk after its JSON: the file is truncated or damaged",
+            )
+
+
+def _glb_has_bin(path: Path) -> bool:
+    """Whether the GLB ``path`` holds a chunk after its JSON chunk, of type BIN."""
+    with path.open("rb") as f:
+        head = f.read(20)
+        json_length = struct.unpack_from("<I", head, 12)[0]
+        f.seek(20 + json_length)
+        chunk = f.read(8)
+    return len(chunk) == 8 and struct.unpack_from("<I", chunk, 4)[0] == 0x004E4942
+
+
+def _primitive_materials(data: dict[str, object]) -> list[PrimitiveMaterial]:
+    """The material of each primitive trimesh makes a geometry of (those of :func:`_color_0_checks`'s names), in
+    its order."""
+    materials = data.get("materials")
+    out: list[PrimitiveMaterial] = []
+    for _, _, p in _primitives(data):
+        mode = p.get("mode", 4)
+        if not (isinstance(mode, int) and mode in _GLTF_MODES):
+            continue
+        k = p.get("material")
+        ok = isinstance(k, int) and not isinstance(k, bool) and isinstance(materials, list)
+        m = materials[k] if ok else None  # type: ignore[index]
+        out.append((k, m) if isinstance(m, dict) else None)  # type: ignore[arg-type]
+    return out

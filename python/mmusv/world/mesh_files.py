@@ -32,7 +32,7 @@ import numpy as np
 from mmusv.errors import ConfigError
 from mmusv.validation import join
 from mmusv.world.asset_spec import AXES, FORMAT_AXES, AssetSpecError, MeshAssetSpec, dimension_problem
-from mmusv.world.gltf_checks import check_gltf
+from mmusv.world.gltf_checks import TEXTURE_SLOTS, PrimitiveMaterial, check_gltf
 from mmusv.world.mesh_materials import (
     GLTF_EMISSIVE_SCALE,
     EmissiveKey,
@@ -97,22 +97,25 @@ _COLOR_0 = "mmusv_color_0"
 """The metadata key of a glTF piece's ``COLOR_0`` as linear RGB per vertex, before processing."""
 
 
-def _load_gltf(trimesh: object, path: Path, where: str, names: list[str]) -> object:
+def _load_gltf(trimesh: object, path: Path, where: str, names: list[str], materials: list[PrimitiveMaterial]) -> object:
     """The glTF ``path`` as an unprocessed trimesh scene whose pieces keep their ``COLOR_0`` exactly
     (metadata :data:`_COLOR_0`): trimesh's loader is called for its keyword arguments, and the raw colours it passes
     on are taken out before trimesh turns them into 8-bit visual colours (a float colour of 0.002 would become
-    1/255) or into an unread vertex attribute. ``names``: :func:`~mmusv.world.gltf_checks.check_gltf`'s, for the
-    errors."""
+    1/255) or into an unread vertex attribute. ``names`` and ``materials``: :func:`~mmusv.world.gltf_checks.
+    check_gltf`'s, for the errors and for each piece's material as the file writes it (:func:`_file_material`)."""
     from trimesh.exchange.gltf import load_glb, load_gltf
 
     loader = load_glb if path.suffix.lower() == ".glb" else load_gltf
     with path.open("rb") as f:
         kwargs = loader(file_obj=f, resolver=_resolver(path))
     geometry = kwargs.get("geometry", {}) if isinstance(kwargs, dict) else {}
-    labels = names if len(names) == len(geometry) else [f"mesh {k!r}" for k in geometry]
-    for label, (key, g) in zip(labels, geometry.items(), strict=True):
+    aligned = len(names) == len(geometry) == len(materials)
+    labels = names if aligned else [f"mesh {k!r}" for k in geometry]
+    for n, (label, (key, g)) in enumerate(zip(labels, geometry.items(), strict=True)):
         if not isinstance(g, dict):
             continue
+        if aligned:
+            _file_material(g, materials[n], path, where)
         raw = g.pop("vertex_colors", None)
         attrs = getattr(g.get("visual"), "vertex_attributes", None)
         if attrs is not None and "color" in attrs:
@@ -121,6 +124,60 @@ def _load_gltf(trimesh: object, path: Path, where: str, names: list[str]) -> obj
             at = f"{str(path)!r}: {label}.attributes.COLOR_0 (geometry {key!r})"
             g.setdefault("metadata", {})[_COLOR_0] = _color_0_linear(raw, at, where)
     return trimesh.load(kwargs, force="scene", process=False)  # type: ignore[attr-defined]
+
+
+_BASE_COLOR = "mmusv_base_color_factor"
+"""The metadata key of a glTF piece's ``baseColorFactor`` RGB as the file writes it (trimesh keeps it as bytes)."""
+
+
+def _file_material(g: dict[str, object], material: PrimitiveMaterial, path: Path, where: str) -> None:
+    """Checks a piece's material against the file's JSON ``material`` and keeps its exact ``baseColorFactor``
+    (metadata :data:`_BASE_COLOR`; trimesh rounds it to 1/255, so a dark linear 0.018 became 0.0196 and 0.001
+    black). A texture slot mmusv reads (:data:`~mmusv.world.gltf_checks.TEXTURE_SLOTS`) that the file gives but
+    trimesh left out (an image Pillow cannot decode, ``image/ktx2``, a texture without ``source``: trimesh logs
+    them at debug level) is an error: the hull came out in the factor's colour, white by default."""
+    if material is None:
+        return
+    k, m = material
+    pbr = m.get("pbrMetallicRoughness")
+    factor = pbr.get("baseColorFactor") if isinstance(pbr, dict) else None
+    if isinstance(factor, list) and len(factor) == 4:
+        meta = g.setdefault("metadata", {})
+        if isinstance(meta, dict):
+            meta[_BASE_COLOR] = tuple(float(c) for c in factor[:3])
+    read = getattr(g.get("visual"), "material", None)
+    if read is None:
+        return
+    for holder, name in TEXTURE_SLOTS:
+        obj = m.get(holder) if holder else m
+        info = obj.get(name) if isinstance(obj, dict) else None
+        if not isinstance(info, dict) or getattr(read, name, None) is not None:
+            continue
+        if name == "metallicRoughnessTexture" and getattr(read, "roughnessFactor", None) is None:
+            continue  # a specular-glossiness material trimesh converted: its textures are its own
+        at = f"materials[{k}].{holder + '.' if holder else ''}{name}"
+        tex_index = info.get("index")
+        textures = _json_list(path, "textures")
+        tex = textures[tex_index] if isinstance(tex_index, int) and 0 <= tex_index < len(textures) else None
+        source = tex.get("source") if isinstance(tex, dict) else None
+        why = (
+            f"textures[{tex_index}] names no image (no source)"
+            if source is None
+            else f"its image images[{source}] could not be read (not an image Pillow decodes, or image/ktx2)"
+        )
+        raise AssetSpecError(
+            where,
+            f"{str(path)!r}: {at} (textures[{tex_index}]): {why}; trimesh's reader would leave the texture out "
+            "without a word",
+        )
+
+
+def _json_list(path: Path, key: str) -> list[object]:
+    """The list ``key`` of the glTF ``path``'s JSON (read again: only for an error's message)."""
+    from mmusv.world.gltf_checks import gltf_json
+
+    value = gltf_json(path, "").get(key)
+    return value if isinstance(value, list) else []
 
 
 def _resolver(path: Path) -> FilePathResolver:
@@ -146,10 +203,12 @@ def _resolver(path: Path) -> FilePathResolver:
         return GltfResolver(str(path))
 
 
-def _check_file(path: Path, where: str, formats: list[str]) -> tuple[dict[EmissiveKey, float], list[str]]:
+def _check_file(
+    path: Path, where: str, formats: list[str]
+) -> tuple[dict[EmissiveKey, float], list[str], list[PrimitiveMaterial]]:
     """Refuses what trimesh would read obscurely or not at all (module docstring); returns a glTF's emissive
-    strengths by material name and factor and the names of its primitives
-    (:func:`~mmusv.world.gltf_checks.check_gltf`), both empty for other formats."""
+    strengths by material name and factor, the names of its primitives and their materials
+    (:func:`~mmusv.world.gltf_checks.check_gltf`), all empty for other formats."""
     shown = repr(str(path))
     name = path.name.lower()
     if not any(name.endswith("." + f) for f in formats):
@@ -159,7 +218,7 @@ def _check_file(path: Path, where: str, formats: list[str]) -> tuple[dict[Emissi
     if path.stat().st_size == 0:
         raise AssetSpecError(where, f"{shown} is empty (0 bytes): it holds no triangles")
     if path.suffix.lower() not in FORMAT_AXES:
-        return {}, []
+        return {}, [], []
     return check_gltf(path, where)
 
 
@@ -192,7 +251,7 @@ def _face_materials(
     colour materials), an OBJ's MTL materials, else its vertex/face colours, else 0, the class default."""
     out: list[np.ndarray] = []
     colour_at: list[tuple[int, np.ndarray, int]] = []
-    cache: dict[int, int] = {}
+    cache: dict[tuple[int, tuple[float, ...] | None], int] = {}
     for g in pieces:
         n = len(g.faces)  # type: ignore[attr-defined]
         visual = getattr(g, "visual", None)
@@ -201,7 +260,8 @@ def _face_materials(
         if strengths is not None:
             has = hasattr(visual, "material")
             try:
-                mid = gltf_material_id(mat, path.stem, cache, strengths) if has else 0
+                exact = getattr(g, "metadata", {}).get(_BASE_COLOR)
+                mid = gltf_material_id(mat, path.stem, cache, strengths, exact) if has else 0
             except ConfigError as exc:
                 raise AssetSpecError(where, f"{str(path)!r}: {one_line(exc)}") from None
             if colours is not None:
@@ -237,7 +297,7 @@ def load_mesh_file(path: Path, where: str) -> tuple[np.ndarray, np.ndarray, np.n
         import trimesh
     except ImportError as exc:  # pragma: no cover - depends on the install
         raise AssetSpecError(where, "loading mesh files needs the 'trimesh' package (pip install trimesh)") from exc
-    strengths, names = _check_file(path, where, list(trimesh.available_formats()))
+    strengths, names, materials = _check_file(path, where, list(trimesh.available_formats()))
     gltf = path.suffix.lower() in FORMAT_AXES
     mtl = obj_materials(path, where) if path.suffix.lower() == ".obj" else None
     if path.suffix.lower() == ".obj":
@@ -246,7 +306,7 @@ def load_mesh_file(path: Path, where: str) -> tuple[np.ndarray, np.ndarray, np.n
         # Read unprocessed: trimesh's processing silently drops every face touching a NaN/inf vertex, so the raw
         # arrays are checked first; each piece is then processed exactly as ``trimesh.load(process=True)`` would.
         if gltf:
-            scene = _load_gltf(trimesh, path, where, names)
+            scene = _load_gltf(trimesh, path, where, names, materials)
         else:
             resolver = _mtl_resolver(path, mtl) if mtl is not None else None
             scene = trimesh.load(str(path), force="scene", process=False, resolver=resolver)

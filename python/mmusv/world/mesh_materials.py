@@ -147,6 +147,11 @@ def _texture_mean(tex: object, *, srgb: bool) -> np.ndarray:
     # Counted per 8-bit level (256 bins a channel), not converted per texel: a 4000 x 4000 texture (a 2 kB PNG) took
     # 2.1 GB as float64 texels, and one near PIL's size limit would have been killed for memory. The mean is the same
     # sum over the same levels.
+    if str(getattr(tex, "mode", "")).startswith("I"):  # a 16-bit grey PNG (I;16, I): convert("RGB") clipped it at 255
+        counts = np.bincount(np.clip(np.asarray(tex), 0, 65535).astype(np.int64).ravel(), minlength=65536)
+        grey = np.arange(65536, dtype=np.float64) / 65535.0
+        mean = float(counts @ (_srgb_to_linear(grey) if srgb else grey) / max(int(counts.sum()), 1))
+        return np.full(3, mean)
     levels = np.arange(256, dtype=np.float64) / 255.0
     if srgb:
         levels = _srgb_to_linear(levels)
@@ -164,19 +169,22 @@ def _material(name: str, base: np.ndarray, rough: float, metal: float, emis: np.
     )
 
 
-def _pbr_material(mat: object, name: str, emissive_strength: float = 1.0) -> Material:
+def _pbr_material(
+    mat: object, name: str, emissive_strength: float = 1.0, base_color: tuple[float, ...] | None = None
+) -> Material:
     """A :class:`Material` from a trimesh material (glTF PBR; a plain material's diffuse colour otherwise).
 
     As glTF 2.0 defines it (module docstring), each texture by its mean: ``baseColorFactor`` (linear) times the
     sRGB ``baseColorTexture``; ``roughnessFactor`` / ``metallicFactor`` (default 1) times the green / blue channel
     of the linear ``metallicRoughnessTexture``; ``emissiveFactor`` (default 0) times the sRGB ``emissiveTexture``
     times ``emissive_strength`` (``KHR_materials_emissive_strength``), scaled by :data:`GLTF_EMISSIVE_SCALE`.
+    ``base_color``: the ``baseColorFactor`` RGB as the file writes it, in place of trimesh's (rounded to 1/255).
     """
     base = np.ones(3)
     rough, metal, emis = 1.0, 1.0, np.zeros(3)
     factor = getattr(mat, "baseColorFactor", None)
     if factor is not None or hasattr(mat, "roughnessFactor"):
-        base = _unit_factor(factor, 3, 1.0)
+        base = _unit_factor(factor, 3, 1.0) if base_color is None else np.array(base_color[:3], dtype=np.float64)
         tex = getattr(mat, "baseColorTexture", None)
         if tex is not None:
             base = base * _texture_mean(tex, srgb=True)
@@ -234,16 +242,25 @@ def emissive_key(name: object, factor: object) -> EmissiveKey | None:
     return (name if isinstance(name, str) else None, f)
 
 
-def gltf_material_id(mat: object, stem: str, cache: dict[int, int], strengths: dict[EmissiveKey, float]) -> int:
+def gltf_material_id(
+    mat: object,
+    stem: str,
+    cache: dict[tuple[int, tuple[float, ...] | None], int],
+    strengths: dict[EmissiveKey, float],
+    base_color: tuple[float, ...] | None = None,
+) -> int:
     """The registered id of a trimesh material (named ``<file stem>:<material name>``, suffixed if that name is
     taken by another material); ``strengths``: the file's ``KHR_materials_emissive_strength`` by
-    :func:`emissive_key`."""
-    key = id(mat)
+    :func:`emissive_key`; ``base_color``: its ``baseColorFactor`` RGB as the file writes it (trimesh rounds it to
+    1/255)."""
+    key = (id(mat), base_color)
     if key not in cache:
         raw = getattr(mat, "name", None)
         found = emissive_key(raw, getattr(mat, "emissiveFactor", None))
         strength = 1.0 if found is None else strengths.get(found, 1.0)
-        cache[key] = _register(stem, str(raw or "material"), lambda name: _pbr_material(mat, name, strength))
+        cache[key] = _register(
+            stem, str(raw or "material"), lambda name: _pbr_material(mat, name, strength, base_color)
+        )
     return cache[key]
 
 
