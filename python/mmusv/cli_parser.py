@@ -130,8 +130,23 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--version", action="version", version=f"mmusv {__version__}", help="print the version and exit")
     sub = p.add_subparsers(dest="command", required=True)
     sub.add_parser("version", help="print the version")
-    p_assets = sub.add_parser("assets", help="list the vessel library")
-    p_assets.add_argument("--render", metavar="DIR", help="also write a close-up PNG per asset and contact_sheet.png")
+    p_assets = sub.add_parser(
+        "assets",
+        help="list the vessel library, or your own assets (of asset files, or of scenarios' assets: lists)",
+        description="Lists the built-in vessel library; given FILEs, lists instead the user's own assets they hold "
+        "(with the file each comes from), built as mmusv run builds them: to check a mesh's size, triangles, parts "
+        "and materials before a run. --render draws the assets listed.",
+    )
+    p_assets.add_argument(
+        "files",
+        nargs="*",
+        metavar="FILE",
+        help="a scenario YAML (the asset files its assets: lists) or an asset YAML (one asset, or a list of them); "
+        "without FILE, the built-in library",
+    )
+    p_assets.add_argument(
+        "--render", metavar="DIR", help="also write a close-up PNG per asset listed and contact_sheet.png"
+    )
     p_assets.add_argument(
         "--overwrite", action="store_true", help="with --render: replace files of those names already in DIR"
     )

@@ -40,17 +40,23 @@ import threading
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from mmusv.errors import ConfigError
+
+if TYPE_CHECKING:
+    from mmusv.world.vessels import VesselAsset
 
 __all__ = [
     "AssetHome",
     "asset_digest",
     "asset_file_path",
     "asset_files",
+    "builtin_owner",
     "holding_library",
     "keep_scenario_assets",
+    "read_asset_file",
+    "read_scenario_assets",
     "register_scenario_assets",
     "use_scenario_assets",
 ]
@@ -193,40 +199,18 @@ def register_scenario_assets(entries: Any, *, base_dir: Path, where: str) -> Non
     paths), relative paths taken from ``base_dir``. :class:`~mmusv.errors.ConfigError` naming ``where`` (the
     scenario file), ``assets[i]``, the file and what is wrong; assets of earlier entries stay registered."""
     from mmusv.world.asset_spec import AssetSpecError
-    from mmusv.world.vessels import get_asset, load_asset_catalog, load_asset_file, register_asset, unregister_asset
-    from mmusv.yamlio import read_yaml
+    from mmusv.world.vessels import get_asset, register_asset, unregister_asset
 
-    if not isinstance(entries, list):
-        raise ConfigError(f"{where}: invalid scenario assets = {entries!r:.60}: must be a list of asset file paths")
-    for i, entry in enumerate(entries):
-        field = f"{where}: invalid scenario assets[{i}] = {entry!r:.80}"
-        if not isinstance(entry, str) or not entry.strip():
-            raise ConfigError(f"{field}: must be the path of an asset YAML file (relative to the scenario's folder)")
-        try:
-            path = asset_file_path(base_dir, entry)
-        except ValueError as exc:
-            raise ConfigError(f"{field}: {exc}; give the path of an asset YAML file") from None
-        if not path.is_file():
-            what = "is a folder" if path.is_dir() else "does not exist"
-            raise ConfigError(f"{field}: {path} {what}; give an asset YAML file (docs/assets.md)")
+    for i, entry in enumerate(_entry_list(entries, where)):
+        path, field = _entry_file(i, entry, base_dir=base_dir, where=where)
         with _lock:
             try:
                 sig = _signature(path)
                 if str(path) in _loaded and _loaded[str(path)][0] == sig:  # unchanged since last read
                     continue
                 parked = _parked.pop(str(path), None)
-                if parked is not None and parked[0] == sig:  # taken out by keep_scenario_assets: put back
-                    assets = parked[1]
-                else:
-                    data = read_yaml(path, kind="asset file")
-                    is_list = isinstance(data, list) or (isinstance(data, dict) and "vessels" in data)
-                    if not is_list and not isinstance(data, dict):  # (load_asset_file's message names its twin)
-                        raise ConfigError(
-                            f"{path} holds {_kind(data)}, not an asset: "
-                            "an asset file holds one asset (a mapping with a name and a mesh or a hull) or a list "
-                            "of them (docs/assets.md)"
-                        )
-                    assets = load_asset_catalog(path) if is_list else [load_asset_file(path)]
+                # taken out by keep_scenario_assets: put back; else built
+                assets = parked[1] if parked is not None and parked[0] == sig else read_asset_file(path)
             except (AssetSpecError, ConfigError, OSError) as exc:
                 raise ConfigError(f"{field}: {exc}") from None
             previous = _loaded.pop(str(path), (None, ()))[1]
@@ -240,11 +224,7 @@ def register_scenario_assets(entries: Any, *, base_dir: Path, where: str) -> Non
                     except KeyError:
                         held = None
                     if held is not None:
-                        owner = "the built-in library" if held.source == "builtin" else held.source
-                        raise ConfigError(
-                            f"{field}: asset {asset.name!r} is already in the library, from {owner}; give it "
-                            "another name"
-                        )
+                        raise ConfigError(_taken(field, asset.name, held.source))
                     register_asset(asset)
                     names.append(asset.name)
             except ConfigError:
@@ -252,6 +232,90 @@ def register_scenario_assets(entries: Any, *, base_dir: Path, where: str) -> Non
                     unregister_asset(name)
                 raise
             _loaded[str(path)] = (sig, tuple(names))
+
+
+def read_scenario_assets(entries: Any, *, base_dir: Path, where: str) -> list[tuple[Path, list[VesselAsset]]]:
+    """The assets of ``entries`` (a scenario's ``assets:`` value, relative to ``base_dir``), built as
+    :func:`register_scenario_assets` builds them but added to no library: ``(asset file, its assets)`` in the
+    order listed, a file listed twice once (``mmusv assets SCENARIO`` shows a user's assets without touching the
+    library). The same :class:`~mmusv.errors.ConfigError` as ``mmusv run`` of the scenario for a bad entry, a bad
+    file, or a name another of its files or the built-in library already holds."""
+    from mmusv.world.asset_spec import AssetSpecError
+
+    out: list[tuple[Path, list[VesselAsset]]] = []
+    owners: dict[str, str] = {}  # asset name -> the file of this scenario that holds it
+    for i, entry in enumerate(_entry_list(entries, where)):
+        path, field = _entry_file(i, entry, base_dir=base_dir, where=where)
+        if any(path == seen for seen, _ in out):  # (register_scenario_assets skips it as unchanged)
+            continue
+        try:
+            assets = read_asset_file(path)
+        except (AssetSpecError, ConfigError, OSError) as exc:
+            raise ConfigError(f"{field}: {exc}") from None
+        for asset in assets:
+            owner = owners.get(asset.name) or builtin_owner(asset.name)
+            if owner is not None:
+                raise ConfigError(_taken(field, asset.name, owner))
+            owners[asset.name] = str(path)
+        out.append((path, assets))
+    return out
+
+
+def builtin_owner(name: str) -> str | None:
+    """``"builtin"`` when the built-in library holds an asset called ``name``, else ``None``."""
+    from mmusv.world.vessels import get_asset
+
+    try:
+        return "builtin" if get_asset(name).source == "builtin" else None
+    except KeyError:
+        return None
+
+
+def _taken(field: str, name: str, owner: str) -> str:
+    """The message for asset ``name`` of ``field`` whose name ``owner`` (an asset file, or ``"builtin"``) holds."""
+    owner = "the built-in library" if owner == "builtin" else owner
+    return f"{field}: asset {name!r} is already in the library, from {owner}; give it another name"
+
+
+def _entry_list(entries: Any, where: str) -> list[Any]:
+    """``entries``, a scenario's ``assets:`` value, when it is a list; else the :class:`ConfigError` saying so."""
+    if not isinstance(entries, list):
+        raise ConfigError(f"{where}: invalid scenario assets = {entries!r:.60}: must be a list of asset file paths")
+    return entries
+
+
+def _entry_file(i: int, entry: Any, *, base_dir: Path, where: str) -> tuple[Path, str]:
+    """``(the resolved asset file, how messages name the entry)`` of ``assets[i]`` = ``entry``; a
+    :class:`ConfigError` when it names no file there."""
+    field = f"{where}: invalid scenario assets[{i}] = {entry!r:.80}"
+    if not isinstance(entry, str) or not entry.strip():
+        raise ConfigError(f"{field}: must be the path of an asset YAML file (relative to the scenario's folder)")
+    try:
+        path = asset_file_path(base_dir, entry)
+    except ValueError as exc:
+        raise ConfigError(f"{field}: {exc}; give the path of an asset YAML file") from None
+    if not path.is_file():
+        what = "is a folder" if path.is_dir() else "does not exist"
+        raise ConfigError(f"{field}: {path} {what}; give an asset YAML file (docs/assets.md)")
+    return path, field
+
+
+def read_asset_file(path: Path) -> list[VesselAsset]:
+    """The assets of the asset file ``path``, built and added to no library (one mapping, or a list of them /
+    ``vessels:``); an :class:`~mmusv.world.asset_spec.AssetSpecError` or :class:`ConfigError` saying what is
+    wrong."""
+    from mmusv.world.vessels import load_asset_catalog, load_asset_file
+    from mmusv.yamlio import read_yaml
+
+    data = read_yaml(path, kind="asset file")
+    is_list = isinstance(data, list) or (isinstance(data, dict) and "vessels" in data)
+    if not is_list and not isinstance(data, dict):  # (load_asset_file's message names its twin)
+        raise ConfigError(
+            f"{path} holds {_kind(data)}, not an asset: "
+            "an asset file holds one asset (a mapping with a name and a mesh or a hull) or a list "
+            "of them (docs/assets.md)"
+        )
+    return load_asset_catalog(path) if is_list else [load_asset_file(path)]
 
 
 def asset_digest(names: Iterable[str]) -> str:

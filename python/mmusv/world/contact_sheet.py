@@ -13,7 +13,7 @@ import contextlib
 import inspect
 import math
 import os
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -132,19 +132,22 @@ def write_contact_sheet(
     out_dir: str | os.PathLike[str],
     *,
     names: list[str] | None = None,
+    assets: Sequence[VesselAsset] | None = None,
     tile: tuple[int, int] = (320, 240),
     asset_size: tuple[int, int] = (640, 480),
     overwrite: bool = False,
 ) -> Path:
-    """Renders every asset of ``names`` (default: the whole library) to ``<out_dir>/<name>.png`` at
-    ``asset_size`` and writes the grid of them, ``tile`` pixels each, to ``<out_dir>/contact_sheet.png``
-    (returned). Raises :class:`mmusv.ConfigError` if ``out_dir`` is a file, ``names`` is not a list of asset names
-    or a size is not ``(width, height)`` in whole pixels (1..:data:`MAX_SIDE_PX` each; a close-up at most a
-    camera's ``MAX_IMAGE_PIXELS``, the sheet at most :data:`MAX_SIDE_PX` a side), and
-    :class:`mmusv.NotFoundError` for a name the library does not hold, all before anything is written;
-    :class:`mmusv.IoError` naming the file that cannot be written, and, unless ``overwrite``, naming the files of
-    those names already in ``out_dir`` (an earlier sheet's, or a user's own ``contact_sheet.png``), before anything
-    is written."""
+    """Renders every asset of ``names`` (default: the whole library), or the assets ``assets`` (built and not
+    registered, e.g. by :func:`~mmusv.world.vessels.load_asset_file`, as ``mmusv assets FILE --render DIR`` does;
+    not with ``names``, and no two of one name), to ``<out_dir>/<name>.png`` at ``asset_size`` and writes the grid
+    of them, ``tile`` pixels each, to ``<out_dir>/contact_sheet.png`` (returned). Raises
+    :class:`mmusv.ConfigError` if ``out_dir`` is a file, ``names`` is not a list of asset names, ``assets`` not a
+    list of :class:`~mmusv.world.vessels.VesselAsset` of distinct names, or a size is not ``(width, height)`` in
+    whole pixels (1..:data:`MAX_SIDE_PX` each; a close-up at most a camera's ``MAX_IMAGE_PIXELS``, the sheet at most
+    :data:`MAX_SIDE_PX` a side), and :class:`mmusv.NotFoundError` for a name the library does not hold, all before
+    anything is written; :class:`mmusv.IoError` naming the file that cannot be written, and, unless ``overwrite``,
+    naming the files of those names already in ``out_dir`` (an earlier sheet's, or a user's own
+    ``contact_sheet.png``), before anything is written."""
     from mmusv.cli_paths import refuse_replacing
     from mmusv.recording.guard import file_in_the_way
     from mmusv.world.vessels import asset_names
@@ -155,7 +158,8 @@ def write_contact_sheet(
         names = list(names)
     if names is not None:  # a bare string was read as its letters ('u' is not an asset)
         arguments.names(names, name="names", example="['usv_wamv']")
-    chosen = asset_names() if names is None else list(names)
+    given = None if assets is None else _assets(assets, names)
+    chosen = [a.name for a in given] if given is not None else asset_names() if names is None else list(names)
     tile = _size(tile, "tile")
     asset_size = _size(asset_size, "asset_size")
     if asset_size[0] * asset_size[1] > MAX_IMAGE_PIXELS:
@@ -163,7 +167,8 @@ def write_contact_sheet(
             f"asset_size = {asset_size}: {asset_size[0] * asset_size[1]:,} pixels, more than a camera's "
             f"{MAX_IMAGE_PIXELS:,} (mmusv.sensors.config.MAX_IMAGE_PIXELS)"
         )
-    assets = [get_asset(name) for name in chosen]  # an unknown name is named before any file is written
+    # an unknown name is named before any file is written
+    drawn = given if given is not None else [get_asset(name) for name in chosen]
     layout = sheet_layout(len(chosen), tile)
     if max(layout.size) > MAX_SIDE_PX:
         raise ConfigError(
@@ -179,7 +184,7 @@ def write_contact_sheet(
     sheet = Image.new("RGB", layout.size, _BG)
     draw = ImageDraw.Draw(sheet)
     font = ImageFont.load_default(size=13)
-    for k, (name, asset) in enumerate(zip(chosen, assets, strict=True)):
+    for k, (name, asset) in enumerate(zip(chosen, drawn, strict=True)):
         img = Image.fromarray(render_asset(asset, size=asset_size))
         _save(img, out / f"{name}.png")
         col, row = k % layout.cols, k // layout.cols
@@ -195,6 +200,27 @@ def sheet_files(names: Sequence[str]) -> list[str]:
     """The names of the files :func:`write_contact_sheet` writes for the assets ``names``: one PNG each and
     ``contact_sheet.png``."""
     return [*(f"{n}.png" for n in names), "contact_sheet.png"]
+
+
+def _assets(assets: object, names: object) -> list[VesselAsset]:
+    """``assets`` as a list of :class:`VesselAsset` of distinct names, else a ConfigError saying why."""
+    if names is not None:
+        raise ConfigError("give names (assets of the library) or assets (VesselAsset objects), not both")
+    if isinstance(assets, (str, bytes, Mapping)) or not isinstance(assets, Iterable):
+        raise ConfigError(f"assets = {arguments.shown(assets)}: must be a list of VesselAsset (load_asset_file)")
+    out = list(assets)
+    seen: dict[str, int] = {}
+    for i, a in enumerate(out):
+        if not isinstance(a, VesselAsset):
+            raise ConfigError(f"assets[{i}] = {arguments.shown(a)}: must be a VesselAsset (load_asset_file)")
+        if a.name in seen:
+            j = seen[a.name]
+            raise ConfigError(
+                f"assets[{i}] ({a.source}) and assets[{j}] ({out[j].source}) are both named {a.name!r}: each is "
+                f"written to {a.name}.png; render them into different folders"
+            )
+        seen[a.name] = i
+    return out
 
 
 def _size(value: Any, name: str) -> tuple[int, int]:
