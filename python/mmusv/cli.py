@@ -1,12 +1,12 @@
 """The ``mmusv`` command line.
 
-Subcommands: ``run`` (a scenario or a folder of them into MCAP + Parquet; folders through :mod:`mmusv.batch`,
-on a local pool or Ray), ``dataset`` (spec → recordings → OPV2V, :mod:`mmusv.batch.dataset`), ``info`` and
-``preview`` (inspect a recording), ``convert`` (to OPV2V, KITTI, ROS 2, COCO, YOLO, MaSTr1325, SemanticKITTI,
-MOTChallenge), ``generate`` (batch scenario generation), ``recover`` (finish a killed run), ``assets`` (the vessel
-library), ``study waves`` (Table I) and ``study agreement`` (Table II), ``study detection`` / ``study robustness``
-(Tables III, IV), ``editor`` (the scenario editor in the browser), ``schema`` (the JSON Schema of scenario and
-spec files, for editors), ``version``.
+Subcommands: ``run`` (a scenario or a folder of them into MCAP + Parquet; folders through :mod:`mmusv.batch`, on a
+local pool or Ray), ``dataset`` (spec → recordings → OPV2V, :mod:`mmusv.batch.dataset`), ``info`` and ``preview``
+(inspect a recording), ``convert`` (to OPV2V, KITTI, ROS 2, COCO, YOLO, MaSTr1325, SemanticKITTI, MOTChallenge),
+``generate`` (batch scenario generation), ``recover`` (finish a killed run), ``assets`` (the vessel library, or a
+user's own assets), ``study waves`` (Table I) and ``study agreement`` (Table II), ``study detection`` / ``study
+robustness`` (Tables III, IV), ``editor`` (the scenario editor in the browser), ``schema`` (the JSON Schema of
+scenario and spec files, for editors), ``version``.
 Errors in the input end with a one-line message naming the problem and exit status 2, never a traceback.
 
 The arguments are :mod:`mmusv.cli_parser`'s; the subcommands run from :mod:`mmusv.cli_run`,
