@@ -129,6 +129,12 @@ def test_render_draws_the_users_assets_only(here: Path, capsys: pytest.CaptureFi
         (["models"], "mmusv: error: scenario or asset 'models' is a directory, not a file"),
         ([""], "mmusv: error: FILE is empty: give a path"),
         (["other.yaml"], "mmusv: error: other.yaml: neither a scenario (a mapping with vessels: and assets:"),
+        (
+            ["models/boat.ply"],
+            "mmusv: error: models/boat.ply: a mesh file, not an asset file: give the asset YAML that names it as "
+            "mesh: boat.ply (with name:, and draft: or waterline_z:; docs/assets.md), or a scenario whose assets: "
+            "lists that YAML",
+        ),
         (["models/bad_draft.yaml"], "mmusv: error: models/bad_draft.yaml: bad.draft: must be > 0.0, got -3"),
         (["models/no_mesh.yaml"], "mmusv: error: models/no_mesh.yaml: lost.mesh: mesh file '"),
         (

@@ -119,12 +119,18 @@ def read_user_assets(files: list[str]) -> tuple[list[UserAsset], list[str]]:
     name."""
     from mmusv.scenario_assets import builtin_owner, read_asset_file, read_scenario_assets
     from mmusv.world.asset_spec import AssetSpecError
+    from mmusv.world.mesh_files import _MESH_FORMATS
     from mmusv.yamlio import read_yaml
 
     out: list[UserAsset] = []
     bare: list[str] = []
     for given in files:
         path = Path(given).expanduser()
+        if path.suffix.lower().lstrip(".") in _MESH_FORMATS and path.is_file():  # the mesh, not its asset file
+            raise ConfigError(
+                f"{given}: a mesh file, not an asset file: give the asset YAML that names it as mesh: {path.name} "
+                "(with name:, and draft: or waterline_z:; docs/assets.md), or a scenario whose assets: lists that YAML"
+            )
         data = read_yaml(path, kind="scenario or asset")
         kind = _kind_of(data)
         if kind == "scenario":
