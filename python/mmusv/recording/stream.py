@@ -436,7 +436,7 @@ class FrameStream:
         if self.incomplete:
             parts.append(
                 "incomplete frames left out: "
-                + "; ".join(f"{k} ({why})" for k, why in self.incomplete[:4])
+                + "; ".join(f"frame {k} ({why})" for k, why in self.incomplete[:4])
                 + (f" and {len(self.incomplete) - 4} more" if len(self.incomplete) > 4 else "")
             )
         for first, stop, name in self._missing_parts:
