@@ -746,6 +746,13 @@ DEFAULTS: list[tuple[str, str, tuple[str, ...], str, Any]] = [
     ("docs/studies/detection.md", "--preset cpu -o out/learned      # train split", ("train",), "--split", "train"),
     ("docs/studies/detection.md", "(`--jobs`, default one per model", ("train",), "--jobs", "auto"),
     ("docs/sea.md", "(`mmusv study waves` uses it by default)", ("study", "waves"), "--motion", "paper"),
+    (
+        "docs/exports.md",
+        "(by default `depth,semantic,radar,top_view`:",
+        ("convert",),
+        "--extras",
+        "depth,semantic,radar,top_view",
+    ),
 ]
 
 
