@@ -3,6 +3,8 @@ is a command or call the docs give, on a tiny input, with what its output should
 
 from __future__ import annotations
 
+import contextlib
+import io
 from pathlib import Path
 
 import mmusv
@@ -53,3 +55,29 @@ def test_the_report_names_an_incomplete_frame_as_a_frame_not_a_count(recording: 
     report = stream.report()
     assert report is not None
     assert "incomplete frames left out: frame 0 (" in report, report
+
+
+def _cli(*args: str) -> tuple[int, str]:
+    """``mmusv ARGS`` in this process: ``(exit status, stderr)``."""
+    from mmusv.cli import main
+
+    err = io.StringIO()
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(err):
+        code = main(list(args))
+    return code, err.getvalue()
+
+
+@pytest.mark.parametrize("command", ["preview", "convert"])
+def test_a_run_folder_given_for_a_recording_names_the_recording_in_it(
+    recording: Path, tmp_path: Path, command: str
+) -> None:
+    """The README's next step after ``mmusv run SCENARIO -o out/run`` is ``mmusv preview`` or ``mmusv convert``
+    of the recording; given the run folder instead (as ``mmusv info`` and ``mmusv recover`` take it), they said
+    only ``is not a file (it is a directory)`` (``... a folder without a dataset.json``). They name the recording
+    the folder holds: ``it holds out/run/NAME.mcap: give that``."""
+    folder = recording.parent
+    extra = ["--to", "kitti", "-o", str(tmp_path / "out"), "--no-progress"] if command == "convert" else []
+    code, err = _cli(command, str(folder), *extra)
+    assert code == 2, err
+    assert f"it holds {recording}: give that" in err, err
+    assert not (tmp_path / "out").exists()

@@ -52,9 +52,11 @@ def as_list(recordings: str | Path | Iterable[str | Path]) -> list[Path]:
         if p.is_dir():
             index = find_index(p)
             if index is None:
+                from mmusv.recording.folders import folder_hint
+
                 raise IoError(
                     f"{p} is not a file but a folder without a dataset.json; give recordings (.mcap, .parts.json) "
-                    "or a batch output folder"
+                    f"or a batch output folder{folder_hint(p)}"
                 )
             found = dataset_recordings(index)
             if not found:

@@ -17,7 +17,7 @@ from mmusv import arguments
 from mmusv.errors import IoError
 from mmusv.recording.parts import read_parts_manifest
 
-__all__ = ["MissingRecording", "find_recordings", "missing_recordings", "unreadable_listings"]
+__all__ = ["MissingRecording", "find_recordings", "folder_hint", "missing_recordings", "unreadable_listings"]
 
 
 def find_recordings(folder: str | os.PathLike[str], *, unfinished: bool = False) -> list[Path]:
@@ -61,6 +61,28 @@ def find_recordings(folder: str | os.PathLike[str], *, unfinished: bool = False)
         [f for f in files if f.name.endswith(".mcap.partial") and not f.with_suffix("").exists()] if unfinished else []
     )
     return sorted([*manifests, *mcaps, *(f for f in partial if f.resolve() not in parts), *(c for c, _ in closed)])
+
+
+def folder_hint(folder: Path) -> str:
+    """For an error about a folder given where a recording file was wanted (``mmusv preview out/run``): the
+    recordings right in it (a run folder's ``NAME.mcap``, a split run's ``NAME.parts.json``, a killed run's
+    ``NAME.mcap.partial``), as ``"; it holds out/run/NAME.mcap: give that"`` (``"; it holds 2 recordings (a.mcap,
+    b.mcap): give one of them"``); ``""`` when it holds none or cannot be read. Only the folder itself is looked
+    at, not the folders below it."""
+    try:
+        names = sorted(e.name for e in os.scandir(folder) if e.is_file())
+    except OSError:
+        return ""
+    manifests = [n for n in names if n.endswith(".parts.json")]
+    mcaps = [n for n in names if n.endswith(".mcap")]
+    partial = [n for n in names if n.endswith(".mcap.partial") and n.removesuffix(".partial") not in names]
+    found = [*manifests, *mcaps, *partial]  # a split run's parts are in folders below it, not listed
+    if not found:
+        return ""
+    if len(found) == 1:
+        return f"; it holds {folder / found[0]}: give that"
+    shown = ", ".join(found[:3]) + (", ..." if len(found) > 3 else "")
+    return f"; it holds {len(found)} recordings ({shown}): give one of them"
 
 
 @dataclass(frozen=True)

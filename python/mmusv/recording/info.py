@@ -146,7 +146,11 @@ def check_mcap(path: str | Path) -> Path:
         if not p.exists():
             raise IoError(f"recording {p} does not exist")
         if not p.is_file():
-            raise IoError(f"recording {p} is not a file" + (" (it is a directory)" if p.is_dir() else ""))
+            if p.is_dir():
+                from mmusv.recording.folders import folder_hint
+
+                raise IoError(f"recording {p} is not a file (it is a directory){folder_hint(p)}")
+            raise IoError(f"recording {p} is not a file")
         with p.open("rb") as f:
             head = f.read(len(MAGIC))
     except OSError as exc:
