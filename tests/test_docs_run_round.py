@@ -81,3 +81,26 @@ def test_a_run_folder_given_for_a_recording_names_the_recording_in_it(
     assert code == 2, err
     assert f"it holds {recording}: give that" in err, err
     assert not (tmp_path / "out").exists()
+
+
+def test_info_of_a_split_recording_missing_a_part_does_not_call_it_a_partial(tmp_path: Path) -> None:
+    """``mmusv run DIR --split-frames N`` (README, *Batch runs*) and ``mmusv info NAME.parts.json`` with a part
+    not recorded (a failed or pending task) began ``incomplete recording (.partial, no summary or damaged)``,
+    where no file is a ``.partial`` or damaged; it says what a split recording lacks."""
+    import yaml
+
+    folder = tmp_path / "scenarios"
+    folder.mkdir()
+    (folder / "split.yaml").write_text(yaml.safe_dump(lidar_scenario("split", frames=2)), encoding="utf-8")
+    report = mmusv.run_many(folder, out_dir=tmp_path / "out", split_frames=1)
+    assert report.ok
+    manifest = tmp_path / "out" / "split" / "split.parts.json"
+    (tmp_path / "out" / "split" / "parts" / "000001-000001" / "split.mcap").unlink()
+    from mmusv.cli import main
+
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):
+        main(["info", str(manifest)])
+    text = out.getvalue()
+    assert ".partial, no summary or damaged" not in text, text
+    assert "incomplete split recording (a part not recorded, unfinished or damaged)" in text, text

@@ -57,11 +57,14 @@ def cmd_info(args: argparse.Namespace) -> int:
     run_meta = meta.get("run", {})
     frames = info.get("frames") or {}
     if not info.get("complete", True):
-        console.print(
-            "[yellow]incomplete recording (.partial, no summary or damaged): counts come from reading every "
-            "chunk[/yellow]",
-            markup=True,
-        )
+        from mmusv.recording.parts import is_parts_manifest
+
+        if is_parts_manifest(target):  # no part is a .partial or damaged when one was not recorded yet
+            what = "incomplete split recording (a part not recorded, unfinished or damaged): counts come from reading "
+            what += "every part's chunks"
+        else:
+            what = "incomplete recording (.partial, no summary or damaged): counts come from reading every chunk"
+        console.print(f"[yellow]{what}[/yellow]", markup=True)
     if info.get("frames") is None:  # an MCAP file, but not a recording of mmusv run: its messages only
         why = (
             "its mmusv metadata cannot be read"
