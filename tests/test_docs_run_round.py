@@ -104,3 +104,18 @@ def test_info_of_a_split_recording_missing_a_part_does_not_call_it_a_partial(tmp
     text = out.getvalue()
     assert ".partial, no summary or damaged" not in text, text
     assert "incomplete split recording (a part not recorded, unfinished or damaged)" in text, text
+
+
+def test_two_copies_of_a_run_given_as_files_are_not_told_to_give_files(recording: Path, tmp_path: Path) -> None:
+    """``mmusv convert A.mcap COPY.mcap`` (docs/exports.md: ``REC [REC ...]``) of two runs of one configuration is
+    refused, and was told to "pass the recordings to convert instead of their folder", though no folder was given;
+    that hint is for a batch folder that lists both, and files given one by one are told to leave one out."""
+    import shutil
+
+    copy = tmp_path / "copy" / recording.name
+    copy.parent.mkdir()
+    shutil.copyfile(recording, copy)
+    code, err = _cli("convert", str(recording), str(copy), "--to", "kitti", "-o", str(tmp_path / "out"))
+    assert code == 2, err
+    assert "runs of the same scenario configuration" in err, err
+    assert "instead of their folder" not in err and "give each only once: leave one of these out" in err, err

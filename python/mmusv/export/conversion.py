@@ -23,7 +23,7 @@ from __future__ import annotations
 import contextlib
 import shutil
 import time
-from collections.abc import Callable, Iterable, Iterator, Sequence
+from collections.abc import Callable, Collection, Iterable, Iterator, Sequence
 from pathlib import Path
 
 from mmusv import arguments
@@ -180,17 +180,24 @@ def _ranges(frames: list[int]) -> list[tuple[int, int]]:
     return out
 
 
-def _folders(infos: list[RecordingInfo]) -> list[str]:
-    """Scenario folder names: the scenario name, or ``<name>_<hash8>`` when names repeat."""
+def _folders(infos: list[RecordingInfo], from_folders: Collection[Path] = ()) -> list[str]:
+    """Scenario folder names: the scenario name, or ``<name>_<hash8>`` when names repeat. ``from_folders``: the
+    recordings that a batch folder given listed (the others were given one by one)."""
     names = [i.scenario_name for i in infos]
     keys = [f"{i.scenario_name}_{i.config_hash[:8]}" for i in infos]
     dup = {k for k in keys if keys.count(k) > 1}
     if dup:
-        a = [str(i.path) for i, k in zip(infos, keys, strict=True) if k in dup]
+        same = [i.path for i, k in zip(infos, keys, strict=True) if k in dup]
+        # the folder's hint only where a batch folder listed one of them: given as files, there is no folder
+        how = (
+            "pass the recordings to convert instead of their folder, leaving one of these out"
+            if any(p in from_folders for p in same)
+            else "leave one of these out"
+        )
         raise ConfigError(
-            f"recordings {', '.join(a)} are runs of the same scenario configuration (the same scenario and seed give "
-            "the same data: converted together, every frame would be in the dataset twice, or in two of its splits); "
-            "give each only once: pass the recordings to convert instead of their folder, leaving one of these out"
+            f"recordings {', '.join(map(str, same))} are runs of the same scenario configuration (the same scenario "
+            "and seed give the same data: converted together, every frame would be in the dataset twice, or in two "
+            f"of its splits); give each only once: {how}"
         )
     return [n if names.count(n) == 1 else k for n, k in zip(names, keys, strict=True)]
 
@@ -316,14 +323,15 @@ def convert(
         oxts_origin=origin,
     )
     cls = cls.for_options(options)
-    paths = as_list(recordings)
+    from_folders: set[Path] = set()
+    paths = as_list(recordings, from_folders=from_folders)
     infos = [read_info(p) for p in paths]  # validates every input before anything is written
     for i in infos:
         cls.check(i)
     if options.agents is not None:
         check_agents(cls, infos, options.agents)
     outside = outside_frames(infos, options.frames)
-    folders = _folders(infos)
+    folders = _folders(infos, from_folders)
     split_of: dict[str, str | None] = dict.fromkeys(folders)
     if ratios is not None:
         split_of = dict(assign_splits(folders, ratios=ratios, seed=seed))

@@ -34,9 +34,10 @@ __all__ = [
 ]
 
 
-def as_list(recordings: str | Path | Iterable[str | Path]) -> list[Path]:
+def as_list(recordings: str | Path | Iterable[str | Path], *, from_folders: set[Path] | None = None) -> list[Path]:
     """The recordings given: files (``.mcap``, parts manifests) as they are, a folder holding a ``dataset.json``
-    (a batch run's output) as its complete recordings."""
+    (a batch run's output) as its complete recordings (also added to ``from_folders``, when given: what a message
+    about them can tell apart from the files given one by one)."""
     from mmusv.batch.index import dataset_recordings, find_index
 
     if isinstance(recordings, (str, os.PathLike)):
@@ -62,6 +63,8 @@ def as_list(recordings: str | Path | Iterable[str | Path]) -> list[Path]:
             if not found:
                 raise ConfigError(f"{index} lists no complete recording")
             out.extend(found)
+            if from_folders is not None:
+                from_folders.update(found)
         else:
             out.append(p)
     if not out:
