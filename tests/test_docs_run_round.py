@@ -15,6 +15,8 @@ from mmusv.recording import read_info
 from mmusv.recording.stream import FrameStream
 from tiny_scenario import lidar_scenario
 
+ROOT = Path(__file__).resolve().parents[1]
+
 
 @pytest.fixture(scope="module")
 def recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
@@ -119,3 +121,34 @@ def test_two_copies_of_a_run_given_as_files_are_not_told_to_give_files(recording
     assert code == 2, err
     assert "runs of the same scenario configuration" in err, err
     assert "instead of their folder" not in err and "give each only once: leave one of these out" in err, err
+
+
+def test_dataset_after_an_edited_spec_says_which_recordings_it_removed(tmp_path: Path) -> None:
+    """README, *Batch runs*: ``mmusv dataset SPEC -o DIR`` re-run "after editing the spec ... removes the recordings
+    of those the spec no longer makes". It did, without a word: a user saw the same summary as a run that removed
+    nothing. It names them now (``DatasetReport.removed`` and a line of the command's output)."""
+    import yaml
+
+    spec = yaml.safe_load((ROOT / "scenarios/specs/island_demo.yaml").read_text(encoding="utf-8"))
+    spec["name"] = "docs_run_ds"
+    spec["acquisition"] = {"frequency_hz": 2, "frames": 2}
+    spec["rigs"] = {"usv_standard": {"preset": "lidar_only", "lidar": {"channels": 8, "points_per_second": 20480}}}
+    spec["combinations"] = [dict(c, quota=1) for c in spec["combinations"][:2]]
+    path = tmp_path / "ds.yaml"
+    path.write_text(yaml.safe_dump(spec, sort_keys=False), encoding="utf-8")
+    out = tmp_path / "ds"
+    code, _ = _cli("dataset", str(path), "-o", str(out))
+    assert code == 0
+    before = sorted(p.name for p in (out / "recordings").iterdir() if not p.name.startswith("."))
+    assert len(before) == 2, before
+    spec["combinations"] = spec["combinations"][:1]  # the spec edited: it no longer makes the second scenario
+    path.write_text(yaml.safe_dump(spec, sort_keys=False), encoding="utf-8")
+    from mmusv.cli import main
+
+    said = io.StringIO()
+    with contextlib.redirect_stdout(said), contextlib.redirect_stderr(io.StringIO()):
+        assert main(["dataset", str(path), "-o", str(out)]) == 0
+    after = sorted(p.name for p in (out / "recordings").iterdir() if not p.name.startswith("."))
+    (gone,) = sorted(set(before) - set(after))
+    text = " ".join(said.getvalue().split())
+    assert f"removed those of 1 scenario the spec no longer makes ({gone})" in text, text

@@ -336,6 +336,13 @@ def run_dataset(args: argparse.Namespace) -> int:
         f"scenarios: {'generated' if rep.generated else 'kept (same spec)'} in {rep.out_dir / 'scenarios'}"
         + (f"; quota not met: {', '.join(rep.shortfall)}" if rep.shortfall else "")
     )
+    if rep.removed:  # an edited spec: the recordings of the scenarios it no longer makes are gone, said so
+        console.print(
+            f"recordings: removed those of {counted(len(rep.removed), 'scenario')} the spec no longer makes "
+            f"({', '.join(rep.removed)}) from {rep.out_dir / 'recordings'}",
+            markup=False,
+            highlight=False,
+        )
     print_report(rep.batch, console)
     if rep.converted == 0:
         console.print("opv2v: nothing to convert (no complete recording)")

@@ -26,7 +26,7 @@ import json
 import os
 import shutil
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -59,6 +59,8 @@ class DatasetReport:
     batch: BatchReport
     converted: int | None
     opv2v: Path
+    removed: list[str] = field(default_factory=list)
+    """The scenarios whose recordings were removed, since the spec no longer makes them (an edited spec)."""
 
     @property
     def ok(self) -> bool:
@@ -178,9 +180,10 @@ def _opv2v_section(old: dict[str, Any]) -> dict[str, Any] | None:
     return section
 
 
-def _remove_stale(rec_dir: Path, own: set[str], stems: set[str]) -> None:
+def _remove_stale(rec_dir: Path, own: set[str], stems: set[str]) -> list[str]:
     """Removes the recording folders of this dataset's own scenarios that the spec no longer makes, and their
-    task files."""
+    task files; the names of the scenarios whose recording folder it removed."""
+    removed: list[str] = []
     for name in sorted(own - stems):
         remove_task_files(rec_dir / STATE_DIR, name, keep=set())
         folder = rec_dir / name
@@ -192,6 +195,8 @@ def _remove_stale(rec_dir: Path, own: set[str], stems: set[str]) -> None:
                     f"{folder}: cannot remove the recording of {name}, which the spec no longer makes: "
                     f"{exc.strerror or exc}"
                 ) from None
+            removed.append(name)
+    return removed
 
 
 def build_dataset(
@@ -255,13 +260,19 @@ def build_dataset(
             shortfall = [f"{c.name}: {c.accepted} of {c.quota}" for c in report.combos if not c.met]
         if progress is not None:
             progress("generate", quota, quota)
-        _remove_stale(rec_dir, own, {p.stem for p in scen_dir.glob("*.yaml")})
+        removed = _remove_stale(rec_dir, own, {p.stem for p in scen_dir.glob("*.yaml")})
         if not any(scen_dir.glob("*.yaml")):  # no candidate met the spec: nothing to record (the shortfall says so)
             nothing = {"folder": opv2v.name, "status": "nothing to convert", "frames": 0, "sources": {}}
             write_index(index_path, [], extra={"spec": spec_section, "opv2v": nothing})
             empty = BatchReport(out_dir=rec_dir, backend="serial", outcomes=[], index=index_path)
             return DatasetReport(
-                out_dir=out, generated=generated, shortfall=shortfall, batch=empty, converted=0, opv2v=opv2v
+                out_dir=out,
+                generated=generated,
+                shortfall=shortfall,
+                batch=empty,
+                converted=0,
+                opv2v=opv2v,
+                removed=removed,
             )
         batch = run_many(
             scen_dir,
@@ -319,7 +330,13 @@ def build_dataset(
             converted = 0  # not "up to date": no recording is complete
         write_index(index_path, entries, extra={"spec": spec_section, "opv2v": section})
         return DatasetReport(
-            out_dir=out, generated=generated, shortfall=shortfall, batch=batch, converted=converted, opv2v=opv2v
+            out_dir=out,
+            generated=generated,
+            shortfall=shortfall,
+            batch=batch,
+            converted=converted,
+            opv2v=opv2v,
+            removed=removed,
         )
     finally:
         if joined is not None:
