@@ -201,6 +201,33 @@ def night_hulls(path: Path) -> None:
     _save_rgb(_scenario("night_hulls", rig=rig, vessels=[tug, pilot], environment=env), path)
 
 
+def night_fog(path: Path) -> None:
+    """``night_hulls``' tug and pilot boat, and a ferry 300 m off, at midnight in clear air (20 km visibility), in
+    haze of 1 km and in fog of 300 m, side by side (640 × 360 each, 70°): the lamps' glow in the air
+    (``sensors/shade/lamp_halo.rs``) widening as the visibility falls."""
+    from PIL import Image
+
+    x, y = _at(0.0, 35.0)
+    tug = {"id": "tug", "asset": "tug_32m", "speed_mps": 2.0, "route": _route(x, y, 150.0)}
+    px, py = _at(-12.0, 30.0)
+    pilot = {"id": "pilot", "asset": "pilot_boat_16m", "speed_mps": 2.5, "route": _route(px, py, 120.0)}
+    fx, fy = _at(20.0, 300.0)
+    ferry = {"id": "ferry", "asset": "ropax_ferry_90m", "speed_mps": 6.0, "route": _route(fx, fy, 265.0)}
+    rig = _camera_rig(resolution=(640, 360), hfov_deg=70.0, xyz=(0.0, 0.0, 3.0), yaw_deg=-5.0, pitch_deg=-4.0)
+    panels = []
+    for weather in (
+        {"weather": "clear"},
+        {"weather": "fog", "visibility_m": 1000.0},
+        {"weather": "fog", "visibility_m": 300.0},
+    ):
+        env = {"time_of_day": "00:00", "wave": "W1", **weather}
+        sim = mmusv.Simulation(_scenario("night_fog", rig=rig, vessels=[tug, pilot, ferry], environment=env))
+        rgb = sim.capture(0, sensors=["cameras"]).agents[sim.agents[0].id].cameras["view"].rgb
+        assert rgb is not None
+        panels.append(np.asarray(rgb))
+    Image.fromarray(np.concatenate(panels, axis=1)).save(path)
+
+
 def dusk_series(path: Path) -> None:
     """``ferry_dusk``'s ferry and view at six times through the hour of dusk (19:45, 20:15, 20:30 above; 20:45,
     21:00, 21:15 below), 480 × 270 each, side by side."""
@@ -414,6 +441,7 @@ VIEWS: dict[str, Callable[[Path], None]] = {
     "dusk_series": dusk_series,
     "night_glitter": night_glitter,
     "night_hulls": night_hulls,
+    "night_fog": night_fog,
     "exposure_settings": exposure_settings,
     "whitecaps_w3": whitecaps_w3,
     "wake_chase": wake_chase,

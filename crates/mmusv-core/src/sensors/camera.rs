@@ -37,6 +37,7 @@ mod antialias;
 mod distortion;
 mod glossy;
 mod lamp_glow;
+mod lamp_halo;
 mod lamp_light;
 mod lamp_points;
 mod lamp_shadows;
@@ -478,6 +479,9 @@ impl Camera {
             self.antialias(scene, pose, (&shader, env.shadows, options.seed, k), centres, &mut linear)?;
         }
         if !shader.lamps().is_empty() {
+            // The lamps' glow in the air along each pixel's centre ray (`camera/lamp_halo.rs`).
+            let grid = (q != Quality::High).then_some(grid);
+            lamp_halo::add_lamp_halos(scene, &shader, (&origins, &dirs, &hits), grid, &self.order, &mut linear);
             // Lamps smaller than a pixel, from the lamps themselves (`camera/lamp_points.rs`).
             self.add_lamp_points(scene, pose, &shader, (&frame, &mut linear))?;
         }

@@ -45,6 +45,7 @@ pub mod envlight;
 pub mod foam;
 pub mod kelvin;
 pub mod lamp_glitter;
+pub mod lamp_halo;
 pub mod lamp_light;
 pub mod rough_water;
 pub mod sea_ms;

@@ -28,8 +28,8 @@
 //! that least step). The lenses of the lamps are not lit by lamps (their own radiance is thousands of times more).
 //! Only while the lamps' glitter is (the sun lower than `lamp_glitter::LAMP_GLITTER_SUN_DEG`): by day a lamp adds
 //! nothing a camera can see. The camera adds it to what its traced water reflections meet too, so a lamp-lit hull
-//! mirrors lit (not at `draft` quality, which traces no reflections). Left out: the glow of a lamp in the fog
-//! around it.
+//! mirrors lit (not at `draft` quality, which traces no reflections). The glow of a lamp in the air around it is
+//! `lamp_halo.rs`'s.
 
 use super::{Lobes, Shader, SurfaceHit};
 use crate::scene::Lamp;
