@@ -7,8 +7,9 @@
 //!
 //! **Model.** Single scattering of a point source in a homogeneous medium, the airlight integral of B. Sun,
 //! R. Ramamoorthi, S. G. Narasimhan and S. K. Nayar, "A practical analytic single scattering model for real time
-//! rendering", ACM SIGGRAPH 2005, eq. 1–3, here with a Henyey–Greenstein phase function (L. G. Henyey and
-//! J. L. Greenstein, "Diffuse radiation in the Galaxy", Astrophys. J. 93, 1941) in place of their isotropic one.
+//! rendering", ACM SIGGRAPH 2005 (its airlight of a point source), here with a Henyey–Greenstein phase function
+//! (L. G. Henyey and J. L. Greenstein, "Diffuse radiation in the Galaxy", Astrophys. J. 93, 1941) in place of their
+//! isotropic one.
 //! A ray from `o` along unit `d` passes the lamp at `c` at distance `h` when it is `t₀ = (c − o)·d` along; a point
 //! of the ray seen from the lamp at scattering angle `θ` (between the light's way on, lamp to point, and the way
 //! back to the camera, `−d`) is `s = t₀ − h cot θ` along it, `r = h / sin θ` from the lamp, and `ds / r² = dθ / h`,
@@ -23,16 +24,18 @@
 //! visibility) and `σ_s = σ`: fog droplets and sea-salt aerosol absorb next to nothing at visible wavelengths. The
 //! phase function is Henyey–Greenstein's with asymmetry [`HALO_G`] = 0.8, between maritime aerosol's (about 0.75
 //! at 550 nm) and fog droplets' (about 0.85). The lens radius `ρ` bounds `h` as it bounds the lamp's light
-//! (`h² + ρ²`). The integral is Gauss–Legendre's, in two pieces split where the forward peak of the phase function
-//! has fallen (8 nodes; within 1 % of a dense sum along the ray in the tests).
+//! (`h² + ρ²`). The integral is 4-point Gauss–Legendre's on pieces over which the integrand is smooth: split where
+//! the forward peak of the phase function has fallen, where the arc's sides cut the ray (the integrand jumps there),
+//! where the ray passes the lamp and where the air beyond has dimmed the light by `e`; within 0.6 % of a dense sum
+//! along the ray in the tests.
 //!
 //! A lamp counts for a ray where the most it could give, `σ e^{−σ D} I_max J(θ₀) / h` (`D` the lamp's distance
 //! from the ray's origin, which bounds `s + r`; `J(θ₀) = ∫_{θ₀}^π p(cos θ) dθ`, the phase function falling with
 //! `θ`), reaches [`LAMP_HALO_LEAST`] of the camera's tone-curve input, windowed as the lamps' light is (Karis
-//! 2013: `(1 − u⁴)²`, `u` the least over that most). Only while the lamps shine (the sun below `lamp_glitter::LAMP_GLITTER_SUN_DEG`). Left out: the
-//! shadows in the glow (the light between the lamp and a point of the ray is not tested for occluders: a lamp's
-//! own screens and hulls cast no shafts), the glow in the water's reflections, and light scattered more than once
-//! (in thick fog the halo would be wider).
+//! 2013: `(1 − u⁴)²`, `u` the least over that most). Only while the lamps shine (the sun below
+//! `lamp_glitter::LAMP_GLITTER_SUN_DEG`). Left out: the shadows in the glow (the light between the lamp and a point
+//! of the ray is not tested for occluders: a lamp's own screens and hulls cast no shafts), the glow in the water's
+//! reflections, and light scattered more than once (in thick fog the halo would be wider).
 
 use super::lamp_light::LAMP_LIGHT_LEAST;
 use super::Shader;
