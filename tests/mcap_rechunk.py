@@ -33,6 +33,33 @@ def rechunk(src: Path, dst: Path, chunk_size: int, *, run_changes: dict[str, str
         w.finish()  # type: ignore[no-untyped-call]
 
 
+def emptied(src: Path, topic: str, frame: int, out: Path) -> Path:
+    """``src`` written again to ``out`` with its ``topic`` message of acquisition ``frame`` (the frame-th distinct log
+    time) empty (0 bytes): a frame the reader leaves out as incomplete."""
+    from mcap.reader import make_reader
+    from mcap.writer import Writer
+
+    out.parent.mkdir(parents=True, exist_ok=True)
+    with src.open("rb") as f, out.open("wb") as g:
+        r, w = make_reader(f), Writer(g)
+        summary, head = r.get_summary(), r.get_header()
+        assert summary is not None
+        w.start(profile=head.profile, library=head.library)
+        schemas = {k: w.register_schema(s.name, s.encoding, s.data) for k, s in summary.schemas.items()}
+        chans = {
+            k: w.register_channel(c.topic, c.message_encoding, schemas.get(c.schema_id, 0), c.metadata)
+            for k, c in summary.channels.items()
+        }
+        times = sorted({m.log_time for _, _, m in r.iter_messages()})
+        for _, ch, m in r.iter_messages():
+            data = b"" if ch.topic == topic and m.log_time == times[frame] else m.data
+            w.add_message(chans[ch.id], m.log_time, data, m.publish_time, m.sequence)
+        for md in r.iter_metadata():
+            w.add_metadata(md.name, md.metadata)
+        w.finish()
+    return out
+
+
 def killed_copy(src: Path, dst: Path, *, messages: int | None = None) -> Path:
     """``dst``: what a run killed after the first ``messages`` messages of ``src`` (all: ``None``) leaves, as the
     recorder writes it (the header, the scenario, manifest and sensors metadata, complete chunks, no ``run``

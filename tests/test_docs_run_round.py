@@ -9,8 +9,7 @@ from pathlib import Path
 
 import mmusv
 import pytest
-from mcap.reader import make_reader
-from mcap.writer import Writer
+from mcap_rechunk import emptied
 from mmusv.recording import read_info
 from mmusv.recording.stream import FrameStream
 from tiny_scenario import lidar_scenario
@@ -24,34 +23,10 @@ def recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return mmusv.run(lidar_scenario("docs_run", frames=2), out_dir=out).recording
 
 
-def _emptied(src: Path, topic: str, frame: int, out: Path) -> Path:
-    """``src`` written again with its ``topic`` message of acquisition ``frame`` empty (0 bytes): a frame the
-    reader leaves out as incomplete."""
-    out.parent.mkdir(parents=True, exist_ok=True)
-    with src.open("rb") as f, out.open("wb") as g:
-        r, w = make_reader(f), Writer(g)
-        summary, head = r.get_summary(), r.get_header()
-        assert summary is not None
-        w.start(profile=head.profile, library=head.library)
-        schemas = {k: w.register_schema(s.name, s.encoding, s.data) for k, s in summary.schemas.items()}
-        chans = {
-            k: w.register_channel(c.topic, c.message_encoding, schemas.get(c.schema_id, 0), c.metadata)
-            for k, c in summary.channels.items()
-        }
-        times = sorted({m.log_time for _, _, m in r.iter_messages()})
-        for _, ch, m in r.iter_messages():
-            data = b"" if ch.topic == topic and m.log_time == times[frame] else m.data
-            w.add_message(chans[ch.id], m.log_time, data, m.publish_time, m.sequence)
-        for md in r.iter_metadata():
-            w.add_metadata(md.name, md.metadata)
-        w.finish()
-    return out
-
-
 def test_the_report_names_an_incomplete_frame_as_a_frame_not_a_count(recording: Path, tmp_path: Path) -> None:
     """``mmusv info`` of a recording whose frame 0 is incomplete said ``incomplete frames left out: 0 (...)``,
     which reads as "none were left out"; it names the frame: ``incomplete frames left out: frame 0 (...)``."""
-    path = _emptied(recording, "/world/state", 0, tmp_path / "hollow" / recording.name)
+    path = emptied(recording, "/world/state", 0, tmp_path / "hollow" / recording.name)
     stream = FrameStream(read_info(path), lambda t: True)
     assert [f.index for f in stream] == [1]
     report = stream.report()

@@ -12,8 +12,7 @@ from pathlib import Path
 
 import mmusv
 import pytest
-from mcap.reader import make_reader
-from mcap.writer import Writer
+from mcap_rechunk import emptied
 from mmusv.recording import read_info
 from mmusv.recording.stream import FrameStream
 from tiny_scenario import lidar_scenario
@@ -25,32 +24,9 @@ def recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return mmusv.run(lidar_scenario("hollow", frames=2), out_dir=out).recording
 
 
-def _emptied(src: Path, topic: str, frame: int, out: Path) -> Path:
-    """``src`` written again with its ``topic`` message of acquisition ``frame`` empty (0 bytes)."""
-    out.parent.mkdir(parents=True, exist_ok=True)
-    with src.open("rb") as f, out.open("wb") as g:
-        r, w = make_reader(f), Writer(g)
-        summary, head = r.get_summary(), r.get_header()
-        assert summary is not None
-        w.start(profile=head.profile, library=head.library)
-        schemas = {k: w.register_schema(s.name, s.encoding, s.data) for k, s in summary.schemas.items()}
-        chans = {
-            k: w.register_channel(c.topic, c.message_encoding, schemas.get(c.schema_id, 0), c.metadata)
-            for k, c in summary.channels.items()
-        }
-        times = sorted({m.log_time for _, _, m in r.iter_messages()})
-        for _, ch, m in r.iter_messages():
-            data = b"" if ch.topic == topic and m.log_time == times[frame] else m.data
-            w.add_message(chans[ch.id], m.log_time, data, m.publish_time, m.sequence)
-        for md in r.iter_metadata():
-            w.add_metadata(md.name, md.metadata)
-        w.finish()
-    return out
-
-
 @pytest.mark.parametrize(("topic", "said"), [("/world/state", "holds 0 vessels"), ("/u/lidar", "without x, y, z")])
 def test_an_empty_message_makes_its_frame_incomplete(recording: Path, tmp_path: Path, topic: str, said: str) -> None:
-    path = _emptied(recording, topic, 1, tmp_path / "hollow" / recording.name)
+    path = emptied(recording, topic, 1, tmp_path / "hollow" / recording.name)
     stream = FrameStream(read_info(path), lambda t: True)
     assert [f.index for f in stream] == [0]
     assert len(stream.incomplete) == 1 and said in stream.incomplete[0][1], stream.incomplete
@@ -59,7 +35,7 @@ def test_an_empty_message_makes_its_frame_incomplete(recording: Path, tmp_path: 
 @pytest.mark.parametrize("topic", ["/world/state", "/u/lidar"])
 @pytest.mark.parametrize("to", ["kitti", "opv2v"])
 def test_convert_skips_the_frame_instead_of_a_traceback(recording: Path, tmp_path: Path, topic: str, to: str) -> None:
-    path = _emptied(recording, topic, 0, tmp_path / "hollow" / recording.name)
+    path = emptied(recording, topic, 0, tmp_path / "hollow" / recording.name)
     done = subprocess.run(
         [sys.executable, "-m", "mmusv", "convert", str(path), "-o", str(tmp_path / "out"), "--to", to, "--no-progress"],
         capture_output=True,

@@ -115,10 +115,10 @@ class Env:
     wind_speed_m_s: float = 0.0
     water_albedo: tuple[float, float, float] = (0.004, 0.018, 0.03)
 
-    def sensor_env(self) -> Any:
-        """The mmusv ``SensorEnv``: no cloud, fog, rain or waves, shadows on; the water's single scattering
-        alone (Mitsuba's ``roughconductor`` reflects once; the multiple scattering is checked against its own
-        reference, ``sensors/shade/sea_ms.rs``)."""
+    def sensor_env(self, *, fog_extinction_per_m: float = 0.0) -> Any:
+        """The mmusv ``SensorEnv``: no cloud, rain or waves, no fog unless ``fog_extinction_per_m`` (1/m), shadows
+        on; the water's single scattering alone (Mitsuba's ``roughconductor`` reflects once; the multiple scattering
+        is checked against its own reference, ``sensors/shade/sea_ms.rs``)."""
         s = np.asarray(self.sun, dtype=np.float64)
         s = s / np.linalg.norm(s)
         return _core.SensorEnv(
@@ -126,7 +126,7 @@ class Env:
             turbidity=self.turbidity,
             cloud_cover=0.0,
             ground_albedo=self.ground_albedo,
-            fog_extinction_per_m=0.0,
+            fog_extinction_per_m=fog_extinction_per_m,
             rain_mm_per_h=0.0,
             wave_height_m=0.0,
             wind_speed_m_s=self.wind_speed_m_s,

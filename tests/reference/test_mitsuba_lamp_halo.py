@@ -40,19 +40,7 @@ SUN = ms.unit((0.3, 0.5, -0.4))
 
 def _env(sigma: float) -> _core.SensorEnv:
     """mmusv's night (the sun 24° below the horizon) in air of extinction ``sigma`` (1/m)."""
-    return _core.SensorEnv(
-        sun_direction=list(SUN),
-        turbidity=3.0,
-        cloud_cover=0.0,
-        ground_albedo=0.0,
-        fog_extinction_per_m=sigma,
-        rain_mm_per_h=0.0,
-        wave_height_m=0.0,
-        wind_speed_m_s=0.0,
-        water_albedo=[0.004, 0.018, 0.03],
-        shadows=True,
-        water_multiple_scattering=False,
-    )
+    return ms.Env(sun=SUN).sensor_env(fog_extinction_per_m=sigma)
 
 
 def _mmusv(on: bool, *, quality: str = "standard", sigma: float = SIGMA) -> npt.NDArray[np.float64]:

@@ -56,19 +56,7 @@ TOL = 0.01
 
 def _env(sun: tuple[float, float, float], fog: float = 0.0) -> Any:
     """A ``SensorEnv``: clear, calm, shadows on, the sun towards ``sun``, fog extinction ``fog`` (1/m)."""
-    return _core.SensorEnv(
-        sun_direction=list(sun),
-        turbidity=3.0,
-        cloud_cover=0.0,
-        ground_albedo=0.0,
-        fog_extinction_per_m=fog,
-        rain_mm_per_h=0.0,
-        wave_height_m=0.0,
-        wind_speed_m_s=0.0,
-        water_albedo=[0.004, 0.018, 0.03],
-        shadows=True,
-        water_multiple_scattering=False,
-    )
+    return ms.Env(sun=sun).sensor_env(fog_extinction_per_m=fog)
 
 
 def _camera(ortho: bool = False) -> Any:
