@@ -250,7 +250,7 @@ def test_infer_without_a_model_is_refused_and_writes_the_name_given(
     # -o peaks wrote peaks.npz, and returned the name of a file that was not there
     out = infer_cache(cache, models=root / "models", out=tmp_path / "peaks")
     assert out == tmp_path / "peaks" and out.is_file() and not (tmp_path / "peaks.npz").exists()
-    assert sorted(np.load(out).files) == ["single_boxes", "single_offsets", "single_scores"]
+    assert sorted(np.load(out).files) == ["single_boxes", "single_model", "single_offsets", "single_scores"]
     # a merge of parts none of which is there: an empty peaks file
     with pytest.raises(InputError, match=r"missing\.npz: none of the peak files is there"):
         merge_peaks([tmp_path / "missing.npz"], tmp_path / "merged.npz")
