@@ -34,6 +34,7 @@ __all__ = [
     "COLREG_RANGE_INTENSITY_CD",
     "LAMP_KINDS",
     "LANTERN_LENS_AREA_M2",
+    "LANTERN_SIZE_M",
     "MATERIALS",
     "NAV_LAMP_RADIANCE",
     "Material",
@@ -48,7 +49,10 @@ __all__ = [
     "register_material",
 ]
 
-LANTERN_LENS_AREA_M2 = 2.0 * (0.36 * 0.3) * (0.57 * 0.3)
+LANTERN_SIZE_M = 0.3
+"""Height of a lantern of the default size (``NavLightsPart.size``), m."""
+
+LANTERN_LENS_AREA_M2 = 2.0 * (0.36 * LANTERN_SIZE_M) * (0.57 * LANTERN_SIZE_M)
 """Projected area of the lens of a lantern of the default size (``NavLightsPart.size`` 0.3 m: a lens band of radius
 0.36 and height 0.57 of the size, ``parts_super._lantern``) seen from the side, m²."""
 
@@ -88,7 +92,7 @@ def colreg_range_nm(light: str, length_m: float) -> int:
 def lantern_lens_area(size: float) -> float:
     """Projected side area (m²) of the lens of a lantern ``size`` metres tall (:data:`LANTERN_LENS_AREA_M2` at the
     default 0.3 m; the lantern scales as a whole)."""
-    return LANTERN_LENS_AREA_M2 * (size / 0.3) ** 2
+    return LANTERN_LENS_AREA_M2 * (size / LANTERN_SIZE_M) ** 2
 
 
 def _lamp_radiance(
@@ -329,7 +333,7 @@ def lamp_material(lamp: str, *, length_m: float, lantern_size: float) -> int:
         raise ValueError(f"unknown navigation lamp {lamp!r}: one of {', '.join(LAMP_KINDS)}")
     base = MATERIALS[_ids[lamp]]
     cd = COLREG_RANGE_INTENSITY_CD[colreg_range_nm(LAMP_KINDS[lamp], length_m)]
-    if lantern_size == 0.3 and cd == COLREG_INTENSITY_CD[LAMP_KINDS[lamp]]:
+    if lantern_size == LANTERN_SIZE_M and cd == COLREG_INTENSITY_CD[LAMP_KINDS[lamp]]:
         return _ids[lamp]
     e = base.emissive
     peak = max(e)

@@ -10,6 +10,7 @@ from typing import Annotated, Literal
 from pydantic import Field, model_validator
 
 from mmusv.validation import Fraction, Vec3, Whole, invalid_field, sequence
+from mmusv.world.materials import LANTERN_SIZE_M
 from mmusv.world.part_fields import (
     MAX_EXTENT,
     MAX_ITEMS,
@@ -186,7 +187,7 @@ class NavLightsPart(Part):
     masthead: Annotated[tuple[Point3, ...], sequence(0, MAX_ITEMS, f"a list of 0 to {MAX_ITEMS} points")] | None = None
     sides: Point3 | None = None
     stern: Point3 | None = None
-    size: Size = 0.3
+    size: Size = LANTERN_SIZE_M
 
 
 class RadarPart(Placed):

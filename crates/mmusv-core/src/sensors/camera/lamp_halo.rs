@@ -201,7 +201,6 @@ pub(super) fn add_lamp_halos(
                     let own = (y0..=y1).flat_map(|y| (x0..=x1).map(move |x| (x, y))).collect();
                     return (Vec::new(), own, Vec::new());
                 }
-                let (xm, ym) = ((x0 + x1).div_ceil(2), (y0 + y1).div_ceil(2));
                 let mut split = Vec::new();
                 for (a0, a1) in [(x0, xm), (xm, x1)] {
                     for (b0, b1) in [(y0, ym), (ym, y1)] {
