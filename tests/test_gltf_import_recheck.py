@@ -24,6 +24,7 @@ import polars as pl
 import pytest
 import yaml
 from mmusv.cli import main
+from mmusv.scenario_checks import MmusvWarning
 from mmusv.world.asset_spec import AssetSpecError
 from mmusv.world.materials import Material, all_materials
 from mmusv.world.mesh_files import GLTF_EMISSIVE_SCALE
@@ -443,6 +444,11 @@ MALFORMED: dict[str, tuple[Any, str]] = {
     "negative baseColorFactor": (_factor({"baseColorFactor": [-0.1, 0.5, 0.5, 1.0]}), "baseColorFactor"),
     "roughness above 1": (_factor({"roughnessFactor": 1.5}), "roughnessFactor"),
     "negative roughness": (_factor({"roughnessFactor": -0.5}), "roughnessFactor"),
+    # glTF draws what its scene's nodes place (spec 3.5.1); points and lines have no surface (3.7.2.1)
+    "meshes but no scene": (_patched(lambda d: (d.j.pop("scene"), d.j.__setitem__("scenes", []))), "has no scene"),
+    "a scene placing no mesh": (_patched(lambda d: d.j["nodes"][0].pop("mesh")), "place none of its 1 meshes"),
+    "points only": (_patched(lambda d: d.j["meshes"][0]["primitives"][0].__setitem__("mode", 0)), "POINTS"),
+    "lines only": (_patched(lambda d: d.j["meshes"][0]["primitives"][0].__setitem__("mode", 3)), "LINE_STRIP"),
 }  # fmt: skip
 
 
@@ -454,6 +460,20 @@ def test_a_malformed_file_is_one_error_naming_the_file_and_the_fault(tmp_path: P
         _load(path)
     msg = str(info.value)
     assert str(path) in msg and words in msg and "\n" not in msg, msg
+
+
+def test_lines_beside_triangles_are_left_out_with_a_warning_naming_them(tmp_path: Path) -> None:
+    # A hull's box and an outline of it as LINES (a mode glTF 2.0 defines, 3.7.2.1): the box's 12 triangles are
+    # read, the lines (no surface) left out, which was without a word.
+    d = _hull_doc()
+    outline = dict(d.j["meshes"][0]["primitives"][0], mode=1)
+    d.j["meshes"][0]["primitives"].append(outline)
+    path = d.glb(tmp_path / "outlined.glb")
+    with pytest.warns(
+        MmusvWarning, match=r"1 primitive\(s\) of points or lines left out \(meshes\[0\]\.primitives\[1\] LINES\)"
+    ):
+        asset = load_asset_file({"name": "outlined", "mesh": str(path)})
+    assert asset.num_triangles == 12
 
 
 # ------------------------------------------------------------------------------------------ the whole path

@@ -14,6 +14,7 @@ from __future__ import annotations
 import json
 import math
 import struct
+import warnings
 from collections.abc import Iterator
 from pathlib import Path
 from typing import TypeGuard
@@ -43,6 +44,7 @@ def check_gltf(path: Path, where: str) -> tuple[dict[EmissiveKey, float], list[s
     _accessor_checks(shown, data, where)
     _node_checks(shown, data, where)
     _buffer_checks(path, data, where)
+    _surface_checks(shown, data, where)
     return strengths, names, _primitive_materials(data)
 
 
@@ -532,6 +534,75 @@ def _node_checks(shown: str, data: dict[str, object], where: str) -> None:
                     where, f"{shown}: nodes[{i}] is its own ancestor (a cycle of children); glTF 2.0 nodes form trees"
                 )
             seen.add(k)
+
+
+def _drawn_meshes(data: dict[str, object]) -> tuple[int, set[int]] | None:
+    """The scene trimesh draws (``scene``, else the first of ``scenes``, as glTF 2.0 leaves the choice to the reader)
+    and the meshes its nodes place, through their children; ``None`` where the file has no scene."""
+    scenes = data.get("scenes")
+    if not isinstance(scenes, list) or not scenes:
+        return None
+    k = data.get("scene", 0)
+    scene = scenes[k] if isinstance(k, int) and not isinstance(k, bool) and 0 <= k < len(scenes) else None
+    nodes = data.get("nodes")
+    items = nodes if isinstance(nodes, list) else []
+    roots = scene.get("nodes") if isinstance(scene, dict) else None
+    todo, seen, placed = list(roots if isinstance(roots, list) else []), set(), set()
+    while todo:
+        n = todo.pop()
+        if isinstance(n, bool) or not isinstance(n, int) or n in seen or not 0 <= n < len(items):
+            continue
+        seen.add(n)
+        node = items[n]
+        if not isinstance(node, dict):
+            continue
+        mesh = node.get("mesh")
+        if isinstance(mesh, int) and not isinstance(mesh, bool):
+            placed.add(mesh)
+        kids = node.get("children")
+        todo.extend(kids if isinstance(kids, list) else [])
+    return (k if isinstance(k, int) else 0), placed
+
+
+def _surface_checks(shown: str, data: dict[str, object], where: str) -> None:
+    """Says why a file with primitives gives no triangle, where trimesh's reading said only that it "holds no
+    triangles": no scene places its meshes (a glTF draws only what its scene's nodes place), or what its scene places
+    is points and lines (no surface); and warns (:class:`~mmusv.scenario_checks.MmusvWarning`) of points and lines
+    left out beside triangles, which were dropped without a word."""
+    prims = list(_primitives(data))
+    if not prims:
+        return  # no primitive at all: "holds no triangles" says it
+    drawn = _drawn_meshes(data)
+    if drawn is None or not drawn[1]:
+        what = (
+            "has no scene (no scenes list)"
+            if drawn is None
+            else f"draws scenes[{drawn[0]}], whose nodes place none of its {len(data.get('meshes') or [])} meshes"  # type: ignore[arg-type]
+        )
+        raise AssetSpecError(
+            where,
+            f"{shown} {what}: a glTF draws only the meshes its scene's nodes place, so it holds no triangles to "
+            "read; export it with its meshes placed in a scene (a node naming each mesh, in scenes[].nodes)",
+        )
+    modes = [(i, j, p.get("mode", 4)) for i, j, p in prims if i in drawn[1]]
+    loose = [(i, j, m) for i, j, m in modes if m in (0, 1, 2, 3)]
+    listed = ", ".join(f"meshes[{i}].primitives[{j}] {_MODES[m]}" for i, j, m in loose[:3])
+    listed += ", ..." if len(loose) > 3 else ""
+    if len(loose) == len(modes):
+        raise AssetSpecError(
+            where,
+            f"{shown} holds no triangles: the primitives its scene places are points or lines ({listed}), which have "
+            "no surface for the sensors to see; a vessel needs triangles (mode 4 TRIANGLES or 5 TRIANGLE_STRIP)",
+        )
+    if loose:
+        from mmusv.scenario_checks import MmusvWarning  # here: scenario_checks imports the config, which imports us
+
+        warnings.warn(
+            f"{where}: {shown}: {len(loose)} primitive(s) of points or lines left out ({listed}): only triangles are "
+            "surfaces the sensors see",
+            MmusvWarning,
+            stacklevel=4,
+        )
 
 
 def _buffer_checks(path: Path, data: dict[str, object], where: str) -> None:
