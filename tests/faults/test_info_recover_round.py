@@ -229,6 +229,25 @@ def _killed_run(small: Path, folder: Path) -> Path:
     return folder
 
 
+def test_recover_of_a_batch_folder_names_the_runs_below_it_to_recover(batch: Path, small: Path, tmp_path: Path) -> None:
+    # A batch killed with two runs unfinished: recover of its folder said only "nothing to recover in OUT: it holds
+    # no .mcap.partial ... nor a finished .mcap", though the runs below it held them; it now names them and the
+    # command for one, and recovers nothing (recover takes one run at a time).
+    copy = tmp_path / "out"
+    shutil.copytree(batch, copy)
+    for name in "ab":
+        shutil.rmtree(copy / name)
+        _killed_run(small, copy / name)
+    before = _files(copy)
+    code, out, err = cli_main("recover", str(copy))
+    assert code == 2 and f"nothing to recover in {copy}" in err, (out, err)
+    assert f"2 below it hold a killed run's .partial: {copy / 'a'}, {copy / 'b'}; recover each: mmusv recover " in err
+    assert _files(copy) == before
+    # every run finished: it names them as the folders whose tables recover rebuilds
+    code, out, err = cli_main("recover", str(batch))
+    assert code == 2 and f"3 below it hold a finished recording: {batch / 'a'}, {batch / 'b'}, {batch / 'c'}" in err
+
+
 def _messages(path: Path) -> list[object]:
     from mcap.reader import make_reader
 

@@ -213,7 +213,7 @@ def _recover_target(target: str | os.PathLike[str]) -> Path:
         if done:
             return check_mcap(done[0])
         split = sorted(f.name for f in p.glob("*.parts.json"))
-        hint = f" ({split[0]} is a split run: give the folder of one of its parts)" if split else ""
+        hint = f" ({split[0]} is a split run: give the folder of one of its parts)" if split else _runs_below(p)
         raise IoError(
             f"nothing to recover in {p}: it holds no .mcap.partial recording of a killed run, nor a finished .mcap"
             + hint
@@ -226,6 +226,28 @@ def _recover_target(target: str | os.PathLike[str]) -> Path:
             "whose tables are missing or damaged"
         )
     return find_partial(p)
+
+
+def _runs_below(folder: Path) -> str:
+    """For a folder of runs (a batch's ``OUT``, a dataset's ``recordings/``) given to recover: the run folders below
+    it holding a killed run's ``.partial`` (``mmusv recover`` takes one at a time), else the finished ones, as
+    ``" (it is a folder of runs: 2 below it hold a killed run's .partial: OUT/a, OUT/b; recover each: mmusv recover
+    OUT/a)"``; ``""`` when none is below it or it cannot be read."""
+    from mmusv.recording.folders import find_recordings
+
+    try:
+        found = find_recordings(folder, unfinished=True)
+    except IoError:
+        return ""
+    killed = sorted({f.parent for f in found if f.name.endswith(".mcap.partial")})
+    done = sorted({f.parent for f in found if f.suffix == ".mcap"})
+    runs, what = (killed, "a killed run's .partial") if killed else (done, "a finished recording")
+    if not runs:
+        return ""
+    shown = ", ".join(str(r) for r in runs[:3]) + (", ..." if len(runs) > 3 else "")
+    many = f"{len(runs)} below it hold" if len(runs) > 1 else "one below it holds"
+    todo = "recover each" if killed else "to rebuild a run's tables, give its folder"
+    return f" (it is a folder of runs: {many} {what}: {shown}; {todo}: mmusv recover {runs[0]})"
 
 
 def rebuild_finished_tables(recording: str | os.PathLike[str]) -> Recovered:
