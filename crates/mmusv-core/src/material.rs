@@ -77,13 +77,39 @@ impl Material {
     /// does.
     #[inline]
     pub fn emits_towards(&self, dir: Vec3) -> bool {
+        self.arc().is_none_or(|arc| arc.contains(dir))
+    }
+
+    /// [`Material::arc_deg`] made ready for many tests ([`LightArc::contains`]); `None` all round (a half-width of 180°).
+    #[inline]
+    pub fn arc(&self) -> Option<LightArc> {
         let [centre, half] = self.arc_deg;
+        (half < 180.0).then(|| {
+            let (sin_centre, cos_centre) = centre.to_radians().sin_cos();
+            LightArc { cos_centre, sin_centre, cos_half: half.to_radians().cos() }
+        })
+    }
+}
+
+/// A light's horizontal arc (not all round), as the cosine and sine of its centre bearing and the cosine of its
+/// half-width (body frame; [`Material::arc_deg`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LightArc {
+    /// Cosine of the centre bearing.
+    pub cos_centre: f32,
+    /// Sine of the centre bearing.
+    pub sin_centre: f32,
+    /// Cosine of the half-width.
+    pub cos_half: f32,
+}
+
+impl LightArc {
+    /// Whether `dir` (body frame, any length) lies inside the arc: its level bearing is within the half-width of
+    /// the centre's; straight up or down (no bearing) it does.
+    #[inline]
+    pub fn contains(&self, dir: Vec3) -> bool {
         let h = (dir.x * dir.x + dir.y * dir.y).sqrt();
-        if half >= 180.0 || h <= 1e-6 * dir.length() {
-            return true;
-        }
-        let (s, c) = centre.to_radians().sin_cos();
-        (dir.x * c + dir.y * s) / h >= half.to_radians().cos()
+        h <= 1e-6 * dir.length() || dir.x * self.cos_centre + dir.y * self.sin_centre >= self.cos_half * h
     }
 }
 

@@ -1,43 +1,110 @@
 //! The scene's lit navigation lamps as small light sources, for the camera's next-event estimation of their
-//! glitter on the water (`sensors/shade/lamp_glitter.rs`).
+//! glitter on the water (`sensors/shade/lamp_glitter.rs`) and their light on other surfaces (`lamp_light.rs`),
+//! their glow in the air (`lamp_halo.rs`) and the lamps smaller than a pixel (`camera/lamp_points.rs`).
 //!
 //! A lamp is the faces of one instance that share a navigation-light material
 //! ([`crate::material::Material::nav_light`]) and lie within [`LAMP_GROUP_M`] of the first face of their group
 //! (a lantern's lens: a ring of faces round a vertical axis). Its intensity towards a direction `ω` is its
 //! radiance times its projected area, `L_e · ½ Σ A_i |n_i · ω|` (the half: a closed lens shows each direction one
-//! side of every pair of opposite faces), inside the lamp's COLREG arc and nothing outside it.
+//! side of every pair of opposite faces), inside the lamp's COLREG arc and nothing outside it. A [`Lamp`] is made
+//! ready once per render for the many queries of those passes: the arc's trigonometry and the body axes worked
+//! out, and the area vectors of faces facing the same way summed (a lens quad's two triangles), which gives the
+//! same `½ Σ |A_i · ω|` every way.
 
 use super::Scene;
 use crate::geometry::RigidPose;
-use crate::material::Material;
+use crate::material::{LightArc, Material};
 use parry3d::math::Vec3;
 
 /// Faces of one navigation-light material within this distance (metres, body frame) of a group's first face
 /// belong to that lamp; farther ones start another (two masthead lanterns of one ship lie metres apart).
 pub const LAMP_GROUP_M: f32 = 1.0;
 
-/// One lit lamp, in the world frame.
+/// One lit lamp, in the world frame, made ready for the many intensity queries of a render ([`Lamp::new`]).
 #[derive(Debug, Clone)]
 pub struct Lamp {
     /// Centre of its faces (area-weighted), world frame, metres.
     pub centre: Vec3,
     /// Largest distance of a face's corner from the centre, metres.
     pub radius: f32,
-    /// Area vectors of its faces (unit normal times area, m²), world frame.
-    pub faces: Vec<Vec3>,
+    /// Area vectors of its faces (unit normal times area, m²), world frame, those facing the same way summed.
+    faces: Vec<Vec3>,
     /// Its material (radiance, arc).
     pub material: Material,
     /// Its instance's pose (the arc is a bearing in the body frame).
     pub pose: RigidPose,
     /// Its instance.
     pub instance: u32,
+    /// The material's arc, made ready; `None` all round.
+    arc: Option<LightArc>,
+    /// The body axes in the world frame: the rows of the world-to-body rotation.
+    body_axes: [Vec3; 3],
+    /// [`Lamp::max_intensity`].
+    max_intensity: f32,
+}
+
+/// `faces` with the area vectors of faces that face the same way summed (the two triangles of a lens quad): the
+/// same `½ Σ |A_i · w|` every way, as `|a · w| + |b · w| = |(a + b) · w|` for `a`, `b` of one direction; faces
+/// without area left out.
+fn merged_faces(faces: &[Vec3]) -> Vec<Vec3> {
+    let mut out: Vec<Vec3> = Vec::new();
+    for &a in faces {
+        let len = a.length();
+        if len.is_nan() || len <= 0.0 {
+            continue;
+        }
+        match out.iter_mut().find(|b| b.dot(a) >= (1.0 - 1e-6) * b.length() * len) {
+            Some(b) => *b += a,
+            None => out.push(a),
+        }
+    }
+    out
 }
 
 impl Lamp {
+    /// The lamp of `material` whose lens has the area vectors `faces` (m², world frame) round `centre` within
+    /// `radius` (world frame, m), on instance `instance` at `pose`: its arc's trigonometry done once and the faces
+    /// that face the same way merged, so that [`Lamp::intensity`] is a few dot products.
+    pub fn new(centre: Vec3, radius: f32, faces: &[Vec3], material: Material, pose: RigidPose, instance: u32) -> Self {
+        let axis = |v: Vec3| pose.transform_vector(v);
+        let max_intensity = material.emissive.iter().fold(0.0f32, |a, &e| a.max(e))
+            * 0.5
+            * faces.iter().map(|a| a.length()).sum::<f32>();
+        Self {
+            centre,
+            radius,
+            faces: merged_faces(faces),
+            material,
+            pose,
+            instance,
+            arc: material.arc(),
+            body_axes: [axis(Vec3::X), axis(Vec3::Y), axis(Vec3::Z)],
+            max_intensity,
+        }
+    }
+
+    /// Area vectors of its lens (m², world frame), those of faces that face the same way summed.
+    pub fn faces(&self) -> &[Vec3] {
+        &self.faces
+    }
+
+    /// The material's arc ([`Material::arc`]); `None` all round.
+    #[inline]
+    pub fn arc(&self) -> Option<LightArc> {
+        self.arc
+    }
+
+    /// World vector `v` in the instance's body frame.
+    #[inline]
+    pub fn to_body(&self, v: Vec3) -> Vec3 {
+        Vec3::new(self.body_axes[0].dot(v), self.body_axes[1].dot(v), self.body_axes[2].dot(v))
+    }
+
     /// Intensity (cd, linear RGB) towards unit world direction `out` (from the lamp outwards): the projected area
-    /// of the lens times its radiance inside the lamp's arc, zero outside it.
+    /// of the lens times its radiance inside the lamp's arc ([`Material::emits_towards`]), zero outside it.
+    #[inline]
     pub fn intensity(&self, out: Vec3) -> Vec3 {
-        if !self.material.emits_towards(self.pose.inverse_transform_vector(out)) {
+        if self.arc.is_some_and(|arc| !arc.contains(self.to_body(out))) {
             return Vec3::ZERO;
         }
         Vec3::from_array(self.material.emissive) * self.projected_area(out)
@@ -45,13 +112,13 @@ impl Lamp {
 
     /// The most intensity (cd) the lamp gives in any direction and any colour: its brightest channel's radiance
     /// times `½ Σ A_i`, a bound on its projected area (every face seen face on).
+    #[inline]
     pub fn max_intensity(&self) -> f32 {
-        self.material.emissive.iter().fold(0.0f32, |a, &e| a.max(e))
-            * 0.5
-            * self.faces.iter().map(|a| a.length()).sum::<f32>()
+        self.max_intensity
     }
 
     /// Area (m²) of the lens seen along unit direction `dir` (either way): `½ Σ A_i |n_i · dir|`.
+    #[inline]
     pub fn projected_area(&self, dir: Vec3) -> f32 {
         0.5 * self.faces.iter().map(|a| a.dot(dir).abs()).sum::<f32>()
     }
@@ -101,14 +168,9 @@ impl Scene {
                     corners.iter().copied().sum::<Vec3>() / corners.len() as f32
                 };
                 let radius = corners.iter().map(|c| (*c - centre).length()).fold(0.0, f32::max);
-                out.push(Lamp {
-                    centre: pose.transform_point(centre),
-                    radius,
-                    faces: areas.iter().map(|a| pose.transform_vector(*a)).collect(),
-                    material: self.materials[mat as usize],
-                    pose,
-                    instance: id as u32,
-                });
+                let faces: Vec<Vec3> = areas.iter().map(|a| pose.transform_vector(*a)).collect();
+                let material = self.materials[mat as usize];
+                out.push(Lamp::new(pose.transform_point(centre), radius, &faces, material, pose, id as u32));
             }
         }
         out
@@ -153,6 +215,11 @@ mod tests {
     }
 
     fn scene_with(arc: [f32; 2], lights: bool) -> crate::error::Result<Scene> {
+        scene_posed(arc, lights, RigidPose::from_xyz_rpy([100.0, 50.0, 0.0], [0.0, 0.0, std::f64::consts::FRAC_PI_2]))
+    }
+
+    /// Two lanterns of arc `arc` 5 m apart on one instance at `pose`, lit or not.
+    fn scene_posed(arc: [f32; 2], lights: bool, pose: RigidPose) -> crate::error::Result<Scene> {
         let (mut v, mut f, mut m) = lantern(Vec3::new(0.0, 0.0, 10.0), 0.2, 0.3);
         // A second lantern of the same material 5 m aft: a lamp of its own.
         let (v2, f2, m2) = lantern(Vec3::new(-5.0, 0.0, 10.0), 0.2, 0.3);
@@ -166,7 +233,6 @@ mod tests {
         let id = scene.add_mesh(mesh);
         let housing = Material { nav_light: false, emissive: [0.0; 3], ..lamp_material(0.0, [0.0, 180.0]) };
         scene.set_materials(vec![housing, lamp_material(2e4, arc), housing])?;
-        let pose = RigidPose::from_xyz_rpy([100.0, 50.0, 0.0], [0.0, 0.0, std::f64::consts::FRAC_PI_2]);
         let inst = scene.add_instance(id, pose, None)?;
         scene.set_lights(&[inst], lights)?;
         Ok(scene)
@@ -202,6 +268,48 @@ mod tests {
         assert!(l.intensity(-Vec3::X).x > 0.0, "towards port");
         assert_eq!(l.intensity(Vec3::X), Vec3::ZERO, "towards starboard");
         assert_eq!(l.intensity(Vec3::new(0.0, -1.0, 0.0)), Vec3::ZERO, "right astern");
+        Ok(())
+    }
+
+    #[test]
+    fn a_lamp_made_ready_has_its_faces_intensity_every_way() -> crate::error::Result<()> {
+        // A port sidelight's lantern on a vessel turned 70° and rolled 0.2 rad: `Lamp::intensity` (the arc's
+        // trigonometry done once, the two triangles of each lens side merged) equals the intensity worked out from
+        // the mesh's own faces over a sphere of directions: `Material::emits_towards` of the direction taken into
+        // the body frame by the pose, times the radiance and `½ Σ |A_i · w|` of every triangle.
+        let pose = RigidPose::from_xyz_rpy([3.0, -2.0, 0.0], [0.2, 0.0, 70f64.to_radians()]);
+        let lamps = scene_posed([56.25, 56.25], true, pose)?.nav_lamps();
+        let l = &lamps[0];
+        assert_eq!(l.faces().len(), 4, "the two triangles of each of the lantern's 4 sides are merged");
+        // The first lantern's 8 side triangles, their area vectors in the world frame.
+        let (verts, tris, _) = lantern(Vec3::new(0.0, 0.0, 10.0), 0.2, 0.3);
+        let areas: Vec<Vec3> = tris[..8]
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| pose.transform_point(Vec3::from_array(verts[i as usize])));
+                0.5 * (b - a).cross(c - a)
+            })
+            .collect();
+        let (mut zero, mut lit) = (0, 0);
+        for i in 0..40 {
+            for j in 0..80 {
+                let (el, az) = (-1.5 + 3.0 * i as f32 / 39.0, std::f32::consts::TAU * j as f32 / 80.0);
+                let w = Vec3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
+                let inside = l.material.emits_towards(pose.inverse_transform_vector(w));
+                let area = 0.5 * areas.iter().map(|a| a.dot(w).abs()).sum::<f32>();
+                let want = if inside { Vec3::splat(2e4 * area) } else { Vec3::ZERO };
+                let got = l.intensity(w);
+                assert!((got - want).length() <= 1e-4 * want.length().max(1.0), "{w:?}: {got:?} against {want:?}");
+                if want == Vec3::ZERO {
+                    zero += 1;
+                } else {
+                    lit += 1;
+                }
+            }
+        }
+        assert!(zero > 1000 && lit > 500, "{zero} {lit}");
+        // The bound: the radiance times half the sum of the triangles' areas (4 sides of 0.2 × 0.3).
+        assert!((l.max_intensity() - 2e4 * 0.5 * 4.0 * 0.06).abs() < 1.0, "{}", l.max_intensity());
         Ok(())
     }
 }

@@ -16,7 +16,7 @@
 
 use super::radiance::PixelGrid;
 use crate::scene::{RayHits, Scene};
-use crate::sensors::shade::lamp_halo::{HaloLamp, LAMP_HALO_LEAST};
+use crate::sensors::shade::lamp_halo::LAMP_HALO_LEAST;
 use crate::sensors::shade::Shader;
 use parry3d::math::Vec3;
 use rayon::prelude::*;
@@ -54,7 +54,7 @@ pub(super) fn add_lamp_halos(
     linear: &mut [Vec3],
 ) {
     let Some((_, exposure)) = shader.halo_air() else { return };
-    let lamps: Vec<HaloLamp> = shader.lamps().lamps().iter().map(HaloLamp::new).collect();
+    let lamps = shader.lamps().lamps();
     if lamps.is_empty() {
         return;
     }

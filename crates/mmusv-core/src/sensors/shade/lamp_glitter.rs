@@ -187,21 +187,15 @@ mod tests {
 
     /// A lamp at `centre` whose lens shows `area` m² along ±x (two opposite faces), radius 5 cm.
     fn lamp(centre: Vec3, area: f32, arc: [f32; 2]) -> Lamp {
-        Lamp {
-            centre,
-            radius: 0.05,
-            faces: vec![Vec3::X * area, -Vec3::X * area],
-            material: Material {
-                base_color: [1.0; 3],
-                roughness: 0.5,
-                metallic: 0.0,
-                emissive: [2e4; 3],
-                nav_light: true,
-                arc_deg: arc,
-            },
-            pose: RigidPose::IDENTITY,
-            instance: 0,
-        }
+        let material = Material {
+            base_color: [1.0; 3],
+            roughness: 0.5,
+            metallic: 0.0,
+            emissive: [2e4; 3],
+            nav_light: true,
+            arc_deg: arc,
+        };
+        Lamp::new(centre, 0.05, &[Vec3::X * area, -Vec3::X * area], material, RigidPose::IDENTITY, 0)
     }
 
     fn water_hit(point: Vec3) -> SurfaceHit {

@@ -95,21 +95,15 @@ mod tests {
 
     /// A lamp at `centre` whose lens shows `area` m² along ±x (two opposite faces), radius `radius`.
     fn lamp(centre: Vec3, area: f32, radius: f32, arc: [f32; 2]) -> Lamp {
-        Lamp {
-            centre,
-            radius,
-            faces: vec![Vec3::X * area, -Vec3::X * area],
-            material: Material {
-                base_color: [1.0; 3],
-                roughness: 0.5,
-                metallic: 0.0,
-                emissive: [2e4, 1e4, 5e3],
-                nav_light: true,
-                arc_deg: arc,
-            },
-            pose: RigidPose::IDENTITY,
-            instance: 0,
-        }
+        let material = Material {
+            base_color: [1.0; 3],
+            roughness: 0.5,
+            metallic: 0.0,
+            emissive: [2e4, 1e4, 5e3],
+            nav_light: true,
+            arc_deg: arc,
+        };
+        Lamp::new(centre, radius, &[Vec3::X * area, -Vec3::X * area], material, RigidPose::IDENTITY, 0)
     }
 
     /// A hit on a wall of material 1 at `point`, normal `normal`, 10 m from the camera.
