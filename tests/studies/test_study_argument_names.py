@@ -72,14 +72,19 @@ def test_a_predictions_file_is_named_by_the_argument_that_gave_it(
     assert said.startswith(f"--predictions {columns}: missing column(s) ['ego',"), said
 
 
+@pytest.mark.parametrize("typed", [True, False], ids=["typed", "untyped"])
 def test_a_predictions_file_that_covers_nothing_names_settings_and_modes_as_given(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], typed: bool
 ) -> None:
+    # an empty table written without a schema (pl.DataFrame({c: [] ...})) has Null columns: it was refused as
+    # "column frame must hold integer acquisition indices, not Null", where the same table typed says it covers
+    # nothing
     empty = tmp_path / "empty.parquet"
     schema = {"sequence": pl.Utf8, "frame": pl.Int64, "ego": pl.Utf8, "mode": pl.Utf8, "score": pl.Float64}
     schema.update(dict.fromkeys(["x", "y", "z", "l", "w", "h", "yaw"], pl.Float64))
-    pl.DataFrame(schema=schema).write_parquet(empty)
+    (pl.DataFrame(schema=schema) if typed else pl.DataFrame({c: [] for c in schema})).write_parquet(empty)
     predictions = load_predictions(empty)
+    assert predictions == {}
     said = _python(lambda: check_prediction_coverage(empty, predictions, modes=("late",), settings=(Setting(),)))
     assert said.startswith(f"path = '{empty}': no row of setting clean (modes late);"), said
     assert "every setting (settings) and mode (modes) scored" in said, said

@@ -239,6 +239,8 @@ def load_predictions(path: str | Path) -> dict[tuple[str, int, str, str, str], t
     missing = [c for c in need if c not in df.columns]
     if missing:
         raise InputError(f"{shown}: missing column(s) {missing}; required: {need}")
+    if df.height == 0:  # no row (and columns of type Null, written without a schema): it covers nothing
+        return {}
     df = df.with_row_index("_row")
     if "setting" not in df.columns:
         df = df.with_columns(pl.lit("clean").alias("setting"))
