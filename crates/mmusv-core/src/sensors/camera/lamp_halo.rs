@@ -161,7 +161,7 @@ pub(super) fn add_lamp_halos(
                     || hi <= 0.1 * least;
                 let lamp_inside = alike_rays && alike_glow && {
                     // The block's middle ray, and the farthest its corner rays stray from it at a lamp's distance.
-                    let (om, dm) = ray(ray_at((x0 + x1) / 2, (y0 + y1) / 2));
+                    let (om, dm) = ray(ray_at(xm, ym));
                     lamps.iter().any(|lamp| {
                         let t0 = (lamp.centre - om).dot(dm);
                         if !(t0 > 0.0) {

@@ -126,6 +126,35 @@ fn arc_crossings(lamp: &Lamp, d: Vec3, n: Vec3) -> [f32; 2] {
     })
 }
 
+/// How a ray passes a lamp: the lamp from the ray's origin (`to`, world frame, m), its distance along the ray
+/// (`t0`), the ray's nearest approach to it across the ray (`across`, its length squared `h2`), and that distance
+/// widened by the lens radius (`h = √(h2 + ρ²)`, m).
+#[derive(Debug, Clone, Copy)]
+struct Passing {
+    to: Vec3,
+    t0: f32,
+    across: Vec3,
+    h2: f32,
+    h: f32,
+}
+
+impl Passing {
+    #[inline]
+    fn new(o: Vec3, d: Vec3, lamp: &Lamp) -> Self {
+        let to = lamp.centre - o;
+        let t0 = to.dot(d);
+        let across = to - d * t0;
+        let h2 = across.length_squared();
+        Self { to, t0, across, h2, h: (h2 + lamp.radius * lamp.radius).sqrt() }
+    }
+
+    /// The scattering angle at the ray's origin, `atan2(h, t0)`.
+    #[inline]
+    fn theta0(&self) -> f32 {
+        self.h.atan2(self.t0)
+    }
+}
+
 impl Shader {
     /// The farthest (m) a ray may pass `lamp` and still be reached by its glow (the most it could be with
     /// `J(0)` and no extinction on the way, [`Shader::lamp_halo`]); 0 without air to scatter.
@@ -150,31 +179,32 @@ impl Shader {
     #[inline]
     pub fn lamp_halo(&self, o: Vec3, d: Vec3, t: f32, lamp: &Lamp) -> Vec3 {
         let Some((sigma, k)) = self.halo_air() else { return Vec3::ZERO };
-        let to = lamp.centre - o;
-        let t0 = to.dot(d);
-        let h = ((to - d * t0).length_squared() + lamp.radius * lamp.radius).sqrt();
-        let most = k * sigma * (-sigma * to.length()).exp() * lamp.max_intensity() * halo_phase_tail(h.atan2(t0)) / h;
+        let ray = Passing::new(o, d, lamp);
+        let most =
+            k * sigma * (-sigma * ray.to.length()).exp() * lamp.max_intensity() * halo_phase_tail(ray.theta0()) / ray.h;
         let u = LAMP_HALO_LEAST / most;
         if u.is_nan() || u >= 1.0 {
             return Vec3::ZERO;
         }
-        self.halo_integral(o, d, t, lamp) * ((1.0 - u * u * u * u) * (1.0 - u * u * u * u))
+        self.passing_integral(d, t, lamp, &ray) * ((1.0 - u * u * u * u) * (1.0 - u * u * u * u))
     }
 
     /// The airlight integral of the module docstring for `lamp` and the ray from `o` along unit `d` up to `t`
     /// metres (linear RGB, cd/m²), in pieces of 4-point Gauss–Legendre.
     #[inline]
     pub fn halo_integral(&self, o: Vec3, d: Vec3, t: f32, lamp: &Lamp) -> Vec3 {
+        self.passing_integral(d, t, lamp, &Passing::new(o, d, lamp))
+    }
+
+    /// [`Shader::halo_integral`] of the ray along unit `d` passing `lamp` as `ray` says.
+    #[inline]
+    fn passing_integral(&self, d: Vec3, t: f32, lamp: &Lamp, ray: &Passing) -> Vec3 {
         let Some((sigma, _)) = self.halo_air() else { return Vec3::ZERO };
         if t.is_nan() || t <= 0.0 {
             return Vec3::ZERO;
         }
-        let to = lamp.centre - o;
-        let t0 = to.dot(d);
-        let across = to - d * t0;
-        let h2 = across.length_squared();
-        let h = (h2 + lamp.radius * lamp.radius).sqrt();
-        let theta0 = h.atan2(t0);
+        let Passing { t0, across, h2, h, .. } = *ray;
+        let theta0 = ray.theta0();
         let n = if h2 > 0.0 { across / h2.sqrt() } else { d.any_orthonormal_vector() };
         let theta1 = if t.is_finite() { h.atan2(t0 - t) } else { PI };
         if theta1.is_nan() || theta0.is_nan() || theta1 <= theta0 {
