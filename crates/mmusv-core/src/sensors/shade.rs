@@ -17,6 +17,9 @@
 //!   displaced wave surface;
 //! * [`tonemap`]: physical exposure from the scene's illuminance and the ACES filmic curve.
 //!
+//! [`ShadeEnv`] and [`SurfaceHit`] (what shading reads) live in `env.rs`, the water's shading from its models in
+//! `water_shading.rs`, [`Lobes`] (a material's lobes for direct light) in [`brdf`].
+//!
 //! A surface of material `m` seen along `d` (`v = −d`) is lit by the sun (irradiance `E_s` along `s`, when the
 //! camera's shadow ray finds it unoccluded) and by the environment:
 //! `L = L_e + (f_d + f_s(v, s)) E_s (n·s) + f_d E_env(n) + P(r', roughness) (F0 A + B)`, with `f_d = (1 − metallic)
@@ -41,6 +44,7 @@ use std::sync::Arc;
 
 pub mod brdf;
 mod class_material;
+mod env;
 pub mod envlight;
 pub mod foam;
 pub mod kelvin;
@@ -58,147 +62,17 @@ pub mod tonemap;
 pub mod twilight;
 pub mod wake;
 pub mod water;
+mod water_shading;
 
-use brdf::{dfg, specular_cos};
+use brdf::dfg;
+pub use brdf::Lobes;
 pub use class_material::class_material;
-use envlight::{Lighting, LightingKey, WATER_IOR};
-use foam::{Foam, FOAM_ALBEDO};
+pub use env::{ShadeEnv, SurfaceHit};
+use envlight::{Lighting, WATER_IOR};
+use foam::Foam;
 use swell::Swell;
-use tables::water_fresnel;
 use wake::Wake;
 use water::ShallowWater;
-
-/// The environment as the cameras see it (and, for fog, rain and waves, the LiDAR and the radar).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ShadeEnv {
-    /// Unit vector towards the sun (world frame); below the horizon at night.
-    pub sun_direction: [f32; 3],
-    /// Preetham turbidity of the air (2 very clear .. 10 hazy).
-    pub turbidity: f32,
-    /// Cloud cover in `[0, 1]`: mixes in the CIE overcast sky and dims the sun's beam.
-    pub cloud_cover: f32,
-    /// Albedo of the lower hemisphere for image-based light (the sea: 0.06).
-    pub ground_albedo: f32,
-    /// Atmospheric extinction (1/m), 3 / visibility.
-    pub fog_extinction_per_m: f32,
-    /// Rain rate (mm/h).
-    pub rain_mm_per_h: f32,
-    /// Significant wave height (m).
-    pub wave_height_m: f32,
-    /// Wind speed at 10 m (m/s): capillary roughness and whitecaps.
-    pub wind_speed_m_s: f32,
-    /// Diffuse reflectance of the water body, linear RGB.
-    pub water_albedo: [f32; 3],
-    /// Fixed exposure value at ISO 100; `NaN` meters it from the scene's horizontal illuminance.
-    pub exposure_ev100: f32,
-    /// Whether to cast shadow rays.
-    pub shadows: bool,
-    /// Whether light reflecting more than once between the sea's wave facets is kept ([`sea_ms`]); `false`
-    /// is the single-scattering microfacet model alone (as renderers' rough BSDFs, for comparisons).
-    pub water_multiple_scattering: bool,
-}
-
-impl Default for ShadeEnv {
-    /// Clear noon, a light breeze.
-    fn default() -> Self {
-        Self {
-            sun_direction: [0.3, 0.2, 0.93],
-            turbidity: 3.0,
-            cloud_cover: 0.1,
-            ground_albedo: 0.06,
-            fog_extinction_per_m: 3.0 / 20_000.0,
-            rain_mm_per_h: 0.0,
-            wave_height_m: 0.5,
-            wind_speed_m_s: 5.0,
-            water_albedo: [0.004, 0.018, 0.03],
-            exposure_ev100: f32::NAN,
-            shadows: true,
-            water_multiple_scattering: true,
-        }
-    }
-}
-
-impl ShadeEnv {
-    /// The key of this environment's sky lighting.
-    pub fn lighting_key(&self) -> LightingKey {
-        LightingKey {
-            sun: self.sun_direction,
-            turbidity: self.turbidity,
-            cloud: self.cloud_cover,
-            ground_albedo: self.ground_albedo,
-        }
-    }
-}
-
-/// What a camera ray hit, as shading needs it.
-#[derive(Debug, Clone, Copy)]
-pub struct SurfaceHit {
-    /// Distance along the ray (m).
-    pub t: f32,
-    /// World hit point.
-    pub point: Vec3,
-    /// Unit world normal, facing the camera.
-    pub normal: Vec3,
-    /// Semantic class.
-    pub class: u16,
-    /// Scene instance id.
-    pub instance: i32,
-    /// The face's material: an index into the shader's table ([`Shader::with_materials`]), 0 for the class's
-    /// default.
-    pub material: u16,
-    /// Whether the instance's navigation lights are on.
-    pub lights_on: bool,
-    /// The shading normal: the geometric one, or for water the swell's ([`Shader::with_swell`]).
-    pub shading_normal: Vec3,
-    /// For water on the displaced sea, the mean square slope of the waves too short for the surface's sampling
-    /// there ([`crate::sea::SurfaceShading`]), added to the glint's roughness; 0 elsewhere.
-    pub unresolved_mss: f32,
-}
-
-/// A material's reflection as the direct light sees it: the Lambert lobe `f_d = (1 − metallic) base / π`, the
-/// GGX lobe's Fresnel at normal incidence `f0` (0.04 for a dielectric, the base colour for a metal) and its
-/// roughness `α = roughness²` (at least [`brdf::ALPHA_MIN`]).
-#[derive(Debug, Clone, Copy)]
-pub struct Lobes {
-    /// `f_d`, linear RGB, 1/sr.
-    pub diffuse: Vec3,
-    /// Fresnel reflectance at normal incidence, linear RGB.
-    pub f0: Vec3,
-    /// GGX roughness `α`.
-    pub alpha: f32,
-}
-
-impl Lobes {
-    /// The lobes of material `m` (metallic workflow).
-    #[inline(always)]
-    pub fn of(m: &Material) -> Self {
-        let base = Vec3::from_array(m.base_color);
-        Self {
-            diffuse: base * ((1.0 - m.metallic) / std::f32::consts::PI),
-            f0: Vec3::splat(0.04) * (1.0 - m.metallic) + base * m.metallic,
-            alpha: (m.roughness * m.roughness).max(brdf::ALPHA_MIN),
-        }
-    }
-
-    /// Radiance towards unit `v` of light arriving from unit `l` with irradiance `e` normal to the beam, at a
-    /// surface of unit normal `n`: `(f_d + f_s(v, l)) (n·l) E`, zero where `l` is below the surface.
-    #[inline(always)]
-    pub fn direct(&self, n: Vec3, v: Vec3, l: Vec3, e: Vec3) -> Vec3 {
-        let nl = n.dot(l);
-        if nl <= 0.0 {
-            return Vec3::ZERO;
-        }
-        (self.diffuse * nl + specular_cos(n, v, l, self.alpha, self.f0)) * e
-    }
-}
-
-impl SurfaceHit {
-    /// Whether this is the sea surface.
-    #[inline]
-    pub fn is_water(&self) -> bool {
-        self.class == 1
-    }
-}
 
 /// Shading of one render: the environment's lighting (shared between renders), swell, foam and exposure,
 /// computed once; then [`Shader::shade`] per ray.
@@ -416,59 +290,6 @@ impl Shader {
         c * f + self.air_light(d) * (1.0 - f)
     }
 
-    /// Swell normal of the water surface at `p` ([`Swell::normal`]).
-    #[inline(always)]
-    pub fn water_normal(&self, p: Vec3) -> Vec3 {
-        self.swell.normal(p)
-    }
-
-    /// `hit` with its shading normal set: for water seen along `d`, the wave surface's (with the roughness of the
-    /// waves it does not draw), or without one the swell's, with the slopes of the vessels' Kelvin waves added
-    /// (those the pixel cannot resolve as roughness; the geometric normal where the result would face away); for
-    /// anything else, the geometric normal.
-    #[inline(always)]
-    pub fn with_swell(&self, d: Vec3, mut hit: SurfaceHit) -> SurfaceHit {
-        hit.shading_normal = hit.normal;
-        hit.unresolved_mss = 0.0;
-        if hit.is_water() {
-            let mut footprint = (self.pixel_m + hit.t * self.pixel_rad) / d.z.abs().max(0.05);
-            if let Some(w) = self.waves.as_ref().filter(|_| self.pixel_rad == 0.0 && self.pixel_m > 0.0) {
-                footprint = footprint.max(w.finest_cell_m());
-            }
-            let n = match self.waves.as_ref().and_then(|w| w.shading(hit.point.x, hit.point.y, footprint)) {
-                Some(s) => {
-                    hit.unresolved_mss = s.unresolved_mss;
-                    Vec3::from_array(s.normal)
-                }
-                None => self.water_normal(hit.point),
-            };
-            let n = if self.kelvin.is_empty() {
-                n
-            } else {
-                // The vessels' Kelvin waves add their slopes (those the footprint cannot resolve, roughness).
-                let k = self.kelvin.slope(hit.point.x, hit.point.y, footprint);
-                hit.unresolved_mss += k.unresolved_mss;
-                kelvin::tilted(n, k.slope)
-            };
-            if n.dot(d) <= 0.0 {
-                hit.shading_normal = n;
-            }
-        }
-        hit
-    }
-
-    /// Origin and unit direction of the ray reflected by a water hit seen along `d` (never below the horizon),
-    /// about its shading normal.
-    #[inline(always)]
-    pub fn reflection_ray(&self, d: Vec3, hit: &SurfaceHit) -> (Vec3, Vec3) {
-        let n = hit.shading_normal;
-        let mut r = d - n * (2.0 * d.dot(n));
-        r.z = r.z.abs().max(1e-4);
-        // A small offset off the surface (2 mm, growing with the distance like the coordinates' rounding), so a
-        // reflected silhouette is not shifted by it.
-        (hit.point + hit.normal * (2e-3 + 1e-5 * hit.t), r.normalize())
-    }
-
     /// The material of a non-water hit: its face's from the table, else its class's default.
     #[inline(always)]
     pub fn material_of(&self, hit: &SurfaceHit) -> Material {
@@ -500,86 +321,6 @@ impl Shader {
         }
         if !m.nav_light || hit.lights_on {
             c += Vec3::from_array(m.emissive);
-        }
-        c
-    }
-
-    /// Mean square slope `α²` (both axes) of the water's roughness where the sampled surface leaves
-    /// `unresolved_mss` out: the Cox–Munk slopes of the wind plus those. The sun's glint and the glossy
-    /// reflections (`sensors/camera/glossy.rs`) both take it.
-    #[inline]
-    pub fn water_mss(&self, unresolved_mss: f32) -> f32 {
-        self.water_alpha * self.water_alpha + unresolved_mss.max(0.0)
-    }
-
-    /// The rough water's directional reflectance seen at `cos_o` with roughness `alpha`, light scattered more than
-    /// once between the facets included when the environment asks for it (`sea_ms.rs`), and its ratio to the
-    /// single-scattering one (what a glint is scaled by).
-    #[inline(always)]
-    fn water_reflectance(&self, cos_o: f32, alpha: f32) -> (f32, f32) {
-        let e_single = rough_water::reflectance(cos_o, alpha);
-        if self.env.water_multiple_scattering {
-            let e = sea_ms::reflectance(cos_o, alpha);
-            (e, if e_single > 0.0 { e / e_single } else { 1.0 })
-        } else {
-            (e_single, 1.0)
-        }
-    }
-
-    /// Radiance (before aerial perspective) of the water seen along `d`: Fresnel-weighted `reflected` radiance
-    /// (along [`Shader::reflection_ray`]; `None` reads the sky there), the sun's Cox–Munk glint when `sunlit`,
-    /// the water body, and foam.
-    #[inline(always)]
-    pub fn water(&self, d: Vec3, hit: &SurfaceHit, sunlit: bool, reflected: Option<Vec3>) -> Vec3 {
-        let n = hit.shading_normal;
-        let v = -d;
-        let cos_o = n.dot(v).clamp(1e-4, 1.0);
-        let f_o = water_fresnel(cos_o);
-        let l_r = match reflected {
-            Some(l) => l,
-            None => self.sky_no_sun(self.reflection_ray(d, hit).1),
-        };
-        // The reflection over the roughness lobe (its radiance spread over the lobe by the camera, `reflected`):
-        // weighted by the rough surface's directional reflectance, not the mirror's Fresnel.
-        let alpha_r = self.water_mss(hit.unresolved_mss).sqrt();
-        // Light scattered more than once between the facets is spent over the same lobe (`sea_ms.rs`): the
-        // reflection weighted by the reflectance of every order, the glitter scaled by its share over the first.
-        let (e_r, ms_gain) = self.water_reflectance(cos_o, alpha_r);
-        let mut c = l_r * e_r;
-        let mut entering = self.light.water_entering;
-        if sunlit {
-            let ns = n.dot(self.sun);
-            if ns > 0.0 {
-                // The glint: Cox–Munk's Gaussian slopes (Beckmann, `rough_water.rs`) with the wind's roughness and
-                // the slope variance of the waves too short for the surface's sampling there (α² adds as mean
-                // square slopes do), weighted by the exact Fresnel at the half vector: the reflections' lobe too.
-                let h = (v + self.sun).normalize_or_zero();
-                let f = water_fresnel(v.dot(h));
-                c += self.sun_e * (rough_water::specular_cos(n, v, self.sun, alpha_r) * f * ms_gain);
-                entering += self.sun_e * (ns * (1.0 - water_fresnel(ns)));
-            }
-        }
-        let rho = match self.seabed.as_ref().and_then(|s| s.depth(hit.point.x, hit.point.y, 0.0)) {
-            Some(depth) => self.shallow.albedo(depth),
-            None => self.water_rho,
-        };
-        c += water::body_factor(rho, self.water_fdr, f_o, WATER_IOR) * entering;
-        if !self.foam.is_empty() {
-            // The normalised elevation η/σ_η (σ_η the sampled sea's own, H_s/4) that gathers the whitecaps on the
-            // crests, where the surface is sampled (beyond, the sea goes on at an elevation not known: the foam's
-            // own coverage).
-            let (x, y) = (hit.point.x, hit.point.y);
-            let crest = (self.waves.as_ref())
-                .filter(|w| w.elevation_std() > 0.0 && w.sampled_at(x, y))
-                .map(|w| (hit.point.z - w.level()) / w.elevation_std());
-            let cover = self.foam.cover(x, y, crest);
-            if cover > 0.0 {
-                let mut e = self.light.irradiance(n);
-                if sunlit {
-                    e += self.sun_e * n.dot(self.sun).max(0.0);
-                }
-                c = c * (1.0 - cover) + e * (cover * FOAM_ALBEDO / std::f32::consts::PI);
-            }
         }
         c
     }

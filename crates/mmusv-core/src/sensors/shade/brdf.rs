@@ -1,5 +1,6 @@
 //! Surface reflection: a GGX microfacet specular with the separable Smith shadowing and Schlick's Fresnel over a
-//! Lambert diffuse, the exact dielectric Fresnel for water, and the split-sum table for image-based lighting.
+//! Lambert diffuse, the exact dielectric Fresnel for water, and the split-sum table for image-based lighting;
+//! [`Lobes`]: a material's two lobes as the direct light (the sun, a lamp) reads them.
 //!
 //! * GGX (Trowbridge–Reitz) distribution: B. Walter, S. Marschner, H. Li, K. Torrance, "Microfacet Models for
 //!   Refraction through Rough Surfaces", EGSR 2007: `D(h) = α² / (π ((n·h)² (α² − 1) + 1)²)` and its Smith
@@ -18,11 +19,49 @@
 //! at normal incidence, the Fresnel values at normal incidence are `((n − 1)/(n + 1))²`, and the table's white
 //! furnace value `A + B` matches a brute-force integral of `f_s · cos`.
 
+use crate::material::Material;
 use parry3d::math::Vec3;
 use std::sync::OnceLock;
 
 /// Smallest GGX `α` used (keeps the distribution finite for mirror-like materials).
 pub const ALPHA_MIN: f32 = 1e-3;
+
+/// A material's reflection as the direct light sees it: the Lambert lobe `f_d = (1 − metallic) base / π`, the
+/// GGX lobe's Fresnel at normal incidence `f0` (0.04 for a dielectric, the base colour for a metal) and its
+/// roughness `α = roughness²` (at least [`ALPHA_MIN`]).
+#[derive(Debug, Clone, Copy)]
+pub struct Lobes {
+    /// `f_d`, linear RGB, 1/sr.
+    pub diffuse: Vec3,
+    /// Fresnel reflectance at normal incidence, linear RGB.
+    pub f0: Vec3,
+    /// GGX roughness `α`.
+    pub alpha: f32,
+}
+
+impl Lobes {
+    /// The lobes of material `m` (metallic workflow).
+    #[inline(always)]
+    pub fn of(m: &Material) -> Self {
+        let base = Vec3::from_array(m.base_color);
+        Self {
+            diffuse: base * ((1.0 - m.metallic) / std::f32::consts::PI),
+            f0: Vec3::splat(0.04) * (1.0 - m.metallic) + base * m.metallic,
+            alpha: (m.roughness * m.roughness).max(ALPHA_MIN),
+        }
+    }
+
+    /// Radiance towards unit `v` of light arriving from unit `l` with irradiance `e` normal to the beam, at a
+    /// surface of unit normal `n`: `(f_d + f_s(v, l)) (n·l) E`, zero where `l` is below the surface.
+    #[inline(always)]
+    pub fn direct(&self, n: Vec3, v: Vec3, l: Vec3, e: Vec3) -> Vec3 {
+        let nl = n.dot(l);
+        if nl <= 0.0 {
+            return Vec3::ZERO;
+        }
+        (self.diffuse * nl + specular_cos(n, v, l, self.alpha, self.f0)) * e
+    }
+}
 
 /// GGX normal distribution `D` for `cos θ_h = n·h` and roughness `alpha`.
 #[inline(always)]

@@ -1,6 +1,6 @@
 //! Unit tests of the parent module (`shade.rs`).
 
-use super::brdf::fresnel_dielectric;
+use super::brdf::{fresnel_dielectric, specular_cos};
 use super::*;
 
 fn hit(class: u16, material: u16) -> SurfaceHit {
