@@ -73,7 +73,11 @@ scenario's `assets:` lists, read as `mmusv run` of it reads them (relative to it
 is not read). Several files may be given, scenarios and asset files mixed. The table has the library's columns
 (length, beam, height and draft in metres, triangles, parts: 0 for a mesh file) and two more: `materials`, how many
 materials its faces use (a file without colours or materials has its class's default look: 1), and `file`, the asset
-file it comes from (and the scenario that lists it); it is printed instead of the built-in library's. `--render DIR`
+file it comes from (and the scenario that lists it); it is printed instead of the built-in library's. `--materials`
+adds a table per asset (the library's too, without FILE): each material by name with its faces, base colour (linear
+RGB and the 8-bit sRGB it shows as), roughness, metallic, emitted radiance (cd/m²) and a navigation lamp's arc, so
+you can see what was read of a glTF's PBR materials, an MTL or vertex colours (`class_default`: the class's
+look). `--render DIR`
 draws those assets' close-ups and their contact sheet, as for the library. A file that does not exist, one that is
 neither a scenario nor an asset file, and an asset a run would refuse (a bad key, a missing mesh, a built-in asset's
 name) are one `mmusv: error:` line naming the file and the key (exit status 2), before `--render`'s folder is made.
@@ -178,7 +182,9 @@ texture whose image cannot be read (trimesh would leave it out: the hull came ou
 that glTF does not allow or that does not fit its
 primitive (naming the primitive and accessor: another count than its `POSITION`, not VEC3/VEC4, not float or
 normalized unsigned byte/short, a sparse accessor (trimesh does not apply its values), non-finite or outside
-[0, 1]), non-finite coordinates, no triangles, or trimesh's own reason for a file it cannot parse. A texture or
+[0, 1]), non-finite coordinates, no triangles (for a glTF, why: no scene, a scene whose nodes place none of
+its meshes, or only points and lines placed; points and lines beside triangles are left out with a warning naming
+them), or trimesh's own reason for a file it cannot parse. A texture or
 buffer URI is read as glTF means it: percent-decoded and relative to the `.gltf` (`../textures/` included).
 """
 

@@ -80,6 +80,69 @@ def test_an_asset_file_lists_its_asset_with_the_library_columns_and_its_file(
     ]
 
 
+def _cells(out: str) -> list[list[str]]:
+    """The tables' rows, each as all its cells (empty ones kept)."""
+    return [[c.strip() for c in line.split("│")[1:-1]] for line in out.splitlines() if line.startswith("│")]
+
+
+def _srgb_hex(linear: list[float]) -> str:
+    """IEC 61966-2-1's encoding of linear RGB, to 8 bits, as #rrggbb (written out here, not mmusv's)."""
+    enc = [12.92 * c if c <= 0.0031308 else 1.055 * c ** (1 / 2.4) - 0.055 for c in linear]
+    return "#" + "".join(f"{round(e * 255):02x}" for e in enc)
+
+
+def test_materials_lists_what_the_importer_read_of_each_material(
+    here: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # A glTF hull of two materials, as glTF 2.0 writes them (3.9.2: baseColorFactor linear, metallicFactor,
+    # roughnessFactor): the table gives each by name with its faces, its values and its sRGB. Before, the asset
+    # table gave the count of materials alone (2), so a user could not see what was read.
+    from test_gltf_import_recheck import HULL, MARK, Doc
+
+    monkeypatch.setenv("COLUMNS", "250")
+    d = Doc()
+    paint = {"baseColorFactor": [0.5, 0.05, 0.02, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.6}
+    rail = {"baseColorFactor": [0.56, 0.57, 0.58, 1.0], "metallicFactor": 1.0, "roughnessFactor": 0.3}
+    red = d.add("materials", name="red_paint", pbrMetallicRoughness=paint)
+    steel = d.add("materials", name="rail_steel", pbrMetallicRoughness=rail)
+    d.add("scenes", nodes=[d.add("nodes", mesh=d.mesh(d.box(*HULL, material=red), d.box(*MARK, material=steel)))])
+    d.glb(here / "models" / "gl.glb")
+    entry = {"name": "gl_boat", "mesh": "gl.glb", "semantic_class": "vessel", "draft": 0.5}
+    (here / "models" / "gl.yaml").write_text(yaml.safe_dump(entry), encoding="utf-8")
+    out, _ = _ok(["assets", "models/gl.yaml", "--materials"], capsys)
+    assert "Materials of gl_boat" in out, out
+    rows = {r[0]: r[1:] for r in _cells(out) if len(r) == 8}
+    paint_row = next(v for k, v in rows.items() if "red_paint" in k)
+    rail_row = next(v for k, v in rows.items() if "rail_steel" in k)
+    assert paint_row[:6] == ["12", "0.5, 0.05, 0.02", _srgb_hex([0.5, 0.05, 0.02]), "0.6", "0", ""], paint_row
+    assert rail_row[:6] == ["12", "0.56, 0.57, 0.58", _srgb_hex([0.56, 0.57, 0.58]), "0.3", "1", ""], rail_row
+    assert paint_row[6] == rail_row[6] == ""  # no lamp
+
+
+def test_materials_of_the_library_give_every_face_and_the_lamps_arcs(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # Every built-in asset's faces are those of its materials; its lamps give COLREG Rule 21's arcs (a sidelight
+    # 112.5° from right ahead to its side, the sternlight 135° round right astern).
+    from mmusv.world.vessels import library
+
+    monkeypatch.setenv("COLUMNS", "250")
+    out, _ = _ok(["assets", "--materials"], capsys)
+    tables = out.split("Materials of ")[1:]
+    assert [t.split()[0] for t in tables] == [a.name for a in library()]
+    for a, t in zip(library(), tables, strict=True):
+        rows = _cells(t)
+        assert sum(int(r[1]) for r in rows) == a.num_triangles, a.name
+        assert [r[0] for r in rows] == sorted(r[0] for r in rows)
+    arcs = {r[0].split("@")[0]: r[7] for t in tables for r in _cells(t) if r[0].startswith("nav_")}
+    assert arcs == {
+        "nav_masthead_white": "0 ± 112.5",
+        "nav_port_red": "56.25 ± 56.25",
+        "nav_starboard_green": "-56.25 ± 56.25",
+        "nav_stern_white": "180 ± 67.5",
+    } | ({"nav_allround_white": "all round"} if "nav_allround_white" in arcs else {}), arcs
+
+
 def test_a_scenario_lists_the_assets_of_its_asset_files_from_its_own_folder(
     here: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -75,6 +75,9 @@ def cmd_assets(args: argparse.Namespace) -> int:
         console.print(_table("mmusv vessel library", [(a, None) for a in library()]))
     elif user:
         console.print(_table("Your vessel assets (from the files given)", [(u.asset, u) for u in user]))
+    if args.materials:
+        for a in library() if user is None else [u.asset for u in user]:
+            console.print(_materials_table(a))
     if args.render is not None:  # one close-up per asset and a contact sheet of them all
         from mmusv.world.contact_sheet import write_contact_sheet
 
@@ -108,6 +111,41 @@ def _table(title: str, rows: list[tuple[VesselAsset, UserAsset | None]]) -> Tabl
             via = f" (assets: of {u.scenario})" if u.scenario is not None else ""
             cells += [str(len(np.unique(a.mesh.materials))), f"{_shown(u.file)}{via}"]
         table.add_row(*cells)
+    return table
+
+
+def _materials_table(asset: VesselAsset) -> Table:
+    """The materials of ``asset``'s faces, by name: the faces of each, base colour (linear RGB and the 8-bit sRGB
+    it shows as), roughness, metallic, emitted radiance (cd/m², linear RGB) and a navigation lamp's arc (centre
+    bearing ± half-width, degrees, body frame: 0 right ahead, +90 to port). ``class_default`` (id 0) is the look of
+    the face's semantic class."""
+    import numpy as np
+    from rich.table import Table
+
+    from mmusv.world.materials import all_materials
+    from mmusv.world.mesh_materials import linear_to_srgb
+
+    table = Table(title=f"Materials of {asset.name}")
+    for col in ("material", "faces", "base colour (linear)", "sRGB", "roughness", "metallic", "emissive cd/m²"):
+        table.add_column(col, justify="right" if col in ("faces", "roughness", "metallic") else "left")
+    table.add_column("lamp arc °")
+    every = all_materials()
+    ids, counts = np.unique(np.asarray(asset.mesh.materials), return_counts=True)
+    rows = sorted(((every[int(i)], int(c)) for i, c in zip(ids, counts, strict=True)), key=lambda r: r[0].name)
+    for m, faces in rows:
+        srgb = np.round(linear_to_srgb(np.asarray(m.base_color)) * 255).astype(int)
+        glow = "" if not any(m.emissive) else ", ".join(f"{e:.4g}" for e in m.emissive)
+        arc = "" if not m.nav_light else ("all round" if m.arc_deg[1] >= 180 else "{:g} ± {:g}".format(*m.arc_deg))
+        table.add_row(
+            m.name,
+            str(faces),
+            ", ".join(f"{c:.4g}" for c in m.base_color),
+            "#{:02x}{:02x}{:02x}".format(*srgb),
+            f"{m.roughness:.3g}",
+            f"{m.metallic:.3g}",
+            glow,
+            arc,
+        )
     return table
 
 

@@ -150,6 +150,12 @@ def parser() -> argparse.ArgumentParser:
     p_assets.add_argument(
         "--overwrite", action="store_true", help="with --render: replace files of those names already in DIR"
     )
+    p_assets.add_argument(
+        "--materials",
+        action="store_true",
+        help="also list each asset's materials: the faces of each, its base colour (linear RGB and 8-bit sRGB), "
+        "roughness, metallic, emitted radiance and, for a navigation lamp, its arc",
+    )
     sub.add_parser("scenarios", help="list the bundled scenarios (mmusv run NAME runs one from any directory)")
     study = sub.add_parser("study", help="reproduce the paper's experiments")
     studies = study.add_subparsers(dest="study", required=True)

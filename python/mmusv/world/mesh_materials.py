@@ -127,7 +127,8 @@ def _srgb_to_linear(c: np.ndarray) -> np.ndarray:
     return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
 
 
-def _linear_to_srgb(c: np.ndarray) -> np.ndarray:
+def linear_to_srgb(c: np.ndarray) -> np.ndarray:
+    """Linear RGB in [0, 1] (clipped) encoded with the sRGB transfer function (IEC 61966-2-1), in [0, 1]."""
     c = np.clip(np.asarray(c, dtype=np.float64), 0.0, 1.0)
     return np.where(c <= 0.0031308, c * 12.92, 1.055 * c ** (1.0 / 2.4) - 0.055)
 
@@ -523,7 +524,7 @@ def colour_material_ids(colours: np.ndarray, path: Path, where: str, tints: np.n
     base = np.ones((len(colours), 3))
     for t in np.unique(tint[tint >= 0]).tolist():
         base[tint == t] = table[t].base_color
-    srgb = _linear_to_srgb(np.asarray(colours, dtype=np.float64) * base)
+    srgb = linear_to_srgb(np.asarray(colours, dtype=np.float64) * base)
     levels = COLOUR_LEVELS
     while True:
         byte = _quantise(srgb, levels)
@@ -535,7 +536,7 @@ def colour_material_ids(colours: np.ndarray, path: Path, where: str, tints: np.n
     if per_material:
         for t in np.unique(tint[tint >= 0]).tolist():
             mean = (np.asarray(colours, dtype=np.float64) * base)[tint == t].mean(axis=0)
-            byte[tint == t] = _quantise(_linear_to_srgb(mean), COLOUR_LEVELS)
+            byte[tint == t] = _quantise(linear_to_srgb(mean), COLOUR_LEVELS)
         uniq, inverse = np.unique(np.c_[tint, byte], axis=0, return_inverse=True)
     if levels < COLOUR_LEVELS:
         from mmusv.scenario_checks import MmusvWarning  # here: scenario_checks imports the config, which imports us
