@@ -60,7 +60,7 @@ def test_modes_of_a_model_the_folder_lacks_name_the_mode(
 
 
 def test_a_log_cut_short_is_whole_again_when_the_run_is_started_again(tmp_path: Path) -> None:
-    from mmusv.learn.train import plot_losses
+    from mmusv.learn.plots import plot_losses
 
     src, p = MemorySource(SCENES), preset("tiny")
     train(src, p=p, mode="single", out=tmp_path, epochs=1, progress=False)

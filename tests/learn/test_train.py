@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 import torch
 from mmusv.learn.detector import load_models
+from mmusv.learn.plots import plot_losses
 from mmusv.learn.presets import preset
-from mmusv.learn.train import TrainingSet, plot_losses, train
+from mmusv.learn.train import TrainingSet, train
 from mmusv.studies.detection.evaluate import FrameMatch, summarize
 
 from learn.scenes import SCENES, MemorySource

@@ -312,7 +312,7 @@ def _check_same_run(out: Path, modes: list[str], *, p: Any, seed: int, identity:
     run into a folder of ``tiny`` models left ``single`` of one preset beside ``early`` of the other, and the
     summary named only the new ones; and refused in each model's process, each printed its refusal and the summary
     was replaced by one of no model."""
-    from mmusv.learn.train import resumable_checkpoint
+    from mmusv.learn.resume import resumable_checkpoint
 
     for mode in [*modes, *(m for m in MODELS if m not in modes)]:
         try:
@@ -520,8 +520,9 @@ def _train_one(task: dict[str, Any]) -> dict[str, Any]:
 
 
 def _train_and_fit(task: dict[str, Any]) -> dict[str, Any]:
+    from mmusv.learn.plots import plot_losses
     from mmusv.learn.presets import preset
-    from mmusv.learn.train import plot_losses, train
+    from mmusv.learn.train import train
 
     out = Path(task["out"])
     r = train(

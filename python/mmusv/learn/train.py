@@ -18,7 +18,7 @@ or through ``mmusv train`` (which builds the cache first). Files in the output f
   sequences, can be told; without the wall-clock time (``last.pt`` has it), so two runs of the same seed on a CPU
   write the same bytes;
 - ``log.jsonl``: one line per logged step (``epoch, step, loss, heatmap, regression, lr, seconds``) and one per
-  epoch (``"epoch_end": true``); :func:`plot_losses` draws it.
+  epoch (``"epoch_end": true``); :func:`mmusv.learn.plots.plot_losses` draws it.
 
 Determinism: weights are initialised after ``torch.manual_seed(seed)``; the order of an epoch is a permutation
 drawn from ``(seed, epoch)``; each sample's augmentation from ``(seed, epoch, index)``, so it does not depend on
@@ -32,9 +32,8 @@ A training whose loss or gradient becomes NaN or infinite (a learning rate too h
 input error naming the step, before that step changes the weights: it went on and saved NaN weights as a finished
 model, which finds nothing.
 
-A ``last.pt`` is resumed only by the same run: the same preset, mode and seed, and the same data (a cache built from
-other sequences is refused; the first cache was trained on again without a word when the recordings given
-changed); the refusal names what differs (``preset 'tiny', this run 'cpu'``, ``seed 0, this run 1``)."""
+A ``last.pt`` is resumed only by the same run (:mod:`mmusv.learn.resume`: the same preset, mode and seed, and the
+same data; the first cache was trained on again without a word when the recordings given changed)."""
 
 from __future__ import annotations
 
@@ -51,18 +50,19 @@ from typing import Any
 import numpy as np
 import torch
 
-from mmusv.learn._errors import input_error, input_error_types
+from mmusv.learn._errors import input_error
 from mmusv.learn.augment import apply, draw
-from mmusv.learn.cache import Cache, same_data
-from mmusv.learn.checkpoint import load_checkpoint, remove_stale_temporaries, save_checkpoint
+from mmusv.learn.cache import Cache
+from mmusv.learn.checkpoint import remove_stale_temporaries, save_checkpoint
 from mmusv.learn.example import MODES, Example, collate, early_cloud, make_example
 from mmusv.learn.loss import centerpoint_loss
 from mmusv.learn.model import PillarNet, checked_device
 from mmusv.learn.presets import PRESETS, Preset, parse_overrides, preset
+from mmusv.learn.resume import not_a_checkpoint, resumable_checkpoint
 from mmusv.learn.targets import points_in_boxes
 from mmusv.text import command_line, counted, given
 
-__all__ = ["TrainResult", "TrainingSet", "main", "plot_losses", "plot_runs", "resumable_checkpoint", "train"]
+__all__ = ["TrainResult", "TrainingSet", "main", "train"]
 
 WARMUP_STEPS = 100
 LOG_EVERY = 10
@@ -176,82 +176,6 @@ def _write_log(path: Path, log: list[dict[str, Any]]) -> None:
         raise
 
 
-def _differs(ck: dict[str, Any], p: Preset, mode: str, seed: int) -> str | None:
-    """What of ``preset``, ``mode`` and ``seed`` a ``last.pt`` holds other than this run (``None``: the same run)."""
-    out = []
-    old = ck.get("preset")
-    if old != p.to_dict():
-        if isinstance(old, dict) and old.get("name") == p.name:
-            changed = sorted(k for k, v in p.to_dict().items() if old.get(k, object()) != v)
-            out.append(f"preset {p.name} with other {', '.join(changed) or 'fields'}")
-        else:
-            name = old.get("name") if isinstance(old, dict) else None
-            out.append(f"preset {name!r}, this run {p.name!r}")
-    if ck.get("mode") != mode:
-        out.append(f"mode {ck.get('mode')!r}, this run {mode!r}")
-    if ck.get("seed") != seed:
-        out.append(f"seed {ck.get('seed')!r}, this run {seed!r}")
-    return "; ".join(out) or None
-
-
-def _not_a_checkpoint(last: Path) -> str:
-    """What is said of a ``last.pt`` that cannot be resumed from."""
-    return f"{last}: not a checkpoint of mmusv train (remove it to start again, or use another -o)"
-
-
-def resumable_checkpoint(
-    out: str | Path,
-    *,
-    p: Preset,
-    mode: str,
-    seed: int,
-    identity: dict[str, Any] | None,
-    device: Any = "cpu",
-) -> dict[str, Any] | None:
-    """The ``last.pt`` in model folder ``out`` that this run (preset ``p``, ``mode``, ``seed``, data ``identity``)
-    resumes, ``None`` without one; refuses one of another run, naming the file and what differs. ``mmusv train``
-    asks it for every model before it starts any: refused only in each model's process, a run of another preset into
-    the same ``-o`` printed the refusal once per model and replaced ``train_summary.json`` with one of no model."""
-    last = Path(out) / "last.pt"
-    if not last.is_file():
-        _check_model_alone(Path(out) / "model.pt", p=p, mode=mode, seed=seed, identity=identity)
-        return None
-    ck = load_checkpoint(last, what=_not_a_checkpoint(last), device=device)
-    other = _differs(ck, p, mode, seed)
-    if other is not None:  # it said "preset/mode/seed differ", not which
-        raise input_error(f"{last}: a checkpoint of another run ({other}); use another -o")
-    if not same_data(ck.get("data"), identity):
-        before = ", ".join(str(x) for x in ck["data"].get("sources", [])) or "?"
-        raise input_error(
-            f"{last}: a checkpoint of a run on other data (trained on {before}); use another -o, or remove "
-            f"{out} to start again"
-        )
-    return ck
-
-
-def _check_model_alone(model: Path, *, p: Preset, mode: str, seed: int, identity: dict[str, Any] | None) -> None:
-    """Refuses a ``model.pt`` without the ``last.pt`` beside it (removed, or the file alone copied there) when it is
-    of another run (another preset, mode, seed or data): training started over and replaced it without a word, the
-    run's ``-o`` check passed it by, and a model of another training was lost. One that cannot be read is no
-    model to lose (it is replaced)."""
-    if not model.is_file():
-        return
-    try:
-        ck = load_checkpoint(model, what=str(model))
-    except input_error_types():
-        return
-    other = _differs(ck, p, mode, seed)
-    if other is None and not same_data(ck.get("data"), identity):
-        data = ck.get("data")
-        before = ", ".join(str(x) for x in data.get("sources", [])) if isinstance(data, dict) else ""
-        other = f"trained on other data: {before or '?'}"
-    if other is not None:
-        raise input_error(
-            f"{model}: a model of another run ({other}), without its last.pt; use another -o, or remove {model.parent} "
-            "to start again"
-        )
-
-
 def train(
     cache: Cache | str | Path,
     *,
@@ -306,7 +230,7 @@ def train(
             opt.load_state_dict(ck["optimizer"])
             start_epoch, step, log, spent = int(ck["epoch"]), int(ck["step"]), list(ck["log"]), float(ck["seconds"])
         except (KeyError, TypeError, RuntimeError, ValueError) as exc:
-            raise input_error(f"{_not_a_checkpoint(last)} ({type(exc).__name__}: {exc})") from None
+            raise input_error(f"{not_a_checkpoint(last)} ({type(exc).__name__}: {exc})") from None
     log_path = out_p / "log.jsonl"
     if ck is not None:  # whole again from last.pt's log, also when nothing is left to train (plot_losses reads it)
         _write_log(log_path, log)
@@ -474,56 +398,6 @@ def _warn_without_targets(cache: Any, p: Preset, mode: str, indices: Sequence[in
         file=sys.stderr,
         flush=True,
     )
-
-
-def plot_losses(log_path: str | Path, png: str | Path) -> Path:
-    """Draws the total, heatmap and regression losses of ``log.jsonl`` (or several: one per line style) over
-    the optimiser steps into ``png``; returns ``png``."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    rows = [json.loads(line) for line in Path(log_path).read_text(encoding="utf-8").splitlines() if line.strip()]
-    steps = [r for r in rows if "loss" in r]
-    fig, ax = plt.subplots(figsize=(7, 4))
-    for key, style in (("loss", "-"), ("heatmap", "--"), ("regression", ":")):
-        ax.plot([r["step"] for r in steps], [r[key] for r in steps], style, label=key)
-    for r in rows:
-        if r.get("epoch_end"):
-            ax.axvline(r["step"], color="0.85", lw=0.8)
-    ax.set_yscale("log")
-    ax.set_xlabel("optimiser step (grey: epoch ends)")
-    ax.set_ylabel("loss per object")
-    ax.legend()
-    ax.set_title(f"training loss: {Path(log_path).parent.name}")
-    fig.tight_layout()
-    fig.savefig(png, dpi=110)
-    plt.close(fig)
-    return Path(png)
-
-
-def plot_runs(logs: dict[str, str | Path], png: str | Path, *, title: str) -> Path:
-    """The total loss of several runs' ``log.jsonl`` (by label) over the optimiser steps in one plot."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(7, 4))
-    for label, path in logs.items():
-        rows = [json.loads(x) for x in Path(path).read_text(encoding="utf-8").splitlines() if x.strip()]
-        steps = [r for r in rows if "loss" in r]
-        ax.plot([r["step"] for r in steps], [r["loss"] for r in steps], label=label, lw=0.9)
-    ax.set_yscale("log")
-    ax.set_xlabel("optimiser step")
-    ax.set_ylabel("loss per object")
-    ax.legend()
-    ax.set_title(title)
-    fig.tight_layout()
-    fig.savefig(png, dpi=110)
-    plt.close(fig)
-    return Path(png)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
