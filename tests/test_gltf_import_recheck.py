@@ -446,7 +446,11 @@ MALFORMED: dict[str, tuple[Any, str]] = {
     "negative roughness": (_factor({"roughnessFactor": -0.5}), "roughnessFactor"),
     # glTF draws what its scene's nodes place (spec 3.5.1); points and lines have no surface (3.7.2.1)
     "meshes but no scene": (_patched(lambda d: (d.j.pop("scene"), d.j.__setitem__("scenes", []))), "has no scene"),
-    "a scene placing no mesh": (_patched(lambda d: d.j["nodes"][0].pop("mesh")), "place none of its 1 meshes"),
+    "a scene placing no mesh": (_patched(lambda d: d.j["nodes"][0].pop("mesh")), "place no primitive of its 1 meshes"),
+    "a scene placing a mesh without primitives": (
+        _patched(lambda d: d.j["meshes"].append({"primitives": []}) or d.j["nodes"][0].__setitem__("mesh", 1)),
+        "scenes[0], whose nodes place no primitive of its 2 meshes",
+    ),
     "points only": (_patched(lambda d: d.j["meshes"][0]["primitives"][0].__setitem__("mode", 0)), "POINTS"),
     "lines only": (_patched(lambda d: d.j["meshes"][0]["primitives"][0].__setitem__("mode", 3)), "LINE_STRIP"),
 }  # fmt: skip

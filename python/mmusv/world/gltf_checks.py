@@ -573,18 +573,20 @@ def _surface_checks(shown: str, data: dict[str, object], where: str) -> None:
     if not prims:
         return  # no primitive at all: "holds no triangles" says it
     drawn = _drawn_meshes(data)
-    if drawn is None or not drawn[1]:
+    modes = [] if drawn is None else [(i, j, p.get("mode", 4)) for i, j, p in prims if i in drawn[1]]
+    if drawn is None or not modes:
+        meshes = data.get("meshes")
+        n = len(meshes) if isinstance(meshes, list) else 0
         what = (
             "has no scene (no scenes list)"
             if drawn is None
-            else f"draws scenes[{drawn[0]}], whose nodes place none of its {len(data.get('meshes') or [])} meshes"  # type: ignore[arg-type]
+            else f"draws scenes[{drawn[0]}], whose nodes place no primitive of its {n} meshes"
         )
         raise AssetSpecError(
             where,
             f"{shown} {what}: a glTF draws only the meshes its scene's nodes place, so it holds no triangles to "
             "read; export it with its meshes placed in a scene (a node naming each mesh, in scenes[].nodes)",
         )
-    modes = [(i, j, p.get("mode", 4)) for i, j, p in prims if i in drawn[1]]
     loose = [(i, j, m) for i, j, m in modes if m in (0, 1, 2, 3)]
     listed = ", ".join(f"meshes[{i}].primitives[{j}] {_MODES[m]}" for i, j, m in loose[:3])
     listed += ", ..." if len(loose) > 3 else ""
