@@ -1,7 +1,11 @@
 """Semantic classes shared by every mesh, sensor and annotation, with a fixed colour palette.
 
-Class ids are ``uint16`` in Rust and numpy. ``0`` means "nothing hit" (sky, no return). The palette is the
-one quick-look images and semantic camera PNGs use: ``PALETTE[class_id]`` is an ``(R, G, B)`` uint8 triple.
+Class ids are ``uint16`` in Rust and in the sensors' numpy arrays (the annotation columns widen them to uint32, the
+Parquet tables and :class:`~mmusv.recording.decode.WorldFrame` to int64). ``0`` means "nothing hit" (sky, no
+return; the radar's rain clutter has it too). The palette is the one the quick-look images use (``mmusv preview``'s
+semantic panels, SemanticKITTI's ``color_map``): ``PALETTE[class_id]`` is an ``(R, G, B)`` uint8 triple. The
+recorded semantic images are not coloured: their PNGs hold the class ids themselves, 16-bit gray
+(``docs/recording.md``).
 """
 
 from __future__ import annotations
