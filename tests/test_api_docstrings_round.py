@@ -8,10 +8,12 @@ import inspect
 from pathlib import Path
 from typing import Any
 
+import mmusv.annotate
 import mmusv.classes
 import numpy as np
 import pytest
 from mmusv import Simulation, run
+from mmusv.annotate import SilhouetteCache, annotate_agent
 from mmusv.recording import decode_image
 from mmusv.recording.info import read_info
 from mmusv.recording.stream import FrameStream
@@ -64,3 +66,38 @@ def test_recorded_semantic_images_are_class_ids_not_the_palette(recorded: Path) 
     doc = inspect.getdoc(mmusv.classes) or ""
     assert "semantic camera PNGs use" not in doc
     assert "class ids themselves" in doc
+
+
+def test_box_pixels_are_the_pixels_the_2d_box_touches() -> None:
+    """``box_pixels`` was "the recorded box's area, whole pixels" (docs/recording.md: "pixels of the clipped box"):
+    it is the count of the pixels the box touches, ``(ceil x_max - floor x_min) * (ceil y_max - floor y_min)``,
+    the window ``visible_pixels`` is counted in, well above the box's area for a small box."""
+    sim = Simulation(_scenario())
+    cap = sim.capture(0, sensors=["lidar", "cameras"])
+    ac, agent = cap.agents["u"], sim.agent("u")
+    assert ac.lidar is not None
+    cams = {n: (agent.cameras[n][0], ac.camera_poses[n], ac.cameras[n].instance) for n in ac.cameras}
+    ann = annotate_agent(
+        agent_id="u",
+        agent_index=agent.index,
+        frame=0,
+        time_s=cap.time_s,
+        vessels=sim.vessels,
+        state=cap.world,
+        lidar_pose=ac.lidar_pose,
+        lidar_instances=ac.lidar.instance,
+        cameras=cams,
+        silhouettes=SilhouetteCache(sim.assets),
+        max_range_m=200.0,
+    )
+    cam = ann.columns()["camera"]
+    assert len(cam["target_id"]) >= 1
+    x0, y0, x1, y1 = (cam[k] for k in ("x_min", "y_min", "x_max", "y_max"))
+    touched = (np.ceil(x1) - np.floor(x0)) * (np.ceil(y1) - np.floor(y0))
+    np.testing.assert_array_equal(cam["box_pixels"], touched.astype(np.uint32))
+    assert (cam["box_pixels"] > np.round((x1 - x0) * (y1 - y0))).all()  # not the area
+    doc = inspect.getdoc(mmusv.annotate) or ""
+    assert "the recorded box's area, whole pixels" not in doc
+    assert "ceil(x_max) − floor(x_min)" in doc
+    docs = (Path(__file__).resolve().parents[1] / "docs/recording.md").read_text()
+    assert "// pixels of the clipped box" not in docs

@@ -13,7 +13,8 @@ agent's own hull is never a target):
   part of the 3D box's image inside the image (its faces' images united and clipped to the border, so a long hull
   seen at a slant and cut by a corner gets no empty band), with ``truncation`` = 1 − the area of the bounding box
   clipped to the image / its unclipped area, ``visible_pixels`` (pixels whose instance is the vessel),
-  ``box_pixels`` (the recorded box's area, whole pixels) and
+  ``box_pixels`` (the pixels the recorded box touches, ``(ceil(x_max) − floor(x_min)) · (ceil(y_max) −
+  floor(y_min))``, not its area in pixels²: the window ``visible_pixels`` is counted in) and
   ``occlusion`` = 1 − visible / silhouette over the vessel's part above the still water level (world z > 0):
   the silhouette is the pixels whose rays, cast against the vessel alone, meet it above that level (the part of
   the hull a flat calm sea never hides; all of them for a vessel met only below it, a small craft wholly in a wave
@@ -209,7 +210,8 @@ class Annotations:
           footprint in the LiDAR frame's xy plane);
         - ``camera`` (pixels, origin top-left, clipped to the image): ``target_id``, ``camera``, ``role`` lists of
           str; ``x_min``, ``y_min``, ``x_max``, ``y_max``, ``truncation``, ``occlusion``, ``wave_occlusion``
-          ``(n2d,)`` float64; ``visible_pixels``, ``box_pixels`` ``(n2d,)`` uint32; ``static`` ``(n2d,)`` bool.
+          ``(n2d,)`` float64; ``visible_pixels``, ``box_pixels`` (the pixels the box touches, module docstring)
+          ``(n2d,)`` uint32; ``static`` ``(n2d,)`` bool.
         """
         n = len(self.lidar_ids)
         centre = np.array(self.lidar_center, dtype=np.float64).reshape(n, 3)
