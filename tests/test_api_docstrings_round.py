@@ -4,6 +4,7 @@ recorded. Each test pins a docstring that said something the code does not do.""
 
 from __future__ import annotations
 
+import dataclasses
 import inspect
 from pathlib import Path
 from typing import Any
@@ -17,6 +18,9 @@ from mmusv.annotate import SilhouetteCache, annotate_agent
 from mmusv.recording import decode_image
 from mmusv.recording.info import read_info
 from mmusv.recording.stream import FrameStream
+from mmusv.sensors.radar import ppi_image
+
+PPI_SIZE = 33  # odd: its default scale is the range over 16 pixels, not 16.5
 
 
 def _scenario() -> dict[str, Any]:
@@ -25,6 +29,7 @@ def _scenario() -> dict[str, Any]:
         "lidar": {"channels": 8, "points_per_second": 8 * 360 * 5},
         "cameras": [{"name": "front", "resolution": [48, 32], "mount": {"point": "camera_front"}}],
         "top_view": {"resolution": [32, 32], "metres_per_pixel": 0.5},
+        "radar": {"range_m": 300, "azimuth_bins": 64, "rays_el": 2, "ppi_size_px": PPI_SIZE},
     }
     return {
         "name": "docstrings",
@@ -101,3 +106,29 @@ def test_box_pixels_are_the_pixels_the_2d_box_touches() -> None:
     assert "ceil(x_max) − floor(x_min)" in doc
     docs = (Path(__file__).resolve().parents[1] / "docs/recording.md").read_text()
     assert "// pixels of the clipped box" not in docs
+
+
+def test_recorded_ppi_scale_is_the_drawn_one_for_an_odd_size(recorded: Path) -> None:
+    """``AgentInfo.ppi_metres_per_pixel`` (and ``RadarConfig``'s docstring) took the default scale as ``range_m /
+    (ppi_size_px / 2)``; the PPI is drawn at ``range_m / (ppi_size_px // 2)`` (``ppi_request``), so for an odd
+    size the scale read back from a recording (and the preview's range rings) was off by one part in ``size``."""
+    sim = Simulation(_scenario())
+    ret = sim.capture(0, sensors=["radar"]).agents["u"].radar
+    assert ret is not None
+    scale = read_info(recorded).agents[0].ppi_metres_per_pixel
+    assert scale is not None
+    # One return dead ahead at 290 m, drawn head-up at the default scale: the ego is pixel (16, 16), centre 16.5,
+    # and the return lies 290 m / scale above it.
+    one = dataclasses.replace(
+        ret,
+        range=np.array([290.0], np.float32),
+        azimuth=np.zeros(1, np.float32),
+        elevation=np.zeros(1, np.float32),
+        intensity=np.ones(1, np.float32),
+        instance_id=np.full(1, -1, np.int32),
+        semantic_class=np.ones(1, np.uint16),
+    )
+    rows, cols = np.nonzero(ppi_image(one, size_px=PPI_SIZE, orientation="head_up") > 0)
+    assert set(cols.tolist()) == {PPI_SIZE // 2}
+    assert set(rows.tolist()) == {int(np.floor(PPI_SIZE // 2 + 0.5 - 290.0 / scale))}
+    assert scale == pytest.approx(300.0 / (PPI_SIZE // 2))

@@ -122,7 +122,7 @@ def test_ppi_ring_scale_from_the_recording(recording: Path) -> None:
     _sheet, panels = compose_preview(recording, frame=0)
     ppi = next(p for p in panels if "PPI" in p.title)
     a = read_info(recording).agents[0]
-    assert a.ppi_metres_per_pixel == pytest.approx(1000 / 32)  # range_m / (ppi_size_px / 2)
+    assert a.ppi_metres_per_pixel == pytest.approx(1000 / 32)  # range_m / (ppi_size_px // 2)
     # the panel spans the PPI image: 64 px × m/px metres across
     assert ppi.scale * 64 * a.ppi_metres_per_pixel == pytest.approx(ppi.box[2] - ppi.box[0])
 

@@ -99,12 +99,13 @@ class AgentInfo:
     @property
     def ppi_metres_per_pixel(self) -> float | None:
         """Metres per pixel of the recorded radar PPI (``ppi_metres_per_pixel``, default ``range_m / (ppi_size_px
-        / 2)``, as in :class:`mmusv.sensors.config.RadarConfig`); ``None`` without a radar."""
+        // 2)``, as :func:`mmusv.sensors.radar.ppi_request` drew it; :class:`mmusv.sensors.config.RadarConfig`);
+        ``None`` without a radar."""
         radar = self.rig.get("radar")
         if not radar:
             return None
         mpp = radar.get("ppi_metres_per_pixel")
-        return float(mpp) if mpp else float(radar["range_m"]) / (int(radar["ppi_size_px"]) / 2)
+        return float(mpp) if mpp else float(radar["range_m"]) / max(int(radar["ppi_size_px"]) // 2, 1)
 
 
 @dataclass

@@ -244,7 +244,8 @@ class RadarConfig(_Model):
         polarisation: ``"HH"`` (marine radars) or ``"VV"``: sea clutter's σ⁰ (NRL model) and rain attenuation
             (ITU-R P.838-3) follow it.
         ppi_size_px, ppi_metres_per_pixel, ppi_orientation: the PPI image; ``ppi_metres_per_pixel`` defaults to
-            ``range_m / (ppi_size_px / 2)``.
+            ``range_m / (ppi_size_px // 2)`` (:func:`mmusv.sensors.radar.ppi_request`: the range from the ego's
+            pixel to the edge of an odd size too).
 
     Why ``detection_threshold`` 0.3 and ``sea_clutter_sigma0`` 4e-7 (and not the 0.01 / 4e-6 the core's unit
     tests use): these are the values every scenario and recording has always been made with, and they keep a
