@@ -11,6 +11,7 @@ from typing import Any
 
 import mmusv.annotate
 import mmusv.classes
+import mmusv.sensors.config
 import numpy as np
 import pytest
 from mmusv import Simulation, run
@@ -18,7 +19,10 @@ from mmusv.annotate import SilhouetteCache, annotate_agent
 from mmusv.recording import decode_image
 from mmusv.recording.info import read_info
 from mmusv.recording.stream import FrameStream
+from mmusv.sensors.config import Mount
+from mmusv.sensors.mounts import mount_matrix
 from mmusv.sensors.radar import ppi_image
+from mmusv.world.vessels import get_asset
 
 PPI_SIZE = 33  # odd: its default scale is the range over 16 pixels, not 16.5
 
@@ -132,3 +136,18 @@ def test_recorded_ppi_scale_is_the_drawn_one_for_an_odd_size(recorded: Path) -> 
     assert set(cols.tolist()) == {PPI_SIZE // 2}
     assert set(rows.tolist()) == {int(np.floor(PPI_SIZE // 2 + 0.5 - 290.0 / scale))}
     assert scale == pytest.approx(300.0 / (PPI_SIZE // 2))
+
+
+def test_a_mount_point_missing_from_an_asset_without_points_is_half_a_metre_over_the_hull() -> None:
+    """``mmusv.sensors.config`` said a sensor on an asset without mount points falls back to "the top of the hull's
+    bounding box"; it sits 0.5 m above it, over the vessel origin, turned the way the point's name looks."""
+    asset = get_asset("fishing_boat_12m")
+    assert not asset.mounts
+    top = float(asset.bbox[1, 2])
+    for point, yaw in (("lidar", 0.0), ("camera_left", 90.0), ("camera_rear", 180.0), ("camera_right", -90.0)):
+        m = mount_matrix(asset, Mount(point=point), where="test")
+        np.testing.assert_allclose(m[:3, 3], [0.0, 0.0, top + 0.5], atol=1e-12)
+        forward = m[:3, 0]
+        assert np.degrees(np.arctan2(forward[1], forward[0])) == pytest.approx(yaw, abs=1e-9)
+    doc = inspect.getdoc(mmusv.sensors.config) or ""
+    assert "0.5 m above the top of the hull's bounding box" in doc

@@ -17,8 +17,10 @@ Mounts: ``point`` names a mount point of the vessel asset (``lidar``, ``radar``,
 ``mmusv assets``); ``xyz`` (metres) and ``rpy_deg`` (degrees) are then relative to that point, in the point's own
 frame (axes of the vessel body frame, x forward, y left, z up, turned by the point's rpy: on ``camera_left``, which
 looks left, ``xyz: [1, 0, 0]`` moves the sensor 1 m to the left). Without ``point``, they are relative to the vessel
-origin (midship, at the waterline), in the vessel body frame. Assets without any mount point fall back to the top
-of the hull's bounding box (a point an asset with mount points lacks is refused). ``xyz`` is within ±100 km
+origin (midship, at the waterline), in the vessel body frame. On an asset without any mount point, a named point
+falls back to 0.5 m above the top of the hull's bounding box over the vessel origin, looking where the name says
+(``camera_left`` +90° yaw, ``camera_rear`` 180°, ``camera_right`` −90°, any other name ahead); a point an asset
+with mount points lacks is refused. ``xyz`` is within ±100 km
 (:data:`MAX_MOUNT_OFFSET_M`) and ``rpy_deg`` within ±360 degrees.
 """
 
