@@ -151,3 +151,33 @@ def test_a_mount_point_missing_from_an_asset_without_points_is_half_a_metre_over
         assert np.degrees(np.arctan2(forward[1], forward[0])) == pytest.approx(yaw, abs=1e-9)
     doc = inspect.getdoc(mmusv.sensors.config) or ""
     assert "0.5 m above the top of the hull's bounding box" in doc
+
+
+def test_lidar_box_beams_hold_every_beam_that_meets_a_box_seen_broadside() -> None:
+    """``lidar_box_beams`` promises the beams within the box's angular extent, and the LiDAR's wave-occlusion share
+    counts "the rays that meet the vessel alone above the still level" (docs/recording.md); the elevation window was
+    the corners' elevations only, and a hull seen broadside reaches lower (and higher) between its corners: beams
+    meeting a 90 m hull 10 m abeam at its waterline were left out of the share."""
+    from mmusv import Scene
+    from mmusv.annotate import box_corners
+    from mmusv.wave_occlusion import lidar_box_beams, pattern_angles
+
+    el = np.deg2rad(np.linspace(-25.0, 15.0, 32))
+    az = np.linspace(-np.pi, np.pi, 720, endpoint=False)
+    a, e = np.meshgrid(az, el, indexing="ij")
+    pattern = np.stack([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)], -1).reshape(-1, 3).astype(np.float32)
+    pose = np.eye(4)
+    pose[2, 3] = 2.2  # a USV's LiDAR, 2.2 m over the still water
+    box = np.eye(4)
+    box[:3, 3] = [0.0, 10.0, 4.0]  # 90 m long, 15 m beam, 4 m draft and 12 m above the water, 10 m abeam
+    size = np.array([90.0, 15.0, 16.0])
+    corners = box_corners(box, size)
+    scene = Scene()
+    faces = [(0, 2, 1), (1, 2, 3), (4, 5, 6), (5, 7, 6), (0, 1, 4), (1, 5, 4), (2, 6, 3), (3, 6, 7)]
+    faces += [(0, 4, 2), (2, 4, 6), (1, 3, 5), (3, 7, 5)]
+    scene.add_instance(scene.add_mesh(corners, np.array(faces), classes=10), pose=np.eye(4))
+    origins = np.tile(pose[:3, 3], (len(pattern), 1))
+    meets = np.flatnonzero(scene.cast_rays(origins, pattern).hit)
+    beams = lidar_box_beams(pattern_angles(pattern), lidar_pose=pose, corners_world=corners)
+    assert len(meets) > 0
+    assert np.setdiff1d(meets, beams).size == 0, "beams that meet the box are outside its window"

@@ -297,15 +297,35 @@ def test_shares_read_from_the_capture_equal_the_beams_cast_again() -> None:
 
 
 def _box_beams_by_testing_every_beam(pattern: np.ndarray, pose: np.ndarray, corners: np.ndarray) -> np.ndarray:
-    """Indices of the beams within the box's azimuth and elevation extent, every beam tested (the definition)."""
+    """Indices of the beams within the box's azimuth and elevation extent, every beam tested (the definition): the
+    azimuths of its corners, the elevations of every point of its edges (a box seen broadside reaches higher and
+    lower between its corners; each edge's extremes found by a bounded search, as the elevation along a segment has
+    one stationary point), every beam where the LiDAR's vertical axis passes through the box (the tests' LiDARs turn
+    about z only and their boxes are upright: where the LiDAR's x, y lie within the box's)."""
+    from scipy.optimize import minimize_scalar
+
     p = np.asarray(pattern, dtype=np.float64)
     paz, pel = np.arctan2(p[:, 1], p[:, 0]), np.arctan2(p[:, 2], np.hypot(p[:, 0], p[:, 1]))
+    lo_xy, hi_xy = corners[:, :2].min(axis=0), corners[:, :2].max(axis=0)
+    if np.all((lo_xy <= pose[:2, 3]) & (pose[:2, 3] <= hi_xy)):
+        return np.arange(len(p))
     inv = np.linalg.inv(pose)
     c = corners @ inv[:3, :3].T + inv[:3, 3]
     az, el = np.arctan2(c[:, 1], c[:, 0]), np.arctan2(c[:, 2], np.hypot(c[:, 0], c[:, 1]))
+    lo, hi = el.min(), el.max()
+    edges = [(i, j) for i in range(8) for j in range(i + 1, 8) if bin(i ^ j).count("1") == 1]
+    for a, b in edges:
+
+        def elevation(t: float, a: int = a, b: int = b) -> float:
+            q = c[a] + t * (c[b] - c[a])
+            return float(np.arctan2(q[2], np.hypot(q[0], q[1])))
+
+        fine = {"xatol": 1e-12}
+        lo = min(lo, minimize_scalar(elevation, bounds=(0.0, 1.0), method="bounded", options=fine).fun)
+        hi = max(hi, -minimize_scalar(lambda t: -elevation(t), bounds=(0.0, 1.0), method="bounded", options=fine).fun)
     mid = np.arctan2(np.sin(az).mean(), np.cos(az).mean())
     rel = np.angle(np.exp(1j * (az - mid)))
-    inside = (pel >= el.min()) & (pel <= el.max())
+    inside = (pel >= lo) & (pel <= hi)
     prel = np.angle(np.exp(1j * (paz - mid)))
     return np.flatnonzero(inside & (prel >= rel.min()) & (prel <= rel.max()))
 

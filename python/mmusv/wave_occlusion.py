@@ -16,10 +16,12 @@ silhouette is empty. :func:`exposed_rays` is the one home of this rule; the came
 
 * Cameras: the rays of the box's pixels; "stopped at the water" reads the captured instance image (the water
   instance there).
-* LiDAR: the LiDAR's own beams within the box's angular extent (azimuth and elevation of its corners seen from
-  the LiDAR), cast against the vessel alone and then against the full scene; in a capture the full scene's
-  answer is the one the LiDAR's own cast found (:attr:`~mmusv.simulation.AgentCapture.lidar_beams`), read
-  rather than cast again. Only the part of the vessel within the LiDAR's range counts.
+* LiDAR: the LiDAR's own beams within the box's angular extent (the azimuths of its corners and the elevations of
+  every point of its edges seen from the LiDAR: a box seen broadside reaches higher and lower between its corners;
+  every beam when the LiDAR's z axis passes through the box), cast against the vessel alone and then against the
+  full scene; in a capture the full scene's answer is the one the LiDAR's own cast found
+  (:attr:`~mmusv.simulation.AgentCapture.lidar_beams`), read rather than cast again. Only the part of the vessel
+  within the LiDAR's range counts.
 
 Frames: world x east, y north, z up, metres; directions need not be unit length. The LiDAR frame is the LiDAR's
 body frame (x forward, y left, z up); a LiDAR pose is the ``(4, 4)`` rigid LiDAR → world transform.
@@ -460,12 +462,15 @@ def lidar_boxes_beams(
     inv = np.linalg.inv(lidar_pose)
     c = corners @ inv[:3, :3].T + inv[:3, 3]  # (B, 8, 3): box by box, the same product as one (8, 3) box alone
     az = np.arctan2(c[..., 1], c[..., 0])
-    el = np.arctan2(c[..., 2], np.hypot(c[..., 0], c[..., 1]))
     # Azimuths relative to each box's mean direction, so a box straddling ±π is one interval.
     mids = [np.arctan2(s, co) for s, co in zip(np.sin(az).mean(axis=1), np.cos(az).mean(axis=1), strict=True)]
     mid = np.array(mids, dtype=np.float64)
     rel = np.angle(np.exp(1j * (az - mid[:, None])))
-    rel_lo, rel_hi, el_lo, el_hi = rel.min(axis=1), rel.max(axis=1), el.min(axis=1), el.max(axis=1)
+    rel_lo, rel_hi = rel.min(axis=1), rel.max(axis=1)
+    el_lo, el_hi, around = _elevation_extent(c)
+    # A box the LiDAR's z axis passes through surrounds it: every azimuth, every elevation.
+    rel_lo, rel_hi = np.where(around, -np.pi, rel_lo), np.where(around, np.pi, rel_hi)
+    el_lo, el_hi = np.where(around, -np.pi / 2, el_lo), np.where(around, np.pi / 2, el_hi)
     # Candidates: the beams whose azimuth lies in the window (a margin wider, wrapped into [-π, π]) by binary
     # search on the sorted azimuths; the exact test below then keeps what testing every beam would keep.
     cands = [
@@ -480,6 +485,43 @@ def lidar_boxes_beams(
     np.cumsum(np.bincount(box[keep], minlength=n_boxes), out=starts[1:])
     beams: npt.NDArray[np.int64] = cand[keep].astype(np.int64, copy=False)
     return beams, starts
+
+
+_PAIRS = np.array([(a, b) for a in range(8) for b in range(a + 1, 8)], dtype=np.int64)
+"""Every pair of a box's corners: its twelve edges among them, whatever order the corners come in."""
+
+
+def _elevation_extent(c: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(el_lo, el_hi, around)`` of ``B`` boxes' corners ``c`` ``(B, 8, 3)`` in the LiDAR frame: the lowest and
+    highest elevation (radians) of any point of each box, and whether the LiDAR's z axis passes through it (then
+    the box surrounds the LiDAR in azimuth and reaches ±π/2; ``el_lo``/``el_hi`` are not meaningful there).
+
+    A box seen broadside reaches higher and lower between its corners than at them (the elevation of its top edge
+    is greatest where the edge passes nearest), so the corners alone bound too narrow a band. The extremes of the
+    elevation over a convex box that the z axis misses lie on its edges; along a segment ``p(t)``, ``tan el = z(t)
+    / r(t)`` has one stationary point, ``t = (z0·B/2 − dz·C) / (dz·B/2 − z0·A)`` with ``r(t)² = A·t² + B·t + C``,
+    so each edge's extremes are its ends or that point (every pair of corners is tried: the edges are among them
+    whatever the corners' order, and the other pairs lie inside the box). The z axis passes through the box when the
+    corners' azimuths leave no gap wider than π (the origin lies in their convex hull in the xy plane)."""
+    x0 = c[:, _PAIRS[:, 0]]  # (B, 28, 3)
+    d = c[:, _PAIRS[:, 1]] - x0
+    a = d[..., 0] ** 2 + d[..., 1] ** 2
+    b = 2.0 * (x0[..., 0] * d[..., 0] + x0[..., 1] * d[..., 1])
+    cc = x0[..., 0] ** 2 + x0[..., 1] ** 2
+    num = x0[..., 2] * b / 2.0 - d[..., 2] * cc
+    den = d[..., 2] * b / 2.0 - x0[..., 2] * a
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.where(den != 0.0, num / np.where(den != 0.0, den, 1.0), 0.0)
+    t = np.clip(np.nan_to_num(t, nan=0.0, posinf=1.0, neginf=0.0), 0.0, 1.0)[..., None]
+    p = np.concatenate([c, x0 + t * d], axis=1)  # the corners and each pair's stationary point
+    el = np.arctan2(p[..., 2], np.hypot(p[..., 0], p[..., 1]))
+    r = np.hypot(c[..., 0], c[..., 1])
+    az = np.sort(np.arctan2(c[..., 1], c[..., 0]), axis=1)
+    gaps = np.concatenate([np.diff(az, axis=1), (az[:, :1] + 2 * np.pi) - az[:, -1:]], axis=1)
+    around = (gaps.max(axis=1) <= np.pi + 1e-9) | (r.min(axis=1) <= 1e-9)
+    lo: np.ndarray = el.min(axis=1)
+    hi: np.ndarray = el.max(axis=1)
+    return lo, hi, around
 
 
 def lidar_beam_rays(
