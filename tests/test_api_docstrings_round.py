@@ -181,3 +181,35 @@ def test_lidar_box_beams_hold_every_beam_that_meets_a_box_seen_broadside() -> No
     beams = lidar_box_beams(pattern_angles(pattern), lidar_pose=pose, corners_world=corners)
     assert len(meets) > 0
     assert np.setdiff1d(meets, beams).size == 0, "beams that meet the box are outside its window"
+
+
+@pytest.mark.parametrize("camera_range", [20.0, 5000.0])
+def test_a_vessel_beyond_the_camera_range_is_not_hidden_by_the_waves(camera_range: float) -> None:
+    """``CameraConfig.range_m``: a vessel beyond it is not seen, and the sea beyond it is still drawn; a 2D box's
+    ``wave_occlusion`` is the share of the vessel the water hides (docs/recording.md: of the rays that meet it
+    alone, the share the full scene stops at the water first). A fishing boat 35 m ahead of a camera of 20 m range
+    got a 2D box with ``wave_occlusion`` 0.6 over a physical sea: the water the camera drew in front of it
+    (beyond its range) counted as waves hiding it. Beyond the range it is neither seen nor hidden: no 2D box."""
+    from mmusv.acquire import annotations_for
+
+    cam = {"name": "f", "resolution": [64, 48], "range_m": camera_range, "mount": {"point": "camera_front"}}
+    sc = {
+        "name": "beyond",
+        "seed": 3,
+        "map": {"type": "open_sea", "seed": 0},
+        "acquisition": {"frames": 1},
+        "environment": {"motion": "physical"},
+        "rigs": {"r": {"preset": "lidar_only", "cameras": [cam]}},
+        "vessels": [
+            {"id": "u", "role": "usv", "asset": "usv_wamv", "rig": "r", "speed_mps": 0, "route": [[0, 0], [50, 0]]},
+            {"id": "t", "asset": "fishing_boat_12m", "speed_mps": 0, "route": [[35, 0], [35, 60]]},
+        ],
+    }
+    sim = Simulation(sc)
+    ann = annotations_for(sim, sim.capture(0), SilhouetteCache())["u"].columns()
+    assert ann["lidar"]["target_id"] == ["t"]  # within the LiDAR's range: a 3D box either way
+    cam_rows = ann["camera"]
+    if camera_range < 35.0:
+        assert cam_rows["target_id"] == []
+    else:
+        assert cam_rows["target_id"] == ["t"] and int(cam_rows["visible_pixels"][0]) > 0

@@ -114,7 +114,10 @@ def annotations_for(sim: Simulation, cap: FrameCapture, silhouettes: SilhouetteC
         ac = cap.agents.get(agent.id)
         if ac is None:
             continue
-        cams = {name: (agent.cameras[name][0], ac.camera_poses[name], img.instance) for name, img in ac.cameras.items()}
+        cams = {
+            name: (agent.cameras[name][0], ac.camera_poses[name], img.instance, agent.cameras[name][1].range_m)
+            for name, img in ac.cameras.items()
+        }
         rng = agent.rig.lidar.range_m if agent.rig.lidar is not None else 200.0
         out[agent.id] = annotate_agent(
             agent_id=agent.id,

@@ -390,7 +390,7 @@ def annotate_agent(
     state: Any,
     lidar_pose: np.ndarray | None,
     lidar_instances: np.ndarray | None,
-    cameras: dict[str, tuple[Any, np.ndarray, np.ndarray]],
+    cameras: Mapping[str, tuple[Any, np.ndarray, np.ndarray] | tuple[Any, np.ndarray, np.ndarray, float]],
     silhouettes: SilhouetteCache,
     max_range_m: float,
     scene: Scene | None = None,
@@ -404,7 +404,11 @@ def annotate_agent(
         state: the ``WorldState`` of the frame.
         lidar_pose: ``(4, 4)`` LiDAR → world (boxes are expressed in this frame; the vessel body if ``None``).
         lidar_instances: ``(N,)`` instance id of each LiDAR point (for the point counts).
-        cameras: name -> (native camera, ``(4, 4)`` camera body → world, ``(H, W)`` instance image).
+        cameras: name -> (native camera, ``(4, 4)`` camera body → world, ``(H, W)`` instance image[, range_m]):
+            ``range_m`` the camera's :attr:`~mmusv.sensors.config.CameraConfig.range_m` (metres; ``inf`` when left
+            out): the part of a vessel beyond it is neither seen nor hidden (the camera draws the sea there), so a
+            vessel wholly beyond it gets no 2D box, and the water drawn in front of it counts for no
+            ``wave_occlusion``.
         max_range_m: vessels whose BEV footprint lies wholly beyond this range of the LiDAR
             (:func:`footprint_in_range`) get no 3D/BEV box.
         scene: the full scene; where it has a wave surface, the boxes' ``wave_occlusion`` is computed (else 0).
@@ -445,10 +449,18 @@ def annotate_agent(
         counts = {int(i): int(c) for i, c in zip(ids, cnt, strict=True)}
     # Per pinhole camera, once: intrinsics, the world → camera-body transform and the pose as the binding takes it.
     views = {}
-    for name, (cam, pose, inst_img) in cameras.items():
+    reaches: dict[str, float] = {}
+    for name, entry in cameras.items():
+        if not isinstance(entry, (tuple, list)) or len(entry) not in (3, 4):
+            raise InputError(
+                f"cameras[{name!r}] = {arguments.shown(entry)}: must be (camera, (4, 4) pose, (H, W) instance image"
+                "[, range_m])"
+            )
+        cam, pose, inst_img = entry[0], entry[1], entry[2]
         if cam.intrinsics is not None:
             inv, p = np.linalg.inv(pose), np.ascontiguousarray(pose, dtype=np.float64)
             views[name] = (cam, cam.intrinsics, inv, p, inst_img, camera_lens(cam, pose=p, world_to_body=inv))
+            reaches[name] = _range(entry[3]) if len(entry) > 3 else float("inf")
     rotations: list[np.ndarray] = []  # the 3D boxes' rotation matrices, turned into quaternions in one call
     share_boxes: list[tuple[int, np.ndarray, str, np.ndarray]] = []  # 3D box row, corners, asset, pose
     # 2D box row, its pixels' rays (origins, unit directions), distances to the vessel alone, instances seen first
@@ -498,6 +510,8 @@ def annotate_agent(
             pix = np.ascontiguousarray((vv * w + uu).reshape(-1), dtype=np.int64)
             o, d = cam.pixel_rays(pose, pix)
             t_alone = silhouettes.distances(info.asset, pose=state.matrices[vi], origins=o, directions=d)
+            # Beyond the camera's range the vessel is not drawn (the sea is): that part is neither seen nor hidden.
+            t_alone = np.where(np.asarray(t_alone) <= reaches[name], t_alone, np.inf)
             alone = np.isfinite(t_alone)
             sil = int(np.count_nonzero(alone))
             if sil == 0 and visible == 0:

@@ -355,7 +355,8 @@ class CameraConfig(_Model):
     order (none by default); ``noise`` adds seeded shot and read noise (none by default); ``exposure``
     (:class:`ExposureConfig`) is automatic unless fixed. Depth, semantic and instance images always come from the
     pixel centres. ``range_m`` (metres) is how far the camera traces surfaces: a vessel or island beyond it is not
-    seen, while the sea beyond it is still drawn, labelled water and given its still water's depth (so depth is
+    seen (a vessel wholly beyond it gets no 2D box, the part of one beyond it neither ``visible`` nor hidden by the
+    waves), while the sea beyond it is still drawn, labelled water and given its still water's depth (so depth is
     +inf, and the instance -1, exactly where the pixel sees the sky)."""
 
     name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$")
