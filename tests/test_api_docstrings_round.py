@@ -213,3 +213,23 @@ def test_a_vessel_beyond_the_camera_range_is_not_hidden_by_the_waves(camera_rang
         assert cam_rows["target_id"] == []
     else:
         assert cam_rows["target_id"] == ["t"] and int(cam_rows["visible_pixels"][0]) > 0
+
+
+def test_opv2v_protocol_fov_is_the_rings_when_elevations_are_given(tmp_path: Path) -> None:
+    """``LidarConfig.elevations_deg`` replaces the uniform ``vertical_fov_deg`` pattern; the OPV2V export's
+    ``data_protocol.yaml`` gave ``upper_fov``/``lower_fov`` from ``vertical_fov_deg`` (its default -25..15) even
+    then, not the rings the LiDAR fired."""
+    import yaml
+    from mmusv.export import convert
+
+    sc = _scenario()
+    sc["name"] = "rings"
+    rig = sc["rigs"]["r"]
+    rig["lidar"] = {"channels": 4, "elevations_deg": [-10.0, 6.0, -3.0, 0.0], "points_per_second": 4 * 360 * 5}
+    for key in ("cameras", "top_view", "radar"):
+        rig.pop(key)
+    rec = run(sc, out_dir=tmp_path / "rec").recording
+    convert([rec], out_dir=tmp_path / "opv2v", to="opv2v")
+    (protocol_file,) = (tmp_path / "opv2v").rglob("data_protocol.yaml")
+    lidar = yaml.safe_load(protocol_file.read_text())["vehicle_base"]["sensing"]["perception"]["lidar"]
+    assert (lidar["lower_fov"], lidar["upper_fov"]) == (-10.0, 6.0)

@@ -85,6 +85,16 @@ def heal_depth_png(d: np.ndarray) -> bytes:
     return encode_png(np.where(near, metres, HEAL_DEPTH_FAR).astype(np.uint8), compress_level=1)
 
 
+def _fov(lidar: dict[str, Any]) -> list[Any]:
+    """``[lower, upper]`` degrees of a recorded LiDAR rig's rings: its ``elevations_deg`` (which replace the
+    uniform ``vertical_fov_deg`` pattern, :class:`~mmusv.sensors.config.LidarConfig`) when given, else its
+    ``vertical_fov_deg``; ``[None, None]`` without either."""
+    rings = lidar.get("elevations_deg")
+    if rings:
+        return [min(rings), max(rings)]
+    return list(lidar.get("vertical_fov_deg") or [None, None])
+
+
 def timestamp(frame: int) -> str:
     """The OPV2V timestamp of acquisition index ``frame`` (6 digits, zero-padded)."""
     return f"{frame:06d}"
@@ -302,8 +312,8 @@ class Opv2vWriter(DatasetWriter):
                             "range": lidar.get("range_m"),
                             "points_per_second": lidar.get("points_per_second"),
                             "rotation_frequency": lidar.get("rotation_hz"),
-                            "upper_fov": (lidar.get("vertical_fov_deg") or [None, None])[1],
-                            "lower_fov": (lidar.get("vertical_fov_deg") or [None, None])[0],
+                            "upper_fov": _fov(lidar)[1],
+                            "lower_fov": _fov(lidar)[0],
                             "noise_stddev": lidar.get("range_noise_std_m"),
                             "dropoff_general_rate": lidar.get("dropout"),
                         },
