@@ -148,10 +148,12 @@ pub struct Box2D {
     /// Pixels of the target visible in the instance image.
     #[prost(uint32, tag = "8")]
     pub visible_pixels: u32,
-    /// Pixels inside the clipped box.
+    /// Pixels the clipped box touches, `(ceil x_max − floor x_min) · (ceil y_max − floor y_min)`: the window
+    /// `visible_pixels` is counted in.
     #[prost(uint32, tag = "9")]
     pub box_pixels: u32,
-    /// Fraction of the target hidden by other objects, 0..1.
+    /// Fraction of the target's part above the still water level that is hidden (by other objects and by the
+    /// waves), 0..1.
     #[prost(double, tag = "10")]
     pub occlusion: f64,
     /// Share of the target's part above the still water level that the waves hide from the camera, 0..1 (0 over
