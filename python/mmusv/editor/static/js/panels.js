@@ -855,7 +855,19 @@ export class Panels {
       if (value === null || value === "") delete d.environment[key];
       else d.environment[key] = value;
     });
-    $("e-time").addEventListener("change", (ev) => env("time_of_day", ev.target.value));
+    $("e-time").addEventListener("change", (ev) => {
+      // A box cleared, or one part of it (Backspace on the hours), reads as "": that was the time deleted, the
+      // schema's noon put in its place while the box showed --:-- (a night scenario saved as a midday one).
+      const box = ev.target;
+      if (box.value === "") {
+        const what = box.validity?.badInput ? "incomplete" : "empty";
+        const now = this.state.doc.environment?.time_of_day ?? "12:00";
+        this.refuse(box, `time of day: ${what}; type a 24-hour time, 00:00 to 23:59. The scenario keeps its time (${now}).`);
+        return;
+      }
+      this.accept(box);
+      env("time_of_day", box.value);
+    });
     $("e-weather").addEventListener("change", (ev) => env("weather", ev.target.value));
     const waveAllowed = () => {
       const [lo, hi] = this.waveRange();

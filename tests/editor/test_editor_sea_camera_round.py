@@ -1,0 +1,52 @@
+"""A sweep of the editor as a person clicking through the newest scenario knobs: the sea (wave, sea state, motion), the
+time of day (night included), the weather and the cameras' settings.
+
+Each browser test checks the browser's console for JavaScript errors (failed requests the page explains are not
+errors).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from selenium.webdriver.common.action_chains import ActionChains
+from selenium.webdriver.common.by import By
+from selenium.webdriver.common.keys import Keys
+from test_browser import LiveServer, document_of, settled
+from test_browser_round import js_errors, note
+from test_browser_round3 import open_file, value, write_scenario
+
+
+def hours(driver: Any, box: Any) -> None:
+    """Clicks the hours of the time box ``box`` (its left end)."""
+    ActionChains(driver).move_to_element_with_offset(box, -box.rect["width"] / 2 + 8, 0).click().perform()
+
+
+def test_a_time_box_left_without_a_time_keeps_the_scenarios_time(browser: Any, live_server: LiveServer) -> None:
+    """Clearing the time box, or one part of it (Backspace on the hours, as when typing a new hour), left the box
+    empty (``--:--``) while the scenario silently became noon, the schema's default: a night scenario saved so was
+    a midday one, with no word next to the box."""
+    env = {"time_of_day": "23:30", "weather": "fog", "visibility_m": 300}
+    write_scenario(live_server.folder, "night.yaml", environment=env)
+    open_file(browser, live_server, "night.yaml")
+    js_errors(browser)
+    box = browser.find_element(By.ID, "e-time")
+    assert value(browser, "e-time") == "23:30"
+    hours(browser, box)
+    box.send_keys(Keys.BACKSPACE)
+    box.send_keys(Keys.TAB)
+    settled(browser)
+    assert document_of(browser)["environment"]["time_of_day"] == "23:30"
+    assert not browser.execute_script("return window.mmusvEditor.state.dirty")
+    text = note(browser, "environment.time_of_day")
+    assert "time of day" in text and "00:00 to 23:59" in text and "keeps its time" in text, text
+    # a whole time typed again is taken (04:15, in the morning or afternoon as the browser's locale shows hours),
+    # and the note goes
+    hours(browser, box)
+    box.send_keys("0415")
+    box.send_keys(Keys.TAB)
+    settled(browser)
+    assert document_of(browser)["environment"]["time_of_day"] == value(browser, "e-time")
+    assert value(browser, "e-time") in ("04:15", "16:15")
+    assert note(browser, "environment.time_of_day") == ""
+    assert js_errors(browser) == []
