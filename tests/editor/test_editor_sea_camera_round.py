@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from typing import Any
 
+import yaml
 from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
@@ -49,4 +50,24 @@ def test_a_time_box_left_without_a_time_keeps_the_scenarios_time(browser: Any, l
     assert document_of(browser)["environment"]["time_of_day"] == value(browser, "e-time")
     assert value(browser, "e-time") in ("04:15", "16:15")
     assert note(browser, "environment.time_of_day") == ""
+    assert js_errors(browser) == []
+
+
+def test_a_wave_preset_written_in_lower_case_shows_as_that_preset(browser: Any, live_server: LiveServer) -> None:
+    """The schema reads ``wave: " w2"`` as W2, but a file that does not validate (here a vessel's speed) comes to the
+    page as written: its wave showed as "custom height…" beside an empty height box and no note, the W2 nowhere; with
+    a ``sea``, ``" w0"`` showed a custom wave instead of the sea."""
+    data = write_scenario(live_server.folder, "low.yaml", environment={"time_of_day": "21:00", "wave": " w2"})
+    data["vessels"][0]["speed_mps"] = -1
+    (live_server.folder / "low.yaml").write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+    open_file(browser, live_server, "low.yaml")
+    js_errors(browser)
+    assert value(browser, "e-wave") == "W2"
+    assert not browser.find_element(By.ID, "e-wave-height").is_displayed()
+    assert document_of(browser)["environment"]["wave"] == " w2"  # shown, not changed
+    data["environment"] = {"wave": "w0", "sea": {"state": 4}}
+    (live_server.folder / "low.yaml").write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+    open_file(browser, live_server, "low.yaml")
+    assert value(browser, "e-wave") == "sea"
+    assert value(browser, "e-sea") == '{"state":4}'
     assert js_errors(browser) == []

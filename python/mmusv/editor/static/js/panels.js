@@ -693,7 +693,9 @@ export class Panels {
   waveChoice() {
     const presets = this.state.choices.wave.map((w) => w.name);
     const env = this.state.doc.environment || {};
-    const wave = env.wave ?? "W0";
+    // a preset as the schema reads it: " w2" is W2 (a file that does not validate comes to the page as written, and
+    // its W2 showed as "custom height…" beside an empty box)
+    const wave = typeof env.wave === "string" ? env.wave.trim().toUpperCase() : env.wave ?? "W0";
     const custom = $("e-wave").querySelector('option[value="custom"]');
     custom.textContent = typeof wave === "number" ? `custom: H ${wave} m` : "custom height…";
     // a `sea` with the default wave: the sea sets the waves, not W0 (the select says so; picking a wave replaces it)
