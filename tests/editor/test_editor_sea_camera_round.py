@@ -13,9 +13,10 @@ import yaml
 from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
+from selenium.webdriver.support.select import Select
 from test_browser import LiveServer, document_of, settled
 from test_browser_round import js_errors, note
-from test_browser_round3 import open_file, value, write_scenario
+from test_browser_round3 import open_file, value, value_of, write_scenario
 
 
 def hours(driver: Any, box: Any) -> None:
@@ -70,4 +71,44 @@ def test_a_wave_preset_written_in_lower_case_shows_as_that_preset(browser: Any, 
     open_file(browser, live_server, "low.yaml")
     assert value(browser, "e-wave") == "sea"
     assert value(browser, "e-sea") == '{"state":4}'
+    assert js_errors(browser) == []
+
+
+def test_the_rig_panel_follows_a_preset_or_quality_picked_in_it(browser: Any, live_server: LiveServer) -> None:
+    """The rig panel was not drawn again while the focus was in it, and a select keeps the focus once picked: a
+    LiDAR-only preset picked there kept saying "radar: on" and "4 surround cameras" (the rig had neither), a camera
+    quality picked kept the summary of the one before ("own quality: rear draft" under a rig at draft), and a rig
+    removed with its button (which then held the focus) stayed on the page, until an edit after the focus left."""
+    rig = {
+        "quality": "high",
+        "cameras": [
+            {"name": "front", "resolution": [320, 240], "mount": {"point": "camera_front"}},
+            {"name": "rear", "resolution": [320, 240], "mount": {"point": "camera_rear"}, "quality": "draft"},
+        ],
+    }
+    write_scenario(live_server.folder, "rigs.yaml", rigs={"usv_standard": rig, "spare": {}})
+    open_file(browser, live_server, "rigs.yaml")
+    js_errors(browser)
+    css = '#rigs [data-rig="usv_standard"]'
+
+    def summary(css: str = css) -> str:
+        return str(browser.find_element(By.CSS_SELECTOR, f"{css} .summary").text)
+
+    assert summary().startswith("2 cameras (own quality: rear draft); carried by usv_1")
+    Select(browser.find_element(By.CSS_SELECTOR, f'{css} select[data-key="quality"]')).select_by_value("draft")
+    settled(browser)
+    assert document_of(browser)["rigs"]["usv_standard"]["quality"] == "draft"
+    assert summary().startswith("2 cameras; carried by usv_1"), summary()
+    spare = '#rigs [data-rig="spare"]'
+    assert summary(spare).startswith("4 surround cameras; carried by no vessel")
+    Select(browser.find_element(By.CSS_SELECTOR, f'{spare} select[data-key="preset"]')).select_by_value("lidar_only")
+    settled(browser)
+    assert document_of(browser)["rigs"]["spare"] == {"preset": "lidar_only"}
+    assert value_of(browser, f'{spare} select[data-key="radar"]') == "off"
+    assert summary(spare).startswith("no cameras; carried by no vessel"), summary(spare)
+    assert browser.execute_script("return document.activeElement.dataset.key") == "preset"  # the focus stays
+    browser.find_element(By.CSS_SELECTOR, f'{spare} button[data-action="remove"]').click()
+    settled(browser)
+    assert "spare" not in document_of(browser)["rigs"]
+    assert browser.find_elements(By.CSS_SELECTOR, spare) == []
     assert js_errors(browser) == []

@@ -706,11 +706,59 @@ export class Panels {
     return typeof wave === "string" && presets.includes(wave) ? wave : "custom";
   }
 
+  /** What the rig panel shows of rig `name`: each field's [label, kind, value, options, placeholder] by its key, and
+   * the summary line. */
+  rigView(name, rig) {
+    const lidar = rig.lidar === null ? null : rig.lidar || {};
+    const radarOn = rig.radar === undefined ? (rig.preset || "full") === "full" : rig.radar !== null;
+    const fields = {
+      preset: ["preset", "select", rig.preset || "full", this.state.choices.rig_preset],
+      "lidar.channels": ["LiDAR channels", "number", lidar?.channels ?? "", null, "default"],
+      "lidar.range_m": ["LiDAR range m", "number", lidar?.range_m ?? "", null, "default"],
+      radar: ["radar", "select", radarOn ? "on" : "off", ["on", "off"]],
+      quality: ["camera quality", "select", rig.quality || "default", ["default", ...this.state.choices.camera_quality]],
+    };
+    const users = (this.state.doc.vessels || []).filter((v) => v.rig === name).map((v) => v.id);
+    const n = Array.isArray(rig.cameras) ? rig.cameras.length : null;
+    const cams = n !== null ? `${n} camera${n === 1 ? "" : "s"}` : (rig.preset || "full") === "full" ? "4 surround cameras" : "no cameras";
+    // a camera or the top view that sets a quality of its own renders at it, whatever the rig's select says
+    const own = [...(Array.isArray(rig.cameras) ? rig.cameras : []).map((c) => [c?.name, c?.quality]), ["top view", rig.top_view?.quality]]
+      .filter(([, q]) => typeof q === "string" && q !== (rig.quality || "standard"))
+      .map(([cam, q]) => `${cam} ${q}`);
+    const quality = own.length ? ` (own quality: ${own.join(", ")})` : "";
+    const summary = `${cams}${quality}; carried by ${users.length ? users.join(", ") : "no vessel"}. Other sensor settings: edit the YAML.`;
+    return { fields, summary };
+  }
+
   renderRigs() {
     const box = $("rigs");
-    if (box.contains(document.activeElement)) return;
-    box.replaceChildren();
     const rigs = this.state.doc.rigs || {};
+    const names = Object.keys(rigs);
+    const shown = [...box.children].map((div) => div.dataset.rig);
+    const focused = box.contains(document.activeElement) ? document.activeElement : null;
+    if (focused && names.length === shown.length && names.every((name, i) => name === shown[i])) {
+      // The person is in one of the rigs' fields, which is left as it is; the others and the summaries follow the
+      // scenario (a preset picked here kept saying "radar: on" and "4 surround cameras" of a LiDAR-only rig, and a
+      // quality picked kept the summary of the one before, until another edit after the focus had left).
+      for (const div of box.children) {
+        const { fields, summary } = this.rigView(div.dataset.rig, rigs[div.dataset.rig]);
+        for (const input of div.querySelectorAll("[data-key]")) {
+          // a select's pick is in the scenario once made (an undo from it shows the value undone); a box being typed
+          // into is not touched
+          const shownValue = String(fields[input.dataset.key][2]);
+          if (input.tagName === "SELECT") input.value = shownValue;
+          else setValue(input, shownValue);
+        }
+        div.querySelector(".summary").textContent = summary;
+      }
+      return;
+    }
+    // Another set of rigs (one removed with its button, which held the focus: it stayed on the page): built again,
+    // the focus given back to the same control where it is still there.
+    const again = focused && focused.closest("[data-rig]")
+      ? `[data-rig="${CSS.escape(focused.closest("[data-rig]").dataset.rig)}"] ${focused.dataset.key ? `[data-key="${CSS.escape(focused.dataset.key)}"]` : "button[data-action=remove]"}`
+      : null;
+    box.replaceChildren();
     for (const [name, rig] of Object.entries(rigs)) {
       const div = document.createElement("div");
       div.className = "rig";
@@ -725,17 +773,8 @@ export class Panels {
       head.appendChild(del);
       const grid = document.createElement("div");
       grid.className = "grid";
-      const lidar = rig.lidar === null ? null : rig.lidar || {};
-      const radarOn = rig.radar === undefined ? (rig.preset || "full") === "full" : rig.radar !== null;
-      const fields = [
-        ["preset", "select", rig.preset || "full", this.state.choices.rig_preset],
-        ["LiDAR channels", "number", lidar?.channels ?? "", null, "default"],
-        ["LiDAR range m", "number", lidar?.range_m ?? "", null, "default"],
-        ["radar", "select", radarOn ? "on" : "off", ["on", "off"]],
-        ["camera quality", "select", rig.quality || "default", ["default", ...this.state.choices.camera_quality]],
-      ];
-      const keys = ["preset", "lidar.channels", "lidar.range_m", "radar", "quality"];
-      fields.forEach(([label, kind, value, options, placeholder], i) => {
+      const { fields, summary: text } = this.rigView(name, rig);
+      for (const [key, [label, kind, value, options, placeholder]] of Object.entries(fields)) {
         const l = document.createElement("label");
         l.textContent = label;
         let input;
@@ -749,26 +788,19 @@ export class Panels {
           if (placeholder) input.placeholder = placeholder;
         }
         input.value = String(value);
-        input.dataset.key = keys[i];
-        input.dataset.field = `rigs.${name}.${keys[i]}`;
+        input.dataset.key = key;
+        input.dataset.field = `rigs.${name}.${key}`;
         if (kind !== "select" && this.refused.has(input.dataset.field)) input.dataset.refused = "1";
         l.appendChild(input);
         grid.appendChild(l);
-      });
+      }
       const summary = document.createElement("div");
       summary.className = "summary";
-      const users = (this.state.doc.vessels || []).filter((v) => v.rig === name).map((v) => v.id);
-      const n = Array.isArray(rig.cameras) ? rig.cameras.length : null;
-      const cams = n !== null ? `${n} camera${n === 1 ? "" : "s"}` : (rig.preset || "full") === "full" ? "4 surround cameras" : "no cameras";
-      // a camera or the top view that sets a quality of its own renders at it, whatever the rig's select says
-      const own = [...(Array.isArray(rig.cameras) ? rig.cameras : []).map((c) => [c?.name, c?.quality]), ["top view", rig.top_view?.quality]]
-        .filter(([, q]) => typeof q === "string" && q !== (rig.quality || "standard"))
-        .map(([name, q]) => `${name} ${q}`);
-      const quality = own.length ? ` (own quality: ${own.join(", ")})` : "";
-      summary.textContent = `${cams}${quality}; carried by ${users.length ? users.join(", ") : "no vessel"}. Other sensor settings: edit the YAML.`;
+      summary.textContent = text;
       div.append(head, grid, summary);
       box.appendChild(div);
     }
+    if (again) box.querySelector(again)?.focus();
   }
 
   editRig(name, key, input) {
