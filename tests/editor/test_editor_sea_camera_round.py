@@ -7,16 +7,27 @@ errors).
 
 from __future__ import annotations
 
+import warnings
+from pathlib import Path
 from typing import Any
 
+import pytest
 import yaml
+from mmusv.bundled import bundled_dir
 from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
 from selenium.webdriver.support.select import Select
-from test_browser import LiveServer, document_of, settled
+from test_api import client
+from test_browser import LiveServer, _wait, document_of, settled
 from test_browser_round import js_errors, note
 from test_browser_round3 import open_file, value, value_of, write_scenario
+
+with warnings.catch_warnings():
+    warnings.simplefilter("ignore")  # starlette's notice about its httpx-based test client
+    from fastapi.testclient import TestClient
+
+__all__ = ["client"]  # the fixture, shared with test_api.py
 
 
 def hours(driver: Any, box: Any) -> None:
@@ -111,4 +122,31 @@ def test_the_rig_panel_follows_a_preset_or_quality_picked_in_it(browser: Any, li
     settled(browser)
     assert "spare" not in document_of(browser)["rigs"]
     assert browser.find_elements(By.CSS_SELECTOR, spare) == []
+    assert js_errors(browser) == []
+
+
+@pytest.mark.filterwarnings("ignore::DeprecationWarning")
+@pytest.mark.parametrize("rig", ["", "5", "[draft]"])
+def test_a_rig_that_is_not_a_mapping_is_named_when_the_file_opens(client: TestClient, folder: Path, rig: str) -> None:
+    """``usv_standard:`` with nothing after it (a rig of ``null``), or a rig of ``5``, came to the page as the raw
+    mapping to be fixed there, which its rig panel could not draw: the page said "cannot open ... Cannot read
+    properties of null (reading 'lidar')". Now the file's answer names the rig and says to fix it as text."""
+    text = (bundled_dir() / "port_entry.yaml").read_text(encoding="utf-8")
+    assert "  usv_standard: {}\n" in text
+    (folder / "r.yaml").write_text(text.replace("  usv_standard: {}\n", f"  usv_standard: {rig}\n"), encoding="utf-8")
+    r = client.get("/api/files/r.yaml")
+    assert r.status_code == 422, r.text[:300]
+    message = r.json()["error"]
+    assert "rigs.usv_standard = " in message and "fix it as text" in message, message
+
+
+def test_a_rig_that_is_not_a_mapping_does_not_break_the_page(browser: Any, live_server: LiveServer) -> None:
+    """The page said why the file did not open, not a JavaScript error's words."""
+    text = (bundled_dir() / "port_entry.yaml").read_text(encoding="utf-8")
+    (live_server.folder / "nullrig.yaml").write_text(text.replace("  usv_standard: {}\n", "  usv_standard:\n"))
+    browser.get("about:blank")
+    browser.get(f"{live_server.url}/#file:nullrig.yaml")
+    _wait(browser, "return document.body.dataset.ready === '1' && document.body.dataset.pending === '0'", "the page")
+    said = browser.find_element(By.ID, "status").text
+    assert "rigs.usv_standard = None" in said and "Cannot read properties" not in said, said
     assert js_errors(browser) == []

@@ -67,8 +67,8 @@ def _raw(data: dict[str, Any], where: str, problem: str) -> dict[str, Any]:
     :class:`ConfigError` when the page could not show it."""
     if not _editable(data):  # the page could not show it: say what is wrong instead
         raise ConfigError(
-            f"{problem}; the editor opens files whose sections are mappings and whose vessels and routes are "
-            "lists (fix it as text)"
+            f"{problem}; the editor opens files whose sections are mappings, each rig too, and whose vessels and "
+            "routes are lists (fix it as text)"
         )
     raw: dict[str, Any] = json.loads(json.dumps(data, default=str))
     unjson = unjsonable(raw, "")
@@ -78,9 +78,12 @@ def _raw(data: dict[str, Any], where: str, problem: str) -> dict[str, Any]:
 
 
 def _editable(data: dict[str, Any]) -> bool:
-    """Whether an invalid scenario mapping still has the shape the page draws: sections are mappings, ``vessels``
-    a list of mappings whose ``route`` is a list of ``[x, y]`` numbers."""
+    """Whether an invalid scenario mapping still has the shape the page draws: sections are mappings, each rig too
+    (``usv_standard:`` with nothing after it, a rig of ``null``, opened and broke the page's rig panel: "Cannot read
+    properties of null"), ``vessels`` a list of mappings whose ``route`` is a list of ``[x, y]`` numbers."""
     if any(k in data and not isinstance(data[k], dict) for k in ("map", "environment", "acquisition", "rigs")):
+        return False
+    if not all(isinstance(rig, dict) for rig in (data.get("rigs") or {}).values()):
         return False
     vessels = data.get("vessels", [])
     if not isinstance(vessels, list) or not all(isinstance(v, dict) for v in vessels):
