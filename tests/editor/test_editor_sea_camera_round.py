@@ -150,3 +150,38 @@ def test_a_rig_that_is_not_a_mapping_does_not_break_the_page(browser: Any, live_
     said = browser.find_element(By.ID, "status").text
     assert "rigs.usv_standard = None" in said and "Cannot read properties" not in said, said
     assert js_errors(browser) == []
+
+
+def shown_choice(driver: Any, css: str) -> str:
+    """The text of the option the select ``css`` shows ("" when it shows none)."""
+    return str(driver.execute_script("return document.querySelector(arguments[0]).selectedOptions[0]?.text ?? ''", css))
+
+
+def test_a_choice_the_schema_refuses_is_shown_in_its_menu(browser: Any, live_server: LiveServer) -> None:
+    """A file opened to be fixed whose weather, motion, rig preset or camera quality is none of the menu's choices
+    showed a blank menu beside the schema's note (the vessel panel's asset and rig menus say "(not in the library)"):
+    now the menu shows the value, saying it is not one of its choices, until another is picked."""
+    env = {"time_of_day": "22:00", "weather": "snow", "motion": "phys"}
+    write_scenario(
+        live_server.folder, "odd.yaml", environment=env, rigs={"usv_standard": {"preset": "lidar", "quality": "ultra"}}
+    )
+    open_file(browser, live_server, "odd.yaml")
+    js_errors(browser)
+    rig = '#rigs [data-rig="usv_standard"]'
+    assert shown_choice(browser, "#e-weather") == "snow (not a weather)"
+    assert shown_choice(browser, "#e-motion") == "phys (not a motion)"
+    assert shown_choice(browser, f'{rig} select[data-key="preset"]') == "lidar (not a rig preset)"
+    assert shown_choice(browser, f'{rig} select[data-key="quality"]') == "ultra (not a camera quality)"
+    assert "environment.weather = 'snow'" in note(browser, "environment.weather")
+    Select(browser.find_element(By.ID, "e-weather")).select_by_value("fog")
+    Select(browser.find_element(By.CSS_SELECTOR, f'{rig} select[data-key="quality"]')).select_by_value("draft")
+    settled(browser)
+    assert document_of(browser)["environment"]["weather"] == "fog"
+    assert document_of(browser)["rigs"]["usv_standard"]["quality"] == "draft"
+    browser.find_element(By.ID, "s-name").click()  # the focus out of the menus: they are drawn again
+    Select(browser.find_element(By.ID, "e-motion")).select_by_value("paper")
+    settled(browser)
+    assert browser.find_elements(By.CSS_SELECTOR, "#e-weather option[data-missing]") == []
+    assert browser.find_elements(By.CSS_SELECTOR, f'{rig} select[data-key="quality"] option[data-missing]') == []
+    assert shown_choice(browser, f'{rig} select[data-key="preset"]') == "lidar (not a rig preset)"
+    assert js_errors(browser) == []

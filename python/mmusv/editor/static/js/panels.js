@@ -36,6 +36,14 @@ function selectValue(select, value, why) {
   select.value = v;
 }
 
+/** Shows `value` in `select` as selectValue does (an option of its own, "snow (not a weather)", where the menu has
+ * no such value: a value the schema refuses, in a file opened to be fixed, showed a blank menu beside its note), but
+ * not while the person is in it. */
+function showChoice(select, value, why) {
+  if (document.activeElement === select) return;
+  selectValue(select, String(value), why);
+}
+
 function numberOrNull(input) {
   if (input.value.trim() === "") return null;
   const n = Number(input.value);
@@ -652,7 +660,7 @@ export class Panels {
     const env = d.environment || {};
     // the time box shows "HH:MM" only: a time the schema takes as "6:05" or " 06:05" is shown as 06:05
     setValue($("e-time"), hhmm(env.time_of_day || "12:00"));
-    setValue($("e-weather"), env.weather || "clear");
+    showChoice($("e-weather"), env.weather || "clear", "not a weather");
     const wave = this.waveChoice();
     setValue($("e-wave"), wave);
     // a custom wave's height has its own box; one field at a time carries the wave's notes: the box while the wave
@@ -671,7 +679,7 @@ export class Panels {
       }
     }
     if (custom) setValue($("e-wave-height"), env.wave);
-    setValue($("e-motion"), env.motion || "physical");
+    showChoice($("e-motion"), env.motion || "physical", "not a motion");
     setValue($("e-sea"), env.sea == null ? "" : JSON.stringify(env.sea));
     setValue($("e-visibility"), env.visibility_m);
     setValue($("e-rain"), env.rain_mm_per_h);
@@ -711,12 +719,13 @@ export class Panels {
   rigView(name, rig) {
     const lidar = rig.lidar === null ? null : rig.lidar || {};
     const radarOn = rig.radar === undefined ? (rig.preset || "full") === "full" : rig.radar !== null;
+    // [label, kind, value, options, placeholder of a box or what a select says of a value it does not offer]
     const fields = {
-      preset: ["preset", "select", rig.preset || "full", this.state.choices.rig_preset],
+      preset: ["preset", "select", rig.preset || "full", this.state.choices.rig_preset, "not a rig preset"],
       "lidar.channels": ["LiDAR channels", "number", lidar?.channels ?? "", null, "default"],
       "lidar.range_m": ["LiDAR range m", "number", lidar?.range_m ?? "", null, "default"],
       radar: ["radar", "select", radarOn ? "on" : "off", ["on", "off"]],
-      quality: ["camera quality", "select", rig.quality || "default", ["default", ...this.state.choices.camera_quality]],
+      quality: ["camera quality", "select", rig.quality || "default", ["default", ...this.state.choices.camera_quality], "not a camera quality"],
     };
     const users = (this.state.doc.vessels || []).filter((v) => v.rig === name).map((v) => v.id);
     const n = Array.isArray(rig.cameras) ? rig.cameras.length : null;
@@ -745,9 +754,9 @@ export class Panels {
         for (const input of div.querySelectorAll("[data-key]")) {
           // a select's pick is in the scenario once made (an undo from it shows the value undone); a box being typed
           // into is not touched
-          const shownValue = String(fields[input.dataset.key][2]);
-          if (input.tagName === "SELECT") input.value = shownValue;
-          else setValue(input, shownValue);
+          const [, , shownValue, , why] = fields[input.dataset.key];
+          if (input.tagName === "SELECT") selectValue(input, String(shownValue), why);
+          else setValue(input, String(shownValue));
         }
         div.querySelector(".summary").textContent = summary;
       }
@@ -787,7 +796,8 @@ export class Panels {
           input.min = "1";
           if (placeholder) input.placeholder = placeholder;
         }
-        input.value = String(value);
+        if (kind === "select") selectValue(input, String(value), placeholder);
+        else input.value = String(value);
         input.dataset.key = key;
         input.dataset.field = `rigs.${name}.${key}`;
         if (kind !== "select" && this.refused.has(input.dataset.field)) input.dataset.refused = "1";
