@@ -114,6 +114,15 @@ impl LightArc {
 }
 
 #[cfg(test)]
+impl Material {
+    /// A navigation lamp's material for the lamp tests: white, roughness 0.5, not metallic, radiance `emissive`
+    /// (cd/m², linear RGB) across `arc` (centre bearing and half-width, degrees).
+    pub(crate) fn test_lamp(emissive: [f32; 3], arc: [f32; 2]) -> Self {
+        Self { base_color: [1.0; 3], roughness: 0.5, metallic: 0.0, emissive, nav_light: true, arc_deg: arc }
+    }
+}
+
+#[cfg(test)]
 mod tests {
     use super::*;
 

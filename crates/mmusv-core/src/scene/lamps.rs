@@ -203,17 +203,6 @@ mod tests {
         (v, f, m)
     }
 
-    fn lamp_material(emissive: f32, arc: [f32; 2]) -> Material {
-        Material {
-            base_color: [1.0; 3],
-            roughness: 0.5,
-            metallic: 0.0,
-            emissive: [emissive; 3],
-            nav_light: true,
-            arc_deg: arc,
-        }
-    }
-
     fn scene_with(arc: [f32; 2], lights: bool) -> crate::error::Result<Scene> {
         scene_posed(arc, lights, RigidPose::from_xyz_rpy([100.0, 50.0, 0.0], [0.0, 0.0, std::f64::consts::FRAC_PI_2]))
     }
@@ -231,8 +220,8 @@ mod tests {
         let mesh = Mesh::new("lanterns", &v, &f, &classes)?.with_materials(&m)?;
         let mut scene = Scene::new();
         let id = scene.add_mesh(mesh);
-        let housing = Material { nav_light: false, emissive: [0.0; 3], ..lamp_material(0.0, [0.0, 180.0]) };
-        scene.set_materials(vec![housing, lamp_material(2e4, arc), housing])?;
+        let housing = Material { nav_light: false, emissive: [0.0; 3], ..Material::test_lamp([0.0; 3], [0.0, 180.0]) };
+        scene.set_materials(vec![housing, Material::test_lamp([2e4; 3], arc), housing])?;
         let inst = scene.add_instance(id, pose, None)?;
         scene.set_lights(&[inst], lights)?;
         Ok(scene)

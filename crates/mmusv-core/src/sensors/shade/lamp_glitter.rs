@@ -187,14 +187,7 @@ mod tests {
 
     /// A lamp at `centre` whose lens shows `area` m² along ±x (two opposite faces), radius 5 cm.
     fn lamp(centre: Vec3, area: f32, arc: [f32; 2]) -> Lamp {
-        let material = Material {
-            base_color: [1.0; 3],
-            roughness: 0.5,
-            metallic: 0.0,
-            emissive: [2e4; 3],
-            nav_light: true,
-            arc_deg: arc,
-        };
+        let material = Material::test_lamp([2e4; 3], arc);
         Lamp::new(centre, 0.05, &[Vec3::X * area, -Vec3::X * area], material, RigidPose::IDENTITY, 0)
     }
 

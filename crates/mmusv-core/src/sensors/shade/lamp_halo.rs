@@ -250,14 +250,7 @@ mod tests {
     /// An all-round lamp at `centre` whose lens shows 0.01 m² every horizontal way (two pairs of faces), radiance
     /// 1e4 cd/m² in every channel: 100 cd; radius 1 mm.
     fn lamp(centre: Vec3, arc: [f32; 2]) -> Lamp {
-        let material = Material {
-            base_color: [1.0; 3],
-            roughness: 0.5,
-            metallic: 0.0,
-            emissive: [1e4; 3],
-            nav_light: true,
-            arc_deg: arc,
-        };
+        let material = Material::test_lamp([1e4; 3], arc);
         let faces = [Vec3::X * 0.01, -Vec3::X * 0.01, Vec3::Z * 0.01, -Vec3::Z * 0.01];
         Lamp::new(centre, 0.001, &faces, material, RigidPose::IDENTITY, 0)
     }

@@ -95,14 +95,7 @@ mod tests {
 
     /// A lamp at `centre` whose lens shows `area` m² along ±x (two opposite faces), radius `radius`.
     fn lamp(centre: Vec3, area: f32, radius: f32, arc: [f32; 2]) -> Lamp {
-        let material = Material {
-            base_color: [1.0; 3],
-            roughness: 0.5,
-            metallic: 0.0,
-            emissive: [2e4, 1e4, 5e3],
-            nav_light: true,
-            arc_deg: arc,
-        };
+        let material = Material::test_lamp([2e4, 1e4, 5e3], arc);
         Lamp::new(centre, radius, &[Vec3::X * area, -Vec3::X * area], material, RigidPose::IDENTITY, 0)
     }
 
