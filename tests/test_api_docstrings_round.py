@@ -15,7 +15,8 @@ import mmusv.sensors.config
 import numpy as np
 import pytest
 from mmusv import Simulation, run
-from mmusv.annotate import SilhouetteCache, annotate_agent
+from mmusv.acquire import annotations_for
+from mmusv.annotate import SilhouetteCache
 from mmusv.recording import decode_image
 from mmusv.recording.info import read_info
 from mmusv.recording.stream import FrameStream
@@ -83,22 +84,7 @@ def test_box_pixels_are_the_pixels_the_2d_box_touches() -> None:
     the window ``visible_pixels`` is counted in, well above the box's area for a small box."""
     sim = Simulation(_scenario())
     cap = sim.capture(0, sensors=["lidar", "cameras"])
-    ac, agent = cap.agents["u"], sim.agent("u")
-    assert ac.lidar is not None
-    cams = {n: (agent.cameras[n][0], ac.camera_poses[n], ac.cameras[n].instance) for n in ac.cameras}
-    ann = annotate_agent(
-        agent_id="u",
-        agent_index=agent.index,
-        frame=0,
-        time_s=cap.time_s,
-        vessels=sim.vessels,
-        state=cap.world,
-        lidar_pose=ac.lidar_pose,
-        lidar_instances=ac.lidar.instance,
-        cameras=cams,
-        silhouettes=SilhouetteCache(sim.assets),
-        max_range_m=200.0,
-    )
+    ann = annotations_for(sim, cap, SilhouetteCache())["u"]  # as a recording annotates the frame
     cam = ann.columns()["camera"]
     assert len(cam["target_id"]) >= 1
     x0, y0, x1, y1 = (cam[k] for k in ("x_min", "y_min", "x_max", "y_max"))
