@@ -226,9 +226,10 @@ def pinhole_truncation(
 
 def camera_lens(cam: Any, *, pose: np.ndarray, world_to_body: np.ndarray) -> tuple[Any, float] | None:
     """A pinhole camera with lens distortion (``mmusv._core.Camera``) and its reach (the largest undistorted
-    normalised radius its image corners see, from the camera's own corner rays), or ``None`` without distortion.
-    Within the reach the camera's distortion maps every point to the pixel whose ray meets it; beyond it, where the
-    polynomial may fold back into the image, points are carried radially outwards, outside the image."""
+    normalised radius the centres of its four corner pixels see, from the camera's own rays there), or ``None``
+    without distortion. Within the reach the camera's distortion maps every point to the pixel whose ray meets it;
+    beyond it, where the polynomial may fold back into the image, points are carried radially outwards (so a point
+    in the outer half of a corner pixel, past its centre's ray, lands just outside the image)."""
     if cam.distortion is None:
         return None
     w, h = cam.resolution
