@@ -371,7 +371,7 @@ def test_lidar_fog_is_koschmieder_two_way() -> None:
 
 
 @pytest.mark.parametrize(
-    "hull", [(4.88, 2.44, 0.35, 0.45, 0.732), (32.0, 12.0, 5.0, 0.52, 1.2), (190.0, 32.3, 12.8, 0.83, 2.584)]
+    "hull", [(4.88, 2.44, 0.35, 0.45, 1.464), (32.0, 12.0, 5.0, 0.52, 1.2), (190.0, 32.3, 12.8, 0.83, 2.584)]
 )
 def test_hull_raos_long_wave_limits_and_roll_resonance(hull: tuple[float, ...]) -> None:
     """``hull_rao`` of the catalogue's USV, tug and bulk carrier particulars. (1) Long waves (ω = 1e-3 rad/s): the

@@ -15,6 +15,13 @@ heave and pitch, a one-degree-of-freedom roll oscillator) needs, per asset, ``L`
   about 0.3–2 m, tankers and bulk carriers larger; small craft and catamarans very stiff, GM a sizeable fraction
   of the beam).
 
+A catamaran's GM comes mostly from its hulls' spread: ``BM = I_T/∇ ≈ (s/2)² C_wp/(C_b T)`` for hulls ``s`` apart
+(each hull's waterplane ``s/2`` off the centreline, its own inertia small: the parallel-axis theorem), a sizeable
+fraction of the overall beam: for the WAM-V 16 (hull centres about 1.9 m apart, the 2.44 m beam less a pontoon's
+width; T = 0.35 m, C_wp ≈ (1 + 2 C_b)/3) BM ≈ 1.5 B. The catalogue's catamarans take ``GM = 0.6 B``; ``usv_wamv``,
+a catamaran in the category of monohull USVs, takes it too (:data:`ASSET_HULL_FORMS`; before 2026-12-06 it had
+the monohulls' 0.3 B).
+
 Units: metres. :func:`hull_particulars` returns ``(length, beam, draft, block_coefficient, gm)``, the row layout
 the core's ``Fleet(hulls=...)``, ``WaveField.hull_response`` and ``hull_rao`` take.
 """
@@ -25,7 +32,7 @@ from typing import NamedTuple
 
 from mmusv.world.vessels import VesselAsset
 
-__all__ = ["HULL_FORMS", "HullForm", "hull_particulars"]
+__all__ = ["ASSET_HULL_FORMS", "HULL_FORMS", "HullForm", "hull_particulars"]
 
 
 class HullForm(NamedTuple):
@@ -73,6 +80,13 @@ HULL_FORMS: dict[str, HullForm] = {
 }
 """Hull form by catalogue category (see the module docstring for the sources of the values)."""
 
+ASSET_HULL_FORMS: dict[str, HullForm] = {
+    "usv_wamv": HullForm(0.45, 0.60),
+}
+"""Per asset name, where an asset's hull differs from its category's: the WAM-V is a catamaran (two pontoons) in the
+``usv`` category of monohull USVs, so it takes the catamarans' GM of 0.6 B (the ``usv`` row's 0.3 B is a
+monohull's; see the module docstring)."""
+
 DEFAULT_HULL_FORM = HullForm(0.55, 0.10)
 """For categories not in the table (user assets, ``custom``): a generic displacement monohull."""
 
@@ -82,6 +96,6 @@ MIN_DRAFT_M = 0.05
 
 def hull_particulars(asset: VesselAsset) -> tuple[float, float, float, float, float]:
     """``(length, beam, draft, block_coefficient, gm)`` of ``asset`` in metres (Cb dimensionless)."""
-    form = HULL_FORMS.get(asset.category, DEFAULT_HULL_FORM)
+    form = ASSET_HULL_FORMS.get(asset.name) or HULL_FORMS.get(asset.category, DEFAULT_HULL_FORM)
     draft = max(asset.draft * form.draft_factor, MIN_DRAFT_M)
     return (float(asset.length), float(asset.beam), float(draft), form.cb, form.gm_over_beam * float(asset.beam))
