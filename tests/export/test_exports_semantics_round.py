@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from pathlib import Path
 from types import SimpleNamespace
+from typing import Any
 
 import numpy as np
 import pytest
@@ -35,18 +36,34 @@ def kitti_case(request: pytest.FixtureRequest, tmp_path: Path) -> tuple[Path, Pa
     return rec, tmp_path / "o" / rec.stem
 
 
-def _share_out_of_image(fields: list[str], calib: Path, image: Path) -> float | None:
-    """The share of a label line's 3D box (KITTI's conventions: bottom-centre location, ``h w l``, ``rotation_y``
-    about the camera's y) whose pinhole image (``P2`` of ``calib``) lies outside ``image``: 1.0 without a camera (zero
+def _share_out_of_image(fields: list[str], boxes: list[Any], calib: Path, image: Path) -> float | None:
+    """The share of a label line's target whose pinhole image (``P2`` of ``calib``) lies outside ``image``: its
+    recorded 3D box (of ``boxes``, the frame's LiDAR boxes, the one whose centre carried by ``Tr_velo_to_cam`` lies
+    nearest the label's box centre), with its whole rotation (a camera rolling on the waves sees the box rolled,
+    which the label's ``rotation_y`` alone cannot say), corners projected by ``P2``; 1.0 without a camera (zero
     ``P2``) or with the box wholly behind it; ``None`` for a box across the camera's plane (not worked out here)."""
-    p = read_calib(calib)["P2"]
+    cal = read_calib(calib)
+    p = cal["P2"]
     if not p.any() or not image.is_file():
         return 1.0
     from PIL import Image
 
     with Image.open(image) as img:
         width, height = img.size
-    corners = label_corners(fields)
+    tr = cal["Tr_velo_to_cam"].reshape(3, 4)
+    label_centre = label_corners(fields).mean(axis=0)
+    box = min(boxes, key=lambda b: float(np.linalg.norm(tr[:, :3] @ np.asarray(b.center) + tr[:, 3] - label_centre)))
+    x, y, z, w = box.rotation
+    rot = np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=np.float64)
+    corners = (signs * np.asarray(box.size) / 2.0) @ rot.T + np.asarray(box.center)
+    corners = corners @ tr[:, :3].T + tr[:, 3]
     if np.all(corners[:, 2] <= 0.0):
         return 1.0
     if np.any(corners[:, 2] <= 0.1):
@@ -80,7 +97,7 @@ def test_kitti_truncated_is_the_share_out_of_the_front_image(kitti_case: tuple[P
                 assert 0.0 <= truncated <= 1.0 and f[1] == f"{truncated:.2f}"
                 if occluded == 3:
                     assert bbox == [0.0, 0.0, 0.0, 0.0]
-                    want = _share_out_of_image(f, calib, agent / "image_2" / f"{path.stem}.png")
+                    want = _share_out_of_image(f, ann.boxes_lidar, calib, agent / "image_2" / f"{path.stem}.png")
                     if want is not None:
                         assert truncated == pytest.approx(want, abs=0.0051), (a.id, k, line)
                     out_of_image += truncated == 1.0
