@@ -467,7 +467,7 @@ def lidar_boxes_beams(
     mid = np.array(mids, dtype=np.float64)
     rel = np.angle(np.exp(1j * (az - mid[:, None])))
     rel_lo, rel_hi = rel.min(axis=1), rel.max(axis=1)
-    el_lo, el_hi, around = _elevation_extent(c)
+    el_lo, el_hi, around = _elevation_extent(c, az)
     # A box the LiDAR's z axis passes through surrounds it: every azimuth, every elevation.
     rel_lo, rel_hi = np.where(around, -np.pi, rel_lo), np.where(around, np.pi, rel_hi)
     el_lo, el_hi = np.where(around, -np.pi / 2, el_lo), np.where(around, np.pi / 2, el_hi)
@@ -491,8 +491,9 @@ _PAIRS = np.array([(a, b) for a in range(8) for b in range(a + 1, 8)], dtype=np.
 """Every pair of a box's corners: its twelve edges among them, whatever order the corners come in."""
 
 
-def _elevation_extent(c: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(el_lo, el_hi, around)`` of ``B`` boxes' corners ``c`` ``(B, 8, 3)`` in the LiDAR frame: the lowest and
+def _elevation_extent(c: np.ndarray, az: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(el_lo, el_hi, around)`` of ``B`` boxes' corners ``c`` ``(B, 8, 3)`` in the LiDAR frame (``az`` ``(B, 8)``
+    their azimuths, radians): the lowest and
     highest elevation (radians) of any point of each box, and whether the LiDAR's z axis passes through it (then
     the box surrounds the LiDAR in azimuth and reaches ±π/2; ``el_lo``/``el_hi`` are not meaningful there).
 
@@ -516,7 +517,7 @@ def _elevation_extent(c: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray
     p = np.concatenate([c, x0 + t * d], axis=1)  # the corners and each pair's stationary point
     el = np.arctan2(p[..., 2], np.hypot(p[..., 0], p[..., 1]))
     r = np.hypot(c[..., 0], c[..., 1])
-    az = np.sort(np.arctan2(c[..., 1], c[..., 0]), axis=1)
+    az = np.sort(az, axis=1)
     gaps = np.concatenate([np.diff(az, axis=1), (az[:, :1] + 2 * np.pi) - az[:, -1:]], axis=1)
     around = (gaps.max(axis=1) <= np.pi + 1e-9) | (r.min(axis=1) <= 1e-9)
     lo: np.ndarray = el.min(axis=1)

@@ -291,6 +291,7 @@ class Opv2vWriter(DatasetWriter):
             return
         info, o = self.info, self.options
         lidar = next((a.rig.get("lidar") for a in self.agents if a.rig.get("lidar")), None) or {}
+        fov = _fov(lidar)  # [lower, upper] degrees
         acq = info.scenario.get("acquisition", {})
         # The OPV2V cameras (camera0..3) some agent writes, by index: none for a LiDAR-only rig.
         indices = {i: n for a in self.agents for n, i in self.agent_cameras(a)}
@@ -312,8 +313,8 @@ class Opv2vWriter(DatasetWriter):
                             "range": lidar.get("range_m"),
                             "points_per_second": lidar.get("points_per_second"),
                             "rotation_frequency": lidar.get("rotation_hz"),
-                            "upper_fov": _fov(lidar)[1],
-                            "lower_fov": _fov(lidar)[0],
+                            "upper_fov": fov[1],
+                            "lower_fov": fov[0],
                             "noise_stddev": lidar.get("range_noise_std_m"),
                             "dropoff_general_rate": lidar.get("dropout"),
                         },
