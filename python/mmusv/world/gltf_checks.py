@@ -3,27 +3,32 @@
 its header says or without a JSON chunk; a buffer or image file that is missing (or an image Pillow cannot read); an
 extension the file requires that mmusv does not read (:data:`READ_EXTENSIONS`), Draco geometry without DracoPy to
 decode it, a normalized or sparse ``POSITION``; a ``COLOR_0`` glTF 2.0 does not allow or that does not fit its
-primitive; two materials of one name and one factor with different ``KHR_materials_emissive_strength``; an index
-into one of its lists that is not in it (a scene, node, mesh, material, accessor, buffer view, buffer or image); a
-material factor outside glTF's [0, 1]. Each is one
+primitive; two materials of one name and one factor with different ``KHR_materials_emissive_strength``; a material
+factor outside glTF's [0, 1]; an accessor or primitive mode glTF 2.0 does not define; a buffer without the ``uri`` it
+needs. The checks of the document's graph (an index into one of its lists that is not in it, node transforms and
+trees, a scene that draws no triangle) are in :mod:`mmusv.world.gltf_graph`. Each is one
 :class:`~mmusv.world.asset_spec.AssetSpecError` at the asset entry naming the file and the glTF entry.
 """
 
 from __future__ import annotations
 
 import json
-import math
 import struct
-import warnings
-from collections.abc import Iterator
 from pathlib import Path
-from typing import TypeGuard
 from urllib.parse import unquote
 
 from mmusv.world.asset_spec import AssetSpecError
+from mmusv.world.gltf_graph import (
+    MODES,
+    finite_number,
+    node_checks,
+    primitives,
+    reference_checks,
+    surface_checks,
+)
 from mmusv.world.mesh_materials import EmissiveKey, check_image, emissive_key, one_line
 
-__all__ = ["READ_EXTENSIONS", "TEXTURE_SLOTS", "PrimitiveMaterial", "check_gltf", "gltf_json"]
+__all__ = ["READ_EXTENSIONS", "PrimitiveMaterial", "check_gltf", "gltf_json"]
 
 
 PrimitiveMaterial = tuple[int, dict[str, object]] | None
@@ -40,11 +45,11 @@ def check_gltf(path: Path, where: str) -> tuple[dict[EmissiveKey, float], list[s
     _asset_checks(shown, data, where)
     _extension_checks(path, data, where)
     strengths, names = _gltf_checks(path, data, where), _color_0_checks(path, data, where)
-    _reference_checks(shown, data, where)  # after the checks that say more of their own entries
+    reference_checks(shown, data, where)  # after the checks that say more of their own entries
     _accessor_checks(shown, data, where)
-    _node_checks(shown, data, where)
+    node_checks(shown, data, where)
     _buffer_checks(path, data, where)
-    _surface_checks(shown, data, where)
+    surface_checks(shown, data, where)
     return strengths, names, _primitive_materials(data)
 
 
@@ -116,7 +121,7 @@ def _gltf_checks(path: Path, data: dict[str, object], where: str) -> dict[Emissi
         ext = m.get("extensions")
         ks = ext.get("KHR_materials_emissive_strength") if isinstance(ext, dict) else None
         value = ks.get("emissiveStrength", 1.0) if isinstance(ks, dict) else 1.0
-        ok = _finite_number(value) and value >= 0
+        ok = finite_number(value) and value >= 0
         if not ok:
             raise AssetSpecError(
                 where,
@@ -133,72 +138,6 @@ def _gltf_checks(path: Path, data: dict[str, object], where: str) -> dict[Emissi
             )
         strengths[key] = float(value)
     return strengths
-
-
-def _references(data: dict[str, object]) -> Iterator[tuple[str, object, str]]:
-    """Every index the glTF's JSON gives into one of its lists: ``(where it is, the index, the list's name)``."""
-
-    def items(name: str) -> list[object]:
-        v = data.get(name)
-        return v if isinstance(v, list) else []
-
-    if "scene" in data:
-        yield "scene", data["scene"], "scenes"
-    for i, sc in enumerate(items("scenes")):
-        for j, n in enumerate(
-            sc.get("nodes", []) if isinstance(sc, dict) and isinstance(sc.get("nodes"), list) else []
-        ):
-            yield f"scenes[{i}].nodes[{j}]", n, "nodes"
-    for i, nd in enumerate(items("nodes")):
-        if not isinstance(nd, dict):
-            continue
-        if "mesh" in nd:
-            yield f"nodes[{i}].mesh", nd["mesh"], "meshes"
-        kids = nd.get("children")
-        for j, n in enumerate(kids if isinstance(kids, list) else []):
-            yield f"nodes[{i}].children[{j}]", n, "nodes"
-    for i, me in enumerate(items("meshes")):
-        prims = me.get("primitives") if isinstance(me, dict) else None
-        for j, pr in enumerate(prims if isinstance(prims, list) else []):
-            if not isinstance(pr, dict):
-                continue
-            at = f"meshes[{i}].primitives[{j}]"
-            if "material" in pr:
-                yield f"{at}.material", pr["material"], "materials"
-            if "indices" in pr:
-                yield f"{at}.indices", pr["indices"], "accessors"
-            attrs = pr.get("attributes")
-            for name, a in attrs.items() if isinstance(attrs, dict) else []:
-                yield f"{at}.attributes.{name}", a, "accessors"
-    for i, ac in enumerate(items("accessors")):
-        if isinstance(ac, dict) and "bufferView" in ac:
-            yield f"accessors[{i}].bufferView", ac["bufferView"], "bufferViews"
-    for i, bv in enumerate(items("bufferViews")):
-        if isinstance(bv, dict) and "buffer" in bv:
-            yield f"bufferViews[{i}].buffer", bv["buffer"], "buffers"
-    for i, tx in enumerate(items("textures")):
-        if isinstance(tx, dict) and "source" in tx:
-            yield f"textures[{i}].source", tx["source"], "images"
-    for i, mat in enumerate(items("materials")):
-        for at, info in _material_textures(mat):
-            if isinstance(info, dict) and "index" in info:
-                yield f"materials[{i}].{at}.index", info["index"], "textures"
-
-
-def _reference_checks(shown: str, data: dict[str, object], where: str) -> None:
-    """Refuses an index into one of the glTF's lists that is not in it (``scene: 5`` with one scene, a primitive's
-    ``material: 7`` with one material): trimesh failed on them with a bare ``IndexError: list index out of range``."""
-    for at, index, kind in _references(data):
-        items = data.get(kind)
-        n = len(items) if isinstance(items, list) else 0
-        if isinstance(index, bool) or not isinstance(index, int) or not 0 <= index < n:
-            have = f"indices 0..{n - 1}" if n else "none"
-            raise AssetSpecError(where, f"{shown}: {at} is {index!r}, but the file has {n} {kind} ({have})")
-
-
-def _finite_number(value: object) -> TypeGuard[float]:
-    """Whether a JSON value is a finite number (``true`` and ``false`` are not)."""
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
 
 
 _FACTORS = (
@@ -222,7 +161,7 @@ def _factor_checks(shown: str, i: int, material: dict[str, object], where: str) 
         shaped = not n or (isinstance(value, list) and len(value) == n)  # n > 0: a list of n numbers
         values = value if n and shaped else [value]
         field = f"materials[{i}].{holder + '.' if holder else ''}{name}"
-        if not shaped or not all(_finite_number(v) and 0.0 <= v <= 1.0 for v in values):
+        if not shaped or not all(finite_number(v) and 0.0 <= v <= 1.0 for v in values):
             what = f"{n} numbers in [0, 1]" if n else "a number in [0, 1]"
             raise AssetSpecError(where, f"{shown}: {field} is {value!r}; glTF 2.0 allows {what}")
 
@@ -257,17 +196,6 @@ with, and how; glTF 2.0 asks a reader to refuse a file that requires any other (
 e.g. meshopt-compressed geometry as zeros, without a word)."""
 
 
-def _primitives(data: dict[str, object]) -> Iterator[tuple[int, int, dict[str, object]]]:
-    """``(i, j, primitive)`` of every ``meshes[i].primitives[j]`` of a glTF JSON that is an object, in file order
-    (entries of other kinds are skipped: trimesh's loader reports them)."""
-    meshes = data.get("meshes")
-    for i, m in enumerate(meshes if isinstance(meshes, list) else []):
-        prims = m.get("primitives") if isinstance(m, dict) else None
-        for j, p in enumerate(prims if isinstance(prims, list) else []):
-            if isinstance(p, dict):
-                yield i, j, p
-
-
 def _extension_checks(path: Path, data: dict[str, object], where: str) -> None:
     """Refuses a glTF that requires an extension outside :data:`READ_EXTENSIONS`, that needs Draco decoding
     without DracoPy installed (Draco required, or a Draco primitive without uncompressed fallback accessors: trimesh
@@ -286,7 +214,7 @@ def _extension_checks(path: Path, data: dict[str, object], where: str) -> None:
                 f"ones it reads are {known}: export the file without {name}",
             )
     draco = "KHR_draco_mesh_compression" in required
-    for i, j, p in _primitives(data):
+    for i, j, p in primitives(data):
         ext = p.get("extensions")
         attrs = p.get("attributes")
         if isinstance(ext, dict) and "KHR_draco_mesh_compression" in ext:
@@ -331,7 +259,7 @@ def _color_0_checks(path: Path, data: dict[str, object], where: str) -> list[str
     geometry of, in its order."""
     shown = repr(str(path))
     names: list[str] = []
-    for i, j, p in _primitives(data):
+    for i, j, p in primitives(data):
         label = f"meshes[{i}].primitives[{j}]"
         mode = p.get("mode", 4)
         if isinstance(mode, int) and mode in _GLTF_MODES:
@@ -372,25 +300,6 @@ def _color_0_checks(path: Path, data: dict[str, object], where: str) -> list[str
     return names
 
 
-TEXTURE_SLOTS = (
-    ("pbrMetallicRoughness", "baseColorTexture"),
-    ("pbrMetallicRoughness", "metallicRoughnessTexture"),
-    (None, "emissiveTexture"),
-)
-"""The texture slots of a material mmusv reads (by their mean): (the object holding it, its name)."""
-
-
-def _material_textures(material: object) -> Iterator[tuple[str, object]]:
-    """``(where, texture info)`` of each of :data:`TEXTURE_SLOTS` a glTF material gives (``pbrMetallicRoughness.
-    baseColorTexture``, ...)."""
-    if not isinstance(material, dict):
-        return
-    for holder, name in TEXTURE_SLOTS:
-        obj = material.get(holder) if holder else material
-        if isinstance(obj, dict) and name in obj:
-            yield (f"{holder}.{name}" if holder else name), obj[name]
-
-
 def _asset_checks(shown: str, data: dict[str, object], where: str) -> None:
     """Refuses JSON that is not glTF 2.x: glTF 2.0 requires ``asset.version`` (``"2.0"``), and a reader refuses a
     major version it does not know (glTF 1.0's JSON is laid out otherwise) or a ``minVersion`` above its own."""
@@ -413,8 +322,6 @@ _TYPES = frozenset({"SCALAR", "VEC2", "VEC3", "VEC4", "MAT2", "MAT3", "MAT4"})
 _POSITION_COMPONENTS = frozenset({5126, 5120, 5121, 5122, 5123})
 """float, and the integer types ``KHR_mesh_quantization`` allows for ``POSITION``."""
 _INDEX_COMPONENTS = frozenset({5121, 5123, 5125})
-_MODES = {0: "POINTS", 1: "LINES", 2: "LINE_LOOP", 3: "LINE_STRIP", 4: "TRIANGLES", 5: "TRIANGLE_STRIP"}
-_MODES[6] = "TRIANGLE_FAN"
 
 
 def _accessor_checks(shown: str, data: dict[str, object], where: str) -> None:
@@ -435,10 +342,10 @@ def _accessor_checks(shown: str, data: dict[str, object], where: str) -> None:
             raise AssetSpecError(
                 where, f"{shown}: accessors[{i}].type is {kind!r}; glTF 2.0 defines {', '.join(sorted(_TYPES))}"
             )
-    for i, j, p in _primitives(data):
+    for i, j, p in primitives(data):
         at = f"{shown}: meshes[{i}].primitives[{j}]"
         mode = p.get("mode", 4)
-        if isinstance(mode, bool) or mode not in _MODES:
+        if isinstance(mode, bool) or mode not in MODES:
             raise AssetSpecError(where, f"{at}.mode is {mode!r}; glTF 2.0 defines modes 0..6")
         if mode == 6:
             raise AssetSpecError(
@@ -467,144 +374,6 @@ def _accessor_checks(shown: str, data: dict[str, object], where: str) -> None:
                 f"{idx.get('componentType')!r}; glTF 2.0 indices are SCALAR unsigned byte, short or int "
                 "(5121, 5123, 5125)",
             )
-
-
-def _numbers(value: object, n: int) -> TypeGuard[list[float]]:
-    """Whether a JSON value is a list of ``n`` finite numbers."""
-    return isinstance(value, list) and len(value) == n and all(_finite_number(v) for v in value)
-
-
-def _node_checks(shown: str, data: dict[str, object], where: str) -> None:
-    """Refuses node transforms and hierarchies glTF 2.0 does not allow, which trimesh read some way without a word:
-    a ``matrix`` given with ``translation``/``rotation``/``scale`` (both were applied), a ``matrix`` that is not 16
-    finite numbers of an affine transform (its last row (0, 0, 0, 1)), a ``rotation`` that is not a unit quaternion
-    (a zero one was read as no rotation), ``translation``/``scale`` not three finite numbers, and a node that is a
-    child of two nodes or of its own subtree (the nodes form disjoint strict trees)."""
-    nodes = data.get("nodes")
-    items = nodes if isinstance(nodes, list) else []
-    parent: dict[int, int] = {}
-    for i, node in enumerate(items):
-        if not isinstance(node, dict):
-            raise AssetSpecError(where, f"{shown}: nodes[{i}] is {node!r:.60}, not an object")
-        at = f"{shown}: nodes[{i}]"
-        trs = [k for k in ("translation", "rotation", "scale") if k in node]
-        if "matrix" in node:
-            m = node["matrix"]
-            if trs:
-                raise AssetSpecError(
-                    where, f"{at} has both a matrix and {', '.join(trs)}; glTF 2.0 allows one or the other"
-                )
-            if not _numbers(m, 16):
-                raise AssetSpecError(where, f"{at}.matrix is {m!r:.80}; glTF 2.0 asks for 16 finite numbers")
-            if [m[3], m[7], m[11], m[15]] != [0, 0, 0, 1]:
-                raise AssetSpecError(
-                    where,
-                    f"{at}.matrix's last row is {[m[3], m[7], m[11], m[15]]} (column-major: elements 3, 7, 11, 15), "
-                    "not [0, 0, 0, 1]; glTF 2.0 node matrices are affine (translation, rotation, scale)",
-                )
-        for key, n in (("translation", 3), ("rotation", 4), ("scale", 3)):
-            if key in node and not _numbers(node[key], n):
-                raise AssetSpecError(where, f"{at}.{key} is {node[key]!r:.80}; glTF 2.0 asks for {n} finite numbers")
-        if "rotation" in node:
-            norm = math.sqrt(sum(float(v) ** 2 for v in node["rotation"]))
-            if abs(norm - 1.0) > 1e-3:
-                raise AssetSpecError(
-                    where,
-                    f"{at}.rotation is {node['rotation']!r}, of length {norm:.6g}; glTF 2.0 rotations are unit "
-                    "quaternions [x, y, z, w] (no rotation: [0, 0, 0, 1])",
-                )
-        kids = node.get("children", [])
-        for c in kids if isinstance(kids, list) else []:
-            if not isinstance(c, int) or isinstance(c, bool):
-                continue  # _reference_checks refused it
-            if c in parent or c == i:
-                other = "itself" if c == i else f"nodes[{parent[c]}] too"
-                raise AssetSpecError(
-                    where,
-                    f"{at} names nodes[{c}] as a child, which is a child of {other}; glTF 2.0 nodes form disjoint "
-                    "trees (a node has one parent at most)",
-                )
-            parent[c] = i
-    for i in range(len(items)):  # a node among its own ancestors
-        seen, k = {i}, i
-        while k in parent:
-            k = parent[k]
-            if k in seen:
-                raise AssetSpecError(
-                    where, f"{shown}: nodes[{i}] is its own ancestor (a cycle of children); glTF 2.0 nodes form trees"
-                )
-            seen.add(k)
-
-
-def _drawn_meshes(data: dict[str, object]) -> tuple[int, set[int]] | None:
-    """The scene trimesh draws (``scene``, else the first of ``scenes``, as glTF 2.0 leaves the choice to the reader)
-    and the meshes its nodes place, through their children; ``None`` where the file has no scene."""
-    scenes = data.get("scenes")
-    if not isinstance(scenes, list) or not scenes:
-        return None
-    k = data.get("scene", 0)
-    scene = scenes[k] if isinstance(k, int) and not isinstance(k, bool) and 0 <= k < len(scenes) else None
-    nodes = data.get("nodes")
-    items = nodes if isinstance(nodes, list) else []
-    roots = scene.get("nodes") if isinstance(scene, dict) else None
-    todo, seen, placed = list(roots if isinstance(roots, list) else []), set(), set()
-    while todo:
-        n = todo.pop()
-        if isinstance(n, bool) or not isinstance(n, int) or n in seen or not 0 <= n < len(items):
-            continue
-        seen.add(n)
-        node = items[n]
-        if not isinstance(node, dict):
-            continue
-        mesh = node.get("mesh")
-        if isinstance(mesh, int) and not isinstance(mesh, bool):
-            placed.add(mesh)
-        kids = node.get("children")
-        todo.extend(kids if isinstance(kids, list) else [])
-    return (k if isinstance(k, int) else 0), placed
-
-
-def _surface_checks(shown: str, data: dict[str, object], where: str) -> None:
-    """Says why a file with primitives gives no triangle, where trimesh's reading said only that it "holds no
-    triangles": no scene places its meshes (a glTF draws only what its scene's nodes place), or what its scene places
-    is points and lines (no surface); and warns (:class:`~mmusv.scenario_checks.MmusvWarning`) of points and lines
-    left out beside triangles, which were dropped without a word."""
-    prims = list(_primitives(data))
-    if not prims:
-        return  # no primitive at all: "holds no triangles" says it
-    drawn = _drawn_meshes(data)
-    modes = [] if drawn is None else [(i, j, p.get("mode", 4)) for i, j, p in prims if i in drawn[1]]
-    if drawn is None or not modes:
-        meshes = data.get("meshes")
-        n = len(meshes) if isinstance(meshes, list) else 0
-        what = (
-            "has no scene (no scenes list)"
-            if drawn is None
-            else f"draws scenes[{drawn[0]}], whose nodes place no primitive of its {n} meshes"
-        )
-        raise AssetSpecError(
-            where,
-            f"{shown} {what}: a glTF draws only the meshes its scene's nodes place, so it holds no triangles to "
-            "read; export it with its meshes placed in a scene (a node naming each mesh, in scenes[].nodes)",
-        )
-    loose = [(i, j, m) for i, j, m in modes if m in (0, 1, 2, 3)]
-    listed = ", ".join(f"meshes[{i}].primitives[{j}] {_MODES[m]}" for i, j, m in loose[:3])
-    listed += ", ..." if len(loose) > 3 else ""
-    if len(loose) == len(modes):
-        raise AssetSpecError(
-            where,
-            f"{shown} holds no triangles: the primitives its scene places are points or lines ({listed}), which have "
-            "no surface for the sensors to see; a vessel needs triangles (mode 4 TRIANGLES or 5 TRIANGLE_STRIP)",
-        )
-    if loose:
-        from mmusv.scenario_checks import MmusvWarning  # here: scenario_checks imports the config, which imports us
-
-        warnings.warn(
-            f"{where}: {shown}: {len(loose)} primitive(s) of points or lines left out ({listed}): only triangles are "
-            "surfaces the sensors see",
-            MmusvWarning,
-            stacklevel=4,
-        )
 
 
 def _buffer_checks(path: Path, data: dict[str, object], where: str) -> None:
@@ -648,7 +417,7 @@ def _primitive_materials(data: dict[str, object]) -> list[PrimitiveMaterial]:
     its order."""
     materials = data.get("materials")
     out: list[PrimitiveMaterial] = []
-    for _, _, p in _primitives(data):
+    for _, _, p in primitives(data):
         mode = p.get("mode", 4)
         if not (isinstance(mode, int) and mode in _GLTF_MODES):
             continue

@@ -32,7 +32,8 @@ import numpy as np
 from mmusv.errors import ConfigError
 from mmusv.validation import join
 from mmusv.world.asset_spec import AXES, FORMAT_AXES, AssetSpecError, MeshAssetSpec, dimension_problem
-from mmusv.world.gltf_checks import TEXTURE_SLOTS, PrimitiveMaterial, check_gltf
+from mmusv.world.gltf_checks import PrimitiveMaterial, check_gltf
+from mmusv.world.gltf_graph import TEXTURE_SLOTS
 from mmusv.world.mesh_materials import (
     GLTF_EMISSIVE_SCALE,
     EmissiveKey,
@@ -133,7 +134,7 @@ _BASE_COLOR = "mmusv_base_color_factor"
 def _file_material(g: dict[str, object], material: PrimitiveMaterial, path: Path, where: str) -> None:
     """Checks a piece's material against the file's JSON ``material`` and keeps its exact ``baseColorFactor``
     (metadata :data:`_BASE_COLOR`; trimesh rounds it to 1/255, so a dark linear 0.018 became 0.0196 and 0.001
-    black). A texture slot mmusv reads (:data:`~mmusv.world.gltf_checks.TEXTURE_SLOTS`) that the file gives but
+    black). A texture slot mmusv reads (:data:`~mmusv.world.gltf_graph.TEXTURE_SLOTS`) that the file gives but
     trimesh left out (an image Pillow cannot decode, ``image/ktx2``, a texture without ``source``: trimesh logs
     them at debug level) is an error: the hull came out in the factor's colour, white by default."""
     if material is None:
