@@ -135,7 +135,8 @@ class Mount(_Model):
 class LidarConfig(_Model):
     """Spinning LiDAR. Columns per sweep = ``points_per_second / (rotation_hz · channels)`` (rounded).
 
-    ``elevations_deg`` (one per channel, any order) replaces the uniform ``vertical_fov_deg`` pattern.
+    ``elevations_deg`` (one per channel, any order) replaces the uniform ``vertical_fov_deg`` pattern (given both,
+    ``vertical_fov_deg`` must be the rings' span ``[min, max]``, or its default).
     Water returns: probability ``water_probability + water_probability_per_wave_m · H`` within
     ``water_range_m + water_range_per_wave_m · H`` metres (H the wave height).
     """
@@ -173,6 +174,15 @@ class LidarConfig(_Model):
             if len(set(self.elevations_deg)) != len(self.elevations_deg):
                 twice = sorted({e for e in self.elevations_deg if self.elevations_deg.count(e) > 1})
                 raise ValueError(f"elevations_deg repeats {twice}: two rings would fire the same rays")
+            span = (min(self.elevations_deg), max(self.elevations_deg))
+            default = type(self).model_fields["vertical_fov_deg"].default
+            if tuple(self.vertical_fov_deg) not in (default, span):
+                # elevations_deg replaces the uniform pattern: a vertical_fov_deg of its own would be ignored silently
+                raise ValueError(
+                    f"vertical_fov_deg {list(self.vertical_fov_deg)} and elevations_deg (rings from {span[0]:g} to "
+                    f"{span[1]:g} degrees) are both given, and elevations_deg replaces vertical_fov_deg: give one or "
+                    f"the other (or vertical_fov_deg [{span[0]:g}, {span[1]:g}], the rings' span)"
+                )
         elif self.channels > 1 and self.vertical_fov_deg[0] == self.vertical_fov_deg[1]:
             raise ValueError(
                 f"vertical_fov_deg {list(self.vertical_fov_deg)} spans no angle: its {self.channels} channels would "
