@@ -2,8 +2,9 @@
 
 :func:`to_document` turns a validated :class:`~mmusv.config.Scenario` into the JSON object the page edits: the
 keys a person writes by hand (name, seed, map, environment, acquisition, rigs, vessels with id, role, asset, rig,
-speed and route) always, everything else only where it differs from its default, and each rig only where it
-differs from its ``preset``. Validating the document again gives a scenario equal to the original, which is why
+speed and route) always, everything else only where it differs from its default, and each rig with the keys its
+file gave and those that differ from its ``preset`` (a camera's quality where its file set it or where it is not the
+rig's). Validating the document again gives a scenario equal to the original, which is why
 "load, save unchanged" gives an equal scenario. :func:`scenario_yaml` writes it the way the bundled scenarios are
 written (top-level blocks, one flow line per vessel), with the file's leading comment kept and its other comments
 written back at their anchors (a key, a rig, a vessel by its id: :mod:`mmusv.editor.comments`). A text holding a line
@@ -21,7 +22,7 @@ import yaml
 
 from mmusv.config import Scenario, VesselConfig
 from mmusv.editor.comments import Comment, place_comments
-from mmusv.sensors.config import RigConfig
+from mmusv.sensors.config import CameraConfig, RigConfig, TopViewConfig
 
 __all__ = ["leading_comment", "scenario_file", "scenario_yaml", "to_document"]
 
@@ -29,37 +30,40 @@ _ALWAYS_VESSEL = ("id", "role", "asset", "speed_mps", "route")
 
 
 def _rig_document(rig: RigConfig) -> dict[str, Any]:
-    """The keys of ``rig`` that differ from what its preset and its quality give (``{}`` for the paper's full
-    suite); nested models (a LiDAR, each camera) only with their non-default keys."""
+    """The keys of ``rig`` its file gave or that differ from what its preset and its quality give (``{}`` for the
+    paper's full suite); nested models (a LiDAR, each camera) only with their non-default keys. A key the file gave
+    equal to its preset's (``radar: null`` under ``lidar_only``), or a camera's quality equal to the rig's, is kept: a
+    later change of the preset or of the rig's quality in the page leaves it as the file set it."""
     base = RigConfig.model_validate({"preset": rig.preset, "quality": rig.quality}).model_dump(mode="json")
     given = rig.model_dump(mode="json", exclude_defaults=True)
     full = rig.model_dump(mode="json")
-    out: dict[str, Any] = {"preset": rig.preset} if rig.preset != "full" else {}
+    out: dict[str, Any] = {"preset": rig.preset} if rig.preset != "full" or "preset" in rig.model_fields_set else {}
     if rig.quality is not None:
         out["quality"] = rig.quality
     for key, value in full.items():
         if key in ("preset", "quality"):
             continue
-        if value != base[key]:  # e.g. a radar added back to a LiDAR-only rig, maybe with all defaults
+        if value != base[key] or key in rig.model_fields_set:  # e.g. a radar added back to a LiDAR-only rig
             out[key] = given.get(key, {} if isinstance(value, dict) else value)
     if rig.quality is not None:
-        # Under a rig's quality a camera (or the top view) states its own exactly where it differs from the rig's:
-        # a camera's `standard`, the model's default, left out would read back as the rig's quality.
+        # Under a rig's quality a camera (or the top view) states its own where it differs from the rig's or where
+        # its file set it: a camera's `standard`, the model's default, left out would read back as the rig's quality.
         cameras = out.get("cameras")
         if isinstance(cameras, list):
             for cam, doc in zip(rig.cameras, cameras, strict=True):
-                _own_quality(doc, cam.quality, rig.quality)
+                _own_quality(doc, cam, rig.quality)
         if rig.top_view is not None and isinstance(out.get("top_view"), dict):
-            _own_quality(out["top_view"], rig.top_view.quality, rig.quality)
+            _own_quality(out["top_view"], rig.top_view, rig.quality)
     return out
 
 
-def _own_quality(doc: dict[str, Any], quality: str, rig_quality: str) -> None:
-    """Writes ``quality`` into a camera's or top view's ``doc`` when it is not the rig's (else leaves it out)."""
-    if quality == rig_quality:
+def _own_quality(doc: dict[str, Any], sensor: CameraConfig | TopViewConfig, rig_quality: str) -> None:
+    """Writes a camera's or top view's quality into its ``doc`` when it is not the rig's or its file set it (else
+    leaves it out: the rig's, passed down)."""
+    if sensor.quality == rig_quality and "quality" not in sensor.model_fields_set:
         doc.pop("quality", None)
     else:
-        doc["quality"] = quality
+        doc["quality"] = sensor.quality
 
 
 def _vessel_document(v: VesselConfig) -> dict[str, Any]:

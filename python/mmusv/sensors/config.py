@@ -30,7 +30,7 @@ import math
 from collections.abc import Sequence
 from typing import Literal, get_args
 
-from pydantic import Field, ValidationInfo, field_validator, model_validator
+from pydantic import Field, ModelWrapValidatorHandler, ValidationInfo, field_validator, model_validator
 
 from mmusv._native import core
 from mmusv.strict import StrictModel
@@ -447,6 +447,13 @@ def _with_quality(rig: dict[str, object], quality: str) -> dict[str, object]:
     return out
 
 
+def _sets_quality(item: object) -> bool:
+    """Whether a camera's or top view's entry in a rig's input sets its own ``quality``."""
+    if isinstance(item, dict):
+        return "quality" in item
+    return isinstance(item, (CameraConfig, TopViewConfig)) and "quality" in item.model_fields_set
+
+
 def default_cameras(resolution: tuple[int, int] = (640, 480)) -> list[CameraConfig]:
     """The surround rig: front, left, rear, right, 90° each, on the asset's ``camera_*`` mount points."""
     return [
@@ -468,17 +475,32 @@ class RigConfig(_Model):
     cameras: list[CameraConfig] = Field(default_factory=default_cameras)
     top_view: TopViewConfig | None = Field(default_factory=TopViewConfig)
 
-    @model_validator(mode="before")
+    @model_validator(mode="wrap")
     @classmethod
-    def _apply_preset(cls, data: object) -> object:
-        if isinstance(data, dict):
-            preset = data.get("preset", "full")
-            if isinstance(preset, str) and preset in RIG_PRESETS:
-                data = {**RIG_PRESETS[preset], **data}
-            quality = data.get("quality")
-            if isinstance(quality, str) and quality in _QUALITIES:
-                data = _with_quality(data, quality)
-        return data
+    def _apply_preset(cls, data: object, handler: ModelWrapValidatorHandler[RigConfig]) -> RigConfig:
+        """Puts the preset's defaults and the rig's quality in place (the quality passed down to every camera and
+        the top view that do not set their own), validates, and leaves in ``model_fields_set`` only what ``data``
+        gave: not the preset's keys, nor a quality passed down (the editor writes a rig back as it was given)."""
+        if not isinstance(data, dict):
+            return handler(data)
+        given = data
+        preset = data.get("preset", "full")
+        if isinstance(preset, str) and preset in RIG_PRESETS:
+            data = {**RIG_PRESETS[preset], **data}
+        quality = data.get("quality")
+        if isinstance(quality, str) and quality in _QUALITIES:
+            data = _with_quality(data, quality)
+        rig = handler(data)
+        rig.__pydantic_fields_set__ = {k for k in given if k in type(rig).model_fields}
+        if rig.quality is not None:
+            raw = given.get("cameras")
+            items = raw if isinstance(raw, list) else []  # the default cameras set no quality of their own
+            for i, cam in enumerate(rig.cameras):
+                if not _sets_quality(items[i] if i < len(items) else None):
+                    cam.__pydantic_fields_set__.discard("quality")
+            if rig.top_view is not None and not _sets_quality(given.get("top_view")):
+                rig.top_view.__pydantic_fields_set__.discard("quality")
+        return rig
 
     def mounts(self) -> list[tuple[str, Mount]]:
         """``(field path within the rig, mount)`` of every sensor the rig has: ``lidar.mount``, ``radar.mount``,
