@@ -3,6 +3,10 @@
 - A LiDAR given both ``elevations_deg`` and a ``vertical_fov_deg`` of its own fired the elevations' rings and
   ignored the field of view without a word; now the two must agree (the field of view the rings' span, or left at
   its default), else the scenario is refused naming both.
+- A scenario named ``off`` (or any text field written ``no``, ``on``, ``yes`` unquoted) was refused as
+  "name = False: Input should be a valid string": YAML 1.1 (PyYAML) reads those words as booleans. They are now
+  refused as the YAML-1.1-only numbers are, naming the field, line and column, the text as written, what YAML 1.1
+  reads and what to write instead.
 """
 
 from __future__ import annotations
@@ -14,6 +18,8 @@ import pytest
 import yaml
 from mmusv.cli import main
 from mmusv.config import Scenario
+from mmusv.errors import ConfigError
+from mmusv.yamlio import parse_yaml
 from tiny_scenario import lidar_scenario
 
 
@@ -48,3 +54,36 @@ def test_elevations_with_the_default_or_their_own_span_still_load(fov: list[floa
     rig = Scenario.model_validate(_with_lidar(**lidar)).rigs["r"]
     assert rig.lidar is not None
     assert sorted(rig.lidar.elevations_rad()) == pytest.approx([math.radians(e) for e in (-15, -5, 2)])
+
+
+@pytest.mark.parametrize(
+    ("text", "said"),
+    [
+        ("name: off\n", "name = off at line 1, column 7 is a boolean in YAML 1.1, which reads it as false"),
+        ("vessels:\n  - {id: no}\n", "vessels[0].id = no at line 2, column 10 is a boolean in YAML 1.1"),
+        ("flags: [Yes]\n", "flags[0] = Yes at line 1, column 9 is a boolean in YAML 1.1, which reads it as true"),
+        ("ON: 1\n", "the key ON at line 1, column 1 is a boolean in YAML 1.1"),
+    ],
+)
+def test_yaml_11_booleans_are_refused_naming_the_field_and_what_to_write(text: str, said: str) -> None:
+    with pytest.raises(ConfigError) as info:
+        parse_yaml(text, "f.yaml")
+    message = str(info.value)
+    assert message.startswith("f.yaml: ") and said in message
+    assert "write true or false or, if it is text, put it in quotes" in message
+
+
+def test_true_false_and_quoted_words_still_read() -> None:
+    got = parse_yaml("a: true\nb: False\nc: [TRUE, \"off\", 'no']\n", "f.yaml")
+    assert got == {"a": True, "b": False, "c": [True, "off", "no"]}
+
+
+def test_a_scenario_named_off_is_refused_on_the_command_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    doc = lidar_scenario("x", frames=1)
+    path = tmp_path / "off.yaml"
+    path.write_text(yaml.safe_dump(doc).replace("name: x", "name: off"))
+    assert main(["run", str(path), "-o", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert "off.yaml: name = off at line" in err and 'put it in quotes ("off")' in err

@@ -13,7 +13,10 @@ what is wrong, never a ``UnicodeDecodeError`` or a bare parser error:
   ``time_of_day: 13:00`` base 60 (60, 780), ``0b11`` binary (3) and ``0x1F`` hexadecimal (31), which YAML 1.2
   and most other readers take otherwise (as text, or 17), and which nobody writing a seed or a frame count means.
   Integers are written in decimal (``17``, ``-60``, ``1_000``), floats as decimals (``0.5``, ``-1.5``,
-  ``1.0e+3``, ``.inf``); a time, a version or any text that looks like one of these numbers goes in quotes.
+  ``1.0e+3``, ``.inf``); a time, a version or any text that looks like one of these numbers goes in quotes;
+* so are the booleans only YAML 1.1 has: an unquoted ``name: off`` or ``weather: no`` is read as false (YAML 1.2
+  and most other readers take it as text), which a scenario's text fields then refused as "not a valid string"
+  without saying why; booleans are written ``true`` and ``false``.
 
 :func:`mapping_source` accepts a path, a dict or an already validated model, which is how ``load_scenario``
 and ``load_spec`` take their input.
@@ -158,8 +161,9 @@ class _DuplicateKey(Exception):
 
 
 class _Yaml11Number(Exception):
-    """A number written in a form only YAML 1.1 reads as a number (:func:`_yaml11_kind`); ``path`` is filled in
-    by :func:`_load` once the node is found in the document."""
+    """A number written in a form only YAML 1.1 reads as a number (:func:`_yaml11_kind`), or a boolean only YAML
+    1.1 reads as one (``yes``, ``no``, ``on``, ``off``: kind ``"boolean"``); ``path`` is filled in by :func:`_load`
+    once the node is found in the document."""
 
     def __init__(self, node: yaml.ScalarNode, kind: str, value: int | float) -> None:
         super().__init__(node.value)
@@ -202,11 +206,19 @@ def _construct_float(loader: Any, node: yaml.ScalarNode) -> float:
     return value
 
 
+def _construct_bool(loader: Any, node: yaml.ScalarNode) -> bool:
+    value: bool = yaml.constructor.SafeConstructor.construct_yaml_bool(loader, node)
+    if str(node.value).lower() not in ("true", "false"):  # yes, no, on, off: booleans in YAML 1.1 only
+        raise _Yaml11Number(node, "boolean", value)
+    return value
+
+
 for _loader in (_UniqueKeyLoader, _FastUniqueKeyLoader):
     if _loader is not None:
         _loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
         _loader.add_constructor("tag:yaml.org,2002:int", _construct_int)
         _loader.add_constructor("tag:yaml.org,2002:float", _construct_float)
+        _loader.add_constructor("tag:yaml.org,2002:bool", _construct_bool)
 
 
 def _load(text: str, loader_class: Any) -> Any:
@@ -263,6 +275,11 @@ def _yaml11_message(exc: _Yaml11Number) -> str:
     else:
         what = f"{path} = {text}" if path else text
     at = f"{what} at line {mark.line + 1}, column {mark.column + 1}"
+    if exc.kind == "boolean":
+        return (
+            f"{at} is a boolean in YAML 1.1, which reads it as {str(exc.value).lower()}; write true or false or, if "
+            f'it is text, put it in quotes ("{text}")'
+        )
     if key == "time_of_day":
         example = f'"{text}"' if exc.kind == "base-60" else '"16:30"'
         return (
