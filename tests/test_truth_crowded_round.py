@@ -585,9 +585,11 @@ def test_3d_exports_keep_every_target_in_range(rec: Rec, exports: dict[str, Path
     """KITTI and OPV2V per agent and frame: a label for every non-USV vessel whose box centre lies within 200 m
     (moored ones included; the 300 m ship, centre beyond, left out, as the exports' documented rule says), each
     matching its own 3D box: KITTI's ``h w l`` the mesh's height, beam and length and its location the box's centre
-    in the front optical frame moved h/2 down the camera's y axis (KITTI's upright box's bottom centre; 1 cm);
-    OPV2V's vehicle id 1000 + the vessel's index, its ``extent`` half the size and its box (location + center, the
-    CARLA frame, y mirrored) the world-state box's centre (1 cm)."""
+    in the front optical frame moved h/2 down the camera's y axis (KITTI's upright box's bottom centre; 1 cm), its
+    ``rotation_y`` the bow's heading about the camera's y axis, its 2D box and truncation the recorded front box's
+    (``0 0 0 0`` and 1 without one: none of them is in view too small for a box here); OPV2V's vehicle id 1000 +
+    the vessel's index, its ``extent`` half the size and its box (location + center, the CARLA frame, y mirrored)
+    the world-state box's centre (1 cm)."""
     kitti_agents = yaml.safe_load((exports["kitti"] / rec.info.scenario_name / "mmusv_kitti.yaml").read_text())[
         "agents"
     ]
@@ -602,6 +604,7 @@ def test_3d_exports_keep_every_target_in_range(rec: Rec, exports: dict[str, Path
             moored += sum(w.roles[w.ids.index(v)] == "moored" for v in want)
             _, cams = _sensor_poses(agent, w)
             inv = np.linalg.inv(cams["front"])
+            ann = f.messages[f"/{agent.id}/annotations"]
             lines = _kitti_lines(
                 exports["kitti"] / rec.info.scenario_name / folder[agent.id] / "label_2" / f"{f.index:06d}.txt"
             )
@@ -612,8 +615,21 @@ def test_3d_exports_keep_every_target_in_range(rec: Rec, exports: dict[str, Path
                 # KITTI's box is upright in the camera frame: its location the centre h/2 down the camera's y axis
                 loc = BODY_TO_OPTICAL @ (inv[:3, :3] @ bw[:3, 3] + inv[:3, 3]) + [0.0, size[2] / 2, 0.0]
                 hwl = [size[2], size[1], size[0]]
-                near = [ln for ln in lines if np.allclose(ln[7:10], hwl, atol=0.006)]
-                assert any(np.allclose(ln[10:13], loc, atol=0.01) for ln in near), (f.index, agent.id, vid, loc)
+                same = [
+                    ln
+                    for ln in lines
+                    if np.allclose(ln[7:10], hwl, atol=0.006) and np.allclose(ln[10:13], loc, atol=0.01)
+                ]
+                assert len(same) == 1, (f.index, agent.id, vid, loc)
+                ln = same[0]
+                heading = BODY_TO_OPTICAL @ inv[:3, :3] @ bw[:3, 0]  # the bow's direction in the optical frame
+                ry = -np.arctan2(heading[2], heading[0])
+                assert abs((ln[13] - ry + np.pi) % (2 * np.pi) - np.pi) < 0.006, (f.index, agent.id, vid)
+                front = {b.target_id: b for b in ann.boxes_camera if b.camera == "front"}
+                b = front.get(vid)
+                bbox = [0.0] * 4 if b is None else [b.x_min, b.y_min, b.x_max, b.y_max]
+                assert np.allclose(ln[3:7], bbox, atol=0.006), (f.index, agent.id, vid)
+                assert ln[0] == pytest.approx(1.0 if b is None else b.truncation, abs=0.006)
             doc = yaml.safe_load(
                 (
                     exports["opv2v"] / rec.info.scenario_name / str(1000 + agent.index) / f"{f.index:06d}.yaml"
