@@ -3,12 +3,13 @@ world state, the asset catalogue's meshes, the cameras' intrinsics and mounts, t
 the LiDAR points, never from the annotation code.
 
 One recording (module-scoped, 3 frames at 5 Hz, about 5 s): the port map (seed 3, four ships moored at its quays and
-piers, one of them behind a pier as the USVs see it) on a W0 sea, two USVs (a 12 m patrol boat and a WAM-V) running
-side by side 0.6 m apart, each with a 32-channel LiDAR and four 160 × 120 pinhole cameras, a 3 m jet ski 1 m off the
-patrol boat's bow, a 4.5 m RIB close astern, a 32 m tug with a 5 m speedboat alongside it (1 m between the hulls) and
-a 300 m cruise ship whose centre lies beyond the LiDAR's 200 m while its stern comes within it. So each camera sees
-the other USV's hull so close that its box reaches behind the camera, hulls cut by the image border, vessels hidden
-by a pier, by each other and by the other USV, and its own hull.
+piers, one of them behind a pier as the USVs see it) on a W0 sea, two USVs (a 12 m patrol boat with a 200 m LiDAR and
+a WAM-V with a 60 m one) running side by side 0.6 m apart, each with a 32-channel LiDAR and four 160 × 120 pinhole
+cameras, a 3 m jet ski 1 m off the patrol boat's bow, a 4.5 m RIB close astern, a 32 m tug with a 5 m speedboat
+alongside it (1 m between the hulls), a yacht at anchor (speed 0) and a 300 m cruise ship whose centre lies beyond
+200 m while its stern comes within it. So each camera sees the other USV's hull so close that its box reaches behind
+the camera, hulls cut by the image border, vessels hidden by a pier, by each other and by the other USV, and its own
+hull.
 """
 
 from __future__ import annotations
@@ -30,15 +31,16 @@ from mmusv.world.maps import generate_port
 from mmusv.world.vessels import get_asset
 from scipy.spatial.transform import Rotation
 
-RANGE_M = 200.0  # the LiDAR's default range_m: the recording's 3D boxes' reach, and the exports' target range
+RANGE_M = 200.0  # the exports' default target range (``--range``), and the patrol boat's LiDAR's (its default)
+SHORT_M = 60.0  # the WAM-V's LiDAR's range: the reach of its 3D boxes
 CAMS = ("front", "left", "right", "rear")
 W, H = 160, 120
 
 
-def _rig() -> dict[str, Any]:
+def _rig(**lidar: Any) -> dict[str, Any]:
     cams = [{"name": n, "resolution": [W, H], "hfov_deg": 90, "mount": {"point": f"camera_{n}"}} for n in CAMS]
     return {
-        "lidar": {"channels": 32, "points_per_second": 57600, "rotation_hz": 5, "range_noise_std_m": 0.0},
+        "lidar": {"channels": 32, "points_per_second": 57600, "rotation_hz": 5, "range_noise_std_m": 0.0, **lidar},
         "cameras": cams,
     }
 
@@ -49,11 +51,11 @@ SCENARIO: dict[str, Any] = {
     "map": {"type": "port", "seed": 3},
     "environment": {"time_of_day": "12:00", "weather": "clear", "wave": "W0"},
     "acquisition": {"frequency_hz": 5, "frames": 3},
-    "rigs": {"r": _rig()},
+    "rigs": {"r": _rig(), "short": _rig(range_m=SHORT_M)},
     "vessels": [
         {"id": "ego", "role": "usv", "asset": "usv_patrol_12m", "rig": "r", "speed_mps": 2.0,
          "route": [[330, 120], [330, 170]]},
-        {"id": "usv2", "role": "usv", "asset": "usv_wamv", "rig": "r", "speed_mps": 2.0,
+        {"id": "usv2", "role": "usv", "asset": "usv_wamv", "rig": "short", "speed_mps": 2.0,
          "route": [[333.8, 118], [333.8, 168]]},
         {"id": "jetski", "role": "target", "asset": "jet_ski_3m", "speed_mps": 2.0,
          "route": [[330, 130.5], [330, 180]]},
@@ -63,6 +65,8 @@ SCENARIO: dict[str, Any] = {
          "route": [[268, 125], [268, 165]]},
         {"id": "cruise", "role": "target", "asset": "cruise_ship_300m", "speed_mps": 1.0,
          "route": [[100, 40], [200, 40]]},
+        {"id": "anchored", "role": "target", "asset": "sailing_yacht_12m", "speed_mps": 0.0,
+         "route": [[300, 100], [300, 110]]},
     ],
 }  # fmt: skip
 
@@ -231,10 +235,11 @@ def test_the_scene_holds_the_awkward_cases(rec: Rec) -> None:
 
 def test_every_vessel_in_range_has_one_3d_and_bev_box_from_the_catalogue(rec: Rec) -> None:
     """Per agent and frame: a 3D box for every other vessel (moored ones, the other USV and the 300 m ship whose
-    centre is out of range included) whose footprint comes within 200 m of the LiDAR, none other, none twice, the
-    agent never; its centre, size and rotation those of the catalogue mesh's extent at the world-state pose, in the
-    LiDAR frame (1e-6); its instance and class the world state's; ``lidar_points`` the points carrying its
-    instance; the BEV box the 3D box's x, y, length, beam and yaw."""
+    centre is out of range included) whose footprint comes within the agent's own LiDAR range of it (200 m for the
+    patrol boat, 60 m for the WAM-V, read from the recorded rig), none other, none twice, the agent never; its
+    centre, size and rotation those of the catalogue mesh's extent at the world-state pose, in the LiDAR frame
+    (1e-6); its instance and class the world state's; ``lidar_points`` the points carrying its instance; the BEV box
+    the 3D box's x, y, length, beam and yaw."""
     seen_moored = set()
     for f in rec.frames:
         w = f.world
@@ -252,7 +257,7 @@ def test_every_vessel_in_range_has_one_3d_and_bev_box_from_the_catalogue(rec: Re
                     continue
                 box, size = _box_world(w, i)
                 rel = inv @ box
-                if _footprint_distance(rel, size) <= RANGE_M:
+                if _footprint_distance(rel, size) <= agent.rig["lidar"]["range_m"]:
                     want.add(vid)
                 if vid not in got:
                     continue
@@ -267,7 +272,7 @@ def test_every_vessel_in_range_has_one_3d_and_bev_box_from_the_catalogue(rec: Re
                 if w.roles[i] == "moored":
                     seen_moored.add(vid)
             assert set(got) == want, (f.index, agent.id, sorted(set(got) ^ want))
-            assert "cruise" in got
+            assert ("cruise" in got) == (agent.id == "ego")  # its stern is within 200 m, not within 60 m
             bev = [(b.target_id, b.x, b.y, b.length, b.width, b.yaw) for b in ann.boxes_bev]
             assert bev == [
                 (b.target_id, b.center[0], b.center[1], b.size[0], b.size[1], b.yaw) for b in ann.boxes_lidar
@@ -278,9 +283,14 @@ def test_every_vessel_in_range_has_one_3d_and_bev_box_from_the_catalogue(rec: Re
 
 def test_the_tables_are_the_messages_and_flag_the_moored_ships_static(rec: Rec) -> None:
     """The Parquet tables a researcher reads instead of the MCAP hold the same boxes, row for row; the moored ships
-    are ``static`` with role ``moored``, the moving vessels are not static."""
+    (role ``moored``) and the scenario's anchored yacht (speed 0) are ``static``, the moving vessels are not."""
     import polars as pl
 
+    w0 = rec.frames[0].world
+    assert w0 is not None
+    still = {v["id"] for v in rec.info.scenario["vessels"] if v["speed_mps"] == 0}
+    still |= {v for v, r in zip(w0.ids, w0.roles, strict=True) if r == "moored"}
+    assert "anchored" in still and len(still) == 5
     root = rec.path.parent / "tables"
     b3 = pl.read_parquet(next((root / "boxes_3d").glob("*.parquet")))
     b2 = pl.read_parquet(next((root / "boxes_2d").glob("*.parquet")))
@@ -295,7 +305,7 @@ def test_the_tables_are_the_messages_and_flag_the_moored_ships_static(rec: Rec) 
                 assert [r["x"], r["y"], r["z"], r["yaw"]] == [*b.center, b.yaw]
                 assert r["lidar_points"] == b.lidar_points
                 i = w.ids.index(b.target_id)
-                assert r["role"] == w.roles[i] and r["static"] == (w.roles[i] == "moored")
+                assert r["role"] == w.roles[i] and r["static"] == (b.target_id in still)
             t2 = b2.filter((pl.col("frame") == f.index) & (pl.col("agent") == agent.id))
             assert list(zip(t2["target_id"], t2["camera"], strict=True)) == [
                 (b.target_id, b.camera) for b in ann.boxes_camera
