@@ -209,7 +209,8 @@ def _targets_by_centre(w: WorldFrame, agent: AgentInfo) -> set[str]:
 def test_the_scene_holds_the_awkward_cases(rec: Rec) -> None:
     """What the checks below rely on: four moored ships at the map's own berths (the map generated here, not read
     from the recording), riding there; the USVs' hulls 0.6 m apart; the tug and speedboat 1 m apart; the cruise
-    ship's centre beyond the range with its footprint within it; a 3 m and a 300 m hull."""
+    ship's centre beyond the range with its footprint within it; a 3 m and a 300 m hull; every vessel under one id
+    and one instance id, the same in every frame."""
     w = rec.frames[0].world
     assert w is not None
     berths = generate_port(seed=3).moored
@@ -231,6 +232,12 @@ def test_the_scene_holds_the_awkward_cases(rec: Rec) -> None:
     rel = np.linalg.inv(lidar) @ box
     assert np.hypot(*rel[:2, 3]) > RANGE_M > _footprint_distance(rel, size)
     assert _mesh_box("jet_ski_3m")[0][0] == pytest.approx(3.0) and _mesh_box("cruise_ship_300m")[0][0] == 300.0
+    # every vessel once, under the same id, instance, asset and role in every frame
+    assert len(set(w.ids)) == len(w.ids) and len(set(w.instance_ids.tolist())) == len(w.ids)
+    for f in rec.frames[1:]:
+        assert f.world is not None
+        assert (f.world.ids, f.world.assets, f.world.roles) == (w.ids, w.assets, w.roles)
+        assert np.array_equal(f.world.instance_ids, w.instance_ids)
 
 
 def test_every_vessel_in_range_has_one_3d_and_bev_box_from_the_catalogue(rec: Rec) -> None:
