@@ -397,7 +397,8 @@ def test_kitti_label_boxes_are_their_projected_3d_boxes(exports: dict[str, Path]
             p2 = read_calib(root / str(cav) / "calib" / f"{ts}.txt")["P2"].reshape(3, 4)
             for line in (root / str(cav) / "label_2" / f"{ts}.txt").read_text().splitlines():
                 f = line.split()
-                if int(f[2]) == 3 or (d.any() and float(f[1]) > 0.0):  # not in the image; truncated by a lens
+                if f[0] == "DontCare" or int(f[2]) == 3 or (d.any() and float(f[1]) > 0.0):  # no 3D box; not in
+                    # the image; truncated by a lens
                     continue
                 corners = kitti_corners(f)
                 assert corners[:, 2].min() > 0.05

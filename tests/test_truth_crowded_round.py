@@ -14,6 +14,7 @@ hull.
 
 from __future__ import annotations
 
+import csv
 import json
 import warnings
 from pathlib import Path
@@ -189,8 +190,8 @@ def _images(f: Frame, agent: str, cam: str) -> tuple[np.ndarray, np.ndarray]:
     return inst, sem
 
 
-def _targets_by_centre(w: WorldFrame, agent: AgentInfo) -> set[str]:
-    """The exports' targets (OPV2V, KITTI): non-USV vessels whose box centre lies within the range, BEV."""
+def _targets_by_centre(w: WorldFrame, agent: AgentInfo, range_m: float = RANGE_M) -> set[str]:
+    """The exports' targets (OPV2V, KITTI): non-USV vessels whose box centre lies within ``range_m``, BEV."""
     lidar, _ = _sensor_poses(agent, w)
     inv = np.linalg.inv(lidar)
     out = set()
@@ -198,7 +199,7 @@ def _targets_by_centre(w: WorldFrame, agent: AgentInfo) -> set[str]:
         if i == agent.index or w.roles[i] == "usv":
             continue
         c = inv[:3, :3] @ _box_world(w, i)[0][:3, 3] + inv[:3, 3]
-        if np.hypot(c[0], c[1]) <= RANGE_M:
+        if np.hypot(c[0], c[1]) <= range_m:
             out.add(vid)
     return out
 
@@ -511,7 +512,7 @@ def exports(rec: Rec, tmp_path_factory: pytest.TempPathFactory) -> dict[str, Pat
     from mmusv.export import convert
 
     out = {}
-    for to in ("coco", "yolo", "mot", "kitti", "opv2v"):
+    for to in ("coco", "yolo", "mot", "kitti", "kitti_tracking", "opv2v"):
         d = tmp_path_factory.mktemp(to)
         convert(rec.path, to=to, out_dir=d, splits=None)
         out[to] = d
@@ -594,7 +595,12 @@ def test_image_exports_keep_every_visible_vessel(rec: Rec, exports: dict[str, Pa
 
 
 def _kitti_lines(path: Path) -> list[list[float]]:
-    return [[float(x) for x in line.split()[1:]] for line in path.read_text().splitlines() if line]
+    # the targets' lines; a DontCare line (a region to ignore) is checked on its own, below
+    return [
+        [float(x) for x in line.split()[1:]]
+        for line in path.read_text().splitlines()
+        if line and "DontCare" not in line
+    ]
 
 
 def test_3d_exports_keep_every_target_in_range(rec: Rec, exports: dict[str, Path]) -> None:
@@ -659,3 +665,61 @@ def test_3d_exports_keep_every_target_in_range(rec: Rec, exports: dict[str, Path
                 centre = np.add(v["location"], v["center"]) * [1, -1, 1]
                 assert np.allclose(centre, bw[:3, 3], atol=0.01), (f.index, agent.id, key)
     assert moored >= 6
+
+
+@pytest.mark.parametrize("range_m", [RANGE_M, 40.0])
+def test_kitti_marks_the_vessels_it_leaves_out_as_dont_care(
+    rec: Rec, exports: dict[str, Path], range_m: float, tmp_path: Path
+) -> None:
+    """KITTI's ``label_2`` (and KITTI tracking's ``label_02``, track id -1) hold, besides the targets, one ``DontCare``
+    line (KITTI's own form: ``-1 -1 -10``, the 2D box, ``-1 -1 -1 -1000 -1000 -1000 -10``) for each vessel the front
+    image shows (a recorded front box with a visible pixel) that is not a target: the other USV, and at a 40 m range
+    the vessels beyond it. KITTI's evaluation ignores detections there; without them a detector finding such a
+    vessel was counted wrong (2026-12-06)."""
+    from mmusv.export import convert
+
+    scenario = rec.info.scenario_name
+    if range_m != RANGE_M:
+        exports = {to: tmp_path / to for to in ("kitti", "kitti_tracking")}
+        for to, d in exports.items():
+            convert(rec.path, to=to, out_dir=d, splits=None, eval_range_m=range_m)
+    kitti_agents = yaml.safe_load((exports["kitti"] / scenario / "mmusv_kitti.yaml").read_text())["agents"]
+    folder = {v: str(k) for k, v in kitti_agents.items()}
+    tracking = exports["kitti_tracking"] / "train"
+    rows = csv.DictReader((exports["kitti_tracking"] / "sequences.csv").read_text().splitlines())
+    sequences = {row["agent"]: row["sequence"] for row in rows}
+    ignored: set[str] = set()
+    for agent in rec.info.agents:
+        seq = (tracking / "label_02" / f"{sequences[agent.id]}.txt").read_text().splitlines()
+        for k, f in enumerate(rec.frames):
+            w = f.world
+            assert w is not None
+            want = _targets_by_centre(w, agent, range_m)
+            ann = f.messages[f"/{agent.id}/annotations"]
+            shown = {b.target_id: b for b in ann.boxes_camera if b.camera == "front" and b.visible_pixels > 0}
+            left = sorted(
+                (round(b.x_min, 2), round(b.y_min, 2), round(b.x_max, 2), round(b.y_max, 2))
+                for vid, b in shown.items()
+                if vid not in want
+            )
+            ignored.update(vid for vid in shown if vid not in want)
+            text = (exports["kitti"] / scenario / folder[agent.id] / "label_2" / f"{f.index:06d}.txt").read_text()
+            dont = [line.split() for line in text.splitlines() if line.startswith("DontCare ")]
+            for fields in dont:
+                assert fields[1:4] == ["-1", "-1", "-10"] and fields[8:] == [
+                    "-1",
+                    "-1",
+                    "-1",
+                    "-1000",
+                    "-1000",
+                    "-1000",
+                    "-10",
+                ]
+            got = sorted(tuple(float(x) for x in fields[4:8]) for fields in dont)
+            assert len(got) == len(left), (f.index, agent.id)
+            np.testing.assert_allclose(np.reshape(got, (-1, 4)), np.reshape(left, (-1, 4)), atol=0.0051)
+            in_seq = [line.split()[2:] for line in seq if line.split()[:3] == [str(k), "-1", "DontCare"]]
+            assert in_seq == dont, (f.index, agent.id)
+    assert "ego" in ignored  # the other USV, never a target
+    if range_m < RANGE_M:  # vessels beyond the range, in the picture
+        assert len(ignored - {"ego"}) >= 2, ignored

@@ -183,7 +183,8 @@ def check_kitti_tracking(out: Path) -> int:
             assert sorted(p.name for p in (split / "velodyne" / seq).iterdir()) == [f"{k:06d}.bin" for k in range(n)]
             for line in (split / "label_02" / f"{seq}.txt").read_text().splitlines():
                 f = line.split()
-                assert len(f) == 17 and 0 <= int(f[0]) < n and int(f[1]) >= 0, line
+                dont_care = f[1:3] == ["-1", "DontCare"]  # a region to ignore, track id -1 as in KITTI's own labels
+                assert len(f) == 17 and 0 <= int(f[0]) < n and (int(f[1]) >= 0 or dont_care), line
             calib = [line.split()[0] for line in (split / "calib" / f"{seq}.txt").read_text().splitlines()]
             assert calib == ["P0:", "P1:", "P2:", "P3:", "R_rect", "Tr_velo_cam", "Tr_imu_velo"]
             assert len((split / "pose" / f"{seq}.txt").read_text().splitlines()) == n
@@ -262,6 +263,8 @@ def kitti_boxes_in_lidar(label: Path, calib: Path) -> list[tuple[np.ndarray, flo
     for line in label.read_text().splitlines():
         f = line.split()
         assert len(f) == 15
+        if f[0] == "DontCare":  # a region to ignore, no box: OpenPCDet's loader drops these lines
+            continue
         h, w, length = (float(v) for v in f[8:11])
         loc = to_velo @ np.array([*(float(v) for v in f[11:14]), 1.0])
         centre = loc[:3] + np.array([0.0, 0.0, h / 2])

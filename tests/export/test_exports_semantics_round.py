@@ -93,6 +93,8 @@ def test_kitti_truncated_is_the_share_out_of_the_front_image(kitti_case: tuple[P
             calib = agent / "calib" / path.name
             for line in path.read_text().splitlines():
                 f = line.split()
+                if f[0] == "DontCare":  # a region to ignore: no truncation of its own (-1)
+                    continue
                 truncated, occluded, bbox = float(f[1]), int(f[2]), [float(v) for v in f[4:8]]
                 assert 0.0 <= truncated <= 1.0 and f[1] == f"{truncated:.2f}"
                 if occluded == 3:

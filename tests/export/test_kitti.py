@@ -19,6 +19,8 @@ def parse_labels(path: Path) -> list[dict[str, Any]]:
     for line in path.read_text().splitlines():
         f = line.split()
         assert len(f) == 15
+        if f[0] == "DontCare":  # a region to ignore, not an object
+            continue
         rows.append(
             {
                 "type": f[0],

@@ -12,6 +12,9 @@ box, so that readers adding h/2 back get the box centre, also when the hull or t
 truncation and occlusion come from the recording's camera annotations (occluded 0: < 25 % hidden, 1: < 60 %,
 2: more, 3: no box in the front image, with box ``0 0 0 0`` and truncated the share of the target out of the image:
 ``1.00`` behind or beside the camera, the projected box's share for one in view too small for any pixel centre).
+After the targets, a ``DontCare`` line (KITTI's own form, :func:`dont_care_lines`) for each vessel the front image
+shows that is not a target (beyond the range by its centre, or another USV): KITTI's evaluation ignores detections
+there.
 An agent without a front camera has no ``image_2``, zero ``P0..P3`` and, as camera, the LiDAR's own optical axes
 (``Tr_velo_to_cam`` = the rotation x right, y down, z forward): its labels keep KITTI's camera conventions, so
 KITTI's readers turn them into LiDAR boxes with the right heading. A front camera's lens distortion (KITTI's
@@ -41,12 +44,14 @@ from mmusv.recording.info import AgentInfo
 from mmusv.recording.stream import Frame
 
 __all__ = [
+    "DONT_CARE_TAIL",
     "LEVEL_TOLERANCE_DEG",
     "LIDAR_OPTICAL",
     "OBJECT_CALIB_KEYS",
     "KittiWriter",
     "calib_text",
     "camera0",
+    "dont_care_lines",
     "front_calib",
     "front_camera_turn",
     "kitti_label",
@@ -182,6 +187,32 @@ def label_lines(
     return lines
 
 
+DONT_CARE_TAIL = "-1 -1 -1 -1000 -1000 -1000 -10"
+"""What follows a ``DontCare`` line's 2D box: KITTI's own (its ``label_2`` files: ``DontCare -1 -1 -10 x1 y1 x2 y2
+-1 -1 -1 -1000 -1000 -1000 -10``)."""
+
+
+def dont_care_lines(view: AgentView, targets: list[Target], messages: dict[str, Any]) -> list[str]:
+    """KITTI's ``DontCare`` lines (type ``DontCare``, truncated and occluded -1, alpha -10, the 2D box, no 3D box:
+    :data:`DONT_CARE_TAIL`) of the vessels the front image shows (a recorded front box with a visible pixel) that are
+    not among ``targets``: beyond the evaluation range (a long ship whose centre is out of range while its bow is in
+    the picture), or another USV without ``--include-usvs``. KITTI's evaluation ignores detections in these regions,
+    as its own labels mark the objects they leave out, so a detector is not counted wrong for finding them. Sorted
+    by the box's position in the image."""
+    ann = messages.get(topics.agent_annotations(view.agent.id))
+    if ann is None or "front" not in view.agent.cameras:
+        return []
+    kept = {t.id for t in targets}
+    boxes = sorted(
+        (b.x_min, b.y_min, b.x_max, b.y_max)
+        for b in ann.boxes_camera
+        if b.camera == "front" and b.target_id not in kept and b.visible_pixels > 0
+    )
+    return [
+        f"DontCare -1 -1 -10 {' '.join(f'{round(float(v), 2) + 0.0:.2f}' for v in bb)} {DONT_CARE_TAIL}" for bb in boxes
+    ]
+
+
 def truncation_level(fraction: float | None) -> int:
     """The KITTI tracking benchmark's truncation (its raw data's tracklet levels: 0 in the image, 1 cut by the image
     border, 2 out of the image) of a target whose box in the image is cut by ``fraction`` (0..1, taken at the object
@@ -233,8 +264,9 @@ def kitti_label(
 class KittiWriter(DatasetWriter):
     """Writes one recording as KITTI-style per-agent folders (see the module docstring)."""
 
-    format_version: ClassVar[int] = 2
-    """2 (2026-12-02): ``truncated`` of a target without a front box is its share out of the image (it was 0)."""
+    format_version: ClassVar[int] = 3
+    """2 (2026-12-02): ``truncated`` of a target without a front box is its share out of the image (it was 0); 3
+    (2026-12-06): ``DontCare`` lines for the vessels the front image shows that are not targets."""
     cameras: ClassVar[dict[str, int]] = {"front": 2}
     needs_agent: ClassVar[bool] = True
     image_folder: ClassVar[str] = "image_2"
@@ -332,7 +364,7 @@ class KittiWriter(DatasetWriter):
             self._dir(a, "calib") / f"{ts}.txt",
             calib_text(k, velo_to_cam=velo_to_cam, lidar_mount=a.lidar_mount, keys=OBJECT_CALIB_KEYS),
         )
-        lines = label_lines(view, targets, frame.messages, velo_to_cam)
+        lines = label_lines(view, targets, frame.messages, velo_to_cam) + dont_care_lines(view, targets, frame.messages)
         self.put(self._dir(a, "label_2") / f"{ts}.txt", "".join(line + "\n" for line in lines).encode())
 
     def finish(self, frames: list[int], skipped: list[dict[str, Any]]) -> None:

@@ -14,7 +14,9 @@ over the whole conversion in its order: split, scenario, agent; so no two sequen
   rotation_y``) with ``truncated`` the tracking benchmark's level 0, 1, 2
   (:func:`mmusv.export.kitti.truncation_level`), sorted by frame, then track id; ``frame`` 0, 1, … over the
   converted frames (whatever ``frames`` selects), ``track_id`` :func:`mmusv.export.mot.track_id` (1 + the
-  vessel's world-state row: the MOT export's id);
+  vessel's world-state row: the MOT export's id); and per frame, first, with track id -1, the ``DontCare`` lines of
+  the vessels the front image shows that are not targets (:func:`mmusv.export.kitti.dont_care_lines`: TrackEval's
+  ``Kitti2DBox`` takes them as regions to ignore, as in KITTI's own labels);
 * ``calib/<seq>.txt``: ``P0:`` … ``P3:``, ``R_rect``, ``Tr_velo_cam``, ``Tr_imu_velo`` (the tracking benchmark's
   names, the last three without a colon), the KITTI export's calibration of the sequence's first frame: the front
   camera is rigid on the hull, so LiDAR → camera is one matrix per sequence, checked on every frame (a camera that
@@ -47,7 +49,7 @@ import numpy as np
 from mmusv.errors import IoError
 from mmusv.export.common import Options, Sink, cav_id
 from mmusv.export.geometry import AgentView, Target
-from mmusv.export.kitti import KittiWriter, calib_text, camera0, kitti_numbers, label_lines
+from mmusv.export.kitti import KittiWriter, calib_text, camera0, dont_care_lines, kitti_numbers, label_lines
 from mmusv.export.kitti_oxts import DEFAULT_ORIGIN, oxts_lines
 from mmusv.export.mot import TRACKS_COLUMNS, TrackRows, csv_bytes, mot_split, track_id, track_rows
 from mmusv.export.splits import SPLIT_NAMES
@@ -185,7 +187,8 @@ class KittiTrackingWriter(KittiWriter):
         self.write_sensors(frame, view)
         lines = label_lines(view, targets, frame.messages, velo_to_cam, self.options.kitti_class, levels=True)
         ids = [track_id(world, t.id) for t in targets]
-        seq.labels[frame.index] = [f"{i} {line}" for i, line in sorted(zip(ids, lines, strict=True))]
+        ignored = [f"-1 {line}" for line in dont_care_lines(view, targets, frame.messages)]  # track id -1, as KITTI's
+        seq.labels[frame.index] = ignored + [f"{i} {line}" for i, line in sorted(zip(ids, lines, strict=True))]
         seq.poses[frame.index] = kitti_numbers(view.lidar[:3, :])
         seq.bodies[frame.index] = np.array(view.body, dtype=np.float64)
 
