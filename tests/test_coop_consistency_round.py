@@ -72,6 +72,8 @@ class Rec:
         for fr in FrameStream(self.info, lambda _t: True):
             self.world[fr.index] = fr.world
             for a in self.info.agents:
+                if a.lidar_mount is None:
+                    continue
                 self.clouds[fr.index, a.id] = decode_point_cloud(fr.messages[f"/{a.id}/lidar"])
                 self.annotations[fr.index, a.id] = fr.messages[f"/{a.id}/annotations"]
 
@@ -487,3 +489,36 @@ def test_pose_noise_has_the_documented_sigmas_on_the_documented_axes(rec: Rec) -
     np.testing.assert_allclose(d.std(axis=0), [2, 2, 2, 0.5, 0.5, 0.5], rtol=0.12)
     corr = np.corrcoef(d.T) - np.eye(6)
     assert np.abs(corr).max() < 0.2
+
+
+def test_a_usv_without_lidar_listed_in_opv2v_is_a_platform_for_the_study_not_a_target(tmp_path: Path) -> None:
+    """Ground truth is every vessel but the instrumented USVs (docs/studies/detection.md), from a recording and from
+    its OPV2V export alike. A USV with cameras but no LiDAR is no CAV of the export, and ``--include-usvs`` lists it
+    among the CAVs' ``vehicles`` (``_additional.yaml``: role ``usv``): the study read it from OPV2V as a target, which
+    the recording's reading never does, and a detection of it counted as a true positive there, a false one ignored
+    here. Read from either, it is a USV platform (its box, where detections are ignored), not ground truth."""
+    import copy
+
+    from mmusv.acquire import run
+    from mmusv.export import convert
+    from mmusv.studies.detection.data import read_opv2v, read_recording
+
+    sc = copy.deepcopy(SCENARIO)
+    sc["name"], sc["acquisition"]["frames"] = "coop_camera_usv", 1
+    camera = {"name": "front", "resolution": [32, 24], "hfov_deg": 90, "mount": {"point": "camera_front"}}
+    sc["rigs"]["camera_only"] = {"lidar": None, "cameras": [camera]}
+    sc["vessels"].append(
+        {"id": "usv_c", "role": "usv", "asset": "usv_wamv", "rig": "camera_only", "speed_mps": 2.0,
+         "route": [[290, 120], [290, 160]]}
+    )  # fmt: skip
+    rec = Path(run(sc, out_dir=tmp_path / "rec").recording)
+    convert(rec, to="opv2v", out_dir=tmp_path / "opv2v", splits=None, extras="", include_usvs=True)
+    a, b = read_recording(rec).frames[0], read_opv2v(tmp_path / "opv2v" / "coop_camera_usv").frames[0]
+    w = Rec(rec).world[0]
+    listed = {w.ids[int(t) - 1000] for t in b.target_ids}
+    assert "usv_c" not in listed and "yacht" in listed and listed <= set(a.target_ids), listed
+    # usv_c's box is among the platforms, as the recording's reading has it (the third of its USV boxes)
+    assert [v for v, r in zip(w.ids, w.roles, strict=True) if r == "usv"] == ["usv_a", "usv_b", "usv_c"]
+    c = next(k for k, m in enumerate(b.usv_boxes) if np.allclose(m[:3, 3], a.usv_boxes[2][:3, 3], atol=1e-5))
+    np.testing.assert_allclose(b.usv_boxes[c], a.usv_boxes[2], atol=1e-5)
+    np.testing.assert_allclose(b.usv_sizes[c], a.usv_sizes[2], atol=1e-5)

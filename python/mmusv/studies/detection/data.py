@@ -270,8 +270,12 @@ def opv2v_scenarios(root: str | Path, *, name: str = "root") -> list[Path]:
 
 def read_opv2v(folder: str | Path) -> SequenceData:
     """One OPV2V scenario folder (as ``mmusv convert --to opv2v`` writes it) as a sequence, converted back from
-    the CARLA frame (y mirrored, degrees) to mmusv frames. Targets are the union of the CAVs' ``vehicles``;
-    the CAVs' platforms are squares of half-size :data:`OPV2V_USV_RADIUS_M` about their body origin."""
+    the CARLA frame (y mirrored, degrees) to mmusv frames. Targets are the union of the CAVs' ``vehicles``
+    but the CAVs themselves and the USVs that mmusv's ``<ts>_additional.yaml`` gives role ``usv`` (a USV without a
+    LiDAR, no CAV, listed with ``--include-usvs``): those are platforms with their listed box, as a recording's
+    USVs are (ground truth was every vessel but the instrumented USVs; such a USV was a target read from OPV2V and
+    a platform read from the recording). The CAVs' platforms are squares of half-size :data:`OPV2V_USV_RADIUS_M`
+    about their body origin."""
     from mmusv.export.pcd import read_pcd
 
     d = Path(folder)
@@ -287,6 +291,7 @@ def read_opv2v(folder: str | Path) -> SequenceData:
         afs: list[AgentFrame] = []
         vehicles: dict[str, np.ndarray] = {}
         sizes: dict[str, np.ndarray] = {}
+        usvs: set[str] = set()
         for c in cavs:
             y_path, p_path = c / f"{ts}.yaml", c / f"{ts}.pcd"
             if not (y_path.is_file() or p_path.is_file()):
@@ -302,6 +307,7 @@ def read_opv2v(folder: str | Path) -> SequenceData:
                 # inside the try: a vehicle without a location or of 2 angles was a bare KeyError / ValueError
                 for vid, (box, size) in _opv2v_vehicles(doc.get("vehicles") or {}).items():
                     vehicles[vid], sizes[vid] = box, size
+                usvs |= _opv2v_usvs(c / f"{ts}_additional.yaml")
             except (OSError, ValueError, KeyError, TypeError, AttributeError, yaml.YAMLError) as exc:
                 why = " ".join(str(exc).split())  # a YAML error spans several lines
                 raise IoError(f"{y_path}: not a readable OPV2V frame ({type(exc).__name__}: {why})") from None
@@ -309,8 +315,11 @@ def read_opv2v(folder: str | Path) -> SequenceData:
             afs.append(AgentFrame(c.name, pts, body, invert(body) @ lidar))
         if not afs:
             continue
-        ids = sorted(k for k in vehicles if k not in {a.id for a in afs})
-        usv = np.stack([a.body for a in afs])
+        cavs_here = {a.id for a in afs}
+        ids = sorted(k for k in vehicles if k not in cavs_here and k not in usvs)
+        others = sorted(k for k in vehicles if k not in cavs_here and k in usvs)
+        usv = np.stack([a.body for a in afs] + [vehicles[k] for k in others])
+        cav_size = [2 * OPV2V_USV_RADIUS_M, 2 * OPV2V_USV_RADIUS_M, 5.0]
         frames.append(
             SceneFrame(
                 frame=int(ts),
@@ -319,10 +328,24 @@ def read_opv2v(folder: str | Path) -> SequenceData:
                 targets=np.stack([vehicles[k] for k in ids]) if ids else np.zeros((0, 4, 4)),
                 target_sizes=np.stack([sizes[k] for k in ids]) if ids else np.zeros((0, 3)),
                 usv_boxes=usv,
-                usv_sizes=np.tile([2 * OPV2V_USV_RADIUS_M, 2 * OPV2V_USV_RADIUS_M, 5.0], (len(afs), 1)),
+                usv_sizes=np.array([cav_size] * len(afs) + [sizes[k] for k in others], dtype=np.float64),
             )
         )
     return SequenceData(d.name, tuple(frames))
+
+
+def _opv2v_usvs(path: Path) -> set[str]:
+    """The ids of the vehicles that an OPV2V frame's ``<ts>_additional.yaml`` (mmusv's, beside the stock files)
+    gives role ``usv``; none without the file (a stock OPV2V folder). A file that is there but not such a document
+    raises as the frame's yaml does (``ValueError``, ``yaml.YAMLError``)."""
+    if not path.is_file():
+        return set()
+    doc = yaml.safe_load(path.read_text(encoding="utf-8"))
+    mm = doc.get("mmusv") if isinstance(doc, dict) else None
+    listed = mm.get("vehicles") if isinstance(mm, dict) else None
+    if not isinstance(listed, dict):
+        raise ValueError(f"{path.name}: not mmusv's additional yaml (mmusv.vehicles: {{id: {{role, ...}}}})")
+    return {str(vid) for vid, v in listed.items() if isinstance(v, dict) and v.get("role") == "usv"}
 
 
 def _opv2v_pose(doc: Any, key: str) -> np.ndarray:
