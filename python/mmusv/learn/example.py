@@ -5,7 +5,10 @@
   :func:`~mmusv.studies.detection.fusion.early_points` rule; the pillar grid crops to the preset's range);
 - ``intermediate``: the ego's pillars plus every neighbour's pillars, encoded in the neighbour's own frame and
   grid, whose centres are moved into the ego frame and assigned to the ego grid cell they fall in (cells off the
-  grid are dropped); the model max-fuses them into the ego canvas (F-Cooper, Chen et al., SEC 2019).
+  grid are dropped); the model max-fuses them into the ego canvas (F-Cooper, Chen et al., SEC 2019). A centre is
+  taken at the neighbour's LiDAR height (z = 0 of its frame), so a relative roll or pitch between the two USVs
+  places a pillar whose points lie z metres above or below that sensor about z·sin(tilt) off in x, y (metres at
+  W3 for tall hulls, docs/studies/detection.md); ``early`` moves every point in 3D.
 
 Inputs: ego points ``(N, 4)`` float32 and ``[(points (N_i, 4), rel (4, 4) neighbour LiDAR → ego LiDAR)]``.
 """
