@@ -319,6 +319,21 @@ def test_opv2v_lidar_pose_is_true_ego_pos_times_the_fixed_mount(rec: Rec, opv2v:
             np.testing.assert_allclose(MIRROR @ x_to_world(doc["lidar_pose"]) @ MIRROR, rec.lidar(f, ag), atol=5e-6)
 
 
+def test_opv2v_timestamps_are_one_instant_for_every_cav(rec: Rec, opv2v: Path) -> None:
+    """docs/exports.md: one file set per acquisition index ``<ts>``, the same for every agent, taken at ``<ts>`` /
+    ``frequency_hz`` s: each CAV has the same timestamps, its ``_additional.yaml`` says that frame and time, and
+    ``data_protocol.yaml`` gives the step OpenCOOD's delay would need (``fixed_delta_seconds`` = 1 / 5 Hz)."""
+    stamps = {ag: sorted(p.stem for p in (opv2v / _cav(rec, ag)).glob("*.pcd")) for ag in ("usv_a", "usv_b")}
+    assert stamps["usv_a"] == stamps["usv_b"] == [f"{f:06d}" for f in sorted(rec.world)]
+    for ag in stamps:
+        for f in rec.world:
+            add = yaml.safe_load((opv2v / _cav(rec, ag) / f"{f:06d}_additional.yaml").read_text())["mmusv"]
+            assert add["agent"] == ag and add["frame"] == f
+            assert add["time_s"] == pytest.approx(f / 5.0, abs=1e-9) == pytest.approx(rec.world[f].time_s, abs=1e-9)
+    protocol = yaml.safe_load((opv2v / "data_protocol.yaml").read_text())
+    assert protocol["world"]["fixed_delta_seconds"] == pytest.approx(0.2)
+
+
 def test_opv2v_a_cav_listed_by_another_is_where_it_says_it_is(rec: Rec, opv2v: Path) -> None:
     """With ``include_usvs``, each CAV lists the other as a vehicle under its CAV id: that entry's ``location`` and
     ``angle`` are the other CAV's ``true_ego_pos`` of the same timestamp, and its box (``location + center`` with
