@@ -483,7 +483,7 @@ def test_late_fusion_under_delay_places_the_neighbour_s_old_boxes_with_its_old_p
 def test_pose_noise_has_the_documented_sigmas_on_the_documented_axes(rec: Rec) -> None:
     """``noise:σxyz/σrpy`` with σxyz ≠ σrpy (the test with 1 m / 1° could not tell them apart): over 300 seeds the
     neighbour's body pose moves by zero-mean draws of σxyz metres on x, y, z and σrpy degrees on roll, pitch and yaw,
-    independent across axes; its mount and points are untouched; the ego is never moved."""
+    independent across axes; its mount and points are untouched."""
     from mmusv.studies.detection.data import read_recording
     from mmusv.studies.detection.robustness import neighbours_for, parse_settings
 
@@ -498,7 +498,8 @@ def test_pose_noise_has_the_documented_sigmas_on_the_documented_axes(rec: Rec) -
         np.testing.assert_array_equal(nb.mount, clean["usv_b"].mount)
         a = Rotation.from_matrix(nb.body[:3, :3]).as_euler("ZYX")[::-1]
         b = Rotation.from_matrix(clean["usv_b"].body[:3, :3]).as_euler("ZYX")[::-1]
-        draws.append([*(nb.body[:3, 3] - clean["usv_b"].body[:3, 3]), *np.degrees(a - b)])
+        turn = np.remainder(a - b + math.pi, math.tau) - math.pi
+        draws.append([*(nb.body[:3, 3] - clean["usv_b"].body[:3, 3]), *np.degrees(turn)])
     d = np.array(draws)
     assert np.all(np.abs(d.mean(axis=0)) < 3 * np.array([2, 2, 2, 0.5, 0.5, 0.5]) / math.sqrt(300))
     np.testing.assert_allclose(d.std(axis=0), [2, 2, 2, 0.5, 0.5, 0.5], rtol=0.12)
@@ -510,8 +511,9 @@ def test_a_usv_without_lidar_listed_in_opv2v_is_a_platform_for_the_study_not_a_t
     """Ground truth is every vessel but the instrumented USVs (docs/studies/detection.md), from a recording and from
     its OPV2V export alike. A USV with cameras but no LiDAR is no CAV of the export, and ``--include-usvs`` lists it
     among the CAVs' ``vehicles`` (``_additional.yaml``: role ``usv``): the study read it from OPV2V as a target, which
-    the recording's reading never does, and a detection of it counted as a true positive there, a false one ignored
-    here. Read from either, it is a USV platform (its box, where detections are ignored), not ground truth."""
+    the recording's reading never does, so a detection of it scored as a true positive from OPV2V and was ignored
+    from the recording. Read from either, it is a USV platform (its box, where detections are ignored), not ground
+    truth."""
     import copy
 
     from mmusv.acquire import run
