@@ -12,7 +12,11 @@ agent's own hull is never a target):
   through a camera's lens distortion, the projected edges); where the image border cuts it, the bounding box of the
   part of the 3D box's image inside the image (its faces' images united and clipped to the border, so a long hull
   seen at a slant and cut by a corner gets no empty band), with ``truncation`` = 1 − the area of the bounding box
-  clipped to the image / its unclipped area, ``visible_pixels`` (pixels whose instance is the vessel),
+  clipped to the image / its unclipped area (a box reaching behind the camera, a hull alongside or passing within a
+  few metres abeam, has an image without bound: its truncation is close to 1 whatever part of the picture it fills,
+  e.g. 0.9999 for a patrol boat 1 m off the camera filling 13 % of it, and depends on the near plane
+  :data:`~mmusv.image_boxes.NEAR_M`; ``visible_pixels`` tells how much of it the picture shows),
+  ``visible_pixels`` (pixels whose instance is the vessel),
   ``box_pixels`` (the pixels the recorded box touches, ``(ceil(x_max) − floor(x_min)) · (ceil(y_max) −
   floor(y_min))``, not its area in pixels²: the window ``visible_pixels`` is counted in) and
   ``occlusion`` = 1 − visible / silhouette over the vessel's part above the still water level (world z > 0):
