@@ -87,3 +87,22 @@ def test_a_scenario_named_off_is_refused_on_the_command_line(
     assert main(["run", str(path), "-o", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err
     assert "off.yaml: name = off at line" in err and 'put it in quotes ("off")' in err
+
+
+def test_an_additional_yaml_another_tool_wrote_is_not_read_as_mmusv_s(tmp_path: Path) -> None:
+    """``read_opv2v`` reads mmusv's ``<ts>_additional.yaml`` for the USVs listed there (role ``usv``); a file of that
+    name without an ``mmusv`` key (another tool's, beside a stock OPV2V frame) holds none of them and is not refused,
+    while mmusv's own, damaged, still is."""
+    from mmusv.studies.detection.data import _opv2v_usvs
+
+    path = tmp_path / "000000_additional.yaml"
+    path.write_text("weather: rain\nvehicles: {7: {role: usv}}\n")
+    assert _opv2v_usvs(path) == set()
+    path.write_text("mmusv: {vehicles: {'1002': {role: usv}, '1003': {role: target}}}\n")
+    assert _opv2v_usvs(path) == {"1002"}
+    path.write_text("mmusv: {vehicles: [1002]}\n")
+    with pytest.raises(ValueError, match="not mmusv's additional yaml"):
+        _opv2v_usvs(path)
+    path.write_text("- a list\n")
+    with pytest.raises(ValueError, match="not mmusv's additional yaml"):
+        _opv2v_usvs(path)

@@ -336,11 +336,14 @@ def read_opv2v(folder: str | Path) -> SequenceData:
 
 def _opv2v_usvs(path: Path) -> set[str]:
     """The ids of the vehicles that an OPV2V frame's ``<ts>_additional.yaml`` (mmusv's, beside the stock files)
-    gives role ``usv``; none without the file (a stock OPV2V folder). A file that is there but not such a document
-    raises as the frame's yaml does (``ValueError``, ``yaml.YAMLError``)."""
+    gives role ``usv``; none without the file (a stock OPV2V folder) or for a mapping without an ``mmusv`` key (a
+    file of that name that another tool wrote). mmusv's that is not such a document, or a file that is not a YAML
+    mapping, raises as the frame's yaml does (``ValueError``, ``yaml.YAMLError``)."""
     if not path.is_file():
         return set()
     doc = yaml.safe_load(path.read_text(encoding="utf-8"))
+    if isinstance(doc, dict) and "mmusv" not in doc:
+        return set()
     mm = doc.get("mmusv") if isinstance(doc, dict) else None
     listed = mm.get("vehicles") if isinstance(mm, dict) else None
     if not isinstance(listed, dict):
