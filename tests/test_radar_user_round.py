@@ -7,18 +7,32 @@ independent computation written out here.
   off went unseen from 164° to 196° off the bow (patrol boat) and 172° to 188° (WAM-V), a blind sector astern of
   ~30°, far more than a real installation accepts (and an antenna 0.15 m from a mast could not turn). The mounts now
   sit above the mast top, clear of every part of the hull.
+* Shadowing: on the paper's island scene and the port, a vessel has radar returns exactly when a ray cast from the
+  radar reaches its box (target_1 behind the island is hidden from usv_1, seen from usv_2 and usv_3); moored ships
+  and the quays return.
+* The PPI: every pixel painted is one whose centre lies in a return's polar cell (written out here per pixel),
+  for odd and even sizes, north-up and head-up, with the return's intensity (max compositing).
+* The recording and the ROS 2 export: the recorded PPI is the colour map of the PPI of the recorded returns (the
+  rig's size, scale and orientation, the radar's pose from the recorded world state and mount); the ROS 2 bag's
+  radar returns and PPI are the recording's, on frame ``<usv>/radar`` at the frame's stamp, with the radar's
+  static transform the recorded mount.
 """
 
 from __future__ import annotations
 
 import math
+from collections import defaultdict
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 import pytest
+import yaml
 from mmusv import Simulation
 from mmusv.classes import SemanticClass
+from mmusv.sensors.config import RadarConfig
+from mmusv.sensors.radar import RadarReturns, ppi_colormap, ppi_image, radar_from_config
 from mmusv.world.vessels import library
 
 REPO = Path(__file__).resolve().parents[1]
@@ -83,3 +97,318 @@ def test_the_default_radar_sees_all_round(asset: str) -> None:
     assert not own.any(), f"{asset}: {int(own.sum())} of the fan's rays meet the own hull, e.g. at azimuth " + str(
         sorted({round(float(np.degrees(a))) for a in az[own]})[:5]
     )
+
+
+# ------------------------------------------------------------------------------------------------------- shadowing
+
+RIG = {
+    "lidar": None,
+    "cameras": [],
+    "top_view": None,
+    "radar": {"azimuth_bins": 720, "rays_az": 2, "rays_el": 64, "range_m": 1500, "ppi_size_px": 64},
+}
+
+
+def _bundled(name: str) -> dict[str, Any]:
+    d: dict[str, Any] = yaml.safe_load((REPO / "scenarios" / f"{name}.yaml").read_text())
+    d["rigs"] = dict.fromkeys(d["rigs"], RIG)
+    d["environment"]["wave"] = "W0"
+    return d
+
+
+def _box_points(centre: npt.NDArray[Any], size: npt.NDArray[Any], yaw: float) -> npt.NDArray[np.float64]:
+    """A 7 × 7 × 7 grid over the inner 90 % of a yawed box, the points above the still water (z > 0.3 m)."""
+    g = np.linspace(-0.45, 0.45, 7)
+    local = np.array(np.meshgrid(g, g, g)).reshape(3, -1).T * np.asarray(size)
+    c, s = math.cos(yaw), math.sin(yaw)
+    pts = local @ np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]).T + np.asarray(centre)
+    return pts[pts[:, 2] > 0.3]
+
+
+def _seen_and_visible(name: str) -> tuple[Simulation, dict[tuple[str, str], tuple[int, float]]]:
+    """Per (agent, vessel): the radar returns of the vessel in frame 0 and the share of the rays cast here from the
+    radar to points of its box that reach it first (nothing in between: no island, quay or other ship)."""
+    sim = Simulation(_bundled(name))
+    cap = sim.capture(0, sensors=["radar"])
+    w, scene = cap.world, sim.ws.scene
+    out = {}
+    for a in sim.agents:
+        ret = cap.agents[a.id].radar
+        assert ret is not None
+        o = ret.pose[:3, 3]
+        for i, v in enumerate(sim.vessels):
+            if v.id == a.id:
+                continue
+            pts = _box_points(w.box_centers[i], v.box_size, float(w.poses[i][5]))
+            dist = np.linalg.norm(pts[:, :2] - o[:2], axis=1)
+            if dist.max() > ret.radar.range_max_m - 50.0:
+                continue
+            hits = scene.cast_rays(np.repeat(o[None], len(pts), axis=0), pts - o, max_range=5000.0)
+            out[(a.id, v.id)] = (
+                int((ret.instance_id == v.instance_id).sum()),
+                float((hits.instance_id == v.instance_id).mean()),
+            )
+    return sim, out
+
+
+def test_a_vessel_returns_exactly_when_the_radar_has_a_line_of_sight_to_it() -> None:
+    """The paper's island scene (W0): every vessel of which over 5 % of the box is in the radar's line of sight (a
+    ray cast here) has returns, and none of which no point is has any: target_1 behind the island is hidden from
+    usv_1 and seen by usv_2 and usv_3 on the island's flanks."""
+    _, pairs = _seen_and_visible("island_occlusion")
+    assert len(pairs) >= 20
+    for key, (returns, visible) in pairs.items():
+        if visible > 0.05:
+            assert returns > 0, f"{key}: {visible:.0%} of the box in sight, no radar return"
+        if visible == 0.0:
+            assert returns == 0, f"{key}: nothing of the box in sight, {returns} radar returns"
+    assert pairs[("usv_1", "target_1")] == (0, 0.0)
+    assert pairs[("usv_2", "target_1")][0] > 0 and pairs[("usv_3", "target_1")][0] > 0
+    assert sum(v == 0.0 for _, v in pairs.values()) >= 2, "the scene should hide some vessels"
+
+
+def test_moored_ships_and_quays_return_in_the_port() -> None:
+    """The port (W0): the moored ships in the radar's line of sight return (class VESSEL), so do the quays (class
+    PORT_STRUCTURE), and the vessels' returns follow the line of sight as on the island."""
+    sim, pairs = _seen_and_visible("port_entry")
+    moored = {v.id for v in sim.vessels if v.role == "moored"}
+    assert len(moored) == 4
+    seen = 0
+    for (agent, vid), (returns, visible) in pairs.items():
+        if visible > 0.05:
+            assert returns > 0, f"{agent} → {vid}: {visible:.0%} in sight, no return"
+            seen += vid in moored
+        if visible == 0.0:
+            assert returns == 0, f"{agent} → {vid}: hidden, {returns} returns"
+    assert seen >= 3, seen
+    cap = sim.capture(0, sensors=["radar"])
+    for a in sim.agents:
+        ret = cap.agents[a.id].radar
+        assert ret is not None
+        quay = ret.semantic_class == SemanticClass.PORT_STRUCTURE
+        assert quay.sum() > 50 and (ret.instance_id[quay] >= 0).all(), a.id
+
+
+# ------------------------------------------------------------------------------------------------------------- PPI
+
+
+def _polar_cells(
+    ret: RadarReturns, size: int, mpp: float, orientation: str, yaw: float, dr: float, bins: int
+) -> npt.NDArray[np.float32]:
+    """The PPI written out pixel by pixel: pixel (row, col) has its centre ``(col - c, c - row)`` pixels right of and
+    above the ego's pixel ``c = size // 2``; it takes the largest intensity of the returns whose polar cell
+    (range ± Δr/2, azimuth ± π/N, the screen angle azimuth + yaw north-up or azimuth + 90° head-up) holds that
+    centre."""
+    c = size // 2
+    rows, cols = np.mgrid[0:size, 0:size]
+    x, y = (cols - c).astype(np.float64), (c - rows).astype(np.float64)
+    rho, ang = np.hypot(x, y) * mpp, np.arctan2(y, x)
+    out = np.zeros((size, size), np.float32)
+    for r, a, v in zip(ret.range.astype(np.float64), ret.azimuth.astype(np.float64), ret.intensity, strict=True):
+        theta = a + (yaw if orientation == "north_up" else math.pi / 2)
+        d = (ang - theta + math.pi) % (2 * math.pi) - math.pi
+        inside = (rho >= r - dr / 2) & (rho < r + dr / 2) & (d >= -math.pi / bins) & (d < math.pi / bins)
+        out[inside] = np.maximum(out[inside], v)
+    return out
+
+
+@pytest.mark.parametrize("size", [63, 64])
+@pytest.mark.parametrize("orientation", ["north_up", "head_up"])
+def test_the_ppi_paints_each_return_over_its_polar_cell(size: int, orientation: str) -> None:
+    """Returns at chosen ranges and azimuths (two in one beam, two in one cell, one on a screen axis, one beyond the
+    image) in a PPI of odd and even size: the pixels lit are those whose centre lies in a return's
+    polar cell, computed here pixel by pixel, with the largest intensity among them; away from the cells' edges
+    (a pixel centre within 1e-6 of an edge may fall either side in float arithmetic) they agree exactly, and the
+    pixel nearest each cell's centre is always lit (a cell thinner than a pixel does not vanish)."""
+    cfg = RadarConfig(range_m=200.0, range_resolution_m=30.0, azimuth_bins=24)
+    radar = radar_from_config(cfg)
+    az_step = 2 * math.pi / cfg.azimuth_bins
+    beams = np.array([0, 0, 3, 6, 12, 17, 17, 23])
+    ranges = np.array([45.0, 135.0, 75.0, 105.0, 135.0, 105.0, 105.0, 400.0], np.float32)
+    intensity = np.array([0.5, 2.0, 30.0, 7.0, 1e3, 4.0, 9.0, 5.0], np.float32)
+    yaw = 0.7
+    pose = np.eye(4)
+    pose[:2, :2] = [[math.cos(yaw), -math.sin(yaw)], [math.sin(yaw), math.cos(yaw)]]
+    n = len(beams)
+    ret = RadarReturns(
+        range=ranges,
+        azimuth=(beams * az_step).astype(np.float32),
+        elevation=np.zeros(n, np.float32),
+        intensity=intensity,
+        instance_id=np.arange(n, dtype=np.int32),
+        semantic_class=np.full(n, 10, np.uint16),
+        pose=pose,
+        radar=radar,
+    )
+    mpp = 5.0
+    img = ppi_image(ret, size_px=size, metres_per_pixel=mpp, orientation=orientation)  # type: ignore[arg-type]
+    want = _polar_cells(ret, size, mpp, orientation, yaw, cfg.range_resolution_m, cfg.azimuth_bins)
+    # The pixels whose centre is not within 1e-6 (metres or radians) of a cell's edge: these must agree exactly.
+    c = size // 2
+    rows, cols = np.mgrid[0:size, 0:size]
+    x, y = (cols - c).astype(np.float64), (c - rows).astype(np.float64)
+    rho, ang = np.hypot(x, y) * mpp, np.arctan2(y, x)
+    edge = np.zeros((size, size), bool)
+    for r, a in zip(ranges.astype(np.float64), ret.azimuth.astype(np.float64), strict=True):
+        theta = a + (yaw if orientation == "north_up" else math.pi / 2)
+        for e in (theta - math.pi / cfg.azimuth_bins, theta + math.pi / cfg.azimuth_bins):
+            edge |= np.abs((ang - e + math.pi) % (2 * math.pi) - math.pi) < 1e-6
+        edge |= np.abs(np.abs(rho - r) - cfg.range_resolution_m / 2) < 1e-6
+    extra = (img != want) & ~edge
+    # Pixels lit beyond the cells: only the pixel nearest a cell's centre, with that return's intensity.
+    for i in range(n):
+        theta = float(ret.azimuth[i]) + (yaw if orientation == "north_up" else math.pi / 2)
+        rr, cc = round(c - ranges[i] / mpp * math.sin(theta)), round(c + ranges[i] / mpp * math.cos(theta))
+        if 0 <= rr < size and 0 <= cc < size:
+            assert img[rr, cc] >= intensity[i], (i, rr, cc)
+            extra[rr, cc] = False
+    assert not extra.any(), list(zip(*np.nonzero(extra), strict=True))[:5]
+    assert img.max() == 1e3 and set(np.unique(img)) == {0.0, *intensity[:4].tolist(), 1e3, 9.0}  # 4 under 9
+    assert (want > 0).sum() > 100 and ((img > 0) & ~(want > 0)).sum() <= n  # the cells, not only their centres
+    assert img[c, c] == 0.0  # nothing drawn on the ego
+
+
+# ------------------------------------------------------------------------------------------ recording and ROS 2
+
+_RECORDED = {
+    # head-up, odd size, the default scale (range over size // 2); north-up, even size, a scale of its own
+    "a": {"azimuth_bins": 360, "rays_el": 8, "rays_az": 2, "range_m": 600, "ppi_size_px": 101,
+          "ppi_orientation": "head_up"},
+    "b": {"azimuth_bins": 256, "rays_el": 8, "rays_az": 1, "range_m": 500, "ppi_size_px": 64,
+          "ppi_metres_per_pixel": 9.0},
+}  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def recorded(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Two USVs with only a radar each (rigs ``a`` and ``b`` above), a tug and a speedboat on the W1 sea; 2 frames."""
+    from mmusv.acquire import run
+
+    rigs = {k: {"lidar": None, "cameras": [], "top_view": None, "radar": r} for k, r in _RECORDED.items()}
+    cfg = {
+        "name": "radar_round",
+        "seed": 7,
+        "map": {"type": "open_sea", "seed": 2, "params": {"extent_m": 1000, "islet_probability": 0.0}},
+        "environment": {"time_of_day": "11:00", "weather": "clear", "wave": "W1"},
+        "acquisition": {"frequency_hz": 5, "frames": 2},
+        "rigs": rigs,
+        "vessels": [
+            {"id": "usv_a", "role": "usv", "asset": "usv_patrol_12m", "rig": "a", "speed_mps": 3.0,
+             "route": [[0, 0], [-300, 200]]},
+            {"id": "usv_b", "role": "usv", "asset": "usv_wamv", "rig": "b", "speed_mps": 2.0,
+             "route": [[90, -30], [60, 0]]},
+            {"id": "tgt", "role": "target", "asset": "tug_32m", "speed_mps": 3.0, "route": [[200, 100], [400, 230]]},
+            {"id": "boat", "role": "target", "asset": "speedboat_5m", "speed_mps": 4.0,
+             "route": [[-150, -100], [80, 20]]},
+        ],
+    }  # fmt: skip
+    return Path(run(cfg, out_dir=tmp_path_factory.mktemp("radar_round")).recording)
+
+
+def _recorded_returns(msg: Any, pose: npt.NDArray[np.float64], cfg: RadarConfig) -> RadarReturns:
+    from mmusv.recording import decode_point_cloud
+
+    r = decode_point_cloud(msg)
+    n = len(r["range"])
+    return RadarReturns(
+        range=r["range"],
+        azimuth=r["azimuth"],
+        elevation=r["elevation"],
+        intensity=r["intensity"],
+        instance_id=r["instance"],
+        semantic_class=np.zeros(n, np.uint16),
+        pose=pose,
+        radar=radar_from_config(cfg),
+    )
+
+
+def test_the_recorded_ppi_is_the_ppi_of_the_recorded_returns(recorded: Path) -> None:
+    """Per frame and USV: the recorded PPI (PNG) is :func:`ppi_colormap` of :func:`ppi_image` of the recorded
+    returns, drawn at the rig's size, scale and orientation from the radar's pose (the recorded world state's body
+    pose times the recorded mount), pixel for pixel."""
+    from mmusv.recording import decode_image, read_info, topics
+    from mmusv.recording.stream import FrameStream
+
+    info = read_info(recorded)
+    frames = list(FrameStream(info, lambda _t: True))
+    assert len(frames) == 2 and len(info.agents) == 2
+    for f in frames:
+        w = f.world
+        assert w is not None
+        for a in info.agents:
+            body, _, _ = a.sensor_poses(w)
+            assert a.radar_mount is not None
+            cfg = RadarConfig(**a.rig["radar"])
+            ret = _recorded_returns(f.messages[topics.radar_returns(a.id)], body @ a.radar_mount, cfg)
+            assert len(ret) > 0
+            img = ppi_image(
+                ret,
+                size_px=cfg.ppi_size_px,
+                metres_per_pixel=cfg.ppi_metres_per_pixel,
+                orientation=cfg.ppi_orientation,
+            )
+            got = decode_image(f.messages[topics.radar_ppi(a.id)])
+            assert got.shape == (cfg.ppi_size_px, cfg.ppi_size_px, 3) and got.dtype == np.uint8
+            np.testing.assert_array_equal(got, ppi_colormap(img), err_msg=f"{a.id} at {f.log_time_ns} ns")
+            assert (img > 0).sum() > 20
+
+
+def test_the_ros2_bag_carries_the_recorded_radar(recorded: Path, tmp_path: Path) -> None:
+    """``--to ros2``: each USV's ``/<usv>/radar/returns`` (``PointCloud2``) holds the recorded returns field by field
+    (x y z range azimuth elevation intensity FLOAT32, instance INT32) and ``/<usv>/radar/ppi`` (``Image``, rgb8) the
+    recorded PPI, both on frame ``<usv>/radar`` stamped at the frame's time (+ the bag's offset); the static
+    transform ``<usv>/base_link → <usv>/radar`` is the recorded mount."""
+    from mmusv.export import convert
+    from mmusv.export.ros2 import TIME_OFFSET_NS, base_link
+    from mmusv.recording import decode_image, decode_point_cloud, read_info, read_messages, topics
+    from rosbags.highlevel import AnyReader
+    from scipy.spatial.transform import Rotation
+
+    info = read_info(recorded)
+    src: dict[str, list[tuple[int, Any]]] = defaultdict(list)
+    for topic, t, msg in read_messages(recorded):
+        src[topic].append((t, msg))
+    convert(recorded, to="ros2", out_dir=tmp_path / "o")
+    got: dict[str, list[tuple[int, Any]]] = defaultdict(list)
+    with AnyReader([tmp_path / "o" / "radar_round"]) as r:
+        for c, t, raw in r.messages():
+            got[c.topic].append((t, r.deserialize(raw, c.msgtype)))
+    datatype = {7: "<f4", 5: "<i4"}  # sensor_msgs/PointField FLOAT32, INT32
+    static = {x.child_frame_id: x for m in got["/tf_static"] for _, m in [m] for x in m.transforms}
+    for a in info.agents:
+        frame = topics.radar_frame(a.id)
+        assert frame == f"{a.id}/radar"
+        ret_topic, ppi_topic = topics.radar_returns(a.id), topics.radar_ppi(a.id)
+        assert len(got[ret_topic]) == len(src[ret_topic]) == 2 and len(got[ppi_topic]) == 2
+        for (t, pc), (t0, msg) in zip(got[ret_topic], src[ret_topic], strict=True):
+            ref = decode_point_cloud(msg)
+            stamp = pc.header.stamp.sec * 10**9 + pc.header.stamp.nanosec
+            assert t == stamp == t0 + TIME_OFFSET_NS and pc.header.frame_id == frame
+            names = [f.name for f in pc.fields]
+            assert names == ["x", "y", "z", "range", "azimuth", "elevation", "intensity", "instance"]
+            dt = np.dtype(
+                {
+                    "names": names,
+                    "formats": [datatype[f.datatype] for f in pc.fields],
+                    "offsets": [f.offset for f in pc.fields],
+                    "itemsize": pc.point_step,
+                }
+            )
+            pts = np.frombuffer(bytes(pc.data), dtype=dt)
+            assert pc.width * pc.height == len(pts) == len(ref["range"]) > 0
+            for name in names:
+                np.testing.assert_array_equal(pts[name], ref[name], err_msg=name)
+        for (t, im), (t0, msg) in zip(got[ppi_topic], src[ppi_topic], strict=True):
+            stamp = im.header.stamp.sec * 10**9 + im.header.stamp.nanosec
+            assert t == stamp == t0 + TIME_OFFSET_NS and im.header.frame_id == frame
+            want = decode_image(msg)
+            assert (im.height, im.width, im.encoding, im.step) == (*want.shape[:2], "rgb8", 3 * want.shape[1])
+            np.testing.assert_array_equal(np.frombuffer(bytes(im.data), np.uint8).reshape(want.shape), want)
+        x = static[frame]
+        assert x.header.frame_id == base_link(a.id)
+        tr, q = x.transform.translation, x.transform.rotation
+        m = np.eye(4)
+        m[:3, :3] = Rotation.from_quat([q.x, q.y, q.z, q.w]).as_matrix()
+        m[:3, 3] = [tr.x, tr.y, tr.z]
+        assert a.radar_mount is not None
+        np.testing.assert_allclose(m, a.radar_mount, atol=1e-9)
