@@ -19,11 +19,15 @@ independent computation written out here.
 * Small boats and the ray sampling: sampled densely, a boat's brightest cell is the radar equation's; at the
   defaults, boats well within their radar-equation range go unseen and those seen are far too bright (a strict
   xfail: the ray pattern is the core's, ``radar/pattern.rs``; the numbers are in ``RadarConfig.rays_el``).
+* Range bins and range noise (one return per bin centre in ``[min_range_m, range_m)``, Gaussian noise of the
+  configured σ), the clutter returns' elevation under a rolled and pitched antenna, and a bad radar in a scenario
+  file (the error names the file, the field and what it may be).
 """
 
 from __future__ import annotations
 
 import math
+import re
 from collections import defaultdict
 from pathlib import Path
 from typing import Any
@@ -490,3 +494,100 @@ def test_the_default_radar_sees_every_small_boat_within_a_kilometre() -> None:
     got = _brightest(RadarConfig(), 5.3, ranges)
     unseen = {r: got[r].count(0.0) for r in ranges if got[r].count(0.0)}
     assert unseen == {}, f"boats unseen (of 12) by range: {unseen}"
+
+
+# ------------------------------------------------------------------------------------ bins, noise, clutter geometry
+
+
+def _sea_only() -> Any:
+    import mmusv
+
+    scene = mmusv.Scene()
+    h = 20_000.0
+    sea = np.array([[-h, -h, 0], [h, -h, 0], [h, h, 0], [-h, h, 0]], dtype=np.float64)
+    scene.add_instance(scene.add_mesh(sea, np.array([[0, 1, 2], [0, 2, 3]], np.int64), classes=1))
+    return scene
+
+
+def test_range_bins_and_range_noise_are_as_documented() -> None:
+    """Threshold 0 over a sea with 2 m waves: every beam has one return per range bin whose centre ``(k + ½) Δr``
+    lies in ``[min_range_m, range_m)`` (190 bins of 3 m from 31.5 to 598.5 m), each at its bin's centre plus
+    Gaussian noise of ``range_noise_std_m`` (0.8 m: mean and standard deviation over 24,320 cells within 2 %)."""
+    from mmusv.sensors import sensor_env
+    from mmusv.sensors.radar import radar_sweep
+
+    cfg = RadarConfig(
+        range_m=600.0,
+        min_range_m=30.0,
+        azimuth_bins=128,
+        rays_el=4,
+        rays_az=1,
+        detection_threshold=0.0,
+        sea_clutter_sigma0=4e-6,
+        range_noise_std_m=0.8,
+    )
+    pose = np.eye(4)
+    pose[2, 3] = 6.0
+    env = sensor_env(fog_extinction_per_m=0.0, rain_mm_per_h=0.0, wave_height_m=2.0)
+    ret = radar_sweep(radar_from_config(cfg), _sea_only(), pose=pose, env=env, seed=3)
+    step = 2 * math.pi / cfg.azimuth_bins
+    beams = np.rint(ret.azimuth / step).astype(np.int64)
+    np.testing.assert_allclose(ret.azimuth, beams * step, atol=1e-6)
+    k = np.arange(math.floor(cfg.range_m / cfg.range_resolution_m) + 1)
+    centres = (k + 0.5) * cfg.range_resolution_m
+    centres = centres[(centres >= cfg.min_range_m) & (centres < cfg.range_m)]
+    assert len(centres) == 190
+    assert np.array_equal(np.bincount(beams, minlength=cfg.azimuth_bins), np.full(cfg.azimuth_bins, 190))
+    noise = ret.range.astype(np.float64) - np.tile(centres, cfg.azimuth_bins)
+    assert abs(noise.mean()) < 0.02 * 0.8 and abs(noise.std() / 0.8 - 1) < 0.02, (noise.mean(), noise.std())
+
+
+@pytest.mark.parametrize("rpy_deg", [(0.0, 0.0, 0.0), (0.0, 5.0, 0.0), (8.0, 0.0, 30.0)])
+def test_clutter_elevation_is_the_still_water_below_the_tilted_horizon(rpy_deg: tuple[float, float, float]) -> None:
+    """A sea clutter return's elevation is the sea horizon's elevation in the (rolled, pitched) sensor frame at its
+    azimuth, ``atan(-(R₂₀ cos a + R₂₁ sin a) / R₂₂)`` for the sensor's rotation R, less ``atan(h / r)``, as the
+    docstring says (to 1e-6 rad), for a level, a pitched and a rolled and yawed radar 6 m up."""
+    from mmusv.sensors import sensor_env
+    from mmusv.sensors.radar import radar_sweep
+    from scipy.spatial.transform import Rotation
+
+    cfg = RadarConfig(range_m=1000.0, azimuth_bins=256, rays_el=4, detection_threshold=0.0, sea_clutter_sigma0=4e-6)
+    pose = np.eye(4)
+    pose[:3, :3] = Rotation.from_euler("xyz", rpy_deg, degrees=True).as_matrix()
+    pose[2, 3] = 6.0
+    env = sensor_env(fog_extinction_per_m=0.0, rain_mm_per_h=0.0, wave_height_m=2.0)
+    ret = radar_sweep(radar_from_config(cfg), _sea_only(), pose=pose, env=env, seed=0)
+    c = ret.is_clutter
+    assert c.sum() > 50_000 and (ret.semantic_class[c] == SemanticClass.WATER).all()
+    a, r = ret.azimuth[c].astype(np.float64), ret.range[c].astype(np.float64)
+    rot = pose[:3, :3]
+    horizon = np.arctan(-(rot[2, 0] * np.cos(a) + rot[2, 1] * np.sin(a)) / rot[2, 2])
+    np.testing.assert_allclose(ret.elevation[c], horizon - np.arctan(6.0 / r), atol=1e-6)
+
+
+def test_a_bad_radar_in_a_scenario_file_names_the_file_the_field_and_what_is_allowed(tmp_path: Path) -> None:
+    """A scenario file with a bad radar: the error names the file, the field's path and what it may be."""
+    import mmusv
+    from mmusv.config import load_scenario
+
+    base = {
+        "name": "bad_radar",
+        "seed": 1,
+        "map": {"type": "open_sea", "seed": 0},
+        "acquisition": {"frequency_hz": 5, "frames": 1},
+        "vessels": [
+            {"id": "u", "role": "usv", "asset": "usv_wamv", "rig": "r", "speed_mps": 1.0, "route": [[0, 0], [10, 0]]}
+        ],
+    }
+    cases = [
+        ({"polarisation": "HV"}, r"rigs\.r\.radar\.polarisation = 'HV'.*'HH' or 'VV'"),
+        ({"ppi_orientation": "sideways"}, r"rigs\.r\.radar\.ppi_orientation = 'sideways'.*'north_up' or 'head_up'"),
+        ({"azimuth_bins": 0}, r"rigs\.r\.radar\.azimuth_bins = 0.*greater than or equal to 1"),
+        ({"range_m": 100, "min_range_m": 200}, r"rigs\.r\.radar\b.*min_range_m \(200\.0\) must be below range_m"),
+        ({"rangem": 100}, r"rigs\.r\.radar\.rangem.*did you mean 'range_m'"),
+    ]
+    for i, (radar, pattern) in enumerate(cases):
+        path = tmp_path / f"bad_{i}.yaml"
+        path.write_text(yaml.safe_dump({**base, "rigs": {"r": {"radar": radar}}}))
+        with pytest.raises(mmusv.ConfigError, match=rf"^{re.escape(str(path))}: .*{pattern}"):
+            load_scenario(path)
