@@ -351,7 +351,8 @@ def test_the_recorded_ppi_is_the_ppi_of_the_recorded_returns(recorded: Path) -> 
             img = ppi_image(
                 ret,
                 size_px=cfg.ppi_size_px,
-                metres_per_pixel=cfg.ppi_metres_per_pixel,
+                # the documented default: the range over half the side, integer division (101 px: 50)
+                metres_per_pixel=cfg.ppi_metres_per_pixel or cfg.range_m / (cfg.ppi_size_px // 2),
                 orientation=cfg.ppi_orientation,
             )
             got = decode_image(f.messages[topics.radar_ppi(a.id)])
