@@ -450,8 +450,11 @@ def _boats(ranges: list[float], per_range: int = 12) -> tuple[Any, dict[tuple[fl
     return scene, ids
 
 
-def _brightest(cfg: RadarConfig, height: float, ranges: list[float]) -> dict[float, list[float]]:
-    """Per range, each boat's brightest cell (0: not seen) in one sweep of ``cfg`` from ``height`` m."""
+def _brightest(
+    cfg: RadarConfig, height: float, ranges: list[float], extents: dict[float, list[float]] | None = None
+) -> dict[float, list[float]]:
+    """Per range, each boat's brightest cell (0: not seen) in one sweep of ``cfg`` from ``height`` m; ``extents``
+    gets each seen boat's azimuth extent, degrees (its beams' span plus one beam)."""
     from mmusv.sensors import sensor_env
     from mmusv.sensors.radar import radar_sweep
 
@@ -464,6 +467,9 @@ def _brightest(cfg: RadarConfig, height: float, ranges: list[float]) -> dict[flo
     for (r, _k), i in ids.items():
         mine = ret.instance_id == i
         out[r].append(float(ret.intensity[mine].max()) if mine.any() else 0.0)
+        if extents is not None and mine.any():
+            a = np.unwrap(np.sort(ret.azimuth[mine].astype(np.float64)))
+            extents[r].append(math.degrees(a[-1] - a[0]) + 360.0 / cfg.azimuth_bins)
     return out
 
 
@@ -471,13 +477,18 @@ def test_densely_sampled_small_boats_follow_the_radar_equation() -> None:
     """Sampled densely (16 rays across the beam, 256 over the fan), every boat out to 1 km is seen, and its
     brightest cell is the radar equation's ``ρ A (1 km / r)⁴`` (ρ = 1 for a vessel, A the 1.8 m² face) within
     a factor 0.7..1.6 (measured 1.01 at 300 m, 1.20 at 600 m, 1.33 at 1 km: a ray stands for 0.075° of a beam
-    the boat fills 0.115° of, the brightest beam holding two such rays)."""
+    the boat fills 0.115° of, the brightest beam holding two such rays); its arc spans the beamwidth plus its own
+    width, within a beam. (At the defaults a boat at 1 km lights a single 0.18° beam: 1 beam of 7.)"""
     ranges = [300.0, 600.0, 1000.0]
-    got = _brightest(RadarConfig(rays_az=16, rays_el=256, azimuth_bins=1024), 2.3, ranges)
+    extents: dict[float, list[float]] = defaultdict(list)
+    got = _brightest(RadarConfig(rays_az=16, rays_el=256, azimuth_bins=1024), 2.3, ranges, extents)
     for r in ranges:
         assert min(got[r]) > 0, f"{r} m: {got[r].count(0.0)} of 12 boats unseen"
         ratio = float(np.median(got[r])) / (BOAT_FACE_M2 * (1000.0 / r) ** 4)
         assert 0.7 < ratio < 1.6, f"{r} m: brightest cell {ratio:.2f} times the radar equation"
+        # A beam sees the boat while it lies within the 1.2° beamwidth: its arc is the beamwidth plus its width.
+        want = 1.2 + math.degrees(2.0 / r)
+        assert abs(float(np.median(extents[r])) - want) <= 360.0 / 1024, (r, np.median(extents[r]), want)
 
 
 @pytest.mark.xfail(

@@ -242,8 +242,9 @@ class RadarConfig(_Model):
             patch: at the defaults, from a 5.3 m mast, of 12 boats with a 2 m × 0.9 m face (1.8 at 1 km by the
             radar equation, six times the threshold) 9 are seen at 150 m and 5 at 200 m (below the horizon band,
             where 4 rays share 18° of fan), all 12 at 300 m, 9 at 600 m and 6 at 1 km, those at 1 km about 11
-            times too bright in their brightest cell; with ``rays_az`` 16 and ``rays_el`` 256 all are seen,
-            within 1.0-1.35 times the radar equation (``tests/test_radar_user_round.py``).
+            times too bright in their brightest cell and lit in one 0.18° beam of the seven the 1.2° beamwidth
+            spans; with ``rays_az`` 16 and ``rays_el`` 256 all are seen, within 1.0-1.35 times the radar
+            equation, over the beamwidth plus their width (``tests/test_radar_user_round.py``).
         horizon_fraction: share of the elevation rays spread over the band around the sea horizon (which follows
             the sensor's roll and pitch), the rest over the remaining fan; ``0..1``, 0 = uniform over the fan.
             Rays are weighted by the fan height they stand for, so intensities do not depend on it.
