@@ -22,6 +22,8 @@ independent computation written out here.
 * Range bins and range noise (one return per bin centre in ``[min_range_m, range_m)``, Gaussian noise of the
   configured σ), the clutter returns' elevation under a rolled and pitched antenna, and a bad radar in a scenario
   file (the error names the file, the field and what it may be).
+* ``sea_clutter_sigma0 = 0`` disables sea clutter on the physical sea too: before the fix the core's NRL σ⁰
+  ignored it there, and about 57,000 sea clutter cells came with it at W3 as with any other value.
 """
 
 from __future__ import annotations
@@ -603,3 +605,38 @@ def test_a_bad_radar_in_a_scenario_file_names_the_file_the_field_and_what_is_all
         path.write_text(yaml.safe_dump({**base, "rigs": {"r": {"radar": radar}}}))
         with pytest.raises(mmusv.ConfigError, match=rf"^{re.escape(str(path))}: .*{pattern}"):
             load_scenario(path)
+
+
+# ----------------------------------------------------------------------------------------- sea clutter switched off
+
+
+@pytest.mark.parametrize("motion", ["physical", "paper"])
+def test_sea_clutter_sigma0_zero_disables_sea_clutter(motion: str) -> None:
+    """``RadarConfig.sea_clutter_sigma0 = 0`` "disables" sea clutter, on the physical sea (the default motion, where
+    σ⁰ is the NRL model's) as on the paper's flat one. Before the fix it did so only on the flat sea: over the
+    physical W3 sea a 512-beam radar drew about 57,000 sea clutter cells with σ⁰ 0, as many as with 4e-7 or 4e-5 (the
+    core's NRL σ⁰ ignores the flat-sea knob; only ``sea_clutter_max_range_m`` reaches it). Rain clutter stays."""
+    rig = {"lidar": None, "cameras": [], "top_view": None, "radar": {"sea_clutter_sigma0": 0.0, "azimuth_bins": 512}}
+    cfg = {
+        "name": "no_sea_clutter",
+        "seed": 7,
+        "map": {"type": "open_sea", "seed": 2, "params": {"extent_m": 1000, "islet_probability": 0.0}},
+        "environment": {"time_of_day": "11:00", "weather": "clear", "wave": "W3", "motion": motion},
+        "acquisition": {"frequency_hz": 5, "frames": 1},
+        "rigs": {"a": rig},
+        "vessels": [
+            {"id": "u", "role": "usv", "asset": "usv_patrol_12m", "rig": "a", "speed_mps": 3.0,
+             "route": [[0, 0], [-300, 200]]},
+            {"id": "t", "role": "target", "asset": "tug_32m", "speed_mps": 3.0, "route": [[300, 0], [600, 0]]},
+        ],
+    }  # fmt: skip
+    sim = Simulation(cfg)
+    ret = sim.capture(0, sensors=["radar"]).agents["u"].radar
+    assert ret is not None
+    sea = ret.is_clutter & (ret.semantic_class == SemanticClass.WATER)
+    assert int(sea.sum()) == 0, f"{int(sea.sum())} sea clutter cells with sea_clutter_sigma0 = 0 ({motion} sea)"
+    assert (ret.instance_id == sim.vessels[1].instance_id).any(), "the tug 300 m off is still seen"
+    # With σ⁰ > 0 the same sea does have clutter (the switch, not the sea, is what turned it off).
+    rig["radar"]["sea_clutter_sigma0"] = 4e-7  # type: ignore[index]
+    on = Simulation(cfg).capture(0, sensors=["radar"]).agents["u"].radar
+    assert on is not None and int((on.is_clutter & (on.semantic_class == SemanticClass.WATER)).sum()) > 1000

@@ -67,9 +67,13 @@ Orientation = Literal["north_up", "head_up"]
 def radar_from_config(cfg: RadarConfig) -> core.Radar:
     """The native radar for ``cfg`` (degrees become radians; the core checks everything again as a last guard,
     naming ``radar.<core field>``, which a validated ``cfg`` never trips). ``cfg`` must be a :class:`RadarConfig`
-    (``RadarConfig(**fields)`` validates a dict), else :class:`mmusv.ConfigError`."""
+    (``RadarConfig(**fields)`` validates a dict), else :class:`mmusv.ConfigError`. ``sea_clutter_sigma0 = 0``
+    becomes a sea-clutter range of 0 as well, so that it disables sea clutter over the physical sea too."""
     check_config(cfg, RadarConfig)
     lo, hi = cfg.elevation_fan_deg
+    # σ⁰ = 0 disables sea clutter on the physical sea too, whose σ⁰ is the NRL model's (the core reads
+    # `sea_sigma0_at_1m` on the flat sea only): no sea clutter at any range.
+    sea_max_range_m = cfg.sea_clutter_max_range_m if cfg.sea_clutter_sigma0 > 0 else 0.0
     return core.Radar(
         range_min_m=cfg.min_range_m,
         range_max_m=cfg.range_m,
@@ -85,7 +89,7 @@ def radar_from_config(cfg: RadarConfig) -> core.Radar:
         range_noise_std_m=cfg.range_noise_std_m,
         sea_sigma0_at_1m=cfg.sea_clutter_sigma0,
         critical_range_per_m=cfg.clutter_critical_range_per_m,
-        sea_max_range_m=cfg.sea_clutter_max_range_m,
+        sea_max_range_m=sea_max_range_m,
         rain_eta_at_1mm_h=cfg.rain_clutter_eta,
         frequency_ghz=cfg.frequency_ghz,
         polarisation=cfg.polarisation,
