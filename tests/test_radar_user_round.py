@@ -24,6 +24,8 @@ independent computation written out here.
   file (the error names the file, the field and what it may be).
 * ``sea_clutter_sigma0 = 0`` disables sea clutter on the physical sea too: before the fix the core's NRL σ⁰
   ignored it there, and about 57,000 sea clutter cells came with it at W3 as with any other value.
+* ``mmusv preview``'s range rings are centred on the ego: they were centred on the panel's middle, half a source
+  pixel off for an even-sized PPI.
 """
 
 from __future__ import annotations
@@ -640,3 +642,30 @@ def test_sea_clutter_sigma0_zero_disables_sea_clutter(motion: str) -> None:
     rig["radar"]["sea_clutter_sigma0"] = 4e-7  # type: ignore[index]
     on = Simulation(cfg).capture(0, sensors=["radar"]).agents["u"].radar
     assert on is not None and int((on.is_clutter & (on.semantic_class == SemanticClass.WATER)).sum()) > 1000
+
+
+def test_the_preview_s_range_rings_are_centred_on_the_ego(recorded: Path) -> None:
+    """``mmusv preview``'s PPI panel: its range rings are centred on the ego, the centre of source pixel
+    ``(S // 2, S // 2)`` (``(S // 2 + ½) · panel / S`` panel pixels from the corner), and the outermost is drawn at
+    its range times the panel's pixels per metre (within a pixel), for the 64 px (even) and 101 px (odd) PPIs.
+    Before the fix they were centred on the panel's middle, half a source pixel off for an even size (10 panel
+    pixels, 4.5 m, on the 64 px PPI at 9 m/px)."""
+    from mmusv.preview import _RING, compose_preview
+
+    for agent, size in (("usv_b", 64), ("usv_a", 101)):
+        sheet, panels = compose_preview(recorded, frame=0, agent=agent)
+        (p,) = [p for p in panels if "PPI" in p.title]
+        left, top, right, bottom = p.box
+        assert right - left == bottom - top
+        a = np.asarray(sheet)[top:bottom, left:right]
+        ys, xs = np.nonzero((a == np.array(_RING, np.uint8)).all(axis=2))
+        # The outermost ring's extreme pixels (the labels sit inside it, up and right at 45°); pixel i spans [i, i+1).
+        cx, cy = (xs.min() + xs.max() + 1) / 2, (ys.min() + ys.max() + 1) / 2
+        ego = (size // 2 + 0.5) * (right - left) / size
+        assert abs(cx - ego) <= 1.0 and abs(cy - ego) <= 1.0, (agent, cx, cy, ego)
+        cfg = RadarConfig(**_RECORDED["b" if agent == "usv_b" else "a"])
+        mpp = cfg.ppi_metres_per_pixel or cfg.range_m / (size // 2)
+        outer = {"usv_b": 200.0, "usv_a": 600.0}[agent]  # rings every 100 m up to 288 m, every 200 m up to 606 m
+        assert mpp * size / 2 >= outer
+        radius = (xs.max() - xs.min() + 1) / 2
+        assert abs(radius - outer * p.scale) <= 1.0 and p.scale == pytest.approx((right - left) / (size * mpp))

@@ -163,13 +163,16 @@ def _bev_half_extent(boxes: list[Any]) -> float:
 
 
 def _ppi_panel(img: np.ndarray, px: int, metres_per_pixel: float | None) -> tuple[Image.Image, float]:
-    """The colour-mapped PPI fitted to ``px`` square with labelled range rings; returns panel pixels per metre."""
+    """The colour-mapped PPI fitted to ``px`` square with labelled range rings centred on the ego (the centre of
+    source pixel ``(h // 2, h // 2)``, half a source pixel off the middle of an even-sized PPI); returns panel pixels
+    per metre."""
     h = img.shape[0]
     pil = _fit(img, (px, px))
     if metres_per_pixel is None:
         return pil, 0.0
     px_per_m = px / (h * metres_per_pixel)
-    _rings(ImageDraw.Draw(pil), centre=(px / 2, px / 2), px_per_m=px_per_m, max_m=h * metres_per_pixel / 2)
+    ego = (h // 2 + 0.5) * px / h
+    _rings(ImageDraw.Draw(pil), centre=(ego, ego), px_per_m=px_per_m, max_m=h * metres_per_pixel / 2)
     return pil, px_per_m
 
 
