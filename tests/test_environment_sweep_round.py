@@ -1,0 +1,359 @@
+"""The environment swept as a user writes it: times of day, weathers, visibilities, rain and waves on each bundled map
+type (island, open sea, port), recorded end to end and read back with the project's reader, Polars and the ``mcap``
+package.
+
+What is checked here, beside the field-level checks of ``tests/world/test_environment.py`` and the physics of
+``tests/test_physics_recheck*.py``:
+
+* the labels are geometry (``docs/recording.md``: depth, semantic and instance images, 3D/BEV/2D boxes, the world
+  state): the same seed under a clear noon and a foggy night, rainy dusk or overcast southern morning gives the same
+  bytes, but for the LiDAR's own ``lidar_points`` count, which the weather thins;
+* each sensor reads only what ``mmusv.sensors.env`` says it uses: the LiDAR fog, rain and waves; the radar rain and
+  waves; the sun (time of day, latitude, day of year) reaches the cameras alone;
+* the pictures through the whole pipeline (render, exposure, tone curve, PNG): no NaN in the depth, +inf exactly
+  on the sky, a day view that is not black, a night view that stays dark, a fog whose contrast falls with distance
+  at its Koschmieder rate and is under the WMO's 0.05 beyond the visibility, and an automatic exposure that meters
+  an overcast sky's light away where a fixed ``ev100`` follows it;
+* the recording's metadata say the environment as given.
+"""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+from typing import Any
+
+import mmusv
+import numpy as np
+import pytest
+import yaml
+from mcap.reader import make_reader
+from mmusv.export.contrast import relative_luminance
+from mmusv.recording import decode_image, decode_point_cloud, read_messages
+from mmusv.recording.tables import read_table
+
+SKY_INSTANCE = 65535
+"""The instance id of the sky (``docs/recording.md``)."""
+
+# Each bundled map type with a USV and a target ahead of it on its water (the island's near ``island_occlusion``'s
+# usv_1, the port's near ``port_entry``'s usv_3).
+MAPS: dict[str, tuple[dict[str, Any], list[list[float]], list[list[float]]]] = {
+    "open_sea": ({"type": "open_sea", "seed": 0}, [[0, 0], [50, 0]], [[40, 15], [90, 15]]),
+    "island": ({"type": "island", "seed": 4}, [[470, -320], [560, -320]], [[530, -335], [620, -340]]),
+    "port": ({"type": "port", "seed": 3}, [[-190, -340], [-100, -350]], [[-130, -330], [-40, -335]]),
+}
+
+CLEAR_NOON = {"time_of_day": "12:00", "weather": "clear", "wave": "W1"}
+OTHER_SKIES = {
+    "fog_night": {"time_of_day": "00:00", "weather": "fog", "visibility_m": 120, "wave": "W1"},
+    "rain_dusk": {"time_of_day": "20:30", "weather": "rain", "rain_mm_per_h": 25, "visibility_m": 1500, "wave": "W1"},
+    "overcast_south": {
+        "time_of_day": "09:40",
+        "weather": "overcast",
+        "latitude_deg": -33.9,
+        "day_of_year": 200,
+        "wave": "W1",
+    },
+}
+
+
+def small_rig() -> dict[str, Any]:
+    """A rig with every sensor, each small: a 64 x 48 bow camera, a 32 x 32 top view, an 8-channel LiDAR and a
+    radar of 512 bearings."""
+    return {
+        "cameras": [
+            {"name": "bow", "resolution": [64, 48], "hfov_deg": 90, "quality": "draft", "mount": {"xyz": [2.6, 0, 1.5]}}
+        ],
+        "top_view": {"resolution": [32, 32], "quality": "draft"},
+        "lidar": {"channels": 8, "points_per_second": 20480},
+        "radar": {"azimuth_bins": 512, "ppi_size_px": 64},
+    }
+
+
+def sweep_scenario(map_type: str, env: dict[str, Any], *, frames: int = 2) -> dict[str, Any]:
+    map_cfg, usv_route, target_route = MAPS[map_type]
+    return {
+        "name": "sweep",
+        "seed": 7,
+        "map": map_cfg,
+        "environment": env,
+        "acquisition": {"frames": frames},
+        "rigs": {"r": small_rig()},
+        "vessels": [
+            {"id": "u", "role": "usv", "asset": "usv_wamv", "rig": "r", "speed_mps": 2, "route": usv_route},
+            {"id": "t", "asset": "fishing_boat_12m", "speed_mps": 3, "route": target_route},
+        ],
+    }
+
+
+def record(scenario: dict[str, Any], folder: Path) -> Path:
+    """Runs ``scenario`` into ``folder``; returns the run folder."""
+    mmusv.run(copy.deepcopy(scenario), out_dir=folder)
+    return folder
+
+
+def messages(run: Path) -> dict[str, list[bytes]]:
+    """Every topic's messages, serialised, in order."""
+    out: dict[str, list[bytes]] = {}
+    for topic, _, msg in read_messages(run / "sweep.mcap"):
+        out.setdefault(topic, []).append(msg.SerializeToString(deterministic=True))
+    return out
+
+
+def decoded(run: Path, suffix: str) -> list[Any]:
+    """The decoded messages of the one topic ending in ``suffix``, in order."""
+    out = []
+    topics = set()
+    for topic, _, msg in read_messages(run / "sweep.mcap"):
+        if topic.endswith(suffix):
+            topics.add(topic)
+            out.append(msg)
+    assert len(topics) == 1, (suffix, topics)
+    return out
+
+
+def annotations_without_lidar_points(run: Path) -> list[bytes]:
+    out = []
+    for msg in decoded(run, "/annotations"):
+        for box in msg.boxes_lidar:
+            box.lidar_points = 0
+        out.append(msg.SerializeToString(deterministic=True))
+    return out
+
+
+def lidar_points_total(run: Path) -> int:
+    return sum(box.lidar_points for msg in decoded(run, "/annotations") for box in msg.boxes_lidar)
+
+
+GEOMETRY_SUFFIXES = ("/depth", "/semantic", "/instance", "/world/state", "/tf", "/boxes")
+"""The topics that are geometry whatever the weather: every image of depth, classes and instances (bow camera and
+top view), the world state, the transforms and the boxes drawn for Foxglove."""
+
+
+@pytest.fixture(scope="module")
+def sky_runs(tmp_path_factory: pytest.TempPathFactory) -> dict[tuple[str, str], Path]:
+    """``(map type, sky) -> run folder``: each map type under the clear noon and each of :data:`OTHER_SKIES`."""
+    root = tmp_path_factory.mktemp("env_sweep")
+    runs = {}
+    for map_type in MAPS:
+        for sky, env in {"clear_noon": CLEAR_NOON, **OTHER_SKIES}.items():
+            runs[map_type, sky] = record(sweep_scenario(map_type, env), root / f"{map_type}_{sky}")
+    return runs
+
+
+@pytest.mark.parametrize("sky", sorted(OTHER_SKIES))
+@pytest.mark.parametrize("map_type", sorted(MAPS))
+def test_labels_do_not_depend_on_the_sky(sky_runs: dict[tuple[str, str], Path], map_type: str, sky: str) -> None:
+    """The same seed under a clear noon and under ``sky``: every geometric output has the same bytes (depth,
+    semantic and instance images of the camera and the top view, world state, transforms, boxes; the 3D, BEV and
+    2D boxes with their visible and box pixels, wave occlusion and range), in the MCAP and in the Parquet tables;
+    only ``lidar_points`` differs, and the weather did reach the sensors (the RGB differs; the fog and the rain thin
+    the LiDAR's returns on the target)."""
+    clear, other = sky_runs[map_type, "clear_noon"], sky_runs[map_type, sky]
+    a, b = messages(clear), messages(other)
+    assert a.keys() == b.keys()
+    geometry = [t for t in a if t.endswith(GEOMETRY_SUFFIXES)]
+    assert len(geometry) == 8, geometry  # 3 camera images, 2 top-view images, state, tf, boxes
+    for topic in geometry:
+        assert a[topic] == b[topic], topic
+    assert annotations_without_lidar_points(clear) == annotations_without_lidar_points(other)
+    rgb = [t for t in a if t.endswith("/rgb")]
+    assert len(rgb) == 2 and all(a[t] != b[t] for t in rgb)
+    for table in ("world_state", "boxes_2d", "boxes_3d"):
+        ta, tb = (read_table(run / "tables", table).rows for run in (clear, other))
+        assert ta.height > 0 and ta.columns == tb.columns, table
+        cols = [c for c in ta.columns if c != "lidar_points"]
+        assert ta.select(cols).equals(tb.select(cols)), table
+        if table == "boxes_3d":
+            assert ta["lidar_points"].sum() > 0
+    if sky != "overcast_south":  # a 10 km overcast hardly dims 905 nm over tens of metres
+        assert lidar_points_total(other) < lidar_points_total(clear), sky
+
+
+def cloud_bytes(run: Path, suffix: str) -> list[bytes]:
+    return [bytes(msg.data) for msg in decoded(run, suffix)]
+
+
+def test_each_sensor_reads_only_its_documented_environment(
+    sky_runs: dict[tuple[str, str], Path], tmp_path: Path
+) -> None:
+    """``mmusv.sensors.env``: "the LiDAR uses fog, rain and waves; the radar rain and waves"; the sun is the
+    cameras'. On the open sea: midnight and a southern winter morning leave the LiDAR and the radar byte for byte
+    as at noon, while the pictures change; fog (no rain) leaves the radar as it was and cuts the LiDAR's returns
+    beyond 30 m (half the visibility) to the two-way transmission's few per cent; rain adds radar returns (its
+    clutter)."""
+    env_noon = dict(CLEAR_NOON)
+    runs = {
+        "noon": sky_runs["open_sea", "clear_noon"],
+        "midnight": record(sweep_scenario("open_sea", {**env_noon, "time_of_day": "00:00"}), tmp_path / "midnight"),
+        "south": record(
+            sweep_scenario("open_sea", {**env_noon, "latitude_deg": -60, "day_of_year": 172, "time_of_day": "09:00"}),
+            tmp_path / "south",
+        ),
+        "fog": record(sweep_scenario("open_sea", {**env_noon, "weather": "fog", "visibility_m": 60}), tmp_path / "fog"),
+    }
+    lidar = {k: cloud_bytes(v, "/lidar") for k, v in runs.items()}
+    radar = {k: cloud_bytes(v, "/radar/returns") for k, v in runs.items()}
+    rgb = {k: cloud_bytes(v, "/camera/bow/rgb") for k, v in runs.items()}
+    for k in ("midnight", "south"):
+        assert lidar[k] == lidar["noon"] and radar[k] == radar["noon"], k
+        assert rgb[k] != rgb["noon"], k
+    assert radar["fog"] == radar["noon"]
+    assert lidar["fog"] != lidar["noon"]
+    far = {}
+    for k in ("noon", "fog"):
+        far[k] = 0
+        for msg in decoded(runs[k], "/lidar"):
+            cloud = decode_point_cloud(msg)
+            r = np.sqrt(cloud["x"].astype(float) ** 2 + cloud["y"] ** 2 + cloud["z"] ** 2)
+            far[k] += int(np.sum(r > 30.0))
+    # A return is kept with the two-way transmission e^(-2 r 3/V), under 0.05 beyond 30 m in a 60 m fog.
+    assert far["noon"] >= 20 and far["fog"] <= 0.15 * far["noon"], far
+    rain = sky_runs["open_sea", "rain_dusk"]
+    n_rain = sum(len(decode_point_cloud(m)["x"]) for m in decoded(rain, "/radar/returns"))
+    n_noon = sum(len(decode_point_cloud(m)["x"]) for m in decoded(runs["noon"], "/radar/returns"))
+    assert n_rain > n_noon
+
+
+@pytest.mark.parametrize("map_type", sorted(MAPS))
+def test_pictures_are_sane_by_day_and_night(sky_runs: dict[tuple[str, str], Path], map_type: str) -> None:
+    """Every sky on every map: the depth has no NaN and is +inf exactly where the instance image is the sky
+    (``docs/recording.md``), finite and positive elsewhere; a day picture (clear noon, overcast morning) is neither
+    black nor white; at night (the fog at midnight) the view stays dark (docs/realism: "at night the views stay
+    dark") with no more than a few lamp pixels bright."""
+    for sky in ("clear_noon", *OTHER_SKIES):
+        run = sky_runs[map_type, sky]
+        for depth_msg, inst_msg in zip(decoded(run, "/bow/depth"), decoded(run, "/bow/instance"), strict=True):
+            depth, inst = decode_image(depth_msg), decode_image(inst_msg)
+            assert not np.isnan(depth).any(), sky
+            assert np.array_equal(np.isposinf(depth), inst == SKY_INSTANCE), sky
+            assert (depth[inst != SKY_INSTANCE] > 0).all() and np.isfinite(depth[inst != SKY_INSTANCE]).all()
+        for suffix in ("/bow/rgb", "/top_view/rgb"):
+            for msg in decoded(run, suffix):
+                rgb = decode_image(msg).astype(float)
+                mean, bright = rgb.mean(), float(np.mean(rgb.max(axis=2) >= 250))
+                if sky in ("clear_noon", "overcast_south"):
+                    assert 40 < mean < 215 and bright < 0.05, (sky, suffix, mean, bright)
+                elif sky == "fog_night":
+                    assert mean < 5 and bright < 0.01, (sky, suffix, mean, bright)
+
+
+def fog_view_scenario(env: dict[str, Any]) -> dict[str, Any]:
+    """Flat water (the paper's motion, W0) seen by a 160 x 120 bow camera with a 20 deg field of view, pitched 4 deg
+    down: water from 7 m to the horizon, each pixel's range in the depth image."""
+    cam = {
+        "name": "bow",
+        "resolution": [160, 120],
+        "hfov_deg": 20,
+        "quality": "draft",
+        "outputs": ["rgb", "depth", "semantic"],
+        "mount": {"xyz": [2.6, 0, 1.5], "rpy_deg": [0, 4, 0]},
+    }
+    return {
+        "name": "sweep",
+        "seed": 2,
+        "map": {"type": "open_sea", "seed": 0},
+        "environment": {"motion": "paper", "wave": "W0", "time_of_day": "12:00", **env},
+        "acquisition": {"frames": 1},
+        "rigs": {"r": {"preset": "lidar_only", "lidar": None, "cameras": [cam]}},
+        "vessels": [
+            {"id": "u", "role": "usv", "asset": "usv_wamv", "rig": "r", "speed_mps": 2, "route": [[0, 0], [50, 0]]},
+            {"id": "t", "asset": "fishing_boat_12m", "speed_mps": 3, "route": [[0, 400], [60, 400]]},
+        ],
+    }
+
+
+def water_contrast(run: Path) -> tuple[np.ndarray, np.ndarray]:
+    """``(range, contrast)`` of each water pixel: its Weber contrast against the mean relative luminance of the
+    sky's pixels (the recorded 8-bit sRGB, linearised), and its range from the camera (the depth over the cosine
+    of the pixel's angle off the axis)."""
+    rgb = decode_image(decoded(run, "/bow/rgb")[0])
+    depth = decode_image(decoded(run, "/bow/depth")[0]).astype(float)
+    sem = decode_image(decoded(run, "/bow/semantic")[0])
+    lum = relative_luminance(rgb)
+    h, w = depth.shape
+    f = (w / 2) / np.tan(np.radians(10.0))
+    v, u = np.mgrid[0:h, 0:w]
+    off_axis = np.sqrt(((u + 0.5 - w / 2) / f) ** 2 + ((v + 0.5 - h / 2) / f) ** 2)
+    rng = depth * np.sqrt(1 + off_axis**2)
+    sky = sem == 0
+    water = sem == 1
+    assert sky.sum() > 500 and water.sum() > 5000
+    l_sky = lum[sky].mean()
+    return rng[water], np.abs(lum[water] - l_sky) / l_sky
+
+
+def test_fog_contrast_falls_with_range_at_the_koschmieder_rate(tmp_path: Path) -> None:
+    """The recorded picture of flat water in fog of visibility V, pixel by pixel against its range from the depth
+    image: its contrast against the fog's sky falls as ``e^{-sigma r}``, sigma = 3 / V (``docs/exports.md``:
+    "in fog a dark vessel fades below 0.05 at about the scenario's visibility_m"), the rate of the clear day's own
+    (slow) fall taken out: a least-squares slope of ln(contrast) between 1.0 and 1.35 sigma (the tone curve
+    steepens it a little; ``docs/exports.md`` measured 1.07). Beyond V no water pixel stands out by 0.05; in the
+    clear the same pixels keep a median of more than 0.3. Two visibilities, so the rate scales with 1/V."""
+    clear_r, clear_c = water_contrast(record(fog_view_scenario({"weather": "clear"}), tmp_path / "clear"))
+    near = (clear_r > 8) & (clear_r < 60)
+    clear_slope = np.polyfit(clear_r[near], np.log(clear_c[near]), 1)[0]
+    for vis in (120.0, 240.0):
+        r, c = water_contrast(record(fog_view_scenario({"weather": "fog", "visibility_m": vis}), tmp_path / f"{vis}"))
+        assert np.array_equal(r, clear_r)  # the same pixels: geometry
+        beyond = r > vis
+        assert beyond.sum() > 100 and c[beyond].max() < 0.05, vis
+        assert np.median(clear_c[beyond]) > 0.3
+        sigma = 3.0 / vis
+        fit = (r > 8) & (r < 0.6 * vis) & (c > 0.03)
+        assert fit.sum() > 500
+        slope = np.polyfit(r[fit], np.log(c[fit]), 1)[0]
+        rate = -(slope - clear_slope) / sigma
+        assert 1.0 <= rate <= 1.35, (vis, rate, slope, clear_slope)
+
+
+TIMES = ("08:00", "12:00", "16:00")
+
+
+def test_automatic_exposure_meters_the_overcast_light_away(tmp_path: Path) -> None:
+    """README: the exposure is automatic by default (an incident-light meter), or fixed at ``ev100`` "so that
+    brightness follows the light". Under a fully overcast sky (the fog: cloud cover 1, no sun beam) every radiance
+    scales with the sky's own level, so at 08:00, 12:00 and 16:00 the metered pictures are the same (to one 8-bit
+    level) while a fixed EV100 of 12 makes 08:00 darker than noon, and the afternoon, at the morning's sun
+    elevation, as dark as the morning."""
+    pictures = {}
+    for ev in (None, 12.0):
+        for t in TIMES:
+            scn = fog_view_scenario({"weather": "fog", "visibility_m": 400, "time_of_day": t})
+            if ev is not None:
+                scn["rigs"]["r"]["cameras"][0]["exposure"] = {"ev100": ev}
+            run = record(scn, tmp_path / f"{ev}_{t.replace(':', '')}")
+            pictures[ev, t] = decode_image(decoded(run, "/bow/rgb")[0]).astype(float)
+    for t in ("08:00", "16:00"):
+        metered = np.abs(pictures[None, t] - pictures[None, "12:00"])
+        assert metered.max() <= 1 and metered.mean() < 0.01, t  # the same picture but for a rounding
+    fixed = {t: float(relative_luminance(pictures[12.0, t].astype(np.uint8)).mean()) for t in TIMES}
+    assert fixed["08:00"] < 0.8 * fixed["12:00"], fixed
+    assert fixed["16:00"] == pytest.approx(fixed["08:00"], rel=1e-3), fixed
+    assert np.abs(pictures[12.0, "12:00"] - pictures[None, "12:00"]).mean() > 3
+
+
+def test_recording_metadata_say_the_environment_as_given(tmp_path: Path) -> None:
+    """The environment as written (``wave`` in lower case, a visibility and rain given as numbers) is what the
+    recording's ``scenario`` metadata hold, read with the ``mcap`` package and with :func:`mmusv.recording.read_info`,
+    with the defaults the user left out filled in."""
+    env = {
+        "time_of_day": "05:45",
+        "weather": "rain",
+        "visibility_m": 900,
+        "rain_mm_per_h": 12.5,
+        "wave": "w2",
+        "latitude_deg": 61.5,
+        "day_of_year": 300,
+    }
+    scn = sweep_scenario("open_sea", env, frames=1)
+    scn["rigs"] = {"r": {"preset": "lidar_only", "lidar": {"channels": 8, "points_per_second": 20480}}}
+    run = record(scn, tmp_path / "run")
+    expected = {**env, "wave": "W2", "visibility_m": 900.0, "sea": None, "motion": "physical"}
+    with open(run / "sweep.mcap", "rb") as fh:
+        meta = {m.name: m.metadata for m in make_reader(fh).iter_metadata()}
+    assert yaml.safe_load(meta["scenario"]["yaml"])["environment"] == expected
+    from mmusv.recording import read_info
+
+    assert read_info(run / "sweep.mcap").scenario["environment"] == expected
+    assert yaml.safe_load((run / "scenario.yaml").read_text(encoding="utf-8"))["environment"] == expected
