@@ -357,3 +357,33 @@ def test_recording_metadata_say_the_environment_as_given(tmp_path: Path) -> None
 
     assert read_info(run / "sweep.mcap").scenario["environment"] == expected
     assert yaml.safe_load((run / "scenario.yaml").read_text(encoding="utf-8"))["environment"] == expected
+
+
+@pytest.mark.parametrize(
+    ("wave", "hint"),
+    [
+        (None, "leave `wave` out for W0"),
+        (["W1", "W2"], "a list of choices belongs in a generation spec"),
+        ({"state": 3}, "environment.sea"),
+        (float("inf"), "0..25 metres"),
+        ("1.5", "write the height as a number, wave: 1.5"),
+    ],
+    ids=["null", "list", "mapping", "inf", "quoted-number"],
+)
+def test_a_wave_of_the_wrong_kind_says_what_is_allowed(tmp_path: Path, wave: object, hint: str) -> None:
+    """``wave: null``, a list (a generation spec's choices), a mapping (a sea state meant for ``environment.sea``)
+    and ``.inf`` were two lines of the schema's union ("Input should be a valid string; ... Input should be a valid
+    number") that did not say what ``wave`` takes; a quoted height ("1.5") was told that heights in metres are
+    allowed. Each is now one message naming the file, ``environment.wave``, the presets and the range in metres, with
+    the way out."""
+    scn = sweep_scenario("open_sea", {"wave": wave}, frames=1)
+    path = tmp_path / "waves.yaml"
+    path.write_text(yaml.safe_dump(scn, sort_keys=False), encoding="utf-8")
+    with pytest.raises(mmusv.ConfigError) as err:
+        mmusv.run(str(path), out_dir=tmp_path / "out")
+    msg = str(err.value)
+    assert msg.startswith(f"{path}: invalid config environment.wave = "), msg
+    assert "0..25" in msg and hint in msg, msg
+    assert "W0, W1, W2, W3" in msg or wave == float("inf"), msg  # inf: the heights' range, as for 26
+    assert "valid string" not in msg and msg.count("environment.wave") == 1, msg
+    assert not (tmp_path / "out").exists()

@@ -41,6 +41,7 @@ from pydantic import (
 )
 from pydantic_core import InitErrorDetails, PydanticCustomError
 
+from mmusv import arguments
 from mmusv.config_errors import short_repr, validation_error, validation_problems
 from mmusv.errors import ConfigError, MmusvError, located
 from mmusv.scenario_assets import AssetHome
@@ -216,6 +217,17 @@ class EnvironmentConfig(_Model):
         except ConfigError:
             raise ValueError('use 24-hour "HH:MM", e.g. "16:30"') from None
         return v
+
+    @field_validator("wave", mode="before")
+    @classmethod
+    def _wave_kind(cls, v: Any) -> Any:
+        # Anything but text or a finite number (null, a list, a mapping, .inf) was the union's two lines, "Input
+        # should be a valid string; ... a valid number", which did not say what `wave` takes. (true/false is left
+        # to the strict numbers' own message.)
+        if isinstance(v, str | bool) or (arguments.is_number(v) and math.isfinite(float(v))):
+            return v
+        problem = wave_problem(v)
+        raise ValueError(problem or "allowed presets are W0..W3 or a wave height in metres")
 
     @field_validator("wave")
     @classmethod

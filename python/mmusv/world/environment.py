@@ -53,12 +53,28 @@ MAX_WAVE_HEIGHT_M: float = core.sea_limits()["hs_m"][1]
 
 
 def wave_problem(wave: object) -> str | None:
-    """What is wrong with ``wave`` as ``environment.wave`` (what is allowed, for an error message), or ``None``
-    when it is a preset name (``"W0"``..``"W3"``, any case) or a height in metres (a real number in
-    ``0..MAX_WAVE_HEIGHT_M``; not ``True``/``False``)."""
+    """What is wrong with ``wave`` as ``environment.wave`` (what is allowed, for an error message, with the way out
+    for a quoted height, ``null``, a list of choices and a sea state's mapping), or ``None`` when it is a preset name
+    (``"W0"``..``"W3"``, any case) or a height in metres (a real number in ``0..MAX_WAVE_HEIGHT_M``; not
+    ``True``/``False``)."""
     allowed = f"allowed presets are {', '.join(WAVE_PRESETS)} or a wave height in metres (0..{MAX_WAVE_HEIGHT_M:g})"
     if isinstance(wave, str):
-        return None if wave.strip().upper() in WAVE_PRESETS else allowed
+        if wave.strip().upper() in WAVE_PRESETS:
+            return None
+        try:
+            height = float(wave)
+        except ValueError:
+            return allowed
+        if not math.isfinite(height):
+            return allowed
+        # a quoted height is text, not a preset (a height is a number: the schema and the editor say so too)
+        return f"{allowed}; {wave!r:.30} is text: write the height as a number, wave: {height:g}"
+    if wave is None:
+        return f"{allowed}, not null: leave `wave` out for W0"
+    if isinstance(wave, list | tuple):
+        return f"{allowed}, not a list: one wave per scenario (a list of choices belongs in a generation spec)"
+    if isinstance(wave, dict):
+        return f"{allowed}, not a mapping: a physical sea (state, hs_m, tp_s, ...) goes under environment.sea"
     if not arguments.is_number(wave):
         return f"{allowed}, not {type(wave).__name__}"
     h = float(wave)
