@@ -387,3 +387,32 @@ def test_a_wave_of_the_wrong_kind_says_what_is_allowed(tmp_path: Path, wave: obj
     assert "W0, W1, W2, W3" in msg or wave == float("inf"), msg  # inf: the heights' range, as for 26
     assert "valid string" not in msg and msg.count("environment.wave") == 1, msg
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize(
+    "environment",
+    [
+        {"rain_mm_per_h": [2, 10, 30]},
+        {"weather": "clear", "rain_mm_per_h": 8},
+        {"weather": ["clear"], "rain_mm_per_h": [0, 5]},
+    ],
+    ids=["no-weather", "clear", "clear-list"],
+)
+def test_a_spec_whose_skies_never_rain_refuses_its_rain_rates(tmp_path: Path, environment: dict[str, Any]) -> None:
+    """A generation spec drops a rain rate drawn beside a clear sky (``mmusv.generate.sampler``); when no weather it
+    draws rains (``weather`` left out, i.e. clear, or only ``clear``) every rate was dropped without a word and the
+    whole dataset came out dry. Refused, naming the file and the fields, as a scenario refuses rain under a clear
+    sky; rates of 0 alone, or a weather that rains among the choices, are taken."""
+    from mmusv.generate.spec import load_spec
+
+    path = tmp_path / "spec.yaml"
+    base = {"name": "s", "combinations": [{"family": "crossing"}]}
+    path.write_text(yaml.safe_dump({**base, "environment": environment}), encoding="utf-8")
+    with pytest.raises(mmusv.ConfigError) as err:
+        load_spec(path)
+    msg = str(err.value)
+    assert str(path) in msg and "environment.rain_mm_per_h" in msg and "weather" in msg, msg
+    assert "clear sky does not rain" in msg, msg
+    for ok in ({**environment, "weather": ["clear", "fog"]}, {"rain_mm_per_h": [0]}, {"weather": "rain"}):
+        path.write_text(yaml.safe_dump({**base, "environment": ok}), encoding="utf-8")
+        assert load_spec(path).environment == ok

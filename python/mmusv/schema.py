@@ -153,7 +153,8 @@ def _spec() -> dict[str, Any]:
         "title": "Environment",
         "description": (
             "Scenario environment keys; a list means one value drawn per scenario (a rain_mm_per_h drawn with a "
-            "clear sky is left out). Give `wave` or `sea`, not both."
+            "clear sky is left out; a rate above 0 needs a weather that rains among the choices). Give `wave` or "
+            "`sea`, not both."
         ),
         "type": "object",
         "additionalProperties": False,

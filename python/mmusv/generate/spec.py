@@ -5,7 +5,7 @@ Units: metres, seconds, metres per second; shares are fractions of the frames in
 - ``name``, ``seed`` (every random draw derives from it), ``map`` (``type``/``seed``/``params`` as in a scenario);
 - ``acquisition`` (``frequency_hz``, ``frames``: the window every scenario covers) and ``environment`` (scenario
   environment keys; a list means one value drawn per scenario; a ``rain_mm_per_h`` drawn with a clear sky is left
-  out, as a clear sky does not rain);
+  out, as a clear sky does not rain, and a rate above 0 with no weather that rains to draw is refused);
 - ``rig``/``rigs``: the sensor rig every USV carries (``{usv_standard: {}}`` = the default rig);
 - ``usv``: USV ``assets`` and ``speed_mps``; ``size_classes``: target classes by hull ``length_m`` (default
   small < 15 m <= medium < 80 m <= large) or an explicit ``assets`` list, with their ``speed_mps``;
@@ -369,6 +369,17 @@ class GenerationSpec(_Model):
         if "sea" in v and "paper" in (motions if isinstance(motions, list) else [motions]):
             raise ValueError(
                 "environment: `sea` is the physical sea, which `motion: paper` leaves out: drop one of them"
+            )
+        # A rate drawn beside a clear sky is dropped (the sampler); with no weather that rains to draw, every rate
+        # would be, and the whole dataset would come out dry without a word.
+        rains = v.get("rain_mm_per_h", [])
+        weathers = v.get("weather", ["clear"])
+        weathers = weathers if isinstance(weathers, list) else [weathers]
+        if any(r for r in (rains if isinstance(rains, list) else [rains])) and set(weathers) == {"clear"}:
+            raise ValueError(
+                f"environment.rain_mm_per_h = {short_repr(rains)} with weather {short_repr(v.get('weather', 'clear'))}"
+                ": a clear sky does not rain, so every rate would be dropped; add a weather that rains (rain, "
+                "overcast or fog) to weather"
             )
         return v
 
