@@ -416,3 +416,26 @@ def test_a_spec_whose_skies_never_rain_refuses_its_rain_rates(tmp_path: Path, en
     for ok in ({**environment, "weather": ["clear", "fog"]}, {"rain_mm_per_h": [0]}, {"weather": "rain"}):
         path.write_text(yaml.safe_dump({**base, "environment": ok}), encoding="utf-8")
         assert load_spec(path).environment == ok
+
+
+@pytest.mark.parametrize(
+    ("weather", "ev_range"), [("clear", (14.5, 15.5)), ("overcast", (11.5, 13.5))], ids=["full-sun", "overcast"]
+)
+def test_metered_exposure_at_noon_is_the_documented_ev100(
+    tmp_path: Path, weather: str, ev_range: tuple[float, float]
+) -> None:
+    """``ExposureConfig``'s (and the schema's) own guide: a fixed ``ev100`` is "e.g. 15 for full sun, 12 for an
+    overcast day" (the photographers' sunny-16 rule: ISO 100, f/16, 1/125 s is EV 15; overcast 12-13). The
+    automatic exposure at noon must land there: its picture lies between those of the fixed EV100s that bracket
+    the value (a higher EV100 is a darker picture)."""
+
+    def mean_luminance(ev: float | None, name: str) -> float:
+        scn = fog_view_scenario({"weather": weather})
+        if ev is not None:
+            scn["rigs"]["r"]["cameras"][0]["exposure"] = {"ev100": ev}
+        run = record(scn, tmp_path / name)
+        return float(relative_luminance(decode_image(decoded(run, "/bow/rgb")[0])).mean())
+
+    lo, hi = ev_range
+    brighter, metered, darker = mean_luminance(lo, "lo"), mean_luminance(None, "auto"), mean_luminance(hi, "hi")
+    assert brighter > metered > darker, (brighter, metered, darker)
