@@ -178,8 +178,9 @@ def test_each_sensor_reads_only_its_documented_environment(
     sky_runs: dict[tuple[str, str], Path], tmp_path: Path
 ) -> None:
     """``mmusv.sensors.env``: "the LiDAR uses fog, rain and waves; the radar rain and waves"; the sun is the
-    cameras'. On the open sea: midnight and a southern winter morning leave the LiDAR and the radar byte for byte
-    as at noon, while the pictures change; fog (no rain) leaves the radar as it was and cuts the LiDAR's returns
+    cameras'. On the open sea: midnight, a southern winter morning and a rain sky without rain (0 mm/h, the clear
+    day's 20 km visibility: the weather's name and its cloud cover alone) leave the LiDAR and the radar byte for
+    byte as at noon, while the pictures change; fog (no rain) leaves the radar as it was and cuts the LiDAR's returns
     beyond 30 m (half the visibility) to the two-way transmission's few per cent; rain adds radar returns (its
     clutter)."""
     env_noon = dict(CLEAR_NOON)
@@ -191,11 +192,16 @@ def test_each_sensor_reads_only_its_documented_environment(
             tmp_path / "south",
         ),
         "fog": record(sweep_scenario("open_sea", {**env_noon, "weather": "fog", "visibility_m": 60}), tmp_path / "fog"),
+        # the rain's sky without its drops, at the clear day's visibility: the weather's name alone
+        "dry_rain": record(
+            sweep_scenario("open_sea", {**env_noon, "weather": "rain", "rain_mm_per_h": 0, "visibility_m": 20000}),
+            tmp_path / "dry_rain",
+        ),
     }
     lidar = {k: cloud_bytes(v, "/lidar") for k, v in runs.items()}
     radar = {k: cloud_bytes(v, "/radar/returns") for k, v in runs.items()}
     rgb = {k: cloud_bytes(v, "/camera/bow/rgb") for k, v in runs.items()}
-    for k in ("midnight", "south"):
+    for k in ("midnight", "south", "dry_rain"):
         assert lidar[k] == lidar["noon"] and radar[k] == radar["noon"], k
         assert rgb[k] != rgb["noon"], k
     assert radar["fog"] == radar["noon"]
