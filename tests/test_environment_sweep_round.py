@@ -479,3 +479,18 @@ def test_min_contrast_leaves_out_the_fog_s_boxes_as_documented(tmp_path: Path) -
     assert len(clear) == len(fog) == 36
     low = {k: sum(1 for c in v if c is not None and c < 0.05) for k, v in (("clear", clear), ("fog", fog))}
     assert 20 <= low["fog"] <= 26 and low["clear"] <= 4, low
+
+
+def test_a_time_of_day_is_one_time_in_the_config_hash() -> None:
+    """``time_of_day`` takes one or two digits for the hour (``"6:30"``, as the schema's pattern says); the scenario
+    kept the text as written, so ``"6:30"`` and ``"06:30"``, the same sun and the same recording, had two config
+    hashes (``dataset.json``, ``RecordingInfo.config_hash``, the converters' folder names) and two spellings in the
+    recording's scenario, where ``wave: " w3 "`` is ``W3`` in both. The time is now written ``HH:MM``."""
+    from mmusv.config import load_scenario, scenario_hash
+
+    def scenario(time: str) -> dict[str, Any]:
+        return sweep_scenario("open_sea", {"time_of_day": time}, frames=1)
+
+    assert load_scenario(scenario("6:30")).environment.time_of_day == "06:30"
+    assert load_scenario(scenario(" 7:05 ")).environment.time_of_day == "07:05"
+    assert scenario_hash(scenario("6:30")) == scenario_hash(scenario("06:30")) != scenario_hash(scenario("06:31"))

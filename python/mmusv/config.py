@@ -213,10 +213,13 @@ class EnvironmentConfig(_Model):
         from mmusv.world.environment import _parse_time
 
         try:
-            _parse_time(v)
+            hours = _parse_time(v)
         except ConfigError:
             raise ValueError('use 24-hour "HH:MM", e.g. "16:30"') from None
-        return v
+        # One spelling of one time ("6:30" is "06:30"): the scenario's hash and its recorded text follow the time,
+        # as they follow the wave preset whatever its case.
+        minutes = round(hours * 60)
+        return f"{minutes // 60:02d}:{minutes % 60:02d}"
 
     @field_validator("wave", mode="before")
     @classmethod
