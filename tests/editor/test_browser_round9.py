@@ -45,7 +45,14 @@ def test_a_new_file_of_the_command_line_opens_a_new_scenario(browser: Any, tmp_p
         assert "does not exist yet" not in status_text(browser)
 
         browser.find_element(By.ID, "save").click()  # no vessel yet: refused, saying what to fix, once
-        _wait(browser, "return document.getElementById('status').classList.contains('error')", "the refusal")
+        # (the live check's own "1 error(s)" line is an error too: wait for the save's, not for the class alone,
+        # which the live check may have set before the save's answer came, on a loaded machine)
+        _wait(
+            browser,
+            "const s = document.getElementById('status');"
+            "return s.classList.contains('error') && s.textContent.startsWith('not saved:')",
+            "the refusal",
+        )
         assert status_text(browser) == (
             "not saved: harbour_new.yaml: the scenario does not validate: vessels = []: must hold at least 1 entry, "
             "got 0"
