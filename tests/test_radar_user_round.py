@@ -45,23 +45,10 @@ from mmusv.classes import SemanticClass
 from mmusv.sensors.config import RadarConfig
 from mmusv.sensors.radar import RadarReturns, ppi_colormap, ppi_image, radar_from_config
 from mmusv.world.vessels import library
+from test_scene import box_mesh
 
 REPO = Path(__file__).resolve().parents[1]
 USV_ASSETS = sorted(a.name for a in library() if a.category == "usv")
-
-
-def _cube(half: float) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
-    a = half
-    v = np.array(
-        [[-a, -a, -a], [a, -a, -a], [a, a, -a], [-a, a, -a], [-a, -a, a], [a, -a, a], [a, a, a], [-a, a, a]],
-        dtype=np.float64,
-    )
-    f = np.array(
-        [[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4],
-         [1, 2, 6], [1, 6, 5], [2, 3, 7], [2, 7, 6], [3, 0, 4], [3, 4, 7]],
-        dtype=np.int64,
-    )  # fmt: skip
-    return v, f
 
 
 # --------------------------------------------------------------------------------------------------- blind sectors
@@ -85,7 +72,7 @@ def test_the_default_radar_sees_all_round(asset: str) -> None:
     }
     sim = Simulation(sc)
     scene = sim.ws.scene
-    v, f = _cube(3.0)
+    v, f = box_mesh((3.0, 3.0, 3.0))
     mesh = scene.add_mesh(v, f, classes=int(SemanticClass.VESSEL))
     bearings = np.arange(0.0, 360.0, 4.0)
     ids = []
@@ -441,7 +428,7 @@ def _boats(ranges: list[float], per_range: int = 12) -> tuple[Any, dict[tuple[fl
     h = 20_000.0
     sea = np.array([[-h, -h, 0], [h, -h, 0], [h, h, 0], [-h, h, 0]], dtype=np.float64)
     scene.add_instance(scene.add_mesh(sea, np.array([[0, 1, 2], [0, 2, 3]], np.int64), classes=1))
-    v, f = _cube(1.0)
+    v, f = box_mesh((1.0, 1.0, 1.0))
     mesh = scene.add_mesh(v * [2.5, 1.0, 0.6], f, classes=int(SemanticClass.VESSEL))
     ids = {}
     for j, r in enumerate(ranges):
