@@ -106,3 +106,27 @@ def test_an_additional_yaml_another_tool_wrote_is_not_read_as_mmusv_s(tmp_path: 
     path.write_text("- a list\n")
     with pytest.raises(ValueError, match="not mmusv's additional yaml"):
         _opv2v_usvs(path)
+
+
+def test_the_background_writer_finds_an_item_whose_wake_up_was_lost() -> None:
+    """A stop (SIGTERM, Ctrl-C) raised in the main thread inside ``Queue.put``, after the item went in but before the
+    waiting writer thread was woken, left the writer asleep beside a full queue: ``close`` then waited for ever (a
+    ``mmusv run`` killed by SIGTERM hung so in CI, its writer thread in ``queue.get``, the main thread in ``close``).
+    Here the item goes in without the wake-up, as that stop left it; the writer must still write it and close."""
+    import threading
+    import time
+
+    from mmusv.recording.background import BackgroundWriter
+
+    written: list[int] = []
+    writer: BackgroundWriter[int] = BackgroundWriter(written.append, depth=1)
+    time.sleep(0.2)  # the writer thread is waiting for an item
+    q = writer._queue
+    with q.mutex:  # what Queue.put does up to its notify
+        q._put(7)  # type: ignore[attr-defined]
+        q.unfinished_tasks += 1
+    closer = threading.Thread(target=writer.close, daemon=True)
+    closer.start()
+    closer.join(timeout=10)
+    assert not closer.is_alive(), "close() waited for ever for a writer that was never woken"
+    assert written == [7] and writer.done == 1

@@ -114,7 +114,13 @@ class BackgroundWriter(Generic[T]):
 
     def _run(self) -> None:
         while True:
-            item = self._queue.get()
+            try:
+                # A poll, not a wait without end: a stop raised in the main thread inside `Queue.put`, after the
+                # item went in but before the waiting writer was woken, left the writer asleep beside a full queue
+                # and `close` waiting for it for ever (a SIGTERM'd run hung so once); a poll finds the item.
+                item = self._queue.get(timeout=_POLL_S)
+            except queue.Empty:
+                continue
             if isinstance(item, _Stop):
                 return
             if self._error is not None:
