@@ -130,3 +130,22 @@ def test_the_background_writer_finds_an_item_whose_wake_up_was_lost() -> None:
     closer.join(timeout=10)
     assert not closer.is_alive(), "close() waited for ever for a writer that was never woken"
     assert written == [7] and writer.done == 1
+
+
+def test_a_close_interrupted_before_its_end_marker_went_in_still_ends_the_writer() -> None:
+    """The hang CI met (a SIGTERM'd ``mmusv run``: the writer thread in ``queue.get``, the main thread joining it in
+    ``close``): the stop came inside ``close`` after it marked the writer closed but before it sent the end marker;
+    the second ``close`` (the run's finishing) saw it closed, sent nothing and joined for ever."""
+    import threading
+
+    from mmusv.recording.background import BackgroundWriter
+
+    written: list[int] = []
+    writer: BackgroundWriter[int] = BackgroundWriter(written.append, depth=1)
+    writer.submit(3)
+    writer._closed = True  # where the stop left the first close
+    closer = threading.Thread(target=writer.close, daemon=True)
+    closer.start()
+    closer.join(timeout=10)
+    assert not closer.is_alive(), "the second close() joined a writer that was never sent its end marker"
+    assert written == [3]

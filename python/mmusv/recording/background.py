@@ -49,6 +49,7 @@ class BackgroundWriter(Generic[T]):
         self._queue: queue.Queue[T | _Stop] = queue.Queue(maxsize=depth)
         self._error: BaseException | None = None
         self._closed = False
+        self._stop_sent = False
         self.done = 0
         """Items written so far."""
         self.wait_seconds = 0.0
@@ -87,8 +88,11 @@ class BackgroundWriter(Generic[T]):
     def close(self) -> None:
         """Waits until every submitted item is written (or the writer failed), then ends the thread. Never raises
         (see :meth:`raise_pending`); calling it again does nothing."""
-        if not self._closed:
-            self._closed = True
+        # `_closed` refuses new items; the end marker is sent until it is in (`_stop_sent`): a stop that came between
+        # setting the one and sending the other left a second `close` joining a writer that nothing would end (a
+        # SIGTERM'd run hung so once in CI: the writer in `queue.get`, the main thread in `_joined`).
+        self._closed = True
+        if not self._stop_sent:
             self._wait(self._put_stop)
         self._wait(self._joined)
 
@@ -101,6 +105,7 @@ class BackgroundWriter(Generic[T]):
             self._queue.put(_Stop(), timeout=_POLL_S)
         except queue.Full:
             return False
+        self._stop_sent = True
         return True
 
     def _wait(self, step: Callable[[], bool]) -> None:
