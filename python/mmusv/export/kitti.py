@@ -170,12 +170,8 @@ def label_lines(
     2D boxes from the frame's ``messages`` (the agent's annotations: the front camera's boxes; none without a front
     camera), ``kind`` the type written for every target (``None``: each target's class name); ``levels``: truncation
     as the tracking benchmark's level (:func:`truncation_level`)."""
-    a = view.agent
-    boxes: dict[str, Any] = {}
-    ann = messages.get(topics.agent_annotations(a.id))
-    cam = a.cameras.get("front")
-    if ann is not None and cam is not None:
-        boxes = {b.target_id: b for b in ann.boxes_camera if b.camera == "front"}
+    cam = view.agent.cameras.get("front")
+    boxes = {b.target_id: b for b in _front_boxes(view, messages)}
     lines = []
     for t in targets:
         box2d = boxes.get(t.id)
@@ -199,18 +195,27 @@ def dont_care_lines(view: AgentView, targets: list[Target], messages: dict[str, 
     the picture), or another USV without ``--include-usvs``. KITTI's evaluation ignores detections in these regions,
     as its own labels mark the objects they leave out, so a detector is not counted wrong for finding them. Sorted
     by the box's position in the image."""
-    ann = messages.get(topics.agent_annotations(view.agent.id))
-    if ann is None or "front" not in view.agent.cameras:
-        return []
     kept = {t.id for t in targets}
     boxes = sorted(
         (b.x_min, b.y_min, b.x_max, b.y_max)
-        for b in ann.boxes_camera
-        if b.camera == "front" and b.target_id not in kept and b.visible_pixels > 0
+        for b in _front_boxes(view, messages)
+        if b.target_id not in kept and b.visible_pixels > 0
     )
-    return [
-        f"DontCare -1 -1 -10 {' '.join(f'{round(float(v), 2) + 0.0:.2f}' for v in bb)} {DONT_CARE_TAIL}" for bb in boxes
-    ]
+    return [f"DontCare -1 -1 -10 {_label_numbers(bb)} {DONT_CARE_TAIL}" for bb in boxes]
+
+
+def _front_boxes(view: AgentView, messages: dict[str, Any]) -> list[Any]:
+    """The front camera's 2D boxes in the frame's ``messages`` (the agent's annotations); none without a front
+    camera or without annotations."""
+    ann = messages.get(topics.agent_annotations(view.agent.id))
+    if ann is None or "front" not in view.agent.cameras:
+        return []
+    return [b for b in ann.boxes_camera if b.camera == "front"]
+
+
+def _label_numbers(values: Any) -> str:
+    """Numbers as a ``label_2`` line writes them: two decimals, no negative zero."""
+    return " ".join(f"{round(float(v), 2) + 0.0:.2f}" for v in values)
 
 
 def truncation_level(fraction: float | None) -> int:
@@ -258,7 +263,7 @@ def kitti_label(
     vals = [trunc, occ, alpha, *bb, height, beam, length, *bottom, ry]
     out_of_image = box2d is None and trunc >= 1.0
     cut = f"{truncation_level(None if out_of_image else trunc)}" if levels else f"{vals[0]:.2f}"
-    return f"{name} {cut} {int(vals[1])} " + " ".join(f"{round(float(v), 2) + 0.0:.2f}" for v in vals[2:])
+    return f"{name} {cut} {int(vals[1])} {_label_numbers(vals[2:])}"
 
 
 class KittiWriter(DatasetWriter):

@@ -342,10 +342,16 @@ class GenerationSpec(_Model):
     @classmethod
     def _environment(cls, v: dict[str, Any]) -> dict[str, Any]:
         fields = EnvironmentConfig.model_fields
-        for key, value in v.items():
+
+        def drawn(key: str, default: list[Any]) -> list[Any]:
+            """The values the sampler can draw for ``key`` (a list is a choice, one value is always drawn)."""
+            value = v.get(key, default)
+            return value if isinstance(value, list) else [value]
+
+        for key in v:
             if key not in fields:
                 raise ValueError(f"unknown environment key {key!r} (allowed: {', '.join(fields)})")
-            choices = value if isinstance(value, list) else [value]
+            choices = drawn(key, [])
             if not choices:
                 raise ValueError(f"environment.{key}: an empty list has nothing to choose from")
             # A rain rate alone is checked under a sky that rains (the sampler leaves it out of clear-sky draws).
@@ -361,23 +367,20 @@ class GenerationSpec(_Model):
                         field, shown = key, repr(c)
                     raise ValueError(f"environment.{field} = {shown}: {msg}") from None
         # What a scenario refuses across keys (EnvironmentConfig's checks), for any choice the sampler can draw.
-        motions = v.get("motion", [])
         if "sea" in v and "wave" in v:
             raise ValueError(
                 "environment: give `wave` or `sea`, not both: `sea` sets the waves every sensor and hull meet"
             )
-        if "sea" in v and "paper" in (motions if isinstance(motions, list) else [motions]):
+        if "sea" in v and "paper" in drawn("motion", []):
             raise ValueError(
                 "environment: `sea` is the physical sea, which `motion: paper` leaves out: drop one of them"
             )
         # A rate drawn beside a clear sky is dropped (the sampler); with no weather that rains to draw, every rate
         # would be, and the whole dataset would come out dry without a word.
-        rains = v.get("rain_mm_per_h", [])
-        weathers = v.get("weather", ["clear"])
-        weathers = weathers if isinstance(weathers, list) else [weathers]
-        if any(r for r in (rains if isinstance(rains, list) else [rains])) and set(weathers) == {"clear"}:
+        if any(drawn("rain_mm_per_h", [])) and set(drawn("weather", ["clear"])) == {"clear"}:
             raise ValueError(
-                f"environment.rain_mm_per_h = {short_repr(rains)} with weather {short_repr(v.get('weather', 'clear'))}"
+                f"environment.rain_mm_per_h = {short_repr(v['rain_mm_per_h'])} with weather "
+                f"{short_repr(v.get('weather', 'clear'))}"
                 ": a clear sky does not rain, so every rate would be dropped; add a weather that rains (rain, "
                 "overcast or fog) to weather"
             )
