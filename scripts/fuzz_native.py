@@ -116,7 +116,7 @@ LIDAR_KW = [("elevations", "[-0.2, 0.0, 0.2]", "q"), ("azimuth_steps", "16", "i"
             ("water_range_m", "20.0", "f"), ("water_range_per_wave_m", "5.0", "f")]  # fmt: skip
 RADAR_KW = [("range_min_m", "5.0", "f"), ("range_max_m", "500.0", "f"), ("range_resolution_m", "5.0", "f"),
             ("azimuth_bins", "64", "i"), ("beamwidth_az_rad", "0.03", "f"), ("elevation_fan_rad", "(-0.2, 0.2)", "q"),
-            ("rays_az", "64", "i"), ("rays_el", "4", "i"), ("horizon_fraction", "0.5", "f"),
+            ("rays_az", "64", "i"), ("rays_el", "4", "i"), ("target_rays", "16", "i"), ("horizon_fraction", "0.5", "f"),
             ("horizon_band_rad", "0.05", "f"), ("detection_threshold", "1e-3", "f"), ("range_noise_std_m", "0.5", "f"),
             ("sea_sigma0_at_1m", "1e-4", "f"), ("critical_range_per_m", "100.0", "f"), ("sea_max_range_m", "300.0", "f"),
             ("rain_eta_at_1mm_h", "1e-6", "f"), ("frequency_ghz", "9.4", "f"), ("polarisation", "'HH'", "s")]  # fmt: skip
@@ -846,7 +846,7 @@ LIDAR = dict(elevations=[-0.2, 0.0, 0.2], azimuth_steps=16, range_min=0.5, range
              dropout=0.0, water_probability=0.1, water_probability_per_wave_m=0.1, water_range_m=20.0,
              water_range_per_wave_m=5.0)
 RADAR = dict(range_min_m=5.0, range_max_m=500.0, range_resolution_m=5.0, azimuth_bins=64, beamwidth_az_rad=0.03,
-             elevation_fan_rad=(-0.2, 0.2), rays_az=64, rays_el=4, horizon_fraction=0.5, horizon_band_rad=0.05,
+             elevation_fan_rad=(-0.2, 0.2), rays_az=64, rays_el=4, target_rays=16, horizon_fraction=0.5, horizon_band_rad=0.05,
              detection_threshold=1e-3, range_noise_std_m=0.5, sea_sigma0_at_1m=1e-4, critical_range_per_m=100.0,
              sea_max_range_m=300.0, rain_eta_at_1mm_h=1e-6, frequency_ghz=9.4, polarisation='HH')
 ROUTE = np.array([[0.0, 0.0], [100.0, 0.0], [100.0, 50.0]])

@@ -132,6 +132,7 @@ def _radar(
         elevation_fan_rad=(math.radians(-10), math.radians(10)),
         rays_az=1,
         rays_el=rays_el,
+        target_rays=0,
         horizon_fraction=0.0,
         horizon_band_rad=0.01,
         detection_threshold=0.0,

@@ -16,9 +16,11 @@ independent computation written out here.
   rig's size, scale and orientation, the radar's pose from the recorded world state and mount); the ROS 2 bag's
   radar returns and PPI are the recording's, on frame ``<usv>/radar`` at the frame's stamp, with the radar's
   static transform the recorded mount.
-* Small boats and the ray sampling: sampled densely, a boat's brightest cell is the radar equation's; at the
-  defaults, boats well within their radar-equation range go unseen and those seen are far too bright (a strict
-  xfail: the ray pattern is the core's, ``radar/pattern.rs``; the numbers are in ``RadarConfig.rays_el``).
+* Small boats and the ray sampling: sampled densely, a boat's brightest cell is the radar equation's. At the
+  defaults, boats well within their radar-equation range went unseen and those seen were far too bright (a strict
+  xfail until 2026-12-06); the core now also casts rays straight at every object in range, combined with the fan's
+  by multiple importance sampling (``radar/targets.rs``, ``RadarConfig.target_rays``), and the defaults see every
+  boat to 1 km at the radar equation's brightness.
 * Range bins and range noise (one return per bin centre in ``[min_range_m, range_m)``, Gaussian noise of the
   configured σ), the clutter returns' elevation under a rolled and pitched antenna, and a bad radar in a scenario
   file (the error names the file, the field and what it may be).
@@ -482,21 +484,32 @@ def test_densely_sampled_small_boats_follow_the_radar_equation() -> None:
         assert abs(float(np.median(extents[r])) - want) <= 360.0 / 1024, (r, np.median(extents[r]), want)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="the default ray pattern (3 rays across the beam, 16 over the fan, 12 of them within ±1° of the horizon) "
-    "misses small boats well inside their radar-equation range: crates/mmusv-core/src/sensors/radar/pattern.rs",
-)
 def test_the_default_radar_sees_every_small_boat_within_a_kilometre() -> None:
     """With the default configuration, from the patrol boat's radar height (5.3 m), every boat from 150 m to 1 km
-    (its brightest cell 1.8 at 1 km by the radar equation, six times the detection threshold 0.3) should be seen.
-    Measured 2026-12-06: 9 of 12 seen at 150 m, 5 at 200 m (the boat lies below the ±1° horizon band, where 4
-    rays share 18° of fan), 12 at 300 m, 9 at 600 m, 6 at 1 km; those seen at 1 km were ~11 times brighter than
-    the radar equation (a ray that hits stands for the whole 0.4° × 0.17° it samples)."""
-    ranges = [150.0, 200.0, 300.0, 600.0, 1000.0]
-    got = _brightest(RadarConfig(), 5.3, ranges)
-    unseen = {r: got[r].count(0.0) for r in ranges if got[r].count(0.0)}
+    (its brightest cell 1.8 at 1 km by the radar equation, six times the detection threshold 0.3) is seen, its
+    brightest cell the radar equation's ``ρ A (1 km / r)⁴`` within a factor 0.6..1.6 (measured 0.74..1.16), over
+    the beamwidth plus its own width within a beam; at 2.5 km (0.05 by the radar equation, a sixth of the
+    threshold) none is. With the fan's rays alone (``target_rays`` 0, all there was until 2026-12-06) 9 of 12 were
+    seen at 150 m, 5 at 200 m (below the ±1° horizon band, where 4 rays share 18° of fan), 12 at 300 m, 9 at 600
+    m and 6 at 1 km, those at 1 km ~11 times brighter than the radar equation in one 0.18° beam (a ray that hits
+    stands for the whole 0.4° × 0.17° it samples), and one at 2.5 km, 71 times too bright."""
+    ranges = [150.0, 200.0, 300.0, 600.0, 1000.0, 2500.0]
+    extents: dict[float, list[float]] = defaultdict(list)
+    got = _brightest(RadarConfig(), 5.3, ranges, extents)
+    unseen = {r: got[r].count(0.0) for r in ranges[:-1] if got[r].count(0.0)}
     assert unseen == {}, f"boats unseen (of 12) by range: {unseen}"
+    assert got[2500.0].count(0.0) == 12, f"boats at 2.5 km seen: {got[2500.0]}"
+    for r in ranges[:-1]:
+        ratio = np.array(got[r]) / (BOAT_FACE_M2 * (1000.0 / r) ** 4)
+        assert ratio.min() > 0.6 and ratio.max() < 1.6, f"{r} m: brightest cells {np.round(ratio, 2)} × radar equation"
+        want = 1.2 + math.degrees(2.0 / r)
+        assert abs(float(np.median(extents[r])) - want) <= 360.0 / 2048, (r, np.median(extents[r]), want)
+
+
+def test_the_fan_alone_is_what_target_rays_0_gives() -> None:
+    """``target_rays = 0`` switches the aimed rays off: the fan's rays alone miss some of the boats at 200 m."""
+    got = _brightest(RadarConfig(target_rays=0), 5.3, [200.0])
+    assert got[200.0].count(0.0) >= 3, got
 
 
 # ------------------------------------------------------------------------------------ bins, noise, clutter geometry

@@ -430,6 +430,7 @@ class Radar:
         elevation_fan_rad: tuple[float, float],
         rays_az: int,
         rays_el: int,
+        target_rays: int,
         horizon_fraction: float,
         horizon_band_rad: float,
         detection_threshold: float,

@@ -660,6 +660,7 @@ def test_radar_sea_clutter_is_the_nrl_model() -> None:
         elevation_fan_rad=(math.radians(-10), math.radians(10)),
         rays_az=1,
         rays_el=1,
+        target_rays=0,
         horizon_fraction=0.0,
         horizon_band_rad=0.01,
         detection_threshold=0.0,

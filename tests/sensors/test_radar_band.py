@@ -50,6 +50,7 @@ def test_the_core_refuses_a_bad_band_too() -> None:
         "elevation_fan_rad": (-0.17, 0.17),
         "rays_az": 1,
         "rays_el": 4,
+        "target_rays": 0,
         "horizon_fraction": 0.0,
         "horizon_band_rad": 0.0,
         "detection_threshold": 0.3,

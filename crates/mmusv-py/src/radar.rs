@@ -28,7 +28,7 @@ impl Radar {
     #[new]
     #[pyo3(signature = (
         *, range_min_m, range_max_m, range_resolution_m, azimuth_bins, beamwidth_az_rad, elevation_fan_rad, rays_az,
-        rays_el, horizon_fraction, horizon_band_rad, detection_threshold, range_noise_std_m, sea_sigma0_at_1m,
+        rays_el, target_rays, horizon_fraction, horizon_band_rad, detection_threshold, range_noise_std_m, sea_sigma0_at_1m,
         critical_range_per_m, sea_max_range_m, rain_eta_at_1mm_h, frequency_ghz, polarisation
     ))]
     #[allow(clippy::too_many_arguments)]
@@ -41,6 +41,7 @@ impl Radar {
         elevation_fan_rad: (f64, f64),
         rays_az: u32,
         rays_el: u32,
+        target_rays: u32,
         horizon_fraction: f64,
         horizon_band_rad: f64,
         detection_threshold: f64,
@@ -61,6 +62,7 @@ impl Radar {
             elevation_fan_rad: [elevation_fan_rad.0, elevation_fan_rad.1],
             rays_az,
             rays_el,
+            target_rays,
             horizon_fraction,
             horizon_band_rad,
             detection_threshold,

@@ -83,6 +83,7 @@ def radar_from_config(cfg: RadarConfig) -> core.Radar:
         elevation_fan_rad=(math.radians(lo), math.radians(hi)),
         rays_az=cfg.rays_az,
         rays_el=cfg.rays_el,
+        target_rays=cfg.target_rays,
         horizon_fraction=cfg.horizon_fraction,
         horizon_band_rad=math.radians(cfg.horizon_band_deg),
         detection_threshold=cfg.detection_threshold,

@@ -40,6 +40,7 @@ fn cfg(frequency_ghz: f64, polarisation: Polarisation) -> RadarConfig {
         range_max_m: 1200.0,
         rays_az: 1,
         rays_el: 4,
+        target_rays: 16,
         detection_threshold: 0.0,
         clutter: ClutterModel { critical_range_per_m: 100_000.0, ..ClutterModel::tuning() },
         frequency_ghz,

@@ -236,6 +236,7 @@ fn physical_sea_clutter_follows_the_nrl_model() {
         azimuth_bins: 1024,
         range_max_m: 1200.0,
         rays_el: 8,
+        target_rays: 16,
         detection_threshold: 0.3,
         ..RadarConfig::tuning()
     };
@@ -301,6 +302,7 @@ fn a_target_above_the_horizon_follows_the_fan_pattern() {
         azimuth_bins: 1024,
         rays_az: 4,
         rays_el: 512,
+        target_rays: 16,
         elevation_fan_rad: [(-45f64).to_radians(), 45f64.to_radians()],
         horizon_fraction: 0.0,
         detection_threshold: 1e-12,

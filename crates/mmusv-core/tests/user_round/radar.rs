@@ -24,6 +24,7 @@ fn quiet_radar() -> RadarConfig {
         elevation_fan_rad: [(-10f64).to_radians(), 10f64.to_radians()],
         rays_az: 2,
         rays_el: 16,
+        target_rays: 16,
         horizon_fraction: 0.0,
         horizon_band_rad: 0.0,
         detection_threshold: 1e-9,

@@ -10,6 +10,8 @@ pub const MAX_AZIMUTH_BINS: u32 = 1 << 16;
 pub const MAX_RANGE_BINS: u64 = 1 << 20;
 /// Most rays per sweep (`azimuth_bins · rays_az · rays_el`).
 pub const MAX_RAYS: u64 = 1 << 24;
+/// Most rays cast at one target per beam spacing ([`RadarConfig::target_rays`]).
+pub const MAX_TARGET_RAYS: u32 = 1024;
 /// Largest `range_max_m`, metres.
 pub const MAX_RANGE_M: f64 = 100_000.0;
 /// Radar parameters. Angles in radians, distances in metres.
@@ -33,6 +35,9 @@ pub struct RadarConfig {
     pub rays_az: u32,
     /// Rays per beam over the elevation fan (`≥ 1`).
     pub rays_el: u32,
+    /// Rays cast straight at each target per beam spacing its angular box spans in azimuth (`0..=`
+    /// [`MAX_TARGET_RAYS`]; 0: none, the fan's rays alone), combined with the fan's without bias (`targets`).
+    pub target_rays: u32,
     /// Share of the elevation rays spread over the horizon band (`0..=1`; 0 = uniform over the fan).
     pub horizon_fraction: f64,
     /// Half-height of the horizon band, radians (`0..=π/4`).
@@ -65,6 +70,7 @@ impl RadarConfig {
             elevation_fan_rad: [(-10f64).to_radians(), 10f64.to_radians()],
             rays_az: 3,
             rays_el: 16,
+            target_rays: 16,
             horizon_fraction: 0.75,
             horizon_band_rad: 1.0f64.to_radians(),
             detection_threshold: 0.01,
@@ -166,6 +172,13 @@ impl RadarConfig {
                 "radar.rays_el",
                 self.rays_el,
                 format!("azimuth_bins · rays_az · rays_el = {} rays per sweep; at most {MAX_RAYS}", self.num_rays()),
+            ));
+        }
+        if self.target_rays > MAX_TARGET_RAYS {
+            return Err(MmusvError::config(
+                "radar.target_rays",
+                self.target_rays,
+                format!("must be in 0..={MAX_TARGET_RAYS} rays per target per beam spacing"),
             ));
         }
         nonneg("horizon_fraction", self.horizon_fraction, 1.0)?;

@@ -51,13 +51,9 @@ impl RadarConfig {
         self.beam_azimuth(b) + ((j as f64 + 0.5) / self.rays_az as f64 - 0.5) * self.beamwidth_az_rad
     }
 
-    /// Elevations (radians, sensor frame) and weights (the fan height in radians each ray stands for; they sum
-    /// to the fan height) of the `rays_el` rays of azimuth sample `g`, whose sea horizon lies at elevation
-    /// `horizon` (`None`: not in view). Written into `out` (length `rays_el`).
-    pub fn sample_elevations(&self, g: u32, horizon: Option<f64>, out: &mut [(f64, f64)]) {
+    /// The strata of the elevation fan of `k_all` rays whose sea horizon lies at `horizon` (`None`: not in view).
+    fn strata(&self, horizon: Option<f64>, k_all: usize) -> Strata {
         let [lo, hi] = self.elevation_fan_rad;
-        let k_all = out.len();
-        let offset = (g as f64 * GOLDEN).fract();
         let (b0, b1) = match horizon {
             Some(e) if self.horizon_fraction > 0.0 && self.horizon_band_rad > 0.0 => {
                 ((e - self.horizon_band_rad).max(lo), (e + self.horizon_band_rad).min(hi))
@@ -73,7 +69,16 @@ impl RadarConfig {
         } else {
             ((self.horizon_fraction * k_all as f64).round() as usize).min(k_all - 1)
         };
-        let k_rest = k_all - k_band;
+        Strata { lo, b0, b1, band, rest, k_band, k_rest: k_all - k_band }
+    }
+
+    /// Elevations (radians, sensor frame) and weights (the fan height in radians each ray stands for; they sum
+    /// to the fan height) of the `rays_el` rays of azimuth sample `g`, whose sea horizon lies at elevation
+    /// `horizon` (`None`: not in view). Written into `out` (length `rays_el`).
+    pub fn sample_elevations(&self, g: u32, horizon: Option<f64>, out: &mut [(f64, f64)]) {
+        let k_all = out.len();
+        let Strata { lo, b0, b1, band, rest, k_band, k_rest } = self.strata(horizon, k_all);
+        let offset = (g as f64 * GOLDEN).fract();
         for (k, slot) in out.iter_mut().enumerate() {
             *slot = if k < k_band {
                 (b0 + band * (k as f64 + offset) / k_band as f64, band / k_band as f64)
@@ -85,6 +90,21 @@ impl RadarConfig {
                 // A zero-height fan: every ray at the one elevation, sharing one beamwidth of height.
                 (lo, self.fan_height() / k_all as f64)
             };
+        }
+    }
+
+    /// The fan height (radians) of the elevation stratum that holds elevation `e` for an azimuth sample whose sea
+    /// horizon lies at `horizon`: the weight [`RadarConfig::sample_elevations`] gives a ray there, the inverse of
+    /// the fan's density of rays at `e` (`targets`).
+    pub(super) fn stratum_height(&self, horizon: Option<f64>, e: f64) -> f64 {
+        let k_all = self.rays_el as usize;
+        let Strata { b0, b1, band, rest, k_band, k_rest, .. } = self.strata(horizon, k_all);
+        if k_band > 0 && (e >= b0 && e <= b1 || rest <= 0.0) {
+            band / k_band as f64
+        } else if rest > 0.0 {
+            rest / k_rest as f64
+        } else {
+            self.fan_height() / k_all as f64
         }
     }
 
@@ -112,6 +132,18 @@ impl RadarConfig {
             antenna_height,
         }
     }
+}
+
+/// The elevation fan's strata: `k_band` rays over the horizon band `[b0, b1]` (height `band`), `k_rest` over the
+/// rest of the fan from `lo` (height `rest`).
+struct Strata {
+    lo: f64,
+    b0: f64,
+    b1: f64,
+    band: f64,
+    rest: f64,
+    k_band: usize,
+    k_rest: usize,
 }
 
 /// Elevation (sensor frame, radians) at which the world's horizontal plane through the sensor cuts azimuth
