@@ -192,12 +192,21 @@ pub(super) fn target_rays(scene: &Scene, cfg: &RadarConfig, sensor_to_world: &Ri
             continue;
         }
         let spans = ((width / spacing).ceil() as u32).clamp(1, MAX_SPANS);
-        let n = cfg.target_rays * spans;
-        // A grid about as fine in azimuth as in elevation.
-        let n_az = (((f64::from(n) * width / (e1 - e0).max(1e-9)).sqrt().round()) as u32).clamp(1, n);
-        let n_el = (n / n_az).max(1);
-        boxes.push(TargetBox { a0, width, e0, e1, n_az, n_el });
+        boxes.push((TargetBox { a0, width, e0, e1, n_az: 0, n_el: 0 }, cfg.target_rays * spans));
     }
+    // Never more aimed rays than the fan has (a scene of very many objects): each object's share scaled down.
+    let total: u64 = boxes.iter().map(|b| u64::from(b.1)).sum();
+    let cap = cfg.num_rays().max(1);
+    let boxes: Vec<TargetBox> = boxes
+        .into_iter()
+        .map(|(mut b, n)| {
+            let n = if total > cap { ((u64::from(n) * cap / total) as u32).max(1) } else { n };
+            // A grid about as fine in azimuth as in elevation.
+            b.n_az = (((f64::from(n) * b.width / (b.e1 - b.e0).max(1e-9)).sqrt().round()) as u32).clamp(1, n);
+            b.n_el = (n / b.n_az).max(1);
+            b
+        })
+        .collect();
     let mut rays = Vec::new();
     for b in &boxes {
         for i in 0..b.n_az {
@@ -277,5 +286,57 @@ mod tests {
         assert_eq!(sorted, vec![0, 1, 2, 358, 359]);
         let mid: Vec<usize> = t.within(90f64.to_radians(), 1.5f64.to_radians()).collect();
         assert_eq!(mid, vec![89, 90, 91]);
+    }
+
+    fn cubes(n: usize, range: f64, half: f32) -> Scene {
+        let mut s = Scene::new();
+        let cube = s.add_mesh(crate::scene::tests::box_mesh([half, half, half], 10));
+        for k in 0..n {
+            let b = std::f64::consts::TAU * k as f64 / n as f64;
+            let pose = RigidPose::from_xyz_rpy([range * b.cos(), range * b.sin(), f64::from(half) - 0.5], [0.0; 3]);
+            let _ = s.add_instance(cube, pose, None);
+        }
+        s
+    }
+
+    /// So many objects that their rays would outnumber the fan's: each one's share is scaled down.
+    #[test]
+    fn aimed_rays_never_outnumber_the_fan() {
+        let cfg = RadarConfig { azimuth_bins: 64, rays_az: 1, rays_el: 16, ..RadarConfig::tuning() };
+        let s = cubes(300, 500.0, 1.0);
+        let pose = RigidPose::from_xyz_rpy([0.0, 0.0, 5.0], [0.0; 3]);
+        let t = target_rays(&s, &cfg, &pose);
+        assert_eq!(t.boxes.len(), 300);
+        assert!(t.rays.len() as u64 <= cfg.num_rays(), "{} aimed rays for a fan of {}", t.rays.len(), cfg.num_rays());
+        assert!(t.boxes.iter().all(|b| b.n_az * b.n_el >= 1));
+        let none = target_rays(&s, &RadarConfig { target_rays: 0, ..cfg }, &pose);
+        assert!(none.rays.is_empty() && none.boxes.is_empty());
+    }
+
+    /// Unbiased: the echo of 60 cubes of 4 m at 700 m, summed over the sweep, is the same with the aimed rays (the
+    /// default fan, 16 aimed rays) as with a fan dense enough to need none (8 × 256 rays a beam), within 3 %
+    /// (measured: 6,823 against 6,861; 6,899 with 16 × 1,024; over 6 cubes the fan's fixed azimuths alone scatter
+    /// the sum by 15 %, so the test takes many).
+    #[test]
+    fn aimed_rays_keep_the_echo_unbiased() {
+        let s = cubes(60, 700.0, 2.0);
+        let pose = RigidPose::from_xyz_rpy([0.0, 0.0, 5.0], [0.0; 3]);
+        let env = crate::sensors::radar::RadarEnv { wave_height_m: 0.0, rain_mm_per_h: 0.0 };
+        let quiet = RadarConfig { detection_threshold: 1e-9, azimuth_bins: 512, ..RadarConfig::tuning() };
+        let off = crate::sensors::radar_model::ClutterModel {
+            sea_sigma0_at_1m: 0.0,
+            critical_range_per_m: 0.0,
+            sea_max_range_m: 0.0,
+            rain_eta_at_1mm_h: 0.0,
+        };
+        let quiet = RadarConfig { clutter: off, ..quiet };
+        let total = |cfg: &RadarConfig| -> f64 {
+            let r = crate::sensors::radar::radar_sweep(&s, &pose, cfg, &env, 0).unwrap_or_else(|e| unreachable!("{e}"));
+            r.intensity.iter().zip(&r.instance).filter(|(_, &i)| i >= 0).map(|(&p, _)| f64::from(p)).sum()
+        };
+        let dense = total(&RadarConfig { rays_az: 8, rays_el: 256, target_rays: 0, ..quiet });
+        let aimed = total(&quiet);
+        assert!(dense > 0.0);
+        assert!((aimed / dense - 1.0).abs() < 0.03, "aimed {aimed} against dense {dense}");
     }
 }
