@@ -16,6 +16,10 @@ rate ``vz`` is part of it, so a vessel sailing at ``speed_mps`` shows a little m
 (0.4 m/s for a 9 m/s speedboat at W2); the speed over ground is ``hypot(vx, vy)`` of the world state (=
 ``speed_mps`` under way).
 
+``data_protocol.yaml``: OpenCDA's ``world`` and ``vehicle_base`` (one LiDAR for every CAV: the first agent's, as
+CARLA's attributes ``channels``, ``range``, ``upper_fov``, ...), and under ``mmusv`` the source, ``cavs`` and
+``lidars``, each agent's LiDAR by ``cav_id`` (the conversion's notes say when they differ).
+
 Files beyond stock OPV2V, which stock loaders skip: ``<ts>_additional.yaml`` (our names, classes and LiDAR point
 counts of the listed vehicles), ``<ts>_depth{i}.png`` (HEAL's OPV2V-H depth: 8-bit grayscale, whole metres
 along the optical axis, 255 = no hit or 254.5 m and farther; :func:`heal_depth_png`), ``<ts>_depth_cm{i}.png`` (the
@@ -95,6 +99,31 @@ def _fov(lidar: dict[str, Any]) -> list[Any]:
     return list(lidar.get("vertical_fov_deg") or [None, None])
 
 
+def _lidar_protocol(lidar: dict[str, Any]) -> dict[str, Any]:
+    """OpenCDA's ``lidar`` entry of ``data_protocol.yaml`` (CARLA's LiDAR attributes) for a recorded rig's LiDAR
+    (``{}``: every value ``None``)."""
+    lower, upper = _fov(lidar)  # degrees
+    return {
+        "channels": lidar.get("channels"),
+        "range": lidar.get("range_m"),
+        "points_per_second": lidar.get("points_per_second"),
+        "rotation_frequency": lidar.get("rotation_hz"),
+        "upper_fov": upper,
+        "lower_fov": lower,
+        "noise_stddev": lidar.get("range_noise_std_m"),
+        "dropoff_general_rate": lidar.get("dropout"),
+    }
+
+
+def _lidar_summary(p: dict[str, Any]) -> str:
+    """One :func:`_lidar_protocol` entry in a few words, for a note (``?`` for a value the rig lacks)."""
+    g = {k: "?" if v is None else f"{v:g}" for k, v in p.items()}
+    return (
+        f"{g['channels']} channels over {g['lower_fov']}..{g['upper_fov']} degrees, "
+        f"{g['points_per_second']} points/s at {g['rotation_frequency']} Hz, {g['range']} m"
+    )
+
+
 def timestamp(frame: int) -> str:
     """The OPV2V timestamp of acquisition index ``frame`` (6 digits, zero-padded)."""
     return f"{frame:06d}"
@@ -132,6 +161,18 @@ class Opv2vWriter(DatasetWriter):
             other = sorted(set(a.cameras) - set(self.cameras))
             if other:
                 self.notes.append(f"agent {a.id}: cameras {other} have no OPV2V slot and are left out")
+        lidars = self.lidars()
+        if len({tuple(v.items()) for v in lidars.values()}) > 1:
+            # OPV2V's data_protocol.yaml has one vehicle_base for every CAV: it gave the first agent's LiDAR as
+            # every agent's, without a word, where a rig of another agent fired another pattern.
+            ids = {cav_id(a.index): a.id for a in self.agents}
+            first = next(iter(lidars))
+            each = "; ".join(f"{ids[c]}: {_lidar_summary(v)}" for c, v in lidars.items())
+            self.notes.append(
+                f"the agents' LiDARs differ ({each}): "
+                f"data_protocol.yaml's vehicle_base, one LiDAR for every CAV, describes {ids[first]}'s (cav {first}); "
+                "mmusv.lidars there gives each agent's"
+            )
 
     @classmethod
     def start(cls, out: Path, options: Any, sink: Any) -> HypesStats:
@@ -274,6 +315,11 @@ class Opv2vWriter(DatasetWriter):
             }
         }
 
+    def lidars(self) -> dict[int, dict[str, Any]]:
+        """Each converted agent's LiDAR as OpenCDA's ``lidar`` entry (:func:`_lidar_protocol`), keyed by its
+        ``cav_id``: ``data_protocol.yaml``'s ``mmusv.lidars``; its ``vehicle_base`` gives the first one's."""
+        return {cav_id(a.index): _lidar_protocol(a.rig["lidar"]) for a in self.agents if a.rig.get("lidar")}
+
     def _static(self, t: Target) -> bool:
         """The vessel never travels (it rides the waves): a moored ship, or a scenario vessel at speed 0
         (``VesselConfig.static``)."""
@@ -290,8 +336,7 @@ class Opv2vWriter(DatasetWriter):
         if not frames:
             return
         info, o = self.info, self.options
-        lidar = next((a.rig.get("lidar") for a in self.agents if a.rig.get("lidar")), None) or {}
-        fov = _fov(lidar)  # [lower, upper] degrees
+        lidars = self.lidars()
         acq = info.scenario.get("acquisition", {})
         # The OPV2V cameras (camera0..3) some agent writes, by index: none for a LiDAR-only rig.
         indices = {i: n for a in self.agents for n, i in self.agent_cameras(a)}
@@ -308,16 +353,7 @@ class Opv2vWriter(DatasetWriter):
             "vehicle_base": {
                 "sensing": {
                     "perception": {
-                        "lidar": {
-                            "channels": lidar.get("channels"),
-                            "range": lidar.get("range_m"),
-                            "points_per_second": lidar.get("points_per_second"),
-                            "rotation_frequency": lidar.get("rotation_hz"),
-                            "upper_fov": fov[1],
-                            "lower_fov": fov[0],
-                            "noise_stddev": lidar.get("range_noise_std_m"),
-                            "dropoff_general_rate": lidar.get("dropout"),
-                        },
+                        "lidar": dict(next(iter(lidars.values()), _lidar_protocol({}))),  # a copy: no YAML alias
                         "camera": {"num": len(written), "order": written},
                     }
                 }
@@ -331,6 +367,7 @@ class Opv2vWriter(DatasetWriter):
                 "poses [x, y, z, roll, yaw, pitch]; mmusv's right-handed frames (world x east, y north, z up; "
                 "body x forward, y left, z up) with y mirrored",
                 "cavs": {cav_id(a.index): a.id for a in self.agents},
+                "lidars": lidars,
                 "eval_range_m": o.eval_range_m,
                 "gt_filter": "vehicles: every vessel whose box centre has hypot(x, y) <= eval_range_m "
                 "in the agent's LiDAR frame; the agent itself never, other USVs only if include_usvs",
