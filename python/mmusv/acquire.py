@@ -49,7 +49,7 @@ from mmusv.run_folder import (
     write_failure,
     writes_into,
 )
-from mmusv.scenario_checks import check_mounts, check_routes, check_sensors
+from mmusv.scenario_checks import check_lidar_water, check_mounts, check_routes, check_sensors
 from mmusv.simulation import FrameCapture, Simulation
 
 __all__ = ["TABLE_PART_FRAMES", "RunResult", "recording_path", "run"]
@@ -237,6 +237,7 @@ def run(
     check_sensors(scenario, source=source)  # not a check of the map: said with or without checks
     if checks:
         check_mounts(scenario, source=source)
+        check_lidar_water(scenario, source=source)
         # The routes as far as this run sails them: frames 0 .. total - 1 (the stop of a frame range).
         upto = scenario.acquisition.model_copy(update={"frames": total})
         check_routes(scenario.model_copy(update={"acquisition": upto}), sim.world, source=source)

@@ -8,6 +8,8 @@ only its inside); ``shore_clearance``, ``structure_clearance`` and ``separation`
 what a user wants). ``mmusv run --no-checks`` and ``mmusv.run(..., checks=False)`` skip them.
 
 :func:`check_mounts` warns about sensor mounts far from their hull (a units mistake: millimetres for metres).
+:func:`check_lidar_water` warns about a LiDAR's flat-sea water knobs (``water_probability`` and the three others of
+:class:`~mmusv.sensors.config.LidarConfig`) set on the physical sea, where they change nothing.
 :func:`check_sensors` warns about a scenario that records no sensor at all: no vessel with ``role: usv``, or USVs
 whose rigs switch every sensor off (``preset: lidar_only`` with ``lidar: null``); such a run records the world state
 and the boxes only, which may be meant (ground-truth trajectories), so it is a warning.
@@ -39,10 +41,12 @@ if TYPE_CHECKING:
     from mmusv.world.maps import MapWorld
 
 __all__ = [
+    "LIDAR_WATER_KNOBS",
     "MOUNT_WARN_FACTOR",
     "SHARP_TURN_RATIO",
     "MapFinding",
     "MmusvWarning",
+    "check_lidar_water",
     "check_mounts",
     "check_routes",
     "check_sensors",
@@ -289,6 +293,40 @@ def check_mounts(scenario: Scenario, *, source: str) -> list[str]:
                 found.append(
                     f"{source}: {where} (vessel {v.id}) is {dist:.0f} m from the {asset.name} hull; xyz is in metres"
                 )
+    for w in found:
+        warnings.warn(w, MmusvWarning, stacklevel=2)
+    return found
+
+
+LIDAR_WATER_KNOBS = ("water_probability", "water_probability_per_wave_m", "water_range_m", "water_range_per_wave_m")
+"""The :class:`~mmusv.sensors.config.LidarConfig` fields of the flat sea's empirical water returns."""
+
+
+def check_lidar_water(scenario: Scenario, *, source: str) -> list[str]:
+    """Warns (and returns the warnings) for every rig of a USV whose LiDAR sets one of :data:`LIDAR_WATER_KNOBS` to
+    other than its default in a scenario on the physical sea (``environment.motion: physical``, the default): they
+    are the flat sea's empirical rule (``motion: paper``), and over the physical sea the water returns follow the
+    physical model (``sensors/lidar_water.rs``) whatever they are, so ``water_probability: 0`` there still records
+    water returns. Before, such a setting was ignored without a word."""
+    from mmusv.sensors.config import LidarConfig
+
+    found: list[str] = []
+    if scenario.environment.motion != "physical":
+        return found
+    for name in sorted({v.rig for v in scenario.vessels if v.role == "usv" and v.rig is not None}):
+        lidar = scenario.rigs[name].lidar
+        if lidar is None:
+            continue
+        given = [(k, getattr(lidar, k)) for k in LIDAR_WATER_KNOBS]
+        given = [(k, v) for k, v in given if v != LidarConfig.model_fields[k].default]
+        if given:
+            values = ", ".join(f"{k} = {v:g}" for k, v in given)
+            it = ("it is", "changes") if len(given) == 1 else ("they are", "change")
+            found.append(
+                f"{source}: rigs.{name}.lidar: {values} {it[1]} nothing: {it[0]} the flat sea's water rule "
+                "(environment.motion: paper), and on the physical sea (motion: physical, the default) the LiDAR's "
+                "water returns follow the physical model (wave facets, whitecaps, wake foam)"
+            )
     for w in found:
         warnings.warn(w, MmusvWarning, stacklevel=2)
     return found

@@ -133,12 +133,31 @@ class Mount(_Model):
 
 
 class LidarConfig(_Model):
-    """Spinning LiDAR. Columns per sweep = ``points_per_second / (rotation_hz · channels)`` (rounded).
+    """Spinning LiDAR. Columns per sweep = ``points_per_second / (rotation_hz · channels)`` (rounded, a half to
+    the even number), column ``a`` at azimuth ``2π a / columns`` counter-clockwise from +x (the bow at the default
+    mounts); ring ``i`` fires at ``elevations_deg[i]``, or uniformly over ``vertical_fov_deg`` from its lower end
+    (ring 0) to its upper (one channel: its middle). At the defaults: 410 columns 0.88° apart, 64 rings 0.63° apart
+    from −25° to 15°, 26,240 rays a sweep. No real sensor's pattern is the default; ``elevations_deg`` gives one.
 
     ``elevations_deg`` (one per channel, any order) replaces the uniform ``vertical_fov_deg`` pattern (given both,
     ``vertical_fov_deg`` must be the rings' span ``[min, max]``, or its default).
-    Water returns: probability ``water_probability + water_probability_per_wave_m · H`` within
-    ``water_range_m + water_range_per_wave_m · H`` metres (H the wave height).
+
+    A sweep is one instant: every ray of a frame's sweep meets the scene frozen at the frame's time (the vessels,
+    the waves and the LiDAR's own pose), so the points carry no motion distortion (no rolling shutter: a real 5 Hz
+    LiDAR on a USV at 5 m/s moves 1 m during its sweep) and need no de-skewing, and no time per point is
+    recorded. ``rotation_hz`` sets the columns per sweep only: each frame (``acquisition.frequency_hz``) records
+    one whole sweep whatever it is.
+
+    Points on the USV's own hull are kept (their ``instance`` is the USV's ``instance_id``, their class
+    ``usv``): the assets' ``lidar`` mount points see none of it (``tests/sensors/test_own_hull.py``), a mount
+    lower on the hull may (on the patrol boat's deck 3 m below its ``lidar`` point, 4 of 5 points).
+
+    Water returns on the flat sea (``environment.motion: paper``, or a simulation without its wave surface):
+    probability ``water_probability + water_probability_per_wave_m · H`` within ``water_range_m +
+    water_range_per_wave_m · H`` metres (H the wave height). On the physical sea (``motion: physical``, the default)
+    these four change nothing: the water returns follow the physical model (glints off the wave facets,
+    whitecaps, the wakes' foam; ``sensors/lidar_water.rs``), and ``mmusv run`` warns about them
+    (:func:`mmusv.scenario_checks.check_lidar_water`).
     """
 
     channels: int = Field(default=64, ge=1, le=1024)
@@ -168,7 +187,11 @@ class LidarConfig(_Model):
     def _check(self) -> LidarConfig:
         if self.elevations_deg is not None:
             if len(self.elevations_deg) != self.channels:
-                raise ValueError(f"elevations_deg has {len(self.elevations_deg)} entries for {self.channels} channels")
+                n = len(self.elevations_deg)
+                raise ValueError(
+                    f"elevations_deg has {n} entries for {self.channels} channels: give one elevation per channel "
+                    f"(channels: {n} with these)"
+                )
             if not all(-90 < e < 90 for e in self.elevations_deg):
                 raise ValueError("every elevation must be strictly between -90 and 90 degrees")
             if len(set(self.elevations_deg)) != len(self.elevations_deg):

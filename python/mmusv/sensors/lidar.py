@@ -1,8 +1,9 @@
 """The spinning LiDAR from Python: build it from a :class:`~mmusv.sensors.config.LidarConfig`, scan a scene.
 
 Points are in the LiDAR frame (x forward, y left, z up, metres), in pattern order (azimuth column, then ring),
-rays without a return left out. See ``mmusv_core::sensors::lidar`` for the return, noise, water and weather
-model.
+rays without a return left out. A sweep is one instant: every ray meets the scene as it is at ``pose`` (no
+motion distortion; :class:`~mmusv.sensors.config.LidarConfig`). See ``mmusv_core::sensors::lidar`` for the
+return, noise, water and weather model.
 """
 
 from __future__ import annotations
