@@ -148,6 +148,10 @@ class LidarConfig(_Model):
     recorded. ``rotation_hz`` sets the columns per sweep only: each frame (``acquisition.frequency_hz``) records
     one whole sweep whatever it is.
 
+    One return per ray: the first surface the ray meets, a ray being a line (no beam divergence: a part thinner
+    than the gap between rays, a railing, is met or missed whole; no second or last return). Fog and rain only
+    lose returns (two-way transmission); they add no points of their own (no backscatter from drops or fog).
+
     Points on the USV's own hull are kept (their ``instance`` is the USV's ``instance_id``, their class
     ``usv``): the assets' ``lidar`` mount points see none of it (``tests/sensors/test_own_hull.py``), a mount
     lower on the hull may (on the patrol boat's deck 3 m below its ``lidar`` point, 4 of 5 points).

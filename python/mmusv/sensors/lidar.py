@@ -31,7 +31,9 @@ class LidarPoints:
     Attributes:
         xyz: ``(N, 3)`` float32, metres, LiDAR frame.
         range: ``(N,)`` float32, measured range in metres (noise included).
-        intensity: ``(N,)`` float32 in [0, 1].
+        intensity: ``(N,)`` float32 in [0, 1]: ``ρ(class) · |cos θ| · τ / (1 + (r / 100 m)²)`` (θ the incidence, τ
+            the two-way transmission), the project's own law, neither a raw power nor a calibrated reflectivity;
+            over the physical sea a water return's is its speckle draw (``mmusv_core::sensors::lidar``).
         ring: ``(N,)`` uint16 channel index.
         azimuth: ``(N,)`` float32 radians in [0, 2π), counter-clockwise from +x.
         semantic_class: ``(N,)`` uint16 class of the surface hit (:mod:`mmusv.classes`).
