@@ -24,8 +24,10 @@ Checked and right, no change:
   the mount's inverse. The recording's ``foxglove.PointCloud`` (decoded by ``mcap-protobuf-support``) is the
   capture in the LiDAR frame (its ``pose`` unset: the identity, now said in ``docs/recording.md``), its ``/tf`` the
   body and the mount. Outside the tests: SemanticKITTI's ``poses.txt`` under a front camera turned 5°/−8° is
-  ``Tr · L₀⁻¹ L_k · Tr⁻¹`` (10⁻⁷), fog and rain drop returns as ``exp(−2 (3 / V + 10⁻⁵ R^0.6) r)`` (437 kept of
-  432 ± 15 at 300 m visibility), and one and two core threads write the same bytes.
+  ``Tr · L₀⁻¹ L_k · Tr⁻¹`` (10⁻⁷), KITTI tracking's ``oxts`` through pykitti's Mercator and ``Tr_imu_velo⁻¹``
+  is its ``pose`` file but the first altitude (rotation 6·10⁻⁸), fog and rain drop returns as
+  ``exp(−2 (3 / V + 10⁻⁵ R^0.6) r)`` (437 kept of 432 ± 15 at 300 m visibility), and one and two core threads
+  write the same bytes.
 * A sweep is one instant (the core's promise): the RIB's points sit in its box at the frame's time, and lie up to
   0.45-0.78 m outside it moved by half a sweep (±0.1 s, 0.8 m). Same seed, same bytes (recording and exports).
 * Bad LiDAR values in a scenario file name the file, the field and what is allowed.
