@@ -7,9 +7,10 @@ Checked and right, no change:
 
 * The pattern: 64 rings uniform over −25°..15° (0.635° apart, ring 0 the lowest), 410 columns (0.878° apart,
   column ``a`` at ``2π a / 410`` from +x, counter-clockwise), 26,240 rays a sweep; ``ring`` = ``ray_index % 64``.
-  The project claims no real sensor's pattern (no Velodyne HDL-64E, whose rings span +2°..−24.9°, nor Ouster
-  OS1-64, ±22.5° in its current version); an OS1-64-like one is ``channels: 64``, ``vertical_fov_deg: [-22.5,
-  22.5]``, ``points_per_second: 655360``, ``rotation_hz: 10`` (1024 columns).
+  The project claims no real sensor's pattern (not Velodyne's HDL-64E, rings +2°..−24.9°, nor Ouster's OS1-64,
+  33.2° of vertical field in its first generation, 42.4° in later revisions, uniform); an OS1-64-like one is
+  ``channels: 64``, ``vertical_fov_deg: [-21.2, 21.2]``, ``points_per_second: 655360``, ``rotation_hz: 10``
+  (1024 columns).
 * Geometry on a rolled, pitched and yawed box under a tilted LiDAR: the rays that return are exactly those the slab
   test says meet the box within range; ranges to 3·10⁻⁵ m, every point on a face (2.8·10⁻⁶ m); the intensity is
   ``ρ · |cos θ| / (1 + (r / 100 m)²)`` to 1.3·10⁻⁷; range noise of σ = 5 cm measures 0.0501 m (mean 0.5 mm, 2,235
@@ -92,7 +93,7 @@ def test_the_default_pattern_is_the_documented_one() -> None:
     np.testing.assert_allclose(pts.azimuth, 2 * np.pi * column / 410, atol=1e-6)
     np.testing.assert_allclose(np.arctan2(xyz[:, 1], xyz[:, 0]) % (2 * np.pi), pts.azimuth, atol=1e-5)
     # An OS1-64-like pattern: 1024 columns at 10 Hz.
-    assert LidarConfig(vertical_fov_deg=(-22.5, 22.5), points_per_second=655_360, rotation_hz=10).azimuth_steps == 1024
+    assert LidarConfig(vertical_fov_deg=(-21.2, 21.2), points_per_second=655_360, rotation_hz=10).azimuth_steps == 1024
 
 
 # ------------------------------------------------------------------------------------------------ geometry
