@@ -39,9 +39,10 @@ Found by the round (each test below failed before its fix):
   second USV has a 32-channel, 10 Hz, 120 m LiDAR was written as all 64-channel, 5 Hz, 200 m, without a word.
   ``mmusv.lidars`` now gives each agent's (by ``cav_id``), and a note says when they differ.
 * The LiDAR's four water knobs (``water_probability`` …) are the flat sea's empirical rule only: on the physical
-  sea, the default, ``water_probability: 0`` records as many water returns as any other value (830 in a frame at
-  W0 behind a USV under way, 8,343 at W2). ``mmusv run`` now warns; ``LidarConfig`` says so (it gave the rule as
-  the rule). Turning the physical water returns off with them is the core's (``sensors/lidar.rs``).
+  sea, the default, ``water_probability: 0`` recorded as many water returns as any other value (830 in a frame at
+  W0 behind a USV under way, 8,343 at W2), and no setting gave a LiDAR without water returns. Both probabilities 0
+  now switch them off on either sea (the core, ``sensors/lidar.rs``); ``mmusv run`` warns about the other settings
+  on the physical sea, which change nothing there; ``LidarConfig`` says so (it gave the rule as the rule).
 * Undocumented, now in ``LidarConfig``: the sweep is one instant (no motion distortion, no time per point, one
   sweep per frame whatever ``rotation_hz``), and points on the USV's own hull are kept (a LiDAR on the patrol
   boat's deck 3 m below its ``lidar`` point: 5,706 of 7,006 points on the own hull).
@@ -609,9 +610,11 @@ def test_opv2v_protocol_gives_each_agents_lidar(tmp_path: Path) -> None:
 
 
 def test_the_flat_sea_water_knobs_on_the_physical_sea_are_warned_about(tmp_path: Path) -> None:
-    """``water_probability: 0`` (and its three siblings) change nothing on the physical sea: the same water returns
-    come in a frame as at the defaults. ``mmusv run`` warns, once per rig, naming the file, the rig and the values;
-    at ``motion: paper``, where they act, and at the defaults (a run's resolved ``scenario.yaml``) it does not."""
+    """Both water probabilities 0 switch the water returns off, on the physical sea too (before, the same water
+    returns came as at the defaults: no setting gave a LiDAR without them); ``water_probability: 0`` alone, or the
+    ranges, change nothing on the physical sea. ``mmusv run`` warns about those, once per rig, naming the file,
+    the rig and the values; at ``motion: paper``, where they act, with the water switched off, and at the
+    defaults (a run's resolved ``scenario.yaml``) it does not."""
     from mmusv import run
     from mmusv.scenario_checks import MmusvWarning
 
@@ -619,37 +622,44 @@ def test_the_flat_sea_water_knobs_on_the_physical_sea_are_warned_about(tmp_path:
     sc["environment"] = {"wave": "W1"}
     sc["vessels"] = sc["vessels"][:2]
     off = {"water_probability": 0.0, "water_probability_per_wave_m": 0.0}
+    half = {"water_probability": 0.0, "water_range_m": 5.0}
     counts = {}
     for motion in ("physical", "paper"):
-        for knobs in ({}, off):
+        for name, knobs in (("default", {}), ("off", off), ("half", half)):
             s = copy.deepcopy(sc)
             s["environment"]["motion"] = motion
             s["rigs"]["r"]["lidar"] = dict(knobs)
             pts = Simulation(s).capture(0).agents["u"].lidar
-            counts[motion, bool(knobs)] = int((pts.semantic_class == 1).sum())
-    assert counts["physical", True] == counts["physical", False] > 500
-    assert counts["paper", False] > 100 and counts["paper", True] == 0
+            counts[motion, name] = int((pts.semantic_class == 1).sum())
+    assert counts["physical", "default"] == counts["physical", "half"] > 500
+    assert counts["physical", "off"] == 0
+    assert counts["paper", "default"] > 100 and counts["paper", "off"] == 0
+    assert counts["paper", "half"] != counts["paper", "default"]
 
     path = tmp_path / "knobs.yaml"
     s = copy.deepcopy(sc)
-    s["rigs"]["r"]["lidar"] = off
+    s["rigs"]["r"]["lidar"] = half
     path.write_text(yaml.safe_dump(s))
     with pytest.warns(MmusvWarning) as got:
         run(path, out_dir=tmp_path / "run", frames=1)
     said = [str(w.message) for w in got if "water rule" in str(w.message)]
     assert said == [
-        f"{path}: rigs.r.lidar: water_probability = 0, water_probability_per_wave_m = 0 change nothing: they are "
-        "the flat sea's water rule (environment.motion: paper), and on the physical sea (motion: physical, the "
-        "default) the LiDAR's water returns follow the physical model (wave facets, whitecaps, wake foam)"
+        f"{path}: rigs.r.lidar: water_probability = 0, water_range_m = 5 change nothing: they are the flat sea's "
+        "water rule (environment.motion: paper), and on the physical sea (motion: physical, the default) the "
+        "LiDAR's water returns follow the physical model (wave facets, whitecaps, wake foam); water_probability "
+        "and water_probability_per_wave_m both 0 switch them off"
     ]
-    # Quiet where they act (motion: paper), and at the defaults, spelled out in a run's resolved scenario.yaml.
+    # Quiet where they act (motion: paper; the water switched off), and at the defaults, spelled out in a run's
+    # resolved scenario.yaml.
     paper = tmp_path / "paper.yaml"
     paper.write_text(yaml.safe_dump({**s, "environment": {**s["environment"], "motion": "paper"}}))
+    dry = tmp_path / "dry.yaml"
+    dry.write_text(yaml.safe_dump({**s, "rigs": {"r": {"lidar": {**off, "water_range_m": 5.0}}}}))
     plain = tmp_path / "plain.yaml"
     plain.write_text(yaml.safe_dump(sc))
-    for i, quiet in enumerate((paper, plain, tmp_path / "quiet_1" / "scenario.yaml")):
+    for i, quiet in enumerate((paper, dry, plain, tmp_path / "quiet_2" / "scenario.yaml")):
         with warnings.catch_warnings(record=True) as seen:
             warnings.simplefilter("always")
             run(quiet, out_dir=tmp_path / f"quiet_{i}", frames=1)
         assert not [w for w in seen if "water rule" in str(w.message)], quiet
-    assert "water_probability: 0.05" in (tmp_path / "quiet_1" / "scenario.yaml").read_text()
+    assert "water_probability: 0.05" in (tmp_path / "quiet_2" / "scenario.yaml").read_text()

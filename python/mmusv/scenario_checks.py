@@ -9,7 +9,8 @@ what a user wants). ``mmusv run --no-checks`` and ``mmusv.run(..., checks=False)
 
 :func:`check_mounts` warns about sensor mounts far from their hull (a units mistake: millimetres for metres).
 :func:`check_lidar_water` warns about a LiDAR's flat-sea water knobs (``water_probability`` and the three others of
-:class:`~mmusv.sensors.config.LidarConfig`) set on the physical sea, where they change nothing.
+:class:`~mmusv.sensors.config.LidarConfig`) set on the physical sea, where they change nothing but for both
+probabilities 0, which switch the water returns off.
 :func:`check_sensors` warns about a scenario that records no sensor at all: no vessel with ``role: usv``, or USVs
 whose rigs switch every sensor off (``preset: lidar_only`` with ``lidar: null``); such a run records the world state
 and the boxes only, which may be meant (ground-truth trajectories), so it is a warning.
@@ -306,8 +307,9 @@ def check_lidar_water(scenario: Scenario, *, source: str) -> list[str]:
     """Warns (and returns the warnings) for every rig of a USV whose LiDAR sets one of :data:`LIDAR_WATER_KNOBS` to
     other than its default in a scenario on the physical sea (``environment.motion: physical``, the default): they
     are the flat sea's empirical rule (``motion: paper``), and over the physical sea the water returns follow the
-    physical model (``sensors/lidar_water.rs``) whatever they are, so ``water_probability: 0`` there still records
-    water returns. Before, such a setting was ignored without a word."""
+    physical model (``sensors/lidar_water.rs``) whatever they are, but for ``water_probability`` and
+    ``water_probability_per_wave_m`` both 0, which switch the water returns off on either sea (no warning then).
+    Before, such a setting was ignored without a word."""
     from mmusv.sensors.config import LidarConfig
 
     found: list[str] = []
@@ -319,13 +321,16 @@ def check_lidar_water(scenario: Scenario, *, source: str) -> list[str]:
             continue
         given = [(k, getattr(lidar, k)) for k in LIDAR_WATER_KNOBS]
         given = [(k, v) for k, v in given if v != LidarConfig.model_fields[k].default]
+        if lidar.water_probability == 0 and lidar.water_probability_per_wave_m == 0:
+            continue  # no water returns on either sea: the ranges do not matter
         if given:
             values = ", ".join(f"{k} = {v:g}" for k, v in given)
             it = ("it is", "changes") if len(given) == 1 else ("they are", "change")
             found.append(
                 f"{source}: rigs.{name}.lidar: {values} {it[1]} nothing: {it[0]} the flat sea's water rule "
                 "(environment.motion: paper), and on the physical sea (motion: physical, the default) the LiDAR's "
-                "water returns follow the physical model (wave facets, whitecaps, wake foam)"
+                "water returns follow the physical model (wave facets, whitecaps, wake foam); water_probability "
+                "and water_probability_per_wave_m both 0 switch them off"
             )
     for w in found:
         warnings.warn(w, MmusvWarning, stacklevel=2)

@@ -159,9 +159,11 @@ class LidarConfig(_Model):
     Water returns on the flat sea (``environment.motion: paper``, or a simulation without its wave surface):
     probability ``water_probability + water_probability_per_wave_m · H`` within ``water_range_m +
     water_range_per_wave_m · H`` metres (H the wave height). On the physical sea (``motion: physical``, the default)
-    these four change nothing: the water returns follow the physical model (glints off the wave facets,
-    whitecaps, the wakes' foam; ``sensors/lidar_water.rs``), and ``mmusv run`` warns about them
-    (:func:`mmusv.scenario_checks.check_lidar_water`).
+    the water returns follow the physical model (glints off the wave facets, whitecaps, the wakes' foam;
+    ``sensors/lidar_water.rs``), and these four change nothing (``mmusv run`` warns about them,
+    :func:`mmusv.scenario_checks.check_lidar_water`) but for ``water_probability`` and
+    ``water_probability_per_wave_m`` both 0, which switch the water returns off on either sea: a dataset of
+    targets only.
     """
 
     channels: int = Field(default=64, ge=1, le=1024)

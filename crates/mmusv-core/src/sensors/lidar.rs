@@ -17,6 +17,8 @@
 //!    2026-12-01 a detected return carried the model's mean, below the threshold for one in seven water returns
 //!    at W1) (the vessels' Kelvin waves, the cameras' slopes, do not tilt the facet: `docs/sea/README.md`,
 //!    *LiDAR returns from wakes*, says what that cost);
+//!    `water_probability` and `water_probability_per_wave_m` both 0 switch these off (no water return at all; until
+//!    2026-12-06 the physical model ignored them, and no setting gave a LiDAR dataset without water returns);
 //!    on a flat sea, the empirical rule: a return only with probability
 //!    `p_w = water_probability + water_probability_per_wave_m · H` (clamped to 1) and only within
 //!    `water_range_m + water_range_per_wave_m · H` — calm water is a mirror at 905 nm, waves give the beam facets
@@ -331,6 +333,8 @@ impl Lidar {
         let water_range = cfg.water_range_m + cfg.water_range_per_wave_m * h;
         let sigma = env.fog_extinction_per_m.max(0.0) + 1e-5 * env.rain_mm_per_h.max(0.0).powf(0.6);
         let waves = scene.wave_surface().is_some();
+        // Both water probabilities 0: no water returns, on the physical sea too (whose model otherwise ignores them).
+        let water_off = cfg.water_probability == 0.0 && cfg.water_probability_per_wave_m == 0.0;
         // The wakes' foam (no whitecaps: those are the model's area mean), only over a wave surface.
         let wake_foam = Some(Foam::new(0.0, wakes, FOAM_SEED))
             .filter(|f| waves && !f.is_empty())
@@ -352,7 +356,9 @@ impl Lidar {
             let cos = n.dot(Vec3::from_array(dirs[k])).abs().min(1.0);
             let mut water_intensity = None;
             if class == CLASS_WATER {
-                if waves {
+                if water_off {
+                    continue;
+                } else if waves {
                     let foam = wake_foam.as_ref().map_or(0.0, |f| {
                         let p = Vec3::from_array(origin) + Vec3::from_array(dirs[k]) * r;
                         f.cover(p.x, p.y, None)
