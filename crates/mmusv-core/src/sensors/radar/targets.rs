@@ -34,6 +34,8 @@ use std::f64::consts::{PI, TAU};
 
 /// Most beam spacings of azimuth one object's rays are spread over (wider objects get as many rays).
 pub const MAX_SPANS: u32 = 32;
+/// Lowest angular box (radians) that gets rays (one touching the fan's edge has none), and lowest fan.
+const MIN_HEIGHT_RAD: f64 = 1e-9;
 /// Widest object, in azimuth, that gets rays of its own (radians): a nearer one is sampled densely by the fan.
 pub const MAX_WIDTH_RAD: f64 = PI / 3.0;
 
@@ -161,7 +163,9 @@ fn segment_distance(p: [f64; 2], q: [f64; 2]) -> f64 {
 /// The rays to cast at the targets of `scene` seen from `sensor_to_world` (see the module documentation): none
 /// when `cfg.target_rays` is 0.
 pub(super) fn target_rays(scene: &Scene, cfg: &RadarConfig, sensor_to_world: &RigidPose) -> TargetRays {
-    if cfg.target_rays == 0 {
+    // A fan of no height samples one elevation, not an interval: nothing to aim within.
+    let [fan_lo, fan_hi] = cfg.elevation_fan_rad;
+    if cfg.target_rays == 0 || fan_hi - fan_lo < MIN_HEIGHT_RAD {
         return TargetRays::default();
     }
     let sea = scene.sea_instance();
@@ -188,7 +192,7 @@ pub(super) fn target_rays(scene: &Scene, cfg: &RadarConfig, sensor_to_world: &Ri
             continue;
         }
         let Some([a0, width, e0, e1]) = angular_box(sensor_to_world, lo, hi, cfg.elevation_fan_rad) else { continue };
-        if width > MAX_WIDTH_RAD {
+        if width > MAX_WIDTH_RAD || e1 - e0 < MIN_HEIGHT_RAD {
             continue;
         }
         let spans = ((width / spacing).ceil() as u32).clamp(1, MAX_SPANS);
@@ -338,5 +342,19 @@ mod tests {
         let aimed = total(&quiet);
         assert!(dense > 0.0);
         assert!((aimed / dense - 1.0).abs() < 0.03, "aimed {aimed} against dense {dense}");
+    }
+
+    /// A fan of no height (every ray at one elevation) gets no aimed rays: its sweep is the fan's alone.
+    #[test]
+    fn a_flat_fan_aims_nothing() {
+        let s = cubes(6, 300.0, 2.0);
+        let pose = RigidPose::from_xyz_rpy([0.0, 0.0, 1.0], [0.0; 3]);
+        let flat = RadarConfig { elevation_fan_rad: [0.0, 0.0], azimuth_bins: 256, ..RadarConfig::tuning() };
+        assert!(target_rays(&s, &flat, &pose).rays.is_empty());
+        let env = crate::sensors::radar::RadarEnv { wave_height_m: 0.0, rain_mm_per_h: 0.0 };
+        let sweep = |cfg: &RadarConfig| crate::sensors::radar::radar_sweep(&s, &pose, cfg, &env, 0).ok();
+        let with = sweep(&flat);
+        assert!(with.as_ref().is_some_and(|r| r.instance.iter().any(|&i| i >= 0)));
+        assert_eq!(with, sweep(&RadarConfig { target_rays: 0, ..flat }));
     }
 }
