@@ -19,7 +19,8 @@ shrinks under a reader must not crash it) and never trusts a length it has not c
   placeholder ``2**64 - 1``) and a closed chunk cut short (an interrupted copy, power loss after its length was
   filled in), whose header must then agree with its record length;
 - the data section's CRC (in the data end record) is checked as well, so damage outside the chunks (metadata,
-  message indexes) is reported too.
+  message indexes) is reported too; when a damaged chunk was found, that chunk alone may break it (the CRC covers
+  every byte of the data section), so it is not blamed on the bytes outside the chunks then.
 
 A reader that wants only some log times (one frame for a preview, ``convert --frames``) gives ``keep``: a chunk
 whose messages all lie outside it is hopped over unread, when the file's summary (its CRC checked) holds every
@@ -288,7 +289,9 @@ class Scan:
             if op == DATA_END:
                 stored = u32(body, 0) if len(body) >= 4 else 0
                 self.data_end = True
-                if self.chunks and crc_valid and stored != 0 and stored != crc:
+                # blamed on the bytes outside the chunks only when every chunk checked out: the CRC covers the
+                # chunks' bytes too, so a damaged chunk (already reported) breaks it alone
+                if self.chunks and crc_valid and stored != 0 and stored != crc and not self.damage:
                     d = Damage(
                         0,
                         pos,

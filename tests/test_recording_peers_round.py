@@ -1,0 +1,254 @@
+"""An ``mmusv run`` recording as a Foxglove / robotics-tools user reads it, with other people's code (a helper's
+round): the official ``mcap`` reader (its record stream, its indexed and time-ordered reads), ``mcap-protobuf-support``
+and ``zstandard``, then mmusv's own reader and ``mmusv info`` on the same file cut and damaged.
+
+What was checked (``tests/test_recording_round.py`` already checks the statistics, CRCs, schemas, timestamps, the
+``/tf`` tree, the metadata and mmusv's reader against an independent decode; this adds what it leaves out):
+
+* The indexes a seeking reader trusts, on the real recorder's output (80 frames of a 32-channel LiDAR, two 4 MiB
+  chunks with frame 43 split across them): every chunk index equals its chunk's header and names its message
+  indexes by their offsets and total length; every message index lists exactly the (log time, offset) of its
+  channel's messages in the decompressed chunk; each chunk's start and end times are its messages' first and last;
+  the summary offsets point at their groups, the metadata indexes at their records. The peer's time-ordered read
+  (forward and reverse) is file order, its decoded messages are mmusv's, and its indexed read of the split frame
+  (``start_time``/``end_time`` of one log time) gives all five topics.
+* The same file cut at every kind of record boundary (inside the header, after it, inside the metadata, inside
+  a chunk, inside a message index, before and after the data end, inside the summary and the footer, the last
+  byte): ``summary`` never says ``complete``, every message mmusv reads is the peer's message at that place, and
+  ``mmusv info`` warns in one line naming the file, without a traceback.
+
+Found and fixed (the test below failed before):
+
+* A damaged chunk (its CRC, or one bit of its data) was reported twice: once rightly, then as "the data section's
+  CRC does not match: bytes outside the chunks (metadata, indexes) were changed", a false statement (the data
+  section's CRC covers the chunk's bytes too, so the damaged chunk alone breaks it). The data section's CRC is now
+  blamed on the bytes outside the chunks only when every chunk checked out (``mmusv.recording.scan``).
+"""
+
+from __future__ import annotations
+
+import collections
+import contextlib
+import io
+import struct
+import zlib
+from pathlib import Path
+from typing import Any
+
+import pytest
+import zstandard
+from mcap.reader import make_reader
+from mcap.records import (
+    Attachment,
+    AttachmentIndex,
+    Chunk,
+    ChunkIndex,
+    DataEnd,
+    Footer,
+    MessageIndex,
+    Metadata,
+    MetadataIndex,
+    Schema,
+    Statistics,
+    SummaryOffset,
+)
+from mcap.records import Channel as ChannelRecord
+from mcap.stream_reader import StreamReader
+from mcap_protobuf.decoder import DecoderFactory
+from tiny_scenario import lidar_scenario
+
+MESSAGE = 0x05
+GROUPS = {0x03: Schema, 0x04: ChannelRecord, 0x08: ChunkIndex, 0x0A: AttachmentIndex, 0x0B: Statistics}
+GROUPS[0x0D] = MetadataIndex
+
+
+@pytest.fixture(scope="module")
+def dense(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """80 frames of a 32-channel LiDAR: two chunks of the real recorder, frame 43 split between them."""
+    from mmusv.acquire import run
+
+    out = tmp_path_factory.mktemp("dense")
+    return Path(run(lidar_scenario("dense", frames=80, dense=True), out_dir=out).recording)
+
+
+def _records(data: bytes) -> list[tuple[int, int, Any]]:
+    """``(start, end, record)`` of every record of an MCAP file, chunks undecoded, CRCs checked by the peer."""
+    f = io.BytesIO(data)
+    out, start = [], 8
+    for rec in StreamReader(f, emit_chunks=True, validate_crcs=True).records:
+        out.append((start, f.tell(), rec))
+        start = f.tell()
+    return out
+
+
+def _inner(chunk: Chunk) -> list[tuple[int, int, bytes]]:
+    """``(offset, opcode, body)`` of every record in a chunk, decompressed with ``zstandard``."""
+    assert chunk.compression == "zstd"
+    raw = zstandard.ZstdDecompressor().decompress(chunk.data, max_output_size=chunk.uncompressed_size)
+    assert len(raw) == chunk.uncompressed_size and zlib.crc32(raw) == chunk.uncompressed_crc
+    out, pos = [], 0
+    while pos < len(raw):
+        op, n = raw[pos], struct.unpack_from("<Q", raw, pos + 1)[0]
+        out.append((pos, op, raw[pos + 9 : pos + 9 + n]))
+        pos += 9 + n
+    assert pos == len(raw)
+    return out
+
+
+def _cli(*args: str) -> tuple[int, str, str]:
+    from mmusv.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(list(args))
+    return code, " ".join(out.getvalue().split()), err.getvalue()
+
+
+# ---------------------------------------------------------------------------------------------- the indexes
+
+
+def test_every_index_points_at_the_records_it_indexes(dense: Path) -> None:
+    data = dense.read_bytes()
+    recs = _records(data)
+    at = {start: (end, rec) for start, end, rec in recs}
+    chunks = [(s, e, r) for s, e, r in recs if isinstance(r, Chunk)]
+    index = {r.chunk_start_offset: r for _s, _e, r in recs if isinstance(r, ChunkIndex)}
+    assert len(chunks) == len(index) == 2
+    counts: collections.Counter[int] = collections.Counter()
+    for start, end, chunk in chunks:
+        ci = index[start]
+        assert ci.chunk_length == end - start
+        assert (ci.message_start_time, ci.message_end_time) == (chunk.message_start_time, chunk.message_end_time)
+        assert (ci.compression, ci.compressed_size) == (chunk.compression, len(chunk.data))
+        assert ci.uncompressed_size == chunk.uncompressed_size
+        listed: dict[int, list[tuple[int, int]]] = collections.defaultdict(list)
+        for pos, op, body in _inner(chunk):
+            if op == MESSAGE:
+                channel, _seq, log_time, publish_time = struct.unpack_from("<HIQQ", body)
+                assert publish_time == log_time
+                listed[channel].append((log_time, pos))
+                counts[channel] += 1
+        times = [t for entries in listed.values() for t, _ in entries]
+        assert (min(times), max(times)) == (chunk.message_start_time, chunk.message_end_time)
+        after = range(end, end + ci.message_index_length)
+        indexes = [(s, e, r) for s, e, r in recs if isinstance(r, MessageIndex) and s in after]
+        assert {r.channel_id: s for s, _e, r in indexes} == ci.message_index_offsets
+        assert indexes[-1][1] - end == ci.message_index_length
+        assert {r.channel_id: sorted(r.records) for _s, _e, r in indexes} == {c: sorted(v) for c, v in listed.items()}
+    reader = make_reader(io.BytesIO(data))
+    summary = reader.get_summary()
+    assert summary is not None and summary.statistics is not None
+    assert summary.statistics.channel_message_counts == dict(counts) and sum(counts.values()) == 400
+    footer = recs[-1][2]
+    assert isinstance(footer, Footer)
+    offsets = [r for _s, _e, r in recs if isinstance(r, SummaryOffset)]
+    assert {o.group_opcode for o in offsets} == {0x03, 0x04, 0x08, 0x0B, 0x0D}
+    for o in offsets:
+        group = [(s, e) for s, e, r in recs if s >= footer.summary_start and isinstance(r, GROUPS[o.group_opcode])]
+        assert (o.group_start, o.group_length) == (group[0][0], group[-1][1] - group[0][0])
+    for m in summary.metadata_indexes:
+        end, rec = at[m.offset]
+        assert isinstance(rec, Metadata) and (rec.name, end - m.offset) == (m.name, m.length)
+    assert not summary.attachment_indexes and not any(isinstance(r, Attachment) for _s, _e, r in recs)
+    assert any(isinstance(r, DataEnd) for _s, _e, r in recs)
+
+
+def test_the_peers_ordered_and_indexed_reads_are_mmusvs_messages(dense: Path) -> None:
+    from mmusv.recording import read_messages
+
+    with dense.open("rb") as f:
+        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        in_file = [(c.topic, m.log_time, m.data) for _s, c, m in reader.iter_messages(log_time_order=False)]
+        ordered = [(c.topic, m.log_time, m.data) for _s, c, m in reader.iter_messages(log_time_order=True)]
+        backwards = [(c.topic, m.log_time, m.data) for _s, c, m in reader.iter_messages(reverse=True)]
+        decoded = [(c.topic, m.log_time, d.SerializeToString()) for _s, c, m, d in reader.iter_decoded_messages()]
+        split = 43 * 200_000_000  # frame 43 at 5 Hz: its messages are in both chunks
+        window = [c.topic for _s, c, _m in reader.iter_messages(starting_at=split, ending_before=split + 1)]
+    assert in_file == ordered and len(in_file) == 400
+    assert sorted(backwards) == sorted(ordered) and [lt for _t, lt, _d in backwards] == sorted(
+        (lt for _t, lt, _d in ordered), reverse=True
+    )
+    assert sorted(window) == ["/tf", "/u/annotations", "/u/boxes", "/u/lidar", "/world/state"]
+    assert [(t, lt, m.SerializeToString()) for t, lt, m in read_messages(dense)] == decoded
+
+
+# ---------------------------------------------------------------------------------------------- cut and damaged
+
+
+def _cuts(data: bytes) -> dict[str, int]:
+    recs = _records(data)
+
+    def first(kind: type, k: int = 0) -> tuple[int, int]:
+        return [(s, e) for s, e, r in recs if isinstance(r, kind)][k]
+
+    chunk, index = first(Chunk), first(MessageIndex)
+    return {
+        "inside the header": 20,
+        "after the header": 8 + 9 + struct.unpack_from("<Q", data, 9)[0],
+        "inside the second metadata record": first(Metadata, 1)[0] + 20,
+        "after the metadata": first(Metadata, 2)[1],
+        "inside the first chunk": chunk[0] + 5000,
+        "after the first chunk": chunk[1],
+        "inside a message index": index[0] + 10,
+        "before the data end": first(DataEnd)[0],
+        "after the data end": first(DataEnd)[1],
+        "inside the summary": first(ChunkIndex)[0] + 3,
+        "before the footer": first(Footer)[0],
+        "inside the closing magic": len(data) - 4,
+        "one byte short": len(data) - 1,
+    }
+
+
+def test_a_recording_cut_anywhere_is_never_called_complete(dense: Path, tmp_path: Path) -> None:
+    from mmusv.recording import read_messages, summary
+
+    data = dense.read_bytes()
+    with dense.open("rb") as f:
+        peer = [(c.topic, m.log_time, m.data) for _s, c, m in make_reader(f).iter_messages(log_time_order=False)]
+    for where, size in _cuts(data).items():
+        cut = tmp_path / f"{where.replace(' ', '_')}.mcap"
+        cut.write_bytes(data[:size])
+        got = summary(cut)
+        assert not got["complete"] and got["damage"], where
+        damage: list[str] = []
+        ours = [(t, lt, m.SerializeToString()) for t, lt, m in read_messages(cut, damage=damage)]
+        assert ours == peer[: len(ours)] and damage, where
+        code, out, err = _cli("info", str(cut))
+        assert not err and "mmusv: warning: " in out, (where, out, err)
+        assert "Traceback" not in out and code == (0 if got["frames"] and got["frames"]["read"] else 1), where
+
+
+def _damaged(data: bytes, chunk: int, *, field: bool) -> bytes:
+    """``data`` with chunk ``chunk`` damaged: its stored CRC changed (``field``), else one bit in its data."""
+    start, end, rec = [(s, e, r) for s, e, r in _records(data) if isinstance(r, Chunk)][chunk]
+    out = bytearray(data)
+    if field:  # opcode, length, start and end times, uncompressed size, then the CRC
+        out[start + 33 : start + 37] = struct.pack("<I", rec.uncompressed_crc ^ 1)
+    else:
+        out[(start + end) // 2] ^= 0x40
+    return bytes(out)
+
+
+@pytest.mark.parametrize("field", [True, False], ids=["its CRC", "a bit of its data"])
+def test_a_damaged_chunk_is_not_also_blamed_on_the_bytes_outside_the_chunks(
+    dense: Path, tmp_path: Path, field: bool
+) -> None:
+    """The data section's CRC covers the chunks' bytes too: it was reported as "bytes outside the chunks
+    (metadata, indexes) were changed" beside every damaged chunk."""
+    from mmusv.recording import summary
+
+    path = tmp_path / "damaged.mcap"
+    path.write_bytes(_damaged(dense.read_bytes(), 1, field=field))
+    got = summary(path)
+    assert not got["complete"] and got["frames"]["read"] == 43, got["frames"]
+    assert len(got["damage"]) == 1 and "damaged chunk, skipped: CRC mismatch" in got["damage"][0], got["damage"]
+    code, out, _err = _cli("info", str(path))
+    assert code == 0 and "CRC mismatch" in out and "outside the chunks" not in out, out
+    # a change outside the chunks is still named so
+    data = dense.read_bytes()
+    changed = tmp_path / "changed.mcap"
+    status = data.rindex(b"complete")  # the run metadata's status
+    changed.write_bytes(data[:status] + b"c0mplete" + data[status + 8 :])
+    got = summary(changed)
+    assert not got["complete"] and got["frames"]["read"] == 80
+    assert ["outside the chunks (metadata, indexes) were changed" in line for line in got["damage"]] == [True]
