@@ -17,12 +17,14 @@ What was checked (``tests/test_recording_round.py`` already checks the statistic
   byte): ``summary`` never says ``complete``, every message mmusv reads is the peer's message at that place, and
   ``mmusv info`` warns in one line naming the file, without a traceback.
 
-Found and fixed (the test below failed before):
+Found and fixed (each test below failed before):
 
 * A damaged chunk (its CRC, or one bit of its data) was reported twice: once rightly, then as "the data section's
   CRC does not match: bytes outside the chunks (metadata, indexes) were changed", a false statement (the data
   section's CRC covers the chunk's bytes too, so the damaged chunk alone breaks it). The data section's CRC is now
   blamed on the bytes outside the chunks only when every chunk checked out (``mmusv.recording.scan``).
+* A recording cut inside its first 8 bytes (the magic) was "not an MCAP file (it does not start with the MCAP
+  magic bytes)", though it starts with as many of them as it has; now "cut off inside the MCAP magic bytes".
 """
 
 from __future__ import annotations
@@ -252,3 +254,18 @@ def test_a_damaged_chunk_is_not_also_blamed_on_the_bytes_outside_the_chunks(
     got = summary(changed)
     assert not got["complete"] and got["frames"]["read"] == 80
     assert ["outside the chunks (metadata, indexes) were changed" in line for line in got["damage"]] == [True]
+
+
+# ---------------------------------------------------------------------------------------------- what a file is called
+
+
+@pytest.mark.parametrize("size", [1, 4, 7])
+def test_a_recording_cut_inside_its_magic_is_said_to_be_cut(dense: Path, tmp_path: Path, size: int) -> None:
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(dense.read_bytes()[:size])
+    code, _out, err = _cli("info", str(cut))
+    assert code == 2 and err == (
+        f"mmusv: error: {cut} is cut off inside the MCAP magic bytes ({size} of 8): not a readable MCAP recording\n"
+    ), err
+    code, _out, err = _cli("info", str(dense.parent / "scenario.yaml"))
+    assert code == 2 and "does not start with the MCAP magic bytes" in err, err

@@ -158,6 +158,10 @@ def check_mcap(path: str | Path) -> Path:
         raise IoError(f"recording {p} cannot be read: {exc.strerror or exc}") from None
     if not head:
         raise IoError(f"{p} is empty (0 bytes): not an MCAP recording")
+    if len(head) < len(MAGIC) and MAGIC.startswith(head):  # a copy cut short: not "another kind of file"
+        raise IoError(
+            f"{p} is cut off inside the MCAP magic bytes ({len(head)} of {len(MAGIC)}): not a readable MCAP recording"
+        )
     if head != MAGIC:
         raise IoError(f"{p} is not an MCAP file (it does not start with the MCAP magic bytes)")
     return p
