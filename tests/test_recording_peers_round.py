@@ -23,6 +23,8 @@ Found and fixed (each test below failed before):
   CRC does not match: bytes outside the chunks (metadata, indexes) were changed", a false statement (the data
   section's CRC covers the chunk's bytes too, so the damaged chunk alone breaks it). The data section's CRC is now
   blamed on the bytes outside the chunks only when every chunk checked out (``mmusv.recording.scan``).
+* A recording cut inside its MCAP header (8 to 35 bytes of a real one) was "an MCAP file not written by mmusv run":
+  which program wrote it cannot be told. ``mmusv info`` now says the file ends inside its header.
 * A recording cut inside its first 8 bytes (the magic) was "not an MCAP file (it does not start with the MCAP
   magic bytes)", though it starts with as many of them as it has; now "cut off inside the MCAP magic bytes".
 """
@@ -257,6 +259,18 @@ def test_a_damaged_chunk_is_not_also_blamed_on_the_bytes_outside_the_chunks(
 
 
 # ---------------------------------------------------------------------------------------------- what a file is called
+
+
+@pytest.mark.parametrize("size", [12, 20, 35])
+def test_a_recording_cut_inside_its_header_is_not_called_another_programs(
+    dense: Path, tmp_path: Path, size: int
+) -> None:
+    """It was "an MCAP file not written by mmusv run": the header that says which program wrote it is cut off."""
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(dense.read_bytes()[:size])
+    code, out, err = _cli("info", str(cut))
+    assert code == 1 and not err, (out, err)
+    assert "not written by mmusv run" not in out and f"{cut}: the file ends inside its MCAP header" in out, out
 
 
 @pytest.mark.parametrize("size", [1, 4, 7])

@@ -66,11 +66,14 @@ def cmd_info(args: argparse.Namespace) -> int:
             what = "incomplete recording (.partial, no summary or damaged): counts come from reading every chunk"
         console.print(f"[yellow]{what}[/yellow]", markup=True)
     if info.get("frames") is None:  # an MCAP file, but not a recording of mmusv run: its messages only
-        why = (
-            "its mmusv metadata cannot be read"
-            if info.get("metadata_problem")
-            else "an MCAP file not written by mmusv run (no scenario/sensors metadata)"
-        )
+        from mmusv.recording.info import ends_in_header
+
+        if ends_in_header(target):  # its header, which names the program that wrote it, is cut off
+            why = "the file ends inside its MCAP header (which program wrote it cannot be told)"
+        elif info.get("metadata_problem"):
+            why = "its mmusv metadata cannot be read"
+        else:
+            why = "an MCAP file not written by mmusv run (no scenario/sensors metadata)"
         console.print(Text.assemble((str(target), "bold"), f": {why}: its messages only"), highlight=False)
     else:
         written = run_meta.get("frames_written", "?")

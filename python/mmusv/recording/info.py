@@ -38,6 +38,7 @@ __all__ = [
     "CameraInfo",
     "RecordingInfo",
     "check_mcap",
+    "ends_in_header",
     "read_info",
     "recording_name",
     "written_by_mmusv",
@@ -187,6 +188,27 @@ def written_by_mmusv(path: str | os.PathLike[str]) -> bool:
         return False
     (n,) = struct.unpack_from("<I", head, at)
     return head[at + 4 : at + 4 + n].startswith(b"mmusv")
+
+
+def ends_in_header(path: str | os.PathLike[str]) -> bool:
+    """Whether ``path`` starts with the MCAP magic but ends before its header record does (a copy cut short right
+    at its start): which program wrote it cannot be told. ``False`` for anything unreadable."""
+    import struct
+
+    try:
+        with open(path, "rb") as f:
+            head = f.read(len(MAGIC) + 9)
+            size = os.fstat(f.fileno()).st_size
+    except OSError:
+        return False
+    if not head.startswith(MAGIC):
+        return False
+    if len(head) < len(MAGIC) + 9:
+        return True
+    if head[len(MAGIC)] != 0x01:  # not a header record: damaged, not cut
+        return False
+    (n,) = struct.unpack_from("<Q", head, len(MAGIC) + 1)
+    return bool(size < len(MAGIC) + 9 + n)
 
 
 def _scan_metadata(p: Path) -> Scan:
