@@ -27,6 +27,9 @@ Found and fixed (each test below failed before):
   which program wrote it cannot be told. ``mmusv info`` now says the file ends inside its header.
 * A recording cut inside its first 8 bytes (the magic) was "not an MCAP file (it does not start with the MCAP
   magic bytes)", though it starts with as many of them as it has; now "cut off inside the MCAP magic bytes".
+* A whole, undamaged MCAP file written with the ``Recording`` API (its header says mmusv) but without the scenario
+  and sensors metadata of ``mmusv run`` was said to have "mmusv metadata [that] cannot be read", as if damaged;
+  it is now what it is, an MCAP file not written by ``mmusv run``.
 """
 
 from __future__ import annotations
@@ -283,3 +286,19 @@ def test_a_recording_cut_inside_its_magic_is_said_to_be_cut(dense: Path, tmp_pat
     ), err
     code, _out, err = _cli("info", str(dense.parent / "scenario.yaml"))
     assert code == 2 and "does not start with the MCAP magic bytes" in err, err
+
+
+def test_a_whole_file_of_the_recording_api_is_not_called_damaged(tmp_path: Path) -> None:
+    """Its header says mmusv (the ``Recording`` API writes it too), so a file without ``mmusv run``'s metadata
+    was said to have mmusv metadata that "cannot be read", as if it were damaged."""
+    import numpy as np
+    from mmusv.recording import Recording, summary
+
+    path = tmp_path / "api.mcap"
+    with Recording(path) as rec:
+        rec.raw_image("/img", log_time_ns=0, frame_id="c", image=np.zeros((2, 2), np.uint8))
+    got = summary(path)
+    assert got["complete"] and got["frames"] is None and "metadata_problem" not in got, got
+    code, out, _err = _cli("info", str(path))
+    assert code == 0 and "an MCAP file not written by mmusv run (no scenario/sensors metadata)" in out, out
+    assert "cannot be read" not in out, out

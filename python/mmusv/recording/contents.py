@@ -41,8 +41,9 @@ def summary(path: str | os.PathLike[str]) -> dict[str, Any]:
         info = read_info(p)
     except IoError as exc:  # not a recording of mmusv run (or its metadata is damaged): messages only
         plain = _plain_summary(p)
-        # damaged, not absent: say why it is not read (metadata cut off or damaged: its header says mmusv wrote it)
-        if {"scenario", "sensors"} <= set(plain["metadata"]) or written_by_mmusv(p):
+        # damaged, not absent: say why it is not read (metadata cut off or damaged: its header says mmusv wrote it;
+        # a whole file whose header says so and that holds no such metadata is one of the Recording API's)
+        if {"scenario", "sensors"} <= set(plain["metadata"]) or (written_by_mmusv(p) and plain["damage"]):
             plain["metadata_problem"] = str(exc)
         return plain
     stream = FrameStream(info, want=lambda _t: False)
