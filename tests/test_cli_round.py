@@ -159,7 +159,7 @@ def test_info_of_a_batch_folder_lists_the_recordings_below(
     assert rows["killed/tiny.mcap.partial"][:4] == ["tiny", "unfinished", "2 of 3", "u"], rows
     assert rows["broken/broken.mcap"][1:4] == ["unreadable", "?", "?"], rows
     assert rows["broken/broken.mcap"][4].startswith("broken/broken.mcap is not an MCAP file"), rows
-    assert rows["killed/tiny.mcap.partial"][4].startswith("2 of 3 frames read; frames 2 missing"), rows
+    assert rows["killed/tiny.mcap.partial"][4].startswith("2 of 3 frames read; frame 2 missing"), rows
     # polars read the tables of a folder a[/b] as a glob pattern, and the row called them damaged
     assert rows["a[/b]/tiny.mcap"] == ["tiny", "complete", "3", "u", ""], rows
     assert rows["bad/bad.parts.json"][1] == "unreadable" and "not a parts manifest" in rows["bad/bad.parts.json"][4]
@@ -287,9 +287,9 @@ def test_recover_of_a_killed_part_keeps_its_parts_manifest_readable(
     done.unlink()
     shutil.rmtree(part / "tables")
     code, out, err = _cli(["recover", str(part)], capsys)
-    assert code == 0 and "recovered 1 of 2 frames (frames 2)" in out, (out, err)
+    assert code == 0 and "recovered 1 of 2 frames (frame 2)" in out, (out, err)
     code, out, err = _cli(["info", str(folder)], capsys)
-    assert code == 0 and "3 of 4 frames" in out and "frames 3 missing" in out, (out, err)
+    assert code == 0 and "3 of 4 frames" in out and "frame 3 missing" in out, (out, err)
     assert json.loads((part / "manifest.json").read_text())["first_frame"] == 2
     code, out, err = _cli(["preview", str(folder / "tiny.parts.json"), "--frame", "2", "-o", str(tmp_path)], capsys)
     assert code == 0 and (tmp_path / "tiny_frame000002_u.png").is_file(), err

@@ -30,6 +30,8 @@ Found and fixed (each test below failed before):
 * A whole, undamaged MCAP file written with the ``Recording`` API (its header says mmusv) but without the scenario
   and sensors metadata of ``mmusv run`` was said to have "mmusv metadata [that] cannot be read", as if damaged;
   it is now what it is, an MCAP file not written by ``mmusv run``.
+* One frame missing was "79 of 80 frames read; frames 79 missing", read as a count, and ``mmusv recover`` said
+  "recovered 1 of 80 frames (frames 0)": one frame is now "frame 79" (``mmusv.recording.stream.frames_text``).
 """
 
 from __future__ import annotations
@@ -302,3 +304,23 @@ def test_a_whole_file_of_the_recording_api_is_not_called_damaged(tmp_path: Path)
     code, out, _err = _cli("info", str(path))
     assert code == 0 and "an MCAP file not written by mmusv run (no scenario/sensors metadata)" in out, out
     assert "cannot be read" not in out, out
+
+
+def test_one_frame_is_named_as_one_frame_not_as_a_count(dense: Path, tmp_path: Path) -> None:
+    """A report of "79 of 80 frames read; frames 79 missing" read as 79 frames missing, and "recovered 1 of 80
+    frames (frames 0)" likewise: one frame is now "frame 79", "frame 0"."""
+    from mcap_rechunk import emptied, killed_copy
+    from mmusv.recording import read_info
+    from mmusv.recording.stream import FrameStream
+
+    path = emptied(dense, "/u/lidar", 79, tmp_path / "dense.mcap")  # a LiDAR cloud without points: incomplete
+    stream = FrameStream(read_info(path), want=lambda _t: True)
+    assert [fr.index for fr in stream][-1] == 78
+    report = stream.report()
+    assert report is not None and report.startswith(f"{path}: 79 of 80 frames read; frame 79 missing;"), report
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "scenario.yaml").write_bytes((dense.parent / "scenario.yaml").read_bytes())
+    killed_copy(dense, run / "dense.mcap.partial", messages=7)  # frame 0 whole, frame 1 cut short
+    code, out, err = _cli("recover", str(run))
+    assert code == 0 and "recovered 1 of 80 frames (frame 0) from" in out, (out, err)

@@ -84,9 +84,9 @@ class Recovered:
 
     def lines(self) -> list[str]:
         """What to tell the user, one line each."""
-        from mmusv.recording.stream import frame_ranges
+        from mmusv.recording.stream import frames_text
 
-        got = f"frames {frame_ranges(self.frames)}" if self.frames else "no complete frame"
+        got = frames_text(self.frames) if self.frames else "no complete frame"
         if self.tables_only:
             return [
                 f"rebuilt the tables of {self.recording} ({len(self.frames)} of "
@@ -257,7 +257,7 @@ def rebuild_finished_tables(recording: str | os.PathLike[str]) -> Recovered:
     changed): whole tables (nothing to recover), tables of another recording's run in the folder, a recording of
     no readable frame, and a damaged recording lacking frames whose rows the tables still hold (a rebuild would
     lose them)."""
-    from mmusv.recording.stream import frame_ranges
+    from mmusv.recording.stream import frames_text
 
     rec = check_mcap(recording_arg(recording))
     folder = rec.parent
@@ -293,7 +293,7 @@ def rebuild_finished_tables(recording: str | os.PathLike[str]) -> Recovered:
         problems, lost = check_tables(tables_dir, span, lacking, listed=listed)
         if lost:
             raise IoError(
-                f"{rec} lacks frames {frame_ranges(lost)}, whose rows its tables still hold: tables rebuilt from it "
+                f"{rec} lacks {frames_text(lost)}, whose rows its tables still hold: tables rebuilt from it "
                 f"would lose them; {tables_dir} is left as it was ({'; '.join(problems)})"
             )
         if not problems:  # the tables lack only frames the recording lacks too: a rebuild gives them back as they are

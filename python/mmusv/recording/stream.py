@@ -7,7 +7,8 @@ written last, is picked up when present. The metadata it starts from: :func:`mmu
 
 A recording split into frame ranges (:mod:`mmusv.recording.parts`) is walked part by part in frame order as one
 sequence; a part not recorded yet is left out (its frames are missing, as those of an interrupted run).
-:func:`warn_missing` says when frames are missing, :func:`frame_ranges` writes frame indices as ``0..3, 7``.
+:func:`warn_missing` says when frames are missing, :func:`frame_ranges` writes frame indices as ``0..3, 7``
+(:func:`frames_text`: ``frames 0..3, 7``, ``frame 7``).
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ from mmusv.recording.parts import is_parts_manifest, part_files
 from mmusv.recording.scan import Scan
 from mmusv.recording.topics import WORLD_STATE
 
-__all__ = ["Frame", "FrameStream", "frame_ranges", "held_text", "warn_missing"]
+__all__ = ["Frame", "FrameStream", "frame_ranges", "frames_text", "held_text", "warn_missing"]
 
 
 @dataclass
@@ -57,6 +58,12 @@ def frame_ranges(frames: Sequence[int]) -> str:
     if run:
         out.append(f"{run[0]}..{run[-1]}" if len(run) > 1 else str(run[0]))
     return ", ".join(out)
+
+
+def frames_text(frames: Sequence[int]) -> str:
+    """``"frame 7"`` for one frame, ``"frames 0..3, 7"`` (:func:`frame_ranges`) for more: "frames 7 missing" was
+    read as a count of seven."""
+    return f"frame {frame_ranges(frames)}" if len(set(frames)) == 1 else f"frames {frame_ranges(frames)}"
 
 
 @dataclass
@@ -432,7 +439,7 @@ class FrameStream:
             status = self.run.get("status")
             if said and status and status != "complete":
                 why.append(f"run status {status}: {self.run.get('frames_written', '?')} frames written")
-            parts.append(f"frames {frame_ranges(missing)} missing" + (f" ({'; '.join(why)})" if why else ""))
+            parts.append(f"{frames_text(missing)} missing" + (f" ({'; '.join(why)})" if why else ""))
         if self.incomplete:
             parts.append(
                 "incomplete frames left out: "
