@@ -32,6 +32,11 @@ Found and fixed (each test below failed before):
   it is now what it is, an MCAP file not written by ``mmusv run``.
 * One frame missing was "79 of 80 frames read; frames 79 missing", read as a count, and ``mmusv recover`` said
   "recovered 1 of 80 frames (frames 0)": one frame is now "frame 79" (``mmusv.recording.stream.frames_text``).
+* A frame with an empty message (whole bytes, 0 of them for one message: a peer tool's or a writer's fault) was
+  named or counted wrongly: an empty ``/world/state`` decodes to frame 0, so the frame left out was reported as
+  "frame 0" (which was read) instead of its own index; an empty LiDAR cloud left its frame out of ``mmusv convert``
+  while ``mmusv info``, which does not decode the clouds, counted it ("80 frames"). Every reader of the frames now
+  leaves such a frame out alike and names it by its log time (``mmusv.recording.stream``).
 """
 
 from __future__ import annotations
@@ -324,3 +329,28 @@ def test_one_frame_is_named_as_one_frame_not_as_a_count(dense: Path, tmp_path: P
     killed_copy(dense, run / "dense.mcap.partial", messages=7)  # frame 0 whole, frame 1 cut short
     code, out, err = _cli("recover", str(run))
     assert code == 0 and "recovered 1 of 80 frames (frame 0) from" in out, (out, err)
+
+
+def test_a_frame_with_an_empty_message_is_named_by_its_index_and_counted_alike_everywhere(
+    dense: Path, tmp_path: Path
+) -> None:
+    """Bytes whole (every CRC matches) but one message empty (0 bytes, a peer tool's or a writer's fault): an empty
+    ``/world/state`` decodes to frame 0, and the frame left out was called "frame 0" (which was read) instead of
+    frame 5; an empty LiDAR cloud left its frame out of ``mmusv convert`` but ``mmusv info`` (which does not
+    decode the clouds) counted it, "80 frames"."""
+    from mcap_rechunk import emptied
+    from mmusv.recording import read_info, summary
+    from mmusv.recording.stream import FrameStream
+
+    path = emptied(dense, "/world/state", 5, tmp_path / "state" / "dense.mcap")
+    for want in (lambda _t: False, lambda _t: True):
+        stream = FrameStream(read_info(path), want=want)
+        assert 5 not in [fr.index for fr in stream] and [k for k, _why in stream.incomplete] == [5]
+    report = summary(path)["frames"]["report"]
+    assert "frame 5 missing; incomplete frames left out: frame 5 (its /world/state message" in report, report
+    path = emptied(dense, "/u/lidar", 79, tmp_path / "lidar" / "dense.mcap")
+    for want in (lambda _t: False, lambda _t: True):
+        stream = FrameStream(read_info(path), want=want)
+        assert [fr.index for fr in stream] == list(range(79)) and [k for k, _why in stream.incomplete] == [79]
+    got = summary(path)["frames"]
+    assert got["read"] == 79 and "frame 79 (its /u/lidar message is empty (0 bytes))" in got["report"], got

@@ -242,6 +242,8 @@ class FrameStream:
                     cur.bad = cur.bad or f"it holds two {topic} messages"
                 cur.topics.add(topic)
                 if topic != WORLD_STATE and not self.want(topic):
+                    if not msg.data:  # as a decoding reader finds it (a cloud without fields): alike undecoded
+                        cur.bad = cur.bad or f"its {topic} message is empty (0 bytes)"
                     continue
                 try:
                     if msg.channel_id not in decoders:
@@ -258,8 +260,12 @@ class FrameStream:
                     cur.bad = cur.bad or f"its {topic} message does not decode ({type(exc).__name__})"
                     continue
                 hollow = self._hollow(topic, decoded, cur.frame.world)
+                if hollow is None and not msg.data:  # no message of an mmusv run is empty: not only those checked
+                    hollow = "is empty (0 bytes)"
                 if hollow is not None:  # bytes that decode to a message without what every reader takes from it
                     cur.bad = cur.bad or f"its {topic} message {hollow}"
+                    if topic == WORLD_STATE:  # its frame number (0, from empty bytes) is not the frame's
+                        cur.frame.world = None
                     continue
                 cur.frame.messages[topic] = decoded
             if cur is not None:
