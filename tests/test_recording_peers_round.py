@@ -37,6 +37,11 @@ Found and fixed (each test below failed before):
   "frame 0" (which was read) instead of its own index; an empty LiDAR cloud left its frame out of ``mmusv convert``
   while ``mmusv info``, which does not decode the clouds, counted it ("80 frames"). Every reader of the frames now
   leaves such a frame out alike and names it by its log time (``mmusv.recording.stream``).
+* A valid MCAP copy whose messages are not in frame order (written channel by channel, as a tool that copies topic
+  by topic leaves them) was read as pieces of frames: ``mmusv info`` said every frame was read beside hundreds of
+  "incomplete frames left out", ``mmusv convert`` found no complete frame. The reader now stops with an error
+  naming the file, the frame whose messages are apart and how to rewrite it in log-time order; a frame recorded
+  twice, each copy whole, is still read once (``tests/export/test_convert.py``).
 """
 
 from __future__ import annotations
@@ -354,3 +359,38 @@ def test_a_frame_with_an_empty_message_is_named_by_its_index_and_counted_alike_e
         assert [fr.index for fr in stream] == list(range(79)) and [k for k, _why in stream.incomplete] == [79]
     got = summary(path)["frames"]
     assert got["read"] == 79 and "frame 79 (its /u/lidar message is empty (0 bytes))" in got["report"], got
+
+
+def _reordered(src: Path, out: Path, key: Any) -> Path:
+    """``src`` written again by the official writer with its messages in the order of ``key(topic, log_time)``."""
+    from mcap.writer import Writer
+    from mcap_rechunk import write_records
+
+    with src.open("rb") as f:
+        reader = make_reader(f)
+        meta = [(m.name, dict(m.metadata)) for m in reader.iter_metadata()]
+        msgs = sorted(reader.iter_messages(), key=lambda t: key(t[1].topic, t[2].log_time))
+    out.parent.mkdir(parents=True, exist_ok=True)
+    with out.open("wb") as g:
+        w = Writer(g)
+        write_records(w, meta, msgs)
+        w.finish()  # type: ignore[no-untyped-call]
+    return out
+
+
+@pytest.mark.parametrize("first", ["/tf", "/world/state"])
+def test_a_copy_written_topic_by_topic_is_refused_not_read_in_pieces(dense: Path, tmp_path: Path, first: str) -> None:
+    """A valid MCAP may hold its messages in any order; one copied channel by channel (every /tf, then every world
+    state, ...) was read as pieces of frames: ``mmusv info`` said every frame was read beside "incomplete frames
+    left out: frame 0 (it has no /world/state message) ...", and ``mmusv convert`` found "no complete frame" (or
+    frames without sensors). It is now an error that says what is wrong and how to mend it."""
+    from mmusv.recording import summary
+
+    path = _reordered(dense, tmp_path / "by_topic" / "dense.mcap", lambda t, lt: (t != first, t, lt))
+    code, out, err = _cli("info", str(path))
+    assert code == 2 and not out and err.startswith(f"mmusv: error: {path}: the messages of the frame at 0.000 s"), err
+    assert "not in log-time order" in err and "iter_messages(log_time_order=True)" in err, err
+    # sorted back into log-time order by the peer, it is the recording's 80 frames
+    again = _reordered(path, tmp_path / "sorted" / "dense.mcap", lambda _t, lt: lt)
+    got = summary(again)["frames"]
+    assert (got["read"], got["report"]) == (80, None), got

@@ -130,6 +130,8 @@ class FrameStream:
         self.yielded: list[int] = []
         self.run: dict[str, str] = dict(info.run)
         self.out_of_order: list[int] = []
+        self._copies: dict[int, bool] = {}  # log time -> whether a clean copy of its frame was whole
+        self._reading: Path = info.path  # the file (or part) being read
         self.topic_counts: dict[str, int] = {}
         self.topic_schemas: dict[str, tuple[str, str]] = {}
         self.messages = 0
@@ -198,6 +200,7 @@ class FrameStream:
         factory = DecoderFactory()
         decoders: dict[int, Callable[[bytes], Any] | None] = {}
         where = f"part {path.name} of {self.info.path.name}" if self.info.parts else "the file"
+        self._reading = path
         times = self._wanted_times()
         scan = Scan(path, keep=times)
         lost: list[tuple[int, int]] = []  # log times of damaged chunks
@@ -322,6 +325,7 @@ class FrameStream:
             if why is None:
                 reference |= op.topics
             yield from self._flush(pending, lost, reference, scan, seen)
+            self._split(op, lost, whole=why is None)
             if why is None:
                 yield self._accept(op.frame, seen)
             else:
@@ -335,11 +339,29 @@ class FrameStream:
     ) -> Iterator[Frame]:
         for op in pending:
             why = self._why(op, lost, reference, scan)
+            self._split(op, lost, whole=why is None)
             if why is None:
                 yield self._accept(op.frame, seen)
             else:
                 self.incomplete.append((self._index(op.frame.log_time_ns, op.frame.world), why))
         pending.clear()
+
+    def _split(self, op: _Open, lost: list[tuple[int, int]], *, whole: bool) -> None:
+        """Raises :class:`~mmusv.errors.IoError` when the messages of one log time come in two runs away from any
+        damage and one of them is not a whole frame: a file whose messages are not in frame order (each topic in
+        turn, as a tool that copies channel by channel writes them), whose every frame would be read in pieces,
+        each incomplete (a frame recorded twice, each copy whole, is read once)."""
+        t = op.frame.log_time_ns
+        if op.suspect or any(a <= t <= b for a, b in lost):
+            return
+        if t in self._copies and not (whole and self._copies[t]):
+            raise IoError(
+                f"{self._reading}: the messages of the frame at {t / 1e9:.3f} s are not together in the file (not "
+                "in log-time order: written topic by topic?); mmusv reads a recording frame by frame in file "
+                "order, as mmusv run writes it: rewrite it in log-time order (the mcap package's "
+                "iter_messages(log_time_order=True) into a new file)"
+            )
+        self._copies[t] = self._copies.get(t, False) or whole
 
     def _why(self, op: _Open, lost: list[tuple[int, int]], reference: set[str], scan: Scan) -> str | None:
         """Why the frame of ``op`` is incomplete, or None."""
