@@ -42,6 +42,9 @@ Found and fixed (each test below failed before):
   "incomplete frames left out", ``mmusv convert`` found no complete frame. The reader now stops with an error
   naming the file, the frame whose messages are apart and how to rewrite it in log-time order; a frame recorded
   twice, each copy whole, is still read once (``tests/export/test_convert.py``).
+* ``mmusv convert`` of such a whole file said "skipped frames 79..79: lost from the recording (run complete: 80 of
+  80 frames written)": now "skipped frame 79: in the recording but incomplete: its /u/lidar message is ..."
+  (``mmusv.export.conversion``, ``convert_report``).
 """
 
 from __future__ import annotations
@@ -394,3 +397,15 @@ def test_a_copy_written_topic_by_topic_is_refused_not_read_in_pieces(dense: Path
     again = _reordered(path, tmp_path / "sorted" / "dense.mcap", lambda _t, lt: lt)
     got = summary(again)["frames"]
     assert (got["read"], got["report"]) == (80, None), got
+
+
+def test_convert_names_one_skipped_frame_and_why_it_is_incomplete(dense: Path, tmp_path: Path) -> None:
+    """It said "skipped frames 79..79: lost from the recording (run complete: 80 of 80 frames written)" of a frame
+    that is in the whole file, its LiDAR message empty."""
+    from mcap_rechunk import emptied
+
+    path = emptied(dense, "/u/lidar", 79, tmp_path / "lidar" / "dense.mcap")
+    code, out, err = _cli("convert", str(path), "--to", "kitti", "-o", str(tmp_path / "kitti"), "--no-progress")
+    assert code == 0 and "79 frames" in out, (out, err)
+    assert "skipped frame 79: in the recording but incomplete: its /u/lidar message is" in out, out
+    assert "79..79" not in out and "lost from the recording" not in out, out

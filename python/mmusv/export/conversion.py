@@ -59,7 +59,7 @@ from mmusv.export.convert_report import load_report as load_report  # importable
 from mmusv.export.splits import DEFAULT_RATIOS, SPLIT_NAMES, assign_splits, parse_ratios
 from mmusv.export.writer import DatasetWriter
 from mmusv.recording.info import RecordingInfo, read_info
-from mmusv.recording.stream import FrameStream
+from mmusv.recording.stream import FrameStream, held_text
 from mmusv.text import counted, given, named
 
 __all__ = ["REPORT_NAME", "ConvertReport", "RecordingReport", "convert", "writer_class"]
@@ -104,7 +104,7 @@ def _why_nothing(reports: list[RecordingReport]) -> str:
     frame in X", and these went with the report that is not written then."""
     parts = []
     for r in reports:
-        why = [f"frames {s['frames'][0]}..{s['frames'][1]} {s['reason']}" for s in r.skipped]
+        why = [f"{held_text(range(s['frames'][0], s['frames'][1] + 1))} {s['reason']}" for s in r.skipped]
         why = why or [n for n in r.notes if not n.startswith("no complete frame")]
         if why:
             parts.append(f"{r.path}: {'; '.join(dict.fromkeys(why))}")
@@ -422,6 +422,16 @@ def convert(
                     span = stream.set_out()
                     first, configured = span.start, len(span)
                     absent = [k for k in span if k not in seen and options.wants_frame(k)]
+                    if not stream.truncated:  # whole bytes: a frame the reader left out is there, but incomplete
+                        hollow: dict[int, str] = {}
+                        for k, why in stream.incomplete:
+                            hollow.setdefault(k, why)
+                        rep.skipped += [
+                            {"frames": [k, k], "reason": f"in the recording but incomplete: {hollow[k]}"}
+                            for k in absent
+                            if k in hollow
+                        ]
+                        absent = [k for k in absent if k not in hollow]
                     if absent:
                         written = stream.run.get("frames_written")
                         # every frame written, yet some not read: lost to damage or a cut (it said "not in the recording

@@ -75,7 +75,7 @@ class ConvertReport:
         for r in self.recordings:
             where = f"{r.split}/{r.folder}" if r.split else r.folder
             out.append(f"{r.path.name} -> {where}: {counted(r.frames_converted, 'frame')}")
-            out += [f"  skipped frames {s['frames'][0]}..{s['frames'][1]}: {s['reason']}" for s in r.skipped]
+            out += [f"  skipped {_frames(*s['frames'])}: {s['reason']}" for s in r.skipped]
             out += [f"  note: {n}" for n in r.notes]
         taken = {r.split for r in self.recordings if r.split}
         empty = [s for s in ("train", "validate", "test") if s not in taken]
@@ -94,6 +94,11 @@ class ConvertReport:
             f"in {self.seconds:.1f} s -> {self.out_dir}"
         )
         return out
+
+
+def _frames(first: int, last: int) -> str:
+    """``"frame 7"`` or ``"frames 3..9"``: "frames 7..7" was read as a range."""
+    return f"frame {first}" if first == last else f"frames {first}..{last}"
 
 
 def load_report(out_dir: str | Path) -> dict[str, Any]:
