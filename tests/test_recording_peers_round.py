@@ -45,6 +45,10 @@ Found and fixed (each test below failed before):
 * ``mmusv convert`` of such a whole file said "skipped frames 79..79: lost from the recording (run complete: 80 of
   80 frames written)": now "skipped frame 79: in the recording but incomplete: its /u/lidar message is ..."
   (``mmusv.export.conversion``, ``convert_report``).
+* A whole recording followed by padding (4096 zero bytes after its closing magic, as a copy written in whole
+  blocks leaves it) was "truncated: ... the summary section after the data is cut off or damaged"; it now says how
+  many bytes follow the end of the MCAP file and that the recording is whole before them (``mmusv.recording.scan``;
+  the official ``make_reader`` cannot open it at all).
 """
 
 from __future__ import annotations
@@ -409,3 +413,19 @@ def test_convert_names_one_skipped_frame_and_why_it_is_incomplete(dense: Path, t
     assert code == 0 and "79 frames" in out, (out, err)
     assert "skipped frame 79: in the recording but incomplete: its /u/lidar message is" in out, out
     assert "79..79" not in out and "lost from the recording" not in out, out
+
+
+def test_bytes_after_the_end_of_a_whole_recording_are_not_called_a_cut(dense: Path, tmp_path: Path) -> None:
+    """A copy padded after its closing magic (a tool that writes whole blocks): every record is there, yet it was
+    "truncated: ... the summary section after the data is cut off or damaged"."""
+    from mmusv.recording import summary
+
+    data = dense.read_bytes()
+    path = tmp_path / "padded.mcap"
+    path.write_bytes(data + bytes(4096))
+    got = summary(path)
+    assert not got["complete"] and got["frames"]["read"] == 80, got["frames"]
+    assert got["damage"] == [
+        f"the file is damaged at bytes {len(data)}..{len(data) + 4096}: 4096 bytes follow the end of the MCAP file "
+        f"(its footer and closing magic end at byte {len(data)}): not part of the recording, whole before them"
+    ], got["damage"]

@@ -301,7 +301,17 @@ class Scan:
                     self.damage.append(d)
                     yield None, d
                 self._footer(f)
-                if not self.complete:
+                ends = None if self.complete else self._end_before(f, end)
+                if ends is not None:  # whole up to its closing magic, with bytes after it (a copy padded to blocks)
+                    d = Damage(
+                        ends,
+                        size,
+                        f"{size - ends} bytes follow the end of the MCAP file (its footer and closing magic end at "
+                        f"byte {ends}): not part of the recording, whole before them",
+                    )
+                    self.damage.append(d)
+                    yield None, d
+                elif not self.complete:
                     d = Damage(
                         end,
                         size,
@@ -424,6 +434,25 @@ class Scan:
             else:
                 out.append(rec)
         return _Cut(out, whole=whole and at == len(raw), cut_time=cut_time)
+
+    def _end_before(self, f: IO[bytes], start: int) -> int | None:
+        """Where the MCAP file ends (after its footer and closing magic) when that is before the end of the file:
+        the summary records from ``start`` (just after the data end) lead to a footer and the magic. ``None`` when
+        they do not (a summary cut off or damaged)."""
+        at = start
+        while at + 9 <= self.size:
+            f.seek(at)
+            head = f.read(9)
+            op, n = head[0], u64(head, 1)
+            if op == FOOTER:
+                if n != 20:
+                    return None
+                f.seek(at + 9 + 20)
+                return at + 9 + 20 + 8 if f.read(8) == MAGIC and at + 37 < self.size else None
+            if op not in NAMES or at + 9 + n > self.size:
+                return None
+            at += 9 + n
+        return None
 
     def _footer(self, f: IO[bytes]) -> None:
         size = self.size
