@@ -49,6 +49,10 @@ Found and fixed (each test below failed before):
   blocks leaves it) was "truncated: ... the summary section after the data is cut off or damaged"; it now says how
   many bytes follow the end of the MCAP file and that the recording is whole before them (``mmusv.recording.scan``;
   the official ``make_reader`` cannot open it at all).
+* ``mmusv recover`` on a run folder whose ``.mcap`` is a copy cut short, or has a damaged chunk, beside whole tables
+  said "nothing to recover: dense.mcap is finished and its tables are whole" without reading the recording; it now
+  reads it through and says what it lacks (``mmusv.recording.recover``). A recording without run metadata that is
+  not a ``.partial`` is no longer only "the run did not finish": its copy may be cut before its end.
 """
 
 from __future__ import annotations
@@ -429,3 +433,26 @@ def test_bytes_after_the_end_of_a_whole_recording_are_not_called_a_cut(dense: Pa
         f"the file is damaged at bytes {len(data)}..{len(data) + 4096}: 4096 bytes follow the end of the MCAP file "
         f"(its footer and closing magic end at byte {len(data)}): not part of the recording, whole before them"
     ], got["damage"]
+
+
+@pytest.mark.parametrize("damage", ["cut", "chunk"])
+def test_recover_does_not_call_a_cut_or_damaged_recording_finished(dense: Path, tmp_path: Path, damage: str) -> None:
+    """``mmusv recover`` on a run folder whose recording is a copy cut short (or has a damaged chunk) and whose
+    tables are whole said "nothing to recover: dense.mcap is finished and its tables are whole", without reading
+    the recording."""
+    import shutil
+
+    run = shutil.copytree(dense.parent, tmp_path / "run")
+    data = dense.read_bytes()
+    (run / dense.name).write_bytes(data[:3_000_000] if damage == "cut" else _damaged(data, 1, field=False))
+    code, _out, err = _cli("recover", str(run))
+    assert code == 2 and "is finished" not in err, err
+    assert err.startswith(f"mmusv: error: nothing to recover in {run}: the tables of dense.mcap are whole, but "), err
+    said = {
+        "cut": "48 of 80 frames read; frames 48..79 missing (the run did not finish, or this copy is cut before its "
+        "end (no run metadata))",
+        "chunk": "43 of 80 frames read; frames 43..79 missing;",
+    }
+    assert said[damage] in err and "does not mend a damaged recording" in err, err
+    code, _out, err = _cli("recover", str(dense.parent))  # a whole one still is
+    assert code == 2 and "dense.mcap is finished and its tables are whole" in err, err

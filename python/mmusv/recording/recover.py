@@ -277,8 +277,18 @@ def rebuild_finished_tables(recording: str | os.PathLike[str]) -> Recovered:
     listed = listed_tables(folder, rec.name)
     held = FrameStream(info, lambda _t: False).held()[0]  # as the run metadata says, before reading every chunk
     problems, _ = check_tables(tables_dir, held, listed=listed)
-    if not problems:
-        raise IoError(f"nothing to recover in {folder}: {rec.name} is finished and its tables are whole")
+    if not problems:  # the recording is read through before it is called finished: a copy may be cut or damaged
+        whole = FrameStream(info, lambda _t: False)
+        for _ in whole:
+            pass
+        report = whole.report()
+        if report is None:
+            raise IoError(f"nothing to recover in {folder}: {rec.name} is finished and its tables are whole")
+        raise IoError(
+            f"nothing to recover in {folder}: the tables of {rec.name} are whole, but the recording is not "
+            f"({report}); recover finishes a killed run's .partial and rebuilds tables, it does not mend a damaged "
+            "recording: restore it from a whole copy or record the scenario again"
+        )
     staged = staging(tables_dir)
     try:
         stream = stage_tables(rec, staged)

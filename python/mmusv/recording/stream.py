@@ -463,7 +463,10 @@ class FrameStream:
         span, said = self.expected()
         parts = [f"{self.info.path}: {len(set(self.yielded))} of {len(span)} frames read"]
         if missing:
-            why = [] if said else ["the run did not finish (no run metadata)"]
+            # a killed run's .partial has no run metadata (written last); nor has a finished run's copy cut short
+            killed = any(str(f).endswith(".partial") for f in (self.info.path, *self.info.parts))
+            unsaid = "the run did not finish" + ("" if killed else ", or this copy is cut before its end")
+            why = [] if said else [f"{unsaid} (no run metadata)"]
             status = self.run.get("status")
             if said and status and status != "complete":
                 why.append(f"run status {status}: {self.run.get('frames_written', '?')} frames written")
