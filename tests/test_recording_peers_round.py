@@ -53,6 +53,8 @@ Found and fixed (each test below failed before):
   said "nothing to recover: dense.mcap is finished and its tables are whole" without reading the recording; it now
   reads it through and says what it lacks (``mmusv.recording.recover``). A recording without run metadata that is
   not a ``.partial`` is no longer only "the run did not finish": its copy may be cut before its end.
+* A recording finished by ``mmusv recover`` held its scenario, manifest and sensors metadata after every message
+  (a run writes them before its first chunk), so a copy of it cut short held no readable frame; they now come first.
 """
 
 from __future__ import annotations
@@ -456,3 +458,25 @@ def test_recover_does_not_call_a_cut_or_damaged_recording_finished(dense: Path, 
     assert said[damage] in err and "does not mend a damaged recording" in err, err
     code, _out, err = _cli("recover", str(dense.parent))  # a whole one still is
     assert code == 2 and "dense.mcap is finished and its tables are whole" in err, err
+
+
+def test_a_recovered_recording_keeps_its_metadata_before_its_frames(dense: Path, tmp_path: Path) -> None:
+    """``mmusv run`` writes the scenario, manifest and sensors metadata before the first chunk, so that a copy cut
+    short still reads up to the cut; ``mmusv recover`` wrote them after every message, and a recovered recording
+    cut short held no frame ("has no scenario/sensors metadata; was it written by mmusv run?")."""
+    from mcap_rechunk import killed_copy
+    from mmusv.recording import summary
+
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "scenario.yaml").write_bytes((dense.parent / "scenario.yaml").read_bytes())
+    killed_copy(dense, run / "dense.mcap.partial", messages=300)  # frames 0..59
+    code, out, err = _cli("recover", str(run))
+    assert code == 0 and "recovered 60 of 80 frames (frames 0..59)" in out, (out, err)
+    data = (run / "dense.mcap").read_bytes()
+    kinds = [type(r).__name__ for _s, _e, r in _records(data)]
+    assert kinds[:4] == ["Header", "Metadata", "Metadata", "Metadata"] and kinds.count("Metadata") == 4, kinds
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(data[: len(data) // 2])
+    got = summary(cut)
+    assert got["frames"] is not None and 0 < got["frames"]["read"] < 60 and not got["complete"], got

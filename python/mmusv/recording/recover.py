@@ -352,6 +352,14 @@ def _finish(src: Path, info: RecordingInfo, final: Path, tmp: Path, staged: Path
         with tmp.open("wb") as f:
             w = Writer(f, chunk_size=_CHUNK_BYTES, compression=CompressionType.ZSTD)
             w.start(profile="", library="mmusv recover")
+            # the scenario, manifest and sensors metadata first, as mmusv run writes them: a copy of the recovered
+            # file cut short still reads up to the cut (written after the messages, such a copy held no frame)
+            head = Scan(src, chunks=False)
+            for _ in head.messages():
+                pass
+            for name in ("scenario", "manifest", "sensors"):
+                if name in head.metadata:
+                    w.add_metadata(name, head.metadata[name])
             schemas: dict[int, int] = {}
             channels: dict[int, int] = {}
             for msg, dmg in scan.messages():
@@ -368,9 +376,6 @@ def _finish(src: Path, info: RecordingInfo, final: Path, tmp: Path, staged: Path
                         ch.topic, ch.message_encoding, schemas.get(ch.schema_id, 0), dict(ch.metadata)
                     )
                 w.add_message(channels[ch.id], msg.log_time, msg.data, msg.publish_time, msg.sequence)
-            for name in ("scenario", "manifest", "sensors"):
-                if name in scan.metadata:
-                    w.add_metadata(name, scan.metadata[name])
             run = dict(scan.metadata.get("run", {}))
             run.update(
                 scenario=info.scenario_name,
