@@ -11,7 +11,7 @@ What was checked (``tests/test_recording_round.py`` already checks the statistic
   channel's messages in the decompressed chunk; each chunk's start and end times are its messages' first and last;
   the summary offsets point at their groups, the metadata indexes at their records. The peer's time-ordered read
   (forward and reverse) is file order, its decoded messages are mmusv's, and its indexed read of the split frame
-  (``start_time``/``end_time`` of one log time) gives all five topics.
+  (``starting_at``/``ending_before`` one log time) gives all five topics; 400 messages in all, as the statistics say.
 * The same file cut at every kind of record boundary (inside the header, after it, inside the metadata, inside
   a chunk, inside a message index, before and after the data end, inside the summary and the footer, the last
   byte): ``summary`` never says ``complete``, every message mmusv reads is the peer's message at that place, and
@@ -55,6 +55,12 @@ Found and fixed (each test below failed before):
   not a ``.partial`` is no longer only "the run did not finish": its copy may be cut before its end.
 * A recording finished by ``mmusv recover`` held its scenario, manifest and sensors metadata after every message
   (a run writes them before its first chunk), so a copy of it cut short held no readable frame; they now come first.
+
+Not fixed here (reported): a Foxglove user gets no ``foxglove.CameraCalibration`` beside the camera images (the
+intrinsics are only in the ``sensors`` metadata, so the 3D panel cannot project them) and no
+``foxglove.ImageAnnotations`` for the 2D boxes (only in ``mmusv.AgentAnnotations``): both need the core's recorder;
+a file finished by ``mmusv recover`` has no data-section CRC (the official Python writer leaves it 0), so changes
+outside its chunks go unseen.
 """
 
 from __future__ import annotations
