@@ -55,6 +55,8 @@ Found and fixed (each test below failed before):
   not a ``.partial`` is no longer only "the run did not finish": its copy may be cut before its end.
 * A recording finished by ``mmusv recover`` held its scenario, manifest and sensors metadata after every message
   (a run writes them before its first chunk), so a copy of it cut short held no readable frame; they now come first.
+* ``mmusv info`` gave a damaged recording of a complete run the status "complete", alone beside "43 of 80 frames"
+  (and so did a folder's overview in its status column): now "complete (file damaged)".
 
 Not fixed here (reported): a Foxglove user gets no ``foxglove.CameraCalibration`` beside the camera images (the
 intrinsics are only in the ``sensors`` metadata, so the 3D panel cannot project them) and no
@@ -486,3 +488,21 @@ def test_a_recovered_recording_keeps_its_metadata_before_its_frames(dense: Path,
     cut.write_bytes(data[: len(data) // 2])
     got = summary(cut)
     assert got["frames"] is not None and 0 < got["frames"]["read"] < 60 and not got["complete"], got
+
+
+def test_info_does_not_call_a_damaged_recording_of_a_complete_run_complete(dense: Path, tmp_path: Path) -> None:
+    """The run's status, "complete", stood alone beside "43 of 80 frames" (``mmusv info`` on the file) and in the
+    status column of a folder's overview, for a file with a damaged chunk or bytes after its end."""
+    import shutil
+
+    data = dense.read_bytes()
+    for name, damaged in (("chunk", _damaged(data, 1, field=True)), ("padded", data + bytes(4096))):
+        run = shutil.copytree(dense.parent, tmp_path / "runs" / name)
+        (run / dense.name).write_bytes(damaged)
+        code, out, _err = _cli("info", str(run / dense.name))
+        assert code == 0 and f"{run / dense.name}: scenario dense, status complete (file damaged), " in out, out
+    code, out, _err = _cli("info", str(tmp_path / "runs"))
+    for name in ("chunk", "padded"):
+        assert f"│ {name}/dense.mcap │ dense │ complete (file damaged) │" in out, out
+    code, out, _err = _cli("info", str(dense))
+    assert code == 0 and "status complete, 80 frames" in out, out

@@ -8,7 +8,7 @@ from __future__ import annotations
 import argparse
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from mmusv.cli_console import rich_console
 from mmusv.cli_paths import output_arg, path_arg
@@ -88,7 +88,7 @@ def cmd_info(args: argparse.Namespace) -> int:
             Text.assemble(
                 (str(target), "bold"),
                 f": scenario {run_meta.get('scenario') or _scenario_of(meta, target)}, "
-                f"status {run_meta.get('status', 'unfinished (no run metadata: the run was killed or is still going)')}"
+                f"status {_status(run_meta, info, _UNSAID)}"
                 f", {written}, agents {run_meta.get('agents') or _agents_of(meta)}",
             ),
             highlight=False,
@@ -131,6 +131,18 @@ def cmd_info(args: argparse.Namespace) -> int:
     if frames:
         return 1 if not frames.get("read") and frames.get("expected") else 0
     return 1 if info.get("frames") is None and problems and not info.get("messages") else 0
+
+
+_UNSAID = "unfinished (no run metadata: the run was killed or is still going)"
+"""The status of a recording without ``run`` metadata, which a run writes last."""
+
+
+def _status(run_meta: dict[str, str], info: dict[str, Any], unsaid: str) -> str:
+    """The run's status as its ``run`` metadata says (``unsaid`` without it), and, for a run that says
+    ``complete`` in a file that is damaged or cut, that the file is not: a bare "complete" beside frames lost to the
+    damage read as a whole recording."""
+    status = str(run_meta.get("status", unsaid))
+    return f"{status} (file damaged)" if status == "complete" and not info.get("complete", True) else status
 
 
 def _scenario_of(meta: dict[str, dict[str, str]], target: Path) -> str:
@@ -230,7 +242,7 @@ def _overview(folder: Path, found: list[Path], gone: list[MissingRecording], dam
         cells: tuple[str, ...] = (
             name,
             str(run_meta.get("scenario") or _scenario_of(meta, rec)),
-            str(run_meta.get("status", "unfinished")),
+            _status(run_meta, info, "unfinished"),
             f"{read}" if read == expected else f"{read} of {expected}",
             str(run_meta.get("agents") or _agents_of(meta)),
             short(name, problems),
