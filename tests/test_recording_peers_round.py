@@ -62,7 +62,11 @@ Not fixed here (reported): a Foxglove user gets no ``foxglove.CameraCalibration`
 intrinsics are only in the ``sensors`` metadata, so the 3D panel cannot project them) and no
 ``foxglove.ImageAnnotations`` for the 2D boxes (only in ``mmusv.AgentAnnotations``): both need the core's recorder;
 a file finished by ``mmusv recover`` has no data-section CRC (the official Python writer leaves it 0), so changes
-outside its chunks go unseen.
+outside its chunks go unseen; the recorder defines every schema and channel only inside the chunk of its first
+message (the first chunk), so a file without a readable summary (a killed run's ``.partial``, a copy cut short)
+whose first chunk is damaged loses every frame, the whole chunks after it included (one flipped bit at 1 MB into
+the 80-frame file: 0 of 80 frames, where 36 are intact), and so does a copy missing a range of bytes (its footer's
+summary offset then points elsewhere).
 """
 
 from __future__ import annotations
