@@ -298,9 +298,10 @@ def test_lidar_water_returns_follow_incidence_and_are_speckle_above_the_threshol
     sea = sea_spec_for_preset("W1")
     scene.set_wave_surface(sea, scenario_seed=4, time_s=3.0, foci=np.zeros((1, 2)), detail=False, slopes=False)
     el = np.radians(np.linspace(-25.0, 2.0, 64)).tolist()
+    # The flat sea's knobs, ignored over the waves, but for both probabilities 0, which switch the water off.
     lidar = core.Lidar(
         elevations=el, azimuth_steps=2048, range_min=0.5, range_max=120.0, range_noise_std=0.0, dropout=0.0,
-        water_probability=0.0, water_probability_per_wave_m=0.0, water_range_m=0.0, water_range_per_wave_m=0.0,
+        water_probability=0.05, water_probability_per_wave_m=0.1, water_range_m=0.0, water_range_per_wave_m=0.0,
     )  # fmt: skip
     pose = mast(3.0)
     wind = 8.0
