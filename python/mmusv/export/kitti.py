@@ -20,7 +20,8 @@ An agent without a front camera has no ``image_2``, zero ``P0..P3`` and, as came
 KITTI's readers turn them into LiDAR boxes with the right heading. A front camera's lens distortion (KITTI's
 images are rectified; ``P2`` is a pinhole) is in ``mmusv_kitti.yaml`` and the conversion's notes.
 Extras: ``depth_2`` (uint16 cm, 0 = no hit, 65535 = 655.35 m or farther), ``semantic_2``, ``instance_2``,
-``radar_ppi``, ``top_view_rgb``, ``top_view_semantic``.
+``radar_ppi``, ``top_view_rgb``, ``top_view_semantic`` (their size, scale, orientation and pixel mapping in
+``mmusv_kitti.yaml``'s ``top_views`` and ``top_view_png``: :func:`mmusv.export.common.top_view_protocol`).
 """
 
 from __future__ import annotations
@@ -33,7 +34,7 @@ import numpy as np
 
 from mmusv.annotate import box_corners
 from mmusv.classes import class_name
-from mmusv.export.common import cav_id, depth_png, dump_yaml, png_bytes
+from mmusv.export.common import cav_id, depth_png, dump_yaml, png_bytes, top_view_protocol
 from mmusv.export.geometry import AgentView, Target
 from mmusv.export.writer import DatasetWriter
 from mmusv.frames import BODY_TO_OPTICAL, invert, wrap_rad
@@ -399,6 +400,11 @@ class KittiWriter(DatasetWriter):
                     "frequency_hz": self.info.frequency_hz,
                     "include_usvs": o.include_usvs,
                     "extras": list(o.extras),
+                    **(
+                        top_view_protocol(self.agents, frame="mmusv", files="<cav_id>/top_view_{rgb,semantic}/<ts>.png")
+                        if "top_view" in o.extras
+                        else {}
+                    ),
                     "frames_converted": len(frames),
                     "frames_skipped": skipped,
                 }

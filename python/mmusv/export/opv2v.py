@@ -18,7 +18,10 @@ rate ``vz`` is part of it, so a vessel sailing at ``speed_mps`` shows a little m
 
 ``data_protocol.yaml``: OpenCDA's ``world`` and ``vehicle_base`` (one LiDAR for every CAV: the first agent's, as
 CARLA's attributes ``channels``, ``range``, ``upper_fov``, ...), and under ``mmusv`` the source, ``cavs`` and
-``lidars``, each agent's LiDAR by ``cav_id`` (the conversion's notes say when they differ).
+``lidars``, each agent's LiDAR by ``cav_id`` (the conversion's notes say when they differ); with the ``top_view``
+extra, ``top_views`` (each agent's top view by ``cav_id``: ``resolution``, ``metres_per_pixel``, ``orientation``,
+``altitude_m``) and ``top_view_png`` (where each pixel lies, from ``true_ego_pos``:
+:func:`mmusv.export.common.top_view_protocol`).
 
 Files beyond stock OPV2V, which stock loaders skip: ``<ts>_additional.yaml`` (our names, classes and LiDAR point
 counts of the listed vehicles), ``<ts>_depth{i}.png`` (HEAL's OPV2V-H depth: 8-bit grayscale, whole metres
@@ -56,6 +59,7 @@ from mmusv.export.common import (
     encode_png,
     png_bytes,
     rounded,
+    top_view_protocol,
 )
 from mmusv.export.geometry import AgentView, Target
 from mmusv.export.opencood import HypesStats, constants, hypes
@@ -390,6 +394,11 @@ class Opv2vWriter(DatasetWriter):
                     "saturated": 65535,
                     "along": "optical axis",
                 },
+                **(
+                    top_view_protocol(self.agents, frame="carla", files="<ts>_topview_{rgb,semantic}.png")
+                    if "top_view" in o.extras
+                    else {}
+                ),
                 "frames_converted": len(frames),
                 "frames_skipped": skipped,
             },
