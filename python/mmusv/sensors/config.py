@@ -451,7 +451,11 @@ class TopViewConfig(_Model):
     """A level orthographic camera ``altitude_m`` above the water over the USV, looking straight down:
     ``resolution`` pixels at ``metres_per_pixel``; ``heading_up`` puts the USV's bow at the top of the image,
     ``north_up`` puts north there; ``outputs`` any of ``rgb``, ``semantic``, ``instance`` (no ``depth``);
-    ``exposure`` as a camera's (:class:`ExposureConfig`)."""
+    ``exposure`` as a camera's (:class:`ExposureConfig`). Pixel ``(u, v)``'s centre lies ``(u + 0.5 − W/2) · m`` to
+    the right of the USV's origin and ``(H/2 − v − 0.5) · m`` ahead of it (``m`` = ``metres_per_pixel``, ``W × H`` =
+    ``resolution``; right = starboard or east). Its rays start ``altitude_m`` up: what rises above that (a ship
+    alongside taller than the top view; the USV's own hull must stay below it) is cut there, and the camera sees
+    its decks below, still that ship's class and instance."""
 
     altitude_m: float = Field(default=120.0, gt=0, le=20_000)
     resolution: tuple[int, int] = (512, 512)
