@@ -24,7 +24,11 @@ them (a helper's round): each check against an independent computation written o
   to place them: no scale, size, orientation or centre anywhere in the export (``data_protocol.yaml``,
   ``mmusv_kitti.yaml``), so a BEV label could not be matched to the labelled boxes. Both now give each agent's top
   view (``top_views`` by ``cav_id``) and the pixel mapping in their frames (``top_view_png``); read with yaml and
-  PIL, the listed vehicles' footprints land on the vessel pixels.
+  PIL, the listed vehicles' footprints land on the vessel pixels. The ROS 2 bag placed its top view by ``/tf``
+  (``map → <usv>/top_view_optical``) but, an orthographic camera having no ``CameraInfo``, gave its metres per pixel
+  nowhere; ``metadata.yaml``'s ``custom_data`` now has ``mmusv.top_view.<usv>``, and read with ``mcap_ros2`` the
+  ``/<usv>/detections`` boxes, through ``/tf`` and ``/tf_static``, land on the ``16UC1`` semantic image's vessels.
+  (KITTI tracking's ``top_view_*`` images still come without it: its export writes no ``mmusv_kitti.yaml``.)
 * Bad top-view values in a scenario file name the file, the field and what it may be; the same seed gives the same
   bytes.
 """
@@ -322,6 +326,57 @@ def test_kitti_top_view_says_where_its_pixels_are(rec: Path, tmp_path: Path) -> 
             # label's box is upright in the LiDAR frame, which tilts with the hull: not its bottom face alone.
             side = world[0, :2] - world[3, :2]
             boxes.append((world[:, :2].mean(axis=0), math.atan2(side[1], side[0]), float(fields[10]), float(fields[9])))
+        seen += _check_semantic(sem, xy, boxes)
+    assert seen >= 5, seen
+
+
+def test_ros2_top_view_says_where_its_pixels_are(rec: Path, tmp_path: Path) -> None:
+    from mcap_ros2.decoder import DecoderFactory as Ros2Decoders
+
+    out = tmp_path / "ros2"
+    convert(rec, to="ros2", out_dir=out)
+    bag = out / SCENARIO["name"]
+    custom = yaml.safe_load((bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]["custom_data"]
+    assert "mmusv.top_view.u" in custom, "the bag says nothing of the top views' scale and orientation"
+    tf: dict[str, tuple[str, np.ndarray]] = {}
+    msgs: dict[str, Any] = {}
+    with (bag / f"{SCENARIO['name']}.mcap").open("rb") as f:
+        for _, channel, message, decoded in make_reader(f, decoder_factories=[Ros2Decoders()]).iter_decoded_messages():
+            if message.log_time != 1_000_000_000:  # the first frame (1 s: the bag's time offset)
+                continue
+            if channel.topic in ("/tf", "/tf_static"):
+                for t in decoded.transforms:
+                    tf[t.child_frame_id] = (t.header.frame_id, _matrix(t.transform.translation, t.transform.rotation))
+            else:
+                msgs[channel.topic] = decoded
+
+    def to_map(frame: str) -> np.ndarray:
+        m = np.eye(4)
+        while frame != "map":
+            frame, step = tf[frame]
+            m = step @ m
+        return m
+
+    seen = 0
+    for agent in ("u", "v"):
+        tv = json.loads(custom[f"mmusv.top_view.{agent}"])
+        m, (w, h) = tv["metres_per_pixel"], tv["resolution"]
+        img = msgs[f"/{agent}/top_view/semantic"]
+        assert (img.width, img.height, img.encoding) == (w, h, "16UC1")
+        sem = np.frombuffer(bytes(img.data), dtype="<u2").reshape(h, w)
+        cam = to_map(img.header.frame_id)
+        vv, uu = np.mgrid[0:h, 0:w]
+        optical = np.stack([(uu + 0.5 - w / 2) * m, (vv + 0.5 - h / 2) * m, np.zeros((h, w))], -1).reshape(-1, 3)
+        xy = (optical @ cam[:3, :3].T + cam[:3, 3])[:, :2]
+        boxes = []
+        dets = msgs[f"/{agent}/detections"]
+        lidar = to_map(dets.header.frame_id)
+        for d in dets.detections:
+            if d.results[0].hypothesis.class_id != "vessel":
+                continue
+            c, q = d.bbox.center.position, d.bbox.center.orientation
+            box = lidar @ _matrix(c, q)
+            boxes.append((box[:2, 3], math.atan2(box[1, 0], box[0, 0]), d.bbox.size.x, d.bbox.size.y))
         seen += _check_semantic(sem, xy, boxes)
     assert seen >= 5, seen
 

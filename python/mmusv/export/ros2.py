@@ -11,8 +11,9 @@ mmusv world: x east, y north, z up); per instrumented USV ``<usv>/odom`` (= ``ma
 (x forward, y left, z up; ``/tf`` every frame) → ``<usv>/lidar``, ``<usv>/radar``, ``<usv>/camera_<name>`` (x
 forward) → ``<usv>/camera_<name>_optical`` (x right, y down, z forward) on ``/tf_static`` (transient local);
 every other vessel ``map`` → ``<vessel>/base_link`` on ``/tf``; the top-view camera ``map`` →
-``<usv>/top_view_optical`` on ``/tf``. Topic names spell vessel ids and camera names as ROS 2 name tokens
-(:func:`ros_token`: ``usv-1`` → ``usv_1``, ``2b`` → ``_2b``); frame ids keep them as they are.
+``<usv>/top_view_optical`` on ``/tf`` (its scale and size in ``metadata.yaml``'s ``custom_data``,
+``mmusv.top_view.<usv>``: :func:`top_view_custom_data`). Topic names spell vessel ids and camera names as ROS 2
+name tokens (:func:`ros_token`: ``usv-1`` → ``usv_1``, ``2b`` → ``_2b``); frame ids keep them as they are.
 
 The frame ids and topic names are :mod:`mmusv.export.ros2_names`'s, the messages built by
 :mod:`mmusv.export.ros2_msgs`; this module writes them into the bag.
@@ -67,6 +68,7 @@ __all__ = [
     "optical_frame",
     "ros_token",
     "ros_topic",
+    "top_view_custom_data",
     "top_view_frame",
 ]
 
@@ -99,6 +101,24 @@ def camera_distortion(agent: AgentInfo, name: str) -> np.ndarray:
         if isinstance(c, dict) and c.get("name") == name and c.get("distortion") is not None:
             return np.asarray(c["distortion"], dtype=np.float64).reshape(5)
     return np.zeros(5)
+
+
+def top_view_custom_data(top_view: dict[str, Any]) -> str:
+    """``metadata.yaml``'s ``custom_data`` ``mmusv.top_view.<usv>`` of a recorded rig's ``top_view``: JSON
+    ``{"altitude_m", "metres_per_pixel", "orientation", "resolution": [W, H]}``. Pixel ``(u, v)`` (column, row of
+    the image) has its centre at ``((u + 0.5 − W/2) · m, (v + 0.5 − H/2) · m, 0)`` in ``<usv>/top_view_optical``
+    (``m`` = ``metres_per_pixel``), the frame ``/tf`` places ``altitude_m`` over the USV, looking straight down."""
+    import json
+
+    return json.dumps(
+        {
+            "altitude_m": float(top_view["altitude_m"]),
+            "metres_per_pixel": float(top_view["metres_per_pixel"]),
+            "orientation": str(top_view["orientation"]),
+            "resolution": [int(x) for x in top_view["resolution"]],
+        },
+        sort_keys=True,
+    )
 
 
 @dataclass(frozen=True)
@@ -552,7 +572,8 @@ class Ros2Writer(DatasetWriter):
     def _close(self, *, status: str) -> None:
         """Writes each USV's last odometry (held for a successor that never came) and the bag's custom data, its
         ``mmusv.status`` ``status`` (``complete``, or ``interrupted``: the bag itself says it holds only the frames
-        converted before a stop, which peers otherwise read as a whole one), and closes the bag."""
+        converted before a stop, which peers otherwise read as a whole one) and each USV's top view
+        (``mmusv.top_view.<usv>``: :func:`top_view_custom_data`), and closes the bag."""
         for a in self.agents:
             self._odometry(a, None)
         self.bag.set_custom_data("mmusv.source", self.info.path.name)
@@ -560,6 +581,10 @@ class Ros2Writer(DatasetWriter):
         self.bag.set_custom_data("mmusv.config_hash", self.info.config_hash)
         self.bag.set_custom_data("mmusv.time_offset_ns", str(TIME_OFFSET_NS))
         self.bag.set_custom_data("mmusv.status", status)
+        for a in self.agents:  # what places the top view's pixels: an orthographic camera has no CameraInfo
+            tv = a.rig.get("top_view")
+            if tv:
+                self.bag.set_custom_data(f"mmusv.top_view.{a.id}", top_view_custom_data(tv))
         try:
             self.bag.close()
         except OSError as exc:
