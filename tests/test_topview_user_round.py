@@ -28,7 +28,8 @@ them (a helper's round): each check against an independent computation written o
   (``map → <usv>/top_view_optical``) but, an orthographic camera having no ``CameraInfo``, gave its metres per pixel
   nowhere; ``metadata.yaml``'s ``custom_data`` now has ``mmusv.top_view.<usv>``, and read with ``mcap_ros2`` the
   ``/<usv>/detections`` boxes, through ``/tf`` and ``/tf_static``, land on the ``16UC1`` semantic image's vessels.
-  (KITTI tracking's ``top_view_*`` images still come without it: its export writes no ``mmusv_kitti.yaml``.)
+  KITTI tracking's ``top_view_*`` images came without it too (that export writes no ``mmusv_kitti.yaml``): its
+  root now has ``top_views.yaml``, by ``<split>/<seq>``, with the mapping from ``pose/<seq>.txt`` and ``Tr_imu_velo``.
 * Bad top-view values in a scenario file name the file, the field and what it may be; the same seed gives the same
   bytes.
 """
@@ -326,6 +327,44 @@ def test_kitti_top_view_says_where_its_pixels_are(rec: Path, tmp_path: Path) -> 
             # label's box is upright in the LiDAR frame, which tilts with the hull: not its bottom face alone.
             side = world[0, :2] - world[3, :2]
             boxes.append((world[:, :2].mean(axis=0), math.atan2(side[1], side[0]), float(fields[10]), float(fields[9])))
+        seen += _check_semantic(sem, xy, boxes)
+    assert seen >= 5, seen
+
+
+def test_kitti_tracking_top_view_says_where_its_pixels_are(rec: Path, tmp_path: Path) -> None:
+    out = tmp_path / "tracking"
+    convert(rec, to="kitti_tracking", out_dir=out, splits=None, extras=("top_view",))
+    assert (out / "top_views.yaml").is_file(), "the tracking export says nothing of the top views' scale"
+    meta = yaml.safe_load((out / "top_views.yaml").read_text())
+    assert "pose/<seq>.txt" in meta["top_view_png"]["pixel"]
+    sequences = {row.split(",")[1]: row.split(",") for row in (out / "sequences.csv").read_text().splitlines()[1:]}
+    assert set(meta["top_views"]) == {f"train/{seq}" for seq in sequences}
+    _, msgs = _read(rec)  # the world state's boxes: the tracking labels are the KITTI export's, checked above
+    boxes = [
+        (np.array(v.box_center[:2]), v.pose[5], v.box_size[0], v.box_size[1])
+        for v in msgs["/world/state"].vessels
+        if v.role != "usv"
+    ]
+    seen = 0
+    for key, tv in meta["top_views"].items():
+        split, seq = key.split("/")
+        m, (w, h) = tv["metres_per_pixel"], tv["resolution"]
+        calib: dict[str, np.ndarray] = {}
+        for line in (out / split / "calib" / f"{seq}.txt").read_text().splitlines():
+            name, _, vals = line.partition(" ")
+            calib[name.rstrip(":")] = np.array([float(x) for x in vals.split()])
+        pose = np.vstack([np.loadtxt(out / split / "pose" / f"{seq}.txt", ndmin=2)[0].reshape(3, 4), [0, 0, 0, 1]])
+        body = pose @ np.vstack([calib["Tr_imu_velo"].reshape(3, 4), [0, 0, 0, 1]])
+        x0, y0, yaw = body[0, 3], body[1, 3], math.atan2(body[1, 0], body[0, 0])
+        sem = _png((out / split / "top_view_semantic" / seq / "000000.png").read_bytes())
+        assert sem.shape == (h, w)
+        vv, uu = np.mgrid[0:h, 0:w]
+        left, ahead = ((w / 2 - uu - 0.5) * m).ravel(), ((h / 2 - vv - 0.5) * m).ravel()
+        if tv["orientation"] == "heading_up":
+            c, s_ = math.cos(yaw), math.sin(yaw)
+            xy = np.stack([x0 + ahead * c - left * s_, y0 + ahead * s_ + left * c], 1)
+        else:
+            xy = np.stack([x0 - left, y0 + ahead], 1)
         seen += _check_semantic(sem, xy, boxes)
     assert seen >= 5, seen
 

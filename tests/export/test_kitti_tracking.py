@@ -100,7 +100,8 @@ def world_states(rec: Path) -> dict[int, Any]:
 def test_layout_sequences_and_seqmap(exports: dict[str, Path], port_rec: Path) -> None:
     root, train = exports["root"], exports["track"]
     info = read_info(port_rec)
-    assert sorted(p.name for p in root.iterdir()) == ["conversion.yaml", "sequences.csv", "tracks.csv", "train"]
+    root_files = ["conversion.yaml", "sequences.csv", "top_views.yaml", "tracks.csv", "train"]  # top view: an extra
+    assert sorted(p.name for p in root.iterdir()) == root_files
     seqs = sequences(root)
     assert [(s, r["agent"], r["cav_id"], r["scenario"], r["split"], r["frames"]) for s, r in seqs.items()] == [
         (f"{i:04d}", a.id, str(1000 + a.index), "port_entry", "train", str(FRAMES)) for i, a in enumerate(info.agents)

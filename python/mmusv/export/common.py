@@ -35,6 +35,8 @@ __all__ = [
     "parse_extras",
     "png_bytes",
     "rounded",
+    "top_view_entry",
+    "top_view_png",
     "top_view_protocol",
 ]
 
@@ -205,49 +207,57 @@ def depth_units_png(d: np.ndarray) -> bytes:
     return encode_png(units, compress_level=1)
 
 
+_KITTI_PIXELS = (
+    "pixel (u, v) (column, row from the top-left corner) has its centre (W/2 - u - 0.5) * metres_per_pixel to the "
+    "left of the vessel and (H/2 - v - 0.5) * metres_per_pixel ahead of it, W x H the resolution, level (its roll and "
+    "pitch left out), the vessel's origin (midship, at the waterline) at {body} (vessel body -> world) of (0, 0, 0): "
+    "heading_up, ahead = along its heading (body x) and left = its port side; north_up, ahead = north (world y) and "
+    "left = west (world -x)"
+)
 TOP_VIEW_PIXELS = {
     "carla": "pixel (u, v) (column, row from the top-left corner) has its centre (u + 0.5 - W/2) * metres_per_pixel "
     "to the right of the ego and (H/2 - v - 0.5) * metres_per_pixel ahead of it, W x H the resolution, level (the "
     "ego's roll and pitch left out), the ego at true_ego_pos (x, y): heading_up, ahead = along its yaw (its x) and "
     "right = its y (starboard); north_up, ahead = north (the world's -y) and right = east (the world's x)",
-    "mmusv": "pixel (u, v) (column, row from the top-left corner) has its centre (W/2 - u - 0.5) * metres_per_pixel "
-    "to the left of the vessel and (H/2 - v - 0.5) * metres_per_pixel ahead of it, W x H the resolution, level (its "
-    "roll and pitch left out), the vessel's origin (midship, at the waterline) at pose * Tr_imu_to_velo (vessel body "
-    "-> world) of (0, 0, 0): heading_up, ahead = along its heading (body x) and left = its port side; north_up, "
-    "ahead = north (world y) and left = west (world -x)",
+    "kitti": _KITTI_PIXELS.format(body="pose * Tr_imu_to_velo"),
+    "kitti_tracking": _KITTI_PIXELS.format(body="the frame's line of pose/<seq>.txt * Tr_imu_velo"),
 }
-"""How a top-view pixel lies on the water, for :func:`top_view_protocol` (``carla``: OPV2V's frames, ``mmusv``: the
-KITTI export's, whose LiDAR and world frames are mmusv's)."""
+"""How a top-view pixel lies on the water, for :func:`top_view_png` (``carla``: OPV2V's frames; ``kitti`` and
+``kitti_tracking``: the KITTI exports', whose LiDAR and world frames are mmusv's)."""
+
+
+def top_view_entry(top_view: dict[str, Any]) -> dict[str, Any]:
+    """A recorded rig's ``top_view`` as the exports describe it: ``resolution`` [W, H] pixels, ``metres_per_pixel``,
+    ``orientation``, ``altitude_m``."""
+    return {
+        "resolution": [int(x) for x in top_view["resolution"]],
+        "metres_per_pixel": float(top_view["metres_per_pixel"]),
+        "orientation": str(top_view["orientation"]),
+        "altitude_m": float(top_view["altitude_m"]),
+    }
+
+
+def top_view_png(*, frame: str, files: str) -> dict[str, Any]:
+    """What the exported top-view images are: ``files``, what they hold and where each pixel lies
+    (:data:`TOP_VIEW_PIXELS` of ``frame``)."""
+    return {
+        "files": files,
+        "rgb": "8-bit sRGB",
+        "semantic": "uint16 class ids (mmusv.classes: 1 water, 2 terrain, 3 vegetation, ..., 10 vessel, 11 usv)",
+        "camera": "orthographic, looking straight down from altitude_m over the vessel's origin; what rises above "
+        "altitude_m is cut there (the camera sees the decks below it)",
+        "pixel": TOP_VIEW_PIXELS[frame],
+    }
 
 
 def top_view_protocol(agents: Iterable[Any], *, frame: str, files: str) -> dict[str, Any]:
     """What places the exported top-view images: ``top_views``, each agent's top view by ``cav_id`` as its rig
-    records it (``resolution`` [W, H] pixels, ``metres_per_pixel``, ``orientation``, ``altitude_m``; agents without
-    one left out), and ``top_view_png`` (``files``, what the images hold and :data:`TOP_VIEW_PIXELS` of ``frame``).
+    records it (:func:`top_view_entry`; agents without one left out), and ``top_view_png`` (:func:`top_view_png`).
     Empty when no agent has a top view."""
-    views = {
-        cav_id(a.index): {
-            "resolution": [int(x) for x in a.rig["top_view"]["resolution"]],
-            "metres_per_pixel": float(a.rig["top_view"]["metres_per_pixel"]),
-            "orientation": str(a.rig["top_view"]["orientation"]),
-            "altitude_m": float(a.rig["top_view"]["altitude_m"]),
-        }
-        for a in agents
-        if a.rig.get("top_view")
-    }
+    views = {cav_id(a.index): top_view_entry(a.rig["top_view"]) for a in agents if a.rig.get("top_view")}
     if not views:
         return {}
-    return {
-        "top_views": views,
-        "top_view_png": {
-            "files": files,
-            "rgb": "8-bit sRGB",
-            "semantic": "uint16 class ids (mmusv.classes: 1 water, 2 terrain, 3 vegetation, ..., 10 vessel, 11 usv)",
-            "camera": "orthographic, looking straight down from altitude_m over the vessel's origin; what rises "
-            "above altitude_m is cut there (the camera sees the decks below it)",
-            "pixel": TOP_VIEW_PIXELS[frame],
-        },
-    }
+    return {"top_views": views, "top_view_png": top_view_png(frame=frame, files=files)}
 
 
 def rounded(values: Iterable[float], nd: int = 6) -> list[float]:

@@ -401,7 +401,7 @@ class KittiWriter(DatasetWriter):
                     "include_usvs": o.include_usvs,
                     "extras": list(o.extras),
                     **(
-                        top_view_protocol(self.agents, frame="mmusv", files="<cav_id>/top_view_{rgb,semantic}/<ts>.png")
+                        top_view_protocol(self.agents, frame="kitti", files="<cav_id>/top_view_{rgb,semantic}/<ts>.png")
                         if "top_view" in o.extras
                         else {}
                     ),

@@ -32,10 +32,12 @@ over the whole conversion in its order: split, scenario, agent; so no two sequen
   devkit's sequence map; ``GT_FOLDER`` = ``<split>``, ``SPLIT_TO_EVAL`` = ``<split>``).
 
 At the root: ``sequences.csv`` (``split,sequence,scenario,agent,cav_id,frames,frequency_hz``: the KITTI export's
-folder of the agent is ``cav_id``) and ``tracks.csv`` (the MOT export's: every vessel of each converted recording's
-world state). ``kind`` (:attr:`~mmusv.export.common.Options.kitti_class`): the type written for every target
-(``Car``: what TrackEval's ``Kitti2DBox`` and the devkit score), each target's class name (``Vessel``, ``Usv``)
-without it.
+folder of the agent is ``cav_id``), ``tracks.csv`` (the MOT export's: every vessel of each converted recording's
+world state) and, with the ``top_view`` extra, ``top_views.yaml``: ``top_views``, each sequence's top view by
+``<split>/<seq>`` (``resolution``, ``metres_per_pixel``, ``orientation``, ``altitude_m``), and ``top_view_png``, where
+each pixel lies (:func:`mmusv.export.common.top_view_png`). ``kind``
+(:attr:`~mmusv.export.common.Options.kitti_class`): the type written for every target (``Car``: what TrackEval's
+``Kitti2DBox`` and the devkit score), each target's class name (``Vessel``, ``Usv``) without it.
 """
 
 from __future__ import annotations
@@ -47,7 +49,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from mmusv.errors import IoError
-from mmusv.export.common import Options, Sink, cav_id
+from mmusv.export.common import Options, Sink, cav_id, dump_yaml, top_view_entry, top_view_png
 from mmusv.export.geometry import AgentView, Target
 from mmusv.export.kitti import KittiWriter, calib_text, camera0, dont_care_lines, kitti_numbers, label_lines
 from mmusv.export.kitti_oxts import DEFAULT_ORIGIN, oxts_lines
@@ -111,6 +113,9 @@ class _Shared:
     seqmaps: dict[str, list[str]] = field(default_factory=dict)
     """Split folder → its seqmap lines."""
     tracks: list[list[Any]] = field(default_factory=list)
+    top_views: dict[str, dict[str, Any]] = field(default_factory=dict)
+    """``<split>/<seq>`` → the sequence agent's top view (:func:`~mmusv.export.common.top_view_entry`), for the
+    sequences whose ``top_view_*`` images were written (``top_views.yaml``)."""
     count: int = 0
     """Sequences numbered so far."""
 
@@ -225,6 +230,8 @@ class KittiTrackingWriter(KittiWriter):
             st.sequences.append(
                 [split, seq.name, self.folder.name, seq.agent.id, cav_id(seq.agent.index), len(order), freq]
             )
+            if any(sub.startswith("top_view_") for sub in seq.files) and seq.agent.rig.get("top_view"):
+                st.top_views[f"{split}/{seq.name}"] = top_view_entry(seq.agent.rig["top_view"])
         if self.world is not None and self.sequences:
             st.tracks += track_rows(self.split_folder, scenario=self.folder.name, world=self.world)
         if self.sequences:
@@ -239,6 +246,13 @@ class KittiTrackingWriter(KittiWriter):
         sink.write(out / "sequences.csv", csv_bytes([list(SEQUENCES_COLUMNS), *st.sequences]))
         tracks = sorted(st.tracks, key=lambda r: (r[1], r[2]))
         sink.write(out / "tracks.csv", csv_bytes([list(TRACKS_COLUMNS), *tracks]))
+        if st.top_views:
+            files = "<split>/top_view_{rgb,semantic}/<seq>/<frame:06d>.png"
+            doc = {
+                "top_views": dict(sorted(st.top_views.items())),
+                "top_view_png": top_view_png(frame="kitti_tracking", files=files),
+            }
+            sink.write(out / "top_views.yaml", dump_yaml(doc))
         for split in SPLIT_NAMES:
             if split in st.seqmaps:
                 lines = sorted(st.seqmaps[split])
