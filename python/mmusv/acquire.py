@@ -49,7 +49,13 @@ from mmusv.run_folder import (
     write_failure,
     writes_into,
 )
-from mmusv.scenario_checks import check_lidar_water, check_mounts, check_routes, check_sensors
+from mmusv.scenario_checks import (
+    check_lidar_water,
+    check_mounts,
+    check_routes,
+    check_sensors,
+    check_top_view_land,
+)
 from mmusv.simulation import FrameCapture, Simulation
 
 __all__ = ["TABLE_PART_FRAMES", "RunResult", "recording_path", "run"]
@@ -241,6 +247,7 @@ def run(
         # The routes as far as this run sails them: frames 0 .. total - 1 (the stop of a frame range).
         upto = scenario.acquisition.model_copy(update={"frames": total})
         check_routes(scenario.model_copy(update={"acquisition": upto}), sim.world, source=source)
+        check_top_view_land(sim, range(first, total), source=source)
     # The first frame is captured before anything is written or replaced: whatever a sensor refuses only when it
     # captures (or any other failure of a capture) fails the run here, with the folder as it was.
     started = clocks()  # the run's clocks start with its first frame

@@ -11,6 +11,7 @@ what a user wants). ``mmusv run --no-checks`` and ``mmusv.run(..., checks=False)
 :func:`check_lidar_water` warns about a LiDAR's flat-sea water knobs (``water_probability`` and the three others of
 :class:`~mmusv.sensors.config.LidarConfig`) set on the physical sea, where they change nothing but for both
 probabilities 0, which switch the water returns off.
+:func:`check_top_view_land` refuses a top view lower than the land within its view (it drew that land as water).
 :func:`check_sensors` warns about a scenario that records no sensor at all: no vessel with ``role: usv``, or USVs
 whose rigs switch every sensor off (``preset: lidar_only`` with ``lidar: null``); such a run records the world state
 and the boxes only, which may be meant (ground-truth trajectories), so it is a warning.
@@ -39,6 +40,7 @@ if TYPE_CHECKING:
     from mmusv.generate.samples import Samples
     from mmusv.generate.spec import GenerationSpec
     from mmusv.sensors.config import RigConfig
+    from mmusv.simulation import Simulation
     from mmusv.world.maps import MapWorld
 
 __all__ = [
@@ -51,6 +53,7 @@ __all__ = [
     "check_mounts",
     "check_routes",
     "check_sensors",
+    "check_top_view_land",
     "map_check_spec",
     "map_findings",
     "scenario_samples",
@@ -335,6 +338,44 @@ def check_lidar_water(scenario: Scenario, *, source: str) -> list[str]:
     for w in found:
         warnings.warn(w, MmusvWarning, stacklevel=2)
     return found
+
+
+def check_top_view_land(sim: Simulation, frames: range, *, source: str) -> None:
+    """Refuses a top view that looks down from below the land it sees: the ground of a map (its heightfield: the
+    islands, the port's quays and hills) within a USV's top view, at any frame of ``frames``, rising to or above
+    the view's ``altitude_m``. The terrain is a surface seen from above: rays that start under it never meet it, so
+    those pixels showed the water beneath (semantic water, the sea's instance) without a word. A ship or a
+    structure taller than the top view is a closed body and stays itself (the camera sees its inside, its class and
+    instance), so only the ground counts. A :class:`ConfigError` naming ``source``, the field and the height."""
+    from scipy.spatial import cKDTree
+
+    hf = sim.world.heightfield
+    xs, ys = hf.axes()
+    for agent in sim.agents:
+        tv = agent.rig.top_view
+        if tv is None or not frames:
+            continue
+        high = hf.z >= tv.altitude_m
+        if not high.any():
+            continue
+        iy, ix = np.nonzero(high)
+        ground = np.column_stack([xs[ix], ys[iy]])
+        # A grid vertex within half the footprint's diagonal (and one grid step) of the USV at some frame.
+        reach = 0.5 * tv.metres_per_pixel * math.hypot(*tv.resolution) + hf.spacing
+        places = np.array([sim.world_state(k).poses[agent.index, :2] for k in frames])
+        dist, _ = cKDTree(places).query(ground, distance_upper_bound=reach)
+        seen = np.isfinite(dist)
+        if not seen.any():
+            continue
+        top = float(hf.z[iy[seen], ix[seen]].max())
+        v = sim.scenario.vessels[agent.index]
+        field = f"rigs.{v.rig}.top_view.altitude_m" if v.rig is not None else "the default rig's top_view.altitude_m"
+        raise ConfigError(
+            f"{source}: {field} = {tv.altitude_m:g}: the top view of {v.id!r} (vessels[{agent.index}]) looks down "
+            f"from {tv.altitude_m:g} m over land that rises to {top:.1f} m within its view: the ground above the "
+            f"camera is not drawn, its pixels would show the water beneath it (semantic water); altitude_m must be "
+            f"above {top:.1f} m (default 120; --no-checks skips this)"
+        )
 
 
 def check_sensors(scenario: Scenario, *, source: str) -> list[str]:
