@@ -453,9 +453,10 @@ class TopViewConfig(_Model):
     ``north_up`` puts north there; ``outputs`` any of ``rgb``, ``semantic``, ``instance`` (no ``depth``);
     ``exposure`` as a camera's (:class:`ExposureConfig`). Pixel ``(u, v)``'s centre lies ``(u + 0.5 − W/2) · m`` to
     the right of the USV's origin and ``(H/2 − v − 0.5) · m`` ahead of it (``m`` = ``metres_per_pixel``, ``W × H`` =
-    ``resolution``; right = starboard or east). Its rays start ``altitude_m`` up: what rises above that (a ship
-    alongside taller than the top view; the USV's own hull must stay below it) is cut there, and the camera sees
-    its decks below, still that ship's class and instance."""
+    ``resolution``; right = starboard or east). Its rays start ``altitude_m`` up: a ship alongside taller than the top
+    view is cut there, and the camera sees its decks below, still that ship's class and instance; the USV's own hull
+    must stay below it (else refused), and so must the land in its view (``mmusv run`` refuses a top view lower than
+    the land it sees, which it drew as water: :func:`mmusv.scenario_checks.check_top_view_land`)."""
 
     altitude_m: float = Field(default=120.0, gt=0, le=20_000)
     resolution: tuple[int, int] = (512, 512)
