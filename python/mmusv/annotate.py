@@ -7,7 +7,10 @@ agent's own hull is never a target):
   number of LiDAR points on the vessel (exact: points carry instance ids) and its range;
 * the vessel's ``role`` (``target``, ``usv`` — another instrumented USV, never a detection target — or
   ``moored``) and ``static`` flag (moored ships, and scenario vessels that never move), so users can filter;
-* an ego-centric BEV box: the 3D box's footprint in the LiDAR frame's xy plane (x, y, length, width, yaw);
+* an ego-centric BEV box: the 3D box's footprint in the LiDAR frame's xy plane (x, y, length, width, yaw: the 3D
+  box's centre, first two sizes and yaw, counter-clockwise from the LiDAR's x axis in [-π, π]); the LiDAR frame
+  pitches and rolls with the hull, so that plane is the hull's, not the water's (to place a box in the world, take
+  the 3D box, its centre's z included, through the LiDAR's pose);
 * per pinhole camera, a 2D box: the bounding box of the projected 3D-box corners (edges clipped at the near plane;
   through a camera's lens distortion, the projected edges); where the image border cuts it, the bounding box of the
   part of the 3D box's image inside the image (its faces' images united and clipped to the border, so a long hull
@@ -211,7 +214,7 @@ class Annotations:
           ``size`` ``(n3d, 3)`` length, beam, height, ``rotation`` ``(n3d, 4)`` quaternion x, y, z, w, ``yaw``,
           ``range_m`` (``|center|``), ``wave_occlusion`` ``(n3d,)`` float64; ``static`` ``(n3d,)`` bool;
         - ``bev``: ``target_id``; ``x``, ``y``, ``length``, ``width``, ``yaw`` ``(n3d,)`` float64 (the 3D box's
-          footprint in the LiDAR frame's xy plane);
+          footprint in the LiDAR frame's xy plane: ``lidar``'s ``center[:, :2]``, ``size[:, :2]`` and ``yaw``);
         - ``camera`` (pixels, origin top-left, clipped to the image): ``target_id``, ``camera``, ``role`` lists of
           str; ``x_min``, ``y_min``, ``x_max``, ``y_max``, ``truncation``, ``occlusion``, ``wave_occlusion``
           ``(n2d,)`` float64; ``visible_pixels``, ``box_pixels`` (the pixels the box touches, module docstring)
