@@ -35,7 +35,7 @@ them (a helper's round): each check against an independent computation written o
   KITTI tracking's ``top_view_*`` images came without it too (that export writes no ``mmusv_kitti.yaml``): its
   root now has ``top_views.yaml``, by ``<split>/<seq>``, with the mapping from ``pose/<seq>.txt`` and ``Tr_imu_velo``.
 * Bad top-view values in a scenario file name the file, the field and what it may be; the same seed gives the same
-  bytes.
+  bytes; the quality changes the RGB only (the labels and depth are the same at draft, standard and high).
 """
 
 from __future__ import annotations
@@ -551,3 +551,20 @@ def test_the_same_seed_gives_the_same_top_view() -> None:
     other = Simulation(sc).capture(0, sensors=["top_view"]).agents["u"].top_view
     assert other is not None and other.rgb is not None and first.rgb is not None
     assert not np.array_equal(other.rgb, first.rgb)
+
+
+def test_the_labels_do_not_depend_on_the_quality() -> None:
+    """``quality`` (draft, standard, high) changes the RGB shading only: the semantic, instance and depth images
+    are the same bytes (each pixel's centre ray), so a BEV set may be rendered at draft for speed."""
+    images = []
+    for quality in ("draft", "standard", "high"):
+        sc = _one_usv({"resolution": [96, 96], "metres_per_pixel": 0.5, "quality": quality}, environment={"wave": "W2"})
+        sc["vessels"].append(
+            {"id": "t", "role": "target", "asset": "fishing_boat_12m", "speed_mps": 2.0, "route": [[10, 12], [60, 12]]}
+        )
+        img = Simulation(sc).capture(0, sensors=["top_view"]).agents["u"].top_view
+        assert img is not None
+        images.append(img)
+    for img in images[1:]:
+        for name in ("semantic", "instance", "depth"):
+            assert np.array_equal(getattr(img, name), getattr(images[0], name)), name
