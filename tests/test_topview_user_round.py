@@ -34,6 +34,8 @@ them (a helper's round): each check against an independent computation written o
   ``/<usv>/detections`` boxes, through ``/tf`` and ``/tf_static``, land on the ``16UC1`` semantic image's vessels.
   KITTI tracking's ``top_view_*`` images came without it too (that export writes no ``mmusv_kitti.yaml``): its
   root now has ``top_views.yaml``, by ``<split>/<seq>``, with the mapping from ``pose/<seq>.txt`` and ``Tr_imu_velo``.
+* ``mmusv preview`` resized a portrait or landscape top view to a square panel (150 × 200: 2.84 panel pixels per
+  source pixel across, 2.13 down), so its hulls were a third wider than long; it now keeps one scale both ways.
 * Bad top-view values in a scenario file name the file, the field and what it may be; the same seed gives the same
   bytes; the quality changes the RGB only (the labels and depth are the same at draft, standard and high).
 """
@@ -422,6 +424,22 @@ def test_ros2_top_view_says_where_its_pixels_are(rec: Path, tmp_path: Path) -> N
             boxes.append((box[:2, 3], math.atan2(box[1, 0], box[0, 0]), d.bbox.size.x, d.bbox.size.y))
         seen += _check_semantic(sem, xy, boxes)
     assert seen >= 5, seen
+
+
+def test_preview_draws_a_portrait_top_view_unstretched(rec: Path) -> None:
+    """``mmusv preview`` of v's 150 × 200 (portrait) top view: the panels resized it to a square, 2.84 panel pixels
+    per source pixel across and 2.13 down, so every hull and distance in them was a third wider than long (and the
+    panel's ``scale``, 2.84, held across only). Now one scale both ways, the panel as tall as the square."""
+    from mmusv.preview import compose_preview
+
+    _, panels = compose_preview(rec, frame=0, agent="v")
+    tops = [p for p in panels if " · top view · " in p.title]
+    assert len(tops) == 2, [p.title for p in panels]
+    for p in tops:
+        left, top, right, bottom = p.box
+        assert (right - left) == pytest.approx(150 * p.scale, abs=1) and (bottom - top) == pytest.approx(
+            200 * p.scale, abs=1
+        ), (p.title, p.box, p.scale)
 
 
 # --------------------------------------------------------------------------------------------------- the edges

@@ -237,9 +237,12 @@ def compose_preview(path: str | Path, *, frame: int = 0, agent: str | None = Non
             img = decode_image(m)
             img = _semantic(img) if kind == "top_semantic" else img
             tv = a.rig.get("top_view") or {}
-            pil = _fit(img, (sq, sq))
+            # One scale both ways, the longer side the square's: a portrait or landscape top view resized to the
+            # square made its hulls and distances wider than long (or the reverse).
+            scale = sq / max(img.shape[0], img.shape[1])
+            pil = _fit(img, (max(round(img.shape[1] * scale), 1), max(round(img.shape[0] * scale), 1)))
             orient = str(tv.get("orientation", "")).replace("_", "-")
-            last.append((f"{a_id} · top view · {kind[4:]} ({orient})", pil, sq / img.shape[1]))
+            last.append((f"{a_id} · top view · {kind[4:]} ({orient})", pil, scale))
         else:
             half = _bev_half_extent(boxes3d)
             pil = _bev_panel(decode_point_cloud(m), boxes3d, sq, half)
