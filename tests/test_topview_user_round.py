@@ -16,10 +16,10 @@ them (a helper's round): each check against an independent computation written o
   (``docs/recording.md`` now says so and which frame, axis and range the BEV yaw has).
 * A top view over an island (island map seed 4, 2 m per pixel): terrain and vegetation pixels are where the map's
   heightfield is above the water (99.7 % of the pixels agree; the others within 0.3 m of the waterline).
-* A top view lower than the land it sees (5 m up beside an islet that rises to 28.8 m) drew that land as water:
+* A top view lower than the land it sees (5 m up beside an islet that rises to 28.9 m) drew that land as water:
   1354 pixels of semantic 1 and the sea's instance where the ground stands above the camera, the terrain being a
   surface seen from above. ``mmusv run`` now refuses it (``mmusv.scenario_checks.check_top_view_land``, skipped by
-  ``--no-checks`` with the other map checks).
+  ``--no-checks`` with the other map checks) and the scenario editor lists it as an error (check ``top_view``).
 * A vessel taller than the top view (a 67 m cruise ship beside a top view at 20 m): the camera sits inside it, its
   rays start there and meet its decks below (depth 0 to 6 m); the ship's footprint is still all its instance, so
   the segmentation stays right; ``TopViewConfig`` now says so. The USV's own hull taller than the top view is
@@ -515,11 +515,12 @@ def test_a_top_view_over_an_island_shows_land_where_the_map_has_it() -> None:
 
 
 def test_a_top_view_below_the_land_it_sees_is_refused(tmp_path: Path) -> None:
-    """The islet of island map seed 4 rises to 28.8 m, 60–140 m off a WAM-V: a top view 5 m up (above the WAM-V's
+    """The islet of island map seed 4 rises to 28.9 m, 60–140 m off a WAM-V: a top view 5 m up (above the WAM-V's
     2.2 m hull, so it loaded) drew the 1354 pixels where the land stands above the camera as water (semantic 1, the
     sea's instance, depth 5 m to the still water under the ground), without a word: the terrain is a surface seen
     from above, and rays starting under it never meet it. ``mmusv run`` refuses it now, naming the file, the field
-    and the height the altitude must pass (``--no-checks`` skips it); at 60 m it runs."""
+    and the height the altitude must pass (``--no-checks`` skips it), and the scenario editor lists it as an error;
+    at 60 m it runs."""
     sc = _one_usv(
         {"altitude_m": 5.0, "resolution": [160, 160], "metres_per_pixel": 2.0, "outputs": ["semantic"]},
         map={"type": "island", "seed": 4},
@@ -533,7 +534,16 @@ def test_a_top_view_below_the_land_it_sees_is_refused(tmp_path: Path) -> None:
     assert str(path) in said and "rigs.r.top_view.altitude_m = 5:" in said, said
     assert "altitude_m must be above" in said and "--no-checks" in said, said
     assert not (tmp_path / "low").exists() or not any((tmp_path / "low").iterdir())
+    # The scenario editor lists it as an error at the field, with the highest ground it sees.
+    from mmusv.editor.evaluate import evaluate
+
+    found = [p for p in evaluate(sc)["problems"] if p["check"] == "top_view"]
+    assert [(p["severity"], p["field"], p["vessels"]) for p in found] == [
+        ("error", "rigs.r.top_view.altitude_m", ["u"])
+    ]
+    assert "rises to 28.9 m" in found[0]["message"], found[0]["message"]
     sc["rigs"]["r"]["top_view"]["altitude_m"] = 60.0
+    assert not [p for p in evaluate(sc)["problems"] if p["check"] == "top_view"]
     path.write_text(yaml.safe_dump(sc))
     assert Path(run(path, out_dir=tmp_path / "high").recording).is_file()
 

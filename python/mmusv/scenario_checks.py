@@ -11,7 +11,8 @@ what a user wants). ``mmusv run --no-checks`` and ``mmusv.run(..., checks=False)
 :func:`check_lidar_water` warns about a LiDAR's flat-sea water knobs (``water_probability`` and the three others of
 :class:`~mmusv.sensors.config.LidarConfig`) set on the physical sea, where they change nothing but for both
 probabilities 0, which switch the water returns off.
-:func:`check_top_view_land` refuses a top view lower than the land within its view (it drew that land as water).
+:func:`check_top_view_land` refuses a top view lower than the land within its view (it drew that land as water;
+:func:`top_view_land` finds them, for ``mmusv run`` and the editor).
 :func:`check_sensors` warns about a scenario that records no sensor at all: no vessel with ``role: usv``, or USVs
 whose rigs switch every sensor off (``preset: lidar_only`` with ``lidar: null``); such a run records the world state
 and the boxes only, which may be meant (ground-truth trajectories), so it is a warning.
@@ -49,6 +50,7 @@ __all__ = [
     "SHARP_TURN_RATIO",
     "MapFinding",
     "MmusvWarning",
+    "TopViewLand",
     "check_lidar_water",
     "check_mounts",
     "check_routes",
@@ -59,6 +61,7 @@ __all__ = [
     "scenario_samples",
     "sensing_range_m",
     "sharp_turns",
+    "top_view_land",
 ]
 
 MOUNT_WARN_FACTOR = 2.0
@@ -340,42 +343,73 @@ def check_lidar_water(scenario: Scenario, *, source: str) -> list[str]:
     return found
 
 
-def check_top_view_land(sim: Simulation, frames: range, *, source: str) -> None:
-    """Refuses a top view that looks down from below the land it sees: the ground of a map (its heightfield: the
-    islands, the port's quays and hills) within a USV's top view, at any frame of ``frames``, rising to or above
-    the view's ``altitude_m``. The terrain is a surface seen from above: rays that start under it never meet it, so
-    those pixels showed the water beneath (semantic water, the sea's instance) without a word. A ship or a
-    structure taller than the top view is a closed body and stays itself (the camera sees its inside, its class and
-    instance), so only the ground counts. A :class:`ConfigError` naming ``source``, the field and the height."""
+@dataclass(frozen=True)
+class TopViewLand:
+    """A USV's top view lower than the land within its view (:func:`top_view_land`): the vessel's index in the
+    scenario, the field to change, the message (without the file) and where the highest ground it sees stands
+    (world ``x, y`` metres)."""
+
+    index: int
+    field: str
+    message: str
+    point: tuple[float, float]
+
+
+def top_view_land(scenario: Scenario, world: MapWorld, positions: dict[int, np.ndarray]) -> list[TopViewLand]:
+    """Every USV whose top view, from some of its ``positions`` (vessel index → ``(N, 2)`` world ``x, y`` of its
+    origin), sees the map's ground (its heightfield: the islands, the port's land and hills) rising to or above the
+    view's ``altitude_m`` within half its footprint's diagonal (and one grid step). The terrain is a surface seen
+    from above: rays that start under it never meet it, so those pixels showed the water beneath (semantic water,
+    the sea's instance) without a word. A ship or a structure taller than the top view stays itself in the picture
+    (the camera sees its decks below the cut), so only the ground counts."""
     from scipy.spatial import cKDTree
 
-    hf = sim.world.heightfield
+    from mmusv.sensors.config import RigConfig
+
+    hf = world.heightfield
     xs, ys = hf.axes()
-    for agent in sim.agents:
-        tv = agent.rig.top_view
-        if tv is None or not frames:
+    out: list[TopViewLand] = []
+    for i, pos in sorted(positions.items()):
+        v = scenario.vessels[i]
+        tv = (scenario.rigs[v.rig] if v.rig is not None else RigConfig()).top_view
+        if tv is None or not len(pos):
             continue
         high = hf.z >= tv.altitude_m
         if not high.any():
             continue
         iy, ix = np.nonzero(high)
-        ground = np.column_stack([xs[ix], ys[iy]])
-        # A grid vertex within half the footprint's diagonal (and one grid step) of the USV at some frame.
         reach = 0.5 * tv.metres_per_pixel * math.hypot(*tv.resolution) + hf.spacing
-        places = np.array([sim.world_state(k).poses[agent.index, :2] for k in frames])
-        dist, _ = cKDTree(places).query(ground, distance_upper_bound=reach)
+        dist, _ = cKDTree(np.asarray(pos, dtype=np.float64)).query(
+            np.column_stack([xs[ix], ys[iy]]), distance_upper_bound=reach
+        )
         seen = np.isfinite(dist)
         if not seen.any():
             continue
-        top = float(hf.z[iy[seen], ix[seen]].max())
-        v = sim.scenario.vessels[agent.index]
+        k = int(np.argmax(np.where(seen, hf.z[iy, ix], -np.inf)))
+        top = float(hf.z[iy[k], ix[k]])
         field = f"rigs.{v.rig}.top_view.altitude_m" if v.rig is not None else "the default rig's top_view.altitude_m"
-        raise ConfigError(
-            f"{source}: {field} = {tv.altitude_m:g}: the top view of {v.id!r} (vessels[{agent.index}]) looks down "
-            f"from {tv.altitude_m:g} m over land that rises to {top:.1f} m within its view: the ground above the "
-            f"camera is not drawn, its pixels would show the water beneath it (semantic water); altitude_m must be "
-            f"above {top:.1f} m (default 120; --no-checks skips this)"
+        message = (
+            f"{field} = {tv.altitude_m:g}: the top view of {v.id!r} (vessels[{i}]) looks down from "
+            f"{tv.altitude_m:g} m over land that rises to {top:.1f} m within its view: the ground above the camera is "
+            f"not drawn, its pixels would show the water beneath it (semantic water); altitude_m must be above "
+            f"{top:.1f} m (default 120)"
         )
+        out.append(TopViewLand(i, field, message, (float(xs[ix[k]]), float(ys[iy[k]]))))
+    return out
+
+
+def check_top_view_land(sim: Simulation, frames: range, *, source: str) -> None:
+    """Refuses a top view lower than the land it sees at some frame of ``frames`` (:func:`top_view_land`, the
+    USVs' positions from the world state of every frame): a :class:`ConfigError` naming ``source``, the field and
+    the height to pass."""
+    positions = {
+        a.index: np.array([sim.world_state(k).poses[a.index, :2] for k in frames]).reshape(-1, 2)
+        for a in sim.agents
+        if a.rig.top_view is not None and bool((sim.world.heightfield.z >= a.rig.top_view.altitude_m).any())
+    }
+    found = top_view_land(sim.scenario, sim.world, positions)
+    if found:
+        raise ConfigError(f"{source}: {found[0].message} (--no-checks skips this)")
 
 
 def check_sensors(scenario: Scenario, *, source: str) -> list[str]:

@@ -2,8 +2,9 @@
 
 :func:`evaluate` validates the document with the scenario schema (:mod:`mmusv.config`), builds the fleet with the
 Rust kinematics (:func:`mmusv.motion.build_fleet`; route geometry errors such as repeated waypoints surface here)
-and runs the named checks on the map (:func:`mmusv.scenario_checks.map_findings`, the generator's checks). It
-returns, JSON-ready:
+and runs the named checks on the map (:func:`mmusv.scenario_checks.map_findings`, the generator's checks, and
+:func:`mmusv.scenario_checks.top_view_land`: a top view lower than the land within its view, the error ``top_view``
+that ``mmusv run`` refuses). It returns, JSON-ready:
 
 * ``errors``: schema and route problems, each ``{field, message, vessel}``: ``field`` is the path in the scenario
   (``vessels[2].speed_mps``), ``vessel`` the id of the vessel it belongs to (or None);
@@ -44,7 +45,7 @@ from mmusv.errors import ConfigError, MmusvError
 from mmusv.generate.mapctx import map_context
 from mmusv.generate.samples import FEWER_TIMES, MAX_CHECK_SAMPLES, budget_problem, sample_counts
 from mmusv.motion import build_fleet
-from mmusv.scenario_checks import check_mounts, check_sensors, map_check_spec, map_findings
+from mmusv.scenario_checks import check_mounts, check_sensors, map_check_spec, map_findings, top_view_land
 from mmusv.sensors.config import RigConfig
 from mmusv.text import counted
 from mmusv.world.vessels import get_asset
@@ -283,6 +284,21 @@ def evaluate(
                 "vessels": list(f.vessels),
                 "point": None if f.point is None else [round(f.point[0], 2), round(f.point[1], 2)],
                 "segments": {vid: _runs(mask) for vid, mask in sorted(f.route.items())},
+            }
+        )
+    # A top view lower than the land within its view (mmusv run refuses it): from the frames' and the motion's samples.
+    usv_rows = {index[vid]: j for j, vid in enumerate(samples.ids) if scenario.vessels[index[vid]].role == "usv"}
+    seen_from = {i: np.concatenate([samples.frames[:, j], samples.motion[:, j]]) for i, j in usv_rows.items()}
+    for tl in top_view_land(scenario, ctx.world, seen_from):
+        out["problems"].append(
+            {
+                "check": "top_view",
+                "severity": "error",
+                "message": tl.message,
+                "field": tl.field if tl.field.startswith("rigs.") else f"vessels[{tl.index}].rig",
+                "vessels": [scenario.vessels[tl.index].id],
+                "point": [round(tl.point[0], 2), round(tl.point[1], 2)],
+                "segments": {},
             }
         )
     with warnings.catch_warnings():
