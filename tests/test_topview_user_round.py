@@ -38,6 +38,15 @@ them (a helper's round): each check against an independent computation written o
   source pixel across, 2.13 down), so its hulls were a third wider than long; it now keeps one scale both ways.
 * Bad top-view values in a scenario file name the file, the field and what it may be; the same seed gives the same
   bytes; the quality changes the RGB only (the labels and depth are the same at draft, standard and high).
+
+Checked outside the tests (one-off scripts, same independent maths): on ``port_entry`` at W3 the moored ships' BEV
+boxes map onto their world-state boxes (6e-14 m, 0°; ``static`` true, role ``moored``) and their top-view pixels stay
+within 0.65 m of the upright footprint (an 85 m supply vessel 40.5 m tall rolled 3.3°); the set of vessels given
+boxes is exactly those whose BEV rectangle comes within 200 m of the LiDAR (shapely's distance; 208.9 m and 219.2 m
+left out); an odd 201 × 151 top view at 0.37 m maps the same way (pixels ≤ 0.065 m off the footprints); every
+library ship above 15 m (23 assets) keeps the same top-view footprint cover (0.90–1.00) with the top view at 0.5 and
+0.8 of its height as from 120 m; top-view depth is the altitude less the surface height, within each box's z range;
+the detection study's BEV IoU matches a Monte Carlo IoU of random rotated boxes within 0.011 (the sampling's error).
 """
 
 from __future__ import annotations
