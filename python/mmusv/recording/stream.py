@@ -130,7 +130,8 @@ class FrameStream:
         self.yielded: list[int] = []
         self.run: dict[str, str] = dict(info.run)
         self.out_of_order: list[int] = []
-        self._copies: dict[int, bool] = {}  # log time -> whether a clean copy of its frame was whole
+        # log time -> whether a clean copy of its frame was whole, and the topics of its copies
+        self._copies: dict[int, tuple[bool, set[str]]] = {}
         self._reading: Path = info.path  # the file (or part) being read
         self.topic_counts: dict[str, int] = {}
         self.topic_schemas: dict[str, tuple[str, str]] = {}
@@ -348,20 +349,24 @@ class FrameStream:
 
     def _split(self, op: _Open, lost: list[tuple[int, int]], *, whole: bool) -> None:
         """Raises :class:`~mmusv.errors.IoError` when the messages of one log time come in two runs away from any
-        damage and one of them is not a whole frame: a file whose messages are not in frame order (each topic in
-        turn, as a tool that copies channel by channel writes them), whose every frame would be read in pieces,
-        each incomplete (a frame recorded twice, each copy whole, is read once)."""
+        damage and neither is a whole frame holding the other's topics: a file whose messages are not in frame order
+        (each topic in turn, as a tool that copies channel by channel writes them), whose every frame would be read
+        in pieces. A frame recorded twice is read once when a copy is whole and holds the other's topics, the later
+        one too (a frame written incomplete, then whole after later frames: ``tests/export/test_ros2_odometry.py``)."""
         t = op.frame.log_time_ns
         if op.suspect or any(a <= t <= b for a, b in lost):
             return
-        if t in self._copies and not (whole and self._copies[t]):
+        prev = self._copies.get(t)
+        # one copy holds the other's topics and is whole: a frame written again, not a frame in pieces
+        if prev is not None and not (whole and op.topics >= prev[1]) and not (prev[0] and prev[1] >= op.topics):
             raise IoError(
                 f"{self._reading}: the messages of the frame at {t / 1e9:.3f} s are not together in the file (not "
                 "in log-time order: written topic by topic?); mmusv reads a recording frame by frame in file "
                 "order, as mmusv run writes it: rewrite it in log-time order (the mcap package's "
                 "iter_messages(log_time_order=True) into a new file)"
             )
-        self._copies[t] = self._copies.get(t, False) or whole
+        was_whole, topics = prev if prev is not None else (False, set())
+        self._copies[t] = (was_whole or whole, topics | set(op.topics))
 
     def _why(self, op: _Open, lost: list[tuple[int, int]], reference: set[str], scan: Scan) -> str | None:
         """Why the frame of ``op`` is incomplete, or None."""
