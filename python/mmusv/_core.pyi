@@ -766,6 +766,34 @@ class Recorder:
         """``foxglove.FrameTransforms``: pose of ``children[i]`` in ``parents[i]``, ``translations`` (N, 3) float64
         metres, ``rotations`` (N, 4) float64 unit quaternions x, y, z, w."""
 
+    def camera_calibration(
+        self,
+        topic: str,
+        *,
+        log_time_ns: int,
+        frame_id: str,
+        width: int,
+        height: int,
+        intrinsics: tuple[float, float, float, float],
+        distortion: tuple[float, float, float, float, float],
+    ) -> None:
+        """``foxglove.CameraCalibration`` of a ``width`` x ``height`` pinhole camera in ``frame_id`` (its optical
+        frame): ``intrinsics`` ``(fx, fy, cx, cy)`` pixels in OpenCV's convention (pixel centres at whole numbers),
+        ``distortion`` ``(k1, k2, p1, p2, k3)`` (``plumb_bob``); R = I, P = [K | 0]."""
+
+    def image_boxes(
+        self,
+        topic: str,
+        *,
+        log_time_ns: int,
+        corners: npt.NDArray[np.float64],
+        colors: npt.NDArray[np.float32],
+        labels: Sequence[str],
+    ) -> None:
+        """``foxglove.ImageAnnotations`` of 2D boxes: ``corners`` (N, 4) float64 ``[x0, y0, x1, y1]`` pixels (origin
+        at the top-left corner of the top-left pixel), ``colors`` (N, 4) float32 RGBA 0..1, ``labels`` N strings
+        (a non-empty one drawn at the box's top-left corner)."""
+
     def boxes(
         self,
         topic: str,

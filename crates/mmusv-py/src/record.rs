@@ -7,8 +7,8 @@
 use crate::errors::InputError;
 use crate::native::{c_order, detached, flat, rows};
 use mmusv_core::record::{
-    encode_images, AgentAnnotations, BevBox, Box2D, Box3D, BoxMarker, Column, ImageFormat, ImageJob, PackedType,
-    Pixels, Recorder as CoreRecorder, Transform, VesselState, WorldState,
+    encode_images, AgentAnnotations, BevBox, Box2D, Box3D, BoxMarker, Column, ImageBox, ImageFormat, ImageJob,
+    PackedType, Pixels, Recorder as CoreRecorder, Transform, VesselState, WorldState,
 };
 use mmusv_core::MmusvError;
 use numpy::PyUntypedArrayMethods;
@@ -327,6 +327,44 @@ impl Recorder {
             })
             .collect();
         self.with(py, |r| r.frame_transforms(topic, log_time_ns, &transforms))
+    }
+
+    /// `foxglove.CameraCalibration` of a pinhole camera: intrinsics `(fx, fy, cx, cy)` pixels in OpenCV's
+    /// convention (pixel centres at whole numbers), `distortion` `(k1, k2, p1, p2, k3)` (`plumb_bob`).
+    #[pyo3(signature = (topic, *, log_time_ns, frame_id, width, height, intrinsics, distortion))]
+    #[allow(clippy::too_many_arguments)]
+    fn camera_calibration(
+        &self,
+        py: Python<'_>,
+        topic: &str,
+        log_time_ns: u64,
+        frame_id: &str,
+        width: u32,
+        height: u32,
+        intrinsics: [f64; 4],
+        distortion: [f64; 5],
+    ) -> PyResult<()> {
+        self.with(py, |r| r.camera_calibration(topic, log_time_ns, frame_id, width, height, intrinsics, distortion))
+    }
+
+    /// `foxglove.ImageAnnotations` of 2D boxes: `corners` `(N, 4)` float64 `[x0, y0, x1, y1]` pixels (origin at the
+    /// top-left corner of the top-left pixel), `colors` `(N, 4)` float32 RGBA in [0, 1], `labels` N strings.
+    #[pyo3(signature = (topic, *, log_time_ns, corners, colors, labels))]
+    fn image_boxes(
+        &self,
+        py: Python<'_>,
+        topic: &str,
+        log_time_ns: u64,
+        corners: PyReadonlyArray2<'_, f64>,
+        colors: PyReadonlyArray2<'_, f32>,
+        labels: Vec<String>,
+    ) -> PyResult<()> {
+        let c = rows::<f64, 4>(&corners, "corners")?;
+        let col = rows::<f32, 4>(&colors, "colors")?;
+        same_len(c.len(), "corners", &[("colors", col.len()), ("labels", labels.len())])?;
+        let boxes: Vec<ImageBox> =
+            labels.into_iter().enumerate().map(|(i, label)| ImageBox { corners: c[i], color: col[i], label }).collect();
+        self.with(py, |r| r.image_boxes(topic, log_time_ns, &boxes))
     }
 
     /// `foxglove.SceneUpdate` with one entity of cubes (and labels).

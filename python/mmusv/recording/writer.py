@@ -278,6 +278,55 @@ class Recording:
             labels=ids_l if labels is None else _strs(labels, "labels"),
         )
 
+    def camera_calibration(
+        self,
+        topic: str,
+        *,
+        log_time_ns: int,
+        frame_id: str,
+        width: int,
+        height: int,
+        intrinsics: Sequence[float],
+        distortion: Sequence[float] | None = None,
+    ) -> None:
+        """``foxglove.CameraCalibration`` of a ``width`` x ``height`` pinhole camera in ``frame_id`` (its optical
+        frame: x right, y down, z forward): ``intrinsics`` ``(fx, fy, cx, cy)`` pixels in OpenCV's convention
+        (pixel centres at whole numbers: :func:`mmusv.sensors.camera.opencv_intrinsics` of mmusv's),
+        ``distortion`` OpenCV's ``(k1, k2, p1, p2, k3)`` (``plumb_bob``; default none)."""
+        fx, fy, cx, cy = (float(v) for v in intrinsics)
+        d = (0.0,) * 5 if distortion is None else tuple(float(v) for v in distortion)
+        if len(d) != 5:
+            raise InputError(f"distortion must be (k1, k2, p1, p2, k3), got {len(d)} values")
+        self._rec.camera_calibration(
+            topic,
+            log_time_ns=log_time_ns,
+            frame_id=frame_id,
+            width=width,
+            height=height,
+            intrinsics=(fx, fy, cx, cy),
+            distortion=d,
+        )
+
+    def image_boxes(
+        self,
+        topic: str,
+        *,
+        log_time_ns: int,
+        corners: npt.ArrayLike,
+        colors: npt.ArrayLike,
+        labels: Sequence[str],
+    ) -> None:
+        """``foxglove.ImageAnnotations`` of 2D boxes: ``corners`` (N, 4) ``[x0, y0, x1, y1]`` pixels (origin at the
+        top-left corner of the top-left pixel, mmusv's and Foxglove's convention), ``colors`` (N, 4) RGBA 0..1,
+        ``labels`` N strings (a non-empty one drawn at its box's top-left corner)."""
+        self._rec.image_boxes(
+            topic,
+            log_time_ns=log_time_ns,
+            corners=_f64(corners, "corners", 4),
+            colors=np.ascontiguousarray(_f64(colors, "colors", 4).astype(np.float32)),
+            labels=_strs(labels, "labels"),
+        )
+
     def world_state(
         self,
         topic: str,

@@ -7,8 +7,9 @@ use super::points::{packed_offsets, PackedType};
 use super::writer::Recorder;
 use crate::error::{MmusvError, Result};
 use foxglove::messages::{
-    Color, CompressedImage, CubePrimitive, Duration, FrameTransform, FrameTransforms, KeyValuePair, PackedElementField,
-    PointCloud, Pose, Quaternion, RawImage, SceneEntity, SceneUpdate, TextPrimitive, Timestamp, Vector3,
+    points_annotation, CameraCalibration, Color, CompressedImage, CubePrimitive, Duration, FrameTransform,
+    FrameTransforms, ImageAnnotations, KeyValuePair, PackedElementField, Point2, PointCloud, PointsAnnotation, Pose,
+    Quaternion, RawImage, SceneEntity, SceneUpdate, TextAnnotation, TextPrimitive, Timestamp, Vector3,
 };
 use prost::bytes::Bytes;
 
@@ -23,6 +24,22 @@ pub struct Transform {
     pub translation: [f64; 3],
     /// Orientation of the child frame in the parent frame, quaternion `x, y, z, w` (unit).
     pub rotation: [f64; 4],
+}
+
+/// Stroke of a 2D box's outline in `foxglove.ImageAnnotations`, pixels.
+pub const IMAGE_BOX_PX: f64 = 2.0;
+/// Font size of a 2D box's label, pixels.
+pub const IMAGE_LABEL_PX: f64 = 12.0;
+
+/// One 2D box of [`Recorder::image_boxes`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImageBox {
+    /// `[x0, y0, x1, y1]`, pixels, origin at the top-left corner of the top-left pixel.
+    pub corners: [f64; 4],
+    /// RGBA in `[0, 1]`.
+    pub color: [f32; 4],
+    /// Drawn at the top-left corner when not empty.
+    pub label: String,
 }
 
 /// One 3-D box for [`Recorder::boxes`].
@@ -329,6 +346,89 @@ impl Recorder {
             ..Default::default()
         };
         self.write(topic, log_time_ns, &SceneUpdate { deletions: Vec::new(), entities: vec![entity] })
+    }
+
+    /// Writes a `foxglove.CameraCalibration` of a `width` × `height` pinhole camera in `frame_id` (its optical
+    /// frame): `intrinsics` `[fx, fy, cx, cy]` pixels in OpenCV's (ROS's, Foxglove's) convention, pixel centres at
+    /// whole numbers; `distortion` OpenCV's `[k1, k2, p1, p2, k3]` (`plumb_bob`), zeros for none; R = I, P = [K | 0].
+    /// Non-finite intrinsics or distortion, or a focal length ≤ 0, are an error naming the field.
+    #[allow(clippy::too_many_arguments)]
+    pub fn camera_calibration(
+        &mut self,
+        topic: &str,
+        log_time_ns: u64,
+        frame_id: &str,
+        width: u32,
+        height: u32,
+        intrinsics: [f64; 4],
+        distortion: [f64; 5],
+    ) -> Result<()> {
+        finite(&intrinsics, "intrinsics")?;
+        finite(&distortion, "distortion")?;
+        let [fx, fy, cx, cy] = intrinsics;
+        if fx <= 0.0 || fy <= 0.0 {
+            return Err(MmusvError::input("intrinsics", format!("focal lengths {fx}, {fy} must be > 0 pixels")));
+        }
+        let message = CameraCalibration {
+            timestamp: Some(timestamp(log_time_ns)?),
+            frame_id: frame_id.to_string(),
+            width,
+            height,
+            distortion_model: "plumb_bob".into(),
+            d: distortion.to_vec(),
+            k: vec![fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0],
+            r: vec![1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+            p: vec![fx, 0.0, cx, 0.0, 0.0, fy, cy, 0.0, 0.0, 0.0, 1.0, 0.0],
+        };
+        self.write(topic, log_time_ns, &message)
+    }
+
+    /// Writes a `foxglove.ImageAnnotations` of 2D boxes: each an outlined rectangle (`LINE_LOOP` through its four
+    /// corners) and, when it has a label, a text at its top-left corner, in pixels with the origin at the top-left
+    /// corner of the image's top-left pixel (Foxglove's convention, and mmusv's). A box with non-finite or
+    /// reversed corners, or a colour outside `[0, 1]`, is an error naming `boxes[i]`.
+    pub fn image_boxes(&mut self, topic: &str, log_time_ns: u64, boxes: &[ImageBox]) -> Result<()> {
+        let stamp = timestamp(log_time_ns)?;
+        let mut points = Vec::with_capacity(boxes.len());
+        let mut texts = Vec::new();
+        for (i, b) in boxes.iter().enumerate() {
+            let field = format!("boxes[{i}]");
+            let [x0, y0, x1, y1] = b.corners;
+            finite(&b.corners, &field)?;
+            if x1 < x0 || y1 < y0 {
+                return Err(MmusvError::input(
+                    field,
+                    format!("corners {:?} are not [x0, y0, x1, y1], x0 <= x1, y0 <= y1", b.corners),
+                ));
+            }
+            if !b.color.iter().all(|c| (0.0..=1.0).contains(c)) {
+                return Err(MmusvError::input(field, format!("color {:?} must be RGBA, each in [0, 1]", b.color)));
+            }
+            let color =
+                Color { r: b.color[0] as f64, g: b.color[1] as f64, b: b.color[2] as f64, a: b.color[3] as f64 };
+            let corner = |x: f64, y: f64| Point2 { x, y };
+            points.push(PointsAnnotation {
+                timestamp: Some(stamp),
+                r#type: points_annotation::Type::LineLoop as i32,
+                points: vec![corner(x0, y0), corner(x1, y0), corner(x1, y1), corner(x0, y1)],
+                outline_color: Some(color),
+                thickness: IMAGE_BOX_PX,
+                ..Default::default()
+            });
+            if !b.label.is_empty() {
+                texts.push(TextAnnotation {
+                    timestamp: Some(stamp),
+                    position: Some(corner(x0, y0)),
+                    text: b.label.clone(),
+                    font_size: IMAGE_LABEL_PX,
+                    text_color: Some(Color { r: 1.0, g: 1.0, b: 1.0, a: 1.0 }),
+                    background_color: Some(Color { a: 0.7, ..color }),
+                    ..Default::default()
+                });
+            }
+        }
+        let message = ImageAnnotations { timestamp: Some(stamp), points, texts, ..Default::default() };
+        self.write(topic, log_time_ns, &message)
     }
 
     /// Writes the project's own `mmusv.WorldState`.

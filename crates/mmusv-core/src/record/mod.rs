@@ -22,7 +22,7 @@ mod tests;
 
 pub use batch::{encode_images, ImageFormat, ImageJob};
 pub use image::Pixels;
-pub use messages::{BoxMarker, Transform};
+pub use messages::{BoxMarker, ImageBox, Transform};
 pub use own_schema::{AgentAnnotations, BevBox, Box2D, Box3D, VesselState, WorldState};
 pub use points::{pack_columns, Column, PackedPoints, PackedType};
 pub use writer::{partial_path, EncodedMessage, RecordSummary, Recorder};

@@ -254,6 +254,16 @@ fn rejects_bad_input() -> Result<()> {
     assert!(rec.raw_image("/p", 0, "f", 1, 1, "mono8", 1, &[0u8]).is_err());
     let bad_q = Transform { parent: "a".into(), child: "b".into(), translation: [0.0; 3], rotation: [0.0; 4] };
     assert!(rec.frame_transforms("/tf", 0, &[bad_q]).is_err());
+    // A camera's calibration and 2D boxes: a focal length of 0, a NaN distortion, reversed corners, a colour out
+    // of [0, 1] are refused, naming the field.
+    let k = [100.0, 100.0, 31.5, 23.5];
+    let no_focal = rec.camera_calibration("/c", 0, "c", 64, 48, [0.0, 100.0, 31.5, 23.5], [0.0; 5]);
+    assert!(no_focal.is_err_and(|e| e.to_string().contains("intrinsics")));
+    assert!(rec.camera_calibration("/c", 0, "c", 64, 48, k, [f64::NAN, 0.0, 0.0, 0.0, 0.0]).is_err());
+    let reversed = ImageBox { corners: [10.0, 5.0, 2.0, 8.0], color: [1.0; 4], label: "v".into() };
+    assert!(rec.image_boxes("/b", 0, &[reversed]).is_err_and(|e| e.to_string().contains("boxes[0]")));
+    let bright = ImageBox { corners: [1.0, 1.0, 2.0, 2.0], color: [2.0, 0.0, 0.0, 1.0], label: String::new() };
+    assert!(rec.image_boxes("/b", 0, &[bright]).is_err());
     assert_eq!(rec.finish()?.messages, 1);
     Ok(())
 }
