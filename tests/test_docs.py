@@ -654,7 +654,12 @@ def test_recording_topics_are_the_codes() -> None:
         documented |= {m.group(1) + k for k in m.group(2).split("|")} if m else {pattern}
     a, c = "{agent}", "{name}"
     expected = {topics.TF, topics.WORLD_STATE, topics.lidar(a), topics.radar_returns(a), topics.radar_ppi(a)}
-    expected |= {topics.boxes(a), topics.agent_annotations(a)}
+    expected |= {
+        topics.boxes(a),
+        topics.agent_annotations(a),
+        topics.camera_calibration(a, c),
+        topics.camera_boxes(a, c),
+    }
     expected |= {topics.camera(a, c, kind=k) for k in topics.CAMERA_KINDS} | {
         topics.top_view(a, k) for k in _TOP_OUTPUTS
     }

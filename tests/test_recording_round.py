@@ -182,8 +182,8 @@ class Tree:
 def _frame_ids(r: Rec) -> list[str]:
     if r.schema == "foxglove.SceneUpdate":
         return [e.frame_id for e in r.msg.entities]
-    if r.schema.startswith("foxglove.") and r.schema != "foxglove.FrameTransforms":
-        return [r.msg.frame_id]
+    if r.schema.startswith("foxglove.") and r.schema not in ("foxglove.FrameTransforms", "foxglove.ImageAnnotations"):
+        return [r.msg.frame_id]  # an image's annotations have no frame: they are drawn on its image
     return []
 
 
@@ -255,7 +255,8 @@ def test_every_message_decodes_with_its_own_schema_at_its_frames_time(coop: Path
     for a in ("usv_a", "usv_b"):
         want |= {f"/{a}/{t}" for t in ("lidar", "radar/returns", "radar/ppi", "boxes", "annotations")}
         want |= {f"/{a}/top_view/{k}" for k in ("rgb", "semantic", "instance")}
-        want |= {f"/{a}/camera/{c}/{k}" for c in ("front", "left") for k in ("rgb", "depth", "semantic", "instance")}
+        kinds = ("rgb", "depth", "semantic", "instance", "calibration", "boxes")
+        want |= {f"/{a}/camera/{c}/{k}" for c in ("front", "left") for k in kinds}
     assert topics == want
 
 
@@ -292,9 +293,8 @@ def test_foxglove_schemas_are_the_official_ones_and_decode_with_their_classes(co
         }
         assert embedded == official, schema.name
         names.add(schema.name)
-    assert names == {f"foxglove.{n}" for n in ("FrameTransforms", "PointCloud", "CompressedImage", "RawImage")} | {
-        "foxglove.SceneUpdate"
-    }
+    kinds = ("FrameTransforms", "PointCloud", "CompressedImage", "RawImage", "SceneUpdate", "CameraCalibration")
+    assert names == {f"foxglove.{n}" for n in (*kinds, "ImageAnnotations")}
     for r in _decode(coop):
         if r.schema.startswith("foxglove."):
             short = r.schema.split(".")[1]
@@ -621,6 +621,7 @@ def test_a_killed_run_reads_with_the_official_reader_up_to_its_last_closed_chunk
         for _schema, ch, m in NonSeekingReader(f).iter_messages(log_time_order=False):
             official.append((ch.topic, m.log_time, m.data))
     topics = {"/tf", "/world/state", "/u/lidar", "/u/camera/front/depth", "/u/annotations", "/u/boxes"}
+    topics |= {"/u/camera/front/calibration", "/u/camera/front/boxes"}
     assert {t for t, lt, _ in official if lt == 0} == topics  # at least frame 0, in a closed chunk
     names = []
     with partial.open("rb") as f, pytest.raises(McapError):

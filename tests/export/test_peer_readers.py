@@ -485,6 +485,8 @@ def test_foxglove_schemas_are_the_official_ones(coop_rec: Path) -> None:
         "foxglove.CompressedImage",
         "foxglove.FrameTransforms",
         "foxglove.SceneUpdate",
+        "foxglove.CameraCalibration",
+        "foxglove.ImageAnnotations",
     }
     checked = 0
     for name, ours in sorted(files.items()):
@@ -544,14 +546,16 @@ def test_foxglove_official_classes_decode_every_message(coop_rec: Path) -> None:
             known.DiscardUnknownFields()
             assert known.SerializeToString(deterministic=True) == message.data, (channel.topic, message.sequence)
             counts[schema.name] = counts.get(schema.name, 0) + 1
-    # 3 frames: per USV (2) a cloud, 4 cameras x (rgb, semantic, instance PNG + depth raw), top view (3 PNG), the
-    # radar PPI (PNG), boxes; /tf
+    # 3 frames: per USV (2) a cloud, 4 cameras x (rgb, semantic, instance PNG + depth raw, calibration, 2D boxes),
+    # top view (3 PNG), the radar PPI (PNG), boxes; /tf
     assert counts == {
         "foxglove.PointCloud": 12,
         "foxglove.CompressedImage": 96,
         "foxglove.RawImage": 24,
         "foxglove.SceneUpdate": 6,
         "foxglove.FrameTransforms": 3,
+        "foxglove.CameraCalibration": 24,
+        "foxglove.ImageAnnotations": 24,
     }
 
 

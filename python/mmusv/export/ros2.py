@@ -52,6 +52,7 @@ from mmusv.recording import topics
 from mmusv.recording.decode import WorldFrame
 from mmusv.recording.info import AgentInfo, RecordingInfo
 from mmusv.recording.stream import Frame
+from mmusv.sensors.camera import PIXEL_CENTRE, opencv_intrinsics
 
 __all__ = [
     "MAP_FRAME",
@@ -83,11 +84,6 @@ time 0 for "no time": tf2 looks a transform up at the *latest* stamp it holds fo
 (``tf2::TimeCache::findClosest``), and rclcpp's clock is not ``started()`` at 0, so a first frame stamped 0 would be
 placed with the newest pose in the buffer and its ``/clock`` read as "not yet". The same for every frame and every
 conversion (``--frames`` too); written in ``metadata.yaml``'s ``custom_data`` as ``mmusv.time_offset_ns``."""
-
-PIXEL_CENTRE = 0.5
-"""Where mmusv's pixel coordinates put a pixel's centre (pixel ``(i, j)`` covers ``[i, i + 1) × [j, j + 1)``: its
-intrinsics, 2D boxes); ROS, like OpenCV (``image_geometry``, ``depth_image_proc``, ``cv2.projectPoints``), puts it
-at ``(i, j)``, so ``CameraInfo``'s principal point and the ``Detection2D`` centres are mmusv's less this."""
 
 
 def camera_distortion(agent: AgentInfo, name: str) -> np.ndarray:
@@ -422,12 +418,12 @@ class Ros2Writer(DatasetWriter):
 
     def _camera_info(self, t: int, a: AgentInfo, name: str) -> Any:
         """Pinhole intrinsics in ROS's (OpenCV's) pixel coordinates, where pixel centres are whole numbers: the
-        recorded principal point (mmusv's, centres at +0.5) less half a pixel (:data:`PIXEL_CENTRE`); ``plumb_bob``
+        recorded principal point (mmusv's, centres at +0.5) less half a pixel
+        (:data:`mmusv.sensors.camera.PIXEL_CENTRE`); ``plumb_bob``
         distortion = the camera's Brown–Conrady ``[k1, k2, p1, p2, k3]`` as recorded in its rig
         (:func:`camera_distortion`), zeros without; R = I, P = [K | 0]."""
         cam = a.cameras[name]
-        fx, fy, cx, cy = cam.intrinsics
-        cx, cy = cx - PIXEL_CENTRE, cy - PIXEL_CENTRE
+        fx, fy, cx, cy = opencv_intrinsics(cam.intrinsics)
         k = np.array([fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0])
         p = np.array([fx, 0.0, cx, 0.0, 0.0, fy, cy, 0.0, 0.0, 0.0, 1.0, 0.0])
         roi = self.T("sensor_msgs/msg/RegionOfInterest")(x_offset=0, y_offset=0, height=0, width=0, do_rectify=False)

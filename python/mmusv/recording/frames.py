@@ -9,7 +9,10 @@ Per frame k (log time = t_k in ns, the same for every message of the frame):
 * per agent: ``/<agent>/lidar`` (``foxglove.PointCloud``: x, y, z, intensity float32, ring uint16, azimuth
   float32, class uint16, instance int32; LiDAR frame), ``/<agent>/camera/<name>/rgb`` (PNG),
   ``.../depth`` (RawImage 32FC1, metres along the optical axis, +inf = sky), ``.../semantic`` (PNG uint16 class
-  ids), ``.../instance`` (PNG uint16 instance ids, 65535 = sky), ``/<agent>/top_view/{rgb,semantic,instance}``,
+  ids), ``.../instance`` (PNG uint16 instance ids, 65535 = sky), ``.../calibration``
+  (``foxglove.CameraCalibration``: the intrinsics in OpenCV's pixel convention and the ``plumb_bob`` distortion),
+  ``.../boxes`` (``foxglove.ImageAnnotations``: the camera's 2D boxes, when the run annotates),
+  ``/<agent>/top_view/{rgb,semantic,instance}``,
   ``/<agent>/radar/returns`` (PointCloud: x, y, z, range, azimuth, elevation, intensity float32, instance int32;
   radar frame), ``/<agent>/radar/ppi`` (PNG, colour-mapped PPI), ``/<agent>/boxes`` (``foxglove.SceneUpdate`` in
   the LiDAR frame, or in the vessel's body frame ``<agent>`` when the rig has no LiDAR) and
@@ -238,6 +241,7 @@ class FrameRecorder:
                 images += _images(topics.top_view(a.id), topics.top_view_frame(a.id), ac.top_view, top)
             if images:  # one call per agent: encoded in parallel, written in this order
                 self.encode_seconds += rec.images(log_time_ns=t, images=images)[0]
+            self._camera_extras(a, list(ac.cameras), t, annotations.get(a.id))
             if ac.radar is not None:
                 self._radar(a.id, t, ac.radar, ac.radar_ppi)
             cols = annotations.get(a.id)
@@ -270,6 +274,38 @@ class FrameRecorder:
                     sizes=lid["size"],
                     colors=colours,
                 )
+
+    def _camera_extras(self, a: Any, names: list[str], t: int, cols: dict[str, Any] | None) -> None:
+        """Each camera's ``foxglove.CameraCalibration`` and, with the frame's annotation columns ``cols``, its 2D
+        boxes as ``foxglove.ImageAnnotations`` (coloured by role, labelled with the target's id)."""
+        from mmusv.sensors.camera import opencv_intrinsics
+
+        for name in names:
+            cam, cfg, _mount = a.cameras[name]
+            if cam.intrinsics:
+                self.rec.camera_calibration(
+                    topics.camera_calibration(a.id, name),
+                    log_time_ns=t,
+                    frame_id=topics.camera_frame(a.id, name),
+                    width=int(cfg.resolution[0]),
+                    height=int(cfg.resolution[1]),
+                    intrinsics=opencv_intrinsics(tuple(cam.intrinsics)),
+                    distortion=cfg.distortion,
+                )
+            if cols is None:
+                continue
+            c = cols["camera"]
+            mine = [i for i, n in enumerate(c["camera"]) if n == name]
+            corners = np.column_stack([c[k] for k in ("x_min", "y_min", "x_max", "y_max")])[mine].reshape(-1, 4)
+            roles = [c["role"][i] for i in mine]
+            colours = [(*ROLE_COLOURS.get(r, (1, 1, 1, 1))[:3], 1.0) for r in roles]
+            self.rec.image_boxes(
+                topics.camera_boxes(a.id, name),
+                log_time_ns=t,
+                corners=corners,
+                colors=np.array(colours, np.float32).reshape(-1, 4),
+                labels=[c["target_id"][i] for i in mine],
+            )
 
     def _radar(self, agent: str, t: int, returns: Any, ppi: np.ndarray | None) -> None:
         from mmusv.sensors.radar import ppi_colormap

@@ -1,6 +1,7 @@
 """Topic names and frame ids of an ``mmusv run`` recording: the one place they are spelled (``docs/recording.md``).
 
 Topics: ``/tf``, ``/world/state``, ``/{agent}/lidar``, ``/{agent}/camera/{name}/{rgb|depth|semantic|instance}``,
+``/{agent}/camera/{name}/calibration``, ``/{agent}/camera/{name}/boxes``,
 ``/{agent}/top_view/{rgb|semantic|instance}``, ``/{agent}/radar/returns``, ``/{agent}/radar/ppi``,
 ``/{agent}/boxes``, ``/{agent}/annotations``. Frame ids: ``world``, ``{vessel}`` (body: x forward, y left, z up),
 ``{agent}/lidar``, ``{agent}/radar`` (sensor frames, x forward, y left, z up), ``{agent}/camera/{name}`` and
@@ -20,6 +21,8 @@ __all__ = [
     "agent_of",
     "boxes",
     "camera",
+    "camera_boxes",
+    "camera_calibration",
     "camera_frame",
     "lidar",
     "lidar_frame",
@@ -66,6 +69,18 @@ def camera(agent: str, name: str, *, kind: str | None = None) -> str:
     """``/{agent}/camera/{name}`` (prefix) or ``/{agent}/camera/{name}/{kind}``."""
     base = f"/{agent}/camera/{name}"
     return base if kind is None else f"{base}/{kind}"
+
+
+def camera_calibration(agent: str, name: str) -> str:
+    """``/{agent}/camera/{name}/calibration``: ``foxglove.CameraCalibration`` of the camera (its optical frame,
+    OpenCV's pixel convention), one per frame, so that Foxglove's Image and 3D panels can project onto its images."""
+    return camera(agent, name, kind="calibration")
+
+
+def camera_boxes(agent: str, name: str) -> str:
+    """``/{agent}/camera/{name}/boxes``: ``foxglove.ImageAnnotations``, the camera's 2D boxes of the frame (as
+    ``/{agent}/annotations`` holds them), outlined and labelled, for Foxglove's Image panel."""
+    return camera(agent, name, kind="boxes")
 
 
 def top_view(agent: str, kind: str | None = None) -> str:

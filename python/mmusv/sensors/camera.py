@@ -24,7 +24,21 @@ from mmusv.scene import Scene, _pose
 from mmusv.sensors.config import CameraConfig, TopViewConfig
 from mmusv.sensors.env import check_config, check_sensor, check_sensor_args, wake_rows
 
-__all__ = ["BODY_TO_OPTICAL", "CameraImages", "camera_from_config", "render", "top_view_from_config"]
+__all__ = ["BODY_TO_OPTICAL", "PIXEL_CENTRE", "CameraImages", "camera_from_config", "opencv_intrinsics", "render"]
+__all__ += ["top_view_from_config"]
+
+PIXEL_CENTRE = 0.5
+"""Where mmusv's pixel coordinates put a pixel's centre (pixel ``(i, j)`` covers ``[i, i + 1) × [j, j + 1)``: its
+intrinsics, 2D boxes); ROS, like OpenCV (``image_geometry``, ``depth_image_proc``, ``cv2.projectPoints``) and
+Foxglove's ``CameraCalibration``, puts it at ``(i, j)``, so their principal point is mmusv's less this (Foxglove's
+image annotations use mmusv's: origin at the top-left corner of the top-left pixel)."""
+
+
+def opencv_intrinsics(intrinsics: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
+    """``(fx, fy, cx, cy)`` pixels of mmusv's intrinsics (pixel centres at +0.5) in OpenCV's, ROS's and Foxglove's
+    convention (pixel centres at whole numbers): the principal point less :data:`PIXEL_CENTRE`."""
+    fx, fy, cx, cy = intrinsics
+    return fx, fy, cx - PIXEL_CENTRE, cy - PIXEL_CENTRE
 
 
 @dataclass(frozen=True, eq=False)
