@@ -58,15 +58,15 @@ Found and fixed (each test below failed before):
 * ``mmusv info`` gave a damaged recording of a complete run the status "complete", alone beside "43 of 80 frames"
   (and so did a folder's overview in its status column): now "complete (file damaged)".
 
-Not fixed here (reported): a Foxglove user gets no ``foxglove.CameraCalibration`` beside the camera images (the
-intrinsics are only in the ``sensors`` metadata, so the 3D panel cannot project them) and no
-``foxglove.ImageAnnotations`` for the 2D boxes (only in ``mmusv.AgentAnnotations``): both need the core's recorder;
-a file finished by ``mmusv recover`` has no data-section CRC (the official Python writer leaves it 0), so changes
-outside its chunks go unseen; the recorder defines every schema and channel only inside the chunk of its first
-message (the first chunk), so a file without a readable summary (a killed run's ``.partial``, a copy cut short)
-whose first chunk is damaged loses every frame, the whole chunks after it included (one flipped bit at 1 MB into
-the 80-frame file: 0 of 80 frames, where 36 are intact), and so does a copy missing a range of bytes (its footer's
-summary offset then points elsewhere).
+Reported here and added since in the core's recorder: a ``foxglove.CameraCalibration`` beside the camera images (the
+intrinsics were only in the ``sensors`` metadata, so the 3D panel could not project them) and
+``foxglove.ImageAnnotations`` for the 2D boxes (only in ``mmusv.AgentAnnotations``;
+``tests/test_recording_foxglove_round.py``). Not fixed (reported): a file finished by ``mmusv recover`` has no
+data-section CRC (the official Python writer leaves it 0), so changes outside its chunks go unseen; the recorder
+defines every schema and channel only inside the chunk of its first message (the first chunk), so a file without a
+readable summary (a killed run's ``.partial``, a copy cut short) whose first chunk is damaged loses every frame, the
+whole chunks after it included (one flipped bit at 1 MB into the 80-frame file: 0 of 80 frames, where 36 are
+intact), and so does a copy missing a range of bytes (its footer's summary offset then points elsewhere).
 """
 
 from __future__ import annotations
