@@ -34,7 +34,8 @@ K1 = [-0.12, 0.03, 0.0005, -0.0003, 0.0]
 
 @pytest.fixture(scope="module")
 def recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """``port_entry``, 2 frames, small cameras (the front one with lens distortion), every vessel annotated."""
+    """``port_entry``, 2 frames, small cameras (the front one 4:3 with lens distortion, the left one 16:9), every
+    vessel annotated."""
     from mmusv.acquire import run
 
     sc = yaml.safe_load((REPO / "scenarios/port_entry.yaml").read_text())
@@ -50,7 +51,7 @@ def recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
             },
             {
                 "name": "left",
-                "resolution": [320, 240],
+                "resolution": [320, 180],
                 "hfov_deg": 90.0,
                 "quality": "draft",
                 "mount": {"point": "camera_left"},
@@ -176,3 +177,18 @@ def test_the_image_annotations_are_the_cameras_2d_boxes(recording: Path) -> None
                     assert (text.position.x, text.position.y) == (min(xs), min(ys))
                     got.append((text.text, *(round(v, 6) for v in (min(xs), min(ys), max(xs), max(ys)))))
                 assert sorted(got) == want and len(want) == len(boxes.points), (agent, name)
+
+
+def test_preview_keeps_a_cameras_aspect_ratio(recording: Path) -> None:
+    """``mmusv preview`` drew every camera panel 320 × 240: a 16:9 camera came out a third taller than it is (its
+    boxes placed with two scales). Its panels now keep the image's aspect ratio (320 × 180 here, one scale), a 4:3
+    one's as before."""
+    from mmusv.preview import compose_preview
+
+    _, panels = compose_preview(recording, frame=0, agent="usv_1")
+    for cam, (w, h) in (("left", (320, 180)), ("front", (320, 240))):
+        mine = [p for p in panels if f" · {cam} camera · " in p.title]
+        assert len(mine) == 3, [p.title for p in panels]
+        for p in mine:
+            left, top, right, bottom = p.box
+            assert (right - left, bottom - top) == (w, h) and p.scale == pytest.approx(1.0), (p.title, p.box)

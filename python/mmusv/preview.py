@@ -95,6 +95,13 @@ def _rings(draw: ImageDraw.ImageDraw, *, centre: tuple[float, float], px_per_m: 
         r_m += step
 
 
+def _tile(img: np.ndarray) -> tuple[int, int]:
+    """A camera panel's size: :data:`_TILE`'s width, the image's aspect ratio kept (a 16:9 camera resized to the
+    4:3 tile came out a third taller than it is)."""
+    h, w = img.shape[:2]
+    return _TILE[0], max(round(_TILE[0] * h / w), 1)
+
+
 def _camera_panel(img: np.ndarray, boxes: list[Any], size: tuple[int, int]) -> tuple[Image.Image, float]:
     """The image fitted to ``size`` with ``boxes`` (``mmusv.Box2D``, source pixels) drawn; returns the scale."""
     h, w = img.shape[:2]
@@ -206,13 +213,13 @@ def compose_preview(path: str | Path, *, frame: int = 0, agent: str | None = Non
                 continue
             img = decode_image(m)
             if kind == "rgb":
-                pil, scale = _camera_panel(img, [b for b in boxes2d if b.camera == cam], _TILE)
+                pil, scale = _camera_panel(img, [b for b in boxes2d if b.camera == cam], _tile(img))
                 row.append((f"{a_id} · {cam} camera · RGB + 2D boxes", pil, scale))
             elif kind == "depth":
-                pil = _fit(_colour_depth(img.astype(np.float32)), _TILE)
+                pil = _fit(_colour_depth(img.astype(np.float32)), _tile(img))
                 row.append((f"{a_id} · {cam} camera · depth 0-{_DEPTH_MAX_M:g} m", pil, _TILE[0] / img.shape[1]))
             else:
-                pil = _fit(_semantic(img), _TILE)
+                pil = _fit(_semantic(img), _tile(img))
                 row.append((f"{a_id} · {cam} camera · semantic", pil, _TILE[0] / img.shape[1]))
         if row:
             rows.append(row)
