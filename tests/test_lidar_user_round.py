@@ -65,6 +65,7 @@ import yaml
 from mmusv import Simulation
 from mmusv.scene import Scene
 from mmusv.sensors import LidarConfig, lidar_from_config, scan, sensor_env
+from test_coop_consistency_round import x_to_world
 from test_scene import box_mesh, rpy_matrix
 
 F64 = npt.NDArray[np.float64]
@@ -293,23 +294,6 @@ def _quaternion(q: list[float]) -> F64:
     )
 
 
-def _opencood_x_to_world(pose: list[float]) -> F64:
-    """OpenCOOD's ``x_to_world`` (``opencood/utils/transformation_utils.py``) of a CARLA pose
-    ``[x, y, z, roll, yaw, pitch]`` (metres, degrees), written out."""
-    x, y, z, roll, yaw, pitch = pose
-    cy, sy = math.cos(math.radians(yaw)), math.sin(math.radians(yaw))
-    cr, sr = math.cos(math.radians(roll)), math.sin(math.radians(roll))
-    cp, sp = math.cos(math.radians(pitch)), math.sin(math.radians(pitch))
-    return np.array(
-        [
-            [cp * cy, cy * sp * sr - sy * cr, -cy * sp * cr - sy * sr, x],
-            [sy * cp, sy * sp * sr + cy * cr, -sy * sp * cr + cy * sr, y],
-            [sp, -cp * sr, cp * cr, z],
-            [0.0, 0.0, 0.0, 1.0],
-        ]
-    )
-
-
 def _ascii_pcd(path: Path) -> tuple[dict[str, list[str]], F64, npt.NDArray[np.uint32]]:
     """Header, ``x y z`` and the packed ``rgb`` of an ASCII ``.pcd``."""
     lines = path.read_text().splitlines()
@@ -431,13 +415,13 @@ def test_the_exports_carry_the_capture_in_the_documented_frames(
         np.testing.assert_allclose(xyz, pts.xyz * np.array([1, -1, 1]), atol=6e-5)
         np.testing.assert_allclose((rgb >> 16) & 0xFF, pts.intensity * 255, atol=0.5 + 1e-4)
         meta = yaml.safe_load((opv2v / f"{k:06d}.yaml").read_text())
-        lidar_to_world = _opencood_x_to_world(meta["lidar_pose"])
+        lidar_to_world = x_to_world(meta["lidar_pose"])
         carla = xyz @ lidar_to_world[:3, :3].T + lidar_to_world[:3, 3]
         world = pts.xyz.astype(np.float64) @ a.lidar_pose[:3, :3].T + a.lidar_pose[:3, 3]
         np.testing.assert_allclose(carla * np.array([1, -1, 1]), world, atol=2e-4)
         assert len(meta["vehicles"]) == 4
         for cav, v in meta["vehicles"].items():
-            box = _opencood_x_to_world([*np.add(v["location"], v["center"]), *v["angle"]])
+            box = x_to_world([*np.add(v["location"], v["center"]), *v["angle"]])
             mine = pts.instance == sim.vessels[int(cav) - 1000].instance_id
             assert _in_box(carla[mine], box, np.zeros(3), 2 * np.array(v["extent"])).max() < 3 * SIGMA + 1e-3
 
