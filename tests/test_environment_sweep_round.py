@@ -126,7 +126,7 @@ def lidar_points_total(run: Path) -> int:
     return sum(box.lidar_points for msg in decoded(run, "/annotations") for box in msg.boxes_lidar)
 
 
-GEOMETRY_SUFFIXES = ("/depth", "/semantic", "/instance", "/world/state", "/tf", "/boxes")
+GEOMETRY_SUFFIXES = ("/depth", "/semantic", "/instance", "/world/state", "/tf", "/boxes", "/calibration")
 """The topics that are geometry whatever the weather: every image of depth, classes and instances (bow camera and
 top view), the world state, the transforms and the boxes drawn for Foxglove."""
 
@@ -154,7 +154,8 @@ def test_labels_do_not_depend_on_the_sky(sky_runs: dict[tuple[str, str], Path], 
     a, b = messages(clear), messages(other)
     assert a.keys() == b.keys()
     geometry = [t for t in a if t.endswith(GEOMETRY_SUFFIXES)]
-    assert len(geometry) == 8, geometry  # 3 camera images, 2 top-view images, state, tf, boxes
+    # 3 camera images, 2 top-view images, state, tf, 3D boxes, the camera's 2D boxes and calibration
+    assert len(geometry) == 10, geometry
     for topic in geometry:
         assert a[topic] == b[topic], topic
     assert annotations_without_lidar_points(clear) == annotations_without_lidar_points(other)
