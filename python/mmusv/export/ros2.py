@@ -30,7 +30,7 @@ from scipy.spatial.transform import Rotation
 
 from mmusv.classes import ROLE_COLOURS, class_name
 from mmusv.errors import ConfigError
-from mmusv.export.common import naming
+from mmusv.export.common import naming, top_view_entry
 from mmusv.export.ros2_msgs import Msgs, stamp
 from mmusv.export.ros2_names import (
     MAP_FRAME,
@@ -106,15 +106,7 @@ def top_view_custom_data(top_view: dict[str, Any]) -> str:
     (``m`` = ``metres_per_pixel``), the frame ``/tf`` places ``altitude_m`` over the USV, looking straight down."""
     import json
 
-    return json.dumps(
-        {
-            "altitude_m": float(top_view["altitude_m"]),
-            "metres_per_pixel": float(top_view["metres_per_pixel"]),
-            "orientation": str(top_view["orientation"]),
-            "resolution": [int(x) for x in top_view["resolution"]],
-        },
-        sort_keys=True,
-    )
+    return json.dumps(top_view_entry(top_view), sort_keys=True)
 
 
 @dataclass(frozen=True)
