@@ -61,12 +61,13 @@ Found and fixed (each test below failed before):
 Reported here and added since in the core's recorder: a ``foxglove.CameraCalibration`` beside the camera images (the
 intrinsics were only in the ``sensors`` metadata, so the 3D panel could not project them) and
 ``foxglove.ImageAnnotations`` for the 2D boxes (only in ``mmusv.AgentAnnotations``;
-``tests/test_recording_foxglove_round.py``). Not fixed (reported): a file finished by ``mmusv recover`` has no
-data-section CRC (the official Python writer leaves it 0), so changes outside its chunks go unseen; the recorder
-defines every schema and channel only inside the chunk of its first message (the first chunk), so a file without a
-readable summary (a killed run's ``.partial``, a copy cut short) whose first chunk is damaged loses every frame, the
-whole chunks after it included (one flipped bit at 1 MB into the 80-frame file: 0 of 80 frames, where 36 are
-intact), and so does a copy missing a range of bytes (its footer's summary offset then points elsewhere).
+``tests/test_recording_foxglove_round.py``). Also reported and fixed since: a file finished by ``mmusv recover`` had
+no data-section CRC (the official Python writer leaves it 0 unless asked), so changes outside its chunks went
+unseen. Not fixed (reported): the recorder defines every schema and channel only inside the chunk of its first
+message (the first chunk), so a file without a readable summary (a killed run's ``.partial``, a copy cut short)
+whose first chunk is damaged loses every frame, the whole chunks after it included (one flipped bit at 1 MB into the
+80-frame file: 0 of 80 frames, where 36 are intact), and so does a copy missing a range of bytes (its footer's
+summary offset then points elsewhere).
 """
 
 from __future__ import annotations
@@ -492,6 +493,31 @@ def test_a_recovered_recording_keeps_its_metadata_before_its_frames(dense: Path,
     cut.write_bytes(data[: len(data) // 2])
     got = summary(cut)
     assert got["frames"] is not None and 0 < got["frames"]["read"] < 60 and not got["complete"], got
+
+
+def test_a_recovered_recording_has_its_data_sections_crc(dense: Path, tmp_path: Path) -> None:
+    """``mmusv recover`` wrote its file with the official Python writer, which leaves the data section's CRC 0
+    unless asked: a change outside the chunks of a recovered recording (its metadata) went unseen. The CRC is now
+    the data section's (zlib's CRC-32 of every byte from the magic to the data end record, written out here), and
+    a changed metadata byte is reported."""
+    from mcap_rechunk import killed_copy
+    from mmusv.recording import summary
+
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "scenario.yaml").write_bytes((dense.parent / "scenario.yaml").read_bytes())
+    killed_copy(dense, run / "dense.mcap.partial", messages=300)
+    code, _out, err = _cli("recover", str(run))
+    assert code == 0, err
+    data = (run / "dense.mcap").read_bytes()
+    (start, _end, end_record) = next((s, e, r) for s, e, r in _records(data) if isinstance(r, DataEnd))
+    assert end_record.data_section_crc == zlib.crc32(data[:start]) != 0
+    assert summary(run / "dense.mcap")["complete"]
+    changed = tmp_path / "changed.mcap"
+    at = data.index(b"dense")  # the scenario metadata's text, outside every chunk
+    changed.write_bytes(data[:at] + b"Dense" + data[at + 5 :])
+    got = summary(changed)
+    assert not got["complete"] and any("outside the chunks" in line for line in got["damage"]), got["damage"]
 
 
 def test_info_does_not_call_a_damaged_recording_of_a_complete_run_complete(dense: Path, tmp_path: Path) -> None:

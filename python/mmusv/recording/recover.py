@@ -350,7 +350,8 @@ def _finish(src: Path, info: RecordingInfo, final: Path, tmp: Path, staged: Path
     scan = Scan(src)
     try:
         with tmp.open("wb") as f:
-            w = Writer(f, chunk_size=_CHUNK_BYTES, compression=CompressionType.ZSTD)
+            # the data section's CRC too (the writer leaves it 0 unless asked): damage outside the chunks is then seen
+            w = Writer(f, chunk_size=_CHUNK_BYTES, compression=CompressionType.ZSTD, enable_data_crcs=True)
             w.start(profile="", library="mmusv recover")
             # the scenario, manifest and sensors metadata first, as mmusv run writes them: a copy of the recovered
             # file cut short still reads up to the cut (written after the messages, such a copy held no frame)
