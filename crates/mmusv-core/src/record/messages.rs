@@ -90,6 +90,14 @@ fn unit_quaternion(q: &[f64; 4], field: &str) -> Result<Quaternion> {
     Ok(Quaternion { x: q[0], y: q[1], z: q[2], w: q[3] })
 }
 
+/// Checks an RGBA colour lies in `[0, 1]` and makes it Foxglove's `Color`.
+fn rgba(c: &[f32; 4], field: &str) -> Result<Color> {
+    if !c.iter().all(|v| (0.0..=1.0).contains(v)) {
+        return Err(MmusvError::input(field, format!("color {c:?} must be RGBA, each in [0, 1]")));
+    }
+    Ok(Color { r: c[0] as f64, g: c[1] as f64, b: c[2] as f64, a: c[3] as f64 })
+}
+
 fn vec3(v: &[f64; 3]) -> Vector3 {
     Vector3 { x: v[0], y: v[1], z: v[2] }
 }
@@ -311,11 +319,7 @@ impl Recorder {
             if b.size.iter().any(|&v| v < 0.0) {
                 return Err(MmusvError::input(field, format!("size {:?} has a negative edge length", b.size)));
             }
-            if !b.color.iter().all(|c| (0.0..=1.0).contains(c)) {
-                return Err(MmusvError::input(field, format!("color {:?} must be RGBA, each in [0, 1]", b.color)));
-            }
-            let color =
-                Color { r: b.color[0] as f64, g: b.color[1] as f64, b: b.color[2] as f64, a: b.color[3] as f64 };
+            let color = rgba(&b.color, &field)?;
             cubes.push(CubePrimitive {
                 pose: Some(pose(&b.center, &b.quaternion, &field)?),
                 size: Some(vec3(&b.size)),
@@ -401,11 +405,7 @@ impl Recorder {
                     format!("corners {:?} are not [x0, y0, x1, y1], x0 <= x1, y0 <= y1", b.corners),
                 ));
             }
-            if !b.color.iter().all(|c| (0.0..=1.0).contains(c)) {
-                return Err(MmusvError::input(field, format!("color {:?} must be RGBA, each in [0, 1]", b.color)));
-            }
-            let color =
-                Color { r: b.color[0] as f64, g: b.color[1] as f64, b: b.color[2] as f64, a: b.color[3] as f64 };
+            let color = rgba(&b.color, &field)?;
             let corner = |x: f64, y: f64| Point2 { x, y };
             points.push(PointsAnnotation {
                 timestamp: Some(stamp),
