@@ -280,6 +280,13 @@ class FrameRecorder:
         boxes as ``foxglove.ImageAnnotations`` (coloured by role, labelled with the target's id)."""
         from mmusv.sensors.camera import opencv_intrinsics
 
+        if cols is not None:  # the agent's 2D boxes, every camera's, once
+            c = cols["camera"]
+            which = np.array(c["camera"], dtype=object)
+            corners = np.column_stack([c[k] for k in ("x_min", "y_min", "x_max", "y_max")]).reshape(-1, 4)
+            colours = [(*ROLE_COLOURS.get(r, (1, 1, 1, 1))[:3], 1.0) for r in c["role"]]
+            colours_rgba = np.array(colours, np.float32).reshape(-1, 4)
+            target_ids = np.array(c["target_id"], dtype=object)
         for name in names:
             cam, cfg, _mount = a.cameras[name]
             if cam.intrinsics:
@@ -292,20 +299,15 @@ class FrameRecorder:
                     intrinsics=opencv_intrinsics(tuple(cam.intrinsics)),
                     distortion=cfg.distortion,
                 )
-            if cols is None:
-                continue
-            c = cols["camera"]
-            mine = [i for i, n in enumerate(c["camera"]) if n == name]
-            corners = np.column_stack([c[k] for k in ("x_min", "y_min", "x_max", "y_max")])[mine].reshape(-1, 4)
-            roles = [c["role"][i] for i in mine]
-            colours = [(*ROLE_COLOURS.get(r, (1, 1, 1, 1))[:3], 1.0) for r in roles]
-            self.rec.image_boxes(
-                topics.camera_boxes(a.id, name),
-                log_time_ns=t,
-                corners=corners,
-                colors=np.array(colours, np.float32).reshape(-1, 4),
-                labels=[c["target_id"][i] for i in mine],
-            )
+            if cols is not None:
+                mine = which == name
+                self.rec.image_boxes(
+                    topics.camera_boxes(a.id, name),
+                    log_time_ns=t,
+                    corners=corners[mine],
+                    colors=colours_rgba[mine],
+                    labels=[str(i) for i in target_ids[mine]],
+                )
 
     def _radar(self, agent: str, t: int, returns: Any, ppi: np.ndarray | None) -> None:
         from mmusv.sensors.radar import ppi_colormap
