@@ -325,10 +325,10 @@ def check_lidar_water(scenario: Scenario, *, source: str) -> list[str]:
         lidar = scenario.rigs[name].lidar
         if lidar is None:
             continue
-        given = [(k, getattr(lidar, k)) for k in LIDAR_WATER_KNOBS]
-        given = [(k, v) for k, v in given if v != LidarConfig.model_fields[k].default]
         if lidar.water_probability == 0 and lidar.water_probability_per_wave_m == 0:
             continue  # no water returns on either sea: the ranges do not matter
+        given = [(k, getattr(lidar, k)) for k in LIDAR_WATER_KNOBS]
+        given = [(k, v) for k, v in given if v != LidarConfig.model_fields[k].default]
         if given:
             values = ", ".join(f"{k} = {v:g}" for k, v in given)
             it = ("it is", "changes") if len(given) == 1 else ("they are", "change")
