@@ -63,11 +63,11 @@ intrinsics were only in the ``sensors`` metadata, so the 3D panel could not proj
 ``foxglove.ImageAnnotations`` for the 2D boxes (only in ``mmusv.AgentAnnotations``;
 ``tests/test_recording_foxglove_round.py``). Also reported and fixed since: a file finished by ``mmusv recover`` had
 no data-section CRC (the official Python writer leaves it 0 unless asked), so changes outside its chunks went
-unseen. Not fixed (reported): the recorder defines every schema and channel only inside the chunk of its first
-message (the first chunk), so a file without a readable summary (a killed run's ``.partial``, a copy cut short)
-whose first chunk is damaged loses every frame, the whole chunks after it included (one flipped bit at 1 MB into the
-80-frame file: 0 of 80 frames, where 36 are intact), and so does a copy missing a range of bytes (its footer's
-summary offset then points elsewhere).
+unseen. Also reported and fixed since: the recorder defined every schema and channel only inside the chunk of its
+first message, so a file without a readable summary (a killed run's ``.partial``, a copy cut short) whose first
+chunk was damaged lost every frame, the whole chunks after it included (one flipped bit in the 80-frame file's first
+chunk: 0 of 80 frames, where 36 are intact); the first frame's schemas and channels now come in a small chunk of
+their own before its messages (:func:`test_a_damaged_first_frame_chunk_loses_its_own_frames_alone`).
 """
 
 from __future__ import annotations
@@ -158,14 +158,18 @@ def test_every_index_points_at_the_records_it_indexes(dense: Path) -> None:
     at = {start: (end, rec) for start, end, rec in recs}
     chunks = [(s, e, r) for s, e, r in recs if isinstance(r, Chunk)]
     index = {r.chunk_start_offset: r for _s, _e, r in recs if isinstance(r, ChunkIndex)}
-    assert len(chunks) == len(index) == 2
+    assert len(chunks) == len(index) == 3
     counts: collections.Counter[int] = collections.Counter()
-    for start, end, chunk in chunks:
+    for k, (start, end, chunk) in enumerate(chunks):
         ci = index[start]
         assert ci.chunk_length == end - start
         assert (ci.message_start_time, ci.message_end_time) == (chunk.message_start_time, chunk.message_end_time)
         assert (ci.compression, ci.compressed_size) == (chunk.compression, len(chunk.data))
         assert ci.uncompressed_size == chunk.uncompressed_size
+        if k == 0:  # the first frame's schemas and channels alone, in a chunk of their own before its messages
+            ops = [op for _pos, op, _body in _inner(chunk)]
+            assert set(ops) == {0x03, 0x04} and ops.count(0x04) == 5 and not ci.message_index_offsets, ops
+            continue
         listed: dict[int, list[tuple[int, int]]] = collections.defaultdict(list)
         for pos, op, body in _inner(chunk):
             if op == MESSAGE:
@@ -264,14 +268,41 @@ def test_a_recording_cut_anywhere_is_never_called_complete(dense: Path, tmp_path
 
 
 def _damaged(data: bytes, chunk: int, *, field: bool) -> bytes:
-    """``data`` with chunk ``chunk`` damaged: its stored CRC changed (``field``), else one bit in its data."""
-    start, end, rec = [(s, e, r) for s, e, r in _records(data) if isinstance(r, Chunk)][chunk]
+    """``data`` with the chunk ``chunk`` of those that hold messages damaged (the first one holds the first frame's
+    schemas and channels alone): its stored CRC changed (``field``), else one bit in its data."""
+    chunks = [(s, e, r) for s, e, r in _records(data) if isinstance(r, Chunk)]
+    start, end, rec = [(s, e, r) for s, e, r in chunks if any(op == MESSAGE for _p, op, _b in _inner(r))][chunk]
     out = bytearray(data)
     if field:  # opcode, length, start and end times, uncompressed size, then the CRC
         out[start + 33 : start + 37] = struct.pack("<I", rec.uncompressed_crc ^ 1)
     else:
         out[(start + end) // 2] ^= 0x40
     return bytes(out)
+
+
+def test_a_damaged_first_frame_chunk_loses_its_own_frames_alone(dense: Path, tmp_path: Path) -> None:
+    """A copy without its summary (cut where the data section ends, as a killed run's ``.partial`` has none) whose
+    first chunk of messages has one flipped bit: the frames whose messages all lie in the chunks after it are read,
+    the same messages as the intact file's (found here from the chunks' own records, decompressed with
+    ``zstandard``). With the channels defined beside frame 0's first messages, not one frame was read."""
+    from mmusv.recording import read_messages, summary
+
+    data = dense.read_bytes()
+    recs = _records(data)
+    chunks = [r for _s, _e, r in recs if isinstance(r, Chunk)]
+    times = [{struct.unpack_from("<HIQ", b)[2] for _p, op, b in _inner(c) if op == MESSAGE} for c in chunks]
+    times = [t for t in times if t]
+    assert len(times) == 2
+    kept = sorted(times[1] - times[0])  # frames wholly in the second chunk of messages
+    data_end = next(s for s, _e, r in recs if isinstance(r, DataEnd))
+    path = tmp_path / "damaged.mcap"
+    path.write_bytes(_damaged(data, 0, field=False)[:data_end])
+    got = summary(path)
+    assert got["frames"]["read"] == len(kept) == 36 and got["damage"], got
+    with dense.open("rb") as f:
+        peer = [(c.topic, m.log_time, m.data) for _s, c, m in make_reader(f).iter_messages(log_time_order=False)]
+    ours = [(t, lt, m.SerializeToString()) for t, lt, m in read_messages(path, damage=[]) if lt in kept]
+    assert ours == [p for p in peer if p[1] in kept] and len(ours) == 5 * len(kept)
 
 
 @pytest.mark.parametrize("field", [True, False], ids=["its CRC", "a bit of its data"])

@@ -21,5 +21,6 @@ def test_a_damaged_recording_says_the_damage(coop_rec: Path, tmp_path: Path) -> 
     msg = str(caught.value)
     assert msg.startswith(f"nothing converted: no complete frame in {bad}; nothing written ("), msg
     assert f"{bad}: frames 0..2 lost from the recording" in msg, msg
-    assert "CRC mismatch" in msg, msg
+    # the flipped byte fails the chunk's CRC or its zstd stream, depending on where it falls
+    assert "damaged chunk, skipped: " in msg and ("CRC mismatch" in msg or "does not decompress" in msg), msg
     assert not (tmp_path / "o").exists()

@@ -34,17 +34,19 @@ def write_yaml(path: Path, data: dict[str, Any]) -> Path:
     return path
 
 
-def chunk_spans(path: Path) -> list[tuple[int, int]]:
-    """``(start, end)`` byte offsets of every chunk record of a file (from the intact file's structure)."""
-    from mcap.records import Chunk
-    from mcap.stream_reader import StreamReader
+def chunk_spans(path: Path, *, declarations: bool = False) -> list[tuple[int, int]]:
+    """``(start, end)`` byte offsets of every chunk record of a file that holds messages (from the intact file's
+    structure); with ``declarations``, the chunks that hold none too (the recorder writes the first frame's schemas
+    and channels in a chunk of their own, before its messages)."""
+    from mcap.records import Chunk, Message
+    from mcap.stream_reader import StreamReader, breakup_chunk
 
     spans = []
     with path.open("rb") as f:
         start = 8
         for rec in StreamReader(f, emit_chunks=True).records:
             end = f.tell()
-            if isinstance(rec, Chunk):
+            if isinstance(rec, Chunk) and (declarations or any(isinstance(r, Message) for r in breakup_chunk(rec))):
                 spans.append((start, end))
             start = end
     return spans

@@ -267,3 +267,72 @@ fn rejects_bad_input() -> Result<()> {
     assert_eq!(rec.finish()?.messages, 1);
     Ok(())
 }
+
+/// The opcodes of each chunk's records, in file order (`mcap`'s raw record reader and chunk decoder).
+fn chunk_opcodes(bytes: &[u8]) -> Result<Vec<Vec<u8>>> {
+    let mut chunks = Vec::new();
+    for rec in mcap::read::LinearReader::new(bytes).map_err(io)? {
+        if let mcap::records::Record::Chunk { header, data } = rec.map_err(io)? {
+            let inner = mcap::read::ChunkReader::new(header, &data).map_err(io)?;
+            chunks.push(inner.map(|r| r.map(|r| r.opcode())).collect::<std::result::Result<_, _>>().map_err(io)?);
+        }
+    }
+    Ok(chunks)
+}
+
+#[test]
+fn the_first_frames_channels_come_first_in_a_chunk_of_their_own() -> Result<()> {
+    use mcap::records::op;
+    let path = scratch("declared.mcap");
+    let mut rec = Recorder::create(&path, false)?;
+    write_all(&mut rec)?;
+    rec.finish()?;
+    let bytes = std::fs::read(&path).map_err(io)?;
+    let chunks = chunk_opcodes(&bytes)?;
+    assert!(chunks.len() >= 2, "{chunks:?}");
+    let (first, rest) = (&chunks[0], &chunks[1..]);
+    assert!(first.iter().all(|&o| o == op::SCHEMA || o == op::CHANNEL), "{first:?}");
+    assert_eq!(first.iter().filter(|&&o| o == op::CHANNEL).count(), 7);
+    assert!(rest.iter().flatten().all(|&o| o == op::MESSAGE), "{rest:?}");
+    // The messages in the order written, each channel's sequence from 0: frame 0's held ones too.
+    let got: Vec<(String, u32, u64)> = mcap::MessageStream::new(&bytes)
+        .map_err(io)?
+        .map(|m| m.map(|m| (m.channel.topic.clone(), m.sequence, m.log_time)))
+        .collect::<std::result::Result<_, _>>()
+        .map_err(io)?;
+    assert_eq!(got.len(), 14);
+    assert_eq!(got[..7].iter().map(|g| (g.1, g.2)).collect::<Vec<_>>(), vec![(0, 0); 7]);
+    assert_eq!(got[7..].iter().map(|g| (g.1, g.2)).collect::<Vec<_>>(), vec![(1, 100_000_000); 7]);
+    assert_eq!(got[..7].iter().map(|g| &g.0).collect::<Vec<_>>(), got[7..].iter().map(|g| &g.0).collect::<Vec<_>>());
+    Ok(())
+}
+
+#[test]
+fn messages_held_at_one_log_time_are_written_by_finish_abandon_and_drop() -> Result<()> {
+    let frame0 = |rec: &mut Recorder| rec.pixels("/d", 0, "cam", 2, 1, &Pixels::Float32(&[1.5, 2.5]));
+    let count = |bytes: &[u8]| -> Result<usize> { Ok(mcap::MessageStream::new(bytes).map_err(io)?.count()) };
+    let path = scratch("held.mcap");
+    let mut rec = Recorder::create(&path, false)?;
+    frame0(&mut rec)?;
+    frame0(&mut rec)?;
+    rec.pixels("/d", 0, "cam", 2, 1, &Pixels::Mono8(&[1, 2]))?; // RawImage too: the same channel
+    rec.finish()?;
+    assert_eq!(count(&std::fs::read(&path).map_err(io)?)?, 3);
+    for abandon in [true, false] {
+        let path = scratch(if abandon { "held_abandoned.mcap" } else { "held_dropped.mcap" });
+        let mut rec = Recorder::create(&path, false)?;
+        frame0(&mut rec)?;
+        if abandon {
+            rec.abandon()?;
+        } else {
+            drop(rec);
+        }
+        assert_eq!(count(&std::fs::read(partial_path(&path)).map_err(io)?)?, 1);
+    }
+    // A second schema on a held topic is refused before it is held.
+    let mut rec = Recorder::create(&scratch("held_conflict.mcap"), false)?;
+    frame0(&mut rec)?;
+    let e = rec.png_image("/d", 0, "cam", 1, 1, &Pixels::Rgb8(&[1, 2, 3])).err().map(|e| e.to_string());
+    assert!(e.unwrap_or_default().contains("already carries foxglove.RawImage"));
+    Ok(())
+}

@@ -1,5 +1,11 @@
-//! The MCAP file itself: creation under a `.partial` name, lazily created channels, per-channel sequence
+//! The MCAP file itself: creation under a `.partial` name, channels created on first use, per-channel sequence
 //! numbers, metadata and attachments, and the rename into place on [`Recorder::finish`].
+//!
+//! The first frame's channels come first, in a chunk of their own: the messages of the first log time are held
+//! until a message of another time (or metadata, an attachment, the end) arrives, then every schema and channel
+//! they use is written and that chunk closed before them. A reader without the summary (a killed run's
+//! `.partial`, a copy cut short) learns the channels from that small chunk, so a damaged chunk of frame 0 loses
+//! its own messages alone; when the channels lay beside frame 0's first messages, it lost every frame after them.
 //!
 //! Deterministic: no wall clock is read; log and publish times are the simulation times the caller gives;
 //! zstd runs single-threaded with a fixed level (`ZSTD_LEVEL`), so the same calls give the same bytes.
@@ -22,6 +28,10 @@ const ZSTD_LEVEL: u32 = 1;
 
 /// Target uncompressed size of one zstd chunk.
 const CHUNK_BYTES: u64 = 4 << 20;
+
+/// The most bytes of first-time messages held back (see the module's header): past it they are written, so a
+/// caller that writes everything at one log time does not keep its whole recording in memory.
+const HOLD_BYTES: usize = 256 << 20;
 
 /// What [`Recorder::finish`] reports.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -76,9 +86,29 @@ impl EncodedMessage {
 
 /// A channel created on first use of its topic.
 struct Slot {
-    id: u16,
+    /// The channel's id; `None` while its first messages are held and it is not yet written.
+    id: Option<u16>,
     schema: String,
     next_sequence: u32,
+}
+
+/// A message of the first log time, held until its channels are written (see the module's header).
+struct Held {
+    topic: String,
+    log_time: u64,
+    sequence: u32,
+    data: Vec<u8>,
+}
+
+/// Where the holding of the first log time's messages stands.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Hold {
+    /// No message yet: the first one starts the holding.
+    Ready,
+    /// Holding the messages of `log_time`, `bytes` of them.
+    Holding { log_time: u64, bytes: usize },
+    /// Released: messages are written as they come.
+    Done,
 }
 
 /// Streams messages into one MCAP file. Write under `<path>.partial`; [`finish`](Self::finish) completes the
@@ -89,6 +119,10 @@ pub struct Recorder {
     path: PathBuf,
     partial: PathBuf,
     channels: BTreeMap<String, Slot>,
+    /// The held messages' channels not yet written, in the order of their first message.
+    pending: Vec<(String, foxglove::Schema, String)>,
+    held: Vec<Held>,
+    hold: Hold,
     messages: u64,
     /// The reason of the first failed write: the MCAP writer refuses every write after one fails, with a
     /// message that no longer says why, so later errors repeat this one.
@@ -205,6 +239,9 @@ impl Recorder {
             path: path.to_path_buf(),
             partial,
             channels: BTreeMap::new(),
+            pending: Vec::new(),
+            held: Vec::new(),
+            hold: Hold::Ready,
             messages: 0,
             first_failure: None,
         })
@@ -255,32 +292,74 @@ impl Recorder {
         data: &[u8],
     ) -> Result<()> {
         self.check_topic(topic, &schema.name)?;
+        self.writer()?;
+        match self.hold {
+            Hold::Ready => self.hold = Hold::Holding { log_time: log_time_ns, bytes: 0 },
+            Hold::Holding { log_time, bytes } if log_time != log_time_ns || bytes > HOLD_BYTES => self.release()?,
+            _ => {}
+        }
         let partial = self.partial.clone();
-        let slot = match self.channels.get_mut(topic) {
-            Some(slot) => slot,
-            None => {
-                let w = self.writer()?;
-                let schema_id =
-                    w.add_schema(&schema.name, &schema.encoding, &schema.data).map_err(mcap_err(&partial))?;
-                let id =
-                    w.add_channel(schema_id, topic, message_encoding, &BTreeMap::new()).map_err(mcap_err(&partial))?;
-                self.channels.entry(topic.to_string()).or_insert(Slot {
-                    id,
-                    schema: schema.name.clone(),
-                    next_sequence: 0,
-                })
-            }
-        };
-        let header = MessageHeader {
-            channel_id: slot.id,
-            sequence: slot.next_sequence,
-            log_time: log_time_ns,
-            publish_time: log_time_ns,
-        };
+        let holding = matches!(self.hold, Hold::Holding { .. });
+        if !self.channels.contains_key(topic) {
+            let id = if holding {
+                self.pending.push((topic.to_string(), schema.clone(), message_encoding.to_string()));
+                None
+            } else {
+                Some(self.add_channel(topic, schema, message_encoding)?)
+            };
+            self.channels.insert(topic.to_string(), Slot { id, schema: schema.name.clone(), next_sequence: 0 });
+        }
+        let Some(slot) = self.channels.get_mut(topic) else { unreachable!("the channel was created above") };
+        let sequence = slot.next_sequence;
         slot.next_sequence = slot.next_sequence.wrapping_add(1);
-        let written = self.writer()?.write_to_known_channel(&header, data);
-        written.map_err(|e| self.failed(&partial, &e))?;
+        if let Hold::Holding { bytes, .. } = &mut self.hold {
+            *bytes += data.len();
+            self.held.push(Held { topic: topic.to_string(), log_time: log_time_ns, sequence, data: data.to_vec() });
+        } else {
+            let header = MessageHeader {
+                channel_id: slot.id.unwrap_or(0),
+                sequence,
+                log_time: log_time_ns,
+                publish_time: log_time_ns,
+            };
+            let written = self.writer()?.write_to_known_channel(&header, data);
+            written.map_err(|e| self.failed(&partial, &e))?;
+        }
         self.messages += 1;
+        Ok(())
+    }
+
+    /// Writes `topic`'s schema and channel; returns the channel's id.
+    fn add_channel(&mut self, topic: &str, schema: &foxglove::Schema, message_encoding: &str) -> Result<u16> {
+        let partial = self.partial.clone();
+        let w = self.writer()?;
+        let schema_id = w.add_schema(&schema.name, &schema.encoding, &schema.data).map_err(mcap_err(&partial))?;
+        w.add_channel(schema_id, topic, message_encoding, &BTreeMap::new()).map_err(mcap_err(&partial))
+    }
+
+    /// Ends the holding of the first log time's messages (see the module's header): writes the schemas and
+    /// channels they use, closes the chunk holding them, then writes the messages in the order they came.
+    fn release(&mut self) -> Result<()> {
+        if !matches!(self.hold, Hold::Holding { .. }) {
+            return Ok(());
+        }
+        self.hold = Hold::Done;
+        let partial = self.partial.clone();
+        for (topic, schema, encoding) in std::mem::take(&mut self.pending) {
+            let id = self.add_channel(&topic, &schema, &encoding)?;
+            if let Some(slot) = self.channels.get_mut(&topic) {
+                slot.id = Some(id);
+            }
+        }
+        let flushed = self.writer()?.flush();
+        flushed.map_err(|e| self.failed(&partial, &e))?;
+        for h in std::mem::take(&mut self.held) {
+            let channel_id = self.channels.get(&h.topic).and_then(|s| s.id).unwrap_or(0);
+            let header =
+                MessageHeader { channel_id, sequence: h.sequence, log_time: h.log_time, publish_time: h.log_time };
+            let written = self.writer()?.write_to_known_channel(&header, &h.data);
+            written.map_err(|e| self.failed(&partial, &e))?;
+        }
         Ok(())
     }
 
@@ -302,6 +381,7 @@ impl Recorder {
     /// Writes an MCAP metadata record `name` holding `map` (e.g. scenario name, seed, mmusv version).
     pub fn metadata(&mut self, name: &str, map: &BTreeMap<String, String>) -> Result<()> {
         let partial = self.partial.clone();
+        self.release()?;
         let record = Metadata { name: name.to_string(), metadata: map.clone() };
         let written = self.writer()?.write_metadata(&record);
         written.map_err(|e| self.failed(&partial, &e))
@@ -322,6 +402,7 @@ impl Recorder {
 
     /// Writes an attachment (e.g. the scenario YAML); `log_time_ns` is also used as its create time.
     pub fn attachment(&mut self, name: &str, media_type: &str, log_time_ns: u64, data: &[u8]) -> Result<()> {
+        self.release()?;
         let partial = self.partial.clone();
         let a = Attachment {
             log_time: log_time_ns,
@@ -336,6 +417,9 @@ impl Recorder {
 
     /// Completes the file and renames it from `<path>.partial` to `path` (replacing `path` if it exists).
     pub fn finish(mut self) -> Result<RecordSummary> {
+        if self.writer.is_some() {
+            self.release()?;
+        }
         let Some(writer) = self.writer.take() else {
             return Err(MmusvError::Io {
                 path: self.partial.display().to_string(),
@@ -356,6 +440,9 @@ impl Recorder {
     /// Completes the MCAP (valid, with everything written so far) but keeps it under `<path>.partial`, for a
     /// run that stopped early. Returns the `.partial` path.
     pub fn abandon(mut self) -> Result<PathBuf> {
+        if self.writer.is_some() {
+            self.release()?;
+        }
         if let Some(writer) = self.writer.take() {
             close(writer, &self.partial)?;
         }
@@ -365,6 +452,9 @@ impl Recorder {
 
 impl Drop for Recorder {
     fn drop(&mut self) {
+        if self.writer.is_some() {
+            let _ = self.release();
+        }
         if let Some(writer) = self.writer.take() {
             let _ = close(writer, &self.partial);
         }
