@@ -307,9 +307,16 @@ class VesselConfig(_Model):
     asset: str
     rig: str | None = None
     speed_mps: float = Field(default=0.0, ge=0, le=MAX_SPEED_MPS, allow_inf_nan=False)
+    """Speed along the route (m/s, constant; 0: the vessel stays at its start, ``static``)."""
     route: list[tuple[float, float]] = Field(min_length=2)
+    """Waypoints ``[x, y]`` (world metres, x east, y north) the centripetal Catmull-Rom spline passes through."""
     end: Literal["stop", "loop", "ping_pong"] = "stop"
+    """At the route's end: ``stop`` (at rest on the last waypoint), ``loop`` (on from the last waypoint round to the
+    first, a closed spline: at least 3 distinct waypoints) or ``ping_pong`` (the route backwards, turned about on
+    the spot, heading by π, and so on)."""
     start_offset_m: float = Field(default=0.0, ge=0, le=MAX_COORDINATE_M, allow_inf_nan=False)
+    """Distance (m) along the route the vessel has sailed at t = 0 (``loop``: wraps round, ``ping_pong``: there and
+    back; ``stop``: at most the route's length)."""
     z_base_m: float = Field(default=0.0, ge=-30, le=30, allow_inf_nan=False)
     """Height (m) of the vessel's frame over the still water: 0 floats the asset at its own waterline, below 0 sits it
     deeper (not so deep that the whole hull is under the water), above 0 lifts it (clear of the water, for a
