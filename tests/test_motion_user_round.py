@@ -13,9 +13,9 @@ What was checked, and found as documented:
   (:func:`test_speed_heading_and_route_ends_sampled_every_millisecond`); ``start_offset_m`` moves the start
   along the route, wrapping for ``loop`` (``d mod L``) and ``ping_pong`` (``d mod 2L``)
   (:func:`test_start_offset_wraps_on_loop_and_ping_pong_routes`).
-* The world-state velocity is the poses' central difference (all three components with ``motion: paper``; the
-  horizontal ones with the physical sea, whose ``vz`` leaves out the turn's share, as documented)
-  (:func:`test_world_state_velocity_is_the_derivative_of_the_poses`).
+* The world-state velocity is the poses' central difference, all three components, with ``motion: paper`` and with
+  the physical sea (:func:`test_world_state_velocity_is_the_derivative_of_the_poses`; its ``vz`` left out the
+  turn's share before finding 2 was fixed).
 * In a recording (3 Hz, so the times are not whole milliseconds): ``time_s`` = k / f, every message's log time
   ``round(k / f · 1e9)`` ns and every header stamp the same; ``/tf`` ``world → vessel`` = the world state's
   pose; the LiDAR frame's 3D boxes = the world state's boxes through ``/tf``; and every LiDAR return of a vessel
@@ -33,16 +33,17 @@ Findings:
    about (heading by π), the hull is set to another response within a microsecond. At W3: a 5 m speedboat rolls
    by 14.7° at the end of a bent ``stop`` route, a 90 m ferry by 7.3°, a 12 m fishing boat heaves 0.62 m at a
    ``ping_pong`` end; in the bundled ``island_port_waves`` (W1) ``target_3`` heaves 0.76 m between two frames at
-   each turn, 6 times its 95th-percentile step, ``usv_3`` pitches by 9.0° (its LiDAR with it). Not documented;
-   a Rust change (``crates/mmusv-core/src/kinematics/mod.rs``), so shown here as a strict xfail
-   (:func:`test_physical_motion_has_no_step_where_a_route_stops_or_turns_about`) and now said in docs/sea.md and
-   docs/recording.md.
+   each turn, 6 times its 95th-percentile step, ``usv_3`` pitches by 9.0° (its LiDAR with it). Fixed in the core
+   since (``kinematics/transient.rs``): across a route event the response passes from the steady state before to
+   the one after with the roll's free-transient envelope ``e^{−ζ ω_φ (t − t_e)}``
+   (:func:`test_physical_motion_has_no_step_where_a_route_stops_or_turns_about`, a strict xfail before).
 2. The world state's ``vz`` (and so OPV2V's 3D speeds and the ROS 2 odometry's linear z) is the heave rate at a
    constant heading, which docs/recording.md put at "about 0.01 m/s" off on a curve (docs/sea.md: "within a few per
    cent"): a fast small vessel in a tight bend is up to 1.4 m/s off the derivative of its own recorded heave
-   (``island_port_waves``' ``target_1``, 9 m/s, W1: 0.16 m/s rms against a heave rate of 0.81 m/s rms). A Rust
-   change; a strict xfail (:func:`test_heave_rate_is_the_derivative_of_the_heave_in_a_fast_turn`), and the docs
-   now give the measured sizes.
+   (``island_port_waves``' ``target_1``, 9 m/s, W1: 0.16 m/s rms against a heave rate of 0.81 m/s rms). Fixed in
+   the core since: ``vz`` is the heave's own derivative (central differences of 0.1 ms,
+   ``kinematics/mod.rs``), bends and route events included
+   (:func:`test_heave_rate_is_the_derivative_of_the_heave_in_a_fast_turn`, a strict xfail before).
 3. A vessel's wake vanishes the frame after its ``stop`` route ends: the foam a camera 60 m away draws behind a
    speedboat at 8 m/s in frames 48-50 is plain water in frame 51, 0.2 s later (the core's wake is empty at rest,
    ``kinematics/path_behind.rs``, and :meth:`mmusv.simulation.Simulation.wakes` drops a vessel under 0.3 m/s). A
@@ -187,10 +188,7 @@ def test_world_state_velocity_is_the_derivative_of_the_poses() -> None:
             p = np.asarray(f.poses_at_times(np.array([t - h, t + h])))
             fd = (p[1, :, :3] - p[0, :, :3]) / (2 * h)
             np.testing.assert_allclose(v[:, :2], fd[:, :2], atol=1e-6)
-            if motion == "paper":
-                np.testing.assert_allclose(v[:, 2], fd[:, 2], atol=1e-6)
-            else:  # the straight leg and the vessel at rest: exact; the loop's bends leave out the turn's share
-                np.testing.assert_allclose(v[1:, 2], fd[1:, 2], atol=1e-5)
+            np.testing.assert_allclose(v[:, 2], fd[:, 2], atol=1e-5)  # the loop's bends included
 
 
 def test_pose_at_a_time_is_the_same_at_every_frame_rate() -> None:
@@ -334,11 +332,6 @@ def test_recording_time_axis_poses_and_rendered_pose_agree(tmp_path: Path) -> No
         assert rms(lt / 1e9) < 0.05 < 0.15 < min(rms(lt / 1e9 - 1 / 3), rms(lt / 1e9 + 1 / 3))
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="the physical response is the steady state at the speed and heading of the instant "
-    "(crates/mmusv-core/src/kinematics/mod.rs): it steps where a route stops or turns about",
-)
 @pytest.mark.parametrize(
     ("asset", "end", "route"),
     [
@@ -360,11 +353,6 @@ def test_physical_motion_has_no_step_where_a_route_stops_or_turns_about(
     assert np.degrees(np.max(np.abs(after[3:5] - before[3:5]))) < 0.01
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="the core's heave rate leaves out the response's change with the heading in a turn "
-    "(crates/mmusv-core/src/kinematics/mod.rs, velocity_unchecked; ocean/response.rs, response)",
-)
 def test_heave_rate_is_the_derivative_of_the_heave_in_a_fast_turn() -> None:
     """``island_port_waves``' ``target_1``: a 5 m speedboat at 9 m/s round a loop whose tightest bend is 16 m in
     radius, at W1. The recorded ``vz`` and the heave's own derivative differed by up to 1.4 m/s (0.16 m/s rms,
