@@ -1,4 +1,4 @@
-"""Table III at two sea states side by side (issue #18: the detection study on a W3 spec beside W1): the
+"""Table III at two sea states side by side (issue #29: the detection study on a W3 spec beside W1): the
 markdown table of docs/studies/detection.md (*Sea state*) and its picture, from two ``mmusv study detection``
 output folders over the same sequences (``scenarios/specs/coop_detection_w1.yaml`` and ``_w3.yaml``).
 
