@@ -389,7 +389,10 @@ def test_wake_lies_behind_a_vessel_under_way() -> None:
 
 def test_camera_image_options_reach_the_recording(tmp_path: Path) -> None:
     """quality, distortion and noise from the scenario schema reach the native camera, and the distortion is
-    written beside the intrinsics (recording metadata, read back by the one reader)."""
+    written beside the intrinsics (recording metadata, read back by the one reader). Noise and quality are seen in
+    the images: a capture with the scenario's noise differs from one without it and is the same again from the
+    same seed, and one at ``high`` differs from the ``draft`` one (before this check a camera built without the
+    scenario's noise passed this file, and no other test renders a scenario's noise)."""
     import yaml
     from mmusv.acquire import run
     from mmusv.recording.info import read_info
@@ -420,6 +423,19 @@ def test_camera_image_options_reach_the_recording(tmp_path: Path) -> None:
     info = read_info(res.recording)
     cam = info.agents[0].cameras["front"]
     assert cam.distortion == pytest.approx(tuple(k))
+    from mmusv.simulation import Simulation
+
+    def front(noise: dict[str, float] | None, quality: str = "draft") -> np.ndarray:
+        one = {**sc["rigs"]["usv_standard"]["cameras"][0], "noise": noise, "quality": quality}
+        rigs = {"usv_standard": {**sc["rigs"]["usv_standard"], "cameras": [one]}}
+        rgb = Simulation({**sc, "rigs": rigs}).capture(0).agents["usv_1"].cameras["front"].rgb
+        assert rgb is not None
+        return rgb
+
+    noisy, clean = front({"full_well_e": 5000, "read_noise_e": 2}), front(None)
+    assert not np.array_equal(noisy, clean), "the scenario's noise did not reach the camera"
+    assert np.array_equal(noisy, front({"full_well_e": 5000, "read_noise_e": 2})), "noise is seeded"
+    assert not np.array_equal(front(None, "high"), clean), "the scenario's quality did not reach the camera"
     bad = dict(sc)
     bad["rigs"] = {"usv_standard": {"cameras": [{"name": "front", "quality": "ultra"}]}}
     with pytest.raises(mmusv.ConfigError, match="quality"):
