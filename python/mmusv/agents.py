@@ -20,7 +20,7 @@ from mmusv.errors import ConfigError
 from mmusv.sensors.camera import camera_from_config, top_view_from_config
 from mmusv.sensors.config import CameraConfig, RigConfig
 from mmusv.sensors.lidar import lidar_from_config
-from mmusv.sensors.mounts import inside_mesh, mount_matrix
+from mmusv.sensors.mounts import camera_mount, inside_mesh, mount_matrix
 from mmusv.sensors.radar import radar_from_config
 from mmusv.world.vessels import VesselAsset, get_asset
 
@@ -137,7 +137,7 @@ def build_agent(
         agent.radar = _built(f"{where}.radar", "radar", functools.partial(radar_from_config, rig.radar))
     for i, c in enumerate(rig.cameras):
         # The path as the YAML spells it (cameras is a list), as the schema's own errors say it.
-        m = frozen(mount_matrix(asset, c.mount, where=f"{where}.cameras[{i}].mount"))
+        m = frozen(mount_matrix(asset, camera_mount(asset, c), where=f"{where}.cameras[{i}].mount"))
         camera = _built(f"{where}.cameras[{i}]", "camera", functools.partial(camera_from_config, c))
         agent.cameras[c.name] = (camera, c, m)
     if rig.top_view is not None:

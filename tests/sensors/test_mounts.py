@@ -62,3 +62,46 @@ def test_inside_mesh_of_two_boxes_is_their_union() -> None:
     assert inside_mesh(v, f, point=np.array([3.5, 0.5, 0.5]))  # rays through the first box count it in and out
     assert inside_mesh(v, f, point=np.array([0.5, 0.5, 0.5]))
     assert not inside_mesh(v, f, point=np.array([2.0, 0.5, 0.5]))  # between them
+
+
+def test_a_camera_without_a_mount_sits_on_the_assets_camera_point_not_at_the_waterline() -> None:
+    """A rig's camera given no ``mount`` sat at the vessel origin, midship at the waterline: at W3 a 160 x 120 camera
+    on a WAM-V saw the water above it labelled sky in its bottom rows and a 90 m ferry 162 m ahead not at all (the
+    acceptance audit's finding). It now sits on the asset's ``camera_<name>`` point, else ``camera_front``, else the
+    hull's top turned as its name says; a mount given stays."""
+    from mmusv.sensors.config import CameraConfig
+    from mmusv.sensors.mounts import camera_mount
+    from mmusv.simulation import Simulation
+
+    wamv, bulk = get_asset("usv_wamv"), get_asset("bulk_carrier_190m")
+    assert camera_mount(wamv, CameraConfig(name="left")) == Mount(point="camera_left")
+    assert camera_mount(wamv, CameraConfig(name="mast")) == Mount(point="camera_front")
+    assert "camera_left" not in bulk.mounts and "camera_front" not in bulk.mounts
+    assert camera_mount(bulk, CameraConfig(name="left")) == Mount(point="camera_left")  # the hull's top, looking left
+    given = Mount(xyz=(0.0, 0.0, 3.0))
+    assert camera_mount(wamv, CameraConfig(name="left", mount=given)) == given
+    sim = Simulation(
+        {
+            "seed": 1,
+            "environment": {"wave": "W3"},
+            "acquisition": {"frequency_hz": 5, "frames": 1},
+            "rigs": {
+                "r": {
+                    "lidar": None,
+                    "radar": None,
+                    "top_view": None,
+                    "cameras": [{"name": "cam", "resolution": [160, 120]}],
+                }
+            },
+            "vessels": [
+                {"id": "u", "role": "usv", "asset": "usv_wamv", "rig": "r", "speed_mps": 0, "route": [[0, 0], [10, 0]]},
+                {"id": "f", "asset": "ropax_ferry_90m", "speed_mps": 0, "route": [[162, 0], [300, 0]]},
+            ],
+        }
+    )
+    front = wamv.mounts["camera_front"]
+    np.testing.assert_allclose(sim.agents[0].mounts()["camera/cam"][:3, 3], front.xyz, atol=1e-12)
+    img = sim.capture(0).agents["u"].cameras["cam"]
+    assert np.all(img.instance[:10] == -1) and not np.any(img.instance[-10:] == -1)  # sky above, water below
+    ferry = sim.vessels[1].instance_id
+    assert np.count_nonzero(img.instance == ferry) > 100

@@ -406,15 +406,17 @@ class ExposureConfig(_Model):
 
 
 class CameraConfig(_Model):
-    """A pinhole camera: ``resolution`` ``[width, height]`` pixels, horizontal field of view ``hfov_deg`` (< 180),
-    the images to produce, and its mount (optical axis = the mount's x axis). ``quality`` (:data:`Quality`) sets
-    the RGB's anti-aliasing and reflections; ``distortion`` is Brown–Conrady ``[k1, k2, p1, p2, k3]`` in OpenCV's
-    order (none by default); ``noise`` adds seeded shot and read noise (none by default); ``exposure``
-    (:class:`ExposureConfig`) is automatic unless fixed. Depth, semantic and instance images always come from the
-    pixel centres. ``range_m`` (metres) is how far the camera traces surfaces: a vessel or island beyond it is not
-    seen (a vessel wholly beyond it gets no 2D box, the part of one beyond it neither ``visible`` nor hidden by the
-    waves), while the sea beyond it is still drawn, labelled water and given its still water's depth (so depth is
-    +inf, and the instance -1, exactly where the pixel sees the sky)."""
+    """A pinhole camera: ``resolution`` ``[width, height]`` pixels, horizontal field of view ``hfov_deg`` (<
+    180), the images to produce, and its mount (optical axis = the mount's x axis; without one, the asset's
+    mount point ``camera_<name>``, else its ``camera_front``: :func:`mmusv.sensors.mounts.camera_mount`).
+    ``quality`` (:data:`Quality`) sets the RGB's anti-aliasing and reflections; ``distortion`` is
+    Brown–Conrady ``[k1, k2, p1, p2, k3]`` in OpenCV's order (none by default); ``noise`` adds seeded shot and
+    read noise (none by default); ``exposure`` (:class:`ExposureConfig`) is automatic unless fixed. Depth,
+    semantic and instance images always come from the pixel centres. ``range_m`` (metres) is how far the
+    camera traces surfaces: a vessel or island beyond it is not seen (a vessel wholly beyond it gets no 2D
+    box, the part of one beyond it neither ``visible`` nor hidden by the waves), while the sea beyond it is
+    still drawn, labelled water and given its still water's depth (so depth is +inf, and the instance -1,
+    exactly where the pixel sees the sky)."""
 
     name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$")
     resolution: tuple[int, int] = (640, 480)

@@ -1,5 +1,6 @@
 """Where a sensor sits on a vessel: the ``(4, 4)`` sensor → body transform of a :class:`~mmusv.sensors.config.Mount`
-on a vessel asset (:func:`mount_matrix`), and the test that a sensor's origin is not inside the hull
+on a vessel asset (:func:`mount_matrix`), a camera's mount where its config gives none (:func:`camera_mount`), and
+the test that a sensor's origin is not inside the hull
 (:func:`inside_mesh`: a sensor there would see nothing but the hull's inside).
 
 Frames: vessel body x forward, y left, z up (metres); angles roll, pitch, yaw in degrees (applied as in
@@ -14,17 +15,29 @@ import numpy as np
 import numpy.typing as npt
 
 from mmusv.errors import ConfigError, InputError
-from mmusv.sensors.config import Mount
+from mmusv.sensors.config import CameraConfig, Mount
 from mmusv.world.build import pose_matrices
 from mmusv.world.vessels import VesselAsset
 
-__all__ = ["inside_mesh", "mount_matrix", "rpy_matrix"]
+__all__ = ["camera_mount", "inside_mesh", "mount_matrix", "rpy_matrix"]
 
 
 def rpy_matrix(xyz: tuple[float, float, float], rpy_deg: tuple[float, float, float]) -> np.ndarray:
     """``(4, 4)`` float64 transform translating by ``xyz`` (m) and rotating by roll, pitch, yaw ``rpy_deg`` (°)."""
     r, p, y = (math.radians(a) for a in rpy_deg)
     return pose_matrices(np.array([*xyz, r, p, y], dtype=np.float64))
+
+
+def camera_mount(asset: VesselAsset, camera: CameraConfig) -> Mount:
+    """The mount of ``camera`` on ``asset``: its own, when its config gives one; else the asset's mount point named
+    after it (``camera_<name>``: a camera ``left`` sits on ``camera_left``, looking left), else its ``camera_front``,
+    else the top of the hull turned as the name says (:func:`mount_matrix`'s fall-back for ``camera_<name>``). Before,
+    a camera without a mount sat at the vessel origin, midship at the waterline: under the crests at W3, it labelled
+    the water above it sky and saw no vessel."""
+    if "mount" in camera.model_fields_set:
+        return camera.mount
+    own = f"camera_{camera.name}"
+    return Mount(point="camera_front" if own not in asset.mounts and "camera_front" in asset.mounts else own)
 
 
 def mount_matrix(asset: VesselAsset, mount: Mount, *, where: str) -> np.ndarray:
