@@ -13,6 +13,7 @@ import yaml
 from mmusv.classes import SemanticClass
 from mmusv.world.maps import (
     MAP_KINDS,
+    WATER_REACH_M,
     IslandParams,
     MapConfigError,
     MapWorld,
@@ -137,6 +138,19 @@ class VerticalCaster:
         return top_cls, obstacle
 
 
+def on_the_map(world: MapWorld) -> list[TriMesh]:
+    """The static meshes with the water cut to its tiles over the map (the sea goes on 1,000 km past the map's edge,
+    ``maps.WATER_REACH_M``, in triangles that would fill every bucket of :class:`VerticalCaster`)."""
+    half = world.params.extent_m / 2.0
+    out = []
+    for name, m in world.static_meshes.items():
+        if name == "water":
+            keep = np.all(np.abs(m.vertices[m.faces][:, :, :2]) <= half + 1e-6, axis=(1, 2))
+            m = TriMesh(m.vertices, m.faces[keep], m.classes[keep])
+        out.append(m)
+    return out
+
+
 def cells_sample(world: MapWorld, cells: np.ndarray, k: int, rng: np.random.Generator, pad: float = 0.0) -> np.ndarray:
     """``k x k`` grid of points per cell (corners included), over the cell grown by ``pad`` metres."""
     pr = world.priors
@@ -161,9 +175,13 @@ def test_each_kind_generates(kind: str) -> None:
         assert mesh.num_triangles > 0
         assert mesh.faces.max() < mesh.vertices.shape[0]
         assert np.isfinite(mesh.vertices).all()
-        half = w.params.extent_m / 2.0
-        assert np.all(np.abs(mesh.vertices[:, :2]) <= half + 1e-6)
+    half = w.params.extent_m / 2.0
+    for name, mesh in w.static_meshes.items():
+        # Everything but the sea lies on the map; the sea goes on past its edge (maps.WATER_REACH_M).
+        if name != "water":
+            assert np.all(np.abs(mesh.vertices[:, :2]) <= half + 1e-6), name
     water = w.static_meshes["water"]
+    assert np.abs(water.vertices[:, :2]).max() == half + WATER_REACH_M
     assert np.all(water.vertices[:, 2] == 0.0) and np.all(water.classes == WATER)
     classes = set(np.concatenate([m.classes for m in w.static_meshes.values()]).tolist())
     expected = {
@@ -279,7 +297,7 @@ def test_priors_agree_with_the_meshes(kind: str, extra: dict[str, Any]) -> None:
     w = small(kind, seed=2, **extra)
     pr = w.priors
     margin = pr.draft_margin
-    caster = VerticalCaster(list(w.static_meshes.values()))
+    caster = VerticalCaster(on_the_map(w))
     rng = np.random.default_rng(0)
     water = pr.water_mask
     # Water cells: all of them next to non-water (the hard ones) and a random share of the rest.

@@ -5,7 +5,8 @@ water surface, port structures, buoys), berths for moored ships as ``(asset_name
 instantiated from the vessel library, and :class:`~mmusv.world.priors.MapPriors`.
 
 Frame and units: world frame, x east, y north, z up, metres, radians; the water surface is z = 0 and the map
-is the square ``[-extent_m/2, extent_m/2]^2`` centred at the origin. A moored ship's ``(x, y)`` is its hull
+is the square ``[-extent_m/2, extent_m/2]^2`` centred at the origin (the water mesh alone reaches beyond it, the sea
+going on past the map: :data:`WATER_REACH_M`). A moored ship's ``(x, y)`` is its hull
 centre on the water surface and ``yaw`` the heading of its bow (body x axis) from +x, counter-clockwise.
 
 Determinism: every random draw comes from ``numpy.random.default_rng(seed)`` in a fixed order, so the same
@@ -41,6 +42,7 @@ from mmusv.world.terrain import FaceClassifier, FractalNoise, Heightfield, Islan
 __all__ = [
     "MAP_KINDS",
     "TERRAIN_MESH_MIN_Z",
+    "WATER_REACH_M",
     "IslandParams",
     "MapConfigError",
     "MapParams",
@@ -60,6 +62,13 @@ __all__ = [
 TERRAIN_MESH_MIN_Z = -2.0
 """Terrain cells whose four vertices are all at or below this height (m) are left out of the terrain mesh."""
 
+WATER_REACH_M = 1.0e6
+"""How far (metres) the water mesh reaches beyond the map's edge: the longest range any sensor takes (a camera's
+``range_m`` bound, :class:`mmusv.sensors.config.CameraConfig`), so that a ray leaving the map downwards meets the sea
+within its range, as the LiDAR's water returns and the cameras' and top view's shading need it to (a flat sea,
+``environment.motion: paper``, ended at the map's edge: the top view drew the sky's grey beyond it, under labels that
+said water, and the LiDAR had no water returns there)."""
+
 
 # ---------------------------------------------------------------------------------------------- the world
 
@@ -73,7 +82,8 @@ class MapWorld:
         seed: the generation seed.
         params: the validated parameters (a pydantic model of :mod:`mmusv.world.map_params`).
         static_meshes: name -> TriMesh in the world frame (metres), keys sorted; a subset of ``"buoys"``,
-            ``"port_structures"``, ``"terrain"``, ``"water"`` (empty parts are left out; ``"water"`` always there).
+            ``"port_structures"``, ``"terrain"``, ``"water"`` (empty parts are left out; ``"water"`` always there,
+            reaching :data:`WATER_REACH_M` beyond the map's square, every other mesh inside it).
         moored: ships to instantiate from the vessel library: ``(asset_name, (x, y, yaw))``, world metres and
             radians (see module docstring).
         priors: the map priors.
@@ -105,16 +115,35 @@ def _grid(extent: float, target: float) -> tuple[float, np.ndarray]:
 
 
 def _water(extent: float, tiles: int = 4) -> TriMesh:
-    """Water surface (class WATER) at z = 0 over the extent, ``tiles x tiles`` quads, normals up."""
-    xs = np.linspace(-extent / 2.0, extent / 2.0, tiles + 1)
+    """Water surface (class WATER) at z = 0, normals up: ``tiles x tiles`` quads over the map's square, then square
+    rings of 8 quads around it, each ring reaching twice as far from the centre as the one inside it, out to
+    :data:`WATER_REACH_M` beyond the map's edge (the sea goes on past the map, as sensors see it from near the edge).
+    Triangles near any point are about as large as the point is far from the centre, so a hit on them is as precise
+    (in float32) as the point's own coordinates allow; the map's own tiles are those it always had."""
+    half = extent / 2.0
+    xs = np.linspace(-half, half, tiles + 1)
     gx, gy = np.meshgrid(xs, xs)
-    v = np.column_stack([gx.ravel(), gy.ravel(), np.zeros(gx.size)])
+    verts = [np.column_stack([gx.ravel(), gy.ravel(), np.zeros(gx.size)])]
     i, j = np.meshgrid(np.arange(tiles), np.arange(tiles), indexing="ij")
     v00 = (i * (tiles + 1) + j).ravel()
-    f = np.concatenate(
-        [np.column_stack([v00, v00 + 1, v00 + tiles + 2]), np.column_stack([v00, v00 + tiles + 2, v00 + tiles + 1])]
+    faces = [
+        np.concatenate(
+            [np.column_stack([v00, v00 + 1, v00 + tiles + 2]), np.column_stack([v00, v00 + tiles + 2, v00 + tiles + 1])]
+        )
+    ]
+    # A ring between the squares of half-sides r and R: the 3 x 3 quads of the grid [-R, -r, r, R]^2 less the middle.
+    ring = np.array([(a * 4 + b) for a in range(3) for b in range(3) if (a, b) != (1, 1)])
+    ring_faces = np.concatenate(
+        [np.column_stack([ring, ring + 1, ring + 5]), np.column_stack([ring, ring + 5, ring + 4])]
     )
-    return TriMesh(v, f, np.array([int(SemanticClass.WATER)]))
+    n, r, reach = verts[0].shape[0], half, half + WATER_REACH_M
+    while r < reach:
+        big = min(2.0 * r, reach)
+        rx, ry = np.meshgrid(np.array([-big, -r, r, big]), np.array([-big, -r, r, big]))
+        verts.append(np.column_stack([rx.ravel(), ry.ravel(), np.zeros(16)]))
+        faces.append(ring_faces + n)
+        n, r = n + 16, big
+    return TriMesh(np.concatenate(verts), np.concatenate(faces), np.array([int(SemanticClass.WATER)]))
 
 
 def _vegetation(rng: np.random.Generator, extent: float, enabled: bool, min_z: float) -> FaceClassifier:

@@ -1,0 +1,123 @@
+"""The maps and worlds as a scenario designer and a perception researcher meet them (a helper's round): each check
+against an independent computation written out here (shapely on the meshes' own triangles, barycentric heights by
+hand, a ray/plane intersection, the top view's pixel geometry from its documented formula), not the project's code.
+
+Checked and right, no change:
+
+* Land: on an island, an open-sea (islet) and two port maps (coast north and west), 20,000 random points each: the
+  priors' ``land`` polygons hold exactly the points where the terrain mesh's own triangles (barycentric height by
+  hand) stand above the water; LiDAR points labelled terrain lie on the heightfield (0.00 m).
+* Moored ships (ports of seeds 0, 1, 3, 7, coast north and east, six ships each): their hulls (the asset meshes'
+  footprints at their berths, shapely) overlap no port structure's triangles and no land, 2.0-3.0 m off the quays and
+  piers; their library sizes are the sizes their berths were laid out for.
+* Route checks in ``mmusv run``: a route over land, into a breakwater and off the map are refused naming the file,
+  the check, the vessel, the point and the route's field (off the map: the map's span).
+* Determinism: the same kind, seed and parameters give the same meshes, berths and priors, byte for byte.
+
+Found by the round (each test below failed before its fix):
+
+* No sea beyond the map's edge on the flat sea (``environment.motion: paper``): the water mesh ended at the map's
+  square, so a ray leaving the map downwards met nothing. A USV 15 m inside the edge of a 400 m open-sea map, bow
+  out: its top view drew the sky's grey (mean RGB 162, 157, 164) over the 36 % of the image beyond the edge, under
+  semantic labels that said water (on the map: 60, 72, 88); its front camera drew sky between the map's edge and
+  the horizon; its LiDAR had 1 water return past the edge against 576 as far astern. The water mesh now reaches
+  1,000 km past the edge (``maps.WATER_REACH_M``, the longest camera range) in rings twice as wide each, the map's
+  own tiles unchanged: the top view's water beyond is (59, 70, 83), the LiDAR's returns past the edge 528. The
+  physical sea (the default) already went on past the map and records the same bytes as before (port_entry, one
+  frame, every sensor); so do the flat sea's sensors whose rays stay on the map.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import mmusv
+import numpy as np
+import pytest
+from mmusv.classes import SemanticClass
+from mmusv.world.build import build_static_scene
+from mmusv.world.maps import generate_map
+
+WATER = int(SemanticClass.WATER)
+
+
+def _edge_scenario(x0: float, *, motion: str = "paper") -> dict[str, Any]:
+    """A USV at ``(x0, 0)`` heading east on a 400 m open-sea map (edge at x = 200), with a LiDAR whose water
+    returns reach 60 m and a 64 x 64 top view at 2 m a pixel, heading up (its top rows lie ahead, to the east)."""
+    return {
+        "name": "edge",
+        "seed": 1,
+        "map": {"type": "open_sea", "seed": 0, "params": {"extent_m": 400, "islet_probability": 0, "n_buoys": 0}},
+        "acquisition": {"frames": 1},
+        "environment": {"motion": motion, "wave": "W2"},
+        "rigs": {
+            "r": {
+                "lidar": {"channels": 16, "points_per_second": 80000, "water_range_m": 60, "water_probability": 0.5},
+                "cameras": [],
+                "top_view": {"resolution": [64, 64], "metres_per_pixel": 2.0, "outputs": ["rgb", "semantic"]},
+                "radar": None,
+            }
+        },
+        "vessels": [
+            {"id": "u", "role": "usv", "asset": "usv_wamv", "rig": "r", "speed_mps": 1, "route": [[x0, 0], [x0 + 1, 0]]}
+        ],
+    }
+
+
+def test_rays_leaving_the_map_downwards_meet_the_sea() -> None:
+    world = generate_map("open_sea", seed=0, extent_m=400, islet_probability=0.0, n_buoys=0)
+    scene = build_static_scene(world).scene
+    # Straight down at 10 m over points off the map, up to 900 km out; and slanting down 1 degree from the edge.
+    xs = np.array([201.0, 350.0, 5_000.0, 80_000.0, 900_000.0])
+    origins = np.column_stack([xs, -xs / 3.0, np.full(xs.size, 10.0)])
+    hits = scene.cast_rays(origins, np.tile([0.0, 0.0, -1.0], (xs.size, 1)))
+    assert hits.hit.all() and (hits.semantic_class == WATER).all()
+    np.testing.assert_allclose(hits.distance, 10.0, rtol=1e-5)
+    dip = np.deg2rad(1.0)
+    d = np.array([[np.cos(dip), 0.0, -np.sin(dip)]])
+    slant = scene.cast_rays(np.array([[195.0, 0.0, 10.0]]), d)
+    # The plane z = 0 is 10 / sin(1 deg) = 573 m along the ray, 378 m past the edge.
+    assert slant.hit.all() and slant.semantic_class[0] == WATER
+    np.testing.assert_allclose(slant.distance, 10.0 / np.sin(dip), rtol=1e-5)
+
+
+@pytest.fixture(scope="module")
+def near_the_edge() -> Any:
+    return mmusv.Simulation(_edge_scenario(185.0)).capture(0).agents["u"]
+
+
+def test_the_top_view_draws_the_sea_beyond_the_map(near_the_edge: Any) -> None:
+    tv = near_the_edge.top_view
+    h, m = 64, 2.0
+    x_usv = float(near_the_edge.top_view_pose[0, 3])
+    ahead = (h / 2.0 - np.arange(h) - 0.5) * m  # the documented pixel-centre formula, rows
+    off = x_usv + ahead > 200.0 + m  # rows wholly beyond the map's edge (a pixel's margin)
+    on = x_usv + ahead < 200.0 - m
+    assert off.sum() >= 10 and on.sum() >= 10
+    water = tv.semantic == WATER
+    assert water[off].mean() > 0.95 and water[on].mean() > 0.95  # labelled water on both sides, before too
+    rgb = tv.rgb.astype(np.float64)
+    mean_off = rgb[off][water[off]].mean(axis=0)
+    mean_on = rgb[on][water[on]].mean(axis=0)
+    # Before: (162, 157, 164) beyond the edge, the sky's grey, against (60, 72, 88) on the map.
+    assert np.abs(mean_off - mean_on).max() < 15.0, (mean_off, mean_on)
+
+
+def test_the_lidar_sees_water_beyond_the_map(near_the_edge: Any) -> None:
+    a = near_the_edge
+    pts = (a.lidar_pose[:3, :3] @ a.lidar.xyz.T.astype(np.float64)).T + a.lidar_pose[:3, 3]
+    water = pts[a.lidar.semantic_class == WATER]
+    x0 = float(a.lidar_pose[0, 3])
+    gap = 200.0 - x0  # the edge lies 15 m ahead
+    beyond, astern = water[:, 0] > x0 + gap, water[:, 0] < x0 - gap
+    # The sea is the same all round: as many returns past the edge as as far astern (528 and 576). Before: 1.
+    assert beyond.sum() > 0.8 * astern.sum() and astern.sum() > 500
+
+
+def test_the_physical_sea_beyond_the_map_is_unchanged() -> None:
+    """The physical sea already went on past the map; the longer water mesh changes none of its bytes' meaning:
+    water returns beyond the edge, and the top view's water the same on both sides."""
+    a = mmusv.Simulation(_edge_scenario(185.0, motion="physical")).capture(0).agents["u"]
+    pts = (a.lidar_pose[:3, :3] @ a.lidar.xyz.T.astype(np.float64)).T + a.lidar_pose[:3, 3]
+    assert (pts[a.lidar.semantic_class == WATER][:, 0] > 200.0).sum() > 100
+    assert (a.top_view.semantic == WATER).mean() > 0.95
