@@ -25,20 +25,31 @@ Found by the round (each test below failed before its fix):
   own tiles unchanged: the top view's water beyond is (59, 70, 83), the LiDAR's returns past the edge 528. The
   physical sea (the default) already went on past the map and records the same bytes as before (port_entry, one
   frame, every sensor); so do the flat sea's sensors whose rays stay on the map.
+* ``shore_clearance`` called the map's edge a shore: ``port_entry`` with ``usv_1`` sailing south to 10 m off the
+  map's southern edge, open sea all round, was warned that it "comes within 10 m of the shore (hull) near
+  (-170, -984)". The check counts the edge with land, shallows and structures (as its spec says); the warning now
+  names what is there: "comes within 10 m of the map's edge (hull) near (-170, -984) (the map spans x -1000..1000
+  m, y -1000..1000 m)", and a real shore is still called the shore.
 """
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 import mmusv
 import numpy as np
 import pytest
+import shapely
+import yaml
 from mmusv.classes import SemanticClass
+from mmusv.config import load_scenario
+from mmusv.scenario_checks import MmusvWarning, check_routes
 from mmusv.world.build import build_static_scene
 from mmusv.world.maps import generate_map
 
 WATER = int(SemanticClass.WATER)
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def _edge_scenario(x0: float, *, motion: str = "paper") -> dict[str, Any]:
@@ -121,3 +132,34 @@ def test_the_physical_sea_beyond_the_map_is_unchanged() -> None:
     pts = (a.lidar_pose[:3, :3] @ a.lidar.xyz.T.astype(np.float64)).T + a.lidar_pose[:3, 3]
     assert (pts[a.lidar.semantic_class == WATER][:, 0] > 200.0).sum() > 100
     assert (a.top_view.semantic == WATER).mean() > 0.95
+
+
+def _port_entry_with(route: list[list[float]]) -> tuple[Any, Any]:
+    """``port_entry`` with ``usv_1`` on ``route``, and its map."""
+    raw = yaml.safe_load((ROOT / "scenarios" / "port_entry.yaml").read_text())
+    raw["vessels"][0]["route"] = route
+    sc = load_scenario(raw)
+    return sc, mmusv.Simulation(sc).world
+
+
+def test_a_route_near_the_maps_edge_is_not_said_to_near_a_shore() -> None:
+    sc, world = _port_entry_with([[-170.0, -110.0], [-170.0, -990.0]])
+    # Independently: the nearest land or structure to the route's end is far; the map's edge is 10 m away.
+    end = np.array([-170.0, -990.0])
+    land = [*world.priors.land, *world.priors.structure_boundaries]
+    assert min(shapely.distance(p, shapely.Point(end)) for p in land) > 400.0
+    with pytest.warns(MmusvWarning):
+        found = check_routes(sc, world, source="port.yaml")
+    shore = [m for m in found if "shore_clearance" in m]
+    assert len(shore) == 1, found
+    assert "of the map's edge (hull)" in shore[0] and "the shore" not in shore[0], shore[0]
+    assert "(the map spans x -1000..1000 m, y -1000..1000 m)" in shore[0]
+
+
+def test_a_route_near_land_is_still_said_to_near_the_shore() -> None:
+    # West of the port, north towards the natural coast (its shallows begin at y = 230 there).
+    sc, world = _port_entry_with([[-800.0, -300.0], [-800.0, 218.0]])
+    with pytest.warns(MmusvWarning):
+        found = check_routes(sc, world, source="port.yaml")
+    shore = [m for m in found if "shore_clearance" in m]
+    assert shore and "of the shore (hull)" in shore[0], found

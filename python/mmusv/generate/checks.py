@@ -27,9 +27,11 @@ from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
+from scipy.ndimage import distance_transform_edt
 from scipy.spatial import cKDTree
 
 from mmusv.generate.hulls import axis_points, segment_distance
+from mmusv.generate.mapctx import MapContext
 from mmusv.generate.samples import Samples
 from mmusv.generate.spec import (
     CooperationCheck,
@@ -100,6 +102,21 @@ def _where(xy: np.ndarray) -> str:
     return f"({xy[0]:.0f}, {xy[1]:.0f})"
 
 
+def _edge_nearer(ctx: MapContext, at: np.ndarray) -> bool:
+    """Whether the map's edge is nearer to point ``at`` (metres) than any cell of the map that is not navigable
+    water: what ``d_shore`` measured there is the edge (open sea beyond, no shore), to be called so."""
+    if "d_inland" not in ctx.cache:
+        water = ctx.priors.water_mask
+        # Distances to the map's own land, shallows and structures (beyond the map counts as water here).
+        ctx.cache["d_inland"] = (
+            np.full(water.shape, np.inf) if water.all() else distance_transform_edt(water) * ctx.resolution
+        )
+    x0, y0 = ctx.origin
+    x1, y1 = x0 + ctx.priors.shape[1] * ctx.resolution, y0 + ctx.priors.shape[0] * ctx.resolution
+    edge = min(at[0] - x0, x1 - at[0], at[1] - y0, y1 - at[1])
+    return bool(edge < float(ctx.lookup(ctx.cache["d_inland"], at)))
+
+
 class _Clearance(_FindingsCheck):
     """Shared body of in_water / shore_clearance / structure_clearance: ``raster - cell slack - δ - hull >= need``
     at every sample of the vessel's centre (``hull=False``) or of its capsule axis (``hull=True``)."""
@@ -136,7 +153,12 @@ class _Clearance(_FindingsCheck):
         x0, y0 = s.ctx.origin  # the map's rectangle, rows along y
         x1, y1 = x0 + s.ctx.priors.shape[1] * s.ctx.resolution, y0 + s.ctx.priors.shape[0] * s.ctx.resolution
         for v, (_, _, at) in sorted(first.items(), key=lambda kv: (kv[1][0], kv[1][1], kv[0])):
-            if self.hull:
+            if self.hull and self.raster == "d_shore" and _edge_nearer(s.ctx, at):  # no shore there: the edge
+                what = (
+                    f"{s.ids[v]} comes within {self.need:g} m of the map's edge (hull) near {_where(at)} (the map "
+                    f"spans x {x0:.0f}..{x1:.0f} m, y {y0:.0f}..{y1:.0f} m)"
+                )
+            elif self.hull:
                 what = f"{s.ids[v]} comes within {self.need:g} m of {self.what} near {_where(at)}"
             elif not (x0 <= at[0] < x1 and y0 <= at[1] < y1):  # off the map, not on land: said so
                 what = (
