@@ -30,10 +30,17 @@ Found by the round (each test below failed before its fix):
   (-170, -984)". The check counts the edge with land, shallows and structures (as its spec says); the warning now
   names what is there: "comes within 10 m of the map's edge (hull) near (-170, -984) (the map spans x -1000..1000
   m, y -1000..1000 m)", and a real shore is still called the shore.
+* A port's ``n_channel_buoy_pairs`` was built as far as the fairway had room, without a word: ``10`` on the default
+  2000 m port built 5 (``MapWorld.params`` saying 10). A number the scenario sets is now built exactly or refused
+  when the port is built, naming the field and the most that fit (as ``n_moored`` is); left at its default, 3, it is
+  as many as fit, as ``PortParams`` now says. ``n_buildings`` is placed at random (each at up to 40 spots), so the
+  most that fit depends on the number asked: it stays "at most this many", now said, with what it gives
+  (``n_buildings: 200`` on the default port of seed 3: 84; an 800 m port: none of its default 8).
 """
 
 from __future__ import annotations
 
+import inspect
 from pathlib import Path
 from typing import Any
 
@@ -46,7 +53,7 @@ from mmusv.classes import SemanticClass
 from mmusv.config import load_scenario
 from mmusv.scenario_checks import MmusvWarning, check_routes
 from mmusv.world.build import build_static_scene
-from mmusv.world.maps import generate_map
+from mmusv.world.maps import MapConfigError, PortParams, generate_map
 
 WATER = int(SemanticClass.WATER)
 ROOT = Path(__file__).resolve().parents[1]
@@ -163,3 +170,30 @@ def test_a_route_near_land_is_still_said_to_near_the_shore() -> None:
         found = check_routes(sc, world, source="port.yaml")
     shore = [m for m in found if "shore_clearance" in m]
     assert shore and "of the shore (hull)" in shore[0], found
+
+
+def _building_footprints(world: Any) -> int:
+    """Separate footprints (shapely) of the port's BUILDING faces: each building and each breakwater head light."""
+    m = world.static_meshes["port_structures"]
+    tri = m.vertices[m.faces[m.classes == int(SemanticClass.BUILDING)]][:, :, :2]
+    polys = [p.buffer(0.01) for p in shapely.polygons(tri) if p.area > 1e-6]
+    return len(shapely.get_parts(shapely.union_all(polys)))
+
+
+def test_a_set_number_of_channel_buoy_pairs_is_built_or_refused() -> None:
+    # The documented layout: pairs 150 m apart from 70 m off the breakwater arms, the last 40 m inside the edge.
+    half, q, hd = 1000.0, 250.0, 420.0
+    fit = int(np.floor(((q - hd - 70.0) - (-half + 40.0)) / 150.0)) + 1
+    with pytest.raises(MapConfigError) as info:
+        generate_map("port", seed=3, n_channel_buoy_pairs=fit + 1)
+    assert info.value.field == "n_channel_buoy_pairs" and f"at most {fit} " in str(info.value)
+    assert len(generate_map("port", seed=3, n_channel_buoy_pairs=fit).priors.buoys) == 2 * fit
+
+
+def test_buildings_are_as_many_as_fit_and_said_so() -> None:
+    w = generate_map("port", seed=0, extent_m=800, n_moored=1)  # no room behind the quay of an 800 m port
+    assert _building_footprints(w) == 2 and w.params.n_buildings == 8  # the two breakwater head lights only
+    assert _building_footprints(generate_map("port", seed=3, n_buildings=200)) == 84 + 2
+    src = inspect.getsource(PortParams)  # the knob's attribute docstring
+    doc = src[src.index("n_buildings: int") :].split('"""')[1]
+    assert "at most this many" in doc and "none" in doc and "84" in doc

@@ -234,7 +234,13 @@ class PortParams(_CommonParams):
     """Probability that a container-stack slot in the yard is occupied."""
     max_container_tiers: int = Field(default=5, ge=1, le=8)
     n_buildings: int = Field(default=8, ge=0, le=200)
+    """Warehouses and offices on the land behind the pier section and behind the container yard: at most this many,
+    as many as the room there takes, each tried at up to 40 random spots (``n_buildings: 200`` on the default
+    2000 m port of seed 3 builds 84; a port under about 900 m has no room: none)."""
     n_channel_buoy_pairs: int = Field(default=3, ge=0, le=50)
+    """Pairs of buoys marking the fairway out from the harbour entrance, 150 m apart, the last at least 40 m inside
+    the map's edge. Left at its default, as many as fit up to 3; a number the scenario sets is built exactly, and a
+    fairway without room for it is refused when the port is built, naming the most that fit."""
     n_moored: int = Field(default=4, ge=0, le=50)
     """Ships moored at the terminal quay and the piers (labelled ``moored_00``, ...); a port whose quay and piers
     have fewer free berths for ``moored_assets`` is refused when it is built, naming the most that fit."""

@@ -425,6 +425,7 @@ def generate_port(*, seed: int, params: PortParams | None = None) -> MapWorld:
             f"berths for only {len(built.berths)} of the {p.n_moored} moored ships (lower n_moored, add piers with "
             "n_piers, or give shorter moored_assets)",
         )
+    _channel_fits(p, len(built.buoys) // 2)
     structures = [transformed(s, rotation=rot3) for s in built.parts]
     buoys = [np.asarray(b, dtype=np.float64) @ m.T for b in built.buoys]
     moored: list[tuple[str, tuple[float, float, float]]] = []
@@ -450,6 +451,19 @@ def generate_port(*, seed: int, params: PortParams | None = None) -> MapWorld:
         moored=moored,
         moored_fp=moored_fp,
     )
+
+
+def _channel_fits(p: PortParams, n_pairs: int) -> None:
+    """A :class:`MapConfigError` when the fairway has room for fewer channel buoy pairs than the scenario set
+    (``n_channel_buoy_pairs: 10`` built 5 without a word); left at its default, they are as many as fit."""
+    if n_pairs < p.n_channel_buoy_pairs and "n_channel_buoy_pairs" in p.model_fields_set:
+        raise MapConfigError(
+            "n_channel_buoy_pairs",
+            p.n_channel_buoy_pairs,
+            f"at most {n_pairs} with this layout: the fairway from the harbour entrance to 40 m inside the map's edge "
+            f"holds only {n_pairs} pairs 150 m apart (lower n_channel_buoy_pairs, raise extent_m, lower "
+            "harbour_depth_m, or leave it out: as many as fit, up to 3)",
+        )
 
 
 def generate_map(kind: str, *, seed: int, **params: Any) -> MapWorld:

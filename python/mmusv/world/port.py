@@ -238,7 +238,7 @@ def _container_block(
 @dataclass(frozen=True)
 class PortStructures:
     """Canonical-frame result of :func:`port_structures`: structure parts (each one footprint unit),
-    channel buoy positions and berths."""
+    channel buoy positions (pairs, two by two: as many as fit, up to ``n_channel_buoy_pairs``) and berths."""
 
     parts: list[TriMesh]
     buoys: list[tuple[float, float]]
