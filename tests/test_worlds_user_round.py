@@ -36,6 +36,13 @@ Found by the round (each test below failed before its fix):
   as many as fit, as ``PortParams`` now says. ``n_buildings`` is placed at random (each at up to 40 spots), so the
   most that fit depends on the number asked: it stays "at most this many", now said, with what it gives
   (``n_buildings: 200`` on the default port of seed 3: 84; an 800 m port: none of its default 8).
+* ``PortParams.coast_offset_m`` is "the quay line", but the quay wall's seaward face stands ``grid_m + 1`` m seaward
+  of it (244 m for the default 250 m, 229 m at ``grid_m: 20``, measured on the quay's top faces with shapely): a
+  designer putting a vessel alongside at 245 m put it in the quay. Now said, with both numbers.
+* ``IslandParams.island_radius_m`` was the "range of mean coast radii"; it is the radius ``R`` the island is drawn
+  in: three islands in four are a 0.72 ``R`` dome with lobes out to ``R``, so their mean coast radius is 0.75-0.82
+  ``R``: ``[100, 120]`` (smooth coasts, 12 seeds) gave islands of 77-119 m area-equivalent radius, 20 of 24 below
+  100 m. Now said as it is built.
 """
 
 from __future__ import annotations
@@ -53,7 +60,7 @@ from mmusv.classes import SemanticClass
 from mmusv.config import load_scenario
 from mmusv.scenario_checks import MmusvWarning, check_routes
 from mmusv.world.build import build_static_scene
-from mmusv.world.maps import MapConfigError, PortParams, generate_map
+from mmusv.world.maps import IslandParams, MapConfigError, PortParams, generate_map
 
 WATER = int(SemanticClass.WATER)
 ROOT = Path(__file__).resolve().parents[1]
@@ -197,3 +204,31 @@ def test_buildings_are_as_many_as_fit_and_said_so() -> None:
     src = inspect.getsource(PortParams)  # the knob's attribute docstring
     doc = src[src.index("n_buildings: int") :].split('"""')[1]
     assert "at most this many" in doc and "none" in doc and "84" in doc
+
+
+@pytest.mark.parametrize(("grid", "side"), [(5.0, "north"), (20.0, "north"), (10.0, "east")])
+def test_the_quay_face_stands_where_the_docs_say(grid: float, side: str) -> None:
+    w = generate_map("port", seed=3, grid_m=grid, coast_side=side, n_moored=0)
+    m = w.static_meshes["port_structures"]
+    tri = m.vertices[m.faces[m.classes == int(SemanticClass.PORT_STRUCTURE)]]
+    top = tri[np.all(np.abs(tri[:, :, 2] - w.params.quay_height_m) < 1e-6, axis=1)]  # the quay's and piers' decks
+    deck = shapely.union_all([p for p in shapely.polygons(top[:, :, :2]) if p.area > 1e-6])
+    across = [(-250.0, 0.0), (-250.0, 1000.0)] if side == "north" else [(0.0, -250.0), (1000.0, -250.0)]
+    face = shapely.get_coordinates(deck.intersection(shapely.LineString(across)))[:, 1 if side == "north" else 0].min()
+    assert face == pytest.approx(w.params.coast_offset_m - grid - 1.0, abs=1e-6)
+    src = inspect.getsource(PortParams)
+    doc = src[src.index("coast_offset_m: float") :].split('"""')[1]
+    assert "``grid_m`` (its effective value) + 1 m seaward" in doc and "244 m" in doc and "229 m" in doc
+
+
+def test_island_radius_is_the_radius_the_island_is_drawn_in() -> None:
+    radii = []
+    for seed in range(12):
+        w = generate_map("island", seed=seed, n_islands=2, island_radius_m=[100, 120], coast_roughness=0.0)
+        radii += [np.sqrt(p.area / np.pi) for p in w.priors.land]
+    r = np.array(radii)
+    assert len(r) == 24 and r.max() <= 121.0 and r.min() >= 0.75 * 100.0 - 2.0
+    assert (r < 100.0).sum() >= 12  # most lie below the range: not the mean coast radius
+    src = inspect.getsource(IslandParams)
+    doc = src[src.index("island_radius_m: tuple") :].split('"""')[1]
+    assert "mean coast radius ``0.75 R`` to ``R``" in doc and "Range of mean coast radii" not in doc

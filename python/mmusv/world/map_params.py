@@ -151,7 +151,10 @@ class IslandParams(_CommonParams):
     n_buoys: int = Field(default=2, ge=0, le=500)
     n_islands: int = Field(default=5, ge=0, le=50)
     island_radius_m: tuple[float, float] = (60.0, 280.0)
-    """Range of mean coast radii (15 m to ``extent_m / 2``)."""
+    """Range of island radii ``R`` (15 m to ``extent_m / 2``): a quarter of the islands are one dome of radius ``R``,
+    the rest a main dome of ``0.72 R`` with one to three lobes reaching out to ``R``, so an island's farthest coast
+    is about ``R`` from its centre and its mean coast radius ``0.75 R`` to ``R`` (before ``coast_roughness``). Where
+    the islands do not fit, ``R`` is cut by 15 % at a time (down to 15 m) before the map is refused."""
     island_height_m: tuple[float, float] = (15.0, 80.0)
     """Range of peak heights (capped at 0.35 x radius)."""
     min_gap_m: float = Field(default=120.0, ge=0.0)
@@ -213,7 +216,9 @@ class PortParams(_CommonParams):
     coast_side: str = "north"
     """Side of the map the land is on: north, south, east or west."""
     coast_offset_m: float | None = None
-    """Distance from the map centre to the quay line, towards the land [0.125 extent: 250]."""
+    """Distance from the map centre to the quay line, towards the land [0.125 extent: 250]. The quay wall's seaward
+    face stands ``grid_m`` (its effective value) + 1 m seaward of it, over the terrain's step: at 244 m with the
+    defaults, 229 m with ``grid_m: 20``."""
     harbour_width_m: float | None = None
     """Length of the harbour front between the two breakwater roots [0.5 extent: 1000]."""
     harbour_depth_m: float | None = None
