@@ -30,6 +30,12 @@ Found by the round (each test below failed before its fix):
   (-170, -984)". The check counts the edge with land, shallows and structures (as its spec says); the warning now
   names what is there: "comes within 10 m of the map's edge (hull) near (-170, -984) (the map spans x -1000..1000
   m, y -1000..1000 m)", and a real shore is still called the shore.
+* A route straight through a ship moored in the port was let through with two warnings ("comes within 15 m of a
+  port structure, buoy or moored ship"): ``port_entry``'s yacht sailing along y = 226 m through the ferry moored at
+  (-91, 233) (its hull overlapping the ferry's by 4.5 m, by the hulls' inscribed capsules, and by shapely on the two
+  hull rectangles). Two of the scenario's own vessels doing so is an error (``hulls_intersect``), and the moored
+  ships are vessels too (world state, boxes, LiDAR labels); ``mmusv run`` and the editor now refuse it alike,
+  naming the moored ship, where, and the route to move.
 * A port's ``n_channel_buoy_pairs`` was built as far as the fairway had room, without a word: ``10`` on the default
   2000 m port built 5 (``MapWorld.params`` saying 10). A number the scenario sets is now built exactly or refused
   when the port is built, naming the field and the most that fit (as ``n_moored`` is); left at its default, 3, it is
@@ -55,12 +61,15 @@ import mmusv
 import numpy as np
 import pytest
 import shapely
+import shapely.affinity
 import yaml
 from mmusv.classes import SemanticClass
 from mmusv.config import load_scenario
+from mmusv.editor.evaluate import evaluate
 from mmusv.scenario_checks import MmusvWarning, check_routes
 from mmusv.world.build import build_static_scene
 from mmusv.world.maps import IslandParams, MapConfigError, PortParams, generate_map
+from mmusv.world.vessels import get_asset
 
 WATER = int(SemanticClass.WATER)
 ROOT = Path(__file__).resolve().parents[1]
@@ -232,3 +241,40 @@ def test_island_radius_is_the_radius_the_island_is_drawn_in() -> None:
     src = inspect.getsource(IslandParams)
     doc = src[src.index("island_radius_m: tuple") :].split('"""')[1]
     assert "mean coast radius ``0.75 R`` to ``R``" in doc and "Range of mean coast radii" not in doc
+
+
+def _hull(asset: str, x: float, y: float, yaw: float) -> Any:
+    """The hull rectangle (shapely) of ``asset`` at ``(x, y, yaw)``: its library length and beam, centred."""
+    a = get_asset(asset)
+    return shapely.affinity.rotate(
+        shapely.box(x - a.length / 2, y - a.beam / 2, x + a.length / 2, y + a.beam / 2),
+        yaw,
+        origin=(x, y),
+        use_radians=True,
+    )
+
+
+def test_a_route_through_a_moored_ship_is_refused() -> None:
+    sc, world = _port_entry_with([[-170.0, -110.0], [-170.0, -30.0], [-120.0, 40.0]])
+    yacht = next(i for i, v in enumerate(sc.vessels) if v.id == "yacht")
+    raw = sc.model_dump(mode="json", exclude_unset=True)
+    raw["vessels"][yacht]["route"] = [[-120.0, 226.0], [-60.0, 226.0]]
+    sc = load_scenario(raw)
+    asset, (x, y, yaw) = world.moored[3]
+    # Independently: the yacht's hull rectangle at its start overlaps the moored ferry's.
+    assert asset == "ropax_ferry_90m"
+    assert _hull("motor_yacht_20m", -120.0, 226.0, 0.0).intersection(_hull(asset, x, y, yaw)).area > 50.0
+    with pytest.raises(mmusv.ConfigError) as info:
+        check_routes(sc, world, source="port.yaml")
+    msg = str(info.value)
+    assert msg.startswith("port.yaml: hulls_intersect: the hulls of yacht and moored_03 (a ropax_ferry_90m moored at")
+    assert f"(vessels[{yacht}].route)" in msg
+    # The editor's map says the same, as an error on the yacht (its route is what to move).
+    hits = [p for p in evaluate(raw)["problems"] if p["check"] == "hulls_intersect"]
+    assert len(hits) == 1 and hits[0]["severity"] == "error" and hits[0]["vessels"] == ["yacht"]
+    assert hits[0]["field"] == f"vessels[{yacht}]" and "moored_03" in hits[0]["message"]
+    # Alongside the same ship, 12 m off its side, it is a close pass (a warning), not an intersection.
+    raw["vessels"][yacht]["route"] = [[-120.0, 212.0], [-60.0, 212.0]]
+    assert not _hull("motor_yacht_20m", -120.0, 212.0, 0.0).intersects(_hull(asset, x, y, yaw))
+    with pytest.warns(MmusvWarning):
+        check_routes(load_scenario(raw), world, source="port.yaml")

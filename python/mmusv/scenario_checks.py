@@ -111,6 +111,7 @@ def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[st
     from mmusv.generate.checks import (
         HullsIntersect,
         InWater,
+        MooredHullsIntersect,
         Separation,
         ShoreClearance,
         StructureClearance,
@@ -143,6 +144,13 @@ def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[st
         )
         raise ConfigError(
             f"{source}: hulls_intersect: {fails}; move a route or a start_offset_m apart (--no-checks skips this)"
+        )
+    aground = MooredHullsIntersect().findings(samples)
+    if aground:
+        index = {v.id: i for i, v in enumerate(scenario.vessels)}
+        fails = "; ".join(f"{f.message} (vessels[{index[f.vessels[0]]}].route)" for f in aground)
+        raise ConfigError(
+            f"{source}: hulls_intersect: {fails}; keep the route off the moored ships (--no-checks skips this)"
         )
     found: list[str] = [f"{source}: sharp_turn: {m}" for m in sharp_turns(scenario, samples)]
     for check in (
@@ -251,6 +259,7 @@ def map_findings(
         HullsIntersect,
         InWater,
         LineOfSight,
+        MooredHullsIntersect,
         SensingRange,
         Separation,
         ShoreClearance,
@@ -263,6 +272,7 @@ def map_findings(
     checks = (
         InWater(),
         HullsIntersect(),
+        MooredHullsIntersect(),
         ShoreClearance(cons.shore_clearance),
         StructureClearance(cons.structure_clearance),
         Separation(cons.separation),

@@ -30,7 +30,7 @@ import numpy as np
 from scipy.ndimage import distance_transform_edt
 from scipy.spatial import cKDTree
 
-from mmusv.generate.hulls import axis_points, segment_distance
+from mmusv.generate.hulls import axis_points, capsule, segment_distance
 from mmusv.generate.mapctx import MapContext
 from mmusv.generate.samples import Samples
 from mmusv.generate.spec import (
@@ -49,6 +49,7 @@ from mmusv.generate.spec_constraints import TargetDensityCheck
 __all__ = [
     "Constraint",
     "Finding",
+    "MooredHullsIntersect",
     "build_constraints",
     "first_failure",
     "separation_words",
@@ -279,6 +280,43 @@ class HullsIntersect(_FindingsCheck):
                 f"(by at least {-float(inner[j]):.1f} m)"
             ),
         )
+
+
+class MooredHullsIntersect(_FindingsCheck):
+    """A vessel whose hull runs into a ship moored in the map's port at some sample (motion samples): the capsules
+    inscribed in the two hull rectangles overlap, as :class:`HullsIntersect` judges two of the scenario's vessels.
+    The moored ships are vessels too (world state, boxes, LiDAR labels), so it is an error alike; the finding names
+    the scenario's vessel (its route is what to move) and says which moored ship, where."""
+
+    name = "hulls_intersect"
+
+    def findings(self, s: Samples) -> list[Finding]:
+        moored = s.ctx.world.moored
+        if not moored or not s.ids:
+            return []
+        caps = np.array([capsule(asset) for asset, _ in moored])  # (M, 2): axis half-length, covering radius
+        pose = np.array([berth for _, berth in moored])  # (M, 3): x, y, yaw
+        d_m = np.column_stack([np.cos(pose[:, 2]), np.sin(pose[:, 2])]) * caps[:, :1]
+        d_v = np.stack([np.cos(s.motion_yaw), np.sin(s.motion_yaw)], axis=-1) * s.half[None, :, None]  # (T, V, 2)
+        p, q = (s.motion - d_v)[:, :, None, :], (s.motion + d_v)[:, :, None, :]
+        axis = segment_distance(p, q, p2=pose[None, None, :, :2] - d_m, q2=pose[None, None, :, :2] + d_m)
+        inner = axis - (s.radius[None, :, None] + caps[None, None, :, 1]) * math.sqrt(0.5)  # (T, V, M)
+        worst = inner.min(axis=0)
+        out = []
+        for v, m in sorted(zip(*np.nonzero(worst < 0.0), strict=True), key=lambda vm: (float(worst[vm]), vm)):
+            k = int(np.argmin(inner[:, v, m]))
+            at = s.motion[k, v]
+            asset, (x, y, _) = moored[m]
+            out.append(
+                Finding(
+                    f"the hulls of {s.ids[v]} and moored_{m:02d} (a {asset} moored at {_where(np.array([x, y]))}, "
+                    f"a ship of the map) intersect at t={float(s.times[k]):.1f} s near {_where(at)} (by at least "
+                    f"{-float(worst[v, m]):.1f} m)",
+                    (s.ids[v],),
+                    (float(at[0]), float(at[1])),
+                )
+            )
+        return out
 
 
 def _pair_findings(
