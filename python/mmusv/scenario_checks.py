@@ -3,9 +3,10 @@
 :func:`check_routes` runs, on the scenario's routes and motion, the checks ``mmusv generate`` applies to every
 scenario it writes (:mod:`mmusv.generate.checks`): ``in_water`` (every vessel's centre on navigable water,
 along the whole route and at every sampled time) is an error, since a vessel sailing over land makes every
-label wrong, and so is ``hulls_intersect`` (two hulls running into each other: a LiDAR inside the other hull sees
-only its inside); ``shore_clearance``, ``structure_clearance`` and ``separation`` are warnings (a close pass can be
-what a user wants). ``mmusv run --no-checks`` and ``mmusv.run(..., checks=False)`` skip them.
+label wrong, and so is ``hulls_intersect`` (two hulls running into each other, a ship moored in the port among
+them: a LiDAR inside the other hull sees only its inside); ``shore_clearance``, ``structure_clearance`` and
+``separation`` are warnings (a close pass can be what a user wants). ``mmusv run --no-checks`` and
+``mmusv.run(..., checks=False)`` skip them.
 
 :func:`check_mounts` warns about sensor mounts far from their hull (a units mistake: millimetres for metres).
 :func:`check_lidar_water` warns about a LiDAR's flat-sea water knobs (``water_probability`` and the three others of
