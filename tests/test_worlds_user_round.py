@@ -36,6 +36,12 @@ Found by the round (each test below failed before its fix):
   hull rectangles). Two of the scenario's own vessels doing so is an error (``hulls_intersect``), and the moored
   ships are vessels too (world state, boxes, LiDAR labels); ``mmusv run`` and the editor now refuse it alike,
   naming the moored ship, where, and the route to move.
+* Which class each part of the world carries was nowhere said (the lights on the breakwater heads are BUILDING,
+  the seabed within 2 m of the surface TERRAIN, a target of a USV asset USV, a ship's deck containers VESSEL):
+  ``SemanticClass`` now says it, each claim checked below on the meshes.
+* Which class each part of the world carries was nowhere said (the lights on the breakwater heads are BUILDING,
+  the seabed of the terrain cells within 2 m of the surface TERRAIN, a target of a USV asset USV, a ship's deck
+  containers VESSEL): ``SemanticClass`` now says it, each claim checked on the meshes.
 * A port's ``n_channel_buoy_pairs`` was built as far as the fairway had room, without a word: ``10`` on the default
   2000 m port built 5 (``MapWorld.params`` saying 10). A number the scenario sets is now built exactly or refused
   when the port is built, naming the field and the most that fit (as ``n_moored`` is); left at its default, 3, it is
@@ -278,3 +284,42 @@ def test_a_route_through_a_moored_ship_is_refused() -> None:
     assert not _hull("motor_yacht_20m", -120.0, 212.0, 0.0).intersects(_hull(asset, x, y, yaw))
     with pytest.warns(MmusvWarning):
         check_routes(load_scenario(raw), world, source="port.yaml")
+
+
+def _face_centroids(mesh: Any, cls: SemanticClass) -> tuple[np.ndarray, np.ndarray]:
+    """Centroids ``(F, 3)`` and unit normals ``(F, 3)`` of ``mesh``'s faces of class ``cls``."""
+    tri = mesh.vertices[mesh.faces[mesh.classes == int(cls)]]
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    return tri.mean(axis=1), n / np.linalg.norm(n, axis=1, keepdims=True)
+
+
+def test_the_classes_of_the_world_are_what_semantic_class_says() -> None:
+    doc = SemanticClass.__doc__ or ""
+    for words in ("lights on its breakwater heads", "ships moored in a port", "reach less than 2 m under the surface"):
+        assert words in doc
+    port = generate_map("port", seed=3)
+    ps = port.static_meshes["port_structures"]
+    # BUILDING: the warehouses stand on land; the rest are the two head lights, 2.5 m columns on the breakwater arms.
+    c, _ = _face_centroids(ps, SemanticClass.BUILDING)
+    wet = port.heightfield.sample(c[:, :2]) < 0.0
+    assert wet.any()
+    lights = shapely.get_parts(shapely.union_all(shapely.buffer(shapely.points(c[wet, :2]), 0.5)))
+    assert len(lights) == 2 and all(shapely.minimum_bounding_radius(g) <= 3.0 for g in lights)
+    arms, _ = _face_centroids(ps, SemanticClass.PORT_STRUCTURE)
+    for g in lights:
+        assert np.min(np.hypot(*(arms[:, :2] - np.asarray(g.centroid.coords[0])).T)) < 15.0
+    # CONTAINER: on the port's land; the container ship's own stacks are VESSEL.
+    c, _ = _face_centroids(ps, SemanticClass.CONTAINER)
+    assert len(c) and (port.heightfield.sample(c[:, :2]) > 0.0).all()
+    assert set(np.unique(get_asset("container_ship_300m").mesh.classes)) == {int(SemanticClass.VESSEL)}
+    # VEGETATION: gentle slopes (normal z >= 0.6) above 2.5 m over the port's land (quay height - 0.3), 4 m on islands.
+    for world, above in ((port, port.params.quay_height_m - 0.3 + 2.5), (generate_map("island", seed=4), 4.0)):
+        c, n = _face_centroids(world.static_meshes["terrain"], SemanticClass.VEGETATION)
+        assert len(c) and (n[:, 2] >= 0.6).all() and (c[:, 2] > above).all()
+        t = world.static_meshes["terrain"]
+        cells = t.vertices[t.faces][:, :, 2].reshape(-1, 6)  # two triangles a grid cell, in order
+        assert (cells.max(axis=1) > -2.0).all() and cells.min() < -2.0  # every cell reaches above 2 m under
+    # BUOY: every face within a float's 1.2 m of a listed buoy, and every buoy drawn.
+    c, _ = _face_centroids(port.static_meshes["buoys"], SemanticClass.BUOY)
+    d = np.hypot(*(c[:, None, :2] - port.priors.buoys[None, :, :]).transpose(2, 0, 1))
+    assert (d.min(axis=1) <= 1.2).all() and (d.min(axis=0) <= 1.2).all()

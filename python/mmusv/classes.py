@@ -21,7 +21,28 @@ __all__ = ["PALETTE", "ROLE_COLOURS", "SemanticClass", "class_name", "palette_ar
 
 
 class SemanticClass(IntEnum):
-    """Semantic class ids (stable: they are written into recordings)."""
+    """Semantic class ids (stable: they are written into recordings), and what of the world carries each:
+
+    ==================  =========================================================================================
+    ``NONE`` 0          nothing hit: the sky, no return (and the radar's rain clutter)
+    ``WATER`` 1         the sea's surface, flat or displaced, on the map and past its edge (and the radar's sea
+                        clutter)
+    ``TERRAIN`` 2       the land, and the seabed of the terrain cells that reach less than 2 m under the surface
+                        (cells wholly deeper are left out: ``mmusv.world.maps.TERRAIN_MESH_MIN_Z``)
+    ``VEGETATION`` 3    terrain on gentle slopes (surface normal at least 0.6 upwards) in patches, above 4 m on an
+                        island map, 3 m on an open-sea islet, 2.5 m above a port's land; none with the map's
+                        ``vegetation: false``
+    ``PORT_STRUCTURE``  a port's quay, piers and breakwaters
+    4
+    ``CONTAINER`` 5     the container stacks of a port's yard (the containers a ship carries are the ship's)
+    ``CRANE`` 6         a port's ship-to-shore gantry cranes
+    ``BUOY`` 7          a map's buoys: a port's channel buoys and the free-standing ones (``n_buoys``)
+    ``BUILDING`` 8      a port's warehouses and offices, and the lights on its breakwater heads
+    ``VESSEL`` 10       every vessel but the USVs: the targets and the ships moored in a port
+    ``USV`` 11          the USVs (``role: usv``, whatever their asset), and any vessel of a USV asset
+                        (``usv_wamv``, ``usv_patrol_12m``)
+    ==================  =========================================================================================
+    """
 
     NONE = 0
     WATER = 1
