@@ -42,6 +42,11 @@ Found by the round (each test below failed before its fix):
 * Which class each part of the world carries was nowhere said (the lights on the breakwater heads are BUILDING,
   the seabed of the terrain cells within 2 m of the surface TERRAIN, a target of a USV asset USV, a ship's deck
   containers VESSEL): ``SemanticClass`` now says it, each claim checked on the meshes.
+* A port of the smallest extent allowed (``extent_m: 600``, "a port needs at least 600 m"), every other knob at its
+  default, was refused for every seed tried (10 of 10; 6 of 10 at 700 and 800 m, 3 of 10 at 1200 m), the error
+  blaming ``n_moored``, which the scenario never set: the default 4 ships did not fit. Left at its default,
+  ``n_moored`` is now as many as fit, up to 4 (2 or 3 at 600 m), and ``MapWorld.params.n_moored`` says how many
+  (the same map again when set to that number); a number the scenario sets is still moored exactly or refused.
 * A port's ``n_channel_buoy_pairs`` was built as far as the fairway had room, without a word: ``10`` on the default
   2000 m port built 5 (``MapWorld.params`` saying 10). A number the scenario sets is now built exactly or refused
   when the port is built, naming the field and the most that fit (as ``n_moored`` is); left at its default, 3, it is
@@ -323,3 +328,21 @@ def test_the_classes_of_the_world_are_what_semantic_class_says() -> None:
     c, _ = _face_centroids(port.static_meshes["buoys"], SemanticClass.BUOY)
     d = np.hypot(*(c[:, None, :2] - port.priors.buoys[None, :, :]).transpose(2, 0, 1))
     assert (d.min(axis=1) <= 1.2).all() and (d.min(axis=0) <= 1.2).all()
+
+
+def test_a_small_port_with_default_knobs_builds_as_many_moored_ships_as_fit() -> None:
+    for seed in range(3):
+        w = generate_map("port", seed=seed, extent_m=600)  # refused before, for every seed: n_moored=4 did not fit
+        k = len(w.moored)
+        assert 0 < k < 4 and w.params.n_moored == k and "n_moored" not in w.params.model_dump(exclude_unset=True)
+        # Independently: no hull (the library's rectangles) overlaps the port's structures or another hull.
+        hulls = [_hull(a, x, y, yaw) for a, (x, y, yaw) in w.moored]
+        m = w.static_meshes["port_structures"]
+        solid = shapely.union_all([p for p in shapely.polygons(m.vertices[m.faces][:, :, :2]) if p.area > 1e-6])
+        assert not any(h.intersects(solid) for h in hulls)
+        assert not any(a.intersects(b) for i, a in enumerate(hulls) for b in hulls[i + 1 :])
+        # The number it says gives the same map; one more, set, is refused naming the most that fit.
+        again = generate_map("port", seed=seed, extent_m=600, n_moored=k)
+        assert again.moored == w.moored and again.priors.buoys.tobytes() == w.priors.buoys.tobytes()
+        with pytest.raises(MapConfigError, match=f"n_moored={k + 1} .*at most {k} "):
+            generate_map("port", seed=seed, extent_m=600, n_moored=k + 1)

@@ -247,8 +247,10 @@ class PortParams(_CommonParams):
     the map's edge. Left at its default, as many as fit up to 3; a number the scenario sets is built exactly, and a
     fairway without room for it is refused when the port is built, naming the most that fit."""
     n_moored: int = Field(default=4, ge=0, le=50)
-    """Ships moored at the terminal quay and the piers (labelled ``moored_00``, ...); a port whose quay and piers
-    have fewer free berths for ``moored_assets`` is refused when it is built, naming the most that fit."""
+    """Ships moored at the terminal quay and the piers (labelled ``moored_00``, ...). A number the scenario sets is
+    moored exactly: a port whose quay and piers have fewer free berths for ``moored_assets`` is refused when it is
+    built, naming the most that fit. Left at its default, as many as fit up to 4 (a port under about 900 m has room
+    for fewer), and ``MapWorld.params.n_moored`` says how many were moored."""
     moored_assets: tuple[_Berth, ...] = DEFAULT_MOORED_ASSETS
     """Candidate moored ships: ``(asset_name, length_m, beam_m)``, the size its berth is laid out for: the ship's
     own length and beam (or larger, for more room), at most :data:`MOORED_SIZE_SLACK_M` less."""

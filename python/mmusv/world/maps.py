@@ -389,8 +389,9 @@ def _wrap(a: float) -> float:
 
 def generate_port(*, seed: int, params: PortParams | None = None) -> MapWorld:
     """``port`` map (see :class:`PortParams`), land on the ``coast_side`` of the map. A port whose quay and piers
-    have fewer free berths than ``n_moored`` is refused (:class:`MapConfigError` on ``n_moored``, naming the most
-    that fit)."""
+    have fewer free berths than an ``n_moored`` the parameters set is refused (:class:`MapConfigError` on
+    ``n_moored``, naming the most that fit); left at its default, as many as fit are moored (up to 4), and
+    ``MapWorld.params.n_moored`` says how many."""
     seed = _check_seed(seed)
     p: PortParams = _check_params(params, PortParams, "port")
     rng = np.random.default_rng(seed)
@@ -415,6 +416,10 @@ def generate_port(*, seed: int, params: PortParams | None = None) -> MapWorld:
         return hf.sample(np.asarray(c, dtype=np.float64) @ m.T)
 
     built = port_structures(p, plan, ground=ground, rng=rng)
+    if len(built.berths) < p.n_moored and "n_moored" not in p.model_fields_set:
+        # Left at its default: as many as fit, and `params` records them (the same map again: the berths are drawn
+        # alike and the first free ones taken whatever the number asked).
+        p = _unset_copy(p, n_moored=len(built.berths))
     if len(built.berths) < p.n_moored:
         # Refused, as islands that do not fit are: fewer ships than asked would be a map other than the one given
         # (and `params` records what was built).
@@ -451,6 +456,14 @@ def generate_port(*, seed: int, params: PortParams | None = None) -> MapWorld:
         moored=moored,
         moored_fp=moored_fp,
     )
+
+
+def _unset_copy(p: PortParams, **values: Any) -> PortParams:
+    """``p`` with ``values`` replaced and the same fields counted as set (a dump with ``exclude_unset`` still gives
+    back only what the user set)."""
+    out = p.model_copy(update=values)
+    object.__setattr__(out, "__pydantic_fields_set__", set(p.model_fields_set))
+    return out
 
 
 def _channel_fits(p: PortParams, n_pairs: int) -> None:
