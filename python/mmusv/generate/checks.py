@@ -297,14 +297,23 @@ class MooredHullsIntersect(_FindingsCheck):
         caps = np.array([capsule(asset) for asset, _ in moored])  # (M, 2): axis half-length, covering radius
         pose = np.array([berth for _, berth in moored])  # (M, 3): x, y, yaw
         d_m = np.column_stack([np.cos(pose[:, 2]), np.sin(pose[:, 2])]) * caps[:, :1]
-        d_v = np.stack([np.cos(s.motion_yaw), np.sin(s.motion_yaw)], axis=-1) * s.half[None, :, None]  # (T, V, 2)
-        p, q = (s.motion - d_v)[:, :, None, :], (s.motion + d_v)[:, :, None, :]
-        axis = segment_distance(p, q, p2=pose[None, None, :, :2] - d_m, q2=pose[None, None, :, :2] + d_m)
-        inner = axis - (s.radius[None, :, None] + caps[None, None, :, 1]) * math.sqrt(0.5)  # (T, V, M)
-        worst = inner.min(axis=0)
+        p2, q2 = pose[None, None, :, :2] - d_m, pose[None, None, :, :2] + d_m
+        n_t, n_v = s.motion.shape[:2]
+        worst = np.full((n_v, len(moored)), np.inf)  # the inscribed capsules' least distance, per vessel and ship
+        when = np.zeros((n_v, len(moored)), dtype=np.int64)
+        step = max(_PAIR_BLOCK // max(n_v * len(moored), 1), 1)  # time samples a block (bounded memory)
+        for t0 in range(0, n_t, step):
+            xy, yaw = s.motion[t0 : t0 + step], s.motion_yaw[t0 : t0 + step]
+            d_v = np.stack([np.cos(yaw), np.sin(yaw)], axis=-1) * s.half[None, :, None]  # (T, V, 2)
+            axis = segment_distance((xy - d_v)[:, :, None, :], (xy + d_v)[:, :, None, :], p2=p2, q2=q2)
+            inner = axis - (s.radius[None, :, None] + caps[None, None, :, 1]) * math.sqrt(0.5)  # (T, V, M)
+            k = inner.argmin(axis=0)
+            low = np.take_along_axis(inner, k[None], axis=0)[0]
+            better = low < worst
+            worst[better], when[better] = low[better], (k + t0)[better]
         out = []
         for v, m in sorted(zip(*np.nonzero(worst < 0.0), strict=True), key=lambda vm: (float(worst[vm]), vm)):
-            k = int(np.argmin(inner[:, v, m]))
+            k = int(when[v, m])
             at = s.motion[k, v]
             asset, (x, y, _) = moored[m]
             out.append(
