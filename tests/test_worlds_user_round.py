@@ -346,3 +346,29 @@ def test_a_small_port_with_default_knobs_builds_as_many_moored_ships_as_fit() ->
         assert again.moored == w.moored and again.priors.buoys.tobytes() == w.priors.buoys.tobytes()
         with pytest.raises(MapConfigError, match=f"n_moored={k + 1} .*at most {k} "):
             generate_map("port", seed=seed, extent_m=600, n_moored=k + 1)
+
+
+def test_moored_hulls_are_compared_in_bounded_memory(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The check holds a block of time samples at a time (``_PAIR_BLOCK`` distances), not every sample x vessel x
+    moored ship at once (2.5e8 distances at the sample budget with 50 moored ships); the findings are the same."""
+    import tracemalloc
+
+    import mmusv.generate.checks as checks
+    from mmusv.generate.mapctx import MapContext
+    from mmusv.scenario_checks import scenario_samples
+
+    sc, world = _port_entry_with([[-170.0, -110.0], [-170.0, -30.0], [-120.0, 40.0]])
+    raw = sc.model_dump(mode="json", exclude_unset=True)
+    raw["acquisition"]["frames"] = 2000
+    raw["vessels"][5]["route"] = [[-190.0, 226.0], [200.0, 226.0]]  # the yacht through the moored ferry
+    s = scenario_samples(load_scenario(raw), MapContext(world))
+    whole = [f.message for f in checks.MooredHullsIntersect().findings(s)]
+    monkeypatch.setattr(checks, "_PAIR_BLOCK", 1024)
+    tracemalloc.start()
+    try:
+        blocks = [f.message for f in checks.MooredHullsIntersect().findings(s)]
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert blocks == whole and len(whole) == 2 and "moored_03" in whole[0]  # the ferry, then a fishing boat
+    assert peak < 2_000_000, peak  # 8.5 MB for the 2,000 x 8 x 4 distances at once
