@@ -12,7 +12,17 @@ Checked and right, no change:
   piers; their library sizes are the sizes their berths were laid out for.
 * Route checks in ``mmusv run``: a route over land, into a breakwater and off the map are refused naming the file,
   the check, the vessel, the point and the route's field (off the map: the map's span).
-* Determinism: the same kind, seed and parameters give the same meshes, berths and priors, byte for byte.
+* Determinism: the same kind, seed and parameters give the same meshes, berths and priors, byte for byte, also in
+  two processes of different hash seeds (one sha256 over the three kinds' meshes, berths, rasters and polygons).
+* The editor's map: its terrain picture (800 x 800 px, a port with its coast east and an island map) shows land on
+  exactly the pixels whose centres the priors' ``land`` polygons hold.
+* Sensors against the geometry (``port_entry``, one frame): camera pixels labelled water, terrain and vegetation,
+  taken to the world through the documented pinhole (depth along the optical axis), lie on the water plane and on
+  the heightfield (0.000 m); the radar's terrain and vegetation returns lie on the land polygons, its structure
+  returns on the structures' footprints (p95 within 1.6-3.4 m, its range bins 3 m), its sea clutter on water.
+* Bad map parameters in a scenario file (17 kinds: unknown knob, kind, negative seed, text for a number, sizes out
+  of range, too many islands or moored ships, unknown or undersized moored asset, a list for ``params``) name the
+  file, the field and what is allowed.
 
 Found by the round (each test below failed before its fix):
 
@@ -35,10 +45,7 @@ Found by the round (each test below failed before its fix):
   (-91, 233) (its hull overlapping the ferry's by 4.5 m, by the hulls' inscribed capsules, and by shapely on the two
   hull rectangles). Two of the scenario's own vessels doing so is an error (``hulls_intersect``), and the moored
   ships are vessels too (world state, boxes, LiDAR labels); ``mmusv run`` and the editor now refuse it alike,
-  naming the moored ship, where, and the route to move.
-* Which class each part of the world carries was nowhere said (the lights on the breakwater heads are BUILDING,
-  the seabed within 2 m of the surface TERRAIN, a target of a USV asset USV, a ship's deck containers VESSEL):
-  ``SemanticClass`` now says it, each claim checked below on the meshes.
+  naming the moored ship, where, and the route to move (in blocks of time samples, so its memory stays bounded).
 * Which class each part of the world carries was nowhere said (the lights on the breakwater heads are BUILDING,
   the seabed of the terrain cells within 2 m of the surface TERRAIN, a target of a USV asset USV, a ship's deck
   containers VESSEL): ``SemanticClass`` now says it, each claim checked on the meshes.
