@@ -63,6 +63,11 @@ Found by the round (each test below failed before its fix):
 * ``PortParams.coast_offset_m`` is "the quay line", but the quay wall's seaward face stands ``grid_m + 1`` m seaward
   of it (244 m for the default 250 m, 229 m at ``grid_m: 20``, measured on the quay's top faces with shapely): a
   designer putting a vessel alongside at 245 m put it in the quay. Now said, with both numbers.
+* ``PortParams.entrance_width_m`` is "the gap between the breakwater heads, at their toes", but each arm's head
+  reaches 19 m into it: along the arms' line the open gap measures ``entrance_width_m - 38`` m on the meshes
+  (shapely: 162 m for the default 200, 62 m for 100; 22 m at the least allowed, 60), at the crest and at the toe
+  alike (the arms' ends are vertical). Now said as built; making the gap what the knob says changes every port map
+  (``port_entry`` among them) and is left to the project (see the report).
 * ``IslandParams.island_radius_m`` was the "range of mean coast radii"; it is the radius ``R`` the island is drawn
   in: three islands in four are a 0.72 ``R`` dome with lobes out to ``R``, so their mean coast radius is 0.75-0.82
   ``R``: ``[100, 120]`` (smooth coasts, 12 seeds) gave islands of 77-119 m area-equivalent radius, 20 of 24 below
@@ -72,6 +77,7 @@ Found by the round (each test below failed before its fix):
 from __future__ import annotations
 
 import inspect
+import itertools
 from pathlib import Path
 from typing import Any
 
@@ -379,3 +385,21 @@ def test_moored_hulls_are_compared_in_bounded_memory(monkeypatch: pytest.MonkeyP
         tracemalloc.stop()
     assert blocks == whole and len(whole) == 2 and "moored_03" in whole[0]  # the ferry, then a fishing boat
     assert peak < 2_000_000, peak  # 8.5 MB for the 2,000 x 8 x 4 distances at once
+
+
+@pytest.mark.parametrize("width", [None, 100.0])
+def test_the_harbour_entrance_is_as_wide_as_the_docs_say(width: float | None) -> None:
+    w = generate_map("port", seed=3, n_moored=0, **({} if width is None else {"entrance_width_m": width}))
+    p = w.params
+    y_out = float(p.coast_offset_m) - float(p.harbour_depth_m)  # the line of the outer arms
+    m = w.static_meshes["port_structures"]
+    tri = m.vertices[m.faces[m.classes == int(SemanticClass.PORT_STRUCTURE)]]
+    arms = shapely.union_all([g for g in shapely.polygons(tri[:, :, :2]) if g.area > 1e-6])
+    cut = sorted(
+        g.bounds for g in shapely.get_parts(arms.intersection(shapely.LineString([(-2e3, y_out), (2e3, y_out)])))
+    )
+    gaps = [b[0] - a[2] for a, b in itertools.pairwise(cut)]
+    assert len(gaps) == 1 and gaps[0] == pytest.approx(float(p.entrance_width_m) - 38.0, abs=1e-6)
+    src = inspect.getsource(PortParams)
+    doc = src[src.index("entrance_width_m: float") :].split('"""')[1]
+    assert "``entrance_width_m - 38`` m: 162 m by default" in doc

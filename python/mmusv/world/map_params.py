@@ -224,7 +224,10 @@ class PortParams(_CommonParams):
     harbour_depth_m: float | None = None
     """Distance from the quay line out to the outer breakwater arms [0.21 extent: 420]."""
     entrance_width_m: float | None = None
-    """Gap between the breakwater heads, at their toes [0.1 extent within 60..250: 200]."""
+    """Width of the harbour entrance the breakwater arms are laid out for [0.1 extent within 60..250: 200]. Each arm's
+    head reaches 19 m into it (the head's light stands 15 m in, the arm's end 4 m past that), so the open gap between
+    the arms' ends is ``entrance_width_m - 38`` m: 162 m by default, 22 m at the least, 60 m; the channel buoy pairs
+    stand ``entrance_width_m / 2 - 15`` m either side of its middle, 4 m wider than the gap."""
     quay_height_m: float = Field(default=2.5, ge=1.0, le=6.0)
     basin_depth_m: float = 14.0
     """Water depth in the basin, from ``draft_margin_m + 3`` to 40 m."""
