@@ -156,7 +156,9 @@ class IslandParams(_CommonParams):
     is about ``R`` from its centre and its mean coast radius ``0.75 R`` to ``R`` (before ``coast_roughness``). Where
     the islands do not fit, ``R`` is cut by 15 % at a time (down to 15 m) before the map is refused."""
     island_height_m: tuple[float, float] = (15.0, 80.0)
-    """Range of peak heights (capped at 0.35 x radius)."""
+    """Range of the islands' dome heights (capped at 0.35 x radius); the terrain's relief adds up to 35 % of it up or
+    down, so a summit may stand above the range's top: ``[40, 40]`` gives summits of 34-47 m, the defaults up to
+    86 m."""
     min_gap_m: float = Field(default=120.0, ge=0.0)
     """Minimum open-water gap between two islands' coasts (at most ``extent_m / 2``)."""
     coast_roughness: float = Field(default=0.25, ge=0.0, le=0.5)
