@@ -33,10 +33,12 @@ from pydantic import (
     Field,
     PrivateAttr,
     SerializationInfo,
+    SerializerFunctionWrapHandler,
     ValidationError,
     ValidationInfo,
     field_serializer,
     field_validator,
+    model_serializer,
     model_validator,
 )
 from pydantic_core import InitErrorDetails, PydanticCustomError
@@ -146,7 +148,11 @@ class SeaConfig(_Model):
     developed), or a significant height ``hs_m`` with optional peak period ``tp_s`` (default: fully developed,
     Pierson–Moskowitz) and peak enhancement ``gamma`` (default: 1 when fully developed, else DNV-RP-C205's value
     for Tp/√Hs); plus the waves' travel direction ``direction_deg`` (counter-clockwise from east, towards) and the
-    cos-2s spreading ``spread_s`` (10: a wind sea; larger is longer-crested)."""
+    cos-2s spreading ``spread_s`` (10: a wind sea; larger is longer-crested); and ``wind_10m_mps``, the wind at 10 m
+    (m/s) the sensors take for the whitecaps (Monahan), the water's slopes and glint (Cox–Munk), the LiDAR's water
+    returns and foam (default: the wind of a fully developed sea of this Hs, :func:`mmusv.sensors.env.
+    wind_from_wave_height`; a swell, long Tp under a light wind, wants a smaller one). The waves themselves, and so
+    the hulls' motion and the wave surface every ray meets, come from the spectrum alone."""
 
     state: int | None = Field(default=None, ge=0, le=9)
     hs_m: float | None = Field(default=None, ge=0, le=MAX_WAVE_HEIGHT_M)
@@ -154,6 +160,16 @@ class SeaConfig(_Model):
     gamma: float | None = Field(default=None, ge=1, le=7)
     direction_deg: float = Field(default=0.0, ge=-360, le=360, allow_inf_nan=False)
     spread_s: float = Field(default=10.0, ge=0.5, le=100)
+    wind_10m_mps: float | None = Field(default=None, ge=0, le=60, allow_inf_nan=False)
+
+    @model_serializer(mode="wrap")
+    def _unset_wind_left_out(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        """The dump without ``wind_10m_mps`` when it is not given: a scenario that gives no wind keeps the config
+        hash it had before the field existed (``scenario_hash`` hashes the dump), as its recordings stay the same."""
+        out: dict[str, Any] = handler(self)
+        if self.wind_10m_mps is None:
+            out.pop("wind_10m_mps", None)
+        return out
 
     @model_validator(mode="after")
     def _one_height(self) -> SeaConfig:

@@ -214,8 +214,14 @@ class Simulation:
         """The sensors' view of the environment, whose sea state (their wind, whitecaps, water returns and
         clutter) is the physical sea's significant height where there is one (``environment.sea``, or the sea of
         ``environment.wave``), else the ``wave`` setting's: a scenario giving ``sea: {state: 6}`` alone is a rough
-        sea to every sensor, not the default W0's calm one."""
-        return sensor_env(self.environment, wave_height_m=self.sea.hs_m if self.sea is not None else None)
+        sea to every sensor, not the default W0's calm one. The wind is ``environment.sea.wind_10m_mps`` when given,
+        else that of a fully developed sea of that height."""
+        sea = self.scenario.environment.sea
+        return sensor_env(
+            self.environment,
+            wave_height_m=self.sea.hs_m if self.sea is not None else None,
+            wind_speed_m_s=sea.wind_10m_mps if sea is not None else None,
+        )
 
     @one_at_a_time
     def set_frame(self, frame: int, *, sea_radius_m: float = 320.0, shading_detail: bool = True) -> WorldState:
