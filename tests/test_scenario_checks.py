@@ -89,3 +89,39 @@ def test_the_editor_lists_it_among_the_problems() -> None:
     ev = evaluate(_no_usv())
     (p,) = [p for p in ev["problems"] if p["check"] == "sensors"]
     assert p["field"] == "vessels" and "no vessel has role: usv" in p["message"]
+
+
+def test_a_vessel_whose_keel_reaches_the_seabed_is_warned_about(tmp_path: Path) -> None:
+    """``under_keel``: ``in_water`` takes every hull's water alike (2 m deep), so the 300 m container ship (draft
+    14.5 m) sailed the port's basin, 14 m deep (``basin_depth_m``'s default), with its keel in the floor and not a
+    word (the maps sweep's finding). ``mmusv run`` now warns, naming the vessel, its draft, the depth, where and
+    when; a 16 m pilot boat there and the container ship over the open sea's 25 m do not."""
+    from mmusv.acquire import run
+    from mmusv.scenario_checks import check_under_keel
+    from mmusv.simulation import Simulation
+
+    def scenario(kind: str) -> dict[str, Any]:
+        return {
+            "seed": 1,
+            "map": {"type": kind, "seed": 3},
+            "acquisition": {"frequency_hz": 1, "frames": 3},
+            "vessels": [
+                {"id": "big", "asset": "container_ship_300m", "speed_mps": 2, "route": [[250, -60], [100, -60]]},
+                {"id": "small", "asset": "pilot_boat_16m", "speed_mps": 2, "route": [[250, -100], [100, -100]]},
+            ],
+        }
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        said = check_under_keel(Simulation(scenario("port")), range(3), source="s.yaml")
+        assert check_under_keel(Simulation(scenario("open_sea")), range(3), source="s.yaml") == []
+    assert len(said) == 1 and [str(w.message) for w in caught] == said
+    assert said[0].startswith("s.yaml: under_keel: vessels[0] (big, container_ship_300m, draft 14.5 m) sails over ")
+    assert "14.0 m of water at (250, -60) m in frame 0" in said[0] and "basin_depth_m" in said[0]
+    # mmusv run says it, and the run goes on (a warning)
+    with pytest.warns(MmusvWarning) as ran:
+        run(scenario("port"), out_dir=tmp_path / "run", frames=1)
+    assert any("under_keel: vessels[0] (big" in str(w.message) for w in ran)
+    deeper = copy.deepcopy(scenario("port"))
+    deeper["map"]["params"] = {"basin_depth_m": 16.0}
+    assert check_under_keel(Simulation(deeper), range(3), source="s.yaml") == []

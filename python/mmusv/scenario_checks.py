@@ -14,6 +14,8 @@ them: a LiDAR inside the other hull sees only its inside); ``shore_clearance``, 
 probabilities 0, which switch the water returns off.
 :func:`check_top_view_land` refuses a top view lower than the land within its view (it drew that land as water;
 :func:`top_view_land` finds them, for ``mmusv run`` and the editor).
+:func:`check_under_keel` warns about a vessel whose draft reaches the seabed under it at some frame (``in_water``
+takes every hull's water alike, 2 m deep: a 300 m ship could sail a port's shallows with its keel in the floor).
 :func:`check_sensors` warns about a scenario that records no sensor at all: no vessel with ``role: usv``, or USVs
 whose rigs switch every sensor off (``preset: lidar_only`` with ``lidar: null``); such a run records the world state
 and the boxes only, which may be meant (ground-truth trajectories), so it is a warning.
@@ -57,6 +59,7 @@ __all__ = [
     "check_routes",
     "check_sensors",
     "check_top_view_land",
+    "check_under_keel",
     "map_check_spec",
     "map_findings",
     "scenario_samples",
@@ -450,3 +453,39 @@ def check_sensors(scenario: Scenario, *, source: str) -> list[str]:
 
 def _no_sensor(rig: RigConfig) -> bool:
     return rig.lidar is None and rig.radar is None and rig.top_view is None and not rig.cameras
+
+
+def check_under_keel(sim: Simulation, frames: range, *, source: str) -> list[str]:
+    """Warns (and returns the warnings) about each scenario vessel whose draft (its hull particulars,
+    :func:`mmusv.world.hydrostatics.hull_particulars`) reaches the seabed under its centre at some frame of
+    ``frames``: the map's heightfield there, its deepest point for the vessel (the still water's depth; the sea floor
+    of open water is 25 m down). The sensors do not see it (the terrain is drawn to 2 m below the surface), but the
+    hull stands on the floor: a warning, with where and when, and how to mend it. A vessel off the map is
+    ``in_water``'s."""
+    from mmusv.world.hydrostatics import hull_particulars
+
+    n = len(sim.scenario.vessels)
+    if not n or not len(frames):
+        return []
+    times = np.array([sim.time_of(k) for k in frames], dtype=np.float64)
+    poses = np.asarray(sim.fleet.poses_at_times(times))[:, :n]
+    found: list[str] = []
+    for i, v in enumerate(sim.scenario.vessels):
+        draft = hull_particulars(sim.assets[v.asset])[2]
+        depth = -sim.world.heightfield.sample(poses[:, i, :2])
+        k = int(np.nanargmin(depth)) if np.isfinite(depth).any() else -1
+        if k >= 0 and depth[k] < draft:
+            x, y = poses[k, i, :2]
+            port = (
+                " (a port's water is map.params.basin_depth_m deep, 14 m by default)"
+                if sim.world.kind == "port"
+                else ""
+            )
+            found.append(
+                f"{source}: under_keel: vessels[{i}] ({v.id}, {v.asset}, draft {draft:.1f} m) sails over "
+                f"{max(depth[k], 0.0):.1f} m of water at ({x:.0f}, {y:.0f}) m in frame {frames[k]}: its keel is in "
+                f"the seabed; route it over deeper water{port}, or give it a smaller asset"
+            )
+    for w in found:
+        warnings.warn(w, MmusvWarning, stacklevel=2)
+    return found
