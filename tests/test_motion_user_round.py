@@ -66,6 +66,7 @@ from mmusv.config import load_scenario
 from mmusv.motion import build_fleet
 from mmusv.simulation import Simulation
 from scipy.spatial.transform import Rotation
+from test_topview_user_round import _matrix  # a foxglove Vector3 and Quaternion as a 4 x 4 matrix
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -226,13 +227,6 @@ def _recording_scenario() -> dict[str, Any]:
             {"id": "b", "role": "usv", "asset": "usv_wamv", "rig": "lid", "route": [[20, 50], [25, 50]]},
         ],
     }
-
-
-def _matrix(translation: Any, rotation: Any) -> np.ndarray:
-    m = np.eye(4)
-    m[:3, :3] = Rotation.from_quat([rotation.x, rotation.y, rotation.z, rotation.w]).as_matrix()
-    m[:3, 3] = [translation.x, translation.y, translation.z]
-    return m
 
 
 def _pose(v: Any) -> np.ndarray:
