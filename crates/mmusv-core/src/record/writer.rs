@@ -316,17 +316,22 @@ impl Recorder {
             *bytes += data.len();
             self.held.push(Held { topic: topic.to_string(), log_time: log_time_ns, sequence, data: data.to_vec() });
         } else {
-            let header = MessageHeader {
-                channel_id: slot.id.unwrap_or(0),
-                sequence,
-                log_time: log_time_ns,
-                publish_time: log_time_ns,
-            };
+            let Some(channel_id) = slot.id else { return Err(self.unwritten_channel(topic)) };
+            let header = MessageHeader { channel_id, sequence, log_time: log_time_ns, publish_time: log_time_ns };
             let written = self.writer()?.write_to_known_channel(&header, data);
             written.map_err(|e| self.failed(&partial, &e))?;
         }
         self.messages += 1;
         Ok(())
+    }
+
+    /// The error of a message whose channel was never written (its declaration failed, and so did the recording).
+    fn unwritten_channel(&self, topic: &str) -> MmusvError {
+        let earlier = self.first_failure.as_deref().unwrap_or("its channel could not be written");
+        MmusvError::Io {
+            path: self.partial.display().to_string(),
+            reason: format!("cannot write a message on {topic}: {earlier}"),
+        }
     }
 
     /// Writes `topic`'s schema and channel; returns the channel's id.
@@ -354,7 +359,9 @@ impl Recorder {
         let flushed = self.writer()?.flush();
         flushed.map_err(|e| self.failed(&partial, &e))?;
         for h in std::mem::take(&mut self.held) {
-            let channel_id = self.channels.get(&h.topic).and_then(|s| s.id).unwrap_or(0);
+            let Some(channel_id) = self.channels.get(&h.topic).and_then(|s| s.id) else {
+                return Err(self.unwritten_channel(&h.topic));
+            };
             let header =
                 MessageHeader { channel_id, sequence: h.sequence, log_time: h.log_time, publish_time: h.log_time };
             let written = self.writer()?.write_to_known_channel(&header, &h.data);
