@@ -21,7 +21,9 @@ origin (midship, at the waterline), in the vessel body frame. On an asset withou
 falls back to 0.5 m above the top of the hull's bounding box over the vessel origin, looking where the name says
 (``camera_left`` +90° yaw, ``camera_rear`` 180°, ``camera_right`` −90°, any other name ahead); a point an asset
 with mount points lacks is refused. ``xyz`` is within ±100 km
-(:data:`MAX_MOUNT_OFFSET_M`) and ``rpy_deg`` within ±360 degrees.
+(:data:`MAX_MOUNT_OFFSET_M`) and ``rpy_deg`` within ±360 degrees. Without a ``mount``, the LiDAR sits on ``lidar``,
+the radar on ``radar`` and a camera on ``camera_<its name>``, else ``camera_front``, else that fall-back
+(:func:`mmusv.sensors.mounts.camera_mount`).
 """
 
 from __future__ import annotations
