@@ -95,7 +95,8 @@ def test_a_vessel_whose_keel_reaches_the_seabed_is_warned_about(tmp_path: Path) 
     """``under_keel``: ``in_water`` takes every hull's water alike (2 m deep), so the 300 m container ship (draft
     14.5 m) sailed the port's basin, 14 m deep (``basin_depth_m``'s default), with its keel in the floor and not a
     word (the maps sweep's finding). ``mmusv run`` now warns, naming the vessel, its draft, the depth, where and
-    when; a 16 m pilot boat there and the container ship over the open sea's 25 m do not."""
+    when, and the editor lists it; a 16 m pilot boat there and the container ship over the open sea's 25 m do
+    not."""
     from mmusv.acquire import run
     from mmusv.scenario_checks import check_under_keel
     from mmusv.simulation import Simulation
@@ -116,12 +117,19 @@ def test_a_vessel_whose_keel_reaches_the_seabed_is_warned_about(tmp_path: Path) 
         said = check_under_keel(Simulation(scenario("port")), range(3), source="s.yaml")
         assert check_under_keel(Simulation(scenario("open_sea")), range(3), source="s.yaml") == []
     assert len(said) == 1 and [str(w.message) for w in caught] == said
-    assert said[0].startswith("s.yaml: under_keel: vessels[0] (big, container_ship_300m, draft 14.5 m) sails over ")
+    assert said[0].startswith("s.yaml: under_keel: vessels[0] big (container_ship_300m, draft 14.5 m) sails over ")
     assert "14.0 m of water at (250, -60) m in frame 0" in said[0] and "basin_depth_m" in said[0]
     # mmusv run says it, and the run goes on (a warning)
     with pytest.warns(MmusvWarning) as ran:
         run(scenario("port"), out_dir=tmp_path / "run", frames=1)
-    assert any("under_keel: vessels[0] (big" in str(w.message) for w in ran)
+    assert any("under_keel: vessels[0] big (" in str(w.message) for w in ran)
+    # the scenario editor lists it too, on the vessel's route, where mmusv run warns
+    from mmusv.editor.evaluate import evaluate
+
+    (p,) = [p for p in evaluate(scenario("port"))["problems"] if p["check"] == "under_keel"]
+    assert p["severity"] == "warning" and p["field"] == "vessels[0].route" and p["vessels"] == ["big"]
+    assert p["message"].startswith("big (container_ship_300m, draft 14.5 m) sails over 14.0 m of water at (250, -60) m")
+    assert p["point"] == [250.0, -60.0]
     deeper = copy.deepcopy(scenario("port"))
     deeper["map"]["params"] = {"basin_depth_m": 16.0}
     assert check_under_keel(Simulation(deeper), range(3), source="s.yaml") == []

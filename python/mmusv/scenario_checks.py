@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -60,6 +61,7 @@ __all__ = [
     "check_sensors",
     "check_top_view_land",
     "check_under_keel",
+    "keel_findings",
     "map_check_spec",
     "map_findings",
     "scenario_samples",
@@ -256,8 +258,9 @@ def map_findings(
     ``in_water`` and ``hulls_intersect`` (errors, as in ``mmusv run``), then as warnings ``shore_clearance``,
     ``structure_clearance``, ``separation``, ``sensing_range`` (every target within range of a USV in a share of
     the frames), ``cooperation`` (each USV's nearest USV within a distance band) and ``line_of_sight`` (each
-    target seen past the static map by a USV within range in a share of the frames), with ``spec``'s thresholds
-    (default :func:`map_check_spec`)."""
+    target seen past the static map by a USV within range in a share of the frames) and ``under_keel`` (a keel that
+    reaches the seabed at a frame, :func:`keel_findings`), with ``spec``'s thresholds (default
+    :func:`map_check_spec`)."""
     from mmusv.generate.checks import (
         Cooperation,
         HullsIntersect,
@@ -289,7 +292,13 @@ def map_findings(
         for c in checks
         for f in c.findings(samples)
     ]
-    return samples, found
+    from mmusv.world.hydrostatics import hull_particulars
+    from mmusv.world.vessels import get_asset
+
+    drafts = [hull_particulars(get_asset(v.asset))[2] for v in scenario.vessels]
+    xy = samples.frames[:, [samples.index(v.id) for v in scenario.vessels]]
+    keels = keel_findings(scenario, ctx.world, drafts, xy, range(len(xy)))
+    return samples, found + [MapFinding("under_keel", "warning", f) for f in keels]
 
 
 def check_mounts(scenario: Scenario, *, source: str) -> list[str]:
@@ -455,37 +464,55 @@ def _no_sensor(rig: RigConfig) -> bool:
     return rig.lidar is None and rig.radar is None and rig.top_view is None and not rig.cameras
 
 
+def keel_findings(
+    scenario: Scenario, world: MapWorld, drafts: Sequence[float], xy: np.ndarray, frames: Sequence[int]
+) -> list[Finding]:
+    """``under_keel``: every vessel of ``scenario`` whose draft (``drafts``, metres, in vessel order: the hull
+    particulars', :func:`mmusv.world.hydrostatics.hull_particulars`) reaches the seabed under its centre at some frame:
+    ``xy`` ``(F, V, 2)`` float world positions (metres) at ``frames`` (F acquisition indices), the depth the map's
+    heightfield's (the still water's; the sea floor of open water is 25 m down). One finding per vessel, at its
+    shallowest frame. The sensors do not see the floor (the terrain is drawn to 2 m below the surface), but the hull
+    stands on it; a vessel off the map is ``in_water``'s."""
+    from mmusv.generate.checks import Finding
+
+    port = " (a port's water is map.params.basin_depth_m deep, 14 m by default)" if world.kind == "port" else ""
+    found: list[Finding] = []
+    for i, v in enumerate(scenario.vessels):
+        depth = -world.heightfield.sample(xy[:, i])
+        if not np.isfinite(depth).any():
+            continue
+        k = int(np.nanargmin(depth))
+        if depth[k] < drafts[i]:
+            x, y = (float(c) for c in xy[k, i])
+            found.append(
+                Finding(
+                    f"{v.id} ({v.asset}, draft {drafts[i]:.1f} m) sails over {max(depth[k], 0.0):.1f} m of water at "
+                    f"({x:.0f}, {y:.0f}) m in frame {frames[k]}: its keel is in the seabed; route it over deeper "
+                    f"water{port}, or give it a smaller asset",
+                    (v.id,),
+                    (x, y),
+                )
+            )
+    return found
+
+
 def check_under_keel(sim: Simulation, frames: range, *, source: str) -> list[str]:
-    """Warns (and returns the warnings) about each scenario vessel whose draft (its hull particulars,
-    :func:`mmusv.world.hydrostatics.hull_particulars`) reaches the seabed under its centre at some frame of
-    ``frames``: the map's heightfield there, its deepest point for the vessel (the still water's depth; the sea floor
-    of open water is 25 m down). The sensors do not see it (the terrain is drawn to 2 m below the surface), but the
-    hull stands on the floor: a warning, with where and when, and how to mend it. A vessel off the map is
-    ``in_water``'s."""
+    """Warns (and returns the warnings) about each scenario vessel whose keel reaches the seabed at some frame of
+    ``frames`` (:func:`keel_findings`, the poses of the frames): a warning naming ``source``, the vessel, its draft,
+    the depth, where and when, and how to mend it."""
     from mmusv.world.hydrostatics import hull_particulars
 
     n = len(sim.scenario.vessels)
     if not n or not len(frames):
         return []
     times = np.array([sim.time_of(k) for k in frames], dtype=np.float64)
-    poses = np.asarray(sim.fleet.poses_at_times(times))[:, :n]
-    found: list[str] = []
-    for i, v in enumerate(sim.scenario.vessels):
-        draft = hull_particulars(sim.assets[v.asset])[2]
-        depth = -sim.world.heightfield.sample(poses[:, i, :2])
-        k = int(np.nanargmin(depth)) if np.isfinite(depth).any() else -1
-        if k >= 0 and depth[k] < draft:
-            x, y = poses[k, i, :2]
-            port = (
-                " (a port's water is map.params.basin_depth_m deep, 14 m by default)"
-                if sim.world.kind == "port"
-                else ""
-            )
-            found.append(
-                f"{source}: under_keel: vessels[{i}] ({v.id}, {v.asset}, draft {draft:.1f} m) sails over "
-                f"{max(depth[k], 0.0):.1f} m of water at ({x:.0f}, {y:.0f}) m in frame {frames[k]}: its keel is in "
-                f"the seabed; route it over deeper water{port}, or give it a smaller asset"
-            )
+    xy = np.asarray(sim.fleet.poses_at_times(times))[:, :n, :2]
+    drafts = [hull_particulars(sim.assets[v.asset])[2] for v in sim.scenario.vessels]
+    index = {v.id: i for i, v in enumerate(sim.scenario.vessels)}
+    found = [
+        f"{source}: under_keel: vessels[{index[f.vessels[0]]}] {f.message}"
+        for f in keel_findings(sim.scenario, sim.world, drafts, xy, frames)
+    ]
     for w in found:
         warnings.warn(w, MmusvWarning, stacklevel=2)
     return found

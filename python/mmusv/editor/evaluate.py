@@ -273,7 +273,7 @@ def evaluate(
         f = mf.finding
         first = index[f.vessels[0]] if f.vessels else None
         field = f"vessels[{first}]" if first is not None else ""
-        if mf.check in ("in_water", "shore_clearance", "structure_clearance"):
+        if mf.check in ("in_water", "shore_clearance", "structure_clearance", "under_keel"):
             field += ".route"
         out["problems"].append(
             {
