@@ -98,8 +98,20 @@ def test_a_vessel_whose_keel_reaches_the_seabed_is_warned_about(tmp_path: Path) 
     when, and the editor lists it; a 16 m pilot boat there and the container ship over the open sea's 25 m do
     not."""
     from mmusv.acquire import run
-    from mmusv.scenario_checks import check_under_keel
+    from mmusv.scenario_checks import check_routes
     from mmusv.simulation import Simulation
+
+    def check_under_keel(sc: dict[str, Any]) -> list[str]:
+        """The ``under_keel`` warnings of the run's route checks (its frames' samples), each also warned."""
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            said = [
+                w
+                for w in check_routes(load_scenario(sc), Simulation(sc).world, source="s.yaml")
+                if ": under_keel: " in w
+            ]
+        assert [str(w.message) for w in caught if ": under_keel: " in str(w.message)] == said
+        return said
 
     def scenario(kind: str) -> dict[str, Any]:
         return {
@@ -112,11 +124,9 @@ def test_a_vessel_whose_keel_reaches_the_seabed_is_warned_about(tmp_path: Path) 
             ],
         }
 
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        said = check_under_keel(Simulation(scenario("port")), range(3), source="s.yaml")
-        assert check_under_keel(Simulation(scenario("open_sea")), range(3), source="s.yaml") == []
-    assert len(said) == 1 and [str(w.message) for w in caught] == said
+    said = check_under_keel(scenario("port"))
+    assert check_under_keel(scenario("open_sea")) == []
+    assert len(said) == 1
     assert said[0].startswith("s.yaml: under_keel: vessels[0] big (container_ship_300m, draft 14.5 m) sails over ")
     assert "14.0 m of water at (250, -60) m in frame 0" in said[0] and "basin_depth_m" in said[0]
     # mmusv run says it, and the run goes on (a warning)
@@ -132,4 +142,4 @@ def test_a_vessel_whose_keel_reaches_the_seabed_is_warned_about(tmp_path: Path) 
     assert p["point"] == [250.0, -60.0]
     deeper = copy.deepcopy(scenario("port"))
     deeper["map"]["params"] = {"basin_depth_m": 16.0}
-    assert check_under_keel(Simulation(deeper), range(3), source="s.yaml") == []
+    assert check_under_keel(deeper) == []

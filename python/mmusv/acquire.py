@@ -55,7 +55,6 @@ from mmusv.scenario_checks import (
     check_routes,
     check_sensors,
     check_top_view_land,
-    check_under_keel,
 )
 from mmusv.simulation import FrameCapture, Simulation
 
@@ -249,7 +248,6 @@ def run(
         upto = scenario.acquisition.model_copy(update={"frames": total})
         check_routes(scenario.model_copy(update={"acquisition": upto}), sim.world, source=source)
         check_top_view_land(sim, range(first, total), source=source)
-        check_under_keel(sim, range(first, total), source=source)
     # The first frame is captured before anything is written or replaced: whatever a sensor refuses only when it
     # captures (or any other failure of a capture) fails the run here, with the folder as it was.
     started = clocks()  # the run's clocks start with its first frame

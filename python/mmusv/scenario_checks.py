@@ -14,8 +14,9 @@ them: a LiDAR inside the other hull sees only its inside); ``shore_clearance``, 
 probabilities 0, which switch the water returns off.
 :func:`check_top_view_land` refuses a top view lower than the land within its view (it drew that land as water;
 :func:`top_view_land` finds them, for ``mmusv run`` and the editor).
-:func:`check_under_keel` warns about a vessel whose draft reaches the seabed under it at some frame (``in_water``
-takes every hull's water alike, 2 m deep: a 300 m ship could sail a port's shallows with its keel in the floor).
+``under_keel`` (:func:`keel_findings`, a warning of :func:`check_routes` and a finding of :func:`map_findings`): a
+vessel whose draft reaches the seabed under it at some frame (``in_water`` takes every hull's water alike, 2 m deep:
+a 300 m ship could sail a port's shallows with its keel in the floor).
 :func:`check_sensors` warns about a scenario that records no sensor at all: no vessel with ``role: usv``, or USVs
 whose rigs switch every sensor off (``preset: lidar_only`` with ``lidar: null``); such a run records the world state
 and the boxes only, which may be meant (ground-truth trajectories), so it is a warning.
@@ -30,7 +31,6 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -60,7 +60,6 @@ __all__ = [
     "check_routes",
     "check_sensors",
     "check_top_view_land",
-    "check_under_keel",
     "keel_findings",
     "map_check_spec",
     "map_findings",
@@ -108,8 +107,9 @@ def scenario_samples(scenario: Scenario, ctx: MapContext, spec: GenerationSpec |
 
 
 def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[str]:
-    """Runs the generator's ``in_water`` check (an error) and clearance/separation checks (warnings, also
-    returned) on ``scenario`` sailing on ``world``; ``source`` names the file in messages.
+    """Runs the generator's ``in_water`` check (an error) and clearance/separation checks and ``under_keel``
+    (:func:`keel_findings`) (warnings, also returned) on ``scenario`` sailing on ``world``; ``source`` names the file
+    in messages.
 
     The checks sample the scenario's whole acquisition (:func:`mmusv.run` passes it cut to the frames it runs); a
     scenario whose checks would take more than :data:`~mmusv.generate.samples.MAX_CHECK_SAMPLES` samples is refused
@@ -167,6 +167,11 @@ def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[st
         msg = check.check(samples)
         if msg is not None:
             found.append(f"{source}: {check.name}: {msg}")
+    index = {v.id: i for i, v in enumerate(scenario.vessels)}
+    found += [
+        f"{source}: under_keel: vessels[{index[f.vessels[0]]}] {f.message}"
+        for f in keel_findings(scenario, world, samples)
+    ]
     for w in found:
         warnings.warn(w, MmusvWarning, stacklevel=2)
     return found
@@ -292,12 +297,7 @@ def map_findings(
         for c in checks
         for f in c.findings(samples)
     ]
-    from mmusv.world.hydrostatics import hull_particulars
-    from mmusv.world.vessels import get_asset
-
-    drafts = [hull_particulars(get_asset(v.asset))[2] for v in scenario.vessels]
-    xy = samples.frames[:, [samples.index(v.id) for v in scenario.vessels]]
-    keels = keel_findings(scenario, ctx.world, drafts, xy, range(len(xy)))
+    keels = keel_findings(scenario, ctx.world, samples)
     return samples, found + [MapFinding("under_keel", "warning", f) for f in keels]
 
 
@@ -464,55 +464,34 @@ def _no_sensor(rig: RigConfig) -> bool:
     return rig.lidar is None and rig.radar is None and rig.top_view is None and not rig.cameras
 
 
-def keel_findings(
-    scenario: Scenario, world: MapWorld, drafts: Sequence[float], xy: np.ndarray, frames: Sequence[int]
-) -> list[Finding]:
-    """``under_keel``: every vessel of ``scenario`` whose draft (``drafts``, metres, in vessel order: the hull
-    particulars', :func:`mmusv.world.hydrostatics.hull_particulars`) reaches the seabed under its centre at some frame:
-    ``xy`` ``(F, V, 2)`` float world positions (metres) at ``frames`` (F acquisition indices), the depth the map's
-    heightfield's (the still water's; the sea floor of open water is 25 m down). One finding per vessel, at its
-    shallowest frame. The sensors do not see the floor (the terrain is drawn to 2 m below the surface), but the hull
-    stands on it; a vessel off the map is ``in_water``'s."""
+def keel_findings(scenario: Scenario, world: MapWorld, samples: Samples) -> list[Finding]:
+    """``under_keel``: every vessel of ``scenario`` whose draft (its hull particulars,
+    :func:`mmusv.world.hydrostatics.hull_particulars`) reaches the seabed under its centre at some acquisition frame
+    of ``samples`` (``Samples.frames``), the depth the map's heightfield's (the still water's; the sea floor of open
+    water is 25 m down). One finding per vessel, at its shallowest frame. The sensors do not see the floor (the
+    terrain is drawn to 2 m below the surface), but the hull stands on it; a vessel off the map is ``in_water``'s."""
     from mmusv.generate.checks import Finding
+    from mmusv.world.hydrostatics import hull_particulars
+    from mmusv.world.vessels import get_asset
 
     port = " (a port's water is map.params.basin_depth_m deep, 14 m by default)" if world.kind == "port" else ""
     found: list[Finding] = []
-    for i, v in enumerate(scenario.vessels):
-        depth = -world.heightfield.sample(xy[:, i])
+    for v in scenario.vessels:
+        draft = hull_particulars(get_asset(v.asset))[2]
+        xy = samples.frames[:, samples.index(v.id)]
+        depth = -world.heightfield.sample(xy)
         if not np.isfinite(depth).any():
             continue
         k = int(np.nanargmin(depth))
-        if depth[k] < drafts[i]:
-            x, y = (float(c) for c in xy[k, i])
+        if depth[k] < draft:
+            x, y = (float(c) for c in xy[k])
             found.append(
                 Finding(
-                    f"{v.id} ({v.asset}, draft {drafts[i]:.1f} m) sails over {max(depth[k], 0.0):.1f} m of water at "
-                    f"({x:.0f}, {y:.0f}) m in frame {frames[k]}: its keel is in the seabed; route it over deeper "
+                    f"{v.id} ({v.asset}, draft {draft:.1f} m) sails over {max(depth[k], 0.0):.1f} m of water at "
+                    f"({x:.0f}, {y:.0f}) m in frame {k}: its keel is in the seabed; route it over deeper "
                     f"water{port}, or give it a smaller asset",
                     (v.id,),
                     (x, y),
                 )
             )
-    return found
-
-
-def check_under_keel(sim: Simulation, frames: range, *, source: str) -> list[str]:
-    """Warns (and returns the warnings) about each scenario vessel whose keel reaches the seabed at some frame of
-    ``frames`` (:func:`keel_findings`, the poses of the frames): a warning naming ``source``, the vessel, its draft,
-    the depth, where and when, and how to mend it."""
-    from mmusv.world.hydrostatics import hull_particulars
-
-    n = len(sim.scenario.vessels)
-    if not n or not len(frames):
-        return []
-    times = np.array([sim.time_of(k) for k in frames], dtype=np.float64)
-    xy = np.asarray(sim.fleet.poses_at_times(times))[:, :n, :2]
-    drafts = [hull_particulars(sim.assets[v.asset])[2] for v in sim.scenario.vessels]
-    index = {v.id: i for i, v in enumerate(sim.scenario.vessels)}
-    found = [
-        f"{source}: under_keel: vessels[{index[f.vessels[0]]}] {f.message}"
-        for f in keel_findings(sim.scenario, sim.world, drafts, xy, frames)
-    ]
-    for w in found:
-        warnings.warn(w, MmusvWarning, stacklevel=2)
     return found
