@@ -38,7 +38,6 @@ pub use waves::{mix_seed, BaseAmplitudes, PeriodicSignal, VesselDims, WaveSettin
 use crate::error::{MmusvError, Result};
 use crate::ocean::{Hull, WaveField};
 use rayon::prelude::*;
-use std::f64::consts::PI;
 use std::sync::Arc;
 
 /// Checks that a simulation time is finite and ≥ 0; `field` names it in the [`MmusvError::InvalidInput`].
@@ -207,10 +206,7 @@ impl VesselMotion {
     fn pose_unchecked(&self, t: f64, wave: &WaveSetting, sea: Option<&WaveField>) -> [f64; 6] {
         let (s, sign) = self.route.distance_to_arc(self.travelled_m(t));
         let [x, y] = self.route.position(s);
-        let mut yaw = self.route.yaw(s);
-        if sign < 0.0 {
-            yaw = wrap_angle(yaw + PI);
-        }
+        let yaw = self.route.heading(s, sign);
         let [dz, roll, pitch] = match sea {
             None => self.perturbation_at(t, wave),
             Some(field) => {
@@ -223,9 +219,7 @@ impl VesselMotion {
 
     /// World-frame horizontal velocity at arc length `s` travelled in direction `sign`.
     fn horizontal_velocity(&self, s: f64, sign: f64) -> [f64; 2] {
-        let v = self.params.speed_mps * sign;
-        let [tx, ty] = if v == 0.0 { [0.0, 0.0] } else { self.route.tangent(s) };
-        [v * tx, v * ty]
+        self.route.velocity(s, sign, self.params.speed_mps)
     }
 
     fn velocity_unchecked(&self, t: f64, wave: &WaveSetting, sea: Option<&WaveField>) -> [f64; 3] {
@@ -359,6 +353,7 @@ impl Fleet {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::PI;
 
     pub(super) fn straight_test_vessel(waypoints: &[[f64; 2]], end: EndBehaviour, speed: f64) -> VesselMotion {
         let route = Route::new(waypoints, end).unwrap_or_else(|e| unreachable!("{e}"));

@@ -320,6 +320,25 @@ impl Route {
         y.atan2(x)
     }
 
+    /// Heading (radians, in `[-π, π]`) of a vessel at arc length `s` travelling in direction `sign` (from
+    /// [`Route::distance_to_arc`]): the tangent's, turned by π when travelling backwards (`sign` < 0).
+    pub fn heading(&self, s: f64, sign: f64) -> f64 {
+        let yaw = self.yaw(s);
+        if sign < 0.0 {
+            wrap_angle(yaw + std::f64::consts::PI)
+        } else {
+            yaw
+        }
+    }
+
+    /// World-frame horizontal velocity (m/s) of a vessel at arc length `s` travelling in direction `sign` at
+    /// `speed` m/s: `speed · sign · tangent(s)` (zero at rest).
+    pub fn velocity(&self, s: f64, sign: f64, speed: f64) -> [f64; 2] {
+        let v = speed * sign;
+        let [tx, ty] = if v == 0.0 { [0.0, 0.0] } else { self.tangent(s) };
+        [v * tx, v * ty]
+    }
+
     /// Maps a travelled distance `d = offset + u·t` (metres) to `(s, sign)` on the route.
     ///
     /// - [`EndBehaviour::Stop`]: `s = clamp(d, 0, L)`; `sign = +1` while `d < L`, `0` once at rest at the end.

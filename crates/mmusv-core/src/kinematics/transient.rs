@@ -28,7 +28,6 @@ use super::spline::{EndBehaviour, Route};
 use super::VesselParams;
 use crate::ocean::response::{encounter_frequency, response};
 use crate::ocean::{Hull, WaveField};
-use std::f64::consts::PI;
 
 /// The weight below which an event's earlier steady state is left out: its share of the difference between two
 /// steady states (at most a few metres or radians) is then under a nanometre or a nanoradian.
@@ -48,12 +47,8 @@ struct Event {
 
 /// The heading and velocity of a hull at arc length `s`, travelling in direction `sign` at `speed` along `route`.
 fn state(route: &Route, speed: f64, s: f64, sign: f64) -> (f64, f64, f64) {
-    let mut yaw = route.yaw(s);
-    if sign < 0.0 {
-        yaw = super::spline::wrap_angle(yaw + PI);
-    }
-    let [tx, ty] = route.tangent(s);
-    (yaw, speed * sign * tx, speed * sign * ty)
+    let [vx, vy] = route.velocity(s, sign, speed);
+    (route.heading(s, sign), vx, vy)
 }
 
 /// The events of `route` sailed with `params` up to time `t` whose weight at `t` is at least [`FADED`] (at most
@@ -207,6 +202,7 @@ pub fn response_through_events(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::PI;
 
     fn route(end: EndBehaviour) -> Route {
         Route::new(&[[0.0, 0.0], [50.0, 0.0]], end).unwrap_or_else(|e| unreachable!("{e}"))
