@@ -46,8 +46,10 @@ Findings:
    (:func:`test_heave_rate_is_the_derivative_of_the_heave_in_a_fast_turn`, a strict xfail before).
 3. A vessel's wake vanishes the frame after its ``stop`` route ends: the foam a camera 60 m away draws behind a
    speedboat at 8 m/s in frames 48-50 is plain water in frame 51, 0.2 s later (the core's wake is empty at rest,
-   ``kinematics/path_behind.rs``, and :meth:`mmusv.simulation.Simulation.wakes` drops a vessel under 0.3 m/s). A
-   Rust change first; a strict xfail (:func:`test_the_foam_behind_a_vessel_outlasts_its_stop`).
+   ``kinematics/path_behind.rs``, and :meth:`mmusv.simulation.Simulation.wakes` drops a vessel under 0.3 m/s). Fixed
+   since: at rest at a ``stop`` route's end a vessel keeps the path behind it as it arrived, every piece older by the
+   time since, at its speed under way, so its track fades with age as under way; its Kelvin arms, which travel with
+   the waves, are no longer drawn (:func:`test_the_foam_behind_a_vessel_outlasts_its_stop`, a strict xfail before).
 """
 
 from __future__ import annotations
@@ -359,23 +361,51 @@ def test_heave_rate_is_the_derivative_of_the_heave_in_a_fast_turn() -> None:
     np.testing.assert_allclose(vz, dz, atol=0.01)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="a vessel at rest has no wake: the core's wake_pieces is empty at rest "
-    "(crates/mmusv-core/src/kinematics/path_behind.rs) and Simulation.wakes drops a vessel under 0.3 m/s",
-)
 def test_the_foam_behind_a_vessel_outlasts_its_stop() -> None:
     """A speedboat at 8 m/s ends its ``stop`` route at t = 10 s: its foam, drawn by the cameras (and met by the
-    LiDAR) up to frame 50, is gone at frame 51, 0.2 s later, as if it had never sailed (the rendered frames of a
-    camera 60 m away show the white streak in frames 48-50 and plain water in 51-52)."""
+    LiDAR) up to frame 50, was gone at frame 51, 0.2 s later, as if it had never sailed (the rendered frames of a
+    camera 60 m away showed the white streak in frames 48-50 and plain water in 51-52)."""
     sim = Simulation(
         {
             "seed": 1,
             "environment": {"wave": "W1"},
-            "acquisition": {"frequency_hz": 5, "frames": 60},
+            "acquisition": {"frequency_hz": 5, "frames": 260},
             "vessels": [{"id": "b", "asset": "speedboat_5m", "speed_mps": 8, "route": [[0, 0], [80, 0]]}],
         }
     )
     assert len(sim.wakes(sim.world_state(50))) > 0  # under way: its own piece and the path behind
     after = sim.wakes(sim.world_state(51))
     assert len(after) > 0 and np.all(after[:, 7] > 0.0)  # the same foam, 0.2 s older
+    # Drawn: a top view over the track (flat water, 0.5 m a pixel, rows along x, columns along y). The track behind
+    # the stern (|y| < 3 m) keeps its foam 0.2 s after the stop, widening and fading as it ages (e-folding 30 s).
+    from mmusv._native import core
+    from mmusv.scene import Scene
+    from mmusv.sensors.camera import render
+    from mmusv.sensors.env import sensor_env
+    from mmusv.world.build import pose_matrices
+
+    scene = Scene()
+    v = np.array([[-5e3, -5e3, 0.0], [5e3, -5e3, 0.0], [5e3, 5e3, 0.0], [-5e3, 5e3, 0.0]])
+    scene.add_instance(scene.add_mesh(v, np.array([[0, 1, 2], [0, 2, 3]]), classes=1, name="water"))
+    env = sensor_env(fog_extinction_per_m=0.0, rain_mm_per_h=0.0, wave_height_m=0.0, wind_speed_m_s=0.0)
+    top = core.Camera(width=60, height=240, rgb=True, metres_per_pixel=0.5, quality="draft", range_max=500.0)
+    pose = pose_matrices(np.array([30.0, 0.0, 300.0, 0.0, math.pi / 2, 0.0]))  # +x at the image top, centre x = 30 m
+
+    def luminance(wakes: np.ndarray | None) -> np.ndarray:
+        img = render(top, scene, pose=pose, env=env, seed=1, wakes=wakes, radiance=True).radiance
+        assert img is not None
+        return np.asarray(img @ np.array([0.2126, 0.7152, 0.0722]))
+
+    water = luminance(None)
+    y = 15.0 - (np.arange(60) + 0.5) * 0.5  # world y of each column
+    x = 90.0 - (np.arange(240) + 0.5) * 0.5  # world x of each row
+    track = (np.abs(y)[None, :] < 3.0) & (x[:, None] < 75.0)  # behind the stopped stern (x = 77.5 m)
+
+    def foam(frame: int) -> np.ndarray:
+        return np.asarray((luminance(sim.wakes(sim.world_state(frame))) - water)[track])
+
+    sailing, stopped, later = foam(49), foam(51), foam(250)  # 40 s at rest
+    lit = 0.05 * float(np.median(water))
+    assert (sailing > lit).sum() > 500
+    assert (stopped > lit).sum() > 0.8 * (sailing > lit).sum(), ((stopped > lit).sum(), (sailing > lit).sum())
+    assert 0.1 * stopped.mean() < later.mean() < 0.5 * stopped.mean(), (later.mean(), stopped.mean())

@@ -584,7 +584,8 @@ class Fleet:
         """(M, 6) float64 rows ``vessel, x, y, heading, reach_m, age_s``: the path behind each vessel at time t (s)
         as straight pieces, newest first: where each starts (metres, radians), how far back from there the path ran
         straight within ``tolerances_m`` (V,) of that line (inf: on to the wake's end), how long ago the vessel
-        passed there (s); out to its wake's reach, at most 32 pieces a vessel; none for a vessel at rest."""
+        passed there (s); out to its wake's reach, at most 32 pieces a vessel; a vessel at rest at a stop route's
+        end keeps those it had on arriving, each older by the time since."""
     def poses_at_times(self, times: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
         """(T, V, 6) float64 poses at each time (seconds), at most 2**26 poses (T·V) a call; GIL released."""
 

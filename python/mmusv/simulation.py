@@ -334,16 +334,18 @@ class Simulation:
 
     def wakes(self, state: WorldState) -> np.ndarray:
         """``(K, 9)`` float32 rows ``x, y, heading, speed, length, beam, reach_m, age_s, displacement_m3`` (world
-        metres, radians, m/s, s, m³) of the scenario vessels under way (horizontal speed above 0.3 m/s) in ``state``:
-        the wakes the cameras draw and the LiDARs see. A wake follows its vessel's path round the bends, as straight
-        pieces, newest first. The first row is the vessel itself (its pose), its foam drawn straight back from the stern
-        along its heading for ``reach_m`` metres (until its path leaves that line by half a beam; ``inf``: as far as the
-        foam lasts). Each further row of the same vessel is a piece of the path from there: its stern on the path where
-        the piece starts (the row's ``x, y`` half a length ahead of it, ``heading`` along the piece's chord to the next
-        one's start), ``reach_m`` the chord's length, ``age_s`` how long ago the vessel's stern passed the piece's start
-        (at least 1 ms: a row older than 0 is a piece further back). A vessel's rows come together, newest first: the
-        core bends the Kelvin arms along them. No foam where the vessel never went, nor under its hull; its older foam
-        and arms round the bends too. ``displacement_m3`` (the hull's ``Cb·L·B·T``,
+        metres, radians, m/s, s, m³) of the scenario vessels under way (horizontal speed above 0.3 m/s) in ``state``,
+        and of those lying at rest at a ``stop`` route's end whose foam has not yet faded (their speed under way, every
+        row as old as it was on arrival plus the time since): the wakes the cameras draw and the LiDARs see. A wake
+        follows its vessel's path round the bends, as straight pieces, newest first. The first row is the vessel itself
+        (its pose), its foam drawn straight back from the stern along its heading for ``reach_m`` metres (until its path
+        leaves that line by half a beam; ``inf``: as far as the foam lasts). Each further row of the same vessel is a
+        piece of the path from there: its stern on the path where the piece starts (the row's ``x, y`` half a length
+        ahead of it, ``heading`` along the piece's chord to the next one's start), ``reach_m`` the chord's length,
+        ``age_s`` how long ago the vessel's stern passed the piece's start (at least 1 ms: a row older than 0 is a piece
+        further back). A vessel's rows come together, newest first: the core bends the Kelvin arms along them. No foam
+        where the vessel never went, nor under its hull; its older foam and arms round the bends too (a vessel at rest
+        draws no arms: its Kelvin waves have run off). ``displacement_m3`` (the hull's ``Cb·L·B·T``,
         :func:`~mmusv.world.hydrostatics.hull_particulars`) sets the Kelvin waves the cameras draw behind it."""
         _check_state(state)
         n = len(self.scenario.vessels)
@@ -352,29 +354,34 @@ class Simulation:
         rows = []
         for i in range(n):
             vx, vy = float(state.velocities[i, 0]), float(state.velocities[i, 1])
-            speed = math.hypot(vx, vy)
             mine = pieces[pieces[:, 0] == i]
+            # At rest at a ``stop`` route's end, its foam (the core's pieces as it arrived, aged since) is that of
+            # its speed under way.
+            rest = float(mine[0, 5]) if len(mine) else 0.0
+            speed = math.hypot(vx, vy) or float(self.scenario.vessels[i].speed_mps)
             if speed <= 0.3 or len(mine) == 0:
                 continue
             length, beam = float(self.vessels[i].box_size[0]), float(beams[i])
             volume = self._displacements[i]
             half = 0.5 * length
             # The vessel's own piece where it is now (its pose), its foam from the stern back to where its path left
-            # the line (the core's reach runs from the vessel's centre).
+            # the line (the core's reach runs from the vessel's centre); at rest, as old as its stop (at least a
+            # millisecond: the core draws no Kelvin arms or waves of a row older than 0).
             x, y, yaw = (float(state.poses[i, k]) for k in (0, 1, 5))
-            rows.append((x, y, yaw, speed, length, beam, max(float(mine[0, 4]) - half, 0.0), 0.0, volume))
+            own_age = max(rest, 1e-3) if rest > 0.0 else 0.0
+            rows.append((x, y, yaw, speed, length, beam, max(float(mine[0, 4]) - half, 0.0), own_age, volume))
             # The older pieces: each row's stern on the path where the piece starts (the row's "vessel" half a length
             # ahead of it along the piece), its foam as old as the time since the stern passed there; a piece the
             # stern has not yet passed all of starts where it is.
             for _, px, py, heading, reach, age in mine[1:]:
                 c, s = math.cos(heading), math.sin(heading)
-                lag = age * speed - half  # how far the stern is past the piece's start, along the path
+                lag = (age - rest) * speed - half  # how far the stern is past the piece's start, along the path
                 cut = max(-lag, 0.0)
                 if reach <= cut:
                     continue
                 px, py, reach = px - cut * c, py - cut * s, reach - cut
                 # (At least a millisecond old: a row older than 0 is a piece further back, its arms bent by the core.)
-                old = max(lag / speed, 1e-3)
+                old = max(rest + lag / speed, 1e-3)
                 rows.append((px + half * c, py + half * s, heading, speed, length, beam, reach, old, volume))
         return np.asarray(rows, dtype=np.float32).reshape(-1, 9)
 

@@ -43,7 +43,10 @@ impl VesselMotion {
     /// before (the vessel's centre there, and how long ago it passed there, `age_s`) and runs along the chord to
     /// the next one's start (`heading` the direction of travel, `reach_m` the chord's length), until `max_m` of
     /// path or `max_pieces` pieces; the last reaches on straight along the vessel's heading there (`reach_m`
-    /// infinite). Empty at rest.
+    /// infinite). A vessel at rest at the end of a `stop` route keeps the pieces it had when it arrived there, each
+    /// as much older as it has lain at rest (`age_s` counts from then: the foam it left outlasts its stop and fades
+    /// with its age), out to `max_m` of path at its speed (none once that is all older than `max_m / speed`); none
+    /// for a vessel of zero speed.
     pub fn wake_pieces(
         &self,
         t: f64,
@@ -56,11 +59,18 @@ impl VesselMotion {
         check_distances(max_m, step_m, tolerance_m)?;
         let speed = self.params.speed_mps;
         let mut d = self.travelled_m(t);
-        if self.route_heading(d).2 == 0.0 || speed == 0.0 {
+        if speed == 0.0 {
             return Ok(Vec::new());
         }
+        // At rest at a `stop` route's end: the path as it was on arrival, the time since then added to every age.
+        let mut rest_s = 0.0;
+        if self.route.distance_to_arc(d).1 == 0.0 {
+            let end = self.route.length();
+            rest_s = (d - end) / speed;
+            d = end;
+        }
         let mut pieces = Vec::new();
-        let mut back = 0.0;
+        let mut back = rest_s * speed;
         while back < max_m && pieces.len() < max_pieces {
             let (p, u, _) = self.route_heading(d);
             let (mut reach, path) = self.straight_run(d, max_m - back, step_m, tolerance_m);
@@ -90,13 +100,15 @@ impl VesselMotion {
         Ok(pieces)
     }
 
-    /// Position, unit heading (the direction of travel) and direction sign (0 at rest) at travelled distance `d`;
-    /// before the start (`d` below the start offset) on the straight line the vessel is taken to have come along.
+    /// Position, unit heading (the direction of travel; at rest at a `stop` route's end, the one it arrived
+    /// with) and direction sign (0 at rest) at travelled distance `d`; before the start (`d` below the start
+    /// offset) on the straight line the vessel is taken to have come along.
     fn route_heading(&self, d: f64) -> ([f64; 2], [f64; 2], f64) {
         let at = |d: f64| {
             let (s, sign) = self.route.distance_to_arc(d);
             let [tx, ty] = self.route.tangent(s);
-            (self.route.position(s), [tx * sign, ty * sign], sign)
+            let u = if sign == 0.0 { 1.0 } else { sign };
+            (self.route.position(s), [tx * u, ty * u], sign)
         };
         let d_start = self.params.start_offset_m;
         if d >= d_start {
@@ -125,6 +137,10 @@ impl VesselMotion {
             }
             reach = along;
             path = back;
+            if back + 1e-6 >= max_m {
+                // (Within a micrometre of `max_m`: a quotient rounded up may ask for a last step of next to nothing.)
+                break;
+            }
         }
         (f64::INFINITY, path)
     }
@@ -159,7 +175,8 @@ mod tests {
         let line = straight_test_vessel(&[[0.0, 0.0], [1000.0, 0.0]], EndBehaviour::Stop, 5.0);
         assert_eq!(own(&line, 10.0, 2.0, 1.0), Some(f64::INFINITY));
         assert_eq!(own(&line, 0.0, 2.0, 1.0), Some(f64::INFINITY));
-        assert_eq!(own(&line, 300.0, 2.0, 1.0), None, "at rest at the end");
+        assert_eq!(own(&line, 210.0, 2.0, 1.0), Some(f64::INFINITY), "at rest for 10 s: its wake as it arrived");
+        assert_eq!(own(&line, 330.0, 2.0, 1.0), None, "at rest for 130 s: the 600 m asked for all older");
         // Ping-pong on a 100 m leg at 5 m/s: at t = 24 s it turned 20 m ago (d = 120 m).
         let pp = straight_test_vessel(&[[0.0, 0.0], [100.0, 0.0]], EndBehaviour::PingPong, 5.0);
         let b = own(&pp, 24.0, 1.0, 1.0).unwrap_or(f64::NAN);
@@ -249,7 +266,26 @@ mod tests {
         let few = ok(circle.wake_pieces(60.0, 300.0, 0.5, 2.0, 3));
         assert_eq!(few.len(), 3);
         assert!(few[2].reach_m.is_infinite() && few[1].reach_m.is_finite());
-        assert!(ok(el.wake_pieces(1000.0, 600.0, 1.0, 2.0, 32)).is_empty(), "at rest at the end");
+        // At rest at the end (there at `t_end`, its route's length at 5 m/s): the pieces it had on arriving, each as
+        // much older as it has lain there, until the oldest is older than the reach asked.
+        let t_end = (el.route.length() - el.params.start_offset_m) / speed;
+        let arrived = ok(el.wake_pieces(t_end, 600.0, 1.0, tol, 32));
+        for later in [t_end + 0.5, t_end + 30.0] {
+            let rest = ok(el.wake_pieces(later, 600.0, 1.0, tol, 32));
+            assert!(!rest.is_empty() && rest.len() <= arrived.len(), "{rest:?}");
+            // (The last one reaches on straight, from wherever the reach asked ends.)
+            for (a, b) in arrived.iter().zip(&rest[..rest.len() - 1]) {
+                assert!((b.age_s - a.age_s - (later - t_end)).abs() < 1e-9, "{a:?} {b:?}");
+                assert!((a.x - b.x).hypot(a.y - b.y) < 1e-9 && (a.heading - b.heading).abs() < 1e-9, "{a:?} {b:?}");
+            }
+            // Covered back to where the path was `max_m` at arrival, less what has aged out.
+            let back = rest[rest.len() - 1].age_s * speed;
+            assert!(back <= 600.0 && (rest[0].age_s - (later - t_end)).abs() < 1e-9, "{rest:?}");
+        }
+        let at_end = el.route.position(el.route.length());
+        assert!((arrived[0].x - at_end[0]).hypot(arrived[0].y - at_end[1]) < 1e-9, "{arrived:?}");
+        assert!((arrived[0].heading - PI / 2.0).abs() < 0.05 && arrived[0].age_s == 0.0, "{arrived:?}");
+        assert!(ok(el.wake_pieces(1000.0, 600.0, 1.0, 2.0, 32)).is_empty(), "at rest for 900 s: 4,500 m of path ago");
         assert!(el.wake_pieces(1.0, 600.0, 0.0, 2.0, 32).is_err());
     }
 }

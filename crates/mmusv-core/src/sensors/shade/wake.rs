@@ -10,7 +10,9 @@
 //! age makes it and ends where the next piece goes on (reaching past its end by the track's half-width, to fill
 //! the bend's outer corner). A wake row without a piece after it whose path bent (`reach_m` short of the foam's own
 //! reach) thins to nothing over the last quarter of that stretch (at most four beams). No foam where the vessel
-//! never went. The foam is broken up by the same noise as the whitecaps (`foam.rs`).
+//! never went. A vessel that has come to rest at its route's end leaves its foam as it lay when it stopped, aging
+//! (every row older by the time since; no Kelvin arms: its waves have run off with their group speed). The foam is
+//! broken up by the same noise as the whitecaps (`foam.rs`).
 //!
 //! Only the Kelvin angle is a published law. The foam is the project's own calibration, not a published model: no
 //! published law for a wake's foam density against speed, its fade time or its track's widening was found
