@@ -155,6 +155,7 @@ def run(
     frame_range: tuple[int, int] | None = None,
     profile: bool = False,
     notes: list[str] | None = None,
+    check_frames: int | None = None,
 ) -> RunResult:
     """Runs a scenario (a YAML path, a dict or a :class:`~mmusv.config.Scenario`) into ``out_dir``.
 
@@ -173,6 +174,10 @@ def run(
         profile: time every stage (each sensor, annotation, encoding, writing, the rest) into
             ``RunResult.profile`` (:class:`~mmusv.profiling.RunProfile`); the output bytes are the same.
         notes: lines for the user are appended here (an interrupted run found and recorded again).
+        check_frames: the route checks cover acquisition indices ``0 .. check_frames - 1``, a whole number from the
+            last index this run records + 1 to ``acquisition.frames`` (default: up to the last index it records). The
+            parts of a split batch (:mod:`mmusv.batch`) pass the whole run's, so that every part finds and says what
+            the whole run would (the batch reports a scenario's warnings once).
 
     The folder is locked while the run writes it (:class:`~mmusv.recording.guard.FolderLock`): a second run into
     the same folder fails at once. A ``.partial`` recording left by a killed run is recorded again from scratch
@@ -232,6 +237,14 @@ def run(
                 f"{scenario.acquisition.frames}, the acquisition.frames of {source}"
             )
         frame_range = span
+    checked = total
+    if check_frames is not None:
+        checked = arguments.whole(check_frames, name="check_frames")
+        if not total <= checked <= scenario.acquisition.frames:
+            raise ConfigError(
+                f"check_frames = {check_frames}: must be in {total}..{scenario.acquisition.frames} (from the frames "
+                f"this run records to the acquisition.frames of {source})"
+            )
     rec_path = recording_path(out, scenario)
     refuse_wrong_kinds(out, rec_path)
     refuse_earlier_run(out, rec_path, overwrite=overwrite)
@@ -244,8 +257,9 @@ def run(
     if checks:
         check_mounts(scenario, source=source)
         check_lidar_water(scenario, source=source)
-        # The routes as far as this run sails them: frames 0 .. total - 1 (the stop of a frame range).
-        upto = scenario.acquisition.model_copy(update={"frames": total})
+        # The routes as far as this run sails them, frames 0 .. total - 1 (the stop of a frame range), or as far as
+        # the whole run a part belongs to (check_frames).
+        upto = scenario.acquisition.model_copy(update={"frames": checked})
         check_routes(scenario.model_copy(update={"acquisition": upto}), sim.world, source=source)
         check_top_view_land(sim, range(first, total), source=source)
     # The first frame is captured before anything is written or replaced: whatever a sensor refuses only when it

@@ -61,6 +61,8 @@ class Task:
     checks: bool
     state_file: str
     run_id: str
+    #: The frames the route checks cover (a part of a split run: the whole run's, so each part warns as it would).
+    check_frames: int | None = None
 
     @property
     def first_frame(self) -> int:
@@ -431,6 +433,7 @@ def _task(
         checks=checks,
         state_file=str(out / STATE_DIR / f"{key}.task"),
         run_id=run_id,
+        check_frames=None if frame_range is None else plan.frames,
     )
 
 

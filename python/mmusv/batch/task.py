@@ -132,6 +132,7 @@ def execute(task: Task) -> TaskResult:
                     frame_range=task.frame_range,
                     checks=task.checks,
                     notes=notes,
+                    check_frames=task.check_frames,
                 )
             res.warnings = sorted({str(w.message) for w in caught} | set(notes))
             res.frames, res.bytes = out.frames_written, out.bytes
