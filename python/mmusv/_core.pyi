@@ -585,7 +585,7 @@ class Fleet:
         as straight pieces, newest first: where each starts (metres, radians), how far back from there the path ran
         straight within ``tolerances_m`` (V,) of that line (inf: on to the wake's end), how long ago the vessel
         passed there (s); out to its wake's reach, at most 32 pieces a vessel; a vessel at rest at a stop route's
-        end keeps those it had on arriving, each older by the time since."""
+        end keeps those it had on arriving, each older by the time since (none if parked there from the start)."""
     def poses_at_times(self, times: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
         """(T, V, 6) float64 poses at each time (seconds), at most 2**26 poses (T·V) a call; GIL released."""
 

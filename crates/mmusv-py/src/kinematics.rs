@@ -158,7 +158,8 @@ impl Fleet {
     /// within `tolerances_m` (V,) metres of that line (checked every 2 m; inf: on to the wake's end), and how long
     /// ago the vessel passed there (s); out to its wake's reach (`speed · WAKE_REACH_S` of path), at most
     /// `WAKE_MAX_PIECES` pieces a vessel. A vessel at rest at a `stop` route's end keeps the pieces it had on
-    /// arriving, each as much older as it has lain there (its first row's `age_s`); none for a speed of 0.
+    /// arriving, each as much older as it has lain there (its first row's `age_s`); none for a speed of 0 or one
+    /// parked there from the start.
     fn wake_pieces<'py>(
         &self,
         py: Python<'py>,

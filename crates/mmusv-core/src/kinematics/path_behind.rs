@@ -46,7 +46,7 @@ impl VesselMotion {
     /// infinite). A vessel at rest at the end of a `stop` route keeps the pieces it had when it arrived there, each
     /// as much older as it has lain at rest (`age_s` counts from then: the foam it left outlasts its stop and fades
     /// with its age), out to `max_m` of path at its speed (none once that is all older than `max_m / speed`); none
-    /// for a vessel of zero speed.
+    /// for a vessel of zero speed or one at rest from the start (a `start_offset_m` at or past its route's end).
     pub fn wake_pieces(
         &self,
         t: f64,
@@ -66,6 +66,10 @@ impl VesselMotion {
         let mut rest_s = 0.0;
         if self.route.distance_to_arc(d).1 == 0.0 {
             let end = self.route.length();
+            if self.params.start_offset_m >= end {
+                // At rest from the start (parked at its route's end): no wake of its own.
+                return Ok(Vec::new());
+            }
             rest_s = (d - end) / speed;
             d = end;
         }
@@ -286,6 +290,14 @@ mod tests {
         assert!((arrived[0].x - at_end[0]).hypot(arrived[0].y - at_end[1]) < 1e-9, "{arrived:?}");
         assert!((arrived[0].heading - PI / 2.0).abs() < 0.05 && arrived[0].age_s == 0.0, "{arrived:?}");
         assert!(ok(el.wake_pieces(1000.0, 600.0, 1.0, 2.0, 32)).is_empty(), "at rest for 900 s: 4,500 m of path ago");
+        // Parked at its route's end from the start: no wake at any time.
+        let mut parked = straight_test_vessel(&[[0.0, 0.0], [100.0, 0.0]], EndBehaviour::Stop, 5.0);
+        for offset in [parked.route.length(), 150.0] {
+            parked.params.start_offset_m = offset;
+            for t in [0.0, 1.0, 30.0] {
+                assert!(ok(parked.wake_pieces(t, 600.0, 1.0, 2.0, 32)).is_empty(), "{offset} {t}");
+            }
+        }
         assert!(el.wake_pieces(1.0, 600.0, 0.0, 2.0, 32).is_err());
     }
 }
