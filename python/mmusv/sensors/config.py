@@ -409,8 +409,9 @@ class ExposureConfig(_Model):
 
 class CameraConfig(_Model):
     """A pinhole camera: ``resolution`` ``[width, height]`` pixels, horizontal field of view ``hfov_deg`` (<
-    180), the images to produce, and its mount (optical axis = the mount's x axis; without one, the asset's
-    mount point ``camera_<name>``, else its ``camera_front``: :func:`mmusv.sensors.mounts.camera_mount`).
+    180), the images to produce, and its mount (optical axis = the mount's x axis; without one, or with the
+    default one, the asset's mount point ``camera_<name>``, else its ``camera_front``:
+    :func:`mmusv.sensors.mounts.camera_mount`).
     ``quality`` (:data:`Quality`) sets the RGB's anti-aliasing and reflections; ``distortion`` is
     Brown–Conrady ``[k1, k2, p1, p2, k3]`` in OpenCV's order (none by default); ``noise`` adds seeded shot and
     read noise (none by default); ``exposure`` (:class:`ExposureConfig`) is automatic unless fixed. Depth,

@@ -33,8 +33,13 @@ def camera_mount(asset: VesselAsset, camera: CameraConfig) -> Mount:
     after it (``camera_<name>``: a camera ``left`` sits on ``camera_left``, looking left), else its ``camera_front``,
     else the top of the hull turned as the name says (:func:`mount_matrix`'s fall-back for ``camera_<name>``). Before,
     a camera without a mount sat at the vessel origin, midship at the waterline: under the crests at W3, it labelled
-    the water above it sky and saw no vessel."""
-    if "mount" in camera.model_fields_set:
+    the water above it sky and saw no vessel.
+
+    A mount equal to the default (no point, no offset, no turn) counts as none: a scenario written out in full (the
+    run's resolved ``scenario.yaml``, the recording's ``scenario`` metadata) gives every camera's mount so, and read
+    back it put the camera at the vessel origin, where the run that wrote it had it on its mount point (with the
+    same config hash)."""
+    if "mount" in camera.model_fields_set and camera.mount.model_dump() != Mount().model_dump():
         return camera.mount
     own = f"camera_{camera.name}"
     return Mount(point="camera_front" if own not in asset.mounts and "camera_front" in asset.mounts else own)
