@@ -9,6 +9,10 @@ Found (each test below failed before its fix, or is a strict xfail where the fix
   offsets), and that file read back put the camera at the vessel origin, midship at the waterline: ``mmusv run
   out/scenario.yaml`` recorded a WAM-V's ``left`` camera at z = 0 m instead of 1.75 m, with the same
   ``config_hash`` (:func:`test_a_run_of_the_resolved_scenario_puts_its_cameras_where_the_run_did`).
+* ``under_keel`` (d5d5ae8, 64e312c) took the depth under the hull's centre alone: a 330 m VLCC stopping with its
+  centre over 25 m of water and its bow over 14-15 m (draft 22.5 m) on the island map went unwarned; the keel is now
+  checked along 0.45 of the hull's length fore and aft
+  (:func:`test_a_deep_draft_ship_whose_bow_runs_over_shallows_is_warned_about`).
 """
 
 from __future__ import annotations
@@ -53,3 +57,34 @@ def test_a_run_of_the_resolved_scenario_puts_its_cameras_where_the_run_did(tmp_p
     for key in ("camera/left", "camera/mast"):
         np.testing.assert_array_equal(again[key], first[key], err_msg=key)
     assert scenario_hash(load_scenario(written)) == scenario_hash(load_scenario(_camera_scenario()))
+
+
+def test_a_deep_draft_ship_whose_bow_runs_over_shallows_is_warned_about() -> None:
+    """``under_keel`` took the depth under the hull's centre alone: on the island map (seed 0) a 330 m VLCC (draft
+    22.5 m) stopping with its centre over the open water's 25 m and its bow over the island's slope (14-15 m deep,
+    150 m ahead) was not warned about, nor by any other check (the bow is on navigable water). The keel is now
+    checked along the hull; a 16 m pilot boat there is not warned about."""
+    import warnings
+
+    from mmusv.config import load_scenario
+    from mmusv.scenario_checks import check_routes
+    from mmusv.simulation import Simulation
+
+    def vessel(vid: str, asset: str, y: float) -> dict[str, Any]:
+        return {"id": vid, "asset": asset, "speed_mps": 2, "route": [[230, y], [240, y]]}
+
+    sc = {
+        "seed": 1,
+        "map": {"type": "island", "seed": 0},
+        "acquisition": {"frequency_hz": 1, "frames": 3},
+        "vessels": [vessel("big", "vlcc_tanker_330m", 0.0), vessel("small", "pilot_boat_16m", 80.0)],
+    }
+    sim = Simulation(sc)
+    centre_depth = -sim.world.heightfield.sample(np.array([[230.0, 0.0], [234.0, 0.0]]))
+    assert np.all(centre_depth > 22.5)  # the centre alone is over deep enough water
+    with warnings.catch_warnings(record=True):
+        warnings.simplefilter("always")
+        said = [w for w in check_routes(load_scenario(sc), sim.world, source="s.yaml") if ": under_keel: " in w]
+    assert len(said) == 1, said
+    assert said[0].startswith("s.yaml: under_keel: vessels[0] big (vlcc_tanker_330m, draft 22.5 m) sails over ")
+    assert "m ahead of its centre" in said[0]

@@ -464,11 +464,22 @@ def _no_sensor(rig: RigConfig) -> bool:
     return rig.lidar is None and rig.radar is None and rig.top_view is None and not rig.cameras
 
 
+KEEL_SPAN = 0.45
+"""The keel's reach fore and aft of a hull's centre, as a share of its length (:func:`keel_findings`): a ship's flat
+bottom runs most of its length, its draft all along it."""
+
+KEEL_STEP_M = 10.0
+"""The most metres between two points of a keel :func:`keel_findings` checks."""
+
+
 def keel_findings(scenario: Scenario, world: MapWorld, samples: Samples) -> list[Finding]:
     """``under_keel``: every vessel of ``scenario`` whose draft (its hull particulars,
-    :func:`mmusv.world.hydrostatics.hull_particulars`) reaches the seabed under its centre at some acquisition frame
+    :func:`mmusv.world.hydrostatics.hull_particulars`) reaches the seabed under its keel at some acquisition frame
     of ``samples`` (``Samples.frames``), the depth the map's heightfield's (the still water's; the sea floor of open
-    water is 25 m down). One finding per vessel, at its shallowest frame. The sensors do not see the floor (the
+    water is 25 m down). The keel is the hull's centre line, :data:`KEEL_SPAN` of its length fore and aft of its
+    centre, at the frame's heading, checked every :data:`KEEL_STEP_M` at most (the centre alone let a 330 m tanker
+    stop with its centre over 25 m of water and its bow over 14 m, its draft 22.5 m, without a word). One finding
+    per vessel, where it is shallowest (its first frame so, the centre first). The sensors do not see the floor (the
     terrain is drawn to 2 m below the surface), but the hull stands on it; a vessel off the map is ``in_water``'s."""
     from mmusv.generate.checks import Finding
     from mmusv.world.hydrostatics import hull_particulars
@@ -477,18 +488,27 @@ def keel_findings(scenario: Scenario, world: MapWorld, samples: Samples) -> list
     port = " (a port's water is map.params.basin_depth_m deep, 14 m by default)" if world.kind == "port" else ""
     found: list[Finding] = []
     for v in scenario.vessels:
-        draft = hull_particulars(get_asset(v.asset))[2]
-        xy = samples.frames[:, samples.index(v.id)]
-        depth = -world.heightfield.sample(xy)
+        length, _, draft, _, _ = hull_particulars(get_asset(v.asset))
+        i = samples.index(v.id)
+        xy, yaw = samples.frames[:, i], samples.frames_yaw[:, i]
+        reach = KEEL_SPAN * length
+        n = math.ceil(reach / KEEL_STEP_M)
+        ahead = np.linspace(0.0, reach, n + 1)[1:] if n > 0 else np.zeros(0)
+        offsets = np.concatenate([[0.0], ahead, -ahead])  # the centre first: it is named on a tie
+        heading = np.stack([np.cos(yaw), np.sin(yaw)], axis=-1)
+        points = xy[:, None, :] + offsets[None, :, None] * heading[:, None, :]  # (frames, points, 2)
+        depth = -world.heightfield.sample(points.reshape(-1, 2)).reshape(points.shape[:2])
         if not np.isfinite(depth).any():
             continue
-        k = int(np.nanargmin(depth))
-        if depth[k] < draft:
-            x, y = (float(c) for c in xy[k])
+        k, j = np.unravel_index(int(np.nanargmin(depth)), depth.shape)
+        if depth[k, j] < draft:
+            x, y = (float(c) for c in points[k, j])
+            off = float(offsets[j])
+            where = "" if off == 0.0 else f" {abs(off):.0f} m {'ahead of' if off > 0 else 'astern of'} its centre"
             found.append(
                 Finding(
-                    f"{v.id} ({v.asset}, draft {draft:.1f} m) sails over {max(depth[k], 0.0):.1f} m of water at "
-                    f"({x:.0f}, {y:.0f}) m in frame {k}: its keel is in the seabed; route it over deeper "
+                    f"{v.id} ({v.asset}, draft {draft:.1f} m) sails over {max(depth[k, j], 0.0):.1f} m of water at "
+                    f"({x:.0f}, {y:.0f}) m in frame {k}: its keel is in the seabed{where}; route it over deeper "
                     f"water{port}, or give it a smaller asset",
                     (v.id,),
                     (x, y),

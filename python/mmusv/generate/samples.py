@@ -77,6 +77,8 @@ class Samples:
     motion_slack: np.ndarray
     motion_turn: np.ndarray
     frames: np.ndarray
+    frames_yaw: np.ndarray
+    """``(frames, vessels)`` the vessels' headings (rad) at the acquisition frames, beside :attr:`frames`."""
     sensor_height: float
     sensor_range: float
     derived: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
@@ -243,6 +245,7 @@ def take_samples(scenario: Scenario, meta: CandidateMeta, ctx: MapContext, spec:
         motion_slack=speeds * (t_last / (n_t - 1)) / 2.0,
         motion_turn=half * _half_turn(motion_yaw),
         frames=frames,
+        frames_yaw=poses[n_t:, :, 5],
         sensor_height=spec.sensor_height_m,
         sensor_range=spec.constraints.sensing_range.range_m,
     )
