@@ -16,6 +16,10 @@ Found (each test below failed before its fix, or is a strict xfail where the fix
 * Not of the last session, found checking its transients: the physical heave, roll and pitch still jump in a bend
   (the steady state at the instant's heading): a 22 m hovercraft at 10 m/s heaves at 320 m/s round a 90 degree bend at
   W1 (0.49 m/s on the straight legs); a strict xfail, a Rust change (:func:`test_the_heave_does_not_jump_in_a_bend`).
+* ``mmusv generate`` writes scenarios that ``mmusv run`` then warns are aground (``under_keel`` is no generator
+  constraint): the ``port_entry`` family with a ``large`` target on the default port (basin 14 m) in 6 of 12 seeds,
+  the bundled coop_detection specs 4 of 254 scenarios at seeds 0 and 1; a strict xfail, a new spec constraint being
+  the maintainers' call (:func:`test_the_generator_writes_no_scenario_that_mmusv_run_warns_is_aground`).
 """
 
 from __future__ import annotations
@@ -117,3 +121,41 @@ def test_the_heave_does_not_jump_in_a_bend() -> None:
     turning = np.abs(np.diff(np.unwrap(p[:, 5]))) / dt > 1e-3
     assert turning.any() and (~turning).any()
     assert rate[turning].max() < 5.0 * rate[~turning].max()
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="mmusv generate has no under_keel constraint (scenario_checks.keel_findings is mmusv run's warning and "
+    "the editor's finding only): rejecting such candidates is a new spec constraint (the spec schema, every spec's "
+    "dataset hash and report.json change), left to the maintainers",
+)
+def test_the_generator_writes_no_scenario_that_mmusv_run_warns_is_aground(tmp_path: Path) -> None:
+    """``mmusv run`` warns ``under_keel`` of a scenario ``mmusv generate`` wrote and accepted: on the default port
+    (its basin 14 m deep) the ``port_entry`` family with a ``large`` target drew a 300 m container ship (draft 14.5 m)
+    or a 290 m bulk carrier (18.2 m) into the basin in 6 of 12 seeds (4 scenarios each); the bundled coop_detection
+    specs at seeds 0 and 1 wrote 4 such scenarios of 254 (a 330 m VLCC, draft 22.5 m, in the 14 m basin)."""
+    from mmusv.config import load_scenario
+    from mmusv.generate.mapctx import MapContext
+    from mmusv.generate.runner import generate
+    from mmusv.scenario_checks import keel_findings, scenario_samples
+    from mmusv.world.maps import generate_map_from
+
+    spec = {
+        "name": "k",
+        "seed": 0,
+        "map": {"type": "port", "seed": 3},
+        "acquisition": {"frequency_hz": 1, "frames": 5},
+        "combinations": [{"family": "port_entry", "difficulty": "easy", "targets": ["large"], "quota": 4}],
+    }
+    generate(spec, tmp_path)
+    files = sorted(tmp_path.glob("*.yaml"))
+    assert files
+    world = None
+    aground = []
+    for p in files:
+        sc = load_scenario(p)
+        if world is None:
+            world = generate_map_from(sc.map.params, seed=sc.map.seed)
+            ctx = MapContext(world)
+        aground += [f.message for f in keel_findings(sc, world, scenario_samples(sc, ctx))]
+    assert aground == []
