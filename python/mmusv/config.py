@@ -150,9 +150,9 @@ class SeaConfig(_Model):
     for Tp/√Hs); plus the waves' travel direction ``direction_deg`` (counter-clockwise from east, towards) and the
     cos-2s spreading ``spread_s`` (10: a wind sea; larger is longer-crested); and ``wind_10m_mps``, the wind at 10 m
     (m/s) the sensors take for the whitecaps (Monahan), the water's slopes and glint (Cox–Munk), the LiDAR's water
-    returns and foam (default: the wind of a fully developed sea of this Hs, :func:`mmusv.sensors.env.
-    wind_from_wave_height`; a swell, long Tp under a light wind, wants a smaller one). The waves themselves, and so
-    the hulls' motion and the wave surface every ray meets, come from the spectrum alone."""
+    returns and foam (default: the wind of a fully developed sea of this Hs,
+    :func:`mmusv.sensors.env.wind_from_wave_height`; a swell, long Tp under a light wind, wants a smaller one). The
+    waves themselves, and so the hulls' motion and the wave surface every ray meets, come from the spectrum alone."""
 
     state: int | None = Field(default=None, ge=0, le=9)
     hs_m: float | None = Field(default=None, ge=0, le=MAX_WAVE_HEIGHT_M)
