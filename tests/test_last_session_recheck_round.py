@@ -9,6 +9,10 @@ Found (each test below failed before its fix, or is a strict xfail where the fix
   offsets), and that file read back put the camera at the vessel origin, midship at the waterline: ``mmusv run
   out/scenario.yaml`` recorded a WAM-V's ``left`` camera at z = 0 m instead of 1.75 m, with the same
   ``config_hash`` (:func:`test_a_run_of_the_resolved_scenario_puts_its_cameras_where_the_run_did`).
+* On an asset that gives ``camera_front`` but not ``camera_rear``, ``camera_left`` or ``camera_right`` (a user's
+  own), a surround rig's ``rear``, ``left`` and ``right`` cameras given no mount all sat on ``camera_front`` looking
+  ahead, four copies of one view; they now take the hull's top turned as their names say, as on an asset without
+  mount points (:func:`test_a_rear_camera_on_an_asset_with_a_front_mount_alone_looks_aft`).
 * ``under_keel`` (d5d5ae8, 64e312c) took the depth under the hull's centre alone: a 330 m VLCC stopping with its
   centre over 25 m of water and its bow over 14-15 m (draft 22.5 m) on the island map went unwarned; the keel is now
   checked along 0.45 of the hull's length fore and aft
@@ -159,3 +163,32 @@ def test_the_generator_writes_no_scenario_that_mmusv_run_warns_is_aground(tmp_pa
             ctx = MapContext(world)
         aground += [f.message for f in keel_findings(sc, world, scenario_samples(sc, ctx))]
     assert aground == []
+
+
+def test_a_rear_camera_on_an_asset_with_a_front_mount_alone_looks_aft() -> None:
+    """A camera given no mount on an asset without its ``camera_<name>`` point went to ``camera_front`` whatever its
+    name (9ab784d): on a user's asset that gives ``camera_front`` alone, a surround rig's ``rear``, ``left`` and
+    ``right`` cameras all looked ahead from the bow, four copies of one view (their optical axes (1, 0, 0) each),
+    while on an asset with no mount point at all they look the way their names say. They now take the hull's top
+    turned as the name says there too; a camera of another name still takes ``camera_front``."""
+    import dataclasses
+
+    from mmusv.sensors.config import CameraConfig
+    from mmusv.sensors.mounts import camera_mount, mount_matrix
+    from mmusv.world.vessels import MountPoint, get_asset
+
+    boat = dataclasses.replace(
+        get_asset("speedboat_5m"), mounts={"camera_front": MountPoint((2.0, 0.0, 1.5), (0, 0, 0))}
+    )
+    axes = {}
+    for name in ("front", "rear", "left", "right", "mast"):
+        m = mount_matrix(boat, camera_mount(boat, CameraConfig(name=name)), where=name)
+        assert m[2, 3] > 0.0, name  # above the still water
+        axes[name] = np.round(m[:3, 0], 6).tolist()
+    assert axes == {
+        "front": [1.0, 0.0, 0.0],
+        "rear": [-1.0, 0.0, 0.0],
+        "left": [0.0, 1.0, 0.0],
+        "right": [0.0, -1.0, 0.0],
+        "mast": [1.0, 0.0, 0.0],
+    }

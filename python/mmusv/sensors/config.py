@@ -22,8 +22,8 @@ falls back to 0.5 m above the top of the hull's bounding box over the vessel ori
 (``camera_left`` +90° yaw, ``camera_rear`` 180°, ``camera_right`` −90°, any other name ahead); a point an asset
 with mount points lacks is refused. ``xyz`` is within ±100 km
 (:data:`MAX_MOUNT_OFFSET_M`) and ``rpy_deg`` within ±360 degrees. Without a ``mount``, the LiDAR sits on ``lidar``,
-the radar on ``radar`` and a camera on ``camera_<its name>``, else ``camera_front``, else that fall-back
-(:func:`mmusv.sensors.mounts.camera_mount`).
+the radar on ``radar`` and a camera on ``camera_<its name>``, else ``camera_front`` (a ``rear``, ``left`` or
+``right`` camera: that fall-back, turned its way), else that fall-back (:func:`mmusv.sensors.mounts.camera_mount`).
 """
 
 from __future__ import annotations
@@ -410,8 +410,8 @@ class ExposureConfig(_Model):
 class CameraConfig(_Model):
     """A pinhole camera: ``resolution`` ``[width, height]`` pixels, horizontal field of view ``hfov_deg`` (<
     180), the images to produce, and its mount (optical axis = the mount's x axis; without one, or with the
-    default one, the asset's mount point ``camera_<name>``, else its ``camera_front``:
-    :func:`mmusv.sensors.mounts.camera_mount`).
+    default one, the asset's mount point ``camera_<name>``, else its ``camera_front`` but for a ``rear``, ``left`` or
+    ``right`` camera: :func:`mmusv.sensors.mounts.camera_mount`).
     ``quality`` (:data:`Quality`) sets the RGB's anti-aliasing and reflections; ``distortion`` is
     Brown–Conrady ``[k1, k2, p1, p2, k3]`` in OpenCV's order (none by default); ``noise`` adds seeded shot and
     read noise (none by default); ``exposure`` (:class:`ExposureConfig`) is automatic unless fixed. Depth,

@@ -28,6 +28,11 @@ def rpy_matrix(xyz: tuple[float, float, float], rpy_deg: tuple[float, float, flo
     return pose_matrices(np.array([*xyz, r, p, y], dtype=np.float64))
 
 
+_TURNED = {"camera_left": 90.0, "camera_rear": 180.0, "camera_right": -90.0}
+"""The mount points named for a direction, and the yaw (degrees) of the hull-top fall-back of each
+(:func:`mount_matrix`)."""
+
+
 def camera_mount(asset: VesselAsset, camera: CameraConfig) -> Mount:
     """The mount of ``camera`` on ``asset``: its own, when its config gives one; else the asset's mount point named
     after it (``camera_<name>``: a camera ``left`` sits on ``camera_left``, looking left), else its ``camera_front``,
@@ -38,11 +43,17 @@ def camera_mount(asset: VesselAsset, camera: CameraConfig) -> Mount:
     A mount equal to the default (no point, no offset, no turn) counts as none: a scenario written out in full (the
     run's resolved ``scenario.yaml``, the recording's ``scenario`` metadata) gives every camera's mount so, and read
     back it put the camera at the vessel origin, where the run that wrote it had it on its mount point (with the
-    same config hash)."""
+    same config hash).
+
+    A camera named ``rear``, ``left`` or ``right`` whose point the asset lacks takes the hull's top turned as its name
+    says, not ``camera_front``: on an asset that gives ``camera_front`` alone (a user's own), a surround rig's four
+    cameras all looked ahead from the bow."""
     if "mount" in camera.model_fields_set and camera.mount.model_dump() != Mount().model_dump():
         return camera.mount
     own = f"camera_{camera.name}"
-    return Mount(point="camera_front" if own not in asset.mounts and "camera_front" in asset.mounts else own)
+    if own in asset.mounts or own in _TURNED or "camera_front" not in asset.mounts:
+        return Mount(point=own)
+    return Mount(point="camera_front")
 
 
 def mount_matrix(asset: VesselAsset, mount: Mount, *, where: str) -> np.ndarray:
@@ -55,7 +66,7 @@ def mount_matrix(asset: VesselAsset, mount: Mount, *, where: str) -> np.ndarray:
             base = rpy_matrix(mp.xyz, mp.rpy_deg)
         else:
             # Fall back to the top of the hull: above the deck, looking where the mount name says.
-            yaw = {"camera_left": 90.0, "camera_rear": 180.0, "camera_right": -90.0}.get(mount.point, 0.0)
+            yaw = _TURNED.get(mount.point, 0.0)
             top = float(asset.bbox[1, 2]) + 0.5
             base = rpy_matrix((0.0, 0.0, top), (0.0, 0.0, yaw))
     m: np.ndarray = base @ rpy_matrix(mount.xyz, mount.rpy_deg)
