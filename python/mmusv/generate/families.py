@@ -10,6 +10,13 @@ straight tracks with a small lateral bend (three-waypoint spline) unless the fam
 shared route with start offsets; ``port_entry``: a planned harbour approach). Templates check nothing; the named
 constraints of :mod:`mmusv.generate.checks` decide. A template that cannot place its vessels at all raises
 :class:`SamplingError`, counted as a rejection by ``sampling``.
+
+Speeds: every USV sails within the spec's ``usv.speed_mps`` (a template that wants its USVs slow, port_entry's
+waiting ego at 0.3-1 m/s, occluded_by_island's at 1.5 m/s at most, surround's group at 0.8 x a drawn speed, takes
+the part of that band inside the range, or its nearest bound). A target's speed is its size class's draw, except
+where the family ties it to others: convoy (one speed for the line and the ego, the slowest member's top speed at
+most), surround (the group's), overtaking (the ego's plus 1-3 m/s or minus 0.8-1.5 m/s), occluded_by_island's
+primary (4 m/s at most) and port_entry's (5 m/s at most), so these may leave the class's ``speed_mps``.
 """
 
 from __future__ import annotations
@@ -92,6 +99,14 @@ def _escorts(inp: FamilyInput, anchor: np.ndarray, vel: np.ndarray, t_at: float)
 
 def _range(inp: FamilyInput) -> float:
     return float(inp.rng.uniform(*inp.range_m))
+
+
+def _usv_band(inp: FamilyInput, lo: float, hi: float) -> tuple[float, float]:
+    """The speeds ``[lo, hi]`` a template wants for its USVs (slow to wait or to stay behind an island), moved
+    into the spec's ``usv.speed_mps``: the band's part inside it, or the spec's bound nearest the band. A template
+    never sails a USV outside the range the spec gives (port_entry's 0.3-1 m/s under ``speed_mps: [2, 3]``)."""
+    a, b = inp.usv_speed
+    return min(max(lo, a), b), min(max(hi, a), b)
 
 
 def _encounter(kind: str) -> Callable[[FamilyInput], Layout]:
@@ -182,7 +197,8 @@ def _convoy(inp: FamilyInput) -> Layout:
 def _surround(inp: FamilyInput) -> Layout:
     """The USVs ring the primary target (other role targets close by), all sailing with it."""
     rng, big_t = inp.rng, inp.duration
-    v = float(rng.uniform(*inp.usv_speed)) * 0.8 * heading(float(rng.uniform(0.0, 2.0 * math.pi)))
+    lo, hi = inp.usv_speed
+    v = float(rng.uniform(*_usv_band(inp, 0.8 * lo, 0.8 * hi))) * heading(float(rng.uniform(0.0, 2.0 * math.pi)))
     t_e = big_t / 2.0
     primary = inp.targets[0]
 
@@ -243,7 +259,8 @@ def _occluded(inp: FamilyInput) -> Layout:
     ego_at = occ.centre + (e1 + d_e) * heading(phi)
     tgt_at = occ.centre + (e2 + extra - d_e) * heading(behind)
     v_t = min(primary.speed, 4.0) * heading(behind + side * math.pi / 2.0)
-    v_e = min(inp.ego.speed, 1.5) * heading(phi + side * math.pi / 2.0)
+    slow = _usv_band(inp, 0.0, 1.5)[1]  # slowly along the island's flank: 1.5 m/s, or the spec's lowest speed
+    v_e = min(inp.ego.speed, slow) * heading(phi + side * math.pi / 2.0)
     tracks = [
         straight_track(inp.ego, at=ego_at, vel=v_e, t_at=t_e, duration=big_t, rng=rng),
         straight_track(primary, at=tgt_at, vel=v_t, t_at=t_e, duration=big_t, rng=rng),
@@ -257,7 +274,7 @@ def _occluded(inp: FamilyInput) -> Layout:
             if e is None:
                 return []
             at = occ.centre + (e + float(rng.uniform(20.0, 120.0))) * heading(ang)
-            v_c = min(coop.speed, 1.5) * heading(ang + side * math.pi / 2.0)
+            v_c = min(coop.speed, slow) * heading(ang + side * math.pi / 2.0)
             return [straight_track(coop, at=at, vel=v_c, t_at=t_e, duration=big_t, rng=rng)]
 
         placed = pick_best(inp, make_coop)
@@ -277,7 +294,8 @@ def _occluded(inp: FamilyInput) -> Layout:
 
 
 def _port_entry(inp: FamilyInput) -> Layout:
-    """Role targets enter the harbour on planned approaches; the ego waits off the primary's track."""
+    """Role targets enter the harbour on planned approaches; the ego waits off the primary's track (0.3-1 m/s, moved
+    into ``usv.speed_mps``)."""
     ctx, rng, big_t = inp.ctx, inp.rng, inp.duration
     try:
         planner = harbour_planner(ctx)
@@ -312,7 +330,7 @@ def _port_entry(inp: FamilyInput) -> Layout:
             break
     else:
         raise SamplingError("no open water for the ego beside the primary target's harbour approach")
-    v_e = float(rng.uniform(0.3, 1.0)) * heading(float(rng.uniform(0.0, 2.0 * math.pi)))
+    v_e = float(rng.uniform(*_usv_band(inp, 0.3, 1.0))) * heading(float(rng.uniform(0.0, 2.0 * math.pi)))
     tracks = [straight_track(inp.ego, at=at, vel=v_e, t_at=t_e, duration=big_t, rng=rng), *target_tracks]
     tracks += _escorts(inp, at, v_e, t_e)
     return Layout(tracks, [inp.targets[0].id], q)
