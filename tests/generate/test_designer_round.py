@@ -18,8 +18,10 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+import pytest
 import yaml
-from mmusv.generate import generate
+from mmusv.errors import ConfigError
+from mmusv.generate import generate, load_spec
 
 USV_SPEED = (2.0, 3.0)
 PORT = {"type": "port", "seed": 3}
@@ -51,3 +53,42 @@ def test_every_usv_sails_within_the_spec_speed_range(tmp_path: Path) -> None:
     assert set(speeds) == {"surround", "occluded_by_island", "port_entry"}, sorted(speeds)
     outside = {f: [s for s in v if not USV_SPEED[0] <= s <= USV_SPEED[1]] for f, v in speeds.items()}
     assert not any(outside.values()), outside
+
+
+def _spec(**changes: Any) -> dict[str, Any]:
+    doc: dict[str, Any] = {
+        "name": "bad",
+        "map": {"type": "open_sea", "seed": 1},
+        "combinations": [{"family": "crossing", "targets": ["small"]}],
+    }
+    doc.update(changes)
+    return doc
+
+
+def test_an_empty_extra_classes_is_refused_not_read_as_every_class() -> None:
+    doc = _spec(difficulties={"easy": {"range_m": [80, 250], "extra_targets": 2, "extra_classes": []}})
+    with pytest.raises(ConfigError) as info:
+        load_spec(doc)
+    msg = str(info.value)
+    assert "difficulties.easy.extra_classes" in msg and "small" in msg, msg
+
+
+def test_an_empty_asset_list_is_named_as_such() -> None:
+    with pytest.raises(ConfigError) as info:
+        load_spec(_spec(size_classes={"small": {"assets": []}}))
+    msg = str(info.value)
+    assert "size_classes.small.assets" in msg and "no target asset has a length" not in msg, msg
+
+
+def test_a_size_class_faster_than_all_its_vessels_is_refused() -> None:
+    doc = _spec(size_classes={"small": {"assets": ["kayak_4m"], "speed_mps": [6, 8]}})
+    with pytest.raises(ConfigError) as info:
+        load_spec(doc)
+    msg = str(info.value)
+    assert "size_classes.small.speed_mps" in msg and "kayak_4m" in msg and "3 m/s" in msg, msg
+
+
+def test_a_size_class_some_of_whose_vessels_can_sail_its_speeds_is_kept() -> None:
+    """The default small class holds kayaks (3 m/s at most) beside jet skis; its 3-10 m/s are kept."""
+    spec = load_spec(_spec(size_classes={"small": {"length_m": [0, 6], "speed_mps": [6, 8]}}))
+    assert spec.size_classes["small"].speed_mps == (6.0, 8.0)

@@ -41,7 +41,10 @@ the value given and what is allowed, in the style of :func:`mmusv.config.load_sc
 candidate of a combination could meet together are refused here, naming the constraint, the combination and the
 other bound (``separation.min_m`` above the difficulty's ``range_m`` or ``cooperation.max_m``, a sensing or
 density range inside the separation, ``target_density.min_targets`` above the targets a combination has, a lone
-ego whose target is kept beyond its sensing range), rather than spending every attempt on them. A clearance that
+ego whose target is kept beyond its sensing range), rather than spending every attempt on them. So are a size class
+none of whose vessels sails as fast as its ``speed_mps`` low (each target is kept below its type's top speed, so
+every draw would fall below the range) and an empty ``assets`` or ``extra_classes`` list (it named no vessel, and
+drew the distractors from every class). A clearance that
 no water of a combination's map offers to its vessels needs the map: :func:`mmusv.generate.runner.generate` refuses
 it the same way once the map is built, before the first attempt.
 """
@@ -70,6 +73,7 @@ from mmusv.config import (
 from mmusv.config_errors import short_repr
 from mmusv.errors import ConfigError, MmusvError, located
 from mmusv.generate.families import FAMILIES
+from mmusv.generate.layout import top_speed_mps
 from mmusv.generate.spec_constraints import (
     Constraints,
     CooperationCheck,
@@ -160,6 +164,10 @@ class SizeClass(_Model):
     @classmethod
     def _assets(cls, v: list[str] | None) -> list[str] | None:
         if v is not None:
+            if not v:  # read as "no list" by class_assets' caller, it was refused as the class's length_m range
+                raise ValueError(
+                    "an empty list names no vessel: name target assets, or leave `assets` out to pick them by length"
+                )
             for name in v:
                 known_asset(name)
                 if get_asset(name).is_usv:
@@ -413,9 +421,27 @@ def _cross_checks(spec: GenerationSpec, source: str) -> None:
     except ConfigError as exc:
         fail(f"rigs.{spec.rig}", spec.rigs[spec.rig], str(exc).removeprefix("scenario: "))
     for name, sc in spec.size_classes.items():
-        if not class_assets(sc):
+        names = class_assets(sc)
+        if not names:
             fail(f"size_classes.{name}.length_m", list(sc.length_m), "no target asset has a length in this range")
+        tops = {a: top_speed_mps(a) for a in names}
+        if all(t < sc.speed_mps[0] for t in tops.values()):
+            # the sampler keeps each target below its type's top speed, so every one was drawn below the range
+            fail(
+                f"size_classes.{name}.speed_mps",
+                list(sc.speed_mps),
+                "no vessel of this class sails that fast ("
+                + ", ".join(f"{a} {t:g} m/s at most" for a, t in sorted(tops.items()))
+                + f"): lower the low speed to {max(tops.values()):g} m/s or less, or add faster assets",
+            )
     for name, d in spec.difficulties.items():
+        if d.extra_classes is not None and not d.extra_classes:
+            fail(
+                f"difficulties.{name}.extra_classes",
+                [],
+                "an empty list has no class to draw the extra targets from: name size classes "
+                f"({', '.join(spec.size_classes)}), or leave it out for every class",
+            )
         for c in d.extra_classes or []:
             if c not in spec.size_classes:
                 fail(f"difficulties.{name}.extra_classes", c, f"not a size class ({', '.join(spec.size_classes)})")
