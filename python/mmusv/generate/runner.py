@@ -2,7 +2,8 @@
 scenarios and ``report.json``.
 
 Per combination ``i`` (in spec order) attempts ``0, 1, ...`` are drawn by :func:`sample_candidate` from
-``(spec.seed, i, attempt)`` and checked by the enabled constraints; an accepted candidate is written as
+``(spec.seed, i, attempt)`` (the distractor count from the place in the quota being filled) and checked by the
+enabled constraints; an accepted candidate is written as
 ``<combination>_<NNN>.yaml`` (``NNN`` = its rank among the combination's accepted scenarios; its name goes into
 the hidden ``.generate.partial`` first, so a run stopped before its report is known by ``--force``), read back (YAML
 safe loader, libyaml's when installed: the same resolver as ``yaml.safe_load``), validated with
@@ -397,7 +398,7 @@ def generate(
             name = f"{rep.name}_{rep.accepted:0{width}d}"
             total_attempts += 1
             try:
-                cand = sample_candidate(spec, combo_index=i, attempt=attempt, ctx=ctx, name=name)
+                cand = sample_candidate(spec, combo_index=i, attempt=attempt, ctx=ctx, name=name, slot=rep.accepted)
             except SamplingError as exc:
                 rep.reject("sampling", str(exc))
             except ConfigError as exc:

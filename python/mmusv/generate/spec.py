@@ -10,7 +10,8 @@ Units: metres, seconds, metres per second; shares are fractions of the frames in
 - ``usv``: USV ``assets`` and ``speed_mps``; ``size_classes``: target classes by hull ``length_m`` (default
   small < 15 m <= medium < 80 m <= large) or an explicit ``assets`` list, with their ``speed_mps``;
 - ``difficulties``: ``range_m`` (ego to target closest approach), ``extra_targets`` (distractors, n or
-  [lo, hi]) from ``extra_classes``, ``occluded_share`` (ask for occlusion of the primary target);
+  [lo, hi], uniform over the accepted scenarios: each one's count is drawn for its place in the quota and kept over
+  its attempts) from ``extra_classes``, ``occluded_share`` (ask for occlusion of the primary target);
 - ``combinations``: ``family`` (:data:`mmusv.generate.families.FAMILIES`), ``difficulty``, ``ego`` asset,
   ``cooperating`` USVs, ``targets`` (one size class per role target, the first is primary), ``quota``,
   optional ``max_attempts`` (default ``quota x max_attempts_per_scenario``), ``name`` and ``map`` (this
