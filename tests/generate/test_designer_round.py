@@ -15,11 +15,13 @@ refused naming the field. Each test failed before its fix.
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import Any
 
 import pytest
 import yaml
+from mmusv.config import load_scenario
 from mmusv.errors import ConfigError
 from mmusv.generate import generate, load_spec
 
@@ -121,3 +123,38 @@ def test_the_distractor_count_is_uniform_over_the_accepted_scenarios(tmp_path: P
         counts[sum(v["id"].startswith("distractor_") for v in vessels)] += 1
     chi2 = sum((c - 25) ** 2 / 25 for c in counts)
     assert chi2 < 11.34, counts  # the 1 % point of chi-square with 3 degrees of freedom
+
+
+KEEL: dict[str, Any] = {
+    "name": "keel",
+    "seed": 3,
+    "map": PORT,
+    "acquisition": {"frequency_hz": 2, "frames": 40},
+    "size_classes": {"huge": {"length_m": [250, 400], "speed_mps": [3, 6]}},
+    "difficulties": {"easy": {"range_m": [80, 300]}},
+    "combinations": [{"family": "port_entry", "cooperating": 1, "targets": ["huge"], "quota": 5}],
+}
+"""Ships of 290-330 m (drafts 14.5-22.5 m) entering a port whose basin is 14 m deep (about a second)."""
+
+
+def test_no_generated_ship_sails_with_its_keel_in_the_seabed(tmp_path: Path) -> None:
+    """mmusv run warned under_keel on 3 of the 5 scenarios generate accepted (a container ship of draft 14.5 m, two
+    bulk carriers of 18.2 m over 14 m of water): the generator did not look at the depth. The scenarios it writes
+    now pass the run's check (:func:`mmusv.scenario_checks.keel_findings`, the depth from the map's heightfield);
+    the report says what it rejected and why."""
+    from mmusv.scenario_checks import check_routes
+    from mmusv.world.maps import generate_map
+
+    report = generate(KEEL, tmp_path)
+    world = generate_map("port", seed=3)
+    files = sorted(tmp_path.glob("*.yaml"))
+    assert files
+    warned = []
+    for path in files:
+        scenario = load_scenario(path)
+        with warnings.catch_warnings(record=True):
+            warnings.simplefilter("always")
+            warned += [m for m in check_routes(scenario, world, source=path.name) if "under_keel" in m]
+    assert not warned, warned
+    combo = report.as_dict()["combinations"][0]
+    assert combo["rejected"].get("under_keel", 0) > 0, combo

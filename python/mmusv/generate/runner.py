@@ -8,9 +8,11 @@ enabled constraints; an accepted candidate is written as
 the hidden ``.generate.partial`` first, so a run stopped before its report is known by ``--force``), read back (YAML
 safe loader, libyaml's when installed: the same resolver as ``yaml.safe_load``), validated with
 :func:`mmusv.config.load_scenario` and compared with the checked scenario before it counts. The loop stops at the
-quota or at ``max_attempts``, so it always ends; the same spec gives the same files byte for byte. A combination
-whose vessels fit nowhere on its map at the clearances asked, or whose distances (closest approach, cooperation)
-exceed what its water spans (:func:`infeasible_error`), is refused before the first attempt, and nothing is written.
+quota or at ``max_attempts``, so it always ends; the same spec gives the same files byte for byte. Beside the
+spec's constraints, a candidate whose vessel's keel reaches the seabed is rejected (``under_keel``, always on). A
+combination whose vessels fit nowhere on its map at the clearances asked, or whose distances (closest approach,
+cooperation) exceed what its water spans (:func:`infeasible_error`), is refused before the first attempt, and nothing
+is written.
 """
 
 from __future__ import annotations
@@ -341,12 +343,21 @@ def _first_failure(
     constraints: list[Constraint], cand: Candidate, ctx: MapContext, spec: GenerationSpec
 ) -> tuple[str, str] | None:
     """The first failing constraint of a candidate, ``("sampling", why)`` when it has too many samples to check
-    (:data:`~mmusv.generate.samples.MAX_CHECK_SAMPLES`), None when it passes."""
+    (:data:`~mmusv.generate.samples.MAX_CHECK_SAMPLES`), then ``("under_keel", why)`` when a vessel's draft reaches
+    the seabed at some frame (:func:`mmusv.scenario_checks.keel_findings`, what ``mmusv run`` warns about: a
+    330 m tanker among islands, a bulk carrier in a 14 m port basin), None when it passes."""
+    from mmusv.scenario_checks import keel_findings
+
     try:
         samples = take_samples(cand.scenario, cand.meta, ctx, spec)
     except ConfigError as exc:
         return "sampling", str(exc)
-    return first_failure(constraints, samples)
+    fail = first_failure(constraints, samples)
+    if fail is None:
+        keel = keel_findings(cand.scenario, ctx.world, samples)
+        if keel:
+            return "under_keel", keel[0].message
+    return fail
 
 
 def generate(
