@@ -57,6 +57,26 @@ def test_every_usv_sails_within_the_spec_speed_range(tmp_path: Path) -> None:
     assert not any(outside.values()), outside
 
 
+def test_a_convoy_does_not_slow_its_usvs_below_the_spec_speed_range(tmp_path: Path) -> None:
+    """A convoy sails at its slowest member's top speed at most (a kayak, 3 m/s) and its ego keeps abeam: 20 of 60
+    USVs sailed below ``usv.speed_mps: [3.5, 5]``. Such a candidate is now a sampling failure."""
+    spec = {
+        **FAMILIES,
+        "map": {"type": "open_sea", "seed": 1},
+        "usv": {"assets": ["usv_wamv"], "speed_mps": [3.5, 5.0]},
+        "combinations": [{"family": "convoy", "cooperating": 1, "targets": ["small", "small"], "quota": 10}],
+    }
+    report = generate(spec, tmp_path)
+    assert report.all_met
+    speeds = [
+        v["speed_mps"]
+        for path in sorted(tmp_path.glob("*.yaml"))
+        for v in yaml.safe_load(path.read_text(encoding="utf-8"))["vessels"]
+        if v["role"] == "usv"
+    ]
+    assert len(speeds) == 20 and all(3.5 <= s <= 5.0 for s in speeds), speeds
+
+
 def _spec(**changes: Any) -> dict[str, Any]:
     doc: dict[str, Any] = {
         "name": "bad",
