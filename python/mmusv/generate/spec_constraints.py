@@ -92,7 +92,11 @@ class TargetRangeCheck(_Check):
 
 
 class SensingRangeCheck(_Check):
-    """Each target within ``range_m`` of at least one USV for at least ``min_share`` of the frames."""
+    """Each target within ``range_m`` of at least one USV for at least ``min_share`` of the frames. A distance of
+    the spec's own, not the rig's: the default 1000 m accepts targets that a 200 m LiDAR (the default rig's) never
+    reaches, and a recording boxes only the vessels within its LiDAR's range (43 % of the targets of 100 scenarios
+    so generated were never within 200 m of a USV); give the rig's range, as the bundled coop_detection specs do,
+    for a batch whose targets are labelled."""
 
     range_m: float = Field(default=1000.0, gt=0.0, le=MAX_DISTANCE_M)
     min_share: float = Field(default=0.8, ge=0.0, le=1.0)
