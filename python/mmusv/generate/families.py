@@ -13,8 +13,8 @@ constraints of :mod:`mmusv.generate.checks` decide. A template that cannot place
 
 Speeds: every USV sails within the spec's ``usv.speed_mps`` (a template that wants its USVs slow, port_entry's
 waiting ego at 0.3-1 m/s, occluded_by_island's at 1.5 m/s at most, surround's group at 0.8 x a drawn speed, takes
-the part of that band inside the range, or its nearest bound; a convoy whose slowest member is slower than the range
-is a sampling failure). A target's speed is its size class's draw, except
+the part of that band inside the range, or its nearest bound; a convoy slower than the range, a kayak's, is
+passed by its USVs at speeds of their own). A target's speed is its size class's draw, except
 where the family ties it to others: convoy (one speed for the line and the ego, the slowest member's top speed at
 most), surround (the group's), overtaking (the ego's plus 1-3 m/s or minus 0.8-1.5 m/s), occluded_by_island's
 primary (4 m/s at most) and port_entry's (5 m/s at most), so these may leave the class's ``speed_mps``.
@@ -159,16 +159,13 @@ def _encounter(kind: str) -> Callable[[FamilyInput], Layout]:
 
 
 def _convoy(inp: FamilyInput) -> Layout:
-    """The role targets sail in line on one shared route (start offsets), the ego abeam of the lead."""
+    """The role targets sail in line on one shared route (start offsets), the ego abeam of the lead (alongside it
+    at the convoy's speed, or passing it at a speed of its own when the convoy is slower than ``usv.speed_mps``)."""
     rng, big_t = inp.rng, inp.duration
     # the convoy sails at its slowest member's top speed at most (a kayak is not towed along at the USV's speed)
     u = min([float(rng.uniform(*inp.usv_speed)), *(top_speed_mps(t.asset) for t in inp.targets)])
-    if u < inp.usv_speed[0]:  # the ego keeps abeam at the line's speed, which must be one the spec gives USVs
-        slow = min(inp.targets, key=lambda t: top_speed_mps(t.asset))
-        raise SamplingError(
-            f"the convoy sails at {slow.asset}'s top speed, {u:g} m/s, below usv.speed_mps ({inp.usv_speed[0]:g} m/s "
-            "at least) that the ego keeping abeam would sail"
-        )
+    # the ego keeps pace where the spec lets USVs sail that slowly; else it passes the line abeam of the lead
+    u_e = u if u >= inp.usv_speed[0] else float(rng.uniform(*inp.usv_speed))
     t_e = big_t * float(rng.uniform(0.35, 0.65))
     gaps = [
         a.radius + b.radius + inp.separation_m + float(rng.uniform(15.0, 60.0))
@@ -185,7 +182,7 @@ def _convoy(inp: FamilyInput) -> Layout:
         end = lead_at + fwd * u * (big_t - t_e)
         mid = (start + end) / 2.0 + perp(fwd) * float(rng.uniform(-0.02, 0.02)) * float(np.hypot(*(end - start)))
         route = np.array([start, mid, end])
-        out = [straight_track(inp.ego, at=centre, vel=u * fwd, t_at=t_e, duration=big_t, rng=rng)]
+        out = [straight_track(inp.ego, at=centre, vel=u_e * fwd, t_at=t_e, duration=big_t, rng=rng)]
         offset = total
         for k, tgt in enumerate(inp.targets):
             out.append(Track(tgt, route.copy(), u, offset))
@@ -196,8 +193,8 @@ def _convoy(inp: FamilyInput) -> Layout:
     tracks = pick_best(inp, make)
     ego = tracks[0]
     fwd = unit(ego.route[-1] - ego.route[0], heading(0.0))
-    centre = ego.route[0] + fwd * u * t_e
-    tracks += _escorts(inp, centre, u * fwd, t_e)
+    centre = ego.route[0] + fwd * u_e * t_e
+    tracks += _escorts(inp, centre, u_e * fwd, t_e)
     return Layout(tracks, [inp.targets[0].id], centre)
 
 
