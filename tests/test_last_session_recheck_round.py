@@ -22,8 +22,9 @@ Found (each test below failed before its fix, or is a strict xfail where the fix
   W1 (0.49 m/s on the straight legs); a strict xfail, a Rust change (:func:`test_the_heave_does_not_jump_in_a_bend`).
 * ``mmusv generate`` writes scenarios that ``mmusv run`` then warns are aground (``under_keel`` is no generator
   constraint): the ``port_entry`` family with a ``large`` target on the default port (basin 14 m) in 6 of 12 seeds,
-  the bundled coop_detection specs 4 of 254 scenarios at seeds 0 and 1; a strict xfail, a new spec constraint being
-  the maintainers' call (:func:`test_the_generator_writes_no_scenario_that_mmusv_run_warns_is_aground`).
+  the bundled coop_detection specs 4 of 254 scenarios at seeds 0 and 1. A strict xfail at first; fixed since: the
+  generator rejects such candidates with the run's own check (``generate.checks``, ``under_keel``, always on)
+  (:func:`test_the_generator_writes_no_scenario_that_mmusv_run_warns_is_aground`).
 
 Checked and found right (no test here; the last session's own tests cover them): recordings of ``mmusv run`` (1 and
 5 frames, ``--split-frames`` parts starting at 0.4 s, a camera rig, a SIGKILLed 3000-frame run's ``.partial`` and
@@ -143,12 +144,6 @@ def test_the_heave_does_not_jump_in_a_bend() -> None:
     assert rate[turning].max() < 5.0 * rate[~turning].max()
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="mmusv generate has no under_keel constraint (scenario_checks.keel_findings is mmusv run's warning and "
-    "the editor's finding only): rejecting such candidates is a new spec constraint (the spec schema, every spec's "
-    "dataset hash and report.json change), left to the maintainers",
-)
 def test_the_generator_writes_no_scenario_that_mmusv_run_warns_is_aground(tmp_path: Path) -> None:
     """``mmusv run`` warns ``under_keel`` of a scenario ``mmusv generate`` wrote and accepted: on the default port
     (its basin 14 m deep) the ``port_entry`` family with a ``large`` target drew a 300 m container ship (draft 14.5 m)
