@@ -60,7 +60,7 @@ def test_report_adds_up_and_names_the_constraints(small_run: tuple[Path, dict[st
     assert rep["constraints"] == [n for n in load_spec(SMALL).constraints.model_dump() if n in CHECK_NAMES]
     for c in rep["combinations"]:
         assert c["accepted"] + sum(c["rejected"].values()) == c["attempts"] <= c["max_attempts"]
-        assert set(c["rejected"]) <= CHECK_NAMES | {"sampling", "schema"}
+        assert set(c["rejected"]) <= CHECK_NAMES | {"sampling", "schema", "under_keel"}  # under_keel: always on
         assert set(c["examples"]) == set(c["rejected"])
         assert c["quota_met"] == (c["accepted"] >= c["quota"]) and len(c["files"]) == c["accepted"]
         assert c["why"] == "quota met" if c["quota_met"] else c["why"].startswith(f"{c['accepted']}/{c['quota']}")
