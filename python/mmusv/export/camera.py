@@ -27,7 +27,7 @@ from typing import Any, ClassVar, TypeVar
 import numpy as np
 
 from mmusv.classes import SemanticClass, class_name
-from mmusv.export.common import Options, Sink, mask_box
+from mmusv.export.common import Options, Sink, mask_box, wave_share
 from mmusv.export.contrast import apparent_contrast
 from mmusv.export.writer import DatasetWriter
 from mmusv.recording import topics
@@ -58,9 +58,11 @@ CATEGORIES: tuple[int, ...] = tuple(int(c) for c in SemanticClass if c != Semant
 class ImageBox:
     """One vessel's 2D box in one image: pixels ``x_min, y_min, x_max, y_max`` (origin at the top-left corner of
     the image, x right, y down), its vessel id, semantic class, instance id and role (``target``, ``usv``,
-    ``moored``), truncation and occlusion (fractions, 0..1), visible pixels and, where measured, ``contrast`` (the
+    ``moored``), truncation and occlusion (fractions, 0..1), visible pixels, where measured ``contrast`` (the
     vessel's Weber contrast in the RGB image, :func:`mmusv.export.contrast.apparent_contrast`; ``None`` when not
-    measured or undefined)."""
+    measured or undefined) and ``wave_occlusion``, the recorded share (0..1) of the vessel's part above the still
+    level that the waves hide from this camera (:mod:`mmusv.wave_occlusion`; 0 over a flat sea, ``None`` for a
+    recording made before the field existed)."""
 
     target_id: str
     semantic_class: int
@@ -74,6 +76,7 @@ class ImageBox:
     occlusion: float
     visible_pixels: int
     contrast: float | None = None
+    wave_occlusion: float | None = None
 
     @property
     def width(self) -> float:
@@ -245,6 +248,7 @@ class CameraWriter(DatasetWriter):
                 truncation=float(b.truncation),
                 occlusion=float(b.occlusion),
                 visible_pixels=int(b.visible_pixels),
+                wave_occlusion=wave_share(b),
             )
             if box.visible_pixels == 0:
                 continue

@@ -17,9 +17,12 @@ pixels (origin at the image's top-left corner, pixel ``(i, j)`` over ``[i, i + 1
 the image: it reaches down to the keel below the waterline and over what hides the vessel); ``category_id`` the
 vessel's semantic class, ``segmentation`` the run-length encoding (pycocotools, ``counts`` as a string) of the
 instance image's pixels equal to the vessel's instance id, ``area`` that mask's pixel count, ``iscrowd`` 0, and the
-extra fields ``truncation``, ``occlusion`` (fractions, as recorded: of the projected box), ``role``, ``mmusv_id``
-(vessel id), ``instance_id``, ``visible_pixels`` and ``contrast`` (the vessel's apparent Weber contrast in the RGB
-image, :func:`mmusv.export.contrast.apparent_contrast`, 6 decimals; ``null`` where undefined).
+extra fields ``truncation`` (as recorded: the share of the projected box outside the image), ``occlusion`` (as
+recorded: the share of the vessel's silhouette above the still water level, within the image, that other objects or
+the waves' crests hide), ``wave_occlusion`` (as recorded: the part of that share the waves hide, 6 decimals; 0 over a
+flat sea, ``null`` for a recording made before the field existed), ``role``, ``mmusv_id`` (vessel id),
+``instance_id``, ``visible_pixels`` and ``contrast`` (the vessel's apparent Weber contrast in the RGB image,
+:func:`mmusv.export.contrast.apparent_contrast`, 6 decimals; ``null`` where undefined).
 """
 
 from __future__ import annotations
@@ -115,6 +118,7 @@ class CocoWriter(CameraWriter):
                     "instance_id": b.instance_id,
                     "visible_pixels": b.visible_pixels,
                     "contrast": None if b.contrast is None else round(b.contrast, 6) + 0.0,
+                    "wave_occlusion": None if b.wave_occlusion is None else round(b.wave_occlusion, 6) + 0.0,
                 }
             )
 

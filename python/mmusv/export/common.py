@@ -38,6 +38,7 @@ __all__ = [
     "top_view_entry",
     "top_view_png",
     "top_view_protocol",
+    "wave_share",
 ]
 
 TARGETS = ("opv2v", "kitti", "ros2", "coco", "yolo", "mastr", "semantickitti", "mot", "kitti_tracking")
@@ -283,3 +284,11 @@ def mask_box(instance: np.ndarray, instance_id: int) -> tuple[int, int, int, int
         return None
     rows = np.flatnonzero(mask.any(axis=1))
     return int(cols[0]), int(rows[0]), int(cols[-1]) + 1, int(rows[-1]) + 1
+
+
+def wave_share(box: Any) -> float | None:
+    """A recorded box's ``wave_occlusion`` (a ``Box2D`` or ``Box3D`` annotation message: the share, 0..1, of the
+    vessel's part above the still level that the waves hide from that sensor, :mod:`mmusv.wave_occlusion`; 0 over a
+    flat sea), ``None`` for a box of a recording made before the field existed (its embedded schema lacks it)."""
+    share = getattr(box, "wave_occlusion", None)
+    return None if share is None else float(share)

@@ -23,8 +23,10 @@ extra, ``top_views`` (each agent's top view by ``cav_id``: ``resolution``, ``met
 ``altitude_m``) and ``top_view_png`` (where each pixel lies, from ``true_ego_pos``:
 :func:`mmusv.export.common.top_view_protocol`).
 
-Files beyond stock OPV2V, which stock loaders skip: ``<ts>_additional.yaml`` (our names, classes and LiDAR point
-counts of the listed vehicles), ``<ts>_depth{i}.png`` (HEAL's OPV2V-H depth: 8-bit grayscale, whole metres
+Files beyond stock OPV2V, which stock loaders skip: ``<ts>_additional.yaml`` (our names, classes, LiDAR point
+counts and wave-occlusion shares of the listed vehicles: ``wave_occlusion``, the recorded share of the vessel's part
+above the still level that the waves hide from this agent's LiDAR, 0 over a flat sea, ``null`` for a recording made
+before the field existed), ``<ts>_depth{i}.png`` (HEAL's OPV2V-H depth: 8-bit grayscale, whole metres
 along the optical axis, 255 = no hit or 254.5 m and farther; :func:`heal_depth_png`), ``<ts>_depth_cm{i}.png`` (the
 same depth as uint16 centimetres, 0 = no hit, 65535 = 655.35 m or farther), ``<ts>_semantic{i}.png``,
 ``<ts>_instance{i}.png`` (uint16 ids), ``<ts>_radar_ppi.png``, ``<ts>_topview_{rgb,semantic}.png``.
@@ -60,6 +62,7 @@ from mmusv.export.common import (
     png_bytes,
     rounded,
     top_view_protocol,
+    wave_share,
 )
 from mmusv.export.geometry import AgentView, Target
 from mmusv.export.opencood import HypesStats, constants, hypes
@@ -131,6 +134,11 @@ def _lidar_summary(p: dict[str, Any]) -> str:
 def timestamp(frame: int) -> str:
     """The OPV2V timestamp of acquisition index ``frame`` (6 digits, zero-padded)."""
     return f"{frame:06d}"
+
+
+def _rounded_share(share: float | None) -> float | None:
+    """A wave-occlusion share at 6 decimals (``None`` stays ``None``: a recording made before the field existed)."""
+    return None if share is None else round(share, 6) + 0.0
 
 
 def _matrix_list(m: np.ndarray) -> list[list[float]]:
@@ -211,6 +219,10 @@ class Opv2vWriter(DatasetWriter):
         sink.mkdir(out / "opencood")
         for stem, doc in hypes(st, root_dir=root, validate_dir=val).items():
             sink.write(out / "opencood" / f"{stem}.yaml", header + dump_yaml(doc))
+
+    def optional_topics(self) -> list[str]:
+        """The extras' topics and every agent's annotations (``_additional.yaml``'s ``wave_occlusion``)."""
+        return super().optional_topics() + [topics.agent_annotations(a.id) for a in self.agents]
 
     def agent_dir(self, view: AgentView) -> Path:
         return self.sink.mkdir(self.folder / str(cav_id(view.agent.index)))
@@ -298,6 +310,9 @@ class Opv2vWriter(DatasetWriter):
         if inst is not None and inst.size:
             ids, n = np.unique(inst, return_counts=True)
             counts = {int(i): int(c) for i, c in zip(ids, n, strict=True)}
+        # The share of each target the waves hide from this LiDAR, as recorded (its 3D box of the agent's annotations).
+        ann = frame.messages.get(topics.agent_annotations(view.agent.id))
+        shares = {str(b.target_id): wave_share(b) for b in getattr(ann, "boxes_lidar", ())}
         return {
             "mmusv": {
                 "agent": view.agent.id,
@@ -313,6 +328,7 @@ class Opv2vWriter(DatasetWriter):
                         "class_name": class_name(t.semantic_class),
                         "instance_id": t.instance_id,
                         "lidar_points": counts.get(t.instance_id, 0),
+                        "wave_occlusion": _rounded_share(shares.get(t.id)),
                     }
                     for t in targets
                 },
