@@ -150,3 +150,30 @@ def test_a_craft_the_waves_hide_wholly_is_left_out_of_coco_yolo_mot_and_kept_by_
     boxes = [np.array(ln.split()[4:8], dtype=float) for ln in labels if ln.split()[2] == "2"]
     want = np.round([row["x_min"], row["y_min"], row["x_max"], row["y_max"]], 2)
     assert any(np.array_equal(b, want) for b in boxes), (labels, want)
+
+
+def test_the_detection_study_reads_the_wave_shares_from_an_opv2v_export_as_from_the_recording(
+    rec: Path, tmp_path: Path
+) -> None:
+    """The detection study scores the recall of the targets the waves hide from the ego (``wave_shares``); read from
+    an OPV2V export it had no share at all (every one NaN), so the W3 tables could only come from recordings. With
+    the shares in ``_additional.yaml`` it reads, for each CAV and target, the recording's share."""
+    from mmusv.studies.detection.data import gt_with_ids, read_opv2v, read_recording, wave_shares
+
+    out = _convert(rec, tmp_path, "opv2v", extras="")
+    from_rec = read_recording(rec)
+    from_opv2v = read_opv2v(out / "wavehide")
+    names: dict[str, str] = {}  # cav id -> vessel id, from the export's own _additional.yaml
+    for f in glob.glob(str(out / "wavehide" / "*" / "*_additional.yaml")):
+        for cav, v in yaml.safe_load(Path(f).read_text())["mmusv"]["vehicles"].items():
+            names[str(cav)] = v["name"]
+    compared = 0
+    for fr_rec, fr_opv in zip(from_rec.frames, from_opv2v.frames, strict=True):
+        for a_rec, a_opv in zip(fr_rec.agents, fr_opv.agents, strict=True):
+            _, ids = gt_with_ids(fr_opv, a_opv)
+            got = wave_shares(a_opv, ids)
+            want = wave_shares(a_rec, [names[i] for i in ids])
+            assert np.isfinite(want).all()
+            np.testing.assert_allclose(got, want, atol=5e-7)
+            compared += len(ids)
+    assert compared >= 4

@@ -57,7 +57,8 @@ class AgentFrame:
     """One instrumented USV at one frame: ``points`` ``(N, 4)`` float32 ``x, y, z, intensity`` in its LiDAR
     frame (metres), ``body`` ``(4, 4)`` float64 body → world and ``mount`` ``(4, 4)`` float64 LiDAR → body;
     ``wave_occlusion``: the share (0..1) of each target (by vessel id) that the waves hide from this USV's LiDAR,
-    from its annotations (a recording's ``boxes_lidar``; empty where the source has none, e.g. OPV2V)."""
+    from its annotations (a recording's ``boxes_lidar``, an OPV2V export's ``<ts>_additional.yaml`` by vehicle id;
+    empty where the source has none: a stock OPV2V folder, an export or recording made before the field)."""
 
     id: str
     points: np.ndarray
@@ -139,8 +140,8 @@ def gt_with_ids(frame: SceneFrame, ego: AgentFrame, *, range_m: float = 200.0) -
 
 def wave_shares(ego: AgentFrame, ids: Sequence[str]) -> np.ndarray:
     """``(len(ids),)`` float64: the share of each target that the waves hide from ``ego``'s LiDAR (its
-    annotations); NaN where the source gives none (no annotation of that target, an OPV2V folder, a recording
-    made before the shares existed)."""
+    annotations); NaN where the source gives none (no annotation of that target, a stock OPV2V folder, an export
+    or recording made before the shares existed)."""
     return np.array([ego.wave_occlusion.get(i, np.nan) for i in ids], dtype=np.float64)
 
 
@@ -307,12 +308,13 @@ def read_opv2v(folder: str | Path) -> SequenceData:
                 # inside the try: a vehicle without a location or of 2 angles was a bare KeyError / ValueError
                 for vid, (box, size) in _opv2v_vehicles(doc.get("vehicles") or {}).items():
                     vehicles[vid], sizes[vid] = box, size
-                usvs |= _opv2v_usvs(c / f"{ts}_additional.yaml")
+                listed_usvs, waves = _opv2v_additional(c / f"{ts}_additional.yaml")
+                usvs |= listed_usvs
             except (OSError, ValueError, KeyError, TypeError, AttributeError, yaml.YAMLError) as exc:
                 why = " ".join(str(exc).split())  # a YAML error spans several lines
                 raise IoError(f"{y_path}: not a readable OPV2V frame ({type(exc).__name__}: {why})") from None
             pts = np.column_stack([xyz[:, 0], -xyz[:, 1], xyz[:, 2], inten]).astype(np.float32)
-            afs.append(AgentFrame(c.name, pts, body, invert(body) @ lidar))
+            afs.append(AgentFrame(c.name, pts, body, invert(body) @ lidar, waves))
         if not afs:
             continue
         cavs_here = {a.id for a in afs}
@@ -339,16 +341,32 @@ def _opv2v_usvs(path: Path) -> set[str]:
     gives role ``usv``; none without the file (a stock OPV2V folder) or for a mapping without an ``mmusv`` key (a
     file of that name that another tool wrote). mmusv's that is not such a document, or a file that is not a YAML
     mapping, raises as the frame's yaml does (``ValueError``, ``yaml.YAMLError``)."""
+    return _opv2v_additional(path)[0]
+
+
+def _opv2v_additional(path: Path) -> tuple[set[str], dict[str, float]]:
+    """What the study reads of an OPV2V frame's ``<ts>_additional.yaml``: the ids of the vehicles it gives role
+    ``usv`` (:func:`_opv2v_usvs`) and, by vehicle id, the share the waves hide of each from this CAV's LiDAR (its
+    ``wave_occlusion``, as the recording's annotations give it; none where the file has no such number: a stock
+    folder, an export made before the field)."""
     if not path.is_file():
-        return set()
+        return set(), {}
     doc = yaml.safe_load(path.read_text(encoding="utf-8"))
     if isinstance(doc, dict) and "mmusv" not in doc:
-        return set()
+        return set(), {}
     mm = doc.get("mmusv") if isinstance(doc, dict) else None
     listed = mm.get("vehicles") if isinstance(mm, dict) else None
     if not isinstance(listed, dict):
         raise ValueError(f"{path.name}: not mmusv's additional yaml (mmusv.vehicles: {{id: {{role, ...}}}})")
-    return {str(vid) for vid, v in listed.items() if isinstance(v, dict) and v.get("role") == "usv"}
+    usvs = {str(vid) for vid, v in listed.items() if isinstance(v, dict) and v.get("role") == "usv"}
+    waves = {
+        str(vid): float(v["wave_occlusion"])
+        for vid, v in listed.items()
+        if isinstance(v, dict)
+        and isinstance(v.get("wave_occlusion"), (int, float))
+        and not isinstance(v["wave_occlusion"], bool)
+    }
+    return usvs, waves
 
 
 def _opv2v_pose(doc: Any, key: str) -> np.ndarray:

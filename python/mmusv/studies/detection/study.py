@@ -13,10 +13,10 @@ height within ±0.5 m), and ``neighbour_points``, the same summed over the other
 *hidden* (fewer from the ego but ≥ 5 from the neighbours: behind an island or another hull, or too small for the
 ego's beams at that range, but seen by cooperating USVs: the case cooperation exists for) or *unseen* (neither).
 Recall at IoU 0.5 and 0.3 is reported for each class. Over waves, each ground truth also records
-``wave_occlusion``, the share of it the waves hide from the ego's LiDAR (the recording's annotations; NaN where the
-source has none), and the targets the waves hide at least :data:`WAVE_HIDDEN_SHARE` of from the ego are a class
-of their own, *wave-hidden*, with its recall (``recall50_wave_hidden``, ...; a target may be wave-hidden and
-visible, hidden or unseen as well).
+``wave_occlusion``, the share of it the waves hide from the ego's LiDAR (the recording's annotations, or an OPV2V
+export's ``<ts>_additional.yaml``; NaN where the source has none), and the targets the waves hide at least
+:data:`WAVE_HIDDEN_SHARE` of from the ego are a class of their own, *wave-hidden*, with its recall
+(``recall50_wave_hidden``, ...; a target may be wave-hidden and visible, hidden or unseen as well).
 
 **Predictions file** (``--predictions``, instead of a detector): a Parquet file with one row per detection and
 columns ``sequence`` (recording stem or OPV2V scenario folder name), ``frame`` (acquisition index), ``ego``
