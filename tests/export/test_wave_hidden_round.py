@@ -177,3 +177,22 @@ def test_the_detection_study_reads_the_wave_shares_from_an_opv2v_export_as_from_
             np.testing.assert_allclose(got, want, atol=5e-7)
             compared += len(ids)
     assert compared >= 4
+
+
+def test_a_rig_without_a_lidar_gives_its_3d_boxes_share_0_and_its_cameras_the_waves_share() -> None:
+    """docs/recording.md: a share is of the rays that meet the vessel, so a rig without a LiDAR has every 3D box at
+    ``wave_occlusion`` 0 (and ``lidar_points`` 0), while its camera gives the craft the crests hide wholly share 1:
+    read the camera boxes for what the waves hide from such a USV."""
+    from mmusv.acquire import annotations_for
+    from mmusv.annotate import SilhouetteCache
+    from mmusv.simulation import Simulation
+
+    cfg = _scenario()
+    cfg["rigs"]["r"]["lidar"] = None
+    sim = Simulation(cfg)
+    cols = annotations_for(sim, sim.capture(0, radar=False), SilhouetteCache())["usv_b"].columns()
+    lid, cam = cols["lidar"], cols["camera"]
+    assert "c180" in list(lid["target_id"])
+    assert (lid["wave_occlusion"] == 0.0).all() and (lid["lidar_points"] == 0).all()
+    j = list(cam["target_id"]).index("c180")
+    assert cam["wave_occlusion"][j] == 1.0 and cam["visible_pixels"][j] == 0
