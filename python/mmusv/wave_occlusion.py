@@ -11,8 +11,9 @@ A target that no ray meets above the still level while some meet it below (a sma
 trough) has its whole silhouette as its exposed silhouette, so that a craft the crests hide is counted hidden
 rather than left out. A camera's box whose part above the still level the image border cuts off entirely is the
 exception: its rays then meet only the lower hull of a ship whose upper part is out of the picture, and its exposed
-silhouette is empty. :func:`exposed_rays` is the one home of this rule; the cameras' ``occlusion``
-(:mod:`mmusv.annotate`) uses it too.
+silhouette is empty. So is a LiDAR's box through whose part above the still level none of its beams passes (the
+vertical field of view, tilted with the hull, runs below it): the annotations pass ``whole_when_low`` false for it.
+:func:`exposed_rays` is the one home of this rule; the cameras' ``occlusion`` (:mod:`mmusv.annotate`) uses it too.
 
 * Cameras: the rays of the box's pixels; "stopped at the water" reads the captured instance image (the water
   instance there).

@@ -196,3 +196,44 @@ def test_a_rig_without_a_lidar_gives_its_3d_boxes_share_0_and_its_cameras_the_wa
     assert (lid["wave_occlusion"] == 0.0).all() and (lid["lidar_points"] == 0).all()
     j = list(cam["target_id"]).index("c180")
     assert cam["wave_occlusion"][j] == 1.0 and cam["visible_pixels"][j] == 0
+
+
+def _lidar_case() -> tuple[Any, Any, Any]:
+    """A frame where ``usv_a``, 30 m abeam of ``usv_b``, lies above ``usv_b``'s LiDAR's lowest reach: rolled and
+    pitched by the sea (Hs 3.5 m, Tp 9 s), its beams towards ``usv_a`` all run below -4.16° and meet the still level
+    20.8 m out, short of ``usv_a`` (29.6 m), whose box reaches from -0.93 to 1.89 m. Over a flat sea no beam meets
+    ``usv_a``; over the waves a trough bares 5 points of its hull below the still level, and the water stops 26 more
+    beams there."""
+    from mmusv.acquire import annotations_for
+    from mmusv.annotate import SilhouetteCache
+    from mmusv.simulation import Simulation
+
+    cfg = _scenario()
+    cfg["acquisition"]["frames"] = 20
+    cfg["environment"].pop("wave")
+    cfg["environment"]["sea"] = {"hs_m": 3.5, "tp_s": 9.0}
+    cfg["rigs"]["r"]["cameras"] = []
+    sim = Simulation(cfg)
+    sea, sil = sim.sea, SilhouetteCache()
+    waves = sim.capture(17, radar=False, sensors=["lidar"])
+    ann = annotations_for(sim, waves, sil)["usv_b"].columns()["lidar"]
+    sim.set_sea_surface(None)
+    flat = sim.capture(17, radar=False, sensors=["lidar"])
+    sim.set_sea_surface(sea)
+    return sim, (waves, flat), ann
+
+
+def test_a_lidar_box_whose_part_above_the_still_level_no_beam_reaches_is_not_called_hidden_by_waves() -> None:
+    """The camera's rule (docs/recording.md): where the image border cuts off all of a box's part above the still
+    level, its rays meet only the lower hull and nothing of it counts as exposed (``wave_occlusion`` 0), rather than
+    calling the lower hull, which a calm sea hides too, hidden by waves. The LiDAR's vertical field of view is its
+    border: ``usv_b``'s LiDAR met ``usv_a`` only below the still level (its part above lies above the beams) and
+    read ``wave_occlusion`` 0.839 (26 of 31 beams), with 5 points on ``usv_a`` that the waves bared, none hidden."""
+    sim, (waves, flat), ann = _lidar_case()
+    a = next(v for v in sim.vessels if v.id == "usv_a").instance_id
+    on_flat = int((np.asarray(flat.agents["usv_b"].lidar_beams) == a).sum())
+    on_waves = int((np.asarray(waves.agents["usv_b"].lidar_beams) == a).sum())
+    assert on_flat == 0 and on_waves > 0  # the premise: the calm sea shows nothing of it, the waves show some
+    j = list(ann["target_id"]).index("usv_a")
+    assert ann["lidar_points"][j] > 0
+    assert ann["wave_occlusion"][j] == 0.0
