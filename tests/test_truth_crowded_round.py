@@ -649,7 +649,8 @@ def test_3d_exports_keep_every_target_in_range(rec: Rec, exports: dict[str, Path
                 assert abs((ln[13] - ry + np.pi) % (2 * np.pi) - np.pi) < 0.006, (f.index, agent.id, vid)
                 front = {b.target_id: b for b in ann.boxes_camera if b.camera == "front"}
                 b = front.get(vid)
-                bbox = [0.0] * 4 if b is None else [b.x_min, b.y_min, b.x_max, b.y_max]
+                # (no box, or one of no pixel seen, hidden wholly: occluded 3, box 0 0 0 0)
+                bbox = [0.0] * 4 if b is None or b.visible_pixels == 0 else [b.x_min, b.y_min, b.x_max, b.y_max]
                 assert np.allclose(ln[3:7], bbox, atol=0.006), (f.index, agent.id, vid)
                 assert ln[0] == pytest.approx(1.0 if b is None else b.truncation, abs=0.006)
             doc = yaml.safe_load(

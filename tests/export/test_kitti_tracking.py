@@ -11,6 +11,7 @@ from __future__ import annotations
 import csv
 import filecmp
 import importlib.util
+import itertools
 from collections import defaultdict
 from pathlib import Path
 from typing import Any
@@ -249,9 +250,15 @@ def test_trackeval_kitti2dbox_scores_gt_perfect_and_a_swap_lower(exports: dict[s
                 per_frame[(s, int(f[0]))].append(int(f[1]))
                 counted += 1
     assert counted >= 5
-    # the swap: two ids evaluated together in frames 0 .. 2 of one sequence
-    s, a, b = next((s, *ids[:2]) for (s, k), ids in sorted(per_frame.items()) if k == 0 and len(ids) >= 2)
-    assert all({a, b} <= set(per_frame[(s, k)]) for k in range(FRAMES))
+    # the swap: two ids evaluated together in every frame of one sequence (a target hidden wholly in a frame is
+    # occluded 3 there, a distractor)
+    s, a, b = next(
+        (s, a, b)
+        for (s, k), ids in sorted(per_frame.items())
+        if k == 0
+        for a, b in itertools.combinations(sorted(ids), 2)
+        if all({a, b} <= set(per_frame[(s, j)]) for j in range(FRAMES))
+    )
     for name in ("gt_copy", "swapped"):
         (tmp_path / name / "data").mkdir(parents=True)
         for q in seqs:

@@ -318,7 +318,8 @@ def kitti_objects(rec: Path, agent: str, k: int) -> list[dict[str, Any]]:
     the front camera's optical frame of ``/tf``: bottom-centre location of the upright box (the box centre h/2 down
     the camera's y axis, where a reader adding h/2 back finds the centre), ``rotation_y`` about the camera's y axis
     (the box's x axis is ``(cos ry, 0, -sin ry)``), dimensions ``h w l``, the front camera's 2D box (``0 0 0 0``
-    with occluded 3 and truncated 1 when it has none)."""
+    with occluded 3 and truncated 1 when it has none; ``0 0 0 0`` with occluded 3 and its truncation when no pixel of
+    it is seen)."""
     msgs = frame_messages(rec, k)
     world = {v.id: v for v in msgs[topics.WORLD_STATE].vessels}
     tf = {(t.parent_frame_id, t.child_frame_id): t for t in msgs[topics.TF].transforms}
@@ -335,11 +336,14 @@ def kitti_objects(rec: Path, agent: str, k: int) -> list[dict[str, Any]]:
         x_axis = velo_to_cam[:3, :3] @ rot[:, 0]
         ry = math.atan2(-x_axis[2], x_axis[0])
         b2 = boxes2d.get(b.target_id)
+        cut = 1.0 if b2 is None else b2.truncation  # out of the image: wholly truncated
+        if b2 is not None and b2.visible_pixels == 0:  # in view, no pixel seen (hidden wholly): KITTI's "unknown"
+            b2 = None
         occ = 3 if b2 is None else 0 if b2.occlusion < 0.25 else 1 if b2.occlusion < 0.6 else 2
         out.append(
             {
                 "type": class_name(world[b.target_id].semantic_class).capitalize(),
-                "truncated": 1.0 if b2 is None else b2.truncation,  # out of the image: wholly truncated
+                "truncated": cut,
                 "occluded": occ,
                 "alpha": wrap(ry - math.atan2(loc[0], loc[2])),
                 "bbox": [0.0] * 4 if b2 is None else [b2.x_min, b2.y_min, b2.x_max, b2.y_max],

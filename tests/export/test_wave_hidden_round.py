@@ -124,12 +124,12 @@ def test_opv2v_vehicles_carry_the_ego_lidar_wave_share(rec: Path, tmp_path: Path
     assert ("usv_b", "c180", 1.0, 0) in seen  # wholly hidden: share 1, no point
 
 
-def test_a_craft_the_waves_hide_wholly_is_left_out_of_coco_yolo_mot_and_kept_by_kitti(
-    rec: Path, tmp_path: Path
-) -> None:
+def test_a_craft_the_waves_hide_wholly_is_left_out_of_coco_yolo_mot_and_kitti_scores(rec: Path, tmp_path: Path) -> None:
     """docs/exports.md: a vessel without a visible pixel gets no box in COCO, YOLO and MOT, whatever hides it (here
-    the crests alone); KITTI keeps a target in range with its recorded (projected) box and ``occluded`` 2, its
-    occlusion being 1. Counted against the recording: every COCO, YOLO and MOT box is one with a visible pixel."""
+    the crests alone); KITTI keeps a target in range with ``occluded`` 3 (its "unknown", a distractor for its
+    evaluations) and box ``0 0 0 0``, as one outside the image: it wrote the recorded (projected) box and ``occluded``
+    2, a ground truth KITTI's evaluation scored. Counted against the recording: every COCO, YOLO and MOT box is one
+    with a visible pixel."""
     b2 = _boxes(rec, "boxes_2d")
     n_visible = b2.filter(pl.col("visible_pixels") > 0).height
     coco = json.loads(Path(glob.glob(str(_convert(rec, tmp_path, "coco") / "annotations" / "*.json"))[0]).read_text())
@@ -146,10 +146,12 @@ def test_a_craft_the_waves_hide_wholly_is_left_out_of_coco_yolo_mot_and_kept_by_
     row = b2.filter((pl.col("frame") == 0) & (pl.col("agent") == "usv_b") & (pl.col("target_id") == "c180")).row(
         0, named=True
     )
-    labels = (kitti / "wavehide" / "1001" / "label_2" / "000000.txt").read_text().splitlines()
-    boxes = [np.array(ln.split()[4:8], dtype=float) for ln in labels if ln.split()[2] == "2"]
-    want = np.round([row["x_min"], row["y_min"], row["x_max"], row["y_max"]], 2)
-    assert any(np.array_equal(b, want) for b in boxes), (labels, want)
+    labels = [ln.split() for ln in (kitti / "wavehide" / "1001" / "label_2" / "000000.txt").read_text().splitlines()]
+    projected = np.round([row["x_min"], row["y_min"], row["x_max"], row["y_max"]], 2)
+    assert not any(np.array_equal(np.array(f[4:8], dtype=float), projected) for f in labels), labels
+    unknown = [f for f in labels if f[0] != "DontCare" and f[2] == "3"]
+    assert unknown and all(f[4:8] == ["0.00"] * 4 for f in unknown), labels
+    assert f"{row['truncation']:.2f}" in {f[1] for f in unknown}, (labels, row["truncation"])
 
 
 def test_the_detection_study_reads_the_wave_shares_from_an_opv2v_export_as_from_the_recording(

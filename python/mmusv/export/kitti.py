@@ -10,7 +10,8 @@ range (same filter as OPV2V): ``type truncated occluded alpha x1 y1 x2 y2 h w l 
 camera frame (location = the box centre moved h/2 down the camera's y axis: KITTI's bottom centre of an upright
 box, so that readers adding h/2 back get the box centre, also when the hull or the USV rolls in waves); the 2D box,
 truncation and occlusion come from the recording's camera annotations (occluded 0: < 25 % hidden, 1: < 60 %,
-2: more, 3: no box in the front image, with box ``0 0 0 0`` and truncated the share of the target out of the image:
+2: more, 3: no box in the front image — out of its view, or in it with no pixel seen, hidden wholly by the crests
+or by hulls — with box ``0 0 0 0`` and truncated the share of the target out of the image:
 ``1.00`` behind or beside the camera, the projected box's share for one in view too small for any pixel centre).
 After the targets, a ``DontCare`` line (KITTI's own form, :func:`dont_care_lines`) for each vessel the front image
 shows that is not a target (beyond the range by its centre, or another USV): KITTI's evaluation ignores detections
@@ -177,7 +178,13 @@ def label_lines(
     for t in targets:
         box2d = boxes.get(t.id)
         unseen = 1.0  # no front camera, or a target out of its view
-        if box2d is None and cam is not None:  # in view but too small for a pixel centre to meet it?
+        if box2d is not None and box2d.visible_pixels == 0:
+            # In view but no pixel of it seen (hidden wholly by the crests or by hulls): not a ground truth of the
+            # image (KITTI's annotators label what they see; its evaluation ignores occluded 3), its share out of it
+            # as recorded.
+            unseen = float(box2d.truncation)
+            box2d = None
+        elif box2d is None and cam is not None:  # in view but too small for a pixel centre to meet it?
             corners = box_corners(velo_to_cam @ t.box_in_lidar, np.asarray(t.size, dtype=np.float64))
             unseen = pinhole_truncation(corners, intrinsics=cam.intrinsics, width=cam.width, height=cam.height)
         lines.append(kitti_label(t, velo_to_cam, box2d=box2d, kind=kind, levels=levels, unseen_truncation=unseen))
@@ -270,9 +277,11 @@ def kitti_label(
 class KittiWriter(DatasetWriter):
     """Writes one recording as KITTI-style per-agent folders (see the module docstring)."""
 
-    format_version: ClassVar[int] = 3
+    format_version: ClassVar[int] = 4
     """2 (2026-12-02): ``truncated`` of a target without a front box is its share out of the image (it was 0); 3
-    (2026-12-06): ``DontCare`` lines for the vessels the front image shows that are not targets."""
+    (2026-12-06): ``DontCare`` lines for the vessels the front image shows that are not targets; 4 (2026-12-06): a
+    target in view with no pixel seen (hidden wholly) is occluded 3 with box ``0 0 0 0`` (it was occluded 2 with its
+    projected box, a ground truth KITTI's evaluation scored)."""
     cameras: ClassVar[dict[str, int]] = {"front": 2}
     needs_agent: ClassVar[bool] = True
     image_folder: ClassVar[str] = "image_2"
