@@ -217,8 +217,9 @@ def sample_candidate(
     except ValueError as exc:  # no valid water cell at all
         raise SamplingError(str(exc)) from None
     # distractors: extra targets around the encounter centre on random straight tracks
-    n_extra = int(rng.integers(diff.extra_targets[0], diff.extra_targets[1] + 1))  # drawn either way: the
-    if slot is not None:  # attempt's later draws stay where they were
+    # (drawn from the attempt's generator either way, so that its later draws stay where they were)
+    n_extra = int(rng.integers(diff.extra_targets[0], diff.extra_targets[1] + 1))
+    if slot is not None:  # the count for the candidate's place in the quota
         n_extra = extra_count(spec.seed, combo_index=combo_index, slot=slot, extra=diff.extra_targets)
     classes = diff.extra_classes or list(spec.size_classes)
     reach = max(diff.range_m[1], 150.0)
