@@ -40,15 +40,17 @@ def camera_mount(asset: VesselAsset, camera: CameraConfig) -> Mount:
     a camera without a mount sat at the vessel origin, midship at the waterline: under the crests at W3, it labelled
     the water above it sky and saw no vessel.
 
-    A mount equal to the default (no point, no offset, no turn) counts as none: a scenario written out in full (the
-    run's resolved ``scenario.yaml``, the recording's ``scenario`` metadata) gives every camera's mount so, and read
-    back it put the camera at the vessel origin, where the run that wrote it had it on its mount point (with the
-    same config hash).
+    A mount written out in full as the default (``point`` null, ``xyz`` and ``rpy_deg`` zero, all three given) counts
+    as none: a scenario written out in full (the run's resolved ``scenario.yaml``, the recording's ``scenario``
+    metadata) gives every camera's mount so, and read back it put the camera at the vessel origin, where the run that
+    wrote it had it on its mount point (with the same config hash). A mount that gives only some of them, such as
+    ``{xyz: [0, 0, 0]}``, is the user's own: the vessel origin.
 
     A camera named ``rear``, ``left`` or ``right`` whose point the asset lacks takes the hull's top turned as its name
     says, not ``camera_front``: on an asset that gives ``camera_front`` alone (a user's own), a surround rig's four
     cameras all looked ahead from the bow."""
-    if "mount" in camera.model_fields_set and camera.mount.model_dump() != Mount().model_dump():
+    written_out = camera.mount.model_fields_set == set(Mount.model_fields)  # every field given, as a dump does
+    if "mount" in camera.model_fields_set and not (written_out and camera.mount.model_dump() == Mount().model_dump()):
         return camera.mount
     own = f"camera_{camera.name}"
     if own in asset.mounts or own in _TURNED or "camera_front" not in asset.mounts:

@@ -3,7 +3,8 @@
 //! Models and sources:
 //! - **Heave and pitch**: Jensen, J. J., Mansour, A. E. & Olsen, A. S. (2004), "Estimation of ship motions using
 //!   closed-form expressions", Ocean Engineering 31, 61–85: a homogeneously loaded box of length `L`, draft `T`
-//!   and breadth `B = Cb·B₀` (block coefficient times beam), at speed `U` and heading `β` to the waves
+//!   and breadth `B = Cb·B₀` (block coefficient times beam; in the damping terms at most `2π T`,
+//!   [`MAX_DAMPING_BREADTH_PER_DRAFT`]), at speed `U` and heading `β` to the waves
 //!   (β = 0 following, π head seas). With `k = ω²/g`, `α = ω_e/ω = 1 − Fn·√(kL)·cos β`, `k_e = |k cos β|`,
 //!   `κ = exp(−k_e T)`:
 //!
@@ -49,6 +50,14 @@ use std::f64::consts::{PI, TAU};
 pub const ROLL_GYRADIUS_RATIO: f64 = 0.39;
 /// Default equivalent linear roll damping ratio ζ.
 pub const ROLL_DAMPING_RATIO: f64 = 0.10;
+
+/// The most breadth per draft JMO's heave and pitch damping takes, `2π`: at heave resonance (`2kTα² = 1`) the
+/// damping term `A²/(kBα²)` has `sin(kBα²/2) = sin(B/4T)`, which rises with `B/T` up to `2π` and then falls, to 0 at
+/// `4π`: an artefact of the box section's sine far outside the ships the closed form was built and checked for
+/// (Jensen et al.'s hulls have `B/T` of 2–4; the widest of the library's, the 60 m deck barge, 6.2). A hull wider
+/// for its draft (the 22 m hovercraft's 26: its heave resonance 92 times the wave, where every other asset's is at most
+/// 4.5) takes `B = 2π T` in the damping terms (its peak then 2.1). The RAOs of hulls within it are unchanged.
+pub const MAX_DAMPING_BREADTH_PER_DRAFT: f64 = TAU;
 
 /// Main particulars of a hull: what the closed-form RAOs need.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -171,7 +180,7 @@ impl Hull {
         let k = omega * omega / GRAVITY;
         let (sb, cb) = beta.sin_cos();
         let (l, t) = (self.length_m, self.draft_m);
-        let b = self.block_coefficient * self.beam_m;
+        let b = (self.block_coefficient * self.beam_m).min(MAX_DAMPING_BREADTH_PER_DRAFT * t);
         let alpha = (omega_e / omega).abs();
         let a2 = alpha * alpha;
         let ke = (k * cb).abs();
@@ -351,6 +360,38 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The heave resonance's damping term never falls as a hull widens for its draft: up to `B = 2π T` the RAOs are
+    /// the closed form's, past it those of a hull `2π T` wide. In beam seas at rest at heave resonance (`κ = 1`,
+    /// `sinc = 1`, `α = 1`, `2kT = 1`) the heave is `√(¼ + d²)/d` per metre of wave, `d = A²/(kB)`: 46 for the
+    /// hovercraft's `B/T` of 26 as the closed form has it, 1.5 with the breadth capped.
+    #[test]
+    fn heave_damping_takes_at_most_two_pi_drafts_of_breadth() {
+        let (draft, cb) = (0.25, 0.6);
+        let hull = |beam: f64| ok(Hull::new(22.0, beam, draft, cb, 1.0));
+        // The beam whose breadth Cb·B₀ is 2π T.
+        let cap = TAU * draft / cb;
+        // Within: the closed form itself, written out independently (`closed_form`).
+        let within = hull(0.9 * cap);
+        for (omega, beta) in [(1.0, 0.3), (3.0, 2.0), (4.4, PI), (6.0, 1.0)] {
+            let k: f64 = omega * omega / GRAVITY;
+            let r = within.rao(omega, beta, omega - k * 5.0 * beta.cos());
+            let want = closed_form(&within, omega, beta, 5.0);
+            assert!((abs(r.heave) - want[0]).abs() <= 1e-9 * want[0].max(1e-6), "{omega} {beta}");
+        }
+        // Past it: the hull 2π T wide, to the bit, however wide (the roll keeps its own beam).
+        let omega = (GRAVITY / (2.0 * draft)).sqrt();
+        let at = hull(cap).rao(omega, PI / 2.0, omega);
+        for beam in [12.0, 11.0, 30.0] {
+            let r = hull(beam).rao(omega, PI / 2.0, omega);
+            assert_eq!((r.heave, r.pitch), (at.heave, at.pitch), "{beam}");
+        }
+        // kB = k · 2π T = π there, so A = 2 sin(π/2) e^{−kT} = 2 e^{−1/2} and d = A²/π.
+        let d = (2.0 * (-0.5_f64).exp()).powi(2) / PI;
+        let want = (0.25 + d * d).sqrt() / d;
+        assert!((abs(at.heave) - want).abs() < 1e-9 * want, "{:?} against {want}", at.heave);
+        assert!(abs(hull(11.0).rao(omega, PI / 2.0, omega).heave) < 1.6);
     }
 
     #[test]
