@@ -136,15 +136,14 @@ def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[st
         )
     samples = scenario_samples(scenario, MapContext(world), spec)
     cons = spec.constraints
+    index = {v.id: i for i, v in enumerate(scenario.vessels)}  # each finding names the vessel's field by its index
     stranded = InWater().findings(samples)
     if stranded:
         # Every vessel that leaves the water, each named by the field to edit.
-        index = {v.id: i for i, v in enumerate(scenario.vessels)}
         fails = "; ".join(f"{f.message} (vessels[{index[f.vessels[0]]}].route)" for f in stranded)
         raise ConfigError(f"{source}: in_water: {fails}; routes must stay on navigable water (--no-checks skips this)")
     crossing = HullsIntersect().findings(samples)
     if crossing:
-        index = {v.id: i for i, v in enumerate(scenario.vessels)}
         fails = "; ".join(
             f"{f.message} (vessels[{index[f.vessels[0]]}] and vessels[{index[f.vessels[1]]}])" for f in crossing
         )
@@ -153,7 +152,6 @@ def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[st
         )
     aground = MooredHullsIntersect().findings(samples)
     if aground:
-        index = {v.id: i for i, v in enumerate(scenario.vessels)}
         fails = "; ".join(f"{f.message} (vessels[{index[f.vessels[0]]}].route)" for f in aground)
         raise ConfigError(
             f"{source}: hulls_intersect: {fails}; keep the route off the moored ships (--no-checks skips this)"
@@ -167,7 +165,6 @@ def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[st
         msg = check.check(samples)
         if msg is not None:
             found.append(f"{source}: {check.name}: {msg}")
-    index = {v.id: i for i, v in enumerate(scenario.vessels)}
     found += [
         f"{source}: under_keel: vessels[{index[f.vessels[0]]}] {f.message}"
         for f in keel_findings(scenario, world, samples)
