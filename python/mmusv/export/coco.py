@@ -34,7 +34,7 @@ import numpy as np
 
 from mmusv.errors import ConfigError
 from mmusv.export.camera import CATEGORIES, CameraWriter, Sample, Shared, category_names
-from mmusv.export.common import BOX_DEFINITIONS, Options, Sink, png_bytes
+from mmusv.export.common import BOX_DEFINITIONS, Options, Sink, png_bytes, rounded_share
 from mmusv.export.splits import SPLIT_NAMES
 from mmusv.jsonio import dump_json
 from mmusv.recording.info import RecordingInfo
@@ -118,7 +118,7 @@ class CocoWriter(CameraWriter):
                     "instance_id": b.instance_id,
                     "visible_pixels": b.visible_pixels,
                     "contrast": None if b.contrast is None else round(b.contrast, 6) + 0.0,
-                    "wave_occlusion": None if b.wave_occlusion is None else round(b.wave_occlusion, 6) + 0.0,
+                    "wave_occlusion": rounded_share(b.wave_occlusion),
                 }
             )
 

@@ -35,6 +35,7 @@ __all__ = [
     "parse_extras",
     "png_bytes",
     "rounded",
+    "rounded_share",
     "top_view_entry",
     "top_view_png",
     "top_view_protocol",
@@ -292,3 +293,9 @@ def wave_share(box: Any) -> float | None:
     flat sea), ``None`` for a box of a recording made before the field existed (its embedded schema lacks it)."""
     share = getattr(box, "wave_occlusion", None)
     return None if share is None else float(share)
+
+
+def rounded_share(share: float | None) -> float | None:
+    """A wave-occlusion share (:func:`wave_share`) as the exports write it: 6 decimals, ``None`` kept (a recording
+    made before the field existed)."""
+    return None if share is None else round(share, 6) + 0.0

@@ -61,6 +61,7 @@ from mmusv.export.common import (
     encode_png,
     png_bytes,
     rounded,
+    rounded_share,
     top_view_protocol,
     wave_share,
 )
@@ -134,11 +135,6 @@ def _lidar_summary(p: dict[str, Any]) -> str:
 def timestamp(frame: int) -> str:
     """The OPV2V timestamp of acquisition index ``frame`` (6 digits, zero-padded)."""
     return f"{frame:06d}"
-
-
-def _rounded_share(share: float | None) -> float | None:
-    """A wave-occlusion share at 6 decimals (``None`` stays ``None``: a recording made before the field existed)."""
-    return None if share is None else round(share, 6) + 0.0
 
 
 def _matrix_list(m: np.ndarray) -> list[list[float]]:
@@ -328,7 +324,7 @@ class Opv2vWriter(DatasetWriter):
                         "class_name": class_name(t.semantic_class),
                         "instance_id": t.instance_id,
                         "lidar_points": counts.get(t.instance_id, 0),
-                        "wave_occlusion": _rounded_share(shares.get(t.id)),
+                        "wave_occlusion": rounded_share(shares.get(t.id)),
                     }
                     for t in targets
                 },
