@@ -93,7 +93,10 @@ def test_an_additional_yaml_another_tool_wrote_is_not_read_as_mmusv_s(tmp_path: 
     """``read_opv2v`` reads mmusv's ``<ts>_additional.yaml`` for the USVs listed there (role ``usv``); a file of that
     name without an ``mmusv`` key (another tool's, beside a stock OPV2V frame) holds none of them and is not refused,
     while mmusv's own, damaged, still is."""
-    from mmusv.studies.detection.data import _opv2v_usvs
+    from mmusv.studies.detection.data import _opv2v_additional
+
+    def _opv2v_usvs(path: Path) -> set[str]:  # the USVs it lists (the first of what the study reads there)
+        return _opv2v_additional(path)[0]
 
     path = tmp_path / "000000_additional.yaml"
     path.write_text("weather: rain\nvehicles: {7: {role: usv}}\n")

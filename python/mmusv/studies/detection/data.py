@@ -336,19 +336,13 @@ def read_opv2v(folder: str | Path) -> SequenceData:
     return SequenceData(d.name, tuple(frames))
 
 
-def _opv2v_usvs(path: Path) -> set[str]:
-    """The ids of the vehicles that an OPV2V frame's ``<ts>_additional.yaml`` (mmusv's, beside the stock files)
-    gives role ``usv``; none without the file (a stock OPV2V folder) or for a mapping without an ``mmusv`` key (a
-    file of that name that another tool wrote). mmusv's that is not such a document, or a file that is not a YAML
-    mapping, raises as the frame's yaml does (``ValueError``, ``yaml.YAMLError``)."""
-    return _opv2v_additional(path)[0]
-
-
 def _opv2v_additional(path: Path) -> tuple[set[str], dict[str, float]]:
-    """What the study reads of an OPV2V frame's ``<ts>_additional.yaml``: the ids of the vehicles it gives role
-    ``usv`` (:func:`_opv2v_usvs`) and, by vehicle id, the share the waves hide of each from this CAV's LiDAR (its
-    ``wave_occlusion``, as the recording's annotations give it; none where the file has no such number: a stock
-    folder, an export made before the field)."""
+    """What the study reads of an OPV2V frame's ``<ts>_additional.yaml`` (mmusv's, beside the stock files): the ids
+    of the vehicles it gives role ``usv`` and, by vehicle id, the share the waves hide of each from this CAV's LiDAR
+    (its ``wave_occlusion``, as the recording's annotations give it; none where the file has no such number: a stock
+    folder, an export made before the field). Neither without the file (a stock OPV2V folder) or for a mapping
+    without an ``mmusv`` key (a file of that name that another tool wrote); mmusv's that is not such a document, or
+    a file that is not a YAML mapping, raises as the frame's yaml does (``ValueError``, ``yaml.YAMLError``)."""
     if not path.is_file():
         return set(), {}
     doc = yaml.safe_load(path.read_text(encoding="utf-8"))
