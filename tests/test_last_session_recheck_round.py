@@ -22,8 +22,9 @@ Found (each test below failed before its fix, or is a strict xfail where the fix
   W1 (0.49 m/s on the straight legs). A strict xfail at first; fixed since for the heave: JMO's damping term fell
   towards 0 for a hull as wide for its draft as the hovercraft (B/T 26, peak heave 92 times the wave), and now takes
   at most 2π drafts of breadth (``ocean/response.rs``, ``MAX_DAMPING_BREADTH_PER_DRAFT``): 1.05 m/s in the bend
-  against 0.31 on the legs (:func:`test_the_heave_does_not_jump_in_a_bend`). The roll of small craft still sweeps
-  through its resonance in tight bends (the steady state at the instant's heading); not a test here.
+  against 0.31 on the legs (:func:`test_the_heave_does_not_jump_in_a_bend`). The roll of small craft swept through
+  its resonance in tight bends (the steady state at the instant's heading) until the response remembered its course
+  (``kinematics/transient.rs``; ``tests/test_motion_user_round.py``).
 * ``mmusv generate`` writes scenarios that ``mmusv run`` then warns are aground (``under_keel`` is no generator
   constraint): the ``port_entry`` family with a ``large`` target on the default port (basin 14 m) in 6 of 12 seeds,
   the bundled coop_detection specs 4 of 254 scenarios at seeds 0 and 1. A strict xfail at first; fixed since: the

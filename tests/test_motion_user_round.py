@@ -361,6 +361,22 @@ def test_heave_rate_is_the_derivative_of_the_heave_in_a_fast_turn() -> None:
     np.testing.assert_allclose(vz, dz, atol=0.01)
 
 
+def test_a_small_craft_does_not_roll_through_its_resonance_in_a_tight_bend() -> None:
+    """``island_port_waves``' ``target_1`` again (5 m speedboat, 9 m/s, bends down to 16 m of radius, W1), its roll
+    sampled every 10 ms over a minute: the steady state of the moment swept through the roll resonance with the
+    heading and rolled at up to 158 deg/s in the bends against 29 deg/s on the straighter stretches. The response now
+    remembers its course at the roll's decay rate (``kinematics/transient.rs``): the bends' rate is of the order of
+    the legs' (measured 55 against 36 deg/s)."""
+    route = [[-160.0, 40.0], [-20.0, 110.0], [40.0, 20.0], [-80.0, -40.0]]
+    f = fleet([vessel(route, end="loop", speed=9.0)], motion="physical", wave="W1", seed=0)
+    dt = 0.01
+    p = np.asarray(f.poses_at_times(np.arange(0.0, 60.0, dt)))[:, 0]
+    rate = np.degrees(np.abs(np.diff(p[:, 3]))) / dt
+    turning = np.abs(np.diff(np.unwrap(p[:, 5]))) / dt > 0.05
+    assert turning.any() and (~turning).any()
+    assert rate[turning].max() < 2.0 * rate[~turning].max(), (rate[turning].max(), rate[~turning].max())
+
+
 def test_the_foam_behind_a_vessel_outlasts_its_stop() -> None:
     """A speedboat at 8 m/s ends its ``stop`` route at t = 10 s: its foam, drawn by the cameras (and met by the
     LiDAR) up to frame 50, was gone at frame 51, 0.2 s later, as if it had never sailed (the rendered frames of a

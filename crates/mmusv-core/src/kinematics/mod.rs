@@ -22,8 +22,8 @@
 //! - [`waves`]: [`WaveSetting`], size factor, base amplitudes and the seeded periodic functions `g(t)`.
 //! - [`path_behind`]: how far back a vessel's path ran straight, and its straight pieces round the bends
 //!   ([`WakePiece`]).
-//! - [`transient`]: the physical response across a route's stop or turn about, from the steady state before to the
-//!   one after.
+//! - [`transient`]: the physical response remembers the recent course: through a route's bends, stops and turns
+//!   about the hull passes from one steady state to the next at the rate its roll's free oscillation decays.
 
 pub mod path_behind;
 pub mod spline;
@@ -189,10 +189,12 @@ impl VesselMotion {
     }
 
     /// The pose with the physical response to `sea` (heave, roll, pitch through the hull's RAOs at the vessel's
-    /// position, heading and velocity) instead of the paper's perturbation.
+    /// position, heading and velocity, remembering its recent course: [`transient`]) instead of the paper's
+    /// perturbation. A [`Fleet`] in a sea keeps each route's steady states from call to call; this works them out
+    /// afresh each time.
     pub fn pose_in_sea(&self, t: f64, sea: &WaveField) -> Result<[f64; 6]> {
         self.check_travel(t, "t")?;
-        Ok(self.pose_unchecked(t, &WaveSetting::W0, Some(sea)))
+        Ok(self.pose_unchecked(t, &WaveSetting::W0, Some((sea, None))))
     }
 
     /// World-frame linear velocity `[vx, vy, vz]` in m/s at time `t`: `u·σ·tangent(s)` horizontally (zero at
@@ -203,16 +205,13 @@ impl VesselMotion {
         Ok(self.velocity_unchecked(t, wave, None))
     }
 
-    fn pose_unchecked(&self, t: f64, wave: &WaveSetting, sea: Option<&WaveField>) -> [f64; 6] {
+    fn pose_unchecked(&self, t: f64, wave: &WaveSetting, sea: Option<Sea<'_>>) -> [f64; 6] {
         let (s, sign) = self.route.distance_to_arc(self.travelled_m(t));
         let [x, y] = self.route.position(s);
         let yaw = self.route.heading(s, sign);
         let [dz, roll, pitch] = match sea {
             None => self.perturbation_at(t, wave),
-            Some(field) => {
-                let v = self.horizontal_velocity(s, sign);
-                transient::response_through_events(field, &self.route, &self.params, [x, y], yaw, v, t)
-            }
+            Some((field, memo)) => transient::remembered_response(field, &self.route, &self.params, [x, y], t, memo),
         };
         [x, y, self.params.z_base_m + dz, roll, pitch, yaw]
     }
@@ -222,7 +221,7 @@ impl VesselMotion {
         self.route.velocity(s, sign, self.params.speed_mps)
     }
 
-    fn velocity_unchecked(&self, t: f64, wave: &WaveSetting, sea: Option<&WaveField>) -> [f64; 3] {
+    fn velocity_unchecked(&self, t: f64, wave: &WaveSetting, sea: Option<Sea<'_>>) -> [f64; 3] {
         let (s, sign) = self.route.distance_to_arc(self.travelled_m(t));
         let [vx, vy] = self.horizontal_velocity(s, sign);
         let vz = match sea {
@@ -245,6 +244,9 @@ impl VesselMotion {
     }
 }
 
+/// A wave field and, where a fleet keeps them, the vessel's route knots' steady states in it.
+type Sea<'a> = (&'a WaveField, Option<&'a transient::KnotGains>);
+
 /// The time step (s) of the heave rate's differences in a sea ([`VesselMotion::velocity_at`]).
 const HEAVE_RATE_STEP_S: f64 = 1e-4;
 
@@ -255,24 +257,32 @@ pub struct Fleet {
     vessels: Vec<VesselMotion>,
     wave: WaveSetting,
     sea: Option<Arc<WaveField>>,
+    /// Per vessel, its route knots' steady states in `sea` (filled as the poses ask for them).
+    memos: Vec<Arc<transient::KnotGains>>,
 }
 
 impl Fleet {
     /// A fleet of `vessels` (index order is kept in every output) under `wave`, moved by the paper's formula.
     pub fn new(vessels: Vec<VesselMotion>, wave: WaveSetting) -> Self {
-        Self { vessels, wave, sea: None }
+        Self { vessels, wave, sea: None, memos: Vec::new() }
     }
 
     /// The same fleet moved physically by `sea`: heave, roll and pitch from each hull's RAOs
     /// ([`crate::ocean::response`](mod@crate::ocean::response)) instead of the paper's perturbation.
     pub fn with_sea(mut self, sea: Arc<WaveField>) -> Self {
         self.sea = Some(sea);
+        self.memos = self.vessels.iter().map(|_| Arc::new(transient::KnotGains::new())).collect();
         self
     }
 
     /// The wave field the fleet sails in, when physical.
     pub fn sea(&self) -> Option<&WaveField> {
         self.sea.as_deref()
+    }
+
+    /// Vessel `v`'s sea: the field and its memo of the route's steady states.
+    fn sea_of(&self, v: usize) -> Option<Sea<'_>> {
+        self.sea.as_deref().map(|f| (f, self.memos.get(v).map(Arc::as_ref)))
     }
 
     /// The vessels, in order.
@@ -309,13 +319,13 @@ impl Fleet {
     /// Poses `η = [x, y, z, roll, pitch, yaw]` of every vessel at time `t` (finite, ≥ 0), in vessel order.
     pub fn poses_at(&self, t: f64) -> Result<Vec<[f64; 6]>> {
         self.check_travel(t, "t")?;
-        Ok(self.vessels.iter().map(|v| v.pose_unchecked(t, &self.wave, self.sea())).collect())
+        Ok(self.vessels.iter().enumerate().map(|(i, v)| v.pose_unchecked(t, &self.wave, self.sea_of(i))).collect())
     }
 
     /// World-frame linear velocities `[vx, vy, vz]` (m/s) of every vessel at time `t`, in vessel order.
     pub fn velocities_at(&self, t: f64) -> Result<Vec<[f64; 3]>> {
         self.check_travel(t, "t")?;
-        Ok(self.vessels.iter().map(|v| v.velocity_unchecked(t, &self.wave, self.sea())).collect())
+        Ok(self.vessels.iter().enumerate().map(|(i, v)| v.velocity_unchecked(t, &self.wave, self.sea_of(i))).collect())
     }
 
     /// Poses at many times, flattened time-major: entry `k · len() + v` is vessel `v` at `times[k]`
@@ -342,8 +352,8 @@ impl Fleet {
             return Ok(out);
         }
         out.par_chunks_mut(nv).zip(times.par_iter()).for_each(|(row, &t)| {
-            for (slot, v) in row.iter_mut().zip(&self.vessels) {
-                *slot = v.pose_unchecked(t, &self.wave, self.sea());
+            for (i, (slot, v)) in row.iter_mut().zip(&self.vessels).enumerate() {
+                *slot = v.pose_unchecked(t, &self.wave, self.sea_of(i));
             }
         });
         Ok(out)

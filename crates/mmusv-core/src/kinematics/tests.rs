@@ -228,25 +228,25 @@ fn a_fleet_in_a_sea_moves_by_its_hulls_response() {
     let t = 37.5;
     let (pp, pq) = (ok(paper.poses_at(t)), ok(physical.poses_at(t)));
     for (v, (a, b)) in paper.vessels().iter().zip(pp.iter().zip(&pq)) {
-        // Same route position and heading; heave, roll, pitch from the RAOs at that place and velocity.
+        // Same route position and heading; heave, roll, pitch from the RAOs at that place, through the memory of
+        // the course (on this curving loop within a few per cent of the steady state of the moment's RMS scale).
         assert_eq!((a[0], a[1], a[5]), (b[0], b[1], b[5]));
+        assert_eq!(ok(v.pose_in_sea(t, &field)), *b);
         let vel = ok(v.velocity_at(t, &WaveSetting::W2));
         let r = response(&field, &v.params().hull, b[0], b[1], b[5], vel[0], vel[1], t)[0];
-        assert_eq!([b[2] - v.params().z_base_m, b[3], b[4]], r);
-        assert_eq!(ok(v.pose_in_sea(t, &field)), *b);
+        let scale = ok(crate::ocean::response_variance(&v.params().hull, &sea, b[5], 3.0)).map(f64::sqrt);
+        for m in 0..3 {
+            let got = [b[2] - v.params().z_base_m, b[3], b[4]][m];
+            assert!((got - r[m]).abs() < 0.1 * scale[m], "{m} {got} {} {}", r[m], scale[m]);
+        }
     }
-    // Vertical velocity is the time derivative of the heave, the turning's change of the response included
-    // (on this curve it is a few per cent of the rate at a fixed heading and velocity).
+    // Vertical velocity is the time derivative of the heave, the turning's change of the response included.
     let h = 1e-5;
     let (a, b) = (ok(physical.poses_at(t - h)), ok(physical.poses_at(t + h)));
     let vz = ok(physical.velocities_at(t));
-    for (i, v) in physical.vessels().iter().enumerate() {
+    for i in 0..physical.len() {
         let fd = (b[i][2] - a[i][2]) / (2.0 * h);
         assert!((fd - vz[i][2]).abs() < 1e-5, "{fd} {}", vz[i][2]);
-        let b = pq[i];
-        let vel = ok(v.velocity_at(t, &WaveSetting::W2));
-        let fixed = response(&field, &v.params().hull, b[0], b[1], b[5], vel[0], vel[1], t)[1][0];
-        assert!((fd - fixed).abs() < 0.05 * (fixed.abs() + 0.01));
     }
     // The paper fleet is untouched by the existence of a sea.
     assert!(paper.sea().is_none() && physical.sea().is_some());
@@ -255,7 +255,7 @@ fn a_fleet_in_a_sea_moves_by_its_hulls_response() {
 #[test]
 fn the_physical_response_passes_smoothly_through_a_stop_and_a_turn_about() {
     use crate::ocean::{response::response, SeaSpec, WaveField};
-    use transient::FADED;
+    use transient::MEMORY;
     let sea = SeaSpec { hs: 3.5, tp: 8.0, gamma: 3.3, direction_rad: 0.3, spread_s: 10.0 };
     let field = ok(WaveField::new(&sea, 5));
     let field = Arc::new(field);
@@ -272,7 +272,7 @@ fn the_physical_response_passes_smoothly_through_a_stop_and_a_turn_about() {
         assert!((steady[1] - b[3]).abs() > 1e-3 || (steady[0] - b[2]).abs() > 1e-3, "{end:?}");
         // Long after, the steady state of the new course (before the next turn of the ping-pong route).
         let hull = &v.params().hull;
-        let faded = -FADED.ln() / (hull.roll_damping_ratio * hull.roll_natural_frequency());
+        let faded = -MEMORY.ln() / (hull.roll_damping_ratio * hull.roll_natural_frequency());
         if end == EndBehaviour::Stop {
             let t = te + faded + 1.0;
             let p = pose(t);
