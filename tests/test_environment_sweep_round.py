@@ -471,15 +471,16 @@ def port_entry_contrasts(tmp_path: Path, name: str, environment: dict[str, Any] 
 
 def test_min_contrast_leaves_out_the_fog_s_boxes_as_documented(tmp_path: Path) -> None:
     """``docs/exports.md``: in the bundled ``port_entry`` (2 frames, four cameras at 160 x 120) ``--min-contrast
-    0.05`` leaves out most boxes in a 300 m fog at 16:30 and a few fragments on the bundled clear afternoon; the
-    boxes themselves are the same 36 in both (geometry). Measured 2026-12-06: 23 and 2 of 36."""
+    0.05`` leaves out most boxes in a 300 m fog at 16:30 and a few on the bundled clear afternoon; the boxes
+    themselves are the same 38 in both (geometry). Measured 2026-12-06: 25 and 2 of 38 (23 and 2 of 36 before the
+    physical response remembered its course through the bends: the USVs' cameras roll and pitch otherwise)."""
     clear = port_entry_contrasts(tmp_path, "clear", None)
     fog = port_entry_contrasts(
         tmp_path, "fog", {"time_of_day": "16:30", "weather": "fog", "visibility_m": 300, "wave": "W1"}
     )
-    assert len(clear) == len(fog) == 36
+    assert len(clear) == len(fog) == 38
     low = {k: sum(1 for c in v if c is not None and c < 0.05) for k, v in (("clear", clear), ("fog", fog))}
-    assert 20 <= low["fog"] <= 26 and low["clear"] <= 4, low
+    assert 22 <= low["fog"] <= 28 and low["clear"] <= 4, low
 
 
 def test_a_time_of_day_is_one_time_in_the_config_hash() -> None:
