@@ -28,9 +28,9 @@
 //!
 //! Quadrature: `G` is taken linear in time between the route's knots ([`route_knots`]: points between which the
 //! heading turns by less than [`KNOT_TURN_RAD`]) and the two courses of each route event (a stop, a turn about: both at
-//! the same time), with the kernel's weights exact for that; the course now and at the window's start are worked
-//! out afresh, the knots' gains once per vessel for the whole run ([`KnotGains`], which a [`super::Fleet`] in a sea
-//! keeps). At a single event on a straight route this is the blend `κ (w G_before + (1 − w) G_after)`,
+//! the same time), with the kernel's weights exact for that; the course now is worked out afresh, the window's
+//! start is taken linear between its two knots, and each knot's gains are worked out once per vessel for the whole
+//! run ([`KnotGains`], which a [`super::Fleet`] in a sea keeps). At a single event on a straight route this is the blend `κ (w G_before + (1 − w) G_after)`,
 //! `w = e^{−λ (t − t_e)}`, of the two steady states.
 //!
 //! Approximations: the free oscillation at the natural frequency itself is not drawn, and every component relaxes at
@@ -136,7 +136,17 @@ impl Course {
 enum Point {
     /// Knot `k` of the route, travelled forwards (`true`) or backwards.
     Knot(usize, bool),
-    /// Any other course (the one now, the one at the window's start).
+    /// The fraction `f` of the way from knot `k` to knot `k + 1`, travelled forwards or backwards: the steady state
+    /// taken linear between them, as the quadrature takes it (the window's start).
+    Between(usize, f64, bool),
+    /// Any other course (the one now, and at rest).
+    Fresh(Course),
+}
+
+/// Where a steady state of the sum comes from: a knot's (memoised) or a course's own.
+#[derive(Debug, Clone, Copy)]
+enum Source {
+    Knot(usize, bool),
     Fresh(Course),
 }
 
@@ -264,7 +274,15 @@ fn history(route: &Route, knots: &[f64], speed: f64, d1: f64, window: f64) -> (V
         }
         n -= 1.0;
     }
-    out.push((window, Point::Fresh(course_at(route, speed, d0))));
+    let (s0, sign) = route.distance_to_arc(d0);
+    let start = if sign == 0.0 || knots.len() < 2 {
+        Point::Fresh(Course::on(route, s0, sign, speed))
+    } else {
+        let k = knots.partition_point(|&x| x <= s0).saturating_sub(1).min(knots.len() - 2);
+        let f = ((s0 - knots[k]) / (knots[k + 1] - knots[k])).clamp(0.0, 1.0);
+        Point::Between(k, f, sign > 0.0)
+    };
+    out.push((window, start));
     (out, window)
 }
 
@@ -298,11 +316,13 @@ pub fn remembered_response(
     };
     let window = t.min(-MEMORY.ln() / lambda);
     let (points, window) = history(route, memo.knots(route), speed, d1, window);
-    let course = |p: &Point| match *p {
-        Point::Fresh(c) => c,
-        Point::Knot(k, fw) => Course::on(route, memo.knots(route)[k], if fw { 1.0 } else { -1.0 }, speed),
-    };
-    if points.iter().all(|p| matches!(p.1, Point::Fresh(_)) && course(&p.1).same(&now)) {
+    // Where the course now is the one all along the window (no knot or event in it): the steady state itself.
+    let constant = points.iter().all(|p| match p.1 {
+        Point::Fresh(c) => c.same(&now),
+        Point::Between(..) => course_at(route, speed, d1 - speed * window).same(&now),
+        Point::Knot(..) => false,
+    });
+    if constant {
         return steady_now();
     }
     // The kernel's weight of each point: exact for G linear in time between consecutive points, and the tail.
@@ -322,14 +342,26 @@ pub fn remembered_response(
     weights[points.len() - 1] += (-lambda * window).exp();
     let mut gains = vec![[[0.0f64; 2]; 3]; field.components().len()];
     let mut target = [0.0f64; 3];
+    // Each point's weight on the steady states it stands for.
+    let mut terms: Vec<(f64, Source)> = Vec::with_capacity(points.len() + 1);
     for (p, &w) in points.iter().zip(&weights) {
+        match p.1 {
+            Point::Knot(k, fw) => terms.push((w, Source::Knot(k, fw))),
+            Point::Between(k, f, fw) => {
+                terms.push((w * (1.0 - f), Source::Knot(k, fw)));
+                terms.push((w * f, Source::Knot(k + 1, fw)));
+            }
+            Point::Fresh(c) => terms.push((w, Source::Fresh(c))),
+        }
+    }
+    for (w, source) in terms {
         if w == 0.0 {
             continue;
         }
         let fresh;
-        let steady = match p.1 {
-            Point::Knot(k, fw) => memo.get(field, hull, route, speed, k, fw),
-            Point::Fresh(c) => {
+        let steady = match source {
+            Source::Knot(k, fw) => memo.get(field, hull, route, speed, k, fw),
+            Source::Fresh(c) => {
                 fresh = Steady::of(field, hull, c);
                 &fresh
             }
