@@ -17,21 +17,22 @@
 //! κ²   = ( ∫₀^W λ e^{−λτ} σ²(t − τ) dτ + e^{−λW} σ²(t − W) ) / Σ_c a_c²/2 |A_c / κ|²      (per mode)
 //! ```
 //!
-//! and the response `Σ_c Re(A_c a_c e^{iψ_c})` at the hull's position now. `λ` is the roll's (the least damped of the
-//! three modes, so its envelope bounds the heave's and the pitch's); `σ²(s) = Σ_c a_c²/2 |G_c(s)|²` is the steady
-//! state's variance over the field's random phases, and `κ` keeps the response's variance the kernel's mean of the
-//! steady variances it remembers (averaging gains whose phases differ would otherwise take energy out of the
-//! motion: 1–2 % of the roll over 20 minutes of turns about in `island_port_waves`). Before `t = 0` the hull is taken
-//! in the steady state of its course at `t = 0`, and beyond the memory `W = −ln(`[`MEMORY`]`)/λ` (13.8/λ: 35 s for a
-//! WAM-V, about 7 minutes for a 190 m bulk carrier) in that of its course at `t − W`, so the pose is continuous in
-//! time. Where the course has not changed over the window (a straight leg, or at rest), `A = G(t)` exactly.
+//! and the response `Σ_c Re(A_c a_c e^{iψ_c})` at the hull's position now. `λ` is the roll's (the least damped of
+//! the three modes, so its envelope bounds the heave's and the pitch's); `σ²(s) = Σ_c a_c²/2 |G_c(s)|²` is the
+//! steady state's variance over the field's random phases, and `κ` keeps the response's variance the kernel's mean of
+//! the steady variances it remembers (averaging gains whose phases differ would otherwise take energy out of the
+//! motion: 1–2 % of the roll over 20 minutes of turns about in `island_port_waves`). Before `t = 0` the hull is
+//! taken in the steady state of its course at `t = 0`, and beyond the memory `W = −ln(`[`MEMORY`]`)/λ` (13.8/λ:
+//! 35 s for a WAM-V, 6 minutes for the 190 m bulk carrier, 10 for the 300 m container ship) in that of its course
+//! at `t − W`, so the pose is continuous in time. Where the course has not changed over the window (a straight
+//! leg, or at rest), `A = G(t)` exactly.
 //!
 //! Quadrature: `G` is taken linear in time between the route's knots ([`route_knots`]: points between which the
 //! heading turns by less than [`KNOT_TURN_RAD`]) and the two courses of each route event (a stop, a turn about: both at
 //! the same time), with the kernel's weights exact for that; the course now is worked out afresh, the window's
 //! start is taken linear between its two knots, and each knot's gains are worked out once per vessel for the whole
-//! run ([`KnotGains`], which a [`super::Fleet`] in a sea keeps). At a single event on a straight route this is the blend `κ (w G_before + (1 − w) G_after)`,
-//! `w = e^{−λ (t − t_e)}`, of the two steady states.
+//! run ([`KnotGains`], which a [`super::Fleet`] in a sea keeps). At a single event on a straight route this is the
+//! blend `κ (w G_before + (1 − w) G_after)`, `w = e^{−λ (t − t_e)}`, of the two steady states.
 //!
 //! Approximations: the free oscillation at the natural frequency itself is not drawn, and every component relaxes at
 //! the roll's rate, where in the oscillator one far from resonance follows the change faster.
@@ -53,9 +54,9 @@ pub const MEMORY: f64 = 1e-6;
 /// changes over a few degrees of heading at the speeds of small craft, and is taken linear between knots.
 pub const KNOT_TURN_RAD: f64 = PI / 360.0;
 
-/// The most points of the course one response remembers (knots and events; a knot is 4.6 KiB of gains): a route
-/// short and curved enough to pass more within its memory (thousands of turns about) is remembered back to its
-/// 8,192nd point and held there.
+/// The most points of the course one response remembers (knots and events; a knot's gains are 12 KiB in a field of
+/// 256 components): a route short and curved enough to pass more within its memory (thousands of turns about) is
+/// remembered back to its 8,192nd point and held there.
 pub const MAX_POINTS: usize = 8192;
 
 /// The shortest step (m) the knots' search bisects down to (a waypoint that doubles back turns the heading by π at
@@ -88,7 +89,7 @@ pub fn route_knots(route: &Route) -> Vec<f64> {
             let s = if j == 8 { b } else { a + (b - a) * f64::from(j) / 8.0 };
             let to = (s, route.yaw(s));
             let mut stack = vec![to];
-            // Bisect (from, top] until each step turns by at most half a knot's turn.
+            // Bisect (from, top] until each step turns by at most a fifth of a knot's turn.
             while let Some(&(sb, yb)) = stack.last() {
                 let (sa, ya) = from;
                 if wrap_angle(yb - ya).abs() > 0.2 * KNOT_TURN_RAD && sb - sa > MIN_KNOT_STEP_M {
