@@ -144,10 +144,11 @@ enum Point {
     Fresh(Course),
 }
 
-/// Where a steady state of the sum comes from: a knot's (memoised) or a course's own.
+/// Where a term of the sum comes from: a knot's steady state or a block's share (memoised), or a course's own.
 #[derive(Debug, Clone, Copy)]
 enum Source {
     Knot(usize, bool),
+    Block(usize, bool),
     Fresh(Course),
 }
 
@@ -188,7 +189,14 @@ impl Steady {
 pub struct KnotGains {
     knots: OnceLock<Vec<f64>>,
     slots: OnceLock<Vec<[OnceLock<Steady>; 2]>>,
+    /// Per block of [`BLOCK`] intervals between knots (`b·BLOCK ..= (b+1)·BLOCK`), forwards and backwards: the
+    /// kernel-weighted sum of its intervals' steady states relative to its youngest knot ([`KnotGains::block`]).
+    blocks: OnceLock<Vec<[OnceLock<Steady>; 2]>>,
 }
+
+/// Knot intervals summed as one in the kernel's sum where the whole block lies inside the memory: the kernel is an
+/// exponential, so a block's share at any time is its share relative to its youngest knot times that knot's weight.
+pub const BLOCK: usize = 32;
 
 impl fmt::Debug for KnotGains {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -217,6 +225,56 @@ impl KnotGains {
         slots[k][usize::from(!forwards)].get_or_init(|| {
             let sign = if forwards { 1.0 } else { -1.0 };
             Steady::of(field, hull, Course::on(route, knots[k], sign, speed))
+        })
+    }
+
+    /// Block `b`'s share of the kernel's sum relative to its youngest knot (the block's end in its direction of
+    /// travel), for `hull` at `speed` with the kernel's rate `lambda`: `Σ e^{−λ τ_a} ((1 − e^{−x} − q) G_a + q G_b)`
+    /// over its intervals `a → b` (from younger to older), `τ_a` the age of `a` from the youngest knot, `x = λ h` and
+    /// `q = (1 − e^{−x})/x − e^{−x}` (the weights of G linear between the two), and the same sum of the variances.
+    #[allow(clippy::too_many_arguments)]
+    fn block(
+        &self,
+        field: &WaveField,
+        hull: &Hull,
+        route: &Route,
+        speed: f64,
+        lambda: f64,
+        b: usize,
+        forwards: bool,
+    ) -> &Steady {
+        let knots = self.knots(route);
+        let blocks =
+            self.blocks.get_or_init(|| (0..knots.len() / BLOCK).map(|_| [OnceLock::new(), OnceLock::new()]).collect());
+        blocks[b][usize::from(!forwards)].get_or_init(|| {
+            let mut sum = Steady { gains: vec![[[0.0; 2]; 3]; field.components().len()], variance: [0.0; 3] };
+            let order: Vec<usize> = if forwards {
+                (b * BLOCK..=(b + 1) * BLOCK).rev().collect()
+            } else {
+                (b * BLOCK..=(b + 1) * BLOCK).collect()
+            };
+            let young = knots[order[0]];
+            for pair in order.windows(2) {
+                let (a, o) = (pair[0], pair[1]);
+                let ea = (-lambda * (knots[a] - young).abs() / speed).exp();
+                let x = lambda * (knots[a] - knots[o]).abs() / speed;
+                let part = -(-x).exp_m1();
+                let wb = ea * (part / x - (-x).exp());
+                let wa = ea * part - wb;
+                for (k, w) in [(a, wa), (o, wb)] {
+                    let g = self.get(field, hull, route, speed, k, forwards);
+                    for (acc, gk) in sum.gains.iter_mut().zip(&g.gains) {
+                        for m in 0..3 {
+                            acc[m][0] += w * gk[m][0];
+                            acc[m][1] += w * gk[m][1];
+                        }
+                    }
+                    for m in 0..3 {
+                        sum.variance[m] += w * g.variance[m];
+                    }
+                }
+            }
+            sum
         })
     }
 }
@@ -327,24 +385,43 @@ pub fn remembered_response(
         return steady_now();
     }
     // The kernel's weight of each point: exact for G linear in time between consecutive points, and the tail.
+    // The kernel's weight of each point: exact for G linear in time between consecutive points, and the tail;
+    // where BLOCK intervals between knots follow each other, their share comes whole from the memo.
+    let knots = memo.knots(route);
+    let block_at = |i: usize| -> Option<(usize, bool)> {
+        let Point::Knot(k, fw) = points[i].1 else { return None };
+        let (b, other) = match fw {
+            true if k % BLOCK == 0 && k >= BLOCK => (k / BLOCK - 1, k - BLOCK),
+            false if k % BLOCK == 0 && k + BLOCK < knots.len() => (k / BLOCK, k + BLOCK),
+            _ => return None,
+        };
+        (points.get(i + BLOCK).map(|p| p.1) == Some(Point::Knot(other, fw))).then_some((b, fw))
+    };
     let mut weights = vec![0.0; points.len()];
-    for (i, pair) in points.windows(2).enumerate() {
-        let (ta, tb) = (pair[0].0, pair[1].0);
-        let h = tb - ta;
-        if h <= 0.0 {
+    let mut blocks = Vec::new();
+    let mut i = 0;
+    while i + 1 < points.len() {
+        if let Some((b, fw)) = block_at(i) {
+            blocks.push(((-lambda * points[i].0).exp(), b, fw));
+            i += BLOCK;
             continue;
         }
-        let (ea, x) = ((-lambda * ta).exp(), lambda * h);
-        let part = -(-x).exp_m1(); // 1 − e^{−λh}
-        let wb = ea * (part / x - (-x).exp());
-        weights[i] += ea * part - wb;
-        weights[i + 1] += wb;
+        let (ta, tb) = (points[i].0, points[i + 1].0);
+        let h = tb - ta;
+        if h > 0.0 {
+            let (ea, x) = ((-lambda * ta).exp(), lambda * h);
+            let part = -(-x).exp_m1(); // 1 − e^{−λh}
+            let wb = ea * (part / x - (-x).exp());
+            weights[i] += ea * part - wb;
+            weights[i + 1] += wb;
+        }
+        i += 1;
     }
     weights[points.len() - 1] += (-lambda * window).exp();
     let mut gains = vec![[[0.0f64; 2]; 3]; field.components().len()];
     let mut target = [0.0f64; 3];
-    // Each point's weight on the steady states it stands for.
-    let mut terms: Vec<(f64, Source)> = Vec::with_capacity(points.len() + 1);
+    // Each point's weight on the steady states it stands for, and the blocks'.
+    let mut terms: Vec<(f64, Source)> = Vec::with_capacity(points.len() + blocks.len() + 1);
     for (p, &w) in points.iter().zip(&weights) {
         match p.1 {
             Point::Knot(k, fw) => terms.push((w, Source::Knot(k, fw))),
@@ -355,6 +432,7 @@ pub fn remembered_response(
             Point::Fresh(c) => terms.push((w, Source::Fresh(c))),
         }
     }
+    terms.extend(blocks.into_iter().map(|(w, b, fw)| (w, Source::Block(b, fw))));
     for (w, source) in terms {
         if w == 0.0 {
             continue;
@@ -362,6 +440,7 @@ pub fn remembered_response(
         let fresh;
         let steady = match source {
             Source::Knot(k, fw) => memo.get(field, hull, route, speed, k, fw),
+            Source::Block(b, fw) => memo.block(field, hull, route, speed, lambda, b, fw),
             Source::Fresh(c) => {
                 fresh = Steady::of(field, hull, c);
                 &fresh
@@ -528,14 +607,17 @@ mod tests {
     fn a_bend_remembers_its_course_as_a_fine_quadrature_of_the_kernel_does() {
         // Brute force: the kernel's integral by the trapezoid rule on 20,000 ages, each course from the route
         // itself, against the knots' quadrature (knots every half degree, exact weights).
+        // A loop (knots travelled forwards, whole blocks of them in the sum) and a ping-pong route after its turn
+        // about (backwards).
         let f = field(1.5, 2.0, 11);
-        let r = square(EndBehaviour::Loop);
         let p = VesselParams { hull: speedboat(), ..params(9.0, 10.0) };
         let lambda = p.hull.roll_damping_ratio * p.hull.roll_natural_frequency();
-        let memo = KnotGains::new();
         let mut worst = [0.0f64; 3];
         let mut scale = [0.0f64; 3];
-        for t in [4.0, 7.5, 9.0, 30.0] {
+        let cases = [(EndBehaviour::Loop, [4.0, 7.5, 9.0, 30.0]), (EndBehaviour::PingPong, [50.0, 62.0, 75.0, 90.0])];
+        for (end, t) in cases.iter().flat_map(|(e, ts)| ts.iter().map(move |t| (*e, *t))) {
+            let r = square(end);
+            let memo = KnotGains::new();
             let d1 = p.start_offset_m + 9.0 * t;
             let [x, y] = r.position(r.distance_to_arc(d1).0);
             let got = remembered_response(&f, &r, &p, [x, y], t, Some(&memo));
@@ -575,6 +657,16 @@ mod tests {
                 worst[m] = worst[m].max((got[m] - want).abs());
                 scale[m] = scale[m].max(lin.variance[m].sqrt());
             }
+        }
+        // Whole blocks were summed in both directions.
+        let used = |memo: &KnotGains, fw: bool| {
+            memo.blocks.get().is_some_and(|b| b.iter().any(|x| x[usize::from(!fw)].get().is_some()))
+        };
+        for (end, t, fw) in [(EndBehaviour::Loop, 30.0, true), (EndBehaviour::PingPong, 75.0, false)] {
+            let (r, memo) = (square(end), KnotGains::new());
+            let [x, y] = r.position(r.distance_to_arc(p.start_offset_m + 9.0 * t).0);
+            remembered_response(&f, &r, &p, [x, y], t, Some(&memo));
+            assert!(used(&memo, fw), "{end:?}");
         }
         // Within 2 % of the response's RMS scale in each mode (measured: 1.3 % for the roll, 0.4 % for the pitch,
         // 0.07 % for the heave; 3.1 % for the roll with knots a degree apart: the steady state is taken linear
