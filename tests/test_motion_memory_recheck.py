@@ -23,6 +23,17 @@ Findings:
    of -3.12 m/s for 0.2 ms where it is -0.068 m/s either side. In the core: Rust (knots also where a turn ends and
    where one starts would fix both) (:func:`test_a_bend_is_forgotten_at_the_kernel_rate_on_the_leg_after`, a strict
    xfail).
+3. Where ``start_offset_m`` puts the hull exactly on a route event (a ``stop`` route's length: at rest from the
+   start; a ``ping_pong`` route's length or twice it), the pose jumps at isolated times: the window's start is
+   worked out as ``(offset + u t) − u t``, which rounds to an ulp either side of the event, so the tail
+   ``e^{−λt}`` (all of the memory early on) takes the course on the other side of it. A speedboat at rest at the end
+   of its ``stop`` route from t = 0 (5 m/s, W3), whose pose must be the steady state at rest throughout: 13 of 5,000
+   samples over the first 0.5 s are off it, by up to 0.234 m of heave and 0.057 rad of pitch, and 302 of the 1,800
+   frames of a minute at 30 Hz (15 of them by more than 1 cm or 0.01 rad, 0.049 at most); at twice a
+   ``ping_pong`` route's length, a single sample rolls 0.228 rad (13°) off its neighbours (``start_offset_m`` =
+   ``route_lengths()``, as a script placing a vessel at its route's end would set it). In the core: Rust (the
+   window's start at ``offset`` itself while ``t`` is within the memory)
+   (:func:`test_a_start_offset_on_a_route_event_gives_no_spikes`, a strict xfail).
 
 Checked and found right:
 
@@ -221,6 +232,27 @@ def test_a_bend_is_forgotten_at_the_kernel_rate_on_the_leg_after() -> None:
     assert np.abs(core_now - steady).max() < 1e-4, core_now - steady
     assert np.all(jump < 10.0 * median + 1e-6), (jump, median)
     assert abs(vz - vz_either_side) < 0.05, (vz, vz_either_side)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="transient.rs: with start_offset_m exactly on a route event, (offset + u t) - u t rounds to either side of "
+    "it and the memory's tail takes the other course: a hull at rest from t = 0 heaves 0.234 m off its steady state "
+    "in single samples, 302 of 1,800 frames at 30 Hz off; a ping_pong one rolls 0.228 rad off in one sample",
+)
+def test_a_start_offset_on_a_route_event_gives_no_spikes() -> None:
+    length = Sea(vessel(CURVY, speed=5.0)).length
+    at_rest = Sea(vessel(CURVY, speed=5.0, start_offset_m=length))
+    t = np.arange(0.0, 0.5, 1e-4)
+    p, steady = at_rest.steady(t)
+    frames = np.arange(1800) / 30.0
+    pf, steady_f = at_rest.steady(frames)
+    x = poses(Sea(vessel(CURVY, end="ping_pong", speed=5.0, start_offset_m=2.0 * length)).fleet, t)[:, 2:5]
+    spike = np.abs(x[1:-1] - 0.5 * (x[:-2] + x[2:])).max()
+    # Measured: 0.234 m (13 samples), 0.049 (302 frames), 0.228 rad; the ping-pong's median 6.5e-10.
+    assert np.abs(p[:, 2:5] - steady).max() < 1e-9
+    assert np.abs(pf[:, 2:5] - steady_f).max() < 1e-9
+    assert spike < 1e-3
 
 
 # ------------------------------------------------------------------------------------------------ found right
