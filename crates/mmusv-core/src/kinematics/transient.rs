@@ -41,9 +41,10 @@ use super::spline::{wrap_angle, EndBehaviour, Route};
 use super::VesselParams;
 use crate::ocean::response::{encounter_frequency, response};
 use crate::ocean::{Hull, WaveField};
+use std::collections::HashMap;
 use std::f64::consts::PI;
 use std::fmt;
-use std::sync::OnceLock;
+use std::sync::{Arc, Mutex, MutexGuard, OnceLock, PoisonError};
 
 /// The weight of the kernel at the memory's end: a course older than that counts as the one the hull had then (its
 /// share of the difference between two steady states, at most a few metres or radians, is then under a few
@@ -196,17 +197,32 @@ impl Steady {
     }
 }
 
-/// The steady states at one vessel's route knots, both directions, each worked out on first use: its route's knots
-/// ([`route_knots`]) and, per knot, the gains of the hull travelling there forwards and backwards in one wave field.
-/// Shared between threads; filled in any order, with the same values.
+/// The steady states at one vessel's route knots, both directions, and the blocks' shares, each worked out on first
+/// use and kept, at most [`MEMO_ENTRIES`] of each (past that the kept ones are let go and worked out again when
+/// asked: the same values, so the poses do not depend on what is kept). Its route's knots ([`route_knots`]) are kept
+/// for good. Shared between threads.
 #[derive(Default)]
 pub struct KnotGains {
     knots: OnceLock<Vec<f64>>,
-    slots: OnceLock<Vec<[OnceLock<Steady>; 2]>>,
-    /// Per block of [`BLOCK`] intervals between knots (`b·BLOCK ..= (b+1)·BLOCK`), forwards and backwards: the
-    /// kernel-weighted sum of its intervals' steady states relative to its youngest knot ([`KnotGains::block`]).
-    blocks: OnceLock<Vec<[OnceLock<Steady>; 2]>>,
+    kept: Mutex<Kept>,
 }
+
+/// The kept steady states: per knot and direction, and per block of [`BLOCK`] intervals between knots
+/// (`b·BLOCK ..= (b+1)·BLOCK`) and direction, the kernel-weighted sum of its intervals' steady states relative to its
+/// youngest knot ([`KnotGains::block`]).
+#[derive(Default)]
+struct Kept {
+    knots: Shelf,
+    blocks: Shelf,
+}
+
+/// Steady states kept by (knot or block index, travelled forwards).
+type Shelf = HashMap<(usize, bool), Arc<Steady>>;
+
+/// The most knots' steady states, and blocks' shares, one vessel's memo keeps (12 KiB each in a field of 256
+/// components: at most 12 MiB a vessel). A pose needs a few dozen knots (at the memory's two ends) and a block per 32
+/// knots between; a route with tens of thousands of knots (a jittery track of 40 km) does not keep them all.
+pub const MEMO_ENTRIES: usize = 512;
 
 /// Knot intervals summed as one in the kernel's sum where the whole block lies inside the memory: the kernel is an
 /// exponential, so a block's share at any time is its share relative to its youngest knot times that knot's weight.
@@ -214,10 +230,11 @@ pub const BLOCK: usize = 32;
 
 impl fmt::Debug for KnotGains {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let filled = self.slots.get().map_or(0, |s| s.iter().flatten().filter(|x| x.get().is_some()).count());
+        let kept = self.lock();
         f.debug_struct("KnotGains")
             .field("knots", &self.knots.get().map_or(0, Vec::len))
-            .field("filled", &filled)
+            .field("kept_knots", &kept.knots.len())
+            .field("kept_blocks", &kept.blocks.len())
             .finish()
     }
 }
@@ -232,14 +249,36 @@ impl KnotGains {
         self.knots.get_or_init(|| route_knots(route))
     }
 
+    /// The kept states (a poisoned lock still holds whole entries: each is inserted complete).
+    fn lock(&self) -> MutexGuard<'_, Kept> {
+        self.kept.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+
+    /// `map[key]`, or `make()` kept there (the map let go first when full).
+    fn kept(&self, key: (usize, bool), map: fn(&mut Kept) -> &mut Shelf, make: impl FnOnce() -> Steady) -> Arc<Steady> {
+        if let Some(s) = map(&mut self.lock()).get(&key) {
+            return Arc::clone(s);
+        }
+        let made = Arc::new(make());
+        let mut kept = self.lock();
+        let m = map(&mut kept);
+        if m.len() >= MEMO_ENTRIES {
+            m.clear();
+        }
+        Arc::clone(m.entry(key).or_insert(made))
+    }
+
     /// The steady state at knot `k` (forwards or not) of `route` sailed at `speed` by `hull` in `field`.
-    fn get(&self, field: &WaveField, hull: &Hull, route: &Route, speed: f64, k: usize, forwards: bool) -> &Steady {
+    fn get(&self, field: &WaveField, hull: &Hull, route: &Route, speed: f64, k: usize, forwards: bool) -> Arc<Steady> {
         let knots = self.knots(route);
-        let slots = self.slots.get_or_init(|| knots.iter().map(|_| [OnceLock::new(), OnceLock::new()]).collect());
-        slots[k][usize::from(!forwards)].get_or_init(|| {
-            let sign = if forwards { 1.0 } else { -1.0 };
-            Steady::of(field, hull, Course::on(route, knots[k], sign, speed))
-        })
+        self.kept(
+            (k, forwards),
+            |kept| &mut kept.knots,
+            || {
+                let sign = if forwards { 1.0 } else { -1.0 };
+                Steady::of(field, hull, Course::on(route, knots[k], sign, speed))
+            },
+        )
     }
 
     /// Block `b`'s share of the kernel's sum relative to its youngest knot (the block's end in its direction of
@@ -256,40 +295,42 @@ impl KnotGains {
         lambda: f64,
         b: usize,
         forwards: bool,
-    ) -> &Steady {
+    ) -> Arc<Steady> {
         let knots = self.knots(route);
-        let blocks =
-            self.blocks.get_or_init(|| (0..knots.len() / BLOCK).map(|_| [OnceLock::new(), OnceLock::new()]).collect());
-        blocks[b][usize::from(!forwards)].get_or_init(|| {
-            let mut sum = Steady { gains: vec![[[0.0; 2]; 3]; field.components().len()], variance: [0.0; 3] };
-            let order: Vec<usize> = if forwards {
-                (b * BLOCK..=(b + 1) * BLOCK).rev().collect()
-            } else {
-                (b * BLOCK..=(b + 1) * BLOCK).collect()
-            };
-            let young = knots[order[0]];
-            for pair in order.windows(2) {
-                let (a, o) = (pair[0], pair[1]);
-                let ea = (-lambda * (knots[a] - young).abs() / speed).exp();
-                let x = lambda * (knots[a] - knots[o]).abs() / speed;
-                let part = -(-x).exp_m1();
-                let wb = ea * (part / x - (-x).exp());
-                let wa = ea * part - wb;
-                for (k, w) in [(a, wa), (o, wb)] {
-                    let g = self.get(field, hull, route, speed, k, forwards);
-                    for (acc, gk) in sum.gains.iter_mut().zip(&g.gains) {
+        self.kept(
+            (b, forwards),
+            |kept| &mut kept.blocks,
+            || {
+                let mut sum = Steady { gains: vec![[[0.0; 2]; 3]; field.components().len()], variance: [0.0; 3] };
+                let order: Vec<usize> = if forwards {
+                    (b * BLOCK..=(b + 1) * BLOCK).rev().collect()
+                } else {
+                    (b * BLOCK..=(b + 1) * BLOCK).collect()
+                };
+                let young = knots[order[0]];
+                for pair in order.windows(2) {
+                    let (a, o) = (pair[0], pair[1]);
+                    let ea = (-lambda * (knots[a] - young).abs() / speed).exp();
+                    let x = lambda * (knots[a] - knots[o]).abs() / speed;
+                    let part = -(-x).exp_m1();
+                    let wb = ea * (part / x - (-x).exp());
+                    let wa = ea * part - wb;
+                    for (k, w) in [(a, wa), (o, wb)] {
+                        let g = self.get(field, hull, route, speed, k, forwards);
+                        for (acc, gk) in sum.gains.iter_mut().zip(&g.gains) {
+                            for m in 0..3 {
+                                acc[m][0] += w * gk[m][0];
+                                acc[m][1] += w * gk[m][1];
+                            }
+                        }
                         for m in 0..3 {
-                            acc[m][0] += w * gk[m][0];
-                            acc[m][1] += w * gk[m][1];
+                            sum.variance[m] += w * g.variance[m];
                         }
                     }
-                    for m in 0..3 {
-                        sum.variance[m] += w * g.variance[m];
-                    }
                 }
-            }
-            sum
-        })
+                sum
+            },
+        )
     }
 }
 
@@ -452,14 +493,10 @@ pub fn remembered_response(
         if w == 0.0 {
             continue;
         }
-        let fresh;
         let steady = match source {
             Source::Knot(k, fw) => memo.get(field, hull, route, speed, k, fw),
             Source::Block(b, fw) => memo.block(field, hull, route, speed, lambda, b, fw),
-            Source::Fresh(c) => {
-                fresh = Steady::of(field, hull, c);
-                &fresh
-            }
+            Source::Fresh(c) => Arc::new(Steady::of(field, hull, c)),
         };
         for (acc, g) in gains.iter_mut().zip(&steady.gains) {
             for m in 0..3 {
@@ -691,9 +728,7 @@ mod tests {
             }
         }
         // Whole blocks were summed in both directions.
-        let used = |memo: &KnotGains, fw: bool| {
-            memo.blocks.get().is_some_and(|b| b.iter().any(|x| x[usize::from(!fw)].get().is_some()))
-        };
+        let used = |memo: &KnotGains, fw: bool| memo.lock().blocks.keys().any(|k| k.1 == fw);
         for (end, t, fw) in [(EndBehaviour::Loop, 30.0, true), (EndBehaviour::PingPong, 75.0, false)] {
             let (r, memo) = (square(end), KnotGains::new());
             let [x, y] = r.position(r.distance_to_arc(p.start_offset_m + 9.0 * t).0);
@@ -743,6 +778,26 @@ mod tests {
         );
         // Measured: 197°/s in the corners against 36°/s on the legs without memory; 58°/s against 37°/s with it.
         assert!(bend < 2.0 * legs && bend < 0.4 * bend_steady, "{} deg/s in the bends, {} on the legs", bend, legs);
+    }
+
+    #[test]
+    fn a_long_jittery_track_keeps_a_bounded_memo_with_the_same_poses() {
+        // 8 km of waypoints every 20 m, each up to a metre off the line (a track's noise): thousands of knots. The
+        // memo keeps at most MEMO_ENTRIES of them, and the poses are those worked out with no memo at all.
+        let pts: Vec<[f64; 2]> =
+            (0..400).map(|i| [20.0 * f64::from(i), ((f64::from(i) * 12.9898).sin() * 43_758.547).fract()]).collect();
+        let r = ok(Route::new(&pts, EndBehaviour::Stop));
+        assert!(route_knots(&r).len() > 2 * MEMO_ENTRIES, "{}", route_knots(&r).len());
+        let (f, p, memo) =
+            (field(1.5, 0.7, 4), VesselParams { hull: speedboat(), ..params(10.0, 0.0) }, KnotGains::new());
+        // Along the whole track (every knot's state worked out, so the memo lets go more than once), then back.
+        for t in (1..=40).map(|i| 19.75 * f64::from(i)).chain([120.0, 30.0]) {
+            let [x, y] = r.position(r.distance_to_arc(10.0 * t).0);
+            let kept = remembered_response(&f, &r, &p, [x, y], t, Some(&memo));
+            assert_eq!(kept, remembered_response(&f, &r, &p, [x, y], t, None), "{t}");
+            let held = memo.lock();
+            assert!(held.knots.len() <= MEMO_ENTRIES && held.blocks.len() <= MEMO_ENTRIES);
+        }
     }
 
     #[test]
