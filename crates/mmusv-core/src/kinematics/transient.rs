@@ -176,6 +176,24 @@ pub struct Steady {
 }
 
 impl Steady {
+    /// Zero gains for `n` components, zero variances.
+    fn zero(n: usize) -> Self {
+        Self { gains: vec![[[0.0; 2]; 3]; n], variance: [0.0; 3] }
+    }
+
+    /// `self += w · other`, gain by gain and variance by variance.
+    fn add(&mut self, w: f64, other: &Steady) {
+        for (acc, g) in self.gains.iter_mut().zip(&other.gains) {
+            for m in 0..3 {
+                acc[m][0] += w * g[m][0];
+                acc[m][1] += w * g[m][1];
+            }
+        }
+        for m in 0..3 {
+            self.variance[m] += w * other.variance[m];
+        }
+    }
+
     /// The steady state of `hull` on `course` in `field` (the RAOs at the encounter frequencies).
     fn of(field: &WaveField, hull: &Hull, course: Course) -> Self {
         let mut variance = [0.0; 3];
@@ -301,7 +319,7 @@ impl KnotGains {
             (b, forwards),
             |kept| &mut kept.blocks,
             || {
-                let mut sum = Steady { gains: vec![[[0.0; 2]; 3]; field.components().len()], variance: [0.0; 3] };
+                let mut sum = Steady::zero(field.components().len());
                 let order: Vec<usize> = if forwards {
                     (b * BLOCK..=(b + 1) * BLOCK).rev().collect()
                 } else {
@@ -316,16 +334,7 @@ impl KnotGains {
                     let wb = ea * (part / x - (-x).exp());
                     let wa = ea * part - wb;
                     for (k, w) in [(a, wa), (o, wb)] {
-                        let g = self.get(field, hull, route, speed, k, forwards);
-                        for (acc, gk) in sum.gains.iter_mut().zip(&g.gains) {
-                            for m in 0..3 {
-                                acc[m][0] += w * gk[m][0];
-                                acc[m][1] += w * gk[m][1];
-                            }
-                        }
-                        for m in 0..3 {
-                            sum.variance[m] += w * g.variance[m];
-                        }
+                        sum.add(w, &self.get(field, hull, route, speed, k, forwards));
                     }
                 }
                 sum
@@ -474,8 +483,7 @@ pub fn remembered_response(
         i += 1;
     }
     weights[points.len() - 1] += (-lambda * window).exp();
-    let mut gains = vec![[[0.0f64; 2]; 3]; field.components().len()];
-    let mut target = [0.0f64; 3];
+    let mut sum = Steady::zero(field.components().len());
     // Each point's weight on the steady states it stands for, and the blocks'.
     let mut terms: Vec<(f64, Source)> = Vec::with_capacity(points.len() + blocks.len() + 1);
     for (p, &w) in points.iter().zip(&weights) {
@@ -498,16 +506,9 @@ pub fn remembered_response(
             Source::Block(b, fw) => memo.block(field, hull, route, speed, lambda, b, fw),
             Source::Fresh(c) => Arc::new(Steady::of(field, hull, c)),
         };
-        for (acc, g) in gains.iter_mut().zip(&steady.gains) {
-            for m in 0..3 {
-                acc[m][0] += w * g[m][0];
-                acc[m][1] += w * g[m][1];
-            }
-        }
-        for m in 0..3 {
-            target[m] += w * steady.variance[m];
-        }
+        sum.add(w, &steady);
     }
+    let (gains, target) = (sum.gains, sum.variance);
     let mut linear = [0.0f64; 3];
     for (c, g) in field.components().iter().zip(&gains) {
         let v = c.elevation_variance();
@@ -694,25 +695,16 @@ mod tests {
             let window = t.min(-MEMORY.ln() / lambda);
             let n = 20_000;
             let h = window / n as f64;
-            let mut acc = vec![[[0.0f64; 2]; 3]; f.components().len()];
-            let mut target = [0.0; 3];
+            let mut acc = Steady::zero(f.components().len());
             for i in 0..=n {
                 let tau = i as f64 * h;
                 let mut w = lambda * (-lambda * tau).exp() * h * if i == 0 || i == n { 0.5 } else { 1.0 };
                 if i == n {
                     w += (-lambda * window).exp();
                 }
-                let s = Steady::of(&f, &p.hull, course_at(&r, 9.0, d1 - 9.0 * tau));
-                for (a, g) in acc.iter_mut().zip(&s.gains) {
-                    for m in 0..3 {
-                        a[m][0] += w * g[m][0];
-                        a[m][1] += w * g[m][1];
-                    }
-                }
-                for m in 0..3 {
-                    target[m] += w * s.variance[m];
-                }
+                acc.add(w, &Steady::of(&f, &p.hull, course_at(&r, 9.0, d1 - 9.0 * tau)));
             }
+            let (acc, target) = (acc.gains, acc.variance);
             let lin = Steady::of(&f, &p.hull, course_at(&r, 9.0, d1)); // for its shape only
             let mut linear = [0.0; 3];
             for (c, g) in f.components().iter().zip(&acc) {
