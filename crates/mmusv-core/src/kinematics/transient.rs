@@ -768,7 +768,7 @@ mod tests {
             bend_steady > 2.5 * legs_steady,
             "the steady state did not show the defect: {bend_steady} {legs_steady}"
         );
-        // Measured: 197°/s in the corners against 36°/s on the legs without memory; 58°/s against 37°/s with it.
+        // Measured: 197°/s in the corners against 36°/s on the legs without memory; 57°/s against 35°/s with it.
         assert!(bend < 2.0 * legs && bend < 0.4 * bend_steady, "{} deg/s in the bends, {} on the legs", bend, legs);
     }
 
