@@ -218,11 +218,21 @@ impl Steady {
 /// The steady states at one vessel's route knots, both directions, and the blocks' shares, each worked out on first
 /// use and kept, at most [`MEMO_ENTRIES`] of each (past that the kept ones are let go and worked out again when
 /// asked: the same values, so the poses do not depend on what is kept). Its route's knots ([`route_knots`]) are kept
-/// for good. Shared between threads.
-#[derive(Default)]
+/// for good. Shared between threads; a child forked from the process that made it keeps a memo of its own (the
+/// parent's lock may have been held, at the fork, by a thread the child does not have: `crate::threads`).
 pub struct KnotGains {
     knots: OnceLock<Vec<f64>>,
     kept: Mutex<Kept>,
+    /// The process that made this memo.
+    pid: u32,
+    /// In a forked child: its own memo, and its process (never locked in the process that made this one).
+    child: Mutex<Option<(u32, Arc<KnotGains>)>>,
+}
+
+impl Default for KnotGains {
+    fn default() -> Self {
+        Self { knots: OnceLock::new(), kept: Mutex::default(), pid: std::process::id(), child: Mutex::new(None) }
+    }
 }
 
 /// The kept steady states: per knot and direction, and per block of [`BLOCK`] intervals between knots
@@ -265,6 +275,23 @@ impl KnotGains {
 
     fn knots(&self, route: &Route) -> &[f64] {
         self.knots.get_or_init(|| route_knots(route))
+    }
+
+    /// The memo of this process: `None` in the one that made it (use it), else the forked child's own.
+    fn in_child(&self) -> Option<Arc<KnotGains>> {
+        let pid = std::process::id();
+        if pid == self.pid {
+            return None;
+        }
+        let mut child = self.child.lock().unwrap_or_else(PoisonError::into_inner);
+        match &*child {
+            Some((p, memo)) if *p == pid => Some(Arc::clone(memo)),
+            _ => {
+                let memo = Arc::new(KnotGains::new());
+                *child = Some((pid, Arc::clone(&memo)));
+                Some(memo)
+            }
+        }
     }
 
     /// The kept states (a poisoned lock still holds whole entries: each is inserted complete).
@@ -426,8 +453,15 @@ pub fn remembered_response(
         return steady_now();
     }
     let own;
+    let child;
     let memo = match memo {
-        Some(m) => m,
+        Some(m) => match m.in_child() {
+            None => m,
+            Some(c) => {
+                child = c;
+                &*child
+            }
+        },
         None => {
             own = KnotGains::new();
             &own
@@ -790,6 +824,22 @@ mod tests {
             let held = memo.lock();
             assert!(held.knots.len() <= MEMO_ENTRIES && held.blocks.len() <= MEMO_ENTRIES);
         }
+    }
+
+    #[test]
+    fn a_forked_child_does_not_wait_on_its_parents_memo() {
+        // A memo made by another process (as the parent's is in a forked child) whose lock a thread of that
+        // process held at the fork: the child keeps a memo of its own and gives the same poses.
+        let (f, r) = (field(1.5, 0.7, 2), square(EndBehaviour::Loop));
+        let p = VesselParams { hull: speedboat(), ..params(9.0, 0.0) };
+        let parent = KnotGains { pid: std::process::id().wrapping_add(1), ..KnotGains::new() };
+        let held = parent.lock();
+        let [x, y] = r.position(r.distance_to_arc(9.0 * 40.0).0);
+        let got = remembered_response(&f, &r, &p, [x, y], 40.0, Some(&parent));
+        assert_eq!(got, remembered_response(&f, &r, &p, [x, y], 40.0, None));
+        assert!(held.knots.is_empty());
+        drop(held);
+        assert!(parent.child.lock().is_ok_and(|c| c.as_ref().is_some_and(|(pid, _)| *pid == std::process::id())));
     }
 
     #[test]
