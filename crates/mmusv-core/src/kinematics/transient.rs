@@ -139,6 +139,11 @@ impl Course {
         Self { yaw: route.heading(s, sign), vx, vy }
     }
 
+    /// The course at knot `k` of `knots` (arc lengths) travelled forwards or backwards at `speed`.
+    fn at_knot(route: &Route, knots: &[f64], k: usize, forwards: bool, speed: f64) -> Self {
+        Self::on(route, knots[k], if forwards { 1.0 } else { -1.0 }, speed)
+    }
+
     /// Whether `other` is this course to within 1e-12 (rad, m/s): a straight leg's headings differ in the last bits.
     fn same(&self, other: &Self) -> bool {
         wrap_angle(self.yaw - other.yaw).abs() <= 1e-12
@@ -196,23 +201,31 @@ impl Steady {
 
     /// The steady state of `hull` on `course` in `field` (the RAOs at the encounter frequencies).
     fn of(field: &WaveField, hull: &Hull, course: Course) -> Self {
-        let mut variance = [0.0; 3];
-        let gains = field
+        let gains: Vec<_> = field
             .components()
             .iter()
             .map(|c| {
                 let we = encounter_frequency(c.omega_rad_s, c.kx, c.ky, course.vx, course.vy);
                 let h = hull.rao(c.omega_rad_s, c.direction_rad - course.yaw, we);
-                let g = [h.heave, h.roll, h.pitch];
-                let v = c.elevation_variance();
-                for m in 0..3 {
-                    variance[m] += v * (g[m][0] * g[m][0] + g[m][1] * g[m][1]);
-                }
-                g
+                [h.heave, h.roll, h.pitch]
             })
             .collect();
+        let variance = variance_of(field, &gains);
         Self { gains, variance }
     }
+}
+
+/// `Σ_c a_c²/2 |g_c|²` per mode: the variance over the field's random phases of the response with gains `gains`
+/// (field order).
+fn variance_of(field: &WaveField, gains: &[[[f64; 2]; 3]]) -> [f64; 3] {
+    let mut out = [0.0; 3];
+    for (c, g) in field.components().iter().zip(gains) {
+        let v = c.elevation_variance();
+        for m in 0..3 {
+            out[m] += v * (g[m][0] * g[m][0] + g[m][1] * g[m][1]);
+        }
+    }
+    out
 }
 
 /// The steady states at one vessel's route knots, both directions, and the blocks' shares, each worked out on first
@@ -319,10 +332,7 @@ impl KnotGains {
         self.kept(
             (k, forwards),
             |kept| &mut kept.knots,
-            || {
-                let sign = if forwards { 1.0 } else { -1.0 };
-                Steady::of(field, hull, Course::on(route, knots[k], sign, speed))
-            },
+            || Steady::of(field, hull, Course::at_knot(route, knots, k, forwards, speed)),
         )
     }
 
@@ -356,10 +366,7 @@ impl KnotGains {
                 for pair in order.windows(2) {
                     let (a, o) = (pair[0], pair[1]);
                     let ea = (-lambda * (knots[a] - young).abs() / speed).exp();
-                    let x = lambda * (knots[a] - knots[o]).abs() / speed;
-                    let part = -(-x).exp_m1();
-                    let wb = ea * (part / x - (-x).exp());
-                    let wa = ea * part - wb;
+                    let (wa, wb) = interval_weights(ea, lambda * (knots[a] - knots[o]).abs() / speed);
                     for (k, w) in [(a, wa), (o, wb)] {
                         sum.add(w, &self.get(field, hull, route, speed, k, forwards));
                     }
@@ -368,6 +375,14 @@ impl KnotGains {
             },
         )
     }
+}
+
+/// The kernel's weights `(w_a, w_b)` of the two ends of an interval of the course, G taken linear between them:
+/// `ea = e^{−λ τ_a}` the kernel at its younger end, `x = λ h` its length in decay times (> 0).
+fn interval_weights(ea: f64, x: f64) -> (f64, f64) {
+    let part = -(-x).exp_m1(); // 1 − e^{−x}
+    let wb = ea * (part / x - (-x).exp());
+    (ea * part - wb, wb)
 }
 
 /// The course of `route` at travelled distance `d` at `speed` (at rest past a `Stop` route's end).
@@ -412,8 +427,7 @@ fn history(route: &Route, knots: &[f64], speed: f64, d1: f64, d0: f64, window: f
             // At d1 itself: a leg's start is the course now or one still to come; a leg's end is the course before
             // an event just passed (Route::distance_to_arc has the hull on the later leg from there).
             let leg_start = if forwards { k == 0 } else { k + 1 == knots.len() };
-            let sign = if forwards { 1.0 } else { -1.0 };
-            if d == d1 && (leg_start || Course::on(route, knots[k], sign, speed).same(&now)) {
+            if d == d1 && (leg_start || Course::at_knot(route, knots, k, forwards, speed).same(&now)) {
                 continue;
             }
             out.push((age(d), Point::Knot(k, forwards)));
@@ -479,12 +493,11 @@ pub fn remembered_response(
     let constant = points.iter().all(|p| match p.1 {
         Point::Fresh(c) => c.same(&now),
         Point::Between(..) => course_at(route, speed, d0).same(&now),
-        Point::Knot(k, fw) => Course::on(route, knots[k], if fw { 1.0 } else { -1.0 }, speed).same(&now),
+        Point::Knot(k, fw) => Course::at_knot(route, knots, k, fw, speed).same(&now),
     });
     if constant {
         return steady_now();
     }
-    // The kernel's weight of each point: exact for G linear in time between consecutive points, and the tail.
     // The kernel's weight of each point: exact for G linear in time between consecutive points, and the tail;
     // where BLOCK intervals between knots follow each other, their share comes whole from the memo.
     let block_at = |i: usize| -> Option<(usize, bool)> {
@@ -508,10 +521,8 @@ pub fn remembered_response(
         let (ta, tb) = (points[i].0, points[i + 1].0);
         let h = tb - ta;
         if h > 0.0 {
-            let (ea, x) = ((-lambda * ta).exp(), lambda * h);
-            let part = -(-x).exp_m1(); // 1 − e^{−λh}
-            let wb = ea * (part / x - (-x).exp());
-            weights[i] += ea * part - wb;
+            let (wa, wb) = interval_weights((-lambda * ta).exp(), lambda * h);
+            weights[i] += wa;
             weights[i + 1] += wb;
         }
         i += 1;
@@ -543,13 +554,7 @@ pub fn remembered_response(
         sum.add(w, &steady);
     }
     let (gains, target) = (sum.gains, sum.variance);
-    let mut linear = [0.0f64; 3];
-    for (c, g) in field.components().iter().zip(&gains) {
-        let v = c.elevation_variance();
-        for m in 0..3 {
-            linear[m] += v * (g[m][0] * g[m][0] + g[m][1] * g[m][1]);
-        }
-    }
+    let linear = variance_of(field, &gains);
     let kappa: [f64; 3] =
         std::array::from_fn(|m| if linear[m] > 0.0 && target[m] > 0.0 { (target[m] / linear[m]).sqrt() } else { 1.0 });
     let mut out = [0.0; 3];
