@@ -20,11 +20,13 @@
 //!
 //! - [`spline`]: [`Route`] and [`EndBehaviour`].
 //! - [`waves`]: [`WaveSetting`], size factor, base amplitudes and the seeded periodic functions `g(t)`.
+//! - [`knots`]: a route's knots, points between which its heading turns by at most half a degree, nearly linearly.
 //! - [`path_behind`]: how far back a vessel's path ran straight, and its straight pieces round the bends
 //!   ([`WakePiece`]).
 //! - [`transient`]: the physical response remembers the recent course: through a route's bends, stops and turns
 //!   about the hull passes from one steady state to the next at the rate its roll's free oscillation decays.
 
+pub mod knots;
 pub mod path_behind;
 pub mod spline;
 pub mod transient;
