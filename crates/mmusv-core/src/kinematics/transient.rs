@@ -348,14 +348,16 @@ fn history(route: &Route, knots: &[f64], speed: f64, d1: f64, d0: f64, window: f
     let mut n = if end == EndBehaviour::Stop { 0.0 } else { (top / len).floor() };
     while n >= 0.0 && (n + 1.0) * len > d0 {
         let forwards = end != EndBehaviour::PingPong || n % 2.0 == 0.0;
-        let dist = |k: usize| if forwards { n * len + knots[k] } else { (n + 1.0) * len - knots[k] };
-        let order: Box<dyn Iterator<Item = usize>> =
-            if forwards { Box::new((0..knots.len()).rev()) } else { Box::new(0..knots.len()) };
+        let dist_of = |x: f64| if forwards { n * len + x } else { (n + 1.0) * len - x };
+        // The knots within `top`, youngest first: `dist_of` is monotone in the knot (a constant plus or minus sorted
+        // distances, rounded), so a binary search finds the first one where a walk from the leg's end would.
+        let order: Box<dyn Iterator<Item = usize>> = if forwards {
+            Box::new((0..knots.partition_point(|&x| dist_of(x) <= top)).rev())
+        } else {
+            Box::new(knots.partition_point(|&x| dist_of(x) > top)..knots.len())
+        };
         for k in order {
-            let d = dist(k);
-            if d > top {
-                continue;
-            }
+            let d = dist_of(knots[k]);
             if d <= d0 {
                 break;
             }
@@ -687,6 +689,77 @@ mod tests {
         );
         // Measured: 197°/s in the corners against 36°/s on the legs without memory; 57°/s against 35°/s with it.
         assert!(bend < 2.0 * legs && bend < 0.4 * bend_steady, "{} deg/s in the bends, {} on the legs", bend, legs);
+    }
+
+    /// The knots of `history`'s legs found by a walk over every knot from the leg's end (its first form).
+    fn history_by_walk(route: &Route, knots: &[f64], speed: f64, d1: f64, d0: f64, window: f64) -> Vec<(f64, Point)> {
+        let (len, end) = (route.length(), route.end_behaviour());
+        let age = |d: f64| ((d1 - d) / speed).clamp(0.0, window);
+        let now = course_at(route, speed, d1);
+        let mut out = vec![(0.0, Point::Fresh(now))];
+        let mut top = d1;
+        if end == EndBehaviour::Stop {
+            if d1 > len {
+                out.push((age(len), Point::Fresh(Course::on(route, len, 0.0, speed))));
+            }
+            top = d1.min(len);
+        }
+        let mut n = if end == EndBehaviour::Stop { 0.0 } else { (top / len).floor() };
+        while n >= 0.0 && (n + 1.0) * len > d0 {
+            let forwards = end != EndBehaviour::PingPong || n % 2.0 == 0.0;
+            let order: Vec<usize> =
+                if forwards { (0..knots.len()).rev().collect() } else { (0..knots.len()).collect() };
+            for k in order {
+                let d = if forwards { n * len + knots[k] } else { (n + 1.0) * len - knots[k] };
+                if d > top {
+                    continue;
+                }
+                if d <= d0 {
+                    break;
+                }
+                let leg_start = if forwards { k == 0 } else { k + 1 == knots.len() };
+                if d == d1 && (leg_start || Course::at_knot(route, knots, k, forwards, speed).same(&now)) {
+                    continue;
+                }
+                out.push((age(d), Point::Knot(k, forwards)));
+            }
+            n -= 1.0;
+        }
+        let (s0, sign) = route.distance_to_arc(d0);
+        let start = if sign == 0.0 || knots.len() < 2 {
+            Point::Fresh(Course::on(route, s0, sign, speed))
+        } else {
+            let k = knots.partition_point(|&x| x <= s0).saturating_sub(1).min(knots.len() - 2);
+            Point::Between(k, ((s0 - knots[k]) / (knots[k + 1] - knots[k])).clamp(0.0, 1.0), sign > 0.0)
+        };
+        out.push((window, start));
+        out
+    }
+
+    #[test]
+    fn history_finds_the_knots_a_walk_over_every_knot_finds() {
+        // Every end behaviour, a rounded square and a jittery track; windows ending on knots, on leg ends, between.
+        let pts: Vec<[f64; 2]> =
+            (0..60).map(|i| [20.0 * f64::from(i), ((f64::from(i) * 12.9898).sin() * 43_758.547).fract()]).collect();
+        let mut checked = 0;
+        for end in [EndBehaviour::Stop, EndBehaviour::Loop, EndBehaviour::PingPong] {
+            for r in [square(end), ok(Route::new(&pts, end))] {
+                let (knots, len, speed) = (route_knots(&r), r.length(), 7.0);
+                let mut ends: Vec<f64> = (0..=300).map(|i| f64::from(i) * 3.1 * len / 300.0).collect();
+                ends.extend(knots.iter().flat_map(|&k| [k, len + k, 2.0 * len - k, 2.0 * len + k]));
+                for d1 in ends {
+                    for window in [0.0, 0.3, 4.0, 25.0, 400.0] {
+                        for d0 in [d1 - speed * window, d1 - speed * window - 1e-9, 0.0] {
+                            let (d0, window) = if d0 == 0.0 { (0.0, d1 / speed) } else { (d0, window) };
+                            let fast = history(&r, &knots, speed, d1, d0, window);
+                            assert_eq!(fast, history_by_walk(&r, &knots, speed, d1, d0, window), "{d1} {d0}");
+                            checked += fast.len();
+                        }
+                    }
+                }
+            }
+        }
+        assert!(checked > 100_000, "{checked}");
     }
 
     #[test]
