@@ -6,9 +6,10 @@
 * the LiDAR's water returns within 60 m at W0 and W3 (on wave faces after; on the flat plane before);
 * the radar PPI at W0 and W3;
 * the LiDAR's returns from a fast boat's wake passing a USV at W1 (after: the capture, whose LiDAR sees the
-  wakes' foam; before: the same sweep without the wakes).
+  wakes' foam; before: the same sweep without the wakes);
+* a buoy ahead of a USV at W3, at rest (before) and riding the waves (after).
 
-Usage: ``python scripts/sea_pictures.py [-o docs/sea] [--only craft,faces,radar,wake]``; prints the counts of
+Usage: ``python scripts/sea_pictures.py [-o docs/sea] [--only craft,faces,radar,wake,buoys]``; prints the counts of
 docs/sea/README.md.
 """
 
@@ -254,10 +255,62 @@ def lidar_wake(out: Path, lines: list[str]) -> None:
     plt.close(fig)
 
 
+def buoys(out: Path, lines: list[str]) -> None:
+    """A buoy 40 m ahead of a USV at W3 at two crests and two troughs: before (at rest at the still-water level,
+    as every build before the buoys rode the waves) and after (riding the waves, :mod:`mmusv.world.buoys`), with
+    the water's height at the buoy and the buoy's waterline."""
+    from PIL import Image
+
+    scenario = _scenario("W3")
+    scenario["map"]["params"] = {"extent_m": 1000, "islet_probability": 0.0, "n_buoys": 4}
+    camera = {"name": "view", "resolution": [320, 220], "hfov_deg": 40.0, "mount": {"point": "camera_front"}}
+    scenario["rigs"]["view"] = {"cameras": [camera], "top_view": None, "lidar": None, "radar": None}
+    scenario["acquisition"]["frames"] = 150  # 30 s: crests and troughs of the W3 sea (Tp 9.3 s) to choose from
+    probe = Simulation({**scenario, "map": {"type": "open_sea", "seed": 2, "params": scenario["map"]["params"]}})
+    bx, by = (float(v) for v in probe.world.priors.buoys[0])
+    scenario["map"] = probe.scenario.map.model_dump()
+    scenario["vessels"] = [
+        {"id": "usv", "role": "usv", "asset": "usv_wamv", "rig": "view", "speed_mps": 0.5,
+         "route": [[bx - 45.0, by], [bx - 35.0, by]]},
+    ]  # fmt: skip
+    # Two crests and two troughs at the buoy (the sea's elevation there, every frame).
+    field = probe.scenario.environment.sea_spec().field(scenario_seed=scenario["seed"])
+    times = np.arange(probe.frames) / probe.scenario.acquisition.frequency_hz
+    eta = np.array([field.elevation(np.array([bx]), np.array([by]), float(t))[0] for t in times])
+
+    def apart(candidates: np.ndarray) -> list[int]:  # the first two at least 10 frames (2 s) apart
+        picked: list[int] = []
+        for f in candidates:
+            if all(abs(int(f) - g) >= 10 for g in picked):
+                picked.append(int(f))
+        return picked[:2]
+
+    order = np.argsort(eta)
+    frames = sorted(apart(order) + apart(order[::-1]))
+    rows = []
+    for name in ("before", "after"):
+        sim = Simulation(scenario)
+        if name == "before":
+            sim._buoy_field = None  # the buoys at rest, as before they rode the waves
+        tiles = []
+        for frame in frames:
+            cap = sim.capture(frame, radar=False)
+            rgb = cap.agents["usv"].cameras["view"].rgb
+            assert rgb is not None
+            tiles.append(np.asarray(rgb))
+            water = float(sim.ws.scene.wave_heights(np.array([[bx, by]]))[0])
+            line = float(sim.ws.scene.instance_pose(sim.ws.buoy_instances[0])[2, 3])
+            lines.append(f"| {name} | {frame} | {water:+.2f} | {line:+.2f} |")
+        rows.append(np.concatenate(tiles, axis=1))
+    Image.fromarray(np.concatenate(rows, axis=0)).save(out / "buoy_w3.png")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=" ".join(__doc__.split("\n\n")[0].split()))
     ap.add_argument("-o", "--out", default=str(ROOT / "docs/sea"), help="output folder (default docs/sea)")
-    ap.add_argument("--only", default="craft,faces,radar,wake", help="comma-separated: craft, faces, radar, wake")
+    ap.add_argument(
+        "--only", default="craft,faces,radar,wake,buoys", help="comma-separated: craft, faces, radar, wake, buoys"
+    )
     args = ap.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -272,6 +325,7 @@ def main() -> None:
         ),
         "radar": ("| sea state | sea | clutter returns | 95th percentile clutter range (m) |", radar_ppi),
         "wake": ("| sweep | water returns | vessel returns |", lidar_wake),
+        "buoys": ("| buoys | frame | water at the buoy (m) | the buoy's waterline (m) |", buoys),
     }
     only = [p.strip() for p in args.only.split(",") if p.strip()]
     unknown = sorted(set(only) - set(parts))

@@ -45,6 +45,7 @@ from mmusv.sensors.radar import RadarReturns, ppi_request
 from mmusv.thread_env import check_thread_environment
 from mmusv.turns import one_at_a_time, take_turns
 from mmusv.world.build import WorldScene, build_world_scene, pose_matrices
+from mmusv.world.buoys import buoy_matrices
 from mmusv.world.environment import Environment
 from mmusv.world.hydrostatics import hull_particulars
 from mmusv.world.maps import MapWorld, generate_map_from
@@ -105,11 +106,14 @@ class Simulation:
             poses0 = np.asarray(self.fleet.poses_at_times(np.zeros(1)))[0]
             # Over a physical sea the moored ships heave, roll and pitch at their berths (motion.build_moored_fleet).
             self._moored_fleet = build_moored_fleet(sc, self.world.moored)
+            # and the map's buoys ride its waves (mmusv.world.buoys).
+            self._buoy_field = self._riding_buoys()
             self.ws: WorldScene = build_world_scene(
                 self.world,
                 [(v.asset, v.role) for v in sc.vessels],
                 poses0,
                 moored_move=self._moored_fleet is not None,
+                buoys_move=self._buoy_field is not None,
             )
             self.vessels: list[VesselInfo] = []
             for v, inst in zip(sc.vessels, self.ws.vessel_instances, strict=True):
@@ -195,7 +199,7 @@ class Simulation:
     def set_sea_surface(self, sea: SeaState | None) -> None:
         """Makes the water the displaced surface of the physical sea ``sea`` (its wave field drawn from the
         scenario's sea seed) from the next :meth:`set_frame` on, or flat again with ``None``. The water only: the
-        vessels and the moored ships keep the motion of the scenario's own sea.
+        vessels, the moored ships and the buoys keep the motion of the scenario's own sea.
 
         Scenarios with ``environment.motion: physical`` (the default) start with their ``environment.sea_spec()``.
         Every frame then samples the surface at the frame time, finest around the USVs (the same surface for
@@ -209,6 +213,15 @@ class Simulation:
         if self.sea is None:
             self.ws.scene.set_wave_surface(None, scenario_seed=self.scenario.seed, time_s=0.0, foci=np.zeros((0, 2)))
         self._frame = None
+
+    def _riding_buoys(self) -> Any | None:
+        """The wave field (``mmusv._core.WaveField``) the map's buoys ride, as the moored ships do: the scenario's
+        own sea where it is physical and has height and the map has buoys; ``None`` where they stand at rest (with
+        ``motion: paper`` the water is the paper's flat plane)."""
+        env = self.scenario.environment
+        if env.motion != "physical" or len(self.world.priors.buoys) == 0 or env.sea_spec().hs_m <= 0.0:
+            return None
+        return env.sea_spec().field(scenario_seed=self.scenario.seed)
 
     def _sensor_env(self) -> core.SensorEnv:
         """The sensors' view of the environment, whose sea state (their wind, whitecaps, water returns and
@@ -238,6 +251,9 @@ class Simulation:
         self.ws.scene.set_poses(self.ws.vessel_instances, state.matrices[:n])
         if self._moored_fleet is not None:
             self.ws.scene.set_poses(self.ws.moored_instances, state.matrices[n:])
+        if self._buoy_field is not None:
+            rest = self.world.priors.buoys
+            self.ws.scene.set_poses(self.ws.buoy_instances, buoy_matrices(self._buoy_field, rest, state.time_s))
         if self.sea is not None and "water" in self.ws.static_instances:
             self.ws.scene.set_wave_surface(self.sea, **self._surface_of(state, sea_radius_m, shading_detail))
         self._frame = frame

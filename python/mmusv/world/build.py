@@ -1,7 +1,9 @@
 """Turning a generated map and a scenario's vessels into a ray-castable :class:`mmusv.Scene`.
 
 Static map meshes become one instance each at the identity pose (instance ids ``0..S-1`` in the key order of
-``MapWorld.static_meshes``); every vessel asset is added once as a mesh and instanced per vessel, so moving
+``MapWorld.static_meshes``), except the buoys: one buoy mesh instanced once per buoy at its position (each buoy
+its own instance id, in ``MapPriors.buoys`` order, where the ``"buoys"`` key falls; over a physical sea they ride
+the waves, :mod:`mmusv.world.buoys`); every vessel asset is added once as a mesh and instanced per vessel, so moving
 vessels only rebuilds the scene's top level. Moored ships of a port map are static instances of their assets.
 """
 
@@ -14,8 +16,10 @@ import numpy as np
 from mmusv.classes import SemanticClass
 from mmusv.frames import pose_matrices  # re-exported: the pose convention lives in mmusv.frames
 from mmusv.scene import Scene
+from mmusv.world.buoys import buoy_matrices
 from mmusv.world.maps import MapWorld
 from mmusv.world.materials import material_table
+from mmusv.world.port import buoy_mesh
 from mmusv.world.primitives import TriMesh
 from mmusv.world.vessels import get_asset
 
@@ -31,6 +35,7 @@ class WorldScene:
         static_instances: map mesh name -> instance id.
         vessel_instances: ``(V,)`` int64 instance id of scenario vessel ``i``.
         moored_instances: instance ids of moored ships (port maps), in ``MapWorld.moored`` order.
+        buoy_instances: instance ids of the map's buoys, in ``MapPriors.buoys`` order (their rest positions).
         asset_meshes: asset name -> mesh id.
     """
 
@@ -38,6 +43,7 @@ class WorldScene:
     static_instances: dict[str, int]
     vessel_instances: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     moored_instances: list[int] = field(default_factory=list)
+    buoy_instances: list[int] = field(default_factory=list)
     asset_meshes: dict[str, int] = field(default_factory=dict)
 
 
@@ -58,16 +64,23 @@ def build_static_scene(world: MapWorld, *, include_water: bool = True, include_m
     scene = Scene()
     scene.set_materials(material_table())
     static: dict[str, int] = {}
+    buoys: list[int] = []
     for name, mesh in world.static_meshes.items():
         if name == "water" and not include_water:
             continue
         if mesh.num_triangles == 0:
             continue
+        if name == "buoys":
+            # One mesh, one instance a buoy (its own instance id), at rest at its position.
+            buoy = _add(scene, buoy_mesh(0.0, 0.0), "buoy")
+            rest = buoy_matrices(None, world.priors.buoys, 0.0)
+            buoys += [scene.add_instance(buoy, pose=m) for m in rest]
+            continue
         static[name] = scene.add_instance(_add(scene, mesh, name))
     hf = world.heightfield
     # The bottom the cameras see through shallow water (the terrain's heights, below the sea surface there).
     scene.set_seabed(hf.z, x0=hf.x0, y0=hf.y0, spacing=hf.spacing)
-    out = WorldScene(scene=scene, static_instances=static)
+    out = WorldScene(scene=scene, static_instances=static, buoy_instances=buoys)
     if include_moored:
         for asset_name, (x, y, yaw) in world.moored:
             mid = _mesh_for(out, asset_name)
@@ -84,7 +97,12 @@ def _mesh_for(ws: WorldScene, asset_name: str) -> int:
 
 
 def build_world_scene(
-    world: MapWorld, vessels: list[tuple[str, str]], initial_poses: np.ndarray, *, moored_move: bool = False
+    world: MapWorld,
+    vessels: list[tuple[str, str]],
+    initial_poses: np.ndarray,
+    *,
+    moored_move: bool = False,
+    buoys_move: bool = False,
 ) -> WorldScene:
     """The full scene: static map, moored ships, and one instance per scenario vessel.
 
@@ -96,6 +114,7 @@ def build_world_scene(
             of the vessels at the first frame.
         moored_move: the moored ships move too (over a physical sea they heave, roll and pitch at their berths):
             the sea's shortcuts count them among the moving instances, not in the static height bound.
+        buoys_move: the buoys ride the waves (a physical sea, :mod:`mmusv.world.buoys`): moving instances too.
     """
     ws = build_static_scene(world)
     mats = pose_matrices(np.asarray(initial_poses, dtype=np.float64).reshape(-1, 6))
@@ -109,5 +128,7 @@ def build_world_scene(
         moving = ws.vessel_instances
         if moored_move and ws.moored_instances:
             moving = np.concatenate([moving, np.asarray(ws.moored_instances, dtype=np.int64)])
+        if buoys_move and ws.buoy_instances:
+            moving = np.concatenate([moving, np.asarray(ws.buoy_instances, dtype=np.int64)])
         ws.scene.set_sea(ws.static_instances["water"], moving=moving)
     return ws
