@@ -89,7 +89,7 @@ def test_a_long_ship_whose_stern_is_near_gets_its_box() -> None:
     assert "vlcc" in ann.lidar_ids and "far" not in ann.lidar_ids
     j = ann.lidar_ids.index("vlcc")
     assert ann.lidar_range[j] > 200.0 and ann.lidar_points[j] > 100
-    from mmusv.annotate import footprint_in_range
+    from mmusv.boxes3d import footprint_in_range
 
     for vi, info in enumerate(sim.vessels):
         if info.id == "usv_1":

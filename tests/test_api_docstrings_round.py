@@ -145,7 +145,7 @@ def test_lidar_box_beams_hold_every_beam_that_meets_a_box_seen_broadside() -> No
     the corners' elevations only, and a hull seen broadside reaches lower (and higher) between its corners: beams
     meeting a 90 m hull 10 m abeam at its waterline were left out of the share."""
     from mmusv import Scene
-    from mmusv.annotate import box_corners
+    from mmusv.boxes3d import box_corners
     from mmusv.wave_occlusion import lidar_box_beams, pattern_angles
 
     el = np.deg2rad(np.linspace(-25.0, 15.0, 32))

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from mmusv.annotate import box_corners
+from mmusv.boxes3d import box_corners
 from mmusv.errors import InputError
 from mmusv.image_boxes import clip_box, faces_above, faces_in_image_box, in_image_box, pinhole_truncation, project_box
 from scipy.spatial import ConvexHull, HalfspaceIntersection

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
-from mmusv.annotate import in_target_range
+from mmusv.boxes3d import in_target_range
 
 
 def test_bev_distance_not_a_square_window_and_height_ignored() -> None:

@@ -536,7 +536,7 @@ def test_cut_2d_boxes_bound_the_pixels_whose_rays_meet_random_boxes(distortion: 
     test): the box holds them to within the pixel grid's quantisation and, 5 px wide and tall, reaches at most 2 px
     beyond."""
     from mmusv import _core as core
-    from mmusv.annotate import box_corners
+    from mmusv.boxes3d import box_corners
     from mmusv.frames import BODY_TO_OPTICAL
     from mmusv.image_boxes import NEAR_M, camera_lens, in_image_box, project_box
 

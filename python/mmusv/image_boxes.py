@@ -9,7 +9,7 @@ the image border cuts off — the geometry of the 2D boxes :mod:`mmusv.annotate`
 * :func:`clip_box`, :func:`pinhole_truncation`: the projected box clipped to the image and the share cut off.
 * :func:`camera_lens`: a distorted camera with its reach, the largest undistorted radius its image sees.
 
-Frames: a box is its ``(8, 3)`` corners (corner bits as :func:`mmusv.annotate.box_corners`: bit 0 → +x, bit 1 →
+Frames: a box is its ``(8, 3)`` corners (corner bits as :func:`mmusv.boxes3d.box_corners`: bit 0 → +x, bit 1 →
 +y, bit 2 → +z) in the camera's optical frame (x right, y down, z forward; metres); pixels u right, v down, with
 pixel centres at +0.5, intrinsics ``(fx, fy, cx, cy)`` pixels.
 """
@@ -86,7 +86,7 @@ def project_box(
 
 _FACES = [[0, 2, 6, 4], [1, 3, 7, 5], [0, 1, 5, 4], [2, 3, 7, 6], [0, 1, 3, 2], [4, 5, 7, 6]]
 """The box's six faces (−x, +x, −y, +y, −z, +z), each as its four corner indices in order round it (corner bits
-as :func:`mmusv.annotate.box_corners`)."""
+as :func:`mmusv.boxes3d.box_corners`)."""
 
 
 def _near_face(face: np.ndarray) -> np.ndarray:

@@ -247,7 +247,7 @@ def convert(
             for one folder of scenarios. ROS 2 bags are never split: with ``to="ros2"`` only the default or
             ``None`` is accepted.
         eval_range_m: OPV2V, KITTI and KITTI tracking: targets are vessels whose box centre lies within
-            ``eval_range_m`` of the agent's LiDAR in bird's-eye view (:func:`mmusv.annotate.in_target_range`). The
+            ``eval_range_m`` of the agent's LiDAR in bird's-eye view (:func:`mmusv.boxes3d.in_target_range`). The
             other formats refuse a value other than the default (they label every vessel they hold).
         include_usvs: OPV2V, KITTI and KITTI tracking: list the other USVs as targets too (default: only
             non-instrumented vessels); the other formats refuse ``True``.

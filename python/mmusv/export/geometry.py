@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mmusv.annotate import in_target_range
+from mmusv.boxes3d import in_target_range
 from mmusv.frames import invert, pose_matrices
 from mmusv.recording.decode import WorldFrame
 from mmusv.recording.info import AgentInfo
@@ -61,7 +61,7 @@ def agent_view(agent: AgentInfo, world: WorldFrame) -> AgentView:
 def targets_of(view: AgentView, world: WorldFrame, *, eval_range_m: float, include_usvs: bool) -> list[Target]:
     """The targets of ``view``'s agent, in world-state order: every vessel but the agent itself (and other USVs
     unless ``include_usvs``) whose box centre lies within ``eval_range_m`` of the agent's LiDAR (its body frame
-    when it has no LiDAR) by the box-centre rule, :func:`mmusv.annotate.in_target_range` (BEV distance)."""
+    when it has no LiDAR) by the box-centre rule, :func:`mmusv.boxes3d.in_target_range` (BEV distance)."""
     ref = view.lidar if view.lidar is not None else view.body
     ref_inv = invert(ref)
     out: list[Target] = []

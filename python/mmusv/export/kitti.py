@@ -33,7 +33,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from mmusv.annotate import box_corners
+from mmusv.boxes3d import box_corners
 from mmusv.classes import class_name
 from mmusv.export.common import cav_id, depth_png, dump_yaml, png_bytes, top_view_protocol
 from mmusv.export.geometry import AgentView, Target

@@ -40,7 +40,7 @@ import polars as pl
 import shapely
 from scipy import ndimage
 
-from mmusv.annotate import box_corners
+from mmusv.boxes3d import box_corners
 from mmusv.bundled import resolve_scenario
 from mmusv.config import Scenario, load_scenario
 from mmusv.errors import ConfigError, located

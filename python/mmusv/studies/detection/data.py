@@ -7,9 +7,9 @@ scenario folder). Sequences are split (train / validate / test) by a seeded shuf
 agent-as-ego expansion (:func:`split_sequences`), so no scene is in two splits.
 
 Ground truth for an ego (:func:`gt_in_ego`): every target box (USVs excluded) moved into the ego LiDAR frame and
-kept when its BEV centre is within ``range_m`` (200 m) of the sensor (:func:`mmusv.annotate.in_target_range`, the
+kept when its BEV centre is within ``range_m`` (200 m) of the sensor (:func:`mmusv.boxes3d.in_target_range`, the
 box-centre rule of OpenCOOD and of the OPV2V and KITTI exports; the recording's own boxes reach farther, to every
-vessel whose footprint comes within range, :func:`mmusv.annotate.footprint_in_range`). USV platforms
+vessel whose footprint comes within range, :func:`mmusv.boxes3d.footprint_in_range`). USV platforms
 (:func:`usv_boxes_in_ego`) are returned separately: detections centred on them are ignored in evaluation.
 """
 
@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 import yaml
 
-from mmusv.annotate import in_target_range
+from mmusv.boxes3d import in_target_range
 from mmusv.errors import InputError, IoError
 from mmusv.frames import carla_matrix, invert, mirror_transform, pose_matrices
 from mmusv.text import given
@@ -125,7 +125,7 @@ def boxes_in_frame(to_frame: np.ndarray, *, boxes: np.ndarray, sizes: np.ndarray
 def gt_in_ego(frame: SceneFrame, ego: AgentFrame, *, range_m: float = 200.0) -> np.ndarray:
     """``(G, 7)`` float64 ground-truth target boxes ``x, y, z, l, w, h, yaw`` (metres, radians) in ``ego``'s
     LiDAR frame within ``range_m`` by the box-centre rule,
-    :func:`mmusv.annotate.in_target_range` (BEV distance ``<= range_m``)."""
+    :func:`mmusv.boxes3d.in_target_range` (BEV distance ``<= range_m``)."""
     return gt_with_ids(frame, ego, range_m=range_m)[0]
 
 

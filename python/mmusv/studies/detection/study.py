@@ -44,7 +44,7 @@ import numpy as np
 import polars as pl
 import shapely
 
-from mmusv.annotate import in_target_range
+from mmusv.boxes3d import in_target_range
 from mmusv.errors import InputError
 from mmusv.forking import check_polars
 from mmusv.frames import transform_points
