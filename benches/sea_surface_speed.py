@@ -22,7 +22,7 @@ from pathlib import Path
 
 import bench_env
 from mmusv.acquire import annotations_for
-from mmusv.annotate import SilhouetteCache
+from mmusv.silhouettes import SilhouetteCache
 from mmusv.simulation import Simulation
 from mmusv.world.sea_state import sea_spec_for_preset
 

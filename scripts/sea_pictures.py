@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 from mmusv.acquire import annotations_for
-from mmusv.annotate import SilhouetteCache
+from mmusv.silhouettes import SilhouetteCache
 from mmusv.simulation import Simulation
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -225,8 +225,8 @@ def test_info_and_preview_commands(
 def _sequential(tmp_path: Path, frames: int, scenario: dict[str, Any] | None = None) -> bytes:
     """The recording written the plain way: capture, annotate, write, one frame after the other, one thread."""
     from mmusv.acquire import annotations_for
-    from mmusv.annotate import SilhouetteCache
     from mmusv.recording.frames import FrameRecorder
+    from mmusv.silhouettes import SilhouetteCache
 
     sim = mmusv.Simulation(scenario or small_scenario(frames))
     path = tmp_path / "sequential.mcap"

@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 from mmusv.acquire import annotations_for
-from mmusv.annotate import SilhouetteCache
 from mmusv.frames import translation
+from mmusv.silhouettes import SilhouetteCache
 from mmusv.simulation import Simulation
 from scipy.spatial.transform import Rotation
 

@@ -16,13 +16,13 @@ import numpy as np
 import pytest
 from mmusv import Simulation, run
 from mmusv.acquire import annotations_for
-from mmusv.annotate import SilhouetteCache
 from mmusv.recording import decode_image
 from mmusv.recording.info import read_info
 from mmusv.recording.stream import FrameStream
 from mmusv.sensors.config import Mount
 from mmusv.sensors.mounts import mount_matrix
 from mmusv.sensors.radar import ppi_image
+from mmusv.silhouettes import SilhouetteCache
 from mmusv.world.vessels import get_asset
 
 PPI_SIZE = 33  # odd: its default scale is the range over 16 pixels, not 16.5

@@ -71,10 +71,10 @@ def test_a_frame_recorder_shared_by_threads_keeps_each_frame_whole(tmp_path: Pat
     """Threads writing frames into one FrameRecorder interleaved the frames' messages, and the reader then gave
     each frame with a few of its topics (silently); now each frame is written together and reads back whole."""
     from mmusv.acquire import annotations_for
-    from mmusv.annotate import SilhouetteCache
     from mmusv.recording.frames import FrameRecorder
     from mmusv.recording.info import read_info
     from mmusv.recording.stream import FrameStream
+    from mmusv.silhouettes import SilhouetteCache
     from mmusv.simulation import Simulation
 
     sim = Simulation(_camera("shared", 6))

@@ -84,7 +84,7 @@ def test_a_simulation_annotates_with_its_own_skiff_after_another_scenario_was_re
     of it hidden) and its wakes (the displacements) looked the asset up again by name when first asked, so a
     scenario read in between, with a ``skiff`` of its own, gave the other scenario's skiff to this one's labels."""
     from mmusv.acquire import annotations_for
-    from mmusv.annotate import SilhouetteCache
+    from mmusv.silhouettes import SilhouetteCache
 
     folder = _folder(tmp_path)
     sim = Simulation(load_scenario(folder / "lake.yaml"))

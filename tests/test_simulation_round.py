@@ -17,13 +17,14 @@ import numpy as np
 import pytest
 from mmusv import frames
 from mmusv.acquire import annotations_for
-from mmusv.annotate import SilhouetteCache, box_corners
+from mmusv.boxes3d import box_corners
 from mmusv.errors import ConfigError, InputError
 from mmusv.sensors.camera import camera_from_config, render, top_view_from_config
 from mmusv.sensors.config import LidarConfig
 from mmusv.sensors.env import sensor_env
 from mmusv.sensors.lidar import lidar_from_config, scan
 from mmusv.sensors.radar import RadarReturns, ppi_colormap, ppi_image, radar_from_config, radar_sweep
+from mmusv.silhouettes import SilhouetteCache
 from mmusv.simulation import Agent, FrameCapture, Simulation, sensor_seed
 from refusals import unrefused
 from tiny_scenario import lidar_scenario

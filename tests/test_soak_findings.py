@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 import pytest
 from mmusv.acquire import annotations_for
-from mmusv.annotate import SilhouetteCache
+from mmusv.silhouettes import SilhouetteCache
 from mmusv.simulation import Simulation
 
 # Small boats 30 m from the USV, across a 90° camera and round its edges: where lens distortion moves

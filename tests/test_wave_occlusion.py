@@ -214,9 +214,9 @@ def test_recordings_carry_the_shares_as_annotated(tmp_path: Path) -> None:
     import sys
 
     from mmusv.acquire import annotations_for, run
-    from mmusv.annotate import SilhouetteCache
     from mmusv.recording.messages import read_messages
     from mmusv.recording.tables import read_table
+    from mmusv.silhouettes import SilhouetteCache
     from mmusv.simulation import Simulation
 
     sys.path.insert(0, str(Path(__file__).parent))
@@ -264,7 +264,7 @@ def test_shares_read_from_the_capture_equal_the_beams_cast_again() -> None:
     import sys
 
     from mmusv.acquire import annotations_for
-    from mmusv.annotate import SilhouetteCache
+    from mmusv.silhouettes import SilhouetteCache
     from mmusv.simulation import Simulation
 
     sys.path.insert(0, str(Path(__file__).parent))
@@ -801,8 +801,9 @@ def test_a_user_round_on_a_real_capture_is_unchanged() -> None:
     """The LiDAR helpers on an ``open_sea_convoy.yaml`` capture (W2 waves), as a user would call them: the rig's
     pattern, the capture's LiDAR pose and each vessel's box pass the checks, the beams are those a test of every
     beam selects, and each share is that of the beams the capture's own cast found."""
-    from mmusv.annotate import SilhouetteCache, box_corners
+    from mmusv.boxes3d import box_corners
     from mmusv.frames import translation
+    from mmusv.silhouettes import SilhouetteCache
     from mmusv.simulation import Simulation
 
     root = Path(__file__).resolve().parents[1]

@@ -31,7 +31,7 @@ from typing import Any
 from threadpoolctl import threadpool_limits
 
 from mmusv import arguments
-from mmusv.annotate import Annotations, SilhouetteCache, annotate_agent
+from mmusv.annotate import Annotations, annotate_agent
 from mmusv.config import Scenario, load_scenario, scenario_hash
 from mmusv.errors import ConfigError, IoError, MmusvError, located
 from mmusv.forking import check_polars
@@ -56,6 +56,7 @@ from mmusv.scenario_checks import (
     check_sensors,
     check_top_view_land,
 )
+from mmusv.silhouettes import SilhouetteCache
 from mmusv.simulation import FrameCapture, Simulation
 
 __all__ = ["TABLE_PART_FRAMES", "RunResult", "recording_path", "run"]

@@ -1,7 +1,7 @@
 """Wave occlusion: the share of a target hidden by the sea surface, per annotated box.
 
 A target's *exposed silhouette* is the set of a sensor's rays that meet the vessel when it is alone in the
-world (:class:`~mmusv.annotate.SilhouetteCache`) at a point above the still water level (world z > 0): the part
+world (:class:`~mmusv.silhouettes.SilhouetteCache`) at a point above the still water level (world z > 0): the part
 of the hull a flat calm sea would never hide. Its wave-occlusion share is the fraction of those rays that the
 full scene stops at the water first — a crest in front, or the local surface over that part of the hull. With a
 flat sea the share is 0 by construction; it is only computed where the scene has a displaced wave surface

@@ -186,7 +186,7 @@ def test_a_rig_without_a_lidar_gives_its_3d_boxes_share_0_and_its_cameras_the_wa
     ``wave_occlusion`` 0 (and ``lidar_points`` 0), while its camera gives the craft the crests hide wholly share 1:
     read the camera boxes for what the waves hide from such a USV."""
     from mmusv.acquire import annotations_for
-    from mmusv.annotate import SilhouetteCache
+    from mmusv.silhouettes import SilhouetteCache
     from mmusv.simulation import Simulation
 
     cfg = _scenario()
@@ -207,7 +207,7 @@ def _lidar_case() -> tuple[Any, Any, Any]:
     ``usv_a``; over the waves a trough bares 5 points of its hull below the still level, and the water stops 26 more
     beams there."""
     from mmusv.acquire import annotations_for
-    from mmusv.annotate import SilhouetteCache
+    from mmusv.silhouettes import SilhouetteCache
     from mmusv.simulation import Simulation
 
     cfg = _scenario()

@@ -15,11 +15,11 @@ import tempfile
 from pathlib import Path
 
 from mmusv.acquire import annotations_for
-from mmusv.annotate import SilhouetteCache
 from mmusv.config import Scenario
 from mmusv.errors import ConfigError
 from mmusv.preview import compose_preview
 from mmusv.recording.frames import FrameRecorder
+from mmusv.silhouettes import SilhouetteCache
 from mmusv.simulation import Simulation
 from mmusv.world.maps import MapWorld
 
