@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 import polars as pl
 from mmusv.acquire import annotations_for
-from mmusv.annotate import Annotations
+from mmusv.agent_annotations import Annotations
 from mmusv.recording.tables import ROWS_DIGEST_KEY, SCHEMAS, TableWriter, rows_digest
 from mmusv.silhouettes import SilhouetteCache
 from mmusv.simulation import FrameCapture, Simulation

@@ -31,7 +31,8 @@ from typing import Any
 from threadpoolctl import threadpool_limits
 
 from mmusv import arguments
-from mmusv.annotate import Annotations, annotate_agent
+from mmusv.agent_annotations import Annotations
+from mmusv.annotate import annotate_agent
 from mmusv.config import Scenario, load_scenario, scenario_hash
 from mmusv.errors import ConfigError, IoError, MmusvError, located
 from mmusv.forking import check_polars
@@ -104,7 +105,7 @@ def recording_path(out_dir: Path, scenario: Scenario) -> Path:
 @dataclass(frozen=True, eq=False)
 class _Frame:
     """One captured and annotated frame on its way to the writer: the capture and, per agent, its
-    :class:`~mmusv.annotate.Annotations` with their ``columns()``."""
+    :class:`~mmusv.agent_annotations.Annotations` with their ``columns()``."""
 
     capture: FrameCapture
     annotations: dict[str, tuple[Annotations, dict[str, Any]]]

@@ -25,7 +25,7 @@ from mmusv.errors import ConfigError, IoError
 from mmusv.forking import check_polars
 
 if TYPE_CHECKING:
-    from mmusv.annotate import Annotations
+    from mmusv.agent_annotations import Annotations
     from mmusv.simulation import FrameCapture, VesselInfo
 
 __all__ = [
@@ -147,7 +147,7 @@ class TableWriter:
         annotations: dict[str, tuple[Annotations, dict[str, Any]]],
     ) -> None:
         """The rows of one frame: every vessel's state, and each agent's boxes; ``annotations`` maps an agent to
-        its :class:`~mmusv.annotate.Annotations` and their ``columns()``."""
+        its :class:`~mmusv.agent_annotations.Annotations` and their ``columns()``."""
         self.add_world(vessels, cap)
         for ann, cols in annotations.values():
             self.add_annotations(ann, cols)
