@@ -43,7 +43,7 @@ if TYPE_CHECKING:
     from mmusv.generate.checks import Finding
     from mmusv.generate.mapctx import MapContext
     from mmusv.generate.samples import Samples
-    from mmusv.generate.spec import GenerationSpec
+    from mmusv.generate.spec_models import GenerationSpec
     from mmusv.sensors.config import RigConfig
     from mmusv.simulation import Simulation
     from mmusv.world.maps import MapWorld
@@ -82,7 +82,7 @@ def scenario_samples(scenario: Scenario, ctx: MapContext, spec: GenerationSpec |
     USV is the ego, every other vessel a role target; ``spec`` gives the thresholds (default: the generator's)."""
     from mmusv.generate.sampler import CandidateMeta
     from mmusv.generate.samples import take_samples
-    from mmusv.generate.spec import GenerationSpec
+    from mmusv.generate.spec_models import GenerationSpec
 
     usvs = [v.id for v in scenario.vessels if v.role == "usv"]
     targets = tuple(v.id for v in scenario.vessels if v.role != "usv")
@@ -124,7 +124,7 @@ def check_routes(scenario: Scenario, world: MapWorld, *, source: str) -> list[st
     )
     from mmusv.generate.mapctx import MapContext
     from mmusv.generate.samples import FEWER_TIMES, budget_problem, sample_counts
-    from mmusv.generate.spec import GenerationSpec
+    from mmusv.generate.spec_models import GenerationSpec
 
     spec = GenerationSpec.model_validate({"combinations": [{"family": "crossing"}]})
     n_motion, n_route = sample_counts(scenario, spec)
@@ -240,7 +240,7 @@ class MapFinding:
 def map_check_spec(scenario: Scenario) -> GenerationSpec:
     """The thresholds :func:`map_findings` applies: the generator's defaults, the sensing range at the USVs' LiDAR
     range (:func:`sensing_range_m`) and the line-of-sight check switched on."""
-    from mmusv.generate.spec import GenerationSpec
+    from mmusv.generate.spec_models import GenerationSpec
 
     return GenerationSpec.model_validate(
         {

@@ -115,7 +115,7 @@ def _scenario() -> dict[str, Any]:
 def _spec() -> dict[str, Any]:
     from mmusv.config import SCENARIO_NAME, EnvironmentConfig
     from mmusv.generate.families import FAMILIES
-    from mmusv.generate.spec import GenerationSpec
+    from mmusv.generate.spec_models import GenerationSpec
     from mmusv.sensors.config import RigConfig
 
     raw = GenerationSpec.model_json_schema()
@@ -129,7 +129,7 @@ def _spec() -> dict[str, Any]:
             assert doc["$defs"].setdefault(name, d) == d, name  # the same model, the same schema
     _map_params_by_type(doc)
     _field_bounds(doc)
-    from mmusv.generate.spec import MAX_RANGE_M
+    from mmusv.generate.spec_models import MAX_RANGE_M
 
     for item in doc["$defs"]["Difficulty"]["properties"]["range_m"]["prefixItems"]:
         _bound(item, minimum=0, maximum=MAX_RANGE_M)

@@ -20,8 +20,8 @@ from mmusv.generate.checks import build_constraints
 from mmusv.generate.cli import add_parser, run
 from mmusv.generate.hulls import capsule
 from mmusv.generate.runner import _infeasible
-from mmusv.generate.spec import class_assets
 from mmusv.generate.spec_constraints import Constraints
+from mmusv.generate.spec_models import class_assets
 
 TINY: dict[str, Any] = {
     "name": "tiny",

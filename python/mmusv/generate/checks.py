@@ -33,9 +33,8 @@ from scipy.spatial import cKDTree
 from mmusv.generate.hulls import axis_points, capsule, segment_distance
 from mmusv.generate.mapctx import MapContext
 from mmusv.generate.samples import Samples
-from mmusv.generate.spec import (
+from mmusv.generate.spec_constraints import (
     CooperationCheck,
-    GenerationSpec,
     LineOfSightCheck,
     OcclusionCheck,
     RouteSeparationCheck,
@@ -43,8 +42,9 @@ from mmusv.generate.spec import (
     SeparationCheck,
     ShoreClearanceCheck,
     StructureClearanceCheck,
+    TargetDensityCheck,
 )
-from mmusv.generate.spec_constraints import TargetDensityCheck
+from mmusv.generate.spec_models import GenerationSpec
 
 __all__ = [
     "Constraint",

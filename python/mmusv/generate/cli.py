@@ -53,7 +53,7 @@ def seed_arg(text: str, *, flag: str = "--seed") -> int:
     import re
 
     from mmusv.errors import ConfigError
-    from mmusv.generate.spec import SEED_LIMIT
+    from mmusv.generate.spec_models import SEED_LIMIT
 
     t = text.strip()
     if not re.fullmatch(r"[+-]?[0-9]+", t) or not 0 <= int(t) < SEED_LIMIT:

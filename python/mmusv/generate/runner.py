@@ -38,7 +38,8 @@ from mmusv.generate.mapctx import MapContext, map_context
 from mmusv.generate.report import ComboReport, RunReport
 from mmusv.generate.sampler import Candidate, sample_candidate
 from mmusv.generate.samples import take_samples
-from mmusv.generate.spec import GenerationSpec, class_assets, load_spec
+from mmusv.generate.spec import load_spec
+from mmusv.generate.spec_models import GenerationSpec, class_assets
 
 __all__ = ["JOURNAL", "Progress", "check_output", "dump_scenario", "generate", "infeasible_error"]
 

@@ -32,7 +32,7 @@ from mmusv.generate.layout import (
     top_speed_mps,
 )
 from mmusv.generate.mapctx import MapContext
-from mmusv.generate.spec import Combination, GenerationSpec, class_assets
+from mmusv.generate.spec_models import Combination, GenerationSpec, class_assets
 from mmusv.world.vessels import get_asset
 
 __all__ = [

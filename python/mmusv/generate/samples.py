@@ -26,7 +26,7 @@ from mmusv.errors import ConfigError
 from mmusv.generate.hulls import capsule
 from mmusv.generate.mapctx import MapContext
 from mmusv.generate.sampler import CandidateMeta
-from mmusv.generate.spec import GenerationSpec
+from mmusv.generate.spec_models import GenerationSpec
 from mmusv.motion import build_fleet
 from mmusv.world.vessels import get_asset
 
