@@ -1,8 +1,8 @@
 """The models of a generation spec, each checking its own fields: the target size classes (:class:`SizeClass`), the
 instrumented USVs (:class:`UsvRoles`), the difficulty levels (:class:`Difficulty`), the role combinations with their
 quotas (:class:`Combination`) and the whole spec (:class:`GenerationSpec`). :mod:`mmusv.generate.spec` describes the
-file (its keys, units and an example), loads it and checks it across fields; the constraint block is
-:mod:`mmusv.generate.spec_constraints`.
+file (its keys, units and an example) and loads it; the checks across fields are :mod:`mmusv.generate.spec_checks`,
+the constraint block :mod:`mmusv.generate.spec_constraints`.
 """
 
 from __future__ import annotations
