@@ -115,6 +115,36 @@ def test_a_real_ctrl_c_during_the_start_is_one_line(tmp_path: Path, delay_s: flo
     assert stderr.strip().endswith("mmusv: interrupted"), stderr
 
 
+@pytest.mark.parametrize(
+    ("signal_name", "status", "line"), [("SIGINT", 130, "interrupted"), ("SIGTERM", 143, "terminated (SIGTERM)")]
+)
+@pytest.mark.parametrize("wrapper", ["RuntimeError", "ValueError"])
+def test_a_stop_a_library_wraps_in_its_own_error_is_still_one_line(
+    tmp_path: Path, signal_name: str, status: int, line: str, wrapper: str
+) -> None:
+    # A Ctrl-C that landed while pydantic built a scenario model (the command's own start, after the held load)
+    # came out of the library as its own error: pydantic-core's SchemaError ("... KeyboardInterrupt:") or
+    # Python's RuntimeError from __set_name__, a traceback and status 1 (3 in 280 starts under load). Any error
+    # that ends a command after a stop is the stop.
+    code = (
+        "import os, signal, sys, time\n"
+        f"sys.argv = ['mmusv', 'run', {str(ROOT / 'scenarios' / 'port_entry.yaml')!r}, '-o', {str(tmp_path)!r}]\n"
+        "import mmusv.cli_run as cli_run\n"
+        "def cut(*args, **kwargs):\n"
+        "    try:\n"
+        f"        os.kill(os.getpid(), signal.{signal_name})\n"
+        "        time.sleep(5)\n"
+        "    except KeyboardInterrupt as exc:\n"
+        f"        raise {wrapper}('Error building a validator: KeyboardInterrupt') from exc\n"
+        "cli_run._run_one = cut\n"
+        "from mmusv._launch import main\nsys.exit(main())\n"
+    )
+    out = _python(code)
+    assert "Traceback" not in out.stderr, out.stderr
+    assert out.stderr == f"mmusv: {line}\n"
+    assert out.returncode == status
+
+
 def test_the_parser_every_command_builds_loads_no_scenario_model_or_dataset_reader() -> None:
     # mmusv --help took 1.5-1.9 s here: the parser imported the detection dataset reader for one constant (0.7 s),
     # the generator's sampler and map builder (0.26 s), and the scenario models for a warning class

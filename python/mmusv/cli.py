@@ -132,12 +132,24 @@ def _run_command(args: argparse.Namespace) -> int:
             )
             code = 2
         except KeyboardInterrupt:
-            name = "terminated (SIGTERM)" if signals.received not in (None, 2) else "interrupted"
-            cli_console.say(f"mmusv: {name}")
-            code = 130
+            code = _stopped(signals)
+        except Exception:
+            # A stop a library turned into an error of its own: the KeyboardInterrupt raised while pydantic built a
+            # scenario model came out as pydantic-core's SchemaError, or Python's RuntimeError from __set_name__.
+            if signals.received is None:
+                raise
+            code = _stopped(signals)
     if signals.received is not None:  # the command ends with its own status, not CPython's for an interrupt
         forget_handled_interrupt()
     return signals.status(code)
+
+
+def _stopped(signals: _Signals) -> int:
+    """Says that the command was stopped (``mmusv: interrupted``, or ``terminated (SIGTERM)``); returns 130, which
+    :meth:`_Signals.status` makes 128 + the signal received."""
+    name = "terminated (SIGTERM)" if signals.received not in (None, 2) else "interrupted"
+    cli_console.say(f"mmusv: {name}")
+    return 130
 
 
 def _dispatch(args: argparse.Namespace) -> int:
