@@ -145,6 +145,35 @@ def test_a_stop_a_library_wraps_in_its_own_error_is_still_one_line(
     assert out.returncode == status
 
 
+def test_a_stop_a_library_swallows_still_ends_the_run(tmp_path: Path) -> None:
+    # A Ctrl-C that landed in a lazy import during the first frames raised in importlib's module-lock callback,
+    # which Python reports ("Exception ignored in ...") and goes on: the run recorded all its frames, then said
+    # "interrupted". The stop is noted and raised again at the next frame.
+    code = (
+        "import os, signal, sys, time\n"
+        f"sys.argv = ['mmusv', 'run', {str(ROOT / 'scenarios' / 'port_entry.yaml')!r}, '-o', {str(tmp_path)!r}, "
+        "'--frames', '6']\n"
+        "import mmusv.simulation as simulation\n"
+        "original, calls = simulation.Simulation.capture, []\n"
+        "def capture(self, frame, **kwargs):\n"
+        "    calls.append(frame)\n"
+        "    if len(calls) == 2:\n"
+        "        try:\n"
+        "            os.kill(os.getpid(), signal.SIGINT)\n"
+        "            time.sleep(5)\n"
+        "        except KeyboardInterrupt:\n"
+        "            pass  # swallowed, as importlib's callback does\n"
+        "    return original(self, frame, **kwargs)\n"
+        "simulation.Simulation.capture = capture\n"
+        "from mmusv._launch import main\ncode = main()\nprint(calls)\nsys.exit(code)\n"
+    )
+    out = _python(code)
+    assert "Traceback" not in out.stderr, out.stderr
+    assert out.stderr.endswith("mmusv: interrupted\n"), out.stderr
+    assert out.returncode == 130
+    assert out.stdout.splitlines()[-1] == "[0, 1]"  # no frame captured after the stop
+
+
 def test_the_parser_every_command_builds_loads_no_scenario_model_or_dataset_reader() -> None:
     # mmusv --help took 1.5-1.9 s here: the parser imported the detection dataset reader for one constant (0.7 s),
     # the generator's sampler and map builder (0.26 s), and the scenario models for a warning class

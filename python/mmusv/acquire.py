@@ -36,7 +36,7 @@ from mmusv.annotate import annotate_agent
 from mmusv.config import Scenario, load_scenario, scenario_hash
 from mmusv.errors import ConfigError, IoError, MmusvError, located
 from mmusv.forking import check_polars
-from mmusv.held_signals import HeldSignals
+from mmusv.held_signals import HeldSignals, raise_noted_stop
 from mmusv.jsonio import dump_json, write_bytes_atomic
 from mmusv.profiling import RunProfile, clocks
 from mmusv.recording.background import BackgroundWriter
@@ -413,6 +413,7 @@ def _record(
     try:
         held.release()  # a stop held since the recording opened: KeyboardInterrupt here, inside the loop's handling
         for k in range(first, total):
+            raise_noted_stop()  # a stop whose KeyboardInterrupt a library swallowed (held_signals)
             tf = time.perf_counter()
             if captured:  # frame `first`, captured before the recording was opened
                 cap, earlier = captured.pop()

@@ -27,7 +27,7 @@ from mmusv.cli_recordings import cmd_info, cmd_preview, cmd_recover
 from mmusv.cli_run import cmd_run
 from mmusv.cli_schema import cmd_schema
 from mmusv.errors import MmusvError
-from mmusv.held_signals import forget_handled_interrupt
+from mmusv.held_signals import forget_handled_interrupt, note_stop
 
 
 class _Signals:
@@ -45,6 +45,7 @@ class _Signals:
     def _handle(self, signum: int, frame: object) -> None:
         if self.received is None:
             self.received = signum
+        note_stop(signum)  # raised again by long loops where a library swallows this KeyboardInterrupt
         raise KeyboardInterrupt
 
     def __enter__(self) -> _Signals:
@@ -63,6 +64,7 @@ class _Signals:
 
         for num, old in self._old.items():
             signal.signal(num, old)  # type: ignore[arg-type]
+        note_stop(None)
 
     def status(self, default: int) -> int:
         """128 + the signal received, else ``default``."""

@@ -9,7 +9,10 @@ from __future__ import annotations
 from types import TracebackType
 from typing import Any
 
-__all__ = ["HeldSignals", "forget_handled_interrupt"]
+__all__ = ["HeldSignals", "forget_handled_interrupt", "note_stop", "raise_noted_stop"]
+
+_stop: list[int] = []
+"""The stop the ``mmusv`` command's handler noted (at most one signal number; :func:`note_stop`)."""
 
 
 class HeldSignals:
@@ -95,3 +98,18 @@ def forget_handled_interrupt() -> None:
     first second of ``python -m mmusv run``). Each string evaluation clears the mark when it starts, so an empty
     one does (CPython's ``run_eval_code_obj``); where there is no mark it does nothing."""
     exec("pass", {})
+
+
+def note_stop(signum: int | None) -> None:
+    """Notes (or, with ``None``, forgets) the stop the ``mmusv`` command's signal handler received, before it
+    raises ``KeyboardInterrupt``: :func:`raise_noted_stop` raises it again where a library swallowed it."""
+    _stop[:] = [] if signum is None else [signum]
+
+
+def raise_noted_stop() -> None:
+    """Raises ``KeyboardInterrupt`` if a stop was noted (:func:`note_stop`) and the work is still going: the one
+    the handler raised was swallowed where it landed. A Ctrl-C that came while a frame's lazy import ran raised
+    inside importlib's module-lock callback, which Python reports as "Exception ignored" and goes on: the run went
+    on to its last frame (1 of 200 starts of ``mmusv run`` under load). Long loops call this once a step."""
+    if _stop:
+        raise KeyboardInterrupt
