@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Callable
+from typing import Any
 
 from mmusv import cli_console
 from mmusv.cli_library import cmd_assets, cmd_scenarios
@@ -41,12 +43,21 @@ class _Signals:
     def __init__(self) -> None:
         self.received: int | None = None
         self._old: dict[int, object] = {}
+        self._hook: Callable[[Any], object] = sys.unraisablehook
 
     def _handle(self, signum: int, frame: object) -> None:
         if self.received is None:
             self.received = signum
         note_stop(signum)  # raised again by long loops where a library swallows this KeyboardInterrupt
         raise KeyboardInterrupt
+
+    def _unraisable(self, unraisable: Any) -> None:
+        # The KeyboardInterrupt this handler raised where Python cannot propagate it (importlib's module-lock
+        # callback, a finalizer) was reported as "Exception ignored in ..." with a traceback; the stop is noted and
+        # raised again by the long loops (held_signals.raise_noted_stop), so it is not reported.
+        if self.received is not None and isinstance(unraisable.exc_value, KeyboardInterrupt):
+            return
+        self._hook(unraisable)
 
     def __enter__(self) -> _Signals:
         import signal
@@ -57,6 +68,7 @@ class _Signals:
                 num = getattr(signal, name, None)
                 if num is not None:
                     self._old[num] = signal.signal(num, self._handle)
+            self._hook, sys.unraisablehook = sys.unraisablehook, self._unraisable
         return self
 
     def __exit__(self, *exc: object) -> None:
@@ -64,6 +76,8 @@ class _Signals:
 
         for num, old in self._old.items():
             signal.signal(num, old)  # type: ignore[arg-type]
+        if self._old:
+            sys.unraisablehook = self._hook
         note_stop(None)
 
     def status(self, default: int) -> int:
